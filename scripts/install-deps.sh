@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs the Debian packages animkit needs to build and test, only those missing.
+# Works as root on a fresh Debian 12; as another user it uses sudo when available, and
+# otherwise prints the exact command to run.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential   # gcc, make
+  cmake             # >= 3.25 (Debian 12 ships 3.25)
+  pkg-config
+  libpng-dev        # PNG output (raster)
+  libgif-dev        # animated GIF output (raster)
+  libassimp-dev     # FBX, Collada, BVH, OBJ import (io)
+  libcjson-dev      # JSON for the glTF 2.0 reader (io)
+  libsuitesparse-dev # CHOLMOD sparse Cholesky for bone-heat weights (skin)
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "animkit: installing missing Debian packages: ${missing[*]}"
+if [ "$(id -u)" -eq 0 ]; then
+  SUDO=""
+elif command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
+  SUDO="sudo"
+else
+  echo "animkit: not root and no password-less sudo. Run this once, then try again:" >&2
+  echo "    sudo apt-get update && sudo apt-get install -y ${missing[*]}" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,118 @@
+/* Tiny test harness: one executable per module, one ctest entry each.
+ *
+ *     AK_TEST(quat_identity) { AK_CHECK_NEAR(ak_quat_norm(ak_quat_identity()), 1.0f, 1e-7); }
+ *     int main(void) { AK_RUN(quat_identity); return ak_test_finish(); }
+ *
+ * Every check prints file:line and both values when it fails. ak_test_finish() prints
+ * "N passed, N failed" (the line CI reads) and returns the process exit code. */
+#ifndef ANIMKIT_TEST_H
+#define ANIMKIT_TEST_H
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+static int ak_test_passed_ = 0, ak_test_failed_ = 0, ak_test_skipped_ = 0;
+static int ak_test_cur_failed_ = 0;
+static const char* ak_test_cur_name_ = "";
+
+#define AK_TEST(name) static void ak_test_##name(void)
+
+#define AK_RUN(name)                                                                       \
+    do {                                                                                   \
+        ak_test_cur_failed_ = 0;                                                           \
+        ak_test_cur_name_ = #name;                                                         \
+        ak_test_##name();                                                                  \
+        if (ak_test_cur_failed_) {                                                         \
+            ++ak_test_failed_;                                                             \
+            printf("FAIL %s\n", #name);                                                    \
+        } else {                                                                           \
+            ++ak_test_passed_;                                                             \
+            printf("ok   %s\n", #name);                                                    \
+        }                                                                                  \
+        fflush(stdout);                                                                    \
+    } while (0)
+
+#define AK_FAIL_(...)                                                                      \
+    do {                                                                                   \
+        printf("  %s:%d: [%s] ", __FILE__, __LINE__, ak_test_cur_name_);                   \
+        printf(__VA_ARGS__);                                                               \
+        printf("\n");                                                                      \
+        ak_test_cur_failed_ = 1;                                                           \
+    } while (0)
+
+#define AK_CHECK(cond)                                                                     \
+    do {                                                                                   \
+        if (!(cond)) AK_FAIL_("check failed: %s", #cond);                                  \
+    } while (0)
+
+#define AK_CHECK_MSG(cond, ...)                                                            \
+    do {                                                                                   \
+        if (!(cond)) AK_FAIL_(__VA_ARGS__);                                                \
+    } while (0)
+
+#define AK_CHECK_EQ(a, b)                                                                  \
+    do {                                                                                   \
+        long long ak_a_ = (long long)(a), ak_b_ = (long long)(b);                          \
+        if (ak_a_ != ak_b_) AK_FAIL_("%s == %s: %lld vs %lld", #a, #b, ak_a_, ak_b_);      \
+    } while (0)
+
+/* |a - b| <= tol, and neither is NaN. */
+#define AK_CHECK_NEAR(a, b, tol)                                                           \
+    do {                                                                                   \
+        double ak_a_ = (double)(a), ak_b_ = (double)(b), ak_t_ = (double)(tol);            \
+        if (!(fabs(ak_a_ - ak_b_) <= ak_t_))                                               \
+            AK_FAIL_("%s ~ %s: %.9g vs %.9g (diff %.3g > tol %.3g)", #a, #b, ak_a_, ak_b_,  \
+                     fabs(ak_a_ - ak_b_), ak_t_);                                          \
+    } while (0)
+
+#define AK_CHECK_STREQ(a, b)                                                               \
+    do {                                                                                   \
+        const char *ak_a_ = (a), *ak_b_ = (b);                                             \
+        if (!ak_a_ || !ak_b_ || strcmp(ak_a_, ak_b_) != 0)                                 \
+            AK_FAIL_("%s == %s: \"%s\" vs \"%s\"", #a, #b, ak_a_ ? ak_a_ : "(null)",       \
+                     ak_b_ ? ak_b_ : "(null)");                                            \
+    } while (0)
+
+/* Record a skipped part with its reason (printed as SKIP, counted separately). */
+#define AK_SKIP(...)                                                                       \
+    do {                                                                                   \
+        printf("SKIP [%s] ", ak_test_cur_name_);                                           \
+        printf(__VA_ARGS__);                                                               \
+        printf("\n");                                                                      \
+        ++ak_test_skipped_;                                                                \
+    } while (0)
+
+static inline int ak_test_finish(void) {
+    printf("%d passed, %d failed, %d skipped\n", ak_test_passed_, ak_test_failed_, ak_test_skipped_);
+    return ak_test_failed_ ? 1 : 0;
+}
+
+/* Directory of the shared real assets: $ANIMKIT_ASSETS, else ../shared/assets relative to the
+ * source tree (AK_SOURCE_DIR is defined by CMake), else NULL. */
+static inline const char* ak_test_assets_dir(void) {
+    static char buf[1024];
+    struct stat st;
+    const char* env = getenv("ANIMKIT_ASSETS");
+    if (env && *env && stat(env, &st) == 0) return env;
+#ifdef AK_SOURCE_DIR
+    snprintf(buf, sizeof buf, "%s/../shared/assets", AK_SOURCE_DIR);
+    if (stat(buf, &st) == 0) return buf;
+#endif
+    if (stat("../shared/assets", &st) == 0) return "../shared/assets";
+    return NULL;
+}
+
+/* Full path of an asset (relative to the assets dir) into buf; NULL when absent. */
+static inline const char* ak_test_asset(char* buf, size_t size, const char* rel) {
+    const char* dir = ak_test_assets_dir();
+    struct stat st;
+    if (!dir) return NULL;
+    snprintf(buf, size, "%s/%s", dir, rel);
+    if (stat(buf, &st) != 0) return NULL;
+    return buf;
+}
+
+#endif
