@@ -1,0 +1,150 @@
+/* animkit skeleton: joint hierarchies, joint types and limits, forward kinematics.
+ *
+ * What it does: an immutable skeleton (names, parents, rest pose, inverse bind matrices,
+ * joint types and limits) built from a desc and validated once; forward kinematics from
+ * local transforms to model-space matrices in one forward pass; skinning matrices
+ * M_j = model_j * inverse_bind_j; clamping a pose to the joint limits.
+ *
+ * What it does NOT do: animation (clip.h), skinning (skin.h), IK (ik.h), file import (io.h).
+ *
+ * Joints are stored parents before children: parent[i] < i, roots have parent -1. A "bone"
+ * is the segment from a joint to one of its children. A pose is an array of local
+ * ak_transform, one per joint, in the parent joint's space.
+ *
+ * Usage:
+ *     ak_joint_desc joints[3] = {
+ *         { .name = "hip",   .parent = -1, .rest = ak_transform_identity() },
+ *         { .name = "knee",  .parent = 0,  .rest = {{0, -0.5f, 0}, {0, 0, 0, 1}, {1, 1, 1}},
+ *           .type = AK_JOINT_HINGE, .limits = { .axis = {1, 0, 0}, .min = 0, .max = 2.5f } },
+ *         { .name = "ankle", .parent = 1,  .rest = {{0, -0.5f, 0}, {0, 0, 0, 1}, {1, 1, 1}} },
+ *     };
+ *     ak_skeleton* sk = NULL;
+ *     ak_skeleton_desc d = { .joints = joints, .joint_count = 3 };
+ *     if (ak_skeleton_create(&d, NULL, &sk) != AK_OK) return 1;
+ *     ak_mat4 model[3];
+ *     ak_skeleton_local_to_model(sk, ak_skeleton_rest_pose(sk), (ak_mat4_span)AK_SPAN(model));
+ *     ak_skeleton_destroy(sk);
+ *
+ * Ownership and threading: a skeleton is one allocation, read-only after create, and may be
+ * shared between threads. FK functions write only their output spans.
+ */
+#ifndef ANIMKIT_SKELETON_H
+#define ANIMKIT_SKELETON_H
+
+#include "math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#ifndef AK_NAME_SIZE
+#define AK_NAME_SIZE 64
+#endif
+
+/* Degrees of freedom of a joint relative to its parent. */
+typedef enum ak_joint_type {
+    AK_JOINT_FREE = 0, /* default: 6 DOF (3 rotation + 3 translation), no limits */
+    AK_JOINT_BALL,     /* 3 rotational DOF; cone limit on the twist axis + twist range */
+    AK_JOINT_HINGE,    /* "pin": 1 rotation about limits.axis within [min, max] radians */
+    AK_JOINT_PRISM,    /* "slider": 1 translation along limits.axis within [min, max] */
+    AK_JOINT_TYPE_COUNT
+} ak_joint_type;
+
+/* Limits, all relative to the joint's rest (bind) local transform. */
+typedef struct ak_joint_limits {
+    ak_vec3 axis;      /* joint space: hinge rotation axis, prism slide axis, ball twist axis
+                          (usually towards the child); zero -> (1,0,0) hinge/prism, (0,1,0) ball */
+    float min, max;    /* hinge: radians; prism: length units; both 0 -> unlimited */
+    float cone_angle;  /* ball: max swing of the twist axis from rest, radians; 0 -> unlimited */
+    float twist_min, twist_max; /* ball: twist about axis, radians; both 0 -> unlimited */
+} ak_joint_limits;
+
+typedef struct ak_joint_desc {
+    const char* name;       /* required, unique; copied (truncated to AK_NAME_SIZE-1) */
+    int parent;             /* index of the parent, -1 for a root; must be < this index */
+    ak_transform rest;      /* local bind/rest transform; zero-init is invalid (zero rotation
+                               and scale): use ak_transform_identity() or set all three */
+    const ak_mat4* inverse_bind; /* model-space inverse bind matrix; NULL -> inverse of the
+                                    rest pose's model matrix */
+    ak_joint_type type;     /* 0 -> AK_JOINT_FREE */
+    ak_joint_limits limits; /* used by the type; zero -> unlimited */
+} ak_joint_desc;
+
+typedef struct ak_skeleton_desc {
+    const ak_joint_desc* joints; /* required, parents before children */
+    size_t joint_count;          /* required, 1 .. 32767 */
+    const char* name;            /* NULL -> "" */
+} ak_skeleton_desc;
+
+typedef struct ak_skeleton ak_skeleton;
+
+/* Build a skeleton. Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no joints), AK_ERR_BAD_ARG (too many
+ * joints, unknown type), AK_ERR_BAD_HIERARCHY (parent >= own index or < -1: use
+ * ak_skeleton_reorder first), AK_ERR_DUPLICATE (two joints share a name), AK_ERR_NULL_ARG
+ * (a joint has no name), AK_ERR_BAD_DATA (NaN/inf in a rest transform, inverse bind or
+ * limits; a zero-length rest rotation; min > max), AK_ERR_NO_MEMORY. diag (optional) names the
+ * joint. On failure *out_skeleton is NULL. */
+AK_API ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* alloc,
+                                    ak_skeleton** out_skeleton, ak_diag* diag);
+/* NULL is a no-op. */
+AK_API void ak_skeleton_destroy(ak_skeleton* skeleton);
+
+/* Sort joints given in any order so that parents come before children (stable: joints keep
+ * their relative order where the hierarchy allows). parents[i] is the parent of joint i (-1 for
+ * roots), in the input numbering. out_order[k] = input index of the joint placed at k.
+ * Returns AK_ERR_BAD_HIERARCHY on a cycle or a parent index out of range,
+ * AK_ERR_SPAN_SMALL when out_order.count < parents.count. */
+AK_API ak_result ak_skeleton_reorder(ak_i32_cspan parents, ak_i32_span out_order);
+
+AK_API size_t ak_skeleton_joint_count(const ak_skeleton* skeleton);
+AK_API ak_i16_cspan ak_skeleton_parents(const ak_skeleton* skeleton);
+AK_API ak_transform_cspan ak_skeleton_rest_pose(const ak_skeleton* skeleton);
+AK_API ak_mat4_cspan ak_skeleton_inverse_binds(const ak_skeleton* skeleton);
+/* Name of joint index; "" when out of range. */
+AK_API const char* ak_skeleton_joint_name(const ak_skeleton* skeleton, size_t joint_index);
+/* Index of the joint with this exact name, or -1. */
+AK_API int ak_skeleton_find_joint(const ak_skeleton* skeleton, const char* name);
+AK_API ak_joint_type ak_skeleton_joint_type(const ak_skeleton* skeleton, size_t joint_index);
+/* Limits with defaults resolved (axis normalised, never zero). */
+AK_API ak_joint_limits ak_skeleton_joint_limits(const ak_skeleton* skeleton, size_t joint_index);
+/* Number of children of a joint, and whether it is a leaf. */
+AK_API size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index);
+
+/* Forward kinematics: local[i] -> model[i] = model[parent] * local[i] (model[root] = local).
+ * Needs local.count >= joint_count, out_model.count >= joint_count. Returns AK_ERR_NULL_ARG,
+ * AK_ERR_SPAN_SMALL. Non-finite input propagates (validate poses with ak_pose_is_finite). */
+AK_API ak_result ak_skeleton_local_to_model(const ak_skeleton* skeleton, ak_transform_cspan local,
+                                            ak_mat4_span out_model);
+/* Same, with an extra root transform (e.g. the node above the skeleton) applied to every root. */
+AK_API ak_result ak_skeleton_local_to_model_rooted(const ak_skeleton* skeleton, ak_mat4 root,
+                                                   ak_transform_cspan local, ak_mat4_span out_model);
+/* Skinning palette: out_skin[i] = model[i] * inverse_bind[i]. Sizes >= joint_count. */
+AK_API ak_result ak_skeleton_skinning_matrices(const ak_skeleton* skeleton, ak_mat4_cspan model,
+                                               ak_mat4_span out_skin);
+/* FK for many characters sharing one skeleton: poses are character-major,
+ * local.count >= character_count * joint_count, same for out_model. */
+AK_API ak_result ak_skeleton_local_to_model_batch(const ak_skeleton* skeleton, size_t character_count,
+                                                  ak_transform_cspan local, ak_mat4_span out_model);
+
+/* Clamp a pose (local transforms, in place) to the joint types and limits: hinge joints keep
+ * only the rotation about their axis relative to rest, clamped to [min, max]; ball joints get
+ * their swing clamped to the cone and their twist to [twist_min, twist_max]; prism joints keep
+ * the rest rotation and slide along their axis within [min, max]; free joints are unchanged.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_skeleton_apply_limits(const ak_skeleton* skeleton, ak_transform_span pose);
+/* Clamp one joint's local transform (the routine ak_skeleton_apply_limits uses per joint). */
+AK_API ak_transform ak_skeleton_limit_joint(const ak_skeleton* skeleton, size_t joint_index, ak_transform local);
+/* True when the local transform satisfies its joint's limits within tol (radians / units). */
+AK_API bool ak_skeleton_joint_within_limits(const ak_skeleton* skeleton, size_t joint_index, ak_transform local,
+                                            float tol);
+
+/* Decompose rotation q into swing * twist about unit axis (twist about axis, swing perpendicular). */
+AK_API void ak_quat_swing_twist(ak_quat q, ak_vec3 axis, ak_quat* out_swing, ak_quat* out_twist);
+
+/* True when every transform in the span is finite. */
+AK_API bool ak_pose_is_finite(ak_transform_cspan pose);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ANIMKIT_SKELETON_H */
