@@ -191,6 +191,9 @@ static inline double ak_rng_double(ak_rng* r) {
     return (double)(hi * 67108864ull + lo) * (1.0 / 9007199254740992.0);
 }
 
+/* Size of the fixed name buffers in joints, meshes, clips (names are truncated to fit). */
+#define AK_NAME_SIZE 64
+
 /* ---- version ------------------------------------------------------------------------ */
 
 #define AK_VERSION_MAJOR 0

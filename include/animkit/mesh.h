@@ -32,7 +32,6 @@ extern "C" {
 
 /* Most influences a vertex may carry. */
 #define AK_MAX_INFLUENCES 8
-#define AK_NAME_SIZE 64
 
 typedef struct ak_mesh_desc {
     size_t vertex_count;       /* required, > 0 */

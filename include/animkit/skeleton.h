@@ -37,10 +37,6 @@
 extern "C" {
 #endif
 
-#ifndef AK_NAME_SIZE
-#define AK_NAME_SIZE 64
-#endif
-
 /* Degrees of freedom of a joint relative to its parent. */
 typedef enum ak_joint_type {
     AK_JOINT_FREE = 0, /* default: 6 DOF (3 rotation + 3 translation), no limits */
