@@ -105,7 +105,7 @@ AK_API bool ak_mesh_is_closed_oriented(const ak_mesh* mesh);
 AK_API ak_result ak_mesh_validate_weights(const ak_mesh* mesh, size_t joint_count, float tolerance, ak_diag* diag);
 
 /* Clean a per-vertex weight array in place: NaN/negative -> 0, duplicate joints merged,
- * sorted by decreasing weight, weights below min_weight dropped, at most max_influences
+ * sorted by decreasing weight, weights below min_weight dropped (the largest always stays), at most max_influences
  * kept (0 -> 4), renormalised to sum to 1 (within 1e-6). A vertex whose weights are all zero
  * gets weight 1 on its first joint (documented fallback). influence_count is the array's
  * stride; slots past max_influences are zeroed. */

@@ -1,0 +1,467 @@
+/* Skeleton: creation and validation, reordering, forward kinematics, joint limits. */
+#include <animkit/skeleton.h>
+
+#include "internal.h"
+
+struct ak_skeleton {
+    ak_allocator alloc;
+    size_t joint_count;
+    char name[AK_NAME_SIZE];
+    int16_t* parents;              /* [n] */
+    ak_transform* rest;            /* [n], rotations normalised */
+    ak_mat4* inverse_binds;        /* [n] */
+    char (*names)[AK_NAME_SIZE];   /* [n] */
+    ak_joint_limits* limits;       /* [n], defaults resolved */
+    uint32_t* child_counts;        /* [n] */
+    uint8_t* types;                /* [n] ak_joint_type */
+};
+
+#define MAX_JOINTS 32767u
+
+static bool limits_finite(const ak_joint_limits* l) {
+    return ak_vec3_is_finite(l->axis) && ak_finitef(l->min) && ak_finitef(l->max) && ak_finitef(l->cone_angle) &&
+           ak_finitef(l->twist_min) && ak_finitef(l->twist_max);
+}
+
+static bool mat4_finite(const ak_mat4* m) {
+    for (int i = 0; i < 16; ++i)
+        if (!ak_finitef(m->m[i])) return false;
+    return true;
+}
+
+static ak_joint_limits resolve_limits(ak_joint_type type, ak_joint_limits l) {
+    ak_vec3 axis = ak_vec3_normalize(l.axis);
+    if (ak_vec3_length_sq(axis) < 0.5f)
+        axis = type == AK_JOINT_BALL ? ak_vec3_make(0.0f, 1.0f, 0.0f) : ak_vec3_make(1.0f, 0.0f, 0.0f);
+    l.axis = axis;
+    return l;
+}
+
+/* Index sort of names for duplicate detection. */
+typedef struct name_ref {
+    const char* name;
+    size_t index;
+} name_ref;
+
+static int cmp_name_ref(const void* a, const void* b) {
+    const name_ref *x = (const name_ref*)a, *y = (const name_ref*)b;
+    int c = strcmp(x->name, y->name);
+    if (c) return c;
+    return (x->index > y->index) - (x->index < y->index);
+}
+
+/* Signed angle of a twist quaternion about unit axis, in [-pi, pi]. */
+static float twist_angle(ak_quat twist, ak_vec3 axis) {
+    if (twist.w < 0.0f) twist = ak_quat_neg(twist);
+    float s = twist.x * axis.x + twist.y * axis.y + twist.z * axis.z;
+    return 2.0f * atan2f(s, twist.w);
+}
+
+/* Angle in [0, pi] of a rotation. */
+static float rotation_angle(ak_quat q) {
+    float s = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z);
+    return 2.0f * atan2f(s, fabsf(q.w));
+}
+
+static float wrap_pi(float a) {
+    while (a > AK_PI) a -= AK_TWO_PI;
+    while (a < -AK_PI) a += AK_TWO_PI;
+    return a;
+}
+
+/* Clamp an angle to [lo, hi] on the circle: outside the range, go to the nearer end. */
+static float clamp_angle(float a, float lo, float hi) {
+    if (a >= lo && a <= hi) return a;
+    float dlo = fabsf(wrap_pi(a - lo)), dhi = fabsf(wrap_pi(a - hi));
+    return dlo <= dhi ? lo : hi;
+}
+
+static bool angle_in_range(float a, float lo, float hi, float tol) {
+    if (a >= lo - tol && a <= hi + tol) return true;
+    /* The same rotation written with the angle one turn away. */
+    float b = a + (a < 0.0f ? AK_TWO_PI : -AK_TWO_PI);
+    return b >= lo - tol && b <= hi + tol;
+}
+
+/* ---- creation ------------------------------------------------------------------------ */
+
+ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* alloc, ak_skeleton** out_skeleton,
+                             ak_diag* diag) {
+    if (out_skeleton) *out_skeleton = NULL;
+    if (!desc || !out_skeleton) return AK_ERR_NULL_ARG;
+    if (desc->joint_count == 0) {
+        akp_diag_set(diag, NULL, "skeleton has no joints");
+        return AK_ERR_EMPTY;
+    }
+    if (!desc->joints) return AK_ERR_NULL_ARG;
+    if (desc->joint_count > MAX_JOINTS) {
+        akp_diag_set(diag, NULL, "skeleton has %zu joints, more than %u", desc->joint_count, MAX_JOINTS);
+        return AK_ERR_BAD_ARG;
+    }
+    if (alloc && (!alloc->alloc != !alloc->free)) return AK_ERR_BAD_ARG;
+    const size_t n = desc->joint_count;
+    for (size_t i = 0; i < n; ++i) {
+        const ak_joint_desc* j = &desc->joints[i];
+        if (!j->name) {
+            akp_diag_set(diag, NULL, "joint %zu has no name", i);
+            return AK_ERR_NULL_ARG;
+        }
+        if ((int)j->type < 0 || j->type >= AK_JOINT_TYPE_COUNT) {
+            akp_diag_set(diag, NULL, "joint %zu '%s' has unknown type %d", i, j->name, (int)j->type);
+            return AK_ERR_BAD_ARG;
+        }
+        if (j->parent < -1 || (j->parent >= 0 && (size_t)j->parent >= i)) {
+            akp_diag_set(diag, NULL, "joint %zu '%s' has parent %d, which is not before it (use ak_skeleton_reorder)",
+                         i, j->name, j->parent);
+            return AK_ERR_BAD_HIERARCHY;
+        }
+        if (!ak_transform_is_finite(j->rest)) {
+            akp_diag_set(diag, NULL, "joint %zu '%s' has a non-finite rest transform", i, j->name);
+            return AK_ERR_BAD_DATA;
+        }
+        if (!(ak_quat_dot(j->rest.rotation, j->rest.rotation) > 1e-12f)) {
+            akp_diag_set(diag, NULL, "joint %zu '%s' has a zero rest rotation (use ak_transform_identity())", i,
+                         j->name);
+            return AK_ERR_BAD_DATA;
+        }
+        if (j->inverse_bind && !mat4_finite(j->inverse_bind)) {
+            akp_diag_set(diag, NULL, "joint %zu '%s' has a non-finite inverse bind matrix", i, j->name);
+            return AK_ERR_BAD_DATA;
+        }
+        const ak_joint_limits* l = &j->limits;
+        if (!limits_finite(l) || l->min > l->max || l->twist_min > l->twist_max || l->cone_angle < 0.0f) {
+            akp_diag_set(diag, NULL, "joint %zu '%s' has invalid limits (non-finite, min > max or negative cone)", i,
+                         j->name);
+            return AK_ERR_BAD_DATA;
+        }
+    }
+
+    size_t total = akp_align16(sizeof(ak_skeleton));
+    const size_t off_parents = total;
+    total = akp_align16(total + n * sizeof(int16_t));
+    const size_t off_rest = total;
+    total = akp_align16(total + n * sizeof(ak_transform));
+    const size_t off_ib = total;
+    total = akp_align16(total + n * sizeof(ak_mat4));
+    const size_t off_names = total;
+    total = akp_align16(total + n * AK_NAME_SIZE);
+    const size_t off_limits = total;
+    total = akp_align16(total + n * sizeof(ak_joint_limits));
+    const size_t off_children = total;
+    total = akp_align16(total + n * sizeof(uint32_t));
+    const size_t off_types = total;
+    total = akp_align16(total + n);
+    /* Scratch for the duplicate-name check, freed before returning. */
+    name_ref* refs = (name_ref*)akp_alloc(alloc, n * sizeof(name_ref));
+    unsigned char* base = (unsigned char*)akp_calloc(alloc, total);
+    if (!base || !refs) {
+        akp_free(alloc, refs);
+        akp_free(alloc, base);
+        return AK_ERR_NO_MEMORY;
+    }
+    ak_skeleton* sk = (ak_skeleton*)base;
+    if (alloc) sk->alloc = *alloc;
+    sk->joint_count = n;
+    if (desc->name) snprintf(sk->name, sizeof sk->name, "%s", desc->name);
+    sk->parents = (int16_t*)(base + off_parents);
+    sk->rest = (ak_transform*)(base + off_rest);
+    sk->inverse_binds = (ak_mat4*)(base + off_ib);
+    sk->names = (char(*)[AK_NAME_SIZE])(base + off_names);
+    sk->limits = (ak_joint_limits*)(base + off_limits);
+    sk->child_counts = (uint32_t*)(base + off_children);
+    sk->types = (uint8_t*)(base + off_types);
+
+    for (size_t i = 0; i < n; ++i) {
+        const ak_joint_desc* j = &desc->joints[i];
+        sk->parents[i] = (int16_t)j->parent;
+        sk->rest[i] = j->rest;
+        sk->rest[i].rotation = ak_quat_normalize(j->rest.rotation);
+        snprintf(sk->names[i], AK_NAME_SIZE, "%s", j->name);
+        sk->types[i] = (uint8_t)j->type;
+        sk->limits[i] = resolve_limits(j->type, j->limits);
+        if (j->parent >= 0) sk->child_counts[j->parent]++;
+        refs[i].name = sk->names[i];
+        refs[i].index = i;
+    }
+    /* Inverse binds: given, or the inverse of the rest pose's model matrix. The rest model
+     * matrices are accumulated in inverse_binds first (parents come first), then inverted. */
+    for (size_t i = 0; i < n; ++i) {
+        ak_mat4 model_i = ak_transform_to_mat4(sk->rest[i]);
+        if (sk->parents[i] >= 0) model_i = ak_mat4_mul(sk->inverse_binds[sk->parents[i]], model_i);
+        sk->inverse_binds[i] = model_i;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const ak_joint_desc* j = &desc->joints[i];
+        sk->inverse_binds[i] = j->inverse_bind ? *j->inverse_bind : ak_mat4_inverse_affine(sk->inverse_binds[i]);
+    }
+
+    qsort(refs, n, sizeof(name_ref), cmp_name_ref);
+    for (size_t i = 1; i < n; ++i) {
+        if (strcmp(refs[i - 1].name, refs[i].name) == 0) {
+            akp_diag_set(diag, NULL, "joints %zu and %zu share the name '%s'", refs[i - 1].index, refs[i].index,
+                         refs[i].name);
+            akp_free(alloc, refs);
+            akp_free(alloc, base);
+            return AK_ERR_DUPLICATE;
+        }
+    }
+    akp_free(alloc, refs);
+    *out_skeleton = sk;
+    return AK_OK;
+}
+
+void ak_skeleton_destroy(ak_skeleton* skeleton) {
+    if (!skeleton) return;
+    ak_allocator a = skeleton->alloc;
+    akp_free(&a, skeleton);
+}
+
+ak_result ak_skeleton_reorder(ak_i32_cspan parents, ak_i32_span out_order) {
+    if ((parents.count && !parents.ptr) || (parents.count && !out_order.ptr)) return AK_ERR_NULL_ARG;
+    if (out_order.count < parents.count) return AK_ERR_SPAN_SMALL;
+    const size_t n = parents.count;
+    if (n == 0) return AK_OK;
+    for (size_t i = 0; i < n; ++i)
+        if (parents.ptr[i] < -1 || (parents.ptr[i] >= 0 && (size_t)parents.ptr[i] >= n)) return AK_ERR_BAD_HIERARCHY;
+    /* Temporary state per joint: 0 not placed, 1 placed, 2 on the chain being walked. This is
+     * an offline helper, so it uses the C heap for its scratch. */
+    uint8_t* state = (uint8_t*)calloc(n, 1);
+    if (!state) return AK_ERR_NO_MEMORY;
+    size_t placed = 0;
+    ak_result r = AK_OK;
+    /* For each joint in input order, place its unplaced ancestors (root-most first), then it.
+     * A joint moves earlier only when a descendant that comes before it in the input needs it. */
+    for (size_t i = 0; i < n && r == AK_OK; ++i) {
+        if (state[i] == 1) continue;
+        size_t len = 0;
+        int32_t j = (int32_t)i;
+        while (j >= 0 && state[j] != 1) {
+            if (state[j] == 2) {
+                r = AK_ERR_BAD_HIERARCHY;
+                break;
+            }
+            state[j] = 2;
+            out_order.ptr[placed + len++] = j; /* the chain: distinct unplaced joints, fits */
+            j = parents.ptr[j];
+        }
+        if (r != AK_OK) break;
+        for (size_t a = 0, b = len - 1; a < b; ++a, --b) {
+            int32_t t = out_order.ptr[placed + a];
+            out_order.ptr[placed + a] = out_order.ptr[placed + b];
+            out_order.ptr[placed + b] = t;
+        }
+        for (size_t k = 0; k < len; ++k) state[out_order.ptr[placed + k]] = 1;
+        placed += len;
+    }
+    free(state);
+    return r;
+}
+
+/* ---- queries ------------------------------------------------------------------------- */
+
+size_t ak_skeleton_joint_count(const ak_skeleton* skeleton) { return skeleton ? skeleton->joint_count : 0; }
+
+ak_i16_cspan ak_skeleton_parents(const ak_skeleton* skeleton) {
+    ak_i16_cspan s = {skeleton ? skeleton->parents : NULL, skeleton ? skeleton->joint_count : 0};
+    return s;
+}
+
+ak_transform_cspan ak_skeleton_rest_pose(const ak_skeleton* skeleton) {
+    ak_transform_cspan s = {skeleton ? skeleton->rest : NULL, skeleton ? skeleton->joint_count : 0};
+    return s;
+}
+
+ak_mat4_cspan ak_skeleton_inverse_binds(const ak_skeleton* skeleton) {
+    ak_mat4_cspan s = {skeleton ? skeleton->inverse_binds : NULL, skeleton ? skeleton->joint_count : 0};
+    return s;
+}
+
+const char* ak_skeleton_joint_name(const ak_skeleton* skeleton, size_t joint_index) {
+    if (!skeleton || joint_index >= skeleton->joint_count) return "";
+    return skeleton->names[joint_index];
+}
+
+int ak_skeleton_find_joint(const ak_skeleton* skeleton, const char* name) {
+    if (!skeleton || !name) return -1;
+    for (size_t i = 0; i < skeleton->joint_count; ++i)
+        if (strcmp(skeleton->names[i], name) == 0) return (int)i;
+    return -1;
+}
+
+ak_joint_type ak_skeleton_joint_type(const ak_skeleton* skeleton, size_t joint_index) {
+    if (!skeleton || joint_index >= skeleton->joint_count) return AK_JOINT_FREE;
+    return (ak_joint_type)skeleton->types[joint_index];
+}
+
+ak_joint_limits ak_skeleton_joint_limits(const ak_skeleton* skeleton, size_t joint_index) {
+    ak_joint_limits zero;
+    memset(&zero, 0, sizeof zero);
+    if (!skeleton || joint_index >= skeleton->joint_count) return resolve_limits(AK_JOINT_FREE, zero);
+    return skeleton->limits[joint_index];
+}
+
+size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index) {
+    if (!skeleton || joint_index >= skeleton->joint_count) return 0;
+    return skeleton->child_counts[joint_index];
+}
+
+/* ---- forward kinematics -------------------------------------------------------------- */
+
+static void fk(const ak_skeleton* sk, const ak_mat4* root, const ak_transform* local, ak_mat4* out) {
+    const size_t n = sk->joint_count;
+    for (size_t i = 0; i < n; ++i) {
+        ak_mat4 m = ak_transform_to_mat4(local[i]);
+        int p = sk->parents[i];
+        if (p >= 0) out[i] = ak_mat4_mul(out[p], m);
+        else out[i] = root ? ak_mat4_mul(*root, m) : m;
+    }
+}
+
+ak_result ak_skeleton_local_to_model(const ak_skeleton* skeleton, ak_transform_cspan local, ak_mat4_span out_model) {
+    if (!skeleton || !local.ptr || !out_model.ptr) return AK_ERR_NULL_ARG;
+    if (local.count < skeleton->joint_count || out_model.count < skeleton->joint_count) return AK_ERR_SPAN_SMALL;
+    fk(skeleton, NULL, local.ptr, out_model.ptr);
+    return AK_OK;
+}
+
+ak_result ak_skeleton_local_to_model_rooted(const ak_skeleton* skeleton, ak_mat4 root, ak_transform_cspan local,
+                                            ak_mat4_span out_model) {
+    if (!skeleton || !local.ptr || !out_model.ptr) return AK_ERR_NULL_ARG;
+    if (local.count < skeleton->joint_count || out_model.count < skeleton->joint_count) return AK_ERR_SPAN_SMALL;
+    fk(skeleton, &root, local.ptr, out_model.ptr);
+    return AK_OK;
+}
+
+ak_result ak_skeleton_skinning_matrices(const ak_skeleton* skeleton, ak_mat4_cspan model, ak_mat4_span out_skin) {
+    if (!skeleton || !model.ptr || !out_skin.ptr) return AK_ERR_NULL_ARG;
+    if (model.count < skeleton->joint_count || out_skin.count < skeleton->joint_count) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < skeleton->joint_count; ++i)
+        out_skin.ptr[i] = ak_mat4_mul(model.ptr[i], skeleton->inverse_binds[i]);
+    return AK_OK;
+}
+
+ak_result ak_skeleton_local_to_model_batch(const ak_skeleton* skeleton, size_t character_count,
+                                           ak_transform_cspan local, ak_mat4_span out_model) {
+    if (!skeleton) return AK_ERR_NULL_ARG;
+    if (character_count == 0) return AK_OK;
+    if (!local.ptr || !out_model.ptr) return AK_ERR_NULL_ARG;
+    const size_t n = skeleton->joint_count;
+    if (character_count > SIZE_MAX / n) return AK_ERR_SPAN_SMALL;
+    if (local.count < character_count * n || out_model.count < character_count * n) return AK_ERR_SPAN_SMALL;
+    for (size_t c = 0; c < character_count; ++c) fk(skeleton, NULL, local.ptr + c * n, out_model.ptr + c * n);
+    return AK_OK;
+}
+
+/* ---- limits -------------------------------------------------------------------------- */
+
+void ak_quat_swing_twist(ak_quat q, ak_vec3 axis, ak_quat* out_swing, ak_quat* out_twist) {
+    ak_vec3 a = ak_vec3_normalize(axis);
+    q = ak_quat_normalize(q);
+    float d = q.x * a.x + q.y * a.y + q.z * a.z;
+    ak_quat twist = ak_quat_make(a.x * d, a.y * d, a.z * d, q.w);
+    /* A 180-degree swing leaves no twist component: any twist works, take the identity. */
+    if (ak_quat_dot(twist, twist) < 1e-12f) twist = ak_quat_identity();
+    else twist = ak_quat_normalize(twist);
+    ak_quat swing = ak_quat_normalize(ak_quat_mul(q, ak_quat_conjugate(twist)));
+    if (out_swing) *out_swing = swing;
+    if (out_twist) *out_twist = twist;
+}
+
+ak_transform ak_skeleton_limit_joint(const ak_skeleton* skeleton, size_t joint_index, ak_transform local) {
+    if (!skeleton || joint_index >= skeleton->joint_count) return local;
+    const ak_joint_type type = (ak_joint_type)skeleton->types[joint_index];
+    if (type == AK_JOINT_FREE) return local;
+    const ak_transform rest = skeleton->rest[joint_index];
+    const ak_joint_limits* l = &skeleton->limits[joint_index];
+    ak_transform out = local;
+    out.translation = rest.translation;
+    /* Rotation relative to rest, in the joint's rest frame: local = rest * rel. */
+    ak_quat rel = ak_quat_mul(ak_quat_conjugate(rest.rotation), ak_quat_normalize(local.rotation));
+    ak_quat swing, twist;
+    ak_quat_swing_twist(rel, l->axis, &swing, &twist);
+    switch (type) {
+    case AK_JOINT_HINGE: {
+        float a = twist_angle(twist, l->axis);
+        if (l->min != 0.0f || l->max != 0.0f) a = clamp_angle(a, l->min, l->max);
+        out.rotation = ak_quat_normalize(ak_quat_mul(rest.rotation, ak_quat_from_axis_angle(l->axis, a)));
+        break;
+    }
+    case AK_JOINT_BALL: {
+        if (l->cone_angle > 0.0f) {
+            float s = rotation_angle(swing);
+            if (s > l->cone_angle) {
+                ak_vec3 ax;
+                float ang;
+                ak_quat_to_axis_angle(swing, &ax, &ang);
+                swing = ak_quat_from_axis_angle(ax, l->cone_angle);
+            }
+        }
+        if (l->twist_min != 0.0f || l->twist_max != 0.0f) {
+            float a = clamp_angle(twist_angle(twist, l->axis), l->twist_min, l->twist_max);
+            twist = ak_quat_from_axis_angle(l->axis, a);
+        }
+        out.rotation = ak_quat_normalize(ak_quat_mul(rest.rotation, ak_quat_mul(swing, twist)));
+        break;
+    }
+    case AK_JOINT_PRISM: {
+        ak_vec3 axis_p = ak_quat_rotate(rest.rotation, l->axis); /* slide axis in parent space */
+        float d = ak_vec3_dot(ak_vec3_sub(local.translation, rest.translation), axis_p);
+        if (!ak_finitef(d)) d = 0.0f;
+        if (l->min != 0.0f || l->max != 0.0f) d = ak_clampf(d, l->min, l->max);
+        out.rotation = rest.rotation;
+        out.translation = ak_vec3_madd(rest.translation, axis_p, d);
+        break;
+    }
+    default: break;
+    }
+    return out;
+}
+
+ak_result ak_skeleton_apply_limits(const ak_skeleton* skeleton, ak_transform_span pose) {
+    if (!skeleton || !pose.ptr) return AK_ERR_NULL_ARG;
+    if (pose.count < skeleton->joint_count) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < skeleton->joint_count; ++i) pose.ptr[i] = ak_skeleton_limit_joint(skeleton, i, pose.ptr[i]);
+    return AK_OK;
+}
+
+bool ak_skeleton_joint_within_limits(const ak_skeleton* skeleton, size_t joint_index, ak_transform local, float tol) {
+    if (!skeleton || joint_index >= skeleton->joint_count) return false;
+    if (!ak_transform_is_finite(local)) return false;
+    const ak_joint_type type = (ak_joint_type)skeleton->types[joint_index];
+    if (type == AK_JOINT_FREE) return true;
+    if (!(tol >= 0.0f)) tol = 0.0f;
+    const ak_transform rest = skeleton->rest[joint_index];
+    const ak_joint_limits* l = &skeleton->limits[joint_index];
+    ak_quat rel = ak_quat_mul(ak_quat_conjugate(rest.rotation), ak_quat_normalize(local.rotation));
+    ak_quat swing, twist;
+    ak_quat_swing_twist(rel, l->axis, &swing, &twist);
+    switch (type) {
+    case AK_JOINT_HINGE:
+        if (ak_vec3_distance(local.translation, rest.translation) > tol) return false;
+        if (rotation_angle(swing) > tol) return false;
+        if (l->min == 0.0f && l->max == 0.0f) return true;
+        return angle_in_range(twist_angle(twist, l->axis), l->min, l->max, tol);
+    case AK_JOINT_BALL:
+        if (ak_vec3_distance(local.translation, rest.translation) > tol) return false;
+        if (l->cone_angle > 0.0f && rotation_angle(swing) > l->cone_angle + tol) return false;
+        if (l->twist_min == 0.0f && l->twist_max == 0.0f) return true;
+        return angle_in_range(twist_angle(twist, l->axis), l->twist_min, l->twist_max, tol);
+    case AK_JOINT_PRISM: {
+        if (rotation_angle(rel) > tol) return false;
+        ak_vec3 axis_p = ak_quat_rotate(rest.rotation, l->axis);
+        ak_vec3 dv = ak_vec3_sub(local.translation, rest.translation);
+        float d = ak_vec3_dot(dv, axis_p);
+        if (ak_vec3_length(ak_vec3_madd(dv, axis_p, -d)) > tol) return false;
+        if (l->min == 0.0f && l->max == 0.0f) return true;
+        return d >= l->min - tol && d <= l->max + tol;
+    }
+    default: return true;
+    }
+}
+
+bool ak_pose_is_finite(ak_transform_cspan pose) {
+    if (pose.count && !pose.ptr) return false;
+    for (size_t i = 0; i < pose.count; ++i)
+        if (!ak_transform_is_finite(pose.ptr[i])) return false;
+    return true;
+}
