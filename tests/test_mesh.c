@@ -1,0 +1,416 @@
+/* Tests for mesh.h: creation (one allocation), clone, validation, bounds, normals, volume,
+ * closed/oriented check, weight validation and normalisation. Oracles are closed forms
+ * (unit cube, sphere bounds) and naive re-computations written here. */
+#include <animkit/mesh.h>
+
+#include "ak_test.h"
+
+#define PI_D 3.14159265358979323846
+
+/* Counting allocator: how many blocks are live and how many were ever made. */
+typedef struct counter {
+    int live, total;
+} counter;
+static void* count_alloc(size_t size, void* user) {
+    counter* c = (counter*)user;
+    c->live++;
+    c->total++;
+    return malloc(size);
+}
+static void count_free(void* p, void* user) {
+    ((counter*)user)->live--;
+    free(p);
+}
+
+/* Cube [0,1]^3 + offset, vertex index = x + 2y + 4z, faces counter-clockwise from outside. */
+static ak_mesh* make_cube(ak_vec3 offset, bool normals) {
+    static const uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                         {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    ak_mesh_desc d = {.vertex_count = 8, .triangle_count = 12, .has_normals = normals, .name = "cube"};
+    ak_mesh* m = NULL;
+    if (ak_mesh_create(&d, NULL, &m) != AK_OK) return NULL;
+    for (uint32_t i = 0; i < 8; ++i)
+        m->positions[i] = ak_vec3_add(offset, ak_vec3_make((float)(i & 1), (float)((i >> 1) & 1), (float)((i >> 2) & 1)));
+    for (int f = 0; f < 6; ++f) {
+        uint32_t* t = m->indices + 6 * f;
+        t[0] = quads[f][0], t[1] = quads[f][1], t[2] = quads[f][2];
+        t[3] = quads[f][0], t[4] = quads[f][2], t[5] = quads[f][3];
+    }
+    return m;
+}
+
+/* UV sphere of radius r with poles: rings latitude bands, segs longitudes; CCW outside. */
+static ak_mesh* make_sphere(float r, uint32_t rings, uint32_t segs) {
+    size_t vc = 2 + (size_t)(rings - 1) * segs, tc = 2 * (size_t)segs * (rings - 1);
+    ak_mesh_desc d = {.vertex_count = vc, .triangle_count = tc};
+    ak_mesh* m = NULL;
+    if (ak_mesh_create(&d, NULL, &m) != AK_OK) return NULL;
+    m->positions[0] = ak_vec3_make(0, r, 0);
+    m->positions[vc - 1] = ak_vec3_make(0, -r, 0);
+    for (uint32_t i = 1; i < rings; ++i)
+        for (uint32_t j = 0; j < segs; ++j) {
+            double th = PI_D * i / rings, ph = 2.0 * PI_D * j / segs;
+            m->positions[1 + (i - 1) * segs + j] =
+                ak_vec3_make((float)(r * sin(th) * cos(ph)), (float)(r * cos(th)), (float)(-r * sin(th) * sin(ph)));
+        }
+    uint32_t* t = m->indices;
+    for (uint32_t j = 0; j < segs; ++j) {
+        uint32_t a = 1 + j, b = 1 + (j + 1) % segs;
+        *t++ = 0, *t++ = a, *t++ = b;
+        uint32_t base = 1 + (rings - 2) * segs;
+        *t++ = (uint32_t)vc - 1, *t++ = base + (j + 1) % segs, *t++ = base + j;
+    }
+    for (uint32_t i = 1; i + 1 < rings; ++i)
+        for (uint32_t j = 0; j < segs; ++j) {
+            uint32_t a = 1 + (i - 1) * segs + j, b = 1 + (i - 1) * segs + (j + 1) % segs;
+            uint32_t c = a + segs, e = b + segs;
+            *t++ = a, *t++ = c, *t++ = e;
+            *t++ = a, *t++ = e, *t++ = b;
+        }
+    return m;
+}
+
+AK_TEST(create_one_allocation_and_zeroed) {
+    counter c = {0, 0};
+    ak_allocator a = {count_alloc, count_free, &c};
+    ak_mesh_desc d = {.vertex_count = 5, .triangle_count = 2, .influence_count = 4, .morph_target_count = 2,
+                      .has_normals = true, .has_uvs = true, .has_colors = true, .has_morph_normals = true,
+                      .name = "box"};
+    ak_mesh* m = NULL;
+    AK_CHECK_EQ(ak_mesh_create(&d, &a, &m), AK_OK);
+    AK_CHECK(m != NULL);
+    if (!m) return;
+    AK_CHECK_EQ(c.live, 1);
+    AK_CHECK_EQ(c.total, 1);
+    AK_CHECK_STREQ(m->name, "box");
+    AK_CHECK(m->positions && m->normals && m->uvs && m->colors && m->indices && m->joints && m->weights);
+    AK_CHECK(m->morph_positions && m->morph_normals && m->morph_weights && m->morph_names);
+    /* Every array zeroed, and writing all of them stays inside the block (ASan checks). */
+    for (size_t i = 0; i < 20; ++i) AK_CHECK(m->weights[i] == 0.0f && m->joints[i] == 0);
+    for (size_t i = 0; i < 6; ++i) AK_CHECK_EQ(m->indices[i], 0);
+    memset(m->positions, 1, 5 * sizeof(ak_vec3));
+    memset(m->morph_normals, 1, 10 * sizeof(ak_vec3));
+    memset(m->morph_names, 'a', 2 * AK_NAME_SIZE);
+    ak_mesh_destroy(m);
+    AK_CHECK_EQ(c.live, 0);
+
+    ak_mesh_desc plain = {.vertex_count = 3};
+    AK_CHECK_EQ(ak_mesh_create(&plain, NULL, &m), AK_OK);
+    AK_CHECK(m->normals == NULL && m->uvs == NULL && m->colors == NULL && m->indices == NULL);
+    AK_CHECK(m->joints == NULL && m->weights == NULL && m->morph_positions == NULL && m->morph_names == NULL);
+    AK_CHECK_STREQ(m->name, "");
+    ak_mesh_destroy(m);
+    ak_mesh_destroy(NULL);
+}
+
+AK_TEST(create_bad_input) {
+    ak_mesh* m = (ak_mesh*)1;
+    ak_mesh_desc d = {.vertex_count = 3};
+    AK_CHECK_EQ(ak_mesh_create(NULL, NULL, &m), AK_ERR_NULL_ARG);
+    AK_CHECK(m == NULL);
+    AK_CHECK_EQ(ak_mesh_create(&d, NULL, NULL), AK_ERR_NULL_ARG);
+    ak_mesh_desc zero = {0};
+    AK_CHECK_EQ(ak_mesh_create(&zero, NULL, &m), AK_ERR_EMPTY);
+    ak_mesh_desc many = {.vertex_count = 3, .influence_count = AK_MAX_INFLUENCES + 1};
+    AK_CHECK_EQ(ak_mesh_create(&many, NULL, &m), AK_ERR_BAD_ARG);
+    ak_mesh_desc huge = {.vertex_count = SIZE_MAX / 4, .triangle_count = 1};
+    AK_CHECK_EQ(ak_mesh_create(&huge, NULL, &m), AK_ERR_BAD_ARG);
+    ak_mesh_desc huge_tris = {.vertex_count = 3, .triangle_count = SIZE_MAX / 2};
+    AK_CHECK_EQ(ak_mesh_create(&huge_tris, NULL, &m), AK_ERR_BAD_ARG);
+    AK_CHECK(m == NULL);
+    char longname[200];
+    memset(longname, 'x', sizeof longname - 1);
+    longname[sizeof longname - 1] = 0;
+    ak_mesh_desc named = {.vertex_count = 1, .name = longname};
+    AK_CHECK_EQ(ak_mesh_create(&named, NULL, &m), AK_OK);
+    AK_CHECK_EQ(strlen(m->name), AK_NAME_SIZE - 1);
+    ak_mesh_destroy(m);
+}
+
+AK_TEST(clone_is_deep) {
+    ak_mesh_desc d = {.vertex_count = 4, .triangle_count = 1, .influence_count = 2, .morph_target_count = 1,
+                      .has_uvs = true, .name = "src"};
+    ak_mesh* m = NULL;
+    AK_CHECK_EQ(ak_mesh_create(&d, NULL, &m), AK_OK);
+    for (int i = 0; i < 4; ++i) {
+        m->positions[i] = ak_vec3_make((float)i, 2.0f * i, -1.0f);
+        m->uvs[i] = ak_vec2_make(0.25f * i, 1.0f);
+        m->joints[2 * i] = (uint16_t)i, m->weights[2 * i] = 1.0f;
+        m->morph_positions[i] = ak_vec3_make(0, (float)i, 0);
+    }
+    m->indices[0] = 0, m->indices[1] = 1, m->indices[2] = 3;
+    m->morph_weights[0] = 0.5f;
+    snprintf(m->morph_names[0], AK_NAME_SIZE, "smile");
+    ak_mesh* c = NULL;
+    AK_CHECK_EQ(ak_mesh_clone(m, NULL, &c), AK_OK);
+    AK_CHECK(c && c != m && c->positions != m->positions);
+    AK_CHECK(c->normals == NULL && c->uvs != NULL);
+    AK_CHECK_STREQ(c->name, "src");
+    AK_CHECK_STREQ(c->morph_names[0], "smile");
+    AK_CHECK(memcmp(c->positions, m->positions, 4 * sizeof(ak_vec3)) == 0);
+    AK_CHECK(memcmp(c->uvs, m->uvs, 4 * sizeof(ak_vec2)) == 0);
+    AK_CHECK(memcmp(c->joints, m->joints, 8 * sizeof(uint16_t)) == 0);
+    AK_CHECK(memcmp(c->weights, m->weights, 8 * sizeof(float)) == 0);
+    AK_CHECK(memcmp(c->morph_positions, m->morph_positions, 4 * sizeof(ak_vec3)) == 0);
+    AK_CHECK_EQ(c->indices[2], 3);
+    AK_CHECK(c->morph_weights[0] == 0.5f);
+    m->positions[0].x = 99.0f;
+    AK_CHECK(c->positions[0].x == 0.0f);
+    ak_mesh_destroy(m);
+    ak_mesh_destroy(c);
+    AK_CHECK_EQ(ak_mesh_clone(NULL, NULL, &c), AK_ERR_NULL_ARG);
+}
+
+AK_TEST(validate_codes) {
+    ak_mesh* m = make_cube(ak_vec3_zero(), true);
+    ak_diag diag;
+    AK_CHECK_EQ(ak_mesh_validate(m, &diag), AK_OK);
+    m->indices[7] = 8;
+    AK_CHECK_EQ(ak_mesh_validate(m, &diag), AK_ERR_BAD_INDEX);
+    AK_CHECK(strstr(diag.message, "triangle 2") != NULL);
+    m->indices[7] = 1;
+    m->positions[5].y = NAN;
+    AK_CHECK_EQ(ak_mesh_validate(m, &diag), AK_ERR_BAD_DATA);
+    AK_CHECK(strstr(diag.message, "vertex 5") != NULL);
+    m->positions[5].y = 0.0f;
+    m->normals[3].z = INFINITY;
+    AK_CHECK_EQ(ak_mesh_validate(m, NULL), AK_ERR_BAD_DATA);
+    AK_CHECK_EQ(ak_mesh_validate(NULL, NULL), AK_ERR_NULL_ARG);
+    ak_mesh_destroy(m);
+}
+
+AK_TEST(bounds) {
+    ak_mesh* m = make_cube(ak_vec3_make(-2.0f, 3.0f, 0.5f), false);
+    ak_vec3 lo, hi;
+    ak_mesh_bounds(m, &lo, &hi);
+    AK_CHECK(lo.x == -2.0f && lo.y == 3.0f && lo.z == 0.5f);
+    AK_CHECK(hi.x == -1.0f && hi.y == 4.0f && hi.z == 1.5f);
+    ak_mesh_destroy(m);
+    ak_vec3_cspan none = {NULL, 0};
+    ak_points_bounds(none, &lo, &hi);
+    AK_CHECK(lo.x == 0 && lo.y == 0 && lo.z == 0 && hi.x == 0 && hi.y == 0 && hi.z == 0);
+    ak_mesh_bounds(NULL, &lo, &hi);
+    AK_CHECK(hi.x == 0.0f);
+}
+
+AK_TEST(normals) {
+    ak_mesh_desc d = {.vertex_count = 4, .triangle_count = 1, .has_normals = true};
+    ak_mesh* m = NULL;
+    AK_CHECK_EQ(ak_mesh_create(&d, NULL, &m), AK_OK);
+    m->positions[1] = ak_vec3_make(1, 0, 0);
+    m->positions[2] = ak_vec3_make(0, 1, 0);
+    m->positions[3] = ak_vec3_make(5, 5, 5); /* on no triangle */
+    m->indices[0] = 0, m->indices[1] = 1, m->indices[2] = 2;
+    AK_CHECK_EQ(ak_mesh_compute_normals(m), AK_OK);
+    for (int i = 0; i < 3; ++i) AK_CHECK(m->normals[i].x == 0.0f && m->normals[i].y == 0.0f && m->normals[i].z == 1.0f);
+    AK_CHECK(m->normals[3].x == 0.0f && m->normals[3].y == 1.0f && m->normals[3].z == 0.0f);
+    ak_mesh_destroy(m);
+
+    /* Cube corners: the normal points away from the centre, into the corner's octant. */
+    m = make_cube(ak_vec3_zero(), true);
+    AK_CHECK_EQ(ak_mesh_compute_normals(m), AK_OK);
+    /* Each corner lies on one or two triangles of each face (depending on the diagonal), so
+     * the area-weighted sum points into the corner's octant without being exactly diagonal. */
+    for (uint32_t i = 0; i < 8; ++i) {
+        ak_vec3 n = m->normals[i];
+        AK_CHECK_NEAR(ak_vec3_length(n), 1.0, 1e-5);
+        AK_CHECK((n.x > 0) == ((i & 1) != 0) && (n.y > 0) == ((i & 2) != 0) && (n.z > 0) == ((i & 4) != 0));
+    }
+    ak_vec3 out[8];
+    ak_vec3_cspan p = {m->positions, 8};
+    ak_u32_cspan idx = {m->indices, 36};
+    ak_vec3_span small = {out, 7};
+    AK_CHECK_EQ(ak_normals_compute(p, idx, small), AK_ERR_SPAN_SMALL);
+    m->indices[4] = 8;
+    AK_CHECK_EQ(ak_normals_compute(p, idx, (ak_vec3_span)AK_SPAN(out)), AK_ERR_BAD_INDEX);
+    ak_vec3_span nul = {NULL, 8};
+    AK_CHECK_EQ(ak_normals_compute(p, idx, nul), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_mesh_compute_normals(NULL), AK_ERR_NULL_ARG);
+    ak_mesh_destroy(m);
+}
+
+AK_TEST(volume_cube_and_sphere) {
+    ak_mesh* m = make_cube(ak_vec3_make(10.0f, -3.0f, 7.0f), false);
+    ak_vec3_cspan p = {m->positions, 8};
+    ak_u32_cspan idx = {m->indices, 36};
+    AK_CHECK_NEAR(ak_volume_compute(p, idx), 1.0, 1e-9);
+    /* Reversed winding gives the negative volume. */
+    for (size_t t = 0; t < 12; ++t) {
+        uint32_t tmp = m->indices[3 * t + 1];
+        m->indices[3 * t + 1] = m->indices[3 * t + 2];
+        m->indices[3 * t + 2] = tmp;
+    }
+    AK_CHECK_NEAR(ak_volume_compute(p, idx), -1.0, 1e-9);
+    ak_mesh_destroy(m);
+
+    /* An inscribed polyhedron has less volume than the sphere, and converges to it. */
+    const double r = 1.5, exact = 4.0 / 3.0 * PI_D * r * r * r;
+    ak_mesh* coarse = make_sphere((float)r, 8, 16);
+    ak_mesh* fine = make_sphere((float)r, 64, 128);
+    double vc = ak_volume_compute((ak_vec3_cspan){coarse->positions, coarse->vertex_count},
+                                  (ak_u32_cspan){coarse->indices, 3 * coarse->triangle_count});
+    double vf = ak_volume_compute((ak_vec3_cspan){fine->positions, fine->vertex_count},
+                                  (ak_u32_cspan){fine->indices, 3 * fine->triangle_count});
+    AK_CHECK(vc > 0.8 * exact && vc < exact);
+    AK_CHECK(vf > vc && vf < exact);
+    AK_CHECK(fabs(vf - exact) / exact < 2e-3);
+    AK_CHECK(ak_mesh_is_closed_oriented(coarse));
+    AK_CHECK(ak_mesh_is_closed_oriented(fine));
+    ak_mesh_destroy(coarse);
+    ak_mesh_destroy(fine);
+}
+
+AK_TEST(closed_oriented) {
+    ak_mesh* m = make_cube(ak_vec3_zero(), false);
+    AK_CHECK(ak_mesh_is_closed_oriented(m));
+    /* One triangle flipped: two edges now run the same way as their neighbours'. */
+    uint32_t tmp = m->indices[1];
+    m->indices[1] = m->indices[2];
+    m->indices[2] = tmp;
+    AK_CHECK(!ak_mesh_is_closed_oriented(m));
+    m->indices[2] = m->indices[1];
+    m->indices[1] = tmp;
+    AK_CHECK(ak_mesh_is_closed_oriented(m));
+    /* A hole: the last triangle dropped. */
+    m->triangle_count = 11;
+    AK_CHECK(!ak_mesh_is_closed_oriented(m));
+    m->triangle_count = 12;
+    /* Degenerate triangle and out-of-range index. */
+    m->indices[0] = m->indices[1];
+    AK_CHECK(!ak_mesh_is_closed_oriented(m));
+    m->indices[0] = 9;
+    AK_CHECK(!ak_mesh_is_closed_oriented(m));
+    AK_CHECK(!ak_mesh_is_closed_oriented(NULL));
+    ak_mesh_destroy(m);
+
+    /* Two copies of a tetrahedron sharing vertices: edges used four times -> not manifold. */
+    ak_mesh_desc d = {.vertex_count = 4, .triangle_count = 8};
+    AK_CHECK_EQ(ak_mesh_create(&d, NULL, &m), AK_OK);
+    static const uint32_t tet[12] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2};
+    memcpy(m->indices, tet, sizeof tet);
+    memcpy(m->indices + 12, tet, sizeof tet);
+    m->positions[1] = ak_vec3_make(1, 0, 0);
+    m->positions[2] = ak_vec3_make(0, 1, 0);
+    m->positions[3] = ak_vec3_make(0, 0, 1);
+    AK_CHECK(!ak_mesh_is_closed_oriented(m));
+    m->triangle_count = 4;
+    AK_CHECK(ak_mesh_is_closed_oriented(m));
+    AK_CHECK_NEAR(ak_volume_compute((ak_vec3_cspan){m->positions, 4}, (ak_u32_cspan){m->indices, 12}), 1.0 / 6.0,
+                  1e-9);
+    ak_mesh_destroy(m);
+}
+
+AK_TEST(validate_weights_codes) {
+    ak_mesh_desc d = {.vertex_count = 3, .influence_count = 2, .name = "w"};
+    ak_mesh* m = NULL;
+    AK_CHECK_EQ(ak_mesh_create(&d, NULL, &m), AK_OK);
+    for (int v = 0; v < 3; ++v) {
+        m->joints[2 * v] = (uint16_t)v, m->weights[2 * v] = 0.75f;
+        m->joints[2 * v + 1] = 3, m->weights[2 * v + 1] = 0.25f;
+    }
+    ak_diag diag;
+    AK_CHECK_EQ(ak_mesh_validate_weights(m, 4, 0.0f, &diag), AK_OK);
+    AK_CHECK_EQ(ak_mesh_validate_weights(m, 3, 0.0f, &diag), AK_ERR_BAD_INDEX);
+    AK_CHECK(strstr(diag.message, "vertex 0") != NULL);
+    m->weights[3] = 0.2f; /* vertex 1 sums to 0.95 */
+    AK_CHECK_EQ(ak_mesh_validate_weights(m, 4, 0.0f, &diag), AK_ERR_BAD_WEIGHTS);
+    AK_CHECK(strstr(diag.message, "vertex 1") != NULL);
+    AK_CHECK_EQ(ak_mesh_validate_weights(m, 4, 0.1f, &diag), AK_OK);
+    m->weights[3] = 0.25f;
+    m->weights[4] = -0.25f, m->weights[5] = 1.25f;
+    AK_CHECK_EQ(ak_mesh_validate_weights(m, 4, 0.0f, &diag), AK_ERR_BAD_WEIGHTS);
+    AK_CHECK(strstr(diag.message, "vertex 2") != NULL);
+    m->weights[4] = NAN;
+    AK_CHECK_EQ(ak_mesh_validate_weights(m, 4, 0.0f, NULL), AK_ERR_BAD_WEIGHTS);
+    AK_CHECK_EQ(ak_mesh_validate_weights(NULL, 4, 0.0f, NULL), AK_ERR_NULL_ARG);
+    ak_mesh_destroy(m);
+    ak_mesh* cube = make_cube(ak_vec3_zero(), false);
+    AK_CHECK_EQ(ak_mesh_validate_weights(cube, 0, 0.0f, NULL), AK_OK);
+    ak_mesh_destroy(cube);
+}
+
+AK_TEST(weights_normalize_keeps_largest) {
+    enum { V = 500, K = 8 };
+    static uint16_t joints[V * K];
+    static float weights[V * K], orig[V * K];
+    static uint16_t orig_j[V * K];
+    ak_rng rng = ak_rng_make(7);
+    for (int i = 0; i < V * K; ++i) {
+        joints[i] = (uint16_t)(i % K * 3 + (i / K) % 2); /* distinct within a vertex */
+        weights[i] = ak_rng_float(&rng) + 1e-3f;
+    }
+    memcpy(orig, weights, sizeof orig);
+    memcpy(orig_j, joints, sizeof orig_j);
+    ak_weights_normalize(joints, weights, V, K, 4, 0.0f);
+    for (int v = 0; v < V; ++v) {
+        /* Naive reference: the 4 largest original weights, divided by their sum (double). */
+        int used[K] = {0};
+        int pick[4];
+        double sum = 0.0;
+        for (int k = 0; k < 4; ++k) {
+            int best = -1;
+            for (int i = 0; i < K; ++i)
+                if (!used[i] && (best < 0 || orig[v * K + i] > orig[v * K + best])) best = i;
+            used[best] = 1;
+            pick[k] = best;
+            sum += orig[v * K + best];
+        }
+        double got_sum = 0.0;
+        for (int k = 0; k < K; ++k) got_sum += weights[v * K + k];
+        AK_CHECK_NEAR(got_sum, 1.0, 1e-6);
+        for (int k = 0; k < 4; ++k) {
+            AK_CHECK_EQ(joints[v * K + k], orig_j[v * K + pick[k]]);
+            AK_CHECK_NEAR(weights[v * K + k], orig[v * K + pick[k]] / sum, 2e-6);
+        }
+        for (int k = 4; k < K; ++k) AK_CHECK(weights[v * K + k] == 0.0f && joints[v * K + k] == 0);
+    }
+}
+
+AK_TEST(weights_normalize_edge_cases) {
+    /* NaN and negatives become 0, duplicates merge, min_weight drops small ones. */
+    uint16_t j[4] = {5, 2, 5, 7};
+    float w[4] = {0.2f, NAN, 0.3f, -1.0f};
+    ak_weights_normalize(j, w, 1, 4, 0, 0.0f);
+    AK_CHECK_EQ(j[0], 5);
+    AK_CHECK_NEAR(w[0], 1.0, 1e-6);
+    AK_CHECK(w[1] == 0.0f && w[2] == 0.0f && w[3] == 0.0f);
+
+    uint16_t j2[4] = {1, 2, 3, 4};
+    float w2[4] = {0.5f, 0.3f, 0.15f, 0.05f};
+    ak_weights_normalize(j2, w2, 1, 4, 4, 0.1f);
+    AK_CHECK_EQ(j2[0], 1);
+    AK_CHECK_EQ(j2[2], 3);
+    AK_CHECK_NEAR(w2[0], 0.5 / 0.95, 1e-6);
+    AK_CHECK_NEAR(w2[2], 0.15 / 0.95, 1e-6);
+    AK_CHECK(w2[3] == 0.0f);
+
+    /* All zero: weight 1 on the first joint (documented fallback). */
+    uint16_t j3[3] = {9, 4, 2};
+    float w3[3] = {0.0f, -0.0f, NAN};
+    ak_weights_normalize(j3, w3, 1, 3, 0, 0.0f);
+    AK_CHECK_EQ(j3[0], 9);
+    AK_CHECK(w3[0] == 1.0f && w3[1] == 0.0f && w3[2] == 0.0f);
+
+    /* Everything under min_weight: the largest still stays. */
+    uint16_t j4[2] = {3, 6};
+    float w4[2] = {0.01f, 0.02f};
+    ak_weights_normalize(j4, w4, 1, 2, 2, 0.5f);
+    AK_CHECK_EQ(j4[0], 6);
+    AK_CHECK(w4[0] == 1.0f && w4[1] == 0.0f);
+    ak_weights_normalize(NULL, w4, 1, 2, 2, 0.0f); /* no-op, no crash */
+}
+
+int main(void) {
+    AK_RUN(create_one_allocation_and_zeroed);
+    AK_RUN(create_bad_input);
+    AK_RUN(clone_is_deep);
+    AK_RUN(validate_codes);
+    AK_RUN(bounds);
+    AK_RUN(normals);
+    AK_RUN(volume_cube_and_sphere);
+    AK_RUN(closed_oriented);
+    AK_RUN(validate_weights_codes);
+    AK_RUN(weights_normalize_keeps_largest);
+    AK_RUN(weights_normalize_edge_cases);
+    return ak_test_finish();
+}
