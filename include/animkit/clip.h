@@ -1,6 +1,43 @@
 /* animkit clip: animation clips, poses, sampling and blending.
- * (Header being completed by the keyframe module; the raw clip structs below are a contract
- * shared with io.h and builtin.h and must keep their fields.) */
+ *
+ * What it does: a clip is a named set of channels, each a track (curve.h) bound to a joint's
+ * local translation, rotation or scale, to a range of morph-target weights, or to a range of
+ * free scalar channels, with a duration. ak_clip_build checks an editable ak_raw_clip and
+ * builds the immutable runtime clip; ak_clip_sample writes the clip's values at a time into
+ * a pose. A pose is an array of local joint transforms (ak_transform) plus morph weights and
+ * scalars, all caller-owned. Sampling through a caller-owned cursor makes forward playback
+ * O(1) amortised per channel and stays correct for any jump. The module also blends poses
+ * (weighted N-way blend, per-joint masks, additive layers, cross-fade) and extracts root
+ * motion (a clip walking in place plus the root's horizontal trajectory).
+ *
+ * glTF: STEP, LINEAR (SLERP for rotations, shortest path) and CUBICSPLINE (tangents scaled by
+ * the key interval, rotations renormalised) follow the glTF 2.0 specification, Appendix C.
+ * Times before a channel's first key give the first key, after its last key the last key.
+ *
+ * What it does NOT do: skeletons or model-space matrices (skeleton.h), file formats (io.h),
+ * retargeting, or time wrapping inside ak_clip_sample (wrap with ak_time_wrap first).
+ *
+ * Usage:
+ *     ak_clip* clip = NULL;
+ *     if (ak_clip_build(&raw, NULL, &clip, &diag) != AK_OK) fprintf(stderr, "%s\n", diag.message);
+ *     uint32_t keys[64];                                   // >= ak_clip_cursor_storage_count
+ *     ak_clip_cursor cursor;
+ *     ak_clip_cursor_init(&cursor, clip, (ak_u32_span)AK_SPAN(keys));
+ *     ak_transform local[32];                              // start from the rest pose
+ *     for (int j = 0; j < 32; ++j) local[j] = rest[j];
+ *     for (float t = 0.0f; t < 10.0f; t += 1.0f / 60.0f) {
+ *         float ct = ak_time_wrap(t, ak_clip_duration(clip), AK_WRAP_LOOP);
+ *         ak_clip_sample(clip, ct, &cursor, (ak_transform_span)AK_SPAN(local),
+ *                        (ak_f32_span){0}, (ak_f32_span){0});
+ *         // ... skeleton local-to-model, skinning ...
+ *     }
+ *     ak_clip_destroy(clip);
+ *
+ * Ownership and threading: a built clip is one allocation, immutable, and may be sampled
+ * from any number of threads at once, each thread with its own cursor. The raw clip is copied
+ * (the caller may free it after the build). Nothing keeps a caller pointer except a cursor,
+ * which keeps its clip and storage pointers until re-initialised.
+ */
 #ifndef ANIMKIT_CLIP_H
 #define ANIMKIT_CLIP_H
 
@@ -49,7 +86,91 @@ typedef struct ak_raw_clip {
 
 typedef struct ak_clip ak_clip;
 
+/* ---- build and query ---------------------------------------------------------------- */
+
+/* Check a raw clip and build the runtime clip (one allocation through alloc; NULL ->
+ * malloc/free). Keys are sorted by time. Rules, first failure returned, with the channel
+ * and key in diag (optional):
+ *   raw or out_clip NULL, or a channel's times/values NULL        -> AK_ERR_NULL_ARG
+ *   channel_count 0, or a channel with key_count 0                 -> AK_ERR_EMPTY
+ *   duration negative, target/interp out of range, component_count not 3 for T/S or 4 for
+ *   R, above AK_TRACK_MAX_COMPONENTS, a rotation-only mode (NLERP, SQUAD) on a non-rotation
+ *   channel, tension negative or not finite                        -> AK_ERR_BAD_ARG
+ *   CARDINAL, BEZIER, NATURAL or LAGRANGE on a rotation channel    -> AK_ERR_UNSUPPORTED
+ *   joint index >= joint_count, or index + component_count above morph_weight_count /
+ *   scalar_count                                                   -> AK_ERR_BAD_INDEX
+ *   duration, a time or a value NaN or infinite, a zero quaternion -> AK_ERR_BAD_DATA
+ *   two keys of a channel at one time, or two channels animating the same joint property
+ *   or overlapping weight/scalar ranges                            -> AK_ERR_DUPLICATE
+ *   allocation failed                                              -> AK_ERR_NO_MEMORY
+ * *out_clip is NULL on failure. */
+AK_API ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc,
+                               ak_clip** out_clip, ak_diag* diag);
+
+/* Free a clip (with the allocator it was built with); NULL is a no-op. */
+AK_API void ak_clip_destroy(ak_clip* clip);
+
+/* Name given at build (truncated to AK_NAME_SIZE - 1 bytes); never NULL ("" for NULL clip). */
+AK_API const char* ak_clip_name(const ak_clip* clip);
+/* Duration in seconds (raw duration, or the last key time when that was 0). NULL -> 0. */
+AK_API float ak_clip_duration(const ak_clip* clip);
+/* Sizes the clip was built for (raw joint_count, morph_weight_count, scalar_count). */
+AK_API size_t ak_clip_joint_count(const ak_clip* clip);
+AK_API size_t ak_clip_morph_weight_count(const ak_clip* clip);
+AK_API size_t ak_clip_scalar_count(const ak_clip* clip);
+/* Number of channels, in the order of the raw clip. NULL -> 0. */
+AK_API size_t ak_clip_channel_count(const ak_clip* clip);
+
+/* Per-channel queries; channel_index < ak_clip_channel_count. An out-of-range index or a
+ * NULL clip gives 0 / AK_CHANNEL_TARGET_COUNT / AK_INTERP_DEFAULT / NULL. */
+AK_API ak_channel_target ak_clip_channel_target(const ak_clip* clip, size_t channel_index);
+/* Joint index (T/R/S) or first morph weight / scalar index. */
+AK_API uint32_t ak_clip_channel_index(const ak_clip* clip, size_t channel_index);
+AK_API ak_interp ak_clip_channel_interp(const ak_clip* clip, size_t channel_index);
+AK_API size_t ak_clip_channel_key_count(const ak_clip* clip, size_t channel_index);
+/* The channel's runtime track, owned by the clip (valid until ak_clip_destroy; never destroy
+ * it): use the ak_track_* queries for key times, values, tangents and plots. */
+AK_API const ak_track* ak_clip_channel_track(const ak_clip* clip, size_t channel_index);
+
+/* ---- sampling ----------------------------------------------------------------------- */
+
+/* Playback state: the last key segment of every channel, so the next sample near the last
+ * one finds its keys without a search. Caller-owned; initialise with ak_clip_cursor_init.
+ * One cursor per playing instance (and per thread). */
+typedef struct ak_clip_cursor {
+    const ak_clip* clip;   /* the clip the cursor was initialised for */
+    uint32_t* segments;    /* caller storage, [ak_clip_cursor_storage_count(clip)] */
+    size_t segment_count;  /* storage elements */
+} ak_clip_cursor;
+
+/* Elements of uint32_t storage a cursor for this clip needs (= channel count). NULL -> 0. */
+AK_API size_t ak_clip_cursor_storage_count(const ak_clip* clip);
+
+/* Bind a cursor to a clip and storage, positioned at the start. The cursor keeps both
+ * pointers. Returns AK_ERR_NULL_ARG (cursor or clip NULL, storage.ptr NULL with a non-zero
+ * requirement) or AK_ERR_SPAN_SMALL (storage.count < ak_clip_cursor_storage_count). */
+AK_API ak_result ak_clip_cursor_init(ak_clip_cursor* cursor, const ak_clip* clip,
+                                     ak_u32_span storage);
+
+/* Write the clip's values at time into a pose. Channels write only what they animate:
+ * joints, weights and scalars the clip does not animate are left untouched, so callers
+ * initialise inout_local with the rest pose (and weights with their defaults).
+ * time is used as given (wrap it first with ak_time_wrap); each channel clamps it to its
+ * own keys. A NaN time samples the first keys.
+ * cursor: NULL -> binary search per channel (fine for one-off samples); else a cursor from
+ * ak_clip_cursor_init for this clip (O(1) amortised per channel when time moves forward by
+ * less than a key interval; any jump is still exact). Results are bit-identical either way.
+ * inout_local.count >= ak_clip_joint_count when the clip has joint channels (may be empty
+ * otherwise); inout_morph_weights / inout_scalars: empty -> those channels are skipped, else
+ * count >= ak_clip_morph_weight_count / ak_clip_scalar_count.
+ * Returns AK_ERR_NULL_ARG (clip NULL, or inout_local empty while the clip animates joints),
+ * AK_ERR_BAD_ARG (cursor initialised for another clip), AK_ERR_SPAN_SMALL. Nothing is
+ * written on failure. */
+AK_API ak_result ak_clip_sample(const ak_clip* clip, float time, ak_clip_cursor* cursor,
+                                ak_transform_span inout_local, ak_f32_span inout_morph_weights,
+                                ak_f32_span inout_scalars);
+
 #ifdef __cplusplus
 }
 #endif
-#endif
+#endif /* ANIMKIT_CLIP_H */

@@ -1,0 +1,29 @@
+/* Runtime clip layout shared by src/clip.c and src/clip/blend.c (never installed). */
+#ifndef ANIMKIT_CLIP_INTERNAL_H
+#define ANIMKIT_CLIP_INTERNAL_H
+
+#include <animkit/clip.h>
+
+#include "curve/track.h"
+
+typedef struct akp_clip_channel {
+    ak_track track; /* data points into the clip's block */
+    ak_channel_target target;
+    uint32_t index;
+} akp_clip_channel;
+
+/* One allocation: this header, the channel array, then every track's data. */
+struct ak_clip {
+    ak_allocator alloc;
+    akp_clip_channel* channels; /* [channel_count] */
+    size_t channel_count;
+    size_t size; /* bytes of the whole block (for copies) */
+    size_t joint_count;
+    size_t morph_weight_count;
+    size_t scalar_count;
+    float duration;
+    bool has_joint_channels;
+    char name[AK_NAME_SIZE];
+};
+
+#endif
