@@ -170,6 +170,92 @@ AK_API ak_result ak_clip_sample(const ak_clip* clip, float time, ak_clip_cursor*
                                 ak_transform_span inout_local, ak_f32_span inout_morph_weights,
                                 ak_f32_span inout_scalars);
 
+/* ---- blending ----------------------------------------------------------------------- */
+
+/* One input pose of a blend. */
+typedef struct ak_blend_layer {
+    ak_transform_cspan pose;    /* required: local transforms, count >= the job's joint count;
+                                   for additive layers a delta from ak_pose_additive_delta */
+    float weight;               /* >= 0; 0 -> the layer contributes nothing */
+    ak_f32_cspan joint_weights; /* optional per-joint mask in [0, 1] multiplying weight (count
+                                   >= joint count); empty -> 1 for every joint */
+} ak_blend_layer;
+
+/* Weighted blend of N poses, then additive layers on top.
+ * Per joint j with w_i = layer i's weight * mask_i[j] and W = sum w_i:
+ *   translation, scale: sum w_i x_i / W;
+ *   rotation: normalise(sum w_i s_i q_i), s_i = +-1 puts every q_i in the hemisphere of the
+ *   first contributing rotation (q and -q are the same rotation);
+ *   when W < threshold the rest pose joins with weight threshold - W, so joints no layer
+ *   covers fade smoothly to the rest pose instead of dividing by zero.
+ * Then each additive layer with weight a = weight * mask[j] and delta (t, r, s) gives
+ *   translation += a t, rotation = rotation * slerp(identity, r, a), scale *= lerp(1, s, a).
+ * A joint covered by a single layer of non-zero weight gets that layer's transform (the
+ * rotation renormalised), so masks leave the joints they exclude exactly as the other
+ * layers make them. */
+typedef struct ak_blend_job {
+    const ak_blend_layer* layers;          /* [layer_count]; may be NULL when layer_count is 0 */
+    size_t layer_count;                    /* 0 -> the output is the rest pose plus additive layers */
+    const ak_blend_layer* additive_layers; /* [additive_count]; may be NULL when the count is 0 */
+    size_t additive_count;
+    ak_transform_cspan rest_pose;          /* required: local rest pose; its count is the joint count */
+    float threshold;                       /* total weight under which the rest pose fills in; 0 -> 0.1 */
+    ak_transform_span out_local;           /* required: count >= rest_pose.count; must not overlap
+                                              any input */
+} ak_blend_job;
+
+/* First rule the job breaks, in order: rest_pose.ptr or out_local.ptr NULL, layers NULL with
+ * layer_count > 0 (same for additive), a layer's pose.ptr NULL -> AK_ERR_NULL_ARG;
+ * rest_pose empty -> AK_ERR_EMPTY; out_local, a pose or a non-empty mask shorter than the
+ * joint count -> AK_ERR_SPAN_SMALL; a weight or the threshold negative -> AK_ERR_BAD_ARG;
+ * a weight, the threshold or a mask entry NaN/infinite, or a mask entry outside [0, 1] ->
+ * AK_ERR_BAD_DATA; out_local overlapping an input -> AK_ERR_BAD_ARG. AK_OK otherwise.
+ * A zero-initialised job gives AK_ERR_NULL_ARG. */
+AK_API ak_result ak_blend_validate(const ak_blend_job* job);
+
+/* Validate, then write the blended pose (nothing written on failure). Never allocates. */
+AK_API ak_result ak_blend_run(const ak_blend_job* job);
+
+/* Additive delta of pose against reference, per joint: translation pose - ref, rotation
+ * conj(ref) * pose (so ref * delta = pose), scale pose / ref (a zero reference scale
+ * component gives 1). Applying the delta of the reference itself changes nothing.
+ * All spans count >= pose.count; out_delta may not overlap the inputs.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (pose empty) or AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_pose_additive_delta(ak_transform_cspan pose, ak_transform_cspan reference,
+                                        ak_transform_span out_delta);
+
+/* Cross-fade: out = blend of from (weight 1 - alpha) and to (weight alpha), alpha clamped to
+ * [0, 1] (NaN -> 0); translations and scales lerp, rotations nlerp on the shorter arc, the
+ * same as ak_blend_run with two layers. Drive alpha with ak_ease(kind, elapsed / fade_time)
+ * for a slow-in, slow-out transition. out may alias from or to.
+ * Spans: from.count and to.count >= out.count. Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY,
+ * AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_pose_crossfade(ak_transform_cspan from, ak_transform_cspan to, float alpha,
+                                   ak_transform_span out);
+
+/* ---- root motion -------------------------------------------------------------------- */
+
+typedef struct ak_root_motion_desc {
+    uint32_t root_joint; /* joint whose translation carries the travel; 0 -> joint 0 */
+} ak_root_motion_desc;
+
+/* Split the root's horizontal (XZ) travel out of a clip, so a character can walk in place
+ * and be moved by the game. With p(t) the root joint's translation channel and p0 its first
+ * key's value:
+ *   *out_in_place: a copy of the clip whose root translation is (p0.x, p(t).y, p0.z);
+ *   *out_trajectory: a 3-component track with (p(t).x - p0.x, 0, p(t).z - p0.z) in the
+ *   root's parent space, same keys and curve shape (CARDINAL, NATURAL and BEZIER become
+ *   HERMITE with their derived tangents), so in_place + trajectory = original exactly up to
+ *   float rounding. Rotation (turning) is not extracted.
+ * A clip without a translation channel on the root gives an unchanged copy and a one-key
+ * zero trajectory. desc NULL -> defaults. alloc (NULL -> malloc/free) allocates both; free
+ * them with ak_clip_destroy and ak_track_destroy.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX (root_joint >= ak_clip_joint_count),
+ * AK_ERR_NO_MEMORY; on failure both outputs are NULL. */
+AK_API ak_result ak_clip_extract_root_motion(const ak_clip* clip, const ak_root_motion_desc* desc,
+                                             const ak_allocator* alloc, ak_clip** out_in_place,
+                                             ak_track** out_trajectory);
+
 #ifdef __cplusplus
 }
 #endif
