@@ -1,0 +1,1298 @@
+/* Render target, camera, clipping, triangle setup and the threaded rasterizer.
+ *
+ * Pipeline of a draw call: inputs (mesh triangles, line segments, points) are processed in
+ * batches. Each batch is split among the threads for setup (transform, cull, clip against the
+ * near/far planes and a guard band, project, snap to 1/256 sample units), then every thread
+ * rasterizes all the batch's triangles restricted to the rows it owns (8-row blocks dealt out
+ * round-robin), so no two threads write the same pixel and the per-pixel drawing order equals
+ * the input order for any thread count. */
+#include <math.h>
+#include <pthread.h>
+
+#include <animkit/raster.h>
+
+#include "../internal.h"
+
+/* ---- private types ------------------------------------------------------------------ */
+
+#define MAXA 12          /* attributes per vertex */
+#define BATCH 1024       /* inputs per batch */
+#define OUT_PER_INPUT 7  /* worst case triangles from one clipped triangle */
+#define MAX_THREADS 64
+#define SUBPIX 256       /* fixed-point sub-sample units */
+#define GUARD 4.0f       /* guard band in NDC units: |x|, |y| <= GUARD * w */
+#define SHADOW_RES 256
+#define ROW_BLOCK_SHIFT 3
+
+typedef enum frag_mode {
+    FRAG_UNLIT_CONST = 0, /* flat[] colour as bytes (unlit), no attributes */
+    FRAG_UNLIT_VCOLOR,    /* attr 0..3 sRGB colour (unlit) */
+    FRAG_FLAT,            /* flat[] linear colour computed at setup */
+    FRAG_GOURAUD,         /* attr 0..3 linear lit colour */
+    FRAG_PHONG,           /* attr 0..2 world pos, 3..5 normal, [6..9 linear vertex colour] */
+    FRAG_POINT,           /* attr 0..1 disc coordinates in [-1,1], flat[] colour */
+    FRAG_GROUND           /* attr 0..2 world position */
+} frag_mode;
+
+typedef struct cvert {
+    float c[4];
+    float a[MAXA];
+} cvert;
+
+typedef struct rtri {
+    int64_t A[3], B[3], C[3];
+    int64_t bias[3];
+    float inv_area;
+    float z0, dz1, dz2;
+    float iw0, diw1, diw2;
+    float a0[MAXA], da1[MAXA], da2[MAXA];
+    float flat[4];
+    int x0, x1, y0, y1;
+    int front;
+} rtri;
+
+typedef struct drawctx drawctx;
+typedef void (*setup_fn)(const drawctx* dc, size_t input_index, rtri* out, size_t* out_count);
+
+struct drawctx {
+    ak_raster* r;
+    frag_mode mode;
+    int attr_count;
+    ak_blend blend;
+    bool depth_test, depth_write;
+    bool cull;
+    bool has_vcolor;
+    float depth_bias;
+    /* transforms */
+    ak_mat4 model, vp;
+    ak_mat3 normal_matrix;
+    ak_vec3 eye, view_forward;
+    bool ortho;
+    /* shading */
+    ak_vec3 base_lin;
+    float base_alpha;
+    float specular, shininess;
+    ak_vec3 key_l, fill_l; /* unit vectors towards the lights */
+    ak_vec3 key_c, fill_c, amb_c;
+    float const_rgba[4];   /* FRAG_UNLIT_CONST bytes / FRAG_POINT linear colour */
+    float outline_rgba[4];
+    float outline_frac;    /* FRAG_POINT: inner radius / outer radius */
+    /* inputs */
+    const ak_raster_mesh* mesh;
+    const ak_raster_lines* lines;
+    const ak_raster_points* points;
+    const cvert* quad;     /* ground: 4 corners */
+    float half_width_px;   /* lines: half width in samples; points: radius in samples */
+    /* ground */
+    ak_vec3 ground_lin, line_lin;
+    float ground_h, ground_cx, ground_cz, ground_e, grid_spacing, pix_angle;
+    bool shadow;
+    setup_fn setup;
+    size_t input_count;
+};
+
+struct ak_raster {
+    ak_raster_desc desc;
+    ak_allocator alloc;
+    bool has_alloc;
+    int sw, sh, ss;
+    uint8_t* color;   /* sw * sh * 4 */
+    float* depth;     /* sw * sh */
+    rtri* tris;       /* BATCH * OUT_PER_INPUT + OUT_PER_INPUT * MAX_THREADS */
+    float* shadow;    /* SHADOW_RES^2 */
+    float* shadow_tmp;
+    float to_srgb_lut[4097]; /* linear [0,1] -> sRGB byte (as float) */
+    float to_lin_lut[256];   /* sRGB byte -> linear */
+};
+
+/* ---- small helpers -------------------------------------------------------------------- */
+
+static inline float clamp01(float x) { return x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x); }
+
+static inline uint8_t enc(const ak_raster* r, float lin) {
+    /* soft shoulder above 0.8 keeps highlights from clipping flat */
+    if (lin > 0.8f) lin = 0.8f + 0.2f * (1.0f - expf(-(lin - 0.8f) * 5.0f));
+    if (!(lin > 0.0f)) lin = 0.0f;
+    if (lin > 1.0f) lin = 1.0f;
+    return (uint8_t)r->to_srgb_lut[(int)(lin * 4096.0f + 0.5f)];
+}
+
+static ak_vec3 srgb3_to_lin(ak_vec4 c) {
+    return ak_vec3_make(ak_srgb_to_linear(clamp01(c.x)), ak_srgb_to_linear(clamp01(c.y)),
+                        ak_srgb_to_linear(clamp01(c.z)));
+}
+
+static bool vec4_is_zero(ak_vec4 v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f && v.w == 0.0f; }
+static bool vec3_is_zero(ak_vec3 v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+static bool vec4_finite(ak_vec4 v) { return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z) && ak_finitef(v.w); }
+
+static ak_vec4 mul4(const ak_mat4* m, ak_vec3 p) {
+    const float* a = m->m;
+    return ak_vec4_make(a[0] * p.x + a[4] * p.y + a[8] * p.z + a[12], a[1] * p.x + a[5] * p.y + a[9] * p.z + a[13],
+                        a[2] * p.x + a[6] * p.y + a[10] * p.z + a[14], a[3] * p.x + a[7] * p.y + a[11] * p.z + a[15]);
+}
+
+static ak_vec3 eye_of(const ak_raster_camera* cam) {
+    ak_mat4 inv = ak_mat4_inverse_affine(cam->view);
+    return ak_mat4_get_translation(inv);
+}
+
+/* ---- camera ----------------------------------------------------------------------------- */
+
+ak_raster_camera ak_raster_camera_perspective(ak_vec3 eye, ak_vec3 target, float fovy, float aspect, float near_z,
+                                              float far_z) {
+    ak_raster_camera c;
+    c.view = ak_mat4_look_at(eye, target, ak_vec3_make(0.0f, 1.0f, 0.0f));
+    c.projection = ak_mat4_perspective(fovy, aspect, near_z, far_z);
+    return c;
+}
+
+ak_raster_camera ak_raster_camera_orthographic(ak_vec3 eye, ak_vec3 target, float half_height, float aspect,
+                                               float near_z, float far_z) {
+    ak_raster_camera c;
+    if (!(half_height > 0.0f) || !ak_finitef(half_height)) half_height = 1.0f;
+    if (!(aspect > 0.0f) || !ak_finitef(aspect)) aspect = 1.0f;
+    c.view = ak_mat4_look_at(eye, target, ak_vec3_make(0.0f, 1.0f, 0.0f));
+    c.projection = ak_mat4_orthographic(-half_height * aspect, half_height * aspect, -half_height, half_height,
+                                        near_z, far_z);
+    return c;
+}
+
+bool ak_raster_camera_project(const ak_raster_camera* camera, int width, int height, ak_vec3 world,
+                              ak_vec3* out_pixel) {
+    if (!camera || !out_pixel || !ak_vec3_is_finite(world)) return false;
+    ak_mat4 vp = ak_mat4_mul(camera->projection, camera->view);
+    ak_vec4 c = mul4(&vp, world);
+    if (!(c.z >= -c.w) || !(c.w > 0.0f)) return false;
+    float iw = 1.0f / c.w;
+    *out_pixel = ak_vec3_make((c.x * iw * 0.5f + 0.5f) * (float)width, (0.5f - c.y * iw * 0.5f) * (float)height,
+                              c.z * iw * 0.5f + 0.5f);
+    return ak_vec3_is_finite(*out_pixel);
+}
+
+/* ---- target lifecycle ----------------------------------------------------------------- */
+
+ak_raster_desc ak_raster_desc_resolved(const ak_raster_desc* desc) {
+    ak_raster_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc) d = *desc;
+    if (d.supersample == 0) d.supersample = 1;
+    if (d.thread_count == 0) d.thread_count = 1;
+    return d;
+}
+
+ak_result ak_raster_create(const ak_raster_desc* desc, const ak_allocator* alloc, ak_raster** out_raster) {
+    if (out_raster) *out_raster = NULL;
+    if (!desc || !out_raster) return AK_ERR_NULL_ARG;
+    if (alloc && (!alloc->alloc != !alloc->free)) return AK_ERR_BAD_ARG;
+    ak_raster_desc d = ak_raster_desc_resolved(desc);
+    if (d.width < 1 || d.width > 8192 || d.height < 1 || d.height > 8192) return AK_ERR_BAD_ARG;
+    if (d.supersample < 1 || d.supersample > 4 || d.thread_count < 1 || d.thread_count > MAX_THREADS)
+        return AK_ERR_BAD_ARG;
+    size_t sw = (size_t)d.width * (size_t)d.supersample, sh = (size_t)d.height * (size_t)d.supersample;
+    size_t ntri = (size_t)BATCH * OUT_PER_INPUT + (size_t)OUT_PER_INPUT * MAX_THREADS;
+    size_t off_color = akp_align16(sizeof(ak_raster));
+    size_t off_depth = off_color + akp_align16(sw * sh * 4u);
+    size_t off_tris = off_depth + akp_align16(sw * sh * sizeof(float));
+    size_t off_shadow = off_tris + akp_align16(ntri * sizeof(rtri));
+    size_t off_tmp = off_shadow + akp_align16((size_t)SHADOW_RES * SHADOW_RES * sizeof(float));
+    size_t total = off_tmp + (size_t)SHADOW_RES * SHADOW_RES * sizeof(float);
+    uint8_t* mem = (uint8_t*)akp_alloc(alloc, total);
+    if (!mem) return AK_ERR_NO_MEMORY;
+    ak_raster* r = (ak_raster*)mem;
+    memset(r, 0, sizeof *r);
+    r->desc = d;
+    if (alloc && alloc->alloc) {
+        r->alloc = *alloc;
+        r->has_alloc = true;
+    }
+    r->ss = d.supersample;
+    r->sw = (int)sw;
+    r->sh = (int)sh;
+    r->color = mem + off_color;
+    r->depth = (float*)(void*)(mem + off_depth);
+    r->tris = (rtri*)(void*)(mem + off_tris);
+    r->shadow = (float*)(void*)(mem + off_shadow);
+    r->shadow_tmp = (float*)(void*)(mem + off_tmp);
+    for (int i = 0; i <= 4096; ++i) r->to_srgb_lut[i] = floorf(ak_linear_to_srgb((float)i / 4096.0f) * 255.0f + 0.5f);
+    for (int i = 0; i < 256; ++i) r->to_lin_lut[i] = ak_srgb_to_linear((float)i / 255.0f);
+    memset(r->color, 0, sw * sh * 4u);
+    for (size_t i = 0; i < sw * sh; ++i) {
+        r->color[i * 4 + 3] = 255;
+        r->depth[i] = 1.0f;
+    }
+    *out_raster = r;
+    return AK_OK;
+}
+
+void ak_raster_destroy(ak_raster* raster) {
+    if (!raster) return;
+    ak_allocator a = raster->alloc;
+    akp_free(raster->has_alloc ? &a : NULL, raster);
+}
+
+ak_raster_desc ak_raster_get_desc(const ak_raster* raster) {
+    ak_raster_desc d;
+    memset(&d, 0, sizeof d);
+    return raster ? raster->desc : d;
+}
+
+void ak_raster_clear(ak_raster* raster, ak_vec4 top_color, ak_vec4 bottom_color) {
+    if (!raster) return;
+    ak_raster_clear_depth(raster);
+    ak_vec3 t = srgb3_to_lin(top_color), b = srgb3_to_lin(bottom_color);
+    float ta = ak_finitef(top_color.w) ? clamp01(top_color.w) : 1.0f;
+    float ba = ak_finitef(bottom_color.w) ? clamp01(bottom_color.w) : 1.0f;
+    for (int y = 0; y < raster->sh; ++y) {
+        float s = raster->sh > 1 ? (float)y / (float)(raster->sh - 1) : 0.0f;
+        ak_vec3 c = ak_vec3_lerp(t, b, s);
+        uint8_t px[4] = {(uint8_t)raster->to_srgb_lut[(int)(clamp01(c.x) * 4096.0f + 0.5f)],
+                         (uint8_t)raster->to_srgb_lut[(int)(clamp01(c.y) * 4096.0f + 0.5f)],
+                         (uint8_t)raster->to_srgb_lut[(int)(clamp01(c.z) * 4096.0f + 0.5f)],
+                         (uint8_t)(ak_lerpf(ta, ba, s) * 255.0f + 0.5f)};
+        uint8_t* row = raster->color + (size_t)y * (size_t)raster->sw * 4u;
+        for (int x = 0; x < raster->sw; ++x) memcpy(row + (size_t)x * 4u, px, 4);
+    }
+}
+
+void ak_raster_clear_depth(ak_raster* raster) {
+    if (!raster) return;
+    size_t n = (size_t)raster->sw * (size_t)raster->sh;
+    for (size_t i = 0; i < n; ++i) raster->depth[i] = 1.0f;
+}
+
+ak_result ak_raster_resolve(const ak_raster* raster, const ak_image* out) {
+    if (!raster || !out || !out->pixels) return AK_ERR_NULL_ARG;
+    if (out->width != raster->desc.width || out->height != raster->desc.height) return AK_ERR_BAD_ARG;
+    const int ss = raster->ss;
+    const float inv = 1.0f / (float)(ss * ss);
+    for (int y = 0; y < out->height; ++y) {
+        for (int x = 0; x < out->width; ++x) {
+            uint8_t* dst = ak_image_pixel(out, x, y);
+            if (ss == 1) {
+                memcpy(dst, raster->color + ((size_t)y * (size_t)raster->sw + (size_t)x) * 4u, 4);
+                continue;
+            }
+            float acc[3] = {0, 0, 0};
+            unsigned alpha = 0;
+            for (int sy = 0; sy < ss; ++sy) {
+                const uint8_t* src = raster->color + ((size_t)(y * ss + sy) * (size_t)raster->sw + (size_t)(x * ss)) * 4u;
+                for (int sx = 0; sx < ss; ++sx, src += 4) {
+                    acc[0] += raster->to_lin_lut[src[0]];
+                    acc[1] += raster->to_lin_lut[src[1]];
+                    acc[2] += raster->to_lin_lut[src[2]];
+                    alpha += src[3];
+                }
+            }
+            for (int k = 0; k < 3; ++k) dst[k] = (uint8_t)raster->to_srgb_lut[(int)(clamp01(acc[k] * inv) * 4096.0f + 0.5f)];
+            dst[3] = (uint8_t)((alpha + (unsigned)(ss * ss) / 2u) / (unsigned)(ss * ss));
+        }
+    }
+    return AK_OK;
+}
+
+/* ---- lighting ------------------------------------------------------------------------- */
+
+ak_raster_lighting ak_raster_lighting_resolved(const ak_raster_lighting* lighting) {
+    ak_raster_lighting l;
+    memset(&l, 0, sizeof l);
+    if (lighting) l = *lighting;
+    if (vec3_is_zero(l.key_direction)) l.key_direction = ak_vec3_make(0.45f, -0.8f, -0.35f);
+    if (vec3_is_zero(l.key_color)) l.key_color = ak_vec3_make(1.05f, 1.0f, 0.94f);
+    if (vec3_is_zero(l.fill_direction)) l.fill_direction = ak_vec3_make(-0.7f, -0.25f, -0.3f);
+    if (vec3_is_zero(l.fill_color)) l.fill_color = ak_vec3_make(0.26f, 0.31f, 0.42f);
+    if (vec3_is_zero(l.ambient_color)) l.ambient_color = ak_vec3_make(0.16f, 0.18f, 0.22f);
+    return l;
+}
+
+static void setup_lighting(drawctx* dc, const ak_raster_lighting* lighting, ak_raster_material mat) {
+    ak_raster_lighting l = ak_raster_lighting_resolved(lighting);
+    dc->key_l = ak_vec3_normalize(ak_vec3_neg(l.key_direction));
+    dc->fill_l = ak_vec3_normalize(ak_vec3_neg(l.fill_direction));
+    dc->key_c = l.key_color;
+    dc->fill_c = l.fill_color;
+    dc->amb_c = l.ambient_color;
+    ak_vec4 base = vec4_is_zero(mat.color) ? ak_vec4_make(0.78f, 0.74f, 0.70f, 1.0f) : mat.color;
+    if (!vec4_finite(base)) base = ak_vec4_make(0.78f, 0.74f, 0.70f, 1.0f);
+    dc->base_lin = srgb3_to_lin(base);
+    dc->base_alpha = clamp01(base.w);
+    dc->specular = mat.specular == 0.0f ? 0.25f : (mat.specular < 0.0f ? 0.0f : mat.specular);
+    dc->shininess = mat.shininess > 0.0f ? mat.shininess : 32.0f;
+    if (!ak_finitef(dc->specular)) dc->specular = 0.25f;
+    if (!ak_finitef(dc->shininess)) dc->shininess = 32.0f;
+}
+
+/* Lit linear colour for unit normal n at world point p with linear albedo alb. */
+static inline ak_vec3 shade(const drawctx* dc, ak_vec3 n, ak_vec3 p, ak_vec3 alb) {
+    ak_vec3 v = dc->ortho ? ak_vec3_neg(dc->view_forward) : ak_vec3_normalize(ak_vec3_sub(dc->eye, p));
+    float kd = ak_vec3_dot(n, dc->key_l), fd = ak_vec3_dot(n, dc->fill_l);
+    kd = kd > 0.0f ? kd : 0.0f;
+    fd = fd > 0.0f ? fd : 0.0f;
+    /* hemisphere ambient: a little brighter facing up */
+    float hemi = 0.8f + 0.2f * n.y;
+    ak_vec3 light = ak_vec3_make(dc->amb_c.x * hemi + dc->key_c.x * kd + dc->fill_c.x * fd,
+                                 dc->amb_c.y * hemi + dc->key_c.y * kd + dc->fill_c.y * fd,
+                                 dc->amb_c.z * hemi + dc->key_c.z * kd + dc->fill_c.z * fd);
+    ak_vec3 c = ak_vec3_mul(alb, light);
+    if (dc->specular > 0.0f && kd > 0.0f) {
+        /* Blinn-Phong half vector */
+        ak_vec3 h = ak_vec3_normalize(ak_vec3_add(dc->key_l, v));
+        float nh = ak_vec3_dot(n, h);
+        if (nh > 0.0f) {
+            float s = dc->specular * powf(nh, dc->shininess);
+            c = ak_vec3_madd(c, dc->key_c, s);
+        }
+    }
+    return c;
+}
+
+/* ---- clipping and setup ------------------------------------------------------------------ */
+
+static const float k_planes[6][4] = {
+    {0, 0, 1, 1}, {0, 0, -1, 1}, {1, 0, 0, GUARD}, {-1, 0, 0, GUARD}, {0, 1, 0, GUARD}, {0, -1, 0, GUARD},
+};
+
+static inline float plane_dist(int p, const float c[4]) {
+    return k_planes[p][0] * c[0] + k_planes[p][1] * c[1] + k_planes[p][2] * c[2] + k_planes[p][3] * c[3];
+}
+
+static inline unsigned outcode(const float c[4]) {
+    unsigned code = 0;
+    for (int p = 0; p < 6; ++p)
+        if (plane_dist(p, c) < 0.0f) code |= 1u << p;
+    return code;
+}
+
+static void lerp_vert(const cvert* a, const cvert* b, float t, int na, cvert* out) {
+    for (int k = 0; k < 4; ++k) out->c[k] = a->c[k] + (b->c[k] - a->c[k]) * t;
+    for (int k = 0; k < na; ++k) out->a[k] = a->a[k] + (b->a[k] - a->a[k]) * t;
+}
+
+/* Project, snap and set up one screen triangle; degenerate ones produce nothing. */
+static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1, const cvert* v2, int front,
+                             const float flat[4], rtri* out, size_t* out_count) {
+    const ak_raster* r = dc->r;
+    const cvert* v[3] = {v0, v1, v2};
+    double sx[3], sy[3];
+    float z[3], iw[3];
+    int64_t fx[3], fy[3];
+    for (int i = 0; i < 3; ++i) {
+        float w = v[i]->c[3];
+        if (!(w > 0.0f)) return;
+        iw[i] = 1.0f / w;
+        sx[i] = ((double)v[i]->c[0] * iw[i] * 0.5 + 0.5) * r->sw;
+        sy[i] = (0.5 - (double)v[i]->c[1] * iw[i] * 0.5) * r->sh;
+        z[i] = v[i]->c[2] * iw[i] * 0.5f + 0.5f + dc->depth_bias;
+        fx[i] = (int64_t)floor(sx[i] * SUBPIX + 0.5);
+        fy[i] = (int64_t)floor(sy[i] * SUBPIX + 0.5);
+    }
+    int64_t area = (fx[1] - fx[0]) * (fy[2] - fy[0]) - (fy[1] - fy[0]) * (fx[2] - fx[0]);
+    if (area == 0) return;
+    int o[3] = {0, 1, 2};
+    if (area < 0) {
+        o[1] = 2;
+        o[2] = 1;
+        area = -area;
+    }
+    rtri* t = &out[*out_count];
+    int64_t X[3] = {fx[o[0]], fx[o[1]], fx[o[2]]}, Y[3] = {fy[o[0]], fy[o[1]], fy[o[2]]};
+    for (int i = 0; i < 3; ++i) {
+        int a = (i + 1) % 3, b = (i + 2) % 3; /* edge opposite vertex i */
+        int64_t A = Y[a] - Y[b], B = X[b] - X[a];
+        t->A[i] = A;
+        t->B[i] = B;
+        t->C[i] = -A * X[a] - B * Y[a];
+        t->bias[i] = (A > 0 || (A == 0 && B > 0)) ? 0 : -1;
+    }
+    int64_t minx = X[0], maxx = X[0], miny = Y[0], maxy = Y[0];
+    for (int i = 1; i < 3; ++i) {
+        if (X[i] < minx) minx = X[i];
+        if (X[i] > maxx) maxx = X[i];
+        if (Y[i] < miny) miny = Y[i];
+        if (Y[i] > maxy) maxy = Y[i];
+    }
+    /* pixel X covered only if its centre X*256+128 lies in [min, max] */
+    int64_t x0 = (minx - SUBPIX / 2 + SUBPIX - 1) / SUBPIX, x1 = (maxx - SUBPIX / 2) / SUBPIX;
+    int64_t y0 = (miny - SUBPIX / 2 + SUBPIX - 1) / SUBPIX, y1 = (maxy - SUBPIX / 2) / SUBPIX;
+    if (minx - SUBPIX / 2 < 0) x0 = 0;
+    if (miny - SUBPIX / 2 < 0) y0 = 0;
+    if (maxx - SUBPIX / 2 < 0 || maxy - SUBPIX / 2 < 0) return;
+    if (x1 >= r->sw) x1 = r->sw - 1;
+    if (y1 >= r->sh) y1 = r->sh - 1;
+    if (x0 > x1 || y0 > y1) return;
+    t->x0 = (int)x0;
+    t->x1 = (int)x1;
+    t->y0 = (int)y0;
+    t->y1 = (int)y1;
+    t->inv_area = (float)(1.0 / (double)area);
+    const int i0 = o[0], i1 = o[1], i2 = o[2];
+    t->z0 = z[i0];
+    t->dz1 = z[i1] - z[i0];
+    t->dz2 = z[i2] - z[i0];
+    t->iw0 = iw[i0];
+    t->diw1 = iw[i1] - iw[i0];
+    t->diw2 = iw[i2] - iw[i0];
+    for (int k = 0; k < dc->attr_count; ++k) {
+        float a0 = v[i0]->a[k] * iw[i0];
+        t->a0[k] = a0;
+        t->da1[k] = v[i1]->a[k] * iw[i1] - a0;
+        t->da2[k] = v[i2]->a[k] * iw[i2] - a0;
+    }
+    if (flat) memcpy(t->flat, flat, sizeof t->flat);
+    t->front = front;
+    ++*out_count;
+}
+
+/* Clip a clip-space triangle against near/far and the guard band, then set up the pieces. */
+static void clip_and_setup(const drawctx* dc, const cvert* a, const cvert* b, const cvert* c, int front,
+                           const float flat[4], rtri* out, size_t* out_count) {
+    unsigned oa = outcode(a->c), ob = outcode(b->c), oc = outcode(c->c);
+    if (oa & ob & oc) return;
+    if ((oa | ob | oc) == 0) {
+        setup_screen_tri(dc, a, b, c, front, flat, out, out_count);
+        return;
+    }
+    cvert buf[2][12];
+    int n = 3;
+    buf[0][0] = *a;
+    buf[0][1] = *b;
+    buf[0][2] = *c;
+    int cur = 0;
+    unsigned any = oa | ob | oc;
+    for (int p = 0; p < 6 && n >= 3; ++p) {
+        if (!(any & (1u << p))) continue;
+        const cvert* in = buf[cur];
+        cvert* o = buf[cur ^ 1];
+        int m = 0;
+        for (int i = 0; i < n; ++i) {
+            const cvert* s = &in[i];
+            const cvert* e = &in[(i + 1) % n];
+            float ds = plane_dist(p, s->c), de = plane_dist(p, e->c);
+            if (ds >= 0.0f) o[m++] = *s;
+            if ((ds >= 0.0f) != (de >= 0.0f) && m < 12) {
+                float t = ds / (ds - de);
+                lerp_vert(s, e, t, dc->attr_count, &o[m++]);
+            }
+        }
+        n = m;
+        cur ^= 1;
+    }
+    for (int i = 1; i + 1 < n; ++i) setup_screen_tri(dc, &buf[cur][0], &buf[cur][i], &buf[cur][i + 1], front, flat, out, out_count);
+}
+
+/* ---- fragments ------------------------------------------------------------------------ */
+
+static inline void write_px(const drawctx* dc, uint8_t* px, float* zb, float z, const uint8_t src[4]) {
+    switch (dc->blend) {
+    case AK_BLEND_ALPHA: {
+        unsigned a = src[3];
+        for (int k = 0; k < 3; ++k) px[k] = (uint8_t)((src[k] * a + px[k] * (255u - a) + 127u) / 255u);
+        break;
+    }
+    case AK_BLEND_ADD:
+        for (int k = 0; k < 4; ++k) {
+            unsigned s = (unsigned)px[k] + src[k];
+            px[k] = (uint8_t)(s > 255u ? 255u : s);
+        }
+        break;
+    default:
+        memcpy(px, src, 4);
+        break;
+    }
+    if (dc->depth_write) *zb = z;
+}
+
+static float shadow_sample(const ak_raster* r, float u, float v) {
+    /* u, v in texel units */
+    u -= 0.5f;
+    v -= 0.5f;
+    if (!(u > -1.0f && v > -1.0f && u < (float)SHADOW_RES && v < (float)SHADOW_RES)) return 0.0f;
+    int x0 = (int)floorf(u), y0 = (int)floorf(v);
+    float fx = u - (float)x0, fy = v - (float)y0;
+    float s = 0.0f;
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            int x = x0 + i, y = y0 + j;
+            if (x < 0 || y < 0 || x >= SHADOW_RES || y >= SHADOW_RES) continue;
+            float w = (i ? fx : 1.0f - fx) * (j ? fy : 1.0f - fy);
+            s += w * r->shadow[y * SHADOW_RES + x];
+        }
+    return s;
+}
+
+static inline float smoothstep(float e0, float e1, float x) {
+    float t = clamp01((x - e0) / (e1 - e0));
+    return t * t * (3.0f - 2.0f * t);
+}
+
+/* Compute the fragment colour; returns false to discard. */
+static inline bool fragment(const drawctx* dc, const rtri* t, const float* a, uint8_t out[4], const uint8_t* dst) {
+    const ak_raster* r = dc->r;
+    switch (dc->mode) {
+    case FRAG_UNLIT_CONST:
+        for (int k = 0; k < 4; ++k) out[k] = (uint8_t)dc->const_rgba[k];
+        return true;
+    case FRAG_UNLIT_VCOLOR:
+        for (int k = 0; k < 4; ++k) out[k] = (uint8_t)(clamp01(a[k]) * 255.0f + 0.5f);
+        return true;
+    case FRAG_FLAT:
+        out[0] = enc(r, t->flat[0]);
+        out[1] = enc(r, t->flat[1]);
+        out[2] = enc(r, t->flat[2]);
+        out[3] = (uint8_t)(clamp01(t->flat[3]) * 255.0f + 0.5f);
+        return true;
+    case FRAG_GOURAUD:
+        out[0] = enc(r, a[0]);
+        out[1] = enc(r, a[1]);
+        out[2] = enc(r, a[2]);
+        out[3] = (uint8_t)(clamp01(a[3]) * 255.0f + 0.5f);
+        return true;
+    case FRAG_PHONG: {
+        ak_vec3 n = ak_vec3_normalize(ak_vec3_make(a[3], a[4], a[5]));
+        if (!t->front) n = ak_vec3_neg(n);
+        ak_vec3 alb = dc->base_lin;
+        float alpha = dc->base_alpha;
+        if (dc->has_vcolor) {
+            alb = ak_vec3_mul(alb, ak_vec3_make(a[6], a[7], a[8]));
+            alpha *= a[9];
+        }
+        ak_vec3 c = shade(dc, n, ak_vec3_make(a[0], a[1], a[2]), alb);
+        out[0] = enc(r, c.x);
+        out[1] = enc(r, c.y);
+        out[2] = enc(r, c.z);
+        out[3] = (uint8_t)(clamp01(alpha) * 255.0f + 0.5f);
+        return true;
+    }
+    case FRAG_POINT: {
+        float d2 = a[0] * a[0] + a[1] * a[1];
+        if (d2 > 1.0f) return false;
+        float inner = dc->outline_frac;
+        if (d2 > inner * inner) {
+            for (int k = 0; k < 4; ++k) out[k] = (uint8_t)dc->outline_rgba[k];
+            return true;
+        }
+        /* shade the disc as a small sphere lit from the upper left */
+        float u = a[0] / inner, v = a[1] / inner;
+        float nz = sqrtf(clamp01(1.0f - u * u - v * v));
+        float lam = 0.55f + 0.45f * clamp01(-0.45f * u + 0.55f * v + 0.7f * nz);
+        float hl = -0.35f * u + 0.45f * v + 0.82f * nz;
+        float spec = hl > 0.0f ? 0.35f * powf(hl, 24.0f) : 0.0f;
+        for (int k = 0; k < 3; ++k) out[k] = enc(r, t->flat[k] * lam + spec);
+        out[3] = (uint8_t)(clamp01(t->flat[3]) * 255.0f + 0.5f);
+        return true;
+    }
+    case FRAG_GROUND: {
+        float px = a[0], pz = a[2];
+        float dx = px - dc->ground_cx, dz = pz - dc->ground_cz;
+        float rad = sqrtf(dx * dx + dz * dz) / dc->ground_e;
+        float fade = 1.0f - smoothstep(0.45f, 1.0f, rad);
+        if (fade <= 0.0f) return false;
+        ak_vec3 c = dc->ground_lin;
+        /* grid: pixel footprint in metres from distance and grazing angle */
+        ak_vec3 to_eye = ak_vec3_sub(dc->eye, ak_vec3_make(a[0], a[1], a[2]));
+        float dist = ak_vec3_length(to_eye);
+        float cosv = dist > 0.0f ? fabsf(to_eye.y) / dist : 1.0f;
+        if (dc->ortho) {
+            dist = 1.0f;
+            cosv = fabsf(dc->view_forward.y);
+        }
+        float foot = dist * dc->pix_angle / (cosv > 0.12f ? cosv : 0.12f);
+        float sp = dc->grid_spacing;
+        float gu = px / sp, gv = pz / sp;
+        float du = fabsf(gu - floorf(gu + 0.5f)) * sp, dv = fabsf(gv - floorf(gv + 0.5f)) * sp;
+        float d = du < dv ? du : dv;
+        float hw = 0.5f * (float)r->ss * foot;
+        float line = clamp01(1.0f - (d - hw) / foot);
+        line *= clamp01(1.6f - 4.0f * foot * (float)r->ss / sp);
+        c = ak_vec3_lerp(c, dc->line_lin, line * 0.8f);
+        if (dc->shadow) {
+            float texel = 2.0f * dc->ground_e / (float)SHADOW_RES;
+            float s = shadow_sample(r, (px - (dc->ground_cx - dc->ground_e)) / texel,
+                                    (pz - (dc->ground_cz - dc->ground_e)) / texel);
+            c = ak_vec3_scale(c, 1.0f - s);
+        }
+        for (int k = 0; k < 3; ++k) {
+            float bg = r->to_lin_lut[dst[k]];
+            float v = (k == 0 ? c.x : (k == 1 ? c.y : c.z));
+            out[k] = (uint8_t)r->to_srgb_lut[(int)(clamp01(bg + (v - bg) * fade) * 4096.0f + 0.5f)];
+        }
+        out[3] = 255;
+        return true;
+    }
+    }
+    return false;
+}
+
+static void raster_tri(const drawctx* dc, const rtri* t, int thread_index, int thread_count) {
+    ak_raster* r = dc->r;
+    const int na = dc->attr_count;
+    for (int y = t->y0; y <= t->y1; ++y) {
+        if (thread_count > 1) {
+            int blk = y >> ROW_BLOCK_SHIFT;
+            if (blk % thread_count != thread_index) {
+                /* jump to the first row of this thread's next block */
+                int skip = (thread_index - blk % thread_count + thread_count) % thread_count;
+                y = ((blk + skip) << ROW_BLOCK_SHIFT) - 1;
+                continue;
+            }
+        }
+        const int64_t py = (int64_t)y * SUBPIX + SUBPIX / 2;
+        const int64_t px0 = (int64_t)t->x0 * SUBPIX + SUBPIX / 2;
+        int64_t e0 = t->A[0] * px0 + t->B[0] * py + t->C[0] + t->bias[0];
+        int64_t e1 = t->A[1] * px0 + t->B[1] * py + t->C[1] + t->bias[1];
+        int64_t e2 = t->A[2] * px0 + t->B[2] * py + t->C[2] + t->bias[2];
+        const int64_t s0 = t->A[0] * SUBPIX, s1 = t->A[1] * SUBPIX, s2 = t->A[2] * SUBPIX;
+        uint8_t* crow = r->color + (size_t)y * (size_t)r->sw * 4u;
+        float* zrow = r->depth + (size_t)y * (size_t)r->sw;
+        for (int x = t->x0; x <= t->x1; ++x, e0 += s0, e1 += s1, e2 += s2) {
+            if ((e0 | e1 | e2) < 0) continue;
+            /* remove the bias again so the barycentrics are exact */
+            float l1 = (float)(e1 - t->bias[1]) * t->inv_area;
+            float l2 = (float)(e2 - t->bias[2]) * t->inv_area;
+            float z = t->z0 + l1 * t->dz1 + l2 * t->dz2;
+            if (dc->depth_test && !(z < zrow[x])) continue;
+            if (!(z >= 0.0f && z <= 1.0f)) continue;
+            float a[MAXA];
+            if (na) {
+                float iw = t->iw0 + l1 * t->diw1 + l2 * t->diw2;
+                float w = 1.0f / iw;
+                for (int k = 0; k < na; ++k) a[k] = (t->a0[k] + l1 * t->da1[k] + l2 * t->da2[k]) * w;
+            }
+            uint8_t src[4];
+            uint8_t* px = crow + (size_t)x * 4u;
+            if (!fragment(dc, t, a, src, px)) continue;
+            write_px(dc, px, &zrow[x], z, src);
+        }
+    }
+}
+
+/* ---- threading -------------------------------------------------------------------------- */
+
+typedef struct gate {
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int go; /* 0 wait, 1 run, -1 quit */
+} gate;
+
+typedef struct worker {
+    const drawctx* dc;
+    int index, count;
+    pthread_barrier_t* barrier;
+    size_t* seg_count; /* [count] */
+    size_t seg_cap;
+    gate* gate;
+} worker;
+
+static void run_worker(const worker* w) {
+    const drawctx* dc = w->dc;
+    const size_t n = dc->input_count;
+    for (size_t start = 0; start < n; start += BATCH) {
+        size_t len = n - start < BATCH ? n - start : BATCH;
+        size_t chunk = (len + (size_t)w->count - 1) / (size_t)w->count;
+        size_t b = start + chunk * (size_t)w->index, e = b + chunk;
+        if (e > start + len) e = start + len;
+        rtri* seg = dc->r->tris + w->seg_cap * (size_t)w->index;
+        size_t cnt = 0;
+        for (size_t i = b; i < e; ++i) dc->setup(dc, i, seg, &cnt);
+        w->seg_count[w->index] = cnt;
+        if (w->count > 1) pthread_barrier_wait(w->barrier);
+        for (int s = 0; s < w->count; ++s) {
+            const rtri* tr = dc->r->tris + w->seg_cap * (size_t)s;
+            for (size_t i = 0; i < w->seg_count[s]; ++i) raster_tri(dc, &tr[i], w->index, w->count);
+        }
+        if (w->count > 1) pthread_barrier_wait(w->barrier);
+    }
+}
+
+static void* worker_main(void* p) {
+    worker* w = (worker*)p;
+    pthread_mutex_lock(&w->gate->mu);
+    while (w->gate->go == 0) pthread_cond_wait(&w->gate->cv, &w->gate->mu);
+    int go = w->gate->go;
+    pthread_mutex_unlock(&w->gate->mu);
+    if (go > 0) run_worker(w);
+    return NULL;
+}
+
+static void set_workers(worker* ws, int tc, const drawctx* dc, pthread_barrier_t* barrier, size_t* seg_count,
+                        gate* g) {
+    size_t seg_cap = tc == 1 ? (size_t)BATCH * OUT_PER_INPUT : ((BATCH + (size_t)tc - 1) / (size_t)tc) * OUT_PER_INPUT;
+    for (int i = 0; i < tc; ++i) {
+        ws[i].dc = dc;
+        ws[i].index = i;
+        ws[i].count = tc;
+        ws[i].barrier = barrier;
+        ws[i].seg_count = seg_count;
+        ws[i].seg_cap = seg_cap;
+        ws[i].gate = g;
+    }
+}
+
+/* Run a draw over up to desc.thread_count threads. Threads that cannot be started are simply
+ * not used: the work is dealt out among those that did start. */
+static void run_draw(const drawctx* dc) {
+    int tc = dc->r->desc.thread_count;
+    if (dc->input_count < 64) tc = 1; /* threads would cost more than they save */
+    size_t seg_count[MAX_THREADS];
+    worker ws[MAX_THREADS];
+    pthread_barrier_t barrier;
+    gate g;
+    if (tc > 1 && pthread_mutex_init(&g.mu, NULL) != 0) tc = 1;
+    if (tc > 1 && pthread_cond_init(&g.cv, NULL) != 0) {
+        pthread_mutex_destroy(&g.mu);
+        tc = 1;
+    }
+    if (tc == 1) {
+        set_workers(ws, 1, dc, NULL, seg_count, NULL);
+        run_worker(&ws[0]);
+        return;
+    }
+    g.go = 0;
+    set_workers(ws, tc, dc, &barrier, seg_count, &g);
+    pthread_t th[MAX_THREADS];
+    int started = 1;
+    for (int i = 1; i < tc; ++i) {
+        if (pthread_create(&th[i], NULL, worker_main, &ws[i]) != 0) break;
+        ++started;
+    }
+    bool barrier_ok = started > 1 && pthread_barrier_init(&barrier, NULL, (unsigned)started) == 0;
+    int use = barrier_ok ? started : 1;
+    set_workers(ws, use, dc, &barrier, seg_count, &g);
+    pthread_mutex_lock(&g.mu);
+    g.go = barrier_ok ? 1 : -1;
+    pthread_cond_broadcast(&g.cv);
+    pthread_mutex_unlock(&g.mu);
+    run_worker(&ws[0]);
+    for (int i = 1; i < started; ++i) pthread_join(th[i], NULL);
+    if (barrier_ok) pthread_barrier_destroy(&barrier);
+    pthread_cond_destroy(&g.cv);
+    pthread_mutex_destroy(&g.mu);
+}
+
+/* ---- meshes ------------------------------------------------------------------------------- */
+
+static void mesh_setup(const drawctx* dc, size_t ti, rtri* out, size_t* out_count) {
+    const ak_raster_mesh* m = dc->mesh;
+    uint32_t idx[3];
+    if (m->indices.count) {
+        idx[0] = m->indices.ptr[ti * 3];
+        idx[1] = m->indices.ptr[ti * 3 + 1];
+        idx[2] = m->indices.ptr[ti * 3 + 2];
+    } else {
+        idx[0] = (uint32_t)(ti * 3);
+        idx[1] = (uint32_t)(ti * 3 + 1);
+        idx[2] = (uint32_t)(ti * 3 + 2);
+    }
+    ak_vec3 wp[3];
+    cvert v[3];
+    for (int k = 0; k < 3; ++k) {
+        ak_vec3 p = m->positions.ptr[idx[k]];
+        if (!ak_vec3_is_finite(p)) return;
+        wp[k] = ak_mat4_transform_point(dc->model, p);
+        ak_vec4 c = mul4(&dc->vp, wp[k]);
+        v[k].c[0] = c.x;
+        v[k].c[1] = c.y;
+        v[k].c[2] = c.z;
+        v[k].c[3] = c.w;
+        if (!vec4_finite(c)) return;
+    }
+    /* orientation in homogeneous coordinates: det[x y w] > 0 <=> counter-clockwise in NDC */
+    float det = v[0].c[0] * (v[1].c[1] * v[2].c[3] - v[2].c[1] * v[1].c[3]) -
+                v[1].c[0] * (v[0].c[1] * v[2].c[3] - v[2].c[1] * v[0].c[3]) +
+                v[2].c[0] * (v[0].c[1] * v[1].c[3] - v[1].c[1] * v[0].c[3]);
+    int front = det > 0.0f;
+    if (det == 0.0f) return;
+    if (dc->cull && !front) return;
+    float flat[4] = {0, 0, 0, 1};
+    ak_vec3 fn = ak_vec3_normalize(ak_vec3_cross(ak_vec3_sub(wp[1], wp[0]), ak_vec3_sub(wp[2], wp[0])));
+    const bool has_n = m->normals.count > 0;
+    ak_vec4 vc[3];
+    for (int k = 0; k < 3; ++k) {
+        if (dc->has_vcolor) {
+            ak_vec4 c = m->colors.ptr[idx[k]];
+            vc[k] = vec4_finite(c) ? c : ak_vec4_make(1, 1, 1, 1);
+        } else {
+            vc[k] = ak_vec4_make(1, 1, 1, 1);
+        }
+    }
+    switch (dc->mode) {
+    case FRAG_UNLIT_CONST:
+        memcpy(flat, dc->const_rgba, sizeof flat);
+        break;
+    case FRAG_UNLIT_VCOLOR:
+        for (int k = 0; k < 3; ++k) {
+            v[k].a[0] = vc[k].x * (dc->const_rgba[0] / 255.0f);
+            v[k].a[1] = vc[k].y * (dc->const_rgba[1] / 255.0f);
+            v[k].a[2] = vc[k].z * (dc->const_rgba[2] / 255.0f);
+            v[k].a[3] = vc[k].w * (dc->const_rgba[3] / 255.0f);
+        }
+        break;
+    case FRAG_FLAT: {
+        ak_vec3 n = front ? fn : ak_vec3_neg(fn);
+        ak_vec3 cen = ak_vec3_scale(ak_vec3_add(ak_vec3_add(wp[0], wp[1]), wp[2]), 1.0f / 3.0f);
+        ak_vec3 alb = dc->base_lin;
+        float alpha = dc->base_alpha;
+        if (dc->has_vcolor) {
+            ak_vec4 avg = ak_vec4_scale(ak_vec4_add(ak_vec4_add(vc[0], vc[1]), vc[2]), 1.0f / 3.0f);
+            alb = ak_vec3_mul(alb, srgb3_to_lin(avg));
+            alpha *= clamp01(avg.w);
+        }
+        ak_vec3 c = shade(dc, n, cen, alb);
+        flat[0] = c.x;
+        flat[1] = c.y;
+        flat[2] = c.z;
+        flat[3] = alpha;
+        break;
+    }
+    case FRAG_GOURAUD:
+        for (int k = 0; k < 3; ++k) {
+            ak_vec3 n = has_n ? ak_vec3_normalize(ak_mat3_mul_vec3(dc->normal_matrix, m->normals.ptr[idx[k]])) : fn;
+            if (!ak_vec3_is_finite(n)) n = fn;
+            if (!front) n = ak_vec3_neg(n);
+            ak_vec3 alb = dc->base_lin;
+            if (dc->has_vcolor) alb = ak_vec3_mul(alb, srgb3_to_lin(vc[k]));
+            ak_vec3 c = shade(dc, n, wp[k], alb);
+            v[k].a[0] = c.x;
+            v[k].a[1] = c.y;
+            v[k].a[2] = c.z;
+            v[k].a[3] = dc->base_alpha * clamp01(vc[k].w);
+        }
+        break;
+    case FRAG_PHONG:
+        for (int k = 0; k < 3; ++k) {
+            ak_vec3 n = has_n ? ak_mat3_mul_vec3(dc->normal_matrix, m->normals.ptr[idx[k]]) : fn;
+            if (!ak_vec3_is_finite(n)) n = fn;
+            v[k].a[0] = wp[k].x;
+            v[k].a[1] = wp[k].y;
+            v[k].a[2] = wp[k].z;
+            v[k].a[3] = n.x;
+            v[k].a[4] = n.y;
+            v[k].a[5] = n.z;
+            if (dc->has_vcolor) {
+                ak_vec3 lc = srgb3_to_lin(vc[k]);
+                v[k].a[6] = lc.x;
+                v[k].a[7] = lc.y;
+                v[k].a[8] = lc.z;
+                v[k].a[9] = clamp01(vc[k].w);
+            }
+        }
+        break;
+    default:
+        break;
+    }
+    clip_and_setup(dc, &v[0], &v[1], &v[2], front, flat, out, out_count);
+}
+
+static void base_ctx(drawctx* dc, ak_raster* r, const ak_raster_camera* cam, const ak_mat4* model) {
+    memset(dc, 0, sizeof *dc);
+    dc->r = r;
+    dc->model = model ? *model : ak_mat4_identity();
+    dc->vp = ak_mat4_mul(cam->projection, cam->view);
+    dc->normal_matrix = ak_mat4_normal_matrix(dc->model);
+    dc->eye = eye_of(cam);
+    /* camera forward (-Z of the view) in world space: third row of the rotation, negated */
+    dc->view_forward = ak_vec3_normalize(ak_vec3_make(-cam->view.m[2], -cam->view.m[6], -cam->view.m[10]));
+    dc->ortho = cam->projection.m[15] != 0.0f;
+    dc->depth_test = true;
+    dc->depth_write = true;
+}
+
+static ak_result check_camera(const ak_raster_camera* cam) {
+    if (!ak_mat4_is_finite(&cam->view) || !ak_mat4_is_finite(&cam->projection)) return AK_ERR_BAD_DATA;
+    return AK_OK;
+}
+
+ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_mesh* mesh) {
+    if (!raster || !camera || !mesh || !mesh->positions.ptr || mesh->positions.count == 0) return AK_ERR_NULL_ARG;
+    ak_result res = check_camera(camera);
+    if (res != AK_OK) return res;
+    if (mesh->indices.count % 3 != 0 || (mesh->indices.count && !mesh->indices.ptr)) return AK_ERR_BAD_ARG;
+    if (mesh->normals.count && (mesh->normals.count != mesh->positions.count || !mesh->normals.ptr))
+        return AK_ERR_BAD_ARG;
+    if (mesh->colors.count && (mesh->colors.count != mesh->positions.count || !mesh->colors.ptr))
+        return AK_ERR_BAD_ARG;
+    if ((unsigned)mesh->shading > (unsigned)AK_SHADING_UNLIT || (unsigned)mesh->blend > (unsigned)AK_BLEND_ADD)
+        return AK_ERR_BAD_ARG;
+    if (mesh->model && !ak_mat4_is_finite(mesh->model)) return AK_ERR_BAD_DATA;
+    for (size_t i = 0; i < mesh->indices.count; ++i)
+        if (mesh->indices.ptr[i] >= mesh->positions.count) return AK_ERR_BAD_INDEX;
+    drawctx dc;
+    base_ctx(&dc, raster, camera, mesh->model);
+    dc.mesh = mesh;
+    dc.cull = mesh->cull_back_faces;
+    dc.has_vcolor = mesh->colors.count > 0;
+    dc.blend = mesh->blend == AK_BLEND_DEFAULT ? AK_BLEND_OPAQUE : mesh->blend;
+    dc.depth_test = !mesh->no_depth_test;
+    dc.depth_write = dc.blend == AK_BLEND_OPAQUE;
+    setup_lighting(&dc, mesh->lighting, mesh->material);
+    ak_shading sh = mesh->shading == AK_SHADING_DEFAULT ? AK_SHADING_PHONG : mesh->shading;
+    switch (sh) {
+    case AK_SHADING_UNLIT: {
+        ak_vec4 c = vec4_is_zero(mesh->material.color) ? ak_vec4_make(1, 1, 1, 1) : mesh->material.color;
+        uint8_t b[4];
+        ak_color_to_rgba8(c, b);
+        for (int k = 0; k < 4; ++k) dc.const_rgba[k] = b[k];
+        dc.mode = dc.has_vcolor ? FRAG_UNLIT_VCOLOR : FRAG_UNLIT_CONST;
+        dc.attr_count = dc.has_vcolor ? 4 : 0;
+        break;
+    }
+    case AK_SHADING_FLAT:
+        dc.mode = FRAG_FLAT;
+        break;
+    case AK_SHADING_GOURAUD:
+        dc.mode = FRAG_GOURAUD;
+        dc.attr_count = 4;
+        break;
+    default:
+        dc.mode = FRAG_PHONG;
+        dc.attr_count = dc.has_vcolor ? 10 : 6;
+        break;
+    }
+    dc.setup = mesh_setup;
+    dc.input_count = mesh->indices.count ? mesh->indices.count / 3 : mesh->positions.count / 3;
+    run_draw(&dc);
+    return AK_OK;
+}
+
+/* ---- lines and points ------------------------------------------------------------------- */
+
+static void emit_quad(const drawctx* dc, const cvert q[4], const float flat[4], rtri* out, size_t* out_count) {
+    setup_screen_tri(dc, &q[0], &q[1], &q[2], 1, flat, out, out_count);
+    setup_screen_tri(dc, &q[0], &q[2], &q[3], 1, flat, out, out_count);
+}
+
+/* A screen-space vertex (NDC x, y, z; w = 1) as a cvert. */
+static cvert ndc_vert(float x, float y, float z) {
+    cvert v;
+    memset(&v, 0, sizeof v);
+    v.c[0] = x;
+    v.c[1] = y;
+    v.c[2] = z;
+    v.c[3] = 1.0f;
+    return v;
+}
+
+static void line_setup(const drawctx* dc, size_t si, rtri* out, size_t* out_count) {
+    const ak_raster_lines* l = dc->lines;
+    uint32_t ia = l->indices.count ? l->indices.ptr[si * 2] : (uint32_t)(si * 2);
+    uint32_t ib = l->indices.count ? l->indices.ptr[si * 2 + 1] : (uint32_t)(si * 2 + 1);
+    ak_vec3 pa = l->positions.ptr[ia], pb = l->positions.ptr[ib];
+    if (!ak_vec3_is_finite(pa) || !ak_vec3_is_finite(pb)) return;
+    ak_vec4 ca = mul4(&dc->vp, ak_mat4_transform_point(dc->model, pa));
+    ak_vec4 cb = mul4(&dc->vp, ak_mat4_transform_point(dc->model, pb));
+    ak_vec4 cola = l->colors.count ? l->colors.ptr[ia] : l->color, colb = l->colors.count ? l->colors.ptr[ib] : l->color;
+    if (!l->colors.count && vec4_is_zero(cola)) cola = colb = ak_vec4_make(0, 0, 0, 1);
+    /* parametric clip against the six planes */
+    float t0 = 0.0f, t1 = 1.0f;
+    float A[4] = {ca.x, ca.y, ca.z, ca.w}, B[4] = {cb.x, cb.y, cb.z, cb.w};
+    for (int p = 0; p < 6; ++p) {
+        float da = plane_dist(p, A), db = plane_dist(p, B);
+        if (da < 0.0f && db < 0.0f) return;
+        if (da < 0.0f) {
+            float t = da / (da - db);
+            if (t > t0) t0 = t;
+        } else if (db < 0.0f) {
+            float t = da / (da - db);
+            if (t < t1) t1 = t;
+        }
+    }
+    if (!(t0 < t1)) return;
+    float P[2][4];
+    ak_vec4 col[2];
+    for (int k = 0; k < 4; ++k) {
+        P[0][k] = A[k] + (B[k] - A[k]) * t0;
+        P[1][k] = A[k] + (B[k] - A[k]) * t1;
+    }
+    col[0] = ak_vec4_add(cola, ak_vec4_scale(ak_vec4_add(colb, ak_vec4_scale(cola, -1.0f)), t0));
+    col[1] = ak_vec4_add(cola, ak_vec4_scale(ak_vec4_add(colb, ak_vec4_scale(cola, -1.0f)), t1));
+    float sx[2], sy[2], sz[2];
+    for (int k = 0; k < 2; ++k) {
+        if (!(P[k][3] > 0.0f)) return;
+        sx[k] = P[k][0] / P[k][3];
+        sy[k] = P[k][1] / P[k][3];
+        sz[k] = P[k][2] / P[k][3];
+    }
+    /* direction in sample pixels */
+    float hx = 0.5f * (float)dc->r->sw, hy = 0.5f * (float)dc->r->sh;
+    float dx = (sx[1] - sx[0]) * hx, dy = (sy[1] - sy[0]) * hy;
+    float len = sqrtf(dx * dx + dy * dy);
+    float ux, uy;
+    if (len < 1e-6f) {
+        ux = 1.0f;
+        uy = 0.0f;
+    } else {
+        ux = dx / len;
+        uy = dy / len;
+    }
+    float w = dc->half_width_px;
+    /* offsets in NDC: along (extension for square caps) and across */
+    float ax = ux * w / hx, ay = uy * w / hy, nx = -uy * w / hx, ny = ux * w / hy;
+    cvert q[4];
+    q[0] = ndc_vert(sx[0] - ax + nx, sy[0] - ay + ny, sz[0]);
+    q[1] = ndc_vert(sx[0] - ax - nx, sy[0] - ay - ny, sz[0]);
+    q[2] = ndc_vert(sx[1] + ax - nx, sy[1] + ay - ny, sz[1]);
+    q[3] = ndc_vert(sx[1] + ax + nx, sy[1] + ay + ny, sz[1]);
+    for (int k = 0; k < 4; ++k) {
+        ak_vec4 c = col[k < 2 ? 0 : 1];
+        q[k].a[0] = c.x;
+        q[k].a[1] = c.y;
+        q[k].a[2] = c.z;
+        q[k].a[3] = c.w;
+    }
+    emit_quad(dc, q, NULL, out, out_count);
+}
+
+ak_result ak_raster_draw_lines(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_lines* lines) {
+    if (!raster || !camera || !lines || !lines->positions.ptr || lines->positions.count == 0) return AK_ERR_NULL_ARG;
+    ak_result res = check_camera(camera);
+    if (res != AK_OK) return res;
+    if (lines->indices.count % 2 != 0 || (lines->indices.count && !lines->indices.ptr)) return AK_ERR_BAD_ARG;
+    if (lines->colors.count && (lines->colors.count != lines->positions.count || !lines->colors.ptr))
+        return AK_ERR_BAD_ARG;
+    if (lines->model && !ak_mat4_is_finite(lines->model)) return AK_ERR_BAD_DATA;
+    for (size_t i = 0; i < lines->indices.count; ++i)
+        if (lines->indices.ptr[i] >= lines->positions.count) return AK_ERR_BAD_INDEX;
+    drawctx dc;
+    base_ctx(&dc, raster, camera, lines->model);
+    dc.lines = lines;
+    dc.mode = FRAG_UNLIT_VCOLOR;
+    dc.attr_count = 4;
+    dc.blend = AK_BLEND_ALPHA;
+    dc.depth_test = !lines->on_top;
+    dc.depth_write = false;
+    dc.depth_bias = -2e-5f;
+    float wpx = lines->width > 0.0f && ak_finitef(lines->width) ? lines->width : 2.0f;
+    dc.half_width_px = 0.5f * wpx * (float)raster->ss;
+    dc.setup = line_setup;
+    dc.input_count = lines->indices.count ? lines->indices.count / 2 : lines->positions.count / 2;
+    run_draw(&dc);
+    return AK_OK;
+}
+
+static void point_setup(const drawctx* dc, size_t pi, rtri* out, size_t* out_count) {
+    const ak_raster_points* pt = dc->points;
+    ak_vec3 p = pt->positions.ptr[pi];
+    if (!ak_vec3_is_finite(p)) return;
+    ak_vec4 c = mul4(&dc->vp, ak_mat4_transform_point(dc->model, p));
+    if (!(c.z >= -c.w) || !(c.z <= c.w) || !(c.w > 0.0f)) return;
+    float x = c.x / c.w, y = c.y / c.w, z = c.z / c.w;
+    if (!(fabsf(x) < GUARD * 0.5f && fabsf(y) < GUARD * 0.5f)) return;
+    ak_vec4 col = pt->colors.count ? pt->colors.ptr[pi] : pt->color;
+    if (!pt->colors.count && vec4_is_zero(col)) col = ak_vec4_make(0, 0, 0, 1);
+    if (!vec4_finite(col)) col = ak_vec4_make(0, 0, 0, 1);
+    float flat[4] = {ak_srgb_to_linear(clamp01(col.x)), ak_srgb_to_linear(clamp01(col.y)),
+                     ak_srgb_to_linear(clamp01(col.z)), clamp01(col.w)};
+    float rx = dc->half_width_px / (0.5f * (float)dc->r->sw), ry = dc->half_width_px / (0.5f * (float)dc->r->sh);
+    cvert q[4];
+    q[0] = ndc_vert(x - rx, y - ry, z);
+    q[1] = ndc_vert(x + rx, y - ry, z);
+    q[2] = ndc_vert(x + rx, y + ry, z);
+    q[3] = ndc_vert(x - rx, y + ry, z);
+    const float uv[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (int k = 0; k < 4; ++k) {
+        q[k].a[0] = uv[k][0];
+        q[k].a[1] = uv[k][1];
+    }
+    emit_quad(dc, q, flat, out, out_count);
+}
+
+ak_result ak_raster_draw_points(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_points* points) {
+    if (!raster || !camera || !points || !points->positions.ptr || points->positions.count == 0)
+        return AK_ERR_NULL_ARG;
+    ak_result res = check_camera(camera);
+    if (res != AK_OK) return res;
+    if (points->colors.count && (points->colors.count != points->positions.count || !points->colors.ptr))
+        return AK_ERR_BAD_ARG;
+    if (points->model && !ak_mat4_is_finite(points->model)) return AK_ERR_BAD_DATA;
+    drawctx dc;
+    base_ctx(&dc, raster, camera, points->model);
+    dc.points = points;
+    dc.mode = FRAG_POINT;
+    dc.attr_count = 2;
+    dc.blend = AK_BLEND_OPAQUE;
+    dc.depth_test = !points->on_top;
+    dc.depth_write = true;
+    dc.depth_bias = -4e-5f;
+    float rad = points->radius > 0.0f && ak_finitef(points->radius) ? points->radius : 4.0f;
+    float ol = points->outline > 0.0f && ak_finitef(points->outline) ? points->outline : 0.0f;
+    dc.half_width_px = (rad + ol) * (float)raster->ss;
+    dc.outline_frac = rad / (rad + ol);
+    /* outline: the point colour darkened */
+    ak_vec4 oc = points->color;
+    if (vec4_is_zero(oc)) oc = ak_vec4_make(0, 0, 0, 1);
+    uint8_t ob[4];
+    ak_color_to_rgba8(ak_vec4_make(oc.x * 0.3f, oc.y * 0.3f, oc.z * 0.3f, 1.0f), ob);
+    for (int k = 0; k < 4; ++k) dc.outline_rgba[k] = ob[k];
+    dc.setup = point_setup;
+    dc.input_count = points->positions.count;
+    run_draw(&dc);
+    return AK_OK;
+}
+
+/* ---- ground ------------------------------------------------------------------------------- */
+
+/* Rasterize the caster triangles, projected onto the plane along the light, into the shadow
+ * map as an opacity that is strongest where the caster touches the plane. */
+static void shadow_render(ak_raster* r, const ak_raster_ground* g, ak_vec3 ldir, float cx, float cz, float e,
+                          float strength) {
+    float* S = r->shadow;
+    memset(S, 0, sizeof(float) * SHADOW_RES * SHADOW_RES);
+    const float texel = 2.0f * e / (float)SHADOW_RES;
+    const float falloff = e * 0.25f;
+    for (size_t ci = 0; ci < g->caster_count; ++ci) {
+        const ak_raster_mesh* m = &g->casters[ci];
+        ak_mat4 model = m->model ? *m->model : ak_mat4_identity();
+        size_t tcount = m->indices.count ? m->indices.count / 3 : m->positions.count / 3;
+        for (size_t t = 0; t < tcount; ++t) {
+            float u[3], v[3], h[3];
+            bool ok = true;
+            for (int k = 0; k < 3; ++k) {
+                size_t idx = m->indices.count ? m->indices.ptr[t * 3 + (size_t)k] : t * 3 + (size_t)k;
+                ak_vec3 p = ak_mat4_transform_point(model, m->positions.ptr[idx]);
+                if (!ak_vec3_is_finite(p)) {
+                    ok = false;
+                    break;
+                }
+                float hh = p.y - g->height;
+                if (hh < 0.0f) hh = 0.0f;
+                float s = hh / -ldir.y;
+                u[k] = (p.x + ldir.x * s - (cx - e)) / texel;
+                v[k] = (p.z + ldir.z * s - (cz - e)) / texel;
+                h[k] = hh;
+            }
+            if (!ok) continue;
+            float area = (u[1] - u[0]) * (v[2] - v[0]) - (v[1] - v[0]) * (u[2] - u[0]);
+            if (!(fabsf(area) > 1e-12f)) continue;
+            float minu = ak_minf(u[0], ak_minf(u[1], u[2])), maxu = ak_maxf(u[0], ak_maxf(u[1], u[2]));
+            float minv = ak_minf(v[0], ak_minf(v[1], v[2])), maxv = ak_maxf(v[0], ak_maxf(v[1], v[2]));
+            int x0 = (int)floorf(minu), x1 = (int)ceilf(maxu), y0 = (int)floorf(minv), y1 = (int)ceilf(maxv);
+            if (x0 < 0) x0 = 0;
+            if (y0 < 0) y0 = 0;
+            if (x1 > SHADOW_RES - 1) x1 = SHADOW_RES - 1;
+            if (y1 > SHADOW_RES - 1) y1 = SHADOW_RES - 1;
+            float ia = 1.0f / area;
+            for (int y = y0; y <= y1; ++y)
+                for (int x = x0; x <= x1; ++x) {
+                    float px = (float)x + 0.5f, py = (float)y + 0.5f;
+                    float l0 = ((u[1] - px) * (v[2] - py) - (v[1] - py) * (u[2] - px)) * ia;
+                    float l1 = ((u[2] - px) * (v[0] - py) - (v[2] - py) * (u[0] - px)) * ia;
+                    float l2 = 1.0f - l0 - l1;
+                    if (l0 < 0.0f || l1 < 0.0f || l2 < 0.0f) continue;
+                    float hh = l0 * h[0] + l1 * h[1] + l2 * h[2];
+                    float o = strength * (0.45f + 0.55f * expf(-hh / falloff));
+                    if (o > S[y * SHADOW_RES + x]) S[y * SHADOW_RES + x] = o;
+                }
+        }
+    }
+}
+
+static void box_blur(float* s, float* tmp, int radius) {
+    if (radius < 1) return;
+    const float inv = 1.0f / (float)(2 * radius + 1);
+    for (int pass = 0; pass < 2; ++pass) {
+        /* horizontal into tmp, vertical back into s */
+        for (int y = 0; y < SHADOW_RES; ++y) {
+            float acc = 0.0f;
+            for (int x = -radius; x <= radius; ++x) acc += (x >= 0 && x < SHADOW_RES) ? s[y * SHADOW_RES + x] : 0.0f;
+            for (int x = 0; x < SHADOW_RES; ++x) {
+                tmp[y * SHADOW_RES + x] = acc * inv;
+                int xa = x + radius + 1, xr = x - radius;
+                acc += (xa < SHADOW_RES ? s[y * SHADOW_RES + xa] : 0.0f) - (xr >= 0 ? s[y * SHADOW_RES + xr] : 0.0f);
+            }
+        }
+        for (int x = 0; x < SHADOW_RES; ++x) {
+            float acc = 0.0f;
+            for (int y = -radius; y <= radius; ++y) acc += (y >= 0 && y < SHADOW_RES) ? tmp[y * SHADOW_RES + x] : 0.0f;
+            for (int y = 0; y < SHADOW_RES; ++y) {
+                s[y * SHADOW_RES + x] = acc * inv;
+                int ya = y + radius + 1, yr = y - radius;
+                acc += (ya < SHADOW_RES ? tmp[ya * SHADOW_RES + x] : 0.0f) - (yr >= 0 ? tmp[yr * SHADOW_RES + x] : 0.0f);
+            }
+        }
+    }
+}
+
+static void ground_setup(const drawctx* dc, size_t ti, rtri* out, size_t* out_count) {
+    const cvert* q = dc->quad;
+    if (ti == 0) clip_and_setup(dc, &q[0], &q[1], &q[2], 1, NULL, out, out_count);
+    else clip_and_setup(dc, &q[0], &q[2], &q[3], 1, NULL, out, out_count);
+}
+
+ak_result ak_raster_draw_ground(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_ground* ground) {
+    if (!raster || !camera || !ground) return AK_ERR_NULL_ARG;
+    ak_result res = check_camera(camera);
+    if (res != AK_OK) return res;
+    if (!ak_finitef(ground->height) || !ak_vec3_is_finite(ground->center) || !ak_finitef(ground->half_extent) ||
+        !ak_finitef(ground->grid_spacing) || ground->half_extent < 0.0f || ground->grid_spacing < 0.0f ||
+        !ak_finitef(ground->shadow_softness) || !ak_finitef(ground->shadow_strength))
+        return AK_ERR_BAD_ARG;
+    if (ground->caster_count && !ground->casters) return AK_ERR_NULL_ARG;
+    for (size_t i = 0; i < ground->caster_count; ++i) {
+        const ak_raster_mesh* m = &ground->casters[i];
+        if (!m->positions.ptr || m->positions.count == 0) return AK_ERR_NULL_ARG;
+        if (m->indices.count % 3 != 0 || (m->indices.count && !m->indices.ptr)) return AK_ERR_BAD_ARG;
+        for (size_t k = 0; k < m->indices.count; ++k)
+            if (m->indices.ptr[k] >= m->positions.count) return AK_ERR_BAD_INDEX;
+        if (m->model && !ak_mat4_is_finite(m->model)) return AK_ERR_BAD_DATA;
+    }
+    drawctx dc;
+    base_ctx(&dc, raster, camera, NULL);
+    float e = ground->half_extent > 0.0f ? ground->half_extent : 4.0f;
+    dc.ground_e = e;
+    dc.ground_h = ground->height;
+    dc.ground_cx = ground->center.x;
+    dc.ground_cz = ground->center.z;
+    dc.grid_spacing = ground->grid_spacing > 0.0f ? ground->grid_spacing : e / 8.0f;
+    dc.ground_lin = srgb3_to_lin(vec4_is_zero(ground->color) ? ak_vec4_make(0.80f, 0.80f, 0.78f, 1) : ground->color);
+    dc.line_lin =
+        srgb3_to_lin(vec4_is_zero(ground->line_color) ? ak_vec4_make(0.55f, 0.56f, 0.58f, 1) : ground->line_color);
+    /* angle of one sample pixel: from the projection's vertical scale */
+    float py = camera->projection.m[5];
+    if (dc.ortho) dc.pix_angle = 2.0f / (py * (float)raster->sh);
+    else dc.pix_angle = 2.0f / ((py > 1e-6f ? py : 1.0f) * (float)raster->sh);
+    if (ground->caster_count) {
+        ak_raster_lighting l = ak_raster_lighting_resolved(ground->lighting);
+        ak_vec3 d = ak_vec3_normalize(l.key_direction);
+        /* contact shadows read best from a mostly vertical light */
+        d = ak_vec3_normalize(ak_vec3_lerp(d, ak_vec3_make(0, -1, 0), 0.5f));
+        if (d.y > -0.3f) d = ak_vec3_normalize(ak_vec3_make(d.x, -0.3f, d.z));
+        float strength = ground->shadow_strength > 0.0f ? clamp01(ground->shadow_strength) : 0.55f;
+        shadow_render(raster, ground, d, dc.ground_cx, dc.ground_cz, e, strength);
+        float soft = ground->shadow_softness > 0.0f ? ground->shadow_softness : e / 40.0f;
+        int rad = (int)(soft / (2.0f * e / (float)SHADOW_RES) * 0.6f + 0.5f);
+        if (rad > 32) rad = 32;
+        box_blur(raster->shadow, raster->shadow_tmp, rad);
+        dc.shadow = true;
+    }
+    cvert q[4];
+    const float sx[4] = {-1, 1, 1, -1}, sz[4] = {1, 1, -1, -1};
+    for (int k = 0; k < 4; ++k) {
+        ak_vec3 p = ak_vec3_make(dc.ground_cx + sx[k] * e, ground->height, dc.ground_cz + sz[k] * e);
+        ak_vec4 c = mul4(&dc.vp, p);
+        memset(&q[k], 0, sizeof q[k]);
+        q[k].c[0] = c.x;
+        q[k].c[1] = c.y;
+        q[k].c[2] = c.z;
+        q[k].c[3] = c.w;
+        q[k].a[0] = p.x;
+        q[k].a[1] = p.y;
+        q[k].a[2] = p.z;
+    }
+    dc.quad = q;
+    dc.mode = FRAG_GROUND;
+    dc.attr_count = 3;
+    dc.blend = AK_BLEND_OPAQUE;
+    dc.setup = ground_setup;
+    dc.input_count = 2;
+    run_draw(&dc);
+    return AK_OK;
+}
+
+/* ---- text ------------------------------------------------------------------------------- */
+
+ak_result ak_raster_draw_text(ak_raster* raster, int x, int y, const char* text, int scale, ak_vec4 color) {
+    if (!raster || !text) return AK_ERR_NULL_ARG;
+    ak_image img = {raster->color, raster->sw, raster->sh, 0};
+    int s = scale > 0 ? scale : 1;
+    return ak_image_draw_text(&img, x * raster->ss, y * raster->ss, text, s * raster->ss, color);
+}
