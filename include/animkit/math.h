@@ -8,14 +8,21 @@
  *   - quaternions are stored (x, y, z, w), w the scalar part; ak_quat_mul(a, b) applies b
  *     first, then a (the same order as matrices); unit quaternions represent rotations and
  *     q and -q are the same rotation;
- *   - ak_transform is T * R * S: scale first, then rotate, then translate.
+ *   - ak_transform is T * R * S: scale first, then rotate, then translate;
+ *   - Euler angles: ak_euler_order names the axes in storage order, ak_euler_frame says
+ *     intrinsic (default) or extrinsic; see those enums;
+ *   - ak_dualquat is (real = rotation r, dual = 0.5 (t, 0) r): rotate first, then translate.
  *
- * What it does: small value types and pure static inline functions on them. Functions over
- * whole arrays, decompositions (polar, SVD) and conversions (Euler) live in src/math.c.
+ * What it does: small value types and pure static inline functions on them (vectors,
+ * quaternions with exp/log/slerp, Rodrigues matrices, 3x3/4x4 matrices, projections, TRS
+ * transforms, dual quaternions). Compiled in src/math: matrix inverses, Euler angles in all
+ * 12 orders (intrinsic and extrinsic), 3x3 SVD and polar decomposition, affine matrix
+ * interpolation, dual quaternion blending, and array functions with SSE2 paths.
  *
- * What it does NOT do: fail. On degenerate input every function returns a documented,
- * finite fallback (normalising a zero vector gives zero; inverting a singular matrix gives
- * the identity; slerp between antipodal quaternions takes the shorter path).
+ * What it does NOT do: fail, allocate or keep state. On degenerate input every function
+ * returns a documented, finite fallback (normalising a zero vector gives zero; inverting a
+ * singular matrix gives the identity; slerp between antipodal quaternions takes the shorter
+ * path). No double-precision API: hot paths are float; decompositions use double inside.
  *
  * Usage:
  *     ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.5f * AK_PI);
@@ -24,8 +31,17 @@
  *     ak_mat4 m = ak_transform_to_mat4(t);
  *     ak_vec3 w = ak_mat4_transform_point(m, p);                      // (1, 2, 2)
  *     ak_quat h = ak_quat_slerp(ak_quat_identity(), q, 0.5f);         // 45 degrees about Y
+ *     ak_vec3 e = ak_quat_to_euler(q, AK_EULER_XYZ, AK_EULER_INTRINSIC); // (0, pi/2, 0)
+ *     ak_dualquat dq = ak_dualquat_from_rigid(q, t.translation);
+ *     ak_vec3 w2 = ak_dualquat_transform_point(dq, ak_vec3_make(1, 0, 0)); // (1, 2, 2)
+ *     ak_polar pd = ak_mat3_polar(ak_mat4_to_mat3(m));                // rotation + stretch
+ *     ak_quat qs[64], out[64];  // ... filled by the caller
+ *     ak_quat_cspan in = {qs, 64};
+ *     ak_quat_span dst = {out, 64};
+ *     if (ak_quat_normalize_array(in, dst) != AK_OK) { ... }
  *
- * Threading: pure functions, reentrant.
+ * Ownership and threading: the library keeps no pointer after a call returns; every function
+ * is pure and reentrant.
  */
 #ifndef ANIMKIT_MATH_H
 #define ANIMKIT_MATH_H
@@ -237,18 +253,53 @@ static inline ak_quat ak_quat_slerp(ak_quat a, ak_quat b, float t) {
 }
 
 /* The shortest rotation taking direction from onto direction to (need not be unit).
- * Opposite vectors give a 180 degree turn about an arbitrary perpendicular axis; a zero
- * input gives the identity. */
+ * Exactly opposite vectors give a 180 degree turn about ak_vec3_any_perpendicular(to); a
+ * zero input gives the identity. Accurate to float precision for every pair, including
+ * nearly opposite ones. */
 static inline ak_quat ak_quat_from_to(ak_vec3 from, ak_vec3 to) {
     ak_vec3 a = ak_vec3_normalize(from), b = ak_vec3_normalize(to);
     if (ak_vec3_length_sq(a) == 0.0f || ak_vec3_length_sq(b) == 0.0f) return ak_quat_identity();
     float d = ak_vec3_dot(a, b);
-    if (d < -0.999999f) {
-        ak_vec3 axis = ak_vec3_any_perpendicular(a);
-        return ak_quat_make(axis.x, axis.y, axis.z, 0.0f);
+    if (d >= 0.0f) {
+        ak_vec3 c = ak_vec3_cross(a, b);
+        return ak_quat_normalize(ak_quat_make(c.x, c.y, c.z, 1.0f + d));
     }
-    ak_vec3 c = ak_vec3_cross(a, b);
-    return ak_quat_normalize(ak_quat_make(c.x, c.y, c.z, 1.0f + d));
+    /* Nearly opposite inputs make a x b and 1 + a.b cancel. Turn a onto -b first (well
+     * conditioned), then half a turn about an axis n perpendicular to b. With n along a x b
+     * both turns share one axis, so the product is exactly the shortest arc. */
+    ak_vec3 c = ak_vec3_cross(a, ak_vec3_neg(b));
+    ak_quat q1 = ak_quat_normalize(ak_quat_make(c.x, c.y, c.z, 1.0f - d));
+    ak_vec3 n = ak_vec3_normalize(ak_vec3_madd(c, b, -ak_vec3_dot(b, c)));
+    if (ak_vec3_length_sq(n) == 0.0f) n = ak_vec3_any_perpendicular(b);
+    return ak_quat_mul(ak_quat_make(n.x, n.y, n.z, 0.0f), q1);
+}
+
+/* Quaternion exponential: exp(v, w) = e^w (v/|v| sin|v|, cos|v|). For a pure quaternion
+ * (axis * angle/2, 0) it gives the unit rotation quaternion of that axis-angle. w is clamped
+ * to 88 so the result stays finite; a non-finite input gives the identity. */
+static inline ak_quat ak_quat_exp(ak_quat q) {
+    if (!ak_quat_is_finite(q)) return ak_quat_identity();
+    float th = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z);
+    float e = expf(ak_minf(q.w, 88.0f));
+    /* sin(th)/th by its series below 1e-4, where the division loses digits. */
+    float k = th < 1e-4f ? 1.0f - th * th * (1.0f / 6.0f) : sinf(th) / th;
+    return ak_quat_make(e * k * q.x, e * k * q.y, e * k * q.z, e * cosf(th));
+}
+
+/* Quaternion logarithm: log(q) = (v/|v| atan2(|v|, w), ln|q|), the inverse of ak_quat_exp.
+ * For a unit q of angle theta about n it is (n theta/2, 0), so 2 log(q).xyz is the rotation
+ * vector. q = -1 gives (pi, 0, 0, 0); the zero or a non-finite quaternion gives (0,0,0,0). */
+static inline ak_quat ak_quat_log(ak_quat q) {
+    float n2 = ak_quat_dot(q, q);
+    if (!(n2 > 1e-30f) || !ak_finitef(n2)) return ak_quat_make(0.0f, 0.0f, 0.0f, 0.0f);
+    float s = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z);
+    float lw = 0.5f * logf(n2);
+    if (!(s > 1e-30f)) {
+        if (q.w > 0.0f) return ak_quat_make(0.0f, 0.0f, 0.0f, lw);
+        return ak_quat_make(AK_PI, 0.0f, 0.0f, lw);
+    }
+    float k = atan2f(s, q.w) / s;
+    return ak_quat_make(q.x * k, q.y * k, q.z * k, lw);
 }
 
 /* ---- mat3 --------------------------------------------------------------------------- */
@@ -296,6 +347,41 @@ static inline ak_mat3 ak_mat3_inverse(ak_mat3 m) {
     return r;
 }
 
+/* Rotation matrix of angle radians about axis (normalised here), by Rodrigues' formula
+ * R = cos(a) I + sin(a) [n]x + (1 - cos(a)) n n^T. A zero axis gives the identity. */
+static inline ak_mat3 ak_mat3_from_axis_angle(ak_vec3 axis, float angle) {
+    ak_vec3 n = ak_vec3_normalize(axis);
+    if (ak_vec3_length_sq(n) == 0.0f) return ak_mat3_identity();
+    float c = cosf(angle), s = sinf(angle);
+    float h = sinf(0.5f * angle), t = 2.0f * h * h; /* 1 - cos(a) without cancellation */
+    ak_mat3 r = {{c + n.x * n.x * t, n.x * n.y * t + n.z * s, n.x * n.z * t - n.y * s,
+                  n.x * n.y * t - n.z * s, c + n.y * n.y * t, n.y * n.z * t + n.x * s,
+                  n.x * n.z * t + n.y * s, n.y * n.z * t - n.x * s, c + n.z * n.z * t}};
+    return r;
+}
+static inline ak_mat3 ak_mat3_diagonal(ak_vec3 d) {
+    ak_mat3 r = {{d.x, 0, 0, 0, d.y, 0, 0, 0, d.z}};
+    return r;
+}
+static inline ak_mat3 ak_mat3_add(ak_mat3 a, ak_mat3 b) {
+    for (int i = 0; i < 9; ++i) a.m[i] += b.m[i];
+    return a;
+}
+static inline ak_mat3 ak_mat3_scale(ak_mat3 a, float s) {
+    for (int i = 0; i < 9; ++i) a.m[i] *= s;
+    return a;
+}
+/* Element-wise a + (b - a) t. */
+static inline ak_mat3 ak_mat3_lerp(ak_mat3 a, ak_mat3 b, float t) {
+    for (int i = 0; i < 9; ++i) a.m[i] += (b.m[i] - a.m[i]) * t;
+    return a;
+}
+static inline bool ak_mat3_is_finite(ak_mat3 m) {
+    for (int i = 0; i < 9; ++i)
+        if (!ak_finitef(m.m[i])) return false;
+    return true;
+}
+
 /* Rotation matrix of unit quaternion q. */
 static inline ak_mat3 ak_mat3_from_quat(ak_quat q) {
     float xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
@@ -331,6 +417,92 @@ static inline ak_quat ak_quat_from_mat3(ak_mat3 m) {
     if (q.w < 0.0f) q = ak_quat_neg(q);
     return ak_quat_normalize(q);
 }
+
+/* ---- Euler angles ------------------------------------------------------------------ */
+
+/* Axis sequence of Euler angles. The letters name the axes in the order the angles are
+ * stored: angles.x is about the first letter's axis, angles.y the second, angles.z the
+ * third (so for AK_EULER_ZYX, angles.x is the angle about Z). The first six are
+ * Tait-Bryan (three distinct axes), the last six proper Euler (first axis repeated). */
+typedef enum ak_euler_order {
+    AK_EULER_XYZ = 0, /* the default */
+    AK_EULER_XZY,
+    AK_EULER_YXZ,
+    AK_EULER_YZX,
+    AK_EULER_ZXY,
+    AK_EULER_ZYX,
+    AK_EULER_XYX,
+    AK_EULER_XZX,
+    AK_EULER_YXY,
+    AK_EULER_YZY,
+    AK_EULER_ZXZ,
+    AK_EULER_ZYZ,
+    AK_EULER_ORDER_COUNT
+} ak_euler_order;
+
+/* Which axes the sequence turns about.
+ * INTRINSIC: each turn is about the axis as moved by the turns before it (body axes, as in
+ *   BVH channel lists): order ABC gives R = R_A(angles.x) * R_B(angles.y) * R_C(angles.z).
+ * EXTRINSIC: each turn is about the fixed parent axis: order ABC gives
+ *   R = R_C(angles.z) * R_B(angles.y) * R_A(angles.x) (A is applied to the vector first).
+ * Intrinsic ABC with angles (a, b, c) is the same rotation as extrinsic CBA with (c, b, a). */
+typedef enum ak_euler_frame {
+    AK_EULER_INTRINSIC = 0, /* the default */
+    AK_EULER_EXTRINSIC
+} ak_euler_frame;
+
+/* Rotation quaternion of Euler angles (radians). An out-of-range order or frame is read as
+ * the default (XYZ, intrinsic). */
+AK_API ak_quat ak_quat_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame);
+/* Rotation matrix of Euler angles (radians); same conventions as ak_quat_from_euler. */
+AK_API ak_mat3 ak_mat3_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame);
+/* Euler angles of rotation matrix m (a rotation; orthonormalise first otherwise), computed
+ * in double precision. Ranges: first and third angle in [-pi, pi]; middle angle in
+ * [-pi/2, pi/2] for Tait-Bryan orders and [0, pi] for proper Euler orders.
+ * Gimbal lock (middle angle at +-pi/2 for Tait-Bryan, 0 or pi for proper Euler, detected
+ * when its cosine resp. sine is below 1e-6): only a combination of the outer angles is
+ * determined, so angles.z is set to 0 and angles.x carries the whole turn, in both frames.
+ * The result always rebuilds m through ak_mat3_from_euler. Non-finite m gives (0, 0, 0). */
+AK_API ak_vec3 ak_mat3_to_euler(ak_mat3 m, ak_euler_order order, ak_euler_frame frame);
+/* Euler angles of quaternion q (normalised here); see ak_mat3_to_euler. The zero or a
+ * non-finite quaternion gives (0, 0, 0). */
+AK_API ak_vec3 ak_quat_to_euler(ak_quat q, ak_euler_order order, ak_euler_frame frame);
+
+/* ---- 3x3 decompositions ------------------------------------------------------------ */
+
+/* Signed singular value decomposition m = U * diag(sigma) * V^T. */
+typedef struct ak_svd3 {
+    ak_mat3 u;     /* proper rotation (det +1) */
+    ak_vec3 sigma; /* sigma.x >= sigma.y >= |sigma.z|; sigma.z < 0 exactly when det(m) < 0 */
+    ak_mat3 v;     /* proper rotation (det +1) */
+} ak_svd3;
+
+/* SVD of a 3x3 matrix by one-sided Jacobi rotations in double precision. U and V are
+ * rotations, so the sign of det(m) moves onto the smallest singular value. For rank-deficient
+ * m the missing columns of U are completed to a right-handed frame. The zero or a non-finite
+ * matrix gives U = V = identity, sigma = 0. */
+AK_API ak_svd3 ak_mat3_svd(ak_mat3 m);
+
+/* Polar decomposition m = R * D. */
+typedef struct ak_polar {
+    ak_mat3 rotation; /* R: proper rotation, det +1 */
+    ak_mat3 stretch;  /* D = R^T m: symmetric; positive semi-definite when det(m) >= 0 */
+    int iterations;   /* iterations of the averaging scheme; 0 when the SVD path ran */
+    bool used_svd;    /* true when m was reflected, near-singular or did not converge */
+} ak_polar;
+
+/* Polar decomposition m = R D with R the rotation nearest to m and D symmetric.
+ * Well-conditioned m with det > 0 runs the averaging scheme R_{i+1} = (g R_i + R_i^-T / g)/2
+ * in double precision (g is Higham's Frobenius-norm scaling while far from convergence,
+ * then 1: the plain scheme), until the change is below 1e-12 relative or 40 iterations.
+ * Otherwise (det <= 0, condition number above 1e5, or no convergence) it uses ak_mat3_svd:
+ * R = U V^T and D = V diag(sigma) V^T. Results for the special cases:
+ *   - reflection (det < 0): R stays a proper rotation and D gets one negative eigenvalue,
+ *     -sigma_min, along the direction of the smallest singular value;
+ *   - rank-deficient m: D has a zero eigenvalue along the null direction and R maps it to
+ *     the right-handed completion of the image (R D = m still holds);
+ *   - the zero matrix: R = identity, D = 0; non-finite m: R = D = identity. */
+AK_API ak_polar ak_mat3_polar(ak_mat3 m);
 
 /* ---- mat4 --------------------------------------------------------------------------- */
 
@@ -418,7 +590,8 @@ AK_API bool ak_mat4_is_finite(const ak_mat4* m);
  * by fovy = 60 degrees, aspect = 1, near = 0.1, far = near * 1000. */
 AK_API ak_mat4 ak_mat4_perspective(float fovy, float aspect, float near_z, float far_z);
 /* OpenGL orthographic projection of the box [l,r]x[b,t]x[-near,-far] to NDC [-1,1]^3.
- * A zero-width range is widened to 1 so the result stays finite. */
+ * A zero-width range is widened to 1 so the result stays finite; a non-finite argument
+ * gives the identity. */
 AK_API ak_mat4 ak_mat4_orthographic(float left, float right, float bottom, float top, float near_z, float far_z);
 /* View matrix of a camera at eye looking at target, up roughly +Y: camera looks down -Z.
  * eye == target gives a translation by -eye; up parallel to the view picks another up. */
@@ -468,6 +641,121 @@ static inline ak_transform ak_transform_inverse(ak_transform t) {
 static inline bool ak_transform_is_finite(ak_transform t) {
     return ak_vec3_is_finite(t.translation) && ak_quat_is_finite(t.rotation) && ak_vec3_is_finite(t.scale);
 }
+
+/* ---- dual quaternions --------------------------------------------------------------
+ * Layout: real is the rotation quaternion r, dual is d = 0.5 * (t, 0) * r, t the
+ * translation. A unit dual quaternion has |r| = 1 and r.d = 0; it applies the rotation
+ * first, then the translation (like ak_transform without scale). ak_dualquat_mul(a, b)
+ * applies b first, then a. Functions below expect unit input unless they say otherwise. */
+
+static inline ak_dualquat ak_dualquat_identity(void) {
+    ak_dualquat r = {{0.0f, 0.0f, 0.0f, 1.0f}, {0.0f, 0.0f, 0.0f, 0.0f}};
+    return r;
+}
+/* Rigid transform "rotate by rotation (normalised here), then translate". */
+static inline ak_dualquat ak_dualquat_from_rigid(ak_quat rotation, ak_vec3 translation) {
+    ak_dualquat r;
+    r.real = ak_quat_normalize(rotation);
+    r.dual = ak_quat_scale(ak_quat_mul(ak_quat_make(translation.x, translation.y, translation.z, 0.0f), r.real), 0.5f);
+    return r;
+}
+/* Translation part t = 2 d r* / |r|^2 (exact also for non-unit dq); zero real part gives 0. */
+static inline ak_vec3 ak_dualquat_get_translation(ak_dualquat dq) {
+    float n2 = ak_quat_dot(dq.real, dq.real);
+    if (!(n2 > 1e-30f) || !ak_finitef(n2)) return ak_vec3_zero();
+    ak_quat t = ak_quat_mul(dq.dual, ak_quat_conjugate(dq.real));
+    float k = 2.0f / n2;
+    return ak_vec3_make(t.x * k, t.y * k, t.z * k);
+}
+/* Rotation part, normalised (zero real part gives the identity). */
+static inline ak_quat ak_dualquat_get_rotation(ak_dualquat dq) { return ak_quat_normalize(dq.real); }
+/* Rotation and translation of t; its scale is ignored. */
+static inline ak_dualquat ak_dualquat_from_transform(ak_transform t) {
+    return ak_dualquat_from_rigid(t.rotation, t.translation);
+}
+/* The rigid transform of dq, with scale (1, 1, 1). */
+static inline ak_transform ak_dualquat_to_transform(ak_dualquat dq) {
+    return ak_transform_make(ak_dualquat_get_translation(dq), ak_dualquat_get_rotation(dq), ak_vec3_one());
+}
+/* Product a * b = (a.r b.r, a.r b.d + a.d b.r): b first, then a. */
+static inline ak_dualquat ak_dualquat_mul(ak_dualquat a, ak_dualquat b) {
+    ak_dualquat r;
+    r.real = ak_quat_mul(a.real, b.real);
+    r.dual = ak_quat_add(ak_quat_mul(a.real, b.dual), ak_quat_mul(a.dual, b.real));
+    return r;
+}
+/* Quaternion conjugate of both parts (r*, d*): the inverse of a unit dual quaternion. */
+static inline ak_dualquat ak_dualquat_conjugate(ak_dualquat dq) {
+    ak_dualquat r = {ak_quat_conjugate(dq.real), ak_quat_conjugate(dq.dual)};
+    return r;
+}
+/* Dual-number conjugate (r, -d). */
+static inline ak_dualquat ak_dualquat_dual_conjugate(ak_dualquat dq) {
+    ak_dualquat r = {dq.real, ak_quat_neg(dq.dual)};
+    return r;
+}
+/* Both conjugates at once (r*, -d*): a point p maps to dq (1 + eps p) this. */
+static inline ak_dualquat ak_dualquat_full_conjugate(ak_dualquat dq) {
+    ak_dualquat r = {ak_quat_conjugate(dq.real), ak_quat_neg(ak_quat_conjugate(dq.dual))};
+    return r;
+}
+/* Unit dual quaternion: both parts divided by |r|, then the part of d along r removed so
+ * that r.d = 0. A zero or non-finite real part gives the identity. */
+static inline ak_dualquat ak_dualquat_normalize(ak_dualquat dq) {
+    float n2 = ak_quat_dot(dq.real, dq.real);
+    if (!(n2 > 1e-30f) || !ak_finitef(n2) || !ak_quat_is_finite(dq.dual)) return ak_dualquat_identity();
+    float inv = 1.0f / sqrtf(n2);
+    ak_dualquat r;
+    r.real = ak_quat_scale(dq.real, inv);
+    r.dual = ak_quat_scale(dq.dual, inv);
+    r.dual = ak_quat_add(r.dual, ak_quat_scale(r.real, -ak_quat_dot(r.real, r.dual)));
+    return r;
+}
+/* Rotate then translate point p. */
+static inline ak_vec3 ak_dualquat_transform_point(ak_dualquat dq, ak_vec3 p) {
+    ak_quat t = ak_quat_mul(dq.dual, ak_quat_conjugate(dq.real));
+    return ak_vec3_add(ak_quat_rotate(dq.real, p), ak_vec3_make(2.0f * t.x, 2.0f * t.y, 2.0f * t.z));
+}
+/* Rotate direction v (no translation). */
+static inline ak_vec3 ak_dualquat_transform_vector(ak_dualquat dq, ak_vec3 v) { return ak_quat_rotate(dq.real, v); }
+/* Affine matrix of a unit dual quaternion (rotation part from the normalised real part). */
+static inline ak_mat4 ak_dualquat_to_mat4(ak_dualquat dq) {
+    return ak_mat4_from_mat3(ak_mat3_from_quat(ak_quat_normalize(dq.real)), ak_dualquat_get_translation(dq));
+}
+
+/* Dual quaternion linear blend sum(w_i dq_i) / |sum(w_i r_i)|, for skinning. Every dq_i is
+ * first moved into the hemisphere of the one with the largest weight (dq and -dq are the
+ * same transform), then the sum is normalised with ak_dualquat_normalize. Uses the first
+ * min(dqs.count, weights.count) pairs; weights need not sum to 1. An empty input, zero total
+ * weight or a sum whose real part vanishes gives the identity. */
+AK_API ak_dualquat ak_dualquat_blend(ak_dualquat_cspan dqs, ak_f32_cspan weights);
+
+/* ---- affine interpolation ------------------------------------------------------------ */
+
+/* Interpolates two affine matrices (the bottom rows are ignored and the result's is
+ * 0,0,0,1): each linear part is split by ak_mat3_polar into R D, R is SLERPed (shorter arc),
+ * D and the translation are lerped, and the result is R(t) D(t) plus the translation.
+ * t = 0 and t = 1 give a and b (to float precision); reflections interpolate their D as
+ * documented in ak_mat3_polar. Non-finite input gives the identity. */
+AK_API ak_mat4 ak_mat4_interpolate_affine(ak_mat4 a, ak_mat4 b, float t);
+
+/* ---- arrays ---------------------------------------------------------------------------
+ * Compiled in src/math, with SSE2 code when the compiler targets it (scalar with AK_NO_SIMD)
+ * and the same results to float rounding. Pointers need no alignment. Each returns
+ * AK_ERR_NULL_ARG when a span with a non-zero count has a NULL pointer, and
+ * AK_ERR_SPAN_SMALL when an input or output is shorter than the first input; nothing is
+ * written then. Outputs may be the same array as an input (exactly, not partly overlapping). */
+
+/* out[i] = ak_quat_normalize(q[i]) for i < q.count. */
+AK_API ak_result ak_quat_normalize_array(ak_quat_cspan q, ak_quat_span out);
+/* out[i] = a[i] * b[i] for i < a.count (needs b.count, out.count >= a.count). */
+AK_API ak_result ak_quat_mul_array(ak_quat_cspan a, ak_quat_cspan b, ak_quat_span out);
+/* out[i] = ak_quat_rotate(q[i], v[i]) for i < v.count. q.count is v.count, or 1 to rotate
+ * every vector by q[0] (any other q.count smaller than v.count gives AK_ERR_SPAN_SMALL). */
+AK_API ak_result ak_quat_rotate_array(ak_quat_cspan q, ak_vec3_cspan v, ak_vec3_span out);
+/* out[i] = a[i] * b[i] for i < b.count. a.count is b.count, or 1 to multiply every b[i] by
+ * a[0] (as for ak_quat_rotate_array). */
+AK_API ak_result ak_mat4_mul_array(ak_mat4_cspan a, ak_mat4_cspan b, ak_mat4_span out);
 
 #ifdef __cplusplus
 }
