@@ -1,0 +1,306 @@
+/* animkit skin: automatic skin weights and skinning (LBS, dual quaternions, centers of rotation).
+ *
+ * What it does:
+ *   - automatic weights from a mesh and its bones: inverse distance to the bone segments, or
+ *     bone heat (Baran & Popovic 2007: one sparse Cholesky factorization of the cotangent
+ *     Laplacian, reused for every joint), then "keep the k largest, drop tiny, renormalise";
+ *   - a compact weights file format (encode/decode to memory, thin file wrappers);
+ *   - one skinning job for three methods: linear blend (LBS), dual quaternions (DQS, Kavan et
+ *     al. 2008) and optimized centers of rotation (CoR, Le & Hodgins 2016), vectorized across
+ *     vertices (AVX2+FMA chosen at run time; scalar reference always built, forced by
+ *     AK_NO_SIMD or job.skip_simd);
+ *   - the CoR precomputation (per-vertex centers), pruned by bone pair and multithreaded, with
+ *     a cache format keyed by a hash of the mesh and weights.
+ *
+ * What it does NOT do: build the palette (ak_skeleton_skinning_matrices does: M_j = model_j *
+ * inverse_bind_j), read asset files (io.h), or measure volume (ak_volume_compute in mesh.h).
+ *
+ * Usage (deform every frame; weights from the mesh, palette from the skeleton):
+ *     ak_skin_job job = {
+ *         .method = AK_SKIN_DQS,
+ *         .influence_count = mesh->influence_count,
+ *         .palette   = { palette, joint_count },
+ *         .joints    = { mesh->joints,  mesh->vertex_count, 0 },
+ *         .weights   = { mesh->weights, mesh->vertex_count, 0 },
+ *         .positions = { mesh->positions, mesh->vertex_count, 0 },
+ *         .normals   = { mesh->normals, mesh->vertex_count, 0 },
+ *         .out_positions = { out_pos, mesh->vertex_count, 0 },
+ *         .out_normals   = { out_nrm, mesh->vertex_count, 0 },
+ *         .scratch = { scratch, sizeof scratch },  // >= ak_skin_job_scratch_size(&job)
+ *     };
+ *     ak_result r = ak_skin_job_validate(&job);   // once, with the data check
+ *     job.skip_data_check = true;                 // then per frame: O(1) validation only
+ *     r = ak_skin_job_run(&job);
+ *
+ * Ownership and threading: every function works on caller-owned arrays and keeps no pointer
+ * after it returns. ak_skin_job_run never allocates (job.thread_count > 1 starts pthreads,
+ * whose stacks the C library allocates; use ak_skin_job_split with your own job system to
+ * avoid that). Jobs whose outputs do not overlap may run concurrently. The weight and CoR
+ * precomputations allocate temporaries through the optional allocator (NULL -> malloc).
+ */
+#ifndef ANIMKIT_SKIN_H
+#define ANIMKIT_SKIN_H
+
+#include "mesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- bones ---------------------------------------------------------------------------- */
+
+/* A bone as a segment in bind (model) space, and the joint that receives its weight. */
+typedef struct ak_skin_bone {
+    ak_vec3 head;          /* model space: the joint's bind position */
+    ak_vec3 tail;          /* model space: the child's bind position; == head for a point bone */
+    uint16_t joint_index;  /* joint (palette entry) that this segment's weight goes to */
+} ak_skin_bone;
+
+AK_DEFINE_SPAN(skin_bone, ak_skin_bone)
+
+/* Most bones ak_skin_bones_from_joints writes for joint_count joints (2 * joint_count). */
+AK_API size_t ak_skin_bones_from_joints_bound(size_t joint_count);
+
+/* Bones of a skeleton given as bind-space joint positions and parents (parent[i] < i, -1 for
+ * roots; e.g. ak_skeleton_parents): one segment joint -> child per child, owned by the joint;
+ * a leaf joint becomes a point bone at its position unless skip_leaf_joints.
+ * Needs parents.count >= joint_positions.count, out_bones.count >= the bound above.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no joints), AK_ERR_BAD_ARG (more than 65535 joints),
+ * AK_ERR_BAD_HIERARCHY (parent >= own index or < -1), AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_skin_bones_from_joints(ak_vec3_cspan joint_positions, ak_i16_cspan parents,
+                                           bool skip_leaf_joints, ak_skin_bone_span out_bones,
+                                           size_t* out_bone_count);
+
+/* ---- automatic weights ---------------------------------------------------------------- */
+
+typedef enum ak_weights_method {
+    AK_WEIGHTS_HEAT = 0, /* default: bone heat diffusion on the surface (needs triangles) */
+    AK_WEIGHTS_DISTANCE, /* inverse distance to the bone segments (triangles unused) */
+    AK_WEIGHTS_METHOD_COUNT
+} ak_weights_method;
+
+typedef struct ak_weights_desc {
+    ak_weights_method method; /* 0 -> AK_WEIGHTS_HEAT */
+    ak_vec3_cspan positions;  /* required: bind-space vertex positions */
+    ak_u32_cspan indices;     /* triangles, 3 per, counter-clockwise; required for HEAT */
+    ak_skin_bone_cspan bones; /* required, >= 1 (see ak_skin_bones_from_joints) */
+    uint32_t max_influences;  /* k, 1..AK_MAX_INFLUENCES; 0 -> 4. Also the output stride */
+    float min_weight;         /* weights below this (after the first renormalisation) are
+                                 dropped; 0 -> 0.001; negative -> keep every weight > 0 */
+    float distance_power;     /* DISTANCE: exponent n of (1/d)^n; 0 -> 4. Larger n gives
+                                 sharper transitions (n -> inf: rigid nearest bone); n = 2
+                                 bleeds noticeably between nearby limbs */
+    float heat_strength;      /* HEAT: c in H_ii = c / d_i^2; 0 -> 1 (Baran & Popovic's value) */
+    bool skip_visibility;     /* HEAT: false -> a vertex only heats from the nearest bone it
+                                 can see (segment to the bone not blocked by the mesh) */
+} ak_weights_desc;
+
+/* The desc with every zero field replaced by its documented default. */
+AK_API ak_weights_desc ak_weights_desc_resolved(const ak_weights_desc* desc);
+
+/* Compute skin weights. Writes k = resolved max_influences slots per vertex, sorted by
+ * decreasing weight; unused slots get joint 0 and weight 0. Every vertex's weights are >= 0
+ * and sum to 1 within 1e-6. Needs out_joints.count and out_weights.count >= vertex_count * k.
+ * Robustness: a vertex on a bone (d = 0) gets weight only from the bones it touches, a vertex
+ * far from every bone still gets finite weights; a vertex no bone can see (HEAT) falls back to
+ * its nearest bone; a vertex on no triangle (HEAT) gets its nearest bone with weight 1.
+ * Heat solves (L + A H) w_j = A H p_j (L the symmetric cotangent Laplacian, A the barycentric
+ * vertex areas) with one CHOLMOD factorization and one multi-column solve.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no vertices or no bones; HEAT: no triangles),
+ * AK_ERR_BAD_ARG (method, max_influences > 8, indices.count % 3, distance_power <= 0 after
+ * defaults), AK_ERR_BAD_INDEX (a triangle index >= vertex count), AK_ERR_BAD_DATA (NaN or
+ * infinite position or bone), AK_ERR_SPAN_SMALL, AK_ERR_NO_MEMORY, AK_ERR_NO_CONVERGENCE
+ * (the sparse factorization failed). */
+AK_API ak_result ak_skin_weights_compute(const ak_weights_desc* desc, const ak_allocator* alloc,
+                                         ak_u16_span out_joints, ak_f32_span out_weights);
+
+/* Check weights: each finite and >= 0, per-vertex sum within tolerance of 1 (tolerance 0 ->
+ * 1e-3), joint indices < joint_count. joints/weights hold vertex_count * influence_count.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (influence_count 0 or > 8), AK_ERR_SPAN_SMALL,
+ * AK_ERR_BAD_WEIGHTS (the first bad vertex goes to *out_bad_vertex, optional),
+ * AK_ERR_BAD_INDEX (idem). */
+AK_API ak_result ak_skin_weights_validate(ak_u16_cspan joints, ak_f32_cspan weights, size_t vertex_count,
+                                          uint32_t influence_count, size_t joint_count, float tolerance,
+                                          size_t* out_bad_vertex);
+
+/* ---- weights file format ----------------------------------------------------------------
+ * Little-endian binary, 16-byte header then two arrays:
+ *   bytes 0..3   magic "AKWT"
+ *   bytes 4..7   u32 version (1)
+ *   bytes 8..11  u32 vertex_count
+ *   bytes 12..15 u32 influence_count (1..8)
+ *   then u16 joints[vertex_count * influence_count], zero-padded to a multiple of 4 bytes,
+ *   then f32 weights[vertex_count * influence_count] (IEEE 754 binary32).
+ * Vertex-major: the influences of vertex v are at [v * influence_count, ...). */
+
+/* Bytes of an encoded weights buffer (0 when the counts overflow). */
+AK_API size_t ak_skin_weights_encoded_size(size_t vertex_count, uint32_t influence_count);
+/* Encode into out_buffer (count >= the size above); *out_size (optional) gets the bytes
+ * written. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (influence_count 0 or > 8, vertex_count
+ * >= 2^32), AK_ERR_SPAN_SMALL (either input or the buffer). */
+AK_API ak_result ak_skin_weights_encode(ak_u16_cspan joints, ak_f32_cspan weights, size_t vertex_count,
+                                        uint32_t influence_count, ak_u8_span out_buffer, size_t* out_size);
+/* Read the counts from an encoded buffer. Returns AK_ERR_NULL_ARG, AK_ERR_PARSE (bad magic,
+ * version or truncated buffer; diag optional). */
+AK_API ak_result ak_skin_weights_decode_info(ak_u8_cspan buffer, size_t* out_vertex_count,
+                                             uint32_t* out_influence_count, ak_diag* diag);
+/* Decode into caller arrays (count >= vertex_count * influence_count). The weights are not
+ * validated (use ak_skin_weights_validate). Returns the decode_info codes, AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_skin_weights_decode(ak_u8_cspan buffer, ak_u16_span out_joints, ak_f32_span out_weights,
+                                        ak_diag* diag);
+/* ak_skin_weights_encode to a file. Adds AK_ERR_IO. */
+AK_API ak_result ak_skin_weights_write_file(const char* path, ak_u16_cspan joints, ak_f32_cspan weights,
+                                            size_t vertex_count, uint32_t influence_count);
+/* Counts of a weights file (reads the header only). Adds AK_ERR_IO to decode_info's codes. */
+AK_API ak_result ak_skin_weights_read_file_info(const char* path, size_t* out_vertex_count,
+                                                uint32_t* out_influence_count, ak_diag* diag);
+/* Read a weights file into caller arrays. Adds AK_ERR_IO to decode's codes. */
+AK_API ak_result ak_skin_weights_read_file(const char* path, ak_u16_span out_joints, ak_f32_span out_weights,
+                                           ak_diag* diag);
+
+/* ---- optimized centers of rotation (precomputation) ------------------------------------ */
+
+typedef struct ak_skin_cor_desc {
+    ak_vec3_cspan positions;   /* required: bind-space positions */
+    ak_u32_cspan indices;      /* required: triangles, 3 per */
+    ak_u16_cspan joints;       /* required: vertex_count * influence_count */
+    ak_f32_cspan weights;      /* required: same layout, valid (ak_skin_weights_validate) */
+    uint32_t influence_count;  /* required: 1..AK_MAX_INFLUENCES */
+    float sigma;               /* similarity kernel width; 0 -> 0.1 (the paper's value) */
+    float subdivision_threshold; /* split an edge while the L2 distance of its end weights
+                                    exceeds this; 0 -> 0.1 */
+    uint32_t thread_count;     /* 0 -> 2; 1 -> calling thread only */
+    bool naive;                /* false -> triangles indexed by bone pair; true -> the
+                                  O(vertices x triangles) reference loop (tests) */
+} ak_skin_cor_desc;
+
+/* The desc with every zero field replaced by its documented default. */
+AK_API ak_skin_cor_desc ak_skin_cor_desc_resolved(const ak_skin_cor_desc* desc);
+
+/* 64-bit FNV-1a hash of positions, indices, joints, weights, influence_count, sigma and the
+ * subdivision threshold: the key of a cached centers file. 0 for a NULL desc. */
+AK_API uint64_t ak_skin_cor_key(const ak_skin_cor_desc* desc);
+
+/* One center of rotation per vertex (Le & Hodgins 2016): p*_i = sum_t s(w_i, w_t) a_t c_t /
+ * sum_t s(w_i, w_t) a_t over the triangles t of the mesh after subdividing edges (until end
+ * weights differ by at most the threshold; at most 12 levels), a_t the area, c_t the centroid,
+ * w_t the mean of the corner weights, s(w_p, w_v) = sum_{j != k} w_pj w_pk w_vj w_vk
+ * exp(-(w_pj w_vk - w_pk w_vj)^2 / sigma^2). Accumulated in double precision.
+ * Fallback: a vertex with a single influence, or whose similarity with every triangle is 0,
+ * gets its own position (CoR then equals rigid / LBS skinning for it).
+ * Needs out_centers.count >= vertex_count. Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY,
+ * AK_ERR_BAD_ARG (influence_count, indices.count % 3, sigma or threshold <= 0),
+ * AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX (triangle index), AK_ERR_BAD_WEIGHTS (NaN or negative
+ * weight), AK_ERR_BAD_DATA (NaN position), AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_skin_cor_centers_compute(const ak_skin_cor_desc* desc, const ak_allocator* alloc,
+                                             ak_vec3_span out_centers);
+
+/* CoR centers file: 24-byte header then the centers.
+ *   bytes 0..3 magic "AKCR", 4..7 u32 version (1), 8..11 u32 vertex_count, 12..15 zero,
+ *   16..23 u64 key (ak_skin_cor_key), then f32 xyz[vertex_count], little-endian. */
+AK_API size_t ak_skin_cor_centers_encoded_size(size_t vertex_count);
+/* Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (vertex_count >= 2^32), AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_skin_cor_centers_encode(ak_vec3_cspan centers, uint64_t key, ak_u8_span out_buffer,
+                                            size_t* out_size);
+/* Decode centers whose key equals key. Returns AK_ERR_NULL_ARG, AK_ERR_PARSE (bad header or
+ * size), AK_ERR_NOT_FOUND (the key differs: the cache is stale), AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_skin_cor_centers_decode(ak_u8_cspan buffer, uint64_t key, ak_vec3_span out_centers);
+AK_API ak_result ak_skin_cor_centers_write_file(const char* path, ak_vec3_cspan centers, uint64_t key);
+/* Same codes as decode plus AK_ERR_IO (missing or unreadable file). */
+AK_API ak_result ak_skin_cor_centers_read_file(const char* path, uint64_t key, ak_vec3_span out_centers);
+/* Read the centers from cache_path when its key matches, else compute them and write the file
+ * (a failed write is not an error: the centers are still returned). *out_from_cache
+ * (optional) says which happened. Codes of ak_skin_cor_centers_compute. */
+AK_API ak_result ak_skin_cor_centers_cached(const ak_skin_cor_desc* desc, const char* cache_path,
+                                            const ak_allocator* alloc, ak_vec3_span out_centers,
+                                            bool* out_from_cache);
+
+/* ---- the skinning job ------------------------------------------------------------------- */
+
+typedef enum ak_skin_method {
+    AK_SKIN_LBS = 0, /* default: p' = sum_j w_j M_j p; normals by the inverse transpose of the
+                        blended matrix (exact for non-rigid blends) */
+    AK_SKIN_DQS,     /* dual quaternions: blend the rigid parts, each aligned to the hemisphere
+                        of the most influential joint's rotation, normalise, transform. Joints
+                        with scale or shear: M_j = [R_j | t_j] S_j (polar decomposition); the
+                        stretch S = sum_j w_j S_j is applied first (matrix blend in bind space),
+                        then the rigid dual-quaternion blend. */
+    AK_SKIN_COR,     /* optimized centers: p' = R (S (p - p*)) + LBS(p*), R the normalised
+                        hemisphere-aligned quaternion blend, S the blended stretch (identity
+                        for rigid palettes), p* from ak_skin_cor_centers_compute */
+    AK_SKIN_METHOD_COUNT
+} ak_skin_method;
+
+/* Streams hold float or uint16_t components: positions/normals 3 floats, tangents 4 floats
+ * (xyz direction, w handedness copied), joints influence_count uint16_t, weights
+ * influence_count floats. A stride of 0 means tightly packed. Pointers need only the natural
+ * alignment of their component type. */
+typedef struct ak_skin_job {
+    ak_skin_method method;      /* 0 -> AK_SKIN_LBS */
+    uint32_t influence_count;   /* required: joints per vertex, 1..AK_MAX_INFLUENCES */
+    ak_mat4_cspan palette;      /* required: skinning matrices M_j, affine (bottom row ignored) */
+    ak_cstream positions;       /* required: bind-space positions; count = the vertex count */
+    ak_cstream joints;          /* required: count >= vertex count */
+    ak_cstream weights;         /* required: count >= vertex count */
+    ak_cstream normals;         /* optional (ptr NULL -> none): unit bind-space normals */
+    ak_cstream tangents;        /* optional (ptr NULL -> none) */
+    ak_cstream cor_centers;     /* AK_SKIN_COR: required, 3 floats per vertex; else unused */
+    ak_u32_cspan indices;       /* triangles; only read when normals_from_faces */
+    bool normals_from_faces;    /* false -> normals by the skinning transform; true ->
+                                   out_normals = area-weighted normals of the deformed
+                                   triangles (normals input unused; vertices on no triangle get
+                                   (0, 1, 0)) */
+    bool skip_data_check;       /* false -> validate also checks every weight, joint index,
+                                   position and triangle index (O(n)); true -> only the O(1)
+                                   rules. Unchecked joint indices are clamped to the palette,
+                                   so bad data never reads out of bounds. */
+    bool skip_simd;             /* false -> fastest kernel for this CPU; true -> scalar code */
+    uint32_t thread_count;      /* 0 or 1 -> calling thread; n (<= 64) -> n contiguous ranges,
+                                   n - 1 of them on new pthreads (falls back to the calling
+                                   thread when a thread cannot start) */
+    ak_u8_span scratch;         /* DQS/COR: >= ak_skin_job_scratch_size(job) bytes, any
+                                   alignment; LBS: unused */
+    ak_stream out_positions;    /* required: count >= vertex count; must not overlap inputs */
+    ak_stream out_normals;      /* required when normals.ptr or normals_from_faces */
+    ak_stream out_tangents;     /* required when tangents.ptr */
+} ak_skin_job;
+
+/* Bytes of scratch the job needs: 0 for LBS, 64 + 128 * palette.count for DQS and CoR. */
+AK_API size_t ak_skin_job_scratch_size(const ak_skin_job* job);
+
+/* Check the job. Rules, in order (the first that fails is returned):
+ *  1. AK_ERR_NULL_ARG: job, positions.ptr, palette.ptr, joints.ptr, weights.ptr or
+ *     out_positions.ptr is NULL (a zero-initialised job fails here);
+ *  2. AK_ERR_BAD_ARG: method out of range, influence_count 0 or > 8, thread_count > 64, a
+ *     nonzero stride smaller than its element;
+ *  3. AK_ERR_NULL_ARG: normals or normals_from_faces without out_normals.ptr, tangents without
+ *     out_tangents.ptr, COR without cor_centers.ptr, normals_from_faces without indices.ptr;
+ *  4. AK_ERR_BAD_ARG: indices.count % 3 != 0 (when normals_from_faces);
+ *  5. AK_ERR_SPAN_SMALL: any input stream or output shorter than the vertex count, scratch
+ *     smaller than ak_skin_job_scratch_size;
+ *  6. AK_ERR_BAD_DATA: a palette matrix holds NaN or infinity;
+ *  7. (unless skip_data_check) AK_ERR_BAD_WEIGHTS: a weight is NaN or negative, or a vertex's
+ *     weights do not sum to 1 within 1e-3; AK_ERR_BAD_INDEX: a joint index >= palette.count;
+ *     AK_ERR_BAD_DATA: a position, normal or center is not finite; AK_ERR_BAD_INDEX: a
+ *     triangle index >= vertex count. */
+AK_API ak_result ak_skin_job_validate(const ak_skin_job* job);
+
+/* Validate, then deform (writing nothing when validation fails). Degenerate blends never
+ * give NaN: a normal whose transform vanishes comes out (0, 0, 0). Returns the validate codes. */
+AK_API ak_result ak_skin_job_run(const ak_skin_job* job);
+
+/* A copy of job restricted to vertices [first_vertex, first_vertex + vertex_count): every
+ * per-vertex stream is offset, palette and scratch are shared (scratch is only read after
+ * ak_skin_job_run's per-call preparation, so give each part its own scratch when running
+ * parts concurrently). normals_from_faces is not splittable: the part gets AK_ERR_BAD_ARG.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (range beyond positions.count, normals_from_faces). */
+AK_API ak_result ak_skin_job_split(const ak_skin_job* job, size_t first_vertex, size_t vertex_count,
+                                   ak_skin_job* out_part);
+
+/* Name of the kernel ak_skin_job_run uses on this CPU: "avx2" or "scalar". */
+AK_API const char* ak_skin_simd_name(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ANIMKIT_SKIN_H */

@@ -1,0 +1,463 @@
+/* The skinning job: validation, per-joint preparation, the scalar reference kernels for LBS,
+ * DQS and CoR, thread split and face-normal recomputation. The AVX2 kernel is in
+ * deform_avx2.c and is only used for configurations it handles (see akp_skin_range_avx2). */
+#include <pthread.h> /* thread_count > 1 */
+
+#include "skin_internal.h"
+
+/* ---- small helpers ---------------------------------------------------------------------- */
+
+static size_t stride_or(size_t stride, size_t tight) { return stride ? stride : tight; }
+
+static ak_vec3 load3(const char* base, size_t stride, size_t i) {
+    float f[3];
+    memcpy(f, base + i * stride, sizeof f);
+    return ak_vec3_make(f[0], f[1], f[2]);
+}
+static void store3(char* base, size_t stride, size_t i, ak_vec3 v) {
+    float f[3] = {v.x, v.y, v.z};
+    memcpy(base + i * stride, f, sizeof f);
+}
+
+/* 3x4 affine in columns: c[0..2] linear part, c[3] translation. */
+typedef struct affine34 {
+    ak_vec3 c[4];
+} affine34;
+
+static affine34 affine_from_mat4(const ak_mat4* m) {
+    affine34 a;
+    for (int i = 0; i < 4; ++i) a.c[i] = ak_vec3_make(m->m[i * 4], m->m[i * 4 + 1], m->m[i * 4 + 2]);
+    return a;
+}
+static ak_vec3 lin_apply(const ak_vec3* c, ak_vec3 v) {
+    return ak_vec3_add(ak_vec3_add(ak_vec3_scale(c[0], v.x), ak_vec3_scale(c[1], v.y)), ak_vec3_scale(c[2], v.z));
+}
+/* Inverse transpose of the linear part applied to n, up to the positive factor 1/|det|, then
+ * normalised (cof(A) n * sign(det)); a vanishing result gives zero. */
+static ak_vec3 normal_apply(const ak_vec3* c, ak_vec3 n) {
+    ak_vec3 k0 = ak_vec3_cross(c[1], c[2]), k1 = ak_vec3_cross(c[2], c[0]), k2 = ak_vec3_cross(c[0], c[1]);
+    float det = ak_vec3_dot(c[0], k0);
+    ak_vec3 r = ak_vec3_add(ak_vec3_add(ak_vec3_scale(k0, n.x), ak_vec3_scale(k1, n.y)), ak_vec3_scale(k2, n.z));
+    if (det < 0.0f) r = ak_vec3_neg(r);
+    return ak_vec3_normalize(r);
+}
+
+/* Polar decomposition A = R S (R a rotation, S symmetric) by Newton iteration in double:
+ * X <- (X + X^-T) / 2. A negative determinant is folded into S (R from -A). */
+static void polar3(const double a[9], double r[9]) {
+    double det = a[0] * (a[4] * a[8] - a[7] * a[5]) - a[3] * (a[1] * a[8] - a[7] * a[2]) +
+                 a[6] * (a[1] * a[5] - a[4] * a[2]);
+    double sgn = det < 0.0 ? -1.0 : 1.0;
+    double x[9];
+    for (int i = 0; i < 9; ++i) x[i] = sgn * a[i];
+    if (!(fabs(det) > 1e-30)) {
+        for (int i = 0; i < 9; ++i) r[i] = (i % 4 == 0) ? 1.0 : 0.0;
+        return;
+    }
+    for (int it = 0; it < 40; ++it) {
+        /* column-major: x[c*3 + r]; inverse transpose = cofactor / det */
+        double c00 = x[4] * x[8] - x[5] * x[7], c01 = x[5] * x[6] - x[3] * x[8], c02 = x[3] * x[7] - x[4] * x[6];
+        double c10 = x[7] * x[2] - x[8] * x[1], c11 = x[8] * x[0] - x[6] * x[2], c12 = x[6] * x[1] - x[7] * x[0];
+        double c20 = x[1] * x[5] - x[2] * x[4], c21 = x[2] * x[3] - x[0] * x[5], c22 = x[0] * x[4] - x[1] * x[3];
+        double d = x[0] * c00 + x[1] * c01 + x[2] * c02;
+        if (!(fabs(d) > 1e-300)) break;
+        /* cofactor matrix as columns: column 0 = (c00, c10, c20)^T in row terms ... the inverse
+         * transpose's element (row i, col j) is cof(i, j) / d where cof(i,j) multiplies x(i,j). */
+        double it_[9] = {c00 / d, c01 / d, c02 / d, c10 / d, c11 / d, c12 / d, c20 / d, c21 / d, c22 / d};
+        double diff = 0.0;
+        for (int i = 0; i < 9; ++i) {
+            double nx = 0.5 * (x[i] + it_[i]);
+            diff += fabs(nx - x[i]);
+            x[i] = nx;
+        }
+        if (diff < 1e-15) break;
+    }
+    memcpy(r, x, sizeof x);
+}
+
+static void prepare_joint(const ak_mat4* m, akp_skin_joint* out, bool* out_stretch) {
+    double a[9], r[9];
+    for (int c = 0; c < 3; ++c)
+        for (int row = 0; row < 3; ++row) a[c * 3 + row] = m->m[c * 4 + row];
+    polar3(a, r);
+    ak_mat3 rf;
+    for (int i = 0; i < 9; ++i) rf.m[i] = (float)r[i];
+    ak_quat q = ak_quat_from_mat3(rf);
+    ak_vec3 t = ak_vec3_make(m->m[12], m->m[13], m->m[14]);
+    ak_quat d = ak_quat_scale(ak_quat_mul(ak_quat_make(t.x, t.y, t.z, 0.0f), q), 0.5f);
+    out->real[0] = q.x; out->real[1] = q.y; out->real[2] = q.z; out->real[3] = q.w;
+    out->dual[0] = d.x; out->dual[1] = d.y; out->dual[2] = d.z; out->dual[3] = d.w;
+    /* S = R^T A: element (row i, col j) = sum_k R(k, i) A(k, j) */
+    bool stretch = false;
+    for (int j = 0; j < 3; ++j) {
+        for (int i = 0; i < 3; ++i) {
+            double s = 0.0;
+            for (int k = 0; k < 3; ++k) s += r[i * 3 + k] * a[j * 3 + k];
+            double ident = (i == j) ? 1.0 : 0.0;
+            if (fabs(s - ident) > 1e-5) stretch = true;
+            out->stretch[j * 4 + i] = (float)s;
+        }
+        out->stretch[j * 4 + 3] = 0.0f;
+    }
+    memset(out->pad, 0, sizeof out->pad);
+    if (!stretch) {
+        for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 4; ++i) out->stretch[j * 4 + i] = (i == j) ? 1.0f : 0.0f;
+    }
+    *out_stretch = stretch;
+}
+
+/* ---- scalar reference kernels ------------------------------------------------------------ */
+
+static void read_influences(const akp_skin_ctx* c, size_t i, uint16_t* j, float* w) {
+    memcpy(j, c->jnt + i * c->jnt_stride, c->k * sizeof(uint16_t));
+    memcpy(w, c->wgt + i * c->wgt_stride, c->k * sizeof(float));
+    for (uint32_t k = 0; k < c->k; ++k)
+        if (j[k] >= c->palette_count) j[k] = (uint16_t)(c->palette_count - 1);
+}
+
+static uint32_t argmax_weight(const float* w, uint32_t k) {
+    uint32_t best = 0;
+    for (uint32_t i = 1; i < k; ++i)
+        if (w[i] > w[best]) best = i;
+    return best;
+}
+
+/* Hemisphere-aligned blend of the joints' rotation (and dual) quaternions. */
+static void blend_quats(const akp_skin_ctx* c, const uint16_t* j, const float* w, ak_quat* real, ak_quat* dual) {
+    const akp_skin_joint* ref = &c->joints_prep[j[argmax_weight(w, c->k)]];
+    float br[4] = {0, 0, 0, 0}, bd[4] = {0, 0, 0, 0};
+    for (uint32_t k = 0; k < c->k; ++k) {
+        const akp_skin_joint* p = &c->joints_prep[j[k]];
+        float d = p->real[0] * ref->real[0] + p->real[1] * ref->real[1] + p->real[2] * ref->real[2] +
+                  p->real[3] * ref->real[3];
+        float wk = d < 0.0f ? -w[k] : w[k];
+        for (int e = 0; e < 4; ++e) {
+            br[e] += wk * p->real[e];
+            bd[e] += wk * p->dual[e];
+        }
+    }
+    float n2 = br[0] * br[0] + br[1] * br[1] + br[2] * br[2] + br[3] * br[3];
+    float inv = n2 > 1e-30f ? 1.0f / sqrtf(n2) : 0.0f;
+    if (inv == 0.0f) { /* weights cancelled out (only with unchecked data): identity */
+        *real = ak_quat_identity();
+        *dual = ak_quat_make(0, 0, 0, 0);
+        return;
+    }
+    *real = ak_quat_make(br[0] * inv, br[1] * inv, br[2] * inv, br[3] * inv);
+    *dual = ak_quat_make(bd[0] * inv, bd[1] * inv, bd[2] * inv, bd[3] * inv);
+}
+
+static void blend_stretch(const akp_skin_ctx* c, const uint16_t* j, const float* w, ak_vec3* s) {
+    s[0] = s[1] = s[2] = ak_vec3_zero();
+    for (uint32_t k = 0; k < c->k; ++k) {
+        const float* m = c->joints_prep[j[k]].stretch;
+        for (int col = 0; col < 3; ++col)
+            s[col] = ak_vec3_madd(s[col], ak_vec3_make(m[col * 4], m[col * 4 + 1], m[col * 4 + 2]), w[k]);
+    }
+}
+
+static affine34 blend_matrix(const akp_skin_ctx* c, const uint16_t* j, const float* w) {
+    affine34 b;
+    memset(&b, 0, sizeof b);
+    for (uint32_t k = 0; k < c->k; ++k) {
+        affine34 m = affine_from_mat4(&c->palette[j[k]]);
+        for (int col = 0; col < 4; ++col) b.c[col] = ak_vec3_madd(b.c[col], m.c[col], w[k]);
+    }
+    return b;
+}
+
+/* Translation of the unit dual quaternion (real, dual): 2 (w dv - dw v + v x dv). */
+static ak_vec3 dq_translation(ak_quat r, ak_quat d) {
+    ak_vec3 v = ak_vec3_make(r.x, r.y, r.z), dv = ak_vec3_make(d.x, d.y, d.z);
+    ak_vec3 t = ak_vec3_sub(ak_vec3_scale(dv, r.w), ak_vec3_scale(v, d.w));
+    return ak_vec3_scale(ak_vec3_add(t, ak_vec3_cross(v, dv)), 2.0f);
+}
+
+void akp_skin_range_scalar(const akp_skin_ctx* c, size_t begin, size_t end) {
+    uint16_t j[AK_MAX_INFLUENCES];
+    float w[AK_MAX_INFLUENCES];
+    for (size_t i = begin; i < end; ++i) {
+        read_influences(c, i, j, w);
+        ak_vec3 p = load3(c->pos, c->pos_stride, i);
+        ak_vec3 n = c->do_normals ? load3(c->nrm, c->nrm_stride, i) : ak_vec3_zero();
+        float tan4[4] = {0, 0, 0, 0};
+        if (c->do_tangents) memcpy(tan4, c->tan + i * c->tan_stride, sizeof tan4);
+        ak_vec3 t = ak_vec3_make(tan4[0], tan4[1], tan4[2]);
+        ak_vec3 op, on = ak_vec3_zero(), ot = ak_vec3_zero();
+        if (c->method == AK_SKIN_LBS) {
+            affine34 b = blend_matrix(c, j, w);
+            op = ak_vec3_add(lin_apply(b.c, p), b.c[3]);
+            if (c->do_normals) on = normal_apply(b.c, n);
+            if (c->do_tangents) ot = ak_vec3_normalize(lin_apply(b.c, t));
+        } else {
+            ak_quat qr, qd;
+            blend_quats(c, j, w, &qr, &qd);
+            ak_vec3 s[3];
+            bool stretch = c->any_stretch;
+            if (stretch) blend_stretch(c, j, w, s);
+            if (c->method == AK_SKIN_DQS) {
+                ak_vec3 ps = stretch ? lin_apply(s, p) : p;
+                op = ak_vec3_add(ak_quat_rotate(qr, ps), dq_translation(qr, qd));
+            } else {
+                ak_vec3 center = load3(c->ctr, c->ctr_stride, i);
+                affine34 b = blend_matrix(c, j, w);
+                ak_vec3 moved = ak_vec3_add(lin_apply(b.c, center), b.c[3]);
+                ak_vec3 d = ak_vec3_sub(p, center);
+                if (stretch) d = lin_apply(s, d);
+                op = ak_vec3_add(ak_quat_rotate(qr, d), moved);
+            }
+            if (c->do_normals) on = ak_vec3_normalize(ak_quat_rotate(qr, stretch ? normal_apply(s, n) : n));
+            if (c->do_tangents) ot = ak_vec3_normalize(ak_quat_rotate(qr, stretch ? lin_apply(s, t) : t));
+        }
+        store3(c->out_pos, c->out_pos_stride, i, op);
+        if (c->do_normals) store3(c->out_nrm, c->out_nrm_stride, i, on);
+        if (c->do_tangents) {
+            float o4[4] = {ot.x, ot.y, ot.z, tan4[3]};
+            memcpy(c->out_tan + i * c->out_tan_stride, o4, sizeof o4);
+        }
+    }
+}
+
+/* ---- public ------------------------------------------------------------------------------ */
+
+size_t ak_skin_job_scratch_size(const ak_skin_job* job) {
+    if (!job || job->method == AK_SKIN_LBS || job->method >= AK_SKIN_METHOD_COUNT) return 0;
+    return 64 + sizeof(akp_skin_joint) * job->palette.count;
+}
+
+static bool stride_ok(size_t stride, size_t elem) { return stride == 0 || stride >= elem; }
+
+static bool finite3(const char* base, size_t stride, size_t i) {
+    return ak_vec3_is_finite(load3(base, stride, i));
+}
+
+ak_result ak_skin_job_validate(const ak_skin_job* job) {
+    if (!job || !job->positions.ptr || !job->palette.ptr || !job->joints.ptr || !job->weights.ptr ||
+        !job->out_positions.ptr)
+        return AK_ERR_NULL_ARG;
+    if (job->palette.count == 0) return AK_ERR_NULL_ARG;
+    const uint32_t k = job->influence_count;
+    if ((unsigned)job->method >= AK_SKIN_METHOD_COUNT || k == 0 || k > AK_MAX_INFLUENCES || job->thread_count > 64)
+        return AK_ERR_BAD_ARG;
+    if (!stride_ok(job->positions.stride, 12) || !stride_ok(job->normals.stride, 12) ||
+        !stride_ok(job->tangents.stride, 16) || !stride_ok(job->cor_centers.stride, 12) ||
+        !stride_ok(job->joints.stride, 2u * k) || !stride_ok(job->weights.stride, 4u * k) ||
+        !stride_ok(job->out_positions.stride, 12) || !stride_ok(job->out_normals.stride, 12) ||
+        !stride_ok(job->out_tangents.stride, 16))
+        return AK_ERR_BAD_ARG;
+    const bool want_normals = job->normals.ptr != NULL || job->normals_from_faces;
+    if ((want_normals && !job->out_normals.ptr) || (job->tangents.ptr && !job->out_tangents.ptr) ||
+        (job->method == AK_SKIN_COR && !job->cor_centers.ptr) || (job->normals_from_faces && !job->indices.ptr))
+        return AK_ERR_NULL_ARG;
+    if (job->normals_from_faces && job->indices.count % 3 != 0) return AK_ERR_BAD_ARG;
+    const size_t n = job->positions.count;
+    if (job->joints.count < n || job->weights.count < n || job->out_positions.count < n)
+        return AK_ERR_SPAN_SMALL;
+    if (job->normals.ptr && !job->normals_from_faces && job->normals.count < n) return AK_ERR_SPAN_SMALL;
+    if (want_normals && job->out_normals.count < n) return AK_ERR_SPAN_SMALL;
+    if (job->tangents.ptr && (job->tangents.count < n || job->out_tangents.count < n)) return AK_ERR_SPAN_SMALL;
+    if (job->method == AK_SKIN_COR && job->cor_centers.count < n) return AK_ERR_SPAN_SMALL;
+    if (job->scratch.count < ak_skin_job_scratch_size(job) ||
+        (ak_skin_job_scratch_size(job) > 0 && !job->scratch.ptr))
+        return AK_ERR_SPAN_SMALL;
+    for (size_t j = 0; j < job->palette.count; ++j)
+        if (!ak_mat4_is_finite(&job->palette.ptr[j])) return AK_ERR_BAD_DATA;
+    if (job->skip_data_check) return AK_OK;
+
+    const size_t js = stride_or(job->joints.stride, 2u * k), ws = stride_or(job->weights.stride, 4u * k);
+    const char* jb = (const char*)job->joints.ptr;
+    const char* wb = (const char*)job->weights.ptr;
+    for (size_t i = 0; i < n; ++i) {
+        float w[AK_MAX_INFLUENCES];
+        uint16_t jj[AK_MAX_INFLUENCES];
+        memcpy(w, wb + i * ws, k * sizeof(float));
+        memcpy(jj, jb + i * js, k * sizeof(uint16_t));
+        double sum = 0.0;
+        for (uint32_t e = 0; e < k; ++e) {
+            if (!(w[e] >= 0.0f) || !ak_finitef(w[e])) return AK_ERR_BAD_WEIGHTS;
+            sum += w[e];
+        }
+        if (fabs(sum - 1.0) > 1e-3) return AK_ERR_BAD_WEIGHTS;
+        for (uint32_t e = 0; e < k; ++e)
+            if (jj[e] >= job->palette.count) return AK_ERR_BAD_INDEX;
+    }
+    const size_t ps = stride_or(job->positions.stride, 12);
+    for (size_t i = 0; i < n; ++i)
+        if (!finite3((const char*)job->positions.ptr, ps, i)) return AK_ERR_BAD_DATA;
+    if (job->normals.ptr && !job->normals_from_faces) {
+        const size_t s = stride_or(job->normals.stride, 12);
+        for (size_t i = 0; i < n; ++i)
+            if (!finite3((const char*)job->normals.ptr, s, i)) return AK_ERR_BAD_DATA;
+    }
+    if (job->method == AK_SKIN_COR) {
+        const size_t s = stride_or(job->cor_centers.stride, 12);
+        for (size_t i = 0; i < n; ++i)
+            if (!finite3((const char*)job->cor_centers.ptr, s, i)) return AK_ERR_BAD_DATA;
+    }
+    if (job->normals_from_faces)
+        for (size_t i = 0; i < job->indices.count; ++i)
+            if (job->indices.ptr[i] >= n) return AK_ERR_BAD_INDEX;
+    return AK_OK;
+}
+
+static akp_skin_ctx make_ctx(const ak_skin_job* job, const akp_skin_joint* prep, bool any_stretch) {
+    akp_skin_ctx c;
+    memset(&c, 0, sizeof c);
+    c.method = job->method;
+    c.k = job->influence_count;
+    c.palette = job->palette.ptr;
+    c.palette_count = job->palette.count;
+    c.joints_prep = prep;
+    c.any_stretch = any_stretch;
+    c.pos = (const char*)job->positions.ptr;
+    c.pos_stride = stride_or(job->positions.stride, 12);
+    c.jnt = (const char*)job->joints.ptr;
+    c.jnt_stride = stride_or(job->joints.stride, 2u * c.k);
+    c.wgt = (const char*)job->weights.ptr;
+    c.wgt_stride = stride_or(job->weights.stride, 4u * c.k);
+    c.do_normals = job->normals.ptr != NULL && !job->normals_from_faces;
+    c.nrm = (const char*)job->normals.ptr;
+    c.nrm_stride = stride_or(job->normals.stride, 12);
+    c.do_tangents = job->tangents.ptr != NULL;
+    c.tan = (const char*)job->tangents.ptr;
+    c.tan_stride = stride_or(job->tangents.stride, 16);
+    c.ctr = (const char*)job->cor_centers.ptr;
+    c.ctr_stride = stride_or(job->cor_centers.stride, 12);
+    c.out_pos = (char*)job->out_positions.ptr;
+    c.out_pos_stride = stride_or(job->out_positions.stride, 12);
+    c.out_nrm = (char*)job->out_normals.ptr;
+    c.out_nrm_stride = stride_or(job->out_normals.stride, 12);
+    c.out_tan = (char*)job->out_tangents.ptr;
+    c.out_tan_stride = stride_or(job->out_tangents.stride, 16);
+    return c;
+}
+
+typedef struct range_task {
+    const akp_skin_ctx* ctx;
+    size_t begin, end;
+    bool simd;
+} range_task;
+
+static void run_range(const range_task* t) {
+    if (t->begin >= t->end) return;
+    if (t->simd && akp_skin_range_avx2(t->ctx, t->begin, t->end)) return;
+    akp_skin_range_scalar(t->ctx, t->begin, t->end);
+}
+
+static void* range_thread(void* arg) {
+    run_range((const range_task*)arg);
+    return NULL;
+}
+
+static void normals_from_faces(const ak_skin_job* job) {
+    const size_t n = job->positions.count;
+    const size_t ps = stride_or(job->out_positions.stride, 12), ns = stride_or(job->out_normals.stride, 12);
+    const char* pos = (const char*)job->out_positions.ptr;
+    char* nrm = (char*)job->out_normals.ptr;
+    for (size_t i = 0; i < n; ++i) store3(nrm, ns, i, ak_vec3_zero());
+    for (size_t t = 0; t + 2 < job->indices.count; t += 3) {
+        uint32_t a = job->indices.ptr[t], b = job->indices.ptr[t + 1], cc = job->indices.ptr[t + 2];
+        ak_vec3 pa = load3(pos, ps, a), pb = load3(pos, ps, b), pc = load3(pos, ps, cc);
+        ak_vec3 f = ak_vec3_cross(ak_vec3_sub(pb, pa), ak_vec3_sub(pc, pa)); /* 2 * area * normal */
+        store3(nrm, ns, a, ak_vec3_add(load3(nrm, ns, a), f));
+        store3(nrm, ns, b, ak_vec3_add(load3(nrm, ns, b), f));
+        store3(nrm, ns, cc, ak_vec3_add(load3(nrm, ns, cc), f));
+    }
+    for (size_t i = 0; i < n; ++i) {
+        ak_vec3 v = ak_vec3_normalize(load3(nrm, ns, i));
+        if (ak_vec3_length_sq(v) == 0.0f) v = ak_vec3_make(0.0f, 1.0f, 0.0f);
+        store3(nrm, ns, i, v);
+    }
+}
+
+ak_result ak_skin_job_run(const ak_skin_job* job) {
+    ak_result r = ak_skin_job_validate(job);
+    if (r != AK_OK) return r;
+    const size_t n = job->positions.count;
+    if (n == 0) return AK_OK;
+
+    akp_skin_joint* prep = NULL;
+    bool any_stretch = false;
+    if (job->method != AK_SKIN_LBS) {
+        uintptr_t base = (uintptr_t)job->scratch.ptr;
+        prep = (akp_skin_joint*)(void*)((base + 63u) & ~(uintptr_t)63u);
+        for (size_t j = 0; j < job->palette.count; ++j) {
+            bool s = false;
+            prepare_joint(&job->palette.ptr[j], &prep[j], &s);
+            any_stretch = any_stretch || s;
+        }
+    }
+    akp_skin_ctx ctx = make_ctx(job, prep, any_stretch);
+    bool simd = !job->skip_simd;
+#if defined(AK_NO_SIMD)
+    simd = false;
+#endif
+
+    uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
+    if (threads > n / 64 + 1) threads = (uint32_t)(n / 64 + 1);
+    range_task tasks[64];
+    pthread_t ids[64];
+    bool started[64];
+    size_t chunk = (n + threads - 1) / threads;
+    chunk = (chunk + 7u) & ~(size_t)7u; /* keep SIMD blocks whole */
+    for (uint32_t t = 0; t < threads; ++t) {
+        size_t b = (size_t)t * chunk, e = b + chunk;
+        if (b > n) b = n;
+        if (e > n) e = n;
+        tasks[t].ctx = &ctx;
+        tasks[t].begin = b;
+        tasks[t].end = e;
+        tasks[t].simd = simd;
+        started[t] = false;
+    }
+    for (uint32_t t = 1; t < threads; ++t)
+        started[t] = pthread_create(&ids[t], NULL, range_thread, &tasks[t]) == 0;
+    run_range(&tasks[0]);
+    for (uint32_t t = 1; t < threads; ++t) {
+        if (started[t]) pthread_join(ids[t], NULL);
+        else run_range(&tasks[t]);
+    }
+    if (job->normals_from_faces) normals_from_faces(job);
+    return AK_OK;
+}
+
+static ak_cstream offset_cstream(ak_cstream s, size_t tight, size_t first, size_t count) {
+    if (!s.ptr) return s;
+    size_t st = stride_or(s.stride, tight);
+    s.ptr = (const char*)s.ptr + first * st;
+    s.count = s.count > first ? s.count - first : 0;
+    if (s.count > count) s.count = count;
+    return s;
+}
+static ak_stream offset_stream(ak_stream s, size_t tight, size_t first, size_t count) {
+    if (!s.ptr) return s;
+    size_t st = stride_or(s.stride, tight);
+    s.ptr = (char*)s.ptr + first * st;
+    s.count = s.count > first ? s.count - first : 0;
+    if (s.count > count) s.count = count;
+    return s;
+}
+
+ak_result ak_skin_job_split(const ak_skin_job* job, size_t first_vertex, size_t vertex_count, ak_skin_job* out_part) {
+    if (!job || !out_part) return AK_ERR_NULL_ARG;
+    if (job->normals_from_faces || first_vertex > job->positions.count ||
+        vertex_count > job->positions.count - first_vertex)
+        return AK_ERR_BAD_ARG;
+    const uint32_t k = job->influence_count;
+    ak_skin_job p = *job;
+    p.positions = offset_cstream(job->positions, 12, first_vertex, vertex_count);
+    p.positions.count = vertex_count;
+    p.joints = offset_cstream(job->joints, 2u * k, first_vertex, vertex_count);
+    p.weights = offset_cstream(job->weights, 4u * k, first_vertex, vertex_count);
+    p.normals = offset_cstream(job->normals, 12, first_vertex, vertex_count);
+    p.tangents = offset_cstream(job->tangents, 16, first_vertex, vertex_count);
+    p.cor_centers = offset_cstream(job->cor_centers, 12, first_vertex, vertex_count);
+    p.out_positions = offset_stream(job->out_positions, 12, first_vertex, vertex_count);
+    p.out_normals = offset_stream(job->out_normals, 12, first_vertex, vertex_count);
+    p.out_tangents = offset_stream(job->out_tangents, 16, first_vertex, vertex_count);
+    *out_part = p;
+    return AK_OK;
+}
+
+const char* ak_skin_simd_name(void) { return akp_skin_have_avx2() ? "avx2" : "scalar"; }

@@ -1,0 +1,336 @@
+/* AVX2 + FMA skinning kernel, vectorized across vertices (8 per block).
+ *
+ * Each block runs in two stages. Per vertex, the joint data are blended with contiguous
+ * loads (matrix columns for LBS and CoR, rotation|dual quaternion pairs for DQS), which avoids
+ * gathers (slow on every x86 core we target); the 8 blended results are then transposed into
+ * structure-of-arrays registers and the transform, normal and normalisation run 8-wide.
+ * Positions and normals are deinterleaved with shuffles when tightly packed (stride 12).
+ *
+ * Handled here: LBS, DQS, CoR with positions and optional normals, rigid or stretched
+ * palettes for LBS, rigid palettes for DQS/CoR. Tangents and stretched DQS/CoR palettes go
+ * to the scalar code (akp_skin_range_avx2 returns false). The block tail (< 8 vertices) also
+ * runs the scalar code.
+ *
+ * Compiled only for GCC/Clang on x86-64 without AK_NO_SIMD; selected at run time with
+ * __builtin_cpu_supports, so the library still runs on CPUs without AVX2. */
+#include "skin_internal.h"
+
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
+#define AKP_HAVE_AVX2_KERNEL 1
+#include <immintrin.h>
+#define AKP_AVX2 __attribute__((target("avx2,fma")))
+#else
+#define AKP_HAVE_AVX2_KERNEL 0
+#endif
+
+#if AKP_HAVE_AVX2_KERNEL
+
+bool akp_skin_have_avx2(void) { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+
+/* Transpose 8 rows of 8 floats (rows r[0..7]) into columns o[0..7]. */
+AKP_AVX2 static inline void transpose8(const __m256* r, __m256* o) {
+    __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+    __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
+    __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
+    __m256 s0 = _mm256_shuffle_ps(t0, t2, 0x44), s1 = _mm256_shuffle_ps(t0, t2, 0xEE);
+    __m256 s2 = _mm256_shuffle_ps(t1, t3, 0x44), s3 = _mm256_shuffle_ps(t1, t3, 0xEE);
+    __m256 s4 = _mm256_shuffle_ps(t4, t6, 0x44), s5 = _mm256_shuffle_ps(t4, t6, 0xEE);
+    __m256 s6 = _mm256_shuffle_ps(t5, t7, 0x44), s7 = _mm256_shuffle_ps(t5, t7, 0xEE);
+    o[0] = _mm256_permute2f128_ps(s0, s4, 0x20);
+    o[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
+    o[2] = _mm256_permute2f128_ps(s2, s6, 0x20);
+    o[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
+    o[4] = _mm256_permute2f128_ps(s0, s4, 0x31);
+    o[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
+    o[6] = _mm256_permute2f128_ps(s2, s6, 0x31);
+    o[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
+}
+
+/* Load 8 xyz triples (stride bytes apart) as x, y, z vectors. Stride 12 uses shuffles: per
+ * 128-bit lane the three quads a = (x0 y0 z0 x1), b = (y1 z1 x2 y2), c = (z2 x3 y3 z3). */
+AKP_AVX2 static inline void load_xyz8(const char* p, size_t stride, __m256* x, __m256* y, __m256* z) {
+    if (stride == 12) {
+        const float* f = (const float*)(const void*)p;
+        __m256 a = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f)), _mm_loadu_ps(f + 12), 1);
+        __m256 b = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f + 4)), _mm_loadu_ps(f + 16), 1);
+        __m256 c = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f + 8)), _mm_loadu_ps(f + 20), 1);
+        __m256 t = _mm256_shuffle_ps(b, c, _MM_SHUFFLE(2, 1, 3, 2)); /* x2 y2 x3 y3 */
+        __m256 u = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(1, 0, 2, 1)); /* y0 z0 y1 z1 */
+        *x = _mm256_shuffle_ps(a, t, _MM_SHUFFLE(2, 0, 3, 0));
+        *y = _mm256_shuffle_ps(u, t, _MM_SHUFFLE(3, 1, 2, 0));
+        *z = _mm256_shuffle_ps(u, c, _MM_SHUFFLE(3, 0, 3, 1));
+        return;
+    }
+    float v[8][3];
+    for (int i = 0; i < 8; ++i) memcpy(v[i], p + (size_t)i * stride, 12);
+    *x = _mm256_setr_ps(v[0][0], v[1][0], v[2][0], v[3][0], v[4][0], v[5][0], v[6][0], v[7][0]);
+    *y = _mm256_setr_ps(v[0][1], v[1][1], v[2][1], v[3][1], v[4][1], v[5][1], v[6][1], v[7][1]);
+    *z = _mm256_setr_ps(v[0][2], v[1][2], v[2][2], v[3][2], v[4][2], v[5][2], v[6][2], v[7][2]);
+}
+
+/* Inverse of load_xyz8. */
+AKP_AVX2 static inline void store_xyz8(char* p, size_t stride, __m256 x, __m256 y, __m256 z) {
+    if (stride == 12) {
+        float* f = (float*)(void*)p;
+        __m256 pp = _mm256_shuffle_ps(x, y, _MM_SHUFFLE(2, 0, 2, 0)); /* x0 x2 y0 y2 */
+        __m256 q = _mm256_shuffle_ps(y, z, _MM_SHUFFLE(3, 1, 3, 1));  /* y1 y3 z1 z3 */
+        __m256 r = _mm256_shuffle_ps(z, x, _MM_SHUFFLE(3, 1, 2, 0));  /* z0 z2 x1 x3 */
+        __m256 a = _mm256_shuffle_ps(pp, r, _MM_SHUFFLE(2, 0, 2, 0));
+        __m256 b = _mm256_shuffle_ps(q, pp, _MM_SHUFFLE(3, 1, 2, 0));
+        __m256 c = _mm256_shuffle_ps(r, q, _MM_SHUFFLE(3, 1, 3, 1));
+        _mm_storeu_ps(f, _mm256_castps256_ps128(a));
+        _mm_storeu_ps(f + 4, _mm256_castps256_ps128(b));
+        _mm_storeu_ps(f + 8, _mm256_castps256_ps128(c));
+        _mm_storeu_ps(f + 12, _mm256_extractf128_ps(a, 1));
+        _mm_storeu_ps(f + 16, _mm256_extractf128_ps(b, 1));
+        _mm_storeu_ps(f + 20, _mm256_extractf128_ps(c, 1));
+        return;
+    }
+    float vx[8], vy[8], vz[8];
+    _mm256_storeu_ps(vx, x);
+    _mm256_storeu_ps(vy, y);
+    _mm256_storeu_ps(vz, z);
+    for (int i = 0; i < 8; ++i) {
+        float v[3] = {vx[i], vy[i], vz[i]};
+        memcpy(p + (size_t)i * stride, v, 12);
+    }
+}
+
+/* (x, y, z) / |(x, y, z)| with rsqrt + one Newton step; a zero vector stays zero. */
+AKP_AVX2 static inline void normalize8(__m256* x, __m256* y, __m256* z) {
+    __m256 l2 = _mm256_fmadd_ps(*x, *x, _mm256_fmadd_ps(*y, *y, _mm256_mul_ps(*z, *z)));
+    l2 = _mm256_max_ps(l2, _mm256_set1_ps(1e-30f));
+    __m256 r = _mm256_rsqrt_ps(l2);
+    /* r' = r (1.5 - 0.5 l2 r^2) */
+    __m256 h = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), l2), _mm256_mul_ps(r, r));
+    r = _mm256_mul_ps(r, _mm256_sub_ps(_mm256_set1_ps(1.5f), h));
+    *x = _mm256_mul_ps(*x, r);
+    *y = _mm256_mul_ps(*y, r);
+    *z = _mm256_mul_ps(*z, r);
+}
+
+/* a x b, componentwise vectors. */
+#define AKP_CROSS(ax, ay, az, bx, by, bz, ox, oy, oz)                                      \
+    do {                                                                                   \
+        ox = _mm256_fmsub_ps(ay, bz, _mm256_mul_ps(az, by));                               \
+        oy = _mm256_fmsub_ps(az, bx, _mm256_mul_ps(ax, bz));                               \
+        oz = _mm256_fmsub_ps(ax, by, _mm256_mul_ps(ay, bx));                               \
+    } while (0)
+
+/* Rotate (px, py, pz) by unit quaternions (qx, qy, qz, qw): p + w t + v x t, t = 2 v x p. */
+AKP_AVX2 static inline void rotate8(__m256 qx, __m256 qy, __m256 qz, __m256 qw, __m256* px, __m256* py,
+                                     __m256* pz) {
+    __m256 tx, ty, tz, ux, uy, uz;
+    AKP_CROSS(qx, qy, qz, *px, *py, *pz, tx, ty, tz);
+    tx = _mm256_add_ps(tx, tx);
+    ty = _mm256_add_ps(ty, ty);
+    tz = _mm256_add_ps(tz, tz);
+    AKP_CROSS(qx, qy, qz, tx, ty, tz, ux, uy, uz);
+    *px = _mm256_add_ps(_mm256_fmadd_ps(qw, tx, *px), ux);
+    *py = _mm256_add_ps(_mm256_fmadd_ps(qw, ty, *py), uy);
+    *pz = _mm256_add_ps(_mm256_fmadd_ps(qw, tz, *pz), uz);
+}
+
+static inline uint32_t clamp_joint(uint32_t j, size_t count) { return j < count ? j : (uint32_t)(count - 1); }
+
+/* Blend the palette matrices of vertex i: rows out[0] = (c0, c1), out[1] = (c2, c3), each
+ * column with its w row (which holds 0 for affine matrices and is overwritten by CoR). */
+AKP_AVX2 static inline void blend_matrix_vertex(const akp_skin_ctx* c, size_t i, uint32_t K, __m256* out01,
+                                                __m256* out23) {
+    uint16_t jj[AK_MAX_INFLUENCES];
+    float ww[AK_MAX_INFLUENCES];
+    memcpy(jj, c->jnt + i * c->jnt_stride, K * sizeof(uint16_t));
+    memcpy(ww, c->wgt + i * c->wgt_stride, K * sizeof(float));
+    __m256 a01 = _mm256_setzero_ps(), a23 = _mm256_setzero_ps();
+    for (uint32_t k = 0; k < K; ++k) {
+        const float* m = c->palette[clamp_joint(jj[k], c->palette_count)].m;
+        __m256 w = _mm256_set1_ps(ww[k]);
+        a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
+        a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
+    }
+    *out01 = a01;
+    *out23 = a23;
+}
+
+/* Hemisphere-aligned blend of (real | dual) quaternions of vertex i. */
+AKP_AVX2 static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size_t i, uint32_t K) {
+    uint16_t jj[AK_MAX_INFLUENCES];
+    float ww[AK_MAX_INFLUENCES];
+    memcpy(jj, c->jnt + i * c->jnt_stride, K * sizeof(uint16_t));
+    memcpy(ww, c->wgt + i * c->wgt_stride, K * sizeof(float));
+    uint32_t best = 0;
+    for (uint32_t k = 1; k < K; ++k)
+        if (ww[k] > ww[best]) best = k;
+    const __m128 ref = _mm_loadu_ps(c->joints_prep[clamp_joint(jj[best], c->palette_count)].real);
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    __m256 acc = _mm256_setzero_ps();
+    for (uint32_t k = 0; k < K; ++k) {
+        __m256 d = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[k], c->palette_count)].real);
+        __m128 pr = _mm_mul_ps(_mm256_castps256_ps128(d), ref);
+        pr = _mm_add_ps(pr, _mm_movehl_ps(pr, pr));
+        pr = _mm_add_ss(pr, _mm_shuffle_ps(pr, pr, 1));
+        __m128 w = _mm_xor_ps(_mm_load_ss(&ww[k]), _mm_and_ps(pr, sign));
+        acc = _mm256_fmadd_ps(d, _mm256_broadcastss_ps(w), acc);
+    }
+    return acc;
+}
+
+AKP_AVX2 static void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+    __m256 rows[8], cols[8];
+    __m256 c01[8], c23[8];
+    for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
+    for (int v = 0; v < 8; ++v) rows[v] = c01[v];
+    transpose8(rows, cols);
+    const __m256 ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];
+    for (int v = 0; v < 8; ++v) rows[v] = c23[v];
+    transpose8(rows, cols);
+    const __m256 cx = cols[0], cy = cols[1], cz = cols[2], tx = cols[4], ty = cols[5], tz = cols[6];
+
+    __m256 px, py, pz;
+    load_xyz8(c->pos + i0 * c->pos_stride, c->pos_stride, &px, &py, &pz);
+    __m256 ox = _mm256_fmadd_ps(ax, px, _mm256_fmadd_ps(bx, py, _mm256_fmadd_ps(cx, pz, tx)));
+    __m256 oy = _mm256_fmadd_ps(ay, px, _mm256_fmadd_ps(by, py, _mm256_fmadd_ps(cy, pz, ty)));
+    __m256 oz = _mm256_fmadd_ps(az, px, _mm256_fmadd_ps(bz, py, _mm256_fmadd_ps(cz, pz, tz)));
+    store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, ox, oy, oz);
+    if (!c->do_normals) return;
+
+    __m256 nx, ny, nz, k0x, k0y, k0z, k1x, k1y, k1z, k2x, k2y, k2z;
+    load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
+    AKP_CROSS(bx, by, bz, cx, cy, cz, k0x, k0y, k0z); /* cofactor columns */
+    AKP_CROSS(cx, cy, cz, ax, ay, az, k1x, k1y, k1z);
+    AKP_CROSS(ax, ay, az, bx, by, bz, k2x, k2y, k2z);
+    __m256 det = _mm256_fmadd_ps(ax, k0x, _mm256_fmadd_ps(ay, k0y, _mm256_mul_ps(az, k0z)));
+    __m256 s = _mm256_and_ps(det, _mm256_set1_ps(-0.0f));
+    __m256 mx = _mm256_fmadd_ps(k0x, nx, _mm256_fmadd_ps(k1x, ny, _mm256_mul_ps(k2x, nz)));
+    __m256 my = _mm256_fmadd_ps(k0y, nx, _mm256_fmadd_ps(k1y, ny, _mm256_mul_ps(k2y, nz)));
+    __m256 mz = _mm256_fmadd_ps(k0z, nx, _mm256_fmadd_ps(k1z, ny, _mm256_mul_ps(k2z, nz)));
+    mx = _mm256_xor_ps(mx, s);
+    my = _mm256_xor_ps(my, s);
+    mz = _mm256_xor_ps(mz, s);
+    normalize8(&mx, &my, &mz);
+    store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, mx, my, mz);
+}
+
+/* Normalise 8 quaternions and scale 4 more lanes (the dual part) by the same factor. */
+AKP_AVX2 static inline __m256 quat_inv_norm8(__m256 x, __m256 y, __m256 z, __m256 w) {
+    __m256 n2 = _mm256_fmadd_ps(x, x, _mm256_fmadd_ps(y, y, _mm256_fmadd_ps(z, z, _mm256_mul_ps(w, w))));
+    __m256 ok = _mm256_cmp_ps(n2, _mm256_set1_ps(1e-30f), _CMP_GT_OQ);
+    n2 = _mm256_max_ps(n2, _mm256_set1_ps(1e-30f));
+    __m256 r = _mm256_rsqrt_ps(n2);
+    __m256 h = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), n2), _mm256_mul_ps(r, r));
+    r = _mm256_mul_ps(r, _mm256_sub_ps(_mm256_set1_ps(1.5f), h));
+    return _mm256_and_ps(r, ok);
+}
+
+AKP_AVX2 static void block_dqs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+    __m256 rows[8], q[8];
+    for (int v = 0; v < 8; ++v) rows[v] = blend_dq_vertex(c, i0 + (size_t)v, K);
+    transpose8(rows, q);
+    __m256 r = quat_inv_norm8(q[0], q[1], q[2], q[3]);
+    /* a vanished blend (r = 0) must act as the identity rotation, like the scalar code */
+    __m256 zero_w = _mm256_andnot_ps(_mm256_cmp_ps(r, _mm256_setzero_ps(), _CMP_NEQ_OQ), _mm256_set1_ps(1.0f));
+    __m256 qx = _mm256_mul_ps(q[0], r), qy = _mm256_mul_ps(q[1], r), qz = _mm256_mul_ps(q[2], r);
+    __m256 qw = _mm256_add_ps(_mm256_mul_ps(q[3], r), zero_w);
+    __m256 dx = _mm256_mul_ps(q[4], r), dy = _mm256_mul_ps(q[5], r), dz = _mm256_mul_ps(q[6], r);
+    __m256 dw = _mm256_mul_ps(q[7], r);
+    /* translation 2 (w dv - dw v + v x dv) */
+    __m256 cx, cy, cz;
+    AKP_CROSS(qx, qy, qz, dx, dy, dz, cx, cy, cz);
+    __m256 tx = _mm256_add_ps(_mm256_fmsub_ps(qw, dx, _mm256_mul_ps(dw, qx)), cx);
+    __m256 ty = _mm256_add_ps(_mm256_fmsub_ps(qw, dy, _mm256_mul_ps(dw, qy)), cy);
+    __m256 tz = _mm256_add_ps(_mm256_fmsub_ps(qw, dz, _mm256_mul_ps(dw, qz)), cz);
+    __m256 px, py, pz;
+    load_xyz8(c->pos + i0 * c->pos_stride, c->pos_stride, &px, &py, &pz);
+    rotate8(qx, qy, qz, qw, &px, &py, &pz);
+    px = _mm256_add_ps(px, _mm256_add_ps(tx, tx));
+    py = _mm256_add_ps(py, _mm256_add_ps(ty, ty));
+    pz = _mm256_add_ps(pz, _mm256_add_ps(tz, tz));
+    store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, px, py, pz);
+    if (!c->do_normals) return;
+    __m256 nx, ny, nz;
+    load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
+    rotate8(qx, qy, qz, qw, &nx, &ny, &nz);
+    normalize8(&nx, &ny, &nz);
+    store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
+}
+
+AKP_AVX2 static void block_cor(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+    __m256 r01[8], r23[8], cols[8];
+    const __m256i lo = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), hi = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
+    for (int v = 0; v < 8; ++v) {
+        blend_matrix_vertex(c, i0 + (size_t)v, K, &r01[v], &r23[v]);
+        /* the rotation blend goes into the unused w rows: (qx, qy) and (qz, qw) */
+        __m256 q = blend_dq_vertex(c, i0 + (size_t)v, K);
+        r01[v] = _mm256_blend_ps(r01[v], _mm256_permutevar8x32_ps(q, lo), 0x88);
+        r23[v] = _mm256_blend_ps(r23[v], _mm256_permutevar8x32_ps(q, hi), 0x88);
+    }
+    transpose8(r01, cols);
+    const __m256 ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];
+    __m256 qx = cols[3], qy = cols[7];
+    transpose8(r23, cols);
+    const __m256 cx = cols[0], cy = cols[1], cz = cols[2], tx = cols[4], ty = cols[5], tz = cols[6];
+    __m256 qz = cols[3], qw = cols[7];
+    __m256 r = quat_inv_norm8(qx, qy, qz, qw);
+    __m256 zero_w = _mm256_andnot_ps(_mm256_cmp_ps(r, _mm256_setzero_ps(), _CMP_NEQ_OQ), _mm256_set1_ps(1.0f));
+    qx = _mm256_mul_ps(qx, r);
+    qy = _mm256_mul_ps(qy, r);
+    qz = _mm256_mul_ps(qz, r);
+    qw = _mm256_add_ps(_mm256_mul_ps(qw, r), zero_w);
+
+    __m256 sx, sy, sz, px, py, pz;
+    load_xyz8(c->ctr + i0 * c->ctr_stride, c->ctr_stride, &sx, &sy, &sz);
+    load_xyz8(c->pos + i0 * c->pos_stride, c->pos_stride, &px, &py, &pz);
+    __m256 mx = _mm256_fmadd_ps(ax, sx, _mm256_fmadd_ps(bx, sy, _mm256_fmadd_ps(cx, sz, tx)));
+    __m256 my = _mm256_fmadd_ps(ay, sx, _mm256_fmadd_ps(by, sy, _mm256_fmadd_ps(cy, sz, ty)));
+    __m256 mz = _mm256_fmadd_ps(az, sx, _mm256_fmadd_ps(bz, sy, _mm256_fmadd_ps(cz, sz, tz)));
+    px = _mm256_sub_ps(px, sx);
+    py = _mm256_sub_ps(py, sy);
+    pz = _mm256_sub_ps(pz, sz);
+    rotate8(qx, qy, qz, qw, &px, &py, &pz);
+    store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, _mm256_add_ps(px, mx),
+               _mm256_add_ps(py, my), _mm256_add_ps(pz, mz));
+    if (!c->do_normals) return;
+    __m256 nx, ny, nz;
+    load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
+    rotate8(qx, qy, qz, qw, &nx, &ny, &nz);
+    normalize8(&nx, &ny, &nz);
+    store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
+}
+
+/* The block loops, specialised for 4 influences (the common case) so the compiler unrolls. */
+#define AKP_BLOCK_LOOP(fn)                                                                 \
+    AKP_AVX2 static void fn##_range(const akp_skin_ctx* c, size_t begin, size_t end) {     \
+        if (c->k == 4)                                                                     \
+            for (size_t i = begin; i < end; i += 8) fn(c, i, 4);                           \
+        else                                                                               \
+            for (size_t i = begin; i < end; i += 8) fn(c, i, c->k);                        \
+    }
+AKP_BLOCK_LOOP(block_lbs)
+AKP_BLOCK_LOOP(block_dqs)
+AKP_BLOCK_LOOP(block_cor)
+
+bool akp_skin_range_avx2(const akp_skin_ctx* c, size_t begin, size_t end) {
+    if (c->do_tangents || !akp_skin_have_avx2()) return false;
+    if (c->method != AK_SKIN_LBS && c->any_stretch) return false;
+    size_t blocks_end = begin + ((end - begin) & ~(size_t)7u);
+    if (blocks_end > begin) {
+        if (c->method == AK_SKIN_LBS) block_lbs_range(c, begin, blocks_end);
+        else if (c->method == AK_SKIN_DQS) block_dqs_range(c, begin, blocks_end);
+        else block_cor_range(c, begin, blocks_end);
+    }
+    if (blocks_end < end) akp_skin_range_scalar(c, blocks_end, end);
+    return true;
+}
+
+#else /* no AVX2 kernel in this build */
+
+bool akp_skin_have_avx2(void) { return false; }
+bool akp_skin_range_avx2(const akp_skin_ctx* c, size_t begin, size_t end) {
+    (void)c;
+    (void)begin;
+    (void)end;
+    return false;
+}
+
+#endif

@@ -1,0 +1,86 @@
+/* Shared between the skin module's .c files; never installed. */
+#ifndef ANIMKIT_SKIN_INTERNAL_H
+#define ANIMKIT_SKIN_INTERNAL_H
+
+#include <animkit/skin.h>
+
+#include "../internal.h"
+
+/* Per-joint data prepared once per run for DQS and CoR (lives in the job's scratch). */
+typedef struct akp_skin_joint {
+    float real[4];    /* rotation quaternion of the rigid part (x, y, z, w) */
+    float dual[4];    /* 0.5 * t * real */
+    float stretch[12]; /* S = R^T A, three columns padded to 4 floats */
+    float pad[12];
+} akp_skin_joint;
+
+/* Resolved view of a job for one vertex range; pointers already offset to vertex 0. */
+typedef struct akp_skin_ctx {
+    ak_skin_method method;
+    uint32_t k;                    /* influence count */
+    const ak_mat4* palette;
+    size_t palette_count;
+    const akp_skin_joint* joints_prep; /* DQS/CoR only */
+    bool any_stretch;              /* some joint has scale or shear */
+    const char *pos, *nrm, *tan, *jnt, *wgt, *ctr;
+    size_t pos_stride, nrm_stride, tan_stride, jnt_stride, wgt_stride, ctr_stride;
+    char *out_pos, *out_nrm, *out_tan;
+    size_t out_pos_stride, out_nrm_stride, out_tan_stride;
+    bool do_normals, do_tangents;
+} akp_skin_ctx;
+
+/* Deform vertices [begin, end) with the scalar reference code. */
+void akp_skin_range_scalar(const akp_skin_ctx* c, size_t begin, size_t end);
+/* Deform [begin, end) with the AVX2 kernel when this CPU and configuration allow it; returns
+ * false (writing nothing) when it cannot handle the configuration. */
+bool akp_skin_range_avx2(const akp_skin_ctx* c, size_t begin, size_t end);
+/* True when the AVX2 kernel is compiled in and the CPU supports AVX2 and FMA. */
+bool akp_skin_have_avx2(void);
+
+/* Closest-point distance squared from p to the segment [a, b] (a == b allowed). */
+static inline float akp_segment_dist_sq(ak_vec3 p, ak_vec3 a, ak_vec3 b, ak_vec3* out_closest) {
+    ak_vec3 ab = ak_vec3_sub(b, a);
+    float len2 = ak_vec3_dot(ab, ab);
+    float t = len2 > 0.0f ? ak_clampf(ak_vec3_dot(ak_vec3_sub(p, a), ab) / len2, 0.0f, 1.0f) : 0.0f;
+    ak_vec3 c = ak_vec3_madd(a, ab, t);
+    if (out_closest) *out_closest = c;
+    return ak_vec3_length_sq(ak_vec3_sub(p, c));
+}
+
+/* Per-vertex post-processing shared by the weight methods: dense[joint_count] holds raw
+ * weights (>= 0); writes the k largest (after dropping those below min_weight relative to
+ * the total) renormalised to sum 1, sorted decreasing; fallback_joint gets 1 when all vanish. */
+void akp_weights_finish(const double* dense, size_t joint_count, uint32_t k, float min_weight,
+                        uint16_t fallback_joint, uint16_t* out_joints, float* out_weights);
+
+/* 64-bit FNV-1a over bytes, continuing from h. */
+static inline uint64_t akp_fnv1a(uint64_t h, const void* data, size_t size) {
+    const unsigned char* p = (const unsigned char*)data;
+    for (size_t i = 0; i < size; ++i) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+/* Little-endian helpers for the file formats. */
+static inline void akp_put_u32(unsigned char* p, uint32_t v) {
+    p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8);
+    p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24);
+}
+static inline uint32_t akp_get_u32(const unsigned char* p) {
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+static inline void akp_put_f32(unsigned char* p, float f) {
+    uint32_t v;
+    memcpy(&v, &f, 4);
+    akp_put_u32(p, v);
+}
+static inline float akp_get_f32(const unsigned char* p) {
+    uint32_t v = akp_get_u32(p);
+    float f;
+    memcpy(&f, &v, 4);
+    return f;
+}
+
+#endif

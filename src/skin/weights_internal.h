@@ -1,0 +1,22 @@
+/* Entry points of the two weight methods (desc already resolved and checked). */
+#ifndef ANIMKIT_SKIN_WEIGHTS_INTERNAL_H
+#define ANIMKIT_SKIN_WEIGHTS_INTERNAL_H
+
+#include "skin_internal.h"
+
+ak_result akp_weights_distance(const ak_weights_desc* d, const ak_allocator* alloc, uint16_t* out_joints,
+                               float* out_weights);
+ak_result akp_weights_heat(const ak_weights_desc* d, const ak_allocator* alloc, uint16_t* out_joints,
+                           float* out_weights);
+/* Whole file into a malloc'd buffer (caller frees). AK_ERR_IO, AK_ERR_NO_MEMORY. */
+ak_result akp_read_file(const char* path, unsigned char** out, size_t* out_size);
+
+/* Number of palette entries the bones reference (max joint_index + 1). */
+static inline size_t akp_bones_joint_count(ak_skin_bone_cspan bones) {
+    size_t n = 0;
+    for (size_t b = 0; b < bones.count; ++b)
+        if ((size_t)bones.ptr[b].joint_index + 1 > n) n = (size_t)bones.ptr[b].joint_index + 1;
+    return n;
+}
+
+#endif
