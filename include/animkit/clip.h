@@ -190,9 +190,8 @@ typedef struct ak_blend_layer {
  *   covers fade smoothly to the rest pose instead of dividing by zero.
  * Then each additive layer with weight a = weight * mask[j] and delta (t, r, s) gives
  *   translation += a t, rotation = rotation * slerp(identity, r, a), scale *= lerp(1, s, a).
- * A joint covered by a single layer of non-zero weight gets that layer's transform (the
- * rotation renormalised), so masks leave the joints they exclude exactly as the other
- * layers make them. */
+ * A joint covered by a single layer of non-zero weight gets that layer's transform unchanged
+ * (bit-exact), so masks leave the joints they exclude exactly as the other layer has them. */
 typedef struct ak_blend_job {
     const ak_blend_layer* layers;          /* [layer_count]; may be NULL when layer_count is 0 */
     size_t layer_count;                    /* 0 -> the output is the rest pose plus additive layers */

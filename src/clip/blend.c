@@ -77,6 +77,8 @@ ak_result ak_blend_run(const ak_blend_job* job) {
         ak_quat q = ak_quat_make(0, 0, 0, 0), ref = ak_quat_identity();
         float total = 0.0f;
         bool have_ref = false;
+        int contributors = 0;
+        const ak_transform* only = NULL;
         for (size_t i = 0; i <= job->layer_count; ++i) {
             const ak_transform* x;
             float w;
@@ -94,6 +96,8 @@ ak_result ak_blend_run(const ak_blend_job* job) {
                 ref = x->rotation;
                 have_ref = true;
             }
+            ++contributors;
+            only = x;
             float sign = ak_quat_dot(ref, x->rotation) < 0.0f ? -w : w;
             t = ak_vec3_madd(t, x->translation, w);
             s = ak_vec3_madd(s, x->scale, w);
@@ -104,6 +108,8 @@ ak_result ak_blend_run(const ak_blend_job* job) {
         out.translation = ak_vec3_scale(t, 1.0f / total);
         out.scale = ak_vec3_scale(s, 1.0f / total);
         out.rotation = ak_quat_normalize(q);
+        /* A single contributor passes through bit-exact (masked-out layers change nothing). */
+        if (contributors == 1) out = *only;
         for (size_t i = 0; i < job->additive_count; ++i) {
             const ak_blend_layer* l = &job->additive_layers[i];
             float a = l->weight * (l->joint_weights.count ? l->joint_weights.ptr[j] : 1.0f);

@@ -1,0 +1,614 @@
+/* Tests for clip.h: build rules, glTF sampling against the specification's formulas in
+ * double, cursor vs binary search bit-identity, blending properties, root motion. */
+#include <animkit/clip.h>
+
+#include "ak_test.h"
+
+/* ---- helpers ------------------------------------------------------------------------- */
+
+static ak_clip* build(const ak_raw_clip* raw) {
+    ak_clip* c = NULL;
+    ak_diag d;
+    ak_result r = ak_clip_build(raw, NULL, &c, &d);
+    if (r != AK_OK) printf("  build failed: %s (%s)\n", ak_result_name(r), d.message);
+    return c;
+}
+
+static ak_quat random_quat(ak_rng* rng) {
+    ak_vec3 axis = ak_vec3_make(ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1));
+    return ak_quat_from_axis_angle(axis, ak_rng_range(rng, -3.0f, 3.0f));
+}
+
+static ak_transform random_transform(ak_rng* rng) {
+    ak_transform t;
+    t.translation = ak_vec3_make(ak_rng_range(rng, -2, 2), ak_rng_range(rng, -2, 2), ak_rng_range(rng, -2, 2));
+    t.rotation = random_quat(rng);
+    t.scale = ak_vec3_make(ak_rng_range(rng, 0.5f, 2), ak_rng_range(rng, 0.5f, 2), ak_rng_range(rng, 0.5f, 2));
+    return t;
+}
+
+static double rot_error(ak_quat a, ak_quat b) { return 1.0 - fabs((double)ak_quat_dot(a, b)); }
+
+/* ---- build rules --------------------------------------------------------------------- */
+
+AK_TEST(build_and_queries) {
+    float t[3] = {0.5f, 0.0f, 2.0f}, v[9] = {1, 1, 1, 0, 0, 0, 2, 2, 2}, w[6] = {0, 1, 1, 0, 0.5f, 0.5f};
+    ak_raw_channel ch[2] = {
+        {.target = AK_CHANNEL_TRANSLATION, .index = 3, .key_count = 3, .times = t, .values = v},
+        {.target = AK_CHANNEL_MORPH_WEIGHTS, .index = 1, .component_count = 2, .interp = AK_INTERP_STEP, .key_count = 3,
+         .times = t, .values = w},
+    };
+    ak_raw_clip raw = {.name = "walk", .channels = ch, .channel_count = 2, .joint_count = 4, .morph_weight_count = 3};
+    ak_clip* c = build(&raw);
+    AK_CHECK(c != NULL);
+    if (!c) return;
+    AK_CHECK_STREQ(ak_clip_name(c), "walk");
+    AK_CHECK_NEAR(ak_clip_duration(c), 2.0, 0);
+    AK_CHECK_EQ(ak_clip_channel_count(c), 2);
+    AK_CHECK_EQ(ak_clip_joint_count(c), 4);
+    AK_CHECK_EQ(ak_clip_channel_target(c, 1), AK_CHANNEL_MORPH_WEIGHTS);
+    AK_CHECK_EQ(ak_clip_channel_index(c, 0), 3);
+    AK_CHECK_EQ(ak_clip_channel_interp(c, 0), AK_INTERP_LINEAR);
+    AK_CHECK_EQ(ak_clip_channel_interp(c, 1), AK_INTERP_STEP);
+    AK_CHECK_EQ(ak_clip_channel_key_count(c, 1), 3);
+    AK_CHECK_EQ(ak_clip_channel_target(c, 2), AK_CHANNEL_TARGET_COUNT);
+    AK_CHECK(ak_clip_channel_track(c, 2) == NULL);
+    /* Keys come back sorted. */
+    ak_f32_cspan times = ak_track_times(ak_clip_channel_track(c, 0));
+    AK_CHECK_EQ(times.count, 3);
+    AK_CHECK(times.ptr[0] == 0.0f && times.ptr[1] == 0.5f && times.ptr[2] == 2.0f);
+    /* Keys are hit; untouched joints and weights keep their values. */
+    ak_transform pose[4];
+    float weights[3] = {9, 9, 9};
+    for (int j = 0; j < 4; ++j) pose[j] = ak_transform_identity();
+    AK_CHECK_EQ(ak_clip_sample(c, 0.5f, NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span)AK_SPAN(weights),
+                               (ak_f32_span){0}),
+                AK_OK);
+    AK_CHECK_NEAR(pose[3].translation.y, 1.0, 1e-6);
+    AK_CHECK(memcmp(&pose[0], &pose[2], sizeof pose[0]) == 0 && pose[0].scale.x == 1.0f);
+    AK_CHECK_EQ(weights[0], 9);
+    AK_CHECK_NEAR(weights[1], 0.0, 0);
+    AK_CHECK_NEAR(weights[2], 1.0, 0);
+    /* STEP holds until the next key; clamps outside the range. */
+    ak_clip_sample(c, 1.99f, NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span)AK_SPAN(weights), (ak_f32_span){0});
+    AK_CHECK_NEAR(weights[1], 0.0, 0);
+    ak_clip_sample(c, 7.0f, NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span)AK_SPAN(weights), (ak_f32_span){0});
+    AK_CHECK_NEAR(weights[1], 0.5, 0);
+    AK_CHECK_NEAR(pose[3].translation.z, 2.0, 0);
+    ak_clip_sample(c, -3.0f, NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span)AK_SPAN(weights), (ak_f32_span){0});
+    AK_CHECK_NEAR(pose[3].translation.x, 0.0, 0);
+    ak_clip_destroy(c);
+    ak_clip_destroy(NULL);
+    AK_CHECK_STREQ(ak_clip_name(NULL), "");
+}
+
+AK_TEST(build_rejects_bad_input_with_exact_codes) {
+    float t2[2] = {0, 1}, v6[6] = {0, 0, 0, 1, 1, 1}, q8[8] = {0, 0, 0, 1, 0, 0, 0, 1};
+    ak_raw_channel good = {.target = AK_CHANNEL_TRANSLATION, .index = 0, .key_count = 2, .times = t2, .values = v6};
+    ak_raw_channel ch[2] = {good, good};
+    ak_raw_clip base = {.channels = ch, .channel_count = 1, .joint_count = 2, .morph_weight_count = 2, .scalar_count = 2};
+    ak_clip* c = (ak_clip*)&c;
+    ak_diag d;
+#define EXPECT(code)                                                                       \
+    do {                                                                                   \
+        memset(&d, 0, sizeof d);                                                           \
+        AK_CHECK_EQ(ak_clip_build(&raw, NULL, &c, &d), code);                              \
+        AK_CHECK(c == NULL);                                                               \
+        AK_CHECK(d.message[0] != '\0');                                                    \
+    } while (0)
+    ak_raw_clip raw = base;
+    AK_CHECK_EQ(ak_clip_build(NULL, NULL, &c, NULL), AK_ERR_NULL_ARG);
+    raw.channel_count = 0;
+    EXPECT(AK_ERR_EMPTY);
+    raw = base;
+    raw.duration = -1.0f;
+    EXPECT(AK_ERR_BAD_ARG);
+    raw.duration = NAN;
+    EXPECT(AK_ERR_BAD_DATA);
+    raw = base;
+    ch[0].key_count = 0;
+    EXPECT(AK_ERR_EMPTY);
+    ch[0] = good;
+    ch[0].values = NULL;
+    EXPECT(AK_ERR_NULL_ARG);
+    ch[0] = good;
+    ch[0].index = 2;
+    EXPECT(AK_ERR_BAD_INDEX);
+    ch[0] = good;
+    ch[0].target = AK_CHANNEL_MORPH_WEIGHTS;
+    ch[0].component_count = 3;
+    ch[0].index = 0;
+    EXPECT(AK_ERR_BAD_INDEX);
+    ch[0].target = AK_CHANNEL_SCALAR;
+    ch[0].component_count = 1;
+    ch[0].index = 2;
+    EXPECT(AK_ERR_BAD_INDEX);
+    ch[0] = good;
+    ch[0].target = (ak_channel_target)17;
+    EXPECT(AK_ERR_BAD_ARG);
+    ch[0] = good;
+    ch[0].component_count = 4;
+    EXPECT(AK_ERR_BAD_ARG);
+    ch[0] = good;
+    ch[0].interp = AK_INTERP_SQUAD;
+    EXPECT(AK_ERR_BAD_ARG);
+    ch[0] = good;
+    ch[0].target = AK_CHANNEL_ROTATION;
+    ch[0].values = q8;
+    ch[0].interp = AK_INTERP_NATURAL;
+    EXPECT(AK_ERR_UNSUPPORTED);
+    float tn[2] = {0, NAN}, vn[6] = {0, 0, 0, 1, NAN, 1}, td[2] = {1, 1};
+    ch[0] = good;
+    ch[0].times = tn;
+    EXPECT(AK_ERR_BAD_DATA);
+    ch[0] = good;
+    ch[0].values = vn;
+    EXPECT(AK_ERR_BAD_DATA);
+    ch[0] = good;
+    ch[0].times = td;
+    EXPECT(AK_ERR_DUPLICATE);
+    ch[0] = good;
+    raw.channel_count = 2; /* two channels on joint 0's translation */
+    EXPECT(AK_ERR_DUPLICATE);
+    ch[1].target = AK_CHANNEL_SCALE; /* different property: fine */
+    c = build(&raw);
+    AK_CHECK(c != NULL);
+    ak_clip_destroy(c);
+#undef EXPECT
+}
+
+AK_TEST(sample_rejects_bad_spans) {
+    float t2[2] = {0, 1}, v6[6] = {0, 0, 0, 1, 1, 1};
+    ak_raw_channel ch = {.target = AK_CHANNEL_TRANSLATION, .index = 1, .key_count = 2, .times = t2, .values = v6};
+    ak_raw_clip raw = {.channels = &ch, .channel_count = 1, .joint_count = 2};
+    ak_clip *a = build(&raw), *b = build(&raw);
+    ak_transform pose[2];
+    AK_CHECK_EQ(ak_clip_sample(a, 0.5f, NULL, (ak_transform_span){pose, 1}, (ak_f32_span){0}, (ak_f32_span){0}),
+                AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_clip_sample(a, 0.5f, NULL, (ak_transform_span){0}, (ak_f32_span){0}, (ak_f32_span){0}), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_clip_sample(NULL, 0.5f, NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0}, (ak_f32_span){0}),
+                AK_ERR_NULL_ARG);
+    uint32_t st[1];
+    ak_clip_cursor cur;
+    AK_CHECK_EQ(ak_clip_cursor_storage_count(a), 1);
+    AK_CHECK_EQ(ak_clip_cursor_init(&cur, a, (ak_u32_span){st, 0}), AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_clip_cursor_init(&cur, a, (ak_u32_span)AK_SPAN(st)), AK_OK);
+    AK_CHECK_EQ(ak_clip_sample(b, 0.5f, &cur, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0}, (ak_f32_span){0}),
+                AK_ERR_BAD_ARG);
+    pose[1] = ak_transform_identity();
+    AK_CHECK_EQ(ak_clip_sample(a, NAN, &cur, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0}, (ak_f32_span){0}), AK_OK);
+    AK_CHECK(ak_vec3_is_finite(pose[1].translation));
+    ak_clip_destroy(a);
+    ak_clip_destroy(b);
+}
+
+/* ---- glTF 2.0 Appendix C --------------------------------------------------------------- */
+
+AK_TEST(gltf_interpolation_matches_spec_formulas) {
+    ak_rng rng = ak_rng_make(11);
+    enum { N = 5 };
+    float times[N] = {0.0f, 0.3f, 1.0f, 1.25f, 2.0f};
+    float tcub[N * 9], rcub[N * 12], rlin[N * 4];
+    for (int i = 0; i < N * 9; ++i) tcub[i] = ak_rng_range(&rng, -2, 2);
+    for (int k = 0; k < N; ++k) {
+        ak_quat q = random_quat(&rng);
+        if (k == 3) q = ak_quat_neg(q); /* negative dot with a neighbour: shortest path */
+        float* r = rcub + k * 12;
+        for (int c = 0; c < 4; ++c) r[c] = ak_rng_range(&rng, -1, 1), r[8 + c] = ak_rng_range(&rng, -1, 1);
+        r[4] = q.x, r[5] = q.y, r[6] = q.z, r[7] = q.w;
+        rlin[k * 4] = q.x, rlin[k * 4 + 1] = q.y, rlin[k * 4 + 2] = q.z, rlin[k * 4 + 3] = q.w;
+    }
+    ak_raw_channel ch[3] = {
+        {.target = AK_CHANNEL_TRANSLATION, .interp = AK_INTERP_CUBICSPLINE, .key_count = N, .times = times, .values = tcub},
+        {.target = AK_CHANNEL_ROTATION, .interp = AK_INTERP_CUBICSPLINE, .key_count = N, .times = times, .values = rcub},
+        {.target = AK_CHANNEL_ROTATION, .index = 1, .interp = AK_INTERP_LINEAR, .key_count = N, .times = times, .values = rlin},
+    };
+    ak_raw_clip raw = {.channels = ch, .channel_count = 3, .joint_count = 2};
+    ak_clip* c = build(&raw);
+    AK_CHECK(c != NULL);
+    if (!c) return;
+    for (int i = 0; i < 400; ++i) {
+        float t = ak_rng_range(&rng, 0.0f, 2.0f);
+        ak_transform pose[2] = {ak_transform_identity(), ak_transform_identity()};
+        ak_clip_sample(c, t, NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0}, (ak_f32_span){0});
+        int k = 0;
+        while (k < N - 2 && times[k + 1] <= t) ++k;
+        double td = (double)times[k + 1] - times[k], s = ((double)t - times[k]) / td;
+        double s2 = s * s, s3 = s2 * s;
+        double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+        /* CUBICSPLINE: p0 = value_k, m0 = td * out_k, p1 = value_k+1, m1 = td * in_k+1. */
+        double p[3], q[4], n = 0.0;
+        for (int j = 0; j < 3; ++j)
+            p[j] = h00 * tcub[k * 9 + 3 + j] + h10 * td * tcub[k * 9 + 6 + j] + h01 * tcub[(k + 1) * 9 + 3 + j] +
+                   h11 * td * tcub[(k + 1) * 9 + j];
+        for (int j = 0; j < 4; ++j) {
+            q[j] = h00 * rcub[k * 12 + 4 + j] + h10 * td * rcub[k * 12 + 8 + j] + h01 * rcub[(k + 1) * 12 + 4 + j] +
+                   h11 * td * rcub[(k + 1) * 12 + j];
+            n += q[j] * q[j];
+        }
+        n = sqrt(n);
+        AK_CHECK_NEAR(pose[0].translation.x, p[0], 2e-6 * (1 + fabs(p[0])));
+        AK_CHECK_NEAR(pose[0].translation.y, p[1], 2e-6 * (1 + fabs(p[1])));
+        AK_CHECK_NEAR(pose[0].translation.z, p[2], 2e-6 * (1 + fabs(p[2])));
+        ak_quat ref = ak_quat_make((float)(q[0] / n), (float)(q[1] / n), (float)(q[2] / n), (float)(q[3] / n));
+        AK_CHECK_NEAR(rot_error(pose[0].rotation, ref), 0.0, 1e-6);
+        /* LINEAR rotation: the spec's slerp, a = acos(|dot|), s = sign(dot). */
+        const float* a = rlin + k * 4;
+        const float* b = rlin + (k + 1) * 4;
+        double dot = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2] + (double)a[3] * b[3];
+        double ang = acos(fmin(1.0, fabs(dot))), sgn = dot < 0 ? -1.0 : 1.0;
+        double wa = sin(ang * (1 - s)) / sin(ang), wb = sgn * sin(ang * s) / sin(ang);
+        ak_quat sl = ak_quat_make((float)(wa * a[0] + wb * b[0]), (float)(wa * a[1] + wb * b[1]),
+                                  (float)(wa * a[2] + wb * b[2]), (float)(wa * a[3] + wb * b[3]));
+        AK_CHECK_NEAR(ak_quat_angle_between(pose[1].rotation, sl), 0.0, 2e-6);
+        AK_CHECK_NEAR(ak_quat_norm(pose[1].rotation), 1.0, 1e-6);
+    }
+    ak_clip_destroy(c);
+}
+
+/* ---- cursor ------------------------------------------------------------------------- */
+
+enum { CJ = 24 };
+
+static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
+    static const ak_interp tmodes[] = {AK_INTERP_STEP, AK_INTERP_LINEAR, AK_INTERP_CUBICSPLINE, AK_INTERP_CARDINAL,
+                                       AK_INTERP_NATURAL};
+    static const ak_interp rmodes[] = {AK_INTERP_STEP, AK_INTERP_LINEAR, AK_INTERP_NLERP, AK_INTERP_SQUAD,
+                                       AK_INTERP_CUBICSPLINE};
+    ak_raw_channel ch[3 * CJ + 2];
+    size_t used = 0, nch = 0;
+    for (int c = 0; c < 3 * CJ + 2; ++c) {
+        ak_raw_channel* r = &ch[nch++];
+        memset(r, 0, sizeof *r);
+        if (c < 3 * CJ) {
+            r->target = (ak_channel_target)(c % 3);
+            r->index = (uint32_t)(c / 3);
+        } else {
+            r->target = c == 3 * CJ ? AK_CHANNEL_MORPH_WEIGHTS : AK_CHANNEL_SCALAR;
+            r->component_count = 3;
+        }
+        bool rot = r->target == AK_CHANNEL_ROTATION;
+        r->interp = rot ? rmodes[ak_rng_u32(rng) % 5] : tmodes[ak_rng_u32(rng) % 5];
+        uint32_t cc = rot ? 4 : 3;
+        size_t n = c % 17 == 5 ? 1 : 2 + ak_rng_u32(rng) % 40;
+        size_t stride = r->interp == AK_INTERP_CUBICSPLINE ? 3 * cc : cc;
+        float* times = store + used;
+        used += n;
+        float* vals = store + used;
+        used += n * stride;
+        if (used > store_count) return NULL;
+        float t = ak_rng_range(rng, -0.5f, 1.0f);
+        for (size_t k = 0; k < n; ++k) {
+            times[k] = t;
+            t += ak_rng_range(rng, 0.01f, 0.5f);
+            for (size_t j = 0; j < stride; ++j) vals[k * stride + j] = ak_rng_range(rng, -1, 1);
+        }
+        r->key_count = n;
+        r->times = times;
+        r->values = vals;
+    }
+    ak_raw_clip raw = {.channels = ch, .channel_count = nch, .joint_count = CJ, .morph_weight_count = 3, .scalar_count = 3};
+    return build(&raw);
+}
+
+static int compare_run(const ak_clip* c, ak_clip_cursor* cur, const float* times, size_t count) {
+    int mismatches = 0;
+    for (size_t i = 0; i < count; ++i) {
+        ak_transform a[CJ], b[CJ];
+        float wa[3] = {0}, wb[3] = {0}, sa[3] = {0}, sb[3] = {0};
+        for (int j = 0; j < CJ; ++j) a[j] = b[j] = ak_transform_identity();
+        ak_clip_sample(c, times[i], cur, (ak_transform_span)AK_SPAN(a), (ak_f32_span)AK_SPAN(wa), (ak_f32_span)AK_SPAN(sa));
+        ak_clip_sample(c, times[i], NULL, (ak_transform_span)AK_SPAN(b), (ak_f32_span)AK_SPAN(wb), (ak_f32_span)AK_SPAN(sb));
+        if (memcmp(a, b, sizeof a) || memcmp(wa, wb, sizeof wa) || memcmp(sa, sb, sizeof sa)) ++mismatches;
+    }
+    return mismatches;
+}
+
+AK_TEST(cursor_is_bit_identical_to_binary_search) {
+    ak_rng rng = ak_rng_make(12);
+    static float store[200000];
+    ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0]);
+    AK_CHECK(c != NULL);
+    if (!c) return;
+    uint32_t seg[3 * CJ + 2];
+    ak_clip_cursor cur;
+    AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg)), AK_OK);
+    enum { T = 10000 };
+    static float times[T];
+    float dur = ak_clip_duration(c);
+    /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
+    for (int i = 0; i < T; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)T;
+    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+    for (int i = 0; i < T; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)T;
+    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+    for (int i = 0; i < T; ++i) times[i] = ak_time_wrap(3.3f * dur * (float)i / (float)T, dur, AK_WRAP_LOOP);
+    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+    for (int i = 0; i < T; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
+    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+    for (size_t ci = 0; ci < ak_clip_channel_count(c); ++ci) {
+        ak_f32_cspan kt = ak_track_times(ak_clip_channel_track(c, ci));
+        AK_CHECK_EQ(compare_run(c, &cur, kt.ptr, kt.count), 0);
+    }
+    ak_clip_destroy(c);
+}
+
+/* ---- blending ----------------------------------------------------------------------- */
+
+AK_TEST(blend_properties) {
+    enum { J = 16 };
+    ak_rng rng = ak_rng_make(13);
+    ak_transform a[J], b[J], rest[J], out[J];
+    for (int j = 0; j < J; ++j) {
+        a[j] = random_transform(&rng);
+        b[j] = random_transform(&rng);
+        rest[j] = random_transform(&rng);
+    }
+    /* Weights summing to 1 of identical poses (one stored with negated quaternions). */
+    ak_transform an[J];
+    for (int j = 0; j < J; ++j) {
+        an[j] = a[j];
+        an[j].rotation = ak_quat_neg(a[j].rotation);
+    }
+    ak_blend_layer same[3] = {{.pose = {a, J}, .weight = 0.2f}, {.pose = {an, J}, .weight = 0.5f}, {.pose = {a, J}, .weight = 0.3f}};
+    ak_blend_job job = {.layers = same, .layer_count = 3, .rest_pose = {rest, J}, .out_local = {out, J}};
+    AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+    for (int j = 0; j < J; ++j) {
+        AK_CHECK_NEAR(ak_vec3_distance(out[j].translation, a[j].translation), 0.0, 1e-6);
+        AK_CHECK_NEAR(ak_vec3_distance(out[j].scale, a[j].scale), 0.0, 1e-6);
+        AK_CHECK_NEAR(rot_error(out[j].rotation, a[j].rotation), 0.0, 1e-6);
+    }
+    /* Two poses 0.25 / 0.75: translation by the closed form, rotation the normalised sum. */
+    ak_blend_layer two[2] = {{.pose = {a, J}, .weight = 1.0f}, {.pose = {b, J}, .weight = 3.0f}};
+    job.layers = two;
+    job.layer_count = 2;
+    AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+    for (int j = 0; j < J; ++j) {
+        ak_vec3 t = ak_vec3_add(ak_vec3_scale(a[j].translation, 0.25f), ak_vec3_scale(b[j].translation, 0.75f));
+        AK_CHECK_NEAR(ak_vec3_distance(out[j].translation, t), 0.0, 1e-5);
+        ak_quat qb = ak_quat_dot(a[j].rotation, b[j].rotation) < 0 ? ak_quat_neg(b[j].rotation) : b[j].rotation;
+        ak_quat q = ak_quat_normalize(ak_quat_add(ak_quat_scale(a[j].rotation, 0.25f), ak_quat_scale(qb, 0.75f)));
+        AK_CHECK_NEAR(rot_error(out[j].rotation, q), 0.0, 1e-6);
+    }
+    /* Masks: b only on the upper half; the lower half is exactly a. */
+    float mask[J];
+    for (int j = 0; j < J; ++j) mask[j] = j < J / 2 ? 0.0f : 1.0f;
+    ak_blend_layer masked[2] = {{.pose = {a, J}, .weight = 1.0f}, {.pose = {b, J}, .weight = 1.0f, .joint_weights = {mask, J}}};
+    job.layers = masked;
+    AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+    for (int j = 0; j < J; ++j) {
+        if (j < J / 2) {
+            AK_CHECK(memcmp(&out[j], &a[j], sizeof(ak_transform)) == 0);
+        } else {
+            ak_vec3 t = ak_vec3_scale(ak_vec3_add(a[j].translation, b[j].translation), 0.5f);
+            AK_CHECK_NEAR(ak_vec3_distance(out[j].translation, t), 0.0, 1e-5);
+        }
+    }
+    /* No weight at all -> the rest pose. */
+    ak_blend_layer none[1] = {{.pose = {a, J}, .weight = 0.0f}};
+    job.layers = none;
+    job.layer_count = 1;
+    AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+    for (int j = 0; j < J; ++j) AK_CHECK_NEAR(ak_vec3_distance(out[j].translation, rest[j].translation), 0.0, 1e-6);
+}
+
+AK_TEST(additive_layers) {
+    enum { J = 12 };
+    ak_rng rng = ak_rng_make(14);
+    ak_transform ref[J], pose[J], base[J], delta[J], out[J], rest[J];
+    for (int j = 0; j < J; ++j) {
+        ref[j] = random_transform(&rng);
+        pose[j] = random_transform(&rng);
+        base[j] = random_transform(&rng);
+        rest[j] = ak_transform_identity();
+    }
+    /* The additive delta of the reference pose is the identity: adding it changes nothing. */
+    AK_CHECK_EQ(ak_pose_additive_delta((ak_transform_cspan){ref, J}, (ak_transform_cspan){ref, J}, (ak_transform_span){delta, J}),
+                AK_OK);
+    ak_blend_layer l = {.pose = {base, J}, .weight = 1.0f}, add = {.pose = {delta, J}, .weight = 1.0f};
+    ak_blend_job job = {.layers = &l, .layer_count = 1, .additive_layers = &add, .additive_count = 1, .rest_pose = {rest, J},
+                        .out_local = {out, J}};
+    AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+    for (int j = 0; j < J; ++j) {
+        AK_CHECK_NEAR(ak_vec3_distance(out[j].translation, base[j].translation), 0.0, 1e-6);
+        AK_CHECK_NEAR(ak_vec3_distance(out[j].scale, base[j].scale), 0.0, 1e-6);
+        AK_CHECK_NEAR(rot_error(out[j].rotation, base[j].rotation), 0.0, 1e-6);
+    }
+    /* Reference + delta(pose) at weight 1 reproduces pose; weight 0 leaves the reference. */
+    ak_pose_additive_delta((ak_transform_cspan){pose, J}, (ak_transform_cspan){ref, J}, (ak_transform_span){delta, J});
+    l.pose = (ak_transform_cspan){ref, J};
+    AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+    for (int j = 0; j < J; ++j) {
+        AK_CHECK_NEAR(ak_vec3_distance(out[j].translation, pose[j].translation), 0.0, 1e-5);
+        AK_CHECK_NEAR(ak_vec3_distance(out[j].scale, pose[j].scale), 0.0, 1e-5);
+        AK_CHECK_NEAR(rot_error(out[j].rotation, pose[j].rotation), 0.0, 1e-6);
+    }
+    add.weight = 0.0f;
+    AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+    for (int j = 0; j < J; ++j) AK_CHECK_NEAR(rot_error(out[j].rotation, ref[j].rotation), 0.0, 1e-6);
+}
+
+AK_TEST(crossfade) {
+    enum { J = 8 };
+    ak_rng rng = ak_rng_make(15);
+    ak_transform a[J], b[J], out[J];
+    for (int j = 0; j < J; ++j) a[j] = random_transform(&rng), b[j] = random_transform(&rng);
+    ak_transform_cspan ca = {a, J}, cb = {b, J};
+    AK_CHECK_EQ(ak_pose_crossfade(ca, cb, 0.0f, (ak_transform_span){out, J}), AK_OK);
+    for (int j = 0; j < J; ++j) AK_CHECK_NEAR(ak_vec3_distance(out[j].translation, a[j].translation), 0.0, 0);
+    AK_CHECK_EQ(ak_pose_crossfade(ca, cb, 2.0f, (ak_transform_span){out, J}), AK_OK);
+    for (int j = 0; j < J; ++j) AK_CHECK_NEAR(rot_error(out[j].rotation, b[j].rotation), 0.0, 1e-6);
+    AK_CHECK_EQ(ak_pose_crossfade(ca, cb, 0.5f, (ak_transform_span){out, J}), AK_OK);
+    for (int j = 0; j < J; ++j) {
+        /* Halfway: equal angles to both ends. */
+        AK_CHECK_NEAR(ak_quat_angle_between(out[j].rotation, a[j].rotation),
+                      ak_quat_angle_between(out[j].rotation, b[j].rotation), 1e-3);
+    }
+    AK_CHECK_EQ(ak_pose_crossfade(ca, (ak_transform_cspan){b, 2}, 0.5f, (ak_transform_span){out, J}), AK_ERR_SPAN_SMALL);
+}
+
+AK_TEST(blend_validate_rules) {
+    enum { J = 4 };
+    ak_transform p[J], out[J], rest[J];
+    for (int j = 0; j < J; ++j) p[j] = rest[j] = ak_transform_identity();
+    float mask[J] = {0, 0.5f, 1, 1};
+    ak_blend_job zero = {0};
+    AK_CHECK_EQ(ak_blend_validate(&zero), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_blend_run(&zero), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_blend_validate(NULL), AK_ERR_NULL_ARG);
+    ak_blend_layer l = {.pose = {p, J}, .weight = 1.0f, .joint_weights = {mask, J}};
+    ak_blend_job ok = {.layers = &l, .layer_count = 1, .rest_pose = {rest, J}, .out_local = {out, J}};
+    AK_CHECK_EQ(ak_blend_validate(&ok), AK_OK);
+    ak_blend_job j = ok;
+    j.layers = NULL;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_NULL_ARG);
+    j = ok;
+    j.rest_pose.count = 0;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_EMPTY);
+    j = ok;
+    j.out_local.count = J - 1;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_SPAN_SMALL);
+    j = ok;
+    j.threshold = -1.0f;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_BAD_ARG);
+    ak_blend_layer bad = l;
+    j = ok;
+    j.layers = &bad;
+    bad.pose.count = J - 1;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_SPAN_SMALL);
+    bad = l;
+    bad.pose.ptr = NULL;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_NULL_ARG);
+    bad = l;
+    bad.joint_weights.count = 2;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_SPAN_SMALL);
+    bad = l;
+    bad.weight = -0.5f;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_BAD_ARG);
+    bad.weight = NAN;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_BAD_DATA);
+    bad = l;
+    mask[1] = 1.5f;
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_BAD_DATA);
+    mask[1] = 0.5f;
+    bad = l;
+    bad.pose.ptr = out; /* output overlaps an input */
+    AK_CHECK_EQ(ak_blend_validate(&j), AK_ERR_BAD_ARG);
+    /* run writes nothing on failure. */
+    out[0].translation.x = 42.0f;
+    AK_CHECK_EQ(ak_blend_run(&j), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(out[0].translation.x, 42);
+}
+
+/* ---- root motion --------------------------------------------------------------------- */
+
+AK_TEST(root_motion_extraction) {
+    enum { N = 9 };
+    float times[N], lin[N * 3], cub[N * 9], rot[N * 4];
+    ak_rng rng = ak_rng_make(16);
+    for (int k = 0; k < N; ++k) {
+        times[k] = 0.25f * (float)k;
+        /* Walking along +x and drifting in z, bobbing in y. */
+        lin[k * 3] = 1.0f + 1.5f * times[k];
+        lin[k * 3 + 1] = 0.9f + 0.05f * sinf(8.0f * times[k]);
+        lin[k * 3 + 2] = -0.5f + 0.3f * times[k] * times[k];
+        for (int c = 0; c < 9; ++c) cub[k * 9 + c] = ak_rng_range(&rng, -1, 1);
+        memcpy(cub + k * 9 + 3, lin + k * 3, 3 * sizeof(float));
+        ak_quat q = random_quat(&rng);
+        rot[k * 4] = q.x, rot[k * 4 + 1] = q.y, rot[k * 4 + 2] = q.z, rot[k * 4 + 3] = q.w;
+    }
+    const ak_interp modes[2] = {AK_INTERP_LINEAR, AK_INTERP_CUBICSPLINE};
+    for (int m = 0; m < 2; ++m) {
+        ak_raw_channel ch[3] = {
+            {.target = AK_CHANNEL_ROTATION, .index = 1, .key_count = N, .times = times, .values = rot},
+            {.target = AK_CHANNEL_TRANSLATION, .index = 1, .interp = modes[m], .key_count = N, .times = times,
+             .values = m ? cub : lin},
+            {.target = AK_CHANNEL_TRANSLATION, .index = 2, .key_count = N, .times = times, .values = lin},
+        };
+        ak_raw_clip raw = {.name = "walk", .channels = ch, .channel_count = 3, .joint_count = 3};
+        ak_clip* clip = build(&raw);
+        ak_clip* in_place = NULL;
+        ak_track* traj = NULL;
+        AK_CHECK_EQ(ak_clip_extract_root_motion(clip, &(ak_root_motion_desc){.root_joint = 1}, NULL, &in_place, &traj), AK_OK);
+        if (!in_place || !traj) return;
+        AK_CHECK_STREQ(ak_clip_name(in_place), "walk");
+        for (int i = 0; i <= 200; ++i) {
+            float t = 2.0f * (float)i / 200.0f;
+            ak_transform o[3], p[3];
+            for (int j = 0; j < 3; ++j) o[j] = p[j] = ak_transform_identity();
+            ak_clip_sample(clip, t, NULL, (ak_transform_span)AK_SPAN(o), (ak_f32_span){0}, (ak_f32_span){0});
+            ak_clip_sample(in_place, t, NULL, (ak_transform_span)AK_SPAN(p), (ak_f32_span){0}, (ak_f32_span){0});
+            float tr[3];
+            ak_track_sample(traj, t, (ak_f32_span)AK_SPAN(tr));
+            /* In place: x, z held at the first key; y untouched; trajectory carries the rest. */
+            AK_CHECK_NEAR(p[1].translation.x, lin[0], 1e-6);
+            AK_CHECK_NEAR(p[1].translation.z, lin[2], 1e-6);
+            AK_CHECK_NEAR(p[1].translation.y, o[1].translation.y, 1e-6);
+            AK_CHECK_NEAR(tr[1], 0.0, 0);
+            AK_CHECK_NEAR(p[1].translation.x + tr[0], o[1].translation.x, 2e-6);
+            AK_CHECK_NEAR(p[1].translation.z + tr[2], o[1].translation.z, 2e-6);
+            /* Other channels are unchanged (bit-exact). */
+            AK_CHECK(memcmp(&p[2], &o[2], sizeof p[2]) == 0);
+            AK_CHECK(memcmp(&p[1].rotation, &o[1].rotation, sizeof p[1].rotation) == 0);
+        }
+        ak_clip *x = NULL;
+        ak_track* y = NULL;
+        AK_CHECK_EQ(ak_clip_extract_root_motion(clip, &(ak_root_motion_desc){.root_joint = 3}, NULL, &x, &y), AK_ERR_BAD_INDEX);
+        AK_CHECK(x == NULL && y == NULL);
+        /* Root without translation: unchanged copy, zero trajectory. */
+        AK_CHECK_EQ(ak_clip_extract_root_motion(clip, NULL, NULL, &x, &y), AK_OK);
+        float z[3] = {1, 1, 1};
+        ak_track_sample(y, 1.0f, (ak_f32_span)AK_SPAN(z));
+        AK_CHECK(z[0] == 0.0f && z[1] == 0.0f && z[2] == 0.0f);
+        ak_clip_destroy(x);
+        ak_track_destroy(y);
+        ak_clip_destroy(in_place);
+        ak_track_destroy(traj);
+        ak_clip_destroy(clip);
+    }
+}
+
+/* A counting allocator: every build frees what it allocates, through the given allocator. */
+static size_t live_blocks;
+static void* count_alloc(size_t size, void* user) {
+    (void)user;
+    ++live_blocks;
+    return malloc(size);
+}
+static void count_free(void* p, void* user) {
+    (void)user;
+    --live_blocks;
+    free(p);
+}
+
+AK_TEST(custom_allocator_is_used_and_balanced) {
+    ak_allocator a = {count_alloc, count_free, NULL};
+    float t[3] = {2, 0, 1}, v[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2};
+    ak_raw_channel ch = {.target = AK_CHANNEL_TRANSLATION, .interp = AK_INTERP_NATURAL, .key_count = 3, .times = t, .values = v};
+    ak_raw_clip raw = {.channels = &ch, .channel_count = 1, .joint_count = 1};
+    ak_clip* c = NULL;
+    AK_CHECK_EQ(ak_clip_build(&raw, &a, &c, NULL), AK_OK);
+    AK_CHECK_EQ(live_blocks, 1);
+    ak_clip* ip = NULL;
+    ak_track* tr = NULL;
+    AK_CHECK_EQ(ak_clip_extract_root_motion(c, NULL, &a, &ip, &tr), AK_OK);
+    AK_CHECK_EQ(live_blocks, 3);
+    ak_clip_destroy(ip);
+    ak_track_destroy(tr);
+    ak_clip_destroy(c);
+    AK_CHECK_EQ(live_blocks, 0);
+}
+
+int main(void) {
+    AK_RUN(build_and_queries);
+    AK_RUN(build_rejects_bad_input_with_exact_codes);
+    AK_RUN(sample_rejects_bad_spans);
+    AK_RUN(gltf_interpolation_matches_spec_formulas);
+    AK_RUN(cursor_is_bit_identical_to_binary_search);
+    AK_RUN(blend_properties);
+    AK_RUN(additive_layers);
+    AK_RUN(crossfade);
+    AK_RUN(blend_validate_rules);
+    AK_RUN(root_motion_extraction);
+    AK_RUN(custom_allocator_is_used_and_balanced);
+    return ak_test_finish();
+}
