@@ -1,0 +1,237 @@
+/* animkit ik: inverse kinematics on joint chains and trees of a skeleton pose.
+ *
+ * What it does: finds local joint rotations (and prism-joint slides) that put an end effector
+ * at a target. Solvers: CCD (cyclic coordinate descent, tip to root), FABRIK (Aristidou &
+ * Lasenby 2011, forward and backward reaching, converted back to rotations keeping each
+ * joint's twist), an analytic two-bone solver (law of cosines, pole vector, soft reach limit,
+ * blend weight), and damped least squares (Jacobian, Levenberg-Marquardt adaptive damping,
+ * position and optional orientation targets). FABRIK also solves trees with several end
+ * effectors (sub-bases, as in the paper). Every chain solver honours the skeleton's joint
+ * types and limits (ak_skeleton_limit_joint after each change) and reports whether the
+ * target was reached, the remaining distance and the iterations used.
+ *
+ * What it does NOT do: forward kinematics for the caller (skeleton.h), animation blending,
+ * collision avoidance, or move the chain root: the root joint's position is fixed, it only
+ * rotates. Non-uniform scale on chain joints is approximated (see ak_transform_mul).
+ *
+ * Spaces: a pose is the skeleton's array of local transforms; targets and positions are in
+ * model space (the skeleton's space, ak_skeleton_local_to_model). A chain is a list of joint
+ * indices from a root to the end effector, each the parent of the next (ak_ik_chain_build).
+ *
+ * Usage:
+ *     int16_t chain[8]; size_t chain_count = 0;
+ *     ak_ik_chain_build(sk, hip, ankle, (ak_i16_span)AK_SPAN(chain), &chain_count);
+ *     unsigned char scratch[4096];                 // >= ak_ik_chain_scratch_size(solver, n)
+ *     bool reached; float error; size_t iterations;
+ *     ak_ik_chain_job job = {
+ *         .skeleton = sk, .pose = pose,            // ak_transform_span, edited in place
+ *         .chain = {chain, chain_count},
+ *         .target = ak_vec3_make(0.2f, 0.1f, 0.3f), // model space
+ *         .solver = AK_IK_SOLVER_FABRIK,
+ *         .scratch = (ak_u8_span)AK_SPAN(scratch),
+ *         .out_reached = &reached, .out_error = &error, .out_iterations = &iterations,
+ *     };
+ *     ak_result r = ak_ik_chain_run(&job);          // AK_OK even when !reached
+ *
+ * Ownership and threading: jobs keep no pointer after run returns and never allocate; the
+ * caller passes scratch memory (any alignment). Jobs writing different poses may run in
+ * parallel on one skeleton.
+ */
+#ifndef ANIMKIT_IK_H
+#define ANIMKIT_IK_H
+
+#include "skeleton.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- chains ------------------------------------------------------------------------- */
+
+/* The joints from root_joint down to effector_joint (inclusive), root first, each the parent
+ * of the next: out_joints[0] = root_joint, out_joints[*out_count - 1] = effector_joint.
+ * root_joint == effector_joint gives a one-joint chain. Needs out_joints.count >= the chain's
+ * joint count (ak_skeleton_joint_count always suffices). Returns AK_ERR_NULL_ARG,
+ * AK_ERR_BAD_INDEX (a joint out of range), AK_ERR_NOT_FOUND (root_joint is not an ancestor
+ * of effector_joint), AK_ERR_SPAN_SMALL (*out_count then holds the size needed). */
+AK_API ak_result ak_ik_chain_build(const ak_skeleton* skeleton, int root_joint, int effector_joint,
+                                   ak_i16_span out_joints, size_t* out_count);
+
+/* Model-space positions of the chain's joints for a pose (the forward kinematics of the
+ * chain's ancestors and the chain only). Needs pose.count >= joint count,
+ * out_positions.count >= chain.count. Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL,
+ * AK_ERR_BAD_INDEX, AK_ERR_BAD_HIERARCHY (chain not parent-linked). */
+AK_API ak_result ak_ik_chain_positions(const ak_skeleton* skeleton, ak_transform_cspan pose,
+                                       ak_i16_cspan chain, ak_vec3_span out_positions);
+
+/* Sum of the chain's bone lengths in model space for a pose (0 on invalid input). */
+AK_API float ak_ik_chain_length(const ak_skeleton* skeleton, ak_transform_cspan pose, ak_i16_cspan chain);
+
+/* ---- the chain job ------------------------------------------------------------------ */
+
+typedef enum ak_ik_solver {
+    AK_IK_SOLVER_DEFAULT = 0, /* -> AK_IK_SOLVER_FABRIK */
+    AK_IK_SOLVER_CCD,         /* cyclic coordinate descent */
+    AK_IK_SOLVER_FABRIK,      /* forward and backward reaching */
+    AK_IK_SOLVER_TWO_BONE,    /* analytic; the chain must have exactly 3 joints */
+    AK_IK_SOLVER_DLS,         /* damped least squares Jacobian, adaptive damping */
+    AK_IK_SOLVER_COUNT
+} ak_ik_solver;
+
+/* "ccd", "fabrik", "twobone", "dls" ("default" for AK_IK_SOLVER_DEFAULT); "" when unknown. */
+AK_API const char* ak_ik_solver_name(ak_ik_solver solver);
+/* Solver from its name (as ak_ik_solver_name writes it; "two_bone" and "two-bone" too).
+ * Returns AK_ERR_NULL_ARG, AK_ERR_NOT_FOUND (unknown name). */
+AK_API ak_result ak_ik_solver_parse(const char* name, ak_ik_solver* out_solver);
+
+/* Solve one chain in place. Inputs first, then options (all zero by default), then outputs. */
+typedef struct ak_ik_chain_job {
+    const ak_skeleton* skeleton; /* required */
+    ak_transform_span pose;      /* required, in/out: local transforms, count >= joint count;
+                                    only the chain's joints are written */
+    ak_i16_cspan chain;          /* required: joint indices root..effector, each the parent of
+                                    the next (ak_ik_chain_build), count >= 1 */
+    ak_vec3 target;              /* model space position for the effector (last chain joint) */
+    const ak_quat* target_rotation; /* model space rotation for the effector; NULL -> position
+                                       only. DLS solves for it with the whole chain; the other
+                                       solvers set the effector joint's own rotation after
+                                       placing it (then clamp it to its limits) */
+    ak_ik_solver solver;         /* 0 -> FABRIK */
+    size_t max_iterations;       /* iteration budget; 0 -> 50. CCD: one sweep over the chain;
+                                    FABRIK: one forward + backward pass; DLS: one step */
+    float tolerance;             /* model units: reached when the effector is this close;
+                                    0 -> 1e-4 * chain length (at least 1e-7) */
+    float angle_tolerance;       /* radians, with target_rotation; 0 -> 1e-3 */
+    float max_step;              /* CCD: largest rotation of one joint in one sweep, radians
+                                    (damping); 0 -> pi (undamped) */
+    bool ccd_from_root;          /* CCD: visit the joints root to tip; false -> tip to root,
+                                    the classic order */
+    bool ignore_limits;          /* false -> joint types and limits are honoured */
+    float dls_damping;           /* DLS: initial lambda, model units (adapted each step);
+                                    0 -> 0.1 * chain length */
+    float orientation_weight;    /* DLS: model units per radian of orientation error;
+                                    0 -> chain length / pi */
+    ak_vec3 pole;                /* TWO_BONE: model-space direction the middle joint bends
+                                    towards (a knee points along it); zero -> keep the
+                                    current bend plane */
+    float soft;                  /* TWO_BONE: softening band, a fraction in [0, 1) of the
+                                    reach: targets beyond (1 - soft) * reach are approached
+                                    smoothly so the limb never snaps straight; 0 -> hard */
+    float keep_animation;        /* TWO_BONE: blend back towards the input pose, [0, 1]:
+                                    0 -> full IK, 1 -> pose unchanged */
+    ak_u8_span scratch;          /* >= ak_ik_chain_scratch_size(solver, chain.count) bytes,
+                                    any alignment */
+    bool* out_reached;           /* optional: effector within tolerance (and angle tolerance) */
+    float* out_error;            /* optional: final effector-to-target distance, model units */
+    float* out_angle_error;      /* optional: final orientation error in radians (0 without
+                                    target_rotation) */
+    size_t* out_iterations;      /* optional: iterations used (0 for TWO_BONE) */
+} ak_ik_chain_job;
+
+/* Bytes of scratch a chain job needs for this solver and chain length (never 0). */
+AK_API size_t ak_ik_chain_scratch_size(ak_ik_solver solver, size_t chain_count);
+
+/* The job with zero options replaced by their defaults (solver, max_iterations, tolerance
+ * from the chain length in the pose, angle_tolerance, max_step, dls_damping,
+ * orientation_weight). Fields that cannot be resolved (no skeleton or pose) stay zero. */
+AK_API ak_ik_chain_job ak_ik_chain_job_resolved(const ak_ik_chain_job* job);
+
+/* Check a chain job; returns the first rule that fails:
+ *   AK_ERR_NULL_ARG    job, skeleton, pose.ptr or chain.ptr is NULL, or chain.count is 0
+ *   AK_ERR_SPAN_SMALL  pose.count < joint count
+ *   AK_ERR_BAD_ARG     solver out of range
+ *   AK_ERR_BAD_INDEX   a chain joint index is out of range
+ *   AK_ERR_BAD_HIERARCHY  chain[k-1] is not the parent of chain[k]
+ *   AK_ERR_BAD_ARG     TWO_BONE with chain.count != 3
+ *   AK_ERR_BAD_DATA    target, *target_rotation (or a zero quaternion) or pole not finite
+ *   AK_ERR_BAD_ARG     tolerance, angle_tolerance, max_step, dls_damping or
+ *                      orientation_weight negative or NaN; soft outside [0, 1);
+ *                      keep_animation outside [0, 1]
+ *   AK_ERR_BAD_DATA    a transform of the chain or its ancestors in the pose is not finite
+ *   AK_ERR_NULL_ARG    scratch.ptr is NULL
+ *   AK_ERR_SPAN_SMALL  scratch.count < ak_ik_chain_scratch_size(solver, chain.count) */
+AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
+
+/* Validate, then solve, writing the chain joints' local rotations (prism joints: local
+ * translations) into pose. Returns validate's codes; nothing is written when it fails.
+ * Unreachable target: AK_OK, the chain straightened towards the target, *out_reached false and
+ * *out_error the remaining distance. Iterations stop early when the error stops improving.
+ * Defined degenerate cases: a one-joint chain cannot move its effector (only target_rotation
+ * is applied; iterations 0); zero-length bones keep their direction; a target on the root
+ * folds the chain as far as lengths and limits allow. FREE and BALL joints rotate freely
+ * (BALL within cone and twist), HINGE joints about their axis, PRISM joints keep their
+ * rotation and slide (CCD and DLS move slides; FABRIK and TWO_BONE keep them). Bone lengths
+ * (other than prism slides) are unchanged: only rotations are written. */
+AK_API ak_result ak_ik_chain_run(const ak_ik_chain_job* job);
+
+/* ---- analytic two-bone (model space, no skeleton) ------------------------------------ */
+
+/* The fast analytic solver on three model-space joint matrices (as ak_skeleton_local_to_model
+ * gives), after ozz's IKTwoBoneJob: outputs rotation corrections to multiply onto the start
+ * and mid joints' local rotations: local.rotation = ak_quat_mul(local.rotation, *out_x_rot).
+ * Matrices must be rigid with uniform positive scale. Does not know about joint limits. */
+typedef struct ak_ik_two_bone_job {
+    ak_mat4 start, mid, end; /* model space joint matrices (e.g. hip, knee, ankle) */
+    ak_vec3 target;          /* model space */
+    ak_vec3 pole;            /* model-space direction the mid joint bends towards; zero -> keep
+                                the current bend plane */
+    ak_vec3 mid_axis;        /* mid joint's local bend axis (a knee hinge); zero -> the normal
+                                of the current bend plane (any perpendicular when straight) */
+    float twist;             /* radians: extra rotation of the bend plane about the
+                                start-to-target axis; 0 -> none */
+    float soft;              /* softening band in [0, 1) of the reach; 0 -> hard limit */
+    float keep_animation;    /* [0, 1]: 0 -> full correction, 1 -> identity corrections */
+    ak_quat* out_start_rot;  /* required: local correction of the start joint */
+    ak_quat* out_mid_rot;    /* required: local correction of the mid joint */
+    bool* out_reached;       /* optional: target within reach (not clamped nor softened) */
+} ak_ik_two_bone_job;
+
+/* AK_ERR_NULL_ARG (job, out_start_rot or out_mid_rot NULL), AK_ERR_BAD_DATA (a matrix,
+ * target, pole or mid_axis not finite), AK_ERR_BAD_ARG (soft outside [0, 1), keep_animation
+ * outside [0, 1]). */
+AK_API ak_result ak_ik_two_bone_validate(const ak_ik_two_bone_job* job);
+/* Validate, then solve; writes nothing when validation fails. Degenerate cases: a target
+ * outside [|a - b|, a + b] (a, b the bone lengths) straightens or folds the limb towards it
+ * and reports not reached; a target on the start joint or zero-length bones give identity
+ * corrections for the undefined part. */
+AK_API ak_result ak_ik_two_bone_run(const ak_ik_two_bone_job* job);
+
+/* ---- FABRIK on a tree with several end effectors ------------------------------------- */
+
+/* FABRIK with sub-bases (Aristidou & Lasenby 2011, section 4.3): the tree is the union of the
+ * paths from root_joint to each effector. Forward reaching runs from every effector towards
+ * the root, placing each sub-base at the centroid of its branches' proposals; backward
+ * reaching runs from the fixed root outwards. Each iteration converts the positions back to
+ * rotations (joints with several tree children get the best-fit rotation of their bones)
+ * and applies limits. */
+typedef struct ak_ik_fabrik_tree_job {
+    const ak_skeleton* skeleton; /* required */
+    ak_transform_span pose;      /* required, in/out: local transforms, count >= joint count */
+    int root_joint;              /* fixed base joint; an ancestor of every effector (or one) */
+    ak_i16_cspan effectors;      /* required: effector joint indices, count >= 1, distinct */
+    ak_vec3_cspan targets;       /* required: model space, count >= effectors.count */
+    size_t max_iterations;       /* 0 -> 50 */
+    float tolerance;             /* model units, per effector; 0 -> 1e-4 * tree bone length */
+    bool ignore_limits;          /* false -> limits honoured */
+    ak_u8_span scratch;          /* >= ak_ik_fabrik_tree_scratch_size(joint count) bytes */
+    bool* out_reached;           /* optional: every effector within tolerance */
+    float* out_error;            /* optional: largest effector-to-target distance */
+    size_t* out_iterations;      /* optional */
+} ak_ik_fabrik_tree_job;
+
+/* Bytes of scratch for a skeleton of joint_count joints (never 0). */
+AK_API size_t ak_ik_fabrik_tree_scratch_size(size_t joint_count);
+/* AK_ERR_NULL_ARG (job, skeleton, pose.ptr, effectors.ptr, targets.ptr NULL or
+ * effectors.count 0), AK_ERR_SPAN_SMALL (pose or targets too short), AK_ERR_BAD_INDEX
+ * (root or an effector out of range), AK_ERR_DUPLICATE (an effector listed twice),
+ * AK_ERR_NOT_FOUND (root_joint not an ancestor of an effector), AK_ERR_BAD_DATA (a target or
+ * a pose transform not finite), AK_ERR_BAD_ARG (tolerance negative or NaN),
+ * AK_ERR_NULL_ARG / AK_ERR_SPAN_SMALL (scratch). */
+AK_API ak_result ak_ik_fabrik_tree_validate(const ak_ik_fabrik_tree_job* job);
+/* Validate, then solve in place; unreachable targets as for chains. */
+AK_API ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ANIMKIT_IK_H */

@@ -1,0 +1,257 @@
+/* IK chains: building and checking chains, the chain job (validation, defaults, dispatch to
+ * the solvers in ccd.c, fabrik.c, dls.c, two_bone.c). */
+#include <string.h>
+
+#include "ik_internal.h"
+
+#define AK_IK_DEFAULT_ITERATIONS 50u
+
+/* ---- helpers ------------------------------------------------------------------------- */
+
+/* Model transform of joint j's parent (identity for a root): walk up, composing on the left. */
+static ak_transform parent_model(const ak_skeleton* sk, const ak_transform* pose, int j) {
+    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_transform acc = ak_transform_identity();
+    for (int p = parents.ptr[j]; p >= 0; p = parents.ptr[p]) acc = ak_transform_mul(pose[p], acc);
+    return acc;
+}
+
+/* Index and hierarchy checks of a chain. */
+static ak_result check_chain(const ak_skeleton* sk, ak_i16_cspan chain) {
+    const size_t n = ak_skeleton_joint_count(sk);
+    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    for (size_t k = 0; k < chain.count; ++k)
+        if (chain.ptr[k] < 0 || (size_t)chain.ptr[k] >= n) return AK_ERR_BAD_INDEX;
+    for (size_t k = 1; k < chain.count; ++k)
+        if (parents.ptr[chain.ptr[k]] != chain.ptr[k - 1]) return AK_ERR_BAD_HIERARCHY;
+    return AK_OK;
+}
+
+static bool pose_chain_finite(const ak_skeleton* sk, const ak_transform* pose, ak_i16_cspan chain) {
+    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    for (int p = parents.ptr[chain.ptr[0]]; p >= 0; p = parents.ptr[p])
+        if (!ak_transform_is_finite(pose[p])) return false;
+    for (size_t k = 0; k < chain.count; ++k)
+        if (!ak_transform_is_finite(pose[chain.ptr[k]])) return false;
+    return true;
+}
+
+/* Sum of bone lengths from already computed world transforms. */
+static float world_length(const ak_transform* world, size_t count) {
+    float len = 0.0f;
+    for (size_t i = 1; i < count; ++i) len += ak_vec3_distance(world[i].translation, world[i - 1].translation);
+    return len;
+}
+
+static bool nonneg(float x) { return x >= 0.0f && ak_finitef(x); }
+
+static void* align16(void* p) { return (void*)(((uintptr_t)p + 15u) & ~(uintptr_t)15u); }
+
+static size_t world_bytes(size_t n) { return akp_align16(n * sizeof(ak_transform)); }
+
+/* ---- chains -------------------------------------------------------------------------- */
+
+ak_result ak_ik_chain_build(const ak_skeleton* skeleton, int root_joint, int effector_joint, ak_i16_span out_joints,
+                            size_t* out_count) {
+    if (!skeleton || !out_count) return AK_ERR_NULL_ARG;
+    const size_t n = ak_skeleton_joint_count(skeleton);
+    if (root_joint < 0 || effector_joint < 0 || (size_t)root_joint >= n || (size_t)effector_joint >= n)
+        return AK_ERR_BAD_INDEX;
+    ak_i16_cspan parents = ak_skeleton_parents(skeleton);
+    size_t count = 1;
+    int j = effector_joint;
+    while (j != root_joint) {
+        j = parents.ptr[j];
+        if (j < 0) return AK_ERR_NOT_FOUND;
+        ++count;
+    }
+    *out_count = count;
+    if (!out_joints.ptr) return AK_ERR_NULL_ARG;
+    if (out_joints.count < count) return AK_ERR_SPAN_SMALL;
+    j = effector_joint;
+    for (size_t k = count; k-- > 0;) {
+        out_joints.ptr[k] = (int16_t)j;
+        j = parents.ptr[j];
+    }
+    return AK_OK;
+}
+
+ak_result ak_ik_chain_positions(const ak_skeleton* skeleton, ak_transform_cspan pose, ak_i16_cspan chain,
+                                ak_vec3_span out_positions) {
+    if (!skeleton || !pose.ptr || !chain.ptr || !out_positions.ptr || chain.count == 0) return AK_ERR_NULL_ARG;
+    if (pose.count < ak_skeleton_joint_count(skeleton) || out_positions.count < chain.count)
+        return AK_ERR_SPAN_SMALL;
+    ak_result r = check_chain(skeleton, chain);
+    if (r != AK_OK) return r;
+    ak_transform w = parent_model(skeleton, pose.ptr, chain.ptr[0]);
+    for (size_t k = 0; k < chain.count; ++k) {
+        w = ak_transform_mul(w, pose.ptr[chain.ptr[k]]);
+        out_positions.ptr[k] = w.translation;
+    }
+    return AK_OK;
+}
+
+float ak_ik_chain_length(const ak_skeleton* skeleton, ak_transform_cspan pose, ak_i16_cspan chain) {
+    if (!skeleton || !pose.ptr || !chain.ptr || chain.count == 0) return 0.0f;
+    if (pose.count < ak_skeleton_joint_count(skeleton) || check_chain(skeleton, chain) != AK_OK) return 0.0f;
+    ak_transform w = parent_model(skeleton, pose.ptr, chain.ptr[0]);
+    float len = 0.0f;
+    ak_vec3 prev = ak_vec3_zero();
+    for (size_t k = 0; k < chain.count; ++k) {
+        w = ak_transform_mul(w, pose.ptr[chain.ptr[k]]);
+        if (k > 0) len += ak_vec3_distance(w.translation, prev);
+        prev = w.translation;
+    }
+    return len;
+}
+
+/* ---- solver names ---------------------------------------------------------------------- */
+
+static const char* const solver_names[AK_IK_SOLVER_COUNT] = {"default", "ccd", "fabrik", "twobone", "dls"};
+
+const char* ak_ik_solver_name(ak_ik_solver solver) {
+    if ((int)solver < 0 || solver >= AK_IK_SOLVER_COUNT) return "";
+    return solver_names[solver];
+}
+
+ak_result ak_ik_solver_parse(const char* name, ak_ik_solver* out_solver) {
+    if (!name || !out_solver) return AK_ERR_NULL_ARG;
+    for (int s = 0; s < AK_IK_SOLVER_COUNT; ++s) {
+        if (strcmp(name, solver_names[s]) == 0) {
+            *out_solver = (ak_ik_solver)s;
+            return AK_OK;
+        }
+    }
+    if (strcmp(name, "two_bone") == 0 || strcmp(name, "two-bone") == 0) {
+        *out_solver = AK_IK_SOLVER_TWO_BONE;
+        return AK_OK;
+    }
+    return AK_ERR_NOT_FOUND;
+}
+
+/* ---- the chain job --------------------------------------------------------------------- */
+
+static ak_ik_solver resolve_solver(ak_ik_solver s) { return s == AK_IK_SOLVER_DEFAULT ? AK_IK_SOLVER_FABRIK : s; }
+
+size_t ak_ik_chain_scratch_size(ak_ik_solver solver, size_t chain_count) {
+    size_t n = chain_count ? chain_count : 1;
+    size_t bytes = 16 + 2 * world_bytes(n); /* 16: room to align the caller's pointer */
+    switch (resolve_solver(solver)) {
+    case AK_IK_SOLVER_FABRIK: bytes += akp_align16(n * sizeof(ak_vec3)) + akp_align16(n * sizeof(float)); break;
+    case AK_IK_SOLVER_DLS: bytes += akp_ik_dls_scratch_size(n); break;
+    default: break;
+    }
+    return bytes;
+}
+
+ak_ik_chain_job ak_ik_chain_job_resolved(const ak_ik_chain_job* job) {
+    ak_ik_chain_job r;
+    memset(&r, 0, sizeof r);
+    if (!job) return r;
+    r = *job;
+    r.solver = resolve_solver(r.solver);
+    if (r.max_iterations == 0) r.max_iterations = AK_IK_DEFAULT_ITERATIONS;
+    if (r.angle_tolerance == 0.0f) r.angle_tolerance = 1e-3f;
+    if (r.max_step == 0.0f) r.max_step = AK_PI;
+    float len = ak_ik_chain_length(job->skeleton, (ak_transform_cspan){job->pose.ptr, job->pose.count}, job->chain);
+    if (job->skeleton && job->pose.ptr && job->chain.ptr && job->chain.count) {
+        if (r.tolerance == 0.0f) r.tolerance = ak_maxf(1e-4f * len, 1e-7f);
+        if (r.dls_damping == 0.0f) r.dls_damping = ak_maxf(0.1f * len, 1e-6f);
+        if (r.orientation_weight == 0.0f) r.orientation_weight = ak_maxf(len / AK_PI, 1e-6f);
+    }
+    return r;
+}
+
+ak_result ak_ik_chain_validate(const ak_ik_chain_job* job) {
+    if (!job || !job->skeleton || !job->pose.ptr || !job->chain.ptr || job->chain.count == 0) return AK_ERR_NULL_ARG;
+    if (job->pose.count < ak_skeleton_joint_count(job->skeleton)) return AK_ERR_SPAN_SMALL;
+    if ((int)job->solver < 0 || job->solver >= AK_IK_SOLVER_COUNT) return AK_ERR_BAD_ARG;
+    ak_result r = check_chain(job->skeleton, job->chain);
+    if (r != AK_OK) return r;
+    if (job->solver == AK_IK_SOLVER_TWO_BONE && job->chain.count != 3) return AK_ERR_BAD_ARG;
+    if (!ak_vec3_is_finite(job->target) || !ak_vec3_is_finite(job->pole)) return AK_ERR_BAD_DATA;
+    if (job->target_rotation) {
+        ak_quat q = *job->target_rotation;
+        if (!ak_quat_is_finite(q) || !(ak_quat_dot(q, q) > 1e-12f)) return AK_ERR_BAD_DATA;
+    }
+    if (!nonneg(job->tolerance) || !nonneg(job->angle_tolerance) || !nonneg(job->max_step) ||
+        !nonneg(job->dls_damping) || !nonneg(job->orientation_weight))
+        return AK_ERR_BAD_ARG;
+    if (!(job->soft >= 0.0f && job->soft < 1.0f)) return AK_ERR_BAD_ARG;
+    if (!(job->keep_animation >= 0.0f && job->keep_animation <= 1.0f)) return AK_ERR_BAD_ARG;
+    if (!pose_chain_finite(job->skeleton, job->pose.ptr, job->chain)) return AK_ERR_BAD_DATA;
+    if (!job->scratch.ptr) return AK_ERR_NULL_ARG;
+    if (job->scratch.count < ak_ik_chain_scratch_size(job->solver, job->chain.count)) return AK_ERR_SPAN_SMALL;
+    return AK_OK;
+}
+
+/* Give the effector the target rotation (then its limits), for the solvers that place only
+ * positions. */
+static void apply_target_rotation(akp_ik_chain* c, const ak_quat* target_rotation) {
+    if (!target_rotation) return;
+    akp_ik_set_world_rot(c, c->count - 1, ak_quat_normalize(*target_rotation));
+}
+
+ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
+    ak_result res = ak_ik_chain_validate(job);
+    if (res != AK_OK) return res;
+    const ak_ik_chain_job rj = ak_ik_chain_job_resolved(job);
+    const size_t n = rj.chain.count;
+
+    unsigned char* mem = (unsigned char*)align16(rj.scratch.ptr);
+    akp_ik_chain c;
+    c.skeleton = rj.skeleton;
+    c.pose = rj.pose.ptr;
+    c.joints = rj.chain.ptr;
+    c.count = n;
+    c.base = parent_model(rj.skeleton, rj.pose.ptr, rj.chain.ptr[0]);
+    c.world = (ak_transform*)mem;
+    mem += world_bytes(n);
+    c.best = (ak_transform*)mem;
+    mem += world_bytes(n);
+    c.target = rj.target;
+    c.limits = !rj.ignore_limits;
+    akp_ik_fk(&c, 0);
+    c.length = world_length(c.world, n);
+    c.tolerance = rj.tolerance;
+    c.best_error = INFINITY;
+    akp_ik_track_best(&c, ak_vec3_distance(c.world[n - 1].translation, c.target));
+
+    akp_ik_outcome out = {0.0f, 0};
+    if (n == 1) {
+        /* Nothing can move the root's own position. */
+        apply_target_rotation(&c, rj.target_rotation);
+    } else {
+        switch (rj.solver) {
+        case AK_IK_SOLVER_CCD:
+            out = akp_ik_ccd(&c, &rj);
+            apply_target_rotation(&c, rj.target_rotation);
+            break;
+        case AK_IK_SOLVER_TWO_BONE:
+            akp_ik_two_bone_chain(&c, &rj);
+            apply_target_rotation(&c, rj.target_rotation);
+            break;
+        case AK_IK_SOLVER_DLS: out = akp_ik_dls(&c, &rj, mem); break;
+        case AK_IK_SOLVER_FABRIK:
+        default: {
+            ak_vec3* pos = (ak_vec3*)mem;
+            float* len = (float*)(mem + akp_align16(n * sizeof(ak_vec3)));
+            out = akp_ik_fabrik(&c, &rj, pos, len);
+            apply_target_rotation(&c, rj.target_rotation);
+            break;
+        }
+        }
+    }
+    const float error = ak_vec3_distance(c.world[n - 1].translation, c.target);
+    float angle_error = 0.0f;
+    if (rj.target_rotation) {
+        ak_quat d = ak_quat_mul(ak_quat_normalize(*rj.target_rotation), ak_quat_conjugate(c.world[n - 1].rotation));
+        angle_error = akp_quat_angle(d);
+    }
+    if (job->out_reached)
+        *job->out_reached = error <= rj.tolerance && (!rj.target_rotation || angle_error <= rj.angle_tolerance);
+    if (job->out_error) *job->out_error = error;
+    if (job->out_angle_error) *job->out_angle_error = angle_error;
+    if (job->out_iterations) *job->out_iterations = out.iterations;
+    return AK_OK;
+}

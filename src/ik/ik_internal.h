@@ -1,0 +1,150 @@
+/* Shared between the IK source files: the chain working state and small math helpers. */
+#ifndef ANIMKIT_IK_INTERNAL_H
+#define ANIMKIT_IK_INTERNAL_H
+
+#include <animkit/ik.h>
+
+#include "internal.h"
+
+/* Working state of one chain solve. world[i] is the model transform of chain joint i;
+ * base is the model transform of the chain root's parent (identity for a skeleton root). */
+typedef struct akp_ik_chain {
+    const ak_skeleton* skeleton;
+    ak_transform* pose;    /* the caller's pose (all joints) */
+    const int16_t* joints; /* chain joint indices, root first */
+    size_t count;
+    ak_transform base;
+    ak_transform* world; /* [count] scratch */
+    ak_transform* best;  /* [count] scratch: chain locals of the best pose seen */
+    float best_error;
+    ak_vec3 target;
+    bool limits; /* honour joint types and limits */
+    float length; /* sum of bone lengths, model units */
+    float tolerance;
+} akp_ik_chain;
+
+/* Solver outcome shared by the chain solvers. */
+typedef struct akp_ik_outcome {
+    float error;
+    size_t iterations;
+} akp_ik_outcome;
+
+/* Model rotation of chain joint i's parent. */
+static inline ak_quat akp_ik_parent_rot(const akp_ik_chain* c, size_t i) {
+    return i == 0 ? c->base.rotation : c->world[i - 1].rotation;
+}
+static inline ak_transform akp_ik_parent_world(const akp_ik_chain* c, size_t i) {
+    return i == 0 ? c->base : c->world[i - 1];
+}
+
+/* Recompute world[from..count-1] from the pose. */
+static inline void akp_ik_fk(akp_ik_chain* c, size_t from) {
+    for (size_t i = from; i < c->count; ++i)
+        c->world[i] = ak_transform_mul(akp_ik_parent_world(c, i), c->pose[c->joints[i]]);
+}
+
+/* Remember the current pose when it beats the best error so far. */
+static inline void akp_ik_track_best(akp_ik_chain* c, float error) {
+    if (!(error < c->best_error)) return;
+    c->best_error = error;
+    for (size_t i = 0; i < c->count; ++i) c->best[i] = c->pose[c->joints[i]];
+}
+
+/* Go back to the best pose seen if the current one is worse; returns the resulting error. */
+static inline float akp_ik_restore_best(akp_ik_chain* c, float error) {
+    if (!(error > c->best_error)) return error;
+    for (size_t i = 0; i < c->count; ++i) c->pose[c->joints[i]] = c->best[i];
+    akp_ik_fk(c, 0);
+    return c->best_error;
+}
+
+/* Joint type as the solver sees it: FREE when limits are ignored. */
+static inline ak_joint_type akp_ik_type(const akp_ik_chain* c, size_t i) {
+    return c->limits ? ak_skeleton_joint_type(c->skeleton, (size_t)c->joints[i]) : AK_JOINT_FREE;
+}
+
+/* Set chain joint i's local rotation so that its model rotation becomes world_rot, then clamp
+ * to its limits. world[i] is updated; descendants are not. */
+static inline void akp_ik_set_world_rot(akp_ik_chain* c, size_t i, ak_quat world_rot) {
+    const size_t j = (size_t)c->joints[i];
+    ak_transform* l = &c->pose[j];
+    l->rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(akp_ik_parent_rot(c, i)), world_rot));
+    if (c->limits) *l = ak_skeleton_limit_joint(c->skeleton, j, *l);
+    c->world[i] = ak_transform_mul(akp_ik_parent_world(c, i), *l);
+}
+
+/* Rotate chain joint i by the model-space rotation q (about its own position). */
+static inline void akp_ik_rotate(akp_ik_chain* c, size_t i, ak_quat q) {
+    akp_ik_set_world_rot(c, i, ak_quat_mul(q, c->world[i].rotation));
+}
+
+/* Quaternion of a rotation vector (axis * angle, radians). */
+static inline ak_quat akp_quat_from_rotvec(ak_vec3 w) {
+    float a = ak_vec3_length(w);
+    if (a < 1e-12f) return ak_quat_normalize(ak_quat_make(0.5f * w.x, 0.5f * w.y, 0.5f * w.z, 1.0f));
+    float s = sinf(0.5f * a) / a;
+    return ak_quat_make(w.x * s, w.y * s, w.z * s, cosf(0.5f * a));
+}
+
+/* Rotation vector (axis * angle in [0, pi]) of a unit quaternion. */
+static inline ak_vec3 akp_quat_to_rotvec(ak_quat q) {
+    if (q.w < 0.0f) q = ak_quat_neg(q);
+    ak_vec3 v = ak_vec3_make(q.x, q.y, q.z);
+    float s = ak_vec3_length(v);
+    if (s < 1e-12f) return ak_vec3_scale(v, 2.0f);
+    return ak_vec3_scale(v, 2.0f * atan2f(s, q.w) / s);
+}
+
+/* Angle in [0, pi] of a unit quaternion's rotation. */
+static inline float akp_quat_angle(ak_quat q) {
+    float s = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z);
+    return 2.0f * atan2f(s, fabsf(q.w));
+}
+
+/* Rotation (model space) that turns re towards rd about the joint, limited to max_step; for a
+ * hinge, about its axis only (both vectors projected onto the plane of rotation). */
+static inline ak_quat akp_ik_aim_rotation(ak_vec3 re, ak_vec3 rd, bool hinge, ak_vec3 axis, float max_step) {
+    if (hinge) {
+        re = ak_vec3_madd(re, axis, -ak_vec3_dot(re, axis));
+        rd = ak_vec3_madd(rd, axis, -ak_vec3_dot(rd, axis));
+    }
+    const float lre = ak_vec3_length(re), lrd = ak_vec3_length(rd);
+    if (!(lre > 1e-12f) || !(lrd > 1e-12f)) return ak_quat_identity();
+    ak_vec3 cr = ak_vec3_cross(re, rd);
+    float sin_l = ak_vec3_length(cr); /* |re||rd| sin(theta) */
+    float cos_l = ak_vec3_dot(re, rd); /* |re||rd| cos(theta) */
+    float angle;
+    ak_vec3 ax;
+    if (hinge) {
+        angle = atan2f(ak_vec3_dot(cr, axis), cos_l); /* signed about the hinge axis */
+        ax = axis;
+        if (angle < 0.0f) {
+            angle = -angle;
+            ax = ak_vec3_neg(axis);
+        }
+    } else {
+        angle = atan2f(sin_l, cos_l);
+        if (sin_l > 1e-12f * lre * lrd) ax = ak_vec3_scale(cr, 1.0f / sin_l);
+        else if (cos_l < 0.0f) ax = ak_vec3_any_perpendicular(re); /* opposite: any axis */
+        else return ak_quat_identity();
+    }
+    if (angle > max_step) angle = max_step;
+    float s = sinf(0.5f * angle);
+    return ak_quat_make(ax.x * s, ax.y * s, ax.z * s, cosf(0.5f * angle));
+}
+
+/* Solvers (src/ik/<name>.c). Each starts from a chain whose world[] is current and returns
+ * with world[] and the pose consistent. */
+akp_ik_outcome akp_ik_ccd(akp_ik_chain* c, const ak_ik_chain_job* job);
+/* One CCD sweep over the chain (world[] consistent before and after). */
+void akp_ik_ccd_sweep(akp_ik_chain* c, float max_step, bool from_root);
+akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec3* positions, float* lengths);
+akp_ik_outcome akp_ik_dls(akp_ik_chain* c, const ak_ik_chain_job* job, void* scratch);
+size_t akp_ik_dls_scratch_size(size_t chain_count);
+void akp_ik_two_bone_chain(akp_ik_chain* c, const ak_ik_chain_job* job);
+
+/* The analytic two-bone core shared by the job and the chain solver. branch 0 picks the bend
+ * closest to the current one, 1 the other. Returns whether the target was within reach. */
+bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* out_start, ak_quat* out_mid);
+
+#endif

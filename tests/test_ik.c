@@ -1,0 +1,1043 @@
+/* Tests for the IK module: chains, the four chain solvers, the two-bone job, the FABRIK tree
+ * job. Oracles are closed forms (law of cosines, a hand-worked CCD example re-derived in
+ * double precision), properties (bone lengths, limits checked with the test's own math,
+ * targets made by forward kinematics of random poses so they are reachable) and exact result
+ * codes for every validate rule. */
+#include <animkit/ik.h>
+
+#include "ak_test.h"
+
+/* ---- helpers ------------------------------------------------------------------------- */
+
+#define MAXJ 40
+#define PI_D 3.14159265358979323846
+
+static const ak_ik_solver iterative[3] = {AK_IK_SOLVER_CCD, AK_IK_SOLVER_FABRIK, AK_IK_SOLVER_DLS};
+static unsigned char scratch[1 << 16];
+
+typedef struct chain_spec {
+    size_t count;        /* joints, root first; the last is the effector */
+    float lengths[MAXJ]; /* bone i: from joint i to joint i + 1, along the parent's +x */
+    ak_joint_type types[MAXJ];
+    ak_joint_limits limits[MAXJ];
+} chain_spec;
+
+static ak_skeleton* make_chain(const chain_spec* s) {
+    ak_joint_desc j[MAXJ];
+    static char names[MAXJ][8];
+    memset(j, 0, sizeof j);
+    for (size_t i = 0; i < s->count; ++i) {
+        snprintf(names[i], sizeof names[i], "j%zu", i);
+        j[i].name = names[i];
+        j[i].parent = (int)i - 1;
+        j[i].rest = ak_transform_identity();
+        if (i > 0) j[i].rest.translation = ak_vec3_make(s->lengths[i - 1], 0.0f, 0.0f);
+        j[i].type = s->types[i];
+        j[i].limits = s->limits[i];
+    }
+    ak_skeleton_desc d = {.joints = j, .joint_count = s->count};
+    ak_skeleton* sk = NULL;
+    if (ak_skeleton_create(&d, NULL, &sk, NULL) != AK_OK) return NULL;
+    return sk;
+}
+
+static void rest_pose(const ak_skeleton* sk, ak_transform* pose) {
+    ak_transform_cspan r = ak_skeleton_rest_pose(sk);
+    memcpy(pose, r.ptr, r.count * sizeof *pose);
+}
+
+static void full_chain(size_t n, int16_t* chain) {
+    for (size_t i = 0; i < n; ++i) chain[i] = (int16_t)i;
+}
+
+/* Model-space joint positions by the test's own forward kinematics in double precision. */
+static void fk_positions(const ak_transform* pose, size_t n, double out[][3]) {
+    double rot[4] = {0, 0, 0, 1}, pos[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; ++i) {
+        const ak_transform* t = &pose[i];
+        double v[3] = {t->translation.x, t->translation.y, t->translation.z};
+        /* pos += rot * v */
+        double qx = rot[0], qy = rot[1], qz = rot[2], qw = rot[3];
+        double tx = 2 * (qy * v[2] - qz * v[1]), ty = 2 * (qz * v[0] - qx * v[2]), tz = 2 * (qx * v[1] - qy * v[0]);
+        pos[0] += v[0] + qw * tx + (qy * tz - qz * ty);
+        pos[1] += v[1] + qw * ty + (qz * tx - qx * tz);
+        pos[2] += v[2] + qw * tz + (qx * ty - qy * tx);
+        out[i][0] = pos[0], out[i][1] = pos[1], out[i][2] = pos[2];
+        double b[4] = {t->rotation.x, t->rotation.y, t->rotation.z, t->rotation.w};
+        double nb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
+        for (int k = 0; k < 4; ++k) b[k] /= nb;
+        double r[4] = {qw * b[0] + qx * b[3] + qy * b[2] - qz * b[1], qw * b[1] - qx * b[2] + qy * b[3] + qz * b[0],
+                       qw * b[2] + qx * b[1] - qy * b[0] + qz * b[3], qw * b[3] - qx * b[0] - qy * b[1] - qz * b[2]};
+        memcpy(rot, r, sizeof r);
+    }
+}
+
+static double dist3(const double* a, const double* b) {
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+/* Every bone length of the chain matches its rest length within 1e-5 relative. */
+static bool lengths_preserved(const chain_spec* s, const ak_transform* pose) {
+    double p[MAXJ][3];
+    fk_positions(pose, s->count, p);
+    for (size_t i = 1; i < s->count; ++i) {
+        if (s->types[i] == AK_JOINT_PRISM) continue;
+        double l = dist3(p[i], p[i - 1]), want = s->lengths[i - 1];
+        if (fabs(l - want) > 1e-5 * fmax(want, 1e-3)) return false;
+    }
+    return true;
+}
+
+static bool pose_finite(const ak_transform* pose, size_t n) {
+    for (size_t i = 0; i < n; ++i)
+        if (!ak_transform_is_finite(pose[i])) return false;
+    return true;
+}
+
+/* The test's own limit check: rel = rest^-1 * local, split about the axis in double. */
+static bool within_limits(const chain_spec* s, const ak_skeleton* sk, size_t i, ak_transform local, double tol) {
+    ak_transform rest = ak_skeleton_rest_pose(sk).ptr[i];
+    ak_quat rel = ak_quat_mul(ak_quat_conjugate(rest.rotation), ak_quat_normalize(local.rotation));
+    if (rel.w < 0) rel = ak_quat_neg(rel);
+    ak_joint_limits l = s->limits[i];
+    double ax[3] = {l.axis.x, l.axis.y, l.axis.z};
+    double na = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+    if (na == 0) {
+        ax[0] = s->types[i] == AK_JOINT_BALL ? 0 : 1, ax[1] = s->types[i] == AK_JOINT_BALL ? 1 : 0, ax[2] = 0, na = 1;
+    }
+    for (int k = 0; k < 3; ++k) ax[k] /= na;
+    double v[3] = {rel.x, rel.y, rel.z};
+    double along = v[0] * ax[0] + v[1] * ax[1] + v[2] * ax[2];
+    double twist = 2 * atan2(along, rel.w); /* signed twist angle about the axis */
+    double tw[4] = {ax[0] * along, ax[1] * along, ax[2] * along, rel.w};
+    double ntw = sqrt(tw[0] * tw[0] + tw[1] * tw[1] + tw[2] * tw[2] + tw[3] * tw[3]);
+    /* swing = rel * conj(twist / |twist|); its angle by atan2 (acos is ill-conditioned near 0) */
+    double swing = 0.0;
+    if (ntw > 1e-12) {
+        double t[4] = {tw[0] / ntw, tw[1] / ntw, tw[2] / ntw, tw[3] / ntw};
+        double r[4] = {rel.x, rel.y, rel.z, rel.w};
+        /* r * conj(t) */
+        double sw = r[3] * t[3] + r[0] * t[0] + r[1] * t[1] + r[2] * t[2];
+        double sx = -r[3] * t[0] + r[0] * t[3] - r[1] * t[2] + r[2] * t[1];
+        double sy = -r[3] * t[1] + r[0] * t[2] + r[1] * t[3] - r[2] * t[0];
+        double sz = -r[3] * t[2] - r[0] * t[1] + r[1] * t[0] + r[2] * t[3];
+        swing = 2 * atan2(sqrt(sx * sx + sy * sy + sz * sz), fabs(sw));
+    } else {
+        swing = PI_D;
+    }
+    double dt[3] = {local.translation.x - rest.translation.x, local.translation.y - rest.translation.y,
+                    local.translation.z - rest.translation.z};
+    switch (s->types[i]) {
+    case AK_JOINT_HINGE:
+        if (swing > tol) return false;
+        if (l.min == 0 && l.max == 0) return true;
+        return twist >= l.min - tol && twist <= l.max + tol;
+    case AK_JOINT_BALL:
+        if (l.cone_angle > 0 && swing > l.cone_angle + tol) return false;
+        if (l.twist_min == 0 && l.twist_max == 0) return true;
+        return twist >= l.twist_min - tol && twist <= l.twist_max + tol;
+    case AK_JOINT_PRISM: {
+        if (2 * atan2(sqrt((double)rel.x * rel.x + (double)rel.y * rel.y + (double)rel.z * rel.z), fabs((double)rel.w)) > tol)
+            return false;
+        ak_vec3 a = ak_quat_rotate(rest.rotation, ak_vec3_normalize(l.axis.x == 0 && l.axis.y == 0 && l.axis.z == 0
+                                                                         ? ak_vec3_make(1, 0, 0)
+                                                                         : l.axis));
+        double d = dt[0] * a.x + dt[1] * a.y + dt[2] * a.z;
+        double off = sqrt(fmax(0.0, dt[0] * dt[0] + dt[1] * dt[1] + dt[2] * dt[2] - d * d));
+        return off <= tol && d >= l.min - tol && d <= l.max + tol;
+    }
+    default: return true;
+    }
+}
+
+/* A random pose inside the limits: random local rotations clamped by the skeleton. */
+static void random_pose(const ak_skeleton* sk, ak_rng* rng, ak_transform* pose, bool planar) {
+    size_t n = ak_skeleton_joint_count(sk);
+    rest_pose(sk, pose);
+    for (size_t i = 0; i < n; ++i) {
+        ak_vec3 axis = planar ? ak_vec3_make(0, 0, 1)
+                              : ak_vec3_make(ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1));
+        pose[i].rotation = ak_quat_mul(pose[i].rotation, ak_quat_from_axis_angle(axis, ak_rng_range(rng, -1.2f, 1.2f)));
+        if (ak_skeleton_joint_type(sk, i) == AK_JOINT_PRISM)
+            pose[i].translation = ak_vec3_add(pose[i].translation, ak_vec3_make(ak_rng_range(rng, -0.3f, 0.3f), 0, 0));
+        pose[i] = ak_skeleton_limit_joint(sk, i, pose[i]);
+    }
+}
+
+static ak_vec3 effector_of(const ak_transform* pose, size_t n) {
+    double p[MAXJ][3];
+    fk_positions(pose, n, p);
+    return ak_vec3_make((float)p[n - 1][0], (float)p[n - 1][1], (float)p[n - 1][2]);
+}
+
+static chain_spec uniform_chain(size_t n, ak_joint_type type) {
+    chain_spec s;
+    memset(&s, 0, sizeof s);
+    s.count = n;
+    for (size_t i = 0; i < n; ++i) {
+        s.lengths[i] = 0.5f + 0.1f * (float)(i % 4);
+        s.types[i] = type;
+        if (type == AK_JOINT_HINGE) s.limits[i].axis = ak_vec3_make(0, 0, 1);
+    }
+    return s;
+}
+
+typedef struct solve_out {
+    ak_result r;
+    bool reached;
+    float error, angle_error, tolerance;
+    size_t iterations;
+} solve_out;
+
+static solve_out solve(const ak_skeleton* sk, ak_transform* pose, const int16_t* chain, size_t count,
+                       ak_vec3 target, ak_ik_solver solver, const ak_ik_chain_job* extra) {
+    ak_ik_chain_job job;
+    if (extra) job = *extra;
+    else memset(&job, 0, sizeof job);
+    solve_out o = {AK_OK, false, -1.0f, -1.0f, 0.0f, 0};
+    job.skeleton = sk;
+    job.pose = (ak_transform_span){pose, ak_skeleton_joint_count(sk)};
+    job.chain = (ak_i16_cspan){chain, count};
+    job.target = target;
+    job.solver = solver;
+    job.scratch = (ak_u8_span)AK_SPAN(scratch);
+    job.out_reached = &o.reached;
+    job.out_error = &o.error;
+    job.out_angle_error = &o.angle_error;
+    job.out_iterations = &o.iterations;
+    o.tolerance = ak_ik_chain_job_resolved(&job).tolerance;
+    o.r = ak_ik_chain_run(&job);
+    return o;
+}
+
+/* ---- chains --------------------------------------------------------------------------- */
+
+AK_TEST(chain_build) {
+    chain_spec s = uniform_chain(5, AK_JOINT_FREE);
+    ak_skeleton* sk = make_chain(&s);
+    AK_CHECK(sk != NULL);
+    if (!sk) return;
+    int16_t c[8];
+    size_t count = 0;
+    AK_CHECK_EQ(ak_ik_chain_build(sk, 1, 4, (ak_i16_span)AK_SPAN(c), &count), AK_OK);
+    AK_CHECK_EQ(count, 4);
+    AK_CHECK_EQ(c[0], 1);
+    AK_CHECK_EQ(c[3], 4);
+    AK_CHECK_EQ(ak_ik_chain_build(sk, 2, 2, (ak_i16_span)AK_SPAN(c), &count), AK_OK);
+    AK_CHECK_EQ(count, 1);
+    AK_CHECK_EQ(ak_ik_chain_build(sk, 3, 1, (ak_i16_span)AK_SPAN(c), &count), AK_ERR_NOT_FOUND);
+    AK_CHECK_EQ(ak_ik_chain_build(sk, 0, 5, (ak_i16_span)AK_SPAN(c), &count), AK_ERR_BAD_INDEX);
+    AK_CHECK_EQ(ak_ik_chain_build(sk, -1, 2, (ak_i16_span)AK_SPAN(c), &count), AK_ERR_BAD_INDEX);
+    AK_CHECK_EQ(ak_ik_chain_build(NULL, 0, 2, (ak_i16_span)AK_SPAN(c), &count), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_ik_chain_build(sk, 0, 4, (ak_i16_span){c, 3}, &count), AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(count, 5);
+
+    /* Positions and length against the test's own FK. */
+    ak_transform pose[5];
+    ak_rng rng = ak_rng_make(7);
+    random_pose(sk, &rng, pose, false);
+    ak_vec3 pos[5];
+    full_chain(5, c);
+    AK_CHECK_EQ(ak_ik_chain_positions(sk, (ak_transform_cspan)AK_SPAN(pose), (ak_i16_cspan){c + 1, 4},
+                                      (ak_vec3_span)AK_SPAN(pos)),
+                AK_OK);
+    double ref[5][3];
+    fk_positions(pose, 5, ref);
+    double len = 0;
+    for (int i = 0; i < 4; ++i) {
+        AK_CHECK_NEAR(pos[i].x, ref[i + 1][0], 1e-5);
+        AK_CHECK_NEAR(pos[i].y, ref[i + 1][1], 1e-5);
+        AK_CHECK_NEAR(pos[i].z, ref[i + 1][2], 1e-5);
+        len += s.lengths[i];
+    }
+    AK_CHECK_NEAR(ak_ik_chain_length(sk, (ak_transform_cspan)AK_SPAN(pose), (ak_i16_cspan){c, 5}), len, 1e-5);
+    int16_t bad[2] = {0, 2};
+    AK_CHECK_EQ(ak_ik_chain_positions(sk, (ak_transform_cspan)AK_SPAN(pose), (ak_i16_cspan)AK_SPAN(bad),
+                                      (ak_vec3_span)AK_SPAN(pos)),
+                AK_ERR_BAD_HIERARCHY);
+    ak_skeleton_destroy(sk);
+}
+
+AK_TEST(solver_names) {
+    ak_ik_solver s = AK_IK_SOLVER_DEFAULT;
+    const char* names[] = {"ccd", "fabrik", "twobone", "dls"};
+    for (int i = 0; i < 4; ++i) {
+        AK_CHECK_EQ(ak_ik_solver_parse(names[i], &s), AK_OK);
+        AK_CHECK_EQ(s, i + 1);
+        AK_CHECK_STREQ(ak_ik_solver_name(s), names[i]);
+    }
+    AK_CHECK_EQ(ak_ik_solver_parse("two-bone", &s), AK_OK);
+    AK_CHECK_EQ(s, AK_IK_SOLVER_TWO_BONE);
+    AK_CHECK_EQ(ak_ik_solver_parse("newton", &s), AK_ERR_NOT_FOUND);
+    AK_CHECK_EQ(ak_ik_solver_parse(NULL, &s), AK_ERR_NULL_ARG);
+    AK_CHECK_STREQ(ak_ik_solver_name((ak_ik_solver)99), "");
+}
+
+/* ---- validity ------------------------------------------------------------------------- */
+
+AK_TEST(chain_job_validity) {
+    chain_spec s = uniform_chain(4, AK_JOINT_FREE);
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    ak_transform pose[4];
+    rest_pose(sk, pose);
+    int16_t chain[4] = {0, 1, 2, 3};
+    ak_ik_chain_job zero;
+    memset(&zero, 0, sizeof zero);
+    AK_CHECK_EQ(ak_ik_chain_validate(&zero), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_ik_chain_run(&zero), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_ik_chain_validate(NULL), AK_ERR_NULL_ARG);
+
+    const ak_ik_chain_job good = {
+        .skeleton = sk,
+        .pose = AK_SPAN(pose),
+        .chain = AK_SPAN(chain),
+        .target = {1, 1, 0},
+        .scratch = AK_SPAN(scratch),
+    };
+    AK_CHECK_EQ(ak_ik_chain_validate(&good), AK_OK);
+    ak_ik_chain_job j;
+#define EXPECT(code, mutate)                                                                       \
+    do {                                                                                           \
+        j = good;                                                                                  \
+        mutate;                                                                                    \
+        AK_CHECK_EQ(ak_ik_chain_validate(&j), code);                                               \
+    } while (0)
+    EXPECT(AK_ERR_NULL_ARG, j.skeleton = NULL);
+    EXPECT(AK_ERR_NULL_ARG, j.pose.ptr = NULL);
+    EXPECT(AK_ERR_NULL_ARG, j.chain.ptr = NULL);
+    EXPECT(AK_ERR_NULL_ARG, j.chain.count = 0);
+    EXPECT(AK_ERR_SPAN_SMALL, j.pose.count = 3);
+    EXPECT(AK_ERR_BAD_ARG, j.solver = AK_IK_SOLVER_COUNT);
+    int16_t out_of_range[2] = {0, 4};
+    EXPECT(AK_ERR_BAD_INDEX, j.chain = (ak_i16_cspan)AK_SPAN(out_of_range));
+    int16_t negative[1] = {-1};
+    EXPECT(AK_ERR_BAD_INDEX, j.chain = (ak_i16_cspan)AK_SPAN(negative));
+    int16_t skip[3] = {0, 2, 3};
+    EXPECT(AK_ERR_BAD_HIERARCHY, j.chain = (ak_i16_cspan)AK_SPAN(skip));
+    int16_t reversed[2] = {1, 0};
+    EXPECT(AK_ERR_BAD_HIERARCHY, j.chain = (ak_i16_cspan)AK_SPAN(reversed));
+    EXPECT(AK_ERR_BAD_ARG, j.solver = AK_IK_SOLVER_TWO_BONE); /* 4 joints */
+    EXPECT(AK_OK, (j.solver = AK_IK_SOLVER_TWO_BONE, j.chain.count = 3));
+    EXPECT(AK_ERR_BAD_DATA, j.target.y = NAN);
+    EXPECT(AK_ERR_BAD_DATA, j.target.z = INFINITY);
+    EXPECT(AK_ERR_BAD_DATA, j.pole.x = NAN);
+    const ak_quat nan_q = {NAN, 0, 0, 1}, zero_q = {0, 0, 0, 0};
+    EXPECT(AK_ERR_BAD_DATA, j.target_rotation = &nan_q);
+    EXPECT(AK_ERR_BAD_DATA, j.target_rotation = &zero_q);
+    EXPECT(AK_ERR_BAD_ARG, j.tolerance = -1.0f);
+    EXPECT(AK_ERR_BAD_ARG, j.tolerance = NAN);
+    EXPECT(AK_ERR_BAD_ARG, j.angle_tolerance = -1.0f);
+    EXPECT(AK_ERR_BAD_ARG, j.max_step = -0.1f);
+    EXPECT(AK_ERR_BAD_ARG, j.dls_damping = -1.0f);
+    EXPECT(AK_ERR_BAD_ARG, j.orientation_weight = INFINITY);
+    EXPECT(AK_ERR_BAD_ARG, j.soft = 1.0f);
+    EXPECT(AK_ERR_BAD_ARG, j.soft = -0.1f);
+    EXPECT(AK_ERR_BAD_ARG, j.keep_animation = 1.5f);
+    EXPECT(AK_ERR_BAD_ARG, j.keep_animation = -0.5f);
+    pose[1].rotation.x = NAN;
+    EXPECT(AK_ERR_BAD_DATA, (void)0);
+    /* An ancestor outside the chain counts too. */
+    int16_t tail[2] = {2, 3};
+    EXPECT(AK_ERR_BAD_DATA, j.chain = (ak_i16_cspan)AK_SPAN(tail));
+    rest_pose(sk, pose);
+    EXPECT(AK_ERR_NULL_ARG, j.scratch.ptr = NULL);
+    EXPECT(AK_ERR_SPAN_SMALL, j.scratch.count = ak_ik_chain_scratch_size(AK_IK_SOLVER_FABRIK, 4) - 1);
+    EXPECT(AK_OK, j.scratch.count = ak_ik_chain_scratch_size(AK_IK_SOLVER_FABRIK, 4));
+    EXPECT(AK_ERR_SPAN_SMALL,
+           (j.solver = AK_IK_SOLVER_DLS, j.scratch.count = ak_ik_chain_scratch_size(AK_IK_SOLVER_DLS, 4) - 1));
+#undef EXPECT
+
+    /* run writes nothing when validation fails. */
+    ak_transform before[4];
+    memcpy(before, pose, sizeof pose);
+    j = good;
+    j.tolerance = -1.0f;
+    bool reached = true;
+    j.out_reached = &reached;
+    AK_CHECK_EQ(ak_ik_chain_run(&j), AK_ERR_BAD_ARG);
+    AK_CHECK(memcmp(before, pose, sizeof pose) == 0);
+    AK_CHECK(reached == true);
+
+    /* Defaults resolved. */
+    ak_ik_chain_job r = ak_ik_chain_job_resolved(&good);
+    AK_CHECK_EQ(r.solver, AK_IK_SOLVER_FABRIK);
+    AK_CHECK_EQ(r.max_iterations, 50);
+    float len = s.lengths[0] + s.lengths[1] + s.lengths[2];
+    AK_CHECK_NEAR(r.tolerance, 1e-4f * len, 1e-9);
+    AK_CHECK_NEAR(r.max_step, AK_PI, 1e-6);
+    AK_CHECK_NEAR(r.angle_tolerance, 1e-3, 1e-9);
+    AK_CHECK_NEAR(r.dls_damping, 0.1f * len, 1e-6);
+    AK_CHECK_NEAR(r.orientation_weight, len / AK_PI, 1e-6);
+    ak_skeleton_destroy(sk);
+}
+
+AK_TEST(two_bone_job_validity) {
+    ak_quat qs, qm;
+    ak_ik_two_bone_job zero;
+    memset(&zero, 0, sizeof zero);
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&zero), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_ik_two_bone_run(&zero), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_ik_two_bone_validate(NULL), AK_ERR_NULL_ARG);
+    ak_ik_two_bone_job good = {.start = ak_mat4_identity(),
+                               .mid = ak_mat4_translation(ak_vec3_make(1, 0, 0)),
+                               .end = ak_mat4_translation(ak_vec3_make(2, 0, 0)),
+                               .target = {1, 1, 0},
+                               .out_start_rot = &qs,
+                               .out_mid_rot = &qm};
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&good), AK_OK);
+    ak_ik_two_bone_job j = good;
+    j.out_mid_rot = NULL;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_NULL_ARG);
+    j = good, j.out_start_rot = NULL;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_NULL_ARG);
+    j = good, j.mid.m[5] = NAN;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_BAD_DATA);
+    j = good, j.end.m[14] = INFINITY;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_BAD_DATA);
+    j = good, j.target.x = NAN;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_BAD_DATA);
+    j = good, j.pole.y = INFINITY;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_BAD_DATA);
+    j = good, j.mid_axis.z = NAN;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_BAD_DATA);
+    j = good, j.twist = NAN;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_BAD_DATA);
+    j = good, j.soft = 1.0f;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_BAD_ARG);
+    j = good, j.keep_animation = 2.0f;
+    AK_CHECK_EQ(ak_ik_two_bone_validate(&j), AK_ERR_BAD_ARG);
+    qs = ak_quat_make(9, 9, 9, 9);
+    j = good, j.soft = NAN;
+    AK_CHECK_EQ(ak_ik_two_bone_run(&j), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(qs.x, 9); /* untouched */
+}
+
+/* ---- CCD, step by step ------------------------------------------------------------------- */
+
+/* Planar chain of three unit bones along +x: joints J0 (0,0), J1 (1,0), J2 (2,0), effector E
+ * (3,0); target T = (1,2). One CCD sweep, tip to root, each joint turned by
+ * atan2(RD) - atan2(RE):
+ *   J2: RE = (1,0) -> 0 deg, RD = T - J2 = (-1,2) -> atan2(2,-1) = 116.565 deg: +116.565 deg,
+ *       E = J2 + (cos, sin)(116.565 deg) = (1.55279, 0.89443)
+ *   J1: RE = E - J1 = (0.55279, 0.89443) -> 58.283 deg, RD = (0,2) -> 90 deg: +31.717 deg,
+ *       E = J1 + 1.05146 (cos, sin)(90 deg) = (1, 1.05146)
+ *   J0: RE = (1, 1.05146) -> 46.437 deg, RD = (1,2) -> 63.435 deg: +16.998 deg,
+ *       E = 1.45141 (cos, sin)(63.435 deg) = (0.64893, 1.29787)
+ * Sweep 2 turns J2 by -42.486, J1 by +2.780, J0 by +1.272 deg, E = (0.95497, 1.90993);
+ * sweep 3: -4.925, +0.943, +0.444 deg, E = (0.98358, 1.96717).
+ * The reference below redoes exactly this with atan2 in double precision. */
+static void ccd_planar_reference(int sweeps, double theta[3], double eff[2]) {
+    const double T[2] = {1, 2};
+    theta[0] = theta[1] = theta[2] = 0;
+    for (int s = 0; s < sweeps; ++s) {
+        for (int i = 2; i >= 0; --i) {
+            double p[4][2] = {{0, 0}}, a = 0;
+            for (int k = 0; k < 3; ++k) {
+                a += theta[k];
+                p[k + 1][0] = p[k][0] + cos(a);
+                p[k + 1][1] = p[k][1] + sin(a);
+            }
+            double d = atan2(T[1] - p[i][1], T[0] - p[i][0]) - atan2(p[3][1] - p[i][1], p[3][0] - p[i][0]);
+            while (d > PI_D) d -= 2 * PI_D;
+            while (d <= -PI_D) d += 2 * PI_D;
+            theta[i] += d;
+        }
+    }
+    double a = 0;
+    eff[0] = eff[1] = 0;
+    for (int k = 0; k < 3; ++k) {
+        a += theta[k];
+        eff[0] += cos(a);
+        eff[1] += sin(a);
+    }
+}
+
+static double z_angle(ak_quat q) { return 2.0 * atan2((double)q.z, (double)q.w); }
+
+AK_TEST(ccd_hand_computed_planar) {
+    chain_spec s = uniform_chain(4, AK_JOINT_FREE);
+    for (int i = 0; i < 3; ++i) s.lengths[i] = 1.0f;
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[4] = {0, 1, 2, 3};
+    /* The hand-computed numbers of the comment, as a check on the reference itself. */
+    double th[3], e[2];
+    ccd_planar_reference(1, th, e);
+    AK_CHECK_NEAR(th[2] * 180 / PI_D, 116.565, 1e-3);
+    AK_CHECK_NEAR(th[1] * 180 / PI_D, 31.717, 1e-3);
+    AK_CHECK_NEAR(th[0] * 180 / PI_D, 16.998, 1e-3);
+    AK_CHECK_NEAR(e[0], 0.64893, 1e-5);
+    AK_CHECK_NEAR(e[1], 1.29787, 1e-5);
+    for (int sweeps = 1; sweeps <= 3; ++sweeps) {
+        for (int planar_hinge = 0; planar_hinge < 2; ++planar_hinge) {
+            ak_skeleton* use = sk;
+            ak_skeleton* hinge_sk = NULL;
+            if (planar_hinge) { /* the same chain with z-hinges must take the same steps */
+                chain_spec h = s;
+                for (int i = 0; i < 4; ++i) h.types[i] = AK_JOINT_HINGE, h.limits[i].axis = ak_vec3_make(0, 0, 1);
+                use = hinge_sk = make_chain(&h);
+                if (!use) continue;
+            }
+            ak_transform pose[4];
+            rest_pose(use, pose);
+            ak_ik_chain_job opts = {.max_iterations = (size_t)sweeps};
+            solve_out o = solve(use, pose, chain, 4, ak_vec3_make(1, 2, 0), AK_IK_SOLVER_CCD, &opts);
+            ccd_planar_reference(sweeps, th, e);
+            AK_CHECK_EQ(o.r, AK_OK);
+            AK_CHECK_EQ(o.iterations, sweeps);
+            for (int i = 0; i < 3; ++i) {
+                double got = z_angle(pose[i].rotation), want = remainder(th[i], 2 * PI_D);
+                AK_CHECK_NEAR(got, want, 2e-5);
+            }
+            ak_vec3 eff = effector_of(pose, 4);
+            AK_CHECK_NEAR(eff.x, e[0], 2e-5);
+            AK_CHECK_NEAR(eff.y, e[1], 2e-5);
+            AK_CHECK_NEAR(eff.z, 0.0, 1e-6);
+            AK_CHECK_NEAR(o.error, hypot(1 - e[0], 2 - e[1]), 2e-5);
+            AK_CHECK(!o.reached);
+            ak_skeleton_destroy(hinge_sk);
+        }
+    }
+    ak_skeleton_destroy(sk);
+}
+
+AK_TEST(ccd_options) {
+    /* max_step bounds each joint's turn per sweep; root-first order differs from tip-first. */
+    chain_spec s = uniform_chain(4, AK_JOINT_FREE);
+    for (int i = 0; i < 3; ++i) s.lengths[i] = 1.0f;
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[4] = {0, 1, 2, 3};
+    ak_transform pose[4];
+    rest_pose(sk, pose);
+    ak_ik_chain_job opts = {.max_iterations = 1, .max_step = 0.1f};
+    solve_out o = solve(sk, pose, chain, 4, ak_vec3_make(1, 2, 0), AK_IK_SOLVER_CCD, &opts);
+    AK_CHECK_EQ(o.iterations, 1);
+    for (int i = 0; i < 3; ++i) AK_CHECK_NEAR(fabs(z_angle(pose[i].rotation)), 0.1, 1e-5);
+
+    /* Root first: J0 turns first, by atan2(2,1) - 0 = 63.435 deg (RE = (3,0), RD = (1,2)). */
+    rest_pose(sk, pose);
+    ak_ik_chain_job root_first = {.max_iterations = 1, .ccd_from_root = true};
+    o = solve(sk, pose, chain, 4, ak_vec3_make(1, 2, 0), AK_IK_SOLVER_CCD, &root_first);
+    AK_CHECK_NEAR(z_angle(pose[0].rotation), atan2(2.0, 1.0), 1e-5);
+    /* Many sweeps from the root converge too. */
+    rest_pose(sk, pose);
+    root_first.max_iterations = 200;
+    o = solve(sk, pose, chain, 4, ak_vec3_make(1, 2, 0), AK_IK_SOLVER_CCD, &root_first);
+    AK_CHECK(o.reached);
+    ak_skeleton_destroy(sk);
+}
+
+/* ---- reachable targets ------------------------------------------------------------------ */
+
+static void reach_random_targets(const chain_spec* s, bool planar, ak_ik_solver solver, int trials, int min_ok,
+                                 size_t max_iterations) {
+    ak_skeleton* sk = make_chain(s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[MAXJ];
+    full_chain(s->count, chain);
+    ak_rng rng = ak_rng_make(1234 + (uint64_t)solver);
+    int ok = 0;
+    double len = 0;
+    for (size_t i = 0; i + 1 < s->count; ++i) len += s->lengths[i];
+    for (int t = 0; t < trials; ++t) {
+        ak_transform goal[MAXJ], pose[MAXJ];
+        random_pose(sk, &rng, goal, planar);
+        ak_vec3 target = effector_of(goal, s->count);
+        random_pose(sk, &rng, pose, planar);
+        ak_ik_chain_job opts = {.max_iterations = max_iterations};
+        solve_out o = solve(sk, pose, chain, s->count, target, solver, &opts);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(pose_finite(pose, s->count));
+        AK_CHECK_MSG(lengths_preserved(s, pose), "%s trial %d: bone lengths changed", ak_ik_solver_name(solver), t);
+        for (size_t i = 0; i < s->count; ++i)
+            AK_CHECK_MSG(within_limits(s, sk, i, pose[i], 1e-4), "%s trial %d: joint %zu outside its limits",
+                         ak_ik_solver_name(solver), t, i);
+        /* reported error is the true distance */
+        ak_vec3 eff = effector_of(pose, s->count);
+        AK_CHECK_NEAR(o.error, ak_vec3_distance(eff, target), 1e-5 * len + 1e-6);
+        if (o.reached) {
+            AK_CHECK(o.error <= o.tolerance);
+            ++ok;
+        } else if (getenv("IKDBG")) {
+            printf("%s miss: err %g (tol %g) iters %zu\n", ak_ik_solver_name(solver), o.error, o.tolerance, o.iterations);
+        }
+    }
+    AK_CHECK_MSG(ok >= min_ok, "%s: %d of %d reached (need %d)", ak_ik_solver_name(solver), ok, trials, min_ok);
+    ak_skeleton_destroy(sk);
+}
+
+AK_TEST(reach_free_3d) {
+    chain_spec s = uniform_chain(6, AK_JOINT_FREE);
+    reach_random_targets(&s, false, AK_IK_SOLVER_CCD, 100, 97, 200);
+    reach_random_targets(&s, false, AK_IK_SOLVER_FABRIK, 100, 99, 50);
+    reach_random_targets(&s, false, AK_IK_SOLVER_DLS, 100, 99, 50);
+}
+
+AK_TEST(reach_planar_hinges) {
+    chain_spec s = uniform_chain(5, AK_JOINT_HINGE);
+    reach_random_targets(&s, true, AK_IK_SOLVER_CCD, 100, 95, 200);
+    reach_random_targets(&s, true, AK_IK_SOLVER_FABRIK, 100, 90, 100);
+    reach_random_targets(&s, true, AK_IK_SOLVER_DLS, 100, 98, 50);
+}
+
+AK_TEST(limits_never_violated) {
+    /* A mixed chain: limited hinges, cone/twist balls, a prism. Targets from random poses
+     * inside the limits; every joint checked after every solve (inside the helper). The
+     * success bar is low: limits make the problem hard for position-based solvers. */
+    chain_spec s = uniform_chain(7, AK_JOINT_BALL);
+    s.types[1] = AK_JOINT_HINGE, s.limits[1].axis = ak_vec3_make(0, 0, 1), s.limits[1].min = -0.2f,
+    s.limits[1].max = 1.5f;
+    s.limits[2].cone_angle = 0.6f, s.limits[2].axis = ak_vec3_make(1, 0, 0), s.limits[2].twist_min = -0.3f,
+    s.limits[2].twist_max = 0.3f;
+    s.types[3] = AK_JOINT_PRISM, s.limits[3].axis = ak_vec3_make(1, 0, 0), s.limits[3].min = -0.2f,
+    s.limits[3].max = 0.2f;
+    s.types[4] = AK_JOINT_HINGE, s.limits[4].axis = ak_vec3_make(0, 1, 0), s.limits[4].min = 0.0f,
+    s.limits[4].max = 2.0f;
+    s.limits[5].cone_angle = 0.8f, s.limits[5].axis = ak_vec3_make(1, 0, 0);
+    for (int k = 0; k < 3; ++k) reach_random_targets(&s, false, iterative[k], 60, k == 2 ? 40 : 20, 100);
+    reach_random_targets(&s, false, AK_IK_SOLVER_DLS, 60, 40, 100);
+}
+
+/* ---- two-bone ----------------------------------------------------------------------------- */
+
+AK_TEST(two_bone_closed_form_and_pole) {
+    /* Hip at the origin, bones a = 1 and b = 0.8 along +x (straight), target at distance
+     * d = 1.3 in the xy-plane. Law of cosines: the knee sits at angle
+     * alpha = acos((a^2 + d^2 - b^2) / (2 a d)) from the hip->target line, on the pole's side. */
+    const double a = 1.0, b = 0.8;
+    const ak_vec3 target = ak_vec3_make(0.6f, 1.153256f, 0.0f); /* |target| = 1.3 */
+    const double d = sqrt(0.6 * 0.6 + 1.153256 * 1.153256);
+    const double alpha = acos((a * a + d * d - b * b) / (2 * a * d));
+    const double interior = acos((a * a + b * b - d * d) / (2 * a * b)); /* at the knee */
+    for (int side = -1; side <= 1; side += 2) {
+        const ak_vec3 pole = ak_vec3_make(0, 0, (float)side); /* bend out of the plane, +z or -z */
+        ak_quat qs, qm;
+        bool reached = false;
+        ak_ik_two_bone_job job = {.start = ak_mat4_identity(),
+                                  .mid = ak_mat4_translation(ak_vec3_make(1, 0, 0)),
+                                  .end = ak_mat4_translation(ak_vec3_make(1.8f, 0, 0)),
+                                  .target = target,
+                                  .pole = pole,
+                                  .out_start_rot = &qs,
+                                  .out_mid_rot = &qm,
+                                  .out_reached = &reached};
+        AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+        AK_CHECK(reached);
+        /* Apply: knee = qs * (1,0,0); ankle = knee + qs * qm * (0.8,0,0). */
+        ak_vec3 knee = ak_quat_rotate(qs, ak_vec3_make(1, 0, 0));
+        ak_vec3 ankle = ak_vec3_add(knee, ak_quat_rotate(ak_quat_mul(qs, qm), ak_vec3_make(0.8f, 0, 0)));
+        AK_CHECK_NEAR(ankle.x, target.x, 1e-5);
+        AK_CHECK_NEAR(ankle.y, target.y, 1e-5);
+        AK_CHECK_NEAR(ankle.z, target.z, 1e-5);
+        /* Closed-form knee: k = a cos(alpha) u + a sin(alpha) w, u along the target, w the pole. */
+        double ux = target.x / d, uy = target.y / d;
+        AK_CHECK_NEAR(knee.x, a * cos(alpha) * ux, 1e-5);
+        AK_CHECK_NEAR(knee.y, a * cos(alpha) * uy, 1e-5);
+        AK_CHECK_NEAR(knee.z, side * a * sin(alpha), 1e-5);
+        /* Knee interior angle: the mid correction bends by pi - interior. */
+        AK_CHECK_NEAR(2 * atan2(sqrt(qm.x * qm.x + qm.y * qm.y + qm.z * qm.z), fabs(qm.w)), PI_D - interior, 1e-5);
+        AK_CHECK_NEAR(ak_quat_norm(qs), 1.0, 1e-6);
+        AK_CHECK_NEAR(ak_quat_norm(qm), 1.0, 1e-6);
+    }
+}
+
+AK_TEST(two_bone_chain_matches_job_and_limits) {
+    /* The chain solver on a leg: hip (ball), knee (hinge about z, bends 0..2.6), ankle. */
+    chain_spec s = uniform_chain(3, AK_JOINT_BALL);
+    s.lengths[0] = 0.45f, s.lengths[1] = 0.42f;
+    s.types[1] = AK_JOINT_HINGE, s.limits[1].axis = ak_vec3_make(0, 0, 1), s.limits[1].min = 0.0f,
+    s.limits[1].max = 2.6f;
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[3] = {0, 1, 2};
+    ak_rng rng = ak_rng_make(99);
+    int ok = 0;
+    for (int t = 0; t < 200; ++t) {
+        ak_transform goal[3], pose[3];
+        random_pose(sk, &rng, goal, false);
+        ak_vec3 target = effector_of(goal, 3);
+        random_pose(sk, &rng, pose, false);
+        ak_ik_chain_job opts = {.pole = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), 1)};
+        solve_out o = solve(sk, pose, chain, 3, target, AK_IK_SOLVER_TWO_BONE, &opts);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK_EQ(o.iterations, 0);
+        AK_CHECK(lengths_preserved(&s, pose));
+        for (int i = 0; i < 3; ++i) AK_CHECK(within_limits(&s, sk, (size_t)i, pose[i], 1e-4));
+        ok += o.reached;
+    }
+    /* Knee hinge within 0..2.6 reaches every distance in [|a-b|.., a+b] one way: all reachable. */
+    AK_CHECK_MSG(ok >= 198, "%d of 200 reached", ok);
+    ak_skeleton_destroy(sk);
+}
+
+AK_TEST(two_bone_soft_weight_unreachable) {
+    ak_quat qs, qm;
+    bool reached = true;
+    ak_ik_two_bone_job job = {.start = ak_mat4_identity(),
+                              .mid = ak_mat4_translation(ak_vec3_make(0, -1, 0)),
+                              .end = ak_mat4_translation(ak_vec3_make(0.3f, -1.9f, 0)),
+                              .target = {0, -5, 3},
+                              .out_start_rot = &qs,
+                              .out_mid_rot = &qm,
+                              .out_reached = &reached};
+    /* Unreachable: straight towards the target, not reached. */
+    AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+    AK_CHECK(!reached);
+    const double b = sqrt(0.3 * 0.3 + 0.9 * 0.9), reach = 1.0 + b;
+    ak_vec3 knee = ak_quat_rotate(qs, ak_vec3_make(0, -1, 0));
+    ak_vec3 ankle = ak_vec3_add(knee, ak_quat_rotate(ak_quat_mul(qs, qm), ak_vec3_make(0.3f, -0.9f, 0)));
+    ak_vec3 dir = ak_vec3_normalize(job.target);
+    AK_CHECK_NEAR(ankle.x, dir.x * reach, 1e-5);
+    AK_CHECK_NEAR(ankle.y, dir.y * reach, 1e-5);
+    AK_CHECK_NEAR(ankle.z, dir.z * reach, 1e-5);
+
+    /* Soft: a target exactly at full reach ends short of it, smoothly: with soft = 0.2 the
+     * distance is ds + (L - ds)(1 - exp(-(d - ds)/(L - ds))), ds = 0.8 L. */
+    job.soft = 0.2f;
+    job.target = ak_vec3_scale(dir, (float)reach);
+    AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+    AK_CHECK(!reached);
+    knee = ak_quat_rotate(qs, ak_vec3_make(0, -1, 0));
+    ankle = ak_vec3_add(knee, ak_quat_rotate(ak_quat_mul(qs, qm), ak_vec3_make(0.3f, -0.9f, 0)));
+    double ds = 0.8 * reach, want = ds + (reach - ds) * (1 - exp(-(reach - ds) / (reach - ds)));
+    AK_CHECK_NEAR(ak_vec3_length(ankle), want, 1e-5);
+    AK_CHECK_NEAR(ak_vec3_dot(ak_vec3_normalize(ankle), dir), 1.0, 1e-5);
+
+    /* keep_animation = 1: identity corrections; 0.5: half the angle (nlerp of a small turn). */
+    job.soft = 0.0f;
+    job.target = ak_vec3_make(0.5f, -1.2f, 0.2f);
+    job.keep_animation = 1.0f;
+    AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+    AK_CHECK_NEAR(fabs(qs.w), 1.0, 1e-6);
+    AK_CHECK_NEAR(fabs(qm.w), 1.0, 1e-6);
+    job.keep_animation = 0.0f;
+    ak_quat full_s, full_m;
+    AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+    full_s = qs, full_m = qm;
+    job.keep_animation = 0.5f;
+    AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+    ak_quat hs = ak_quat_nlerp(ak_quat_identity(), full_s, 0.5f), hm = ak_quat_nlerp(ak_quat_identity(), full_m, 0.5f);
+    AK_CHECK_NEAR(ak_quat_dot(qs, hs), 1.0, 1e-6);
+    AK_CHECK_NEAR(ak_quat_dot(qm, hm), 1.0, 1e-6);
+
+    /* Degenerate: target on the start joint, zero-length bones: finite output. */
+    job.keep_animation = 0.0f;
+    job.target = ak_vec3_zero();
+    AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+    AK_CHECK(ak_quat_is_finite(qs) && ak_quat_is_finite(qm));
+    job.mid = job.end = ak_mat4_identity();
+    job.target = ak_vec3_make(1, 1, 1);
+    AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+    AK_CHECK(ak_quat_is_finite(qs) && ak_quat_is_finite(qm));
+    AK_CHECK(!reached);
+}
+
+/* ---- unreachable and degenerate ------------------------------------------------------------ */
+
+AK_TEST(unreachable_straightens) {
+    chain_spec s = uniform_chain(5, AK_JOINT_FREE);
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[5] = {0, 1, 2, 3, 4};
+    double len = 0;
+    for (int i = 0; i < 4; ++i) len += s.lengths[i];
+    const ak_vec3 target = ak_vec3_make(1.0f, 3.0f, -2.0f); /* |t| = 3.74 > len = 2.6 */
+    const ak_ik_solver all[4] = {AK_IK_SOLVER_CCD, AK_IK_SOLVER_FABRIK, AK_IK_SOLVER_DLS, AK_IK_SOLVER_TWO_BONE};
+    for (int k = 0; k < 3; ++k) {
+        ak_rng rng = ak_rng_make(5);
+        ak_transform pose[5];
+        random_pose(sk, &rng, pose, false);
+        ak_ik_chain_job opts = {.max_iterations = 500};
+        solve_out o = solve(sk, pose, chain, 5, target, all[k], &opts);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(!o.reached);
+        AK_CHECK(pose_finite(pose, 5));
+        AK_CHECK(lengths_preserved(&s, pose));
+        double want = ak_vec3_length(target) - len;
+        AK_CHECK_MSG(fabs(o.error - want) < 2e-3 * len, "%s: error %g, remaining distance %g", ak_ik_solver_name(all[k]),
+                     o.error, want);
+        /* It stops by itself (no oscillation until the budget runs out). */
+        AK_CHECK_MSG(o.iterations < 500, "%s used the whole budget", ak_ik_solver_name(all[k]));
+        /* Every joint on the root->target line. */
+        double p[5][3];
+        fk_positions(pose, 5, p);
+        ak_vec3 dir = ak_vec3_normalize(target);
+        for (int i = 1; i < 5; ++i) {
+            double along = p[i][0] * dir.x + p[i][1] * dir.y + p[i][2] * dir.z;
+            double off = sqrt(fmax(0, p[i][0] * p[i][0] + p[i][1] * p[i][1] + p[i][2] * p[i][2] - along * along));
+            AK_CHECK_MSG(off < 0.03, "%s: joint %d is %g off the line", ak_ik_solver_name(all[k]), i, off);
+        }
+        /* Solving again from the result changes nothing much (a fixed point). */
+        ak_transform again[5];
+        memcpy(again, pose, sizeof pose);
+        solve_out o2 = solve(sk, again, chain, 5, target, all[k], &opts);
+        AK_CHECK(o2.error <= o.error + 1e-4 * len);
+    }
+    ak_skeleton_destroy(sk);
+}
+
+AK_TEST(degenerate_chains) {
+    /* One-joint chain: nothing moves, 0 iterations; reached only when already there. */
+    chain_spec s = uniform_chain(4, AK_JOINT_FREE);
+    s.lengths[1] = 0.0f; /* a zero-length bone in the middle */
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[4] = {0, 1, 2, 3};
+    for (int k = 0; k < 4; ++k) {
+        ak_ik_solver solver = k < 3 ? iterative[k] : AK_IK_SOLVER_TWO_BONE;
+        ak_transform pose[4], before[4];
+        rest_pose(sk, pose);
+        memcpy(before, pose, sizeof pose);
+        if (solver != AK_IK_SOLVER_TWO_BONE) {
+            int16_t one[1] = {2};
+            solve_out o = solve(sk, pose, one, 1, ak_vec3_make(3, 3, 3), solver, NULL);
+            AK_CHECK_EQ(o.r, AK_OK);
+            AK_CHECK(!o.reached);
+            AK_CHECK_EQ(o.iterations, 0);
+            AK_CHECK(memcmp(pose, before, sizeof pose) == 0);
+            /* the root's own position (0.5 + 0 along x for joint 2) */
+            AK_CHECK_NEAR(o.error, ak_vec3_distance(ak_vec3_make(3, 3, 3), ak_vec3_make(0.5f, 0, 0)), 1e-6);
+            o = solve(sk, pose, one, 1, ak_vec3_make(0.5f, 0, 0), solver, NULL);
+            AK_CHECK(o.reached);
+        }
+        /* Zero-length bone inside: reachable target reached, lengths (incl. the zero) kept. */
+        const size_t n = solver == AK_IK_SOLVER_TWO_BONE ? 3 : 4;
+        rest_pose(sk, pose);
+        ak_vec3 target = solver == AK_IK_SOLVER_TWO_BONE ? ak_vec3_make(0.2f, 0.3f, 0.1f) : ak_vec3_make(0.4f, 0.6f, 0.3f);
+        ak_ik_chain_job opts = {.max_iterations = 200};
+        solve_out o = solve(sk, pose, chain, n, target, solver, &opts);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(pose_finite(pose, 4));
+        AK_CHECK(lengths_preserved(&s, pose));
+        if (solver != AK_IK_SOLVER_TWO_BONE) AK_CHECK_MSG(o.reached, "%s: error %g", ak_ik_solver_name(solver), o.error);
+        /* Target on the root: defined, finite, error never above the start. */
+        rest_pose(sk, pose);
+        ak_vec3 e0 = effector_of(pose, n);
+        o = solve(sk, pose, chain, n, ak_vec3_zero(), solver, &opts);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(pose_finite(pose, 4));
+        AK_CHECK(lengths_preserved(&s, pose));
+        AK_CHECK(o.error <= ak_vec3_length(e0) + 1e-6);
+    }
+    ak_skeleton_destroy(sk);
+
+    /* All bones zero-length: everything sits on the root; finite, reached only at the root. */
+    chain_spec z = uniform_chain(3, AK_JOINT_FREE);
+    z.lengths[0] = z.lengths[1] = 0.0f;
+    sk = make_chain(&z);
+    if (!sk) return;
+    for (int k = 0; k < 4; ++k) {
+        ak_ik_solver solver = k < 3 ? iterative[k] : AK_IK_SOLVER_TWO_BONE;
+        ak_transform pose[3];
+        rest_pose(sk, pose);
+        solve_out o = solve(sk, pose, chain, 3, ak_vec3_make(1, 0, 0), solver, NULL);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(pose_finite(pose, 3));
+        AK_CHECK(!o.reached);
+        AK_CHECK_NEAR(o.error, 1.0, 1e-6);
+    }
+    ak_skeleton_destroy(sk);
+}
+
+AK_TEST(dls_orientation_target) {
+    chain_spec s = uniform_chain(6, AK_JOINT_FREE);
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[6] = {0, 1, 2, 3, 4, 5};
+    ak_rng rng = ak_rng_make(42);
+    int ok = 0;
+    for (int t = 0; t < 50; ++t) {
+        ak_transform goal[6], pose[6];
+        random_pose(sk, &rng, goal, false);
+        /* The goal effector's model rotation: product of the local rotations. */
+        ak_quat rot = ak_quat_identity();
+        for (int i = 0; i < 6; ++i) rot = ak_quat_mul(rot, goal[i].rotation);
+        ak_vec3 target = effector_of(goal, 6);
+        random_pose(sk, &rng, pose, false);
+        ak_ik_chain_job opts = {.target_rotation = &rot, .max_iterations = 100};
+        solve_out o = solve(sk, pose, chain, 6, target, AK_IK_SOLVER_DLS, &opts);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(lengths_preserved(&s, pose));
+        if (o.reached) {
+            ++ok;
+            /* independent check of the angle: model rotation from the pose */
+            ak_quat got = ak_quat_identity();
+            for (int i = 0; i < 6; ++i) got = ak_quat_mul(got, pose[i].rotation);
+            AK_CHECK(ak_quat_angle_between(got, rot) <= 1.5e-3f);
+            AK_CHECK(o.angle_error <= 1e-3f);
+        }
+    }
+    AK_CHECK_MSG(ok >= 47, "%d of 50 reached with orientation", ok);
+    /* Other solvers set the effector's own rotation to the target rotation. */
+    ak_transform pose[6];
+    rest_pose(sk, pose);
+    ak_quat rot = ak_quat_from_axis_angle(ak_vec3_make(1, 2, 3), 0.7f);
+    ak_ik_chain_job opts = {.target_rotation = &rot};
+    solve_out o = solve(sk, pose, chain, 6, ak_vec3_make(1, 1, 1), AK_IK_SOLVER_FABRIK, &opts);
+    AK_CHECK_EQ(o.r, AK_OK);
+    AK_CHECK(o.angle_error < 1e-4f);
+    ak_skeleton_destroy(sk);
+}
+
+/* ---- FABRIK on a tree ---------------------------------------------------------------------- */
+
+/* root -> spine -> {l1 -> l2 -> l3, r1 -> r2 -> r3} */
+static ak_skeleton* make_tree(void) {
+    ak_joint_desc j[9];
+    memset(j, 0, sizeof j);
+    const char* names[9] = {"root", "spine", "l1", "l2", "l3", "r1", "r2", "r3", "head"};
+    const int parents[9] = {-1, 0, 1, 2, 3, 1, 5, 6, 1};
+    const ak_vec3 offs[9] = {{0, 0, 0},  {0, 1, 0},   {0.3f, 0.4f, 0}, {0.5f, 0, 0}, {0.4f, 0, 0},
+                             {-0.3f, 0.4f, 0}, {-0.5f, 0, 0}, {-0.4f, 0, 0}, {0, 0.5f, 0}};
+    for (int i = 0; i < 9; ++i) {
+        j[i].name = names[i];
+        j[i].parent = parents[i];
+        j[i].rest = ak_transform_identity();
+        j[i].rest.translation = offs[i];
+    }
+    ak_skeleton_desc d = {.joints = j, .joint_count = 9};
+    ak_skeleton* sk = NULL;
+    ak_skeleton_create(&d, NULL, &sk, NULL);
+    return sk;
+}
+
+AK_TEST(fabrik_tree) {
+    ak_skeleton* sk = make_tree();
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t eff[2] = {4, 7};
+    ak_rng rng = ak_rng_make(3);
+    int ok = 0;
+    for (int t = 0; t < 50; ++t) {
+        ak_transform goal[9], pose[9];
+        ak_mat4 model[9];
+        random_pose(sk, &rng, goal, false);
+        ak_skeleton_local_to_model(sk, (ak_transform_cspan)AK_SPAN(goal), (ak_mat4_span)AK_SPAN(model));
+        ak_vec3 targets[2] = {ak_mat4_get_translation(model[4]), ak_mat4_get_translation(model[7])};
+        random_pose(sk, &rng, pose, false);
+        pose[0] = goal[0]; /* above the solved tree: the same in both, so the targets are reachable */
+        ak_mat4 before[9];
+        ak_skeleton_local_to_model(sk, (ak_transform_cspan)AK_SPAN(pose), (ak_mat4_span)AK_SPAN(before));
+        bool reached = false;
+        float error = -1;
+        size_t iterations = 0;
+        ak_ik_fabrik_tree_job job = {.skeleton = sk,
+                                     .pose = AK_SPAN(pose),
+                                     .root_joint = 1,
+                                     .effectors = AK_SPAN(eff),
+                                     .targets = AK_SPAN(targets),
+                                     .max_iterations = 100,
+                                     .scratch = AK_SPAN(scratch),
+                                     .out_reached = &reached,
+                                     .out_error = &error,
+                                     .out_iterations = &iterations};
+        AK_CHECK_EQ(ak_ik_fabrik_tree_run(&job), AK_OK);
+        AK_CHECK(pose_finite(pose, 9));
+        ak_mat4 after[9];
+        ak_skeleton_local_to_model(sk, (ak_transform_cspan)AK_SPAN(pose), (ak_mat4_span)AK_SPAN(after));
+        /* Root (spine) stays; every bone keeps its length; reported error is the true max. */
+        AK_CHECK_NEAR(ak_vec3_distance(ak_mat4_get_translation(after[1]), ak_mat4_get_translation(before[1])), 0, 1e-6);
+        const int16_t* par = ak_skeleton_parents(sk).ptr;
+        for (int i = 1; i < 9; ++i) {
+            float l0 = ak_vec3_distance(ak_mat4_get_translation(before[i]), ak_mat4_get_translation(before[par[i]]));
+            float l1 = ak_vec3_distance(ak_mat4_get_translation(after[i]), ak_mat4_get_translation(after[par[i]]));
+            AK_CHECK_NEAR(l1, l0, 1e-5 * l0);
+        }
+        float e0 = ak_vec3_distance(ak_mat4_get_translation(after[4]), targets[0]);
+        float e1 = ak_vec3_distance(ak_mat4_get_translation(after[7]), targets[1]);
+        AK_CHECK_NEAR(error, fmaxf(e0, e1), 1e-5);
+        ok += reached;
+    }
+    AK_CHECK_MSG(ok >= 45, "%d of 50 trees reached", ok);
+
+    /* Validity, one case per rule. */
+    ak_transform pose[9];
+    rest_pose(sk, pose);
+    ak_vec3 targets[2] = {{1, 1, 0}, {-1, 1, 0}};
+    const ak_ik_fabrik_tree_job good = {.skeleton = sk,
+                                        .pose = AK_SPAN(pose),
+                                        .root_joint = 1,
+                                        .effectors = AK_SPAN(eff),
+                                        .targets = AK_SPAN(targets),
+                                        .scratch = AK_SPAN(scratch)};
+    ak_ik_fabrik_tree_job j, zero;
+    memset(&zero, 0, sizeof zero);
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&zero), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&good), AK_OK);
+    j = good, j.effectors.count = 0;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_NULL_ARG);
+    j = good, j.targets.count = 1;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_SPAN_SMALL);
+    j = good, j.pose.count = 8;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_SPAN_SMALL);
+    j = good, j.root_joint = 9;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_BAD_INDEX);
+    int16_t bad_eff[2] = {4, 12}, dup[2] = {4, 4}, off_tree[2] = {4, 8};
+    j = good, j.effectors = (ak_i16_cspan)AK_SPAN(bad_eff);
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_BAD_INDEX);
+    j = good, j.effectors = (ak_i16_cspan)AK_SPAN(dup);
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_DUPLICATE);
+    j = good, j.effectors = (ak_i16_cspan)AK_SPAN(off_tree), j.root_joint = 2;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_NOT_FOUND);
+    targets[1].x = NAN;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&good), AK_ERR_BAD_DATA);
+    targets[1].x = -1;
+    pose[0].translation.y = INFINITY; /* an ancestor of the root joint */
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&good), AK_ERR_BAD_DATA);
+    rest_pose(sk, pose);
+    j = good, j.tolerance = -1;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_BAD_ARG);
+    j = good, j.scratch.ptr = NULL;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_NULL_ARG);
+    j = good, j.scratch.count = ak_ik_fabrik_tree_scratch_size(9) - 1;
+    AK_CHECK_EQ(ak_ik_fabrik_tree_validate(&j), AK_ERR_SPAN_SMALL);
+    ak_skeleton_destroy(sk);
+}
+
+int main(void) {
+    AK_RUN(chain_build);
+    AK_RUN(solver_names);
+    AK_RUN(chain_job_validity);
+    AK_RUN(two_bone_job_validity);
+    AK_RUN(ccd_hand_computed_planar);
+    AK_RUN(ccd_options);
+    AK_RUN(reach_free_3d);
+    AK_RUN(reach_planar_hinges);
+    AK_RUN(limits_never_violated);
+    AK_RUN(two_bone_closed_form_and_pole);
+    AK_RUN(two_bone_chain_matches_job_and_limits);
+    AK_RUN(two_bone_soft_weight_unreachable);
+    AK_RUN(unreachable_straightens);
+    AK_RUN(degenerate_chains);
+    AK_RUN(dls_orientation_target);
+    AK_RUN(fabrik_tree);
+    return ak_test_finish();
+}
