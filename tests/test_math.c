@@ -12,6 +12,9 @@
 
 /* ---- helpers ------------------------------------------------------------------------- */
 
+/* max that turns NaN into +inf, so a NaN anywhere fails the check (fmax would drop it). */
+static double dmax(double a, double b) { return a != a || b != b ? INFINITY : a > b ? a : b; }
+
 static ref_q rq(ak_quat q) { ref_q r = {q.x, q.y, q.z, q.w}; return r; }
 static ak_quat fq(ref_q q) { return ak_quat_make((float)q.x, (float)q.y, (float)q.z, (float)q.w); }
 static ref_v3 rv(ak_vec3 v) { return ref_v3_make(v.x, v.y, v.z); }
@@ -37,23 +40,23 @@ static ref_m4 rm4(ak_mat4 m) {
 static double m3_diff(ak_mat3 a, ref_m3 b) {
     double d = 0.0;
     for (int c = 0; c < 3; ++c)
-        for (int i = 0; i < 3; ++i) d = fmax(d, fabs(a.m[c * 3 + i] - b.m[i][c]));
+        for (int i = 0; i < 3; ++i) d = dmax(d, fabs(a.m[c * 3 + i] - b.m[i][c]));
     return d;
 }
 static double m3_scale(ref_m3 a) {
     double s = 0.0;
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) s = fmax(s, fabs(a.m[i][j]));
+        for (int j = 0; j < 3; ++j) s = dmax(s, fabs(a.m[i][j]));
     return s;
 }
 static double v3_diff(ak_vec3 a, ref_v3 b) {
-    return fmax(fabs(a.x - b.x), fmax(fabs(a.y - b.y), fabs(a.z - b.z)));
+    return dmax(fabs(a.x - b.x), dmax(fabs(a.y - b.y), fabs(a.z - b.z)));
 }
 /* Max difference of two quaternions up to sign (q and -q are one rotation). */
 static double q_diff_sign(ak_quat a, ref_q b) {
-    double p = fmax(fmax(fabs(a.x - b.x), fabs(a.y - b.y)), fmax(fabs(a.z - b.z), fabs(a.w - b.w)));
-    double m = fmax(fmax(fabs(a.x + b.x), fabs(a.y + b.y)), fmax(fabs(a.z + b.z), fabs(a.w + b.w)));
-    return fmin(p, m);
+    double p = dmax(dmax(fabs(a.x - b.x), fabs(a.y - b.y)), dmax(fabs(a.z - b.z), fabs(a.w - b.w)));
+    double m = dmax(dmax(fabs(a.x + b.x), fabs(a.y + b.y)), dmax(fabs(a.z + b.z), fabs(a.w + b.w)));
+    return (p != p || m != m ? INFINITY : p < m ? p : m);
 }
 static bool m3_finite(ak_mat3 m) {
     for (int i = 0; i < 9; ++i)
@@ -82,7 +85,7 @@ static double orth_err(ak_mat3 m) {
     ref_m3 r = rm3(m), p = ref_m3_mul(ref_m3_transpose(r), r);
     double e = 0.0;
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) e = fmax(e, fabs(p.m[i][j] - (i == j)));
+        for (int j = 0; j < 3; ++j) e = dmax(e, fabs(p.m[i][j] - (i == j)));
     return e;
 }
 
@@ -94,8 +97,8 @@ AK_TEST(quat_matrix_round_trip) {
     for (int n = 0; n < CASES; ++n) {
         ref_q q = rand_quat(&g);
         ak_mat3 m = ak_mat3_from_quat(fq(q));
-        worst_m = fmax(worst_m, m3_diff(m, ref_m3_from_q(q)));
-        worst_q = fmax(worst_q, q_diff_sign(ak_quat_from_mat3(m), q));
+        worst_m = dmax(worst_m, m3_diff(m, ref_m3_from_q(q)));
+        worst_q = dmax(worst_q, q_diff_sign(ak_quat_from_mat3(m), q));
         AK_CHECK(ak_quat_from_mat3(m).w >= 0.0f);
     }
     AK_CHECK_NEAR(worst_m, 0.0, 1e-6);
@@ -108,15 +111,15 @@ AK_TEST(quat_product_matches_matrix_product) {
     for (int n = 0; n < CASES; ++n) {
         ref_q a = rand_quat(&g), b = rand_quat(&g);
         ak_quat p = ak_quat_mul(fq(a), fq(b));
-        worst_q = fmax(worst_q, q_diff_sign(p, ref_q_mul(a, b)));
+        worst_q = dmax(worst_q, q_diff_sign(p, ref_q_mul(a, b)));
         /* R(a b) = R(a) R(b): the product applies b first, then a. */
         ref_m3 rab = ref_m3_mul(ref_m3_from_q(a), ref_m3_from_q(b));
-        worst_m = fmax(worst_m, m3_diff(ak_mat3_from_quat(p), rab));
+        worst_m = dmax(worst_m, m3_diff(ak_mat3_from_quat(p), rab));
         ref_v3 v = ref_v3_scale(rand_dir(&g), rand_range(&g, 0.1, 10.0));
-        worst_v = fmax(worst_v, v3_diff(ak_quat_rotate(fq(a), fv(v)), ref_m3_apply(ref_m3_from_q(a), v)) / 10.0);
+        worst_v = dmax(worst_v, v3_diff(ak_quat_rotate(fq(a), fv(v)), ref_m3_apply(ref_m3_from_q(a), v)) / 10.0);
         /* inverse of a scaled quaternion */
         ak_quat s = ak_quat_scale(fq(a), 3.0f);
-        worst_inv = fmax(worst_inv, q_diff_sign(ak_quat_mul(s, ak_quat_inverse(s)), (ref_q){0, 0, 0, 1}));
+        worst_inv = dmax(worst_inv, q_diff_sign(ak_quat_mul(s, ak_quat_inverse(s)), (ref_q){0, 0, 0, 1}));
     }
     AK_CHECK_NEAR(worst_q, 0.0, 1e-6);
     AK_CHECK_NEAR(worst_m, 0.0, 2e-6);
@@ -132,15 +135,15 @@ AK_TEST(rodrigues_and_axis_angle) {
         double angle = rand_range(&g, -2.0 * REF_PI, 2.0 * REF_PI);
         ak_vec3 fa = fv(axis);
         ref_m3 ref = ref_m3_axis_angle(rv(fa), (float)angle);
-        worst = fmax(worst, m3_diff(ak_mat3_from_axis_angle(fa, (float)angle), ref));
+        worst = dmax(worst, m3_diff(ak_mat3_from_axis_angle(fa, (float)angle), ref));
         ak_quat q = ak_quat_from_axis_angle(fa, (float)angle);
-        worst_q = fmax(worst_q, m3_diff(ak_mat3_from_quat(q), ref));
+        worst_q = dmax(worst_q, m3_diff(ak_mat3_from_quat(q), ref));
         /* back to axis-angle: angle in [0, pi], and it rebuilds the rotation */
         ak_vec3 ax2;
         float an2;
         ak_quat_to_axis_angle(q, &ax2, &an2);
         AK_CHECK(an2 >= 0.0f && an2 <= AK_PI + 1e-6f);
-        worst_rt = fmax(worst_rt, m3_diff(ak_mat3_from_axis_angle(ax2, an2), ref));
+        worst_rt = dmax(worst_rt, m3_diff(ak_mat3_from_axis_angle(ax2, an2), ref));
     }
     AK_CHECK_NEAR(worst, 0.0, 2e-6);
     AK_CHECK_NEAR(worst_q, 0.0, 2e-6);
@@ -159,20 +162,20 @@ AK_TEST(quat_exp_log) {
         ref_q q = ref_q_axis_angle(axis, angle);
         ak_quat lq = ak_quat_log(fq(q));
         /* log of a unit quaternion is (axis angle/2, 0) */
-        worst_log = fmax(worst_log, q_diff_sign(lq, (ref_q){axis.x * angle / 2, axis.y * angle / 2, axis.z * angle / 2, 0.0}));
-        worst_rt = fmax(worst_rt, q_diff_sign(ak_quat_exp(lq), q));
+        worst_log = dmax(worst_log, q_diff_sign(lq, (ref_q){axis.x * angle / 2, axis.y * angle / 2, axis.z * angle / 2, 0.0}));
+        worst_rt = dmax(worst_rt, q_diff_sign(ak_quat_exp(lq), q));
         /* exp of a pure quaternion (v, 0) is (sin|v| v/|v|, cos|v|), |v| up to 3 pi */
         ref_v3 v = ref_v3_scale(rand_dir(&g), rand_range(&g, 0.0, 3.0 * REF_PI));
         double th = ref_v3_len(v);
         ak_quat e = ak_quat_exp(ak_quat_make((float)v.x, (float)v.y, (float)v.z, 0.0f));
         ref_q ev = {sin(th) * v.x / th, sin(th) * v.y / th, sin(th) * v.z / th, cos(th)};
-        worst_exp = fmax(worst_exp, q_diff_sign(e, ev) / fmax(1.0, th));
+        worst_exp = dmax(worst_exp, q_diff_sign(e, ev) / dmax(1.0, th));
         /* general quaternions: exp(log(q)) = q, relative to |q| */
         ref_q s = rand_quat(&g);
         double k = exp(rand_range(&g, -3.0, 3.0));
         ak_quat sq = fq((ref_q){s.x * k, s.y * k, s.z * k, s.w * k});
         ak_quat back = ak_quat_exp(ak_quat_log(sq));
-        worst_gen = fmax(worst_gen, q_diff_sign(ak_quat_scale(back, (float)(1.0 / k)), s));
+        worst_gen = dmax(worst_gen, q_diff_sign(ak_quat_scale(back, (float)(1.0 / k)), s));
     }
     AK_CHECK_NEAR(worst_log, 0.0, 2e-6);
     AK_CHECK_NEAR(worst_rt, 0.0, 2e-6);
@@ -216,16 +219,16 @@ AK_TEST(euler_round_trip_all_orders) {
                 double ed[3] = {fe.x, fe.y, fe.z};
                 ref_m3 ref = ref_m3_euler(euler_axes[o], ed, f == 0);
                 ak_euler_frame frame = f == 0 ? AK_EULER_INTRINSIC : AK_EULER_EXTRINSIC;
-                wm = fmax(wm, m3_diff(ak_mat3_from_euler(fe, (ak_euler_order)o, frame), ref));
+                wm = dmax(wm, m3_diff(ak_mat3_from_euler(fe, (ak_euler_order)o, frame), ref));
                 ak_quat q = ak_quat_from_euler(fe, (ak_euler_order)o, frame);
-                wq = fmax(wq, m3_diff(ak_mat3_from_quat(q), ref));
+                wq = dmax(wq, m3_diff(ak_mat3_from_quat(q), ref));
                 ak_vec3 back = ak_mat3_to_euler(fm3(ref), (ak_euler_order)o, frame);
                 ak_vec3 backq = ak_quat_to_euler(q, (ak_euler_order)o, frame);
                 for (int k = 0; k < 3; ++k) {
                     double b = k == 0 ? back.x : k == 1 ? back.y : back.z;
                     double bq = k == 0 ? backq.x : k == 1 ? backq.y : backq.z;
-                    wa = fmax(wa, fabs(wrap_angle(b - ed[k])));
-                    wqa = fmax(wqa, fabs(wrap_angle(bq - ed[k])));
+                    wa = dmax(wa, fabs(wrap_angle(b - ed[k])));
+                    wqa = dmax(wqa, fabs(wrap_angle(bq - ed[k])));
                 }
                 if (proper) AK_CHECK(back.y >= 0.0f && back.y <= AK_PI);
                 else AK_CHECK(fabsf(back.y) <= AK_HALF_PI);
@@ -253,8 +256,8 @@ AK_TEST(euler_gimbal_lock) {
                 AK_CHECK(ak_vec3_is_finite(back) && ak_vec3_is_finite(backq));
                 if (jitter == 0.0) AK_CHECK_MSG(back.z == 0.0f, "%s: third angle %g at gimbal lock", euler_names[o], back.z);
                 double bd[3] = {back.x, back.y, back.z}, bqd[3] = {backq.x, backq.y, backq.z};
-                worst = fmax(worst, m3_diff(fm3(ref_m3_euler(euler_axes[o], bd, f == 0)), ref));
-                worst = fmax(worst, m3_diff(fm3(ref_m3_euler(euler_axes[o], bqd, f == 0)), ref));
+                worst = dmax(worst, m3_diff(fm3(ref_m3_euler(euler_axes[o], bd, f == 0)), ref));
+                worst = dmax(worst, m3_diff(fm3(ref_m3_euler(euler_axes[o], bqd, f == 0)), ref));
             }
             AK_CHECK_MSG(worst <= 2e-5, "order %s frame %d: rebuilt matrix off by %.3g", euler_names[o], f, worst);
         }
@@ -312,24 +315,24 @@ AK_TEST(slerp_properties) {
             b = ref_q_mul(a, d);
         }
         ak_quat fa = fq(a), fb = fq(b);
-        w_end = fmax(w_end, q_diff_sign(ak_quat_slerp(fa, fb, 0.0f), a));
-        w_end = fmax(w_end, q_diff_sign(ak_quat_slerp(fa, fb, 1.0f), b));
+        w_end = dmax(w_end, q_diff_sign(ak_quat_slerp(fa, fb, 0.0f), a));
+        w_end = dmax(w_end, q_diff_sign(ak_quat_slerp(fa, fb, 1.0f), b));
         double total = ref_q_angle(rq(fa), rq(fb)); /* rotation angle, <= pi: the shorter arc */
         ref_q prev = rq(fa);
         double sum = 0.0;
         for (int k = 1; k <= STEPS; ++k) {
             ak_quat s = ak_quat_slerp(fa, fb, (float)k / STEPS);
-            w_norm = fmax(w_norm, fabs(ak_quat_norm(s) - 1.0));
+            w_norm = dmax(w_norm, fabs(ak_quat_norm(s) - 1.0));
             double step = ref_q_angle(prev, rq(s));
             /* equal angles for equal steps: constant angular speed */
-            w_speed = fmax(w_speed, fabs(step - total / STEPS));
+            w_speed = dmax(w_speed, fabs(step - total / STEPS));
             sum += step;
             prev = rq(s);
         }
-        w_total = fmax(w_total, fabs(sum - total));
+        w_total = dmax(w_total, fabs(sum - total));
         /* shortest path: slerp towards -b is the same rotation as towards b */
         float t = ak_rng_float(&g);
-        w_short = fmax(w_short, q_diff_sign(ak_quat_slerp(fa, ak_quat_neg(fb), t), rq(ak_quat_slerp(fa, fb, t))));
+        w_short = dmax(w_short, q_diff_sign(ak_quat_slerp(fa, ak_quat_neg(fb), t), rq(ak_quat_slerp(fa, fb, t))));
     }
     AK_CHECK_NEAR(w_end, 0.0, 1e-6);
     AK_CHECK_NEAR(w_norm, 0.0, 1e-6);
@@ -345,9 +348,9 @@ AK_TEST(nlerp_properties) {
         ak_quat a = fq(rand_quat(&g)), b = fq(rand_quat(&g));
         float t = ak_rng_float(&g);
         ak_quat r = ak_quat_nlerp(a, b, t);
-        w_norm = fmax(w_norm, fabs(ak_quat_norm(r) - 1.0));
-        w_short = fmax(w_short, q_diff_sign(ak_quat_nlerp(a, ak_quat_neg(b), t), rq(r)));
-        w_end = fmax(w_end, q_diff_sign(ak_quat_nlerp(a, b, 1.0f), rq(b)));
+        w_norm = dmax(w_norm, fabs(ak_quat_norm(r) - 1.0));
+        w_short = dmax(w_short, q_diff_sign(ak_quat_nlerp(a, ak_quat_neg(b), t), rq(r)));
+        w_end = dmax(w_end, q_diff_sign(ak_quat_nlerp(a, b, 1.0f), rq(b)));
         /* the shorter arc: the midpoint is at most 90 degrees of rotation from a */
         AK_CHECK(ref_q_angle(rq(a), rq(ak_quat_nlerp(a, b, 0.5f))) <= REF_PI / 2 + 1e-5);
     }
@@ -407,10 +410,10 @@ AK_TEST(quat_from_to) {
         ak_vec3 fa = ak_vec3_scale(fv(a), 3.0f), fb = ak_vec3_scale(fv(b), 0.5f); /* any length */
         ak_quat q = ak_quat_from_to(fa, fb);
         ref_v3 an = rv(ak_vec3_normalize(fa)), bn = rv(ak_vec3_normalize(fb));
-        worst = fmax(worst, v3_diff(ak_quat_rotate(q, fv(an)), bn));
+        worst = dmax(worst, v3_diff(ak_quat_rotate(q, fv(an)), bn));
         /* shortest: the rotation angle equals the angle between the vectors */
         double want = atan2(ref_v3_len(ref_v3_cross(an, bn)), ref_v3_dot(an, bn));
-        worst_angle = fmax(worst_angle, fabs(ref_q_angle((ref_q){0, 0, 0, 1}, rq(q)) - want));
+        worst_angle = dmax(worst_angle, fabs(ref_q_angle((ref_q){0, 0, 0, 1}, rq(q)) - want));
     }
     AK_CHECK_NEAR(worst, 0.0, 2e-6);
     AK_CHECK_NEAR(worst_angle, 0.0, 1e-5);
@@ -440,8 +443,8 @@ AK_TEST(shepperd_180_degrees) {
         double angle = n % 2 ? REF_PI : REF_PI - rand_range(&g, 0.0, 1e-2);
         ref_m3 r = ref_m3_axis_angle(axis, angle);
         ak_quat q = ak_quat_from_mat3(fm3(r));
-        worst = fmax(worst, q_diff_sign(q, ref_q_axis_angle(axis, angle)));
-        worst = fmax(worst, m3_diff(ak_mat3_from_quat(q), r));
+        worst = dmax(worst, q_diff_sign(q, ref_q_axis_angle(axis, angle)));
+        worst = dmax(worst, m3_diff(ak_mat3_from_quat(q), r));
     }
     AK_CHECK_NEAR(worst, 0.0, 2e-6);
 }
@@ -451,18 +454,18 @@ AK_TEST(shepperd_180_degrees) {
 /* Checks R D = M, R a rotation, D symmetric and (for det M >= 0) PSD. */
 static void check_polar(ak_mat3 m, ak_polar p, double* w_rd, double* w_orth, double* w_sym, double* w_psd) {
     ref_m3 rm = rm3(m);
-    double sc = fmax(m3_scale(rm), 1e-30);
+    double sc = dmax(m3_scale(rm), 1e-30);
     ref_m3 prod = ref_m3_mul(rm3(p.rotation), rm3(p.stretch));
     double e = 0;
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) e = fmax(e, fabs(prod.m[i][j] - rm.m[i][j]) / sc);
-    *w_rd = fmax(*w_rd, e);
-    *w_orth = fmax(*w_orth, fmax(orth_err(p.rotation), fabs(ref_m3_det(rm3(p.rotation)) - 1.0)));
+        for (int j = 0; j < 3; ++j) e = dmax(e, fabs(prod.m[i][j] - rm.m[i][j]) / sc);
+    *w_rd = dmax(*w_rd, e);
+    *w_orth = dmax(*w_orth, dmax(orth_err(p.rotation), fabs(ref_m3_det(rm3(p.rotation)) - 1.0)));
     ref_m3 d = rm3(p.stretch);
     double s = 0;
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) s = fmax(s, fabs(d.m[i][j] - d.m[j][i]) / sc);
-    *w_sym = fmax(*w_sym, s);
+        for (int j = 0; j < 3; ++j) s = dmax(s, fabs(d.m[i][j] - d.m[j][i]) / sc);
+    *w_sym = dmax(*w_sym, s);
     /* eigenvalues of D (symmetrised in double) are the singular values, the smallest one
      * negated for det M < 0 */
     for (int i = 0; i < 3; ++i)
@@ -470,8 +473,8 @@ static void check_polar(ak_mat3 m, ak_polar p, double* w_rd, double* w_orth, dou
     double ev[3];
     ref_sym3_eigenvalues(d, ev);
     double detm = ref_m3_det(rm);
-    if (detm >= 0) *w_psd = fmax(*w_psd, -ev[0] / sc);
-    else *w_psd = fmax(*w_psd, ev[1] < -1e-5 * sc ? 1.0 : 0.0); /* only one negative eigenvalue */
+    if (detm >= 0) *w_psd = dmax(*w_psd, -ev[0] / sc);
+    else *w_psd = dmax(*w_psd, ev[1] < -1e-5 * sc ? 1.0 : 0.0); /* only one negative eigenvalue */
 }
 
 AK_TEST(polar_properties) {
@@ -496,7 +499,7 @@ AK_TEST(polar_properties) {
         ak_polar p = ak_mat3_polar(m);
         check_polar(m, p, &w_rd, &w_orth, &w_sym, &w_psd);
         if (kind == 1 || kind == 2) /* nonsingular: the polar factors are unique */
-            w_uniq = fmax(w_uniq, fmax(m3_diff(p.rotation, rot), m3_diff(p.stretch, s) / m3_scale(s)));
+            w_uniq = dmax(w_uniq, dmax(m3_diff(p.rotation, rot), m3_diff(p.stretch, s) / m3_scale(s)));
         if (p.used_svd) ++svd;
         else ++newton, max_iter = p.iterations > max_iter ? p.iterations : max_iter;
     }
@@ -569,8 +572,8 @@ AK_TEST(svd_properties) {
         ak_svd3 s = ak_mat3_svd(m);
         ref_m3 sig = {{{s.sigma.x, 0, 0}, {0, s.sigma.y, 0}, {0, 0, s.sigma.z}}};
         ref_m3 rec = ref_m3_mul(ref_m3_mul(rm3(s.u), sig), ref_m3_transpose(rm3(s.v)));
-        w_rec = fmax(w_rec, m3_diff(m, rec));
-        w_orth = fmax(w_orth, fmax(orth_err(s.u), orth_err(s.v)));
+        w_rec = dmax(w_rec, m3_diff(m, rec));
+        w_orth = dmax(w_orth, dmax(orth_err(s.u), orth_err(s.v)));
         AK_CHECK(fabs(ref_m3_det(rm3(s.u)) - 1.0) < 1e-5 && fabs(ref_m3_det(rm3(s.v)) - 1.0) < 1e-5);
         AK_CHECK(s.sigma.x >= s.sigma.y && s.sigma.y >= fabsf(s.sigma.z));
         double det = ref_m3_det(rm3(m));
@@ -594,37 +597,37 @@ AK_TEST(dualquat_matches_matrices) {
         ak_dualquat d1 = ak_dualquat_from_rigid(fq(q1), fv(t1)), d2 = ak_dualquat_from_rigid(fq(q2), fv(t2));
         /* point: R p + t against the reference matrix */
         ref_v3 want = ref_v3_add(ref_m3_apply(ref_m3_from_q(q1), p), t1);
-        w_pt = fmax(w_pt, v3_diff(ak_dualquat_transform_point(d1, fv(p)), want) / 10.0);
-        w_vec = fmax(w_vec, v3_diff(ak_dualquat_transform_vector(d1, fv(p)), ref_m3_apply(ref_m3_from_q(q1), p)) / 10.0);
+        w_pt = dmax(w_pt, v3_diff(ak_dualquat_transform_point(d1, fv(p)), want) / 10.0);
+        w_vec = dmax(w_vec, v3_diff(ak_dualquat_transform_vector(d1, fv(p)), ref_m3_apply(ref_m3_from_q(q1), p)) / 10.0);
         ak_mat4 m = ak_dualquat_to_mat4(d1);
-        w_mat = fmax(w_mat, v3_diff(ak_mat4_transform_point(m, fv(p)), want) / 10.0);
+        w_mat = dmax(w_mat, v3_diff(ak_mat4_transform_point(m, fv(p)), want) / 10.0);
         /* the same as the TRS matrix with unit scale */
         ak_mat4 trs = ak_transform_to_mat4(ak_transform_make(fv(t1), fq(q1), ak_vec3_one()));
-        w_mat = fmax(w_mat, v3_diff(ak_mat4_transform_point(trs, fv(p)), want) / 10.0);
+        w_mat = dmax(w_mat, v3_diff(ak_mat4_transform_point(trs, fv(p)), want) / 10.0);
         /* product: d1 d2 applies d2 first */
         ref_v3 want2 = ref_v3_add(ref_m3_apply(ref_m3_from_q(q1), ref_v3_add(ref_m3_apply(ref_m3_from_q(q2), p), t2)), t1);
-        w_mul = fmax(w_mul, v3_diff(ak_dualquat_transform_point(ak_dualquat_mul(d1, d2), fv(p)), want2) / 20.0);
+        w_mul = dmax(w_mul, v3_diff(ak_dualquat_transform_point(ak_dualquat_mul(d1, d2), fv(p)), want2) / 20.0);
         /* round trip of the parts */
-        w_rt = fmax(w_rt, fmax(v3_diff(ak_dualquat_get_translation(d1), t1) / 10.0, q_diff_sign(ak_dualquat_get_rotation(d1), q1)));
+        w_rt = dmax(w_rt, dmax(v3_diff(ak_dualquat_get_translation(d1), t1) / 10.0, q_diff_sign(ak_dualquat_get_rotation(d1), q1)));
         ak_transform tr = ak_dualquat_to_transform(ak_dualquat_from_transform(ak_transform_make(fv(t1), fq(q1), ak_vec3_splat(3))));
-        w_rt = fmax(w_rt, fmax(v3_diff(tr.translation, t1) / 10.0, v3_diff(tr.scale, ref_v3_make(1, 1, 1))));
+        w_rt = dmax(w_rt, dmax(v3_diff(tr.translation, t1) / 10.0, v3_diff(tr.scale, ref_v3_make(1, 1, 1))));
         /* the conjugate of a unit dual quaternion is its inverse */
         ak_dualquat id = ak_dualquat_mul(d1, ak_dualquat_conjugate(d1));
-        w_inv = fmax(w_inv, fmax(q_diff_sign(id.real, (ref_q){0, 0, 0, 1}), q_diff_sign(id.dual, (ref_q){0, 0, 0, 0}) / 10.0));
+        w_inv = dmax(w_inv, dmax(q_diff_sign(id.real, (ref_q){0, 0, 0, 1}), q_diff_sign(id.dual, (ref_q){0, 0, 0, 0}) / 10.0));
         /* sandwich with the full conjugate: d (1 + eps p) d_bar = 1 + eps (R p + t) */
         ak_dualquat dp = {ak_quat_identity(), ak_quat_make((float)p.x, (float)p.y, (float)p.z, 0.0f)};
         ak_dualquat sw = ak_dualquat_mul(ak_dualquat_mul(d1, dp), ak_dualquat_full_conjugate(d1));
-        w_sand = fmax(w_sand, v3_diff(ak_vec3_make(sw.dual.x, sw.dual.y, sw.dual.z), want) / 10.0);
-        w_sand = fmax(w_sand, q_diff_sign(sw.real, (ref_q){0, 0, 0, 1}));
+        w_sand = dmax(w_sand, v3_diff(ak_vec3_make(sw.dual.x, sw.dual.y, sw.dual.z), want) / 10.0);
+        w_sand = dmax(w_sand, q_diff_sign(sw.real, (ref_q){0, 0, 0, 1}));
         /* dual conjugate: (r, -d) is the rotation followed by -t */
         ak_dualquat dc = ak_dualquat_dual_conjugate(d1);
-        w_sand = fmax(w_sand, v3_diff(ak_dualquat_get_translation(dc), ref_v3_scale(t1, -1.0)) / 10.0);
+        w_sand = dmax(w_sand, v3_diff(ak_dualquat_get_translation(dc), ref_v3_scale(t1, -1.0)) / 10.0);
         /* normalize: a scaled, slightly non-unit dq gives back the unit one */
         float k = (float)rand_range(&g, 0.2, 5.0);
         ak_dualquat sc = {ak_quat_scale(d1.real, k), ak_quat_add(ak_quat_scale(d1.dual, k), ak_quat_scale(d1.real, 1e-3f))};
         ak_dualquat nd = ak_dualquat_normalize(sc);
-        w_norm = fmax(w_norm, fmax(fabs(ak_quat_norm(nd.real) - 1.0), fabs(ak_quat_dot(nd.real, nd.dual))));
-        w_norm = fmax(w_norm, v3_diff(ak_dualquat_transform_point(nd, fv(p)), want) / 10.0);
+        w_norm = dmax(w_norm, dmax(fabs(ak_quat_norm(nd.real) - 1.0), fabs(ak_quat_dot(nd.real, nd.dual))));
+        w_norm = dmax(w_norm, v3_diff(ak_dualquat_transform_point(nd, fv(p)), want) / 10.0);
     }
     AK_CHECK_NEAR(w_pt, 0.0, 2e-6);
     AK_CHECK_NEAR(w_vec, 0.0, 2e-6);
@@ -654,15 +657,15 @@ AK_TEST(dualquat_blend) {
         float ws[2] = {1.0f - w, w};
         ak_dualquat r = ak_dualquat_blend((ak_dualquat_cspan){ds, 2}, (ak_f32_cspan){ws, 2});
         ref_v3 tl = ref_v3_add(ref_v3_scale(ta, 1.0 - w), ref_v3_scale(tb, w));
-        w_trans = fmax(w_trans, fmax(v3_diff(ak_dualquat_get_translation(r), tl) / 5.0, q_diff_sign(r.real, q)));
+        w_trans = dmax(w_trans, dmax(v3_diff(ak_dualquat_get_translation(r), tl) / 5.0, q_diff_sign(r.real, q)));
         /* one weight: that dual quaternion */
         float w1[2] = {0.0f, 2.0f};
-        w_same = fmax(w_same, q_diff_sign(ak_dualquat_blend((ak_dualquat_cspan){ds, 2}, (ak_f32_cspan){w1, 2}).dual, rq(b.dual)));
+        w_same = dmax(w_same, q_diff_sign(ak_dualquat_blend((ak_dualquat_cspan){ds, 2}, (ak_f32_cspan){w1, 2}).dual, rq(b.dual)));
         /* hemisphere: -a is the same transform as a, so blending a with -a gives a */
         ak_dualquat na = {ak_quat_neg(a.real), ak_quat_neg(a.dual)};
         ak_dualquat hs[2] = {a, na};
         ak_dualquat h = ak_dualquat_blend((ak_dualquat_cspan){hs, 2}, (ak_f32_cspan){ws, 2});
-        w_hemi = fmax(w_hemi, v3_diff(ak_dualquat_transform_point(h, ak_vec3_make(1, 2, 3)),
+        w_hemi = dmax(w_hemi, v3_diff(ak_dualquat_transform_point(h, ak_vec3_make(1, 2, 3)),
                                       rv(ak_dualquat_transform_point(a, ak_vec3_make(1, 2, 3)))) / 5.0);
         /* four random transforms: a unit result */
         ak_dualquat four[4];
@@ -672,13 +675,13 @@ AK_TEST(dualquat_blend) {
             w4[k] = ak_rng_float(&g) + 0.01f;
         }
         ak_dualquat u = ak_dualquat_blend((ak_dualquat_cspan){four, 4}, (ak_f32_cspan){w4, 4});
-        w_unit = fmax(w_unit, fmax(fabs(ak_quat_norm(u.real) - 1.0), fabs(ak_quat_dot(u.real, u.dual))));
+        w_unit = dmax(w_unit, dmax(fabs(ak_quat_norm(u.real) - 1.0), fabs(ak_quat_dot(u.real, u.dual))));
         /* zero translation: the rotation part is the nlerp of the rotations */
         ak_quat r1 = fq(rand_quat(&g)), r2 = fq(rand_quat(&g));
         ak_dualquat rs[2] = {ak_dualquat_from_rigid(r1, ak_vec3_zero()), ak_dualquat_from_rigid(r2, ak_vec3_zero())};
         float wr[2] = {0.5f, 0.5f};
         ak_dualquat rb = ak_dualquat_blend((ak_dualquat_cspan){rs, 2}, (ak_f32_cspan){wr, 2});
-        w_nlerp = fmax(w_nlerp, q_diff_sign(rb.real, rq(ak_quat_nlerp(r1, r2, 0.5f))));
+        w_nlerp = dmax(w_nlerp, q_diff_sign(rb.real, rq(ak_quat_nlerp(r1, r2, 0.5f))));
     }
     AK_CHECK_NEAR(w_trans, 0.0, 2e-6);
     AK_CHECK_NEAR(w_same, 0.0, 1e-6);
@@ -698,7 +701,7 @@ AK_TEST(dualquat_blend) {
 
 static double m4_diff(ak_mat4 a, ak_mat4 b) {
     double d = 0.0;
-    for (int i = 0; i < 16; ++i) d = fmax(d, fabs(a.m[i] - b.m[i]));
+    for (int i = 0; i < 16; ++i) d = dmax(d, fabs(a.m[i] - b.m[i]));
     return d;
 }
 
@@ -713,27 +716,27 @@ AK_TEST(affine_interpolation) {
                 b.m[c * 4 + r] = (float)rand_range(&g, -2, 2);
             }
         /* endpoints (relative to the matrix size) */
-        w_end = fmax(w_end, m4_diff(ak_mat4_interpolate_affine(a, b, 0.0f), a) / 4.0);
-        w_end = fmax(w_end, m4_diff(ak_mat4_interpolate_affine(a, b, 1.0f), b) / 4.0);
+        w_end = dmax(w_end, m4_diff(ak_mat4_interpolate_affine(a, b, 0.0f), a) / 4.0);
+        w_end = dmax(w_end, m4_diff(ak_mat4_interpolate_affine(a, b, 1.0f), b) / 4.0);
         /* pure rotations interpolate like slerp */
         ak_quat qa = fq(rand_quat(&g)), qb = fq(rand_quat(&g));
         float t = ak_rng_float(&g);
         ak_mat4 r = ak_mat4_interpolate_affine(ak_mat4_from_quat(qa), ak_mat4_from_quat(qb), t);
-        w_rot = fmax(w_rot, m4_diff(r, ak_mat4_from_quat(ak_quat_slerp(qa, qb, t))));
+        w_rot = dmax(w_rot, m4_diff(r, ak_mat4_from_quat(ak_quat_slerp(qa, qb, t))));
         /* shared rotation and uniform scale, different translations: translation lerps */
         ref_v3 ta = ref_v3_scale(rand_dir(&g), 4), tb = ref_v3_scale(rand_dir(&g), 4);
         ak_mat4 ma = ak_transform_to_mat4(ak_transform_make(fv(ta), qa, ak_vec3_splat(2)));
         ak_mat4 mb = ak_transform_to_mat4(ak_transform_make(fv(tb), qa, ak_vec3_splat(2)));
         ak_mat4 mt = ak_mat4_interpolate_affine(ma, mb, t);
-        w_tr = fmax(w_tr, v3_diff(ak_mat4_get_translation(mt), ref_v3_add(ref_v3_scale(ta, 1 - t), ref_v3_scale(tb, t))) / 4.0);
-        w_tr = fmax(w_tr, m3_diff(ak_mat4_to_mat3(mt), rm3(ak_mat4_to_mat3(ma))) / 2.0);
+        w_tr = dmax(w_tr, v3_diff(ak_mat4_get_translation(mt), ref_v3_add(ref_v3_scale(ta, 1 - t), ref_v3_scale(tb, t))) / 4.0);
+        w_tr = dmax(w_tr, m3_diff(ak_mat4_to_mat3(mt), rm3(ak_mat4_to_mat3(ma))) / 2.0);
         /* non-uniform scales under one rotation: D lerps, so scales lerp */
         ak_vec3 sa = ak_vec3_make((float)rand_range(&g, 0.1, 3), (float)rand_range(&g, 0.1, 3), (float)rand_range(&g, 0.1, 3));
         ak_vec3 sb = ak_vec3_make((float)rand_range(&g, 0.1, 3), (float)rand_range(&g, 0.1, 3), (float)rand_range(&g, 0.1, 3));
         ak_mat4 ms = ak_mat4_interpolate_affine(ak_transform_to_mat4(ak_transform_make(ak_vec3_zero(), qb, sa)),
                                                 ak_transform_to_mat4(ak_transform_make(ak_vec3_zero(), qb, sb)), t);
         ak_mat4 want = ak_transform_to_mat4(ak_transform_make(ak_vec3_zero(), qb, ak_vec3_lerp(sa, sb, t)));
-        w_sc = fmax(w_sc, m4_diff(ms, want) / 3.0);
+        w_sc = dmax(w_sc, m4_diff(ms, want) / 3.0);
     }
     AK_CHECK_NEAR(w_end, 0.0, 3e-6);
     AK_CHECK_NEAR(w_rot, 0.0, 2e-6);
@@ -766,19 +769,19 @@ AK_TEST(mat4_inverse) {
         AK_CHECK(ref_m4_inverse(rm4(m), &ri));
         ak_mat4 inv = ak_mat4_inverse(m);
         for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) w_inv = fmax(w_inv, fabs(inv.m[c * 4 + r] - ri.m[r][c]));
+            for (int r = 0; r < 4; ++r) w_inv = dmax(w_inv, fabs(inv.m[c * 4 + r] - ri.m[r][c]));
         double det = ref_m4_det(rm4(m));
-        w_det = fmax(w_det, fabs(ak_mat4_determinant(m) - det) / fabs(det));
+        w_det = dmax(w_det, fabs(ak_mat4_determinant(m) - det) / fabs(det));
         /* affine: bottom row 0 0 0 1 */
         m.m[3] = m.m[7] = m.m[11] = 0.0f, m.m[15] = 1.0f;
         AK_CHECK(ref_m4_inverse(rm4(m), &ri));
         ak_mat4 ai = ak_mat4_inverse_affine(m);
         for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) w_aff = fmax(w_aff, fabs(ai.m[c * 4 + r] - ri.m[r][c]));
+            for (int r = 0; r < 4; ++r) w_aff = dmax(w_aff, fabs(ai.m[c * 4 + r] - ri.m[r][c]));
         /* normal matrix = inverse transpose of the upper 3x3 */
         ak_mat3 nm = ak_mat4_normal_matrix(m);
         for (int c = 0; c < 3; ++c)
-            for (int r = 0; r < 3; ++r) w_nrm = fmax(w_nrm, fabs(nm.m[c * 3 + r] - ri.m[c][r]));
+            for (int r = 0; r < 3; ++r) w_nrm = dmax(w_nrm, fabs(nm.m[c * 3 + r] - ri.m[c][r]));
     }
     AK_CHECK_NEAR(w_inv, 0.0, 1e-6);
     AK_CHECK_NEAR(w_aff, 0.0, 1e-6);
@@ -788,6 +791,14 @@ AK_TEST(mat4_inverse) {
     ak_mat4 s = ak_mat4_scaling(ak_vec3_make(1, 0, 1));
     AK_CHECK_NEAR(m4_diff(ak_mat4_inverse(s), ak_mat4_identity()), 0.0, 0.0);
     AK_CHECK_NEAR(m4_diff(ak_mat4_inverse_affine(s), ak_mat4_identity()), 0.0, 0.0);
+    ak_mat4 inf = ak_mat4_identity();
+    inf.m[12] = INFINITY;
+    AK_CHECK_NEAR(m4_diff(ak_mat4_inverse(inf), ak_mat4_identity()), 0.0, 0.0);
+    inf.m[12] = 0.0f, inf.m[5] = NAN;
+    AK_CHECK_NEAR(m4_diff(ak_mat4_inverse(inf), ak_mat4_identity()), 0.0, 0.0);
+    AK_CHECK_NEAR(m4_diff(ak_mat4_inverse_affine(inf), ak_mat4_identity()), 0.0, 0.0);
+    /* a determinant that overflows float is documented as the identity too */
+    AK_CHECK_NEAR(m4_diff(ak_mat4_inverse(ak_mat4_scaling(ak_vec3_splat(1e20f))), ak_mat4_identity()), 0.0, 0.0);
     ak_mat3 nm = ak_mat4_normal_matrix(s);
     AK_CHECK(m3_finite(nm));
     ak_mat3 m3s = ak_mat3_diagonal(ak_vec3_make(0, 1, 1));
@@ -804,7 +815,7 @@ AK_TEST(perspective_closed_form) {
         double want[4][4] = {{f / aspect, 0, 0, 0}, {0, f, 0, 0}, {0, 0, C, D}, {0, 0, -1, 0}};
         double e = 0;
         for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c) e = fmax(e, fabs(ak_mat4_at(&m, r, c) - want[r][c]) / fmax(1.0, fabs(want[r][c])));
+            for (int c = 0; c < 4; ++c) e = dmax(e, fabs(ak_mat4_at(&m, r, c) - want[r][c]) / dmax(1.0, fabs(want[r][c])));
         AK_CHECK_MSG(e < 2e-6, "perspective off by %g", e);
         if (n < 100) { /* near plane -> NDC z = -1, far plane -> +1 */
             AK_CHECK_NEAR(ak_mat4_project_point(m, ak_vec3_make(0, 0, (float)-nz)).z, -1.0, 1e-4);
@@ -832,13 +843,13 @@ AK_TEST(look_at) {
         ref_v3 eye = ref_v3_scale(rand_dir(&g), rand_range(&g, 0, 20));
         ref_v3 tgt = ref_v3_add(eye, ref_v3_scale(rand_dir(&g), rand_range(&g, 0.1, 20)));
         ak_mat4 m = ak_mat4_look_at(fv(eye), fv(tgt), ak_vec3_make(0, 1, 0));
-        w_eye = fmax(w_eye, v3_diff(ak_mat4_transform_point(m, fv(eye)), ref_v3_make(0, 0, 0)) / 20.0);
+        w_eye = dmax(w_eye, v3_diff(ak_mat4_transform_point(m, fv(eye)), ref_v3_make(0, 0, 0)) / 20.0);
         double dist = ref_v3_len(ref_v3_add(tgt, ref_v3_scale(eye, -1)));
-        w_tgt = fmax(w_tgt, v3_diff(ak_mat4_transform_point(m, fv(tgt)), ref_v3_make(0, 0, -dist)) / 20.0);
-        w_orth = fmax(w_orth, orth_err(ak_mat4_to_mat3(m)));
+        w_tgt = dmax(w_tgt, v3_diff(ak_mat4_transform_point(m, fv(tgt)), ref_v3_make(0, 0, -dist)) / 20.0);
+        w_orth = dmax(w_orth, orth_err(ak_mat4_to_mat3(m)));
         /* world up stays in the upper half of the view (y >= 0) */
         ak_vec3 up = ak_mat4_transform_vector(m, ak_vec3_make(0, 1, 0));
-        w_up = fmax(w_up, -up.y);
+        w_up = dmax(w_up, -up.y);
         AK_CHECK_NEAR(ref_m3_det(rm3(ak_mat4_to_mat3(m))), 1.0, 1e-5);
     }
     AK_CHECK_NEAR(w_eye, 0.0, 2e-6);
@@ -865,11 +876,11 @@ AK_TEST(transforms) {
         ref_v3 want = {mab.m[0][0] * p.x + mab.m[0][1] * p.y + mab.m[0][2] * p.z + mab.m[0][3],
                        mab.m[1][0] * p.x + mab.m[1][1] * p.y + mab.m[1][2] * p.z + mab.m[1][3],
                        mab.m[2][0] * p.x + mab.m[2][1] * p.y + mab.m[2][2] * p.z + mab.m[2][3]};
-        w_mul = fmax(w_mul, v3_diff(q, want) / 50.0);
+        w_mul = dmax(w_mul, v3_diff(q, want) / 50.0);
         /* inverse: a^-1 (a p) = p */
         ak_vec3 back = ak_transform_point(ak_transform_inverse(a), ak_transform_point(a, p));
-        w_inv = fmax(w_inv, v3_diff(back, rv(p)) / 5.0);
-        w_pt = fmax(w_pt, v3_diff(ak_transform_point(a, p), rv(ak_mat4_transform_point(ak_transform_to_mat4(a), p))) / 20.0);
+        w_inv = dmax(w_inv, v3_diff(back, rv(p)) / 5.0);
+        w_pt = dmax(w_pt, v3_diff(ak_transform_point(a, p), rv(ak_mat4_transform_point(ak_transform_to_mat4(a), p))) / 20.0);
     }
     AK_CHECK_NEAR(w_mul, 0.0, 2e-6);
     AK_CHECK_NEAR(w_inv, 0.0, 2e-6);
@@ -896,43 +907,44 @@ AK_TEST(array_functions) {
             va[i] = fv(ref_v3_scale(rand_dir(&g), rand_range(&g, 0, 10)));
             for (int j = 0; j < 16; ++j) ma[i].m[j] = (float)rand_range(&g, -1, 1), mb[i].m[j] = (float)rand_range(&g, -1, 1);
         }
-        if (n > 5) qa[3] = ak_quat_make(0, 0, 0, 0), qa[5] = ak_quat_make(NAN, 1, 0, 0); /* degenerate lanes */
+        if (n > 6) /* degenerate lanes: zero, infinite, NaN */
+            qa[3] = ak_quat_make(0, 0, 0, 0), qa[4] = ak_quat_make(INFINITY, 0, 0, 1), qa[5] = ak_quat_make(NAN, 1, 0, 0);
         AK_CHECK_EQ(ak_quat_normalize_array((ak_quat_cspan){qa, n}, (ak_quat_span){qo, n}), AK_OK);
-        for (size_t i = 0; i < n; ++i) w_n = fmax(w_n, q_diff_sign(qo[i], rq(ak_quat_normalize(qa[i]))));
+        for (size_t i = 0; i < n; ++i) w_n = dmax(w_n, q_diff_sign(qo[i], rq(ak_quat_normalize(qa[i]))));
         AK_CHECK_EQ(ak_quat_mul_array((ak_quat_cspan){qb, n}, (ak_quat_cspan){qb, n}, (ak_quat_span){qo, n}), AK_OK);
-        for (size_t i = 0; i < n; ++i) w_m = fmax(w_m, q_diff_sign(qo[i], ref_q_mul(rq(qb[i]), rq(qb[i]))));
+        for (size_t i = 0; i < n; ++i) w_m = dmax(w_m, q_diff_sign(qo[i], ref_q_mul(rq(qb[i]), rq(qb[i]))));
         AK_CHECK_EQ(ak_quat_rotate_array((ak_quat_cspan){qb, n}, (ak_vec3_cspan){va, n}, (ak_vec3_span){vo, n}), AK_OK);
-        for (size_t i = 0; i < n; ++i) w_r = fmax(w_r, v3_diff(vo[i], ref_q_rotate(rq(qb[i]), rv(va[i]))) / 10.0);
+        for (size_t i = 0; i < n; ++i) w_r = dmax(w_r, v3_diff(vo[i], ref_q_rotate(rq(qb[i]), rv(va[i]))) / 10.0);
         AK_CHECK_EQ(ak_quat_rotate_array((ak_quat_cspan){qb, 1}, (ak_vec3_cspan){va, n}, (ak_vec3_span){vo, n}), AK_OK);
-        for (size_t i = 0; i < n; ++i) w_rb = fmax(w_rb, v3_diff(vo[i], ref_q_rotate(rq(qb[0]), rv(va[i]))) / 10.0);
+        for (size_t i = 0; i < n; ++i) w_rb = dmax(w_rb, v3_diff(vo[i], ref_q_rotate(rq(qb[0]), rv(va[i]))) / 10.0);
         AK_CHECK_EQ(ak_mat4_mul_array((ak_mat4_cspan){ma, n}, (ak_mat4_cspan){mb, n}, (ak_mat4_span){mo, n}), AK_OK);
         for (size_t i = 0; i < n; ++i) {
             ref_m4 p = ref_m4_mul(rm4(ma[i]), rm4(mb[i]));
             for (int c = 0; c < 4; ++c)
-                for (int r = 0; r < 4; ++r) w_4 = fmax(w_4, fabs(mo[i].m[c * 4 + r] - p.m[r][c]));
+                for (int r = 0; r < 4; ++r) w_4 = dmax(w_4, fabs(mo[i].m[c * 4 + r] - p.m[r][c]));
         }
         AK_CHECK_EQ(ak_mat4_mul_array((ak_mat4_cspan){ma, 1}, (ak_mat4_cspan){mb, n}, (ak_mat4_span){mo, n}), AK_OK);
         for (size_t i = 0; i < n; ++i) {
             ref_m4 p = ref_m4_mul(rm4(ma[0]), rm4(mb[i]));
             for (int c = 0; c < 4; ++c)
-                for (int r = 0; r < 4; ++r) w_4b = fmax(w_4b, fabs(mo[i].m[c * 4 + r] - p.m[r][c]));
+                for (int r = 0; r < 4; ++r) w_4b = dmax(w_4b, fabs(mo[i].m[c * 4 + r] - p.m[r][c]));
         }
         /* in place (out is the input array) */
         for (size_t i = 0; i < n; ++i) qo[i] = qa[i];
         AK_CHECK_EQ(ak_quat_normalize_array((ak_quat_cspan){qo, n}, (ak_quat_span){qo, n}), AK_OK);
-        for (size_t i = 0; i < n; ++i) w_n = fmax(w_n, q_diff_sign(qo[i], rq(ak_quat_normalize(qa[i]))));
+        for (size_t i = 0; i < n; ++i) w_n = dmax(w_n, q_diff_sign(qo[i], rq(ak_quat_normalize(qa[i]))));
         for (size_t i = 0; i < n; ++i) vo[i] = va[i];
         AK_CHECK_EQ(ak_quat_rotate_array((ak_quat_cspan){qb, n}, (ak_vec3_cspan){vo, n}, (ak_vec3_span){vo, n}), AK_OK);
-        for (size_t i = 0; i < n; ++i) w_r = fmax(w_r, v3_diff(vo[i], ref_q_rotate(rq(qb[i]), rv(va[i]))) / 10.0);
+        for (size_t i = 0; i < n; ++i) w_r = dmax(w_r, v3_diff(vo[i], ref_q_rotate(rq(qb[i]), rv(va[i]))) / 10.0);
         for (size_t i = 0; i < n; ++i) mo[i] = mb[i];
         AK_CHECK_EQ(ak_mat4_mul_array((ak_mat4_cspan){ma, n}, (ak_mat4_cspan){mo, n}, (ak_mat4_span){mo, n}), AK_OK);
         for (size_t i = 0; i < n; ++i) {
             ref_m4 p = ref_m4_mul(rm4(ma[i]), rm4(mb[i]));
             for (int c = 0; c < 4; ++c)
-                for (int r = 0; r < 4; ++r) w_4 = fmax(w_4, fabs(mo[i].m[c * 4 + r] - p.m[r][c]));
+                for (int r = 0; r < 4; ++r) w_4 = dmax(w_4, fabs(mo[i].m[c * 4 + r] - p.m[r][c]));
         }
-        if (n > 5) {
-            AK_CHECK(qo[3].w == 1.0f && qo[5].w == 1.0f && qo[5].x == 0.0f); /* zero and NaN -> identity */
+        if (n > 6) { /* zero, infinite and NaN -> identity */
+            AK_CHECK(qo[3].w == 1.0f && qo[4].w == 1.0f && qo[4].x == 0.0f && qo[5].w == 1.0f && qo[5].x == 0.0f);
         }
     }
     AK_CHECK_NEAR(w_n, 0.0, 2e-7);

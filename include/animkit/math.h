@@ -335,7 +335,7 @@ static inline float ak_mat3_determinant(ak_mat3 m) {
     return m.m[0] * (m.m[4] * m.m[8] - m.m[7] * m.m[5]) - m.m[3] * (m.m[1] * m.m[8] - m.m[7] * m.m[2]) +
            m.m[6] * (m.m[1] * m.m[5] - m.m[4] * m.m[2]);
 }
-/* Inverse; a singular matrix (|det| below 1e-30) gives the identity. */
+/* Inverse; a singular matrix (|det| below 1e-30) or a non-finite det gives the identity. */
 static inline ak_mat3 ak_mat3_inverse(ak_mat3 m) {
     ak_vec3 c0 = ak_mat3_col(m, 0), c1 = ak_mat3_col(m, 1), c2 = ak_mat3_col(m, 2);
     ak_vec3 r0 = ak_vec3_cross(c1, c2), r1 = ak_vec3_cross(c2, c0), r2 = ak_vec3_cross(c0, c1);
@@ -573,7 +573,8 @@ static inline ak_mat4 ak_mat4_from_mat3(ak_mat3 l, ak_vec3 t) {
 static inline ak_vec3 ak_mat4_get_translation(ak_mat4 m) { return ak_vec3_make(m.m[12], m.m[13], m.m[14]); }
 static inline ak_mat4 ak_mat4_from_quat(ak_quat q) { return ak_mat4_from_mat3(ak_mat3_from_quat(q), ak_vec3_zero()); }
 
-/* General 4x4 inverse (cofactors). A singular matrix (|det| below 1e-30) gives the identity. */
+/* General 4x4 inverse (cofactors). A singular matrix (|det| below 1e-30) or a non-finite
+ * determinant gives the identity. */
 AK_API ak_mat4 ak_mat4_inverse(ak_mat4 m);
 /* Inverse of an affine matrix (bottom row 0,0,0,1): cheaper and more accurate than the
  * general inverse. A singular linear part gives the identity. */
