@@ -1,0 +1,136 @@
+/* animkit io: import of real assets into an ak_scene, and OBJ export of posed meshes.
+ *
+ * What it does:
+ *   - glTF 2.0 (.gltf with data: URIs or external .bin files, .glb) through animkit's own
+ *     reader on cJSON. Why not Assimp for glTF: Assimp 5.2.5's glTF importer keeps only the
+ *     values of CUBICSPLINE keys (it drops the tangents), merges a node's translation,
+ *     rotation and scale channels into one, and adds synthetic root nodes; glTF is judged
+ *     exactly, so it gets a reader that keeps the file's data as the specification defines
+ *     it (accessors with byteStride, sparse accessors, normalized integers, every component
+ *     type, matrix or TRS nodes, skins, morph targets, STEP/LINEAR/CUBICSPLINE samplers).
+ *   - Everything else (BVH, FBX, Collada, OBJ, ...) through Assimp's C API: the node tree
+ *     becomes the skeleton, aiAnimation channels become clips (ticks -> seconds), meshes with
+ *     bones get skins.
+ *   - ak_io_write_obj: Wavefront OBJ of a scene's meshes at positions the caller computed
+ *     (one `o` group per scene mesh, vertices in the scene's order, no welding).
+ *
+ * What it does NOT do: materials, textures, cameras, lights, glTF extensions (files that
+ * list one in extensionsRequired are refused), morph targets through Assimp, posing
+ * (scene.h, skin.h, blendshape.h). It never prints; warnings go to desc->logger.
+ *
+ * How a glTF file maps to the scene (docs/io.md has the details):
+ *   - every node (also nodes outside the default scene) is one skeleton joint, reordered
+ *     parents-before-children (a stable sort: file order where the hierarchy allows). Joint
+ *     names identify nodes: the node's name, "node_<i>" when it has none, "<name>#<i>" when
+ *     an earlier node already took the name (i = node index; names cut to AK_NAME_SIZE-1);
+ *   - one ak_scene_mesh per (mesh, instancing node, primitive): meshes in file order, then
+ *     the nodes that instance the mesh in node order, then primitives; a mesh no node uses
+ *     appears once with node -1;
+ *   - skin i of the scene is glTF skin i; mesh->joints hold skin slots;
+ *   - morph weights: scene mesh m's target t has morph weight index
+ *     sum_{k<m} meshes[k].mesh->morph_target_count + t; a glTF "weights" channel becomes
+ *     one AK_CHANNEL_MORPH_WEIGHTS channel per scene mesh the node carries;
+ *   - clip i is animation i, named by its name or "animation_<i>", duration = the largest
+ *     sampler input time; interpolation kept (rotation LINEAR = SLERP; CUBICSPLINE keys keep
+ *     their (in-tangent, value, out-tangent) triples).
+ *
+ * Usage:
+ *     ak_scene* scene = NULL;
+ *     ak_diag diag;
+ *     ak_io_desc desc = { .max_influences = 4 };
+ *     ak_result r = ak_io_load("Fox.glb", &desc, NULL, &scene, &diag);
+ *     if (r != AK_OK) {
+ *         fprintf(stderr, "%s: %s (%s)\n", diag.path, diag.message, ak_result_string(r));
+ *         return 1;
+ *     }
+ *     printf("%zu joints, %zu meshes, %zu clips\n", ak_scene_joint_count(scene),
+ *            scene->mesh_count, scene->clip_count);
+ *     // ... pose, skin, then write what was computed:
+ *     ak_io_write_obj("posed.obj", scene, NULL, NULL, &diag);   // NULL: the bind pose
+ *     ak_scene_destroy(scene);
+ *
+ * Ownership and threading: the scene returned belongs to the caller (ak_scene_destroy).
+ * The library keeps no pointer to the caller's data. The glTF path is reentrant (cJSON's
+ * malloc is used for the parse tree; animkit never sets cJSON's global hooks). The Assimp
+ * path is not safe to call from several threads at once: Assimp keeps its last error
+ * message in a global.
+ */
+#ifndef ANIMKIT_IO_H
+#define ANIMKIT_IO_H
+
+#include "scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Default and largest number of skin influences kept per vertex. */
+#define AK_IO_DEFAULT_INFLUENCES 4
+
+/* Which reader handles a file. */
+typedef enum ak_io_format {
+    AK_IO_FORMAT_AUTO = 0, /* default: .gltf/.glb extension or glTF content -> GLTF, else ASSIMP */
+    AK_IO_FORMAT_GLTF,     /* animkit's glTF 2.0 reader (.gltf or .glb, decided by the bytes) */
+    AK_IO_FORMAT_ASSIMP,   /* Assimp's importer (BVH, FBX, Collada, OBJ, ...) */
+    AK_IO_FORMAT_COUNT
+} ak_io_format;
+
+typedef struct ak_io_desc {
+    uint32_t max_influences; /* skin influences kept per vertex (largest weights, then
+                                renormalised); 0 -> AK_IO_DEFAULT_INFLUENCES, at most
+                                AK_MAX_INFLUENCES */
+    float min_weight;        /* influences below this are dropped before renormalising;
+                                0 -> keep every positive weight */
+    ak_io_format format;     /* 0 -> AK_IO_FORMAT_AUTO */
+    bool skip_animations;    /* true -> no clips */
+    bool keep_bvh_mesh;      /* Assimp builds a bone-visualisation mesh for BVH files; false
+                                (default) drops it, so a BVH scene has no meshes */
+    ak_logger logger;        /* warnings (ignored extensions, dropped keys); zero -> silent */
+} ak_io_desc;
+
+/* The desc with its zero fields replaced by their defaults (NULL -> all defaults).
+ * max_influences above AK_MAX_INFLUENCES is clamped to it; a negative or NaN min_weight -> 0. */
+AK_API ak_io_desc ak_io_desc_resolved(const ak_io_desc* desc);
+
+/* Load a file into a new scene (*out_scene, freed with ak_scene_destroy).
+ * desc NULL -> defaults; alloc NULL -> malloc/free (used for the scene and everything in it;
+ * temporary memory also comes from it). diag (optional) names the file and the problem.
+ * Returns AK_ERR_NULL_ARG (path or out_scene NULL), AK_ERR_IO (cannot open or read the file
+ * or an external buffer), AK_ERR_PARSE (malformed JSON/GLB, a glTF rule broken, an Assimp
+ * failure: diag holds Assimp's message), AK_ERR_BAD_INDEX (an index out of range: accessor,
+ * node, vertex index, joint slot), AK_ERR_BAD_DATA (NaN or infinity in positions, transforms,
+ * inverse binds or key values), AK_ERR_BAD_HIERARCHY (node cycle or a node with two parents),
+ * AK_ERR_UNSORTED (sampler times not strictly increasing), AK_ERR_UNSUPPORTED (a required
+ * extension, more than 32767 nodes, a skin of more than 65535 joints, glTF 1.0),
+ * AK_ERR_NO_MEMORY. On failure *out_scene is NULL. */
+AK_API ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
+                            ak_scene** out_scene, ak_diag* diag);
+
+/* Load a glTF 2.0 document (.gltf JSON text or .glb bytes, told apart by the "glTF" magic)
+ * from memory. name (NULL -> "memory") is used for the scene name and in diag; base_dir
+ * (NULL -> external buffers are refused with AK_ERR_IO) is the directory external buffer URIs
+ * are relative to. data is read only during the call. Returns the codes of ak_io_load, and
+ * AK_ERR_NULL_ARG when data is NULL with size > 0. desc->format must be AUTO or GLTF
+ * (AK_ERR_UNSUPPORTED otherwise). */
+AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* name, const char* base_dir,
+                                   const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
+                                   ak_diag* diag);
+
+/* Write the scene's meshes as Wavefront OBJ: for each scene mesh in order, "o <name>"
+ * (the mesh name, or "mesh_<index>", whitespace replaced by '_'), its vertices in order
+ * ("v x y z", 9 significant digits), "vt" when the mesh has UVs, "vn" when normals are
+ * available, and its triangles as "f" lines (1-based, offset by the vertices written
+ * before). No welding, no reordering.
+ * posed_positions: NULL, or an array of scene->mesh_count pointers, each to vertex_count
+ * positions (NULL entry -> that mesh's own bind-space positions, as stored).
+ * posed_normals: same shape; NULL or a NULL entry -> the mesh's own normals when it has them,
+ * else no "vn" for that mesh. Point clouds (no triangles) write only vertices.
+ * Returns AK_ERR_NULL_ARG (path or scene NULL), AK_ERR_BAD_DATA (a non-finite coordinate:
+ * the file is removed), AK_ERR_IO (cannot create or write the file; diag names it). */
+AK_API ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3* const* posed_positions,
+                                 const ak_vec3* const* posed_normals, ak_diag* diag);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ANIMKIT_IO_H */

@@ -1,0 +1,254 @@
+/* io: format dispatch, file reading and the pieces both readers share (skeleton building,
+ * matrix decomposition, skin weight clean-up). The readers are in src/io/. */
+#include "io/io_internal.h"
+
+#include <ctype.h>
+
+/* ---- static helpers ------------------------------------------------------------------ */
+
+static uint32_t name_hash(const char* s) {
+    uint32_t h = 2166136261u; /* FNV-1a */
+    for (; *s; ++s) h = (h ^ (uint8_t)*s) * 16777619u;
+    return h;
+}
+
+/* Open-addressing set of names (indices into a names array). */
+typedef struct name_set {
+    int32_t* slots; /* -1 empty */
+    size_t mask;
+    char (*names)[AK_NAME_SIZE];
+} name_set;
+
+static bool name_set_has(const name_set* s, const char* name) {
+    for (size_t i = name_hash(name) & s->mask;; i = (i + 1) & s->mask) {
+        if (s->slots[i] < 0) return false;
+        if (strcmp(s->names[s->slots[i]], name) == 0) return true;
+    }
+}
+
+static void name_set_add(name_set* s, int32_t index) {
+    size_t i = name_hash(s->names[index]) & s->mask;
+    while (s->slots[i] >= 0) i = (i + 1) & s->mask;
+    s->slots[i] = index;
+}
+
+static bool has_extension(const char* path, const char* ext) {
+    size_t n = strlen(path), e = strlen(ext);
+    if (n < e) return false;
+    for (size_t i = 0; i < e; ++i)
+        if (tolower((unsigned char)path[n - e + i]) != ext[i]) return false;
+    return true;
+}
+
+/* ---- shared internals ---------------------------------------------------------------- */
+
+void akp_io_copy_name(char dst[AK_NAME_SIZE], const char* src) {
+    snprintf(dst, AK_NAME_SIZE, "%s", src ? src : "");
+}
+
+ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, uint8_t** out_data, size_t* out_size,
+                           ak_diag* diag) {
+    *out_data = NULL;
+    *out_size = 0;
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        akp_diag_set(diag, path, "cannot open file");
+        return AK_ERR_IO;
+    }
+    long end = -1;
+    if (fseek(f, 0, SEEK_END) == 0) end = ftell(f);
+    if (end < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        akp_diag_set(diag, path, "cannot determine the file size (not a regular file?)");
+        return AK_ERR_IO;
+    }
+    uint8_t* data = (uint8_t*)akp_alloc(alloc, (size_t)end + 1); /* +1: never a zero-size alloc */
+    if (!data) {
+        fclose(f);
+        akp_diag_set(diag, path, "out of memory reading %ld bytes", end);
+        return AK_ERR_NO_MEMORY;
+    }
+    size_t got = fread(data, 1, (size_t)end, f);
+    fclose(f);
+    if (got != (size_t)end) {
+        akp_free(alloc, data);
+        akp_diag_set(diag, path, "read %zu of %ld bytes", got, end);
+        return AK_ERR_IO;
+    }
+    data[end] = 0;
+    *out_data = data;
+    *out_size = (size_t)end;
+    return AK_OK;
+}
+
+ak_result akp_io_build_skeleton(ak_scene* scene, const akp_io_node* nodes, size_t count, int32_t* out_joint_of_node,
+                                const char* path, ak_diag* diag) {
+    const ak_allocator* a = &scene->alloc;
+    if (count == 0) return AK_OK;
+    if (count > AKP_IO_MAX_NODES) {
+        akp_diag_set(diag, path, "%zu nodes; at most %u are supported", count, AKP_IO_MAX_NODES);
+        return AK_ERR_UNSUPPORTED;
+    }
+    size_t table = 1;
+    while (table < 2 * count) table <<= 1;
+    int32_t* parents = (int32_t*)akp_alloc(a, count * sizeof(int32_t));
+    int32_t* order = (int32_t*)akp_alloc(a, count * sizeof(int32_t));
+    ak_joint_desc* joints = (ak_joint_desc*)akp_calloc(a, count * sizeof(ak_joint_desc));
+    char(*names)[AK_NAME_SIZE] = (char(*)[AK_NAME_SIZE])akp_alloc(a, count * AK_NAME_SIZE);
+    name_set set = {(int32_t*)akp_alloc(a, table * sizeof(int32_t)), table - 1, names};
+    ak_result r = AK_ERR_NO_MEMORY;
+    if (!parents || !order || !joints || !names || !set.slots) {
+        akp_diag_set(diag, path, "out of memory building a skeleton of %zu nodes", count);
+        goto done;
+    }
+    for (size_t i = 0; i < table; ++i) set.slots[i] = -1;
+    for (size_t i = 0; i < count; ++i) parents[i] = nodes[i].parent;
+    r = ak_skeleton_reorder((ak_i32_cspan){parents, count}, (ak_i32_span){order, count});
+    if (r != AK_OK) {
+        akp_diag_set(diag, path, "the node hierarchy has a cycle or a parent out of range");
+        goto done;
+    }
+    /* Unique names in file order, so the first node keeps its name whatever the reordering. */
+    for (size_t i = 0; i < count; ++i) {
+        char* nm = names[i];
+        if (nodes[i].name && nodes[i].name[0]) akp_io_copy_name(nm, nodes[i].name);
+        else snprintf(nm, AK_NAME_SIZE, "node_%zu", i);
+        for (unsigned k = 0; name_set_has(&set, nm); ++k) {
+            char suffix[32];
+            int sl = k == 0 ? snprintf(suffix, sizeof suffix, "#%zu", i) : snprintf(suffix, sizeof suffix, "#%zu_%u", i, k);
+            const char* base = (nodes[i].name && nodes[i].name[0]) ? nodes[i].name : "node";
+            int keep = (int)AK_NAME_SIZE - 1 - sl;
+            snprintf(nm, AK_NAME_SIZE, "%.*s%s", keep, base, suffix);
+        }
+        name_set_add(&set, (int32_t)i);
+    }
+    for (size_t k = 0; k < count; ++k) out_joint_of_node[order[k]] = (int32_t)k;
+    for (size_t k = 0; k < count; ++k) {
+        const akp_io_node* n = &nodes[order[k]];
+        joints[k].name = names[order[k]];
+        joints[k].parent = n->parent < 0 ? -1 : out_joint_of_node[n->parent];
+        joints[k].rest = n->rest;
+        joints[k].inverse_bind = n->inverse_bind;
+    }
+    ak_skeleton_desc sd = {.joints = joints, .joint_count = count, .name = scene->name};
+    r = ak_skeleton_create(&sd, a, &scene->skeleton, diag);
+    if (r != AK_OK && diag) {
+        char msg[sizeof diag->message];
+        memcpy(msg, diag->message, sizeof msg);
+        akp_diag_set(diag, path, "skeleton: %.480s", msg);
+    }
+done:
+    akp_free(a, parents);
+    akp_free(a, order);
+    akp_free(a, joints);
+    akp_free(a, names);
+    akp_free(a, set.slots);
+    return r;
+}
+
+ak_transform akp_io_decompose(ak_mat4 m) {
+    ak_transform t = ak_transform_identity();
+    t.translation = ak_mat4_get_translation(m);
+    ak_vec3 c[3];
+    float s[3];
+    for (int i = 0; i < 3; ++i) {
+        c[i] = ak_vec3_make(m.m[i * 4], m.m[i * 4 + 1], m.m[i * 4 + 2]);
+        s[i] = ak_vec3_length(c[i]);
+    }
+    ak_mat3 lin = ak_mat3_from_cols(c[0], c[1], c[2]);
+    if (ak_mat3_determinant(lin) < 0.0f) {
+        s[0] = -s[0];
+        c[0] = ak_vec3_neg(c[0]);
+    }
+    t.scale = ak_vec3_make(s[0], s[1], s[2]);
+    /* Rebuild an orthonormal frame (Gram-Schmidt) so rounding and degenerate axes still give a
+     * unit quaternion. */
+    ak_vec3 x = ak_vec3_normalize(c[0]);
+    ak_vec3 y = ak_vec3_sub(c[1], ak_vec3_scale(x, ak_vec3_dot(x, c[1])));
+    y = ak_vec3_normalize(y);
+    if (ak_vec3_length_sq(x) == 0.0f && ak_vec3_length_sq(y) == 0.0f) return t;
+    if (ak_vec3_length_sq(x) == 0.0f) x = ak_vec3_normalize(ak_vec3_any_perpendicular(y));
+    if (ak_vec3_length_sq(y) == 0.0f) y = ak_vec3_normalize(ak_vec3_cross(ak_vec3_normalize(c[2]), x));
+    if (ak_vec3_length_sq(y) == 0.0f) y = ak_vec3_normalize(ak_vec3_any_perpendicular(x));
+    ak_vec3 z = ak_vec3_cross(x, y);
+    t.rotation = ak_quat_normalize(ak_quat_from_mat3(ak_mat3_from_cols(x, y, z)));
+    return t;
+}
+
+void akp_io_store_weights(ak_mesh* mesh, uint16_t* joints, float* weights, uint32_t src_influences,
+                          const ak_io_desc* desc) {
+    uint32_t k = mesh->influence_count;
+    ak_weights_normalize(joints, weights, mesh->vertex_count, src_influences, k, desc->min_weight);
+    for (size_t v = 0; v < mesh->vertex_count; ++v) {
+        for (uint32_t i = 0; i < k; ++i) {
+            float w = weights[v * src_influences + i];
+            /* an unused slot points at joint 0, so no reader indexes past a palette */
+            mesh->joints[v * k + i] = w > 0.0f ? joints[v * src_influences + i] : 0;
+            mesh->weights[v * k + i] = w;
+        }
+    }
+}
+
+/* ---- public -------------------------------------------------------------------------- */
+
+ak_io_desc ak_io_desc_resolved(const ak_io_desc* desc) {
+    ak_io_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc) d = *desc;
+    if (d.max_influences == 0) d.max_influences = AK_IO_DEFAULT_INFLUENCES;
+    if (d.max_influences > AK_MAX_INFLUENCES) d.max_influences = AK_MAX_INFLUENCES;
+    if (!(d.min_weight > 0.0f) || !ak_finitef(d.min_weight)) d.min_weight = 0.0f;
+    if ((int)d.format < 0 || d.format >= AK_IO_FORMAT_COUNT) d.format = AK_IO_FORMAT_AUTO;
+    return d;
+}
+
+ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
+                     ak_diag* diag) {
+    if (out_scene) *out_scene = NULL;
+    if (!path || !out_scene) {
+        akp_diag_set(diag, path, "path and out_scene are required");
+        return AK_ERR_NULL_ARG;
+    }
+    if (desc && ((int)desc->format < 0 || desc->format >= AK_IO_FORMAT_COUNT)) {
+        akp_diag_set(diag, path, "unknown format %d", (int)desc->format);
+        return AK_ERR_BAD_ARG;
+    }
+    ak_io_desc d = ak_io_desc_resolved(desc);
+    ak_io_format fmt = d.format;
+    if (fmt == AK_IO_FORMAT_AUTO)
+        fmt = (has_extension(path, ".gltf") || has_extension(path, ".glb")) ? AK_IO_FORMAT_GLTF : AK_IO_FORMAT_ASSIMP;
+    if (fmt == AK_IO_FORMAT_ASSIMP) return akp_io_load_assimp(path, &d, alloc, out_scene, diag);
+
+    uint8_t* data = NULL;
+    size_t size = 0;
+    ak_result r = akp_io_read_file(path, alloc, &data, &size, diag);
+    if (r != AK_OK) return r;
+    /* External buffers are relative to the file's directory. */
+    char dir[1024];
+    const char* slash = strrchr(path, '/');
+    if (slash) snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    else snprintf(dir, sizeof dir, ".");
+    if (slash && slash == path) snprintf(dir, sizeof dir, "/");
+    const char* base = strrchr(path, '/');
+    r = akp_io_load_gltf(data, size, base ? base + 1 : path, dir, &d, alloc, out_scene, diag);
+    if (r != AK_OK && diag) snprintf(diag->path, sizeof diag->path, "%s", path);
+    akp_free(alloc, data);
+    return r;
+}
+
+ak_result ak_io_load_memory(const void* data, size_t size, const char* name, const char* base_dir,
+                            const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene, ak_diag* diag) {
+    if (out_scene) *out_scene = NULL;
+    if (!name) name = "memory";
+    if (!out_scene || (!data && size > 0)) {
+        akp_diag_set(diag, name, "data and out_scene are required");
+        return AK_ERR_NULL_ARG;
+    }
+    ak_io_desc d = ak_io_desc_resolved(desc);
+    if (desc && desc->format != AK_IO_FORMAT_AUTO && desc->format != AK_IO_FORMAT_GLTF) {
+        akp_diag_set(diag, name, "ak_io_load_memory reads glTF only");
+        return AK_ERR_UNSUPPORTED;
+    }
+    static const uint8_t empty[1] = {0};
+    return akp_io_load_gltf(data ? (const uint8_t*)data : empty, size, name, base_dir, &d, alloc, out_scene, diag);
+}

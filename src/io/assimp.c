@@ -1,0 +1,454 @@
+/* Everything but glTF (BVH, FBX, Collada, OBJ, ...) through Assimp's C API: the node tree
+ * becomes the skeleton (depth-first, so parents come first), aiAnimation channels become
+ * clips (ticks -> seconds), meshes with bones get one skin each. */
+#include <assimp/cimport.h> /* Debian libassimp-dev (5.2.5) */
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <ctype.h>
+
+#include "io_internal.h"
+
+/* ---- private types ------------------------------------------------------------------- */
+
+typedef struct as_ctx {
+    const ak_allocator* alloc;
+    const ak_io_desc* desc;
+    const char* path;
+    ak_diag* diag;
+    const struct aiScene* ai;
+    const struct aiNode** nodes; /* depth-first */
+    size_t node_count;
+    int32_t* joint_of_node;
+    ak_scene* scene;
+} as_ctx;
+
+/* ---- static helpers ------------------------------------------------------------------ */
+
+static ak_mat4 to_mat4(const struct aiMatrix4x4* m) {
+    /* aiMatrix4x4 is row-major (a1..a4 the first row); ak_mat4 is column-major. */
+    ak_mat4 r = {{m->a1, m->b1, m->c1, m->d1, m->a2, m->b2, m->c2, m->d2, m->a3, m->b3, m->c3, m->d3, m->a4, m->b4,
+                  m->c4, m->d4}};
+    return r;
+}
+
+static size_t count_nodes(const struct aiNode* n, unsigned depth) {
+    if (!n || depth > 4096) return 0;
+    size_t c = 1;
+    for (unsigned i = 0; i < n->mNumChildren; ++i) c += count_nodes(n->mChildren[i], depth + 1);
+    return c;
+}
+
+static void collect_nodes(as_ctx* c, const struct aiNode* n, int32_t parent, int32_t* parents, unsigned depth) {
+    if (!n || depth > 4096 || c->node_count >= AKP_IO_MAX_NODES + 1) return;
+    size_t me = c->node_count++;
+    c->nodes[me] = n;
+    parents[me] = parent;
+    for (unsigned i = 0; i < n->mNumChildren; ++i) collect_nodes(c, n->mChildren[i], (int32_t)me, parents, depth + 1);
+}
+
+static int32_t find_node(const as_ctx* c, const struct aiString* name) {
+    for (size_t i = 0; i < c->node_count; ++i)
+        if (strcmp(c->nodes[i]->mName.data, name->data) == 0) return (int32_t)i;
+    return -1;
+}
+
+static bool is_bvh(const char* path) {
+    size_t n = strlen(path);
+    return n >= 4 && path[n - 4] == '.' && tolower((unsigned char)path[n - 3]) == 'b' &&
+           tolower((unsigned char)path[n - 2]) == 'v' && tolower((unsigned char)path[n - 1]) == 'h';
+}
+
+static ak_result build_skeleton(as_ctx* c) {
+    size_t total = count_nodes(c->ai->mRootNode, 0);
+    if (total > AKP_IO_MAX_NODES) {
+        akp_diag_set(c->diag, c->path, "%zu nodes; at most %u are supported", total, AKP_IO_MAX_NODES);
+        return AK_ERR_UNSUPPORTED;
+    }
+    c->nodes = (const struct aiNode**)akp_alloc(c->alloc, (total ? total : 1) * sizeof(*c->nodes));
+    int32_t* parents = (int32_t*)akp_alloc(c->alloc, (total ? total : 1) * sizeof(int32_t));
+    akp_io_node* desc = (akp_io_node*)akp_calloc(c->alloc, (total ? total : 1) * sizeof(akp_io_node));
+    c->joint_of_node = (int32_t*)akp_alloc(c->alloc, (total ? total : 1) * sizeof(int32_t));
+    ak_result r = AK_ERR_NO_MEMORY;
+    if (!c->nodes || !parents || !desc || !c->joint_of_node) {
+        akp_diag_set(c->diag, c->path, "out of memory");
+        goto done;
+    }
+    collect_nodes(c, c->ai->mRootNode, -1, parents, 0);
+    for (size_t i = 0; i < c->node_count; ++i) {
+        ak_mat4 m = to_mat4(&c->nodes[i]->mTransformation);
+        if (!ak_mat4_is_finite(&m)) {
+            akp_diag_set(c->diag, c->path, "node '%.100s' has a non-finite transform", c->nodes[i]->mName.data);
+            r = AK_ERR_BAD_DATA;
+            goto done;
+        }
+        desc[i].name = c->nodes[i]->mName.data;
+        desc[i].parent = parents[i];
+        desc[i].rest = akp_io_decompose(m);
+    }
+    r = akp_io_build_skeleton(c->scene, desc, c->node_count, c->joint_of_node, c->path, c->diag);
+done:
+    akp_free(c->alloc, parents);
+    akp_free(c->alloc, desc);
+    return r;
+}
+
+static ak_result make_mesh(as_ctx* c, const struct aiMesh* am, size_t mi, ak_mesh** out) {
+    size_t nv = am->mNumVertices, tris = 0;
+    if (nv == 0 || nv > AKP_IO_MAX_ELEMENTS || !am->mVertices) {
+        akp_diag_set(c->diag, c->path, "mesh %zu has %zu vertices", mi, nv);
+        return nv ? AK_ERR_UNSUPPORTED : AK_ERR_EMPTY;
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) tris += am->mFaces[f].mNumIndices == 3;
+    /* Influences: the most any vertex has (the clean-up keeps the largest max_influences). */
+    uint32_t* per_vertex = NULL;
+    uint32_t stride = 0;
+    if (am->mNumBones) {
+        per_vertex = (uint32_t*)akp_calloc(c->alloc, nv * sizeof(uint32_t));
+        if (!per_vertex) goto oom;
+        for (unsigned b = 0; b < am->mNumBones; ++b) {
+            const struct aiBone* bone = am->mBones[b];
+            for (unsigned w = 0; w < bone->mNumWeights; ++w) {
+                unsigned v = bone->mWeights[w].mVertexId;
+                if (v >= nv) {
+                    akp_free(c->alloc, per_vertex);
+                    akp_diag_set(c->diag, c->path, "mesh %zu bone '%.100s' weights vertex %u of %zu", mi,
+                                 bone->mName.data, v, nv);
+                    return AK_ERR_BAD_INDEX;
+                }
+                if (++per_vertex[v] > stride) stride = per_vertex[v];
+            }
+        }
+    }
+    ak_mesh_desc d = {
+        .vertex_count = nv,
+        .triangle_count = tris,
+        .influence_count = stride ? (stride < c->desc->max_influences ? stride : c->desc->max_influences) : 0,
+        .has_normals = am->mNormals != NULL,
+        .has_uvs = am->mTextureCoords[0] != NULL,
+        .has_colors = am->mColors[0] != NULL,
+        .name = am->mName.data,
+    };
+    ak_mesh* m = NULL;
+    ak_result r = ak_mesh_create(&d, c->alloc, &m);
+    if (r != AK_OK) {
+        akp_free(c->alloc, per_vertex);
+        akp_diag_set(c->diag, c->path, "mesh %zu: cannot create a mesh of %zu vertices", mi, nv);
+        return r;
+    }
+    for (size_t v = 0; v < nv; ++v) {
+        const struct aiVector3D* p = &am->mVertices[v];
+        m->positions[v] = ak_vec3_make(p->x, p->y, p->z);
+        if (!ak_vec3_is_finite(m->positions[v])) {
+            akp_diag_set(c->diag, c->path, "mesh %zu vertex %zu is not finite", mi, v);
+            r = AK_ERR_BAD_DATA;
+        }
+        if (am->mNormals) m->normals[v] = ak_vec3_make(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
+        if (am->mTextureCoords[0]) m->uvs[v] = ak_vec2_make(am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y);
+        if (am->mColors[0]) {
+            const struct aiColor4D* col = &am->mColors[0][v];
+            m->colors[v] = ak_vec4_make(col->r, col->g, col->b, col->a);
+        }
+    }
+    size_t t = 0;
+    for (unsigned f = 0; f < am->mNumFaces && r == AK_OK; ++f) {
+        const struct aiFace* face = &am->mFaces[f];
+        if (face->mNumIndices != 3) continue; /* points and lines carry no surface */
+        for (int k = 0; k < 3; ++k) {
+            if (face->mIndices[k] >= nv) {
+                akp_diag_set(c->diag, c->path, "mesh %zu face %u uses vertex %u of %zu", mi, f, face->mIndices[k], nv);
+                r = AK_ERR_BAD_INDEX;
+            }
+            m->indices[3 * t + (size_t)k] = face->mIndices[k];
+        }
+        ++t;
+    }
+    if (r == AK_OK && stride) {
+        uint16_t* joints = (uint16_t*)akp_calloc(c->alloc, nv * stride * sizeof(uint16_t));
+        float* weights = (float*)akp_calloc(c->alloc, nv * stride * sizeof(float));
+        if (!joints || !weights || am->mNumBones > 65535) {
+            akp_diag_set(c->diag, c->path, "mesh %zu: out of memory or more than 65535 bones", mi);
+            r = joints && weights ? AK_ERR_UNSUPPORTED : AK_ERR_NO_MEMORY;
+        } else {
+            memset(per_vertex, 0, nv * sizeof(uint32_t));
+            for (unsigned b = 0; b < am->mNumBones; ++b) {
+                const struct aiBone* bone = am->mBones[b];
+                for (unsigned w = 0; w < bone->mNumWeights; ++w) {
+                    size_t v = bone->mWeights[w].mVertexId, o = v * stride + per_vertex[v]++;
+                    joints[o] = (uint16_t)b;
+                    weights[o] = bone->mWeights[w].mWeight;
+                }
+            }
+            akp_io_store_weights(m, joints, weights, stride, c->desc);
+        }
+        akp_free(c->alloc, joints);
+        akp_free(c->alloc, weights);
+    }
+    akp_free(c->alloc, per_vertex);
+    if (r != AK_OK) {
+        ak_mesh_destroy(m);
+        return r;
+    }
+    *out = m;
+    return AK_OK;
+oom:
+    akp_diag_set(c->diag, c->path, "out of memory");
+    return AK_ERR_NO_MEMORY;
+}
+
+/* Keys of one Assimp key array: times in seconds, strictly increasing (later duplicates are
+ * dropped), values of comps floats. Returns the kept key count. */
+static size_t copy_keys(const double* key_times, size_t key_stride, size_t n, double tps, float* times) {
+    size_t kept = 0;
+    for (size_t k = 0; k < n; ++k) {
+        double t = *(const double*)((const uint8_t*)key_times + k * key_stride);
+        float s = (float)(t / tps);
+        if (kept && !(s > times[kept - 1])) continue;
+        times[kept++] = s;
+    }
+    return kept;
+}
+
+static ak_result build_clip(as_ctx* c, const struct aiAnimation* an, size_t ai) {
+    double tps = an->mTicksPerSecond > 0.0 ? an->mTicksPerSecond : 25.0; /* Assimp's documented default */
+    size_t max_ch = (size_t)an->mNumChannels * 3;
+    ak_raw_channel* ch = (ak_raw_channel*)akp_calloc(c->alloc, (max_ch ? max_ch : 1) * sizeof(ak_raw_channel));
+    float** bufs = (float**)akp_calloc(c->alloc, (max_ch ? max_ch : 1) * 2 * sizeof(float*));
+    size_t nch = 0, nbuf = 0;
+    ak_result r = AK_OK;
+    if (!ch || !bufs) {
+        r = AK_ERR_NO_MEMORY;
+        akp_diag_set(c->diag, c->path, "out of memory");
+    }
+    for (unsigned i = 0; r == AK_OK && i < an->mNumChannels; ++i) {
+        const struct aiNodeAnim* na = an->mChannels[i];
+        int32_t node = find_node(c, &na->mNodeName);
+        if (node < 0) {
+            akp_diag_set(c->diag, c->path, "animation %zu channel %u targets unknown node '%.100s'", ai, i,
+                         na->mNodeName.data);
+            r = AK_ERR_NOT_FOUND;
+            break;
+        }
+        for (int kind = 0; kind < 3 && r == AK_OK; ++kind) {
+            size_t n = kind == 0 ? na->mNumPositionKeys : kind == 1 ? na->mNumRotationKeys : na->mNumScalingKeys;
+            if (n == 0) continue;
+            if (n > AKP_IO_MAX_ELEMENTS) {
+                r = AK_ERR_UNSUPPORTED;
+                akp_diag_set(c->diag, c->path, "animation %zu channel %u has %zu keys", ai, i, n);
+                break;
+            }
+            uint32_t comps = kind == 1 ? 4 : 3;
+            float* times = (float*)akp_alloc(c->alloc, n * sizeof(float));
+            float* vals = (float*)akp_alloc(c->alloc, n * comps * sizeof(float));
+            bufs[nbuf++] = times;
+            bufs[nbuf++] = vals;
+            if (!times || !vals) {
+                r = AK_ERR_NO_MEMORY;
+                akp_diag_set(c->diag, c->path, "out of memory");
+                break;
+            }
+            size_t kept = 0;
+            if (kind == 1) {
+                kept = copy_keys(&na->mRotationKeys[0].mTime, sizeof(struct aiQuatKey), n, tps, times);
+                for (size_t k = 0, o = 0; k < n && o < kept; ++k) {
+                    float t = (float)(na->mRotationKeys[k].mTime / tps);
+                    if (t != times[o]) continue;
+                    const struct aiQuaternion* q = &na->mRotationKeys[k].mValue;
+                    float v[4] = {q->x, q->y, q->z, q->w};
+                    memcpy(vals + 4 * o++, v, sizeof v);
+                }
+            } else {
+                const struct aiVectorKey* keys = kind == 0 ? na->mPositionKeys : na->mScalingKeys;
+                kept = copy_keys(&keys[0].mTime, sizeof(struct aiVectorKey), n, tps, times);
+                for (size_t k = 0, o = 0; k < n && o < kept; ++k) {
+                    float t = (float)(keys[k].mTime / tps);
+                    if (t != times[o]) continue;
+                    float v[3] = {keys[k].mValue.x, keys[k].mValue.y, keys[k].mValue.z};
+                    memcpy(vals + 3 * o++, v, sizeof v);
+                }
+            }
+            if (kept < n) {
+                char msg[200];
+                snprintf(msg, sizeof msg, "%s: animation %zu channel '%.60s': %zu keys at repeated times dropped",
+                         c->path, ai, na->mNodeName.data, n - kept);
+                akp_log(&c->desc->logger, AK_LOG_WARN, msg);
+            }
+            ak_raw_channel* rc = &ch[nch++];
+            rc->target = kind == 0 ? AK_CHANNEL_TRANSLATION : kind == 1 ? AK_CHANNEL_ROTATION : AK_CHANNEL_SCALE;
+            rc->index = (uint32_t)c->joint_of_node[node];
+            rc->component_count = comps;
+            rc->interp = AK_INTERP_LINEAR;
+            rc->key_count = kept;
+            rc->times = times;
+            rc->values = vals;
+        }
+    }
+    if (r == AK_OK && an->mNumMorphMeshChannels) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "%s: animation %zu: morph channels are not imported through Assimp", c->path, ai);
+        akp_log(&c->desc->logger, AK_LOG_WARN, msg);
+    }
+    if (r == AK_OK) {
+        char name[AK_NAME_SIZE];
+        if (an->mName.length) akp_io_copy_name(name, an->mName.data);
+        else snprintf(name, sizeof name, "animation_%zu", ai);
+        double dur = an->mDuration / tps;
+        ak_raw_clip raw = {
+            .name = name,
+            .duration = dur > 0.0 && dur < 1e30 ? (float)dur : 0.0f,
+            .channels = ch,
+            .channel_count = nch,
+            .joint_count = ak_scene_joint_count(c->scene),
+        };
+        ak_diag sub;
+        r = ak_clip_build(&raw, c->alloc, &c->scene->clips[ai], &sub);
+        if (r != AK_OK) akp_diag_set(c->diag, c->path, "animation %zu: %s", ai, sub.message);
+    }
+    for (size_t i = 0; i < nbuf; ++i) akp_free(c->alloc, bufs[i]);
+    akp_free(c->alloc, bufs);
+    akp_free(c->alloc, ch);
+    return r;
+}
+
+static ak_result convert(as_ctx* c) {
+    const struct aiScene* ai = c->ai;
+    bool drop_meshes = is_bvh(c->path) && !c->desc->keep_bvh_mesh;
+    ak_result r = AK_OK;
+    /* Scene meshes: meshes in file order x instancing nodes (depth-first order). */
+    size_t n_meshes = drop_meshes ? 0 : ai->mNumMeshes;
+    size_t* inst = (size_t*)akp_calloc(c->alloc, (n_meshes ? n_meshes : 1) * sizeof(size_t));
+    size_t* skin_of_mesh = (size_t*)akp_calloc(c->alloc, (n_meshes ? n_meshes : 1) * sizeof(size_t));
+    if (!inst || !skin_of_mesh) {
+        akp_free(c->alloc, inst);
+        akp_free(c->alloc, skin_of_mesh);
+        akp_diag_set(c->diag, c->path, "out of memory");
+        return AK_ERR_NO_MEMORY;
+    }
+    /* A provisional scene holds the skeleton while node indices are gathered. */
+    size_t clip_count = c->desc->skip_animations ? 0 : ai->mNumAnimations;
+    r = ak_scene_alloc(0, 0, 0, c->alloc, &c->scene);
+    if (r == AK_OK) {
+        const char* base = strrchr(c->path, '/');
+        akp_io_copy_name(c->scene->name, base ? base + 1 : c->path);
+        r = build_skeleton(c);
+    }
+    size_t mesh_total = 0, skin_total = 0;
+    for (size_t i = 0; r == AK_OK && i < c->node_count; ++i)
+        for (unsigned k = 0; k < c->nodes[i]->mNumMeshes; ++k) {
+            unsigned mi = c->nodes[i]->mMeshes[k];
+            if (mi >= ai->mNumMeshes) {
+                akp_diag_set(c->diag, c->path, "node '%.100s' refers to mesh %u of %u", c->nodes[i]->mName.data, mi,
+                             ai->mNumMeshes);
+                r = AK_ERR_BAD_INDEX;
+            } else if (mi < n_meshes) {
+                ++inst[mi];
+            }
+        }
+    for (size_t m = 0; r == AK_OK && m < n_meshes; ++m) {
+        mesh_total += inst[m] ? inst[m] : 1;
+        skin_of_mesh[m] = ai->mMeshes[m]->mNumBones ? skin_total++ : (size_t)-1;
+    }
+    /* Re-home the skeleton in a scene with the final array sizes. */
+    ak_scene* full = NULL;
+    if (r == AK_OK) r = ak_scene_alloc(mesh_total, skin_total, clip_count, c->alloc, &full);
+    if (r == AK_OK) {
+        memcpy(full->name, c->scene->name, sizeof full->name);
+        full->skeleton = c->scene->skeleton;
+        c->scene->skeleton = NULL;
+        ak_scene_destroy(c->scene);
+        c->scene = full;
+    } else if (r == AK_ERR_NO_MEMORY) {
+        akp_diag_set(c->diag, c->path, "out of memory");
+    }
+    size_t out = 0;
+    for (size_t m = 0; r == AK_OK && m < n_meshes; ++m) {
+        const struct aiMesh* am = ai->mMeshes[m];
+        if (skin_of_mesh[m] != (size_t)-1) {
+            size_t s = skin_of_mesh[m];
+            r = ak_scene_skin_alloc(c->scene, s, am->mNumBones);
+            if (r != AK_OK) {
+                akp_diag_set(c->diag, c->path, "out of memory");
+                break;
+            }
+            ak_scene_skin* sk = &c->scene->skins[s];
+            akp_io_copy_name(sk->name, am->mName.data);
+            for (unsigned b = 0; b < am->mNumBones && r == AK_OK; ++b) {
+                int32_t node = find_node(c, &am->mBones[b]->mName);
+                if (node < 0) {
+                    akp_diag_set(c->diag, c->path, "mesh %zu bone '%.100s' names no node", m, am->mBones[b]->mName.data);
+                    r = AK_ERR_NOT_FOUND;
+                    break;
+                }
+                sk->joints[b] = c->joint_of_node[node];
+                sk->inverse_binds[b] = to_mat4(&am->mBones[b]->mOffsetMatrix);
+                if (!ak_mat4_is_finite(&sk->inverse_binds[b])) {
+                    akp_diag_set(c->diag, c->path, "bone '%.100s' has a non-finite offset matrix", am->mBones[b]->mName.data);
+                    r = AK_ERR_BAD_DATA;
+                }
+            }
+        }
+        size_t first = out;
+        for (size_t i = 0; r == AK_OK && i <= c->node_count; ++i) {
+            bool uses = false;
+            if (i < c->node_count) {
+                for (unsigned k = 0; k < c->nodes[i]->mNumMeshes; ++k) uses = uses || c->nodes[i]->mMeshes[k] == m;
+                if (!uses) continue;
+            } else if (out > first) {
+                break;
+            }
+            ak_scene_mesh* sm = &c->scene->meshes[out++];
+            sm->node = i < c->node_count ? c->joint_of_node[i] : -1;
+            sm->skin = skin_of_mesh[m] != (size_t)-1 ? (int32_t)skin_of_mesh[m] : -1;
+            r = make_mesh(c, am, m, &sm->mesh);
+        }
+    }
+    if (r == AK_OK && skin_total) {
+        size_t nj = ak_scene_joint_count(c->scene);
+        c->scene->is_joint = (bool*)akp_calloc(&c->scene->alloc, (nj ? nj : 1) * sizeof(bool));
+        if (!c->scene->is_joint) r = AK_ERR_NO_MEMORY;
+        for (size_t s = 0; r == AK_OK && s < skin_total; ++s)
+            for (size_t j = 0; j < c->scene->skins[s].joint_count; ++j) c->scene->is_joint[c->scene->skins[s].joints[j]] = true;
+    }
+    for (size_t a = 0; r == AK_OK && a < clip_count; ++a) r = build_clip(c, ai->mAnimations[a], a);
+    akp_free(c->alloc, inst);
+    akp_free(c->alloc, skin_of_mesh);
+    return r;
+}
+
+/* ---- the reader ------------------------------------------------------------------------ */
+
+ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
+                             ak_scene** out_scene, ak_diag* diag) {
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        akp_diag_set(diag, path, "cannot open file");
+        return AK_ERR_IO;
+    }
+    fclose(f);
+    const struct aiScene* ai = aiImportFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+    if (!ai) {
+        akp_diag_set(diag, path, "Assimp: %s", aiGetErrorString());
+        return AK_ERR_PARSE;
+    }
+    if (!ai->mRootNode) {
+        aiReleaseImport(ai);
+        akp_diag_set(diag, path, "Assimp returned a scene without nodes");
+        return AK_ERR_PARSE;
+    }
+    as_ctx c;
+    memset(&c, 0, sizeof c);
+    c.alloc = alloc;
+    c.desc = desc;
+    c.path = path;
+    c.diag = diag;
+    c.ai = ai;
+    ak_result r = convert(&c);
+    aiReleaseImport(ai);
+    akp_free(alloc, (void*)c.nodes);
+    akp_free(alloc, c.joint_of_node);
+    if (r != AK_OK) {
+        ak_scene_destroy(c.scene);
+        return r;
+    }
+    *out_scene = c.scene;
+    return AK_OK;
+}

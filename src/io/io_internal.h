@@ -1,0 +1,51 @@
+/* Helpers shared by the io readers (src/io.c, src/io/gltf.c, src/io/assimp.c); never installed. */
+#ifndef ANIMKIT_IO_INTERNAL_H
+#define ANIMKIT_IO_INTERNAL_H
+
+#include <animkit/clip.h>
+#include <animkit/io.h>
+
+#include "../internal.h"
+
+/* Most nodes a file may have: the skeleton stores parents as int16. */
+#define AKP_IO_MAX_NODES 32767u
+/* Most elements an accessor (or Assimp array) may declare; guards allocations against
+ * absurd counts in corrupt files. */
+#define AKP_IO_MAX_ELEMENTS (1u << 26)
+
+/* Read a whole file through alloc. Returns AK_ERR_IO (diag names the file) or AK_ERR_NO_MEMORY. */
+ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, uint8_t** out_data, size_t* out_size,
+                           ak_diag* diag);
+
+/* Nodes of a file in file order: name (NULL or "" -> "node_<i>"), parent (-1 root, any order),
+ * rest transform, optional inverse bind. Builds scene->skeleton (parents first, unique names:
+ * a repeated name becomes "<name>#<i>") and writes out_joint_of_node[i] (count entries).
+ * Returns the codes of ak_skeleton_reorder / ak_skeleton_create. */
+typedef struct akp_io_node {
+    const char* name;
+    int32_t parent;
+    ak_transform rest;
+    const ak_mat4* inverse_bind; /* NULL -> inverse of the rest world matrix */
+} akp_io_node;
+ak_result akp_io_build_skeleton(ak_scene* scene, const akp_io_node* nodes, size_t count, int32_t* out_joint_of_node,
+                                const char* path, ak_diag* diag);
+
+/* Split an affine matrix into T * R * S (no shear assumed; a negative determinant flips the
+ * x scale). Degenerate columns give scale 0 and the rotation of the remaining frame. */
+ak_transform akp_io_decompose(ak_mat4 m);
+
+/* Clean skin weights read with stride src_influences (joints/weights arrays of
+ * vertex_count * src_influences, modified) into mesh (already created with
+ * influence_count <= src_influences): limit, renormalise, copy. */
+void akp_io_store_weights(ak_mesh* mesh, uint16_t* joints, float* weights, uint32_t src_influences,
+                          const ak_io_desc* desc);
+
+/* Copy a name into a fixed buffer, truncating. */
+void akp_io_copy_name(char dst[AK_NAME_SIZE], const char* src);
+
+ak_result akp_io_load_gltf(const uint8_t* data, size_t size, const char* name, const char* base_dir,
+                           const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene, ak_diag* diag);
+ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
+                             ak_scene** out_scene, ak_diag* diag);
+
+#endif

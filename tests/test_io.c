@@ -1,0 +1,1363 @@
+/* Tests of the io module: every glTF in the shared assets checked against the file's own JSON
+ * (read here with cJSON, independently of the loader), variants agreeing, bind poses, BVH
+ * against a hand FK from the file's OFFSETs and channels, truncation and malformed input with
+ * exact codes, synthetic files for each glTF feature, the OBJ writer, allocator failures. */
+#include <animkit/io.h>
+#include <cjson/cJSON.h>
+#include <dirent.h>
+#include <stdint.h>
+
+#include "ak_test.h"
+
+/* Assimp 5.2.5 leaks one small object when an import fails (the garbage.bvh case below).
+ * The leak is inside libassimp, not animkit, so LeakSanitizer is told to skip that library. */
+const char* __lsan_default_suppressions(void);
+const char* __lsan_default_suppressions(void) { return "leak:libassimp.so\n"; }
+
+/* ---- small helpers ------------------------------------------------------------------- */
+
+static uint8_t* slurp(const char* path, size_t* size) {
+    FILE* f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    uint8_t* d = (uint8_t*)malloc((size_t)n + 1);
+    if (d && fread(d, 1, (size_t)n, f) != (size_t)n) {
+        free(d);
+        d = NULL;
+    }
+    fclose(f);
+    if (d) d[n] = 0;
+    *size = (size_t)n;
+    return d;
+}
+
+static const char k_b64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+static char* b64_encode(const void* data, size_t n) {
+    const uint8_t* p = (const uint8_t*)data;
+    char* out = (char*)malloc(4 * ((n + 2) / 3) + 1);
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
+        out[o++] = k_b64[v >> 18];
+        out[o++] = k_b64[(v >> 12) & 63];
+        out[o++] = i + 1 < n ? k_b64[(v >> 6) & 63] : '=';
+        out[o++] = i + 2 < n ? k_b64[v & 63] : '=';
+    }
+    out[o] = 0;
+    return out;
+}
+
+static uint8_t* b64_decode(const char* s, size_t* out_n) {
+    size_t n = strlen(s);
+    uint8_t* d = (uint8_t*)malloc(n + 1);
+    uint32_t acc = 0;
+    int bits = 0;
+    size_t o = 0;
+    for (size_t i = 0; i < n && s[i] != '='; ++i) {
+        const char* q = strchr(k_b64, s[i]);
+        if (!q) break;
+        acc = acc << 6 | (uint32_t)(q - k_b64);
+        bits += 6;
+        if (bits >= 8) {
+            bits -= 8;
+            d[o++] = (uint8_t)(acc >> bits);
+        }
+    }
+    *out_n = o;
+    return d;
+}
+
+/* ---- an independent glTF document reader (float accessors without sparse only) ---------- */
+
+typedef struct doc {
+    cJSON* root;
+    uint8_t* file;
+    uint8_t* bufs[16];
+    size_t buf_size[16];
+    const uint8_t* buf_ptr[16];
+} doc;
+
+static bool doc_open(doc* d, const char* path) {
+    memset(d, 0, sizeof *d);
+    size_t size = 0;
+    d->file = slurp(path, &size);
+    if (!d->file) return false;
+    const char* json = (const char*)d->file;
+    size_t json_len = size;
+    const uint8_t* bin = NULL;
+    size_t bin_len = 0;
+    if (size > 20 && memcmp(d->file, "glTF", 4) == 0) {
+        uint32_t jl;
+        memcpy(&jl, d->file + 12, 4);
+        json = (const char*)d->file + 20;
+        json_len = jl;
+        if (20 + jl + 8 <= size) {
+            uint32_t bl;
+            memcpy(&bl, d->file + 20 + jl, 4);
+            bin = d->file + 28 + jl;
+            bin_len = bl;
+        }
+    }
+    d->root = cJSON_ParseWithLength(json, json_len);
+    if (!d->root) return false;
+    cJSON* buffers = cJSON_GetObjectItem(d->root, "buffers");
+    int i = 0;
+    cJSON* b;
+    cJSON_ArrayForEach(b, buffers) {
+        if (i >= 16) break;
+        cJSON* uri = cJSON_GetObjectItem(b, "uri");
+        if (!uri) {
+            d->buf_ptr[i] = bin;
+            d->buf_size[i] = bin_len;
+        } else if (strncmp(uri->valuestring, "data:", 5) == 0) {
+            d->bufs[i] = b64_decode(strchr(uri->valuestring, ',') + 1, &d->buf_size[i]);
+            d->buf_ptr[i] = d->bufs[i];
+        } else {
+            char p[1024];
+            const char* slash = strrchr(path, '/');
+            snprintf(p, sizeof p, "%.*s/%s", (int)(slash - path), path, uri->valuestring);
+            d->bufs[i] = slurp(p, &d->buf_size[i]);
+            d->buf_ptr[i] = d->bufs[i];
+        }
+        ++i;
+    }
+    return true;
+}
+
+static void doc_close(doc* d) {
+    cJSON_Delete(d->root);
+    free(d->file);
+    for (int i = 0; i < 16; ++i) free(d->bufs[i]);
+}
+
+static cJSON* jget(const cJSON* o, const char* key) { return cJSON_GetObjectItemCaseSensitive(o, key); }
+static int jint(const cJSON* o, const char* key, int dflt) {
+    const cJSON* v = jget(o, key);
+    return cJSON_IsNumber(v) ? v->valueint : dflt;
+}
+static int jsize(const cJSON* o, const char* key) {
+    const cJSON* v = jget(o, key);
+    return cJSON_IsArray(v) ? cJSON_GetArraySize(v) : 0;
+}
+static cJSON* jat(const cJSON* o, const char* key, int i) { return cJSON_GetArrayItem(jget(o, key), i); }
+
+static int accessor_count(const doc* d, int ai) { return jint(jat(d->root, "accessors", ai), "count", -1); }
+
+/* Float accessor (no sparse) into out[count * comps]; false when not plain floats. */
+static bool doc_floats(const doc* d, int ai, int comps, float* out) {
+    const cJSON* a = jat(d->root, "accessors", ai);
+    if (!a || jget(a, "sparse") || jint(a, "componentType", 0) != 5126) return false;
+    const cJSON* v = jat(d->root, "bufferViews", jint(a, "bufferView", -1));
+    if (!v) return false;
+    int stride = jint(v, "byteStride", comps * 4);
+    size_t off = (size_t)jint(v, "byteOffset", 0) + (size_t)jint(a, "byteOffset", 0);
+    int bi = jint(v, "buffer", 0);
+    int n = jint(a, "count", 0);
+    if (!d->buf_ptr[bi] || off + (size_t)(n - 1) * (size_t)stride + (size_t)comps * 4 > d->buf_size[bi]) return false;
+    for (int i = 0; i < n; ++i) memcpy(out + (size_t)i * comps, d->buf_ptr[bi] + off + (size_t)i * stride, (size_t)comps * 4);
+    return true;
+}
+
+/* The loader's documented joint names: node name, "node_<i>", "<name>#<i>" when taken. */
+static void expected_names(const doc* d, char (*names)[AK_NAME_SIZE], int n) {
+    for (int i = 0; i < n; ++i) {
+        const cJSON* nm = jget(jat(d->root, "nodes", i), "name");
+        if (cJSON_IsString(nm) && nm->valuestring[0]) snprintf(names[i], AK_NAME_SIZE, "%s", nm->valuestring);
+        else snprintf(names[i], AK_NAME_SIZE, "node_%d", i);
+        for (int j = 0; j < i; ++j)
+            if (strcmp(names[j], names[i]) == 0) {
+                char tmp[AK_NAME_SIZE];
+                snprintf(tmp, sizeof tmp, "%.50s#%d", cJSON_IsString(nm) && nm->valuestring[0] ? nm->valuestring : "node", i);
+                memcpy(names[i], tmp, sizeof tmp);
+                break;
+            }
+    }
+}
+
+/* Every .gltf / .glb under dir (recursive), sorted. */
+static int list_gltf(const char* dir, char paths[][512], int max, int n) {
+    DIR* dp = opendir(dir);
+    if (!dp) return n;
+    struct dirent* e;
+    while ((e = readdir(dp)) && n < max) {
+        if (e->d_name[0] == '.') continue;
+        char p[512];
+        snprintf(p, sizeof p, "%.400s/%.100s", dir, e->d_name);
+        size_t l = strlen(p);
+        struct stat st;
+        if (stat(p, &st) != 0) continue;
+        if (S_ISDIR(st.st_mode)) n = list_gltf(p, paths, max, n);
+        else if ((l > 5 && strcmp(p + l - 5, ".gltf") == 0) || (l > 4 && strcmp(p + l - 4, ".glb") == 0))
+            snprintf(paths[n++], 512, "%s", p);
+    }
+    closedir(dp);
+    return n;
+}
+
+static int cmp_paths(const void* a, const void* b) { return strcmp((const char*)a, (const char*)b); }
+
+static char g_paths[64][512];
+static int g_path_count = -1;
+
+static int gltf_assets(void) {
+    if (g_path_count >= 0) return g_path_count;
+    const char* dir = ak_test_assets_dir();
+    g_path_count = 0;
+    if (!dir) return 0;
+    char gdir[1100];
+    snprintf(gdir, sizeof gdir, "%s/gltf", dir);
+    g_path_count = list_gltf(gdir, g_paths, 64, 0);
+    qsort(g_paths, (size_t)g_path_count, sizeof g_paths[0], cmp_paths);
+    return g_path_count;
+}
+
+static ak_scene* load(const char* path, ak_result* out_r) {
+    ak_scene* s = NULL;
+    ak_diag diag;
+    ak_result r = ak_io_load(path, NULL, NULL, &s, &diag);
+    if (out_r) *out_r = r;
+    if (r != AK_OK) printf("  load %s: %s: %s\n", path, ak_result_name(r), diag.message);
+    return s;
+}
+
+/* ---- desc ---------------------------------------------------------------------------- */
+
+AK_TEST(desc_defaults) {
+    ak_io_desc d = ak_io_desc_resolved(NULL);
+    AK_CHECK_EQ(d.max_influences, 4);
+    AK_CHECK_EQ(d.format, AK_IO_FORMAT_AUTO);
+    AK_CHECK(d.min_weight == 0.0f);
+    ak_io_desc big = {.max_influences = 99, .min_weight = -1.0f};
+    d = ak_io_desc_resolved(&big);
+    AK_CHECK_EQ(d.max_influences, AK_MAX_INFLUENCES);
+    AK_CHECK(d.min_weight == 0.0f);
+    ak_io_desc nan = {.min_weight = NAN};
+    AK_CHECK(ak_io_desc_resolved(&nan).min_weight == 0.0f);
+}
+
+/* ---- every glTF asset against its own JSON ----------------------------------------------- */
+
+static void check_gltf_file(const char* path) {
+    doc d;
+    if (!doc_open(&d, path)) {
+        AK_FAIL_("test could not read %s", path);
+        return;
+    }
+    ak_scene* s = load(path, NULL);
+    AK_CHECK_MSG(s != NULL, "%s did not load", path);
+    if (!s) {
+        doc_close(&d);
+        return;
+    }
+    const cJSON* root = d.root;
+    int n_nodes = jsize(root, "nodes");
+    AK_CHECK_EQ(ak_scene_joint_count(s), n_nodes);
+
+    /* Joints: names, parents and rest translations per node. */
+    char(*names)[AK_NAME_SIZE] = (char(*)[AK_NAME_SIZE])calloc((size_t)n_nodes + 1, AK_NAME_SIZE);
+    int* joint = (int*)calloc((size_t)n_nodes + 1, sizeof(int));
+    int* parent = (int*)malloc(((size_t)n_nodes + 1) * sizeof(int));
+    expected_names(&d, names, n_nodes);
+    for (int i = 0; i < n_nodes; ++i) parent[i] = -1;
+    for (int i = 0; i < n_nodes; ++i) {
+        cJSON* ch;
+        cJSON_ArrayForEach(ch, jget(jat(root, "nodes", i), "children")) parent[ch->valueint] = i;
+    }
+    int bad_joint = 0;
+    for (int i = 0; i < n_nodes; ++i) {
+        joint[i] = ak_skeleton_find_joint(s->skeleton, names[i]);
+        if (joint[i] < 0) ++bad_joint;
+    }
+    AK_CHECK_MSG(bad_joint == 0, "%s: %d nodes not found by name", path, bad_joint);
+    if (bad_joint == 0 && n_nodes) {
+        ak_i16_cspan par = ak_skeleton_parents(s->skeleton);
+        ak_transform_cspan rest = ak_skeleton_rest_pose(s->skeleton);
+        int bad_parent = 0, bad_rest = 0;
+        for (int i = 0; i < n_nodes; ++i) {
+            int want = parent[i] < 0 ? -1 : joint[parent[i]];
+            if (par.ptr[joint[i]] != want) ++bad_parent;
+            const cJSON* t = jget(jat(root, "nodes", i), "translation");
+            if (t) {
+                ak_vec3 r = rest.ptr[joint[i]].translation;
+                double e = fabs(r.x - cJSON_GetArrayItem(t, 0)->valuedouble) +
+                           fabs(r.y - cJSON_GetArrayItem(t, 1)->valuedouble) +
+                           fabs(r.z - cJSON_GetArrayItem(t, 2)->valuedouble);
+                if (e > 1e-6 * (1.0 + ak_vec3_length(r))) ++bad_rest;
+            }
+        }
+        AK_CHECK_MSG(bad_parent == 0, "%s: %d joints with the wrong parent", path, bad_parent);
+        AK_CHECK_MSG(bad_rest == 0, "%s: %d rest translations differ", path, bad_rest);
+    }
+
+    /* Skins. */
+    AK_CHECK_EQ(s->skin_count, jsize(root, "skins"));
+    for (int k = 0; k < jsize(root, "skins") && k < (int)s->skin_count; ++k) {
+        const cJSON* sk = jat(root, "skins", k);
+        AK_CHECK_EQ(s->skins[k].joint_count, jsize(sk, "joints"));
+        int bad = 0;
+        for (int j = 0; j < jsize(sk, "joints") && bad_joint == 0; ++j)
+            bad += s->skins[k].joints[j] != joint[jat(sk, "joints", j)->valueint];
+        AK_CHECK_MSG(bad == 0, "%s skin %d: %d slots map to the wrong joint", path, k, bad);
+    }
+
+    /* Meshes: mesh-major, then instancing nodes, then primitives. */
+    size_t sm = 0;
+    int bad_pos = 0, checked_pos = 0;
+    for (int m = 0; m < jsize(root, "meshes"); ++m) {
+        const cJSON* mesh = jat(root, "meshes", m);
+        int inst[1024], ni = 0;
+        for (int i = 0; i < n_nodes && ni < 1024; ++i)
+            if (jint(jat(root, "nodes", i), "mesh", -1) == m) inst[ni++] = i;
+        if (ni == 0) inst[ni++] = -1;
+        for (int k = 0; k < ni; ++k) {
+            for (int p = 0; p < jsize(mesh, "primitives"); ++p, ++sm) {
+                if (sm >= s->mesh_count) continue;
+                const cJSON* prim = jat(mesh, "primitives", p);
+                const ak_scene_mesh* got = &s->meshes[sm];
+                int pa = jint(jget(prim, "attributes"), "POSITION", -1);
+                int vc = accessor_count(&d, pa);
+                AK_CHECK_EQ(got->mesh->vertex_count, vc);
+                int ia = jint(prim, "indices", -1);
+                AK_CHECK_EQ(jint(prim, "mode", 4), 4);
+                AK_CHECK_EQ(got->mesh->triangle_count, (ia >= 0 ? accessor_count(&d, ia) : vc) / 3);
+                AK_CHECK_EQ(got->node, inst[k] >= 0 ? joint[inst[k]] : -1);
+                AK_CHECK_EQ(got->skin, inst[k] >= 0 ? jint(jat(root, "nodes", inst[k]), "skin", -1) : -1);
+                AK_CHECK_EQ(got->mesh->morph_target_count, jsize(prim, "targets"));
+                AK_CHECK_EQ(got->mesh->normals != NULL, jget(jget(prim, "attributes"), "NORMAL") != NULL);
+                if (jget(jget(prim, "attributes"), "JOINTS_0"))
+                    AK_CHECK_EQ(got->mesh->influence_count, 4);
+                float* raw = (float*)malloc((size_t)vc * 3 * sizeof(float));
+                if (doc_floats(&d, pa, 3, raw)) {
+                    ++checked_pos;
+                    for (int v = 0; v < vc; ++v)
+                        if (memcmp(&got->mesh->positions[v], raw + 3 * v, 3 * sizeof(float)) != 0) ++bad_pos;
+                }
+                free(raw);
+            }
+        }
+    }
+    AK_CHECK_EQ(s->mesh_count, sm);
+    AK_CHECK_MSG(checked_pos > 0 || jsize(root, "meshes") == 0, "%s: no POSITION accessor could be checked", path);
+    AK_CHECK_MSG(bad_pos == 0, "%s: %d positions differ from the file's floats", path, bad_pos);
+
+    /* Clips: names, durations (largest sampler input max) and channel counts. */
+    AK_CHECK_EQ(s->clip_count, jsize(root, "animations"));
+    for (int a = 0; a < jsize(root, "animations") && a < (int)s->clip_count; ++a) {
+        const cJSON* an = jat(root, "animations", a);
+        double dur = 0.0;
+        const cJSON* smp;
+        cJSON_ArrayForEach(smp, jget(an, "samplers")) {
+            double mx = jat(jat(root, "accessors", jint(smp, "input", 0)), "max", 0)->valuedouble;
+            if (mx > dur) dur = mx;
+        }
+        AK_CHECK_NEAR(ak_clip_duration(s->clips[a]), dur, 1e-6 * (1.0 + dur));
+        size_t channels = 0;
+        const cJSON* ch;
+        cJSON_ArrayForEach(ch, jget(an, "channels")) {
+            const cJSON* tg = jget(ch, "target");
+            if (strcmp(jget(tg, "path")->valuestring, "weights") != 0) {
+                ++channels;
+                continue;
+            }
+            int node = jint(tg, "node", -1), mesh = jint(jat(root, "nodes", node), "mesh", -1);
+            channels += (size_t)jsize(jat(root, "meshes", mesh), "primitives");
+        }
+        AK_CHECK_EQ(ak_clip_channel_count(s->clips[a]), channels);
+        const cJSON* nm = jget(an, "name");
+        char want[AK_NAME_SIZE];
+        if (cJSON_IsString(nm) && nm->valuestring[0]) snprintf(want, sizeof want, "%s", nm->valuestring);
+        else snprintf(want, sizeof want, "animation_%d", a);
+        AK_CHECK_STREQ(ak_clip_name(s->clips[a]), want);
+    }
+    free(names);
+    free(joint);
+    free(parent);
+    ak_scene_destroy(s);
+    doc_close(&d);
+}
+
+AK_TEST(gltf_assets_match_their_json) {
+    int n = gltf_assets();
+    if (n == 0) {
+        AK_SKIP("no glTF assets (set ANIMKIT_ASSETS or provide ../shared/assets)");
+        return;
+    }
+    for (int i = 0; i < n; ++i) check_gltf_file(g_paths[i]);
+    printf("  checked %d glTF files\n", n);
+}
+
+/* ---- variants agree ------------------------------------------------------------------- */
+
+/* Equal values (so -0 == 0: CesiumMan's variants write rotations as -0.0 and 0). */
+static bool same_floats(const float* a, const float* b, size_t n) {
+    for (size_t i = 0; i < n; ++i)
+        if (!(a[i] == b[i])) return false;
+    return true;
+}
+
+static void compare_scenes(const char* what, const ak_scene* a, const ak_scene* b, bool clips) {
+    AK_CHECK_MSG(ak_scene_joint_count(a) == ak_scene_joint_count(b), "%s: joint counts differ", what);
+    AK_CHECK_MSG(a->mesh_count == b->mesh_count && a->skin_count == b->skin_count && a->clip_count == b->clip_count,
+                 "%s: mesh/skin/clip counts differ", what);
+    if (ak_scene_joint_count(a) == ak_scene_joint_count(b) && a->skeleton) {
+        ak_transform_cspan ra = ak_skeleton_rest_pose(a->skeleton), rb = ak_skeleton_rest_pose(b->skeleton);
+        AK_CHECK_MSG(same_floats((const float*)ra.ptr, (const float*)rb.ptr, ra.count * 10), "%s: rest poses differ",
+                     what);
+    }
+    for (size_t m = 0; m < a->mesh_count && m < b->mesh_count; ++m) {
+        const ak_mesh *x = a->meshes[m].mesh, *y = b->meshes[m].mesh;
+        AK_CHECK_MSG(x->vertex_count == y->vertex_count && x->triangle_count == y->triangle_count &&
+                         x->influence_count == y->influence_count && x->morph_target_count == y->morph_target_count,
+                     "%s mesh %zu: sizes differ", what, m);
+        if (x->vertex_count != y->vertex_count) continue;
+        AK_CHECK_MSG(same_floats((const float*)x->positions, (const float*)y->positions, 3 * x->vertex_count),
+                     "%s mesh %zu: positions differ", what, m);
+        AK_CHECK_MSG(x->triangle_count != y->triangle_count ||
+                         memcmp(x->indices, y->indices, 12 * x->triangle_count) == 0,
+                     "%s mesh %zu: indices differ", what, m);
+        size_t w = x->vertex_count * x->influence_count;
+        AK_CHECK_MSG(x->influence_count != y->influence_count ||
+                         (same_floats(x->weights, y->weights, w) && (w == 0 || memcmp(x->joints, y->joints, 2 * w) == 0)),
+                     "%s mesh %zu: skin weights differ", what, m);
+        if (x->morph_target_count == y->morph_target_count)
+            AK_CHECK_MSG(same_floats((const float*)x->morph_positions, (const float*)y->morph_positions,
+                                     3 * x->vertex_count * x->morph_target_count),
+                         "%s mesh %zu: morph targets differ", what, m);
+    }
+    for (size_t k = 0; k < a->skin_count && k < b->skin_count; ++k)
+        AK_CHECK_MSG(a->skins[k].joint_count == b->skins[k].joint_count &&
+                         same_floats((const float*)a->skins[k].inverse_binds, (const float*)b->skins[k].inverse_binds,
+                                     16 * a->skins[k].joint_count),
+                     "%s skin %zu: inverse binds differ", what, k);
+    for (size_t c = 0; clips && c < a->clip_count && c < b->clip_count; ++c) {
+        AK_CHECK_MSG(ak_clip_duration(a->clips[c]) == ak_clip_duration(b->clips[c]), "%s clip %zu: durations differ",
+                     what, c);
+        size_t nc = ak_clip_channel_count(a->clips[c]);
+        AK_CHECK_MSG(nc == ak_clip_channel_count(b->clips[c]), "%s clip %zu: channel counts differ", what, c);
+        for (size_t ch = 0; ch < nc && ch < ak_clip_channel_count(b->clips[c]); ++ch) {
+            const ak_track *ta = ak_clip_channel_track(a->clips[c], ch), *tb = ak_clip_channel_track(b->clips[c], ch);
+            ak_f32_cspan xa = ak_track_times(ta), xb = ak_track_times(tb);
+            AK_CHECK_MSG(xa.count == xb.count && same_floats(xa.ptr, xb.ptr, xa.count),
+                         "%s clip %zu channel %zu: key times differ", what, c, ch);
+            float va[16], vb[16];
+            size_t keys = ak_track_key_count(ta);
+            for (size_t k = 0; k < keys && k < ak_track_key_count(tb); ++k) {
+                ak_track_key(ta, k, (ak_f32_span)AK_SPAN(va), (ak_f32_span){NULL, 0}, (ak_f32_span){NULL, 0});
+                ak_track_key(tb, k, (ak_f32_span)AK_SPAN(vb), (ak_f32_span){NULL, 0}, (ak_f32_span){NULL, 0});
+                if (!same_floats(va, vb, ak_track_component_count(ta))) {
+                    AK_FAIL_("%s clip %zu channel %zu key %zu: values differ", what, c, ch, k);
+                    break;
+                }
+            }
+        }
+    }
+}
+
+AK_TEST(gltf_variants_agree) {
+    static const struct {
+        const char* a;
+        const char* b;
+        bool clips;
+    } pairs[] = {
+        {"gltf/RiggedSimple/glTF-Binary/RiggedSimple.glb", "gltf/RiggedSimple/glTF-Embedded/RiggedSimple.gltf", true},
+        {"gltf/RiggedSimple/glTF-Binary/RiggedSimple.glb", "gltf/RiggedSimple/glTF/RiggedSimple.gltf", true},
+        {"gltf/RiggedFigure/glTF-Binary/RiggedFigure.glb", "gltf/RiggedFigure/glTF-Embedded/RiggedFigure.gltf", true},
+        {"gltf/RiggedFigure/glTF-Binary/RiggedFigure.glb", "gltf/RiggedFigure/glTF/RiggedFigure.gltf", true},
+        /* CesiumMan's two variants carry different animations (README): geometry only. */
+        {"gltf/CesiumMan/glTF-Binary/CesiumMan.glb", "gltf/CesiumMan/glTF-Embedded/CesiumMan.gltf", false},
+        {"gltf/Fox/glTF-Binary/Fox.glb", "gltf/Fox/glTF/Fox.gltf", true},
+        {"gltf/SimpleSkin/glTF-Embedded/SimpleSkin.gltf", "gltf/SimpleSkin/glTF/SimpleSkin.gltf", true},
+        {"gltf/SimpleMorph/glTF-Embedded/SimpleMorph.gltf", "gltf/SimpleMorph/glTF/SimpleMorph.gltf", true},
+        {"gltf/AnimatedMorphCube/glTF-Binary/AnimatedMorphCube.glb", "gltf/AnimatedMorphCube/glTF/AnimatedMorphCube.gltf",
+         true},
+        {"gltf/MorphPrimitivesTest/glTF-Binary/MorphPrimitivesTest.glb",
+         "gltf/MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf", true},
+    };
+    int done = 0;
+    for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; ++i) {
+        char pa[2048], pb[2048];
+        if (!ak_test_asset(pa, sizeof pa, pairs[i].a) || !ak_test_asset(pb, sizeof pb, pairs[i].b)) continue;
+        ak_scene *a = load(pa, NULL), *b = load(pb, NULL);
+        AK_CHECK(a && b);
+        if (a && b) compare_scenes(pairs[i].b, a, b, pairs[i].clips);
+        ak_scene_destroy(a);
+        ak_scene_destroy(b);
+        ++done;
+    }
+    if (done == 0) AK_SKIP("no glTF assets");
+}
+
+/* ---- bind poses ------------------------------------------------------------------------ */
+
+static void mat_mul4d(const double* a, const double* b, double* out);
+
+/* Double-precision 4x4 inverse (Gauss-Jordan with partial pivoting), column-major. */
+static bool inverse4d(const double* m, double* out) {
+    double a[4][8];
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) {
+            a[r][c] = m[c * 4 + r];
+            a[r][c + 4] = r == c;
+        }
+    for (int c = 0; c < 4; ++c) {
+        int p = c;
+        for (int r = c + 1; r < 4; ++r)
+            if (fabs(a[r][c]) > fabs(a[p][c])) p = r;
+        if (fabs(a[p][c]) < 1e-300) return false;
+        for (int k = 0; k < 8; ++k) {
+            double t = a[c][k];
+            a[c][k] = a[p][k];
+            a[p][k] = t;
+        }
+        double inv = 1.0 / a[c][c];
+        for (int k = 0; k < 8; ++k) a[c][k] *= inv;
+        for (int r = 0; r < 4; ++r)
+            if (r != c) {
+                double f = a[r][c];
+                for (int k = 0; k < 8; ++k) a[r][k] -= f * a[c][k];
+            }
+    }
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) out[c * 4 + r] = a[r][c + 4];
+    return true;
+}
+
+/* Largest relative deviation of world(joint) from B * inverse(IBM) over the file's first
+ * skin, the IBMs read from the file independently; B = the rest world matrix of the node
+ * named bind_node, or the identity when bind_node is NULL. */
+static double bind_pose_error(const char* path, const char* bind_node) {
+    doc d;
+    if (!doc_open(&d, path)) return -1.0;
+    ak_scene* s = load(path, NULL);
+    double worst = -1.0;
+    if (s && s->skin_count) {
+        size_t n = ak_scene_joint_count(s);
+        ak_transform* local = (ak_transform*)malloc(n * sizeof *local);
+        ak_mat4* world = (ak_mat4*)malloc(n * sizeof *world);
+        ak_scene_rest_pose(s, (ak_transform_span){local, n});
+        ak_scene_world_matrices(s, (ak_transform_cspan){local, n}, (ak_mat4_span){world, n});
+        const cJSON* skin = jat(d.root, "skins", 0);
+        int jc = jsize(skin, "joints");
+        float* ibm = (float*)malloc((size_t)jc * 16 * sizeof(float));
+        double place[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        int bn = bind_node ? ak_skeleton_find_joint(s->skeleton, bind_node) : -1;
+        for (int e = 0; bn >= 0 && e < 16; ++e) place[e] = world[bn].m[e];
+        if ((!bind_node || bn >= 0) && doc_floats(&d, jint(skin, "inverseBindMatrices", -1), 16, ibm)) {
+            worst = 0.0;
+            for (int k = 0; k < jc; ++k) {
+                double m[16], inv[16];
+                for (int e = 0; e < 16; ++e) m[e] = ibm[16 * k + e];
+                if (!inverse4d(m, inv)) worst = 1e30;
+                mat_mul4d(place, inv, inv);
+                const ak_mat4* w = &world[s->skins[0].joints[k]];
+                double scale = 0.0;
+                for (int e = 0; e < 16; ++e) scale = fmax(scale, fabs(inv[e]));
+                for (int e = 0; e < 16; ++e) worst = fmax(worst, fabs(w->m[e] - inv[e]) / fmax(1.0, scale));
+            }
+        }
+        free(ibm);
+        free(local);
+        free(world);
+    }
+    ak_scene_destroy(s);
+    doc_close(&d);
+    return worst;
+}
+
+AK_TEST(gltf_bind_pose_fk) {
+    /* Files whose node transforms are their bind pose. The strict relation
+     * world(joint) = inverse(IBM) holds where the IBMs were made in model space (SimpleSkin,
+     * Fox). RiggedSimple, RiggedFigure and CesiumMan made theirs in the space of an ancestor
+     * node: there world(joint) = world(node) * inverse(IBM) for every joint, with node "Z_UP"
+     * (RiggedSimple, RiggedFigure) or the skinned mesh node "Cesium_Man" (CesiumMan), and the
+     * strict relation must fail. */
+    static const struct {
+        const char* path;
+        const char* bind_node; /* NULL: model space */
+    } files[] = {{"gltf/RiggedSimple/glTF-Binary/RiggedSimple.glb", "Z_UP"},
+                 {"gltf/RiggedFigure/glTF-Binary/RiggedFigure.glb", "Z_UP"},
+                 {"gltf/CesiumMan/glTF-Binary/CesiumMan.glb", "Cesium_Man"},
+                 {"gltf/SimpleSkin/glTF/SimpleSkin.gltf", NULL},
+                 {"gltf/Fox/glTF-Binary/Fox.glb", NULL}};
+    int done = 0;
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
+        char p[2048];
+        if (!ak_test_asset(p, sizeof p, files[i].path)) continue;
+        double e_strict = bind_pose_error(p, NULL);
+        double e_space = files[i].bind_node ? bind_pose_error(p, files[i].bind_node) : e_strict;
+        printf("  %s: relative error %.3g against inverse(IBM), %.3g against world(%s) * inverse(IBM)\n",
+               files[i].path, e_strict, e_space, files[i].bind_node ? files[i].bind_node : "-");
+        AK_CHECK_MSG(e_space >= 0.0 && e_space <= 1e-4, "%s: bind pose error %.3g", files[i].path, e_space);
+        if (files[i].bind_node) AK_CHECK_MSG(e_strict > 1e-2, "%s: expected IBMs outside model space", files[i].path);
+        ++done;
+    }
+    if (done == 0) AK_SKIP("no glTF assets");
+}
+
+/* ---- BVH through Assimp ------------------------------------------------------------------ */
+
+typedef struct bvh_joint {
+    char name[64];
+    int parent;
+    double offset[3];
+    int nch, ch0;
+    char ch[6][12];
+} bvh_joint;
+
+typedef struct bvh_file {
+    bvh_joint j[128];
+    int count, joints, end_sites, channels, frames;
+    double frame_time;
+    double* motion;
+} bvh_file;
+
+static bool bvh_parse(const char* path, bvh_file* b) {
+    memset(b, 0, sizeof *b);
+    size_t size;
+    char* text = (char*)slurp(path, &size);
+    if (!text) return false;
+    int stack[64], depth = 0, last = -1;
+    char* save = NULL;
+    for (char* tok = strtok_r(text, " \t\r\n", &save); tok; tok = strtok_r(NULL, " \t\r\n", &save)) {
+        if (!strcmp(tok, "ROOT") || !strcmp(tok, "JOINT") || !strcmp(tok, "End")) {
+            bvh_joint* j = &b->j[b->count];
+            bool end = !strcmp(tok, "End");
+            snprintf(j->name, sizeof j->name, "%s", strtok_r(NULL, " \t\r\n", &save));
+            if (end) b->end_sites++;
+            else b->joints++;
+            j->parent = depth ? stack[depth - 1] : -1;
+            last = b->count++;
+        } else if (!strcmp(tok, "{")) {
+            stack[depth++] = last;
+        } else if (!strcmp(tok, "}")) {
+            --depth;
+        } else if (!strcmp(tok, "OFFSET")) {
+            for (int k = 0; k < 3; ++k) b->j[last].offset[k] = strtod(strtok_r(NULL, " \t\r\n", &save), NULL);
+        } else if (!strcmp(tok, "CHANNELS")) {
+            bvh_joint* j = &b->j[last];
+            j->nch = atoi(strtok_r(NULL, " \t\r\n", &save));
+            j->ch0 = b->channels;
+            b->channels += j->nch;
+            for (int k = 0; k < j->nch; ++k) snprintf(j->ch[k], sizeof j->ch[k], "%s", strtok_r(NULL, " \t\r\n", &save));
+        } else if (!strcmp(tok, "Frames:")) {
+            b->frames = atoi(strtok_r(NULL, " \t\r\n", &save));
+        } else if (!strcmp(tok, "Time:")) {
+            b->frame_time = strtod(strtok_r(NULL, " \t\r\n", &save), NULL);
+            size_t n = (size_t)b->frames * (size_t)b->channels;
+            b->motion = (double*)malloc(n * sizeof(double));
+            for (size_t i = 0; i < n; ++i) {
+                char* v = strtok_r(NULL, " \t\r\n", &save);
+                b->motion[i] = v ? strtod(v, NULL) : NAN;
+            }
+        }
+    }
+    free(text);
+    return b->frames > 0;
+}
+
+static void mat_mul4d(const double* a, const double* b, double* out) {
+    double r[16];
+    for (int c = 0; c < 4; ++c)
+        for (int i = 0; i < 4; ++i) {
+            double s = 0;
+            for (int k = 0; k < 4; ++k) s += a[k * 4 + i] * b[c * 4 + k];
+            r[c * 4 + i] = s;
+        }
+    memcpy(out, r, sizeof r);
+}
+
+/* World matrix of joint j at frame f: parent * T(offset or position channels) * R(ch1) R(ch2) R(ch3). */
+static void bvh_world(const bvh_file* b, int j, int f, double* out) {
+    double m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    const bvh_joint* jt = &b->j[j];
+    const double* vals = b->motion + (size_t)f * (size_t)b->channels + jt->ch0;
+    m[12] = jt->offset[0];
+    m[13] = jt->offset[1];
+    m[14] = jt->offset[2];
+    for (int k = 0; k < jt->nch; ++k) {
+        const char* c = jt->ch[k];
+        int axis = c[0] - 'X';
+        if (strstr(c, "position")) {
+            m[12 + axis] = vals[k]; /* the CMU roots have OFFSET 0: the channel is the position */
+        } else {
+            double a = vals[k] * 3.14159265358979323846 / 180.0, cs = cos(a), sn = sin(a);
+            double r[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+            int u = (axis + 1) % 3, v = (axis + 2) % 3;
+            r[u * 4 + u] = cs;
+            r[u * 4 + v] = sn;
+            r[v * 4 + u] = -sn;
+            r[v * 4 + v] = cs;
+            mat_mul4d(m, r, m);
+        }
+    }
+    if (jt->parent >= 0) {
+        double p[16];
+        bvh_world(b, jt->parent, f, p);
+        mat_mul4d(p, m, m);
+    }
+    memcpy(out, m, sizeof m);
+}
+
+static void check_bvh(const char* rel) {
+    char path[2048];
+    if (!ak_test_asset(path, sizeof path, rel)) {
+        AK_SKIP("%s absent", rel);
+        return;
+    }
+    bvh_file* b = (bvh_file*)calloc(1, sizeof *b);
+    AK_CHECK(bvh_parse(path, b));
+    ak_scene* s = load(path, NULL);
+    AK_CHECK(s != NULL);
+    if (!s) {
+        free(b->motion);
+        free(b);
+        return;
+    }
+    AK_CHECK_EQ(ak_scene_joint_count(s), b->joints + b->end_sites);
+    AK_CHECK_EQ(s->mesh_count, 0); /* the bone-visualisation mesh is dropped by default */
+    AK_CHECK_EQ(s->clip_count, 1);
+    const ak_clip* clip = s->clips[0];
+    int root = ak_skeleton_find_joint(s->skeleton, b->j[0].name);
+    AK_CHECK(root >= 0);
+    /* The root's rotation channel: one key per frame, frame_time apart. */
+    const ak_track* rt = NULL;
+    for (size_t c = 0; c < ak_clip_channel_count(clip); ++c)
+        if (ak_clip_channel_index(clip, c) == (uint32_t)root && ak_clip_channel_target(clip, c) == AK_CHANNEL_ROTATION)
+            rt = ak_clip_channel_track(clip, c);
+    AK_CHECK(rt != NULL);
+    if (rt) {
+        ak_f32_cspan times = ak_track_times(rt);
+        AK_CHECK_EQ(times.count, b->frames);
+        AK_CHECK_NEAR(times.ptr[1] - times.ptr[0], b->frame_time, 1e-6);
+        AK_CHECK_NEAR(times.ptr[times.count - 1], (b->frames - 1) * b->frame_time, 1e-4);
+    }
+    AK_CHECK_NEAR(ak_clip_duration(clip), (b->frames - 1) * b->frame_time, 1e-3);
+    /* World positions of every joint at a few frames against the hand FK. */
+    size_t n = ak_scene_joint_count(s);
+    ak_transform* local = (ak_transform*)malloc(n * sizeof *local);
+    ak_mat4* world = (ak_mat4*)malloc(n * sizeof *world);
+    int frames[3] = {1, b->frames / 2, b->frames - 1};
+    double worst = 0.0;
+    for (int fi = 0; fi < 3 && rt; ++fi) {
+        int f = frames[fi];
+        ak_scene_rest_pose(s, (ak_transform_span){local, n});
+        ak_clip_sample(clip, ak_track_times(rt).ptr[f], NULL, (ak_transform_span){local, n}, (ak_f32_span){NULL, 0},
+                       (ak_f32_span){NULL, 0});
+        ak_scene_world_matrices(s, (ak_transform_cspan){local, n}, (ak_mat4_span){world, n});
+        for (int j = 0; j < b->count; ++j) {
+            if (!strcmp(b->j[j].name, "Site")) continue;
+            int k = ak_skeleton_find_joint(s->skeleton, b->j[j].name);
+            if (k < 0) {
+                AK_FAIL_("%s: joint %s not found", rel, b->j[j].name);
+                continue;
+            }
+            double m[16];
+            bvh_world(b, j, f, m);
+            for (int e = 0; e < 3; ++e) worst = fmax(worst, fabs(world[k].m[12 + e] - m[12 + e]));
+        }
+    }
+    printf("  %s: %d joints, %d frames, max world position error %.3g\n", rel, b->joints, b->frames, worst);
+    AK_CHECK_MSG(worst < 2e-3, "%s: world positions differ from the hand FK by %.3g", rel, worst);
+    free(local);
+    free(world);
+    ak_scene_destroy(s);
+    free(b->motion);
+    free(b);
+}
+
+AK_TEST(bvh_header_and_fk) {
+    check_bvh("bvh/49_04.bvh");  /* ZYX everywhere, CRLF */
+    check_bvh("bvh/131_03.bvh"); /* ZXY on the arms, CRLF */
+}
+
+/* ---- OBJ through Assimp ------------------------------------------------------------------ */
+
+AK_TEST(obj_through_assimp) {
+    char path[2048];
+    if (!ak_test_asset(path, sizeof path, "obj/makehuman/base.obj")) {
+        AK_SKIP("obj/makehuman/base.obj absent");
+        return;
+    }
+    /* Independent count: each "f" line of n corners becomes n vertices and n - 2 triangles. */
+    size_t size;
+    char* text = (char*)slurp(path, &size);
+    size_t corners = 0, tris = 0;
+    for (char* line = text; line && *line;) {
+        char* nl = strchr(line, '\n');
+        if (line[0] == 'f' && line[1] == ' ') {
+            size_t n = 0;
+            for (char* p = line + 1; p < (nl ? nl : line + strlen(line)); ++p)
+                if (*p != ' ' && (p[-1] == ' ')) ++n;
+            corners += n;
+            tris += n - 2;
+        }
+        line = nl ? nl + 1 : NULL;
+    }
+    free(text);
+    ak_scene* s = load(path, NULL);
+    AK_CHECK(s != NULL);
+    if (!s) return;
+    size_t v = 0, t = 0;
+    for (size_t m = 0; m < s->mesh_count; ++m) {
+        v += s->meshes[m].mesh->vertex_count;
+        t += s->meshes[m].mesh->triangle_count;
+    }
+    AK_CHECK_EQ(v, corners);
+    AK_CHECK_EQ(t, tris);
+    AK_CHECK_EQ(s->clip_count, 0);
+    ak_scene_destroy(s);
+}
+
+/* ---- synthetic glTF documents ----------------------------------------------------------- */
+
+/* Load a glTF JSON text in which "@BUF@" stands for a base64 data URI of bin. */
+static ak_result load_doc(const char* json, const void* bin, size_t bin_size, const ak_io_desc* desc, ak_scene** out,
+                          ak_diag* diag) {
+    char* b64 = b64_encode(bin, bin_size);
+    size_t cap = strlen(json) + strlen(b64) + 64;
+    char* text = (char*)malloc(cap);
+    const char* at = strstr(json, "@BUF@");
+    if (at) snprintf(text, cap, "%.*sdata:application/octet-stream;base64,%s%s", (int)(at - json), json, b64, at + 5);
+    else snprintf(text, cap, "%s", json);
+    ak_result r = ak_io_load_memory(text, strlen(text), "test.gltf", NULL, desc, NULL, out, diag);
+    free(text);
+    free(b64);
+    return r;
+}
+
+static ak_result load_expect(const char* json, const void* bin, size_t bin_size, ak_result want) {
+    ak_scene* s = NULL;
+    ak_diag diag;
+    memset(&diag, 0, sizeof diag);
+    ak_result r = load_doc(json, bin, bin_size, NULL, &s, &diag);
+    if (r != want) printf("  got %s (%s), wanted %s\n", ak_result_name(r), diag.message, ak_result_name(want));
+    if (r != AK_OK) {
+        AK_CHECK(s == NULL);
+        AK_CHECK(diag.message[0] != 0);
+        AK_CHECK_STREQ(diag.path, "test.gltf");
+    }
+    ak_scene_destroy(s);
+    return r;
+}
+
+/* One triangle: positions (3 x vec3 float, 36 bytes) then u16 indices 0,1,2 (6 bytes, +2 pad). */
+typedef struct tri_bin {
+    float pos[9];
+    uint16_t idx[4];
+} tri_bin;
+
+static const tri_bin k_tri = {{0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2, 0}};
+
+#define TRI_BUFFERS                                                                                         \
+    "\"buffers\":[{\"byteLength\":44,\"uri\":\"@BUF@\"}],"                                                 \
+    "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+
+#define TRI_ACCESSORS                                                                                       \
+    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"              \
+    "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}],"
+
+AK_TEST(malformed_gltf_exact_codes) {
+    const char* asset = "\"asset\":{\"version\":\"2.0\"}";
+    char doc_text[4096];
+    /* JSON and header problems */
+    load_expect("", NULL, 0, AK_ERR_PARSE);
+    load_expect("{\"asset\":{\"version\":\"2.0\"}", NULL, 0, AK_ERR_PARSE); /* unterminated */
+    load_expect("[1,2]", NULL, 0, AK_ERR_PARSE);
+    load_expect("{}", NULL, 0, AK_ERR_PARSE); /* no asset */
+    load_expect("{\"asset\":{\"version\":\"1.0\"}}", NULL, 0, AK_ERR_UNSUPPORTED);
+    load_expect("{\"asset\":{\"version\":\"2.0\"},\"extensionsRequired\":[\"KHR_draco_mesh_compression\"]}", NULL, 0,
+                AK_ERR_UNSUPPORTED);
+    AK_CHECK_EQ(load_expect("{\"asset\":{\"version\":\"2.0\"}}", NULL, 0, AK_OK), AK_OK); /* empty but valid */
+    load_expect("{\"asset\":{\"version\":\"2.0\"},\"nodes\":{}}", NULL, 0, AK_ERR_PARSE);
+    load_expect("{\"asset\":{\"version\":\"2.0\"},\"scene\":0}", NULL, 0, AK_ERR_BAD_INDEX);
+    /* nodes */
+    snprintf(doc_text, sizeof doc_text, "{%s,\"nodes\":[{\"children\":[5]}]}", asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_BAD_INDEX);
+    snprintf(doc_text, sizeof doc_text, "{%s,\"nodes\":[{\"children\":[1]},{\"children\":[0]}]}", asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_BAD_HIERARCHY); /* cycle */
+    snprintf(doc_text, sizeof doc_text, "{%s,\"nodes\":[{\"children\":[2]},{\"children\":[2]},{}]}", asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_BAD_HIERARCHY); /* two parents */
+    snprintf(doc_text, sizeof doc_text, "{%s,\"nodes\":[{\"translation\":[0,1e999,0]}]}", asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_BAD_DATA);
+    snprintf(doc_text, sizeof doc_text, "{%s,\"nodes\":[{\"rotation\":[0,0,0,0]}]}", asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_BAD_DATA);
+    snprintf(doc_text, sizeof doc_text, "{%s,\"nodes\":[{\"matrix\":[1,0,0,0]}]}", asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_PARSE);
+    snprintf(doc_text, sizeof doc_text, "{%s,\"nodes\":[{\"mesh\":0}]}", asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_BAD_INDEX);
+    /* a valid triangle, then broken variants of it */
+    const char* mesh = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+                       "\"nodes\":[{\"mesh\":0}]";
+    snprintf(doc_text, sizeof doc_text, "{%s," TRI_BUFFERS TRI_ACCESSORS "%s}", asset, mesh);
+    AK_CHECK_EQ(load_expect(doc_text, &k_tri, sizeof k_tri, AK_OK), AK_OK);
+    tri_bin bad = k_tri;
+    bad.idx[2] = 3; /* vertex index out of range */
+    load_expect(doc_text, &bad, sizeof bad, AK_ERR_BAD_INDEX);
+    bad = k_tri;
+    bad.pos[4] = NAN;
+    load_expect(doc_text, &bad, sizeof bad, AK_ERR_BAD_DATA);
+    load_expect(doc_text, &k_tri, 20, AK_ERR_PARSE); /* buffer shorter than byteLength */
+    /* accessor past its bufferView */
+    snprintf(doc_text, sizeof doc_text,
+             "{%s," TRI_BUFFERS
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}",
+             asset);
+    load_expect(doc_text, &k_tri, sizeof k_tri, AK_ERR_BAD_INDEX);
+    /* bufferView past its buffer */
+    snprintf(doc_text, sizeof doc_text,
+             "{%s,\"buffers\":[{\"byteLength\":44,\"uri\":\"@BUF@\"}],\"bufferViews\":[{\"buffer\":0,\"byteOffset\":40,"
+             "\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}",
+             asset);
+    load_expect(doc_text, &k_tri, sizeof k_tri, AK_ERR_BAD_INDEX);
+    /* bad accessor type and component type */
+    snprintf(doc_text, sizeof doc_text,
+             "{%s," TRI_BUFFERS "\"accessors\":[{\"bufferView\":0,\"componentType\":5127,\"count\":3,\"type\":\"VEC3\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}",
+             asset);
+    load_expect(doc_text, &k_tri, sizeof k_tri, AK_ERR_PARSE);
+    /* bad base64 */
+    snprintf(doc_text, sizeof doc_text,
+             "{%s,\"buffers\":[{\"byteLength\":4,\"uri\":\"data:application/octet-stream;base64,AB!D\"}]," 
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":4}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":1,\"type\":\"SCALAR\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}",
+             asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_PARSE);
+    /* external buffer without a base directory */
+    snprintf(doc_text, sizeof doc_text,
+             "{%s,\"buffers\":[{\"byteLength\":4,\"uri\":\"missing.bin\"}],\"bufferViews\":[{\"buffer\":0,"
+             "\"byteLength\":4}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":1,\"type\":"
+             "\"SCALAR\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}",
+             asset);
+    load_expect(doc_text, NULL, 0, AK_ERR_IO);
+}
+
+/* A skinned triangle: positions, u16 indices, u8 joints, float weights; skin of `slots` joints. */
+typedef struct skin_bin {
+    float pos[9];
+    uint16_t idx[4];
+    uint8_t joints[12];
+    float weights[12];
+    float ibm[32];
+} skin_bin;
+
+static void skin_doc(char* out, size_t cap, int slots) {
+    snprintf(out, cap,
+             "{\"asset\":{\"version\":\"2.0\"},"
+             "\"buffers\":[{\"byteLength\":%zu,\"uri\":\"@BUF@\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6},"
+             "{\"buffer\":0,\"byteOffset\":44,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":56,\"byteLength\":48},"
+             "{\"buffer\":0,\"byteOffset\":104,\"byteLength\":128}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"},"
+             "{\"bufferView\":2,\"componentType\":5121,\"count\":3,\"type\":\"VEC4\"},"
+             "{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"
+             "{\"bufferView\":4,\"componentType\":5126,\"count\":%d,\"type\":\"MAT4\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":2,\"WEIGHTS_0\":3},"
+             "\"indices\":1}]}],"
+             "\"skins\":[{\"joints\":[%s],\"inverseBindMatrices\":4}],"
+             "\"nodes\":[{\"mesh\":0,\"skin\":0},{\"name\":\"a\",\"children\":[2]},{\"name\":\"b\",\"translation\":[0,1,0]}]}",
+             sizeof(skin_bin), slots, slots == 2 ? "1,2" : "1");
+}
+
+static skin_bin make_skin_bin(void) {
+    skin_bin b;
+    memset(&b, 0, sizeof b);
+    memcpy(b.pos, k_tri.pos, sizeof b.pos);
+    memcpy(b.idx, k_tri.idx, sizeof b.idx);
+    for (int v = 0; v < 3; ++v) {
+        b.joints[4 * v] = 0;
+        b.joints[4 * v + 1] = 1;
+        b.weights[4 * v] = 0.75f;
+        b.weights[4 * v + 1] = 0.25f;
+    }
+    for (int k = 0; k < 2; ++k)
+        for (int e = 0; e < 16; e += 5) b.ibm[16 * k + e] = 1.0f;
+    b.ibm[16 + 13] = -1.0f; /* joint b sits at y = 1 */
+    return b;
+}
+
+AK_TEST(gltf_skin_weights_and_slots) {
+    char text[4096];
+    skin_bin b = make_skin_bin();
+    skin_doc(text, sizeof text, 2);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_doc(text, &b, sizeof b, NULL, &s, &diag), AK_OK);
+    if (s) {
+        AK_CHECK_EQ(s->skin_count, 1);
+        AK_CHECK_EQ(s->skins[0].joints[0], ak_skeleton_find_joint(s->skeleton, "a"));
+        AK_CHECK_EQ(s->skins[0].joints[1], ak_skeleton_find_joint(s->skeleton, "b"));
+        AK_CHECK_NEAR(s->skins[0].inverse_binds[1].m[13], -1.0f, 0);
+        const ak_mesh* m = s->meshes[0].mesh;
+        AK_CHECK_EQ(m->influence_count, 4);
+        AK_CHECK_NEAR(m->weights[0], 0.75f, 1e-7);
+        AK_CHECK_NEAR(m->weights[1], 0.25f, 1e-7);
+        AK_CHECK_EQ(m->joints[1], 1);
+        AK_CHECK_EQ(s->meshes[0].skin, 0);
+        AK_CHECK(s->is_joint && s->is_joint[s->skins[0].joints[1]] && !s->is_joint[s->meshes[0].node]);
+        /* Skeleton inverse binds come from the skin. */
+        AK_CHECK_NEAR(ak_skeleton_inverse_binds(s->skeleton).ptr[s->skins[0].joints[1]].m[13], -1.0f, 0);
+        ak_scene_destroy(s);
+    }
+    /* max_influences = 1: the larger weight kept, renormalised to 1. */
+    ak_io_desc one = {.max_influences = 1};
+    s = NULL;
+    AK_CHECK_EQ(load_doc(text, &b, sizeof b, &one, &s, &diag), AK_OK);
+    if (s) {
+        AK_CHECK_EQ(s->meshes[0].mesh->influence_count, 1);
+        AK_CHECK_NEAR(s->meshes[0].mesh->weights[0], 1.0f, 1e-6);
+        AK_CHECK_EQ(s->meshes[0].mesh->joints[0], 0);
+        ak_scene_destroy(s);
+    }
+    /* A weight on a slot the skin does not have. */
+    skin_doc(text, sizeof text, 1);
+    load_expect(text, &b, sizeof b, AK_ERR_BAD_INDEX);
+    /* A zero weight on a missing slot is harmless (its joint index becomes 0). */
+    skin_bin z = b;
+    for (int v = 0; v < 3; ++v) {
+        z.weights[4 * v] = 1.0f;
+        z.weights[4 * v + 1] = 0.0f;
+    }
+    AK_CHECK_EQ(load_expect(text, &z, sizeof z, AK_OK), AK_OK);
+    /* Negative weights. */
+    z.weights[0] = -1.0f;
+    load_expect(text, &z, sizeof z, AK_ERR_BAD_WEIGHTS);
+}
+
+/* Feature file: interleaved (byteStride) positions + normals, normalized u8 weights with
+ * JOINTS_1/WEIGHTS_1, a sparse accessor, a matrix node, a strip, STEP and CUBICSPLINE samplers,
+ * morph targets with weights animation and names. */
+typedef struct feat_bin {
+    float inter[4 * 6];      /* 0: 4 vertices x (pos, normal), stride 24 */
+    uint8_t j0[16], j1[16];  /* 96, 112 */
+    uint8_t w0[16], w1[16];  /* 128, 144: normalized u8 */
+    uint16_t sp_idx[2];      /* 160 */
+    float sp_val[6];         /* 164 */
+    float times[3];          /* 188 */
+    float cubic[3 * 3 * 3];  /* 200: 3 keys x (in, value, out) x vec3 */
+    float step[3 * 3];       /* 308 */
+    float morph_w[3 * 2];    /* 344 */
+    float ibm[16 * 8];       /* 368 */
+} feat_bin;
+
+AK_TEST(gltf_features) {
+    feat_bin b;
+    memset(&b, 0, sizeof b);
+    const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+    for (int v = 0; v < 4; ++v) {
+        memcpy(&b.inter[6 * v], p[v], 12);
+        b.inter[6 * v + 5] = 1.0f;
+        for (int k = 0; k < 4; ++k) {
+            b.j0[4 * v + k] = (uint8_t)k;
+            b.j1[4 * v + k] = (uint8_t)(4 + k);
+        }
+        /* weights 51,51,51,0 | 102,0,0,0 (u8/255): the largest is slot 4 (0.4) */
+        b.w0[4 * v] = b.w0[4 * v + 1] = b.w0[4 * v + 2] = 51;
+        b.w1[4 * v] = 102;
+    }
+    b.sp_idx[0] = 1;
+    b.sp_idx[1] = 3;
+    const float spv[6] = {0, 0, 1, 0, 0, 2};
+    memcpy(b.sp_val, spv, sizeof spv);
+    const float t[3] = {0.0f, 0.5f, 2.0f};
+    memcpy(b.times, t, sizeof t);
+    for (int i = 0; i < 27; ++i) b.cubic[i] = (float)i;
+    for (int i = 0; i < 9; ++i) b.step[i] = (float)(i + 1);
+    const float mw[6] = {0, 1, 0.5f, 0.5f, 1, 0};
+    memcpy(b.morph_w, mw, sizeof mw);
+    for (int k = 0; k < 8; ++k)
+        for (int e = 0; e < 16; e += 5) b.ibm[16 * k + e] = 1.0f;
+    char text[8192];
+    snprintf(text, sizeof text,
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
+        "\"buffers\":[{\"byteLength\":%zu,\"uri\":\"@BUF@\"}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":96,\"byteStride\":24},"
+        "{\"buffer\":0,\"byteOffset\":96,\"byteLength\":32},{\"buffer\":0,\"byteOffset\":128,\"byteLength\":32},"
+        "{\"buffer\":0,\"byteOffset\":160,\"byteLength\":4},{\"buffer\":0,\"byteOffset\":164,\"byteLength\":24},"
+        "{\"buffer\":0,\"byteOffset\":188,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":200,\"byteLength\":108},"
+        "{\"buffer\":0,\"byteOffset\":308,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":344,\"byteLength\":24},"
+        "{\"buffer\":0,\"byteOffset\":368,\"byteLength\":512}],"
+        "\"accessors\":["
+        "{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"                       /* 0 pos */
+        "{\"bufferView\":0,\"byteOffset\":12,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"     /* 1 nrm */
+        "{\"bufferView\":1,\"componentType\":5121,\"count\":4,\"type\":\"VEC4\"},"                       /* 2 j0 */
+        "{\"bufferView\":1,\"byteOffset\":16,\"componentType\":5121,\"count\":4,\"type\":\"VEC4\"},"     /* 3 j1 */
+        "{\"bufferView\":2,\"componentType\":5121,\"normalized\":true,\"count\":4,\"type\":\"VEC4\"},"   /* 4 w0 */
+        "{\"bufferView\":2,\"byteOffset\":16,\"componentType\":5121,\"normalized\":true,\"count\":4,\"type\":\"VEC4\"}," /* 5 w1 */
+        "{\"componentType\":5126,\"count\":4,\"type\":\"VEC3\",\"sparse\":{\"count\":2,"
+        "\"indices\":{\"bufferView\":3,\"componentType\":5123},\"values\":{\"bufferView\":4}}},"        /* 6 morph delta */
+        "{\"bufferView\":5,\"componentType\":5126,\"count\":3,\"type\":\"SCALAR\",\"max\":[2.0]},"      /* 7 times */
+        "{\"bufferView\":6,\"componentType\":5126,\"count\":9,\"type\":\"VEC3\"},"                       /* 8 cubic */
+        "{\"bufferView\":7,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"                       /* 9 step */
+        "{\"bufferView\":8,\"componentType\":5126,\"count\":6,\"type\":\"SCALAR\"},"                     /* 10 weights */
+        "{\"bufferView\":9,\"componentType\":5126,\"count\":8,\"type\":\"MAT4\"}],"                      /* 11 ibm */
+        "\"meshes\":[{\"name\":\"quad\",\"weights\":[0.25,0.5],\"extras\":{\"targetNames\":[\"up\",\"down\"]},"
+        "\"primitives\":[{\"mode\":5,\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"JOINTS_0\":2,\"JOINTS_1\":3,"
+        "\"WEIGHTS_0\":4,\"WEIGHTS_1\":5},\"targets\":[{\"POSITION\":6},{\"POSITION\":6}]}]}],"
+        "\"skins\":[{\"joints\":[1,2,3,4,5,6,7,8],\"inverseBindMatrices\":11}],"
+        "\"nodes\":[{\"name\":\"m\",\"mesh\":0,\"skin\":0},"
+        "{\"name\":\"r\",\"children\":[2],\"matrix\":[0,1,0,0, -2,0,0,0, 0,0,2,0, 5,6,7,1]},"
+        "{\"name\":\"c\",\"children\":[3]},{\"children\":[4]},{\"children\":[5]},{\"children\":[6]},{\"name\":\"r\","
+        "\"children\":[7]},{\"children\":[8]},{}],"
+        "\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":2,\"path\":\"translation\"}},"
+        "{\"sampler\":1,\"target\":{\"node\":3,\"path\":\"scale\"}},{\"sampler\":2,\"target\":{\"node\":0,\"path\":\"weights\"}}],"
+        "\"samplers\":[{\"input\":7,\"output\":8,\"interpolation\":\"CUBICSPLINE\"},{\"input\":7,\"output\":9,"
+        "\"interpolation\":\"STEP\"},{\"input\":7,\"output\":10}]}]}",
+        sizeof b);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    ak_result r = load_doc(text, &b, sizeof b, NULL, &s, &diag);
+    AK_CHECK_EQ(r, AK_OK);
+    if (r != AK_OK) {
+        printf("  %s\n", diag.message);
+        return;
+    }
+    /* names: duplicates and nameless nodes */
+    AK_CHECK(ak_skeleton_find_joint(s->skeleton, "r") >= 0);
+    AK_CHECK(ak_skeleton_find_joint(s->skeleton, "r#6") >= 0);
+    AK_CHECK(ak_skeleton_find_joint(s->skeleton, "node_3") >= 0);
+    /* matrix node: columns (0,1,0)*1, (-2,0,0)... -> rotation 90 deg about z, scale (1,2,2) */
+    ak_transform rt = ak_skeleton_rest_pose(s->skeleton).ptr[ak_skeleton_find_joint(s->skeleton, "r")];
+    AK_CHECK_NEAR(rt.translation.x, 5, 1e-6);
+    AK_CHECK_NEAR(rt.translation.z, 7, 1e-6);
+    AK_CHECK_NEAR(rt.scale.x, 1, 1e-6);
+    AK_CHECK_NEAR(rt.scale.y, 2, 1e-6);
+    AK_CHECK_NEAR(rt.scale.z, 2, 1e-6);
+    ak_vec3 xr = ak_quat_rotate(rt.rotation, ak_vec3_make(1, 0, 0));
+    AK_CHECK_NEAR(xr.y, 1, 1e-6);
+    /* strip of 4 vertices -> triangles (0,1,2), (1,3,2) */
+    const ak_mesh* m = s->meshes[0].mesh;
+    AK_CHECK_EQ(m->triangle_count, 2);
+    const uint32_t want_idx[6] = {0, 1, 2, 1, 3, 2};
+    for (int i = 0; i < 6; ++i) AK_CHECK_EQ(m->indices[i], want_idx[i]);
+    /* interleaved normals */
+    AK_CHECK_NEAR(m->normals[3].z, 1, 0);
+    AK_CHECK_NEAR(m->positions[3].x, 1, 0);
+    /* 8 influences (0.2,0.2,0.2,0,0.4,0,0,0) limited to 4: slot 4 first, then three 0.2 */
+    AK_CHECK_EQ(m->influence_count, 4);
+    AK_CHECK_EQ(m->joints[0], 4);
+    AK_CHECK_NEAR(m->weights[0], 0.4, 1e-6);
+    float sum = m->weights[0] + m->weights[1] + m->weights[2] + m->weights[3];
+    AK_CHECK_NEAR(sum, 1.0, 1e-6);
+    /* sparse morph delta: zeros except vertices 1 and 3 */
+    AK_CHECK_EQ(m->morph_target_count, 2);
+    AK_CHECK_NEAR(m->morph_positions[1].z, 1, 0);
+    AK_CHECK_NEAR(m->morph_positions[3].z, 2, 0);
+    AK_CHECK_NEAR(m->morph_positions[2].z, 0, 0);
+    AK_CHECK_NEAR(m->morph_positions[4 + 3].z, 2, 0);
+    AK_CHECK_NEAR(m->morph_weights[1], 0.5f, 0);
+    AK_CHECK_STREQ(m->morph_names[1], "down");
+    /* clip: interpolation kept, cubic tangents passed through, weights channel */
+    AK_CHECK_EQ(s->clip_count, 1);
+    const ak_clip* c = s->clips[0];
+    AK_CHECK_STREQ(ak_clip_name(c), "animation_0");
+    AK_CHECK_NEAR(ak_clip_duration(c), 2.0, 0);
+    AK_CHECK_EQ(ak_clip_channel_count(c), 3);
+    AK_CHECK_EQ(ak_clip_channel_interp(c, 0), AK_INTERP_CUBICSPLINE);
+    AK_CHECK_EQ(ak_clip_channel_interp(c, 1), AK_INTERP_STEP);
+    AK_CHECK_EQ(ak_clip_channel_target(c, 2), AK_CHANNEL_MORPH_WEIGHTS);
+    AK_CHECK_EQ(ak_clip_channel_index(c, 2), 0);
+    AK_CHECK_EQ(ak_clip_channel_index(c, 0), ak_skeleton_find_joint(s->skeleton, "c"));
+    float v[3], tin[3], tout[3];
+    ak_track_key(ak_clip_channel_track(c, 0), 1, (ak_f32_span)AK_SPAN(v), (ak_f32_span)AK_SPAN(tin),
+                 (ak_f32_span)AK_SPAN(tout));
+    /* key 1 = floats 9..17: in (9,10,11), value (12,13,14), out (15,16,17) */
+    AK_CHECK_NEAR(tin[0], 9, 0);
+    AK_CHECK_NEAR(v[1], 13, 0);
+    AK_CHECK_NEAR(tout[2], 17, 0);
+    /* STEP holds the previous key; weights channel at t = 0.25 is halfway (0,1)->(0.5,0.5) */
+    ak_vec3 scl[16];
+    ak_transform local[16];
+    float w[2] = {9, 9};
+    size_t n = ak_scene_joint_count(s);
+    ak_scene_rest_pose(s, (ak_transform_span){local, n});
+    ak_clip_sample(c, 0.25f, NULL, (ak_transform_span){local, n}, (ak_f32_span)AK_SPAN(w), (ak_f32_span){NULL, 0});
+    (void)scl;
+    int j3 = ak_skeleton_find_joint(s->skeleton, "node_3");
+    AK_CHECK_NEAR(local[j3].scale.x, 1, 0);
+    AK_CHECK_NEAR(w[0], 0.25, 1e-6);
+    AK_CHECK_NEAR(w[1], 0.75, 1e-6);
+    ak_scene_destroy(s);
+}
+
+/* ---- truncation -------------------------------------------------------------------------- */
+
+static int cut_everywhere(const char* rel, size_t step) {
+    char path[2048];
+    if (!ak_test_asset(path, sizeof path, rel)) return 0;
+    size_t size;
+    uint8_t* data = slurp(path, &size);
+    /* a .gltf stays valid JSON when only trailing whitespace is cut */
+    size_t valid_from = size;
+    if (data[0] == '{')
+        while (valid_from > 0 && data[valid_from - 1] != '}') --valid_from;
+    int failures = 0, cuts = 0;
+    for (size_t len = 0; len < valid_from; len += (len < 64 ? 1 : step)) {
+        ak_scene* s = NULL;
+        ak_result r = ak_io_load_memory(data, len, rel, NULL, NULL, NULL, &s, NULL);
+        if (r == AK_OK) ++failures;
+        ak_scene_destroy(s);
+        ++cuts;
+    }
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(data, size, rel, NULL, NULL, NULL, &s, NULL), AK_OK);
+    ak_scene_destroy(s);
+    AK_CHECK_MSG(failures == 0, "%s: %d of %d truncated copies loaded", rel, failures, cuts);
+    free(data);
+    return cuts;
+}
+
+AK_TEST(truncated_files_fail_cleanly) {
+    int cuts = 0;
+    cuts += cut_everywhere("gltf/SimpleSkin/glTF-Embedded/SimpleSkin.gltf", 1);
+    cuts += cut_everywhere("gltf/SimpleMorph/glTF-Embedded/SimpleMorph.gltf", 1);
+    cuts += cut_everywhere("gltf/AnimatedMorphCube/glTF-Binary/AnimatedMorphCube.glb", 1);
+    cuts += cut_everywhere("gltf/RiggedSimple/glTF-Binary/RiggedSimple.glb", 7);
+    if (cuts == 0) AK_SKIP("no glTF assets");
+    else printf("  %d truncated copies rejected\n", cuts);
+    /* GLB header lies */
+    uint8_t glb[12] = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 12, 0, 0, 0};
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(glb, 12, "x.glb", NULL, NULL, NULL, &s, NULL), AK_ERR_PARSE); /* no JSON chunk */
+    glb[8] = 200;
+    AK_CHECK_EQ(ak_io_load_memory(glb, 12, "x.glb", NULL, NULL, NULL, &s, NULL), AK_ERR_PARSE);
+    glb[4] = 1;
+    AK_CHECK_EQ(ak_io_load_memory(glb, 12, "x.glb", NULL, NULL, NULL, &s, NULL), AK_ERR_UNSUPPORTED);
+    AK_CHECK(s == NULL);
+}
+
+/* ---- files and arguments ------------------------------------------------------------------ */
+
+AK_TEST(load_arguments_and_missing_files) {
+    ak_scene* s = (ak_scene*)1;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(NULL, NULL, NULL, &s, &diag), AK_ERR_NULL_ARG);
+    AK_CHECK(s == NULL);
+    AK_CHECK_EQ(ak_io_load("x.gltf", NULL, NULL, NULL, &diag), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_io_load_memory(NULL, 5, NULL, NULL, NULL, NULL, &s, &diag), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_io_load("no/such/file.gltf", NULL, NULL, &s, &diag), AK_ERR_IO);
+    AK_CHECK_STREQ(diag.path, "no/such/file.gltf");
+    AK_CHECK_EQ(ak_io_load("no/such/file.bvh", NULL, NULL, &s, &diag), AK_ERR_IO);
+    ak_io_desc bvh = {.format = AK_IO_FORMAT_ASSIMP};
+    AK_CHECK_EQ(ak_io_load_memory("{}", 2, NULL, NULL, &bvh, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
+    /* Assimp rejects a garbage file: AK_ERR_PARSE with Assimp's message */
+    FILE* f = fopen("garbage.bvh", "wb");
+    fputs("HIERARCHY\nROOT x {\n OFFSET 1 2\n", f);
+    fclose(f);
+    AK_CHECK_EQ(ak_io_load("garbage.bvh", NULL, NULL, &s, &diag), AK_ERR_PARSE);
+    AK_CHECK(strstr(diag.message, "Assimp") != NULL);
+    AK_CHECK_STREQ(diag.path, "garbage.bvh");
+    remove("garbage.bvh");
+    /* external .bin missing next to a .gltf */
+    f = fopen("ext.gltf", "wb");
+    fputs("{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":4,\"uri\":\"ext%20missing.bin\"}],"
+          "\"bufferViews\":[{\"buffer\":0,\"byteLength\":4}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,"
+          "\"count\":1,\"type\":\"SCALAR\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}",
+          f);
+    fclose(f);
+    AK_CHECK_EQ(ak_io_load("ext.gltf", NULL, NULL, &s, &diag), AK_ERR_IO);
+    AK_CHECK(strstr(diag.message, "ext missing.bin") != NULL); /* percent-decoded */
+    remove("ext.gltf");
+}
+
+/* ---- OBJ writer -------------------------------------------------------------------------- */
+
+AK_TEST(obj_writer) {
+    char text[4096];
+    skin_bin b = make_skin_bin();
+    skin_doc(text, sizeof text, 2);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_doc(text, &b, sizeof b, NULL, &s, &diag), AK_OK);
+    if (!s) return;
+    AK_CHECK_EQ(ak_io_write_obj("io_test.obj", s, NULL, NULL, &diag), AK_OK);
+    size_t size;
+    char* out = (char*)slurp("io_test.obj", &size);
+    AK_CHECK(out && strstr(out, "o mesh_0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n") != NULL);
+    free(out);
+    /* posed positions and normals replace the stored ones */
+    ak_vec3 posed[3] = {{0.5f, 0, 0}, {1, 2, 3}, {-1, 0.25f, 0}};
+    ak_vec3 nrm[3] = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+    const ak_vec3* pp[1] = {posed};
+    const ak_vec3* np[1] = {nrm};
+    AK_CHECK_EQ(ak_io_write_obj("io_test.obj", s, pp, np, &diag), AK_OK);
+    out = (char*)slurp("io_test.obj", &size);
+    AK_CHECK(out && strstr(out, "v 0.5 0 0\nv 1 2 3\nv -1 0.25 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n"));
+    free(out);
+    posed[1].y = NAN;
+    AK_CHECK_EQ(ak_io_write_obj("io_test2.obj", s, pp, NULL, &diag), AK_ERR_BAD_DATA);
+    FILE* f = fopen("io_test2.obj", "rb");
+    AK_CHECK(f == NULL);
+    if (f) fclose(f);
+    AK_CHECK_EQ(ak_io_write_obj("no/such/dir/x.obj", s, NULL, NULL, &diag), AK_ERR_IO);
+    AK_CHECK_EQ(ak_io_write_obj(NULL, s, NULL, NULL, &diag), AK_ERR_NULL_ARG);
+    remove("io_test.obj");
+    ak_scene_destroy(s);
+}
+
+/* ---- allocator: every allocation failing in turn ------------------------------------------- */
+
+typedef struct fail_alloc {
+    int left;  /* allocations that succeed before one fails; < 0 -> never fail */
+    int live;
+} fail_alloc;
+
+static void* fa_alloc(size_t size, void* user) {
+    fail_alloc* f = (fail_alloc*)user;
+    if (f->left == 0) return NULL;
+    if (f->left > 0) --f->left;
+    ++f->live;
+    return malloc(size);
+}
+static void fa_free(void* p, void* user) {
+    --((fail_alloc*)user)->live;
+    free(p);
+}
+
+AK_TEST(allocation_failures) {
+    char text[4096];
+    skin_bin b = make_skin_bin();
+    skin_doc(text, sizeof text, 2);
+    char* b64 = b64_encode(&b, sizeof b);
+    char doc_text[8192];
+    const char* at = strstr(text, "@BUF@");
+    snprintf(doc_text, sizeof doc_text, "%.*sdata:application/octet-stream;base64,%s%s", (int)(at - text), text, b64,
+             at + 5);
+    free(b64);
+    int ok_at = -1;
+    for (int n = 0; n < 400 && ok_at < 0; ++n) {
+        fail_alloc fa = {n, 0};
+        ak_allocator a = {fa_alloc, fa_free, &fa};
+        ak_scene* s = NULL;
+        ak_result r = ak_io_load_memory(doc_text, strlen(doc_text), "t.gltf", NULL, NULL, &a, &s, NULL);
+        if (r == AK_OK) ok_at = n;
+        else AK_CHECK_MSG(r == AK_ERR_NO_MEMORY, "failing allocation %d gave %s", n, ak_result_name(r));
+        ak_scene_destroy(s);
+        AK_CHECK_MSG(fa.live == 0, "failing allocation %d leaked %d blocks", n, fa.live);
+    }
+    AK_CHECK(ok_at > 0);
+}
+
+int main(void) {
+    AK_RUN(desc_defaults);
+    AK_RUN(gltf_assets_match_their_json);
+    AK_RUN(gltf_variants_agree);
+    AK_RUN(gltf_bind_pose_fk);
+    AK_RUN(bvh_header_and_fk);
+    AK_RUN(obj_through_assimp);
+    AK_RUN(malformed_gltf_exact_codes);
+    AK_RUN(gltf_skin_weights_and_slots);
+    AK_RUN(gltf_features);
+    AK_RUN(truncated_files_fail_cleanly);
+    AK_RUN(load_arguments_and_missing_files);
+    AK_RUN(obj_writer);
+    AK_RUN(allocation_failures);
+    return ak_test_finish();
+}
