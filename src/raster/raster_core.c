@@ -16,13 +16,19 @@
 /* ---- private types ------------------------------------------------------------------ */
 
 #define MAXA 12          /* attributes per vertex */
-#define BATCH 1024       /* inputs per batch */
-#define OUT_PER_INPUT 7  /* worst case triangles from one clipped triangle */
 #define MAX_THREADS 64
 #define SUBPIX 256       /* fixed-point sub-sample units */
 #define GUARD 4.0f       /* guard band in NDC units: |x|, |y| <= GUARD * w */
 #define SHADOW_RES 256
 #define ROW_BLOCK_SHIFT 3
+#define TONE_LUT_SIZE 8192 /* covers linear [0, 2] */
+#define POW_LUT_SIZE 1024
+
+#if defined(__GNUC__)
+#define FORCE_INLINE inline __attribute__((always_inline))
+#else
+#define FORCE_INLINE inline
+#endif
 
 typedef enum frag_mode {
     FRAG_UNLIT_CONST = 0, /* flat[] colour as bytes (unlit), no attributes */
@@ -52,7 +58,12 @@ typedef struct rtri {
 } rtri;
 
 typedef struct drawctx drawctx;
-typedef void (*setup_fn)(const drawctx* dc, size_t input_index, rtri* out, size_t* out_count);
+/* Where set-up triangles go: straight to the rasterizer of the thread that made them. */
+typedef struct sink {
+    rtri t;
+    int ti, tc; /* this thread's index and the thread count */
+} sink;
+typedef void (*setup_fn)(const drawctx* dc, size_t input_index, sink* sk);
 
 struct drawctx {
     ak_raster* r;
@@ -72,6 +83,7 @@ struct drawctx {
     ak_vec3 base_lin;
     float base_alpha;
     float specular, shininess;
+    float pow_lut[POW_LUT_SIZE + 1]; /* specular * x^shininess for x in [0, 1] */
     ak_vec3 key_l, fill_l; /* unit vectors towards the lights */
     ak_vec3 key_c, fill_c, amb_c;
     float const_rgba[4];   /* FRAG_UNLIT_CONST bytes / FRAG_POINT linear colour */
@@ -98,23 +110,28 @@ struct ak_raster {
     int sw, sh, ss;
     uint8_t* color;   /* sw * sh * 4 */
     float* depth;     /* sw * sh */
-    rtri* tris;       /* BATCH * OUT_PER_INPUT + OUT_PER_INPUT * MAX_THREADS */
     float* shadow;    /* SHADOW_RES^2 */
     float* shadow_tmp;
     float to_srgb_lut[4097]; /* linear [0,1] -> sRGB byte (as float) */
     float to_lin_lut[256];   /* sRGB byte -> linear */
+    float tone_lut[TONE_LUT_SIZE + 1]; /* shaded linear [0, 2] -> sRGB byte, soft shoulder */
 };
 
 /* ---- small helpers -------------------------------------------------------------------- */
 
 static inline float clamp01(float x) { return x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x); }
 
+/* Shaded linear value -> sRGB byte through the tone curve (a soft shoulder above 0.8 keeps
+ * highlights from clipping flat). */
 static inline uint8_t enc(const ak_raster* r, float lin) {
-    /* soft shoulder above 0.8 keeps highlights from clipping flat */
-    if (lin > 0.8f) lin = 0.8f + 0.2f * (1.0f - expf(-(lin - 0.8f) * 5.0f));
     if (!(lin > 0.0f)) lin = 0.0f;
-    if (lin > 1.0f) lin = 1.0f;
-    return (uint8_t)r->to_srgb_lut[(int)(lin * 4096.0f + 0.5f)];
+    if (lin > 2.0f) lin = 2.0f;
+    return (uint8_t)r->tone_lut[(int)(lin * (TONE_LUT_SIZE / 2) + 0.5f)];
+}
+
+static float tone(float lin) {
+    if (lin > 0.8f) lin = 0.8f + 0.2f * (1.0f - expf(-(lin - 0.8f) * 5.0f));
+    return lin > 1.0f ? 1.0f : lin;
 }
 
 static ak_vec3 srgb3_to_lin(ak_vec4 c) {
@@ -190,11 +207,9 @@ ak_result ak_raster_create(const ak_raster_desc* desc, const ak_allocator* alloc
     if (d.supersample < 1 || d.supersample > 4 || d.thread_count < 1 || d.thread_count > MAX_THREADS)
         return AK_ERR_BAD_ARG;
     size_t sw = (size_t)d.width * (size_t)d.supersample, sh = (size_t)d.height * (size_t)d.supersample;
-    size_t ntri = (size_t)BATCH * OUT_PER_INPUT + (size_t)OUT_PER_INPUT * MAX_THREADS;
     size_t off_color = akp_align16(sizeof(ak_raster));
     size_t off_depth = off_color + akp_align16(sw * sh * 4u);
-    size_t off_tris = off_depth + akp_align16(sw * sh * sizeof(float));
-    size_t off_shadow = off_tris + akp_align16(ntri * sizeof(rtri));
+    size_t off_shadow = off_depth + akp_align16(sw * sh * sizeof(float));
     size_t off_tmp = off_shadow + akp_align16((size_t)SHADOW_RES * SHADOW_RES * sizeof(float));
     size_t total = off_tmp + (size_t)SHADOW_RES * SHADOW_RES * sizeof(float);
     uint8_t* mem = (uint8_t*)akp_alloc(alloc, total);
@@ -211,11 +226,12 @@ ak_result ak_raster_create(const ak_raster_desc* desc, const ak_allocator* alloc
     r->sh = (int)sh;
     r->color = mem + off_color;
     r->depth = (float*)(void*)(mem + off_depth);
-    r->tris = (rtri*)(void*)(mem + off_tris);
     r->shadow = (float*)(void*)(mem + off_shadow);
     r->shadow_tmp = (float*)(void*)(mem + off_tmp);
     for (int i = 0; i <= 4096; ++i) r->to_srgb_lut[i] = floorf(ak_linear_to_srgb((float)i / 4096.0f) * 255.0f + 0.5f);
     for (int i = 0; i < 256; ++i) r->to_lin_lut[i] = ak_srgb_to_linear((float)i / 255.0f);
+    for (int i = 0; i <= TONE_LUT_SIZE; ++i)
+        r->tone_lut[i] = floorf(ak_linear_to_srgb(tone(2.0f * (float)i / TONE_LUT_SIZE)) * 255.0f + 0.5f);
     memset(r->color, 0, sw * sh * 4u);
     for (size_t i = 0; i < sw * sh; ++i) {
         r->color[i * 4 + 3] = 255;
@@ -320,6 +336,8 @@ static void setup_lighting(drawctx* dc, const ak_raster_lighting* lighting, ak_r
     dc->shininess = mat.shininess > 0.0f ? mat.shininess : 32.0f;
     if (!ak_finitef(dc->specular)) dc->specular = 0.25f;
     if (!ak_finitef(dc->shininess)) dc->shininess = 32.0f;
+    for (int i = 0; i <= POW_LUT_SIZE; ++i)
+        dc->pow_lut[i] = dc->specular * powf((float)i / POW_LUT_SIZE, dc->shininess);
 }
 
 /* Lit linear colour for unit normal n at world point p with linear albedo alb. */
@@ -339,11 +357,23 @@ static inline ak_vec3 shade(const drawctx* dc, ak_vec3 n, ak_vec3 p, ak_vec3 alb
         ak_vec3 h = ak_vec3_normalize(ak_vec3_add(dc->key_l, v));
         float nh = ak_vec3_dot(n, h);
         if (nh > 0.0f) {
-            float s = dc->specular * powf(nh, dc->shininess);
+            float s = dc->pow_lut[(int)(ak_minf(nh, 1.0f) * POW_LUT_SIZE + 0.5f)];
             c = ak_vec3_madd(c, dc->key_c, s);
         }
     }
     return c;
+}
+
+static void raster_tri(const drawctx* dc, const rtri* t, int ti, int tc);
+
+/* Whether thread ti of tc owns any row in [y0, y1] (8-row blocks dealt out round-robin). */
+static inline bool rows_owned(int y0, int y1, int ti, int tc) {
+    if (tc <= 1) return true;
+    int b0 = y0 >> ROW_BLOCK_SHIFT, b1 = y1 >> ROW_BLOCK_SHIFT;
+    if (b1 - b0 + 1 >= tc) return true;
+    for (int b = b0; b <= b1; ++b)
+        if (b % tc == ti) return true;
+    return false;
 }
 
 /* ---- clipping and setup ------------------------------------------------------------------ */
@@ -370,7 +400,7 @@ static void lerp_vert(const cvert* a, const cvert* b, float t, int na, cvert* ou
 
 /* Project, snap and set up one screen triangle; degenerate ones produce nothing. */
 static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1, const cvert* v2, int front,
-                             const float flat[4], rtri* out, size_t* out_count) {
+                             const float flat[4], sink* sk) {
     const ak_raster* r = dc->r;
     const cvert* v[3] = {v0, v1, v2};
     double sx[3], sy[3];
@@ -394,7 +424,7 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
         o[2] = 1;
         area = -area;
     }
-    rtri* t = &out[*out_count];
+    rtri* t = &sk->t;
     int64_t X[3] = {fx[o[0]], fx[o[1]], fx[o[2]]}, Y[3] = {fy[o[0]], fy[o[1]], fy[o[2]]};
     for (int i = 0; i < 3; ++i) {
         int a = (i + 1) % 3, b = (i + 2) % 3; /* edge opposite vertex i */
@@ -420,6 +450,7 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
     if (x1 >= r->sw) x1 = r->sw - 1;
     if (y1 >= r->sh) y1 = r->sh - 1;
     if (x0 > x1 || y0 > y1) return;
+    if (!rows_owned((int)y0, (int)y1, sk->ti, sk->tc)) return;
     t->x0 = (int)x0;
     t->x1 = (int)x1;
     t->y0 = (int)y0;
@@ -440,16 +471,16 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
     }
     if (flat) memcpy(t->flat, flat, sizeof t->flat);
     t->front = front;
-    ++*out_count;
+    raster_tri(dc, t, sk->ti, sk->tc);
 }
 
 /* Clip a clip-space triangle against near/far and the guard band, then set up the pieces. */
 static void clip_and_setup(const drawctx* dc, const cvert* a, const cvert* b, const cvert* c, int front,
-                           const float flat[4], rtri* out, size_t* out_count) {
+                           const float flat[4], sink* sk) {
     unsigned oa = outcode(a->c), ob = outcode(b->c), oc = outcode(c->c);
     if (oa & ob & oc) return;
     if ((oa | ob | oc) == 0) {
-        setup_screen_tri(dc, a, b, c, front, flat, out, out_count);
+        setup_screen_tri(dc, a, b, c, front, flat, sk);
         return;
     }
     cvert buf[2][12];
@@ -477,7 +508,7 @@ static void clip_and_setup(const drawctx* dc, const cvert* a, const cvert* b, co
         n = m;
         cur ^= 1;
     }
-    for (int i = 1; i + 1 < n; ++i) setup_screen_tri(dc, &buf[cur][0], &buf[cur][i], &buf[cur][i + 1], front, flat, out, out_count);
+    for (int i = 1; i + 1 < n; ++i) setup_screen_tri(dc, &buf[cur][0], &buf[cur][i], &buf[cur][i + 1], front, flat, sk);
 }
 
 /* ---- fragments ------------------------------------------------------------------------ */
@@ -526,9 +557,10 @@ static inline float smoothstep(float e0, float e1, float x) {
 }
 
 /* Compute the fragment colour; returns false to discard. */
-static inline bool fragment(const drawctx* dc, const rtri* t, const float* a, uint8_t out[4], const uint8_t* dst) {
+static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri* t, const float* a, uint8_t out[4],
+                                  const uint8_t* dst) {
     const ak_raster* r = dc->r;
-    switch (dc->mode) {
+    switch (mode) {
     case FRAG_UNLIT_CONST:
         for (int k = 0; k < 4; ++k) out[k] = (uint8_t)dc->const_rgba[k];
         return true;
@@ -623,7 +655,8 @@ static inline bool fragment(const drawctx* dc, const rtri* t, const float* a, ui
     return false;
 }
 
-static void raster_tri(const drawctx* dc, const rtri* t, int thread_index, int thread_count) {
+static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, const rtri* t, int thread_index,
+                                         int thread_count) {
     ak_raster* r = dc->r;
     const int na = dc->attr_count;
     for (int y = t->y0; y <= t->y1; ++y) {
@@ -660,9 +693,21 @@ static void raster_tri(const drawctx* dc, const rtri* t, int thread_index, int t
             }
             uint8_t src[4];
             uint8_t* px = crow + (size_t)x * 4u;
-            if (!fragment(dc, t, a, src, px)) continue;
+            if (!fragment(dc, mode, t, a, src, px)) continue;
             write_px(dc, px, &zrow[x], z, src);
         }
+    }
+}
+
+static void raster_tri(const drawctx* dc, const rtri* t, int ti, int tc) {
+    switch (dc->mode) {
+    case FRAG_UNLIT_CONST: raster_tri_mode(dc, FRAG_UNLIT_CONST, t, ti, tc); break;
+    case FRAG_UNLIT_VCOLOR: raster_tri_mode(dc, FRAG_UNLIT_VCOLOR, t, ti, tc); break;
+    case FRAG_FLAT: raster_tri_mode(dc, FRAG_FLAT, t, ti, tc); break;
+    case FRAG_GOURAUD: raster_tri_mode(dc, FRAG_GOURAUD, t, ti, tc); break;
+    case FRAG_PHONG: raster_tri_mode(dc, FRAG_PHONG, t, ti, tc); break;
+    case FRAG_POINT: raster_tri_mode(dc, FRAG_POINT, t, ti, tc); break;
+    case FRAG_GROUND: raster_tri_mode(dc, FRAG_GROUND, t, ti, tc); break;
     }
 }
 
@@ -677,31 +722,15 @@ typedef struct gate {
 typedef struct worker {
     const drawctx* dc;
     int index, count;
-    pthread_barrier_t* barrier;
-    size_t* seg_count; /* [count] */
-    size_t seg_cap;
     gate* gate;
 } worker;
 
 static void run_worker(const worker* w) {
     const drawctx* dc = w->dc;
-    const size_t n = dc->input_count;
-    for (size_t start = 0; start < n; start += BATCH) {
-        size_t len = n - start < BATCH ? n - start : BATCH;
-        size_t chunk = (len + (size_t)w->count - 1) / (size_t)w->count;
-        size_t b = start + chunk * (size_t)w->index, e = b + chunk;
-        if (e > start + len) e = start + len;
-        rtri* seg = dc->r->tris + w->seg_cap * (size_t)w->index;
-        size_t cnt = 0;
-        for (size_t i = b; i < e; ++i) dc->setup(dc, i, seg, &cnt);
-        w->seg_count[w->index] = cnt;
-        if (w->count > 1) pthread_barrier_wait(w->barrier);
-        for (int s = 0; s < w->count; ++s) {
-            const rtri* tr = dc->r->tris + w->seg_cap * (size_t)s;
-            for (size_t i = 0; i < w->seg_count[s]; ++i) raster_tri(dc, &tr[i], w->index, w->count);
-        }
-        if (w->count > 1) pthread_barrier_wait(w->barrier);
-    }
+    sink sk;
+    sk.ti = w->index;
+    sk.tc = w->count;
+    for (size_t i = 0; i < dc->input_count; ++i) dc->setup(dc, i, &sk);
 }
 
 static void* worker_main(void* p) {
@@ -714,28 +743,23 @@ static void* worker_main(void* p) {
     return NULL;
 }
 
-static void set_workers(worker* ws, int tc, const drawctx* dc, pthread_barrier_t* barrier, size_t* seg_count,
-                        gate* g) {
-    size_t seg_cap = tc == 1 ? (size_t)BATCH * OUT_PER_INPUT : ((BATCH + (size_t)tc - 1) / (size_t)tc) * OUT_PER_INPUT;
+static void set_workers(worker* ws, int tc, const drawctx* dc, gate* g) {
     for (int i = 0; i < tc; ++i) {
         ws[i].dc = dc;
         ws[i].index = i;
         ws[i].count = tc;
-        ws[i].barrier = barrier;
-        ws[i].seg_count = seg_count;
-        ws[i].seg_cap = seg_cap;
         ws[i].gate = g;
     }
 }
 
-/* Run a draw over up to desc.thread_count threads. Threads that cannot be started are simply
- * not used: the work is dealt out among those that did start. */
+/* Run a draw over up to desc.thread_count threads. Every thread sets up every input (cheap
+ * rejection first) and rasterizes only the rows it owns, so threads never write the same
+ * pixel and need no synchronisation. Threads that cannot be started are simply not used:
+ * the rows are dealt out among those that did start. */
 static void run_draw(const drawctx* dc) {
     int tc = dc->r->desc.thread_count;
     if (dc->input_count < 64) tc = 1; /* threads would cost more than they save */
-    size_t seg_count[MAX_THREADS];
     worker ws[MAX_THREADS];
-    pthread_barrier_t barrier;
     gate g;
     if (tc > 1 && pthread_mutex_init(&g.mu, NULL) != 0) tc = 1;
     if (tc > 1 && pthread_cond_init(&g.cv, NULL) != 0) {
@@ -743,35 +767,32 @@ static void run_draw(const drawctx* dc) {
         tc = 1;
     }
     if (tc == 1) {
-        set_workers(ws, 1, dc, NULL, seg_count, NULL);
+        set_workers(ws, 1, dc, NULL);
         run_worker(&ws[0]);
         return;
     }
     g.go = 0;
-    set_workers(ws, tc, dc, &barrier, seg_count, &g);
+    set_workers(ws, tc, dc, &g);
     pthread_t th[MAX_THREADS];
     int started = 1;
     for (int i = 1; i < tc; ++i) {
         if (pthread_create(&th[i], NULL, worker_main, &ws[i]) != 0) break;
         ++started;
     }
-    bool barrier_ok = started > 1 && pthread_barrier_init(&barrier, NULL, (unsigned)started) == 0;
-    int use = barrier_ok ? started : 1;
-    set_workers(ws, use, dc, &barrier, seg_count, &g);
+    set_workers(ws, started, dc, &g);
     pthread_mutex_lock(&g.mu);
-    g.go = barrier_ok ? 1 : -1;
+    g.go = 1;
     pthread_cond_broadcast(&g.cv);
     pthread_mutex_unlock(&g.mu);
     run_worker(&ws[0]);
     for (int i = 1; i < started; ++i) pthread_join(th[i], NULL);
-    if (barrier_ok) pthread_barrier_destroy(&barrier);
     pthread_cond_destroy(&g.cv);
     pthread_mutex_destroy(&g.mu);
 }
 
 /* ---- meshes ------------------------------------------------------------------------------- */
 
-static void mesh_setup(const drawctx* dc, size_t ti, rtri* out, size_t* out_count) {
+static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
     const ak_raster_mesh* m = dc->mesh;
     uint32_t idx[3];
     if (m->indices.count) {
@@ -803,6 +824,18 @@ static void mesh_setup(const drawctx* dc, size_t ti, rtri* out, size_t* out_coun
     int front = det > 0.0f;
     if (det == 0.0f) return;
     if (dc->cull && !front) return;
+    if (sk->tc > 1 && v[0].c[3] > 0.0f && v[1].c[3] > 0.0f && v[2].c[3] > 0.0f) {
+        /* skip the attribute work when this thread owns none of the triangle's rows */
+        float ymin = 1e30f, ymax = -1e30f;
+        for (int k = 0; k < 3; ++k) {
+            float sy = (0.5f - 0.5f * v[k].c[1] / v[k].c[3]) * (float)dc->r->sh;
+            ymin = ak_minf(ymin, sy);
+            ymax = ak_maxf(ymax, sy);
+        }
+        if (ymax < 0.0f || ymin > (float)dc->r->sh) return;
+        if (!rows_owned((int)ak_maxf(ymin - 1.0f, 0.0f), (int)ak_minf(ymax + 1.0f, (float)dc->r->sh), sk->ti, sk->tc))
+            return;
+    }
     float flat[4] = {0, 0, 0, 1};
     ak_vec3 fn = ak_vec3_normalize(ak_vec3_cross(ak_vec3_sub(wp[1], wp[0]), ak_vec3_sub(wp[2], wp[0])));
     const bool has_n = m->normals.count > 0;
@@ -880,7 +913,7 @@ static void mesh_setup(const drawctx* dc, size_t ti, rtri* out, size_t* out_coun
     default:
         break;
     }
-    clip_and_setup(dc, &v[0], &v[1], &v[2], front, flat, out, out_count);
+    clip_and_setup(dc, &v[0], &v[1], &v[2], front, flat, sk);
 }
 
 static void base_ctx(drawctx* dc, ak_raster* r, const ak_raster_camera* cam, const ak_mat4* model) {
@@ -956,9 +989,9 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
 
 /* ---- lines and points ------------------------------------------------------------------- */
 
-static void emit_quad(const drawctx* dc, const cvert q[4], const float flat[4], rtri* out, size_t* out_count) {
-    setup_screen_tri(dc, &q[0], &q[1], &q[2], 1, flat, out, out_count);
-    setup_screen_tri(dc, &q[0], &q[2], &q[3], 1, flat, out, out_count);
+static void emit_quad(const drawctx* dc, const cvert q[4], const float flat[4], sink* sk) {
+    setup_screen_tri(dc, &q[0], &q[1], &q[2], 1, flat, sk);
+    setup_screen_tri(dc, &q[0], &q[2], &q[3], 1, flat, sk);
 }
 
 /* A screen-space vertex (NDC x, y, z; w = 1) as a cvert. */
@@ -972,7 +1005,7 @@ static cvert ndc_vert(float x, float y, float z) {
     return v;
 }
 
-static void line_setup(const drawctx* dc, size_t si, rtri* out, size_t* out_count) {
+static void line_setup(const drawctx* dc, size_t si, sink* sk) {
     const ak_raster_lines* l = dc->lines;
     uint32_t ia = l->indices.count ? l->indices.ptr[si * 2] : (uint32_t)(si * 2);
     uint32_t ib = l->indices.count ? l->indices.ptr[si * 2 + 1] : (uint32_t)(si * 2 + 1);
@@ -1039,7 +1072,7 @@ static void line_setup(const drawctx* dc, size_t si, rtri* out, size_t* out_coun
         q[k].a[2] = c.z;
         q[k].a[3] = c.w;
     }
-    emit_quad(dc, q, NULL, out, out_count);
+    emit_quad(dc, q, NULL, sk);
 }
 
 ak_result ak_raster_draw_lines(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_lines* lines) {
@@ -1069,7 +1102,7 @@ ak_result ak_raster_draw_lines(ak_raster* raster, const ak_raster_camera* camera
     return AK_OK;
 }
 
-static void point_setup(const drawctx* dc, size_t pi, rtri* out, size_t* out_count) {
+static void point_setup(const drawctx* dc, size_t pi, sink* sk) {
     const ak_raster_points* pt = dc->points;
     ak_vec3 p = pt->positions.ptr[pi];
     if (!ak_vec3_is_finite(p)) return;
@@ -1093,7 +1126,7 @@ static void point_setup(const drawctx* dc, size_t pi, rtri* out, size_t* out_cou
         q[k].a[0] = uv[k][0];
         q[k].a[1] = uv[k][1];
     }
-    emit_quad(dc, q, flat, out, out_count);
+    emit_quad(dc, q, flat, sk);
 }
 
 ak_result ak_raster_draw_points(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_points* points) {
@@ -1212,10 +1245,10 @@ static void box_blur(float* s, float* tmp, int radius) {
     }
 }
 
-static void ground_setup(const drawctx* dc, size_t ti, rtri* out, size_t* out_count) {
+static void ground_setup(const drawctx* dc, size_t ti, sink* sk) {
     const cvert* q = dc->quad;
-    if (ti == 0) clip_and_setup(dc, &q[0], &q[1], &q[2], 1, NULL, out, out_count);
-    else clip_and_setup(dc, &q[0], &q[2], &q[3], 1, NULL, out, out_count);
+    if (ti == 0) clip_and_setup(dc, &q[0], &q[1], &q[2], 1, NULL, sk);
+    else clip_and_setup(dc, &q[0], &q[2], &q[3], 1, NULL, sk);
 }
 
 ak_result ak_raster_draw_ground(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_ground* ground) {
