@@ -548,9 +548,12 @@ static double bind_pose_error(const char* path, const char* bind_node) {
         if ((!bind_node || bn >= 0) && doc_floats(&d, jint(skin, "inverseBindMatrices", -1), 16, ibm)) {
             worst = 0.0;
             for (int k = 0; k < jc; ++k) {
-                double m[16], inv[16];
+                double m[16], inv[16] = {0};
                 for (int e = 0; e < 16; ++e) m[e] = ibm[16 * k + e];
-                if (!inverse4d(m, inv)) worst = 1e30;
+                if (!inverse4d(m, inv)) {
+                    worst = 1e30;
+                    continue;
+                }
                 mat_mul4d(place, inv, inv);
                 const ak_mat4* w = &world[s->skins[0].joints[k]];
                 double scale = 0.0;
@@ -1199,13 +1202,39 @@ static int cut_everywhere(const char* rel, size_t step) {
     if (data[0] == '{')
         while (valid_from > 0 && data[valid_from - 1] != '}') --valid_from;
     int failures = 0, cuts = 0;
+    bool glb = size >= 12 && memcmp(data, "glTF", 4) == 0;
+    uint8_t* copy = (uint8_t*)malloc(size);
     for (size_t len = 0; len < valid_from; len += (len < 64 ? 1 : step)) {
         ak_scene* s = NULL;
         ak_result r = ak_io_load_memory(data, len, rel, NULL, NULL, NULL, &s, NULL);
         if (r == AK_OK) ++failures;
         ak_scene_destroy(s);
         ++cuts;
+        if (glb && len >= 12) {
+            /* the same cut with the header's length field fixed, so the chunk checks run */
+            memcpy(copy, data, len);
+            uint32_t l32 = (uint32_t)len;
+            for (int k = 0; k < 4; ++k) copy[8 + k] = (uint8_t)(l32 >> (8 * k));
+            s = NULL;
+            r = ak_io_load_memory(copy, len, rel, NULL, NULL, NULL, &s, NULL);
+            if (r == AK_OK) ++failures;
+            ak_scene_destroy(s);
+            ++cuts;
+        }
     }
+    /* Random byte corruption: any outcome but a crash, a leak or a NaN in the scene. */
+    ak_rng rng = ak_rng_make(7);
+    for (int trial = 0; trial < 300; ++trial) {
+        memcpy(copy, data, size);
+        for (int k = 0; k < 4; ++k) copy[ak_rng_u32(&rng) % size] = (uint8_t)ak_rng_u32(&rng);
+        ak_scene* s = NULL;
+        if (ak_io_load_memory(copy, size, rel, NULL, NULL, NULL, &s, NULL) == AK_OK) {
+            for (size_t m = 0; m < s->mesh_count; ++m)
+                AK_CHECK(ak_mesh_validate(s->meshes[m].mesh, NULL) == AK_OK);
+        }
+        ak_scene_destroy(s);
+    }
+    free(copy);
     ak_scene* s = NULL;
     AK_CHECK_EQ(ak_io_load_memory(data, size, rel, NULL, NULL, NULL, &s, NULL), AK_OK);
     ak_scene_destroy(s);
