@@ -29,11 +29,20 @@ static inline ak_vec3 mat_unrotate(const float* m, ak_vec3 v) {
     return r;
 }
 
-/* Half-angle quaternion about unit axis from the full angle's cosine and the sign of its sine. */
+/* Half-angle quaternion about unit axis from the full angle's (cos, sin), c^2 + s^2 = 1. The
+ * larger of cos(a/2), sin(a/2) comes from a square root and the other from
+ * sin(a) = 2 sin(a/2) cos(a/2), so small angles keep their precision (sqrt(1 - c) alone
+ * would quantise them to ~3e-4 rad in float). */
 static inline ak_quat half_angle(ak_vec3 axis, float c, float s) {
-    float ch = sqrtf(ak_maxf(0.5f + 0.5f * c, 0.0f));
-    float sh = sqrtf(ak_maxf(0.5f - 0.5f * c, 0.0f));
-    if (s < 0.0f) sh = -sh;
+    float ch, sh;
+    if (c >= 0.0f) {
+        ch = sqrtf(0.5f + 0.5f * c);
+        sh = 0.5f * s / ch;
+    } else {
+        sh = sqrtf(ak_maxf(0.5f - 0.5f * c, 0.0f));
+        if (s < 0.0f) sh = -sh;
+        ch = 0.5f * s / sh;
+    }
     return ak_quat_make(axis.x * sh, axis.y * sh, axis.z * sh, ch);
 }
 
@@ -123,7 +132,7 @@ bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* o
             const ak_vec3 pp = ak_vec3_madd(job->pole, k, -ak_vec3_dot(k, job->pole));
             const float c = ak_vec3_dot(mp, pp), sn = ak_vec3_dot(k, ak_vec3_cross(mp, pp));
             const float r = sqrtf(c * c + sn * sn);
-            if (r > 1e-20f) q_start = ak_quat_mul(half_angle(k, c / r, sn), q_start);
+            if (r > 1e-20f) q_start = ak_quat_mul(half_angle(k, c / r, sn / r), q_start);
         }
         if (job->twist != 0.0f) q_start = ak_quat_mul(ak_quat_from_axis_angle(k, job->twist), q_start);
     }
