@@ -242,12 +242,13 @@ static inline ak_quat ak_quat_slerp(ak_quat a, ak_quat b, float t) {
         d = -d;
     }
     if (d > 0.9999995f) return ak_quat_nlerp(a, b, t);
-    /* atan2 of the chord lengths is accurate for all angles, unlike acos near 1. */
+    /* atan2 of the chord lengths is accurate for all angles, unlike acos near 1. The usual
+     * 1/sin(theta) factor is left out: the normalisation below removes any common scale. */
     ak_quat diff = ak_quat_make(b.x - a.x * d, b.y - a.y * d, b.z - a.z * d, b.w - a.w * d);
     float s = ak_quat_norm(diff);
     float theta = atan2f(s, d);
-    float wa = sinf((1.0f - t) * theta) / sinf(theta);
-    float wb = sinf(t * theta) / sinf(theta);
+    float wa = sinf((1.0f - t) * theta);
+    float wb = sinf(t * theta);
     return ak_quat_normalize(ak_quat_make(wa * a.x + wb * b.x, wa * a.y + wb * b.y,
                                           wa * a.z + wb * b.z, wa * a.w + wb * b.w));
 }
