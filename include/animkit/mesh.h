@@ -96,7 +96,9 @@ AK_API ak_result ak_mesh_compute_normals(ak_mesh* mesh);
 AK_API double ak_volume_compute(ak_vec3_cspan positions, ak_u32_cspan indices);
 
 /* True when every edge is shared by exactly two triangles that traverse it in opposite
- * directions (closed, manifold and consistently oriented). */
+ * directions (closed, edge-manifold and consistently oriented). Degenerate triangles (a
+ * repeated index), out-of-range indices and meshes without triangles give false. Sorts the
+ * 3 * triangle_count directed edges in temporary heap memory (malloc); false if that fails. */
 AK_API bool ak_mesh_is_closed_oriented(const ak_mesh* mesh);
 
 /* Check skin weights: each finite and >= 0, per-vertex sum within tolerance of 1
@@ -105,10 +107,11 @@ AK_API bool ak_mesh_is_closed_oriented(const ak_mesh* mesh);
 AK_API ak_result ak_mesh_validate_weights(const ak_mesh* mesh, size_t joint_count, float tolerance, ak_diag* diag);
 
 /* Clean a per-vertex weight array in place: NaN/negative -> 0, duplicate joints merged,
- * sorted by decreasing weight, weights below min_weight dropped (the largest always stays), at most max_influences
- * kept (0 -> 4), renormalised to sum to 1 (within 1e-6). A vertex whose weights are all zero
- * gets weight 1 on its first joint (documented fallback). influence_count is the array's
- * stride; slots past max_influences are zeroed. */
+ * sorted by decreasing weight (ties: lower joint first), at most max_influences kept
+ * (0 -> 4), weights below min_weight dropped (the largest always stays), renormalised to sum
+ * to 1 (within 1e-6). A vertex whose weights are all zero gets weight 1 on its first joint
+ * (documented fallback). influence_count is the array's stride; slots past the kept ones are
+ * zeroed (joint 0, weight 0). */
 AK_API void ak_weights_normalize(uint16_t* joints, float* weights, size_t vertex_count, uint32_t influence_count,
                                  uint32_t max_influences, float min_weight);
 

@@ -46,7 +46,9 @@ typedef enum ak_joint_type {
     AK_JOINT_TYPE_COUNT
 } ak_joint_type;
 
-/* Limits, all relative to the joint's rest (bind) local transform. */
+/* Limits, all relative to the joint's rest (bind) local transform. Rotations are measured
+ * as rel = rest.rotation^-1 * local.rotation, i.e. in the joint's own rest frame, where the
+ * axis is given; a prism slides along rest.rotation * axis in the parent's space. */
 typedef struct ak_joint_limits {
     ak_vec3 axis;      /* joint space: hinge rotation axis, prism slide axis, ball twist axis
                           (usually towards the child); zero -> (1,0,0) hinge/prism, (0,1,0) ball */
@@ -89,7 +91,9 @@ AK_API void ak_skeleton_destroy(ak_skeleton* skeleton);
  * their relative order where the hierarchy allows). parents[i] is the parent of joint i (-1 for
  * roots), in the input numbering. out_order[k] = input index of the joint placed at k.
  * Returns AK_ERR_BAD_HIERARCHY on a cycle or a parent index out of range,
- * AK_ERR_SPAN_SMALL when out_order.count < parents.count. */
+ * AK_ERR_SPAN_SMALL when out_order.count < parents.count, AK_ERR_NULL_ARG, AK_ERR_NO_MEMORY
+ * (an offline helper: it keeps one byte per joint of scratch on the C heap). A joint moves
+ * earlier only when a joint listed before it needs it as an ancestor. */
 AK_API ak_result ak_skeleton_reorder(ak_i32_cspan parents, ak_i32_span out_order);
 
 AK_API size_t ak_skeleton_joint_count(const ak_skeleton* skeleton);
@@ -123,18 +127,24 @@ AK_API ak_result ak_skeleton_local_to_model_batch(const ak_skeleton* skeleton, s
                                                   ak_transform_cspan local, ak_mat4_span out_model);
 
 /* Clamp a pose (local transforms, in place) to the joint types and limits: hinge joints keep
- * only the rotation about their axis relative to rest, clamped to [min, max]; ball joints get
- * their swing clamped to the cone and their twist to [twist_min, twist_max]; prism joints keep
- * the rest rotation and slide along their axis within [min, max]; free joints are unchanged.
+ * only the rotation about their axis relative to rest, clamped to [min, max] (an angle outside
+ * goes to the nearer end on the circle); ball joints get their swing clamped to the cone and
+ * their twist to [twist_min, twist_max]; prism joints keep the rest rotation and slide along
+ * their axis within [min, max]; free joints are unchanged. Hinge, ball and prism joints have
+ * no free translation: hinge and ball get the rest translation back. Scale is left as given.
  * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_skeleton_apply_limits(const ak_skeleton* skeleton, ak_transform_span pose);
 /* Clamp one joint's local transform (the routine ak_skeleton_apply_limits uses per joint). */
 AK_API ak_transform ak_skeleton_limit_joint(const ak_skeleton* skeleton, size_t joint_index, ak_transform local);
-/* True when the local transform satisfies its joint's limits within tol (radians / units). */
+/* True when the local transform satisfies its joint's limits within tol (radians / units):
+ * the same rules as the clamp (a hinge also needs its off-axis swing <= tol and translation
+ * within tol of rest). Free joints: always true. Out-of-range index or non-finite input: false. */
 AK_API bool ak_skeleton_joint_within_limits(const ak_skeleton* skeleton, size_t joint_index, ak_transform local,
                                             float tol);
 
-/* Decompose rotation q into swing * twist about unit axis (twist about axis, swing perpendicular). */
+/* Decompose rotation q into swing * twist about axis (normalised here): twist is a rotation
+ * about axis, swing one about an axis perpendicular to it (q = swing * twist, both unit).
+ * When q turns axis by exactly 180 degrees the twist is undefined: twist = identity. */
 AK_API void ak_quat_swing_twist(ak_quat q, ak_vec3 axis, ak_quat* out_swing, ak_quat* out_twist);
 
 /* True when every transform in the span is finite. */
