@@ -188,11 +188,11 @@ typedef enum ak_blend {
 /* Two directional lights plus ambient. Directions point FROM the light (the way the light
  * travels), world space, need not be unit. Colours are linear intensities. */
 typedef struct ak_raster_lighting {
-    ak_vec3 key_direction;  /* zero -> (0.45, -0.8, -0.35): from the upper left, in front */
+    ak_vec3 key_direction;  /* zero -> (0.4, -0.6, -0.7): from the upper left, in front */
     ak_vec3 key_color;      /* zero -> (1.05, 1.0, 0.94), warm white */
     ak_vec3 fill_direction; /* zero -> (-0.7, -0.25, -0.3): from the right, low */
-    ak_vec3 fill_color;     /* zero -> (0.26, 0.31, 0.42), cool; a tiny value for none */
-    ak_vec3 ambient_color;  /* zero -> (0.16, 0.18, 0.22), times 0.8..1 by normal.y */
+    ak_vec3 fill_color;     /* zero -> (0.30, 0.34, 0.44), cool; a tiny value for none */
+    ak_vec3 ambient_color;  /* zero -> (0.20, 0.22, 0.26), times 0.6..1 by normal.y */
 } ak_raster_lighting;
 
 /* The lighting with zero fields replaced by defaults; NULL gives the full default rig. */
@@ -218,7 +218,7 @@ typedef struct ak_raster_mesh {
     const ak_raster_lighting* lighting; /* NULL -> ak_raster_lighting_resolved(NULL) */
     ak_shading shading;      /* DEFAULT -> PHONG */
     ak_blend blend;          /* DEFAULT -> OPAQUE */
-    bool cull_back_faces;    /* false -> both sides drawn, back faces lit with the flipped normal */
+    bool cull_back_faces;    /* false -> both sides drawn and lit on the side facing the camera */
     bool no_depth_test;      /* false -> z-buffered; true -> always drawn (depth still written when opaque) */
 } ak_raster_mesh;
 

@@ -313,11 +313,11 @@ ak_raster_lighting ak_raster_lighting_resolved(const ak_raster_lighting* lightin
     ak_raster_lighting l;
     memset(&l, 0, sizeof l);
     if (lighting) l = *lighting;
-    if (vec3_is_zero(l.key_direction)) l.key_direction = ak_vec3_make(0.45f, -0.8f, -0.35f);
+    if (vec3_is_zero(l.key_direction)) l.key_direction = ak_vec3_make(0.4f, -0.6f, -0.7f);
     if (vec3_is_zero(l.key_color)) l.key_color = ak_vec3_make(1.05f, 1.0f, 0.94f);
     if (vec3_is_zero(l.fill_direction)) l.fill_direction = ak_vec3_make(-0.7f, -0.25f, -0.3f);
-    if (vec3_is_zero(l.fill_color)) l.fill_color = ak_vec3_make(0.26f, 0.31f, 0.42f);
-    if (vec3_is_zero(l.ambient_color)) l.ambient_color = ak_vec3_make(0.16f, 0.18f, 0.22f);
+    if (vec3_is_zero(l.fill_color)) l.fill_color = ak_vec3_make(0.30f, 0.34f, 0.44f);
+    if (vec3_is_zero(l.ambient_color)) l.ambient_color = ak_vec3_make(0.20f, 0.22f, 0.26f);
     return l;
 }
 
@@ -343,6 +343,8 @@ static void setup_lighting(drawctx* dc, const ak_raster_lighting* lighting, ak_r
 /* Lit linear colour for unit normal n at world point p with linear albedo alb. */
 static inline ak_vec3 shade(const drawctx* dc, ak_vec3 n, ak_vec3 p, ak_vec3 alb) {
     ak_vec3 v = dc->ortho ? ak_vec3_neg(dc->view_forward) : ak_vec3_normalize(ak_vec3_sub(dc->eye, p));
+    /* two-sided lighting: light the side that faces the viewer, whatever the winding says */
+    if (!dc->cull && ak_vec3_dot(n, v) < 0.0f) n = ak_vec3_neg(n);
     float kd = ak_vec3_dot(n, dc->key_l), fd = ak_vec3_dot(n, dc->fill_l);
     kd = kd > 0.0f ? kd : 0.0f;
     fd = fd > 0.0f ? fd : 0.0f;
@@ -581,7 +583,6 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri*
         return true;
     case FRAG_PHONG: {
         ak_vec3 n = ak_vec3_normalize(ak_vec3_make(a[3], a[4], a[5]));
-        if (!t->front) n = ak_vec3_neg(n);
         ak_vec3 alb = dc->base_lin;
         float alpha = dc->base_alpha;
         if (dc->has_vcolor) {
@@ -861,7 +862,7 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
         }
         break;
     case FRAG_FLAT: {
-        ak_vec3 n = front ? fn : ak_vec3_neg(fn);
+        ak_vec3 n = fn;
         ak_vec3 cen = ak_vec3_scale(ak_vec3_add(ak_vec3_add(wp[0], wp[1]), wp[2]), 1.0f / 3.0f);
         ak_vec3 alb = dc->base_lin;
         float alpha = dc->base_alpha;
@@ -881,7 +882,6 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
         for (int k = 0; k < 3; ++k) {
             ak_vec3 n = has_n ? ak_vec3_normalize(ak_mat3_mul_vec3(dc->normal_matrix, m->normals.ptr[idx[k]])) : fn;
             if (!ak_vec3_is_finite(n)) n = fn;
-            if (!front) n = ak_vec3_neg(n);
             ak_vec3 alb = dc->base_lin;
             if (dc->has_vcolor) alb = ak_vec3_mul(alb, srgb3_to_lin(vc[k]));
             ak_vec3 c = shade(dc, n, wp[k], alb);
