@@ -313,7 +313,7 @@ ak_result ak_blendshape_set_create(const ak_blendshape_set_desc* desc, const ak_
         size_t moved = 0;
         for (size_t i = 0; i < v; ++i) moved += delta_kept(d, n, i, t2);
         bool sparse = desc->storage == AK_BLENDSHAPE_STORAGE_SPARSE ||
-                      (desc->storage == AK_BLENDSHAPE_STORAGE_AUTO && moved * 4 <= v);
+                      (desc->storage == AK_BLENDSHAPE_STORAGE_AUTO && moved * 3 <= v);
         size_t rows = sparse ? moved : v;
         if (sparse) size += akp_align16(rows * sizeof(uint32_t));
         size += akp_align16(rows * sizeof(ak_vec3)) * (has_n ? 2u : 1u);
@@ -338,7 +338,7 @@ ak_result ak_blendshape_set_create(const ak_blendshape_set_desc* desc, const ak_
         size_t moved = 0;
         for (size_t i = 0; i < v; ++i) moved += delta_kept(d, n, i, t2);
         bool sparse = desc->storage == AK_BLENDSHAPE_STORAGE_SPARSE ||
-                      (desc->storage == AK_BLENDSHAPE_STORAGE_AUTO && moved * 4 <= v);
+                      (desc->storage == AK_BLENDSHAPE_STORAGE_AUTO && moved * 3 <= v);
         bs_target* tg = &set->targets[t];
         size_t rows = sparse ? moved : v;
         uint32_t* idx = NULL;

@@ -125,8 +125,9 @@ AK_API ak_result ak_blendshape_mesh_run(const ak_blendshape_mesh_job* job);
 /* ---- built sets: dense or sparse storage ------------------------------------------------ */
 
 typedef enum ak_blendshape_storage {
-    AK_BLENDSHAPE_STORAGE_AUTO = 0, /* default: per target, sparse when at most a quarter of the
-                                       vertices move, dense otherwise */
+    AK_BLENDSHAPE_STORAGE_AUTO = 0, /* default: per target, sparse when at most a third of the
+                                       vertices move, dense otherwise (bench_blendshape: sparse
+                                       wins up to roughly half) */
     AK_BLENDSHAPE_STORAGE_DENSE,    /* every target keeps all V deltas */
     AK_BLENDSHAPE_STORAGE_SPARSE,   /* every target keeps only its moving vertices */
     AK_BLENDSHAPE_STORAGE_COUNT

@@ -25,7 +25,7 @@
  *     ak_jiggle_joint tail[3] = { {.joint = 5, .tip = {0, 0, -0.2f}}, {.joint = 6, ...}, ... };
  *     ak_jiggle_state state[3] = {0};                     // zero -> starts at rest
  *     ak_jiggle_job job = {
- *         .params = { .stiffness = 150.0f, .damping = 6.0f, .gravity = {0, -9.81f, 0} },
+ *         .params = { .stiffness = 150.0f, .damping = 10.0f, .gravity = {0, -9.81f, 0} },
  *         .parents = ak_skeleton_parents(skeleton),
  *         .joints = tail, .joint_count = 3, .states = AK_SPAN(state),
  *         .model = { animated, joint_count },             // FK output of the animated pose
@@ -166,7 +166,10 @@ AK_API float ak_bounce_period(const ak_bounce_desc* desc);
 
 typedef struct ak_jiggle_params {
     float stiffness;        /* spring, 1/s^2 (omega^2: 100 -> ~1.6 Hz); 0 = no spring (pendulum) */
-    float damping;          /* 1/s (damping ratio = damping / (2 sqrt(stiffness))); 0 = none */
+    float damping;          /* 1/s (damping ratio = damping / (2 sqrt(stiffness))); 0 = none.
+                               Chained joints share one frequency, so each drives its child at
+                               resonance: light damping rings long down a tail; a ratio of
+                               0.4 or more is a good start for chains */
     ak_vec3 gravity;        /* model-space acceleration (m/s^2); zero -> none */
     float substep;          /* integration step (s); 0 -> 1/240; shortened so that
                                substep * sqrt(stiffness) <= 0.25 and substep * damping <= 0.25 */
