@@ -696,6 +696,8 @@ AK_TEST(arc_length_constant_speed) {
     AK_CHECK(path != NULL);
     if (!path) return;
     ak_arc_table* tab = NULL;
+    AK_CHECK_EQ(ak_arc_table_desc_resolved(NULL).cell_count, 256);
+    AK_CHECK_EQ(ak_arc_table_desc_resolved(&(ak_arc_table_desc){.cell_count = 9}).cell_count, 9);
     AK_CHECK_EQ(ak_arc_table_create(&(ak_arc_table_desc){.path = path}, NULL, &tab), AK_OK);
     if (!tab) return;
     /* Reference length: a fine polyline in double. */

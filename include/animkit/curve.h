@@ -237,6 +237,9 @@ typedef struct ak_arc_table_desc {
                              key segment is always used */
 } ak_arc_table_desc;
 
+/* The desc with its defaults filled in (cell_count 0 -> 256); desc NULL -> all defaults. */
+AK_API ak_arc_table_desc ak_arc_table_desc_resolved(const ak_arc_table_desc* desc);
+
 /* Build the table. Returns AK_ERR_NULL_ARG (desc, path or out NULL), AK_ERR_BAD_ARG (path not
  * a 3-component plain track, cell_count above 1 << 20), AK_ERR_NO_MEMORY. A path whose keys are
  * all equal has length 0 (time_at then returns the start time). */

@@ -151,13 +151,21 @@ bool ak_track_is_monotonic(const ak_track* tr) {
 
 /* ---- arc length --------------------------------------------------------------------- */
 
+ak_arc_table_desc ak_arc_table_desc_resolved(const ak_arc_table_desc* desc) {
+    ak_arc_table_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc) d = *desc;
+    if (d.cell_count == 0) d.cell_count = 256u;
+    return d;
+}
+
 ak_result ak_arc_table_create(const ak_arc_table_desc* desc, const ak_allocator* alloc, ak_arc_table** out) {
     if (out) *out = NULL;
     if (!desc || !desc->path || !out) return AK_ERR_NULL_ARG;
     const ak_track* path = desc->path;
     if (path->component_count != 3 || path->is_rotation) return AK_ERR_BAD_ARG;
     if (desc->cell_count > ((size_t)1 << 20)) return AK_ERR_BAD_ARG;
-    size_t want = desc->cell_count ? desc->cell_count : 256u;
+    size_t want = ak_arc_table_desc_resolved(desc).cell_count;
     size_t n = path->key_count, segs = n > 1 ? n - 1 : 1;
     double total_time = n > 1 ? (double)path->times[n - 1] - (double)path->times[0] : 0.0;
     /* Cells per segment proportional to its duration, at least one. */
