@@ -1224,9 +1224,17 @@ static int cut_everywhere(const char* rel, size_t step) {
     }
     /* Random byte corruption: any outcome but a crash, a leak or a NaN in the scene. */
     ak_rng rng = ak_rng_make(7);
-    for (int trial = 0; trial < 300; ++trial) {
+    size_t json_end = size; /* half the corruptions hit the JSON (a GLB's first chunk) */
+    if (glb && size >= 20) json_end = 20 + ((size_t)data[12] | (size_t)data[13] << 8 | (size_t)data[14] << 16);
+    if (json_end > size) json_end = size;
+    static const char alphabet[] = "0123456789{}[]\",:-.eE ";
+    for (int trial = 0; trial < 1500; ++trial) {
         memcpy(copy, data, size);
-        for (int k = 0; k < 4; ++k) copy[ak_rng_u32(&rng) % size] = (uint8_t)ak_rng_u32(&rng);
+        for (int k = 0; k < 4; ++k) {
+            uint32_t pick = ak_rng_u32(&rng);
+            if (pick & 1) copy[pick / 2 % json_end] = (uint8_t)alphabet[ak_rng_u32(&rng) % (sizeof alphabet - 1)];
+            else copy[pick / 2 % size] = (uint8_t)ak_rng_u32(&rng);
+        }
         ak_scene* s = NULL;
         if (ak_io_load_memory(copy, size, rel, NULL, NULL, NULL, &s, NULL) == AK_OK) {
             for (size_t m = 0; m < s->mesh_count; ++m)

@@ -84,6 +84,8 @@ static void warn(gl_ctx* c, const char* msg) {
     akp_log(&c->desc->logger, AK_LOG_WARN, buf);
 }
 
+#define NO_LIMIT ((size_t)-1)
+
 #define TRY(expr)                                                                          \
     do {                                                                                   \
         ak_result tr_ = (expr);                                                            \
@@ -113,14 +115,15 @@ static bool as_uint(const cJSON* v, size_t* out) {
 }
 
 /* Integer member: absent -> *out = dflt and AK_OK unless required (AK_ERR_PARSE); not a
- * non-negative integer -> AK_ERR_PARSE; >= limit -> AK_ERR_BAD_INDEX (limit 0: no limit). */
+ * non-negative integer -> AK_ERR_PARSE; >= limit -> AK_ERR_BAD_INDEX (NO_LIMIT: any value; a limit
+ * of 0, an empty array, rejects every index). */
 static ak_result get_uint(gl_ctx* c, const cJSON* obj, const char* key, const char* where, bool required,
                           size_t dflt, size_t limit, size_t* out) {
     const cJSON* v = cJSON_GetObjectItemCaseSensitive(obj, key);
     *out = dflt;
     if (!v) return required ? fail(c, AK_ERR_PARSE, "%s.%s is required", where, key) : AK_OK;
     if (!as_uint(v, out)) return fail(c, AK_ERR_PARSE, "%s.%s must be a non-negative integer", where, key);
-    if (limit && *out >= limit)
+    if (*out >= limit)
         return fail(c, AK_ERR_BAD_INDEX, "%s.%s = %zu is out of range (only %zu)", where, key, *out, limit);
     return AK_OK;
 }
@@ -239,7 +242,7 @@ static ak_result load_buffer(gl_ctx* c, size_t bi) {
     char where[160];
     snprintf(where, sizeof where, "buffers[%zu]", bi);
     size_t len = 0;
-    TRY(get_uint(c, b, "byteLength", where, true, 0, 0, &len));
+    TRY(get_uint(c, b, "byteLength", where, true, 0, NO_LIMIT, &len));
     if (len == 0) return fail(c, AK_ERR_PARSE, "%s.byteLength must be at least 1", where);
     const cJSON* uri_item = cJSON_GetObjectItemCaseSensitive(b, "uri");
     gl_buffer* gb = &c->bufs[bi];
@@ -306,9 +309,9 @@ static ak_result view_range(gl_ctx* c, size_t vi, const char* who, const uint8_t
     snprintf(where, sizeof where, "bufferViews[%zu]", vi);
     size_t bi = 0, off = 0, len = 0, stride = 0;
     TRY(get_uint(c, v, "buffer", where, true, 0, c->n_buffers, &bi));
-    TRY(get_uint(c, v, "byteOffset", where, false, 0, 0, &off));
-    TRY(get_uint(c, v, "byteLength", where, true, 0, 0, &len));
-    TRY(get_uint(c, v, "byteStride", where, false, 0, 0, &stride));
+    TRY(get_uint(c, v, "byteOffset", where, false, 0, NO_LIMIT, &off));
+    TRY(get_uint(c, v, "byteLength", where, true, 0, NO_LIMIT, &len));
+    TRY(get_uint(c, v, "byteStride", where, false, 0, NO_LIMIT, &stride));
     if (len == 0) return fail(c, AK_ERR_PARSE, "%s.byteLength must be at least 1", where);
     if (cJSON_GetObjectItemCaseSensitive(v, "byteStride") && (stride < 4 || stride > 252 || stride % 4))
         return fail(c, AK_ERR_PARSE, "%s.byteStride %zu must be a multiple of 4 in [4, 252]", where, stride);
@@ -328,9 +331,9 @@ static ak_result resolve_accessor(gl_ctx* c, size_t ai, gl_acc* a) {
     char where[160];
     snprintf(where, sizeof where, "accessors[%zu]", ai);
     size_t ctype = 0, off = 0;
-    TRY(get_uint(c, j, "componentType", where, true, 0, 0, &ctype));
-    TRY(get_uint(c, j, "count", where, true, 0, 0, &a->count));
-    TRY(get_uint(c, j, "byteOffset", where, false, 0, 0, &off));
+    TRY(get_uint(c, j, "componentType", where, true, 0, NO_LIMIT, &ctype));
+    TRY(get_uint(c, j, "count", where, true, 0, NO_LIMIT, &a->count));
+    TRY(get_uint(c, j, "byteOffset", where, false, 0, NO_LIMIT, &off));
     a->ctype = (int)ctype;
     a->csize = ctype_size(a->ctype);
     if (a->csize == 0) return fail(c, AK_ERR_PARSE, "%s.componentType %zu is not a glTF component type", where, ctype);
@@ -384,7 +387,7 @@ static ak_result resolve_accessor(gl_ctx* c, size_t ai, gl_acc* a) {
         char sw[200];
         snprintf(sw, sizeof sw, "%s.sparse", where);
         if (!cJSON_IsObject(sp)) return fail(c, AK_ERR_PARSE, "%s is not an object", sw);
-        TRY(get_uint(c, sp, "count", sw, true, 0, 0, &a->sparse_count));
+        TRY(get_uint(c, sp, "count", sw, true, 0, NO_LIMIT, &a->sparse_count));
         if (a->sparse_count == 0 || a->sparse_count > a->count)
             return fail(c, AK_ERR_PARSE, "%s.count %zu must be in [1, %zu]", sw, a->sparse_count, a->count);
         const cJSON* idx = cJSON_GetObjectItemCaseSensitive(sp, "indices");
@@ -396,10 +399,10 @@ static ak_result resolve_accessor(gl_ctx* c, size_t ai, gl_acc* a) {
         snprintf(vw, sizeof vw, "%s.values", sw);
         size_t ivi = 0, ioff = 0, ict = 0, vvi = 0, voff = 0;
         TRY(get_uint(c, idx, "bufferView", iw, true, 0, c->n_views, &ivi));
-        TRY(get_uint(c, idx, "byteOffset", iw, false, 0, 0, &ioff));
-        TRY(get_uint(c, idx, "componentType", iw, true, 0, 0, &ict));
+        TRY(get_uint(c, idx, "byteOffset", iw, false, 0, NO_LIMIT, &ioff));
+        TRY(get_uint(c, idx, "componentType", iw, true, 0, NO_LIMIT, &ict));
         TRY(get_uint(c, val, "bufferView", vw, true, 0, c->n_views, &vvi));
-        TRY(get_uint(c, val, "byteOffset", vw, false, 0, 0, &voff));
+        TRY(get_uint(c, val, "byteOffset", vw, false, 0, NO_LIMIT, &voff));
         if (ict != GL_UNSIGNED_BYTE && ict != GL_UNSIGNED_SHORT && ict != GL_UNSIGNED_INT)
             return fail(c, AK_ERR_PARSE, "%s.componentType must be an unsigned integer type", iw);
         a->sparse_idx_type = (int)ict;
