@@ -471,13 +471,8 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
     const size_t np = (size_t)g.nx * (size_t)g.ny * (size_t)g.nz;
     double* f = (double*)akp_alloc(alloc, np * sizeof(double));
     g.edge_vert = (int32_t*)akp_calloc(alloc, 7 * np * sizeof(int32_t));
-    /* Generous bounds for the output (a surface cell yields at most 6 * 2 triangles). */
-    g.vert_cap = np / 2 + 1024;
-    g.tri_cap = np + 2048;
-    g.verts = (ak_vec3*)akp_alloc(alloc, g.vert_cap * sizeof(ak_vec3));
-    g.tris = (uint32_t*)akp_alloc(alloc, 3 * g.tri_cap * sizeof(uint32_t));
     ak_result r = AK_OK;
-    if (!f || !g.edge_vert || !g.verts || !g.tris) {
+    if (!f || !g.edge_vert) {
         r = AK_ERR_NO_MEMORY;
         goto done;
     }
@@ -486,6 +481,32 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
         for (int j = 0; j < g.ny; ++j)
             for (int i = 0; i < g.nx; ++i)
                 f[grid_index(&g, i, j, k)] = body_field(h, g.x0 + hstep * i, g.y0 + hstep * j, g.z0 + hstep * k);
+    /* Exact output bounds: one vertex per sign-changing edge (lower end, direction 1..7),
+     * at most two triangles per tetrahedron with mixed signs. */
+    for (int k = 0; k < g.nz; ++k)
+        for (int j = 0; j < g.ny; ++j)
+            for (int i = 0; i < g.nx; ++i) {
+                const bool in0 = f[grid_index(&g, i, j, k)] < 0.0;
+                for (int c = 1; c < 8; ++c) {
+                    int i1 = i + (c & 1), j1 = j + ((c >> 1) & 1), k1 = k + ((c >> 2) & 1);
+                    if (i1 < g.nx && j1 < g.ny && k1 < g.nz) g.vert_cap += in0 != (f[grid_index(&g, i1, j1, k1)] < 0.0);
+                }
+                if (i + 1 == g.nx || j + 1 == g.ny || k + 1 == g.nz) continue;
+                for (int t = 0; t < 6; ++t) {
+                    int n_in = 0;
+                    for (int v = 0; v < 4; ++v) {
+                        int c = kuhn_tets[t][v];
+                        n_in += f[grid_index(&g, i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] < 0.0;
+                    }
+                    if (n_in > 0 && n_in < 4) g.tri_cap += 2;
+                }
+            }
+    g.verts = (ak_vec3*)akp_alloc(alloc, (g.vert_cap ? g.vert_cap : 1) * sizeof(ak_vec3));
+    g.tris = (uint32_t*)akp_alloc(alloc, 3 * (g.tri_cap ? g.tri_cap : 1) * sizeof(uint32_t));
+    if (!g.verts || !g.tris) {
+        r = AK_ERR_NO_MEMORY;
+        goto done;
+    }
     for (int k = 0; k + 1 < g.nz; ++k)
         for (int j = 0; j + 1 < g.ny; ++j)
             for (int i = 0; i + 1 < g.nx; ++i)
