@@ -243,8 +243,8 @@ typedef struct ak_root_motion_desc {
  * key's value:
  *   *out_in_place: a copy of the clip whose root translation is (p0.x, p(t).y, p0.z);
  *   *out_trajectory: a 3-component track with (p(t).x - p0.x, 0, p(t).z - p0.z) in the
- *   root's parent space, same keys and curve shape (CARDINAL, NATURAL and BEZIER become
- *   HERMITE with their derived tangents), so in_place + trajectory = original exactly up to
+ *   root's parent space, same keys and curve shape (the cubic modes become HERMITE with
+ *   their tangents), so in_place + trajectory = original exactly up to
  *   float rounding. Rotation (turning) is not extracted.
  * A clip without a translation channel on the root gives an unchanged copy and a one-key
  * zero trajectory. desc NULL -> defaults. alloc (NULL -> malloc/free) allocates both; free

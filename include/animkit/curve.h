@@ -242,7 +242,8 @@ AK_API ak_arc_table_desc ak_arc_table_desc_resolved(const ak_arc_table_desc* des
 
 /* Build the table. Returns AK_ERR_NULL_ARG (desc, path or out NULL), AK_ERR_BAD_ARG (path not
  * a 3-component plain track, cell_count above 1 << 20), AK_ERR_NO_MEMORY. A path whose keys are
- * all equal has length 0 (time_at then returns the start time). */
+ * all equal, or a STEP path (it jumps, it does not travel), has length 0 (time_at then returns
+ * the start time). */
 AK_API ak_result ak_arc_table_create(const ak_arc_table_desc* desc, const ak_allocator* alloc,
                                      ak_arc_table** out_table);
 /* Free; NULL is a no-op. */
