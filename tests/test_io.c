@@ -292,6 +292,21 @@ static void check_gltf_file(const char* path) {
         AK_CHECK_MSG(bad_rest == 0, "%s: %d rest translations differ", path, bad_rest);
     }
 
+    /* is_joint: exactly the nodes some skin lists. */
+    if (bad_joint == 0 && n_nodes) {
+        int bad = 0;
+        AK_CHECK(s->is_joint != NULL);
+        for (int i = 0; s->is_joint && i < n_nodes; ++i) {
+            bool listed = false;
+            for (int k = 0; k < jsize(root, "skins"); ++k) {
+                const cJSON* e;
+                cJSON_ArrayForEach(e, jget(jat(root, "skins", k), "joints")) listed = listed || e->valueint == i;
+            }
+            bad += s->is_joint[joint[i]] != listed;
+        }
+        AK_CHECK_MSG(bad == 0, "%s: %d joints with the wrong is_joint flag", path, bad);
+    }
+
     /* Skins. */
     AK_CHECK_EQ(s->skin_count, jsize(root, "skins"));
     for (int k = 0; k < jsize(root, "skins") && k < (int)s->skin_count; ++k) {
@@ -932,6 +947,35 @@ AK_TEST(malformed_gltf_exact_codes) {
              "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}",
              asset);
     load_expect(doc_text, NULL, 0, AK_ERR_PARSE);
+    /* animations: unsorted times, a node path animated twice, no usable channel */
+    {
+        const float anim[12] = {0, 1, 2, 0, 0, 0, 1, 1, 1, 2, 2, 2};
+        const char* fmt = "{%s,\"buffers\":[{\"byteLength\":48,\"uri\":\"@BUF@\"}],"
+                          "\"bufferViews\":[{\"buffer\":0,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":12,"
+                          "\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,"
+                          "\"type\":\"SCALAR\"},{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":"
+                          "\"VEC3\"}],\"nodes\":[{}],\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1}],"
+                          "\"channels\":[%s]}]}";
+        const char* one = "{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}";
+        snprintf(doc_text, sizeof doc_text, fmt, asset, one);
+        AK_CHECK_EQ(load_expect(doc_text, anim, sizeof anim, AK_OK), AK_OK);
+        float unsorted[12];
+        memcpy(unsorted, anim, sizeof anim);
+        unsorted[2] = 0.5f;
+        load_expect(doc_text, unsorted, sizeof unsorted, AK_ERR_UNSORTED);
+        char two[512];
+        snprintf(two, sizeof two, "%s,%s", one, one);
+        snprintf(doc_text, sizeof doc_text, fmt, asset, two);
+        load_expect(doc_text, anim, sizeof anim, AK_ERR_DUPLICATE);
+        snprintf(doc_text, sizeof doc_text, fmt, asset, "{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"pointer\"}}");
+        load_expect(doc_text, anim, sizeof anim, AK_ERR_UNSUPPORTED);
+        snprintf(doc_text, sizeof doc_text, fmt, asset, "{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"rotation\"}}");
+        load_expect(doc_text, anim, sizeof anim, AK_ERR_PARSE); /* 3 values per key for a rotation */
+        snprintf(doc_text, sizeof doc_text, fmt, asset, "{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"weights\"}}");
+        load_expect(doc_text, anim, sizeof anim, AK_ERR_PARSE); /* node without morph targets */
+        snprintf(doc_text, sizeof doc_text, fmt, asset, "{\"sampler\":1,\"target\":{\"node\":0,\"path\":\"scale\"}}");
+        load_expect(doc_text, anim, sizeof anim, AK_ERR_BAD_INDEX);
+    }
     /* external buffer without a base directory */
     snprintf(doc_text, sizeof doc_text,
              "{%s,\"buffers\":[{\"byteLength\":4,\"uri\":\"missing.bin\"}],\"bufferViews\":[{\"buffer\":0,"

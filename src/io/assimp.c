@@ -401,7 +401,8 @@ static ak_result convert(as_ctx* c) {
             r = make_mesh(c, am, m, &sm->mesh);
         }
     }
-    if (r == AK_OK && skin_total) {
+    /* BVH nodes are all joints (is_joint NULL); elsewhere only the nodes bones name are. */
+    if (r == AK_OK && (skin_total || !is_bvh(c->path))) {
         size_t nj = ak_scene_joint_count(c->scene);
         c->scene->is_joint = (bool*)akp_calloc(&c->scene->alloc, (nj ? nj : 1) * sizeof(bool));
         if (!c->scene->is_joint) r = AK_ERR_NO_MEMORY;

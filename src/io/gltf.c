@@ -765,7 +765,7 @@ static ak_result load_nodes_and_skins(gl_ctx* c, const gl_table* nodes) {
     for (size_t si = 0; si < scene->skin_count; ++si)
         for (size_t j = 0; j < scene->skins[si].joint_count; ++j)
             scene->skins[si].joints[j] = c->joint_of_node[scene->skins[si].joints[j]];
-    if (n && scene->skin_count) {
+    if (n) { /* without skins every node is a plain node */
         scene->is_joint = (bool*)akp_calloc(a, n * sizeof(bool));
         if (!scene->is_joint) {
             r = fail(c, AK_ERR_NO_MEMORY, "out of memory");
@@ -1285,7 +1285,7 @@ static ak_result load_animation(gl_ctx* c, const cJSON* an, size_t ai, ak_raw_ch
             ++done;
         }
     }
-    if (r == AK_OK && out == 0) r = fail(c, AK_ERR_PARSE, "%s has no channel animkit can use", where);
+    if (r == AK_OK && out == 0) r = fail(c, AK_ERR_UNSUPPORTED, "%s has no channel animkit can use", where);
     if (r == AK_OK) {
         char name[AK_NAME_SIZE];
         const char* an_name = get_string(an, "name");
