@@ -521,6 +521,46 @@ AK_TEST(squad_is_c1_nlerp_is_not) {
     ak_track_destroy(nl);
 }
 
+AK_TEST(rotation_angular_velocity_matches_samples) {
+    /* Every rotation mode's reported angular velocity against a central difference of
+     * samples: w ~ axis * angle of q(t+h) q(t-h)^-1 / 2h (parent space). */
+    ak_rng rng = ak_rng_make(10);
+    enum { N = 5 };
+    float times[N], dummy[N], vals[N * 12];
+    random_keys(&rng, N, times, dummy, 1);
+    const ak_interp modes[] = {AK_INTERP_LINEAR, AK_INTERP_NLERP, AK_INTERP_SQUAD, AK_INTERP_CUBICSPLINE};
+    for (size_t m = 0; m < sizeof modes / sizeof modes[0]; ++m) {
+        size_t stride = modes[m] == AK_INTERP_CUBICSPLINE ? 12 : 4, off = stride == 12 ? 4 : 0;
+        for (int k = 0; k < N; ++k) {
+            ak_quat q = random_quat(&rng);
+            for (size_t c = 0; c < stride; ++c) vals[k * stride + c] = ak_rng_range(&rng, -0.5f, 0.5f);
+            vals[k * stride + off] = q.x, vals[k * stride + off + 1] = q.y;
+            vals[k * stride + off + 2] = q.z, vals[k * stride + off + 3] = q.w;
+        }
+        ak_raw_track raw = {.is_rotation = true, .interp = modes[m], .key_count = N, .times = times, .values = vals};
+        ak_track* tr = build(&raw);
+        AK_CHECK(tr != NULL);
+        if (!tr) continue;
+        for (int i = 0; i < 40; ++i) {
+            int k = i % (N - 1);
+            float t = times[k] + (times[k + 1] - times[k]) * ak_rng_range(&rng, 0.1f, 0.9f);
+            float h = 1e-3f;
+            ak_quat a = sampleq(tr, t - h), b = sampleq(tr, t + h);
+            if (ak_quat_dot(a, b) < 0.0f) b = ak_quat_neg(b);
+            ak_vec3 axis;
+            float angle;
+            ak_quat_to_axis_angle(ak_quat_mul(b, ak_quat_conjugate(a)), &axis, &angle);
+            ak_vec3 fd = ak_vec3_scale(axis, angle / (2.0f * h));
+            float w[3];
+            AK_CHECK_EQ(ak_track_derivative(tr, t, 1, (ak_f32_span)AK_SPAN(w)), AK_OK);
+            double err = ak_vec3_distance(ak_vec3_make(w[0], w[1], w[2]), fd);
+            AK_CHECK_MSG(err < 5e-3 * (1.0 + ak_vec3_length(fd)), "%s: |w - fd| = %g (|fd| %g)", ak_interp_name(modes[m]),
+                         err, (double)ak_vec3_length(fd));
+        }
+        ak_track_destroy(tr);
+    }
+}
+
 /* ---- bad input ----------------------------------------------------------------------- */
 
 AK_TEST(bad_input_codes) {
@@ -774,6 +814,7 @@ int main(void) {
     AK_RUN(derivatives_reproduce_a_cubic);
     AK_RUN(slerp_constant_angular_speed_and_shortest_path);
     AK_RUN(squad_is_c1_nlerp_is_not);
+    AK_RUN(rotation_angular_velocity_matches_samples);
     AK_RUN(bad_input_codes);
     AK_RUN(uniform_sampling_and_key_access);
     AK_RUN(time_wrap_modes);
