@@ -19,9 +19,15 @@ static void print_ankle(const char* label, const ak_skeleton* sk, const ak_trans
 int main(void) {
     const ak_quat id = ak_quat_identity();
     ak_joint_desc joints[3] = {
-        {.name = "hip", .parent = -1, .rest = {{0, 0.9f, 0}, id, {1, 1, 1}}, .type = AK_JOINT_BALL,
+        {.name = "hip",
+         .parent = -1,
+         .rest = {{0, 0.9f, 0}, id, {1, 1, 1}},
+         .type = AK_JOINT_BALL,
          .limits = {.axis = {0, -1, 0}, .cone_angle = 1.2f, .twist_min = -0.5f, .twist_max = 0.5f}},
-        {.name = "knee", .parent = 0, .rest = {{0, -0.42f, 0}, id, {1, 1, 1}}, .type = AK_JOINT_HINGE,
+        {.name = "knee",
+         .parent = 0,
+         .rest = {{0, -0.42f, 0}, id, {1, 1, 1}},
+         .type = AK_JOINT_HINGE,
          .limits = {.axis = {1, 0, 0}, .min = 0.0f, .max = 2.4f}},
         {.name = "ankle", .parent = 1, .rest = {{0, -0.4f, 0}, id, {1, 1, 1}}},
     };
@@ -57,8 +63,8 @@ int main(void) {
     ak_vec3 axis;
     float angle;
     ak_quat_to_axis_angle(k2.rotation, &axis, &angle);
-    printf("knee 3.000 rad -> %.3f rad about (%.0f, %.0f, %.0f)\n", (double)angle, (double)axis.x, (double)axis.y,
-           (double)axis.z);
+    printf("knee 3.000 rad -> %.3f rad about (%.0f, %.0f, %.0f)\n", (double)angle, (double)axis.x,
+           (double)axis.y, (double)axis.z);
     ak_skeleton_destroy(sk);
     return 0;
 }

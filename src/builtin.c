@@ -32,15 +32,29 @@ typedef struct hjoint {
     ak_vec3 pos; /* model space, rest */
     ak_joint_type type;
     ak_joint_limits limits;
-    int side;               /* +1 left (+X), -1 right, 0 centre */
-    ak_vec3 seg_a, seg_b;   /* bone segment whose vertices this joint drives */
-    float radius;           /* flesh radius around that segment (weights measure from it) */
+    int side;             /* +1 left (+X), -1 right, 0 centre */
+    ak_vec3 seg_a, seg_b; /* bone segment whose vertices this joint drives */
+    float radius;         /* flesh radius around that segment (weights measure from it) */
 } hjoint;
 
 enum {
-    H_PELVIS, H_SPINE1, H_SPINE2, H_NECK, H_HEAD,
-    H_LSHOULDER, H_LELBOW, H_LWRIST, H_RSHOULDER, H_RELBOW, H_RWRIST,
-    H_LHIP, H_LKNEE, H_LANKLE, H_RHIP, H_RKNEE, H_RANKLE,
+    H_PELVIS,
+    H_SPINE1,
+    H_SPINE2,
+    H_NECK,
+    H_HEAD,
+    H_LSHOULDER,
+    H_LELBOW,
+    H_LWRIST,
+    H_RSHOULDER,
+    H_RELBOW,
+    H_RWRIST,
+    H_LHIP,
+    H_LKNEE,
+    H_LANKLE,
+    H_RHIP,
+    H_RKNEE,
+    H_RANKLE,
     H_COUNT
 };
 
@@ -85,9 +99,13 @@ static void put_vec3(float* v, size_t key, ak_vec3 p) {
     v[3 * key + 0] = p.x, v[3 * key + 1] = p.y, v[3 * key + 2] = p.z;
 }
 
-static ak_result build_clip(const keyed_clip* k, float duration, size_t joint_count, ak_scene* scene, size_t slot) {
-    ak_raw_clip raw = {.name = k->name, .duration = duration, .channels = k->channels,
-                       .channel_count = k->channel_count, .joint_count = joint_count};
+static ak_result build_clip(const keyed_clip* k, float duration, size_t joint_count,
+                            ak_scene* scene, size_t slot) {
+    ak_raw_clip raw = {.name = k->name,
+                       .duration = duration,
+                       .channels = k->channels,
+                       .channel_count = k->channel_count,
+                       .joint_count = joint_count};
     ak_result r = ak_clip_build(&raw, &scene->alloc, &scene->clips[slot], NULL);
     /* The keys are written in this file: anything but NO_MEMORY is a bug here. */
     AK_ASSERT(r == AK_OK || r == AK_ERR_NO_MEMORY);
@@ -95,7 +113,8 @@ static ak_result build_clip(const keyed_clip* k, float duration, size_t joint_co
 }
 
 /* Skeleton, one skinned mesh and a 1:1 skin: the shape every builtin shares. */
-static ak_result scene_assemble(ak_scene* scene, const ak_joint_desc* joints, size_t joint_count, ak_mesh* mesh) {
+static ak_result scene_assemble(ak_scene* scene, const ak_joint_desc* joints, size_t joint_count,
+                                ak_mesh* mesh) {
     ak_skeleton_desc sd = {.joints = joints, .joint_count = joint_count, .name = scene->name};
     ak_result r = ak_skeleton_create(&sd, &scene->alloc, &scene->skeleton, NULL);
     if (r != AK_OK) {
@@ -122,8 +141,12 @@ static ak_result cylinder_create(const ak_builtin_desc* d, ak_scene* scene) {
     const uint32_t B = d->bone_count, R = d->rings, S = d->segments;
     const float L = d->length, rad = d->radius, bone_len = L / (float)B, band = d->blend * bone_len;
     const size_t side_v = (size_t)(R + 1) * S;
-    ak_mesh_desc md = {.vertex_count = side_v + 2, .triangle_count = 2 * (size_t)R * S + 2 * (size_t)S,
-                       .influence_count = 4, .has_normals = true, .has_uvs = true, .name = "cylinder"};
+    ak_mesh_desc md = {.vertex_count = side_v + 2,
+                       .triangle_count = 2 * (size_t)R * S + 2 * (size_t)S,
+                       .influence_count = 4,
+                       .has_normals = true,
+                       .has_uvs = true,
+                       .name = "cylinder"};
     ak_mesh* m = NULL;
     ak_result r = ak_mesh_create(&md, &scene->alloc, &m);
     if (r != AK_OK) return r;
@@ -164,7 +187,9 @@ static ak_result cylinder_create(const ak_builtin_desc* d, ak_scene* scene) {
         float s_prev = 1.0f;
         uint32_t slot = 0;
         for (uint32_t b = 0; b < B; ++b) {
-            float s_next = b + 1 < B ? smoothstep01((y - ((float)(b + 1) * bone_len - 0.5f * band)) / band) : 0.0f;
+            float s_next =
+                b + 1 < B ? smoothstep01((y - ((float)(b + 1) * bone_len - 0.5f * band)) / band)
+                          : 0.0f;
             float w = s_prev - s_next;
             if (w > 0.0f && slot < 4) {
                 m->joints[4 * v + slot] = (uint16_t)b;
@@ -177,7 +202,8 @@ static ak_result cylinder_create(const ak_builtin_desc* d, ak_scene* scene) {
     ak_weights_normalize(m->joints, m->weights, md.vertex_count, 4, 4, 0.0f);
 
     /* Skeleton: root at the base, interior balls, a leaf tip at the top. */
-    static const char* const names[2][4] = {{"root", "joint1", "tip", ""}, {"root", "joint1", "joint2", "tip"}};
+    static const char* const names[2][4] = {{"root", "joint1", "tip", ""},
+                                            {"root", "joint1", "joint2", "tip"}};
     ak_joint_desc js[4];
     memset(js, 0, sizeof js);
     for (uint32_t i = 0; i <= B; ++i) {
@@ -208,8 +234,10 @@ static ak_result cylinder_create(const ak_builtin_desc* d, ak_scene* scene) {
             float* v = clip_channel(k, AK_CHANNEL_ROTATION, j);
             for (size_t i = 0; i < 5; ++i) {
                 float u = k->times[i];
-                ak_quat bend = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), u * bend_total / (float)(B - 1));
-                ak_quat twist = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), u * twist_total / (float)(B - 1));
+                ak_quat bend =
+                    ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), u * bend_total / (float)(B - 1));
+                ak_quat twist = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0),
+                                                        u * twist_total / (float)(B - 1));
                 ak_quat q = c == 0 ? bend : c == 1 ? twist : ak_quat_mul(bend, twist);
                 put_quat(v, i, q);
             }
@@ -236,18 +264,30 @@ static ak_joint_limits hinge_limits(ak_vec3 axis, float lo, float hi) {
 static void humanoid_define(humanoid_def* h) {
     memset(h, 0, sizeof *h);
     const float c45 = 0.70710678f;
-    const ak_vec3 up = ak_vec3_make(0, 1, 0), down = ak_vec3_make(0, -1, 0), xaxis = ak_vec3_make(1, 0, 0);
+    const ak_vec3 up = ak_vec3_make(0, 1, 0), down = ak_vec3_make(0, -1, 0),
+                  xaxis = ak_vec3_make(1, 0, 0);
     hjoint* J = h->joints;
-    J[H_PELVIS] = (hjoint){"pelvis", -1, {0, 0.95f, 0}, AK_JOINT_FREE, {{0, 0, 0}, 0, 0, 0, 0, 0}, 0,
-                           {-0.1f, 0.93f, 0}, {0.1f, 0.93f, 0}, 0.115f};
-    J[H_SPINE1] = (hjoint){"spine_01", H_PELVIS, {0, 1.05f, 0}, AK_JOINT_BALL, ball_limits(up, 0.45f, 0.5f), 0,
-                           {0, 1.05f, 0}, {0, 1.22f, 0}, 0.125f};
-    J[H_SPINE2] = (hjoint){"spine_02", H_SPINE1, {0, 1.22f, 0}, AK_JOINT_BALL, ball_limits(up, 0.45f, 0.5f), 0,
-                           {0, 1.22f, 0}, {0, 1.42f, 0}, 0.15f};
-    J[H_NECK] = (hjoint){"neck", H_SPINE2, {0, 1.47f, 0}, AK_JOINT_BALL, ball_limits(up, 0.7f, 1.0f), 0,
-                         {0, 1.47f, 0}, {0, 1.57f, 0}, 0.05f};
-    J[H_HEAD] = (hjoint){"head", H_NECK, {0, 1.57f, 0}, AK_JOINT_BALL, ball_limits(up, 0.6f, 0.8f), 0,
-                         {0, 1.60f, 0}, {0, 1.80f, 0}, 0.1f};
+    J[H_PELVIS] = (hjoint){"pelvis",
+                           -1,
+                           {0, 0.95f, 0},
+                           AK_JOINT_FREE,
+                           {{0, 0, 0}, 0, 0, 0, 0, 0},
+                           0,
+                           {-0.1f, 0.93f, 0},
+                           {0.1f, 0.93f, 0},
+                           0.115f};
+    J[H_SPINE1] = (hjoint){
+        "spine_01", H_PELVIS,      {0, 1.05f, 0}, AK_JOINT_BALL, ball_limits(up, 0.45f, 0.5f),
+        0,          {0, 1.05f, 0}, {0, 1.22f, 0}, 0.125f};
+    J[H_SPINE2] = (hjoint){
+        "spine_02", H_SPINE1,      {0, 1.22f, 0}, AK_JOINT_BALL, ball_limits(up, 0.45f, 0.5f),
+        0,          {0, 1.22f, 0}, {0, 1.42f, 0}, 0.15f};
+    J[H_NECK] =
+        (hjoint){"neck", H_SPINE2,      {0, 1.47f, 0}, AK_JOINT_BALL, ball_limits(up, 0.7f, 1.0f),
+                 0,      {0, 1.47f, 0}, {0, 1.57f, 0}, 0.05f};
+    J[H_HEAD] =
+        (hjoint){"head", H_NECK,        {0, 1.57f, 0}, AK_JOINT_BALL, ball_limits(up, 0.6f, 0.8f),
+                 0,      {0, 1.60f, 0}, {0, 1.80f, 0}, 0.1f};
     for (int s = 0; s < 2; ++s) {
         const float sx = s == 0 ? 1.0f : -1.0f; /* left is +X */
         const int side = s == 0 ? 1 : -1;
@@ -259,31 +299,76 @@ static void humanoid_define(humanoid_def* h) {
         const ak_vec3 hand_end = ak_vec3_madd(wr, d, 0.15f);
         /* Elbow flexion turns the forearm towards +Z: axis d x Z. */
         const ak_vec3 elbow_axis = ak_vec3_cross(d, ak_vec3_make(0, 0, 1));
-        J[base] = (hjoint){s == 0 ? "left_shoulder" : "right_shoulder", H_SPINE2, sh, AK_JOINT_BALL,
-                           ball_limits(d, 2.4f, 2.0f), side, sh, el, 0.05f};
-        J[base + 1] = (hjoint){s == 0 ? "left_elbow" : "right_elbow", base, el, AK_JOINT_HINGE,
-                               hinge_limits(elbow_axis, 0.0f, ak_radians(145.0f)), side, el, wr, 0.04f};
-        J[base + 2] = (hjoint){s == 0 ? "left_wrist" : "right_wrist", base + 1, wr, AK_JOINT_BALL,
-                               ball_limits(d, 1.2f, 0.8f), side, wr, hand_end, 0.035f};
+        J[base] = (hjoint){s == 0 ? "left_shoulder" : "right_shoulder",
+                           H_SPINE2,
+                           sh,
+                           AK_JOINT_BALL,
+                           ball_limits(d, 2.4f, 2.0f),
+                           side,
+                           sh,
+                           el,
+                           0.05f};
+        J[base + 1] = (hjoint){s == 0 ? "left_elbow" : "right_elbow",
+                               base,
+                               el,
+                               AK_JOINT_HINGE,
+                               hinge_limits(elbow_axis, 0.0f, ak_radians(145.0f)),
+                               side,
+                               el,
+                               wr,
+                               0.04f};
+        J[base + 2] = (hjoint){s == 0 ? "left_wrist" : "right_wrist",
+                               base + 1,
+                               wr,
+                               AK_JOINT_BALL,
+                               ball_limits(d, 1.2f, 0.8f),
+                               side,
+                               wr,
+                               hand_end,
+                               0.035f};
         const int lb = s == 0 ? H_LHIP : H_RHIP;
-        const ak_vec3 hip = ak_vec3_make(sx * 0.1f, 0.90f, 0.0f), knee = ak_vec3_make(sx * 0.1f, 0.48f, 0.0f);
-        const ak_vec3 ankle = ak_vec3_make(sx * 0.1f, 0.085f, 0.0f), toe = ak_vec3_make(sx * 0.1f, 0.04f, 0.14f);
+        const ak_vec3 hip = ak_vec3_make(sx * 0.1f, 0.90f, 0.0f),
+                      knee = ak_vec3_make(sx * 0.1f, 0.48f, 0.0f);
+        const ak_vec3 ankle = ak_vec3_make(sx * 0.1f, 0.085f, 0.0f),
+                      toe = ak_vec3_make(sx * 0.1f, 0.04f, 0.14f);
         /* Knee flexion swings the shank backwards (-Z): +X; positive ankle angle = toes down. */
-        J[lb] = (hjoint){s == 0 ? "left_hip" : "right_hip", H_PELVIS, hip, AK_JOINT_BALL,
-                         ball_limits(down, ak_radians(90.0f), 0.7f), side, hip, knee, 0.07f};
-        J[lb + 1] = (hjoint){s == 0 ? "left_knee" : "right_knee", lb, knee, AK_JOINT_HINGE,
-                             hinge_limits(xaxis, 0.0f, ak_radians(140.0f)), side, knee, ankle, 0.05f};
-        J[lb + 2] = (hjoint){s == 0 ? "left_ankle" : "right_ankle", lb + 1, ankle, AK_JOINT_HINGE,
-                             hinge_limits(xaxis, ak_radians(-25.0f), ak_radians(35.0f)), side, ankle, toe, 0.04f};
+        J[lb] = (hjoint){s == 0 ? "left_hip" : "right_hip",
+                         H_PELVIS,
+                         hip,
+                         AK_JOINT_BALL,
+                         ball_limits(down, ak_radians(90.0f), 0.7f),
+                         side,
+                         hip,
+                         knee,
+                         0.07f};
+        J[lb + 1] = (hjoint){s == 0 ? "left_knee" : "right_knee",
+                             lb,
+                             knee,
+                             AK_JOINT_HINGE,
+                             hinge_limits(xaxis, 0.0f, ak_radians(140.0f)),
+                             side,
+                             knee,
+                             ankle,
+                             0.05f};
+        J[lb + 2] = (hjoint){s == 0 ? "left_ankle" : "right_ankle",
+                             lb + 1,
+                             ankle,
+                             AK_JOINT_HINGE,
+                             hinge_limits(xaxis, ak_radians(-25.0f), ak_radians(35.0f)),
+                             side,
+                             ankle,
+                             toe,
+                             0.04f};
         /* Limb capsules. */
         capsule* c = h->caps + 8 + 5 * s;
         c[0] = (capsule){sh, el, 0.056f, 0.046f, 1.0f};
         c[1] = (capsule){el, wr, 0.045f, 0.034f, 1.0f};
-        c[2] = (capsule){ak_vec3_madd(wr, d, 0.03f), ak_vec3_madd(wr, d, 0.12f), 0.04f, 0.036f, 0.8f};
+        c[2] =
+            (capsule){ak_vec3_madd(wr, d, 0.03f), ak_vec3_madd(wr, d, 0.12f), 0.04f, 0.036f, 0.8f};
         c[3] = (capsule){hip, knee, 0.082f, 0.06f, 1.0f};
         c[4] = (capsule){knee, ankle, 0.06f, 0.042f, 1.0f};
-        h->caps[6 + s] = (capsule){ak_vec3_make(sx * 0.1f, 0.045f, -0.05f), ak_vec3_make(sx * 0.1f, 0.04f, 0.16f),
-                                   0.042f, 0.04f, 1.0f};
+        h->caps[6 + s] = (capsule){ak_vec3_make(sx * 0.1f, 0.045f, -0.05f),
+                                   ak_vec3_make(sx * 0.1f, 0.04f, 0.16f), 0.042f, 0.04f, 1.0f};
     }
     /* Trunk and head. */
     h->caps[0] = (capsule){{-0.085f, 0.93f, 0}, {0.085f, 0.93f, 0}, 0.115f, 0.115f, 0.78f};
@@ -299,7 +384,8 @@ static void humanoid_define(humanoid_def* h) {
 #define BLEND_K 0.012 /* smooth-union radius, metres */
 
 static double capsule_distance(const capsule* c, double px, double py, double pz) {
-    double abx = (double)c->b.x - c->a.x, aby = (double)c->b.y - c->a.y, abz = (double)c->b.z - c->a.z;
+    double abx = (double)c->b.x - c->a.x, aby = (double)c->b.y - c->a.y,
+           abz = (double)c->b.z - c->a.z;
     double apx = px - c->a.x, apy = py - c->a.y, apz = pz - c->a.z;
     double len2 = abx * abx + aby * aby + abz * abz;
     double t = len2 > 0.0 ? (apx * abx + apy * aby + apz * abz) / len2 : 0.0;
@@ -334,13 +420,14 @@ static ak_vec3 body_gradient(const humanoid_def* h, ak_vec3 p, double eps) {
  * iso-segment on a tetrahedron face is produced by exactly the two tetrahedra sharing it:
  * the result is closed and manifold. Orientation is decided on exact integer geometry (edge
  * midpoints against the inside -> outside direction), never on the float crossings. */
-static const int kuhn_tets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+static const int kuhn_tets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
+                                    {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
 
 typedef struct mt_grid {
     int nx, ny, nz;
     double x0, y0, z0, h;
-    const double* f;     /* [nx*ny*nz] */
-    int32_t* edge_vert;  /* [7 * nx*ny*nz], vertex index + 1, 0 = none */
+    const double* f;    /* [nx*ny*nz] */
+    int32_t* edge_vert; /* [7 * nx*ny*nz], vertex index + 1, 0 = none */
     ak_vec3* verts;
     size_t vert_count, vert_cap;
     uint32_t* tris;
@@ -390,7 +477,8 @@ static void emit_tri(mt_grid* g, int32_t a, int32_t b, int32_t c) {
 
 /* True when the triangle over edges (e[0], e[1], e[2]) (corner pairs, midpoints) turns
  * counter-clockwise seen from the outside corners. */
-static bool midpoint_ccw(const int e[3][2], const int* inside, int in_count, const int* outside, int out_count) {
+static bool midpoint_ccw(const int e[3][2], const int* inside, int in_count, const int* outside,
+                         int out_count) {
     long m[3][3];
     for (int i = 0; i < 3; ++i) {
         long a[3], b[3];
@@ -421,20 +509,25 @@ static void march_tet(mt_grid* g, int ci, int cj, int ck, const int corners[4]) 
     for (int v = 0; v < 4; ++v) {
         int c = corners[v];
         double f = g->f[grid_index(g, ci + (c & 1), cj + ((c >> 1) & 1), ck + ((c >> 2) & 1))];
-        if (f < 0.0) inside[ni++] = c;
-        else outside[no++] = c;
+        if (f < 0.0)
+            inside[ni++] = c;
+        else
+            outside[no++] = c;
     }
     if (ni == 0 || no == 0) return;
 #define EDGE_(a, b) ((a) < (b) ? (a) : (b)), ((a) < (b) ? (b) : (a))
     if (ni == 1 || no == 1) {
         const int lone = ni == 1 ? inside[0] : outside[0];
         const int* others = ni == 1 ? outside : inside;
-        int e[3][2] = {{EDGE_(lone, others[0])}, {EDGE_(lone, others[1])}, {EDGE_(lone, others[2])}};
+        int e[3][2] = {
+            {EDGE_(lone, others[0])}, {EDGE_(lone, others[1])}, {EDGE_(lone, others[2])}};
         bool ccw = midpoint_ccw((const int(*)[2])e, inside, ni, outside, no);
         int32_t v[3];
         for (int i = 0; i < 3; ++i) v[i] = edge_vertex(g, ci, cj, ck, e[i][0], e[i][1]);
-        if (ccw) emit_tri(g, v[0], v[1], v[2]);
-        else emit_tri(g, v[0], v[2], v[1]);
+        if (ccw)
+            emit_tri(g, v[0], v[1], v[2]);
+        else
+            emit_tri(g, v[0], v[2], v[1]);
     } else {
         const int a = inside[0], b = inside[1], c = outside[0], d = outside[1];
         int e[4][2] = {{EDGE_(a, c)}, {EDGE_(a, d)}, {EDGE_(b, d)}, {EDGE_(b, c)}};
@@ -453,12 +546,15 @@ static void march_tet(mt_grid* g, int ci, int cj, int ck, const int corners[4]) 
 }
 
 /* Polygonise the body into a new mesh (positions, indices, normals). */
-static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_allocator* alloc, ak_mesh** out) {
+static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_allocator* alloc,
+                                  ak_mesh** out) {
     ak_vec3 lo = ak_vec3_splat(1e30f), hi = ak_vec3_splat(-1e30f);
     for (int i = 0; i < H_CAPSULES; ++i) {
         float r = ak_maxf(h->caps[i].ra, h->caps[i].rb);
-        lo = ak_vec3_min(lo, ak_vec3_sub(ak_vec3_min(h->caps[i].a, h->caps[i].b), ak_vec3_splat(r)));
-        hi = ak_vec3_max(hi, ak_vec3_add(ak_vec3_max(h->caps[i].a, h->caps[i].b), ak_vec3_splat(r)));
+        lo =
+            ak_vec3_min(lo, ak_vec3_sub(ak_vec3_min(h->caps[i].a, h->caps[i].b), ak_vec3_splat(r)));
+        hi =
+            ak_vec3_max(hi, ak_vec3_add(ak_vec3_max(h->caps[i].a, h->caps[i].b), ak_vec3_splat(r)));
     }
     const double hstep = cell, margin = 3.0 * cell;
     mt_grid g;
@@ -480,7 +576,8 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
     for (int k = 0; k < g.nz; ++k)
         for (int j = 0; j < g.ny; ++j)
             for (int i = 0; i < g.nx; ++i)
-                f[grid_index(&g, i, j, k)] = body_field(h, g.x0 + hstep * i, g.y0 + hstep * j, g.z0 + hstep * k);
+                f[grid_index(&g, i, j, k)] =
+                    body_field(h, g.x0 + hstep * i, g.y0 + hstep * j, g.z0 + hstep * k);
     /* Exact output bounds: one vertex per sign-changing edge (lower end, direction 1..7),
      * at most two triangles per tetrahedron with mixed signs. */
     for (int k = 0; k < g.nz; ++k)
@@ -489,14 +586,17 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
                 const bool in0 = f[grid_index(&g, i, j, k)] < 0.0;
                 for (int c = 1; c < 8; ++c) {
                     int i1 = i + (c & 1), j1 = j + ((c >> 1) & 1), k1 = k + ((c >> 2) & 1);
-                    if (i1 < g.nx && j1 < g.ny && k1 < g.nz) g.vert_cap += in0 != (f[grid_index(&g, i1, j1, k1)] < 0.0);
+                    if (i1 < g.nx && j1 < g.ny && k1 < g.nz)
+                        g.vert_cap += in0 != (f[grid_index(&g, i1, j1, k1)] < 0.0);
                 }
                 if (i + 1 == g.nx || j + 1 == g.ny || k + 1 == g.nz) continue;
                 for (int t = 0; t < 6; ++t) {
                     int n_in = 0;
                     for (int v = 0; v < 4; ++v) {
                         int c = kuhn_tets[t][v];
-                        n_in += f[grid_index(&g, i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] < 0.0;
+                        n_in +=
+                            f[grid_index(&g, i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] <
+                            0.0;
                     }
                     if (n_in > 0 && n_in < 4) g.tri_cap += 2;
                 }
@@ -533,7 +633,8 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
             memset(cnt, 0, g.vert_count * sizeof(uint32_t));
             for (size_t t = 0; t < g.tri_count; ++t)
                 for (int e = 0; e < 3; ++e) {
-                    uint32_t a = g.tris[3 * t + (size_t)e], b = g.tris[3 * t + (size_t)((e + 1) % 3)];
+                    uint32_t a = g.tris[3 * t + (size_t)e],
+                             b = g.tris[3 * t + (size_t)((e + 1) % 3)];
                     acc[a] = ak_vec3_add(acc[a], g.verts[b]);
                     cnt[a]++;
                 }
@@ -558,8 +659,11 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
         akp_free(alloc, cnt);
     }
     {
-        ak_mesh_desc md = {.vertex_count = g.vert_count, .triangle_count = g.tri_count, .influence_count = 4,
-                           .has_normals = true, .name = "humanoid"};
+        ak_mesh_desc md = {.vertex_count = g.vert_count,
+                           .triangle_count = g.tri_count,
+                           .influence_count = 4,
+                           .has_normals = true,
+                           .name = "humanoid"};
         ak_mesh* m = NULL;
         r = ak_mesh_create(&md, alloc, &m);
         if (r != AK_OK) goto done;
@@ -617,7 +721,8 @@ static void humanoid_weights(const humanoid_def* h, ak_mesh* m) {
         /* Scale so the largest is 1 before the float renormalisation. */
         float top = m->weights[4 * v];
         for (int k = 0; k < 4; ++k)
-            m->weights[4 * v + (size_t)k] = top > 0.0f ? ak_maxf(m->weights[4 * v + (size_t)k], 0.0f) / top : 0.0f;
+            m->weights[4 * v + (size_t)k] =
+                top > 0.0f ? ak_maxf(m->weights[4 * v + (size_t)k], 0.0f) / top : 0.0f;
     }
     ak_weights_normalize(m->joints, m->weights, m->vertex_count, 4, 4, 0.01f);
 }
@@ -650,7 +755,8 @@ static ak_result humanoid_clips(const humanoid_def* h, ak_scene* scene) {
         hip[s] = clip_channel(k, AK_CHANNEL_ROTATION, (uint32_t)(s ? H_RHIP : H_LHIP));
         knee[s] = clip_channel(k, AK_CHANNEL_ROTATION, (uint32_t)(s ? H_RKNEE : H_LKNEE));
         ankle[s] = clip_channel(k, AK_CHANNEL_ROTATION, (uint32_t)(s ? H_RANKLE : H_LANKLE));
-        shoulder[s] = clip_channel(k, AK_CHANNEL_ROTATION, (uint32_t)(s ? H_RSHOULDER : H_LSHOULDER));
+        shoulder[s] =
+            clip_channel(k, AK_CHANNEL_ROTATION, (uint32_t)(s ? H_RSHOULDER : H_LSHOULDER));
         elbow[s] = clip_channel(k, AK_CHANNEL_ROTATION, (uint32_t)(s ? H_RELBOW : H_LELBOW));
     }
     for (size_t i = 0; i < 17; ++i) {
@@ -665,13 +771,16 @@ static ak_result humanoid_clips(const humanoid_def* h, ak_scene* scene) {
             const float sx = s == 0 ? 1.0f : -1.0f;
             put_quat(hip[s], i, qaxis(1, 0, 0, -0.42f * sinf(ps)));
             float swing = ak_maxf(0.0f, cosf(ps));
-            put_quat(knee[s], i, ak_quat_from_axis_angle(h->joints[H_LKNEE].limits.axis, 0.1f + 0.8f * swing * swing));
+            put_quat(knee[s], i,
+                     ak_quat_from_axis_angle(h->joints[H_LKNEE].limits.axis,
+                                             0.1f + 0.8f * swing * swing));
             put_quat(ankle[s], i, qaxis(1, 0, 0, 0.18f * sinf(ps)));
             /* Arm: lowered 30 degrees towards the body, then swung against the same-side leg. */
             ak_quat lower = qaxis(0, 0, 1, -sx * ak_radians(30.0f));
             put_quat(shoulder[s], i, ak_quat_mul(qaxis(1, 0, 0, 0.35f * sinf(ps)), lower));
             const int ej = s == 0 ? H_LELBOW : H_RELBOW;
-            put_quat(elbow[s], i, ak_quat_from_axis_angle(h->joints[ej].limits.axis, 0.4f + 0.2f * sinf(ps)));
+            put_quat(elbow[s], i,
+                     ak_quat_from_axis_angle(h->joints[ej].limits.axis, 0.4f + 0.2f * sinf(ps)));
         }
     }
     ak_result r = build_clip(k, 1.0f, H_COUNT, scene, 0);
@@ -694,12 +803,15 @@ static ak_result humanoid_clips(const humanoid_def* h, ak_scene* scene) {
     const ak_vec3 d = h->arm_dir[1];
     for (size_t i = 0; i < 21; ++i) {
         const float t = k->times[i];
-        const float env = t < 0.4f ? smoothstep01(t / 0.4f) : (t > 1.6f ? smoothstep01((2.0f - t) / 0.4f) : 1.0f);
+        const float env =
+            t < 0.4f ? smoothstep01(t / 0.4f) : (t > 1.6f ? smoothstep01((2.0f - t) / 0.4f) : 1.0f);
         const float osc = (t > 0.4f && t < 1.6f) ? sinf(tau * (t - 0.4f) / 0.4f) : 0.0f;
         ak_quat raise = qaxis(0, 0, 1, -ak_radians(65.0f) * env);
         ak_quat turn = ak_quat_from_axis_angle(d, env * (AK_HALF_PI + ak_radians(20.0f) * osc));
         put_quat(rs, i, ak_quat_mul(raise, turn));
-        put_quat(re, i, ak_quat_from_axis_angle(h->joints[H_RELBOW].limits.axis, env * (1.5f + 0.1f * osc)));
+        put_quat(
+            re, i,
+            ak_quat_from_axis_angle(h->joints[H_RELBOW].limits.axis, env * (1.5f + 0.1f * osc)));
         put_quat(rw, i, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.2f * env * osc));
         put_quat(hd, i, qaxis(0, 1, 0, -0.25f * env));
     }
@@ -723,7 +835,8 @@ static ak_result humanoid_create(const ak_builtin_desc* d, ak_scene* scene) {
             js[j].name = J->name;
             js[j].parent = J->parent;
             js[j].rest = ak_transform_identity();
-            js[j].rest.translation = J->parent < 0 ? J->pos : ak_vec3_sub(J->pos, h->joints[J->parent].pos);
+            js[j].rest.translation =
+                J->parent < 0 ? J->pos : ak_vec3_sub(J->pos, h->joints[J->parent].pos);
             js[j].type = J->type;
             js[j].limits = J->limits;
         }
@@ -750,8 +863,8 @@ ak_builtin_desc ak_builtin_desc_resolved(const ak_builtin_desc* desc) {
     return d;
 }
 
-ak_result ak_builtin_create(const char* name, const ak_builtin_desc* desc, const ak_allocator* alloc,
-                            ak_scene** out_scene) {
+ak_result ak_builtin_create(const char* name, const ak_builtin_desc* desc,
+                            const ak_allocator* alloc, ak_scene** out_scene) {
     if (out_scene) *out_scene = NULL;
     if (!name || !out_scene) return AK_ERR_NULL_ARG;
     if (strncmp(name, "builtin:", 8) == 0) name += 8;
@@ -763,7 +876,8 @@ ak_result ak_builtin_create(const char* name, const ak_builtin_desc* desc, const
     const ak_builtin_desc d = ak_builtin_desc_resolved(desc);
     if (which == 0) {
         if (!finite_pos(d.length) || !finite_pos(d.radius) || d.rings > 4096 || d.segments < 3 ||
-            d.segments > 4096 || d.bone_count < 2 || d.bone_count > 3 || !finite_pos(d.blend) || d.blend > 1.0f)
+            d.segments > 4096 || d.bone_count < 2 || d.bone_count > 3 || !finite_pos(d.blend) ||
+            d.blend > 1.0f)
             return AK_ERR_BAD_ARG;
     } else if (!(d.cell_size >= 0.008f && d.cell_size <= 0.1f)) {
         return AK_ERR_BAD_ARG;

@@ -46,7 +46,8 @@ ak_result ak_mesh_create(const ak_mesh_desc* desc, const ak_allocator* alloc, ak
 
     const size_t v = desc->vertex_count, t = desc->triangle_count, m = desc->morph_target_count;
     size_t idx_count, infl_count, morph_count;
-    if (!mul_ok(t, 3, &idx_count) || !mul_ok(v, desc->influence_count, &infl_count) || !mul_ok(v, m, &morph_count))
+    if (!mul_ok(t, 3, &idx_count) || !mul_ok(v, desc->influence_count, &infl_count) ||
+        !mul_ok(v, m, &morph_count))
         return AK_ERR_BAD_ARG;
     if (idx_count > 0 && v > (size_t)UINT32_MAX + 1u) return AK_ERR_BAD_ARG; /* indices are u32 */
 
@@ -55,8 +56,10 @@ ak_result ak_mesh_create(const ak_mesh_desc* desc, const ak_allocator* alloc, ak
               add_array(&total, desc->has_normals ? v : 0, sizeof(ak_vec3)) &&
               add_array(&total, desc->has_uvs ? v : 0, sizeof(ak_vec2)) &&
               add_array(&total, desc->has_colors ? v : 0, sizeof(ak_vec4)) &&
-              add_array(&total, idx_count, sizeof(uint32_t)) && add_array(&total, infl_count, sizeof(uint16_t)) &&
-              add_array(&total, infl_count, sizeof(float)) && add_array(&total, morph_count, sizeof(ak_vec3)) &&
+              add_array(&total, idx_count, sizeof(uint32_t)) &&
+              add_array(&total, infl_count, sizeof(uint16_t)) &&
+              add_array(&total, infl_count, sizeof(float)) &&
+              add_array(&total, morph_count, sizeof(ak_vec3)) &&
               add_array(&total, desc->has_morph_normals ? morph_count : 0, sizeof(ak_vec3)) &&
               add_array(&total, m, sizeof(float)) && add_array(&total, m, AK_NAME_SIZE);
     if (!ok) return AK_ERR_BAD_ARG;
@@ -81,7 +84,8 @@ ak_result ak_mesh_create(const ak_mesh_desc* desc, const ak_allocator* alloc, ak
     mesh->joints = (uint16_t*)carve(base, &off, infl_count, sizeof(uint16_t));
     mesh->weights = (float*)carve(base, &off, infl_count, sizeof(float));
     mesh->morph_positions = (ak_vec3*)carve(base, &off, morph_count, sizeof(ak_vec3));
-    mesh->morph_normals = (ak_vec3*)carve(base, &off, desc->has_morph_normals ? morph_count : 0, sizeof(ak_vec3));
+    mesh->morph_normals =
+        (ak_vec3*)carve(base, &off, desc->has_morph_normals ? morph_count : 0, sizeof(ak_vec3));
     mesh->morph_weights = (float*)carve(base, &off, m, sizeof(float));
     mesh->morph_names = (char(*)[AK_NAME_SIZE])carve(base, &off, m, AK_NAME_SIZE);
     AK_ASSERT(off <= total);
@@ -113,7 +117,8 @@ ak_result ak_mesh_clone(const ak_mesh* mesh, const ak_allocator* alloc, ak_mesh*
     ak_mesh* c = NULL;
     ak_result r = ak_mesh_create(&d, alloc, &c);
     if (r != AK_OK) return r;
-    const size_t v = mesh->vertex_count, infl = v * mesh->influence_count, morph = v * mesh->morph_target_count;
+    const size_t v = mesh->vertex_count, infl = v * mesh->influence_count,
+                 morph = v * mesh->morph_target_count;
     if (mesh->positions) memcpy(c->positions, mesh->positions, v * sizeof(ak_vec3));
     if (mesh->normals) memcpy(c->normals, mesh->normals, v * sizeof(ak_vec3));
     if (mesh->uvs) memcpy(c->uvs, mesh->uvs, v * sizeof(ak_vec2));
@@ -122,8 +127,10 @@ ak_result ak_mesh_clone(const ak_mesh* mesh, const ak_allocator* alloc, ak_mesh*
         memcpy(c->indices, mesh->indices, 3 * mesh->triangle_count * sizeof(uint32_t));
     if (infl && mesh->joints) memcpy(c->joints, mesh->joints, infl * sizeof(uint16_t));
     if (infl && mesh->weights) memcpy(c->weights, mesh->weights, infl * sizeof(float));
-    if (morph && mesh->morph_positions) memcpy(c->morph_positions, mesh->morph_positions, morph * sizeof(ak_vec3));
-    if (morph && mesh->morph_normals) memcpy(c->morph_normals, mesh->morph_normals, morph * sizeof(ak_vec3));
+    if (morph && mesh->morph_positions)
+        memcpy(c->morph_positions, mesh->morph_positions, morph * sizeof(ak_vec3));
+    if (morph && mesh->morph_normals)
+        memcpy(c->morph_normals, mesh->morph_normals, morph * sizeof(ak_vec3));
     if (mesh->morph_target_count && mesh->morph_weights)
         memcpy(c->morph_weights, mesh->morph_weights, mesh->morph_target_count * sizeof(float));
     if (mesh->morph_target_count && mesh->morph_names)
@@ -139,17 +146,21 @@ ak_result ak_mesh_validate(const ak_mesh* mesh, ak_diag* diag) {
     for (size_t t = 0; t < mesh->triangle_count; ++t)
         for (int k = 0; k < 3; ++k)
             if (mesh->indices[3 * t + (size_t)k] >= mesh->vertex_count) {
-                akp_diag_set(diag, NULL, "mesh '%s': triangle %zu uses vertex %u, but there are %zu vertices",
-                             mesh->name, t, (unsigned)mesh->indices[3 * t + (size_t)k], mesh->vertex_count);
+                akp_diag_set(diag, NULL,
+                             "mesh '%s': triangle %zu uses vertex %u, but there are %zu vertices",
+                             mesh->name, t, (unsigned)mesh->indices[3 * t + (size_t)k],
+                             mesh->vertex_count);
                 return AK_ERR_BAD_INDEX;
             }
     for (size_t v = 0; v < mesh->vertex_count; ++v) {
         if (!ak_vec3_is_finite(mesh->positions[v])) {
-            akp_diag_set(diag, NULL, "mesh '%s': vertex %zu has a non-finite position", mesh->name, v);
+            akp_diag_set(diag, NULL, "mesh '%s': vertex %zu has a non-finite position", mesh->name,
+                         v);
             return AK_ERR_BAD_DATA;
         }
         if (mesh->normals && !ak_vec3_is_finite(mesh->normals[v])) {
-            akp_diag_set(diag, NULL, "mesh '%s': vertex %zu has a non-finite normal", mesh->name, v);
+            akp_diag_set(diag, NULL, "mesh '%s': vertex %zu has a non-finite normal", mesh->name,
+                         v);
             return AK_ERR_BAD_DATA;
         }
     }
@@ -175,7 +186,8 @@ void ak_mesh_bounds(const ak_mesh* mesh, ak_vec3* out_min, ak_vec3* out_max) {
     ak_points_bounds(p, out_min, out_max);
 }
 
-ak_result ak_normals_compute(ak_vec3_cspan positions, ak_u32_cspan indices, ak_vec3_span out_normals) {
+ak_result ak_normals_compute(ak_vec3_cspan positions, ak_u32_cspan indices,
+                             ak_vec3_span out_normals) {
     if (!out_normals.ptr || (positions.count && !positions.ptr) || (indices.count && !indices.ptr))
         return AK_ERR_NULL_ARG;
     if (out_normals.count < positions.count) return AK_ERR_SPAN_SMALL;
@@ -197,7 +209,7 @@ ak_result ak_normals_compute(ak_vec3_cspan positions, ak_u32_cspan indices, ak_v
         ak_vec3 n = out_normals.ptr[v];
         float len = ak_vec3_length(n);
         out_normals.ptr[v] = (len > 1e-30f && ak_finitef(len)) ? ak_vec3_scale(n, 1.0f / len)
-                                                                : ak_vec3_make(0.0f, 1.0f, 0.0f);
+                                                               : ak_vec3_make(0.0f, 1.0f, 0.0f);
     }
     return AK_OK;
 }
@@ -243,7 +255,8 @@ bool ak_mesh_is_closed_oriented(const ak_mesh* mesh) {
     bool ok = true;
     for (size_t t = 0; t < mesh->triangle_count && ok; ++t)
         for (int k = 0; k < 3; ++k) {
-            uint32_t a = mesh->indices[3 * t + (size_t)k], b = mesh->indices[3 * t + (size_t)((k + 1) % 3)];
+            uint32_t a = mesh->indices[3 * t + (size_t)k],
+                     b = mesh->indices[3 * t + (size_t)((k + 1) % 3)];
             if (a == b || a >= mesh->vertex_count || b >= mesh->vertex_count) ok = false;
             edges[3 * t + (size_t)k] = ((uint64_t)a << 32) | b;
         }
@@ -261,7 +274,8 @@ bool ak_mesh_is_closed_oriented(const ak_mesh* mesh) {
     return ok;
 }
 
-ak_result ak_mesh_validate_weights(const ak_mesh* mesh, size_t joint_count, float tolerance, ak_diag* diag) {
+ak_result ak_mesh_validate_weights(const ak_mesh* mesh, size_t joint_count, float tolerance,
+                                   ak_diag* diag) {
     if (!mesh) return AK_ERR_NULL_ARG;
     const uint32_t k = mesh->influence_count;
     if (k == 0) return AK_OK;
@@ -273,27 +287,29 @@ ak_result ak_mesh_validate_weights(const ak_mesh* mesh, size_t joint_count, floa
             float w = mesh->weights[v * k + i];
             uint16_t j = mesh->joints[v * k + i];
             if (!ak_finitef(w) || w < 0.0f) {
-                akp_diag_set(diag, NULL, "mesh '%s': vertex %zu influence %u has weight %g", mesh->name, v,
-                             (unsigned)i, (double)w);
+                akp_diag_set(diag, NULL, "mesh '%s': vertex %zu influence %u has weight %g",
+                             mesh->name, v, (unsigned)i, (double)w);
                 return AK_ERR_BAD_WEIGHTS;
             }
             if (j >= joint_count) {
-                akp_diag_set(diag, NULL, "mesh '%s': vertex %zu influence %u refers to joint %u of %zu",
+                akp_diag_set(diag, NULL,
+                             "mesh '%s': vertex %zu influence %u refers to joint %u of %zu",
                              mesh->name, v, (unsigned)i, (unsigned)j, joint_count);
                 return AK_ERR_BAD_INDEX;
             }
             sum += w;
         }
         if (fabs(sum - 1.0) > tol) {
-            akp_diag_set(diag, NULL, "mesh '%s': vertex %zu weights sum to %.6g, not 1", mesh->name, v, sum);
+            akp_diag_set(diag, NULL, "mesh '%s': vertex %zu weights sum to %.6g, not 1", mesh->name,
+                         v, sum);
             return AK_ERR_BAD_WEIGHTS;
         }
     }
     return AK_OK;
 }
 
-void ak_weights_normalize(uint16_t* joints, float* weights, size_t vertex_count, uint32_t influence_count,
-                          uint32_t max_influences, float min_weight) {
+void ak_weights_normalize(uint16_t* joints, float* weights, size_t vertex_count,
+                          uint32_t influence_count, uint32_t max_influences, float min_weight) {
     if (!joints || !weights || influence_count == 0) return;
     if (influence_count > AK_MAX_INFLUENCES) influence_count = AK_MAX_INFLUENCES;
     uint32_t keep_max = max_influences ? max_influences : 4u;

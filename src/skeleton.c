@@ -7,20 +7,20 @@ struct ak_skeleton {
     ak_allocator alloc;
     size_t joint_count;
     char name[AK_NAME_SIZE];
-    int16_t* parents;              /* [n] */
-    ak_transform* rest;            /* [n], rotations normalised */
-    ak_mat4* inverse_binds;        /* [n] */
-    char (*names)[AK_NAME_SIZE];   /* [n] */
-    ak_joint_limits* limits;       /* [n], defaults resolved */
-    uint32_t* child_counts;        /* [n] */
-    uint8_t* types;                /* [n] ak_joint_type */
+    int16_t* parents;            /* [n] */
+    ak_transform* rest;          /* [n], rotations normalised */
+    ak_mat4* inverse_binds;      /* [n] */
+    char (*names)[AK_NAME_SIZE]; /* [n] */
+    ak_joint_limits* limits;     /* [n], defaults resolved */
+    uint32_t* child_counts;      /* [n] */
+    uint8_t* types;              /* [n] ak_joint_type */
 };
 
 #define MAX_JOINTS 32767u
 
 static bool limits_finite(const ak_joint_limits* l) {
-    return ak_vec3_is_finite(l->axis) && ak_finitef(l->min) && ak_finitef(l->max) && ak_finitef(l->cone_angle) &&
-           ak_finitef(l->twist_min) && ak_finitef(l->twist_max);
+    return ak_vec3_is_finite(l->axis) && ak_finitef(l->min) && ak_finitef(l->max) &&
+           ak_finitef(l->cone_angle) && ak_finitef(l->twist_min) && ak_finitef(l->twist_max);
 }
 
 static bool mat4_finite(const ak_mat4* m) {
@@ -32,7 +32,8 @@ static bool mat4_finite(const ak_mat4* m) {
 static ak_joint_limits resolve_limits(ak_joint_type type, ak_joint_limits l) {
     ak_vec3 axis = ak_vec3_normalize(l.axis);
     if (ak_vec3_length_sq(axis) < 0.5f)
-        axis = type == AK_JOINT_BALL ? ak_vec3_make(0.0f, 1.0f, 0.0f) : ak_vec3_make(1.0f, 0.0f, 0.0f);
+        axis =
+            type == AK_JOINT_BALL ? ak_vec3_make(0.0f, 1.0f, 0.0f) : ak_vec3_make(1.0f, 0.0f, 0.0f);
     l.axis = axis;
     return l;
 }
@@ -85,8 +86,8 @@ static bool angle_in_range(float a, float lo, float hi, float tol) {
 
 /* ---- creation ------------------------------------------------------------------------ */
 
-ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* alloc, ak_skeleton** out_skeleton,
-                             ak_diag* diag) {
+ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* alloc,
+                             ak_skeleton** out_skeleton, ak_diag* diag) {
     if (out_skeleton) *out_skeleton = NULL;
     if (!desc || !out_skeleton) return AK_ERR_NULL_ARG;
     if (desc->joint_count == 0) {
@@ -95,7 +96,8 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
     }
     if (!desc->joints) return AK_ERR_NULL_ARG;
     if (desc->joint_count > MAX_JOINTS) {
-        akp_diag_set(diag, NULL, "skeleton has %zu joints, more than %u", desc->joint_count, MAX_JOINTS);
+        akp_diag_set(diag, NULL, "skeleton has %zu joints, more than %u", desc->joint_count,
+                     MAX_JOINTS);
         return AK_ERR_BAD_ARG;
     }
     if (alloc && (!alloc->alloc != !alloc->free)) return AK_ERR_BAD_ARG;
@@ -107,12 +109,15 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
             return AK_ERR_NULL_ARG;
         }
         if ((int)j->type < 0 || j->type >= AK_JOINT_TYPE_COUNT) {
-            akp_diag_set(diag, NULL, "joint %zu '%s' has unknown type %d", i, j->name, (int)j->type);
+            akp_diag_set(diag, NULL, "joint %zu '%s' has unknown type %d", i, j->name,
+                         (int)j->type);
             return AK_ERR_BAD_ARG;
         }
         if (j->parent < -1 || (j->parent >= 0 && (size_t)j->parent >= i)) {
-            akp_diag_set(diag, NULL, "joint %zu '%s' has parent %d, which is not before it (use ak_skeleton_reorder)",
-                         i, j->name, j->parent);
+            akp_diag_set(
+                diag, NULL,
+                "joint %zu '%s' has parent %d, which is not before it (use ak_skeleton_reorder)", i,
+                j->name, j->parent);
             return AK_ERR_BAD_HIERARCHY;
         }
         if (!ak_transform_is_finite(j->rest)) {
@@ -120,18 +125,23 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
             return AK_ERR_BAD_DATA;
         }
         if (!(ak_quat_dot(j->rest.rotation, j->rest.rotation) > 1e-12f)) {
-            akp_diag_set(diag, NULL, "joint %zu '%s' has a zero rest rotation (use ak_transform_identity())", i,
+            akp_diag_set(diag, NULL,
+                         "joint %zu '%s' has a zero rest rotation (use ak_transform_identity())", i,
                          j->name);
             return AK_ERR_BAD_DATA;
         }
         if (j->inverse_bind && !mat4_finite(j->inverse_bind)) {
-            akp_diag_set(diag, NULL, "joint %zu '%s' has a non-finite inverse bind matrix", i, j->name);
+            akp_diag_set(diag, NULL, "joint %zu '%s' has a non-finite inverse bind matrix", i,
+                         j->name);
             return AK_ERR_BAD_DATA;
         }
         const ak_joint_limits* l = &j->limits;
-        if (!limits_finite(l) || l->min > l->max || l->twist_min > l->twist_max || l->cone_angle < 0.0f) {
-            akp_diag_set(diag, NULL, "joint %zu '%s' has invalid limits (non-finite, min > max or negative cone)", i,
-                         j->name);
+        if (!limits_finite(l) || l->min > l->max || l->twist_min > l->twist_max ||
+            l->cone_angle < 0.0f) {
+            akp_diag_set(
+                diag, NULL,
+                "joint %zu '%s' has invalid limits (non-finite, min > max or negative cone)", i,
+                j->name);
             return AK_ERR_BAD_DATA;
         }
     }
@@ -192,14 +202,15 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
     }
     for (size_t i = 0; i < n; ++i) {
         const ak_joint_desc* j = &desc->joints[i];
-        sk->inverse_binds[i] = j->inverse_bind ? *j->inverse_bind : ak_mat4_inverse_affine(sk->inverse_binds[i]);
+        sk->inverse_binds[i] =
+            j->inverse_bind ? *j->inverse_bind : ak_mat4_inverse_affine(sk->inverse_binds[i]);
     }
 
     qsort(refs, n, sizeof(name_ref), cmp_name_ref);
     for (size_t i = 1; i < n; ++i) {
         if (strcmp(refs[i - 1].name, refs[i].name) == 0) {
-            akp_diag_set(diag, NULL, "joints %zu and %zu share the name '%s'", refs[i - 1].index, refs[i].index,
-                         refs[i].name);
+            akp_diag_set(diag, NULL, "joints %zu and %zu share the name '%s'", refs[i - 1].index,
+                         refs[i].index, refs[i].name);
             akp_free(alloc, refs);
             akp_free(alloc, base);
             return AK_ERR_DUPLICATE;
@@ -217,12 +228,14 @@ void ak_skeleton_destroy(ak_skeleton* skeleton) {
 }
 
 ak_result ak_skeleton_reorder(ak_i32_cspan parents, ak_i32_span out_order) {
-    if ((parents.count && !parents.ptr) || (parents.count && !out_order.ptr)) return AK_ERR_NULL_ARG;
+    if ((parents.count && !parents.ptr) || (parents.count && !out_order.ptr))
+        return AK_ERR_NULL_ARG;
     if (out_order.count < parents.count) return AK_ERR_SPAN_SMALL;
     const size_t n = parents.count;
     if (n == 0) return AK_OK;
     for (size_t i = 0; i < n; ++i)
-        if (parents.ptr[i] < -1 || (parents.ptr[i] >= 0 && (size_t)parents.ptr[i] >= n)) return AK_ERR_BAD_HIERARCHY;
+        if (parents.ptr[i] < -1 || (parents.ptr[i] >= 0 && (size_t)parents.ptr[i] >= n))
+            return AK_ERR_BAD_HIERARCHY;
     /* Temporary state per joint: 0 not placed, 1 placed, 2 on the chain being walked. This is
      * an offline helper, so it uses the C heap for its scratch. */
     uint8_t* state = (uint8_t*)calloc(n, 1);
@@ -259,7 +272,9 @@ ak_result ak_skeleton_reorder(ak_i32_cspan parents, ak_i32_span out_order) {
 
 /* ---- queries ------------------------------------------------------------------------- */
 
-size_t ak_skeleton_joint_count(const ak_skeleton* skeleton) { return skeleton ? skeleton->joint_count : 0; }
+size_t ak_skeleton_joint_count(const ak_skeleton* skeleton) {
+    return skeleton ? skeleton->joint_count : 0;
+}
 
 ak_i16_cspan ak_skeleton_parents(const ak_skeleton* skeleton) {
     ak_i16_cspan s = {skeleton ? skeleton->parents : NULL, skeleton ? skeleton->joint_count : 0};
@@ -272,7 +287,8 @@ ak_transform_cspan ak_skeleton_rest_pose(const ak_skeleton* skeleton) {
 }
 
 ak_mat4_cspan ak_skeleton_inverse_binds(const ak_skeleton* skeleton) {
-    ak_mat4_cspan s = {skeleton ? skeleton->inverse_binds : NULL, skeleton ? skeleton->joint_count : 0};
+    ak_mat4_cspan s = {skeleton ? skeleton->inverse_binds : NULL,
+                       skeleton ? skeleton->joint_count : 0};
     return s;
 }
 
@@ -296,7 +312,8 @@ ak_joint_type ak_skeleton_joint_type(const ak_skeleton* skeleton, size_t joint_i
 ak_joint_limits ak_skeleton_joint_limits(const ak_skeleton* skeleton, size_t joint_index) {
     ak_joint_limits zero;
     memset(&zero, 0, sizeof zero);
-    if (!skeleton || joint_index >= skeleton->joint_count) return resolve_limits(AK_JOINT_FREE, zero);
+    if (!skeleton || joint_index >= skeleton->joint_count)
+        return resolve_limits(AK_JOINT_FREE, zero);
     return skeleton->limits[joint_index];
 }
 
@@ -307,34 +324,42 @@ size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index) 
 
 /* ---- forward kinematics -------------------------------------------------------------- */
 
-static void fk(const ak_skeleton* sk, const ak_mat4* root, const ak_transform* local, ak_mat4* out) {
+static void fk(const ak_skeleton* sk, const ak_mat4* root, const ak_transform* local,
+               ak_mat4* out) {
     const size_t n = sk->joint_count;
     for (size_t i = 0; i < n; ++i) {
         ak_mat4 m = ak_transform_to_mat4(local[i]);
         int p = sk->parents[i];
-        if (p >= 0) out[i] = ak_mat4_mul(out[p], m);
-        else out[i] = root ? ak_mat4_mul(*root, m) : m;
+        if (p >= 0)
+            out[i] = ak_mat4_mul(out[p], m);
+        else
+            out[i] = root ? ak_mat4_mul(*root, m) : m;
     }
 }
 
-ak_result ak_skeleton_local_to_model(const ak_skeleton* skeleton, ak_transform_cspan local, ak_mat4_span out_model) {
+ak_result ak_skeleton_local_to_model(const ak_skeleton* skeleton, ak_transform_cspan local,
+                                     ak_mat4_span out_model) {
     if (!skeleton || !local.ptr || !out_model.ptr) return AK_ERR_NULL_ARG;
-    if (local.count < skeleton->joint_count || out_model.count < skeleton->joint_count) return AK_ERR_SPAN_SMALL;
+    if (local.count < skeleton->joint_count || out_model.count < skeleton->joint_count)
+        return AK_ERR_SPAN_SMALL;
     fk(skeleton, NULL, local.ptr, out_model.ptr);
     return AK_OK;
 }
 
-ak_result ak_skeleton_local_to_model_rooted(const ak_skeleton* skeleton, ak_mat4 root, ak_transform_cspan local,
-                                            ak_mat4_span out_model) {
+ak_result ak_skeleton_local_to_model_rooted(const ak_skeleton* skeleton, ak_mat4 root,
+                                            ak_transform_cspan local, ak_mat4_span out_model) {
     if (!skeleton || !local.ptr || !out_model.ptr) return AK_ERR_NULL_ARG;
-    if (local.count < skeleton->joint_count || out_model.count < skeleton->joint_count) return AK_ERR_SPAN_SMALL;
+    if (local.count < skeleton->joint_count || out_model.count < skeleton->joint_count)
+        return AK_ERR_SPAN_SMALL;
     fk(skeleton, &root, local.ptr, out_model.ptr);
     return AK_OK;
 }
 
-ak_result ak_skeleton_skinning_matrices(const ak_skeleton* skeleton, ak_mat4_cspan model, ak_mat4_span out_skin) {
+ak_result ak_skeleton_skinning_matrices(const ak_skeleton* skeleton, ak_mat4_cspan model,
+                                        ak_mat4_span out_skin) {
     if (!skeleton || !model.ptr || !out_skin.ptr) return AK_ERR_NULL_ARG;
-    if (model.count < skeleton->joint_count || out_skin.count < skeleton->joint_count) return AK_ERR_SPAN_SMALL;
+    if (model.count < skeleton->joint_count || out_skin.count < skeleton->joint_count)
+        return AK_ERR_SPAN_SMALL;
     for (size_t i = 0; i < skeleton->joint_count; ++i)
         out_skin.ptr[i] = ak_mat4_mul(model.ptr[i], skeleton->inverse_binds[i]);
     return AK_OK;
@@ -347,8 +372,10 @@ ak_result ak_skeleton_local_to_model_batch(const ak_skeleton* skeleton, size_t c
     if (!local.ptr || !out_model.ptr) return AK_ERR_NULL_ARG;
     const size_t n = skeleton->joint_count;
     if (character_count > SIZE_MAX / n) return AK_ERR_SPAN_SMALL;
-    if (local.count < character_count * n || out_model.count < character_count * n) return AK_ERR_SPAN_SMALL;
-    for (size_t c = 0; c < character_count; ++c) fk(skeleton, NULL, local.ptr + c * n, out_model.ptr + c * n);
+    if (local.count < character_count * n || out_model.count < character_count * n)
+        return AK_ERR_SPAN_SMALL;
+    for (size_t c = 0; c < character_count; ++c)
+        fk(skeleton, NULL, local.ptr + c * n, out_model.ptr + c * n);
     return AK_OK;
 }
 
@@ -360,14 +387,17 @@ void ak_quat_swing_twist(ak_quat q, ak_vec3 axis, ak_quat* out_swing, ak_quat* o
     float d = q.x * a.x + q.y * a.y + q.z * a.z;
     ak_quat twist = ak_quat_make(a.x * d, a.y * d, a.z * d, q.w);
     /* A 180-degree swing leaves no twist component: any twist works, take the identity. */
-    if (ak_quat_dot(twist, twist) < 1e-12f) twist = ak_quat_identity();
-    else twist = ak_quat_normalize(twist);
+    if (ak_quat_dot(twist, twist) < 1e-12f)
+        twist = ak_quat_identity();
+    else
+        twist = ak_quat_normalize(twist);
     ak_quat swing = ak_quat_normalize(ak_quat_mul(q, ak_quat_conjugate(twist)));
     if (out_swing) *out_swing = swing;
     if (out_twist) *out_twist = twist;
 }
 
-ak_transform ak_skeleton_limit_joint(const ak_skeleton* skeleton, size_t joint_index, ak_transform local) {
+ak_transform ak_skeleton_limit_joint(const ak_skeleton* skeleton, size_t joint_index,
+                                     ak_transform local) {
     if (!skeleton || joint_index >= skeleton->joint_count) return local;
     const ak_joint_type type = (ak_joint_type)skeleton->types[joint_index];
     if (type == AK_JOINT_FREE) return local;
@@ -383,7 +413,8 @@ ak_transform ak_skeleton_limit_joint(const ak_skeleton* skeleton, size_t joint_i
     case AK_JOINT_HINGE: {
         float a = twist_angle(twist, l->axis);
         if (l->min != 0.0f || l->max != 0.0f) a = clamp_angle(a, l->min, l->max);
-        out.rotation = ak_quat_normalize(ak_quat_mul(rest.rotation, ak_quat_from_axis_angle(l->axis, a)));
+        out.rotation =
+            ak_quat_normalize(ak_quat_mul(rest.rotation, ak_quat_from_axis_angle(l->axis, a)));
         break;
     }
     case AK_JOINT_BALL: {
@@ -412,7 +443,8 @@ ak_transform ak_skeleton_limit_joint(const ak_skeleton* skeleton, size_t joint_i
         out.translation = ak_vec3_madd(rest.translation, axis_p, d);
         break;
     }
-    default: break;
+    default:
+        break;
     }
     return out;
 }
@@ -420,11 +452,13 @@ ak_transform ak_skeleton_limit_joint(const ak_skeleton* skeleton, size_t joint_i
 ak_result ak_skeleton_apply_limits(const ak_skeleton* skeleton, ak_transform_span pose) {
     if (!skeleton || !pose.ptr) return AK_ERR_NULL_ARG;
     if (pose.count < skeleton->joint_count) return AK_ERR_SPAN_SMALL;
-    for (size_t i = 0; i < skeleton->joint_count; ++i) pose.ptr[i] = ak_skeleton_limit_joint(skeleton, i, pose.ptr[i]);
+    for (size_t i = 0; i < skeleton->joint_count; ++i)
+        pose.ptr[i] = ak_skeleton_limit_joint(skeleton, i, pose.ptr[i]);
     return AK_OK;
 }
 
-bool ak_skeleton_joint_within_limits(const ak_skeleton* skeleton, size_t joint_index, ak_transform local, float tol) {
+bool ak_skeleton_joint_within_limits(const ak_skeleton* skeleton, size_t joint_index,
+                                     ak_transform local, float tol) {
     if (!skeleton || joint_index >= skeleton->joint_count) return false;
     if (!ak_transform_is_finite(local)) return false;
     const ak_joint_type type = (ak_joint_type)skeleton->types[joint_index];
@@ -455,7 +489,8 @@ bool ak_skeleton_joint_within_limits(const ak_skeleton* skeleton, size_t joint_i
         if (l->min == 0.0f && l->max == 0.0f) return true;
         return d >= l->min - tol && d <= l->max + tol;
     }
-    default: return true;
+    default:
+        return true;
     }
 }
 

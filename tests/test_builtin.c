@@ -31,8 +31,8 @@ static double mesh_volume(const ak_mesh* m) {
 /* Sample a clip into a pose that starts at the rest pose; returns false on error. */
 static bool sample(const ak_scene* s, size_t clip, float t, ak_transform* local, size_t n) {
     if (ak_scene_rest_pose(s, (ak_transform_span){local, n}) != AK_OK) return false;
-    return ak_clip_sample(s->clips[clip], t, NULL, (ak_transform_span){local, n}, (ak_f32_span){NULL, 0},
-                          (ak_f32_span){NULL, 0}) == AK_OK;
+    return ak_clip_sample(s->clips[clip], t, NULL, (ak_transform_span){local, n},
+                          (ak_f32_span){NULL, 0}, (ak_f32_span){NULL, 0}) == AK_OK;
 }
 
 /* Common structure: one skinned mesh on skin 0, slots = joints, palette at bind = identity. */
@@ -57,11 +57,15 @@ static void check_scene_shape(const ak_scene* s) {
     ak_mat4* world = (ak_mat4*)malloc(n * sizeof *world);
     ak_mat4* pal = (ak_mat4*)malloc(n * sizeof *pal);
     ak_scene_rest_pose(s, (ak_transform_span){local, n});
-    AK_CHECK_EQ(ak_scene_world_matrices(s, (ak_transform_cspan){local, n}, (ak_mat4_span){world, n}), AK_OK);
-    AK_CHECK_EQ(ak_scene_skin_palette(s, 0, (ak_mat4_cspan){world, n}, (ak_mat4_span){pal, n}), AK_OK);
+    AK_CHECK_EQ(
+        ak_scene_world_matrices(s, (ak_transform_cspan){local, n}, (ak_mat4_span){world, n}),
+        AK_OK);
+    AK_CHECK_EQ(ak_scene_skin_palette(s, 0, (ak_mat4_cspan){world, n}, (ak_mat4_span){pal, n}),
+                AK_OK);
     double worst = 0.0;
     for (size_t j = 0; j < n; ++j)
-        for (int e = 0; e < 16; ++e) worst = fmax(worst, fabs(pal[j].m[e] - ((e % 5 == 0) ? 1.0 : 0.0)));
+        for (int e = 0; e < 16; ++e)
+            worst = fmax(worst, fabs(pal[j].m[e] - ((e % 5 == 0) ? 1.0 : 0.0)));
     AK_CHECK_MSG(worst < 1e-5, "bind palette differs from identity by %g", worst);
     /* Joint names present and unique. */
     for (size_t j = 0; j < n; ++j) {
@@ -83,7 +87,8 @@ static void check_scene_shape(const ak_scene* s) {
             for (size_t j = 0; j < n; ++j)
                 if (!ak_skeleton_joint_within_limits(s->skeleton, j, local[j], 1e-3f)) {
                     if (outside < 3)
-                        printf("  clip %s t=%.3f joint %s outside its limits\n", ak_clip_name(s->clips[c]), (double)t,
+                        printf("  clip %s t=%.3f joint %s outside its limits\n",
+                               ak_clip_name(s->clips[c]), (double)t,
                                ak_skeleton_joint_name(s->skeleton, j));
                     ++outside;
                 }
@@ -110,8 +115,9 @@ AK_TEST(names_and_errors) {
     AK_CHECK_EQ(ak_builtin_create("builtin:", NULL, NULL, &s), AK_ERR_NOT_FOUND);
     AK_CHECK_EQ(ak_builtin_create(NULL, NULL, NULL, &s), AK_ERR_NULL_ARG);
     AK_CHECK_EQ(ak_builtin_create("cylinder", NULL, NULL, NULL), AK_ERR_NULL_ARG);
-    ak_builtin_desc bad[] = {{.bone_count = 4}, {.bone_count = 1}, {.length = -1.0f}, {.radius = NAN},
-                             {.segments = 2},   {.rings = 5000},   {.blend = 1.5f},   {.blend = -0.1f}};
+    ak_builtin_desc bad[] = {{.bone_count = 4}, {.bone_count = 1}, {.length = -1.0f},
+                             {.radius = NAN},   {.segments = 2},   {.rings = 5000},
+                             {.blend = 1.5f},   {.blend = -0.1f}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i)
         AK_CHECK_EQ(ak_builtin_create("cylinder", &bad[i], NULL, &s), AK_ERR_BAD_ARG);
     ak_builtin_desc bad_cell = {.cell_size = 0.001f}, nan_cell = {.cell_size = NAN};
@@ -120,7 +126,8 @@ AK_TEST(names_and_errors) {
     AK_CHECK(s == NULL);
     /* Defaults documented in the header. */
     ak_builtin_desc d = ak_builtin_desc_resolved(NULL);
-    AK_CHECK(d.length == 2.0f && d.radius == 0.25f && d.rings == 48 && d.segments == 32 && d.bone_count == 2);
+    AK_CHECK(d.length == 2.0f && d.radius == 0.25f && d.rings == 48 && d.segments == 32 &&
+             d.bone_count == 2);
     AK_CHECK(d.blend == 0.5f && d.cell_size == 0.03f);
     ak_builtin_desc some = {.rings = 7};
     AK_CHECK_EQ(ak_builtin_desc_resolved(&some).rings, 7);
@@ -154,7 +161,8 @@ AK_TEST(cylinder_default) {
         float w1 = 0.0f;
         for (int k = 0; k < 4; ++k) {
             if (m->weights[4 * v + (size_t)k] > 0.0f) ++nz;
-            if (m->weights[4 * v + (size_t)k] > 0.0f && m->joints[4 * v + (size_t)k] == 1) w1 += m->weights[4 * v + (size_t)k];
+            if (m->weights[4 * v + (size_t)k] > 0.0f && m->joints[4 * v + (size_t)k] == 1)
+                w1 += m->weights[4 * v + (size_t)k];
             if (m->weights[4 * v + (size_t)k] > 0.0f && m->joints[4 * v + (size_t)k] == 2) ++many;
         }
         if (nz > 2) ++many;
@@ -202,7 +210,12 @@ AK_TEST(cylinder_default) {
 }
 
 AK_TEST(cylinder_three_bones) {
-    ak_builtin_desc d = {.length = 3.0f, .radius = 0.1f, .rings = 30, .segments = 12, .bone_count = 3, .blend = 0.2f};
+    ak_builtin_desc d = {.length = 3.0f,
+                         .radius = 0.1f,
+                         .rings = 30,
+                         .segments = 12,
+                         .bone_count = 3,
+                         .blend = 0.2f};
     ak_scene* s = NULL;
     AK_CHECK_EQ(ak_builtin_create("cylinder", &d, NULL, &s), AK_OK);
     if (!s) return;
@@ -218,7 +231,8 @@ AK_TEST(cylinder_three_bones) {
     ak_mat4 world[4];
     AK_CHECK(sample(s, (size_t)ak_scene_find_clip(s, "bend"), 1.0f, local, 4));
     ak_scene_world_matrices(s, (ak_transform_cspan){local, 4}, (ak_mat4_span){world, 4});
-    ak_vec3 dir = ak_vec3_normalize(ak_vec3_sub(ak_mat4_get_translation(world[3]), ak_mat4_get_translation(world[2])));
+    ak_vec3 dir = ak_vec3_normalize(
+        ak_vec3_sub(ak_mat4_get_translation(world[3]), ak_mat4_get_translation(world[2])));
     AK_CHECK_NEAR(dir.x, -sin(2.0 * PI_D / 3.0), 1e-4);
     AK_CHECK_NEAR(dir.y, cos(2.0 * PI_D / 3.0), 1e-4);
     /* Narrow blend band: a vertex 0.2 above joint1 (y = 1) belongs to bone 1 only. */
@@ -231,9 +245,9 @@ AK_TEST(cylinder_three_bones) {
 }
 
 static const char* const required_joints[] = {
-    "pelvis",      "spine_01",   "spine_02",    "neck",       "head",        "left_shoulder",
-    "left_elbow",  "left_wrist", "right_shoulder", "right_elbow", "right_wrist", "left_hip",
-    "left_knee",   "left_ankle", "right_hip",   "right_knee", "right_ankle"};
+    "pelvis",     "spine_01",   "spine_02",       "neck",        "head",        "left_shoulder",
+    "left_elbow", "left_wrist", "right_shoulder", "right_elbow", "right_wrist", "left_hip",
+    "left_knee",  "left_ankle", "right_hip",      "right_knee",  "right_ankle"};
 
 AK_TEST(humanoid) {
     ak_scene* s = NULL;
@@ -244,8 +258,8 @@ AK_TEST(humanoid) {
     const size_t n = ak_scene_joint_count(s);
     AK_CHECK(n >= 17);
     for (size_t i = 0; i < sizeof required_joints / sizeof required_joints[0]; ++i)
-        AK_CHECK_MSG(ak_skeleton_find_joint(s->skeleton, required_joints[i]) >= 0, "joint %s missing",
-                     required_joints[i]);
+        AK_CHECK_MSG(ak_skeleton_find_joint(s->skeleton, required_joints[i]) >= 0,
+                     "joint %s missing", required_joints[i]);
     const char* hinges[] = {"left_elbow", "right_elbow", "left_knee", "right_knee"};
     for (int i = 0; i < 4; ++i) {
         int j = ak_skeleton_find_joint(s->skeleton, hinges[i]);
@@ -261,8 +275,8 @@ AK_TEST(humanoid) {
     }
 
     const ak_mesh* m = s->meshes[0].mesh;
-    printf("  humanoid: %zu vertices, %zu triangles, volume %.4f m^3\n", m->vertex_count, m->triangle_count,
-           mesh_volume(m));
+    printf("  humanoid: %zu vertices, %zu triangles, volume %.4f m^3\n", m->vertex_count,
+           m->triangle_count, mesh_volume(m));
     AK_CHECK(m->triangle_count >= 5000 && m->triangle_count <= 20000);
     /* Hand bounds: a 1.8 m figure. An adult of ~70 kg displaces ~0.07 m^3; a capsule
      * figure is slimmer, but more than its trunk cylinder (pi 0.11^2 0.75 * 0.5 m). */
@@ -277,7 +291,8 @@ AK_TEST(humanoid) {
 
     /* Normals: unit, and agreeing with the geometric (area-weighted) normals. */
     ak_vec3* geo = (ak_vec3*)malloc(m->vertex_count * sizeof *geo);
-    ak_normals_compute((ak_vec3_cspan){m->positions, m->vertex_count}, (ak_u32_cspan){m->indices, 3 * m->triangle_count},
+    ak_normals_compute((ak_vec3_cspan){m->positions, m->vertex_count},
+                       (ak_u32_cspan){m->indices, 3 * m->triangle_count},
                        (ak_vec3_span){geo, m->vertex_count});
     size_t disagree = 0, nonunit = 0;
     for (size_t v = 0; v < m->vertex_count; ++v) {
@@ -286,8 +301,8 @@ AK_TEST(humanoid) {
     }
     free(geo);
     AK_CHECK_EQ(nonunit, 0);
-    AK_CHECK_MSG(disagree * 100 < m->vertex_count, "%zu of %zu normals disagree with the faces", disagree,
-                 m->vertex_count);
+    AK_CHECK_MSG(disagree * 100 < m->vertex_count, "%zu of %zu normals disagree with the faces",
+                 disagree, m->vertex_count);
 
     /* Left/right separation: no vertex clearly on one side is driven by the other side's limbs. */
     size_t crossed = 0;
@@ -295,7 +310,8 @@ AK_TEST(humanoid) {
         float x = m->positions[v].x;
         for (uint32_t k = 0; k < m->influence_count; ++k) {
             if (m->weights[v * m->influence_count + k] <= 0.0f) continue;
-            const char* nm = ak_skeleton_joint_name(s->skeleton, m->joints[v * m->influence_count + k]);
+            const char* nm =
+                ak_skeleton_joint_name(s->skeleton, m->joints[v * m->influence_count + k]);
             if (x > 0.03f && strncmp(nm, "right_", 6) == 0) ++crossed;
             if (x < -0.03f && strncmp(nm, "left_", 5) == 0) ++crossed;
         }
@@ -337,7 +353,8 @@ AK_TEST(humanoid) {
             max_knee = ak_maxf(max_knee, ang);
         }
         AK_CHECK(max_knee > 0.6f);
-        int rw = ak_skeleton_find_joint(s->skeleton, "right_wrist"), rs = ak_skeleton_find_joint(s->skeleton, "right_shoulder");
+        int rw = ak_skeleton_find_joint(s->skeleton, "right_wrist"),
+            rs = ak_skeleton_find_joint(s->skeleton, "right_shoulder");
         sample(s, (size_t)wave, 1.0f, a, n);
         ak_scene_world_matrices(s, (ak_transform_cspan){a, n}, (ak_mat4_span){world, n});
         AK_CHECK(world[rw].m[13] > world[rs].m[13] + 0.1f);

@@ -26,11 +26,13 @@ static void count_free(void* p, void* user) {
 static ak_mesh* make_cube(ak_vec3 offset, bool normals) {
     static const uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
                                          {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-    ak_mesh_desc d = {.vertex_count = 8, .triangle_count = 12, .has_normals = normals, .name = "cube"};
+    ak_mesh_desc d = {
+        .vertex_count = 8, .triangle_count = 12, .has_normals = normals, .name = "cube"};
     ak_mesh* m = NULL;
     if (ak_mesh_create(&d, NULL, &m) != AK_OK) return NULL;
     for (uint32_t i = 0; i < 8; ++i)
-        m->positions[i] = ak_vec3_add(offset, ak_vec3_make((float)(i & 1), (float)((i >> 1) & 1), (float)((i >> 2) & 1)));
+        m->positions[i] = ak_vec3_add(
+            offset, ak_vec3_make((float)(i & 1), (float)((i >> 1) & 1), (float)((i >> 2) & 1)));
     for (int f = 0; f < 6; ++f) {
         uint32_t* t = m->indices + 6 * f;
         t[0] = quads[f][0], t[1] = quads[f][1], t[2] = quads[f][2];
@@ -51,7 +53,8 @@ static ak_mesh* make_sphere(float r, uint32_t rings, uint32_t segs) {
         for (uint32_t j = 0; j < segs; ++j) {
             double th = PI_D * i / rings, ph = 2.0 * PI_D * j / segs;
             m->positions[1 + (i - 1) * segs + j] =
-                ak_vec3_make((float)(r * sin(th) * cos(ph)), (float)(r * cos(th)), (float)(-r * sin(th) * sin(ph)));
+                ak_vec3_make((float)(r * sin(th) * cos(ph)), (float)(r * cos(th)),
+                             (float)(-r * sin(th) * sin(ph)));
         }
     uint32_t* t = m->indices;
     for (uint32_t j = 0; j < segs; ++j) {
@@ -73,8 +76,14 @@ static ak_mesh* make_sphere(float r, uint32_t rings, uint32_t segs) {
 AK_TEST(create_one_allocation_and_zeroed) {
     counter c = {0, 0};
     ak_allocator a = {count_alloc, count_free, &c};
-    ak_mesh_desc d = {.vertex_count = 5, .triangle_count = 2, .influence_count = 4, .morph_target_count = 2,
-                      .has_normals = true, .has_uvs = true, .has_colors = true, .has_morph_normals = true,
+    ak_mesh_desc d = {.vertex_count = 5,
+                      .triangle_count = 2,
+                      .influence_count = 4,
+                      .morph_target_count = 2,
+                      .has_normals = true,
+                      .has_uvs = true,
+                      .has_colors = true,
+                      .has_morph_normals = true,
                       .name = "box"};
     ak_mesh* m = NULL;
     AK_CHECK_EQ(ak_mesh_create(&d, &a, &m), AK_OK);
@@ -83,7 +92,8 @@ AK_TEST(create_one_allocation_and_zeroed) {
     AK_CHECK_EQ(c.live, 1);
     AK_CHECK_EQ(c.total, 1);
     AK_CHECK_STREQ(m->name, "box");
-    AK_CHECK(m->positions && m->normals && m->uvs && m->colors && m->indices && m->joints && m->weights);
+    AK_CHECK(m->positions && m->normals && m->uvs && m->colors && m->indices && m->joints &&
+             m->weights);
     AK_CHECK(m->morph_positions && m->morph_normals && m->morph_weights && m->morph_names);
     /* Every array zeroed, and writing all of them stays inside the block (ASan checks). */
     for (size_t i = 0; i < 20; ++i) AK_CHECK(m->weights[i] == 0.0f && m->joints[i] == 0);
@@ -97,7 +107,8 @@ AK_TEST(create_one_allocation_and_zeroed) {
     ak_mesh_desc plain = {.vertex_count = 3};
     AK_CHECK_EQ(ak_mesh_create(&plain, NULL, &m), AK_OK);
     AK_CHECK(m->normals == NULL && m->uvs == NULL && m->colors == NULL && m->indices == NULL);
-    AK_CHECK(m->joints == NULL && m->weights == NULL && m->morph_positions == NULL && m->morph_names == NULL);
+    AK_CHECK(m->joints == NULL && m->weights == NULL && m->morph_positions == NULL &&
+             m->morph_names == NULL);
     AK_CHECK_STREQ(m->name, "");
     ak_mesh_destroy(m);
     ak_mesh_destroy(NULL);
@@ -128,8 +139,12 @@ AK_TEST(create_bad_input) {
 }
 
 AK_TEST(clone_is_deep) {
-    ak_mesh_desc d = {.vertex_count = 4, .triangle_count = 1, .influence_count = 2, .morph_target_count = 1,
-                      .has_uvs = true, .name = "src"};
+    ak_mesh_desc d = {.vertex_count = 4,
+                      .triangle_count = 1,
+                      .influence_count = 2,
+                      .morph_target_count = 1,
+                      .has_uvs = true,
+                      .name = "src"};
     ak_mesh* m = NULL;
     AK_CHECK_EQ(ak_mesh_create(&d, NULL, &m), AK_OK);
     for (int i = 0; i < 4; ++i) {
@@ -202,7 +217,8 @@ AK_TEST(normals) {
     m->positions[3] = ak_vec3_make(5, 5, 5); /* on no triangle */
     m->indices[0] = 0, m->indices[1] = 1, m->indices[2] = 2;
     AK_CHECK_EQ(ak_mesh_compute_normals(m), AK_OK);
-    for (int i = 0; i < 3; ++i) AK_CHECK(m->normals[i].x == 0.0f && m->normals[i].y == 0.0f && m->normals[i].z == 1.0f);
+    for (int i = 0; i < 3; ++i)
+        AK_CHECK(m->normals[i].x == 0.0f && m->normals[i].y == 0.0f && m->normals[i].z == 1.0f);
     AK_CHECK(m->normals[3].x == 0.0f && m->normals[3].y == 1.0f && m->normals[3].z == 0.0f);
     ak_mesh_destroy(m);
 
@@ -214,7 +230,8 @@ AK_TEST(normals) {
     for (uint32_t i = 0; i < 8; ++i) {
         ak_vec3 n = m->normals[i];
         AK_CHECK_NEAR(ak_vec3_length(n), 1.0, 1e-5);
-        AK_CHECK((n.x > 0) == ((i & 1) != 0) && (n.y > 0) == ((i & 2) != 0) && (n.z > 0) == ((i & 4) != 0));
+        AK_CHECK((n.x > 0) == ((i & 1) != 0) && (n.y > 0) == ((i & 2) != 0) &&
+                 (n.z > 0) == ((i & 4) != 0));
     }
     ak_vec3 out[8];
     ak_vec3_cspan p = {m->positions, 8};
@@ -295,8 +312,9 @@ AK_TEST(closed_oriented) {
     AK_CHECK(!ak_mesh_is_closed_oriented(m));
     m->triangle_count = 4;
     AK_CHECK(ak_mesh_is_closed_oriented(m));
-    AK_CHECK_NEAR(ak_volume_compute((ak_vec3_cspan){m->positions, 4}, (ak_u32_cspan){m->indices, 12}), 1.0 / 6.0,
-                  1e-9);
+    AK_CHECK_NEAR(
+        ak_volume_compute((ak_vec3_cspan){m->positions, 4}, (ak_u32_cspan){m->indices, 12}),
+        1.0 / 6.0, 1e-9);
     ak_mesh_destroy(m);
 }
 

@@ -27,7 +27,10 @@ static bool near3(ak_vec3 a, float x, float y, float z, float tol) {
 static ak_clip* make_clip(const char* name, uint32_t joint, const ak_allocator* alloc) {
     static const float times[2] = {0.0f, 1.0f};
     static const float values[8] = {0, 0, 0, 1, 0, 0, 0.70710678f, 0.70710678f};
-    ak_raw_channel ch = {.target = AK_CHANNEL_ROTATION, .index = joint, .key_count = 2, .times = times,
+    ak_raw_channel ch = {.target = AK_CHANNEL_ROTATION,
+                         .index = joint,
+                         .key_count = 2,
+                         .times = times,
                          .values = values};
     ak_raw_clip raw = {.name = name, .channels = &ch, .channel_count = 1, .joint_count = 3};
     ak_clip* c = NULL;
@@ -44,7 +47,9 @@ static ak_scene* make_scene(const ak_allocator* alloc) {
     snprintf(s->name, sizeof s->name, "hand-built");
     ak_joint_desc js[3] = {
         {.name = "root", .parent = -1, .rest = {{1, 0, 0}, {0, 0, 0, 1}, {1, 1, 1}}},
-        {.name = "arm", .parent = 0, .rest = {{0, 2, 0}, {0, 0, 0.70710678f, 0.70710678f}, {1, 1, 1}}},
+        {.name = "arm",
+         .parent = 0,
+         .rest = {{0, 2, 0}, {0, 0, 0.70710678f, 0.70710678f}, {1, 1, 1}}},
         {.name = "hand", .parent = 1, .rest = {{1, 0, 0}, {0, 0, 0, 1}, {1, 1, 1}}},
     };
     ak_skeleton_desc sd = {.joints = js, .joint_count = 3};
@@ -86,7 +91,8 @@ AK_TEST(alloc_and_destroy) {
     AK_CHECK(s->is_joint == NULL);
     AK_CHECK_EQ(ak_scene_joint_count(s), 3);
     /* The fresh skin slots have identity inverse binds. */
-    for (int e = 0; e < 16; ++e) AK_CHECK(s->skins[0].inverse_binds[1].m[e] == ((e % 5 == 0) ? 1.0f : 0.0f));
+    for (int e = 0; e < 16; ++e)
+        AK_CHECK(s->skins[0].inverse_binds[1].m[e] == ((e % 5 == 0) ? 1.0f : 0.0f));
     AK_CHECK_EQ(ak_scene_skin_alloc(s, 1, 4), AK_ERR_BAD_INDEX);
     AK_CHECK_EQ(ak_scene_skin_alloc(NULL, 0, 4), AK_ERR_NULL_ARG);
     ak_scene_destroy(s);
@@ -148,17 +154,21 @@ AK_TEST(rest_world_palette) {
     AK_CHECK_EQ(ak_scene_rest_pose(NULL, (ak_transform_span){local, 4}), AK_ERR_NULL_ARG);
 
     ak_mat4 world[3];
-    AK_CHECK_EQ(ak_scene_world_matrices(s, (ak_transform_cspan){local, 3}, (ak_mat4_span){world, 3}), AK_OK);
+    AK_CHECK_EQ(
+        ak_scene_world_matrices(s, (ak_transform_cspan){local, 3}, (ak_mat4_span){world, 3}),
+        AK_OK);
     AK_CHECK(near3(ak_mat4_get_translation(world[0]), 1, 0, 0, 1e-6f));
     AK_CHECK(near3(ak_mat4_get_translation(world[1]), 1, 2, 0, 1e-6f));
     /* The arm is turned 90 degrees about Z: its +X is world +Y, so the hand is 1 above. */
     AK_CHECK(near3(ak_mat4_get_translation(world[2]), 1, 3, 0, 1e-6f));
-    AK_CHECK_EQ(ak_scene_world_matrices(s, (ak_transform_cspan){local, 2}, (ak_mat4_span){world, 3}),
-                AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(
+        ak_scene_world_matrices(s, (ak_transform_cspan){local, 2}, (ak_mat4_span){world, 3}),
+        AK_ERR_SPAN_SMALL);
 
     /* Palette with identity inverse binds = the slots' world matrices (slot 0 -> hand). */
     ak_mat4 pal[2];
-    AK_CHECK_EQ(ak_scene_skin_palette(s, 0, (ak_mat4_cspan){world, 3}, (ak_mat4_span){pal, 2}), AK_OK);
+    AK_CHECK_EQ(ak_scene_skin_palette(s, 0, (ak_mat4_cspan){world, 3}, (ak_mat4_span){pal, 2}),
+                AK_OK);
     AK_CHECK(memcmp(&pal[0], &world[2], sizeof(ak_mat4)) == 0);
     AK_CHECK(memcmp(&pal[1], &world[0], sizeof(ak_mat4)) == 0);
     /* With real inverse binds, the bind pose gives identity palettes. */
@@ -170,16 +180,20 @@ AK_TEST(rest_world_palette) {
         for (int e = 0; e < 16; ++e) AK_CHECK_NEAR(pal[k].m[e], (e % 5 == 0) ? 1.0 : 0.0, 1e-6);
     /* A clip sample moves the hand: at t = 0 "idle" gives the arm the identity rotation
      * (instead of its 90-degree rest turn), so the hand sits 1 along +X: (2,2,0). */
-    AK_CHECK_EQ(ak_clip_sample(s->clips[0], 0.0f, NULL, (ak_transform_span){local, 3}, (ak_f32_span){NULL, 0},
-                               (ak_f32_span){NULL, 0}),
+    AK_CHECK_EQ(ak_clip_sample(s->clips[0], 0.0f, NULL, (ak_transform_span){local, 3},
+                               (ak_f32_span){NULL, 0}, (ak_f32_span){NULL, 0}),
                 AK_OK);
     ak_scene_world_matrices(s, (ak_transform_cspan){local, 3}, (ak_mat4_span){world, 3});
     AK_CHECK(near3(ak_mat4_get_translation(world[2]), 2, 2, 0, 1e-5f));
 
-    AK_CHECK_EQ(ak_scene_skin_palette(s, 1, (ak_mat4_cspan){world, 3}, (ak_mat4_span){pal, 2}), AK_ERR_BAD_INDEX);
-    AK_CHECK_EQ(ak_scene_skin_palette(s, 0, (ak_mat4_cspan){world, 3}, (ak_mat4_span){pal, 1}), AK_ERR_SPAN_SMALL);
-    AK_CHECK_EQ(ak_scene_skin_palette(s, 0, (ak_mat4_cspan){world, 2}, (ak_mat4_span){pal, 2}), AK_ERR_BAD_INDEX);
-    AK_CHECK_EQ(ak_scene_skin_palette(NULL, 0, (ak_mat4_cspan){world, 3}, (ak_mat4_span){pal, 2}), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_scene_skin_palette(s, 1, (ak_mat4_cspan){world, 3}, (ak_mat4_span){pal, 2}),
+                AK_ERR_BAD_INDEX);
+    AK_CHECK_EQ(ak_scene_skin_palette(s, 0, (ak_mat4_cspan){world, 3}, (ak_mat4_span){pal, 1}),
+                AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_scene_skin_palette(s, 0, (ak_mat4_cspan){world, 2}, (ak_mat4_span){pal, 2}),
+                AK_ERR_BAD_INDEX);
+    AK_CHECK_EQ(ak_scene_skin_palette(NULL, 0, (ak_mat4_cspan){world, 3}, (ak_mat4_span){pal, 2}),
+                AK_ERR_NULL_ARG);
     ak_scene_destroy(s);
 }
 

@@ -54,14 +54,17 @@ static double max_diff(const ak_mat4* a, const dmat4* b) {
 
 static ak_quat random_quat(ak_rng* rng) {
     /* Uniform on SO(3) (Shoemake). */
-    double u1 = ak_rng_double(rng), u2 = ak_rng_double(rng) * 2 * PI_D, u3 = ak_rng_double(rng) * 2 * PI_D;
+    double u1 = ak_rng_double(rng), u2 = ak_rng_double(rng) * 2 * PI_D,
+           u3 = ak_rng_double(rng) * 2 * PI_D;
     double a = sqrt(1 - u1), b = sqrt(u1);
-    return ak_quat_make((float)(a * sin(u2)), (float)(a * cos(u2)), (float)(b * sin(u3)), (float)(b * cos(u3)));
+    return ak_quat_make((float)(a * sin(u2)), (float)(a * cos(u2)), (float)(b * sin(u3)),
+                        (float)(b * cos(u3)));
 }
 
 static ak_transform random_transform(ak_rng* rng) {
     ak_transform t;
-    t.translation = ak_vec3_make(ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1));
+    t.translation =
+        ak_vec3_make(ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1));
     t.rotation = random_quat(rng);
     float s = ak_rng_range(rng, 0.7f, 1.3f);
     t.scale = ak_vec3_make(s, s * ak_rng_range(rng, 0.9f, 1.1f), s);
@@ -92,8 +95,8 @@ static ak_joint_desc joint(const char* name, int parent, float y) {
 }
 
 AK_TEST(create_and_query) {
-    ak_joint_desc js[4] = {joint("hip", -1, 1.0f), joint("knee", 0, -0.5f), joint("ankle", 1, -0.5f),
-                           joint("other", 0, 0.2f)};
+    ak_joint_desc js[4] = {joint("hip", -1, 1.0f), joint("knee", 0, -0.5f),
+                           joint("ankle", 1, -0.5f), joint("other", 0, 0.2f)};
     js[1].type = AK_JOINT_HINGE;
     js[1].limits.min = 0.0f, js[1].limits.max = 2.5f;
     js[3].type = AK_JOINT_BALL;
@@ -228,7 +231,10 @@ AK_TEST(reorder_shuffled) {
     ak_rng rng = ak_rng_make(11);
     for (int trial = 0; trial < 20; ++trial) {
         int32_t sorted_parent[N];
-        for (int i = 0; i < N; ++i) sorted_parent[i] = (i == 0 || ak_rng_float(&rng) < 0.03f) ? -1 : (int32_t)(ak_rng_u32(&rng) % (uint32_t)i);
+        for (int i = 0; i < N; ++i)
+            sorted_parent[i] = (i == 0 || ak_rng_float(&rng) < 0.03f)
+                                   ? -1
+                                   : (int32_t)(ak_rng_u32(&rng) % (uint32_t)i);
         /* Shuffle: perm[new] = old. */
         int32_t perm[N], inv[N];
         for (int i = 0; i < N; ++i) perm[i] = i;
@@ -240,9 +246,11 @@ AK_TEST(reorder_shuffled) {
         }
         for (int i = 0; i < N; ++i) inv[perm[i]] = i;
         int32_t shuffled[N];
-        for (int i = 0; i < N; ++i) shuffled[i] = sorted_parent[perm[i]] < 0 ? -1 : inv[sorted_parent[perm[i]]];
+        for (int i = 0; i < N; ++i)
+            shuffled[i] = sorted_parent[perm[i]] < 0 ? -1 : inv[sorted_parent[perm[i]]];
         int32_t order[N];
-        AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){shuffled, N}, (ak_i32_span){order, N}), AK_OK);
+        AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){shuffled, N}, (ak_i32_span){order, N}),
+                    AK_OK);
         /* A permutation, with every parent placed before its child. */
         int pos[N], seen[N] = {0};
         for (int k = 0; k < N; ++k) {
@@ -270,13 +278,17 @@ AK_TEST(reorder_shuffled) {
 
 AK_TEST(reorder_errors) {
     int32_t cyc[4] = {-1, 2, 3, 1}, o[4];
-    AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){cyc, 4}, (ak_i32_span){o, 4}), AK_ERR_BAD_HIERARCHY);
+    AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){cyc, 4}, (ak_i32_span){o, 4}),
+                AK_ERR_BAD_HIERARCHY);
     int32_t self[2] = {-1, 1};
-    AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){self, 2}, (ak_i32_span){o, 2}), AK_ERR_BAD_HIERARCHY);
+    AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){self, 2}, (ak_i32_span){o, 2}),
+                AK_ERR_BAD_HIERARCHY);
     int32_t range[2] = {-1, 5};
-    AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){range, 2}, (ak_i32_span){o, 2}), AK_ERR_BAD_HIERARCHY);
+    AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){range, 2}, (ak_i32_span){o, 2}),
+                AK_ERR_BAD_HIERARCHY);
     range[1] = -3;
-    AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){range, 2}, (ak_i32_span){o, 2}), AK_ERR_BAD_HIERARCHY);
+    AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){range, 2}, (ak_i32_span){o, 2}),
+                AK_ERR_BAD_HIERARCHY);
     int32_t ok[3] = {-1, 0, 0};
     AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){ok, 3}, (ak_i32_span){o, 2}), AK_ERR_SPAN_SMALL);
     AK_CHECK_EQ(ak_skeleton_reorder((ak_i32_cspan){NULL, 3}, (ak_i32_span){o, 4}), AK_ERR_NULL_ARG);
@@ -313,7 +325,8 @@ AK_TEST(fk_matches_naive_double) {
     if (!sk) return;
     for (int i = 0; i < FK_N; ++i) pose[i] = random_transform(&rng);
     ak_mat4 model[FK_N];
-    AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N}, (ak_mat4_span){model, FK_N}),
+    AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N},
+                                           (ak_mat4_span){model, FK_N}),
                 AK_OK);
     double worst = 0.0;
     for (int i = 0; i < FK_N; ++i) {
@@ -327,7 +340,8 @@ AK_TEST(fk_matches_naive_double) {
     /* Rooted: every root gets the extra transform. */
     ak_transform rt = random_transform(&rng);
     ak_mat4 rooted[FK_N];
-    AK_CHECK_EQ(ak_skeleton_local_to_model_rooted(sk, ak_transform_to_mat4(rt), (ak_transform_cspan){pose, FK_N},
+    AK_CHECK_EQ(ak_skeleton_local_to_model_rooted(sk, ak_transform_to_mat4(rt),
+                                                  (ak_transform_cspan){pose, FK_N},
                                                   (ak_mat4_span){rooted, FK_N}),
                 AK_OK);
     worst = 0.0;
@@ -342,7 +356,8 @@ AK_TEST(fk_matches_naive_double) {
      * matrix onto the posed one. */
     ak_mat4 rest_model[FK_N], skin[FK_N];
     ak_skeleton_local_to_model(sk, ak_skeleton_rest_pose(sk), (ak_mat4_span){rest_model, FK_N});
-    AK_CHECK_EQ(ak_skeleton_skinning_matrices(sk, (ak_mat4_cspan){rest_model, FK_N}, (ak_mat4_span){skin, FK_N}),
+    AK_CHECK_EQ(ak_skeleton_skinning_matrices(sk, (ak_mat4_cspan){rest_model, FK_N},
+                                              (ak_mat4_span){skin, FK_N}),
                 AK_OK);
     worst = 0.0;
     dmat4 id;
@@ -360,14 +375,18 @@ AK_TEST(fk_matches_naive_double) {
     AK_CHECK_MSG(worst < 1e-3, "palette * rest != posed: %g", worst);
 
     /* Error codes. */
-    AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N - 1}, (ak_mat4_span){model, FK_N}),
+    AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N - 1},
+                                           (ak_mat4_span){model, FK_N}),
                 AK_ERR_SPAN_SMALL);
-    AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N}, (ak_mat4_span){model, 3}),
-                AK_ERR_SPAN_SMALL);
-    AK_CHECK_EQ(ak_skeleton_local_to_model(NULL, (ak_transform_cspan){pose, FK_N}, (ak_mat4_span){model, FK_N}),
+    AK_CHECK_EQ(
+        ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N}, (ak_mat4_span){model, 3}),
+        AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_skeleton_local_to_model(NULL, (ak_transform_cspan){pose, FK_N},
+                                           (ak_mat4_span){model, FK_N}),
                 AK_ERR_NULL_ARG);
-    AK_CHECK_EQ(ak_skeleton_skinning_matrices(sk, (ak_mat4_cspan){model, 2}, (ak_mat4_span){skin, FK_N}),
-                AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(
+        ak_skeleton_skinning_matrices(sk, (ak_mat4_cspan){model, 2}, (ak_mat4_span){skin, FK_N}),
+        AK_ERR_SPAN_SMALL);
     ak_skeleton_destroy(sk);
 }
 
@@ -393,7 +412,8 @@ AK_TEST(fk_batch) {
     AK_CHECK_EQ(ak_skeleton_local_to_model_batch(sk, C, (ak_transform_cspan){poses, C * FK_N - 1},
                                                  (ak_mat4_span){batch, C * FK_N}),
                 AK_ERR_SPAN_SMALL);
-    AK_CHECK_EQ(ak_skeleton_local_to_model_batch(sk, 0, (ak_transform_cspan){NULL, 0}, (ak_mat4_span){NULL, 0}),
+    AK_CHECK_EQ(ak_skeleton_local_to_model_batch(sk, 0, (ak_transform_cspan){NULL, 0},
+                                                 (ak_mat4_span){NULL, 0}),
                 AK_OK);
     ak_skeleton_destroy(sk);
 }
@@ -404,8 +424,8 @@ AK_TEST(swing_twist) {
     ak_rng rng = ak_rng_make(17);
     for (int t = 0; t < 500; ++t) {
         ak_quat q = random_quat(&rng);
-        ak_vec3 axis = ak_vec3_normalize(ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1),
-                                                      ak_rng_range(&rng, -1, 1)));
+        ak_vec3 axis = ak_vec3_normalize(ak_vec3_make(
+            ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1)));
         ak_quat sw, tw;
         ak_quat_swing_twist(q, axis, &sw, &tw);
         /* q = swing * twist, twist's vector part parallel to axis, swing's perpendicular. */
@@ -427,13 +447,14 @@ static ak_skeleton* limited_skeleton(void) {
     for (int i = 0; i < 5; ++i) {
         js[i].name = names[i];
         js[i].parent = i - 1;
-        js[i].rest = ak_transform_make(ak_vec3_make(0.1f * i, 0.5f, 0.0f), i ? tilt : ak_quat_identity(),
-                                       ak_vec3_one());
+        js[i].rest = ak_transform_make(ak_vec3_make(0.1f * i, 0.5f, 0.0f),
+                                       i ? tilt : ak_quat_identity(), ak_vec3_one());
     }
     js[1].type = AK_JOINT_HINGE;
     js[1].limits = (ak_joint_limits){.axis = {0, 0, 2}, .min = -0.5f, .max = 1.2f};
     js[2].type = AK_JOINT_BALL;
-    js[2].limits = (ak_joint_limits){.axis = {0, 1, 0}, .cone_angle = 0.6f, .twist_min = -0.3f, .twist_max = 0.4f};
+    js[2].limits = (ak_joint_limits){
+        .axis = {0, 1, 0}, .cone_angle = 0.6f, .twist_min = -0.3f, .twist_max = 0.4f};
     js[3].type = AK_JOINT_PRISM;
     js[3].limits = (ak_joint_limits){.axis = {1, 1, 0}, .min = -0.1f, .max = 0.25f};
     js[4].type = AK_JOINT_FREE;
@@ -458,29 +479,33 @@ AK_TEST(limits_clamp_properties) {
         AK_CHECK_EQ(ak_skeleton_apply_limits(sk, (ak_transform_span){pose, 5}), AK_OK);
         for (int i = 0; i < 5; ++i)
             if (!ak_skeleton_joint_within_limits(sk, (size_t)i, pose[i], 1e-3f)) ++fails_within;
-        /* Hinge: rest^-1 * rot is a rotation about the (normalised) axis (0,0,1), angle in range. */
+        /* Hinge: rest^-1 * rot is a rotation about the (normalised) axis (0,0,1), angle in range.
+         */
         ak_quat rel = ak_quat_mul(ak_quat_conjugate(rest.ptr[1].rotation), pose[1].rotation);
         if (rel.w < 0) rel = ak_quat_neg(rel);
         double ang = 2.0 * atan2((double)rel.z, (double)rel.w);
-        if (fabs(rel.x) > 1e-5 || fabs(rel.y) > 1e-5 || ang < -0.5 - 1e-4 || ang > 1.2 + 1e-4) ++fails_hinge;
+        if (fabs(rel.x) > 1e-5 || fabs(rel.y) > 1e-5 || ang < -0.5 - 1e-4 || ang > 1.2 + 1e-4)
+            ++fails_hinge;
         if (ak_vec3_distance(pose[1].translation, rest.ptr[1].translation) > 0) ++fails_hinge;
         /* Ball: the twist axis (0,1,0) moves at most the cone angle; twist in range. */
         ak_quat relb = ak_quat_mul(ak_quat_conjugate(rest.ptr[2].rotation), pose[2].rotation);
         ak_vec3 ya = ak_quat_rotate(relb, ak_vec3_make(0, 1, 0));
         double cone = acos(fmin(1.0, fmax(-1.0, (double)ya.y)));
         if (cone > 0.6 + 1e-3) ++fails_cone;
-        /* Twist measured independently: undo the swing (shortest arc y -> ya), read angle about y. */
+        /* Twist measured independently: undo the swing (shortest arc y -> ya), read angle about y.
+         */
         ak_quat undo = ak_quat_from_to(ya, ak_vec3_make(0, 1, 0));
         ak_quat tw = ak_quat_mul(undo, relb);
         if (tw.w < 0) tw = ak_quat_neg(tw);
         double twist = 2.0 * atan2((double)tw.y, (double)tw.w);
         if (twist < -0.3 - 1e-3 || twist > 0.4 + 1e-3) ++fails_twist;
         /* Prism: rest rotation, translation = rest + d * axis_parent, d in range. */
-        ak_vec3 axp = ak_quat_rotate(rest.ptr[3].rotation, ak_vec3_normalize(ak_vec3_make(1, 1, 0)));
+        ak_vec3 axp =
+            ak_quat_rotate(rest.ptr[3].rotation, ak_vec3_normalize(ak_vec3_make(1, 1, 0)));
         ak_vec3 dv = ak_vec3_sub(pose[3].translation, rest.ptr[3].translation);
         double dd = ak_vec3_dot(dv, axp);
-        if (quat_angle_d(pose[3].rotation, rest.ptr[3].rotation) > 1e-3 || dd < -0.1 - 1e-5 || dd > 0.25 + 1e-5 ||
-            ak_vec3_length(ak_vec3_madd(dv, axp, -(float)dd)) > 1e-5f)
+        if (quat_angle_d(pose[3].rotation, rest.ptr[3].rotation) > 1e-3 || dd < -0.1 - 1e-5 ||
+            dd > 0.25 + 1e-5 || ak_vec3_length(ak_vec3_madd(dv, axp, -(float)dd)) > 1e-5f)
             ++fails_prism;
         /* Free joints are untouched. */
         AK_CHECK(memcmp(&pose[4], &orig[4], sizeof(ak_transform)) == 0);
@@ -503,30 +528,37 @@ AK_TEST(limits_inside_unchanged_outside_detected) {
     ak_transform_cspan rest = ak_skeleton_rest_pose(sk);
     /* A hinge rotation inside the range is kept (up to rounding). */
     ak_transform h = rest.ptr[1];
-    h.rotation = ak_quat_mul(rest.ptr[1].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.8f));
+    h.rotation =
+        ak_quat_mul(rest.ptr[1].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.8f));
     AK_CHECK(ak_skeleton_joint_within_limits(sk, 1, h, 1e-4f));
     ak_transform hc = ak_skeleton_limit_joint(sk, 1, h);
     AK_CHECK(quat_angle_d(hc.rotation, h.rotation) < 1e-4);
     /* Past max: not within, and clamps to exactly max. */
-    h.rotation = ak_quat_mul(rest.ptr[1].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 1.5f));
+    h.rotation =
+        ak_quat_mul(rest.ptr[1].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 1.5f));
     AK_CHECK(!ak_skeleton_joint_within_limits(sk, 1, h, 1e-4f));
     hc = ak_skeleton_limit_joint(sk, 1, h);
-    ak_quat want = ak_quat_mul(rest.ptr[1].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 1.2f));
+    ak_quat want =
+        ak_quat_mul(rest.ptr[1].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 1.2f));
     AK_CHECK(quat_angle_d(hc.rotation, want) < 1e-4);
     /* Off-axis rotation is not a hinge motion. */
-    h.rotation = ak_quat_mul(rest.ptr[1].rotation, ak_quat_from_axis_angle(ak_vec3_make(1, 0, 0), 0.3f));
+    h.rotation =
+        ak_quat_mul(rest.ptr[1].rotation, ak_quat_from_axis_angle(ak_vec3_make(1, 0, 0), 0.3f));
     AK_CHECK(!ak_skeleton_joint_within_limits(sk, 1, h, 1e-3f));
     /* Ball: swing 0.5 inside the 0.6 cone is fine, 0.9 is not and clamps to 0.6. */
     ak_transform b = rest.ptr[2];
-    b.rotation = ak_quat_mul(rest.ptr[2].rotation, ak_quat_from_axis_angle(ak_vec3_make(1, 0, 0), 0.5f));
+    b.rotation =
+        ak_quat_mul(rest.ptr[2].rotation, ak_quat_from_axis_angle(ak_vec3_make(1, 0, 0), 0.5f));
     AK_CHECK(ak_skeleton_joint_within_limits(sk, 2, b, 1e-4f));
-    b.rotation = ak_quat_mul(rest.ptr[2].rotation, ak_quat_from_axis_angle(ak_vec3_make(1, 0, 0), 0.9f));
+    b.rotation =
+        ak_quat_mul(rest.ptr[2].rotation, ak_quat_from_axis_angle(ak_vec3_make(1, 0, 0), 0.9f));
     AK_CHECK(!ak_skeleton_joint_within_limits(sk, 2, b, 1e-4f));
     ak_transform bc = ak_skeleton_limit_joint(sk, 2, b);
     want = ak_quat_mul(rest.ptr[2].rotation, ak_quat_from_axis_angle(ak_vec3_make(1, 0, 0), 0.6f));
     AK_CHECK(quat_angle_d(bc.rotation, want) < 1e-4);
     /* Twist 0.5 > 0.4 about the ball axis. */
-    b.rotation = ak_quat_mul(rest.ptr[2].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.5f));
+    b.rotation =
+        ak_quat_mul(rest.ptr[2].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.5f));
     AK_CHECK(!ak_skeleton_joint_within_limits(sk, 2, b, 1e-4f));
     /* Prism: slide 0.2 inside, 0.3 outside -> 0.25. */
     ak_vec3 axp = ak_quat_rotate(rest.ptr[3].rotation, ak_vec3_normalize(ak_vec3_make(1, 1, 0)));
@@ -536,7 +568,8 @@ AK_TEST(limits_inside_unchanged_outside_detected) {
     p.translation = ak_vec3_madd(rest.ptr[3].translation, axp, 0.3f);
     AK_CHECK(!ak_skeleton_joint_within_limits(sk, 3, p, 1e-5f));
     ak_transform pc = ak_skeleton_limit_joint(sk, 3, p);
-    AK_CHECK_NEAR(ak_vec3_dot(ak_vec3_sub(pc.translation, rest.ptr[3].translation), axp), 0.25, 1e-5);
+    AK_CHECK_NEAR(ak_vec3_dot(ak_vec3_sub(pc.translation, rest.ptr[3].translation), axp), 0.25,
+                  1e-5);
     /* NaN poses are never within limits; out-of-range joints are refused. */
     p.translation.x = NAN;
     AK_CHECK(!ak_skeleton_joint_within_limits(sk, 3, p, 1.0f));

@@ -24,15 +24,14 @@
  *     shoulder (balls, 137-degree cone), elbow (hinges, 0..145 degrees of flexion), wrist
  *     (balls), hip (balls, 90-degree cone), knee (hinges about +X, 0..140 degrees), ankle
  *     (hinges about +X, -25..35 degrees, positive tips the toes down). Rest rotations are
- *     the identity, so limit axes are model axes at rest. The mesh is one closed, consistently oriented
- *     surface: the zero set of a smooth union of (tapered) capsules, polygonised with
- *     marching tetrahedra on a grid of `cell_size`, then relaxed (Laplacian steps projected
- *     back onto the surface); normals are the field's gradient. Weights fall off as
- *     1 / d^4, d the distance to each joint's bone segment less 3/4 of the limb's radius
- *     there (clamped at 0, softened by 2 cm); limb joints of one side never influence
- *     the other side (a smoothstep band 4 cm wide around x = 0 separates them). Clips:
- *     "walk" (1 s loop, in place: legs and arms swing in opposition, knees bend within their
- *     hinge range, the pelvis bobs and yaws) and "wave" (2 s: the right arm rises, waves
+ *     the identity, so limit axes are model axes at rest. The mesh is one closed, consistently
+ * oriented surface: the zero set of a smooth union of (tapered) capsules, polygonised with marching
+ * tetrahedra on a grid of `cell_size`, then relaxed (Laplacian steps projected back onto the
+ * surface); normals are the field's gradient. Weights fall off as 1 / d^4, d the distance to each
+ * joint's bone segment less 3/4 of the limb's radius there (clamped at 0, softened by 2 cm); limb
+ * joints of one side never influence the other side (a smoothstep band 4 cm wide around x = 0
+ * separates them). Clips: "walk" (1 s loop, in place: legs and arms swing in opposition, knees bend
+ * within their hinge range, the pelvis bobs and yaws) and "wave" (2 s: the right arm rises, waves
  *     three times, and comes back). Every keyed pose respects the joint limits.
  *
  * What it does NOT do: read files (io.h) or deform (skin.h).
@@ -86,8 +85,8 @@ AK_API ak_builtin_desc ak_builtin_desc_resolved(const ak_builtin_desc* desc);
  * prefix. desc NULL -> defaults. Returns AK_ERR_NULL_ARG (name or out_scene NULL),
  * AK_ERR_NOT_FOUND (unknown name), AK_ERR_BAD_ARG (a desc field outside its range, e.g.
  * bone_count 4, negative length, NaN), AK_ERR_NO_MEMORY. *out_scene is NULL on failure. */
-AK_API ak_result ak_builtin_create(const char* name, const ak_builtin_desc* desc, const ak_allocator* alloc,
-                                   ak_scene** out_scene);
+AK_API ak_result ak_builtin_create(const char* name, const ak_builtin_desc* desc,
+                                   const ak_allocator* alloc, ak_scene** out_scene);
 
 /* Names of the built-in models ("cylinder", "humanoid"), without the prefix; a static
  * table. out_count (optional) receives its length. */
