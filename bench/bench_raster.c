@@ -34,8 +34,15 @@ static double median(double* t, int n) {
     return t[n / 2];
 }
 
+static double proc_s(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 typedef struct timing {
     double wall_ms, cpu_ms; /* medians per frame; cpu is the calling thread only */
+    double proc_ms;         /* median CPU time of all threads per frame */
 } timing;
 
 static void make_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* idx) {
@@ -64,26 +71,27 @@ static timing time_frames(int threads, int ss, ak_shading shading, const ak_rast
     ak_raster* r = NULL;
     if (ak_raster_create(&(ak_raster_desc){.width = W, .height = H, .supersample = ss, .thread_count = threads}, NULL,
                          &r) != AK_OK)
-        return (timing){-1, -1};
+        return (timing){-1, -1, -1};
     uint8_t* px = malloc((size_t)W * H * 4);
     ak_image img = {.pixels = px, .width = W, .height = H};
     ak_raster_camera cam = ak_raster_camera_perspective(ak_vec3_make(0.0f, 1.6f, 2.2f), ak_vec3_make(0, -0.05f, 0),
                                                         ak_radians(45), (float)W / H, 0.1f, 20);
     ak_raster_mesh m = *base;
     m.shading = shading;
-    double tw[64], tc[64];
+    double tw[64], tc[64], tp[64];
     for (int i = 0; i < reps; ++i) {
-        double t0 = now_s(), c0 = cpu_s();
+        double t0 = now_s(), c0 = cpu_s(), p0 = proc_s();
         ak_raster_clear(r, ak_vec4_make(0.82f, 0.86f, 0.92f, 1), ak_vec4_make(0.5f, 0.52f, 0.58f, 1));
         ak_raster_draw_mesh(r, &cam, &m);
         ak_raster_resolve(r, &img);
         tw[i] = (now_s() - t0) * 1e3;
         tc[i] = (cpu_s() - c0) * 1e3;
+        tp[i] = (proc_s() - p0) * 1e3;
     }
     if (png) ak_png_write(png, &img);
     ak_raster_destroy(r);
     free(px);
-    return (timing){median(tw, reps), median(tc, reps)};
+    return (timing){median(tw, reps), median(tc, reps), median(tp, reps)};
 }
 
 int main(int argc, char** argv) {
@@ -107,14 +115,17 @@ int main(int argc, char** argv) {
     printf("  flat     1 thread : %7.2f   %7.2f\n", flat1.wall_ms, flat1.cpu_ms);
     printf("  gouraud  1 thread : %7.2f   %7.2f\n", gour1.wall_ms, gour1.cpu_ms);
     printf("  phong    1 thread : %7.2f   %7.2f   (target <= 20 ms on one core)\n", phong1.wall_ms, phong1.cpu_ms);
-    printf("  phong    2 threads: %7.2f\n", phong2.wall_ms);
-    printf("  flat     2 threads: %7.2f\n", flat2.wall_ms);
+    printf("  phong    2 threads: %7.2f   (all threads: %.2f CPU ms)\n", phong2.wall_ms, phong2.proc_ms);
+    printf("  flat     2 threads: %7.2f   (all threads: %.2f CPU ms)\n", flat2.wall_ms, flat2.proc_ms);
     printf("  phong SSAA 2x2 1t : %7.2f   %7.2f\n", ss1.wall_ms, ss1.cpu_ms);
     printf("  phong throughput  : %.2f Mtri/s (CPU time)\n", 0.05 / phong1.cpu_ms * 1e3);
     printf("ratios (CPU time): phong/flat %.2f, gouraud/flat %.2f, SSAA2x2/phong %.2f\n", phong1.cpu_ms / flat1.cpu_ms,
            gour1.cpu_ms / flat1.cpu_ms, ss1.cpu_ms / phong1.cpu_ms);
     printf("ratios (wall): phong 1t/2t %.2f, flat 1t/2t %.2f\n", phong1.wall_ms / phong2.wall_ms,
            flat1.wall_ms / flat2.wall_ms);
+    /* total work with 2 threads over 1 (1.0 = no overhead): the redundant per-thread setup */
+    printf("work overhead of 2 threads (CPU all threads / CPU 1 thread): phong %.2f, flat %.2f\n",
+           phong2.proc_ms / phong1.cpu_ms, flat2.proc_ms / flat1.cpu_ms);
     free(pos);
     free(nrm);
     free(idx);
