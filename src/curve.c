@@ -155,6 +155,14 @@ static void natural_tangents(const float* times, size_t n, const float* y, size_
     }
 }
 
+/* double -> float without leaving the finite range (Lagrange can overshoot wildly). */
+static float clamp_to_float(double x) {
+    if (x != x) return 0.0f;
+    if (x > 3.4028234663852886e38) return 3.4028234663852886e38f;
+    if (x < -3.4028234663852886e38) return -3.4028234663852886e38f;
+    return (float)x;
+}
+
 /* ---- segment evaluation ------------------------------------------------------------- */
 
 static float seg_u(const ak_track* tr, size_t k, float t) {
@@ -199,7 +207,7 @@ void akp_track_eval(const ak_track* tr, size_t seg, float t, float* out) {
         for (uint32_t c = 0; c < cc; ++c) {
             double r[3];
             newton_eval(tr, c, (double)t, r);
-            out[c] = (float)r[0];
+            out[c] = clamp_to_float(r[0]);
         }
         return;
     }
@@ -299,7 +307,7 @@ static void plain_derivative(const ak_track* tr, size_t seg, float t, int order,
         for (uint32_t c = 0; c < cc; ++c) {
             double r[3];
             newton_eval(tr, c, (double)t, r);
-            out[c] = (float)r[order];
+            out[c] = clamp_to_float(r[order]);
         }
         return;
     }
@@ -640,6 +648,12 @@ ak_result akp_track_build_into(const ak_raw_track* r, ak_track* tr, void* data, 
                 for (uint32_t c = 0; c < cc; ++c)
                     newton[k * cc + c] = (newton[k * cc + c] - newton[(k - 1) * cc + c]) /
                                          ((double)times[k] - (double)times[k - level]);
+        for (size_t i = 0; i < n * cc; ++i) {
+            if (!(newton[i] - newton[i] == 0.0)) {
+                akp_diag_set(diag, NULL, "%sthe Lagrange polynomial through %zu keys overflows", prefix, n);
+                return AK_ERR_BAD_DATA;
+            }
+        }
         break;
     case AK_INTERP_DEFAULT:
     case AK_INTERP_COUNT:
@@ -730,7 +744,7 @@ ak_result ak_track_key(const ak_track* tr, size_t k, ak_f32_span out_value, ak_f
         for (uint32_t c = 0; c < cc; ++c) {
             double r[3];
             newton_eval(tr, c, (double)tr->times[k], r);
-            in[c] = out[c] = (float)r[1];
+            in[c] = out[c] = clamp_to_float(r[1]);
         }
     }
     if (out_in.count) memcpy(out_in.ptr, in, cc * sizeof(float));

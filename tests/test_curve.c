@@ -383,6 +383,20 @@ AK_TEST(lagrange_is_global_cardinal_is_local) {
     ak_track_destroy(b);
     ak_track_destroy(c);
     ak_track_destroy(d);
+    /* Hundreds of close keys: either a clear error or finite (clamped) output, never NaN. */
+    enum { M = 400 };
+    static float mt[M], mv[M];
+    ak_rng rng = ak_rng_make(17);
+    for (int k = 0; k < M; ++k) mt[k] = 1e-3f * (float)k, mv[k] = ak_rng_range(&rng, -1, 1);
+    ak_raw_track big = {.interp = AK_INTERP_LAGRANGE, .key_count = M, .times = mt, .values = mv};
+    ak_track* e = NULL;
+    ak_result r = ak_track_build(&big, NULL, &e, NULL);
+    AK_CHECK(r == AK_OK || r == AK_ERR_BAD_DATA);
+    for (int i = 0; e && i < 1000; ++i) {
+        float v = sample1(e, ak_rng_range(&rng, 0.0f, 0.4f));
+        AK_CHECK(v - v == 0.0f);
+    }
+    ak_track_destroy(e);
 }
 
 /* ---- derivatives --------------------------------------------------------------------- */

@@ -65,7 +65,8 @@ typedef enum ak_interp {
                                (the controls are values; time stays uniform in u) */
     AK_INTERP_NATURAL,      /* natural C2 cubic spline (global tridiagonal solve, second
                                derivative zero at both end keys) */
-    AK_INTERP_LAGRANGE,     /* one polynomial through all keys (teaching; oscillates) */
+    AK_INTERP_LAGRANGE,     /* one polynomial through all keys (teaching; oscillates, Runge's
+                               phenomenon; outputs are clamped to the float range) */
     AK_INTERP_NLERP,        /* rotations: normalised lerp, shortest path */
     AK_INTERP_SQUAD,        /* rotations: C1 spherical cubic (SQUAD, with inner quadrangle
                                points corrected for non-uniform key spacing) */
@@ -105,7 +106,8 @@ typedef struct ak_track ak_track;
  * (NLERP, SQUAD) on plain values, or a negative / non-finite tension -> AK_ERR_BAD_ARG;
  * CARDINAL, BEZIER, NATURAL or LAGRANGE on a rotation track -> AK_ERR_UNSUPPORTED; a NaN or
  * infinite time or value -> AK_ERR_BAD_DATA; two keys at the same time -> AK_ERR_DUPLICATE;
- * a zero rotation key -> AK_ERR_BAD_DATA; allocation failure -> AK_ERR_NO_MEMORY.
+ * a zero rotation key, or a LAGRANGE polynomial whose coefficients overflow double (hundreds
+ * of closely spaced keys) -> AK_ERR_BAD_DATA; allocation failure -> AK_ERR_NO_MEMORY.
  * diag (optional) receives which key is wrong. *out_track is NULL on failure.
  * Rotation keys of STEP/LINEAR/NLERP/SQUAD tracks are normalised at build time. */
 AK_API ak_result ak_track_build(const ak_raw_track* raw, const ak_allocator* alloc,
