@@ -66,7 +66,8 @@ typedef struct ak_mesh {
 
 /* Allocate a mesh with every array zeroed (weights zero, joints zero, indices zero).
  * Returns AK_ERR_NULL_ARG (desc or out_mesh NULL), AK_ERR_EMPTY (vertex_count 0),
- * AK_ERR_BAD_ARG (influence_count > AK_MAX_INFLUENCES, or counts that overflow),
+ * AK_ERR_BAD_ARG (influence_count > AK_MAX_INFLUENCES, counts that overflow, more than 2^32
+ * vertices with triangles, or an allocator with only one of alloc/free set),
  * AK_ERR_NO_MEMORY. On failure *out_mesh is NULL. */
 AK_API ak_result ak_mesh_create(const ak_mesh_desc* desc, const ak_allocator* alloc, ak_mesh** out_mesh);
 /* Free a mesh made by ak_mesh_create or a loader; NULL is a no-op. */
@@ -78,9 +79,9 @@ AK_API ak_result ak_mesh_clone(const ak_mesh* mesh, const ak_allocator* alloc, a
  * AK_ERR_BAD_DATA (diag, optional, says which vertex or triangle). */
 AK_API ak_result ak_mesh_validate(const ak_mesh* mesh, ak_diag* diag);
 
-/* Axis-aligned bounds of the positions; an empty mesh gives min = max = 0. */
+/* Axis-aligned bounds of the positions (as ak_points_bounds); NULL or empty gives zeros. */
 AK_API void ak_mesh_bounds(const ak_mesh* mesh, ak_vec3* out_min, ak_vec3* out_max);
-/* Bounds of any point array; count 0 gives zeros. */
+/* Bounds of any point array, skipping non-finite points; no finite point gives zeros. */
 AK_API void ak_points_bounds(ak_vec3_cspan points, ak_vec3* out_min, ak_vec3* out_max);
 
 /* Area-weighted vertex normals of triangles over positions, written to out_normals

@@ -20,7 +20,7 @@
  *     };
  *     ak_skeleton* sk = NULL;
  *     ak_skeleton_desc d = { .joints = joints, .joint_count = 3 };
- *     if (ak_skeleton_create(&d, NULL, &sk) != AK_OK) return 1;
+ *     if (ak_skeleton_create(&d, NULL, &sk, NULL) != AK_OK) return 1;
  *     ak_mat4 model[3];
  *     ak_skeleton_local_to_model(sk, ak_skeleton_rest_pose(sk), (ak_mat4_span)AK_SPAN(model));
  *     ak_skeleton_destroy(sk);
@@ -77,7 +77,7 @@ typedef struct ak_skeleton_desc {
 typedef struct ak_skeleton ak_skeleton;
 
 /* Build a skeleton. Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no joints), AK_ERR_BAD_ARG (too many
- * joints, unknown type), AK_ERR_BAD_HIERARCHY (parent >= own index or < -1: use
+ * joints, unknown type, an allocator with only one of alloc/free set), AK_ERR_BAD_HIERARCHY (parent >= own index or < -1: use
  * ak_skeleton_reorder first), AK_ERR_DUPLICATE (two joints share a name), AK_ERR_NULL_ARG
  * (a joint has no name), AK_ERR_BAD_DATA (NaN/inf in a rest transform, inverse bind or
  * limits; a zero-length rest rotation; min > max), AK_ERR_NO_MEMORY. diag (optional) names the
