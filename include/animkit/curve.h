@@ -43,8 +43,9 @@
 extern "C" {
 #endif
 
-/* How values between keys are computed. In every cubic mode, the segment [t_k, t_k+1] of
- * duration D = t_k+1 - t_k is the cubic Hermite curve with u = (t - t_k) / D:
+/* How values between keys are computed. In the cubic modes (CUBICSPLINE, HERMITE, CARDINAL,
+ * BEZIER, NATURAL) the segment [t_k, t_k+1] of duration D = t_k+1 - t_k is the cubic Hermite
+ * curve with u = (t - t_k) / D:
  *     p(u) = (2u^3-3u^2+1) p_k + (u^3-2u^2+u) D m_k + (-2u^3+3u^2) p_k+1 + (u^3-u^2) D m_k+1
  * where m_k is key k's out-tangent and m_k+1 key k+1's in-tangent (per second). The modes
  * differ in where the tangents come from. */
