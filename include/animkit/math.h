@@ -360,14 +360,17 @@ static inline ak_mat3 ak_mat3_from_axis_angle(ak_vec3 axis, float angle) {
                   n.x * n.z * t + n.y * s, n.y * n.z * t - n.x * s, c + n.z * n.z * t}};
     return r;
 }
+/* diag(d.x, d.y, d.z). */
 static inline ak_mat3 ak_mat3_diagonal(ak_vec3 d) {
     ak_mat3 r = {{d.x, 0, 0, 0, d.y, 0, 0, 0, d.z}};
     return r;
 }
+/* Element-wise a + b. */
 static inline ak_mat3 ak_mat3_add(ak_mat3 a, ak_mat3 b) {
     for (int i = 0; i < 9; ++i) a.m[i] += b.m[i];
     return a;
 }
+/* Every element times s. */
 static inline ak_mat3 ak_mat3_scale(ak_mat3 a, float s) {
     for (int i = 0; i < 9; ++i) a.m[i] *= s;
     return a;
@@ -377,6 +380,7 @@ static inline ak_mat3 ak_mat3_lerp(ak_mat3 a, ak_mat3 b, float t) {
     for (int i = 0; i < 9; ++i) a.m[i] += (b.m[i] - a.m[i]) * t;
     return a;
 }
+/* True when every element is finite. */
 static inline bool ak_mat3_is_finite(ak_mat3 m) {
     for (int i = 0; i < 9; ++i)
         if (!ak_finitef(m.m[i])) return false;
@@ -650,6 +654,7 @@ static inline bool ak_transform_is_finite(ak_transform t) {
  * first, then the translation (like ak_transform without scale). ak_dualquat_mul(a, b)
  * applies b first, then a. Functions below expect unit input unless they say otherwise. */
 
+/* No rotation, no translation: real (0,0,0,1), dual 0. */
 static inline ak_dualquat ak_dualquat_identity(void) {
     ak_dualquat r = {{0.0f, 0.0f, 0.0f, 1.0f}, {0.0f, 0.0f, 0.0f, 0.0f}};
     return r;
