@@ -249,6 +249,13 @@ AK_TEST(bezier_matches_bernstein_form) {
             double ref = v * v * v * p0 + 3 * v * v * u * c0 + 3 * v * u * u * c1 + u * u * u * p1;
             AK_CHECK_NEAR(sample1(tr, t), ref, 4e-6);
         }
+        /* Derived tangents: the Bezier end derivatives 3 (c0 - p0) / D and 3 (p1 - c1) / D. */
+        double d = (double)times[k + 1] - times[k];
+        float out, in;
+        ak_track_key(tr, k, (ak_f32_span){0}, (ak_f32_span){0}, (ak_f32_span){&out, 1});
+        ak_track_key(tr, k + 1, (ak_f32_span){0}, (ak_f32_span){&in, 1}, (ak_f32_span){0});
+        AK_CHECK_NEAR(out, 3.0 * (c0 - p0) / d, 1e-5 * (1 + fabs(3.0 * (c0 - p0) / d)));
+        AK_CHECK_NEAR(in, 3.0 * (p1 - c1) / d, 1e-5 * (1 + fabs(3.0 * (p1 - c1) / d)));
     }
     ak_track_destroy(tr);
 }
