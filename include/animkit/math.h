@@ -90,24 +90,28 @@ AK_DEFINE_SPAN(dualquat, ak_dualquat)
 
 /* ---- scalars ------------------------------------------------------------------------ */
 
+/* Clamp, lerp, min and max of floats. */
 static inline float ak_clampf(float x, float lo, float hi) { return x < lo ? lo : (x > hi ? hi : x); }
 static inline float ak_lerpf(float a, float b, float t) { return a + (b - a) * t; }
 static inline float ak_minf(float a, float b) { return a < b ? a : b; }
 static inline float ak_maxf(float a, float b) { return a > b ? a : b; }
 /* True when x is neither NaN nor infinite. */
 static inline bool ak_finitef(float x) { return x - x == 0.0f; }
+/* Degrees <-> radians. */
 static inline float ak_radians(float degrees) { return degrees * (AK_PI / 180.0f); }
 static inline float ak_degrees(float radians) { return radians * (180.0f / AK_PI); }
 
 /* ---- vec2 / vec3 / vec4 -------------------------------------------------------------- */
 
 static inline ak_vec2 ak_vec2_make(float x, float y) { ak_vec2 r = {x, y}; return r; }
+/* Constructors and constants. */
 static inline ak_vec3 ak_vec3_make(float x, float y, float z) { ak_vec3 r = {x, y, z}; return r; }
 static inline ak_vec4 ak_vec4_make(float x, float y, float z, float w) { ak_vec4 r = {x, y, z, w}; return r; }
 static inline ak_vec3 ak_vec3_zero(void) { ak_vec3 r = {0.0f, 0.0f, 0.0f}; return r; }
 static inline ak_vec3 ak_vec3_one(void) { ak_vec3 r = {1.0f, 1.0f, 1.0f}; return r; }
 static inline ak_vec3 ak_vec3_splat(float s) { ak_vec3 r = {s, s, s}; return r; }
 
+/* Component-wise arithmetic (ak_vec3_mul is the component-wise product). */
 static inline ak_vec3 ak_vec3_add(ak_vec3 a, ak_vec3 b) { return ak_vec3_make(a.x + b.x, a.y + b.y, a.z + b.z); }
 static inline ak_vec3 ak_vec3_sub(ak_vec3 a, ak_vec3 b) { return ak_vec3_make(a.x - b.x, a.y - b.y, a.z - b.z); }
 static inline ak_vec3 ak_vec3_mul(ak_vec3 a, ak_vec3 b) { return ak_vec3_make(a.x * b.x, a.y * b.y, a.z * b.z); }
@@ -117,6 +121,7 @@ static inline ak_vec3 ak_vec3_neg(ak_vec3 a) { return ak_vec3_make(-a.x, -a.y, -
 static inline ak_vec3 ak_vec3_madd(ak_vec3 a, ak_vec3 b, float s) {
     return ak_vec3_make(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s);
 }
+/* Dot and cross product (right-handed: x cross y = z), lengths and distance. */
 static inline float ak_vec3_dot(ak_vec3 a, ak_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static inline ak_vec3 ak_vec3_cross(ak_vec3 a, ak_vec3 b) {
     return ak_vec3_make(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
@@ -130,9 +135,11 @@ static inline ak_vec3 ak_vec3_normalize(ak_vec3 a) {
     if (!(l2 > 1e-30f) || !ak_finitef(l2)) return ak_vec3_zero();
     return ak_vec3_scale(a, 1.0f / sqrtf(l2));
 }
+/* a + (b - a) t; t outside [0, 1] extrapolates. */
 static inline ak_vec3 ak_vec3_lerp(ak_vec3 a, ak_vec3 b, float t) {
     return ak_vec3_make(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t, a.z + (b.z - a.z) * t);
 }
+/* Component-wise min and max; true when all three components are finite. */
 static inline ak_vec3 ak_vec3_min(ak_vec3 a, ak_vec3 b) { return ak_vec3_make(ak_minf(a.x, b.x), ak_minf(a.y, b.y), ak_minf(a.z, b.z)); }
 static inline ak_vec3 ak_vec3_max(ak_vec3 a, ak_vec3 b) { return ak_vec3_make(ak_maxf(a.x, b.x), ak_maxf(a.y, b.y), ak_maxf(a.z, b.z)); }
 static inline bool ak_vec3_is_finite(ak_vec3 a) { return ak_finitef(a.x) && ak_finitef(a.y) && ak_finitef(a.z); }
@@ -143,6 +150,7 @@ static inline ak_vec3 ak_vec3_any_perpendicular(ak_vec3 a) {
     return ak_vec3_length_sq(p) > 0.0f ? p : ak_vec3_make(1, 0, 0);
 }
 
+/* vec2 and vec4 arithmetic; ak_vec2_cross is the z of the 3D cross product. */
 static inline ak_vec2 ak_vec2_add(ak_vec2 a, ak_vec2 b) { return ak_vec2_make(a.x + b.x, a.y + b.y); }
 static inline ak_vec2 ak_vec2_sub(ak_vec2 a, ak_vec2 b) { return ak_vec2_make(a.x - b.x, a.y - b.y); }
 static inline ak_vec2 ak_vec2_scale(ak_vec2 a, float s) { return ak_vec2_make(a.x * s, a.y * s); }
@@ -156,6 +164,7 @@ static inline float ak_vec4_dot(ak_vec4 a, ak_vec4 b) { return a.x * b.x + a.y *
 
 /* ---- quaternions -------------------------------------------------------------------- */
 
+/* Basic quaternion algebra; ak_quat_conjugate (-x,-y,-z,w) inverts a unit quaternion. */
 static inline ak_quat ak_quat_make(float x, float y, float z, float w) { ak_quat q = {x, y, z, w}; return q; }
 static inline ak_quat ak_quat_identity(void) { return ak_quat_make(0.0f, 0.0f, 0.0f, 1.0f); }
 static inline float ak_quat_dot(ak_quat a, ak_quat b) { return a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w; }
@@ -305,17 +314,20 @@ static inline ak_quat ak_quat_log(ak_quat q) {
 
 /* ---- mat3 --------------------------------------------------------------------------- */
 
+/* The identity. */
 static inline ak_mat3 ak_mat3_identity(void) {
     ak_mat3 r = {{1, 0, 0, 0, 1, 0, 0, 0, 1}};
     return r;
 }
 /* Element at row r, column c. */
 static inline float ak_mat3_at(const ak_mat3* m, int r, int c) { return m->m[c * 3 + r]; }
+/* Matrix with the given columns; ak_mat3_col reads column c (0..2). */
 static inline ak_mat3 ak_mat3_from_cols(ak_vec3 c0, ak_vec3 c1, ak_vec3 c2) {
     ak_mat3 r = {{c0.x, c0.y, c0.z, c1.x, c1.y, c1.z, c2.x, c2.y, c2.z}};
     return r;
 }
 static inline ak_vec3 ak_mat3_col(ak_mat3 m, int c) { return ak_vec3_make(m.m[c * 3], m.m[c * 3 + 1], m.m[c * 3 + 2]); }
+/* Product a * b (b applies first). */
 static inline ak_mat3 ak_mat3_mul(ak_mat3 a, ak_mat3 b) {
     ak_mat3 r;
     for (int c = 0; c < 3; ++c)
@@ -323,15 +335,18 @@ static inline ak_mat3 ak_mat3_mul(ak_mat3 a, ak_mat3 b) {
             r.m[c * 3 + row] = a.m[row] * b.m[c * 3] + a.m[3 + row] * b.m[c * 3 + 1] + a.m[6 + row] * b.m[c * 3 + 2];
     return r;
 }
+/* m * v (column vector). */
 static inline ak_vec3 ak_mat3_mul_vec3(ak_mat3 m, ak_vec3 v) {
     return ak_vec3_make(m.m[0] * v.x + m.m[3] * v.y + m.m[6] * v.z,
                         m.m[1] * v.x + m.m[4] * v.y + m.m[7] * v.z,
                         m.m[2] * v.x + m.m[5] * v.y + m.m[8] * v.z);
 }
+/* Transpose; the inverse of a rotation. */
 static inline ak_mat3 ak_mat3_transpose(ak_mat3 m) {
     ak_mat3 r = {{m.m[0], m.m[3], m.m[6], m.m[1], m.m[4], m.m[7], m.m[2], m.m[5], m.m[8]}};
     return r;
 }
+/* Determinant: negative for reflections, ~0 for singular matrices. */
 static inline float ak_mat3_determinant(ak_mat3 m) {
     return m.m[0] * (m.m[4] * m.m[8] - m.m[7] * m.m[5]) - m.m[3] * (m.m[1] * m.m[8] - m.m[7] * m.m[2]) +
            m.m[6] * (m.m[1] * m.m[5] - m.m[4] * m.m[2]);
@@ -511,12 +526,14 @@ AK_API ak_polar ak_mat3_polar(ak_mat3 m);
 
 /* ---- mat4 --------------------------------------------------------------------------- */
 
+/* The identity. */
 static inline ak_mat4 ak_mat4_identity(void) {
     ak_mat4 r = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
     return r;
 }
 /* Element at row r, column c. */
 static inline float ak_mat4_at(const ak_mat4* m, int r, int c) { return m->m[c * 4 + r]; }
+/* Product a * b (b applies first). */
 static inline ak_mat4 ak_mat4_mul(ak_mat4 a, ak_mat4 b) {
     ak_mat4 r;
     for (int c = 0; c < 4; ++c)
@@ -525,6 +542,7 @@ static inline ak_mat4 ak_mat4_mul(ak_mat4 a, ak_mat4 b) {
                                a.m[8 + row] * b.m[c * 4 + 2] + a.m[12 + row] * b.m[c * 4 + 3];
     return r;
 }
+/* m * v (column vector). */
 static inline ak_vec4 ak_mat4_mul_vec4(ak_mat4 m, ak_vec4 v) {
     return ak_vec4_make(m.m[0] * v.x + m.m[4] * v.y + m.m[8] * v.z + m.m[12] * v.w,
                         m.m[1] * v.x + m.m[5] * v.y + m.m[9] * v.z + m.m[13] * v.w,
@@ -549,17 +567,20 @@ static inline ak_vec3 ak_mat4_project_point(ak_mat4 m, ak_vec3 p) {
     if (r.w == 0.0f) return ak_vec3_zero();
     return ak_vec3_make(r.x / r.w, r.y / r.w, r.z / r.w);
 }
+/* Transpose. */
 static inline ak_mat4 ak_mat4_transpose(ak_mat4 m) {
     ak_mat4 r;
     for (int c = 0; c < 4; ++c)
         for (int row = 0; row < 4; ++row) r.m[c * 4 + row] = m.m[row * 4 + c];
     return r;
 }
+/* Translation by t. */
 static inline ak_mat4 ak_mat4_translation(ak_vec3 t) {
     ak_mat4 r = ak_mat4_identity();
     r.m[12] = t.x; r.m[13] = t.y; r.m[14] = t.z;
     return r;
 }
+/* Axis-aligned scale by s. */
 static inline ak_mat4 ak_mat4_scaling(ak_vec3 s) {
     ak_mat4 r = ak_mat4_identity();
     r.m[0] = s.x; r.m[5] = s.y; r.m[10] = s.z;
@@ -575,6 +596,7 @@ static inline ak_mat4 ak_mat4_from_mat3(ak_mat3 l, ak_vec3 t) {
     ak_mat4 r = {{l.m[0], l.m[1], l.m[2], 0, l.m[3], l.m[4], l.m[5], 0, l.m[6], l.m[7], l.m[8], 0, t.x, t.y, t.z, 1}};
     return r;
 }
+/* Translation column (m[12], m[13], m[14]); ak_mat4_from_quat is the rotation matrix of unit q. */
 static inline ak_vec3 ak_mat4_get_translation(ak_mat4 m) { return ak_vec3_make(m.m[12], m.m[13], m.m[14]); }
 static inline ak_mat4 ak_mat4_from_quat(ak_quat q) { return ak_mat4_from_mat3(ak_mat3_from_quat(q), ak_vec3_zero()); }
 
@@ -605,10 +627,12 @@ AK_API ak_mat4 ak_mat4_look_at(ak_vec3 eye, ak_vec3 target, ak_vec3 up);
 
 /* ---- transforms --------------------------------------------------------------------- */
 
+/* Translation 0, rotation identity, scale 1. */
 static inline ak_transform ak_transform_identity(void) {
     ak_transform t = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}, {1.0f, 1.0f, 1.0f}};
     return t;
 }
+/* Transform from its three parts (no normalisation). */
 static inline ak_transform ak_transform_make(ak_vec3 translation, ak_quat rotation, ak_vec3 scale) {
     ak_transform t = {translation, rotation, scale};
     return t;
@@ -623,6 +647,7 @@ static inline ak_mat4 ak_transform_to_mat4(ak_transform t) {
     }
     return ak_mat4_from_mat3(r, t.translation);
 }
+/* T R S p: scale, rotate, then translate point p. */
 static inline ak_vec3 ak_transform_point(ak_transform t, ak_vec3 p) {
     return ak_vec3_add(ak_quat_rotate(t.rotation, ak_vec3_mul(t.scale, p)), t.translation);
 }
@@ -644,6 +669,7 @@ static inline ak_transform ak_transform_inverse(ak_transform t) {
     r.translation = ak_vec3_mul(r.scale, ak_quat_rotate(r.rotation, ak_vec3_neg(t.translation)));
     return r;
 }
+/* True when every component is finite. */
 static inline bool ak_transform_is_finite(ak_transform t) {
     return ak_vec3_is_finite(t.translation) && ak_quat_is_finite(t.rotation) && ak_vec3_is_finite(t.scale);
 }
