@@ -3,6 +3,93 @@
  * kernels in src/math/array.c. */
 #include <animkit/math.h>
 
+/* ---- private types and helpers (Euler angles in double precision) ------------------ */
+
+/* Axis index (0 = X, 1 = Y, 2 = Z) of each letter of each order, in enum order. */
+static const unsigned char euler_axes[AK_EULER_ORDER_COUNT][3] = {
+    {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0},
+    {0, 1, 0}, {0, 2, 0}, {1, 0, 1}, {1, 2, 1}, {2, 0, 2}, {2, 1, 2},
+};
+
+typedef struct dmat3 {
+    double m[3][3]; /* [row][column] */
+} dmat3;
+
+static const unsigned char* euler_resolve(ak_euler_order order, ak_euler_frame* frame) {
+    if ((unsigned)*frame > (unsigned)AK_EULER_EXTRINSIC) *frame = AK_EULER_INTRINSIC;
+    if ((unsigned)order >= (unsigned)AK_EULER_ORDER_COUNT) order = AK_EULER_XYZ;
+    return euler_axes[order];
+}
+
+static dmat3 dmat3_axis_rotation(int axis, double angle) {
+    dmat3 r = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+    int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    double c = cos(angle), s = sin(angle);
+    r.m[i][i] = c, r.m[i][j] = -s;
+    r.m[j][i] = s, r.m[j][j] = c;
+    return r;
+}
+
+static dmat3 dmat3_mul(dmat3 a, dmat3 b) {
+    dmat3 r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][0] * b.m[0][j] + a.m[i][1] * b.m[1][j] + a.m[i][2] * b.m[2][j];
+    return r;
+}
+
+
+/* Intrinsic angles (a, b, c) of R = R_i(a) R_j(b) R_k(c) (k = i for proper Euler orders).
+ * s is +1 when (i, j, third axis) is a cyclic permutation of (X, Y, Z), else -1; then
+ * e_i x e_j = s e_third, which fixes every sign below. At gimbal lock either c = 0
+ * (zero_first false) or a = 0, and the other outer angle is read from the column resp. row
+ * of the middle axis, which the zeroed turn leaves untouched. */
+static void euler_decompose(const dmat3* R, int i, int j, int k, int zero_first, double out[3]) {
+    const double (*m)[3] = R->m;
+    double s = j == (i + 1) % 3 ? 1.0 : -1.0;
+    const double eps = 1e-6;
+    double a, b, c;
+    if (k != i) {
+        double cb = sqrt(m[i][i] * m[i][i] + m[i][j] * m[i][j]);
+        b = atan2(s * m[i][k], cb);
+        if (cb > eps) {
+            a = atan2(-s * m[j][k], m[k][k]);
+            c = atan2(-s * m[i][j], m[i][i]);
+        } else if (!zero_first) {
+            c = 0.0, a = atan2(s * m[k][j], m[j][j]);
+        } else {
+            a = 0.0, c = atan2(s * m[j][i], m[j][j]);
+        }
+    } else {
+        int t = 3 - i - j; /* the third axis */
+        double sb = sqrt(m[i][j] * m[i][j] + m[i][t] * m[i][t]);
+        b = atan2(sb, m[i][i]);
+        if (sb > eps) {
+            c = atan2(m[i][j], s * m[i][t]);
+            a = atan2(m[j][i], -s * m[t][i]);
+        } else if (!zero_first) {
+            c = 0.0, a = atan2(s * m[t][j], m[j][j]);
+        } else {
+            a = 0.0, c = atan2(-s * m[j][t], m[j][j]);
+        }
+    }
+    out[0] = a, out[1] = b, out[2] = c;
+}
+
+static ak_vec3 euler_from_dmat3(const dmat3* r, ak_euler_order order, ak_euler_frame frame) {
+    const unsigned char* ax = euler_resolve(order, &frame);
+    double e[3];
+    if (frame == AK_EULER_INTRINSIC) {
+        euler_decompose(r, ax[0], ax[1], ax[2], 0, e);
+        return ak_vec3_make((float)e[0], (float)e[1], (float)e[2]);
+    }
+    /* Extrinsic ABC (x, y, z) is intrinsic CBA (z, y, x); zeroing the intrinsic first angle
+     * puts the gimbal-lock zero into angles.z as documented. */
+    euler_decompose(r, ax[2], ax[1], ax[0], 1, e);
+    return ak_vec3_make((float)e[2], (float)e[1], (float)e[0]);
+}
+
+/* ---- matrices and projections -------------------------------------------------------- */
+
 ak_mat4 ak_mat4_inverse(ak_mat4 m) {
     const float* a = m.m;
     float inv[16];
@@ -126,51 +213,8 @@ ak_mat4 ak_mat4_look_at(ak_vec3 eye, ak_vec3 target, ak_vec3 up) {
 
 /* ---- Euler angles ------------------------------------------------------------------ */
 
-/* Axis index (0 = X, 1 = Y, 2 = Z) of each letter of each order, in enum order. */
-static const unsigned char euler_axes[AK_EULER_ORDER_COUNT][3] = {
-    {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0},
-    {0, 1, 0}, {0, 2, 0}, {1, 0, 1}, {1, 2, 1}, {2, 0, 2}, {2, 1, 2},
-};
-
-typedef struct dmat3 {
-    double m[3][3]; /* [row][column] */
-} dmat3;
-
-static const unsigned char* euler_resolve(ak_euler_order order, ak_euler_frame* frame) {
-    if ((unsigned)*frame > (unsigned)AK_EULER_EXTRINSIC) *frame = AK_EULER_INTRINSIC;
-    if ((unsigned)order >= (unsigned)AK_EULER_ORDER_COUNT) order = AK_EULER_XYZ;
-    return euler_axes[order];
-}
-
-static dmat3 dmat3_axis_rotation(int axis, double angle) {
-    dmat3 r = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-    int i = (axis + 1) % 3, j = (axis + 2) % 3;
-    double c = cos(angle), s = sin(angle);
-    r.m[i][i] = c, r.m[i][j] = -s;
-    r.m[j][i] = s, r.m[j][j] = c;
-    return r;
-}
-
-static dmat3 dmat3_mul(dmat3 a, dmat3 b) {
-    dmat3 r;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][0] * b.m[0][j] + a.m[i][1] * b.m[1][j] + a.m[i][2] * b.m[2][j];
-    return r;
-}
-
-ak_mat3 ak_mat3_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame) {
-    const unsigned char* ax = euler_resolve(order, &frame);
-    dmat3 r0 = dmat3_axis_rotation(ax[0], angles.x);
-    dmat3 r1 = dmat3_axis_rotation(ax[1], angles.y);
-    dmat3 r2 = dmat3_axis_rotation(ax[2], angles.z);
-    dmat3 r = frame == AK_EULER_INTRINSIC ? dmat3_mul(dmat3_mul(r0, r1), r2) : dmat3_mul(dmat3_mul(r2, r1), r0);
-    ak_mat3 out;
-    for (int c = 0; c < 3; ++c)
-        for (int row = 0; row < 3; ++row) out.m[c * 3 + row] = (float)r.m[row][c];
-    return out;
-}
-
 ak_quat ak_quat_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame) {
+    if (!ak_vec3_is_finite(angles)) return ak_quat_identity();
     const unsigned char* ax = euler_resolve(order, &frame);
     const float a[3] = {angles.x, angles.y, angles.z};
     double q[4] = {0, 0, 0, 1}; /* x y z w, accumulated in double */
@@ -189,54 +233,17 @@ ak_quat ak_quat_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame 
     return ak_quat_make((float)q[0], (float)q[1], (float)q[2], (float)q[3]);
 }
 
-/* Intrinsic angles (a, b, c) of R = R_i(a) R_j(b) R_k(c) (k = i for proper Euler orders).
- * s is +1 when (i, j, third axis) is a cyclic permutation of (X, Y, Z), else -1; then
- * e_i x e_j = s e_third, which fixes every sign below. At gimbal lock either c = 0
- * (zero_first false) or a = 0, and the other outer angle is read from the column resp. row
- * of the middle axis, which the zeroed turn leaves untouched. */
-static void euler_decompose(const dmat3* R, int i, int j, int k, int zero_first, double out[3]) {
-    const double (*m)[3] = R->m;
-    double s = j == (i + 1) % 3 ? 1.0 : -1.0;
-    const double eps = 1e-6;
-    double a, b, c;
-    if (k != i) {
-        double cb = sqrt(m[i][i] * m[i][i] + m[i][j] * m[i][j]);
-        b = atan2(s * m[i][k], cb);
-        if (cb > eps) {
-            a = atan2(-s * m[j][k], m[k][k]);
-            c = atan2(-s * m[i][j], m[i][i]);
-        } else if (!zero_first) {
-            c = 0.0, a = atan2(s * m[k][j], m[j][j]);
-        } else {
-            a = 0.0, c = atan2(s * m[j][i], m[j][j]);
-        }
-    } else {
-        int t = 3 - i - j; /* the third axis */
-        double sb = sqrt(m[i][j] * m[i][j] + m[i][t] * m[i][t]);
-        b = atan2(sb, m[i][i]);
-        if (sb > eps) {
-            c = atan2(m[i][j], s * m[i][t]);
-            a = atan2(m[j][i], -s * m[t][i]);
-        } else if (!zero_first) {
-            c = 0.0, a = atan2(s * m[t][j], m[j][j]);
-        } else {
-            a = 0.0, c = atan2(-s * m[j][t], m[j][j]);
-        }
-    }
-    out[0] = a, out[1] = b, out[2] = c;
-}
-
-static ak_vec3 euler_from_dmat3(const dmat3* r, ak_euler_order order, ak_euler_frame frame) {
+ak_mat3 ak_mat3_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame) {
+    if (!ak_vec3_is_finite(angles)) return ak_mat3_identity();
     const unsigned char* ax = euler_resolve(order, &frame);
-    double e[3];
-    if (frame == AK_EULER_INTRINSIC) {
-        euler_decompose(r, ax[0], ax[1], ax[2], 0, e);
-        return ak_vec3_make((float)e[0], (float)e[1], (float)e[2]);
-    }
-    /* Extrinsic ABC (x, y, z) is intrinsic CBA (z, y, x); zeroing the intrinsic first angle
-     * puts the gimbal-lock zero into angles.z as documented. */
-    euler_decompose(r, ax[2], ax[1], ax[0], 1, e);
-    return ak_vec3_make((float)e[2], (float)e[1], (float)e[0]);
+    dmat3 r0 = dmat3_axis_rotation(ax[0], angles.x);
+    dmat3 r1 = dmat3_axis_rotation(ax[1], angles.y);
+    dmat3 r2 = dmat3_axis_rotation(ax[2], angles.z);
+    dmat3 r = frame == AK_EULER_INTRINSIC ? dmat3_mul(dmat3_mul(r0, r1), r2) : dmat3_mul(dmat3_mul(r2, r1), r0);
+    ak_mat3 out;
+    for (int c = 0; c < 3; ++c)
+        for (int row = 0; row < 3; ++row) out.m[c * 3 + row] = (float)r.m[row][c];
+    return out;
 }
 
 ak_vec3 ak_mat3_to_euler(ak_mat3 m, ak_euler_order order, ak_euler_frame frame) {

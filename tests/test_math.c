@@ -148,7 +148,9 @@ AK_TEST(rodrigues_and_axis_angle) {
     AK_CHECK_NEAR(worst, 0.0, 2e-6);
     AK_CHECK_NEAR(worst_q, 0.0, 2e-6);
     AK_CHECK_NEAR(worst_rt, 0.0, 3e-6);
-    /* zero axis: identity */
+    /* zero axis, non-finite angle: identity */
+    AK_CHECK_NEAR(m3_diff(ak_mat3_from_axis_angle(ak_vec3_make(0, 1, 0), NAN), ref_m3_identity()), 0.0, 0.0);
+    AK_CHECK(ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), INFINITY).w == 1.0f);
     AK_CHECK_NEAR(m3_diff(ak_mat3_from_axis_angle(ak_vec3_zero(), 1.0f), ref_m3_identity()), 0.0, 0.0);
     AK_CHECK_NEAR(q_diff_sign(ak_quat_from_axis_angle(ak_vec3_zero(), 1.0f), (ref_q){0, 0, 0, 1}), 0.0, 0.0);
 }
@@ -303,6 +305,8 @@ AK_TEST(euler_known_values) {
     AK_CHECK(z.x == 0 && z.y == 0 && z.z == 0);
     z = ak_quat_to_euler(ak_quat_make(0, 0, 0, 0), AK_EULER_ZYX, AK_EULER_INTRINSIC);
     AK_CHECK(z.x == 0 && z.y == 0 && z.z == 0);
+    AK_CHECK_NEAR(m3_diff(ak_mat3_from_euler(ak_vec3_make(0, NAN, 0), AK_EULER_XYZ, AK_EULER_INTRINSIC), ref_m3_identity()), 0.0, 0.0);
+    AK_CHECK(ak_quat_from_euler(ak_vec3_make(INFINITY, 0, 0), AK_EULER_ZXZ, AK_EULER_EXTRINSIC).w == 1.0f);
 }
 
 /* ---- interpolation ------------------------------------------------------------------------ */

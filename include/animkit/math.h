@@ -204,10 +204,11 @@ static inline ak_vec3 ak_quat_rotate(ak_quat q, ak_vec3 v) {
     return ak_vec3_add(ak_vec3_add(v, ak_vec3_scale(t, q.w)), ak_vec3_cross(u, t));
 }
 
-/* Rotation of angle radians about axis (normalised here); a zero axis gives the identity. */
+/* Rotation of angle radians about axis (normalised here); a zero or non-finite axis or a
+ * non-finite angle gives the identity. */
 static inline ak_quat ak_quat_from_axis_angle(ak_vec3 axis, float angle) {
     ak_vec3 n = ak_vec3_normalize(axis);
-    if (ak_vec3_length_sq(n) == 0.0f) return ak_quat_identity();
+    if (ak_vec3_length_sq(n) == 0.0f || !ak_finitef(angle)) return ak_quat_identity();
     float s = sinf(0.5f * angle);
     return ak_quat_make(n.x * s, n.y * s, n.z * s, cosf(0.5f * angle));
 }
@@ -364,10 +365,11 @@ static inline ak_mat3 ak_mat3_inverse(ak_mat3 m) {
 }
 
 /* Rotation matrix of angle radians about axis (normalised here), by Rodrigues' formula
- * R = cos(a) I + sin(a) [n]x + (1 - cos(a)) n n^T. A zero axis gives the identity. */
+ * R = cos(a) I + sin(a) [n]x + (1 - cos(a)) n n^T. A zero or non-finite axis or a
+ * non-finite angle gives the identity. */
 static inline ak_mat3 ak_mat3_from_axis_angle(ak_vec3 axis, float angle) {
     ak_vec3 n = ak_vec3_normalize(axis);
-    if (ak_vec3_length_sq(n) == 0.0f) return ak_mat3_identity();
+    if (ak_vec3_length_sq(n) == 0.0f || !ak_finitef(angle)) return ak_mat3_identity();
     float c = cosf(angle), s = sinf(angle);
     float h = sinf(0.5f * angle), t = 2.0f * h * h; /* 1 - cos(a) without cancellation */
     ak_mat3 r = {{c + n.x * n.x * t, n.x * n.y * t + n.z * s, n.x * n.z * t - n.y * s,
@@ -437,92 +439,6 @@ static inline ak_quat ak_quat_from_mat3(ak_mat3 m) {
     if (q.w < 0.0f) q = ak_quat_neg(q);
     return ak_quat_normalize(q);
 }
-
-/* ---- Euler angles ------------------------------------------------------------------ */
-
-/* Axis sequence of Euler angles. The letters name the axes in the order the angles are
- * stored: angles.x is about the first letter's axis, angles.y the second, angles.z the
- * third (so for AK_EULER_ZYX, angles.x is the angle about Z). The first six are
- * Tait-Bryan (three distinct axes), the last six proper Euler (first axis repeated). */
-typedef enum ak_euler_order {
-    AK_EULER_XYZ = 0, /* the default */
-    AK_EULER_XZY,
-    AK_EULER_YXZ,
-    AK_EULER_YZX,
-    AK_EULER_ZXY,
-    AK_EULER_ZYX,
-    AK_EULER_XYX,
-    AK_EULER_XZX,
-    AK_EULER_YXY,
-    AK_EULER_YZY,
-    AK_EULER_ZXZ,
-    AK_EULER_ZYZ,
-    AK_EULER_ORDER_COUNT
-} ak_euler_order;
-
-/* Which axes the sequence turns about.
- * INTRINSIC: each turn is about the axis as moved by the turns before it (body axes, as in
- *   BVH channel lists): order ABC gives R = R_A(angles.x) * R_B(angles.y) * R_C(angles.z).
- * EXTRINSIC: each turn is about the fixed parent axis: order ABC gives
- *   R = R_C(angles.z) * R_B(angles.y) * R_A(angles.x) (A is applied to the vector first).
- * Intrinsic ABC with angles (a, b, c) is the same rotation as extrinsic CBA with (c, b, a). */
-typedef enum ak_euler_frame {
-    AK_EULER_INTRINSIC = 0, /* the default */
-    AK_EULER_EXTRINSIC
-} ak_euler_frame;
-
-/* Rotation quaternion of Euler angles (radians). An out-of-range order or frame is read as
- * the default (XYZ, intrinsic). */
-AK_API ak_quat ak_quat_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame);
-/* Rotation matrix of Euler angles (radians); same conventions as ak_quat_from_euler. */
-AK_API ak_mat3 ak_mat3_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame);
-/* Euler angles of rotation matrix m (a rotation; orthonormalise first otherwise), computed
- * in double precision. Ranges: first and third angle in [-pi, pi]; middle angle in
- * [-pi/2, pi/2] for Tait-Bryan orders and [0, pi] for proper Euler orders.
- * Gimbal lock (middle angle at +-pi/2 for Tait-Bryan, 0 or pi for proper Euler, detected
- * when its cosine resp. sine is below 1e-6): only a combination of the outer angles is
- * determined, so angles.z is set to 0 and angles.x carries the whole turn, in both frames.
- * The result always rebuilds m through ak_mat3_from_euler. Non-finite m gives (0, 0, 0). */
-AK_API ak_vec3 ak_mat3_to_euler(ak_mat3 m, ak_euler_order order, ak_euler_frame frame);
-/* Euler angles of quaternion q (normalised here); see ak_mat3_to_euler. The zero or a
- * non-finite quaternion gives (0, 0, 0). */
-AK_API ak_vec3 ak_quat_to_euler(ak_quat q, ak_euler_order order, ak_euler_frame frame);
-
-/* ---- 3x3 decompositions ------------------------------------------------------------ */
-
-/* Signed singular value decomposition m = U * diag(sigma) * V^T. */
-typedef struct ak_svd3 {
-    ak_mat3 u;     /* proper rotation (det +1) */
-    ak_vec3 sigma; /* sigma.x >= sigma.y >= |sigma.z|; sigma.z < 0 exactly when det(m) < 0 */
-    ak_mat3 v;     /* proper rotation (det +1) */
-} ak_svd3;
-
-/* SVD of a 3x3 matrix by one-sided Jacobi rotations in double precision. U and V are
- * rotations, so the sign of det(m) moves onto the smallest singular value. For rank-deficient
- * m the missing columns of U are completed to a right-handed frame. The zero or a non-finite
- * matrix gives U = V = identity, sigma = 0. */
-AK_API ak_svd3 ak_mat3_svd(ak_mat3 m);
-
-/* Polar decomposition m = R * D. */
-typedef struct ak_polar {
-    ak_mat3 rotation; /* R: proper rotation, det +1 */
-    ak_mat3 stretch;  /* D = R^T m: symmetric; positive semi-definite when det(m) >= 0 */
-    int iterations;   /* iterations of the averaging scheme; 0 when the SVD path ran */
-    bool used_svd;    /* true when m was reflected, near-singular or did not converge */
-} ak_polar;
-
-/* Polar decomposition m = R D with R the rotation nearest to m and D symmetric.
- * Well-conditioned m with det > 0 runs the averaging scheme R_{i+1} = (g R_i + R_i^-T / g)/2
- * in double precision (g is Higham's Frobenius-norm scaling while far from convergence,
- * then 1: the plain scheme), until the change is below 1e-12 relative or 40 iterations.
- * Otherwise (det <= 0, condition number above 1e5, or no convergence) it uses ak_mat3_svd:
- * R = U V^T and D = V diag(sigma) V^T. Results for the special cases:
- *   - reflection (det < 0): R stays a proper rotation and D gets one negative eigenvalue,
- *     -sigma_min, along the direction of the smallest singular value;
- *   - rank-deficient m: D has a zero eigenvalue along the null direction and R maps it to
- *     the right-handed completion of the image (R D = m still holds);
- *   - the zero matrix: R = identity, D = 0; non-finite m: R = D = identity. */
-AK_API ak_polar ak_mat3_polar(ak_mat3 m);
 
 /* ---- mat4 --------------------------------------------------------------------------- */
 
@@ -624,6 +540,93 @@ AK_API ak_mat4 ak_mat4_orthographic(float left, float right, float bottom, float
 /* View matrix of a camera at eye looking at target, up roughly +Y: camera looks down -Z.
  * eye == target gives a translation by -eye; up parallel to the view picks another up. */
 AK_API ak_mat4 ak_mat4_look_at(ak_vec3 eye, ak_vec3 target, ak_vec3 up);
+
+/* ---- Euler angles ------------------------------------------------------------------ */
+
+/* Axis sequence of Euler angles. The letters name the axes in the order the angles are
+ * stored: angles.x is about the first letter's axis, angles.y the second, angles.z the
+ * third (so for AK_EULER_ZYX, angles.x is the angle about Z). The first six are
+ * Tait-Bryan (three distinct axes), the last six proper Euler (first axis repeated). */
+typedef enum ak_euler_order {
+    AK_EULER_XYZ = 0, /* the default */
+    AK_EULER_XZY,
+    AK_EULER_YXZ,
+    AK_EULER_YZX,
+    AK_EULER_ZXY,
+    AK_EULER_ZYX,
+    AK_EULER_XYX,
+    AK_EULER_XZX,
+    AK_EULER_YXY,
+    AK_EULER_YZY,
+    AK_EULER_ZXZ,
+    AK_EULER_ZYZ,
+    AK_EULER_ORDER_COUNT
+} ak_euler_order;
+
+/* Which axes the sequence turns about.
+ * INTRINSIC: each turn is about the axis as moved by the turns before it (body axes, as in
+ *   BVH channel lists): order ABC gives R = R_A(angles.x) * R_B(angles.y) * R_C(angles.z).
+ * EXTRINSIC: each turn is about the fixed parent axis: order ABC gives
+ *   R = R_C(angles.z) * R_B(angles.y) * R_A(angles.x) (A is applied to the vector first).
+ * Intrinsic ABC with angles (a, b, c) is the same rotation as extrinsic CBA with (c, b, a). */
+typedef enum ak_euler_frame {
+    AK_EULER_INTRINSIC = 0, /* the default */
+    AK_EULER_EXTRINSIC
+} ak_euler_frame;
+
+/* Rotation quaternion of Euler angles (radians). An out-of-range order or frame is read as
+ * the default (XYZ, intrinsic); a non-finite angle gives the identity. */
+AK_API ak_quat ak_quat_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame);
+/* Rotation matrix of Euler angles (radians); same conventions and fallbacks as
+ * ak_quat_from_euler. */
+AK_API ak_mat3 ak_mat3_from_euler(ak_vec3 angles, ak_euler_order order, ak_euler_frame frame);
+/* Euler angles of rotation matrix m (a rotation; orthonormalise first otherwise), computed
+ * in double precision. Ranges: first and third angle in [-pi, pi]; middle angle in
+ * [-pi/2, pi/2] for Tait-Bryan orders and [0, pi] for proper Euler orders.
+ * Gimbal lock (middle angle at +-pi/2 for Tait-Bryan, 0 or pi for proper Euler, detected
+ * when its cosine resp. sine is below 1e-6): only a combination of the outer angles is
+ * determined, so angles.z is set to 0 and angles.x carries the whole turn, in both frames.
+ * The result always rebuilds m through ak_mat3_from_euler. Non-finite m gives (0, 0, 0). */
+AK_API ak_vec3 ak_mat3_to_euler(ak_mat3 m, ak_euler_order order, ak_euler_frame frame);
+/* Euler angles of quaternion q (normalised here); see ak_mat3_to_euler. The zero or a
+ * non-finite quaternion gives (0, 0, 0). */
+AK_API ak_vec3 ak_quat_to_euler(ak_quat q, ak_euler_order order, ak_euler_frame frame);
+
+/* ---- 3x3 decompositions ------------------------------------------------------------ */
+
+/* Signed singular value decomposition m = U * diag(sigma) * V^T. */
+typedef struct ak_svd3 {
+    ak_mat3 u;     /* proper rotation (det +1) */
+    ak_vec3 sigma; /* sigma.x >= sigma.y >= |sigma.z|; sigma.z < 0 exactly when det(m) < 0 */
+    ak_mat3 v;     /* proper rotation (det +1) */
+} ak_svd3;
+
+/* SVD of a 3x3 matrix by one-sided Jacobi rotations in double precision. U and V are
+ * rotations, so the sign of det(m) moves onto the smallest singular value. For rank-deficient
+ * m the missing columns of U are completed to a right-handed frame. The zero or a non-finite
+ * matrix gives U = V = identity, sigma = 0. */
+AK_API ak_svd3 ak_mat3_svd(ak_mat3 m);
+
+/* Polar decomposition m = R * D. */
+typedef struct ak_polar {
+    ak_mat3 rotation; /* R: proper rotation, det +1 */
+    ak_mat3 stretch;  /* D = R^T m: symmetric; positive semi-definite when det(m) >= 0 */
+    int iterations;   /* iterations of the averaging scheme; 0 when the SVD path ran */
+    bool used_svd;    /* true when m was reflected, near-singular or did not converge */
+} ak_polar;
+
+/* Polar decomposition m = R D with R the rotation nearest to m and D symmetric.
+ * Well-conditioned m with det > 0 runs the averaging scheme R_{i+1} = (g R_i + R_i^-T / g)/2
+ * in double precision (g is Higham's Frobenius-norm scaling while far from convergence,
+ * then 1: the plain scheme), until the change is below 1e-12 relative or 40 iterations.
+ * Otherwise (det <= 0, condition number above 1e5, or no convergence) it uses ak_mat3_svd:
+ * R = U V^T and D = V diag(sigma) V^T. Results for the special cases:
+ *   - reflection (det < 0): R stays a proper rotation and D gets one negative eigenvalue,
+ *     -sigma_min, along the direction of the smallest singular value;
+ *   - rank-deficient m: D has a zero eigenvalue along the null direction and R maps it to
+ *     the right-handed completion of the image (R D = m still holds);
+ *   - the zero matrix: R = identity, D = 0; non-finite m: R = D = identity. */
+AK_API ak_polar ak_mat3_polar(ak_mat3 m);
 
 /* ---- transforms --------------------------------------------------------------------- */
 
