@@ -170,7 +170,8 @@ typedef struct ak_skin_cor_desc {
     float subdivision_threshold; /* split an edge while the L2 distance of its end weights
                                     exceeds this; 0 -> 0.1 */
     uint32_t thread_count;     /* 0 -> 2; 1 -> calling thread only */
-    bool naive;                /* false -> triangles indexed by bone pair; true -> the
+    bool naive;                /* false -> triangles indexed by bone pair, vertices with
+                                  equal weights computed once; true -> the plain
                                   O(vertices x triangles) reference loop (tests) */
 } ak_skin_cor_desc;
 

@@ -24,11 +24,6 @@ typedef struct affine34 {
     ak_vec3 c[4];
 } affine34;
 
-static affine34 affine_from_mat4(const ak_mat4* m) {
-    affine34 a;
-    for (int i = 0; i < 4; ++i) a.c[i] = ak_vec3_make(m->m[i * 4], m->m[i * 4 + 1], m->m[i * 4 + 2]);
-    return a;
-}
 static ak_vec3 lin_apply(const ak_vec3* c, ak_vec3 v) {
     return ak_vec3_add(ak_vec3_add(ak_vec3_scale(c[0], v.x), ak_vec3_scale(c[1], v.y)), ak_vec3_scale(c[2], v.z));
 }
@@ -110,16 +105,18 @@ static void prepare_joint(const ak_mat4* m, akp_skin_joint* out, bool* out_stret
 /* ---- scalar reference kernels ------------------------------------------------------------ */
 
 static void read_influences(const akp_skin_ctx* c, size_t i, uint16_t* j, float* w) {
-    memcpy(j, c->jnt + i * c->jnt_stride, c->k * sizeof(uint16_t));
-    memcpy(w, c->wgt + i * c->wgt_stride, c->k * sizeof(float));
-    for (uint32_t k = 0; k < c->k; ++k)
+    const char* jp = c->jnt + i * c->jnt_stride;
+    const char* wp = c->wgt + i * c->wgt_stride;
+    for (uint32_t k = 0; k < c->k; ++k) { /* fixed-size copies: plain loads, any alignment */
+        memcpy(&j[k], jp + 2u * k, sizeof(uint16_t));
+        memcpy(&w[k], wp + 4u * k, sizeof(float));
         if (j[k] >= c->palette_count) j[k] = (uint16_t)(c->palette_count - 1);
+    }
 }
 
 static uint32_t argmax_weight(const float* w, uint32_t k) {
     uint32_t best = 0;
-    for (uint32_t i = 1; i < k; ++i)
-        if (w[i] > w[best]) best = i;
+    for (uint32_t i = 1; i < k; ++i) best = w[i] > w[best] ? i : best;
     return best;
 }
 
@@ -158,12 +155,15 @@ static void blend_stretch(const akp_skin_ctx* c, const uint16_t* j, const float*
 }
 
 static affine34 blend_matrix(const akp_skin_ctx* c, const uint16_t* j, const float* w) {
-    affine34 b;
-    memset(&b, 0, sizeof b);
+    /* flat accumulation over the 12 used entries of each column-major matrix */
+    float m[16] = {0};
     for (uint32_t k = 0; k < c->k; ++k) {
-        affine34 m = affine_from_mat4(&c->palette[j[k]]);
-        for (int col = 0; col < 4; ++col) b.c[col] = ak_vec3_madd(b.c[col], m.c[col], w[k]);
+        const float* p = c->palette[j[k]].m;
+        const float wk = w[k];
+        for (int e = 0; e < 16; ++e) m[e] += wk * p[e];
     }
+    affine34 b;
+    for (int col = 0; col < 4; ++col) b.c[col] = ak_vec3_make(m[col * 4], m[col * 4 + 1], m[col * 4 + 2]);
     return b;
 }
 

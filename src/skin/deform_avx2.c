@@ -19,6 +19,8 @@
 #define AKP_HAVE_AVX2_KERNEL 1
 #include <immintrin.h>
 #define AKP_AVX2 __attribute__((target("avx2,fma")))
+/* helpers must inline into the block functions at -O2 too (registers, not memory) */
+#define AKP_AVX2_INLINE __attribute__((target("avx2,fma"), always_inline))
 #else
 #define AKP_HAVE_AVX2_KERNEL 0
 #endif
@@ -28,7 +30,7 @@
 bool akp_skin_have_avx2(void) { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
 
 /* Transpose 8 rows of 8 floats (rows r[0..7]) into columns o[0..7]. */
-AKP_AVX2 static inline void transpose8(const __m256* r, __m256* o) {
+AKP_AVX2_INLINE static inline void transpose8(const __m256* r, __m256* o) {
     __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
     __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
     __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
@@ -49,7 +51,7 @@ AKP_AVX2 static inline void transpose8(const __m256* r, __m256* o) {
 
 /* Load 8 xyz triples (stride bytes apart) as x, y, z vectors. Stride 12 uses shuffles: per
  * 128-bit lane the three quads a = (x0 y0 z0 x1), b = (y1 z1 x2 y2), c = (z2 x3 y3 z3). */
-AKP_AVX2 static inline void load_xyz8(const char* p, size_t stride, __m256* x, __m256* y, __m256* z) {
+AKP_AVX2_INLINE static inline void load_xyz8(const char* p, size_t stride, __m256* x, __m256* y, __m256* z) {
     if (stride == 12) {
         const float* f = (const float*)(const void*)p;
         __m256 a = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f)), _mm_loadu_ps(f + 12), 1);
@@ -70,7 +72,7 @@ AKP_AVX2 static inline void load_xyz8(const char* p, size_t stride, __m256* x, _
 }
 
 /* Inverse of load_xyz8. */
-AKP_AVX2 static inline void store_xyz8(char* p, size_t stride, __m256 x, __m256 y, __m256 z) {
+AKP_AVX2_INLINE static inline void store_xyz8(char* p, size_t stride, __m256 x, __m256 y, __m256 z) {
     if (stride == 12) {
         float* f = (float*)(void*)p;
         __m256 pp = _mm256_shuffle_ps(x, y, _MM_SHUFFLE(2, 0, 2, 0)); /* x0 x2 y0 y2 */
@@ -98,7 +100,7 @@ AKP_AVX2 static inline void store_xyz8(char* p, size_t stride, __m256 x, __m256 
 }
 
 /* (x, y, z) / |(x, y, z)| with rsqrt + one Newton step; a zero vector stays zero. */
-AKP_AVX2 static inline void normalize8(__m256* x, __m256* y, __m256* z) {
+AKP_AVX2_INLINE static inline void normalize8(__m256* x, __m256* y, __m256* z) {
     __m256 l2 = _mm256_fmadd_ps(*x, *x, _mm256_fmadd_ps(*y, *y, _mm256_mul_ps(*z, *z)));
     l2 = _mm256_max_ps(l2, _mm256_set1_ps(1e-30f));
     __m256 r = _mm256_rsqrt_ps(l2);
@@ -119,7 +121,7 @@ AKP_AVX2 static inline void normalize8(__m256* x, __m256* y, __m256* z) {
     } while (0)
 
 /* Rotate (px, py, pz) by unit quaternions (qx, qy, qz, qw): p + w t + v x t, t = 2 v x p. */
-AKP_AVX2 static inline void rotate8(__m256 qx, __m256 qy, __m256 qz, __m256 qw, __m256* px, __m256* py,
+AKP_AVX2_INLINE static inline void rotate8(__m256 qx, __m256 qy, __m256 qz, __m256 qw, __m256* px, __m256* py,
                                      __m256* pz) {
     __m256 tx, ty, tz, ux, uy, uz;
     AKP_CROSS(qx, qy, qz, *px, *py, *pz, tx, ty, tz);
@@ -134,14 +136,24 @@ AKP_AVX2 static inline void rotate8(__m256 qx, __m256 qy, __m256 qz, __m256 qw, 
 
 static inline uint32_t clamp_joint(uint32_t j, size_t count) { return j < count ? j : (uint32_t)(count - 1); }
 
+/* Joints and weights of vertex i, element by element (fixed-size copies become plain loads;
+ * a variable-length memcpy would be a library call per vertex). */
+static inline void load_influences(const akp_skin_ctx* c, size_t i, uint32_t K, uint16_t* jj, float* ww) {
+    const char* jp = c->jnt + i * c->jnt_stride;
+    const char* wp = c->wgt + i * c->wgt_stride;
+    for (uint32_t k = 0; k < K; ++k) {
+        memcpy(&jj[k], jp + 2u * k, sizeof(uint16_t));
+        memcpy(&ww[k], wp + 4u * k, sizeof(float));
+    }
+}
+
 /* Blend the palette matrices of vertex i: rows out[0] = (c0, c1), out[1] = (c2, c3), each
  * column with its w row (which holds 0 for affine matrices and is overwritten by CoR). */
-AKP_AVX2 static inline void blend_matrix_vertex(const akp_skin_ctx* c, size_t i, uint32_t K, __m256* out01,
+AKP_AVX2_INLINE static inline void blend_matrix_vertex(const akp_skin_ctx* c, size_t i, uint32_t K, __m256* out01,
                                                 __m256* out23) {
     uint16_t jj[AK_MAX_INFLUENCES];
     float ww[AK_MAX_INFLUENCES];
-    memcpy(jj, c->jnt + i * c->jnt_stride, K * sizeof(uint16_t));
-    memcpy(ww, c->wgt + i * c->wgt_stride, K * sizeof(float));
+    load_influences(c, i, K, jj, ww);
     __m256 a01 = _mm256_setzero_ps(), a23 = _mm256_setzero_ps();
     for (uint32_t k = 0; k < K; ++k) {
         const float* m = c->palette[clamp_joint(jj[k], c->palette_count)].m;
@@ -154,14 +166,12 @@ AKP_AVX2 static inline void blend_matrix_vertex(const akp_skin_ctx* c, size_t i,
 }
 
 /* Hemisphere-aligned blend of (real | dual) quaternions of vertex i. */
-AKP_AVX2 static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size_t i, uint32_t K) {
+AKP_AVX2_INLINE static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size_t i, uint32_t K) {
     uint16_t jj[AK_MAX_INFLUENCES];
     float ww[AK_MAX_INFLUENCES];
-    memcpy(jj, c->jnt + i * c->jnt_stride, K * sizeof(uint16_t));
-    memcpy(ww, c->wgt + i * c->wgt_stride, K * sizeof(float));
+    load_influences(c, i, K, jj, ww);
     uint32_t best = 0;
-    for (uint32_t k = 1; k < K; ++k)
-        if (ww[k] > ww[best]) best = k;
+    for (uint32_t k = 1; k < K; ++k) best = ww[k] > ww[best] ? k : best;
     const __m128 ref = _mm_loadu_ps(c->joints_prep[clamp_joint(jj[best], c->palette_count)].real);
     const __m128 sign = _mm_set1_ps(-0.0f);
     __m256 acc = _mm256_setzero_ps();
@@ -176,7 +186,42 @@ AKP_AVX2 static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size_t i, u
     return acc;
 }
 
-AKP_AVX2 static void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+/* The same for exactly 4 influences: the four hemisphere tests share one horizontal sum. */
+AKP_AVX2_INLINE static inline __m256 blend_dq_vertex4(const akp_skin_ctx* c, size_t i) {
+    uint16_t jj[4];
+    float ww[4];
+    memcpy(jj, c->jnt + i * c->jnt_stride, sizeof jj);
+    memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
+    /* branch-free argmax: weights come in any order, and a mispredicted branch per vertex
+     * costs more than the whole blend */
+    const __m128 w4 = _mm_loadu_ps(ww);
+    __m128 mx = _mm_max_ps(w4, _mm_shuffle_ps(w4, w4, _MM_SHUFFLE(2, 3, 0, 1)));
+    mx = _mm_max_ps(mx, _mm_shuffle_ps(mx, mx, _MM_SHUFFLE(1, 0, 3, 2)));
+    const uint32_t best = (uint32_t)__builtin_ctz((unsigned)_mm_movemask_ps(_mm_cmpeq_ps(w4, mx)) | 16u) & 3u;
+    const size_t pc = c->palette_count;
+    const __m256 d0 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[0], pc)].real);
+    const __m256 d1 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[1], pc)].real);
+    const __m256 d2 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[2], pc)].real);
+    const __m256 d3 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[3], pc)].real);
+    const __m128 ref = _mm_loadu_ps(c->joints_prep[clamp_joint(jj[best], pc)].real);
+    __m128 p0 = _mm_mul_ps(_mm256_castps256_ps128(d0), ref), p1 = _mm_mul_ps(_mm256_castps256_ps128(d1), ref);
+    __m128 p2 = _mm_mul_ps(_mm256_castps256_ps128(d2), ref), p3 = _mm_mul_ps(_mm256_castps256_ps128(d3), ref);
+    __m128 dots = _mm_hadd_ps(_mm_hadd_ps(p0, p1), _mm_hadd_ps(p2, p3)); /* (q_k . ref) for k = 0..3 */
+    /* signed weights go through memory: broadcasts from memory are plain loads, cheaper than
+     * four cross-lane permutes */
+    float sw[4];
+    _mm_storeu_ps(sw, _mm_xor_ps(w4, _mm_and_ps(dots, _mm_set1_ps(-0.0f))));
+    __m256 acc = _mm256_mul_ps(d0, _mm256_broadcast_ss(&sw[0]));
+    acc = _mm256_fmadd_ps(d1, _mm256_broadcast_ss(&sw[1]), acc);
+    acc = _mm256_fmadd_ps(d2, _mm256_broadcast_ss(&sw[2]), acc);
+    return _mm256_fmadd_ps(d3, _mm256_broadcast_ss(&sw[3]), acc);
+}
+
+AKP_AVX2_INLINE static inline __m256 blend_dq_any(const akp_skin_ctx* c, size_t i, uint32_t K) {
+    return K == 4 ? blend_dq_vertex4(c, i) : blend_dq_vertex(c, i, K);
+}
+
+AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
     for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
@@ -213,7 +258,7 @@ AKP_AVX2 static void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
 }
 
 /* Normalise 8 quaternions and scale 4 more lanes (the dual part) by the same factor. */
-AKP_AVX2 static inline __m256 quat_inv_norm8(__m256 x, __m256 y, __m256 z, __m256 w) {
+AKP_AVX2_INLINE static inline __m256 quat_inv_norm8(__m256 x, __m256 y, __m256 z, __m256 w) {
     __m256 n2 = _mm256_fmadd_ps(x, x, _mm256_fmadd_ps(y, y, _mm256_fmadd_ps(z, z, _mm256_mul_ps(w, w))));
     __m256 ok = _mm256_cmp_ps(n2, _mm256_set1_ps(1e-30f), _CMP_GT_OQ);
     n2 = _mm256_max_ps(n2, _mm256_set1_ps(1e-30f));
@@ -223,9 +268,9 @@ AKP_AVX2 static inline __m256 quat_inv_norm8(__m256 x, __m256 y, __m256 z, __m25
     return _mm256_and_ps(r, ok);
 }
 
-AKP_AVX2 static void block_dqs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
     __m256 rows[8], q[8];
-    for (int v = 0; v < 8; ++v) rows[v] = blend_dq_vertex(c, i0 + (size_t)v, K);
+    for (int v = 0; v < 8; ++v) rows[v] = blend_dq_any(c, i0 + (size_t)v, K);
     transpose8(rows, q);
     __m256 r = quat_inv_norm8(q[0], q[1], q[2], q[3]);
     /* a vanished blend (r = 0) must act as the identity rotation, like the scalar code */
@@ -255,13 +300,13 @@ AKP_AVX2 static void block_dqs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
-AKP_AVX2 static void block_cor(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, uint32_t K) {
     __m256 r01[8], r23[8], cols[8];
     const __m256i lo = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), hi = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
     for (int v = 0; v < 8; ++v) {
         blend_matrix_vertex(c, i0 + (size_t)v, K, &r01[v], &r23[v]);
         /* the rotation blend goes into the unused w rows: (qx, qy) and (qz, qw) */
-        __m256 q = blend_dq_vertex(c, i0 + (size_t)v, K);
+        __m256 q = blend_dq_any(c, i0 + (size_t)v, K);
         r01[v] = _mm256_blend_ps(r01[v], _mm256_permutevar8x32_ps(q, lo), 0x88);
         r23[v] = _mm256_blend_ps(r23[v], _mm256_permutevar8x32_ps(q, hi), 0x88);
     }

@@ -1,0 +1,374 @@
+/* bench_skin: skinning throughput and precomputation times, with the memory bandwidth of the
+ * same machine measured in the same run (a STREAM-like triad), so the ratios carry over.
+ *
+ *   build/bench/bench_skin [vertex_count]      (default 1,000,000 vertices, 64 joints, 4 influences)
+ *
+ * Prints, for LBS (positions; positions + normals), DQS and CoR (positions + normals):
+ * M vertices/s and effective GB/s for the AVX2 kernel, the library's scalar code and a plain
+ * scalar loop written here (what a straightforward implementation does), on 1 and 2 threads;
+ * then the CoR precomputation and heat weights on a CesiumMan-sized generated mesh and on
+ * CesiumMan itself when the assets and the io module are available. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <animkit/io.h>
+#include <animkit/skin.h>
+
+/* $ANIMKIT_ASSETS/rel, else <source>/../shared/assets/rel; NULL when the file is absent. */
+static const char* asset_path(char* buf, size_t size, const char* rel) {
+    const char* env = getenv("ANIMKIT_ASSETS");
+    if (env && *env) snprintf(buf, size, "%s/%s", env, rel);
+    else snprintf(buf, size, "%s/../shared/assets/%s", AK_SOURCE_DIR, rel);
+    FILE* f = fopen(buf, "rb");
+    if (!f) return NULL;
+    fclose(f);
+    return buf;
+}
+
+/* Single-thread figures use this thread's CPU time, so that other processes on a loaded
+ * machine do not count (cache and memory contention still do); two-thread figures and the
+ * precomputations use wall time (g_use_cpu_time = false). */
+static int g_use_cpu_time = 1;
+static double now_s(void) {
+    struct timespec ts;
+    clock_gettime(g_use_cpu_time ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- STREAM-like triad: a[i] = b[i] + s * c[i] (12 bytes counted per float element) ---- */
+
+static double triad_gbps(size_t n) {
+    float* a = (float*)malloc(n * sizeof(float));
+    float* b = (float*)malloc(n * sizeof(float));
+    float* c = (float*)malloc(n * sizeof(float));
+    for (size_t i = 0; i < n; ++i) {
+        a[i] = 0.0f;
+        b[i] = (float)(i & 1023);
+        c[i] = 1.0f;
+    }
+    double best = 1e30;
+    for (int rep = 0; rep < 6; ++rep) {
+        const float s = 1.0f + 1e-3f * (float)rep;
+        double t0 = now_s();
+        for (size_t i = 0; i < n; ++i) a[i] = b[i] + s * c[i];
+        double t = now_s() - t0;
+        if (t < best) best = t;
+    }
+    volatile float sink = a[n / 2];
+    (void)sink;
+    free(a);
+    free(b);
+    free(c);
+    return 12.0 * (double)n / best * 1e-9;
+}
+
+/* ---- the plain scalar loop: blend four matrices, transform, inverse-transpose normal ---- */
+
+static void plain_lbs(size_t n, const ak_vec3* pos, const ak_vec3* nrm, const uint16_t* jn, const float* w,
+                      const ak_mat4* pal, ak_vec3* op, ak_vec3* on) {
+    for (size_t i = 0; i < n; ++i) {
+        float m[12] = {0};
+        for (int k = 0; k < 4; ++k) {
+            const float* p = pal[jn[4 * i + k]].m;
+            float wk = w[4 * i + k];
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 3; ++r) m[c * 3 + r] += wk * p[c * 4 + r];
+        }
+        ak_vec3 p = pos[i];
+        op[i] = ak_vec3_make(m[0] * p.x + m[3] * p.y + m[6] * p.z + m[9], m[1] * p.x + m[4] * p.y + m[7] * p.z + m[10],
+                             m[2] * p.x + m[5] * p.y + m[8] * p.z + m[11]);
+        if (on) {
+            ak_vec3 c0 = ak_vec3_make(m[0], m[1], m[2]), c1 = ak_vec3_make(m[3], m[4], m[5]), c2 = ak_vec3_make(m[6], m[7], m[8]);
+            ak_mat3 it = ak_mat3_transpose(ak_mat3_inverse(ak_mat3_from_cols(c0, c1, c2)));
+            on[i] = ak_vec3_normalize(ak_mat3_mul_vec3(it, nrm[i]));
+        }
+    }
+}
+
+typedef struct bench_data {
+    size_t n;
+    ak_vec3 *pos, *nrm, *ctr, *op, *on;
+    uint16_t* jn;
+    float* w;
+    ak_mat4 pal[64];
+    unsigned char scratch[64 + 128 * 64];
+} bench_data;
+
+/* Best of reps runs of the job, in seconds. */
+static double time_job(const ak_skin_job* job, int reps) {
+    double best = 1e30;
+    for (int r = 0; r < reps; ++r) {
+        double t0 = now_s();
+        ak_result res = ak_skin_job_run(job);
+        double t = now_s() - t0;
+        if (res != AK_OK) {
+            printf("job failed: %s\n", ak_result_string(res));
+            exit(1);
+        }
+        if (t < best) best = t;
+    }
+    return best;
+}
+
+static void row(const char* name, double bytes_per_vertex, size_t n, double t, double triad, double plain_t) {
+    double mvs = (double)n / t * 1e-6, gbs = bytes_per_vertex * (double)n / t * 1e-9;
+    printf("  %-34s %8.1f Mvert/s %6.1f GB/s %5.0f%% of triad", name, mvs, gbs, 100.0 * gbs / triad);
+    if (plain_t > 0.0) printf("  x%.2f vs plain loop", plain_t / t);
+    printf("\n");
+}
+
+/* A capped cylinder of `rings` x `segments` with a chain of `joints` joints along +Y, skinned
+ * with inverse-distance weights (4 influences): a stand-in for a character limb mesh. */
+static void make_limb(int rings, int segments, int joints, ak_vec3** out_pos, uint32_t** out_idx, size_t* out_n,
+                      size_t* out_tris, ak_skin_bone* bones) {
+    size_t n = (size_t)rings * segments + 2, tris = (size_t)(rings - 1) * segments * 2 + 2 * (size_t)segments;
+    ak_vec3* pos = (ak_vec3*)malloc(n * sizeof(ak_vec3));
+    uint32_t* idx = (uint32_t*)malloc(tris * 3 * sizeof(uint32_t));
+    const float len = (float)joints * 0.5f;
+    ak_rng rng = ak_rng_make(77);
+    for (int r = 0; r < rings; ++r)
+        for (int s = 0; s < segments; ++s) {
+            /* radius jitter: no two vertices share their weights (no symmetric shortcut) */
+            float a = AK_TWO_PI * (float)s / (float)segments, y = len * (float)r / (float)(rings - 1);
+            float rad = 0.2f * ak_rng_range(&rng, 0.95f, 1.05f);
+            pos[(size_t)r * segments + s] = ak_vec3_make(rad * cosf(a), y, -rad * sinf(a));
+        }
+    size_t bottom = (size_t)rings * segments;
+    pos[bottom] = ak_vec3_make(0, 0, 0);
+    pos[bottom + 1] = ak_vec3_make(0, len, 0);
+    size_t t = 0;
+    for (int r = 0; r + 1 < rings; ++r)
+        for (int s = 0; s < segments; ++s) {
+            uint32_t a = (uint32_t)(r * segments + s), b = (uint32_t)(r * segments + (s + 1) % segments);
+            uint32_t q[6] = {a, b, b + (uint32_t)segments, a, b + (uint32_t)segments, a + (uint32_t)segments};
+            memcpy(&idx[3 * t], q, sizeof q);
+            t += 2;
+        }
+    for (int s = 0; s < segments; ++s) {
+        uint32_t a = (uint32_t)s, b = (uint32_t)((s + 1) % segments), o = (uint32_t)((rings - 1) * segments);
+        uint32_t lo[3] = {(uint32_t)bottom, b, a}, hi[3] = {(uint32_t)bottom + 1, o + a, o + b};
+        memcpy(&idx[3 * t++], lo, sizeof lo);
+        memcpy(&idx[3 * t++], hi, sizeof hi);
+    }
+    for (int j = 0; j < joints; ++j) {
+        ak_skin_bone b = {{0, 0.5f * (float)j, 0}, {0, 0.5f * (float)(j + 1), 0}, (uint16_t)j};
+        bones[j] = b;
+    }
+    *out_pos = pos;
+    *out_idx = idx;
+    *out_n = n;
+    *out_tris = tris;
+}
+
+static void precompute_bench(const char* name, const ak_vec3* pos, size_t n, const uint32_t* idx, size_t tris,
+                             const uint16_t* jn, const float* w, uint32_t k) {
+    ak_vec3* ctr = (ak_vec3*)malloc(n * sizeof(ak_vec3));
+    ak_skin_cor_desc d = {
+        .positions = {pos, n},
+        .indices = {idx, 3 * tris},
+        .joints = {jn, n * k},
+        .weights = {w, n * k},
+        .influence_count = k,
+    };
+    double t[3], cpu[3];
+    for (int v = 0; v < 3; ++v) {
+        d.thread_count = v == 0 ? 2u : 1u;
+        d.naive = v == 2;
+        struct timespec c0, c1;
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+        double t0 = now_s();
+        ak_result r = ak_skin_cor_centers_compute(&d, NULL, (ak_vec3_span){ctr, n});
+        t[v] = now_s() - t0;
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+        cpu[v] = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
+        if (r != AK_OK) printf("  CoR precompute failed: %s\n", ak_result_string(r));
+    }
+    printf("  CoR precompute %s (%zu verts, %zu tris), wall / CPU seconds:\n"
+           "      pruned 2 threads %.3f / %.3f, pruned 1 thread %.3f / %.3f, naive 1 thread %.3f / %.3f "
+           "(naive/pruned CPU x%.1f)\n",
+           name, n, tris, t[0], cpu[0], t[1], cpu[1], t[2], cpu[2], cpu[2] / cpu[1]);
+    free(ctr);
+}
+
+int main(int argc, char** argv) {
+    size_t n = argc > 1 ? (size_t)strtoull(argv[1], NULL, 10) : 1000000u;
+    if (n < 64) n = 64;
+    printf("bench_skin: %zu vertices, 64 joints, 4 influences, kernel %s\n", n, ak_skin_simd_name());
+    double triad = triad_gbps(16u << 20);
+    printf("  STREAM-like triad (3 x 64 MiB float arrays): %.1f GB/s\n", triad);
+
+    bench_data* b = (bench_data*)calloc(1, sizeof *b);
+    b->n = n;
+    b->pos = (ak_vec3*)malloc(n * sizeof(ak_vec3));
+    b->nrm = (ak_vec3*)malloc(n * sizeof(ak_vec3));
+    b->ctr = (ak_vec3*)malloc(n * sizeof(ak_vec3));
+    b->op = (ak_vec3*)malloc(n * sizeof(ak_vec3));
+    b->on = (ak_vec3*)malloc(n * sizeof(ak_vec3));
+    b->jn = (uint16_t*)malloc(n * 4 * sizeof(uint16_t));
+    b->w = (float*)malloc(n * 4 * sizeof(float));
+    ak_rng rng = ak_rng_make(1234);
+    for (int j = 0; j < 64; ++j) {
+        ak_vec3 axis = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+        b->pal[j] = ak_mat4_from_quat(ak_quat_from_axis_angle(axis, ak_rng_range(&rng, -3, 3)));
+        b->pal[j].m[12] = ak_rng_range(&rng, -1, 1);
+        b->pal[j].m[13] = ak_rng_range(&rng, -1, 1);
+        b->pal[j].m[14] = ak_rng_range(&rng, -1, 1);
+    }
+    for (size_t i = 0; i < n; ++i) {
+        b->pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+        b->nrm[i] = ak_vec3_normalize(ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), 1.0f));
+        b->ctr[i] = ak_vec3_scale(b->pos[i], 0.5f);
+        /* neighbouring vertices share nearby joints, as in real meshes */
+        uint32_t base = (uint32_t)((i * 64) / n);
+        float a = ak_rng_float(&rng), c = ak_rng_float(&rng) * (1.0f - a), d = ak_rng_float(&rng) * (1.0f - a - c);
+        float ws[4] = {a, c, d, 1.0f - a - c - d};
+        for (int k = 0; k < 4; ++k) {
+            b->jn[4 * i + k] = (uint16_t)((base + (uint32_t)k) % 64u);
+            b->w[4 * i + k] = ws[k];
+        }
+    }
+    ak_skin_job job = {
+        .influence_count = 4,
+        .palette = {b->pal, 64},
+        .positions = {b->pos, n, 0},
+        .joints = {b->jn, n, 0},
+        .weights = {b->w, n, 0},
+        .cor_centers = {b->ctr, n, 0},
+        .out_positions = {b->op, n, 0},
+        .out_normals = {b->on, n, 0},
+        .scratch = {b->scratch, sizeof b->scratch},
+    };
+    if (ak_skin_job_validate(&job) != AK_OK) {
+        printf("invalid benchmark data\n");
+        return 1;
+    }
+    job.skip_data_check = true; /* checked once above; the per-frame path is O(1) */
+    const int reps = 7;
+    /* bytes moved per vertex: inputs (pos 12, joints 8, weights 16, normals 12, centers 12) + outputs */
+    const double bytes_pos = 12 + 8 + 16 + 12, bytes_pn = bytes_pos + 12 + 12, bytes_cor = bytes_pn + 12;
+
+    double plain_p = 1e30, plain_pn = 1e30;
+    for (int r = 0; r < reps; ++r) {
+        double t0 = now_s();
+        plain_lbs(n, b->pos, NULL, b->jn, b->w, b->pal, b->op, NULL);
+        double t1 = now_s();
+        plain_lbs(n, b->pos, b->nrm, b->jn, b->w, b->pal, b->op, b->on);
+        double t2 = now_s();
+        plain_p = fmin(plain_p, t1 - t0);
+        plain_pn = fmin(plain_pn, t2 - t1);
+    }
+    printf("\n  single thread:\n");
+    row("plain scalar loop, positions", bytes_pos, n, plain_p, triad, 0);
+    row("plain scalar loop, positions+normals", bytes_pn, n, plain_pn, triad, 0);
+
+    double t_lbs_pn[2] = {0, 0}, t_dqs[2] = {0, 0}, t_cor[2] = {0, 0}, t_ratio[3] = {0, 0, 0};
+    for (int threads = 1; threads <= 2; ++threads) {
+        if (threads == 2) {
+            g_use_cpu_time = 0;
+            printf("\n  two threads (job.thread_count = 2, wall time; the single-thread rows above use CPU time):\n");
+            /* the same kernel on one thread, in wall time, for the scaling ratio */
+            job.thread_count = 1;
+            job.skip_simd = false;
+            job.method = AK_SKIN_LBS;
+            job.normals = (ak_cstream){b->nrm, n, 0};
+            t_lbs_pn[0] = time_job(&job, reps);
+            job.method = AK_SKIN_DQS;
+            t_dqs[0] = time_job(&job, reps);
+            job.method = AK_SKIN_COR;
+            t_cor[0] = time_job(&job, reps);
+            row("(1 thread, wall) LBS positions+normals", bytes_pn, n, t_lbs_pn[0], triad, plain_pn);
+            row("(1 thread, wall) DQS positions+normals", bytes_pn, n, t_dqs[0], triad, plain_pn);
+            row("(1 thread, wall) CoR positions+normals", bytes_cor, n, t_cor[0], triad, plain_pn);
+        }
+        job.thread_count = (uint32_t)threads;
+        for (int simd = 1; simd >= 0; --simd) {
+            job.skip_simd = !simd;
+            const char* tag = simd ? ak_skin_simd_name() : "library scalar";
+            char name[64];
+            job.method = AK_SKIN_LBS;
+            job.normals = (ak_cstream){NULL, 0, 0};
+            snprintf(name, sizeof name, "LBS positions (%s)", tag);
+            row(name, bytes_pos, n, time_job(&job, reps), triad, plain_p);
+            job.normals = (ak_cstream){b->nrm, n, 0};
+            double t = time_job(&job, reps);
+            snprintf(name, sizeof name, "LBS positions+normals (%s)", tag);
+            row(name, bytes_pn, n, t, triad, plain_pn);
+            if (simd) t_lbs_pn[threads - 1] = t;
+            if (simd && threads == 1) t_ratio[0] = t;
+            job.method = AK_SKIN_DQS;
+            t = time_job(&job, reps);
+            snprintf(name, sizeof name, "DQS positions+normals (%s)", tag);
+            row(name, bytes_pn, n, t, triad, plain_pn);
+            if (simd) t_dqs[threads - 1] = t;
+            if (simd && threads == 1) t_ratio[1] = t;
+            job.method = AK_SKIN_COR;
+            t = time_job(&job, reps);
+            snprintf(name, sizeof name, "CoR positions+normals (%s)", tag);
+            row(name, bytes_cor, n, t, triad, plain_pn);
+            if (simd) t_cor[threads - 1] = t;
+            if (simd && threads == 1) t_ratio[2] = t;
+        }
+    }
+    printf("\n  ratios (%s, positions+normals, CPU time): DQS/LBS %.2f, CoR/DQS %.2f; 2 threads vs 1 (wall): "
+           "LBS x%.2f, DQS x%.2f, CoR x%.2f\n",
+           ak_skin_simd_name(), t_ratio[1] / t_ratio[0], t_ratio[2] / t_ratio[1], t_lbs_pn[0] / t_lbs_pn[1],
+           t_dqs[0] / t_dqs[1], t_cor[0] / t_cor[1]);
+
+    /* ---- precomputation on character-sized meshes ---- */
+    printf("\n  precomputation:\n");
+    {
+        ak_vec3* pos;
+        uint32_t* idx;
+        size_t vn, tris;
+        ak_skin_bone bones[19];
+        make_limb(102, 32, 19, &pos, &idx, &vn, &tris, bones); /* 3266 vertices, 19 joints: CesiumMan's size */
+        uint16_t* jn = (uint16_t*)malloc(vn * 4 * sizeof(uint16_t));
+        float* w = (float*)malloc(vn * 4 * sizeof(float));
+        for (int m = 0; m < 2; ++m) {
+            ak_weights_desc wd = {
+                .method = m == 0 ? AK_WEIGHTS_DISTANCE : AK_WEIGHTS_HEAT,
+                .positions = {pos, vn},
+                .indices = {idx, 3 * tris},
+                .bones = {bones, 19},
+            };
+            double t0 = now_s();
+            ak_result r = ak_skin_weights_compute(&wd, NULL, (ak_u16_span){jn, 4 * vn}, (ak_f32_span){w, 4 * vn});
+            printf("  weights %-8s on the generated limb (%zu verts, 19 joints): %.3f s (%s)\n",
+                   m == 0 ? "distance" : "heat", vn, now_s() - t0, ak_result_string(r));
+        }
+        precompute_bench("generated limb, heat w.", pos, vn, idx, tris, jn, w, 4);
+        free(jn);
+        free(w);
+        free(pos);
+        free(idx);
+    }
+    char path[1024];
+    if (asset_path(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) {
+        ak_scene* scene = NULL;
+        ak_result r = ak_io_load(path, NULL, NULL, &scene, NULL);
+        if (r == AK_OK) {
+            for (size_t m = 0; m < scene->mesh_count; ++m) {
+                const ak_mesh* mesh = scene->meshes[m].mesh;
+                if (!mesh->influence_count || !mesh->triangle_count) continue;
+                precompute_bench("CesiumMan.glb", mesh->positions, mesh->vertex_count, mesh->indices,
+                                 mesh->triangle_count, mesh->joints, mesh->weights, mesh->influence_count);
+            }
+            ak_scene_destroy(scene);
+        } else {
+            printf("  CesiumMan: not loaded (%s)\n", ak_result_string(r));
+        }
+    } else {
+        printf("  CesiumMan: SKIP (assets not found)\n");
+    }
+    free(b->pos);
+    free(b->nrm);
+    free(b->ctr);
+    free(b->op);
+    free(b->on);
+    free(b->jn);
+    free(b->w);
+    free(b);
+    return 0;
+}
