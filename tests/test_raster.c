@@ -614,6 +614,80 @@ AK_TEST(gif_round_trip) {
     free(b);
 }
 
+/* Copy the first len bytes of src to dst. */
+static bool copy_prefix(const char* src, const char* dst, long len) {
+    FILE* f = fopen(src, "rb");
+    if (!f) return false;
+    char* buf = (char*)malloc((size_t)len + 1);
+    size_t got = fread(buf, 1, (size_t)len, f);
+    fclose(f);
+    FILE* g = fopen(dst, "wb");
+    if (!g) {
+        free(buf);
+        return false;
+    }
+    fwrite(buf, 1, got, g);
+    fclose(g);
+    free(buf);
+    return true;
+}
+
+static long file_size(const char* path) {
+    FILE* f = fopen(path, "rb");
+    if (!f) return -1;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fclose(f);
+    return n;
+}
+
+static ak_result write_small_gif(const ak_image* img) {
+    ak_gif_writer* w = NULL;
+    ak_result r = ak_gif_writer_create("raster_trunc.gif", &(ak_gif_desc){.width = img->width, .height = img->height},
+                                       NULL, &w);
+    if (r != AK_OK) return r;
+    r = ak_gif_writer_add_frame(w, img);
+    ak_result f = ak_gif_writer_finish(w);
+    return r != AK_OK ? r : f;
+}
+
+AK_TEST(truncated_files_give_errors_not_crashes) {
+    /* small valid files, then every prefix: readers must fail cleanly (ASan/UBSan watch) */
+    enum { W = 9, H = 7 };
+    uint8_t px[W * H * 4], back[W * H * 4];
+    for (int i = 0; i < W * H * 4; ++i) px[i] = (uint8_t)(i * 37);
+    ak_image img = {.pixels = px, .width = W, .height = H}, out = {.pixels = back, .width = W, .height = H};
+    AK_CHECK_EQ(ak_png_write("raster_trunc.png", &img), AK_OK);
+    AK_CHECK_EQ(write_small_gif(&img), AK_OK);
+    const char* files[2] = {"raster_trunc.png", "raster_trunc.gif"};
+    for (int f = 0; f < 2; ++f) {
+        long n = file_size(files[f]);
+        AK_CHECK(n > 20);
+        int ok_prefixes = 0;
+        for (long len = 0; len < n; ++len) {
+            AK_CHECK(copy_prefix(files[f], "raster_cut.bin", len));
+            ak_result r;
+            int w = 0, h = 0, c = 0;
+            if (f == 0) {
+                r = ak_png_info("raster_cut.bin", &w, &h);
+                if (r == AK_OK) r = ak_png_read("raster_cut.bin", &out);
+            } else {
+                r = ak_gif_info("raster_cut.bin", &w, &h, &c);
+                if (r == AK_OK) r = ak_gif_read_frame("raster_cut.bin", 0, &out);
+            }
+            AK_CHECK(r == AK_OK || r == AK_ERR_PARSE || r == AK_ERR_BAD_ARG);
+            if (r == AK_OK) {
+                /* only the end marker (PNG's 12-byte IEND chunk, GIF's 1-byte trailer) may be
+                   missing, and then the pixels must be the real ones */
+                ++ok_prefixes;
+                AK_CHECK_MSG(len >= n - 12, "%s: prefix of %ld of %ld bytes decoded", files[f], len, n);
+                if (f == 0) AK_CHECK(memcmp(back, px, sizeof px) == 0);
+            }
+        }
+        AK_CHECK(ok_prefixes <= 12);
+    }
+}
+
 /* ---- bad input --------------------------------------------------------------------------------- */
 
 AK_TEST(bad_input_codes) {
@@ -708,6 +782,7 @@ int main(void) {
     AK_RUN(text_glyphs_and_size);
     AK_RUN(png_round_trip);
     AK_RUN(gif_round_trip);
+    AK_RUN(truncated_files_give_errors_not_crashes);
     AK_RUN(bad_input_codes);
     return ak_test_finish();
 }

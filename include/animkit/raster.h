@@ -100,12 +100,12 @@ AK_API ak_result ak_image_blit(const ak_image* dst, int x, int y, const ak_image
 /* The 7 row bitmaps of an ASCII character; bit 4 is the leftmost column. Non-printable ->
  * the '?' glyph. out_rows needs 7 bytes. */
 AK_API void ak_font_glyph(char c, uint8_t out_rows[7]);
-/* Size in pixels of text drawn at an integer scale (0 -> 1): the widest line times
+/* Size in pixels of text drawn at an integer scale (0 -> 1, above 64 -> 64): the widest line times
  * AK_FONT_ADVANCE_X * scale (minus the trailing gap) and the line count times
  * AK_FONT_ADVANCE_Y * scale (minus the gap). NULL or "" -> 0 x 0. */
 AK_API void ak_text_size(const char* text, int scale, int* out_width, int* out_height);
 /* Alpha-blend text with its top-left corner at pixel (x, y), each font pixel a scale x scale
- * block (0 -> 1). Clipped to the image. AK_ERR_NULL_ARG for a NULL image or text. */
+ * block (0 -> 1, above 64 -> 64). Clipped to the image. AK_ERR_NULL_ARG for a NULL image or text. */
 AK_API ak_result ak_image_draw_text(const ak_image* image, int x, int y, const char* text, int scale,
                                     ak_vec4 color);
 

@@ -54,7 +54,6 @@ typedef struct rtri {
     float a0[MAXA], da1[MAXA], da2[MAXA];
     float flat[4];
     int x0, x1, y0, y1;
-    int front;
 } rtri;
 
 typedef struct drawctx drawctx;
@@ -401,7 +400,7 @@ static void lerp_vert(const cvert* a, const cvert* b, float t, int na, cvert* ou
 }
 
 /* Project, snap and set up one screen triangle; degenerate ones produce nothing. */
-static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1, const cvert* v2, int front,
+static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1, const cvert* v2,
                              const float flat[4], sink* sk) {
     const ak_raster* r = dc->r;
     const cvert* v[3] = {v0, v1, v2};
@@ -472,17 +471,16 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
         t->da2[k] = v[i2]->a[k] * iw[i2] - a0;
     }
     if (flat) memcpy(t->flat, flat, sizeof t->flat);
-    t->front = front;
     raster_tri(dc, t, sk->ti, sk->tc);
 }
 
 /* Clip a clip-space triangle against near/far and the guard band, then set up the pieces. */
-static void clip_and_setup(const drawctx* dc, const cvert* a, const cvert* b, const cvert* c, int front,
+static void clip_and_setup(const drawctx* dc, const cvert* a, const cvert* b, const cvert* c,
                            const float flat[4], sink* sk) {
     unsigned oa = outcode(a->c), ob = outcode(b->c), oc = outcode(c->c);
     if (oa & ob & oc) return;
     if ((oa | ob | oc) == 0) {
-        setup_screen_tri(dc, a, b, c, front, flat, sk);
+        setup_screen_tri(dc, a, b, c, flat, sk);
         return;
     }
     cvert buf[2][12];
@@ -510,7 +508,7 @@ static void clip_and_setup(const drawctx* dc, const cvert* a, const cvert* b, co
         n = m;
         cur ^= 1;
     }
-    for (int i = 1; i + 1 < n; ++i) setup_screen_tri(dc, &buf[cur][0], &buf[cur][i], &buf[cur][i + 1], front, flat, sk);
+    for (int i = 1; i + 1 < n; ++i) setup_screen_tri(dc, &buf[cur][0], &buf[cur][i], &buf[cur][i + 1], flat, sk);
 }
 
 /* ---- fragments ------------------------------------------------------------------------ */
@@ -913,7 +911,7 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
     default:
         break;
     }
-    clip_and_setup(dc, &v[0], &v[1], &v[2], front, flat, sk);
+    clip_and_setup(dc, &v[0], &v[1], &v[2], flat, sk);
 }
 
 static void base_ctx(drawctx* dc, ak_raster* r, const ak_raster_camera* cam, const ak_mat4* model) {
@@ -990,8 +988,8 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
 /* ---- lines and points ------------------------------------------------------------------- */
 
 static void emit_quad(const drawctx* dc, const cvert q[4], const float flat[4], sink* sk) {
-    setup_screen_tri(dc, &q[0], &q[1], &q[2], 1, flat, sk);
-    setup_screen_tri(dc, &q[0], &q[2], &q[3], 1, flat, sk);
+    setup_screen_tri(dc, &q[0], &q[1], &q[2], flat, sk);
+    setup_screen_tri(dc, &q[0], &q[2], &q[3], flat, sk);
 }
 
 /* A screen-space vertex (NDC x, y, z; w = 1) as a cvert. */
@@ -1247,8 +1245,8 @@ static void box_blur(float* s, float* tmp, int radius) {
 
 static void ground_setup(const drawctx* dc, size_t ti, sink* sk) {
     const cvert* q = dc->quad;
-    if (ti == 0) clip_and_setup(dc, &q[0], &q[1], &q[2], 1, NULL, sk);
-    else clip_and_setup(dc, &q[0], &q[2], &q[3], 1, NULL, sk);
+    if (ti == 0) clip_and_setup(dc, &q[0], &q[1], &q[2], NULL, sk);
+    else clip_and_setup(dc, &q[0], &q[2], &q[3], NULL, sk);
 }
 
 ak_result ak_raster_draw_ground(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_ground* ground) {

@@ -260,7 +260,7 @@ void ak_font_glyph(char c, uint8_t out_rows[7]) {
 }
 
 void ak_text_size(const char* text, int scale, int* out_width, int* out_height) {
-    int s = scale > 0 ? scale : 1;
+    int s = scale > 0 ? (scale > 64 ? 64 : scale) : 1;
     int w = 0, lines = 0, cur = 0;
     if (text && *text) {
         lines = 1;
@@ -282,7 +282,7 @@ void ak_text_size(const char* text, int scale, int* out_width, int* out_height) 
 ak_result ak_image_draw_text(const ak_image* image, int x, int y, const char* text, int scale, ak_vec4 color) {
     if (!image || !text || !image->pixels) return AK_ERR_NULL_ARG;
     if (!image_ok(image)) return AK_ERR_BAD_ARG;
-    int s = scale > 0 ? scale : 1;
+    int s = scale > 0 ? (scale > 64 ? 64 : scale) : 1;
     uint8_t c[4];
     ak_color_to_rgba8(color, c);
     int cx = x, cy = y;
