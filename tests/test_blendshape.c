@@ -5,15 +5,24 @@
 
 /* ---- helpers ------------------------------------------------------------------------------ */
 
+/* Three draws in a fixed order (argument evaluation order is unspecified in C, so
+ * make(rng(), rng(), rng()) would give different data under gcc and clang). */
+static ak_vec3 rand3(ak_rng* r, float lx, float hx, float ly, float hy, float lz, float hz) {
+    float x = ak_rng_range(r, lx, hx);
+    float y = ak_rng_range(r, ly, hy);
+    float z = ak_rng_range(r, lz, hz);
+    return ak_vec3_make(x, y, z);
+}
+
 static void fill_random(ak_vec3* v, size_t n, ak_rng* rng, float lo, float hi) {
     for (size_t i = 0; i < n; ++i)
-        v[i] = ak_vec3_make(ak_rng_range(rng, lo, hi), ak_rng_range(rng, lo, hi), ak_rng_range(rng, lo, hi));
+        v[i] = rand3(rng, lo, hi, lo, hi, lo, hi);
 }
 
 static void fill_unit(ak_vec3* v, size_t n, ak_rng* rng) {
     for (size_t i = 0; i < n; ++i) {
         ak_vec3 d;
-        do d = ak_vec3_make(ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1));
+        do d = rand3(rng, -1, 1, -1, 1, -1, 1);
         while (ak_vec3_length(d) < 0.1f);
         v[i] = ak_vec3_normalize(d);
     }
@@ -206,7 +215,7 @@ AK_TEST(threshold_drops_small_deltas_in_every_storage) {
     /* Add noise of length < 1e-4 everywhere: it must be dropped with threshold 1e-3. */
     const float thr = 1e-3f;
     for (size_t i = 0; i < K * V; ++i) {
-        ak_vec3 noise = ak_vec3_make(ak_rng_range(&rng, -5e-5f, 5e-5f), ak_rng_range(&rng, -5e-5f, 5e-5f), 0.0f);
+        ak_vec3 noise = rand3(&rng, -5e-5f, 5e-5f, -5e-5f, 5e-5f, 0.0f, 0.0f);
         if (ak_vec3_length(d[i]) < 2.0f * thr) d[i] = noise; /* small local deltas also become noise */
         else d[i] = ak_vec3_add(d[i], noise);
         kept[i] = ak_vec3_length(d[i]) > thr ? d[i] : ak_vec3_zero();
