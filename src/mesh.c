@@ -308,10 +308,13 @@ ak_result ak_mesh_validate_weights(const ak_mesh* mesh, size_t joint_count, floa
     return AK_OK;
 }
 
+/* Most slots per vertex that ak_weights_normalize reads (an importer may gather several
+ * glTF JOINTS_n/WEIGHTS_n sets into one wide stride before limiting). */
+#define WEIGHTS_READ_MAX 64
+
 void ak_weights_normalize(uint16_t* joints, float* weights, size_t vertex_count,
                           uint32_t influence_count, uint32_t max_influences, float min_weight) {
     if (!joints || !weights || influence_count == 0) return;
-    if (influence_count > AK_MAX_INFLUENCES) influence_count = AK_MAX_INFLUENCES;
     uint32_t keep_max = max_influences ? max_influences : 4u;
     if (keep_max > influence_count) keep_max = influence_count;
     if (!(min_weight >= 0.0f)) min_weight = 0.0f;
@@ -319,10 +322,12 @@ void ak_weights_normalize(uint16_t* joints, float* weights, size_t vertex_count,
         uint16_t* jv = joints + v * influence_count;
         float* wv = weights + v * influence_count;
         const uint16_t first_joint = jv[0];
-        uint16_t j[AK_MAX_INFLUENCES];
-        float w[AK_MAX_INFLUENCES];
+        uint16_t j[WEIGHTS_READ_MAX];
+        float w[WEIGHTS_READ_MAX];
         uint32_t n = 0;
-        for (uint32_t i = 0; i < influence_count; ++i) {
+        const uint32_t read =
+            influence_count < WEIGHTS_READ_MAX ? influence_count : WEIGHTS_READ_MAX;
+        for (uint32_t i = 0; i < read; ++i) {
             float wi = wv[i];
             if (!(wi > 0.0f) || !ak_finitef(wi)) continue;
             uint32_t m = 0;

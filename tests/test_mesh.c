@@ -416,6 +416,18 @@ AK_TEST(weights_normalize_edge_cases) {
     AK_CHECK_EQ(j4[0], 6);
     AK_CHECK(w4[0] == 1.0f && w4[1] == 0.0f);
     ak_weights_normalize(NULL, w4, 1, 2, 2, 0.0f); /* no-op, no crash */
+
+    /* A wide stride (three glTF JOINTS_n sets, 12 slots) limited to 4: the 4 largest. */
+    uint16_t j5[24];
+    float w5[24];
+    for (int i = 0; i < 24; ++i) j5[i] = (uint16_t)(100 + i), w5[i] = (float)(i % 12 + 1);
+    ak_weights_normalize(j5, w5, 2, 12, 4, 0.0f);
+    for (int v = 0; v < 2; ++v) {
+        AK_CHECK_EQ(j5[12 * v], 100 + 12 * v + 11);
+        AK_CHECK_EQ(j5[12 * v + 3], 100 + 12 * v + 8);
+        AK_CHECK_NEAR(w5[12 * v], 12.0 / 42.0, 1e-6);
+        AK_CHECK(w5[12 * v + 4] == 0.0f && w5[12 * v + 11] == 0.0f);
+    }
 }
 
 int main(void) {

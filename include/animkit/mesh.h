@@ -111,8 +111,9 @@ AK_API ak_result ak_mesh_validate_weights(const ak_mesh* mesh, size_t joint_coun
  * sorted by decreasing weight (ties: lower joint first), at most max_influences kept
  * (0 -> 4), weights below min_weight dropped (the largest always stays), renormalised to sum
  * to 1 (within 1e-6). A vertex whose weights are all zero gets weight 1 on its first joint
- * (documented fallback). influence_count is the array's stride; slots past the kept ones are
- * zeroed (joint 0, weight 0). */
+ * (documented fallback). influence_count is the array's stride (any value; the first 64
+ * slots of a vertex are read, so wide strides gathered from several glTF JOINTS_n sets work);
+ * slots past the kept ones are zeroed (joint 0, weight 0). */
 AK_API void ak_weights_normalize(uint16_t* joints, float* weights, size_t vertex_count, uint32_t influence_count,
                                  uint32_t max_influences, float min_weight);
 
