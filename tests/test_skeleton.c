@@ -580,6 +580,48 @@ AK_TEST(limits_inside_unchanged_outside_detected) {
     ak_skeleton_destroy(sk);
 }
 
+/* Random, mostly broken descs: never a crash (ASan/UBSan), always a documented code, and a
+ * skeleton exactly when every rule holds (checked here independently). */
+AK_TEST(create_random_descs) {
+    ak_rng rng = ak_rng_make(99);
+    static const char* const pool[6] = {"a", "b", "c", "d", "e", "f"};
+    int mismatches = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        ak_joint_desc js[6];
+        memset(js, 0, sizeof js);
+        size_t n = 1 + ak_rng_u32(&rng) % 6;
+        bool valid = true;
+        for (size_t i = 0; i < n; ++i) {
+            uint32_t r = ak_rng_u32(&rng);
+            js[i].name = (r % 40 == 0) ? NULL : pool[(r >> 8) % 6];
+            js[i].parent = (int)(ak_rng_u32(&rng) % 8) - 2; /* -2 .. 5 */
+            js[i].rest = ak_transform_identity();
+            if (r % 23 == 1) js[i].rest.translation.y = NAN;
+            if (r % 29 == 2) js[i].rest.rotation = ak_quat_make(0, 0, 0, 0);
+            js[i].type = (ak_joint_type)(ak_rng_u32(&rng) % 5);
+            js[i].limits.min = ak_rng_range(&rng, -1, 1),
+            js[i].limits.max = ak_rng_range(&rng, -1, 1);
+            bool ok = js[i].name && js[i].type < AK_JOINT_TYPE_COUNT && js[i].parent >= -1 &&
+                      js[i].parent < (int)i && r % 23 != 1 && r % 29 != 2 &&
+                      js[i].limits.min <= js[i].limits.max;
+            for (size_t k = 0; ok && k < i; ++k)
+                if (js[k].name && js[i].name && strcmp(js[k].name, js[i].name) == 0) ok = false;
+            valid = valid && ok;
+        }
+        ak_skeleton_desc d = {.joints = js, .joint_count = n};
+        ak_skeleton* sk = NULL;
+        ak_diag diag;
+        ak_result r = ak_skeleton_create(&d, NULL, &sk, &diag);
+        bool documented = r == AK_OK || r == AK_ERR_NULL_ARG || r == AK_ERR_BAD_ARG ||
+                          r == AK_ERR_BAD_HIERARCHY || r == AK_ERR_DUPLICATE ||
+                          r == AK_ERR_BAD_DATA;
+        if (!documented || (r == AK_OK) != valid || (r == AK_OK) != (sk != NULL)) ++mismatches;
+        if (r != AK_OK && diag.message[0] == 0) ++mismatches;
+        ak_skeleton_destroy(sk);
+    }
+    AK_CHECK_EQ(mismatches, 0);
+}
+
 AK_TEST(pose_is_finite) {
     ak_transform p[2] = {ak_transform_identity(), ak_transform_identity()};
     AK_CHECK(ak_pose_is_finite((ak_transform_cspan){p, 2}));
@@ -600,6 +642,7 @@ int main(void) {
     AK_RUN(swing_twist);
     AK_RUN(limits_clamp_properties);
     AK_RUN(limits_inside_unchanged_outside_detected);
+    AK_RUN(create_random_descs);
     AK_RUN(pose_is_finite);
     return ak_test_finish();
 }
