@@ -25,7 +25,7 @@ static ak_vec3 ccd_slide(akp_ik_chain* c, size_t i, ak_vec3 effector) {
     ak_transform* l = &c->pose[j];
     l->translation = ak_vec3_madd(l->translation, axis_p, s);
     *l = ak_skeleton_limit_joint(c->skeleton, j, *l);
-    c->world[i] = ak_transform_mul(parent, *l);
+    c->world[i] = akp_ik_compose(parent, *l);
     return ak_vec3_sub(c->world[i].translation, before);
 }
 
@@ -41,8 +41,8 @@ static ak_vec3 ccd_step(akp_ik_chain* c, size_t i, ak_vec3 e, float max_step) {
     ak_quat q = akp_ik_aim_rotation(ak_vec3_sub(e, p), ak_vec3_sub(c->target, p), type == AK_JOINT_HINGE, axis, max_step);
     const ak_quat old_rot = c->world[i].rotation;
     akp_ik_rotate(c, i, q);
-    /* The rotation really applied (limits may have changed it). */
-    ak_quat applied = ak_quat_mul(c->world[i].rotation, ak_quat_conjugate(old_rot));
+    /* The rotation really applied: q itself unless limits clipped it. */
+    ak_quat applied = c->clamp[i] ? ak_quat_mul(c->world[i].rotation, ak_quat_conjugate(old_rot)) : q;
     return ak_vec3_add(p, ak_quat_rotate(applied, ak_vec3_sub(e, p)));
 }
 
@@ -52,7 +52,7 @@ void akp_ik_ccd_sweep(akp_ik_chain* c, float max_step, bool from_root) {
     if (from_root) {
         for (size_t i = 0; i < last; ++i) {
             e = ccd_step(c, i, e, max_step);
-            c->world[i + 1] = ak_transform_mul(c->world[i], c->pose[c->joints[i + 1]]);
+            c->world[i + 1] = akp_ik_compose(c->world[i], c->pose[c->joints[i + 1]]);
         }
     } else {
         for (size_t i = last; i-- > 0;) e = ccd_step(c, i, e, max_step);

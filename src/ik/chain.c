@@ -135,7 +135,8 @@ static ak_ik_solver resolve_solver(ak_ik_solver s) { return s == AK_IK_SOLVER_DE
 
 size_t ak_ik_chain_scratch_size(ak_ik_solver solver, size_t chain_count) {
     size_t n = chain_count ? chain_count : 1;
-    size_t bytes = 16 + 2 * world_bytes(n); /* 16: room to align the caller's pointer */
+    /* 16: room to align the caller's pointer */
+    size_t bytes = 16 + 2 * world_bytes(n) + 2 * akp_align16(n);
     switch (resolve_solver(solver)) {
     case AK_IK_SOLVER_FABRIK: bytes += akp_align16(n * sizeof(ak_vec3)) + akp_align16(n * sizeof(float)); break;
     case AK_IK_SOLVER_DLS: bytes += akp_ik_dls_scratch_size(n); break;
@@ -189,7 +190,12 @@ ak_result ak_ik_chain_validate(const ak_ik_chain_job* job) {
  * positions. */
 static void apply_target_rotation(akp_ik_chain* c, const ak_quat* target_rotation) {
     if (!target_rotation) return;
-    akp_ik_set_world_rot(c, c->count - 1, ak_quat_normalize(*target_rotation));
+    const size_t last = c->count - 1, j = (size_t)c->joints[last];
+    akp_ik_set_world_rot(c, last, ak_quat_normalize(*target_rotation));
+    if (c->types[last] != AK_JOINT_FREE && !c->clamp[last]) { /* an arbitrary turn: clamp anyway */
+        c->pose[j] = ak_skeleton_limit_joint(c->skeleton, j, c->pose[j]);
+        c->world[last] = akp_ik_compose(akp_ik_parent_world(c, last), c->pose[j]);
+    }
 }
 
 ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
@@ -209,6 +215,19 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
     mem += world_bytes(n);
     c.best = (ak_transform*)mem;
     mem += world_bytes(n);
+    c.types = mem;
+    mem += akp_align16(n);
+    c.clamp = mem;
+    mem += akp_align16(n);
+    for (size_t i = 0; i < n; ++i) {
+        const size_t j = (size_t)rj.chain.ptr[i];
+        const ak_joint_type type = rj.ignore_limits ? AK_JOINT_FREE : ak_skeleton_joint_type(rj.skeleton, j);
+        const ak_joint_limits l = ak_skeleton_joint_limits(rj.skeleton, j);
+        c.types[i] = (uint8_t)type;
+        c.clamp[i] = (uint8_t)(type == AK_JOINT_PRISM ||
+                               (type == AK_JOINT_HINGE && (l.min != 0.0f || l.max != 0.0f)) ||
+                               (type == AK_JOINT_BALL && (l.cone_angle > 0.0f || l.twist_min != 0.0f || l.twist_max != 0.0f)));
+    }
     c.target = rj.target;
     c.limits = !rj.ignore_limits;
     akp_ik_fk(&c, 0);

@@ -32,7 +32,7 @@ static void aim_bone(akp_ik_chain* c, size_t i, ak_vec3 desired) {
     } else if (type != AK_JOINT_PRISM && ak_vec3_length_sq(cur) > 1e-24f && ak_vec3_length_sq(want) > 1e-24f) {
         akp_ik_rotate(c, i, ak_quat_from_to(cur, want));
     }
-    c->world[i + 1] = ak_transform_mul(c->world[i], child_local);
+    c->world[i + 1] = akp_ik_compose(c->world[i], child_local);
 }
 
 /* Positions -> rotations for the whole chain, root first; world[] ends consistent. */
@@ -41,12 +41,51 @@ static void positions_to_rotations(akp_ik_chain* c, const ak_vec3* pos) {
 }
 
 static bool chain_has_limits(const akp_ik_chain* c) {
-    if (!c->limits) return false;
     for (size_t i = 0; i < c->count; ++i)
-        if (ak_skeleton_joint_type(c->skeleton, (size_t)c->joints[i]) != AK_JOINT_FREE) return true;
+        if (c->types[i] != AK_JOINT_FREE) return true;
     return false;
 }
 
+/* One FABRIK iteration. Unconstrained: on positions only. Constrained: the backward pass goes
+ * through rotations: each joint turns (within its limits) to aim its bone from where it really
+ * is at the forward-pass spot, and the child lands where forward kinematics puts it; then a
+ * constrained CCD sweep, because a joint held at a limit can leave the passes at a fixed point
+ * short of the target, and the sweep lets its neighbours take up the slack. */
+static void fabrik_pass(akp_ik_chain* c, ak_vec3* pos, const float* len, float total, ak_vec3 root, bool constrained) {
+    const size_t n = c->count, last = n - 1;
+    const ak_vec3 t = c->target;
+    if (ak_vec3_distance(root, t) >= total) {
+        /* Out of reach: stretch the chain straight towards the target. */
+        for (size_t i = 0; i < last; ++i) {
+            ak_vec3 fallback = ak_vec3_normalize(ak_vec3_sub(pos[i + 1], pos[i]));
+            pos[i + 1] = reach(pos[i], t, len[i], fallback);
+        }
+    } else {
+        /* Forward reaching: effector onto the target, then each joint towards its child. */
+        pos[last] = t;
+        for (size_t i = last; i-- > 0;) {
+            ak_vec3 fallback = ak_vec3_normalize(ak_vec3_sub(c->world[i].translation, c->world[i + 1].translation));
+            pos[i] = reach(pos[i + 1], pos[i], len[i], fallback);
+        }
+        /* Backward reaching: the root back in place, then each child towards its new spot. */
+        pos[0] = root;
+        if (!constrained) {
+            for (size_t i = 0; i < last; ++i) {
+                ak_vec3 fallback = ak_vec3_normalize(ak_vec3_sub(c->world[i + 1].translation, c->world[i].translation));
+                pos[i + 1] = reach(pos[i], pos[i + 1], len[i], fallback);
+            }
+        }
+    }
+    if (constrained) {
+        positions_to_rotations(c, pos);
+        akp_ik_ccd_sweep(c, AK_PI, false);
+        for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
+    }
+}
+
+/* Chains with limits first try the plain passes (often the answer already respects the limits,
+ * e.g. a planar chain of hinges); only if the converted pose misses do the constrained
+ * iterations take over for the rest of the budget. */
 akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec3* pos, float* len) {
     const size_t n = c->count, last = n - 1;
     const ak_vec3 t = c->target;
@@ -57,52 +96,31 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
     const bool limited = chain_has_limits(c);
     const float noise = 1e-6f * ak_maxf(total, 1e-6f);
     akp_ik_outcome out = {ak_vec3_distance(pos[last], t), 0};
-    float best = out.error;
-    int stalled = 0;
-
-    while (out.error > c->tolerance && out.iterations < job->max_iterations) {
-        if (ak_vec3_distance(root, t) >= total) {
-            /* Out of reach: stretch the chain straight towards the target. */
-            for (size_t i = 0; i < last; ++i) {
-                ak_vec3 fallback = ak_vec3_normalize(ak_vec3_sub(pos[i + 1], pos[i]));
-                pos[i + 1] = reach(pos[i], t, len[i], fallback);
-            }
-        } else {
-            /* Forward reaching: effector onto the target, then each joint towards its child. */
-            pos[last] = t;
-            for (size_t i = last; i-- > 0;) {
-                ak_vec3 fallback = ak_vec3_normalize(ak_vec3_sub(c->world[i].translation, c->world[i + 1].translation));
-                pos[i] = reach(pos[i + 1], pos[i], len[i], fallback);
-            }
-            /* Backward reaching: the root back in place, then each child towards its new spot.
-             * With limits, each joint turns (within its limits) to aim its bone from where it
-             * really is at the forward-pass spot, and the child lands where FK puts it. */
-            pos[0] = root;
-            if (!limited) {
-                for (size_t i = 0; i < last; ++i) {
-                    ak_vec3 fallback = ak_vec3_normalize(ak_vec3_sub(c->world[i + 1].translation, c->world[i].translation));
-                    pos[i + 1] = reach(pos[i], pos[i + 1], len[i], fallback);
-                }
+    bool constrained = false;
+    for (;;) {
+        float best = out.error;
+        int stalled = 0;
+        while (out.error > c->tolerance && out.iterations < job->max_iterations) {
+            fabrik_pass(c, pos, len, total, root, constrained);
+            out.error = ak_vec3_distance(pos[last], t);
+            ++out.iterations;
+            if (constrained) akp_ik_track_best(c, out.error);
+            if (out.error < best - noise) {
+                best = out.error;
+                stalled = 0;
+            } else if (++stalled >= 3) {
+                break;
             }
         }
-        if (limited) {
-            positions_to_rotations(c, pos);
-            /* A joint held at a limit can leave the passes at a fixed point short of the
-             * target; one constrained CCD sweep lets its neighbours take up the slack. */
-            akp_ik_ccd_sweep(c, AK_PI, false);
-            for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
-        }
-        out.error = ak_vec3_distance(pos[last], t);
-        ++out.iterations;
-        if (limited) akp_ik_track_best(c, out.error);
-        if (out.error < best - noise) {
-            best = out.error;
-            stalled = 0;
-        } else if (++stalled >= 3) {
-            break;
-        }
+        if (constrained) break;
+        if (out.iterations > 0) positions_to_rotations(c, pos);
+        out.error = ak_vec3_distance(c->world[last].translation, t);
+        if (!limited) break;
+        akp_ik_track_best(c, out.error);
+        if (out.error <= c->tolerance || out.iterations >= job->max_iterations) break;
+        constrained = true;
+        for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
     }
-    if (!limited && out.iterations > 0) positions_to_rotations(c, pos);
     if (limited) out.error = akp_ik_restore_best(c, out.error);
     return out;
 }

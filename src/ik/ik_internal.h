@@ -16,6 +16,10 @@ typedef struct akp_ik_chain {
     ak_transform base;
     ak_transform* world; /* [count] scratch */
     ak_transform* best;  /* [count] scratch: chain locals of the best pose seen */
+    uint8_t* types;      /* [count] scratch: ak_joint_type per chain joint, FREE when limits are off */
+    uint8_t* clamp;      /* [count] scratch: 1 when the joint has limits that can clip a rotation
+                            the solvers produce (an unlimited hinge turned about its own axis,
+                            or an unlimited ball, cannot be clipped) */
     float best_error;
     ak_vec3 target;
     bool limits; /* honour joint types and limits */
@@ -37,10 +41,20 @@ static inline ak_transform akp_ik_parent_world(const akp_ik_chain* c, size_t i) 
     return i == 0 ? c->base : c->world[i - 1];
 }
 
+/* parent * local for unit rotations: like ak_transform_mul without the renormalisation, which
+ * the solvers do once per changed joint instead. */
+static inline ak_transform akp_ik_compose(ak_transform parent, ak_transform local) {
+    ak_transform r;
+    r.rotation = ak_quat_mul(parent.rotation, local.rotation);
+    r.scale = ak_vec3_mul(parent.scale, local.scale);
+    r.translation = ak_vec3_add(parent.translation, ak_quat_rotate(parent.rotation, ak_vec3_mul(parent.scale, local.translation)));
+    return r;
+}
+
 /* Recompute world[from..count-1] from the pose. */
 static inline void akp_ik_fk(akp_ik_chain* c, size_t from) {
     for (size_t i = from; i < c->count; ++i)
-        c->world[i] = ak_transform_mul(akp_ik_parent_world(c, i), c->pose[c->joints[i]]);
+        c->world[i] = akp_ik_compose(akp_ik_parent_world(c, i), c->pose[c->joints[i]]);
 }
 
 /* Remember the current pose when it beats the best error so far. */
@@ -59,9 +73,7 @@ static inline float akp_ik_restore_best(akp_ik_chain* c, float error) {
 }
 
 /* Joint type as the solver sees it: FREE when limits are ignored. */
-static inline ak_joint_type akp_ik_type(const akp_ik_chain* c, size_t i) {
-    return c->limits ? ak_skeleton_joint_type(c->skeleton, (size_t)c->joints[i]) : AK_JOINT_FREE;
-}
+static inline ak_joint_type akp_ik_type(const akp_ik_chain* c, size_t i) { return (ak_joint_type)c->types[i]; }
 
 /* Set chain joint i's local rotation so that its model rotation becomes world_rot, then clamp
  * to its limits. world[i] is updated; descendants are not. */
@@ -69,8 +81,8 @@ static inline void akp_ik_set_world_rot(akp_ik_chain* c, size_t i, ak_quat world
     const size_t j = (size_t)c->joints[i];
     ak_transform* l = &c->pose[j];
     l->rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(akp_ik_parent_rot(c, i)), world_rot));
-    if (c->limits) *l = ak_skeleton_limit_joint(c->skeleton, j, *l);
-    c->world[i] = ak_transform_mul(akp_ik_parent_world(c, i), *l);
+    if (c->clamp[i]) *l = ak_skeleton_limit_joint(c->skeleton, j, *l);
+    c->world[i] = akp_ik_compose(akp_ik_parent_world(c, i), *l);
 }
 
 /* Rotate chain joint i by the model-space rotation q (about its own position). */
@@ -101,36 +113,53 @@ static inline float akp_quat_angle(ak_quat q) {
     return 2.0f * atan2f(s, fabsf(q.w));
 }
 
-/* Rotation (model space) that turns re towards rd about the joint, limited to max_step; for a
- * hinge, about its axis only (both vectors projected onto the plane of rotation). */
+/* Half-angle quaternion about unit axis from the full angle's (cos, sin), c^2 + s^2 = 1. The
+ * larger of cos(a/2), sin(a/2) comes from a square root and the other from
+ * sin(a) = 2 sin(a/2) cos(a/2), so small angles keep their precision (sqrt(1 - c) alone
+ * would quantise them to ~3e-4 rad in float). */
+static inline ak_quat akp_quat_half_angle(ak_vec3 axis, float c, float s) {
+    float ch, sh;
+    if (c >= 0.0f) {
+        ch = sqrtf(0.5f + 0.5f * c);
+        sh = 0.5f * s / ch;
+    } else {
+        sh = sqrtf(0.5f - 0.5f * c);
+        if (s < 0.0f) sh = -sh;
+        ch = 0.5f * s / sh;
+    }
+    return ak_quat_make(axis.x * sh, axis.y * sh, axis.z * sh, ch);
+}
+
+/* Rotation (model space) that turns re towards rd, limited to max_step radians (>= pi: no
+ * limit); for a hinge, about its unit axis only (both vectors projected onto the plane of
+ * rotation). Opposite vectors turn half a turn about any normal; zero vectors give the
+ * identity. Unlimited, it is the shortest-arc quaternion (cross, |re||rd| + dot), normalised:
+ * two square roots, no trig. */
 static inline ak_quat akp_ik_aim_rotation(ak_vec3 re, ak_vec3 rd, bool hinge, ak_vec3 axis, float max_step) {
     if (hinge) {
         re = ak_vec3_madd(re, axis, -ak_vec3_dot(re, axis));
         rd = ak_vec3_madd(rd, axis, -ak_vec3_dot(rd, axis));
     }
-    const float lre = ak_vec3_length(re), lrd = ak_vec3_length(rd);
-    if (!(lre > 1e-12f) || !(lrd > 1e-12f)) return ak_quat_identity();
-    ak_vec3 cr = ak_vec3_cross(re, rd);
-    float sin_l = ak_vec3_length(cr); /* |re||rd| sin(theta) */
-    float cos_l = ak_vec3_dot(re, rd); /* |re||rd| cos(theta) */
-    float angle;
-    ak_vec3 ax;
-    if (hinge) {
-        angle = atan2f(ak_vec3_dot(cr, axis), cos_l); /* signed about the hinge axis */
-        ax = axis;
-        if (angle < 0.0f) {
-            angle = -angle;
-            ax = ak_vec3_neg(axis);
+    const float l2 = ak_vec3_length_sq(re) * ak_vec3_length_sq(rd);
+    if (!(l2 > 1e-24f)) return ak_quat_identity();
+    const float m = sqrtf(l2), d = ak_vec3_dot(re, rd);
+    ak_vec3 v = ak_vec3_cross(re, rd);
+    if (hinge) v = ak_vec3_scale(axis, ak_vec3_dot(v, axis));
+    if (max_step < AK_PI) {
+        const float c = d / m, cmax = cosf(max_step);
+        if (c < cmax) { /* limit the turn, keeping its axis */
+            ak_vec3 ax = ak_vec3_normalize(v);
+            if (ak_vec3_length_sq(ax) == 0.0f) ax = hinge ? axis : ak_vec3_any_perpendicular(re);
+            return akp_quat_half_angle(ax, cmax, sinf(max_step));
         }
-    } else {
-        angle = atan2f(sin_l, cos_l);
-        if (sin_l > 1e-12f * lre * lrd) ax = ak_vec3_scale(cr, 1.0f / sin_l);
-        else if (cos_l < 0.0f) ax = ak_vec3_any_perpendicular(re); /* opposite: any axis */
-        else return ak_quat_identity();
     }
-    if (angle > max_step) angle = max_step;
-    float s = sinf(0.5f * angle);
-    return ak_quat_make(ax.x * s, ax.y * s, ax.z * s, cosf(0.5f * angle));
+    const float w = m + d;
+    if (w < 1e-6f * m) { /* opposite */
+        ak_vec3 ax = hinge ? axis : ak_vec3_any_perpendicular(re);
+        return ak_quat_make(ax.x, ax.y, ax.z, 0.0f);
+    }
+    const float inv = 1.0f / sqrtf(ak_vec3_length_sq(v) + w * w);
+    return ak_quat_make(v.x * inv, v.y * inv, v.z * inv, w * inv);
 }
 
 /* Solvers (src/ik/<name>.c). Each starts from a chain whose world[] is current and returns

@@ -10,15 +10,23 @@
  * nearer the current bend keeps the knee bending the way it did. Every angle is handled as a
  * (cos, sin) pair and half angles come from sqrt((1 +- cos) / 2), so the solve needs no trig.
  *
- * Start joint: the shortest arc taking start->end onto start->target, then a turn about the
- * start->target axis that puts the mid joint in the half plane of the pole direction. */
+ * Start joint: the rotation taking start->end onto start->target and putting the mid joint
+ * in the half plane of the pole direction (or, without a pole, the shortest arc). */
+#include <string.h>
+
 #include "ik_internal.h"
 
-static inline ak_vec3 mat_col(const float* m, int c) { return ak_vec3_make(m[c * 4], m[c * 4 + 1], m[c * 4 + 2]); }
 static inline ak_vec3 mat_pos(const float* m) { return ak_vec3_make(m[12], m[13], m[14]); }
 static inline ak_vec3 mat_rotate(const float* m, ak_vec3 v) {
     return ak_vec3_make(m[0] * v.x + m[4] * v.y + m[8] * v.z, m[1] * v.x + m[5] * v.y + m[9] * v.z,
                         m[2] * v.x + m[6] * v.y + m[10] * v.z);
+}
+/* A unit local direction into model space (rescaled when the matrix has a uniform scale). */
+static inline ak_vec3 mat_rotate_dir(const float* m, ak_vec3 v) {
+    ak_vec3 r = mat_rotate(m, v);
+    float s2 = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+    if (fabsf(s2 - 1.0f) > 1e-5f && s2 > 0.0f) r = ak_vec3_scale(r, 1.0f / sqrtf(s2));
+    return r;
 }
 /* Direction of a model-space vector in the joint's local frame (transpose, rescaled). */
 static inline ak_vec3 mat_unrotate(const float* m, ak_vec3 v) {
@@ -29,21 +37,32 @@ static inline ak_vec3 mat_unrotate(const float* m, ak_vec3 v) {
     return r;
 }
 
-/* Half-angle quaternion about unit axis from the full angle's (cos, sin), c^2 + s^2 = 1. The
- * larger of cos(a/2), sin(a/2) comes from a square root and the other from
- * sin(a) = 2 sin(a/2) cos(a/2), so small angles keep their precision (sqrt(1 - c) alone
- * would quantise them to ~3e-4 rad in float). */
-static inline ak_quat half_angle(ak_vec3 axis, float c, float s) {
-    float ch, sh;
-    if (c >= 0.0f) {
-        ch = sqrtf(0.5f + 0.5f * c);
-        sh = 0.5f * s / ch;
-    } else {
-        sh = sqrtf(ak_maxf(0.5f - 0.5f * c, 0.0f));
-        if (s < 0.0f) sh = -sh;
-        ch = 0.5f * s / sh;
+/* The rotation taking the orthonormal frame (a0, a1, a0 x a1) onto (b0, b1, b0 x b1):
+ * Q = b0 a0^T + b1 a1^T + b2 a2^T, to a quaternion by Shepperd's method. */
+static inline ak_quat frame_rotation(ak_vec3 a0, ak_vec3 a1, ak_vec3 b0, ak_vec3 b1) {
+    const ak_vec3 a2 = ak_vec3_cross(a0, a1), b2 = ak_vec3_cross(b0, b1);
+    /* q[r][c] = row r, column c */
+    const float q00 = b0.x * a0.x + b1.x * a1.x + b2.x * a2.x, q01 = b0.x * a0.y + b1.x * a1.y + b2.x * a2.y,
+                q02 = b0.x * a0.z + b1.x * a1.z + b2.x * a2.z;
+    const float q10 = b0.y * a0.x + b1.y * a1.x + b2.y * a2.x, q11 = b0.y * a0.y + b1.y * a1.y + b2.y * a2.y,
+                q12 = b0.y * a0.z + b1.y * a1.z + b2.y * a2.z;
+    const float q20 = b0.z * a0.x + b1.z * a1.x + b2.z * a2.x, q21 = b0.z * a0.y + b1.z * a1.y + b2.z * a2.y,
+                q22 = b0.z * a0.z + b1.z * a1.z + b2.z * a2.z;
+    const float tr = q00 + q11 + q22;
+    if (tr > 0.0f) {
+        const float r = sqrtf(1.0f + tr), h = 0.5f / r;
+        return ak_quat_make((q21 - q12) * h, (q02 - q20) * h, (q10 - q01) * h, 0.5f * r);
     }
-    return ak_quat_make(axis.x * sh, axis.y * sh, axis.z * sh, ch);
+    if (q00 >= q11 && q00 >= q22) {
+        const float r = sqrtf(ak_maxf(1.0f + q00 - q11 - q22, 1e-30f)), h = 0.5f / r;
+        return ak_quat_make(0.5f * r, (q01 + q10) * h, (q02 + q20) * h, (q21 - q12) * h);
+    }
+    if (q11 >= q22) {
+        const float r = sqrtf(ak_maxf(1.0f + q11 - q00 - q22, 1e-30f)), h = 0.5f / r;
+        return ak_quat_make((q01 + q10) * h, 0.5f * r, (q12 + q21) * h, (q02 - q20) * h);
+    }
+    const float r = sqrtf(ak_maxf(1.0f + q22 - q00 - q11, 1e-30f)), h = 0.5f / r;
+    return ak_quat_make((q02 + q20) * h, (q12 + q21) * h, 0.5f * r, (q10 - q01) * h);
 }
 
 static inline ak_quat weight_toward_identity(ak_quat q, float keep) {
@@ -56,27 +75,30 @@ bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* o
     const ak_vec3 s = mat_pos(S), m = mat_pos(M), e = mat_pos(E);
     const ak_vec3 u = ak_vec3_sub(m, s), v = ak_vec3_sub(e, m), st = ak_vec3_sub(job->target, s);
     const float a2 = ak_vec3_dot(u, u), b2 = ak_vec3_dot(v, v), d2 = ak_vec3_dot(st, st);
-    const float a = sqrtf(a2), b = sqrtf(b2), d = sqrtf(d2);
 
-    /* Reach: softened, then clamped to what the two bones can span. */
-    const float lmax = a + b, lmin = fabsf(a - b);
-    bool reached = d <= lmax * (1.0f + 1e-6f) && d >= lmin - 1e-6f * lmax;
-    float dd = d;
+    /* Reach, in squared lengths (one square root): softened, then clamped to what the two
+     * bones can span, |a - b| <= d <= a + b. */
+    const float ab = sqrtf(a2 * b2);
+    const float lmax2 = a2 + b2 + 2.0f * ab, lmin2 = ak_maxf(a2 + b2 - 2.0f * ab, 0.0f);
+    bool reached = d2 <= lmax2 * (1.0f + 2e-6f) && d2 >= lmin2 - 2e-6f * lmax2;
+    float dd2 = d2;
     if (job->soft > 0.0f) {
+        const float d = sqrtf(d2), lmax = sqrtf(lmax2);
         const float ds = (1.0f - job->soft) * lmax, band = lmax - ds;
         if (d > ds && band > 0.0f) {
-            dd = ds + band * (1.0f - expf((ds - d) / band));
+            const float dd = ds + band * (1.0f - expf((ds - d) / band));
+            dd2 = dd * dd;
             reached = false;
         }
     }
-    dd = ak_clampf(dd, lmin, lmax);
+    dd2 = ak_clampf(dd2, lmin2, lmax2);
 
-    /* Bend axis in model space. */
+    /* Bend axis n in model space, n_local in the mid joint's frame. */
     ak_vec3 n, n_local;
     const bool axis_given = job->mid_axis.x != 0.0f || job->mid_axis.y != 0.0f || job->mid_axis.z != 0.0f;
     if (axis_given) {
         n_local = ak_vec3_normalize(job->mid_axis);
-        n = ak_vec3_normalize(mat_rotate(M, n_local));
+        n = mat_rotate_dir(M, n_local);
     } else {
         n = ak_vec3_cross(u, v);
         float n2 = ak_vec3_dot(n, n);
@@ -86,55 +108,71 @@ bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* o
             n = ak_vec3_normalize(ak_vec3_cross(u, job->pole));
             if (ak_vec3_dot(n, n) == 0.0f) n = ak_vec3_any_perpendicular(a2 > 0.0f ? u : v);
         }
-        n_local = ak_vec3_normalize(mat_unrotate(M, n));
+        n_local = mat_unrotate(M, n);
     }
 
-    /* Mid joint: A cos(phi) + B sin(phi) = K. */
+    /* Mid joint: A cos(phi) + B sin(phi) = K. With R^2 = A^2 + B^2 and S = sqrt(R^2 - K^2),
+     * the two solutions are (cos, sin) = ((A K -+ B S), (B K +- A S)) / R^2. */
     const float vn = ak_vec3_dot(n, v);
     const ak_vec3 v_perp = ak_vec3_madd(v, n, -vn);
     const ak_vec3 n_x_vp = ak_vec3_cross(n, v_perp);
     const float A = ak_vec3_dot(u, v_perp), B = ak_vec3_dot(u, n_x_vp);
-    const float K = 0.5f * (dd * dd - a2 - b2) - vn * ak_vec3_dot(u, n);
+    float K = 0.5f * (dd2 - a2 - b2) - vn * ak_vec3_dot(u, n);
     const float r2 = A * A + B * B;
     float cphi = 1.0f, sphi = 0.0f;
     if (r2 > 1e-24f * (a2 * b2 + 1e-30f)) {
-        const float inv = 1.0f / sqrtf(r2);
-        const float ca = A * inv, sa = B * inv;
-        const float c = ak_clampf(K * inv, -1.0f, 1.0f), sn = sqrtf(1.0f - c * c);
-        const float c1 = ca * c - sa * sn, s1 = sa * c + ca * sn; /* phi = alpha + beta */
-        const float c2 = ca * c + sa * sn, s2 = sa * c - ca * sn; /* phi = alpha - beta */
+        float S = 0.0f;
+        if (K * K < r2) S = sqrtf(r2 - K * K);
+        else K = K > 0.0f ? sqrtf(r2) : -sqrtf(r2); /* out of the axis' range: nearest end */
+        const float inv = 1.0f / r2;
+        const float c1 = (A * K - B * S) * inv, s1 = (B * K + A * S) * inv; /* phi = alpha + beta */
+        const float c2 = (A * K + B * S) * inv, s2 = (B * K - A * S) * inv; /* phi = alpha - beta */
         if ((c1 >= c2) != (branch != 0)) cphi = c1, sphi = s1;
         else cphi = c2, sphi = s2;
     }
-    ak_quat q_mid = half_angle(n_local, cphi, sphi);
+    ak_quat q_mid = akp_quat_half_angle(n_local, cphi, sphi);
 
-    /* Start joint: aim start->end at the target, then turn the plane towards the pole. */
+    /* Start joint. With a pole: the rotation taking the frame (f, knee side) of the bent limb
+     * onto (target direction, pole side), one matrix product and one matrix-to-quaternion,
+     * all normalisations independent of each other. Without: the shortest arc from f to the
+     * target direction, which keeps the current bend plane as far as it can. */
     ak_quat q_start = ak_quat_identity();
     if (d2 > 1e-24f) {
         const ak_vec3 v_rot = ak_vec3_add(ak_vec3_madd(ak_vec3_scale(n, vn), v_perp, cphi), ak_vec3_scale(n_x_vp, sphi));
         const ak_vec3 f = ak_vec3_add(u, v_rot);
         const float f2 = ak_vec3_dot(f, f);
-        if (f2 > 1e-24f) {
+        const bool has_pole = job->pole.x != 0.0f || job->pole.y != 0.0f || job->pole.z != 0.0f;
+        bool done = false;
+        if (has_pole && f2 > 1e-24f) {
+            const ak_vec3 fh = ak_vec3_scale(f, 1.0f / sqrtf(f2));
+            const ak_vec3 k = ak_vec3_scale(st, 1.0f / sqrtf(d2));
+            const ak_vec3 e1 = ak_vec3_madd(u, fh, -ak_vec3_dot(u, fh));
+            const ak_vec3 p1 = ak_vec3_madd(job->pole, k, -ak_vec3_dot(job->pole, k));
+            const float e12 = ak_vec3_dot(e1, e1), p12 = ak_vec3_dot(p1, p1);
+            if (e12 > 1e-12f * a2 && p12 > 1e-12f * ak_vec3_dot(job->pole, job->pole)) {
+                /* A second projection: with the limb nearly straight, e1 comes out of a
+                 * cancellation and the first one leaves it measurably off the normal plane; a
+                 * frame that is not orthonormal would move the effector, not just twist. */
+                ak_vec3 eh = ak_vec3_scale(e1, 1.0f / sqrtf(e12));
+                ak_vec3 ph = ak_vec3_scale(p1, 1.0f / sqrtf(p12));
+                eh = ak_vec3_madd(eh, fh, -ak_vec3_dot(eh, fh));
+                ph = ak_vec3_madd(ph, k, -ak_vec3_dot(ph, k));
+                q_start = frame_rotation(fh, eh, k, ph);
+                done = true;
+            }
+        }
+        if (!done && f2 > 1e-24f) {
             const ak_vec3 cr = ak_vec3_cross(f, st);
-            const float w = sqrtf(f2 * d2) + ak_vec3_dot(f, st);
-            if (w > 1e-6f * sqrtf(f2 * d2)) {
+            const float fd = sqrtf(f2 * d2), w = fd + ak_vec3_dot(f, st);
+            if (w > 1e-6f * fd) {
                 q_start = ak_quat_normalize(ak_quat_make(cr.x, cr.y, cr.z, w));
             } else { /* opposite: half a turn about an axis normal to the limb, n if possible */
                 ak_vec3 ax = ak_vec3_dot(n, f) * ak_vec3_dot(n, f) < 1e-6f * f2 ? n : ak_vec3_any_perpendicular(f);
                 q_start = ak_quat_make(ax.x, ax.y, ax.z, 0.0f);
             }
         }
-        const ak_vec3 k = ak_vec3_scale(st, 1.0f / d);
-        const bool has_pole = job->pole.x != 0.0f || job->pole.y != 0.0f || job->pole.z != 0.0f;
-        if (has_pole) {
-            const ak_vec3 m1 = ak_quat_rotate(q_start, u);
-            const ak_vec3 mp = ak_vec3_madd(m1, k, -ak_vec3_dot(k, m1));
-            const ak_vec3 pp = ak_vec3_madd(job->pole, k, -ak_vec3_dot(k, job->pole));
-            const float c = ak_vec3_dot(mp, pp), sn = ak_vec3_dot(k, ak_vec3_cross(mp, pp));
-            const float r = sqrtf(c * c + sn * sn);
-            if (r > 1e-20f) q_start = ak_quat_mul(half_angle(k, c / r, sn / r), q_start);
-        }
-        if (job->twist != 0.0f) q_start = ak_quat_mul(ak_quat_from_axis_angle(k, job->twist), q_start);
+        if (job->twist != 0.0f)
+            q_start = ak_quat_mul(ak_quat_from_axis_angle(ak_vec3_scale(st, 1.0f / sqrtf(d2)), job->twist), q_start);
     }
     /* Into the start joint's local frame: same angle, axis seen from the joint. */
     ak_vec3 axis_local = mat_unrotate(S, ak_vec3_make(q_start.x, q_start.y, q_start.z));
@@ -145,18 +183,21 @@ bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* o
     return reached;
 }
 
-/* 0 when every element of the 16 floats is finite: x * 0 is 0 for finite x, NaN otherwise. */
-static inline float nonfinite16(const float* m) {
-    float acc = 0.0f;
-    for (int i = 0; i < 16; ++i) acc += m[i] * 0.0f;
-    return acc;
+/* Nonzero when one of the 16 floats is NaN or infinite: with the exponent bits masked,
+ * adding one exponent step carries into the sign bit only for an all-ones exponent. Integer
+ * OR-reduction, which the compiler may vectorise (float sums could not be reassociated). */
+static inline uint32_t nonfinite16(const float* f) {
+    uint32_t bits[16], acc = 0;
+    memcpy(bits, f, sizeof bits);
+    for (int i = 0; i < 16; ++i) acc |= (bits[i] & 0x7f800000u) + 0x00800000u;
+    return acc & 0x80000000u;
 }
 
 ak_result ak_ik_two_bone_validate(const ak_ik_two_bone_job* job) {
     if (!job || !job->out_start_rot || !job->out_mid_rot) return AK_ERR_NULL_ARG;
-    float bad = nonfinite16(job->start.m) + nonfinite16(job->mid.m) + nonfinite16(job->end.m);
-    if (bad != 0.0f || !ak_vec3_is_finite(job->target) || !ak_vec3_is_finite(job->pole) ||
-        !ak_vec3_is_finite(job->mid_axis) || !ak_finitef(job->twist))
+    const float vecs[16] = {job->target.x,   job->target.y,   job->target.z,   job->pole.x, job->pole.y, job->pole.z,
+                            job->mid_axis.x, job->mid_axis.y, job->mid_axis.z, job->twist};
+    if (nonfinite16(job->start.m) | nonfinite16(job->mid.m) | nonfinite16(job->end.m) | nonfinite16(vecs))
         return AK_ERR_BAD_DATA;
     if (!(job->soft >= 0.0f && job->soft < 1.0f)) return AK_ERR_BAD_ARG;
     if (!(job->keep_animation >= 0.0f && job->keep_animation <= 1.0f)) return AK_ERR_BAD_ARG;
