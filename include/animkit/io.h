@@ -14,9 +14,10 @@
  *   - ak_io_write_obj: Wavefront OBJ of a scene's meshes at positions the caller computed
  *     (one `o` group per scene mesh, vertices in the scene's order, no welding).
  *
- * What it does NOT do: materials, textures, cameras, lights, glTF extensions (files that
- * list one in extensionsRequired are refused), morph targets through Assimp, posing
- * (scene.h, skin.h, blendshape.h). It never prints; warnings go to desc->logger.
+ * What it does NOT do: materials, textures, cameras, lights, glTF extensions (a file whose
+ * extensionsRequired names one that changes geometry or animation, e.g. Draco, is refused),
+ * morph targets through Assimp, posing (scene.h, skin.h, blendshape.h). It never prints;
+ * warnings go to desc->logger.
  *
  * How a glTF file maps to the scene (docs/io.md has the details):
  *   - every node (also nodes outside the default scene) is one skeleton joint, reordered
@@ -46,14 +47,14 @@
  *     printf("%zu joints, %zu meshes, %zu clips\n", ak_scene_joint_count(scene),
  *            scene->mesh_count, scene->clip_count);
  *     // ... pose, skin, then write what was computed:
- *     ak_io_write_obj("posed.obj", scene, NULL, NULL, &diag);   // NULL: the bind pose
+ *     ak_io_write_obj("mesh.obj", scene, NULL, NULL, &diag);  // NULL: positions as stored
  *     ak_scene_destroy(scene);
  *
  * Ownership and threading: the scene returned belongs to the caller (ak_scene_destroy).
- * The library keeps no pointer to the caller's data. The glTF path is reentrant (cJSON's
- * malloc is used for the parse tree; animkit never sets cJSON's global hooks). The Assimp
- * path is not safe to call from several threads at once: Assimp keeps its last error
- * message in a global.
+ * The library keeps no pointer to the caller's data. The glTF path is reentrant: the JSON
+ * parse tree comes from cJSON's own malloc (animkit never sets cJSON's global hooks) and
+ * animkit never reads cJSON's global last-error pointer. The Assimp path must not run on
+ * several threads at once: Assimp keeps its last error message in a global.
  */
 #ifndef ANIMKIT_IO_H
 #define ANIMKIT_IO_H
@@ -99,10 +100,13 @@ AK_API ak_io_desc ak_io_desc_resolved(const ak_io_desc* desc);
  * or an external buffer), AK_ERR_PARSE (malformed JSON/GLB, a glTF rule broken, an Assimp
  * failure: diag holds Assimp's message), AK_ERR_BAD_INDEX (an index out of range: accessor,
  * node, vertex index, joint slot), AK_ERR_BAD_DATA (NaN or infinity in positions, transforms,
- * inverse binds or key values), AK_ERR_BAD_HIERARCHY (node cycle or a node with two parents),
- * AK_ERR_UNSORTED (sampler times not strictly increasing), AK_ERR_UNSUPPORTED (a required
- * extension, more than 32767 nodes, a skin of more than 65535 joints, glTF 1.0),
- * AK_ERR_NO_MEMORY. On failure *out_scene is NULL. */
+ * inverse binds or key values), AK_ERR_BAD_WEIGHTS (a negative skin weight),
+ * AK_ERR_BAD_HIERARCHY (node cycle or a node with two parents), AK_ERR_UNSORTED (sampler
+ * times not strictly increasing), AK_ERR_DUPLICATE (two channels animate one node path),
+ * AK_ERR_UNSUPPORTED (a required extension, glTF 1.x, more than 32767 nodes, a skin of more
+ * than 65535 joints, an animation with no usable channel), AK_ERR_NOT_FOUND (Assimp: a bone
+ * or channel names no node), AK_ERR_EMPTY (Assimp: a mesh without vertices), AK_ERR_BAD_ARG
+ * (desc->format out of range), AK_ERR_NO_MEMORY. On failure *out_scene is NULL. */
 AK_API ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
                             ak_scene** out_scene, ak_diag* diag);
 
