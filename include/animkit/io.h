@@ -94,8 +94,8 @@ typedef struct ak_io_desc {
 AK_API ak_io_desc ak_io_desc_resolved(const ak_io_desc* desc);
 
 /* Load a file into a new scene (*out_scene, freed with ak_scene_destroy).
- * desc NULL -> defaults; alloc NULL -> malloc/free (used for the scene and everything in it;
- * temporary memory also comes from it). diag (optional) names the file and the problem.
+ * desc NULL -> defaults; alloc NULL -> malloc/free (used for the scene, everything in it and
+ * the temporary arrays; only cJSON's parse tree and Assimp's scene use their own malloc). diag (optional) names the file and the problem.
  * Returns AK_ERR_NULL_ARG (path or out_scene NULL), AK_ERR_IO (cannot open or read the file
  * or an external buffer), AK_ERR_PARSE (malformed JSON/GLB, a glTF rule broken, an Assimp
  * failure: diag holds Assimp's message), AK_ERR_BAD_INDEX (an index out of range: accessor,
