@@ -56,19 +56,29 @@ ak_raster_camera ak_view_orbit_camera(ak_vec3 lo, ak_vec3 hi, const ak_view_orbi
     ak_vec3 c = ak_vec3_scale(ak_vec3_add(lo, hi), 0.5f);
     float R = 0.5f * ak_vec3_length(ak_vec3_sub(hi, lo));
     if (!(R > 1e-4f)) R = 1e-4f;
-    ak_vec3 dir = ak_vec3_make(cosf(el) * sinf(az), sinf(el), cosf(el) * cosf(az));
-    if (o.orthographic) {
-        float hh = R * margin * (aspect < 1.0f ? 1.0f / aspect : 1.0f);
-        ak_vec3 eye = ak_vec3_madd(c, dir, 3.0f * R);
-        return ak_raster_camera_orthographic(eye, c, hh, aspect, 0.1f * R, 6.0f * R);
-    }
+    ak_vec3 dir = ak_vec3_make(cosf(el) * sinf(az), sinf(el), cosf(el) * cosf(az)); /* towards the eye */
+    ak_vec3 right = ak_vec3_normalize(ak_vec3_cross(ak_vec3_neg(dir), ak_vec3_make(0, 1, 0)));
+    ak_vec3 up = ak_vec3_cross(right, ak_vec3_neg(dir));
+    /* fit the eight corners themselves (tighter than the bounding sphere for long boxes) */
     float half_v = 0.5f * fovy, half_h = atanf(tanf(half_v) * aspect);
-    float half = half_v < half_h ? half_v : half_h;
-    float d = R * margin / sinf(half);
+    float tx = tanf(half_h) / margin, ty = tanf(half_v) / margin;
+    float d = 0.0f, zmax = -INFINITY, xy_max = 0.0f;
+    for (int k = 0; k < 8; ++k) {
+        ak_vec3 q = ak_vec3_sub(ak_vec3_make(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z), c);
+        float x = fabsf(ak_vec3_dot(q, right)), y = fabsf(ak_vec3_dot(q, up)), z = ak_vec3_dot(q, dir);
+        d = ak_maxf(d, ak_maxf(z + x / tx, z + y / ty));
+        zmax = ak_maxf(zmax, z);
+        xy_max = ak_maxf(xy_max, ak_maxf(x / aspect, y));
+    }
+    if (o.orthographic) {
+        float hh = ak_maxf(xy_max * margin, 1e-4f);
+        ak_vec3 eye = ak_vec3_madd(c, dir, zmax + R);
+        return ak_raster_camera_orthographic(eye, c, hh, aspect, 0.1f * R, zmax + 6.0f * R);
+    }
+    d = ak_maxf(d, zmax + 0.05f * R);
     ak_vec3 eye = ak_vec3_madd(c, dir, d);
-    float near_z = d - 2.0f * R * margin;
-    if (near_z < 0.01f * d) near_z = 0.01f * d;
-    return ak_raster_camera_perspective(eye, c, fovy, aspect, near_z, d + 4.0f * R * margin);
+    float near_z = ak_maxf(0.5f * (d - zmax), 0.001f * d);
+    return ak_raster_camera_perspective(eye, c, fovy, aspect, near_z, d + 6.0f * R);
 }
 
 /* ---- colours ---------------------------------------------------------------------------------- */

@@ -377,6 +377,26 @@ AK_TEST(lambert_diffuse_matches_formula) {
     target_free(&t);
 }
 
+AK_TEST(model_matrix_moves_geometry) {
+    target t;
+    AK_CHECK(target_make(&t, 32, 32, 1, 1));
+    ak_raster_camera cam = identity_camera();
+    /* a small triangle around pixel (8, 16); translated by +1 NDC in x = +16 pixels */
+    ak_vec3 p[3] = {px_to_ndc(6, 18, 32, 32, 0), px_to_ndc(10, 18, 32, 32, 0), px_to_ndc(8, 14, 32, 32, 0)};
+    ak_mat4 move = ak_mat4_translation(ak_vec3_make(1, 0, 0));
+    ak_raster_mesh m = unlit_tri(p, ak_vec4_make(1, 1, 1, 1));
+    m.model = &move;
+    for (int s = 0; s < 4; ++s) {
+        m.shading = (ak_shading)(s + 1);
+        ak_raster_clear(t.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+        AK_CHECK_EQ(ak_raster_draw_mesh(t.r, &cam, &m), AK_OK);
+        ak_raster_resolve(t.r, &t.img);
+        AK_CHECK(at(&t, 24, 16)[0] > 0);
+        AK_CHECK_EQ(at(&t, 8, 16)[0], 0);
+    }
+    target_free(&t);
+}
+
 AK_TEST(back_face_culling_and_two_sided) {
     target t;
     AK_CHECK(target_make(&t, 16, 16, 1, 1));
@@ -775,6 +795,7 @@ int main(void) {
     AK_RUN(cube_corners_where_projection_puts_them);
     AK_RUN(perspective_correct_interpolation);
     AK_RUN(lambert_diffuse_matches_formula);
+    AK_RUN(model_matrix_moves_geometry);
     AK_RUN(back_face_culling_and_two_sided);
     AK_RUN(lines_and_points_respect_depth);
     AK_RUN(threads_give_identical_images);

@@ -50,8 +50,9 @@ typedef struct ak_view_orbit {
     bool orthographic; /* false -> perspective */
 } ak_view_orbit;
 
-/* Camera orbiting the box centre at the given angles, far enough that the box's bounding
- * sphere (and so the whole box) fits in the view times margin. orbit NULL -> all defaults.
+/* Camera looking at the box centre from the given angles, just far enough that all eight
+ * corners fit in the view with the margin (the box touches the image edge when margin = 1).
+ * orbit NULL -> all defaults.
  * Non-finite or inverted bounds fall back to the unit cube around the origin. */
 AK_API ak_raster_camera ak_view_orbit_camera(ak_vec3 bbox_min, ak_vec3 bbox_max, const ak_view_orbit* orbit);
 

@@ -74,7 +74,8 @@ struct drawctx {
     bool has_vcolor;
     float depth_bias;
     /* transforms */
-    ak_mat4 model, vp;
+    ak_mat4 model, vp, mvp; /* mvp = vp * model */
+    bool model_identity;
     ak_mat3 normal_matrix;
     ak_vec3 eye, view_forward;
     bool ortho;
@@ -808,8 +809,8 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
     for (int k = 0; k < 3; ++k) {
         ak_vec3 p = m->positions.ptr[idx[k]];
         if (!ak_vec3_is_finite(p)) return;
-        wp[k] = ak_mat4_transform_point(dc->model, p);
-        ak_vec4 c = mul4(&dc->vp, wp[k]);
+        wp[k] = p; /* model space until the cheap rejections are done */
+        ak_vec4 c = mul4(&dc->mvp, p);
         v[k].c[0] = c.x;
         v[k].c[1] = c.y;
         v[k].c[2] = c.z;
@@ -835,6 +836,8 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
         if (!rows_owned((int)ak_maxf(ymin - 1.0f, 0.0f), (int)ak_minf(ymax + 1.0f, (float)dc->r->sh), sk->ti, sk->tc))
             return;
     }
+    if (!dc->model_identity)
+        for (int k = 0; k < 3; ++k) wp[k] = ak_mat4_transform_point(dc->model, wp[k]);
     float flat[4] = {0, 0, 0, 1};
     ak_vec3 fn = ak_vec3_normalize(ak_vec3_cross(ak_vec3_sub(wp[1], wp[0]), ak_vec3_sub(wp[2], wp[0])));
     const bool has_n = m->normals.count > 0;
@@ -919,6 +922,8 @@ static void base_ctx(drawctx* dc, ak_raster* r, const ak_raster_camera* cam, con
     dc->r = r;
     dc->model = model ? *model : ak_mat4_identity();
     dc->vp = ak_mat4_mul(cam->projection, cam->view);
+    dc->mvp = ak_mat4_mul(dc->vp, dc->model);
+    dc->model_identity = model == NULL;
     dc->normal_matrix = ak_mat4_normal_matrix(dc->model);
     dc->eye = eye_of(cam);
     /* camera forward (-Z of the view) in world space: third row of the rotation, negated */
