@@ -255,7 +255,9 @@ typedef struct ak_skin_job {
                                    position and triangle index (O(n)); true -> only the O(1)
                                    rules. Unchecked joint indices are clamped to the palette,
                                    so bad data never reads out of bounds. */
-    bool skip_simd;             /* false -> fastest kernel for this CPU; true -> scalar code */
+    bool skip_simd;             /* false -> fastest kernel for this CPU (tangents, and DQS/CoR
+                                   with scaled or sheared joints, always run the scalar code);
+                                   true -> scalar code */
     uint32_t thread_count;      /* 0 or 1 -> calling thread; n (<= 64) -> n contiguous ranges,
                                    n - 1 of them on new pthreads (falls back to the calling
                                    thread when a thread cannot start) */
