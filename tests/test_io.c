@@ -1383,6 +1383,121 @@ AK_TEST(obj_writer) {
     ak_scene_destroy(s);
 }
 
+AK_TEST(obj_writer_offsets_and_round_trip) {
+    /* Two meshes: the first without normals or UVs, the second with both, so v/vt/vn offsets
+     * differ (v: 3 + 3, vt and vn: only the second mesh's 3). */
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_scene_alloc(2, 0, 0, NULL, &s), AK_OK);
+    if (!s) return;
+    ak_mesh_desc d0 = {.vertex_count = 3, .triangle_count = 1, .name = "plain mesh"};
+    ak_mesh_desc d1 = {.vertex_count = 3, .triangle_count = 1, .has_normals = true, .has_uvs = true};
+    AK_CHECK_EQ(ak_mesh_create(&d0, NULL, &s->meshes[0].mesh), AK_OK);
+    AK_CHECK_EQ(ak_mesh_create(&d1, NULL, &s->meshes[1].mesh), AK_OK);
+    for (int m = 0; m < 2; ++m)
+        for (uint32_t k = 0; k < 3; ++k) {
+            s->meshes[m].mesh->indices[k] = 2 - k;
+            s->meshes[m].mesh->positions[k] = ak_vec3_make((float)k, (float)m, 0.1f);
+        }
+    for (int k = 0; k < 3; ++k) {
+        s->meshes[1].mesh->normals[k] = ak_vec3_make(0, 0, 1);
+        s->meshes[1].mesh->uvs[k] = ak_vec2_make(0.25f * (float)k, 1);
+    }
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_write_obj("io_offsets.obj", s, NULL, NULL, &diag), AK_OK);
+    size_t size;
+    char* out = (char*)slurp("io_offsets.obj", &size);
+    AK_CHECK(out && strstr(out, "o plain_mesh\nv 0 0 0.100000001\n") != NULL);
+    AK_CHECK(out && strstr(out, "f 3 2 1\no mesh_1\n") != NULL);
+    AK_CHECK(out && strstr(out, "vt 0.5 1\n") != NULL);
+    AK_CHECK(out && strstr(out, "f 6/3/3 5/2/2 4/1/1\n") != NULL);
+    free(out);
+    remove("io_offsets.obj");
+    ak_scene_destroy(s);
+
+    /* Real data: the file's POSITION floats come back bit for bit from the "v" lines. */
+    char path[2048];
+    if (!ak_test_asset(path, sizeof path, "gltf/Fox/glTF-Binary/Fox.glb")) {
+        AK_SKIP("Fox.glb absent");
+        return;
+    }
+    doc dc;
+    AK_CHECK(doc_open(&dc, path));
+    s = load(path, NULL);
+    if (!s) {
+        doc_close(&dc);
+        return;
+    }
+    AK_CHECK_EQ(ak_io_write_obj("io_fox.obj", s, NULL, NULL, &diag), AK_OK);
+    const cJSON* prim0 = jat(jat(dc.root, "meshes", 0), "primitives", 0);
+    int pa = jint(jget(prim0, "attributes"), "POSITION", -1);
+    int vc = accessor_count(&dc, pa);
+    float* raw = (float*)malloc((size_t)vc * 3 * sizeof(float));
+    AK_CHECK(doc_floats(&dc, pa, 3, raw));
+    out = (char*)slurp("io_fox.obj", &size);
+    int v = 0, bad = 0, faces = 0;
+    for (char* line = out; line && *line; line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
+        if (line[0] == 'v' && line[1] == ' ' && v < vc) {
+            char* e = line + 2;
+            for (int k = 0; k < 3; ++k) {
+                float f = strtof(e, &e);
+                bad += memcmp(&f, &raw[3 * v + k], sizeof f) != 0;
+            }
+            ++v;
+        }
+        faces += line[0] == 'f';
+    }
+    AK_CHECK_EQ(v, vc);
+    AK_CHECK_EQ(bad, 0);
+    AK_CHECK_EQ(faces, vc / 3); /* non-indexed: one face per three vertices, none welded */
+    free(out);
+    free(raw);
+    remove("io_fox.obj");
+    ak_scene_destroy(s);
+    doc_close(&dc);
+}
+
+/* Assimp's bone-visualisation mesh of a BVH: a skinned mesh through the Assimp skin path. */
+AK_TEST(bvh_mesh_skin_through_assimp) {
+    char path[2048];
+    if (!ak_test_asset(path, sizeof path, "bvh/49_04.bvh")) {
+        AK_SKIP("bvh/49_04.bvh absent");
+        return;
+    }
+    ak_io_desc desc = {.keep_bvh_mesh = true};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(path, &desc, NULL, &s, &diag), AK_OK);
+    if (!s) return;
+    AK_CHECK_EQ(s->mesh_count, 1);
+    AK_CHECK_EQ(s->skin_count, 1);
+    if (s->mesh_count == 1 && s->skin_count == 1) {
+        const ak_mesh* m = s->meshes[0].mesh;
+        AK_CHECK_EQ(s->meshes[0].skin, 0);
+        AK_CHECK(s->skins[0].joint_count > 0);
+        AK_CHECK(m->influence_count >= 1 && m->influence_count <= 4);
+        AK_CHECK_EQ(ak_mesh_validate_weights(m, s->skins[0].joint_count, 1e-5f, NULL), AK_OK);
+        /* Every bone slot names a node; the bind relation world(joint) * offset is the same
+         * matrix for all slots (the mesh's bind space). */
+        size_t n = ak_scene_joint_count(s);
+        ak_transform* local = (ak_transform*)malloc(n * sizeof *local);
+        ak_mat4* world = (ak_mat4*)malloc(n * sizeof *world);
+        ak_scene_rest_pose(s, (ak_transform_span){local, n});
+        ak_scene_world_matrices(s, (ak_transform_cspan){local, n}, (ak_mat4_span){world, n});
+        ak_mat4 b0 = ak_mat4_mul(world[s->skins[0].joints[0]], s->skins[0].inverse_binds[0]);
+        double worst = 0.0;
+        for (size_t k = 0; k < s->skins[0].joint_count; ++k) {
+            ak_mat4 b = ak_mat4_mul(world[s->skins[0].joints[k]], s->skins[0].inverse_binds[k]);
+            for (int e = 0; e < 16; ++e) worst = fmax(worst, fabs(b.m[e] - b0.m[e]));
+        }
+        printf("  bone-visualisation mesh: %zu vertices, %zu slots, bind spread %.3g\n", m->vertex_count,
+               s->skins[0].joint_count, worst);
+        AK_CHECK(worst < 1e-3);
+        free(local);
+        free(world);
+    }
+    ak_scene_destroy(s);
+}
+
 /* ---- allocator: every allocation failing in turn ------------------------------------------- */
 
 typedef struct fail_alloc {
@@ -1439,6 +1554,8 @@ int main(void) {
     AK_RUN(truncated_files_fail_cleanly);
     AK_RUN(load_arguments_and_missing_files);
     AK_RUN(obj_writer);
+    AK_RUN(obj_writer_offsets_and_round_trip);
+    AK_RUN(bvh_mesh_skin_through_assimp);
     AK_RUN(allocation_failures);
     return ak_test_finish();
 }
