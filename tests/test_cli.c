@@ -1,0 +1,376 @@
+/* The animkit command: exit codes, JSON contracts, outputs checked against independent
+ * computations (the library's data read back, double-precision skinning in the test). */
+#include <animkit/animkit.h>
+#include <cjson/cJSON.h>
+
+#include <sys/wait.h>
+
+#include "ak_test.h"
+
+#ifndef AK_CLI_PATH
+#error "AK_CLI_PATH must name the animkit executable"
+#endif
+
+static char out_buf[1 << 20];
+
+/* Run "animkit ARGS", capture stdout (stderr appended when merge), return the exit status. */
+static int run(const char* args, bool merge) {
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "%s %s %s", AK_CLI_PATH, args, merge ? "2>&1" : "2>/dev/null");
+    FILE* p = popen(cmd, "r");
+    if (!p) return -1;
+    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
+    out_buf[n] = '\0';
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static cJSON* run_json(const char* args) {
+    if (run(args, false) != 0) return NULL;
+    return cJSON_Parse(out_buf);
+}
+
+AK_TEST(usage_and_help) {
+    AK_CHECK_EQ(run("", true), 2);
+    AK_CHECK_EQ(run("help", true), 0);
+    AK_CHECK(strstr(out_buf, "render") && strstr(out_buf, "demo"));
+    AK_CHECK_EQ(run("frobnicate", true), 2);
+    const char* cmds[] = {"demo", "info", "export", "render", "curves", "weights", "skin", "ik"};
+    for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; ++i) {
+        char a[64];
+        snprintf(a, sizeof a, "%s --help", cmds[i]);
+        AK_CHECK_MSG(run(a, true) == 0 && strstr(out_buf, "usage: animkit"), "%s --help", cmds[i]);
+        snprintf(a, sizeof a, "help %s", cmds[i]);
+        AK_CHECK_MSG(run(a, true) == 0, "help %s", cmds[i]);
+        snprintf(a, sizeof a, "%s --no-such-flag x", cmds[i]);
+        AK_CHECK_MSG(run(a, true) == 2, "%s unknown flag", cmds[i]);
+    }
+}
+
+AK_TEST(bad_input_paths) {
+    /* missing file, directory, garbage file, unknown builtin: exit 1 and one line naming it */
+    const char* subs[] = {"info %s", "export %s -o x.obj", "render %s -o x.png", "curves %s --clip 0 -o x.png",
+                          "weights %s --method distance -o w.json", "ik %s --effector a --target 0,0,0",
+                          "skin --compare %s"};
+    FILE* f = fopen("garbage.gltf", "wb");
+    AK_CHECK(f != NULL);
+    if (f) {
+        fputs("{ this is not json", f);
+        fclose(f);
+    }
+    const char* inputs[] = {"no_such_file.glb", ".", "garbage.gltf", "builtin:nope"};
+    for (size_t s = 0; s < sizeof subs / sizeof subs[0]; ++s) {
+        for (size_t i = 0; i < sizeof inputs / sizeof inputs[0]; ++i) {
+            char a[256];
+            snprintf(a, sizeof a, subs[s], inputs[i]);
+            int rc = run(a, true);
+            AK_CHECK_MSG(rc == 1, "'%s' exit %d (want 1): %s", a, rc, out_buf);
+            AK_CHECK_MSG(strstr(out_buf, inputs[i]) != NULL, "'%s' message does not name the input: %s", a, out_buf);
+            const char* nl = strchr(out_buf, '\n');
+            AK_CHECK_MSG(nl && nl[1] == '\0', "'%s' should print exactly one line: %s", a, out_buf);
+        }
+    }
+    /* unknown joint, bad numbers, unknown clip */
+    AK_CHECK_EQ(run("ik builtin:humanoid --effector no_joint --target 0,1,0", true), 1);
+    AK_CHECK(strstr(out_buf, "no_joint") != NULL);
+    AK_CHECK_EQ(run("ik builtin:humanoid --effector left_wrist --target 0,abc,0", true), 2);
+    AK_CHECK_EQ(run("ik builtin:humanoid --effector left_wrist --target 0,1", true), 2);
+    AK_CHECK_EQ(run("ik builtin:humanoid --effector left_wrist --target 0,1,0 --iterations -3", true), 2);
+    AK_CHECK_EQ(run("export builtin:cylinder --time nan -o x.obj", true), 2);
+    AK_CHECK_EQ(run("export builtin:cylinder --time 1e99 -o x.obj", true), 2);
+    AK_CHECK_EQ(run("export builtin:cylinder --clip nope -o x.obj", true), 1);
+    AK_CHECK(strstr(out_buf, "nope") != NULL);
+    AK_CHECK_EQ(run("export builtin:cylinder", true), 2);
+    AK_CHECK_EQ(run("export builtin:cylinder -o x.txt", true), 2);
+    AK_CHECK_EQ(run("render builtin:cylinder --size 0x0 -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:cylinder --weights nobone -o x.png", true), 1);
+    AK_CHECK_EQ(run("render builtin:cylinder --method xyz -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:cylinder --frames 1:0:0 -o x.gif", true), 2);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --joint nobody -o c.png", true), 1);
+    AK_CHECK_EQ(run("weights builtin:cylinder --method magic -o w.json", true), 2);
+    AK_CHECK_EQ(run("weights builtin:cylinder --method distance --power -1 -o w.json", true), 2);
+    AK_CHECK_EQ(run("skin", true), 2);
+}
+
+static int find_joint_json(cJSON* joints, const char* name) {
+    int i = 0;
+    cJSON* j;
+    cJSON_ArrayForEach(j, joints) {
+        if (strcmp(cJSON_GetObjectItem(j, "name")->valuestring, name) == 0) return i;
+        ++i;
+    }
+    return -1;
+}
+
+AK_TEST(info_json_contract) {
+    cJSON* root = run_json("info builtin:humanoid --json");
+    AK_CHECK(root != NULL);
+    if (!root) return;
+    cJSON* joints = cJSON_GetObjectItem(root, "joints");
+    cJSON* meshes = cJSON_GetObjectItem(root, "meshes");
+    cJSON* clips = cJSON_GetObjectItem(root, "clips");
+    AK_CHECK(cJSON_IsArray(joints) && cJSON_IsArray(meshes) && cJSON_IsArray(clips));
+    AK_CHECK(cJSON_GetArraySize(joints) >= 17);
+    /* compare with the library's own scene (what the command must report) */
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_builtin_create("builtin:humanoid", NULL, NULL, &s), AK_OK);
+    if (s) {
+        AK_CHECK_EQ(cJSON_GetArraySize(joints), (int)ak_scene_joint_count(s));
+        AK_CHECK_EQ(cJSON_GetArraySize(meshes), (int)s->mesh_count);
+        AK_CHECK_EQ(cJSON_GetArraySize(clips), (int)s->clip_count);
+        cJSON* m0 = cJSON_GetArrayItem(meshes, 0);
+        AK_CHECK_EQ(cJSON_GetObjectItem(m0, "vertices")->valueint, (int)s->meshes[0].mesh->vertex_count);
+        AK_CHECK_EQ(cJSON_GetObjectItem(m0, "triangles")->valueint, (int)s->meshes[0].mesh->triangle_count);
+        AK_CHECK(cJSON_IsTrue(cJSON_GetObjectItem(m0, "skinned")));
+        AK_CHECK_EQ(cJSON_GetObjectItem(m0, "morph_targets")->valueint, 0);
+        for (size_t c = 0; c < s->clip_count; ++c) {
+            cJSON* cj = cJSON_GetArrayItem(clips, (int)c);
+            AK_CHECK_STREQ(cJSON_GetObjectItem(cj, "name")->valuestring, ak_clip_name(s->clips[c]));
+            AK_CHECK_NEAR(cJSON_GetObjectItem(cj, "duration")->valuedouble, ak_clip_duration(s->clips[c]), 1e-6);
+            AK_CHECK_EQ(cJSON_GetObjectItem(cj, "channels")->valueint, (int)ak_clip_channel_count(s->clips[c]));
+        }
+        ak_scene_destroy(s);
+    }
+    int elbow = find_joint_json(joints, "left_elbow"), shoulder = find_joint_json(joints, "left_shoulder");
+    AK_CHECK(elbow >= 0 && shoulder >= 0);
+    if (elbow >= 0)
+        AK_CHECK_EQ(cJSON_GetObjectItem(cJSON_GetArrayItem(joints, elbow), "parent")->valueint, shoulder);
+    AK_CHECK_EQ(cJSON_GetObjectItem(cJSON_GetArrayItem(joints, 0), "parent")->valueint, -1);
+    cJSON_Delete(root);
+}
+
+/* Read the "v" lines of an OBJ file. */
+static size_t read_obj_vertices(const char* path, ak_vec3* out, size_t cap, size_t* out_groups) {
+    FILE* f = fopen(path, "r");
+    size_t n = 0;
+    *out_groups = 0;
+    if (!f) return 0;
+    char line[512];
+    while (fgets(line, sizeof line, f)) {
+        float x, y, z;
+        if (line[0] == 'o' && line[1] == ' ') ++*out_groups;
+        if (line[0] == 'v' && line[1] == ' ' && sscanf(line + 2, "%f %f %f", &x, &y, &z) == 3 && n < cap)
+            out[n++] = ak_vec3_make(x, y, z);
+    }
+    fclose(f);
+    return n;
+}
+
+AK_TEST(export_matches_double_precision_skinning) {
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_builtin_create("builtin:cylinder", NULL, NULL, &s), AK_OK);
+    if (!s) return;
+    const ak_mesh* mesh = s->meshes[0].mesh;
+    size_t vc = mesh->vertex_count;
+    ak_vec3* v = calloc(vc + 16, sizeof(ak_vec3));
+    size_t groups = 0;
+    /* --bind writes the stored positions */
+    AK_CHECK_EQ(run("export builtin:cylinder --bind -o bind.obj", true), 0);
+    AK_CHECK_EQ(read_obj_vertices("bind.obj", v, vc + 16, &groups), (long long)vc);
+    AK_CHECK_EQ(groups, 1);
+    double worst = 0.0;
+    for (size_t i = 0; i < vc; ++i) worst = fmax(worst, ak_vec3_distance(v[i], mesh->positions[i]));
+    AK_CHECK_NEAR(worst, 0.0, 1e-6);
+    /* bend clip at 0.5 s: LBS in double from the clip's pose */
+    int clip = ak_scene_find_clip(s, "bend");
+    AK_CHECK(clip >= 0);
+    size_t n = ak_scene_joint_count(s);
+    ak_transform local[16];
+    ak_mat4 world[16];
+    ak_scene_rest_pose(s, (ak_transform_span){local, n});
+    ak_clip_sample(s->clips[clip], 0.5f, NULL, (ak_transform_span){local, n}, (ak_f32_span){0}, (ak_f32_span){0});
+    /* world matrices in double, by walking the parents */
+    double W[16][16];
+    ak_i16_cspan par = ak_skeleton_parents(s->skeleton);
+    for (size_t j = 0; j < n; ++j) {
+        ak_mat4 lm = ak_transform_to_mat4(local[j]);
+        double L[16];
+        for (int e = 0; e < 16; ++e) L[e] = lm.m[e];
+        if (par.ptr[j] < 0) {
+            memcpy(W[j], L, sizeof L);
+        } else {
+            const double* P = W[par.ptr[j]];
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r) {
+                    double acc = 0;
+                    for (int k = 0; k < 4; ++k) acc += P[k * 4 + r] * L[c * 4 + k];
+                    W[j][c * 4 + r] = acc;
+                }
+        }
+    }
+    (void)world;
+    AK_CHECK_EQ(run("export builtin:cylinder --clip bend --time 0.5 -o bend.obj", true), 0);
+    AK_CHECK_EQ(read_obj_vertices("bend.obj", v, vc + 16, &groups), (long long)vc);
+    const ak_scene_skin* sk = &s->skins[0];
+    worst = 0.0;
+    for (size_t i = 0; i < vc; ++i) {
+        double acc[3] = {0, 0, 0};
+        for (uint32_t k = 0; k < mesh->influence_count; ++k) {
+            double w = mesh->weights[i * mesh->influence_count + k];
+            size_t slot = mesh->joints[i * mesh->influence_count + k];
+            const double* M = W[sk->joints[slot]];
+            const float* B = sk->inverse_binds[slot].m;
+            double p[4] = {mesh->positions[i].x, mesh->positions[i].y, mesh->positions[i].z, 1.0}, q[4];
+            for (int r = 0; r < 4; ++r) q[r] = B[r] * p[0] + B[4 + r] * p[1] + B[8 + r] * p[2] + B[12 + r] * p[3];
+            for (int r = 0; r < 3; ++r) acc[r] += w * (M[r] * q[0] + M[4 + r] * q[1] + M[8 + r] * q[2] + M[12 + r] * q[3]);
+        }
+        double d = sqrt((acc[0] - v[i].x) * (acc[0] - v[i].x) + (acc[1] - v[i].y) * (acc[1] - v[i].y) +
+                        (acc[2] - v[i].z) * (acc[2] - v[i].z));
+        worst = fmax(worst, d);
+    }
+    AK_CHECK_NEAR(worst, 0.0, 1e-5);
+    free(v);
+    ak_scene_destroy(s);
+}
+
+AK_TEST(ik_json_contract) {
+    cJSON* root = run_json("ik builtin:humanoid --effector left_wrist --root left_shoulder --target 0.45,1.0,0.25 --json");
+    AK_CHECK(root != NULL);
+    if (!root) return;
+    AK_CHECK(cJSON_IsBool(cJSON_GetObjectItem(root, "reached")));
+    AK_CHECK(cJSON_IsNumber(cJSON_GetObjectItem(root, "error")));
+    AK_CHECK(cJSON_IsNumber(cJSON_GetObjectItem(root, "iterations")));
+    cJSON* joints = cJSON_GetObjectItem(root, "joints");
+    cJSON* initial = cJSON_GetObjectItem(root, "initial");
+    AK_CHECK(cJSON_GetArraySize(joints) == 3 && cJSON_GetArraySize(initial) == 3);
+    AK_CHECK_STREQ(cJSON_GetObjectItem(cJSON_GetArrayItem(joints, 0), "name")->valuestring, "left_shoulder");
+    AK_CHECK_STREQ(cJSON_GetObjectItem(cJSON_GetArrayItem(joints, 2), "name")->valuestring, "left_wrist");
+    /* the root stays put, bone lengths are kept, and the error is the effector's distance */
+    double p[2][3][3];
+    for (int set = 0; set < 2; ++set)
+        for (int i = 0; i < 3; ++i)
+            for (int c = 0; c < 3; ++c)
+                p[set][i][c] = cJSON_GetArrayItem(cJSON_GetObjectItem(cJSON_GetArrayItem(set ? initial : joints, i), "position"), c)->valuedouble;
+    for (int c = 0; c < 3; ++c) AK_CHECK_NEAR(p[0][0][c], p[1][0][c], 1e-6);
+    for (int i = 0; i < 2; ++i) {
+        double l0 = 0, l1 = 0;
+        for (int c = 0; c < 3; ++c) {
+            l0 += (p[0][i + 1][c] - p[0][i][c]) * (p[0][i + 1][c] - p[0][i][c]);
+            l1 += (p[1][i + 1][c] - p[1][i][c]) * (p[1][i + 1][c] - p[1][i][c]);
+        }
+        AK_CHECK_NEAR(sqrt(l0), sqrt(l1), 1e-5 * sqrt(l1));
+    }
+    double t[3] = {0.45, 1.0, 0.25}, e = 0;
+    for (int c = 0; c < 3; ++c) e += (p[0][2][c] - t[c]) * (p[0][2][c] - t[c]);
+    AK_CHECK_NEAR(sqrt(e), cJSON_GetObjectItem(root, "error")->valuedouble, 1e-5);
+    cJSON_Delete(root);
+    /* an unreachable target: reached false, chain straightened (error = distance - reach) */
+    root = run_json("ik builtin:humanoid --effector left_wrist --root left_shoulder --target 5,1.4,0 --solver ccd --json");
+    AK_CHECK(root != NULL);
+    if (root) {
+        AK_CHECK(cJSON_IsFalse(cJSON_GetObjectItem(root, "reached")));
+        AK_CHECK(cJSON_GetObjectItem(root, "error")->valuedouble > 1.0);
+        cJSON_Delete(root);
+    }
+    AK_CHECK_EQ(run("ik builtin:humanoid --effector left_wrist --target 0.45,1.0,0.25 --solver twobone -o ik.obj", true), 0);
+}
+
+AK_TEST(skin_compare_orders_methods) {
+    cJSON* root = run_json("skin --compare --json");
+    AK_CHECK(root != NULL);
+    if (!root) return;
+    cJSON* poses = cJSON_GetObjectItem(root, "poses");
+    AK_CHECK_EQ(cJSON_GetArraySize(poses), 3);
+    cJSON* bend = cJSON_GetArrayItem(poses, 0);
+    cJSON* twist = cJSON_GetArrayItem(poses, 2);
+#define VAL(pose, m, key) cJSON_GetObjectItem(cJSON_GetObjectItem(pose, m), key)->valuedouble
+    /* candy wrapper: under a 180-degree twist LBS pinches the blend band (a quarter of the
+     * length) towards the axis, so the whole tube loses several percent of its volume and its
+     * narrowest section nearly vanishes; DQS and CoR rotate the band rigidly and keep both
+     * within the tessellation error (1%). */
+    AK_CHECK(VAL(twist, "LBS", "volume_ratio") < 0.95);
+    AK_CHECK(VAL(twist, "LBS", "min_radius") < 0.1);
+    AK_CHECK(fabs(VAL(twist, "DQS", "volume_ratio") - 1.0) < 0.01);
+    AK_CHECK(fabs(VAL(twist, "CoR", "volume_ratio") - 1.0) < 0.01);
+    AK_CHECK(VAL(twist, "DQS", "min_radius") > 0.95);
+    /* bend: DQS bulges more than CoR */
+    AK_CHECK(VAL(bend, "CoR", "max_bulge") < VAL(bend, "DQS", "max_bulge"));
+#undef VAL
+    cJSON_Delete(root);
+}
+
+AK_TEST(weights_json_sum_to_one) {
+    AK_CHECK_EQ(run("weights builtin:cylinder --method distance --max-influences 3 -o w.json", true), 0);
+    FILE* f = fopen("w.json", "rb");
+    AK_CHECK(f != NULL);
+    if (!f) return;
+    static char buf[1 << 22];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    cJSON* root = cJSON_Parse(buf);
+    AK_CHECK(root != NULL);
+    if (!root) return;
+    int vc = cJSON_GetObjectItem(root, "vertex_count")->valueint;
+    AK_CHECK_EQ(cJSON_GetObjectItem(root, "influence_count")->valueint, 3);
+    cJSON* w = cJSON_GetObjectItem(root, "weights");
+    AK_CHECK_EQ(cJSON_GetArraySize(w), vc * 3);
+    double worst = 0.0;
+    for (int v = 0; v < vc; ++v) {
+        double s = 0;
+        for (int k = 0; k < 3; ++k) {
+            double x = cJSON_GetArrayItem(w, v * 3 + k)->valuedouble;
+            AK_CHECK(x >= 0.0);
+            s += x;
+        }
+        worst = fmax(worst, fabs(s - 1.0));
+    }
+    AK_CHECK_NEAR(worst, 0.0, 1e-5);
+    cJSON_Delete(root);
+}
+
+AK_TEST(render_outputs_decode) {
+    int w = 0, h = 0, frames = 0;
+    AK_CHECK_EQ(run("render builtin:cylinder --clip bend --time 0.5 --size 200x150 -o r.png", true), 0);
+    AK_CHECK_EQ(ak_png_info("r.png", &w, &h), AK_OK);
+    AK_CHECK(w == 200 && h == 150);
+    AK_CHECK_EQ(run("render builtin:cylinder --clip twist --frames 0:1:0.25 --size 120x90 -o r.gif", true), 0);
+    AK_CHECK_EQ(ak_gif_info("r.gif", &w, &h, &frames), AK_OK);
+    AK_CHECK(w == 120 && h == 90);
+    AK_CHECK_EQ(frames, 5);
+    AK_CHECK_EQ(run("render builtin:cylinder --fps 10 --duration 0.5 --size 64x48 --method all -o all.gif", true), 0);
+    AK_CHECK_EQ(ak_gif_info("all.gif", &w, &h, &frames), AK_OK);
+    AK_CHECK_EQ(frames, 5);
+    AK_CHECK(w > 3 * 64 && h > 48);
+    AK_CHECK_EQ(run("render builtin:humanoid --clip wave --frames 0:0.2:0.1 --size 64x64 --skeleton --weights right_elbow -o seq.png", true), 0);
+    for (int i = 0; i < 3; ++i) {
+        char path[64];
+        snprintf(path, sizeof path, "seq_%04d.png", i);
+        AK_CHECK_MSG(ak_png_info(path, &w, &h) == AK_OK && w == 64 && h == 64, "%s", path);
+    }
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk -o curves.png", true), 0);
+    AK_CHECK_EQ(ak_png_info("curves.png", &w, &h), AK_OK);
+    AK_CHECK_EQ(run("weights builtin:cylinder --method heat --bone joint1 -o heat.png", true), 0);
+    AK_CHECK_EQ(ak_png_info("heat.png", &w, &h), AK_OK);
+    AK_CHECK_EQ(run("ik builtin:humanoid --effector left_wrist --target 0.45,1.0,0.25 -o ik.png", true), 0);
+    AK_CHECK_EQ(ak_png_info("ik.png", &w, &h), AK_OK);
+}
+
+AK_TEST(demo_writes_its_files) {
+    AK_CHECK_EQ(run("demo --size 128x72 -o demo_out", true), 0);
+    AK_CHECK(strstr(out_buf, "demo.gif") != NULL);
+    int w = 0, h = 0, frames = 0;
+    AK_CHECK_EQ(ak_gif_info("demo_out/demo.gif", &w, &h, &frames), AK_OK);
+    AK_CHECK(w == 128 && h == 72);
+    AK_CHECK(frames > 60);
+    const char* stills[] = {"demo_walk.png", "demo_wave.png", "demo_skinning.png", "demo_weights.png", "demo_curves.png",
+                            "demo_easing.png"};
+    for (size_t i = 0; i < sizeof stills / sizeof stills[0]; ++i) {
+        char path[128];
+        snprintf(path, sizeof path, "demo_out/%s", stills[i]);
+        AK_CHECK_MSG(ak_png_info(path, &w, &h) == AK_OK && w > 0 && h > 0, "%s", path);
+    }
+}
+
+int main(void) {
+    AK_RUN(usage_and_help);
+    AK_RUN(bad_input_paths);
+    AK_RUN(info_json_contract);
+    AK_RUN(export_matches_double_precision_skinning);
+    AK_RUN(ik_json_contract);
+    AK_RUN(skin_compare_orders_methods);
+    AK_RUN(weights_json_sum_to_one);
+    AK_RUN(render_outputs_decode);
+    AK_RUN(demo_writes_its_files);
+    return ak_test_finish();
+}

@@ -1,0 +1,120 @@
+/* animkit command line: shared glue (argument parsing, errors, scene loading, JSON, progress).
+ * The CLI includes only public headers. Exit codes: 0 ok, 1 bad input, 2 bad usage. */
+#ifndef ANIMKIT_CLI_H
+#define ANIMKIT_CLI_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include <animkit/animkit.h>
+
+enum { CLI_OK = 0, CLI_BAD_INPUT = 1, CLI_BAD_USAGE = 2 };
+
+/* One option a command accepts. */
+typedef struct cli_opt {
+    const char* name;  /* "--time" */
+    const char* alias; /* "-t" or NULL */
+    bool has_value;    /* takes the next argument as its value */
+} cli_opt;
+
+#define CLI_MAX_OPTS 32
+#define CLI_MAX_POS 8
+
+typedef struct cli_args {
+    const char* cmd;                  /* "render" */
+    const char* values[CLI_MAX_OPTS]; /* value per option (or "1" for flags); NULL when absent */
+    const char* pos[CLI_MAX_POS];     /* positional arguments */
+    int pos_count;
+    bool help;                        /* --help / -h seen */
+} cli_args;
+
+/* Parse argv (after the command word) against opts. Prints a usage error and returns
+ * CLI_BAD_USAGE on an unknown option, a missing value or too many positionals. */
+int cli_parse(const char* cmd, int argc, char** argv, const cli_opt* opts, size_t opt_count, cli_args* out);
+/* Value of option name ("--time"), or NULL. */
+const char* cli_get(const cli_args* a, const cli_opt* opts, size_t opt_count, const char* name);
+#define CLI_GET(args, name) cli_get((args), opts, sizeof(opts) / sizeof(opts[0]), (name))
+
+/* "animkit CMD: message" on stderr; returns CLI_BAD_INPUT. */
+int cli_fail(const char* cmd, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* "animkit CMD: message" + "try 'animkit CMD --help'" on stderr; returns CLI_BAD_USAGE. */
+int cli_usage(const char* cmd, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* Strict number parsing: the whole string, finite. */
+bool cli_parse_float(const char* s, float* out);
+bool cli_parse_int(const char* s, long lo, long hi, long* out);
+/* "X,Y,Z" */
+bool cli_parse_vec3(const char* s, ak_vec3* out);
+/* "WxH" */
+bool cli_parse_size(const char* s, int* w, int* h);
+/* True when path ends with ext (case-insensitive, ext like ".png"). */
+bool cli_has_ext(const char* path, const char* ext);
+
+/* Load FILE or builtin:NAME. On failure prints "animkit CMD: SPEC: problem" and returns
+ * CLI_BAD_INPUT. */
+int cli_load_scene(const char* cmd, const char* spec, ak_scene** out);
+
+/* JSON string literal with escapes. */
+void cli_json_string(FILE* f, const char* s);
+
+/* Progress bar on stderr when it is a terminal; silent otherwise. done == total ends it. */
+void cli_progress(const char* label, size_t done, size_t total);
+
+/* Seconds since an arbitrary epoch (monotonic). */
+double cli_now(void);
+
+/* Make a directory (and parents); true when it exists afterwards. */
+bool cli_mkdir_p(const char* path);
+
+/* ---- posing: sample a clip, FK, morph, skin (the pipeline every command shares) ---- */
+
+typedef enum cli_method { CLI_LBS = 0, CLI_DQS, CLI_COR } cli_method;
+
+/* Per-scene working state for posing. */
+typedef struct cli_poser {
+    const ak_scene* scene;
+    size_t joint_count;
+    ak_transform* local;      /* [joint_count] */
+    ak_mat4* world;           /* [joint_count] */
+    ak_mat4* palette;         /* [max skin joints] */
+    float* morph_weights;     /* [max morph targets] */
+    ak_vec3** positions;      /* per mesh: posed positions */
+    ak_vec3** normals;        /* per mesh: posed normals */
+    ak_vec3* morphed;         /* scratch [max vertices] */
+    ak_vec3* morphed_normals; /* scratch [max vertices] */
+    ak_vec3** cor_centers;    /* per mesh, computed on first CoR use; NULL until then */
+    ak_clip_cursor* cursor;
+} cli_poser;
+
+bool cli_method_parse(const char* s, cli_method* out);
+const char* cli_method_name(cli_method m);
+int cli_poser_init(cli_poser* p, const ak_scene* scene);
+void cli_poser_free(cli_poser* p);
+/* Pose at time t of clip (clip < 0 or bind -> rest pose); results in p->positions/normals
+ * and p->world. Returns AK_OK or the first failing code. */
+ak_result cli_poser_pose(cli_poser* p, int clip, float t, bool bind, cli_method method);
+/* The two halves of cli_poser_pose: fill p->local (rest pose + clip) and default morph
+ * weights; then FK, morph and skin from whatever p->local holds. */
+ak_result cli_poser_sample(cli_poser* p, int clip, float t, bool bind);
+ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method);
+
+/* Commands. */
+int cmd_demo(int argc, char** argv);
+int cmd_info(int argc, char** argv);
+int cmd_export(int argc, char** argv);
+int cmd_render(int argc, char** argv);
+int cmd_curves(int argc, char** argv);
+int cmd_weights(int argc, char** argv);
+int cmd_skin(int argc, char** argv);
+int cmd_ik(int argc, char** argv);
+
+#endif

@@ -1,0 +1,172 @@
+/* animkit weights: automatic skin weights (inverse distance or bone heat) for a model. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "render.h"
+
+static const char* const usage =
+    "usage: animkit weights FILE|builtin:NAME --method distance|heat [--power n]\n"
+    "                       [--max-influences k] [--mesh M] [--bone NAME] -o OUT\n"
+    "Compute skin weights for mesh M (default 0) from the bones of its skin (the skeleton's\n"
+    "joints in bind pose): inverse distance to the bone segments, (1/d)^n normalized, or bone\n"
+    "heat diffusion (Baran & Popovic 2007). Keeps the k largest influences (default 4).\n"
+    "  OUT.json  {\"vertex_count\", \"influence_count\", \"joints\": [names of skin slots],\n"
+    "             \"indices\": [...], \"weights\": [...]} vertex-major\n"
+    "  OUT.png   a heatmap of --bone's weights (blue 0 -> red 1) on the model\n"
+    "  OUT (any other name)  the binary AKWT format documented in skin.h\n"
+    "  --power   distance exponent n (default 4)\n";
+
+
+/* Bind-space bones of mesh m's skin: one segment from each slot's joint to each child slot's
+ * joint, and a point bone for slots without a child slot. */
+static size_t skin_bones(const ak_scene* s, const ak_scene_skin* skin, ak_skin_bone* out) {
+    size_t n = skin->joint_count, count = 0;
+    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_vec3* pos = calloc(n, sizeof(ak_vec3));
+    int* parent_slot = calloc(n, sizeof(int));
+    bool* has_child = calloc(n, sizeof(bool));
+    if (!pos || !parent_slot || !has_child) goto done;
+    for (size_t k = 0; k < n; ++k) pos[k] = ak_mat4_get_translation(ak_mat4_inverse_affine(skin->inverse_binds[k]));
+    for (size_t k = 0; k < n; ++k) {
+        parent_slot[k] = -1;
+        for (int j = parents.ptr[skin->joints[k]]; j >= 0 && parent_slot[k] < 0; j = parents.ptr[j])
+            for (size_t q = 0; q < n; ++q)
+                if (skin->joints[q] == j) parent_slot[k] = (int)q;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        if (parent_slot[k] < 0) continue;
+        size_t ps = (size_t)parent_slot[k];
+        has_child[ps] = true;
+        out[count++] = (ak_skin_bone){pos[ps], pos[k], (uint16_t)ps};
+    }
+    for (size_t k = 0; k < n; ++k)
+        if (!has_child[k]) out[count++] = (ak_skin_bone){pos[k], pos[k], (uint16_t)k};
+done:
+    free(pos);
+    free(parent_slot);
+    free(has_child);
+    return count;
+}
+
+static int write_json(const char* path, const ak_scene* s, const ak_scene_skin* skin, size_t vc, uint32_t k,
+                      const uint16_t* joints, const float* weights) {
+    FILE* f = fopen(path, "w");
+    if (!f) return cli_fail("weights", "%s: cannot create the file", path);
+    fprintf(f, "{\"vertex_count\": %zu, \"influence_count\": %u, \"joints\": [", vc, k);
+    for (size_t q = 0; q < skin->joint_count; ++q) {
+        fprintf(f, q ? ", " : "");
+        cli_json_string(f, ak_skeleton_joint_name(s->skeleton, (size_t)skin->joints[q]));
+    }
+    fprintf(f, "],\n\"indices\": [");
+    for (size_t i = 0; i < vc * k; ++i) fprintf(f, "%s%u", i ? "," : "", joints[i]);
+    fprintf(f, "],\n\"weights\": [");
+    for (size_t i = 0; i < vc * k; ++i) fprintf(f, "%s%.7g", i ? "," : "", (double)weights[i]);
+    fprintf(f, "]}\n");
+    if (fclose(f) != 0) return cli_fail("weights", "%s: write failed", path);
+    return CLI_OK;
+}
+
+int cmd_weights(int argc, char** argv) {
+    static const cli_opt opts[] = {{"--method", "-m", true},     {"--power", NULL, true}, {"--max-influences", "-k", true},
+                                   {"--mesh", NULL, true},       {"--bone", NULL, true},  {"--output", "-o", true}};
+    cli_args a;
+    int rc = cli_parse("weights", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+    if (rc) return rc;
+    if (a.help) {
+        fputs(usage, stdout);
+        return CLI_OK;
+    }
+    if (a.pos_count != 1) return cli_usage("weights", "expected one FILE or builtin:NAME");
+    const char* method = CLI_GET(&a, "--method");
+    if (!method) return cli_usage("weights", "missing --method distance|heat");
+    ak_weights_method wm;
+    if (strcmp(method, "distance") == 0) wm = AK_WEIGHTS_DISTANCE;
+    else if (strcmp(method, "heat") == 0) wm = AK_WEIGHTS_HEAT;
+    else return cli_usage("weights", "--method must be distance or heat, not '%s'", method);
+    float power = 0.0f;
+    if (CLI_GET(&a, "--power") && (!cli_parse_float(CLI_GET(&a, "--power"), &power) || power <= 0.0f))
+        return cli_usage("weights", "--power '%s' is not a number > 0", CLI_GET(&a, "--power"));
+    long k = 4, mesh_index = 0;
+    if (CLI_GET(&a, "--max-influences") && !cli_parse_int(CLI_GET(&a, "--max-influences"), 1, AK_MAX_INFLUENCES, &k))
+        return cli_usage("weights", "--max-influences '%s' is not a whole number in 1..%d", CLI_GET(&a, "--max-influences"),
+                         AK_MAX_INFLUENCES);
+    if (CLI_GET(&a, "--mesh") && !cli_parse_int(CLI_GET(&a, "--mesh"), 0, 1000000, &mesh_index))
+        return cli_usage("weights", "--mesh '%s' is not a mesh index", CLI_GET(&a, "--mesh"));
+    const char* out = CLI_GET(&a, "--output");
+    if (!out) return cli_usage("weights", "missing -o OUT");
+    bool png = cli_has_ext(out, ".png");
+
+    ak_scene* s = NULL;
+    if ((rc = cli_load_scene("weights", a.pos[0], &s))) return rc;
+    uint16_t* joints = NULL;
+    float* weights = NULL;
+    ak_skin_bone* bones = NULL;
+    if ((size_t)mesh_index >= s->mesh_count) {
+        rc = cli_fail("weights", "%s: no mesh %ld (%zu meshes)", a.pos[0], mesh_index, s->mesh_count);
+        goto done;
+    }
+    const ak_scene_mesh* sm = &s->meshes[mesh_index];
+    if (sm->skin < 0 || !s->skeleton) {
+        rc = cli_fail("weights", "%s: mesh %ld has no skin, so no bones to weight against", a.pos[0], mesh_index);
+        goto done;
+    }
+    const ak_scene_skin* skin = &s->skins[sm->skin];
+    int slot = 0;
+    const char* bone_name = CLI_GET(&a, "--bone");
+    if (bone_name) {
+        int j = ak_skeleton_find_joint(s->skeleton, bone_name);
+        slot = -1;
+        for (size_t q = 0; j >= 0 && q < skin->joint_count; ++q)
+            if (skin->joints[q] == j) slot = (int)q;
+        if (slot < 0) {
+            rc = cli_fail("weights", "%s: no joint named '%s' in the skin", a.pos[0], bone_name);
+            goto done;
+        }
+    } else if (png) {
+        bone_name = ak_skeleton_joint_name(s->skeleton, (size_t)skin->joints[0]);
+    }
+    const ak_mesh* mesh = sm->mesh;
+    size_t vc = mesh->vertex_count;
+    joints = calloc(vc * (size_t)k, sizeof(uint16_t));
+    weights = calloc(vc * (size_t)k, sizeof(float));
+    bones = calloc(2 * skin->joint_count + 1, sizeof(ak_skin_bone));
+    if (!joints || !weights || !bones) {
+        rc = cli_fail("weights", "out of memory");
+        goto done;
+    }
+    size_t bone_count = skin_bones(s, skin, bones);
+    ak_weights_desc d = {
+        .method = wm,
+        .positions = {mesh->positions, vc},
+        .indices = {mesh->indices, mesh->triangle_count * 3},
+        .bones = {bones, bone_count},
+        .max_influences = (uint32_t)k,
+        .distance_power = power,
+    };
+    double t0 = cli_now();
+    ak_result r = ak_skin_weights_compute(&d, NULL, (ak_u16_span){joints, vc * (size_t)k}, (ak_f32_span){weights, vc * (size_t)k});
+    double dt = cli_now() - t0;
+    if (r != AK_OK) {
+        rc = cli_fail("weights", "%s: %s", a.pos[0], ak_result_string(r));
+        goto done;
+    }
+    if (png) {
+        rc = cli_render_weights_png(out, s, (size_t)mesh_index, joints, weights, (uint32_t)k, slot, bone_name);
+    } else if (cli_has_ext(out, ".json")) {
+        rc = write_json(out, s, skin, vc, (uint32_t)k, joints, weights);
+    } else {
+        r = ak_skin_weights_write_file(out, (ak_u16_cspan){joints, vc * (size_t)k}, (ak_f32_cspan){weights, vc * (size_t)k},
+                                       vc, (uint32_t)k);
+        if (r != AK_OK) rc = cli_fail("weights", "%s: %s", out, ak_result_string(r));
+    }
+    if (rc == CLI_OK)
+        fprintf(stderr, "wrote %s: %s weights, %zu vertices, %zu bones, %u influences, %.3f s\n", out, method, vc,
+                bone_count, (unsigned)k, dt);
+done:
+    free(joints);
+    free(weights);
+    free(bones);
+    ak_scene_destroy(s);
+    return rc;
+}

@@ -1,0 +1,62 @@
+/* animkit: the command-line tool. Each subcommand lives in its own cmd_*.c file. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+typedef struct command {
+    const char* name;
+    int (*run)(int argc, char** argv);
+    const char* summary;
+} command;
+
+static const command commands[] = {
+    {"demo", cmd_demo, "render the built-in characters (no files needed) to DIR/demo.gif and PNGs"},
+    {"info", cmd_info, "print a model's skeleton, meshes and clips (--json for scripts)"},
+    {"export", cmd_export, "write the posed meshes as Wavefront OBJ"},
+    {"render", cmd_render, "render a posed or animated model to PNG or GIF"},
+    {"curves", cmd_curves, "plot a clip's animation curves to PNG (a read-only curve editor)"},
+    {"weights", cmd_weights, "compute automatic skin weights (inverse distance or bone heat)"},
+    {"skin", cmd_skin, "compare LBS, DQS and CoR skinning: volume and bulge"},
+    {"ik", cmd_ik, "solve inverse kinematics for a joint chain"},
+};
+#define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
+
+static void print_help(FILE* f) {
+    fprintf(f, "animkit %s: character animation and deformation\n\n", ak_version_string());
+    fprintf(f, "usage: animkit COMMAND [ARGS]   (animkit COMMAND --help for details)\n\n");
+    for (size_t i = 0; i < COMMAND_COUNT; ++i) fprintf(f, "  %-8s %s\n", commands[i].name, commands[i].summary);
+    fprintf(f, "\nMODEL arguments are a file (glTF/GLB, BVH, FBX, Collada, OBJ) or builtin:humanoid,\n"
+               "builtin:cylinder. Exit status: 0 success, 1 bad input, 2 bad usage.\n");
+}
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        print_help(stderr);
+        return CLI_BAD_USAGE;
+    }
+    const char* name = argv[1];
+    if (strcmp(name, "help") == 0 || strcmp(name, "--help") == 0 || strcmp(name, "-h") == 0) {
+        if (argc >= 3) {
+            for (size_t i = 0; i < COMMAND_COUNT; ++i) {
+                if (strcmp(argv[2], commands[i].name) == 0) {
+                    char help[] = "--help";
+                    char* hv[] = {help};
+                    return commands[i].run(1, hv);
+                }
+            }
+            fprintf(stderr, "animkit: unknown command '%s'\n", argv[2]);
+            return CLI_BAD_USAGE;
+        }
+        print_help(stdout);
+        return CLI_OK;
+    }
+    if (strcmp(name, "--version") == 0 || strcmp(name, "version") == 0) {
+        printf("animkit %s\n", ak_version_string());
+        return CLI_OK;
+    }
+    for (size_t i = 0; i < COMMAND_COUNT; ++i)
+        if (strcmp(name, commands[i].name) == 0) return commands[i].run(argc - 2, argv + 2);
+    fprintf(stderr, "animkit: unknown command '%s'\ntry 'animkit help'\n", name);
+    return CLI_BAD_USAGE;
+}

@@ -1,0 +1,234 @@
+/* The posing pipeline shared by the commands: sample a clip into the local pose, forward
+ * kinematics, morph targets, then skinning, exactly as glTF 2.0 defines it (see scene.h). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+bool cli_method_parse(const char* s, cli_method* out) {
+    if (!s) return false;
+    if (strcmp(s, "lbs") == 0) *out = CLI_LBS;
+    else if (strcmp(s, "dqs") == 0) *out = CLI_DQS;
+    else if (strcmp(s, "cor") == 0) *out = CLI_COR;
+    else return false;
+    return true;
+}
+
+const char* cli_method_name(cli_method m) {
+    switch (m) {
+    case CLI_DQS: return "DQS";
+    case CLI_COR: return "CoR";
+    default: return "LBS";
+    }
+}
+
+static size_t total_morph_targets(const ak_scene* s) {
+    size_t n = 0;
+    for (size_t m = 0; m < s->mesh_count; ++m)
+        if (s->meshes[m].mesh) n += s->meshes[m].mesh->morph_target_count;
+    return n;
+}
+
+int cli_poser_init(cli_poser* p, const ak_scene* scene) {
+    memset(p, 0, sizeof(*p));
+    p->scene = scene;
+    p->joint_count = ak_scene_joint_count(scene);
+    size_t jc = p->joint_count ? p->joint_count : 1;
+    size_t max_skin = 1, max_vertices = 1;
+    for (size_t k = 0; k < scene->skin_count; ++k)
+        if (scene->skins[k].joint_count > max_skin) max_skin = scene->skins[k].joint_count;
+    for (size_t m = 0; m < scene->mesh_count; ++m)
+        if (scene->meshes[m].mesh && scene->meshes[m].mesh->vertex_count > max_vertices)
+            max_vertices = scene->meshes[m].mesh->vertex_count;
+    size_t morphs = total_morph_targets(scene);
+    p->local = calloc(jc, sizeof(ak_transform));
+    p->world = calloc(jc, sizeof(ak_mat4));
+    p->palette = calloc(max_skin, sizeof(ak_mat4));
+    p->morph_weights = calloc(morphs ? morphs : 1, sizeof(float));
+    p->morphed = calloc(max_vertices, sizeof(ak_vec3));
+    p->morphed_normals = calloc(max_vertices, sizeof(ak_vec3));
+    size_t mc = scene->mesh_count ? scene->mesh_count : 1;
+    p->positions = calloc(mc, sizeof(ak_vec3*));
+    p->normals = calloc(mc, sizeof(ak_vec3*));
+    p->cor_centers = calloc(mc, sizeof(ak_vec3*));
+    bool ok = p->local && p->world && p->palette && p->morph_weights && p->morphed && p->morphed_normals &&
+              p->positions && p->normals && p->cor_centers;
+    for (size_t m = 0; ok && m < scene->mesh_count; ++m) {
+        size_t n = scene->meshes[m].mesh ? scene->meshes[m].mesh->vertex_count : 1;
+        p->positions[m] = calloc(n, sizeof(ak_vec3));
+        p->normals[m] = calloc(n, sizeof(ak_vec3));
+        ok = p->positions[m] && p->normals[m];
+    }
+    if (!ok) {
+        cli_poser_free(p);
+        return CLI_BAD_INPUT;
+    }
+    return CLI_OK;
+}
+
+void cli_poser_free(cli_poser* p) {
+    if (p->scene) {
+        for (size_t m = 0; m < p->scene->mesh_count; ++m) {
+            if (p->positions) free(p->positions[m]);
+            if (p->normals) free(p->normals[m]);
+            if (p->cor_centers) free(p->cor_centers[m]);
+        }
+    }
+    free(p->positions);
+    free(p->normals);
+    free(p->cor_centers);
+    free(p->local);
+    free(p->world);
+    free(p->palette);
+    free(p->morph_weights);
+    free(p->morphed);
+    free(p->morphed_normals);
+    memset(p, 0, sizeof(*p));
+}
+
+/* Centers of rotation for mesh m, computed on first use. */
+static ak_result cor_centers(cli_poser* p, size_t m) {
+    if (p->cor_centers[m]) return AK_OK;
+    const ak_mesh* mesh = p->scene->meshes[m].mesh;
+    ak_vec3* c = calloc(mesh->vertex_count, sizeof(ak_vec3));
+    if (!c) return AK_ERR_NO_MEMORY;
+    size_t wn = mesh->vertex_count * mesh->influence_count;
+    ak_skin_cor_desc d = {
+        .positions = {mesh->positions, mesh->vertex_count},
+        .indices = {mesh->indices, mesh->triangle_count * 3},
+        .joints = {mesh->joints, wn},
+        .weights = {mesh->weights, wn},
+        .influence_count = mesh->influence_count,
+    };
+    ak_result r = ak_skin_cor_centers_compute(&d, NULL, (ak_vec3_span){c, mesh->vertex_count});
+    if (r != AK_OK) {
+        free(c);
+        return r;
+    }
+    p->cor_centers[m] = c;
+    return AK_OK;
+}
+
+static void transform_rigid(const ak_mesh* mesh, ak_mat4 m, const ak_vec3* pos, const ak_vec3* nrm, ak_vec3* out_p,
+                            ak_vec3* out_n) {
+    ak_mat3 nm = ak_mat4_normal_matrix(m);
+    for (size_t v = 0; v < mesh->vertex_count; ++v) {
+        out_p[v] = ak_mat4_transform_point(m, pos[v]);
+        if (nrm) out_n[v] = ak_vec3_normalize(ak_mat3_mul_vec3(nm, nrm[v]));
+    }
+}
+
+ak_result cli_poser_sample(cli_poser* p, int clip, float t, bool bind) {
+    const ak_scene* s = p->scene;
+    ak_result r = AK_OK;
+    size_t morphs = total_morph_targets(s);
+    /* default morph weights (glTF mesh.weights), in the scene's flat morph index space */
+    for (size_t m = 0, off = 0; m < s->mesh_count; ++m) {
+        const ak_mesh* mesh = s->meshes[m].mesh;
+        if (!mesh) continue;
+        for (size_t k = 0; k < mesh->morph_target_count; ++k)
+            p->morph_weights[off + k] = mesh->morph_weights ? mesh->morph_weights[k] : 0.0f;
+        off += mesh->morph_target_count;
+    }
+    if (!p->joint_count) return AK_OK;
+    ak_transform_span local = {p->local, p->joint_count};
+    if ((r = ak_scene_rest_pose(s, local)) != AK_OK) return r;
+    if (!bind && clip >= 0 && (size_t)clip < s->clip_count) {
+        const ak_clip* c = s->clips[clip];
+        ak_f32_span mw = {NULL, 0};
+        if (ak_clip_morph_weight_count(c) > 0 && morphs >= ak_clip_morph_weight_count(c))
+            mw = (ak_f32_span){p->morph_weights, morphs};
+        ak_transform_span lp = ak_clip_joint_count(c) ? local : (ak_transform_span){NULL, 0};
+        if ((r = ak_clip_sample(c, t, NULL, lp, mw, (ak_f32_span){NULL, 0})) != AK_OK) return r;
+    }
+    return AK_OK;
+}
+
+ak_result cli_poser_pose(cli_poser* p, int clip, float t, bool bind, cli_method method) {
+    ak_result r = cli_poser_sample(p, clip, t, bind);
+    return r != AK_OK ? r : cli_poser_deform(p, bind, method);
+}
+
+ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method) {
+    const ak_scene* s = p->scene;
+    ak_result r = AK_OK;
+    if (p->joint_count &&
+        (r = ak_scene_world_matrices(s, (ak_transform_cspan){p->local, p->joint_count},
+                                     (ak_mat4_span){p->world, p->joint_count})) != AK_OK)
+        return r;
+    for (size_t m = 0, off = 0; m < s->mesh_count; ++m) {
+        const ak_scene_mesh* sm = &s->meshes[m];
+        const ak_mesh* mesh = sm->mesh;
+        if (!mesh) continue;
+        size_t n = mesh->vertex_count;
+        const ak_vec3* pos = mesh->positions;
+        const ak_vec3* nrm = mesh->normals;
+        size_t morph_off = off;
+        off += mesh->morph_target_count;
+        if (bind) {
+            memcpy(p->positions[m], pos, n * sizeof(ak_vec3));
+            if (nrm) memcpy(p->normals[m], nrm, n * sizeof(ak_vec3));
+            else ak_normals_compute((ak_vec3_cspan){p->positions[m], n},
+                                    (ak_u32_cspan){mesh->indices, mesh->triangle_count * 3},
+                                    (ak_vec3_span){p->normals[m], n});
+            continue;
+        }
+        if (mesh->morph_target_count > 0) {
+            ak_blendshape_mesh_job mj = {
+                .mesh = mesh,
+                .weights = {p->morph_weights + morph_off, mesh->morph_target_count},
+                .out_positions = {p->morphed, n},
+                .out_normals = {nrm ? p->morphed_normals : NULL, nrm ? n : 0},
+            };
+            if ((r = ak_blendshape_mesh_run(&mj)) != AK_OK) return r;
+            pos = p->morphed;
+            if (nrm) nrm = p->morphed_normals;
+        }
+        bool skinned = sm->skin >= 0 && (size_t)sm->skin < s->skin_count && mesh->influence_count > 0 && p->joint_count;
+        if (skinned) {
+            const ak_scene_skin* skin = &s->skins[sm->skin];
+            if ((r = ak_scene_skin_palette(s, (size_t)sm->skin, (ak_mat4_cspan){p->world, p->joint_count},
+                                           (ak_mat4_span){p->palette, skin->joint_count})) != AK_OK)
+                return r;
+            ak_skin_method sm_method = method == CLI_DQS ? AK_SKIN_DQS : method == CLI_COR ? AK_SKIN_COR : AK_SKIN_LBS;
+            if (sm_method == AK_SKIN_COR && mesh->triangle_count == 0) sm_method = AK_SKIN_DQS;
+            if (sm_method == AK_SKIN_COR && (r = cor_centers(p, m)) != AK_OK) return r;
+            bool faces = nrm == NULL && mesh->triangle_count > 0;
+            uint8_t* scratch = NULL;
+            ak_skin_job job = {
+                .method = sm_method,
+                .influence_count = mesh->influence_count,
+                .palette = {p->palette, skin->joint_count},
+                .positions = {pos, n, 0},
+                .joints = {mesh->joints, n, mesh->influence_count * sizeof(uint16_t)},
+                .weights = {mesh->weights, n, mesh->influence_count * sizeof(float)},
+                .normals = {nrm, nrm ? n : 0, 0},
+                .cor_centers = {p->cor_centers[m], p->cor_centers[m] ? n : 0, 0},
+                .indices = {mesh->indices, mesh->triangle_count * 3},
+                .normals_from_faces = faces,
+                .out_positions = {p->positions[m], n, 0},
+                .out_normals = {(nrm || faces) ? p->normals[m] : NULL, n, 0},
+            };
+            size_t ss = ak_skin_job_scratch_size(&job);
+            if (ss) {
+                scratch = malloc(ss);
+                if (!scratch) return AK_ERR_NO_MEMORY;
+                job.scratch = (ak_u8_span){scratch, ss};
+            }
+            r = ak_skin_job_run(&job);
+            free(scratch);
+            if (r != AK_OK) return r;
+            if (!nrm && !faces)
+                for (size_t v = 0; v < n; ++v) p->normals[m][v] = ak_vec3_make(0, 1, 0);
+        } else {
+            ak_mat4 place = ak_mat4_identity();
+            if (sm->node >= 0 && (size_t)sm->node < p->joint_count) place = p->world[sm->node];
+            transform_rigid(mesh, place, pos, nrm, p->positions[m], p->normals[m]);
+            if (!nrm)
+                ak_normals_compute((ak_vec3_cspan){p->positions[m], n},
+                                   (ak_u32_cspan){mesh->indices, mesh->triangle_count * 3},
+                                   (ak_vec3_span){p->normals[m], n});
+        }
+    }
+    return AK_OK;
+}

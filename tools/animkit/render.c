@@ -1,0 +1,238 @@
+/* Rendering glue for the commands: a fixed camera and ground framed on a whole animation,
+ * posed meshes, skeleton overlays, heatmaps, IK overlays, frames to PNG or GIF. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "render.h"
+
+static ak_vec4 rgba(float r, float g, float b, float a) { return ak_vec4_make(r, g, b, a); }
+
+void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi) {
+    const ak_scene* s = p->scene;
+    bool any = false;
+    for (size_t m = 0; m < s->mesh_count; ++m) {
+        const ak_mesh* mesh = s->meshes[m].mesh;
+        if (!mesh || mesh->vertex_count == 0) continue;
+        ak_vec3 a, b;
+        ak_points_bounds((ak_vec3_cspan){p->positions[m], mesh->vertex_count}, &a, &b);
+        *lo = ak_vec3_min(*lo, a);
+        *hi = ak_vec3_max(*hi, b);
+        any = true;
+    }
+    if (!any) {
+        for (size_t j = 0; j < p->joint_count; ++j) {
+            if (s->is_joint && !s->is_joint[j]) continue;
+            ak_vec3 t = ak_mat4_get_translation(p->world[j]);
+            if (!ak_vec3_is_finite(t)) continue;
+            *lo = ak_vec3_min(*lo, t);
+            *hi = ak_vec3_max(*hi, t);
+        }
+    }
+}
+
+int cli_frame_init(cli_frame* f, const ak_scene* s, int width, int height, ak_vec3 lo, ak_vec3 hi, float azimuth) {
+    memset(f, 0, sizeof(*f));
+    f->width = width;
+    f->height = height;
+    f->bmin = lo;
+    f->bmax = hi;
+    ak_raster_desc d = {.width = width, .height = height, .supersample = 2, .thread_count = 2};
+    if (ak_raster_create(&d, NULL, &f->raster) != AK_OK) return CLI_BAD_INPUT;
+    ak_view_orbit orbit = {.azimuth = azimuth, .elevation = 0.22f, .aspect = (float)width / (float)height, .margin = 1.08f};
+    f->camera = ak_view_orbit_camera(lo, hi, &orbit);
+    /* skeleton overlay arrays: the skin joints only, parents remapped to listed ancestors */
+    size_t n = s ? ak_scene_joint_count(s) : 0;
+    f->joint_list = calloc(n + 1, sizeof(int));
+    f->joint_parent = calloc(n + 1, sizeof(int16_t));
+    f->joint_model = calloc(n + 1, sizeof(ak_mat4));
+    int* map = calloc(n + 1, sizeof(int));
+    if (!f->joint_list || !f->joint_parent || !f->joint_model || !map) {
+        free(map);
+        cli_frame_free(f);
+        return CLI_BAD_INPUT;
+    }
+    if (n) {
+        ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+        for (size_t j = 0; j < n; ++j) {
+            map[j] = -1;
+            if (s->is_joint && !s->is_joint[j]) continue;
+            int p = parents.ptr[j];
+            while (p >= 0 && map[p] < 0) p = parents.ptr[p];
+            map[j] = (int)f->joint_count;
+            f->joint_list[f->joint_count] = (int)j;
+            f->joint_parent[f->joint_count] = (int16_t)(p >= 0 ? map[p] : -1);
+            ++f->joint_count;
+        }
+    }
+    free(map);
+    return CLI_OK;
+}
+
+void cli_frame_free(cli_frame* f) {
+    ak_raster_destroy(f->raster);
+    free(f->joint_list);
+    free(f->joint_parent);
+    free(f->joint_model);
+    memset(f, 0, sizeof(*f));
+}
+
+ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* o, const ak_image* out) {
+    const ak_scene* s = p ? p->scene : NULL;
+    ak_raster* r = f->raster;
+    ak_raster_clear(r, rgba(0.83f, 0.87f, 0.93f, 1), rgba(0.48f, 0.51f, 0.58f, 1));
+    ak_raster_mesh meshes[64];
+    size_t mc = 0;
+    ak_vec4 clay = rgba(0.80f, 0.74f, 0.68f, 1);
+    for (size_t m = 0; s && m < s->mesh_count && mc < 64; ++m) {
+        const ak_mesh* mesh = s->meshes[m].mesh;
+        if (!mesh || mesh->triangle_count == 0) continue;
+        ak_raster_mesh rm = {
+            .positions = {p->positions[m], mesh->vertex_count},
+            .normals = {p->normals[m], mesh->vertex_count},
+            .indices = {mesh->indices, mesh->triangle_count * 3},
+            .material = {.color = o && o->tint.w > 0 ? o->tint : clay},
+        };
+        if (o && o->colors && o->colors[m]) {
+            rm.colors = (ak_vec4_cspan){o->colors[m], mesh->vertex_count};
+            rm.material.color = rgba(1, 1, 1, 1);
+            rm.material.specular = 0.15f;
+        }
+        meshes[mc++] = rm;
+    }
+    for (size_t e = 0; o && e < o->extra_count && mc < 64; ++e) meshes[mc++] = o->extra[e];
+    ak_vec3 size = ak_vec3_sub(f->bmax, f->bmin);
+    float extent = ak_maxf(ak_maxf(1.3f * ak_maxf(size.x, size.z), 0.9f * size.y), 1e-3f);
+    float step = powf(10.0f, floorf(log10f(extent / 4.0f)));
+    ak_raster_ground g = {
+        .height = f->bmin.y,
+        .center = ak_vec3_scale(ak_vec3_add(f->bmin, f->bmax), 0.5f),
+        .half_extent = extent,
+        .grid_spacing = step,
+        .casters = meshes,
+        .caster_count = mc,
+    };
+    ak_result res = ak_raster_draw_ground(r, &f->camera, &g);
+    for (size_t m = 0; res == AK_OK && m < mc; ++m) res = ak_raster_draw_mesh(r, &f->camera, &meshes[m]);
+    bool skeleton = (o && o->skeleton) || mc == 0;
+    if (res == AK_OK && skeleton && p && f->joint_count) {
+        for (size_t k = 0; k < f->joint_count; ++k) f->joint_model[k] = p->world[f->joint_list[k]];
+        ak_view_skeleton sk = {
+            .joint_model = {f->joint_model, f->joint_count},
+            .parents = {f->joint_parent, f->joint_count},
+            .depth_tested = mc == 0,
+        };
+        res = ak_view_draw_skeleton(r, &f->camera, &sk);
+    }
+    if (res == AK_OK && o && o->title) res = ak_raster_draw_text(r, 10, 10, o->title, f->height >= 300 ? 2 : 1, rgba(0.08f, 0.09f, 0.12f, 1));
+    if (res == AK_OK) res = ak_raster_resolve(r, out);
+    return res;
+}
+
+int cli_image_alloc(ak_image* img, int w, int h) {
+    img->width = w;
+    img->height = h;
+    img->stride = 0;
+    img->pixels = calloc((size_t)w * (size_t)h, 4);
+    return img->pixels ? CLI_OK : CLI_BAD_INPUT;
+}
+
+/* Heatmap colours of one skin slot's weights on mesh m (the rest of the meshes clay). */
+static int heat_colors(const ak_scene* s, size_t mesh_index, const uint16_t* joints, const float* weights, uint32_t k,
+                       int slot, ak_vec4** out) {
+    const ak_mesh* mesh = s->meshes[mesh_index].mesh;
+    size_t n = mesh->vertex_count;
+    float* w = calloc(n, sizeof(float));
+    ak_vec4* c = calloc(n, sizeof(ak_vec4));
+    if (!w || !c) {
+        free(w), free(c);
+        return CLI_BAD_INPUT;
+    }
+    for (size_t v = 0; v < n; ++v)
+        for (uint32_t i = 0; i < k; ++i)
+            if (joints[v * k + i] == slot) w[v] += weights[v * k + i];
+    ak_view_heatmap_colors((ak_f32_cspan){w, n}, 0.0f, 1.0f, (ak_vec4_span){c, n});
+    free(w);
+    *out = c;
+    return CLI_OK;
+}
+
+int cli_weights_colors(const ak_scene* s, const char* bone, ak_vec4** colors, int* out_found) {
+    *out_found = 0;
+    int j = s->skeleton ? ak_skeleton_find_joint(s->skeleton, bone) : -1;
+    for (size_t m = 0; m < s->mesh_count; ++m) {
+        const ak_scene_mesh* sm = &s->meshes[m];
+        colors[m] = NULL;
+        if (sm->skin < 0 || !sm->mesh->influence_count || j < 0) continue;
+        const ak_scene_skin* skin = &s->skins[sm->skin];
+        int slot = -1;
+        for (size_t q = 0; q < skin->joint_count; ++q)
+            if (skin->joints[q] == j) slot = (int)q;
+        if (slot < 0) continue;
+        if (heat_colors(s, m, sm->mesh->joints, sm->mesh->weights, sm->mesh->influence_count, slot, &colors[m])) return CLI_BAD_INPUT;
+        *out_found = 1;
+    }
+    return CLI_OK;
+}
+
+/* Render one still of the scene at its rest pose with heat colours on mesh_index. */
+int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
+                           const float* weights, uint32_t k, int slot, const char* bone_name) {
+    cli_poser p;
+    cli_frame f;
+    ak_image img = {0};
+    ak_vec4* colors[64] = {0};
+    int rc = CLI_OK;
+    if (cli_poser_init(&p, s)) return cli_fail("weights", "out of memory");
+    cli_poser_pose(&p, -1, 0.0f, false, CLI_LBS);
+    ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
+    cli_bounds_add_pose(&p, &lo, &hi);
+    if (mesh_index < 64) rc = heat_colors(s, mesh_index, joints, weights, k, slot, &colors[mesh_index]);
+    if (rc == CLI_OK && cli_frame_init(&f, s, 640, 640, lo, hi, 0.5f) == CLI_OK) {
+        char title[160];
+        snprintf(title, sizeof title, "weights of %s", bone_name ? bone_name : "?");
+        cli_draw_opts o = {.colors = colors, .title = title};
+        if (cli_image_alloc(&img, 640, 640) || cli_frame_draw(&f, &p, &o, &img) != AK_OK || ak_png_write(path, &img) != AK_OK)
+            rc = cli_fail("weights", "%s: cannot write the image", path);
+        cli_frame_free(&f);
+    } else {
+        rc = cli_fail("weights", "out of memory");
+    }
+    for (int m = 0; m < 64; ++m) free(colors[m]);
+    free(img.pixels);
+    cli_poser_free(&p);
+    return rc;
+}
+
+int cli_render_ik_png(const char* path, cli_poser* p, const int16_t* chain, size_t n, ak_vec3 target) {
+    cli_frame f;
+    ak_image img = {0};
+    int rc = CLI_OK;
+    ak_vec3 lo = target, hi = target;
+    cli_bounds_add_pose(p, &lo, &hi);
+    if (cli_frame_init(&f, p->scene, 640, 640, lo, hi, 0.5f) || cli_image_alloc(&img, 640, 640)) {
+        cli_frame_free(&f);
+        free(img.pixels);
+        return cli_fail("ik", "out of memory");
+    }
+    cli_draw_opts o = {.skeleton = true, .title = "IK solve"};
+    ak_result r = cli_frame_draw(&f, p, &o, &img);
+    /* the chain and the target, drawn over the picture */
+    ak_vec2 prev = {0, 0};
+    for (size_t i = 0; r == AK_OK && i < n; ++i) {
+        ak_vec3 px;
+        if (!ak_raster_camera_project(&f.camera, 640, 640, ak_mat4_get_translation(p->world[chain[i]]), &px)) continue;
+        ak_vec2 q = {px.x, px.y};
+        if (i) ak_image_draw_line(&img, prev, q, 4.0f, rgba(0.1f, 0.55f, 1.0f, 1));
+        ak_image_draw_disc(&img, q, 5.0f, rgba(0.1f, 0.55f, 1.0f, 1), 1.5f, rgba(0, 0, 0, 1));
+        prev = q;
+    }
+    ak_vec3 tp;
+    if (r == AK_OK && ak_raster_camera_project(&f.camera, 640, 640, target, &tp))
+        ak_image_draw_disc(&img, (ak_vec2){tp.x, tp.y}, 7.0f, rgba(0.95f, 0.15f, 0.2f, 1), 2.0f, rgba(1, 1, 1, 1));
+    if (r != AK_OK || ak_png_write(path, &img) != AK_OK) rc = cli_fail("ik", "%s: cannot write the image", path);
+    cli_frame_free(&f);
+    free(img.pixels);
+    return rc;
+}

@@ -1,0 +1,45 @@
+/* Rendering glue shared by render, demo, weights and ik. */
+#ifndef ANIMKIT_CLI_RENDER_H
+#define ANIMKIT_CLI_RENDER_H
+
+#include <animkit/view.h>
+
+#include "cli.h"
+
+/* A camera, ground and skeleton overlay fixed for a whole animation. */
+typedef struct cli_frame {
+    int width, height;
+    ak_raster* raster;
+    ak_raster_camera camera;
+    ak_vec3 bmin, bmax;
+    int* joint_list;      /* skeleton joints drawn in the overlay */
+    int16_t* joint_parent;
+    ak_mat4* joint_model;
+    size_t joint_count;
+} cli_frame;
+
+typedef struct cli_draw_opts {
+    bool skeleton;         /* overlay the skeleton */
+    ak_vec4** colors;      /* per scene mesh: per-vertex colours or NULL */
+    const char* title;
+    ak_vec4 tint;          /* material colour; w = 0 -> clay */
+    const ak_raster_mesh* extra; /* more meshes (props, the demo's tail and ball) */
+    size_t extra_count;
+} cli_draw_opts;
+
+/* Grow [lo, hi] by the posed meshes (or the joints when there is no mesh). */
+void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi);
+int cli_frame_init(cli_frame* f, const ak_scene* s, int width, int height, ak_vec3 lo, ak_vec3 hi, float azimuth);
+void cli_frame_free(cli_frame* f);
+/* Draw the posed scene (p may be NULL: extras only) into out. */
+ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* o, const ak_image* out);
+int cli_image_alloc(ak_image* img, int w, int h);
+/* Heat colours of bone's weights for every mesh its skin reaches (colors[m] NULL elsewhere;
+ * the caller frees them). *out_found says whether any mesh has the bone. */
+int cli_weights_colors(const ak_scene* s, const char* bone, ak_vec4** colors, int* out_found);
+
+int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
+                           const float* weights, uint32_t k, int slot, const char* bone_name);
+int cli_render_ik_png(const char* path, cli_poser* p, const int16_t* chain, size_t n, ak_vec3 target);
+
+#endif
