@@ -29,7 +29,7 @@
  *     ak_vec3 p = ak_quat_rotate(q, ak_vec3_make(1, 0, 0));          // (0, 0, -1)
  *     ak_transform t = { .translation = {1, 2, 3}, .rotation = q, .scale = {1, 1, 1} };
  *     ak_mat4 m = ak_transform_to_mat4(t);
- *     ak_vec3 w = ak_mat4_transform_point(m, p);                      // (1, 2, 2)
+ *     ak_vec3 w = ak_mat4_transform_point(m, ak_vec3_make(1, 0, 0));  // (1, 2, 2)
  *     ak_quat h = ak_quat_slerp(ak_quat_identity(), q, 0.5f);         // 45 degrees about Y
  *     ak_vec3 e = ak_quat_to_euler(q, AK_EULER_XYZ, AK_EULER_INTRINSIC); // (0, pi/2, 0)
  *     ak_dualquat dq = ak_dualquat_from_rigid(q, t.translation);

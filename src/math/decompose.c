@@ -2,8 +2,6 @@
  * M = R D by the averaging scheme R_{i+1} = (R_i + R_i^-T)/2 with an SVD fallback.
  * Everything runs in double precision and is rounded to float once at the end, so float
  * inputs come out with float-rounding accuracy even when badly conditioned. */
-#include <float.h>
-
 #include <animkit/math.h>
 
 typedef struct dm3 {
