@@ -2,6 +2,7 @@
  * reference code in tests/ref/ref_math.h, and properties (round trips, orthonormality,
  * unit norms). Property tests run 10,000 seeded random cases each. */
 #include <float.h>
+#include <stdint.h>
 
 #include <animkit/math.h>
 
@@ -965,6 +966,28 @@ AK_TEST(array_functions) {
     AK_CHECK_NEAR(w_4b, 0.0, 2e-6);
 }
 
+AK_TEST(array_unaligned) {
+    /* The arrays sit 4 bytes past a 16-byte boundary: the SSE2 kernels must load unaligned. */
+    static struct { float pad; ak_quat q[37]; ak_quat o[37]; ak_mat4 m[9]; ak_mat4 mo[9]; } u;
+    AK_CHECK(((uintptr_t)u.q) % 16 != 0);
+    ak_rng g = ak_rng_make(23);
+    for (int i = 0; i < 37; ++i) u.q[i] = fq(rand_quat(&g));
+    for (int i = 0; i < 9; ++i)
+        for (int k = 0; k < 16; ++k) u.m[i].m[k] = ak_rng_float(&g);
+    double w = 0;
+    AK_CHECK_EQ(ak_quat_mul_array((ak_quat_cspan){u.q, 37}, (ak_quat_cspan){u.q, 37}, (ak_quat_span){u.o, 37}), AK_OK);
+    for (int i = 0; i < 37; ++i) w = dmax(w, q_diff_sign(u.o[i], ref_q_mul(rq(u.q[i]), rq(u.q[i]))));
+    AK_CHECK_EQ(ak_quat_normalize_array((ak_quat_cspan){u.o, 37}, (ak_quat_span){u.o, 37}), AK_OK);
+    for (int i = 0; i < 37; ++i) w = dmax(w, fabs(ak_quat_norm(u.o[i]) - 1.0));
+    AK_CHECK_EQ(ak_mat4_mul_array((ak_mat4_cspan){u.m, 9}, (ak_mat4_cspan){u.m, 9}, (ak_mat4_span){u.mo, 9}), AK_OK);
+    for (int i = 0; i < 9; ++i) {
+        ref_m4 p = ref_m4_mul(rm4(u.m[i]), rm4(u.m[i]));
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) w = dmax(w, fabs(u.mo[i].m[c * 4 + r] - p.m[r][c]) / 4.0);
+    }
+    AK_CHECK_NEAR(w, 0.0, 1e-6);
+}
+
 AK_TEST(array_bad_input) {
     ak_quat q[4] = {{0, 0, 0, 2}, {0, 0, 0, 2}, {0, 0, 0, 2}, {0, 0, 0, 2}}, o[4];
     ak_vec3 v[4] = {{1, 0, 0}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0}}, vo[4];
@@ -1012,6 +1035,7 @@ int main(void) {
     AK_RUN(look_at);
     AK_RUN(transforms);
     AK_RUN(array_functions);
+    AK_RUN(array_unaligned);
     AK_RUN(array_bad_input);
     return ak_test_finish();
 }
