@@ -64,23 +64,32 @@ static void run_once(const bench_ctx* c) {
     }
 }
 
-/* Best of 5 repetitions, each at least ~0.15 s; returns seconds per blend. */
-static double time_blend(const bench_ctx* c) {
+/* Iterations that take at least ~0.1 s. */
+static int calibrate(const bench_ctx* c) {
     int iters = 1;
     for (;;) {
         double t0 = now_s();
         for (int i = 0; i < iters; ++i) run_once(c);
-        if (now_s() - t0 > 0.15 || iters >= (1 << 20)) break;
+        if (now_s() - t0 > 0.1 || iters >= (1 << 20)) return iters;
         iters *= 2;
     }
-    double best = 1e30;
-    for (int r = 0; r < 5; ++r) {
-        double t0 = now_s();
-        for (int i = 0; i < iters; ++i) run_once(c);
-        double t = (now_s() - t0) / iters;
-        if (t < best) best = t;
+}
+
+/* Seconds per blend for each context, best of `rounds`, the contexts taking turns within every
+ * round so that a busy machine slows them all alike (the ratios are what carry over). */
+static void time_blends(const bench_ctx* c, size_t count, int rounds, double* out_best) {
+    int iters[16];
+    for (size_t m = 0; m < count; ++m) {
+        iters[m] = calibrate(&c[m]);
+        out_best[m] = 1e30;
     }
-    return best;
+    for (int r = 0; r < rounds; ++r)
+        for (size_t m = 0; m < count; ++m) {
+            double t0 = now_s();
+            for (int i = 0; i < iters[m]; ++i) run_once(&c[m]);
+            double t = (now_s() - t0) / iters[m];
+            if (t < out_best[m]) out_best[m] = t;
+        }
 }
 
 static void fill(ak_vec3* d, size_t n, ak_rng* rng, float s) {
@@ -162,21 +171,23 @@ int main(int argc, char** argv) {
         {"set, sparse storage, + normals", 3, NULL},
     };
     rows[2].set = dense, rows[3].set = sparse, rows[4].set = dense, rows[5].set = sparse;
-    double t_naive = 0.0;
     bench_ctx c0 = {v, k, base, normals, d, w, ref, out_n, NULL, 0};
     run_once(&c0); /* reference result for the check below */
+    enum { ROWS = sizeof(rows) / sizeof(rows[0]) };
+    bench_ctx ctx[ROWS];
+    double best[ROWS];
+    for (size_t r = 0; r < ROWS; ++r) ctx[r] = (bench_ctx){v, k, base, normals, d, w, out, out_n, rows[r].set, rows[r].mode};
+    time_blends(ctx, ROWS, 7, best);
     printf("%-40s %12s %14s %10s %12s\n", "method", "ms/blend", "Mvert*tgt/s", "vs naive", "max |diff|");
-    for (size_t r = 0; r < sizeof(rows) / sizeof(rows[0]); ++r) {
-        bench_ctx c = {v, k, base, normals, d, w, out, out_n, rows[r].set, rows[r].mode};
-        double t = time_blend(&c);
-        if (r == 0) t_naive = t;
-        run_once(&c);
+    for (size_t r = 0; r < ROWS; ++r) {
+        run_once(&ctx[r]);
         double err = 0.0;
         for (size_t i = 0; i < v; ++i) {
             double e = fabs(out[i].x - ref[i].x) + fabs(out[i].y - ref[i].y) + fabs(out[i].z - ref[i].z);
             if (e > err) err = e;
         }
-        printf("%-40s %12.3f %14.1f %9.2fx %12.2g\n", rows[r].name, t * 1e3, work / t / 1e6, t_naive / t, err);
+        printf("%-40s %12.3f %14.1f %9.2fx %12.2g\n", rows[r].name, best[r] * 1e3, work / best[r] / 1e6,
+               best[0] / best[r], err);
     }
     ak_blendshape_set_destroy(dense);
     ak_blendshape_set_destroy(sparse);
@@ -189,9 +200,10 @@ int main(int argc, char** argv) {
         fill_local(d, nd, k, v, (size_t)(v * fractions[f] / 100.0), &rng);
         ak_blendshape_set* sd = make_set(v, k, d, nd, AK_BLENDSHAPE_STORAGE_DENSE);
         ak_blendshape_set* ss = make_set(v, k, d, nd, AK_BLENDSHAPE_STORAGE_SPARSE);
-        bench_ctx cd = {v, k, base, normals, d, w, out, out_n, sd, 2};
-        bench_ctx cs = {v, k, base, normals, d, w, out, out_n, ss, 2};
-        double td = time_blend(&cd), ts = time_blend(&cs);
+        bench_ctx pair[2] = {{v, k, base, normals, d, w, out, out_n, sd, 2}, {v, k, base, normals, d, w, out, out_n, ss, 2}};
+        double bt[2];
+        time_blends(pair, 2, 5, bt);
+        const double td = bt[0], ts = bt[1];
         printf("%10.0f %14.3f %14.3f %13.2fx\n", fractions[f], td * 1e3, ts * 1e3, td / ts);
         ak_blendshape_set_destroy(sd);
         ak_blendshape_set_destroy(ss);

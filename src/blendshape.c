@@ -128,10 +128,36 @@ static void blend_sparse(ak_vec3* out, const ak_blendshape_set* set, const float
 }
 
 static void renormalize(ak_vec3* n, size_t count) {
-    for (size_t i = 0; i < count; ++i) {
-        float l2 = n[i].x * n[i].x + n[i].y * n[i].y + n[i].z * n[i].z;
-        if (l2 > 1e-24f && ak_finitef(l2)) {
-            float s = 1.0f / sqrtf(l2);
+    size_t i = 0;
+#if BS_SSE2
+    /* Four square roots and divisions at a time; the dot products and the scaling stay scalar
+     * (the array is xyz-interleaved). */
+    const __m128 tiny = _mm_set1_ps(1e-24f), huge = _mm_set1_ps(3.0e38f), one = _mm_set1_ps(1.0f);
+    for (; i + 4 <= count; i += 4) {
+        float l2[4], s[4];
+        for (int q = 0; q < 4; ++q) {
+            const ak_vec3 v = n[i + q];
+            l2[q] = v.x * v.x + v.y * v.y + v.z * v.z;
+        }
+        const __m128 l = _mm_loadu_ps(l2);
+        const int ok = _mm_movemask_ps(_mm_and_ps(_mm_cmpgt_ps(l, tiny), _mm_cmplt_ps(l, huge)));
+        _mm_storeu_ps(s, _mm_div_ps(one, _mm_sqrt_ps(_mm_max_ps(l, tiny))));
+        for (int q = 0; q < 4; ++q) {
+            ak_vec3* v = &n[i + q];
+            if (ok & (1 << q)) {
+                v->x *= s[q];
+                v->y *= s[q];
+                v->z *= s[q];
+            } else {
+                *v = ak_vec3_make(0.0f, 1.0f, 0.0f);
+            }
+        }
+    }
+#endif
+    for (; i < count; ++i) {
+        const float l2 = n[i].x * n[i].x + n[i].y * n[i].y + n[i].z * n[i].z;
+        if (l2 > 1e-24f && l2 < 3.0e38f) {
+            const float s = 1.0f / sqrtf(l2);
             n[i].x *= s;
             n[i].y *= s;
             n[i].z *= s;
