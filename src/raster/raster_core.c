@@ -779,8 +779,10 @@ static void run_draw(const drawctx* dc) {
         if (pthread_create(&th[i], NULL, worker_main, &ws[i]) != 0) break;
         ++started;
     }
-    set_workers(ws, started, dc, &g);
     pthread_mutex_lock(&g.mu);
+    /* the rows are dealt out among the threads that did start; workers read count only
+       after taking the lock */
+    for (int i = 0; i < started; ++i) ws[i].count = started;
     g.go = 1;
     pthread_cond_broadcast(&g.cv);
     pthread_mutex_unlock(&g.mu);
