@@ -230,9 +230,18 @@ void akp_track_eval(const ak_track* tr, size_t seg, float t, float* out) {
         for (uint32_t c = 0; c < cc; ++c) out[c] = a[c] + (b[c] - a[c]) * u;
         return;
     }
-    case AKP_EVAL_SLERP:
-        quat_store(out, ak_quat_slerp(quat_load(a), quat_load(b), seg_u(tr, seg, t)));
+    case AKP_EVAL_SLERP: {
+        /* glTF LINEAR rotation with the per-segment constants from build time. */
+        float u = seg_u(tr, seg, t);
+        if (a[5] == 0.0f) {
+            quat_store(out, ak_quat_nlerp(quat_load(a), quat_load(b), u));
+            return;
+        }
+        float wa = sinf((1.0f - u) * a[4]) * a[5], wb = sinf(u * a[4]) * a[5] * a[6];
+        quat_store(out, ak_quat_normalize(ak_quat_make(wa * a[0] + wb * b[0], wa * a[1] + wb * b[1],
+                                                       wa * a[2] + wb * b[2], wa * a[3] + wb * b[3])));
         return;
+    }
     case AKP_EVAL_NLERP:
         quat_store(out, ak_quat_nlerp(quat_load(a), quat_load(b), seg_u(tr, seg, t)));
         return;
@@ -470,7 +479,30 @@ ak_result akp_track_check(const ak_raw_track* raw, ak_raw_track* r, ak_diag* dia
 static uint32_t runtime_stride(const ak_raw_track* r) {
     if (interp_is_hermite_family(r->interp) || (r->is_rotation && r->interp == AK_INTERP_SQUAD))
         return 3u * r->component_count;
+    if (r->is_rotation && r->interp == AK_INTERP_LINEAR) return 8u; /* q, then the slerp constants */
     return r->component_count;
+}
+
+/* SLERP constants of each segment, computed once in double: angle theta, 1 / sin(theta) (0
+ * -> nearly parallel keys, use NLERP) and the sign that takes the shorter arc. Stored after
+ * key k's quaternion (stride 8). */
+static void slerp_constants(float* vals, size_t n) {
+    for (size_t k = 0; k + 1 < n; ++k) {
+        float* a = vals + k * 8;
+        const float* b = a + 8;
+        double d = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2] + (double)a[3] * b[3];
+        double sign = d < 0.0 ? -1.0 : 1.0, ad = fabs(d), chord = 0.0;
+        for (int c = 0; c < 4; ++c) {
+            double e = sign * b[c] - ad * a[c];
+            chord += e * e;
+        }
+        double theta = atan2(sqrt(chord), ad);
+        bool tiny = ad > 0.9999995;
+        a[4] = tiny ? 0.0f : (float)theta;
+        a[5] = tiny ? 0.0f : (float)(1.0 / sin(theta));
+        a[6] = (float)sign;
+        a[7] = 0.0f;
+    }
 }
 
 size_t akp_track_data_size(const ak_raw_track* r) {
@@ -500,7 +532,7 @@ ak_result akp_track_build_into(const ak_raw_track* r, ak_track* tr, void* data, 
     tr->key_count = (uint32_t)n;
     tr->component_count = cc;
     tr->stride = stride;
-    tr->value_offset = stride == cc ? 0u : cc;
+    tr->value_offset = stride == 3u * cc ? cc : 0u;
     tr->interp = r->interp;
     tr->tension = r->tension;
     tr->is_rotation = r->is_rotation;
@@ -578,6 +610,7 @@ ak_result akp_track_build_into(const ak_raw_track* r, ak_track* tr, void* data, 
         break;
     case AK_INTERP_LINEAR:
         tr->eval = r->is_rotation ? AKP_EVAL_SLERP : AKP_EVAL_LINEAR;
+        if (r->is_rotation) slerp_constants(vals, n);
         break;
     case AK_INTERP_NLERP:
         tr->eval = AKP_EVAL_NLERP;
