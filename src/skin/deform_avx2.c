@@ -192,18 +192,21 @@ AKP_AVX2_INLINE static inline __m256 blend_dq_vertex4(const akp_skin_ctx* c, siz
     float ww[4];
     memcpy(jj, c->jnt + i * c->jnt_stride, sizeof jj);
     memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
-    /* branch-free argmax: weights come in any order, and a mispredicted branch per vertex
-     * costs more than the whole blend */
-    const __m128 w4 = _mm_loadu_ps(ww);
-    __m128 mx = _mm_max_ps(w4, _mm_shuffle_ps(w4, w4, _MM_SHUFFLE(2, 3, 0, 1)));
-    mx = _mm_max_ps(mx, _mm_shuffle_ps(mx, mx, _MM_SHUFFLE(1, 0, 3, 2)));
-    const uint32_t best = (uint32_t)__builtin_ctz((unsigned)_mm_movemask_ps(_mm_cmpeq_ps(w4, mx)) | 16u) & 3u;
     const size_t pc = c->palette_count;
     const __m256 d0 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[0], pc)].real);
     const __m256 d1 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[1], pc)].real);
     const __m256 d2 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[2], pc)].real);
     const __m256 d3 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[3], pc)].real);
-    const __m128 ref = _mm_loadu_ps(c->joints_prep[clamp_joint(jj[best], pc)].real);
+    /* reference = rotation of the largest weight (lowest slot on ties), picked with blends:
+     * no branch (weights come in any order) and no index round trip through memory */
+    const __m128 w4 = _mm_loadu_ps(ww);
+    __m128 mx = _mm_max_ps(w4, _mm_shuffle_ps(w4, w4, _MM_SHUFFLE(2, 3, 0, 1)));
+    mx = _mm_max_ps(mx, _mm_shuffle_ps(mx, mx, _MM_SHUFFLE(1, 0, 3, 2)));
+    const __m128 is_max = _mm_cmpeq_ps(w4, mx);
+    __m128 ref = _mm256_castps256_ps128(d3);
+    ref = _mm_blendv_ps(ref, _mm256_castps256_ps128(d2), _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(2, 2, 2, 2)));
+    ref = _mm_blendv_ps(ref, _mm256_castps256_ps128(d1), _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(1, 1, 1, 1)));
+    ref = _mm_blendv_ps(ref, _mm256_castps256_ps128(d0), _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(0, 0, 0, 0)));
     __m128 p0 = _mm_mul_ps(_mm256_castps256_ps128(d0), ref), p1 = _mm_mul_ps(_mm256_castps256_ps128(d1), ref);
     __m128 p2 = _mm_mul_ps(_mm256_castps256_ps128(d2), ref), p3 = _mm_mul_ps(_mm256_castps256_ps128(d3), ref);
     __m128 dots = _mm_hadd_ps(_mm_hadd_ps(p0, p1), _mm_hadd_ps(p2, p3)); /* (q_k . ref) for k = 0..3 */
