@@ -42,7 +42,7 @@ static double percentile(double* v, size_t n, double p) {
 
 static ak_skeleton* make_chain(size_t n, bool planar, ak_rng* rng) {
     ak_joint_desc j[MAXJ];
-    char names[MAXJ][8];
+    char names[MAXJ][24];
     memset(j, 0, sizeof j);
     for (size_t i = 0; i < n; ++i) {
         snprintf(names[i], sizeof names[i], "j%zu", i);
