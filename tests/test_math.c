@@ -954,6 +954,14 @@ AK_TEST(array_functions) {
             for (int c = 0; c < 4; ++c)
                 for (int r = 0; r < 4; ++r) w_4 = dmax(w_4, fabs(mo[i].m[c * 4 + r] - p.m[r][c]));
         }
+        /* broadcast in place: out is the array holding the broadcast a[0] */
+        for (size_t i = 0; i < n; ++i) mo[i] = ma[i];
+        AK_CHECK_EQ(ak_mat4_mul_array((ak_mat4_cspan){mo, 1}, (ak_mat4_cspan){mb, n}, (ak_mat4_span){mo, n}), AK_OK);
+        for (size_t i = 0; i < n; ++i) {
+            ref_m4 p = ref_m4_mul(rm4(ma[0]), rm4(mb[i]));
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r) w_4b = dmax(w_4b, fabs(mo[i].m[c * 4 + r] - p.m[r][c]));
+        }
         if (n > 6) { /* zero, infinite and NaN -> identity */
             AK_CHECK(qo[3].w == 1.0f && qo[4].w == 1.0f && qo[4].x == 0.0f && qo[5].w == 1.0f && qo[5].x == 0.0f);
         }

@@ -130,9 +130,11 @@ ak_result ak_mat4_mul_array(ak_mat4_cspan a, ak_mat4_cspan b, ak_mat4_span out) 
     if (r == AK_OK) r = check_in(a.ptr, a.count, broadcast ? 1 : b.count);
     if (r == AK_OK) r = check_in(out.ptr, out.count, b.count);
     if (r != AK_OK) return r;
+    /* A copy of the broadcast matrix, so that out may be the array a[0] lives in. */
+    const ak_mat4 a0 = a.count > 0 ? a.ptr[0] : ak_mat4_identity();
 #if AK_SIMD_SSE2
     for (size_t i = 0; i < b.count; ++i) {
-        const float* am = a.ptr[broadcast ? 0 : i].m;
+        const float* am = broadcast ? a0.m : a.ptr[i].m;
         const float* bm = b.ptr[i].m;
         __m128 a0 = _mm_loadu_ps(am), a1 = _mm_loadu_ps(am + 4);
         __m128 a2 = _mm_loadu_ps(am + 8), a3 = _mm_loadu_ps(am + 12);
@@ -148,7 +150,7 @@ ak_result ak_mat4_mul_array(ak_mat4_cspan a, ak_mat4_cspan b, ak_mat4_span out) 
         for (int col = 0; col < 4; ++col) _mm_storeu_ps(om + 4 * col, c[col]);
     }
 #else
-    for (size_t i = 0; i < b.count; ++i) out.ptr[i] = ak_mat4_mul(a.ptr[broadcast ? 0 : i], b.ptr[i]);
+    for (size_t i = 0; i < b.count; ++i) out.ptr[i] = ak_mat4_mul(broadcast ? a0 : a.ptr[i], b.ptr[i]);
 #endif
     return AK_OK;
 }
