@@ -41,6 +41,12 @@ typedef struct gl_acc {
     const uint8_t* sparse_val;
 } gl_acc;
 
+/* cJSON_GetArrayItem walks a linked list; the big arrays are indexed through a table. */
+typedef struct gl_table {
+    const cJSON** items;
+    size_t count;
+} gl_table;
+
 typedef struct gl_ctx {
     const ak_allocator* alloc;
     const ak_io_desc* desc;
@@ -50,6 +56,7 @@ typedef struct gl_ctx {
     cJSON* root;
     cJSON *accessors, *views, *buffers, *nodes, *meshes, *skins, *animations;
     size_t n_acc, n_views, n_buffers, n_nodes, n_meshes, n_skins, n_anims;
+    gl_table t_acc, t_views, t_buffers;
     gl_buffer* bufs;
     const uint8_t* glb_bin;
     size_t glb_bin_size;
@@ -164,7 +171,6 @@ static const char* get_string(const cJSON* obj, const char* key) {
     return cJSON_IsString(v) ? v->valuestring : NULL;
 }
 
-static const cJSON* array_at(const cJSON* a, size_t i) { return cJSON_GetArrayItem(a, (int)i); }
 
 /* Elements of a top-level array must be objects. */
 static ak_result check_objects(gl_ctx* c, const cJSON* a, const char* what) {
@@ -174,11 +180,6 @@ static ak_result check_objects(gl_ctx* c, const cJSON* a, const char* what) {
     return AK_OK;
 }
 
-/* cJSON_GetArrayItem walks a linked list; the big arrays are indexed through a table. */
-typedef struct gl_table {
-    const cJSON** items;
-    size_t count;
-} gl_table;
 
 static ak_result make_table(gl_ctx* c, const cJSON* a, size_t n, gl_table* t) {
     t->count = n;
@@ -238,7 +239,7 @@ static int hex_value(char ch) {
 }
 
 static ak_result load_buffer(gl_ctx* c, size_t bi) {
-    const cJSON* b = array_at(c->buffers, bi);
+    const cJSON* b = c->t_buffers.items[bi];
     char where[160];
     snprintf(where, sizeof where, "buffers[%zu]", bi);
     size_t len = 0;
@@ -304,7 +305,7 @@ static size_t ctype_size(int t) {
 /* Bytes [offset, offset + length) of bufferView vi, checked against its buffer. */
 static ak_result view_range(gl_ctx* c, size_t vi, const char* who, const uint8_t** out_ptr, size_t* out_len,
                             size_t* out_stride) {
-    const cJSON* v = array_at(c->views, vi);
+    const cJSON* v = c->t_views.items[vi];
     char where[160];
     snprintf(where, sizeof where, "bufferViews[%zu]", vi);
     size_t bi = 0, off = 0, len = 0, stride = 0;
@@ -327,7 +328,7 @@ static ak_result view_range(gl_ctx* c, size_t vi, const char* who, const uint8_t
 
 static ak_result resolve_accessor(gl_ctx* c, size_t ai, gl_acc* a) {
     memset(a, 0, sizeof *a);
-    const cJSON* j = array_at(c->accessors, ai);
+    const cJSON* j = c->t_acc.items[ai];
     char where[160];
     snprintf(where, sizeof where, "accessors[%zu]", ai);
     size_t ctype = 0, off = 0;
@@ -630,6 +631,9 @@ static ak_result check_header(gl_ctx* c) {
             if (v >= c->n_nodes) return fail(c, AK_ERR_BAD_INDEX, "%s.nodes[%zu] = %zu is out of range", where, k, v);
         }
     }
+    TRY(make_table(c, c->accessors, c->n_acc, &c->t_acc));
+    TRY(make_table(c, c->views, c->n_views, &c->t_views));
+    TRY(make_table(c, c->buffers, c->n_buffers, &c->t_buffers));
     c->bufs = (gl_buffer*)akp_calloc(c->alloc, (c->n_buffers ? c->n_buffers : 1) * sizeof(gl_buffer));
     if (!c->bufs) return fail(c, AK_ERR_NO_MEMORY, "out of memory");
     return AK_OK;
@@ -1383,6 +1387,9 @@ ak_result akp_io_load_gltf(const uint8_t* data, size_t size, const char* name, c
     akp_free(alloc, c.joint_of_node);
     akp_free(alloc, c.node_parent);
     akp_free(alloc, c.morph_base);
+    akp_free(alloc, (void*)c.t_acc.items);
+    akp_free(alloc, (void*)c.t_views.items);
+    akp_free(alloc, (void*)c.t_buffers.items);
     cJSON_Delete(c.root);
     if (r != AK_OK) {
         ak_scene_destroy(c.scene);
