@@ -215,8 +215,15 @@ ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocato
     }
     ak_io_desc d = ak_io_desc_resolved(desc);
     ak_io_format fmt = d.format;
-    if (fmt == AK_IO_FORMAT_AUTO)
+    if (fmt == AK_IO_FORMAT_AUTO) {
         fmt = (has_extension(path, ".gltf") || has_extension(path, ".glb")) ? AK_IO_FORMAT_GLTF : AK_IO_FORMAT_ASSIMP;
+        char magic[4] = {0};
+        FILE* f = fmt == AK_IO_FORMAT_ASSIMP ? fopen(path, "rb") : NULL;
+        if (f) { /* a GLB under another extension */
+            if (fread(magic, 1, 4, f) == 4 && memcmp(magic, "glTF", 4) == 0) fmt = AK_IO_FORMAT_GLTF;
+            fclose(f);
+        }
+    }
     if (fmt == AK_IO_FORMAT_ASSIMP) return akp_io_load_assimp(path, &d, alloc, out_scene, diag);
 
     uint8_t* data = NULL;

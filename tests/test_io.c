@@ -1336,6 +1336,20 @@ AK_TEST(load_arguments_and_missing_files) {
     AK_CHECK(strstr(diag.message, "Assimp") != NULL);
     AK_CHECK_STREQ(diag.path, "garbage.bvh");
     remove("garbage.bvh");
+    /* a GLB under another extension is still read as glTF (the magic decides) */
+    char glbp[2048];
+    if (ak_test_asset(glbp, sizeof glbp, "gltf/AnimatedMorphCube/glTF-Binary/AnimatedMorphCube.glb")) {
+        size_t n;
+        uint8_t* bytes = slurp(glbp, &n);
+        f = fopen("cube.bin3d", "wb");
+        fwrite(bytes, 1, n, f);
+        fclose(f);
+        free(bytes);
+        AK_CHECK_EQ(ak_io_load("cube.bin3d", NULL, NULL, &s, &diag), AK_OK);
+        AK_CHECK(s && s->mesh_count == 1 && s->meshes[0].mesh->morph_target_count == 2);
+        ak_scene_destroy(s);
+        remove("cube.bin3d");
+    }
     /* external .bin missing next to a .gltf */
     f = fopen("ext.gltf", "wb");
     fputs("{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":4,\"uri\":\"ext%20missing.bin\"}],"

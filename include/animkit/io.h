@@ -70,7 +70,7 @@ extern "C" {
 
 /* Which reader handles a file. */
 typedef enum ak_io_format {
-    AK_IO_FORMAT_AUTO = 0, /* default: .gltf/.glb extension or glTF content -> GLTF, else ASSIMP */
+    AK_IO_FORMAT_AUTO = 0, /* default: a .gltf/.glb extension or the GLB magic -> GLTF, else ASSIMP */
     AK_IO_FORMAT_GLTF,     /* animkit's glTF 2.0 reader (.gltf or .glb, decided by the bytes) */
     AK_IO_FORMAT_ASSIMP,   /* Assimp's importer (BVH, FBX, Collada, OBJ, ...) */
     AK_IO_FORMAT_COUNT
