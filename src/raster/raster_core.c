@@ -282,13 +282,15 @@ ak_result ak_raster_resolve(const ak_raster* raster, const ak_image* out) {
     if (out->width != raster->desc.width || out->height != raster->desc.height) return AK_ERR_BAD_ARG;
     const int ss = raster->ss;
     const float inv = 1.0f / (float)(ss * ss);
+    if (ss == 1) {
+        for (int y = 0; y < out->height; ++y)
+            memcpy(ak_image_pixel(out, 0, y), raster->color + (size_t)y * (size_t)raster->sw * 4u,
+                   (size_t)out->width * 4u);
+        return AK_OK;
+    }
     for (int y = 0; y < out->height; ++y) {
         for (int x = 0; x < out->width; ++x) {
             uint8_t* dst = ak_image_pixel(out, x, y);
-            if (ss == 1) {
-                memcpy(dst, raster->color + ((size_t)y * (size_t)raster->sw + (size_t)x) * 4u, 4);
-                continue;
-            }
             float acc[3] = {0, 0, 0};
             unsigned alpha = 0;
             for (int sy = 0; sy < ss; ++sy) {
@@ -355,11 +357,11 @@ static inline ak_vec3 shade(const drawctx* dc, ak_vec3 n, ak_vec3 p, ak_vec3 alb
                                  dc->amb_c.z * hemi + dc->key_c.z * kd + dc->fill_c.z * fd);
     ak_vec3 c = ak_vec3_mul(alb, light);
     if (dc->specular > 0.0f && kd > 0.0f) {
-        /* Blinn-Phong half vector */
-        ak_vec3 h = ak_vec3_normalize(ak_vec3_add(dc->key_l, v));
-        float nh = ak_vec3_dot(n, h);
-        if (nh > 0.0f) {
-            float s = dc->pow_lut[(int)(ak_minf(nh, 1.0f) * POW_LUT_SIZE + 0.5f)];
+        /* Phong: the light's mirror direction R = 2 (n.l) n - l against the view direction */
+        ak_vec3 rl = ak_vec3_sub(ak_vec3_scale(n, 2.0f * kd), dc->key_l);
+        float rv = ak_vec3_dot(rl, v);
+        if (rv > 0.0f) {
+            float s = dc->pow_lut[(int)(ak_minf(rv, 1.0f) * POW_LUT_SIZE + 0.5f)];
             c = ak_vec3_madd(c, dc->key_c, s);
         }
     }
