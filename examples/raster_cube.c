@@ -1,5 +1,5 @@
-/* raster_cube: the software renderer on its own. Renders a lit cube on a ground grid with a
- * soft shadow, its edges as lines and corners as points, a title, to cube.png; then a
+/* raster_cube: the software renderer on its own. Renders a lit cube and sphere on a ground grid
+ * with soft shadows, a "bone" as a line with two joint points, and a title, to cube.png; then a
  * 24-frame turntable to cube.gif. Prints what it wrote and the formats this build can write. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,10 +25,32 @@ static void make_cube(ak_vec3 pos[24], ak_vec3 nrm[24], uint32_t idx[36]) {
     }
 }
 
+/* A UV sphere of radius 0.35 standing on the floor at x = 1.1. */
+enum { SLICES = 32, STACKS = 16, SPHERE_V = (SLICES + 1) * (STACKS + 1), SPHERE_I = SLICES * STACKS * 6 };
+static void make_sphere(ak_vec3* pos, ak_vec3* nrm, uint32_t* idx) {
+    for (int i = 0; i <= SLICES; ++i)
+        for (int j = 0; j <= STACKS; ++j) {
+            float ph = AK_TWO_PI * (float)i / SLICES, th = AK_PI * (float)j / STACKS;
+            ak_vec3 n = ak_vec3_make(sinf(th) * cosf(ph), cosf(th), sinf(th) * sinf(ph));
+            pos[i * (STACKS + 1) + j] = ak_vec3_add(ak_vec3_scale(n, 0.35f), ak_vec3_make(1.1f, 0.35f, 0.2f));
+            nrm[i * (STACKS + 1) + j] = n;
+        }
+    int k = 0;
+    for (int i = 0; i < SLICES; ++i)
+        for (int j = 0; j < STACKS; ++j) {
+            uint32_t a = (uint32_t)(i * (STACKS + 1) + j), b = a + STACKS + 1;
+            const uint32_t q[6] = {a, b, a + 1, b, b + 1, a + 1};
+            for (int m = 0; m < 6; ++m) idx[k++] = q[m];
+        }
+}
+
 static int render(ak_raster* r, float azimuth, const ak_image* img, int w, int h, bool labels) {
     ak_vec3 pos[24], nrm[24];
     uint32_t idx[36];
+    static ak_vec3 spos[SPHERE_V], snrm[SPHERE_V];
+    static uint32_t sidx[SPHERE_I];
     make_cube(pos, nrm, idx);
+    make_sphere(spos, snrm, sidx);
     ak_vec3 eye = ak_vec3_make(4.2f * sinf(azimuth), 2.6f, 4.2f * cosf(azimuth));
     ak_raster_camera cam = ak_raster_camera_perspective(eye, ak_vec3_make(0, 0.4f, 0), ak_radians(38.0f),
                                                         (float)w / (float)h, 0.1f, 50.0f);
@@ -38,9 +60,13 @@ static int render(ak_raster* r, float azimuth, const ak_image* img, int w, int h
         .material = {.color = ak_vec4_make(0.85f, 0.45f, 0.25f, 1), .specular = 0.4f, .shininess = 48},
         .cull_back_faces = true,
     };
-    ak_raster_ground ground = {.half_extent = 3.0f, .grid_spacing = 0.25f, .casters = &cube, .caster_count = 1};
+    ak_raster_mesh things[2] = {cube, {.positions = {spos, SPHERE_V}, .normals = {snrm, SPHERE_V},
+                                       .indices = {sidx, SPHERE_I}, .cull_back_faces = true,
+                                       .material = {.color = {0.2f, 0.6f, 0.65f, 1}, .specular = 0.6f}}};
+    ak_raster_ground ground = {.half_extent = 3.0f, .grid_spacing = 0.25f, .casters = things, .caster_count = 2};
     if (ak_raster_draw_ground(r, &cam, &ground) != AK_OK) return 1;
-    if (ak_raster_draw_mesh(r, &cam, &cube) != AK_OK) return 1;
+    for (int i = 0; i < 2; ++i)
+        if (ak_raster_draw_mesh(r, &cam, &things[i]) != AK_OK) return 1;
     /* the 12 edges of the top face and a vertical "bone" with joints */
     ak_vec3 bone[2] = {{0, 1.0f, 0}, {0, 1.6f, 0}};
     ak_raster_lines lines = {.positions = {bone, 2}, .color = {0.1f, 0.2f, 0.5f, 1}, .width = 3};
