@@ -15,8 +15,10 @@
  * rotates. Non-uniform scale on chain joints is approximated (see ak_transform_mul).
  *
  * Spaces: a pose is the skeleton's array of local transforms; targets and positions are in
- * model space (the skeleton's space, ak_skeleton_local_to_model). A chain is a list of joint
- * indices from a root to the end effector, each the parent of the next (ak_ik_chain_build).
+ * model space (the skeleton's space, ak_skeleton_local_to_model; for a scene this is world
+ * space). A chain is a list of joint indices from a root to the end effector, each the parent
+ * of the next (ak_ik_chain_build); ak_ik_chain_positions gives its joint positions before
+ * and after a solve.
  *
  * Usage:
  *     int16_t chain[8]; size_t chain_count = 0;
@@ -154,14 +156,26 @@ AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
 
 /* Validate, then solve, writing the chain joints' local rotations (prism joints: local
  * translations) into pose. Returns validate's codes; nothing is written when it fails.
- * Unreachable target: AK_OK, the chain straightened towards the target, *out_reached false and
- * *out_error the remaining distance. Iterations stop early when the error stops improving.
- * Defined degenerate cases: a one-joint chain cannot move its effector (only target_rotation
- * is applied; iterations 0); zero-length bones keep their direction; a target on the root
- * folds the chain as far as lengths and limits allow. FREE and BALL joints rotate freely
- * (BALL within cone and twist), HINGE joints about their axis, PRISM joints keep their
- * rotation and slide (CCD and DLS move slides; FABRIK and TWO_BONE keep them). Bone lengths
- * (other than prism slides) are unchanged: only rotations are written. */
+ * Outcome: AK_OK whether or not the target was reached. Unreachable targets leave the chain
+ * straightened towards the target, *out_reached false and *out_error the remaining distance.
+ * Iterations stop early when the error has not improved for 3 iterations (no oscillation
+ * until the budget runs out), and the iterative solvers return the best pose they met, so
+ * never one farther from the target than the input pose.
+ * Joint types: FREE and BALL joints rotate freely (BALL within cone and twist), HINGE joints
+ * about their axis, PRISM joints keep their rotation and slide (CCD and DLS move slides;
+ * FABRIK and TWO_BONE keep them). Only rotations and slides are written, so bone lengths
+ * (other than prism slides) are unchanged.
+ * Solver notes: CCD is the course's algorithm as is: its tail is slow (one joint at a time),
+ * and a straight chain pointing through the target is a fixed point of root-first CCD.
+ * FABRIK on a chain with limits first runs the plain passes (their answer often respects the
+ * limits, e.g. a planar chain of hinges); if the converted pose misses, the remaining
+ * iterations run constrained: the backward pass turns each joint within its limits, followed
+ * by one constrained CCD sweep so joints pinned at a limit do not freeze the chain.
+ * TWO_BONE bends a HINGE mid joint about the hinge axis (trying the other bend when the limits
+ * refuse the first). DLS stops when lambda tops out without an improving step.
+ * Degenerate cases: a one-joint chain cannot move its effector (only target_rotation is
+ * applied; 0 iterations); zero-length bones keep their direction; a target on the root folds
+ * the chain as far as lengths and limits allow. */
 AK_API ak_result ak_ik_chain_run(const ak_ik_chain_job* job);
 
 /* ---- analytic two-bone (model space, no skeleton) ------------------------------------ */
@@ -202,8 +216,8 @@ AK_API ak_result ak_ik_two_bone_run(const ak_ik_two_bone_job* job);
  * paths from root_joint to each effector. Forward reaching runs from every effector towards
  * the root, placing each sub-base at the centroid of its branches' proposals; backward
  * reaching runs from the fixed root outwards. Each iteration converts the positions back to
- * rotations (joints with several tree children get the best-fit rotation of their bones)
- * and applies limits. */
+ * rotations (joints with several tree children get the best-fit rotation of their bones, the
+ * first 64 children only) and applies limits. */
 typedef struct ak_ik_fabrik_tree_job {
     const ak_skeleton* skeleton; /* required */
     ak_transform_span pose;      /* required, in/out: local transforms, count >= joint count */

@@ -121,7 +121,7 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
         constrained = true;
         for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
     }
-    if (limited) out.error = akp_ik_restore_best(c, out.error);
+    out.error = akp_ik_restore_best(c, out.error);
     return out;
 }
 
