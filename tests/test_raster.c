@@ -269,7 +269,8 @@ AK_TEST(cube_corners_where_projection_puts_them) {
         pos[i] = ak_vec3_make(i & 1 ? 0.5f : -0.5f, i & 2 ? 0.5f : -0.5f, i & 4 ? 0.5f : -0.5f);
     const uint32_t idx[36] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
                               2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
-    ak_raster_mesh m = {.positions = {pos, 8}, .indices = {idx, 36}, .shading = AK_SHADING_UNLIT};
+    ak_raster_mesh m = {.positions = {pos, 8}, .indices = {idx, 36}, .shading = AK_SHADING_UNLIT,
+                        .material = {.color = {1, 1, 1, 1}}};
     ak_raster_clear(t.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
     AK_CHECK_EQ(ak_raster_draw_mesh(t.r, &cam, &m), AK_OK);
     ak_raster_resolve(t.r, &t.img);
@@ -324,7 +325,8 @@ AK_TEST(perspective_correct_interpolation) {
     ak_vec3 p[4] = {{-1, 0, -1}, {1, 0, -1}, {1, 0, -9}, {-1, 0, -9}};
     ak_vec4 c[4] = {{1, 0, 0, 1}, {1, 0, 0, 1}, {0, 0, 1, 1}, {0, 0, 1, 1}};
     uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    ak_raster_mesh m = {.positions = {p, 4}, .colors = {c, 4}, .indices = {idx, 6}, .shading = AK_SHADING_UNLIT};
+    ak_raster_mesh m = {.positions = {p, 4}, .colors = {c, 4}, .indices = {idx, 6}, .shading = AK_SHADING_UNLIT,
+                        .material = {.color = {1, 1, 1, 1}}};
     ak_raster_clear(t.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
     AK_CHECK_EQ(ak_raster_draw_mesh(t.r, &cam, &m), AK_OK);
     ak_raster_resolve(t.r, &t.img);

@@ -968,7 +968,7 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
     ak_shading sh = mesh->shading == AK_SHADING_DEFAULT ? AK_SHADING_PHONG : mesh->shading;
     switch (sh) {
     case AK_SHADING_UNLIT: {
-        ak_vec4 c = vec4_is_zero(mesh->material.color) ? ak_vec4_make(1, 1, 1, 1) : mesh->material.color;
+        ak_vec4 c = vec4_is_zero(mesh->material.color) ? ak_vec4_make(0.78f, 0.74f, 0.70f, 1) : mesh->material.color;
         uint8_t b[4];
         ak_color_to_rgba8(c, b);
         for (int k = 0; k < 4; ++k) dc.const_rgba[k] = b[k];
