@@ -619,7 +619,8 @@ typedef struct ak_polar {
  * Well-conditioned m with det > 0 runs the averaging scheme R_{i+1} = (g R_i + R_i^-T / g)/2
  * in double precision (g is Higham's Frobenius-norm scaling while far from convergence,
  * then 1: the plain scheme), until the change is below 1e-12 relative or 40 iterations.
- * Otherwise (det <= 0, condition number above 1e5, or no convergence) it uses ak_mat3_svd:
+ * Otherwise (det <= 0, condition |m|_F |m^-1|_F above 1e5, or no convergence) it uses the
+ * SVD (ak_mat3_svd):
  * R = U V^T and D = V diag(sigma) V^T. Results for the special cases:
  *   - reflection (det < 0): R stays a proper rotation and D gets one negative eigenvalue,
  *     -sigma_min, along the direction of the smallest singular value;
@@ -779,18 +780,20 @@ AK_API ak_mat4 ak_mat4_interpolate_affine(ak_mat4 a, ak_mat4 b, float t);
  * Compiled in src/math, with SSE2 code when the compiler targets it (scalar with AK_NO_SIMD)
  * and the same results to float rounding. Pointers need no alignment. Each returns
  * AK_ERR_NULL_ARG when a span with a non-zero count has a NULL pointer, and
- * AK_ERR_SPAN_SMALL when an input or output is shorter than the first input; nothing is
- * written then. Outputs may be the same array as an input (exactly, not partly overlapping). */
+ * AK_ERR_SPAN_SMALL when an input or output is shorter than the count the function works
+ * on (named per function); nothing is written then. An output may be the same array as an
+ * input (exactly the same, not partly overlapping). Counts larger than needed are fine. */
 
-/* out[i] = ak_quat_normalize(q[i]) for i < q.count. */
+/* out[i] = ak_quat_normalize(q[i]) for i < q.count (needs out.count >= q.count); zero,
+ * infinite or NaN quaternions give the identity. */
 AK_API ak_result ak_quat_normalize_array(ak_quat_cspan q, ak_quat_span out);
 /* out[i] = a[i] * b[i] for i < a.count (needs b.count, out.count >= a.count). */
 AK_API ak_result ak_quat_mul_array(ak_quat_cspan a, ak_quat_cspan b, ak_quat_span out);
-/* out[i] = ak_quat_rotate(q[i], v[i]) for i < v.count. q.count is v.count, or 1 to rotate
- * every vector by q[0] (any other q.count smaller than v.count gives AK_ERR_SPAN_SMALL). */
+/* out[i] = ak_quat_rotate(q[i], v[i]) for i < v.count (needs out.count >= v.count; q unit).
+ * q.count is at least v.count, or exactly 1 to rotate every vector by q[0]. */
 AK_API ak_result ak_quat_rotate_array(ak_quat_cspan q, ak_vec3_cspan v, ak_vec3_span out);
-/* out[i] = a[i] * b[i] for i < b.count. a.count is b.count, or 1 to multiply every b[i] by
- * a[0] (as for ak_quat_rotate_array). */
+/* out[i] = a[i] * b[i] for i < b.count (needs out.count >= b.count). a.count is at least
+ * b.count, or exactly 1 to multiply every b[i] by a[0] (out may then also hold a[0]). */
 AK_API ak_result ak_mat4_mul_array(ak_mat4_cspan a, ak_mat4_cspan b, ak_mat4_span out);
 
 #ifdef __cplusplus
