@@ -76,7 +76,9 @@ AK_API float ak_linear_to_srgb(float linear);
 
 /* Fill the whole image with one colour. AK_ERR_NULL_ARG / AK_ERR_BAD_ARG (size <= 0). */
 AK_API ak_result ak_image_fill(const ak_image* image, ak_vec4 color);
-/* Alpha-blend a filled axis-aligned rectangle [x, x+w) x [y, y+h), clipped to the image. */
+/* Alpha-blend a filled axis-aligned rectangle [x, x+w) x [y, y+h), clipped to the image, with
+ * fractional edge coverage. Non-finite values draw nothing. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG
+ * (image size <= 0). The other 2D calls below return the same codes. */
 AK_API ak_result ak_image_fill_rect(const ak_image* image, float x, float y, float w, float h, ak_vec4 color);
 /* Alpha-blend an anti-aliased line segment between pixel-space points (pixel centres at
  * +0.5) of the given width in pixels (<= 0 -> 1). Non-finite endpoints draw nothing. */
@@ -225,7 +227,8 @@ typedef struct ak_raster_mesh {
 /* Draw a triangle mesh. Triangles with a non-finite vertex are skipped (counted nowhere, no
  * error: the rest still draws). Returns AK_ERR_NULL_ARG (raster, camera or mesh NULL, or
  * positions empty), AK_ERR_BAD_ARG (indices.count not a multiple of 3, normals/colours count
- * mismatch, bad enum), AK_ERR_BAD_INDEX (an index >= positions.count; nothing drawn). */
+ * mismatch, bad enum), AK_ERR_BAD_INDEX (an index >= positions.count), AK_ERR_BAD_DATA (a
+ * non-finite camera or model matrix); nothing is drawn on error. */
 AK_API ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_mesh* mesh);
 
 /* Depth-tested (or on-top) lines: screen-space ribbons of constant pixel width. */
@@ -239,9 +242,10 @@ typedef struct ak_raster_lines {
     bool on_top;             /* false -> depth-tested; true -> drawn over everything */
 } ak_raster_lines;
 
-/* Draw line segments, clipped against the near plane. Non-finite segments are skipped.
- * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (odd indices.count, colour count mismatch),
- * AK_ERR_BAD_INDEX. */
+/* Draw line segments, clipped against the near plane. Non-finite segments are skipped; without
+ * indices an odd last position is ignored. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (odd
+ * indices.count, colour count mismatch), AK_ERR_BAD_INDEX, AK_ERR_BAD_DATA (non-finite camera
+ * or model matrix). */
 AK_API ak_result ak_raster_draw_lines(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_lines* lines);
 
 /* Depth-tested round points (joints, targets, particles) with a darker outline. */
@@ -256,7 +260,8 @@ typedef struct ak_raster_points {
 } ak_raster_points;
 
 /* Draw points; points behind the near plane or non-finite are skipped.
- * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (colour count mismatch). */
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (colour count mismatch), AK_ERR_BAD_DATA (non-finite
+ * camera or model matrix). */
 AK_API ak_result ak_raster_draw_points(ak_raster* raster, const ak_raster_camera* camera,
                                        const ak_raster_points* points);
 
@@ -276,8 +281,10 @@ typedef struct ak_raster_ground {
     const ak_raster_lighting* lighting; /* key light direction casts the shadow; NULL -> default */
 } ak_raster_ground;
 
-/* Draw the ground. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (a non-finite field), and the
- * codes of ak_raster_draw_mesh for a bad caster. */
+/* Draw the ground. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (a non-finite or negative size
+ * field), AK_ERR_BAD_DATA (non-finite camera), and AK_ERR_NULL_ARG / AK_ERR_BAD_ARG /
+ * AK_ERR_BAD_INDEX / AK_ERR_BAD_DATA for a bad caster (as ak_raster_draw_mesh). The shadow map
+ * is 256x256 texels over the plane, rendered on the calling thread. */
 AK_API ak_result ak_raster_draw_ground(ak_raster* raster, const ak_raster_camera* camera,
                                        const ak_raster_ground* ground);
 
@@ -321,7 +328,8 @@ typedef struct ak_gif_desc {
 AK_API ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const ak_allocator* alloc,
                                       ak_gif_writer** out_writer);
 /* Quantize frame to its own 256-colour palette (median cut) and append it. The frame's size
- * must equal the desc's. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_IO. */
+ * must equal the desc's; alpha is ignored. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_IO,
+ * AK_ERR_NO_MEMORY (giflib's colour map). */
 AK_API ak_result ak_gif_writer_add_frame(ak_gif_writer* writer, const ak_image* frame);
 /* Close the file and free the writer (always, even on error). AK_ERR_IO when the file could
  * not be completed, AK_ERR_EMPTY when no frame was added (the file is still valid-ish: one
