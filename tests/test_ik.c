@@ -852,6 +852,26 @@ AK_TEST(degenerate_chains) {
     }
     ak_skeleton_destroy(sk);
 
+    /* A straight chain and a target on its own line, inside the reach: the Jacobian is
+     * singular along the line, CCD's RE is parallel to RD at every joint and FABRIK's passes
+     * stay on the line (all three are stuck there as textbook algorithms). The job bends the
+     * chain slightly first, so all of them get there. */
+    chain_spec line = uniform_chain(4, AK_JOINT_FREE);
+    sk = make_chain(&line);
+    if (!sk) return;
+    for (int k = 0; k < 3; ++k) {
+        ak_transform pose[4];
+        rest_pose(sk, pose);
+        ak_ik_chain_job opts = {.max_iterations = 100};
+        solve_out o = solve(sk, pose, chain, 4, ak_vec3_make(1.0f, 0, 0), iterative[k], &opts);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(pose_finite(pose, 4));
+        AK_CHECK(lengths_preserved(&line, pose));
+        AK_CHECK(o.error <= 0.8f + 1e-5f); /* the straight effector is at 1.8 */
+        AK_CHECK_MSG(o.reached, "%s: error %g", ak_ik_solver_name(iterative[k]), o.error);
+    }
+    ak_skeleton_destroy(sk);
+
     /* All bones zero-length: everything sits on the root; finite, reached only at the root. */
     chain_spec z = uniform_chain(3, AK_JOINT_FREE);
     z.lengths[0] = z.lengths[1] = 0.0f;

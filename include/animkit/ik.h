@@ -165,8 +165,10 @@ AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
  * about their axis, PRISM joints keep their rotation and slide (CCD and DLS move slides;
  * FABRIK and TWO_BONE keep them). Only rotations and slides are written, so bone lengths
  * (other than prism slides) are unchanged.
- * Solver notes: CCD is the course's algorithm as is: its tail is slow (one joint at a time),
- * and a straight chain pointing through the target is a fixed point of root-first CCD.
+ * Solver notes: CCD is the course's algorithm as is; its tail is slow (one joint at a time).
+ * A straight chain whose line passes through the target is singular for CCD, FABRIK and DLS
+ * alike, so such a chain is first bent by 0.1 rad per joint (about a hinge's axis, else about
+ * one normal of the line).
  * FABRIK on a chain with limits first runs the plain passes (their answer often respects the
  * limits, e.g. a planar chain of hinges); if the converted pose misses, the remaining
  * iterations run constrained: the backward pass turns each joint within its limits, followed

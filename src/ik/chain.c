@@ -198,6 +198,34 @@ static void apply_target_rotation(akp_ik_chain* c, const ak_quat* target_rotatio
     }
 }
 
+/* A straight chain whose line passes through the target is a singular configuration for the
+ * iterative solvers: CCD's RE is parallel to RD at every joint, the Jacobian has no column
+ * along the line, and FABRIK's passes stay on the line. Bend every joint a little (about its
+ * axis for a hinge, else about one fixed normal of the line) so they can start. */
+static void unstraighten(akp_ik_chain* c) {
+    const size_t last = c->count - 1;
+    const ak_vec3 root = c->world[0].translation;
+    const ak_vec3 dir = ak_vec3_normalize(ak_vec3_sub(c->world[last].translation, root));
+    if (ak_vec3_length_sq(dir) == 0.0f || !(c->length > 0.0f)) return;
+    const float eps = 1e-5f * c->length;
+    for (size_t i = 1; i <= last; ++i) {
+        ak_vec3 d = ak_vec3_sub(c->world[i].translation, root);
+        if (ak_vec3_length(ak_vec3_madd(d, dir, -ak_vec3_dot(d, dir))) > eps) return; /* not straight */
+    }
+    ak_vec3 dt = ak_vec3_sub(c->target, root);
+    if (ak_vec3_length(ak_vec3_madd(dt, dir, -ak_vec3_dot(dt, dir))) > eps) return; /* target off the line */
+    const ak_vec3 normal = ak_vec3_any_perpendicular(dir);
+    for (size_t i = 0; i < last; ++i) {
+        ak_vec3 axis = normal;
+        if (c->types[i] == AK_JOINT_PRISM) continue;
+        if (c->types[i] == AK_JOINT_HINGE)
+            axis = ak_vec3_normalize(
+                ak_quat_rotate(c->world[i].rotation, ak_skeleton_joint_limits(c->skeleton, (size_t)c->joints[i]).axis));
+        akp_ik_rotate(c, i, ak_quat_from_axis_angle(axis, 0.1f));
+        akp_ik_fk(c, i + 1);
+    }
+}
+
 ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
     ak_result res = ak_ik_chain_validate(job);
     if (res != AK_OK) return res;
@@ -241,6 +269,8 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
         /* Nothing can move the root's own position. */
         apply_target_rotation(&c, rj.target_rotation);
     } else {
+        const float start_error = ak_vec3_distance(c.world[n - 1].translation, c.target);
+        if (rj.solver != AK_IK_SOLVER_TWO_BONE && start_error > c.tolerance) unstraighten(&c);
         switch (rj.solver) {
         case AK_IK_SOLVER_CCD:
             out = akp_ik_ccd(&c, &rj);
