@@ -174,7 +174,62 @@ static ak_vec3 dq_translation(ak_quat r, ak_quat d) {
     return ak_vec3_scale(ak_vec3_add(t, ak_vec3_cross(v, dv)), 2.0f);
 }
 
+/* LBS without tangents, as one flat loop the compiler can keep in registers: the path that
+ * AK_NO_SIMD builds run most. */
+static inline void lbs_range_scalar_k(const akp_skin_ctx* c, size_t begin, size_t end, uint32_t K) {
+    uint16_t j[AK_MAX_INFLUENCES];
+    float w[AK_MAX_INFLUENCES];
+    for (size_t i = begin; i < end; ++i) {
+        const char* jp = c->jnt + i * c->jnt_stride;
+        const char* wp = c->wgt + i * c->wgt_stride;
+        for (uint32_t k = 0; k < K; ++k) {
+            memcpy(&j[k], jp + 2u * k, sizeof(uint16_t));
+            memcpy(&w[k], wp + 4u * k, sizeof(float));
+            if (j[k] >= c->palette_count) j[k] = (uint16_t)(c->palette_count - 1);
+        }
+        float m[12] = {0}; /* columns 0..3, rows 0..2 */
+        for (uint32_t k = 0; k < K; ++k) {
+            const float* p = c->palette[j[k]].m;
+            const float wk = w[k];
+            for (int col = 0; col < 4; ++col)
+                for (int r = 0; r < 3; ++r) m[col * 3 + r] += wk * p[col * 4 + r];
+        }
+        float p[3];
+        memcpy(p, c->pos + i * c->pos_stride, sizeof p);
+        float o[3];
+        for (int r = 0; r < 3; ++r) o[r] = m[r] * p[0] + m[3 + r] * p[1] + m[6 + r] * p[2] + m[9 + r];
+        memcpy(c->out_pos + i * c->out_pos_stride, o, sizeof o);
+        if (!c->do_normals) continue;
+        float n[3];
+        memcpy(n, c->nrm + i * c->nrm_stride, sizeof n);
+        /* cofactor columns c1 x c2, c2 x c0, c0 x c1; times sign(det); then normalised */
+        const float* c0 = m;
+        const float* c1 = m + 3;
+        const float* c2 = m + 6;
+        float k0[3] = {c1[1] * c2[2] - c1[2] * c2[1], c1[2] * c2[0] - c1[0] * c2[2], c1[0] * c2[1] - c1[1] * c2[0]};
+        float k1[3] = {c2[1] * c0[2] - c2[2] * c0[1], c2[2] * c0[0] - c2[0] * c0[2], c2[0] * c0[1] - c2[1] * c0[0]};
+        float k2[3] = {c0[1] * c1[2] - c0[2] * c1[1], c0[2] * c1[0] - c0[0] * c1[2], c0[0] * c1[1] - c0[1] * c1[0]};
+        float det = c0[0] * k0[0] + c0[1] * k0[1] + c0[2] * k0[2];
+        float on[3];
+        for (int r = 0; r < 3; ++r) on[r] = k0[r] * n[0] + k1[r] * n[1] + k2[r] * n[2];
+        float l2 = on[0] * on[0] + on[1] * on[1] + on[2] * on[2];
+        float s = l2 > 1e-30f ? 1.0f / sqrtf(l2) : 0.0f;
+        if (det < 0.0f) s = -s;
+        for (int r = 0; r < 3; ++r) on[r] *= s;
+        memcpy(c->out_nrm + i * c->out_nrm_stride, on, sizeof on);
+    }
+}
+
+static void lbs_range_scalar(const akp_skin_ctx* c, size_t begin, size_t end) {
+    if (c->k == 4) lbs_range_scalar_k(c, begin, end, 4); /* constant: unrolled loops */
+    else lbs_range_scalar_k(c, begin, end, c->k);
+}
+
 void akp_skin_range_scalar(const akp_skin_ctx* c, size_t begin, size_t end) {
+    if (c->method == AK_SKIN_LBS && !c->do_tangents) {
+        lbs_range_scalar(c, begin, end);
+        return;
+    }
     uint16_t j[AK_MAX_INFLUENCES];
     float w[AK_MAX_INFLUENCES];
     for (size_t i = begin; i < end; ++i) {
