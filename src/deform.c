@@ -176,6 +176,15 @@ ak_result ak_deform_run(const ak_deform_job* job) {
 
 /* ---- automatic squash & stretch --------------------------------------------------------------- */
 
+ak_squash_tracker_desc ak_squash_tracker_desc_resolved(const ak_squash_tracker_desc* desc) {
+    ak_squash_tracker_desc d;
+    memset(&d, 0, sizeof(d));
+    if (desc) d = *desc;
+    if (d.min_stretch == 0.0f) d.min_stretch = 0.5f;
+    if (d.max_stretch == 0.0f) d.max_stretch = 2.0f;
+    return d;
+}
+
 ak_result ak_squash_tracker_update(ak_squash_tracker* tr, const ak_squash_tracker_desc* desc, ak_vec3 position,
                                    float dt, ak_deformer* out_deformer) {
     if (!tr || !desc || !out_deformer) return AK_ERR_NULL_ARG;
@@ -186,8 +195,8 @@ ak_result ak_squash_tracker_update(ak_squash_tracker* tr, const ak_squash_tracke
         !ak_finitef(desc->accel_gain) || !ak_finitef(desc->response_time) || !ak_finitef(desc->max_stretch) ||
         !vec3_finite(desc->gravity))
         return AK_ERR_BAD_ARG;
-    const float lo = desc->min_stretch > 0.0f ? desc->min_stretch : 0.5f;
-    const float hi = desc->max_stretch > 0.0f ? desc->max_stretch : 2.0f;
+    const ak_squash_tracker_desc rd = ak_squash_tracker_desc_resolved(desc);
+    const float lo = rd.min_stretch, hi = rd.max_stretch;
     if (lo > hi) return AK_ERR_BAD_ARG;
     if (!vec3_finite(position)) return AK_ERR_BAD_DATA;
 
@@ -240,19 +249,32 @@ typedef struct bounce_params {
 
 static float pos_or(float x, float def) { return (x > 0.0f && ak_finitef(x)) ? x : def; }
 
-static bounce_params bounce_resolve(const ak_bounce_desc* d) {
-    ak_bounce_desc z;
-    memset(&z, 0, sizeof(z));
-    if (!d) d = &z;
+ak_bounce_desc ak_bounce_desc_resolved(const ak_bounce_desc* desc) {
+    ak_bounce_desc d;
+    memset(&d, 0, sizeof(d));
+    if (desc) d = *desc;
+    d.height = pos_or(d.height, 1.0f);
+    d.radius = pos_or(d.radius, 0.25f);
+    d.gravity = pos_or(d.gravity, 9.81f);
+    d.contact_time = pos_or(d.contact_time, 0.1f);
+    d.squash = ak_clampf(pos_or(d.squash, 0.6f), 0.05f, 1.0f);
+    d.stretch_per_speed = pos_or(d.stretch_per_speed, 0.04f);
+    if (!ak_finitef(d.forward_speed)) d.forward_speed = 0.0f;
+    if (!vec3_finite(d.start)) d.start = ak_vec3_zero();
+    return d;
+}
+
+static bounce_params bounce_resolve(const ak_bounce_desc* desc) {
+    const ak_bounce_desc d = ak_bounce_desc_resolved(desc);
     bounce_params p;
-    p.h = pos_or(d->height, 1.0f);
-    p.r = pos_or(d->radius, 0.25f);
-    p.g = pos_or(d->gravity, 9.81f);
-    p.tc = pos_or(d->contact_time, 0.1f);
-    p.sq = ak_clampf(pos_or(d->squash, 0.6f), 0.05f, 1.0f);
-    p.k = pos_or(d->stretch_per_speed, 0.04f);
-    p.vx = ak_finitef(d->forward_speed) ? d->forward_speed : 0.0f;
-    p.start = vec3_finite(d->start) ? d->start : ak_vec3_zero();
+    p.h = d.height;
+    p.r = d.radius;
+    p.g = d.gravity;
+    p.tc = d.contact_time;
+    p.sq = d.squash;
+    p.k = d.stretch_per_speed;
+    p.vx = d.forward_speed;
+    p.start = d.start;
     p.v0 = sqrtf(2.0f * p.g * p.h);
     p.tf = 2.0f * p.v0 / p.g;
     return p;
@@ -305,22 +327,29 @@ ak_bounce_state ak_bounce_sample(const ak_bounce_desc* desc, float t) {
 
 /* ---- jiggle ------------------------------------------------------------------------------------ */
 
+ak_jiggle_params ak_jiggle_params_resolved(ak_jiggle_params p) {
+    if (!(p.substep > 0.0f) || !ak_finitef(p.substep)) p.substep = 1.0f / 240.0f;
+    const float w = p.stiffness > 0.0f && ak_finitef(p.stiffness) ? sqrtf(p.stiffness) : 0.0f;
+    if (p.substep * w > 0.25f) p.substep = 0.25f / w;
+    if (p.damping > 0.0f && ak_finitef(p.damping) && p.substep * p.damping > 0.25f) p.substep = 0.25f / p.damping;
+    if (p.max_substeps == 0) p.max_substeps = 64u;
+    return p;
+}
+
 typedef struct jiggle_resolved {
     float k, c, h;
     ak_vec3 g;
     uint32_t max_steps;
 } jiggle_resolved;
 
-static jiggle_resolved jiggle_resolve(const ak_jiggle_params* p) {
+static jiggle_resolved jiggle_resolve(const ak_jiggle_params* params) {
+    const ak_jiggle_params p = ak_jiggle_params_resolved(*params);
     jiggle_resolved r;
-    r.k = p->stiffness;
-    r.c = p->damping;
-    r.g = p->gravity;
-    r.h = p->substep > 0.0f ? p->substep : 1.0f / 240.0f;
-    const float w = sqrtf(r.k);
-    if (r.h * w > 0.25f) r.h = 0.25f / w;
-    if (r.h * r.c > 0.25f) r.h = 0.25f / r.c;
-    r.max_steps = p->max_substeps ? p->max_substeps : 64u;
+    r.k = p.stiffness;
+    r.c = p.damping;
+    r.g = p.gravity;
+    r.h = p.substep;
+    r.max_steps = p.max_substeps;
     return r;
 }
 

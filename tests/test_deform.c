@@ -348,6 +348,19 @@ AK_TEST(bouncing_ball) {
     AK_CHECK_NEAR(deep.stretch, 0.6, 1e-4);
     ak_bounce_state dflt = ak_bounce_sample(NULL, NAN);
     AK_CHECK(ak_vec3_is_finite(dflt.center));
+    /* Defaults. */
+    ak_bounce_desc r = ak_bounce_desc_resolved(NULL);
+    AK_CHECK_NEAR(r.height, 1.0, 0.0);
+    AK_CHECK_NEAR(r.radius, 0.25, 0.0);
+    AK_CHECK_NEAR(r.gravity, 9.81, 1e-6);
+    AK_CHECK_NEAR(r.contact_time, 0.1, 1e-7);
+    AK_CHECK_NEAR(r.squash, 0.6, 1e-7);
+    AK_CHECK_NEAR(r.stretch_per_speed, 0.04, 1e-7);
+    ak_bounce_desc odd = {.squash = 0.001f, .forward_speed = INFINITY, .height = -3.0f};
+    r = ak_bounce_desc_resolved(&odd);
+    AK_CHECK_NEAR(r.squash, 0.05, 1e-7);
+    AK_CHECK_NEAR(r.forward_speed, 0.0, 0.0);
+    AK_CHECK_NEAR(r.height, 1.0, 0.0);
 }
 
 AK_TEST(squash_tracker_from_motion) {
@@ -401,6 +414,9 @@ AK_TEST(squash_tracker_from_motion) {
     AK_CHECK_EQ(ak_squash_tracker_update(&t4, &sm, ak_vec3_zero(), dt, &d), AK_OK);
     AK_CHECK_EQ(ak_squash_tracker_update(&t4, &sm, ak_vec3_make(4.0f * dt, 0, 0), dt, &d), AK_OK);
     AK_CHECK_NEAR(log(d.amount), log(1.4) * (1.0 - exp(-dt / 0.1)), 1e-4);
+    ak_squash_tracker_desc rd = ak_squash_tracker_desc_resolved(NULL);
+    AK_CHECK_NEAR(rd.min_stretch, 0.5, 0.0);
+    AK_CHECK_NEAR(rd.max_stretch, 2.0, 0.0);
     /* Bad input; the tracker is untouched on failure. */
     ak_squash_tracker before = t4;
     AK_CHECK_EQ(ak_squash_tracker_update(NULL, &desc, ak_vec3_zero(), dt, &d), AK_ERR_NULL_ARG);
@@ -671,6 +687,15 @@ AK_TEST(jiggle_bad_input_codes) {
     AK_CHECK_NEAR(s.out[2].m[0], 9.0, 0.0);
     AK_CHECK_EQ(ak_jiggle_run(&ok), AK_OK);
     AK_CHECK_EQ(s.states[0].initialized, 1);
+    /* Defaults and the stability shortening of the substep. */
+    ak_jiggle_params jp = ak_jiggle_params_resolved((ak_jiggle_params){.stiffness = 100.0f});
+    AK_CHECK_NEAR(jp.substep, 1.0 / 240.0, 1e-9);
+    AK_CHECK_EQ(jp.max_substeps, 64);
+    jp = ak_jiggle_params_resolved((ak_jiggle_params){.stiffness = 1e4f, .substep = 0.01f});
+    AK_CHECK_NEAR(jp.substep, 0.25 / 100.0, 1e-9);
+    jp = ak_jiggle_params_resolved((ak_jiggle_params){.damping = 100.0f, .max_substeps = 5});
+    AK_CHECK_NEAR(jp.substep, 0.25 / 100.0, 1e-9);
+    AK_CHECK_EQ(jp.max_substeps, 5);
     /* A huge hitch is bounded by max_substeps and stays finite. */
     j = ok, j.dt = 1000.0f;
     AK_CHECK_EQ(ak_jiggle_run(&j), AK_OK);

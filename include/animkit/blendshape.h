@@ -61,8 +61,9 @@ typedef struct ak_blendshape_dense_job {
     ak_vec3_cspan deltas;          /* K * V position deltas, target-major; may be empty if K = 0 */
     ak_vec3_cspan base_normals;    /* V unit normals; needed only with out_normals */
     ak_vec3_cspan normal_deltas;   /* K * V normal deltas; empty -> normals are not morphed */
-    ak_vec3_span out_positions;    /* required, count >= V; may be base_positions itself */
-    ak_vec3_span out_normals;      /* optional, count >= V; unit (see ak_blendshape_run) */
+    ak_vec3_span out_positions;    /* required, count >= V; may be base_positions itself, must
+                                      not overlap the deltas */
+    ak_vec3_span out_normals;      /* optional, count >= V; unit; may be base_normals itself */
 } ak_blendshape_dense_job;
 
 /* First rule the job breaks: AK_ERR_NULL_ARG (weights.ptr NULL with K > 0, base_positions or

@@ -113,6 +113,10 @@ typedef struct ak_squash_tracker_desc {
     float response_time;    /* seconds to close 63% of the gap to the target stretch; 0 -> instant */
 } ak_squash_tracker_desc;
 
+/* The desc with its zero defaults filled in (min_stretch 0 -> 0.5, max_stretch 0 -> 2); NULL
+ * gives every default. Other fields are copied unchanged (the update checks them). */
+AK_API ak_squash_tracker_desc ak_squash_tracker_desc_resolved(const ak_squash_tracker_desc* desc);
+
 /* Caller-owned state; zero-initialised means "no samples yet". */
 typedef struct ak_squash_tracker {
     ak_vec3 prev_position;  /* last sample */
@@ -140,7 +144,7 @@ typedef struct ak_bounce_desc {
     float radius;           /* rest radius (m); 0 -> 0.25 */
     float gravity;          /* m/s^2, downwards (-Y); 0 -> 9.81 */
     float contact_time;     /* seconds the ball stays on the floor squashing; 0 -> 0.1 */
-    float squash;           /* stretch at the deepest squash, (0, 1]; 0 -> 0.6 (1 = rigid) */
+    float squash;           /* stretch at the deepest squash, [0.05, 1]; 0 -> 0.6 (1 = rigid) */
     float stretch_per_speed;/* in flight s = 1 + this * speed, (1/(m/s)); 0 -> 0.04 */
     float forward_speed;    /* constant +X speed (m/s); 0 -> bounces in place */
     ak_vec3 start;          /* floor point under the ball at t = 0 (the floor is y = start.y) */
@@ -154,6 +158,11 @@ typedef struct ak_bounce_state {
     bool in_contact;        /* true while on the floor */
     ak_mat4 model;          /* unit sphere at the origin -> deformed ball: T(center) Squash R */
 } ak_bounce_state;
+
+/* The desc with defaults filled in: zero, negative or non-finite height, radius, gravity,
+ * contact_time, squash and stretch_per_speed take their defaults (squash is then clamped to
+ * [0.05, 1]); a non-finite forward_speed or start becomes zero. NULL gives every default. */
+AK_API ak_bounce_desc ak_bounce_desc_resolved(const ak_bounce_desc* desc);
 
 /* The ball at time t (seconds; periodic, negative t wraps too). The bottom of the deformed
  * ball touches the floor exactly during contact and is above it in flight. Pure function;
@@ -176,6 +185,11 @@ typedef struct ak_jiggle_params {
     uint32_t max_substeps;  /* per run, bounds the work after a long hitch; 0 -> 64 (time
                                beyond it is dropped) */
 } ak_jiggle_params;
+
+/* The parameters with defaults filled in: substep 0 -> 1/240 s, then shortened for stability
+ * (substep * sqrt(stiffness) <= 0.25, substep * damping <= 0.25); max_substeps 0 -> 64.
+ * The other fields are copied unchanged (the job checks them). */
+AK_API ak_jiggle_params ak_jiggle_params_resolved(ak_jiggle_params params);
 
 /* One jiggling joint. */
 typedef struct ak_jiggle_joint {
