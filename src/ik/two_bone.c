@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "ik_internal.h"
+#include "simd.h"
 
 static inline ak_vec3 mat_pos(const float* m) { return ak_vec3_make(m[12], m[13], m[14]); }
 static inline ak_vec3 mat_rotate(const float* m, ak_vec3 v) {
@@ -183,14 +184,24 @@ bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* o
     return reached;
 }
 
-/* Nonzero when one of the 16 floats is NaN or infinite: with the exponent bits masked,
- * adding one exponent step carries into the sign bit only for an all-ones exponent. Integer
- * OR-reduction, which the compiler may vectorise (float sums could not be reassociated). */
-static inline uint32_t nonfinite16(const float* f) {
+/* Nonzero when one of the 16 floats is NaN or infinite (exponent bits all ones). */
+static inline int nonfinite16(const float* f) {
+#if AK_SIMD_SSE2
+    const __m128 expo = _mm_castsi128_ps(_mm_set1_epi32(0x7f800000));
+    __m128 bad = _mm_setzero_ps();
+    for (int i = 0; i < 16; i += 4) {
+        const __m128 e = _mm_and_ps(_mm_loadu_ps(f + i), expo);
+        bad = _mm_or_ps(bad, _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_castps_si128(e), _mm_castps_si128(expo))));
+    }
+    return _mm_movemask_ps(bad);
+#else
+    /* With the exponent masked, one more exponent step carries into the sign bit only for an
+     * all-ones exponent; an integer OR-reduction. */
     uint32_t bits[16], acc = 0;
     memcpy(bits, f, sizeof bits);
     for (int i = 0; i < 16; ++i) acc |= (bits[i] & 0x7f800000u) + 0x00800000u;
-    return acc & 0x80000000u;
+    return (int)(acc >> 31);
+#endif
 }
 
 ak_result ak_ik_two_bone_validate(const ak_ik_two_bone_job* job) {
