@@ -186,43 +186,53 @@ AKP_AVX2_INLINE static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size
     return acc;
 }
 
-/* The same for exactly 4 influences: the four hemisphere tests share one horizontal sum. */
-AKP_AVX2_INLINE static inline __m256 blend_dq_vertex4(const akp_skin_ctx* c, size_t i) {
+/* The same for exactly 4 influences, in two phases so that a block can run the long
+ * dependency chain (argmax -> reference -> dots -> signs) of all 8 vertices before the
+ * blends: phase 1 gives the joint pointers and the signed weights. */
+AKP_AVX2_INLINE static inline void dq_signs4(const akp_skin_ctx* c, size_t i, const float** ptr, float* sw) {
     uint16_t jj[4];
     float ww[4];
     memcpy(jj, c->jnt + i * c->jnt_stride, sizeof jj);
     memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
     const size_t pc = c->palette_count;
-    const __m256 d0 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[0], pc)].real);
-    const __m256 d1 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[1], pc)].real);
-    const __m256 d2 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[2], pc)].real);
-    const __m256 d3 = _mm256_loadu_ps(c->joints_prep[clamp_joint(jj[3], pc)].real);
+    for (int k = 0; k < 4; ++k) ptr[k] = c->joints_prep[clamp_joint(jj[k], pc)].real;
+    const __m128 r0 = _mm_loadu_ps(ptr[0]), r1 = _mm_loadu_ps(ptr[1]);
+    const __m128 r2 = _mm_loadu_ps(ptr[2]), r3 = _mm_loadu_ps(ptr[3]);
     /* reference = rotation of the largest weight (lowest slot on ties), picked with blends:
      * no branch (weights come in any order) and no index round trip through memory */
     const __m128 w4 = _mm_loadu_ps(ww);
     __m128 mx = _mm_max_ps(w4, _mm_shuffle_ps(w4, w4, _MM_SHUFFLE(2, 3, 0, 1)));
     mx = _mm_max_ps(mx, _mm_shuffle_ps(mx, mx, _MM_SHUFFLE(1, 0, 3, 2)));
     const __m128 is_max = _mm_cmpeq_ps(w4, mx);
-    __m128 ref = _mm256_castps256_ps128(d3);
-    ref = _mm_blendv_ps(ref, _mm256_castps256_ps128(d2), _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(2, 2, 2, 2)));
-    ref = _mm_blendv_ps(ref, _mm256_castps256_ps128(d1), _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(1, 1, 1, 1)));
-    ref = _mm_blendv_ps(ref, _mm256_castps256_ps128(d0), _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(0, 0, 0, 0)));
-    __m128 p0 = _mm_mul_ps(_mm256_castps256_ps128(d0), ref), p1 = _mm_mul_ps(_mm256_castps256_ps128(d1), ref);
-    __m128 p2 = _mm_mul_ps(_mm256_castps256_ps128(d2), ref), p3 = _mm_mul_ps(_mm256_castps256_ps128(d3), ref);
-    __m128 dots = _mm_hadd_ps(_mm_hadd_ps(p0, p1), _mm_hadd_ps(p2, p3)); /* (q_k . ref) for k = 0..3 */
-    /* signed weights go through memory: broadcasts from memory are plain loads, cheaper than
-     * four cross-lane permutes */
-    float sw[4];
+    __m128 ref = r3;
+    ref = _mm_blendv_ps(ref, r2, _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(2, 2, 2, 2)));
+    ref = _mm_blendv_ps(ref, r1, _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(1, 1, 1, 1)));
+    ref = _mm_blendv_ps(ref, r0, _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(0, 0, 0, 0)));
+    __m128 dots = _mm_hadd_ps(_mm_hadd_ps(_mm_mul_ps(r0, ref), _mm_mul_ps(r1, ref)),
+                              _mm_hadd_ps(_mm_mul_ps(r2, ref), _mm_mul_ps(r3, ref))); /* q_k . ref */
     _mm_storeu_ps(sw, _mm_xor_ps(w4, _mm_and_ps(dots, _mm_set1_ps(-0.0f))));
-    __m256 acc = _mm256_mul_ps(d0, _mm256_broadcast_ss(&sw[0]));
-    acc = _mm256_fmadd_ps(d1, _mm256_broadcast_ss(&sw[1]), acc);
-    acc = _mm256_fmadd_ps(d2, _mm256_broadcast_ss(&sw[2]), acc);
-    return _mm256_fmadd_ps(d3, _mm256_broadcast_ss(&sw[3]), acc);
 }
 
-AKP_AVX2_INLINE static inline __m256 blend_dq_any(const akp_skin_ctx* c, size_t i, uint32_t K) {
-    return K == 4 ? blend_dq_vertex4(c, i) : blend_dq_vertex(c, i, K);
+/* Phase 2: sum of signed weight * (real | dual); broadcasts from memory are plain loads. */
+AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const float* const* ptr, const float* sw) {
+    __m256 acc = _mm256_mul_ps(_mm256_loadu_ps(ptr[0]), _mm256_broadcast_ss(&sw[0]));
+    acc = _mm256_fmadd_ps(_mm256_loadu_ps(ptr[1]), _mm256_broadcast_ss(&sw[1]), acc);
+    acc = _mm256_fmadd_ps(_mm256_loadu_ps(ptr[2]), _mm256_broadcast_ss(&sw[2]), acc);
+    return _mm256_fmadd_ps(_mm256_loadu_ps(ptr[3]), _mm256_broadcast_ss(&sw[3]), acc);
 }
+
+/* Blended (real | dual) of the 8 vertices of a block. */
+AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t i0, uint32_t K, __m256* rows) {
+    if (K == 4) {
+        const float* ptr[8][4];
+        float sw[8][4];
+        for (int v = 0; v < 8; ++v) dq_signs4(c, i0 + (size_t)v, ptr[v], sw[v]);
+        for (int v = 0; v < 8; ++v) rows[v] = dq_accumulate4(ptr[v], sw[v]);
+        return;
+    }
+    for (int v = 0; v < 8; ++v) rows[v] = blend_dq_vertex(c, i0 + (size_t)v, K);
+}
+
 
 AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
     __m256 rows[8], cols[8];
@@ -273,7 +283,7 @@ AKP_AVX2_INLINE static inline __m256 quat_inv_norm8(__m256 x, __m256 y, __m256 z
 
 AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
     __m256 rows[8], q[8];
-    for (int v = 0; v < 8; ++v) rows[v] = blend_dq_any(c, i0 + (size_t)v, K);
+    blend_dq_block(c, i0, K, rows);
     transpose8(rows, q);
     __m256 r = quat_inv_norm8(q[0], q[1], q[2], q[3]);
     /* a vanished blend (r = 0) must act as the identity rotation, like the scalar code */
@@ -298,20 +308,20 @@ AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, u
     if (!c->do_normals) return;
     __m256 nx, ny, nz;
     load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
-    rotate8(qx, qy, qz, qw, &nx, &ny, &nz);
-    normalize8(&nx, &ny, &nz);
+    rotate8(qx, qy, qz, qw, &nx, &ny, &nz); /* unit quaternion: lengths are kept */
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
 AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, uint32_t K) {
     __m256 r01[8], r23[8], cols[8];
     const __m256i lo = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), hi = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
+    __m256 q[8];
+    blend_dq_block(c, i0, K, q);
     for (int v = 0; v < 8; ++v) {
         blend_matrix_vertex(c, i0 + (size_t)v, K, &r01[v], &r23[v]);
         /* the rotation blend goes into the unused w rows: (qx, qy) and (qz, qw) */
-        __m256 q = blend_dq_any(c, i0 + (size_t)v, K);
-        r01[v] = _mm256_blend_ps(r01[v], _mm256_permutevar8x32_ps(q, lo), 0x88);
-        r23[v] = _mm256_blend_ps(r23[v], _mm256_permutevar8x32_ps(q, hi), 0x88);
+        r01[v] = _mm256_blend_ps(r01[v], _mm256_permutevar8x32_ps(q[v], lo), 0x88);
+        r23[v] = _mm256_blend_ps(r23[v], _mm256_permutevar8x32_ps(q[v], hi), 0x88);
     }
     transpose8(r01, cols);
     const __m256 ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];
@@ -341,8 +351,7 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     if (!c->do_normals) return;
     __m256 nx, ny, nz;
     load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
-    rotate8(qx, qy, qz, qw, &nx, &ny, &nz);
-    normalize8(&nx, &ny, &nz);
+    rotate8(qx, qy, qz, qw, &nx, &ny, &nz); /* unit quaternion: lengths are kept */
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
