@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 
 #include "ak_test.h"
+#include "ref/ref_gltf.h"
 
 #ifndef AK_CLI_PATH
 #error "AK_CLI_PATH must name the animkit executable"
@@ -362,6 +363,67 @@ AK_TEST(demo_writes_its_files) {
     }
 }
 
+/* Every glTF: `export --bind` writes each primitive's POSITION accessor, in the loader's
+ * documented order (meshes in file order, the nodes instancing each in node order, then
+ * primitives; a mesh no node uses once), read here straight from the file. */
+AK_TEST(export_bind_reproduces_gltf_positions) {
+    char dir[1100];
+    if (!ak_test_asset(dir, sizeof dir, "gltf")) {
+        AK_SKIP("no assets (set ANIMKIT_ASSETS or put them in ../shared/assets)");
+        return;
+    }
+    const char* files[] = {"RiggedSimple/glTF/RiggedSimple.gltf", "RiggedFigure/glTF-Binary/RiggedFigure.glb",
+                           "CesiumMan/glTF-Embedded/CesiumMan.gltf", "Fox/glTF-Binary/Fox.glb",
+                           "SimpleSkin/glTF/SimpleSkin.gltf", "SimpleMorph/glTF/SimpleMorph.gltf",
+                           "AnimatedMorphCube/glTF-Binary/AnimatedMorphCube.glb",
+                           "MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf",
+                           "MorphStressTest/glTF-Binary/MorphStressTest.glb",
+                           "RecursiveSkeletons/glTF-Binary/RecursiveSkeletons.glb"};
+    static ak_vec3 obj[200000];
+    for (size_t f = 0; f < sizeof files / sizeof files[0]; ++f) {
+        char path[1300], args[1500];
+        snprintf(path, sizeof path, "%s/%s", dir, files[f]);
+        snprintf(args, sizeof args, "export '%s' --bind -o bind_asset.obj", path);
+        AK_CHECK_MSG(run(args, true) == 0, "%s: %s", files[f], out_buf);
+        size_t groups = 0, nv = read_obj_vertices("bind_asset.obj", obj, 200000, &groups);
+        doc d;
+        if (!doc_open(&d, path)) {
+            AK_CHECK_MSG(false, "%s: reference reader", files[f]);
+            continue;
+        }
+        size_t at = 0, expect_groups = 0;
+        double worst = 0;
+        for (int mi = 0; mi < jsize(d.root, "meshes"); ++mi) {
+            const cJSON* prims = jget(jat(d.root, "meshes", mi), "primitives");
+            int users = 0;
+            for (int ni = 0; ni < jsize(d.root, "nodes"); ++ni) users += jint(jat(d.root, "nodes", ni), "mesh", -1) == mi;
+            for (int u = 0; u < (users ? users : 1); ++u) {
+                for (int pi = 0; pi < cJSON_GetArraySize(prims); ++pi) {
+                    int pa = jint(jget(cJSON_GetArrayItem(prims, pi), "attributes"), "POSITION", -1);
+                    int vc = accessor_count(&d, pa);
+                    float* pos = vc > 0 ? malloc((size_t)vc * 12) : NULL;
+                    ++expect_groups;
+                    if (!pos || !doc_floats(&d, pa, 3, pos)) {
+                        AK_CHECK_MSG(false, "%s: POSITION accessor %d", files[f], pa);
+                        free(pos);
+                        continue;
+                    }
+                    for (int v = 0; v < vc && at < nv; ++v, ++at) {
+                        worst = fmax(worst, fabs(obj[at].x - pos[v * 3]));
+                        worst = fmax(worst, fabs(obj[at].y - pos[v * 3 + 1]));
+                        worst = fmax(worst, fabs(obj[at].z - pos[v * 3 + 2]));
+                    }
+                    free(pos);
+                }
+            }
+        }
+        AK_CHECK_MSG(at == nv, "%s: %zu vertices in the OBJ, %zu in the file", files[f], nv, at);
+        AK_CHECK_MSG(groups == expect_groups, "%s: %zu groups, expected %zu", files[f], groups, expect_groups);
+        AK_CHECK_MSG(worst == 0.0, "%s: bind positions differ by %.3g", files[f], worst);
+        doc_close(&d);
+    }
+}
+
 int main(void) {
     AK_RUN(usage_and_help);
     AK_RUN(bad_input_paths);
@@ -372,5 +434,6 @@ int main(void) {
     AK_RUN(weights_json_sum_to_one);
     AK_RUN(render_outputs_decode);
     AK_RUN(demo_writes_its_files);
+    AK_RUN(export_bind_reproduces_gltf_positions);
     return ak_test_finish();
 }
