@@ -100,7 +100,10 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
     for (;;) {
         float best = out.error;
         int stalled = 0;
-        while (out.error > c->tolerance && out.iterations < job->max_iterations) {
+        /* On positions, aim a little inside the tolerance: turning the positions back into
+         * rotations adds float round-off, which must not push a converged answer out. */
+        const float goal = constrained ? c->tolerance : 0.9f * c->tolerance;
+        while (out.error > goal && out.iterations < job->max_iterations) {
             fabrik_pass(c, pos, len, total, root, constrained);
             out.error = ak_vec3_distance(pos[last], t);
             ++out.iterations;
