@@ -135,16 +135,16 @@ static void renormalize(ak_vec3* n, size_t count) {
     const __m128 tiny = _mm_set1_ps(1e-24f), huge = _mm_set1_ps(3.0e38f), one = _mm_set1_ps(1.0f);
     for (; i + 4 <= count; i += 4) {
         float l2[4], s[4];
-        for (int q = 0; q < 4; ++q) {
+        for (unsigned q = 0; q < 4; ++q) {
             const ak_vec3 v = n[i + q];
             l2[q] = v.x * v.x + v.y * v.y + v.z * v.z;
         }
         const __m128 l = _mm_loadu_ps(l2);
-        const int ok = _mm_movemask_ps(_mm_and_ps(_mm_cmpgt_ps(l, tiny), _mm_cmplt_ps(l, huge)));
+        const unsigned ok = (unsigned)_mm_movemask_ps(_mm_and_ps(_mm_cmpgt_ps(l, tiny), _mm_cmplt_ps(l, huge)));
         _mm_storeu_ps(s, _mm_div_ps(one, _mm_sqrt_ps(_mm_max_ps(l, tiny))));
-        for (int q = 0; q < 4; ++q) {
+        for (unsigned q = 0; q < 4; ++q) {
             ak_vec3* v = &n[i + q];
-            if (ok & (1 << q)) {
+            if (ok & (1u << q)) {
                 v->x *= s[q];
                 v->y *= s[q];
                 v->z *= s[q];
