@@ -148,7 +148,8 @@ AK_API ak_result ak_skin_weights_decode_info(ak_u8_cspan buffer, size_t* out_ver
  * validated (use ak_skin_weights_validate). Returns the decode_info codes, AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_skin_weights_decode(ak_u8_cspan buffer, ak_u16_span out_joints, ak_f32_span out_weights,
                                         ak_diag* diag);
-/* ak_skin_weights_encode to a file. Adds AK_ERR_IO. */
+/* ak_skin_weights_encode to a file (built in memory with malloc first). Adds AK_ERR_IO,
+ * AK_ERR_NO_MEMORY. The file wrappers use malloc, not an ak_allocator. */
 AK_API ak_result ak_skin_weights_write_file(const char* path, ak_u16_cspan joints, ak_f32_cspan weights,
                                             size_t vertex_count, uint32_t influence_count);
 /* Counts of a weights file (reads the header only). Adds AK_ERR_IO to decode_info's codes. */
@@ -199,15 +200,22 @@ AK_API ak_result ak_skin_cor_centers_compute(const ak_skin_cor_desc* desc, const
 /* CoR centers file: 24-byte header then the centers.
  *   bytes 0..3 magic "AKCR", 4..7 u32 version (1), 8..11 u32 vertex_count, 12..15 zero,
  *   16..23 u64 key (ak_skin_cor_key), then f32 xyz[vertex_count], little-endian. */
+/* Bytes of an encoded centers buffer: 24 + 12 * vertex_count (0 when vertex_count >= 2^32). */
 AK_API size_t ak_skin_cor_centers_encoded_size(size_t vertex_count);
-/* Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (vertex_count >= 2^32), AK_ERR_SPAN_SMALL. */
+/* Encode centers.count centers with their key into out_buffer (count >= the size above);
+ * *out_size (optional) gets the bytes written. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG
+ * (vertex_count >= 2^32), AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_skin_cor_centers_encode(ak_vec3_cspan centers, uint64_t key, ak_u8_span out_buffer,
                                             size_t* out_size);
-/* Decode centers whose key equals key. Returns AK_ERR_NULL_ARG, AK_ERR_PARSE (bad header or
- * size), AK_ERR_NOT_FOUND (the key differs: the cache is stale), AK_ERR_SPAN_SMALL. */
+/* Decode centers whose key equals key into out_centers (count >= the stored vertex count).
+ * Returns AK_ERR_NULL_ARG, AK_ERR_PARSE (bad magic, version or truncated buffer),
+ * AK_ERR_NOT_FOUND (the key differs: the cache is stale), AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_skin_cor_centers_decode(ak_u8_cspan buffer, uint64_t key, ak_vec3_span out_centers);
+/* ak_skin_cor_centers_encode to a file (the whole buffer is built in memory with malloc
+ * first). Encode's codes plus AK_ERR_IO, AK_ERR_NO_MEMORY. */
 AK_API ak_result ak_skin_cor_centers_write_file(const char* path, ak_vec3_cspan centers, uint64_t key);
-/* Same codes as decode plus AK_ERR_IO (missing or unreadable file). */
+/* Read and decode a centers file. Decode's codes plus AK_ERR_IO (missing or unreadable file),
+ * AK_ERR_NO_MEMORY. */
 AK_API ak_result ak_skin_cor_centers_read_file(const char* path, uint64_t key, ak_vec3_span out_centers);
 /* Read the centers from cache_path when its key matches, else compute them and write the file
  * (a failed write is not an error: the centers are still returned). *out_from_cache
