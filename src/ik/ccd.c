@@ -29,8 +29,10 @@ static ak_vec3 ccd_slide(akp_ik_chain* c, size_t i, ak_vec3 effector) {
     return ak_vec3_sub(c->world[i].translation, before);
 }
 
-/* One CCD step at chain joint i; returns the new effector position. */
-static ak_vec3 ccd_step(akp_ik_chain* c, size_t i, ak_vec3 e, float max_step) {
+/* One CCD step at chain joint i; returns the new effector position. need_world: world[i] must
+ * be brought up to date (root-first order reads it for the next joint; tip-first order only
+ * needs it when limits may have changed the rotation, and rebuilds everything after a sweep). */
+static ak_vec3 ccd_step(akp_ik_chain* c, size_t i, ak_vec3 e, float max_step, bool need_world) {
     const ak_joint_type type = akp_ik_type(c, i);
     if (type == AK_JOINT_PRISM) return ak_vec3_add(e, ccd_slide(c, i, e));
     const size_t j = (size_t)c->joints[i];
@@ -39,10 +41,18 @@ static ak_vec3 ccd_step(akp_ik_chain* c, size_t i, ak_vec3 e, float max_step) {
     if (type == AK_JOINT_HINGE)
         axis = ak_vec3_normalize(ak_quat_rotate(c->world[i].rotation, ak_skeleton_joint_limits(c->skeleton, j).axis));
     ak_quat q = akp_ik_aim_rotation(ak_vec3_sub(e, p), ak_vec3_sub(c->target, p), type == AK_JOINT_HINGE, axis, max_step);
+    if (!c->clamp[i]) {
+        /* Nothing can clip q: apply it to the local rotation and move the effector by it. */
+        ak_transform* l = &c->pose[j];
+        const ak_quat parent_rot = akp_ik_parent_rot(c, i);
+        l->rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(parent_rot), ak_quat_mul(q, c->world[i].rotation)));
+        if (need_world) c->world[i] = akp_ik_compose(akp_ik_parent_world(c, i), *l);
+        return ak_vec3_add(p, ak_quat_rotate(q, ak_vec3_sub(e, p)));
+    }
     const ak_quat old_rot = c->world[i].rotation;
     akp_ik_rotate(c, i, q);
-    /* The rotation really applied: q itself unless limits clipped it. */
-    ak_quat applied = c->clamp[i] ? ak_quat_mul(c->world[i].rotation, ak_quat_conjugate(old_rot)) : q;
+    /* The rotation really applied, after the limits. */
+    ak_quat applied = ak_quat_mul(c->world[i].rotation, ak_quat_conjugate(old_rot));
     return ak_vec3_add(p, ak_quat_rotate(applied, ak_vec3_sub(e, p)));
 }
 
@@ -51,11 +61,11 @@ void akp_ik_ccd_sweep(akp_ik_chain* c, float max_step, bool from_root) {
     ak_vec3 e = c->world[last].translation;
     if (from_root) {
         for (size_t i = 0; i < last; ++i) {
-            e = ccd_step(c, i, e, max_step);
+            e = ccd_step(c, i, e, max_step, true);
             c->world[i + 1] = akp_ik_compose(c->world[i], c->pose[c->joints[i + 1]]);
         }
     } else {
-        for (size_t i = last; i-- > 0;) e = ccd_step(c, i, e, max_step);
+        for (size_t i = last; i-- > 0;) e = ccd_step(c, i, e, max_step, false);
     }
     akp_ik_fk(c, 0); /* exact positions, no drift from the incremental updates */
 }
