@@ -1024,6 +1024,35 @@ AK_TEST(heat_weights_on_cylinder_are_smooth_and_normalized) {
     cylinder_free(&c);
 }
 
+AK_TEST(heat_weights_degenerate_input) {
+    /* a tetrahedron plus: an isolated vertex, a zero-area triangle, a duplicate vertex, a vertex
+     * exactly on a bone, and a zero-length (point) bone far away */
+    ak_vec3 pos[7] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {5, 5, 5}, {1, 0, 0}, {0.25f, 0.25f, 0.25f}};
+    uint32_t idx[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3, 1, 5, 1, 6, 6, 6};
+    ak_skin_bone bones[3] = {{{0.1f, 0.1f, 0.1f}, {0.3f, 0.3f, 0.3f}, 0},
+                             {{0.25f, 0.25f, 0.25f}, {0.25f, 0.25f, 0.6f}, 1},
+                             {{9, 9, 9}, {9, 9, 9}, 2}};
+    uint16_t jn[7 * 4];
+    float w[7 * 4];
+    for (int method = 0; method < 2; ++method)
+        for (int vis = 0; vis < 2; ++vis) {
+            ak_weights_desc d = {
+                .method = method ? AK_WEIGHTS_DISTANCE : AK_WEIGHTS_HEAT,
+                .positions = {pos, 7},
+                .indices = {idx, sizeof idx / sizeof idx[0]},
+                .bones = {bones, 3},
+                .skip_visibility = vis == 1,
+            };
+            AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 28}, (ak_f32_span){w, 28}), AK_OK);
+            AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 28}, (ak_f32_cspan){w, 28}, 7, 4, 3, 1e-6f, NULL),
+                        AK_OK);
+            /* heat: the isolated vertex takes its nearest bone (the point at (9, 9, 9)) fully;
+             * distance: it blends, the nearest first */
+            AK_CHECK(jn[4 * 4] == 2);
+            if (method == 0) AK_CHECK(w[4 * 4] == 1.0f);
+        }
+}
+
 AK_TEST(weights_format_round_trip) {
     enum { N = 50, K = 3 };
     ak_rng rng = ak_rng_make(9);
@@ -1113,6 +1142,7 @@ int main(void) {
     AK_RUN(heat_weights_do_not_bleed_between_legs);
     AK_RUN(distance_weights_closed_forms_and_robustness);
     AK_RUN(heat_weights_on_cylinder_are_smooth_and_normalized);
+    AK_RUN(heat_weights_degenerate_input);
     AK_RUN(weights_format_round_trip);
     AK_RUN(bones_from_joints);
     return ak_test_finish();
