@@ -7,9 +7,11 @@
  * system symmetric positive definite: (L + A H) w_j = A H p_j, L_ij = -(cot a + cot b) / 2.
  *
  * Solver: CHOLMOD (SuiteSparse) sparse Cholesky, one factorization and one multi-column
- * solve for all joints. A direct factorization is the right tool here: the matrix is the
- * same for every joint (tens of right-hand sides), and the diffusion is stiff where H is small
- * (far from bones), where a Jacobi-preconditioned CG needs hundreds of iterations per joint.
+ * solve for all joints. Measured against a Jacobi-preconditioned CG written for the purpose
+ * (same matrix, relative residual 1e-8, 19 joints) on a limb mesh: 3266 vertices CHOLMOD
+ * 0.055 s vs PCG 0.20 s (1738 iterations); 25602 vertices 0.52 s vs 3.3 s (3913 iterations).
+ * The matrix is shared by every joint and is poorly conditioned where H is small (far from
+ * bones), so one factorization beats per-column iterations.
  * CHOLMOD allocates with malloc internally (not through the ak_allocator) and is silenced
  * (print = 0): the library prints nothing.
  *
