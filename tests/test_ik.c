@@ -619,6 +619,33 @@ AK_TEST(limits_never_violated) {
     for (int k = 0; k < 3; ++k) reach_random_targets(&s, false, iterative[k], 60, k == 2 ? 54 : 45, 100, 1e-3f);
 }
 
+AK_TEST(animated_translation_kept) {
+    /* An animated pose may move a hinge joint off its rest offset; the solvers change only
+     * rotations, so that (longer) bone stays as the animation made it. */
+    chain_spec s = uniform_chain(4, AK_JOINT_HINGE);
+    s.limits[1].min = -1.0f, s.limits[1].max = 1.0f;
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[4] = {0, 1, 2, 3};
+    const ak_ik_solver all[4] = {AK_IK_SOLVER_CCD, AK_IK_SOLVER_FABRIK, AK_IK_SOLVER_DLS, AK_IK_SOLVER_TWO_BONE};
+    for (int k = 0; k < 4; ++k) {
+        ak_transform pose[4];
+        rest_pose(sk, pose);
+        pose[1].translation = ak_vec3_make(0.65f, 0.0f, 0.0f); /* rest 0.5 */
+        pose[2].translation = ak_vec3_make(0.8f, 0.0f, 0.0f);  /* rest 0.6 */
+        const size_t n = all[k] == AK_IK_SOLVER_TWO_BONE ? 3 : 4;
+        solve_out o = solve(sk, pose, chain, n, ak_vec3_make(0.5f, 0.7f, 0.0f), all[k], NULL);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK_NEAR(pose[1].translation.x, 0.65, 1e-7);
+        AK_CHECK_NEAR(pose[2].translation.x, 0.8, 1e-7);
+        AK_CHECK(pose_finite(pose, 4));
+    }
+    ak_skeleton_destroy(sk);
+}
+
 /* ---- two-bone ----------------------------------------------------------------------------- */
 
 AK_TEST(two_bone_closed_form_and_pole) {
@@ -1060,6 +1087,7 @@ int main(void) {
     AK_RUN(reach_free_3d);
     AK_RUN(reach_planar_hinges);
     AK_RUN(limits_never_violated);
+    AK_RUN(animated_translation_kept);
     AK_RUN(two_bone_closed_form_and_pole);
     AK_RUN(two_bone_chain_matches_job_and_limits);
     AK_RUN(two_bone_soft_weight_unreachable);

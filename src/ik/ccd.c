@@ -24,7 +24,7 @@ static ak_vec3 ccd_slide(akp_ik_chain* c, size_t i, ak_vec3 effector) {
     ak_vec3 before = c->world[i].translation;
     ak_transform* l = &c->pose[j];
     l->translation = ak_vec3_madd(l->translation, axis_p, s);
-    *l = ak_skeleton_limit_joint(c->skeleton, j, *l);
+    *l = akp_ik_limit(c->skeleton, j, *l);
     c->world[i] = akp_ik_compose(parent, *l);
     return ak_vec3_sub(c->world[i].translation, before);
 }

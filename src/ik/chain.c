@@ -193,7 +193,7 @@ static void apply_target_rotation(akp_ik_chain* c, const ak_quat* target_rotatio
     const size_t last = c->count - 1, j = (size_t)c->joints[last];
     akp_ik_set_world_rot(c, last, ak_quat_normalize(*target_rotation));
     if (c->types[last] != AK_JOINT_FREE && !c->clamp[last]) { /* an arbitrary turn: clamp anyway */
-        c->pose[j] = ak_skeleton_limit_joint(c->skeleton, j, c->pose[j]);
+        c->pose[j] = akp_ik_limit(c->skeleton, j, c->pose[j]);
         c->world[last] = akp_ik_compose(akp_ik_parent_world(c, last), c->pose[j]);
     }
 }

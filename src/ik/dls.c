@@ -185,7 +185,7 @@ akp_ik_outcome akp_ik_dls(akp_ik_chain* c, const ak_ik_chain_job* job, void* scr
                     ak_quat local_q = ak_quat_mul(ak_quat_conjugate(parent_rot), ak_quat_mul(q, parent_rot));
                     l->rotation = ak_quat_normalize(ak_quat_mul(local_q, l->rotation));
                 }
-                if (c->types[i] != AK_JOINT_FREE) *l = ak_skeleton_limit_joint(c->skeleton, j, *l);
+                if (c->types[i] != AK_JOINT_FREE) *l = akp_ik_limit(c->skeleton, j, *l);
             }
             /* world[] stayed pre-step while the joints were set (the axes were measured there). */
             akp_ik_fk(c, 0);

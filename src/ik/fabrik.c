@@ -318,7 +318,7 @@ ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job) {
                 ak_quat q = fit_rotation(from, to, cc);
                 ak_quat wr = ak_quat_mul(q, m.world[j].rotation);
                 pose[j].rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(parent_w.rotation), wr));
-                if (limits) pose[j] = ak_skeleton_limit_joint(sk, (size_t)j, pose[j]);
+                if (limits) pose[j] = akp_ik_limit(sk, (size_t)j, pose[j]);
                 m.world[j] = ak_transform_mul(parent_w, pose[j]);
             }
             m.pos[j] = m.world[j].translation;

@@ -72,6 +72,15 @@ static inline float akp_ik_restore_best(akp_ik_chain* c, float error) {
     return c->best_error;
 }
 
+/* Clamp a local transform's rotation (a prism joint's slide) to the joint's limits. Unlike
+ * ak_skeleton_limit_joint alone, the translation of a rotating joint is kept as it is (an
+ * animated pose may move it off the rest value; IK must not change bone lengths). */
+static inline ak_transform akp_ik_limit(const ak_skeleton* sk, size_t joint, ak_transform local) {
+    ak_transform r = ak_skeleton_limit_joint(sk, joint, local);
+    if (ak_skeleton_joint_type(sk, joint) != AK_JOINT_PRISM) r.translation = local.translation;
+    return r;
+}
+
 /* Joint type as the solver sees it: FREE when limits are ignored. */
 static inline ak_joint_type akp_ik_type(const akp_ik_chain* c, size_t i) { return (ak_joint_type)c->types[i]; }
 
@@ -81,7 +90,7 @@ static inline void akp_ik_set_world_rot(akp_ik_chain* c, size_t i, ak_quat world
     const size_t j = (size_t)c->joints[i];
     ak_transform* l = &c->pose[j];
     l->rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(akp_ik_parent_rot(c, i)), world_rot));
-    if (c->clamp[i]) *l = ak_skeleton_limit_joint(c->skeleton, j, *l);
+    if (c->clamp[i]) *l = akp_ik_limit(c->skeleton, j, *l);
     c->world[i] = akp_ik_compose(akp_ik_parent_world(c, i), *l);
 }
 

@@ -250,8 +250,8 @@ void akp_ik_two_bone_chain(akp_ik_chain* c, const ak_ik_chain_job* job) {
         n1.rotation = ak_quat_normalize(ak_quat_mul(l1.rotation, qm));
         bool clamped = false;
         if (c->limits) {
-            ak_transform k0 = ak_skeleton_limit_joint(c->skeleton, j0, n0);
-            ak_transform k1 = ak_skeleton_limit_joint(c->skeleton, j1, n1);
+            ak_transform k0 = akp_ik_limit(c->skeleton, j0, n0);
+            ak_transform k1 = akp_ik_limit(c->skeleton, j1, n1);
             clamped = akp_quat_angle(ak_quat_mul(ak_quat_conjugate(k1.rotation), n1.rotation)) > 1e-4f ||
                       akp_quat_angle(ak_quat_mul(ak_quat_conjugate(k0.rotation), n0.rotation)) > 1e-4f;
             n0 = k0, n1 = k1;
