@@ -1,11 +1,13 @@
 /* Render target, camera, clipping, triangle setup and the threaded rasterizer.
  *
- * Pipeline of a draw call: inputs (mesh triangles, line segments, points) are processed in
- * batches. Each batch is split among the threads for setup (transform, cull, clip against the
- * near/far planes and a guard band, project, snap to 1/256 sample units), then every thread
- * rasterizes all the batch's triangles restricted to the rows it owns (8-row blocks dealt out
- * round-robin), so no two threads write the same pixel and the per-pixel drawing order equals
- * the input order for any thread count. */
+ * Pipeline of a draw call: every thread walks all inputs (mesh triangles, line segments,
+ * points) in order: transform to clip space, cull, and skip the input at once when it covers
+ * none of the rows the thread owns (32-row blocks of samples dealt out round-robin); otherwise
+ * compute the shading attributes, clip against the near/far planes and a guard band, project,
+ * snap to 1/256 sample units and rasterize the thread's rows of it straight away. No two
+ * threads write the same pixel, no locks are needed, and the per-pixel drawing order equals
+ * the input order for any thread count (so the image does not depend on it). The price is
+ * that every thread transforms every vertex. */
 #include <math.h>
 #include <pthread.h>
 
@@ -20,7 +22,7 @@
 #define SUBPIX 256       /* fixed-point sub-sample units */
 #define GUARD 4.0f       /* guard band in NDC units: |x|, |y| <= GUARD * w */
 #define SHADOW_RES 256
-#define ROW_BLOCK_SHIFT 3
+#define ROW_BLOCK_SHIFT 5
 #define TONE_LUT_SIZE 8192 /* covers linear [0, 2] */
 #define POW_LUT_SIZE 1024
 
@@ -35,7 +37,8 @@ typedef enum frag_mode {
     FRAG_UNLIT_VCOLOR,    /* attr 0..3 sRGB colour (unlit) */
     FRAG_FLAT,            /* flat[] linear colour computed at setup */
     FRAG_GOURAUD,         /* attr 0..3 linear lit colour */
-    FRAG_PHONG,           /* attr 0..2 world pos, 3..5 normal, [6..9 linear vertex colour] */
+    FRAG_PHONG,           /* attr 0..2 world pos, 3..5 normal */
+    FRAG_PHONG_VC,        /* FRAG_PHONG plus 6..9 linear vertex colour */
     FRAG_POINT,           /* attr 0..1 disc coordinates in [-1,1], flat[] colour */
     FRAG_GROUND           /* attr 0..2 world position */
 } frag_mode;
@@ -342,9 +345,16 @@ static void setup_lighting(drawctx* dc, const ak_raster_lighting* lighting, ak_r
         dc->pow_lut[i] = dc->specular * powf((float)i / POW_LUT_SIZE, dc->shininess);
 }
 
+/* Unit vector, or zero for a zero/degenerate vector (NaN-free). */
+static inline ak_vec3 fast_normalize(ak_vec3 a) {
+    float l2 = a.x * a.x + a.y * a.y + a.z * a.z;
+    float s = l2 > 1e-30f ? 1.0f / sqrtf(l2) : 0.0f;
+    return ak_vec3_make(a.x * s, a.y * s, a.z * s);
+}
+
 /* Lit linear colour for unit normal n at world point p with linear albedo alb. */
 static inline ak_vec3 shade(const drawctx* dc, ak_vec3 n, ak_vec3 p, ak_vec3 alb) {
-    ak_vec3 v = dc->ortho ? ak_vec3_neg(dc->view_forward) : ak_vec3_normalize(ak_vec3_sub(dc->eye, p));
+    ak_vec3 v = dc->ortho ? ak_vec3_neg(dc->view_forward) : fast_normalize(ak_vec3_sub(dc->eye, p));
     /* two-sided lighting: light the side that faces the viewer, whatever the winding says */
     if (!dc->cull && ak_vec3_dot(n, v) < 0.0f) n = ak_vec3_neg(n);
     float kd = ak_vec3_dot(n, dc->key_l), fd = ak_vec3_dot(n, dc->fill_l);
@@ -370,7 +380,7 @@ static inline ak_vec3 shade(const drawctx* dc, ak_vec3 n, ak_vec3 p, ak_vec3 alb
 
 static void raster_tri(const drawctx* dc, const rtri* t, int ti, int tc);
 
-/* Whether thread ti of tc owns any row in [y0, y1] (8-row blocks dealt out round-robin). */
+/* Whether thread ti of tc owns any row in [y0, y1] (row blocks dealt out round-robin). */
 static inline bool rows_owned(int y0, int y1, int ti, int tc) {
     if (tc <= 1) return true;
     int b0 = y0 >> ROW_BLOCK_SHIFT, b1 = y1 >> ROW_BLOCK_SHIFT;
@@ -582,11 +592,12 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri*
         out[2] = enc(r, a[2]);
         out[3] = (uint8_t)(clamp01(a[3]) * 255.0f + 0.5f);
         return true;
-    case FRAG_PHONG: {
-        ak_vec3 n = ak_vec3_normalize(ak_vec3_make(a[3], a[4], a[5]));
+    case FRAG_PHONG:
+    case FRAG_PHONG_VC: {
+        ak_vec3 n = fast_normalize(ak_vec3_make(a[3], a[4], a[5]));
         ak_vec3 alb = dc->base_lin;
         float alpha = dc->base_alpha;
-        if (dc->has_vcolor) {
+        if (mode == FRAG_PHONG_VC) {
             alb = ak_vec3_mul(alb, ak_vec3_make(a[6], a[7], a[8]));
             alpha *= a[9];
         }
@@ -657,10 +668,23 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri*
     return false;
 }
 
+/* Attributes each fragment mode interpolates (a constant once the mode is). */
+static FORCE_INLINE int mode_attr_count(frag_mode mode) {
+    switch (mode) {
+    case FRAG_UNLIT_VCOLOR: return 4;
+    case FRAG_GOURAUD: return 4;
+    case FRAG_PHONG: return 6;
+    case FRAG_PHONG_VC: return 10;
+    case FRAG_POINT: return 2;
+    case FRAG_GROUND: return 3;
+    default: return 0;
+    }
+}
+
 static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, const rtri* t, int thread_index,
                                          int thread_count) {
     ak_raster* r = dc->r;
-    const int na = dc->attr_count;
+    const int na = mode_attr_count(mode);
     for (int y = t->y0; y <= t->y1; ++y) {
         if (thread_count > 1) {
             int blk = y >> ROW_BLOCK_SHIFT;
@@ -708,6 +732,7 @@ static void raster_tri(const drawctx* dc, const rtri* t, int ti, int tc) {
     case FRAG_FLAT: raster_tri_mode(dc, FRAG_FLAT, t, ti, tc); break;
     case FRAG_GOURAUD: raster_tri_mode(dc, FRAG_GOURAUD, t, ti, tc); break;
     case FRAG_PHONG: raster_tri_mode(dc, FRAG_PHONG, t, ti, tc); break;
+    case FRAG_PHONG_VC: raster_tri_mode(dc, FRAG_PHONG_VC, t, ti, tc); break;
     case FRAG_POINT: raster_tri_mode(dc, FRAG_POINT, t, ti, tc); break;
     case FRAG_GROUND: raster_tri_mode(dc, FRAG_GROUND, t, ti, tc); break;
     }
@@ -897,6 +922,7 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
         }
         break;
     case FRAG_PHONG:
+    case FRAG_PHONG_VC:
         for (int k = 0; k < 3; ++k) {
             ak_vec3 n = has_n ? ak_mat3_mul_vec3(dc->normal_matrix, m->normals.ptr[idx[k]]) : fn;
             if (!ak_vec3_is_finite(n)) n = fn;
@@ -984,8 +1010,8 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
         dc.attr_count = 4;
         break;
     default:
-        dc.mode = FRAG_PHONG;
-        dc.attr_count = dc.has_vcolor ? 10 : 6;
+        dc.mode = dc.has_vcolor ? FRAG_PHONG_VC : FRAG_PHONG;
+        dc.attr_count = mode_attr_count(dc.mode);
         break;
     }
     dc.setup = mesh_setup;
