@@ -362,10 +362,16 @@ AK_TEST(lambert_diffuse_matches_formula) {
             .fill_color = ak_vec3_splat(1e-9f),
             .ambient_color = ak_vec3_splat(1e-9f),
         };
-        for (int s = 0; s < 3; ++s) {
+        /* also through the per-vertex colour paths: colour (0.7, 0.5, 0.3) on a white material */
+        const ak_vec4 vc[4] = {{0.7f, 0.5f, 0.3f, 1}, {0.7f, 0.5f, 0.3f, 1}, {0.7f, 0.5f, 0.3f, 1}, {0.7f, 0.5f, 0.3f, 1}};
+        for (int s = 0; s < 6; ++s) {
             ak_raster_mesh m = {.positions = {p, 4}, .normals = {n, 4}, .indices = {idx, 6},
                                 .material = {.color = ak_vec4_make(0.7f, 0.5f, 0.3f, 1), .specular = -1},
-                                .lighting = &light, .shading = modes[s]};
+                                .lighting = &light, .shading = modes[s % 3]};
+            if (s >= 3) {
+                m.colors = (ak_vec4_cspan){vc, 4};
+                m.material.color = ak_vec4_make(1, 1, 1, 1);
+            }
             ak_raster_clear(t.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
             AK_CHECK_EQ(ak_raster_draw_mesh(t.r, &cam, &m), AK_OK);
             ak_raster_resolve(t.r, &t.img);
