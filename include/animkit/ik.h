@@ -7,7 +7,8 @@
  * blend weight), and damped least squares (Jacobian, Levenberg-Marquardt adaptive damping,
  * position and optional orientation targets). FABRIK also solves trees with several end
  * effectors (sub-bases, as in the paper). Every chain solver honours the skeleton's joint
- * types and limits (ak_skeleton_limit_joint after each change) and reports whether the
+ * types and limits (each changed rotation or slide is clamped as ak_skeleton_limit_joint
+ * does; a rotating joint's translation is left as the pose has it) and reports whether the
  * target was reached, the remaining distance and the iterations used.
  *
  * What it does NOT do: forward kinematics for the caller (skeleton.h), animation blending,
