@@ -778,6 +778,10 @@ AK_TEST(bad_input_codes) {
     AK_CHECK_EQ(ak_raster_draw_lines(t.r, &cam, &l), AK_ERR_BAD_INDEX);
     ak_raster_points pts = {0};
     AK_CHECK_EQ(ak_raster_draw_points(t.r, &cam, &pts), AK_ERR_NULL_ARG);
+    ak_raster_lines zero_lines = {0};
+    AK_CHECK_EQ(ak_raster_draw_lines(t.r, &cam, &zero_lines), AK_ERR_NULL_ARG);
+    ak_raster_ground zero_ground = {0}; /* every field zero is a valid default ground */
+    AK_CHECK_EQ(ak_raster_draw_ground(t.r, &cam, &zero_ground), AK_OK);
     ak_raster_ground g = {.half_extent = NAN};
     AK_CHECK_EQ(ak_raster_draw_ground(t.r, &cam, &g), AK_ERR_BAD_ARG);
     g = (ak_raster_ground){.caster_count = 1};

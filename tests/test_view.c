@@ -234,6 +234,12 @@ AK_TEST(scene_render_skeleton_and_gif) {
     sk.parents = (ak_i16_cspan){parents, 1};
     AK_CHECK_EQ(ak_view_draw_skeleton(r, &cam, &sk), AK_ERR_BAD_ARG);
     AK_CHECK_EQ(ak_view_render(r, &cam, NULL, &frames[0]), AK_ERR_NULL_ARG);
+    ak_view_skeleton zero_sk = {0};
+    AK_CHECK_EQ(ak_view_draw_skeleton(r, &cam, &zero_sk), AK_ERR_NULL_ARG);
+    ak_view_scene empty = {0}; /* background only: every pixel is a background colour */
+    AK_CHECK_EQ(ak_view_render(r, &cam, &empty, &frames[0]), AK_OK);
+    AK_CHECK(memcmp(ak_image_pixel(&frames[0], 3, 5), ak_image_pixel(&frames[0], W - 3, 5), 4) == 0);
+    AK_CHECK(ak_image_pixel(&frames[0], 3, 2)[2] > ak_image_pixel(&frames[0], 3, H - 2)[2]); /* light top */
     ak_raster_destroy(r);
 }
 
