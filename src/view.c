@@ -382,13 +382,18 @@ static ak_result plot_layout_make(const ak_view_plot* p, int w, int h, plot_layo
         double pad = 0.08 * (ymax - ymin);
         ymin -= pad, ymax += pad;
     }
+    /* spans beyond float range cannot be mapped to pixels */
+    if (!isfinite(xmax - xmin) || !isfinite(ymax - ymin) || fabs(xmin) > 1e30 || fabs(xmax) > 1e30 ||
+        fabs(ymin) > 1e30 || fabs(ymax) > 1e30)
+        return AK_ERR_BAD_ARG;
     L->xmin = xmin, L->xmax = xmax, L->ymin = ymin, L->ymax = ymax;
     L->ystep = nice_step(ymax - ymin, h > 300 ? 6.0 : 4.0, &L->ydec);
     L->xstep = nice_step(xmax - xmin, fmax(2.0, (double)w / 90.0), &L->xdec);
     /* widest y tick label sets the left margin */
     int maxlen = 1;
     char buf[64];
-    for (double v = ceil(ymin / L->ystep) * L->ystep; v <= ymax + L->ystep * 1e-6; v += L->ystep) {
+    int guard = 0;
+    for (double v = ceil(ymin / L->ystep) * L->ystep; v <= ymax + L->ystep * 1e-6 && guard < 64; v += L->ystep, ++guard) {
         format_tick(buf, sizeof buf, v, L->ystep, L->ydec);
         int len = (int)strlen(buf);
         if (len > maxlen) maxlen = len;
@@ -459,7 +464,8 @@ ak_result ak_view_plot_draw(const ak_view_plot* p, const ak_image* out) {
     ak_image_fill_rect(out, L.ax0, L.ay0, L.ax1 - L.ax0, L.ay1 - L.ay0, rgba(1, 1, 1, 1));
     char buf[64];
     /* grid and ticks */
-    for (double v = ceil(L.ymin / L.ystep) * L.ystep; v <= L.ymax + L.ystep * 1e-6; v += L.ystep) {
+    int guard = 0;
+    for (double v = ceil(L.ymin / L.ystep) * L.ystep; v <= L.ymax + L.ystep * 1e-6 && guard < 64; v += L.ystep, ++guard) {
         float y = map_pt(&L, L.xmin, v).y;
         ak_image_draw_line(out, ak_vec2_make(L.ax0, y), ak_vec2_make(L.ax1, y), 1.0f, grid);
         format_tick(buf, sizeof buf, v, L.ystep, L.ydec);
@@ -467,7 +473,8 @@ ak_result ak_view_plot_draw(const ak_view_plot* p, const ak_image* out) {
         ak_text_size(buf, 1, &tw, &th);
         ak_image_draw_text(out, (int)L.ax0 - 6 - tw, (int)(y - 3.5f), buf, 1, ink);
     }
-    for (double v = ceil(L.xmin / L.xstep) * L.xstep; v <= L.xmax + L.xstep * 1e-6; v += L.xstep) {
+    guard = 0;
+    for (double v = ceil(L.xmin / L.xstep) * L.xstep; v <= L.xmax + L.xstep * 1e-6 && guard < 64; v += L.xstep, ++guard) {
         float x = map_pt(&L, v, L.ymin).x;
         ak_image_draw_line(out, ak_vec2_make(x, L.ay0), ak_vec2_make(x, L.ay1), 1.0f, grid);
         ak_image_draw_line(out, ak_vec2_make(x, L.ay1), ak_vec2_make(x, L.ay1 + 4.0f), 1.0f, ink);

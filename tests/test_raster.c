@@ -790,6 +790,26 @@ AK_TEST(bad_input_codes) {
     AK_CHECK_EQ(ak_raster_resolve(t.r, &wrong), AK_ERR_BAD_ARG);
     AK_CHECK_EQ(ak_raster_resolve(t.r, NULL), AK_ERR_NULL_ARG);
     AK_CHECK_EQ(ak_raster_draw_text(t.r, 0, 0, NULL, 1, ak_vec4_make(1, 1, 1, 1)), AK_ERR_NULL_ARG);
+    /* huge but finite 2D coordinates and sizes: clipped, no overflow (UBSan watches) */
+    AK_CHECK_EQ(ak_image_fill_rect(&t.img, -1e30f, -1e30f, 3e30f, 3e30f, ak_vec4_make(1, 0, 0, 1)), AK_OK);
+    AK_CHECK_EQ(ak_image_fill_rect(&t.img, 1e30f, 1e30f, 1, 1, ak_vec4_make(1, 0, 0, 1)), AK_OK);
+    AK_CHECK_EQ(ak_image_draw_line(&t.img, ak_vec2_make(-1e30f, 0), ak_vec2_make(1e30f, 5), 1e30f, ak_vec4_make(1, 1, 1, 1)),
+                AK_OK);
+    AK_CHECK_EQ(ak_image_draw_disc(&t.img, ak_vec2_make(1e30f, -1e30f), 1e30f, ak_vec4_make(1, 1, 1, 1), 1e30f,
+                                   ak_vec4_make(0, 0, 0, 1)),
+                AK_OK);
+    AK_CHECK_EQ(ak_image_draw_text(&t.img, 2147483000, -2147483000, "overflow?", 64, ak_vec4_make(1, 1, 1, 1)), AK_OK);
+    AK_CHECK_EQ(ak_raster_draw_text(t.r, 2147483000, 0, "x", 3, ak_vec4_make(1, 1, 1, 1)), AK_OK);
+    ak_raster_points huge_pt = {.positions = {p, 1}, .radius = 1e30f, .outline = 1e30f};
+    AK_CHECK_EQ(ak_raster_draw_points(t.r, &cam, &huge_pt), AK_OK);
+    ak_raster_lines huge_ln = {.positions = {p, 2}, .width = 1e30f};
+    AK_CHECK_EQ(ak_raster_draw_lines(t.r, &cam, &huge_ln), AK_OK);
+    ak_raster_ground soft = {.shadow_softness = 1e30f, .casters = &mq, .caster_count = 1};
+    AK_CHECK_EQ(ak_raster_draw_ground(t.r, &cam, &soft), AK_OK);
+    ak_vec3 far_tri[3] = {{1e30f, 0, 0}, {-1e30f, 0, 1e30f}, {0, 1e30f, 0}};
+    ak_raster_mesh far_caster = {.positions = {far_tri, 3}};
+    soft.casters = &far_caster;
+    AK_CHECK_EQ(ak_raster_draw_ground(t.r, &cam, &soft), AK_OK);
     ak_image zero_img = {.pixels = t.px, .width = 0, .height = 4};
     AK_CHECK_EQ(ak_image_fill(&zero_img, ak_vec4_make(1, 1, 1, 1)), AK_ERR_BAD_ARG);
     AK_CHECK_EQ(ak_png_write("x.png", &zero_img), AK_ERR_BAD_ARG);

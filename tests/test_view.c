@@ -186,6 +186,12 @@ AK_TEST(plot_draws_at_mapped_pixels) {
     ak_view_series ns = {.x = {nanx, 2}, .y = {nanx, 2}};
     ak_view_plot np = {.series = &ns, .series_count = 1};
     AK_CHECK_EQ(ak_view_plot_draw(&np, &img), AK_ERR_EMPTY);
+    float hugey[2] = {-3e38f, 3e38f}, hugex[2] = {0, 1};
+    ak_view_series hs = {.x = {hugex, 2}, .y = {hugey, 2}};
+    ak_view_plot hp = {.series = &hs, .series_count = 1};
+    AK_CHECK_EQ(ak_view_plot_draw(&hp, &img), AK_ERR_BAD_ARG); /* and no endless tick loop */
+    hugey[0] = 1e6f, hugey[1] = 1e6f + 0.5f;                   /* tiny range far from zero: fine */
+    AK_CHECK_EQ(ak_view_plot_draw(&hp, &img), AK_OK);
     ak_view_plot inv = plot;
     inv.x_min = 5, inv.x_max = 1;
     AK_CHECK_EQ(ak_view_plot_draw(&inv, &img), AK_ERR_BAD_ARG);

@@ -237,7 +237,7 @@ typedef struct ak_raster_lines {
     ak_u32_cspan indices;    /* 2 per segment; empty -> positions taken two at a time */
     ak_vec4_cspan colors;    /* per-vertex sRGB colours; empty -> color */
     ak_vec4 color;           /* sRGB; all zero -> opaque black */
-    float width;             /* pixels of the output image; 0 -> 2 */
+    float width;             /* pixels of the output image; 0 -> 2, at most 256 */
     const ak_mat4* model;    /* NULL -> identity */
     bool on_top;             /* false -> depth-tested; true -> drawn over everything */
 } ak_raster_lines;
@@ -253,8 +253,8 @@ typedef struct ak_raster_points {
     ak_vec3_cspan positions; /* required; model space */
     ak_vec4_cspan colors;    /* per-point sRGB colours; empty -> color */
     ak_vec4 color;           /* sRGB; all zero -> opaque black */
-    float radius;            /* pixels of the output image; 0 -> 4 */
-    float outline;           /* outline width in pixels; 0 -> none */
+    float radius;            /* pixels of the output image; 0 -> 4, at most 256 */
+    float outline;           /* outline width in pixels; 0 -> none, at most 256 */
     const ak_mat4* model;    /* NULL -> identity */
     bool on_top;             /* false -> depth-tested; true -> drawn over everything */
 } ak_raster_points;

@@ -173,7 +173,7 @@ AK_API bool ak_view_plot_map(const ak_view_plot* plot, int width, int height, fl
                              ak_vec2* out_pixel);
 /* Draw the chart into out (whole image). AK_ERR_NULL_ARG, AK_ERR_EMPTY (no series or no
  * points at all), AK_ERR_BAD_ARG (count mismatches, image smaller than 120 x 80, non-finite
- * or inverted range). Non-finite samples break the line (a gap), non-finite keys are skipped. */
+ * or inverted range, data beyond +-1e30). Non-finite samples break the line (a gap), non-finite keys are skipped. */
 AK_API ak_result ak_view_plot_draw(const ak_view_plot* plot, const ak_image* out);
 
 /* ---- animation -------------------------------------------------------------------------------- */

@@ -1127,7 +1127,7 @@ ak_result ak_raster_draw_lines(ak_raster* raster, const ak_raster_camera* camera
     dc.depth_test = !lines->on_top;
     dc.depth_write = false;
     dc.depth_bias = -2e-5f;
-    float wpx = lines->width > 0.0f && ak_finitef(lines->width) ? lines->width : 2.0f;
+    float wpx = lines->width > 0.0f && ak_finitef(lines->width) ? ak_minf(lines->width, 256.0f) : 2.0f;
     dc.half_width_px = 0.5f * wpx * (float)raster->ss;
     dc.setup = line_setup;
     dc.input_count = lines->indices.count ? lines->indices.count / 2 : lines->positions.count / 2;
@@ -1179,8 +1179,8 @@ ak_result ak_raster_draw_points(ak_raster* raster, const ak_raster_camera* camer
     dc.depth_test = !points->on_top;
     dc.depth_write = true;
     dc.depth_bias = -4e-5f;
-    float rad = points->radius > 0.0f && ak_finitef(points->radius) ? points->radius : 4.0f;
-    float ol = points->outline > 0.0f && ak_finitef(points->outline) ? points->outline : 0.0f;
+    float rad = points->radius > 0.0f && ak_finitef(points->radius) ? ak_minf(points->radius, 256.0f) : 4.0f;
+    float ol = points->outline > 0.0f && ak_finitef(points->outline) ? ak_minf(points->outline, 256.0f) : 0.0f;
     dc.half_width_px = (rad + ol) * (float)raster->ss;
     dc.outline_frac = rad / (rad + ol);
     /* outline: the point colour darkened */
@@ -1231,11 +1231,9 @@ static void shadow_render(ak_raster* r, const ak_raster_ground* g, ak_vec3 ldir,
             if (!(fabsf(area) > 1e-12f)) continue;
             float minu = ak_minf(u[0], ak_minf(u[1], u[2])), maxu = ak_maxf(u[0], ak_maxf(u[1], u[2]));
             float minv = ak_minf(v[0], ak_minf(v[1], v[2])), maxv = ak_maxf(v[0], ak_maxf(v[1], v[2]));
-            int x0 = (int)floorf(minu), x1 = (int)ceilf(maxu), y0 = (int)floorf(minv), y1 = (int)ceilf(maxv);
-            if (x0 < 0) x0 = 0;
-            if (y0 < 0) y0 = 0;
-            if (x1 > SHADOW_RES - 1) x1 = SHADOW_RES - 1;
-            if (y1 > SHADOW_RES - 1) y1 = SHADOW_RES - 1;
+            if (!(maxu >= 0.0f && maxv >= 0.0f && minu <= (float)SHADOW_RES && minv <= (float)SHADOW_RES)) continue;
+            int x0 = (int)floorf(ak_maxf(minu, 0.0f)), x1 = (int)ceilf(ak_minf(maxu, (float)SHADOW_RES - 1.0f));
+            int y0 = (int)floorf(ak_maxf(minv, 0.0f)), y1 = (int)ceilf(ak_minf(maxv, (float)SHADOW_RES - 1.0f));
             float ia = 1.0f / area;
             for (int y = y0; y <= y1; ++y)
                 for (int x = x0; x <= x1; ++x) {
@@ -1325,8 +1323,8 @@ ak_result ak_raster_draw_ground(ak_raster* raster, const ak_raster_camera* camer
         float strength = ground->shadow_strength > 0.0f ? clamp01(ground->shadow_strength) : 0.55f;
         shadow_render(raster, ground, d, dc.ground_cx, dc.ground_cz, e, strength);
         float soft = ground->shadow_softness > 0.0f ? ground->shadow_softness : e / 40.0f;
-        int rad = (int)(soft / (2.0f * e / (float)SHADOW_RES) * 0.6f + 0.5f);
-        if (rad > 32) rad = 32;
+        float frad = soft / (2.0f * e / (float)SHADOW_RES) * 0.6f + 0.5f;
+        int rad = frad < 32.0f ? (int)frad : 32;
         box_blur(raster->shadow, raster->shadow_tmp, rad);
         dc.shadow = true;
     }
@@ -1358,7 +1356,8 @@ ak_result ak_raster_draw_ground(ak_raster* raster, const ak_raster_camera* camer
 
 ak_result ak_raster_draw_text(ak_raster* raster, int x, int y, const char* text, int scale, ak_vec4 color) {
     if (!raster || !text) return AK_ERR_NULL_ARG;
+    if (x < -(1 << 24) || x > (1 << 24) || y < -(1 << 24) || y > (1 << 24)) return AK_OK; /* off any image */
     ak_image img = {raster->color, raster->sw, raster->sh, 0};
-    int s = scale > 0 ? scale : 1;
+    int s = scale > 0 ? (scale > 64 ? 64 : scale) : 1;
     return ak_image_draw_text(&img, x * raster->ss, y * raster->ss, text, s * raster->ss, color);
 }

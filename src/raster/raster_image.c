@@ -110,6 +110,13 @@ static const uint8_t k_font[95][7] = {
 
 static inline float clamp01(float x) { return x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x); }
 
+/* float -> int clamped to [lo, hi] without undefined behaviour for huge values or NaN (-> lo). */
+static inline int to_int_clamped(float v, int lo, int hi) {
+    if (!(v >= (float)lo)) return lo;
+    if (v >= (float)hi) return hi;
+    return (int)v;
+}
+
 static bool image_ok(const ak_image* im) {
     return im && im->pixels && im->width > 0 && im->height > 0 &&
            (im->stride == 0 || im->stride >= (size_t)im->width * 4u);
@@ -173,8 +180,8 @@ ak_result ak_image_fill_rect(const ak_image* image, float x, float y, float w, f
     uint8_t c[4];
     ak_color_to_rgba8(color, c);
     float x1 = x + w, y1 = y + h;
-    int ix0 = (int)floorf(ak_maxf(x, 0.0f)), iy0 = (int)floorf(ak_maxf(y, 0.0f));
-    int ix1 = (int)ceilf(ak_minf(x1, (float)image->width)), iy1 = (int)ceilf(ak_minf(y1, (float)image->height));
+    int ix0 = to_int_clamped(floorf(x), 0, image->width), iy0 = to_int_clamped(floorf(y), 0, image->height);
+    int ix1 = to_int_clamped(ceilf(x1), 0, image->width), iy1 = to_int_clamped(ceilf(y1), 0, image->height);
     for (int py = iy0; py < iy1; ++py) {
         float cy = clamp01(ak_minf((float)py + 1.0f, y1) - ak_maxf((float)py, y));
         for (int px = ix0; px < ix1; ++px) {
@@ -195,8 +202,8 @@ ak_result ak_image_draw_line(const ak_image* image, ak_vec2 a, ak_vec2 b, float 
     const float hw = 0.5f * width;
     float minx = ak_minf(a.x, b.x) - hw - 1.0f, maxx = ak_maxf(a.x, b.x) + hw + 1.0f;
     float miny = ak_minf(a.y, b.y) - hw - 1.0f, maxy = ak_maxf(a.y, b.y) + hw + 1.0f;
-    int x0 = (int)floorf(ak_maxf(minx, 0.0f)), x1 = (int)ceilf(ak_minf(maxx, (float)image->width - 1.0f));
-    int y0 = (int)floorf(ak_maxf(miny, 0.0f)), y1 = (int)ceilf(ak_minf(maxy, (float)image->height - 1.0f));
+    int x0 = to_int_clamped(floorf(minx), 0, image->width), x1 = to_int_clamped(ceilf(maxx), -1, image->width - 1);
+    int y0 = to_int_clamped(floorf(miny), 0, image->height), y1 = to_int_clamped(ceilf(maxy), -1, image->height - 1);
     float dx = b.x - a.x, dy = b.y - a.y, l2 = dx * dx + dy * dy;
     for (int py = y0; py <= y1; ++py)
         for (int px = x0; px <= x1; ++px) {
@@ -221,10 +228,10 @@ ak_result ak_image_draw_disc(const ak_image* image, ak_vec2 center, float radius
     ak_color_to_rgba8(color, c);
     ak_color_to_rgba8(outline_color, oc);
     float R = radius + outline_width;
-    int x0 = (int)floorf(ak_maxf(center.x - R - 1.0f, 0.0f));
-    int x1 = (int)ceilf(ak_minf(center.x + R + 1.0f, (float)image->width - 1.0f));
-    int y0 = (int)floorf(ak_maxf(center.y - R - 1.0f, 0.0f));
-    int y1 = (int)ceilf(ak_minf(center.y + R + 1.0f, (float)image->height - 1.0f));
+    int x0 = to_int_clamped(floorf(center.x - R - 1.0f), 0, image->width);
+    int x1 = to_int_clamped(ceilf(center.x + R + 1.0f), -1, image->width - 1);
+    int y0 = to_int_clamped(floorf(center.y - R - 1.0f), 0, image->height);
+    int y1 = to_int_clamped(ceilf(center.y + R + 1.0f), -1, image->height - 1);
     for (int py = y0; py <= y1; ++py)
         for (int px = x0; px <= x1; ++px) {
             float qx = (float)px + 0.5f - center.x, qy = (float)py + 0.5f - center.y;
@@ -283,6 +290,8 @@ ak_result ak_image_draw_text(const ak_image* image, int x, int y, const char* te
     if (!image || !text || !image->pixels) return AK_ERR_NULL_ARG;
     if (!image_ok(image)) return AK_ERR_BAD_ARG;
     int s = scale > 0 ? (scale > 64 ? 64 : scale) : 1;
+    /* far outside any image: nothing to draw (and no int overflow further down) */
+    if (x < -(1 << 24) || x > (1 << 24) || y < -(1 << 24) || y > (1 << 24)) return AK_OK;
     uint8_t c[4];
     ak_color_to_rgba8(color, c);
     int cx = x, cy = y;
