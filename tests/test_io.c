@@ -735,6 +735,11 @@ static void check_bvh(const char* rel) {
         return;
     }
     AK_CHECK_EQ(ak_scene_joint_count(s), b->joints + b->end_sites);
+    /* joints are the ROOT and JOINT entries; End Sites are nodes but not joints */
+    size_t marked = 0;
+    for (size_t j = 0; s->is_joint && j < ak_scene_joint_count(s); ++j) marked += s->is_joint[j];
+    AK_CHECK(s->is_joint != NULL);
+    AK_CHECK_EQ(marked, b->joints);
     AK_CHECK_EQ(s->mesh_count, 0); /* the bone-visualisation mesh is dropped by default */
     AK_CHECK_EQ(s->clip_count, 1);
     const ak_clip* clip = s->clips[0];

@@ -401,13 +401,21 @@ static ak_result convert(as_ctx* c) {
             r = make_mesh(c, am, m, &sm->mesh);
         }
     }
-    /* BVH nodes are all joints (is_joint NULL); elsewhere only the nodes bones name are. */
-    if (r == AK_OK && (skin_total || !is_bvh(c->path))) {
+    /* Joints are the nodes bones name; in a BVH file without a skin they are the nodes the
+     * motion animates (ROOT and JOINT entries), so End Sites (leaf offsets) are not joints. */
+    if (r == AK_OK && (skin_total || !is_bvh(c->path) || clip_count)) {
         size_t nj = ak_scene_joint_count(c->scene);
         c->scene->is_joint = (bool*)akp_calloc(&c->scene->alloc, (nj ? nj : 1) * sizeof(bool));
         if (!c->scene->is_joint) r = AK_ERR_NO_MEMORY;
         for (size_t s = 0; r == AK_OK && s < skin_total; ++s)
             for (size_t j = 0; j < c->scene->skins[s].joint_count; ++j) c->scene->is_joint[c->scene->skins[s].joints[j]] = true;
+        for (size_t a = 0; r == AK_OK && !skin_total && is_bvh(c->path) && a < clip_count; ++a) {
+            const struct aiAnimation* an = ai->mAnimations[a];
+            for (unsigned i = 0; i < an->mNumChannels; ++i) {
+                int32_t node = find_node(c, &an->mChannels[i]->mNodeName);
+                if (node >= 0 && (size_t)node < c->node_count) c->scene->is_joint[c->joint_of_node[node]] = true;
+            }
+        }
     }
     for (size_t a = 0; r == AK_OK && a < clip_count; ++a) r = build_clip(c, ai->mAnimations[a], a);
     akp_free(c->alloc, inst);
