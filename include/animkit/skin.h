@@ -191,7 +191,8 @@ AK_API uint64_t ak_skin_cor_key(const ak_skin_cor_desc* desc);
  * Fallback: a vertex with a single influence, or whose similarity with every triangle is 0,
  * gets its own position (CoR then equals rigid / LBS skinning for it).
  * Needs out_centers.count >= vertex_count. Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY,
- * AK_ERR_BAD_ARG (influence_count, indices.count % 3, sigma or threshold <= 0),
+ * AK_ERR_BAD_ARG (influence_count, indices.count % 3, sigma or threshold <= 0, more than 64
+ * threads),
  * AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX (triangle index), AK_ERR_BAD_WEIGHTS (NaN or negative
  * weight), AK_ERR_BAD_DATA (NaN position), AK_ERR_NO_MEMORY. */
 AK_API ak_result ak_skin_cor_centers_compute(const ak_skin_cor_desc* desc, const ak_allocator* alloc,
@@ -251,7 +252,8 @@ typedef struct ak_skin_job {
     ak_cstream positions;       /* required: bind-space positions; count = the vertex count */
     ak_cstream joints;          /* required: count >= vertex count */
     ak_cstream weights;         /* required: count >= vertex count */
-    ak_cstream normals;         /* optional (ptr NULL -> none): unit bind-space normals */
+    ak_cstream normals;         /* optional (ptr NULL -> none): unit bind-space normals
+                                   (DQS/CoR rotate them: unit in, unit out) */
     ak_cstream tangents;        /* optional (ptr NULL -> none) */
     ak_cstream cor_centers;     /* AK_SKIN_COR: required, 3 floats per vertex; else unused */
     ak_u32_cspan indices;       /* triangles; only read when normals_from_faces */
