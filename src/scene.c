@@ -117,7 +117,7 @@ void ak_scene_bounds(const ak_scene* scene, ak_vec3* out_min, ak_vec3* out_max) 
     ak_mat4* world = NULL;
     if (n) {
         ak_transform_cspan rest = ak_skeleton_rest_pose(scene->skeleton);
-        world = (ak_mat4*)malloc(n * sizeof(ak_mat4));
+        world = (ak_mat4*)akp_alloc(&scene->alloc, n * sizeof(ak_mat4));
         if (world) ak_skeleton_local_to_model(scene->skeleton, rest, (ak_mat4_span){world, n});
     }
     bool any = false;
@@ -143,7 +143,7 @@ void ak_scene_bounds(const ak_scene* scene, ak_vec3* out_min, ak_vec3* out_max) 
             any = true;
         }
     }
-    free(world);
+    if (world) akp_free(&scene->alloc, world);
     if (!any) lo = hi = ak_vec3_zero();
     if (out_min) *out_min = lo;
     if (out_max) *out_max = hi;

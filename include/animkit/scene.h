@@ -10,6 +10,9 @@
  *     palette[k] = world[skin.joints[k]] * skin.inverse_binds[k]   (ak_scene_skin_palette)
  *     skinned vertex = sum_k w_k palette[joint_k] p       (the mesh node's own transform ignored)
  *     unskinned mesh vertex = world[mesh.node] p          (mesh.node -1 -> identity)
+ * Morph targets come before skinning: clips address one flat array of morph weights, in which
+ * target t of scene mesh m has index sum_{k<m} meshes[k].mesh->morph_target_count + t; its
+ * default is meshes[m].mesh->morph_weights[t].
  *
  * What it does NOT do: read files (io.h), make models (builtin.h), deform (skin.h, blendshape.h).
  *
@@ -100,7 +103,8 @@ AK_API ak_result ak_scene_skin_palette(const ak_scene* scene, size_t skin_index,
                                        ak_mat4_span out_palette);
 
 /* Model-space bounding box of every mesh in its bind/rest placement (skinned meshes as given,
- * unskinned moved by their node's rest world matrix). No meshes: the joints' positions. */
+ * unskinned moved by their node's rest world matrix). No meshes: the joints' positions.
+ * Temporary memory comes from the scene's allocator; NULL scene or no data -> zeros. */
 AK_API void ak_scene_bounds(const ak_scene* scene, ak_vec3* out_min, ak_vec3* out_max);
 
 #ifdef __cplusplus
