@@ -495,6 +495,46 @@ AK_TEST(threads_give_identical_images) {
     target_free(&b);
 }
 
+AK_TEST(threads_keep_order_when_segments_overflow) {
+    /* 5000 huge triangles that cross the near plane and the guard band: each is clipped into
+       several pieces, so the per-thread segments fill up and rounds end early; alpha blending
+       makes the result depend on the drawing order, which must match one thread exactly */
+    enum { N = 5000 };
+    ak_vec3* pos = (ak_vec3*)malloc(sizeof(ak_vec3) * N * 3);
+    ak_vec4* col = (ak_vec4*)malloc(sizeof(ak_vec4) * N * 3);
+    ak_rng rng = ak_rng_make(5);
+    for (int i = 0; i < N; ++i) {
+        /* a floor triangle far larger than the view, turned about the camera's vertical axis:
+           near, far and the side guard planes all cut it */
+        float a = ak_rng_range(&rng, 0, AK_TWO_PI), cs = cosf(a), sn = sinf(a);
+        const float fx[3] = {-1000, 1000, 0}, fz[3] = {-1000, -1000, 1000};
+        for (int k = 0; k < 3; ++k)
+            pos[i * 3 + k] = ak_vec3_make(cs * fx[k] + sn * fz[k], -1.0f, -sn * fx[k] + cs * fz[k] + 3.0f);
+        ak_vec4 c = ak_vec4_make(ak_rng_float(&rng), ak_rng_float(&rng), ak_rng_float(&rng), 0.5f);
+        col[i * 3] = col[i * 3 + 1] = col[i * 3 + 2] = c;
+    }
+    ak_raster_camera cam = ak_raster_camera_perspective(ak_vec3_make(0, 0, 3), ak_vec3_zero(), ak_radians(60), 1.25f, 0.5f, 100);
+    ak_raster_mesh m = {.positions = {pos, N * 3}, .colors = {col, N * 3}, .shading = AK_SHADING_UNLIT,
+                        .blend = AK_BLEND_ALPHA, .material = {.color = {1, 1, 1, 1}}};
+    target one, three;
+    AK_CHECK(target_make(&one, 80, 64, 1, 1));
+    AK_CHECK(target_make(&three, 80, 64, 1, 3));
+    ak_raster_clear(one.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+    ak_raster_clear(three.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+    AK_CHECK_EQ(ak_raster_draw_mesh(one.r, &cam, &m), AK_OK);
+    AK_CHECK_EQ(ak_raster_draw_mesh(three.r, &cam, &m), AK_OK);
+    ak_raster_resolve(one.r, &one.img);
+    ak_raster_resolve(three.r, &three.img);
+    AK_CHECK(memcmp(one.px, three.px, 80 * 64 * 4) == 0);
+    int lit = 0;
+    for (int i = 0; i < 80 * 64; ++i) lit += one.px[i * 4] + one.px[i * 4 + 1] + one.px[i * 4 + 2] > 0;
+    AK_CHECK(lit > 80 * 64 / 3); /* the clipped pieces really cover the floor half of the image */
+    target_free(&one);
+    target_free(&three);
+    free(pos);
+    free(col);
+}
+
 AK_TEST(supersampling_softens_edges) {
     for (int ss = 1; ss <= 4; ss += 3) {
         target t;
@@ -831,6 +871,7 @@ int main(void) {
     AK_RUN(back_face_culling_and_two_sided);
     AK_RUN(lines_and_points_respect_depth);
     AK_RUN(threads_give_identical_images);
+    AK_RUN(threads_keep_order_when_segments_overflow);
     AK_RUN(supersampling_softens_edges);
     AK_RUN(text_glyphs_and_size);
     AK_RUN(png_round_trip);

@@ -1,13 +1,14 @@
 /* Render target, camera, clipping, triangle setup and the threaded rasterizer.
  *
- * Pipeline of a draw call: every thread walks all inputs (mesh triangles, line segments,
- * points) in order: transform to clip space, cull, and skip the input at once when it covers
- * none of the rows the thread owns (32-row blocks of samples dealt out round-robin); otherwise
- * compute the shading attributes, clip against the near/far planes and a guard band, project,
- * snap to 1/256 sample units and rasterize the thread's rows of it straight away. No two
- * threads write the same pixel, no locks are needed, and the per-pixel drawing order equals
- * the input order for any thread count (so the image does not depend on it). The price is
- * that every thread transforms every vertex. */
+ * Pipeline of a draw call: each input (mesh triangle, line segment, point) is transformed to
+ * clip space, culled, shaded at the vertices as the mode needs, clipped against the near/far
+ * planes and a guard band, projected, snapped to 1/256 sample units and rasterized with
+ * integer edge functions. With one thread every triangle is rasterized as soon as it is set
+ * up. With several, the draw runs in rounds: the threads set up consecutive chunks of inputs
+ * into their own segments, meet at a barrier, and then each rasterizes only the rows it owns
+ * (32-row blocks of samples dealt out round-robin) of every segment in input order. No two
+ * threads write the same pixel, and the per-pixel drawing order is the input order for any
+ * thread count, so the image does not depend on it. */
 #include <math.h>
 #include <pthread.h>
 
@@ -23,6 +24,9 @@
 #define GUARD 4.0f       /* guard band in NDC units: |x|, |y| <= GUARD * w */
 #define SHADOW_RES 256
 #define ROW_BLOCK_SHIFT 5
+#define CHUNK 2048          /* inputs each thread sets up per round */
+#define SEG_CAP (2 * CHUNK) /* set-up triangles a thread's segment holds */
+#define OUT_PER_INPUT 7     /* worst case triangles from one clipped triangle */
 #define TONE_LUT_SIZE 8192 /* covers linear [0, 2] */
 #define POW_LUT_SIZE 1024
 
@@ -61,9 +65,12 @@ typedef struct rtri {
 
 typedef struct drawctx drawctx;
 /* Where set-up triangles go: straight to the rasterizer of the thread that made them. */
+/* Where set-up triangles go: appended to a thread's segment (buf != NULL), or straight to
+ * the rasterizer (single thread). */
 typedef struct sink {
     rtri t;
-    int ti, tc; /* this thread's index and the thread count */
+    rtri* buf;          /* segment, or NULL to rasterize at once */
+    size_t count, cap;  /* triangles in buf, and its capacity */
 } sink;
 typedef void (*setup_fn)(const drawctx* dc, size_t input_index, sink* sk);
 
@@ -114,6 +121,7 @@ struct ak_raster {
     uint8_t* color;   /* sw * sh * 4 */
     float* depth;     /* sw * sh */
     float* shadow;    /* SHADOW_RES^2 */
+    rtri* segs;       /* thread_count * SEG_CAP when thread_count > 1, else NULL */
     float* shadow_tmp;
     float to_srgb_lut[4097]; /* linear [0,1] -> sRGB byte (as float) */
     float to_lin_lut[256];   /* sRGB byte -> linear */
@@ -214,7 +222,9 @@ ak_result ak_raster_create(const ak_raster_desc* desc, const ak_allocator* alloc
     size_t off_depth = off_color + akp_align16(sw * sh * 4u);
     size_t off_shadow = off_depth + akp_align16(sw * sh * sizeof(float));
     size_t off_tmp = off_shadow + akp_align16((size_t)SHADOW_RES * SHADOW_RES * sizeof(float));
-    size_t total = off_tmp + (size_t)SHADOW_RES * SHADOW_RES * sizeof(float);
+    size_t off_segs = off_tmp + akp_align16((size_t)SHADOW_RES * SHADOW_RES * sizeof(float));
+    size_t nseg = d.thread_count > 1 ? (size_t)d.thread_count * SEG_CAP : 0;
+    size_t total = off_segs + nseg * sizeof(rtri);
     uint8_t* mem = (uint8_t*)akp_alloc(alloc, total);
     if (!mem) return AK_ERR_NO_MEMORY;
     ak_raster* r = (ak_raster*)mem;
@@ -231,6 +241,7 @@ ak_result ak_raster_create(const ak_raster_desc* desc, const ak_allocator* alloc
     r->depth = (float*)(void*)(mem + off_depth);
     r->shadow = (float*)(void*)(mem + off_shadow);
     r->shadow_tmp = (float*)(void*)(mem + off_tmp);
+    r->segs = nseg ? (rtri*)(void*)(mem + off_segs) : NULL;
     for (int i = 0; i <= 4096; ++i) r->to_srgb_lut[i] = floorf(ak_linear_to_srgb((float)i / 4096.0f) * 255.0f + 0.5f);
     for (int i = 0; i < 256; ++i) r->to_lin_lut[i] = ak_srgb_to_linear((float)i / 255.0f);
     for (int i = 0; i <= TONE_LUT_SIZE; ++i)
@@ -380,16 +391,6 @@ static inline ak_vec3 shade(const drawctx* dc, ak_vec3 n, ak_vec3 p, ak_vec3 alb
 
 static void raster_tri(const drawctx* dc, const rtri* t, int ti, int tc);
 
-/* Whether thread ti of tc owns any row in [y0, y1] (row blocks dealt out round-robin). */
-static inline bool rows_owned(int y0, int y1, int ti, int tc) {
-    if (tc <= 1) return true;
-    int b0 = y0 >> ROW_BLOCK_SHIFT, b1 = y1 >> ROW_BLOCK_SHIFT;
-    if (b1 - b0 + 1 >= tc) return true;
-    for (int b = b0; b <= b1; ++b)
-        if (b % tc == ti) return true;
-    return false;
-}
-
 /* ---- clipping and setup ------------------------------------------------------------------ */
 
 static const float k_planes[6][4] = {
@@ -438,7 +439,7 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
         o[2] = 1;
         area = -area;
     }
-    rtri* t = &sk->t;
+    rtri* t = sk->buf ? &sk->buf[sk->count] : &sk->t;
     int64_t X[3] = {fx[o[0]], fx[o[1]], fx[o[2]]}, Y[3] = {fy[o[0]], fy[o[1]], fy[o[2]]};
     for (int i = 0; i < 3; ++i) {
         int a = (i + 1) % 3, b = (i + 2) % 3; /* edge opposite vertex i */
@@ -464,7 +465,6 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
     if (x1 >= r->sw) x1 = r->sw - 1;
     if (y1 >= r->sh) y1 = r->sh - 1;
     if (x0 > x1 || y0 > y1) return;
-    if (!rows_owned((int)y0, (int)y1, sk->ti, sk->tc)) return;
     t->x0 = (int)x0;
     t->x1 = (int)x1;
     t->y0 = (int)y0;
@@ -484,7 +484,8 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
         t->da2[k] = v[i2]->a[k] * iw[i2] - a0;
     }
     if (flat) memcpy(t->flat, flat, sizeof t->flat);
-    raster_tri(dc, t, sk->ti, sk->tc);
+    if (sk->buf) ++sk->count;
+    else raster_tri(dc, t, 0, 1);
 }
 
 /* Clip a clip-space triangle against near/far and the guard band, then set up the pieces. */
@@ -746,18 +747,65 @@ typedef struct gate {
     int go; /* 0 wait, 1 run, -1 quit */
 } gate;
 
+/* What each thread's setup produced in a round; written before the first barrier of the
+ * round, read after it. */
+typedef struct rounds {
+    size_t count[MAX_THREADS]; /* triangles in the thread's segment */
+    size_t next[MAX_THREADS];  /* first input the thread did not set up */
+    bool full[MAX_THREADS];    /* the segment filled up before the thread's chunk ended */
+} rounds;
+
 typedef struct worker {
     const drawctx* dc;
     int index, count;
     gate* gate;
+    pthread_barrier_t* barrier;
+    rounds* rounds;
 } worker;
 
+static void run_single(const drawctx* dc) {
+    sink sk;
+    memset(&sk, 0, sizeof sk);
+    for (size_t i = 0; i < dc->input_count; ++i) dc->setup(dc, i, &sk);
+}
+
+/* One thread of a parallel draw. Each round the threads set up consecutive chunks of the
+ * inputs into their own segments, wait, then each rasterizes its own rows of every segment in
+ * input order, and wait again. A segment that fills up ends the round early: the segments after
+ * it are dropped and redone, so the per-pixel order is always the input order. */
 static void run_worker(const worker* w) {
     const drawctx* dc = w->dc;
+    rounds* st = w->rounds;
+    const size_t n = dc->input_count, T = (size_t)w->count;
     sink sk;
-    sk.ti = w->index;
-    sk.tc = w->count;
-    for (size_t i = 0; i < dc->input_count; ++i) dc->setup(dc, i, &sk);
+    memset(&sk, 0, sizeof sk);
+    sk.buf = dc->r->segs + (size_t)w->index * SEG_CAP;
+    sk.cap = SEG_CAP;
+    size_t base = 0;
+    while (base < n) {
+        size_t b = base + (size_t)w->index * CHUNK, e = b + CHUNK, i;
+        if (b > n) b = n;
+        if (e > n) e = n;
+        sk.count = 0;
+        for (i = b; i < e && sk.cap - sk.count >= OUT_PER_INPUT; ++i) dc->setup(dc, i, &sk);
+        st->count[w->index] = sk.count;
+        st->next[w->index] = i;
+        st->full[w->index] = i < e;
+        pthread_barrier_wait(w->barrier);
+        size_t last = T - 1;
+        for (size_t k = 0; k < T; ++k)
+            if (st->full[k]) {
+                last = k;
+                break;
+            }
+        for (size_t k = 0; k <= last; ++k) {
+            const rtri* seg = dc->r->segs + k * SEG_CAP;
+            for (size_t t = 0; t < st->count[k]; ++t) raster_tri(dc, &seg[t], w->index, w->count);
+        }
+        size_t next_base = st->full[last] ? st->next[last] : base + T * CHUNK;
+        pthread_barrier_wait(w->barrier);
+        base = next_base;
+    }
 }
 
 static void* worker_main(void* p) {
@@ -770,51 +818,54 @@ static void* worker_main(void* p) {
     return NULL;
 }
 
-static void set_workers(worker* ws, int tc, const drawctx* dc, gate* g) {
+/* Run a draw over up to desc.thread_count threads (see run_worker). Threads that cannot be
+ * started are simply not used. */
+static void run_draw(const drawctx* dc) {
+    int tc = dc->r->desc.thread_count;
+    if (dc->input_count < 256 || !dc->r->segs) tc = 1; /* threads would cost more than they save */
+    if (tc == 1) {
+        run_single(dc);
+        return;
+    }
+    worker ws[MAX_THREADS];
+    gate g;
+    rounds st;
+    pthread_barrier_t barrier;
+    if (pthread_mutex_init(&g.mu, NULL) != 0) {
+        run_single(dc);
+        return;
+    }
+    if (pthread_cond_init(&g.cv, NULL) != 0) {
+        pthread_mutex_destroy(&g.mu);
+        run_single(dc);
+        return;
+    }
+    g.go = 0;
     for (int i = 0; i < tc; ++i) {
         ws[i].dc = dc;
         ws[i].index = i;
         ws[i].count = tc;
-        ws[i].gate = g;
+        ws[i].gate = &g;
+        ws[i].barrier = &barrier;
+        ws[i].rounds = &st;
     }
-}
-
-/* Run a draw over up to desc.thread_count threads. Every thread sets up every input (cheap
- * rejection first) and rasterizes only the rows it owns, so threads never write the same
- * pixel and need no synchronisation. Threads that cannot be started are simply not used:
- * the rows are dealt out among those that did start. */
-static void run_draw(const drawctx* dc) {
-    int tc = dc->r->desc.thread_count;
-    if (dc->input_count < 64) tc = 1; /* threads would cost more than they save */
-    worker ws[MAX_THREADS];
-    gate g;
-    if (tc > 1 && pthread_mutex_init(&g.mu, NULL) != 0) tc = 1;
-    if (tc > 1 && pthread_cond_init(&g.cv, NULL) != 0) {
-        pthread_mutex_destroy(&g.mu);
-        tc = 1;
-    }
-    if (tc == 1) {
-        set_workers(ws, 1, dc, NULL);
-        run_worker(&ws[0]);
-        return;
-    }
-    g.go = 0;
-    set_workers(ws, tc, dc, &g);
     pthread_t th[MAX_THREADS];
     int started = 1;
     for (int i = 1; i < tc; ++i) {
         if (pthread_create(&th[i], NULL, worker_main, &ws[i]) != 0) break;
         ++started;
     }
+    bool ok = started > 1 && pthread_barrier_init(&barrier, NULL, (unsigned)started) == 0;
     pthread_mutex_lock(&g.mu);
-    /* the rows are dealt out among the threads that did start; workers read count only
-       after taking the lock */
+    /* workers read count only after taking the lock */
     for (int i = 0; i < started; ++i) ws[i].count = started;
-    g.go = 1;
+    g.go = ok ? 1 : -1;
     pthread_cond_broadcast(&g.cv);
     pthread_mutex_unlock(&g.mu);
-    run_worker(&ws[0]);
+    if (ok) run_worker(&ws[0]);
     for (int i = 1; i < started; ++i) pthread_join(th[i], NULL);
+    if (ok) pthread_barrier_destroy(&barrier);
+    else run_single(dc);
     pthread_cond_destroy(&g.cv);
     pthread_mutex_destroy(&g.mu);
 }
@@ -853,18 +904,6 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
     int front = det > 0.0f;
     if (det == 0.0f) return;
     if (dc->cull && !front) return;
-    if (sk->tc > 1 && v[0].c[3] > 0.0f && v[1].c[3] > 0.0f && v[2].c[3] > 0.0f) {
-        /* skip the attribute work when this thread owns none of the triangle's rows */
-        float ymin = 1e30f, ymax = -1e30f;
-        for (int k = 0; k < 3; ++k) {
-            float sy = (0.5f - 0.5f * v[k].c[1] / v[k].c[3]) * (float)dc->r->sh;
-            ymin = ak_minf(ymin, sy);
-            ymax = ak_maxf(ymax, sy);
-        }
-        if (ymax < 0.0f || ymin > (float)dc->r->sh) return;
-        if (!rows_owned((int)ak_maxf(ymin - 1.0f, 0.0f), (int)ak_minf(ymax + 1.0f, (float)dc->r->sh), sk->ti, sk->tc))
-            return;
-    }
     if (!dc->model_identity)
         for (int k = 0; k < 3; ++k) wp[k] = ak_mat4_transform_point(dc->model, wp[k]);
     float flat[4] = {0, 0, 0, 1};
