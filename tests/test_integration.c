@@ -23,17 +23,6 @@ static void mat_identity(double* m) {
     m[0] = m[5] = m[10] = m[15] = 1.0;
 }
 
-static void mat_mul(const double* a, const double* b, double* out) {
-    double r[16];
-    for (int c = 0; c < 4; ++c)
-        for (int k = 0; k < 4; ++k) {
-            double acc = 0;
-            for (int i = 0; i < 4; ++i) acc += a[i * 4 + k] * b[c * 4 + i];
-            r[c * 4 + k] = acc;
-        }
-    memcpy(out, r, sizeof r);
-}
-
 static void trs_matrix(const double* t, const double* q, const double* s, double* m) {
     double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     double x = q[0] / n, y = q[1] / n, z = q[2] / n, w = q[3] / n;
@@ -156,7 +145,7 @@ static void pose_nodes(const doc* d, ref_node* nodes, int n, int ai, double t, d
         for (int j = i; j >= 0; j = nodes[j].parent) {
             if (nodes[j].has_matrix) memcpy(local, nodes[j].m, sizeof local);
             else trs_matrix(nodes[j].t, nodes[j].r, nodes[j].s, local);
-            mat_mul(local, m, m);
+            ref_mat4d_mul(local, m, m);
         }
         memcpy(world[i], m, sizeof m);
     }
@@ -186,6 +175,16 @@ static int list_gltf_files(const char* dir, char (*out)[1024], int cap) {
     }
     closedir(top);
     return n;
+}
+
+/* Every .gltf/.glb under the assets' gltf folder; 0 (and a SKIP line) without the assets. */
+static int gltf_asset_files(char (*files)[1024], int cap) {
+    char dir[1100];
+    if (!ak_test_asset(dir, sizeof dir, "gltf")) {
+        AK_SKIP("no assets (set ANIMKIT_ASSETS or put them in ../shared/assets)");
+        return 0;
+    }
+    return list_gltf_files(dir, files, cap);
 }
 
 /* ---- LBS on every skinned glTF ------------------------------------------------------------ */
@@ -291,7 +290,7 @@ static void check_skinned_file(const char* path, int* files_checked) {
                                     int node = cJSON_GetArrayItem(jget(sk, "joints"), slot)->valueint;
                                     double ib[16], M[16];
                                     for (int e = 0; e < 16; ++e) ib[e] = ibm[slot * 16 + e];
-                                    mat_mul(world[node], ib, M);
+                                    ref_mat4d_mul(world[node], ib, M);
                                     const float* p = pos + v * 3;
                                     for (int c = 0; c < 3; ++c)
                                         acc[c] += w * (M[c] * p[0] + M[4 + c] * p[1] + M[8 + c] * p[2] + M[12 + c]);
@@ -323,13 +322,9 @@ static void check_skinned_file(const char* path, int* files_checked) {
 }
 
 AK_TEST(lbs_matches_double_reference_on_skinned_gltf) {
-    char dir[1100];
-    if (!ak_test_asset(dir, sizeof dir, "gltf")) {
-        AK_SKIP("no assets (set ANIMKIT_ASSETS or put them in ../shared/assets)");
-        return;
-    }
     static char files[64][1024];
-    int n = list_gltf_files(dir, files, 64), checked = 0;
+    int n = gltf_asset_files(files, 64), checked = 0;
+    if (n == 0) return;
     for (int i = 0; i < n; ++i) {
         doc d;
         if (!doc_open(&d, files[i])) continue;
@@ -440,13 +435,9 @@ static void check_morph_file(const char* path, int* checked) {
 }
 
 AK_TEST(morph_targets_match_accessors) {
-    char dir[1100];
-    if (!ak_test_asset(dir, sizeof dir, "gltf")) {
-        AK_SKIP("no assets (set ANIMKIT_ASSETS or put them in ../shared/assets)");
-        return;
-    }
     static char files[64][1024];
-    int n = list_gltf_files(dir, files, 64), checked = 0;
+    int n = gltf_asset_files(files, 64), checked = 0;
+    if (n == 0) return;
     for (int i = 0; i < n; ++i) {
         if (!strstr(files[i], "Morph")) continue;
         check_morph_file(files[i], &checked);

@@ -361,7 +361,6 @@ AK_TEST(gltf_variants_agree) {
 
 /* ---- bind poses ------------------------------------------------------------------------ */
 
-static void mat_mul4d(const double* a, const double* b, double* out);
 
 /* Double-precision 4x4 inverse (Gauss-Jordan with partial pivoting), column-major. */
 static bool inverse4d(const double* m, double* out) {
@@ -423,7 +422,7 @@ static double bind_pose_error(const char* path, const char* bind_node) {
                     worst = 1e30;
                     continue;
                 }
-                mat_mul4d(place, inv, inv);
+                ref_mat4d_mul(place, inv, inv);
                 const ak_mat4* w = &world[s->skins[0].joints[k]];
                 double scale = 0.0;
                 for (int e = 0; e < 16; ++e) scale = fmax(scale, fabs(inv[e]));
@@ -530,17 +529,6 @@ static bool bvh_parse(const char* path, bvh_file* b) {
     return b->frames > 0;
 }
 
-static void mat_mul4d(const double* a, const double* b, double* out) {
-    double r[16];
-    for (int c = 0; c < 4; ++c)
-        for (int i = 0; i < 4; ++i) {
-            double s = 0;
-            for (int k = 0; k < 4; ++k) s += a[k * 4 + i] * b[c * 4 + k];
-            r[c * 4 + i] = s;
-        }
-    memcpy(out, r, sizeof r);
-}
-
 /* World matrix of joint j at frame f: parent * T(offset or position channels) * R(ch1) R(ch2) R(ch3). */
 static void bvh_world(const bvh_file* b, int j, int f, double* out) {
     double m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
@@ -562,13 +550,13 @@ static void bvh_world(const bvh_file* b, int j, int f, double* out) {
             r[u * 4 + v] = sn;
             r[v * 4 + u] = -sn;
             r[v * 4 + v] = cs;
-            mat_mul4d(m, r, m);
+            ref_mat4d_mul(m, r, m);
         }
     }
     if (jt->parent >= 0) {
         double p[16];
         bvh_world(b, jt->parent, f, p);
-        mat_mul4d(p, m, m);
+        ref_mat4d_mul(p, m, m);
     }
     memcpy(out, m, sizeof m);
 }

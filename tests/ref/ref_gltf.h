@@ -16,6 +16,18 @@
 #define REF_UNUSED __attribute__((unused))
 #else
 #define REF_UNUSED
+/* Column-major double 4x4 product out = a * b (out may alias either input). */
+static REF_UNUSED void ref_mat4d_mul(const double* a, const double* b, double* out) {
+    double r[16];
+    for (int c = 0; c < 4; ++c)
+        for (int i = 0; i < 4; ++i) {
+            double acc = 0;
+            for (int k = 0; k < 4; ++k) acc += a[k * 4 + i] * b[c * 4 + k];
+            r[c * 4 + i] = acc;
+        }
+    memcpy(out, r, sizeof r);
+}
+
 #endif
 
 /* ---- small helpers ------------------------------------------------------------------- */
@@ -201,6 +213,18 @@ static REF_UNUSED int accessor_comps(const doc* d, int ai) {
     for (int i = 0; i < 7; ++i)
         if (strcmp(t->valuestring, names[i]) == 0) return comps[i];
     return 0;
+}
+
+/* Column-major double 4x4 product out = a * b (out may alias either input). */
+static REF_UNUSED void ref_mat4d_mul(const double* a, const double* b, double* out) {
+    double r[16];
+    for (int c = 0; c < 4; ++c)
+        for (int i = 0; i < 4; ++i) {
+            double acc = 0;
+            for (int k = 0; k < 4; ++k) acc += a[k * 4 + i] * b[c * 4 + k];
+            r[c * 4 + i] = acc;
+        }
+    memcpy(out, r, sizeof r);
 }
 
 #endif
