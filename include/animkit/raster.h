@@ -141,15 +141,17 @@ typedef struct ak_raster_desc {
     int width;        /* output image width in pixels; required, 1..8192 */
     int height;       /* output image height in pixels; required, 1..8192 */
     int supersample;  /* samples per pixel along each axis, 1..4; 0 -> 1 (no anti-aliasing) */
-    int thread_count; /* threads a draw call may use, 1..64; 0 -> 1 (the calling thread only) */
+    int thread_count; /* threads a draw call may use, 1..64; 0 -> 1 (the calling thread only);
+                         draws of fewer than 256 primitives always use one */
 } ak_raster_desc;
 
 typedef struct ak_raster ak_raster;
 
 /* desc with its zero fields replaced by their documented defaults (not range-checked). */
 AK_API ak_raster_desc ak_raster_desc_resolved(const ak_raster_desc* desc);
-/* Create a render target (one allocation: colour + depth at width*supersample x
- * height*supersample, plus fixed scratch). The target starts cleared to opaque black.
+/* Create a render target (one allocation: RGBA8 colour + float depth at width*supersample x
+ * height*supersample, a 2 x 256 KiB shadow map, and about 1.2 MiB of set-up scratch per thread
+ * when thread_count > 1). The target starts cleared to opaque black.
  * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (a field out of range), AK_ERR_NO_MEMORY;
  * *out_raster is NULL on failure. */
 AK_API ak_result ak_raster_create(const ak_raster_desc* desc, const ak_allocator* alloc, ak_raster** out_raster);
