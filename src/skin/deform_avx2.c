@@ -188,29 +188,32 @@ AKP_AVX2_INLINE static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size
 
 /* The same for exactly 4 influences, in two phases so that a block can run the long
  * dependency chain (argmax -> reference -> dots -> signs) of all 8 vertices before the
- * blends: phase 1 gives the joint pointers and the signed weights. */
-AKP_AVX2_INLINE static inline void dq_signs4(const akp_skin_ctx* c, size_t i, const float** ptr, float* sw) {
-    uint16_t jj[4];
-    float ww[4];
-    memcpy(jj, c->jnt + i * c->jnt_stride, sizeof jj);
-    memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
+ * blends. Phase 1, for vertices i and i + 1 at once (one per 128-bit lane): the joint
+ * pointers and the signed weights; ptr[0..3], sw[0..3] belong to vertex i and ptr[4..7],
+ * sw[4..7] to vertex i + 1. The reference is the rotation of the largest weight (lowest slot
+ * on ties), picked with blends: no branch and no index round trip through memory. */
+AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, const float** ptr, float* sw) {
+    uint16_t jj[8];
+    const char* wp = c->wgt + i * c->wgt_stride;
+    memcpy(jj, c->jnt + i * c->jnt_stride, 4 * sizeof(uint16_t));
+    memcpy(jj + 4, c->jnt + (i + 1) * c->jnt_stride, 4 * sizeof(uint16_t));
     const size_t pc = c->palette_count;
-    for (int k = 0; k < 4; ++k) ptr[k] = c->joints_prep[clamp_joint(jj[k], pc)].real;
-    const __m128 r0 = _mm_loadu_ps(ptr[0]), r1 = _mm_loadu_ps(ptr[1]);
-    const __m128 r2 = _mm_loadu_ps(ptr[2]), r3 = _mm_loadu_ps(ptr[3]);
-    /* reference = rotation of the largest weight (lowest slot on ties), picked with blends:
-     * no branch (weights come in any order) and no index round trip through memory */
-    const __m128 w4 = _mm_loadu_ps(ww);
-    __m128 mx = _mm_max_ps(w4, _mm_shuffle_ps(w4, w4, _MM_SHUFFLE(2, 3, 0, 1)));
-    mx = _mm_max_ps(mx, _mm_shuffle_ps(mx, mx, _MM_SHUFFLE(1, 0, 3, 2)));
-    const __m128 is_max = _mm_cmpeq_ps(w4, mx);
-    __m128 ref = r3;
-    ref = _mm_blendv_ps(ref, r2, _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(2, 2, 2, 2)));
-    ref = _mm_blendv_ps(ref, r1, _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(1, 1, 1, 1)));
-    ref = _mm_blendv_ps(ref, r0, _mm_shuffle_ps(is_max, is_max, _MM_SHUFFLE(0, 0, 0, 0)));
-    __m128 dots = _mm_hadd_ps(_mm_hadd_ps(_mm_mul_ps(r0, ref), _mm_mul_ps(r1, ref)),
-                              _mm_hadd_ps(_mm_mul_ps(r2, ref), _mm_mul_ps(r3, ref))); /* q_k . ref */
-    _mm_storeu_ps(sw, _mm_xor_ps(w4, _mm_and_ps(dots, _mm_set1_ps(-0.0f))));
+    for (int k = 0; k < 8; ++k) ptr[k] = c->joints_prep[clamp_joint(jj[k], pc)].real;
+    __m256 r[4];
+    for (int k = 0; k < 4; ++k)
+        r[k] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(ptr[k])), _mm_loadu_ps(ptr[4 + k]), 1);
+    const __m256 w8 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)wp)),
+                                           _mm_loadu_ps((const float*)(const void*)(wp + c->wgt_stride)), 1);
+    __m256 mx = _mm256_max_ps(w8, _mm256_permute_ps(w8, _MM_SHUFFLE(2, 3, 0, 1)));
+    mx = _mm256_max_ps(mx, _mm256_permute_ps(mx, _MM_SHUFFLE(1, 0, 3, 2)));
+    const __m256 is_max = _mm256_cmp_ps(w8, mx, _CMP_EQ_OQ);
+    __m256 ref = r[3];
+    ref = _mm256_blendv_ps(ref, r[2], _mm256_permute_ps(is_max, _MM_SHUFFLE(2, 2, 2, 2)));
+    ref = _mm256_blendv_ps(ref, r[1], _mm256_permute_ps(is_max, _MM_SHUFFLE(1, 1, 1, 1)));
+    ref = _mm256_blendv_ps(ref, r[0], _mm256_permute_ps(is_max, _MM_SHUFFLE(0, 0, 0, 0)));
+    __m256 dots = _mm256_hadd_ps(_mm256_hadd_ps(_mm256_mul_ps(r[0], ref), _mm256_mul_ps(r[1], ref)),
+                                 _mm256_hadd_ps(_mm256_mul_ps(r[2], ref), _mm256_mul_ps(r[3], ref)));
+    _mm256_storeu_ps(sw, _mm256_xor_ps(w8, _mm256_and_ps(dots, _mm256_set1_ps(-0.0f))));
 }
 
 /* Phase 2: sum of signed weight * (real | dual); broadcasts from memory are plain loads. */
@@ -221,13 +224,22 @@ AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const float* const* ptr, con
     return _mm256_fmadd_ps(_mm256_loadu_ps(ptr[3]), _mm256_broadcast_ss(&sw[3]), acc);
 }
 
-/* Blended (real | dual) of the 8 vertices of a block. */
-AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t i0, uint32_t K, __m256* rows) {
-    if (K == 4) {
-        const float* ptr[8][4];
-        float sw[8][4];
-        for (int v = 0; v < 8; ++v) dq_signs4(c, i0 + (size_t)v, ptr[v], sw[v]);
-        for (int v = 0; v < 8; ++v) rows[v] = dq_accumulate4(ptr[v], sw[v]);
+/* Phase 1 of a whole block with 4 influences; the block loops run it one block ahead, so
+ * that its dependency chain overlaps the previous block's transform. */
+typedef struct dq_prep {
+    const float* ptr[32];
+    float sw[32];
+} dq_prep;
+AKP_AVX2_INLINE static inline void dq_prep_block(const akp_skin_ctx* c, size_t i0, dq_prep* p) {
+    for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->ptr + 4 * v, p->sw + 4 * v);
+}
+
+/* Blended (real | dual) of the 8 vertices of a block: from the phase-1 data p (K == 4) when
+ * given, else vertex by vertex. */
+AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p,
+                                                  __m256* rows) {
+    if (p) {
+        for (int v = 0; v < 8; ++v) rows[v] = dq_accumulate4(p->ptr + 4 * v, p->sw + 4 * v);
         return;
     }
     for (int v = 0; v < 8; ++v) rows[v] = blend_dq_vertex(c, i0 + (size_t)v, K);
@@ -281,9 +293,9 @@ AKP_AVX2_INLINE static inline __m256 quat_inv_norm8(__m256 x, __m256 y, __m256 z
     return _mm256_and_ps(r, ok);
 }
 
-AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p) {
     __m256 rows[8], q[8];
-    blend_dq_block(c, i0, K, rows);
+    blend_dq_block(c, i0, K, p, rows);
     transpose8(rows, q);
     __m256 r = quat_inv_norm8(q[0], q[1], q[2], q[3]);
     /* a vanished blend (r = 0) must act as the identity rotation, like the scalar code */
@@ -312,11 +324,11 @@ AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, u
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
-AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p) {
     __m256 r01[8], r23[8], cols[8];
     const __m256i lo = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), hi = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
     __m256 q[8];
-    blend_dq_block(c, i0, K, q);
+    blend_dq_block(c, i0, K, p, q);
     for (int v = 0; v < 8; ++v) {
         blend_matrix_vertex(c, i0 + (size_t)v, K, &r01[v], &r23[v]);
         /* the rotation blend goes into the unused w rows: (qx, qy) and (qz, qw) */
@@ -364,8 +376,25 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
             for (size_t i = begin; i < end; i += 8) fn(c, i, c->k);                        \
     }
 AKP_BLOCK_LOOP(block_lbs)
-AKP_BLOCK_LOOP(block_dqs)
-AKP_BLOCK_LOOP(block_cor)
+
+/* DQS and CoR: with 4 influences, phase 1 of the next block runs before the current block's
+ * blend and transform (two phase-1 buffers in turn). */
+#define AKP_DQ_BLOCK_LOOP(fn)                                                              \
+    AKP_AVX2 static void fn##_range(const akp_skin_ctx* c, size_t begin, size_t end) {     \
+        if (c->k == 4) {                                                                   \
+            dq_prep p[2];                                                                  \
+            dq_prep_block(c, begin, &p[0]);                                                \
+            unsigned b = 0;                                                                \
+            for (size_t i = begin; i < end; i += 8, b ^= 1u) {                             \
+                if (i + 8 < end) dq_prep_block(c, i + 8, &p[b ^ 1u]);                      \
+                fn(c, i, 4, &p[b]);                                                        \
+            }                                                                              \
+        } else {                                                                           \
+            for (size_t i = begin; i < end; i += 8) fn(c, i, c->k, NULL);                  \
+        }                                                                                  \
+    }
+AKP_DQ_BLOCK_LOOP(block_dqs)
+AKP_DQ_BLOCK_LOOP(block_cor)
 
 bool akp_skin_range_avx2(const akp_skin_ctx* c, size_t begin, size_t end) {
     if (c->do_tangents || !akp_skin_have_avx2()) return false;
