@@ -96,18 +96,23 @@ AK_API void ak_skeleton_destroy(ak_skeleton* skeleton);
  * earlier only when a joint listed before it needs it as an ancestor. */
 AK_API ak_result ak_skeleton_reorder(ak_i32_cspan parents, ak_i32_span out_order);
 
+/* Number of joints (0 for NULL). */
 AK_API size_t ak_skeleton_joint_count(const ak_skeleton* skeleton);
+/* Parent index per joint (parent[i] < i, -1 for roots); empty span for NULL. */
 AK_API ak_i16_cspan ak_skeleton_parents(const ak_skeleton* skeleton);
+/* Rest (bind) local transform per joint; empty span for NULL. */
 AK_API ak_transform_cspan ak_skeleton_rest_pose(const ak_skeleton* skeleton);
+/* Model-space inverse bind matrix per joint; empty span for NULL. */
 AK_API ak_mat4_cspan ak_skeleton_inverse_binds(const ak_skeleton* skeleton);
 /* Name of joint index; "" when out of range. */
 AK_API const char* ak_skeleton_joint_name(const ak_skeleton* skeleton, size_t joint_index);
 /* Index of the joint with this exact name, or -1. */
 AK_API int ak_skeleton_find_joint(const ak_skeleton* skeleton, const char* name);
+/* Type of a joint (AK_JOINT_FREE when out of range). */
 AK_API ak_joint_type ak_skeleton_joint_type(const ak_skeleton* skeleton, size_t joint_index);
 /* Limits with defaults resolved (axis normalised, never zero). */
 AK_API ak_joint_limits ak_skeleton_joint_limits(const ak_skeleton* skeleton, size_t joint_index);
-/* Number of children of a joint, and whether it is a leaf. */
+/* Number of children of a joint (0: a leaf, or out of range). */
 AK_API size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index);
 
 /* Forward kinematics: local[i] -> model[i] = model[parent] * local[i] (model[root] = local).
