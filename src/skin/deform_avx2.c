@@ -165,6 +165,45 @@ AKP_AVX2_INLINE static inline void blend_matrix_vertex(const akp_skin_ctx* c, si
     *out23 = a23;
 }
 
+/* With 4 influences: the byte offsets (joint index clamped to the palette, shifted left by
+ * shift) of the 8 vertices of the block at i0, off[4 v + k]; two vertices per SIMD step instead
+ * of a compare, select, shift and add per influence. */
+_Static_assert(sizeof(ak_mat4) == 64 && sizeof(akp_skin_joint) == 128, "offset shifts below");
+#define AKP_MAT_SHIFT 6
+#define AKP_JOINT_SHIFT 7
+AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t i0, int shift, uint32_t* off) {
+    const char* jp = c->jnt + i0 * c->jnt_stride;
+    const size_t js = c->jnt_stride;
+    const size_t last = c->palette_count - 1;
+    const __m128i lim = _mm_set1_epi16((short)(uint16_t)(last > 65535u ? 65535u : last));
+    const __m128i count = _mm_cvtsi32_si128(shift);
+    for (int h = 0; h < 4; ++h) {
+        __m128i a = _mm_loadl_epi64((const __m128i*)(const void*)(jp + (size_t)(2 * h) * js));
+        __m128i b = _mm_loadl_epi64((const __m128i*)(const void*)(jp + (size_t)(2 * h + 1) * js));
+        __m128i j = _mm_min_epu16(_mm_unpacklo_epi64(a, b), lim);
+        _mm256_storeu_si256((__m256i*)(void*)(off + 8 * h), _mm256_sll_epi32(_mm256_cvtepu16_epi32(j), count));
+    }
+}
+
+/* blend_matrix_vertex for 4 influences with offsets from joint_offsets4 (AKP_MAT_SHIFT). */
+AKP_AVX2_INLINE static inline void blend_matrix_vertex4(const akp_skin_ctx* c, size_t i, const uint32_t* off,
+                                                        __m256* out01, __m256* out23) {
+    float ww[4];
+    memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
+    const char* pal = (const char*)c->palette;
+    __m256 w = _mm256_set1_ps(ww[0]);
+    const float* m = (const float*)(const void*)(pal + off[0]);
+    __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
+    for (int k = 1; k < 4; ++k) {
+        m = (const float*)(const void*)(pal + off[k]);
+        w = _mm256_set1_ps(ww[k]);
+        a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
+        a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
+    }
+    *out01 = a01;
+    *out23 = a23;
+}
+
 /* Hemisphere-aligned blend of (real | dual) quaternions of vertex i. */
 AKP_AVX2_INLINE static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size_t i, uint32_t K) {
     uint16_t jj[AK_MAX_INFLUENCES];
@@ -188,20 +227,17 @@ AKP_AVX2_INLINE static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size
 
 /* The same for exactly 4 influences, in two phases so that a block can run the long
  * dependency chain (argmax -> reference -> dots -> signs) of all 8 vertices before the
- * blends. Phase 1, for vertices i and i + 1 at once (one per 128-bit lane): the joint
- * pointers and the signed weights; ptr[0..3], sw[0..3] belong to vertex i and ptr[4..7],
- * sw[4..7] to vertex i + 1. The reference is the rotation of the largest weight (lowest slot
+ * blends. Phase 1, for vertices i and i + 1 at once (one per 128-bit lane): the signed
+ * weights, from the joint offsets off (joint_offsets4, AKP_JOINT_SHIFT); off[0..3], sw[0..3]
+ * belong to vertex i and off[4..7], sw[4..7] to vertex i + 1. The reference is the rotation of the largest weight (lowest slot
  * on ties), picked with blends: no branch and no index round trip through memory. */
-AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, const float** ptr, float* sw) {
-    uint16_t jj[8];
+AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, const uint32_t* off, float* sw) {
     const char* wp = c->wgt + i * c->wgt_stride;
-    memcpy(jj, c->jnt + i * c->jnt_stride, 4 * sizeof(uint16_t));
-    memcpy(jj + 4, c->jnt + (i + 1) * c->jnt_stride, 4 * sizeof(uint16_t));
-    const size_t pc = c->palette_count;
-    for (int k = 0; k < 8; ++k) ptr[k] = c->joints_prep[clamp_joint(jj[k], pc)].real;
+    const char* jb = (const char*)c->joints_prep;
     __m256 r[4];
     for (int k = 0; k < 4; ++k)
-        r[k] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(ptr[k])), _mm_loadu_ps(ptr[4 + k]), 1);
+        r[k] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)(jb + off[k]))),
+                                    _mm_loadu_ps((const float*)(const void*)(jb + off[4 + k])), 1);
     const __m256 w8 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)wp)),
                                            _mm_loadu_ps((const float*)(const void*)(wp + c->wgt_stride)), 1);
     __m256 mx = _mm256_max_ps(w8, _mm256_permute_ps(w8, _MM_SHUFFLE(2, 3, 0, 1)));
@@ -217,21 +253,25 @@ AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, 
 }
 
 /* Phase 2: sum of signed weight * (real | dual); broadcasts from memory are plain loads. */
-AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const float* const* ptr, const float* sw) {
-    __m256 acc = _mm256_mul_ps(_mm256_loadu_ps(ptr[0]), _mm256_broadcast_ss(&sw[0]));
-    acc = _mm256_fmadd_ps(_mm256_loadu_ps(ptr[1]), _mm256_broadcast_ss(&sw[1]), acc);
-    acc = _mm256_fmadd_ps(_mm256_loadu_ps(ptr[2]), _mm256_broadcast_ss(&sw[2]), acc);
-    return _mm256_fmadd_ps(_mm256_loadu_ps(ptr[3]), _mm256_broadcast_ss(&sw[3]), acc);
+AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const akp_skin_ctx* c, const uint32_t* off, const float* sw) {
+    const char* jb = (const char*)c->joints_prep;
+#define AKP_JQ(k) _mm256_loadu_ps((const float*)(const void*)(jb + off[k]))
+    __m256 acc = _mm256_mul_ps(AKP_JQ(0), _mm256_broadcast_ss(&sw[0]));
+    acc = _mm256_fmadd_ps(AKP_JQ(1), _mm256_broadcast_ss(&sw[1]), acc);
+    acc = _mm256_fmadd_ps(AKP_JQ(2), _mm256_broadcast_ss(&sw[2]), acc);
+    return _mm256_fmadd_ps(AKP_JQ(3), _mm256_broadcast_ss(&sw[3]), acc);
+#undef AKP_JQ
 }
 
 /* Phase 1 of a whole block with 4 influences; the block loops run it one block ahead, so
  * that its dependency chain overlaps the previous block's transform. */
 typedef struct dq_prep {
-    const float* ptr[32];
+    uint32_t off[32];
     float sw[32];
 } dq_prep;
 AKP_AVX2_INLINE static inline void dq_prep_block(const akp_skin_ctx* c, size_t i0, dq_prep* p) {
-    for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->ptr + 4 * v, p->sw + 4 * v);
+    joint_offsets4(c, i0, AKP_JOINT_SHIFT, p->off);
+    for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->off + 4 * v, p->sw + 4 * v);
 }
 
 /* Blended (real | dual) of the 8 vertices of a block: from the phase-1 data p (K == 4) when
@@ -239,7 +279,7 @@ AKP_AVX2_INLINE static inline void dq_prep_block(const akp_skin_ctx* c, size_t i
 AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p,
                                                   __m256* rows) {
     if (p) {
-        for (int v = 0; v < 8; ++v) rows[v] = dq_accumulate4(p->ptr + 4 * v, p->sw + 4 * v);
+        for (int v = 0; v < 8; ++v) rows[v] = dq_accumulate4(c, p->off + 4 * v, p->sw + 4 * v);
         return;
     }
     for (int v = 0; v < 8; ++v) rows[v] = blend_dq_vertex(c, i0 + (size_t)v, K);
@@ -249,7 +289,13 @@ AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t 
 AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
-    for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
+    if (K == 4) {
+        uint32_t off[32];
+        joint_offsets4(c, i0, AKP_MAT_SHIFT, off);
+        for (int v = 0; v < 8; ++v) blend_matrix_vertex4(c, i0 + (size_t)v, off + 4 * v, &c01[v], &c23[v]);
+    } else {
+        for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
+    }
     for (int v = 0; v < 8; ++v) rows[v] = c01[v];
     transpose8(rows, cols);
     const __m256 ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];
@@ -329,8 +375,11 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     const __m256i lo = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), hi = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
     __m256 q[8];
     blend_dq_block(c, i0, K, p, q);
+    uint32_t moff[32];
+    if (p) joint_offsets4(c, i0, AKP_MAT_SHIFT, moff);
     for (int v = 0; v < 8; ++v) {
-        blend_matrix_vertex(c, i0 + (size_t)v, K, &r01[v], &r23[v]);
+        if (p) blend_matrix_vertex4(c, i0 + (size_t)v, moff + 4 * v, &r01[v], &r23[v]);
+        else blend_matrix_vertex(c, i0 + (size_t)v, K, &r01[v], &r23[v]);
         /* the rotation blend goes into the unused w rows: (qx, qy) and (qz, qw) */
         r01[v] = _mm256_blend_ps(r01[v], _mm256_permutevar8x32_ps(q[v], lo), 0x88);
         r23[v] = _mm256_blend_ps(r23[v], _mm256_permutevar8x32_ps(q[v], hi), 0x88);
