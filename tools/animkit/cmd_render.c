@@ -131,6 +131,8 @@ int cmd_render(int argc, char** argv) {
         rc = cli_fail("render", "%s: %zu meshes; at most 64 can be rendered", a.pos[0], s->mesh_count);
         goto done;
     }
+    bool skinned = false;
+    for (size_t m = 0; m < s->mesh_count; ++m) skinned = skinned || (s->meshes[m].skin >= 0 && s->meshes[m].mesh->influence_count);
     const char* bone = CLI_GET(&a, "--weights");
     if (bone) {
         int found = 0;
@@ -191,7 +193,7 @@ int cmd_render(int argc, char** argv) {
             if (method_count > 1)
                 snprintf(title, sizeof title, "t=%.2fs", (double)ft.t[i]);
             else
-                snprintf(title, sizeof title, "%s  t=%.2fs  %s", strip, (double)ft.t[i], labels[methods[0]]);
+                snprintf(title, sizeof title, "%s  t=%.2fs  %s", strip, (double)ft.t[i], skinned ? labels[methods[0]] : "");
             cli_draw_opts o = {.skeleton = CLI_GET(&a, "--skeleton") != NULL, .colors = bone ? colors : NULL, .title = title};
             if (r == AK_OK) r = cli_frame_draw(&f, &p, &o, &panel[k]);
             if (r != AK_OK) {
