@@ -71,6 +71,60 @@ static inline ak_quat weight_toward_identity(ak_quat q, float keep) {
     return ak_quat_nlerp(ak_quat_identity(), q, 1.0f - keep);
 }
 
+/* The common case in closed form: no mid_axis (the bend axis is the normal n = u x v of the
+ * current bend plane, not straight), a pole, target off the start joint. With n normal to u
+ * and v, v_par = 0 and the mid equation's coefficients need no normalised vector:
+ * A = u.v, B = u.(n^ x v) = -|n|, r^2 = A^2 + B^2. After the bend, f x u = (B cos - A sin) n^,
+ * so the limb's frame is (f^, a2 x f^, a2), a2 = +-n^, and the target's (k, b2 x k, b2), b2 = st x pole
+ * normalised. The rotation between two orthonormal frames is the quaternion
+ * (sum a_i x b_i, 1 + sum a_i.b_i) normalised (Shepperd's trace branch); written with the
+ * unnormalised f, st and p = st x pole it needs sqrt(|f|^2 |st|^2), |p| and the final norm.
+ * Returns false (nothing written) when the case does not apply or the start rotation is too
+ * close to a half turn for the trace form; the general path then runs. */
+static bool two_bone_fast(const ak_ik_two_bone_job* job, int branch, ak_vec3 u, ak_vec3 v, ak_vec3 st, float a2,
+                          float b2, float d2, float dd2, ak_quat* out_start, ak_quat* out_mid) {
+    const ak_vec3 n = ak_vec3_cross(u, v), pole = job->pole, p = ak_vec3_cross(st, pole);
+    const float n2 = ak_vec3_dot(n, n), p2 = ak_vec3_dot(p, p), pole2 = ak_vec3_dot(pole, pole);
+    if (!(n2 > 2.5e-3f * a2 * b2) || !(d2 > 1e-24f) || !(p2 > 1e-12f * pole2 * d2)) return false;
+    const float nl = sqrtf(n2), A = ak_vec3_dot(u, v), B = -nl;
+    const float r2 = A * A + n2;
+    float K = 0.5f * (dd2 - a2 - b2), S = 0.0f;
+    if (K * K < r2) S = sqrtf(r2 - K * K);
+    else K = K > 0.0f ? sqrtf(r2) : -sqrtf(r2);
+    const float inv = 1.0f / r2;
+    const float c1 = (A * K - B * S) * inv, s1 = (B * K + A * S) * inv;
+    const float c2 = (A * K + B * S) * inv, s2 = (B * K - A * S) * inv;
+    /* B <= 0, so c1 >= c2: branch 0 takes (c1, s1). Then B cos - A sin = -S (branch 0) or
+     * +S (branch 1): the limb frame's third axis is -n^ or +n^ exactly. */
+    const bool first = branch == 0;
+    const float cphi = first ? c1 : c2, sphi = first ? s1 : s2;
+    const ak_vec3 nh = ak_vec3_scale(n, 1.0f / nl);
+    const ak_vec3 f = ak_vec3_add(ak_vec3_madd(u, v, cphi), ak_vec3_scale(ak_vec3_cross(nh, v), sphi));
+    const float f2 = ak_vec3_dot(f, f);
+    /* Straight after the bend (|u x f^|^2 = S^2 / |f|^2 tiny): the general path's shortest arc. */
+    if (!(f2 > 1e-24f) || !(S * S > 1e-12f * a2 * f2)) return false;
+    const ak_vec3 a2v = first ? ak_vec3_neg(nh) : nh;
+    const float P = sqrtf(p2), FD = sqrtf(f2 * d2);
+    const ak_vec3 af = ak_vec3_cross(a2v, f), ps = ak_vec3_cross(p, st);
+    const ak_vec3 x1 = ak_vec3_cross(f, st), x2 = ak_vec3_cross(af, ps), x3 = ak_vec3_cross(a2v, p);
+    const float qx = P * x1.x + x2.x + FD * x3.x, qy = P * x1.y + x2.y + FD * x3.y, qz = P * x1.z + x2.z + FD * x3.z;
+    const float qw = FD * (P + ak_vec3_dot(a2v, p)) + P * ak_vec3_dot(f, st) + ak_vec3_dot(af, ps);
+    const float q2 = qx * qx + qy * qy + qz * qz + qw * qw;
+    /* |q| = 4 w |f||st||p|: keep w >= 0.125 (a turn of at most ~166 degrees), where the
+     * components' rounding stays far below the tests' tolerances. */
+    if (!(qw > 0.0f) || !(64.0f * qw * qw > q2)) return false;
+    const float qi = 1.0f / sqrtf(q2);
+    ak_quat q_start = ak_quat_make(qx * qi, qy * qi, qz * qi, qw * qi);
+    if (job->twist != 0.0f)
+        q_start = ak_quat_mul(ak_quat_from_axis_angle(ak_vec3_scale(st, 1.0f / sqrtf(d2)), job->twist), q_start);
+    const ak_vec3 axis_local = mat_unrotate(job->start.m, ak_vec3_make(q_start.x, q_start.y, q_start.z));
+    q_start = ak_quat_make(axis_local.x, axis_local.y, axis_local.z, q_start.w);
+    const ak_quat q_mid = akp_quat_half_angle(mat_unrotate(job->mid.m, nh), cphi, sphi);
+    *out_start = weight_toward_identity(q_start, job->keep_animation);
+    *out_mid = weight_toward_identity(q_mid, job->keep_animation);
+    return true;
+}
+
 bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* out_start, ak_quat* out_mid) {
     const float *S = job->start.m, *M = job->mid.m, *E = job->end.m;
     const ak_vec3 s = mat_pos(S), m = mat_pos(M), e = mat_pos(E);
@@ -93,10 +147,13 @@ bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* o
         }
     }
     dd2 = ak_clampf(dd2, lmin2, lmax2);
+    const bool axis_given = job->mid_axis.x != 0.0f || job->mid_axis.y != 0.0f || job->mid_axis.z != 0.0f;
+    const bool has_pole = job->pole.x != 0.0f || job->pole.y != 0.0f || job->pole.z != 0.0f;
+    if (!axis_given && has_pole && two_bone_fast(job, branch, u, v, st, a2, b2, d2, dd2, out_start, out_mid))
+        return reached;
 
     /* Bend axis n in model space, n_local in the mid joint's frame. */
     ak_vec3 n, n_local;
-    const bool axis_given = job->mid_axis.x != 0.0f || job->mid_axis.y != 0.0f || job->mid_axis.z != 0.0f;
     if (axis_given) {
         n_local = ak_vec3_normalize(job->mid_axis);
         n = mat_rotate_dir(M, n_local);
@@ -142,7 +199,6 @@ bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* o
         const ak_vec3 v_rot = ak_vec3_add(ak_vec3_madd(ak_vec3_scale(n, vn), v_perp, cphi), ak_vec3_scale(n_x_vp, sphi));
         const ak_vec3 f = ak_vec3_add(u, v_rot);
         const float f2 = ak_vec3_dot(f, f);
-        const bool has_pole = job->pole.x != 0.0f || job->pole.y != 0.0f || job->pole.z != 0.0f;
         bool done = false;
         if (has_pole && f2 > 1e-24f) {
             const ak_vec3 fh = ak_vec3_scale(f, 1.0f / sqrtf(f2));
