@@ -120,20 +120,6 @@ AKP_AVX2_INLINE static inline void normalize8(__m256* x, __m256* y, __m256* z) {
         oz = _mm256_fmsub_ps(ax, by, _mm256_mul_ps(ay, bx));                               \
     } while (0)
 
-/* Rotate (px, py, pz) by unit quaternions (qx, qy, qz, qw): p + w t + v x t, t = 2 v x p. */
-AKP_AVX2_INLINE static inline void rotate8(__m256 qx, __m256 qy, __m256 qz, __m256 qw, __m256* px, __m256* py,
-                                     __m256* pz) {
-    __m256 tx, ty, tz, ux, uy, uz;
-    AKP_CROSS(qx, qy, qz, *px, *py, *pz, tx, ty, tz);
-    tx = _mm256_add_ps(tx, tx);
-    ty = _mm256_add_ps(ty, ty);
-    tz = _mm256_add_ps(tz, tz);
-    AKP_CROSS(qx, qy, qz, tx, ty, tz, ux, uy, uz);
-    *px = _mm256_add_ps(_mm256_fmadd_ps(qw, tx, *px), ux);
-    *py = _mm256_add_ps(_mm256_fmadd_ps(qw, ty, *py), uy);
-    *pz = _mm256_add_ps(_mm256_fmadd_ps(qw, tz, *pz), uz);
-}
-
 static inline uint32_t clamp_joint(uint32_t j, size_t count) { return j < count ? j : (uint32_t)(count - 1); }
 
 /* Joints and weights of vertex i, element by element (fixed-size copies become plain loads;
@@ -328,29 +314,36 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, mx, my, mz);
 }
 
-/* Normalise 8 quaternions and scale 4 more lanes (the dual part) by the same factor. */
-AKP_AVX2_INLINE static inline __m256 quat_inv_norm8(__m256 x, __m256 y, __m256 z, __m256 w) {
+/* 2 / |q|^2 for 8 blended quaternions, and 0 where the blend vanished (|q|^2 <= 1e-30: the
+ * scalar code's identity). The blends are not normalised: the rotation and translation
+ * formulas below divide by |q|^2 through this factor, so the division runs in parallel with
+ * the cross products instead of ahead of them. */
+AKP_AVX2_INLINE static inline __m256 quat_scale8(__m256 x, __m256 y, __m256 z, __m256 w) {
     __m256 n2 = _mm256_fmadd_ps(x, x, _mm256_fmadd_ps(y, y, _mm256_fmadd_ps(z, z, _mm256_mul_ps(w, w))));
     __m256 ok = _mm256_cmp_ps(n2, _mm256_set1_ps(1e-30f), _CMP_GT_OQ);
-    n2 = _mm256_max_ps(n2, _mm256_set1_ps(1e-30f));
-    __m256 r = _mm256_rsqrt_ps(n2);
-    __m256 h = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), n2), _mm256_mul_ps(r, r));
-    r = _mm256_mul_ps(r, _mm256_sub_ps(_mm256_set1_ps(1.5f), h));
-    return _mm256_and_ps(r, ok);
+    __m256 s = _mm256_div_ps(_mm256_set1_ps(2.0f), _mm256_max_ps(n2, _mm256_set1_ps(1e-30f)));
+    return _mm256_and_ps(s, ok);
+}
+
+/* Rotate (px, py, pz) by q / |q| for any nonzero q, given s = 2 / |q|^2 (quat_scale8):
+ * p + s (w (v x p) + v x (v x p)); s = 0 leaves p unchanged. */
+AKP_AVX2_INLINE static inline void rotate8_scaled(__m256 qx, __m256 qy, __m256 qz, __m256 qw, __m256 s, __m256* px,
+                                                  __m256* py, __m256* pz) {
+    __m256 tx, ty, tz, ux, uy, uz;
+    AKP_CROSS(qx, qy, qz, *px, *py, *pz, tx, ty, tz);
+    AKP_CROSS(qx, qy, qz, tx, ty, tz, ux, uy, uz);
+    *px = _mm256_fmadd_ps(s, _mm256_fmadd_ps(qw, tx, ux), *px);
+    *py = _mm256_fmadd_ps(s, _mm256_fmadd_ps(qw, ty, uy), *py);
+    *pz = _mm256_fmadd_ps(s, _mm256_fmadd_ps(qw, tz, uz), *pz);
 }
 
 AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p) {
     __m256 rows[8], q[8];
     blend_dq_block(c, i0, K, p, rows);
     transpose8(rows, q);
-    __m256 r = quat_inv_norm8(q[0], q[1], q[2], q[3]);
-    /* a vanished blend (r = 0) must act as the identity rotation, like the scalar code */
-    __m256 zero_w = _mm256_andnot_ps(_mm256_cmp_ps(r, _mm256_setzero_ps(), _CMP_NEQ_OQ), _mm256_set1_ps(1.0f));
-    __m256 qx = _mm256_mul_ps(q[0], r), qy = _mm256_mul_ps(q[1], r), qz = _mm256_mul_ps(q[2], r);
-    __m256 qw = _mm256_add_ps(_mm256_mul_ps(q[3], r), zero_w);
-    __m256 dx = _mm256_mul_ps(q[4], r), dy = _mm256_mul_ps(q[5], r), dz = _mm256_mul_ps(q[6], r);
-    __m256 dw = _mm256_mul_ps(q[7], r);
-    /* translation 2 (w dv - dw v + v x dv) */
+    const __m256 qx = q[0], qy = q[1], qz = q[2], qw = q[3], dx = q[4], dy = q[5], dz = q[6], dw = q[7];
+    const __m256 sc = quat_scale8(qx, qy, qz, qw);
+    /* translation of the normalised dual quaternion: (2 / |q|^2) (w dv - dw v + v x dv) */
     __m256 cx, cy, cz;
     AKP_CROSS(qx, qy, qz, dx, dy, dz, cx, cy, cz);
     __m256 tx = _mm256_add_ps(_mm256_fmsub_ps(qw, dx, _mm256_mul_ps(dw, qx)), cx);
@@ -358,15 +351,15 @@ AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, u
     __m256 tz = _mm256_add_ps(_mm256_fmsub_ps(qw, dz, _mm256_mul_ps(dw, qz)), cz);
     __m256 px, py, pz;
     load_xyz8(c->pos + i0 * c->pos_stride, c->pos_stride, &px, &py, &pz);
-    rotate8(qx, qy, qz, qw, &px, &py, &pz);
-    px = _mm256_add_ps(px, _mm256_add_ps(tx, tx));
-    py = _mm256_add_ps(py, _mm256_add_ps(ty, ty));
-    pz = _mm256_add_ps(pz, _mm256_add_ps(tz, tz));
+    rotate8_scaled(qx, qy, qz, qw, sc, &px, &py, &pz);
+    px = _mm256_fmadd_ps(sc, tx, px);
+    py = _mm256_fmadd_ps(sc, ty, py);
+    pz = _mm256_fmadd_ps(sc, tz, pz);
     store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, px, py, pz);
     if (!c->do_normals) return;
     __m256 nx, ny, nz;
     load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
-    rotate8(qx, qy, qz, qw, &nx, &ny, &nz); /* unit quaternion: lengths are kept */
+    rotate8_scaled(qx, qy, qz, qw, sc, &nx, &ny, &nz); /* a rotation: lengths are kept */
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
@@ -386,16 +379,11 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     }
     transpose8(r01, cols);
     const __m256 ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];
-    __m256 qx = cols[3], qy = cols[7];
+    const __m256 qx = cols[3], qy = cols[7];
     transpose8(r23, cols);
     const __m256 cx = cols[0], cy = cols[1], cz = cols[2], tx = cols[4], ty = cols[5], tz = cols[6];
-    __m256 qz = cols[3], qw = cols[7];
-    __m256 r = quat_inv_norm8(qx, qy, qz, qw);
-    __m256 zero_w = _mm256_andnot_ps(_mm256_cmp_ps(r, _mm256_setzero_ps(), _CMP_NEQ_OQ), _mm256_set1_ps(1.0f));
-    qx = _mm256_mul_ps(qx, r);
-    qy = _mm256_mul_ps(qy, r);
-    qz = _mm256_mul_ps(qz, r);
-    qw = _mm256_add_ps(_mm256_mul_ps(qw, r), zero_w);
+    const __m256 qz = cols[3], qw = cols[7];
+    const __m256 sc = quat_scale8(qx, qy, qz, qw);
 
     __m256 sx, sy, sz, px, py, pz;
     load_xyz8(c->ctr + i0 * c->ctr_stride, c->ctr_stride, &sx, &sy, &sz);
@@ -406,13 +394,13 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     px = _mm256_sub_ps(px, sx);
     py = _mm256_sub_ps(py, sy);
     pz = _mm256_sub_ps(pz, sz);
-    rotate8(qx, qy, qz, qw, &px, &py, &pz);
+    rotate8_scaled(qx, qy, qz, qw, sc, &px, &py, &pz);
     store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, _mm256_add_ps(px, mx),
                _mm256_add_ps(py, my), _mm256_add_ps(pz, mz));
     if (!c->do_normals) return;
     __m256 nx, ny, nz;
     load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
-    rotate8(qx, qy, qz, qw, &nx, &ny, &nz); /* unit quaternion: lengths are kept */
+    rotate8_scaled(qx, qy, qz, qw, sc, &nx, &ny, &nz); /* a rotation: lengths are kept */
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
