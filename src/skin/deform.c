@@ -442,6 +442,15 @@ ak_result ak_skin_job_run(const ak_skin_job* job) {
             prepare_joint(&job->palette.ptr[j], &prep[j], &s);
             any_stretch = any_stretch || s;
         }
+        if (job->method == AK_SKIN_COR && !any_stretch) {
+            for (size_t j = 0; j < job->palette.count; ++j) {
+                const float* m = job->palette.ptr[j].m;
+                for (int col = 0; col < 4; ++col) {
+                    for (int r = 0; r < 3; ++r) prep[j].cor_rows[col * 4 + r] = m[col * 4 + r];
+                    prep[j].cor_rows[col * 4 + 3] = prep[j].real[col];
+                }
+            }
+        }
     }
     akp_skin_ctx ctx = make_ctx(job, prep, any_stretch);
     bool simd = !job->skip_simd;

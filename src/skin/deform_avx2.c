@@ -366,16 +366,33 @@ AKP_AVX2_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, u
 AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p) {
     __m256 r01[8], r23[8], cols[8];
     const __m256i lo = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), hi = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
-    __m256 q[8];
-    blend_dq_block(c, i0, K, p, q);
-    uint32_t moff[32];
-    if (p) joint_offsets4(c, i0, AKP_MAT_SHIFT, moff);
-    for (int v = 0; v < 8; ++v) {
-        if (p) blend_matrix_vertex4(c, i0 + (size_t)v, moff + 4 * v, &r01[v], &r23[v]);
-        else blend_matrix_vertex(c, i0 + (size_t)v, K, &r01[v], &r23[v]);
-        /* the rotation blend goes into the unused w rows: (qx, qy) and (qz, qw) */
-        r01[v] = _mm256_blend_ps(r01[v], _mm256_permutevar8x32_ps(q[v], lo), 0x88);
-        r23[v] = _mm256_blend_ps(r23[v], _mm256_permutevar8x32_ps(q[v], hi), 0x88);
+    if (p) {
+        /* one blend of the joints' cor_rows: weight w for the matrix lanes, the signed weight
+         * (+-w, hemisphere-aligned) for the rotation in the w lanes */
+        const char* jb = (const char*)c->joints_prep + offsetof(akp_skin_joint, cor_rows);
+        for (int v = 0; v < 8; ++v) {
+            float ww[4];
+            memcpy(ww, c->wgt + (i0 + (size_t)v) * c->wgt_stride, sizeof ww);
+            __m256 a01 = _mm256_setzero_ps(), a23 = _mm256_setzero_ps();
+            for (int k = 0; k < 4; ++k) {
+                const float* m = (const float*)(const void*)(jb + p->off[4 * v + k]);
+                const __m256 w =
+                    _mm256_blend_ps(_mm256_set1_ps(ww[k]), _mm256_broadcast_ss(&p->sw[4 * v + k]), 0x88);
+                a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
+                a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
+            }
+            r01[v] = a01;
+            r23[v] = a23;
+        }
+    } else {
+        __m256 q[8];
+        blend_dq_block(c, i0, K, p, q);
+        for (int v = 0; v < 8; ++v) {
+            blend_matrix_vertex(c, i0 + (size_t)v, K, &r01[v], &r23[v]);
+            /* the rotation blend goes into the unused w rows: (qx, qy) and (qz, qw) */
+            r01[v] = _mm256_blend_ps(r01[v], _mm256_permutevar8x32_ps(q[v], lo), 0x88);
+            r23[v] = _mm256_blend_ps(r23[v], _mm256_permutevar8x32_ps(q[v], hi), 0x88);
+        }
     }
     transpose8(r01, cols);
     const __m256 ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];

@@ -10,8 +10,16 @@
 typedef struct akp_skin_joint {
     float real[4];    /* rotation quaternion of the rigid part (x, y, z, w) */
     float dual[4];    /* 0.5 * t * real */
-    float stretch[12]; /* S = R^T A, three columns padded to 4 floats */
-    float pad[12];
+    union {
+        struct {
+            float stretch[12]; /* S = R^T A, three columns padded to 4 floats */
+            float pad[12];
+        };
+        /* CoR when no joint has stretch (stretch is then unused): the palette matrix's four
+         * columns (x, y, z) with real[0..3] in their w slots, so that one blend of two 8-float
+         * rows gives both the matrix and the rotation (filled by ak_skin_job_run) */
+        float cor_rows[16];
+    };
 } akp_skin_joint;
 
 /* Resolved view of a job for one vertex range; pointers already offset to vertex 0. */
