@@ -71,6 +71,66 @@ static inline ak_quat weight_toward_identity(ak_quat q, float keep) {
     return ak_quat_nlerp(ak_quat_identity(), q, 1.0f - keep);
 }
 
+/* 3-vectors for the fast path: SSE registers (x, y, z, 0), or ak_vec3 without SIMD. */
+#if AK_SIMD_SSE2
+typedef __m128 tbv;
+static inline tbv tbv_make(ak_vec3 a) { return _mm_set_ps(0.0f, a.z, a.y, a.x); }
+static inline tbv tbv_pos(const float* m) { /* (m[12], m[13], m[14], 0) */
+    return _mm_and_ps(_mm_loadu_ps(m + 12), _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1)));
+}
+static inline tbv tbv_sub(tbv a, tbv b) { return _mm_sub_ps(a, b); }
+static inline tbv tbv_add(tbv a, tbv b) { return _mm_add_ps(a, b); }
+static inline tbv tbv_scale(tbv a, float s) { return _mm_mul_ps(a, _mm_set1_ps(s)); }
+static inline tbv tbv_neg(tbv a) { return _mm_xor_ps(a, _mm_set1_ps(-0.0f)); }
+/* a x b from (a * b.yzx - a.yzx * b).yzx: three shuffles. */
+static inline tbv tbv_cross(tbv a, tbv b) {
+    const tbv a1 = _mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 0, 2, 1)), b1 = _mm_shuffle_ps(b, b, _MM_SHUFFLE(3, 0, 2, 1));
+    const tbv c = _mm_sub_ps(_mm_mul_ps(a, b1), _mm_mul_ps(a1, b));
+    return _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 0, 2, 1));
+}
+static inline float tbv_dot(tbv a, tbv b) {
+    tbv p = _mm_mul_ps(a, b);
+    p = _mm_add_ps(p, _mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 3, 0, 1)));
+    p = _mm_add_ss(p, _mm_movehl_ps(p, p));
+    return _mm_cvtss_f32(p);
+}
+static inline ak_vec3 tbv_vec3(tbv a) {
+    float f[4];
+    _mm_storeu_ps(f, a);
+    return ak_vec3_make(f[0], f[1], f[2]);
+}
+#else
+typedef ak_vec3 tbv;
+static inline tbv tbv_make(ak_vec3 a) { return a; }
+static inline tbv tbv_pos(const float* m) { return mat_pos(m); }
+static inline tbv tbv_sub(tbv a, tbv b) { return ak_vec3_sub(a, b); }
+static inline tbv tbv_add(tbv a, tbv b) { return ak_vec3_add(a, b); }
+static inline tbv tbv_scale(tbv a, float s) { return ak_vec3_scale(a, s); }
+static inline tbv tbv_neg(tbv a) { return ak_vec3_neg(a); }
+static inline tbv tbv_cross(tbv a, tbv b) { return ak_vec3_cross(a, b); }
+static inline float tbv_dot(tbv a, tbv b) { return ak_vec3_dot(a, b); }
+static inline ak_vec3 tbv_vec3(tbv a) { return a; }
+#endif
+
+/* Reach, in squared lengths (one square root): softened, then clamped to what the two bones
+ * can span, |a - b| <= d <= a + b. Returns the squared distance to solve for. */
+static inline float two_bone_reach(float a2, float b2, float d2, float soft, bool* reached) {
+    const float ab = sqrtf(a2 * b2);
+    const float lmax2 = a2 + b2 + 2.0f * ab, lmin2 = ak_maxf(a2 + b2 - 2.0f * ab, 0.0f);
+    *reached = d2 <= lmax2 * (1.0f + 2e-6f) && d2 >= lmin2 - 2e-6f * lmax2;
+    float dd2 = d2;
+    if (soft > 0.0f) {
+        const float d = sqrtf(d2), lmax = sqrtf(lmax2);
+        const float ds = (1.0f - soft) * lmax, band = lmax - ds;
+        if (d > ds && band > 0.0f) {
+            const float dd = ds + band * (1.0f - expf((ds - d) / band));
+            dd2 = dd * dd;
+            *reached = false;
+        }
+    }
+    return ak_clampf(dd2, lmin2, lmax2);
+}
+
 /* The common case in closed form: no mid_axis (the bend axis is the normal n = u x v of the
  * current bend plane, not straight), a pole, target off the start joint. With n normal to u
  * and v, v_par = 0 and the mid equation's coefficients need no normalised vector:
@@ -81,12 +141,18 @@ static inline ak_quat weight_toward_identity(ak_quat q, float keep) {
  * unnormalised f, st and p = st x pole it needs sqrt(|f|^2 |st|^2), |p| and the final norm.
  * Returns false (nothing written) when the case does not apply or the start rotation is too
  * close to a half turn for the trace form; the general path then runs. */
-static bool two_bone_fast(const ak_ik_two_bone_job* job, int branch, ak_vec3 u, ak_vec3 v, ak_vec3 st, float a2,
-                          float b2, float d2, float dd2, ak_quat* out_start, ak_quat* out_mid) {
-    const ak_vec3 n = ak_vec3_cross(u, v), pole = job->pole, p = ak_vec3_cross(st, pole);
-    const float n2 = ak_vec3_dot(n, n), p2 = ak_vec3_dot(p, p), pole2 = ak_vec3_dot(pole, pole);
+static bool two_bone_fast(const ak_ik_two_bone_job* job, int branch, ak_quat* out_start, ak_quat* out_mid,
+                          bool* out_reached) {
+    const tbv s = tbv_pos(job->start.m), m = tbv_pos(job->mid.m), e = tbv_pos(job->end.m);
+    const tbv u = tbv_sub(m, s), v = tbv_sub(e, m), st = tbv_sub(tbv_make(job->target), s);
+    const tbv pole = tbv_make(job->pole), n = tbv_cross(u, v), p = tbv_cross(st, pole);
+    const float a2 = tbv_dot(u, u), b2 = tbv_dot(v, v), d2 = tbv_dot(st, st);
+    const float n2 = tbv_dot(n, n), p2 = tbv_dot(p, p), pole2 = tbv_dot(pole, pole);
+    /* The bend normal is trusted to ~1e-6 rad only with the limb bent by more than ~3 degrees. */
     if (!(n2 > 2.5e-3f * a2 * b2) || !(d2 > 1e-24f) || !(p2 > 1e-12f * pole2 * d2)) return false;
-    const float nl = sqrtf(n2), A = ak_vec3_dot(u, v), B = -nl;
+    bool reached;
+    const float dd2 = two_bone_reach(a2, b2, d2, job->soft, &reached);
+    const float nl = sqrtf(n2), A = tbv_dot(u, v), B = -nl;
     const float r2 = A * A + n2;
     float K = 0.5f * (dd2 - a2 - b2), S = 0.0f;
     if (K * K < r2) S = sqrtf(r2 - K * K);
@@ -98,59 +164,46 @@ static bool two_bone_fast(const ak_ik_two_bone_job* job, int branch, ak_vec3 u, 
      * +S (branch 1): the limb frame's third axis is -n^ or +n^ exactly. */
     const bool first = branch == 0;
     const float cphi = first ? c1 : c2, sphi = first ? s1 : s2;
-    const ak_vec3 nh = ak_vec3_scale(n, 1.0f / nl);
-    const ak_vec3 f = ak_vec3_add(ak_vec3_madd(u, v, cphi), ak_vec3_scale(ak_vec3_cross(nh, v), sphi));
-    const float f2 = ak_vec3_dot(f, f);
+    const tbv nh = tbv_scale(n, 1.0f / nl);
+    const tbv f = tbv_add(tbv_add(u, tbv_scale(v, cphi)), tbv_scale(tbv_cross(nh, v), sphi));
+    const float f2 = tbv_dot(f, f);
     /* Straight after the bend (|u x f^|^2 = S^2 / |f|^2 tiny): the general path's shortest arc. */
     if (!(f2 > 1e-24f) || !(S * S > 1e-12f * a2 * f2)) return false;
-    const ak_vec3 a2v = first ? ak_vec3_neg(nh) : nh;
+    const tbv a2v = first ? tbv_neg(nh) : nh;
     const float P = sqrtf(p2), FD = sqrtf(f2 * d2);
-    const ak_vec3 af = ak_vec3_cross(a2v, f), ps = ak_vec3_cross(p, st);
-    const ak_vec3 x1 = ak_vec3_cross(f, st), x2 = ak_vec3_cross(af, ps), x3 = ak_vec3_cross(a2v, p);
-    const float qx = P * x1.x + x2.x + FD * x3.x, qy = P * x1.y + x2.y + FD * x3.y, qz = P * x1.z + x2.z + FD * x3.z;
-    const float qw = FD * (P + ak_vec3_dot(a2v, p)) + P * ak_vec3_dot(f, st) + ak_vec3_dot(af, ps);
-    const float q2 = qx * qx + qy * qy + qz * qz + qw * qw;
+    const tbv af = tbv_cross(a2v, f), ps = tbv_cross(p, st);
+    const tbv qv = tbv_add(tbv_add(tbv_scale(tbv_cross(f, st), P), tbv_cross(af, ps)), tbv_scale(tbv_cross(a2v, p), FD));
+    const float qw = FD * (P + tbv_dot(a2v, p)) + P * tbv_dot(f, st) + tbv_dot(af, ps);
+    const float q2 = tbv_dot(qv, qv) + qw * qw;
     /* |q| = 4 w |f||st||p|: keep w >= 0.125 (a turn of at most ~166 degrees), where the
      * components' rounding stays far below the tests' tolerances. */
     if (!(qw > 0.0f) || !(64.0f * qw * qw > q2)) return false;
     const float qi = 1.0f / sqrtf(q2);
-    ak_quat q_start = ak_quat_make(qx * qi, qy * qi, qz * qi, qw * qi);
+    const ak_vec3 qa = ak_vec3_scale(tbv_vec3(qv), qi);
+    ak_quat q_start = ak_quat_make(qa.x, qa.y, qa.z, qw * qi);
     if (job->twist != 0.0f)
-        q_start = ak_quat_mul(ak_quat_from_axis_angle(ak_vec3_scale(st, 1.0f / sqrtf(d2)), job->twist), q_start);
+        q_start = ak_quat_mul(ak_quat_from_axis_angle(ak_vec3_scale(tbv_vec3(st), 1.0f / sqrtf(d2)), job->twist), q_start);
     const ak_vec3 axis_local = mat_unrotate(job->start.m, ak_vec3_make(q_start.x, q_start.y, q_start.z));
     q_start = ak_quat_make(axis_local.x, axis_local.y, axis_local.z, q_start.w);
-    const ak_quat q_mid = akp_quat_half_angle(mat_unrotate(job->mid.m, nh), cphi, sphi);
+    const ak_quat q_mid = akp_quat_half_angle(mat_unrotate(job->mid.m, tbv_vec3(nh)), cphi, sphi);
     *out_start = weight_toward_identity(q_start, job->keep_animation);
     *out_mid = weight_toward_identity(q_mid, job->keep_animation);
+    *out_reached = reached;
     return true;
 }
 
 bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* out_start, ak_quat* out_mid) {
+    const bool axis_given = job->mid_axis.x != 0.0f || job->mid_axis.y != 0.0f || job->mid_axis.z != 0.0f;
+    const bool has_pole = job->pole.x != 0.0f || job->pole.y != 0.0f || job->pole.z != 0.0f;
+    bool fast_reached;
+    if (!axis_given && has_pole && two_bone_fast(job, branch, out_start, out_mid, &fast_reached)) return fast_reached;
     const float *S = job->start.m, *M = job->mid.m, *E = job->end.m;
     const ak_vec3 s = mat_pos(S), m = mat_pos(M), e = mat_pos(E);
     const ak_vec3 u = ak_vec3_sub(m, s), v = ak_vec3_sub(e, m), st = ak_vec3_sub(job->target, s);
     const float a2 = ak_vec3_dot(u, u), b2 = ak_vec3_dot(v, v), d2 = ak_vec3_dot(st, st);
 
-    /* Reach, in squared lengths (one square root): softened, then clamped to what the two
-     * bones can span, |a - b| <= d <= a + b. */
-    const float ab = sqrtf(a2 * b2);
-    const float lmax2 = a2 + b2 + 2.0f * ab, lmin2 = ak_maxf(a2 + b2 - 2.0f * ab, 0.0f);
-    bool reached = d2 <= lmax2 * (1.0f + 2e-6f) && d2 >= lmin2 - 2e-6f * lmax2;
-    float dd2 = d2;
-    if (job->soft > 0.0f) {
-        const float d = sqrtf(d2), lmax = sqrtf(lmax2);
-        const float ds = (1.0f - job->soft) * lmax, band = lmax - ds;
-        if (d > ds && band > 0.0f) {
-            const float dd = ds + band * (1.0f - expf((ds - d) / band));
-            dd2 = dd * dd;
-            reached = false;
-        }
-    }
-    dd2 = ak_clampf(dd2, lmin2, lmax2);
-    const bool axis_given = job->mid_axis.x != 0.0f || job->mid_axis.y != 0.0f || job->mid_axis.z != 0.0f;
-    const bool has_pole = job->pole.x != 0.0f || job->pole.y != 0.0f || job->pole.z != 0.0f;
-    if (!axis_given && has_pole && two_bone_fast(job, branch, u, v, st, a2, b2, d2, dd2, out_start, out_mid))
-        return reached;
+    bool reached;
+    const float dd2 = two_bone_reach(a2, b2, d2, job->soft, &reached);
 
     /* Bend axis n in model space, n_local in the mid joint's frame. */
     ak_vec3 n, n_local;
