@@ -174,6 +174,9 @@ AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
  * limits, e.g. a planar chain of hinges); if the converted pose misses, the remaining
  * iterations run constrained: the backward pass turns each joint within its limits, followed
  * by one constrained CCD sweep so joints pinned at a limit do not freeze the chain.
+ * While plain FABRIK passes shrink the error by less than half per pass (slow convergence
+ * near full reach), each next pass starts from the positions extrapolated by the last pass's
+ * step (a momentum step; the passes themselves keep the bone lengths).
  * TWO_BONE bends a HINGE mid joint about the hinge axis (trying the other bend when the limits
  * refuse the first). DLS stops when lambda tops out without an improving step.
  * Degenerate cases: a one-joint chain cannot move its effector (only target_rotation is

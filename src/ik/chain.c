@@ -138,7 +138,7 @@ size_t ak_ik_chain_scratch_size(ak_ik_solver solver, size_t chain_count) {
     /* 16: room to align the caller's pointer */
     size_t bytes = 16 + 2 * world_bytes(n) + 2 * akp_align16(n);
     switch (resolve_solver(solver)) {
-    case AK_IK_SOLVER_FABRIK: bytes += akp_align16(n * sizeof(ak_vec3)) + akp_align16(n * sizeof(float)); break;
+    case AK_IK_SOLVER_FABRIK: bytes += 2 * akp_align16(n * sizeof(ak_vec3)) + akp_align16(n * sizeof(float)); break;
     case AK_IK_SOLVER_DLS: bytes += akp_ik_dls_scratch_size(n); break;
     default: break;
     }
@@ -284,8 +284,9 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
         case AK_IK_SOLVER_FABRIK:
         default: {
             ak_vec3* pos = (ak_vec3*)mem;
-            float* len = (float*)(mem + akp_align16(n * sizeof(ak_vec3)));
-            out = akp_ik_fabrik(&c, &rj, pos, len);
+            ak_vec3* prev = (ak_vec3*)(mem + akp_align16(n * sizeof(ak_vec3)));
+            float* len = (float*)(mem + 2 * akp_align16(n * sizeof(ak_vec3)));
+            out = akp_ik_fabrik(&c, &rj, pos, prev, len);
             apply_target_rotation(&c, rj.target_rotation);
             break;
         }

@@ -86,7 +86,7 @@ static void fabrik_pass(akp_ik_chain* c, ak_vec3* pos, const float* len, float t
 /* Chains with limits first try the plain passes (often the answer already respects the limits,
  * e.g. a planar chain of hinges); only if the converted pose misses do the constrained
  * iterations take over for the rest of the budget. */
-akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec3* pos, float* len) {
+akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec3* pos, ak_vec3* prev, float* len) {
     const size_t n = c->count, last = n - 1;
     const ak_vec3 t = c->target;
     for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
@@ -103,7 +103,23 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
         /* On positions, aim a little inside the tolerance: turning the positions back into
          * rotations adds float round-off, which must not push a converged answer out. */
         const float goal = constrained ? c->tolerance : 0.9f * c->tolerance;
+        float prev_error = out.error;
         while (out.error > goal && out.iterations < job->max_iterations) {
+            /* Near full reach the passes converge linearly and slowly (each one straightens
+             * the chain a little). While the error shrinks by less than half per pass, start
+             * the next pass from the last one extrapolated by its own step (a momentum step
+             * on the positions); the passes restore the bone lengths, so only where they
+             * start changes. Positions only: the constrained iterations go through limits. */
+            if (!constrained && out.iterations >= 2 && out.error > 0.5f * prev_error) {
+                for (size_t i = 1; i < n; ++i) {
+                    const ak_vec3 x = pos[i];
+                    pos[i] = ak_vec3_add(x, ak_vec3_sub(x, prev[i]));
+                    prev[i] = x;
+                }
+            } else {
+                memcpy(prev, pos, n * sizeof *pos);
+            }
+            prev_error = out.error;
             fabrik_pass(c, pos, len, total, root, constrained);
             out.error = ak_vec3_distance(pos[last], t);
             ++out.iterations;

@@ -176,7 +176,9 @@ static inline ak_quat akp_ik_aim_rotation(ak_vec3 re, ak_vec3 rd, bool hinge, ak
 akp_ik_outcome akp_ik_ccd(akp_ik_chain* c, const ak_ik_chain_job* job);
 /* One CCD sweep over the chain (world[] consistent before and after). */
 void akp_ik_ccd_sweep(akp_ik_chain* c, float max_step, bool from_root);
-akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec3* positions, float* lengths);
+/* positions, previous: [count] scratch (the previous pass's positions, for the momentum step). */
+akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec3* positions, ak_vec3* previous,
+                             float* lengths);
 akp_ik_outcome akp_ik_dls(akp_ik_chain* c, const ak_ik_chain_job* job, void* scratch);
 size_t akp_ik_dls_scratch_size(size_t chain_count);
 void akp_ik_two_bone_chain(akp_ik_chain* c, const ak_ik_chain_job* job);
