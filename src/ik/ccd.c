@@ -37,6 +37,24 @@ static ak_vec3 ccd_step(akp_ik_chain* c, size_t i, ak_vec3 e, float max_step, bo
     if (type == AK_JOINT_PRISM) return ak_vec3_add(e, ccd_slide(c, i, e));
     const size_t j = (size_t)c->joints[i];
     const ak_vec3 p = c->world[i].translation;
+    if (type != AK_JOINT_HINGE && !c->clamp[i] && max_step >= AK_PI) {
+        /* Free and undamped: the shortest arc q = (RE x RD, |RE||RD| + RE.RD) left unnormalised
+         * (the local rotation is normalised once after the product), and the effector lands
+         * exactly on RD at distance |RE|: p + RD |RE||RD| / |RD|^2. One square root on the
+         * sweep's chain from joint to joint. */
+        const ak_vec3 re = ak_vec3_sub(e, p), rd = ak_vec3_sub(c->target, p);
+        const float rd2 = ak_vec3_length_sq(rd), l2 = ak_vec3_length_sq(re) * rd2;
+        if (!(l2 > 1e-24f)) return e;
+        const float m = sqrtf(l2), w = m + ak_vec3_dot(re, rd);
+        if (w > 1e-6f * m) {
+            const ak_vec3 v = ak_vec3_cross(re, rd);
+            ak_transform* l = &c->pose[j];
+            const ak_quat q = ak_quat_make(v.x, v.y, v.z, w);
+            l->rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(akp_ik_parent_rot(c, i)), ak_quat_mul(q, c->world[i].rotation)));
+            if (need_world) c->world[i] = akp_ik_compose(akp_ik_parent_world(c, i), *l);
+            return ak_vec3_madd(p, rd, m / rd2);
+        }
+    }
     ak_vec3 axis = ak_vec3_zero();
     if (type == AK_JOINT_HINGE)
         axis = ak_vec3_normalize(ak_quat_rotate(c->world[i].rotation, ak_skeleton_joint_limits(c->skeleton, j).axis));
