@@ -1,9 +1,12 @@
 /* AVX2 + FMA skinning kernel, vectorized across vertices (8 per block).
  *
  * Each block runs in two stages. Per vertex, the joint data are blended with contiguous
- * loads (matrix columns for LBS and CoR, rotation|dual quaternion pairs for DQS), which avoids
- * gathers (slow on every x86 core we target); the 8 blended results are then transposed into
- * structure-of-arrays registers and the transform, normal and normalisation run 8-wide.
+ * loads (matrix columns for LBS, rotation|dual quaternion pairs for DQS, matrix columns with
+ * the rotation in their w slots for CoR), which avoids gathers (slow on every x86 core we
+ * target); the 8 blended results are then transposed into structure-of-arrays registers and
+ * the transform, normal and normalisation run 8-wide. With 4 influences the joint offsets of
+ * a block are computed with SIMD, and DQS/CoR compute the hemisphere signs one block ahead.
+ * DQS/CoR never normalise the blended quaternion: the rotation formulas take 2 / |q|^2.
  * Positions and normals are deinterleaved with shuffles when tightly packed (stride 12).
  *
  * Handled here: LBS, DQS, CoR with positions and optional normals, rigid or stretched
