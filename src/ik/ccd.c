@@ -8,6 +8,34 @@
  * rotation actually applied, after limits). Visiting root to tip, the next joint's world
  * transform is rebuilt from the joint just changed. */
 #include "ik_internal.h"
+#include "simd.h"
+
+/* normalize(conj(parent) * q * world): a joint's new local rotation after the model-space turn
+ * q (q need not be unit). In SSE registers, the two products take about a third of the
+ * scalar instructions. */
+#if AK_SIMD_SSE2
+static inline __m128 qmul_sse(__m128 a, __m128 b) {
+    /* a.w b + a.x (b.w, -b.z, b.y, -b.x) + a.y (b.z, b.w, -b.x, -b.y) + a.z (-b.y, b.x, b.w, -b.z) */
+    const __m128 b1 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(0, 1, 2, 3)), _mm_set_ps(-0.0f, 0.0f, -0.0f, 0.0f));
+    const __m128 b2 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(1, 0, 3, 2)), _mm_set_ps(-0.0f, -0.0f, 0.0f, 0.0f));
+    const __m128 b3 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(2, 3, 0, 1)), _mm_set_ps(-0.0f, 0.0f, 0.0f, -0.0f));
+    __m128 r = _mm_mul_ps(AKP_SIMD_SPLAT(a, 3), b);
+    r = _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 0), b1));
+    r = _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 1), b2));
+    return _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 2), b3));
+}
+#endif
+static inline ak_quat local_after_turn(ak_quat parent, ak_quat q, ak_quat world) {
+#if AK_SIMD_SSE2
+    const __m128 pc = _mm_xor_ps(_mm_loadu_ps(&parent.x), _mm_set_ps(0.0f, -0.0f, -0.0f, -0.0f));
+    const __m128 r = qmul_sse(pc, qmul_sse(_mm_loadu_ps(&q.x), _mm_loadu_ps(&world.x)));
+    float f[4];
+    _mm_storeu_ps(f, r);
+    return ak_quat_normalize(ak_quat_make(f[0], f[1], f[2], f[3]));
+#else
+    return ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(parent), ak_quat_mul(q, world)));
+#endif
+}
 
 /* Slide a prism joint so that the effector moves as close to the target as its axis allows.
  * Returns the effector's displacement. */
@@ -50,7 +78,7 @@ static ak_vec3 ccd_step(akp_ik_chain* c, size_t i, ak_vec3 e, float max_step, bo
             const ak_vec3 v = ak_vec3_cross(re, rd);
             ak_transform* l = &c->pose[j];
             const ak_quat q = ak_quat_make(v.x, v.y, v.z, w);
-            l->rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(akp_ik_parent_rot(c, i)), ak_quat_mul(q, c->world[i].rotation)));
+            l->rotation = local_after_turn(akp_ik_parent_rot(c, i), q, c->world[i].rotation);
             if (need_world) c->world[i] = akp_ik_compose(akp_ik_parent_world(c, i), *l);
             return ak_vec3_madd(p, rd, m / rd2);
         }
