@@ -8,30 +8,20 @@
  * rotation actually applied, after limits). Visiting root to tip, the next joint's world
  * transform is rebuilt from the joint just changed. */
 #include "ik_internal.h"
-#include "simd.h"
 
 /* normalize(conj(parent) * q * world): a joint's new local rotation after the model-space turn
  * q (q need not be unit). In SSE registers, the two products take about a third of the
  * scalar instructions. */
-#if AK_SIMD_SSE2
-static inline __m128 qmul_sse(__m128 a, __m128 b) {
-    /* a.w b + a.x (b.w, -b.z, b.y, -b.x) + a.y (b.z, b.w, -b.x, -b.y) + a.z (-b.y, b.x, b.w, -b.z) */
-    const __m128 b1 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(0, 1, 2, 3)), _mm_set_ps(-0.0f, 0.0f, -0.0f, 0.0f));
-    const __m128 b2 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(1, 0, 3, 2)), _mm_set_ps(-0.0f, -0.0f, 0.0f, 0.0f));
-    const __m128 b3 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(2, 3, 0, 1)), _mm_set_ps(-0.0f, 0.0f, 0.0f, -0.0f));
-    __m128 r = _mm_mul_ps(AKP_SIMD_SPLAT(a, 3), b);
-    r = _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 0), b1));
-    r = _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 1), b2));
-    return _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 2), b3));
-}
-#endif
 static inline ak_quat local_after_turn(ak_quat parent, ak_quat q, ak_quat world) {
 #if AK_SIMD_SSE2
     const __m128 pc = _mm_xor_ps(_mm_loadu_ps(&parent.x), _mm_set_ps(0.0f, -0.0f, -0.0f, -0.0f));
-    const __m128 r = qmul_sse(pc, qmul_sse(_mm_loadu_ps(&q.x), _mm_loadu_ps(&world.x)));
-    float f[4];
-    _mm_storeu_ps(f, r);
-    return ak_quat_normalize(ak_quat_make(f[0], f[1], f[2], f[3]));
+    const __m128 r = akp_ik_qmul_sse(pc, akp_ik_qmul_sse(_mm_loadu_ps(&q.x), _mm_loadu_ps(&world.x)));
+    const __m128 n2 = _mm_mul_ps(r, r);
+    const float s = _mm_cvtss_f32(_mm_add_ss(_mm_add_ss(n2, AKP_SIMD_SPLAT(n2, 1)), _mm_add_ss(AKP_SIMD_SPLAT(n2, 2), AKP_SIMD_SPLAT(n2, 3))));
+    ak_quat out;
+    if (!(s > 1e-30f) || !ak_finitef(s)) return ak_quat_identity();
+    _mm_storeu_ps(&out.x, _mm_mul_ps(r, _mm_set1_ps(1.0f / sqrtf(s))));
+    return out;
 #else
     return ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(parent), ak_quat_mul(q, world)));
 #endif

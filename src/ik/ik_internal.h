@@ -5,6 +5,7 @@
 #include <animkit/ik.h>
 
 #include "internal.h"
+#include "simd.h"
 
 /* Working state of one chain solve. world[i] is the model transform of chain joint i;
  * base is the model transform of the chain root's parent (identity for a skeleton root). */
@@ -41,14 +42,51 @@ static inline ak_transform akp_ik_parent_world(const akp_ik_chain* c, size_t i) 
     return i == 0 ? c->base : c->world[i - 1];
 }
 
+#if AK_SIMD_SSE2
+/* Quaternion product a * b, (x, y, z, w) lanes:
+ * a.w b + a.x (b.w, -b.z, b.y, -b.x) + a.y (b.z, b.w, -b.x, -b.y) + a.z (-b.y, b.x, b.w, -b.z). */
+static inline __m128 akp_ik_qmul_sse(__m128 a, __m128 b) {
+    const __m128 b1 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(0, 1, 2, 3)), _mm_set_ps(-0.0f, 0.0f, -0.0f, 0.0f));
+    const __m128 b2 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(1, 0, 3, 2)), _mm_set_ps(-0.0f, -0.0f, 0.0f, 0.0f));
+    const __m128 b3 = _mm_xor_ps(_mm_shuffle_ps(b, b, _MM_SHUFFLE(2, 3, 0, 1)), _mm_set_ps(-0.0f, 0.0f, 0.0f, -0.0f));
+    __m128 r = _mm_mul_ps(AKP_SIMD_SPLAT(a, 3), b);
+    r = _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 0), b1));
+    r = _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 1), b2));
+    return _mm_add_ps(r, _mm_mul_ps(AKP_SIMD_SPLAT(a, 2), b3));
+}
+/* a x b in the x, y, z lanes (w lane: 0 for finite input): (a * b.yzx - a.yzx * b).yzx. */
+static inline __m128 akp_ik_cross_sse(__m128 a, __m128 b) {
+    const __m128 a1 = _mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 0, 2, 1)), b1 = _mm_shuffle_ps(b, b, _MM_SHUFFLE(3, 0, 2, 1));
+    const __m128 c = _mm_sub_ps(_mm_mul_ps(a, b1), _mm_mul_ps(a1, b));
+    return _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 0, 2, 1));
+}
+#endif
+
 /* parent * local for unit rotations: like ak_transform_mul without the renormalisation, which
  * the solvers do once per changed joint instead. */
 static inline ak_transform akp_ik_compose(ak_transform parent, ak_transform local) {
     ak_transform r;
+#if AK_SIMD_SSE2
+    /* rotation: one SSE product; translation: v + w t + q x t, t = 2 q x v (v the scaled
+     * local translation), two SSE cross products. */
+    const __m128 pq = _mm_loadu_ps(&parent.rotation.x);
+    _mm_storeu_ps(&r.rotation.x, akp_ik_qmul_sse(pq, _mm_loadu_ps(&local.rotation.x)));
+    r.scale = ak_vec3_mul(parent.scale, local.scale);
+    const ak_vec3 lv = ak_vec3_mul(parent.scale, local.translation);
+    const __m128 v = _mm_set_ps(0.0f, lv.z, lv.y, lv.x);
+    const __m128 qv = _mm_and_ps(pq, _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1)));
+    const __m128 t = akp_ik_cross_sse(qv, _mm_add_ps(v, v));
+    const __m128 o = _mm_add_ps(_mm_add_ps(v, _mm_mul_ps(AKP_SIMD_SPLAT(pq, 3), t)), akp_ik_cross_sse(qv, t));
+    float f[4];
+    _mm_storeu_ps(f, o);
+    r.translation = ak_vec3_make(parent.translation.x + f[0], parent.translation.y + f[1], parent.translation.z + f[2]);
+    return r;
+#else
     r.rotation = ak_quat_mul(parent.rotation, local.rotation);
     r.scale = ak_vec3_mul(parent.scale, local.scale);
     r.translation = ak_vec3_add(parent.translation, ak_quat_rotate(parent.rotation, ak_vec3_mul(parent.scale, local.translation)));
     return r;
+#endif
 }
 
 /* Recompute world[from..count-1] from the pose. */
