@@ -430,6 +430,68 @@ AK_TEST(lbs_tangents_and_face_normals) {
     cylinder_free(&c);
 }
 
+AK_TEST(bad_joint_indices_clamp_in_every_kernel) {
+    /* With skip_data_check, out-of-range joint indices are documented to be clamped to the
+     * last palette entry. Each kernel (the SIMD one runs blocks of 8 vertices, with its own
+     * clamp for 4 influences, and the scalar code) must give the result of the same job with
+     * those indices replaced by J - 1 and the data validated, for LBS, DQS and CoR. */
+    enum { N = 61, J = 6 };
+    ak_rng rng = ak_rng_make(23);
+    ak_mat4 pal[J];
+    for (int j = 0; j < J; ++j) pal[j] = rand_matrix(&rng, false); /* rigid: DQS/CoR SIMD path */
+    ak_vec3 pos[N], nrm[N], ctr[N], ref_p[N], ref_n[N], op[N], on[N];
+    uint16_t jn[N * 4], jfix[N * 4];
+    float w[N * 4];
+    unsigned char scratch[64 + 128 * J];
+    for (uint32_t k = 3; k <= 4; ++k) {
+        for (int i = 0; i < N; ++i) {
+            pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+            nrm[i] = rand_unit(&rng);
+            ctr[i] = ak_vec3_scale(pos[i], 0.5f);
+            rand_influences(&rng, k, J, &jn[k * i], &w[k * i]);
+        }
+        memcpy(jfix, jn, sizeof jn);
+        for (int i = 0; i < N; i += 3) {
+            jn[k * (uint32_t)i + (uint32_t)i % k] = (uint16_t)(i % 2 ? 65535 : J + 2);
+            jfix[k * (uint32_t)i + (uint32_t)i % k] = J - 1;
+        }
+        for (int m = AK_SKIN_LBS; m <= AK_SKIN_COR; ++m) {
+            ak_skin_job job = {
+                .method = (ak_skin_method)m,
+                .influence_count = k,
+                .palette = {pal, J},
+                .positions = {pos, N, 0},
+                .normals = {nrm, N, 0},
+                .joints = {jfix, N, 0},
+                .weights = {w, N, 0},
+                .cor_centers = {ctr, N, 0},
+                .scratch = {scratch, sizeof scratch},
+                .out_positions = {ref_p, N, 0},
+                .out_normals = {ref_n, N, 0},
+                .skip_simd = true,
+            };
+            AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+            job.joints.ptr = jn;
+            AK_CHECK_EQ(ak_skin_job_validate(&job), AK_ERR_BAD_INDEX);
+            job.skip_data_check = true;
+            job.out_positions.ptr = op;
+            job.out_normals.ptr = on;
+            for (int simd = 0; simd < 2; ++simd) {
+                job.skip_simd = simd == 0;
+                memset(op, 0, sizeof op);
+                memset(on, 0, sizeof on);
+                AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+                double worst = 0.0;
+                for (int i = 0; i < N; ++i) {
+                    worst = fmax(worst, ak_vec3_length(ak_vec3_sub(op[i], ref_p[i])));
+                    worst = fmax(worst, ak_vec3_length(ak_vec3_sub(on[i], ref_n[i])));
+                }
+                AK_CHECK(worst < 1e-4); /* a wrong joint moves points by O(1) */
+            }
+        }
+    }
+}
+
 AK_TEST(job_split_matches_whole) {
     cylinder c = cylinder_make(21, 16);
     ak_mat4 pal[2] = {ak_mat4_identity(), rot_about(ak_vec3_make(0, 1, 0), ak_vec3_make(1, 0, 0), 0.7f)};
@@ -1132,6 +1194,7 @@ int main(void) {
     AK_RUN(job_bad_data_codes);
     AK_RUN(lbs_matches_double_reference);
     AK_RUN(lbs_tangents_and_face_normals);
+    AK_RUN(bad_joint_indices_clamp_in_every_kernel);
     AK_RUN(job_split_matches_whole);
     AK_RUN(dqs_single_influence_is_rigid);
     AK_RUN(dqs_rigid_blend_keeps_distance_to_joint);
