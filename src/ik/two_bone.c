@@ -139,8 +139,7 @@ static inline float two_bone_reach(float a2, float b2, float d2, float soft, boo
  * normalised. The rotation between two orthonormal frames is the quaternion
  * (sum a_i x b_i, 1 + sum a_i.b_i) normalised (Shepperd's trace branch); written with the
  * unnormalised f, st and p = st x pole it needs sqrt(|f|^2 |st|^2), |p| and the final norm.
- * Returns false (nothing written) when the case does not apply or the start rotation is too
- * close to a half turn for the trace form; the general path then runs. */
+ * Returns false (nothing written) when the case does not apply; the general path then runs. */
 static bool two_bone_fast(const ak_ik_two_bone_job* job, int branch, ak_quat* out_start, ak_quat* out_mid,
                           bool* out_reached) {
     const tbv s = tbv_pos(job->start.m), m = tbv_pos(job->mid.m), e = tbv_pos(job->end.m);
@@ -172,12 +171,30 @@ static bool two_bone_fast(const ak_ik_two_bone_job* job, int branch, ak_quat* ou
     const tbv a2v = first ? tbv_neg(nh) : nh;
     const float P = sqrtf(p2), FD = sqrtf(f2 * d2);
     const tbv af = tbv_cross(a2v, f), ps = tbv_cross(p, st);
-    const tbv qv = tbv_add(tbv_add(tbv_scale(tbv_cross(f, st), P), tbv_cross(af, ps)), tbv_scale(tbv_cross(a2v, p), FD));
-    const float qw = FD * (P + tbv_dot(a2v, p)) + P * tbv_dot(f, st) + tbv_dot(af, ps);
+    /* Scaled by |f||st||p|: a_i x b_i -> T_i, a_i . b_i -> d_i. */
+    const tbv T0 = tbv_scale(tbv_cross(f, st), P), T1 = tbv_cross(af, ps), T2 = tbv_scale(tbv_cross(a2v, p), FD);
+    const float base = FD * P, e0 = P * tbv_dot(f, st), e1 = tbv_dot(af, ps), e2 = FD * tbv_dot(a2v, p);
+    /* Shepperd's choice in frame form: with F_k the half turn about a_k, R = R' F_k where R'
+     * takes (+-a_i) onto b_i; of the four candidates (the trace form and one per axis) take
+     * the one with the largest scalar part (at least a quarter of the sum 4 |f||st||p|), so
+     * the normalisation never divides a cancellation. q = q' (a_k, 0), a_0 = f, a_1 = a2 x f
+     * (both |f| long: the final normalisation absorbs it), a_2 = +-n^. */
+    const float w_id = base + e0 + e1 + e2, w_2 = base - e0 - e1 + e2, w_0 = base + e0 - e1 - e2,
+                w_1 = base - e0 + e1 - e2;
+    tbv qv;
+    float qw;
+    if (w_id >= w_2 && w_id >= w_0 && w_id >= w_1) {
+        qv = tbv_add(tbv_add(T0, T1), T2), qw = w_id;
+    } else {
+        tbv vk, ak;
+        float wk;
+        if (w_2 >= w_0 && w_2 >= w_1) vk = tbv_sub(T2, tbv_add(T0, T1)), wk = w_2, ak = a2v;
+        else if (w_0 >= w_1) vk = tbv_sub(T0, tbv_add(T1, T2)), wk = w_0, ak = f;
+        else vk = tbv_sub(T1, tbv_add(T0, T2)), wk = w_1, ak = af;
+        qv = tbv_add(tbv_scale(ak, wk), tbv_cross(vk, ak)), qw = -tbv_dot(vk, ak);
+    }
     const float q2 = tbv_dot(qv, qv) + qw * qw;
-    /* |q| = 4 w |f||st||p|: keep w >= 0.125 (a turn of at most ~166 degrees), where the
-     * components' rounding stays far below the tests' tolerances. */
-    if (!(qw > 0.0f) || !(64.0f * qw * qw > q2)) return false;
+    if (!(q2 > 0.0f)) return false;
     const float qi = 1.0f / sqrtf(q2);
     const ak_vec3 qa = ak_vec3_scale(tbv_vec3(qv), qi);
     ak_quat q_start = ak_quat_make(qa.x, qa.y, qa.z, qw * qi);
