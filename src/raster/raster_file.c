@@ -1,7 +1,9 @@
 /* PNG (libpng's simplified API) and animated GIF (giflib) writing and reading. The GIF colour
  * quantizer (median cut over a 15-bit histogram, ordered dithering) is animkit's own. */
+#include <fcntl.h> /* open: GIF files with the usual permissions */
 #include <stdio.h>
 #include <stdlib.h>
+#include <unistd.h> /* close */
 
 #include <gif_lib.h> /* giflib 5: EGif* writer, DGif* reader */
 #include <png.h>     /* libpng 1.6 simplified API: png_image */
@@ -242,7 +244,11 @@ ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const 
     w->cells = (uint16_t*)(void*)(mem + o_cells);
     w->map = (uint16_t*)(void*)(mem + o_map);
     int err = 0;
-    w->gif = EGifOpenFileName(path, false, &err);
+    /* Open the file ourselves: EGifOpenFileName creates it with mode 0600; users expect the
+     * same permissions as any other output (0666 less the umask, as fopen gives). */
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0666);
+    w->gif = fd >= 0 ? EGifOpenFileHandle(fd, &err) : NULL;
+    if (!w->gif && fd >= 0) close(fd);
     if (!w->gif) {
         akp_free(w->has_alloc ? &w->alloc : NULL, mem);
         return AK_ERR_IO;
