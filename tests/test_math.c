@@ -156,6 +156,46 @@ AK_TEST(rodrigues_and_axis_angle) {
     AK_CHECK_NEAR(q_diff_sign(ak_quat_from_axis_angle(ak_vec3_zero(), 1.0f), (ref_q){0, 0, 0, 1}), 0.0, 0.0);
 }
 
+/* Finite inputs whose squared length overflows float (components above ~1.8e19) still have a
+ * direction: normalising gives it (not the zero / identity fallback of non-finite input), and
+ * exp stays finite. Oracles are the exact directions. */
+AK_TEST(huge_finite_inputs) {
+    const float big[3] = {2e19f, 1e30f, 3e38f};
+    for (int i = 0; i < 3; ++i) {
+        float b = big[i];
+        ak_vec3 v = ak_vec3_normalize(ak_vec3_make(b, 0, 0));
+        AK_CHECK_MSG(v.x == 1.0f && v.y == 0.0f && v.z == 0.0f, "normalize(%g, 0, 0) = (%g %g %g)", (double)b, (double)v.x,
+                     (double)v.y, (double)v.z);
+        v = ak_vec3_normalize(ak_vec3_make(-b, b, 0));
+        AK_CHECK_NEAR(v.x, -0.70710678, 1e-6);
+        AK_CHECK_NEAR(v.y, 0.70710678, 1e-6);
+        ak_quat q = ak_quat_normalize(ak_quat_make(0, b, 0, 0));
+        AK_CHECK_MSG(q.y == 1.0f && q.w == 0.0f, "quat_normalize(0, %g, 0, 0) = (%g %g %g %g)", (double)b, (double)q.x,
+                     (double)q.y, (double)q.z, (double)q.w);
+        q = ak_quat_normalize(ak_quat_make(b, b, b, -b));
+        AK_CHECK_NEAR(q.x, 0.5, 1e-6);
+        AK_CHECK_NEAR(q.w, -0.5, 1e-6);
+        ak_quat r = ak_quat_from_axis_angle(ak_vec3_make(0, 0, b), 1.0f);
+        AK_CHECK_NEAR(r.z, sin(0.5), 1e-6);
+        AK_CHECK_NEAR(r.w, cos(0.5), 1e-6);
+        /* exp of a huge pure quaternion: unit length (its angle is meaningless, but finite) */
+        ak_quat e = ak_quat_exp(ak_quat_make(b, b, 0, 0));
+        AK_CHECK_MSG(ak_quat_is_finite(e), "exp(%g, %g, 0, 0) = (%g %g %g %g)", (double)b, (double)b, (double)e.x,
+                     (double)e.y, (double)e.z, (double)e.w);
+        AK_CHECK_NEAR(ak_quat_norm(e), 1.0, 1e-5);
+        /* the array path agrees with the scalar one, SIMD lanes included */
+        ak_quat in[5] = {{0, b, 0, 0}, {0, 0, 0, 1}, {b, b, b, -b}, {0, 0, 0, 0}, {0, 0, b, 0}}, out[5];
+        AK_CHECK_EQ(ak_quat_normalize_array((ak_quat_cspan){in, 5}, (ak_quat_span){out, 5}), AK_OK);
+        AK_CHECK(out[0].y == 1.0f && out[1].w == 1.0f && out[3].w == 1.0f && out[4].z == 1.0f);
+        AK_CHECK_NEAR(out[2].w, -0.5, 1e-6);
+    }
+    /* genuinely non-finite input keeps its fallbacks */
+    ak_vec3 z = ak_vec3_normalize(ak_vec3_make(INFINITY, 0, 0));
+    AK_CHECK(z.x == 0 && z.y == 0 && z.z == 0);
+    ak_quat qi = ak_quat_normalize(ak_quat_make(0, INFINITY, 0, 0));
+    AK_CHECK(qi.w == 1 && qi.y == 0);
+}
+
 AK_TEST(quat_exp_log) {
     ak_rng g = ak_rng_make(4);
     double worst_rt = 0, worst_log = 0, worst_exp = 0, worst_gen = 0;
@@ -1045,5 +1085,6 @@ int main(void) {
     AK_RUN(array_functions);
     AK_RUN(array_unaligned);
     AK_RUN(array_bad_input);
+    AK_RUN(huge_finite_inputs);
     return ak_test_finish();
 }

@@ -129,10 +129,17 @@ static inline ak_vec3 ak_vec3_cross(ak_vec3 a, ak_vec3 b) {
 static inline float ak_vec3_length_sq(ak_vec3 a) { return ak_vec3_dot(a, a); }
 static inline float ak_vec3_length(ak_vec3 a) { return sqrtf(ak_vec3_dot(a, a)); }
 static inline float ak_vec3_distance(ak_vec3 a, ak_vec3 b) { return ak_vec3_length(ak_vec3_sub(a, b)); }
-/* Unit vector along a; the zero vector (length below 1e-30) gives zero. */
+/* Unit vector along a; the zero vector (length below 1e-30) or a non-finite one gives zero.
+ * A finite vector whose squared length overflows (components above ~1e19) is rescaled first,
+ * so it still gives its direction. */
 static inline ak_vec3 ak_vec3_normalize(ak_vec3 a) {
     float l2 = ak_vec3_dot(a, a);
-    if (!(l2 > 1e-30f) || !ak_finitef(l2)) return ak_vec3_zero();
+    if (!(l2 > 1e-30f) || !ak_finitef(l2)) {
+        if (!(l2 > 1e-30f) || !ak_finitef(a.x) || !ak_finitef(a.y) || !ak_finitef(a.z)) return ak_vec3_zero();
+        float m = fmaxf(fabsf(a.x), fmaxf(fabsf(a.y), fabsf(a.z)));
+        a = ak_vec3_make(a.x / m, a.y / m, a.z / m);
+        l2 = ak_vec3_dot(a, a);
+    }
     return ak_vec3_scale(a, 1.0f / sqrtf(l2));
 }
 /* a + (b - a) t; t outside [0, 1] extrapolates. */
@@ -175,10 +182,16 @@ static inline ak_quat ak_quat_add(ak_quat a, ak_quat b) { return ak_quat_make(a.
 static inline ak_quat ak_quat_conjugate(ak_quat q) { return ak_quat_make(-q.x, -q.y, -q.z, q.w); }
 static inline bool ak_quat_is_finite(ak_quat q) { return ak_finitef(q.x) && ak_finitef(q.y) && ak_finitef(q.z) && ak_finitef(q.w); }
 
-/* Unit quaternion; a zero, tiny or non-finite quaternion gives the identity. */
+/* Unit quaternion; a zero, tiny or non-finite quaternion gives the identity. A finite one
+ * whose squared norm overflows (components above ~1e19) is rescaled first. */
 static inline ak_quat ak_quat_normalize(ak_quat q) {
     float n2 = ak_quat_dot(q, q);
-    if (!(n2 > 1e-30f) || !ak_finitef(n2)) return ak_quat_identity();
+    if (!(n2 > 1e-30f) || !ak_finitef(n2)) {
+        if (!(n2 > 1e-30f) || !ak_quat_is_finite(q)) return ak_quat_identity();
+        float m = fmaxf(fmaxf(fabsf(q.x), fabsf(q.y)), fmaxf(fabsf(q.z), fabsf(q.w)));
+        q = ak_quat_make(q.x / m, q.y / m, q.z / m, q.w / m);
+        n2 = ak_quat_dot(q, q);
+    }
     return ak_quat_scale(q, 1.0f / sqrtf(n2));
 }
 
@@ -291,6 +304,12 @@ static inline ak_quat ak_quat_from_to(ak_vec3 from, ak_vec3 to) {
 static inline ak_quat ak_quat_exp(ak_quat q) {
     if (!ak_quat_is_finite(q)) return ak_quat_identity();
     float th = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z);
+    if (!ak_finitef(th)) {
+        /* |v| overflows float: angle and direction in double (sin and cos stay bounded). */
+        double dth = sqrt((double)q.x * q.x + (double)q.y * q.y + (double)q.z * q.z);
+        double e2 = exp((double)ak_minf(q.w, 88.0f)), k2 = e2 * sin(dth) / dth;
+        return ak_quat_make((float)(k2 * q.x), (float)(k2 * q.y), (float)(k2 * q.z), (float)(e2 * cos(dth)));
+    }
     float e = expf(ak_minf(q.w, 88.0f));
     /* sin(th)/th by its series below 1e-4, where the division loses digits. */
     float k = th < 1e-4f ? 1.0f - th * th * (1.0f / 6.0f) : sinf(th) / th;

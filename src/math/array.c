@@ -44,6 +44,11 @@ ak_result ak_quat_normalize_array(ak_quat_cspan q, ak_quat_span out) {
                                _mm_add_ps(_mm_mul_ps(z, z), _mm_mul_ps(w, w)));
         /* n2 > tiny is false for NaN, n2 < inf rejects infinity: ak_quat_normalize's test. */
         __m128 ok = _mm_and_ps(_mm_cmpgt_ps(n2, tiny), _mm_cmplt_ps(n2, inf));
+        if (_mm_movemask_ps(_mm_cmpeq_ps(n2, inf))) {
+            /* A norm overflowing float (or an infinite component): the scalar rescaling path. */
+            for (size_t k = 0; k < 4; ++k) out.ptr[i + k] = ak_quat_normalize(q.ptr[i + k]);
+            continue;
+        }
         __m128 inv = _mm_div_ps(one, _mm_sqrt_ps(n2));
         x = akp_simd_select(ok, _mm_mul_ps(x, inv), zero);
         y = akp_simd_select(ok, _mm_mul_ps(y, inv), zero);
