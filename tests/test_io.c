@@ -1081,6 +1081,59 @@ AK_TEST(gltf_features) {
     ak_scene_destroy(s);
 }
 
+/* A mesh with two primitives instanced by two nodes: scene meshes come in the documented order
+ * (mesh, then instancing node, then primitive), each node's primitives together, node.weights
+ * per instance, and a weights channel on the second node writes that node's morph indices. */
+AK_TEST(gltf_instanced_primitives_order) {
+    float b[16] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, /* 4 positions */ 0, 1, /* times */ 0.25f, 1};
+    const char* json =
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":64,\"uri\":\"@BUF@\"}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":8},"
+        "{\"buffer\":0,\"byteOffset\":56,\"byteLength\":8}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+        "{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+        "{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},{\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+        "{\"bufferView\":1,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"},"
+        "{\"bufferView\":2,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"}],"
+        "\"meshes\":[{\"name\":\"two\",\"weights\":[0.5],\"primitives\":["
+        "{\"attributes\":{\"POSITION\":0},\"targets\":[{\"POSITION\":2}]},"
+        "{\"attributes\":{\"POSITION\":1},\"mode\":6,\"targets\":[{\"POSITION\":3}]}]}],"
+        "\"nodes\":[{\"name\":\"a\",\"mesh\":0},{\"name\":\"b\",\"mesh\":0,\"weights\":[0.125]}],"
+        "\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":1,\"path\":\"weights\"}}],"
+        "\"samplers\":[{\"input\":4,\"output\":5}]}]}";
+    ak_scene* s = NULL;
+    ak_diag diag;
+    ak_result r = load_doc(json, b, sizeof b, NULL, &s, &diag);
+    AK_CHECK_EQ(r, AK_OK);
+    if (r != AK_OK) {
+        printf("  %s\n", diag.message);
+        return;
+    }
+    AK_CHECK_EQ(s->mesh_count, 4);
+    if (s->mesh_count == 4) {
+        const int na = ak_skeleton_find_joint(s->skeleton, "a"), nb = ak_skeleton_find_joint(s->skeleton, "b");
+        const int want_node[4] = {na, na, nb, nb};
+        const size_t want_vertices[4] = {3, 4, 3, 4};
+        const float want_w[4] = {0.5f, 0.5f, 0.125f, 0.125f};
+        for (int m = 0; m < 4; ++m) {
+            AK_CHECK_MSG(s->meshes[m].node == want_node[m], "scene mesh %d: node %d, want %d", m, s->meshes[m].node,
+                         want_node[m]);
+            AK_CHECK_EQ(s->meshes[m].mesh->vertex_count, want_vertices[m]);
+            AK_CHECK_NEAR(s->meshes[m].mesh->morph_weights[0], want_w[m], 0);
+        }
+        /* the weights channel animates node b: morph indices 2 and 3, one channel per primitive */
+        const ak_clip* c = s->clips[0];
+        AK_CHECK_EQ(ak_clip_channel_count(c), 2);
+        float w[4] = {9, 9, 9, 9};
+        ak_clip_sample(c, 0.5f, NULL, (ak_transform_span){NULL, 0}, (ak_f32_span)AK_SPAN(w), (ak_f32_span){NULL, 0});
+        AK_CHECK_NEAR(w[0], 9, 0);
+        AK_CHECK_NEAR(w[1], 9, 0);
+        AK_CHECK_NEAR(w[2], 0.625, 1e-6);
+        AK_CHECK_NEAR(w[3], 0.625, 1e-6);
+    }
+    ak_scene_destroy(s);
+}
+
 /* ---- truncation -------------------------------------------------------------------------- */
 
 static int cut_everywhere(const char* rel, size_t step) {
@@ -1412,6 +1465,7 @@ int main(void) {
     AK_RUN(malformed_gltf_exact_codes);
     AK_RUN(gltf_skin_weights_and_slots);
     AK_RUN(gltf_features);
+    AK_RUN(gltf_instanced_primitives_order);
     AK_RUN(truncated_files_fail_cleanly);
     AK_RUN(load_arguments_and_missing_files);
     AK_RUN(obj_writer);

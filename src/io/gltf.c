@@ -1084,7 +1084,9 @@ static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* m
         const cJSON* prims = cJSON_GetObjectItemCaseSensitive(mj, "primitives");
         size_t np = (size_t)cJSON_GetArraySize(prims);
         const char* mname = get_string(mj, "name");
-        size_t pi = 0, targets0 = 0;
+        size_t pi = 0, targets0 = 0, instances = 0;
+        /* Primitives are read one at a time, but scene mesh k of primitive pi goes to slot
+         * out + k * np + pi: node-major, so each node's primitives stay together. */
         for (const cJSON* prim = prims->child; prim; prim = prim->next, ++pi) {
             char where[160], name[AK_NAME_SIZE];
             snprintf(where, sizeof where, "meshes[%zu].primitives[%zu]", mi, pi);
@@ -1104,6 +1106,7 @@ static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* m
                          p.targets);
             /* Instances in node order; one uninstanced entry when no node uses the mesh. */
             bool any = false;
+            size_t k = 0;
             for (size_t ni = 0; r == AK_OK && ni <= c->n_nodes; ++ni) {
                 int64_t nm = -1, ns = -1;
                 const cJSON* node = ni < c->n_nodes ? nodes->items[ni] : NULL;
@@ -1115,7 +1118,8 @@ static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* m
                     break;
                 }
                 any = true;
-                ak_scene_mesh* sm = &scene->meshes[out];
+                size_t slot = out + k * np + pi;
+                ak_scene_mesh* sm = &scene->meshes[slot];
                 sm->node = node ? c->joint_of_node[ni] : -1;
                 sm->skin = -1;
                 if (ns >= 0 && !p.infl)
@@ -1131,13 +1135,15 @@ static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* m
                     snprintf(nw, sizeof nw, "nodes[%zu]", ni);
                     r = get_floats(c, node, "weights", nw, p.targets, sm->mesh->morph_weights, NULL);
                 }
-                c->morph_base[out] = base;
-                base += p.targets;
-                ++out;
+                c->morph_base[slot] = base + (k * np + pi) * targets0;
+                ++k;
             }
+            instances = k;
             prim_free(c, &p);
             if (r != AK_OK) return r;
         }
+        out += instances * np;
+        base += instances * np * targets0;
     }
     return AK_OK;
 }
