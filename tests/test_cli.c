@@ -140,6 +140,75 @@ AK_TEST(info_json_contract) {
     cJSON_Delete(root);
 }
 
+/* info --json on every glTF asset against the file's JSON read here: mesh entries (one per
+ * primitive and instancing node) with their vertex counts, clips with their names, the
+ * channel count the file declares and the largest sampler input max as duration. */
+AK_TEST(info_json_matches_gltf_files) {
+    char dir[1100];
+    if (!ak_test_asset(dir, sizeof dir, "gltf")) {
+        AK_SKIP("no assets (set ANIMKIT_ASSETS or put them in ../shared/assets)");
+        return;
+    }
+    const char* files[] = {"RiggedSimple/glTF/RiggedSimple.gltf", "CesiumMan/glTF-Binary/CesiumMan.glb",
+                           "Fox/glTF-Binary/Fox.glb", "SimpleSkin/glTF/SimpleSkin.gltf",
+                           "SimpleMorph/glTF/SimpleMorph.gltf", "AnimatedMorphCube/glTF-Binary/AnimatedMorphCube.glb",
+                           "MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf",
+                           "MorphStressTest/glTF-Binary/MorphStressTest.glb"};
+    for (size_t f = 0; f < sizeof files / sizeof files[0]; ++f) {
+        char path[1300], args[1500];
+        snprintf(path, sizeof path, "%s/%s", dir, files[f]);
+        snprintf(args, sizeof args, "info '%s' --json", path);
+        cJSON* root = run_json(args);
+        doc d;
+        bool opened = doc_open(&d, path);
+        AK_CHECK_MSG(root && opened, "%s: info or reference reader failed", files[f]);
+        if (!root || !opened) {
+            cJSON_Delete(root);
+            if (opened) doc_close(&d);
+            continue;
+        }
+        const cJSON* meshes = cJSON_GetObjectItem(root, "meshes");
+        int at = 0;
+        for (int mi = 0; mi < jsize(d.root, "meshes"); ++mi) {
+            const cJSON* prims = jget(jat(d.root, "meshes", mi), "primitives");
+            int users = 0;
+            for (int ni = 0; ni < jsize(d.root, "nodes"); ++ni) users += jint(jat(d.root, "nodes", ni), "mesh", -1) == mi;
+            for (int u = 0; u < (users ? users : 1); ++u)
+                for (int pi = 0; pi < cJSON_GetArraySize(prims); ++pi, ++at) {
+                    int pa = jint(jget(cJSON_GetArrayItem(prims, pi), "attributes"), "POSITION", -1);
+                    const cJSON* mj = cJSON_GetArrayItem(meshes, at);
+                    AK_CHECK_MSG(mj && cJSON_GetObjectItem(mj, "vertices")->valueint == accessor_count(&d, pa),
+                                 "%s: mesh entry %d vertices", files[f], at);
+                }
+        }
+        AK_CHECK_MSG(cJSON_GetArraySize(meshes) == at, "%s: %d mesh entries, want %d", files[f],
+                     cJSON_GetArraySize(meshes), at);
+        const cJSON* clips = cJSON_GetObjectItem(root, "clips");
+        AK_CHECK_MSG(cJSON_GetArraySize(clips) == jsize(d.root, "animations"), "%s: clip count", files[f]);
+        for (int ai = 0; ai < jsize(d.root, "animations") && ai < cJSON_GetArraySize(clips); ++ai) {
+            const cJSON* an = jat(d.root, "animations", ai);
+            const cJSON* cj = cJSON_GetArrayItem(clips, ai);
+            int file_channels = jsize(an, "channels");
+            int got = cJSON_GetObjectItem(cj, "channels")->valueint;
+            AK_CHECK_MSG(got == file_channels, "%s: animations[%d] has %d channels, info says %d", files[f], ai,
+                         file_channels, got);
+            double dur = 0;
+            for (int si = 0; si < jsize(an, "samplers"); ++si) {
+                const cJSON* acc = jat(d.root, "accessors", jint(jat(an, "samplers", si), "input", -1));
+                dur = fmax(dur, cJSON_GetArrayItem(jget(acc, "max"), 0)->valuedouble);
+            }
+            AK_CHECK_NEAR(cJSON_GetObjectItem(cj, "duration")->valuedouble, dur, 1e-6);
+            const cJSON* name = jget(an, "name");
+            char want[64];
+            snprintf(want, sizeof want, "animation_%d", ai);
+            AK_CHECK_STREQ(cJSON_GetObjectItem(cj, "name")->valuestring,
+                           cJSON_IsString(name) && name->valuestring[0] ? name->valuestring : want);
+        }
+        doc_close(&d);
+        cJSON_Delete(root);
+    }
+}
+
 /* Read the "v" lines of an OBJ file. */
 static size_t read_obj_vertices(const char* path, ak_vec3* out, size_t cap, size_t* out_groups) {
     FILE* f = fopen(path, "r");
@@ -428,6 +497,7 @@ int main(void) {
     AK_RUN(usage_and_help);
     AK_RUN(bad_input_paths);
     AK_RUN(info_json_contract);
+    AK_RUN(info_json_matches_gltf_files);
     AK_RUN(export_matches_double_precision_skinning);
     AK_RUN(ik_json_contract);
     AK_RUN(skin_compare_orders_methods);
