@@ -1000,6 +1000,30 @@ AK_TEST(heat_weights_do_not_bleed_between_legs) {
     free(s.idx);
 }
 
+AK_TEST(distance_weights_stray_far_vertex) {
+    /* One stray vertex far from everything must not change the other vertices' weights: the
+     * "on a bone" threshold used to scale with the mesh's bounding box, so a vertex at 1e9
+     * made every vertex within ~100 units count as on every bone (equal weights). Closed
+     * forms with n = 4 as in the test above: d = 1 and 2 -> 16/17, 1/17. */
+    ak_skin_bone bones[2] = {{{0, 0, 0}, {0, 0, 0}, 0}, {{3, 0, 0}, {3, 0, 0}, 1}};
+    const float far[3] = {1e9f, 1e20f, 3e38f};
+    for (int f = 0; f < 3; ++f) {
+        ak_vec3 pos[3] = {{1, 0, 0}, {far[f], 0, 0}, {2, 0, 0}};
+        uint16_t jn[3 * 2];
+        float w[3 * 2];
+        ak_weights_desc d = {.method = AK_WEIGHTS_DISTANCE, .positions = {pos, 3}, .bones = {bones, 2}, .max_influences = 2};
+        AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 6}, (ak_f32_span){w, 6}), AK_OK);
+        AK_CHECK_EQ(jn[0], 0);
+        AK_CHECK_MSG(fabs(w[0] - 16.0 / 17.0) < 1e-6 && fabs(w[1] - 1.0 / 17.0) < 1e-6,
+                     "stray vertex at %g: weights %g %g, want 16/17 1/17", (double)far[f], (double)w[0], (double)w[1]);
+        AK_CHECK_EQ(jn[4], 1);
+        AK_CHECK_NEAR(w[4], 16.0 / 17.0, 1e-6);
+        /* the far vertex itself: finite, sums to 1 */
+        AK_CHECK(ak_finitef(w[2]) && ak_finitef(w[3]));
+        AK_CHECK_NEAR(w[2] + w[3], 1.0, 1e-6);
+    }
+}
+
 AK_TEST(distance_weights_closed_forms_and_robustness) {
     ak_skin_bone bones[2] = {{{0, 0, 0}, {0, 0, 0}, 0}, {{3, 0, 0}, {3, 0, 0}, 1}};
     ak_vec3 pos[5] = {{1, 0, 0}, {1.5f, 0, 0}, {0, 0, 0}, {1e6f, 3e6f, 0}, {3, 0, 0}};
@@ -1204,6 +1228,7 @@ int main(void) {
     AK_RUN(quality_ordering_bend_and_twist);
     AK_RUN(heat_weights_do_not_bleed_between_legs);
     AK_RUN(distance_weights_closed_forms_and_robustness);
+    AK_RUN(distance_weights_stray_far_vertex);
     AK_RUN(heat_weights_on_cylinder_are_smooth_and_normalized);
     AK_RUN(heat_weights_degenerate_input);
     AK_RUN(weights_format_round_trip);
