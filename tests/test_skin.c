@@ -1080,6 +1080,44 @@ AK_TEST(distance_weights_closed_forms_and_robustness) {
     AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}), AK_ERR_BAD_ARG);
 }
 
+AK_TEST(heat_weights_ignore_a_stray_far_vertex) {
+    /* A loose vertex far away (on no triangle) must not change the cylinder's heat weights.
+     * The "on a bone" clamp and the tie band of the nearest-bone test used to scale with the
+     * mesh's bounding box: with a vertex at 1e9 every cylinder vertex became a tie between
+     * both bones and the weights flattened towards 1/2 all along the cylinder. */
+    cylinder c = cylinder_make(41, 16);
+    ak_skin_bone bones[2] = {{{0, 0, 0}, {0, 1, 0}, 0}, {{0, 1, 0}, {0, 2, 0}, 1}};
+    size_t n = c.vertex_count;
+    ak_vec3* pos = (ak_vec3*)malloc((n + 1) * sizeof(ak_vec3));
+    uint16_t* jn = (uint16_t*)malloc(2 * (n + 1) * 4 * sizeof(uint16_t));
+    float* w = (float*)malloc(2 * (n + 1) * 4 * sizeof(float));
+    memcpy(pos, c.pos, n * sizeof(ak_vec3));
+    pos[n] = ak_vec3_make(1e9f, 0.0f, 0.0f);
+    ak_weights_desc d = {.positions = {pos, n}, .indices = {c.idx, 3 * c.tri_count}, .bones = {bones, 2}};
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 4 * n}, (ak_f32_span){w, 4 * n}), AK_OK);
+    d.positions.count = n + 1;
+    uint16_t* jn2 = jn + 4 * (n + 1);
+    float* w2 = w + 4 * (n + 1);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn2, 4 * (n + 1)}, (ak_f32_span){w2, 4 * (n + 1)}),
+                AK_OK);
+    double worst = 0.0;
+    for (size_t v = 0; v < n; ++v) {
+        double a[2] = {0, 0}, b[2] = {0, 0};
+        for (int e = 0; e < 4; ++e) {
+            if (jn[4 * v + e] < 2) a[jn[4 * v + e]] += w[4 * v + e];
+            if (jn2[4 * v + e] < 2) b[jn2[4 * v + e]] += w2[4 * v + e];
+        }
+        worst = fmax(worst, fabs(a[1] - b[1]));
+    }
+    AK_CHECK_MSG(worst < 1e-4, "a stray vertex at 1e9 changed a cylinder weight by %g", worst);
+    /* the stray vertex itself: its nearest bone, weight 1 */
+    AK_CHECK(w2[4 * n] == 1.0f);
+    free(pos);
+    free(jn);
+    free(w);
+    cylinder_free(&c);
+}
+
 AK_TEST(heat_weights_on_cylinder_are_smooth_and_normalized) {
     cylinder c = cylinder_make(41, 16);
     ak_skin_bone bones[2] = {{{0, 0, 0}, {0, 1, 0}, 0}, {{0, 1, 0}, {0, 2, 0}, 1}};
@@ -1230,6 +1268,7 @@ int main(void) {
     AK_RUN(distance_weights_closed_forms_and_robustness);
     AK_RUN(distance_weights_stray_far_vertex);
     AK_RUN(heat_weights_on_cylinder_are_smooth_and_normalized);
+    AK_RUN(heat_weights_ignore_a_stray_far_vertex);
     AK_RUN(heat_weights_degenerate_input);
     AK_RUN(weights_format_round_trip);
     AK_RUN(bones_from_joints);

@@ -11,18 +11,8 @@ ak_result akp_weights_distance(const ak_weights_desc* d, const ak_allocator* all
     if (!dist2) return AK_ERR_NO_MEMORY;
     double* dense = dist2 + jc;
 
-    /* Distances below this count as "on the bone": relative to the bones' size and distance
-     * from the origin (the float rounding of a point placed on a bone), not to the mesh's
-     * bounding box, which one stray far vertex would blow up until every vertex counted as
-     * on every bone. */
-    double scale = 0.0;
-    for (size_t b = 0; b < d->bones.count; ++b) {
-        const ak_skin_bone* bone = &d->bones.ptr[b];
-        double len = ak_vec3_length(ak_vec3_sub(bone->tail, bone->head));
-        double mag = fmax(fmax(fabs((double)bone->head.x), fabs((double)bone->head.y)), fabs((double)bone->head.z));
-        mag = fmax(mag, fmax(fmax(fabs((double)bone->tail.x), fabs((double)bone->tail.y)), fabs((double)bone->tail.z)));
-        scale = fmax(scale, fmax(len, mag));
-    }
+    /* Distances below this count as "on the bone" (relative to the bones, see akp_bones_scale). */
+    double scale = akp_bones_scale(d->bones);
     double eps2 = (scale > 0.0 ? scale * 1e-7 : 1e-12);
     eps2 *= eps2;
     const double half_power = 0.5 * (double)d->distance_power;

@@ -281,12 +281,9 @@ ak_result akp_weights_heat(const ak_weights_desc* d, const ak_allocator* alloc, 
         res = bvh_build(&tree, alloc, pos, idx, tris);
         if (res != AK_OK) goto done;
     }
-    ak_vec3 lo = pos[0], hi = pos[0];
-    for (size_t i = 1; i < n; ++i) {
-        lo = ak_vec3_min(lo, pos[i]);
-        hi = ak_vec3_max(hi, pos[i]);
-    }
-    double diag = ak_vec3_length(ak_vec3_sub(hi, lo));
+    /* relative to the bones, not the mesh's bounding box (a stray far vertex would make every
+     * vertex a tie between all nearby bones) */
+    double diag = akp_bones_scale(d->bones);
     const double min_d2 = diag > 0.0 ? (diag * 1e-6) * (diag * 1e-6) : 1e-24;
     for (size_t i = 0; i < n; ++i) {
         for (size_t b = 0; b < nb; ++b) {

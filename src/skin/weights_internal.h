@@ -19,4 +19,18 @@ static inline size_t akp_bones_joint_count(ak_skin_bone_cspan bones) {
     return n;
 }
 
+/* Length scale of the bones: the largest bone length or bone coordinate magnitude. Distance
+ * thresholds ("on the bone") are relative to it, never to the mesh's bounding box, which one
+ * stray far vertex can blow up. 0 when every bone is a point at the origin. */
+static inline double akp_bones_scale(ak_skin_bone_cspan bones) {
+    double scale = 0.0;
+    for (size_t b = 0; b < bones.count; ++b) {
+        const ak_skin_bone* bone = &bones.ptr[b];
+        const float c[6] = {bone->head.x, bone->head.y, bone->head.z, bone->tail.x, bone->tail.y, bone->tail.z};
+        for (int i = 0; i < 6; ++i) scale = fmax(scale, fabs((double)c[i]));
+        scale = fmax(scale, (double)ak_vec3_length(ak_vec3_sub(bone->tail, bone->head)));
+    }
+    return scale;
+}
+
 #endif
