@@ -676,6 +676,50 @@ AK_TEST(obj_through_assimp) {
     ak_scene_destroy(s);
 }
 
+/* BVH headers the Assimp path must not turn into nonsense: "Frames: 0" (Assimp's duration
+ * wraps to 2^32 - 1 ticks), and a zero or negative Frame Time (1 / Frame Time ticks per
+ * second: infinite or negative). */
+static ak_result load_bvh_text(const char* frames, const char* frame_time, const char* motion, ak_scene** out) {
+    char text[1024];
+    snprintf(text, sizeof text,
+             "HIERARCHY\nROOT a\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+             "Yrotation\nJOINT b\n{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nEnd Site\n{\nOFFSET 0 1 "
+             "0\n}\n}\n}\nMOTION\nFrames: %s\nFrame Time: %s\n%s",
+             frames, frame_time, motion);
+    FILE* f = fopen("degenerate.bvh", "wb");
+    if (!f) return AK_ERR_IO;
+    fputs(text, f);
+    fclose(f);
+    ak_diag diag;
+    memset(&diag, 0, sizeof diag);
+    ak_result r = ak_io_load("degenerate.bvh", NULL, NULL, out, &diag);
+    if (r != AK_OK) printf("  Frames %s, Frame Time %s: %s (%s)\n", frames, frame_time, ak_result_name(r), diag.message);
+    return r;
+}
+
+AK_TEST(bvh_degenerate_headers) {
+    const char* two = "0 0 0 0 0 0 0 0 0\n1 2 3 10 20 30 1 2 3\n";
+    ak_scene* s = NULL;
+    /* control: 2 frames 0.25 s apart end at 0.25 s */
+    AK_CHECK_EQ(load_bvh_text("2", "0.25", two, &s), AK_OK);
+    if (s) {
+        AK_CHECK_EQ(s->clip_count, 1);
+        if (s->clip_count) AK_CHECK_NEAR(ak_clip_duration(s->clips[0]), 0.25, 1e-6);
+        ak_scene_destroy(s);
+        s = NULL;
+    }
+    /* no frames: whatever loads must not claim a 4e8-second clip */
+    if (load_bvh_text("0", "0.1", "", &s) == AK_OK) {
+        for (size_t c = 0; c < s->clip_count; ++c) AK_CHECK_NEAR(ak_clip_duration(s->clips[c]), 0.0, 0);
+        ak_scene_destroy(s);
+        s = NULL;
+    }
+    AK_CHECK_EQ(load_bvh_text("2", "0", two, &s), AK_ERR_BAD_DATA);
+    AK_CHECK(s == NULL);
+    AK_CHECK_EQ(load_bvh_text("2", "-0.1", two, &s), AK_ERR_BAD_DATA);
+    AK_CHECK(s == NULL);
+}
+
 /* ---- synthetic glTF documents ----------------------------------------------------------- */
 
 /* Load a glTF JSON text in which "@BUF@" stands for a base64 data URI of bin. */
@@ -1462,6 +1506,7 @@ int main(void) {
     AK_RUN(gltf_bind_pose_fk);
     AK_RUN(bvh_header_and_fk);
     AK_RUN(obj_through_assimp);
+    AK_RUN(bvh_degenerate_headers);
     AK_RUN(malformed_gltf_exact_codes);
     AK_RUN(gltf_skin_weights_and_slots);
     AK_RUN(gltf_features);

@@ -5,6 +5,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <ctype.h>
+#include <math.h>
 
 #include "io_internal.h"
 
@@ -209,7 +210,15 @@ static size_t copy_keys(const double* key_times, size_t key_stride, size_t n, do
 }
 
 static ak_result build_clip(as_ctx* c, const struct aiAnimation* an, size_t ai) {
+    /* A BVH's ticks per second is 1 / Frame Time: a zero or negative Frame Time gives an
+     * infinite or negative rate, which would silently collapse or misplace every key. */
+    if (!(an->mTicksPerSecond >= 0.0) || !isfinite(an->mTicksPerSecond)) {
+        akp_diag_set(c->diag, c->path, "animation %zu: %g ticks per second (a BVH Frame Time must be positive)", ai,
+                     an->mTicksPerSecond);
+        return AK_ERR_BAD_DATA;
+    }
     double tps = an->mTicksPerSecond > 0.0 ? an->mTicksPerSecond : 25.0; /* Assimp's documented default */
+    double last_key = 0.0; /* the latest key time kept */
     size_t max_ch = (size_t)an->mNumChannels * 3;
     ak_raw_channel* ch = (ak_raw_channel*)akp_calloc(c->alloc, (max_ch ? max_ch : 1) * sizeof(ak_raw_channel));
     float** bufs = (float**)akp_calloc(c->alloc, (max_ch ? max_ch : 1) * 2 * sizeof(float*));
@@ -272,6 +281,7 @@ static ak_result build_clip(as_ctx* c, const struct aiAnimation* an, size_t ai) 
                          c->path, ai, na->mNodeName.data, n - kept);
                 akp_log(&c->desc->logger, AK_LOG_WARN, msg);
             }
+            if (kept && times[kept - 1] > last_key) last_key = times[kept - 1];
             ak_raw_channel* rc = &ch[nch++];
             rc->target = kind == 0 ? AK_CHANNEL_TRANSLATION : kind == 1 ? AK_CHANNEL_ROTATION : AK_CHANNEL_SCALE;
             rc->index = (uint32_t)c->joint_of_node[node];
@@ -292,6 +302,9 @@ static ak_result build_clip(as_ctx* c, const struct aiAnimation* an, size_t ai) 
         if (an->mName.length) akp_io_copy_name(name, an->mName.data);
         else snprintf(name, sizeof name, "animation_%zu", ai);
         double dur = an->mDuration / tps;
+        /* A BVH clip ends at its last frame, (Frames - 1) x Frame Time. Assimp computes its
+         * duration as the unsigned Frames - 1, which wraps to 2^32 - 1 ticks for "Frames: 0". */
+        if (is_bvh(c->path)) dur = last_key;
         ak_raw_clip raw = {
             .name = name,
             .duration = dur > 0.0 && dur < 1e30 ? (float)dur : 0.0f,
