@@ -3,6 +3,7 @@
 #include "io/io_internal.h"
 
 #include <ctype.h>
+#include <sys/stat.h>
 
 /* ---- static helpers ------------------------------------------------------------------ */
 
@@ -53,6 +54,13 @@ ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, uint8_t*
     FILE* f = fopen(path, "rb");
     if (!f) {
         akp_diag_set(diag, path, "cannot open file");
+        return AK_ERR_IO;
+    }
+    /* fopen succeeds on a directory on Linux, and ftell then reports LONG_MAX */
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(f);
+        akp_diag_set(diag, path, "%s", S_ISDIR(st.st_mode) ? "is a directory, not a file" : "not a regular file");
         return AK_ERR_IO;
     }
     long end = -1;
@@ -212,6 +220,11 @@ ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocato
     if (desc && ((int)desc->format < 0 || desc->format >= AK_IO_FORMAT_COUNT)) {
         akp_diag_set(diag, path, "unknown format %d", (int)desc->format);
         return AK_ERR_BAD_ARG;
+    }
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) { /* Assimp would call it a parse error */
+        akp_diag_set(diag, path, "is a directory, not a file");
+        return AK_ERR_IO;
     }
     ak_io_desc d = ak_io_desc_resolved(desc);
     ak_io_format fmt = d.format;

@@ -7,6 +7,9 @@
 #include <dirent.h>
 #include <stdint.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "ak_test.h"
 #include "ref/ref_gltf.h"
 
@@ -1303,6 +1306,15 @@ AK_TEST(load_arguments_and_missing_files) {
     fclose(f);
     AK_CHECK_EQ(ak_io_load("ext.gltf", NULL, NULL, &s, &diag), AK_ERR_IO);
     AK_CHECK(strstr(diag.message, "ext missing.bin") != NULL); /* percent-decoded */
+    /* a directory is not a file: AK_ERR_IO, as the model and as an external buffer (glibc
+     * opens a directory and reports a size of LONG_MAX, which once read as out of memory) */
+    mkdir("ext missing.bin", 0777);
+    AK_CHECK_EQ(ak_io_load("ext.gltf", NULL, NULL, &s, &diag), AK_ERR_IO);
+    AK_CHECK(s == NULL);
+    AK_CHECK_MSG(strstr(diag.message, "directory") != NULL, "%s", diag.message);
+    AK_CHECK_EQ(ak_io_load("ext missing.bin", NULL, NULL, &s, &diag), AK_ERR_IO);
+    AK_CHECK(s == NULL);
+    rmdir("ext missing.bin");
     remove("ext.gltf");
 }
 
