@@ -446,6 +446,38 @@ AK_TEST(crossfade) {
     AK_CHECK_EQ(ak_pose_crossfade(ca, (ak_transform_cspan){b, 2}, 0.5f, (ak_transform_span){out, J}), AK_ERR_SPAN_SMALL);
 }
 
+AK_TEST(blend_huge_weights_stay_finite) {
+    /* Valid finite weights near FLT_MAX: the weighted sums used to overflow to inf and the
+     * output was inf / inf = NaN. The blend is an average, so it must equal the one with the
+     * weights scaled down (here 1:1 -> the midpoint, closed form). Also huge translations with
+     * ordinary weights. */
+    ak_transform rest[1] = {ak_transform_identity()}, a[1], b[1], out[1];
+    a[0] = b[0] = rest[0];
+    a[0].translation = ak_vec3_make(2, 0, -6);
+    b[0].translation = ak_vec3_make(4, 2, 6);
+    a[0].scale = ak_vec3_make(1, 1, 1);
+    b[0].scale = ak_vec3_make(3, 3, 3);
+    a[0].rotation = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.5f);
+    b[0].rotation = ak_quat_neg(ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 1.5f)); /* other hemisphere */
+    const float big[3] = {3e38f, 2e38f, 1e38f};
+    for (int k = 0; k < 3; ++k) {
+        ak_blend_layer l[2] = {{.pose = {a, 1}, .weight = big[k]}, {.pose = {b, 1}, .weight = big[k]}};
+        ak_blend_job job = {.layers = l, .layer_count = 2, .rest_pose = {rest, 1}, .out_local = {out, 1}};
+        AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+        AK_CHECK_MSG(ak_transform_is_finite(out[0]), "weights %g: non-finite blend", (double)big[k]);
+        AK_CHECK_NEAR(ak_vec3_distance(out[0].translation, ak_vec3_make(3, 1, 0)), 0.0, 1e-6);
+        AK_CHECK_NEAR(out[0].scale.x, 2.0, 1e-6);
+        AK_CHECK_NEAR(rot_error(out[0].rotation, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 1.0f)), 0.0, 1e-6);
+    }
+    a[0].translation = ak_vec3_make(3e38f, 0, 0);
+    b[0].translation = ak_vec3_make(3e38f, 0, 0);
+    ak_blend_layer l[2] = {{.pose = {a, 1}, .weight = 1.0f}, {.pose = {b, 1}, .weight = 1.0f}};
+    ak_blend_job job = {.layers = l, .layer_count = 2, .rest_pose = {rest, 1}, .out_local = {out, 1}};
+    AK_CHECK_EQ(ak_blend_run(&job), AK_OK);
+    AK_CHECK_MSG(ak_transform_is_finite(out[0]), "translations 3e38: %g", (double)out[0].translation.x);
+    AK_CHECK_NEAR(out[0].translation.x / 3e38, 1.0, 1e-6);
+}
+
 AK_TEST(blend_validate_rules) {
     enum { J = 4 };
     ak_transform p[J], out[J], rest[J];
@@ -605,6 +637,7 @@ int main(void) {
     AK_RUN(gltf_interpolation_matches_spec_formulas);
     AK_RUN(cursor_is_bit_identical_to_binary_search);
     AK_RUN(blend_properties);
+    AK_RUN(blend_huge_weights_stay_finite);
     AK_RUN(additive_layers);
     AK_RUN(crossfade);
     AK_RUN(blend_validate_rules);

@@ -72,6 +72,11 @@ ak_result ak_blend_run(const ak_blend_job* job) {
     if (r != AK_OK) return r;
     size_t joints = job->rest_pose.count;
     float threshold = job->threshold > 0.0f ? job->threshold : 0.1f;
+    /* Where a weighted sum overflows float (weights or values near FLT_MAX), the joint is
+     * redone with every weight (and the threshold) divided by the sum of the layer weights:
+     * the same average, and sums of weights <= 1 times finite values stay finite. */
+    double weight_sum = 0.0;
+    for (size_t i = 0; i < job->layer_count; ++i) weight_sum += (double)job->layers[i].weight;
     for (size_t j = 0; j < joints; ++j) {
         ak_vec3 t = ak_vec3_zero(), s = ak_vec3_zero();
         ak_quat q = ak_quat_make(0, 0, 0, 0), ref = ak_quat_identity();
@@ -79,30 +84,41 @@ ak_result ak_blend_run(const ak_blend_job* job) {
         bool have_ref = false;
         int contributors = 0;
         const ak_transform* only = NULL;
-        for (size_t i = 0; i <= job->layer_count; ++i) {
-            const ak_transform* x;
-            float w;
-            if (i < job->layer_count) {
-                const ak_blend_layer* l = &job->layers[i];
-                w = l->weight * (l->joint_weights.count ? l->joint_weights.ptr[j] : 1.0f);
-                x = &l->pose.ptr[j];
-            } else {
-                /* The rest pose fills in where the layers carry too little weight. */
-                w = total < threshold ? threshold - total : 0.0f;
-                x = &job->rest_pose.ptr[j];
+        for (float ws = 1.0f;;) {
+            float thr = threshold * ws;
+            for (size_t i = 0; i <= job->layer_count; ++i) {
+                const ak_transform* x;
+                float w;
+                if (i < job->layer_count) {
+                    const ak_blend_layer* l = &job->layers[i];
+                    w = l->weight * ws * (l->joint_weights.count ? l->joint_weights.ptr[j] : 1.0f);
+                    x = &l->pose.ptr[j];
+                } else {
+                    /* The rest pose fills in where the layers carry too little weight. */
+                    w = total < thr ? thr - total : 0.0f;
+                    x = &job->rest_pose.ptr[j];
+                }
+                if (!(w > 0.0f)) continue;
+                if (!have_ref) {
+                    ref = x->rotation;
+                    have_ref = true;
+                }
+                ++contributors;
+                only = x;
+                float sign = ak_quat_dot(ref, x->rotation) < 0.0f ? -w : w;
+                t = ak_vec3_madd(t, x->translation, w);
+                s = ak_vec3_madd(s, x->scale, w);
+                q = ak_quat_add(q, ak_quat_scale(x->rotation, sign));
+                total += w;
             }
-            if (!(w > 0.0f)) continue;
-            if (!have_ref) {
-                ref = x->rotation;
-                have_ref = true;
-            }
-            ++contributors;
-            only = x;
-            float sign = ak_quat_dot(ref, x->rotation) < 0.0f ? -w : w;
-            t = ak_vec3_madd(t, x->translation, w);
-            s = ak_vec3_madd(s, x->scale, w);
-            q = ak_quat_add(q, ak_quat_scale(x->rotation, sign));
-            total += w;
+            bool finite = ak_finitef(total) && ak_vec3_is_finite(t) && ak_vec3_is_finite(s) && ak_quat_is_finite(q);
+            if (finite || ws != 1.0f || !(weight_sum > 1.0)) break;
+            ws = (float)(1.0 / weight_sum); /* rare path: start over with scaled weights */
+            t = s = ak_vec3_zero();
+            q = ak_quat_make(0, 0, 0, 0);
+            total = 0.0f;
+            have_ref = false;
+            contributors = 0;
         }
         ak_transform out;
         out.translation = ak_vec3_scale(t, 1.0f / total);
