@@ -91,6 +91,22 @@ AK_TEST(bad_input_paths) {
     AK_CHECK_EQ(run("weights builtin:cylinder --method magic -o w.json", true), 2);
     AK_CHECK_EQ(run("weights builtin:cylinder --method distance --power -1 -o w.json", true), 2);
     AK_CHECK_EQ(run("skin", true), 2);
+    /* a target far beyond float range for squared distances: bad usage, or valid JSON with a
+     * finite error (never "inf" or "nan" in the output) */
+    const char* far[] = {"1e30,0,0", "3e38,3e38,-3e38", "1e20,0,1e20"};
+    for (size_t i = 0; i < sizeof far / sizeof far[0]; ++i) {
+        char a[160];
+        snprintf(a, sizeof a, "ik builtin:humanoid --effector left_wrist --target %s --json", far[i]);
+        int rc = run(a, false);
+        if (rc == 0) {
+            cJSON* root = cJSON_Parse(out_buf);
+            const cJSON* err = cJSON_GetObjectItem(root, "error");
+            AK_CHECK_MSG(cJSON_IsNumber(err) && isfinite(err->valuedouble), "'%s' printed %s", a, out_buf);
+            cJSON_Delete(root);
+        } else {
+            AK_CHECK_MSG(rc == 2, "'%s' exit %d", a, rc);
+        }
+    }
 }
 
 static int find_joint_json(cJSON* joints, const char* name) {

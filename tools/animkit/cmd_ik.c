@@ -1,5 +1,6 @@
 /* animkit ik: solve a joint chain of a model so its effector reaches a target. */
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 
 #include "cli.h"
@@ -56,6 +57,10 @@ int cmd_ik(int argc, char** argv) {
     if (!CLI_GET(&a, "--target")) return cli_usage("ik", "missing --target X,Y,Z");
     if (!cli_parse_vec3(CLI_GET(&a, "--target"), &target))
         return cli_usage("ik", "--target '%s' is not three numbers X,Y,Z", CLI_GET(&a, "--target"));
+    /* The solvers work in float: beyond this a squared distance overflows to inf (and so
+     * would the printed error), and nothing in a scene is that far anyway. */
+    if (!(fabsf(target.x) <= 1e9f && fabsf(target.y) <= 1e9f && fabsf(target.z) <= 1e9f))
+        return cli_usage("ik", "--target '%s' is outside +-1e9", CLI_GET(&a, "--target"));
     ak_ik_solver solver = AK_IK_SOLVER_FABRIK;
     if (CLI_GET(&a, "--solver") && ak_ik_solver_parse(CLI_GET(&a, "--solver"), &solver) != AK_OK)
         return cli_usage("ik", "--solver must be ccd, fabrik, twobone or dls, not '%s'", CLI_GET(&a, "--solver"));
