@@ -70,18 +70,25 @@ static float wrap_pi(float a) {
     return a;
 }
 
+/* The angle equal to a modulo a full turn in [lo, lo + 2 pi): the same rotation. Limits may
+ * cross +-pi (e.g. [2.5, 3.5]) while twist angles come in (-pi, pi]. */
+static float angle_from(float a, float lo) {
+    float d = fmodf(a - lo, AK_TWO_PI);
+    if (d < 0.0f) d += AK_TWO_PI;
+    return lo + d;
+}
+
 /* Clamp an angle to [lo, hi] on the circle: outside the range, go to the nearer end. */
 static float clamp_angle(float a, float lo, float hi) {
-    if (a >= lo && a <= hi) return a;
+    if ((a >= lo && a <= hi) || angle_from(a, lo) <= hi) return a;
     float dlo = fabsf(wrap_pi(a - lo)), dhi = fabsf(wrap_pi(a - hi));
     return dlo <= dhi ? lo : hi;
 }
 
 static bool angle_in_range(float a, float lo, float hi, float tol) {
     if (a >= lo - tol && a <= hi + tol) return true;
-    /* The same rotation written with the angle one turn away. */
-    float b = a + (a < 0.0f ? AK_TWO_PI : -AK_TWO_PI);
-    return b >= lo - tol && b <= hi + tol;
+    /* The same rotation written with the angle a whole number of turns away. */
+    return angle_from(a, lo - tol) <= hi + tol;
 }
 
 /* ---- creation ------------------------------------------------------------------------ */

@@ -582,6 +582,48 @@ AK_TEST(limits_inside_unchanged_outside_detected) {
 
 /* Random, mostly broken descs: never a crash (ASan/UBSan), always a documented code, and a
  * skeleton exactly when every rule holds (checked here independently). */
+AK_TEST(hinge_limits_across_pi) {
+    /* Hinge ranges may cross +-pi ([2.5, 3.5]) or span more than one turn's representation
+     * ([-0.5, 6]); the twist angle comes in (-pi, pi]. An angle whose rotation lies inside the
+     * range (modulo a full turn) must be left unchanged, and one outside must go to an end.
+     * The clamp used to compare only the (-pi, pi] value, moving allowed rotations (3.4 rad ->
+     * the 3.5 end) although the within-limits check accepted them. */
+    const float range[3][2] = {{2.5f, 3.5f}, {-3.5f, -2.5f}, {-0.5f, 6.0f}};
+    for (int r = 0; r < 3; ++r) {
+        ak_joint_desc j = {.name = "hinge", .parent = -1, .rest = ak_transform_identity(), .type = AK_JOINT_HINGE};
+        j.limits.axis = ak_vec3_make(0, 0, 1);
+        j.limits.min = range[r][0];
+        j.limits.max = range[r][1];
+        ak_skeleton_desc d = {.joints = &j, .joint_count = 1};
+        ak_skeleton* sk = NULL;
+        AK_CHECK_EQ(ak_skeleton_create(&d, NULL, &sk, NULL), AK_OK);
+        if (!sk) return;
+        for (int i = 0; i <= 60; ++i) {
+            double a = -3.1 + 6.2 * i / 60.0;
+            bool inside = false;
+            for (int k = -1; k <= 1; ++k)
+                inside = inside || (a + 2 * PI_D * k >= range[r][0] && a + 2 * PI_D * k <= range[r][1]);
+            ak_transform t = ak_transform_identity();
+            t.rotation = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), (float)a);
+            ak_transform c = ak_skeleton_limit_joint(sk, 0, t);
+            /* the clamped rotation's angle about z, as the nearest end or the input */
+            double dot = fabs((double)ak_quat_dot(c.rotation, t.rotation));
+            if (inside) {
+                AK_CHECK_MSG(dot > 1.0 - 1e-6, "range [%g, %g]: allowed angle %g was moved", (double)range[r][0],
+                             (double)range[r][1], a);
+            } else {
+                double ang = 2.0 * atan2((double)c.rotation.z, (double)c.rotation.w);
+                double e0 = fabs(remainder(ang - range[r][0], 2 * PI_D)), e1 = fabs(remainder(ang - range[r][1], 2 * PI_D));
+                AK_CHECK_MSG(fmin(e0, e1) < 1e-5, "range [%g, %g]: angle %g clamped to %g, not an end", (double)range[r][0],
+                             (double)range[r][1], a, ang);
+            }
+            AK_CHECK(ak_skeleton_joint_within_limits(sk, 0, c, 1e-4f));
+            AK_CHECK_EQ(ak_skeleton_joint_within_limits(sk, 0, t, 1e-4f), inside);
+        }
+        ak_skeleton_destroy(sk);
+    }
+}
+
 AK_TEST(create_random_descs) {
     ak_rng rng = ak_rng_make(99);
     static const char* const pool[6] = {"a", "b", "c", "d", "e", "f"};
@@ -642,6 +684,7 @@ int main(void) {
     AK_RUN(swing_twist);
     AK_RUN(limits_clamp_properties);
     AK_RUN(limits_inside_unchanged_outside_detected);
+    AK_RUN(hinge_limits_across_pi);
     AK_RUN(create_random_descs);
     AK_RUN(pose_is_finite);
     return ak_test_finish();
