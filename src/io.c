@@ -221,9 +221,10 @@ ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocato
         akp_diag_set(diag, path, "unknown format %d", (int)desc->format);
         return AK_ERR_BAD_ARG;
     }
+    /* A directory would be an Assimp parse error; opening a FIFO would block. */
     struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) { /* Assimp would call it a parse error */
-        akp_diag_set(diag, path, "is a directory, not a file");
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        akp_diag_set(diag, path, "%s", S_ISDIR(st.st_mode) ? "is a directory, not a file" : "not a regular file");
         return AK_ERR_IO;
     }
     ak_io_desc d = ak_io_desc_resolved(desc);

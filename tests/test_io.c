@@ -1316,6 +1316,13 @@ AK_TEST(load_arguments_and_missing_files) {
     AK_CHECK(s == NULL);
     rmdir("ext missing.bin");
     remove("ext.gltf");
+    /* a FIFO is not a file either (opening it would wait for a writer) */
+    remove("fifo.glb");
+    if (mkfifo("fifo.glb", 0600) == 0) {
+        AK_CHECK_EQ(ak_io_load("fifo.glb", NULL, NULL, &s, &diag), AK_ERR_IO);
+        AK_CHECK(s == NULL);
+        remove("fifo.glb");
+    }
 }
 
 /* ---- OBJ writer -------------------------------------------------------------------------- */
