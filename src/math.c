@@ -196,6 +196,7 @@ ak_mat4 ak_mat4_orthographic(float l, float r, float b, float t, float n, float 
 }
 
 ak_mat4 ak_mat4_look_at(ak_vec3 eye, ak_vec3 target, ak_vec3 up) {
+    if (!ak_vec3_is_finite(eye) || !ak_vec3_is_finite(target) || !ak_vec3_is_finite(up)) return ak_mat4_identity();
     ak_vec3 fwd = ak_vec3_normalize(ak_vec3_sub(target, eye));
     if (ak_vec3_length_sq(fwd) == 0.0f) return ak_mat4_translation(ak_vec3_neg(eye));
     ak_vec3 side = ak_vec3_normalize(ak_vec3_cross(fwd, up));

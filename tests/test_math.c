@@ -912,6 +912,19 @@ AK_TEST(look_at) {
     ak_mat4 b = ak_mat4_look_at(ak_vec3_zero(), ak_vec3_make(0, 5, 0), ak_vec3_make(0, 1, 0));
     AK_CHECK(ak_mat4_is_finite(&a) && ak_mat4_is_finite(&b));
     AK_CHECK(v3_diff(ak_mat4_transform_point(b, ak_vec3_make(0, 5, 0)), ref_v3_make(0, 0, -5)) < 1e-5);
+    /* non-finite eye, target or up: the documented identity fallback, never NaN */
+    const float bad[3] = {NAN, INFINITY, -INFINITY};
+    for (int k = 0; k < 3; ++k) {
+        ak_vec3 v = ak_vec3_make(0, bad[k], 0);
+        ak_mat4 m[3] = {ak_mat4_look_at(v, ak_vec3_make(0, 0, -1), ak_vec3_make(0, 1, 0)),
+                        ak_mat4_look_at(ak_vec3_zero(), v, ak_vec3_make(0, 1, 0)),
+                        ak_mat4_look_at(ak_vec3_zero(), ak_vec3_make(0, 0, -1), v)};
+        for (int i = 0; i < 3; ++i) {
+            AK_CHECK(ak_mat4_is_finite(&m[i]));
+            ak_mat4 id = ak_mat4_identity();
+            AK_CHECK(memcmp(&m[i], &id, sizeof id) == 0);
+        }
+    }
 }
 
 AK_TEST(transforms) {

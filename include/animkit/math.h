@@ -557,7 +557,8 @@ AK_API ak_mat4 ak_mat4_perspective(float fovy, float aspect, float near_z, float
  * gives the identity. */
 AK_API ak_mat4 ak_mat4_orthographic(float left, float right, float bottom, float top, float near_z, float far_z);
 /* View matrix of a camera at eye looking at target, up roughly +Y: camera looks down -Z.
- * eye == target gives a translation by -eye; up parallel to the view picks another up. */
+ * eye == target gives a translation by -eye; up parallel to the view picks another up;
+ * a non-finite eye, target or up gives the identity. */
 AK_API ak_mat4 ak_mat4_look_at(ak_vec3 eye, ak_vec3 target, ak_vec3 up);
 
 /* ---- Euler angles ------------------------------------------------------------------ */
