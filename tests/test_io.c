@@ -721,6 +721,7 @@ AK_TEST(bvh_degenerate_headers) {
     AK_CHECK(s == NULL);
     AK_CHECK_EQ(load_bvh_text("2", "-0.1", two, &s), AK_ERR_BAD_DATA);
     AK_CHECK(s == NULL);
+    remove("degenerate.bvh");
 }
 
 /* ---- synthetic glTF documents ----------------------------------------------------------- */
