@@ -539,14 +539,7 @@ ak_result ak_skin_cor_centers_write_file(const char* path, ak_vec3_cspan centers
     if (!buf) return AK_ERR_NO_MEMORY;
     ak_u8_span span = {buf, size};
     ak_result r = ak_skin_cor_centers_encode(centers, key, span, NULL);
-    if (r == AK_OK) {
-        FILE* f = fopen(path, "wb");
-        if (!f) r = AK_ERR_IO;
-        else {
-            if (fwrite(buf, 1, size, f) != size) r = AK_ERR_IO;
-            if (fclose(f) != 0) r = AK_ERR_IO;
-        }
-    }
+    if (r == AK_OK) r = akp_write_file(path, buf, size);
     free(buf);
     return r;
 }

@@ -240,14 +240,7 @@ ak_result ak_skin_weights_write_file(const char* path, ak_u16_cspan joints, ak_f
     if (!buf) return AK_ERR_NO_MEMORY;
     ak_u8_span span = {buf, size};
     ak_result r = ak_skin_weights_encode(joints, weights, vertex_count, influence_count, span, NULL);
-    if (r == AK_OK) {
-        FILE* f = fopen(path, "wb");
-        if (!f) r = AK_ERR_IO;
-        else {
-            if (fwrite(buf, 1, size, f) != size) r = AK_ERR_IO;
-            if (fclose(f) != 0) r = AK_ERR_IO;
-        }
-    }
+    if (r == AK_OK) r = akp_write_file(path, buf, size);
     free(buf);
     return r;
 }
@@ -290,9 +283,18 @@ static ak_result read_all(const char* path, unsigned char** out, size_t* out_siz
 
 ak_result akp_read_file(const char* path, unsigned char** out, size_t* out_size) { return read_all(path, out, out_size); }
 
-ak_result ak_skin_weights_read_file_info(const char* path, size_t* out_vertex_count, uint32_t* out_influence_count,
-                                         ak_diag* diag) {
-    if (!path || !out_vertex_count || !out_influence_count) return AK_ERR_NULL_ARG;
+ak_result akp_write_file(const char* path, const unsigned char* buf, size_t size) {
+    FILE* f = fopen(path, "wb");
+    if (!f) return AK_ERR_IO;
+    ak_result r = fwrite(buf, 1, size, f) == size ? AK_OK : AK_ERR_IO;
+    if (fclose(f) != 0) r = AK_ERR_IO;
+    return r;
+}
+
+/* Read a weights file and decode it: the header only (out_joints NULL) or everything. The
+ * diag names the file whichever step fails. */
+static ak_result read_weights_file(const char* path, size_t* out_vertex_count, uint32_t* out_influence_count,
+                                   ak_u16_span out_joints, ak_f32_span out_weights, ak_diag* diag) {
     unsigned char* buf = NULL;
     size_t size = 0;
     ak_result r = read_all(path, &buf, &size);
@@ -301,24 +303,21 @@ ak_result ak_skin_weights_read_file_info(const char* path, size_t* out_vertex_co
         return r;
     }
     ak_u8_cspan span = {buf, size};
-    r = ak_skin_weights_decode_info(span, out_vertex_count, out_influence_count, diag);
+    r = out_joints.ptr ? ak_skin_weights_decode(span, out_joints, out_weights, diag)
+                       : ak_skin_weights_decode_info(span, out_vertex_count, out_influence_count, diag);
     if (r != AK_OK && diag) snprintf(diag->path, sizeof diag->path, "%s", path);
     free(buf);
     return r;
 }
 
+ak_result ak_skin_weights_read_file_info(const char* path, size_t* out_vertex_count, uint32_t* out_influence_count,
+                                         ak_diag* diag) {
+    if (!path || !out_vertex_count || !out_influence_count) return AK_ERR_NULL_ARG;
+    return read_weights_file(path, out_vertex_count, out_influence_count, (ak_u16_span){NULL, 0},
+                             (ak_f32_span){NULL, 0}, diag);
+}
+
 ak_result ak_skin_weights_read_file(const char* path, ak_u16_span out_joints, ak_f32_span out_weights, ak_diag* diag) {
     if (!path || !out_joints.ptr || !out_weights.ptr) return AK_ERR_NULL_ARG;
-    unsigned char* buf = NULL;
-    size_t size = 0;
-    ak_result r = read_all(path, &buf, &size);
-    if (r != AK_OK) {
-        akp_diag_set(diag, path, "cannot read the weights file");
-        return r;
-    }
-    ak_u8_cspan span = {buf, size};
-    r = ak_skin_weights_decode(span, out_joints, out_weights, diag);
-    if (r != AK_OK && diag) snprintf(diag->path, sizeof diag->path, "%s", path);
-    free(buf);
-    return r;
+    return read_weights_file(path, NULL, NULL, out_joints, out_weights, diag);
 }

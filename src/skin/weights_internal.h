@@ -10,6 +10,8 @@ ak_result akp_weights_heat(const ak_weights_desc* d, const ak_allocator* alloc, 
                            float* out_weights);
 /* Whole file into a malloc'd buffer (caller frees). AK_ERR_IO, AK_ERR_NO_MEMORY. */
 ak_result akp_read_file(const char* path, unsigned char** out, size_t* out_size);
+/* Write size bytes to a new file at path: AK_OK or AK_ERR_IO. */
+ak_result akp_write_file(const char* path, const unsigned char* buf, size_t size);
 
 /* Number of palette entries the bones reference (max joint_index + 1). */
 static inline size_t akp_bones_joint_count(ak_skin_bone_cspan bones) {
