@@ -124,7 +124,9 @@ AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* na
  * (the mesh name, or "mesh_<index>", whitespace replaced by '_'), its vertices in order
  * ("v x y z", 9 significant digits), "vt" when the mesh has UVs, "vn" when normals are
  * available, and its triangles as "f" lines (1-based, offset by the vertices written
- * before). No welding, no reordering.
+ * before). No welding, no reordering: UVs are written as the mesh stores them (for glTF,
+ * origin at the top left, so tools that assume OBJ's bottom-left origin show textures
+ * flipped), and triangles keep the file's index order, also under a mirroring node.
  * posed_positions: NULL, or an array of scene->mesh_count pointers, each to vertex_count
  * positions (NULL entry -> that mesh's own bind-space positions, as stored).
  * posed_normals: same shape; NULL or a NULL entry -> the mesh's own normals when it has them,
