@@ -92,7 +92,8 @@ typedef struct cli_poser {
     ak_vec3* morphed;         /* scratch [max vertices] */
     ak_vec3* morphed_normals; /* scratch [max vertices] */
     ak_vec3** cor_centers;    /* per mesh, computed on first CoR use; NULL until then */
-    ak_clip_cursor* cursor;
+    uint8_t* skin_scratch;    /* DQS/CoR scratch for the largest skin, allocated once */
+    size_t skin_scratch_size;
 } cli_poser;
 
 bool cli_method_parse(const char* s, cli_method* out);

@@ -51,8 +51,12 @@ int cli_poser_init(cli_poser* p, const ak_scene* scene) {
     p->positions = calloc(mc, sizeof(ak_vec3*));
     p->normals = calloc(mc, sizeof(ak_vec3*));
     p->cor_centers = calloc(mc, sizeof(ak_vec3*));
+    /* DQS/CoR scratch depends only on the palette size: size it once for the largest skin */
+    ak_skin_job probe = {.method = AK_SKIN_DQS, .palette = {p->palette, max_skin}};
+    p->skin_scratch_size = ak_skin_job_scratch_size(&probe);
+    p->skin_scratch = malloc(p->skin_scratch_size);
     bool ok = p->local && p->world && p->palette && p->morph_weights && p->morphed && p->morphed_normals &&
-              p->positions && p->normals && p->cor_centers;
+              p->positions && p->normals && p->cor_centers && p->skin_scratch;
     for (size_t m = 0; ok && m < scene->mesh_count; ++m) {
         size_t n = scene->meshes[m].mesh ? scene->meshes[m].mesh->vertex_count : 1;
         p->positions[m] = calloc(n, sizeof(ak_vec3));
@@ -83,6 +87,7 @@ void cli_poser_free(cli_poser* p) {
     free(p->morph_weights);
     free(p->morphed);
     free(p->morphed_normals);
+    free(p->skin_scratch);
     memset(p, 0, sizeof(*p));
 }
 
@@ -194,7 +199,6 @@ ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method) {
             if (sm_method == AK_SKIN_COR && mesh->triangle_count == 0) sm_method = AK_SKIN_DQS;
             if (sm_method == AK_SKIN_COR && (r = cor_centers(p, m)) != AK_OK) return r;
             bool faces = nrm == NULL && mesh->triangle_count > 0;
-            uint8_t* scratch = NULL;
             ak_skin_job job = {
                 .method = sm_method,
                 .influence_count = mesh->influence_count,
@@ -209,15 +213,8 @@ ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method) {
                 .out_positions = {p->positions[m], n, 0},
                 .out_normals = {(nrm || faces) ? p->normals[m] : NULL, n, 0},
             };
-            size_t ss = ak_skin_job_scratch_size(&job);
-            if (ss) {
-                scratch = malloc(ss);
-                if (!scratch) return AK_ERR_NO_MEMORY;
-                job.scratch = (ak_u8_span){scratch, ss};
-            }
-            r = ak_skin_job_run(&job);
-            free(scratch);
-            if (r != AK_OK) return r;
+            job.scratch = (ak_u8_span){p->skin_scratch, p->skin_scratch_size};
+            if ((r = ak_skin_job_run(&job)) != AK_OK) return r;
             if (!nrm && !faces)
                 for (size_t v = 0; v < n; ++v) p->normals[m][v] = ak_vec3_make(0, 1, 0);
         } else {
