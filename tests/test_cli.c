@@ -509,6 +509,21 @@ AK_TEST(export_bind_reproduces_gltf_positions) {
     }
 }
 
+/* A scene of more meshes than any fixed-size table would hold (84 skinned instances). */
+AK_TEST(render_scene_with_many_meshes) {
+    char path[1100];
+    if (!ak_test_asset(path, sizeof path, "gltf/RecursiveSkeletons/glTF-Binary/RecursiveSkeletons.glb")) {
+        AK_SKIP("RecursiveSkeletons.glb absent (set ANIMKIT_ASSETS)");
+        return;
+    }
+    char args[1300];
+    snprintf(args, sizeof args, "render '%s' --time 1 --size 96x64 -o many.png", path);
+    AK_CHECK_MSG(run(args, true) == 0, "%s", out_buf);
+    int w = 0, h = 0;
+    AK_CHECK_EQ(ak_png_info("many.png", &w, &h), AK_OK);
+    AK_CHECK(w == 96 && h == 64);
+}
+
 int main(void) {
     AK_RUN(usage_and_help);
     AK_RUN(bad_input_paths);
@@ -521,5 +536,6 @@ int main(void) {
     AK_RUN(render_outputs_decode);
     AK_RUN(demo_writes_its_files);
     AK_RUN(export_bind_reproduces_gltf_positions);
+    AK_RUN(render_scene_with_many_meshes);
     return ak_test_finish();
 }

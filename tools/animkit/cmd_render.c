@@ -113,7 +113,7 @@ int cmd_render(int argc, char** argv) {
     cli_frame f;
     frame_times ft = {0};
     ak_image panel[3] = {{0}}, composed = {0};
-    ak_vec4* colors[64] = {0};
+    ak_vec4** colors = NULL;
     ak_gif_writer* gw = NULL;
     memset(&p, 0, sizeof p);
     memset(&f, 0, sizeof f);
@@ -127,8 +127,8 @@ int cmd_render(int argc, char** argv) {
     } else if (s->clip_count) {
         clip = 0;
     }
-    if (s->mesh_count > 64) {
-        rc = cli_fail("render", "%s: %zu meshes; at most 64 can be rendered", a.pos[0], s->mesh_count);
+    if (!(colors = calloc(s->mesh_count + 1, sizeof(ak_vec4*)))) {
+        rc = cli_fail("render", "out of memory");
         goto done;
     }
     bool skinned = false;
@@ -233,7 +233,8 @@ int cmd_render(int argc, char** argv) {
             frame_img->height, cli_now() - t_start);
 done:
     if (gw) ak_gif_writer_finish(gw);
-    for (int m = 0; m < 64; ++m) free(colors[m]);
+    for (size_t m = 0; colors && m < s->mesh_count; ++m) free(colors[m]);
+    free(colors);
     for (int k = 0; k < 3; ++k) free(panel[k].pixels);
     free(composed.pixels);
     free(ft.t);

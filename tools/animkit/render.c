@@ -44,11 +44,13 @@ int cli_frame_init(cli_frame* f, const ak_scene* s, int width, int height, ak_ve
     f->camera = ak_view_orbit_camera(lo, hi, &orbit);
     /* skeleton overlay arrays: the skin joints only, parents remapped to listed ancestors */
     size_t n = s ? ak_scene_joint_count(s) : 0;
+    f->draw_capacity = (s ? s->mesh_count : 0) + CLI_MAX_EXTRA;
+    f->draw = calloc(f->draw_capacity, sizeof(ak_raster_mesh));
     f->joint_list = calloc(n + 1, sizeof(int));
     f->joint_parent = calloc(n + 1, sizeof(int16_t));
     f->joint_model = calloc(n + 1, sizeof(ak_mat4));
     int* map = calloc(n + 1, sizeof(int));
-    if (!f->joint_list || !f->joint_parent || !f->joint_model || !map) {
+    if (!f->draw || !f->joint_list || !f->joint_parent || !f->joint_model || !map) {
         free(map);
         cli_frame_free(f);
         return CLI_BAD_INPUT;
@@ -75,6 +77,7 @@ void cli_frame_free(cli_frame* f) {
     free(f->joint_list);
     free(f->joint_parent);
     free(f->joint_model);
+    free(f->draw);
     memset(f, 0, sizeof(*f));
 }
 
@@ -82,10 +85,10 @@ ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* 
     const ak_scene* s = p ? p->scene : NULL;
     ak_raster* r = f->raster;
     ak_raster_clear(r, rgba(0.83f, 0.87f, 0.93f, 1), rgba(0.48f, 0.51f, 0.58f, 1));
-    ak_raster_mesh meshes[64];
+    ak_raster_mesh* meshes = f->draw;
     size_t mc = 0;
     ak_vec4 clay = rgba(0.80f, 0.74f, 0.68f, 1);
-    for (size_t m = 0; s && m < s->mesh_count && mc < 64; ++m) {
+    for (size_t m = 0; s && m < s->mesh_count && mc < f->draw_capacity; ++m) {
         const ak_mesh* mesh = s->meshes[m].mesh;
         if (!mesh || mesh->triangle_count == 0) continue;
         ak_raster_mesh rm = {
@@ -101,7 +104,7 @@ ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* 
         }
         meshes[mc++] = rm;
     }
-    for (size_t e = 0; o && e < o->extra_count && mc < 64; ++e) meshes[mc++] = o->extra[e];
+    for (size_t e = 0; o && e < o->extra_count && mc < f->draw_capacity; ++e) meshes[mc++] = o->extra[e];
     ak_vec3 size = ak_vec3_sub(f->bmax, f->bmin);
     float extent = ak_maxf(ak_maxf(1.3f * ak_maxf(size.x, size.z), 0.9f * size.y), 1e-3f);
     float step = powf(10.0f, floorf(log10f(extent / 4.0f)));
@@ -182,13 +185,16 @@ int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_inde
     cli_poser p;
     cli_frame f;
     ak_image img = {0};
-    ak_vec4* colors[64] = {0};
+    ak_vec4** colors = calloc(s->mesh_count + 1, sizeof(ak_vec4*));
     int rc = CLI_OK;
-    if (cli_poser_init(&p, s)) return cli_fail("weights", "out of memory");
+    if (!colors || cli_poser_init(&p, s)) {
+        free(colors);
+        return cli_fail("weights", "out of memory");
+    }
     cli_poser_pose(&p, -1, 0.0f, false, CLI_LBS);
     ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
     cli_bounds_add_pose(&p, &lo, &hi);
-    if (mesh_index < 64) rc = heat_colors(s, mesh_index, joints, weights, k, slot, &colors[mesh_index]);
+    if (mesh_index < s->mesh_count) rc = heat_colors(s, mesh_index, joints, weights, k, slot, &colors[mesh_index]);
     if (rc == CLI_OK && cli_frame_init(&f, s, 640, 640, lo, hi, 0.5f) == CLI_OK) {
         char title[160];
         snprintf(title, sizeof title, "weights of %s", bone_name ? bone_name : "?");
@@ -199,7 +205,8 @@ int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_inde
     } else {
         rc = cli_fail("weights", "out of memory");
     }
-    for (int m = 0; m < 64; ++m) free(colors[m]);
+    for (size_t m = 0; m < s->mesh_count; ++m) free(colors[m]);
+    free(colors);
     free(img.pixels);
     cli_poser_free(&p);
     return rc;

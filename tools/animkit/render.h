@@ -16,7 +16,12 @@ typedef struct cli_frame {
     int16_t* joint_parent;
     ak_mat4* joint_model;
     size_t joint_count;
+    ak_raster_mesh* draw;  /* draw list: every scene mesh plus CLI_MAX_EXTRA extras */
+    size_t draw_capacity;
 } cli_frame;
+
+/* Extra meshes (props) one frame may draw besides the scene's. */
+#define CLI_MAX_EXTRA 8
 
 typedef struct cli_draw_opts {
     bool skeleton;         /* overlay the skeleton */
@@ -35,7 +40,8 @@ void cli_frame_free(cli_frame* f);
 ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* o, const ak_image* out);
 int cli_image_alloc(ak_image* img, int w, int h);
 /* Heat colours of bone's weights for every mesh its skin reaches (colors[m] NULL elsewhere;
- * the caller frees them). *out_found says whether any mesh has the bone. */
+ * colors has scene->mesh_count entries; the caller frees them). *out_found says whether any
+ * mesh has the bone. */
 int cli_weights_colors(const ak_scene* s, const char* bone, ak_vec4** colors, int* out_found);
 
 int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
