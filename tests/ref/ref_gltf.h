@@ -16,18 +16,6 @@
 #define REF_UNUSED __attribute__((unused))
 #else
 #define REF_UNUSED
-/* Column-major double 4x4 product out = a * b (out may alias either input). */
-static REF_UNUSED void ref_mat4d_mul(const double* a, const double* b, double* out) {
-    double r[16];
-    for (int c = 0; c < 4; ++c)
-        for (int i = 0; i < 4; ++i) {
-            double acc = 0;
-            for (int k = 0; k < 4; ++k) acc += a[k * 4 + i] * b[c * 4 + k];
-            r[c * 4 + i] = acc;
-        }
-    memcpy(out, r, sizeof r);
-}
-
 #endif
 
 /* ---- small helpers ------------------------------------------------------------------- */
