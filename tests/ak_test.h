@@ -14,6 +14,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include <animkit/core.h>
+
 static int ak_test_passed_ = 0, ak_test_failed_ = 0, ak_test_skipped_ = 0;
 static int ak_test_cur_failed_ = 0;
 static const char* ak_test_cur_name_ = "";
@@ -88,6 +90,29 @@ static const char* ak_test_cur_name_ = "";
 static inline int ak_test_finish(void) {
     printf("%d passed, %d failed, %d skipped\n", ak_test_passed_, ak_test_failed_, ak_test_skipped_);
     return ak_test_failed_ ? 1 : 0;
+}
+
+/* Counting allocator: blocks live now and ever made. fail_from > 0 makes allocation number
+ * fail_from (1-based) and every later one return NULL; 0 never fails.
+ *     ak_test_counter c = {.fail_from = 3};
+ *     ak_allocator a = ak_test_counting_allocator(&c);   // the third allocation fails */
+typedef struct ak_test_counter {
+    int live, total, fail_from;
+} ak_test_counter;
+static inline void* ak_test_count_alloc(size_t size, void* user) {
+    ak_test_counter* c = (ak_test_counter*)user;
+    if (c->fail_from > 0 && c->total + 1 >= c->fail_from) return NULL;
+    c->live++;
+    c->total++;
+    return malloc(size);
+}
+static inline void ak_test_count_free(void* p, void* user) {
+    ((ak_test_counter*)user)->live--;
+    free(p);
+}
+static inline ak_allocator ak_test_counting_allocator(ak_test_counter* c) {
+    ak_allocator a = {ak_test_count_alloc, ak_test_count_free, c};
+    return a;
 }
 
 /* Directory of the shared real assets: $ANIMKIT_ASSETS, else ../shared/assets relative to the

@@ -405,36 +405,22 @@ AK_TEST(blend_straight_from_mesh) {
     ak_blendshape_set_destroy(set);
 }
 
-typedef struct counting_alloc {
-    int allocs, frees;
-} counting_alloc;
-static void* count_alloc(size_t size, void* user) {
-    ++((counting_alloc*)user)->allocs;
-    return malloc(size);
-}
-static void count_free(void* p, void* user) {
-    ++((counting_alloc*)user)->frees;
-    free(p);
-}
-static void* fail_alloc(size_t size, void* user) {
-    (void)size, (void)user;
-    return NULL;
-}
 
 AK_TEST(set_is_one_allocation_through_the_allocator) {
     static ak_vec3 d[K * V];
     ak_rng rng = ak_rng_make(10);
     fill_local(d, K, V, V / 10, &rng);
-    counting_alloc c = {0, 0};
-    ak_allocator a = {count_alloc, count_free, &c};
+    ak_test_counter c = {0};
+    ak_allocator a = ak_test_counting_allocator(&c);
     ak_blendshape_set* set = NULL;
     ak_blendshape_set_desc desc = {.vertex_count = V, .target_count = K, .deltas = {d, K * V}};
     AK_CHECK_EQ(ak_blendshape_set_create(&desc, &a, &set), AK_OK);
-    AK_CHECK_EQ(c.allocs, 1);
+    AK_CHECK_EQ(c.total, 1);
     ak_blendshape_set_destroy(set);
-    AK_CHECK_EQ(c.frees, 1);
+    AK_CHECK_EQ(c.live, 0);
     ak_blendshape_set_destroy(NULL);
-    ak_allocator bad = {fail_alloc, count_free, &c};
+    ak_test_counter failing = {.fail_from = 1};
+    ak_allocator bad = ak_test_counting_allocator(&failing);
     set = (ak_blendshape_set*)&c;
     AK_CHECK_EQ(ak_blendshape_set_create(&desc, &bad, &set), AK_ERR_NO_MEMORY);
     AK_CHECK(set == NULL);

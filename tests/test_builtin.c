@@ -8,20 +8,6 @@
 
 #define PI_D 3.14159265358979323846
 
-typedef struct counter {
-    int live, total, fail_at; /* fail_at < 0: never fail */
-} counter;
-static void* count_alloc(size_t size, void* user) {
-    counter* c = (counter*)user;
-    if (c->fail_at >= 0 && c->total >= c->fail_at) return NULL;
-    c->live++;
-    c->total++;
-    return malloc(size);
-}
-static void count_free(void* p, void* user) {
-    ((counter*)user)->live--;
-    free(p);
-}
 
 static double mesh_volume(const ak_mesh* m) {
     return ak_volume_compute((ak_vec3_cspan){m->positions, m->vertex_count},
@@ -367,8 +353,8 @@ AK_TEST(humanoid) {
 }
 
 AK_TEST(allocator_and_failures) {
-    counter c = {0, 0, -1};
-    ak_allocator a = {count_alloc, count_free, &c};
+    ak_test_counter c = {0};
+    ak_allocator a = ak_test_counting_allocator(&c);
     ak_scene* s = NULL;
     AK_CHECK_EQ(ak_builtin_create("cylinder", NULL, &a, &s), AK_OK);
     AK_CHECK(c.live > 0);
@@ -378,23 +364,23 @@ AK_TEST(allocator_and_failures) {
     const int total = c.total;
     int wrong = 0;
     for (int f = 0; f < total; ++f) {
-        counter cf = {0, 0, f};
-        ak_allocator af = {count_alloc, count_free, &cf};
+        ak_test_counter cf = {.fail_from = f + 1};
+        ak_allocator af = ak_test_counting_allocator(&cf);
         ak_result r = ak_builtin_create("cylinder", NULL, &af, &s);
         if (r != AK_ERR_NO_MEMORY || s != NULL || cf.live != 0) ++wrong;
     }
     AK_CHECK_EQ(wrong, 0);
     /* The humanoid: first, middle and last allocations. */
-    counter ch = {0, 0, -1};
-    ak_allocator ah = {count_alloc, count_free, &ch};
+    ak_test_counter ch = {0};
+    ak_allocator ah = ak_test_counting_allocator(&ch);
     ak_builtin_desc coarse = {.cell_size = 0.05f};
     AK_CHECK_EQ(ak_builtin_create("humanoid", &coarse, &ah, &s), AK_OK);
     ak_scene_destroy(s);
     AK_CHECK_EQ(ch.live, 0);
     int fails[3] = {0, ch.total / 2, ch.total - 1};
     for (int i = 0; i < 3; ++i) {
-        counter cf = {0, 0, fails[i]};
-        ak_allocator af = {count_alloc, count_free, &cf};
+        ak_test_counter cf = {.fail_from = fails[i] + 1};
+        ak_allocator af = ak_test_counting_allocator(&cf);
         AK_CHECK_EQ(ak_builtin_create("humanoid", &coarse, &af, &s), AK_ERR_NO_MEMORY);
         AK_CHECK(s == NULL);
         AK_CHECK_EQ(cf.live, 0);

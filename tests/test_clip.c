@@ -599,35 +599,25 @@ AK_TEST(root_motion_extraction) {
     }
 }
 
-/* A counting allocator: every build frees what it allocates, through the given allocator. */
-static size_t live_blocks;
-static void* count_alloc(size_t size, void* user) {
-    (void)user;
-    ++live_blocks;
-    return malloc(size);
-}
-static void count_free(void* p, void* user) {
-    (void)user;
-    --live_blocks;
-    free(p);
-}
 
 AK_TEST(custom_allocator_is_used_and_balanced) {
-    ak_allocator a = {count_alloc, count_free, NULL};
+    /* every build frees what it allocates, through the given allocator */
+    ak_test_counter cnt = {0};
+    ak_allocator a = ak_test_counting_allocator(&cnt);
     float t[3] = {2, 0, 1}, v[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2};
     ak_raw_channel ch = {.target = AK_CHANNEL_TRANSLATION, .interp = AK_INTERP_NATURAL, .key_count = 3, .times = t, .values = v};
     ak_raw_clip raw = {.channels = &ch, .channel_count = 1, .joint_count = 1};
     ak_clip* c = NULL;
     AK_CHECK_EQ(ak_clip_build(&raw, &a, &c, NULL), AK_OK);
-    AK_CHECK_EQ(live_blocks, 1);
+    AK_CHECK_EQ(cnt.live, 1);
     ak_clip* ip = NULL;
     ak_track* tr = NULL;
     AK_CHECK_EQ(ak_clip_extract_root_motion(c, NULL, &a, &ip, &tr), AK_OK);
-    AK_CHECK_EQ(live_blocks, 3);
+    AK_CHECK_EQ(cnt.live, 3);
     ak_clip_destroy(ip);
     ak_track_destroy(tr);
     ak_clip_destroy(c);
-    AK_CHECK_EQ(live_blocks, 0);
+    AK_CHECK_EQ(cnt.live, 0);
 }
 
 int main(void) {

@@ -1478,22 +1478,6 @@ AK_TEST(bvh_mesh_skin_through_assimp) {
 
 /* ---- allocator: every allocation failing in turn ------------------------------------------- */
 
-typedef struct fail_alloc {
-    int left;  /* allocations that succeed before one fails; < 0 -> never fail */
-    int live;
-} fail_alloc;
-
-static void* fa_alloc(size_t size, void* user) {
-    fail_alloc* f = (fail_alloc*)user;
-    if (f->left == 0) return NULL;
-    if (f->left > 0) --f->left;
-    ++f->live;
-    return malloc(size);
-}
-static void fa_free(void* p, void* user) {
-    --((fail_alloc*)user)->live;
-    free(p);
-}
 
 AK_TEST(allocation_failures) {
     char text[4096];
@@ -1507,8 +1491,8 @@ AK_TEST(allocation_failures) {
     free(b64);
     int ok_at = -1;
     for (int n = 0; n < 400 && ok_at < 0; ++n) {
-        fail_alloc fa = {n, 0};
-        ak_allocator a = {fa_alloc, fa_free, &fa};
+        ak_test_counter fa = {.fail_from = n + 1};
+        ak_allocator a = ak_test_counting_allocator(&fa);
         ak_scene* s = NULL;
         ak_result r = ak_io_load_memory(doc_text, strlen(doc_text), "t.gltf", NULL, NULL, &a, &s, NULL);
         if (r == AK_OK) ok_at = n;

@@ -7,20 +7,6 @@
 
 #define PI_D 3.14159265358979323846
 
-/* Counting allocator: how many blocks are live and how many were ever made. */
-typedef struct counter {
-    int live, total;
-} counter;
-static void* count_alloc(size_t size, void* user) {
-    counter* c = (counter*)user;
-    c->live++;
-    c->total++;
-    return malloc(size);
-}
-static void count_free(void* p, void* user) {
-    ((counter*)user)->live--;
-    free(p);
-}
 
 /* Cube [0,1]^3 + offset, vertex index = x + 2y + 4z, faces counter-clockwise from outside. */
 static ak_mesh* make_cube(ak_vec3 offset, bool normals) {
@@ -74,8 +60,8 @@ static ak_mesh* make_sphere(float r, uint32_t rings, uint32_t segs) {
 }
 
 AK_TEST(create_one_allocation_and_zeroed) {
-    counter c = {0, 0};
-    ak_allocator a = {count_alloc, count_free, &c};
+    ak_test_counter c = {0};
+    ak_allocator a = ak_test_counting_allocator(&c);
     ak_mesh_desc d = {.vertex_count = 5,
                       .triangle_count = 2,
                       .influence_count = 4,

@@ -5,20 +5,6 @@
 
 #include "ak_test.h"
 
-typedef struct counter {
-    int live, total, fail_at;
-} counter;
-static void* count_alloc(size_t size, void* user) {
-    counter* c = (counter*)user;
-    if (c->fail_at >= 0 && c->total >= c->fail_at) return NULL;
-    c->live++;
-    c->total++;
-    return malloc(size);
-}
-static void count_free(void* p, void* user) {
-    ((counter*)user)->live--;
-    free(p);
-}
 
 static bool near3(ak_vec3 a, float x, float y, float z, float tol) {
     return fabsf(a.x - x) <= tol && fabsf(a.y - y) <= tol && fabsf(a.z - z) <= tol;
@@ -77,8 +63,8 @@ static ak_scene* make_scene(const ak_allocator* alloc) {
 }
 
 AK_TEST(alloc_and_destroy) {
-    counter c = {0, 0, -1};
-    ak_allocator a = {count_alloc, count_free, &c};
+    ak_test_counter c = {0};
+    ak_allocator a = ak_test_counting_allocator(&c);
     ak_scene* s = make_scene(&a);
     AK_CHECK(s != NULL);
     if (!s) return;
@@ -102,8 +88,8 @@ AK_TEST(alloc_and_destroy) {
 
     AK_CHECK_EQ(ak_scene_alloc(1, 1, 1, NULL, NULL), AK_ERR_NULL_ARG);
     for (int f = 0; f < 4; ++f) {
-        counter cf = {0, 0, f};
-        ak_allocator af = {count_alloc, count_free, &cf};
+        ak_test_counter cf = {.fail_from = f + 1};
+        ak_allocator af = ak_test_counting_allocator(&cf);
         ak_scene* t = (ak_scene*)1;
         AK_CHECK_EQ(ak_scene_alloc(2, 2, 2, &af, &t), AK_ERR_NO_MEMORY);
         AK_CHECK(t == NULL);

@@ -196,22 +196,10 @@ AK_TEST(create_validation_codes) {
     ak_skeleton_destroy(sk);
 }
 
-typedef struct counter {
-    int live, total;
-} counter;
-static void* count_alloc(size_t size, void* user) {
-    ((counter*)user)->live++;
-    ((counter*)user)->total++;
-    return malloc(size);
-}
-static void count_free(void* p, void* user) {
-    ((counter*)user)->live--;
-    free(p);
-}
 
 AK_TEST(one_allocation) {
-    counter c = {0, 0};
-    ak_allocator a = {count_alloc, count_free, &c};
+    ak_test_counter c = {0};
+    ak_allocator a = ak_test_counting_allocator(&c);
     ak_joint_desc js[2] = {joint("a", -1, 0), joint("b", 0, 1)};
     ak_skeleton_desc d = {.joints = js, .joint_count = 2};
     ak_skeleton* sk = NULL;
