@@ -275,12 +275,12 @@ AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t 
 }
 
 
-AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K) {
+/* off: with 4 influences, the block's palette offsets (joint_offsets4), computed a block ahead
+ * by the caller so that they are read back from memory as plain loads; NULL otherwise. */
+AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K, const uint32_t* off) {
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
-    if (K == 4) {
-        uint32_t off[32];
-        joint_offsets4(c, i0, AKP_MAT_SHIFT, off);
+    if (off) {
         for (int v = 0; v < 8; ++v) blend_matrix_vertex4(c, i0 + (size_t)v, off + 4 * v, &c01[v], &c23[v]);
     } else {
         for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
@@ -424,15 +424,23 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
-/* The block loops, specialised for 4 influences (the common case) so the compiler unrolls. */
-#define AKP_BLOCK_LOOP(fn)                                                                 \
-    AKP_AVX2 static void fn##_range(const akp_skin_ctx* c, size_t begin, size_t end) {     \
-        if (c->k == 4)                                                                     \
-            for (size_t i = begin; i < end; i += 8) fn(c, i, 4);                           \
-        else                                                                               \
-            for (size_t i = begin; i < end; i += 8) fn(c, i, c->k);                        \
+/* The LBS block loop, specialised for 4 influences (the common case) so the compiler unrolls;
+ * the palette offsets of the next block are computed before the current block runs (two
+ * buffers in turn), so the blend reads them back as plain loads: extracting 32 offsets from
+ * SIMD registers costs more, and reading them right after the vector store stalls. */
+AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
+    if (c->k == 4) {
+        uint32_t off[2][32];
+        joint_offsets4(c, begin, AKP_MAT_SHIFT, off[0]);
+        unsigned b = 0;
+        for (size_t i = begin; i < end; i += 8, b ^= 1u) {
+            if (i + 8 < end) joint_offsets4(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u]);
+            block_lbs(c, i, 4, off[b]);
+        }
+    } else {
+        for (size_t i = begin; i < end; i += 8) block_lbs(c, i, c->k, NULL);
     }
-AKP_BLOCK_LOOP(block_lbs)
+}
 
 /* DQS and CoR: with 4 influences, phase 1 of the next block runs before the current block's
  * blend and transform (two phase-1 buffers in turn). */
