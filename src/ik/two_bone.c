@@ -165,15 +165,22 @@ static bool two_bone_fast(const ak_ik_two_bone_job* job, int branch, ak_quat* ou
     const float cphi = first ? c1 : c2, sphi = first ? s1 : s2;
     const tbv nh = tbv_scale(n, 1.0f / nl);
     const tbv f = tbv_add(tbv_add(u, tbv_scale(v, cphi)), tbv_scale(tbv_cross(nh, v), sphi));
-    const float f2 = tbv_dot(f, f);
+    /* |f|^2 = a^2 + b^2 + 2 u.R(v) = a^2 + b^2 + 2K: the mid equation, solved or clamped */
+    const float f2 = a2 + b2 + 2.0f * K;
     /* Straight after the bend (|u x f^|^2 = S^2 / |f|^2 tiny): the general path's shortest arc. */
     if (!(f2 > 1e-24f) || !(S * S > 1e-12f * a2 * f2)) return false;
     const tbv a2v = first ? tbv_neg(nh) : nh;
     const float P = sqrtf(p2), FD = sqrtf(f2 * d2);
-    const tbv af = tbv_cross(a2v, f), ps = tbv_cross(p, st);
-    /* Scaled by |f||st||p|: a_i x b_i -> T_i, a_i . b_i -> d_i. */
-    const tbv T0 = tbv_scale(tbv_cross(f, st), P), T1 = tbv_cross(af, ps), T2 = tbv_scale(tbv_cross(a2v, p), FD);
-    const float base = FD * P, e0 = P * tbv_dot(f, st), e1 = tbv_dot(af, ps), e2 = FD * tbv_dot(a2v, p);
+    /* Scaled by |f||st||p|: a_i x b_i -> T_i, a_i . b_i -> e_i. The middle axes a_1 = a_2 x a_0,
+     * b_1 = b_2 x b_0 need no cross products (Binet-Cauchy and the (A x B) x (C x D) rule):
+     * e_1 = (a2.p)(f.st) - (a2.st)(f.p), T_1 = (f.(st x a2)) p + (f.(a2 x p)) st, so after the
+     * bend only f x st and four dot products with f remain. */
+    const tbv x2 = tbv_cross(a2v, p), sa = tbv_cross(st, a2v);
+    const float a2p = tbv_dot(a2v, p), a2st = tbv_dot(a2v, st);
+    const float fst = tbv_dot(f, st), fp = tbv_dot(f, p), fsa = tbv_dot(f, sa), fx2 = tbv_dot(f, x2);
+    const tbv T0 = tbv_scale(tbv_cross(f, st), P), T1 = tbv_add(tbv_scale(p, fsa), tbv_scale(st, fx2)),
+              T2 = tbv_scale(x2, FD);
+    const float base = FD * P, e0 = P * fst, e1 = a2p * fst - a2st * fp, e2 = FD * a2p;
     /* Shepperd's choice in frame form: with F_k the half turn about a_k, R = R' F_k where R'
      * takes (+-a_i) onto b_i; of the four candidates (the trace form and one per axis) take
      * the one with the largest scalar part (at least a quarter of the sum 4 |f||st||p|), so
@@ -190,7 +197,7 @@ static bool two_bone_fast(const ak_ik_two_bone_job* job, int branch, ak_quat* ou
         float wk;
         if (w_2 >= w_0 && w_2 >= w_1) vk = tbv_sub(T2, tbv_add(T0, T1)), wk = w_2, ak = a2v;
         else if (w_0 >= w_1) vk = tbv_sub(T0, tbv_add(T1, T2)), wk = w_0, ak = f;
-        else vk = tbv_sub(T1, tbv_add(T0, T2)), wk = w_1, ak = af;
+        else vk = tbv_sub(T1, tbv_add(T0, T2)), wk = w_1, ak = tbv_cross(a2v, f);
         qv = tbv_add(tbv_scale(ak, wk), tbv_cross(vk, ak)), qw = -tbv_dot(vk, ak);
     }
     const float q2 = tbv_dot(qv, qv) + qw * qw;
