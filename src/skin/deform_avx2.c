@@ -180,11 +180,15 @@ AKP_AVX2_INLINE static inline void blend_matrix_vertex4(const akp_skin_ctx* c, s
     float ww[4];
     memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
     const char* pal = (const char*)c->palette;
+    uint64_t o01, o23; /* two offsets per load: the blend is load-bound */
+    memcpy(&o01, off, 8);
+    memcpy(&o23, off + 2, 8);
+    const size_t o[4] = {(uint32_t)o01, (size_t)(o01 >> 32), (uint32_t)o23, (size_t)(o23 >> 32)};
     __m256 w = _mm256_set1_ps(ww[0]);
-    const float* m = (const float*)(const void*)(pal + off[0]);
+    const float* m = (const float*)(const void*)(pal + o[0]);
     __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
     for (int k = 1; k < 4; ++k) {
-        m = (const float*)(const void*)(pal + off[k]);
+        m = (const float*)(const void*)(pal + o[k]);
         w = _mm256_set1_ps(ww[k]);
         a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
         a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
