@@ -321,8 +321,12 @@ typedef struct interleaved_vertex {
 AK_TEST(lbs_matches_double_reference) {
     enum { N = 1003, J = 20, K = 4 };
     ak_rng rng = ak_rng_make(11);
-    ak_mat4 pal[J];
-    for (int j = 0; j < J; ++j) pal[j] = rand_matrix(&rng, j % 2 == 1); /* half with scale/shear */
+    /* the palette at a 64-byte aligned address and 16 bytes past one (the AVX2 LBS kernel then
+     * works on an aligned copy: both paths must give the reference) */
+    _Alignas(64) ak_mat4 pal_storage[J + 1];
+    ak_mat4 pal_in[J];
+    for (int j = 0; j < J; ++j) pal_in[j] = rand_matrix(&rng, j % 2 == 1); /* half with scale/shear */
+    ak_mat4* pal = pal_storage;
     interleaved_vertex* v = (interleaved_vertex*)malloc(N * sizeof *v);
     ak_vec3* op = (ak_vec3*)malloc(N * sizeof(ak_vec3));
     ak_vec3* on = (ak_vec3*)malloc(N * sizeof(ak_vec3));
@@ -334,7 +338,9 @@ AK_TEST(lbs_matches_double_reference) {
         rand_influences(&rng, K, J, v[i].joints, v[i].weights);
     }
     const double scale = 2.0 * sqrt(3.0) + 4.0; /* bounding size of the deformed points, roughly */
-    for (int variant = 0; variant < 4; ++variant) {
+    for (int variant = 0; variant < 8; ++variant) {
+        pal = (variant & 4) ? (ak_mat4*)(void*)((char*)pal_storage + 16) : pal_storage;
+        memcpy(pal, pal_in, sizeof pal_in);
         ak_skin_job job = {
             .influence_count = K,
             .palette = {pal, J},
