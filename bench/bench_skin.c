@@ -128,7 +128,7 @@ typedef struct bench_data {
     uint16_t* jn;
     float* w;
     ak_mat4 pal[64];
-    unsigned char scratch[64 + 128 * 64];
+    unsigned char scratch[64 + 192 * 64]; /* ak_skin_job_scratch_size for CoR, 64 joints */
 } bench_data;
 
 /* The four jobs (LBS positions, LBS positions+normals, DQS, CoR) run in turn, one run each

@@ -80,7 +80,7 @@ int main(void) {
         float degrees;
     } poses[3] = {{"bend 90", {0, 0, 1}, 90}, {"twist 90", {0, 1, 0}, 90}, {"twist 180", {0, 1, 0}, 180}};
     const char* methods[3] = {"LBS", "DQS", "CoR"};
-    unsigned char scratch[64 + 128 * 2];
+    unsigned char scratch[64 + 192 * 2]; /* >= ak_skin_job_scratch_size for every method */
     printf("pose       method  volume/rest  bulge/radius\n");
     for (int p = 0; p < 3; ++p) {
         /* joint 1 turns about its own position; joint 0 stays */

@@ -21,7 +21,9 @@ static void check_mesh(const char* file, const ak_scene* scene, const ak_mesh* m
     (void)scene;
     ak_vec3* out = (ak_vec3*)malloc(n * sizeof(ak_vec3));
     ak_vec3* out2 = (ak_vec3*)malloc(n * sizeof(ak_vec3));
-    unsigned char* scratch = (unsigned char*)malloc(64 + 128 * palette_count);
+    ak_skin_job probe = {.method = AK_SKIN_COR, .palette = {palette, palette_count}};
+    const size_t scratch_size = ak_skin_job_scratch_size(&probe); /* the largest: CoR */
+    unsigned char* scratch = (unsigned char*)malloc(scratch_size);
     ak_skin_job job = {
         .influence_count = k,
         .palette = {palette, palette_count},
@@ -29,7 +31,7 @@ static void check_mesh(const char* file, const ak_scene* scene, const ak_mesh* m
         .joints = {mesh->joints, n, 0},
         .weights = {mesh->weights, n, 0},
         .cor_centers = {centers, n, 0},
-        .scratch = {scratch, 64 + 128 * palette_count},
+        .scratch = {scratch, scratch_size},
         .out_positions = {out, n, 0},
     };
     ak_result r = ak_skin_job_run(&job);

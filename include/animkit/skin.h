@@ -281,7 +281,8 @@ typedef struct ak_skin_job {
     ak_stream out_tangents;     /* required when tangents.ptr */
 } ak_skin_job;
 
-/* Bytes of scratch the job needs: 0 for LBS, 64 + 128 * palette.count for DQS and CoR. */
+/* Bytes of scratch the job needs: 0 for LBS, 64 + 128 * palette.count for DQS,
+ * 64 + 192 * palette.count for CoR. */
 AK_API size_t ak_skin_job_scratch_size(const ak_skin_job* job);
 
 /* Check the job. Rules, in order (the first that fails is returned):

@@ -281,7 +281,8 @@ void akp_skin_range_scalar(const akp_skin_ctx* c, size_t begin, size_t end) {
 
 size_t ak_skin_job_scratch_size(const ak_skin_job* job) {
     if (!job || job->method == AK_SKIN_LBS || job->method >= AK_SKIN_METHOD_COUNT) return 0;
-    return 64 + sizeof(akp_skin_joint) * job->palette.count;
+    const size_t per_joint = sizeof(akp_skin_joint) + (job->method == AK_SKIN_COR ? 64u : 0u);
+    return 64 + per_joint * job->palette.count;
 }
 
 static bool stride_ok(size_t stride, size_t elem) { return stride == 0 || stride >= elem; }
@@ -448,9 +449,11 @@ ak_result ak_skin_job_run(const ak_skin_job* job) {
         if (job->method == AK_SKIN_COR && !any_stretch) {
             for (size_t j = 0; j < job->palette.count; ++j) {
                 const float* m = job->palette.ptr[j].m;
+                float* neg = akp_skin_cor_neg_rows(prep, job->palette.count, j);
                 for (int col = 0; col < 4; ++col) {
-                    for (int r = 0; r < 3; ++r) prep[j].cor_rows[col * 4 + r] = m[col * 4 + r];
+                    for (int r = 0; r < 3; ++r) prep[j].cor_rows[col * 4 + r] = neg[col * 4 + r] = m[col * 4 + r];
                     prep[j].cor_rows[col * 4 + 3] = prep[j].real[col];
+                    neg[col * 4 + 3] = -prep[j].real[col];
                 }
             }
         }

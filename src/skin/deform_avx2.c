@@ -174,21 +174,21 @@ AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t 
     }
 }
 
-/* blend_matrix_vertex for 4 influences with offsets from joint_offsets4 (AKP_MAT_SHIFT). */
-AKP_AVX2_INLINE static inline void blend_matrix_vertex4(const akp_skin_ctx* c, size_t i, const uint32_t* off,
-                                                        __m256* out01, __m256* out23) {
+/* Blend of two 8-float rows at base + off[k] with the 4 weights of vertex i: the palette
+ * matrices for LBS (offsets from joint_offsets4 with AKP_MAT_SHIFT), the CoR rows for CoR. */
+AKP_AVX2_INLINE static inline void blend_matrix_rows4(const akp_skin_ctx* c, size_t i, const char* base,
+                                                      const uint32_t* off, __m256* out01, __m256* out23) {
     float ww[4];
     memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
-    const char* pal = (const char*)c->palette;
     uint64_t o01, o23; /* two offsets per load: the blend is load-bound */
     memcpy(&o01, off, 8);
     memcpy(&o23, off + 2, 8);
     const size_t o[4] = {(uint32_t)o01, (size_t)(o01 >> 32), (uint32_t)o23, (size_t)(o23 >> 32)};
     __m256 w = _mm256_set1_ps(ww[0]);
-    const float* m = (const float*)(const void*)(pal + o[0]);
+    const float* m = (const float*)(const void*)(base + o[0]);
     __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
     for (int k = 1; k < 4; ++k) {
-        m = (const float*)(const void*)(pal + o[k]);
+        m = (const float*)(const void*)(base + o[k]);
         w = _mm256_set1_ps(ww[k]);
         a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
         a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
@@ -224,7 +224,8 @@ AKP_AVX2_INLINE static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size
  * weights, from the joint offsets off (joint_offsets4, AKP_JOINT_SHIFT); off[0..3], sw[0..3]
  * belong to vertex i and off[4..7], sw[4..7] to vertex i + 1. The reference is the rotation of the largest weight (lowest slot
  * on ties), picked with blends: no branch and no index round trip through memory. */
-AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, const uint32_t* off, float* sw) {
+AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, uint32_t* off, float* sw,
+                                               uint32_t cor_neg) {
     const char* wp = c->wgt + i * c->wgt_stride;
     const char* jb = (const char*)c->joints_prep;
     __m256 r[4];
@@ -242,6 +243,15 @@ AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, 
     ref = _mm256_blendv_ps(ref, r[0], _mm256_permute_ps(is_max, _MM_SHUFFLE(0, 0, 0, 0)));
     __m256 dots = _mm256_hadd_ps(_mm256_hadd_ps(_mm256_mul_ps(r[0], ref), _mm256_mul_ps(r[1], ref)),
                                  _mm256_hadd_ps(_mm256_mul_ps(r[2], ref), _mm256_mul_ps(r[3], ref)));
+    if (cor_neg) {
+        /* CoR: point the offsets of negative influences at the joint's negated rows instead,
+         * (count * 128 - 32) + j * 64 from the cor_rows of joint 0 */
+        const __m256i o = _mm256_loadu_si256((const __m256i*)(const void*)off);
+        const __m256i neg = _mm256_add_epi32(_mm256_srli_epi32(o, 1), _mm256_set1_epi32((int)cor_neg));
+        _mm256_storeu_si256((__m256i*)(void*)off,
+                            _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(o), _mm256_castsi256_ps(neg), dots)));
+        return;
+    }
     _mm256_storeu_ps(sw, _mm256_xor_ps(w8, _mm256_and_ps(dots, _mm256_set1_ps(-0.0f))));
 }
 
@@ -262,9 +272,9 @@ typedef struct dq_prep {
     uint32_t off[32];
     float sw[32];
 } dq_prep;
-AKP_AVX2_INLINE static inline void dq_prep_block(const akp_skin_ctx* c, size_t i0, dq_prep* p) {
+AKP_AVX2_INLINE static inline void dq_prep_block(const akp_skin_ctx* c, size_t i0, dq_prep* p, uint32_t cor_neg) {
     joint_offsets4(c, i0, AKP_JOINT_SHIFT, p->off);
-    for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->off + 4 * v, p->sw + 4 * v);
+    for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->off + 4 * v, p->sw + 4 * v, cor_neg);
 }
 
 /* Blended (real | dual) of the 8 vertices of a block: from the phase-1 data p (K == 4) when
@@ -285,7 +295,8 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
     if (off) {
-        for (int v = 0; v < 8; ++v) blend_matrix_vertex4(c, i0 + (size_t)v, off + 4 * v, &c01[v], &c23[v]);
+        for (int v = 0; v < 8; ++v)
+            blend_matrix_rows4(c, i0 + (size_t)v, (const char*)c->palette, off + 4 * v, &c01[v], &c23[v]);
     } else {
         for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
     }
@@ -374,22 +385,11 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     __m256 r01[8], r23[8], cols[8];
     const __m256i lo = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), hi = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
     if (p) {
-        /* one blend of the joints' cor_rows: weight w for the matrix lanes, the signed weight
-         * (+-w, hemisphere-aligned) for the rotation in the w lanes */
-        const char* jb = (const char*)c->joints_prep + offsetof(akp_skin_joint, cor_rows);
+        /* one blend of the joints' cor_rows, as LBS blends matrices: the offsets already point
+         * at the copies whose rotation (w lanes) is on the reference's hemisphere */
         for (int v = 0; v < 8; ++v) {
-            float ww[4];
-            memcpy(ww, c->wgt + (i0 + (size_t)v) * c->wgt_stride, sizeof ww);
-            __m256 a01 = _mm256_setzero_ps(), a23 = _mm256_setzero_ps();
-            for (int k = 0; k < 4; ++k) {
-                const float* m = (const float*)(const void*)(jb + p->off[4 * v + k]);
-                const __m256 w =
-                    _mm256_blend_ps(_mm256_set1_ps(ww[k]), _mm256_broadcast_ss(&p->sw[4 * v + k]), 0x88);
-                a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
-                a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
-            }
-            r01[v] = a01;
-            r23[v] = a23;
+            blend_matrix_rows4(c, i0 + (size_t)v, (const char*)c->joints_prep + offsetof(akp_skin_joint, cor_rows),
+                               p->off + 4 * v, &r01[v], &r23[v]);
         }
     } else {
         __m256 q[8];
@@ -448,22 +448,24 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
 
 /* DQS and CoR: with 4 influences, phase 1 of the next block runs before the current block's
  * blend and transform (two phase-1 buffers in turn). */
-#define AKP_DQ_BLOCK_LOOP(fn)                                                              \
+#define AKP_DQ_BLOCK_LOOP(fn, cor_neg)                                                     \
     AKP_AVX2 static void fn##_range(const akp_skin_ctx* c, size_t begin, size_t end) {     \
         if (c->k == 4) {                                                                   \
             dq_prep p[2];                                                                  \
-            dq_prep_block(c, begin, &p[0]);                                                \
+            const uint32_t neg = (cor_neg);                                                \
+            dq_prep_block(c, begin, &p[0], neg);                                           \
             unsigned b = 0;                                                                \
             for (size_t i = begin; i < end; i += 8, b ^= 1u) {                             \
-                if (i + 8 < end) dq_prep_block(c, i + 8, &p[b ^ 1u]);                      \
+                if (i + 8 < end) dq_prep_block(c, i + 8, &p[b ^ 1u], neg);                 \
                 fn(c, i, 4, &p[b]);                                                        \
             }                                                                              \
         } else {                                                                           \
             for (size_t i = begin; i < end; i += 8) fn(c, i, c->k, NULL);                  \
         }                                                                                  \
     }
-AKP_DQ_BLOCK_LOOP(block_dqs)
-AKP_DQ_BLOCK_LOOP(block_cor)
+AKP_DQ_BLOCK_LOOP(block_dqs, 0u)
+/* CoR: offset from joint 0's cor_rows to joint 0's negated rows (see akp_skin_cor_neg_rows) */
+AKP_DQ_BLOCK_LOOP(block_cor, (uint32_t)(c->palette_count * sizeof(akp_skin_joint) - offsetof(akp_skin_joint, cor_rows)))
 
 bool akp_skin_range_avx2(const akp_skin_ctx* c, size_t begin, size_t end) {
     if (c->do_tangents || !akp_skin_have_avx2()) return false;

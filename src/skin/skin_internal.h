@@ -22,13 +22,20 @@ typedef struct akp_skin_joint {
     };
 } akp_skin_joint;
 
+/* CoR without stretch: after the palette.count joints, the scratch holds palette.count more
+ * copies of cor_rows with the rotation negated (64 bytes each, akp_skin_cor_neg_rows), so the
+ * AVX2 kernel applies the hemisphere sign by choosing a copy instead of per-influence blends. */
+static inline float* akp_skin_cor_neg_rows(akp_skin_joint* prep, size_t palette_count, size_t j) {
+    return (float*)(void*)((char*)(prep + palette_count) + 64 * j);
+}
+
 /* Resolved view of a job for one vertex range; pointers already offset to vertex 0. */
 typedef struct akp_skin_ctx {
     ak_skin_method method;
     uint32_t k;                    /* influence count */
     const ak_mat4* palette;
     size_t palette_count;
-    const akp_skin_joint* joints_prep; /* DQS/CoR only */
+    const akp_skin_joint* joints_prep; /* DQS/CoR only (CoR: then the negated rows) */
     bool any_stretch;              /* some joint has scale or shear */
     const char *pos, *nrm, *tan, *jnt, *wgt, *ctr;
     size_t pos_stride, nrm_stride, tan_stride, jnt_stride, wgt_stride, ctr_stride;

@@ -51,8 +51,9 @@ int cli_poser_init(cli_poser* p, const ak_scene* scene) {
     p->positions = calloc(mc, sizeof(ak_vec3*));
     p->normals = calloc(mc, sizeof(ak_vec3*));
     p->cor_centers = calloc(mc, sizeof(ak_vec3*));
-    /* DQS/CoR scratch depends only on the palette size: size it once for the largest skin */
-    ak_skin_job probe = {.method = AK_SKIN_DQS, .palette = {p->palette, max_skin}};
+    /* DQS/CoR scratch depends only on the method and palette size: size it once for the
+     * largest skin and the method that needs most (CoR) */
+    ak_skin_job probe = {.method = AK_SKIN_COR, .palette = {p->palette, max_skin}};
     p->skin_scratch_size = ak_skin_job_scratch_size(&probe);
     p->skin_scratch = malloc(p->skin_scratch_size);
     bool ok = p->local && p->world && p->palette && p->morph_weights && p->morphed && p->morphed_normals &&
