@@ -173,6 +173,53 @@ static double two_bone_job_ns(const ak_skeleton* sk, const ak_vec3* targets, siz
     return med;
 }
 
+/* ns per solve of ak_ik_two_bone_run_many over batches of 64 jobs (the same limb and
+ * targets as two_bone_job_ns): the median over batches of the wall time per solve, and the
+ * single job timed the same way in the same loop (batch of 64 run one by one), for the ratio. */
+static double two_bone_many_ns(const ak_skeleton* sk, const ak_vec3* targets, size_t count, double* sink,
+                               double* out_single_ns) {
+    ak_transform pose[3];
+    start_pose(sk, false, pose);
+    ak_mat4 model[3];
+    ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, 3}, (ak_mat4_span){model, 3});
+    enum { B = 64 };
+    static ak_ik_two_bone_job jobs[B];
+    static ak_quat qs[B], qm[B];
+    for (size_t i = 0; i < B; ++i) {
+        ak_ik_two_bone_job j = {.start = model[0],
+                                .mid = model[1],
+                                .end = model[2],
+                                .pole = ak_vec3_make(0, 0, 1),
+                                .out_start_rot = &qs[i],
+                                .out_mid_rot = &qm[i]};
+        jobs[i] = j;
+    }
+    const size_t batches = 10 * count / B;
+    double* many = malloc(batches * sizeof *many);
+    double* single = malloc(batches * sizeof *single);
+    if (!many || !single) {
+        free(many), free(single);
+        return 0.0;
+    }
+    double acc = 0.0;
+    for (size_t k = 0; k < batches; ++k) {
+        for (size_t i = 0; i < B; ++i) jobs[i].target = targets[(k * B + i) % count];
+        double t0 = now_s();
+        ak_ik_two_bone_run_many(jobs, B, NULL);
+        double t1 = now_s();
+        for (size_t i = 0; i < B; ++i) ak_ik_two_bone_run(&jobs[i]);
+        double t2 = now_s();
+        many[k] = (t1 - t0) * 1e9 / B;
+        single[k] = (t2 - t1) * 1e9 / B;
+        acc += (double)qs[k % B].w + (double)qm[k % B].w;
+    }
+    *sink += acc;
+    const double med = percentile(many, batches, 0.5);
+    *out_single_ns = percentile(single, batches, 0.5);
+    free(many), free(single);
+    return med;
+}
+
 int main(int argc, char** argv) {
     size_t count = argc > 1 ? (size_t)strtoul(argv[1], NULL, 10) : 10000;
     if (count < 10) count = 10;
@@ -219,6 +266,11 @@ int main(int argc, char** argv) {
                        "wall), %.1f ns/solve (thread CPU time), %.1f M solves/s; chain job TWO_BONE (validate, FK, "
                        "limits, error): %.3f us/solve = %.1fx the job\n\n",
                        ns, cpu_ns, 1e3 / ns, res[3].us_median, res[3].us_median * 1e3 / ns);
+                double single_ns = 0.0;
+                double many_ns = two_bone_many_ns(sk, targets, count, &sink, &single_ns);
+                printf("two-bone ak_ik_two_bone_run_many (batches of 64 jobs, same limb and targets): %.1f ns/solve, "
+                       "%.1f M solves/s; the single job in the same loop %.1f ns/solve: x%.2f\n\n",
+                       many_ns, 1e3 / many_ns, single_ns, single_ns / many_ns);
             }
             ak_skeleton_destroy(sk);
         }

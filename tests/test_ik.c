@@ -722,6 +722,106 @@ AK_TEST(two_bone_chain_matches_job_and_limits) {
     ak_skeleton_destroy(sk);
 }
 
+/* A random rigid model matrix (uniform scale 1 or s) placed at pos. */
+static ak_mat4 rand_joint_matrix(ak_rng* rng, ak_vec3 pos, float scale) {
+    ak_vec3 axis = ak_vec3_make(ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1) + 0.01f);
+    ak_mat4 m = ak_mat4_from_quat(ak_quat_from_axis_angle(axis, ak_rng_range(rng, -3.0f, 3.0f)));
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) m.m[4 * c + r] *= scale;
+    m.m[12] = pos.x, m.m[13] = pos.y, m.m[14] = pos.z;
+    return m;
+}
+
+AK_TEST(two_bone_run_many_equals_single_jobs) {
+    /* Random limbs (bent, straight, scaled frames), targets near, far and on the start joint,
+     * with a mix of the options that leave the SIMD lanes (mid_axis, soft, keep_animation,
+     * twist, no pole) and of invalid jobs: every job must get what ak_ik_two_bone_run gives it. */
+    enum { N = 2003 };
+    ak_rng rng = ak_rng_make(4242);
+    ak_ik_two_bone_job* jobs = calloc(N, sizeof *jobs);
+    ak_quat* qa = calloc(4 * N, sizeof *qa);
+    bool* ra = calloc(2 * N, sizeof *ra);
+    if (!jobs || !qa || !ra) {
+        AK_CHECK(false);
+        free(jobs), free(qa), free(ra);
+        return;
+    }
+    int first_bad = -1;
+    for (int i = 0; i < N; ++i) {
+        const float scale = (i % 7 == 3) ? 1.7f : 1.0f;
+        ak_vec3 s = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+        ak_vec3 d1 = ak_vec3_normalize(ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1)));
+        ak_vec3 d2 = (i % 11 == 5) ? d1 /* straight limb */
+                                   : ak_vec3_normalize(ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1),
+                                                                    ak_rng_range(&rng, -1, 1)));
+        const float a = ak_rng_range(&rng, 0.3f, 1.2f), b = ak_rng_range(&rng, 0.3f, 1.2f);
+        ak_vec3 m = ak_vec3_madd(s, d1, a), e = ak_vec3_madd(m, d2, b);
+        const float reach = ak_rng_range(&rng, 0.0f, 1.3f) * (a + b);
+        ak_vec3 t = ak_vec3_madd(s, ak_vec3_normalize(ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1),
+                                                                    ak_rng_range(&rng, -1, 1))), reach);
+        if (i % 97 == 13) t = s; /* target on the start joint */
+        ak_ik_two_bone_job j = {
+            .start = rand_joint_matrix(&rng, s, scale),
+            .mid = rand_joint_matrix(&rng, m, scale),
+            .end = rand_joint_matrix(&rng, e, scale),
+            .target = t,
+            .pole = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1)),
+            .out_start_rot = &qa[2 * i],
+            .out_mid_rot = &qa[2 * i + 1],
+            .out_reached = &ra[i],
+        };
+        switch (i % 29) {
+        case 1: j.mid_axis = ak_vec3_make(0, 0, 1); break;
+        case 2: j.soft = 0.2f; break;
+        case 3: j.keep_animation = 0.3f; break;
+        case 4: j.twist = 0.4f; break;
+        case 5: j.pole = ak_vec3_zero(); break;
+        case 6: j.end.m[5] = NAN; if (first_bad < 0) first_bad = i; break;  /* invalid: BAD_DATA */
+        case 7: j.soft = 1.5f; if (first_bad < 0) first_bad = i; break;     /* invalid: BAD_ARG */
+        default: break;
+        }
+        jobs[i] = j;
+    }
+    /* reference: one job at a time, outputs redirected to the second half */
+    for (int i = 0; i < N; ++i) qa[2 * N + 2 * i] = qa[2 * N + 2 * i + 1] = ak_quat_make(7, 7, 7, 7);
+    for (int i = 0; i < N; ++i) qa[2 * i] = qa[2 * i + 1] = ak_quat_make(7, 7, 7, 7);
+    int bad_single = 0;
+    for (int i = 0; i < N; ++i) {
+        ak_ik_two_bone_job j = jobs[i];
+        j.out_start_rot = &qa[2 * N + 2 * i], j.out_mid_rot = &qa[2 * N + 2 * i + 1], j.out_reached = &ra[N + i];
+        bad_single += ak_ik_two_bone_run(&j) != AK_OK;
+    }
+    size_t failed = 0;
+    AK_CHECK_EQ(ak_ik_two_bone_run_many(jobs, N, &failed), AK_ERR_BAD_DATA); /* job 6 fails first */
+    AK_CHECK_EQ((int)failed, first_bad);
+    int exact = 0, worse = 0;
+    for (int i = 0; i < N; ++i) {
+        const float* x = &qa[2 * i].x;
+        const float* y = &qa[2 * N + 2 * i].x;
+        bool same = memcmp(x, y, 2 * sizeof(ak_quat)) == 0;
+        exact += same;
+        if (!same) {
+            double dmax = 0;
+            for (int k = 0; k < 8; ++k) dmax = fmax(dmax, fabs((double)x[k] - y[k]));
+            if (!(dmax < 1e-6)) ++worse;
+        }
+        AK_CHECK_EQ(ra[i], ra[N + i]);
+    }
+    /* invalid jobs: nothing written by either (both halves start as 7s) */
+    AK_CHECK_EQ(qa[2 * 6].x, 7.0f);
+    AK_CHECK_EQ(qa[2 * 7 + 1].w, 7.0f);
+    printf("  run_many vs single jobs: %d of %d bit-identical, %d differ by >= 1e-6; %d invalid jobs\n", exact, N, worse,
+           bad_single);
+    AK_CHECK_EQ(worse, 0);
+    AK_CHECK_EQ(exact, N);
+    /* empty and NULL */
+    AK_CHECK_EQ(ak_ik_two_bone_run_many(NULL, 0, NULL), AK_OK);
+    AK_CHECK_EQ(ak_ik_two_bone_run_many(NULL, 3, &failed), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_ik_two_bone_run_many(jobs, 0, &failed), AK_OK);
+    AK_CHECK_EQ((int)failed, 0);
+    free(jobs), free(qa), free(ra);
+}
+
 AK_TEST(two_bone_soft_weight_unreachable) {
     ak_quat qs, qm;
     bool reached = true;
@@ -1091,6 +1191,7 @@ int main(void) {
     AK_RUN(two_bone_closed_form_and_pole);
     AK_RUN(two_bone_chain_matches_job_and_limits);
     AK_RUN(two_bone_soft_weight_unreachable);
+    AK_RUN(two_bone_run_many_equals_single_jobs);
     AK_RUN(unreachable_straightens);
     AK_RUN(degenerate_chains);
     AK_RUN(dls_orientation_target);

@@ -6,7 +6,8 @@
  * joint's twist), an analytic two-bone solver (law of cosines, pole vector, soft reach limit,
  * blend weight), and damped least squares (Jacobian, Levenberg-Marquardt adaptive damping,
  * position and optional orientation targets). FABRIK also solves trees with several end
- * effectors (sub-bases, as in the paper). Every chain solver honours the skeleton's joint
+ * effectors (sub-bases, as in the paper). The two-bone solver also comes as a batch
+ * (ak_ik_two_bone_run_many: many limbs per call, four at a time in SIMD registers). Every chain solver honours the skeleton's joint
  * types and limits (each changed rotation or slide is clamped as ak_skeleton_limit_joint
  * does; a rotating joint's translation is left as the pose has it) and reports whether the
  * target was reached, the remaining distance and the iterations used.
@@ -215,6 +216,14 @@ AK_API ak_result ak_ik_two_bone_validate(const ak_ik_two_bone_job* job);
  * and reports not reached; a target on the start joint or zero-length bones give identity
  * corrections for the undefined part. */
 AK_API ak_result ak_ik_two_bone_run(const ak_ik_two_bone_job* job);
+/* ak_ik_two_bone_run on each of jobs[0..count) (e.g. both legs of every character of a crowd),
+ * with exactly its results, four jobs at a time in SIMD registers where the common case
+ * applies (a pole, no mid_axis, soft, keep_animation or twist, a limb bent by more than ~3
+ * degrees); the other jobs run ak_ik_two_bone_run one by one. Each job is validated on its
+ * own: a job that fails gets nothing written and the others are still solved. Returns AK_OK,
+ * or the first failing job's code with its index in *out_failed (optional; count when none
+ * failed); AK_ERR_NULL_ARG when jobs is NULL and count > 0. */
+AK_API ak_result ak_ik_two_bone_run_many(const ak_ik_two_bone_job* jobs, size_t count, size_t* out_failed);
 
 /* ---- FABRIK on a tree with several end effectors ------------------------------------- */
 
