@@ -137,21 +137,27 @@ static result run_solver(const ak_skeleton* sk, bool planar, const ak_vec3* targ
     return res;
 }
 
-/* ns per solve of the model-space two-bone job: the median over batches of 64 solves of the
- * wall time (robust to preemption on a loaded machine), and thread CPU time over 10 passes. */
-static double two_bone_job_ns(const ak_skeleton* sk, const ak_vec3* targets, size_t count, double* sink,
-                              double* out_cpu_ns) {
+/* The benchmark's two-bone job: the 3-joint chain in its start pose, pole +z. */
+static ak_ik_two_bone_job limb_job(const ak_skeleton* sk, ak_quat* qs, ak_quat* qm) {
     ak_transform pose[3];
     start_pose(sk, false, pose);
     ak_mat4 model[3];
     ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, 3}, (ak_mat4_span){model, 3});
-    ak_quat qs, qm;
     ak_ik_two_bone_job job = {.start = model[0],
                               .mid = model[1],
                               .end = model[2],
                               .pole = ak_vec3_make(0, 0, 1),
-                              .out_start_rot = &qs,
-                              .out_mid_rot = &qm};
+                              .out_start_rot = qs,
+                              .out_mid_rot = qm};
+    return job;
+}
+
+/* ns per solve of the model-space two-bone job: the median over batches of 64 solves of the
+ * wall time (robust to preemption on a loaded machine), and thread CPU time over 10 passes. */
+static double two_bone_job_ns(const ak_skeleton* sk, const ak_vec3* targets, size_t count, double* sink,
+                              double* out_cpu_ns) {
+    ak_quat qs, qm;
+    ak_ik_two_bone_job job = limb_job(sk, &qs, &qm);
     const size_t batch = 64, batches = 10 * count / batch;
     double* per = malloc(batches * sizeof *per);
     if (!per) return 0.0;
@@ -178,22 +184,10 @@ static double two_bone_job_ns(const ak_skeleton* sk, const ak_vec3* targets, siz
  * single job timed the same way in the same loop (batch of 64 run one by one), for the ratio. */
 static double two_bone_many_ns(const ak_skeleton* sk, const ak_vec3* targets, size_t count, double* sink,
                                double* out_single_ns) {
-    ak_transform pose[3];
-    start_pose(sk, false, pose);
-    ak_mat4 model[3];
-    ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, 3}, (ak_mat4_span){model, 3});
     enum { B = 64 };
     static ak_ik_two_bone_job jobs[B];
     static ak_quat qs[B], qm[B];
-    for (size_t i = 0; i < B; ++i) {
-        ak_ik_two_bone_job j = {.start = model[0],
-                                .mid = model[1],
-                                .end = model[2],
-                                .pole = ak_vec3_make(0, 0, 1),
-                                .out_start_rot = &qs[i],
-                                .out_mid_rot = &qm[i]};
-        jobs[i] = j;
-    }
+    for (size_t i = 0; i < B; ++i) jobs[i] = limb_job(sk, &qs[i], &qm[i]);
     const size_t batches = 10 * count / B;
     double* many = malloc(batches * sizeof *many);
     double* single = malloc(batches * sizeof *single);
