@@ -10,12 +10,14 @@
 
 static ak_mat4 rot_about(ak_vec3 pivot, ak_vec3 axis, float angle) {
     ak_mat4 r = ak_mat4_from_quat(ak_quat_from_axis_angle(axis, angle));
-    return ak_mat4_mul(ak_mat4_translation(pivot), ak_mat4_mul(r, ak_mat4_translation(ak_vec3_neg(pivot))));
+    return ak_mat4_mul(ak_mat4_translation(pivot),
+                       ak_mat4_mul(r, ak_mat4_translation(ak_vec3_neg(pivot))));
 }
 
 static ak_vec3 rand_unit(ak_rng* r) {
     for (;;) {
-        ak_vec3 v = ak_vec3_make(ak_rng_range(r, -1, 1), ak_rng_range(r, -1, 1), ak_rng_range(r, -1, 1));
+        ak_vec3 v =
+            ak_vec3_make(ak_rng_range(r, -1, 1), ak_rng_range(r, -1, 1), ak_rng_range(r, -1, 1));
         float l = ak_vec3_length(v);
         if (l > 0.1f && l <= 1.0f) return ak_vec3_scale(v, 1.0f / l);
     }
@@ -23,12 +25,14 @@ static ak_vec3 rand_unit(ak_rng* r) {
 
 /* Random rigid transform, or with scale/shear when affine. */
 static ak_mat4 rand_matrix(ak_rng* r, bool affine) {
-    ak_mat4 m = ak_mat4_from_quat(ak_quat_from_axis_angle(rand_unit(r), ak_rng_range(r, -3.1f, 3.1f)));
+    ak_mat4 m =
+        ak_mat4_from_quat(ak_quat_from_axis_angle(rand_unit(r), ak_rng_range(r, -3.1f, 3.1f)));
     if (affine) {
         ak_mat4 s = ak_mat4_identity();
         for (int c = 0; c < 3; ++c)
             for (int row = 0; row < 3; ++row)
-                s.m[c * 4 + row] = (c == row ? ak_rng_range(r, 0.6f, 1.5f) : ak_rng_range(r, -0.2f, 0.2f));
+                s.m[c * 4 + row] =
+                    (c == row ? ak_rng_range(r, 0.6f, 1.5f) : ak_rng_range(r, -0.2f, 0.2f));
         m = ak_mat4_mul(m, s);
     }
     m.m[12] = ak_rng_range(r, -2, 2);
@@ -59,14 +63,16 @@ static void rand_influences(ak_rng* r, uint32_t k, size_t joint_count, uint16_t*
 }
 
 /* Double-precision LBS reference: blended matrix, point, normal by inverse transpose. */
-static void ref_lbs(const ak_mat4* pal, const uint16_t* j, const float* w, uint32_t k, ak_vec3 p, ak_vec3 n,
-                    double* op, double* on) {
+static void ref_lbs(const ak_mat4* pal, const uint16_t* j, const float* w, uint32_t k, ak_vec3 p,
+                    ak_vec3 n, double* op, double* on) {
     double m[12] = {0};
     for (uint32_t e = 0; e < k; ++e)
         for (int c = 0; c < 4; ++c)
-            for (int row = 0; row < 3; ++row) m[c * 3 + row] += (double)w[e] * pal[j[e]].m[c * 4 + row];
+            for (int row = 0; row < 3; ++row)
+                m[c * 3 + row] += (double)w[e] * pal[j[e]].m[c * 4 + row];
     double pp[3] = {p.x, p.y, p.z}, nn[3] = {n.x, n.y, n.z};
-    for (int row = 0; row < 3; ++row) op[row] = m[9 + row] + m[row] * pp[0] + m[3 + row] * pp[1] + m[6 + row] * pp[2];
+    for (int row = 0; row < 3; ++row)
+        op[row] = m[9 + row] + m[row] * pp[0] + m[3 + row] * pp[1] + m[6 + row] * pp[2];
     /* inverse transpose via the explicit 3x3 inverse */
     double a = m[0], b = m[3], c = m[6], d = m[1], e = m[4], f = m[7], g = m[2], h = m[5], i = m[8];
     double det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
@@ -86,7 +92,8 @@ static double vol_closed(const ak_vec3* p, const uint32_t* idx, size_t tri_count
     double v = 0.0;
     for (size_t t = 0; t < tri_count; ++t) {
         ak_vec3 a = p[idx[3 * t]], b = p[idx[3 * t + 1]], c = p[idx[3 * t + 2]];
-        v += (double)a.x * ((double)b.y * c.z - (double)b.z * c.y) - (double)a.y * ((double)b.x * c.z - (double)b.z * c.x) +
+        v += (double)a.x * ((double)b.y * c.z - (double)b.z * c.y) -
+             (double)a.y * ((double)b.x * c.z - (double)b.z * c.x) +
              (double)a.z * ((double)b.x * c.y - (double)b.y * c.x);
     }
     return v / 6.0;
@@ -121,7 +128,8 @@ static cylinder cylinder_make(int rings, int segments) {
     c.weights = (float*)malloc(c.vertex_count * 2 * sizeof(float));
     for (int r = 0; r < rings; ++r)
         for (int s = 0; s < segments; ++s) {
-            float a = AK_TWO_PI * (float)s / (float)segments, y = CYL_LENGTH * (float)r / (float)(rings - 1);
+            float a = AK_TWO_PI * (float)s / (float)segments,
+                  y = CYL_LENGTH * (float)r / (float)(rings - 1);
             size_t v = (size_t)r * segments + s;
             c.pos[v] = ak_vec3_make(CYL_RADIUS * cosf(a), y, -CYL_RADIUS * sinf(a));
             c.nrm[v] = ak_vec3_make(cosf(a), 0.0f, -sinf(a));
@@ -134,7 +142,8 @@ static cylinder cylinder_make(int rings, int segments) {
     size_t t = 0;
     for (int r = 0; r + 1 < rings; ++r)
         for (int s = 0; s < segments; ++s) {
-            uint32_t a = (uint32_t)(r * segments + s), b = (uint32_t)(r * segments + (s + 1) % segments);
+            uint32_t a = (uint32_t)(r * segments + s),
+                     b = (uint32_t)(r * segments + (s + 1) % segments);
             uint32_t a2 = a + (uint32_t)segments, b2 = b + (uint32_t)segments;
             /* counter-clockwise from outside: angle grows towards -z from +x, seen from outside */
             uint32_t q[6] = {a, b, b2, a, b2, a2};
@@ -167,8 +176,9 @@ static void cylinder_free(cylinder* c) {
     free(c->weights);
 }
 
-static ak_skin_job cylinder_job(const cylinder* c, ak_skin_method method, const ak_mat4* palette, ak_vec3* out,
-                                const ak_vec3* centers, unsigned char* scratch, size_t scratch_size) {
+static ak_skin_job cylinder_job(const cylinder* c, ak_skin_method method, const ak_mat4* palette,
+                                ak_vec3* out, const ak_vec3* centers, unsigned char* scratch,
+                                size_t scratch_size) {
     ak_skin_job job = {
         .method = method,
         .influence_count = 2,
@@ -192,7 +202,8 @@ AK_TEST(job_validate_rules) {
     AK_CHECK_EQ(ak_skin_job_validate(NULL), AK_ERR_NULL_ARG);
     AK_CHECK_EQ(ak_skin_job_run(&zero), AK_ERR_NULL_ARG);
 
-    ak_vec3 pos[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, nrm[3] = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}}, out[3], outn[3];
+    ak_vec3 pos[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, nrm[3] = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}},
+            out[3], outn[3];
     uint16_t jn[3] = {0, 1, 0};
     float w[3] = {1, 1, 1};
     ak_mat4 pal[2] = {ak_mat4_identity(), ak_mat4_identity()};
@@ -209,34 +220,75 @@ AK_TEST(job_validate_rules) {
     AK_CHECK_EQ(ak_skin_job_validate(&good), AK_OK);
     ak_skin_job j;
     /* rule 1 */
-    j = good; j.positions.ptr = NULL; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good; j.palette.ptr = NULL; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good; j.joints.ptr = NULL; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good; j.weights.ptr = NULL; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good; j.out_positions.ptr = NULL; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    j = good;
+    j.positions.ptr = NULL;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    j = good;
+    j.palette.ptr = NULL;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    j = good;
+    j.joints.ptr = NULL;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    j = good;
+    j.weights.ptr = NULL;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    j = good;
+    j.out_positions.ptr = NULL;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
     /* rule 2 */
-    j = good; j.method = AK_SKIN_METHOD_COUNT; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good; j.influence_count = 0; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good; j.influence_count = 9; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good; j.thread_count = 65; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good; j.positions.stride = 8; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good; j.weights.stride = 2; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
+    j = good;
+    j.method = AK_SKIN_METHOD_COUNT;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
+    j = good;
+    j.influence_count = 0;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
+    j = good;
+    j.influence_count = 9;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
+    j = good;
+    j.thread_count = 65;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
+    j = good;
+    j.positions.stride = 8;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
+    j = good;
+    j.weights.stride = 2;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
     /* rule 3 */
-    j = good; j.normals = (ak_cstream){nrm, 3, 0}; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good; j.normals_from_faces = true; j.out_normals = (ak_stream){outn, 3, 0};
+    j = good;
+    j.normals = (ak_cstream){nrm, 3, 0};
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    j = good;
+    j.normals_from_faces = true;
+    j.out_normals = (ak_stream){outn, 3, 0};
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG); /* no indices */
-    j = good; j.method = AK_SKIN_COR; j.scratch = (ak_u8_span){scratch, sizeof scratch};
+    j = good;
+    j.method = AK_SKIN_COR;
+    j.scratch = (ak_u8_span){scratch, sizeof scratch};
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG); /* no centers */
-    j = good; j.tangents = (ak_cstream){w, 1, 16}; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    j = good;
+    j.tangents = (ak_cstream){w, 1, 16};
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
     /* rule 4 */
-    j = good; j.normals_from_faces = true; j.out_normals = (ak_stream){outn, 3, 0}; j.indices = (ak_u32_cspan){idx, 2};
+    j = good;
+    j.normals_from_faces = true;
+    j.out_normals = (ak_stream){outn, 3, 0};
+    j.indices = (ak_u32_cspan){idx, 2};
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
     /* rule 5 */
-    j = good; j.weights.count = 2; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
-    j = good; j.out_positions.count = 2; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
-    j = good; j.normals = (ak_cstream){nrm, 3, 0}; j.out_normals = (ak_stream){outn, 2, 0};
+    j = good;
+    j.weights.count = 2;
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
-    j = good; j.method = AK_SKIN_DQS; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL); /* no scratch */
+    j = good;
+    j.out_positions.count = 2;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
+    j = good;
+    j.normals = (ak_cstream){nrm, 3, 0};
+    j.out_normals = (ak_stream){outn, 2, 0};
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
+    j = good;
+    j.method = AK_SKIN_DQS;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL); /* no scratch */
     j.scratch = (ak_u8_span){scratch, ak_skin_job_scratch_size(&j) - 1};
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
     j.scratch.count += 1;
@@ -245,8 +297,11 @@ AK_TEST(job_validate_rules) {
     /* rule 6 */
     ak_mat4 bad[2] = {ak_mat4_identity(), ak_mat4_identity()};
     bad[1].m[5] = NAN;
-    j = good; j.palette.ptr = bad; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_DATA);
-    j.skip_data_check = true; AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_DATA);
+    j = good;
+    j.palette.ptr = bad;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_DATA);
+    j.skip_data_check = true;
+    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_DATA);
 }
 
 AK_TEST(job_bad_data_codes) {
@@ -293,20 +348,26 @@ AK_TEST(job_bad_data_codes) {
     /* the standalone weight check reports the vertex */
     size_t bad_v = 99;
     w[3] = 0.8f;
-    AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 4}, (ak_f32_cspan){w, 4}, 2, 2, 2, 0.0f, &bad_v),
+    AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 4}, (ak_f32_cspan){w, 4}, 2, 2, 2, 0.0f,
+                                         &bad_v),
                 AK_ERR_BAD_WEIGHTS);
     AK_CHECK_EQ(bad_v, 1);
     w[3] = 0.75f;
     jn[0] = 5;
-    AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 4}, (ak_f32_cspan){w, 4}, 2, 2, 2, 0.0f, &bad_v),
+    AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 4}, (ak_f32_cspan){w, 4}, 2, 2, 2, 0.0f,
+                                         &bad_v),
                 AK_ERR_BAD_INDEX);
     AK_CHECK_EQ(bad_v, 0);
     jn[0] = 0;
-    AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 4}, (ak_f32_cspan){w, 4}, 2, 2, 2, 0.0f, NULL), AK_OK);
-    AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 3}, (ak_f32_cspan){w, 4}, 2, 2, 2, 0.0f, NULL),
-                AK_ERR_SPAN_SMALL);
-    AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 4}, (ak_f32_cspan){w, 4}, 2, 0, 2, 0.0f, NULL),
-                AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(
+        ak_skin_weights_validate((ak_u16_cspan){jn, 4}, (ak_f32_cspan){w, 4}, 2, 2, 2, 0.0f, NULL),
+        AK_OK);
+    AK_CHECK_EQ(
+        ak_skin_weights_validate((ak_u16_cspan){jn, 3}, (ak_f32_cspan){w, 4}, 2, 2, 2, 0.0f, NULL),
+        AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(
+        ak_skin_weights_validate((ak_u16_cspan){jn, 4}, (ak_f32_cspan){w, 4}, 2, 0, 2, 0.0f, NULL),
+        AK_ERR_BAD_ARG);
 }
 
 /* ---- LBS against the double reference ------------------------------------------------------- */
@@ -314,71 +375,139 @@ AK_TEST(job_bad_data_codes) {
 typedef struct interleaved_vertex {
     float pos[3];
     float nrm[3];
-    uint16_t joints[4];
-    float weights[4];
+    uint16_t joints[AK_MAX_INFLUENCES];
+    float weights[AK_MAX_INFLUENCES];
 } interleaved_vertex;
 
+/* every influence count the kernels specialise (1, 2, 3, 4, 8) and one they do not (5) */
+static const uint32_t k_counts[6] = {1, 2, 3, 4, 5, 8};
+
 AK_TEST(lbs_matches_double_reference) {
-    enum { N = 1003, J = 20, K = 4 };
-    ak_rng rng = ak_rng_make(11);
-    /* the palette at a 64-byte aligned address and 16 bytes past one (the AVX2 LBS kernel then
-     * works on an aligned copy: both paths must give the reference) */
-    _Alignas(64) ak_mat4 pal_storage[J + 1];
-    ak_mat4 pal_in[J];
-    for (int j = 0; j < J; ++j) pal_in[j] = rand_matrix(&rng, j % 2 == 1); /* half with scale/shear */
-    ak_mat4* pal = pal_storage;
-    interleaved_vertex* v = (interleaved_vertex*)malloc(N * sizeof *v);
-    ak_vec3* op = (ak_vec3*)malloc(N * sizeof(ak_vec3));
-    ak_vec3* on = (ak_vec3*)malloc(N * sizeof(ak_vec3));
-    for (int i = 0; i < N; ++i) {
-        ak_vec3 p = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
-        ak_vec3 n = rand_unit(&rng);
-        memcpy(v[i].pos, &p, 12);
-        memcpy(v[i].nrm, &n, 12);
-        rand_influences(&rng, K, J, v[i].joints, v[i].weights);
-    }
-    const double scale = 2.0 * sqrt(3.0) + 4.0; /* bounding size of the deformed points, roughly */
-    for (int variant = 0; variant < 8; ++variant) {
-        pal = (variant & 4) ? (ak_mat4*)(void*)((char*)pal_storage + 16) : pal_storage;
-        memcpy(pal, pal_in, sizeof pal_in);
-        ak_skin_job job = {
-            .influence_count = K,
-            .palette = {pal, J},
-            .positions = {v[0].pos, N, sizeof *v},
-            .normals = {v[0].nrm, N, sizeof *v},
-            .joints = {v[0].joints, N, sizeof *v},
-            .weights = {v[0].weights, N, sizeof *v},
-            .out_positions = {op, N, 0},
-            .out_normals = {on, N, 0},
-            .skip_simd = (variant & 1) != 0,
-            .thread_count = (variant & 2) ? 2u : 0u,
-        };
-        memset(op, 0, N * sizeof(ak_vec3));
-        AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
-        double worst_p = 0.0, worst_n = 0.0;
+    for (int kc = 0; kc < 6; ++kc) {
+        enum { N = 1003, J = 20 };
+        const uint32_t K = k_counts[kc];
+        ak_rng rng = ak_rng_make(11 + (uint64_t)K);
+        /* the palette at a 64-byte aligned address and 16 bytes past one (the AVX2 LBS kernel then
+         * works on an aligned copy: both paths must give the reference) */
+        _Alignas(64) ak_mat4 pal_storage[J + 1];
+        ak_mat4 pal_in[J];
+        for (int j = 0; j < J; ++j)
+            pal_in[j] = rand_matrix(&rng, j % 2 == 1); /* half with scale/shear */
+        ak_mat4* pal = pal_storage;
+        interleaved_vertex* v = (interleaved_vertex*)malloc(N * sizeof *v);
+        ak_vec3* op = (ak_vec3*)malloc(N * sizeof(ak_vec3));
+        ak_vec3* on = (ak_vec3*)malloc(N * sizeof(ak_vec3));
         for (int i = 0; i < N; ++i) {
-            double rp[3], rn[3];
-            ak_vec3 p, n;
-            memcpy(&p, v[i].pos, 12);
-            memcpy(&n, v[i].nrm, 12);
-            ref_lbs(pal, v[i].joints, v[i].weights, K, p, n, rp, rn);
-            double ep = fabs(rp[0] - op[i].x) + fabs(rp[1] - op[i].y) + fabs(rp[2] - op[i].z);
-            double en = fabs(rn[0] - on[i].x) + fabs(rn[1] - on[i].y) + fabs(rn[2] - on[i].z);
-            if (ep > worst_p) worst_p = ep;
-            if (en > worst_n) worst_n = en;
+            ak_vec3 p = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1),
+                                     ak_rng_range(&rng, -1, 1));
+            ak_vec3 n = rand_unit(&rng);
+            memcpy(v[i].pos, &p, 12);
+            memcpy(v[i].nrm, &n, 12);
+            rand_influences(&rng, K, J, v[i].joints, v[i].weights);
         }
-        /* float arithmetic on values of size ~4 with 4 influences: a few ulps of the scale */
-        AK_CHECK_MSG(worst_p <= 1e-5 * scale, "variant %d: position error %g", variant, worst_p);
-        AK_CHECK_MSG(worst_n <= 2e-5, "variant %d: normal error %g", variant, worst_n);
+        const double scale =
+            2.0 * sqrt(3.0) + 4.0; /* bounding size of the deformed points, roughly */
+        for (int variant = 0; variant < 8; ++variant) {
+            pal = (variant & 4) ? (ak_mat4*)(void*)((char*)pal_storage + 16) : pal_storage;
+            memcpy(pal, pal_in, sizeof pal_in);
+            ak_skin_job job = {
+                .influence_count = K,
+                .palette = {pal, J},
+                .positions = {v[0].pos, N, sizeof *v},
+                .normals = {v[0].nrm, N, sizeof *v},
+                .joints = {v[0].joints, N, sizeof *v},
+                .weights = {v[0].weights, N, sizeof *v},
+                .out_positions = {op, N, 0},
+                .out_normals = {on, N, 0},
+                .skip_simd = (variant & 1) != 0,
+                .thread_count = (variant & 2) ? 2u : 0u,
+            };
+            memset(op, 0, N * sizeof(ak_vec3));
+            AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+            double worst_p = 0.0, worst_n = 0.0;
+            for (int i = 0; i < N; ++i) {
+                double rp[3], rn[3];
+                ak_vec3 p, n;
+                memcpy(&p, v[i].pos, 12);
+                memcpy(&n, v[i].nrm, 12);
+                ref_lbs(pal, v[i].joints, v[i].weights, K, p, n, rp, rn);
+                double ep = fabs(rp[0] - op[i].x) + fabs(rp[1] - op[i].y) + fabs(rp[2] - op[i].z);
+                double en = fabs(rn[0] - on[i].x) + fabs(rn[1] - on[i].y) + fabs(rn[2] - on[i].z);
+                if (ep > worst_p) worst_p = ep;
+                if (en > worst_n) worst_n = en;
+            }
+            /* float arithmetic on values of size ~4 with 4 influences: a few ulps of the scale */
+            AK_CHECK_MSG(worst_p <= 1e-5 * scale, "K %u variant %d: position error %g", K, variant,
+                         worst_p);
+            AK_CHECK_MSG(worst_n <= 2e-5, "K %u variant %d: normal error %g", K, variant, worst_n);
+        }
+        free(v);
+        free(op);
+        free(on);
     }
-    free(v);
-    free(op);
-    free(on);
+}
+
+AK_TEST(dqs_cor_simd_matches_scalar_for_every_influence_count) {
+    /* The scalar code is checked against closed forms above (rigid single influences, distances
+     * to the joint, hemisphere flips, the cylinder); here the SIMD kernels must give the same
+     * points and normals for every influence count, rigid palettes with random rotations. */
+    enum { N = 517, J = 24 };
+    for (int kc = 0; kc < 6; ++kc) {
+        const uint32_t K = k_counts[kc];
+        ak_rng rng = ak_rng_make(77 + (uint64_t)K);
+        ak_mat4 pal[J];
+        for (int j = 0; j < J; ++j) pal[j] = rand_matrix(&rng, false);
+        ak_vec3 *pos = malloc(N * sizeof *pos), *nrm = malloc(N * sizeof *nrm),
+                *ctr = malloc(N * sizeof *ctr);
+        ak_vec3 *op[2], *on[2];
+        for (int s2 = 0; s2 < 2; ++s2)
+            op[s2] = malloc(N * sizeof(ak_vec3)), on[s2] = malloc(N * sizeof(ak_vec3));
+        uint16_t* jn = malloc(N * K * sizeof *jn);
+        float* w = malloc(N * K * sizeof *w);
+        unsigned char* scratch = malloc(64 + 192 * J);
+        for (int i = 0; i < N; ++i) {
+            pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1),
+                                  ak_rng_range(&rng, -1, 1));
+            nrm[i] = rand_unit(&rng);
+            ctr[i] = ak_vec3_scale(pos[i], 0.7f);
+            rand_influences(&rng, K, J, &jn[K * i], &w[K * i]);
+        }
+        for (int method = AK_SKIN_DQS; method <= AK_SKIN_COR; ++method) {
+            for (int simd = 0; simd < 2; ++simd) {
+                ak_skin_job job = {
+                    .method = (ak_skin_method)method,
+                    .influence_count = K,
+                    .palette = {pal, J},
+                    .positions = {pos, N, 0},
+                    .normals = {nrm, N, 0},
+                    .joints = {jn, N, 0},
+                    .weights = {w, N, 0},
+                    .cor_centers = {ctr, N, 0},
+                    .scratch = {scratch, 64 + 192 * J},
+                    .out_positions = {op[simd], N, 0},
+                    .out_normals = {on[simd], N, 0},
+                    .skip_simd = simd == 0,
+                };
+                AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+            }
+            double worst_p = 0.0, worst_n = 0.0;
+            for (int i = 0; i < N; ++i) {
+                worst_p = fmax(worst_p, ak_vec3_length(ak_vec3_sub(op[0][i], op[1][i])));
+                worst_n = fmax(worst_n, ak_vec3_length(ak_vec3_sub(on[0][i], on[1][i])));
+            }
+            /* points of size ~3, float rounding in a different order */
+            AK_CHECK_MSG(worst_p <= 1e-5 && worst_n <= 1e-5, "%s K %u: SIMD vs scalar %g / %g",
+                         method == AK_SKIN_DQS ? "DQS" : "CoR", K, worst_p, worst_n);
+        }
+        free(pos), free(nrm), free(ctr), free(jn), free(w), free(scratch);
+        for (int s2 = 0; s2 < 2; ++s2) free(op[s2]), free(on[s2]);
+    }
 }
 
 AK_TEST(lbs_tangents_and_face_normals) {
     cylinder c = cylinder_make(21, 16);
-    ak_mat4 pal[2] = {ak_mat4_identity(), rot_about(ak_vec3_make(0, 1, 0), ak_vec3_make(0, 0, 1), 1.0f)};
+    ak_mat4 pal[2] = {ak_mat4_identity(),
+                      rot_about(ak_vec3_make(0, 1, 0), ak_vec3_make(0, 0, 1), 1.0f)};
     pal[1] = ak_mat4_mul(pal[1], ak_mat4_scaling(ak_vec3_make(1.2f, 0.9f, 1.0f)));
     size_t n = c.vertex_count;
     float* tan = (float*)malloc(n * 16);
@@ -404,7 +533,8 @@ AK_TEST(lbs_tangents_and_face_normals) {
         double m[9] = {0};
         for (int e = 0; e < 2; ++e)
             for (int col = 0; col < 3; ++col)
-                for (int row = 0; row < 3; ++row) m[col * 3 + row] += (double)c.weights[2 * i + e] * pal[e].m[col * 4 + row];
+                for (int row = 0; row < 3; ++row)
+                    m[col * 3 + row] += (double)c.weights[2 * i + e] * pal[e].m[col * 4 + row];
         double t[3] = {m[3], m[4], m[5]}, l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
         for (int a = 0; a < 3; ++a) worst_t = fmax(worst_t, fabs(t[a] / l - otan[4 * i + a]));
         AK_CHECK(otan[4 * i + 3] == tan[4 * i + 3]);
@@ -413,16 +543,21 @@ AK_TEST(lbs_tangents_and_face_normals) {
     double* acc = (double*)calloc(3 * n, sizeof(double));
     for (size_t t = 0; t < c.tri_count; ++t) {
         const uint32_t* f = &c.idx[3 * t];
-        double e1[3] = {out[f[1]].x - out[f[0]].x, out[f[1]].y - out[f[0]].y, out[f[1]].z - out[f[0]].z};
-        double e2[3] = {out[f[2]].x - out[f[0]].x, out[f[2]].y - out[f[0]].y, out[f[2]].z - out[f[0]].z};
-        double cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        double e1[3] = {out[f[1]].x - out[f[0]].x, out[f[1]].y - out[f[0]].y,
+                        out[f[1]].z - out[f[0]].z};
+        double e2[3] = {out[f[2]].x - out[f[0]].x, out[f[2]].y - out[f[0]].y,
+                        out[f[2]].z - out[f[0]].z};
+        double cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                        e1[0] * e2[1] - e1[1] * e2[0]};
         for (int k = 0; k < 3; ++k)
             for (int a = 0; a < 3; ++a) acc[3 * f[k] + a] += cr[a];
     }
     for (size_t i = 0; i < n; ++i) {
-        double l = sqrt(acc[3 * i] * acc[3 * i] + acc[3 * i + 1] * acc[3 * i + 1] + acc[3 * i + 2] * acc[3 * i + 2]);
-        worst_n = fmax(worst_n, fabs(acc[3 * i] / l - outn[i].x) + fabs(acc[3 * i + 1] / l - outn[i].y) +
-                                    fabs(acc[3 * i + 2] / l - outn[i].z));
+        double l = sqrt(acc[3 * i] * acc[3 * i] + acc[3 * i + 1] * acc[3 * i + 1] +
+                        acc[3 * i + 2] * acc[3 * i + 2]);
+        worst_n =
+            fmax(worst_n, fabs(acc[3 * i] / l - outn[i].x) + fabs(acc[3 * i + 1] / l - outn[i].y) +
+                              fabs(acc[3 * i + 2] / l - outn[i].z));
     }
     AK_CHECK_MSG(worst_t < 1e-5, "tangent error %g", worst_t);
     AK_CHECK_MSG(worst_n < 1e-4, "face normal error %g", worst_n);
@@ -451,7 +586,8 @@ AK_TEST(bad_joint_indices_clamp_in_every_kernel) {
     unsigned char scratch[64 + 192 * J]; /* the largest ak_skin_job_scratch_size: CoR */
     for (uint32_t k = 3; k <= 4; ++k) {
         for (int i = 0; i < N; ++i) {
-            pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+            pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1),
+                                  ak_rng_range(&rng, -1, 1));
             nrm[i] = rand_unit(&rng);
             ctr[i] = ak_vec3_scale(pos[i], 0.5f);
             rand_influences(&rng, k, J, &jn[k * i], &w[k * i]);
@@ -500,7 +636,8 @@ AK_TEST(bad_joint_indices_clamp_in_every_kernel) {
 
 AK_TEST(job_split_matches_whole) {
     cylinder c = cylinder_make(21, 16);
-    ak_mat4 pal[2] = {ak_mat4_identity(), rot_about(ak_vec3_make(0, 1, 0), ak_vec3_make(1, 0, 0), 0.7f)};
+    ak_mat4 pal[2] = {ak_mat4_identity(),
+                      rot_about(ak_vec3_make(0, 1, 0), ak_vec3_make(1, 0, 0), 0.7f)};
     size_t n = c.vertex_count;
     ak_vec3* a = (ak_vec3*)malloc(n * sizeof(ak_vec3));
     ak_vec3* b = (ak_vec3*)malloc(n * sizeof(ak_vec3));
@@ -521,18 +658,21 @@ AK_TEST(job_split_matches_whole) {
     cylinder_free(&c);
 }
 
-/* ---- DQS -------------------------------------------------------------------------------------- */
+/* ---- DQS --------------------------------------------------------------------------------------
+ */
 
 AK_TEST(dqs_single_influence_is_rigid) {
     enum { N = 37, J = 5 };
     ak_rng rng = ak_rng_make(3);
     ak_mat4 pal[J];
-    for (int j = 0; j < J; ++j) pal[j] = rand_matrix(&rng, j == 4); /* joint 4 carries scale/shear */
+    for (int j = 0; j < J; ++j)
+        pal[j] = rand_matrix(&rng, j == 4); /* joint 4 carries scale/shear */
     ak_vec3 pos[N], nrm[N], out[N], outn[N];
     uint16_t jn[N];
     float w[N];
     for (int i = 0; i < N; ++i) {
-        pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+        pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1),
+                              ak_rng_range(&rng, -1, 1));
         nrm[i] = rand_unit(&rng);
         jn[i] = (uint16_t)(i % J);
         w[i] = 1.0f;
@@ -557,8 +697,10 @@ AK_TEST(dqs_single_influence_is_rigid) {
         for (int i = 0; i < N; ++i) {
             double rp[3], rn[3];
             ref_lbs(pal, &jn[i], &w[i], 1, pos[i], nrm[i], rp, rn);
-            worst = fmax(worst, fabs(rp[0] - out[i].x) + fabs(rp[1] - out[i].y) + fabs(rp[2] - out[i].z));
-            worst_n = fmax(worst_n, fabs(rn[0] - outn[i].x) + fabs(rn[1] - outn[i].y) + fabs(rn[2] - outn[i].z));
+            worst = fmax(worst,
+                         fabs(rp[0] - out[i].x) + fabs(rp[1] - out[i].y) + fabs(rp[2] - out[i].z));
+            worst_n = fmax(worst_n, fabs(rn[0] - outn[i].x) + fabs(rn[1] - outn[i].y) +
+                                        fabs(rn[2] - outn[i].z));
         }
         /* M p with one matrix: equal up to float rounding of a rotation and translation */
         AK_CHECK_MSG(worst < 2e-5, "variant %d: %g", variant, worst);
@@ -601,16 +743,19 @@ AK_TEST(dqs_rigid_blend_keeps_distance_to_joint) {
         AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
         double worst = 0.0;
         for (int i = 0; i < N; ++i)
-            worst = fmax(worst, fabs(ak_vec3_distance(out[i], pw) - ak_vec3_distance(pos[i], pivot)));
-        AK_CHECK_MSG(worst < 1e-5, "variant %d: distance to the joint changes by %g", variant, worst);
+            worst =
+                fmax(worst, fabs(ak_vec3_distance(out[i], pw) - ak_vec3_distance(pos[i], pivot)));
+        AK_CHECK_MSG(worst < 1e-5, "variant %d: distance to the joint changes by %g", variant,
+                     worst);
     }
 }
 
 AK_TEST(dqs_hemisphere_flip) {
     /* +170 and -170 degrees about Z: their quaternions (w >= 0) have dot cos(170) < 0, nearly
      * antipodal. Aligned blending gives the 180 degree midpoint; unaligned would give ~0. */
-    ak_mat4 pal[2] = {ak_mat4_from_quat(ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), ak_radians(170.0f))),
-                      ak_mat4_from_quat(ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), ak_radians(-170.0f)))};
+    ak_mat4 pal[2] = {
+        ak_mat4_from_quat(ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), ak_radians(170.0f))),
+        ak_mat4_from_quat(ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), ak_radians(-170.0f)))};
     ak_vec3 pos[9], out[9];
     uint16_t jn[18];
     float w[18];
@@ -664,7 +809,8 @@ AK_TEST(dqs_hemisphere_flip) {
     };
     AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
     /* reference: normalised blend 0.25 q(160) + 0.75 q(200) (the 200 degree form of -160) */
-    ak_quat qa = ak_quat_from_axis_angle(axis, ak_radians(160.0f)), qb = ak_quat_from_axis_angle(axis, ak_radians(200.0f));
+    ak_quat qa = ak_quat_from_axis_angle(axis, ak_radians(160.0f)),
+            qb = ak_quat_from_axis_angle(axis, ak_radians(200.0f));
     ak_quat qr = ak_quat_normalize(ak_quat_add(ak_quat_scale(qa, 0.25f), ak_quat_scale(qb, 0.75f)));
     ak_vec3 e = ak_quat_rotate(qr, p2);
     AK_CHECK_NEAR(o2.x, e.x, 1e-5);
@@ -682,7 +828,8 @@ AK_TEST(cor_pruned_equals_naive) {
     float* w = (float*)malloc(n * 3 * sizeof(float));
     for (size_t i = 0; i < n; ++i) {
         float y = c.pos[i].y, z = c.pos[i].z;
-        float a = smoothstep01((y - 0.4f) / 0.8f), b = smoothstep01((z + 0.1f) / 0.2f) * smoothstep01((y - 1.0f) / 0.6f);
+        float a = smoothstep01((y - 0.4f) / 0.8f),
+              b = smoothstep01((z + 0.1f) / 0.2f) * smoothstep01((y - 1.0f) / 0.6f);
         float w0 = 1.0f - a, w1 = a * (1.0f - b), w2 = a * b;
         jn[3 * i] = 0;
         jn[3 * i + 1] = 1;
@@ -726,7 +873,8 @@ AK_TEST(cor_pruned_equals_naive) {
     w[4] = -0.1f;
     AK_CHECK_EQ(ak_skin_cor_centers_compute(&d, NULL, (ak_vec3_span){one, n}), AK_ERR_BAD_WEIGHTS);
     w[4] = 0.0f;
-    AK_CHECK_EQ(ak_skin_cor_centers_compute(&d, NULL, (ak_vec3_span){one, n - 1}), AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_skin_cor_centers_compute(&d, NULL, (ak_vec3_span){one, n - 1}),
+                AK_ERR_SPAN_SMALL);
     d.influence_count = 0;
     AK_CHECK_EQ(ak_skin_cor_centers_compute(&d, NULL, (ak_vec3_span){one, n}), AK_ERR_BAD_ARG);
     AK_CHECK_EQ(ak_skin_cor_centers_compute(NULL, NULL, (ak_vec3_span){one, n}), AK_ERR_NULL_ARG);
@@ -754,7 +902,8 @@ AK_TEST(cor_center_in_joint_region_and_cache) {
      * around y = 1, so the center lies on the axis at the joint */
     for (int s = 0; s < 32; ++s) {
         ak_vec3 p = ctr[20 * 32 + s];
-        AK_CHECK_MSG(fabsf(p.x) < 0.01f * CYL_RADIUS && fabsf(p.z) < 0.01f * CYL_RADIUS && fabsf(p.y - 1.0f) < 0.02f,
+        AK_CHECK_MSG(fabsf(p.x) < 0.01f * CYL_RADIUS && fabsf(p.z) < 0.01f * CYL_RADIUS &&
+                         fabsf(p.y - 1.0f) < 0.02f,
                      "center %d = (%g, %g, %g)", s, p.x, p.y, p.z);
     }
     /* rigid vertices keep their own position */
@@ -768,27 +917,35 @@ AK_TEST(cor_center_in_joint_region_and_cache) {
     ak_vec3* back = (ak_vec3*)malloc(n * sizeof(ak_vec3));
     AK_CHECK_EQ(ak_skin_cor_centers_read_file(path, key, (ak_vec3_span){back, n}), AK_OK);
     AK_CHECK(memcmp(back, ctr, n * sizeof(ak_vec3)) == 0);
-    AK_CHECK_EQ(ak_skin_cor_centers_read_file(path, key ^ 1u, (ak_vec3_span){back, n}), AK_ERR_NOT_FOUND);
-    AK_CHECK_EQ(ak_skin_cor_centers_read_file("no/such/file.akcr", key, (ak_vec3_span){back, n}), AK_ERR_IO);
+    AK_CHECK_EQ(ak_skin_cor_centers_read_file(path, key ^ 1u, (ak_vec3_span){back, n}),
+                AK_ERR_NOT_FOUND);
+    AK_CHECK_EQ(ak_skin_cor_centers_read_file("no/such/file.akcr", key, (ak_vec3_span){back, n}),
+                AK_ERR_IO);
     bool from_cache = false;
     memset(back, 0, n * sizeof(ak_vec3));
-    AK_CHECK_EQ(ak_skin_cor_centers_cached(&d, path, NULL, (ak_vec3_span){back, n}, &from_cache), AK_OK);
+    AK_CHECK_EQ(ak_skin_cor_centers_cached(&d, path, NULL, (ak_vec3_span){back, n}, &from_cache),
+                AK_OK);
     AK_CHECK(from_cache);
     AK_CHECK(memcmp(back, ctr, n * sizeof(ak_vec3)) == 0);
     c.weights[2 * 300] += 0.0f; /* unchanged data: same key */
     AK_CHECK(ak_skin_cor_key(&d) == key);
     c.pos[5].x += 1e-3f; /* changed mesh: the key changes, cache is recomputed */
     AK_CHECK(ak_skin_cor_key(&d) != key);
-    AK_CHECK_EQ(ak_skin_cor_centers_cached(&d, path, NULL, (ak_vec3_span){back, n}, &from_cache), AK_OK);
+    AK_CHECK_EQ(ak_skin_cor_centers_cached(&d, path, NULL, (ak_vec3_span){back, n}, &from_cache),
+                AK_OK);
     AK_CHECK(!from_cache);
     remove(path);
     /* truncated buffers are parse errors at every length */
     size_t size = ak_skin_cor_centers_encoded_size(n);
     unsigned char* buf = (unsigned char*)malloc(size);
-    AK_CHECK_EQ(ak_skin_cor_centers_encode((ak_vec3_cspan){ctr, n}, key, (ak_u8_span){buf, size}, NULL), AK_OK);
+    AK_CHECK_EQ(
+        ak_skin_cor_centers_encode((ak_vec3_cspan){ctr, n}, key, (ak_u8_span){buf, size}, NULL),
+        AK_OK);
     int wrong = 0;
     for (size_t len = 0; len < size; len += 7)
-        if (ak_skin_cor_centers_decode((ak_u8_cspan){buf, len}, key, (ak_vec3_span){back, n}) != AK_ERR_PARSE) ++wrong;
+        if (ak_skin_cor_centers_decode((ak_u8_cspan){buf, len}, key, (ak_vec3_span){back, n}) !=
+            AK_ERR_PARSE)
+            ++wrong;
     AK_CHECK_EQ(wrong, 0);
     free(buf);
     free(back);
@@ -796,7 +953,8 @@ AK_TEST(cor_center_in_joint_region_and_cache) {
     cylinder_free(&c);
 }
 
-/* ---- quality on the cylinder ------------------------------------------------------------------ */
+/* ---- quality on the cylinder ------------------------------------------------------------------
+ */
 
 typedef struct quality {
     double volume_ratio; /* deformed / rest */
@@ -811,8 +969,10 @@ static double seg_dist(ak_vec3 p, ak_vec3 a, ak_vec3 b) {
 
 static quality measure(const cylinder* c, const ak_vec3* out, const ak_mat4* pal) {
     quality q;
-    q.volume_ratio = vol_closed(out, c->idx, c->tri_count) / vol_closed(c->pos, c->idx, c->tri_count);
-    ak_vec3 j0 = ak_vec3_make(0, 0, 0), j1 = ak_vec3_make(0, 1, 0), j2 = ak_mat4_transform_point(pal[1], ak_vec3_make(0, 2, 0));
+    q.volume_ratio =
+        vol_closed(out, c->idx, c->tri_count) / vol_closed(c->pos, c->idx, c->tri_count);
+    ak_vec3 j0 = ak_vec3_make(0, 0, 0), j1 = ak_vec3_make(0, 1, 0),
+            j2 = ak_mat4_transform_point(pal[1], ak_vec3_make(0, 2, 0));
     q.bulge = 0.0;
     for (size_t i = 0; i + 2 < c->vertex_count; ++i) { /* skip the two cap centers */
         double d = fmin(seg_dist(out[i], j0, j1), seg_dist(out[i], j1, j2)) - CYL_RADIUS;
@@ -840,18 +1000,22 @@ AK_TEST(quality_ordering_bend_and_twist) {
         const char* name;
         ak_vec3 axis;
         float degrees;
-    } poses[3] = {{"bend 90", {0, 0, 1}, 90.0f}, {"twist 90", {0, 1, 0}, 90.0f}, {"twist 180", {0, 1, 0}, 180.0f}};
+    } poses[3] = {{"bend 90", {0, 0, 1}, 90.0f},
+                  {"twist 90", {0, 1, 0}, 90.0f},
+                  {"twist 180", {0, 1, 0}, 180.0f}};
     quality q[3][3];
     for (int p = 0; p < 3; ++p) {
-        ak_mat4 pal[2] = {ak_mat4_identity(), rot_about(pivot, poses[p].axis, ak_radians(poses[p].degrees))};
+        ak_mat4 pal[2] = {ak_mat4_identity(),
+                          rot_about(pivot, poses[p].axis, ak_radians(poses[p].degrees))};
         for (int m = 0; m < 3; ++m) {
-            ak_skin_job job = cylinder_job(&c, (ak_skin_method)m, pal, out, ctr, scratch, sizeof scratch);
+            ak_skin_job job =
+                cylinder_job(&c, (ak_skin_method)m, pal, out, ctr, scratch, sizeof scratch);
             AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
             q[p][m] = measure(&c, out, pal);
         }
-        printf("  %-9s volume LBS %.4f DQS %.4f CoR %.4f | bulge LBS %.4f DQS %.4f CoR %.4f\n", poses[p].name,
-               q[p][0].volume_ratio, q[p][1].volume_ratio, q[p][2].volume_ratio, q[p][0].bulge, q[p][1].bulge,
-               q[p][2].bulge);
+        printf("  %-9s volume LBS %.4f DQS %.4f CoR %.4f | bulge LBS %.4f DQS %.4f CoR %.4f\n",
+               poses[p].name, q[p][0].volume_ratio, q[p][1].volume_ratio, q[p][2].volume_ratio,
+               q[p][0].bulge, q[p][1].bulge, q[p][2].bulge);
     }
     /* Twist 180: LBS averages I and a half turn, so the middle ring collapses onto the axis
      * (candy wrapper). Over the 0.6-long blend zone of a 2-long cylinder the analytic loss is
@@ -867,7 +1031,7 @@ AK_TEST(quality_ordering_bend_and_twist) {
      * bulges on the outside of the bend, CoR keeps the volume with less bulge than DQS. */
     AK_CHECK(q[0][0].volume_ratio < q[0][1].volume_ratio);
     AK_CHECK(fabs(q[0][2].volume_ratio - 1.0) < 0.05);
-    AK_CHECK(q[0][1].bulge > 0.02 * CYL_RADIUS);  /* DQS bulge is real, not rounding */
+    AK_CHECK(q[0][1].bulge > 0.02 * CYL_RADIUS);    /* DQS bulge is real, not rounding */
     AK_CHECK(q[0][2].bulge < 0.75 * q[0][1].bulge); /* CoR: clearly less bulge than DQS */
     /* scalar and SIMD agree on the CoR result */
     ak_mat4 pal[2] = {ak_mat4_identity(), rot_about(pivot, poses[0].axis, ak_radians(90.0f))};
@@ -901,8 +1065,8 @@ typedef struct voxel_shape {
 #define VH 0.025f
 static bool pants_solid(int x, int y, int z) {
     if (x < 0 || y < 0 || z < 0 || x >= VX || y >= VY || z >= VZ) return false;
-    if (y >= 32) return true;   /* pelvis: y in [0.8, 1.0] */
-    return x < 8 || x >= 12;    /* legs: x in [-0.25, -0.05] and [0.05, 0.25] */
+    if (y >= 32) return true; /* pelvis: y in [0.8, 1.0] */
+    return x < 8 || x >= 12;  /* legs: x in [-0.25, -0.05] and [0.05, 0.25] */
 }
 
 static voxel_shape pants_make(void) {
@@ -935,8 +1099,9 @@ static voxel_shape pants_make(void) {
                             int gi = (g[0] * gy + g[1]) * gz + g[2];
                             if (map[gi] < 0) {
                                 map[gi] = (int32_t)s.vertex_count;
-                                s.pos[s.vertex_count++] = ak_vec3_make(-0.25f + VH * (float)g[0], VH * (float)g[1],
-                                                                       -0.1f + VH * (float)g[2]);
+                                s.pos[s.vertex_count++] =
+                                    ak_vec3_make(-0.25f + VH * (float)g[0], VH * (float)g[1],
+                                                 -0.1f + VH * (float)g[2]);
                             }
                             q[k] = (uint32_t)map[gi];
                         }
@@ -956,15 +1121,17 @@ static voxel_shape pants_make(void) {
 
 AK_TEST(heat_weights_do_not_bleed_between_legs) {
     voxel_shape s = pants_make();
-    /* the surface is closed and consistently oriented: positive volume = 0.5*0.2*0.2 + 2*0.2*0.2*0.8 */
-    AK_CHECK_NEAR(vol_closed(s.pos, s.idx, s.tri_count), 0.5 * 0.2 * 0.2 + 2 * 0.2 * 0.2 * 0.8, 1e-5);
-    ak_vec3 joints[7] = {{0, 0.9f, 0},      {-0.15f, 0.8f, 0}, {-0.15f, 0.4f, 0}, {-0.15f, 0.05f, 0},
+    /* the surface is closed and consistently oriented: positive volume = 0.5*0.2*0.2 +
+     * 2*0.2*0.2*0.8 */
+    AK_CHECK_NEAR(vol_closed(s.pos, s.idx, s.tri_count), 0.5 * 0.2 * 0.2 + 2 * 0.2 * 0.2 * 0.8,
+                  1e-5);
+    ak_vec3 joints[7] = {{0, 0.9f, 0},     {-0.15f, 0.8f, 0}, {-0.15f, 0.4f, 0}, {-0.15f, 0.05f, 0},
                          {0.15f, 0.8f, 0}, {0.15f, 0.4f, 0},  {0.15f, 0.05f, 0}};
     int16_t parents[7] = {-1, 0, 1, 2, 0, 4, 5};
     ak_skin_bone bones[14];
     size_t bone_count = 0;
-    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){joints, 7}, (ak_i16_cspan){parents, 7}, false,
-                                          (ak_skin_bone_span){bones, 14}, &bone_count),
+    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){joints, 7}, (ak_i16_cspan){parents, 7},
+                                          false, (ak_skin_bone_span){bones, 14}, &bone_count),
                 AK_OK);
     AK_CHECK_EQ(bone_count, 8); /* pelvis->2 hips, hip->knee, knee->ankle, two point ankles */
     const uint32_t k = 4;
@@ -983,7 +1150,8 @@ AK_TEST(heat_weights_do_not_bleed_between_legs) {
                                             (ak_f32_span){w, s.vertex_count * k}),
                     AK_OK);
         AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, s.vertex_count * k},
-                                             (ak_f32_cspan){w, s.vertex_count * k}, s.vertex_count, k, 7, 1e-6f, NULL),
+                                             (ak_f32_cspan){w, s.vertex_count * k}, s.vertex_count,
+                                             k, 7, 1e-6f, NULL),
                     AK_OK);
         for (size_t v = 0; v < s.vertex_count; ++v) {
             /* The left leg: left of the gap and at least one leg width (0.2) below the crotch
@@ -997,7 +1165,8 @@ AK_TEST(heat_weights_do_not_bleed_between_legs) {
             worst[method] = fmax(worst[method], right);
         }
     }
-    printf("  largest right-leg weight on the left leg: heat %.2e, inverse distance %.3f\n", worst[0], worst[1]);
+    printf("  largest right-leg weight on the left leg: heat %.2e, inverse distance %.3f\n",
+           worst[0], worst[1]);
     AK_CHECK(worst[0] < 0.01);
     AK_CHECK(worst[1] > 0.01); /* inverse distance bleeds across the gap */
     free(jn);
@@ -1017,11 +1186,16 @@ AK_TEST(distance_weights_stray_far_vertex) {
         ak_vec3 pos[3] = {{1, 0, 0}, {far[f], 0, 0}, {2, 0, 0}};
         uint16_t jn[3 * 2];
         float w[3 * 2];
-        ak_weights_desc d = {.method = AK_WEIGHTS_DISTANCE, .positions = {pos, 3}, .bones = {bones, 2}, .max_influences = 2};
-        AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 6}, (ak_f32_span){w, 6}), AK_OK);
+        ak_weights_desc d = {.method = AK_WEIGHTS_DISTANCE,
+                             .positions = {pos, 3},
+                             .bones = {bones, 2},
+                             .max_influences = 2};
+        AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 6}, (ak_f32_span){w, 6}),
+                    AK_OK);
         AK_CHECK_EQ(jn[0], 0);
         AK_CHECK_MSG(fabs(w[0] - 16.0 / 17.0) < 1e-6 && fabs(w[1] - 1.0 / 17.0) < 1e-6,
-                     "stray vertex at %g: weights %g %g, want 16/17 1/17", (double)far[f], (double)w[0], (double)w[1]);
+                     "stray vertex at %g: weights %g %g, want 16/17 1/17", (double)far[f],
+                     (double)w[0], (double)w[1]);
         AK_CHECK_EQ(jn[4], 1);
         AK_CHECK_NEAR(w[4], 16.0 / 17.0, 1e-6);
         /* the far vertex itself: finite, sums to 1 */
@@ -1041,7 +1215,8 @@ AK_TEST(distance_weights_closed_forms_and_robustness) {
         .bones = {bones, 2},
         .max_influences = 2,
     };
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 10}, (ak_f32_span){w, 10}), AK_OK);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 10}, (ak_f32_span){w, 10}),
+                AK_OK);
     /* d = 1 and 2, n = 4: w = 16/17 and 1/17 */
     AK_CHECK_EQ(jn[0], 0);
     AK_CHECK_NEAR(w[0], 16.0 / 17.0, 1e-6);
@@ -1060,11 +1235,13 @@ AK_TEST(distance_weights_closed_forms_and_robustness) {
     AK_CHECK_NEAR(w[6], 0.5, 1e-3);
     /* power 2: 4/5 and 1/5 */
     d.distance_power = 2.0f;
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 10}, (ak_f32_span){w, 10}), AK_OK);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 10}, (ak_f32_span){w, 10}),
+                AK_OK);
     AK_CHECK_NEAR(w[0], 0.8, 1e-6);
     /* k = 1 keeps the nearest only; defaults */
     d.max_influences = 1;
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}), AK_OK);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}),
+                AK_OK);
     AK_CHECK(w[0] == 1.0f && jn[0] == 0);
     ak_weights_desc r = ak_weights_desc_resolved(&(ak_weights_desc){0});
     AK_CHECK_EQ(r.max_influences, 4);
@@ -1072,18 +1249,24 @@ AK_TEST(distance_weights_closed_forms_and_robustness) {
     AK_CHECK_NEAR(r.min_weight, 0.001, 1e-9);
     AK_CHECK_EQ(r.method, AK_WEIGHTS_HEAT);
     /* bad input */
-    AK_CHECK_EQ(ak_skin_weights_compute(NULL, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}), AK_ERR_NULL_ARG);
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 4}, (ak_f32_span){w, 5}), AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_skin_weights_compute(NULL, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}),
+                AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 4}, (ak_f32_span){w, 5}),
+                AK_ERR_SPAN_SMALL);
     pos[2].y = NAN;
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}), AK_ERR_BAD_DATA);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}),
+                AK_ERR_BAD_DATA);
     pos[2].y = 0.0f;
     d.method = AK_WEIGHTS_HEAT; /* needs triangles */
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}), AK_ERR_EMPTY);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}),
+                AK_ERR_EMPTY);
     uint32_t tri[3] = {0, 1, 7};
     d.indices = (ak_u32_cspan){tri, 3};
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}), AK_ERR_BAD_INDEX);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}),
+                AK_ERR_BAD_INDEX);
     d.max_influences = 9;
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 5}, (ak_f32_span){w, 5}),
+                AK_ERR_BAD_ARG);
 }
 
 AK_TEST(heat_weights_ignore_a_stray_far_vertex) {
@@ -1099,12 +1282,16 @@ AK_TEST(heat_weights_ignore_a_stray_far_vertex) {
     float* w = (float*)malloc(2 * (n + 1) * 4 * sizeof(float));
     memcpy(pos, c.pos, n * sizeof(ak_vec3));
     pos[n] = ak_vec3_make(1e9f, 0.0f, 0.0f);
-    ak_weights_desc d = {.positions = {pos, n}, .indices = {c.idx, 3 * c.tri_count}, .bones = {bones, 2}};
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 4 * n}, (ak_f32_span){w, 4 * n}), AK_OK);
+    ak_weights_desc d = {
+        .positions = {pos, n}, .indices = {c.idx, 3 * c.tri_count}, .bones = {bones, 2}};
+    AK_CHECK_EQ(
+        ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 4 * n}, (ak_f32_span){w, 4 * n}),
+        AK_OK);
     d.positions.count = n + 1;
     uint16_t* jn2 = jn + 4 * (n + 1);
     float* w2 = w + 4 * (n + 1);
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn2, 4 * (n + 1)}, (ak_f32_span){w2, 4 * (n + 1)}),
+    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn2, 4 * (n + 1)},
+                                        (ak_f32_span){w2, 4 * (n + 1)}),
                 AK_OK);
     double worst = 0.0;
     for (size_t v = 0; v < n; ++v) {
@@ -1130,8 +1317,11 @@ AK_TEST(heat_weights_on_cylinder_are_smooth_and_normalized) {
     size_t n = c.vertex_count;
     uint16_t* jn = (uint16_t*)malloc(n * 4 * sizeof(uint16_t));
     float* w = (float*)malloc(n * 4 * sizeof(float));
-    ak_weights_desc d = {.positions = {c.pos, n}, .indices = {c.idx, 3 * c.tri_count}, .bones = {bones, 2}};
-    AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 4 * n}, (ak_f32_span){w, 4 * n}), AK_OK);
+    ak_weights_desc d = {
+        .positions = {c.pos, n}, .indices = {c.idx, 3 * c.tri_count}, .bones = {bones, 2}};
+    AK_CHECK_EQ(
+        ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 4 * n}, (ak_f32_span){w, 4 * n}),
+        AK_OK);
     double worst_sum = 0.0;
     for (size_t v = 0; v < n; ++v) {
         double s = 0.0;
@@ -1142,7 +1332,8 @@ AK_TEST(heat_weights_on_cylinder_are_smooth_and_normalized) {
         worst_sum = fmax(worst_sum, fabs(s - 1.0));
     }
     AK_CHECK(worst_sum <= 1e-6);
-    /* far ends are rigid, the joint ring is shared roughly evenly, weight of joint 1 grows with y */
+    /* far ends are rigid, the joint ring is shared roughly evenly, weight of joint 1 grows with y
+     */
     AK_CHECK(jn[0] == 0 && w[0] > 0.99f);
     AK_CHECK(jn[4 * (40 * 16)] == 1 && w[4 * (40 * 16)] > 0.99f);
     float w1_mid = 0.0f;
@@ -1157,7 +1348,8 @@ AK_TEST(heat_weights_on_cylinder_are_smooth_and_normalized) {
 AK_TEST(heat_weights_degenerate_input) {
     /* a tetrahedron plus: an isolated vertex, a zero-area triangle, a duplicate vertex, a vertex
      * exactly on a bone, and a zero-length (point) bone far away */
-    ak_vec3 pos[7] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {5, 5, 5}, {1, 0, 0}, {0.25f, 0.25f, 0.25f}};
+    ak_vec3 pos[7] = {
+        {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {5, 5, 5}, {1, 0, 0}, {0.25f, 0.25f, 0.25f}};
     uint32_t idx[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3, 1, 5, 1, 6, 6, 6};
     ak_skin_bone bones[3] = {{{0.1f, 0.1f, 0.1f}, {0.3f, 0.3f, 0.3f}, 0},
                              {{0.25f, 0.25f, 0.25f}, {0.25f, 0.25f, 0.6f}, 1},
@@ -1173,8 +1365,11 @@ AK_TEST(heat_weights_degenerate_input) {
                 .bones = {bones, 3},
                 .skip_visibility = vis == 1,
             };
-            AK_CHECK_EQ(ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 28}, (ak_f32_span){w, 28}), AK_OK);
-            AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 28}, (ak_f32_cspan){w, 28}, 7, 4, 3, 1e-6f, NULL),
+            AK_CHECK_EQ(
+                ak_skin_weights_compute(&d, NULL, (ak_u16_span){jn, 28}, (ak_f32_span){w, 28}),
+                AK_OK);
+            AK_CHECK_EQ(ak_skin_weights_validate((ak_u16_cspan){jn, 28}, (ak_f32_cspan){w, 28}, 7,
+                                                 4, 3, 1e-6f, NULL),
                         AK_OK);
             /* heat: the isolated vertex takes its nearest bone (the point at (9, 9, 9)) fully;
              * distance: it blends, the nearest first */
@@ -1202,14 +1397,15 @@ AK_TEST(weights_format_round_trip) {
     uint32_t k = 0;
     AK_CHECK_EQ(ak_skin_weights_decode_info((ak_u8_cspan){buf, size}, &vc, &k, NULL), AK_OK);
     AK_CHECK(vc == N && k == K);
-    AK_CHECK_EQ(ak_skin_weights_decode((ak_u8_cspan){buf, size}, (ak_u16_span){jb, N * K}, (ak_f32_span){wb, N * K}, NULL),
+    AK_CHECK_EQ(ak_skin_weights_decode((ak_u8_cspan){buf, size}, (ak_u16_span){jb, N * K},
+                                       (ak_f32_span){wb, N * K}, NULL),
                 AK_OK);
     AK_CHECK(memcmp(jb, jn, sizeof jn) == 0 && memcmp(wb, w, sizeof w) == 0);
     int wrong = 0;
     ak_diag diag;
     for (size_t len = 0; len < size; ++len)
-        if (ak_skin_weights_decode((ak_u8_cspan){buf, len}, (ak_u16_span){jb, N * K}, (ak_f32_span){wb, N * K}, &diag) !=
-            AK_ERR_PARSE)
+        if (ak_skin_weights_decode((ak_u8_cspan){buf, len}, (ak_u16_span){jb, N * K},
+                                   (ak_f32_span){wb, N * K}, &diag) != AK_ERR_PARSE)
             ++wrong;
     AK_CHECK_EQ(wrong, 0);
     AK_CHECK(diag.message[0] != 0);
@@ -1217,16 +1413,23 @@ AK_TEST(weights_format_round_trip) {
     AK_CHECK_EQ(ak_skin_weights_decode_info((ak_u8_cspan){buf, size}, &vc, &k, NULL), AK_ERR_PARSE);
     buf[4] = 1;
     const char* path = "test_skin_weights.akwt";
-    AK_CHECK_EQ(ak_skin_weights_write_file(path, (ak_u16_cspan){jn, N * K}, (ak_f32_cspan){w, N * K}, N, K), AK_OK);
+    AK_CHECK_EQ(
+        ak_skin_weights_write_file(path, (ak_u16_cspan){jn, N * K}, (ak_f32_cspan){w, N * K}, N, K),
+        AK_OK);
     AK_CHECK_EQ(ak_skin_weights_read_file_info(path, &vc, &k, NULL), AK_OK);
     AK_CHECK(vc == N && k == K);
     memset(wb, 0, sizeof wb);
-    AK_CHECK_EQ(ak_skin_weights_read_file(path, (ak_u16_span){jb, N * K}, (ak_f32_span){wb, N * K}, NULL), AK_OK);
+    AK_CHECK_EQ(
+        ak_skin_weights_read_file(path, (ak_u16_span){jb, N * K}, (ak_f32_span){wb, N * K}, NULL),
+        AK_OK);
     AK_CHECK(memcmp(wb, w, sizeof w) == 0);
-    AK_CHECK_EQ(ak_skin_weights_read_file(path, (ak_u16_span){jb, N * K - 1}, (ak_f32_span){wb, N * K}, NULL),
+    AK_CHECK_EQ(ak_skin_weights_read_file(path, (ak_u16_span){jb, N * K - 1},
+                                          (ak_f32_span){wb, N * K}, NULL),
                 AK_ERR_SPAN_SMALL);
     remove(path);
-    AK_CHECK_EQ(ak_skin_weights_read_file(path, (ak_u16_span){jb, N * K}, (ak_f32_span){wb, N * K}, NULL), AK_ERR_IO);
+    AK_CHECK_EQ(
+        ak_skin_weights_read_file(path, (ak_u16_span){jb, N * K}, (ak_f32_span){wb, N * K}, NULL),
+        AK_ERR_IO);
     free(buf);
 }
 
@@ -1261,6 +1464,7 @@ int main(void) {
     AK_RUN(job_validate_rules);
     AK_RUN(job_bad_data_codes);
     AK_RUN(lbs_matches_double_reference);
+    AK_RUN(dqs_cor_simd_matches_scalar_for_every_influence_count);
     AK_RUN(lbs_tangents_and_face_normals);
     AK_RUN(bad_joint_indices_clamp_in_every_kernel);
     AK_RUN(job_split_matches_whole);
