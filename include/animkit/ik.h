@@ -7,8 +7,8 @@
  * blend weight), and damped least squares (Jacobian, Levenberg-Marquardt adaptive damping,
  * position and optional orientation targets). FABRIK also solves trees with several end
  * effectors (sub-bases, as in the paper). The two-bone solver also comes as a batch
- * (ak_ik_two_bone_run_many: many limbs per call, four at a time in SIMD registers). Every chain solver honours the skeleton's joint
- * types and limits (each changed rotation or slide is clamped as ak_skeleton_limit_joint
+ * (ak_ik_two_bone_run_many: many limbs per call, four at a time in SIMD registers). Every
+ * chain solver honours the skeleton's joint types and limits (each changed rotation or slide is clamped as ak_skeleton_limit_joint
  * does; a rotating joint's translation is left as the pose has it) and reports whether the
  * target was reached, the remaining distance and the iterations used.
  *

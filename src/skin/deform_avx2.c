@@ -496,6 +496,10 @@ AKP_DQ_BLOCK_LOOP(block_cor, (uint32_t)(c->palette_count * sizeof(akp_skin_joint
 bool akp_skin_range_avx2(const akp_skin_ctx* c, size_t begin, size_t end) {
     if (c->do_tangents || !akp_skin_have_avx2()) return false;
     if (c->method != AK_SKIN_LBS && c->any_stretch) return false;
+    /* DQS/CoR address their per-joint records with 32-bit offsets (CoR: past the whole
+     * table); joint indices are 16-bit, so only absurd palettes get here, and take the
+     * scalar code */
+    if (c->method != AK_SKIN_LBS && c->palette_count > 65536u) return false;
     size_t blocks_end = begin + ((end - begin) & ~(size_t)7u);
     if (blocks_end > begin) {
         if (c->method == AK_SKIN_LBS) block_lbs_range(c, begin, blocks_end);
