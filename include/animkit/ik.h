@@ -8,9 +8,10 @@
  * position and optional orientation targets). FABRIK also solves trees with several end
  * effectors (sub-bases, as in the paper). The two-bone solver also comes as a batch
  * (ak_ik_two_bone_run_many: many limbs per call, four at a time in SIMD registers). Every
- * chain solver honours the skeleton's joint types and limits (each changed rotation or slide is clamped as ak_skeleton_limit_joint
- * does; a rotating joint's translation is left as the pose has it) and reports whether the
- * target was reached, the remaining distance and the iterations used.
+ * chain solver honours the skeleton's joint types and limits (each changed rotation or slide
+ * is clamped as ak_skeleton_limit_joint does; a rotating joint's translation is left as the
+ * pose has it) and reports whether the target was reached, the remaining distance and the
+ * iterations used.
  *
  * What it does NOT do: forward kinematics for the caller (skeleton.h), animation blending,
  * collision avoidance, or move the chain root: the root joint's position is fixed, it only
