@@ -195,6 +195,14 @@ static ak_skin_job cylinder_job(const cylinder* c, ak_skin_method method, const 
 
 /* ---- validation ------------------------------------------------------------------------------ */
 
+/* j = good with one edit, then the code validate must return */
+#define EXPECT_JOB(code, ...)                                                                  \
+    do {                                                                                       \
+        j = good;                                                                              \
+        __VA_ARGS__;                                                                           \
+        AK_CHECK_EQ(ak_skin_job_validate(&j), code);                                           \
+    } while (0)
+
 AK_TEST(job_validate_rules) {
     ak_skin_job zero;
     memset(&zero, 0, sizeof zero);
@@ -220,44 +228,20 @@ AK_TEST(job_validate_rules) {
     AK_CHECK_EQ(ak_skin_job_validate(&good), AK_OK);
     ak_skin_job j;
     /* rule 1 */
-    j = good;
-    j.positions.ptr = NULL;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good;
-    j.palette.ptr = NULL;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good;
-    j.joints.ptr = NULL;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good;
-    j.weights.ptr = NULL;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
-    j = good;
-    j.out_positions.ptr = NULL;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    EXPECT_JOB(AK_ERR_NULL_ARG, j.positions.ptr = NULL);
+    EXPECT_JOB(AK_ERR_NULL_ARG, j.palette.ptr = NULL);
+    EXPECT_JOB(AK_ERR_NULL_ARG, j.joints.ptr = NULL);
+    EXPECT_JOB(AK_ERR_NULL_ARG, j.weights.ptr = NULL);
+    EXPECT_JOB(AK_ERR_NULL_ARG, j.out_positions.ptr = NULL);
     /* rule 2 */
-    j = good;
-    j.method = AK_SKIN_METHOD_COUNT;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good;
-    j.influence_count = 0;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good;
-    j.influence_count = 9;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good;
-    j.thread_count = 65;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good;
-    j.positions.stride = 8;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
-    j = good;
-    j.weights.stride = 2;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
+    EXPECT_JOB(AK_ERR_BAD_ARG, j.method = AK_SKIN_METHOD_COUNT);
+    EXPECT_JOB(AK_ERR_BAD_ARG, j.influence_count = 0);
+    EXPECT_JOB(AK_ERR_BAD_ARG, j.influence_count = 9);
+    EXPECT_JOB(AK_ERR_BAD_ARG, j.thread_count = 65);
+    EXPECT_JOB(AK_ERR_BAD_ARG, j.positions.stride = 8);
+    EXPECT_JOB(AK_ERR_BAD_ARG, j.weights.stride = 2);
     /* rule 3 */
-    j = good;
-    j.normals = (ak_cstream){nrm, 3, 0};
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    EXPECT_JOB(AK_ERR_NULL_ARG, j.normals = (ak_cstream){nrm, 3, 0});
     j = good;
     j.normals_from_faces = true;
     j.out_normals = (ak_stream){outn, 3, 0};
@@ -266,9 +250,7 @@ AK_TEST(job_validate_rules) {
     j.method = AK_SKIN_COR;
     j.scratch = (ak_u8_span){scratch, sizeof scratch};
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG); /* no centers */
-    j = good;
-    j.tangents = (ak_cstream){w, 1, 16};
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_NULL_ARG);
+    EXPECT_JOB(AK_ERR_NULL_ARG, j.tangents = (ak_cstream){w, 1, 16});
     /* rule 4 */
     j = good;
     j.normals_from_faces = true;
@@ -276,19 +258,13 @@ AK_TEST(job_validate_rules) {
     j.indices = (ak_u32_cspan){idx, 2};
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_ARG);
     /* rule 5 */
-    j = good;
-    j.weights.count = 2;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
-    j = good;
-    j.out_positions.count = 2;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
+    EXPECT_JOB(AK_ERR_SPAN_SMALL, j.weights.count = 2);
+    EXPECT_JOB(AK_ERR_SPAN_SMALL, j.out_positions.count = 2);
     j = good;
     j.normals = (ak_cstream){nrm, 3, 0};
     j.out_normals = (ak_stream){outn, 2, 0};
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
-    j = good;
-    j.method = AK_SKIN_DQS;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL); /* no scratch */
+    EXPECT_JOB(AK_ERR_SPAN_SMALL, j.method = AK_SKIN_DQS); /* no scratch */
     j.scratch = (ak_u8_span){scratch, ak_skin_job_scratch_size(&j) - 1};
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_SPAN_SMALL);
     j.scratch.count += 1;
@@ -297,9 +273,7 @@ AK_TEST(job_validate_rules) {
     /* rule 6 */
     ak_mat4 bad[2] = {ak_mat4_identity(), ak_mat4_identity()};
     bad[1].m[5] = NAN;
-    j = good;
-    j.palette.ptr = bad;
-    AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_DATA);
+    EXPECT_JOB(AK_ERR_BAD_DATA, j.palette.ptr = bad);
     j.skip_data_check = true;
     AK_CHECK_EQ(ak_skin_job_validate(&j), AK_ERR_BAD_DATA);
 }
