@@ -8,13 +8,9 @@
 #include <string.h>
 #include <time.h>
 
-#include <animkit/blendshape.h>
+#include "bench_clock.h"
 
-static double now_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include <animkit/blendshape.h>
 
 /* The textbook loop: for each vertex, p = b_0 + sum_k w_k d_k, deltas target-major. */
 static void naive_blend(const ak_vec3* base, const ak_vec3* deltas, const float* w, size_t k_count, size_t v,
@@ -68,9 +64,9 @@ static void run_once(const bench_ctx* c) {
 static int calibrate(const bench_ctx* c) {
     int iters = 1;
     for (;;) {
-        double t0 = now_s();
+        double t0 = bench_wall_s();
         for (int i = 0; i < iters; ++i) run_once(c);
-        if (now_s() - t0 > 0.1 || iters >= (1 << 20)) return iters;
+        if (bench_wall_s() - t0 > 0.1 || iters >= (1 << 20)) return iters;
         iters *= 2;
     }
 }
@@ -85,9 +81,9 @@ static void time_blends(const bench_ctx* c, size_t count, int rounds, double* ou
     }
     for (int r = 0; r < rounds; ++r)
         for (size_t m = 0; m < count; ++m) {
-            double t0 = now_s();
+            double t0 = bench_wall_s();
             for (int i = 0; i < iters[m]; ++i) run_once(&c[m]);
-            double t = (now_s() - t0) / iters[m];
+            double t = (bench_wall_s() - t0) / iters[m];
             if (t < out_best[m]) out_best[m] = t;
         }
 }

@@ -9,13 +9,9 @@
 #include <string.h>
 #include <time.h>
 
-enum { JOINTS = 64, KEYS = 301, FRAMES = 4096 };
+#include "bench_clock.h"
 
-static double now_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts); /* CPU time: robust on a loaded machine */
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+enum { JOINTS = 64, KEYS = 301, FRAMES = 4096 };
 
 static ak_clip* make_clip(ak_interp interp, ak_rng* rng) {
     size_t per_key = interp == AK_INTERP_CUBICSPLINE ? 3 : 1;
@@ -57,11 +53,11 @@ static double run_once(const ak_clip* clip, const float* times, bool use_cursor,
     ak_clip_cursor cursor;
     ak_clip_cursor_init(&cursor, clip, (ak_u32_span)AK_SPAN(seg));
     for (int j = 0; j < JOINTS; ++j) pose[j] = ak_transform_identity();
-    double t0 = now_s();
+    double t0 = bench_cpu_s();
     for (int f = 0; f < FRAMES; ++f)
         ak_clip_sample(clip, times[f], use_cursor ? &cursor : NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0},
                        (ak_f32_span){0});
-    double dt = now_s() - t0;
+    double dt = bench_cpu_s() - t0;
     *checksum += pose[JOINTS / 2].translation.x;
     return dt;
 }

@@ -14,31 +14,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_clock.h"
+
 #define MAXJ 30
-
-static double now_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* CPU time of this thread: on a loaded machine, closer to what an idle core would take. */
-static double cpu_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void* a, const void* b) {
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
-
-static double percentile(double* v, size_t n, double p) {
-    qsort(v, n, sizeof *v, cmp_double);
-    size_t k = (size_t)(p * (double)(n - 1) + 0.5);
-    return v[k];
-}
 
 static ak_skeleton* make_chain(size_t n, bool planar, ak_rng* rng) {
     ak_joint_desc j[MAXJ];
@@ -118,9 +96,9 @@ static result run_solver(const ak_skeleton* sk, bool planar, const ak_vec3* targ
                                .scratch = AK_SPAN(scratch),
                                .out_reached = &reached,
                                .out_iterations = &iterations};
-        double t0 = now_s();
+        double t0 = bench_wall_s();
         ak_result r = ak_ik_chain_run(&job);
-        double t1 = now_s();
+        double t1 = bench_wall_s();
         if (r != AK_OK) {
             fprintf(stderr, "solve failed: %s\n", ak_result_string(r));
             exit(1);
@@ -131,9 +109,9 @@ static result run_solver(const ak_skeleton* sk, bool planar, const ak_vec3* targ
     }
     result res;
     res.success = 100.0 * (double)ok / (double)count;
-    res.it_median = percentile(it_buf, count, 0.5);
-    res.it_p99 = percentile(it_buf, count, 0.99);
-    res.us_median = percentile(us_buf, count, 0.5);
+    res.it_median = bench_percentile(it_buf, count, 0.5);
+    res.it_p99 = bench_percentile(it_buf, count, 0.99);
+    res.us_median = bench_percentile(us_buf, count, 0.5);
     return res;
 }
 
@@ -162,19 +140,19 @@ static double two_bone_job_ns(const ak_skeleton* sk, const ak_vec3* targets, siz
     double* per = malloc(batches * sizeof *per);
     if (!per) return 0.0;
     double acc = 0.0;
-    const double c0 = cpu_s();
+    const double c0 = bench_cpu_s();
     for (size_t k = 0; k < batches; ++k) {
-        const double t0 = now_s();
+        const double t0 = bench_wall_s();
         for (size_t i = 0; i < batch; ++i) {
             job.target = targets[(k * batch + i) % count];
             ak_ik_two_bone_run(&job);
             acc += (double)qs.w + (double)qm.w;
         }
-        per[k] = (now_s() - t0) * 1e9 / (double)batch;
+        per[k] = (bench_wall_s() - t0) * 1e9 / (double)batch;
     }
-    *out_cpu_ns = (cpu_s() - c0) * 1e9 / (double)(batches * batch);
+    *out_cpu_ns = (bench_cpu_s() - c0) * 1e9 / (double)(batches * batch);
     *sink += acc;
-    const double med = percentile(per, batches, 0.5);
+    const double med = bench_percentile(per, batches, 0.5);
     free(per);
     return med;
 }
@@ -198,18 +176,18 @@ static double two_bone_many_ns(const ak_skeleton* sk, const ak_vec3* targets, si
     double acc = 0.0;
     for (size_t k = 0; k < batches; ++k) {
         for (size_t i = 0; i < B; ++i) jobs[i].target = targets[(k * B + i) % count];
-        double t0 = now_s();
+        double t0 = bench_wall_s();
         ak_ik_two_bone_run_many(jobs, B, NULL);
-        double t1 = now_s();
+        double t1 = bench_wall_s();
         for (size_t i = 0; i < B; ++i) ak_ik_two_bone_run(&jobs[i]);
-        double t2 = now_s();
+        double t2 = bench_wall_s();
         many[k] = (t1 - t0) * 1e9 / B;
         single[k] = (t2 - t1) * 1e9 / B;
         acc += (double)qs[k % B].w + (double)qm[k % B].w;
     }
     *sink += acc;
-    const double med = percentile(many, batches, 0.5);
-    *out_single_ns = percentile(single, batches, 0.5);
+    const double med = bench_percentile(many, batches, 0.5);
+    *out_single_ns = bench_percentile(single, batches, 0.5);
     free(many), free(single);
     return med;
 }

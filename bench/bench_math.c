@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <time.h>
 
+#include "bench_clock.h"
+
 #include <animkit/math.h>
 
 #include "simd.h" /* only for AK_SIMD_NAME */
@@ -18,19 +20,11 @@ static float ts[N];
 static ak_mat3 m3[N];
 static volatile float sink;
 
-/* Thread CPU time: on a shared, loaded machine it leaves out the time this thread was
- * descheduled, which wall time would count. */
-static double now(void) {
-    struct timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 /* Seconds per element of one run: the kernel over N elements, `inner` times. */
 static double time_once(void (*fn)(void), int inner) {
-    double t0 = now();
+    double t0 = bench_cpu_s();
     for (int k = 0; k < inner; ++k) fn();
-    return (now() - t0) / ((double)inner * N);
+    return (bench_cpu_s() - t0) / ((double)inner * N);
 }
 
 /* Best of REPS runs of each of two kernels, alternating, so both see the same machine load. */

@@ -6,39 +6,11 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_clock.h"
+
 #include <animkit/raster.h>
 
 enum { SEG_U = 250, SEG_V = 100 }; /* 250 * 100 * 2 = 50,000 triangles */
-
-static double now_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* CPU time of the calling thread: on a loaded machine this, not wall time, is what one core
- * spends on a single-threaded frame. */
-static double cpu_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double median(double* t, int n) {
-    for (int i = 1; i < n; ++i)
-        for (int j = i; j > 0 && t[j] < t[j - 1]; --j) {
-            double s = t[j];
-            t[j] = t[j - 1];
-            t[j - 1] = s;
-        }
-    return t[n / 2];
-}
-
-static double proc_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 typedef struct timing {
     double wall_ms, cpu_ms; /* medians per frame; cpu is the calling thread only */
@@ -80,18 +52,18 @@ static timing time_frames(int threads, int ss, ak_shading shading, const ak_rast
     m.shading = shading;
     double tw[64], tc[64], tp[64];
     for (int i = 0; i < reps; ++i) {
-        double t0 = now_s(), c0 = cpu_s(), p0 = proc_s();
+        double t0 = bench_wall_s(), c0 = bench_cpu_s(), p0 = bench_proc_s();
         ak_raster_clear(r, ak_vec4_make(0.82f, 0.86f, 0.92f, 1), ak_vec4_make(0.5f, 0.52f, 0.58f, 1));
         ak_raster_draw_mesh(r, &cam, &m);
         ak_raster_resolve(r, &img);
-        tw[i] = (now_s() - t0) * 1e3;
-        tc[i] = (cpu_s() - c0) * 1e3;
-        tp[i] = (proc_s() - p0) * 1e3;
+        tw[i] = (bench_wall_s() - t0) * 1e3;
+        tc[i] = (bench_cpu_s() - c0) * 1e3;
+        tp[i] = (bench_proc_s() - p0) * 1e3;
     }
     if (png) ak_png_write(png, &img);
     ak_raster_destroy(r);
     free(px);
-    return (timing){median(tw, reps), median(tc, reps), median(tp, reps)};
+    return (timing){bench_percentile(tw, (size_t)reps, 0.5), bench_percentile(tc, (size_t)reps, 0.5), bench_percentile(tp, (size_t)reps, 0.5)};
 }
 
 int main(int argc, char** argv) {

@@ -10,13 +10,9 @@
 #include <string.h>
 #include <time.h>
 
-#include <animkit/builtin.h>
+#include "bench_clock.h"
 
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include <animkit/builtin.h>
 
 enum { J = 64, CHARS = 256, REPS = 15 };
 
@@ -49,10 +45,10 @@ int main(void) {
     ak_i16_cspan parents = ak_skeleton_parents(sk);
     double best_mat = 1e9, best_trs = 1e9, best_batch = 1e9;
     for (int rep = 0; rep < REPS; ++rep) {
-        double t0 = now();
+        double t0 = bench_cpu_s();
         for (int c = 0; c < CHARS; ++c)
             ak_skeleton_local_to_model(sk, (ak_transform_cspan){poses + c * J, J}, (ak_mat4_span){model + c * J, J});
-        double t1 = now();
+        double t1 = bench_cpu_s();
         for (int c = 0; c < CHARS; ++c) {
             const ak_transform* p = poses + c * J;
             for (int i = 0; i < J; ++i) {
@@ -60,10 +56,10 @@ int main(void) {
                 model[c * J + i] = ak_transform_to_mat4(tmp[i]);
             }
         }
-        double t2 = now();
+        double t2 = bench_cpu_s();
         ak_skeleton_local_to_model_batch(sk, CHARS, (ak_transform_cspan){poses, CHARS * J},
                                          (ak_mat4_span){model, CHARS * J});
-        double t3 = now();
+        double t3 = bench_cpu_s();
         sink = model[CHARS * J - 1].m[12];
         if (t1 - t0 < best_mat) best_mat = t1 - t0;
         if (t2 - t1 < best_trs) best_trs = t2 - t1;
@@ -82,12 +78,12 @@ int main(void) {
     ak_scene* hs = NULL;
     for (int rep = 0; rep < 3; ++rep) {
         ak_scene* s = NULL;
-        double t0 = now();
+        double t0 = bench_cpu_s();
         ak_builtin_create("humanoid", NULL, NULL, &s);
-        double t1 = now();
+        double t1 = bench_cpu_s();
         ak_scene* c = NULL;
         ak_builtin_create("cylinder", NULL, NULL, &c);
-        double t2 = now();
+        double t2 = bench_cpu_s();
         ak_scene_destroy(c);
         if (t1 - t0 < best_h) best_h = t1 - t0;
         if (t2 - t1 < best_c) best_c = t2 - t1;
@@ -101,15 +97,15 @@ int main(void) {
     ak_vec3* nrm = (ak_vec3*)malloc(m->vertex_count * sizeof(ak_vec3));
     double best_closed = 1e9, best_norm = 1e9, best_vol = 1e9;
     for (int rep = 0; rep < REPS; ++rep) {
-        double t0 = now();
+        double t0 = bench_cpu_s();
         bool closed = ak_mesh_is_closed_oriented(m);
-        double t1 = now();
+        double t1 = bench_cpu_s();
         ak_normals_compute((ak_vec3_cspan){m->positions, m->vertex_count},
                            (ak_u32_cspan){m->indices, 3 * m->triangle_count}, (ak_vec3_span){nrm, m->vertex_count});
-        double t2 = now();
+        double t2 = bench_cpu_s();
         double v = ak_volume_compute((ak_vec3_cspan){m->positions, m->vertex_count},
                                      (ak_u32_cspan){m->indices, 3 * m->triangle_count});
-        double t3 = now();
+        double t3 = bench_cpu_s();
         sink = (float)v + (closed ? 1.0f : 0.0f) + nrm[0].x;
         if (t1 - t0 < best_closed) best_closed = t1 - t0;
         if (t2 - t1 < best_norm) best_norm = t2 - t1;

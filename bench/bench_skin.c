@@ -15,6 +15,8 @@
 #include <pthread.h>
 #include <time.h>
 
+#include "bench_clock.h"
+
 #include <animkit/io.h>
 #include <animkit/skin.h>
 
@@ -33,11 +35,7 @@ static const char* asset_path(char* buf, size_t size, const char* rel) {
  * machine do not count (cache and memory contention still do); two-thread figures and the
  * precomputations use wall time (g_use_cpu_time = false). */
 static int g_use_cpu_time = 1;
-static double now_s(void) {
-    struct timespec ts;
-    clock_gettime(g_use_cpu_time ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+static double now_s(void) { return g_use_cpu_time ? bench_cpu_s() : bench_wall_s(); }
 
 /* ---- STREAM-like triad: a[i] = b[i] + s * c[i] (12 bytes counted per float element) ---- */
 
