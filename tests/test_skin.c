@@ -632,8 +632,7 @@ AK_TEST(job_split_matches_whole) {
     cylinder_free(&c);
 }
 
-/* ---- DQS --------------------------------------------------------------------------------------
- */
+/* ---- DQS ------------------------------------------------------------------------------------- */
 
 AK_TEST(dqs_single_influence_is_rigid) {
     enum { N = 37, J = 5 };
@@ -927,8 +926,7 @@ AK_TEST(cor_center_in_joint_region_and_cache) {
     cylinder_free(&c);
 }
 
-/* ---- quality on the cylinder ------------------------------------------------------------------
- */
+/* ---- quality on the cylinder ----------------------------------------------------------------- */
 
 typedef struct quality {
     double volume_ratio; /* deformed / rest */
