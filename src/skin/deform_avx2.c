@@ -174,16 +174,22 @@ AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t 
     }
 }
 
+/* The four byte offsets of a vertex, read two per 64-bit load (the blends are load-bound). */
+static inline void offsets4(const uint32_t* off, size_t* o) {
+    uint64_t o01, o23;
+    memcpy(&o01, off, 8);
+    memcpy(&o23, off + 2, 8);
+    o[0] = (uint32_t)o01, o[1] = (size_t)(o01 >> 32), o[2] = (uint32_t)o23, o[3] = (size_t)(o23 >> 32);
+}
+
 /* Blend of two 8-float rows at base + off[k] with the 4 weights of vertex i: the palette
  * matrices for LBS (offsets from joint_offsets4 with AKP_MAT_SHIFT), the CoR rows for CoR. */
 AKP_AVX2_INLINE static inline void blend_matrix_rows4(const akp_skin_ctx* c, size_t i, const char* base,
                                                       const uint32_t* off, __m256* out01, __m256* out23) {
     float ww[4];
     memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
-    uint64_t o01, o23; /* two offsets per load: the blend is load-bound */
-    memcpy(&o01, off, 8);
-    memcpy(&o23, off + 2, 8);
-    const size_t o[4] = {(uint32_t)o01, (size_t)(o01 >> 32), (uint32_t)o23, (size_t)(o23 >> 32)};
+    size_t o[4];
+    offsets4(off, o);
     __m256 w = _mm256_set1_ps(ww[0]);
     const float* m = (const float*)(const void*)(base + o[0]);
     __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
@@ -258,10 +264,8 @@ AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, 
 /* Phase 2: sum of signed weight * (real | dual); broadcasts from memory are plain loads. */
 AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const akp_skin_ctx* c, const uint32_t* off, const float* sw) {
     const char* jb = (const char*)c->joints_prep;
-    uint64_t o01, o23; /* two offsets per load, as in blend_matrix_rows4 */
-    memcpy(&o01, off, 8);
-    memcpy(&o23, off + 2, 8);
-    const size_t o[4] = {(uint32_t)o01, (size_t)(o01 >> 32), (uint32_t)o23, (size_t)(o23 >> 32)};
+    size_t o[4];
+    offsets4(off, o);
 #define AKP_JQ(k) _mm256_loadu_ps((const float*)(const void*)(jb + o[k]))
     __m256 acc = _mm256_mul_ps(AKP_JQ(0), _mm256_broadcast_ss(&sw[0]));
     acc = _mm256_fmadd_ps(AKP_JQ(1), _mm256_broadcast_ss(&sw[1]), acc);
