@@ -356,6 +356,98 @@ typedef struct interleaved_vertex {
 /* every influence count the kernels specialise (1, 2, 3, 4, 8) and one they do not (5) */
 static const uint32_t k_counts[6] = {1, 2, 3, 4, 5, 8};
 
+/* The data rules run as a fast screen over the whole job and, only where it flags, the exact
+ * vertex-by-vertex checks. Every fault must be caught wherever it sits (first vertex, inside a
+ * SIMD step, in the scalar tail), for every influence count, on one thread and on the
+ * parallel screen of a large job; and the cases the screen flags but the rules accept (-0.0,
+ * a sum 0.95e-3 off) must still pass. */
+AK_TEST(job_data_screen_catches_faults_everywhere) {
+    enum { J = 9 };
+    ak_mat4 pal[J];
+    for (int j = 0; j < J; ++j) pal[j] = ak_mat4_identity();
+    const size_t sizes[2] = {37, 70001}; /* the second takes the two-thread screen */
+    for (int si = 0; si < 2; ++si) {
+        const size_t n = sizes[si];
+        for (int kc = 0; kc < 6; ++kc) {
+            const uint32_t K = k_counts[kc];
+            if (si == 1 && K != 3 && K != 4) continue; /* large: one specialised count, one not */
+            ak_rng rng = ak_rng_make(900 + K);
+            ak_vec3 *pos = malloc(n * sizeof *pos), *nrm = malloc(n * sizeof *nrm), *ctr = malloc(n * sizeof *ctr),
+                    *out = malloc(n * sizeof *out), *outn = malloc(n * sizeof *outn);
+            uint16_t* jn = malloc(n * K * sizeof *jn);
+            float* w = malloc(n * K * sizeof *w);
+            unsigned char* scratch = malloc(64 + 192 * J);
+            for (size_t i = 0; i < n; ++i) {
+                pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), 0.5f, 0.25f);
+                nrm[i] = ak_vec3_make(0, 1, 0);
+                ctr[i] = pos[i];
+                rand_influences(&rng, K, J, &jn[K * i], &w[K * i]);
+            }
+            ak_skin_job job = {
+                .method = AK_SKIN_COR,
+                .influence_count = K,
+                .palette = {pal, J},
+                .positions = {pos, n, 0},
+                .normals = {nrm, n, 0},
+                .joints = {jn, n, 0},
+                .weights = {w, n, 0},
+                .cor_centers = {ctr, n, 0},
+                .scratch = {scratch, 64 + 192 * J},
+                .out_positions = {out, n, 0},
+                .out_normals = {outn, n, 0},
+                .thread_count = 2,
+            };
+            AK_CHECK_EQ(ak_skin_job_validate(&job), AK_OK);
+            const size_t at[4] = {0, n / 2 + 1, n - 4, n - 1};
+            for (int a = 0; a < 4; ++a) {
+                const size_t v = at[a];
+                float* wv = &w[K * v];
+                const float w0 = wv[0];
+                const uint16_t j0 = jn[K * v];
+                const ak_vec3 p0 = pos[v], n0 = nrm[v], c0 = ctr[v];
+                /* rejected, with the exact rule's code */
+                const float bad_w[4] = {-0.25f, NAN, INFINITY, w0 + 2e-3f};
+                const float w1 = K > 1 ? wv[1] : 0.0f;
+                for (int b = 0; b < 4; ++b) {
+                    wv[0] = bad_w[b];
+                    if (b == 0 && K > 1) wv[1] = w1 + w0 + 0.25f; /* negative with the sum kept at 1 */
+                    AK_CHECK_MSG(ak_skin_job_validate(&job) == AK_ERR_BAD_WEIGHTS, "K %u n %zu vertex %zu weight %g", K,
+                                 n, v, (double)bad_w[b]);
+                    AK_CHECK_EQ(ak_skin_job_run(&job), AK_ERR_BAD_WEIGHTS);
+                    if (K > 1) wv[1] = w1;
+                }
+                wv[0] = w0;
+                jn[K * v] = J;
+                AK_CHECK_MSG(ak_skin_job_run(&job) == AK_ERR_BAD_INDEX, "K %u n %zu vertex %zu index", K, n, v);
+                jn[K * v] = j0;
+                pos[v].y = NAN;
+                AK_CHECK_EQ(ak_skin_job_run(&job), AK_ERR_BAD_DATA);
+                pos[v] = p0;
+                nrm[v].z = -INFINITY;
+                AK_CHECK_EQ(ak_skin_job_run(&job), AK_ERR_BAD_DATA);
+                nrm[v] = n0;
+                ctr[v].x = NAN;
+                AK_CHECK_EQ(ak_skin_job_run(&job), AK_ERR_BAD_DATA);
+                ctr[v] = c0;
+                /* accepted: within the rule's 1e-3 but outside the screen's 0.9e-3, and -0.0 */
+                wv[0] = w0 + 0.95e-3f;
+                AK_CHECK_MSG(ak_skin_job_run(&job) == AK_OK, "K %u n %zu vertex %zu sum 1 + 0.95e-3", K, n, v);
+                wv[0] = w0;
+                if (K > 1) {
+                    const float wl = wv[K - 1];
+                    wv[0] = w0 + wl;
+                    wv[K - 1] = -0.0f;
+                    AK_CHECK_MSG(ak_skin_job_run(&job) == AK_OK, "K %u n %zu vertex %zu weight -0.0", K, n, v);
+                    wv[0] = w0;
+                    wv[K - 1] = wl;
+                }
+            }
+            AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+            free(pos), free(nrm), free(ctr), free(out), free(outn), free(jn), free(w), free(scratch);
+        }
+    }
+}
+
 AK_TEST(lbs_matches_double_reference) {
     for (int kc = 0; kc < 6; ++kc) {
         enum { N = 1003, J = 20 };
@@ -1435,6 +1527,7 @@ int main(void) {
     printf("skin kernel: %s\n", ak_skin_simd_name());
     AK_RUN(job_validate_rules);
     AK_RUN(job_bad_data_codes);
+    AK_RUN(job_data_screen_catches_faults_everywhere);
     AK_RUN(lbs_matches_double_reference);
     AK_RUN(dqs_cor_simd_matches_scalar_for_every_influence_count);
     AK_RUN(lbs_tangents_and_face_normals);

@@ -3,6 +3,7 @@
  * deform_avx2.c and is only used for configurations it handles (see akp_skin_range_avx2). */
 #include <pthread.h> /* thread_count > 1 */
 
+#include "simd.h"
 #include "skin_internal.h"
 
 /* Palettes up to this many joints get a 64-byte aligned stack copy for the AVX2 LBS kernel. */
@@ -291,39 +292,159 @@ static bool finite3(const char* base, size_t stride, size_t i) {
     return ak_vec3_is_finite(load3(base, stride, i));
 }
 
-ak_result ak_skin_job_validate(const ak_skin_job* job) {
-    if (!job || !job->positions.ptr || !job->palette.ptr || !job->joints.ptr || !job->weights.ptr ||
-        !job->out_positions.ptr)
-        return AK_ERR_NULL_ARG;
-    if (job->palette.count == 0) return AK_ERR_NULL_ARG;
-    const uint32_t k = job->influence_count;
-    if ((unsigned)job->method >= AK_SKIN_METHOD_COUNT || k == 0 || k > AK_MAX_INFLUENCES || job->thread_count > 64)
-        return AK_ERR_BAD_ARG;
-    if (!stride_ok(job->positions.stride, 12) || !stride_ok(job->normals.stride, 12) ||
-        !stride_ok(job->tangents.stride, 16) || !stride_ok(job->cor_centers.stride, 12) ||
-        !stride_ok(job->joints.stride, 2u * k) || !stride_ok(job->weights.stride, 4u * k) ||
-        !stride_ok(job->out_positions.stride, 12) || !stride_ok(job->out_normals.stride, 12) ||
-        !stride_ok(job->out_tangents.stride, 16))
-        return AK_ERR_BAD_ARG;
-    const bool want_normals = job->normals.ptr != NULL || job->normals_from_faces;
-    if ((want_normals && !job->out_normals.ptr) || (job->tangents.ptr && !job->out_tangents.ptr) ||
-        (job->method == AK_SKIN_COR && !job->cor_centers.ptr) || (job->normals_from_faces && !job->indices.ptr))
-        return AK_ERR_NULL_ARG;
-    if (job->normals_from_faces && job->indices.count % 3 != 0) return AK_ERR_BAD_ARG;
-    const size_t n = job->positions.count;
-    if (job->joints.count < n || job->weights.count < n || job->out_positions.count < n)
-        return AK_ERR_SPAN_SMALL;
-    if (job->normals.ptr && !job->normals_from_faces && job->normals.count < n) return AK_ERR_SPAN_SMALL;
-    if (want_normals && job->out_normals.count < n) return AK_ERR_SPAN_SMALL;
-    if (job->tangents.ptr && (job->tangents.count < n || job->out_tangents.count < n)) return AK_ERR_SPAN_SMALL;
-    if (job->method == AK_SKIN_COR && job->cor_centers.count < n) return AK_ERR_SPAN_SMALL;
-    if (job->scratch.count < ak_skin_job_scratch_size(job) ||
-        (ak_skin_job_scratch_size(job) > 0 && !job->scratch.ptr))
-        return AK_ERR_SPAN_SMALL;
-    for (size_t j = 0; j < job->palette.count; ++j)
-        if (!ak_mat4_is_finite(&job->palette.ptr[j])) return AK_ERR_BAD_DATA;
-    if (job->skip_data_check) return AK_OK;
+/* ---- the O(n) data rules: a fast screen, then the exact checks where it flags ------------ */
 
+/* Flags of the screen below, OR-ed over all data; nonzero means "run the exact checks". A
+ * float is flagged when all its exponent bits are set (infinite or NaN); a weight also when
+ * its sign bit is set (negative, or -0.0, which the exact check accepts). */
+static uint32_t float_flags(uint32_t b, uint32_t sign_mask) {
+    return (b & sign_mask) | (uint32_t)((b & 0x7f800000u) == 0x7f800000u);
+}
+
+/* Flags of `total` tightly packed floats at base. */
+static uint32_t flags_packed(const char* base, size_t total, uint32_t sign_mask) {
+    uint32_t bad = 0;
+    size_t i = 0;
+#if AK_SIMD_SSE2
+    const __m128i exp = _mm_set1_epi32(0x7f800000), sign = _mm_set1_epi32((int)sign_mask);
+    __m128i acc = _mm_setzero_si128();
+    for (; i + 4 <= total; i += 4) {
+        __m128i v = _mm_loadu_si128((const __m128i*)(const void*)(base + 4 * i));
+        acc = _mm_or_si128(acc, _mm_or_si128(_mm_and_si128(v, sign), _mm_cmpeq_epi32(_mm_and_si128(v, exp), exp)));
+    }
+    bad = (uint32_t)_mm_movemask_epi8(_mm_cmpeq_epi32(acc, _mm_setzero_si128())) != 0xffffu;
+#endif
+    for (; i < total; ++i) {
+        uint32_t b;
+        memcpy(&b, base + 4 * i, 4);
+        bad |= float_flags(b, sign_mask);
+    }
+    return bad;
+}
+
+/* Flags of count elements of `floats` floats, stride bytes apart. */
+static uint32_t flags_floats(const char* base, size_t stride, size_t count, size_t floats, uint32_t sign_mask) {
+    if (stride == 4 * floats) return flags_packed(base, count * floats, sign_mask);
+    uint32_t bad = 0;
+    for (size_t i = 0; i < count; ++i)
+        for (size_t e = 0; e < floats; ++e) {
+            uint32_t b;
+            memcpy(&b, base + i * stride + 4 * e, 4);
+            bad |= float_flags(b, sign_mask);
+        }
+    return bad;
+}
+
+/* Nonzero when some of the count joint indices (uint16_t, tightly packed) is >= limit. */
+static uint32_t flags_joints_packed(const char* base, size_t count, uint32_t limit) {
+    if (limit > 65535u) return 0;
+    uint32_t bad = 0;
+    size_t i = 0;
+#if AK_SIMD_SSE2
+    const __m128i top = _mm_set1_epi16((short)(uint16_t)(limit - 1));
+    __m128i acc = _mm_setzero_si128();
+    for (; i + 8 <= count; i += 8) /* j - (limit - 1) saturates to 0 iff j < limit */
+        acc = _mm_or_si128(acc, _mm_subs_epu16(_mm_loadu_si128((const __m128i*)(const void*)(base + 2 * i)), top));
+    bad = (uint32_t)_mm_movemask_epi8(_mm_cmpeq_epi16(acc, _mm_setzero_si128())) != 0xffffu;
+#endif
+    for (; i < count; ++i) {
+        uint16_t j;
+        memcpy(&j, base + 2 * i, 2);
+        bad |= j >= limit;
+    }
+    return bad;
+}
+
+#if AK_SIMD_SSE2
+/* flags_sums for tightly packed weights, k in {1, 2, 4, 8}, four vertices per step; *done
+ * = the vertices checked (a multiple of 4). */
+static inline uint32_t sums_flags_sse2(const char* wb, size_t n, const uint32_t k, size_t* done) {
+    const __m128 one = _mm_set1_ps(1.0f), tol = _mm_set1_ps(0.9e-3f);
+    const __m128 abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) { /* the sums of vertices i .. i + 3 */
+        const float* f = (const float*)(const void*)(wb + 4u * k * i);
+        __m128 s4;
+        if (k == 1) {
+            s4 = _mm_loadu_ps(f);
+        } else if (k == 2) {
+            __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4);
+            s4 = _mm_add_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)), _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+        } else {
+            __m128 r0 = _mm_loadu_ps(f), r1 = _mm_loadu_ps(f + k), r2 = _mm_loadu_ps(f + 2 * k),
+                   r3 = _mm_loadu_ps(f + 3 * k);
+            if (k == 8) {
+                r0 = _mm_add_ps(r0, _mm_loadu_ps(f + 4));
+                r1 = _mm_add_ps(r1, _mm_loadu_ps(f + 12));
+                r2 = _mm_add_ps(r2, _mm_loadu_ps(f + 20));
+                r3 = _mm_add_ps(r3, _mm_loadu_ps(f + 28));
+            }
+            _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+            s4 = _mm_add_ps(_mm_add_ps(r0, r1), _mm_add_ps(r2, r3));
+        }
+        ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(s4, one), abs), tol)); /* false for NaN */
+    }
+    *done = i;
+    return _mm_movemask_ps(ok) != 0xf;
+}
+#endif
+
+/* Nonzero when some vertex's float weight sum is not within 0.9e-3 of 1. Conservative: the
+ * float sum of <= 8 weights in [0, 1] is within 1e-6 of the exact sum, far less than the 1e-4
+ * between this tolerance and the exact rule's 1e-3, so a vertex the exact rule rejects is
+ * always flagged (weights outside [0, 1] are flagged by their bits or their sum). */
+static uint32_t flags_sums(const char* wb, size_t ws, size_t n, uint32_t k) {
+    uint32_t bad = 0;
+    size_t i = 0;
+#if AK_SIMD_SSE2
+    if (ws == 4u * k) { /* tightly packed: the loop specialised for the counts it handles */
+        size_t done = 0;
+        switch (k) {
+        case 1: bad = sums_flags_sse2(wb, n, 1, &done); break;
+        case 2: bad = sums_flags_sse2(wb, n, 2, &done); break;
+        case 4: bad = sums_flags_sse2(wb, n, 4, &done); break;
+        case 8: bad = sums_flags_sse2(wb, n, 8, &done); break;
+        default: break;
+        }
+        i = done;
+    }
+#endif
+    for (; i < n; ++i) {
+        float sum = 0.0f;
+        for (uint32_t e = 0; e < k; ++e) {
+            float w;
+            memcpy(&w, wb + i * ws + 4 * e, 4);
+            sum += w;
+        }
+        bad |= !(fabsf(sum - 1.0f) <= 0.9e-3f);
+    }
+    return bad;
+}
+
+/* Whether every weight is finite with its sign bit clear, every weight sum is near 1 (see
+ * flags_sums) and every joint index is below joint_limit: a fast screen for the exact rules. */
+static bool influences_surely_ok(const char* wb, size_t ws, const char* jb, size_t js, size_t n, uint32_t k,
+                                 size_t joint_limit) {
+    const uint32_t limit = joint_limit > 65535u ? 65536u : (uint32_t)joint_limit;
+    uint32_t bad = flags_floats(wb, ws, n, k, 0x80000000u) | flags_sums(wb, ws, n, k);
+    if (js == 2u * k) {
+        bad |= flags_joints_packed(jb, n * k, limit);
+    } else {
+        for (size_t i = 0; i < n; ++i)
+            for (uint32_t e = 0; e < k; ++e) {
+                uint16_t j;
+                memcpy(&j, jb + i * js + 2 * e, 2);
+                bad |= j >= limit;
+            }
+    }
+    return bad == 0;
+}
+
+/* The data rules (rule 7 of ak_skin_job_validate) in rule order; the first failure wins. */
+static ak_result check_data_exact(const ak_skin_job* job) {
+    const uint32_t k = job->influence_count;
+    const size_t n = job->positions.count;
     const size_t js = stride_or(job->joints.stride, 2u * k), ws = stride_or(job->weights.stride, 4u * k);
     const char* jb = (const char*)job->joints.ptr;
     const char* wb = (const char*)job->weights.ptr;
@@ -359,6 +480,104 @@ ak_result ak_skin_job_validate(const ak_skin_job* job) {
             if (job->indices.ptr[i] >= n) return AK_ERR_BAD_INDEX;
     return AK_OK;
 }
+
+/* The screen of the per-vertex data rules on vertices [b, e): true when all surely pass. */
+static bool screen_range(const ak_skin_job* job, size_t b, size_t e) {
+    const uint32_t k = job->influence_count;
+    const size_t n = e - b, ws = stride_or(job->weights.stride, 4u * k), js = stride_or(job->joints.stride, 2u * k);
+    const size_t ps = stride_or(job->positions.stride, 12), ns = stride_or(job->normals.stride, 12),
+                 cs = stride_or(job->cor_centers.stride, 12);
+    bool ok = influences_surely_ok((const char*)job->weights.ptr + b * ws, ws, (const char*)job->joints.ptr + b * js,
+                                   js, n, k, job->palette.count);
+    ok = ok && !flags_floats((const char*)job->positions.ptr + b * ps, ps, n, 3, 0);
+    if (ok && job->normals.ptr && !job->normals_from_faces)
+        ok = !flags_floats((const char*)job->normals.ptr + b * ns, ns, n, 3, 0);
+    if (ok && job->method == AK_SKIN_COR) ok = !flags_floats((const char*)job->cor_centers.ptr + b * cs, cs, n, 3, 0);
+    return ok;
+}
+
+typedef struct screen_task {
+    const ak_skin_job* job;
+    size_t begin, end;
+    bool ok;
+} screen_task;
+
+static void* screen_thread(void* arg) {
+    screen_task* t = (screen_task*)arg;
+    t->ok = screen_range(t->job, t->begin, t->end);
+    return NULL;
+}
+
+/* Jobs below this many vertices screen on the calling thread (a thread start costs more). */
+#define AKP_SKIN_PARALLEL_SCREEN 65536u
+
+/* The data rules: a branch-free screen of the whole job (valid data, the common case, costs
+ * about 2 ns per vertex), on up to `threads` threads for large jobs, and the exact
+ * vertex-by-vertex checks only when the screen flags something. */
+static ak_result check_data(const ak_skin_job* job, uint32_t threads) {
+    const size_t n = job->positions.count;
+    if (threads > 64) threads = 64;
+    if (threads == 0 || n < AKP_SKIN_PARALLEL_SCREEN) threads = 1;
+    screen_task tasks[64];
+    pthread_t ids[64];
+    bool started[64];
+    const size_t chunk = (n + threads - 1) / threads;
+    for (uint32_t t = 0; t < threads; ++t) {
+        size_t b = (size_t)t * chunk, e = b + chunk;
+        tasks[t] = (screen_task){job, b < n ? b : n, e < n ? e : n, false};
+        started[t] = t > 0 && pthread_create(&ids[t], NULL, screen_thread, &tasks[t]) == 0;
+    }
+    bool ok = screen_range(job, tasks[0].begin, tasks[0].end);
+    for (uint32_t t = 1; t < threads; ++t) {
+        if (started[t]) pthread_join(ids[t], NULL);
+        else screen_thread(&tasks[t]);
+        ok = ok && tasks[t].ok;
+    }
+    if (ok && job->normals_from_faces) {
+        uint32_t bad = 0;
+        for (size_t i = 0; i < job->indices.count; ++i) bad |= job->indices.ptr[i] >= n;
+        ok = bad == 0;
+    }
+    return ok ? AK_OK : check_data_exact(job);
+}
+
+/* ak_skin_job_validate with the data screen on up to screen_threads threads. */
+static ak_result validate_job(const ak_skin_job* job, uint32_t screen_threads) {
+    if (!job || !job->positions.ptr || !job->palette.ptr || !job->joints.ptr || !job->weights.ptr ||
+        !job->out_positions.ptr)
+        return AK_ERR_NULL_ARG;
+    if (job->palette.count == 0) return AK_ERR_NULL_ARG;
+    const uint32_t k = job->influence_count;
+    if ((unsigned)job->method >= AK_SKIN_METHOD_COUNT || k == 0 || k > AK_MAX_INFLUENCES || job->thread_count > 64)
+        return AK_ERR_BAD_ARG;
+    if (!stride_ok(job->positions.stride, 12) || !stride_ok(job->normals.stride, 12) ||
+        !stride_ok(job->tangents.stride, 16) || !stride_ok(job->cor_centers.stride, 12) ||
+        !stride_ok(job->joints.stride, 2u * k) || !stride_ok(job->weights.stride, 4u * k) ||
+        !stride_ok(job->out_positions.stride, 12) || !stride_ok(job->out_normals.stride, 12) ||
+        !stride_ok(job->out_tangents.stride, 16))
+        return AK_ERR_BAD_ARG;
+    const bool want_normals = job->normals.ptr != NULL || job->normals_from_faces;
+    if ((want_normals && !job->out_normals.ptr) || (job->tangents.ptr && !job->out_tangents.ptr) ||
+        (job->method == AK_SKIN_COR && !job->cor_centers.ptr) || (job->normals_from_faces && !job->indices.ptr))
+        return AK_ERR_NULL_ARG;
+    if (job->normals_from_faces && job->indices.count % 3 != 0) return AK_ERR_BAD_ARG;
+    const size_t n = job->positions.count;
+    if (job->joints.count < n || job->weights.count < n || job->out_positions.count < n)
+        return AK_ERR_SPAN_SMALL;
+    if (job->normals.ptr && !job->normals_from_faces && job->normals.count < n) return AK_ERR_SPAN_SMALL;
+    if (want_normals && job->out_normals.count < n) return AK_ERR_SPAN_SMALL;
+    if (job->tangents.ptr && (job->tangents.count < n || job->out_tangents.count < n)) return AK_ERR_SPAN_SMALL;
+    if (job->method == AK_SKIN_COR && job->cor_centers.count < n) return AK_ERR_SPAN_SMALL;
+    if (job->scratch.count < ak_skin_job_scratch_size(job) ||
+        (ak_skin_job_scratch_size(job) > 0 && !job->scratch.ptr))
+        return AK_ERR_SPAN_SMALL;
+    for (size_t j = 0; j < job->palette.count; ++j)
+        if (!ak_mat4_is_finite(&job->palette.ptr[j])) return AK_ERR_BAD_DATA;
+    if (job->skip_data_check) return AK_OK;
+    return check_data(job, screen_threads);
+}
+
+ak_result ak_skin_job_validate(const ak_skin_job* job) { return validate_job(job, 1); }
 
 static akp_skin_ctx make_ctx(const ak_skin_job* job, const akp_skin_joint* prep, bool any_stretch) {
     akp_skin_ctx c;
@@ -431,7 +650,7 @@ static void normals_from_faces(const ak_skin_job* job) {
 }
 
 ak_result ak_skin_job_run(const ak_skin_job* job) {
-    ak_result r = ak_skin_job_validate(job);
+    ak_result r = validate_job(job, job ? job->thread_count : 1);
     if (r != AK_OK) return r;
     const size_t n = job->positions.count;
     if (n == 0) return AK_OK;
