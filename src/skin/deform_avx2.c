@@ -160,15 +160,36 @@ AKP_AVX2_INLINE static inline void blend_matrix_vertex(const akp_skin_ctx* c, si
 _Static_assert(sizeof(ak_mat4) == 64 && sizeof(akp_skin_joint) == 128, "offset shifts below");
 #define AKP_MAT_SHIFT 6
 #define AKP_JOINT_SHIFT 7
-AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t i0, int shift, uint32_t* off) {
+/* The K (2..4) joint indices of the vertex at p in the low 64 bits, zero-padded to 4 (joint 0,
+ * which the zero-padded weights of load_weights4 give no weight): never reads past them. */
+AKP_AVX2_INLINE static inline __m128i load_joints4(const char* p, const uint32_t K) {
+    if (K == 4) return _mm_loadl_epi64((const __m128i*)(const void*)p);
+    uint32_t lo;
+    memcpy(&lo, p, 4);
+    if (K == 2) return _mm_cvtsi32_si128((int)lo);
+    uint16_t hi; /* K == 3; one 6-byte copy into a zeroed word would stall on store forwarding */
+    memcpy(&hi, p + 4, 2);
+    return _mm_insert_epi16(_mm_cvtsi32_si128((int)lo), hi, 2);
+}
+
+/* The K (2..4) weights of the vertex at p, zero-padded to 4 lanes (a masked load: the lanes
+ * past K are neither read nor faulted). */
+AKP_AVX2_INLINE static inline __m128 load_weights4(const char* p, const uint32_t K) {
+    if (K == 4) return _mm_loadu_ps((const float*)(const void*)p);
+    const __m128i mask = _mm_setr_epi32(-1, -1, K > 2 ? -1 : 0, 0);
+    return _mm_maskload_ps((const float*)(const void*)p, mask);
+}
+
+AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t i0, int shift, uint32_t* off,
+                                                  const uint32_t K) {
     const char* jp = c->jnt + i0 * c->jnt_stride;
     const size_t js = c->jnt_stride;
     const size_t last = c->palette_count - 1;
     const __m128i lim = _mm_set1_epi16((short)(uint16_t)(last > 65535u ? 65535u : last));
     const __m128i count = _mm_cvtsi32_si128(shift);
     for (int h = 0; h < 4; ++h) {
-        __m128i a = _mm_loadl_epi64((const __m128i*)(const void*)(jp + (size_t)(2 * h) * js));
-        __m128i b = _mm_loadl_epi64((const __m128i*)(const void*)(jp + (size_t)(2 * h + 1) * js));
+        __m128i a = load_joints4(jp + (size_t)(2 * h) * js, K);
+        __m128i b = load_joints4(jp + (size_t)(2 * h + 1) * js, K);
         __m128i j = _mm_min_epu16(_mm_unpacklo_epi64(a, b), lim);
         _mm256_storeu_si256((__m256i*)(void*)(off + 8 * h), _mm256_sll_epi32(_mm256_cvtepu16_epi32(j), count));
     }
@@ -185,15 +206,16 @@ static inline void offsets4(const uint32_t* off, size_t* o) {
 /* Blend of two 8-float rows at base + off[k] with the 4 weights of vertex i: the palette
  * matrices for LBS (offsets from joint_offsets4 with AKP_MAT_SHIFT), the CoR rows for CoR. */
 AKP_AVX2_INLINE static inline void blend_matrix_rows4(const akp_skin_ctx* c, size_t i, const char* base,
-                                                      const uint32_t* off, __m256* out01, __m256* out23) {
+                                                      const uint32_t* off, __m256* out01, __m256* out23,
+                                                      const uint32_t K) {
     float ww[4];
-    memcpy(ww, c->wgt + i * c->wgt_stride, sizeof ww);
+    memcpy(ww, c->wgt + i * c->wgt_stride, 4u * K);
     size_t o[4];
     offsets4(off, o);
     __m256 w = _mm256_set1_ps(ww[0]);
     const float* m = (const float*)(const void*)(base + o[0]);
     __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
-    for (int k = 1; k < 4; ++k) {
+    for (uint32_t k = 1; k < K; ++k) {
         m = (const float*)(const void*)(base + o[k]);
         w = _mm256_set1_ps(ww[k]);
         a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
@@ -231,15 +253,15 @@ AKP_AVX2_INLINE static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size
  * belong to vertex i and off[4..7], sw[4..7] to vertex i + 1. The reference is the rotation of the largest weight (lowest slot
  * on ties), picked with blends: no branch and no index round trip through memory. */
 AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, uint32_t* off, float* sw,
-                                               uint32_t cor_neg) {
+                                               uint32_t cor_neg, const uint32_t K) {
     const char* wp = c->wgt + i * c->wgt_stride;
     const char* jb = (const char*)c->joints_prep;
     __m256 r[4];
     for (int k = 0; k < 4; ++k)
         r[k] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)(jb + off[k]))),
                                     _mm_loadu_ps((const float*)(const void*)(jb + off[4 + k])), 1);
-    const __m256 w8 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)wp)),
-                                           _mm_loadu_ps((const float*)(const void*)(wp + c->wgt_stride)), 1);
+    const __m256 w8 = _mm256_insertf128_ps(_mm256_castps128_ps256(load_weights4(wp, K)),
+                                           load_weights4(wp + c->wgt_stride, K), 1);
     __m256 mx = _mm256_max_ps(w8, _mm256_permute_ps(w8, _MM_SHUFFLE(2, 3, 0, 1)));
     mx = _mm256_max_ps(mx, _mm256_permute_ps(mx, _MM_SHUFFLE(1, 0, 3, 2)));
     const __m256 is_max = _mm256_cmp_ps(w8, mx, _CMP_EQ_OQ);
@@ -262,15 +284,15 @@ AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, 
 }
 
 /* Phase 2: sum of signed weight * (real | dual); broadcasts from memory are plain loads. */
-AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const akp_skin_ctx* c, const uint32_t* off, const float* sw) {
+AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const akp_skin_ctx* c, const uint32_t* off, const float* sw,
+                                                   const uint32_t K) {
     const char* jb = (const char*)c->joints_prep;
     size_t o[4];
     offsets4(off, o);
 #define AKP_JQ(k) _mm256_loadu_ps((const float*)(const void*)(jb + o[k]))
     __m256 acc = _mm256_mul_ps(AKP_JQ(0), _mm256_broadcast_ss(&sw[0]));
-    acc = _mm256_fmadd_ps(AKP_JQ(1), _mm256_broadcast_ss(&sw[1]), acc);
-    acc = _mm256_fmadd_ps(AKP_JQ(2), _mm256_broadcast_ss(&sw[2]), acc);
-    return _mm256_fmadd_ps(AKP_JQ(3), _mm256_broadcast_ss(&sw[3]), acc);
+    for (uint32_t k = 1; k < K; ++k) acc = _mm256_fmadd_ps(AKP_JQ(k), _mm256_broadcast_ss(&sw[k]), acc);
+    return acc;
 #undef AKP_JQ
 }
 
@@ -280,8 +302,9 @@ typedef struct dq_prep {
     uint32_t off[32];
     float sw[32];
 } dq_prep;
-AKP_AVX2_INLINE static inline void dq_signs_block(const akp_skin_ctx* c, size_t i0, dq_prep* p, uint32_t cor_neg) {
-    for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->off + 4 * v, p->sw + 4 * v, cor_neg);
+AKP_AVX2_INLINE static inline void dq_signs_block(const akp_skin_ctx* c, size_t i0, dq_prep* p, uint32_t cor_neg,
+                                                  const uint32_t K) {
+    for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->off + 4 * v, p->sw + 4 * v, cor_neg, K);
 }
 
 /* Blended (real | dual) of the 8 vertices of a block: from the phase-1 data p (K == 4) when
@@ -289,7 +312,7 @@ AKP_AVX2_INLINE static inline void dq_signs_block(const akp_skin_ctx* c, size_t 
 AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p,
                                                   __m256* rows) {
     if (p) {
-        for (int v = 0; v < 8; ++v) rows[v] = dq_accumulate4(c, p->off + 4 * v, p->sw + 4 * v);
+        for (int v = 0; v < 8; ++v) rows[v] = dq_accumulate4(c, p->off + 4 * v, p->sw + 4 * v, K);
         return;
     }
     for (int v = 0; v < 8; ++v) rows[v] = blend_dq_vertex(c, i0 + (size_t)v, K);
@@ -303,7 +326,7 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
     __m256 c01[8], c23[8];
     if (off) {
         for (int v = 0; v < 8; ++v)
-            blend_matrix_rows4(c, i0 + (size_t)v, (const char*)c->palette, off + 4 * v, &c01[v], &c23[v]);
+            blend_matrix_rows4(c, i0 + (size_t)v, (const char*)c->palette, off + 4 * v, &c01[v], &c23[v], 4);
     } else {
         for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
     }
@@ -396,7 +419,7 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
          * at the copies whose rotation (w lanes) is on the reference's hemisphere */
         for (int v = 0; v < 8; ++v) {
             blend_matrix_rows4(c, i0 + (size_t)v, (const char*)c->joints_prep + offsetof(akp_skin_joint, cor_rows),
-                               p->off + 4 * v, &r01[v], &r23[v]);
+                               p->off + 4 * v, &r01[v], &r23[v], K);
         }
     } else {
         __m256 q[8];
@@ -454,10 +477,10 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
 AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
     if (c->k == 4) {
         uint32_t off[2][32];
-        joint_offsets4(c, begin, AKP_MAT_SHIFT, off[0]);
+        joint_offsets4(c, begin, AKP_MAT_SHIFT, off[0], 4);
         unsigned b = 0;
         for (size_t i = begin; i < end; i += 8, b ^= 1u) {
-            if (i + 8 < end) joint_offsets4(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u]);
+            if (i + 8 < end) joint_offsets4(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], 4);
             block_lbs(c, i, 4, off[b]);
         }
     } else {
@@ -472,23 +495,31 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
  * (the signs) one block ahead, three buffers in turn: phase 1 reads the offsets back as plain
  * loads, and reading them right after their vector store would stall on the store forwarding
  * (measured: the signs then cost 40% of DQS). */
+#define AKP_DQ_PIPELINE(fn, neg, K)                                                        \
+    do {                                                                                   \
+        dq_prep p[3];                                                                      \
+        joint_offsets4(c, begin, AKP_JOINT_SHIFT, p[0].off, (K));                          \
+        if (begin + 8 < end) joint_offsets4(c, begin + 8, AKP_JOINT_SHIFT, p[1].off, (K)); \
+        dq_signs_block(c, begin, &p[0], (neg), (K));                                       \
+        unsigned b = 0;                                                                    \
+        for (size_t i = begin; i < end; i += 8, b = b == 2u ? 0u : b + 1u) {               \
+            const unsigned b1 = b == 2u ? 0u : b + 1u, b2 = b1 == 2u ? 0u : b1 + 1u;       \
+            if (i + 16 < end) joint_offsets4(c, i + 16, AKP_JOINT_SHIFT, p[b2].off, (K));  \
+            if (i + 8 < end) dq_signs_block(c, i + 8, &p[b1], (neg), (K));                 \
+            fn(c, i, (K), &p[b]);                                                          \
+        }                                                                                  \
+    } while (0)
+/* 2 and 3 influences run the same pipeline with the missing slots zero-padded (joint 0,
+ * weight 0) in the sign pass and skipped in the blends: vertex by vertex, DQS ran 2 and 3
+ * influences slower than 4. */
 #define AKP_DQ_BLOCK_LOOP(fn, cor_neg)                                                     \
     AKP_AVX2 static void fn##_range(const akp_skin_ctx* c, size_t begin, size_t end) {     \
-        if (c->k == 4) {                                                                   \
-            dq_prep p[3];                                                                  \
-            const uint32_t neg = (cor_neg);                                                \
-            joint_offsets4(c, begin, AKP_JOINT_SHIFT, p[0].off);                           \
-            if (begin + 8 < end) joint_offsets4(c, begin + 8, AKP_JOINT_SHIFT, p[1].off);  \
-            dq_signs_block(c, begin, &p[0], neg);                                          \
-            unsigned b = 0;                                                                \
-            for (size_t i = begin; i < end; i += 8, b = b == 2u ? 0u : b + 1u) {           \
-                const unsigned b1 = b == 2u ? 0u : b + 1u, b2 = b1 == 2u ? 0u : b1 + 1u;   \
-                if (i + 16 < end) joint_offsets4(c, i + 16, AKP_JOINT_SHIFT, p[b2].off);   \
-                if (i + 8 < end) dq_signs_block(c, i + 8, &p[b1], neg);                    \
-                fn(c, i, 4, &p[b]);                                                        \
-            }                                                                              \
-        } else {                                                                           \
-            AKP_K_DISPATCH(AKP_DQ_K_##fn)                                                  \
+        const uint32_t neg = (cor_neg);                                                    \
+        switch (c->k) {                                                                    \
+        case 2: AKP_DQ_PIPELINE(fn, neg, 2u); break;                                       \
+        case 3: AKP_DQ_PIPELINE(fn, neg, 3u); break;                                       \
+        case 4: AKP_DQ_PIPELINE(fn, neg, 4u); break;                                       \
+        default: AKP_K_DISPATCH(AKP_DQ_K_##fn) break;                                      \
         }                                                                                  \
     }
 #define AKP_DQ_K_block_dqs(K) for (size_t i = begin; i < end; i += 8) block_dqs(c, i, (K), NULL)
