@@ -180,6 +180,9 @@ AKP_AVX2_INLINE static inline __m128 load_weights4(const char* p, const uint32_t
     return _mm_maskload_ps((const float*)(const void*)p, mask);
 }
 
+/* Offset slots per vertex in the pipelined paths: 4 for 2..4 influences, 8 for 8. */
+#define AKP_SLOTS(K) ((K) <= 4u ? 4u : 8u)
+
 AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t i0, int shift, uint32_t* off,
                                                   const uint32_t K) {
     const char* jp = c->jnt + i0 * c->jnt_stride;
@@ -187,6 +190,13 @@ AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t 
     const size_t last = c->palette_count - 1;
     const __m128i lim = _mm_set1_epi16((short)(uint16_t)(last > 65535u ? 65535u : last));
     const __m128i count = _mm_cvtsi32_si128(shift);
+    if (K == 8) { /* one vertex per step */
+        for (int v = 0; v < 8; ++v) {
+            __m128i j = _mm_min_epu16(_mm_loadu_si128((const __m128i*)(const void*)(jp + (size_t)v * js)), lim);
+            _mm256_storeu_si256((__m256i*)(void*)(off + 8 * v), _mm256_sll_epi32(_mm256_cvtepu16_epi32(j), count));
+        }
+        return;
+    }
     for (int h = 0; h < 4; ++h) {
         __m128i a = load_joints4(jp + (size_t)(2 * h) * js, K);
         __m128i b = load_joints4(jp + (size_t)(2 * h + 1) * js, K);
@@ -195,12 +205,14 @@ AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t 
     }
 }
 
-/* The four byte offsets of a vertex, read two per 64-bit load (the blends are load-bound). */
-static inline void offsets4(const uint32_t* off, size_t* o) {
-    uint64_t o01, o23;
-    memcpy(&o01, off, 8);
-    memcpy(&o23, off + 2, 8);
-    o[0] = (uint32_t)o01, o[1] = (size_t)(o01 >> 32), o[2] = (uint32_t)o23, o[3] = (size_t)(o23 >> 32);
+/* The AKP_SLOTS(K) byte offsets of a vertex, read two per 64-bit load (fewer load operations
+ * for the blends). */
+static inline void offsets4(const uint32_t* off, size_t* o, const uint32_t K) {
+    for (uint32_t k = 0; k < AKP_SLOTS(K); k += 2) {
+        uint64_t pair;
+        memcpy(&pair, off + k, 8);
+        o[k] = (uint32_t)pair, o[k + 1] = (size_t)(pair >> 32);
+    }
 }
 
 /* Blend of two 8-float rows at base + off[k] with the 4 weights of vertex i: the palette
@@ -208,10 +220,10 @@ static inline void offsets4(const uint32_t* off, size_t* o) {
 AKP_AVX2_INLINE static inline void blend_matrix_rows4(const akp_skin_ctx* c, size_t i, const char* base,
                                                       const uint32_t* off, __m256* out01, __m256* out23,
                                                       const uint32_t K) {
-    float ww[4];
+    float ww[8];
     memcpy(ww, c->wgt + i * c->wgt_stride, 4u * K);
-    size_t o[4];
-    offsets4(off, o);
+    size_t o[8];
+    offsets4(off, o, K);
     __m256 w = _mm256_set1_ps(ww[0]);
     const float* m = (const float*)(const void*)(base + o[0]);
     __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
@@ -287,8 +299,8 @@ AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, 
 AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const akp_skin_ctx* c, const uint32_t* off, const float* sw,
                                                    const uint32_t K) {
     const char* jb = (const char*)c->joints_prep;
-    size_t o[4];
-    offsets4(off, o);
+    size_t o[8];
+    offsets4(off, o, K);
 #define AKP_JQ(k) _mm256_loadu_ps((const float*)(const void*)(jb + o[k]))
     __m256 acc = _mm256_mul_ps(AKP_JQ(0), _mm256_broadcast_ss(&sw[0]));
     for (uint32_t k = 1; k < K; ++k) acc = _mm256_fmadd_ps(AKP_JQ(k), _mm256_broadcast_ss(&sw[k]), acc);
@@ -296,14 +308,48 @@ AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const akp_skin_ctx* c, const
 #undef AKP_JQ
 }
 
-/* Phase 1 of a whole block with 4 influences; the block loops run it one block ahead, so
- * that its dependency chain overlaps the previous block's transform. */
+/* Phase 1 for one vertex with 8 influences: as dq_signs4x2 with the two 128-bit lanes holding
+ * influences 0-3 and 4-7 of the same vertex, and one reference, the rotation of its largest
+ * weight (lowest slot on ties). */
+AKP_AVX2_INLINE static inline void dq_signs8(const akp_skin_ctx* c, size_t i, uint32_t* off, float* sw,
+                                             uint32_t cor_neg) {
+    const char* jb = (const char*)c->joints_prep;
+    const __m256 w8 = _mm256_loadu_ps((const float*)(const void*)(c->wgt + i * c->wgt_stride));
+    __m256 mx = _mm256_max_ps(w8, _mm256_permute_ps(w8, _MM_SHUFFLE(2, 3, 0, 1)));
+    mx = _mm256_max_ps(mx, _mm256_permute_ps(mx, _MM_SHUFFLE(1, 0, 3, 2)));
+    mx = _mm256_max_ps(mx, _mm256_permute2f128_ps(mx, mx, 1));
+    const unsigned is_max = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(w8, mx, _CMP_EQ_OQ));
+    const unsigned best = is_max ? (unsigned)__builtin_ctz(is_max) : 0u; /* no max: NaN weights */
+    const __m256 ref = _mm256_broadcast_ps((const __m128*)(const void*)(jb + off[best]));
+    __m256 m[4];
+    for (int k = 0; k < 4; ++k) {
+        const __m256 r = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)(jb + off[k]))),
+                                              _mm_loadu_ps((const float*)(const void*)(jb + off[4 + k])), 1);
+        m[k] = _mm256_mul_ps(r, ref);
+    }
+    const __m256 dots = _mm256_hadd_ps(_mm256_hadd_ps(m[0], m[1]), _mm256_hadd_ps(m[2], m[3]));
+    if (cor_neg) {
+        const __m256i o = _mm256_loadu_si256((const __m256i*)(const void*)off);
+        const __m256i neg = _mm256_add_epi32(_mm256_srli_epi32(o, 1), _mm256_set1_epi32((int)cor_neg));
+        _mm256_storeu_si256((__m256i*)(void*)off,
+                            _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(o), _mm256_castsi256_ps(neg), dots)));
+        return;
+    }
+    _mm256_storeu_ps(sw, _mm256_xor_ps(w8, _mm256_and_ps(dots, _mm256_set1_ps(-0.0f))));
+}
+
+/* Phase 1 of a whole block (2, 3, 4 or 8 influences); the block loops run it one block ahead,
+ * so that its dependency chain overlaps the previous block's transform. */
 typedef struct dq_prep {
-    uint32_t off[32];
-    float sw[32];
+    uint32_t off[64];
+    float sw[64];
 } dq_prep;
 AKP_AVX2_INLINE static inline void dq_signs_block(const akp_skin_ctx* c, size_t i0, dq_prep* p, uint32_t cor_neg,
                                                   const uint32_t K) {
+    if (K == 8) {
+        for (int v = 0; v < 8; ++v) dq_signs8(c, i0 + (size_t)v, p->off + 8 * v, p->sw + 8 * v, cor_neg);
+        return;
+    }
     for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->off + 4 * v, p->sw + 4 * v, cor_neg, K);
 }
 
@@ -312,7 +358,8 @@ AKP_AVX2_INLINE static inline void dq_signs_block(const akp_skin_ctx* c, size_t 
 AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p,
                                                   __m256* rows) {
     if (p) {
-        for (int v = 0; v < 8; ++v) rows[v] = dq_accumulate4(c, p->off + 4 * v, p->sw + 4 * v, K);
+        for (int v = 0; v < 8; ++v)
+            rows[v] = dq_accumulate4(c, p->off + AKP_SLOTS(K) * v, p->sw + AKP_SLOTS(K) * v, K);
         return;
     }
     for (int v = 0; v < 8; ++v) rows[v] = blend_dq_vertex(c, i0 + (size_t)v, K);
@@ -419,7 +466,7 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
          * at the copies whose rotation (w lanes) is on the reference's hemisphere */
         for (int v = 0; v < 8; ++v) {
             blend_matrix_rows4(c, i0 + (size_t)v, (const char*)c->joints_prep + offsetof(akp_skin_joint, cor_rows),
-                               p->off + 4 * v, &r01[v], &r23[v], K);
+                               p->off + AKP_SLOTS(K) * v, &r01[v], &r23[v], K);
         }
     } else {
         __m256 q[8];
@@ -519,6 +566,7 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
         case 2: AKP_DQ_PIPELINE(fn, neg, 2u); break;                                       \
         case 3: AKP_DQ_PIPELINE(fn, neg, 3u); break;                                       \
         case 4: AKP_DQ_PIPELINE(fn, neg, 4u); break;                                       \
+        case 8: AKP_DQ_PIPELINE(fn, neg, 8u); break;                                       \
         default: AKP_K_DISPATCH(AKP_DQ_K_##fn) break;                                      \
         }                                                                                  \
     }
