@@ -4,8 +4,9 @@
  * loads (matrix columns for LBS, rotation|dual quaternion pairs for DQS, matrix columns with
  * the rotation in their w slots for CoR), which avoids gathers (slow on every x86 core we
  * target); the 8 blended results are then transposed into structure-of-arrays registers and
- * the transform, normal and normalisation run 8-wide. With 4 influences the joint offsets of
- * a block are computed with SIMD, and DQS/CoR compute the hemisphere signs one block ahead.
+ * the transform, normal and normalisation run 8-wide. The joint offsets of a block are
+ * computed with SIMD ahead of it (LBS: 4 influences; DQS/CoR: 2, 3, 4 or 8, which also compute
+ * the hemisphere signs one block ahead); other counts run the blends vertex by vertex.
  * DQS/CoR never normalise the blended quaternion: the rotation formulas take 2 / |q|^2.
  * Positions and normals are deinterleaved with shuffles when tightly packed (stride 12).
  *
@@ -353,8 +354,8 @@ AKP_AVX2_INLINE static inline void dq_signs_block(const akp_skin_ctx* c, size_t 
     for (int v = 0; v < 8; v += 2) dq_signs4x2(c, i0 + (size_t)v, p->off + 4 * v, p->sw + 4 * v, cor_neg, K);
 }
 
-/* Blended (real | dual) of the 8 vertices of a block: from the phase-1 data p (K == 4) when
- * given, else vertex by vertex. */
+/* Blended (real | dual) of the 8 vertices of a block: from the phase-1 data p (K = 2, 3, 4
+ * or 8) when given, else vertex by vertex. */
 AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t i0, uint32_t K, const dq_prep* p,
                                                   __m256* rows) {
     if (p) {
@@ -557,8 +558,8 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
         }                                                                                  \
     } while (0)
 /* 2 and 3 influences run the same pipeline with the missing slots zero-padded (joint 0,
- * weight 0) in the sign pass and skipped in the blends: vertex by vertex, DQS ran 2 and 3
- * influences slower than 4. */
+ * weight 0) in the sign pass and skipped in the blends, 8 with 8 slots per vertex: vertex by
+ * vertex, DQS ran 2 and 3 influences slower than 4 and 8 at a third of 4's speed. */
 #define AKP_DQ_BLOCK_LOOP(fn, cor_neg)                                                     \
     AKP_AVX2 static void fn##_range(const akp_skin_ctx* c, size_t begin, size_t end) {     \
         const uint32_t neg = (cor_neg);                                                    \
