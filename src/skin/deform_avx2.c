@@ -155,9 +155,10 @@ AKP_AVX2_INLINE static inline void blend_matrix_vertex(const akp_skin_ctx* c, si
     *out23 = a23;
 }
 
-/* With 4 influences: the byte offsets (joint index clamped to the palette, shifted left by
- * shift) of the 8 vertices of the block at i0, off[4 v + k]; two vertices per SIMD step instead
- * of a compare, select, shift and add per influence. */
+/* The byte offsets (joint index clamped to the palette, shifted left by shift) of the 8
+ * vertices of the block at i0, off[AKP_SLOTS(K) v + k], K = 2, 3, 4 or 8 (slots past K are
+ * joint 0): two vertices per SIMD step (one with 8 influences) instead of a compare, select,
+ * shift and add per influence. */
 _Static_assert(sizeof(ak_mat4) == 64 && sizeof(akp_skin_joint) == 128, "offset shifts below");
 #define AKP_MAT_SHIFT 6
 #define AKP_JOINT_SHIFT 7
@@ -539,7 +540,7 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
     }
 }
 
-/* DQS and CoR: with 4 influences, the joint offsets are computed two blocks ahead and phase 1
+/* DQS and CoR: with 2, 3, 4 or 8 influences, the joint offsets are computed two blocks ahead and phase 1
  * (the signs) one block ahead, three buffers in turn: phase 1 reads the offsets back as plain
  * loads, and reading them right after their vector store would stall on the store forwarding
  * (measured: the signs then cost 40% of DQS). */
