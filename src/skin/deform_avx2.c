@@ -540,10 +540,10 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
     }
 }
 
-/* DQS and CoR: with 2, 3, 4 or 8 influences, the joint offsets are computed two blocks ahead and phase 1
- * (the signs) one block ahead, three buffers in turn: phase 1 reads the offsets back as plain
- * loads, and reading them right after their vector store would stall on the store forwarding
- * (measured: the signs then cost 40% of DQS). */
+/* DQS and CoR: with 2, 3, 4 or 8 influences, the joint offsets are computed two blocks ahead
+ * and phase 1 (the signs) one block ahead, three buffers in turn: phase 1 reads the offsets
+ * back as plain loads, and reading them right after their vector store would stall on the
+ * store forwarding (measured: the signs then cost 40% of DQS). */
 #define AKP_DQ_PIPELINE(fn, neg, K)                                                        \
     do {                                                                                   \
         dq_prep p[3];                                                                      \
