@@ -260,20 +260,41 @@ AKP_AVX2_INLINE static inline __m256 blend_dq_vertex(const akp_skin_ctx* c, size
     return acc;
 }
 
+/* The rotations (first 4 floats of the joint records at jb + off[k] and jb + off[4 + k]) in
+ * the low and high 128-bit lanes. */
+AKP_AVX2_INLINE static inline __m256 quat_pair(const char* jb, const uint32_t* off, int k) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)(jb + off[k]))),
+                                _mm_loadu_ps((const float*)(const void*)(jb + off[4 + k])), 1);
+}
+
+/* End of phase 1 for the 8 slots at off/sw with weights w8 and dots (negative: the slot's
+ * rotation is on the other hemisphere from the reference). DQS: the signed weights to sw.
+ * CoR (cor_neg != 0): point the offsets of negative slots at the joint's negated rows instead,
+ * (count * 128 - 32) + j * 64 from the cor_rows of joint 0. */
+AKP_AVX2_INLINE static inline void store_signs(uint32_t* off, float* sw, __m256 w8, __m256 dots, uint32_t cor_neg) {
+    if (cor_neg) {
+        const __m256i o = _mm256_loadu_si256((const __m256i*)(const void*)off);
+        const __m256i neg = _mm256_add_epi32(_mm256_srli_epi32(o, 1), _mm256_set1_epi32((int)cor_neg));
+        _mm256_storeu_si256((__m256i*)(void*)off,
+                            _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(o), _mm256_castsi256_ps(neg), dots)));
+        return;
+    }
+    _mm256_storeu_ps(sw, _mm256_xor_ps(w8, _mm256_and_ps(dots, _mm256_set1_ps(-0.0f))));
+}
+
 /* The same for exactly 4 influences, in two phases so that a block can run the long
  * dependency chain (argmax -> reference -> dots -> signs) of all 8 vertices before the
  * blends. Phase 1, for vertices i and i + 1 at once (one per 128-bit lane): the signed
  * weights, from the joint offsets off (joint_offsets4, AKP_JOINT_SHIFT); off[0..3], sw[0..3]
- * belong to vertex i and off[4..7], sw[4..7] to vertex i + 1. The reference is the rotation of the largest weight (lowest slot
- * on ties), picked with blends: no branch and no index round trip through memory. */
+ * belong to vertex i and off[4..7], sw[4..7] to vertex i + 1. The reference is the rotation
+ * of the largest weight (lowest slot on ties), picked with blends: no branch and no index
+ * round trip through memory. */
 AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, uint32_t* off, float* sw,
                                                uint32_t cor_neg, const uint32_t K) {
     const char* wp = c->wgt + i * c->wgt_stride;
     const char* jb = (const char*)c->joints_prep;
     __m256 r[4];
-    for (int k = 0; k < 4; ++k)
-        r[k] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)(jb + off[k]))),
-                                    _mm_loadu_ps((const float*)(const void*)(jb + off[4 + k])), 1);
+    for (int k = 0; k < 4; ++k) r[k] = quat_pair(jb, off, k);
     const __m256 w8 = _mm256_insertf128_ps(_mm256_castps128_ps256(load_weights4(wp, K)),
                                            load_weights4(wp + c->wgt_stride, K), 1);
     __m256 mx = _mm256_max_ps(w8, _mm256_permute_ps(w8, _MM_SHUFFLE(2, 3, 0, 1)));
@@ -285,16 +306,7 @@ AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, 
     ref = _mm256_blendv_ps(ref, r[0], _mm256_permute_ps(is_max, _MM_SHUFFLE(0, 0, 0, 0)));
     __m256 dots = _mm256_hadd_ps(_mm256_hadd_ps(_mm256_mul_ps(r[0], ref), _mm256_mul_ps(r[1], ref)),
                                  _mm256_hadd_ps(_mm256_mul_ps(r[2], ref), _mm256_mul_ps(r[3], ref)));
-    if (cor_neg) {
-        /* CoR: point the offsets of negative influences at the joint's negated rows instead,
-         * (count * 128 - 32) + j * 64 from the cor_rows of joint 0 */
-        const __m256i o = _mm256_loadu_si256((const __m256i*)(const void*)off);
-        const __m256i neg = _mm256_add_epi32(_mm256_srli_epi32(o, 1), _mm256_set1_epi32((int)cor_neg));
-        _mm256_storeu_si256((__m256i*)(void*)off,
-                            _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(o), _mm256_castsi256_ps(neg), dots)));
-        return;
-    }
-    _mm256_storeu_ps(sw, _mm256_xor_ps(w8, _mm256_and_ps(dots, _mm256_set1_ps(-0.0f))));
+    store_signs(off, sw, w8, dots, cor_neg);
 }
 
 /* Phase 2: sum of signed weight * (real | dual); broadcasts from memory are plain loads. */
@@ -324,20 +336,9 @@ AKP_AVX2_INLINE static inline void dq_signs8(const akp_skin_ctx* c, size_t i, ui
     const unsigned best = is_max ? (unsigned)__builtin_ctz(is_max) : 0u; /* no max: NaN weights */
     const __m256 ref = _mm256_broadcast_ps((const __m128*)(const void*)(jb + off[best]));
     __m256 m[4];
-    for (int k = 0; k < 4; ++k) {
-        const __m256 r = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)(jb + off[k]))),
-                                              _mm_loadu_ps((const float*)(const void*)(jb + off[4 + k])), 1);
-        m[k] = _mm256_mul_ps(r, ref);
-    }
+    for (int k = 0; k < 4; ++k) m[k] = _mm256_mul_ps(quat_pair(jb, off, k), ref);
     const __m256 dots = _mm256_hadd_ps(_mm256_hadd_ps(m[0], m[1]), _mm256_hadd_ps(m[2], m[3]));
-    if (cor_neg) {
-        const __m256i o = _mm256_loadu_si256((const __m256i*)(const void*)off);
-        const __m256i neg = _mm256_add_epi32(_mm256_srli_epi32(o, 1), _mm256_set1_epi32((int)cor_neg));
-        _mm256_storeu_si256((__m256i*)(void*)off,
-                            _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(o), _mm256_castsi256_ps(neg), dots)));
-        return;
-    }
-    _mm256_storeu_ps(sw, _mm256_xor_ps(w8, _mm256_and_ps(dots, _mm256_set1_ps(-0.0f))));
+    store_signs(off, sw, w8, dots, cor_neg);
 }
 
 /* Phase 1 of a whole block (2, 3, 4 or 8 influences); the block loops run it one block ahead,
