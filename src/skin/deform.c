@@ -326,12 +326,7 @@ static uint32_t flags_packed(const char* base, size_t total, uint32_t sign_mask)
 static uint32_t flags_floats(const char* base, size_t stride, size_t count, size_t floats, uint32_t sign_mask) {
     if (stride == 4 * floats) return flags_packed(base, count * floats, sign_mask);
     uint32_t bad = 0;
-    for (size_t i = 0; i < count; ++i)
-        for (size_t e = 0; e < floats; ++e) {
-            uint32_t b;
-            memcpy(&b, base + i * stride + 4 * e, 4);
-            bad |= float_flags(b, sign_mask);
-        }
+    for (size_t i = 0; i < count; ++i) bad |= flags_packed(base + i * stride, floats, sign_mask);
     return bad;
 }
 
@@ -431,12 +426,7 @@ static bool influences_surely_ok(const char* wb, size_t ws, const char* jb, size
     if (js == 2u * k) {
         bad |= flags_joints_packed(jb, n * k, limit);
     } else {
-        for (size_t i = 0; i < n; ++i)
-            for (uint32_t e = 0; e < k; ++e) {
-                uint16_t j;
-                memcpy(&j, jb + i * js + 2 * e, 2);
-                bad |= j >= limit;
-            }
+        for (size_t i = 0; i < n; ++i) bad |= flags_joints_packed(jb + i * js, k, limit);
     }
     return bad == 0;
 }
@@ -496,6 +486,20 @@ static bool screen_range(const ak_skin_job* job, size_t b, size_t e) {
     return ok;
 }
 
+/* Run fn on the count (<= 64) tasks at tasks, size bytes apart: task 0 on the calling thread,
+ * the others on new pthreads, or on the calling thread when one cannot start. */
+static void run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count) {
+    pthread_t ids[64];
+    bool started[64];
+    char* base = (char*)tasks;
+    for (uint32_t t = 1; t < count; ++t) started[t] = pthread_create(&ids[t], NULL, fn, base + t * size) == 0;
+    fn(base);
+    for (uint32_t t = 1; t < count; ++t) {
+        if (started[t]) pthread_join(ids[t], NULL);
+        else fn(base + t * size);
+    }
+}
+
 typedef struct screen_task {
     const ak_skin_job* job;
     size_t begin, end;
@@ -519,20 +523,14 @@ static ak_result check_data(const ak_skin_job* job, uint32_t threads) {
     if (threads > 64) threads = 64;
     if (threads == 0 || n < AKP_SKIN_PARALLEL_SCREEN) threads = 1;
     screen_task tasks[64];
-    pthread_t ids[64];
-    bool started[64];
     const size_t chunk = (n + threads - 1) / threads;
     for (uint32_t t = 0; t < threads; ++t) {
         size_t b = (size_t)t * chunk, e = b + chunk;
         tasks[t] = (screen_task){job, b < n ? b : n, e < n ? e : n, false};
-        started[t] = t > 0 && pthread_create(&ids[t], NULL, screen_thread, &tasks[t]) == 0;
     }
-    bool ok = screen_range(job, tasks[0].begin, tasks[0].end);
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else screen_thread(&tasks[t]);
-        ok = ok && tasks[t].ok;
-    }
+    run_tasks(screen_thread, tasks, sizeof tasks[0], threads);
+    bool ok = true;
+    for (uint32_t t = 0; t < threads; ++t) ok = ok && tasks[t].ok;
     if (ok && job->normals_from_faces) {
         uint32_t bad = 0;
         for (size_t i = 0; i < job->indices.count; ++i) bad |= job->indices.ptr[i] >= n;
@@ -617,14 +615,10 @@ typedef struct range_task {
     bool simd;
 } range_task;
 
-static void run_range(const range_task* t) {
-    if (t->begin >= t->end) return;
-    if (t->simd && akp_skin_range_avx2(t->ctx, t->begin, t->end)) return;
-    akp_skin_range_scalar(t->ctx, t->begin, t->end);
-}
-
 static void* range_thread(void* arg) {
-    run_range((const range_task*)arg);
+    const range_task* t = (const range_task*)arg;
+    if (t->begin < t->end && !(t->simd && akp_skin_range_avx2(t->ctx, t->begin, t->end)))
+        akp_skin_range_scalar(t->ctx, t->begin, t->end);
     return NULL;
 }
 
@@ -696,8 +690,6 @@ ak_result ak_skin_job_run(const ak_skin_job* job) {
     uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
     if (threads > n / 64 + 1) threads = (uint32_t)(n / 64 + 1);
     range_task tasks[64];
-    pthread_t ids[64];
-    bool started[64];
     size_t chunk = (n + threads - 1) / threads;
     chunk = (chunk + 7u) & ~(size_t)7u; /* keep SIMD blocks whole */
     for (uint32_t t = 0; t < threads; ++t) {
@@ -708,15 +700,8 @@ ak_result ak_skin_job_run(const ak_skin_job* job) {
         tasks[t].begin = b;
         tasks[t].end = e;
         tasks[t].simd = simd;
-        started[t] = false;
     }
-    for (uint32_t t = 1; t < threads; ++t)
-        started[t] = pthread_create(&ids[t], NULL, range_thread, &tasks[t]) == 0;
-    run_range(&tasks[0]);
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else run_range(&tasks[t]);
-    }
+    run_tasks(range_thread, tasks, sizeof tasks[0], threads);
     if (job->normals_from_faces) normals_from_faces(job);
     return AK_OK;
 }

@@ -570,7 +570,8 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
         case 3: AKP_DQ_PIPELINE(fn, neg, 3u); break;                                       \
         case 4: AKP_DQ_PIPELINE(fn, neg, 4u); break;                                       \
         case 8: AKP_DQ_PIPELINE(fn, neg, 8u); break;                                       \
-        default: AKP_K_DISPATCH(AKP_DQ_K_##fn) break;                                      \
+        case 1: AKP_DQ_K_##fn(1u); break;                                                  \
+        default: AKP_DQ_K_##fn(c->k); break; /* 5, 6, 7 */                                 \
         }                                                                                  \
     }
 #define AKP_DQ_K_block_dqs(K) for (size_t i = begin; i < end; i += 8) block_dqs(c, i, (K), NULL)
