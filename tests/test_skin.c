@@ -446,6 +446,41 @@ AK_TEST(job_data_screen_catches_faults_everywhere) {
             free(pos), free(nrm), free(ctr), free(out), free(outn), free(jn), free(w), free(scratch);
         }
     }
+    /* interleaved vertices (strided streams take the screen's element-by-element path) */
+    enum { NI = 21 };
+    interleaved_vertex iv[NI];
+    ak_vec3 out[NI], outn[NI];
+    ak_rng rng = ak_rng_make(31);
+    memset(iv, 0, sizeof iv);
+    for (int i = 0; i < NI; ++i) {
+        iv[i].pos[0] = ak_rng_range(&rng, -1, 1);
+        iv[i].nrm[1] = 1.0f;
+        rand_influences(&rng, 4, J, iv[i].joints, iv[i].weights);
+    }
+    const ak_skin_job ij = {
+        .influence_count = 4,
+        .palette = {pal, J},
+        .positions = {iv[0].pos, NI, sizeof iv[0]},
+        .normals = {iv[0].nrm, NI, sizeof iv[0]},
+        .joints = {iv[0].joints, NI, sizeof iv[0]},
+        .weights = {iv[0].weights, NI, sizeof iv[0]},
+        .out_positions = {out, NI, 0},
+        .out_normals = {outn, NI, 0},
+    };
+    AK_CHECK_EQ(ak_skin_job_run(&ij), AK_OK);
+    interleaved_vertex* last = &iv[NI - 1];
+    const interleaved_vertex keep = *last;
+    last->weights[1] += last->weights[0] + 0.25f, last->weights[0] = -0.25f; /* sum kept at 1 */
+    AK_CHECK_EQ(ak_skin_job_run(&ij), AK_ERR_BAD_WEIGHTS);
+    *last = keep;
+    last->joints[3] = J;
+    AK_CHECK_EQ(ak_skin_job_run(&ij), AK_ERR_BAD_INDEX);
+    *last = keep;
+    last->nrm[2] = NAN;
+    AK_CHECK_EQ(ak_skin_job_run(&ij), AK_ERR_BAD_DATA);
+    *last = keep;
+    last->pos[1] = INFINITY;
+    AK_CHECK_EQ(ak_skin_job_run(&ij), AK_ERR_BAD_DATA);
 }
 
 AK_TEST(lbs_matches_double_reference) {
