@@ -21,7 +21,7 @@
         unsigned b = 0;                                                                            \
         for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                         \
             __asm volatile("# LLVM-MCA-BEGIN " #name);                                             \
-            joint_offsets4(&c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], 4);                              \
+            joint_offsets(&c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], 4);                               \
             block_lbs(&c, i, 4, off[b]);                                                           \
             __asm volatile("# LLVM-MCA-END " #name);                                               \
         }                                                                                          \
@@ -35,7 +35,7 @@
         for (size_t i = begin; i < end; i += 8, b = b == 2u ? 0u : b + 1u) {                       \
             const unsigned b1 = b == 2u ? 0u : b + 1u, b2 = b1 == 2u ? 0u : b1 + 1u;               \
             __asm volatile("# LLVM-MCA-BEGIN " #name);                                             \
-            joint_offsets4(&c, i + 16, AKP_JOINT_SHIFT, p[b2].off, 4);                             \
+            joint_offsets(&c, i + 16, AKP_JOINT_SHIFT, p[b2].off, 4);                              \
             dq_signs_block(&c, i + 8, &p[b1], (neg), 4);                                           \
             block(&c, i, 4, &p[b]);                                                                \
             __asm volatile("# LLVM-MCA-END " #name);                                               \

@@ -185,7 +185,7 @@ AKP_AVX2_INLINE static inline __m128 load_weights4(const char* p, const uint32_t
 /* Offset slots per vertex in the pipelined paths: 4 for 2..4 influences, 8 for 8. */
 #define AKP_SLOTS(K) ((K) <= 4u ? 4u : 8u)
 
-AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t i0, int shift, uint32_t* off,
+AKP_AVX2_INLINE static inline void joint_offsets(const akp_skin_ctx* c, size_t i0, int shift, uint32_t* off,
                                                   const uint32_t K) {
     const char* jp = c->jnt + i0 * c->jnt_stride;
     const size_t js = c->jnt_stride;
@@ -209,7 +209,7 @@ AKP_AVX2_INLINE static inline void joint_offsets4(const akp_skin_ctx* c, size_t 
 
 /* The AKP_SLOTS(K) byte offsets of a vertex, read two per 64-bit load (fewer load operations
  * for the blends). */
-static inline void offsets4(const uint32_t* off, size_t* o, const uint32_t K) {
+static inline void vertex_offsets(const uint32_t* off, size_t* o, const uint32_t K) {
     for (uint32_t k = 0; k < AKP_SLOTS(K); k += 2) {
         uint64_t pair;
         memcpy(&pair, off + k, 8);
@@ -218,14 +218,14 @@ static inline void offsets4(const uint32_t* off, size_t* o, const uint32_t K) {
 }
 
 /* Blend of two 8-float rows at base + off[k] with the 4 weights of vertex i: the palette
- * matrices for LBS (offsets from joint_offsets4 with AKP_MAT_SHIFT), the CoR rows for CoR. */
-AKP_AVX2_INLINE static inline void blend_matrix_rows4(const akp_skin_ctx* c, size_t i, const char* base,
+ * matrices for LBS (offsets from joint_offsets with AKP_MAT_SHIFT), the CoR rows for CoR. */
+AKP_AVX2_INLINE static inline void blend_matrix_rows(const akp_skin_ctx* c, size_t i, const char* base,
                                                       const uint32_t* off, __m256* out01, __m256* out23,
                                                       const uint32_t K) {
     float ww[8];
     memcpy(ww, c->wgt + i * c->wgt_stride, 4u * K);
     size_t o[8];
-    offsets4(off, o, K);
+    vertex_offsets(off, o, K);
     __m256 w = _mm256_set1_ps(ww[0]);
     const float* m = (const float*)(const void*)(base + o[0]);
     __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
@@ -285,7 +285,7 @@ AKP_AVX2_INLINE static inline void store_signs(uint32_t* off, float* sw, __m256 
 /* The same for exactly 4 influences, in two phases so that a block can run the long
  * dependency chain (argmax -> reference -> dots -> signs) of all 8 vertices before the
  * blends. Phase 1, for vertices i and i + 1 at once (one per 128-bit lane): the signed
- * weights, from the joint offsets off (joint_offsets4, AKP_JOINT_SHIFT); off[0..3], sw[0..3]
+ * weights, from the joint offsets off (joint_offsets, AKP_JOINT_SHIFT); off[0..3], sw[0..3]
  * belong to vertex i and off[4..7], sw[4..7] to vertex i + 1. The reference is the rotation
  * of the largest weight (lowest slot on ties), picked with blends: no branch and no index
  * round trip through memory. */
@@ -310,11 +310,11 @@ AKP_AVX2_INLINE static inline void dq_signs4x2(const akp_skin_ctx* c, size_t i, 
 }
 
 /* Phase 2: sum of signed weight * (real | dual); broadcasts from memory are plain loads. */
-AKP_AVX2_INLINE static inline __m256 dq_accumulate4(const akp_skin_ctx* c, const uint32_t* off, const float* sw,
+AKP_AVX2_INLINE static inline __m256 dq_accumulate(const akp_skin_ctx* c, const uint32_t* off, const float* sw,
                                                    const uint32_t K) {
     const char* jb = (const char*)c->joints_prep;
     size_t o[8];
-    offsets4(off, o, K);
+    vertex_offsets(off, o, K);
 #define AKP_JQ(k) _mm256_loadu_ps((const float*)(const void*)(jb + o[k]))
     __m256 acc = _mm256_mul_ps(AKP_JQ(0), _mm256_broadcast_ss(&sw[0]));
     for (uint32_t k = 1; k < K; ++k) acc = _mm256_fmadd_ps(AKP_JQ(k), _mm256_broadcast_ss(&sw[k]), acc);
@@ -362,21 +362,21 @@ AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t 
                                                   __m256* rows) {
     if (p) {
         for (int v = 0; v < 8; ++v)
-            rows[v] = dq_accumulate4(c, p->off + AKP_SLOTS(K) * v, p->sw + AKP_SLOTS(K) * v, K);
+            rows[v] = dq_accumulate(c, p->off + AKP_SLOTS(K) * v, p->sw + AKP_SLOTS(K) * v, K);
         return;
     }
     for (int v = 0; v < 8; ++v) rows[v] = blend_dq_vertex(c, i0 + (size_t)v, K);
 }
 
 
-/* off: with 4 influences, the block's palette offsets (joint_offsets4), computed a block ahead
+/* off: with 4 influences, the block's palette offsets (joint_offsets), computed a block ahead
  * by the caller so that they are read back from memory as plain loads; NULL otherwise. */
 AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K, const uint32_t* off) {
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
     if (off) {
         for (int v = 0; v < 8; ++v)
-            blend_matrix_rows4(c, i0 + (size_t)v, (const char*)c->palette, off + 4 * v, &c01[v], &c23[v], 4);
+            blend_matrix_rows(c, i0 + (size_t)v, (const char*)c->palette, off + 4 * v, &c01[v], &c23[v], 4);
     } else {
         for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
     }
@@ -468,8 +468,8 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
         /* one blend of the joints' cor_rows, as LBS blends matrices: the offsets already point
          * at the copies whose rotation (w lanes) is on the reference's hemisphere */
         for (int v = 0; v < 8; ++v) {
-            blend_matrix_rows4(c, i0 + (size_t)v, (const char*)c->joints_prep + offsetof(akp_skin_joint, cor_rows),
-                               p->off + AKP_SLOTS(K) * v, &r01[v], &r23[v], K);
+            blend_matrix_rows(c, i0 + (size_t)v, (const char*)c->joints_prep + offsetof(akp_skin_joint, cor_rows),
+                              p->off + AKP_SLOTS(K) * v, &r01[v], &r23[v], K);
         }
     } else {
         __m256 q[8];
@@ -527,10 +527,10 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
 AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
     if (c->k == 4) {
         uint32_t off[2][32];
-        joint_offsets4(c, begin, AKP_MAT_SHIFT, off[0], 4);
+        joint_offsets(c, begin, AKP_MAT_SHIFT, off[0], 4);
         unsigned b = 0;
         for (size_t i = begin; i < end; i += 8, b ^= 1u) {
-            if (i + 8 < end) joint_offsets4(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], 4);
+            if (i + 8 < end) joint_offsets(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], 4);
             block_lbs(c, i, 4, off[b]);
         }
     } else {
@@ -548,13 +548,13 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
 #define AKP_DQ_PIPELINE(fn, neg, K)                                                        \
     do {                                                                                   \
         dq_prep p[3];                                                                      \
-        joint_offsets4(c, begin, AKP_JOINT_SHIFT, p[0].off, (K));                          \
-        if (begin + 8 < end) joint_offsets4(c, begin + 8, AKP_JOINT_SHIFT, p[1].off, (K)); \
+        joint_offsets(c, begin, AKP_JOINT_SHIFT, p[0].off, (K));                          \
+        if (begin + 8 < end) joint_offsets(c, begin + 8, AKP_JOINT_SHIFT, p[1].off, (K)); \
         dq_signs_block(c, begin, &p[0], (neg), (K));                                       \
         unsigned b = 0;                                                                    \
         for (size_t i = begin; i < end; i += 8, b = b == 2u ? 0u : b + 1u) {               \
             const unsigned b1 = b == 2u ? 0u : b + 1u, b2 = b1 == 2u ? 0u : b1 + 1u;       \
-            if (i + 16 < end) joint_offsets4(c, i + 16, AKP_JOINT_SHIFT, p[b2].off, (K));  \
+            if (i + 16 < end) joint_offsets(c, i + 16, AKP_JOINT_SHIFT, p[b2].off, (K));  \
             if (i + 8 < end) dq_signs_block(c, i + 8, &p[b1], (neg), (K));                 \
             fn(c, i, (K), &p[b]);                                                          \
         }                                                                                  \
