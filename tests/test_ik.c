@@ -1177,6 +1177,127 @@ AK_TEST(fabrik_tree) {
     ak_skeleton_destroy(sk);
 }
 
+/* ---- straight chains, targets on their own line ------------------------------------------ */
+
+/* Distance from the root of the end of nb equal bones of length a, each bent by beta from its
+ * parent in one plane (a regular polygon's chord): a |sin(nb beta / 2) / sin(beta / 2)|. */
+static double curl_reach(int nb, double a, double beta) {
+    if (beta < 1e-12) return nb * a;
+    return a * fabs(sin(nb * beta / 2) / sin(beta / 2));
+}
+
+/* A straight chain pointing through its target is the singular configuration of CCD (RE is
+ * parallel to RD at every joint), FABRIK (the passes keep the chain on its line) and DLS (no
+ * Jacobian column along the line). Chains of nb = 2..10 equal bones lie straight along their
+ * parent's +x (the base joint, not in the chain, either at rest or turned to an oblique
+ * direction); the target lies on the chain's line at 5%, 10%, ..., 95% of its length. Joint
+ * variants: all free; all unlimited hinges; a free or unlimited-hinge root with hinges limited
+ * to one side ([0, 3.1] or [-3.1, 0]); a ball root (cone 2 rad) over limited hinges whose axis
+ * is oblique to the chain. Every target is reachable: the test finds, in double precision, a
+ * uniform bend beta in [0, 3.1] of the non-root joints whose chord equals the target
+ * distance (bent within the hinges' allowed side; the root then turns the chord onto the
+ * line). Every solver must reach every target with the default budget and tolerance, and
+ * keep bone lengths and limits. */
+AK_TEST(straight_chain_targets_on_its_line) {
+    enum { VARIANTS = 6 };
+    const float side_limit = 3.1f;
+    int misses[3] = {0, 0, 0}, total = 0;
+    size_t most[3] = {0, 0, 0};
+    for (int nb = 2; nb <= 10; ++nb) {
+        const size_t count = (size_t)nb + 2; /* base + nb + 1 chain joints */
+        const double a = 0.2 + 0.05 * nb;
+        for (int variant = 0; variant < VARIANTS; ++variant) {
+            chain_spec s;
+            memset(&s, 0, sizeof s);
+            s.count = count;
+            s.lengths[0] = 0.3f;
+            for (int i = 1; i <= nb; ++i) s.lengths[i] = (float)a;
+            const ak_vec3 hinge_axis = variant >= 4 ? ak_vec3_normalize(ak_vec3_make(0, 0.6f, 0.8f)) : ak_vec3_make(0, 0, 1);
+            for (size_t i = 1; i < count; ++i) {
+                const bool root = i == 1, effector = i + 1 == count;
+                ak_joint_type t = AK_JOINT_FREE;
+                ak_joint_limits l;
+                memset(&l, 0, sizeof l);
+                if (effector) {
+                    t = AK_JOINT_FREE;
+                } else if (variant == 1 || (root && (variant == 2 || variant == 3))) {
+                    t = AK_JOINT_HINGE, l.axis = hinge_axis; /* unlimited */
+                } else if (root && variant == 4) {
+                    t = AK_JOINT_FREE;
+                } else if (root && variant == 5) {
+                    t = AK_JOINT_BALL, l.axis = ak_vec3_make(1, 0, 0), l.cone_angle = 2.0f;
+                } else if (variant >= 2) {
+                    t = AK_JOINT_HINGE, l.axis = hinge_axis;
+                    l.min = variant == 3 ? -side_limit : 0.0f;
+                    l.max = variant == 3 ? 0.0f : side_limit;
+                }
+                s.types[i] = t;
+                s.limits[i] = l;
+            }
+            ak_skeleton* sk = make_chain(&s);
+            if (!sk) {
+                AK_CHECK(sk != NULL);
+                return;
+            }
+            int16_t chain[MAXJ];
+            for (size_t i = 1; i < count; ++i) chain[i - 1] = (int16_t)i;
+            const size_t chain_count = count - 1;
+            for (int oblique = 0; oblique < 2; ++oblique) {
+                const ak_quat base_rot = oblique ? ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(0.3f, 0.5f, 0.8f)), 1.0f)
+                                                 : ak_quat_identity();
+                for (int pct = 5; pct <= 95; pct += 5) {
+                    const double d = nb * a * pct / 100.0;
+                    /* the witness: curl_reach decreases from nb a (beta = 0) to its first zero
+                     * at 2 pi / nb, or to beta = 3.1 for two bones */
+                    double lo = 0.0, hi = fmin(2 * PI_D / nb, side_limit);
+                    AK_CHECK_MSG(curl_reach(nb, a, hi) <= d, "%d bones, %d%%: no witness", nb, pct);
+                    for (int it = 0; it < 60; ++it) {
+                        double mid = 0.5 * (lo + hi);
+                        if (curl_reach(nb, a, mid) > d) lo = mid;
+                        else hi = mid;
+                    }
+                    AK_CHECK_NEAR(curl_reach(nb, a, hi), d, 1e-9);
+                    for (int k = 0; k < 3; ++k) {
+                        ak_transform pose[MAXJ];
+                        rest_pose(sk, pose);
+                        pose[0].rotation = base_rot;
+                        double p[MAXJ][3];
+                        fk_positions(pose, count, p);
+                        const double* r = p[1];
+                        const double* e = p[count - 1];
+                        ak_vec3 target = ak_vec3_make((float)(r[0] + (e[0] - r[0]) * pct / 100.0),
+                                                      (float)(r[1] + (e[1] - r[1]) * pct / 100.0),
+                                                      (float)(r[2] + (e[2] - r[2]) * pct / 100.0));
+                        solve_out o = solve(sk, pose, chain, chain_count, target, iterative[k], NULL); /* defaults */
+                        AK_CHECK_EQ(o.r, AK_OK);
+                        ++total;
+                        if (o.iterations > most[k]) most[k] = o.iterations;
+                        bool ok = pose_finite(pose, count) && lengths_preserved(&s, pose);
+                        for (size_t i = 1; i < count; ++i) ok = ok && within_limits(&s, sk, i, pose[i], 1e-4);
+                        AK_CHECK_MSG(ok, "%s, %d bones, variant %d: lengths or limits broken",
+                                     ak_ik_solver_name(iterative[k]), nb, variant);
+                        if (!o.reached) {
+                            ++misses[k];
+                            if (misses[k] <= 4 || getenv("IKDBG"))
+                                printf("  %s missed: %d bones, variant %d, oblique %d, %d%%: error %g (tolerance %g), "
+                                       "%zu iterations\n",
+                                       ak_ik_solver_name(iterative[k]), nb, variant, oblique, pct, o.error,
+                                       o.tolerance, o.iterations);
+                        }
+                    }
+                }
+            }
+            ak_skeleton_destroy(sk);
+        }
+    }
+    printf("  targets on the line: %d per solver; most iterations used: ccd %zu, fabrik %zu, dls %zu\n", total / 3,
+           most[0], most[1], most[2]);
+    for (int k = 0; k < 3; ++k)
+        AK_CHECK_MSG(misses[k] == 0, "%s: %d of %d targets on the chain's line missed", ak_ik_solver_name(iterative[k]),
+                     misses[k], total / 3);
+}
+
+
 int main(void) {
     AK_RUN(chain_build);
     AK_RUN(solver_names);
@@ -1194,6 +1315,7 @@ int main(void) {
     AK_RUN(two_bone_run_many_equals_single_jobs);
     AK_RUN(unreachable_straightens);
     AK_RUN(degenerate_chains);
+    AK_RUN(straight_chain_targets_on_its_line);
     AK_RUN(dls_orientation_target);
     AK_RUN(fabrik_tree);
     return ak_test_finish();

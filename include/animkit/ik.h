@@ -169,13 +169,19 @@ AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
  * FABRIK and TWO_BONE keep them). Only rotations and slides are written, so bone lengths
  * (other than prism slides) are unchanged.
  * Solver notes: CCD is the course's algorithm as is; its tail is slow (one joint at a time).
- * A straight chain whose line passes through the target is singular for CCD, FABRIK and DLS
- * alike, so such a chain is first bent by 0.1 rad per joint (about a hinge's axis, else about
- * one normal of the line).
+ * A straight chain whose line passes through the target (inside its reach) is singular for
+ * CCD, FABRIK and DLS alike, so such a chain is first curled in one plane: the plane of the
+ * first hinge below the root (bent to the side its limits allow), else of the root's hinge,
+ * else ak_vec3_any_perpendicular of the line; every joint below the root turns by one angle
+ * (bisected so the curled chord equals the target's distance, within the hinges' limits)
+ * and the root turns the effector back onto the line. CCD and constrained FABRIK curl the
+ * chain again if they stall straight on the target's line (a hinge clamped straight).
  * FABRIK on a chain with limits first runs the plain passes (their answer often respects the
  * limits, e.g. a planar chain of hinges); if the converted pose misses, the remaining
- * iterations run constrained: the backward pass turns each joint within its limits, followed
- * by one constrained CCD sweep so joints pinned at a limit do not freeze the chain.
+ * iterations run constrained, from the better of the converted pose and the input: the
+ * backward pass turns each joint within its limits, followed by one constrained CCD sweep
+ * (from the best pose met when the limits made the pass's pose worse) so joints pinned at a
+ * limit do not freeze the chain.
  * While plain FABRIK passes shrink the error by less than half per pass (slow convergence
  * near full reach), each next pass starts from the positions extrapolated by the last pass's
  * step (a momentum step; the passes themselves keep the bone lengths).

@@ -198,32 +198,137 @@ static void apply_target_rotation(akp_ik_chain* c, const ak_quat* target_rotatio
     }
 }
 
+/* Angle of a hinge joint's local rotation about its axis, relative to its rest rotation. */
+static float hinge_angle(const ak_skeleton* sk, size_t joint, ak_quat local) {
+    const ak_quat rel = ak_quat_mul(ak_quat_conjugate(ak_skeleton_rest_pose(sk).ptr[joint].rotation), local);
+    const ak_vec3 axis = ak_skeleton_joint_limits(sk, joint).axis;
+    return 2.0f * atan2f(rel.x * axis.x + rel.y * axis.y + rel.z * axis.z, rel.w);
+}
+
+/* Direction (+1, -1) in which a hinge joint may bend from where it is, preferring
+ * `preferred` when its limits leave at least 1e-3 rad that way, and the room left that way
+ * (radians, INFINITY when unlimited); 0 when neither way has room. */
+static float hinge_bend_sign(const akp_ik_chain* c, size_t i, float preferred, float* out_room) {
+    const size_t j = (size_t)c->joints[i];
+    const ak_joint_limits l = ak_skeleton_joint_limits(c->skeleton, j);
+    *out_room = INFINITY;
+    if (!c->clamp[i] || (l.min == 0.0f && l.max == 0.0f)) return preferred;
+    const float a = hinge_angle(c->skeleton, j, c->pose[j].rotation);
+    const float up = l.max - a, down = a - l.min, need = 1e-3f;
+    if ((preferred > 0.0f ? up : down) >= need) {
+        *out_room = preferred > 0.0f ? up : down;
+        return preferred;
+    }
+    if ((preferred > 0.0f ? down : up) >= need) {
+        *out_room = preferred > 0.0f ? down : up;
+        return -preferred;
+    }
+    *out_room = 0.0f;
+    return 0.0f;
+}
+
+/* World axis of chain joint i's hinge. */
+static ak_vec3 hinge_world_axis(const akp_ik_chain* c, size_t i) {
+    return ak_vec3_normalize(ak_quat_rotate(c->world[i].rotation, ak_skeleton_joint_limits(c->skeleton, (size_t)c->joints[i]).axis));
+}
+
+/* How chain joint i (below the root) bends in the plane of `normal`: the turn's sign about
+ * its own axis (0: it does not bend) and the room its limits leave (radians). */
+static float bend_sign(const akp_ik_chain* c, size_t i, ak_vec3 normal, float* out_room) {
+    *out_room = INFINITY;
+    if (c->types[i] == AK_JOINT_PRISM) return 0.0f;
+    if (c->types[i] != AK_JOINT_HINGE) return 1.0f;
+    return hinge_bend_sign(c, i, ak_vec3_dot(hinge_world_axis(c, i), normal) < 0.0f ? -1.0f : 1.0f, out_room);
+}
+
+/* Distance from the root to the effector of the straight chain (bones lengths[k] from
+ * chain joint k to k + 1) once every bending joint below the root turns by beta in one
+ * plane: |sum_k length_k e^(i theta_k)|, theta_k = beta x (bending joints among 1..k). */
+static float curled_chord(const akp_ik_chain* c, ak_vec3 normal, float beta) {
+    float x = 0.0f, y = 0.0f, theta = 0.0f, room;
+    for (size_t k = 0; k + 1 < c->count; ++k) {
+        if (k > 0 && bend_sign(c, k, normal, &room) != 0.0f) theta += beta;
+        const float len = ak_vec3_distance(c->world[k + 1].translation, c->world[k].translation);
+        x += len * cosf(theta);
+        y += len * sinf(theta);
+    }
+    return sqrtf(x * x + y * y);
+}
+
 /* A straight chain whose line passes through the target is a singular configuration for the
  * iterative solvers: CCD's RE is parallel to RD at every joint, the Jacobian has no column
- * along the line, and FABRIK's passes stay on the line. Bend every joint a little (about its
- * axis for a hinge, else about one fixed normal of the line) so they can start. */
-static void unstraighten(akp_ik_chain* c) {
+ * along the line, and FABRIK's passes stay on the line. Bend the chain in one plane before
+ * iterating: the plane's normal is the axis of the first hinge below the root (turned to
+ * the side its limits allow), else the root's hinge axis, else a fixed normal of the line
+ * (ak_vec3_any_perpendicular). Every joint below the root (prism joints excepted) turns by
+ * the same angle beta about that normal (a hinge about its own axis, on the side its limits
+ * allow), beta chosen by bisection so that the curled chain's chord equals the target's
+ * distance (at most 3 rad, 2 pi / bones, and what the hinges' limits leave); then the root
+ * turns the effector back onto the line towards the target. In one plane this reaches the
+ * target at once; the solvers finish what limits or off-plane axes leave. The chain curls
+ * like a limb flexing its hinges, the side the solvers keep (a hinge bent the other way
+ * would be clamped straight again). */
+bool akp_ik_unstraighten(akp_ik_chain* c) {
     const size_t last = c->count - 1;
     const ak_vec3 root = c->world[0].translation;
     const ak_vec3 dir = ak_vec3_normalize(ak_vec3_sub(c->world[last].translation, root));
-    if (ak_vec3_length_sq(dir) == 0.0f || !(c->length > 0.0f)) return;
+    if (ak_vec3_length_sq(dir) == 0.0f || !(c->length > 0.0f)) return false;
     const float eps = 1e-5f * c->length;
     for (size_t i = 1; i <= last; ++i) {
         ak_vec3 d = ak_vec3_sub(c->world[i].translation, root);
-        if (ak_vec3_length(ak_vec3_madd(d, dir, -ak_vec3_dot(d, dir))) > eps) return; /* not straight */
+        if (ak_vec3_length(ak_vec3_madd(d, dir, -ak_vec3_dot(d, dir))) > eps) return false; /* not straight */
     }
-    ak_vec3 dt = ak_vec3_sub(c->target, root);
-    if (ak_vec3_length(ak_vec3_madd(dt, dir, -ak_vec3_dot(dt, dir))) > eps) return; /* target off the line */
-    const ak_vec3 normal = ak_vec3_any_perpendicular(dir);
-    for (size_t i = 0; i < last; ++i) {
-        ak_vec3 axis = normal;
-        if (c->types[i] == AK_JOINT_PRISM) continue;
-        if (c->types[i] == AK_JOINT_HINGE)
-            axis = ak_vec3_normalize(
-                ak_quat_rotate(c->world[i].rotation, ak_skeleton_joint_limits(c->skeleton, (size_t)c->joints[i]).axis));
-        akp_ik_rotate(c, i, ak_quat_from_axis_angle(axis, 0.1f));
+    const ak_vec3 dt = ak_vec3_sub(c->target, root);
+    if (ak_vec3_length(ak_vec3_madd(dt, dir, -ak_vec3_dot(dt, dir))) > eps) return false; /* target off the line */
+    if (ak_vec3_dot(dt, dir) >= c->length - eps) return false; /* beyond the reach: straight is the answer */
+    /* The bend plane's normal: a hinge's axis (on its allowed side) fixes the plane the chain
+     * can bend in; without hinges any normal of the line does. */
+    ak_vec3 normal = ak_vec3_zero();
+    float room;
+    for (size_t k = 0; k < last && ak_vec3_length_sq(normal) == 0.0f; ++k) {
+        const size_t i = k + 1 < last ? k + 1 : 0; /* joints below the root first, then the root */
+        if (c->types[i] != AK_JOINT_HINGE) continue;
+        const ak_vec3 w = hinge_world_axis(c, i);
+        const ak_vec3 n = ak_vec3_madd(w, dir, -ak_vec3_dot(w, dir));
+        if (ak_vec3_length_sq(n) < 1e-6f) continue; /* turns about the line itself: no bend */
+        const float sign = i == 0 ? 1.0f : hinge_bend_sign(c, i, 1.0f, &room);
+        if (sign != 0.0f) normal = ak_vec3_scale(ak_vec3_normalize(n), sign);
+    }
+    if (ak_vec3_length_sq(normal) == 0.0f) normal = ak_vec3_any_perpendicular(dir);
+    /* The largest common turn: 3 rad, the first zero of a regular curl's chord (2 pi over
+     * the bones), and the room of every limited hinge. */
+    float hi = ak_minf(3.0f, 2.0f * AK_PI / (float)last);
+    size_t bending = 0;
+    for (size_t i = 1; i < last; ++i) {
+        if (bend_sign(c, i, normal, &room) == 0.0f) continue;
+        ++bending;
+        hi = ak_minf(hi, room);
+    }
+    if (bending == 0) return false; /* nothing below the root can bend */
+    const float d = ak_vec3_length(dt);
+    float lo = 0.0f, beta = hi;
+    if (curled_chord(c, normal, hi) < d) {
+        for (int it = 0; it < 32; ++it) { /* chord(lo) > d >= chord(beta) */
+            const float mid = 0.5f * (lo + beta);
+            if (curled_chord(c, normal, mid) > d) lo = mid;
+            else beta = mid;
+        }
+    }
+    for (size_t i = 1; i < last; ++i) {
+        const float sign = bend_sign(c, i, normal, &room);
+        if (sign == 0.0f) continue;
+        const ak_vec3 axis = c->types[i] == AK_JOINT_HINGE ? hinge_world_axis(c, i) : normal;
+        akp_ik_rotate(c, i, ak_quat_from_axis_angle(axis, sign * beta));
         akp_ik_fk(c, i + 1);
     }
+    if (c->types[0] != AK_JOINT_PRISM) {
+        const bool hinge = c->types[0] == AK_JOINT_HINGE;
+        const ak_vec3 axis = hinge ? hinge_world_axis(c, 0) : ak_vec3_zero();
+        akp_ik_rotate(c, 0, akp_ik_aim_rotation(ak_vec3_sub(c->world[last].translation, root), dt, hinge, axis, AK_PI));
+        akp_ik_fk(c, 1);
+    }
+    akp_ik_track_best(c, ak_vec3_distance(c->world[last].translation, c->target));
+    return true;
 }
 
 ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
@@ -270,7 +375,7 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
         apply_target_rotation(&c, rj.target_rotation);
     } else {
         const float start_error = ak_vec3_distance(c.world[n - 1].translation, c.target);
-        if (rj.solver != AK_IK_SOLVER_TWO_BONE && start_error > c.tolerance) unstraighten(&c);
+        if (rj.solver != AK_IK_SOLVER_TWO_BONE && start_error > c.tolerance) akp_ik_unstraighten(&c);
         switch (rj.solver) {
         case AK_IK_SOLVER_CCD:
             out = akp_ik_ccd(&c, &rj);

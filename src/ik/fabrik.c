@@ -78,6 +78,9 @@ static void fabrik_pass(akp_ik_chain* c, ak_vec3* pos, const float* len, float t
     }
     if (constrained) {
         positions_to_rotations(c, pos);
+        /* Limits can turn the passes' answer into a worse pose than the best one met (a bend
+         * the hinges refuse comes back straight): sweep from the best pose then. */
+        akp_ik_restore_best(c, ak_vec3_distance(c->world[last].translation, t));
         akp_ik_ccd_sweep(c, AK_PI, false);
         for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
     }
@@ -97,6 +100,7 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
     const float noise = 1e-6f * ak_maxf(total, 1e-6f);
     akp_ik_outcome out = {ak_vec3_distance(pos[last], t), 0};
     bool constrained = false;
+    int rebends = 0;
     for (;;) {
         float best = out.error;
         int stalled = 0;
@@ -128,6 +132,14 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
                 best = out.error;
                 stalled = 0;
             } else if (++stalled >= 3) {
+                /* Constrained and stuck straight on the target's line: bend again. */
+                if (constrained && rebends < 2 && akp_ik_unstraighten(c)) {
+                    ++rebends;
+                    stalled = 0;
+                    for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
+                    best = out.error = ak_vec3_distance(pos[last], t);
+                    continue;
+                }
                 break;
             }
         }
@@ -138,6 +150,12 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
         akp_ik_track_best(c, out.error);
         if (out.error <= c->tolerance || out.iterations >= job->max_iterations) break;
         constrained = true;
+        /* The plain passes need not bend the way the limits allow (from a nearly straight
+         * chain, the forward pass folds the last bones back, zigzagging): when the converted
+         * answer is worse than the input, the constrained iterations start from the input;
+         * when it came back straight on the target's line, bend it the allowed way. */
+        out.error = akp_ik_restore_best(c, out.error);
+        akp_ik_unstraighten(c);
         for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
     }
     out.error = akp_ik_restore_best(c, out.error);
