@@ -1298,6 +1298,85 @@ AK_TEST(straight_chain_targets_on_its_line) {
 }
 
 
+/* Bones of 1e30 (squared distances overflow float) and of 1e-30 (squared distances vanish
+ * under any fixed threshold): the job solves in a scaled frame, so reachable targets are
+ * reached, unreachable ones are not, and every reported number is finite. The oracles are
+ * the scale-free answers: the same chain with unit bones, scaled. */
+AK_TEST(extreme_scales) {
+    const float scales[] = {1e30f, 3e35f, 1e-30f, 1.0f};
+    for (size_t si = 0; si < sizeof scales / sizeof scales[0]; ++si) {
+        const float k = scales[si];
+        chain_spec s = uniform_chain(4, AK_JOINT_FREE);
+        for (int i = 0; i < 3; ++i) s.lengths[i] = k; /* reach 3k */
+        ak_skeleton* sk = make_chain(&s);
+        if (!sk) {
+            AK_CHECK(sk != NULL);
+            return;
+        }
+        int16_t chain[4] = {0, 1, 2, 3};
+        const float len = ak_ik_chain_length(sk, (ak_transform_cspan){ak_skeleton_rest_pose(sk).ptr, 4},
+                                             (ak_i16_cspan){chain, 4});
+        AK_CHECK_MSG(isfinite(len) && fabs(len - 3.0 * k) <= 1e-6 * 3.0 * k, "scale %g: chain length %g", k, len);
+        for (int k2 = 0; k2 < 4; ++k2) {
+            const ak_ik_solver solver = k2 < 3 ? iterative[k2] : AK_IK_SOLVER_FABRIK;
+            /* reachable (1.2, 1.5, 0.4) k; unreachable (5, 0, 0) k: error 2k */
+            const ak_vec3 near = ak_vec3_make(1.2f * k, 1.5f * k, 0.4f * k), far = ak_vec3_make(5.0f * k, 0, 0);
+            ak_transform pose[4];
+            rest_pose(sk, pose);
+            pose[1].rotation = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.4f);
+            solve_out o = solve(sk, pose, chain, 4, k2 == 3 ? far : near, solver, NULL);
+            AK_CHECK_EQ(o.r, AK_OK);
+            AK_CHECK_MSG(isfinite(o.error) && isfinite(o.tolerance) && o.tolerance < 1e-3 * k,
+                         "scale %g %s: error %g tolerance %g", k, ak_ik_solver_name(solver), o.error, o.tolerance);
+            AK_CHECK(pose_finite(pose, 4));
+            if (k2 < 3) {
+                AK_CHECK_MSG(o.reached && o.error <= o.tolerance, "scale %g %s: not reached, error %g (tolerance %g)",
+                             k, ak_ik_solver_name(solver), o.error, o.tolerance);
+            } else {
+                AK_CHECK_MSG(!o.reached, "scale %g: an unreachable target reported reached", k);
+                AK_CHECK_MSG(fabs(o.error - 2.0 * k) <= 1e-4 * k, "scale %g: error %g, want %g", k, o.error, 2.0 * k);
+            }
+            /* the reported error is the true distance (computed here in double) */
+            double p[MAXJ][3];
+            fk_positions(pose, 4, p);
+            const ak_vec3 t = k2 == 3 ? far : near;
+            double tt[3] = {t.x, t.y, t.z};
+            AK_CHECK_MSG(fabs(dist3(p[3], tt) - o.error) <= 1e-5 * k, "scale %g: error %g vs %g", k, o.error, dist3(p[3], tt));
+        }
+        /* the FABRIK tree job, one effector: same answers */
+        for (int far_case = 0; far_case < 2; ++far_case) {
+            ak_transform pose[4];
+            rest_pose(sk, pose);
+            pose[1].rotation = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.4f);
+            int16_t eff[1] = {3};
+            ak_vec3 tg[1] = {far_case ? ak_vec3_make(5.0f * k, 0, 0) : ak_vec3_make(1.2f * k, 1.5f * k, 0.4f * k)};
+            bool reached = !far_case;
+            float error = -1.0f;
+            ak_ik_fabrik_tree_job tj = {.skeleton = sk, .pose = AK_SPAN(pose), .root_joint = 0,
+                                        .effectors = AK_SPAN(eff), .targets = AK_SPAN(tg),
+                                        .scratch = AK_SPAN(scratch), .out_reached = &reached, .out_error = &error};
+            AK_CHECK_EQ(ak_ik_fabrik_tree_run(&tj), AK_OK);
+            AK_CHECK_MSG(isfinite(error) && reached == !far_case, "tree, scale %g, far %d: reached %d error %g", k,
+                         far_case, reached, error);
+            if (far_case) AK_CHECK_MSG(fabs(error - 2.0 * k) <= 1e-4 * k, "tree, scale %g: error %g", k, error);
+            else AK_CHECK(error <= 1e-4 * 3.0 * k);
+        }
+        ak_skeleton_destroy(sk);
+    }
+    /* Chain positions beyond float range (two bones of 3e38 along x): rejected, not inf. */
+    chain_spec big = uniform_chain(3, AK_JOINT_FREE);
+    big.lengths[0] = big.lengths[1] = 3e38f;
+    ak_skeleton* sk = make_chain(&big);
+    if (sk) {
+        int16_t chain[3] = {0, 1, 2};
+        ak_transform pose[3];
+        rest_pose(sk, pose);
+        solve_out o = solve(sk, pose, chain, 3, ak_vec3_make(1, 0, 0), AK_IK_SOLVER_CCD, NULL);
+        AK_CHECK_EQ(o.r, AK_ERR_BAD_DATA);
+        ak_skeleton_destroy(sk);
+    }
+}
+
 int main(void) {
     AK_RUN(chain_build);
     AK_RUN(solver_names);
@@ -1316,6 +1395,7 @@ int main(void) {
     AK_RUN(unreachable_straightens);
     AK_RUN(degenerate_chains);
     AK_RUN(straight_chain_targets_on_its_line);
+    AK_RUN(extreme_scales);
     AK_RUN(dls_orientation_target);
     AK_RUN(fabrik_tree);
     return ak_test_finish();

@@ -1,5 +1,7 @@
 /* IK chains: building and checking chains, the chain job (validation, defaults, dispatch to
  * the solvers in ccd.c, fabrik.c, dls.c, two_bone.c). */
+#include <float.h>
+#include <math.h>
 #include <string.h>
 
 #include "ik_internal.h"
@@ -44,6 +46,24 @@ static float world_length(const ak_transform* world, size_t count) {
 }
 
 static bool nonneg(float x) { return x >= 0.0f && ak_finitef(x); }
+
+/* |a - b| in double: neither overflows nor underflows for any finite floats. */
+static double distance_d(ak_vec3 a, ak_vec3 b) {
+    const double x = (double)a.x - b.x, y = (double)a.y - b.y, z = (double)a.z - b.z;
+    return sqrt(x * x + y * y + z * z);
+}
+
+/* The model-space transforms of the chain (and its ancestors) stay finite: float FK of finite
+ * locals can still overflow (bones of 3e38 end to end). */
+static bool chain_fk_finite(const ak_skeleton* sk, const ak_transform* pose, ak_i16_cspan chain) {
+    ak_transform w = parent_model(sk, pose, chain.ptr[0]);
+    if (!ak_transform_is_finite(w)) return false;
+    for (size_t k = 0; k < chain.count; ++k) {
+        w = ak_transform_mul(w, pose[chain.ptr[k]]);
+        if (!ak_transform_is_finite(w)) return false;
+    }
+    return true;
+}
 
 static void* align16(void* p) { return (void*)(((uintptr_t)p + 15u) & ~(uintptr_t)15u); }
 
@@ -95,14 +115,14 @@ float ak_ik_chain_length(const ak_skeleton* skeleton, ak_transform_cspan pose, a
     if (!skeleton || !pose.ptr || !chain.ptr || chain.count == 0) return 0.0f;
     if (pose.count < ak_skeleton_joint_count(skeleton) || check_chain(skeleton, chain) != AK_OK) return 0.0f;
     ak_transform w = parent_model(skeleton, pose.ptr, chain.ptr[0]);
-    float len = 0.0f;
+    double len = 0.0; /* in double: a float squared distance overflows from bones of ~1e19 */
     ak_vec3 prev = ak_vec3_zero();
     for (size_t k = 0; k < chain.count; ++k) {
         w = ak_transform_mul(w, pose.ptr[chain.ptr[k]]);
-        if (k > 0) len += ak_vec3_distance(w.translation, prev);
+        if (k > 0) len += distance_d(w.translation, prev);
         prev = w.translation;
     }
-    return len;
+    return len < FLT_MAX ? (float)len : (len == len ? FLT_MAX : 0.0f);
 }
 
 /* ---- solver names ---------------------------------------------------------------------- */
@@ -156,9 +176,11 @@ ak_ik_chain_job ak_ik_chain_job_resolved(const ak_ik_chain_job* job) {
     if (r.max_step == 0.0f) r.max_step = AK_PI;
     float len = ak_ik_chain_length(job->skeleton, (ak_transform_cspan){job->pose.ptr, job->pose.count}, job->chain);
     if (job->skeleton && job->pose.ptr && job->chain.ptr && job->chain.count) {
-        if (r.tolerance == 0.0f) r.tolerance = ak_maxf(1e-4f * len, 1e-7f);
-        if (r.dls_damping == 0.0f) r.dls_damping = ak_maxf(0.1f * len, 1e-6f);
-        if (r.orientation_weight == 0.0f) r.orientation_weight = ak_maxf(len / AK_PI, 1e-6f);
+        /* Relative to the chain's length, whatever its scale; fixed values only for a chain
+         * of zero length. */
+        if (r.tolerance == 0.0f) r.tolerance = len > 0.0f ? 1e-4f * len : 1e-7f;
+        if (r.dls_damping == 0.0f) r.dls_damping = len > 0.0f ? 0.1f * len : 1e-6f;
+        if (r.orientation_weight == 0.0f) r.orientation_weight = len > 0.0f ? len / AK_PI : 1e-6f;
     }
     return r;
 }
@@ -180,7 +202,9 @@ ak_result ak_ik_chain_validate(const ak_ik_chain_job* job) {
         return AK_ERR_BAD_ARG;
     if (!(job->soft >= 0.0f && job->soft < 1.0f)) return AK_ERR_BAD_ARG;
     if (!(job->keep_animation >= 0.0f && job->keep_animation <= 1.0f)) return AK_ERR_BAD_ARG;
-    if (!pose_chain_finite(job->skeleton, job->pose.ptr, job->chain)) return AK_ERR_BAD_DATA;
+    if (!pose_chain_finite(job->skeleton, job->pose.ptr, job->chain) ||
+        !chain_fk_finite(job->skeleton, job->pose.ptr, job->chain))
+        return AK_ERR_BAD_DATA;
     if (!job->scratch.ptr) return AK_ERR_NULL_ARG;
     if (job->scratch.count < ak_ik_chain_scratch_size(job->solver, job->chain.count)) return AK_ERR_SPAN_SMALL;
     return AK_OK;
@@ -361,11 +385,43 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
                                (type == AK_JOINT_HINGE && (l.min != 0.0f || l.max != 0.0f)) ||
                                (type == AK_JOINT_BALL && (l.cone_angle > 0.0f || l.twist_min != 0.0f || l.twist_max != 0.0f)));
     }
-    c.target = rj.target;
     c.limits = !rj.ignore_limits;
+    /* Solve in a frame centred on the chain root and scaled by a power of two S that brings
+     * the chain's extent into [0.5, 1): squared distances can neither overflow (bones of
+     * 1e30) nor vanish under the solvers' fixed thresholds (bones of 1e-30), and scaling by
+     * a power of two is exact. Only the chain's base moves into the frame (its translation
+     * shifted, its scale divided by S), so local rotations and prism slides come out in the
+     * pose's own units. A target farther than 1e6 chain extents is moved onto the same ray
+     * from the root at that distance (out of reach either way). */
+    akp_ik_fk(&c, 0);
+    const ak_vec3 root = c.world[0].translation;
+    double extent = 0.0;
+    for (size_t i = 1; i < n; ++i) {
+        const ak_vec3 p = c.world[i].translation;
+        extent = fmax(extent, fmax(fabs((double)p.x - root.x), fmax(fabs((double)p.y - root.y), fabs((double)p.z - root.z))));
+    }
+    int exponent = 0;
+    if (extent > 0.0) frexp(extent, &exponent);
+    const double scale = ldexp(1.0, exponent), inv = 1.0 / scale;
+    c.base.translation = ak_vec3_make((float)(((double)c.base.translation.x - root.x) * inv),
+                                      (float)(((double)c.base.translation.y - root.y) * inv),
+                                      (float)(((double)c.base.translation.z - root.z) * inv));
+    c.base.scale = ak_vec3_make((float)(c.base.scale.x * inv), (float)(c.base.scale.y * inv), (float)(c.base.scale.z * inv));
+    {
+        double t[3] = {((double)rj.target.x - root.x) * inv, ((double)rj.target.y - root.y) * inv,
+                       ((double)rj.target.z - root.z) * inv};
+        const double d = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]), far = 1e6;
+        if (d > far)
+            for (int k = 0; k < 3; ++k) t[k] *= far / d;
+        c.target = ak_vec3_make((float)t[0], (float)t[1], (float)t[2]);
+    }
     akp_ik_fk(&c, 0);
     c.length = world_length(c.world, n);
-    c.tolerance = rj.tolerance;
+    c.tolerance = (float)(rj.tolerance * inv);
+    ak_ik_chain_job sj = rj; /* the job's lengths in the solve's frame */
+    sj.tolerance = c.tolerance;
+    sj.dls_damping = (float)(rj.dls_damping * inv);
+    sj.orientation_weight = (float)(rj.orientation_weight * inv);
     c.best_error = INFINITY;
     akp_ik_track_best(&c, ak_vec3_distance(c.world[n - 1].translation, c.target));
 
@@ -378,33 +434,38 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
         if (rj.solver != AK_IK_SOLVER_TWO_BONE && start_error > c.tolerance) akp_ik_unstraighten(&c);
         switch (rj.solver) {
         case AK_IK_SOLVER_CCD:
-            out = akp_ik_ccd(&c, &rj);
+            out = akp_ik_ccd(&c, &sj);
             apply_target_rotation(&c, rj.target_rotation);
             break;
         case AK_IK_SOLVER_TWO_BONE:
-            akp_ik_two_bone_chain(&c, &rj);
+            akp_ik_two_bone_chain(&c, &sj);
             apply_target_rotation(&c, rj.target_rotation);
             break;
-        case AK_IK_SOLVER_DLS: out = akp_ik_dls(&c, &rj, mem); break;
+        case AK_IK_SOLVER_DLS: out = akp_ik_dls(&c, &sj, mem); break;
         case AK_IK_SOLVER_FABRIK:
         default: {
             ak_vec3* pos = (ak_vec3*)mem;
             ak_vec3* prev = (ak_vec3*)(mem + akp_align16(n * sizeof(ak_vec3)));
             float* len = (float*)(mem + 2 * akp_align16(n * sizeof(ak_vec3)));
-            out = akp_ik_fabrik(&c, &rj, pos, prev, len);
+            out = akp_ik_fabrik(&c, &sj, pos, prev, len);
             apply_target_rotation(&c, rj.target_rotation);
             break;
         }
         }
     }
-    const float error = ak_vec3_distance(c.world[n - 1].translation, c.target);
+    /* The error in model units, in double: the effector back out of the solve's frame. */
+    const ak_vec3 e = c.world[n - 1].translation;
+    const double ex = (double)e.x * scale + root.x - rj.target.x, ey = (double)e.y * scale + root.y - rj.target.y,
+                 ez = (double)e.z * scale + root.z - rj.target.z;
+    const double error_d = sqrt(ex * ex + ey * ey + ez * ez);
+    const float error = error_d < FLT_MAX ? (float)error_d : FLT_MAX;
     float angle_error = 0.0f;
     if (rj.target_rotation) {
         ak_quat d = ak_quat_mul(ak_quat_normalize(*rj.target_rotation), ak_quat_conjugate(c.world[n - 1].rotation));
         angle_error = akp_quat_angle(d);
     }
     if (job->out_reached)
-        *job->out_reached = error <= rj.tolerance && (!rj.target_rotation || angle_error <= rj.angle_tolerance);
+        *job->out_reached = error_d <= rj.tolerance && (!rj.target_rotation || angle_error <= rj.angle_tolerance);
     if (job->out_error) *job->out_error = error;
     if (job->out_angle_error) *job->out_angle_error = angle_error;
     if (job->out_iterations) *job->out_iterations = out.iterations;
