@@ -29,12 +29,41 @@ static ak_result check_chain(const ak_skeleton* sk, ak_i16_cspan chain) {
     return AK_OK;
 }
 
+/* Largest absolute scale component of a transform, in double. */
+static double max_scale(const ak_transform* t) {
+    return fmax(fabs((double)t->scale.x), fmax(fabs((double)t->scale.y), fabs((double)t->scale.z)));
+}
+
+/* |translation|_1 of a transform, in double. */
+static double translation_l1(const ak_transform* t) {
+    return fabs((double)t->translation.x) + fabs((double)t->translation.y) + fabs((double)t->translation.z);
+}
+
+/* Every transform of the chain and its ancestors is finite, and so are their model-space
+ * transforms: float FK of finite locals can still overflow (bones of 3e38 end to end). The
+ * model translations are bounded, in double, by sum_k |t_k|_1 prod_{j<k} max|s_j|
+ * (rotations keep lengths); only when that passes 1e30 does the exact float FK decide. */
 static bool pose_chain_finite(const ak_skeleton* sk, const ak_transform* pose, ak_i16_cspan chain) {
     ak_i16_cspan parents = ak_skeleton_parents(sk);
-    for (int p = parents.ptr[chain.ptr[0]]; p >= 0; p = parents.ptr[p])
-        if (!ak_transform_is_finite(pose[p])) return false;
-    for (size_t k = 0; k < chain.count; ++k)
-        if (!ak_transform_is_finite(pose[chain.ptr[k]])) return false;
+    double bound = 0.0, scale = 1.0;
+    for (size_t k = chain.count; k-- > 0;) { /* bottom-up: the chain, then its ancestors */
+        const ak_transform* t = &pose[chain.ptr[k]];
+        if (!ak_transform_is_finite(*t)) return false;
+        bound = bound * max_scale(t) + translation_l1(t);
+    }
+    for (int p = parents.ptr[chain.ptr[0]]; p >= 0; p = parents.ptr[p]) {
+        const ak_transform* t = &pose[p];
+        if (!ak_transform_is_finite(*t)) return false;
+        bound = bound * max_scale(t) + translation_l1(t);
+        scale *= max_scale(t);
+    }
+    if (bound < 1e30 && scale < 1e30) return true;
+    ak_transform w = parent_model(sk, pose, chain.ptr[0]);
+    if (!ak_transform_is_finite(w)) return false;
+    for (size_t k = 0; k < chain.count; ++k) {
+        w = ak_transform_mul(w, pose[chain.ptr[k]]);
+        if (!ak_transform_is_finite(w)) return false;
+    }
     return true;
 }
 
@@ -51,18 +80,6 @@ static bool nonneg(float x) { return x >= 0.0f && ak_finitef(x); }
 static double distance_d(ak_vec3 a, ak_vec3 b) {
     const double x = (double)a.x - b.x, y = (double)a.y - b.y, z = (double)a.z - b.z;
     return sqrt(x * x + y * y + z * z);
-}
-
-/* The model-space transforms of the chain (and its ancestors) stay finite: float FK of finite
- * locals can still overflow (bones of 3e38 end to end). */
-static bool chain_fk_finite(const ak_skeleton* sk, const ak_transform* pose, ak_i16_cspan chain) {
-    ak_transform w = parent_model(sk, pose, chain.ptr[0]);
-    if (!ak_transform_is_finite(w)) return false;
-    for (size_t k = 0; k < chain.count; ++k) {
-        w = ak_transform_mul(w, pose[chain.ptr[k]]);
-        if (!ak_transform_is_finite(w)) return false;
-    }
-    return true;
 }
 
 static void* align16(void* p) { return (void*)(((uintptr_t)p + 15u) & ~(uintptr_t)15u); }
@@ -202,9 +219,7 @@ ak_result ak_ik_chain_validate(const ak_ik_chain_job* job) {
         return AK_ERR_BAD_ARG;
     if (!(job->soft >= 0.0f && job->soft < 1.0f)) return AK_ERR_BAD_ARG;
     if (!(job->keep_animation >= 0.0f && job->keep_animation <= 1.0f)) return AK_ERR_BAD_ARG;
-    if (!pose_chain_finite(job->skeleton, job->pose.ptr, job->chain) ||
-        !chain_fk_finite(job->skeleton, job->pose.ptr, job->chain))
-        return AK_ERR_BAD_DATA;
+    if (!pose_chain_finite(job->skeleton, job->pose.ptr, job->chain)) return AK_ERR_BAD_DATA;
     if (!job->scratch.ptr) return AK_ERR_NULL_ARG;
     if (job->scratch.count < ak_ik_chain_scratch_size(job->solver, job->chain.count)) return AK_ERR_SPAN_SMALL;
     return AK_OK;
@@ -386,37 +401,45 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
                                (type == AK_JOINT_BALL && (l.cone_angle > 0.0f || l.twist_min != 0.0f || l.twist_max != 0.0f)));
     }
     c.limits = !rj.ignore_limits;
-    /* Solve in a frame centred on the chain root and scaled by a power of two S that brings
-     * the chain's extent into [0.5, 1): squared distances can neither overflow (bones of
-     * 1e30) nor vanish under the solvers' fixed thresholds (bones of 1e-30), and scaling by
-     * a power of two is exact. Only the chain's base moves into the frame (its translation
-     * shifted, its scale divided by S), so local rotations and prism slides come out in the
-     * pose's own units. A target farther than 1e6 chain extents is moved onto the same ray
-     * from the root at that distance (out of reach either way). */
+    /* Outside common sizes, solve in a frame centred on the chain root and scaled by a power
+     * of two S that brings the chain's extent into [0.5, 1): squared distances can neither
+     * overflow (bones of 1e30) nor vanish under the solvers' fixed thresholds (bones of
+     * 1e-30), and scaling by a power of two is exact. Only the chain's base moves into the
+     * frame (its translation shifted, its scale divided by S), so local rotations and prism
+     * slides come out in the pose's own units. A target farther than 1e6 chain extents is
+     * moved onto the same ray from the root at that distance (out of reach either way). */
     akp_ik_fk(&c, 0);
     const ak_vec3 root = c.world[0].translation;
-    double extent = 0.0;
-    for (size_t i = 1; i < n; ++i) {
-        const ak_vec3 p = c.world[i].translation;
-        extent = fmax(extent, fmax(fabs((double)p.x - root.x), fmax(fabs((double)p.y - root.y), fabs((double)p.z - root.z))));
+    const double tx = (double)rj.target.x - root.x, ty = (double)rj.target.y - root.y, tz = (double)rj.target.z - root.z;
+    const double target_distance = sqrt(tx * tx + ty * ty + tz * tz);
+    double scale = 1.0, inv = 1.0;
+    c.target = rj.target;
+    c.length = world_length(c.world, n); /* inf or 0 when squares overflow or vanish */
+    /* Common sizes (a chain between 1e-3 and 1e6 units long, a target within 1e9 of its
+     * root) are solved as they are: every product of squared lengths stays far inside float. */
+    const bool common = c.length >= 0x1p-10f && c.length <= 0x1p20f && target_distance <= 0x1p30;
+    if (!common) {
+        double extent = 0.0;
+        for (size_t i = 1; i < n; ++i) {
+            const ak_vec3 p = c.world[i].translation;
+            extent = fmax(extent, fmax(fabs((double)p.x - root.x), fmax(fabs((double)p.y - root.y), fabs((double)p.z - root.z))));
+        }
+        int exponent = 0;
+        if (extent > 0.0) frexp(extent, &exponent);
+        scale = ldexp(1.0, exponent), inv = 1.0 / scale;
+        /* The same affine map on the base and on the world transforms already computed: what
+         * FK from the moved base gives, without running it again. */
+        for (size_t i = 0; i <= n; ++i) {
+            ak_transform* w = i == 0 ? &c.base : &c.world[i - 1];
+            w->translation = ak_vec3_make((float)(((double)w->translation.x - root.x) * inv),
+                                          (float)(((double)w->translation.y - root.y) * inv),
+                                          (float)(((double)w->translation.z - root.z) * inv));
+            w->scale = ak_vec3_make((float)(w->scale.x * inv), (float)(w->scale.y * inv), (float)(w->scale.z * inv));
+        }
+        const double far = 1e6, k = target_distance * inv > far ? far / (target_distance * inv) : 1.0;
+        c.target = ak_vec3_make((float)(tx * inv * k), (float)(ty * inv * k), (float)(tz * inv * k));
+        c.length = world_length(c.world, n);
     }
-    int exponent = 0;
-    if (extent > 0.0) frexp(extent, &exponent);
-    const double scale = ldexp(1.0, exponent), inv = 1.0 / scale;
-    c.base.translation = ak_vec3_make((float)(((double)c.base.translation.x - root.x) * inv),
-                                      (float)(((double)c.base.translation.y - root.y) * inv),
-                                      (float)(((double)c.base.translation.z - root.z) * inv));
-    c.base.scale = ak_vec3_make((float)(c.base.scale.x * inv), (float)(c.base.scale.y * inv), (float)(c.base.scale.z * inv));
-    {
-        double t[3] = {((double)rj.target.x - root.x) * inv, ((double)rj.target.y - root.y) * inv,
-                       ((double)rj.target.z - root.z) * inv};
-        const double d = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]), far = 1e6;
-        if (d > far)
-            for (int k = 0; k < 3; ++k) t[k] *= far / d;
-        c.target = ak_vec3_make((float)t[0], (float)t[1], (float)t[2]);
-    }
-    akp_ik_fk(&c, 0);
-    c.length = world_length(c.world, n);
     c.tolerance = (float)(rj.tolerance * inv);
     ak_ik_chain_job sj = rj; /* the job's lengths in the solve's frame */
     sj.tolerance = c.tolerance;
@@ -455,8 +478,9 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
     }
     /* The error in model units, in double: the effector back out of the solve's frame. */
     const ak_vec3 e = c.world[n - 1].translation;
-    const double ex = (double)e.x * scale + root.x - rj.target.x, ey = (double)e.y * scale + root.y - rj.target.y,
-                 ez = (double)e.z * scale + root.z - rj.target.z;
+    const ak_vec3 shift = common ? ak_vec3_zero() : root;
+    const double ex = (double)e.x * scale + shift.x - rj.target.x, ey = (double)e.y * scale + shift.y - rj.target.y,
+                 ez = (double)e.z * scale + shift.z - rj.target.z;
     const double error_d = sqrt(ex * ex + ey * ey + ez * ez);
     const float error = error_d < FLT_MAX ? (float)error_d : FLT_MAX;
     float angle_error = 0.0f;
