@@ -1672,7 +1672,7 @@ AK_TEST(gltf_negative_key_times) {
                            "\"type\":\"SCALAR\"},{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":"
                            "\"VEC3\"}],\"nodes\":[{}],\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1}],"
                            "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}";
-    load_expect(doc_text, anim, sizeof anim, AK_ERR_UNSORTED);
+    AK_CHECK_EQ(load_expect(doc_text, anim, sizeof anim, AK_ERR_UNSORTED), AK_ERR_UNSORTED);
     float ok[12];
     memcpy(ok, anim, sizeof ok);
     ok[0] = 0.0f, ok[1] = 0.5f; /* 0 is allowed */
@@ -1961,6 +1961,34 @@ AK_TEST(bvh_truncated_prefixes_fail) {
     free(text);
 }
 
+/* Assimp formats: cheap checks before Assimp runs (nesting depth of XML and brace formats,
+ * file size against an explicit budget); an ordinary file still loads. */
+AK_TEST(assimp_prechecks) {
+    size_t depth = AK_IO_ASSIMP_MAX_DEPTH + 10, cap = depth * 40 + 512, o = 0;
+    char* x = (char*)malloc(cap);
+    o += (size_t)snprintf(x + o, cap - o, "<?xml version=\"1.0\"?>\n<!-- a comment <a> -->\n<COLLADA "
+                                          "xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n");
+    for (size_t i = 0; i < depth; ++i) o += (size_t)snprintf(x + o, cap - o, "<node id=\"n%zu\">", i);
+    for (size_t i = 0; i < depth; ++i) o += (size_t)snprintf(x + o, cap - o, "</node>");
+    snprintf(x + o, cap - o, "</COLLADA>\n");
+    write_file("deep.dae", x, strlen(x));
+    free(x);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load("deep.dae", NULL, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK(strstr(diag.message, "nested deeper") != NULL);
+    remove("deep.dae");
+    const char* obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    write_file("tri.obj", obj, strlen(obj));
+    AK_CHECK_EQ(ak_io_load("tri.obj", NULL, NULL, &s, &diag), AK_OK);
+    if (s) AK_CHECK_EQ(s->mesh_count, 1);
+    ak_scene_destroy(s);
+    s = NULL;
+    ak_io_desc tight = {.memory_budget = 100};
+    AK_CHECK_EQ(ak_io_load("tri.obj", &tight, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
+    remove("tri.obj");
+}
+
 int main(void) {
     AK_RUN(desc_defaults);
     AK_RUN(gltf_assets_match_their_json);
@@ -1987,5 +2015,6 @@ int main(void) {
     AK_RUN(bvh_channel_semantics);
     AK_RUN(bvh_reader_matches_assimp);
     AK_RUN(bvh_truncated_prefixes_fail);
+    AK_RUN(assimp_prechecks);
     return ak_test_finish();
 }
