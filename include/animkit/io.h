@@ -52,8 +52,15 @@
  *     ak_io_write_obj("mesh.obj", scene, NULL, NULL, &diag);  // NULL: positions as stored
  *     ak_scene_destroy(scene);
  *
+ * Untrusted input: glTF and BVH are safe to load from untrusted sources (memory bounded by
+ * desc->memory_budget, checked before allocating; recursion bounded (cJSON stops at 1000
+ * nesting levels, the BVH reader does not recurse); external glTF
+ * buffers only inside the model's directory unless desc->extra_roots/allow_any_path say
+ * otherwise; images never opened). Assimp formats (FBX, Collada, OBJ, ...) are NOT: animkit
+ * only pre-checks their size and nesting depth. docs/io.md lists every limit and its default.
+ *
  * Ownership and threading: the scene returned belongs to the caller (ak_scene_destroy).
- * The library keeps no pointer to the caller's data. The glTF path is reentrant: the JSON
+ * The library keeps no pointer to the caller's data. The glTF and BVH paths are reentrant: the JSON
  * parse tree comes from cJSON's own malloc (animkit never sets cJSON's global hooks) and
  * animkit never reads cJSON's global last-error pointer. The Assimp path must not run on
  * several threads at once: Assimp keeps its last error message in a global.
