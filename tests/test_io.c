@@ -1752,6 +1752,17 @@ AK_TEST(bvh_hostile_files) {
     AK_CHECK_EQ(load_bvh_mem(ok, strlen(ok), &as_bvh, &ca, &diag), AK_OK);
     free(ok);
     free(data);
+    /* an End Site that is the 65th node (the node array grows as it is added; found by
+     * fuzz_bvh: its name was read from the array just freed) */
+    char* grow = bvh_chain(64, "0", "");
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(grow, strlen(grow), "t.bvh", NULL, &as_bvh, NULL, &s, &diag), AK_OK);
+    if (s) {
+        AK_CHECK_EQ(ak_scene_joint_count(s), 65);
+        if (ak_scene_joint_count(s) == 65) AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 64), "EndSite_j63");
+    }
+    ak_scene_destroy(s);
+    free(grow);
     /* Frames: 4000000000 with two lines: refused without allocating for the claim */
     const char* two = "0 0 0 0 0 0 0 0 0\n1 2 3 10 20 30 1 2 3\n";
     char* huge = bvh_chain(2, "4000000000", two);

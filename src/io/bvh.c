@@ -278,7 +278,9 @@ static ak_result read_hierarchy(bv_ctx* c) {
             if (!end_site && (!name[0] || strcmp(name, "{") == 0))
                 return fail(c, AK_ERR_PARSE, "line %ld: JOINT has no name", c->token_line);
             int32_t parent = stack[depth - 1];
-            TRY(add_node(c, end_site ? c->nodes[parent].name : name, parent, end_site, &me));
+            /* add_node may move c->nodes: an End Site's name comes from a copy of its parent's */
+            if (end_site) snprintf(name, sizeof name, "%s", c->nodes[parent].name);
+            TRY(add_node(c, name, parent, end_site, &me));
             TRY(expect(c, "{", end_site ? "after End Site" : "after the JOINT name"));
             stack[depth++] = (int32_t)me;
         } else {
