@@ -1663,6 +1663,83 @@ AK_TEST(gltf_memory_budget) {
     rmdir("budget");
 }
 
+/* One sampler of 65,536 keys shared by 3,000 channels (legal: each on its own node): the clip
+ * copies the keys per channel, 3 GB from a 1 MB file. Refused by the budget, before the
+ * copies; an allocator that stops at 512 MiB live keeps a failing loader from taking the
+ * machine down. */
+typedef struct live_cap {
+    size_t live_bytes;
+    int live;
+} live_cap;
+static void* live_cap_malloc(size_t size, void* user) {
+    live_cap* c = (live_cap*)user;
+    if (c->live_bytes + size > ((size_t)512 << 20)) return NULL;
+    size_t* p = (size_t*)malloc(size + 16);
+    if (!p) return NULL;
+    p[0] = size;
+    c->live_bytes += size;
+    c->live++;
+    return (char*)p + 16;
+}
+static void live_cap_free(void* q, void* user) {
+    live_cap* c = (live_cap*)user;
+    size_t* p = (size_t*)((char*)q - 16);
+    c->live_bytes -= p[0];
+    c->live--;
+    free(p);
+}
+
+AK_TEST(gltf_shared_sampler_amplification) {
+    const size_t keys = 65536, nodes = 3000;
+    float* bin = (float*)malloc(keys * 4 * sizeof(float));
+    for (size_t k = 0; k < keys; ++k) {
+        bin[k] = (float)k * 0.01f;
+        bin[keys + 3 * k] = bin[keys + 3 * k + 1] = bin[keys + 3 * k + 2] = (float)k;
+    }
+    mkdir("amp", 0755);
+    write_file("amp/anim.bin", bin, keys * 4 * sizeof(float));
+    free(bin);
+    size_t cap = nodes * 120 + 2048, o = 0;
+    char* text = (char*)malloc(cap);
+    o += (size_t)snprintf(text + o, cap - o,
+                          "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,\"uri\":\"anim.bin\"}],"
+                          "\"bufferViews\":[{\"buffer\":0,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,"
+                          "\"byteLength\":%zu}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,"
+                          "\"type\":\"SCALAR\"},{\"bufferView\":1,\"componentType\":5126,\"count\":%zu,\"type\":"
+                          "\"VEC3\"}],\"nodes\":[",
+                          keys * 16, keys * 4, keys * 4, keys * 12, keys, keys);
+    for (size_t n = 0; n < nodes; ++n) o += (size_t)snprintf(text + o, cap - o, "%s{}", n ? "," : "");
+    o += (size_t)snprintf(text + o, cap - o, "],\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1}],\"channels\":[");
+    for (size_t n = 0; n < nodes; ++n)
+        o += (size_t)snprintf(text + o, cap - o, "%s{\"sampler\":0,\"target\":{\"node\":%zu,\"path\":\"translation\"}}",
+                              n ? "," : "", n);
+    snprintf(text + o, cap - o, "]}]}");
+    live_cap lc = {0, 0};
+    ak_allocator a = {live_cap_malloc, live_cap_free, &lc};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    ak_result r = ak_io_load_memory(text, strlen(text), "amp.gltf", "amp", NULL, &a, &s, &diag);
+    printf("  3000 channels on one 65536-key sampler: %s (%s)\n", ak_result_name(r), diag.message);
+    AK_CHECK_EQ(r, AK_ERR_UNSUPPORTED);
+    AK_CHECK(strstr(diag.message, "memory budget") != NULL);
+    AK_CHECK_EQ(lc.live, 0);
+    ak_scene_destroy(s);
+    /* the same file with 30 channels loads */
+    char* cut = strstr(text, "\"channels\":[");
+    char* thirty = cut;
+    for (int k = 0; k < 31 && thirty; ++k) thirty = strstr(thirty + 1, "{\"sampler\"");
+    if (thirty) {
+        snprintf(thirty - 1, 5, "]}]}");
+        s = NULL;
+        AK_CHECK_EQ(ak_io_load_memory(text, strlen(text), "amp.gltf", "amp", NULL, &a, &s, &diag), AK_OK);
+        if (s) AK_CHECK_EQ(s->clip_count, 1);
+        ak_scene_destroy(s);
+    }
+    free(text);
+    remove("amp/anim.bin");
+    rmdir("amp");
+}
+
 /* glTF requires key times >= 0: a negative first time is refused like decreasing times. */
 AK_TEST(gltf_negative_key_times) {
     const float anim[12] = {-1, 0, 1, 0, 0, 0, 1, 1, 1, 2, 2, 2};
@@ -2020,6 +2097,7 @@ int main(void) {
     AK_RUN(allocation_failures);
     AK_RUN(gltf_uri_stays_inside_model_dir);
     AK_RUN(gltf_memory_budget);
+    AK_RUN(gltf_shared_sampler_amplification);
     AK_RUN(gltf_negative_key_times);
     AK_RUN(glb_bad_magic);
     AK_RUN(bvh_hostile_files);

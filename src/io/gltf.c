@@ -1334,6 +1334,11 @@ static ak_result load_animation(gl_ctx* c, const cJSON* an, size_t ai, ak_raw_ch
             if (target == AK_CHANNEL_MORPH_WEIGHTS &&
                 !(scene->meshes[m].node == c->joint_of_node[node] && scene->meshes[m].mesh->morph_target_count))
                 continue;
+            /* ak_clip_build copies the keys for every channel, also when many channels share
+             * one sampler: charge each copy (times and values, twice for the build's work) */
+            r = charge(c, s->keys, 2 * sizeof(float) * (1 + (size_t)comps * (s->interp == AK_INTERP_CUBICSPLINE ? 3 : 1)),
+                       cw);
+            if (r != AK_OK) break;
             if (out == *chan_cap) {
                 size_t cap = *chan_cap ? *chan_cap * 2 : 16;
                 ak_raw_channel* nc2 = (ak_raw_channel*)akp_alloc(c->alloc, cap * sizeof(ak_raw_channel));
