@@ -1865,6 +1865,14 @@ AK_TEST(bvh_hostile_files) {
     char* word = bvh_chain(2, "1", "0 0 0 0 0 0 0 0 x\n");
     AK_CHECK_EQ(load_bvh_mem(word, strlen(word), &as_bvh, &ca, &diag), AK_ERR_PARSE);
     free(word);
+    char* long_time = bvh_chain(2, "2", two); /* Frame Time 0.1 -> 1e38: the second key is at 1e38 */
+    char* ft = strstr(long_time, "0.1\n");
+    if (ft) {
+        memmove(ft + 4, ft + 3, strlen(ft + 3) + 1);
+        memcpy(ft, "4e38", 4);
+        AK_CHECK_EQ(load_bvh_mem(long_time, strlen(long_time), &as_bvh, &ca, &diag), AK_ERR_BAD_DATA);
+    }
+    free(long_time);
     char* inf = bvh_chain(2, "1", "0 0 0 0 0 0 0 0 1e999\n");
     AK_CHECK_EQ(load_bvh_mem(inf, strlen(inf), &as_bvh, &ca, &diag), AK_ERR_BAD_DATA);
     free(inf);

@@ -325,6 +325,9 @@ static ak_result read_motion(bv_ctx* c) {
     TRY(next_number(c, "Frame Time", &c->frame_time));
     if (!(c->frame_time > 0.0))
         return fail(c, AK_ERR_BAD_DATA, "line %ld: Frame Time %g must be positive", c->token_line, c->frame_time);
+    if (frames > 0 && !ak_finitef((float)((double)(frames - 1) * c->frame_time)))
+        return fail(c, AK_ERR_BAD_DATA, "line %ld: %llu frames of %g s overflow the clip's float time", c->token_line,
+                    frames, c->frame_time);
     if (frames > 0 && c->channel_total == 0)
         return fail(c, AK_ERR_PARSE, "line %ld: %llu frames declared but no joint has CHANNELS", c->token_line, frames);
     /* The declared count must fit the budget before anything is read for it... */
