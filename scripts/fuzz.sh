@@ -31,11 +31,13 @@ SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-fram
 
 command -v "$CC" >/dev/null || { echo "fuzz.sh: $CC not found (scripts/install-deps.sh installs clang)" >&2; exit 1; }
 
+mkdir -p "$OUT"
 echo "== fuzz: building the library with $CC, libFuzzer + ASan + UBSan"
 cmake -S . -B "$OUT/lib" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER="$CC" \
   -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_C_FLAGS="-fsanitize=fuzzer-no-link $SAN" \
-  -DAK_BUILD_TESTS=OFF -DAK_BUILD_EXAMPLES=OFF -DAK_BUILD_BENCH=OFF -DAK_BUILD_TOOLS=OFF >/dev/null
-cmake --build "$OUT/lib" -j "$JOBS" --target animkit_static >/dev/null
+  -DAK_BUILD_TESTS=OFF -DAK_BUILD_EXAMPLES=OFF -DAK_BUILD_BENCH=OFF -DAK_BUILD_TOOLS=OFF \
+  > "$OUT/lib.log" 2>&1 || { tail -30 "$OUT/lib.log"; exit 1; }
+cmake --build "$OUT/lib" -j "$JOBS" --target animkit_static >> "$OUT/lib.log" 2>&1 || { tail -30 "$OUT/lib.log"; exit 1; }
 LIBS=$(sed -n 's/^Libs.private: //p' "$OUT/lib/animkit.pc")
 
 CFLAGS=(-std=c11 -D_POSIX_C_SOURCE=200809L -O1 -g $SAN -Wall -Wextra -Werror
