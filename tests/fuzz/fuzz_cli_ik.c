@@ -7,7 +7,7 @@
  *     clang -g -O1 -fsanitize=fuzzer,address,undefined -std=c11 -D_POSIX_C_SOURCE=200809L \
  *         -Iinclude -Isrc -Itools/animkit tests/fuzz/fuzz_cli_ik.c <library and CLI sources> \
  *         -lassimp -lcjson -lpng -lgif -lcholmod -lm -lpthread -o fuzz_cli_ik
- *     ./fuzz_cli_ik -dict=tests/fuzz/ik.dict -max_total_time=60 corpus/
+ *     scripts/fuzz.sh 60 cli_ik      (seeds: tests/fuzz/seeds/cli_ik_*, dictionary cli_ik.dict)
  * The model is fixed (a positional argument from the input is a usage error), and arguments
  * naming an output (-o, --output, with or without =value) are dropped, so a run never reads
  * or writes files. stdout goes to /dev/null. Any crash, leak or sanitizer report is a bug;
