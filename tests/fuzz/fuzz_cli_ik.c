@@ -2,12 +2,9 @@
  * parsing, numbers, joint and clip lookup, the default chain, every solver, --json output).
  *
  * The input is the argument list, one argument per line (a NUL also ends one); the target
- * runs `animkit ik builtin:cylinder ARGS...` in process through cmd_ik. Built with the whole
- * library and tools/animkit/*.c except main.c (scripts/fuzz.sh, see COMMON.md's convention):
- *     clang -g -O1 -fsanitize=fuzzer,address,undefined -std=c11 -D_POSIX_C_SOURCE=200809L \
- *         -Iinclude -Isrc -Itools/animkit tests/fuzz/fuzz_cli_ik.c <library and CLI sources> \
- *         -lassimp -lcjson -lpng -lgif -lcholmod -lm -lpthread -o fuzz_cli_ik
- *     scripts/fuzz.sh 60 cli_ik      (seeds: tests/fuzz/seeds/cli_ik_*, dictionary cli_ik.dict)
+ * runs `animkit ik builtin:cylinder ARGS...` in process through cmd_ik. scripts/fuzz.sh
+ * builds it with the whole library and the CLI's sources except main.c, and runs it:
+ *     scripts/fuzz.sh 60 cli_ik      (seeds: tests/fuzz/cli_ik.seeds, dictionary cli_ik.dict)
  * The model is fixed (a positional argument from the input is a usage error), and arguments
  * naming an output (-o, --output, with or without =value) are dropped, so a run never reads
  * or writes files. stdout goes to /dev/null. Any crash, leak or sanitizer report is a bug;
