@@ -136,6 +136,22 @@ AK_TEST(builtin_keeps_skeleton_palette) {
         for (int k = 0; k < 16; ++k) worst = fmax(worst, fabs((double)a[j].m[k] - b[j].m[k]));
     AK_CHECK_NEAR(worst, 0.0, 1e-6);
     ak_scene_destroy(scene);
+
+    /* the flag itself: refused, nothing written */
+    ak_joint_desc j[2] = {{.name = "a", .parent = -1, .rest = ak_transform_identity()},
+                          {.name = "b", .parent = 0, .rest = ak_transform_identity()}};
+    ak_skeleton_desc d = {.joints = j, .joint_count = 2, .palette_from_skins = true};
+    ak_skeleton* sk = NULL;
+    AK_CHECK_EQ(ak_skeleton_create(&d, NULL, &sk, NULL), AK_OK);
+    if (!sk) return;
+    AK_CHECK(ak_skeleton_palette_from_skins(sk));
+    ak_mat4 m[2] = {ak_mat4_identity(), ak_mat4_identity()}, out[2];
+    memset(out, 0x5a, sizeof out);
+    AK_CHECK_EQ(ak_skeleton_skinning_matrices(sk, (ak_mat4_cspan)AK_SPAN(m), (ak_mat4_span)AK_SPAN(out)), AK_ERR_UNSUPPORTED);
+    unsigned char pattern[sizeof out];
+    memset(pattern, 0x5a, sizeof pattern);
+    AK_CHECK(memcmp(out, pattern, sizeof out) == 0);
+    ak_skeleton_destroy(sk);
 }
 
 int main(void) {

@@ -192,12 +192,13 @@ AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
  * step (a momentum step; the passes themselves keep the bone lengths).
  * TWO_BONE bends a HINGE mid joint about the hinge axis (trying the other bend when the limits
  * refuse the first). DLS stops when lambda tops out without an improving step.
- * Scale: the solve runs in a frame centred on the chain root and scaled by a power of two
- * that brings the chain's extent into [0.5, 1) (exact), so chains of any size work alike:
- * bones of 1e30 do not overflow squared distances, bones of 1e-30 do not fall under fixed
- * thresholds. A target farther than 1e6 chain extents from the root is solved as the point
- * on its ray from the root at that distance (out of reach either way); error and reached
- * always use the true target, in double.
+ * Scale: chains of any size work alike. A chain 1e-3 to 1e6 units long with its target
+ * within 1e9 of its root is solved as it is; any other runs in a frame centred on the chain
+ * root and scaled by a power of two that brings the chain's extent into [0.5, 1) (exact), so
+ * bones of 1e30 do not overflow squared distances and bones of 1e-30 do not fall under fixed
+ * thresholds; there a target farther than 1e6 chain extents from the root is solved as the
+ * point on its ray from the root at that distance (out of reach either way). Error and
+ * reached always use the true target, in double.
  * Degenerate cases: a one-joint chain cannot move its effector (only target_rotation is
  * applied; 0 iterations); zero-length bones keep their direction; a target on the root folds
  * the chain as far as lengths and limits allow. */
