@@ -6,7 +6,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "noise_internal.h"
+#include "perlin_core.h"
 
 float ak_noise_eval(const ak_noise* noise, ak_noise_basis basis, uint32_t dimensions, const float* point,
                     float* out_gradient) {
@@ -54,6 +54,12 @@ ak_result ak_fractal_desc_validate(const ak_fractal_desc* desc) {
     return AK_OK;
 }
 
+/* One basis function of a valid desc (the scalar batch path: inlined). */
+static inline float basis_eval(const ak_noise* noise, ak_noise_basis basis, uint32_t dims, const float* q, float* g) {
+    (void)basis;
+    return perlin_any(noise, dims, q, g);
+}
+
 /* The octave sum at p (no warping). */
 static float octaves(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad) {
     float freq = d->frequency, amp = 1.0f, sum = 0.0f, weight = 1.0f;
@@ -61,7 +67,7 @@ static float octaves(const ak_noise* noise, const ak_fractal_desc* d, uint32_t d
     for (uint32_t o = 0; o < d->octaves; ++o) {
         float q[4], g[4];
         for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
-        const float n = ak_noise_eval(noise, d->basis, dims, q, grad ? g : NULL);
+        const float n = basis_eval(noise, d->basis, dims, q, grad ? g : NULL);
         if (d->type == AK_FRACTAL_FBM) {
             sum = sum + amp * n;
             if (grad)

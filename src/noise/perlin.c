@@ -7,10 +7,9 @@
  * first, then y, z, w) with the quintic fade. The gradient rides along the same blend:
  * lerp(t, a, b) has derivative lerp(t, da, db) + (b - a) dt. The AVX2 kernel (batch_avx2.c)
  * repeats these float operations in the same order, so both give the same bits. */
-#include <math.h>
 #include <string.h>
 
-#include "noise_internal.h"
+#include "perlin_core.h"
 
 /* Perlin's permutation from the reference implementation (ImprovedNoise, 2002). */
 static const uint8_t perlin_permutation[256] = {
@@ -46,152 +45,6 @@ ak_noise ak_noise_make(uint64_t seed) {
     }
     memcpy(n.perm + 256, n.perm, 256);
     return n;
-}
-
-static inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
-/* d/dt fade = 30 t^2 (t - 1)^2 */
-static inline float dfade(float t) { return 30.0f * t * t * (t * (t - 2.0f) + 1.0f); }
-static inline float lerp(float t, float a, float b) { return a + t * (b - a); }
-
-/* Gradient of corner hash h in `dims` dimensions as a vector g (components -1..1, or the 1D
- * slope). The value g . d is computed by corner_dot in the same float order as the kernel. */
-static inline void corner_gradient(uint32_t dims, int h, float* g) {
-    switch (dims) {
-    case 1: {
-        float s = (float)(1 + (h & 7)) * 0.25f;
-        g[0] = (h & 8) ? -s : s;
-        break;
-    }
-    case 2: {
-        h &= 7;
-        float su = (h & 1) ? -1.0f : 1.0f, sv = (h & 2) ? -1.0f : 1.0f;
-        if (h < 4) {
-            g[0] = su;
-            g[1] = sv;
-        } else {
-            g[0] = (h & 2) ? 0.0f : su;
-            g[1] = (h & 2) ? su : 0.0f;
-        }
-        break;
-    }
-    case 3: {
-        h &= 15;
-        float su = (h & 1) ? -1.0f : 1.0f, sv = (h & 2) ? -1.0f : 1.0f;
-        g[0] = g[1] = g[2] = 0.0f;
-        g[h < 8 ? 0 : 1] += su;
-        g[h < 4 ? 1 : (h == 12 || h == 14) ? 0 : 2] += sv;
-        break;
-    }
-    default: {
-        h &= 31;
-        int zero = (h >> 3) & 3, bit = 0;
-        for (int k = 0; k < 4; ++k) {
-            if (k == zero) {
-                g[k] = 0.0f;
-            } else {
-                g[k] = (h >> bit & 1) ? -1.0f : 1.0f;
-                ++bit;
-            }
-        }
-        break;
-    }
-    }
-}
-
-/* g . d with Perlin's operation order for 3D ((+-u) + (+-v)); 2D the same with v = 0 for the
- * axis gradients; 1D g x; 4D ((a + b) + c) over the three non-zero slots. */
-static inline float corner_dot(uint32_t dims, int h, const float* d) {
-    switch (dims) {
-    case 1: {
-        float s = (float)(1 + (h & 7)) * 0.25f;
-        return ((h & 8) ? -s : s) * d[0];
-    }
-    case 2: {
-        h &= 7;
-        float u = (h >= 4 && (h & 2)) ? d[1] : d[0];
-        float v = h < 4 ? d[1] : 0.0f;
-        return ((h & 1) ? -u : u) + ((h & 2) ? -v : v);
-    }
-    case 3: {
-        h &= 15;
-        float u = h < 8 ? d[0] : d[1];
-        float v = h < 4 ? d[1] : (h == 12 || h == 14) ? d[0] : d[2];
-        return ((h & 1) ? -u : u) + ((h & 2) ? -v : v);
-    }
-    default: {
-        h &= 31;
-        int zero = (h >> 3) & 3, bit = 0;
-        float t[3];
-        for (int k = 0; k < 4; ++k) {
-            if (k == zero) continue;
-            t[bit] = (h >> bit & 1) ? -d[k] : d[k];
-            ++bit;
-        }
-        return (t[0] + t[1]) + t[2];
-    }
-    }
-}
-
-/* The lattice routine: lo[k], hi[k] the wrapped lattice indices (0..255) of the cell's two
- * corners along axis k, f[k] the fractional offset in [0, 1). */
-static inline __attribute__((always_inline)) float lattice(const uint8_t* perm, uint32_t dims, const int* lo,
-                                                           const int* hi, const float* f, float* grad) {
-    float val[16], gv[16][4];
-    const uint32_t corners = 1u << dims;
-    for (uint32_t c = 0; c < corners; ++c) {
-        int h = 0;
-        float d[4];
-        for (uint32_t k = 0; k < dims; ++k) {
-            const bool up = (c >> k) & 1u;
-            h = perm[h + (up ? hi[k] : lo[k])];
-            d[k] = up ? f[k] - 1.0f : f[k];
-        }
-        val[c] = corner_dot(dims, h, d);
-        if (grad) corner_gradient(dims, h, gv[c]);
-    }
-    for (uint32_t k = 0; k < dims; ++k) {
-        const float t = fade(f[k]);
-        const float dt = grad ? dfade(f[k]) : 0.0f;
-        const uint32_t step = 1u << k;
-        for (uint32_t c = 0; c < corners; c += 2u * step) {
-            const float a = val[c], b = val[c + step];
-            val[c] = lerp(t, a, b);
-            if (grad) {
-                for (uint32_t m = 0; m < dims; ++m) gv[c][m] = lerp(t, gv[c][m], gv[c + step][m]);
-                gv[c][k] = gv[c][k] + (b - a) * dt;
-            }
-        }
-    }
-    if (grad)
-        for (uint32_t m = 0; m < dims; ++m) grad[m] = gv[0][m];
-    return val[0];
-}
-
-static inline __attribute__((always_inline)) float perlin_n(const ak_noise* noise, uint32_t dims, const float* p,
-                                                            const int* period, float* grad) {
-    int lo[4], hi[4];
-    float f[4];
-    for (uint32_t k = 0; k < dims; ++k) {
-        if (!(fabsf(p[k]) < AKP_NOISE_LIMIT)) {
-            if (grad)
-                for (uint32_t m = 0; m < dims; ++m) grad[m] = 0.0f;
-            return 0.0f;
-        }
-        const float fl = floorf(p[k]);
-        const int i = (int)fl;
-        f[k] = p[k] - fl;
-        if (period) {
-            const int per = period[k];
-            int w = i % per;
-            if (w < 0) w += per;
-            lo[k] = w;
-            hi[k] = w + 1 == per ? 0 : w + 1;
-        } else {
-            lo[k] = i & 255;
-            hi[k] = (i + 1) & 255;
-        }
-    }
-    return lattice(noise->perm, dims, lo, hi, f, grad);
 }
 
 float ak_noise_perlin1(const ak_noise* noise, float x, float* out_gradient) {
