@@ -463,6 +463,266 @@ AK_TEST(job_validity) {
     AK_CHECK_EQ(ak_noise_grid_job_validate(&gj), AK_ERR_BAD_ARG);
 }
 
+
+static double cd_of(const ak_noise* n, ak_noise_basis basis, uint32_t dims, const float* p, uint32_t k, float h) {
+    float a[4], b[4];
+    memcpy(a, p, sizeof a);
+    memcpy(b, p, sizeof b);
+    a[k] += h;
+    b[k] -= h;
+    return ((double)ak_noise_eval(n, basis, dims, a, NULL) - ak_noise_eval(n, basis, dims, b, NULL)) / (2.0 * h);
+}
+
+/* Simplex and value noise: gradients against central differences; simplex 1D/4D and Worley 4D
+ * are outside their domains. */
+AK_TEST(other_bases_gradients) {
+    ak_noise n = ak_noise_make(21);
+    ak_rng rng = ak_rng_make(3);
+    const struct {
+        ak_noise_basis basis;
+        uint32_t dims;
+    } cases[] = {{AK_NOISE_BASIS_SIMPLEX, 2}, {AK_NOISE_BASIS_SIMPLEX, 3}, {AK_NOISE_BASIS_VALUE, 1},
+                 {AK_NOISE_BASIS_VALUE, 2},   {AK_NOISE_BASIS_VALUE, 3},   {AK_NOISE_BASIS_VALUE, 4}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        double worst = 0;
+        for (int i = 0; i < 1500; ++i) {
+            float p[4] = {0, 0, 0, 0}, g[4];
+            for (uint32_t k = 0; k < cases[c].dims; ++k) p[k] = frand(&rng, -40, 40);
+            ak_noise_eval(&n, cases[c].basis, cases[c].dims, p, g);
+            for (uint32_t k = 0; k < cases[c].dims; ++k) {
+                const double cd = cd_of(&n, cases[c].basis, cases[c].dims, p, k, 1.0f / 1024.0f);
+                worst = fmax(worst, fabs(g[k] - cd));
+                AK_CHECK_MSG(fabs(g[k] - cd) <= 0.01 * (1.0 + fabs(cd)), "basis %d dims %u: %.6g vs %.6g",
+                             (int)cases[c].basis, cases[c].dims, (double)g[k], cd);
+            }
+        }
+        printf("  basis %d %uD: worst |gradient - central difference| = %.3g\n", (int)cases[c].basis, cases[c].dims,
+               worst);
+    }
+    const float p[4] = {0.3f, 0.4f, 0.5f, 0.6f};
+    AK_CHECK(ak_noise_eval(&n, AK_NOISE_BASIS_SIMPLEX, 4, p, NULL) == 0.0f);
+    AK_CHECK(ak_noise_eval(&n, AK_NOISE_BASIS_WORLEY, 4, p, NULL) == 0.0f);
+    AK_CHECK(!ak_noise_basis_supports(AK_NOISE_BASIS_SIMPLEX, 4) && ak_noise_basis_supports(AK_NOISE_BASIS_VALUE, 4));
+    AK_CHECK(ak_noise_eval(&n, AK_NOISE_BASIS_SIMPLEX, 1, p, NULL) == ak_noise_simplex2(&n, 0.3f, 0.0f, NULL));
+    AK_CHECK(ak_noise_simplex3(&n, NAN, 0, 0, NULL) == 0.0f);
+}
+
+AK_TEST(other_bases_ranges) {
+    ak_noise n = ak_noise_make(0);
+    const size_t count = range_points() / 4;
+    const ak_noise_basis bases[] = {AK_NOISE_BASIS_SIMPLEX, AK_NOISE_BASIS_SIMPLEX, AK_NOISE_BASIS_VALUE,
+                                    AK_NOISE_BASIS_VALUE, AK_NOISE_BASIS_WORLEY, AK_NOISE_BASIS_WORLEY};
+    const uint32_t dims[] = {2, 3, 2, 3, 2, 3};
+    const char* names[] = {"simplex", "simplex", "value", "value", "worley", "worley"};
+    for (int c = 0; c < 6; ++c)
+        check_range_job(&n, (ak_fractal_desc){.basis = bases[c], .octaves = 1}, dims[c],
+                        bases[c] == AK_NOISE_BASIS_WORLEY ? count / 8 : count, names[c]);
+}
+
+/* Worley against brute force: the nearest feature point of a probe p is p - F1 * grad F1, so a
+ * dense grid of probes collects every feature point of a region; F1 and F2 of test points
+ * inside it must equal the two smallest distances to that collected set. */
+AK_TEST(worley_matches_brute_force) {
+    ak_noise n = ak_noise_make(13);
+    for (uint32_t dims = 1; dims <= 3; ++dims) {
+        enum { MAXP = 4096 };
+        static float pts[MAXP][3];
+        int count = 0;
+        const float lo = -3.0f, hi = 3.0f, step = dims == 3 ? 0.2f : 0.1f;
+        const int steps = (int)((hi - lo) / step) + 1;
+        const int total = dims == 1 ? steps : dims == 2 ? steps * steps : steps * steps * steps;
+        for (int s = 0; s < total; ++s) {
+            float p[3] = {0, 0, 0}, g[3];
+            int r = s;
+            for (uint32_t k = 0; k < dims; ++k) p[k] = lo + step * (float)(r % steps), r /= steps;
+            const float f1 = ak_noise_worley(&n, dims, p, NULL, g);
+            float q[3];
+            for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] - f1 * g[k];
+            AK_CHECK(ak_noise_worley(&n, dims, q, NULL, NULL) < 1e-4f); /* q is a feature point */
+            int found = 0;
+            for (int i = 0; i < count && !found; ++i) {
+                float d = 0;
+                for (uint32_t k = 0; k < dims; ++k) d += fabsf(pts[i][k] - q[k]);
+                found = d < 1e-3f;
+            }
+            if (!found && count < MAXP) {
+                for (uint32_t k = 0; k < 3; ++k) pts[count][k] = k < dims ? q[k] : 0.0f;
+                ++count;
+            }
+        }
+        ak_rng rng = ak_rng_make(dims);
+        for (int t = 0; t < 300; ++t) {
+            float p[3] = {0, 0, 0}, f2 = 0;
+            for (uint32_t k = 0; k < dims; ++k) p[k] = frand(&rng, -1.0f, 1.0f);
+            double b1 = INFINITY, b2 = INFINITY;
+            for (int i = 0; i < count; ++i) {
+                double d = 0;
+                for (uint32_t k = 0; k < dims; ++k) d += ((double)p[k] - pts[i][k]) * ((double)p[k] - pts[i][k]);
+                d = sqrt(d);
+                if (d < b1) b2 = b1, b1 = d;
+                else if (d < b2) b2 = d;
+            }
+            const float f1 = ak_noise_worley(&n, dims, p, &f2, NULL);
+            AK_CHECK_NEAR(f1, b1, 2e-4);
+            AK_CHECK_NEAR(f2, b2, 2e-4);
+            AK_CHECK(f1 <= f2 && f1 <= sqrtf((float)dims));
+        }
+        printf("  worley %uD: %d feature points collected\n", dims, count);
+    }
+}
+
+static float comp(ak_vec3 v, int k) { return k == 0 ? v.x : k == 1 ? v.y : v.z; }
+static void set_comp(ak_vec3* v, int k, float x) {
+    if (k == 0) v->x = x;
+    else if (k == 1) v->y = x;
+    else v->z = x;
+}
+
+/* div v = sum_k dv_k/dx_k by central differences is ~0 while its terms are O(1). */
+AK_TEST(curl_noise_is_divergence_free) {
+    ak_noise n = ak_noise_make(8);
+    ak_rng rng = ak_rng_make(12);
+    const ak_fractal_desc fd = {.octaves = 3};
+    const float h = 1.0f / 2048.0f;
+    double worst = 0, terms = 0;
+    for (int i = 0; i < 300; ++i) {
+        const ak_vec3 p = ak_vec3_make(frand(&rng, -20, 20), frand(&rng, -20, 20), frand(&rng, -20, 20));
+        double div = 0, mag = 0;
+        for (int k = 0; k < 3; ++k) {
+            ak_vec3 a = p, b = p;
+            set_comp(&a, k, comp(a, k) + h);
+            set_comp(&b, k, comp(b, k) - h);
+            const ak_vec3 va = ak_noise_curl3(&n, &fd, a), vb = ak_noise_curl3(&n, &fd, b);
+            const double d = ((double)comp(va, k) - comp(vb, k)) / (2.0 * h);
+            div += d;
+            mag += fabs(d);
+        }
+        worst = fmax(worst, fabs(div));
+        terms += mag / 300.0;
+        AK_CHECK_MSG(fabs(div) <= 1e-3 * mag + 5e-3, "div %.4g (terms %.3g)", div, mag);
+    }
+    printf("  3D curl: worst |div| %.3g, mean sum of |dv_k/dx_k| %.3g\n", worst, terms);
+    AK_CHECK(terms > 0.5);
+    for (int i = 0; i < 300; ++i) {
+        const ak_vec2 p = ak_vec2_make(frand(&rng, -20, 20), frand(&rng, -20, 20));
+        const ak_vec2 ax = ak_noise_curl2(&n, &fd, ak_vec2_make(p.x + h, p.y)),
+                      bx = ak_noise_curl2(&n, &fd, ak_vec2_make(p.x - h, p.y));
+        const ak_vec2 ay = ak_noise_curl2(&n, &fd, ak_vec2_make(p.x, p.y + h)),
+                      by = ak_noise_curl2(&n, &fd, ak_vec2_make(p.x, p.y - h));
+        const double dx = ((double)ax.x - bx.x) / (2 * h), dy = ((double)ay.y - by.y) / (2 * h);
+        AK_CHECK_MSG(fabs(dx + dy) <= 1e-3 * (fabs(dx) + fabs(dy)) + 5e-3, "2D div %.4g", dx + dy);
+    }
+    AK_CHECK(ak_vec3_length(ak_noise_curl3(NULL, &fd, ak_vec3_zero())) == 0.0f);
+}
+
+AK_TEST(wind) {
+    ak_noise n = ak_noise_make(1);
+    const ak_vec3 p = ak_vec3_make(1, 2, 3);
+    ak_noise_wind_desc calm = {0};
+    AK_CHECK(ak_vec3_length(ak_noise_wind(&n, &calm, p, 1.0f)) == 0.0f);
+    ak_noise_wind_desc steady = {.direction = ak_vec3_make(0, 0, 2), .speed = 3};
+    const ak_vec3 v = ak_noise_wind(&n, &steady, p, 7.0f);
+    AK_CHECK_NEAR(v.x, 0, 1e-6);
+    AK_CHECK_NEAR(v.z, 3, 1e-6);
+    ak_noise_wind_desc gusty = {.direction = ak_vec3_make(1, 0, 0), .speed = 5, .gust = 0.4f};
+    float mn = 1e9f, mx = -1e9f;
+    for (int i = 0; i < 2000; ++i) {
+        const float s = ak_noise_wind(&n, &gusty, p, (float)i * 0.05f).x;
+        mn = fminf(mn, s), mx = fmaxf(mx, s);
+        AK_CHECK(s >= 5.0f * 0.6f - 1e-4f && s <= 5.0f * 1.4f + 1e-4f);
+    }
+    AK_CHECK(mx - mn > 1.0f); /* it does gust */
+    /* the swirl is divergence-free and smooth in time */
+    ak_noise_wind_desc swirl = {.direction = ak_vec3_make(1, 0, 1), .speed = 2, .turbulence = 1.5f};
+    ak_rng rng = ak_rng_make(4);
+    const float h = 1.0f / 256.0f;
+    for (int i = 0; i < 100; ++i) {
+        const ak_vec3 q = ak_vec3_make(frand(&rng, -5, 5), frand(&rng, -5, 5), frand(&rng, -5, 5));
+        const float t = frand(&rng, 0, 10);
+        double div = 0;
+        for (int k = 0; k < 3; ++k) {
+            ak_vec3 a = q, b = q;
+            set_comp(&a, k, comp(a, k) + h);
+            set_comp(&b, k, comp(b, k) - h);
+            div += ((double)comp(ak_noise_wind(&n, &swirl, a, t), k) - comp(ak_noise_wind(&n, &swirl, b, t), k)) / (2.0 * h);
+        }
+        AK_CHECK_MSG(fabs(div) < 0.02, "wind div %.4g", div);
+        const ak_vec3 w0 = ak_noise_wind(&n, &swirl, q, t), w1 = ak_noise_wind(&n, &swirl, q, t + 1e-3f);
+        AK_CHECK(ak_vec3_length(ak_vec3_sub(w0, w1)) < 0.05f);
+    }
+    AK_CHECK(ak_vec3_length(ak_noise_wind(&n, &swirl, ak_vec3_make(NAN, 0, 0), 0)) == 0.0f);
+}
+
+AK_TEST(sway_layer) {
+    ak_noise n = ak_noise_make(2);
+    enum { J = 5 };
+    ak_transform pose[J], out[J], out2[J];
+    for (int j = 0; j < J; ++j) {
+        pose[j].translation = ak_vec3_make((float)j, 0, 0);
+        pose[j].rotation = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.3f * (float)j);
+        pose[j].scale = ak_vec3_make(1, 1, 1);
+    }
+    const float amp[J] = {0, 0.05f, 0.1f, 0.2f, 0.02f}, freq[J] = {1, 0.3f, 0.5f, 2, 0.25f};
+    const float tamp[J] = {0, 0, 0.01f, 0, 0};
+    ak_noise_sway_job job = {.noise = &n, .time = 3.7f, .pose = {pose, J}, .amplitudes = {amp, J},
+                             .frequencies = {freq, J}, .translation_amplitudes = {tamp, J}, .out_pose = {out, J}};
+    AK_CHECK_EQ(ak_noise_sway_run(&job), AK_OK);
+    AK_CHECK(memcmp(&out[0], &pose[0], sizeof pose[0]) == 0); /* amplitude 0: untouched */
+    for (int j = 1; j < J; ++j) {
+        /* delta = pose^-1 * out, its angle within amplitude * |n|, |n| <= sqrt 3 */
+        const ak_quat d = ak_quat_mul(ak_quat_conjugate(pose[j].rotation), out[j].rotation);
+        const float angle = 2.0f * acosf(fminf(1.0f, fabsf(d.w)));
+        AK_CHECK(angle <= amp[j] * sqrtf(3.0f) + 1e-5f);
+        AK_CHECK(angle > 0.0f);
+    }
+    AK_CHECK(ak_vec3_length(ak_vec3_sub(out[2].translation, pose[2].translation)) <= 0.01f * sqrtf(3.0f) + 1e-6f);
+    AK_CHECK(memcmp(&out[3].translation, &pose[3].translation, sizeof(ak_vec3)) == 0);
+    /* time * frequency is what matters: doubling one and halving the other changes nothing */
+    float freq2[J];
+    for (int j = 0; j < J; ++j) freq2[j] = freq[j] * 0.5f;
+    ak_noise_sway_job job2 = job;
+    job2.time = 7.4f;
+    job2.frequencies = (ak_f32_cspan){freq2, J};
+    job2.out_pose = (ak_transform_span){out2, J};
+    AK_CHECK_EQ(ak_noise_sway_run(&job2), AK_OK);
+    AK_CHECK(memcmp(out, out2, sizeof out) == 0);
+    /* smooth in time; in place works; zero mean over a long time */
+    job2 = job;
+    job2.time = 3.7f + 1e-3f;
+    job2.out_pose = (ak_transform_span){out2, J};
+    ak_noise_sway_run(&job2);
+    for (int j = 0; j < J; ++j) AK_CHECK(fabsf(ak_quat_dot(out[j].rotation, out2[j].rotation)) > 0.99999f);
+    ak_transform inplace[J];
+    memcpy(inplace, pose, sizeof pose);
+    job2 = job;
+    job2.pose = (ak_transform_cspan){inplace, J};
+    job2.out_pose = (ak_transform_span){inplace, J};
+    AK_CHECK_EQ(ak_noise_sway_run(&job2), AK_OK);
+    AK_CHECK(memcmp(inplace, out, sizeof out) == 0);
+    double mean = 0, mean_abs = 0;
+    for (int i = 0; i < 4000; ++i) {
+        job2 = job;
+        job2.time = (float)i * 0.37f;
+        job2.out_pose = (ak_transform_span){out2, J};
+        ak_noise_sway_run(&job2);
+        const ak_quat d = ak_quat_mul(ak_quat_conjugate(pose[3].rotation), out2[3].rotation);
+        mean += d.x / 4000.0, mean_abs += fabs(d.x) / 4000.0;
+    }
+    AK_CHECK(fabs(mean) < 0.25 * mean_abs);
+    /* validation */
+    AK_CHECK_EQ(ak_noise_sway_validate(&(ak_noise_sway_job){0}), AK_ERR_NULL_ARG);
+    job2 = job;
+    job2.amplitudes.count = J - 1;
+    AK_CHECK_EQ(ak_noise_sway_validate(&job2), AK_ERR_SPAN_SMALL);
+    job2 = job;
+    job2.time = INFINITY;
+    AK_CHECK_EQ(ak_noise_sway_run(&job2), AK_ERR_BAD_DATA);
+    const float badf[J] = {1, -1, 1, 1, 1};
+    job2 = job;
+    job2.frequencies = (ak_f32_cspan){badf, J};
+    AK_CHECK_EQ(ak_noise_sway_validate(&job2), AK_ERR_BAD_DATA);
+}
+
 int main(void) {
     AK_RUN(permutations);
     AK_RUN(perlin3_published_value);
@@ -477,6 +737,12 @@ int main(void) {
     AK_RUN(batch_simd_equals_scalar);
     AK_RUN(grid_job_equals_points);
     AK_RUN(job_validity);
+    AK_RUN(other_bases_gradients);
+    AK_RUN(worley_matches_brute_force);
+    AK_RUN(curl_noise_is_divergence_free);
+    AK_RUN(wind);
+    AK_RUN(sway_layer);
     AK_RUN(documented_ranges_hold);
+    AK_RUN(other_bases_ranges);
     return ak_test_finish();
 }

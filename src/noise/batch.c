@@ -99,6 +99,7 @@ ak_result ak_noise_job_validate(const ak_noise_job* job) {
     const uint32_t dims = job_dims(job);
     if (dims > 4 || job->thread_count > 64) return AK_ERR_BAD_ARG;
     if (ak_fractal_desc_validate(&job->fractal) != AK_OK) return AK_ERR_BAD_ARG;
+    if (!ak_noise_basis_supports(ak_fractal_desc_resolved(&job->fractal).basis, dims)) return AK_ERR_BAD_ARG;
     const ak_f32_cspan in[4] = {job->x, job->y, job->z, job->w};
     const ak_f32_span gr[4] = {job->out_gradient_x, job->out_gradient_y, job->out_gradient_z, job->out_gradient_w};
     const size_t n = job->out_values.count;

@@ -8,26 +8,62 @@
 
 #include "perlin_core.h"
 
+bool ak_noise_basis_supports(ak_noise_basis basis, uint32_t dimensions) {
+    if (basis == AK_NOISE_BASIS_DEFAULT) basis = AK_NOISE_BASIS_PERLIN;
+    switch (basis) {
+    case AK_NOISE_BASIS_PERLIN:
+    case AK_NOISE_BASIS_VALUE: return dimensions >= 1 && dimensions <= 4;
+    case AK_NOISE_BASIS_SIMPLEX:
+    case AK_NOISE_BASIS_WORLEY: return dimensions >= 1 && dimensions <= 3;
+    default: return false;
+    }
+}
+
+/* One basis function, arguments already checked (the octave loop's path). */
+static inline float basis_eval(const ak_noise* noise, ak_noise_basis basis, uint32_t dims, const float* q, float* g) {
+    switch (basis) {
+    case AK_NOISE_BASIS_SIMPLEX:
+        if (dims == 1) {
+            float g2[2];
+            const float v = ak_noise_simplex2(noise, q[0], 0.0f, g ? g2 : NULL);
+            if (g) g[0] = g2[0];
+            return v;
+        }
+        return dims == 2 ? ak_noise_simplex2(noise, q[0], q[1], g) : ak_noise_simplex3(noise, q[0], q[1], q[2], g);
+    case AK_NOISE_BASIS_VALUE: return ak_noise_value(noise, dims, q, g);
+    case AK_NOISE_BASIS_WORLEY: return ak_noise_worley(noise, dims, q, NULL, g);
+    default: return perlin_any(noise, dims, q, g);
+    }
+}
+
 float ak_noise_eval(const ak_noise* noise, ak_noise_basis basis, uint32_t dimensions, const float* point,
                     float* out_gradient) {
     if (out_gradient && dimensions <= 4)
         for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = 0.0f;
-    if (!noise || !point || dimensions < 1 || dimensions > 4 || (unsigned)basis >= AK_NOISE_BASIS_COUNT) return 0.0f;
-    switch (dimensions) {
-    case 1: return ak_noise_perlin1(noise, point[0], out_gradient);
-    case 2: return ak_noise_perlin2(noise, point[0], point[1], out_gradient);
-    case 3: return ak_noise_perlin3(noise, point[0], point[1], point[2], out_gradient);
-    default: return ak_noise_perlin4(noise, point[0], point[1], point[2], point[3], out_gradient);
-    }
+    if (basis == AK_NOISE_BASIS_DEFAULT) basis = AK_NOISE_BASIS_PERLIN;
+    if (!noise || !point || !ak_noise_basis_supports(basis, dimensions)) return 0.0f;
+    return basis_eval(noise, basis, dimensions, point, out_gradient);
 }
 
 void ak_noise_range(ak_noise_basis basis, uint32_t dimensions, float* out_lo, float* out_hi) {
-    float r = 1.0f;
-    (void)basis;
-    if (dimensions == 3) r = 1.04f;
-    if (dimensions >= 4) r = 1.5f;
-    if (out_lo) *out_lo = -r;
-    if (out_hi) *out_hi = r;
+    float lo = -1.0f, hi = 1.0f;
+    switch (basis) {
+    case AK_NOISE_BASIS_SIMPLEX:
+        lo = dimensions >= 3 ? -1.1f : -1.05f;
+        hi = -lo;
+        break;
+    case AK_NOISE_BASIS_VALUE: break;
+    case AK_NOISE_BASIS_WORLEY:
+        lo = 0.0f;
+        hi = sqrtf((float)(dimensions < 1 ? 1 : dimensions > 3 ? 3 : dimensions));
+        break;
+    default:
+        if (dimensions == 3) lo = -1.04f, hi = 1.04f;
+        if (dimensions >= 4) lo = -1.5f, hi = 1.5f;
+        break;
+    }
+    if (out_lo) *out_lo = lo;
+    if (out_hi) *out_hi = hi;
 }
 
 ak_fractal_desc ak_fractal_desc_resolved(const ak_fractal_desc* desc) {
@@ -52,12 +88,6 @@ ak_result ak_fractal_desc_validate(const ak_fractal_desc* desc) {
     if (!(d.frequency > 0.0f && d.frequency <= 1e6f)) return AK_ERR_BAD_ARG;
     if (!(fabsf(d.warp) <= 1e6f)) return AK_ERR_BAD_ARG;
     return AK_OK;
-}
-
-/* One basis function of a valid desc (the scalar batch path: inlined). */
-static inline float basis_eval(const ak_noise* noise, ak_noise_basis basis, uint32_t dims, const float* q, float* g) {
-    (void)basis;
-    return perlin_any(noise, dims, q, g);
 }
 
 /* The octave sum at p (no warping). */
@@ -129,8 +159,9 @@ float ak_fractal_eval(const ak_noise* noise, const ak_fractal_desc* desc, uint32
                       float* out_gradient) {
     if (out_gradient && dimensions <= 4)
         for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = 0.0f;
-    if (!noise || !point || dimensions < 1 || dimensions > 4 || ak_fractal_desc_validate(desc) != AK_OK) return 0.0f;
+    if (!noise || !point || ak_fractal_desc_validate(desc) != AK_OK) return 0.0f;
     const ak_fractal_desc d = ak_fractal_desc_resolved(desc);
+    if (!ak_noise_basis_supports(d.basis, dimensions)) return 0.0f;
     return akp_fractal_point(noise, &d, dimensions, point, out_gradient);
 }
 
