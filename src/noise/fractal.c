@@ -6,7 +6,18 @@
 #include <math.h>
 #include <string.h>
 
-#include "perlin_core.h"
+#include "noise_internal.h"
+
+/* Perlin noise with a run-time dims (1..4) and optional gradient, through the public
+ * functions (one compiled body per dimension, shared by every caller). */
+static inline float perlin_any(const ak_noise* noise, uint32_t dims, const float* p, float* grad) {
+    switch (dims) {
+    case 1: return ak_noise_perlin1(noise, p[0], grad);
+    case 2: return ak_noise_perlin2(noise, p[0], p[1], grad);
+    case 3: return ak_noise_perlin3(noise, p[0], p[1], p[2], grad);
+    default: return ak_noise_perlin4(noise, p[0], p[1], p[2], p[3], grad);
+    }
+}
 
 bool ak_noise_basis_supports(ak_noise_basis basis, uint32_t dimensions) {
     if (basis == AK_NOISE_BASIS_DEFAULT) basis = AK_NOISE_BASIS_PERLIN;
