@@ -34,8 +34,8 @@
  * Ranges: every basis function returns values in a documented interval ("range" at each
  * function) and the fractal range is ak_fractal_range(). Coordinates are lattice units; noise
  * repeats every 256 units (the permutation size) along each axis. Inputs are expected finite
- * and within +-2^23 (beyond, float coordinates have no fractional part and the noise is 0);
- * non-finite inputs give 0 and a zero gradient, never NaN.
+ * with |coordinate| < 2^24; at or beyond that (where floats have no fractional part) and for
+ * non-finite inputs every basis gives 0 and a zero gradient, never NaN.
  *
  * Ownership and threading: ak_noise is a plain value (520 bytes), read-only after
  * ak_noise_make and safe to share between threads. Nothing here allocates; jobs with
@@ -233,7 +233,9 @@ AK_API ak_vec3 ak_noise_curl3(const ak_noise* noise, const ak_fractal_desc* desc
 AK_API ak_vec2 ak_noise_curl2(const ak_noise* noise, const ak_fractal_desc* desc, ak_vec2 p);
 
 /* Noise wind for cloth and particles: a mean wind whose strength gusts in time, plus a
- * divergence-free curl-noise swirl drifting with the wind. */
+ * divergence-free curl-noise swirl drifting with the wind. The swirl's potential is 2-octave
+ * 4D Perlin fBm with time as the fourth coordinate (times evolution), so the pattern changes
+ * shape as it drifts; only spatial derivatives enter the curl. */
 typedef struct ak_noise_wind_desc {
     ak_vec3 direction;      /* world; need not be unit; zero -> +x */
     float speed;            /* mean speed, m/s; 0 -> calm (only the swirl) */
@@ -242,7 +244,8 @@ typedef struct ak_noise_wind_desc {
     float gust_frequency;   /* Hz; 0 -> 0.25 */
     float turbulence;       /* swirl amplitude, m/s per unit curl; 0 -> none */
     float turbulence_scale; /* metres per noise cell of the swirl; 0 -> 2 */
-    float evolution;        /* how fast the swirl changes shape, noise cells per second; 0 -> 0.3 */
+    float evolution;        /* how fast the swirl changes shape: noise cells per second along the
+                               potential's time axis; 0 -> 0.3 */
 } ak_noise_wind_desc;
 
 /* Wind velocity (m/s, world) at world point p and time t (seconds); smooth in p and t. NULL

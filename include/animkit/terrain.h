@@ -19,7 +19,8 @@
  *                           .height_scale = 20, .fractal = { .type = AK_FRACTAL_RIDGED, .octaves = 8 } };
  *     float* h = malloc(257 * 257 * sizeof *h);  ak_vec3* nrm = malloc(257 * 257 * sizeof *nrm);
  *     ak_terrain_generate(&d, (ak_f32_span){h, 257 * 257}, (ak_vec3_span){nrm, 257 * 257});
- *     ak_terrain_erode(&(ak_terrain_erosion){ .droplets = 50000 }, &d, (ak_f32_span){h, 257 * 257});
+ *     ak_terrain_erode(&(ak_terrain_erosion){ .droplets = 50000 }, &d, (ak_f32_span){h, 257 * 257},
+ *                      NULL, NULL);     // no progress callback
  *     ak_terrain_normals(&d, (ak_f32_cspan){h, 257 * 257}, (ak_vec3_span){nrm, 257 * 257});
  *     ak_terrain_write_png16("height.png", &d, (ak_f32_cspan){h, 257 * 257}, 0, 0);
  *

@@ -37,14 +37,21 @@ ak_vec3 ak_noise_wind(const ak_noise* noise, const ak_noise_wind_desc* desc, ak_
     if (desc->turbulence != 0.0f) {
         const float scale = desc->turbulence_scale != 0.0f ? desc->turbulence_scale : 2.0f;
         const float evo = desc->evolution != 0.0f ? desc->evolution : 0.3f;
-        /* the swirl drifts with the mean wind and changes shape by moving through a fourth
-         * direction of the potential (here: an extra offset along the diagonal) */
-        const float drift = desc->speed * t / scale, shift = evo * t;
-        const ak_vec3 q = ak_vec3_make(p.x / scale - dir.x * drift + shift, p.y / scale - dir.y * drift + 0.5f * shift,
-                                       p.z / scale - dir.z * drift - 0.7f * shift);
+        /* the swirl drifts with the mean wind; its potential is 4D noise whose fourth
+         * coordinate is time, so the pattern also changes shape. The curl takes only the
+         * spatial derivatives, so the field stays divergence-free at every instant. */
+        const float drift = desc->speed * t / scale;
+        const float q[3] = {p.x / scale - dir.x * drift, p.y / scale - dir.y * drift, p.z / scale - dir.z * drift};
         const ak_fractal_desc fd = {.octaves = 2};
-        /* d/dp of psi(p / scale) is grad / scale */
-        v = ak_vec3_add(v, ak_vec3_scale(ak_noise_curl3(noise, &fd, q), desc->turbulence / scale));
+        static const float off[3][3] = {{0, 0, 0}, {31.4f, 0, 0}, {0, 47.2f, 0}};
+        float g[3][4];
+        for (int k = 0; k < 3; ++k) {
+            const float p4[4] = {q[0] + off[k][0], q[1] + off[k][1], q[2] + off[k][2], (float)fmod((double)t * evo, 256.0)};
+            ak_fractal_eval(noise, &fd, 4, p4, g[k]);
+        }
+        /* curl of psi(p / scale): derivatives carry 1 / scale */
+        const ak_vec3 curl = ak_vec3_make(g[2][1] - g[1][2], g[0][2] - g[2][0], g[1][0] - g[0][1]);
+        v = ak_vec3_add(v, ak_vec3_scale(curl, desc->turbulence / scale));
     }
     return finite3(v) ? v : ak_vec3_zero();
 }
