@@ -402,7 +402,9 @@ AK_TEST(grid_job_equals_points) {
     AK_CHECK(memcmp(v[0], v[1], sizeof v[0]) == 0 && memcmp(gx[0], gx[1], sizeof gx[0]) == 0);
     for (int j = 0; j < H; ++j)
         for (int i = 0; i < W; ++i) {
-            const float p[2] = {-3.5f + (float)i * 0.173f, 1.25f + (float)j * 0.31f};
+            /* two statements: a compiler allowed to contract must not fuse into an FMA here */
+            const float dx = (float)i * 0.173f, dy = (float)j * 0.31f;
+            const float p[2] = {-3.5f + dx, 1.25f + dy};
             float g[2];
             const float e = ak_fractal_eval(&n, &fd, 2, p, g);
             AK_CHECK(e == v[0][j * W + i] && g[1] == gy[0][j * W + i]);
