@@ -123,6 +123,36 @@ done:
     return rc;
 }
 
+/* Images are at most 960 pixels wide: grids above 513 samples are rendered from every k-th
+ * sample (the same world rectangle; heights and normals copied, not resampled). */
+static int render_decimated(const terrain_data* t, const char* path, bool gif) {
+    const ak_terrain_desc* d = &t->desc;
+    const uint32_t side = d->width > d->height ? d->width : d->height;
+    const uint32_t k = side > 513 ? (side - 1 + 511) / 512 : 1;
+    if (k == 1) return render_frames(t, path, gif);
+    terrain_data s = *t;
+    s.desc.width = (d->width - 1) / k + 1;
+    s.desc.height = (d->height - 1) / k + 1;
+    s.desc.world_size = d->world_size / (float)(d->width - 1) * (float)(k * (s.desc.width - 1));
+    s.count = (size_t)s.desc.width * s.desc.height;
+    s.heights = malloc(s.count * sizeof *s.heights);
+    s.normals = malloc(s.count * sizeof *s.normals);
+    int rc;
+    if (!s.heights || !s.normals) {
+        rc = cli_fail("terrain", "out of memory for a %ux%u render", s.desc.width, s.desc.height);
+    } else {
+        for (uint32_t j = 0; j < s.desc.height; ++j)
+            for (uint32_t i = 0; i < s.desc.width; ++i) {
+                const size_t from = (size_t)j * k * d->width + (size_t)i * k;
+                s.heights[(size_t)j * s.desc.width + i] = t->heights[from];
+                s.normals[(size_t)j * s.desc.width + i] = t->normals[from];
+            }
+        rc = render_frames(&s, path, gif);
+    }
+    free(s.heights), free(s.normals);
+    return rc;
+}
+
 int cmd_terrain(int argc, char** argv) {
     static const cli_opt opts[] = {
         {"--size", NULL, true},   {"--world", NULL, true},   {"--height", NULL, true},     {"--noise", NULL, true},
@@ -219,7 +249,7 @@ int cmd_terrain(int argc, char** argv) {
         rc = res == AK_OK ? CLI_OK : cli_fail("terrain", "%s: %s", out, ak_result_string(res));
     } else {
         what = gif ? "turntable GIF" : "shaded render";
-        rc = render_frames(&t, out, gif);
+        rc = render_decimated(&t, out, gif);
     }
     if (rc == CLI_OK)
         printf("terrain %ux%u, %g m wide, heights [%.3f, %.3f] m, %ld droplets: wrote %s (%s) in %.2f s\n", d->width,
