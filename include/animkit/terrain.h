@@ -4,7 +4,8 @@
  *   - a W x H heightfield over a square-celled world rectangle from any fractal of noise.h,
  *     with normals from the fractal's analytic gradient (no finite differences);
  *   - a particle-based hydraulic erosion pass (water droplets that pick up and drop sediment,
- *     after Mei et al. 2007 / Beyer 2015, simplified) and a thermal pass (talus slumping);
+ *     after H. T. Beyer 2015, "Implementation of a method for hydraulic erosion", simplified)
+ *     and a thermal pass (material above the talus slope slides to the lowest neighbour);
  *   - normals from the heights (after erosion), colours by height and slope, and a triangle
  *     mesh (positions, normals, UVs, colours, indices) for the raster module or a file;
  *   - files: Wavefront OBJ with normals and UVs, and a 16-bit greyscale PNG heightmap.
