@@ -21,7 +21,7 @@
  * Usage:
  *     ak_noise n = ak_noise_make(0);                       // Perlin's own permutation
  *     float g[3];
- *     float v = ak_noise_perlin3(&n, 3.14f, 42.0f, 7.0f, g); // 0.136919958..., gradient in g
+ *     float v = ak_noise_perlin3(&n, 3.14f, 42.0f, 7.0f, g); // 0.13692005 (Perlin: 0.136919959)
  *     ak_fractal_desc fd = { .type = AK_FRACTAL_FBM, .octaves = 8 };  // lacunarity 2, gain 0.5
  *     float p[2] = { 0.3f, 1.7f };
  *     float h = ak_fractal_eval(&n, &fd, 2, p, NULL);
