@@ -24,5 +24,7 @@
 #include "io.h"
 #include "raster.h"
 #include "view.h"
+#include "noise.h"
+#include "terrain.h"
 
 #endif

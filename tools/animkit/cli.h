@@ -120,5 +120,7 @@ int cmd_curves(int argc, char** argv);
 int cmd_weights(int argc, char** argv);
 int cmd_skin(int argc, char** argv);
 int cmd_ik(int argc, char** argv);
+int cmd_noise(int argc, char** argv);
+int cmd_terrain(int argc, char** argv);
 
 #endif

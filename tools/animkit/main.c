@@ -19,6 +19,8 @@ static const command commands[] = {
     {"weights", cmd_weights, "compute automatic skin weights (inverse distance or bone heat)"},
     {"skin", cmd_skin, "compare LBS, DQS and CoR skinning: volume and bulge"},
     {"ik", cmd_ik, "solve inverse kinematics for a joint chain"},
+    {"noise", cmd_noise, "evaluate Perlin, simplex, value or Worley noise (or a fractal sum) at a point"},
+    {"terrain", cmd_terrain, "generate a fractal terrain: OBJ, 16-bit PNG heightmap, render or GIF flight"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 
