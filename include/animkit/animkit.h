@@ -26,5 +26,6 @@
 #include "view.h"
 #include "noise.h"
 #include "terrain.h"
+#include "grid.h"
 
 #endif
