@@ -11,6 +11,7 @@
 #define PS_MAX_CAPACITY (1u << 30)
 #define PS_CONTACT_ITERATIONS 4
 #define PS_MESH_OFFSET 1e-5f     /* mesh contacts leave particles this far off the surface */
+#define PS_EMIT_OFFSET 1e-4f     /* mesh emission starts this far out along the triangle normal */
 
 struct ak_particles {
     ak_allocator alloc;
@@ -332,7 +333,9 @@ static void emit_one(ak_particles* ps, const ak_particle_emitter* e, ak_vec3 axi
         float s = sqrtf(ak_rng_float(rng)), w = ak_rng_float(rng);
         p = ak_vec3_add(ak_vec3_add(ak_vec3_scale(a, 1.0f - s), ak_vec3_scale(b, s * (1.0f - w))),
                         ak_vec3_scale(c, s * w));
-        if (!e->use_direction_on_mesh) axis = unit_or_up(ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(c, a)));
+        const ak_vec3 n = unit_or_up(ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(c, a)));
+        p = ak_vec3_madd(p, n, PS_EMIT_OFFSET); /* off the surface, so a collider of the same mesh lets it go */
+        if (!e->use_direction_on_mesh) axis = n;
         break;
     }
     default: break;

@@ -143,7 +143,8 @@ typedef enum ak_emitter_shape {
     AK_EMITTER_SPHERE_SURFACE, /* uniform on the sphere */
     AK_EMITTER_DISC,          /* uniform on the disc of radius around center, facing direction */
     AK_EMITTER_BOX,           /* uniform in center +- half_extents */
-    AK_EMITTER_MESH,          /* uniform over the area of a triangle mesh (see mesh_*) */
+    AK_EMITTER_MESH,          /* uniform over the area of a triangle mesh (see mesh_*), 1e-4 m out
+                                 along the triangle's normal (counter-clockwise front) */
     AK_EMITTER_SHAPE_COUNT
 } ak_emitter_shape;
 
