@@ -264,7 +264,12 @@ bool particles_scene_parse(const char* file, const char* text, size_t size, part
     if (root) read_scene(&j, root, out);
     cJSON_Delete(root);
     if (j.failed) {
-        if (err && err_size) snprintf(err, err_size, "%s", j.message);
+        if (err && err_size) {
+            snprintf(err, err_size, "%s", j.message);
+            /* One line: keys quoted in the message may hold control characters (\n). */
+            for (char* c = err; *c; ++c)
+                if ((unsigned char)*c < 0x20) *c = '?';
+        }
         particles_scene_free(out);
         return false;
     }
