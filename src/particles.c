@@ -5,6 +5,7 @@
 #include <pthread.h>
 
 #include "internal.h"
+#include "simd.h"
 
 #define PS_MAX_THREADS 64u
 #define PS_MIN_PER_THREAD 8192u  /* below this a thread start costs more than it saves */
@@ -68,37 +69,42 @@ static void basis(ak_vec3 n, ak_vec3* t, ak_vec3* b) {
     *b = ak_vec3_cross(n, *t);
 }
 
+/* A pass over particles [begin, end); returns true when one of them is now dead (age >=
+ * lifetime or non-finite), so the step knows whether to compact. */
+typedef bool (*range_fn)(void* ctx, size_t begin, size_t end);
+
 typedef struct range_task {
-    void (*fn)(void* ctx, size_t begin, size_t end);
+    range_fn fn;
     void* ctx;
     size_t begin, end;
+    bool dead;
 } range_task;
 
 static void* range_thread(void* arg) {
     range_task* t = (range_task*)arg;
-    t->fn(t->ctx, t->begin, t->end);
+    t->dead = t->fn(t->ctx, t->begin, t->end);
     return NULL;
 }
 
 /* Runs fn over [0, n) split in contiguous ranges. Each element's work is independent of the
  * split, so results do not depend on the thread count. */
-static void parallel_for(uint32_t threads, size_t n, void (*fn)(void*, size_t, size_t), void* ctx) {
+static bool parallel_for(uint32_t threads, size_t n, range_fn fn, void* ctx) {
     size_t most = n / PS_MIN_PER_THREAD;
     if (threads > most) threads = most ? (uint32_t)most : 1;
-    if (threads <= 1) {
-        fn(ctx, 0, n);
-        return;
-    }
+    if (threads <= 1) return fn(ctx, 0, n);
     range_task tasks[PS_MAX_THREADS];
     pthread_t ids[PS_MAX_THREADS];
     bool started[PS_MAX_THREADS];
-    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (range_task){fn, ctx, n * t / threads, n * (t + 1) / threads};
+    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (range_task){fn, ctx, n * t / threads, n * (t + 1) / threads, false};
     for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, range_thread, &tasks[t]) == 0;
     range_thread(&tasks[0]);
+    bool dead = tasks[0].dead;
     for (uint32_t t = 1; t < threads; ++t) {
         if (started[t]) pthread_join(ids[t], NULL);
         else range_thread(&tasks[t]);
+        dead = dead || tasks[t].dead;
     }
+    return dead;
 }
 
 /* ---- lifecycle ---------------------------------------------------------------------- */
@@ -544,7 +550,7 @@ static inline ak_vec3 accel_one(const step_ctx* c, size_t i, ak_vec3 x, ak_vec3 
     return ak_vec3_madd(w->gravity, f, im);
 }
 
-static void lj_range(void* arg, size_t begin, size_t end) {
+static bool lj_range(void* arg, size_t begin, size_t end) {
     step_ctx* c = (step_ctx*)arg;
     const ak_grid* g = &c->lj_grid;
     const ak_particle_lennard_jones* lj = &c->w->lennard_jones;
@@ -570,11 +576,13 @@ static void lj_range(void* arg, size_t begin, size_t end) {
                 }
         c->ps->force[i] = ak_vec3_add(c->ps->force[i], f);
     }
+    return false;
 }
 
-static void accel_range(void* arg, size_t begin, size_t end) {
+static bool accel_range(void* arg, size_t begin, size_t end) {
     step_ctx* c = (step_ctx*)arg;
     for (size_t i = begin; i < end; ++i) c->A[i] = accel_one(c, i, c->X[i], c->V[i]);
+    return false;
 }
 
 /* Accelerations of every particle at state (X, V) and time t into A. */
@@ -832,32 +840,128 @@ static inline bool any_colliders(const ak_particles_world* w) {
 
 /* ---- integration passes ------------------------------------------------------------- */
 
-/* Symplectic Euler without pair forces: one fused pass (read and write each array once). */
-static void fused_symplectic(void* arg, size_t begin, size_t end) {
-    step_ctx* c = (step_ctx*)arg;
+/* Symplectic Euler without pair forces, one particle: returns true when it is now dead. */
+static inline bool fused_one(const step_ctx* c, size_t i, bool coll) {
     ak_particles* ps = c->ps;
     const float dt = c->dt;
-    const bool coll = any_colliders(c->w);
-    for (size_t i = begin; i < end; ++i) {
-        ps->age[i] += dt;
-        if (ps->inv_mass[i] == 0.0f) continue;
-        const ak_vec3 x0 = ps->pos[i], v0 = ps->vel[i];
-        ak_vec3 v1 = ak_vec3_madd(v0, accel_one(c, i, x0, v0), dt);
-        ak_vec3 x1 = ak_vec3_madd(x0, v1, dt);
-        if (coll) collide_one(c, x0, v0, &x1, &v1, dt);
-        ps->pos[i] = x1;
-        ps->vel[i] = v1;
-    }
+    const float age = ps->age[i] + dt;
+    ps->age[i] = age;
+    bool dead = !(age < ps->life[i]);
+    if (ps->inv_mass[i] == 0.0f) return dead;
+    const ak_vec3 x0 = ps->pos[i], v0 = ps->vel[i];
+    ak_vec3 v1 = ak_vec3_madd(v0, accel_one(c, i, x0, v0), dt);
+    ak_vec3 x1 = ak_vec3_madd(x0, v1, dt);
+    if (coll) collide_one(c, x0, v0, &x1, &v1, dt);
+    ps->pos[i] = x1;
+    ps->vel[i] = v1;
+    const float sum = x1.x + x1.y + x1.z + v1.x + v1.y + v1.z; /* NaN or inf when any is */
+    return dead || !(sum - sum == 0.0f);
 }
 
-static void save_state(void* arg, size_t begin, size_t end) {
+#if AK_SIMD_SSE2
+/* Four particles at a time for worlds of gravity, drag, wind and at most PS_CACHE planes.
+ * Every operation is the scalar path's, in the same order (no FMA), so a particle gets the
+ * same bits whichever path (and so whichever thread split) handles it. Lanes whose new
+ * position is behind a plane finish through the scalar collide_one. */
+static bool simple_world(const ak_particles_world* w) {
+    return w->attractors.count == 0 && w->vortices.count == 0 && w->spheres.count == 0 && w->boxes.count == 0 &&
+           w->meshes.count == 0 && w->planes.count <= PS_CACHE;
+}
+
+static size_t fused_sse2(step_ctx* c, size_t begin, size_t end, bool* out_dead) {
+    ak_particles* ps = c->ps;
+    const ak_particles_world* w = c->w;
+    const __m128 dt = _mm_set1_ps(c->dt), zero = _mm_setzero_ps();
+    const __m128 gx = _mm_set1_ps(w->gravity.x), gy = _mm_set1_ps(w->gravity.y), gz = _mm_set1_ps(w->gravity.z);
+    const __m128 wx = _mm_set1_ps(w->wind.x), wy = _mm_set1_ps(w->wind.y), wz = _mm_set1_ps(w->wind.z);
+    const __m128 kl = _mm_set1_ps(w->drag_linear), kq = _mm_set1_ps(w->drag_quadratic);
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    const bool drag = w->drag_linear != 0.0f || w->drag_quadratic != 0.0f;
+    const size_t planes = w->planes.count;
+    __m128 dead = zero;
+    size_t i = begin;
+    for (; i + 4 <= end; i += 4) {
+        const __m128 age = _mm_add_ps(_mm_loadu_ps(ps->age + i), dt);
+        _mm_storeu_ps(ps->age + i, age);
+        dead = _mm_or_ps(dead, _mm_cmpnlt_ps(age, _mm_loadu_ps(ps->life + i)));
+        const __m128 im = _mm_loadu_ps(ps->inv_mass + i);
+        const __m128 moving = _mm_cmpneq_ps(im, zero);
+        __m128 x, y, z, vx, vy, vz;
+        akp_simd_load_vec3x4(&ps->pos[i].x, &x, &y, &z);
+        akp_simd_load_vec3x4(&ps->vel[i].x, &vx, &vy, &vz);
+        __m128 fx = zero, fy = zero, fz = zero;
+        if (drag) {
+            const __m128 rx = _mm_sub_ps(vx, wx), ry = _mm_sub_ps(vy, wy), rz = _mm_sub_ps(vz, wz);
+            const __m128 len = _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, rx), _mm_mul_ps(ry, ry)), _mm_mul_ps(rz, rz)));
+            const __m128 nk = _mm_xor_ps(_mm_add_ps(kl, _mm_mul_ps(kq, len)), sign); /* -k */
+            fx = _mm_add_ps(zero, _mm_mul_ps(rx, nk));
+            fy = _mm_add_ps(zero, _mm_mul_ps(ry, nk));
+            fz = _mm_add_ps(zero, _mm_mul_ps(rz, nk));
+        }
+        const __m128 ax = _mm_add_ps(gx, _mm_mul_ps(fx, im)), ay = _mm_add_ps(gy, _mm_mul_ps(fy, im)),
+                     az = _mm_add_ps(gz, _mm_mul_ps(fz, im));
+        const __m128 nvx = akp_simd_select(moving, _mm_add_ps(vx, _mm_mul_ps(ax, dt)), vx);
+        const __m128 nvy = akp_simd_select(moving, _mm_add_ps(vy, _mm_mul_ps(ay, dt)), vy);
+        const __m128 nvz = akp_simd_select(moving, _mm_add_ps(vz, _mm_mul_ps(az, dt)), vz);
+        const __m128 nx = akp_simd_select(moving, _mm_add_ps(x, _mm_mul_ps(nvx, dt)), x);
+        const __m128 ny = akp_simd_select(moving, _mm_add_ps(y, _mm_mul_ps(nvy, dt)), y);
+        const __m128 nz = akp_simd_select(moving, _mm_add_ps(z, _mm_mul_ps(nvz, dt)), z);
+        __m128 behind = zero;
+        for (size_t k = 0; k < planes; ++k) {
+            const ak_vec3 n = c->plane_n[k];
+            const __m128 s1 = _mm_sub_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(n.x), nx), _mm_mul_ps(_mm_set1_ps(n.y), ny)),
+                                                    _mm_mul_ps(_mm_set1_ps(n.z), nz)),
+                                         _mm_set1_ps(w->planes.ptr[k].d));
+            behind = _mm_or_ps(behind, _mm_cmplt_ps(s1, zero));
+        }
+        const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(nx, ny), nz), nvx), nvy), nvz);
+        dead = _mm_or_ps(dead, _mm_and_ps(moving, _mm_cmpneq_ps(_mm_sub_ps(sum, sum), zero)));
+        int hits = _mm_movemask_ps(_mm_and_ps(behind, moving));
+        if (hits) { /* keep the start of the step for the scalar contact code */
+            ak_vec3 x0[4], v0[4];
+            memcpy(x0, &ps->pos[i], sizeof x0);
+            memcpy(v0, &ps->vel[i], sizeof v0);
+            akp_simd_store_vec3x4(&ps->pos[i].x, nx, ny, nz);
+            akp_simd_store_vec3x4(&ps->vel[i].x, nvx, nvy, nvz);
+            for (int l = 0; l < 4; ++l) {
+                if (!(hits & (1 << l))) continue;
+                collide_one(c, x0[l], v0[l], &ps->pos[i + (size_t)l], &ps->vel[i + (size_t)l], c->dt);
+                const ak_vec3 p = ps->pos[i + (size_t)l], v = ps->vel[i + (size_t)l];
+                const float sm = p.x + p.y + p.z + v.x + v.y + v.z;
+                if (!(sm - sm == 0.0f)) *out_dead = true;
+            }
+        } else {
+            akp_simd_store_vec3x4(&ps->pos[i].x, nx, ny, nz);
+            akp_simd_store_vec3x4(&ps->vel[i].x, nvx, nvy, nvz);
+        }
+    }
+    if (_mm_movemask_ps(dead)) *out_dead = true;
+    return i;
+}
+#endif
+
+/* Symplectic Euler without pair forces: one fused pass (read and write each array once). */
+static bool fused_symplectic(void* arg, size_t begin, size_t end) {
+    step_ctx* c = (step_ctx*)arg;
+    const bool coll = any_colliders(c->w);
+    bool dead = false;
+    size_t i = begin;
+#if AK_SIMD_SSE2
+    if (simple_world(c->w)) i = fused_sse2(c, begin, end, &dead);
+#endif
+    for (; i < end; ++i) dead |= fused_one(c, i, coll);
+    return dead;
+}
+
+static bool save_state(void* arg, size_t begin, size_t end) {
     step_ctx* c = (step_ctx*)arg;
     ak_particles* ps = c->ps;
     memcpy(ps->x0 + begin, ps->pos + begin, (end - begin) * sizeof(ak_vec3));
     memcpy(ps->v0 + begin, ps->vel + begin, (end - begin) * sizeof(ak_vec3));
+    return false;
 }
 
-static void pass_euler(void* arg, size_t begin, size_t end) {
+static bool pass_euler(void* arg, size_t begin, size_t end) {
     step_ctx* c = (step_ctx*)arg;
     ak_particles* ps = c->ps;
     for (size_t i = begin; i < end; ++i) {
@@ -865,9 +969,10 @@ static void pass_euler(void* arg, size_t begin, size_t end) {
         ps->pos[i] = ak_vec3_madd(ps->x0[i], ps->v0[i], c->dt);
         ps->vel[i] = ak_vec3_madd(ps->v0[i], ps->acc[i], c->dt);
     }
+    return false;
 }
 
-static void pass_symplectic(void* arg, size_t begin, size_t end) {
+static bool pass_symplectic(void* arg, size_t begin, size_t end) {
     step_ctx* c = (step_ctx*)arg;
     ak_particles* ps = c->ps;
     for (size_t i = begin; i < end; ++i) {
@@ -875,10 +980,11 @@ static void pass_symplectic(void* arg, size_t begin, size_t end) {
         ps->vel[i] = ak_vec3_madd(ps->v0[i], ps->acc[i], c->dt);
         ps->pos[i] = ak_vec3_madd(ps->x0[i], ps->vel[i], c->dt);
     }
+    return false;
 }
 
 /* Verlet, first half: new positions and the predicted velocities (into vs). */
-static void pass_verlet_a(void* arg, size_t begin, size_t end) {
+static bool pass_verlet_a(void* arg, size_t begin, size_t end) {
     step_ctx* c = (step_ctx*)arg;
     ak_particles* ps = c->ps;
     const float dt = c->dt;
@@ -890,10 +996,11 @@ static void pass_verlet_a(void* arg, size_t begin, size_t end) {
         ps->xs[i] = ak_vec3_madd(ak_vec3_madd(ps->x0[i], ps->v0[i], dt), ps->acc[i], 0.5f * dt * dt);
         ps->vs[i] = ak_vec3_madd(ps->v0[i], ps->acc[i], dt);
     }
+    return false;
 }
 
 /* Verlet, second half: acc holds a(t), sx holds a(t + dt). */
-static void pass_verlet_b(void* arg, size_t begin, size_t end) {
+static bool pass_verlet_b(void* arg, size_t begin, size_t end) {
     step_ctx* c = (step_ctx*)arg;
     ak_particles* ps = c->ps;
     for (size_t i = begin; i < end; ++i) {
@@ -901,6 +1008,7 @@ static void pass_verlet_b(void* arg, size_t begin, size_t end) {
         ps->pos[i] = ps->xs[i];
         ps->vel[i] = ak_vec3_madd(ps->v0[i], ak_vec3_add(ps->acc[i], ps->sx[i]), 0.5f * c->dt);
     }
+    return false;
 }
 
 /* RK4 stage s (1..3): accumulate k_s (velocity = V stage, acceleration = acc) into the sums
@@ -911,7 +1019,7 @@ typedef struct rk_ctx {
     bool first, last;
 } rk_ctx;
 
-static void pass_rk(void* arg, size_t begin, size_t end) {
+static bool pass_rk(void* arg, size_t begin, size_t end) {
     rk_ctx* r = (rk_ctx*)arg;
     ak_particles* ps = r->c->ps;
     const float dt = r->c->dt;
@@ -931,16 +1039,23 @@ static void pass_rk(void* arg, size_t begin, size_t end) {
             ps->vs[i] = ak_vec3_madd(ps->v0[i], ka, r->h);
         }
     }
+    return false;
 }
 
-static void pass_collide_age(void* arg, size_t begin, size_t end) {
+static bool pass_collide_age(void* arg, size_t begin, size_t end) {
     step_ctx* c = (step_ctx*)arg;
     ak_particles* ps = c->ps;
     const bool coll = any_colliders(c->w);
+    bool dead = false;
     for (size_t i = begin; i < end; ++i) {
         ps->age[i] += c->dt;
+        dead |= !(ps->age[i] < ps->life[i]);
         if (coll && ps->inv_mass[i] != 0.0f) collide_one(c, ps->x0[i], ps->v0[i], &ps->pos[i], &ps->vel[i], c->dt);
+        const ak_vec3 x1 = ps->pos[i], v1 = ps->vel[i];
+        const float sum = x1.x + x1.y + x1.z + v1.x + v1.y + v1.z;
+        dead |= !(sum - sum == 0.0f);
     }
+    return dead;
 }
 
 /* Stable removal of dead (age >= lifetime) and non-finite particles. */
@@ -1037,8 +1152,9 @@ ak_result ak_particles_step(ak_particles* ps, const ak_particles_world* w, float
     const uint32_t th = ps->thread_count;
     const double t = ps->time;
 
+    bool dead;
     if (ps->integrator == AK_INTEGRATOR_SYMPLECTIC && !c.pair_forces) {
-        parallel_for(th, n, fused_symplectic, &c);
+        dead = parallel_for(th, n, fused_symplectic, &c);
     } else {
         parallel_for(th, n, save_state, &c);
         switch (ps->integrator) {
@@ -1072,9 +1188,9 @@ ak_result ak_particles_step(ak_particles* ps, const ak_particles_world* w, float
             parallel_for(th, n, pass_symplectic, &c);
             break;
         }
-        parallel_for(th, n, pass_collide_age, &c);
+        dead = parallel_for(th, n, pass_collide_age, &c);
     }
-    compact(ps);
+    if (dead) compact(ps);
     ps->time += (double)dt;
     return AK_OK;
 }
