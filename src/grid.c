@@ -405,21 +405,29 @@ ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
     }
     *job->out_pair_count = total;
     if (total > cap) return AK_ERR_SPAN_SMALL;
-    if (overflow) {
-        size_t off = 0;
-        for (uint32_t t = 0; t < threads; ++t) {
-            tasks[t].out = job->out_pairs.ptr + off;
-            tasks[t].capacity = tasks[t].count;
-            off += tasks[t].count;
-        }
-        run_tasks(pair_thread, tasks, threads);
-        return AK_OK;
-    }
+    /* Exact offsets; threads that fit move their pairs there (leftward moves in increasing
+     * order, then rightward moves in decreasing order, so no block overwrites one not yet
+     * moved), and threads that overflowed their share run again into their exact place. */
+    size_t offset[GRID_MAX_THREADS];
     size_t off = 0;
-    for (uint32_t t = 0; t < threads; ++t) {
-        if (tasks[t].out != job->out_pairs.ptr + off)
-            memmove(job->out_pairs.ptr + off, tasks[t].out, tasks[t].count * sizeof(ak_grid_pair));
-        off += tasks[t].count;
+    for (uint32_t t = 0; t < threads; ++t) offset[t] = off, off += tasks[t].count;
+    for (uint32_t t = 0; t < threads; ++t)
+        if (!(tasks[t].count > tasks[t].capacity) && job->out_pairs.ptr + offset[t] <= tasks[t].out)
+            memmove(job->out_pairs.ptr + offset[t], tasks[t].out, tasks[t].count * sizeof(ak_grid_pair));
+    for (uint32_t t = threads; t-- > 0;)
+        if (!(tasks[t].count > tasks[t].capacity) && job->out_pairs.ptr + offset[t] > tasks[t].out)
+            memmove(job->out_pairs.ptr + offset[t], tasks[t].out, tasks[t].count * sizeof(ak_grid_pair));
+    if (overflow) {
+        pair_task again[GRID_MAX_THREADS];
+        uint32_t rerun = 0;
+        for (uint32_t t = 0; t < threads; ++t) {
+            if (!(tasks[t].count > tasks[t].capacity)) continue;
+            again[rerun] = tasks[t];
+            again[rerun].out = job->out_pairs.ptr + offset[t];
+            again[rerun].capacity = tasks[t].count;
+            ++rerun;
+        }
+        run_tasks(pair_thread, again, rerun);
     }
     return AK_OK;
 }
