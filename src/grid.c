@@ -13,7 +13,7 @@
 
 static inline int32_t cell_coord(float p, double inv_cell) {
     double v = floor((double)p * inv_cell);
-    if (v < -GRID_COORD_LIMIT) v = -GRID_COORD_LIMIT;
+    if (!(v >= -GRID_COORD_LIMIT)) v = -GRID_COORD_LIMIT; /* NaN too */
     if (v > GRID_COORD_LIMIT) v = GRID_COORD_LIMIT;
     return (int32_t)v;
 }
@@ -393,7 +393,7 @@ ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
     const size_t cap = job->out_pairs.count;
     for (uint32_t t = 0; t < threads; ++t) {
         size_t lo = cap * t / threads, hi = cap * (t + 1) / threads;
-        tasks[t].out = job->out_pairs.ptr + lo;
+        tasks[t].out = job->out_pairs.ptr ? job->out_pairs.ptr + lo : NULL;
         tasks[t].capacity = hi - lo;
     }
     run_tasks(pair_thread, tasks, threads);
@@ -405,6 +405,7 @@ ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
     }
     *job->out_pair_count = total;
     if (total > cap) return AK_ERR_SPAN_SMALL;
+    if (total == 0) return AK_OK;
     /* Exact offsets; threads that fit move their pairs there (leftward moves in increasing
      * order, then rightward moves in decreasing order, so no block overwrites one not yet
      * moved), and threads that overflowed their share run again into their exact place. */

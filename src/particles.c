@@ -737,9 +737,9 @@ static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, si
         ak_vec3 bmin = ak_vec3_make(fminf(x0.x, x1.x) - grow, fminf(x0.y, x1.y) - grow, fminf(x0.z, x1.z) - grow);
         ak_vec3 bmax = ak_vec3_make(fmaxf(x0.x, x1.x) + grow, fmaxf(x0.y, x1.y) + grow, fmaxf(x0.z, x1.z) + grow);
         ak_grid_cell c0 = ak_grid_cell_of(g, bmin), c1 = ak_grid_cell_of(g, bmax);
-        int64_t span = ((int64_t)c1.x - c0.x + 1) * ((int64_t)c1.y - c0.y + 1) * ((int64_t)c1.z - c0.z + 1);
-        bool scan = span > (int64_t)g->cell_count;
-        int64_t total = scan ? g->cell_count : span;
+        const double span = ((double)c1.x - c0.x + 1) * ((double)c1.y - c0.y + 1) * ((double)c1.z - c0.z + 1);
+        const bool scan = span > (double)g->cell_count;
+        const int64_t total = scan ? (int64_t)g->cell_count : (int64_t)span;
         for (int64_t q = 0; q < total; ++q) {
             uint32_t cell;
             if (scan) {

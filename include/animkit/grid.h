@@ -97,7 +97,8 @@ AK_API size_t ak_grid_memory_size(size_t point_count, const ak_grid_desc* desc);
 AK_API ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_span memory,
                                ak_grid* out_grid);
 
-/* The cell holding p (floor(p / cell_size), clamped as ak_grid_cell says). */
+/* The cell holding p (floor(p / cell_size), clamped as ak_grid_cell says; a NaN coordinate
+ * gives -2^30). */
 AK_API ak_grid_cell ak_grid_cell_of(const ak_grid* grid, ak_vec3 p);
 
 /* Index m of a cell in the grid (its points are sorted entries [cell_start[m],
