@@ -100,7 +100,8 @@ typedef struct ak_particles_state {
     uint32_t* id;      /* unique per system, in order of addition */
 } ak_particles_state;
 
-/* Defaults filled in (integrator, thread_count). */
+/* The desc with its zero fields replaced by their defaults (integrator, thread_count);
+ * NULL -> all defaults (capacity stays 0, which create rejects). */
 AK_API ak_particles_desc ak_particles_desc_resolved(const ak_particles_desc* desc);
 
 /* Create an empty system. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (capacity 0 or above 2^30,
@@ -110,12 +111,17 @@ AK_API ak_result ak_particles_create(const ak_particles_desc* desc, const ak_all
 /* NULL is a no-op. */
 AK_API void ak_particles_destroy(ak_particles* particles);
 
+/* The live arrays (count entries each; zeros for NULL). Valid until the next call that adds
+ * or removes particles moves them (emit, burst, add, step, clear) or destroy. */
 AK_API ak_particles_state ak_particles_get_state(ak_particles* particles);
+/* Particles alive now (0 for NULL). */
 AK_API size_t ak_particles_count(const ak_particles* particles);
+/* The capacity fixed at creation (0 for NULL). */
 AK_API size_t ak_particles_capacity(const ak_particles* particles);
-/* Seconds simulated so far (sum of the steps' dt, in double). */
+/* Seconds simulated so far (sum of the steps' dt, in double; 0 for NULL). */
 AK_API double ak_particles_time(const ak_particles* particles);
-/* Change the integrator between steps. AK_ERR_BAD_ARG when out of range. */
+/* Change the integrator between steps (DEFAULT -> SYMPLECTIC). AK_ERR_NULL_ARG,
+ * AK_ERR_BAD_ARG when out of range. */
 AK_API ak_result ak_particles_set_integrator(ak_particles* particles, ak_particles_integrator integrator);
 
 /* One particle to add by hand. */
@@ -132,7 +138,7 @@ typedef struct ak_particle_init {
  * system is full, AK_ERR_BAD_DATA for non-finite values or a negative mass/lifetime. */
 AK_API ak_result ak_particles_add(ak_particles* particles, const ak_particle_init* init, size_t* out_index);
 
-/* Remove every particle (time and the rng go on). */
+/* Remove every particle (time, ids and the rng go on). NULL is a no-op. */
 AK_API void ak_particles_clear(ak_particles* particles);
 
 /* ---- emitters ----------------------------------------------------------------------- */
@@ -290,6 +296,7 @@ AK_API ak_result ak_particle_mesh_create(const ak_particle_mesh_desc* desc, cons
  * Rebuilds the grid without allocating. AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_ARG
  * (elapsed negative or not finite), AK_ERR_BAD_DATA (a non-finite position). */
 AK_API ak_result ak_particle_mesh_update(ak_particle_mesh* mesh, ak_vec3_cspan positions, float elapsed);
+/* NULL is a no-op. */
 AK_API void ak_particle_mesh_destroy(ak_particle_mesh* mesh);
 
 typedef struct ak_particle_plane_cspan { const ak_particle_plane* ptr; size_t count; } ak_particle_plane_cspan;
