@@ -321,7 +321,10 @@ static void pairs_within(pair_task* t, uint32_t c) {
 }
 
 static void* pair_thread(void* arg) {
-    pair_task* t = (pair_task*)arg;
+    /* Work on a copy: the tasks sit side by side in one array, and a count updated per pair
+     * in shared cache lines would make the threads slower than one. */
+    pair_task local = *(pair_task*)arg;
+    pair_task* t = &local;
     const ak_grid* g = t->grid;
     const int64_t k = t->rings;
     t->count = 0;
@@ -347,6 +350,7 @@ static void* pair_thread(void* arg) {
             }
         }
     }
+    ((pair_task*)arg)->count = local.count;
     return NULL;
 }
 
