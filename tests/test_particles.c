@@ -37,9 +37,12 @@ AK_TEST(projectile_closed_forms) {
         double y = 1.0 + vy * t + 0.5 * g * t * t;
         if (kIntegrators[k] == AK_INTEGRATOR_EULER) y = 1.0 + vy * t + g * dt * dt * n * (n - 1) / 2.0;
         if (kIntegrators[k] == AK_INTEGRATOR_SYMPLECTIC) y = 1.0 + vy * t + g * dt * dt * n * (n + 1) / 2.0;
-        AK_CHECK_NEAR(st.position[0].y, y, 2e-5 * n);
-        AK_CHECK_NEAR(st.position[0].x, vx * t, 2e-5 * n);
-        AK_CHECK_NEAR(st.velocity[0].y, vy + g * t, 2e-5 * n);
+        printf("  integrator %d: position error %.2g, velocity error %.2g\n", k, fabs(st.position[0].y - y),
+               fabs(st.velocity[0].y - (vy + g * t)));
+        /* Float rounding only: a few ulps of the magnitudes (about 10) per step. */
+        AK_CHECK_NEAR(st.position[0].y, y, 2e-6 * n);
+        AK_CHECK_NEAR(st.position[0].x, vx * t, 2e-6 * n);
+        AK_CHECK_NEAR(st.velocity[0].y, vy + g * t, 2e-6 * n);
         AK_CHECK_NEAR(st.velocity[0].x, vx, 1e-6);
         AK_CHECK_NEAR(ak_particles_time(ps), n * (double)(float)dt, 1e-9);
         if (kIntegrators[k] == AK_INTEGRATOR_EULER || kIntegrators[k] == AK_INTEGRATOR_SYMPLECTIC) /* first order */
