@@ -58,8 +58,10 @@ static double triad_gbps(int threads) {
         pthread_t id;
         bool started = threads == 2 && pthread_create(&id, NULL, triad_thread, &p1) == 0;
         triad_thread(&p0);
-        if (started) pthread_join(id, NULL);
-        else if (threads == 2) triad_thread(&p1);
+        if (started)
+            pthread_join(id, NULL);
+        else if (threads == 2)
+            triad_thread(&p1);
         double t = clock_s((uint32_t)threads) - t0;
         if (t < best) best = t;
     }
@@ -80,14 +82,17 @@ static double step_rate(size_t n, uint32_t threads) {
     }
     ak_rng rng = ak_rng_make(7);
     for (size_t i = 0; i < n; ++i) {
-        ak_particle_init in = {
-            .position = {ak_rng_range(&rng, -10, 10), ak_rng_range(&rng, 0, 20), ak_rng_range(&rng, -10, 10)},
-            .velocity = {ak_rng_range(&rng, -2, 2), ak_rng_range(&rng, -2, 2), ak_rng_range(&rng, -2, 2)},
-            .mass = 1.0f};
+        ak_particle_init in = {.position = {ak_rng_range(&rng, -10, 10), ak_rng_range(&rng, 0, 20),
+                                            ak_rng_range(&rng, -10, 10)},
+                               .velocity = {ak_rng_range(&rng, -2, 2), ak_rng_range(&rng, -2, 2),
+                                            ak_rng_range(&rng, -2, 2)},
+                               .mass = 1.0f};
         ak_particles_add(ps, &in, NULL);
     }
     ak_particle_plane floor = {.normal = {0, 1, 0}, .restitution = 0.5f, .friction = 0.2f};
-    ak_particles_world w = {.gravity = {0, -9.81f, 0}, .drag_linear = 0.1f, .drag_quadratic = 0.01f,
+    ak_particles_world w = {.gravity = {0, -9.81f, 0},
+                            .drag_linear = 0.1f,
+                            .drag_quadratic = 0.01f,
                             .planes = {&floor, 1}};
     double best = 1e30;
     for (int s = 0; s < 14; ++s) {
@@ -107,7 +112,8 @@ static ak_vec3* cloud(size_t n, float side, uint64_t seed) {
     ak_vec3* p = (ak_vec3*)malloc(n * sizeof *p);
     ak_rng rng = ak_rng_make(seed);
     for (size_t i = 0; i < n; ++i)
-        p[i] = ak_vec3_make(ak_rng_range(&rng, 0, side), ak_rng_range(&rng, 0, side), ak_rng_range(&rng, 0, side));
+        p[i] = ak_vec3_make(ak_rng_range(&rng, 0, side), ak_rng_range(&rng, 0, side),
+                            ak_rng_range(&rng, 0, side));
     return p;
 }
 
@@ -175,13 +181,15 @@ int main(int argc, char** argv) {
     const double triad1 = triad_gbps(1), triad2 = triad_gbps(2);
     printf("triad: %.1f GB/s (1 thread), %.1f GB/s (2 threads)\n", triad1, triad2);
 
-    printf("\nparticle step: %zu particles, semi-implicit Euler, gravity + drag + 1 plane, %.0f bytes each\n", n,
-           STEP_BYTES);
+    printf("\nparticle step: %zu particles, semi-implicit Euler, gravity + drag + 1 plane, %.0f "
+           "bytes each\n",
+           n, STEP_BYTES);
     for (uint32_t th = 1; th <= 2; ++th) {
         double rate = step_rate(n, th);
         double gbs = rate * STEP_BYTES * 1e-9;
-        printf("  %u thread%s: %7.1f M particles/s  %5.1f GB/s  = %3.0f%% of the %u-thread triad\n", th,
-               th > 1 ? "s" : " ", rate * 1e-6, gbs, 100.0 * gbs / (th == 1 ? triad1 : triad2), th);
+        printf("  %u thread%s: %7.1f M particles/s  %5.1f GB/s  = %3.0f%% of the %u-thread triad\n",
+               th, th > 1 ? "s" : " ", rate * 1e-6, gbs, 100.0 * gbs / (th == 1 ? triad1 : triad2),
+               th);
     }
 
     /* Side chosen so each point has about 20 neighbours within r: n (4/3 pi r^3) / side^3. */
@@ -189,14 +197,16 @@ int main(int argc, char** argv) {
     const size_t big = 100000, small = 10000;
     ak_vec3* p = cloud(big, 10.0f, 11);
     grid_times gt = grid_run(p, big, r, 5);
-    printf("\ngrid: %zu points, r = cell = %.3f, %zu pairs (%.1f neighbours each)\n", big, (double)r, gt.pairs,
-           2.0 * (double)gt.pairs / (double)big);
-    printf("  build: %.2f ms (%.1f M points/s)\n", gt.build_s * 1e3, (double)big / gt.build_s * 1e-6);
+    printf("\ngrid: %zu points, r = cell = %.3f, %zu pairs (%.1f neighbours each)\n", big,
+           (double)r, gt.pairs, 2.0 * (double)gt.pairs / (double)big);
+    printf("  build: %.2f ms (%.1f M points/s)\n", gt.build_s * 1e3,
+           (double)big / gt.build_s * 1e-6);
     for (int th = 0; th < 2; ++th)
-        printf("  all pairs, %d thread%s: %.2f ms  %.1f M pairs/s\n", th + 1, th ? "s" : " ", gt.pairs_s[th] * 1e3,
-               (double)gt.pairs / gt.pairs_s[th] * 1e-6);
-    printf("  (2 threads: %.2f ms of CPU time over both, vs %.2f ms on one: the work does not grow)\n",
-           gt.pairs2_cpu_s * 1e3, gt.pairs_s[0] * 1e3);
+        printf("  all pairs, %d thread%s: %.2f ms  %.1f M pairs/s\n", th + 1, th ? "s" : " ",
+               gt.pairs_s[th] * 1e3, (double)gt.pairs / gt.pairs_s[th] * 1e-6);
+    printf(
+        "  (2 threads: %.2f ms of CPU time over both, vs %.2f ms on one: the work does not grow)\n",
+        gt.pairs2_cpu_s * 1e3, gt.pairs_s[0] * 1e3);
     free(p);
 
     p = cloud(small, 10.0f * 0.46416f, 12); /* same density */
@@ -204,8 +214,10 @@ int main(int argc, char** argv) {
     size_t brute_count = 0;
     double brute = brute_pairs_s(p, small, r, &brute_count);
     double grid_total = gs.build_s + gs.pairs_s[0];
-    printf("  at %zu points: brute force %.2f ms, grid build + pairs %.3f ms (1 thread): grid %.0fx faster%s\n", small,
-           brute * 1e3, grid_total * 1e3, brute / grid_total, brute_count == gs.pairs ? "" : "  (PAIR COUNTS DIFFER)");
+    printf("  at %zu points: brute force %.2f ms, grid build + pairs %.3f ms (1 thread): grid "
+           "%.0fx faster%s\n",
+           small, brute * 1e3, grid_total * 1e3, brute / grid_total,
+           brute_count == gs.pairs ? "" : "  (PAIR COUNTS DIFFER)");
     free(p);
     return 0;
 }

@@ -13,15 +13,18 @@ int main(void) {
     if (!p) return 1;
     ak_rng rng = ak_rng_make(3);
     for (int i = 0; i < N; ++i)
-        p[i] = ak_vec3_make(ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 3));
+        p[i] = ak_vec3_make(ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 3),
+                            ak_rng_range(&rng, -3, 3));
     p[0] = ak_vec3_make(1e7f, -1e7f, 0); /* far away: no bounds to declare */
 
     ak_grid_desc gd = {.cell_size = r};
     size_t bytes = ak_grid_memory_size(N, &gd);
     void* mem = malloc(bytes);
     ak_grid grid;
-    if (!mem || ak_grid_build(&gd, (ak_vec3_cspan){p, N}, (ak_u8_span){mem, bytes}, &grid) != AK_OK) return 1;
-    printf("%u points in %u occupied cells (%zu bytes of grid memory)\n", grid.point_count, grid.cell_count, bytes);
+    if (!mem || ak_grid_build(&gd, (ak_vec3_cspan){p, N}, (ak_u8_span){mem, bytes}, &grid) != AK_OK)
+        return 1;
+    printf("%u points in %u occupied cells (%zu bytes of grid memory)\n", grid.point_count,
+           grid.cell_count, bytes);
 
     size_t count = 0;
     ak_grid_pairs_job job = {.grid = &grid, .radius = r, .out_pair_count = &count};

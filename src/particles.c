@@ -8,11 +8,11 @@
 #include "simd.h"
 
 #define PS_MAX_THREADS 64u
-#define PS_MIN_PER_THREAD 8192u  /* below this a thread start costs more than it saves */
+#define PS_MIN_PER_THREAD 8192u /* below this a thread start costs more than it saves */
 #define PS_MAX_CAPACITY (1u << 30)
 #define PS_CONTACT_ITERATIONS 4
-#define PS_MESH_OFFSET 1e-5f     /* mesh contacts leave particles this far off the surface */
-#define PS_EMIT_OFFSET 1e-4f     /* mesh emission starts this far out along the triangle normal */
+#define PS_MESH_OFFSET 1e-5f /* mesh contacts leave particles this far off the surface */
+#define PS_EMIT_OFFSET 1e-4f /* mesh emission starts this far out along the triangle normal */
 
 struct ak_particles {
     ak_allocator alloc;
@@ -41,11 +41,11 @@ struct ak_particle_mesh {
     size_t vertex_count, tri_count;
     uint32_t* indices;
     ak_vec3* verts;
-    ak_vec3* vel;      /* vertex velocities from the last update */
-    ak_vec3* tri_vel;  /* mean vertex velocity of each triangle */
+    ak_vec3* vel;     /* vertex velocities from the last update */
+    ak_vec3* tri_vel; /* mean vertex velocity of each triangle */
     ak_vec3* centroid;
-    float reach;       /* largest distance from a centroid to its triangle's corners */
-    float max_speed;   /* largest triangle speed */
+    float reach;     /* largest distance from a centroid to its triangle's corners */
+    float max_speed; /* largest triangle speed */
     float restitution, friction;
     ak_grid grid;
     uint8_t* grid_mem;
@@ -54,8 +54,12 @@ struct ak_particle_mesh {
 
 /* ---- small helpers ------------------------------------------------------------------ */
 
-static inline bool finite3(ak_vec3 v) { return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z); }
-static inline bool finite4(ak_vec4 v) { return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z) && ak_finitef(v.w); }
+static inline bool finite3(ak_vec3 v) {
+    return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z);
+}
+static inline bool finite4(ak_vec4 v) {
+    return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z) && ak_finitef(v.w);
+}
 
 static inline ak_vec3 unit_or_up(ak_vec3 v) {
     ak_vec3 n = ak_vec3_normalize(v);
@@ -95,13 +99,17 @@ static bool parallel_for(uint32_t threads, size_t n, range_fn fn, void* ctx) {
     range_task tasks[PS_MAX_THREADS];
     pthread_t ids[PS_MAX_THREADS];
     bool started[PS_MAX_THREADS];
-    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (range_task){fn, ctx, n * t / threads, n * (t + 1) / threads, false};
-    for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, range_thread, &tasks[t]) == 0;
+    for (uint32_t t = 0; t < threads; ++t)
+        tasks[t] = (range_task){fn, ctx, n * t / threads, n * (t + 1) / threads, false};
+    for (uint32_t t = 1; t < threads; ++t)
+        started[t] = pthread_create(&ids[t], NULL, range_thread, &tasks[t]) == 0;
     range_thread(&tasks[0]);
     bool dead = tasks[0].dead;
     for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else range_thread(&tasks[t]);
+        if (started[t])
+            pthread_join(ids[t], NULL);
+        else
+            range_thread(&tasks[t]);
         dead = dead || tasks[t].dead;
     }
     return dead;
@@ -118,7 +126,8 @@ ak_particles_desc ak_particles_desc_resolved(const ak_particles_desc* desc) {
 }
 
 typedef struct ps_layout {
-    size_t pos, vel, force, inv_mass, age, life, size, colour, id, x0, v0, acc, xs, vs, sx, sv, grid, total;
+    size_t pos, vel, force, inv_mass, age, life, size, colour, id, x0, v0, acc, xs, vs, sx, sv,
+        grid, total;
 } ps_layout;
 
 static ps_layout ps_carve(size_t cap, size_t grid_size) {
@@ -146,12 +155,13 @@ static ps_layout ps_carve(size_t cap, size_t grid_size) {
     return l;
 }
 
-ak_result ak_particles_create(const ak_particles_desc* desc, const ak_allocator* alloc, ak_particles** out_particles) {
+ak_result ak_particles_create(const ak_particles_desc* desc, const ak_allocator* alloc,
+                              ak_particles** out_particles) {
     if (out_particles) *out_particles = NULL;
     if (!desc || !out_particles) return AK_ERR_NULL_ARG;
     ak_particles_desc d = ak_particles_desc_resolved(desc);
-    if (d.capacity == 0 || d.capacity > PS_MAX_CAPACITY || (unsigned)d.integrator >= AK_INTEGRATOR_COUNT ||
-        d.thread_count > PS_MAX_THREADS)
+    if (d.capacity == 0 || d.capacity > PS_MAX_CAPACITY ||
+        (unsigned)d.integrator >= AK_INTEGRATOR_COUNT || d.thread_count > PS_MAX_THREADS)
         return AK_ERR_BAD_ARG;
     ak_grid_desc gd = {.cell_size = 1.0f};
     const size_t grid_size = ak_grid_memory_size(d.capacity, &gd);
@@ -222,10 +232,12 @@ ak_result ak_particles_set_integrator(ak_particles* ps, ak_particles_integrator 
 }
 
 static inline ak_vec4 colour_or_white(ak_vec4 c) {
-    return (c.x == 0.0f && c.y == 0.0f && c.z == 0.0f && c.w == 0.0f) ? ak_vec4_make(1, 1, 1, 1) : c;
+    return (c.x == 0.0f && c.y == 0.0f && c.z == 0.0f && c.w == 0.0f) ? ak_vec4_make(1, 1, 1, 1)
+                                                                      : c;
 }
 
-static void push(ak_particles* ps, ak_vec3 p, ak_vec3 v, float inv_mass, float life, float size, ak_vec4 colour) {
+static void push(ak_particles* ps, ak_vec3 p, ak_vec3 v, float inv_mass, float life, float size,
+                 ak_vec4 colour) {
     size_t i = ps->count++;
     ps->pos[i] = p;
     ps->vel[i] = v;
@@ -240,8 +252,9 @@ static void push(ak_particles* ps, ak_vec3 p, ak_vec3 v, float inv_mass, float l
 
 ak_result ak_particles_add(ak_particles* ps, const ak_particle_init* init, size_t* out_index) {
     if (!ps || !init) return AK_ERR_NULL_ARG;
-    if (!finite3(init->position) || !finite3(init->velocity) || !finite4(init->colour) || !ak_finitef(init->mass) ||
-        init->mass < 0.0f || !(init->lifetime >= 0.0f) || !ak_finitef(init->size) || init->size < 0.0f)
+    if (!finite3(init->position) || !finite3(init->velocity) || !finite4(init->colour) ||
+        !ak_finitef(init->mass) || init->mass < 0.0f || !(init->lifetime >= 0.0f) ||
+        !ak_finitef(init->size) || init->size < 0.0f)
         return AK_ERR_BAD_DATA;
     if (ps->count >= ps->capacity) return AK_ERR_SPAN_SMALL;
     if (out_index) *out_index = ps->count;
@@ -259,14 +272,15 @@ void ak_particles_clear(ak_particles* ps) {
 
 static ak_result emitter_check(const ak_particle_emitter* e) {
     if ((unsigned)e->shape >= AK_EMITTER_SHAPE_COUNT) return AK_ERR_BAD_ARG;
-    if (!finite3(e->center) || !finite3(e->direction) || !finite3(e->half_extents) || !finite3(e->base_velocity) ||
-        !finite4(e->colour))
+    if (!finite3(e->center) || !finite3(e->direction) || !finite3(e->half_extents) ||
+        !finite3(e->base_velocity) || !finite4(e->colour))
         return AK_ERR_BAD_DATA;
-    const float vals[] = {e->radius, e->speed_min, e->speed_max, e->lifetime_min, e->lifetime_max,
-                          e->size_min, e->size_max, e->mass, e->cone_angle};
+    const float vals[] = {e->radius,   e->speed_min, e->speed_max, e->lifetime_min, e->lifetime_max,
+                          e->size_min, e->size_max,  e->mass,      e->cone_angle};
     for (size_t k = 0; k < sizeof vals / sizeof vals[0]; ++k)
         if (!ak_finitef(vals[k]) || vals[k] < 0.0f) return AK_ERR_BAD_ARG;
-    if (e->half_extents.x < 0.0f || e->half_extents.y < 0.0f || e->half_extents.z < 0.0f) return AK_ERR_BAD_ARG;
+    if (e->half_extents.x < 0.0f || e->half_extents.y < 0.0f || e->half_extents.z < 0.0f)
+        return AK_ERR_BAD_ARG;
     if (e->cone_angle > AK_PI + 1e-6f) return AK_ERR_BAD_ARG;
     if (e->shape == AK_EMITTER_MESH) {
         const size_t tris = e->mesh_indices.count / 3;
@@ -313,7 +327,9 @@ static void emit_one(ak_particles* ps, const ak_particle_emitter* e, ak_vec3 axi
     case AK_EMITTER_SPHERE:
         p = ak_vec3_madd(e->center, unit_sphere_sample(rng), e->radius * cbrtf(ak_rng_float(rng)));
         break;
-    case AK_EMITTER_SPHERE_SURFACE: p = ak_vec3_madd(e->center, unit_sphere_sample(rng), e->radius); break;
+    case AK_EMITTER_SPHERE_SURFACE:
+        p = ak_vec3_madd(e->center, unit_sphere_sample(rng), e->radius);
+        break;
     case AK_EMITTER_DISC: {
         ak_vec3 t, b;
         basis(axis, &t, &b);
@@ -332,26 +348,32 @@ static void emit_one(ak_particles* ps, const ak_particle_emitter* e, ak_vec3 axi
         size_t lo = 0, hi = tris - 1; /* first t with cdf[t] > u */
         while (lo < hi) {
             size_t mid = (lo + hi) / 2;
-            if (e->mesh_area_cdf.ptr[mid] > u) hi = mid;
-            else lo = mid + 1;
+            if (e->mesh_area_cdf.ptr[mid] > u)
+                hi = mid;
+            else
+                lo = mid + 1;
         }
         ak_vec3 a = tri_corner(e, lo, 0), b = tri_corner(e, lo, 1), c = tri_corner(e, lo, 2);
         float s = sqrtf(ak_rng_float(rng)), w = ak_rng_float(rng);
         p = ak_vec3_add(ak_vec3_add(ak_vec3_scale(a, 1.0f - s), ak_vec3_scale(b, s * (1.0f - w))),
                         ak_vec3_scale(c, s * w));
         const ak_vec3 n = unit_or_up(ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(c, a)));
-        p = ak_vec3_madd(p, n, PS_EMIT_OFFSET); /* off the surface, so a collider of the same mesh lets it go */
+        p = ak_vec3_madd(
+            p, n, PS_EMIT_OFFSET); /* off the surface, so a collider of the same mesh lets it go */
         if (!e->use_direction_on_mesh) axis = n;
         break;
     }
-    default: break;
+    default:
+        break;
     }
     /* Direction uniform over the cone's solid angle. */
     ak_vec3 t, b;
     basis(axis, &t, &b);
     float cz = 1.0f - ak_rng_float(rng) * (1.0f - cosf(e->cone_angle));
     float sz = sqrtf(fmaxf(0.0f, 1.0f - cz * cz)), phi = 2.0f * AK_PI * ak_rng_float(rng);
-    ak_vec3 dir = ak_vec3_add(ak_vec3_scale(axis, cz), ak_vec3_add(ak_vec3_scale(t, sz * cosf(phi)), ak_vec3_scale(b, sz * sinf(phi))));
+    ak_vec3 dir =
+        ak_vec3_add(ak_vec3_scale(axis, cz), ak_vec3_add(ak_vec3_scale(t, sz * cosf(phi)),
+                                                         ak_vec3_scale(b, sz * sinf(phi))));
     float smax = e->speed_max > e->speed_min ? e->speed_max : e->speed_min;
     float speed = ak_rng_range(rng, e->speed_min, smax);
     float lmax = e->lifetime_max > e->lifetime_min ? e->lifetime_max : e->lifetime_min;
@@ -361,10 +383,12 @@ static void emit_one(ak_particles* ps, const ak_particle_emitter* e, ak_vec3 axi
     float size_max = e->size_max > size_min ? e->size_max : size_min;
     float size = ak_rng_range(rng, size_min, size_max);
     float mass = e->mass > 0.0f ? e->mass : 1.0f;
-    push(ps, p, ak_vec3_madd(e->base_velocity, dir, speed), 1.0f / mass, life, size, colour_or_white(e->colour));
+    push(ps, p, ak_vec3_madd(e->base_velocity, dir, speed), 1.0f / mass, life, size,
+         colour_or_white(e->colour));
 }
 
-static ak_result emit_count(ak_particles* ps, const ak_particle_emitter* e, uint64_t n, uint32_t* out_emitted) {
+static ak_result emit_count(ak_particles* ps, const ak_particle_emitter* e, uint64_t n,
+                            uint32_t* out_emitted) {
     if (e->shape == AK_EMITTER_MESH && n > 0) {
         ak_result r = mesh_cdf(e);
         if (r != AK_OK) return r;
@@ -376,11 +400,12 @@ static ak_result emit_count(ak_particles* ps, const ak_particle_emitter* e, uint
     return AK_OK;
 }
 
-ak_result ak_particles_emit(ak_particles* ps, ak_particle_emitter* e, float dt, uint32_t* out_emitted) {
+ak_result ak_particles_emit(ak_particles* ps, ak_particle_emitter* e, float dt,
+                            uint32_t* out_emitted) {
     if (out_emitted) *out_emitted = 0;
     if (!ps || !e) return AK_ERR_NULL_ARG;
-    if (!(dt >= 0.0f) || !ak_finitef(dt) || !(e->rate >= 0.0f) || !ak_finitef(e->rate) || !(e->carry >= 0.0) ||
-        !isfinite(e->carry))
+    if (!(dt >= 0.0f) || !ak_finitef(dt) || !(e->rate >= 0.0f) || !ak_finitef(e->rate) ||
+        !(e->carry >= 0.0) || !isfinite(e->carry))
         return AK_ERR_BAD_ARG;
     ak_result r = emitter_check(e);
     if (r != AK_OK) return r;
@@ -393,7 +418,8 @@ ak_result ak_particles_emit(ak_particles* ps, ak_particle_emitter* e, float dt, 
     return AK_OK;
 }
 
-ak_result ak_particles_burst(ak_particles* ps, const ak_particle_emitter* e, uint32_t count, uint32_t* out_emitted) {
+ak_result ak_particles_burst(ak_particles* ps, const ak_particle_emitter* e, uint32_t count,
+                             uint32_t* out_emitted) {
     if (out_emitted) *out_emitted = 0;
     if (!ps || !e) return AK_ERR_NULL_ARG;
     ak_result r = emitter_check(e);
@@ -406,30 +432,36 @@ ak_result ak_particles_burst(ak_particles* ps, const ak_particle_emitter* e, uin
 static ak_result mesh_rebuild(ak_particle_mesh* m) {
     float reach = 0.0f, speed = 0.0f;
     for (size_t t = 0; t < m->tri_count; ++t) {
-        ak_vec3 a = m->verts[m->indices[3 * t]], b = m->verts[m->indices[3 * t + 1]], c = m->verts[m->indices[3 * t + 2]];
+        ak_vec3 a = m->verts[m->indices[3 * t]], b = m->verts[m->indices[3 * t + 1]],
+                c = m->verts[m->indices[3 * t + 2]];
         ak_vec3 g = ak_vec3_scale(ak_vec3_add(ak_vec3_add(a, b), c), 1.0f / 3.0f);
         m->centroid[t] = g;
-        ak_vec3 tv = ak_vec3_scale(ak_vec3_add(ak_vec3_add(m->vel[m->indices[3 * t]], m->vel[m->indices[3 * t + 1]]),
-                                               m->vel[m->indices[3 * t + 2]]), 1.0f / 3.0f);
+        ak_vec3 tv = ak_vec3_scale(
+            ak_vec3_add(ak_vec3_add(m->vel[m->indices[3 * t]], m->vel[m->indices[3 * t + 1]]),
+                        m->vel[m->indices[3 * t + 2]]),
+            1.0f / 3.0f);
         m->tri_vel[t] = tv;
         speed = fmaxf(speed, ak_vec3_length(tv));
-        reach = fmaxf(reach, fmaxf(ak_vec3_distance(a, g), fmaxf(ak_vec3_distance(b, g), ak_vec3_distance(c, g))));
+        reach = fmaxf(reach, fmaxf(ak_vec3_distance(a, g),
+                                   fmaxf(ak_vec3_distance(b, g), ak_vec3_distance(c, g))));
     }
     /* A little over the exact reach so rounding cannot drop a triangle from a query. */
     m->reach = reach * 1.0001f + 1e-6f;
     m->max_speed = speed * 1.0001f;
     ak_grid_desc gd = {.cell_size = m->reach > 1e-6f ? 2.0f * m->reach : 1e-3f};
-    return ak_grid_build(&gd, (ak_vec3_cspan){m->centroid, m->tri_count}, (ak_u8_span){m->grid_mem, m->grid_mem_size},
-                         &m->grid);
+    return ak_grid_build(&gd, (ak_vec3_cspan){m->centroid, m->tri_count},
+                         (ak_u8_span){m->grid_mem, m->grid_mem_size}, &m->grid);
 }
 
-ak_result ak_particle_mesh_create(const ak_particle_mesh_desc* desc, const ak_allocator* alloc, ak_particle_mesh** out_mesh) {
+ak_result ak_particle_mesh_create(const ak_particle_mesh_desc* desc, const ak_allocator* alloc,
+                                  ak_particle_mesh** out_mesh) {
     if (out_mesh) *out_mesh = NULL;
     if (!desc || !out_mesh || !desc->positions.ptr || !desc->indices.ptr) return AK_ERR_NULL_ARG;
     const size_t tris = desc->indices.count / 3;
     if (tris == 0) return AK_ERR_EMPTY;
-    if (desc->indices.count % 3 || tris >= (1u << 30) || !(desc->restitution >= 0.0f && desc->restitution <= 1.0f) ||
-        !(desc->friction >= 0.0f) || !ak_finitef(desc->friction))
+    if (desc->indices.count % 3 || tris >= (1u << 30) ||
+        !(desc->restitution >= 0.0f && desc->restitution <= 1.0f) || !(desc->friction >= 0.0f) ||
+        !ak_finitef(desc->friction))
         return AK_ERR_BAD_ARG;
     for (size_t k = 0; k < desc->indices.count; ++k)
         if (desc->indices.ptr[k] >= desc->positions.count) return AK_ERR_BAD_INDEX;
@@ -484,8 +516,9 @@ ak_result ak_particle_mesh_update(ak_particle_mesh* m, ak_vec3_cspan positions, 
     for (size_t k = 0; k < m->vertex_count; ++k)
         if (!finite3(positions.ptr[k])) return AK_ERR_BAD_DATA;
     for (size_t k = 0; k < m->vertex_count; ++k) {
-        ak_vec3 v = elapsed > 0.0f ? ak_vec3_scale(ak_vec3_sub(positions.ptr[k], m->verts[k]), 1.0f / elapsed)
-                                   : ak_vec3_zero();
+        ak_vec3 v = elapsed > 0.0f
+                        ? ak_vec3_scale(ak_vec3_sub(positions.ptr[k], m->verts[k]), 1.0f / elapsed)
+                        : ak_vec3_zero();
         m->vel[k] = finite3(v) ? v : ak_vec3_zero();
     }
     memcpy(m->verts, positions.ptr, m->vertex_count * sizeof(ak_vec3));
@@ -600,14 +633,15 @@ static void eval_accel(step_ctx* c, const ak_vec3* X, const ak_vec3* V, ak_vec3*
             float len = ak_vec3_length(d);
             if (!(len > 0.0f)) continue;
             ak_vec3 u = ak_vec3_scale(d, 1.0f / len);
-            float mag = s->k * (len - s->rest) + s->damping * ak_vec3_dot(ak_vec3_sub(V[s->j], V[s->i]), u);
+            float mag =
+                s->k * (len - s->rest) + s->damping * ak_vec3_dot(ak_vec3_sub(V[s->j], V[s->i]), u);
             ps->force[s->i] = ak_vec3_madd(ps->force[s->i], u, mag);
             ps->force[s->j] = ak_vec3_madd(ps->force[s->j], u, -mag);
         }
         if (w->lennard_jones.epsilon != 0.0f && n > 1) {
             ak_grid_desc gd = {.cell_size = c->lj_cutoff};
-            if (ak_grid_build(&gd, (ak_vec3_cspan){X, n}, (ak_u8_span){ps->grid_mem, ps->grid_mem_size}, &c->lj_grid) ==
-                AK_OK)
+            if (ak_grid_build(&gd, (ak_vec3_cspan){X, n},
+                              (ak_u8_span){ps->grid_mem, ps->grid_mem_size}, &c->lj_grid) == AK_OK)
                 parallel_for(ps->thread_count, n, lj_range, c);
         }
         if (w->callback) w->callback(X, V, ps->inv_mass, n, t, ps->force, w->callback_user);
@@ -628,8 +662,8 @@ typedef struct contact {
 
 /* Earliest contact of the segment x0 -> x1 with the colliders, skipping the collider `skip`
  * (index over planes, spheres, boxes, meshes in that order). */
-static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, size_t skip, contact* out,
-                          size_t* out_which) {
+static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, size_t skip,
+                          contact* out, size_t* out_which) {
     const ak_particles_world* w = c->w;
     bool hit = false;
     float best = 2.0f;
@@ -672,14 +706,20 @@ static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, si
         }
         if (tau < best) {
             best = tau, hit = true, *out_which = which;
-            *out = (contact){tau, n, ak_vec3_madd(sp->center, n, sp->radius), sp->restitution, sp->friction, false,
-                            {0, 0, 0}};
+            *out = (contact){tau,
+                             n,
+                             ak_vec3_madd(sp->center, n, sp->radius),
+                             sp->restitution,
+                             sp->friction,
+                             false,
+                             {0, 0, 0}};
         }
     }
     for (size_t k = 0; k < w->boxes.count; ++k, ++which) {
         if (which == skip) continue;
         const ak_particle_box* bx = &w->boxes.ptr[k];
-        const float lo[3] = {bx->min.x, bx->min.y, bx->min.z}, hi[3] = {bx->max.x, bx->max.y, bx->max.z};
+        const float lo[3] = {bx->min.x, bx->min.y, bx->min.z},
+                    hi[3] = {bx->max.x, bx->max.y, bx->max.z};
         const float p0[3] = {x0.x, x0.y, x0.z}, dd[3] = {d.x, d.y, d.z};
         bool inside = true;
         for (int a = 0; a < 3; ++a) inside = inside && p0[a] > lo[a] && p0[a] < hi[a];
@@ -724,8 +764,9 @@ static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, si
             float pc[3] = {p.x, p.y, p.z};
             pc[axis] = sign > 0.0f ? hi[axis] : lo[axis];
             best = tau, hit = true, *out_which = which;
-            *out = (contact){tau, n, ak_vec3_make(pc[0], pc[1], pc[2]), bx->restitution, bx->friction, false,
-                            {0, 0, 0}};
+            *out = (contact){
+                tau,   n,        ak_vec3_make(pc[0], pc[1], pc[2]), bx->restitution, bx->friction,
+                false, {0, 0, 0}};
         }
     }
     for (size_t k = 0; k < w->meshes.count; ++k, ++which) {
@@ -735,10 +776,13 @@ static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, si
         /* Cells whose triangles' centroids lie within reach (plus the triangles' motion over
          * the step) of the segment's box. */
         const float grow = m->reach + m->max_speed * h;
-        ak_vec3 bmin = ak_vec3_make(fminf(x0.x, x1.x) - grow, fminf(x0.y, x1.y) - grow, fminf(x0.z, x1.z) - grow);
-        ak_vec3 bmax = ak_vec3_make(fmaxf(x0.x, x1.x) + grow, fmaxf(x0.y, x1.y) + grow, fmaxf(x0.z, x1.z) + grow);
+        ak_vec3 bmin = ak_vec3_make(fminf(x0.x, x1.x) - grow, fminf(x0.y, x1.y) - grow,
+                                    fminf(x0.z, x1.z) - grow);
+        ak_vec3 bmax = ak_vec3_make(fmaxf(x0.x, x1.x) + grow, fmaxf(x0.y, x1.y) + grow,
+                                    fmaxf(x0.z, x1.z) + grow);
         ak_grid_cell c0 = ak_grid_cell_of(g, bmin), c1 = ak_grid_cell_of(g, bmax);
-        const double span = ((double)c1.x - c0.x + 1) * ((double)c1.y - c0.y + 1) * ((double)c1.z - c0.z + 1);
+        const double span =
+            ((double)c1.x - c0.x + 1) * ((double)c1.y - c0.y + 1) * ((double)c1.z - c0.z + 1);
         const bool scan = span > (double)g->cell_count;
         const int64_t total = scan ? (int64_t)g->cell_count : (int64_t)span;
         for (int64_t q = 0; q < total; ++q) {
@@ -747,7 +791,8 @@ static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, si
                 cell = (uint32_t)q;
             } else {
                 int64_t nx = c1.x - c0.x + 1, ny = c1.y - c0.y + 1;
-                ak_grid_cell cc = {(int32_t)(c0.x + q % nx), (int32_t)(c0.y + (q / nx) % ny), (int32_t)(c0.z + q / (nx * ny))};
+                ak_grid_cell cc = {(int32_t)(c0.x + q % nx), (int32_t)(c0.y + (q / nx) % ny),
+                                   (int32_t)(c0.z + q / (nx * ny))};
                 cell = ak_grid_cell_find(g, cc);
                 if (cell == UINT32_MAX) continue;
             }
@@ -757,7 +802,8 @@ static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, si
                  * its current pose) the particle goes from x0 + D to x1. */
                 const ak_vec3 sv = m->tri_vel[t];
                 const ak_vec3 r0 = ak_vec3_madd(x0, sv, h), dr = ak_vec3_sub(x1, r0);
-                ak_vec3 a = m->verts[m->indices[3 * t]], b = m->verts[m->indices[3 * t + 1]], cv = m->verts[m->indices[3 * t + 2]];
+                ak_vec3 a = m->verts[m->indices[3 * t]], b = m->verts[m->indices[3 * t + 1]],
+                        cv = m->verts[m->indices[3 * t + 2]];
                 /* Moller-Trumbore, two-sided */
                 ak_vec3 e1 = ak_vec3_sub(b, a), e2 = ak_vec3_sub(cv, a);
                 ak_vec3 pv = ak_vec3_cross(dr, e2);
@@ -789,7 +835,8 @@ static bool first_contact(const step_ctx* c, ak_vec3 x0, ak_vec3 x1, float h, si
  * of the step continues with the step's mean acceleration, penetration at the end is
  * projected out (that normal velocity change also counts as impulse), and Coulomb friction
  * takes at most friction times the normal impulse from the tangential velocity. */
-static void collide_one(const step_ctx* c, ak_vec3 x0, ak_vec3 v0, ak_vec3* x1, ak_vec3* v1, float h) {
+static void collide_one(const step_ctx* c, ak_vec3 x0, ak_vec3 v0, ak_vec3* x1, ak_vec3* v1,
+                        float h) {
     size_t skip = SIZE_MAX;
     for (int iter = 0; iter < PS_CONTACT_ITERATIONS; ++iter) {
         contact ct = {0};
@@ -865,16 +912,18 @@ static inline bool fused_one(const step_ctx* c, size_t i, bool coll) {
  * same bits whichever path (and so whichever thread split) handles it. Lanes whose new
  * position is behind a plane finish through the scalar collide_one. */
 static bool simple_world(const ak_particles_world* w) {
-    return w->attractors.count == 0 && w->vortices.count == 0 && w->spheres.count == 0 && w->boxes.count == 0 &&
-           w->meshes.count == 0 && w->planes.count <= PS_CACHE;
+    return w->attractors.count == 0 && w->vortices.count == 0 && w->spheres.count == 0 &&
+           w->boxes.count == 0 && w->meshes.count == 0 && w->planes.count <= PS_CACHE;
 }
 
 static size_t fused_sse2(step_ctx* c, size_t begin, size_t end, bool* out_dead) {
     ak_particles* ps = c->ps;
     const ak_particles_world* w = c->w;
     const __m128 dt = _mm_set1_ps(c->dt), zero = _mm_setzero_ps();
-    const __m128 gx = _mm_set1_ps(w->gravity.x), gy = _mm_set1_ps(w->gravity.y), gz = _mm_set1_ps(w->gravity.z);
-    const __m128 wx = _mm_set1_ps(w->wind.x), wy = _mm_set1_ps(w->wind.y), wz = _mm_set1_ps(w->wind.z);
+    const __m128 gx = _mm_set1_ps(w->gravity.x), gy = _mm_set1_ps(w->gravity.y),
+                 gz = _mm_set1_ps(w->gravity.z);
+    const __m128 wx = _mm_set1_ps(w->wind.x), wy = _mm_set1_ps(w->wind.y),
+                 wz = _mm_set1_ps(w->wind.z);
     const __m128 kl = _mm_set1_ps(w->drag_linear), kq = _mm_set1_ps(w->drag_quadratic);
     const __m128 sign = _mm_set1_ps(-0.0f);
     const bool drag = w->drag_linear != 0.0f || w->drag_quadratic != 0.0f;
@@ -893,13 +942,15 @@ static size_t fused_sse2(step_ctx* c, size_t begin, size_t end, bool* out_dead) 
         __m128 fx = zero, fy = zero, fz = zero;
         if (drag) {
             const __m128 rx = _mm_sub_ps(vx, wx), ry = _mm_sub_ps(vy, wy), rz = _mm_sub_ps(vz, wz);
-            const __m128 len = _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, rx), _mm_mul_ps(ry, ry)), _mm_mul_ps(rz, rz)));
+            const __m128 len = _mm_sqrt_ps(
+                _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, rx), _mm_mul_ps(ry, ry)), _mm_mul_ps(rz, rz)));
             const __m128 nk = _mm_xor_ps(_mm_add_ps(kl, _mm_mul_ps(kq, len)), sign); /* -k */
             fx = _mm_add_ps(zero, _mm_mul_ps(rx, nk));
             fy = _mm_add_ps(zero, _mm_mul_ps(ry, nk));
             fz = _mm_add_ps(zero, _mm_mul_ps(rz, nk));
         }
-        const __m128 ax = _mm_add_ps(gx, _mm_mul_ps(fx, im)), ay = _mm_add_ps(gy, _mm_mul_ps(fy, im)),
+        const __m128 ax = _mm_add_ps(gx, _mm_mul_ps(fx, im)),
+                     ay = _mm_add_ps(gy, _mm_mul_ps(fy, im)),
                      az = _mm_add_ps(gz, _mm_mul_ps(fz, im));
         const __m128 nvx = akp_simd_select(moving, _mm_add_ps(vx, _mm_mul_ps(ax, dt)), vx);
         const __m128 nvy = akp_simd_select(moving, _mm_add_ps(vy, _mm_mul_ps(ay, dt)), vy);
@@ -910,12 +961,14 @@ static size_t fused_sse2(step_ctx* c, size_t begin, size_t end, bool* out_dead) 
         __m128 behind = zero;
         for (size_t k = 0; k < planes; ++k) {
             const ak_vec3 n = c->plane_n[k];
-            const __m128 s1 = _mm_sub_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(n.x), nx), _mm_mul_ps(_mm_set1_ps(n.y), ny)),
+            const __m128 s1 = _mm_sub_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(n.x), nx),
+                                                               _mm_mul_ps(_mm_set1_ps(n.y), ny)),
                                                     _mm_mul_ps(_mm_set1_ps(n.z), nz)),
                                          _mm_set1_ps(w->planes.ptr[k].d));
             behind = _mm_or_ps(behind, _mm_cmplt_ps(s1, zero));
         }
-        const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(nx, ny), nz), nvx), nvy), nvz);
+        const __m128 sum =
+            _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(nx, ny), nz), nvx), nvy), nvz);
         dead = _mm_or_ps(dead, _mm_and_ps(moving, _mm_cmpneq_ps(_mm_sub_ps(sum, sum), zero)));
         int hits = _mm_movemask_ps(_mm_and_ps(behind, moving));
         if (hits) { /* keep the start of the step for the scalar contact code */
@@ -926,7 +979,8 @@ static size_t fused_sse2(step_ctx* c, size_t begin, size_t end, bool* out_dead) 
             akp_simd_store_vec3x4(&ps->vel[i].x, nvx, nvy, nvz);
             for (int l = 0; l < 4; ++l) {
                 if (!(hits & (1 << l))) continue;
-                collide_one(c, x0[l], v0[l], &ps->pos[i + (size_t)l], &ps->vel[i + (size_t)l], c->dt);
+                collide_one(c, x0[l], v0[l], &ps->pos[i + (size_t)l], &ps->vel[i + (size_t)l],
+                            c->dt);
                 const ak_vec3 p = ps->pos[i + (size_t)l], v = ps->vel[i + (size_t)l];
                 const float sm = p.x + p.y + p.z + v.x + v.y + v.z;
                 if (!(sm - sm == 0.0f)) *out_dead = true;
@@ -945,12 +999,15 @@ static size_t fused_sse2(step_ctx* c, size_t begin, size_t end, bool* out_dead) 
 #include <immintrin.h>
 /* The same block eight particles wide (AVX2 without FMA: the same roundings as SSE2 and the
  * scalar path). Chosen at run time when the CPU has AVX2. */
-__attribute__((target("avx2"))) static size_t fused_avx2(step_ctx* c, size_t begin, size_t end, bool* out_dead) {
+__attribute__((target("avx2"))) static size_t fused_avx2(step_ctx* c, size_t begin, size_t end,
+                                                         bool* out_dead) {
     ak_particles* ps = c->ps;
     const ak_particles_world* w = c->w;
     const __m256 dt = _mm256_set1_ps(c->dt), zero = _mm256_setzero_ps();
-    const __m256 gx = _mm256_set1_ps(w->gravity.x), gy = _mm256_set1_ps(w->gravity.y), gz = _mm256_set1_ps(w->gravity.z);
-    const __m256 wx = _mm256_set1_ps(w->wind.x), wy = _mm256_set1_ps(w->wind.y), wz = _mm256_set1_ps(w->wind.z);
+    const __m256 gx = _mm256_set1_ps(w->gravity.x), gy = _mm256_set1_ps(w->gravity.y),
+                 gz = _mm256_set1_ps(w->gravity.z);
+    const __m256 wx = _mm256_set1_ps(w->wind.x), wy = _mm256_set1_ps(w->wind.y),
+                 wz = _mm256_set1_ps(w->wind.z);
     const __m256 kl = _mm256_set1_ps(w->drag_linear), kq = _mm256_set1_ps(w->drag_quadratic);
     const __m256 sign = _mm256_set1_ps(-0.0f);
     const bool drag = w->drag_linear != 0.0f || w->drag_quadratic != 0.0f;
@@ -968,19 +1025,24 @@ __attribute__((target("avx2"))) static size_t fused_avx2(step_ctx* c, size_t beg
         akp_simd_load_vec3x4(&ps->pos[i + 4].x, &x1, &y1, &z1);
         akp_simd_load_vec3x4(&ps->vel[i].x, &vx0, &vy0, &vz0);
         akp_simd_load_vec3x4(&ps->vel[i + 4].x, &vx1, &vy1, &vz1);
-        const __m256 x = _mm256_set_m128(x1, x0), y = _mm256_set_m128(y1, y0), z = _mm256_set_m128(z1, z0);
-        const __m256 vx = _mm256_set_m128(vx1, vx0), vy = _mm256_set_m128(vy1, vy0), vz = _mm256_set_m128(vz1, vz0);
+        const __m256 x = _mm256_set_m128(x1, x0), y = _mm256_set_m128(y1, y0),
+                     z = _mm256_set_m128(z1, z0);
+        const __m256 vx = _mm256_set_m128(vx1, vx0), vy = _mm256_set_m128(vy1, vy0),
+                     vz = _mm256_set_m128(vz1, vz0);
         __m256 fx = zero, fy = zero, fz = zero;
         if (drag) {
-            const __m256 rx = _mm256_sub_ps(vx, wx), ry = _mm256_sub_ps(vy, wy), rz = _mm256_sub_ps(vz, wz);
+            const __m256 rx = _mm256_sub_ps(vx, wx), ry = _mm256_sub_ps(vy, wy),
+                         rz = _mm256_sub_ps(vz, wz);
             const __m256 len = _mm256_sqrt_ps(
-                _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)), _mm256_mul_ps(rz, rz)));
+                _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)),
+                              _mm256_mul_ps(rz, rz)));
             const __m256 nk = _mm256_xor_ps(_mm256_add_ps(kl, _mm256_mul_ps(kq, len)), sign);
             fx = _mm256_add_ps(zero, _mm256_mul_ps(rx, nk));
             fy = _mm256_add_ps(zero, _mm256_mul_ps(ry, nk));
             fz = _mm256_add_ps(zero, _mm256_mul_ps(rz, nk));
         }
-        const __m256 ax = _mm256_add_ps(gx, _mm256_mul_ps(fx, im)), ay = _mm256_add_ps(gy, _mm256_mul_ps(fy, im)),
+        const __m256 ax = _mm256_add_ps(gx, _mm256_mul_ps(fx, im)),
+                     ay = _mm256_add_ps(gy, _mm256_mul_ps(fy, im)),
                      az = _mm256_add_ps(gz, _mm256_mul_ps(fz, im));
         const __m256 nvx = _mm256_blendv_ps(vx, _mm256_add_ps(vx, _mm256_mul_ps(ax, dt)), moving);
         const __m256 nvy = _mm256_blendv_ps(vy, _mm256_add_ps(vy, _mm256_mul_ps(ay, dt)), moving);
@@ -991,27 +1053,31 @@ __attribute__((target("avx2"))) static size_t fused_avx2(step_ctx* c, size_t beg
         __m256 behind = zero;
         for (size_t k = 0; k < planes; ++k) {
             const ak_vec3 n = c->plane_n[k];
-            const __m256 s1 = _mm256_sub_ps(
-                _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(n.x), nx), _mm256_mul_ps(_mm256_set1_ps(n.y), ny)),
-                              _mm256_mul_ps(_mm256_set1_ps(n.z), nz)),
-                _mm256_set1_ps(w->planes.ptr[k].d));
+            const __m256 s1 =
+                _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(n.x), nx),
+                                                          _mm256_mul_ps(_mm256_set1_ps(n.y), ny)),
+                                            _mm256_mul_ps(_mm256_set1_ps(n.z), nz)),
+                              _mm256_set1_ps(w->planes.ptr[k].d));
             behind = _mm256_or_ps(behind, _mm256_cmp_ps(s1, zero, _CMP_LT_OQ));
         }
-        const __m256 sum = _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_add_ps(nx, ny), nz), nvx), nvy), nvz);
-        dead = _mm256_or_ps(dead, _mm256_and_ps(moving, _mm256_cmp_ps(_mm256_sub_ps(sum, sum), zero, _CMP_NEQ_UQ)));
+        const __m256 sum = _mm256_add_ps(
+            _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_add_ps(nx, ny), nz), nvx), nvy), nvz);
+        dead = _mm256_or_ps(
+            dead, _mm256_and_ps(moving, _mm256_cmp_ps(_mm256_sub_ps(sum, sum), zero, _CMP_NEQ_UQ)));
         const int hits = _mm256_movemask_ps(_mm256_and_ps(behind, moving));
         ak_vec3 xs0[8], vs0[8];
         if (hits) {
             memcpy(xs0, &ps->pos[i], sizeof xs0);
             memcpy(vs0, &ps->vel[i], sizeof vs0);
         }
-        akp_simd_store_vec3x4(&ps->pos[i].x, _mm256_castps256_ps128(nx), _mm256_castps256_ps128(ny), _mm256_castps256_ps128(nz));
-        akp_simd_store_vec3x4(&ps->pos[i + 4].x, _mm256_extractf128_ps(nx, 1), _mm256_extractf128_ps(ny, 1),
-                              _mm256_extractf128_ps(nz, 1));
-        akp_simd_store_vec3x4(&ps->vel[i].x, _mm256_castps256_ps128(nvx), _mm256_castps256_ps128(nvy),
-                              _mm256_castps256_ps128(nvz));
-        akp_simd_store_vec3x4(&ps->vel[i + 4].x, _mm256_extractf128_ps(nvx, 1), _mm256_extractf128_ps(nvy, 1),
-                              _mm256_extractf128_ps(nvz, 1));
+        akp_simd_store_vec3x4(&ps->pos[i].x, _mm256_castps256_ps128(nx), _mm256_castps256_ps128(ny),
+                              _mm256_castps256_ps128(nz));
+        akp_simd_store_vec3x4(&ps->pos[i + 4].x, _mm256_extractf128_ps(nx, 1),
+                              _mm256_extractf128_ps(ny, 1), _mm256_extractf128_ps(nz, 1));
+        akp_simd_store_vec3x4(&ps->vel[i].x, _mm256_castps256_ps128(nvx),
+                              _mm256_castps256_ps128(nvy), _mm256_castps256_ps128(nvz));
+        akp_simd_store_vec3x4(&ps->vel[i + 4].x, _mm256_extractf128_ps(nvx, 1),
+                              _mm256_extractf128_ps(nvy, 1), _mm256_extractf128_ps(nvz, 1));
         for (int l = 0; hits && l < 8; ++l) {
             if (!(hits & (1 << l))) continue;
             collide_one(c, xs0[l], vs0[l], &ps->pos[i + (size_t)l], &ps->vel[i + (size_t)l], c->dt);
@@ -1086,7 +1152,8 @@ static bool pass_verlet_a(void* arg, size_t begin, size_t end) {
             ps->xs[i] = ps->x0[i], ps->vs[i] = ps->v0[i];
             continue;
         }
-        ps->xs[i] = ak_vec3_madd(ak_vec3_madd(ps->x0[i], ps->v0[i], dt), ps->acc[i], 0.5f * dt * dt);
+        ps->xs[i] =
+            ak_vec3_madd(ak_vec3_madd(ps->x0[i], ps->v0[i], dt), ps->acc[i], 0.5f * dt * dt);
         ps->vs[i] = ak_vec3_madd(ps->v0[i], ps->acc[i], dt);
     }
     return false;
@@ -1118,8 +1185,9 @@ static bool pass_rk(void* arg, size_t begin, size_t end) {
     const float dt = r->c->dt;
     for (size_t i = begin; i < end; ++i) {
         const ak_vec3 kv = r->first ? ps->v0[i] : ps->vs[i]; /* dx/dt of this stage */
-        const ak_vec3 ka = ps->acc[i];                        /* dv/dt of this stage */
-        ak_vec3 sx = r->first ? ak_vec3_zero() : ps->sx[i], sv = r->first ? ak_vec3_zero() : ps->sv[i];
+        const ak_vec3 ka = ps->acc[i];                       /* dv/dt of this stage */
+        ak_vec3 sx = r->first ? ak_vec3_zero() : ps->sx[i],
+                sv = r->first ? ak_vec3_zero() : ps->sv[i];
         sx = ak_vec3_madd(sx, kv, r->weight);
         sv = ak_vec3_madd(sv, ka, r->weight);
         if (r->last) {
@@ -1143,7 +1211,8 @@ static bool pass_collide_age(void* arg, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
         ps->age[i] += c->dt;
         dead |= !(ps->age[i] < ps->life[i]);
-        if (coll && ps->inv_mass[i] != 0.0f) collide_one(c, ps->x0[i], ps->v0[i], &ps->pos[i], &ps->vel[i], c->dt);
+        if (coll && ps->inv_mass[i] != 0.0f)
+            collide_one(c, ps->x0[i], ps->v0[i], &ps->pos[i], &ps->vel[i], c->dt);
         const ak_vec3 x1 = ps->pos[i], v1 = ps->vel[i];
         const float sum = x1.x + x1.y + x1.z + v1.x + v1.y + v1.z;
         dead |= !(sum - sum == 0.0f);
@@ -1178,35 +1247,43 @@ static void compact(ak_particles* ps) {
 #define PS_SPAN_OK(s) ((s).ptr != NULL || (s).count == 0)
 
 static ak_result world_check(const ak_particles* ps, const ak_particles_world* w) {
-    if (!PS_SPAN_OK(w->attractors) || !PS_SPAN_OK(w->vortices) || !PS_SPAN_OK(w->springs) || !PS_SPAN_OK(w->planes) ||
-        !PS_SPAN_OK(w->spheres) || !PS_SPAN_OK(w->boxes) || !PS_SPAN_OK(w->meshes))
+    if (!PS_SPAN_OK(w->attractors) || !PS_SPAN_OK(w->vortices) || !PS_SPAN_OK(w->springs) ||
+        !PS_SPAN_OK(w->planes) || !PS_SPAN_OK(w->spheres) || !PS_SPAN_OK(w->boxes) ||
+        !PS_SPAN_OK(w->meshes))
         return AK_ERR_NULL_ARG;
     for (size_t k = 0; k < w->meshes.count; ++k)
         if (!w->meshes.ptr[k]) return AK_ERR_NULL_ARG;
-    if (!finite3(w->gravity) || !finite3(w->wind) || !ak_finitef(w->drag_linear) || !ak_finitef(w->drag_quadratic))
+    if (!finite3(w->gravity) || !finite3(w->wind) || !ak_finitef(w->drag_linear) ||
+        !ak_finitef(w->drag_quadratic))
         return AK_ERR_BAD_DATA;
     if (w->drag_linear < 0.0f || w->drag_quadratic < 0.0f) return AK_ERR_BAD_ARG;
     for (size_t k = 0; k < w->attractors.count; ++k) {
         const ak_particle_attractor* a = &w->attractors.ptr[k];
-        if (!finite3(a->position) || !ak_finitef(a->strength) || !ak_finitef(a->softening)) return AK_ERR_BAD_DATA;
+        if (!finite3(a->position) || !ak_finitef(a->strength) || !ak_finitef(a->softening))
+            return AK_ERR_BAD_DATA;
         if (a->softening < 0.0f) return AK_ERR_BAD_ARG;
     }
     for (size_t k = 0; k < w->vortices.count; ++k) {
         const ak_particle_vortex* v = &w->vortices.ptr[k];
-        if (!finite3(v->center) || !finite3(v->axis) || !ak_finitef(v->strength) || !ak_finitef(v->softening))
+        if (!finite3(v->center) || !finite3(v->axis) || !ak_finitef(v->strength) ||
+            !ak_finitef(v->softening))
             return AK_ERR_BAD_DATA;
         if (v->softening < 0.0f) return AK_ERR_BAD_ARG;
     }
     for (size_t k = 0; k < w->springs.count; ++k) {
         const ak_particle_spring* s = &w->springs.ptr[k];
-        if (!ak_finitef(s->rest) || !ak_finitef(s->k) || !ak_finitef(s->damping)) return AK_ERR_BAD_DATA;
+        if (!ak_finitef(s->rest) || !ak_finitef(s->k) || !ak_finitef(s->damping))
+            return AK_ERR_BAD_DATA;
         if (s->rest < 0.0f || s->k < 0.0f || s->damping < 0.0f) return AK_ERR_BAD_ARG;
         if (s->i >= ps->count || s->j >= ps->count) return AK_ERR_BAD_INDEX;
     }
     const ak_particle_lennard_jones* lj = &w->lennard_jones;
-    if (!ak_finitef(lj->epsilon) || !ak_finitef(lj->sigma) || !ak_finitef(lj->cutoff)) return AK_ERR_BAD_DATA;
+    if (!ak_finitef(lj->epsilon) || !ak_finitef(lj->sigma) || !ak_finitef(lj->cutoff))
+        return AK_ERR_BAD_DATA;
     if (lj->epsilon != 0.0f && (!(lj->sigma > 0.0f) || lj->cutoff < 0.0f)) return AK_ERR_BAD_ARG;
-#define PS_RESPONSE_OK(o) ((o).restitution >= 0.0f && (o).restitution <= 1.0f && (o).friction >= 0.0f && ak_finitef((o).friction))
+#define PS_RESPONSE_OK(o)                                                                          \
+    ((o).restitution >= 0.0f && (o).restitution <= 1.0f && (o).friction >= 0.0f &&                 \
+     ak_finitef((o).friction))
     for (size_t k = 0; k < w->planes.count; ++k) {
         const ak_particle_plane* p = &w->planes.ptr[k];
         if (!finite3(p->normal) || !ak_finitef(p->d)) return AK_ERR_BAD_DATA;
@@ -1220,7 +1297,8 @@ static ak_result world_check(const ak_particles* ps, const ak_particles_world* w
     for (size_t k = 0; k < w->boxes.count; ++k) {
         const ak_particle_box* b = &w->boxes.ptr[k];
         if (!finite3(b->min) || !finite3(b->max)) return AK_ERR_BAD_DATA;
-        if (!PS_RESPONSE_OK(*b) || b->min.x > b->max.x || b->min.y > b->max.y || b->min.z > b->max.z)
+        if (!PS_RESPONSE_OK(*b) || b->min.x > b->max.x || b->min.y > b->max.y ||
+            b->min.z > b->max.z)
             return AK_ERR_BAD_ARG;
     }
 #undef PS_RESPONSE_OK
@@ -1241,9 +1319,12 @@ ak_result ak_particles_step(ak_particles* ps, const ak_particles_world* w, float
 #if AK_SIMD_SSE2 && PS_HAVE_AVX2
     c.avx2 = __builtin_cpu_supports("avx2");
 #endif
-    c.lj_cutoff = w->lennard_jones.cutoff > 0.0f ? w->lennard_jones.cutoff : 2.5f * w->lennard_jones.sigma;
-    for (size_t k = 0; k < w->planes.count && k < PS_CACHE; ++k) c.plane_n[k] = unit_or_up(w->planes.ptr[k].normal);
-    for (size_t k = 0; k < w->vortices.count && k < PS_CACHE; ++k) c.vortex_axis[k] = unit_or_up(w->vortices.ptr[k].axis);
+    c.lj_cutoff =
+        w->lennard_jones.cutoff > 0.0f ? w->lennard_jones.cutoff : 2.5f * w->lennard_jones.sigma;
+    for (size_t k = 0; k < w->planes.count && k < PS_CACHE; ++k)
+        c.plane_n[k] = unit_or_up(w->planes.ptr[k].normal);
+    for (size_t k = 0; k < w->vortices.count && k < PS_CACHE; ++k)
+        c.vortex_axis[k] = unit_or_up(w->vortices.ptr[k].axis);
     const size_t n = ps->count;
     const uint32_t th = ps->thread_count;
     const double t = ps->time;

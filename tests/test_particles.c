@@ -3,12 +3,14 @@
 
 #include "ak_test.h"
 
-static const ak_particles_integrator kIntegrators[4] = {AK_INTEGRATOR_EULER, AK_INTEGRATOR_SYMPLECTIC,
-                                                        AK_INTEGRATOR_VERLET, AK_INTEGRATOR_RK4};
+static const ak_particles_integrator kIntegrators[4] = {
+    AK_INTEGRATOR_EULER, AK_INTEGRATOR_SYMPLECTIC, AK_INTEGRATOR_VERLET, AK_INTEGRATOR_RK4};
 
-static ak_particles* make(uint32_t cap, ak_particles_integrator integ, uint32_t threads, uint64_t seed) {
+static ak_particles* make(uint32_t cap, ak_particles_integrator integ, uint32_t threads,
+                          uint64_t seed) {
     ak_particles* ps = NULL;
-    ak_particles_desc d = {.capacity = cap, .integrator = integ, .thread_count = threads, .seed = seed};
+    ak_particles_desc d = {
+        .capacity = cap, .integrator = integ, .thread_count = threads, .seed = seed};
     AK_CHECK_EQ(ak_particles_create(&d, NULL, &ps), AK_OK);
     return ps;
 }
@@ -35,17 +37,20 @@ AK_TEST(projectile_closed_forms) {
         /* Exact: y = 1 + vy t + g t^2 / 2. Explicit Euler lags by g dt t / 2, semi-implicit
          * Euler leads by it (sum of n(n-1)/2 vs n(n+1)/2 dt^2 g). */
         double y = 1.0 + vy * t + 0.5 * g * t * t;
-        if (kIntegrators[k] == AK_INTEGRATOR_EULER) y = 1.0 + vy * t + g * dt * dt * n * (n - 1) / 2.0;
-        if (kIntegrators[k] == AK_INTEGRATOR_SYMPLECTIC) y = 1.0 + vy * t + g * dt * dt * n * (n + 1) / 2.0;
-        printf("  integrator %d: position error %.2g, velocity error %.2g\n", k, fabs(st.position[0].y - y),
-               fabs(st.velocity[0].y - (vy + g * t)));
+        if (kIntegrators[k] == AK_INTEGRATOR_EULER)
+            y = 1.0 + vy * t + g * dt * dt * n * (n - 1) / 2.0;
+        if (kIntegrators[k] == AK_INTEGRATOR_SYMPLECTIC)
+            y = 1.0 + vy * t + g * dt * dt * n * (n + 1) / 2.0;
+        printf("  integrator %d: position error %.2g, velocity error %.2g\n", k,
+               fabs(st.position[0].y - y), fabs(st.velocity[0].y - (vy + g * t)));
         /* Float rounding only: a few ulps of the magnitudes (about 10) per step. */
         AK_CHECK_NEAR(st.position[0].y, y, 2e-6 * n);
         AK_CHECK_NEAR(st.position[0].x, vx * t, 2e-6 * n);
         AK_CHECK_NEAR(st.velocity[0].y, vy + g * t, 2e-6 * n);
         AK_CHECK_NEAR(st.velocity[0].x, vx, 1e-6);
         AK_CHECK_NEAR(ak_particles_time(ps), n * (double)(float)dt, 1e-9);
-        if (kIntegrators[k] == AK_INTEGRATOR_EULER || kIntegrators[k] == AK_INTEGRATOR_SYMPLECTIC) /* first order */
+        if (kIntegrators[k] == AK_INTEGRATOR_EULER ||
+            kIntegrators[k] == AK_INTEGRATOR_SYMPLECTIC) /* first order */
             AK_CHECK(fabs(st.position[0].y - (1.0 + vy * t + 0.5 * g * t * t)) > 0.05);
         ak_particles_destroy(ps);
     }
@@ -81,7 +86,8 @@ AK_TEST(convergence_orders) {
         double e1 = oscillator_error(kIntegrators[k], dts[k], 4.0);
         double e2 = oscillator_error(kIntegrators[k], dts[k] / 2, 4.0);
         double ratio = e1 / e2;
-        printf("  integrator %d: error %.3g -> %.3g, ratio %.3f (want %.0f)\n", k, e1, e2, ratio, want[k]);
+        printf("  integrator %d: error %.3g -> %.3g, ratio %.3f (want %.0f)\n", k, e1, e2, ratio,
+               want[k]);
         AK_CHECK_NEAR(ratio, want[k], 0.15 * want[k]);
     }
 }
@@ -109,8 +115,9 @@ AK_TEST(energy_symplectic_vs_euler) {
     double euler = spring_energy_drift(AK_INTEGRATOR_EULER);
     double sympl = spring_energy_drift(AK_INTEGRATOR_SYMPLECTIC);
     double verlet = spring_energy_drift(AK_INTEGRATOR_VERLET);
-    printf("  worst relative energy change over 10000 steps: euler %+.4f symplectic %+.5f verlet %+.7f\n", euler,
-           sympl, verlet);
+    printf("  worst relative energy change over 10000 steps: euler %+.4f symplectic %+.5f verlet "
+           "%+.7f\n",
+           euler, sympl, verlet);
     AK_CHECK(fabs(sympl) < 0.01);
     AK_CHECK(fabs(verlet) < 0.01);
     AK_CHECK(euler > 0.05); /* explicit Euler gains energy: (1 + w^2 dt^2)^(n/2) - 1 = 13% */
@@ -142,10 +149,12 @@ AK_TEST(drag_wind_attractor_vortex) {
     ps = make(4, AK_INTEGRATOR_EULER, 1, 1);
     add(ps, ak_vec3_make(3, 4, 0), ak_vec3_zero(), 2.0f);
     ak_particle_attractor at = {.position = {0, 0, 0}, .strength = 10.0f, .softening = 1.0f};
-    ak_particle_vortex vo = {.center = {0, 7, 0}, .axis = {0, 2, 0}, .strength = 3.0f, .softening = 0.5f};
+    ak_particle_vortex vo = {
+        .center = {0, 7, 0}, .axis = {0, 2, 0}, .strength = 3.0f, .softening = 0.5f};
     ak_particles_world fw = {.attractors = {&at, 1}, .vortices = {&vo, 1}};
     ak_particles_step(ps, &fw, 0.1f);
-    /* attractor: 10 * (-3,-4,0) / 26^1.5; vortex: axis y, r = (3,0,0): (y x r) = (0,0,-3), 3/(9+0.25) */
+    /* attractor: 10 * (-3,-4,0) / 26^1.5; vortex: axis y, r = (3,0,0): (y x r) = (0,0,-3),
+     * 3/(9+0.25) */
     double s = 10.0 / pow(26.0, 1.5), sv = 3.0 / 9.25;
     ak_vec3 v1 = ak_particles_get_state(ps).velocity[0];
     AK_CHECK_NEAR(v1.x, 0.1 * (-3 * s) / 2.0, 1e-7);
@@ -154,7 +163,8 @@ AK_TEST(drag_wind_attractor_vortex) {
     ak_particles_destroy(ps);
 }
 
-static void push_up(const ak_vec3* p, const ak_vec3* v, const float* im, size_t n, double t, ak_vec3* f, void* user) {
+static void push_up(const ak_vec3* p, const ak_vec3* v, const float* im, size_t n, double t,
+                    ak_vec3* f, void* user) {
     (void)p, (void)v, (void)im, (void)t;
     int* calls = (int*)user;
     ++*calls;
@@ -179,7 +189,8 @@ AK_TEST(spring_damping_and_callback) {
     int calls = 0;
     ps = make(4, AK_INTEGRATOR_RK4, 1, 1);
     add(ps, ak_vec3_make(0, 1, 0), ak_vec3_zero(), 1.0f);
-    ak_particles_world cw = {.gravity = {0, -9.81f, 0}, .callback = push_up, .callback_user = &calls};
+    ak_particles_world cw = {
+        .gravity = {0, -9.81f, 0}, .callback = push_up, .callback_user = &calls};
     for (int s = 0; s < 10; ++s) ak_particles_step(ps, &cw, 0.01f);
     AK_CHECK_EQ(calls, 40); /* four evaluations per RK4 step */
     AK_CHECK_NEAR(ak_particles_get_state(ps).position[0].y, 1.0, 1e-6);
@@ -190,7 +201,9 @@ AK_TEST(lennard_jones_matches_brute_force) {
     ak_particles* ps = make(600, AK_INTEGRATOR_SYMPLECTIC, 1, 1);
     ak_rng rng = ak_rng_make(4);
     for (int i = 0; i < 500; ++i)
-        add(ps, ak_vec3_make(ak_rng_range(&rng, 0, 4), ak_rng_range(&rng, 0, 4), ak_rng_range(&rng, 0, 4)),
+        add(ps,
+            ak_vec3_make(ak_rng_range(&rng, 0, 4), ak_rng_range(&rng, 0, 4),
+                         ak_rng_range(&rng, 0, 4)),
             ak_vec3_zero(), 1.0f);
     ak_particles_state st = ak_particles_get_state(ps);
     ak_vec3 p[500];
@@ -263,13 +276,17 @@ static double rebound_height(ak_particles_integrator integ, float e, int use_sph
     ak_vec3 quad[4] = {{-5, 0, -5}, {5, 0, -5}, {5, 0, 5}, {-5, 0, 5}};
     uint32_t tri[6] = {0, 2, 1, 0, 3, 2};
     ak_particle_mesh* mesh = NULL;
-    ak_particle_mesh_desc md = {.positions = AK_SPAN(quad), .indices = AK_SPAN(tri), .restitution = e};
+    ak_particle_mesh_desc md = {
+        .positions = AK_SPAN(quad), .indices = AK_SPAN(tri), .restitution = e};
     AK_CHECK_EQ(ak_particle_mesh_create(&md, NULL, &mesh), AK_OK);
     const ak_particle_mesh* meshes[1] = {mesh};
     ak_particles_world w = {.gravity = {0, -9.81f, 0}};
-    if (use_sphere) w.spheres = (ak_particle_sphere_cspan){&ball, 1};
-    else if (use_mesh) w.meshes = (ak_particle_mesh_cspan){meshes, 1};
-    else w.planes = (ak_particle_plane_cspan){&floor, 1};
+    if (use_sphere)
+        w.spheres = (ak_particle_sphere_cspan){&ball, 1};
+    else if (use_mesh)
+        w.meshes = (ak_particle_mesh_cspan){meshes, 1};
+    else
+        w.planes = (ak_particle_plane_cspan){&floor, 1};
     double best = 0.0;
     bool bounced = false;
     for (int s = 0; s < 3000; ++s) {
@@ -290,8 +307,10 @@ AK_TEST(restitution_rebound_ratio) {
         double e2 = (double)es[k] * es[k];
         AK_CHECK_NEAR(rebound_height(AK_INTEGRATOR_VERLET, es[k], 0, 0), e2, 0.01 * e2);
         AK_CHECK_NEAR(rebound_height(AK_INTEGRATOR_SYMPLECTIC, es[k], 0, 0), e2, 0.01 * e2);
-        AK_CHECK_NEAR(rebound_height(AK_INTEGRATOR_RK4, es[k], 1, 0), e2, 0.01 * e2); /* top of a sphere */
-        AK_CHECK_NEAR(rebound_height(AK_INTEGRATOR_VERLET, es[k], 0, 1), e2, 0.01 * e2); /* triangle mesh */
+        AK_CHECK_NEAR(rebound_height(AK_INTEGRATOR_RK4, es[k], 1, 0), e2,
+                      0.01 * e2); /* top of a sphere */
+        AK_CHECK_NEAR(rebound_height(AK_INTEGRATOR_VERLET, es[k], 0, 1), e2,
+                      0.01 * e2); /* triangle mesh */
     }
 }
 
@@ -301,7 +320,8 @@ AK_TEST(friction_stopping_distance) {
         for (int integ = 1; integ < 4; ++integ) {
             ak_particles* ps = make(4, kIntegrators[integ], 1, 1);
             add(ps, ak_vec3_zero(), ak_vec3_make(4, 0, 0), 1.0f);
-            ak_particle_plane floor = {.normal = {0, 1, 0}, .friction = mus[k], .restitution = 0.5f};
+            ak_particle_plane floor = {
+                .normal = {0, 1, 0}, .friction = mus[k], .restitution = 0.5f};
             ak_particles_world w = {.gravity = {0, -9.81f, 0}, .planes = {&floor, 1}};
             for (int s = 0; s < 5000; ++s) ak_particles_step(ps, &w, 0.001f);
             ak_particles_state st = ak_particles_get_state(ps);
@@ -327,7 +347,8 @@ AK_TEST(box_and_moving_mesh) {
 
     /* A mesh moved between steps: particles resting on it stay above it (never fall through). */
     ps = make(64, AK_INTEGRATOR_SYMPLECTIC, 1, 1);
-    for (int i = 0; i < 50; ++i) add(ps, ak_vec3_make(-2 + 0.08f * i, 0.5f, 0.03f * i - 1), ak_vec3_zero(), 1.0f);
+    for (int i = 0; i < 50; ++i)
+        add(ps, ak_vec3_make(-2 + 0.08f * i, 0.5f, 0.03f * i - 1), ak_vec3_zero(), 1.0f);
     ak_vec3 quad[4] = {{-5, 0, -5}, {5, 0, -5}, {5, 0, 5}, {-5, 0, 5}};
     uint32_t tri[6] = {0, 2, 1, 0, 3, 2};
     ak_particle_mesh* mesh = NULL;
@@ -384,9 +405,17 @@ AK_TEST(emission_counts) {
 AK_TEST(emitter_shapes_and_ranges) {
     ak_particles* ps = make(20000, AK_INTEGRATOR_DEFAULT, 1, 3);
     const ak_vec3 c = {1, 2, 3};
-    ak_particle_emitter base = {.center = c, .radius = 0.5f, .half_extents = {0.2f, 0.4f, 0.6f}, .direction = {0, 0, 3},
-                                .cone_angle = 0.4f, .speed_min = 2, .speed_max = 3, .lifetime_min = 1,
-                                .lifetime_max = 2, .size_min = 0.1f, .size_max = 0.2f};
+    ak_particle_emitter base = {.center = c,
+                                .radius = 0.5f,
+                                .half_extents = {0.2f, 0.4f, 0.6f},
+                                .direction = {0, 0, 3},
+                                .cone_angle = 0.4f,
+                                .speed_min = 2,
+                                .speed_max = 3,
+                                .lifetime_min = 1,
+                                .lifetime_max = 2,
+                                .size_min = 0.1f,
+                                .size_max = 0.2f};
     for (int shape = 0; shape < 5; ++shape) {
         ak_particles_clear(ps);
         ak_particle_emitter e = base;
@@ -401,12 +430,15 @@ AK_TEST(emitter_shapes_and_ranges) {
             mean_r += r / (double)st.count;
             float cosang = st.velocity[i].z / speed;
             bad += speed < 2.0f - 1e-5f || speed > 3.0f + 1e-5f || cosang < cosf(0.4f) - 1e-5f;
-            bad += st.lifetime[i] < 1.0f || st.lifetime[i] > 2.0f || st.size[i] < 0.1f || st.size[i] > 0.2f;
+            bad += st.lifetime[i] < 1.0f || st.lifetime[i] > 2.0f || st.size[i] < 0.1f ||
+                   st.size[i] > 0.2f;
             if (shape == AK_EMITTER_POINT) bad += r != 0.0f;
             if (shape == AK_EMITTER_SPHERE) bad += r > 0.5f + 1e-5f;
             if (shape == AK_EMITTER_SPHERE_SURFACE) bad += fabsf(r - 0.5f) > 1e-5f;
-            if (shape == AK_EMITTER_DISC) bad += r > 0.5f + 1e-5f || fabsf(d.z) > 1e-5f; /* disc faces +Z */
-            if (shape == AK_EMITTER_BOX) bad += fabsf(d.x) > 0.2f || fabsf(d.y) > 0.4f || fabsf(d.z) > 0.6f;
+            if (shape == AK_EMITTER_DISC)
+                bad += r > 0.5f + 1e-5f || fabsf(d.z) > 1e-5f; /* disc faces +Z */
+            if (shape == AK_EMITTER_BOX)
+                bad += fabsf(d.x) > 0.2f || fabsf(d.y) > 0.4f || fabsf(d.z) > 0.6f;
         }
         AK_CHECK_EQ(bad, 0);
         /* Uniform densities: mean radius 3/4 R in a ball, 2/3 R on a disc. */
@@ -418,8 +450,12 @@ AK_TEST(emitter_shapes_and_ranges) {
     ak_vec3 v[5] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 0, 0}, {2, 3, 0}};
     uint32_t idx[6] = {0, 1, 2, 1, 3, 4};
     float cdf[2];
-    ak_particle_emitter me = {.shape = AK_EMITTER_MESH, .mesh_positions = AK_SPAN(v), .mesh_indices = AK_SPAN(idx),
-                              .mesh_area_cdf = AK_SPAN(cdf), .speed_min = 1, .speed_max = 1};
+    ak_particle_emitter me = {.shape = AK_EMITTER_MESH,
+                              .mesh_positions = AK_SPAN(v),
+                              .mesh_indices = AK_SPAN(idx),
+                              .mesh_area_cdf = AK_SPAN(cdf),
+                              .speed_min = 1,
+                              .speed_max = 1};
     ak_particles_clear(ps);
     AK_CHECK_EQ(ak_particles_burst(ps, &me, 20000, NULL), AK_OK);
     ak_particles_state st = ak_particles_get_state(ps);
@@ -458,27 +494,46 @@ AK_TEST(lifetime_expiry_keeps_order) {
 /* A busy scene: everything on, 20000 particles (enough for several threads). */
 static ak_particles* busy_run(ak_particles_integrator integ, uint32_t threads, uint64_t seed) {
     ak_particles* ps = make(20000, integ, threads, seed);
-    ak_particle_emitter e = {.shape = AK_EMITTER_SPHERE, .center = {0, 2, 0}, .radius = 1.5f, .cone_angle = 1.0f,
-                             .speed_min = 0, .speed_max = 3, .lifetime_min = 0.1f, .lifetime_max = 2.0f};
+    ak_particle_emitter e = {.shape = AK_EMITTER_SPHERE,
+                             .center = {0, 2, 0},
+                             .radius = 1.5f,
+                             .cone_angle = 1.0f,
+                             .speed_min = 0,
+                             .speed_max = 3,
+                             .lifetime_min = 0.1f,
+                             .lifetime_max = 2.0f};
     ak_particles_burst(ps, &e, 18000, NULL);
     ak_particle_spring springs[100];
-    for (uint32_t k = 0; k < 100; ++k) springs[k] = (ak_particle_spring){k, k + 1, 0.1f, 50.0f, 0.2f};
+    for (uint32_t k = 0; k < 100; ++k)
+        springs[k] = (ak_particle_spring){k, k + 1, 0.1f, 50.0f, 0.2f};
     for (uint32_t k = 0; k < 101; ++k) ak_particles_get_state(ps).lifetime[k] = INFINITY;
     ak_particle_attractor at = {.position = {1, 1, 1}, .strength = 2.0f, .softening = 0.1f};
-    ak_particle_vortex vo = {.center = {0, 0, 0}, .axis = {0, 1, 0}, .strength = 1.0f, .softening = 0.2f};
+    ak_particle_vortex vo = {
+        .center = {0, 0, 0}, .axis = {0, 1, 0}, .strength = 1.0f, .softening = 0.2f};
     ak_particle_plane pl = {.normal = {0, 1, 0}, .restitution = 0.4f, .friction = 0.3f};
-    ak_particle_sphere sp = {.center = {0.5f, 0.5f, 0}, .radius = 0.4f, .restitution = 0.7f, .friction = 0.1f};
-    ak_particle_box bx = {.min = {-1, 0, -1}, .max = {-0.5f, 0.6f, -0.4f}, .restitution = 0.2f, .friction = 0.5f};
+    ak_particle_sphere sp = {
+        .center = {0.5f, 0.5f, 0}, .radius = 0.4f, .restitution = 0.7f, .friction = 0.1f};
+    ak_particle_box bx = {
+        .min = {-1, 0, -1}, .max = {-0.5f, 0.6f, -0.4f}, .restitution = 0.2f, .friction = 0.5f};
     ak_vec3 quad[4] = {{-3, 0.3f, -3}, {3, 0.2f, -3}, {3, 0.3f, 3}, {-3, 0.25f, 3}};
     uint32_t tri[6] = {0, 2, 1, 0, 3, 2};
     ak_particle_mesh* mesh = NULL;
-    ak_particle_mesh_desc md = {.positions = AK_SPAN(quad), .indices = AK_SPAN(tri), .restitution = 0.3f};
+    ak_particle_mesh_desc md = {
+        .positions = AK_SPAN(quad), .indices = AK_SPAN(tri), .restitution = 0.3f};
     ak_particle_mesh_create(&md, NULL, &mesh);
     const ak_particle_mesh* meshes[1] = {mesh};
-    ak_particles_world w = {.gravity = {0, -9.81f, 0}, .drag_linear = 0.1f, .drag_quadratic = 0.05f,
-                            .wind = {1, 0, 0}, .attractors = {&at, 1}, .vortices = {&vo, 1},
-                            .springs = {springs, 100}, .lennard_jones = {.epsilon = 1e-4f, .sigma = 0.02f},
-                            .planes = {&pl, 1}, .spheres = {&sp, 1}, .boxes = {&bx, 1}, .meshes = {meshes, 1}};
+    ak_particles_world w = {.gravity = {0, -9.81f, 0},
+                            .drag_linear = 0.1f,
+                            .drag_quadratic = 0.05f,
+                            .wind = {1, 0, 0},
+                            .attractors = {&at, 1},
+                            .vortices = {&vo, 1},
+                            .springs = {springs, 100},
+                            .lennard_jones = {.epsilon = 1e-4f, .sigma = 0.02f},
+                            .planes = {&pl, 1},
+                            .spheres = {&sp, 1},
+                            .boxes = {&bx, 1},
+                            .meshes = {meshes, 1}};
     ak_particle_emitter rate = e;
     rate.rate = 5000.0f;
     for (int s = 0; s < 6; ++s) {
@@ -508,12 +563,14 @@ AK_TEST(determinism_and_threads) {
         AK_CHECK(st.count > 16384); /* more than one thread's share */
         int finite = 1;
         for (size_t i = 0; i < st.count; ++i)
-            finite &= ak_finitef(st.position[i].x) && ak_finitef(st.position[i].y) && ak_finitef(st.velocity[i].z);
+            finite &= ak_finitef(st.position[i].x) && ak_finitef(st.position[i].y) &&
+                      ak_finitef(st.velocity[i].z);
         AK_CHECK(finite);
-        AK_CHECK(same_state(a, c)); /* same seed: bit for bit */
-        AK_CHECK(same_state(a, b)); /* 1 and 2 threads */
+        AK_CHECK(same_state(a, c));  /* same seed: bit for bit */
+        AK_CHECK(same_state(a, b));  /* 1 and 2 threads */
         AK_CHECK(!same_state(a, d)); /* another seed differs */
-        ak_particles_destroy(a), ak_particles_destroy(b), ak_particles_destroy(c), ak_particles_destroy(d);
+        ak_particles_destroy(a), ak_particles_destroy(b), ak_particles_destroy(c),
+            ak_particles_destroy(d);
     }
 }
 
@@ -525,16 +582,20 @@ static ak_particles* simple_run(uint32_t threads) {
     ak_particles* ps = make((uint32_t)n, AK_INTEGRATOR_SYMPLECTIC, threads, 9);
     ak_rng rng = ak_rng_make(21);
     for (size_t i = 0; i < n; ++i) {
-        ak_particle_init in = {.position = {ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, 0, 0.3f), 0},
-                               .velocity = {ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 1), 0},
-                               .mass = i % 17 ? ak_rng_range(&rng, 0.5f, 2) : 0.0f,
-                               .lifetime = i % 5 ? 0.0f : ak_rng_range(&rng, 0.01f, 0.2f)};
+        ak_particle_init in = {
+            .position = {ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, 0, 0.3f), 0},
+            .velocity = {ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 1), 0},
+            .mass = i % 17 ? ak_rng_range(&rng, 0.5f, 2) : 0.0f,
+            .lifetime = i % 5 ? 0.0f : ak_rng_range(&rng, 0.01f, 0.2f)};
         ak_particles_add(ps, &in, NULL);
     }
     ak_particle_plane planes[2] = {{.normal = {0, 1, 0}, .restitution = 0.6f, .friction = 0.3f},
                                    {.normal = {-1, 0, 0}, .d = -0.9f, .restitution = 0.9f}};
-    ak_particles_world w = {.gravity = {0, -9.81f, 0}, .drag_linear = 0.3f, .drag_quadratic = 0.05f,
-                            .wind = {0.5f, 0, 0}, .planes = {planes, 2}};
+    ak_particles_world w = {.gravity = {0, -9.81f, 0},
+                            .drag_linear = 0.3f,
+                            .drag_quadratic = 0.05f,
+                            .wind = {0.5f, 0, 0},
+                            .planes = {planes, 2}};
     for (int s = 0; s < 20; ++s) ak_particles_step(ps, &w, 0.01f);
     return ps;
 }

@@ -49,7 +49,8 @@ AK_TEST(bad_scenes_exit_1_with_path) {
         const char* text;
         const char* expect; /* key path and problem in the one line */
     } cases[] = {
-        {"{\"particles\": [{\"p\": [0,0,0]}], \"springs\": [{\"i\": 0, \"j\": 5}]}", "springs[0].j"},
+        {"{\"particles\": [{\"p\": [0,0,0]}], \"springs\": [{\"i\": 0, \"j\": 5}]}",
+         "springs[0].j"},
         {"{\"spheres\": [{\"r\": -1}]}", "spheres[0].r"},
         {"{\"gravty\": [0, 1, 0]}", "unknown key \"gravty\""},
         {"{\"particles\": [{\"p\": [0, \"x\", 0]}]}", "particles[0].p"},
@@ -66,8 +67,8 @@ AK_TEST(bad_scenes_exit_1_with_path) {
         write_file("particles_bad.json", cases[k].text);
         int rc = run("particles particles_bad.json --steps 2");
         AK_CHECK_MSG(rc == 1, "case %zu: exit %d (%s)", k, rc, out_buf);
-        AK_CHECK_MSG(strstr(out_buf, "particles_bad.json") && strstr(out_buf, cases[k].expect), "case %zu: %s", k,
-                     out_buf);
+        AK_CHECK_MSG(strstr(out_buf, "particles_bad.json") && strstr(out_buf, cases[k].expect),
+                     "case %zu: %s", k, out_buf);
         int lines = 0;
         for (const char* p = out_buf; *p; ++p) lines += *p == '\n';
         AK_CHECK_MSG(lines == 1, "case %zu: %d lines", k, lines);
@@ -86,10 +87,13 @@ AK_TEST(bad_scenes_exit_1_with_path) {
 AK_TEST(json_matches_closed_form) {
     /* A thrown particle (Verlet: exact for constant gravity) and a pinned one; the file's
      * dt is overridden on the command line. */
-    write_file("particles_throw.json",
-               "{\"dt\": 0.5, \"integrator\": \"euler\", \"gravity\": [0, -10, 0],"
-               " \"particles\": [{\"p\": [1, 2, 3], \"v\": [2, 5, 0]}, {\"p\": [0, 1, 0], \"m\": 0}]}");
-    AK_CHECK_EQ(run("particles particles_throw.json --steps 40 --dt 0.025 --integrator verlet --json throw.json"), 0);
+    write_file(
+        "particles_throw.json",
+        "{\"dt\": 0.5, \"integrator\": \"euler\", \"gravity\": [0, -10, 0],"
+        " \"particles\": [{\"p\": [1, 2, 3], \"v\": [2, 5, 0]}, {\"p\": [0, 1, 0], \"m\": 0}]}");
+    AK_CHECK_EQ(run("particles particles_throw.json --steps 40 --dt 0.025 --integrator verlet "
+                    "--json throw.json"),
+                0);
     cJSON* j = read_json("throw.json");
     AK_CHECK(j != NULL);
     if (!j) return;
@@ -112,7 +116,8 @@ AK_TEST(json_matches_closed_form) {
     write_file("particles_emit.json",
                "{\"gravity\": [0, 0, 0], \"particles\": [{\"p\": [9, 9, 9]}],"
                " \"emitters\": [{\"rate\": 2.5, \"speed\": [0, 0], \"lifetime\": [100, 100]}]}");
-    AK_CHECK_EQ(run("particles particles_emit.json --steps 200 --dt 0.01 --json emit.json --threads 2"), 0);
+    AK_CHECK_EQ(
+        run("particles particles_emit.json --steps 200 --dt 0.01 --json emit.json --threads 2"), 0);
     j = read_json("emit.json");
     AK_CHECK(j != NULL);
     if (!j) return;
@@ -126,8 +131,10 @@ AK_TEST(presets_run_and_render) {
     const char* presets[] = {"fountain", "rain", "fireworks", "character"};
     for (int k = 0; k < 4; ++k) {
         char args[256];
-        snprintf(args, sizeof args, "particles --preset %s --steps 12 --size 96x72 -o preset_%s.png --json preset_%s.json",
-                 presets[k], presets[k], presets[k]);
+        snprintf(
+            args, sizeof args,
+            "particles --preset %s --steps 12 --size 96x72 -o preset_%s.png --json preset_%s.json",
+            presets[k], presets[k], presets[k]);
         AK_CHECK_MSG(run(args) == 0, "%s: %s", presets[k], out_buf);
         char path[64];
         snprintf(path, sizeof path, "preset_%s.png", presets[k]);

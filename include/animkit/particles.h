@@ -122,7 +122,8 @@ AK_API size_t ak_particles_capacity(const ak_particles* particles);
 AK_API double ak_particles_time(const ak_particles* particles);
 /* Change the integrator between steps (DEFAULT -> SYMPLECTIC). AK_ERR_NULL_ARG,
  * AK_ERR_BAD_ARG when out of range. */
-AK_API ak_result ak_particles_set_integrator(ak_particles* particles, ak_particles_integrator integrator);
+AK_API ak_result ak_particles_set_integrator(ak_particles* particles,
+                                             ak_particles_integrator integrator);
 
 /* One particle to add by hand. */
 typedef struct ak_particle_init {
@@ -136,7 +137,8 @@ typedef struct ak_particle_init {
 
 /* Append a particle; *out_index (optional) gets its index. AK_ERR_SPAN_SMALL when the
  * system is full, AK_ERR_BAD_DATA for non-finite values or a negative mass/lifetime. */
-AK_API ak_result ak_particles_add(ak_particles* particles, const ak_particle_init* init, size_t* out_index);
+AK_API ak_result ak_particles_add(ak_particles* particles, const ak_particle_init* init,
+                                  size_t* out_index);
 
 /* Remove every particle (time, ids and the rng go on). NULL is a no-op. */
 AK_API void ak_particles_clear(ak_particles* particles);
@@ -144,13 +146,13 @@ AK_API void ak_particles_clear(ak_particles* particles);
 /* ---- emitters ----------------------------------------------------------------------- */
 
 typedef enum ak_emitter_shape {
-    AK_EMITTER_POINT = 0,     /* at center */
-    AK_EMITTER_SPHERE,        /* uniform in the ball of radius around center */
+    AK_EMITTER_POINT = 0,      /* at center */
+    AK_EMITTER_SPHERE,         /* uniform in the ball of radius around center */
     AK_EMITTER_SPHERE_SURFACE, /* uniform on the sphere */
-    AK_EMITTER_DISC,          /* uniform on the disc of radius around center, facing direction */
-    AK_EMITTER_BOX,           /* uniform in center +- half_extents */
-    AK_EMITTER_MESH,          /* uniform over the area of a triangle mesh (see mesh_*), 1e-4 m out
-                                 along the triangle's normal (counter-clockwise front) */
+    AK_EMITTER_DISC,           /* uniform on the disc of radius around center, facing direction */
+    AK_EMITTER_BOX,            /* uniform in center +- half_extents */
+    AK_EMITTER_MESH,           /* uniform over the area of a triangle mesh (see mesh_*), 1e-4 m out
+                                  along the triangle's normal (counter-clockwise front) */
     AK_EMITTER_SHAPE_COUNT
 } ak_emitter_shape;
 
@@ -161,21 +163,21 @@ typedef struct ak_particle_emitter {
     ak_vec3 half_extents;   /* BOX: metres */
     ak_vec3 direction;      /* cone axis (normalised here); zero -> +Y. MESH: the triangle
                                normal is the axis unless use_direction_on_mesh */
-    bool use_direction_on_mesh;
-    float cone_angle;       /* half-angle, radians, [0, pi]; 0 = along the axis; uniform over
-                               the cone's solid angle */
-    float speed_min;        /* m/s; speed uniform in [speed_min, speed_max] */
-    float speed_max;        /* m/s; below speed_min -> speed_min */
-    float lifetime_min;     /* seconds; lifetime uniform in [min, max] */
-    float lifetime_max;     /* seconds; 0 (with min 0) -> INFINITY (never dies) */
-    float size_min;         /* metres; 0 -> 0.05 */
-    float size_max;         /* metres; below size_min -> size_min */
-    float mass;             /* kg of each particle; 0 -> 1 (emitted particles are never pinned) */
-    ak_vec4 colour;         /* all zero -> opaque white */
-    ak_vec3 base_velocity;  /* added to every emitted velocity (a moving emitter), m/s */
-    float rate;             /* particles per second for ak_particles_emit; 0 = none */
-    double carry;           /* fraction carried between calls; written by ak_particles_emit
-                               (start at 0) */
+    bool use_direction_on_mesh; /* MESH: false -> the cone axis is each triangle's normal */
+    float cone_angle;      /* half-angle, radians, [0, pi]; 0 = along the axis; uniform over
+                              the cone's solid angle */
+    float speed_min;       /* m/s; speed uniform in [speed_min, speed_max] */
+    float speed_max;       /* m/s; below speed_min -> speed_min */
+    float lifetime_min;    /* seconds; lifetime uniform in [min, max] */
+    float lifetime_max;    /* seconds; 0 (with min 0) -> INFINITY (never dies) */
+    float size_min;        /* metres; 0 -> 0.05 */
+    float size_max;        /* metres; below size_min -> size_min */
+    float mass;            /* kg of each particle; 0 -> 1 (emitted particles are never pinned) */
+    ak_vec4 colour;        /* all zero -> opaque white */
+    ak_vec3 base_velocity; /* added to every emitted velocity (a moving emitter), m/s */
+    float rate;            /* particles per second for ak_particles_emit; 0 = none */
+    double carry;          /* fraction carried between calls; written by ak_particles_emit
+                              (start at 0) */
     /* MESH: positions and triangle indices (world space, e.g. the skinned pose of this frame),
      * and scratch for the area table: mesh_area_cdf.count >= triangle count. */
     ak_vec3_cspan mesh_positions;
@@ -195,8 +197,8 @@ typedef struct ak_particle_emitter {
 AK_API ak_result ak_particles_emit(ak_particles* particles, ak_particle_emitter* emitter, float dt,
                                    uint32_t* out_emitted);
 /* Emit count particles at once (rate and carry are not used). Same codes as emit. */
-AK_API ak_result ak_particles_burst(ak_particles* particles, const ak_particle_emitter* emitter, uint32_t count,
-                                    uint32_t* out_emitted);
+AK_API ak_result ak_particles_burst(ak_particles* particles, const ak_particle_emitter* emitter,
+                                    uint32_t count, uint32_t* out_emitted);
 
 /* ---- forces ------------------------------------------------------------------------- */
 
@@ -221,10 +223,10 @@ typedef struct ak_particle_vortex {
  * F_i = (k (|p_j - p_i| - rest) + damping ((v_j - v_i) . u)) u, F_j = -F_i. Coincident
  * endpoints feel no force. */
 typedef struct ak_particle_spring {
-    uint32_t i, j;  /* particle indices (see the note on indices above) */
-    float rest;     /* metres */
-    float k;        /* N/m */
-    float damping;  /* N s/m */
+    uint32_t i, j; /* particle indices (see the note on indices above) */
+    float rest;    /* metres */
+    float k;       /* N/m */
+    float damping; /* N s/m */
 } ak_particle_spring;
 
 /* Lennard-Jones between every pair closer than cutoff: V(r) = 4 epsilon ((sigma/r)^12 -
@@ -238,8 +240,9 @@ typedef struct ak_particle_lennard_jones {
 
 /* Caller forces: add newtons to force[0 .. count) for the given state (which may be an
  * intermediate RK4/Verlet stage). Called on the calling thread. */
-typedef void (*ak_particle_force_fn)(const ak_vec3* position, const ak_vec3* velocity, const float* inv_mass,
-                                     size_t count, double time, ak_vec3* force, void* user);
+typedef void (*ak_particle_force_fn)(const ak_vec3* position, const ak_vec3* velocity,
+                                     const float* inv_mass, size_t count, double time,
+                                     ak_vec3* force, void* user);
 
 /* ---- colliders ---------------------------------------------------------------------- */
 
@@ -249,8 +252,8 @@ typedef void (*ak_particle_force_fn)(const ak_vec3* position, const ak_vec3* vel
 
 /* The half-space n . x >= d is free space (n normalised here). */
 typedef struct ak_particle_plane {
-    ak_vec3 normal; /* zero -> +Y */
-    float d;        /* metres: offset along normal */
+    ak_vec3 normal;    /* zero -> +Y */
+    float d;           /* metres: offset along normal */
     float restitution; /* [0, 1] */
     float friction;    /* Coulomb coefficient, >= 0 */
 } ak_particle_plane;
@@ -289,30 +292,52 @@ typedef struct ak_particle_mesh_desc {
 /* Copies the triangles and builds their grid. Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no
  * triangles), AK_ERR_BAD_ARG (indices.count not a multiple of 3), AK_ERR_BAD_INDEX,
  * AK_ERR_BAD_DATA (non-finite positions), AK_ERR_NO_MEMORY. */
-AK_API ak_result ak_particle_mesh_create(const ak_particle_mesh_desc* desc, const ak_allocator* alloc,
-                                         ak_particle_mesh** out_mesh);
+AK_API ak_result ak_particle_mesh_create(const ak_particle_mesh_desc* desc,
+                                         const ak_allocator* alloc, ak_particle_mesh** out_mesh);
 /* New vertex positions for the same triangles (positions.count >= the count at create),
  * reached `elapsed` seconds after the previous ones; elapsed 0 = a jump (velocities 0).
  * Rebuilds the grid without allocating. AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_ARG
  * (elapsed negative or not finite), AK_ERR_BAD_DATA (a non-finite position). */
-AK_API ak_result ak_particle_mesh_update(ak_particle_mesh* mesh, ak_vec3_cspan positions, float elapsed);
+AK_API ak_result ak_particle_mesh_update(ak_particle_mesh* mesh, ak_vec3_cspan positions,
+                                         float elapsed);
 /* NULL is a no-op. */
 AK_API void ak_particle_mesh_destroy(ak_particle_mesh* mesh);
 
-typedef struct ak_particle_plane_cspan { const ak_particle_plane* ptr; size_t count; } ak_particle_plane_cspan;
-typedef struct ak_particle_sphere_cspan { const ak_particle_sphere* ptr; size_t count; } ak_particle_sphere_cspan;
-typedef struct ak_particle_box_cspan { const ak_particle_box* ptr; size_t count; } ak_particle_box_cspan;
-typedef struct ak_particle_spring_cspan { const ak_particle_spring* ptr; size_t count; } ak_particle_spring_cspan;
-typedef struct ak_particle_attractor_cspan { const ak_particle_attractor* ptr; size_t count; } ak_particle_attractor_cspan;
-typedef struct ak_particle_vortex_cspan { const ak_particle_vortex* ptr; size_t count; } ak_particle_vortex_cspan;
-typedef struct ak_particle_mesh_cspan { const ak_particle_mesh* const* ptr; size_t count; } ak_particle_mesh_cspan;
+typedef struct ak_particle_plane_cspan {
+    const ak_particle_plane* ptr;
+    size_t count;
+} ak_particle_plane_cspan;
+typedef struct ak_particle_sphere_cspan {
+    const ak_particle_sphere* ptr;
+    size_t count;
+} ak_particle_sphere_cspan;
+typedef struct ak_particle_box_cspan {
+    const ak_particle_box* ptr;
+    size_t count;
+} ak_particle_box_cspan;
+typedef struct ak_particle_spring_cspan {
+    const ak_particle_spring* ptr;
+    size_t count;
+} ak_particle_spring_cspan;
+typedef struct ak_particle_attractor_cspan {
+    const ak_particle_attractor* ptr;
+    size_t count;
+} ak_particle_attractor_cspan;
+typedef struct ak_particle_vortex_cspan {
+    const ak_particle_vortex* ptr;
+    size_t count;
+} ak_particle_vortex_cspan;
+typedef struct ak_particle_mesh_cspan {
+    const ak_particle_mesh* const* ptr;
+    size_t count;
+} ak_particle_mesh_cspan;
 
 /* Everything acting on the particles during a step. Zero = nothing (no gravity, still air). */
 typedef struct ak_particles_world {
-    ak_vec3 gravity;        /* m/s^2, an acceleration (acts on every unpinned particle) */
-    float drag_linear;      /* N s/m: F = -drag_linear (v - wind) */
-    float drag_quadratic;   /* N s^2/m^2: F = -drag_quadratic |v - wind| (v - wind) */
-    ak_vec3 wind;           /* m/s: velocity of the air the drag pulls towards */
+    ak_vec3 gravity;      /* m/s^2, an acceleration (acts on every unpinned particle) */
+    float drag_linear;    /* N s/m: F = -drag_linear (v - wind) */
+    float drag_quadratic; /* N s^2/m^2: F = -drag_quadratic |v - wind| (v - wind) */
+    ak_vec3 wind;         /* m/s: velocity of the air the drag pulls towards */
     ak_particle_attractor_cspan attractors;
     ak_particle_vortex_cspan vortices;
     ak_particle_spring_cspan springs;
@@ -332,7 +357,8 @@ typedef struct ak_particles_world {
  * index >= count), AK_ERR_BAD_DATA (non-finite world values). On error nothing changes.
  * A particle whose state becomes non-finite (e.g. an exploding stiff spring) is removed at
  * the end of the step rather than poisoning the output. */
-AK_API ak_result ak_particles_step(ak_particles* particles, const ak_particles_world* world, float dt);
+AK_API ak_result ak_particles_step(ak_particles* particles, const ak_particles_world* world,
+                                   float dt);
 
 #ifdef __cplusplus
 }

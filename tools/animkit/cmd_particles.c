@@ -9,7 +9,8 @@
 #include "scene_particles.h"
 
 static const char* const usage =
-    "usage: animkit particles [SCENE.json | --preset fountain|rain|fireworks|character] [--steps N]\n"
+    "usage: animkit particles [SCENE.json | --preset fountain|rain|fireworks|character] [--steps "
+    "N]\n"
     "                         [--dt DT] [--integrator euler|symplectic|verlet|rk4] [--seed K]\n"
     "                         [--threads T] [--json OUT.json] [-o OUT.gif|OUT.png] [--size WxH]\n"
     "Simulate a particle system (docs/particles.md describes the scene format).\n"
@@ -20,7 +21,8 @@ static const char* const usage =
     "  --integrator overrides the file (default symplectic)\n"
     "  --seed       seed of the emitters' random numbers (default 1)\n"
     "  --threads    threads for the step (default 1; results are identical for any count)\n"
-    "  --json       write {\"time\", \"steps\", \"particles\": [{\"p\", \"v\"}]} after the last step,\n"
+    "  --json       write {\"time\", \"steps\", \"particles\": [{\"p\", \"v\"}]} after the last "
+    "step,\n"
     "               the file's particles first, emitted ones after them\n"
     "  -o           render: a GIF of the run (up to 100 frames) or a PNG of the last step\n"
     "  --size       image size (default 480x360)\n";
@@ -28,8 +30,15 @@ static const char* const usage =
 /* ---- presets -------------------------------------------------------------------------- */
 
 static ak_particle_emitter emitter_base(void) {
-    ak_particle_emitter e = {.direction = {0, 1, 0}, .cone_angle = 0.3f, .speed_min = 1, .speed_max = 2,
-                             .lifetime_min = 1, .lifetime_max = 2, .size_min = 0.03f, .size_max = 0.03f, .mass = 1};
+    ak_particle_emitter e = {.direction = {0, 1, 0},
+                             .cone_angle = 0.3f,
+                             .speed_min = 1,
+                             .speed_max = 2,
+                             .lifetime_min = 1,
+                             .lifetime_max = 2,
+                             .size_min = 0.03f,
+                             .size_max = 0.03f,
+                             .mass = 1};
     return e;
 }
 
@@ -55,46 +64,57 @@ static bool preset_scene(const char* name, particles_scene* s) {
         e.colour = ak_vec4_make(0.25f, 0.55f, 1.0f, 1), e.rate = 1500.0f;
         s->emitters[0] = e;
         s->emitter_count = 1;
-        s->spheres[0] = (ak_particle_sphere){.center = {0.45f, 0.35f, 0}, .radius = 0.35f, .restitution = 0.3f, .friction = 0.2f};
+        s->spheres[0] = (ak_particle_sphere){
+            .center = {0.45f, 0.35f, 0}, .radius = 0.35f, .restitution = 0.3f, .friction = 0.2f};
         s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
         s->world.drag_linear = 0.02f;
     } else if (strcmp(name, "rain") == 0) {
-        e.shape = AK_EMITTER_BOX, e.center = ak_vec3_make(0, 4, 0), e.half_extents = ak_vec3_make(2, 0.1f, 2);
-        e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f, e.speed_min = 3, e.speed_max = 4;
+        e.shape = AK_EMITTER_BOX, e.center = ak_vec3_make(0, 4, 0),
+        e.half_extents = ak_vec3_make(2, 0.1f, 2);
+        e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f, e.speed_min = 3,
+        e.speed_max = 4;
         e.lifetime_min = 2.5f, e.lifetime_max = 3.0f, e.size_min = 0.015f, e.size_max = 0.02f;
         e.colour = ak_vec4_make(0.55f, 0.7f, 1.0f, 1), e.rate = 3000.0f;
         s->emitters[0] = e;
         s->emitter_count = 1;
-        s->spheres[0] = (ak_particle_sphere){.center = {0, 1.2f, 0}, .radius = 0.8f, .restitution = 0.2f, .friction = 0.1f};
+        s->spheres[0] = (ak_particle_sphere){
+            .center = {0, 1.2f, 0}, .radius = 0.8f, .restitution = 0.2f, .friction = 0.1f};
         s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
         s->world.wind = ak_vec3_make(1.5f, 0, 0);
         s->world.drag_linear = 0.3f;
         s->planes[0].restitution = 0.1f;
     } else if (strcmp(name, "fireworks") == 0) {
-        const ak_vec4 colours[4] = {{1, 0.3f, 0.2f, 1}, {0.3f, 1, 0.4f, 1}, {1, 0.85f, 0.3f, 1}, {0.6f, 0.5f, 1, 1}};
+        const ak_vec4 colours[4] = {
+            {1, 0.3f, 0.2f, 1}, {0.3f, 1, 0.4f, 1}, {1, 0.85f, 0.3f, 1}, {0.6f, 0.5f, 1, 1}};
         const float x[4] = {-1.2f, 0.9f, 0.0f, 1.6f}, y[4] = {3.0f, 3.6f, 4.2f, 2.8f};
         for (int k = 0; k < 4; ++k) {
             ak_particle_emitter f = emitter_base();
-            f.shape = AK_EMITTER_SPHERE, f.center = ak_vec3_make(x[k], y[k], -0.5f * k), f.radius = 0.05f;
-            f.cone_angle = AK_PI, f.speed_min = 2.5f, f.speed_max = 3.2f, f.lifetime_min = 1.2f, f.lifetime_max = 1.8f;
+            f.shape = AK_EMITTER_SPHERE, f.center = ak_vec3_make(x[k], y[k], -0.5f * k),
+            f.radius = 0.05f;
+            f.cone_angle = AK_PI, f.speed_min = 2.5f, f.speed_max = 3.2f, f.lifetime_min = 1.2f,
+            f.lifetime_max = 1.8f;
             f.colour = colours[k];
             s->emitters[k] = f;
-            s->bursts[k] = (particles_burst){.count = 800, .start = 0.45f * (float)k, .interval = 1.8f};
+            s->bursts[k] =
+                (particles_burst){.count = 800, .start = 0.45f * (float)k, .interval = 1.8f};
         }
         s->emitter_count = 4;
         s->world.drag_quadratic = 0.02f;
         s->world.gravity = ak_vec3_make(0, -3.0f, 0);
     } else if (strcmp(name, "character") == 0) {
         /* Rain on the character (collides with its posed mesh) and sparks from its surface. */
-        e.shape = AK_EMITTER_BOX, e.center = ak_vec3_make(0, 2.6f, 0), e.half_extents = ak_vec3_make(0.7f, 0.05f, 0.7f);
-        e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f, e.speed_min = 2, e.speed_max = 2.5f;
+        e.shape = AK_EMITTER_BOX, e.center = ak_vec3_make(0, 2.6f, 0),
+        e.half_extents = ak_vec3_make(0.7f, 0.05f, 0.7f);
+        e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f, e.speed_min = 2,
+        e.speed_max = 2.5f;
         e.lifetime_min = 2, e.lifetime_max = 2.5f, e.size_min = 0.012f, e.size_max = 0.016f;
         e.colour = ak_vec4_make(0.45f, 0.65f, 1.0f, 1), e.rate = 2500.0f;
         s->emitters[0] = e;
         ak_particle_emitter sp = emitter_base();
         sp.shape = AK_EMITTER_MESH, sp.cone_angle = 0.5f, sp.speed_min = 0.3f, sp.speed_max = 0.8f;
         sp.lifetime_min = 0.6f, sp.lifetime_max = 1.0f, sp.size_min = 0.01f, sp.size_max = 0.015f;
-        sp.colour = ak_vec4_make(1.0f, 0.55f, 0.15f, 1), sp.rate = 800.0f, sp.base_velocity = ak_vec3_make(0, 0.5f, 0);
+        sp.colour = ak_vec4_make(1.0f, 0.55f, 0.15f, 1), sp.rate = 800.0f,
+        sp.base_velocity = ak_vec3_make(0, 0.5f, 0);
         s->emitters[1] = sp;
         s->emitter_count = 2;
         s->planes[0].restitution = 0.2f;
@@ -141,19 +161,25 @@ static int character_init(character* c, int* rc) {
     c->positions = calloc(c->vertex_count + 1, sizeof(ak_vec3));
     c->indices = calloc(c->index_count + 1, sizeof(uint32_t));
     c->cdf = calloc(c->index_count / 3 + 1, sizeof(float));
-    if (!c->positions || !c->indices || !c->cdf) return *rc = cli_fail("particles", "out of memory");
+    if (!c->positions || !c->indices || !c->cdf)
+        return *rc = cli_fail("particles", "out of memory");
     size_t v = 0, k = 0;
     for (size_t m = 0; m < c->scene->mesh_count; ++m) {
         const ak_mesh* mesh = c->scene->meshes[m].mesh;
         if (!mesh) continue;
-        for (size_t i = 0; i < 3 * mesh->triangle_count; ++i) c->indices[k++] = (uint32_t)(mesh->indices[i] + v);
+        for (size_t i = 0; i < 3 * mesh->triangle_count; ++i)
+            c->indices[k++] = (uint32_t)(mesh->indices[i] + v);
         v += mesh->vertex_count;
     }
-    if (cli_poser_pose(&c->poser, 0, 0.0f, false, CLI_LBS) != AK_OK) return *rc = cli_fail("particles", "cannot pose the character");
+    if (cli_poser_pose(&c->poser, 0, 0.0f, false, CLI_LBS) != AK_OK)
+        return *rc = cli_fail("particles", "cannot pose the character");
     character_gather(c);
-    ak_particle_mesh_desc md = {.positions = {c->positions, c->vertex_count}, .indices = {c->indices, c->index_count},
-                                .restitution = 0.2f, .friction = 0.3f};
-    if (ak_particle_mesh_create(&md, NULL, &c->collider) != AK_OK) return *rc = cli_fail("particles", "cannot build the character collider");
+    ak_particle_mesh_desc md = {.positions = {c->positions, c->vertex_count},
+                                .indices = {c->indices, c->index_count},
+                                .restitution = 0.2f,
+                                .friction = 0.3f};
+    if (ak_particle_mesh_create(&md, NULL, &c->collider) != AK_OK)
+        return *rc = cli_fail("particles", "cannot build the character collider");
     return *rc = CLI_OK;
 }
 
@@ -162,7 +188,8 @@ static ak_result character_pose(character* c, float t, float elapsed) {
     ak_result r = cli_poser_pose(&c->poser, 0, t, false, CLI_LBS);
     if (r != AK_OK) return r;
     character_gather(c);
-    return ak_particle_mesh_update(c->collider, (ak_vec3_cspan){c->positions, c->vertex_count}, elapsed);
+    return ak_particle_mesh_update(c->collider, (ak_vec3_cspan){c->positions, c->vertex_count},
+                                   elapsed);
 }
 
 static void character_free(character* c) {
@@ -189,12 +216,17 @@ static int run_init(run* r, particles_scene* s, character* ch, uint64_t seed, ui
     memset(r, 0, sizeof *r);
     r->scene = s;
     r->ch = ch;
-    ak_particles_desc d = {.capacity = s->capacity, .integrator = s->integrator, .seed = seed, .thread_count = threads};
+    ak_particles_desc d = {.capacity = s->capacity,
+                           .integrator = s->integrator,
+                           .seed = seed,
+                           .thread_count = threads};
     ak_result res = ak_particles_create(&d, NULL, &r->ps);
-    if (res != AK_OK) return cli_fail("particles", "cannot create the system: %s", ak_result_string(res));
+    if (res != AK_OK)
+        return cli_fail("particles", "cannot create the system: %s", ak_result_string(res));
     for (size_t i = 0; i < s->particle_count; ++i) {
         res = ak_particles_add(r->ps, &s->particles[i], NULL);
-        if (res != AK_OK) return cli_fail("particles", "particle %zu: %s", i, ak_result_string(res));
+        if (res != AK_OK)
+            return cli_fail("particles", "particle %zu: %s", i, ak_result_string(res));
     }
     r->fired = calloc(s->emitter_count + 1, sizeof(uint32_t));
     if (!r->fired) return cli_fail("particles", "out of memory");
@@ -283,10 +315,13 @@ static bool shapes_build(shapes* sh, const particles_scene* s) {
                 size_t base = sh->vcount;
                 for (int c = 0; c < 4; ++c) {
                     float u = (c == 1 || c == 2) ? 1.0f : 0.0f, v = (c >= 2) ? 1.0f : 0.0f;
-                    float f[3], lo[3] = {b->min.x, b->min.y, b->min.z}, hi[3] = {b->max.x, b->max.y, b->max.z};
+                    float f[3], lo[3] = {b->min.x, b->min.y, b->min.z},
+                                hi[3] = {b->max.x, b->max.y, b->max.z};
                     f[axis] = side ? hi[axis] : lo[axis];
-                    f[(axis + 1) % 3] = lo[(axis + 1) % 3] + u * (hi[(axis + 1) % 3] - lo[(axis + 1) % 3]);
-                    f[(axis + 2) % 3] = lo[(axis + 2) % 3] + v * (hi[(axis + 2) % 3] - lo[(axis + 2) % 3]);
+                    f[(axis + 1) % 3] =
+                        lo[(axis + 1) % 3] + u * (hi[(axis + 1) % 3] - lo[(axis + 1) % 3]);
+                    f[(axis + 2) % 3] =
+                        lo[(axis + 2) % 3] + v * (hi[(axis + 2) % 3] - lo[(axis + 2) % 3]);
                     float n[3] = {0, 0, 0};
                     n[axis] = side ? 1.0f : -1.0f;
                     sh->pos[sh->vcount] = ak_vec3_make(f[0], f[1], f[2]);
@@ -324,24 +359,31 @@ typedef struct renderer {
 static int render_frame(renderer* rd, run* r, const ak_image* out) {
     cli_frame* f = &rd->frame;
     ak_raster* ras = f->raster;
-    ak_raster_clear(ras, ak_vec4_make(0.83f, 0.87f, 0.93f, 1), ak_vec4_make(0.48f, 0.51f, 0.58f, 1));
+    ak_raster_clear(ras, ak_vec4_make(0.83f, 0.87f, 0.93f, 1),
+                    ak_vec4_make(0.48f, 0.51f, 0.58f, 1));
     ak_raster_mesh meshes[2];
     size_t mc = 0;
     if (rd->sh.icount)
-        meshes[mc++] = (ak_raster_mesh){.positions = {rd->sh.pos, rd->sh.vcount}, .normals = {rd->sh.nrm, rd->sh.vcount},
+        meshes[mc++] = (ak_raster_mesh){.positions = {rd->sh.pos, rd->sh.vcount},
+                                        .normals = {rd->sh.nrm, rd->sh.vcount},
                                         .indices = {rd->sh.idx, rd->sh.icount},
                                         .material = {.color = {0.75f, 0.72f, 0.68f, 1}}};
     if (r->ch)
         meshes[mc++] = (ak_raster_mesh){.positions = {r->ch->positions, r->ch->vertex_count},
                                         .indices = {r->ch->indices, r->ch->index_count},
-                                        .material = {.color = {0.80f, 0.74f, 0.68f, 1}}, .shading = AK_SHADING_FLAT};
+                                        .material = {.color = {0.80f, 0.74f, 0.68f, 1}},
+                                        .shading = AK_SHADING_FLAT};
     ak_vec3 size = ak_vec3_sub(f->bmax, f->bmin);
     float extent = ak_maxf(ak_maxf(1.3f * ak_maxf(size.x, size.z), 0.9f * size.y), 1e-3f);
-    ak_raster_ground g = {.height = rd->ground, .center = ak_vec3_scale(ak_vec3_add(f->bmin, f->bmax), 0.5f),
-                          .half_extent = extent, .grid_spacing = powf(10.0f, floorf(log10f(extent / 4.0f))),
-                          .casters = meshes, .caster_count = mc};
+    ak_raster_ground g = {.height = rd->ground,
+                          .center = ak_vec3_scale(ak_vec3_add(f->bmin, f->bmax), 0.5f),
+                          .half_extent = extent,
+                          .grid_spacing = powf(10.0f, floorf(log10f(extent / 4.0f))),
+                          .casters = meshes,
+                          .caster_count = mc};
     ak_result res = ak_raster_draw_ground(ras, &f->camera, &g);
-    for (size_t m = 0; res == AK_OK && m < mc; ++m) res = ak_raster_draw_mesh(ras, &f->camera, &meshes[m]);
+    for (size_t m = 0; res == AK_OK && m < mc; ++m)
+        res = ak_raster_draw_mesh(ras, &f->camera, &meshes[m]);
     ak_particles_state st = ak_particles_get_state(r->ps);
     if (res == AK_OK && st.count) {
         /* sRGB-ish colours fading with age; radius from the mean size at the view distance. */
@@ -357,15 +399,21 @@ static int render_frame(renderer* rd, run* r, const ak_image* out) {
         ak_vec3 a, b;
         float px = 2.0f;
         if (ak_raster_camera_project(&f->camera, f->width, f->height, centre, &a) &&
-            ak_raster_camera_project(&f->camera, f->width, f->height, ak_vec3_add(centre, ak_vec3_make(0, (float)mean, 0)), &b))
+            ak_raster_camera_project(&f->camera, f->width, f->height,
+                                     ak_vec3_add(centre, ak_vec3_make(0, (float)mean, 0)), &b))
             px = fabsf(a.y - b.y);
-        ak_raster_points pts = {.positions = {st.position, st.count}, .colors = {rd->colours, st.count},
-                                .radius = ak_clampf(px, 1.0f, 12.0f), .outline = px > 3.0f ? 1.0f : 0.0f};
+        ak_raster_points pts = {.positions = {st.position, st.count},
+                                .colors = {rd->colours, st.count},
+                                .radius = ak_clampf(px, 1.0f, 12.0f),
+                                .outline = px > 3.0f ? 1.0f : 0.0f};
         res = ak_raster_draw_points(ras, &f->camera, &pts);
     }
     char title[160];
-    snprintf(title, sizeof title, "%s  t=%.2fs  %zu particles", rd->title, ak_particles_time(r->ps), st.count);
-    if (res == AK_OK) res = ak_raster_draw_text(ras, 10, 10, title, f->height >= 300 ? 2 : 1, ak_vec4_make(0.08f, 0.09f, 0.12f, 1));
+    snprintf(title, sizeof title, "%s  t=%.2fs  %zu particles", rd->title, ak_particles_time(r->ps),
+             st.count);
+    if (res == AK_OK)
+        res = ak_raster_draw_text(ras, 10, 10, title, f->height >= 300 ? 2 : 1,
+                                  ak_vec4_make(0.08f, 0.09f, 0.12f, 1));
     if (res == AK_OK) res = ak_raster_resolve(ras, out);
     return res == AK_OK ? CLI_OK : cli_fail("particles", "render: %s", ak_result_string(res));
 }
@@ -379,8 +427,8 @@ static int write_json(const char* path, run* r, int steps) {
     fprintf(f, "{\"time\": %.9g, \"steps\": %d, \"particles\": [", ak_particles_time(r->ps), steps);
     for (size_t i = 0; i < st.count; ++i) {
         ak_vec3 p = st.position[i], v = st.velocity[i];
-        fprintf(f, "%s\n  {\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g]}", i ? "," : "", (double)p.x,
-                (double)p.y, (double)p.z, (double)v.x, (double)v.y, (double)v.z);
+        fprintf(f, "%s\n  {\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g]}", i ? "," : "",
+                (double)p.x, (double)p.y, (double)p.z, (double)v.x, (double)v.y, (double)v.z);
     }
     fprintf(f, "%s]}\n", st.count ? "\n" : "");
     if (fclose(f) != 0) return cli_fail("particles", "%s: write failed", path);
@@ -389,9 +437,9 @@ static int write_json(const char* path, run* r, int steps) {
 
 int cmd_particles(int argc, char** argv) {
     static const cli_opt opts[] = {
-        {"--preset", NULL, true}, {"--steps", NULL, true}, {"--dt", NULL, true},      {"--integrator", NULL, true},
-        {"--seed", NULL, true},   {"--threads", NULL, true}, {"--json", NULL, true}, {"--output", "-o", true},
-        {"--size", NULL, true},
+        {"--preset", NULL, true},     {"--steps", NULL, true},  {"--dt", NULL, true},
+        {"--integrator", NULL, true}, {"--seed", NULL, true},   {"--threads", NULL, true},
+        {"--json", NULL, true},       {"--output", "-o", true}, {"--size", NULL, true},
     };
     cli_args a;
     int rc = cli_parse("particles", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
@@ -401,33 +449,47 @@ int cmd_particles(int argc, char** argv) {
         return CLI_OK;
     }
     const char* preset = CLI_GET(&a, "--preset");
-    if ((a.pos_count == 1) == (preset != NULL)) return cli_usage("particles", "give either SCENE.json or --preset NAME");
+    if ((a.pos_count == 1) == (preset != NULL))
+        return cli_usage("particles", "give either SCENE.json or --preset NAME");
     if (a.pos_count > 1) return cli_usage("particles", "expected one SCENE.json");
-    if (preset && strcmp(preset, "fountain") && strcmp(preset, "rain") && strcmp(preset, "fireworks") &&
-        strcmp(preset, "character"))
-        return cli_usage("particles", "--preset must be fountain, rain, fireworks or character, not '%s'", preset);
+    if (preset && strcmp(preset, "fountain") && strcmp(preset, "rain") &&
+        strcmp(preset, "fireworks") && strcmp(preset, "character"))
+        return cli_usage("particles",
+                         "--preset must be fountain, rain, fireworks or character, not '%s'",
+                         preset);
     long steps = 200, seed = 1, threads = 1;
     if (CLI_GET(&a, "--steps") && !cli_parse_int(CLI_GET(&a, "--steps"), 0, 100000000, &steps))
-        return cli_usage("particles", "--steps '%s' is not a whole number >= 0", CLI_GET(&a, "--steps"));
+        return cli_usage("particles", "--steps '%s' is not a whole number >= 0",
+                         CLI_GET(&a, "--steps"));
     if (CLI_GET(&a, "--seed") && !cli_parse_int(CLI_GET(&a, "--seed"), 0, 2147483647L, &seed))
-        return cli_usage("particles", "--seed '%s' is not a whole number >= 0", CLI_GET(&a, "--seed"));
+        return cli_usage("particles", "--seed '%s' is not a whole number >= 0",
+                         CLI_GET(&a, "--seed"));
     if (CLI_GET(&a, "--threads") && !cli_parse_int(CLI_GET(&a, "--threads"), 1, 64, &threads))
-        return cli_usage("particles", "--threads '%s' is not a whole number in 1..64", CLI_GET(&a, "--threads"));
+        return cli_usage("particles", "--threads '%s' is not a whole number in 1..64",
+                         CLI_GET(&a, "--threads"));
     float dt = 0.0f;
-    if (CLI_GET(&a, "--dt") && (!cli_parse_float(CLI_GET(&a, "--dt"), &dt) || !(dt > 0.0f) || dt > 10.0f))
+    if (CLI_GET(&a, "--dt") &&
+        (!cli_parse_float(CLI_GET(&a, "--dt"), &dt) || !(dt > 0.0f) || dt > 10.0f))
         return cli_usage("particles", "--dt '%s' is not a number in (0, 10]", CLI_GET(&a, "--dt"));
     ak_particles_integrator integ = AK_INTEGRATOR_DEFAULT;
     const char* in = CLI_GET(&a, "--integrator");
     if (in) {
-        if (!strcmp(in, "euler")) integ = AK_INTEGRATOR_EULER;
-        else if (!strcmp(in, "symplectic")) integ = AK_INTEGRATOR_SYMPLECTIC;
-        else if (!strcmp(in, "verlet")) integ = AK_INTEGRATOR_VERLET;
-        else if (!strcmp(in, "rk4")) integ = AK_INTEGRATOR_RK4;
-        else return cli_usage("particles", "--integrator must be euler, symplectic, verlet or rk4, not '%s'", in);
+        if (!strcmp(in, "euler"))
+            integ = AK_INTEGRATOR_EULER;
+        else if (!strcmp(in, "symplectic"))
+            integ = AK_INTEGRATOR_SYMPLECTIC;
+        else if (!strcmp(in, "verlet"))
+            integ = AK_INTEGRATOR_VERLET;
+        else if (!strcmp(in, "rk4"))
+            integ = AK_INTEGRATOR_RK4;
+        else
+            return cli_usage("particles",
+                             "--integrator must be euler, symplectic, verlet or rk4, not '%s'", in);
     }
     const char* out = CLI_GET(&a, "--output");
     bool gif = out && cli_has_ext(out, ".gif");
-    if (out && !gif && !cli_has_ext(out, ".png")) return cli_usage("particles", "output '%s' must end in .gif or .png", out);
+    if (out && !gif && !cli_has_ext(out, ".png"))
+        return cli_usage("particles", "output '%s' must end in .gif or .png", out);
     int width = 480, height = 360;
     if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &width, &height))
         return cli_usage("particles", "--size '%s' is not WxH", CLI_GET(&a, "--size"));
@@ -478,7 +540,8 @@ int cmd_particles(int argc, char** argv) {
     const long every = gif && frames > 0 ? (steps + frames - 1) / frames : steps;
     if (out) {
         /* A dry run finds the bounds for a camera fixed over the whole animation. */
-        if ((rc = run_init(&r, &scene, use_char ? &ch : NULL, (uint64_t)seed, (uint32_t)threads))) goto done;
+        if ((rc = run_init(&r, &scene, use_char ? &ch : NULL, (uint64_t)seed, (uint32_t)threads)))
+            goto done;
         ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
         for (size_t k = 0; k < scene.world.spheres.count; ++k) {
             const ak_particle_sphere* s = &scene.world.spheres.ptr[k];
@@ -489,14 +552,17 @@ int cmd_particles(int argc, char** argv) {
             bounds_add(&lo, &hi, scene.world.boxes.ptr[k].min);
             bounds_add(&lo, &hi, scene.world.boxes.ptr[k].max);
         }
-        for (size_t k = 0; k < scene.emitter_count; ++k) bounds_add(&lo, &hi, scene.emitters[k].center);
+        for (size_t k = 0; k < scene.emitter_count; ++k)
+            bounds_add(&lo, &hi, scene.emitters[k].center);
         for (long s = 0; s <= steps; ++s) {
             if (s > 0 && (rc = run_step(&r, (int)s - 1))) goto done;
             if (s % (every ? every : 1) && s != steps) continue;
             ak_particles_state st = ak_particles_get_state(r.ps);
-            for (size_t i = 0; i < st.count; i += 1 + st.count / 4000) bounds_add(&lo, &hi, st.position[i]);
+            for (size_t i = 0; i < st.count; i += 1 + st.count / 4000)
+                bounds_add(&lo, &hi, st.position[i]);
             if (use_char)
-                for (size_t v = 0; v < ch.vertex_count; v += 7) bounds_add(&lo, &hi, ch.positions[v]);
+                for (size_t v = 0; v < ch.vertex_count; v += 7)
+                    bounds_add(&lo, &hi, ch.positions[v]);
         }
         run_free(&r);
         memset(&r, 0, sizeof r);
@@ -504,13 +570,15 @@ int cmd_particles(int argc, char** argv) {
         rd.ground = lo.y;
         for (size_t k = 0; k < scene.world.planes.count; ++k) {
             ak_vec3 n = ak_vec3_normalize(scene.world.planes.ptr[k].normal);
-            if (n.y > 0.99f) rd.ground = scene.world.planes.ptr[k].d / n.y, lo.y = fminf(lo.y, rd.ground);
+            if (n.y > 0.99f)
+                rd.ground = scene.world.planes.ptr[k].d / n.y, lo.y = fminf(lo.y, rd.ground);
         }
         if (use_char && character_pose(&ch, 0.0f, 0.0f) != AK_OK) {
             rc = cli_fail("particles", "cannot pose the character");
             goto done;
         }
-        if (cli_frame_init(&rd.frame, NULL, width, height, lo, hi, 0.5f) || cli_image_alloc(&rd.image, width, height)) {
+        if (cli_frame_init(&rd.frame, NULL, width, height, lo, hi, 0.5f) ||
+            cli_image_alloc(&rd.image, width, height)) {
             rc = cli_fail("particles", "out of memory for a %dx%d image", width, height);
             goto done;
         }
@@ -522,7 +590,10 @@ int cmd_particles(int argc, char** argv) {
         }
         rd.title = preset ? preset : "particles";
         if (gif) {
-            ak_gif_desc gd = {.width = width, .height = height, .delay_cs = (int)fmaxf(2.0f, roundf(100.0f * scene.dt * (float)every))};
+            ak_gif_desc gd = {.width = width,
+                              .height = height,
+                              .delay_cs =
+                                  (int)fmaxf(2.0f, roundf(100.0f * scene.dt * (float)every))};
             ak_result res = ak_gif_writer_create(out, &gd, NULL, &gw);
             if (res != AK_OK) {
                 rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
@@ -530,7 +601,8 @@ int cmd_particles(int argc, char** argv) {
             }
         }
     }
-    if ((rc = run_init(&r, &scene, use_char ? &ch : NULL, (uint64_t)seed, (uint32_t)threads))) goto done;
+    if ((rc = run_init(&r, &scene, use_char ? &ch : NULL, (uint64_t)seed, (uint32_t)threads)))
+        goto done;
     for (long s = 0; s <= steps; ++s) {
         if (s > 0 && (rc = run_step(&r, (int)s - 1))) goto done;
         cli_progress("particles", (size_t)s, (size_t)steps);
@@ -552,7 +624,8 @@ int cmd_particles(int argc, char** argv) {
 done:
     if (gw) {
         ak_result res = ak_gif_writer_finish(gw);
-        if (rc == CLI_OK && res != AK_OK) rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
+        if (rc == CLI_OK && res != AK_OK)
+            rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
     }
     run_free(&r);
     if (rd.framed) cli_frame_free(&rd.frame);

@@ -11,13 +11,13 @@
 #define BIG 1e9f
 
 static const char* const integrator_names[] = {"euler", "symplectic", "verlet", "rk4", NULL};
-static const ak_particles_integrator integrator_values[] = {AK_INTEGRATOR_EULER, AK_INTEGRATOR_SYMPLECTIC,
-                                                            AK_INTEGRATOR_VERLET, AK_INTEGRATOR_RK4};
+static const ak_particles_integrator integrator_values[] = {
+    AK_INTEGRATOR_EULER, AK_INTEGRATOR_SYMPLECTIC, AK_INTEGRATOR_VERLET, AK_INTEGRATOR_RK4};
 static const char* const shape_names[] = {"point", "sphere", "sphere_surface", "disc", "box", NULL};
 
 /* An optional array member allocated with count elements of size each (NULL when absent). */
-static void* read_array(cli_json* j, const cJSON* root, const char* key, size_t size, size_t* out_count,
-                        const cJSON** out_first) {
+static void* read_array(cli_json* j, const cJSON* root, const char* key, size_t size,
+                        size_t* out_count, const cJSON** out_first) {
     *out_first = cli_json_array(j, root, "", key, PARTICLES_SCENE_MAX_ITEMS, out_count);
     if (j->failed || *out_count == 0) return NULL;
     void* p = calloc(*out_count, size);
@@ -26,7 +26,8 @@ static void* read_array(cli_json* j, const cJSON* root, const char* key, size_t 
 }
 
 /* Restitution and friction of a collider: defaults 0.5 and 0. */
-static void read_response(cli_json* j, const cJSON* o, const char* path, float* restitution, float* friction) {
+static void read_response(cli_json* j, const cJSON* o, const char* path, float* restitution,
+                          float* friction) {
     *restitution = 0.5f;
     *friction = 0.0f;
     cli_json_float(j, o, path, "restitution", 0.0f, 1.0f, restitution);
@@ -34,22 +35,26 @@ static void read_response(cli_json* j, const cJSON* o, const char* path, float* 
 }
 
 /* [min, max] with 0 <= min <= max. */
-static void read_range(cli_json* j, const cJSON* o, const char* path, const char* key, float* lo, float* hi) {
+static void read_range(cli_json* j, const cJSON* o, const char* path, const char* key, float* lo,
+                       float* hi) {
     float r[2] = {*lo, *hi};
     if (cli_json_floats(j, o, path, key, 2, 0.0f, BIG, r) && r[0] > r[1])
-        cli_json_fail(j, path, key, "the minimum %g is above the maximum %g", (double)r[0], (double)r[1]);
+        cli_json_fail(j, path, key, "the minimum %g is above the maximum %g", (double)r[0],
+                      (double)r[1]);
     *lo = r[0];
     *hi = r[1];
 }
 
 static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
-    static const char* const keys[] = {"dt", "integrator", "capacity", "gravity", "drag", "wind", "particles",
-                                       "springs", "planes", "spheres", "boxes", "attractors", "vortices",
-                                       "lennard_jones", "emitters", NULL};
+    static const char* const keys[] = {"dt",       "integrator",    "capacity",  "gravity",
+                                       "drag",     "wind",          "particles", "springs",
+                                       "planes",   "spheres",       "boxes",     "attractors",
+                                       "vortices", "lennard_jones", "emitters",  NULL};
     if (!cli_json_object(j, root, "", keys)) return;
     cli_json_float(j, root, "", "dt", 1e-7f, 10.0f, &s->dt);
     int integ = 1;
-    if (cli_json_enum(j, root, "", "integrator", integrator_names, &integ)) s->integrator = integrator_values[integ];
+    if (cli_json_enum(j, root, "", "integrator", integrator_names, &integ))
+        s->integrator = integrator_values[integ];
     ak_particles_world* w = &s->world;
     w->gravity = ak_vec3_make(0.0f, -9.81f, 0.0f);
     cli_json_vec3(j, root, "", "gravity", &w->gravity);
@@ -74,7 +79,8 @@ static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
     size_t n = 0;
     const cJSON* e = NULL;
 
-    s->particles = (ak_particle_init*)read_array(j, root, "particles", sizeof *s->particles, &n, &e);
+    s->particles =
+        (ak_particle_init*)read_array(j, root, "particles", sizeof *s->particles, &n, &e);
     s->particle_count = s->particles ? n : 0;
     for (size_t i = 0; i < s->particle_count && !j->failed; ++i, e = e->next) {
         static const char* const pk[] = {"p", "v", "m", "lifetime", "size", "colour", NULL};
@@ -101,7 +107,8 @@ static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
         long a = 0, b = 0;
         const long last = (long)s->particle_count - 1;
         cli_json_object(j, e, path, sk);
-        if (!cJSON_GetObjectItemCaseSensitive(e, "i") || !cJSON_GetObjectItemCaseSensitive(e, "j")) {
+        if (!cJSON_GetObjectItemCaseSensitive(e, "i") ||
+            !cJSON_GetObjectItemCaseSensitive(e, "j")) {
             cli_json_fail(j, path, NULL, "a spring needs both \"i\" and \"j\"");
             break;
         }
@@ -112,7 +119,8 @@ static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
         cli_json_int(j, e, path, "i", 0, last, &a);
         cli_json_int(j, e, path, "j", 0, last, &b);
         if (j->failed) break;
-        if (a == b) cli_json_fail(j, path, "j", "a spring needs two different particles (i = j = %ld)", a);
+        if (a == b)
+            cli_json_fail(j, path, "j", "a spring needs two different particles (i = j = %ld)", a);
         sp->i = (uint32_t)a;
         sp->j = (uint32_t)b;
         sp->rest = ak_vec3_distance(s->particles[a].position, s->particles[b].position);
@@ -131,7 +139,8 @@ static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
         pl->normal = ak_vec3_make(0, 1, 0);
         cli_json_object(j, e, path, k);
         cli_json_vec3(j, e, path, "n", &pl->normal);
-        if (!j->failed && !(ak_vec3_length_sq(pl->normal) > 1e-12f)) cli_json_fail(j, path, "n", "the normal is zero");
+        if (!j->failed && !(ak_vec3_length_sq(pl->normal) > 1e-12f))
+            cli_json_fail(j, path, "n", "the normal is zero");
         cli_json_float(j, e, path, "d", -BIG, BIG, &pl->d);
         read_response(j, e, path, &pl->restitution, &pl->friction);
     }
@@ -165,7 +174,8 @@ static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
         read_response(j, e, path, &b->restitution, &b->friction);
     }
 
-    s->attractors = (ak_particle_attractor*)read_array(j, root, "attractors", sizeof *s->attractors, &n, &e);
+    s->attractors =
+        (ak_particle_attractor*)read_array(j, root, "attractors", sizeof *s->attractors, &n, &e);
     w->attractors = (ak_particle_attractor_cspan){s->attractors, s->attractors ? n : 0};
     for (size_t i = 0; i < w->attractors.count && !j->failed; ++i, e = e->next) {
         static const char* const k[] = {"p", "strength", "softening", NULL};
@@ -195,16 +205,18 @@ static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
         cli_json_float(j, e, path, "softening", 0.0f, BIG, &v->softening);
     }
 
-    s->emitters = (ak_particle_emitter*)read_array(j, root, "emitters", sizeof *s->emitters, &n, &e);
+    s->emitters =
+        (ak_particle_emitter*)read_array(j, root, "emitters", sizeof *s->emitters, &n, &e);
     s->emitter_count = s->emitters ? n : 0;
     if (s->emitter_count) {
         s->bursts = (particles_burst*)calloc(s->emitter_count, sizeof *s->bursts);
         if (!s->bursts) cli_json_fail(j, "", "emitters", "out of memory");
     }
     for (size_t i = 0; i < s->emitter_count && !j->failed; ++i, e = e->next) {
-        static const char* const k[] = {"shape", "center", "radius", "half_extents", "direction", "cone_angle",
-                                        "speed", "lifetime", "size", "mass", "colour", "velocity", "rate",
-                                        "burst", "burst_start", "burst_interval", NULL};
+        static const char* const k[] = {
+            "shape", "center",   "radius",      "half_extents",   "direction", "cone_angle",
+            "speed", "lifetime", "size",        "mass",           "colour",    "velocity",
+            "rate",  "burst",    "burst_start", "burst_interval", NULL};
         cli_json_index(path, sizeof path, "emitters", i);
         ak_particle_emitter* em = &s->emitters[i];
         particles_burst* b = &s->bursts[i];
@@ -225,7 +237,8 @@ static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
         cli_json_vec3(j, e, path, "center", &em->center);
         cli_json_float(j, e, path, "radius", 0.0f, BIG, &em->radius);
         cli_json_vec3(j, e, path, "half_extents", &em->half_extents);
-        if (!j->failed && (em->half_extents.x < 0 || em->half_extents.y < 0 || em->half_extents.z < 0))
+        if (!j->failed &&
+            (em->half_extents.x < 0 || em->half_extents.y < 0 || em->half_extents.z < 0))
             cli_json_fail(j, path, "half_extents", "a negative extent");
         cli_json_vec3(j, e, path, "direction", &em->direction);
         cli_json_float(j, e, path, "cone_angle", 0.0f, AK_PI, &em->cone_angle);
@@ -248,14 +261,15 @@ static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
     if (!j->failed && cJSON_GetObjectItemCaseSensitive(root, "capacity")) {
         cli_json_int(j, root, "", "capacity", 1, PARTICLES_SCENE_MAX_CAPACITY, &cap);
         if (!j->failed && (size_t)cap < s->particle_count)
-            cli_json_fail(j, "", "capacity", "%ld is below the %zu particles listed", cap, s->particle_count);
+            cli_json_fail(j, "", "capacity", "%ld is below the %zu particles listed", cap,
+                          s->particle_count);
     }
     if (cap > (long)PARTICLES_SCENE_MAX_CAPACITY) cap = PARTICLES_SCENE_MAX_CAPACITY;
     s->capacity = (uint32_t)cap;
 }
 
-bool particles_scene_parse(const char* file, const char* text, size_t size, particles_scene* out, char* err,
-                           size_t err_size) {
+bool particles_scene_parse(const char* file, const char* text, size_t size, particles_scene* out,
+                           char* err, size_t err_size) {
     memset(out, 0, sizeof *out);
     out->dt = 0.01f;
     out->integrator = AK_INTEGRATOR_SYMPLECTIC;

@@ -40,8 +40,8 @@ typedef struct particles_scene {
 /* Parse text[0, size) from file (the name used in messages). Emitter shapes "mesh" are not
  * allowed in files. Returns true and fills *out, or false with one line "FILE: PATH: problem"
  * in err (err_size bytes) and *out empty. */
-bool particles_scene_parse(const char* file, const char* text, size_t size, particles_scene* out, char* err,
-                           size_t err_size);
+bool particles_scene_parse(const char* file, const char* text, size_t size, particles_scene* out,
+                           char* err, size_t err_size);
 /* Free the arrays (safe on an empty or failed scene). */
 void particles_scene_free(particles_scene* s);
 
