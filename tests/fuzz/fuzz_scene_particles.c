@@ -6,7 +6,7 @@
  *         tools/animkit/scene_particles.c tools/animkit/cli_json.c src/core.c src/math.c \
  *         src/math/[a-z]*.c src/grid.c src/particles.c -lcjson -lm -lpthread -o
  * fuzz_scene_particles
- *     ./fuzz_scene_particles -dict=tests/fuzz/particles.dict examples/particles_fountain.json
+ *     ./fuzz_scene_particles -dict=tests/fuzz/scene_particles.dict examples/particles_fountain.json
  *
  * Each input is parsed from memory; an accepted scene (capacity cut to 2000) is stepped three
  * times with every emitter firing, and every particle left must be finite. A rejected one must
