@@ -142,6 +142,10 @@ AK_TEST(presets_run_and_render) {
         AK_CHECK_EQ(ak_png_info(path, &w, &h), AK_OK);
         AK_CHECK(w == 96 && h == 72);
     }
+    AK_CHECK_EQ(run("particles --preset rain --steps 0 --size 64x48 -o zero.gif --json zero.json"), 0);
+    int zw = 0, zh = 0, zf = 0;
+    AK_CHECK_EQ(ak_gif_info("zero.gif", &zw, &zh, &zf), AK_OK);
+    AK_CHECK_EQ(zf, 1);
     AK_CHECK_EQ(run("particles --preset fireworks --steps 6 --size 64x48 -o fw.gif"), 0);
     int w = 0, h = 0, frames = 0;
     AK_CHECK_EQ(ak_gif_info("fw.gif", &w, &h, &frames), AK_OK);

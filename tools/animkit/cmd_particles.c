@@ -537,7 +537,7 @@ int cmd_particles(int argc, char** argv) {
     ak_gif_writer* gw = NULL;
     if (use_char && character_init(&ch, &rc)) goto done;
     const int frames = gif ? (int)(steps < 100 ? steps : 100) : 1;
-    const long every = gif && frames > 0 ? (steps + frames - 1) / frames : steps;
+    const long every = gif && frames > 0 ? (steps + frames - 1) / frames : (steps > 0 ? steps : 1);
     if (out) {
         /* A dry run finds the bounds for a camera fixed over the whole animation. */
         if ((rc = run_init(&r, &scene, use_char ? &ch : NULL, (uint64_t)seed, (uint32_t)threads)))
@@ -556,7 +556,7 @@ int cmd_particles(int argc, char** argv) {
             bounds_add(&lo, &hi, scene.emitters[k].center);
         for (long s = 0; s <= steps; ++s) {
             if (s > 0 && (rc = run_step(&r, (int)s - 1))) goto done;
-            if (s % (every ? every : 1) && s != steps) continue;
+            if (s % every && s != steps) continue;
             ak_particles_state st = ak_particles_get_state(r.ps);
             for (size_t i = 0; i < st.count; i += 1 + st.count / 4000)
                 bounds_add(&lo, &hi, st.position[i]);

@@ -35,7 +35,7 @@ typedef struct particles_scene {
 
 /* Limits a scene file may ask for (memory budget before allocating). */
 #define PARTICLES_SCENE_MAX_ITEMS 1000000u
-#define PARTICLES_SCENE_MAX_CAPACITY 10000000u
+#define PARTICLES_SCENE_MAX_CAPACITY 2000000u /* about 0.5 GB of system state */
 
 /* Parse text[0, size) from file (the name used in messages). Emitter shapes "mesh" are not
  * allowed in files. Returns true and fills *out, or false with one line "FILE: PATH: problem"
