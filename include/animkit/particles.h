@@ -26,6 +26,9 @@
  *               trajectories (not symplectic: slowly loses energy on oscillators).
  * Collisions run after the integration of each step on the segment from the old to the new
  * position, so a plane or sphere cannot be tunnelled through within a step.
+ * The semi-implicit step of a world with only gravity, drag, wind and planes (the common
+ * effects case) runs fused SIMD blocks (AVX2 when the CPU has it, else SSE2; scalar with
+ * AK_NO_SIMD) that round exactly as the scalar path does.
  *
  * Dead particles (age >= lifetime) are removed at the end of the step that kills them by a
  * stable compaction: survivors keep their relative order, so the indices of particles after
