@@ -21,6 +21,7 @@ static const command commands[] = {
     {"ik", cmd_ik, "solve inverse kinematics for a joint chain"},
     {"noise", cmd_noise, "evaluate Perlin, simplex, value or Worley noise (or a fractal sum) at a point"},
     {"terrain", cmd_terrain, "generate a fractal terrain: OBJ, 16-bit PNG heightmap, render or GIF flight"},
+    {"particles", cmd_particles, "simulate a particle system (scene file or preset) to JSON, PNG or GIF"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 
