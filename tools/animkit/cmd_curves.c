@@ -118,7 +118,7 @@ int cmd_curves(int argc, char** argv) {
     const char* joint = CLI_GET(&a, "--joint");
     int jidx = -1;
     if (ci < 0) {
-        rc = cli_fail("curves", "%s: no clip '%s' (%zu clips)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count);
+        rc = cli_fail("curves", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count, cli_plural(s->clip_count));
         goto done;
     }
     if (joint && (jidx = s->skeleton ? ak_skeleton_find_joint(s->skeleton, joint) : -1) < 0) {

@@ -103,7 +103,8 @@ int cmd_weights(int argc, char** argv) {
     float* weights = NULL;
     ak_skin_bone* bones = NULL;
     if ((size_t)mesh_index >= s->mesh_count) {
-        rc = cli_fail("weights", "%s: no mesh %ld (%zu meshes)", a.pos[0], mesh_index, s->mesh_count);
+        rc = cli_fail("weights", "%s: no mesh %ld (%zu mesh%s)", a.pos[0], mesh_index, s->mesh_count,
+                      s->mesh_count == 1 ? "" : "es");
         goto done;
     }
     const ak_scene_mesh* sm = &s->meshes[mesh_index];

@@ -9,12 +9,14 @@
 
 static ak_vec4 rgba(float r, float g, float b, float a) { return ak_vec4_make(r, g, b, a); }
 
-void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi) {
+void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi) { cli_bounds_add_visible(p, NULL, lo, hi); }
+
+void cli_bounds_add_visible(const cli_poser* p, const bool* hidden, ak_vec3* lo, ak_vec3* hi) {
     const ak_scene* s = p->scene;
     bool any = false;
     for (size_t m = 0; m < s->mesh_count; ++m) {
         const ak_mesh* mesh = s->meshes[m].mesh;
-        if (!mesh || mesh->vertex_count == 0) continue;
+        if (!mesh || mesh->vertex_count == 0 || (hidden && hidden[m])) continue;
         ak_vec3 a, b;
         ak_points_bounds((ak_vec3_cspan){p->positions[m], mesh->vertex_count}, &a, &b);
         *lo = ak_vec3_min(*lo, a);
@@ -32,7 +34,35 @@ void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi) {
     }
 }
 
+void cli_frame_aim(cli_frame* f, ak_vec3 lo, ak_vec3 hi, const cli_camera* cam) {
+    cli_camera c = cam ? *cam : (cli_camera){0};
+    if (!c.has_angles) {
+        c.yaw = ak_degrees(0.55f);
+        c.pitch = ak_degrees(0.22f);
+    }
+    float fovy = c.fov > 0.0f && c.fov < 170.0f ? ak_radians(c.fov) : ak_radians(40.0f);
+    float az = ak_radians(c.yaw), el = ak_radians(ak_clampf(c.pitch, -85.0f, 85.0f));
+    float aspect = (float)f->width / (float)f->height;
+    ak_view_orbit orbit = {.azimuth = az, .elevation = el, .fovy = fovy, .aspect = aspect, .margin = 1.08f};
+    f->camera = ak_view_orbit_camera(lo, hi, &orbit);
+    if (c.distance > 0.0f && ak_finitef(c.distance) && ak_vec3_is_finite(lo) && ak_vec3_is_finite(hi)) {
+        /* the same direction as the orbit camera, at the distance asked for */
+        ak_vec3 centre = ak_vec3_scale(ak_vec3_add(lo, hi), 0.5f);
+        float R = ak_maxf(0.5f * ak_vec3_length(ak_vec3_sub(hi, lo)), 1e-4f);
+        ak_vec3 dir = ak_vec3_make(cosf(el) * sinf(az), sinf(el), cosf(el) * cosf(az));
+        ak_vec3 eye = ak_vec3_madd(centre, dir, c.distance);
+        float near_z = ak_maxf(0.001f * c.distance, ak_minf(0.1f * c.distance, 0.5f * (c.distance - R)));
+        f->camera = ak_raster_camera_perspective(eye, centre, fovy, aspect, near_z, c.distance + 6.0f * R);
+    }
+}
+
 int cli_frame_init(cli_frame* f, const ak_scene* s, int width, int height, ak_vec3 lo, ak_vec3 hi, float azimuth) {
+    cli_camera cam = {.has_angles = true, .yaw = ak_degrees(azimuth), .pitch = ak_degrees(0.22f)};
+    return cli_frame_init_camera(f, s, width, height, lo, hi, &cam);
+}
+
+int cli_frame_init_camera(cli_frame* f, const ak_scene* s, int width, int height, ak_vec3 lo, ak_vec3 hi,
+                          const cli_camera* cam) {
     memset(f, 0, sizeof(*f));
     f->width = width;
     f->height = height;
@@ -40,8 +70,7 @@ int cli_frame_init(cli_frame* f, const ak_scene* s, int width, int height, ak_ve
     f->bmax = hi;
     ak_raster_desc d = {.width = width, .height = height, .supersample = 2, .thread_count = 2};
     if (ak_raster_create(&d, NULL, &f->raster) != AK_OK) return CLI_BAD_INPUT;
-    ak_view_orbit orbit = {.azimuth = azimuth, .elevation = 0.22f, .aspect = (float)width / (float)height, .margin = 1.08f};
-    f->camera = ak_view_orbit_camera(lo, hi, &orbit);
+    cli_frame_aim(f, lo, hi, cam);
     /* skeleton overlay arrays: the skin joints only, parents remapped to listed ancestors */
     size_t n = s ? ak_scene_joint_count(s) : 0;
     f->draw_capacity = (s ? s->mesh_count : 0) + CLI_MAX_EXTRA;
@@ -90,7 +119,7 @@ ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* 
     ak_vec4 clay = rgba(0.80f, 0.74f, 0.68f, 1);
     for (size_t m = 0; s && m < s->mesh_count && mc < f->draw_capacity; ++m) {
         const ak_mesh* mesh = s->meshes[m].mesh;
-        if (!mesh || mesh->triangle_count == 0) continue;
+        if (!mesh || mesh->triangle_count == 0 || (o && o->hidden && o->hidden[m])) continue;
         ak_raster_mesh rm = {
             .positions = {p->positions[m], mesh->vertex_count},
             .normals = {p->normals[m], mesh->vertex_count},
