@@ -141,6 +141,8 @@ int cmd_info(int argc, char** argv);
 int cmd_export(int argc, char** argv);
 int cmd_render(int argc, char** argv);
 int cmd_curves(int argc, char** argv);
+/* cmd_curves without its "wrote ..." line (demo prints its own list). */
+int cli_curves_run(int argc, char** argv, bool quiet);
 int cmd_weights(int argc, char** argv);
 int cmd_skin(int argc, char** argv);
 int cmd_ik(int argc, char** argv);
