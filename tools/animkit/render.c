@@ -208,9 +208,21 @@ int cli_weights_colors(const ak_scene* s, const char* bone, ak_vec4** colors, in
     return CLI_OK;
 }
 
-/* Render one still of the scene at its rest pose with heat colours on mesh_index. */
-int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
-                           const float* weights, uint32_t k, int slot, const char* bone_name) {
+ak_vec4 cli_bone_color(size_t slot) {
+    /* hue steps of the golden angle: neighbours in the joint list get far-apart hues */
+    double hue = fmod((double)slot * 137.508, 360.0) / 60.0, s = 0.75, v = 0.95;
+    int sector = (int)hue;
+    double f = hue - sector, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+    double rgb[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
+    const double* c = rgb[sector % 6];
+    return rgba((float)c[0], (float)c[1], (float)c[2], 1);
+}
+
+/* Render one still of the scene at its rest pose with colours on mesh_index; legend: up to
+ * legend_count names with swatches down the left side. */
+static int render_colored_png(const char* path, const ak_scene* s, size_t mesh_index, ak_vec4* mesh_colors,
+                              const char* title, const char* const* legend, const ak_vec4* legend_colors,
+                              size_t legend_count) {
     cli_poser p;
     cli_frame f;
     ak_image img = {0};
@@ -223,21 +235,79 @@ int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_inde
     cli_poser_pose(&p, -1, 0.0f, false, CLI_LBS);
     ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
     cli_bounds_add_pose(&p, &lo, &hi);
-    if (mesh_index < s->mesh_count) rc = heat_colors(s, mesh_index, joints, weights, k, slot, &colors[mesh_index]);
-    if (rc == CLI_OK && cli_frame_init(&f, s, 640, 640, lo, hi, 0.5f) == CLI_OK) {
-        char title[160];
-        snprintf(title, sizeof title, "weights of %s", bone_name ? bone_name : "?");
+    if (mesh_index < s->mesh_count) colors[mesh_index] = mesh_colors;
+    if (cli_frame_init(&f, s, 640, 640, lo, hi, 0.5f) == CLI_OK) {
         cli_draw_opts o = {.colors = colors, .title = title};
-        if (cli_image_alloc(&img, 640, 640) || cli_frame_draw(&f, &p, &o, &img) != AK_OK || ak_png_write(path, &img) != AK_OK)
+        if (cli_image_alloc(&img, 640, 640) || cli_frame_draw(&f, &p, &o, &img) != AK_OK) {
             rc = cli_fail("weights", "%s: cannot write the image", path);
+        } else {
+            /* legend: one row per bone, as many as fit */
+            int rows = (640 - 50) / 12;
+            for (size_t i = 0; i < legend_count && (int)i < rows; ++i) {
+                int y = 40 + 12 * (int)i;
+                const char* name = (int)i == rows - 1 && legend_count > (size_t)rows ? "..." : legend[i];
+                ak_image_fill_rect(&img, 10, (float)y, 9, 9, legend_colors[i]);
+                ak_image_draw_text(&img, 23, y + 1, name, 1, rgba(0.08f, 0.09f, 0.12f, 1));
+            }
+            if (ak_png_write(path, &img) != AK_OK) rc = cli_fail("weights", "%s: cannot write the image", path);
+        }
         cli_frame_free(&f);
     } else {
         rc = cli_fail("weights", "out of memory");
     }
-    for (size_t m = 0; m < s->mesh_count; ++m) free(colors[m]);
     free(colors);
     free(img.pixels);
     cli_poser_free(&p);
+    return rc;
+}
+
+/* Render one still of the scene at its rest pose with heat colours on mesh_index. */
+int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
+                           const float* weights, uint32_t k, int slot, const char* bone_name) {
+    ak_vec4* c = NULL;
+    if (mesh_index < s->mesh_count && heat_colors(s, mesh_index, joints, weights, k, slot, &c))
+        return cli_fail("weights", "out of memory");
+    char title[160];
+    snprintf(title, sizeof title, "weights of %s", bone_name ? bone_name : "?");
+    int rc = render_colored_png(path, s, mesh_index, c, title, NULL, NULL, 0);
+    free(c);
+    return rc;
+}
+
+int cli_render_bones_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
+                         const float* weights, uint32_t k, size_t slot_count, const char* const* slot_names) {
+    const ak_mesh* mesh = s->meshes[mesh_index].mesh;
+    size_t n = mesh->vertex_count;
+    ak_vec4* c = calloc(n + 1, sizeof(ak_vec4));
+    ak_vec4* sw = calloc(slot_count + 1, sizeof(ak_vec4));
+    const char** names = calloc(slot_count + 1, sizeof(char*));
+    size_t* dominant = calloc(slot_count + 1, sizeof(size_t));
+    if (!c || !sw || !names || !dominant) {
+        free(c), free(sw), free(names), free(dominant);
+        return cli_fail("weights", "out of memory");
+    }
+    for (size_t v = 0; v < n; ++v) {
+        float best = 0.0f;
+        size_t top = slot_count;
+        for (uint32_t i = 0; i < k; ++i) {
+            float wi = weights[v * k + i];
+            size_t q = joints[v * k + i];
+            if (wi > best && q < slot_count) best = wi, top = q;
+        }
+        c[v] = top < slot_count ? cli_bone_color(top) : rgba(0.5f, 0.5f, 0.5f, 1);
+        if (top < slot_count) ++dominant[top];
+    }
+    /* legend: the bones that dominate some vertex, in slot order */
+    size_t shown = 0;
+    for (size_t q = 0; q < slot_count; ++q) {
+        if (!dominant[q]) continue;
+        sw[shown] = cli_bone_color(q);
+        names[shown++] = slot_names[q];
+    }
+    char title[160];
+    snprintf(title, sizeof title, "dominant bone per vertex (%zu bone%s)", shown, cli_plural(shown));
+    int rc = render_colored_png(path, s, mesh_index, c, title, names, sw, shown);
+    free(c), free(sw), free(names), free(dominant);
     return rc;
 }
 
