@@ -64,6 +64,7 @@ int cmd_info(int argc, char** argv) {
     if (a.pos_count != 1) return cli_usage("info", "expected one FILE or builtin:NAME");
     ak_scene* s = NULL;
     if ((rc = cli_load_scene("info", a.pos[0], &s))) return rc;
+    if (cli_has_ext(a.pos[0], ".obj")) cli_obj_rig_note("info", a.pos[0]);
     size_t n = ak_scene_joint_count(s);
     int* list = calloc(n + 1, sizeof(int));
     int* parent = calloc(n + 1, sizeof(int));

@@ -85,7 +85,8 @@ static int parse_times(cli_args* a, const cli_opt* opts, size_t nopts, bool gif,
     } else {
         step = 1;
     }
-    double count = floor((double)(t1 - t0) / (double)step + 1e-6) + 1.0;
+    /* a last frame within 1e-4 steps of B counts (float steps such as 1/12 do not divide exactly) */
+    double count = floor((double)(t1 - t0) / (double)step + 1e-4) + 1.0;
     if (count > 10000) return cli_usage("render", "%.0f frames is too many (at most 10000)", count);
     out->count = (size_t)count;
     out->step = step;
