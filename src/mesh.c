@@ -240,9 +240,10 @@ static uint32_t coord_bits(float f) {
 
 static bool same_position(ak_vec3 a, ak_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
-ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indices, ak_u32_span scratch,
-                                    ak_vec3_span out_normals) {
-    if (!out_normals.ptr || !scratch.ptr || (positions.count && !positions.ptr) || (indices.count && !indices.ptr))
+ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indices,
+                                    ak_u32_span scratch, ak_vec3_span out_normals) {
+    if (!out_normals.ptr || !scratch.ptr || (positions.count && !positions.ptr) ||
+        (indices.count && !indices.ptr))
         return AK_ERR_NULL_ARG;
     const size_t n = positions.count;
     if (out_normals.count < n) return AK_ERR_SPAN_SMALL;
@@ -293,7 +294,8 @@ ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indice
         }
         ak_vec3 nv = out_normals.ptr[v];
         float len = ak_vec3_length(nv);
-        out_normals.ptr[v] = (len > 1e-30f && ak_finitef(len)) ? ak_vec3_scale(nv, 1.0f / len) : ak_vec3_make(0.0f, 1.0f, 0.0f);
+        out_normals.ptr[v] = (len > 1e-30f && ak_finitef(len)) ? ak_vec3_scale(nv, 1.0f / len)
+                                                               : ak_vec3_make(0.0f, 1.0f, 0.0f);
     }
     return AK_OK;
 }

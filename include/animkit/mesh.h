@@ -101,9 +101,10 @@ AK_API size_t ak_normals_welded_scratch_count(size_t vertex_count);
  * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL (out_normals or scratch), AK_ERR_BAD_INDEX.
  *     uint32_t* scratch = malloc(ak_normals_welded_scratch_count(n) * sizeof(uint32_t));
  *     ak_normals_compute_welded(positions, indices,
- *                               (ak_u32_span){scratch, ak_normals_welded_scratch_count(n)}, normals); */
-AK_API ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indices, ak_u32_span scratch,
-                                           ak_vec3_span out_normals);
+ *                               (ak_u32_span){scratch, ak_normals_welded_scratch_count(n)},
+ * normals); */
+AK_API ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indices,
+                                           ak_u32_span scratch, ak_vec3_span out_normals);
 /* ak_normals_compute on the mesh's own arrays (no-op when normals == NULL). */
 AK_API ak_result ak_mesh_compute_normals(ak_mesh* mesh);
 

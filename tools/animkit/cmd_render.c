@@ -108,7 +108,7 @@ static bool parse_camera(const char* s, cli_camera* cam) {
         if (n == 3 || !cli_parse_float(tok, &v[n])) return false;
         ++n;
     }
-    if (n < 2 || v[1] < -85.0f || v[1] > 85.0f || (n == 3 && !(v[2] > 0.0f))) return false;
+    if (n < 2 || v[1] < -85.0f || v[1] > 85.0f || (n == 3 && !(v[2] > 0.0f && v[2] <= 1e9f))) return false;
     cam->has_angles = true;
     cam->yaw = v[0];
     cam->pitch = v[1];
@@ -158,7 +158,7 @@ int cmd_render(int argc, char** argv) {
     else if (ms && !cli_method_parse(ms, &methods[0])) return cli_usage("render", "--method must be lbs, dqs, cor or all, not '%s'", ms);
     cli_camera cam = {0};
     if (CLI_GET(&a, "--camera") && !parse_camera(CLI_GET(&a, "--camera"), &cam))
-        return cli_usage("render", "--camera '%s' is not YAW,PITCH[,DIST] (degrees, pitch in -85..85, distance > 0)",
+        return cli_usage("render", "--camera '%s' is not YAW,PITCH[,DIST] (degrees, pitch in -85..85, distance in (0, 1e9])",
                          CLI_GET(&a, "--camera"));
     if (CLI_GET(&a, "--fov") && (!cli_parse_float(CLI_GET(&a, "--fov"), &cam.fov) || !(cam.fov >= 1.0f && cam.fov <= 170.0f)))
         return cli_usage("render", "--fov '%s' is not an angle in 1..170 degrees", CLI_GET(&a, "--fov"));
@@ -314,7 +314,12 @@ int cmd_render(int argc, char** argv) {
         goto done;
     }
     const ak_image* frame_img = method_count > 1 ? &composed : &panel[0];
+    /* GIF delays are whole 1/100 s: 100 fps at most */
     float rate = ft.step > 0 ? 1.0f / ft.step : 24.0f;
+    if (gif && rate > 100.0f) {
+        fprintf(stderr, "note: frames %.4g s apart play at 100 fps, the fastest a GIF holds\n", (double)ft.step);
+        rate = 100.0f;
+    }
     if (gif && ak_gif_writer_create(out, &(ak_gif_desc){.width = frame_img->width, .height = frame_img->height, .frame_rate = rate},
                                     NULL, &gw) != AK_OK) {
         rc = cli_fail("render", "%s: cannot create the file", out);
