@@ -1,5 +1,6 @@
 /* PNG (libpng's simplified API) and animated GIF (giflib) writing and reading. The GIF colour
- * quantizer (median cut over a 15-bit histogram, ordered dithering) is animkit's own. */
+ * quantizer (median cut over a 15-bit histogram, ordered dithering) and the delta frames
+ * (unchanged pixels transparent, palette kept while it fits) are animkit's own. */
 #include <fcntl.h> /* open: GIF files with the usual permissions */
 #include <stdio.h>
 #include <stdlib.h>

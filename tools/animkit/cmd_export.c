@@ -44,8 +44,8 @@ int cmd_export(int argc, char** argv) {
     for (size_t m = 0; m < s->mesh_count; ++m) vertices += s->meshes[m].mesh ? s->meshes[m].mesh->vertex_count : 0;
     if (vertices == 0) {
         /* an empty OBJ would look like success: a BVH is a skeleton and motion only */
-        rc = cli_fail("export", "%s: no mesh to export (%zu joints, %zu clip%s; try 'animkit render' to see the skeleton)",
-                      a.pos[0], ak_scene_joint_count(s), s->clip_count, s->clip_count == 1 ? "" : "s");
+        rc = cli_fail("export", "%s: no mesh to export (only a skeleton and %zu clip%s; 'animkit render' draws them)", a.pos[0],
+                      s->clip_count, s->clip_count == 1 ? "" : "s");
         ak_scene_destroy(s);
         return rc;
     }
