@@ -782,6 +782,7 @@ AK_TEST(render_camera_options) {
      * large and centred at the start and at the end */
     AK_CHECK(write_walk_bvh("walk20.bvh", 11, 1.0));
     AK_CHECK_EQ(run("render walk20.bvh --frames 0:10:10 --size 200x200 -o still.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "--follow") != NULL, "no hint to use --follow: %s", out_buf);
     AK_CHECK_EQ(run("render walk20.bvh --frames 0:10:10 --size 200x200 --follow -o follow.png", true), 0);
     for (int i = 0; i < 2; ++i) {
         char p1[32], p2[32];

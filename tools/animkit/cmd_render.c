@@ -282,17 +282,23 @@ int cmd_render(int argc, char** argv) {
     /* --follow: a box of the largest single-frame size around the root, offset by the mean
      * of (frame centre - root) so the body sits in it as it does on average */
     ak_vec3 follow_size = ak_vec3_zero(), follow_offset = ak_vec3_zero();
-    if (follow) {
-        size_t n = 0;
-        for (size_t i = 0; i < ft.count; ++i) {
-            if (!ak_vec3_is_finite(frame_lo[i]) || !ak_vec3_is_finite(frame_hi[i])) continue;
-            follow_size = ak_vec3_max(follow_size, ak_vec3_sub(frame_hi[i], frame_lo[i]));
-            ak_vec3 c = ak_vec3_scale(ak_vec3_add(frame_lo[i], frame_hi[i]), 0.5f);
-            if (!ak_vec3_is_finite(roots[i])) roots[i] = c;
-            follow_offset = ak_vec3_add(follow_offset, ak_vec3_sub(c, roots[i]));
-            ++n;
-        }
-        if (n) follow_offset = ak_vec3_scale(follow_offset, 1.0f / (float)n);
+    size_t framed = 0;
+    for (size_t i = 0; i < ft.count; ++i) {
+        if (!ak_vec3_is_finite(frame_lo[i]) || !ak_vec3_is_finite(frame_hi[i])) continue;
+        follow_size = ak_vec3_max(follow_size, ak_vec3_sub(frame_hi[i], frame_lo[i]));
+        ak_vec3 c = ak_vec3_scale(ak_vec3_add(frame_lo[i], frame_hi[i]), 0.5f);
+        if (!ak_vec3_is_finite(roots[i])) roots[i] = c;
+        follow_offset = ak_vec3_add(follow_offset, ak_vec3_sub(c, roots[i]));
+        ++framed;
+    }
+    if (framed) follow_offset = ak_vec3_scale(follow_offset, 1.0f / (float)framed);
+    if (!follow && framed > 1) {
+        /* a path much longer than the body: say how to keep the body large */
+        float body = ak_maxf(ak_maxf(follow_size.x, follow_size.y), follow_size.z);
+        float path = ak_maxf(hi.x - lo.x, hi.z - lo.z);
+        if (body > 0.0f && path > 2.0f * body)
+            fprintf(stderr, "note: the motion travels %.3g units, %.1f times the body's size; --follow keeps the body framed\n",
+                    (double)path, (double)(path / body));
     }
     if (cli_frame_init_camera(&f, s, w, h, lo, hi, &cam)) {
         rc = cli_fail("render", "out of memory");
