@@ -647,6 +647,11 @@ AK_TEST(messages_say_what_happened) {
     AK_CHECK_MSG(strstr(out_buf, "'-o' needs a value") != NULL, "%s", out_buf);
     AK_CHECK_EQ(run("render builtin:cylinder --output", true), 2);
     AK_CHECK_MSG(strstr(out_buf, "'--output' needs a value") != NULL, "%s", out_buf);
+    /* repeatable options are bounded */
+    char many[2048] = "render builtin:cylinder -o x.png";
+    for (int i = 0; i < 70; ++i) strcat(many, " --mesh cylinder");
+    AK_CHECK_EQ(run(many, true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "too many options") != NULL, "%s", out_buf);
     /* subnormal and underflowing times are numbers (they round to 0 s) */
     AK_CHECK_EQ(run("export builtin:cylinder --time 1e-320 -o sub.obj", true), 0);
     AK_CHECK_EQ(run("export builtin:cylinder --time 1e-400 -o sub.obj", true), 0);

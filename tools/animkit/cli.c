@@ -41,10 +41,9 @@ int cli_parse(const char* cmd, int argc, char** argv, const cli_opt* opts, size_
                 if (eq) return cli_usage(cmd, "option '%s' takes no value", opts[k].name);
                 out->values[k] = "1";
             }
-            if (out->all_count < CLI_MAX_ALL) {
-                out->all_opt[out->all_count] = (int)k;
-                out->all_values[out->all_count++] = out->values[k];
-            }
+            if (out->all_count == CLI_MAX_ALL) return cli_usage(cmd, "too many options (at most %d)", CLI_MAX_ALL);
+            out->all_opt[out->all_count] = (int)k;
+            out->all_values[out->all_count++] = out->values[k];
             continue;
         }
         if (out->pos_count >= CLI_MAX_POS) return cli_usage(cmd, "too many arguments");

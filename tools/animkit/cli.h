@@ -35,7 +35,8 @@ typedef struct cli_args {
 } cli_args;
 
 /* Parse argv (after the command word) against opts. Prints a usage error and returns
- * CLI_BAD_USAGE on an unknown option, a missing value or too many positionals. */
+ * CLI_BAD_USAGE on an unknown option, a missing value (naming the option as typed), too many
+ * positionals or more than CLI_MAX_ALL options. */
 int cli_parse(const char* cmd, int argc, char** argv, const cli_opt* opts, size_t opt_count, cli_args* out);
 /* Value of option name ("--time"), or NULL. */
 const char* cli_get(const cli_args* a, const cli_opt* opts, size_t opt_count, const char* name);
