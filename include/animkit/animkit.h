@@ -25,5 +25,6 @@
 #include "raster.h"
 #include "view.h"
 #include "grid.h"
+#include "boids.h"
 
 #endif
