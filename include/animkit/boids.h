@@ -11,7 +11,11 @@
  *     agents of the same species, other than i, with |p_j - p_i| < the largest of the three
  *     radii AND inside the field-of-view cone (view_angle degrees around the velocity), then
  *     optionally capped to the k nearest (topological neighbours; ties broken by the smaller
- *     agent index);
+ *     agent index). Exactly, in float: d = p_j - p_i, d2 = d.x*d.x + d.y*d.y + d.z*d.z, a rule
+ *     uses j when d2 < radius*radius; with c = cos(view_angle/2), dot = d . v_i, lim =
+ *     c*c * d2 * |v_i|^2, j is in view when (c >= 0) dot > 0 && dot*dot >= lim, (c < 0)
+ *     dot >= 0 || dot*dot <= lim, and always when |v_i| = 0 or d2 = 0. The separation
+ *     distance is clamped below at 1e-3 separation_radius (coincident agents push nothing);
  *   - extensions, each a weighted steering force: obstacle avoidance (spheres, planes,
  *     axis-aligned boxes) with a hard projection as the last resort so that no agent ever
  *     enters an obstacle, bounds (wrap or steer back), goal seeking, leader following, flee
@@ -26,6 +30,14 @@
  * max_force; v' = v + F dt clamped to [min_speed, max_speed]; p' = p + v' dt; then the bounds
  * wrap and the obstacle projection (below). In 2D (params.planar) every force and velocity has
  * y = 0 and agents keep their y.
+ *
+ * Obstacles: the avoid force steers away before contact; the hard projection is the last
+ * resort and always runs: a step whose segment p -> p' would enter an obstacle (or end inside
+ * one) stops at the entry point, is pushed 1e-5 m (+ 4e-7 relative) outside along the surface
+ * normal, and loses the inward part of its velocity (out_contact_count counts these agents).
+ * An agent the caller placed inside leaves by the nearest face. Overlapping obstacles are
+ * resolved by up to four passes; agents therefore end every step at distance >= 0 from every
+ * obstacle (tests check this on spheres, planes and boxes in 2D and 3D).
  *
  * Determinism: each agent's sums are accumulated in 64-bit fixed point (2^-32 of the rule's
  * natural unit), which is exact and so independent of the order neighbours are visited in.
@@ -74,7 +86,7 @@ typedef struct ak_boids_species {
     float max_speed;         /* m/s; 0 -> 2 */
     float min_speed;         /* m/s, <= max_speed; 0 -> none (agents may stop) */
     float max_force;         /* m/s^2, clamp on the summed steering; 0 -> 8 */
-    float separation_weight; /* 1/s^2 times m^2... : F_s = w * sum (p_i - p_j)/d^2; 0 -> off */
+    float separation_weight; /* m^2/s^2: F_s = w * sum (p_i - p_j)/d^2; 0 -> off */
     float separation_radius; /* m; 0 -> 1 */
     float alignment_weight;  /* 1/s: F_a = w * (mean v_j - v_i); 0 -> off */
     float alignment_radius;  /* m; 0 -> 2 */
@@ -87,7 +99,7 @@ typedef struct ak_boids_species {
     float leader_weight;     /* 1/s: seek the point leader_distance behind the leader; 0 -> off */
     float wander_weight;     /* m/s^2: force along the agent's wander direction; 0 -> off */
     float wander_jitter;     /* radians per sqrt(second) of random walk of that direction; 0 -> 2 */
-    float avoid_weight;      /* m^2/s^2... : F = w * (L - s)/s * n within avoid_distance L of an
+    float avoid_weight;      /* m/s^2: F = w * (L - s)/s * n within avoid_distance L of an
                                 obstacle (s = distance, n = outward normal); 0 -> off */
     float avoid_distance;    /* m: L above; 0 -> 1 */
     float bounds_weight;     /* 1/s^2: STEER bounds pull back with w * (depth into the margin); 0 -> 4 */
@@ -141,8 +153,7 @@ typedef struct ak_boids_params {
     float leader_distance;               /* m behind the leader that followers seek; 0 -> 1 */
 } ak_boids_params;
 
-/* params with every zero default filled in (species beyond 32 are not read); for tests and
- * tools. The species array is not copied: out_species must hold species_count entries. */
+/* A species with every zero default filled in (NULL -> all defaults); for tests and tools. */
 AK_API void ak_boids_species_resolved(const ak_boids_species* species, ak_boids_species* out_species);
 
 /* ---- the step job --------------------------------------------------------------------- */
