@@ -647,6 +647,27 @@ AK_TEST(threads_and_paths_bit_identical) {
     AK_CHECK(memcmp(runs[0].p, base.p, base.n * sizeof(ak_vec3)) != 0);
     for (size_t i = 0; i < base.n; ++i) AK_CHECK(ak_vec3_is_finite(runs[0].p[i]) && ak_vec3_is_finite(runs[0].v[i]));
     for (int k = 0; k < 4; ++k) flock_free(&runs[k]);
+    /* The plain flock (no cap, no predators: the grid's register-sum fast path), 2D and 3D. */
+    ak_boids_species plain = {.max_speed = 2, .separation_weight = 2, .separation_radius = 0.6f,
+                              .alignment_weight = 1, .alignment_radius = 1.4f, .cohesion_weight = 1,
+                              .cohesion_radius = 1.6f, .view_angle = 250};
+    ak_boids_params pp = {.species = &plain, .species_count = 1};
+    for (int planar = 0; planar < 2; ++planar) {
+        pp.planar = planar != 0;
+        flock_random(&base, 78, 5.5f, 1.5f, pp.planar);
+        memset(base.s, 0, base.n);
+        for (int k = 0; k < 4; ++k) {
+            runs[k] = flock_make(base.n);
+            memcpy(runs[k].p, base.p, base.n * sizeof(ak_vec3));
+            memcpy(runs[k].v, base.v, base.n * sizeof(ak_vec3));
+            for (int s = 0; s < 6; ++s) AK_CHECK_EQ(step(&runs[k], &pp, 0.05f, threads[k], naive[k], (uint64_t)s), AK_OK);
+        }
+        for (int k = 1; k < 4; ++k) {
+            AK_CHECK(memcmp(runs[0].p, runs[k].p, base.n * sizeof(ak_vec3)) == 0);
+            AK_CHECK(memcmp(runs[0].v, runs[k].v, base.n * sizeof(ak_vec3)) == 0);
+        }
+        for (int k = 0; k < 4; ++k) flock_free(&runs[k]);
+    }
     flock_free(&base);
 }
 

@@ -41,10 +41,14 @@ typedef struct akp_boids_ctx {
     /* Grid path (use_naive false). */
     ak_grid grid;
     int rings;              /* cells visited on each side of an agent's cell */
-    const float* svx;       /* [n] velocities in the grid's sorted order */
-    const float* svy;
-    const float* svz;
+    const int64_t* sqv;     /* [3n] velocities in sorted order, fixed point (alignment sums) */
     const uint8_t* ssp;     /* [n] species in sorted order */
+    /* Dense cell table over the occupied cells' bounding box (when it is small enough): cell
+     * (x, y, z) -> grid cell index m or UINT32_MAX, so a neighbour cell costs one load instead
+     * of a hash probe, and cells can be walked in spatial order. NULL when not built. */
+    uint32_t* dense;
+    int32_t dense_min[3];
+    int32_t dense_dim[3];
 } akp_boids_ctx;
 
 /* What one agent gathers from its neighbours. */

@@ -29,7 +29,8 @@ static void gather_begin(const akp_boids_ctx* c, size_t i, akp_boids_gather* g) 
 }
 
 static inline int64_t fix(float x) {
-    x = x > AKP_BOIDS_FIX_CLAMP ? AKP_BOIDS_FIX_CLAMP : (x < -AKP_BOIDS_FIX_CLAMP ? -AKP_BOIDS_FIX_CLAMP : x);
+    x = x > -AKP_BOIDS_FIX_CLAMP ? x : -AKP_BOIDS_FIX_CLAMP; /* maxss/minss, no libm call */
+    x = x < AKP_BOIDS_FIX_CLAMP ? x : AKP_BOIDS_FIX_CLAMP;
     return (int64_t)x;
 }
 
@@ -43,8 +44,9 @@ static inline bool in_view(const akp_boids_sp* S, const akp_boids_gather* g, flo
 }
 
 /* Add one flock neighbour to the rule sums. */
+/* qv: the neighbour's velocity in fixed point (fix(v * ali_scale) per component). */
 static inline void accumulate(const akp_boids_sp* S, akp_boids_gather* g, float dx, float dy, float dz, float d2,
-                              float vx, float vy, float vz) {
+                              int64_t qvx, int64_t qvy, int64_t qvz) {
     ++g->nflock;
     if (d2 < S->rs2) {
         const float inv = S->sep_scale / (d2 > S->dmin2 ? d2 : S->dmin2);
@@ -54,9 +56,9 @@ static inline void accumulate(const akp_boids_sp* S, akp_boids_gather* g, float 
         ++g->ns;
     }
     if (d2 < S->ra2) {
-        g->ali[0] += fix(vx * S->ali_scale);
-        g->ali[1] += fix(vy * S->ali_scale);
-        g->ali[2] += fix(vz * S->ali_scale);
+        g->ali[0] += qvx;
+        g->ali[1] += qvy;
+        g->ali[2] += qvz;
         ++g->na;
     }
     if (d2 < S->rc2) {
@@ -89,15 +91,15 @@ static inline void keep_nearest(akp_boids_gather* g, uint32_t k, float d2, uint3
 
 /* One candidate j (position and velocity as stored, species sj). The only place that decides
  * what a neighbour is. */
-static inline void visit(akp_boids_gather* g, uint32_t j, float dx, float dy, float dz, float d2, float vx,
-                         float vy, float vz, uint8_t sj) {
+static inline void visit(akp_boids_gather* g, uint32_t j, float dx, float dy, float dz, float d2, int64_t qvx,
+                         int64_t qvy, int64_t qvz, uint8_t sj) {
     const akp_boids_sp* S = g->sp;
     if (j == g->i) return;
     if (sj == g->species && d2 < S->rn2 && in_view(S, g, dx, dy, dz, d2)) {
         if (S->s.k_nearest) keep_nearest(g, S->s.k_nearest, d2, j);
         else {
             if (g->list) g->list[g->list_count++] = j;
-            accumulate(S, g, dx, dy, dz, d2, vx, vy, vz);
+            accumulate(S, g, dx, dy, dz, d2, qvx, qvy, qvz);
         }
     }
     const uint32_t bit = 1u << sj;
@@ -122,7 +124,8 @@ static void gather_end(const akp_boids_ctx* c, akp_boids_gather* g) {
         const uint32_t j = g->kj[a];
         const float dx = P[j].x - g->p.x, dy = P[j].y - g->p.y, dz = P[j].z - g->p.z;
         if (g->list) g->list[g->list_count++] = j;
-        accumulate(S, g, dx, dy, dz, g->kd2[a], V[j].x, V[j].y, V[j].z);
+        accumulate(S, g, dx, dy, dz, g->kd2[a], fix(V[j].x * S->ali_scale), fix(V[j].y * S->ali_scale),
+                   fix(V[j].z * S->ali_scale));
     }
 }
 
@@ -137,7 +140,9 @@ static void gather_naive(const akp_boids_ctx* c, akp_boids_gather* g) {
         const float dx = P[j].x - g->p.x, dy = P[j].y - g->p.y, dz = P[j].z - g->p.z;
         const float d2 = dx * dx + dy * dy + dz * dz;
         if (!(d2 < q2)) continue;
-        visit(g, (uint32_t)j, dx, dy, dz, d2, V[j].x, V[j].y, V[j].z, sp ? sp[j] : 0);
+        const uint8_t sj = sp ? sp[j] : 0;
+        const float as = c->sp[sj].ali_scale;
+        visit(g, (uint32_t)j, dx, dy, dz, d2, fix(V[j].x * as), fix(V[j].y * as), fix(V[j].z * as), sj);
     }
 }
 
@@ -155,6 +160,27 @@ static void ranges_around(const akp_boids_ctx* c, ak_grid_cell cc, cell_ranges* 
     const ak_grid* gr = &c->grid;
     const int R = c->rings;
     r->count = 0;
+    if (c->dense) {
+        const int32_t* lo = c->dense_min;
+        const int32_t* dim = c->dense_dim;
+        const int64_t x0 = (int64_t)cc.x - lo[0], y0 = (int64_t)cc.y - lo[1], z0 = (int64_t)cc.z - lo[2];
+        for (int64_t z = z0 - R; z <= z0 + R; ++z) {
+            if (z < 0 || z >= dim[2]) continue;
+            for (int64_t y = y0 - R; y <= y0 + R; ++y) {
+                if (y < 0 || y >= dim[1]) continue;
+                const uint32_t* row = c->dense + ((size_t)z * (size_t)dim[1] + (size_t)y) * (size_t)dim[0];
+                for (int64_t x = x0 - R; x <= x0 + R; ++x) {
+                    if (x < 0 || x >= dim[0]) continue;
+                    const uint32_t m = row[x];
+                    if (m == UINT32_MAX) continue;
+                    r->begin[r->count] = gr->cell_start[m];
+                    r->end[r->count] = gr->cell_start[m + 1];
+                    ++r->count;
+                }
+            }
+        }
+        return;
+    }
     for (int dz = -R; dz <= R; ++dz)
         for (int dy = -R; dy <= R; ++dy)
             for (int dx = -R; dx <= R; ++dx) {
@@ -177,9 +203,112 @@ static void gather_cells(const akp_boids_ctx* c, const cell_ranges* r, akp_boids
             const float dx = X[k] - px, dy = Y[k] - py, dz = Z[k] - pz;
             const float d2 = dx * dx + dy * dy + dz * dz;
             if (!(d2 < q2)) continue;
-            visit(g, gr->order[k], dx, dy, dz, d2, c->svx[k], c->svy[k], c->svz[k], c->ssp[k]);
+            visit(g, gr->order[k], dx, dy, dz, d2, c->sqv[3 * k], c->sqv[3 * k + 1], c->sqv[3 * k + 2], c->ssp[k]);
         }
     }
+}
+
+/* The candidates of one cell (its neighbour cells' agents) copied into contiguous arrays, so
+ * each agent of the cell tests them all in one vectorisable loop, then visits only the hits. */
+#define CAND_CAP 1024
+
+typedef struct cand_buf {
+    uint32_t count;
+    float x[CAND_CAP], y[CAND_CAP], z[CAND_CAP], d2[CAND_CAP];
+    uint32_t k[CAND_CAP], hit[CAND_CAP];
+} cand_buf;
+
+static bool cand_fill(const akp_boids_ctx* c, const cell_ranges* r, cand_buf* b) {
+    const ak_grid* gr = &c->grid;
+    uint32_t n = 0;
+    for (uint32_t a = 0; a < r->count; ++a) n += r->end[a] - r->begin[a];
+    if (n > CAND_CAP) return false;
+    n = 0;
+    for (uint32_t a = 0; a < r->count; ++a) {
+        const uint32_t k0 = r->begin[a], m = r->end[a] - k0;
+        memcpy(b->x + n, gr->x + k0, m * sizeof(float));
+        memcpy(b->y + n, gr->y + k0, m * sizeof(float));
+        memcpy(b->z + n, gr->z + k0, m * sizeof(float));
+        for (uint32_t t = 0; t < m; ++t) b->k[n + t] = k0 + t;
+        n += m;
+    }
+    b->count = n;
+    return true;
+}
+
+static void gather_buffered(const akp_boids_ctx* c, cand_buf* b, akp_boids_gather* g) {
+    const ak_grid* gr = &c->grid;
+    const float q2 = g->sp->query_radius * g->sp->query_radius;
+    const float px = g->p.x, py = g->p.y, pz = g->p.z;
+    const uint32_t n = b->count;
+    float* restrict d2 = b->d2;
+    const float* restrict X = b->x;
+    const float* restrict Y = b->y;
+    const float* restrict Z = b->z;
+    for (uint32_t t = 0; t < n; ++t) {
+        const float dx = X[t] - px, dy = Y[t] - py, dz = Z[t] - pz;
+        d2[t] = dx * dx + dy * dy + dz * dz;
+    }
+    uint32_t h = 0;
+    for (uint32_t t = 0; t < n; ++t) {
+        b->hit[h] = t;
+        h += d2[t] < q2;
+    }
+    const akp_boids_sp* S = g->sp;
+    if (S->s.k_nearest || g->list || S->fr2 > 0.0f || S->pr2 > 0.0f) {
+        for (uint32_t u = 0; u < h; ++u) {
+            const uint32_t t = b->hit[u], k = b->k[t];
+            visit(g, gr->order[k], X[t] - px, Y[t] - py, Z[t] - pz, d2[t], c->sqv[3 * k], c->sqv[3 * k + 1],
+                  c->sqv[3 * k + 2], c->ssp[k]);
+        }
+        return;
+    }
+    /* The common case (no cap, no predators, no list): visit() and accumulate() with the sums in
+     * registers. Same tests, same values, same integer sums. */
+    int64_t s0 = 0, s1 = 0, s2 = 0, a0 = 0, a1 = 0, a2 = 0, c0 = 0, c1 = 0, c2 = 0;
+    uint32_t ns = 0, na = 0, nc = 0, nf = 0;
+    const uint8_t me = g->species;
+    const uint32_t self = g->i;
+    for (uint32_t u = 0; u < h; ++u) {
+        const uint32_t t = b->hit[u], k = b->k[t];
+        const float dd = d2[t];
+        if (c->ssp[k] != me || !(dd < S->rn2) || gr->order[k] == self) continue;
+        const float dx = X[t] - px, dy = Y[t] - py, dz = Z[t] - pz;
+        if (!in_view(S, g, dx, dy, dz, dd)) continue;
+        ++nf;
+        if (dd < S->rs2) {
+            const float inv = S->sep_scale / (dd > S->dmin2 ? dd : S->dmin2);
+            s0 += fix(-dx * inv);
+            s1 += fix(-dy * inv);
+            s2 += fix(-dz * inv);
+            ++ns;
+        }
+        if (dd < S->ra2) {
+            a0 += c->sqv[3 * k];
+            a1 += c->sqv[3 * k + 1];
+            a2 += c->sqv[3 * k + 2];
+            ++na;
+        }
+        if (dd < S->rc2) {
+            c0 += fix(dx * S->coh_scale);
+            c1 += fix(dy * S->coh_scale);
+            c2 += fix(dz * S->coh_scale);
+            ++nc;
+        }
+    }
+    g->sep[0] += s0;
+    g->sep[1] += s1;
+    g->sep[2] += s2;
+    g->ali[0] += a0;
+    g->ali[1] += a1;
+    g->ali[2] += a2;
+    g->coh[0] += c0;
+    g->coh[1] += c1;
+    g->coh[2] += c2;
+    g->ns += ns;
+    g->na += na;
+    g->nc += nc;
+    g->nflock += nf;
 }
 
 /* ---- scratch ----------------------------------------------------------------------------- */
@@ -208,6 +337,41 @@ static float cell_size_for(const ak_boids_params* p, float* out_search) {
 
 static size_t align64(size_t n) { return (n + 63u) & ~(size_t)63u; }
 
+/* Entries of the dense cell table (4 per agent: a flock fills a fair part of its box). */
+static size_t dense_cap(size_t n) { return 4 * n + 4096; }
+
+static void build_dense(akp_boids_ctx* c, uint32_t* table) {
+    const ak_grid* gr = &c->grid;
+    c->dense = NULL;
+    if (gr->cell_count == 0) return;
+    int64_t lo[3] = {INT64_MAX, INT64_MAX, INT64_MAX}, hi[3] = {INT64_MIN, INT64_MIN, INT64_MIN};
+    for (uint32_t m = 0; m < gr->cell_count; ++m) {
+        const int64_t v[3] = {gr->cell_coord[m].x, gr->cell_coord[m].y, gr->cell_coord[m].z};
+        for (int a = 0; a < 3; ++a) {
+            if (v[a] < lo[a]) lo[a] = v[a];
+            if (v[a] > hi[a]) hi[a] = v[a];
+        }
+    }
+    const int64_t dx = hi[0] - lo[0] + 1, dy = hi[1] - lo[1] + 1, dz = hi[2] - lo[2] + 1;
+    const size_t cap = dense_cap(c->n);
+    if (dx > (int64_t)cap || dy > (int64_t)cap || dz > (int64_t)cap || dx * dy > (int64_t)cap ||
+        dx * dy * dz > (int64_t)cap)
+        return;
+    const size_t volume = (size_t)(dx * dy * dz);
+    memset(table, 0xFF, volume * sizeof(uint32_t));
+    for (uint32_t m = 0; m < gr->cell_count; ++m) {
+        const ak_grid_cell q = gr->cell_coord[m];
+        table[((size_t)(q.z - lo[2]) * (size_t)dy + (size_t)(q.y - lo[1])) * (size_t)dx + (size_t)(q.x - lo[0])] = m;
+    }
+    c->dense = table;
+    c->dense_min[0] = (int32_t)lo[0];
+    c->dense_min[1] = (int32_t)lo[1];
+    c->dense_min[2] = (int32_t)lo[2];
+    c->dense_dim[0] = (int32_t)dx;
+    c->dense_dim[1] = (int32_t)dy;
+    c->dense_dim[2] = (int32_t)dz;
+}
+
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job) {
     float search;
     const float cs = cell_size_for(job->params, &search);
@@ -216,7 +380,7 @@ size_t akp_boids_search_scratch_size(const ak_boids_step_job* job) {
     const ak_grid_desc gd = {.cell_size = cs};
     const size_t g = ak_grid_memory_size(n, &gd);
     if (g == 0) return 0;
-    return align64(g) + 3 * align64(n * sizeof(float)) + align64(n) + 64;
+    return align64(g) + align64(3 * n * sizeof(int64_t)) + align64(n) + dense_cap(n) * sizeof(uint32_t) + 64;
 }
 
 ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
@@ -234,23 +398,22 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     if (c->rings < 1) c->rings = 1;
     if (c->rings > MAX_RINGS) c->rings = MAX_RINGS;
     uint8_t* q = base + align64(gbytes);
-    float* vx = (float*)(void*)q;
-    float* vy = (float*)(void*)(q + align64(n * sizeof(float)));
-    float* vz = (float*)(void*)(q + 2 * align64(n * sizeof(float)));
-    uint8_t* sp = q + 3 * align64(n * sizeof(float));
+    int64_t* qv = (int64_t*)(void*)q;
+    uint8_t* sp = q + align64(3 * n * sizeof(int64_t));
     const ak_vec3* V = c->job->velocities.ptr;
     const uint8_t* S = c->job->species.ptr;
     for (size_t k = 0; k < n; ++k) {
         const uint32_t j = c->grid.order[k];
-        vx[k] = V[j].x;
-        vy[k] = V[j].y;
-        vz[k] = V[j].z;
-        sp[k] = S ? S[j] : 0;
+        const uint8_t sj = S ? S[j] : 0;
+        const float as = c->sp[sj].ali_scale;
+        qv[3 * k] = fix(V[j].x * as);
+        qv[3 * k + 1] = fix(V[j].y * as);
+        qv[3 * k + 2] = fix(V[j].z * as);
+        sp[k] = sj;
     }
-    c->svx = vx;
-    c->svy = vy;
-    c->svz = vz;
+    c->sqv = qv;
     c->ssp = sp;
+    build_dense(c, (uint32_t*)(void*)(sp + align64(n)));
     return AK_OK;
 }
 
@@ -323,22 +486,49 @@ void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, a
         }
         return;
     }
-    /* Cells whose first sorted entry falls in [b, e): each cell's neighbour cells once. */
     const ak_grid* gr = &c->grid;
+    cand_buf bufv; /* 24 KiB on this thread's stack */
+    cand_buf* buf = &bufv;
+    cell_ranges r;
+    if (c->dense) {
+        /* Cells in spatial order (neighbouring cells share their candidates in cache), the
+         * z slabs split between the threads. */
+        const int32_t* dim = c->dense_dim;
+        const size_t z0 = (size_t)dim[2] * part / parts, z1 = (size_t)dim[2] * (part + 1) / parts;
+        const size_t slab = (size_t)dim[0] * (size_t)dim[1];
+        for (size_t cell = z0 * slab; cell < z1 * slab; ++cell) {
+            const uint32_t m = c->dense[cell];
+            if (m == UINT32_MAX) continue;
+            const uint32_t k0 = gr->cell_start[m], k1 = gr->cell_start[m + 1];
+            ranges_around(c, gr->cell_coord[m], &r);
+            const bool buffered = cand_fill(c, &r, buf);
+            for (uint32_t k = k0; k < k1; ++k) {
+                const uint32_t i = gr->order[k];
+                gather_begin(c, i, &g);
+                if (buffered) gather_buffered(c, buf, &g);
+                else gather_cells(c, &r, &g);
+                gather_end(c, &g);
+                fn(c, i, &g, user);
+            }
+        }
+        return;
+    }
+    /* Cells whose first sorted entry falls in [b, e): each cell's neighbour cells once. */
     uint32_t lo = 0, hi = gr->cell_count;
     while (lo < hi) {
         const uint32_t mid = lo + (hi - lo) / 2;
         if (gr->cell_start[mid] < b) lo = mid + 1;
         else hi = mid;
     }
-    cell_ranges r;
     for (uint32_t m = lo; m < gr->cell_count && gr->cell_start[m] < e; ++m) {
         const uint32_t k0 = gr->cell_start[m], k1 = gr->cell_start[m + 1];
         ranges_around(c, gr->cell_coord[m], &r);
+        const bool buffered = cand_fill(c, &r, buf);
         for (uint32_t k = k0; k < k1; ++k) {
             const uint32_t i = gr->order[k];
             gather_begin(c, i, &g);
-            gather_cells(c, &r, &g);
+            if (buffered) gather_buffered(c, buf, &g);
+            else gather_cells(c, &r, &g);
             gather_end(c, &g);
             fn(c, i, &g, user);
         }
