@@ -178,8 +178,9 @@ typedef struct ak_boids_step_job {
 } ak_boids_step_job;
 
 /* Scratch bytes ak_boids_step_run needs for this job (positions.count, params and use_naive
- * are read; 0 for the naive path). The grid path needs about 40 bytes per agent plus the
- * grid's cell table. Returns 0 when the job is not valid. */
+ * are read; 0 for the naive path, and 0 when no species looks at neighbours). The grid path
+ * needs about 110 bytes per agent (the grid, velocities in fixed point, a dense cell table).
+ * Returns 0 when the job's params are unusable (validate says why). */
 AK_API size_t ak_boids_step_scratch_size(const ak_boids_step_job* job);
 
 /* Check a step job. Returns, in this order: AK_ERR_NULL_ARG (no job, params, species, arrays
