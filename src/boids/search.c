@@ -227,10 +227,13 @@ static bool cand_fill(const akp_boids_ctx* c, const cell_ranges* r, cand_buf* b)
     n = 0;
     for (uint32_t a = 0; a < r->count; ++a) {
         const uint32_t k0 = r->begin[a], m = r->end[a] - k0;
-        memcpy(b->x + n, gr->x + k0, m * sizeof(float));
-        memcpy(b->y + n, gr->y + k0, m * sizeof(float));
-        memcpy(b->z + n, gr->z + k0, m * sizeof(float));
-        for (uint32_t t = 0; t < m; ++t) b->k[n + t] = k0 + t;
+        /* A few entries per cell: plain loops beat memcpy calls here. */
+        for (uint32_t t = 0; t < m; ++t) {
+            b->x[n + t] = gr->x[k0 + t];
+            b->y[n + t] = gr->y[k0 + t];
+            b->z[n + t] = gr->z[k0 + t];
+            b->k[n + t] = k0 + t;
+        }
         n += m;
     }
     b->count = n;
