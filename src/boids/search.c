@@ -216,7 +216,9 @@ static void gather_cells(const akp_boids_ctx* c, const cell_ranges* r, akp_boids
 typedef struct cand_buf {
     uint32_t count;
     float x[CAND_CAP], y[CAND_CAP], z[CAND_CAP], d2[CAND_CAP];
-    uint32_t k[CAND_CAP], hit[CAND_CAP];
+    uint32_t k[CAND_CAP], j[CAND_CAP], hit[CAND_CAP];
+    int64_t qv[3 * CAND_CAP];
+    uint8_t sp[CAND_CAP];
 } cand_buf;
 
 static bool cand_fill(const akp_boids_ctx* c, const cell_ranges* r, cand_buf* b) {
@@ -233,15 +235,18 @@ static bool cand_fill(const akp_boids_ctx* c, const cell_ranges* r, cand_buf* b)
             b->y[n + t] = gr->y[k0 + t];
             b->z[n + t] = gr->z[k0 + t];
             b->k[n + t] = k0 + t;
+            b->j[n + t] = gr->order[k0 + t];
+            b->sp[n + t] = c->ssp[k0 + t];
         }
+        /* The hits read these: copied here (sequentially), they stay in L1 for the whole cell. */
+        for (uint32_t t = 0; t < 3 * m; ++t) b->qv[3 * n + t] = c->sqv[3 * k0 + t];
         n += m;
     }
     b->count = n;
     return true;
 }
 
-static void gather_buffered(const akp_boids_ctx* c, cand_buf* b, akp_boids_gather* g) {
-    const ak_grid* gr = &c->grid;
+static void gather_buffered(cand_buf* b, akp_boids_gather* g) {
     const float q2 = g->sp->query_radius * g->sp->query_radius;
     const float px = g->p.x, py = g->p.y, pz = g->p.z;
     const uint32_t n = b->count;
@@ -279,9 +284,9 @@ static void gather_buffered(const akp_boids_ctx* c, cand_buf* b, akp_boids_gathe
     const akp_boids_sp* S = g->sp;
     if (S->s.k_nearest || g->list || S->fr2 > 0.0f || S->pr2 > 0.0f) {
         for (uint32_t u = 0; u < h; ++u) {
-            const uint32_t t = b->hit[u], k = b->k[t];
-            visit(g, gr->order[k], X[t] - px, Y[t] - py, Z[t] - pz, d2[t], c->sqv[3 * k], c->sqv[3 * k + 1],
-                  c->sqv[3 * k + 2], c->ssp[k]);
+            const uint32_t t = b->hit[u];
+            visit(g, b->j[t], X[t] - px, Y[t] - py, Z[t] - pz, d2[t], b->qv[3 * t], b->qv[3 * t + 1],
+                  b->qv[3 * t + 2], b->sp[t]);
         }
         return;
     }
@@ -292,9 +297,9 @@ static void gather_buffered(const akp_boids_ctx* c, cand_buf* b, akp_boids_gathe
     const uint8_t me = g->species;
     const uint32_t self = g->i;
     for (uint32_t u = 0; u < h; ++u) {
-        const uint32_t t = b->hit[u], k = b->k[t];
+        const uint32_t t = b->hit[u];
         const float dd = d2[t];
-        if (c->ssp[k] != me || !(dd < S->rn2) || gr->order[k] == self) continue;
+        if (b->sp[t] != me || !(dd < S->rn2) || b->j[t] == self) continue;
         const float dx = X[t] - px, dy = Y[t] - py, dz = Z[t] - pz;
         if (!in_view(S, g, dx, dy, dz, dd)) continue;
         ++nf;
@@ -306,9 +311,9 @@ static void gather_buffered(const akp_boids_ctx* c, cand_buf* b, akp_boids_gathe
             ++ns;
         }
         if (dd < S->ra2) {
-            a0 += c->sqv[3 * k];
-            a1 += c->sqv[3 * k + 1];
-            a2 += c->sqv[3 * k + 2];
+            a0 += b->qv[3 * t];
+            a1 += b->qv[3 * t + 1];
+            a2 += b->qv[3 * t + 2];
             ++na;
         }
         if (dd < S->rc2) {
@@ -527,7 +532,7 @@ void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, a
             for (uint32_t k = k0; k < k1; ++k) {
                 const uint32_t i = gr->order[k];
                 gather_begin(c, i, &g);
-                if (buffered) gather_buffered(c, buf, &g);
+                if (buffered) gather_buffered(buf, &g);
                 else gather_cells(c, &r, &g);
                 gather_end(c, &g);
                 fn(c, i, &g, user);
@@ -549,7 +554,7 @@ void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, a
         for (uint32_t k = k0; k < k1; ++k) {
             const uint32_t i = gr->order[k];
             gather_begin(c, i, &g);
-            if (buffered) gather_buffered(c, buf, &g);
+            if (buffered) gather_buffered(buf, &g);
             else gather_cells(c, &r, &g);
             gather_end(c, &g);
             fn(c, i, &g, user);
