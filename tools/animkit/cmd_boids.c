@@ -55,7 +55,21 @@ typedef struct renderer {
     uint32_t* oidx;
     size_t overt, otri;
     uint8_t* pixels;
+    ak_clip* beat;  /* the wing-beat (or tail-sway) clip: one scalar channel, looped */
 } renderer;
+
+/* The flap: one scalar channel in [-1, 1] over a third of a second (wings up, a slow
+ * downstroke, a quick recovery), Catmull-Rom through the keys. Each agent samples it at its
+ * own phase. */
+static ak_clip* make_beat_clip(void) {
+    static const float times[] = {0.0f, 0.06f, 0.19f, 0.27f, 1.0f / 3.0f};
+    static const float values[] = {1.0f, 0.7f, -1.0f, -0.3f, 1.0f};
+    const ak_raw_channel ch = {.target = AK_CHANNEL_SCALAR, .index = 0, .component_count = 1,
+                               .interp = AK_INTERP_CARDINAL, .key_count = 5, .times = times, .values = values};
+    const ak_raw_clip raw = {.name = "beat", .channels = &ch, .channel_count = 1, .scalar_count = 1};
+    ak_clip* clip = NULL;
+    return ak_clip_build(&raw, NULL, &clip, NULL) == AK_OK ? clip : NULL;
+}
 
 /* A plane facing up: the renderer's ground plane shows it. */
 static bool is_floor(const ak_boids_obstacle* o) {
@@ -155,7 +169,8 @@ static int renderer_init(renderer* r, int w, int h, const cli_boids_scene* sc, s
         memcpy(r->idx + 12 * i, tri, sizeof tri);
     }
     add_obstacles(r, prm, r->extent);
-    return 0;
+    r->beat = make_beat_clip();
+    return r->beat ? 0 : 1;
 }
 
 static void renderer_free(renderer* r) {
@@ -166,10 +181,11 @@ static void renderer_free(renderer* r) {
     free(r->opos);
     free(r->oidx);
     free(r->pixels);
+    ak_clip_destroy(r->beat);
 }
 
-/* One frame: every agent a small bird (a body and two wings that flap with the agent's own
- * phase) or fish (a body whose tail sways), aligned with its velocity. */
+/* One frame: every agent a small bird (a body and two wings that flap) or fish (a body whose
+ * tail sways), aligned with its velocity, animated by the beat clip at the agent's own phase. */
 static ak_result draw_frame(renderer* r, const cli_boids_scene* sc, const run_state* st, float time, ak_image* out) {
     const float L = sc->shape_size;
     for (size_t i = 0; i < st->n; ++i) {
@@ -179,7 +195,10 @@ static ak_result draw_frame(renderer* r, const cli_boids_scene* sc, const run_st
         if (ak_vec3_length_sq(right) < 0.5f) right = ak_vec3_make(1, 0, 0);
         const ak_vec3 up = ak_vec3_cross(right, f);
         const float phase = (float)((i * 2654435761u) & 1023u) / 1024.0f;
-        const float beat = sinf(AK_TWO_PI * (3.0f * time + phase));
+        const float period = ak_clip_duration(r->beat);
+        float beat = 0.0f;
+        ak_clip_sample(r->beat, ak_time_wrap(time + phase * period, period, AK_WRAP_LOOP), NULL,
+                       (ak_transform_span){NULL, 0}, (ak_f32_span){NULL, 0}, (ak_f32_span){&beat, 1});
         const ak_vec3 p = st->p[i];
         ak_vec3* q = r->pos + 5 * i;
         if (sc->shape == 0) {
