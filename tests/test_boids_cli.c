@@ -70,6 +70,8 @@ AK_TEST(bad_scenes_name_the_key) {
         {"{\"species\": [{\"k_nearest\": 65}]}", "species[0].k_nearest"},
         {"{\"species\": [{\"min_speed\": 5, \"max_speed\": 1}]}", "species[0].min_speed"},
         {"{\"species\": [{\"flee\": [3]}]}", "species[0].flee[0]"},
+        {"{\"species\": [{\"pursue\": [2.2e82]}]}", "species[0].pursue[0]"}, /* fuzz: was a UB cast */
+        {"{\"species\": [{\"flee\": [0.5]}]}", "species[0].flee[0]"},
         {"{\"species\": [{\"colour\": [1, 0, 0]}]}", "colour"},
         {"{\"species\": []}", "species"},
         {"{\"obstacles\": [{\"type\": \"cone\"}]}", "obstacles[0].type"},

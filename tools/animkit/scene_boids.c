@@ -56,8 +56,9 @@ static bool read_mask(cli_json* j, const cJSON* obj, const char* path, const cha
     cli_json_key(p, sizeof p, path, key);
     uint32_t m = 0;
     for (size_t i = 0; e && i < n; ++i, e = e->next) {
-        if (!cJSON_IsNumber(e) || e->valuedouble != (double)(long)e->valuedouble || e->valuedouble < 0 ||
-            e->valuedouble >= (double)species_count) {
+        /* Range first: the integrality test casts, and a cast of an out-of-range double is UB. */
+        if (!cJSON_IsNumber(e) || !(e->valuedouble >= 0 && e->valuedouble < (double)species_count) ||
+            e->valuedouble != (double)(long)e->valuedouble) {
             char q[160];
             return cli_json_fail(j, cli_json_index(q, sizeof q, p, i), NULL,
                                  "expected a species index in [0, %u]", species_count - 1);
