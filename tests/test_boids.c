@@ -132,6 +132,11 @@ AK_TEST(validate_rules) {
     bad.max_speed = 1.0f;
     AK_CHECK_EQ(ak_boids_step_validate(&j), AK_ERR_BAD_ARG);
     bad = sp;
+    bad.min_speed = 1.5f; /* below the default max_speed 2: fine */
+    AK_CHECK_EQ(ak_boids_step_validate(&j), AK_OK);
+    bad.min_speed = 2.5f;
+    AK_CHECK_EQ(ak_boids_step_validate(&j), AK_ERR_BAD_ARG);
+    bad = sp;
     bad.wander_weight = 1.0f;
     j.wander.ptr = NULL;
     AK_CHECK_EQ(ak_boids_step_validate(&j), AK_ERR_NULL_ARG);

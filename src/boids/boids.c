@@ -38,7 +38,8 @@ static bool species_ok(const ak_boids_species* s) {
                        s->pursue_radius};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
         if (!(f[i] >= 0.0f) || !ak_finitef(f[i]) || f[i] > 1e15f) return false;
-    return s->k_nearest <= AK_BOIDS_MAX_K && s->min_speed <= s->max_speed;
+    const float max_speed = s->max_speed > 0.0f ? s->max_speed : 2.0f; /* the resolved default */
+    return s->k_nearest <= AK_BOIDS_MAX_K && s->min_speed <= max_speed;
 }
 
 /* The runtime form of a species: squared radii, the view cone, fixed-point scales. */
