@@ -39,8 +39,9 @@
  * resolved by up to four passes; agents therefore end every step at distance >= 0 from every
  * obstacle (tests check this on spheres, planes and boxes in 2D and 3D).
  *
- * Determinism: each agent's sums are accumulated in 64-bit fixed point (2^-32 of the rule's
- * natural unit), which is exact and so independent of the order neighbours are visited in.
+ * Determinism: each agent's sums are accumulated in 64-bit fixed point (2^-28 of the
+ * cohesion radius for offsets, of max_speed for velocities; 2^-24 of 1/separation_radius for
+ * separation), which is exact and so independent of the order neighbours are visited in.
  * Any thread_count, the grid and the naive path give bit-identical results.
  *
  * What it does NOT do: rendering (the `animkit boids` command draws flocks with raster.h),
@@ -60,8 +61,8 @@
  *     job.scratch = (ak_u8_span){malloc(bytes), bytes};
  *     for (int s = 0; s < steps; ++s) {
  *         job.step_index = (uint64_t)s;
- *         ak_result r = ak_boids_step_run(&job);          // then swap pos/pos2, vel/vel2
- *     }
+ *         ak_result r = ak_boids_step_run(&job);          // then swap pos/pos2, vel/vel2 (and
+ *     }                                                   // the job's pointers) for the next step
  *
  * Ownership and threading: the job reads and writes caller-owned arrays and keeps no pointer.
  * ak_boids_step_run never allocates (thread_count > 1 starts pthreads). Outputs must not alias
