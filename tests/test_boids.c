@@ -616,6 +616,43 @@ AK_TEST(no_agent_enters_an_obstacle) {
     }
 }
 
+AK_TEST(bounds_wrap_and_steer) {
+    /* STEER alone: each axis is a spring of stiffness w inside the margin, so an agent leaving
+     * at speed v goes at most v / sqrt(w) into the band (1 m here, the band is 2 m wide). */
+    flock f = flock_make(200);
+    flock_random(&f, 31, 2.9f, 1.15f, false); /* |v| up to 2 */
+    ak_boids_species sp = {.max_speed = 2, .max_force = 100, .bounds_weight = 4};
+    ak_boids_params prm = {.species = &sp, .species_count = 1, .bounds_min = {-5, -5, -5},
+                           .bounds_max = {5, 5, 5}, .bounds_margin = 2};
+    float deepest = 0;
+    for (int s = 0; s < 300; ++s) {
+        AK_CHECK_EQ(step(&f, &prm, 0.01f, 1, false, (uint64_t)s), AK_OK);
+        for (size_t i = 0; i < f.n; ++i) {
+            const float m = fmaxf(fabsf(f.p[i].x), fmaxf(fabsf(f.p[i].y), fabsf(f.p[i].z)));
+            deepest = fmaxf(deepest, m - 3.0f);
+        }
+    }
+    printf("  steer: deepest %.3f m into the 2 m band (bound 1)\n", deepest);
+    AK_CHECK(deepest > 0.3f);   /* agents did reach the band */
+    AK_CHECK(deepest <= 1.02f); /* v / sqrt(w) = 1, up to time stepping */
+    /* WRAP: everything stays in [min, max) and agents do cross the seam. */
+    prm.bounds = AK_BOIDS_BOUNDS_WRAP;
+    flock_random(&f, 32, 4.9f, 1.15f, true);
+    prm.planar = true;
+    int wrapped = 0;
+    for (int s = 0; s < 200; ++s) {
+        memcpy(f.w, f.p, f.n * sizeof(ak_vec3));
+        AK_CHECK_EQ(step(&f, &prm, 0.05f, 2, false, (uint64_t)s), AK_OK);
+        for (size_t i = 0; i < f.n; ++i) {
+            AK_CHECK(f.p[i].x >= -5 && f.p[i].x < 5 && f.p[i].z >= -5 && f.p[i].z < 5);
+            AK_CHECK_NEAR(f.p[i].y, 0.0f, 0);
+            wrapped += fabsf(f.p[i].x - f.w[i].x) > 5 || fabsf(f.p[i].z - f.w[i].z) > 5;
+        }
+    }
+    AK_CHECK(wrapped > 50);
+    flock_free(&f);
+}
+
 /* ---- determinism ------------------------------------------------------------------------ */
 
 AK_TEST(threads_and_paths_bit_identical) {
@@ -711,6 +748,7 @@ int main(void) {
     AK_RUN(alignment_orders_the_flock);
     AK_RUN(separation_keeps_its_bound);
     AK_RUN(no_agent_enters_an_obstacle);
+    AK_RUN(bounds_wrap_and_steer);
     AK_RUN(threads_and_paths_bit_identical);
     AK_RUN(order_and_min_distance);
     return ak_test_finish();
