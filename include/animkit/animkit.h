@@ -28,5 +28,6 @@
 #include "terrain.h"
 #include "grid.h"
 #include "particles.h"
+#include "boids.h"
 
 #endif

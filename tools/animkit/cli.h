@@ -153,5 +153,6 @@ int cmd_ik(int argc, char** argv);
 int cmd_noise(int argc, char** argv);
 int cmd_terrain(int argc, char** argv);
 int cmd_particles(int argc, char** argv);
+int cmd_boids(int argc, char** argv);
 
 #endif

@@ -22,6 +22,7 @@ static const command commands[] = {
     {"noise", cmd_noise, "evaluate Perlin, simplex, value or Worley noise (or a fractal sum) at a point"},
     {"terrain", cmd_terrain, "generate a fractal terrain: OBJ, 16-bit PNG heightmap, render or GIF flight"},
     {"particles", cmd_particles, "simulate a particle system (scene file or preset) to JSON, PNG or GIF"},
+    {"boids", cmd_boids, "flocking: Reynolds boids with obstacles and predators (JSON, PNG, GIF)"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 
