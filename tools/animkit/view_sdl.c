@@ -1,0 +1,137 @@
+/* animkit view: the SDL2 window. Built with SDL2 when CMake finds it (AK_HAVE_SDL2); without
+ * it view_window_available() is false and `animkit view` needs --headless. The image is
+ * animkit's own software rasterizer output, uploaded to a streaming texture each frame. */
+#include "view_app.h"
+
+#ifdef AK_HAVE_SDL2
+#include <SDL.h>
+
+typedef struct sdl_window {
+    SDL_Window* window;
+    SDL_Renderer* renderer;
+    SDL_Texture* texture;
+    int tex_w, tex_h;
+    bool minimised;
+} sdl_window;
+
+static int map_key(SDL_Keycode k) {
+    switch (k) {
+    case SDLK_ESCAPE: return VIEW_KEY_ESCAPE;
+    case SDLK_LEFT: return VIEW_KEY_LEFT;
+    case SDLK_RIGHT: return VIEW_KEY_RIGHT;
+    case SDLK_UP: return VIEW_KEY_UP;
+    case SDLK_DOWN: return VIEW_KEY_DOWN;
+    case SDLK_SPACE: return ' ';
+    case SDLK_TAB: return '\t';
+    case SDLK_LEFTBRACKET: return '[';
+    case SDLK_RIGHTBRACKET: return ']';
+    default: break;
+    }
+    if ((k >= SDLK_a && k <= SDLK_z) || (k >= SDLK_0 && k <= SDLK_9)) return (int)k;
+    return 0;
+}
+
+static int map_button(Uint8 b) {
+    return b == SDL_BUTTON_LEFT ? VIEW_BUTTON_LEFT : b == SDL_BUTTON_MIDDLE ? VIEW_BUTTON_MIDDLE : b == SDL_BUTTON_RIGHT ? VIEW_BUTTON_RIGHT : 0;
+}
+
+static bool sdl_poll(void* user, view_app* a) {
+    sdl_window* w = user;
+    SDL_Event e;
+    /* minimised: sleep in the event queue instead of drawing */
+    if (w->minimised && SDL_WaitEventTimeout(NULL, 100) == 0) return false;
+    while (SDL_PollEvent(&e)) {
+        view_event ev = {.type = VIEW_EV_KEY};
+        switch (e.type) {
+        case SDL_QUIT: a->quit = true; break;
+        case SDL_WINDOWEVENT:
+            if (e.window.event == SDL_WINDOWEVENT_MINIMIZED) w->minimised = true;
+            else if (e.window.event == SDL_WINDOWEVENT_RESTORED || e.window.event == SDL_WINDOWEVENT_SHOWN ||
+                     e.window.event == SDL_WINDOWEVENT_EXPOSED)
+                w->minimised = false;
+            else if (e.window.event == SDL_WINDOWEVENT_SIZE_CHANGED) {
+                w->minimised = false;
+                if (view_app_resize(a, e.window.data1, e.window.data2)) a->quit = true;
+            }
+            break;
+        case SDL_KEYDOWN:
+            if ((ev.key = map_key(e.key.keysym.sym))) view_app_event(a, &ev);
+            break;
+        case SDL_MOUSEBUTTONDOWN:
+        case SDL_MOUSEBUTTONUP:
+            ev.type = e.type == SDL_MOUSEBUTTONDOWN ? VIEW_EV_MOUSE_DOWN : VIEW_EV_MOUSE_UP;
+            ev.button = map_button(e.button.button);
+            ev.x = (float)e.button.x;
+            ev.y = (float)e.button.y;
+            ev.shift = (SDL_GetModState() & KMOD_SHIFT) != 0;
+            if (ev.button) view_app_event(a, &ev);
+            break;
+        case SDL_MOUSEMOTION:
+            ev.type = VIEW_EV_MOUSE_MOVE;
+            ev.x = (float)e.motion.x;
+            ev.y = (float)e.motion.y;
+            view_app_event(a, &ev);
+            break;
+        case SDL_MOUSEWHEEL:
+            ev.type = VIEW_EV_WHEEL;
+            ev.dy = (float)e.wheel.y;
+            view_app_event(a, &ev);
+            break;
+        default: break;
+        }
+    }
+    return !w->minimised;
+}
+
+static int sdl_present(void* user, const view_app* a) {
+    sdl_window* w = user;
+    if (!w->texture || w->tex_w != a->width || w->tex_h != a->height) {
+        if (w->texture) SDL_DestroyTexture(w->texture);
+        w->texture = SDL_CreateTexture(w->renderer, SDL_PIXELFORMAT_RGBA32, SDL_TEXTUREACCESS_STREAMING, a->width, a->height);
+        if (!w->texture) return cli_fail("view", "cannot create a %dx%d texture: %s", a->width, a->height, SDL_GetError());
+        w->tex_w = a->width;
+        w->tex_h = a->height;
+    }
+    SDL_UpdateTexture(w->texture, NULL, a->image.pixels, a->width * 4);
+    SDL_RenderClear(w->renderer);
+    SDL_RenderCopy(w->renderer, w->texture, NULL, NULL);
+    SDL_RenderPresent(w->renderer);
+    return CLI_OK;
+}
+
+bool view_window_available(void) { return true; }
+
+int view_window_run(view_app* a, const view_script* script) {
+    if (SDL_Init(SDL_INIT_VIDEO) != 0)
+        return cli_fail("view", "cannot open a window (%s); use --headless where there is no display", SDL_GetError());
+    sdl_window w = {0};
+    int rc = CLI_OK;
+    char title[300];
+    snprintf(title, sizeof title, "animkit view - %s", a->scene->name);
+    w.window = SDL_CreateWindow(title, SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, a->width, a->height,
+                                SDL_WINDOW_RESIZABLE);
+    if (w.window) w.renderer = SDL_CreateRenderer(w.window, -1, 0);
+    if (!w.window || !w.renderer) {
+        rc = cli_fail("view", "cannot open a window (%s); use --headless where there is no display", SDL_GetError());
+    } else {
+        view_platform pl = {.user = &w, .poll = sdl_poll, .present = sdl_present};
+        rc = view_app_run(a, script, 0, &pl);
+    }
+    if (w.texture) SDL_DestroyTexture(w.texture);
+    if (w.renderer) SDL_DestroyRenderer(w.renderer);
+    if (w.window) SDL_DestroyWindow(w.window);
+    SDL_Quit();
+    return rc;
+}
+
+#else
+
+bool view_window_available(void) { return false; }
+
+int view_window_run(view_app* a, const view_script* script) {
+    (void)a;
+    (void)script;
+    return cli_fail("view", "this build has no window (SDL2 was not found); use --headless");
+}
+
+#endif
