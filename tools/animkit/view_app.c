@@ -358,6 +358,7 @@ static void draw_hud(view_app* a) {
     do {                                                                                               \
         if (o < sizeof line2) o += (size_t)snprintf(line2 + o, sizeof line2 - o, __VA_ARGS__);           \
     } while (0)
+    if (a->message_frames > 0) APPEND("%s | ", a->message);
     if (a->weight_bone >= 0)
         APPEND("weights %s | ", ak_skeleton_joint_name(skel(a), (size_t)a->weight_joints[a->weight_bone]));
     if (a->effector >= 0) {
@@ -372,8 +373,7 @@ static void draw_hud(view_app* a) {
     if (a->show_skeleton) APPEND("skeleton | ");
     if (a->show_normals) APPEND("normals | ");
     if (a->show_limits) APPEND("limits | ");
-    if (a->message_frames > 0) APPEND("%s", a->message);
-    else APPEND("h: help");
+    APPEND("h: help");
 #undef APPEND
     ak_image_fill_rect(img, 0, 0, (float)a->width, 2.0f * lh + 6.0f, rgba(0.05f, 0.06f, 0.08f, 0.72f));
     ak_image_draw_text(img, 6, 3, line1, sc, rgba(1, 1, 1, 1));
