@@ -22,7 +22,7 @@ static const char* const usage =
     "  --frames N       headless without a script: run N frames (default 1)\n"
     "  --ik-log FILE    after each IK solve, one JSON line: {\"frame\": n, \"solver\": s,\n"
     "                   \"effector\": name, \"target\": [x,y,z], \"reached\": b, \"error\": e}\n"
-    "  --supersample N  anti-aliasing samples per axis, 1..4 (default 2, as render)\n"
+    "  --supersample N  anti-aliasing samples per axis, 1..4 (default 1 for speed; render uses 2)\n"
     "  --threads N      raster threads, 1..64 (default 2)\n"
     "  --stats          print the frame-time breakdown at exit (stderr)\n"
     "  --shot-dir DIR   where the P key writes view_NNNN.png (default .)\n"
@@ -77,7 +77,7 @@ int cmd_view(int argc, char** argv) {
         return CLI_OK;
     }
     if (a.pos_count != 1) return cli_usage("view", "expected one FILE or builtin:NAME");
-    view_options vo = {.width = 960, .height = 600, .clip = -1, .supersample = 2, .threads = 2};
+    view_options vo = {.width = 960, .height = 600, .clip = -1, .supersample = 1, .threads = 2};
     if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &vo.width, &vo.height))
         return cli_usage("view", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
     long v = 0, frames = 1;

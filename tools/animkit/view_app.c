@@ -11,31 +11,31 @@
 
 const view_help_entry view_help[] = {
     {"space", "play / pause"},
-    {"left", "one frame (1/30 s) back, paused"},
-    {"right", "one frame (1/30 s) forward, paused"},
-    {"up", "play faster (x2, up to x16)"},
-    {"down", "play slower (/2, down to x1/16)"},
+    {"left", "back one frame (1/30 s)"},
+    {"right", "forward one frame (1/30 s)"},
+    {"up", "play faster (x2)"},
+    {"down", "play slower (/2)"},
     {"tab", "next clip"},
-    {"l", "loop on / off (off: stop at the end)"},
+    {"l", "loop on / off"},
     {"b", "bind pose on / off"},
-    {"f", "frame all (reset the camera on the current pose)"},
-    {"1", "skinning: linear blend (LBS)"},
-    {"2", "skinning: dual quaternion (DQS)"},
-    {"3", "skinning: centers of rotation (CoR)"},
+    {"f", "frame all (reset the camera)"},
+    {"1", "LBS skinning"},
+    {"2", "DQS skinning"},
+    {"3", "CoR skinning"},
     {"4", "LBS | DQS | CoR side by side"},
-    {"w", "weight heatmap of the next bone (after the last: off)"},
+    {"w", "weight heatmap: next bone"},
     {"n", "normals overlay"},
     {"k", "skeleton overlay"},
-    {"i", "IK solver: CCD, FABRIK, two-bone, DLS"},
-    {"r", "IK chain root one joint up (wraps to the effector's parent)"},
+    {"i", "next IK solver (CCD..DLS)"},
+    {"r", "IK chain root one joint up"},
     {"a", "IK target left"},
     {"d", "IK target right"},
     {"e", "IK target up"},
     {"q", "IK target down"},
     {"z", "IK target towards the camera"},
-    {"x", "IK target away from the camera"},
-    {"j", "joint limits of the IK chain (hinge arcs, ball cones)"},
-    {"escape", "drop the IK effector (quit when there is none)"},
+    {"x", "IK target away from camera"},
+    {"j", "joint limits of the IK chain"},
+    {"escape", "drop the IK effector / quit"},
     {"m", "next morph target"},
     {"[", "morph weight -0.1"},
     {"]", "morph weight +0.1"},
@@ -45,9 +45,12 @@ const view_help_entry view_help[] = {
 const size_t view_help_count = sizeof view_help / sizeof view_help[0];
 
 static const char* const mouse_help[] = {
-    "left drag: orbit; on a joint: pick the IK effector and drag its target",
-    "middle or shift+left drag: pan; wheel: zoom; drag the bottom bar: scrub",
+    "left drag: orbit the camera",
+    "left on a joint: IK effector, drag target",
+    "middle / shift+left drag: pan",
+    "wheel: zoom; bottom bar: drag to scrub",
 };
+#define MOUSE_HELP_COUNT (sizeof mouse_help / sizeof mouse_help[0])
 
 static ak_vec4 rgba(float r, float g, float b, float a) { return ak_vec4_make(r, g, b, a); }
 
@@ -400,19 +403,26 @@ static void draw_hud(view_app* a) {
         }
     }
     if (a->show_help) {
-        size_t lines = view_help_count + 3;
-        float bw = (float)(64 * AK_FONT_ADVANCE_X * sc) + 16.0f, bh = (float)lines * lh + 16.0f;
-        float bx = ((float)a->width - bw) * 0.5f, by = ak_maxf(2.0f * lh + 10.0f, ((float)a->height - bh) * 0.5f);
+        /* one column when it fits, else two; each column 41 characters */
+        float top = 2.0f * lh + 8.0f, avail = (float)a->height - top - 24.0f * (float)sc;
+        int cols = ((float)(view_help_count + MOUSE_HELP_COUNT + 2) * lh + 16.0f <= avail) ? 1 : 2;
+        size_t rows = (view_help_count + (size_t)cols - 1) / (size_t)cols;
+        float cw = (float)(41 * AK_FONT_ADVANCE_X * sc);
+        float bw = (float)cols * cw + 16.0f, bh = (float)(rows + MOUSE_HELP_COUNT + 2) * lh + 16.0f;
+        float bx = ak_maxf(0.0f, ((float)a->width - bw) * 0.5f), by = ak_maxf(top, top + (avail - bh) * 0.5f);
         ak_image_fill_rect(img, bx, by, bw, bh, rgba(0.05f, 0.06f, 0.08f, 0.85f));
         int ty = (int)by + 8;
-        ak_image_draw_text(img, (int)bx + 8, ty, "keys", sc, rgba(1, 0.85f, 0.3f, 1));
+        ak_image_draw_text(img, (int)bx + 8, ty, "keys (h closes)", sc, rgba(1, 0.85f, 0.3f, 1));
         ty += (int)lh;
-        for (size_t i = 0; i < view_help_count; ++i, ty += (int)lh) {
+        for (size_t i = 0; i < view_help_count; ++i) {
             char l[128];
             snprintf(l, sizeof l, "%-7s %s", view_help[i].key, view_help[i].what);
-            ak_image_draw_text(img, (int)bx + 8, ty, l, sc, rgba(1, 1, 1, 1));
+            int col = (int)(i / rows), row = (int)(i % rows);
+            ak_image_draw_text(img, (int)(bx + 8.0f + (float)col * cw), ty + row * (int)lh, l, sc, rgba(1, 1, 1, 1));
         }
-        for (size_t i = 0; i < 2; ++i, ty += (int)lh) ak_image_draw_text(img, (int)bx + 8, ty, mouse_help[i], sc, rgba(0.8f, 0.9f, 1, 1));
+        ty += (int)((float)(rows + 1) * lh);
+        for (size_t i = 0; i < MOUSE_HELP_COUNT; ++i, ty += (int)lh)
+            ak_image_draw_text(img, (int)bx + 8, ty, mouse_help[i], sc, rgba(0.8f, 0.9f, 1, 1));
     }
 }
 
