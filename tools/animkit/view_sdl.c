@@ -12,6 +12,7 @@ typedef struct sdl_window {
     SDL_Texture* texture;
     int tex_w, tex_h;
     bool minimised;
+    double last_present; /* cli_now() of the last present, for the 60 fps cap */
 } sdl_window;
 
 static int map_key(SDL_Keycode k) {
@@ -38,6 +39,9 @@ static int map_button(Uint8 b) {
 static bool sdl_poll(void* user, view_app* a) {
     sdl_window* w = user;
     SDL_Event e;
+    /* live (not scripted): at most 60 frames a second, so an idle viewer leaves the CPU alone */
+    double since = cli_now() - w->last_present;
+    if (!a->opt.scripted && since >= 0.0 && since < 1.0 / 60.0) SDL_Delay((Uint32)((1.0 / 60.0 - since) * 1000.0));
     /* minimised: sleep in the event queue instead of drawing */
     if (w->minimised && SDL_WaitEventTimeout(NULL, 100) == 0) return false;
     while (SDL_PollEvent(&e)) {
@@ -45,7 +49,7 @@ static bool sdl_poll(void* user, view_app* a) {
         switch (e.type) {
         case SDL_QUIT: a->quit = true; break;
         case SDL_WINDOWEVENT:
-            if (e.window.event == SDL_WINDOWEVENT_MINIMIZED) w->minimised = true;
+            if (e.window.event == SDL_WINDOWEVENT_MINIMIZED || e.window.event == SDL_WINDOWEVENT_HIDDEN) w->minimised = true;
             else if (e.window.event == SDL_WINDOWEVENT_RESTORED || e.window.event == SDL_WINDOWEVENT_SHOWN ||
                      e.window.event == SDL_WINDOWEVENT_EXPOSED)
                 w->minimised = false;
@@ -96,6 +100,7 @@ static int sdl_present(void* user, const view_app* a) {
     SDL_RenderClear(w->renderer);
     SDL_RenderCopy(w->renderer, w->texture, NULL, NULL);
     SDL_RenderPresent(w->renderer);
+    w->last_present = cli_now();
     return CLI_OK;
 }
 
