@@ -381,6 +381,32 @@ AK_TEST(long_session) {
     if (f) fclose(f);
 }
 
+/* The interaction script runs on every kind of model the importers give (skinned glTF, morph
+ * targets, skeleton-only BVH, a static OBJ) without an error. */
+AK_TEST(assets_session) {
+    const char* root = getenv("ANIMKIT_ASSETS");
+    char base[1024];
+    snprintf(base, sizeof base, "%s", root ? root : AK_SOURCE_DIR "/../shared/assets");
+    static const char* const models[] = {"gltf/CesiumMan/glTF-Binary/CesiumMan.glb", "gltf/Fox/glTF-Binary/Fox.glb",
+                                         "gltf/MorphStressTest/glTF-Binary/MorphStressTest.glb", "bvh/01_01.bvh",
+                                         "obj/makehuman/base.obj"};
+    write_text("assets.txt", "key w\nkey j\nkey n\nmouse_down left 60 45\nmouse_move 70 50\nmouse_up left 70 50\nkey a\n"
+                             "key i\nkey r\nkey tab\nkey 4\nwait 3\nkey ]\nkey 4\nkey k\nkey f\nwait 2\nscreenshot assets.png\n");
+    int ran = 0;
+    for (size_t i = 0; i < sizeof models / sizeof models[0]; ++i) {
+        char path[1200], args[1400];
+        snprintf(path, sizeof path, "%s/%s", base, models[i]);
+        FILE* f = fopen(path, "rb");
+        if (!f) continue;
+        fclose(f);
+        snprintf(args, sizeof args, "view %s --headless --size 120x90 --script assets.txt", path);
+        int rc = run(args);
+        AK_CHECK_MSG(rc == 0, "%s: exit %d: %s", models[i], rc, out_buf);
+        ++ran;
+    }
+    if (!ran) printf("  SKIP: no assets found (set ANIMKIT_ASSETS)\n");
+}
+
 /* The real window under a virtual X display gives the headless images. */
 AK_TEST(window_under_xvfb) {
     AK_CHECK_EQ(run("view --help"), 0);
@@ -413,6 +439,7 @@ int main(void) {
     AK_RUN(every_help_key_does_something);
     AK_RUN(morph_keys);
     AK_RUN(long_session);
+    AK_RUN(assets_session);
     AK_RUN(window_under_xvfb);
     return ak_test_finish();
 }

@@ -325,6 +325,11 @@ static void draw_ik(const view_app* a, const cli_frame* f, const ak_image* img) 
     if (project(f, a->target, &t)) {
         ak_vec4 c = a->ik_valid && a->ik_reached ? rgba(0.15f, 0.85f, 0.3f, 1) : rgba(0.95f, 0.15f, 0.2f, 1);
         ak_image_draw_disc(img, t, 7.0f, c, 2.0f, rgba(1, 1, 1, 1));
+        char label[64];
+        if (a->ik_problem) snprintf(label, sizeof label, "%s", a->ik_problem);
+        else if (a->ik_valid) snprintf(label, sizeof label, "%s %.3g", a->ik_reached ? "reached" : "error", (double)a->ik_error);
+        else label[0] = '\0';
+        ak_image_draw_text(img, (int)(t.x + 11.0f), (int)(t.y - 4.0f), label, 1, rgba(0.05f, 0.05f, 0.08f, 1));
     }
 }
 
