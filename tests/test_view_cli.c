@@ -345,7 +345,7 @@ AK_TEST(morph_keys) {
         f = fopen(path, "rb");
     }
     if (!f) {
-        printf("  SKIP: AnimatedMorphCube not found (set ANIMKIT_ASSETS)\n");
+        AK_SKIP("AnimatedMorphCube not found (set ANIMKIT_ASSETS)");
         return;
     }
     fclose(f);
@@ -404,18 +404,18 @@ AK_TEST(assets_session) {
         AK_CHECK_MSG(rc == 0, "%s: exit %d: %s", models[i], rc, out_buf);
         ++ran;
     }
-    if (!ran) printf("  SKIP: no assets found (set ANIMKIT_ASSETS)\n");
+    if (!ran) AK_SKIP("no assets found (set ANIMKIT_ASSETS)");
 }
 
 /* The real window under a virtual X display gives the headless images. */
 AK_TEST(window_under_xvfb) {
     AK_CHECK_EQ(run("view --help"), 0);
     if (!strstr(out_buf, "This build has a window")) {
-        printf("  SKIP: this build has no SDL2 window\n");
+        AK_SKIP("this build has no SDL2 window");
         return;
     }
     if (system("command -v xvfb-run >/dev/null 2>&1") != 0) {
-        printf("  SKIP: xvfb-run not found (Debian xvfb, xauth)\n");
+        AK_SKIP("xvfb-run not found (Debian xvfb, xauth)");
         return;
     }
     write_text("win_x.txt", "wait 10\nkey space\nkey w\nscreenshot win_x.png\nquit\n");

@@ -87,7 +87,10 @@ int view_app_resize(view_app* a, int w, int h) {
     memset(&a->panel_image, 0, sizeof a->panel_image);
     a->width = w;
     a->height = h;
-    return make_frame(a, &a->frame, &a->image, w, h);
+    if (make_frame(a, &a->frame, &a->image, w, h) == CLI_OK) return CLI_OK;
+    a->quit = true;
+    a->exit_code = cli_fail("view", "out of memory for a %dx%d view", w, h);
+    return a->exit_code;
 }
 
 /* ---- IK ---- */
@@ -802,7 +805,7 @@ int view_app_init(view_app* a, const ak_scene* s, const view_options* opt) {
     view_app_frame_all(a);
     if (view_app_resize(a, opt->width, opt->height)) {
         view_app_free(a);
-        return cli_fail("view", "out of memory for a %dx%d view", opt->width, opt->height);
+        return CLI_BAD_INPUT;
     }
     return CLI_OK;
 }
@@ -869,5 +872,5 @@ int view_app_run(view_app* a, const view_script* script, long max_frames, const 
         ++done;
         if (pending > 0) --pending;
     }
-    return rc;
+    return rc != CLI_OK ? rc : a->exit_code;
 }

@@ -172,6 +172,7 @@ typedef struct view_app {
     int shot_count;
     view_stats stats;
     bool quit;
+    int exit_code;           /* set with quit when the loop must end with an error */
     /* simulation plug-in (NULL: none) */
     const view_sim* sim;
     void* sim_state;
@@ -179,7 +180,8 @@ typedef struct view_app {
 
 int view_app_init(view_app* app, const ak_scene* scene, const view_options* opt);
 void view_app_free(view_app* app);
-/* Re-create the targets for a new window size. */
+/* Re-create the targets for a new window size (below 8 pixels: kept as they are). On failure
+ * prints why and sets quit with exit_code CLI_BAD_INPUT. */
 int view_app_resize(view_app* app, int width, int height);
 /* Apply one input event (KEY, MOUSE_*, WHEEL). */
 void view_app_event(view_app* app, const view_event* ev);

@@ -55,7 +55,7 @@ static bool sdl_poll(void* user, view_app* a) {
                 w->minimised = false;
             else if (e.window.event == SDL_WINDOWEVENT_SIZE_CHANGED) {
                 w->minimised = false;
-                if (view_app_resize(a, e.window.data1, e.window.data2)) a->quit = true;
+                view_app_resize(a, e.window.data1, e.window.data2); /* sets quit on failure */
             }
             break;
         case SDL_KEYDOWN:
