@@ -1,6 +1,6 @@
 /* animkit view: the SDL2 window. Built with SDL2 when CMake finds it (AK_HAVE_SDL2); without
  * it view_window_available() is false and `animkit view` needs --headless. The image is
- * animkit's own software rasterizer output, uploaded to a streaming texture each frame. */
+ * animkit's own software rasterizer output, copied to the window surface each frame. */
 #include "view_app.h"
 
 #ifdef AK_HAVE_SDL2
@@ -8,9 +8,6 @@
 
 typedef struct sdl_window {
     SDL_Window* window;
-    SDL_Renderer* renderer;
-    SDL_Texture* texture;
-    int tex_w, tex_h;
     bool minimised;
     double last_present; /* cli_now() of the last present, for the 60 fps cap */
 } sdl_window;
@@ -87,19 +84,19 @@ static bool sdl_poll(void* user, view_app* a) {
     return !w->minimised;
 }
 
+/* The frame goes to the window surface (converted from RGBA8 to its format): no renderer, so
+ * no GL context on machines whose only GL is a software one (Xvfb, llvmpipe). */
 static int sdl_present(void* user, const view_app* a) {
     sdl_window* w = user;
-    if (!w->texture || w->tex_w != a->width || w->tex_h != a->height) {
-        if (w->texture) SDL_DestroyTexture(w->texture);
-        w->texture = SDL_CreateTexture(w->renderer, SDL_PIXELFORMAT_RGBA32, SDL_TEXTUREACCESS_STREAMING, a->width, a->height);
-        if (!w->texture) return cli_fail("view", "cannot create a %dx%d texture: %s", a->width, a->height, SDL_GetError());
-        w->tex_w = a->width;
-        w->tex_h = a->height;
-    }
-    SDL_UpdateTexture(w->texture, NULL, a->image.pixels, a->width * 4);
-    SDL_RenderClear(w->renderer);
-    SDL_RenderCopy(w->renderer, w->texture, NULL, NULL);
-    SDL_RenderPresent(w->renderer);
+    SDL_Surface* surf = SDL_GetWindowSurface(w->window); /* re-fetched: a resize invalidates it */
+    if (!surf) return cli_fail("view", "cannot draw into the window: %s", SDL_GetError());
+    int cw = surf->w < a->width ? surf->w : a->width, ch = surf->h < a->height ? surf->h : a->height;
+    if (SDL_MUSTLOCK(surf) && SDL_LockSurface(surf) != 0) return cli_fail("view", "cannot lock the window: %s", SDL_GetError());
+    int r = SDL_ConvertPixels(cw, ch, SDL_PIXELFORMAT_RGBA32, a->image.pixels, a->width * 4, surf->format->format, surf->pixels,
+                              surf->pitch);
+    if (SDL_MUSTLOCK(surf)) SDL_UnlockSurface(surf);
+    if (r != 0 || SDL_UpdateWindowSurface(w->window) != 0)
+        return cli_fail("view", "cannot update the window: %s", SDL_GetError());
     w->last_present = cli_now();
     return CLI_OK;
 }
@@ -115,15 +112,12 @@ int view_window_run(view_app* a, const view_script* script) {
     snprintf(title, sizeof title, "animkit view - %s", a->scene->name);
     w.window = SDL_CreateWindow(title, SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, a->width, a->height,
                                 SDL_WINDOW_RESIZABLE);
-    if (w.window) w.renderer = SDL_CreateRenderer(w.window, -1, 0);
-    if (!w.window || !w.renderer) {
+    if (!w.window) {
         rc = cli_fail("view", "cannot open a window (%s); use --headless where there is no display", SDL_GetError());
     } else {
         view_platform pl = {.user = &w, .poll = sdl_poll, .present = sdl_present};
         rc = view_app_run(a, script, 0, &pl);
     }
-    if (w.texture) SDL_DestroyTexture(w.texture);
-    if (w.renderer) SDL_DestroyRenderer(w.renderer);
     if (w.window) SDL_DestroyWindow(w.window);
     SDL_Quit();
     return rc;
