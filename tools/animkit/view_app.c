@@ -346,6 +346,18 @@ static void timeline_rect(const view_app* a, float* x, float* y, float* w, float
     *y = (float)a->height - *h - 6.0f * (float)s;
 }
 
+/* Name of morph target k in the scene's flat morph index (mesh order), "" when unnamed. */
+static const char* morph_name(const view_app* a, size_t k) {
+    const ak_scene* s = a->scene;
+    for (size_t m = 0; m < s->mesh_count; ++m) {
+        const ak_mesh* mesh = s->meshes[m].mesh;
+        if (!mesh) continue;
+        if (k < mesh->morph_target_count) return mesh->morph_names ? mesh->morph_names[k] : "";
+        k -= mesh->morph_target_count;
+    }
+    return "";
+}
+
 static void draw_hud(view_app* a) {
     const ak_image* img = &a->image;
     const ak_scene* s = a->scene;
@@ -380,7 +392,9 @@ static void draw_hud(view_app* a) {
     } else {
         APPEND("IK %s | ", ak_ik_solver_name(a->solver));
     }
-    if (a->morph_count) APPEND("morph %d: %.2f | ", a->morph_index, (double)a->poser.morph_weights[a->morph_index]);
+    if (a->morph_count)
+        APPEND("morph %d %s: %.2f | ", a->morph_index, morph_name(a, (size_t)a->morph_index),
+               (double)a->poser.morph_weights[a->morph_index]);
     if (a->show_skeleton) APPEND("skeleton | ");
     if (a->show_normals) APPEND("normals | ");
     if (a->show_limits) APPEND("limits | ");
@@ -400,6 +414,14 @@ static void draw_hud(view_app* a) {
         u = ak_clampf(u, 0.0f, 1.0f);
         ak_image_fill_rect(img, x, y, w * u, h, rgba(0.35f, 0.65f, 1.0f, 1));
         ak_image_fill_rect(img, x + w * u - 2.0f, y - 2.0f, 4.0f, h + 4.0f, rgba(1, 1, 1, 1));
+    }
+    if (a->morph_count) {
+        /* the selected morph target's weight as a slider under the status band ([ and ] move it) */
+        float sw = 120.0f * (float)sc, sh = 6.0f * (float)sc, sx = (float)a->width - sw - 10.0f, sy = 2.0f * lh + 12.0f;
+        float u = ak_clampf(a->poser.morph_weights[a->morph_index], 0.0f, 1.0f);
+        ak_image_fill_rect(img, sx, sy, sw, sh, rgba(0.3f, 0.32f, 0.36f, 0.9f));
+        ak_image_fill_rect(img, sx, sy, sw * u, sh, rgba(1.0f, 0.6f, 0.2f, 1));
+        ak_image_fill_rect(img, sx + sw * u - 1.5f, sy - 2.0f, 3.0f, sh + 4.0f, rgba(1, 1, 1, 1));
     }
     if (a->side_by_side) {
         static const char* const names[3] = {"LBS", "DQS", "CoR"};
@@ -578,6 +600,7 @@ static void key(view_app* a, int k) {
             a->clip = (a->clip + 1) % (int)a->scene->clip_count;
             a->time = 0;
             a->bind = false;
+            if (a->sim && a->sim->reset) a->sim->reset(a->sim_state);
         } else {
             message(a, "this model has no clips");
         }

@@ -80,7 +80,7 @@ void view_script_free(view_script* s);
 
 /* A live simulation the viewer steps and draws with the model's camera. The viewer calls
  * init once, step once per frame while playing (dt in seconds, fixed while scripted), reset
- * on the reset key, meshes before drawing (extra meshes added to the frame, as props are),
+ * when time restarts (tab), meshes before drawing (extra meshes added to the frame, as props are),
  * overlay after drawing (2D marks over the image), and destroy at exit. */
 typedef struct view_sim {
     const char* name;
