@@ -16,6 +16,8 @@ PACKAGES=(
   libsdl2-dev       # the window of `animkit view` (optional: without it, --headless only)
   xvfb              # virtual display: tests run the viewer's window under xvfb-run
   xauth             # xvfb-run needs it
+  clang             # the ASan+UBSan CI stage and scripts/fuzz.sh
+  libclang-rt-14-dev # clang's sanitizer and libFuzzer runtimes (-fsanitize=fuzzer), Debian 12
 )
 
 missing=()

@@ -1,0 +1,314 @@
+/* Strict JSON scene reading for the command line: see cli_json.h. */
+#include "cli_json.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char* type_name(const cJSON* v) {
+    if (cJSON_IsNumber(v)) return "a number";
+    if (cJSON_IsString(v)) return "a string";
+    if (cJSON_IsBool(v)) return "a boolean";
+    if (cJSON_IsNull(v)) return "null";
+    if (cJSON_IsArray(v)) return "an array";
+    if (cJSON_IsObject(v)) return "an object";
+    return "an invalid value";
+}
+
+bool cli_json_fail(cli_json* j, const char* path, const char* key, const char* fmt, ...) {
+    if (j->failed) return false;
+    j->failed = true;
+    char where[256];
+    cli_json_key(where, sizeof where, path ? path : "", key ? key : "");
+    char what[384];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    const char* file = j->file ? j->file : "(scene)";
+    if (where[0])
+        snprintf(j->message, sizeof j->message, "%.150s: %.120s: %.230s", file, where, what);
+    else
+        snprintf(j->message, sizeof j->message, "%.150s: %.350s", file, what);
+    return false;
+}
+
+const char* cli_json_index(char* buf, size_t size, const char* base, size_t index) {
+    if (size) snprintf(buf, size, "%s[%zu]", base ? base : "", index);
+    return buf;
+}
+
+const char* cli_json_key(char* buf, size_t size, const char* base, const char* key) {
+    if (!size) return buf;
+    base = base ? base : "";
+    key = key ? key : "";
+    if (!base[0])
+        snprintf(buf, size, "%s", key);
+    else if (!key[0])
+        snprintf(buf, size, "%s", base);
+    else
+        snprintf(buf, size, "%s.%s", base, key);
+    return buf;
+}
+
+cJSON* cli_json_parse(cli_json* j, const char* text, size_t size) {
+    if (j->failed) return NULL;
+    const char* end = NULL;
+    cJSON* root = cJSON_ParseWithLengthOpts(text, size, &end, false);
+    if (!root) {
+        /* cJSON reports where it stopped; turn the byte offset into a line and column. */
+        size_t at = (end && end >= text && end <= text + size) ? (size_t)(end - text) : 0;
+        size_t line = 1, col = 1;
+        for (size_t i = 0; i < at; ++i) {
+            if (text[i] == '\n') {
+                ++line;
+                col = 1;
+            } else {
+                ++col;
+            }
+        }
+        cli_json_fail(j, "", NULL, "invalid JSON at line %zu, column %zu", line, col);
+        return NULL;
+    }
+    /* Trailing content other than whitespace is an error, as in any strict reader. */
+    if (end) {
+        for (const char* p = end; p < text + size; ++p) {
+            if (*p == '\0') break;
+            if (*p != ' ' && *p != '\t' && *p != '\n' && *p != '\r') {
+                cJSON_Delete(root);
+                cli_json_fail(j, "", NULL, "unexpected content after the JSON value");
+                return NULL;
+            }
+        }
+    }
+    if (!cJSON_IsObject(root)) {
+        cli_json_fail(j, "", NULL, "the top level is not an object (got %s)", type_name(root));
+        cJSON_Delete(root);
+        return NULL;
+    }
+    return root;
+}
+
+cJSON* cli_json_load(cli_json* j, const char* path, size_t max_size) {
+    if (!j->file) j->file = path;
+    if (j->failed) return NULL;
+    if (!max_size) max_size = CLI_JSON_MAX_SIZE;
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        cli_json_fail(j, "", NULL, "cannot open the file");
+        return NULL;
+    }
+    size_t cap = 4096, size = 0;
+    char* text = malloc(cap);
+    while (text) {
+        if (size == cap) {
+            if (cap >= max_size + 1) break;
+            size_t next = cap * 2 > max_size + 1 ? max_size + 1 : cap * 2;
+            char* grown = realloc(text, next);
+            if (!grown) {
+                free(text);
+                text = NULL;
+                break;
+            }
+            text = grown;
+            cap = next;
+        }
+        size_t got = fread(text + size, 1, cap - size, f);
+        size += got;
+        if (got == 0) break;
+    }
+    bool read_error = ferror(f) != 0;
+    fclose(f);
+    if (!text) {
+        cli_json_fail(j, "", NULL, "out of memory reading the file");
+        return NULL;
+    }
+    cJSON* root = NULL;
+    if (read_error)
+        cli_json_fail(j, "", NULL, "read error");
+    else if (size > max_size)
+        cli_json_fail(j, "", NULL, "the file is larger than %zu bytes", max_size);
+    else
+        root = cli_json_parse(j, text, size);
+    free(text);
+    return root;
+}
+
+bool cli_json_object(cli_json* j, const cJSON* obj, const char* path, const char* const* allowed) {
+    if (j->failed) return false;
+    if (!cJSON_IsObject(obj)) return cli_json_fail(j, path, NULL, "expected an object, got %s", type_name(obj));
+    for (const cJSON* m = obj->child; m; m = m->next) {
+        const char* name = m->string ? m->string : "";
+        bool known = false;
+        for (size_t i = 0; allowed && allowed[i]; ++i)
+            if (strcmp(allowed[i], name) == 0) known = true;
+        if (!known) {
+            char list[256] = "";
+            size_t used = 0;
+            for (size_t i = 0; allowed && allowed[i] && used < sizeof list; ++i) {
+                int w = snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", allowed[i]);
+                if (w < 0) break;
+                used += (size_t)w;
+            }
+            return cli_json_fail(j, path, NULL, "unknown key \"%s\" (allowed: %s)", name, list);
+        }
+        for (const cJSON* o = obj->child; o != m; o = o->next)
+            if (o->string && strcmp(o->string, name) == 0)
+                return cli_json_fail(j, path, name, "the key appears twice");
+    }
+    return true;
+}
+
+/* The member key of obj, or NULL; fails when obj itself is not an object. */
+static const cJSON* member(cli_json* j, const cJSON* obj, const char* path, const char* key, bool* ok) {
+    *ok = !j->failed;
+    if (!*ok) return NULL;
+    if (!cJSON_IsObject(obj)) {
+        *ok = cli_json_fail(j, path, NULL, "expected an object, got %s", type_name(obj));
+        return NULL;
+    }
+    return cJSON_GetObjectItemCaseSensitive(obj, key);
+}
+
+/* A finite number in [lo, hi] from v, or an error at path.key. */
+static bool number_value(cli_json* j, const cJSON* v, const char* path, const char* key, double lo, double hi,
+                         double* out) {
+    if (!cJSON_IsNumber(v)) return cli_json_fail(j, path, key, "expected a number, got %s", type_name(v));
+    double x = v->valuedouble;
+    if (!isfinite(x)) return cli_json_fail(j, path, key, "the number is not finite");
+    if (x < lo || x > hi) return cli_json_fail(j, path, key, "%.9g is outside [%g, %g]", x, lo, hi);
+    *out = x;
+    return true;
+}
+
+bool cli_json_number(cli_json* j, const cJSON* obj, const char* path, const char* key, double lo, double hi,
+                     double* inout) {
+    bool ok;
+    const cJSON* v = member(j, obj, path, key, &ok);
+    if (!ok || !v) return ok;
+    return number_value(j, v, path, key, lo, hi, inout);
+}
+
+bool cli_json_float(cli_json* j, const cJSON* obj, const char* path, const char* key, float lo, float hi,
+                    float* inout) {
+    double x = *inout;
+    if (!cli_json_number(j, obj, path, key, lo, hi, &x)) return false;
+    *inout = (float)x;
+    return true;
+}
+
+bool cli_json_int(cli_json* j, const cJSON* obj, const char* path, const char* key, long lo, long hi,
+                  long* inout) {
+    bool ok;
+    const cJSON* v = member(j, obj, path, key, &ok);
+    if (!ok || !v) return ok;
+    double x = 0.0;
+    if (!number_value(j, v, path, key, (double)lo, (double)hi, &x)) return false;
+    if (x != floor(x)) return cli_json_fail(j, path, key, "expected an integer, got %.9g", x);
+    *inout = (long)x;
+    return true;
+}
+
+bool cli_json_bool(cli_json* j, const cJSON* obj, const char* path, const char* key, bool* inout) {
+    bool ok;
+    const cJSON* v = member(j, obj, path, key, &ok);
+    if (!ok || !v) return ok;
+    if (!cJSON_IsBool(v)) return cli_json_fail(j, path, key, "expected true or false, got %s", type_name(v));
+    *inout = cJSON_IsTrue(v);
+    return true;
+}
+
+bool cli_json_str(cli_json* j, const cJSON* obj, const char* path, const char* key, const char** inout) {
+    bool ok;
+    const cJSON* v = member(j, obj, path, key, &ok);
+    if (!ok || !v) return ok;
+    if (!cJSON_IsString(v) || !v->valuestring)
+        return cli_json_fail(j, path, key, "expected a string, got %s", type_name(v));
+    *inout = v->valuestring;
+    return true;
+}
+
+bool cli_json_enum(cli_json* j, const cJSON* obj, const char* path, const char* key, const char* const* names,
+                   int* inout) {
+    const char* s = NULL;
+    if (!cli_json_str(j, obj, path, key, &s)) return false;
+    if (!s) return true;
+    char list[256] = "";
+    size_t used = 0;
+    for (int i = 0; names[i]; ++i) {
+        if (strcmp(names[i], s) == 0) {
+            *inout = i;
+            return true;
+        }
+        if (used < sizeof list) {
+            int w = snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", names[i]);
+            if (w > 0) used += (size_t)w;
+        }
+    }
+    return cli_json_fail(j, path, key, "\"%s\" is not one of: %s", s, list);
+}
+
+bool cli_json_floats(cli_json* j, const cJSON* obj, const char* path, const char* key, size_t count, float lo,
+                     float hi, float* inout) {
+    bool ok;
+    const cJSON* v = member(j, obj, path, key, &ok);
+    if (!ok || !v) return ok;
+    if (!cJSON_IsArray(v)) return cli_json_fail(j, path, key, "expected an array of %zu numbers, got %s", count, type_name(v));
+    size_t n = 0;
+    for (const cJSON* e = v->child; e; e = e->next) ++n;
+    if (n != count) return cli_json_fail(j, path, key, "expected %zu numbers, got %zu", count, n);
+    float tmp[16];
+    float* dst = count <= 16 ? tmp : inout; /* small arrays are all-or-nothing */
+    char at[256], el[280];
+    cli_json_key(at, sizeof at, path, key);
+    size_t i = 0;
+    for (const cJSON* e = v->child; e; e = e->next, ++i) {
+        double x = 0.0;
+        if (!number_value(j, e, cli_json_index(el, sizeof el, at, i), NULL, lo, hi, &x)) return false;
+        dst[i] = (float)x;
+    }
+    if (dst == tmp) memcpy(inout, tmp, count * sizeof(float));
+    return true;
+}
+
+bool cli_json_vec3(cli_json* j, const cJSON* obj, const char* path, const char* key, ak_vec3* inout) {
+    float v[3] = {inout->x, inout->y, inout->z};
+    if (!cli_json_floats(j, obj, path, key, 3, -HUGE_VALF, HUGE_VALF, v)) return false;
+    inout->x = v[0];
+    inout->y = v[1];
+    inout->z = v[2];
+    return true;
+}
+
+const cJSON* cli_json_array(cli_json* j, const cJSON* obj, const char* path, const char* key, size_t max_count,
+                            size_t* out_count) {
+    *out_count = 0;
+    bool ok;
+    const cJSON* v = member(j, obj, path, key, &ok);
+    if (!ok || !v) return NULL;
+    if (!cJSON_IsArray(v)) {
+        cli_json_fail(j, path, key, "expected an array, got %s", type_name(v));
+        return NULL;
+    }
+    size_t n = 0;
+    for (const cJSON* e = v->child; e; e = e->next) ++n;
+    if (n > max_count) {
+        cli_json_fail(j, path, key, "%zu elements, more than the limit of %zu", n, max_count);
+        return NULL;
+    }
+    *out_count = n;
+    return v->child;
+}
+
+const cJSON* cli_json_member(cli_json* j, const cJSON* obj, const char* path, const char* key) {
+    bool ok;
+    const cJSON* v = member(j, obj, path, key, &ok);
+    if (!ok || !v) return NULL;
+    if (!cJSON_IsObject(v)) {
+        cli_json_fail(j, path, key, "expected an object, got %s", type_name(v));
+        return NULL;
+    }
+    return v;
+}
