@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../../tools/animkit/view_app.h"
+#include "view_app.h" /* tools/animkit, on the include path of scripts/fuzz.sh */
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
