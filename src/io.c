@@ -173,7 +173,9 @@ ak_result akp_io_build_skeleton(ak_scene* scene, const akp_io_node* nodes, size_
         joints[k].rest = n->rest;
         joints[k].inverse_bind = n->inverse_bind;
     }
-    ak_skeleton_desc sd = {.joints = joints, .joint_count = count, .name = scene->name};
+    /* A loaded mesh's joint indices are slots of its skin (scene.h), so a palette indexed by
+     * skeleton joint is refused (ak_skeleton_skinning_matrices) rather than silently wrong. */
+    ak_skeleton_desc sd = {.joints = joints, .joint_count = count, .name = scene->name, .palette_from_skins = true};
     r = ak_skeleton_create(&sd, a, &scene->skeleton, diag);
     if (r != AK_OK && diag) {
         char msg[sizeof diag->message];

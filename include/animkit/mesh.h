@@ -56,7 +56,8 @@ typedef struct ak_mesh {
     ak_vec2* uvs;               /* [vertex_count], or NULL */
     ak_vec4* colors;            /* [vertex_count] linear RGBA, or NULL */
     uint32_t* indices;          /* [3 * triangle_count], counter-clockwise from outside */
-    uint16_t* joints;           /* [vertex_count * influence_count] skeleton joint indices */
+    uint16_t* joints;           /* [vertex_count * influence_count] palette indices: in a
+                                   scene, slots of the mesh's skin (ak_scene_skin_palette) */
     float* weights;             /* [vertex_count * influence_count], >= 0, sum 1 per vertex */
     ak_vec3* morph_positions;   /* [morph_target_count * vertex_count] deltas, target-major */
     ak_vec3* morph_normals;     /* same layout, or NULL */

@@ -170,6 +170,11 @@ void cli_json_string(FILE* f, const char* s) {
     fputc('"', f);
 }
 
+void cli_json_write_number(FILE* f, double v) {
+    if (isfinite(v)) fprintf(f, "%.9g", v);
+    else fputs("null", f);
+}
+
 void cli_progress(const char* label, size_t done, size_t total) {
     if (!isatty(STDERR_FILENO) || total == 0) return;
     const int width = 30;

@@ -65,6 +65,9 @@ int cli_load_scene(const char* cmd, const char* spec, ak_scene** out);
 
 /* JSON string literal with escapes. */
 void cli_json_string(FILE* f, const char* s);
+/* JSON number: "%.9g" for a finite value; `null` for NaN or infinity (JSON has no token for
+ * them), so what --json prints always parses. Readers of our JSON treat null as "no value". */
+void cli_json_write_number(FILE* f, double v);
 
 /* Progress bar on stderr when it is a terminal; silent otherwise. done == total ends it. */
 void cli_progress(const char* label, size_t done, size_t total);
