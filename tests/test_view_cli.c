@@ -134,6 +134,30 @@ AK_TEST(methods_match_render) {
     AK_CHECK_MSG(d12 > 100, "LBS and DQS differ in only %ld pixels", d12);
 }
 
+/* Orbit, pan and zoom change the view; F puts back the opening view exactly (no frame runs in
+ * between, so the pose is the same). Dragging the timeline to its middle gives the frame that
+ * playing 15 fixed steps (0.5 s of the 1 s clip) and pausing gives. */
+AK_TEST(camera_and_scrub) {
+    const int w = 320, h = 240;
+    write_text("cam.txt", "screenshot cam0.png\nmouse_down left 30 50\nmouse_move 90 80\nmouse_up left 90 80\n"
+                          "screenshot cam1.png\nkey f\nscreenshot cam2.png\nmouse_down middle 100 100\nmouse_move 140 120\n"
+                          "mouse_up middle 140 120\nscreenshot cam3.png\nwheel 3\nscreenshot cam4.png\nkey f\n"
+                          "screenshot cam5.png\nquit\n");
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script cam.txt"), 0);
+    AK_CHECK(count_diff("cam0.png", "cam1.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 500);
+    AK_CHECK_EQ(count_diff("cam0.png", "cam2.png", w, h, 0, h, NULL), 0);
+    AK_CHECK(count_diff("cam2.png", "cam3.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 500);
+    AK_CHECK(count_diff("cam3.png", "cam4.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 500);
+    AK_CHECK_EQ(count_diff("cam0.png", "cam5.png", w, h, 0, h, NULL), 0);
+    /* the bar spans x in [8, w - 8] at the bottom: its middle is x = w / 2 */
+    write_text("play.txt", "wait 15\nkey space\nscreenshot played.png\nquit\n");
+    write_text("scrub.txt", "mouse_down left 100 230\nmouse_move 160 231\nmouse_up left 160 231\nscreenshot scrubbed.png\nquit\n");
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script play.txt"), 0);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script scrub.txt"), 0);
+    AK_CHECK_EQ(count_diff("played.png", "scrubbed.png", w, h, 0, h, NULL), 0);
+    AK_CHECK(count_diff("played.png", "cam0.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 100);
+}
+
 /* Where the library puts the humanoid's joints on screen at the bind pose after F. */
 typedef struct arm_view {
     ak_raster_camera cam;
@@ -435,6 +459,7 @@ AK_TEST(window_under_xvfb) {
 int main(void) {
     AK_RUN(bad_scripts_exit_2_naming_the_line);
     AK_RUN(methods_match_render);
+    AK_RUN(camera_and_scrub);
     AK_RUN(ik_drag_wrist);
     AK_RUN(every_help_key_does_something);
     AK_RUN(morph_keys);
