@@ -154,5 +154,6 @@ int cmd_noise(int argc, char** argv);
 int cmd_terrain(int argc, char** argv);
 int cmd_particles(int argc, char** argv);
 int cmd_boids(int argc, char** argv);
+int cmd_view(int argc, char** argv);
 
 #endif
