@@ -51,6 +51,10 @@ void akp_skin_range_scalar(const akp_skin_ctx* c, size_t begin, size_t end);
 bool akp_skin_range_avx2(const akp_skin_ctx* c, size_t begin, size_t end);
 /* True when the AVX2 kernel is compiled in and the CPU supports AVX2 and FMA. */
 bool akp_skin_have_avx2(void);
+/* The same for the AVX-512 kernel (deform_avx512.c: 16 vertices per block, partial blocks
+ * masked, so it handles any range): AVX-512 F, VL, DQ, BW plus AVX2 and FMA. */
+bool akp_skin_range_avx512(const akp_skin_ctx* c, size_t begin, size_t end);
+bool akp_skin_have_avx512(void);
 
 /* Closest-point distance squared from p to the segment [a, b] (a == b allowed). */
 static inline float akp_segment_dist_sq(ak_vec3 p, ak_vec3 a, ak_vec3 b, ak_vec3* out_closest) {
