@@ -4,10 +4,13 @@
  *   build/bench/bench_skin [vertex_count]      (default 1,000,000 vertices, 64 joints, 4 influences)
  *
  * Prints, for LBS (positions; positions + normals), DQS and CoR (positions + normals):
- * M vertices/s and effective GB/s for the AVX2 kernel, the library's scalar code and a plain
- * scalar loop written here (what a straightforward implementation does), on 1 and 2 threads;
- * then the CoR precomputation and heat weights on a CesiumMan-sized generated mesh and on
- * CesiumMan itself when the assets and the io module are available. */
+ * M vertices/s and effective GB/s on every kernel this CPU has (AVX-512, AVX2, the library's
+ * scalar code, picked with job.simd_limit) and a plain scalar loop written here, single thread
+ * in CPU time, all in the same interleaved rounds; 1 vs 2 threads in wall time, interleaved,
+ * each against the triad with the same thread count; every kernel on 1..8 influences in
+ * cache; the data check; then the CoR precomputation and heat weights on a CesiumMan-sized
+ * generated mesh and on CesiumMan itself when the assets and the io module are available.
+ * Every ratio printed compares rows measured in the same rounds. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
