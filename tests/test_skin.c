@@ -665,8 +665,9 @@ AK_TEST(every_simd_kernel_matches_scalar) {
             memcpy(v[i].pos, &pos[i], 12), memcpy(v[i].nrm, &nrm[i], 12), memcpy(v[i].ctr, &ctr[i], 12);
             memcpy(v[i].joints, &jn[K * i], K * sizeof *jn), memcpy(v[i].weights, &w[K * i], K * sizeof *w);
         }
-        for (int method = AK_SKIN_LBS; method <= AK_SKIN_COR; ++method) {
-            const ak_mat4* pm = method == AK_SKIN_LBS ? pal : pal_rigid; /* DQS/CoR SIMD: rigid only */
+        for (int mi = 0; mi < 4; ++mi) { /* LBS, DQS, CoR, and LBS with a rigid palette */
+            const int method = mi == 3 ? AK_SKIN_LBS : mi;
+            const ak_mat4* pm = mi == 0 ? pal : pal_rigid; /* DQS/CoR SIMD: rigid only */
             for (int variant = 0; variant < 16; ++variant) {
                 const int N = counts[variant & 3];
                 const bool strided = (variant & 4) != 0, normals = (variant & 8) != 0;
@@ -731,6 +732,60 @@ AK_TEST(every_simd_kernel_matches_scalar) {
     AK_CHECK_EQ(ak_skin_job_validate(&bad), AK_ERR_BAD_ARG);
     free(v), free(pos), free(nrm), free(ctr), free(jn), free(w), free(scratch);
     for (int l = 0; l < 3; ++l) free(op[l]), free(on[l]);
+}
+
+AK_TEST(lbs_single_influence_rigid_path) {
+    /* LBS with 1 influence, normals and a rigid palette takes a path without the blend and the
+     * normal's renormalisation in the SIMD kernels: against the scalar code for valid weights
+     * (1, and 1 - 5e-4 within the rule's tolerance) and, with skip_data_check, 0 and -1; unit
+     * normals out. A palette that is only nearly rigid (scale 1.001) must not take that path:
+     * its normals are still unit. */
+    enum { N = 45, J = 7 };
+    ak_skin_simd levels[3];
+    const char* names[3];
+    const int level_count = cpu_simd_levels(levels, names);
+    ak_rng rng = ak_rng_make(5);
+    ak_mat4 pal[J];
+    ak_vec3 pos[N], nrm[N], op[3][N], on[3][N];
+    uint16_t jn[N];
+    float w[N];
+    for (int i = 0; i < N; ++i) {
+        pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+        nrm[i] = rand_unit(&rng);
+        jn[i] = (uint16_t)(ak_rng_u32(&rng) % J);
+        w[i] = i % 5 == 1 ? 1.0f - 5e-4f : 1.0f;
+    }
+    for (int variant = 0; variant < 3; ++variant) {
+        for (int j = 0; j < J; ++j) pal[j] = rand_matrix(&rng, false);
+        if (variant == 1) { /* nearly rigid: one joint scaled by 1.001 */
+            for (int e = 0; e < 3; ++e) pal[3].m[e] *= 1.001f, pal[3].m[4 + e] *= 1.001f, pal[3].m[8 + e] *= 1.001f;
+        }
+        if (variant == 2) w[7] = 0.0f, w[20] = -1.0f, w[44] = 0.0f; /* unchecked data */
+        for (int l = 0; l < level_count; ++l) {
+            ak_skin_job job = {
+                .influence_count = 1,
+                .palette = {pal, J},
+                .positions = {pos, N, 0},
+                .normals = {nrm, N, 0},
+                .joints = {jn, N, 0},
+                .weights = {w, N, 0},
+                .out_positions = {op[l], N, 0},
+                .out_normals = {on[l], N, 0},
+                .simd_limit = levels[l],
+                .skip_data_check = variant == 2,
+            };
+            AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+            double worst = 0.0, worst_len = 0.0;
+            for (int i = 0; i < N; ++i) {
+                worst = fmax(worst, ak_vec3_length(ak_vec3_sub(op[l][i], op[0][i])));
+                worst = fmax(worst, ak_vec3_length(ak_vec3_sub(on[l][i], on[0][i])));
+                if (w[i] != 0.0f) worst_len = fmax(worst_len, fabs(ak_vec3_length(on[l][i]) - 1.0));
+                else AK_CHECK(ak_vec3_length(on[l][i]) == 0.0f);
+            }
+            AK_CHECK_MSG(worst <= 2e-5 && worst_len <= 2e-6, "%s variant %d: vs scalar %g, |n| - 1 %g", names[l],
+                         variant, worst, worst_len);
+        }
+    }
 }
 
 AK_TEST(lbs_tangents_and_face_normals) {
@@ -1698,6 +1753,7 @@ int main(void) {
     AK_RUN(lbs_matches_double_reference);
     AK_RUN(dqs_cor_simd_matches_scalar_for_every_influence_count);
     AK_RUN(every_simd_kernel_matches_scalar);
+    AK_RUN(lbs_single_influence_rigid_path);
     AK_RUN(lbs_tangents_and_face_normals);
     AK_RUN(bad_joint_indices_clamp_in_every_kernel);
     AK_RUN(job_split_matches_whole);

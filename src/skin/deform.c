@@ -579,6 +579,21 @@ static ak_result validate_job(const ak_skin_job* job, uint32_t screen_threads) {
 
 ak_result ak_skin_job_validate(const ak_skin_job* job) { return validate_job(job, 1); }
 
+/* True when every palette matrix's linear part is a rotation: columns of unit length and
+ * orthogonal within 1e-5, determinant > 0 (then its cofactor matrix is itself, so a unit
+ * normal maps to a unit normal). */
+static bool palette_rigid(const ak_mat4* pal, size_t count) {
+    for (size_t j = 0; j < count; ++j) {
+        const float* m = pal[j].m;
+        ak_vec3 c[3] = {ak_vec3_make(m[0], m[1], m[2]), ak_vec3_make(m[4], m[5], m[6]), ak_vec3_make(m[8], m[9], m[10])};
+        for (int a = 0; a < 3; ++a)
+            for (int b = a; b < 3; ++b)
+                if (!(fabsf(ak_vec3_dot(c[a], c[b]) - (a == b ? 1.0f : 0.0f)) <= 1e-5f)) return false;
+        if (!(ak_vec3_dot(c[0], ak_vec3_cross(c[1], c[2])) > 0.0f)) return false;
+    }
+    return true;
+}
+
 static akp_skin_ctx make_ctx(const ak_skin_job* job, const akp_skin_joint* prep, bool any_stretch) {
     akp_skin_ctx c;
     memset(&c, 0, sizeof c);
@@ -678,6 +693,8 @@ ak_result ak_skin_job_run(const ak_skin_job* job) {
         }
     }
     akp_skin_ctx ctx = make_ctx(job, prep, any_stretch);
+    ctx.rigid_single = job->method == AK_SKIN_LBS && job->influence_count == 1 && !ctx.do_tangents &&
+                       (!ctx.do_normals || palette_rigid(job->palette.ptr, job->palette.count));
     ak_skin_simd level = job->simd_limit == AK_SKIN_SIMD_DEFAULT ? AK_SKIN_SIMD_AVX512 : job->simd_limit;
     if (job->skip_simd) level = AK_SKIN_SIMD_SCALAR;
 #if defined(AK_NO_SIMD)

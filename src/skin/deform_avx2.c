@@ -256,6 +256,51 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, mx, my, mz);
 }
 
+/* LBS with 1 influence (ctx.rigid_single: no normals, or a rigid palette): p' = w (M p) and
+ * n' = sign(w) R n, without the blend, the cofactor and the renormalisation (R is a rotation:
+ * a unit normal stays unit; w = 1 for checked data). */
+AKP_AVX2_INLINE static inline void block_lbs_rigid1(const akp_skin_ctx* c, size_t i0) {
+    __m256 r01[8], r23[8], cols[8];
+    for (int v = 0; v < 8; ++v) {
+        uint16_t j;
+        memcpy(&j, c->jnt + (i0 + (size_t)v) * c->jnt_stride, sizeof j);
+        const float* m = c->palette[clamp_joint(j, c->palette_count)].m;
+        r01[v] = _mm256_loadu_ps(m);
+        r23[v] = _mm256_loadu_ps(m + 8);
+    }
+    transpose8(r01, cols);
+    const __m256 ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];
+    transpose8(r23, cols);
+    const __m256 cx = cols[0], cy = cols[1], cz = cols[2], tx = cols[4], ty = cols[5], tz = cols[6];
+    __m256 w;
+    if (c->wgt_stride == 4) {
+        w = _mm256_loadu_ps((const float*)(const void*)(c->wgt + i0 * 4));
+    } else {
+        float t[8];
+        for (int v = 0; v < 8; ++v) memcpy(&t[v], c->wgt + (i0 + (size_t)v) * c->wgt_stride, 4);
+        w = _mm256_loadu_ps(t);
+    }
+    __m256 px, py, pz;
+    load_xyz8(c->pos + i0 * c->pos_stride, c->pos_stride, &px, &py, &pz);
+    const __m256 ox = _mm256_mul_ps(w, _mm256_fmadd_ps(ax, px, _mm256_fmadd_ps(bx, py, _mm256_fmadd_ps(cx, pz, tx))));
+    const __m256 oy = _mm256_mul_ps(w, _mm256_fmadd_ps(ay, px, _mm256_fmadd_ps(by, py, _mm256_fmadd_ps(cy, pz, ty))));
+    const __m256 oz = _mm256_mul_ps(w, _mm256_fmadd_ps(az, px, _mm256_fmadd_ps(bz, py, _mm256_fmadd_ps(cz, pz, tz))));
+    store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, ox, oy, oz);
+    if (!c->do_normals) return;
+    __m256 nx, ny, nz;
+    load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
+    /* sign(w): 0 where w is 0 (or NaN: only with unchecked data), negated where w < 0 */
+    const __m256 keep = _mm256_cmp_ps(w, _mm256_setzero_ps(), _CMP_NEQ_OQ);
+    const __m256 sign = _mm256_and_ps(w, _mm256_set1_ps(-0.0f));
+    __m256 mx = _mm256_fmadd_ps(ax, nx, _mm256_fmadd_ps(bx, ny, _mm256_mul_ps(cx, nz)));
+    __m256 my = _mm256_fmadd_ps(ay, nx, _mm256_fmadd_ps(by, ny, _mm256_mul_ps(cy, nz)));
+    __m256 mz = _mm256_fmadd_ps(az, nx, _mm256_fmadd_ps(bz, ny, _mm256_mul_ps(cz, nz)));
+    mx = _mm256_xor_ps(_mm256_and_ps(mx, keep), sign);
+    my = _mm256_xor_ps(_mm256_and_ps(my, keep), sign);
+    mz = _mm256_xor_ps(_mm256_and_ps(mz, keep), sign);
+    store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, mx, my, mz);
+}
+
 /* 2 / |q|^2 for 8 blended quaternions, and 0 where the blend vanished (|q|^2 <= 1e-30: the
  * scalar code's identity). The blends are not normalised: the rotation and translation
  * formulas below divide by |q|^2 through this factor, so the division runs in parallel with
@@ -369,7 +414,9 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     }
 
 AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
-    if (c->k == 4) {
+    if (c->rigid_single) {
+        for (size_t i = begin; i < end; i += 8) block_lbs_rigid1(c, i);
+    } else if (c->k == 4) {
         uint32_t off[2][32];
         joint_offsets(c, begin, AKP_MAT_SHIFT, off[0], 4);
         unsigned b = 0;

@@ -359,6 +359,55 @@ AKP_AVX512_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0,
     store_xyz16(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, n, mx, my, mz);
 }
 
+/* The palette matrix of vertex i's single joint (index clamped). */
+AKP_AVX512_INLINE static inline __m512 joint_matrix(const akp_skin_ctx* c, size_t i) {
+    uint16_t j;
+    memcpy(&j, c->jnt + i * c->jnt_stride, sizeof j);
+    return _mm512_loadu_ps(c->palette[clamp_joint(j, c->palette_count)].m);
+}
+
+/* LBS with 1 influence (ctx.rigid_single: no normals, or a rigid palette): p' = w (M p) and
+ * n' = sign(w) R n, the scalar code's results without the blend, the cofactor and the
+ * renormalisation (R is a rotation: a unit normal stays unit; w = 1 for checked data). */
+AKP_AVX512_INLINE static inline void block_lbs_rigid1(const akp_skin_ctx* c, size_t i0, unsigned n) {
+    __m512 r01[8], r23[8], k01[8], k23[8];
+    const __m512 zero = _mm512_setzero_ps();
+    for (unsigned v = 0; v < 8; ++v)
+        pair_rows(v < n ? joint_matrix(c, i0 + v) : zero, v + 8 < n ? joint_matrix(c, i0 + v + 8) : zero, &r01[v],
+                  &r23[v]);
+    transpose8x2(r01, k01);
+    transpose8x2(r23, k23);
+    const __m512 ax = k01[0], ay = k01[1], az = k01[2], bx = k01[4], by = k01[5], bz = k01[6];
+    const __m512 cx = k23[0], cy = k23[1], cz = k23[2], tx = k23[4], ty = k23[5], tz = k23[6];
+    __m512 w;
+    const float* wp = (const float*)(const void*)(c->wgt + i0 * c->wgt_stride);
+    if (c->wgt_stride == 4) {
+        w = n == 16 ? _mm512_loadu_ps(wp) : _mm512_maskz_loadu_ps(first_lanes(n), wp);
+    } else {
+        float t[16] = {0};
+        for (unsigned v = 0; v < n; ++v) memcpy(&t[v], c->wgt + (i0 + v) * c->wgt_stride, 4);
+        w = _mm512_loadu_ps(t);
+    }
+    __m512 px, py, pz;
+    load_xyz16(c->pos + i0 * c->pos_stride, c->pos_stride, n, &px, &py, &pz);
+    const __m512 ox = _mm512_mul_ps(w, _mm512_fmadd_ps(ax, px, _mm512_fmadd_ps(bx, py, _mm512_fmadd_ps(cx, pz, tx))));
+    const __m512 oy = _mm512_mul_ps(w, _mm512_fmadd_ps(ay, px, _mm512_fmadd_ps(by, py, _mm512_fmadd_ps(cy, pz, ty))));
+    const __m512 oz = _mm512_mul_ps(w, _mm512_fmadd_ps(az, px, _mm512_fmadd_ps(bz, py, _mm512_fmadd_ps(cz, pz, tz))));
+    store_xyz16(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, n, ox, oy, oz);
+    if (!c->do_normals) return;
+    __m512 nx, ny, nz;
+    load_xyz16(c->nrm + i0 * c->nrm_stride, c->nrm_stride, n, &nx, &ny, &nz);
+    /* sign(w): 0 where w is 0 (or NaN: only with unchecked data), negated where w < 0 */
+    const __mmask16 keep = _mm512_cmp_ps_mask(w, zero, _CMP_NEQ_OQ), neg = _mm512_cmp_ps_mask(w, zero, _CMP_LT_OQ);
+    __m512 mx = _mm512_maskz_mov_ps(keep, _mm512_fmadd_ps(ax, nx, _mm512_fmadd_ps(bx, ny, _mm512_mul_ps(cx, nz))));
+    __m512 my = _mm512_maskz_mov_ps(keep, _mm512_fmadd_ps(ay, nx, _mm512_fmadd_ps(by, ny, _mm512_mul_ps(cy, nz))));
+    __m512 mz = _mm512_maskz_mov_ps(keep, _mm512_fmadd_ps(az, nx, _mm512_fmadd_ps(bz, ny, _mm512_mul_ps(cz, nz))));
+    mx = _mm512_mask_sub_ps(mx, neg, zero, mx);
+    my = _mm512_mask_sub_ps(my, neg, zero, my);
+    mz = _mm512_mask_sub_ps(mz, neg, zero, mz);
+    store_xyz16(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, n, mx, my, mz);
+}
+
 /* p: for a whole block with 2, 3, 4 or 8 influences, phase 1 (dq_signs_block) run ahead;
  * else NULL (vertex by vertex). */
 AKP_AVX512_INLINE static inline void block_dqs(const akp_skin_ctx* c, size_t i0, unsigned n, const uint32_t K,
@@ -513,6 +562,12 @@ AKP_DQ_RANGE_K(block_cor)
     default: call(8u); break;                                                              \
     }
 AKP_AVX512 static void lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
+    if (c->rigid_single) {
+        size_t i = begin;
+        for (; i + 16 <= end; i += 16) block_lbs_rigid1(c, i, 16u);
+        if (i < end) block_lbs_rigid1(c, i, (unsigned)(end - i));
+        return;
+    }
 #define AKP_CALL(K) lbs_range_k(c, begin, end, (K))
     AKP_K_SWITCH(AKP_CALL)
 #undef AKP_CALL

@@ -42,6 +42,11 @@ typedef struct akp_skin_ctx {
     char *out_pos, *out_nrm, *out_tan;
     size_t out_pos_stride, out_nrm_stride, out_tan_stride;
     bool do_normals, do_tangents;
+    /* LBS with 1 influence, no tangents, and no normals or every palette matrix rigid
+     * (orthonormal linear part, det > 0, within 1e-5): the SIMD kernels may skip the blend
+     * (p' = w (M p)) and the normal's cofactor and renormalisation (n' = sign(w) R n); the
+     * results then differ from the scalar code's by float rounding */
+    bool rigid_single;
 } akp_skin_ctx;
 
 /* Deform vertices [begin, end) with the scalar reference code. */
