@@ -2,6 +2,7 @@
 #include <animkit/skeleton.h>
 
 #include "internal.h"
+#include "simd.h" /* SSE2 columns in the FK products */
 
 struct ak_skeleton {
     ak_allocator alloc;
@@ -331,9 +332,50 @@ size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index) 
 
 /* ---- forward kinematics -------------------------------------------------------------- */
 
+/* parent * child for affine matrices (bottom rows (0, 0, 0, 1)): the 4x4 product without the
+ * terms that multiply the child's bottom row (0 or 1), summed in the same order as
+ * ak_mat4_mul, so the result is the same floats (up to the sign of a zero). */
+static inline void affine_mul(const ak_mat4* a, const ak_mat4* b, ak_mat4* out) {
+#if AK_SIMD_SSE2
+    const __m128 a0 = _mm_loadu_ps(a->m), a1 = _mm_loadu_ps(a->m + 4), a2 = _mm_loadu_ps(a->m + 8),
+                 a3 = _mm_loadu_ps(a->m + 12);
+    for (int c = 0; c < 4; ++c) {
+        const float* bc = b->m + 4 * c;
+        __m128 r = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(bc[0])), _mm_mul_ps(a1, _mm_set1_ps(bc[1]))),
+                              _mm_mul_ps(a2, _mm_set1_ps(bc[2])));
+        if (c == 3) r = _mm_add_ps(r, a3);
+        _mm_storeu_ps(out->m + 4 * c, r);
+    }
+#else
+    for (int c = 0; c < 4; ++c)
+        for (int row = 0; row < 4; ++row) {
+            float r = a->m[row] * b->m[c * 4] + a->m[4 + row] * b->m[c * 4 + 1] + a->m[8 + row] * b->m[c * 4 + 2];
+            out->m[c * 4 + row] = c == 3 ? r + a->m[12 + row] : r;
+        }
+#endif
+}
+
+static bool mat4_affine(const ak_mat4* m) {
+    return m->m[3] == 0.0f && m->m[7] == 0.0f && m->m[11] == 0.0f && m->m[15] == 1.0f;
+}
+
+/* Local TRS to model matrices, parents first. Local matrices are affine, so with no root or an
+ * affine root every model matrix is affine and the products skip the bottom row's terms
+ * (affine_mul: a quarter fewer multiplies, SSE2 columns); a projective root keeps the full
+ * 4x4 products. */
 static void fk(const ak_skeleton* sk, const ak_mat4* root, const ak_transform* local,
                ak_mat4* out) {
     const size_t n = sk->joint_count;
+    if (!root || mat4_affine(root)) {
+        for (size_t i = 0; i < n; ++i) {
+            const ak_mat4 m = ak_transform_to_mat4(local[i]);
+            const int p = sk->parents[i];
+            if (p >= 0) affine_mul(&out[p], &m, &out[i]);
+            else if (root) affine_mul(root, &m, &out[i]);
+            else out[i] = m;
+        }
+        return;
+    }
     for (size_t i = 0; i < n; ++i) {
         ak_mat4 m = ak_transform_to_mat4(local[i]);
         int p = sk->parents[i];
