@@ -256,10 +256,13 @@ typedef enum ak_skin_simd {
 /* Streams hold float or uint16_t components: positions/normals 3 floats, tangents 4 floats
  * (xyz direction, w handedness copied), joints influence_count uint16_t, weights
  * influence_count floats. A stride of 0 means tightly packed. Pointers need only the natural
- * alignment of their component type. Speed: the AVX2 LBS kernel loads palette matrices in
- * 32-byte halves; palettes of up to 128 joints that are not 64-byte aligned are copied to an
- * aligned stack buffer (8 KiB) for meshes of at least 16 vertices per joint; a larger palette
- * is fastest when the caller aligns it to 64 bytes (about 1.1-1.15x). */
+ * alignment of their component type. Speed: the SIMD LBS kernels load palette matrices in
+ * 32-byte halves (AVX2) or whole (AVX-512); palettes of up to 128 joints that are not 64-byte
+ * aligned are copied to an aligned stack buffer (8 KiB) for meshes of at least 16 vertices per
+ * joint; a larger palette is fastest when the caller aligns it to 64 bytes (about 1.1-1.15x).
+ * LBS with 1 influence skips the blend (p' = w (M p)), and with normals also the normal's
+ * cofactor and renormalisation when every palette matrix is a rotation plus translation
+ * (checked per run, O(palette.count)). */
 typedef struct ak_skin_job {
     ak_skin_method method;      /* 0 -> AK_SKIN_LBS */
     uint32_t influence_count;   /* required: joints per vertex, 1..AK_MAX_INFLUENCES */
