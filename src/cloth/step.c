@@ -495,8 +495,7 @@ static void run_spmd(ctx* c, unsigned t) {
             }
             for (size_t v = b; v < e; ++v) {
                 if (!is_free(cl, v)) continue;
-                ak_vec3 vel = ak_vec3_madd(c->v[v], c->acc[v], h * cl->inv_mass[v]);
-                vel = ak_vec3_scale(vel, c->decay);
+                const ak_vec3 vel = ak_vec3_madd(ak_vec3_scale(c->v[v], c->decay), c->acc[v], h * cl->inv_mass[v]);
                 c->prev[v] = c->x[v];
                 c->v[v] = vel;
                 c->x[v] = ak_vec3_madd(c->x[v], vel, h);
@@ -516,8 +515,9 @@ static void run_spmd(ctx* c, unsigned t) {
         /* XPBD / PBD: predict */
         for (size_t v = b; v < e; ++v) {
             if (!is_free(cl, v)) continue;
-            ak_vec3 vel = ak_vec3_madd(c->v[v], ak_vec3_madd(job->gravity, c->ext[v], cl->inv_mass[v]), h);
-            vel = ak_vec3_scale(vel, c->decay);
+            /* damp, then accelerate: at rest (v = 0) damping then leaves the rest point alone */
+            const ak_vec3 vel = ak_vec3_madd(ak_vec3_scale(c->v[v], c->decay),
+                                             ak_vec3_madd(job->gravity, c->ext[v], cl->inv_mass[v]), h);
             c->prev[v] = c->x[v];
             c->x[v] = ak_vec3_madd(c->x[v], vel, h);
         }
