@@ -24,6 +24,7 @@
 #include "io.h"
 #include "raster.h"
 #include "view.h"
+#include "grid.h"
 #include "cloth.h"
 
 #endif
