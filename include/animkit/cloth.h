@@ -22,12 +22,13 @@
  *     wind), global damping;
  *   - collisions with planes, spheres, capsules (a character's limbs) and a triangle mesh (the
  *     character's skin, through a spatial hash rebuilt each step), with thickness and friction;
+ *   - self-collision between particles through the shared neighbour grid (grid.h), switchable;
  *   - smooth (area-weighted) vertex normals, max stretch and energy for output and tests;
  *   - thread_count: threads split each phase over disjoint particles or over constraints of one
  *     colour (constraints of a colour share no particle), so results are bit-identical for any
  *     thread count.
  *
- * What it does NOT do: self-collision, continuous collision detection (a particle moving
+ * What it does NOT do: continuous collision detection (a particle moving
  * further than the thickness in one substep can tunnel through a thin collider), tearing,
  * or moving the colliders inside a step (they are taken at their end-of-step pose).
  *
@@ -203,6 +204,12 @@ typedef struct ak_cloth_step_job {
     ak_cloth_collider_mesh mesh;   /* optional character mesh */
     float thickness;               /* metres kept between particles and colliders; 0 -> 0.01 */
     float friction;                /* Coulomb coefficient at contacts, >= 0; 0 -> frictionless */
+    bool self_collision;           /* true -> particles keep self_distance apart (pairs closer at
+                                      rest keep their rest distance), found each substep through
+                                      the shared neighbour grid (grid.h), resolved Jacobi-style
+                                      (each particle moves by the mean of its pair corrections,
+                                      at most 32 neighbours) */
+    float self_distance;           /* metres; 0 -> 2 * thickness */
     ak_vec3_cspan attachment_targets; /* world, one per attachment (required when the cloth has
                                          attachments): where the attached particles are at the end
                                          of this step; substeps move them linearly from where
@@ -221,7 +228,7 @@ AK_API size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job);
 /* First failing rule: AK_ERR_NULL_ARG (job, cloth, positions, velocities or scratch empty, a
  * collider count without its array, attachments without targets), AK_ERR_BAD_ARG (dt <= 0 or
  * non-finite, thread_count > 64, substeps or iterations > 10000, negative or non-finite drag,
- * lift, air density, damping, thickness or friction, a negative radius, collider mesh indices
+ * lift, air density, damping, thickness, friction or self_distance, a negative radius, collider mesh indices
  * not a multiple of 3, positions/velocities count != vertex count, attachment_targets count !=
  * attachment count), AK_ERR_SPAN_SMALL (out_normals or scratch too small), AK_ERR_BAD_INDEX (a
  * collider mesh index out of range), AK_ERR_BAD_DATA (a non-finite position, velocity,

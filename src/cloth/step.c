@@ -10,6 +10,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#include <animkit/grid.h>
+
 #include "cloth_impl.h"
 #include "internal.h"
 
@@ -18,7 +20,7 @@
 /* ---- scratch layout --------------------------------------------------------------------- */
 
 typedef struct layout {
-    size_t prev, ext, acc, lambda, tri_force, att_start, hash_start, hash_entry, tri_normal, size;
+    size_t prev, ext, acc, lambda, tri_force, att_start, hash_start, hash_entry, tri_normal, grid, grid_size, size;
     size_t buckets, mesh_tris;
 } layout;
 
@@ -28,7 +30,12 @@ static size_t pow2_at_least(size_t x) {
     return p;
 }
 
-static layout make_layout(const ak_cloth* c, size_t mesh_tris) {
+static float self_distance(const ak_cloth_step_job* job) {
+    const float th = job->thickness > 0.0f ? job->thickness : 0.01f;
+    return job->self_distance > 0.0f ? job->self_distance : 2.0f * th;
+}
+
+static layout make_layout(const ak_cloth* c, size_t mesh_tris, const ak_cloth_step_job* job) {
     layout l;
     size_t s = 0;
     l.prev = s, s += akp_align16(c->n * sizeof(ak_vec3));
@@ -42,13 +49,19 @@ static layout make_layout(const ak_cloth* c, size_t mesh_tris) {
     l.hash_start = s, s += akp_align16(mesh_tris ? (l.buckets + 1) * sizeof(uint32_t) : 0);
     l.hash_entry = s, s += akp_align16(mesh_tris * 8 * sizeof(uint32_t));
     l.tri_normal = s, s += akp_align16(mesh_tris * sizeof(ak_vec3));
+    l.grid_size = 0;
+    if (job->self_collision) {
+        const ak_grid_desc gd = {.cell_size = self_distance(job)};
+        l.grid_size = ak_grid_memory_size(c->n, &gd);
+    }
+    l.grid = s, s += akp_align16(l.grid_size);
     l.size = s + 16; /* room to align the caller's pointer */
     return l;
 }
 
 size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job) {
     if (!job || !job->cloth) return 0;
-    return make_layout(job->cloth, job->mesh.indices.count / 3).size;
+    return make_layout(job->cloth, job->mesh.indices.count / 3, job).size;
 }
 
 /* ---- validation ------------------------------------------------------------------------- */
@@ -66,7 +79,7 @@ ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) {
         job->iterations > 10000)
         return AK_ERR_BAD_ARG;
     if (bad_nonneg(job->drag) || bad_nonneg(job->lift) || bad_nonneg(job->air_density) || bad_nonneg(job->damping) ||
-        bad_nonneg(job->thickness) || bad_nonneg(job->friction))
+        bad_nonneg(job->thickness) || bad_nonneg(job->friction) || bad_nonneg(job->self_distance))
         return AK_ERR_BAD_ARG;
     if (job->mesh.indices.count % 3 || job->positions.count != c->n || job->velocities.count != c->n ||
         job->attachment_targets.count != c->attach_count)
@@ -120,6 +133,12 @@ typedef struct ctx {
     ak_vec3* tri_normal;
     size_t buckets;
     float cell;
+    /* self-collision */
+    bool self;
+    float self_dist;
+    ak_u8_span grid_mem;
+    ak_grid grid;
+    ak_result grid_result;
     /* barrier */
     pthread_mutex_t m;
     pthread_cond_t cv;
@@ -388,6 +407,51 @@ static void spring_force(const ctx* c, size_t k) {
     c->acc[d->j] = ak_vec3_sub(c->acc[d->j], f);
 }
 
+/* ---- self-collision ------------------------------------------------------------------- */
+
+#define SELF_MAX_NEIGHBOURS 32u
+
+/* Rebuild the grid over the current positions (one thread). */
+static void self_grid(ctx* c) {
+    const ak_grid_desc gd = {.cell_size = c->self_dist};
+    const ak_result r = ak_grid_build(&gd, (ak_vec3_cspan){c->x, c->c->n}, c->grid_mem, &c->grid);
+    if (r != AK_OK) c->grid_result = r;
+}
+
+/* Jacobi correction of particle i into acc[i]: the mean over its pairs closer than the target
+ * distance (self_distance, or their rest distance when that is smaller) of the move that
+ * separates them, shared by inverse mass. */
+static void self_delta(const ctx* c, size_t i) {
+    const ak_cloth* cl = c->c;
+    ak_vec3 sum = ak_vec3_make(0, 0, 0);
+    c->acc[i] = sum;
+    const float wi = cl->inv_mass[i];
+    if (wi == 0.0f || c->grid_result != AK_OK) return;
+    uint32_t nb[SELF_MAX_NEIGHBOURS];
+    size_t total = ak_grid_query(&c->grid, c->x[i], c->self_dist, (ak_u32_span){nb, SELF_MAX_NEIGHBOURS});
+    if (total > SELF_MAX_NEIGHBOURS) total = SELF_MAX_NEIGHBOURS;
+    /* the grid returns neighbours in its own order: sort them so the sum is the same for any
+     * grid layout (insertion sort of at most 32) */
+    for (size_t a = 1; a < total; ++a)
+        for (size_t b = a; b > 0 && nb[b - 1] > nb[b]; --b) {
+            const uint32_t t = nb[b];
+            nb[b] = nb[b - 1], nb[b - 1] = t;
+        }
+    int count = 0;
+    for (size_t k = 0; k < total; ++k) {
+        const uint32_t j = nb[k];
+        if (j == i) continue;
+        const float target = ak_minf(c->self_dist, ak_vec3_distance(cl->rest[i], cl->rest[j]));
+        const ak_vec3 d = ak_vec3_sub(c->x[i], c->x[j]);
+        const float l = ak_vec3_length(d);
+        if (l >= target || l < 1e-9f) continue;
+        const float wj = cl->inv_mass[j];
+        sum = ak_vec3_madd(sum, d, (target - l) / l * wi / (wi + wj));
+        ++count;
+    }
+    if (count) c->acc[i] = ak_vec3_scale(sum, 1.0f / (float)count);
+}
+
 /* ---- phases ----------------------------------------------------------------------------- */
 
 /* Wind: drag and lift per triangle from the relative air velocity, a third to each corner. */
@@ -464,22 +528,23 @@ static void run_spmd(ctx* c, unsigned t) {
     const size_t n = cl->n;
     const float h = c->h;
     size_t b, e;
-    /* wind, once per step from the state at its start */
     const bool wind = (job->drag > 0.0f || job->lift > 0.0f) && cl->tri_count > 0;
+    size_t tb, te;
     range(n, t, c->T, &b, &e);
-    if (wind) {
-        size_t tb, te;
-        range(cl->tri_count, t, c->T, &tb, &te);
-        wind_triangles(c, tb, te);
-        barrier(c);
-        gather_wind(c, b, e);
-    } else {
-        memset(c->ext + b, 0, (e - b) * sizeof(ak_vec3));
-    }
+    range(cl->tri_count, t, c->T, &tb, &te);
+    memset(c->ext + b, 0, (e - b) * sizeof(ak_vec3));
     barrier(c);
     const bool springs = cl->desc.solver == AK_CLOTH_SPRINGS;
     for (uint32_t s = 0; s < c->substeps; ++s) {
         const float f = (float)(s + 1) / (float)c->substeps;
+        /* wind each substep: drag acts like a damper of rate rho C_d A |v| / m, which an
+         * explicit force only follows stably when that rate times the step is small */
+        if (wind) {
+            wind_triangles(c, tb, te);
+            barrier(c);
+            gather_wind(c, b, e);
+            barrier(c);
+        }
         if (springs) {
             for (size_t v = b; v < e; ++v)
                 c->acc[v] = is_free(cl, v) ? ak_vec3_madd(c->ext[v], job->gravity, cl->mass[v]) : ak_vec3_make(0, 0, 0);
@@ -502,9 +567,16 @@ static void run_spmd(ctx* c, unsigned t) {
             }
             kinematic_targets(c, f, t);
             barrier(c);
+            if (c->self) {
+                if (t == 0) self_grid(c);
+                barrier(c);
+                for (size_t v = b; v < e; ++v) self_delta(c, v);
+                barrier(c);
+            }
             for (size_t v = b; v < e; ++v) {
                 if (!is_free(cl, v)) continue;
                 const ak_vec3 before = c->x[v];
+                if (c->self) c->x[v] = ak_vec3_add(c->x[v], c->acc[v]);
                 collide(c, v);
                 if (c->x[v].x != before.x || c->x[v].y != before.y || c->x[v].z != before.z)
                     c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / h);
@@ -553,8 +625,17 @@ static void run_spmd(ctx* c, unsigned t) {
                 barrier(c);
             }
         }
+        if (c->self) {
+            if (t == 0) self_grid(c);
+            barrier(c);
+            for (size_t v = b; v < e; ++v) self_delta(c, v);
+            barrier(c);
+        }
         for (size_t v = b; v < e; ++v) {
-            if (is_free(cl, v)) collide(c, v);
+            if (is_free(cl, v)) {
+                if (c->self) c->x[v] = ak_vec3_add(c->x[v], c->acc[v]);
+                collide(c, v);
+            }
             c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / h);
         }
         barrier(c);
@@ -576,7 +657,7 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     if (r != AK_OK) return r;
     const ak_cloth* cl = job->cloth;
     const size_t mesh_tris = job->mesh.indices.count / 3;
-    const layout l = make_layout(cl, mesh_tris);
+    const layout l = make_layout(cl, mesh_tris, job);
     uint8_t* base = job->scratch.ptr;
     base += (16u - ((uintptr_t)base & 15u)) & 15u;
     ctx c;
@@ -600,6 +681,9 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.hash_entry = (uint32_t*)(base + l.hash_entry);
     c.tri_normal = (ak_vec3*)(base + l.tri_normal);
     c.buckets = l.buckets;
+    c.self = job->self_collision;
+    c.self_dist = self_distance(job);
+    c.grid_mem = (ak_u8_span){base + l.grid, l.grid_size};
     memcpy(c.prev, c.x, cl->n * sizeof(ak_vec3));
     for (size_t k = 0; k < cl->attach_count; ++k) c.att_start[k] = c.x[cl->attach[k]];
     if (mesh_tris) build_hash(&c, 2.0f * c.thickness);
