@@ -51,23 +51,37 @@ static bool buf_push(vec_buf* b, const ak_allocator* a, const void* item) {
 
 static bool nonneg_finite(float x) { return x >= 0.0f && ak_finitef(x); }
 
+/* atan2 to about 1e-5 rad: odd minimax polynomial of atan on [0, 1] after folding the octant
+ * (libm's atan2f was a quarter of the XPBD step with dihedral bending). */
+static float fast_atan2(float y, float x) {
+    const float ax = fabsf(x), ay = fabsf(y);
+    const float mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
+    if (mx == 0.0f) return 0.0f;
+    const float z = mn / mx, z2 = z * z;
+    float r = z * (0.99997726f +
+                   z2 * (-0.33262347f + z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f + z2 * -0.01172120f)))));
+    if (ay > ax) r = 1.57079633f - r;
+    if (x < 0.0f) r = 3.14159265f - r;
+    return y < 0.0f ? -r : r;
+}
+
 float akp_dihedral(const ak_vec3 x[4], ak_vec3 grad[4]) {
-    /* Bridson, Marino, Fedkiw 2003: wings x0, x1, edge x2 -> x3 */
+    /* Bridson, Marino, Fedkiw 2003: wings x0, x1, edge x2 -> x3; the signed angle between the
+     * triangle normals about the edge, from unnormalised normals (atan2 ignores a common
+     * positive scale) */
     const ak_vec3 e = ak_vec3_sub(x[3], x[2]);
-    const ak_vec3 n1 = ak_vec3_cross(ak_vec3_sub(x[3], x[2]), ak_vec3_sub(x[0], x[2]));
-    const ak_vec3 n2 = ak_vec3_cross(ak_vec3_sub(x[1], x[2]), ak_vec3_sub(x[3], x[2]));
-    const float l1 = ak_vec3_length_sq(n1), l2 = ak_vec3_length_sq(n2), le = ak_vec3_length(e);
-    if (l1 < 1e-24f || l2 < 1e-24f || le < 1e-12f) {
-        if (grad) for (int k = 0; k < 4; ++k) grad[k] = ak_vec3_make(0, 0, 0);
+    const ak_vec3 n1 = ak_vec3_cross(e, ak_vec3_sub(x[0], x[2]));
+    const ak_vec3 n2 = ak_vec3_cross(ak_vec3_sub(x[1], x[2]), e);
+    const float l1 = ak_vec3_length_sq(n1), l2 = ak_vec3_length_sq(n2), le2 = ak_vec3_length_sq(e);
+    if (l1 < 1e-24f || l2 < 1e-24f || le2 < 1e-24f) {
+        if (grad)
+            for (int k = 0; k < 4; ++k) grad[k] = ak_vec3_make(0, 0, 0);
         return 0.0f;
     }
-    const ak_vec3 m1 = ak_vec3_scale(n1, 1.0f / sqrtf(l1)), m2 = ak_vec3_scale(n2, 1.0f / sqrtf(l2));
-    const float c = ak_vec3_dot(m1, m2);
-    const float s = ak_vec3_dot(ak_vec3_cross(m1, m2), ak_vec3_scale(e, 1.0f / le));
-    const float theta = atan2f(s, c);
+    const float le = sqrtf(le2), inv = 1.0f / le;
+    const float theta = fast_atan2(ak_vec3_dot(ak_vec3_cross(n1, n2), e) * inv, ak_vec3_dot(n1, n2));
     if (grad) {
         const ak_vec3 u1 = ak_vec3_scale(n1, 1.0f / l1), u2 = ak_vec3_scale(n2, 1.0f / l2);
-        const float inv = 1.0f / le;
         grad[0] = ak_vec3_scale(u1, -le);
         grad[1] = ak_vec3_scale(u2, -le);
         const float a0 = ak_vec3_dot(ak_vec3_sub(x[0], x[3]), e) * inv, a1 = ak_vec3_dot(ak_vec3_sub(x[1], x[3]), e) * inv;
