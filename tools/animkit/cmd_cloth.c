@@ -367,7 +367,7 @@ int cmd_cloth(int argc, char** argv) {
         rc = cli_fail("cloth", "out of memory");
         goto done;
     }
-    memcpy(caps, sc.capsules, sc.capsule_count * sizeof(ak_cloth_capsule));
+    if (sc.capsule_count) memcpy(caps, sc.capsules, sc.capsule_count * sizeof(ak_cloth_capsule));
 
     ak_cloth_step_job job = {
         .cloth = cloth, .dt = sc.dt, .substeps = sc.substeps, .iterations = sc.iterations, .gravity = sc.gravity,
