@@ -1,5 +1,5 @@
 /* Cloth step timings: a W x W cloth draped on a sphere, 1/60 s frames.
- *   - XPBD, 10 substeps per frame, 64 x 64 (dihedral bending, bending distance constraints, no
+ *   - XPBD, 10 substeps per frame, 64 x 64 (dihedral, isometric, distance-constraint or no
  *     bending) and 256 x 256, on 1 and 2 threads: ms per frame and ns per particle-substep;
  *   - the mass-spring solver with the same spring constants (XPBD compliance = 1 / k): the
  *     smallest power-of-two substep count that stays finite and within 50% stretch for 2 s of
@@ -98,11 +98,12 @@ int main(int argc, char** argv) {
         uint32_t size;
         ak_cloth_bending bending;
         const char* name;
-    } cases[4] = {{64, AK_CLOTH_BEND_DIHEDRAL, "XPBD"},
+    } cases[5] = {{64, AK_CLOTH_BEND_DIHEDRAL, "XPBD"},
+                  {64, AK_CLOTH_BEND_ISOMETRIC, "XPBD-iso"},
                   {64, AK_CLOTH_BEND_SPRINGS, "XPBD-bs"},
                   {64, AK_CLOTH_BEND_NONE, "XPBD-nb"},
                   {256, AK_CLOTH_BEND_DIHEDRAL, "XPBD"}};
-    for (int s = 0; s < 4; ++s) {
+    for (int s = 0; s < 5; ++s) {
         const int fr = cases[s].size == 256 ? (frames / 8 > 5 ? frames / 8 : 5) : frames;
         double one = 0.0;
         for (uint32_t th = 1; th <= 2; ++th) {
@@ -117,7 +118,7 @@ int main(int argc, char** argv) {
             run_free(&r);
         }
     }
-    printf("(XPBD: dihedral bending; -bs: bending distance constraints; -nb: no bending)\n");
+    printf("(XPBD: dihedral bending; -iso: isometric bending; -bs: bending distance constraints; -nb: none)\n");
     /* mass-spring at the step it needs for the same stiffness */
     uint32_t sub = 10;
     while (sub <= 5120 && !springs_stable(64, sub)) sub *= 2;

@@ -223,6 +223,55 @@ AK_TEST(dihedral_gradient) {
     ak_cloth_destroy(c);
 }
 
+/* Isometric bending: zero energy for any flat or rigidly moved configuration, k |b|^2 3 / (2 (A0 +
+ * A1)) for a fold, with b computed here from the cotangent weights (Bergou et al. 2006). */
+AK_TEST(isometric_bending) {
+    ak_vec3 flat[4] = {{0, 0, 0}, {1.1f, 0, 0.1f}, {0.2f, 0, -0.9f}, {1, 0, -1.2f}};
+    uint32_t tris[6] = {0, 1, 3, 0, 3, 2};
+    ak_cloth_desc d = {.positions = AK_SPAN(flat), .indices = AK_SPAN(tris), .dihedral_stiffness = 2.0f,
+                       .bending = AK_CLOTH_BEND_ISOMETRIC, .stretch_stiffness = INFINITY, .shear_stiffness = INFINITY};
+    ak_cloth* c = NULL;
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_OK);
+    ak_vec3 v[4] = {{0}}, moved[4];
+    ak_cloth_energy e;
+    const ak_quat q = ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(1, 2, 3)), 0.7f);
+    for (int k = 0; k < 4; ++k) moved[k] = ak_vec3_add(ak_quat_rotate(q, flat[k]), ak_vec3_make(3, -1, 2));
+    AK_CHECK_EQ(ak_cloth_energy_compute(c, (ak_vec3_cspan)AK_SPAN(moved), (ak_vec3_cspan)AK_SPAN(v), ak_vec3_make(0, 0, 0), &e),
+                AK_OK);
+    AK_CHECK_NEAR(e.elastic, 0.0, 1e-9);
+    /* fold vertex 2 about the edge 0-3 by 0.4 rad: b = K2 (x2' - x2) as only x2 moved (the
+     * weights sum to zero), K2 = -(cot of the angles at 0 and 3 in triangle 0-3-2) */
+    const ak_vec3 axis = ak_vec3_normalize(ak_vec3_sub(flat[3], flat[0]));
+    ak_vec3 folded[4] = {flat[0], flat[1], ak_vec3_add(flat[0], ak_quat_rotate(ak_quat_from_axis_angle(axis, 0.4f),
+                                                                                ak_vec3_sub(flat[2], flat[0]))), flat[3]};
+    AK_CHECK_EQ(ak_cloth_energy_compute(c, (ak_vec3_cspan)AK_SPAN(folded), (ak_vec3_cspan)AK_SPAN(v), ak_vec3_make(0, 0, 0), &e),
+                AK_OK);
+    double cot0, cot3, area0, area1;
+    {
+        const ak_vec3 a = flat[0], b = flat[3], w = flat[2], o = flat[1];
+        ak_vec3 u = ak_vec3_sub(b, a), t = ak_vec3_sub(w, a);
+        cot0 = ak_vec3_dot(u, t) / ak_vec3_length(ak_vec3_cross(u, t));
+        u = ak_vec3_sub(a, b), t = ak_vec3_sub(w, b);
+        cot3 = ak_vec3_dot(u, t) / ak_vec3_length(ak_vec3_cross(u, t));
+        area0 = 0.5 * ak_vec3_length(ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(w, a)));
+        area1 = 0.5 * ak_vec3_length(ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(o, a)));
+    }
+    const double db = (cot0 + cot3) * ak_vec3_distance(folded[2], flat[2]);
+    AK_CHECK_NEAR(e.elastic, 3.0 * 2.0 * db * db / (2.0 * (area0 + area1)), 1e-5);
+    ak_cloth_destroy(c);
+    /* a drape with isometric bending stays finite and out of the sphere */
+    ak_cloth_desc g = {.grid_width = 10, .grid_height = 10, .spacing = 0.1f, .grid_origin = {-0.45f, 1, 0.45f},
+                       .bending = AK_CLOTH_BEND_ISOMETRIC};
+    sim s;
+    AK_CHECK(sim_init(&s, &g));
+    const ak_cloth_sphere sp = {{0, 0.5f, 0}, 0.3f};
+    s.job.spheres = &sp, s.job.sphere_count = 1;
+    sim_scratch(&s);
+    for (int f = 0; f < 90; ++f) AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+    for (size_t i = 0; i < s.n; ++i) AK_CHECK(ak_vec3_distance(s.x[i], sp.center) >= sp.radius);
+    sim_free(&s);
+}
+
 /* ---- XPBD vs PBD ------------------------------------------------------------------------ */
 
 /* Mean stretch of the vertical structural edges of a hanging cloth at rest. */
@@ -490,6 +539,7 @@ int main(void) {
     AK_RUN(step_rules);
     AK_RUN(single_spring_static_stretch);
     AK_RUN(dihedral_gradient);
+    AK_RUN(isometric_bending);
     AK_RUN(xpbd_stretch_independent_of_substeps);
     AK_RUN(drape_no_penetration_and_rest);
     AK_RUN(mesh_collider);

@@ -8,8 +8,8 @@
  *   - three solvers over the same cloth:
  *       AK_CLOTH_XPBD (default): extended position-based dynamics (Macklin, Mueller, Chentanez
  *         2016): distance constraints with compliance alpha = 1/stiffness, alpha~ = alpha/h^2,
- *         the Lagrange multipliers reset at the start of every substep, dihedral-angle bending
- *         with compliance 1/dihedral_stiffness (or bending distance constraints), constraint
+ *         the Lagrange multipliers reset at the start of every substep, dihedral-angle or
+ *         isometric bending (or bending distance constraints), constraint
  *         damping (their eq. 26), substeps of h = dt/substeps with `iterations` Gauss-Seidel
  *         sweeps each; optional long-range attachments (Kim, Chentanez, Mueller 2012);
  *       AK_CLOTH_SPRINGS: the classic mass-spring model: structural, shear and bending springs
@@ -74,11 +74,17 @@ typedef enum ak_cloth_solver {
 } ak_cloth_solver;
 
 typedef enum ak_cloth_bending {
-    AK_CLOTH_BEND_DEFAULT = 0, /* -> DIHEDRAL for XPBD and PBD, SPRINGS for the spring solver */
+    AK_CLOTH_BEND_DEFAULT = 0, /* -> DIHEDRAL for XPBD and PBD; the spring solver always uses SPRINGS
+                                  (or NONE) */
     AK_CLOTH_BEND_DIHEDRAL,    /* angle between the two triangles of each interior edge */
     AK_CLOTH_BEND_SPRINGS,     /* distance between the wing vertices of each interior edge (grid:
                                   particles two apart along each axis) */
     AK_CLOTH_BEND_NONE,        /* no bending resistance */
+    AK_CLOTH_BEND_ISOMETRIC,   /* isometric bending (Bergou et al. 2006): the cotangent-weighted
+                                  bending vector b = sum_i K_i x_i of each interior edge's four
+                                  particles, energy 3 k |b|^2 / (2 (A0 + A1)), as one XPBD/PBD
+                                  constraint C = |b| - |b_rest| (exact for a flat rest shape);
+                                  about a third of the dihedral constraint's cost */
     AK_CLOTH_BENDING_COUNT
 } ak_cloth_bending;
 
@@ -109,7 +115,8 @@ typedef struct ak_cloth_desc {
                                     0 -> 5000 */
     float shear_stiffness;       /* N/m of grid diagonals; 0 -> stretch_stiffness */
     float bend_stiffness;        /* N/m of bending springs; 0 -> stretch_stiffness / 100 */
-    float dihedral_stiffness;    /* N m/rad of dihedral bending (XPBD compliance 1/this); 0 -> 0.01 */
+    float dihedral_stiffness;    /* bending modulus k of dihedral bending (N m/rad: energy k theta^2 / 2,
+                                    XPBD compliance 1/k) and of isometric bending (N m); 0 -> 0.01 */
     ak_cloth_bending bending;    /* 0 -> see ak_cloth_bending */
     float spring_damping;        /* SPRINGS: N s/m along each spring; 0 -> none */
     float constraint_damping;    /* XPBD: beta (s) of the paper's eq. 26, stiffness-proportional

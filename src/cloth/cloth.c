@@ -92,6 +92,30 @@ float akp_dihedral(const ak_vec3 x[4], ak_vec3 grad[4]) {
     return theta;
 }
 
+static float cot_at(ak_vec3 apex, ak_vec3 a, ak_vec3 b) {
+    const ak_vec3 u = ak_vec3_sub(a, apex), v = ak_vec3_sub(b, apex);
+    const float s = ak_vec3_length(ak_vec3_cross(u, v));
+    return s > 1e-20f ? ak_vec3_dot(u, v) / s : 0.0f;
+}
+
+/* Isometric bending of the element x (wings x0, x1, edge x2 -> x3) at rest (Bergou, Wardetzky,
+ * Harmon, Zorin, Grinspun 2006): with the edge (x2, x3) as their x0, x1 and c_0j the cotangents of
+ * the angles at x2 and x3 in the two triangles, K = (-c01 - c03, -c02 - c04, c03 + c04, c01 + c02)
+ * in the order (x0, x1, x2, x3); b = sum K_i x_i vanishes on any flat configuration. */
+static bool isometric_weights(const ak_vec3 x[4], float k, akp_bend* e) {
+    const float c01 = cot_at(x[2], x[3], x[0]), c02 = cot_at(x[2], x[3], x[1]);
+    const float c03 = cot_at(x[3], x[2], x[0]), c04 = cot_at(x[3], x[2], x[1]);
+    const float a0 = 0.5f * ak_vec3_length(ak_vec3_cross(ak_vec3_sub(x[3], x[2]), ak_vec3_sub(x[0], x[2])));
+    const float a1 = 0.5f * ak_vec3_length(ak_vec3_cross(ak_vec3_sub(x[3], x[2]), ak_vec3_sub(x[1], x[2])));
+    if (!(a0 > 1e-20f) || !(a1 > 1e-20f) || !ak_finitef(c01 + c02 + c03 + c04)) return false;
+    e->K[0] = -c01 - c03, e->K[1] = -c02 - c04, e->K[2] = c03 + c04, e->K[3] = c01 + c02;
+    ak_vec3 bv = ak_vec3_make(0, 0, 0);
+    for (int q = 0; q < 4; ++q) bv = ak_vec3_madd(bv, x[q], e->K[q]);
+    e->rest = ak_vec3_length(bv);
+    e->alpha = isinf(k) ? 0.0f : (a0 + a1) / (3.0f * k);
+    return true;
+}
+
 /* Greedy colouring in input order: the smallest colour none of the constraint's particles has
  * used; AKP_SERIAL_COLOR when all are taken. Writes color[k]. */
 static void color_constraints(const uint32_t* parts, size_t stride, size_t count, size_t n, uint64_t* used,
@@ -142,7 +166,8 @@ ak_cloth_desc ak_cloth_desc_resolved(const ak_cloth_desc* desc) {
     if (d.dihedral_stiffness == 0.0f) d.dihedral_stiffness = 0.01f;
     if (d.bending == AK_CLOTH_BEND_DEFAULT)
         d.bending = d.solver == AK_CLOTH_SPRINGS ? AK_CLOTH_BEND_SPRINGS : AK_CLOTH_BEND_DIHEDRAL;
-    if (d.solver == AK_CLOTH_SPRINGS && d.bending == AK_CLOTH_BEND_DIHEDRAL) d.bending = AK_CLOTH_BEND_SPRINGS;
+    if (d.solver == AK_CLOTH_SPRINGS && (d.bending == AK_CLOTH_BEND_DIHEDRAL || d.bending == AK_CLOTH_BEND_ISOMETRIC))
+        d.bending = AK_CLOTH_BEND_SPRINGS;
     if (d.pbd_stiffness == 0.0f) d.pbd_stiffness = 1.0f;
     return d;
 }
@@ -325,17 +350,20 @@ static ak_result build_constraints(build* b, const ak_cloth_desc* d) {
         if (he[k].lo != he[k + 1].lo || he[k].hi != he[k + 1].hi) continue;
         if (k > 0 && he[k].lo == he[k - 1].lo && he[k].hi == he[k - 1].hi) continue;
         if (he[k].opp == he[k + 1].opp) continue;
-        if (d->bending == AK_CLOTH_BEND_DIHEDRAL) {
-            /* edge walked from -> to in the first triangle: that triangle is (to, from, ...)?
-             * Triangle A walks p2 -> p3 with wing p0 as (p2, p3, p0). */
+        if (d->bending == AK_CLOTH_BEND_DIHEDRAL || d->bending == AK_CLOTH_BEND_ISOMETRIC) {
+            /* triangle A walks p2 -> p3 with wing p0: (p2, p3, p0) */
             const uint32_t p2 = he[k].from, p3 = he[k].from == he[k].lo ? he[k].hi : he[k].lo;
-            akp_bend e = {{he[k].opp, he[k + 1].opp, p2, p3}, 0.0f};
+            akp_bend e = {{he[k].opp, he[k + 1].opp, p2, p3}, 0.0f, {0, 0, 0, 0}, 0.0f};
             /* the second triangle must walk the edge the other way (consistent orientation);
              * otherwise its wing's sign flips: skip such edges (non-orientable neighbourhoods) */
             if (he[k + 1].from == p2) continue;
             ak_vec3 x[4];
             for (int q = 0; q < 4; ++q) x[q] = b->rest[e.p[q]];
-            e.rest = akp_dihedral(x, NULL);
+            if (d->bending == AK_CLOTH_BEND_DIHEDRAL) {
+                e.rest = akp_dihedral(x, NULL);
+            } else if (!isometric_weights(x, d->dihedral_stiffness, &e)) {
+                continue; /* a degenerate triangle: no bending there */
+            }
             ok = buf_push(&b->bend, b->a, &e);
         } else if (d->bending == AK_CLOTH_BEND_SPRINGS && !grid) {
             ok = add_dist(b, d, he[k].opp, he[k + 1].opp, AKP_BEND);
@@ -543,9 +571,21 @@ ak_result ak_cloth_energy_compute(const ak_cloth* cloth, ak_vec3_cspan positions
         e.elastic += 0.5 * c->k * C * C;
     }
     const double kb = cloth->desc.dihedral_stiffness;
+    const bool iso = cloth->desc.bending == AK_CLOTH_BEND_ISOMETRIC;
     for (size_t k = 0; k < cloth->bend_count && !isinf(kb); ++k) {
         ak_vec3 x[4];
         for (int q = 0; q < 4; ++q) x[q] = positions.ptr[cloth->bend[k].p[q]];
+        if (iso) {
+            double b[3] = {0, 0, 0};
+            for (int q = 0; q < 4; ++q) {
+                b[0] += (double)cloth->bend[k].K[q] * x[q].x;
+                b[1] += (double)cloth->bend[k].K[q] * x[q].y;
+                b[2] += (double)cloth->bend[k].K[q] * x[q].z;
+            }
+            const double C = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]) - cloth->bend[k].rest;
+            if (cloth->bend[k].alpha > 0.0f) e.elastic += 0.5 * C * C / cloth->bend[k].alpha;
+            continue;
+        }
         double C = (double)akp_dihedral(x, NULL) - cloth->bend[k].rest;
         if (C > AK_PI) C -= 2.0 * AK_PI;
         if (C < -AK_PI) C += 2.0 * AK_PI;

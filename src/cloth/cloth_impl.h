@@ -24,7 +24,9 @@ typedef struct akp_dist {
  * (p[3], p[2], p[1]) (both counter-clockwise). */
 typedef struct akp_bend {
     uint32_t p[4];
-    float rest;   /* rest angle (radians) */
+    float rest;   /* dihedral: rest angle (radians); isometric: |b| at rest (m) */
+    float K[4];   /* isometric: cotangent weights of p[0..3] */
+    float alpha;  /* isometric: compliance (A0 + A1) / (3 k) */
 } akp_bend;
 
 struct ak_cloth {

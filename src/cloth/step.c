@@ -367,20 +367,31 @@ static void solve_bend(const ctx* c, size_t k, bool first) {
     const ak_cloth* cl = c->c;
     const akp_bend* b = &cl->bend[k];
     ak_vec3 x[4], g[4];
-    float w[4], wsum = 0.0f;
+    float w[4], wsum = 0.0f, C, alpha;
     for (int q = 0; q < 4; ++q) x[q] = c->x[b->p[q]], w[q] = cl->inv_mass[b->p[q]];
-    const float theta = akp_dihedral(x, g);
-    float C = theta - b->rest;
-    if (C > AK_PI) C -= 2.0f * AK_PI;
-    if (C < -AK_PI) C += 2.0f * AK_PI;
-    for (int q = 0; q < 4; ++q) wsum += w[q] * ak_vec3_length_sq(g[q]);
+    if (cl->desc.bending == AK_CLOTH_BEND_ISOMETRIC) {
+        /* C = |b| - |b_rest|, grad_i C = K_i b / |b| */
+        ak_vec3 bv = ak_vec3_make(0, 0, 0);
+        for (int q = 0; q < 4; ++q) bv = ak_vec3_madd(bv, x[q], b->K[q]);
+        const float l = ak_vec3_length(bv);
+        if (l < 1e-12f) return;
+        const ak_vec3 n = ak_vec3_scale(bv, 1.0f / l);
+        for (int q = 0; q < 4; ++q) g[q] = ak_vec3_scale(n, b->K[q]), wsum += w[q] * b->K[q] * b->K[q];
+        C = l - b->rest;
+        alpha = b->alpha;
+    } else {
+        C = akp_dihedral(x, g) - b->rest;
+        if (C > AK_PI) C -= 2.0f * AK_PI;
+        if (C < -AK_PI) C += 2.0f * AK_PI;
+        for (int q = 0; q < 4; ++q) wsum += w[q] * ak_vec3_length_sq(g[q]);
+        alpha = 1.0f / cl->desc.dihedral_stiffness; /* 0 when infinite */
+    }
     if (wsum < 1e-20f) return;
     float dl;
     float* lam_slot = c->lambda + cl->dist_count + k;
     if (cl->desc.solver == AK_CLOTH_PBD) {
         dl = -cl->desc.pbd_stiffness * C / wsum;
     } else {
-        const float alpha = 1.0f / cl->desc.dihedral_stiffness; /* 0 when infinite */
         const float at = alpha / (c->h * c->h);
         const float lam = first ? 0.0f : *lam_slot;
         const float gamma = alpha * cl->desc.constraint_damping / c->h;

@@ -231,7 +231,8 @@ int cmd_cloth(int argc, char** argv) {
         if (strcmp(v, "xpbd") == 0) sc.desc.solver = AK_CLOTH_XPBD;
         else if (strcmp(v, "springs") == 0) sc.desc.solver = AK_CLOTH_SPRINGS;
         else rc = cli_usage("cloth", "--solver must be springs or xpbd, not '%s'", v);
-        if (sc.desc.solver == AK_CLOTH_SPRINGS && sc.desc.bending == AK_CLOTH_BEND_DIHEDRAL)
+        if (sc.desc.solver == AK_CLOTH_SPRINGS &&
+            (sc.desc.bending == AK_CLOTH_BEND_DIHEDRAL || sc.desc.bending == AK_CLOTH_BEND_ISOMETRIC))
             sc.desc.bending = AK_CLOTH_BEND_SPRINGS;
     }
     if (!rc && (v = CLI_GET(&a, "--steps"))) {

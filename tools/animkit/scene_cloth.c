@@ -78,7 +78,7 @@ static void parse_material(cli_json* j, const cJSON* root, cloth_scene* s) {
     static const char* const keys[] = {"stretch_stiffness", "shear_stiffness", "bend_stiffness", "dihedral_stiffness",
                                        "bending", "spring_damping", "constraint_damping", "pbd_stiffness",
                                        "long_range_attachments", "long_range_slack", "area_density", NULL};
-    static const char* const bendings[] = {"default", "dihedral", "springs", "none", NULL};
+    static const char* const bendings[] = {"default", "dihedral", "springs", "none", "isometric", NULL};
     ak_cloth_desc* d = &s->desc;
     cli_json_object(j, m, "material", keys);
     cli_json_float(j, m, "material", "stretch_stiffness", 1e-3f, 1e9f, &d->stretch_stiffness);
