@@ -51,7 +51,7 @@ AK_TEST(desc_defaults) {
     AK_CHECK_NEAR(d.stretch_stiffness, 5000.0f, 0);
     AK_CHECK_NEAR(d.shear_stiffness, 5000.0f, 0);
     AK_CHECK_NEAR(d.bend_stiffness, 50.0f, 0);
-    AK_CHECK_NEAR(d.dihedral_stiffness, 0.01f, 0);
+    AK_CHECK_NEAR(d.dihedral_stiffness, 1e-4f, 0);
     AK_CHECK_NEAR(d.area_density, 0.2f, 0);
     AK_CHECK_NEAR(d.pbd_stiffness, 1.0f, 0);
     AK_CHECK_EQ(d.bending, AK_CLOTH_BEND_DIHEDRAL);

@@ -116,7 +116,8 @@ typedef struct ak_cloth_desc {
     float shear_stiffness;       /* N/m of grid diagonals; 0 -> stretch_stiffness */
     float bend_stiffness;        /* N/m of bending springs; 0 -> stretch_stiffness / 100 */
     float dihedral_stiffness;    /* bending modulus k of dihedral bending (N m/rad: energy k theta^2 / 2,
-                                    XPBD compliance 1/k) and of isometric bending (N m); 0 -> 0.01 */
+                                    XPBD compliance 1/k) and of isometric bending (N m); 0 -> 1e-4
+                                    (cotton-like: a draped sheet folds) */
     ak_cloth_bending bending;    /* 0 -> see ak_cloth_bending */
     float spring_damping;        /* SPRINGS: N s/m along each spring; 0 -> none */
     float constraint_damping;    /* XPBD: beta (s) of the paper's eq. 26, stiffness-proportional

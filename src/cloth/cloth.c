@@ -163,7 +163,7 @@ ak_cloth_desc ak_cloth_desc_resolved(const ak_cloth_desc* desc) {
     if (d.stretch_stiffness == 0.0f) d.stretch_stiffness = 5000.0f;
     if (d.shear_stiffness == 0.0f) d.shear_stiffness = d.stretch_stiffness;
     if (d.bend_stiffness == 0.0f) d.bend_stiffness = d.stretch_stiffness / 100.0f;
-    if (d.dihedral_stiffness == 0.0f) d.dihedral_stiffness = 0.01f;
+    if (d.dihedral_stiffness == 0.0f) d.dihedral_stiffness = 1e-4f;
     if (d.bending == AK_CLOTH_BEND_DEFAULT)
         d.bending = d.solver == AK_CLOTH_SPRINGS ? AK_CLOTH_BEND_SPRINGS : AK_CLOTH_BEND_DIHEDRAL;
     if (d.solver == AK_CLOTH_SPRINGS && (d.bending == AK_CLOTH_BEND_DIHEDRAL || d.bending == AK_CLOTH_BEND_ISOMETRIC))

@@ -412,7 +412,8 @@ int cmd_cloth(int argc, char** argv) {
             hi = ak_vec3_max(hi, ak_vec3_madd(hi, w, 0.3f * span));
             lo = ak_vec3_min(lo, ak_vec3_madd(lo, w, 0.3f * span));
         }
-        if (cli_frame_init(&frame, ch.scene, 480, 360, lo, hi, 0.6f) || cli_image_alloc(&img, 480, 360)) {
+        /* a character faces +Z: look from behind, where a cape hangs */
+        if (cli_frame_init(&frame, ch.scene, 480, 360, lo, hi, ch.scene ? 3.6f : 0.6f) || cli_image_alloc(&img, 480, 360)) {
             rc = cli_fail("cloth", "out of memory");
             goto done;
         }
@@ -518,7 +519,8 @@ int cmd_cloth(int argc, char** argv) {
            " (kinetic %.3g)\n",
            name, sc.desc.solver == AK_CLOTH_SPRINGS ? "mass-spring" : sc.desc.solver == AK_CLOTH_PBD ? "PBD" : "XPBD", n,
            sc.steps, (double)sc.dt, sc.substeps, (double)time, (double)stretch, e.total, e.kinetic);
-    if (out) fprintf(stderr, "wrote %s%s%d frame%s\n", out, gif ? ": " : "", gif ? frames : 0, gif ? "s" : "");
+    if (gif) fprintf(stderr, "wrote %s: %d frames\n", out, frames);
+    else if (out) fprintf(stderr, "wrote %s\n", out);
     if (sc.steps > 0) fprintf(stderr, "%.3f ms per step (including rendering)\n", 1e3 * elapsed / (double)sc.steps);
 
 done:

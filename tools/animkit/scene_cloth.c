@@ -18,7 +18,7 @@ void cloth_scene_defaults(cloth_scene* s) {
     s->desc.grid_axis_v = ak_vec3_make(0, 0, -1);
     s->desc.area_density = 0.2f;
     s->desc.stretch_stiffness = 5000.0f;
-    s->desc.dihedral_stiffness = 0.01f;
+    s->desc.dihedral_stiffness = 1e-4f;
     s->dt = 1.0f / 60.0f;
     s->steps = 120;
     s->substeps = 10;
