@@ -157,7 +157,9 @@ AK_API ak_u32_cspan ak_cloth_indices(const ak_cloth* cloth);
 AK_API ak_f32_cspan ak_cloth_inverse_masses(const ak_cloth* cloth);
 /* Number of attachments (the count attachment_targets must have). */
 AK_API size_t ak_cloth_attachment_count(const ak_cloth* cloth);
-/* The desc the cloth was built with, resolved (its spans point at the cloth's own copies). */
+/* The desc the cloth was built with, resolved. Its indices, inverse_masses (after pins and
+ * attachments), pins, pin_positions and attachments point at the cloth's own arrays; positions
+ * and edges are not kept (empty spans; ak_cloth_rest_positions gives the rest state). */
 AK_API ak_cloth_desc ak_cloth_get_desc(const ak_cloth* cloth);
 
 /* Rest positions, with pinned vertices at their pin positions, into out_positions
