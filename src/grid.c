@@ -13,7 +13,7 @@
 
 static inline int32_t cell_coord(float p, double inv_cell) {
     double v = floor((double)p * inv_cell);
-    if (v < -GRID_COORD_LIMIT) v = -GRID_COORD_LIMIT;
+    if (!(v >= -GRID_COORD_LIMIT)) v = -GRID_COORD_LIMIT; /* NaN too */
     if (v > GRID_COORD_LIMIT) v = GRID_COORD_LIMIT;
     return (int32_t)v;
 }
@@ -24,14 +24,17 @@ static inline ak_grid_cell cell_of(float x, float y, float z, double inv_cell) {
 }
 
 static inline uint32_t cell_hash(ak_grid_cell c) {
-    uint32_t h = (uint32_t)c.x * 0x9E3779B1u ^ (uint32_t)c.y * 0x85EBCA77u ^ (uint32_t)c.z * 0xC2B2AE3Du;
+    uint32_t h =
+        (uint32_t)c.x * 0x9E3779B1u ^ (uint32_t)c.y * 0x85EBCA77u ^ (uint32_t)c.z * 0xC2B2AE3Du;
     h ^= h >> 15;
     h *= 0x2C1B3C6Du;
     h ^= h >> 12;
     return h;
 }
 
-static inline bool cell_eq(ak_grid_cell a, ak_grid_cell b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+static inline bool cell_eq(ak_grid_cell a, ak_grid_cell b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+}
 
 static inline bool cell_less(ak_grid_cell a, ak_grid_cell b) {
     if (a.z != b.z) return a.z < b.z;
@@ -60,10 +63,10 @@ typedef struct layout {
 
 static size_t carve(uint8_t* base, size_t n, size_t buckets, layout* l) {
     size_t off = 0;
-#define GRID_TAKE(field, type, count)                                                      \
-    do {                                                                                   \
-        l->field = base ? (type*)(void*)(base + off) : NULL;                               \
-        off += akp_align16(sizeof(type) * (count));                                        \
+#define GRID_TAKE(field, type, count)                                                              \
+    do {                                                                                           \
+        l->field = base ? (type*)(void*)(base + off) : NULL;                                       \
+        off += akp_align16(sizeof(type) * (count));                                                \
     } while (0)
     GRID_TAKE(order, uint32_t, n);
     GRID_TAKE(x, float, n);
@@ -87,7 +90,8 @@ static void sort_by_cell(uint32_t* idx, uint32_t* tmp, size_t n, const ak_grid_c
         for (size_t lo = 0; lo < n; lo += 2 * w) {
             size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
             size_t a = lo, b = mid, o = lo;
-            while (a < mid && b < hi) dst[o++] = cell_less(pc[src[b]], pc[src[a]]) ? src[b++] : src[a++];
+            while (a < mid && b < hi)
+                dst[o++] = cell_less(pc[src[b]], pc[src[a]]) ? src[b++] : src[a++];
             while (a < mid) dst[o++] = src[a++];
             while (b < hi) dst[o++] = src[b++];
         }
@@ -116,7 +120,8 @@ static bool scan_all_cells(const ak_grid* g, int64_t k) {
 static inline int64_t abs64(int64_t v) { return v < 0 ? -v : v; }
 
 static inline bool cells_within(ak_grid_cell a, ak_grid_cell b, int64_t k) {
-    return abs64((int64_t)a.x - b.x) <= k && abs64((int64_t)a.y - b.y) <= k && abs64((int64_t)a.z - b.z) <= k;
+    return abs64((int64_t)a.x - b.x) <= k && abs64((int64_t)a.y - b.y) <= k &&
+           abs64((int64_t)a.z - b.z) <= k;
 }
 
 static inline bool coord_offset_ok(int32_t c, int64_t d) {
@@ -132,10 +137,13 @@ size_t ak_grid_memory_size(size_t point_count, const ak_grid_desc* desc) {
     return carve(NULL, point_count, bucket_count_for(point_count), &l) + 16;
 }
 
-ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_span memory, ak_grid* out_grid) {
+ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_span memory,
+                        ak_grid* out_grid) {
     if (out_grid) memset(out_grid, 0, sizeof *out_grid);
-    if (!desc || !out_grid || !memory.ptr || (!points.ptr && points.count > 0)) return AK_ERR_NULL_ARG;
-    if (!(desc->cell_size > 0.0f) || !ak_finitef(desc->cell_size) || points.count >= ((size_t)1 << 31))
+    if (!desc || !out_grid || !memory.ptr || (!points.ptr && points.count > 0))
+        return AK_ERR_NULL_ARG;
+    if (!(desc->cell_size > 0.0f) || !ak_finitef(desc->cell_size) ||
+        points.count >= ((size_t)1 << 31))
         return AK_ERR_BAD_ARG;
     const size_t n = points.count;
     if (memory.count < ak_grid_memory_size(n, desc)) return AK_ERR_SPAN_SMALL;
@@ -224,8 +232,8 @@ uint32_t ak_grid_cell_find(const ak_grid* grid, ak_grid_cell cell) {
 }
 
 /* Points of cell m within radius of q (the module's distance test); returns the new total. */
-static size_t query_cell(const ak_grid* g, uint32_t m, float qx, float qy, float qz, float r2, ak_u32_span out,
-                         size_t total) {
+static size_t query_cell(const ak_grid* g, uint32_t m, float qx, float qy, float qz, float r2,
+                         ak_u32_span out, size_t total) {
     for (uint32_t k = g->cell_start[m]; k < g->cell_start[m + 1]; ++k) {
         const float dx = g->x[k] - qx, dy = g->y[k] - qy, dz = g->z[k] - qz;
         if (dx * dx + dy * dy + dz * dz < r2) {
@@ -237,8 +245,8 @@ static size_t query_cell(const ak_grid* g, uint32_t m, float qx, float qy, float
 }
 
 size_t ak_grid_query(const ak_grid* grid, ak_vec3 q, float radius, ak_u32_span out_indices) {
-    if (!grid || grid->point_count == 0 || !(radius > 0.0f) || !ak_finitef(radius) || !ak_finitef(q.x) ||
-        !ak_finitef(q.y) || !ak_finitef(q.z))
+    if (!grid || grid->point_count == 0 || !(radius > 0.0f) || !ak_finitef(radius) ||
+        !ak_finitef(q.x) || !ak_finitef(q.y) || !ak_finitef(q.z))
         return 0;
     if (!out_indices.ptr) out_indices.count = 0;
     const float r2 = radius * radius;
@@ -247,7 +255,8 @@ size_t ak_grid_query(const ak_grid* grid, ak_vec3 q, float radius, ak_u32_span o
     size_t total = 0;
     if (scan_all_cells(grid, k)) {
         for (uint32_t m = 0; m < grid->cell_count; ++m)
-            if (cells_within(grid->cell_coord[m], c, k)) total = query_cell(grid, m, q.x, q.y, q.z, r2, out_indices, total);
+            if (cells_within(grid->cell_coord[m], c, k))
+                total = query_cell(grid, m, q.x, q.y, q.z, r2, out_indices, total);
         return total;
     }
     for (int64_t dz = -k; dz <= k; ++dz) {
@@ -258,7 +267,8 @@ size_t ak_grid_query(const ak_grid* grid, ak_vec3 q, float radius, ak_u32_span o
                 if (!coord_offset_ok(c.x, dx)) continue;
                 ak_grid_cell n = {(int32_t)(c.x + dx), (int32_t)(c.y + dy), (int32_t)(c.z + dz)};
                 uint32_t m = ak_grid_cell_find(grid, n);
-                if (m != UINT32_MAX) total = query_cell(grid, m, q.x, q.y, q.z, r2, out_indices, total);
+                if (m != UINT32_MAX)
+                    total = query_cell(grid, m, q.x, q.y, q.z, r2, out_indices, total);
             }
         }
     }
@@ -321,7 +331,10 @@ static void pairs_within(pair_task* t, uint32_t c) {
 }
 
 static void* pair_thread(void* arg) {
-    pair_task* t = (pair_task*)arg;
+    /* Work on a copy: the tasks sit side by side in one array, and a count updated per pair
+     * in shared cache lines would make the threads slower than one. */
+    pair_task local = *(pair_task*)arg;
+    pair_task* t = &local;
     const ak_grid* g = t->grid;
     const int64_t k = t->rings;
     t->count = 0;
@@ -340,29 +353,35 @@ static void* pair_thread(void* arg) {
                 if (!coord_offset_ok(c.y, dy)) continue;
                 for (int64_t dx = (dz == 0 && dy == 0) ? 1 : -k; dx <= k; ++dx) {
                     if (!coord_offset_ok(c.x, dx)) continue;
-                    ak_grid_cell n = {(int32_t)(c.x + dx), (int32_t)(c.y + dy), (int32_t)(c.z + dz)};
+                    ak_grid_cell n = {(int32_t)(c.x + dx), (int32_t)(c.y + dy),
+                                      (int32_t)(c.z + dz)};
                     uint32_t o = ak_grid_cell_find(g, n);
                     if (o != UINT32_MAX) pairs_between(t, m, o);
                 }
             }
         }
     }
+    ((pair_task*)arg)->count = local.count;
     return NULL;
 }
 
 static void run_tasks(void* (*fn)(void*), pair_task* tasks, uint32_t count) {
     pthread_t ids[GRID_MAX_THREADS];
     bool started[GRID_MAX_THREADS];
-    for (uint32_t t = 1; t < count; ++t) started[t] = pthread_create(&ids[t], NULL, fn, &tasks[t]) == 0;
+    for (uint32_t t = 1; t < count; ++t)
+        started[t] = pthread_create(&ids[t], NULL, fn, &tasks[t]) == 0;
     fn(&tasks[0]);
     for (uint32_t t = 1; t < count; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else fn(&tasks[t]);
+        if (started[t])
+            pthread_join(ids[t], NULL);
+        else
+            fn(&tasks[t]);
     }
 }
 
 ak_result ak_grid_pairs_validate(const ak_grid_pairs_job* job) {
-    if (!job || !job->grid || !job->out_pair_count || (!job->out_pairs.ptr && job->out_pairs.count > 0))
+    if (!job || !job->grid || !job->out_pair_count ||
+        (!job->out_pairs.ptr && job->out_pairs.count > 0))
         return AK_ERR_NULL_ARG;
     if (!(job->radius > 0.0f) || !ak_finitef(job->radius) || job->thread_count > GRID_MAX_THREADS)
         return AK_ERR_BAD_ARG;
@@ -393,7 +412,7 @@ ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
     const size_t cap = job->out_pairs.count;
     for (uint32_t t = 0; t < threads; ++t) {
         size_t lo = cap * t / threads, hi = cap * (t + 1) / threads;
-        tasks[t].out = job->out_pairs.ptr + lo;
+        tasks[t].out = job->out_pairs.ptr ? job->out_pairs.ptr + lo : NULL;
         tasks[t].capacity = hi - lo;
     }
     run_tasks(pair_thread, tasks, threads);
@@ -405,21 +424,32 @@ ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
     }
     *job->out_pair_count = total;
     if (total > cap) return AK_ERR_SPAN_SMALL;
-    if (overflow) {
-        size_t off = 0;
-        for (uint32_t t = 0; t < threads; ++t) {
-            tasks[t].out = job->out_pairs.ptr + off;
-            tasks[t].capacity = tasks[t].count;
-            off += tasks[t].count;
-        }
-        run_tasks(pair_thread, tasks, threads);
-        return AK_OK;
-    }
+    if (total == 0) return AK_OK;
+    /* Exact offsets; threads that fit move their pairs there (leftward moves in increasing
+     * order, then rightward moves in decreasing order, so no block overwrites one not yet
+     * moved), and threads that overflowed their share run again into their exact place. */
+    size_t offset[GRID_MAX_THREADS];
     size_t off = 0;
-    for (uint32_t t = 0; t < threads; ++t) {
-        if (tasks[t].out != job->out_pairs.ptr + off)
-            memmove(job->out_pairs.ptr + off, tasks[t].out, tasks[t].count * sizeof(ak_grid_pair));
-        off += tasks[t].count;
+    for (uint32_t t = 0; t < threads; ++t) offset[t] = off, off += tasks[t].count;
+    for (uint32_t t = 0; t < threads; ++t)
+        if (!(tasks[t].count > tasks[t].capacity) && job->out_pairs.ptr + offset[t] <= tasks[t].out)
+            memmove(job->out_pairs.ptr + offset[t], tasks[t].out,
+                    tasks[t].count * sizeof(ak_grid_pair));
+    for (uint32_t t = threads; t-- > 0;)
+        if (!(tasks[t].count > tasks[t].capacity) && job->out_pairs.ptr + offset[t] > tasks[t].out)
+            memmove(job->out_pairs.ptr + offset[t], tasks[t].out,
+                    tasks[t].count * sizeof(ak_grid_pair));
+    if (overflow) {
+        pair_task again[GRID_MAX_THREADS];
+        uint32_t rerun = 0;
+        for (uint32_t t = 0; t < threads; ++t) {
+            if (!(tasks[t].count > tasks[t].capacity)) continue;
+            again[rerun] = tasks[t];
+            again[rerun].out = job->out_pairs.ptr + offset[t];
+            again[rerun].capacity = tasks[t].count;
+            ++rerun;
+        }
+        run_tasks(pair_thread, again, rerun);
     }
     return AK_OK;
 }

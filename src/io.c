@@ -47,8 +47,28 @@ void akp_io_copy_name(char dst[AK_NAME_SIZE], const char* src) {
     snprintf(dst, AK_NAME_SIZE, "%s", src ? src : "");
 }
 
-ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, uint8_t** out_data, size_t* out_size,
-                           ak_diag* diag) {
+akp_budget akp_io_budget(const ak_io_desc* desc, size_t input_size) {
+    akp_budget b = {desc ? desc->memory_budget : 0, 0};
+    if (b.limit == 0) {
+        b.limit = AK_IO_DEFAULT_BUDGET;
+        if (input_size <= SIZE_MAX / AK_IO_BUDGET_INPUT_FACTOR && input_size * AK_IO_BUDGET_INPUT_FACTOR > b.limit)
+            b.limit = input_size * AK_IO_BUDGET_INPUT_FACTOR;
+        else if (input_size > SIZE_MAX / AK_IO_BUDGET_INPUT_FACTOR)
+            b.limit = SIZE_MAX;
+    }
+    return b;
+}
+
+bool akp_budget_take(akp_budget* b, size_t a, size_t n) {
+    if (a != 0 && n > SIZE_MAX / a) return false;
+    size_t bytes = a * n;
+    if (bytes > b->limit - b->used) return false;
+    b->used += bytes;
+    return true;
+}
+
+ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, size_t want, akp_budget* budget,
+                           uint8_t** out_data, size_t* out_size, ak_diag* diag) {
     *out_data = NULL;
     *out_size = 0;
     FILE* f = fopen(path, "rb");
@@ -70,22 +90,37 @@ ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, uint8_t*
         akp_diag_set(diag, path, "cannot determine the file size (not a regular file?)");
         return AK_ERR_IO;
     }
-    uint8_t* data = (uint8_t*)akp_alloc(alloc, (size_t)end + 1); /* +1: never a zero-size alloc */
+    size_t size = (size_t)end;
+    if (want) {
+        if (size < want) {
+            fclose(f);
+            akp_diag_set(diag, path, "has %zu bytes, fewer than the %zu declared", size, want);
+            return AK_ERR_PARSE;
+        }
+        size = want; /* only the declared bytes are read, whatever follows them */
+    }
+    if (budget && !akp_budget_take(budget, 1, size + 1)) {
+        fclose(f);
+        akp_diag_set(diag, path, "%zu bytes exceed the memory budget of %zu bytes (ak_io_desc.memory_budget)", size,
+                     budget->limit);
+        return AK_ERR_UNSUPPORTED;
+    }
+    uint8_t* data = (uint8_t*)akp_alloc(alloc, size + 1); /* +1: never a zero-size alloc */
     if (!data) {
         fclose(f);
-        akp_diag_set(diag, path, "out of memory reading %ld bytes", end);
+        akp_diag_set(diag, path, "out of memory reading %zu bytes", size);
         return AK_ERR_NO_MEMORY;
     }
-    size_t got = fread(data, 1, (size_t)end, f);
+    size_t got = fread(data, 1, size, f);
     fclose(f);
-    if (got != (size_t)end) {
+    if (got != size) {
         akp_free(alloc, data);
-        akp_diag_set(diag, path, "read %zu of %ld bytes", got, end);
+        akp_diag_set(diag, path, "read %zu of %zu bytes", got, size);
         return AK_ERR_IO;
     }
-    data[end] = 0;
+    data[size] = 0;
     *out_data = data;
-    *out_size = (size_t)end;
+    *out_size = size;
     return AK_OK;
 }
 
@@ -138,7 +173,9 @@ ak_result akp_io_build_skeleton(ak_scene* scene, const akp_io_node* nodes, size_
         joints[k].rest = n->rest;
         joints[k].inverse_bind = n->inverse_bind;
     }
-    ak_skeleton_desc sd = {.joints = joints, .joint_count = count, .name = scene->name};
+    /* A loaded mesh's joint indices are slots of its skin (scene.h), so a palette indexed by
+     * skeleton joint is refused (ak_skeleton_skinning_matrices) rather than silently wrong. */
+    ak_skeleton_desc sd = {.joints = joints, .joint_count = count, .name = scene->name, .palette_from_skins = true};
     r = ak_skeleton_create(&sd, a, &scene->skeleton, diag);
     if (r != AK_OK && diag) {
         char msg[sizeof diag->message];
@@ -223,6 +260,7 @@ ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocato
     }
     /* A directory would be an Assimp parse error; opening a FIFO would block. */
     struct stat st;
+    memset(&st, 0, sizeof st);
     if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
         akp_diag_set(diag, path, "%s", S_ISDIR(st.st_mode) ? "is a directory, not a file" : "not a regular file");
         return AK_ERR_IO;
@@ -230,7 +268,9 @@ ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocato
     ak_io_desc d = ak_io_desc_resolved(desc);
     ak_io_format fmt = d.format;
     if (fmt == AK_IO_FORMAT_AUTO) {
-        fmt = (has_extension(path, ".gltf") || has_extension(path, ".glb")) ? AK_IO_FORMAT_GLTF : AK_IO_FORMAT_ASSIMP;
+        fmt = (has_extension(path, ".gltf") || has_extension(path, ".glb")) ? AK_IO_FORMAT_GLTF
+              : has_extension(path, ".bvh")                                 ? AK_IO_FORMAT_BVH
+                                                                            : AK_IO_FORMAT_ASSIMP;
         char magic[4] = {0};
         FILE* f = fmt == AK_IO_FORMAT_ASSIMP ? fopen(path, "rb") : NULL;
         if (f) { /* a GLB under another extension */
@@ -239,18 +279,19 @@ ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocato
         }
     }
     if (fmt == AK_IO_FORMAT_ASSIMP) return akp_io_load_assimp(path, &d, alloc, out_scene, diag);
+    const char* base = strrchr(path, '/');
+    if (fmt == AK_IO_FORMAT_BVH) return akp_io_load_bvh(path, NULL, 0, base ? base + 1 : path, &d, alloc, out_scene, diag);
 
     uint8_t* data = NULL;
     size_t size = 0;
-    ak_result r = akp_io_read_file(path, alloc, &data, &size, diag);
+    akp_budget budget = akp_io_budget(&d, (size_t)st.st_size);
+    ak_result r = akp_io_read_file(path, alloc, 0, &budget, &data, &size, diag);
     if (r != AK_OK) return r;
     /* External buffers are relative to the file's directory. */
-    char dir[1024];
-    const char* slash = strrchr(path, '/');
-    if (slash) snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    char dir[4096];
+    if (base && base == path) snprintf(dir, sizeof dir, "/");
+    else if (base) snprintf(dir, sizeof dir, "%.*s", (int)(base - path), path);
     else snprintf(dir, sizeof dir, ".");
-    if (slash && slash == path) snprintf(dir, sizeof dir, "/");
-    const char* base = strrchr(path, '/');
     r = akp_io_load_gltf(data, size, base ? base + 1 : path, dir, &d, alloc, out_scene, diag);
     if (r != AK_OK && diag) snprintf(diag->path, sizeof diag->path, "%s", path);
     akp_free(alloc, data);
@@ -266,10 +307,20 @@ ak_result ak_io_load_memory(const void* data, size_t size, const char* name, con
         return AK_ERR_NULL_ARG;
     }
     ak_io_desc d = ak_io_desc_resolved(desc);
-    if (desc && desc->format != AK_IO_FORMAT_AUTO && desc->format != AK_IO_FORMAT_GLTF) {
-        akp_diag_set(diag, name, "ak_io_load_memory reads glTF only");
+    if (desc && desc->format != AK_IO_FORMAT_AUTO && desc->format != AK_IO_FORMAT_GLTF &&
+        desc->format != AK_IO_FORMAT_BVH) {
+        akp_diag_set(diag, name, "ak_io_load_memory reads glTF and BVH only");
         return AK_ERR_UNSUPPORTED;
     }
     static const uint8_t empty[1] = {0};
+    bool bvh = d.format == AK_IO_FORMAT_BVH;
+    if (d.format == AK_IO_FORMAT_AUTO && data) { /* BVH text starts with HIERARCHY */
+        size_t i = 0;
+        const uint8_t* p = (const uint8_t*)data;
+        if (size >= 3 && p[0] == 0xEF && p[1] == 0xBB && p[2] == 0xBF) i = 3;
+        while (i < size && isspace(p[i])) ++i;
+        bvh = size - i >= 9 && memcmp(p + i, "HIERARCHY", 9) == 0;
+    }
+    if (bvh) return akp_io_load_bvh(NULL, data ? (const uint8_t*)data : empty, size, name, &d, alloc, out_scene, diag);
     return akp_io_load_gltf(data ? (const uint8_t*)data : empty, size, name, base_dir, &d, alloc, out_scene, diag);
 }

@@ -14,6 +14,7 @@ struct ak_skeleton {
     ak_joint_limits* limits;     /* [n], defaults resolved */
     uint32_t* child_counts;      /* [n] */
     uint8_t* types;              /* [n] ak_joint_type */
+    bool palette_from_skins;     /* desc.palette_from_skins */
 };
 
 #define MAX_JOINTS 32767u
@@ -180,6 +181,7 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
     if (alloc) sk->alloc = *alloc;
     sk->joint_count = n;
     if (desc->name) snprintf(sk->name, sizeof sk->name, "%s", desc->name);
+    sk->palette_from_skins = desc->palette_from_skins;
     sk->parents = (int16_t*)(base + off_parents);
     sk->rest = (ak_transform*)(base + off_rest);
     sk->inverse_binds = (ak_mat4*)(base + off_ib);
@@ -324,6 +326,8 @@ ak_joint_limits ak_skeleton_joint_limits(const ak_skeleton* skeleton, size_t joi
     return skeleton->limits[joint_index];
 }
 
+bool ak_skeleton_palette_from_skins(const ak_skeleton* skeleton) { return skeleton && skeleton->palette_from_skins; }
+
 size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index) {
     if (!skeleton || joint_index >= skeleton->joint_count) return 0;
     return skeleton->child_counts[joint_index];
@@ -365,6 +369,7 @@ ak_result ak_skeleton_local_to_model_rooted(const ak_skeleton* skeleton, ak_mat4
 ak_result ak_skeleton_skinning_matrices(const ak_skeleton* skeleton, ak_mat4_cspan model,
                                         ak_mat4_span out_skin) {
     if (!skeleton || !model.ptr || !out_skin.ptr) return AK_ERR_NULL_ARG;
+    if (skeleton->palette_from_skins) return AK_ERR_UNSUPPORTED; /* see ak_scene_skin_palette */
     if (model.count < skeleton->joint_count || out_skin.count < skeleton->joint_count)
         return AK_ERR_SPAN_SMALL;
     for (size_t i = 0; i < skeleton->joint_count; ++i)

@@ -30,7 +30,8 @@ static built build(const ak_vec3* p, size_t n, float cell) {
     ak_grid_desc d = {.cell_size = cell};
     size_t bytes = ak_grid_memory_size(n, &d);
     b.mem = malloc(bytes);
-    ak_result r = ak_grid_build(&d, (ak_vec3_cspan){p, n}, (ak_u8_span){(uint8_t*)b.mem, bytes}, &b.grid);
+    ak_result r =
+        ak_grid_build(&d, (ak_vec3_cspan){p, n}, (ak_u8_span){(uint8_t*)b.mem, bytes}, &b.grid);
     AK_CHECK_EQ(r, AK_OK);
     return b;
 }
@@ -52,8 +53,11 @@ static size_t check_cloud(const ak_vec3* p, size_t n, float cell, float r) {
     for (uint32_t threads = 1; threads <= 3; ++threads) {
         ak_grid_pair* got = (ak_grid_pair*)malloc((brute + 1) * sizeof *got);
         size_t count = 0;
-        ak_grid_pairs_job job = {.grid = &b.grid, .radius = r, .thread_count = threads,
-                                 .out_pairs = {got, brute}, .out_pair_count = &count};
+        ak_grid_pairs_job job = {.grid = &b.grid,
+                                 .radius = r,
+                                 .thread_count = threads,
+                                 .out_pairs = {got, brute},
+                                 .out_pair_count = &count};
         AK_CHECK_EQ(ak_grid_pairs_run(&job), AK_OK);
         AK_CHECK_EQ(count, brute);
         if (count == brute) {
@@ -98,9 +102,10 @@ AK_TEST(random_cloud_matches_brute_force) {
     const size_t n = 3000;
     ak_vec3* p = (ak_vec3*)malloc(n * sizeof *p);
     for (size_t i = 0; i < n; ++i)
-        p[i] = ak_vec3_make(ak_rng_range(&rng, -4, 4), ak_rng_range(&rng, -4, 4), ak_rng_range(&rng, -4, 4));
+        p[i] = ak_vec3_make(ak_rng_range(&rng, -4, 4), ak_rng_range(&rng, -4, 4),
+                            ak_rng_range(&rng, -4, 4));
     size_t pairs = check_cloud(p, n, 0.5f, 0.5f);
-    AK_CHECK(pairs > 1000); /* the cloud is dense enough to test something */
+    AK_CHECK(pairs > 1000);         /* the cloud is dense enough to test something */
     check_cloud(p, n, 0.35f, 0.3f); /* r below the cell size */
     free(p);
 }
@@ -125,10 +130,12 @@ AK_TEST(points_far_outside_any_bounds) {
     ak_rng rng = ak_rng_make(11);
     ak_vec3 p[600];
     size_t n = 0;
-    const float centres[5][3] = {{1e6f, 0, 0}, {-3e7f, 2e7f, 1e5f}, {4e9f, -4e9f, 4e9f}, {-1e30f, 1e30f, 0}, {0, 0, 0}};
+    const float centres[5][3] = {
+        {1e6f, 0, 0}, {-3e7f, 2e7f, 1e5f}, {4e9f, -4e9f, 4e9f}, {-1e30f, 1e30f, 0}, {0, 0, 0}};
     for (int c = 0; c < 5; ++c)
         for (int k = 0; k < 120; ++k) {
-            float s = fabsf(centres[c][0]) > 1e8f ? 1e-7f * fabsf(centres[c][0]) : 1.0f; /* float spacing there */
+            float s = fabsf(centres[c][0]) > 1e8f ? 1e-7f * fabsf(centres[c][0])
+                                                  : 1.0f; /* float spacing there */
             p[n++] = ak_vec3_make(centres[c][0] + s * ak_rng_range(&rng, -2, 2),
                                   centres[c][1] + s * ak_rng_range(&rng, -2, 2),
                                   centres[c][2] + s * ak_rng_range(&rng, -2, 2));
@@ -142,10 +149,11 @@ AK_TEST(duplicates_and_large_radius) {
     ak_vec3 p[200];
     ak_rng rng = ak_rng_make(3);
     for (int i = 0; i < 200; ++i)
-        p[i] = i < 50 ? ak_vec3_make(1, 2, 3) : ak_vec3_make(ak_rng_range(&rng, 0, 4), ak_rng_range(&rng, 0, 4), 0);
+        p[i] = i < 50 ? ak_vec3_make(1, 2, 3)
+                      : ak_vec3_make(ak_rng_range(&rng, 0, 4), ak_rng_range(&rng, 0, 4), 0);
     AK_CHECK(check_cloud(p, 200, 0.2f, 0.2f) >= 50 * 49 / 2);
-    check_cloud(p, 200, 0.2f, 0.7f);  /* r = 3.5 cells: four rings */
-    check_cloud(p, 200, 0.2f, 1.0f);  /* r = exactly 5 cells */
+    check_cloud(p, 200, 0.2f, 0.7f);                               /* r = 3.5 cells: four rings */
+    check_cloud(p, 200, 0.2f, 1.0f);                               /* r = exactly 5 cells */
     AK_CHECK_EQ(check_cloud(p, 200, 0.2f, 100.0f), 200 * 199 / 2); /* all pairs: scans every cell */
 }
 
@@ -164,7 +172,8 @@ AK_TEST(sorted_layout_and_cells) {
     ak_rng rng = ak_rng_make(5);
     ak_vec3 p[500];
     for (int i = 0; i < 500; ++i)
-        p[i] = ak_vec3_make(ak_rng_range(&rng, -2, 2), ak_rng_range(&rng, -2, 2), ak_rng_range(&rng, -2, 2));
+        p[i] = ak_vec3_make(ak_rng_range(&rng, -2, 2), ak_rng_range(&rng, -2, 2),
+                            ak_rng_range(&rng, -2, 2));
     built b = build(p, 500, 0.5f);
     const ak_grid* g = &b.grid;
     int seen[500] = {0};
@@ -195,7 +204,8 @@ AK_TEST(short_output_reports_count) {
     ak_rng rng = ak_rng_make(9);
     ak_vec3 p[400];
     for (int i = 0; i < 400; ++i)
-        p[i] = ak_vec3_make(ak_rng_range(&rng, 0, 3), ak_rng_range(&rng, 0, 3), ak_rng_range(&rng, 0, 3));
+        p[i] = ak_vec3_make(ak_rng_range(&rng, 0, 3), ak_rng_range(&rng, 0, 3),
+                            ak_rng_range(&rng, 0, 3));
     built b = build(p, 400, 0.5f);
     size_t brute = 0;
     for (int i = 0; i < 400; ++i)
@@ -239,15 +249,22 @@ AK_TEST(validation_codes) {
     ak_grid_desc zero = {0};
     AK_CHECK(ak_grid_memory_size(2, &d) <= sizeof mem);
     AK_CHECK_EQ(ak_grid_memory_size(2, NULL), 0);
-    AK_CHECK_EQ(ak_grid_build(NULL, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g), AK_ERR_NULL_ARG);
-    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){NULL, 1}, (ak_u8_span)AK_SPAN(mem), &g), AK_ERR_NULL_ARG);
-    AK_CHECK_EQ(ak_grid_build(&zero, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_grid_build(NULL, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){NULL, 1}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_grid_build(&zero, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_BAD_ARG);
     ak_grid_desc inf = {.cell_size = INFINITY};
-    AK_CHECK_EQ(ak_grid_build(&inf, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g), AK_ERR_BAD_ARG);
-    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 1}, (ak_u8_span){mem, 8}, &g), AK_ERR_SPAN_SMALL);
-    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 2}, (ak_u8_span)AK_SPAN(mem), &g), AK_ERR_BAD_DATA);
+    AK_CHECK_EQ(ak_grid_build(&inf, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 1}, (ak_u8_span){mem, 8}, &g),
+                AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 2}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_BAD_DATA);
     AK_CHECK_EQ(g.point_count, 0);
-    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 1}, (ak_u8_span){mem + 3, sizeof mem - 3}, &g), AK_OK);
+    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 1}, (ak_u8_span){mem + 3, sizeof mem - 3}, &g),
+                AK_OK);
     size_t count;
     ak_grid_pairs_job zj = {0};
     AK_CHECK_EQ(ak_grid_pairs_run(&zj), AK_ERR_NULL_ARG);

@@ -1177,6 +1177,206 @@ AK_TEST(fabrik_tree) {
     ak_skeleton_destroy(sk);
 }
 
+/* ---- straight chains, targets on their own line ------------------------------------------ */
+
+/* Distance from the root of the end of nb equal bones of length a, each bent by beta from its
+ * parent in one plane (a regular polygon's chord): a |sin(nb beta / 2) / sin(beta / 2)|. */
+static double curl_reach(int nb, double a, double beta) {
+    if (beta < 1e-12) return nb * a;
+    return a * fabs(sin(nb * beta / 2) / sin(beta / 2));
+}
+
+/* A straight chain pointing through its target is the singular configuration of CCD (RE is
+ * parallel to RD at every joint), FABRIK (the passes keep the chain on its line) and DLS (no
+ * Jacobian column along the line). Chains of nb = 2..10 equal bones lie straight along their
+ * parent's +x (the base joint, not in the chain, either at rest or turned to an oblique
+ * direction); the target lies on the chain's line at 5%, 10%, ..., 95% of its length. Joint
+ * variants: all free; all unlimited hinges; a free or unlimited-hinge root with hinges limited
+ * to one side ([0, 3.1] or [-3.1, 0]); a ball root (cone 2 rad) over limited hinges whose axis
+ * is oblique to the chain. Every target is reachable: the test finds, in double precision, a
+ * uniform bend beta in [0, 3.1] of the non-root joints whose chord equals the target
+ * distance (bent within the hinges' allowed side; the root then turns the chord onto the
+ * line). Every solver must reach every target with the default budget and tolerance, and
+ * keep bone lengths and limits. */
+AK_TEST(straight_chain_targets_on_its_line) {
+    enum { VARIANTS = 6 };
+    const float side_limit = 3.1f;
+    int misses[3] = {0, 0, 0}, total = 0;
+    size_t most[3] = {0, 0, 0};
+    for (int nb = 2; nb <= 10; ++nb) {
+        const size_t count = (size_t)nb + 2; /* base + nb + 1 chain joints */
+        const double a = 0.2 + 0.05 * nb;
+        for (int variant = 0; variant < VARIANTS; ++variant) {
+            chain_spec s;
+            memset(&s, 0, sizeof s);
+            s.count = count;
+            s.lengths[0] = 0.3f;
+            for (int i = 1; i <= nb; ++i) s.lengths[i] = (float)a;
+            const ak_vec3 hinge_axis = variant >= 4 ? ak_vec3_normalize(ak_vec3_make(0, 0.6f, 0.8f)) : ak_vec3_make(0, 0, 1);
+            for (size_t i = 1; i < count; ++i) {
+                const bool root = i == 1, effector = i + 1 == count;
+                ak_joint_type t = AK_JOINT_FREE;
+                ak_joint_limits l;
+                memset(&l, 0, sizeof l);
+                if (effector) {
+                    t = AK_JOINT_FREE;
+                } else if (variant == 1 || (root && (variant == 2 || variant == 3))) {
+                    t = AK_JOINT_HINGE, l.axis = hinge_axis; /* unlimited */
+                } else if (root && variant == 4) {
+                    t = AK_JOINT_FREE;
+                } else if (root && variant == 5) {
+                    t = AK_JOINT_BALL, l.axis = ak_vec3_make(1, 0, 0), l.cone_angle = 2.0f;
+                } else if (variant >= 2) {
+                    t = AK_JOINT_HINGE, l.axis = hinge_axis;
+                    l.min = variant == 3 ? -side_limit : 0.0f;
+                    l.max = variant == 3 ? 0.0f : side_limit;
+                }
+                s.types[i] = t;
+                s.limits[i] = l;
+            }
+            ak_skeleton* sk = make_chain(&s);
+            if (!sk) {
+                AK_CHECK(sk != NULL);
+                return;
+            }
+            int16_t chain[MAXJ];
+            for (size_t i = 1; i < count; ++i) chain[i - 1] = (int16_t)i;
+            const size_t chain_count = count - 1;
+            for (int oblique = 0; oblique < 2; ++oblique) {
+                const ak_quat base_rot = oblique ? ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(0.3f, 0.5f, 0.8f)), 1.0f)
+                                                 : ak_quat_identity();
+                for (int pct = 5; pct <= 95; pct += 5) {
+                    const double d = nb * a * pct / 100.0;
+                    /* the witness: curl_reach decreases from nb a (beta = 0) to its first zero
+                     * at 2 pi / nb, or to beta = 3.1 for two bones */
+                    double lo = 0.0, hi = fmin(2 * PI_D / nb, side_limit);
+                    AK_CHECK_MSG(curl_reach(nb, a, hi) <= d, "%d bones, %d%%: no witness", nb, pct);
+                    for (int it = 0; it < 60; ++it) {
+                        double mid = 0.5 * (lo + hi);
+                        if (curl_reach(nb, a, mid) > d) lo = mid;
+                        else hi = mid;
+                    }
+                    AK_CHECK_NEAR(curl_reach(nb, a, hi), d, 1e-9);
+                    for (int k = 0; k < 3; ++k) {
+                        ak_transform pose[MAXJ];
+                        rest_pose(sk, pose);
+                        pose[0].rotation = base_rot;
+                        double p[MAXJ][3];
+                        fk_positions(pose, count, p);
+                        const double* r = p[1];
+                        const double* e = p[count - 1];
+                        ak_vec3 target = ak_vec3_make((float)(r[0] + (e[0] - r[0]) * pct / 100.0),
+                                                      (float)(r[1] + (e[1] - r[1]) * pct / 100.0),
+                                                      (float)(r[2] + (e[2] - r[2]) * pct / 100.0));
+                        solve_out o = solve(sk, pose, chain, chain_count, target, iterative[k], NULL); /* defaults */
+                        AK_CHECK_EQ(o.r, AK_OK);
+                        ++total;
+                        if (o.iterations > most[k]) most[k] = o.iterations;
+                        bool ok = pose_finite(pose, count) && lengths_preserved(&s, pose);
+                        for (size_t i = 1; i < count; ++i) ok = ok && within_limits(&s, sk, i, pose[i], 1e-4);
+                        AK_CHECK_MSG(ok, "%s, %d bones, variant %d: lengths or limits broken",
+                                     ak_ik_solver_name(iterative[k]), nb, variant);
+                        if (!o.reached) {
+                            ++misses[k];
+                            if (misses[k] <= 4 || getenv("IKDBG"))
+                                printf("  %s missed: %d bones, variant %d, oblique %d, %d%%: error %g (tolerance %g), "
+                                       "%zu iterations\n",
+                                       ak_ik_solver_name(iterative[k]), nb, variant, oblique, pct, o.error,
+                                       o.tolerance, o.iterations);
+                        }
+                    }
+                }
+            }
+            ak_skeleton_destroy(sk);
+        }
+    }
+    printf("  targets on the line: %d per solver; most iterations used: ccd %zu, fabrik %zu, dls %zu\n", total / 3,
+           most[0], most[1], most[2]);
+    for (int k = 0; k < 3; ++k)
+        AK_CHECK_MSG(misses[k] == 0, "%s: %d of %d targets on the chain's line missed", ak_ik_solver_name(iterative[k]),
+                     misses[k], total / 3);
+}
+
+
+/* Bones of 1e30 (squared distances overflow float) and of 1e-30 (squared distances vanish
+ * under any fixed threshold): the job solves in a scaled frame, so reachable targets are
+ * reached, unreachable ones are not, and every reported number is finite. The oracles are
+ * the scale-free answers: the same chain with unit bones, scaled. */
+AK_TEST(extreme_scales) {
+    const float scales[] = {1e30f, 3e35f, 1e-30f, 1.0f};
+    for (size_t si = 0; si < sizeof scales / sizeof scales[0]; ++si) {
+        const float k = scales[si];
+        chain_spec s = uniform_chain(4, AK_JOINT_FREE);
+        for (int i = 0; i < 3; ++i) s.lengths[i] = k; /* reach 3k */
+        ak_skeleton* sk = make_chain(&s);
+        if (!sk) {
+            AK_CHECK(sk != NULL);
+            return;
+        }
+        int16_t chain[4] = {0, 1, 2, 3};
+        const float len = ak_ik_chain_length(sk, (ak_transform_cspan){ak_skeleton_rest_pose(sk).ptr, 4},
+                                             (ak_i16_cspan){chain, 4});
+        AK_CHECK_MSG(isfinite(len) && fabs(len - 3.0 * k) <= 1e-6 * 3.0 * k, "scale %g: chain length %g", k, len);
+        for (int k2 = 0; k2 < 4; ++k2) {
+            const ak_ik_solver solver = k2 < 3 ? iterative[k2] : AK_IK_SOLVER_FABRIK;
+            /* reachable (1.2, 1.5, 0.4) k; unreachable (5, 0, 0) k: error 2k */
+            const ak_vec3 near = ak_vec3_make(1.2f * k, 1.5f * k, 0.4f * k), far = ak_vec3_make(5.0f * k, 0, 0);
+            ak_transform pose[4];
+            rest_pose(sk, pose);
+            pose[1].rotation = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.4f);
+            solve_out o = solve(sk, pose, chain, 4, k2 == 3 ? far : near, solver, NULL);
+            AK_CHECK_EQ(o.r, AK_OK);
+            AK_CHECK_MSG(isfinite(o.error) && isfinite(o.tolerance) && o.tolerance < 1e-3 * k,
+                         "scale %g %s: error %g tolerance %g", k, ak_ik_solver_name(solver), o.error, o.tolerance);
+            AK_CHECK(pose_finite(pose, 4));
+            if (k2 < 3) {
+                AK_CHECK_MSG(o.reached && o.error <= o.tolerance, "scale %g %s: not reached, error %g (tolerance %g)",
+                             k, ak_ik_solver_name(solver), o.error, o.tolerance);
+            } else {
+                AK_CHECK_MSG(!o.reached, "scale %g: an unreachable target reported reached", k);
+                AK_CHECK_MSG(fabs(o.error - 2.0 * k) <= 1e-4 * k, "scale %g: error %g, want %g", k, o.error, 2.0 * k);
+            }
+            /* the reported error is the true distance (computed here in double) */
+            double p[MAXJ][3];
+            fk_positions(pose, 4, p);
+            const ak_vec3 t = k2 == 3 ? far : near;
+            double tt[3] = {t.x, t.y, t.z};
+            AK_CHECK_MSG(fabs(dist3(p[3], tt) - o.error) <= 1e-5 * k, "scale %g: error %g vs %g", k, o.error, dist3(p[3], tt));
+        }
+        /* the FABRIK tree job, one effector: same answers */
+        for (int far_case = 0; far_case < 2; ++far_case) {
+            ak_transform pose[4];
+            rest_pose(sk, pose);
+            pose[1].rotation = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.4f);
+            int16_t eff[1] = {3};
+            ak_vec3 tg[1] = {far_case ? ak_vec3_make(5.0f * k, 0, 0) : ak_vec3_make(1.2f * k, 1.5f * k, 0.4f * k)};
+            bool reached = !far_case;
+            float error = -1.0f;
+            ak_ik_fabrik_tree_job tj = {.skeleton = sk, .pose = AK_SPAN(pose), .root_joint = 0,
+                                        .effectors = AK_SPAN(eff), .targets = AK_SPAN(tg),
+                                        .scratch = AK_SPAN(scratch), .out_reached = &reached, .out_error = &error};
+            AK_CHECK_EQ(ak_ik_fabrik_tree_run(&tj), AK_OK);
+            AK_CHECK_MSG(isfinite(error) && reached == !far_case, "tree, scale %g, far %d: reached %d error %g", k,
+                         far_case, reached, error);
+            if (far_case) AK_CHECK_MSG(fabs(error - 2.0 * k) <= 1e-4 * k, "tree, scale %g: error %g", k, error);
+            else AK_CHECK(error <= 1e-4 * 3.0 * k);
+        }
+        ak_skeleton_destroy(sk);
+    }
+    /* Chain positions beyond float range (two bones of 3e38 along x): rejected, not inf. */
+    chain_spec big = uniform_chain(3, AK_JOINT_FREE);
+    big.lengths[0] = big.lengths[1] = 3e38f;
+    ak_skeleton* sk = make_chain(&big);
+    if (sk) {
+        int16_t chain[3] = {0, 1, 2};
+        ak_transform pose[3];
+        rest_pose(sk, pose);
+        solve_out o = solve(sk, pose, chain, 3, ak_vec3_make(1, 0, 0), AK_IK_SOLVER_CCD, NULL);
+        AK_CHECK_EQ(o.r, AK_ERR_BAD_DATA);
+        ak_skeleton_destroy(sk);
+    }
+}
+
 int main(void) {
     AK_RUN(chain_build);
     AK_RUN(solver_names);
@@ -1194,6 +1394,8 @@ int main(void) {
     AK_RUN(two_bone_run_many_equals_single_jobs);
     AK_RUN(unreachable_straightens);
     AK_RUN(degenerate_chains);
+    AK_RUN(straight_chain_targets_on_its_line);
+    AK_RUN(extreme_scales);
     AK_RUN(dls_orientation_target);
     AK_RUN(fabrik_tree);
     return ak_test_finish();

@@ -4,6 +4,7 @@
  * exact codes, synthetic files for each glTF feature, the OBJ writer, allocator failures. */
 #include <animkit/io.h>
 #include <cjson/cJSON.h>
+#include <ctype.h>
 #include <dirent.h>
 #include <stdint.h>
 
@@ -639,6 +640,8 @@ static void check_bvh(const char* rel) {
 AK_TEST(bvh_header_and_fk) {
     check_bvh("bvh/49_04.bvh");  /* ZYX everywhere, CRLF */
     check_bvh("bvh/131_03.bvh"); /* ZXY on the arms, CRLF */
+    check_bvh("bvh/02_01.bvh");
+    check_bvh("bvh/01_01.bvh");  /* 2 MB, 2752 frames */
 }
 
 /* ---- OBJ through Assimp ------------------------------------------------------------------ */
@@ -1276,11 +1279,16 @@ AK_TEST(load_arguments_and_missing_files) {
     AK_CHECK_EQ(ak_io_load("no/such/file.bvh", NULL, NULL, &s, &diag), AK_ERR_IO);
     ak_io_desc bvh = {.format = AK_IO_FORMAT_ASSIMP};
     AK_CHECK_EQ(ak_io_load_memory("{}", 2, NULL, NULL, &bvh, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
-    /* Assimp rejects a garbage file: AK_ERR_PARSE with Assimp's message */
+    /* a garbage BVH: animkit's reader names the line; Assimp (asked for explicitly) rejects it
+     * with its own message */
     FILE* f = fopen("garbage.bvh", "wb");
     fputs("HIERARCHY\nROOT x {\n OFFSET 1 2\n", f);
     fclose(f);
     AK_CHECK_EQ(ak_io_load("garbage.bvh", NULL, NULL, &s, &diag), AK_ERR_PARSE);
+    AK_CHECK(strstr(diag.message, "OFFSET") != NULL);
+    AK_CHECK_STREQ(diag.path, "garbage.bvh");
+    ak_io_desc via_assimp = {.format = AK_IO_FORMAT_ASSIMP};
+    AK_CHECK_EQ(ak_io_load("garbage.bvh", &via_assimp, NULL, &s, &diag), AK_ERR_PARSE);
     AK_CHECK(strstr(diag.message, "Assimp") != NULL);
     AK_CHECK_STREQ(diag.path, "garbage.bvh");
     remove("garbage.bvh");
@@ -1441,7 +1449,7 @@ AK_TEST(bvh_mesh_skin_through_assimp) {
         AK_SKIP("bvh/49_04.bvh absent");
         return;
     }
-    ak_io_desc desc = {.keep_bvh_mesh = true};
+    ak_io_desc desc = {.keep_bvh_mesh = true, .format = AK_IO_FORMAT_ASSIMP};
     ak_scene* s = NULL;
     ak_diag diag;
     AK_CHECK_EQ(ak_io_load(path, &desc, NULL, &s, &diag), AK_OK);
@@ -1503,6 +1511,580 @@ AK_TEST(allocation_failures) {
     AK_CHECK(ok_at > 0);
 }
 
+/* ---- untrusted input (issue 19) ------------------------------------------------------------ */
+
+/* An allocator that records the largest request and refuses anything above 256 MiB, so a
+ * loader that would allocate gigabytes fails the test instead of the machine. */
+typedef struct capped_alloc {
+    size_t largest;
+    int live;
+} capped_alloc;
+static void* capped_malloc(size_t size, void* user) {
+    capped_alloc* c = (capped_alloc*)user;
+    if (size > c->largest) c->largest = size;
+    if (size > ((size_t)256 << 20)) return NULL;
+    void* p = malloc(size);
+    if (p) c->live++;
+    return p;
+}
+static void capped_free(void* p, void* user) {
+    ((capped_alloc*)user)->live--;
+    free(p);
+}
+
+static void write_file(const char* path, const void* data, size_t size) {
+    FILE* f = fopen(path, "wb");
+    AK_CHECK(f != NULL);
+    if (!f) return;
+    fwrite(data, 1, size, f);
+    fclose(f);
+}
+
+/* A one-triangle glTF whose buffer is the external uri. */
+static void tri_doc_with_uri(char* out, size_t cap, const char* uri, size_t byte_length) {
+    snprintf(out, cap,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+             TRI_ACCESSORS "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}]}",
+             byte_length, uri);
+}
+
+static ak_result load_tri_file(const char* gltf_path, const char* uri, const ak_io_desc* desc, ak_diag* diag) {
+    char text[2048];
+    tri_doc_with_uri(text, sizeof text, uri, sizeof k_tri);
+    write_file(gltf_path, text, strlen(text));
+    ak_scene* s = NULL;
+    memset(diag, 0, sizeof *diag);
+    ak_result r = ak_io_load(gltf_path, desc, NULL, &s, diag);
+    if (r == AK_OK) {
+        AK_CHECK_EQ(s->mesh_count, 1);
+        if (s->mesh_count) AK_CHECK_NEAR(s->meshes[0].mesh->positions[1].x, 1.0, 0);
+    }
+    ak_scene_destroy(s);
+    return r;
+}
+
+/* A buffer uri must not reach outside the model's folder: plain "..", percent-encoded "..",
+ * an absolute-looking path, a symlink; explicit roots or allow_any_path let it. */
+AK_TEST(gltf_uri_stays_inside_model_dir) {
+    mkdir("trav", 0755);
+    mkdir("trav/model", 0755);
+    write_file("trav/secret.bin", &k_tri, sizeof k_tri);
+    write_file("trav/model/inside.bin", &k_tri, sizeof k_tri);
+    remove("trav/model/link.bin");
+    AK_CHECK_EQ(symlink("../secret.bin", "trav/model/link.bin"), 0);
+    ak_diag diag;
+    AK_CHECK_EQ(load_tri_file("trav/model/m.gltf", "inside.bin", NULL, &diag), AK_OK);
+    AK_CHECK_EQ(load_tri_file("trav/model/m.gltf", "./sub/../inside.bin", NULL, &diag), AK_ERR_IO); /* no sub/ */
+    const char* outside[] = {"../secret.bin", "%2E%2E/secret.bin", "%2e%2e%2fsecret.bin", "link.bin",
+                             "../model/../secret.bin"};
+    for (size_t i = 0; i < sizeof outside / sizeof outside[0]; ++i) {
+        ak_result r = load_tri_file("trav/model/m.gltf", outside[i], NULL, &diag);
+        AK_CHECK_MSG(r == AK_ERR_IO, "uri %s: %s (%s)", outside[i], ak_result_name(r), diag.message);
+        AK_CHECK_MSG(strstr(diag.message, outside[i]) != NULL, "the message names the uri: %s", diag.message);
+    }
+    printf("  %s\n", diag.message);
+    /* the same through ak_io_load_memory with a base directory */
+    char text[2048];
+    tri_doc_with_uri(text, sizeof text, "%2E%2E/secret.bin", sizeof k_tri);
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(text, strlen(text), "m.gltf", "trav/model", NULL, NULL, &s, &diag), AK_ERR_IO);
+    /* explicit permission */
+    const char* roots[] = {"trav"};
+    ak_io_desc extra = {.extra_roots = roots, .extra_root_count = 1};
+    AK_CHECK_EQ(load_tri_file("trav/model/m.gltf", "../secret.bin", &extra, &diag), AK_OK);
+    AK_CHECK_EQ(load_tri_file("trav/model/m.gltf", "link.bin", &extra, &diag), AK_OK);
+    const char* other[] = {"trav/model/inside.bin"}; /* a root that does not hold the file */
+    ak_io_desc wrong = {.extra_roots = other, .extra_root_count = 1};
+    AK_CHECK_EQ(load_tri_file("trav/model/m.gltf", "../secret.bin", &wrong, &diag), AK_ERR_IO);
+    ak_io_desc any = {.allow_any_path = true};
+    AK_CHECK_EQ(load_tri_file("trav/model/m.gltf", "%2E%2E/secret.bin", &any, &diag), AK_OK);
+    remove("trav/model/link.bin");
+    remove("trav/model/inside.bin");
+    remove("trav/model/m.gltf");
+    remove("trav/secret.bin");
+    rmdir("trav/model");
+    rmdir("trav");
+}
+
+/* A 170-byte file that declares 2^26 vertices without a bufferView (all zeros, legal) must be
+ * refused before the gigabytes are allocated; an explicit small budget is honoured; an
+ * external buffer is read for its byteLength only. */
+AK_TEST(gltf_memory_budget) {
+    const char* tiny = "{\"asset\":{\"version\":\"2.0\"},\"accessors\":[{\"componentType\":5126,\"count\":67108864,"
+                       "\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}";
+    AK_CHECK(strlen(tiny) <= 170);
+    capped_alloc ca = {0, 0};
+    ak_allocator a = {capped_malloc, capped_free, &ca};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    ak_result r = ak_io_load_memory(tiny, strlen(tiny), "tiny.gltf", NULL, NULL, &a, &s, &diag);
+    printf("  %zu-byte file: %s (%s), largest allocation %zu bytes\n", strlen(tiny), ak_result_name(r), diag.message,
+           ca.largest);
+    AK_CHECK_EQ(r, AK_ERR_UNSUPPORTED);
+    AK_CHECK(strstr(diag.message, "memory budget") != NULL);
+    AK_CHECK(ca.largest < ((size_t)1 << 20));
+    AK_CHECK_EQ(ca.live, 0);
+    ak_scene_destroy(s);
+    /* a budget the caller chose: a real file over it fails, under it loads */
+    char path[2048];
+    if (ak_test_asset(path, sizeof path, "gltf/Fox/glTF-Binary/Fox.glb")) {
+        ak_io_desc small = {.memory_budget = 64 * 1024};
+        s = NULL;
+        AK_CHECK_EQ(ak_io_load(path, &small, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
+        AK_CHECK(s == NULL);
+        ak_io_desc enough = {.memory_budget = 64 << 20};
+        AK_CHECK_EQ(ak_io_load(path, &enough, NULL, &s, &diag), AK_OK);
+        ak_scene_destroy(s);
+    }
+    /* 44 declared bytes of a 4 MiB file: only 44 are read */
+    mkdir("budget", 0755);
+    size_t big = (size_t)4 << 20;
+    uint8_t* bytes = (uint8_t*)calloc(1, big);
+    memcpy(bytes, &k_tri, sizeof k_tri);
+    write_file("budget/big.bin", bytes, big);
+    free(bytes);
+    char text[2048];
+    tri_doc_with_uri(text, sizeof text, "big.bin", sizeof k_tri);
+    ca.largest = 0;
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(text, strlen(text), "m.gltf", "budget", NULL, &a, &s, &diag), AK_OK);
+    printf("  %zu-byte buffer in a %zu-byte file: largest allocation %zu bytes\n", sizeof k_tri, big, ca.largest);
+    AK_CHECK(ca.largest < 65536);
+    ak_scene_destroy(s);
+    /* a file shorter than byteLength */
+    write_file("budget/short.bin", &k_tri, 20);
+    tri_doc_with_uri(text, sizeof text, "short.bin", sizeof k_tri);
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(text, strlen(text), "m.gltf", "budget", NULL, NULL, &s, &diag), AK_ERR_PARSE);
+    AK_CHECK(strstr(diag.message, "short.bin") != NULL);
+    remove("budget/big.bin");
+    remove("budget/short.bin");
+    rmdir("budget");
+}
+
+/* One sampler of 65,536 keys shared by 3,000 channels (legal: each on its own node): the clip
+ * copies the keys per channel, 3 GB from a 1 MB file. Refused by the budget, before the
+ * copies; an allocator that stops at 512 MiB live keeps a failing loader from taking the
+ * machine down. */
+typedef struct live_cap {
+    size_t live_bytes;
+    int live;
+} live_cap;
+static void* live_cap_malloc(size_t size, void* user) {
+    live_cap* c = (live_cap*)user;
+    if (c->live_bytes + size > ((size_t)512 << 20)) return NULL;
+    size_t* p = (size_t*)malloc(size + 16);
+    if (!p) return NULL;
+    p[0] = size;
+    c->live_bytes += size;
+    c->live++;
+    return (char*)p + 16;
+}
+static void live_cap_free(void* q, void* user) {
+    live_cap* c = (live_cap*)user;
+    size_t* p = (size_t*)((char*)q - 16);
+    c->live_bytes -= p[0];
+    c->live--;
+    free(p);
+}
+
+AK_TEST(gltf_shared_sampler_amplification) {
+    const size_t keys = 65536, nodes = 3000;
+    float* bin = (float*)malloc(keys * 4 * sizeof(float));
+    for (size_t k = 0; k < keys; ++k) {
+        bin[k] = (float)k * 0.01f;
+        bin[keys + 3 * k] = bin[keys + 3 * k + 1] = bin[keys + 3 * k + 2] = (float)k;
+    }
+    mkdir("amp", 0755);
+    write_file("amp/anim.bin", bin, keys * 4 * sizeof(float));
+    free(bin);
+    size_t cap = nodes * 120 + 2048, o = 0;
+    char* text = (char*)malloc(cap);
+    o += (size_t)snprintf(text + o, cap - o,
+                          "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,\"uri\":\"anim.bin\"}],"
+                          "\"bufferViews\":[{\"buffer\":0,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,"
+                          "\"byteLength\":%zu}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,"
+                          "\"type\":\"SCALAR\"},{\"bufferView\":1,\"componentType\":5126,\"count\":%zu,\"type\":"
+                          "\"VEC3\"}],\"nodes\":[",
+                          keys * 16, keys * 4, keys * 4, keys * 12, keys, keys);
+    for (size_t n = 0; n < nodes; ++n) o += (size_t)snprintf(text + o, cap - o, "%s{}", n ? "," : "");
+    o += (size_t)snprintf(text + o, cap - o, "],\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1}],\"channels\":[");
+    for (size_t n = 0; n < nodes; ++n)
+        o += (size_t)snprintf(text + o, cap - o, "%s{\"sampler\":0,\"target\":{\"node\":%zu,\"path\":\"translation\"}}",
+                              n ? "," : "", n);
+    snprintf(text + o, cap - o, "]}]}");
+    live_cap lc = {0, 0};
+    ak_allocator a = {live_cap_malloc, live_cap_free, &lc};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    ak_result r = ak_io_load_memory(text, strlen(text), "amp.gltf", "amp", NULL, &a, &s, &diag);
+    printf("  3000 channels on one 65536-key sampler: %s (%s)\n", ak_result_name(r), diag.message);
+    AK_CHECK_EQ(r, AK_ERR_UNSUPPORTED);
+    AK_CHECK(strstr(diag.message, "memory budget") != NULL);
+    AK_CHECK_EQ(lc.live, 0);
+    ak_scene_destroy(s);
+    /* the same file with 30 channels loads */
+    char* cut = strstr(text, "\"channels\":[");
+    char* thirty = cut;
+    for (int k = 0; k < 31 && thirty; ++k) thirty = strstr(thirty + 1, "{\"sampler\"");
+    if (thirty) {
+        snprintf(thirty - 1, 5, "]}]}");
+        s = NULL;
+        AK_CHECK_EQ(ak_io_load_memory(text, strlen(text), "amp.gltf", "amp", NULL, &a, &s, &diag), AK_OK);
+        if (s) AK_CHECK_EQ(s->clip_count, 1);
+        ak_scene_destroy(s);
+    }
+    free(text);
+    remove("amp/anim.bin");
+    rmdir("amp");
+}
+
+/* glTF requires key times >= 0: a negative first time is refused like decreasing times. */
+AK_TEST(gltf_negative_key_times) {
+    const float anim[12] = {-1, 0, 1, 0, 0, 0, 1, 1, 1, 2, 2, 2};
+    const char* doc_text = "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":48,\"uri\":\"@BUF@\"}],"
+                           "\"bufferViews\":[{\"buffer\":0,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":12,"
+                           "\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,"
+                           "\"type\":\"SCALAR\"},{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":"
+                           "\"VEC3\"}],\"nodes\":[{}],\"animations\":[{\"samplers\":[{\"input\":0,\"output\":1}],"
+                           "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}";
+    AK_CHECK_EQ(load_expect(doc_text, anim, sizeof anim, AK_ERR_UNSORTED), AK_ERR_UNSORTED);
+    float ok[12];
+    memcpy(ok, anim, sizeof ok);
+    ok[0] = 0.0f, ok[1] = 0.5f; /* 0 is allowed */
+    AK_CHECK_EQ(load_expect(doc_text, ok, sizeof ok, AK_OK), AK_OK);
+}
+
+/* An empty or random .glb is "not a GLB", not "invalid JSON". */
+AK_TEST(glb_bad_magic) {
+    const uint8_t junk[16] = {0x89, 'P', 'N', 'G', 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+    const struct {
+        const void* data;
+        size_t size;
+    } cases[] = {{"", 0}, {junk, sizeof junk}, {"glTX\2\0\0\0", 8}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        ak_scene* s = NULL;
+        ak_diag diag;
+        AK_CHECK_EQ(ak_io_load_memory(cases[i].data, cases[i].size, "x.glb", NULL, NULL, NULL, &s, &diag), AK_ERR_PARSE);
+        AK_CHECK_MSG(strstr(diag.message, "not a GLB (bad magic") != NULL, "case %zu: %s", i, diag.message);
+    }
+    write_file("empty.glb", "", 0);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load("empty.glb", NULL, NULL, &s, &diag), AK_ERR_PARSE);
+    AK_CHECK(strstr(diag.message, "not a GLB") != NULL);
+    remove("empty.glb");
+}
+
+/* A BVH text with a chain of depth joints and the given motion header and data. */
+static char* bvh_chain(size_t depth, const char* frames, const char* data) {
+    size_t cap = depth * 100 + strlen(data) + 512;
+    char* t = (char*)malloc(cap);
+    size_t o = (size_t)snprintf(t, cap, "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition "
+                                        "Zposition Zrotation Xrotation Yrotation\n");
+    for (size_t i = 1; i < depth; ++i)
+        o += (size_t)snprintf(t + o, cap - o, "JOINT j%zu\n{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n", i);
+    o += (size_t)snprintf(t + o, cap - o, "End Site\n{\nOFFSET 0 1 0\n}\n");
+    for (size_t i = 0; i < depth; ++i) t[o++] = '}', t[o++] = '\n';
+    snprintf(t + o, cap - o, "MOTION\nFrames: %s\nFrame Time: 0.1\n%s", frames, data);
+    return t;
+}
+
+static ak_result load_bvh_mem(const char* text, size_t size, const ak_io_desc* desc, capped_alloc* ca, ak_diag* diag) {
+    ak_allocator a = {capped_malloc, capped_free, ca};
+    ak_scene* s = NULL;
+    memset(diag, 0, sizeof *diag);
+    ak_result r = ak_io_load_memory(text, size, "t.bvh", NULL, desc, &a, &s, diag);
+    ak_scene_destroy(s);
+    AK_CHECK_MSG(ca->live == 0, "%d blocks leaked", ca->live);
+    return r;
+}
+
+/* The attacks Assimp's BVH importer failed: deep nesting, a huge Frames count, leaks on
+ * failure; and truncated motion data. Through ak_io_load (file, streamed) and from memory. */
+AK_TEST(bvh_hostile_files) {
+    ak_io_desc as_bvh = {.format = AK_IO_FORMAT_BVH};
+    capped_alloc ca = {0, 0};
+    ak_diag diag;
+    /* 30,000 nested JOINTs: a clean error, no recursion */
+    char* deep = bvh_chain(30000, "1", "");
+    AK_CHECK_EQ(load_bvh_mem(deep, strlen(deep), &as_bvh, &ca, &diag), AK_ERR_UNSUPPORTED);
+    printf("  30000 nested joints: %s\n", diag.message);
+    write_file("deep.bvh", deep, strlen(deep));
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load("deep.bvh", NULL, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK(strstr(diag.message, "deeper") != NULL);
+    remove("deep.bvh");
+    free(deep);
+    /* the documented depth limit itself loads */
+    const char* frame = "0 0 0 0 0 0";
+    size_t d = AK_IO_BVH_MAX_DEPTH - 1; /* the End Site is one level deeper */
+    char* data = (char*)malloc(d * 16 + 64);
+    size_t o = (size_t)sprintf(data, "%s", frame);
+    for (size_t i = 1; i < d; ++i) o += (size_t)sprintf(data + o, " 0 0 0");
+    data[o++] = '\n';
+    data[o] = 0;
+    char* ok = bvh_chain(d, "1", data);
+    AK_CHECK_EQ(load_bvh_mem(ok, strlen(ok), &as_bvh, &ca, &diag), AK_OK);
+    free(ok);
+    free(data);
+    /* an End Site that is the 65th node (the node array grows as it is added; found by
+     * fuzz_bvh: its name was read from the array just freed) */
+    char* grow = bvh_chain(64, "0", "");
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(grow, strlen(grow), "t.bvh", NULL, &as_bvh, NULL, &s, &diag), AK_OK);
+    if (s) {
+        AK_CHECK_EQ(ak_scene_joint_count(s), 65);
+        if (ak_scene_joint_count(s) == 65) AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 64), "EndSite_j63");
+    }
+    ak_scene_destroy(s);
+    free(grow);
+    /* Frames: 4000000000 with two lines: refused without allocating for the claim */
+    const char* two = "0 0 0 0 0 0 0 0 0\n1 2 3 10 20 30 1 2 3\n";
+    char* huge = bvh_chain(2, "4000000000", two);
+    ca.largest = 0;
+    AK_CHECK_EQ(load_bvh_mem(huge, strlen(huge), &as_bvh, &ca, &diag), AK_ERR_UNSUPPORTED);
+    printf("  Frames: 4000000000: %s (largest allocation %zu bytes)\n", diag.message, ca.largest);
+    AK_CHECK(ca.largest < ((size_t)1 << 20));
+    write_file("huge.bvh", huge, strlen(huge));
+    AK_CHECK_EQ(ak_io_load("huge.bvh", NULL, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
+    remove("huge.bvh");
+    free(huge);
+    /* a count within the budget but more than the data: the data decides (an error) */
+    char* more = bvh_chain(2, "1000000", two);
+    ca.largest = 0;
+    AK_CHECK_EQ(load_bvh_mem(more, strlen(more), &as_bvh, &ca, &diag), AK_ERR_PARSE);
+    AK_CHECK(strstr(diag.message, "after 2 complete frames") != NULL);
+    AK_CHECK(ca.largest < ((size_t)1 << 20));
+    free(more);
+    /* extra values after the declared frames, a non-number, an infinite value */
+    char* extra = bvh_chain(2, "1", two);
+    AK_CHECK_EQ(load_bvh_mem(extra, strlen(extra), &as_bvh, &ca, &diag), AK_ERR_PARSE);
+    free(extra);
+    char* word = bvh_chain(2, "1", "0 0 0 0 0 0 0 0 x\n");
+    AK_CHECK_EQ(load_bvh_mem(word, strlen(word), &as_bvh, &ca, &diag), AK_ERR_PARSE);
+    free(word);
+    char* long_time = bvh_chain(2, "2", two); /* Frame Time 0.1 -> 1e38: the second key is at 1e38 */
+    char* ft = strstr(long_time, "0.1\n");
+    if (ft) {
+        memmove(ft + 4, ft + 3, strlen(ft + 3) + 1);
+        memcpy(ft, "4e38", 4);
+        AK_CHECK_EQ(load_bvh_mem(long_time, strlen(long_time), &as_bvh, &ca, &diag), AK_ERR_BAD_DATA);
+    }
+    free(long_time);
+    char* inf = bvh_chain(2, "1", "0 0 0 0 0 0 0 0 1e999\n");
+    AK_CHECK_EQ(load_bvh_mem(inf, strlen(inf), &as_bvh, &ca, &diag), AK_ERR_BAD_DATA);
+    free(inf);
+    /* Frames: 0 -> the skeleton and no clip */
+    char* none = bvh_chain(2, "0", "");
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(none, strlen(none), "t.bvh", NULL, NULL, NULL, &s, &diag), AK_OK); /* AUTO */
+    if (s) {
+        AK_CHECK_EQ(ak_scene_joint_count(s), 3);
+        AK_CHECK_EQ(s->clip_count, 0);
+    }
+    ak_scene_destroy(s);
+    free(none);
+    /* every allocation failing in turn: AK_ERR_NO_MEMORY, nothing leaked */
+    char* small = bvh_chain(3, "2", "0 0 0 0 0 0 0 0 0 0 0 0\n1 2 3 10 20 30 1 2 3 4 5 6\n");
+    int ok_at = -1;
+    for (int n = 0; n < 100 && ok_at < 0; ++n) {
+        ak_test_counter fa = {.fail_from = n + 1};
+        ak_allocator a = ak_test_counting_allocator(&fa);
+        s = NULL;
+        ak_result r = ak_io_load_memory(small, strlen(small), "t.bvh", NULL, NULL, &a, &s, NULL);
+        if (r == AK_OK) ok_at = n;
+        else AK_CHECK_MSG(r == AK_ERR_NO_MEMORY, "failing allocation %d gave %s", n, ak_result_name(r));
+        ak_scene_destroy(s);
+        AK_CHECK_MSG(fa.live == 0, "failing allocation %d leaked %d blocks", n, fa.live);
+    }
+    AK_CHECK(ok_at > 0);
+    free(small);
+}
+
+/* Rotation channels apply in the order listed, intrinsically (R = R1 R2 R3 on column
+ * vectors); position channels replace the OFFSET's axes they name, also on a JOINT. Checked
+ * against rotations written out by hand for 90-degree angles. */
+AK_TEST(bvh_channel_semantics) {
+    const char* text = "HIERARCHY\nROOT r\n{\nOFFSET 5 5 5\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+                       "JOINT c\n{\nOFFSET 1 0 0\nCHANNELS 2 Yposition Xrotation\nEnd Site\n{\nOFFSET 0 0 1\n}\n}\n}\n"
+                       "MOTION\nFrames: 1\nFrame Time: 0.5\n90 90 0 7 0\n";
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load_memory(text, strlen(text), "t.bvh", NULL, NULL, NULL, &s, &diag), AK_OK);
+    if (!s) return;
+    size_t n = ak_scene_joint_count(s);
+    AK_CHECK_EQ(n, 3);
+    AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 2), "EndSite_c");
+    ak_transform local[3];
+    ak_mat4 world[3];
+    ak_scene_rest_pose(s, (ak_transform_span){local, 3});
+    ak_clip_sample(s->clips[0], 0.0f, NULL, (ak_transform_span){local, 3}, (ak_f32_span){NULL, 0},
+                   (ak_f32_span){NULL, 0});
+    ak_scene_world_matrices(s, (ak_transform_cspan){local, 3}, (ak_mat4_span){world, 3});
+    /* Rz(90) Rx(90): x -> (0,1,0), y -> (0,0,1), z -> (1,0,0). Child at 5 + R (1, 7, 0)
+     * (Yposition 7 replaces the OFFSET's y) = (5,5,5) + (0,1,0) + 7 (0,0,1) = (5, 6, 12). */
+    AK_CHECK_NEAR(world[1].m[12], 5.0, 1e-5);
+    AK_CHECK_NEAR(world[1].m[13], 6.0, 1e-5);
+    AK_CHECK_NEAR(world[1].m[14], 12.0, 1e-5);
+    /* End Site: child rotation Rz Rx (child Rx 0) -> its (0,0,1) maps to (1,0,0). */
+    AK_CHECK_NEAR(world[2].m[12], 6.0, 1e-5);
+    AK_CHECK_NEAR(world[2].m[13], 6.0, 1e-5);
+    AK_CHECK_NEAR(world[2].m[14], 12.0, 1e-5);
+    ak_scene_destroy(s);
+}
+
+/* animkit's reader against Assimp's on the shared files (while Assimp can still read them):
+ * same names, parents, channel count, duration, and world joint positions at several frames. */
+static void compare_bvh_readers(const char* rel) {
+    char path[2048];
+    if (!ak_test_asset(path, sizeof path, rel)) {
+        AK_SKIP("%s absent", rel);
+        return;
+    }
+    ak_io_desc via_assimp = {.format = AK_IO_FORMAT_ASSIMP};
+    ak_scene *own = NULL, *ref = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(path, NULL, NULL, &own, &diag), AK_OK);
+    AK_CHECK_EQ(ak_io_load(path, &via_assimp, NULL, &ref, &diag), AK_OK);
+    if (!own || !ref) {
+        ak_scene_destroy(own);
+        ak_scene_destroy(ref);
+        return;
+    }
+    size_t n = ak_scene_joint_count(own);
+    AK_CHECK_EQ(n, ak_scene_joint_count(ref));
+    for (size_t j = 0; j < n && j < ak_scene_joint_count(ref); ++j) {
+        AK_CHECK_STREQ(ak_skeleton_joint_name(own->skeleton, j), ak_skeleton_joint_name(ref->skeleton, j));
+        AK_CHECK_EQ(ak_skeleton_parents(own->skeleton).ptr[j], ak_skeleton_parents(ref->skeleton).ptr[j]);
+        AK_CHECK_EQ(own->is_joint[j], ref->is_joint[j]);
+    }
+    AK_CHECK_EQ(own->clip_count, 1);
+    AK_CHECK_EQ(ref->clip_count, 1);
+    const ak_clip *a = own->clips[0], *b = ref->clips[0];
+    AK_CHECK_STREQ(ak_clip_name(a), ak_clip_name(b));
+    AK_CHECK_EQ(ak_clip_channel_count(a), ak_clip_channel_count(b));
+    AK_CHECK_NEAR(ak_clip_duration(a), ak_clip_duration(b), 1e-5);
+    ak_transform* la = (ak_transform*)malloc(n * sizeof *la);
+    ak_transform* lb = (ak_transform*)malloc(n * sizeof *lb);
+    ak_mat4* wa = (ak_mat4*)malloc(n * sizeof *wa);
+    ak_mat4* wb = (ak_mat4*)malloc(n * sizeof *wb);
+    double worst = 0.0, scale = 1e-9;
+    for (int k = 0; k <= 6; ++k) {
+        float t = ak_clip_duration(a) * (float)k / 6.0f;
+        ak_scene_rest_pose(own, (ak_transform_span){la, n});
+        ak_scene_rest_pose(ref, (ak_transform_span){lb, n});
+        ak_clip_sample(a, t, NULL, (ak_transform_span){la, n}, (ak_f32_span){NULL, 0}, (ak_f32_span){NULL, 0});
+        ak_clip_sample(b, t, NULL, (ak_transform_span){lb, n}, (ak_f32_span){NULL, 0}, (ak_f32_span){NULL, 0});
+        ak_scene_world_matrices(own, (ak_transform_cspan){la, n}, (ak_mat4_span){wa, n});
+        ak_scene_world_matrices(ref, (ak_transform_cspan){lb, n}, (ak_mat4_span){wb, n});
+        for (size_t j = 0; j < n; ++j)
+            for (int e = 12; e < 15; ++e) {
+                worst = fmax(worst, fabs(wa[j].m[e] - wb[j].m[e]));
+                scale = fmax(scale, fabs(wb[j].m[e]));
+            }
+    }
+    printf("  %s: %zu nodes, largest world position difference to Assimp %.3g (positions up to %.3g)\n", rel, n, worst,
+           scale);
+    AK_CHECK(worst <= 1e-5 * scale);
+    free(la);
+    free(lb);
+    free(wa);
+    free(wb);
+    ak_scene_destroy(own);
+    ak_scene_destroy(ref);
+}
+
+AK_TEST(bvh_reader_matches_assimp) {
+    compare_bvh_readers("bvh/49_04.bvh");
+    compare_bvh_readers("bvh/02_01.bvh");
+    compare_bvh_readers("bvh/131_03.bvh");
+}
+
+/* Every prefix of a BVH fails cleanly (49_04's hierarchy and first 20 frames: every cut in
+ * the hierarchy and the first 2 KiB of motion, every 61st byte after). A cut inside the last
+ * number can still be a valid file; every earlier cut must fail. */
+AK_TEST(bvh_truncated_prefixes_fail) {
+    char path[2048];
+    if (!ak_test_asset(path, sizeof path, "bvh/49_04.bvh")) {
+        AK_SKIP("bvh/49_04.bvh absent");
+        return;
+    }
+    size_t size;
+    char* text = (char*)slurp(path, &size);
+    char* motion = strstr(text, "MOTION");
+    char* first = motion ? strstr(motion, "Time:") : NULL;
+    first = first ? strchr(first, '\n') : NULL;
+    AK_CHECK(first != NULL);
+    if (!first) {
+        free(text);
+        return;
+    }
+    ++first;
+    char* end = first;
+    for (int f = 0; f < 20 && end; ++f) end = strchr(end, '\n') ? strchr(end, '\n') + 1 : NULL;
+    AK_CHECK(end != NULL);
+    if (!end) {
+        free(text);
+        return;
+    }
+    /* rebuild: hierarchy, "Frames: 20", the frame time line, 20 frames */
+    size_t cap = (size_t)(end - text) + 64;
+    char* small = (char*)malloc(cap);
+    char* time_line = strstr(motion, "Frame Time:");
+    int len = snprintf(small, cap, "%.*sMOTION\nFrames: 20\n%.*s%.*s", (int)(motion - text), text,
+                       (int)(first - time_line), time_line, (int)(end - first), first);
+    size_t n = (size_t)len;
+    size_t last = n;
+    while (last > 0 && isspace((unsigned char)small[last - 1])) --last;
+    while (last > 0 && !isspace((unsigned char)small[last - 1])) --last; /* start of the last number */
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(small, n, "cut.bvh", NULL, NULL, NULL, &s, NULL), AK_OK);
+    ak_scene_destroy(s);
+    size_t hier = (size_t)(motion - text) + 2048;
+    int loaded = 0, cuts = 0;
+    for (size_t l = 0; l < last; l += l < hier ? 1 : 61) {
+        ak_io_desc as_bvh = {.format = AK_IO_FORMAT_BVH};
+        s = NULL;
+        if (ak_io_load_memory(small, l, "cut.bvh", NULL, &as_bvh, NULL, &s, NULL) == AK_OK) ++loaded;
+        ak_scene_destroy(s);
+        ++cuts;
+    }
+    printf("  %d truncated BVH copies, %d loaded\n", cuts, loaded);
+    AK_CHECK_EQ(loaded, 0);
+    free(small);
+    free(text);
+}
+
+/* Assimp formats: cheap checks before Assimp runs (nesting depth of XML and brace formats,
+ * file size against an explicit budget); an ordinary file still loads. */
+AK_TEST(assimp_prechecks) {
+    size_t depth = AK_IO_ASSIMP_MAX_DEPTH + 10, cap = depth * 40 + 512, o = 0;
+    char* x = (char*)malloc(cap);
+    o += (size_t)snprintf(x + o, cap - o, "<?xml version=\"1.0\"?>\n<!-- a comment <a> -->\n<COLLADA "
+                                          "xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n");
+    for (size_t i = 0; i < depth; ++i) o += (size_t)snprintf(x + o, cap - o, "<node id=\"n%zu\">", i);
+    for (size_t i = 0; i < depth; ++i) o += (size_t)snprintf(x + o, cap - o, "</node>");
+    snprintf(x + o, cap - o, "</COLLADA>\n");
+    write_file("deep.dae", x, strlen(x));
+    free(x);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load("deep.dae", NULL, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK(strstr(diag.message, "nested deeper") != NULL);
+    remove("deep.dae");
+    const char* obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    write_file("tri.obj", obj, strlen(obj));
+    AK_CHECK_EQ(ak_io_load("tri.obj", NULL, NULL, &s, &diag), AK_OK);
+    if (s) AK_CHECK_EQ(s->mesh_count, 1);
+    ak_scene_destroy(s);
+    s = NULL;
+    ak_io_desc tight = {.memory_budget = 100};
+    AK_CHECK_EQ(ak_io_load("tri.obj", &tight, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
+    remove("tri.obj");
+}
+
 int main(void) {
     AK_RUN(desc_defaults);
     AK_RUN(gltf_assets_match_their_json);
@@ -1521,5 +2103,15 @@ int main(void) {
     AK_RUN(obj_writer_offsets_and_round_trip);
     AK_RUN(bvh_mesh_skin_through_assimp);
     AK_RUN(allocation_failures);
+    AK_RUN(gltf_uri_stays_inside_model_dir);
+    AK_RUN(gltf_memory_budget);
+    AK_RUN(gltf_shared_sampler_amplification);
+    AK_RUN(gltf_negative_key_times);
+    AK_RUN(glb_bad_magic);
+    AK_RUN(bvh_hostile_files);
+    AK_RUN(bvh_channel_semantics);
+    AK_RUN(bvh_reader_matches_assimp);
+    AK_RUN(bvh_truncated_prefixes_fail);
+    AK_RUN(assimp_prechecks);
     return ak_test_finish();
 }

@@ -69,17 +69,19 @@ typedef struct ak_grid_desc {
 
 /* A built grid: every array points into the memory given to ak_grid_build. Read-only. */
 typedef struct ak_grid {
-    float cell_size;                /* as in the desc */
-    uint32_t point_count;           /* points sorted */
-    uint32_t cell_count;            /* occupied cells (<= point_count) */
-    uint32_t bucket_count;          /* hash table size, a power of two */
-    const uint32_t* order;          /* [point_count]: original index of the k-th sorted point */
-    const float* x;                 /* [point_count]: sorted positions, SoA */
+    float cell_size;       /* as in the desc */
+    uint32_t point_count;  /* points sorted */
+    uint32_t cell_count;   /* occupied cells (<= point_count) */
+    uint32_t bucket_count; /* hash table size, a power of two */
+    const uint32_t* order; /* [point_count]: original index of the k-th sorted point */
+    const float* x;        /* [point_count]: sorted positions, SoA */
     const float* y;
     const float* z;
-    const uint32_t* cell_start;     /* [cell_count + 1]: cell m = sorted [cell_start[m], cell_start[m+1]) */
+    const uint32_t*
+        cell_start; /* [cell_count + 1]: cell m = sorted [cell_start[m], cell_start[m+1]) */
     const ak_grid_cell* cell_coord; /* [cell_count]: integer coordinates of cell m */
-    const uint32_t* bucket_start;   /* [bucket_count + 1]: cells of bucket b = [bucket_start[b], [b+1]) */
+    const uint32_t*
+        bucket_start; /* [bucket_count + 1]: cells of bucket b = [bucket_start[b], [b+1]) */
 } ak_grid;
 
 /* Bytes of memory ak_grid_build needs for point_count points (any alignment is fine; the
@@ -97,7 +99,8 @@ AK_API size_t ak_grid_memory_size(size_t point_count, const ak_grid_desc* desc);
 AK_API ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_span memory,
                                ak_grid* out_grid);
 
-/* The cell holding p (floor(p / cell_size), clamped as ak_grid_cell says). */
+/* The cell holding p (floor(p / cell_size), clamped as ak_grid_cell says; a NaN coordinate
+ * gives -2^30). */
 AK_API ak_grid_cell ak_grid_cell_of(const ak_grid* grid, ak_vec3 p);
 
 /* Index m of a cell in the grid (its points are sorted entries [cell_start[m],

@@ -69,7 +69,8 @@ AK_API ak_result ak_ik_chain_build(const ak_skeleton* skeleton, int root_joint, 
 AK_API ak_result ak_ik_chain_positions(const ak_skeleton* skeleton, ak_transform_cspan pose,
                                        ak_i16_cspan chain, ak_vec3_span out_positions);
 
-/* Sum of the chain's bone lengths in model space for a pose (0 on invalid input). */
+/* Sum of the chain's bone lengths in model space for a pose (0 on invalid input), summed in
+ * double and saturated at FLT_MAX (never infinite). */
 AK_API float ak_ik_chain_length(const ak_skeleton* skeleton, ak_transform_cspan pose, ak_i16_cspan chain);
 
 /* ---- the chain job ------------------------------------------------------------------ */
@@ -105,7 +106,8 @@ typedef struct ak_ik_chain_job {
     size_t max_iterations;       /* iteration budget; 0 -> 50. CCD: one sweep over the chain;
                                     FABRIK: one forward + backward pass; DLS: one step */
     float tolerance;             /* model units: reached when the effector is this close;
-                                    0 -> 1e-4 * chain length (at least 1e-7) */
+                                    0 -> 1e-4 * chain length (1e-7 for a chain of zero
+                                    length) */
     float angle_tolerance;       /* radians, with target_rotation; 0 -> 1e-3 */
     float max_step;              /* CCD: largest rotation of one joint in one sweep, radians
                                     (damping); 0 -> pi (undamped) */
@@ -113,9 +115,9 @@ typedef struct ak_ik_chain_job {
                                     the classic order */
     bool ignore_limits;          /* false -> joint types and limits are honoured */
     float dls_damping;           /* DLS: initial lambda, model units (adapted each step);
-                                    0 -> 0.1 * chain length */
+                                    0 -> 0.1 * chain length (1e-6 at zero length) */
     float orientation_weight;    /* DLS: model units per radian of orientation error;
-                                    0 -> chain length / pi */
+                                    0 -> chain length / pi (1e-6 at zero length) */
     ak_vec3 pole;                /* TWO_BONE: model-space direction the middle joint bends
                                     towards (a knee points along it); zero -> keep the
                                     current bend plane */
@@ -127,7 +129,8 @@ typedef struct ak_ik_chain_job {
     ak_u8_span scratch;          /* >= ak_ik_chain_scratch_size(solver, chain.count) bytes,
                                     any alignment */
     bool* out_reached;           /* optional: effector within tolerance (and angle tolerance) */
-    float* out_error;            /* optional: final effector-to-target distance, model units */
+    float* out_error;            /* optional: final effector-to-target distance, model units
+                                    (computed in double; saturates at FLT_MAX, never inf) */
     float* out_angle_error;      /* optional: final orientation error in radians (0 without
                                     target_rotation) */
     size_t* out_iterations;      /* optional: iterations used (0 for TWO_BONE) */
@@ -152,7 +155,9 @@ AK_API ak_ik_chain_job ak_ik_chain_job_resolved(const ak_ik_chain_job* job);
  *   AK_ERR_BAD_ARG     tolerance, angle_tolerance, max_step, dls_damping or
  *                      orientation_weight negative or NaN; soft outside [0, 1);
  *                      keep_animation outside [0, 1]
- *   AK_ERR_BAD_DATA    a transform of the chain or its ancestors in the pose is not finite
+ *   AK_ERR_BAD_DATA    a transform of the chain or its ancestors in the pose is not finite,
+ *                      or the chain's model-space transforms overflow (finite locals whose
+ *                      forward kinematics is not finite, e.g. bones of 3e38 end to end)
  *   AK_ERR_NULL_ARG    scratch.ptr is NULL
  *   AK_ERR_SPAN_SMALL  scratch.count < ak_ik_chain_scratch_size(solver, chain.count) */
 AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
@@ -169,18 +174,31 @@ AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
  * FABRIK and TWO_BONE keep them). Only rotations and slides are written, so bone lengths
  * (other than prism slides) are unchanged.
  * Solver notes: CCD is the course's algorithm as is; its tail is slow (one joint at a time).
- * A straight chain whose line passes through the target is singular for CCD, FABRIK and DLS
- * alike, so such a chain is first bent by 0.1 rad per joint (about a hinge's axis, else about
- * one normal of the line).
+ * A straight chain whose line passes through the target (inside its reach) is singular for
+ * CCD, FABRIK and DLS alike, so such a chain is first curled in one plane: the plane of the
+ * first hinge below the root (bent to the side its limits allow), else of the root's hinge,
+ * else ak_vec3_any_perpendicular of the line; every joint below the root turns by one angle
+ * (bisected so the curled chord equals the target's distance, within the hinges' limits)
+ * and the root turns the effector back onto the line. CCD and constrained FABRIK curl the
+ * chain again if they stall straight on the target's line (a hinge clamped straight).
  * FABRIK on a chain with limits first runs the plain passes (their answer often respects the
  * limits, e.g. a planar chain of hinges); if the converted pose misses, the remaining
- * iterations run constrained: the backward pass turns each joint within its limits, followed
- * by one constrained CCD sweep so joints pinned at a limit do not freeze the chain.
+ * iterations run constrained, from the better of the converted pose and the input: the
+ * backward pass turns each joint within its limits, followed by one constrained CCD sweep
+ * (from the best pose met when the limits made the pass's pose worse) so joints pinned at a
+ * limit do not freeze the chain.
  * While plain FABRIK passes shrink the error by less than half per pass (slow convergence
  * near full reach), each next pass starts from the positions extrapolated by the last pass's
  * step (a momentum step; the passes themselves keep the bone lengths).
  * TWO_BONE bends a HINGE mid joint about the hinge axis (trying the other bend when the limits
  * refuse the first). DLS stops when lambda tops out without an improving step.
+ * Scale: chains of any size work alike. A chain 1e-3 to 1e6 units long with its target
+ * within 1e9 of its root is solved as it is; any other runs in a frame centred on the chain
+ * root and scaled by a power of two that brings the chain's extent into [0.5, 1) (exact), so
+ * bones of 1e30 do not overflow squared distances and bones of 1e-30 do not fall under fixed
+ * thresholds; there a target farther than 1e6 chain extents from the root is solved as the
+ * point on its ray from the root at that distance (out of reach either way). Error and
+ * reached always use the true target, in double.
  * Degenerate cases: a one-joint chain cannot move its effector (only target_rotation is
  * applied; 0 iterations); zero-length bones keep their direction; a target on the root folds
  * the chain as far as lengths and limits allow. */
@@ -241,11 +259,13 @@ typedef struct ak_ik_fabrik_tree_job {
     ak_i16_cspan effectors;      /* required: effector joint indices, count >= 1, distinct */
     ak_vec3_cspan targets;       /* required: model space, count >= effectors.count */
     size_t max_iterations;       /* 0 -> 50 */
-    float tolerance;             /* model units, per effector; 0 -> 1e-4 * tree bone length */
+    float tolerance;             /* model units, per effector; 0 -> 1e-4 * tree bone length
+                                    (1e-7 at zero length) */
     bool ignore_limits;          /* false -> limits honoured */
     ak_u8_span scratch;          /* >= ak_ik_fabrik_tree_scratch_size(joint count) bytes */
     bool* out_reached;           /* optional: every effector within tolerance */
-    float* out_error;            /* optional: largest effector-to-target distance */
+    float* out_error;            /* optional: largest effector-to-target distance (double,
+                                    saturates at FLT_MAX) */
     size_t* out_iterations;      /* optional */
 } ak_ik_fabrik_tree_job;
 
@@ -255,10 +275,10 @@ AK_API size_t ak_ik_fabrik_tree_scratch_size(size_t joint_count);
  * effectors.count 0), AK_ERR_SPAN_SMALL (pose or targets too short), AK_ERR_BAD_INDEX
  * (root or an effector out of range), AK_ERR_DUPLICATE (an effector listed twice),
  * AK_ERR_NOT_FOUND (root_joint not an ancestor of an effector), AK_ERR_BAD_DATA (a target or
- * a pose transform not finite), AK_ERR_BAD_ARG (tolerance negative or NaN),
+ * a pose transform not finite, or an effector's model transform overflows), AK_ERR_BAD_ARG (tolerance negative or NaN),
  * AK_ERR_NULL_ARG / AK_ERR_SPAN_SMALL (scratch). */
 AK_API ak_result ak_ik_fabrik_tree_validate(const ak_ik_fabrik_tree_job* job);
-/* Validate, then solve in place; unreachable targets as for chains. */
+/* Validate, then solve in place; unreachable targets, scale and far targets as for chains. */
 AK_API ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job);
 
 #ifdef __cplusplus

@@ -8,7 +8,9 @@
  *     exactly, so it gets a reader that keeps the file's data as the specification defines
  *     it (accessors with byteStride, sparse accessors, normalized integers, every component
  *     type, matrix or TRS nodes, skins, morph targets, STEP/LINEAR/CUBICSPLINE samplers).
- *   - Everything else (BVH, FBX, Collada, OBJ, ...) through Assimp's C API: the node tree
+ *   - BVH through animkit's own streaming reader (src/io/bvh.c): bounded nesting, the frame
+ *     count checked against the data present, the same scene layout Assimp gave (docs/io.md).
+ *   - Everything else (FBX, Collada, OBJ, ...) through Assimp's C API: the node tree
  *     becomes the skeleton, aiAnimation channels become clips (ticks -> seconds), meshes with
  *     bones get skins.
  *   - ak_io_write_obj: Wavefront OBJ of a scene's meshes at positions the caller computed
@@ -50,8 +52,15 @@
  *     ak_io_write_obj("mesh.obj", scene, NULL, NULL, &diag);  // NULL: positions as stored
  *     ak_scene_destroy(scene);
  *
+ * Untrusted input: glTF and BVH are safe to load from untrusted sources (memory bounded by
+ * desc->memory_budget, checked before allocating; recursion bounded (cJSON stops at 1000
+ * nesting levels, the BVH reader does not recurse); external glTF
+ * buffers only inside the model's directory unless desc->extra_roots/allow_any_path say
+ * otherwise; images never opened). Assimp formats (FBX, Collada, OBJ, ...) are NOT: animkit
+ * only pre-checks their size and nesting depth. docs/io.md lists every limit and its default.
+ *
  * Ownership and threading: the scene returned belongs to the caller (ak_scene_destroy).
- * The library keeps no pointer to the caller's data. The glTF path is reentrant: the JSON
+ * The library keeps no pointer to the caller's data. The glTF and BVH paths are reentrant: the JSON
  * parse tree comes from cJSON's own malloc (animkit never sets cJSON's global hooks) and
  * animkit never reads cJSON's global last-error pointer. The Assimp path must not run on
  * several threads at once: Assimp keeps its last error message in a global.
@@ -67,12 +76,23 @@ extern "C" {
 
 /* Default and largest number of skin influences kept per vertex. */
 #define AK_IO_DEFAULT_INFLUENCES 4
+/* Default memory budget of one load (ak_io_desc.memory_budget = 0): the larger of 1 GiB and
+ * AK_IO_BUDGET_INPUT_FACTOR times the size of the file (or memory block) being loaded. */
+#define AK_IO_DEFAULT_BUDGET ((size_t)1 << 30)
+#define AK_IO_BUDGET_INPUT_FACTOR 16u
+/* Deepest ROOT/JOINT nesting animkit's BVH reader accepts. */
+#define AK_IO_BVH_MAX_DEPTH 256u
+/* Deepest element/brace nesting the pre-check lets through to Assimp (Collada, ASCII FBX). */
+#define AK_IO_ASSIMP_MAX_DEPTH 1024u
 
 /* Which reader handles a file. */
 typedef enum ak_io_format {
     AK_IO_FORMAT_AUTO = 0, /* default: a .gltf/.glb extension or the GLB magic -> GLTF, else ASSIMP */
     AK_IO_FORMAT_GLTF,     /* animkit's glTF 2.0 reader (.gltf or .glb, decided by the bytes) */
-    AK_IO_FORMAT_ASSIMP,   /* Assimp's importer (BVH, FBX, Collada, OBJ, ...) */
+    AK_IO_FORMAT_ASSIMP,   /* Assimp's importer (FBX, Collada, OBJ, ...; BVH only when named
+                              explicitly: Assimp's BVH importer is not safe on untrusted files) */
+    AK_IO_FORMAT_BVH,      /* animkit's BVH reader (AUTO picks it for .bvh and for data that
+                              starts with HIERARCHY) */
     AK_IO_FORMAT_COUNT
 } ak_io_format;
 
@@ -84,9 +104,22 @@ typedef struct ak_io_desc {
                                 0 -> keep every positive weight */
     ak_io_format format;     /* 0 -> AK_IO_FORMAT_AUTO */
     bool skip_animations;    /* true -> no clips */
-    bool keep_bvh_mesh;      /* Assimp builds a bone-visualisation mesh for BVH files; false
-                                (default) drops it, so a BVH scene has no meshes */
+    bool keep_bvh_mesh;      /* only for BVH read through Assimp (format AK_IO_FORMAT_ASSIMP):
+                                Assimp builds a bone-visualisation mesh; false (default) drops it.
+                                animkit's own BVH reader never makes a mesh */
     ak_logger logger;        /* warnings (ignored extensions, dropped keys); zero -> silent */
+    size_t memory_budget;    /* most bytes one load may allocate for file data, the JSON tree
+                                and arrays, checked before each allocation (a conservative sum,
+                                the peak is lower); over it -> AK_ERR_UNSUPPORTED.
+                                0 -> max(AK_IO_DEFAULT_BUDGET, AK_IO_BUDGET_INPUT_FACTOR x input
+                                size). Assimp formats: the file size must fit it */
+    const char* const* extra_roots; /* directories that external glTF buffer URIs may also
+                                resolve into (after percent-decoding, normalising and resolving
+                                symlinks); NULL -> only the model's own directory */
+    size_t extra_root_count;
+    bool allow_any_path;     /* true -> external buffer URIs may resolve anywhere (only for
+                                trusted files); false (default) -> outside the model's directory
+                                and extra_roots is AK_ERR_IO */
 } ak_io_desc;
 
 /* The desc with its zero fields replaced by their defaults (NULL -> all defaults).
@@ -97,25 +130,29 @@ AK_API ak_io_desc ak_io_desc_resolved(const ak_io_desc* desc);
  * desc NULL -> defaults; alloc NULL -> malloc/free (used for the scene, everything in it and
  * the temporary arrays; only cJSON's parse tree and Assimp's scene use their own malloc). diag (optional) names the file and the problem.
  * Returns AK_ERR_NULL_ARG (path or out_scene NULL), AK_ERR_IO (cannot open or read the file
- * or an external buffer), AK_ERR_PARSE (malformed JSON/GLB, a glTF rule broken, an Assimp
+ * or an external buffer, or an external buffer URI that resolves outside the model's directory:
+ * diag names the uri), AK_ERR_PARSE (malformed JSON/GLB, a glTF rule broken, an Assimp
  * failure: diag holds Assimp's message), AK_ERR_BAD_INDEX (an index out of range: accessor,
  * node, vertex index, joint slot), AK_ERR_BAD_DATA (NaN or infinity in positions, transforms,
  * inverse binds or key values), AK_ERR_BAD_WEIGHTS (a negative skin weight),
  * AK_ERR_BAD_HIERARCHY (node cycle or a node with two parents), AK_ERR_UNSORTED (sampler
  * times not strictly increasing), AK_ERR_DUPLICATE (two channels animate one node path),
  * AK_ERR_UNSUPPORTED (a required extension, glTF 1.x, more than 32767 nodes, a skin of more
- * than 65535 joints, an animation with no usable channel), AK_ERR_NOT_FOUND (Assimp: a bone
+ * than 65535 joints, an animation with no usable channel, the memory budget exceeded, BVH
+ * nesting deeper than AK_IO_BVH_MAX_DEPTH or Assimp input nested deeper than
+ * AK_IO_ASSIMP_MAX_DEPTH), AK_ERR_NOT_FOUND (Assimp: a bone
  * or channel names no node), AK_ERR_EMPTY (Assimp: a mesh without vertices), AK_ERR_BAD_ARG
  * (desc->format out of range), AK_ERR_NO_MEMORY. On failure *out_scene is NULL. */
 AK_API ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
                             ak_scene** out_scene, ak_diag* diag);
 
-/* Load a glTF 2.0 document (.gltf JSON text or .glb bytes, told apart by the "glTF" magic)
- * from memory. name (NULL -> "memory") is used for the scene name and in diag; base_dir
- * (NULL -> external buffers are refused with AK_ERR_IO) is the directory external buffer URIs
- * are relative to. data is read only during the call. Returns the codes of ak_io_load, and
- * AK_ERR_NULL_ARG when data is NULL with size > 0. desc->format must be AUTO or GLTF
- * (AK_ERR_UNSUPPORTED otherwise). */
+/* Load a glTF 2.0 document (.gltf JSON text or .glb bytes, told apart by the "glTF" magic) or
+ * a BVH file (desc->format BVH, or AUTO and the data starts with "HIERARCHY") from memory.
+ * name (NULL -> "memory") is used for the scene name and in diag; base_dir (NULL -> external
+ * buffers are refused with AK_ERR_IO) is the directory external buffer URIs are relative to
+ * and must stay inside (see ak_io_desc.extra_roots). data is read only during the call.
+ * Returns the codes of ak_io_load, and AK_ERR_NULL_ARG when data is NULL with size > 0.
+ * desc->format must be AUTO, GLTF or BVH (AK_ERR_UNSUPPORTED otherwise). */
 AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* name, const char* base_dir,
                                    const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
                                    ak_diag* diag);

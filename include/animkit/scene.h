@@ -26,6 +26,8 @@
  *     ak_scene_world_matrices(scene, (ak_transform_cspan){local, n}, (ak_mat4_span){world, n});
  *     ak_mat4 palette[64];
  *     ak_scene_skin_palette(scene, 0, (ak_mat4_cspan){world, n}, (ak_mat4_span)AK_SPAN(palette));
+ *     // then skin.h's job with .palette = {palette, scene->skins[0].joint_count}
+ *     // (the whole path as a program: examples/skin_gltf_minimal.c)
  *     ak_scene_destroy(scene);
  *
  * Ownership: a scene owns its skeleton, meshes, skins and clips and frees them all in
@@ -97,7 +99,10 @@ AK_API ak_result ak_scene_rest_pose(const ak_scene* scene, ak_transform_span out
 AK_API ak_result ak_scene_world_matrices(const ak_scene* scene, ak_transform_cspan local, ak_mat4_span out_world);
 
 /* Skinning palette of skin skin_index: out_palette[k] = world[joints[k]] * inverse_binds[k].
- * out_palette.count >= skin joint_count. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX,
+ * out_palette.count >= skin joint_count. This is the palette a scene mesh's joint indices
+ * (skin slots) address: pass it to the skin job (skin.h) as {palette, skin joint_count}.
+ * ak_skeleton_skinning_matrices, indexed by skeleton joint, does not fit loaded scenes and
+ * refuses them (AK_ERR_UNSUPPORTED). Returns AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX,
  * AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_scene_skin_palette(const ak_scene* scene, size_t skin_index, ak_mat4_cspan world,
                                        ak_mat4_span out_palette);

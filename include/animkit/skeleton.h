@@ -72,6 +72,13 @@ typedef struct ak_skeleton_desc {
     const ak_joint_desc* joints; /* required, parents before children */
     size_t joint_count;          /* required, 1 .. 32767 */
     const char* name;            /* NULL -> "" */
+    bool palette_from_skins;     /* true: meshes bound to this skeleton index the slots of
+                                    their own skins, not skeleton joints (every scene loaded
+                                    from a file, see scene.h), so a palette indexed by joint
+                                    would skin them wrong: ak_skeleton_skinning_matrices then
+                                    refuses (AK_ERR_UNSUPPORTED) and ak_scene_skin_palette
+                                    is the way. false: a mesh's joint indices are skeleton
+                                    joint indices (builtin scenes, hand-made skeletons) */
 } ak_skeleton_desc;
 
 typedef struct ak_skeleton ak_skeleton;
@@ -112,6 +119,8 @@ AK_API int ak_skeleton_find_joint(const ak_skeleton* skeleton, const char* name)
 AK_API ak_joint_type ak_skeleton_joint_type(const ak_skeleton* skeleton, size_t joint_index);
 /* Limits with defaults resolved (axis normalised, never zero). */
 AK_API ak_joint_limits ak_skeleton_joint_limits(const ak_skeleton* skeleton, size_t joint_index);
+/* desc.palette_from_skins as created (false for NULL). */
+AK_API bool ak_skeleton_palette_from_skins(const ak_skeleton* skeleton);
 /* Number of children of a joint (0: a leaf, or out of range). */
 AK_API size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index);
 
@@ -123,7 +132,13 @@ AK_API ak_result ak_skeleton_local_to_model(const ak_skeleton* skeleton, ak_tran
 /* Same, with an extra root transform (e.g. the node above the skeleton) applied to every root. */
 AK_API ak_result ak_skeleton_local_to_model_rooted(const ak_skeleton* skeleton, ak_mat4 root,
                                                    ak_transform_cspan local, ak_mat4_span out_model);
-/* Skinning palette: out_skin[i] = model[i] * inverse_bind[i]. Sizes >= joint_count. */
+/* Skinning palette indexed by skeleton joint: out_skin[i] = model[i] * inverse_bind[i]. Sizes
+ * >= joint_count. Right for meshes whose joint indices are skeleton joints (builtin scenes,
+ * your own skeletons). A scene loaded from a file indexes each mesh's joints by the slots of
+ * its skin, whose order and inverse binds are the skin's own: build its palette with
+ * ak_scene_skin_palette. Such a skeleton (desc.palette_from_skins, set by the loaders) makes
+ * this function return AK_ERR_UNSUPPORTED, writing nothing, instead of a palette that would
+ * silently skin the mesh wrong. Also AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_skeleton_skinning_matrices(const ak_skeleton* skeleton, ak_mat4_cspan model,
                                                ak_mat4_span out_skin);
 /* FK for many characters sharing one skeleton: poses are character-major,

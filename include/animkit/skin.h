@@ -12,10 +12,22 @@
  *   - the CoR precomputation (per-vertex centers), pruned by bone pair and multithreaded, with
  *     a cache format keyed by a hash of the mesh and weights.
  *
- * What it does NOT do: build the palette (ak_skeleton_skinning_matrices does: M_j = model_j *
- * inverse_bind_j), read asset files (io.h), or measure volume (ak_volume_compute in mesh.h).
+ * What it does NOT do: build the palette (scene.h's ak_scene_skin_palette does for a scene:
+ * M_k = world(skin.joints[k]) * skin.inverse_binds[k]), read asset files (io.h), or measure
+ * volume (ak_volume_compute in mesh.h).
  *
- * Usage (deform every frame; weights from the mesh, palette from the skeleton):
+ * The palette is indexed the way the mesh's joint indices are. For a scene (ak_io_load,
+ * ak_builtin_create) those are the slots of the mesh's skin, so its palette comes from
+ * ak_scene_skin_palette, never from ak_skeleton_skinning_matrices (indexed by skeleton joint,
+ * which a loaded skeleton refuses with AK_ERR_UNSUPPORTED; it only fits meshes whose joint
+ * indices are skeleton joints). examples/skin_gltf_minimal.c is this note as a program.
+ *
+ * Usage (scene mesh m posed by local transforms `local`; deform every frame):
+ *     const ak_scene_mesh* sm = &scene->meshes[m];
+ *     const ak_mesh* mesh = sm->mesh;
+ *     size_t joint_count = scene->skins[sm->skin].joint_count;   // palette size: skin slots
+ *     ak_scene_world_matrices(scene, local, world);              // FK of every node
+ *     ak_scene_skin_palette(scene, (size_t)sm->skin, world, (ak_mat4_span){palette, joint_count});
  *     ak_skin_job job = {
  *         .method = AK_SKIN_DQS,
  *         .influence_count = mesh->influence_count,

@@ -111,7 +111,7 @@ akp_ik_outcome akp_ik_ccd(akp_ik_chain* c, const ak_ik_chain_job* job) {
     const size_t last = n - 1;
     akp_ik_outcome out = {ak_vec3_distance(c->world[last].translation, c->target), 0};
     float best = out.error;
-    int stalled = 0;
+    int stalled = 0, rebends = 0;
     /* Improvements below this are float noise: further sweeps cannot help. */
     const float noise = 1e-6f * ak_maxf(c->length, 1e-6f);
     while (out.error > c->tolerance && out.iterations < job->max_iterations) {
@@ -123,6 +123,14 @@ akp_ik_outcome akp_ik_ccd(akp_ik_chain* c, const ak_ik_chain_job* job) {
             best = out.error;
             stalled = 0;
         } else if (++stalled >= 3) {
+            /* Stuck straight on the target's line (a hinge clamped back to straight): bend
+             * again, a couple of times at most. */
+            if (rebends < 2 && akp_ik_unstraighten(c)) {
+                ++rebends;
+                stalled = 0;
+                best = out.error = ak_vec3_distance(c->world[last].translation, c->target);
+                continue;
+            }
             break; /* converged as far as it can (unreachable, or held by limits) */
         }
     }

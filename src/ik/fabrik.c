@@ -6,6 +6,8 @@
  * (any non-FREE joint), every iteration converts to rotations, clamps each joint to its limits
  * and reads the positions back by forward kinematics, so the next pass starts from a pose
  * the joints can take. The tree job always does the latter. */
+#include <float.h>
+#include <math.h>
 #include <string.h>
 
 #include "ik_internal.h"
@@ -78,6 +80,9 @@ static void fabrik_pass(akp_ik_chain* c, ak_vec3* pos, const float* len, float t
     }
     if (constrained) {
         positions_to_rotations(c, pos);
+        /* Limits can turn the passes' answer into a worse pose than the best one met (a bend
+         * the hinges refuse comes back straight): sweep from the best pose then. */
+        akp_ik_restore_best(c, ak_vec3_distance(c->world[last].translation, t));
         akp_ik_ccd_sweep(c, AK_PI, false);
         for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
     }
@@ -97,6 +102,7 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
     const float noise = 1e-6f * ak_maxf(total, 1e-6f);
     akp_ik_outcome out = {ak_vec3_distance(pos[last], t), 0};
     bool constrained = false;
+    int rebends = 0;
     for (;;) {
         float best = out.error;
         int stalled = 0;
@@ -128,6 +134,14 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
                 best = out.error;
                 stalled = 0;
             } else if (++stalled >= 3) {
+                /* Constrained and stuck straight on the target's line: bend again. */
+                if (constrained && rebends < 2 && akp_ik_unstraighten(c)) {
+                    ++rebends;
+                    stalled = 0;
+                    for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
+                    best = out.error = ak_vec3_distance(pos[last], t);
+                    continue;
+                }
                 break;
             }
         }
@@ -138,6 +152,12 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
         akp_ik_track_best(c, out.error);
         if (out.error <= c->tolerance || out.iterations >= job->max_iterations) break;
         constrained = true;
+        /* The plain passes need not bend the way the limits allow (from a nearly straight
+         * chain, the forward pass folds the last bones back, zigzagging): when the converted
+         * answer is worse than the input, the constrained iterations start from the input;
+         * when it came back straight on the target's line, bend it the allowed way. */
+        out.error = akp_ik_restore_best(c, out.error);
+        akp_ik_unstraighten(c);
         for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
     }
     out.error = akp_ik_restore_best(c, out.error);
@@ -158,6 +178,7 @@ typedef struct tree_mem {
     int16_t* first_child;
     int16_t* next_sibling;
     int16_t* nodes; /* tree joints, ascending (parents first) */
+    ak_vec3* goal;  /* [effector count] targets in the solve's frame */
 } tree_mem;
 
 static size_t tree_layout(size_t n, unsigned char* base, tree_mem* m) {
@@ -177,6 +198,7 @@ static size_t tree_layout(size_t n, unsigned char* base, tree_mem* m) {
     AKP_CARVE(first_child, int16_t);
     AKP_CARVE(next_sibling, int16_t);
     AKP_CARVE(nodes, int16_t);
+    AKP_CARVE(goal, ak_vec3);
 #undef AKP_CARVE
     return off;
 }
@@ -209,6 +231,14 @@ ak_result ak_ik_fabrik_tree_validate(const ak_ik_fabrik_tree_job* job) {
         if (!ak_transform_is_finite(job->pose.ptr[p])) return AK_ERR_BAD_DATA;
     for (size_t j = (size_t)job->root_joint; j < n; ++j)
         if (!ak_transform_is_finite(job->pose.ptr[j])) return AK_ERR_BAD_DATA;
+    /* Finite locals can still overflow on the way to model space (bones of 3e38 end to end). */
+    for (size_t k = 0; k < job->effectors.count; ++k) {
+        ak_transform acc = ak_transform_identity();
+        for (int p = job->effectors.ptr[k]; p >= 0; p = parents.ptr[p]) {
+            acc = ak_transform_mul(job->pose.ptr[p], acc);
+            if (!ak_transform_is_finite(acc)) return AK_ERR_BAD_DATA;
+        }
+    }
     if (!(job->tolerance >= 0.0f && ak_finitef(job->tolerance))) return AK_ERR_BAD_ARG;
     if (!job->scratch.ptr) return AK_ERR_NULL_ARG;
     if (job->scratch.count < ak_ik_fabrik_tree_scratch_size(n)) return AK_ERR_SPAN_SMALL;
@@ -271,6 +301,34 @@ ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job) {
     /* Forward kinematics of the tree. */
     ak_transform base = ak_transform_identity();
     for (int p = parents[root]; p >= 0; p = parents[p]) base = ak_transform_mul(pose[p], base);
+    /* As for chains (chain.c): solve in a frame centred on the root joint and scaled by a
+     * power of two that brings the tree's extent into [0.5, 1), so no squared distance
+     * overflows or vanishes; targets farther than 1e6 extents move onto their ray. */
+    for (size_t k = 0; k < node_count; ++k) {
+        int j = m.nodes[k];
+        m.world[j] = ak_transform_mul(k == 0 ? base : m.world[parents[j]], pose[j]);
+    }
+    const ak_vec3 origin = m.world[root].translation;
+    double extent = 0.0;
+    for (size_t k = 1; k < node_count; ++k) {
+        const ak_vec3 p = m.world[m.nodes[k]].translation;
+        extent = fmax(extent, fmax(fabs((double)p.x - origin.x), fmax(fabs((double)p.y - origin.y), fabs((double)p.z - origin.z))));
+    }
+    int exponent = 0;
+    if (extent > 0.0) frexp(extent, &exponent);
+    const double scale = ldexp(1.0, exponent), inv = 1.0 / scale;
+    base.translation = ak_vec3_make((float)(((double)base.translation.x - origin.x) * inv),
+                                    (float)(((double)base.translation.y - origin.y) * inv),
+                                    (float)(((double)base.translation.z - origin.z) * inv));
+    base.scale = ak_vec3_make((float)(base.scale.x * inv), (float)(base.scale.y * inv), (float)(base.scale.z * inv));
+    for (size_t k = 0; k < job->effectors.count; ++k) {
+        const ak_vec3 t = job->targets.ptr[k];
+        double g[3] = {((double)t.x - origin.x) * inv, ((double)t.y - origin.y) * inv, ((double)t.z - origin.z) * inv};
+        const double d = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]), far = 1e6;
+        if (d > far)
+            for (int c = 0; c < 3; ++c) g[c] *= far / d;
+        m.goal[k] = ak_vec3_make((float)g[0], (float)g[1], (float)g[2]);
+    }
     float total = 0.0f;
     for (size_t k = 0; k < node_count; ++k) {
         int j = m.nodes[k];
@@ -278,13 +336,15 @@ ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job) {
         m.pos[j] = m.world[j].translation;
         if (k > 0) total += (m.len[j] = ak_vec3_distance(m.pos[j], m.pos[parents[j]]));
     }
-    const float tolerance = job->tolerance > 0.0f ? job->tolerance : ak_maxf(1e-4f * total, 1e-7f);
+    /* in the solve's frame; the default is relative to the tree's length at any scale */
+    const float tolerance = job->tolerance > 0.0f ? (float)(job->tolerance * inv) : total > 0.0f ? 1e-4f * total
+                                                                                              : (float)(1e-7 * inv);
     const float noise = 1e-6f * ak_maxf(total, 1e-6f);
     const ak_vec3 root_pos = m.pos[root];
 
     float error = 0.0f;
     for (size_t k = 0; k < job->effectors.count; ++k)
-        error = ak_maxf(error, ak_vec3_distance(m.pos[job->effectors.ptr[k]], job->targets.ptr[k]));
+        error = ak_maxf(error, ak_vec3_distance(m.pos[job->effectors.ptr[k]], m.goal[k]));
     float best = error;
     size_t iterations = 0;
     int stalled = 0;
@@ -298,7 +358,7 @@ ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job) {
         }
         for (size_t k = node_count; k-- > 0;) {
             int j = m.nodes[k];
-            ak_vec3 p = m.target[j] >= 0 ? job->targets.ptr[m.target[j]]
+            ak_vec3 p = m.target[j] >= 0 ? m.goal[m.target[j]]
                         : m.count[j] > 0 ? ak_vec3_scale(m.sum[j], 1.0f / (float)m.count[j])
                                          : m.pos[j];
             m.fwd[j] = p;
@@ -341,7 +401,7 @@ ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job) {
         }
         error = 0.0f;
         for (size_t k = 0; k < job->effectors.count; ++k)
-            error = ak_maxf(error, ak_vec3_distance(m.pos[job->effectors.ptr[k]], job->targets.ptr[k]));
+            error = ak_maxf(error, ak_vec3_distance(m.pos[job->effectors.ptr[k]], m.goal[k]));
         ++iterations;
         if (error < best - noise) {
             best = error;
@@ -350,8 +410,16 @@ ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job) {
             break;
         }
     }
-    if (job->out_reached) *job->out_reached = error <= tolerance;
-    if (job->out_error) *job->out_error = error;
+    /* The largest error in model units, in double, out of the solve's frame. */
+    double error_d = 0.0;
+    for (size_t k = 0; k < job->effectors.count; ++k) {
+        const ak_vec3 e = m.pos[job->effectors.ptr[k]], t = job->targets.ptr[k];
+        const double x = (double)e.x * scale + origin.x - t.x, y = (double)e.y * scale + origin.y - t.y,
+                     z = (double)e.z * scale + origin.z - t.z;
+        error_d = fmax(error_d, sqrt(x * x + y * y + z * z));
+    }
+    if (job->out_reached) *job->out_reached = error_d <= (double)tolerance * scale;
+    if (job->out_error) *job->out_error = error_d < FLT_MAX ? (float)error_d : FLT_MAX;
     if (job->out_iterations) *job->out_iterations = iterations;
     return AK_OK;
 }

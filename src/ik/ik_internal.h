@@ -209,6 +209,11 @@ static inline ak_quat akp_ik_aim_rotation(ak_vec3 re, ak_vec3 rd, bool hinge, ak
     return ak_quat_make(v.x * inv, v.y * inv, v.z * inv, w * inv);
 }
 
+/* When the chain is straight and the target lies on its line inside the reach (the singular
+ * configuration of CCD, FABRIK and DLS), bend it in one plane towards the side its hinges
+ * allow, effector back on the line (chain.c); returns whether it did. world[] consistent. */
+bool akp_ik_unstraighten(akp_ik_chain* c);
+
 /* Solvers (src/ik/<name>.c). Each starts from a chain whose world[] is current and returns
  * with world[] and the pose consistent. */
 akp_ik_outcome akp_ik_ccd(akp_ik_chain* c, const ak_ik_chain_job* job);

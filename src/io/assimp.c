@@ -436,6 +436,55 @@ static ak_result convert(as_ctx* c) {
     return r;
 }
 
+/* Cheap checks before Assimp sees a file: its size must fit the memory budget (times
+ * AK_IO_BUDGET_INPUT_FACTOR, Assimp's own use is not bounded), and text formats with nesting
+ * (XML: Collada, ...; braces: ASCII FBX, .x) must not nest deeper than AK_IO_ASSIMP_MAX_DEPTH,
+ * since Assimp's readers recurse per level. One streaming pass; binary FBX is not scanned. */
+static ak_result precheck(FILE* f, const char* path, const ak_io_desc* desc, ak_diag* diag) {
+    long end = -1;
+    if (fseek(f, 0, SEEK_END) == 0) end = ftell(f);
+    if (end < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        akp_diag_set(diag, path, "cannot determine the file size (not a regular file?)");
+        return AK_ERR_IO;
+    }
+    akp_budget b = akp_io_budget(desc, (size_t)end);
+    if (!akp_budget_take(&b, (size_t)end, AK_IO_BUDGET_INPUT_FACTOR)) {
+        akp_diag_set(diag, path, "%ld bytes: %u x the file size exceeds the memory budget of %zu bytes", end,
+                     AK_IO_BUDGET_INPUT_FACTOR, b.limit);
+        return AK_ERR_UNSUPPORTED;
+    }
+    static const char fbx_binary[] = "Kaydara FBX Binary";
+    char buf[65536];
+    size_t got, total = 0;
+    long depth = 0, max_depth = 0;
+    int prev = 0;
+    bool in_string = false;
+    while ((got = fread(buf, 1, sizeof buf, f)) > 0) {
+        if (total == 0 && got >= sizeof fbx_binary - 1 && memcmp(buf, fbx_binary, sizeof fbx_binary - 1) == 0) break;
+        for (size_t i = 0; i < got; ++i) {
+            int ch = (unsigned char)buf[i];
+            if (ch == '"') in_string = !in_string;
+            else if (ch == '\n') in_string = false;
+            if (in_string) {
+                prev = ch;
+                continue;
+            }
+            /* an element opens at '<' + name, closes at "</" or "/>"; a brace block at '{' */
+            if (ch == '{' || (prev == '<' && (isalpha(ch) || ch == '_'))) ++depth;
+            else if (ch == '}' || (prev == '<' && ch == '/') || (prev == '/' && ch == '>')) --depth;
+            if (depth > max_depth) max_depth = depth;
+            if (max_depth > (long)AK_IO_ASSIMP_MAX_DEPTH) {
+                akp_diag_set(diag, path, "nested deeper than %u levels near byte %zu (AK_IO_ASSIMP_MAX_DEPTH)",
+                             AK_IO_ASSIMP_MAX_DEPTH, total + i);
+                return AK_ERR_UNSUPPORTED;
+            }
+            prev = ch;
+        }
+        total += got;
+    }
+    return AK_OK;
+}
+
 /* ---- the reader ------------------------------------------------------------------------ */
 
 ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
@@ -445,7 +494,9 @@ ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_
         akp_diag_set(diag, path, "cannot open file");
         return AK_ERR_IO;
     }
+    ak_result pr = precheck(f, path, desc, diag);
     fclose(f);
+    if (pr != AK_OK) return pr;
     const struct aiScene* ai = aiImportFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
     if (!ai) {
         akp_diag_set(diag, path, "Assimp: %s", aiGetErrorString());

@@ -1,8 +1,13 @@
 /* glTF 2.0 reader (.gltf and .glb) on cJSON, following the specification's rules for
  * buffers, accessors (byteStride, sparse, normalized integers, matrix column padding),
  * nodes, meshes, skins and animations. Every failure names the file and the element. */
+#ifndef _XOPEN_SOURCE
+#define _XOPEN_SOURCE 700 /* realpath */
+#endif
 #include <cjson/cJSON.h> /* Debian libcjson-dev; see io.h for why glTF does not use Assimp */
+#include <limits.h>
 #include <stdarg.h>
+#include <stdlib.h>
 
 #include "io_internal.h"
 
@@ -65,6 +70,7 @@ typedef struct gl_ctx {
     int32_t* node_parent;    /* [n_nodes] */
     size_t* morph_base;      /* [scene mesh count] first morph weight index */
     ak_scene* scene;
+    akp_budget budget;
 } gl_ctx;
 
 /* ---- static helpers: errors and JSON --------------------------------------------------- */
@@ -92,6 +98,15 @@ static void warn(gl_ctx* c, const char* msg) {
 }
 
 #define NO_LIMIT ((size_t)-1)
+
+/* Charge n elements of size bytes to the load's memory budget before allocating them. */
+static ak_result charge(gl_ctx* c, size_t n, size_t size, const char* what) {
+    if (akp_budget_take(&c->budget, n, size)) return AK_OK;
+    return fail(c, AK_ERR_UNSUPPORTED,
+                "%s: %zu x %zu bytes would exceed the memory budget of %zu bytes (%zu already used; "
+                "ak_io_desc.memory_budget)",
+                what, n, size, c->budget.limit, c->budget.used);
+}
 
 #define TRY(expr)                                                                          \
     do {                                                                                   \
@@ -208,6 +223,9 @@ static ak_result b64_decode(gl_ctx* c, const char* s, size_t n, size_t bi, uint8
     while (n > 0 && s[n - 1] == '=') --n;
     if (n % 4 == 1) return fail(c, AK_ERR_PARSE, "buffers[%zu]: base64 data has a bad length", bi);
     size_t size = n / 4 * 3 + (n % 4 ? n % 4 - 1 : 0);
+    char what[64];
+    snprintf(what, sizeof what, "buffers[%zu]", bi);
+    TRY(charge(c, size + 1, 1, what));
     uint8_t* d = (uint8_t*)akp_alloc(c->alloc, size + 1);
     if (!d) return fail(c, AK_ERR_NO_MEMORY, "buffers[%zu]: out of memory decoding %zu bytes", bi, size);
     uint32_t acc = 0;
@@ -238,6 +256,43 @@ static int hex_value(char ch) {
     return -1;
 }
 
+/* Is the resolved path p inside directory root (both canonical)? */
+static bool path_inside(const char* p, const char* root) {
+    size_t n = strlen(root);
+    if (n == 1 && root[0] == '/') return p[0] == '/';
+    return strncmp(p, root, n) == 0 && (p[n] == '/' || p[n] == 0);
+}
+
+/* An external URI -> a canonical path (percent-decoded, relative to base_dir, "..", "." and
+ * symlinks resolved by realpath) that must lie inside base_dir or one of desc->extra_roots
+ * unless desc->allow_any_path. */
+static ak_result resolve_uri(gl_ctx* c, const char* uri, const char* where, char out[PATH_MAX]) {
+    char path[PATH_MAX];
+    int n = snprintf(path, sizeof path, "%s/", c->base_dir);
+    size_t o = (size_t)(n > 0 ? n : 0);
+    for (const char* p = uri; *p; ++p) {
+        char ch = *p;
+        if (*p == '%' && hex_value(p[1]) >= 0 && hex_value(p[2]) >= 0) {
+            ch = (char)(hex_value(p[1]) * 16 + hex_value(p[2]));
+            p += 2;
+        }
+        if (ch == 0) return fail(c, AK_ERR_IO, "%s: uri '%.200s' decodes to a NUL byte", where, uri);
+        if (o + 1 >= sizeof path) return fail(c, AK_ERR_IO, "%s: uri '%.200s' is too long", where, uri);
+        path[o++] = ch;
+    }
+    path[o] = 0;
+    if (!realpath(path, out)) return fail(c, AK_ERR_IO, "%s: uri '%.200s': cannot open '%s'", where, uri, path);
+    if (c->desc->allow_any_path) return AK_OK;
+    char root[PATH_MAX];
+    if (realpath(c->base_dir, root) && path_inside(out, root)) return AK_OK;
+    for (size_t i = 0; c->desc->extra_roots && i < c->desc->extra_root_count; ++i)
+        if (c->desc->extra_roots[i] && realpath(c->desc->extra_roots[i], root) && path_inside(out, root)) return AK_OK;
+    return fail(c, AK_ERR_IO,
+                "%s: uri '%.200s' resolves to '%s', outside the model's directory (allow it with "
+                "ak_io_desc.extra_roots or allow_any_path)",
+                where, uri, out);
+}
+
 static ak_result load_buffer(gl_ctx* c, size_t bi) {
     const cJSON* b = c->t_buffers.items[bi];
     char where[160];
@@ -263,21 +318,11 @@ static ak_result load_buffer(gl_ctx* c, size_t bi) {
         } else {
             if (!c->base_dir)
                 return fail(c, AK_ERR_IO, "%s: external buffer '%.200s' needs a base directory", where, uri);
-            char path[1024];
-            int n = snprintf(path, sizeof path, "%s/", c->base_dir);
-            size_t o = (size_t)(n > 0 ? n : 0);
-            for (const char* p = uri; *p && o + 1 < sizeof path; ++p) {
-                if (*p == '%' && hex_value(p[1]) >= 0 && hex_value(p[2]) >= 0) {
-                    path[o++] = (char)(hex_value(p[1]) * 16 + hex_value(p[2]));
-                    p += 2;
-                } else {
-                    path[o++] = *p;
-                }
-            }
-            path[o] = 0;
+            char path[PATH_MAX];
+            TRY(resolve_uri(c, uri, where, path));
             ak_diag sub;
-            ak_result r = akp_io_read_file(path, c->alloc, &gb->owned, &gb->size, &sub);
-            if (r != AK_OK) return fail(c, r, "%s: %s '%s'", where, sub.message, path);
+            ak_result r = akp_io_read_file(path, c->alloc, len, &c->budget, &gb->owned, &gb->size, &sub);
+            if (r != AK_OK) return fail(c, r, "%s: uri '%.200s': %s '%s'", where, uri, sub.message, path);
         }
         gb->data = gb->owned;
     }
@@ -464,6 +509,10 @@ static void load_element(const gl_acc* a, const uint8_t* elem, double* out) {
 static ak_result read_accessor(gl_ctx* c, size_t ai, gl_acc* a, double** out) {
     *out = NULL;
     TRY(resolve_accessor(c, ai, a));
+    char what[64];
+    snprintf(what, sizeof what, "accessors[%zu]", ai);
+    /* count * comps doubles now, then as many floats or u32 in the caller's copy */
+    TRY(charge(c, a->count * a->comps, sizeof(double) + sizeof(float), what));
     double* d = (double*)akp_alloc(c->alloc, a->count * a->comps * sizeof(double));
     if (!d) return fail(c, AK_ERR_NO_MEMORY, "accessors[%zu]: out of memory for %zu elements", ai, a->count);
     for (size_t i = 0; i < a->count; ++i) {
@@ -867,6 +916,7 @@ static ak_result read_primitive(gl_ctx* c, const cJSON* prim, const char* where,
     }
     if (ja[0] >= 0) {
         p->infl = ja[1] >= 0 ? 8 : 4;
+        TRY(charge(c, nv * p->infl, sizeof(uint16_t) + sizeof(float), where));
         p->joints = (uint16_t*)akp_calloc(c->alloc, nv * p->infl * sizeof(uint16_t));
         p->weights = (float*)akp_calloc(c->alloc, nv * p->infl * sizeof(float));
         if (!p->joints || !p->weights) return fail(c, AK_ERR_NO_MEMORY, "%s: out of memory", where);
@@ -932,6 +982,11 @@ static ak_result read_primitive(gl_ctx* c, const cJSON* prim, const char* where,
     }
     p->idx_count = tris * 3;
     if (tris) {
+        ak_result cr = charge(c, p->idx_count, sizeof(uint32_t), where);
+        if (cr != AK_OK) {
+            akp_free(c->alloc, src);
+            return cr;
+        }
         p->idx = (uint32_t*)akp_alloc(c->alloc, p->idx_count * sizeof(uint32_t));
         if (!p->idx) {
             akp_free(c->alloc, src);
@@ -959,6 +1014,7 @@ static ak_result read_primitive(gl_ctx* c, const cJSON* prim, const char* where,
     cJSON* targets = NULL;
     TRY(opt_array(c, prim, "targets", where, &targets, &p->targets));
     if (p->targets) {
+        TRY(charge(c, p->targets * nv, 6 * sizeof(float), where));
         p->mpos = (float*)akp_calloc(c->alloc, p->targets * nv * 3 * sizeof(float));
         p->mnrm = (float*)akp_calloc(c->alloc, p->targets * nv * 3 * sizeof(float));
         if (!p->mpos || !p->mnrm) return fail(c, AK_ERR_NO_MEMORY, "%s: out of memory for morph targets", where);
@@ -997,6 +1053,11 @@ static ak_result make_mesh(gl_ctx* c, prim_data* p, const char* name, const cJSO
         .has_morph_normals = p->has_mnrm,
         .name = name,
     };
+    /* every instance is a full copy: charge what ak_mesh_create will allocate */
+    size_t per_vertex = sizeof(ak_vec3) * (2 + 2 * p->targets) + sizeof(ak_vec2) + sizeof(ak_vec4) +
+                        d.influence_count * (sizeof(uint16_t) + sizeof(float));
+    TRY(charge(c, p->vertex_count, per_vertex, where));
+    TRY(charge(c, p->idx_count, sizeof(uint32_t), where));
     ak_mesh* m = NULL;
     ak_result r = ak_mesh_create(&d, c->alloc, &m);
     if (r != AK_OK) return fail(c, r, "%s: cannot create a mesh of %zu vertices", where, p->vertex_count);
@@ -1175,6 +1236,8 @@ static ak_result read_sampler(gl_ctx* c, const cJSON* s, const char* where, samp
     snprintf(what, sizeof what, "%s input", where);
     TRY(read_floats(c, in, what, scalar, &sd->times, &acc));
     sd->keys = acc.count;
+    if (sd->keys && sd->times[0] < 0.0f) /* glTF: times are >= 0; rejected like decreasing times */
+        return fail(c, AK_ERR_UNSORTED, "%s: input time 0 (%g) is negative", where, (double)sd->times[0]);
     for (size_t k = 1; k < sd->keys; ++k)
         if (!(sd->times[k] > sd->times[k - 1]))
             return fail(c, AK_ERR_UNSORTED, "%s: input time %zu (%g) is not after time %zu (%g)", where, k,
@@ -1271,6 +1334,11 @@ static ak_result load_animation(gl_ctx* c, const cJSON* an, size_t ai, ak_raw_ch
             if (target == AK_CHANNEL_MORPH_WEIGHTS &&
                 !(scene->meshes[m].node == c->joint_of_node[node] && scene->meshes[m].mesh->morph_target_count))
                 continue;
+            /* ak_clip_build copies the keys for every channel, also when many channels share
+             * one sampler: charge each copy (times and values, twice for the build's work) */
+            r = charge(c, s->keys, 2 * sizeof(float) * (1 + (size_t)comps * (s->interp == AK_INTERP_CUBICSPLINE ? 3 : 1)),
+                       cw);
+            if (r != AK_OK) break;
             if (out == *chan_cap) {
                 size_t cap = *chan_cap ? *chan_cap * 2 : 16;
                 ak_raw_channel* nc2 = (ak_raw_channel*)akp_alloc(c->alloc, cap * sizeof(ak_raw_channel));
@@ -1328,11 +1396,30 @@ static ak_result load_animation(gl_ctx* c, const cJSON* an, size_t ai, ak_raw_ch
 static ak_result load_document(gl_ctx* c, const uint8_t* data, size_t size) {
     const char* json = (const char*)data;
     size_t json_size = size;
-    if (size >= 4 && memcmp(data, "glTF", 4) == 0) TRY(parse_glb(c, data, size, &json, &json_size));
+    if (size >= 4 && memcmp(data, "glTF", 4) == 0) {
+        TRY(parse_glb(c, data, size, &json, &json_size));
+    } else {
+        /* A .glb that is not one (empty, random bytes): say so rather than "invalid JSON". A
+         * .glb holding JSON text is still read as JSON. */
+        size_t nl = strlen(c->name), i = 0;
+        bool glb_name = nl >= 4 && (strcmp(c->name + nl - 4, ".glb") == 0 || strcmp(c->name + nl - 4, ".GLB") == 0);
+        while (i < size && (data[i] == ' ' || data[i] == '\t' || data[i] == '\r' || data[i] == '\n')) ++i;
+        bool json_like = i < size && data[i] == '{';
+        if (size >= i + 3 && data[i] == 0xEF && data[i + 1] == 0xBB && data[i + 2] == 0xBF) json_like = true;
+        if (glb_name && !json_like)
+            return fail(c, AK_ERR_PARSE, "not a GLB (bad magic: the file does not start with \"glTF\"%s)",
+                        size == 0 ? "; it is empty" : "");
+    }
     if (json_size >= 3 && (uint8_t)json[0] == 0xEF && (uint8_t)json[1] == 0xBB && (uint8_t)json[2] == 0xBF) {
         json += 3; /* UTF-8 byte order mark */
         json_size -= 3;
     }
+    /* cJSON makes one node per value: at most one per ',', '[', '{' plus one, each with its
+     * own copy of strings and keys (bounded by the text) */
+    size_t values = 1;
+    for (size_t i = 0; i < json_size; ++i) values += json[i] == ',' || json[i] == '[' || json[i] == '{';
+    TRY(charge(c, values, sizeof(cJSON), "the JSON tree"));
+    TRY(charge(c, json_size, 1, "the JSON strings"));
     const char* end = NULL;
     c->root = cJSON_ParseWithLengthOpts(json, json_size, &end, 0);
     if (!c->root) {
@@ -1387,6 +1474,7 @@ ak_result akp_io_load_gltf(const uint8_t* data, size_t size, const char* name, c
     c.name = name;
     c.base_dir = base_dir;
     c.diag = diag;
+    c.budget = akp_io_budget(desc, size);
     ak_result r = load_document(&c, data, size);
     for (size_t i = 0; c.bufs && i < c.n_buffers; ++i) akp_free(alloc, c.bufs[i].owned);
     akp_free(alloc, c.bufs);

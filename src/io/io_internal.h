@@ -13,9 +13,25 @@
  * absurd counts in corrupt files. */
 #define AKP_IO_MAX_ELEMENTS (1u << 26)
 
-/* Read a whole file through alloc. Returns AK_ERR_IO (diag names the file) or AK_ERR_NO_MEMORY. */
-ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, uint8_t** out_data, size_t* out_size,
-                           ak_diag* diag);
+/* Memory budget of one load: every large allocation is charged before it is made. */
+typedef struct akp_budget {
+    size_t limit, used;
+} akp_budget;
+
+/* The budget of a load whose input is input_size bytes: desc->memory_budget, or when 0
+ * the larger of AK_IO_DEFAULT_BUDGET and AK_IO_BUDGET_INPUT_FACTOR x input_size. */
+akp_budget akp_io_budget(const ak_io_desc* desc, size_t input_size);
+
+/* Charge n bytes (a * b, checked for overflow) to the budget. false -> over budget (nothing
+ * charged); the caller reports it as AK_ERR_UNSUPPORTED. */
+bool akp_budget_take(akp_budget* b, size_t a, size_t n);
+
+/* Read a file through alloc (a NUL byte is appended). want 0: the whole file, which must fit
+ * the budget (charged); want > 0: exactly the first want bytes (charged), and a file shorter
+ * than that is AK_ERR_PARSE. Returns AK_ERR_IO (diag names the file), AK_ERR_UNSUPPORTED
+ * (over budget), AK_ERR_NO_MEMORY. */
+ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, size_t want, akp_budget* budget,
+                           uint8_t** out_data, size_t* out_size, ak_diag* diag);
 
 /* Nodes of a file in file order: name (NULL or "" -> "node_<i>"), parent (-1 root, any order),
  * rest transform, optional inverse bind. Builds scene->skeleton (parents first, unique names:
@@ -45,6 +61,9 @@ void akp_io_copy_name(char dst[AK_NAME_SIZE], const char* src);
 
 ak_result akp_io_load_gltf(const uint8_t* data, size_t size, const char* name, const char* base_dir,
                            const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene, ak_diag* diag);
+/* BVH from a file (streamed, path != NULL) or from memory (data, size). */
+ak_result akp_io_load_bvh(const char* path, const uint8_t* data, size_t size, const char* name,
+                          const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene, ak_diag* diag);
 ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
                              ak_scene** out_scene, ak_diag* diag);
 

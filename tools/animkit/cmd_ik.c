@@ -12,14 +12,19 @@ static const char* const usage =
     "                  [--clip C --time T] [--json] [-o OUT.obj|OUT.png]\n"
     "Solve on the model's pose (bind pose, or clip C at time T) so JOINT reaches the world-space\n"
     "target, honouring joint types and limits. Prints reached, error, iterations and time.\n"
-    "  --root       first joint of the chain (default: the effector's grandparent for twobone,\n"
-    "               else the topmost ancestor)\n"
+    "  --root       first joint of the chain. Default: the effector's grandparent for twobone;\n"
+    "               else the limb: up from the effector through skin joints (every node when\n"
+    "               no skin), stopping below the first joint with several child joints (the\n"
+    "               chest for an arm, the pelvis for a leg) or at the topmost joint; plain\n"
+    "               nodes above the skeleton (e.g. a Z_UP node) never join. The chain used\n"
+    "               is printed\n"
     "  --solver     default fabrik\n"
     "  --iterations iteration budget (default 50)\n"
     "  --tolerance  distance counted as reached, model units (default 1e-4 x chain length)\n"
     "  --json       one JSON object: reached, error, iterations, time_ms, solver, joints (the\n"
     "               chain root..effector after solving: [{name, position [x,y,z]}]) and\n"
-    "               initial (the same chain before solving)\n"
+    "               initial (the same chain before solving). Numbers are finite; a value that\n"
+    "               is not (NaN, infinity) is written null\n"
     "  -o           write the posed meshes (.obj) or a rendered image of the chain and target (.png)\n";
 
 static int find_joint(const ak_scene* s, const char* name) {
@@ -31,9 +36,42 @@ static void print_chain_json(const ak_scene* s, const int16_t* chain, const ak_v
     for (size_t i = 0; i < n; ++i) {
         printf(i ? ", {\"name\": " : "{\"name\": ");
         cli_json_string(stdout, ak_skeleton_joint_name(s->skeleton, (size_t)chain[i]));
-        printf(", \"position\": [%.9g, %.9g, %.9g]}", (double)pos[i].x, (double)pos[i].y, (double)pos[i].z);
+        printf(", \"position\": [");
+        cli_json_write_number(stdout, (double)pos[i].x);
+        printf(", ");
+        cli_json_write_number(stdout, (double)pos[i].y);
+        printf(", ");
+        cli_json_write_number(stdout, (double)pos[i].z);
+        printf("]}");
     }
     printf("]");
+}
+
+static bool is_joint(const ak_scene* s, bool all, int j) { return all || !s->is_joint || s->is_joint[j]; }
+
+/* The default chain root for the iterative solvers: the limb the effector ends. Walk up from
+ * the effector through joints (nodes a skin uses), stopping below the first ancestor with
+ * more than one child joint (the chest for an arm, the pelvis for a leg) once the chain has
+ * two joints, and at the topmost joint. Plain nodes above the skeleton never join (unless
+ * the effector is itself a plain node: then every node counts as a joint). */
+static int default_root(const ak_scene* s, int eff) {
+    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    const bool all = !is_joint(s, false, eff); /* an effector no skin uses: every node counts */
+    size_t size = 1;
+    int root = eff;
+    for (;;) {
+        const int p = parents.ptr[root];
+        if (p < 0 || !is_joint(s, all, p)) break;
+        if (size >= 2) {
+            size_t kids = 0;
+            for (size_t j = (size_t)p + 1; j < parents.count && kids < 2; ++j)
+                if (parents.ptr[j] == p && is_joint(s, all, (int)j)) ++kids;
+            if (kids > 1) break;
+        }
+        root = p;
+        ++size;
+    }
+    return root;
 }
 
 
@@ -57,10 +95,10 @@ int cmd_ik(int argc, char** argv) {
     if (!CLI_GET(&a, "--target")) return cli_usage("ik", "missing --target X,Y,Z");
     if (!cli_parse_vec3(CLI_GET(&a, "--target"), &target))
         return cli_usage("ik", "--target '%s' is not three numbers X,Y,Z", CLI_GET(&a, "--target"));
-    /* The solvers work in float: beyond this a squared distance overflows to inf (and so
-     * would the printed error), and nothing in a scene is that far anyway. */
-    if (!(fabsf(target.x) <= 1e9f && fabsf(target.y) <= 1e9f && fabsf(target.z) <= 1e9f))
-        return cli_usage("ik", "--target '%s' is outside +-1e9", CLI_GET(&a, "--target"));
+    /* The library solves at any scale and reports the error in double, saturated at FLT_MAX
+     * (3.4e38): within +-1e37 every distance to the model is far below that. */
+    if (!(fabsf(target.x) <= 1e37f && fabsf(target.y) <= 1e37f && fabsf(target.z) <= 1e37f))
+        return cli_usage("ik", "--target '%s' is outside +-1e37", CLI_GET(&a, "--target"));
     ak_ik_solver solver = AK_IK_SOLVER_FABRIK;
     if (CLI_GET(&a, "--solver") && ak_ik_solver_parse(CLI_GET(&a, "--solver"), &solver) != AK_OK)
         return cli_usage("ik", "--solver must be ccd, fabrik, twobone or dls, not '%s'", CLI_GET(&a, "--solver"));
@@ -101,14 +139,13 @@ int cmd_ik(int argc, char** argv) {
         root = eff;
         for (int k = 0; k < 2 && parents.ptr[root] >= 0; ++k) root = parents.ptr[root];
     } else {
-        root = eff;
-        while (parents.ptr[root] >= 0) root = parents.ptr[root];
+        root = default_root(s, eff);
     }
     int clip = -1;
     if (CLI_GET(&a, "--clip")) {
         clip = ak_scene_find_clip(s, CLI_GET(&a, "--clip"));
         if (clip < 0) {
-            rc = cli_fail("ik", "%s: no clip '%s' (%zu clips)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count);
+            rc = cli_fail("ik", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count, s->clip_count == 1 ? "" : "s");
             goto done;
         }
     }
@@ -155,20 +192,25 @@ int cmd_ik(int argc, char** argv) {
         goto done;
     }
     if (json) {
-        printf("{\"reached\": %s, \"error\": %.9g, \"iterations\": %zu, \"time_ms\": %.6f, \"solver\": \"%s\", "
-               "\"joints\": ",
-               reached ? "true" : "false", (double)error, used, elapsed * 1e3, ak_ik_solver_name(solver));
+        printf("{\"reached\": %s, \"error\": ", reached ? "true" : "false");
+        cli_json_write_number(stdout, (double)error);
+        printf(", \"iterations\": %zu, \"time_ms\": ", used);
+        cli_json_write_number(stdout, elapsed * 1e3);
+        printf(", \"solver\": \"%s\", \"joints\": ", ak_ik_solver_name(solver));
         print_chain_json(s, chain, after, chain_count);
         printf(", \"initial\": ");
         print_chain_json(s, chain, before, chain_count);
         printf("}\n");
     } else {
-        printf("solver %s, chain %s .. %s (%zu joints)\n", ak_ik_solver_name(solver),
-               ak_skeleton_joint_name(s->skeleton, (size_t)root), eff_name, chain_count);
+        printf("solver %s, chain (%zu joint%s%s):", ak_ik_solver_name(solver), chain_count, chain_count == 1 ? "" : "s",
+               CLI_GET(&a, "--root") ? "" : ", default root; --root to change");
+        for (size_t i = 0; i < chain_count; ++i)
+            printf("%s %s", i ? " ->" : "", ak_skeleton_joint_name(s->skeleton, (size_t)chain[i]));
+        printf("\n");
         printf("reached %s, error %.6g, iterations %zu, time %.3f ms\n", reached ? "yes" : "no", (double)error, used,
                elapsed * 1e3);
         for (size_t i = 0; i < chain_count; ++i)
-            printf("  %-20s (%9.5f %9.5f %9.5f) -> (%9.5f %9.5f %9.5f)\n",
+            printf("  %-20s (%9.5g %9.5g %9.5g) -> (%9.5g %9.5g %9.5g)\n",
                    ak_skeleton_joint_name(s->skeleton, (size_t)chain[i]), (double)before[i].x, (double)before[i].y,
                    (double)before[i].z, (double)after[i].x, (double)after[i].y, (double)after[i].z);
     }

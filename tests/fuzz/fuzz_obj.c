@@ -1,0 +1,41 @@
+/* libFuzzer target for the OBJ path (ak_io_load -> the Assimp pre-checks -> Assimp's OBJ
+ * importer -> animkit's conversion); built and run by scripts/fuzz.sh.
+ *
+ * Assimp reads files only, so each input is written to one temporary .obj file (in $TMPDIR or
+ * /tmp, removed at exit) and loaded from there. Assimp is not built with the sanitizers, so
+ * this finds crashes in it but not its silent memory errors; its one known leak on failed
+ * imports is suppressed through tests/fuzz/lsan.supp. A loaded scene's meshes must validate. */
+#include <animkit/io.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
+
+static char g_path[4096];
+
+static void remove_tmp(void) {
+    if (g_path[0]) unlink(g_path);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    if (!g_path[0]) {
+        const char* tmp = getenv("TMPDIR");
+        snprintf(g_path, sizeof g_path, "%s/animkit_fuzz_%ld.obj", tmp && tmp[0] ? tmp : "/tmp", (long)getpid());
+        atexit(remove_tmp);
+    }
+    FILE* f = fopen(g_path, "wb");
+    if (!f) abort();
+    if (size && fwrite(data, 1, size, f) != size) abort();
+    fclose(f);
+    ak_scene* scene = NULL;
+    ak_diag diag;
+    ak_io_desc desc = {.format = AK_IO_FORMAT_ASSIMP, .memory_budget = 64u << 20};
+    if (ak_io_load(g_path, &desc, NULL, &scene, &diag) == AK_OK) {
+        for (size_t m = 0; m < scene->mesh_count; ++m)
+            if (ak_mesh_validate(scene->meshes[m].mesh, NULL) != AK_OK) abort();
+    }
+    ak_scene_destroy(scene);
+    return 0;
+}
