@@ -1,5 +1,5 @@
 /* libFuzzer harness for the cloth scene reader (tools/animkit/scene_cloth.c) and the cloth
- * module behind it (built by scripts/fuzz.sh with the library and tools/animkit/*.c).
+ * module behind it (built by scripts/fuzz.sh with the library and the CLI sources).
  *
  * Each input is parsed as a scene file. A parsed scene must hold its documented invariants
  * (pins inside the grid, positive step); when its grid is small it is built into a cloth and
