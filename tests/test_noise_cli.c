@@ -72,7 +72,8 @@ AK_TEST(noise_bad_parameters) {
                          "noise worley 1,2,3,4", "noise perlin 1,x", "noise perlin 1e30", "noise perlin 1 --octaves 0",
                          "noise perlin 1 --octaves 17", "noise perlin 1 --gain 2.5", "noise perlin 1 --lacunarity -1",
                          "noise perlin 1 --type fractal", "noise perlin 1 --seed -3", "noise perlin 1 --seed 1x",
-                         "noise perlin 1 --bogus"};
+                         "noise perlin 1 --bogus",
+                         "noise perlin 1,,2", "noise perlin 1,", "noise perlin ,1"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) AK_CHECK_MSG(run(bad[i], true) == 2, "%s", bad[i]);
     AK_CHECK(run("noise perlin 1 --octaves 17", true) == 2 && strstr(out_buf, "allowed range 1 to 16"));
     AK_CHECK(run("noise perlin 1 --gain 3", true) == 2 && strstr(out_buf, "(0, 2]"));
