@@ -782,6 +782,10 @@ AK_TEST(render_camera_options) {
     AK_CHECK_EQ(run("render builtin:humanoid --camera 10 -o x.png", true), 2);
     AK_CHECK_EQ(run("render builtin:humanoid --camera 10,95 -o x.png", true), 2);
     AK_CHECK_EQ(run("render builtin:humanoid --camera 10,5,-1 -o x.png", true), 2);
+    /* empty items are not skipped ("0,,10" used to be yaw 0, pitch 10) */
+    AK_CHECK_EQ(run("render builtin:humanoid --camera 0,,10 -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:humanoid --camera 0,10, -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:humanoid --camera ,0,10 -o x.png", true), 2);
     AK_CHECK_EQ(run("render builtin:humanoid --fov 0 -o x.png", true), 2);
     /* a walk 20 units long: framed on the whole path the figure is small; --follow keeps it
      * large and centred at the start and at the end */
