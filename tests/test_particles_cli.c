@@ -80,6 +80,9 @@ AK_TEST(bad_scenes_exit_1_with_path) {
     AK_CHECK_EQ(run("particles --preset rain --integrator midpoint"), 2);
     AK_CHECK_EQ(run("particles --preset rain --dt -1"), 2);
     AK_CHECK_EQ(run("particles --preset rain -o out.bmp"), 2);
+    /* out-of-range flags name the allowed range */
+    AK_CHECK(run("particles --preset rain --steps 100000001") == 2 && strstr(out_buf, "0..100000000"));
+    AK_CHECK(run("particles --preset rain --size 100000x100000 -o big.png") == 2 && strstr(out_buf, "8..8192"));
     AK_CHECK_EQ(run("particles --help"), 0);
     AK_CHECK(strstr(out_buf, "usage: animkit particles") != NULL);
 }

@@ -16,7 +16,7 @@ static const char* const usage =
     "Simulate a particle system (docs/particles.md describes the scene format).\n"
     "  --preset     a built-in scene instead of a file (character: rain and sparks on the walking\n"
     "               builtin:humanoid, which the particles collide with)\n"
-    "  --steps      steps to run (default 200)\n"
+    "  --steps      steps to run, 0 to 100000000 (default 200)\n"
     "  --dt         step in seconds (overrides the file; default 0.01)\n"
     "  --integrator overrides the file (default symplectic)\n"
     "  --seed       seed of the emitters' random numbers (default 1)\n"
@@ -25,7 +25,7 @@ static const char* const usage =
     "step,\n"
     "               the file's particles first, emitted ones after them\n"
     "  -o           render: a GIF of the run (up to 100 frames) or a PNG of the last step\n"
-    "  --size       image size (default 480x360)\n";
+    "  --size       image size, 8x8 to 8192x8192 (default 480x360)\n";
 
 /* ---- presets -------------------------------------------------------------------------- */
 
@@ -501,7 +501,7 @@ int cmd_particles(int argc, char** argv) {
                          preset);
     long steps = 200, seed = 1, threads = 1;
     if (CLI_GET(&a, "--steps") && !cli_parse_int(CLI_GET(&a, "--steps"), 0, 100000000, &steps))
-        return cli_usage("particles", "--steps '%s' is not a whole number >= 0",
+        return cli_usage("particles", "--steps '%s' is not a whole number in 0..100000000",
                          CLI_GET(&a, "--steps"));
     if (CLI_GET(&a, "--seed") && !cli_parse_int(CLI_GET(&a, "--seed"), 0, 2147483647L, &seed))
         return cli_usage("particles", "--seed '%s' is not a whole number >= 0",
@@ -534,7 +534,7 @@ int cmd_particles(int argc, char** argv) {
         return cli_usage("particles", "output '%s' must end in .gif or .png", out);
     int width = 480, height = 360;
     if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &width, &height))
-        return cli_usage("particles", "--size '%s' is not WxH", CLI_GET(&a, "--size"));
+        return cli_usage("particles", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
     const char* json = CLI_GET(&a, "--json");
 
     particles_scene scene;
