@@ -166,6 +166,21 @@ AK_TEST(springs_survive_a_death) {
     remove("particles_die.json"), remove("die.json"), remove("particles_bursts.json"), remove("bursts.json");
 }
 
+/* One red particle alone is framed with room around it (zero-size bounds put the camera on
+ * it: the image showed only the ground); the title says "1 particle". */
+AK_TEST(single_particle_is_framed) {
+    write_file("particles_one.json", "{\"particles\": [{\"m\": 0, \"p\": [0, 5, 0], \"colour\": [1, 0, 0, 1]}]}");
+    AK_CHECK_EQ(run("particles particles_one.json --steps 0 --size 160x120 -o one.png"), 0);
+    int w = 0, h = 0, red = 0;
+    AK_CHECK(ak_png_info("one.png", &w, &h) == AK_OK && w == 160 && h == 120);
+    static uint8_t px[160 * 120 * 4];
+    const ak_image img = {.pixels = px, .width = 160, .height = 120};
+    AK_CHECK(ak_png_read("one.png", &img) == AK_OK);
+    for (int i = 0; i < 160 * 120; ++i) red += px[4 * i] > 150 && px[4 * i + 1] < 80 && px[4 * i + 2] < 80;
+    AK_CHECK_MSG(red >= 4, "%d red pixels", red);
+    remove("particles_one.json"), remove("one.png");
+}
+
 AK_TEST(presets_run_and_render) {
     const char* presets[] = {"fountain", "rain", "fireworks", "character"};
     for (int k = 0; k < 4; ++k) {
@@ -204,6 +219,7 @@ int main(void) {
     AK_RUN(bad_scenes_exit_1_with_path);
     AK_RUN(json_matches_closed_form);
     AK_RUN(springs_survive_a_death);
+    AK_RUN(single_particle_is_framed);
     AK_RUN(presets_run_and_render);
     return ak_test_finish();
 }

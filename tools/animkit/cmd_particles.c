@@ -451,8 +451,8 @@ static int render_frame(renderer* rd, run* r, const ak_image* out) {
         res = ak_raster_draw_points(ras, &f->camera, &pts);
     }
     char title[160];
-    snprintf(title, sizeof title, "%s  t=%.2fs  %zu particles", rd->title, ak_particles_time(r->ps),
-             st.count);
+    snprintf(title, sizeof title, "%s  t=%.2fs  %zu particle%s", rd->title, ak_particles_time(r->ps),
+             st.count, cli_plural(st.count));
     if (res == AK_OK)
         res = ak_raster_draw_text(ras, 10, 10, title, f->height >= 300 ? 2 : 1,
                                   ak_vec4_make(0.08f, 0.09f, 0.12f, 1));
@@ -609,6 +609,11 @@ int cmd_particles(int argc, char** argv) {
         run_free(&r);
         memset(&r, 0, sizeof r);
         if (!(lo.x <= hi.x)) lo = ak_vec3_splat(-1), hi = ak_vec3_splat(1);
+        /* at least 1 m on every axis: a single particle (or a flat sheet) framed at its own
+         * zero size put the camera on top of it, showing nothing but the ground */
+        const ak_vec3 mid = ak_vec3_scale(ak_vec3_add(lo, hi), 0.5f);
+        lo = ak_vec3_min(lo, ak_vec3_sub(mid, ak_vec3_splat(0.5f)));
+        hi = ak_vec3_max(hi, ak_vec3_add(mid, ak_vec3_splat(0.5f)));
         rd.ground = lo.y;
         for (size_t k = 0; k < scene.world.planes.count; ++k) {
             ak_vec3 n = ak_vec3_normalize(scene.world.planes.ptr[k].normal);
