@@ -3,7 +3,9 @@
 #include "io/io_internal.h"
 
 #include <ctype.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* ---- static helpers ------------------------------------------------------------------ */
 
@@ -71,16 +73,25 @@ ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, size_t w
                            uint8_t** out_data, size_t* out_size, ak_diag* diag) {
     *out_data = NULL;
     *out_size = 0;
-    FILE* f = fopen(path, "rb");
-    if (!f) {
+    /* opened non-blocking and checked before reading: a FIFO (e.g. a glTF buffer uri naming
+     * one in the model's folder) would otherwise block the load forever in fopen; fopen also
+     * succeeds on a directory on Linux, and ftell then reports LONG_MAX */
+    const int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st;
+    memset(&st, 0, sizeof st);
+    if (fd < 0) {
         akp_diag_set(diag, path, "cannot open file");
         return AK_ERR_IO;
     }
-    /* fopen succeeds on a directory on Linux, and ftell then reports LONG_MAX */
-    struct stat st;
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-        fclose(f);
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
         akp_diag_set(diag, path, "%s", S_ISDIR(st.st_mode) ? "is a directory, not a file" : "not a regular file");
+        return AK_ERR_IO;
+    }
+    FILE* f = fdopen(fd, "rb");
+    if (!f) {
+        close(fd);
+        akp_diag_set(diag, path, "cannot open file");
         return AK_ERR_IO;
     }
     long end = -1;

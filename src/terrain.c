@@ -193,8 +193,11 @@ ak_result ak_terrain_erode(const ak_terrain_erosion* erosion, const ak_terrain_d
         !pos_finite(e.capacity) || e.capacity > 1e3f || !pos_finite(e.min_slope) || !pos_finite(e.talus) ||
         e.max_steps > 4096 || e.radius > 8 || e.droplets > 100000000u || e.thermal_iterations > 100000u)
         return AK_ERR_BAD_ARG;
-    for (size_t i = 0; i < n; ++i)
+    float base = heights.ptr[0]; /* the base level: no cell is eroded below the lowest start height */
+    for (size_t i = 0; i < n; ++i) {
         if (!isfinite(heights.ptr[i])) return AK_ERR_BAD_DATA;
+        base = fminf(base, heights.ptr[i]);
+    }
     float* hm = heights.ptr;
     const uint32_t w = d.width, hgt = d.height;
     const float c = cell_size(&d), inv_c = 1.0f / c;
@@ -239,9 +242,12 @@ ak_result ak_terrain_erode(const ak_terrain_erosion* erosion, const ak_terrain_d
             dirx /= len;
             dirz /= len;
             const float nx = px + dirx, nz = pz + dirz;
-            const bool inside = nx >= 0.0f && nz >= 0.0f && nx < (float)(w - 1) && nz < (float)(hgt - 1);
+            /* a droplet leaving the grid stops without eroding (Beyer 2015): eroding towards an
+             * edge assumed lower dug the border cells without bound (-868 m after 10^6 droplets
+             * on a +-9 m terrain) */
+            if (!(nx >= 0.0f && nz >= 0.0f && nx < (float)(w - 1) && nz < (float)(hgt - 1))) break;
             float tx, tz;
-            const float h1 = inside ? bilinear(hm, w, nx, nz, &tx, &tz) * inv_c : h0 - e.min_slope;
+            const float h1 = bilinear(hm, w, nx, nz, &tx, &tz) * inv_c;
             const float dh = h1 - h0;
             const float cap = fmaxf(-dh, e.min_slope) * speed * water * e.capacity;
             const size_t a = (size_t)cj * w + ci;
@@ -255,14 +261,27 @@ ak_result ak_terrain_erode(const ak_terrain_erosion* erosion, const ak_terrain_d
                 hm[a + w + 1] += m * u * v;
             } else {
                 const float take = fminf((cap - sediment) * e.erosion, -dh);
+                /* the brush's weights renormalised over the cells inside the grid, and the
+                 * sediment picked up is exactly the material removed (the clipped brush used
+                 * to create sediment near a border: a 3x3 grid rose to 1e23 m); no cell goes
+                 * below the base level (as Beyer's heights stay >= 0: without it, droplets
+                 * draining off the edge deepened their valleys without bound, -5e9 m) */
+                float inside_w = 0.0f;
+                for (int b = 0; b < bcount; ++b) {
+                    const int bi = (int)ci + bdx[b], bj = (int)cj + bdz[b];
+                    if (bi >= 0 && bj >= 0 && bi < (int)w && bj < (int)hgt) inside_w += bw[b];
+                }
+                float removed = 0.0f;
                 for (int b = 0; b < bcount; ++b) {
                     const int bi = (int)ci + bdx[b], bj = (int)cj + bdz[b];
                     if (bi < 0 || bj < 0 || bi >= (int)w || bj >= (int)hgt) continue;
-                    hm[(size_t)bj * w + (size_t)bi] -= take * bw[b] * c;
+                    float* cell = &hm[(size_t)bj * w + (size_t)bi];
+                    const float m = fminf(take * (bw[b] / inside_w) * c, fmaxf(*cell - base, 0.0f));
+                    *cell -= m;
+                    removed += m;
                 }
-                sediment += take;
+                sediment += removed * inv_c;
             }
-            if (!inside) break;
             speed = sqrtf(fmaxf(speed * speed - dh * gravity, 0.0f));
             water *= 1.0f - e.evaporation;
             px = nx, pz = nz;

@@ -782,6 +782,10 @@ AK_TEST(render_camera_options) {
     AK_CHECK_EQ(run("render builtin:humanoid --camera 10 -o x.png", true), 2);
     AK_CHECK_EQ(run("render builtin:humanoid --camera 10,95 -o x.png", true), 2);
     AK_CHECK_EQ(run("render builtin:humanoid --camera 10,5,-1 -o x.png", true), 2);
+    /* empty items are not skipped ("0,,10" used to be yaw 0, pitch 10) */
+    AK_CHECK_EQ(run("render builtin:humanoid --camera 0,,10 -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:humanoid --camera 0,10, -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:humanoid --camera ,0,10 -o x.png", true), 2);
     AK_CHECK_EQ(run("render builtin:humanoid --fov 0 -o x.png", true), 2);
     /* a walk 20 units long: framed on the whole path the figure is small; --follow keeps it
      * large and centred at the start and at the end */
@@ -851,6 +855,15 @@ AK_TEST(curves_select_and_paginate) {
     AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel nobody -o sel.png", true), 1);
     AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --page 0 -o sel.png", true), 2);
     AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --page 99 -o sel.png", true), 1);
+    /* chart sizes: below the plot's 120x80 minimum, or a page above 8192x8192, is bad usage
+     * (exit 2) before anything is drawn (8192x8192 charts used to allocate gigabytes) */
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --size 8x8 -o sel.png", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "120..8192") != NULL, "%s", out_buf);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --size 8192x8192 -o sel.png", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "above the 8192x8192 limit") != NULL, "%s", out_buf);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel 0 --size 4000x3000 -o sel.png", true), 0);
+    int sw = 0, sh = 0;
+    AK_CHECK(ak_png_info("sel.png", &sw, &sh) == AK_OK && sw >= 4000 && sw <= 8192 && sh >= 3000 && sh <= 8192);
     char path[1100], a[1300];
     if (!ak_test_asset(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) {
         AK_SKIP("CesiumMan.glb absent (set ANIMKIT_ASSETS)");

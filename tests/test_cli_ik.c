@@ -216,9 +216,24 @@ AK_TEST(ik_json_valid_at_extreme_scales) {
     AK_CHECK_EQ(run("ik bones_1e30.gltf --effector c --target 3e38,0,0 --json", true), 2);
 }
 
+/* --target is exactly three numbers: an empty or trailing component is bad usage, not skipped;
+ * --iterations names its range */
+AK_TEST(ik_target_and_iterations_usage) {
+    const char* bad[] = {"1,,2,3", "1,2,3,", ",1,2,3", "1,2,,", "1,2,3,4"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        char args[160];
+        snprintf(args, sizeof args, "ik builtin:humanoid --effector left_wrist --target '%s'", bad[i]);
+        AK_CHECK_MSG(run(args, true) == 2 && strstr(out_buf, "three numbers"), "%s: %s", args, out_buf);
+    }
+    AK_CHECK_EQ(run("ik builtin:humanoid --effector left_wrist --target ' 0.4, 1, 0.2'", true), 0);
+    AK_CHECK(run("ik builtin:humanoid --effector left_wrist --target 0.4,1,0.2 --iterations 2000000", true) == 2 &&
+             strstr(out_buf, "1..1000000"));
+}
+
 int main(void) {
     AK_RUN(ik_default_chain_is_the_limb);
     AK_RUN(ik_straight_arm_targets_on_its_line);
     AK_RUN(ik_json_valid_at_extreme_scales);
+    AK_RUN(ik_target_and_iterations_usage);
     return ak_test_finish();
 }

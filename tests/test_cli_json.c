@@ -88,6 +88,9 @@ AK_TEST(errors_name_file_path_and_problem) {
         {"{} x", "s.json: unexpected content after the JSON value"},
         {"", "s.json: invalid JSON at line 1, column 1"},
         {"{\"a\\nb\\u001b\": 1}", "s.json: unknown key \"a?b?\" (allowed: dt, particles, mode)"},
+        /* a NUL escape would cut the string short: "a\u0000x" read as "a", "dt\u0000" as "dt" */
+        {"{\"mode\": \"a\\u0000x\"}", "s.json: a string holds \\u0000 (NUL) at line 1, column 12"},
+        {"{\"dt\\u0000\": 0.1}", "s.json: a string holds \\u0000 (NUL) at line 1, column 5"},
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         cli_json j = {.file = "s.json"};
@@ -133,6 +136,16 @@ AK_TEST(load_checks_size_and_missing_files) {
 }
 
 /* Deep nesting ends in an error from cJSON's nesting limit, not a stack overflow. */
+/* An escaped backslash followed by "u0000" is text, not a NUL. */
+AK_TEST(escaped_backslash_is_not_a_nul) {
+    cli_json j = {.file = "s.json"};
+    cJSON* root = parse(&j, "{\"mode\": \"\\\\u0000\"}");
+    AK_CHECK(root != NULL && !j.failed);
+    const cJSON* m = cJSON_GetObjectItemCaseSensitive(root, "mode");
+    AK_CHECK(cJSON_IsString(m) && strcmp(m->valuestring, "\\u0000") == 0);
+    cJSON_Delete(root);
+}
+
 AK_TEST(deep_nesting_is_an_error) {
     enum { DEPTH = 100000 };
     static char text[2 * DEPTH + 16];
@@ -154,6 +167,7 @@ int main(void) {
     AK_RUN(errors_name_file_path_and_problem);
     AK_RUN(first_error_is_kept);
     AK_RUN(load_checks_size_and_missing_files);
+    AK_RUN(escaped_backslash_is_not_a_nul);
     AK_RUN(deep_nesting_is_an_error);
     return ak_test_finish();
 }

@@ -72,7 +72,8 @@ AK_TEST(noise_bad_parameters) {
                          "noise worley 1,2,3,4", "noise perlin 1,x", "noise perlin 1e30", "noise perlin 1 --octaves 0",
                          "noise perlin 1 --octaves 17", "noise perlin 1 --gain 2.5", "noise perlin 1 --lacunarity -1",
                          "noise perlin 1 --type fractal", "noise perlin 1 --seed -3", "noise perlin 1 --seed 1x",
-                         "noise perlin 1 --bogus"};
+                         "noise perlin 1 --bogus",
+                         "noise perlin 1,,2", "noise perlin 1,", "noise perlin ,1"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) AK_CHECK_MSG(run(bad[i], true) == 2, "%s", bad[i]);
     AK_CHECK(run("noise perlin 1 --octaves 17", true) == 2 && strstr(out_buf, "allowed range 1 to 16"));
     AK_CHECK(run("noise perlin 1 --gain 3", true) == 2 && strstr(out_buf, "(0, 2]"));
@@ -108,6 +109,32 @@ AK_TEST(terrain_files) {
     remove("cli_t.png"), remove("cli_t.obj"), remove("cli_t.gif"), remove("cli_r.png");
 }
 
+/* The shaded render frames the whole terrain: every pixel on the image's border is sky (bluish:
+ * blue well above red, where the terrain's sand, grass, rock and shaded snow are not). The
+ * near corner used to run off the bottom and left edges. */
+AK_TEST(terrain_render_framed) {
+    const char* cases[] = {"terrain --size 65x65 --render -o cli_f.png", "terrain --size 65x17 --render -o cli_f.png",
+                           "terrain --size 17x65 --height 60 --render -o cli_f.png"};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        AK_CHECK_EQ(run(cases[c], false), 0);
+        int w = 0, h = 0;
+        AK_CHECK(ak_png_info("cli_f.png", &w, &h) == AK_OK && w > 0 && h > 0);
+        uint8_t* px = malloc((size_t)w * (size_t)h * 4);
+        const ak_image img = {.pixels = px, .width = w, .height = h};
+        AK_CHECK(px && ak_png_read("cli_f.png", &img) == AK_OK);
+        int ground = 0;
+        for (int y = 0; px && y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                if (x != 0 && y != 0 && x != w - 1 && y != h - 1) continue;
+                const uint8_t* p = px + ((size_t)y * (size_t)w + (size_t)x) * 4;
+                ground += p[2] < p[0] + 15;
+            }
+        AK_CHECK_MSG(ground == 0, "%s: %d border pixels are terrain", cases[c], ground);
+        free(px);
+    }
+    remove("cli_f.png");
+}
+
 AK_TEST(terrain_bad_parameters) {
     const char* bad[] = {"terrain", "terrain -o x.txt", "terrain --size 1x5 -o x.obj", "terrain --size 5000x5 -o x.obj",
                          "terrain --world 0 -o x.obj", "terrain --height -2 -o x.obj", "terrain --noise value -o x.obj",
@@ -124,6 +151,7 @@ int main(void) {
     AK_RUN(noise_values);
     AK_RUN(noise_bad_parameters);
     AK_RUN(terrain_files);
+    AK_RUN(terrain_render_framed);
     AK_RUN(terrain_bad_parameters);
     return ak_test_finish();
 }

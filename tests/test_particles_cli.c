@@ -80,6 +80,9 @@ AK_TEST(bad_scenes_exit_1_with_path) {
     AK_CHECK_EQ(run("particles --preset rain --integrator midpoint"), 2);
     AK_CHECK_EQ(run("particles --preset rain --dt -1"), 2);
     AK_CHECK_EQ(run("particles --preset rain -o out.bmp"), 2);
+    /* out-of-range flags name the allowed range */
+    AK_CHECK(run("particles --preset rain --steps 100000001") == 2 && strstr(out_buf, "0..100000000"));
+    AK_CHECK(run("particles --preset rain --size 100000x100000 -o big.png") == 2 && strstr(out_buf, "8..8192"));
     AK_CHECK_EQ(run("particles --help"), 0);
     AK_CHECK(strstr(out_buf, "usage: animkit particles") != NULL);
 }
@@ -127,6 +130,57 @@ AK_TEST(json_matches_closed_form) {
     cJSON_Delete(j);
 }
 
+/* A file particle that dies (its lifetime) before particles joined by a spring: the spring
+ * follows the survivors to their new indices (two unit masses on a k = 100 spring released
+ * 1 m stretched: L(t) = 1 + cos(sqrt(200) t)), and the springs to the dead particle go. The
+ * step after the death used to fail with "an index is out of range". */
+AK_TEST(springs_survive_a_death) {
+    write_file("particles_die.json",
+               "{\"dt\": 0.0005, \"gravity\": [0, 0, 0],"
+               " \"particles\": [{\"p\": [1, 5, 0], \"lifetime\": 0.01}, {\"p\": [0, 0, 0]}, {\"p\": [2, 0, 0]}],"
+               " \"springs\": [{\"i\": 1, \"j\": 2, \"rest\": 1, \"k\": 100}, {\"i\": 0, \"j\": 2, \"k\": 0}]}");
+    AK_CHECK_EQ(run("particles particles_die.json --steps 400 --json die.json"), 0);
+    cJSON* j = read_json("die.json");
+    AK_CHECK(j != NULL);
+    if (!j) return;
+    const cJSON* ps = cJSON_GetObjectItem(j, "particles");
+    AK_CHECK_EQ(cJSON_GetArraySize(ps), 2);
+    if (cJSON_GetArraySize(ps) == 2) {
+        const cJSON* a = cJSON_GetObjectItem(cJSON_GetArrayItem(ps, 0), "p");
+        const cJSON* b = cJSON_GetObjectItem(cJSON_GetArrayItem(ps, 1), "p");
+        const double t = 400 * 0.0005, len = num(b, 0) - num(a, 0);
+        AK_CHECK_NEAR(len, 1 + cos(sqrt(200.0) * t), 0.01);
+        AK_CHECK_NEAR(num(a, 0) + num(b, 0), 2.0, 1e-4); /* the centre stays: no force from the dead one */
+        AK_CHECK_NEAR(num(a, 1), 0.0, 1e-6);
+    }
+    cJSON_Delete(j);
+
+    /* bursts every 1e-12 s into a full system of 10: the due bursts are dropped (the loop
+     * used to call the emitter 10^7 times per step, and its 32-bit count wrapped and spun) */
+    write_file("particles_bursts.json", "{\"capacity\": 10, \"emitters\": [{\"burst\": 4, \"burst_interval\": 1e-12,"
+                                        " \"lifetime\": [0, 0]}]}");
+    AK_CHECK_EQ(run("particles particles_bursts.json --steps 3 --json bursts.json"), 0);
+    j = read_json("bursts.json");
+    AK_CHECK(j != NULL && cJSON_GetArraySize(cJSON_GetObjectItem(j, "particles")) == 10);
+    cJSON_Delete(j);
+    remove("particles_die.json"), remove("die.json"), remove("particles_bursts.json"), remove("bursts.json");
+}
+
+/* One red particle alone is framed with room around it (zero-size bounds put the camera on
+ * it: the image showed only the ground); the title says "1 particle". */
+AK_TEST(single_particle_is_framed) {
+    write_file("particles_one.json", "{\"particles\": [{\"m\": 0, \"p\": [0, 5, 0], \"colour\": [1, 0, 0, 1]}]}");
+    AK_CHECK_EQ(run("particles particles_one.json --steps 0 --size 160x120 -o one.png"), 0);
+    int w = 0, h = 0, red = 0;
+    AK_CHECK(ak_png_info("one.png", &w, &h) == AK_OK && w == 160 && h == 120);
+    static uint8_t px[160 * 120 * 4];
+    const ak_image img = {.pixels = px, .width = 160, .height = 120};
+    AK_CHECK(ak_png_read("one.png", &img) == AK_OK);
+    for (int i = 0; i < 160 * 120; ++i) red += px[4 * i] > 150 && px[4 * i + 1] < 80 && px[4 * i + 2] < 80;
+    AK_CHECK_MSG(red >= 4, "%d red pixels", red);
+    remove("particles_one.json"), remove("one.png");
+}
+
 AK_TEST(presets_run_and_render) {
     const char* presets[] = {"fountain", "rain", "fireworks", "character"};
     for (int k = 0; k < 4; ++k) {
@@ -164,6 +218,8 @@ AK_TEST(presets_run_and_render) {
 int main(void) {
     AK_RUN(bad_scenes_exit_1_with_path);
     AK_RUN(json_matches_closed_form);
+    AK_RUN(springs_survive_a_death);
+    AK_RUN(single_particle_is_framed);
     AK_RUN(presets_run_and_render);
     return ak_test_finish();
 }

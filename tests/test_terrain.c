@@ -296,6 +296,33 @@ AK_TEST(erosion_properties) {
     AK_CHECK_EQ(ak_terrain_erode(&e, &d, (ak_f32_span){h1, 10}, NULL, NULL), AK_ERR_SPAN_SMALL);
 }
 
+/* Small grids, where the erosion brush (radius 3) reaches past the border at every droplet:
+ * the material picked up must still be the material removed (a 3x3 grid used to rise to
+ * 1e23 m), and droplets must not dig the border cells without bound by eroding towards an
+ * edge assumed lower (used to reach -868 m on a +-9 m terrain). */
+AK_TEST(erosion_small_grids_conserve) {
+    static const uint32_t sizes[] = {3, 5, 9, 33};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; ++k) {
+        const uint32_t n = sizes[k];
+        float h0[33 * 33], h1[33 * 33];
+        ak_terrain_desc d = {.noise = test_noise(), .width = n, .height = n, .world_size = 20,
+                             .fractal = {.octaves = 4}};
+        AK_CHECK_EQ(ak_terrain_generate(&d, (ak_f32_span){h0, n * n}, (ak_vec3_span){0}), AK_OK);
+        memcpy(h1, h0, sizeof(float) * n * n);
+        float lo = h0[0], hi = h0[0];
+        for (uint32_t i = 0; i < n * n; ++i) lo = fminf(lo, h0[i]), hi = fmaxf(hi, h0[i]);
+        AK_CHECK_EQ(ak_terrain_erode(&(ak_terrain_erosion){.droplets = 20000, .seed = 5}, &d, (ak_f32_span){h1, n * n},
+                                     NULL, NULL),
+                    AK_OK);
+        float lo1 = h1[0], hi1 = h1[0];
+        for (uint32_t i = 0; i < n * n; ++i) lo1 = fminf(lo1, h1[i]), hi1 = fmaxf(hi1, h1[i]);
+        const double s0 = sum_of(h0, n * n), s1 = sum_of(h1, n * n);
+        AK_CHECK_MSG(s1 <= s0 + 1e-3 * (1.0 + fabs(s0)), "%ux%u: height sum %g -> %g", n, n, s0, s1);
+        AK_CHECK_MSG(lo1 >= lo - 1e-4f * (hi - lo) && hi1 <= hi + (hi - lo), "%ux%u: heights [%g, %g] -> [%g, %g]", n, n,
+                     (double)lo, (double)hi, (double)lo1, (double)hi1);
+    }
+}
+
 AK_TEST(colors_by_height_and_slope) {
     ak_terrain_desc d = {.noise = test_noise(), .width = 2, .height = 2, .height_scale = 10};
     /* fbm: heights span [-10, 10] */
@@ -321,6 +348,7 @@ int main(void) {
     AK_RUN(png16_reads_back);
     AK_RUN(obj_structure);
     AK_RUN(erosion_properties);
+    AK_RUN(erosion_small_grids_conserve);
     AK_RUN(colors_by_height_and_slope);
     return ak_test_finish();
 }

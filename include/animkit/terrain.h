@@ -78,7 +78,9 @@ AK_API ak_result ak_terrain_normals(const ak_terrain_desc* desc, ak_f32_cspan he
 /* Erosion parameters. Hydraulic: each droplet starts at a random point, follows the slope
  * with inertia, carries sediment up to capacity = max(-dh, min_slope) * speed * water *
  * capacity, erodes (spread over a radius) when below capacity and deposits when above or
- * going uphill, evaporates, and dies after max_steps. Thermal: material above the talus
+ * going uphill, evaporates, and dies after max_steps or when it would leave the grid (its
+ * sediment leaves with it). No cell is eroded below the lowest starting height (the base
+ * level), and the sediment picked up is exactly the material removed. Thermal: material above the talus
  * slope moves to lower neighbours. */
 typedef struct ak_terrain_erosion {
     uint32_t droplets;       /* hydraulic droplets; 0 -> no hydraulic pass */

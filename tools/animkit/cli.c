@@ -114,13 +114,15 @@ bool cli_parse_vec3(const char* s, ak_vec3* out) {
     if (strlen(s) >= sizeof buf) return false;
     strcpy(buf, s);
     float v[3];
-    char* save = NULL;
-    char* tok = strtok_r(buf, ",", &save);
+    /* split by hand: strtok would read "1,,2,3" as 1,2,3 and ignore a trailing "," */
+    char* tok = buf;
     for (int i = 0; i < 3; ++i) {
-        if (!tok || !cli_parse_float(tok, &v[i])) return false;
-        tok = strtok_r(NULL, ",", &save);
+        char* comma = strchr(tok, ',');
+        if ((i < 2) != (comma != NULL)) return false;
+        if (comma) *comma = '\0';
+        if (!cli_parse_float(tok, &v[i])) return false;
+        if (comma) tok = comma + 1;
     }
-    if (tok) return false;
     *out = ak_vec3_make(v[0], v[1], v[2]);
     return true;
 }

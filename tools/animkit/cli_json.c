@@ -57,8 +57,33 @@ const char* cli_json_key(char* buf, size_t size, const char* base, const char* k
     return buf;
 }
 
+/* Where a string in text[0, size) holds the escape \u0000, or NULL. cJSON decodes it into a
+ * NUL that ends the C string early, so "rk4\u0000junk" would read as "rk4" and a key
+ * "dt\u0000" as "dt". Other escapes are skipped whole ("\\u0000" is a backslash and text). */
+static const char* nul_escape(const char* text, size_t size) {
+    bool in_string = false;
+    for (size_t i = 0; i < size; ++i) {
+        if (!in_string) {
+            in_string = text[i] == '"';
+        } else if (text[i] == '"') {
+            in_string = false;
+        } else if (text[i] == '\\' && i + 1 < size) {
+            if (text[i + 1] == 'u' && i + 5 < size && memcmp(text + i + 2, "0000", 4) == 0) return text + i;
+            ++i;
+        }
+    }
+    return NULL;
+}
+
 cJSON* cli_json_parse(cli_json* j, const char* text, size_t size) {
     if (j->failed) return NULL;
+    const char* nul = nul_escape(text, size);
+    if (nul) {
+        size_t line = 1, col = 1;
+        for (const char* p = text; p < nul; ++p) line += *p == '\n', col = *p == '\n' ? 1 : col + 1;
+        cli_json_fail(j, "", NULL, "a string holds \\u0000 (NUL) at line %zu, column %zu", line, col);
+        return NULL;
+    }
     const char* end = NULL;
     cJSON* root = cJSON_ParseWithLengthOpts(text, size, &end, false);
     if (!root) {

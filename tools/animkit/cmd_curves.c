@@ -14,12 +14,13 @@ static const char* const usage =
     "marked and their in/out tangents drawn as handles (markers only where keys are at least\n"
     "8 pixels apart; a dense capture is drawn as its line). Charts are numbered #0, #1, ... as\n"
     "the file declares its channels. A page holds 24 charts; --size is the size of one chart\n"
-    "(default 420x260).\n"
+    "(default 420x260, at least 120x80; the page is at most 8192x8192).\n"
     "  --joint NAME    only that joint's channels\n"
     "  --channel LIST  only these charts: numbers and ranges (3,7-9) and joint names, a name\n"
     "                  with .translation, .rotation or .scale for one channel (Hips.rotation)\n"
     "  --page P        page P (from 1) of the selected charts; the title says how many pages\n";
 
+#define MAX_SIDE 8192 /* the page, like render's images */
 #define MAX_CHARTS 24
 #define SAMPLES 240
 
@@ -176,8 +177,10 @@ int cli_curves_run(int argc, char** argv, bool quiet) {
     if (!cli_has_ext(out, ".png")) return cli_usage("curves", "output '%s' must end in .png", out);
     if (!CLI_GET(&a, "--clip")) return cli_usage("curves", "missing --clip C");
     int w = 420, h = 260;
-    if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &w, &h))
-        return cli_usage("curves", "--size '%s' is not WxH", CLI_GET(&a, "--size"));
+    /* a chart is at least 120x80 (ak_view_plot's minimum) */
+    if (CLI_GET(&a, "--size") && (!cli_parse_size(CLI_GET(&a, "--size"), &w, &h) || w < 120 || h < 80))
+        return cli_usage("curves", "--size '%s' is not WxH with 120..8192 x 80..8192 pixels",
+                         CLI_GET(&a, "--size"));
     long page = 0;
     if (CLI_GET(&a, "--page") && !cli_parse_int(CLI_GET(&a, "--page"), 1, 1000000, &page))
         return cli_usage("curves", "--page '%s' is not a page number (from 1)", CLI_GET(&a, "--page"));
@@ -236,6 +239,23 @@ int cli_curves_run(int argc, char** argv, bool quiet) {
         goto done;
     }
     size_t first = (page ? (size_t)page - 1 : 0) * MAX_CHARTS, rank = 0, first_shown = 0, last_shown = 0;
+    {
+        /* the page's size before any chart is allocated: at most MAX_SIDE on each side */
+        const size_t n = selected - first < MAX_CHARTS ? selected - first : MAX_CHARTS;
+        const ak_view_panels_desc probe = {.columns = n < 3 ? (int)n : 3, .title = "title", .label_scale = 1};
+        int pw, ph, mw = w, mh = h;
+        ak_view_panels_size(&probe, n, w, h, &pw, &ph);
+        if (pw > MAX_SIDE || ph > MAX_SIDE) {
+            int cw = pw, ch = ph;
+            while (mw > 120 && mh > 80 && (cw > MAX_SIDE || ch > MAX_SIDE)) {
+                mw = mw * 15 / 16 > 120 ? mw * 15 / 16 : 120, mh = mh * 15 / 16 > 80 ? mh * 15 / 16 : 80;
+                ak_view_panels_size(&probe, n, mw, mh, &cw, &ch);
+            }
+            rc = cli_usage("curves", "--size %dx%d makes a %dx%d page of %zu chart%s, above the %dx%d limit (try --size %dx%d)",
+                           w, h, pw, ph, n, cli_plural(n), MAX_SIDE, MAX_SIDE, mw, mh);
+            goto done;
+        }
+    }
     for (size_t k = 0; k < file_count && count < MAX_CHARTS; ++k) {
         if (!sel[k] || rank++ < first) continue;
         if (cli_image_alloc(&charts[count], w, h)) {

@@ -19,7 +19,7 @@ static const char* const usage =
     "               nodes above the skeleton (e.g. a Z_UP node) never join. The chain used\n"
     "               is printed\n"
     "  --solver     default fabrik\n"
-    "  --iterations iteration budget (default 50)\n"
+    "  --iterations iteration budget, 1 to 1000000 (default 50)\n"
     "  --tolerance  distance counted as reached, model units (default 1e-4 x chain length)\n"
     "  --json       one JSON object: reached, error, iterations, time_ms, solver, joints (the\n"
     "               chain root..effector after solving: [{name, position [x,y,z]}]) and\n"
@@ -104,7 +104,7 @@ int cmd_ik(int argc, char** argv) {
         return cli_usage("ik", "--solver must be ccd, fabrik, twobone or dls, not '%s'", CLI_GET(&a, "--solver"));
     long iterations = 0;
     if (CLI_GET(&a, "--iterations") && !cli_parse_int(CLI_GET(&a, "--iterations"), 1, 1000000, &iterations))
-        return cli_usage("ik", "--iterations '%s' is not a whole number >= 1", CLI_GET(&a, "--iterations"));
+        return cli_usage("ik", "--iterations '%s' is not a whole number in 1..1000000", CLI_GET(&a, "--iterations"));
     float tolerance = 0.0f, t = 0.0f;
     if (CLI_GET(&a, "--tolerance") && (!cli_parse_float(CLI_GET(&a, "--tolerance"), &tolerance) || tolerance < 0))
         return cli_usage("ik", "--tolerance '%s' is not a number >= 0", CLI_GET(&a, "--tolerance"));

@@ -36,13 +36,16 @@ static int parse_point(const char* s, float* p) {
     char buf[256];
     if (!s || strlen(s) >= sizeof buf) return 0;
     strcpy(buf, s);
+    /* split by hand: strtok would merge "1,,2" into two coordinates and drop a trailing "," */
     int n = 0;
-    char* save = NULL;
-    for (char* tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+    for (char* tok = buf;;) {
+        char* comma = strchr(tok, ',');
+        if (comma) *comma = '\0';
         if (n == 4 || !cli_parse_float(tok, &p[n])) return 0;
         ++n;
+        if (!comma) return n;
+        tok = comma + 1;
     }
-    return n;
 }
 
 int cmd_noise(int argc, char** argv) {

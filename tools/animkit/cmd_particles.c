@@ -16,7 +16,7 @@ static const char* const usage =
     "Simulate a particle system (docs/particles.md describes the scene format).\n"
     "  --preset     a built-in scene instead of a file (character: rain and sparks on the walking\n"
     "               builtin:humanoid, which the particles collide with)\n"
-    "  --steps      steps to run (default 200)\n"
+    "  --steps      steps to run, 0 to 100000000 (default 200)\n"
     "  --dt         step in seconds (overrides the file; default 0.01)\n"
     "  --integrator overrides the file (default symplectic)\n"
     "  --seed       seed of the emitters' random numbers (default 1)\n"
@@ -25,7 +25,7 @@ static const char* const usage =
     "step,\n"
     "               the file's particles first, emitted ones after them\n"
     "  -o           render: a GIF of the run (up to 100 frames) or a PNG of the last step\n"
-    "  --size       image size (default 480x360)\n";
+    "  --size       image size, 8x8 to 8192x8192 (default 480x360)\n";
 
 /* ---- presets -------------------------------------------------------------------------- */
 
@@ -209,7 +209,9 @@ typedef struct run {
     character* ch; /* NULL unless the character preset */
     const ak_particle_mesh* meshes[1];
     ak_particles_world world;
-    uint32_t* fired; /* bursts fired per emitter */
+    uint64_t* fired; /* bursts fired per emitter */
+    ak_particle_spring* springs; /* the world's springs, re-indexed as file particles die */
+    size_t file_alive;           /* file particles still alive */
 } run;
 
 static int run_init(run* r, particles_scene* s, character* ch, uint64_t seed, uint32_t threads) {
@@ -228,10 +230,15 @@ static int run_init(run* r, particles_scene* s, character* ch, uint64_t seed, ui
         if (res != AK_OK)
             return cli_fail("particles", "particle %zu: %s", i, ak_result_string(res));
     }
-    r->fired = calloc(s->emitter_count + 1, sizeof(uint32_t));
-    if (!r->fired) return cli_fail("particles", "out of memory");
+    r->fired = calloc(s->emitter_count + 1, sizeof(uint64_t));
+    r->springs = calloc(s->world.springs.count + 1, sizeof(ak_particle_spring));
+    if (!r->fired || !r->springs) return cli_fail("particles", "out of memory");
     for (size_t e = 0; e < s->emitter_count; ++e) s->emitters[e].carry = 0.0;
     r->world = s->world;
+    if (s->world.springs.count)
+        memcpy(r->springs, s->world.springs.ptr, s->world.springs.count * sizeof *r->springs);
+    r->world.springs.ptr = r->springs;
+    r->file_alive = s->particle_count;
     if (ch) {
         r->meshes[0] = ch->collider;
         r->world.meshes = (ak_particle_mesh_cspan){r->meshes, 1};
@@ -258,18 +265,53 @@ static int run_step(run* r, int step) {
         const particles_burst* b = &s->bursts[e];
         while (res == AK_OK && b->count > 0 && (b->interval > 0.0f || r->fired[e] == 0)) {
             if ((double)b->start + (double)r->fired[e] * (double)b->interval >= t1) break;
+            if (b->interval > 0.0f && ak_particles_count(r->ps) >= ak_particles_capacity(r->ps)) {
+                /* full: every burst still due this step would be dropped (a full system emits
+                 * nothing and draws no random numbers), so count them without calling; a tiny
+                 * burst_interval used to make millions of calls per step */
+                double k = ceil((t1 - (double)b->start) / (double)b->interval);
+                if (k < (double)r->fired[e]) k = (double)r->fired[e];
+                while (k > (double)r->fired[e] && (double)b->start + (k - 1.0) * (double)b->interval >= t1) k -= 1.0;
+                while ((double)b->start + k * (double)b->interval < t1) k += 1.0;
+                r->fired[e] = (uint64_t)k;
+                break;
+            }
             res = ak_particles_burst(r->ps, &s->emitters[e], b->count, NULL);
             ++r->fired[e];
         }
     }
     if (res == AK_OK) res = ak_particles_step(r->ps, &r->world, dt);
     if (res != AK_OK) return cli_fail("particles", "step %d: %s", step, ak_result_string(res));
+    /* File particles come first and keep their order (ids 0.. in file order); when some die
+     * (a lifetime, or a state that stopped being finite) the springs follow the survivors'
+     * new indices and springs to a dead particle go (they used to point past the end: the
+     * next step failed with "an index is out of range") */
+    const ak_particles_state st = ak_particles_get_state(r->ps);
+    size_t alive = 0;
+    while (alive < st.count && st.id[alive] < s->particle_count) ++alive;
+    if (alive != r->file_alive && s->world.springs.count) {
+        uint32_t* where = malloc(s->particle_count * sizeof *where);
+        if (!where) return cli_fail("particles", "out of memory");
+        for (size_t i = 0; i < s->particle_count; ++i) where[i] = UINT32_MAX;
+        for (size_t i = 0; i < alive; ++i) where[st.id[i]] = (uint32_t)i;
+        size_t n = 0;
+        for (size_t k = 0; k < s->world.springs.count; ++k) {
+            ak_particle_spring sp = s->world.springs.ptr[k];
+            if (where[sp.i] == UINT32_MAX || where[sp.j] == UINT32_MAX) continue;
+            sp.i = where[sp.i], sp.j = where[sp.j];
+            r->springs[n++] = sp;
+        }
+        r->world.springs.count = n;
+        free(where);
+    }
+    r->file_alive = alive;
     return CLI_OK;
 }
 
 static void run_free(run* r) {
     ak_particles_destroy(r->ps);
     free(r->fired);
+    free(r->springs);
 }
 
 /* ---- rendering ------------------------------------------------------------------------- */
@@ -409,8 +451,8 @@ static int render_frame(renderer* rd, run* r, const ak_image* out) {
         res = ak_raster_draw_points(ras, &f->camera, &pts);
     }
     char title[160];
-    snprintf(title, sizeof title, "%s  t=%.2fs  %zu particles", rd->title, ak_particles_time(r->ps),
-             st.count);
+    snprintf(title, sizeof title, "%s  t=%.2fs  %zu particle%s", rd->title, ak_particles_time(r->ps),
+             st.count, cli_plural(st.count));
     if (res == AK_OK)
         res = ak_raster_draw_text(ras, 10, 10, title, f->height >= 300 ? 2 : 1,
                                   ak_vec4_make(0.08f, 0.09f, 0.12f, 1));
@@ -459,7 +501,7 @@ int cmd_particles(int argc, char** argv) {
                          preset);
     long steps = 200, seed = 1, threads = 1;
     if (CLI_GET(&a, "--steps") && !cli_parse_int(CLI_GET(&a, "--steps"), 0, 100000000, &steps))
-        return cli_usage("particles", "--steps '%s' is not a whole number >= 0",
+        return cli_usage("particles", "--steps '%s' is not a whole number in 0..100000000",
                          CLI_GET(&a, "--steps"));
     if (CLI_GET(&a, "--seed") && !cli_parse_int(CLI_GET(&a, "--seed"), 0, 2147483647L, &seed))
         return cli_usage("particles", "--seed '%s' is not a whole number >= 0",
@@ -492,7 +534,7 @@ int cmd_particles(int argc, char** argv) {
         return cli_usage("particles", "output '%s' must end in .gif or .png", out);
     int width = 480, height = 360;
     if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &width, &height))
-        return cli_usage("particles", "--size '%s' is not WxH", CLI_GET(&a, "--size"));
+        return cli_usage("particles", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
     const char* json = CLI_GET(&a, "--json");
 
     particles_scene scene;
@@ -567,6 +609,11 @@ int cmd_particles(int argc, char** argv) {
         run_free(&r);
         memset(&r, 0, sizeof r);
         if (!(lo.x <= hi.x)) lo = ak_vec3_splat(-1), hi = ak_vec3_splat(1);
+        /* at least 1 m on every axis: a single particle (or a flat sheet) framed at its own
+         * zero size put the camera on top of it, showing nothing but the ground */
+        const ak_vec3 mid = ak_vec3_scale(ak_vec3_add(lo, hi), 0.5f);
+        lo = ak_vec3_min(lo, ak_vec3_sub(mid, ak_vec3_splat(0.5f)));
+        hi = ak_vec3_max(hi, ak_vec3_add(mid, ak_vec3_splat(0.5f)));
         rd.ground = lo.y;
         for (size_t k = 0; k < scene.world.planes.count; ++k) {
             ak_vec3 n = ak_vec3_normalize(scene.world.planes.ptr[k].normal);

@@ -103,11 +103,15 @@ static bool parse_camera(const char* s, cli_camera* cam) {
     strcpy(buf, s);
     float v[3] = {0, 0, 0};
     int n = 0;
-    char* save = NULL;
-    for (char* tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+    /* split by hand: strtok would read "0,,10" as YAW 0, PITCH 10 */
+    for (char* tok = buf;; ++n) {
+        char* comma = strchr(tok, ',');
+        if (comma) *comma = '\0';
         if (n == 3 || !cli_parse_float(tok, &v[n])) return false;
-        ++n;
+        if (!comma) break;
+        tok = comma + 1;
     }
+    ++n;
     if (n < 2 || v[1] < -85.0f || v[1] > 85.0f || (n == 3 && !(v[2] > 0.0f && v[2] <= 1e9f))) return false;
     cam->has_angles = true;
     cam->yaw = v[0];

@@ -59,6 +59,22 @@ static bool parse_u64(const char* s, uint64_t* out) {
     return true;
 }
 
+/* Whether the box lo..hi projects inside 95% of the view from eye towards target (vertical
+ * field of view fovy, aspect w / h), every corner in front of the camera. */
+static bool box_in_view(ak_vec3 eye, ak_vec3 target, ak_vec3 lo, ak_vec3 hi, float fovy, float aspect) {
+    const ak_vec3 f = ak_vec3_normalize(ak_vec3_sub(target, eye));
+    const ak_vec3 rt = ak_vec3_normalize(ak_vec3_cross(f, ak_vec3_make(0, 1, 0)));
+    const ak_vec3 up = ak_vec3_cross(rt, f);
+    const float ty = 0.95f * tanf(0.5f * fovy), tx = ty * aspect;
+    for (int c = 0; c < 8; ++c) {
+        const ak_vec3 p = ak_vec3_make(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+        const ak_vec3 d = ak_vec3_sub(p, eye);
+        const float z = ak_vec3_dot(d, f);
+        if (!(z > 0.0f) || fabsf(ak_vec3_dot(d, rt)) > tx * z || fabsf(ak_vec3_dot(d, up)) > ty * z) return false;
+    }
+    return true;
+}
+
 /* Render the coloured mesh from orbit angle a (radians) into img. */
 static int render_frames(const terrain_data* t, const char* path, bool gif) {
     const ak_terrain_desc* d = &t->desc;
@@ -99,13 +115,27 @@ static int render_frames(const terrain_data* t, const char* path, bool gif) {
                                  .indices = {idx, ni}, .material = {.color = {1, 1, 1, 1}, .specular = 0.05f}};
     const int frames = gif ? 48 : 1;
     ak_image img = {.pixels = px, .width = w, .height = h};
+    /* one distance for every frame, far enough that the whole terrain is in view in each (the
+     * near corner used to leave the image) */
+    ak_vec3 lo = pos[0], hi = pos[0];
+    for (size_t i = 1; i < n; ++i) lo = ak_vec3_min(lo, pos[i]), hi = ak_vec3_max(hi, pos[i]);
+    float zoom = 1.0f;
+    for (int f = 0; f < frames; ++f) {
+        const float a = 0.6f + AK_TWO_PI * (float)f / (float)frames;
+        const float elev = 0.5f * S + (gif ? 0.12f * S * sinf(2.0f * a) : 0.0f);
+        while (zoom < 20.0f && !box_in_view(ak_vec3_add(target, ak_vec3_scale(ak_vec3_make(1.1f * S * cosf(a), elev,
+                                                                                                1.1f * S * sinf(a)),
+                                                                                  zoom)),
+                                            target, lo, hi, 0.75f, (float)w / (float)h))
+            zoom *= 1.03f;
+    }
     for (int f = 0; f < frames && rc == CLI_OK; ++f) {
         const float a = 0.6f + AK_TWO_PI * (float)f / (float)frames;
-        const float elev = 0.5f * S + (gif ? 0.12f * S * sinf(2.0f * a) : 0.0f); /* the flight bobs */
-        const float rad = 1.1f * S;
+        const float elev = zoom * (0.5f * S + (gif ? 0.12f * S * sinf(2.0f * a) : 0.0f)); /* the flight bobs */
+        const float rad = zoom * 1.1f * S;
         const ak_vec3 eye = ak_vec3_make(rad * cosf(a), (float)mean + elev, rad * sinf(a));
         const ak_raster_camera cam = ak_raster_camera_perspective(eye, target, 0.75f, (float)w / (float)h,
-                                                                  0.01f * S, 10.0f * S);
+                                                                  0.01f * S, 10.0f * zoom * S);
         ak_raster_clear(r, ak_vec4_make(0.58f, 0.72f, 0.90f, 1), ak_vec4_make(0.86f, 0.90f, 0.95f, 1));
         res = ak_raster_draw_mesh(r, &cam, &mesh);
         if (res == AK_OK) res = ak_raster_resolve(r, &img);
