@@ -4,6 +4,9 @@
 
 #include "clip/clip_internal.h"
 #include "internal.h"
+#include <float.h>
+
+#include "simd.h" /* SSE2: four slerp channels at a time */
 
 /* ---- static helpers ------------------------------------------------------------------ */
 
@@ -104,6 +107,203 @@ static void write_channel(const akp_clip_channel* ch, size_t seg, float t, ak_tr
     }
 }
 
+/* ---- fast path ------------------------------------------------------------------------ */
+
+/* Which inline evaluator channel ch can use, and where its value lands in a pose. */
+static void set_fast(akp_clip_channel* ch) {
+    const ak_track* tr = &ch->track;
+    ch->fast = AKP_CLIP_FAST_NONE;
+    ch->dst = 0;
+    if (tr->key_count < 2) return;
+    const size_t per = sizeof(ak_transform) / sizeof(float);
+    size_t field;
+    if (ch->target == AK_CHANNEL_TRANSLATION && tr->eval == AKP_EVAL_LINEAR) {
+        ch->fast = AKP_CLIP_FAST_VEC3;
+        field = offsetof(ak_transform, translation);
+    } else if (ch->target == AK_CHANNEL_SCALE && tr->eval == AKP_EVAL_LINEAR) {
+        ch->fast = AKP_CLIP_FAST_VEC3;
+        field = offsetof(ak_transform, scale);
+    } else if (ch->target == AK_CHANNEL_ROTATION && tr->eval == AKP_EVAL_SLERP) {
+        ch->fast = AKP_CLIP_FAST_SLERP;
+        field = offsetof(ak_transform, rotation);
+    } else if (ch->target == AK_CHANNEL_ROTATION && tr->eval == AKP_EVAL_NLERP) {
+        ch->fast = AKP_CLIP_FAST_NLERP;
+        field = offsetof(ak_transform, rotation);
+    } else {
+        return;
+    }
+    ch->dst = (uint32_t)(ch->index * per + field / sizeof(float));
+}
+
+/* akp_track_eval for a FAST channel, inlined: the same operations in the same order, so the
+ * same floats (tests/test_clip.c compares it with ak_track_sample on the channel's track). */
+static inline void eval_fast(const akp_clip_channel* ch, size_t seg, float t, float* pose) {
+    const ak_track* tr = &ch->track;
+    const float* times = tr->times;
+    size_t n = tr->key_count, stride = tr->stride;
+    float* out = pose + ch->dst;
+    const float* a;
+    if (!(t > times[0])) {
+        a = tr->values;
+    } else if (t >= times[n - 1]) {
+        a = tr->values + (n - 1) * stride;
+    } else {
+        a = tr->values + seg * stride;
+        const float* b = a + stride;
+        float t0 = times[seg], t1 = times[seg + 1];
+        float u = (t - t0) / (t1 - t0);
+        u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+        if (ch->fast == AKP_CLIP_FAST_VEC3) {
+            out[0] = a[0] + (b[0] - a[0]) * u;
+            out[1] = a[1] + (b[1] - a[1]) * u;
+            out[2] = a[2] + (b[2] - a[2]) * u;
+            return;
+        }
+        ak_quat q;
+        if (ch->fast == AKP_CLIP_FAST_NLERP || a[5] == 0.0f) {
+            q = ak_quat_nlerp(ak_quat_make(a[0], a[1], a[2], a[3]), ak_quat_make(b[0], b[1], b[2], b[3]), u);
+        } else {
+            float wa = akp_sin_half_pi((1.0f - u) * a[4]) * a[5], wb = akp_sin_half_pi(u * a[4]) * a[5] * a[6];
+            q = ak_quat_normalize(ak_quat_make(wa * a[0] + wb * b[0], wa * a[1] + wb * b[1], wa * a[2] + wb * b[2],
+                                               wa * a[3] + wb * b[3]));
+        }
+        out[0] = q.x;
+        out[1] = q.y;
+        out[2] = q.z;
+        out[3] = q.w;
+        return;
+    }
+    out[0] = a[0];
+    out[1] = a[1];
+    out[2] = a[2];
+    if (ch->fast != AKP_CLIP_FAST_VEC3) out[3] = a[3];
+}
+
+#if AK_SIMD_SSE2
+/* akp_sin_half_pi on four lanes: the same operations in the same order. */
+static inline __m128 sin4_half_pi(__m128 x) {
+    __m128 x2 = _mm_mul_ps(x, x);
+    __m128 p = _mm_set1_ps(1.0f / 6227020800.0f);
+    p = _mm_sub_ps(_mm_mul_ps(p, x2), _mm_set1_ps(1.0f / 39916800.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, x2), _mm_set1_ps(1.0f / 362880.0f));
+    p = _mm_sub_ps(_mm_mul_ps(p, x2), _mm_set1_ps(1.0f / 5040.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, x2), _mm_set1_ps(1.0f / 120.0f));
+    p = _mm_sub_ps(_mm_mul_ps(p, x2), _mm_set1_ps(1.0f / 6.0f));
+    return _mm_add_ps(x, _mm_mul_ps(x, _mm_mul_ps(x2, p)));
+}
+
+/* A SLERP channel strictly inside its keys with a non-degenerate segment (a[5] != 0). */
+typedef struct slerp_lane {
+    const akp_clip_channel* ch;
+    size_t seg;
+} slerp_lane;
+
+/* eval_fast of four such channels in SSE2 lanes, float for float: the keys and their slerp
+ * constants are transposed to lanes, the weights, the blend and the normalisation run in the
+ * scalar code's order; a lane whose squared norm needs ak_quat_normalize's rescue path (tiny,
+ * infinite or NaN) is redone by eval_fast. */
+static void slerp4(const slerp_lane* L, float t, float* pose) {
+    const float* a[4];
+    float u[4];
+    for (int l = 0; l < 4; ++l) {
+        const ak_track* tr = &L[l].ch->track;
+        a[l] = tr->values + L[l].seg * tr->stride;
+        float t0 = tr->times[L[l].seg], t1 = tr->times[L[l].seg + 1];
+        float v = (t - t0) / (t1 - t0);
+        u[l] = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+    }
+    __m128 ax = _mm_loadu_ps(a[0]), ay = _mm_loadu_ps(a[1]), az = _mm_loadu_ps(a[2]), aw = _mm_loadu_ps(a[3]);
+    __m128 th = _mm_loadu_ps(a[0] + 4), is = _mm_loadu_ps(a[1] + 4), sg = _mm_loadu_ps(a[2] + 4),
+           z3 = _mm_loadu_ps(a[3] + 4);
+    __m128 bx = _mm_loadu_ps(a[0] + 8), by = _mm_loadu_ps(a[1] + 8), bz = _mm_loadu_ps(a[2] + 8),
+           bw = _mm_loadu_ps(a[3] + 8);
+    AKP_SIMD_TRANSPOSE4(ax, ay, az, aw);
+    AKP_SIMD_TRANSPOSE4(th, is, sg, z3);
+    AKP_SIMD_TRANSPOSE4(bx, by, bz, bw);
+    (void)z3;
+    __m128 U = _mm_loadu_ps(u), one = _mm_set1_ps(1.0f);
+    __m128 wa = _mm_mul_ps(sin4_half_pi(_mm_mul_ps(_mm_sub_ps(one, U), th)), is);
+    __m128 wb = _mm_mul_ps(_mm_mul_ps(sin4_half_pi(_mm_mul_ps(U, th)), is), sg);
+    __m128 qx = _mm_add_ps(_mm_mul_ps(wa, ax), _mm_mul_ps(wb, bx));
+    __m128 qy = _mm_add_ps(_mm_mul_ps(wa, ay), _mm_mul_ps(wb, by));
+    __m128 qz = _mm_add_ps(_mm_mul_ps(wa, az), _mm_mul_ps(wb, bz));
+    __m128 qw = _mm_add_ps(_mm_mul_ps(wa, aw), _mm_mul_ps(wb, bw));
+    __m128 n2 = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(qx, qx), _mm_mul_ps(qy, qy)), _mm_mul_ps(qz, qz)),
+                           _mm_mul_ps(qw, qw));
+    __m128 ok = _mm_and_ps(_mm_cmpgt_ps(n2, _mm_set1_ps(1e-30f)), _mm_cmple_ps(n2, _mm_set1_ps(FLT_MAX)));
+    __m128 sc = _mm_div_ps(one, _mm_sqrt_ps(n2));
+    qx = _mm_mul_ps(qx, sc);
+    qy = _mm_mul_ps(qy, sc);
+    qz = _mm_mul_ps(qz, sc);
+    qw = _mm_mul_ps(qw, sc);
+    AKP_SIMD_TRANSPOSE4(qx, qy, qz, qw);
+    int good = _mm_movemask_ps(ok);
+    __m128 q[4] = {qx, qy, qz, qw};
+    for (int l = 0; l < 4; ++l) {
+        if (good >> l & 1) _mm_storeu_ps(pose + L[l].ch->dst, q[l]);
+        else eval_fast(L[l].ch, L[l].seg, t, pose);
+    }
+}
+#endif
+
+/* Sample every channel at segments segs (NULL: binary search; else the cursor's, updated). */
+static void sample_channels(const ak_clip* clip, float time, uint32_t* segs, ak_transform* local, float* w,
+                            float* s) {
+    const akp_clip_channel* ch = clip->channels;
+    float* pose = local ? &local[0].translation.x : NULL;
+#if AK_SIMD_SSE2
+    slerp_lane batch[4];
+    int nb = 0;
+#endif
+    for (size_t i = 0; i < clip->channel_count; ++i) {
+        const ak_track* tr = &ch[i].track;
+        size_t seg;
+        if (segs) {
+            /* The cached segment still holds time: no search (forward playback within a key). */
+            seg = segs[i];
+            size_t last = tr->key_count >= 2 ? tr->key_count - 2 : 0;
+            if (!(seg <= last && tr->times[seg] <= time && (seg == last || time < tr->times[seg + 1]))) {
+                seg = akp_track_find_from(tr, time, seg);
+                segs[i] = (uint32_t)seg;
+            }
+        } else {
+            seg = akp_track_find(tr, time);
+        }
+        if (ch[i].fast == AKP_CLIP_FAST_NONE) {
+            write_channel(&ch[i], seg, time, local, w, s);
+            continue;
+        }
+        if (ch[i].fast == AKP_CLIP_FAST_VEC3 && time > tr->times[0] && time < tr->times[tr->key_count - 1]) {
+            /* eval_fast's interior lerp, written here so the common case makes no call. */
+            const float* a = tr->values + seg * 3;
+            float t0 = tr->times[seg], t1 = tr->times[seg + 1];
+            float u = (time - t0) / (t1 - t0);
+            u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+            float* out = pose + ch[i].dst;
+            out[0] = a[0] + (a[3] - a[0]) * u;
+            out[1] = a[1] + (a[4] - a[1]) * u;
+            out[2] = a[2] + (a[5] - a[2]) * u;
+            continue;
+        }
+#if AK_SIMD_SSE2
+        if (ch[i].fast == AKP_CLIP_FAST_SLERP && time > tr->times[0] && time < tr->times[tr->key_count - 1] &&
+            tr->values[seg * tr->stride + 5] != 0.0f) {
+            batch[nb].ch = &ch[i];
+            batch[nb].seg = seg;
+            if (++nb == 4) {
+                slerp4(batch, time, pose);
+                nb = 0;
+            }
+            continue;
+        }
+#endif
+        eval_fast(&ch[i], seg, time, pose);
+    }
+#if AK_SIMD_SSE2
+    for (int l = 0; l < nb; ++l) eval_fast(batch[l].ch, batch[l].seg, time, pose);
+#endif
+}
+
 /* ---- build and query ---------------------------------------------------------------- */
 
 ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_clip** out_clip, ak_diag* diag) {
@@ -179,6 +379,7 @@ ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_cl
             akp_free(alloc, mem);
             return r;
         }
+        set_fast(ch);
         data += akp_track_data_size(&resolved);
         float end = ch->track.times[ch->track.key_count - 1];
         if (end > last) last = end;
@@ -244,17 +445,6 @@ ak_result ak_clip_sample(const ak_clip* clip, float time, ak_clip_cursor* cursor
     float* s = scalars.ptr && scalars.count ? scalars.ptr : NULL;
     if (w && weights.count < clip->morph_weight_count) return AK_ERR_SPAN_SMALL;
     if (s && scalars.count < clip->scalar_count) return AK_ERR_SPAN_SMALL;
-    const akp_clip_channel* ch = clip->channels;
-    if (cursor) {
-        uint32_t* segs = cursor->segments;
-        for (size_t i = 0; i < clip->channel_count; ++i) {
-            size_t seg = akp_track_find_from(&ch[i].track, time, segs[i]);
-            segs[i] = (uint32_t)seg;
-            write_channel(&ch[i], seg, time, local.ptr, w, s);
-        }
-    } else {
-        for (size_t i = 0; i < clip->channel_count; ++i)
-            write_channel(&ch[i], akp_track_find(&ch[i].track, time), time, local.ptr, w, s);
-    }
+    sample_channels(clip, time, cursor ? cursor->segments : NULL, local.ptr, w, s);
     return AK_OK;
 }

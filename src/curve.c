@@ -237,7 +237,7 @@ void akp_track_eval(const ak_track* tr, size_t seg, float t, float* out) {
             quat_store(out, ak_quat_nlerp(quat_load(a), quat_load(b), u));
             return;
         }
-        float wa = sinf((1.0f - u) * a[4]) * a[5], wb = sinf(u * a[4]) * a[5] * a[6];
+        float wa = akp_sin_half_pi((1.0f - u) * a[4]) * a[5], wb = akp_sin_half_pi(u * a[4]) * a[5] * a[6];
         quat_store(out, ak_quat_normalize(ak_quat_make(wa * a[0] + wb * b[0], wa * a[1] + wb * b[1],
                                                        wa * a[2] + wb * b[2], wa * a[3] + wb * b[3])));
         return;

@@ -6,10 +6,21 @@
 
 #include "curve/track.h"
 
+/* Channels ak_clip_sample evaluates inline (set at build; everything else goes through
+ * akp_track_eval): at least two keys and one of these shapes. */
+typedef enum akp_clip_fast {
+    AKP_CLIP_FAST_NONE = 0,
+    AKP_CLIP_FAST_VEC3,  /* translation or scale, LINEAR */
+    AKP_CLIP_FAST_SLERP, /* rotation, LINEAR (slerp with the per-segment constants) */
+    AKP_CLIP_FAST_NLERP  /* rotation, NLERP */
+} akp_clip_fast;
+
 typedef struct akp_clip_channel {
     ak_track track; /* data points into the clip's block */
     ak_channel_target target;
     uint32_t index;
+    akp_clip_fast fast;
+    uint32_t dst; /* FAST_*: float offset of the value in the pose (index * transform + field) */
 } akp_clip_channel;
 
 /* One allocation: this header, the channel array, then every track's data. */

@@ -49,6 +49,20 @@ ak_result akp_track_build_into(const ak_raw_track* resolved, ak_track* track, vo
 size_t akp_track_find(const ak_track* track, float t);
 /* Same result as akp_track_find, starting from a previous segment (O(1) for small moves). */
 size_t akp_track_find_from(const ak_track* track, float t, size_t hint);
+/* sin(x) for x in [0, pi/2] (the slerp weights' range): the odd Taylor polynomial through
+ * x^13 in Horner form. Truncation error <= (pi/2)^15 / 15! < 6.7e-10; with float rounding the
+ * result is within a few float ulps of sin(x) (tests/test_clip.c checks 2e-7 against sin()). */
+static inline float akp_sin_half_pi(float x) {
+    float x2 = x * x;
+    float p = 1.0f / 6227020800.0f;
+    p = p * x2 - 1.0f / 39916800.0f;
+    p = p * x2 + 1.0f / 362880.0f;
+    p = p * x2 - 1.0f / 5040.0f;
+    p = p * x2 + 1.0f / 120.0f;
+    p = p * x2 - 1.0f / 6.0f;
+    return x + x * (x2 * p);
+}
+
 /* Value at t on segment seg (from akp_track_find*): writes component_count floats. */
 void akp_track_eval(const ak_track* track, size_t seg, float t, float* out);
 
