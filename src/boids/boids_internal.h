@@ -41,14 +41,21 @@ typedef struct akp_boids_ctx {
     /* Grid path (use_naive false). */
     ak_grid grid;
     int rings;              /* cells visited on each side of an agent's cell */
-    const int64_t* sqv;     /* [3n] velocities in sorted order, fixed point (alignment sums) */
+    const int64_t* sqv;     /* [3n] velocities, fixed point (alignment sums), in sorted order */
     const uint8_t* ssp;     /* [n] species in sorted order */
-    /* Dense cell table over the occupied cells' bounding box (when it is small enough): cell
-     * (x, y, z) -> grid cell index m or UINT32_MAX, so a neighbour cell costs one load instead
-     * of a hash probe, and cells can be walked in spatial order. NULL when not built. */
-    uint32_t* dense;
+    /* Spatial layout, built when the occupied cells' bounding box is small enough: the agents
+     * re-sorted by cell in (z, y, x) order over that box, so the cells of one row of a
+     * neighbourhood are one contiguous range and no candidate is copied. dstart[cell] is the
+     * first agent of box cell (x, y, z) (cell = (z * dim[1] + y) * dim[0] + x), dstart[cell + 1]
+     * its end; empty cells are empty ranges. "Sorted order" above is this order when dstart is
+     * set, else the grid's. NULL when not built (the grid's hashed cells are used). */
+    uint32_t* dstart;
     int32_t dense_min[3];
     int32_t dense_dim[3];
+    const float *sx, *sy, *sz; /* [n] positions in spatial order */
+    const ak_vec3* sv;         /* [n] velocities in spatial order */
+    const uint32_t* sj;        /* [n] the agent's index in the caller's arrays */
+    bool avx512;               /* the spatial filter runs akp_boids_filter_avx512 */
 } akp_boids_ctx;
 
 /* What one agent gathers from its neighbours. */
@@ -75,6 +82,13 @@ ak_boids_bounds akp_boids_bounds_mode(const ak_boids_params* p);
 void akp_boids_ctx_init(akp_boids_ctx* c, const ak_boids_step_job* job);
 void akp_boids_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
 uint32_t akp_boids_threads(uint32_t requested, size_t n);
+
+/* search_avx512.c: whether this CPU runs the AVX-512 filter; the filter appends the candidates
+ * t in [begin, end) with d2 < q2 to hk/hd (index, d2) and returns how many. It stores 16 entries
+ * at a time: hk and hd need room for the hits plus 16. */
+bool akp_boids_have_avx512(void);
+uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end, ak_vec3 p,
+                                 float q2, uint32_t* hk, float* hd);
 
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);
