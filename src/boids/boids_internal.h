@@ -55,7 +55,8 @@ typedef struct akp_boids_ctx {
     const float *sx, *sy, *sz; /* [n] positions in spatial order */
     const ak_vec3* sv;         /* [n] velocities in spatial order */
     const uint32_t* sj;        /* [n] the agent's index in the caller's arrays */
-    bool avx512;               /* the spatial filter runs akp_boids_filter_avx512 */
+    bool avx512;               /* the spatial path runs the AVX-512 kernels */
+    bool one_species;          /* species_count == 1 */
 } akp_boids_ctx;
 
 /* What one agent gathers from its neighbours. */
@@ -83,12 +84,24 @@ void akp_boids_ctx_init(akp_boids_ctx* c, const ak_boids_step_job* job);
 void akp_boids_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
 uint32_t akp_boids_threads(uint32_t requested, size_t n);
 
-/* search_avx512.c: whether this CPU runs the AVX-512 filter; the filter appends the candidates
- * t in [begin, end) with d2 < q2 to hk/hd (index, d2) and returns how many. It stores 16 entries
- * at a time: hk and hd need room for the hits plus 16. */
+/* Candidates of one agent that passed the distance test, before the neighbour rules: spatial
+ * index, d2 and the offset (candidate - agent). */
+#define AKP_BOIDS_HIT_CAP 512
+typedef struct akp_boids_hits {
+    uint32_t k[AKP_BOIDS_HIT_CAP];
+    float d2[AKP_BOIDS_HIT_CAP], dx[AKP_BOIDS_HIT_CAP], dy[AKP_BOIDS_HIT_CAP], dz[AKP_BOIDS_HIT_CAP];
+} akp_boids_hits;
+
+/* search_avx512.c (x86-64 GCC/Clang without AK_NO_SIMD; elsewhere have_avx512 is false).
+ * have_avx512: this CPU runs the kernels (AVX-512 F and DQ).
+ * filter: appends the candidates t in [begin, end) of the spatial arrays with d2 < q2 to h at
+ * `at` and returns how many; it stores 16 entries at a time, so h needs room for 16 more.
+ * visit: the register-sum fast path of visit_hits (one species, no cap, no list, no flee or
+ * pursue) for hits [0, count): the same tests and the same integer sums as the scalar code. */
 bool akp_boids_have_avx512(void);
 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end, ak_vec3 p,
-                                 float q2, uint32_t* hk, float* hd);
+                                 float q2, akp_boids_hits* h, uint32_t at);
+void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count);
 
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);

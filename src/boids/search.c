@@ -365,11 +365,13 @@ static void gather_begin_spatial(const akp_boids_ctx* c, uint32_t k, akp_boids_g
 }
 
 /* Hits held before they are visited (a bound on the stack, not on the candidates). */
-#define HIT_CAP 512
+#define HIT_CAP AKP_BOIDS_HIT_CAP
 #define HIT_PIECE 128
 
 /* Visit the hits hk[0..h) (spatial indices, with their d2). */
-static void visit_hits(const akp_boids_ctx* c, akp_boids_gather* g, const uint32_t* hk, const float* hd, uint32_t h) {
+static void visit_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* hb, uint32_t h) {
+    const uint32_t* hk = hb->k;
+    const float* hd = hb->d2;
     const float *X = c->sx, *Y = c->sy, *Z = c->sz;
     const int64_t* qv = c->sqv;
     const float px = g->p.x, py = g->p.y, pz = g->p.z;
@@ -384,6 +386,10 @@ static void visit_hits(const akp_boids_ctx* c, akp_boids_gather* g, const uint32
     }
     /* The common case (no cap, no predators, no list): visit() and accumulate() with the sums in
      * registers. Same tests, same values, same integer sums. */
+    if (c->avx512 && c->one_species) {
+        akp_boids_visit_avx512(c, g, hb, h);
+        return;
+    }
     int64_t s0 = 0, s1 = 0, s2 = 0, a0 = 0, a1 = 0, a2 = 0, c0 = 0, c1 = 0, c2 = 0;
     uint32_t ns = 0, na = 0, nc = 0, nf = 0;
     const uint8_t me = g->species;
@@ -438,26 +444,25 @@ static void gather_rows(const akp_boids_ctx* c, const row_ranges* r, akp_boids_g
     const float* restrict X = c->sx;
     const float* restrict Y = c->sy;
     const float* restrict Z = c->sz;
-    uint32_t hk[HIT_CAP];
-    float hd[HIT_CAP];
+    akp_boids_hits hb;
     uint32_t h = 0;
-#if AK_SIMD_SSE2
-    const __m128 vx = _mm_set1_ps(px), vy = _mm_set1_ps(py), vz = _mm_set1_ps(pz), vq = _mm_set1_ps(q2);
-#endif
     if (c->avx512) {
         /* Rows in pieces of at most HIT_PIECE, so a piece's hits (+16 stored past them) fit. */
         for (uint32_t a = 0; a < r->count; ++a)
             for (uint32_t t = r->begin[a]; t < r->end[a]; t += HIT_PIECE) {
                 const uint32_t e = r->end[a] - t > HIT_PIECE ? t + HIT_PIECE : r->end[a];
                 if (h + HIT_PIECE + 16 > HIT_CAP) {
-                    visit_hits(c, g, hk, hd, h);
+                    visit_hits(c, g, &hb, h);
                     h = 0;
                 }
-                h += akp_boids_filter_avx512(X, Y, Z, t, e, g->p, q2, hk + h, hd + h);
+                h += akp_boids_filter_avx512(X, Y, Z, t, e, g->p, q2, &hb, h);
             }
-        visit_hits(c, g, hk, hd, h);
+        visit_hits(c, g, &hb, h);
         return;
     }
+#if AK_SIMD_SSE2
+    const __m128 vx = _mm_set1_ps(px), vy = _mm_set1_ps(py), vz = _mm_set1_ps(pz), vq = _mm_set1_ps(q2);
+#endif
     for (uint32_t a = 0; a < r->count; ++a) {
         uint32_t t = r->begin[a];
         const uint32_t e = r->end[a];
@@ -471,12 +476,12 @@ static void gather_rows(const akp_boids_ctx* c, const row_ranges* r, akp_boids_g
             float d4[4];
             _mm_storeu_ps(d4, dd);
             for (unsigned l = 0; l < 4; ++l) {
-                hk[h] = t + l;
-                hd[h] = d4[l];
+                hb.k[h] = t + l;
+                hb.d2[h] = d4[l];
                 h += (m >> l) & 1u;
             }
             if (h > HIT_CAP - 4) {
-                visit_hits(c, g, hk, hd, h);
+                visit_hits(c, g, &hb, h);
                 h = 0;
             }
         }
@@ -484,16 +489,16 @@ static void gather_rows(const akp_boids_ctx* c, const row_ranges* r, akp_boids_g
         for (; t < e; ++t) {
             const float dx = X[t] - px, dy = Y[t] - py, dz = Z[t] - pz;
             const float dd = dx * dx + dy * dy + dz * dz;
-            hk[h] = t;
-            hd[h] = dd;
+            hb.k[h] = t;
+            hb.d2[h] = dd;
             h += dd < q2;
             if (h > HIT_CAP - 4) {
-                visit_hits(c, g, hk, hd, h);
+                visit_hits(c, g, &hb, h);
                 h = 0;
             }
         }
     }
-    visit_hits(c, g, hk, hd, h);
+    visit_hits(c, g, &hb, h);
 }
 
 /* Box coordinates of p's cell (p is an agent of the step, so its cell is in the box). */
@@ -656,6 +661,7 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     c->sj = sj;
     c->dstart = dstart;
     c->avx512 = akp_boids_have_avx512();
+    c->one_species = c->params->species_count == 1;
     return AK_OK;
 }
 
