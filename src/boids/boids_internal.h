@@ -63,6 +63,7 @@ typedef struct akp_boids_ctx {
 typedef struct akp_boids_gather {
     const akp_boids_sp* sp;
     uint32_t i;                    /* the agent (original index) */
+    uint32_t self_k;               /* its index in the spatial arrays, UINT32_MAX when not known */
     uint8_t species;
     ak_vec3 p, v;
     float v2;

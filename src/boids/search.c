@@ -15,6 +15,7 @@ static void gather_begin(const akp_boids_ctx* c, size_t i, akp_boids_gather* g) 
     const uint8_t s = job->species.ptr ? job->species.ptr[i] : 0;
     g->sp = &c->sp[s];
     g->i = (uint32_t)i;
+    g->self_k = UINT32_MAX;
     g->species = s;
     g->p = job->positions.ptr[i];
     g->v = job->velocities.ptr[i];
@@ -350,6 +351,7 @@ static void gather_begin_spatial(const akp_boids_ctx* c, uint32_t k, akp_boids_g
     const uint8_t s = c->ssp[k];
     g->sp = &c->sp[s];
     g->i = c->sj[k];
+    g->self_k = k;
     g->species = s;
     g->p = ak_vec3_make(c->sx[k], c->sy[k], c->sz[k]);
     g->v = c->sv[k];

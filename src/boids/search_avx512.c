@@ -78,7 +78,8 @@ AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather*
     const __m512 vx = _mm512_set1_ps(g->v.x), vy = _mm512_set1_ps(g->v.y), vz = _mm512_set1_ps(g->v.z);
     const __m512 lim_scale = _mm512_set1_ps(S->cos2), v2 = _mm512_set1_ps(g->v2);
     const bool cone = !(S->fov == 0 || g->v2 == 0.0f);
-    const __m512i self = _mm512_set1_epi32((int)g->i);
+    const __m512i self = _mm512_set1_epi32((int)g->i), self_slot = _mm512_set1_epi32((int)g->self_k);
+    const bool by_slot = g->self_k != UINT32_MAX;
     __m512i s0 = _mm512_setzero_si512(), s1 = s0, s2 = s0, a0 = s0, a1 = s0, a2 = s0, c0 = s0, c1 = s0, c2 = s0;
     uint32_t ns = 0, na = 0, nc = 0, nf = 0;
     for (uint32_t u = 0; u < count; u += 16) {
@@ -89,9 +90,12 @@ AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather*
         const __m512 dy = _mm512_maskz_loadu_ps(live, h->dy + u);
         const __m512 dz = _mm512_maskz_loadu_ps(live, h->dz + u);
         const __m512i kk = _mm512_maskz_loadu_epi32(live, h->k + u);
-        const __m512i jj = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), live, kk, (const void*)c->sj, 4);
         __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, rn2, _CMP_LT_OQ);
-        m &= _mm512_cmpneq_epi32_mask(jj, self);
+        if (by_slot) /* sj is a permutation: sj[t] == i exactly when t is the agent's slot */
+            m &= _mm512_cmpneq_epi32_mask(kk, self_slot);
+        else
+            m &= _mm512_cmpneq_epi32_mask(
+                _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), live, kk, (const void*)c->sj, 4), self);
         if (cone) {
             /* in_view(): dot = dx vx + dy vy + dz vz, lim = cos2 d2 v2; d2 == 0 is in view. */
             const __m512 dot =
