@@ -235,6 +235,11 @@ AK_API size_t ak_boids_min_distance_scratch_size(size_t count);
  * AK_ERR_SPAN_SMALL (scratch), AK_ERR_BAD_DATA (non-finite position). */
 AK_API ak_result ak_boids_min_distance(ak_vec3_cspan positions, ak_u8_span scratch, float* out_distance);
 
+/* Name of the grid-path kernels ak_boids_step_run uses on this CPU (chosen at run time):
+ * "avx512" (AVX-512 F+DQ distance filter and, for one species, neighbour rules), "sse2" or
+ * "scalar" (AK_NO_SIMD builds). Every kernel gives bit-identical results. */
+AK_API const char* ak_boids_simd_name(void);
+
 #ifdef __cplusplus
 }
 #endif

@@ -667,6 +667,14 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     return AK_OK;
 }
 
+const char* ak_boids_simd_name(void) {
+#if AK_SIMD_SSE2
+    return akp_boids_have_avx512() ? "avx512" : "sse2";
+#else
+    return "scalar";
+#endif
+}
+
 /* ---- drivers ----------------------------------------------------------------------------- */
 
 /* The search for one agent whose gather_begin is done, on whichever path the step uses. */
