@@ -180,7 +180,8 @@ typedef struct ak_boids_step_job {
 
 /* Scratch bytes ak_boids_step_run needs for this job (positions.count, params and use_naive
  * are read; 0 for the naive path, and 0 when no species looks at neighbours). The grid path
- * needs about 110 bytes per agent (the grid, velocities in fixed point, a dense cell table).
+ * needs about 140 bytes per agent (the grid, the agents re-sorted by cell, velocities in fixed
+ * point, a cell table).
  * Returns 0 when the job's params are unusable (validate says why). */
 AK_API size_t ak_boids_step_scratch_size(const ak_boids_step_job* job);
 
