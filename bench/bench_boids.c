@@ -119,7 +119,8 @@ int main(int argc, char** argv) {
     const double cpu1 = cpu_ms_last;
     const double ms2 = run(&w, 2, false, steps, &inter);
     const double cpu2 = cpu_ms_last;
-    printf("100,000 agents, 3D, radius 1 (separation 0.5), cube %.1f m, wrap\n", w.side);
+    printf("100,000 agents, 3D, radius 1 (separation 0.5), cube %.1f m, wrap; kernels %s\n", w.side,
+           ak_boids_simd_name());
     printf("  neighbours/agent     %.1f\n", (double)inter / (double)w.n);
     printf("  step, 1 thread       %.2f ms wall, %.2f ms CPU\n", ms1, cpu1);
     printf("  step, 2 threads      %.2f ms wall (x%.2f), %.2f ms CPU in all (%.2f per thread)\n", ms2, ms1 / ms2,

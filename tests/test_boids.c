@@ -690,14 +690,23 @@ AK_TEST(threads_and_paths_bit_identical) {
     AK_CHECK(memcmp(runs[0].p, base.p, base.n * sizeof(ak_vec3)) != 0);
     for (size_t i = 0; i < base.n; ++i) AK_CHECK(ak_vec3_is_finite(runs[0].p[i]) && ak_vec3_is_finite(runs[0].v[i]));
     for (int k = 0; k < 4; ++k) flock_free(&runs[k]);
-    /* The plain flock (no cap, no predators: the grid's register-sum fast path), 2D and 3D. */
+    /* The plain flock (no cap, no predators, one species: the grid's register-sum fast path and,
+     * on CPUs with AVX-512, its vector kernels), 2D and 3D, cones narrower and wider than a
+     * half-space and none, and a clump where every agent sees every other (more hits than the
+     * grid path holds at once, so they are visited in batches). */
     ak_boids_species plain = {.max_speed = 2, .separation_weight = 2, .separation_radius = 0.6f,
                               .alignment_weight = 1, .alignment_radius = 1.4f, .cohesion_weight = 1,
                               .cohesion_radius = 1.6f, .view_angle = 250};
     ak_boids_params pp = {.species = &plain, .species_count = 1};
-    for (int planar = 0; planar < 2; ++planar) {
-        pp.planar = planar != 0;
-        flock_random(&base, 78, 5.5f, 1.5f, pp.planar);
+    const struct {
+        bool planar;
+        float view, extent;
+    } cases[] = {{false, 250, 5.5f}, {true, 250, 5.5f}, {false, 120, 5.5f}, {false, 360, 5.5f}, {false, 250, 0.6f}};
+    for (size_t cs = 0; cs < sizeof cases / sizeof cases[0]; ++cs) {
+        pp.planar = cases[cs].planar;
+        plain.view_angle = cases[cs].view;
+        flock_random(&base, 78, cases[cs].extent, 1.5f, pp.planar);
+        base.p[1] = base.p[0]; /* coincident agents: distance 0 is in view, separation clamped */
         memset(base.s, 0, base.n);
         for (int k = 0; k < 4; ++k) {
             runs[k] = flock_make(base.n);

@@ -165,6 +165,41 @@ AK_TEST(json_contract) {
     free(copy);
 }
 
+/* Largest |coordinate| per axis of the agents in a --json file (-1 when unreadable). */
+static void json_extent(const char* path, double ext[3]) {
+    ext[0] = ext[1] = ext[2] = -1.0;
+    cJSON* root = cJSON_Parse(read_file(path));
+    if (!root) return;
+    const cJSON* agents = cJSON_GetObjectItem(root, "agents");
+    for (int i = 0; i < cJSON_GetArraySize(agents); ++i) {
+        const cJSON* p = cJSON_GetObjectItem(cJSON_GetArrayItem(agents, i), "p");
+        for (int a = 0; a < 3; ++a) ext[a] = fmax(ext[a], fabs(cJSON_GetArrayItem(p, a)->valuedouble));
+    }
+    cJSON_Delete(root);
+}
+
+AK_TEST(default_box_grows_with_count) {
+    double e[3];
+    /* Up to 500 agents: the documented 20 m box. */
+    AK_CHECK_EQ(run("boids --count 500 --steps 0 --json box500.json"), 0);
+    json_extent("box500.json", e);
+    for (int a = 0; a < 3; ++a) AK_CHECK(e[a] > 9.0 && e[a] <= 10.0);
+    /* 4,000 agents in 3D: 8x the agents, 2x the side (the same density). */
+    AK_CHECK_EQ(run("boids --count 4000 --steps 0 --json box4000.json"), 0);
+    json_extent("box4000.json", e);
+    for (int a = 0; a < 3; ++a) AK_CHECK(e[a] > 19.0 && e[a] <= 20.0);
+    /* 2,000 agents in 2D: 4x the agents, 2x the side of the plane. */
+    AK_CHECK_EQ(run("boids --count 2000 --2d --steps 0 --json box2d.json"), 0);
+    json_extent("box2d.json", e);
+    AK_CHECK(e[0] > 19.0 && e[0] <= 20.0 && e[2] > 19.0 && e[2] <= 20.0);
+    AK_CHECK_EQ(e[1], 0.0);
+    /* Bounds from the scene are kept. */
+    write_file("box_given.json", "{\"bounds\": {\"min\": [-5, -5, -5], \"max\": [5, 5, 5]}}");
+    AK_CHECK_EQ(run("boids box_given.json --count 4000 --steps 0 --json box_given_out.json"), 0);
+    json_extent("box_given_out.json", e);
+    for (int a = 0; a < 3; ++a) AK_CHECK(e[a] > 4.5 && e[a] <= 5.0);
+}
+
 AK_TEST(render_and_example_scene) {
     char args[1024];
     snprintf(args, sizeof args, "boids %s/examples/boids_flock.json --steps 20 --count 100 -o boids.png --size 160x120",
@@ -186,6 +221,7 @@ int main(void) {
     AK_RUN(usage);
     AK_RUN(bad_scenes_name_the_key);
     AK_RUN(json_contract);
+    AK_RUN(default_box_grows_with_count);
     AK_RUN(render_and_example_scene);
     return ak_test_finish();
 }

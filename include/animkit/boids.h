@@ -180,7 +180,8 @@ typedef struct ak_boids_step_job {
 
 /* Scratch bytes ak_boids_step_run needs for this job (positions.count, params and use_naive
  * are read; 0 for the naive path, and 0 when no species looks at neighbours). The grid path
- * needs about 110 bytes per agent (the grid, velocities in fixed point, a dense cell table).
+ * needs about 140 bytes per agent (the grid, the agents re-sorted by cell, velocities in fixed
+ * point, a cell table).
  * Returns 0 when the job's params are unusable (validate says why). */
 AK_API size_t ak_boids_step_scratch_size(const ak_boids_step_job* job);
 
@@ -234,6 +235,11 @@ AK_API size_t ak_boids_min_distance_scratch_size(size_t count);
  * spread-out agents). Fewer than two agents -> AK_ERR_EMPTY. Returns AK_ERR_NULL_ARG,
  * AK_ERR_SPAN_SMALL (scratch), AK_ERR_BAD_DATA (non-finite position). */
 AK_API ak_result ak_boids_min_distance(ak_vec3_cspan positions, ak_u8_span scratch, float* out_distance);
+
+/* Name of the grid-path kernels ak_boids_step_run uses on this CPU (chosen at run time):
+ * "avx512" (AVX-512 F+DQ distance filter and, for one species, neighbour rules), "sse2" or
+ * "scalar" (AK_NO_SIMD builds). Every kernel gives bit-identical results. */
+AK_API const char* ak_boids_simd_name(void);
 
 #ifdef __cplusplus
 }

@@ -41,20 +41,29 @@ typedef struct akp_boids_ctx {
     /* Grid path (use_naive false). */
     ak_grid grid;
     int rings;              /* cells visited on each side of an agent's cell */
-    const int64_t* sqv;     /* [3n] velocities in sorted order, fixed point (alignment sums) */
+    const int64_t* sqv;     /* [3n] velocities, fixed point (alignment sums), in sorted order */
     const uint8_t* ssp;     /* [n] species in sorted order */
-    /* Dense cell table over the occupied cells' bounding box (when it is small enough): cell
-     * (x, y, z) -> grid cell index m or UINT32_MAX, so a neighbour cell costs one load instead
-     * of a hash probe, and cells can be walked in spatial order. NULL when not built. */
-    uint32_t* dense;
+    /* Spatial layout, built when the occupied cells' bounding box is small enough: the agents
+     * re-sorted by cell in (z, y, x) order over that box, so the cells of one row of a
+     * neighbourhood are one contiguous range and no candidate is copied. dstart[cell] is the
+     * first agent of box cell (x, y, z) (cell = (z * dim[1] + y) * dim[0] + x), dstart[cell + 1]
+     * its end; empty cells are empty ranges. "Sorted order" above is this order when dstart is
+     * set, else the grid's. NULL when not built (the grid's hashed cells are used). */
+    uint32_t* dstart;
     int32_t dense_min[3];
     int32_t dense_dim[3];
+    const float *sx, *sy, *sz; /* [n] positions in spatial order */
+    const ak_vec3* sv;         /* [n] velocities in spatial order */
+    const uint32_t* sj;        /* [n] the agent's index in the caller's arrays */
+    bool avx512;               /* the spatial path runs the AVX-512 kernels */
+    bool one_species;          /* species_count == 1 */
 } akp_boids_ctx;
 
 /* What one agent gathers from its neighbours. */
 typedef struct akp_boids_gather {
     const akp_boids_sp* sp;
     uint32_t i;                    /* the agent (original index) */
+    uint32_t self_k;               /* its index in the spatial arrays, UINT32_MAX when not known */
     uint8_t species;
     ak_vec3 p, v;
     float v2;
@@ -75,6 +84,25 @@ ak_boids_bounds akp_boids_bounds_mode(const ak_boids_params* p);
 void akp_boids_ctx_init(akp_boids_ctx* c, const ak_boids_step_job* job);
 void akp_boids_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
 uint32_t akp_boids_threads(uint32_t requested, size_t n);
+
+/* Candidates of one agent that passed the distance test, before the neighbour rules: spatial
+ * index, d2 and the offset (candidate - agent). */
+#define AKP_BOIDS_HIT_CAP 512
+typedef struct akp_boids_hits {
+    uint32_t k[AKP_BOIDS_HIT_CAP];
+    float d2[AKP_BOIDS_HIT_CAP], dx[AKP_BOIDS_HIT_CAP], dy[AKP_BOIDS_HIT_CAP], dz[AKP_BOIDS_HIT_CAP];
+} akp_boids_hits;
+
+/* search_avx512.c (x86-64 GCC/Clang without AK_NO_SIMD; elsewhere have_avx512 is false).
+ * have_avx512: this CPU runs the kernels (AVX-512 F and DQ).
+ * filter: appends the candidates t in [begin, end) of the spatial arrays with d2 < q2 to h at
+ * `at` and returns how many; it stores 16 entries at a time, so h needs room for 16 more.
+ * visit: the register-sum fast path of visit_hits (one species, no cap, no list, no flee or
+ * pursue) for hits [0, count): the same tests and the same integer sums as the scalar code. */
+bool akp_boids_have_avx512(void);
+uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end, ak_vec3 p,
+                                 float q2, akp_boids_hits* h, uint32_t at);
+void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count);
 
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);

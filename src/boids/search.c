@@ -15,6 +15,7 @@ static void gather_begin(const akp_boids_ctx* c, size_t i, akp_boids_gather* g) 
     const uint8_t s = job->species.ptr ? job->species.ptr[i] : 0;
     g->sp = &c->sp[s];
     g->i = (uint32_t)i;
+    g->self_k = UINT32_MAX;
     g->species = s;
     g->p = job->positions.ptr[i];
     g->v = job->velocities.ptr[i];
@@ -161,27 +162,6 @@ static void ranges_around(const akp_boids_ctx* c, ak_grid_cell cc, cell_ranges* 
     const ak_grid* gr = &c->grid;
     const int R = c->rings;
     r->count = 0;
-    if (c->dense) {
-        const int32_t* lo = c->dense_min;
-        const int32_t* dim = c->dense_dim;
-        const int64_t x0 = (int64_t)cc.x - lo[0], y0 = (int64_t)cc.y - lo[1], z0 = (int64_t)cc.z - lo[2];
-        for (int64_t z = z0 - R; z <= z0 + R; ++z) {
-            if (z < 0 || z >= dim[2]) continue;
-            for (int64_t y = y0 - R; y <= y0 + R; ++y) {
-                if (y < 0 || y >= dim[1]) continue;
-                const uint32_t* row = c->dense + ((size_t)z * (size_t)dim[1] + (size_t)y) * (size_t)dim[0];
-                for (int64_t x = x0 - R; x <= x0 + R; ++x) {
-                    if (x < 0 || x >= dim[0]) continue;
-                    const uint32_t m = row[x];
-                    if (m == UINT32_MAX) continue;
-                    r->begin[r->count] = gr->cell_start[m];
-                    r->end[r->count] = gr->cell_start[m + 1];
-                    ++r->count;
-                }
-            }
-        }
-        return;
-    }
     for (int dz = -R; dz <= R; ++dz)
         for (int dy = -R; dy <= R; ++dy)
             for (int dx = -R; dx <= R; ++dx) {
@@ -338,6 +318,199 @@ static void gather_buffered(cand_buf* b, akp_boids_gather* g) {
     g->nflock += nf;
 }
 
+/* ---- spatial path ------------------------------------------------------------------------ */
+
+/* The rows of a neighbourhood in the spatial layout: (2R+1)^2 contiguous ranges. */
+typedef struct row_ranges {
+    uint32_t count;
+    uint32_t begin[(2 * MAX_RINGS + 1) * (2 * MAX_RINGS + 1)], end[(2 * MAX_RINGS + 1) * (2 * MAX_RINGS + 1)];
+} row_ranges;
+
+/* Rows around box cell (x, y, z) (box coordinates). */
+static void rows_around(const akp_boids_ctx* c, int64_t x, int64_t y, int64_t z, row_ranges* r) {
+    const int R = c->rings;
+    const int32_t* dim = c->dense_dim;
+    const int64_t xa = x - R > 0 ? x - R : 0, xb = x + R < dim[0] - 1 ? x + R : dim[0] - 1;
+    r->count = 0;
+    for (int64_t zz = z - R; zz <= z + R; ++zz) {
+        if (zz < 0 || zz >= dim[2]) continue;
+        for (int64_t yy = y - R; yy <= y + R; ++yy) {
+            if (yy < 0 || yy >= dim[1]) continue;
+            const size_t row = ((size_t)zz * (size_t)dim[1] + (size_t)yy) * (size_t)dim[0];
+            const uint32_t kb = c->dstart[row + (size_t)xa], ke = c->dstart[row + (size_t)xb + 1];
+            if (kb == ke) continue;
+            r->begin[r->count] = kb;
+            r->end[r->count] = ke;
+            ++r->count;
+        }
+    }
+}
+
+/* gather_begin from the spatial arrays (the same values, read in order). */
+static void gather_begin_spatial(const akp_boids_ctx* c, uint32_t k, akp_boids_gather* g) {
+    const uint8_t s = c->ssp[k];
+    g->sp = &c->sp[s];
+    g->i = c->sj[k];
+    g->self_k = k;
+    g->species = s;
+    g->p = ak_vec3_make(c->sx[k], c->sy[k], c->sz[k]);
+    g->v = c->sv[k];
+    g->v2 = ak_vec3_length_sq(g->v);
+    memset(g->sep, 0, sizeof g->sep);
+    memset(g->ali, 0, sizeof g->ali);
+    memset(g->coh, 0, sizeof g->coh);
+    g->ns = g->na = g->nc = g->nflock = g->kcount = 0;
+    g->flee_d2 = g->prey_d2 = INFINITY;
+    g->flee_j = g->prey_j = UINT32_MAX;
+    g->list = NULL;
+    g->list_count = 0;
+}
+
+/* Hits held before they are visited (a bound on the stack, not on the candidates). */
+#define HIT_CAP AKP_BOIDS_HIT_CAP
+#define HIT_PIECE 128
+
+/* Visit the hits hk[0..h) (spatial indices, with their d2). */
+static void visit_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* hb, uint32_t h) {
+    const uint32_t* hk = hb->k;
+    const float* hd = hb->d2;
+    const float *X = c->sx, *Y = c->sy, *Z = c->sz;
+    const int64_t* qv = c->sqv;
+    const float px = g->p.x, py = g->p.y, pz = g->p.z;
+    const akp_boids_sp* S = g->sp;
+    if (S->s.k_nearest || g->list || S->fr2 > 0.0f || S->pr2 > 0.0f) {
+        for (uint32_t u = 0; u < h; ++u) {
+            const uint32_t t = hk[u];
+            visit(g, c->sj[t], X[t] - px, Y[t] - py, Z[t] - pz, hd[u], qv[3 * t], qv[3 * t + 1], qv[3 * t + 2],
+                  c->ssp[t]);
+        }
+        return;
+    }
+    /* The common case (no cap, no predators, no list): visit() and accumulate() with the sums in
+     * registers. Same tests, same values, same integer sums. */
+    if (c->avx512 && c->one_species) {
+        akp_boids_visit_avx512(c, g, hb, h);
+        return;
+    }
+    int64_t s0 = 0, s1 = 0, s2 = 0, a0 = 0, a1 = 0, a2 = 0, c0 = 0, c1 = 0, c2 = 0;
+    uint32_t ns = 0, na = 0, nc = 0, nf = 0;
+    const uint8_t me = g->species;
+    const uint32_t self = g->i;
+    for (uint32_t u = 0; u < h; ++u) {
+        const uint32_t t = hk[u];
+        const float dd = hd[u];
+        if (c->ssp[t] != me || !(dd < S->rn2) || c->sj[t] == self) continue;
+        const float dx = X[t] - px, dy = Y[t] - py, dz = Z[t] - pz;
+        if (!in_view(S, g, dx, dy, dz, dd)) continue;
+        ++nf;
+        if (dd < S->rs2) {
+            const float inv = S->sep_scale / (dd > S->dmin2 ? dd : S->dmin2);
+            s0 += fix(-dx * inv);
+            s1 += fix(-dy * inv);
+            s2 += fix(-dz * inv);
+            ++ns;
+        }
+        if (dd < S->ra2) {
+            a0 += qv[3 * t];
+            a1 += qv[3 * t + 1];
+            a2 += qv[3 * t + 2];
+            ++na;
+        }
+        if (dd < S->rc2) {
+            c0 += fix(dx * S->coh_scale);
+            c1 += fix(dy * S->coh_scale);
+            c2 += fix(dz * S->coh_scale);
+            ++nc;
+        }
+    }
+    g->sep[0] += s0;
+    g->sep[1] += s1;
+    g->sep[2] += s2;
+    g->ali[0] += a0;
+    g->ali[1] += a1;
+    g->ali[2] += a2;
+    g->coh[0] += c0;
+    g->coh[1] += c1;
+    g->coh[2] += c2;
+    g->ns += ns;
+    g->na += na;
+    g->nc += nc;
+    g->nflock += nf;
+}
+
+/* The candidates of the rows straight from the spatial arrays: distances (the same operations
+ * as everywhere, so the same d2 bits), hits appended branch-free, visited in batches. */
+static void gather_rows(const akp_boids_ctx* c, const row_ranges* r, akp_boids_gather* g) {
+    const float q2 = g->sp->query_radius * g->sp->query_radius;
+    const float px = g->p.x, py = g->p.y, pz = g->p.z;
+    const float* restrict X = c->sx;
+    const float* restrict Y = c->sy;
+    const float* restrict Z = c->sz;
+    akp_boids_hits hb;
+    uint32_t h = 0;
+    if (c->avx512) {
+        /* Rows in pieces of at most HIT_PIECE, so a piece's hits (+16 stored past them) fit. */
+        for (uint32_t a = 0; a < r->count; ++a)
+            for (uint32_t t = r->begin[a]; t < r->end[a]; t += HIT_PIECE) {
+                const uint32_t e = r->end[a] - t > HIT_PIECE ? t + HIT_PIECE : r->end[a];
+                if (h + HIT_PIECE + 16 > HIT_CAP) {
+                    visit_hits(c, g, &hb, h);
+                    h = 0;
+                }
+                h += akp_boids_filter_avx512(X, Y, Z, t, e, g->p, q2, &hb, h);
+            }
+        visit_hits(c, g, &hb, h);
+        return;
+    }
+#if AK_SIMD_SSE2
+    const __m128 vx = _mm_set1_ps(px), vy = _mm_set1_ps(py), vz = _mm_set1_ps(pz), vq = _mm_set1_ps(q2);
+#endif
+    for (uint32_t a = 0; a < r->count; ++a) {
+        uint32_t t = r->begin[a];
+        const uint32_t e = r->end[a];
+#if AK_SIMD_SSE2
+        for (; t + 4 <= e; t += 4) {
+            const __m128 dx = _mm_sub_ps(_mm_loadu_ps(X + t), vx), dy = _mm_sub_ps(_mm_loadu_ps(Y + t), vy),
+                         dz = _mm_sub_ps(_mm_loadu_ps(Z + t), vz);
+            const __m128 dd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+            const unsigned m = (unsigned)_mm_movemask_ps(_mm_cmplt_ps(dd, vq));
+            if (!m) continue;
+            float d4[4];
+            _mm_storeu_ps(d4, dd);
+            for (unsigned l = 0; l < 4; ++l) {
+                hb.k[h] = t + l;
+                hb.d2[h] = d4[l];
+                h += (m >> l) & 1u;
+            }
+            if (h > HIT_CAP - 4) {
+                visit_hits(c, g, &hb, h);
+                h = 0;
+            }
+        }
+#endif
+        for (; t < e; ++t) {
+            const float dx = X[t] - px, dy = Y[t] - py, dz = Z[t] - pz;
+            const float dd = dx * dx + dy * dy + dz * dz;
+            hb.k[h] = t;
+            hb.d2[h] = dd;
+            h += dd < q2;
+            if (h > HIT_CAP - 4) {
+                visit_hits(c, g, &hb, h);
+                h = 0;
+            }
+        }
+    }
+    visit_hits(c, g, &hb, h);
+}
+
+/* Box coordinates of p's cell (p is an agent of the step, so its cell is in the box). */
+static void box_cell(const akp_boids_ctx* c, ak_vec3 p, int64_t* x, int64_t* y, int64_t* z) {
+    const ak_grid_cell q = ak_grid_cell_of(&c->grid, p);
+    *x = (int64_t)q.x - c->dense_min[0];
+    *y = (int64_t)q.y - c->dense_min[1];
+    *z = (int64_t)q.z - c->dense_min[2];
+}
+
 /* ---- scratch ----------------------------------------------------------------------------- */
 
 /* Cell size: the largest flock radius (most agents' queries then visit 27 cells); species
@@ -367,10 +540,10 @@ static size_t align64(size_t n) { return (n + 63u) & ~(size_t)63u; }
 /* Entries of the dense cell table (4 per agent: a flock fills a fair part of its box). */
 static size_t dense_cap(size_t n) { return 4 * n + 4096; }
 
-static void build_dense(akp_boids_ctx* c, uint32_t* table) {
+/* Bounding box of the occupied cells; true when its cell count fits dense_cap. */
+static bool dense_box(akp_boids_ctx* c) {
     const ak_grid* gr = &c->grid;
-    c->dense = NULL;
-    if (gr->cell_count == 0) return;
+    if (gr->cell_count == 0) return false;
     int64_t lo[3] = {INT64_MAX, INT64_MAX, INT64_MAX}, hi[3] = {INT64_MIN, INT64_MIN, INT64_MIN};
     for (uint32_t m = 0; m < gr->cell_count; ++m) {
         const int64_t v[3] = {gr->cell_coord[m].x, gr->cell_coord[m].y, gr->cell_coord[m].z};
@@ -383,20 +556,18 @@ static void build_dense(akp_boids_ctx* c, uint32_t* table) {
     const size_t cap = dense_cap(c->n);
     if (dx > (int64_t)cap || dy > (int64_t)cap || dz > (int64_t)cap || dx * dy > (int64_t)cap ||
         dx * dy * dz > (int64_t)cap)
-        return;
-    const size_t volume = (size_t)(dx * dy * dz);
-    memset(table, 0xFF, volume * sizeof(uint32_t));
-    for (uint32_t m = 0; m < gr->cell_count; ++m) {
-        const ak_grid_cell q = gr->cell_coord[m];
-        table[((size_t)(q.z - lo[2]) * (size_t)dy + (size_t)(q.y - lo[1])) * (size_t)dx + (size_t)(q.x - lo[0])] = m;
-    }
-    c->dense = table;
-    c->dense_min[0] = (int32_t)lo[0];
-    c->dense_min[1] = (int32_t)lo[1];
-    c->dense_min[2] = (int32_t)lo[2];
+        return false;
+    for (int a = 0; a < 3; ++a) c->dense_min[a] = (int32_t)lo[a];
     c->dense_dim[0] = (int32_t)dx;
     c->dense_dim[1] = (int32_t)dy;
     c->dense_dim[2] = (int32_t)dz;
+    return true;
+}
+
+static size_t box_index(const akp_boids_ctx* c, ak_grid_cell q) {
+    return ((size_t)(q.z - c->dense_min[2]) * (size_t)c->dense_dim[1] + (size_t)(q.y - c->dense_min[1])) *
+               (size_t)c->dense_dim[0] +
+           (size_t)(q.x - c->dense_min[0]);
 }
 
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job) {
@@ -407,7 +578,8 @@ size_t akp_boids_search_scratch_size(const ak_boids_step_job* job) {
     const ak_grid_desc gd = {.cell_size = cs};
     const size_t g = ak_grid_memory_size(n, &gd);
     if (g == 0) return 0;
-    return align64(g) + align64(3 * n * sizeof(int64_t)) + align64(n) + dense_cap(n) * sizeof(uint32_t) + 64;
+    return align64(g) + align64(3 * n * sizeof(int64_t)) + align64(n) + align64((dense_cap(n) + 1) * sizeof(uint32_t)) +
+           3 * align64(n * sizeof(float)) + align64(n * sizeof(ak_vec3)) + align64(n * sizeof(uint32_t)) + 64;
 }
 
 ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
@@ -426,35 +598,105 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     if (c->rings > MAX_RINGS) c->rings = MAX_RINGS;
     uint8_t* q = base + align64(gbytes);
     int64_t* qv = (int64_t*)(void*)q;
-    uint8_t* sp = q + align64(3 * n * sizeof(int64_t));
+    q += align64(3 * n * sizeof(int64_t));
+    uint8_t* sp = q;
+    q += align64(n);
+    uint32_t* dstart = (uint32_t*)(void*)q;
+    q += align64((dense_cap(n) + 1) * sizeof(uint32_t));
+    float* sx = (float*)(void*)q;
+    q += align64(n * sizeof(float));
+    float* sy = (float*)(void*)q;
+    q += align64(n * sizeof(float));
+    float* sz = (float*)(void*)q;
+    q += align64(n * sizeof(float));
+    ak_vec3* sv = (ak_vec3*)(void*)q;
+    q += align64(n * sizeof(ak_vec3));
+    uint32_t* sj = (uint32_t*)(void*)q;
     const ak_vec3* V = c->job->velocities.ptr;
     const uint8_t* S = c->job->species.ptr;
-    for (size_t k = 0; k < n; ++k) {
-        const uint32_t j = c->grid.order[k];
-        const uint8_t sj = S ? S[j] : 0;
-        const float as = c->sp[sj].ali_scale;
-        qv[3 * k] = fix(V[j].x * as);
-        qv[3 * k + 1] = fix(V[j].y * as);
-        qv[3 * k + 2] = fix(V[j].z * as);
-        sp[k] = sj;
-    }
+    const ak_grid* gr = &c->grid;
     c->sqv = qv;
     c->ssp = sp;
-    build_dense(c, (uint32_t*)(void*)(sp + align64(n)));
+    c->dstart = NULL;
+    if (!dense_box(c)) {
+        /* Sparse flock: the grid's order, cells found through its hash. */
+        for (size_t k = 0; k < n; ++k) {
+            const uint32_t j = gr->order[k];
+            const uint8_t s = S ? S[j] : 0;
+            const float as = c->sp[s].ali_scale;
+            qv[3 * k] = fix(V[j].x * as);
+            qv[3 * k + 1] = fix(V[j].y * as);
+            qv[3 * k + 2] = fix(V[j].z * as);
+            sp[k] = s;
+        }
+        return AK_OK;
+    }
+    /* Counting sort of the grid's cells into the box's (z, y, x) order. */
+    const size_t volume = (size_t)c->dense_dim[0] * (size_t)c->dense_dim[1] * (size_t)c->dense_dim[2];
+    memset(dstart, 0, (volume + 1) * sizeof(uint32_t));
+    for (uint32_t m = 0; m < gr->cell_count; ++m)
+        dstart[box_index(c, gr->cell_coord[m]) + 1] = gr->cell_start[m + 1] - gr->cell_start[m];
+    for (size_t b = 0; b < volume; ++b) dstart[b + 1] += dstart[b];
+    for (uint32_t m = 0; m < gr->cell_count; ++m) {
+        const uint32_t k0 = gr->cell_start[m], k1 = gr->cell_start[m + 1];
+        uint32_t d = dstart[box_index(c, gr->cell_coord[m])];
+        for (uint32_t k = k0; k < k1; ++k, ++d) {
+            const uint32_t j = gr->order[k];
+            const uint8_t s = S ? S[j] : 0;
+            const float as = c->sp[s].ali_scale;
+            const ak_vec3 v = V[j];
+            sx[d] = gr->x[k];
+            sy[d] = gr->y[k];
+            sz[d] = gr->z[k];
+            sv[d] = v;
+            sj[d] = j;
+            sp[d] = s;
+            qv[3 * d] = fix(v.x * as);
+            qv[3 * d + 1] = fix(v.y * as);
+            qv[3 * d + 2] = fix(v.z * as);
+        }
+    }
+    c->sx = sx;
+    c->sy = sy;
+    c->sz = sz;
+    c->sv = sv;
+    c->sj = sj;
+    c->dstart = dstart;
+    c->avx512 = akp_boids_have_avx512();
+    c->one_species = c->params->species_count == 1;
     return AK_OK;
+}
+
+const char* ak_boids_simd_name(void) {
+#if AK_SIMD_SSE2
+    return akp_boids_have_avx512() ? "avx512" : "sse2";
+#else
+    return "scalar";
+#endif
 }
 
 /* ---- drivers ----------------------------------------------------------------------------- */
 
-void akp_boids_gather_agent(const akp_boids_ctx* c, size_t i, akp_boids_gather* g) {
-    gather_begin(c, i, g);
-    if (c->search_radius <= 0.0f) return;
+/* The search for one agent whose gather_begin is done, on whichever path the step uses. */
+static void gather_search(const akp_boids_ctx* c, akp_boids_gather* g) {
     if (c->job->use_naive) gather_naive(c, g);
-    else {
+    else if (c->dstart) {
+        int64_t x, y, z;
+        row_ranges rr;
+        box_cell(c, g->p, &x, &y, &z);
+        rows_around(c, x, y, z, &rr);
+        gather_rows(c, &rr, g);
+    } else {
         cell_ranges r;
         ranges_around(c, ak_grid_cell_of(&c->grid, g->p), &r);
         gather_cells(c, &r, g);
     }
+}
+
+void akp_boids_gather_agent(const akp_boids_ctx* c, size_t i, akp_boids_gather* g) {
+    gather_begin(c, i, g);
+    if (c->search_radius <= 0.0f) return;
+    gather_search(c, g);
     gather_end(c, g);
 }
 
@@ -484,12 +726,7 @@ void akp_boids_list_agent(const akp_boids_ctx* c, size_t i, uint32_t* out, uint3
     gather_begin(c, i, &g);
     if (c->search_radius <= 0.0f || count == 0) return;
     g.list = out;
-    if (c->job->use_naive) gather_naive(c, &g);
-    else {
-        cell_ranges r;
-        ranges_around(c, ak_grid_cell_of(&c->grid, g.p), &r);
-        gather_cells(c, &r, &g);
-    }
+    gather_search(c, &g);
     gather_end(c, &g);
     AK_ASSERT(g.list_count == count);
     const size_t n = g.list_count;
@@ -513,33 +750,34 @@ void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, a
         }
         return;
     }
-    const ak_grid* gr = &c->grid;
-    cand_buf bufv; /* 24 KiB on this thread's stack */
-    cand_buf* buf = &bufv;
-    cell_ranges r;
-    if (c->dense) {
-        /* Cells in spatial order (neighbouring cells share their candidates in cache), the
+    if (c->dstart) {
+        /* Box cells in spatial order (neighbouring cells share their candidates in cache), the
          * z slabs split between the threads. */
         const int32_t* dim = c->dense_dim;
         const size_t z0 = (size_t)dim[2] * part / parts, z1 = (size_t)dim[2] * (part + 1) / parts;
         const size_t slab = (size_t)dim[0] * (size_t)dim[1];
-        for (size_t cell = z0 * slab; cell < z1 * slab; ++cell) {
-            const uint32_t m = c->dense[cell];
-            if (m == UINT32_MAX) continue;
-            const uint32_t k0 = gr->cell_start[m], k1 = gr->cell_start[m + 1];
-            ranges_around(c, gr->cell_coord[m], &r);
-            const bool buffered = cand_fill(c, &r, buf);
-            for (uint32_t k = k0; k < k1; ++k) {
-                const uint32_t i = gr->order[k];
-                gather_begin(c, i, &g);
-                if (buffered) gather_buffered(buf, &g);
-                else gather_cells(c, &r, &g);
-                gather_end(c, &g);
-                fn(c, i, &g, user);
+        row_ranges rr;
+        for (size_t z = z0; z < z1; ++z)
+            for (size_t y = 0; y < (size_t)dim[1]; ++y) {
+                const size_t row = z * slab + y * (size_t)dim[0];
+                for (size_t x = 0; x < (size_t)dim[0]; ++x) {
+                    const uint32_t k0 = c->dstart[row + x], k1 = c->dstart[row + x + 1];
+                    if (k0 == k1) continue;
+                    rows_around(c, (int64_t)x, (int64_t)y, (int64_t)z, &rr);
+                    for (uint32_t k = k0; k < k1; ++k) {
+                        gather_begin_spatial(c, k, &g);
+                        gather_rows(c, &rr, &g);
+                        gather_end(c, &g);
+                        fn(c, g.i, &g, user);
+                    }
+                }
             }
-        }
         return;
     }
+    const ak_grid* gr = &c->grid;
+    cand_buf bufv; /* 24 KiB on this thread's stack */
+    cand_buf* buf = &bufv;
+    cell_ranges r;
     /* Cells whose first sorted entry falls in [b, e): each cell's neighbour cells once. */
     uint32_t lo = 0, hi = gr->cell_count;
     while (lo < hi) {

@@ -12,7 +12,8 @@ static const char* const usage =
     "                     [--json OUT.json] [-o OUT.gif|OUT.png] [--size WxH]\n"
     "Reynolds flocking (separation, alignment, cohesion with a view cone and a k-nearest cap),\n"
     "obstacles, bounds, goal, leader, predators and wander; see docs/boids.md for the scene keys.\n"
-    "  --count    agents placed at random in the bounds when the scene has no \"agents\" (default 500)\n"
+    "  --count    agents placed at random in the bounds when the scene has no \"agents\" (default 500;\n"
+    "             beyond 500 the default 20 m box grows with the count, so the density stays)\n"
     "  --steps    steps to run (default 200)        --dt  seconds per step (default 0.02)\n"
     "  --seed     random placement and wander (default 1)\n"
     "  --threads  threads per step (default 1; results are identical for any count)\n"
@@ -336,6 +337,7 @@ int cmd_boids(int argc, char** argv) {
     if (seed >= 0) sc.seed = seed;
     if (dt > 0.0f) sc.dt = dt;
     if (CLI_GET(&a, "--2d")) sc.params.planar = true;
+    if (sc.agent_count == 0) cli_boids_scene_scale_bounds(&sc, sc.count);
 
     run_state st = {0};
     st.n = sc.agent_count > 0 ? sc.agent_count : sc.count;

@@ -33,6 +33,14 @@ void cli_boids_scene_defaults(cli_boids_scene* s) {
     s->shape_size = 0.5f;
 }
 
+void cli_boids_scene_scale_bounds(cli_boids_scene* s, size_t count) {
+    if (s->bounds_given || count <= CLI_BOIDS_BOX_AGENTS) return;
+    const double r = (double)count / CLI_BOIDS_BOX_AGENTS;
+    const float k = (float)(s->params.planar ? sqrt(r) : cbrt(r));
+    s->params.bounds_min = ak_vec3_scale(s->params.bounds_min, k);
+    s->params.bounds_max = ak_vec3_scale(s->params.bounds_max, k);
+}
+
 void cli_boids_scene_free(cli_boids_scene* s) {
     free(s->obstacles);
     free(s->positions);
@@ -176,6 +184,7 @@ int cli_boids_scene_parse(const char* file, const char* text, size_t size, cli_b
             static const char* const bkeys[] = {"min", "max", "mode", "margin", NULL};
             static const char* const modes[] = {"steer", "wrap", "none", NULL};
             cli_json_object(&j, b, "bounds", bkeys);
+            s->bounds_given = cJSON_GetObjectItemCaseSensitive(b, "min") || cJSON_GetObjectItemCaseSensitive(b, "max");
             cli_json_vec3(&j, b, "bounds", "min", &s->params.bounds_min);
             cli_json_vec3(&j, b, "bounds", "max", &s->params.bounds_max);
             int mode = 0;

@@ -26,6 +26,7 @@ typedef struct cli_boids_scene {
     long seed;
     float shape_size;                     /* metres, length of a rendered bird */
     int shape;                            /* 0 bird, 1 fish */
+    bool bounds_given;                    /* the scene set bounds.min or bounds.max */
 } cli_boids_scene;
 
 /* Defaults of every key (the scene without a file). */
@@ -38,5 +39,12 @@ int cli_boids_scene_parse(const char* file, const char* text, size_t size, cli_b
                           size_t message_size);
 
 void cli_boids_scene_free(cli_boids_scene* s);
+
+/* The default box for `count` random agents (call after --count and --2d are applied, only when
+ * the scene lists no agents): unless the scene set bounds.min or bounds.max, the 20 m box of the
+ * defaults grows beyond CLI_BOIDS_BOX_AGENTS agents by cbrt(count / CLI_BOIDS_BOX_AGENTS) on every
+ * axis (sqrt in 2D), so the density, and the neighbours per agent, stay those of 500 agents. */
+#define CLI_BOIDS_BOX_AGENTS 500u
+void cli_boids_scene_scale_bounds(cli_boids_scene* s, size_t count);
 
 #endif

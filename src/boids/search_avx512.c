@@ -1,0 +1,169 @@
+/* AVX-512 kernels of the boids grid path (spatial layout), 16 lanes at a time:
+ * - the distance filter: the row's tail through masked loads (no read past the row), hits
+ *   packed with compress into registers;
+ * - the neighbour rules of the common case, with the fixed-point sums in 64-bit lanes.
+ * Every float operation is the scalar code's, in the same order, each rounded (no FMA:
+ * intrinsics only, C11 mode), and float -> int64 truncates like the C cast, so d2, the hit
+ * set and the integer sums are bit-identical to the scalar and naive paths (tested).
+ *
+ * Compiled only for GCC/Clang on x86-64 without AK_NO_SIMD; selected at run time with
+ * __builtin_cpu_supports (search.c falls back to its SSE2/scalar loops). */
+#include "boids_internal.h"
+
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
+#include <immintrin.h>
+
+#define AKP_AVX512 __attribute__((target("avx512f,avx512dq")))
+
+bool akp_boids_have_avx512(void) { return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq"); }
+
+AKP_AVX512 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin,
+                                            uint32_t end, ak_vec3 p, float q2, akp_boids_hits* h, uint32_t at) {
+    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
+    const __m512 vq = _mm512_set1_ps(q2);
+    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    uint32_t n = at;
+    for (uint32_t t = begin; t < end; t += 16) {
+        const uint32_t left = end - t;
+        const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
+        const __m512 dx = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, X + t), vx);
+        const __m512 dy = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, Y + t), vy);
+        const __m512 dz = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, Z + t), vz);
+        const __m512 dd = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+        const __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, vq, _CMP_LT_OQ);
+        if (!m) continue;
+        const __m512i k = _mm512_add_epi32(_mm512_set1_epi32((int)t), lane);
+        _mm512_storeu_si512((void*)(h->k + n), _mm512_maskz_compress_epi32(m, k));
+        _mm512_storeu_ps(h->d2 + n, _mm512_maskz_compress_ps(m, dd));
+        _mm512_storeu_ps(h->dx + n, _mm512_maskz_compress_ps(m, dx));
+        _mm512_storeu_ps(h->dy + n, _mm512_maskz_compress_ps(m, dy));
+        _mm512_storeu_ps(h->dz + n, _mm512_maskz_compress_ps(m, dz));
+        n += (uint32_t)__builtin_popcount(m);
+    }
+    return n - at;
+}
+
+/* fix() of search.c on 16 lanes: clamp to +-AKP_BOIDS_FIX_CLAMP, truncate to int64 (lo, hi). */
+AKP_AVX512 static inline void fix16(__m512 x, __m512i* lo, __m512i* hi) {
+    x = _mm512_max_ps(x, _mm512_set1_ps(-AKP_BOIDS_FIX_CLAMP));
+    x = _mm512_min_ps(x, _mm512_set1_ps(AKP_BOIDS_FIX_CLAMP));
+    *lo = _mm512_cvttps_epi64(_mm512_castps512_ps256(x));
+    *hi = _mm512_cvttps_epi64(_mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(x), 1)));
+}
+
+/* sum += fix(x) on the lanes of m. */
+AKP_AVX512 static inline void add_fixed(__m512i* sum, __mmask16 m, __m512 x) {
+    __m512i lo, hi;
+    fix16(x, &lo, &hi);
+    *sum = _mm512_mask_add_epi64(*sum, (__mmask8)(m & 0xFF), *sum, lo);
+    *sum = _mm512_mask_add_epi64(*sum, (__mmask8)(m >> 8), *sum, hi);
+}
+
+/* sum += qv[3 k + comp] on the lanes of m. */
+AKP_AVX512 static inline void add_gathered(__m512i* sum, __mmask16 m, __m512i k3, const int64_t* qv) {
+    const __m256i ilo = _mm512_castsi512_si256(k3);
+    const __m256i ihi = _mm512_extracti64x4_epi64(k3, 1);
+    const __m512i z = _mm512_setzero_si512();
+    const __m512i lo = _mm512_mask_i32gather_epi64(z, (__mmask8)(m & 0xFF), ilo, (const void*)qv, 8);
+    const __m512i hi = _mm512_mask_i32gather_epi64(z, (__mmask8)(m >> 8), ihi, (const void*)qv, 8);
+    *sum = _mm512_add_epi64(*sum, _mm512_add_epi64(lo, hi));
+}
+
+AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h,
+                                       uint32_t count) {
+    const akp_boids_sp* S = g->sp;
+    const __m512 rn2 = _mm512_set1_ps(S->rn2), rs2 = _mm512_set1_ps(S->rs2), ra2 = _mm512_set1_ps(S->ra2),
+                 rc2 = _mm512_set1_ps(S->rc2), dmin2 = _mm512_set1_ps(S->dmin2), sep = _mm512_set1_ps(S->sep_scale),
+                 coh = _mm512_set1_ps(S->coh_scale), zero = _mm512_setzero_ps();
+    const __m512 vx = _mm512_set1_ps(g->v.x), vy = _mm512_set1_ps(g->v.y), vz = _mm512_set1_ps(g->v.z);
+    const __m512 lim_scale = _mm512_set1_ps(S->cos2), v2 = _mm512_set1_ps(g->v2);
+    const bool cone = !(S->fov == 0 || g->v2 == 0.0f);
+    const __m512i self = _mm512_set1_epi32((int)g->i), self_slot = _mm512_set1_epi32((int)g->self_k);
+    const bool by_slot = g->self_k != UINT32_MAX;
+    __m512i s0 = _mm512_setzero_si512(), s1 = s0, s2 = s0, a0 = s0, a1 = s0, a2 = s0, c0 = s0, c1 = s0, c2 = s0;
+    uint32_t ns = 0, na = 0, nc = 0, nf = 0;
+    for (uint32_t u = 0; u < count; u += 16) {
+        const uint32_t left = count - u;
+        const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
+        const __m512 dd = _mm512_maskz_loadu_ps(live, h->d2 + u);
+        const __m512 dx = _mm512_maskz_loadu_ps(live, h->dx + u);
+        const __m512 dy = _mm512_maskz_loadu_ps(live, h->dy + u);
+        const __m512 dz = _mm512_maskz_loadu_ps(live, h->dz + u);
+        const __m512i kk = _mm512_maskz_loadu_epi32(live, h->k + u);
+        __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, rn2, _CMP_LT_OQ);
+        if (by_slot) /* sj is a permutation: sj[t] == i exactly when t is the agent's slot */
+            m &= _mm512_cmpneq_epi32_mask(kk, self_slot);
+        else
+            m &= _mm512_cmpneq_epi32_mask(
+                _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), live, kk, (const void*)c->sj, 4), self);
+        if (cone) {
+            /* in_view(): dot = dx vx + dy vy + dz vz, lim = cos2 d2 v2; d2 == 0 is in view. */
+            const __m512 dot =
+                _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, vx), _mm512_mul_ps(dy, vy)), _mm512_mul_ps(dz, vz));
+            const __m512 lim = _mm512_mul_ps(_mm512_mul_ps(lim_scale, dd), v2);
+            const __m512 dot2 = _mm512_mul_ps(dot, dot);
+            __mmask16 ok;
+            if (S->fov == 1)
+                ok = _mm512_cmp_ps_mask(dot, zero, _CMP_GT_OQ) & _mm512_cmp_ps_mask(dot2, lim, _CMP_GE_OQ);
+            else
+                ok = _mm512_cmp_ps_mask(dot, zero, _CMP_GE_OQ) | _mm512_cmp_ps_mask(dot2, lim, _CMP_LE_OQ);
+            ok |= _mm512_cmp_ps_mask(dd, zero, _CMP_EQ_OQ);
+            m &= ok;
+        }
+        if (!m) continue;
+        nf += (uint32_t)__builtin_popcount(m);
+        const __mmask16 ms = _mm512_mask_cmp_ps_mask(m, dd, rs2, _CMP_LT_OQ);
+        if (ms) {
+            /* inv = sep_scale / (d2 > dmin2 ? d2 : dmin2); fix(-d * inv) */
+            const __m512 den = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(dd, dmin2, _CMP_GT_OQ), dmin2, dd);
+            const __m512 inv = _mm512_div_ps(sep, den);
+            const __m512 sign = _mm512_set1_ps(-0.0f);
+            add_fixed(&s0, ms, _mm512_mul_ps(_mm512_xor_ps(dx, sign), inv));
+            add_fixed(&s1, ms, _mm512_mul_ps(_mm512_xor_ps(dy, sign), inv));
+            add_fixed(&s2, ms, _mm512_mul_ps(_mm512_xor_ps(dz, sign), inv));
+            ns += (uint32_t)__builtin_popcount(ms);
+        }
+        const __mmask16 ma = _mm512_mask_cmp_ps_mask(m, dd, ra2, _CMP_LT_OQ);
+        if (ma) {
+            const __m512i k3 = _mm512_add_epi32(_mm512_add_epi32(kk, kk), kk);
+            add_gathered(&a0, ma, k3, c->sqv);
+            add_gathered(&a1, ma, k3, c->sqv + 1);
+            add_gathered(&a2, ma, k3, c->sqv + 2);
+            na += (uint32_t)__builtin_popcount(ma);
+        }
+        const __mmask16 mc = _mm512_mask_cmp_ps_mask(m, dd, rc2, _CMP_LT_OQ);
+        if (mc) {
+            add_fixed(&c0, mc, _mm512_mul_ps(dx, coh));
+            add_fixed(&c1, mc, _mm512_mul_ps(dy, coh));
+            add_fixed(&c2, mc, _mm512_mul_ps(dz, coh));
+            nc += (uint32_t)__builtin_popcount(mc);
+        }
+    }
+    g->sep[0] += _mm512_reduce_add_epi64(s0);
+    g->sep[1] += _mm512_reduce_add_epi64(s1);
+    g->sep[2] += _mm512_reduce_add_epi64(s2);
+    g->ali[0] += _mm512_reduce_add_epi64(a0);
+    g->ali[1] += _mm512_reduce_add_epi64(a1);
+    g->ali[2] += _mm512_reduce_add_epi64(a2);
+    g->coh[0] += _mm512_reduce_add_epi64(c0);
+    g->coh[1] += _mm512_reduce_add_epi64(c1);
+    g->coh[2] += _mm512_reduce_add_epi64(c2);
+    g->ns += ns;
+    g->na += na;
+    g->nc += nc;
+    g->nflock += nf;
+}
+
+#else
+bool akp_boids_have_avx512(void) { return false; }
+
+uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end, ak_vec3 p,
+                                 float q2, akp_boids_hits* h, uint32_t at) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)p, (void)q2, (void)h, (void)at;
+    return 0;
+}
+
+void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count) {
+    (void)c, (void)g, (void)h, (void)count;
+}
+#endif
