@@ -1,15 +1,16 @@
 /* animkit view: the simulations it runs live (view_sim plug-ins). `animkit view KIND:SPEC`
- * picks one: particles:SCENE.json, particles:preset:NAME. Each reuses its command's scene
- * parser and drawing (particles_run.c), so the viewer shows what the command renders. */
+ * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json]. Each reuses its
+ * command's scene parser and drawing (particles_run.c, boids_run.c), so the viewer shows what the command renders. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "boids_run.h"
 #include "cli_json.h"
 #include "particles_run.h"
 #include "view_app.h"
 
-const char* const view_sim_kinds = "particles";
+const char* const view_sim_kinds = "particles, boids";
 
 #define MAX_STEPS_PER_FRAME 64
 #define WIND_STEP 0.5f
@@ -324,6 +325,179 @@ static const view_sim particles_sim = {
     .key_count = sizeof psim_keys / sizeof psim_keys[0],
 };
 
+/* ---- boids ------------------------------------------------------------------------------- */
+
+typedef struct bsim {
+    cli_boids_scene sc;
+    ak_boids_obstacle* obstacles0; /* as loaded (reset puts them back) */
+    boids_run run;
+    boids_shapes sh;
+    long step_index;
+    double carry;
+    bool failed;
+    const char* file;
+    ak_vec3 lo, hi;
+    float extent;
+    int grabbed;
+} bsim;
+
+static void bsim_destroy(void* state) {
+    bsim* b = state;
+    if (!b) return;
+    boids_run_free(&b->run);
+    boids_shapes_free(&b->sh);
+    free(b->obstacles0);
+    cli_boids_scene_free(&b->sc);
+    free(b);
+}
+
+static int bsim_restart(bsim* b) {
+    uint32_t no = b->sc.params.obstacle_count;
+    if (no) memcpy(b->sc.obstacles, b->obstacles0, no * sizeof *b->obstacles0);
+    boids_run_free(&b->run);
+    b->step_index = 0;
+    b->carry = 0.0;
+    b->failed = false;
+    int rc = boids_run_init(&b->run, &b->sc, "view", b->file, 1);
+    if (rc) return rc;
+    return boids_shapes_obstacles(&b->sh, &b->sc.params, b->extent) ? CLI_OK : cli_fail("view", "out of memory");
+}
+
+static int bsim_init(void** state, const char* spec, char* err, size_t err_size) {
+    bsim* b = calloc(1, sizeof *b);
+    if (!b) {
+        snprintf(err, err_size, "out of memory");
+        return CLI_BAD_INPUT;
+    }
+    b->grabbed = -1;
+    b->file = spec[0] ? spec : "boids (default scene)";
+    cli_boids_scene_defaults(&b->sc);
+    if (spec[0]) {
+        size_t size = 0;
+        char* text = read_scene(spec, &size, err, err_size);
+        int bad = !text || cli_boids_scene_parse(spec, text, size, &b->sc, err, err_size);
+        free(text);
+        if (bad) {
+            bsim_destroy(b);
+            return CLI_BAD_INPUT;
+        }
+    }
+    /* the box the command's camera looks at, down to its ground */
+    const ak_boids_params* prm = &b->sc.params;
+    b->lo = prm->bounds_min;
+    b->hi = prm->bounds_max;
+    b->extent = 0.5f * ak_vec3_length(ak_vec3_sub(b->hi, b->lo));
+    float ground = prm->planar ? -0.5f * b->sc.shape_size - 0.3f : b->lo.y - 0.05f * b->extent;
+    for (uint32_t k = 0; k < prm->obstacle_count; ++k)
+        if (boids_is_floor(&prm->obstacles[k])) ground = prm->obstacles[k].center.y;
+    if (prm->planar) b->lo.y = b->hi.y = 0.0f;
+    b->lo.y = ak_minf(b->lo.y, ground);
+    size_t n = b->sc.agent_count > 0 ? b->sc.agent_count : b->sc.count;
+    b->obstacles0 = calloc(prm->obstacle_count + 1u, sizeof *b->obstacles0);
+    if (!b->obstacles0 || !boids_shapes_init(&b->sh, &b->sc, n, b->extent)) {
+        snprintf(err, err_size, "out of memory");
+        bsim_destroy(b);
+        return CLI_BAD_INPUT;
+    }
+    if (prm->obstacle_count) memcpy(b->obstacles0, b->sc.obstacles, prm->obstacle_count * sizeof *b->obstacles0);
+    if (bsim_restart(b)) {
+        snprintf(err, err_size, "cannot start the flock");
+        bsim_destroy(b);
+        return CLI_BAD_INPUT;
+    }
+    *state = b;
+    return CLI_OK;
+}
+
+static void bsim_step(void* state, float dt) {
+    bsim* b = state;
+    if (b->failed) return;
+    const float sdt = b->sc.dt;
+    b->carry += (double)dt;
+    for (int n = 0; b->carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
+        if (boids_run_step(&b->run, b->step_index) != AK_OK) {
+            b->failed = true;
+            return;
+        }
+        ++b->step_index;
+        b->carry -= (double)sdt;
+    }
+    if (b->carry > (double)sdt) b->carry = 0.0;
+}
+
+static void bsim_reset(void* state) {
+    bsim* b = state;
+    if (bsim_restart(b) != CLI_OK) b->failed = true;
+}
+
+static size_t bsim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
+    bsim* b = state;
+    ak_raster_mesh birds, obs;
+    boids_shapes_update(&b->sh, &b->sc, &b->run, (float)b->step_index * b->sc.dt, &birds, &obs);
+    size_t n = 0;
+    if (n < cap && b->run.n) out[n++] = birds;
+    if (n < cap && b->sh.otri) out[n++] = obs;
+    return n;
+}
+
+static void bsim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
+    bsim* b = state;
+    *lo = ak_vec3_min(*lo, b->lo);
+    *hi = ak_vec3_max(*hi, b->hi);
+}
+
+static bool bsim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
+    bsim* b = state;
+    b->grabbed = -1;
+    float best = INFINITY;
+    for (uint32_t k = 0; k < b->sc.params.obstacle_count; ++k) {
+        const ak_boids_obstacle* o = &b->sc.obstacles[k];
+        ak_vec3 c;
+        float r;
+        if (o->kind != AK_BOIDS_SPHERE || !project_sphere(cam, w, h, o->center, o->radius, &c, &r)) continue;
+        float d = hypotf(c.x - x, c.y - y);
+        if (d <= r && c.z < best) best = c.z, b->grabbed = (int)k;
+    }
+    if (b->grabbed < 0) return false;
+    *anchor = b->sc.obstacles[b->grabbed].center;
+    return true;
+}
+
+static void bsim_drag(void* state, ak_vec3 delta) {
+    bsim* b = state;
+    if (b->grabbed < 0 || !ak_vec3_is_finite(delta)) return;
+    ak_boids_obstacle* o = &b->sc.obstacles[b->grabbed];
+    o->center = ak_vec3_add(o->center, delta);
+    if (b->sc.params.planar) o->center.y = 0.0f; /* 2D flocks cut obstacles at y = 0 */
+    if (!boids_shapes_obstacles(&b->sh, &b->sc.params, b->extent)) b->sh.overt = b->sh.otri = 0;
+}
+
+static void bsim_status(void* state, char* out, size_t n) {
+    bsim* b = state;
+    snprintf(out, n, "t %.2fs, %zu agents, order %.3f%s", (double)b->step_index * (double)b->sc.dt, b->run.n,
+             (double)ak_boids_order((ak_vec3_cspan){b->run.v, b->run.n}), b->failed ? ", stopped (step failed)" : "");
+}
+
+static const view_help_entry bsim_keys[] = {
+    {"r", "restart the flock (also tab)"},
+    {"right", "one frame of simulation, paused"},
+};
+
+static const view_sim boids_sim = {
+    .name = "boids",
+    .init = bsim_init,
+    .step = bsim_step,
+    .reset = bsim_reset,
+    .meshes = bsim_meshes,
+    .bounds = bsim_bounds,
+    .grab = bsim_grab,
+    .drag = bsim_drag,
+    .status = bsim_status,
+    .destroy = bsim_destroy,
+    .keys = bsim_keys,
+    .key_count = sizeof bsim_keys / sizeof bsim_keys[0],
+};
+
 /* ---- the table ---------------------------------------------------------------------------- */
 
 static const struct {
@@ -331,6 +505,7 @@ static const struct {
     const view_sim* sim;
 } sims[] = {
     {"particles", &particles_sim},
+    {"boids", &boids_sim},
 };
 
 const view_sim* view_sim_find(const char* arg, const char** spec) {
