@@ -29,5 +29,6 @@
 #include "grid.h"
 #include "particles.h"
 #include "boids.h"
+#include "cloth.h"
 
 #endif

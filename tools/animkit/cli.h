@@ -155,5 +155,6 @@ int cmd_terrain(int argc, char** argv);
 int cmd_particles(int argc, char** argv);
 int cmd_boids(int argc, char** argv);
 int cmd_view(int argc, char** argv);
+int cmd_cloth(int argc, char** argv);
 
 #endif

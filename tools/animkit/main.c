@@ -24,6 +24,7 @@ static const command commands[] = {
     {"particles", cmd_particles, "simulate a particle system (scene file or preset) to JSON, PNG or GIF"},
     {"boids", cmd_boids, "flocking: Reynolds boids with obstacles and predators (JSON, PNG, GIF)"},
     {"view", cmd_view, "interactive viewer: play clips, compare skinning, drag IK targets (--headless, --script)"},
+    {"cloth", cmd_cloth, "simulate cloth (XPBD or mass-spring): flag, curtain, drape, cape"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 
