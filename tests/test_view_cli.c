@@ -474,6 +474,9 @@ AK_TEST(sim_bad_specs) {
         {"view particles:sim_bad.json --headless", 1, "spheres"},
         {"view particles:preset:rain --headless --clip 0", 2, "--clip"},
         {"view boids:no_such_flock.json --headless", 1, "no_such_flock.json"},
+        {"view cloth:preset:tent --headless", 2, "flag, curtain, drape, cape"},
+        {"view cloth --headless", 2, "cloth:preset:NAME"},
+        {"view cloth:no_such_cloth.json --headless", 1, "no_such_cloth.json"},
         {"view boids:sim_bad.json --headless", 1, "sim_bad.json"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
@@ -513,6 +516,11 @@ AK_TEST(sim_particles_play_pause_reset) {
     sim_play_pause_reset("particles:preset:fountain", "fountain", 240, 180, true);
     sim_play_pause_reset("particles:preset:fireworks", "fireworks", 200, 150, true);
     sim_play_pause_reset("particles:" AK_SOURCE_DIR "/examples/particles_fountain.json", "pfile", 200, 150, true);
+}
+
+AK_TEST(sim_cloth_play_pause_reset) {
+    sim_play_pause_reset("cloth:preset:flag", "flag", 200, 150, true);
+    sim_play_pause_reset("cloth:preset:drape", "drape", 200, 150, false); /* no wind to speak of in 12 frames */
 }
 
 AK_TEST(sim_boids_play_pause_reset) {
@@ -615,6 +623,7 @@ int main(void) {
     AK_RUN(sim_bad_specs);
     AK_RUN(sim_particles_play_pause_reset);
     AK_RUN(sim_boids_play_pause_reset);
+    AK_RUN(sim_cloth_play_pause_reset);
     AK_RUN(sim_drag_sphere);
     AK_RUN(sim_long_session);
     return ak_test_finish();

@@ -13,8 +13,9 @@ static const char* const usage =
     "Open a window on the model, shaded by animkit's own rasterizer, playing clip C (default the\n"
     "first). The camera starts framed on the first pose as `animkit render` frames one time.\n"
     "SIM runs a simulation live: particles:SCENE.json, particles:preset:fountain|rain|fireworks|\n"
-    "character, boids[:SCENE.json] (space pauses, right steps one frame, r restarts, left drag\n"
-    "on a sphere collider moves it, a/d/q/e change the particles' wind; docs/view.md).\n"
+    "character, boids[:SCENE.json], cloth:SCENE.json, cloth:preset:flag|curtain|drape|cape (space\n"
+    "pauses, right steps one frame, r restarts, left drag on a sphere collider moves it, a/d/q/e\n"
+    "change the wind of particles and cloth; docs/view.md).\n"
     "  --size WxH       window size (default 960x600)\n"
     "  --script FILE    replay input from FILE, one event a line: key NAME, mouse_down BUTTON X Y,\n"
     "                   mouse_move X Y, mouse_up BUTTON X Y, wheel DY, wait FRAMES,\n"
@@ -109,8 +110,8 @@ int cmd_view(int argc, char** argv) {
         if (n > 0 && a.pos[0][n] == ':' && strncmp(a.pos[0], "builtin:", 8) != 0)
             return cli_usage("view", "'%.*s' is not a simulation (%s): %s", (int)n, a.pos[0], view_sim_kinds, a.pos[0]);
         if (cli_has_ext(a.pos[0], ".json"))
-            return cli_usage("view", "%s: name the simulation of a scene file: particles:%s or boids:%s", a.pos[0],
-                             a.pos[0], a.pos[0]);
+            return cli_usage("view", "%s: name the simulation of a scene file: particles:%s, boids:%s or cloth:%s",
+                             a.pos[0], a.pos[0], a.pos[0], a.pos[0]);
     }
 
     view_script script = {0};

@@ -107,10 +107,10 @@ typedef struct view_sim {
     size_t key_count;
 } view_sim;
 
-/* The simulation a `animkit view` argument names ("particles:...", "boids", "boids:..."), with *spec the text after the colon ("" when none); NULL when the argument
+/* The simulation a `animkit view` argument names ("particles:...", "boids", "boids:...", "cloth:..."), with *spec the text after the colon ("" when none); NULL when the argument
  * names no simulation (a model path or builtin:NAME). */
 const view_sim* view_sim_find(const char* arg, const char** spec);
-/* The kinds, for messages ("particles, boids"). */
+/* The kinds, for messages ("particles, boids, cloth"). */
 extern const char* const view_sim_kinds;
 
 /* ---- the app ---- */

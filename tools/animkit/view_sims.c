@@ -1,16 +1,18 @@
 /* animkit view: the simulations it runs live (view_sim plug-ins). `animkit view KIND:SPEC`
- * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json]. Each reuses its
- * command's scene parser and drawing (particles_run.c, boids_run.c), so the viewer shows what the command renders. */
+ * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json], cloth:SCENE.json,
+ * cloth:preset:NAME. Each reuses its command's scene parser and drawing (particles_run.c,
+ * boids_run.c, cloth_run.c), so the viewer shows what the command renders. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "boids_run.h"
 #include "cli_json.h"
+#include "cloth_run.h"
 #include "particles_run.h"
 #include "view_app.h"
 
-const char* const view_sim_kinds = "particles, boids";
+const char* const view_sim_kinds = "particles, boids, cloth";
 
 #define MAX_STEPS_PER_FRAME 64
 #define WIND_STEP 0.5f
@@ -498,6 +500,227 @@ static const view_sim boids_sim = {
     .key_count = sizeof bsim_keys / sizeof bsim_keys[0],
 };
 
+/* ---- cloth -------------------------------------------------------------------------------- */
+
+typedef struct csim {
+    cloth_scene sc;
+    bool sc_ready;
+    char name[64];
+    ak_cloth_sphere* spheres0; /* as loaded (reset puts them back, and the wind) */
+    ak_vec3 wind0;
+    cloth_run run;
+    cloth_prop* props;         /* spheres, then the scene's capsules */
+    size_t prop_count;
+    double carry;
+    bool failed;
+    ak_vec3 lo, hi;
+    int grabbed;
+} csim;
+
+static void csim_destroy(void* state) {
+    csim* c = state;
+    if (!c) return;
+    cloth_run_free(&c->run);
+    free(c->props);
+    free(c->spheres0);
+    if (c->sc_ready) cloth_scene_free(&c->sc);
+    free(c);
+}
+
+static void csim_props(csim* c) {
+    for (size_t k = 0; k < c->prop_count; ++k) {
+        if (k < c->sc.sphere_count) {
+            cloth_prop_build(&c->props[k], c->sc.spheres[k].center, c->sc.spheres[k].center, c->sc.spheres[k].radius);
+        } else {
+            const ak_cloth_capsule* cp = &c->sc.capsules[k - c->sc.sphere_count];
+            cloth_prop_build(&c->props[k], cp->a, cp->b, cp->radius);
+        }
+    }
+}
+
+static int csim_restart(csim* c) {
+    if (c->sc.sphere_count) memcpy(c->sc.spheres, c->spheres0, c->sc.sphere_count * sizeof *c->spheres0);
+    c->sc.wind = c->wind0;
+    cloth_run_free(&c->run);
+    c->carry = 0.0;
+    c->failed = false;
+    csim_props(c);
+    return cloth_run_init(&c->run, &c->sc, "view", c->name);
+}
+
+static int csim_init(void** state, const char* spec, char* err, size_t err_size) {
+    csim* c = calloc(1, sizeof *c);
+    if (!c) {
+        snprintf(err, err_size, "out of memory");
+        return CLI_BAD_INPUT;
+    }
+    c->grabbed = -1;
+    snprintf(c->name, sizeof c->name, "%s", spec);
+    if (strncmp(spec, "preset:", 7) == 0) {
+        c->sc_ready = true;
+        if (!cloth_scene_preset(spec + 7, &c->sc)) {
+            snprintf(err, err_size, "cloth:%s: the presets are flag, curtain, drape, cape", spec);
+            csim_destroy(c);
+            return CLI_BAD_USAGE;
+        }
+        snprintf(c->name, sizeof c->name, "%s", spec + 7);
+    } else if (!spec[0]) {
+        snprintf(err, err_size, "cloth: give a scene file (cloth:SCENE.json) or a preset (cloth:preset:NAME)");
+        csim_destroy(c);
+        return CLI_BAD_USAGE;
+    } else {
+        size_t size = 0;
+        char* text = read_scene(spec, &size, err, err_size);
+        bool ok = text && cloth_scene_parse(spec, text, size, &c->sc, err, err_size);
+        free(text);
+        c->sc_ready = ok;
+        if (!ok) {
+            csim_destroy(c);
+            return CLI_BAD_INPUT;
+        }
+    }
+    c->wind0 = c->sc.wind;
+    c->prop_count = c->sc.sphere_count + c->sc.capsule_count;
+    if (c->prop_count > CLI_MAX_EXTRA - 1) c->prop_count = CLI_MAX_EXTRA - 1;
+    c->spheres0 = calloc(c->sc.sphere_count + 1, sizeof *c->spheres0);
+    c->props = calloc(c->prop_count + 1, sizeof *c->props);
+    if (!c->spheres0 || !c->props) {
+        snprintf(err, err_size, "out of memory");
+        csim_destroy(c);
+        return CLI_BAD_INPUT;
+    }
+    if (c->sc.sphere_count) memcpy(c->spheres0, c->sc.spheres, c->sc.sphere_count * sizeof *c->spheres0);
+    if (csim_restart(c)) {
+        snprintf(err, err_size, "cannot start the cloth");
+        csim_destroy(c);
+        return CLI_BAD_INPUT;
+    }
+    cloth_run_bounds(&c->run, &c->lo, &c->hi);
+    *state = c;
+    return CLI_OK;
+}
+
+static void csim_step(void* state, float dt) {
+    csim* c = state;
+    if (c->failed) return;
+    const float sdt = c->sc.dt;
+    c->carry += (double)dt;
+    for (int n = 0; c->carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
+        if (cloth_run_step(&c->run, "view", c->name) != CLI_OK) {
+            c->failed = true;
+            return;
+        }
+        c->carry -= (double)sdt;
+    }
+    if (c->carry > (double)sdt) c->carry = 0.0;
+}
+
+static void csim_reset(void* state) {
+    csim* c = state;
+    if (csim_restart(c) != CLI_OK) c->failed = true;
+}
+
+/* The cloth, the collider props and the character's posed meshes, as `animkit cloth` draws them. */
+static size_t csim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
+    csim* c = state;
+    size_t n = 0;
+    if (n < cap && c->run.cloth)
+        out[n++] = (ak_raster_mesh){.positions = {c->run.x, c->run.n}, .normals = {c->run.nrm, c->run.n},
+                                    .indices = ak_cloth_indices(c->run.cloth),
+                                    .material = {.color = {0.72f, 0.16f, 0.18f, 1}, .specular = 0.1f}};
+    for (size_t k = 0; k < c->prop_count && n < cap; ++k)
+        out[n++] = (ak_raster_mesh){.positions = {c->props[k].pos, PROP_VERTS}, .normals = {c->props[k].nrm, PROP_VERTS},
+                                    .indices = {c->props[k].idx, PROP_TRIS * 3},
+                                    .material = {.color = {0.55f, 0.62f, 0.72f, 1}}};
+    const ak_scene* s = c->run.ch.scene;
+    for (size_t m = 0; s && m < s->mesh_count && n < cap; ++m) {
+        const ak_mesh* mesh = s->meshes[m].mesh;
+        if (!mesh || !mesh->triangle_count) continue;
+        out[n++] = (ak_raster_mesh){.positions = {c->run.ch.poser.positions[m], mesh->vertex_count},
+                                    .normals = {c->run.ch.poser.normals[m], mesh->vertex_count},
+                                    .indices = {mesh->indices, mesh->triangle_count * 3},
+                                    .material = {.color = {0.80f, 0.74f, 0.68f, 1}}};
+    }
+    return n;
+}
+
+static void csim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
+    csim* c = state;
+    *lo = ak_vec3_min(*lo, c->lo);
+    *hi = ak_vec3_max(*hi, c->hi);
+}
+
+static bool csim_key(void* state, int key, char* msg, size_t msg_size) {
+    csim* c = state;
+    ak_vec3 d;
+    switch (key) {
+    case 'a': d = ak_vec3_make(-WIND_STEP, 0, 0); break;
+    case 'd': d = ak_vec3_make(WIND_STEP, 0, 0); break;
+    case 'q': d = ak_vec3_make(0, 0, -WIND_STEP); break;
+    case 'e': d = ak_vec3_make(0, 0, WIND_STEP); break;
+    default: return false;
+    }
+    c->sc.wind = ak_vec3_add(c->sc.wind, d);
+    ak_vec3 w = c->sc.wind;
+    snprintf(msg, msg_size, "wind %.2g %.2g %.2g m/s", (double)w.x, (double)w.y, (double)w.z);
+    return true;
+}
+
+static bool csim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
+    csim* c = state;
+    c->grabbed = -1;
+    float best = INFINITY;
+    for (size_t k = 0; k < c->sc.sphere_count; ++k) {
+        ak_vec3 p;
+        float r;
+        if (!project_sphere(cam, w, h, c->sc.spheres[k].center, c->sc.spheres[k].radius, &p, &r)) continue;
+        if (hypotf(p.x - x, p.y - y) <= r && p.z < best) best = p.z, c->grabbed = (int)k;
+    }
+    if (c->grabbed < 0) return false;
+    *anchor = c->sc.spheres[c->grabbed].center;
+    return true;
+}
+
+static void csim_drag(void* state, ak_vec3 delta) {
+    csim* c = state;
+    if (c->grabbed < 0 || !ak_vec3_is_finite(delta)) return;
+    ak_cloth_sphere* s = &c->sc.spheres[c->grabbed];
+    s->center = ak_vec3_add(s->center, delta);
+    if ((size_t)c->grabbed < c->prop_count) cloth_prop_build(&c->props[c->grabbed], s->center, s->center, s->radius);
+}
+
+static void csim_status(void* state, char* out, size_t n) {
+    csim* c = state;
+    ak_vec3 w = c->sc.wind;
+    snprintf(out, n, "t %.2fs, %zu particles, wind %.2g %.2g %.2g%s", (double)c->run.time, c->run.n, (double)w.x,
+             (double)w.y, (double)w.z, c->failed ? ", stopped (step failed)" : "");
+}
+
+static const view_help_entry csim_keys[] = {
+    {"r", "restart the cloth (also tab)"},
+    {"right", "one frame of simulation, paused"},
+    {"a", "wind -x (0.5 m/s)"},
+    {"d", "wind +x"},
+    {"q", "wind -z"},
+    {"e", "wind +z"},
+};
+
+static const view_sim cloth_sim = {
+    .name = "cloth",
+    .init = csim_init,
+    .step = csim_step,
+    .reset = csim_reset,
+    .meshes = csim_meshes,
+    .bounds = csim_bounds,
+    .key = csim_key,
+    .grab = csim_grab,
+    .drag = csim_drag,
+    .status = csim_status,
+    .destroy = csim_destroy,
+    .keys = csim_keys,
+    .key_count = sizeof csim_keys / sizeof csim_keys[0],
+};
+
 /* ---- the table ---------------------------------------------------------------------------- */
 
 static const struct {
@@ -506,6 +729,7 @@ static const struct {
 } sims[] = {
     {"particles", &particles_sim},
     {"boids", &boids_sim},
+    {"cloth", &cloth_sim},
 };
 
 const view_sim* view_sim_find(const char* arg, const char** spec) {
