@@ -456,6 +456,160 @@ AK_TEST(window_under_xvfb) {
     AK_CHECK_EQ(count_diff("win_x.png", "win_h.png", 200, 150, 0, 150, &mx), 0);
 }
 
+/* ---- simulations ---- */
+
+/* Bad simulation arguments: exit 2 for a bad spec, 1 for a bad or missing scene file. */
+AK_TEST(sim_bad_specs) {
+    write_text("sim_bad.json", "{\"spheres\": 3}\n");
+    struct {
+        const char* args;
+        int rc;
+        const char* says;
+    } cases[] = {
+        {"view sim_bad.json --headless", 2, "particles:sim_bad.json"},
+        {"view cloud:x.json --headless", 2, "'cloud' is not a simulation"},
+        {"view particles --headless", 2, "particles:preset:NAME"},
+        {"view particles:preset:volcano --headless", 2, "fountain, rain, fireworks"},
+        {"view particles:no_such_scene.json --headless", 1, "no_such_scene.json"},
+        {"view particles:sim_bad.json --headless", 1, "spheres"},
+        {"view particles:preset:rain --headless --clip 0", 2, "--clip"},
+        {"view boids:no_such_flock.json --headless", 1, "no_such_flock.json"},
+        {"view cloth:preset:tent --headless", 2, "flag, curtain, drape, cape"},
+        {"view cloth --headless", 2, "cloth:preset:NAME"},
+        {"view cloth:no_such_cloth.json --headless", 1, "no_such_cloth.json"},
+        {"view boids:sim_bad.json --headless", 1, "sim_bad.json"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        int rc = run(cases[i].args);
+        AK_CHECK_MSG(rc == cases[i].rc, "%s: exit %d (want %d): %s", cases[i].args, rc, cases[i].rc, out_buf);
+        AK_CHECK_MSG(strstr(out_buf, cases[i].says) != NULL, "%s: '%s' not said: %s", cases[i].args, cases[i].says, out_buf);
+    }
+}
+
+/* Playing changes the picture, paused it does not, the right arrow steps one frame, R gives
+ * back the first images exactly (the run is deterministic from its seed) and the wind keys
+ * change where the particles go. */
+static void sim_play_pause_reset(const char* spec, const char* tag, int w, int h, bool wind) {
+    char script[1024], args[512], a[16][64];
+    for (int k = 0; k < 8; ++k) snprintf(a[k], sizeof a[k], "sim_%s_%d.png", tag, k);
+    snprintf(script, sizeof script,
+             "screenshot %s\nwait 12\nscreenshot %s\nkey space\nscreenshot %s\nwait 6\nscreenshot %s\n"
+             "key right\nscreenshot %s\nkey space\nkey r\nscreenshot %s\nwait 12\nscreenshot %s\n"
+             "key r\nkey d\nkey d\nkey d\nkey d\nkey q\nwait 12\nscreenshot %s\n",
+             a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7]);
+    write_text("sim_play.txt", script);
+    snprintf(args, sizeof args, "view %s --headless --size %dx%d --script sim_play.txt", spec, w, h);
+    AK_CHECK_MSG(run(args) == 0, "%s: %s", spec, out_buf);
+    int y0 = HUD_TOP, y1 = h - HUD_BOTTOM;
+    AK_CHECK_MSG(count_diff(a[0], a[1], w, h, y0, y1, NULL) > 50, "%s: playing did not change the view", spec);
+    AK_CHECK_MSG(count_diff(a[2], a[3], w, h, 0, h, NULL) == 0, "%s: paused but the view changed", spec);
+    AK_CHECK_MSG(count_diff(a[3], a[4], w, h, y0, y1, NULL) > 0, "%s: the right arrow did not step", spec);
+    AK_CHECK_MSG(count_diff(a[0], a[5], w, h, 0, h, NULL) == 0, "%s: R did not give the first image back", spec);
+    AK_CHECK_MSG(count_diff(a[1], a[6], w, h, 0, h, NULL) == 0, "%s: the run after R differs from the first", spec);
+    if (wind) {
+        AK_CHECK_MSG(count_diff(a[6], a[7], w, h, y0, y1, NULL) > 20, "%s: the wind keys changed nothing", spec);
+        AK_CHECK_MSG(count_diff(a[6], a[7], w, h, 0, y0, NULL) > 0, "%s: the wind is not in the status line", spec);
+    }
+}
+
+AK_TEST(sim_particles_play_pause_reset) {
+    sim_play_pause_reset("particles:preset:fountain", "fountain", 240, 180, true);
+    sim_play_pause_reset("particles:preset:fireworks", "fireworks", 200, 150, true);
+    sim_play_pause_reset("particles:" AK_SOURCE_DIR "/examples/particles_fountain.json", "pfile", 200, 150, true);
+}
+
+AK_TEST(sim_cloth_play_pause_reset) {
+    sim_play_pause_reset("cloth:preset:flag", "flag", 200, 150, true);
+    sim_play_pause_reset("cloth:preset:drape", "drape", 200, 150, false); /* no wind to speak of in 12 frames */
+}
+
+AK_TEST(sim_boids_play_pause_reset) {
+    sim_play_pause_reset("boids:" AK_SOURCE_DIR "/examples/boids_flock.json", "flock", 240, 180, false);
+    sim_play_pause_reset("boids", "boids_default", 200, 150, false);
+}
+
+/* Dragging a sphere collider: the camera is recomputed here (the viewer frames the sphere and
+ * the floor: box [-0.5, 0, -0.5]..[0.5, 1, 0.5]), the press lands on the sphere's projected
+ * centre and the drag moves it 70 px right; the image changes where it was and where it went,
+ * and not in the sky far from both. A press off the sphere orbits instead of moving it. */
+/* Pixels of the 9x9 window around (x, y) that differ by more than 8 in some channel. */
+static int window_diff(const ak_image* a, const ak_image* b, int x, int y) {
+    int n = 0;
+    for (int v = y - 4; v <= y + 4; ++v)
+        for (int u = x - 4; u <= x + 4; ++u)
+            if (u >= 0 && v >= 0 && u < a->width && v < a->height && channel_diff(a, b, u, v) > 8) ++n;
+    return n;
+}
+
+static void drag_sphere(const char* spec, ak_vec3 lo, ak_vec3 hi, ak_vec3 centre) {
+    const int w = 320, h = 240;
+    ak_view_orbit o = {.azimuth = 0.55f, .elevation = 0.22f, .aspect = (float)w / (float)h, .margin = 1.08f};
+    ak_raster_camera cam = ak_view_orbit_camera(lo, hi, &o);
+    ak_vec3 c = {0, 0, 0};
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, centre, &c));
+    char args[512];
+    int cx = (int)c.x, cy = (int)c.y, nx = cx + 70;
+    char script[512];
+    snprintf(script, sizeof script,
+             "screenshot drag0.png\nmouse_down left %d %d\nmouse_move %d %d\nmouse_move %d %d\nmouse_up left %d %d\n"
+             "screenshot drag1.png\nkey r\nscreenshot drag2.png\n",
+             cx, cy, cx + 30, cy, nx, cy, nx, cy);
+    write_text("sim_drag.txt", script);
+    snprintf(args, sizeof args, "view %s --headless --size 320x240 --script sim_drag.txt", spec);
+    AK_CHECK_MSG(run(args) == 0, "%s: %s", spec, out_buf);
+    ak_image a = {0}, b = {0};
+    if (load_png("drag0.png", &a, w, h) && load_png("drag1.png", &b, w, h)) {
+        AK_CHECK_MSG(window_diff(&a, &b, cx, cy) >= 40, "%s: nothing changed where the sphere was (%d, %d)", spec, cx, cy);
+        AK_CHECK_MSG(window_diff(&a, &b, nx, cy) >= 40, "%s: nothing changed where the sphere went (%d, %d)", spec, nx, cy);
+        for (int y = HUD_TOP; y < HUD_TOP + 10; ++y)
+            for (int x = 0; x < 20; ++x) AK_CHECK_MSG(channel_diff(&a, &b, x, y) == 0, "sky changed at (%d, %d)", x, y);
+    } else {
+        AK_CHECK_MSG(false, "cannot read the drag screenshots");
+    }
+    free(a.pixels);
+    free(b.pixels);
+    AK_CHECK_EQ(count_diff("drag0.png", "drag2.png", w, h, 0, h, NULL), 0); /* R puts it back */
+    /* pressing on the sky orbits the camera: the whole view turns, the sphere stays centred */
+    snprintf(script, sizeof script, "mouse_down left 10 %d\nmouse_move 80 %d\nmouse_up left 80 %d\nkey f\nscreenshot drag3.png\n",
+             HUD_TOP + 5, HUD_TOP + 5, HUD_TOP + 5);
+    write_text("sim_drag2.txt", script);
+    snprintf(args, sizeof args, "view %s --headless --size 320x240 --script sim_drag2.txt", spec);
+    AK_CHECK_MSG(run(args) == 0, "%s: %s", spec, out_buf);
+    AK_CHECK_EQ(count_diff("drag0.png", "drag3.png", w, h, 0, h, NULL), 0); /* F frames it as at the start */
+}
+
+AK_TEST(sim_drag_sphere) {
+    write_text("sim_ball.json", "{\"planes\": [{\"n\": [0, 1, 0], \"d\": 0}], \"spheres\": [{\"c\": [0, 0.5, 0], \"r\": 0.5}]}\n");
+    drag_sphere("particles:sim_ball.json", ak_vec3_make(-0.5f, 0, -0.5f), ak_vec3_make(0.5f, 1, 0.5f), ak_vec3_make(0, 0.5f, 0));
+    /* a flock of one small bird in [-2, 2]^3 over a floor plane at 0: the viewer frames the
+     * bounds down to the floor */
+    write_text("sim_flock.json", "{\"count\": 1, \"bounds\": {\"min\": [-2, 0, -2], \"max\": [2, 2, 2]}, "
+                                 "\"obstacles\": [{\"type\": \"sphere\", \"center\": [0, 1, 0], \"radius\": 0.5}, "
+                                 "{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0]}], "
+                                 "\"render\": {\"size\": 0.05}}\n");
+    drag_sphere("boids:sim_flock.json", ak_vec3_make(-2, 0, -2), ak_vec3_make(2, 2, 2), ak_vec3_make(0, 1, 0));
+}
+
+/* 300 frames of a live simulation with every simulation key and a drag; under the ASan build a
+ * leak fails the child's exit code. */
+AK_TEST(sim_long_session) {
+    char* script = calloc(1, 1 << 16);
+    if (!script) return;
+    size_t o = 0;
+    static const char* const steps[] = {"key a", "key e", "mouse_down left 120 90", "mouse_move 140 95", "mouse_up left 140 95",
+                                        "key space", "key right", "key space", "key h", "key h", "key r", "key q",
+                                        "key tab", "key f", "wheel 1"};
+    for (int i = 0; i < 30; ++i)
+        o += (size_t)snprintf(script + o, 65536 - o, "%s\nwait 10\n", steps[i % (sizeof steps / sizeof steps[0])]);
+    snprintf(script + o, 65536 - o, "screenshot sim_long.png\n");
+    write_text("sim_long.txt", script);
+    free(script);
+    int rc = run("view particles:preset:character --headless --size 160x120 --script sim_long.txt");
+    AK_CHECK_MSG(rc == 0, "exit %d: %s", rc, out_buf);
+    rc = run("view boids:" AK_SOURCE_DIR "/examples/boids_flock.json --headless --size 160x120 --script sim_long.txt");
+    AK_CHECK_MSG(rc == 0, "boids: exit %d: %s", rc, out_buf);
+}
+
 int main(void) {
     AK_RUN(bad_scripts_exit_2_naming_the_line);
     AK_RUN(methods_match_render);
@@ -466,5 +620,11 @@ int main(void) {
     AK_RUN(long_session);
     AK_RUN(assets_session);
     AK_RUN(window_under_xvfb);
+    AK_RUN(sim_bad_specs);
+    AK_RUN(sim_particles_play_pause_reset);
+    AK_RUN(sim_boids_play_pause_reset);
+    AK_RUN(sim_cloth_play_pause_reset);
+    AK_RUN(sim_drag_sphere);
+    AK_RUN(sim_long_session);
     return ak_test_finish();
 }

@@ -7,11 +7,15 @@
 #define MAX_SCRIPT_SIZE (4u << 20)
 
 static const char* const usage =
-    "usage: animkit view FILE|builtin:NAME [--clip C] [--size WxH] [--script FILE] [--headless]\n"
+    "usage: animkit view FILE|builtin:NAME|SIM [--clip C] [--size WxH] [--script FILE] [--headless]\n"
     "                    [--ik-log FILE] [--frames N] [--supersample N] [--threads N] [--stats]\n"
     "                    [--shot-dir DIR]\n"
     "Open a window on the model, shaded by animkit's own rasterizer, playing clip C (default the\n"
     "first). The camera starts framed on the first pose as `animkit render` frames one time.\n"
+    "SIM runs a simulation live: particles:SCENE.json, particles:preset:fountain|rain|fireworks|\n"
+    "character, boids[:SCENE.json], cloth:SCENE.json, cloth:preset:flag|curtain|drape|cape (space\n"
+    "pauses, right steps one frame, r restarts, left drag on a sphere collider moves it, a/d/q/e\n"
+    "change the wind of particles and cloth; docs/view.md).\n"
     "  --size WxH       window size (default 960x600)\n"
     "  --script FILE    replay input from FILE, one event a line: key NAME, mouse_down BUTTON X Y,\n"
     "                   mouse_move X Y, mouse_up BUTTON X Y, wheel DY, wait FRAMES,\n"
@@ -76,7 +80,7 @@ int cmd_view(int argc, char** argv) {
         print_usage();
         return CLI_OK;
     }
-    if (a.pos_count != 1) return cli_usage("view", "expected one FILE or builtin:NAME");
+    if (a.pos_count != 1) return cli_usage("view", "expected one FILE, builtin:NAME or simulation");
     view_options vo = {.width = 960, .height = 600, .clip = -1, .supersample = 1, .threads = 2};
     if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &vo.width, &vo.height))
         return cli_usage("view", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
@@ -97,9 +101,18 @@ int cmd_view(int argc, char** argv) {
     if (!headless && !view_window_available())
         return cli_fail("view", "this build has no window (SDL2 was not found at build time); use --headless");
     vo.shot_dir = CLI_GET(&a, "--shot-dir");
-    if (cli_has_ext(a.pos[0], ".json"))
-        return cli_fail("view", "%s: simulation scenes are not supported yet (no simulation is built into this viewer)",
-                        a.pos[0]);
+    const char* sim_spec = NULL;
+    vo.sim = view_sim_find(a.pos[0], &sim_spec);
+    vo.sim_spec = sim_spec;
+    if (!vo.sim) {
+        /* KIND:... with a kind that is not a simulation (builtin:NAME is a model) */
+        size_t n = strspn(a.pos[0], "abcdefghijklmnopqrstuvwxyz");
+        if (n > 0 && a.pos[0][n] == ':' && strncmp(a.pos[0], "builtin:", 8) != 0)
+            return cli_usage("view", "'%.*s' is not a simulation (%s): %s", (int)n, a.pos[0], view_sim_kinds, a.pos[0]);
+        if (cli_has_ext(a.pos[0], ".json"))
+            return cli_usage("view", "%s: name the simulation of a scene file: particles:%s, boids:%s or cloth:%s",
+                             a.pos[0], a.pos[0], a.pos[0], a.pos[0]);
+    }
 
     view_script script = {0};
     const char* script_path = CLI_GET(&a, "--script");
@@ -110,7 +123,20 @@ int cmd_view(int argc, char** argv) {
     view_app app;
     memset(&app, 0, sizeof app);
     FILE* log = NULL;
-    if ((rc = cli_load_scene("view", a.pos[0], &s))) goto done;
+    if (vo.sim) {
+        /* a simulation draws on an empty model scene (no meshes, joints or clips) */
+        if (ak_scene_alloc(0, 0, 0, NULL, &s) != AK_OK) {
+            rc = cli_fail("view", "out of memory");
+            goto done;
+        }
+        snprintf(s->name, sizeof s->name, "%s", a.pos[0]);
+        if (CLI_GET(&a, "--clip") || CLI_GET(&a, "--ik-log")) {
+            rc = cli_usage("view", "--clip and --ik-log are for models, not simulations");
+            goto done;
+        }
+    } else if ((rc = cli_load_scene("view", a.pos[0], &s))) {
+        goto done;
+    }
     if (CLI_GET(&a, "--clip")) {
         vo.clip = ak_scene_find_clip(s, CLI_GET(&a, "--clip"));
         if (vo.clip < 0) {

@@ -157,6 +157,7 @@ ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* 
         };
         res = ak_view_draw_skeleton(r, &f->camera, &sk);
     }
+    if (res == AK_OK && o && o->draw) res = o->draw(o->draw_user, r, &f->camera, f->width, f->height);
     if (res == AK_OK && o && o->title) res = ak_raster_draw_text(r, 10, 10, o->title, f->height >= 300 ? 2 : 1, rgba(0.08f, 0.09f, 0.12f, 1));
     if (res == AK_OK) res = ak_raster_resolve(r, out);
     return res;

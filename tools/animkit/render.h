@@ -31,6 +31,10 @@ typedef struct cli_draw_opts {
     const ak_raster_mesh* extra; /* more meshes (props, the demo's tail and ball) */
     size_t extra_count;
     const bool* hidden;    /* per scene mesh: true -> not drawn; NULL -> every mesh drawn */
+    /* drawn after the meshes and the skeleton, before the title and the resolve (the viewer's
+     * simulations draw their particles and agents here); NULL -> nothing */
+    ak_result (*draw)(void* user, ak_raster* raster, const ak_raster_camera* camera, int width, int height);
+    void* draw_user;
 } cli_draw_opts;
 
 /* Where the camera looks from. Zero -> the orbit framing cli_frame_init uses (yaw 31.5, pitch

@@ -358,6 +358,11 @@ static const char* morph_name(const view_app* a, size_t k) {
     return "";
 }
 
+/* The viewer's keys that still apply with a simulation (the rest are about the model). */
+static bool sim_help_key(const char* k) {
+    return !strcmp(k, "space") || !strcmp(k, "f") || !strcmp(k, "escape") || !strcmp(k, "p") || !strcmp(k, "h");
+}
+
 static void draw_hud(view_app* a) {
     const ak_image* img = &a->image;
     const ak_scene* s = a->scene;
@@ -368,7 +373,9 @@ static void draw_hud(view_app* a) {
     else snprintf(fps, sizeof fps, "%.1f fps", a->fps);
     double dur = clip_duration(a);
     const char* method = a->side_by_side ? "LBS|DQS|CoR" : cli_method_name(a->method);
-    if (a->bind)
+    if (a->sim)
+        snprintf(line1, sizeof line1, "%s | %s%s", fps, a->sim->name, a->playing ? "" : " paused");
+    else if (a->bind)
         snprintf(line1, sizeof line1, "%s | bind pose | %s", fps, method);
     else if (a->clip >= 0)
         snprintf(line1, sizeof line1, "%s | %s %.2f/%.2fs x%g %s%s | %s", fps, ak_clip_name(s->clips[a->clip]), a->time,
@@ -382,6 +389,12 @@ static void draw_hud(view_app* a) {
         if (o < sizeof line2) o += (size_t)snprintf(line2 + o, sizeof line2 - o, __VA_ARGS__);           \
     } while (0)
     if (a->message_frames > 0) APPEND("%s | ", a->message);
+    if (a->sim && a->sim->status) {
+        char st[200];
+        st[0] = '\0';
+        a->sim->status(a->sim_state, st, sizeof st);
+        APPEND("%s | ", st);
+    }
     if (a->weight_bone >= 0)
         APPEND("weights %s | ", ak_skeleton_joint_name(skel(a), (size_t)a->weight_joints[a->weight_bone]));
     if (a->effector >= 0) {
@@ -389,7 +402,7 @@ static void draw_hud(view_app* a) {
                ak_skeleton_joint_name(skel(a), (size_t)a->effector));
         if (a->ik_problem) APPEND("%s | ", a->ik_problem);
         else APPEND("%s, error %.4g | ", a->ik_reached ? "reached" : "not reached", (double)a->ik_error);
-    } else {
+    } else if (!a->sim) {
         APPEND("IK %s | ", ak_ik_solver_name(a->solver));
     }
     if (a->morph_count)
@@ -435,8 +448,14 @@ static void draw_hud(view_app* a) {
     if (a->show_help) {
         /* one column when it fits, else two; each column 41 characters */
         float top = 2.0f * lh + 8.0f, avail = (float)a->height - top - 24.0f * (float)sc;
-        int cols = ((float)(view_help_count + MOUSE_HELP_COUNT + 2) * lh + 16.0f <= avail) ? 1 : 2;
-        size_t rows = (view_help_count + (size_t)cols - 1) / (size_t)cols;
+        /* a simulation's keys, then the viewer's that apply to it; else the viewer's */
+        const view_help_entry* list[64];
+        size_t nkeys = 0;
+        for (size_t i = 0; a->sim && i < a->sim->key_count && nkeys < 64; ++i) list[nkeys++] = &a->sim->keys[i];
+        for (size_t i = 0; i < view_help_count && nkeys < 64; ++i)
+            if (!a->sim || sim_help_key(view_help[i].key)) list[nkeys++] = &view_help[i];
+        int cols = ((float)(nkeys + MOUSE_HELP_COUNT + 2) * lh + 16.0f <= avail) ? 1 : 2;
+        size_t rows = (nkeys + (size_t)cols - 1) / (size_t)cols;
         float cw = (float)(41 * AK_FONT_ADVANCE_X * sc);
         float bw = (float)cols * cw + 16.0f, bh = (float)(rows + MOUSE_HELP_COUNT + 2) * lh + 16.0f;
         float bx = ak_maxf(0.0f, ((float)a->width - bw) * 0.5f), by = ak_maxf(top, top + (avail - bh) * 0.5f);
@@ -444,15 +463,17 @@ static void draw_hud(view_app* a) {
         int ty = (int)by + 8;
         ak_image_draw_text(img, (int)bx + 8, ty, "keys (h closes)", sc, rgba(1, 0.85f, 0.3f, 1));
         ty += (int)lh;
-        for (size_t i = 0; i < view_help_count; ++i) {
+        for (size_t i = 0; i < nkeys; ++i) {
+            const view_help_entry* e = list[i];
             char l[128];
-            snprintf(l, sizeof l, "%-7s %s", view_help[i].key, view_help[i].what);
+            snprintf(l, sizeof l, "%-7s %s", e->key, e->what);
             int col = (int)(i / rows), row = (int)(i % rows);
             ak_image_draw_text(img, (int)(bx + 8.0f + (float)col * cw), ty + row * (int)lh, l, sc, rgba(1, 1, 1, 1));
         }
         ty += (int)((float)(rows + 1) * lh);
         for (size_t i = 0; i < MOUSE_HELP_COUNT; ++i, ty += (int)lh)
-            ak_image_draw_text(img, (int)bx + 8, ty, mouse_help[i], sc, rgba(0.8f, 0.9f, 1, 1));
+            ak_image_draw_text(img, (int)bx + 8, ty, a->sim && i == 1 ? "left on a sphere: drag the collider" : mouse_help[i],
+                               sc, rgba(0.8f, 0.9f, 1, 1));
     }
 }
 
@@ -467,6 +488,8 @@ static ak_result draw_view(view_app* a, cli_frame* f, const ak_image* img) {
         .colors = a->weight_bone >= 0 ? a->colors : NULL,
         .extra = extra,
         .extra_count = extra_count,
+        .draw = a->sim ? a->sim->draw : NULL,
+        .draw_user = a->sim_state,
     };
     ak_result r = cli_frame_draw(f, &a->poser, &o, img);
     if (r != AK_OK) return r;
@@ -578,8 +601,29 @@ static void morph_step(view_app* a, float delta) {
     a->poser.morph_weights[k] = a->morph_user[k];
 }
 
+/* Keys a simulation takes: its own first, then R / tab reset and the right arrow steps. */
+static bool sim_key(view_app* a, int k) {
+    char m[160];
+    m[0] = '\0';
+    if (a->sim->key && a->sim->key(a->sim_state, k, m, sizeof m)) {
+        if (m[0]) message(a, m);
+        return true;
+    }
+    if (k == 'r' || k == '\t') {
+        if (a->sim->reset) a->sim->reset(a->sim_state); /* the status line shows t 0 */
+        return true;
+    }
+    if (k == VIEW_KEY_RIGHT) {
+        a->playing = false;
+        if (a->sim->step) a->sim->step(a->sim_state, (float)FIXED_STEP);
+        return true;
+    }
+    return false;
+}
+
 static void key(view_app* a, int k) {
     double dur = clip_duration(a);
+    if (a->sim && sim_key(a, k)) return;
     switch (k) {
     case ' ':
         a->playing = !a->playing;
@@ -718,6 +762,11 @@ void view_app_event(view_app* a, const view_event* ev) {
             break;
         }
         if (ev->button != VIEW_BUTTON_LEFT) break;
+        if (a->sim && a->sim->grab && !a->side_by_side &&
+            a->sim->grab(a->sim_state, &a->frame.camera, a->frame.width, a->frame.height, ev->x, ev->y, &a->sim_anchor)) {
+            a->drag = VIEW_DRAG_SIM;
+            break;
+        }
         if (a->clip >= 0 && ev->y >= by - 6.0f && ev->y <= by + bh + 6.0f) {
             a->drag = VIEW_DRAG_TIMELINE;
             scrub(a, ev->x);
@@ -758,6 +807,10 @@ void view_app_event(view_app* a, const view_event* ev) {
             a->target = plane_point(f, x, ev->y, a->target);
         } else if (a->drag == VIEW_DRAG_TIMELINE) {
             scrub(a, ev->x);
+        } else if (a->drag == VIEW_DRAG_SIM) {
+            ak_vec3 to = plane_point(&a->frame, ev->x, ev->y, a->sim_anchor);
+            if (a->sim->drag) a->sim->drag(a->sim_state, ak_vec3_sub(to, a->sim_anchor));
+            a->sim_anchor = to;
         }
         a->mouse_x = ev->x;
         a->mouse_y = ev->y;
@@ -799,7 +852,22 @@ int view_app_init(view_app* a, const ak_scene* s, const view_options* opt) {
     a->effector = a->root = -1;
     a->solver = AK_IK_SOLVER_FABRIK;
     a->zoom = 1.0f;
-    if (cli_poser_init(&a->poser, s)) return cli_fail("view", "out of memory");
+    if (opt->sim) {
+        char err[640];
+        err[0] = '\0';
+        int rc = opt->sim->init(&a->sim_state, opt->sim_spec ? opt->sim_spec : "", err, sizeof err);
+        if (rc) {
+            fprintf(stderr, "animkit view: %s\n", err[0] ? err : "cannot start the simulation");
+            memset(a, 0, sizeof(*a));
+            return rc;
+        }
+        a->sim = opt->sim;
+        a->playing = true;
+    }
+    if (cli_poser_init(&a->poser, s)) {
+        view_app_free(a);
+        return cli_fail("view", "out of memory");
+    }
     size_t n = a->poser.joint_count ? a->poser.joint_count : 1;
     for (size_t m = 0; m < s->mesh_count; ++m)
         if (s->meshes[m].mesh) a->morph_count += s->meshes[m].mesh->morph_target_count;

@@ -76,22 +76,42 @@ typedef struct view_script {
 int view_script_parse(const char* text, size_t size, view_script* out, char* err, size_t err_size);
 void view_script_free(view_script* s);
 
-/* ---- simulations: the plug-in point for particles, boids, cloth (none built yet) ---- */
+/* ---- simulations (view_sims.c) ---- */
 
 /* A live simulation the viewer steps and draws with the model's camera. The viewer calls
- * init once, step once per frame while playing (dt in seconds, fixed while scripted), reset
- * when time restarts (tab), meshes before drawing (extra meshes added to the frame, as props are),
- * overlay after drawing (2D marks over the image), and destroy at exit. */
+ * init once with the spec after "KIND:", step once per frame while playing (dt in seconds,
+ * fixed while scripted; the right arrow runs one such frame while paused), reset on R or tab
+ * (back to the state init made, colliders and wind included), meshes before drawing (extra
+ * meshes added to the frame, casting shadows), draw after the meshes (points, arrows: in the
+ * raster, depth tested), overlay after the resolve (2D marks), bounds for F, key for the
+ * simulation's own keys (true when used; msg gets a status message), grab when the left button
+ * goes down (true when a collider is under the pixel: *anchor is its centre) and drag with the
+ * world-space move of the anchor, status for the second status line, destroy at exit. Any
+ * hook but init may be NULL. */
 typedef struct view_sim {
     const char* name;
-    int (*init)(void** state, const char* scene_path, char* err, size_t err_size);
+    /* Returns CLI_OK, CLI_BAD_INPUT (bad file: message in err) or CLI_BAD_USAGE (bad spec). */
+    int (*init)(void** state, const char* spec, char* err, size_t err_size);
     void (*step)(void* state, float dt);
     void (*reset)(void* state);
     size_t (*meshes)(void* state, ak_raster_mesh* out, size_t capacity);
+    ak_result (*draw)(void* state, ak_raster* raster, const ak_raster_camera* camera, int width, int height);
     void (*overlay)(void* state, const ak_raster_camera* camera, const ak_image* image);
     void (*bounds)(void* state, ak_vec3* lo, ak_vec3* hi);
+    bool (*key)(void* state, int key, char* msg, size_t msg_size);
+    bool (*grab)(void* state, const ak_raster_camera* camera, int width, int height, float x, float y, ak_vec3* anchor);
+    void (*drag)(void* state, ak_vec3 delta);
+    void (*status)(void* state, char* out, size_t out_size);
     void (*destroy)(void* state);
+    const view_help_entry* keys; /* the simulation's keys for the help overlay */
+    size_t key_count;
 } view_sim;
+
+/* The simulation a `animkit view` argument names ("particles:...", "boids", "boids:...", "cloth:..."), with *spec the text after the colon ("" when none); NULL when the argument
+ * names no simulation (a model path or builtin:NAME). */
+const view_sim* view_sim_find(const char* arg, const char** spec);
+/* The kinds, for messages ("particles, boids, cloth"). */
+extern const char* const view_sim_kinds;
 
 /* ---- the app ---- */
 
@@ -103,9 +123,11 @@ typedef struct view_options {
     bool scripted;        /* fixed time step, deterministic status line */
     FILE* ik_log;         /* NULL -> none */
     const char* shot_dir; /* where P writes screenshots; NULL -> "." */
+    const view_sim* sim;  /* NULL -> none; else initialised by view_app_init with sim_spec */
+    const char* sim_spec;
 } view_options;
 
-enum { VIEW_DRAG_NONE = 0, VIEW_DRAG_ORBIT, VIEW_DRAG_PAN, VIEW_DRAG_TARGET, VIEW_DRAG_TIMELINE };
+enum { VIEW_DRAG_NONE = 0, VIEW_DRAG_ORBIT, VIEW_DRAG_PAN, VIEW_DRAG_TARGET, VIEW_DRAG_TIMELINE, VIEW_DRAG_SIM };
 
 /* Frame-time breakdown accumulated over rendered frames (seconds). */
 typedef struct view_stats {
@@ -176,6 +198,7 @@ typedef struct view_app {
     /* simulation plug-in (NULL: none) */
     const view_sim* sim;
     void* sim_state;
+    ak_vec3 sim_anchor; /* the dragged collider's centre (VIEW_DRAG_SIM) */
 } view_app;
 
 int view_app_init(view_app* app, const ak_scene* scene, const view_options* opt);

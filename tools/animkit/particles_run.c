@@ -1,0 +1,364 @@
+/* A particle run shared by `animkit particles` and `animkit view` (particles_run.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "particles_run.h"
+#include "render.h"
+
+/* ---- presets -------------------------------------------------------------------------- */
+
+static ak_particle_emitter emitter_base(void) {
+    ak_particle_emitter e = {.direction = {0, 1, 0},
+                             .cone_angle = 0.3f,
+                             .speed_min = 1,
+                             .speed_max = 2,
+                             .lifetime_min = 1,
+                             .lifetime_max = 2,
+                             .size_min = 0.03f,
+                             .size_max = 0.03f,
+                             .mass = 1};
+    return e;
+}
+
+/* Fills s for a preset; false when out of memory. */
+bool particles_preset(const char* name, particles_scene* s) {
+    memset(s, 0, sizeof *s);
+    s->dt = 0.01f;
+    s->integrator = AK_INTEGRATOR_SYMPLECTIC;
+    s->capacity = 60000;
+    s->world.gravity = ak_vec3_make(0, -9.81f, 0);
+    s->planes = calloc(1, sizeof *s->planes);
+    s->spheres = calloc(1, sizeof *s->spheres);
+    s->emitters = calloc(4, sizeof *s->emitters);
+    s->bursts = calloc(4, sizeof *s->bursts);
+    if (!s->planes || !s->spheres || !s->emitters || !s->bursts) return false;
+    s->planes[0] = (ak_particle_plane){.normal = {0, 1, 0}, .restitution = 0.4f, .friction = 0.3f};
+    s->world.planes = (ak_particle_plane_cspan){s->planes, 1};
+    ak_particle_emitter e = emitter_base();
+    if (strcmp(name, "fountain") == 0) {
+        e.center = ak_vec3_make(0, 0.05f, 0);
+        e.cone_angle = 0.18f, e.speed_min = 5.0f, e.speed_max = 5.6f;
+        e.lifetime_min = 2.5f, e.lifetime_max = 3.5f;
+        e.colour = ak_vec4_make(0.25f, 0.55f, 1.0f, 1), e.rate = 1500.0f;
+        s->emitters[0] = e;
+        s->emitter_count = 1;
+        s->spheres[0] = (ak_particle_sphere){
+            .center = {0.45f, 0.35f, 0}, .radius = 0.35f, .restitution = 0.3f, .friction = 0.2f};
+        s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
+        s->world.drag_linear = 0.02f;
+    } else if (strcmp(name, "rain") == 0) {
+        e.shape = AK_EMITTER_BOX, e.center = ak_vec3_make(0, 4, 0),
+        e.half_extents = ak_vec3_make(2, 0.1f, 2);
+        e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f, e.speed_min = 3,
+        e.speed_max = 4;
+        e.lifetime_min = 2.5f, e.lifetime_max = 3.0f, e.size_min = 0.015f, e.size_max = 0.02f;
+        e.colour = ak_vec4_make(0.55f, 0.7f, 1.0f, 1), e.rate = 3000.0f;
+        s->emitters[0] = e;
+        s->emitter_count = 1;
+        s->spheres[0] = (ak_particle_sphere){
+            .center = {0, 1.2f, 0}, .radius = 0.8f, .restitution = 0.2f, .friction = 0.1f};
+        s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
+        s->world.wind = ak_vec3_make(1.5f, 0, 0);
+        s->world.drag_linear = 0.3f;
+        s->planes[0].restitution = 0.1f;
+    } else if (strcmp(name, "fireworks") == 0) {
+        const ak_vec4 colours[4] = {
+            {1, 0.3f, 0.2f, 1}, {0.3f, 1, 0.4f, 1}, {1, 0.85f, 0.3f, 1}, {0.6f, 0.5f, 1, 1}};
+        const float x[4] = {-1.2f, 0.9f, 0.0f, 1.6f}, y[4] = {3.0f, 3.6f, 4.2f, 2.8f};
+        for (int k = 0; k < 4; ++k) {
+            ak_particle_emitter f = emitter_base();
+            f.shape = AK_EMITTER_SPHERE, f.center = ak_vec3_make(x[k], y[k], -0.5f * k),
+            f.radius = 0.05f;
+            f.cone_angle = AK_PI, f.speed_min = 2.5f, f.speed_max = 3.2f, f.lifetime_min = 1.2f,
+            f.lifetime_max = 1.8f;
+            f.colour = colours[k];
+            s->emitters[k] = f;
+            s->bursts[k] =
+                (particles_burst){.count = 800, .start = 0.45f * (float)k, .interval = 1.8f};
+        }
+        s->emitter_count = 4;
+        s->world.drag_quadratic = 0.02f;
+        s->world.gravity = ak_vec3_make(0, -3.0f, 0);
+    } else if (strcmp(name, "character") == 0) {
+        /* Rain on the character (collides with its posed mesh) and sparks from its surface. */
+        e.shape = AK_EMITTER_BOX, e.center = ak_vec3_make(0, 2.6f, 0),
+        e.half_extents = ak_vec3_make(0.7f, 0.05f, 0.7f);
+        e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f, e.speed_min = 2,
+        e.speed_max = 2.5f;
+        e.lifetime_min = 2, e.lifetime_max = 2.5f, e.size_min = 0.012f, e.size_max = 0.016f;
+        e.colour = ak_vec4_make(0.45f, 0.65f, 1.0f, 1), e.rate = 2500.0f;
+        s->emitters[0] = e;
+        ak_particle_emitter sp = emitter_base();
+        sp.shape = AK_EMITTER_MESH, sp.cone_angle = 0.5f, sp.speed_min = 0.3f, sp.speed_max = 0.8f;
+        sp.lifetime_min = 0.6f, sp.lifetime_max = 1.0f, sp.size_min = 0.01f, sp.size_max = 0.015f;
+        sp.colour = ak_vec4_make(1.0f, 0.55f, 0.15f, 1), sp.rate = 800.0f,
+        sp.base_velocity = ak_vec3_make(0, 0.5f, 0);
+        s->emitters[1] = sp;
+        s->emitter_count = 2;
+        s->planes[0].restitution = 0.2f;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+/* ---- the character ----------------------------------------------------------------------- */
+
+
+static void character_gather(particles_character* c) {
+    size_t v = 0;
+    for (size_t m = 0; m < c->scene->mesh_count; ++m) {
+        const ak_mesh* mesh = c->scene->meshes[m].mesh;
+        if (!mesh) continue;
+        memcpy(c->positions + v, c->poser.positions[m], mesh->vertex_count * sizeof(ak_vec3));
+        v += mesh->vertex_count;
+    }
+}
+
+int particles_character_init(particles_character* c, int* rc) {
+    memset(c, 0, sizeof *c);
+    if ((*rc = cli_load_scene("particles", "builtin:humanoid", &c->scene))) return *rc;
+    if (cli_poser_init(&c->poser, c->scene)) return *rc = cli_fail("particles", "out of memory");
+    c->posed = true;
+    for (size_t m = 0; m < c->scene->mesh_count; ++m) {
+        const ak_mesh* mesh = c->scene->meshes[m].mesh;
+        if (!mesh) continue;
+        c->vertex_count += mesh->vertex_count;
+        c->index_count += 3 * mesh->triangle_count;
+    }
+    c->positions = calloc(c->vertex_count + 1, sizeof(ak_vec3));
+    c->indices = calloc(c->index_count + 1, sizeof(uint32_t));
+    c->cdf = calloc(c->index_count / 3 + 1, sizeof(float));
+    if (!c->positions || !c->indices || !c->cdf)
+        return *rc = cli_fail("particles", "out of memory");
+    size_t v = 0, k = 0;
+    for (size_t m = 0; m < c->scene->mesh_count; ++m) {
+        const ak_mesh* mesh = c->scene->meshes[m].mesh;
+        if (!mesh) continue;
+        for (size_t i = 0; i < 3 * mesh->triangle_count; ++i)
+            c->indices[k++] = (uint32_t)(mesh->indices[i] + v);
+        v += mesh->vertex_count;
+    }
+    if (cli_poser_pose(&c->poser, 0, 0.0f, false, CLI_LBS) != AK_OK)
+        return *rc = cli_fail("particles", "cannot pose the character");
+    character_gather(c);
+    ak_particle_mesh_desc md = {.positions = {c->positions, c->vertex_count},
+                                .indices = {c->indices, c->index_count},
+                                .restitution = 0.2f,
+                                .friction = 0.3f};
+    if (ak_particle_mesh_create(&md, NULL, &c->collider) != AK_OK)
+        return *rc = cli_fail("particles", "cannot build the character collider");
+    return *rc = CLI_OK;
+}
+
+/* Pose at time t; the collider gets the pose with the elapsed time since the last one. */
+ak_result particles_character_pose(particles_character* c, float t, float elapsed) {
+    ak_result r = cli_poser_pose(&c->poser, 0, t, false, CLI_LBS);
+    if (r != AK_OK) return r;
+    character_gather(c);
+    return ak_particle_mesh_update(c->collider, (ak_vec3_cspan){c->positions, c->vertex_count},
+                                   elapsed);
+}
+
+void particles_character_free(particles_character* c) {
+    if (c->posed) cli_poser_free(&c->poser);
+    ak_particle_mesh_destroy(c->collider);
+    free(c->positions);
+    free(c->indices);
+    free(c->cdf);
+    ak_scene_destroy(c->scene);
+}
+
+/* ---- simulation ------------------------------------------------------------------------ */
+
+
+int particles_run_init(particles_run* r, particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads) {
+    memset(r, 0, sizeof *r);
+    r->scene = s;
+    r->ch = ch;
+    ak_particles_desc d = {.capacity = s->capacity,
+                           .integrator = s->integrator,
+                           .seed = seed,
+                           .thread_count = threads};
+    ak_result res = ak_particles_create(&d, NULL, &r->ps);
+    if (res != AK_OK)
+        return cli_fail("particles", "cannot create the system: %s", ak_result_string(res));
+    for (size_t i = 0; i < s->particle_count; ++i) {
+        res = ak_particles_add(r->ps, &s->particles[i], NULL);
+        if (res != AK_OK)
+            return cli_fail("particles", "particle %zu: %s", i, ak_result_string(res));
+    }
+    r->fired = calloc(s->emitter_count + 1, sizeof(uint64_t));
+    r->springs = calloc(s->world.springs.count + 1, sizeof(ak_particle_spring));
+    if (!r->fired || !r->springs) return cli_fail("particles", "out of memory");
+    for (size_t e = 0; e < s->emitter_count; ++e) s->emitters[e].carry = 0.0;
+    r->world = s->world;
+    if (s->world.springs.count)
+        memcpy(r->springs, s->world.springs.ptr, s->world.springs.count * sizeof *r->springs);
+    r->world.springs.ptr = r->springs;
+    r->file_alive = s->particle_count;
+    if (ch) {
+        r->meshes[0] = ch->collider;
+        r->world.meshes = (ak_particle_mesh_cspan){r->meshes, 1};
+        for (size_t e = 0; e < s->emitter_count; ++e)
+            if (s->emitters[e].shape == AK_EMITTER_MESH) {
+                s->emitters[e].mesh_positions = (ak_vec3_cspan){ch->positions, ch->vertex_count};
+                s->emitters[e].mesh_indices = (ak_u32_cspan){ch->indices, ch->index_count};
+                s->emitters[e].mesh_area_cdf = (ak_f32_span){ch->cdf, ch->index_count / 3};
+            }
+    }
+    return CLI_OK;
+}
+
+/* One step: pose the character for the end of the step, emit, step. */
+int particles_run_step(particles_run* r, int step) {
+    particles_scene* s = r->scene;
+    const float dt = s->dt;
+    const double t1 = (double)(step + 1) * dt;
+    ak_result res = AK_OK;
+    if (r->ch) res = particles_character_pose(r->ch, (float)t1, dt);
+    for (size_t e = 0; e < s->emitter_count && res == AK_OK; ++e) {
+        res = ak_particles_emit(r->ps, &s->emitters[e], dt, NULL);
+        /* Bursts due before the end of this step (start, start + interval, ...). */
+        const particles_burst* b = &s->bursts[e];
+        while (res == AK_OK && b->count > 0 && (b->interval > 0.0f || r->fired[e] == 0)) {
+            if ((double)b->start + (double)r->fired[e] * (double)b->interval >= t1) break;
+            if (b->interval > 0.0f && ak_particles_count(r->ps) >= ak_particles_capacity(r->ps)) {
+                /* full: every burst still due this step would be dropped (a full system emits
+                 * nothing and draws no random numbers), so count them without calling; a tiny
+                 * burst_interval used to make millions of calls per step */
+                double k = ceil((t1 - (double)b->start) / (double)b->interval);
+                if (k < (double)r->fired[e]) k = (double)r->fired[e];
+                while (k > (double)r->fired[e] && (double)b->start + (k - 1.0) * (double)b->interval >= t1) k -= 1.0;
+                while ((double)b->start + k * (double)b->interval < t1) k += 1.0;
+                r->fired[e] = (uint64_t)k;
+                break;
+            }
+            res = ak_particles_burst(r->ps, &s->emitters[e], b->count, NULL);
+            ++r->fired[e];
+        }
+    }
+    if (res == AK_OK) res = ak_particles_step(r->ps, &r->world, dt);
+    if (res != AK_OK) return cli_fail("particles", "step %d: %s", step, ak_result_string(res));
+    /* File particles come first and keep their order (ids 0.. in file order); when some die
+     * (a lifetime, or a state that stopped being finite) the springs follow the survivors'
+     * new indices and springs to a dead particle go (they used to point past the end: the
+     * next step failed with "an index is out of range") */
+    const ak_particles_state st = ak_particles_get_state(r->ps);
+    size_t alive = 0;
+    while (alive < st.count && st.id[alive] < s->particle_count) ++alive;
+    if (alive != r->file_alive && s->world.springs.count) {
+        uint32_t* where = malloc(s->particle_count * sizeof *where);
+        if (!where) return cli_fail("particles", "out of memory");
+        for (size_t i = 0; i < s->particle_count; ++i) where[i] = UINT32_MAX;
+        for (size_t i = 0; i < alive; ++i) where[st.id[i]] = (uint32_t)i;
+        size_t n = 0;
+        for (size_t k = 0; k < s->world.springs.count; ++k) {
+            ak_particle_spring sp = s->world.springs.ptr[k];
+            if (where[sp.i] == UINT32_MAX || where[sp.j] == UINT32_MAX) continue;
+            sp.i = where[sp.i], sp.j = where[sp.j];
+            r->springs[n++] = sp;
+        }
+        r->world.springs.count = n;
+        free(where);
+    }
+    r->file_alive = alive;
+    return CLI_OK;
+}
+
+void particles_run_free(particles_run* r) {
+    ak_particles_destroy(r->ps);
+    free(r->fired);
+    free(r->springs);
+}
+
+
+/* UV spheres and boxes of the colliders as one triangle mesh. */
+bool particles_shapes_build(particles_shapes* sh, const particles_scene* s) {
+    enum { SEG = 24, RINGS = 14 };
+    size_t nv = s->world.spheres.count * (SEG + 1) * (RINGS + 1) + s->world.boxes.count * 24;
+    size_t ni = s->world.spheres.count * SEG * RINGS * 6 + s->world.boxes.count * 36;
+    memset(sh, 0, sizeof *sh);
+    sh->pos = calloc(nv + 1, sizeof(ak_vec3));
+    sh->nrm = calloc(nv + 1, sizeof(ak_vec3));
+    sh->idx = calloc(ni + 1, sizeof(uint32_t));
+    if (!sh->pos || !sh->nrm || !sh->idx) return false;
+    for (size_t k = 0; k < s->world.spheres.count; ++k) {
+        const ak_particle_sphere* sp = &s->world.spheres.ptr[k];
+        size_t base = sh->vcount;
+        for (int i = 0; i <= RINGS; ++i)
+            for (int j = 0; j <= SEG; ++j) {
+                float th = AK_PI * (float)i / RINGS, ph = 2 * AK_PI * (float)j / SEG;
+                ak_vec3 n = ak_vec3_make(sinf(th) * cosf(ph), cosf(th), sinf(th) * sinf(ph));
+                sh->nrm[sh->vcount] = n;
+                sh->pos[sh->vcount++] = ak_vec3_madd(sp->center, n, sp->radius);
+            }
+        for (int i = 0; i < RINGS; ++i)
+            for (int j = 0; j < SEG; ++j) {
+                uint32_t a = (uint32_t)(base + (size_t)i * (SEG + 1) + (size_t)j), b = a + SEG + 1;
+                uint32_t q[6] = {a, a + 1, b, a + 1, b + 1, b};
+                for (int t = 0; t < 6; ++t) sh->idx[sh->icount++] = q[t];
+            }
+    }
+    for (size_t k = 0; k < s->world.boxes.count; ++k) {
+        const ak_particle_box* b = &s->world.boxes.ptr[k];
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                size_t base = sh->vcount;
+                for (int c = 0; c < 4; ++c) {
+                    float u = (c == 1 || c == 2) ? 1.0f : 0.0f, v = (c >= 2) ? 1.0f : 0.0f;
+                    float f[3], lo[3] = {b->min.x, b->min.y, b->min.z},
+                                hi[3] = {b->max.x, b->max.y, b->max.z};
+                    f[axis] = side ? hi[axis] : lo[axis];
+                    f[(axis + 1) % 3] =
+                        lo[(axis + 1) % 3] + u * (hi[(axis + 1) % 3] - lo[(axis + 1) % 3]);
+                    f[(axis + 2) % 3] =
+                        lo[(axis + 2) % 3] + v * (hi[(axis + 2) % 3] - lo[(axis + 2) % 3]);
+                    float n[3] = {0, 0, 0};
+                    n[axis] = side ? 1.0f : -1.0f;
+                    sh->pos[sh->vcount] = ak_vec3_make(f[0], f[1], f[2]);
+                    sh->nrm[sh->vcount++] = ak_vec3_make(n[0], n[1], n[2]);
+                }
+                uint32_t q[6] = {0, 1, 2, 0, 2, 3};
+                for (int t = 0; t < 6; ++t) sh->idx[sh->icount++] = (uint32_t)base + q[t];
+            }
+    }
+    return true;
+}
+
+void particles_shapes_free(particles_shapes* sh) {
+    free(sh->pos);
+    free(sh->nrm);
+    free(sh->idx);
+}
+
+void particles_bounds_add(ak_vec3* lo, ak_vec3* hi, ak_vec3 p) {
+    if (!(fabsf(p.x) < 1e6f && fabsf(p.y) < 1e6f && fabsf(p.z) < 1e6f)) return;
+    *lo = ak_vec3_make(fminf(lo->x, p.x), fminf(lo->y, p.y), fminf(lo->z, p.z));
+    *hi = ak_vec3_make(fmaxf(hi->x, p.x), fmaxf(hi->y, p.y), fmaxf(hi->z, p.z));
+}
+ak_result particles_draw_points(ak_raster* ras, const ak_raster_camera* camera, int width, int height, ak_vec3 centre,
+                                ak_particles* ps, ak_vec4* colours) {
+    ak_particles_state st = ak_particles_get_state(ps);
+    if (!st.count) return AK_OK;
+    /* sRGB-ish colours fading with age; radius from the mean size at the view distance. */
+    double mean = 0.0;
+    for (size_t i = 0; i < st.count; ++i) {
+        float fade = isfinite(st.lifetime[i]) ? 1.0f - 0.6f * st.age[i] / st.lifetime[i] : 1.0f;
+        ak_vec4 c = st.colour[i];
+        colours[i] = ak_vec4_make(c.x * fade, c.y * fade, c.z * fade, 1.0f);
+        mean += st.size[i];
+    }
+    mean /= (double)st.count;
+    ak_vec3 a, b;
+    float px = 2.0f;
+    if (ak_raster_camera_project(camera, width, height, centre, &a) &&
+        ak_raster_camera_project(camera, width, height, ak_vec3_add(centre, ak_vec3_make(0, (float)mean, 0)), &b))
+        px = fabsf(a.y - b.y);
+    ak_raster_points pts = {.positions = {st.position, st.count},
+                            .colors = {colours, st.count},
+                            .radius = ak_clampf(px, 1.0f, 12.0f),
+                            .outline = px > 3.0f ? 1.0f : 0.0f};
+    return ak_raster_draw_points(ras, camera, &pts);
+}

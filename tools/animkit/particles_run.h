@@ -1,0 +1,73 @@
+/* animkit command line: a particle run shared by `animkit particles` and `animkit view`
+ * (presets, the character preset's posed humanoid, stepping with emitters and bursts, the
+ * collider shapes as triangles, and drawing the particles as points). */
+#ifndef ANIMKIT_CLI_PARTICLES_RUN_H
+#define ANIMKIT_CLI_PARTICLES_RUN_H
+
+#include "cli.h"
+#include "scene_particles.h"
+
+/* Fill s for a preset: fountain, rain, fireworks or character; false for another name or
+ * when out of memory (s is then safe to free). */
+bool particles_preset(const char* name, particles_scene* s);
+
+/* The character preset: builtin:humanoid walking (clip 0), its posed meshes concatenated as
+ * one collider and one emitter surface. */
+typedef struct particles_character {
+    ak_scene* scene;
+    cli_poser poser;
+    bool posed;
+    ak_vec3* positions; /* all meshes concatenated */
+    uint32_t* indices;
+    size_t vertex_count, index_count;
+    ak_particle_mesh* collider;
+    float* cdf;
+} particles_character;
+
+/* Load and pose the humanoid at time 0; returns (and stores in *rc) an exit code. */
+int particles_character_init(particles_character* c, int* rc);
+/* Pose at time t; the collider gets the pose with the elapsed time since the last one. */
+ak_result particles_character_pose(particles_character* c, float t, float elapsed);
+void particles_character_free(particles_character* c);
+
+/* A system built from a scene (which it points to and whose emitters it updates). */
+typedef struct particles_run {
+    particles_scene* scene;
+    ak_particles* ps;
+    particles_character* ch; /* NULL unless the character preset */
+    const ak_particle_mesh* meshes[1];
+    ak_particles_world world;
+    uint64_t* fired; /* bursts fired per emitter */
+    ak_particle_spring* springs; /* the world's springs, re-indexed as file particles die */
+    size_t file_alive;           /* file particles still alive */
+} particles_run;
+
+/* Create the system, add the scene's particles; ch NULL unless the character preset.
+ * Returns an exit code (message printed). */
+int particles_run_init(particles_run* r, particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads);
+/* Step number `step` (0-based): pose the character for its end, emit, fire bursts, step. */
+int particles_run_step(particles_run* r, int step);
+/* Free the system (safe on a zeroed run). */
+void particles_run_free(particles_run* r);
+
+/* UV spheres and boxes of the scene's colliders as one triangle mesh. */
+typedef struct particles_shapes {
+    ak_vec3* pos;
+    ak_vec3* nrm;
+    uint32_t* idx;
+    size_t vcount, icount;
+} particles_shapes;
+
+/* Build sh from the world's spheres and boxes; false when out of memory (free it anyway). */
+bool particles_shapes_build(particles_shapes* sh, const particles_scene* s);
+void particles_shapes_free(particles_shapes* sh);
+
+/* Grow [lo, hi] by p (points beyond 1e6 in some axis are skipped). */
+void particles_bounds_add(ak_vec3* lo, ak_vec3* hi, ak_vec3 p);
+
+/* Draw the live particles as points: colours fade with age, the radius is the mean size seen
+ * at `centre` (1..12 pixels), outlined above 3 pixels. colours has room for the capacity. */
+ak_result particles_draw_points(ak_raster* ras, const ak_raster_camera* camera, int width, int height, ak_vec3 centre,
+                                ak_particles* ps, ak_vec4* colours);
+
+#endif

@@ -1,0 +1,744 @@
+/* animkit view: the simulations it runs live (view_sim plug-ins). `animkit view KIND:SPEC`
+ * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json], cloth:SCENE.json,
+ * cloth:preset:NAME. Each reuses its command's scene parser and drawing (particles_run.c,
+ * boids_run.c, cloth_run.c), so the viewer shows what the command renders. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "boids_run.h"
+#include "cli_json.h"
+#include "cloth_run.h"
+#include "particles_run.h"
+#include "view_app.h"
+
+const char* const view_sim_kinds = "particles, boids, cloth";
+
+#define MAX_STEPS_PER_FRAME 64
+#define WIND_STEP 0.5f
+
+/* Read a scene file after checking it with the strict JSON reader (size budget, syntax). */
+static char* read_scene(const char* path, size_t* size, char* err, size_t err_size) {
+    cli_json j = {.file = path};
+    cJSON* root = cli_json_load(&j, path, 0);
+    if (!root) {
+        snprintf(err, err_size, "%s", j.message);
+        return NULL;
+    }
+    cJSON_Delete(root);
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, err_size, "%s: cannot open the file", path);
+        return NULL;
+    }
+    char* text = NULL;
+    long n = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    if (n >= 0 && fseek(f, 0, SEEK_SET) == 0) text = malloc((size_t)n + 1);
+    size_t got = text ? fread(text, 1, (size_t)n, f) : 0;
+    fclose(f);
+    if (!text || got != (size_t)n) {
+        free(text);
+        snprintf(err, err_size, "%s: cannot read the file", path);
+        return NULL;
+    }
+    text[got] = '\0';
+    *size = got;
+    return text;
+}
+
+/* Pixel radius of a sphere (centre c, radius r) as the camera sees it; false when behind. */
+static bool project_sphere(const ak_raster_camera* cam, int w, int h, ak_vec3 c, float r, ak_vec3* px, float* pr) {
+    const float* v = cam->view.m;
+    ak_vec3 up = ak_vec3_make(v[1], v[5], v[9]);
+    ak_vec3 top;
+    if (!ak_raster_camera_project(cam, w, h, c, px) ||
+        !ak_raster_camera_project(cam, w, h, ak_vec3_madd(c, up, r), &top))
+        return false;
+    *pr = hypotf(top.x - px->x, top.y - px->y);
+    return true;
+}
+
+/* ---- particles ---------------------------------------------------------------------------- */
+
+typedef struct psim {
+    particles_scene scene;
+    ak_particle_sphere* spheres0; /* the spheres as loaded (reset puts them back) */
+    particles_character ch;
+    bool use_char, char_ready;
+    particles_run run;
+    bool run_ready, failed;
+    particles_shapes sh;
+    ak_vec4* colours;
+    long step_index;
+    double carry; /* simulated time owed to the next step */
+    ak_vec3 lo, hi;
+    int grabbed;
+} psim;
+
+static void psim_destroy(void* state) {
+    psim* p = state;
+    if (!p) return;
+    particles_run_free(&p->run);
+    particles_shapes_free(&p->sh);
+    if (p->char_ready) particles_character_free(&p->ch);
+    free(p->spheres0);
+    free(p->colours);
+    particles_scene_free(&p->scene);
+    free(p);
+}
+
+/* Back to the loaded state: spheres, wind (the run copies the scene's world), time 0. */
+static int psim_restart(psim* p) {
+    for (size_t k = 0; k < p->scene.world.spheres.count; ++k) p->scene.spheres[k] = p->spheres0[k];
+    if (p->run_ready) particles_run_free(&p->run);
+    memset(&p->run, 0, sizeof p->run);
+    p->run_ready = false;
+    p->step_index = 0;
+    p->carry = 0.0;
+    p->failed = false;
+    if (p->use_char && particles_character_pose(&p->ch, 0.0f, 0.0f) != AK_OK)
+        return cli_fail("view", "cannot pose the character");
+    int rc = particles_run_init(&p->run, &p->scene, p->use_char ? &p->ch : NULL, 1, 1);
+    p->run_ready = true;
+    if (rc) return rc;
+    particles_shapes_free(&p->sh);
+    return particles_shapes_build(&p->sh, &p->scene) ? CLI_OK : cli_fail("view", "out of memory");
+}
+
+/* The box the camera frames: colliders, emitters, and where the particles go in a dry run of
+ * the first 2 seconds (as `animkit particles -o` frames its whole run); the floor plane. */
+static int psim_bounds_run(psim* p) {
+    ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
+    const particles_scene* s = &p->scene;
+    for (size_t k = 0; k < s->world.spheres.count; ++k) {
+        const ak_particle_sphere* sp = &s->world.spheres.ptr[k];
+        particles_bounds_add(&lo, &hi, ak_vec3_sub(sp->center, ak_vec3_splat(sp->radius)));
+        particles_bounds_add(&lo, &hi, ak_vec3_add(sp->center, ak_vec3_splat(sp->radius)));
+    }
+    for (size_t k = 0; k < s->world.boxes.count; ++k) {
+        particles_bounds_add(&lo, &hi, s->world.boxes.ptr[k].min);
+        particles_bounds_add(&lo, &hi, s->world.boxes.ptr[k].max);
+    }
+    for (size_t k = 0; k < s->emitter_count; ++k) particles_bounds_add(&lo, &hi, s->emitters[k].center);
+    int rc = psim_restart(p);
+    long steps = (long)ceilf(2.0f / s->dt);
+    if (steps > 400) steps = 400;
+    for (long k = 0; rc == CLI_OK && k <= steps; ++k) {
+        if (k > 0) rc = particles_run_step(&p->run, (int)k - 1);
+        if (k % 10 && k != steps) continue;
+        ak_particles_state st = ak_particles_get_state(p->run.ps);
+        for (size_t i = 0; i < st.count; i += 1 + st.count / 4000) particles_bounds_add(&lo, &hi, st.position[i]);
+        if (p->use_char)
+            for (size_t v = 0; v < p->ch.vertex_count; v += 7) particles_bounds_add(&lo, &hi, p->ch.positions[v]);
+    }
+    if (rc) return rc;
+    if (!(lo.x <= hi.x)) lo = ak_vec3_splat(-1), hi = ak_vec3_splat(1);
+    for (size_t k = 0; k < s->world.planes.count; ++k) {
+        ak_vec3 n = ak_vec3_normalize(s->world.planes.ptr[k].normal);
+        if (n.y > 0.99f) lo.y = fminf(lo.y, s->world.planes.ptr[k].d / n.y);
+    }
+    p->lo = lo;
+    p->hi = hi;
+    return psim_restart(p);
+}
+
+static int psim_init(void** state, const char* spec, char* err, size_t err_size) {
+    psim* p = calloc(1, sizeof *p);
+    if (!p) {
+        snprintf(err, err_size, "out of memory");
+        return CLI_BAD_INPUT;
+    }
+    p->grabbed = -1;
+    int rc = CLI_OK;
+    if (strncmp(spec, "preset:", 7) == 0) {
+        const char* name = spec + 7;
+        if (strcmp(name, "fountain") && strcmp(name, "rain") && strcmp(name, "fireworks") && strcmp(name, "character")) {
+            snprintf(err, err_size, "particles:preset:%s: the presets are fountain, rain, fireworks, character", name);
+            psim_destroy(p);
+            return CLI_BAD_USAGE;
+        }
+        if (!particles_preset(name, &p->scene)) {
+            snprintf(err, err_size, "out of memory");
+            psim_destroy(p);
+            return CLI_BAD_INPUT;
+        }
+        p->use_char = strcmp(name, "character") == 0;
+    } else if (!spec[0]) {
+        snprintf(err, err_size, "particles: give a scene file (particles:SCENE.json) or a preset (particles:preset:NAME)");
+        psim_destroy(p);
+        return CLI_BAD_USAGE;
+    } else {
+        size_t size = 0;
+        char* text = read_scene(spec, &size, err, err_size);
+        bool ok = text && particles_scene_parse(spec, text, size, &p->scene, err, err_size);
+        free(text);
+        if (!ok) {
+            psim_destroy(p);
+            return CLI_BAD_INPUT;
+        }
+    }
+    size_t ns = p->scene.world.spheres.count;
+    p->spheres0 = calloc(ns + 1, sizeof *p->spheres0);
+    p->colours = calloc((size_t)p->scene.capacity + 1, sizeof(ak_vec4));
+    if (!p->spheres0 || !p->colours) {
+        snprintf(err, err_size, "out of memory");
+        psim_destroy(p);
+        return CLI_BAD_INPUT;
+    }
+    if (ns) memcpy(p->spheres0, p->scene.spheres, ns * sizeof *p->spheres0);
+    if (p->use_char) {
+        particles_character_init(&p->ch, &rc);
+        p->char_ready = true; /* freed at the end whatever init made */
+    }
+    if (rc == CLI_OK) rc = psim_bounds_run(p);
+    if (rc) {
+        snprintf(err, err_size, "cannot start the particle simulation");
+        psim_destroy(p);
+        return CLI_BAD_INPUT;
+    }
+    *state = p;
+    return CLI_OK;
+}
+
+static void psim_step(void* state, float dt) {
+    psim* p = state;
+    if (p->failed) return;
+    const float sdt = p->scene.dt;
+    p->carry += (double)dt;
+    for (int n = 0; p->carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
+        if (particles_run_step(&p->run, (int)p->step_index) != CLI_OK) {
+            p->failed = true;
+            return;
+        }
+        ++p->step_index;
+        p->carry -= (double)sdt;
+    }
+    if (p->carry > (double)sdt) p->carry = 0.0; /* fell behind: drop the debt */
+}
+
+static void psim_reset(void* state) {
+    psim* p = state;
+    if (psim_restart(p) != CLI_OK) p->failed = true;
+}
+
+static size_t psim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
+    psim* p = state;
+    size_t n = 0;
+    if (p->sh.icount && n < cap)
+        out[n++] = (ak_raster_mesh){.positions = {p->sh.pos, p->sh.vcount},
+                                    .normals = {p->sh.nrm, p->sh.vcount},
+                                    .indices = {p->sh.idx, p->sh.icount},
+                                    .material = {.color = {0.75f, 0.72f, 0.68f, 1}}};
+    if (p->use_char && n < cap)
+        out[n++] = (ak_raster_mesh){.positions = {p->ch.positions, p->ch.vertex_count},
+                                    .indices = {p->ch.indices, p->ch.index_count},
+                                    .material = {.color = {0.80f, 0.74f, 0.68f, 1}},
+                                    .shading = AK_SHADING_FLAT};
+    return n;
+}
+
+static ak_result psim_draw(void* state, ak_raster* ras, const ak_raster_camera* cam, int w, int h) {
+    psim* p = state;
+    return particles_draw_points(ras, cam, w, h, ak_vec3_scale(ak_vec3_add(p->lo, p->hi), 0.5f), p->run.ps, p->colours);
+}
+
+static void psim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
+    psim* p = state;
+    *lo = ak_vec3_min(*lo, p->lo);
+    *hi = ak_vec3_max(*hi, p->hi);
+}
+
+static bool psim_key(void* state, int key, char* msg, size_t msg_size) {
+    psim* p = state;
+    ak_vec3 d;
+    switch (key) {
+    case 'a': d = ak_vec3_make(-WIND_STEP, 0, 0); break;
+    case 'd': d = ak_vec3_make(WIND_STEP, 0, 0); break;
+    case 'q': d = ak_vec3_make(0, 0, -WIND_STEP); break;
+    case 'e': d = ak_vec3_make(0, 0, WIND_STEP); break;
+    default: return false;
+    }
+    p->run.world.wind = ak_vec3_add(p->run.world.wind, d);
+    ak_vec3 w = p->run.world.wind;
+    snprintf(msg, msg_size, "wind %.2g %.2g %.2g m/s", (double)w.x, (double)w.y, (double)w.z);
+    return true;
+}
+
+static bool psim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
+    psim* p = state;
+    p->grabbed = -1;
+    float best = INFINITY;
+    for (size_t k = 0; k < p->scene.world.spheres.count; ++k) {
+        const ak_particle_sphere* s = &p->scene.spheres[k];
+        ak_vec3 c;
+        float r;
+        if (!project_sphere(cam, w, h, s->center, s->radius, &c, &r)) continue;
+        float d = hypotf(c.x - x, c.y - y);
+        if (d <= r && c.z < best) best = c.z, p->grabbed = (int)k;
+    }
+    if (p->grabbed < 0) return false;
+    *anchor = p->scene.spheres[p->grabbed].center;
+    return true;
+}
+
+static void psim_drag(void* state, ak_vec3 delta) {
+    psim* p = state;
+    if (p->grabbed < 0 || !ak_vec3_is_finite(delta)) return;
+    ak_particle_sphere* s = &p->scene.spheres[p->grabbed];
+    s->center = ak_vec3_add(s->center, delta);
+    particles_shapes_free(&p->sh);
+    if (!particles_shapes_build(&p->sh, &p->scene)) {
+        particles_shapes_free(&p->sh);
+        memset(&p->sh, 0, sizeof p->sh);
+    }
+}
+
+static void psim_status(void* state, char* out, size_t n) {
+    psim* p = state;
+    ak_vec3 w = p->run.world.wind;
+    snprintf(out, n, "t %.2fs, %zu particles, wind %.2g %.2g %.2g%s", ak_particles_time(p->run.ps),
+             ak_particles_get_state(p->run.ps).count, (double)w.x, (double)w.y, (double)w.z,
+             p->failed ? ", stopped (step failed)" : "");
+}
+
+static const view_help_entry psim_keys[] = {
+    {"r", "restart the simulation (also tab)"},
+    {"right", "one frame of simulation, paused"},
+    {"a", "wind -x (0.5 m/s)"},
+    {"d", "wind +x"},
+    {"q", "wind -z"},
+    {"e", "wind +z"},
+};
+
+static const view_sim particles_sim = {
+    .name = "particles",
+    .init = psim_init,
+    .step = psim_step,
+    .reset = psim_reset,
+    .meshes = psim_meshes,
+    .draw = psim_draw,
+    .bounds = psim_bounds,
+    .key = psim_key,
+    .grab = psim_grab,
+    .drag = psim_drag,
+    .status = psim_status,
+    .destroy = psim_destroy,
+    .keys = psim_keys,
+    .key_count = sizeof psim_keys / sizeof psim_keys[0],
+};
+
+/* ---- boids ------------------------------------------------------------------------------- */
+
+typedef struct bsim {
+    cli_boids_scene sc;
+    ak_boids_obstacle* obstacles0; /* as loaded (reset puts them back) */
+    boids_run run;
+    boids_shapes sh;
+    long step_index;
+    double carry;
+    bool failed;
+    const char* file;
+    ak_vec3 lo, hi;
+    float extent;
+    int grabbed;
+} bsim;
+
+static void bsim_destroy(void* state) {
+    bsim* b = state;
+    if (!b) return;
+    boids_run_free(&b->run);
+    boids_shapes_free(&b->sh);
+    free(b->obstacles0);
+    cli_boids_scene_free(&b->sc);
+    free(b);
+}
+
+static int bsim_restart(bsim* b) {
+    uint32_t no = b->sc.params.obstacle_count;
+    if (no) memcpy(b->sc.obstacles, b->obstacles0, no * sizeof *b->obstacles0);
+    boids_run_free(&b->run);
+    b->step_index = 0;
+    b->carry = 0.0;
+    b->failed = false;
+    int rc = boids_run_init(&b->run, &b->sc, "view", b->file, 1);
+    if (rc) return rc;
+    return boids_shapes_obstacles(&b->sh, &b->sc.params, b->extent) ? CLI_OK : cli_fail("view", "out of memory");
+}
+
+static int bsim_init(void** state, const char* spec, char* err, size_t err_size) {
+    bsim* b = calloc(1, sizeof *b);
+    if (!b) {
+        snprintf(err, err_size, "out of memory");
+        return CLI_BAD_INPUT;
+    }
+    b->grabbed = -1;
+    b->file = spec[0] ? spec : "boids (default scene)";
+    cli_boids_scene_defaults(&b->sc);
+    if (spec[0]) {
+        size_t size = 0;
+        char* text = read_scene(spec, &size, err, err_size);
+        int bad = !text || cli_boids_scene_parse(spec, text, size, &b->sc, err, err_size);
+        free(text);
+        if (bad) {
+            bsim_destroy(b);
+            return CLI_BAD_INPUT;
+        }
+    }
+    /* the box the command's camera looks at, down to its ground */
+    const ak_boids_params* prm = &b->sc.params;
+    b->lo = prm->bounds_min;
+    b->hi = prm->bounds_max;
+    b->extent = 0.5f * ak_vec3_length(ak_vec3_sub(b->hi, b->lo));
+    float ground = prm->planar ? -0.5f * b->sc.shape_size - 0.3f : b->lo.y - 0.05f * b->extent;
+    for (uint32_t k = 0; k < prm->obstacle_count; ++k)
+        if (boids_is_floor(&prm->obstacles[k])) ground = prm->obstacles[k].center.y;
+    if (prm->planar) b->lo.y = b->hi.y = 0.0f;
+    b->lo.y = ak_minf(b->lo.y, ground);
+    size_t n = b->sc.agent_count > 0 ? b->sc.agent_count : b->sc.count;
+    b->obstacles0 = calloc(prm->obstacle_count + 1u, sizeof *b->obstacles0);
+    if (!b->obstacles0 || !boids_shapes_init(&b->sh, &b->sc, n, b->extent)) {
+        snprintf(err, err_size, "out of memory");
+        bsim_destroy(b);
+        return CLI_BAD_INPUT;
+    }
+    if (prm->obstacle_count) memcpy(b->obstacles0, b->sc.obstacles, prm->obstacle_count * sizeof *b->obstacles0);
+    if (bsim_restart(b)) {
+        snprintf(err, err_size, "cannot start the flock");
+        bsim_destroy(b);
+        return CLI_BAD_INPUT;
+    }
+    *state = b;
+    return CLI_OK;
+}
+
+static void bsim_step(void* state, float dt) {
+    bsim* b = state;
+    if (b->failed) return;
+    const float sdt = b->sc.dt;
+    b->carry += (double)dt;
+    for (int n = 0; b->carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
+        if (boids_run_step(&b->run, b->step_index) != AK_OK) {
+            b->failed = true;
+            return;
+        }
+        ++b->step_index;
+        b->carry -= (double)sdt;
+    }
+    if (b->carry > (double)sdt) b->carry = 0.0;
+}
+
+static void bsim_reset(void* state) {
+    bsim* b = state;
+    if (bsim_restart(b) != CLI_OK) b->failed = true;
+}
+
+static size_t bsim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
+    bsim* b = state;
+    ak_raster_mesh birds, obs;
+    boids_shapes_update(&b->sh, &b->sc, &b->run, (float)b->step_index * b->sc.dt, &birds, &obs);
+    size_t n = 0;
+    if (n < cap && b->run.n) out[n++] = birds;
+    if (n < cap && b->sh.otri) out[n++] = obs;
+    return n;
+}
+
+static void bsim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
+    bsim* b = state;
+    *lo = ak_vec3_min(*lo, b->lo);
+    *hi = ak_vec3_max(*hi, b->hi);
+}
+
+static bool bsim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
+    bsim* b = state;
+    b->grabbed = -1;
+    float best = INFINITY;
+    for (uint32_t k = 0; k < b->sc.params.obstacle_count; ++k) {
+        const ak_boids_obstacle* o = &b->sc.obstacles[k];
+        ak_vec3 c;
+        float r;
+        if (o->kind != AK_BOIDS_SPHERE || !project_sphere(cam, w, h, o->center, o->radius, &c, &r)) continue;
+        float d = hypotf(c.x - x, c.y - y);
+        if (d <= r && c.z < best) best = c.z, b->grabbed = (int)k;
+    }
+    if (b->grabbed < 0) return false;
+    *anchor = b->sc.obstacles[b->grabbed].center;
+    return true;
+}
+
+static void bsim_drag(void* state, ak_vec3 delta) {
+    bsim* b = state;
+    if (b->grabbed < 0 || !ak_vec3_is_finite(delta)) return;
+    ak_boids_obstacle* o = &b->sc.obstacles[b->grabbed];
+    o->center = ak_vec3_add(o->center, delta);
+    if (b->sc.params.planar) o->center.y = 0.0f; /* 2D flocks cut obstacles at y = 0 */
+    if (!boids_shapes_obstacles(&b->sh, &b->sc.params, b->extent)) b->sh.overt = b->sh.otri = 0;
+}
+
+static void bsim_status(void* state, char* out, size_t n) {
+    bsim* b = state;
+    snprintf(out, n, "t %.2fs, %zu agents, order %.3f%s", (double)b->step_index * (double)b->sc.dt, b->run.n,
+             (double)ak_boids_order((ak_vec3_cspan){b->run.v, b->run.n}), b->failed ? ", stopped (step failed)" : "");
+}
+
+static const view_help_entry bsim_keys[] = {
+    {"r", "restart the flock (also tab)"},
+    {"right", "one frame of simulation, paused"},
+};
+
+static const view_sim boids_sim = {
+    .name = "boids",
+    .init = bsim_init,
+    .step = bsim_step,
+    .reset = bsim_reset,
+    .meshes = bsim_meshes,
+    .bounds = bsim_bounds,
+    .grab = bsim_grab,
+    .drag = bsim_drag,
+    .status = bsim_status,
+    .destroy = bsim_destroy,
+    .keys = bsim_keys,
+    .key_count = sizeof bsim_keys / sizeof bsim_keys[0],
+};
+
+/* ---- cloth -------------------------------------------------------------------------------- */
+
+typedef struct csim {
+    cloth_scene sc;
+    bool sc_ready;
+    char name[64];
+    ak_cloth_sphere* spheres0; /* as loaded (reset puts them back, and the wind) */
+    ak_vec3 wind0;
+    cloth_run run;
+    cloth_prop* props;         /* spheres, then the scene's capsules */
+    size_t prop_count;
+    double carry;
+    bool failed;
+    ak_vec3 lo, hi;
+    int grabbed;
+} csim;
+
+static void csim_destroy(void* state) {
+    csim* c = state;
+    if (!c) return;
+    cloth_run_free(&c->run);
+    free(c->props);
+    free(c->spheres0);
+    if (c->sc_ready) cloth_scene_free(&c->sc);
+    free(c);
+}
+
+static void csim_props(csim* c) {
+    for (size_t k = 0; k < c->prop_count; ++k) {
+        if (k < c->sc.sphere_count) {
+            cloth_prop_build(&c->props[k], c->sc.spheres[k].center, c->sc.spheres[k].center, c->sc.spheres[k].radius);
+        } else {
+            const ak_cloth_capsule* cp = &c->sc.capsules[k - c->sc.sphere_count];
+            cloth_prop_build(&c->props[k], cp->a, cp->b, cp->radius);
+        }
+    }
+}
+
+static int csim_restart(csim* c) {
+    if (c->sc.sphere_count) memcpy(c->sc.spheres, c->spheres0, c->sc.sphere_count * sizeof *c->spheres0);
+    c->sc.wind = c->wind0;
+    cloth_run_free(&c->run);
+    c->carry = 0.0;
+    c->failed = false;
+    csim_props(c);
+    return cloth_run_init(&c->run, &c->sc, "view", c->name);
+}
+
+static int csim_init(void** state, const char* spec, char* err, size_t err_size) {
+    csim* c = calloc(1, sizeof *c);
+    if (!c) {
+        snprintf(err, err_size, "out of memory");
+        return CLI_BAD_INPUT;
+    }
+    c->grabbed = -1;
+    snprintf(c->name, sizeof c->name, "%s", spec);
+    if (strncmp(spec, "preset:", 7) == 0) {
+        c->sc_ready = true;
+        if (!cloth_scene_preset(spec + 7, &c->sc)) {
+            snprintf(err, err_size, "cloth:%s: the presets are flag, curtain, drape, cape", spec);
+            csim_destroy(c);
+            return CLI_BAD_USAGE;
+        }
+        snprintf(c->name, sizeof c->name, "%s", spec + 7);
+    } else if (!spec[0]) {
+        snprintf(err, err_size, "cloth: give a scene file (cloth:SCENE.json) or a preset (cloth:preset:NAME)");
+        csim_destroy(c);
+        return CLI_BAD_USAGE;
+    } else {
+        size_t size = 0;
+        char* text = read_scene(spec, &size, err, err_size);
+        bool ok = text && cloth_scene_parse(spec, text, size, &c->sc, err, err_size);
+        free(text);
+        c->sc_ready = ok;
+        if (!ok) {
+            csim_destroy(c);
+            return CLI_BAD_INPUT;
+        }
+    }
+    c->wind0 = c->sc.wind;
+    c->prop_count = c->sc.sphere_count + c->sc.capsule_count;
+    if (c->prop_count > CLI_MAX_EXTRA - 1) c->prop_count = CLI_MAX_EXTRA - 1;
+    c->spheres0 = calloc(c->sc.sphere_count + 1, sizeof *c->spheres0);
+    c->props = calloc(c->prop_count + 1, sizeof *c->props);
+    if (!c->spheres0 || !c->props) {
+        snprintf(err, err_size, "out of memory");
+        csim_destroy(c);
+        return CLI_BAD_INPUT;
+    }
+    if (c->sc.sphere_count) memcpy(c->spheres0, c->sc.spheres, c->sc.sphere_count * sizeof *c->spheres0);
+    if (csim_restart(c)) {
+        snprintf(err, err_size, "cannot start the cloth");
+        csim_destroy(c);
+        return CLI_BAD_INPUT;
+    }
+    cloth_run_bounds(&c->run, &c->lo, &c->hi);
+    *state = c;
+    return CLI_OK;
+}
+
+static void csim_step(void* state, float dt) {
+    csim* c = state;
+    if (c->failed) return;
+    const float sdt = c->sc.dt;
+    c->carry += (double)dt;
+    for (int n = 0; c->carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
+        if (cloth_run_step(&c->run, "view", c->name) != CLI_OK) {
+            c->failed = true;
+            return;
+        }
+        c->carry -= (double)sdt;
+    }
+    if (c->carry > (double)sdt) c->carry = 0.0;
+}
+
+static void csim_reset(void* state) {
+    csim* c = state;
+    if (csim_restart(c) != CLI_OK) c->failed = true;
+}
+
+/* The cloth, the collider props and the character's posed meshes, as `animkit cloth` draws them. */
+static size_t csim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
+    csim* c = state;
+    size_t n = 0;
+    if (n < cap && c->run.cloth)
+        out[n++] = (ak_raster_mesh){.positions = {c->run.x, c->run.n}, .normals = {c->run.nrm, c->run.n},
+                                    .indices = ak_cloth_indices(c->run.cloth),
+                                    .material = {.color = {0.72f, 0.16f, 0.18f, 1}, .specular = 0.1f}};
+    for (size_t k = 0; k < c->prop_count && n < cap; ++k)
+        out[n++] = (ak_raster_mesh){.positions = {c->props[k].pos, PROP_VERTS}, .normals = {c->props[k].nrm, PROP_VERTS},
+                                    .indices = {c->props[k].idx, PROP_TRIS * 3},
+                                    .material = {.color = {0.55f, 0.62f, 0.72f, 1}}};
+    const ak_scene* s = c->run.ch.scene;
+    for (size_t m = 0; s && m < s->mesh_count && n < cap; ++m) {
+        const ak_mesh* mesh = s->meshes[m].mesh;
+        if (!mesh || !mesh->triangle_count) continue;
+        out[n++] = (ak_raster_mesh){.positions = {c->run.ch.poser.positions[m], mesh->vertex_count},
+                                    .normals = {c->run.ch.poser.normals[m], mesh->vertex_count},
+                                    .indices = {mesh->indices, mesh->triangle_count * 3},
+                                    .material = {.color = {0.80f, 0.74f, 0.68f, 1}}};
+    }
+    return n;
+}
+
+static void csim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
+    csim* c = state;
+    *lo = ak_vec3_min(*lo, c->lo);
+    *hi = ak_vec3_max(*hi, c->hi);
+}
+
+static bool csim_key(void* state, int key, char* msg, size_t msg_size) {
+    csim* c = state;
+    ak_vec3 d;
+    switch (key) {
+    case 'a': d = ak_vec3_make(-WIND_STEP, 0, 0); break;
+    case 'd': d = ak_vec3_make(WIND_STEP, 0, 0); break;
+    case 'q': d = ak_vec3_make(0, 0, -WIND_STEP); break;
+    case 'e': d = ak_vec3_make(0, 0, WIND_STEP); break;
+    default: return false;
+    }
+    c->sc.wind = ak_vec3_add(c->sc.wind, d);
+    ak_vec3 w = c->sc.wind;
+    snprintf(msg, msg_size, "wind %.2g %.2g %.2g m/s", (double)w.x, (double)w.y, (double)w.z);
+    return true;
+}
+
+static bool csim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
+    csim* c = state;
+    c->grabbed = -1;
+    float best = INFINITY;
+    for (size_t k = 0; k < c->sc.sphere_count; ++k) {
+        ak_vec3 p;
+        float r;
+        if (!project_sphere(cam, w, h, c->sc.spheres[k].center, c->sc.spheres[k].radius, &p, &r)) continue;
+        if (hypotf(p.x - x, p.y - y) <= r && p.z < best) best = p.z, c->grabbed = (int)k;
+    }
+    if (c->grabbed < 0) return false;
+    *anchor = c->sc.spheres[c->grabbed].center;
+    return true;
+}
+
+static void csim_drag(void* state, ak_vec3 delta) {
+    csim* c = state;
+    if (c->grabbed < 0 || !ak_vec3_is_finite(delta)) return;
+    ak_cloth_sphere* s = &c->sc.spheres[c->grabbed];
+    s->center = ak_vec3_add(s->center, delta);
+    if ((size_t)c->grabbed < c->prop_count) cloth_prop_build(&c->props[c->grabbed], s->center, s->center, s->radius);
+}
+
+static void csim_status(void* state, char* out, size_t n) {
+    csim* c = state;
+    ak_vec3 w = c->sc.wind;
+    snprintf(out, n, "t %.2fs, %zu particles, wind %.2g %.2g %.2g%s", (double)c->run.time, c->run.n, (double)w.x,
+             (double)w.y, (double)w.z, c->failed ? ", stopped (step failed)" : "");
+}
+
+static const view_help_entry csim_keys[] = {
+    {"r", "restart the cloth (also tab)"},
+    {"right", "one frame of simulation, paused"},
+    {"a", "wind -x (0.5 m/s)"},
+    {"d", "wind +x"},
+    {"q", "wind -z"},
+    {"e", "wind +z"},
+};
+
+static const view_sim cloth_sim = {
+    .name = "cloth",
+    .init = csim_init,
+    .step = csim_step,
+    .reset = csim_reset,
+    .meshes = csim_meshes,
+    .bounds = csim_bounds,
+    .key = csim_key,
+    .grab = csim_grab,
+    .drag = csim_drag,
+    .status = csim_status,
+    .destroy = csim_destroy,
+    .keys = csim_keys,
+    .key_count = sizeof csim_keys / sizeof csim_keys[0],
+};
+
+/* ---- the table ---------------------------------------------------------------------------- */
+
+static const struct {
+    const char* kind;
+    const view_sim* sim;
+} sims[] = {
+    {"particles", &particles_sim},
+    {"boids", &boids_sim},
+    {"cloth", &cloth_sim},
+};
+
+const view_sim* view_sim_find(const char* arg, const char** spec) {
+    for (size_t k = 0; k < sizeof sims / sizeof sims[0]; ++k) {
+        size_t n = strlen(sims[k].kind);
+        if (strncmp(arg, sims[k].kind, n) == 0 && (arg[n] == ':' || arg[n] == '\0')) {
+            *spec = arg[n] ? arg + n + 1 : "";
+            return sims[k].sim;
+        }
+    }
+    return NULL;
+}
