@@ -24,5 +24,6 @@
 #include "io.h"
 #include "raster.h"
 #include "view.h"
+#include "retarget.h"
 
 #endif

@@ -49,7 +49,8 @@ ak_result ak_clip_bake(const ak_clip_bake_desc* desc, const ak_allocator* alloc,
     if (nf > SIZE_MAX / 16 / (nj + 1) || (nw && nf > SIZE_MAX / 4 / nw)) return AK_ERR_NO_MEMORY;
     ak_interp interp = desc->step ? AK_INTERP_STEP : AK_INTERP_LINEAR;
     /* one float block: times, then per joint and part the values of the channels kept */
-    size_t floats = nf + nf * nj * 10 + nf * nw;
+    /* (each part is gathered 4 floats per frame, then packed: room for one more frame block) */
+    size_t floats = nf + nf * nj * 10 + nf * nw + 4 * nf;
     float* buf = (float*)akp_alloc(alloc, floats * sizeof(float));
     ak_raw_channel* ch = (ak_raw_channel*)akp_alloc(alloc, (3 * nj + 1) * sizeof(ak_raw_channel));
     if (!buf || !ch) {
