@@ -325,6 +325,9 @@ ak_result ak_retarget_clip(const ak_retarget_desc* desc_in, const ak_allocator* 
     }
     ak_humanoid_bones_of_skeleton(src, (ak_i32_span){sbones, ns});
     ak_humanoid_bones_of_skeleton(dst, (ak_i32_span){tbones, nt});
+    /* a target joint whose name says nothing takes the bone of its source joint (user maps) */
+    for (size_t k = 0; k < nt; ++k)
+        if (tbones[k] == AK_BONE_NONE && map[k] >= 0 && find_bone(tbones, nt, sbones[map[k]]) < 0) tbones[k] = sbones[map[k]];
 
     /* rest poses in model space */
     ak_transform_cspan s_rest = ak_skeleton_rest_pose(src), t_rest = ak_skeleton_rest_pose(dst);
@@ -409,7 +412,7 @@ ak_result ak_retarget_clip(const ak_retarget_desc* desc_in, const ak_allocator* 
     if (r != AK_OK) goto done;
 
     /* foot contacts on the source, pinned on the target */
-    size_t contact_frames = 0, pinned = 0;
+    size_t contact_frames = 0, pinned = 0, unreached = 0;
     for (int s = 0; s < 2 && !d.skip_foot_contacts; ++s) {
         int foot = feet[s];
         if (foot < 0 || map[foot] < 0) continue;
@@ -426,23 +429,40 @@ ak_result ak_retarget_clip(const ak_retarget_desc* desc_in, const ak_allocator* 
             contact[2 * f + (size_t)s] = foot_pos[2 * f + (size_t)s].y - floor_y < h && speed < v;
             contact_frames += contact[2 * f + (size_t)s];
         }
-        ak_vec3 pin = ak_vec3_make(0, 0, 0);
-        for (size_t f = 0; f < nf; ++f) {
-            if (!contact[2 * f + (size_t)s]) continue;
-            ak_transform* out = poses + f * nt;
-            ak_skeleton_local_to_model(dst, (ak_transform_cspan){out, nt}, (ak_mat4_span){t_m, nt});
-            if (f == 0 || !contact[2 * (f - 1) + (size_t)s]) pin = model_position(&t_m[foot]);
-            model_rotations(dst, out, t_q);
-            ak_quat foot_world = t_q[foot];
-            ak_quat cs, cm;
-            ak_ik_two_bone_job job = {.start = t_m[upper], .mid = t_m[lower], .end = t_m[foot], .target = pin,
-                                      .out_start_rot = &cs, .out_mid_rot = &cm};
-            if (ak_ik_two_bone_run(&job) != AK_OK) continue;
-            out[upper].rotation = ak_quat_normalize(ak_quat_mul(out[upper].rotation, cs));
-            out[lower].rotation = ak_quat_normalize(ak_quat_mul(out[lower].rotation, cm));
-            model_rotations(dst, out, t_q);
-            out[foot].rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(t_q[lower]), foot_world));
-            ++pinned;
+        /* each contact run: the foot is pinned at its mean position over the run (half the
+         * reach the first frame's position would ask of the leg at the run's far end) */
+        for (size_t a = 0; a < nf;) {
+            if (!contact[2 * a + (size_t)s]) {
+                ++a;
+                continue;
+            }
+            size_t b = a;
+            double sum[3] = {0, 0, 0};
+            for (; b < nf && contact[2 * b + (size_t)s]; ++b) {
+                ak_skeleton_local_to_model(dst, (ak_transform_cspan){poses + b * nt, nt}, (ak_mat4_span){t_m, nt});
+                ak_vec3 p = model_position(&t_m[foot]);
+                sum[0] += p.x, sum[1] += p.y, sum[2] += p.z;
+            }
+            double cnt = (double)(b - a);
+            ak_vec3 pin = ak_vec3_make((float)(sum[0] / cnt), (float)(sum[1] / cnt), (float)(sum[2] / cnt));
+            for (size_t f = a; f < b; ++f) {
+                ak_transform* out = poses + f * nt;
+                ak_skeleton_local_to_model(dst, (ak_transform_cspan){out, nt}, (ak_mat4_span){t_m, nt});
+                model_rotations(dst, out, t_q);
+                ak_quat foot_world = t_q[foot];
+                ak_quat cs, cm;
+                bool reached = false;
+                ak_ik_two_bone_job job = {.start = t_m[upper], .mid = t_m[lower], .end = t_m[foot], .target = pin,
+                                          .out_start_rot = &cs, .out_mid_rot = &cm, .out_reached = &reached};
+                if (ak_ik_two_bone_run(&job) != AK_OK) continue;
+                out[upper].rotation = ak_quat_normalize(ak_quat_mul(out[upper].rotation, cs));
+                out[lower].rotation = ak_quat_normalize(ak_quat_mul(out[lower].rotation, cm));
+                model_rotations(dst, out, t_q);
+                out[foot].rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(t_q[lower]), foot_world));
+                ++pinned;
+                unreached += !reached;
+            }
+            a = b;
         }
     }
 
@@ -456,6 +476,7 @@ ak_result ak_retarget_clip(const ak_retarget_desc* desc_in, const ak_allocator* 
         out_stats->root_scale = scale;
         out_stats->contact_frames = contact_frames;
         out_stats->pinned_frames = pinned;
+        out_stats->unreached_frames = unreached;
     }
 done:
     akp_free(alloc, mem);

@@ -20,9 +20,10 @@
  *     not mapped), or unscaled;
  *   - optionally cleans up foot contacts: a source foot is in contact at a frame when its
  *     height above its lowest point in the clip is below contact_height and its horizontal
- *     speed below contact_speed; during each contact run the target foot is pinned where it
- *     was at the run's first frame with the two-bone IK (upper leg, lower leg, foot; the foot
- *     keeps its model-space rotation);
+ *     speed below contact_speed; during each run of contact frames the target foot is pinned
+ *     at its mean position over the run with the two-bone IK (upper leg, lower leg, foot; the
+ *     foot keeps its model-space rotation); a pin out of the leg's reach stretches the leg
+ *     towards it (ak_retarget_stats.unreached_frames);
  *   - bakes the result at frame_rate into a clip for the target (ak_clip_bake).
  * Both skeletons are assumed to share the up axis and facing direction of their model space.
  *
@@ -114,13 +115,15 @@ typedef struct ak_retarget_stats {
     float root_scale;       /* factor applied to the root displacement */
     size_t contact_frames;  /* source foot-frames in contact (both feet counted) */
     size_t pinned_frames;   /* target foot-frames the IK pinned */
+    size_t unreached_frames; /* of those, frames the pin was out of the leg's reach (the leg is
+                                stretched towards it and the foot slides) */
 } ak_retarget_stats;
 
 /* The desc with zero fields replaced by their defaults (NULL -> all defaults). */
 AK_API ak_retarget_desc ak_retarget_desc_resolved(const ak_retarget_desc* desc);
 
 /* Retarget desc->clip onto desc->target and bake it (frames at 0, 1/rate, ... up to the clip's
- * duration, the last frame at the duration). alloc NULL -> malloc/free (temporary arrays and
+ * duration; the last frame samples the source at its duration). alloc NULL -> malloc/free (temporary arrays and
  * the clip). Returns AK_ERR_NULL_ARG (desc, source, clip, target or out_clip NULL),
  * AK_ERR_SPAN_SMALL (source_of_target shorter than the target's joint count),
  * AK_ERR_BAD_INDEX (a map entry >= the source's joint count or < -1, or the clip addresses
