@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "ak_test.h"
@@ -173,7 +174,110 @@ AK_TEST(cmu_bvh_onto_builtin_and_cesiumman) {
     ak_scene_destroy(cesium);
 }
 
+
+#ifdef AK_CLI_PATH
+/* Run the CLI; returns the exit status and the first line of stderr in line. */
+static int run_cli(const char* args, char* line, size_t n) {
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "'%s' retarget %s 2>&1 >/dev/null", AK_CLI_PATH, args);
+    FILE* p = popen(cmd, "r");
+    if (!p) return -1;
+    line[0] = '\0';
+    char buf[1024];
+    int lines = 0;
+    while (fgets(buf, sizeof buf, p))
+        if (lines++ == 0) snprintf(line, n, "%s", buf);
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+AK_TEST(cli_retarget) {
+    char bvh[1200], cesium[1200], nomotion[1200];
+    if (!ak_test_asset(bvh, sizeof bvh, "bvh/02_01.bvh") ||
+        !ak_test_asset(cesium, sizeof cesium, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb") ||
+        !ak_test_asset(nomotion, sizeof nomotion, "gltf/MorphPrimitivesTest/glTF-Binary/MorphPrimitivesTest.glb")) {
+        AK_SKIP("assets absent (set ANIMKIT_ASSETS)");
+        return;
+    }
+    char dir[] = "/tmp/test_retarget_cli.XXXXXX";
+    if (!mkdtemp(dir)) {
+        AK_FAIL_("mkdtemp");
+        return;
+    }
+    char args[4096], line[1024], out[256], mapf[256];
+    /* builtin humanoid by names, glb out: loads back with the clip on 17 joints */
+    snprintf(out, sizeof out, "%s/human.glb", dir);
+    snprintf(args, sizeof args, "'%s' builtin:humanoid -o '%s'", bvh, out);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 0);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(out, NULL, NULL, &s, &diag), AK_OK);
+    if (s) {
+        AK_CHECK_EQ(s->clip_count, 1u);
+        AK_CHECK_EQ(ak_scene_joint_count(s) >= 17u, true);
+    }
+    ak_scene_destroy(s);
+    /* CesiumMan with a map file */
+    snprintf(mapf, sizeof mapf, "%s/cesium.map", dir);
+    FILE* f = fopen(mapf, "w");
+    fprintf(f, "# CesiumMan <- CMU\n");
+    for (size_t i = 0; i < sizeof k_cesium_map / sizeof k_cesium_map[0]; ++i)
+        fprintf(f, "%s = %s\n", k_cesium_map[i][0], k_cesium_map[i][1]);
+    fclose(f);
+    snprintf(out, sizeof out, "%s/cesium.gltf", dir);
+    snprintf(args, sizeof args, "'%s' '%s' --map '%s' -o '%s'", bvh, cesium, mapf, out);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 0);
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load(out, NULL, NULL, &s, &diag), AK_OK);
+    ak_scene_destroy(s);
+    /* no name in common: exit 1, one line naming the target */
+    snprintf(args, sizeof args, "'%s' '%s' -o '%s'", bvh, cesium, out);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
+    AK_CHECK(strstr(line, "CesiumMan.glb") && strstr(line, "--map"));
+    /* bad map files: each exits 1 with one line naming the file and the problem */
+    struct {
+        const char* text;
+        const char* expect;
+    } bad[] = {
+        {"leg_joint_L_1 = LeftUpLeg\nnot_a_joint = Hips\n", "has no joint 'not_a_joint'"},
+        {"leg_joint_L_1 = NoSuchSourceJoint\n", "has no joint 'NoSuchSourceJoint'"},
+        {"leg_joint_L_1 LeftUpLeg\n", "expected 'TARGET_JOINT = SOURCE_JOINT'"},
+        {"# nothing\n", "maps no joint"},
+        {"leg_joint_L_1 = LeftUpLeg\nleg_joint_L_1 = RightUpLeg\n", "mapped twice"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        f = fopen(mapf, "w");
+        fputs(bad[i].text, f);
+        fclose(f);
+        snprintf(args, sizeof args, "'%s' '%s' --map '%s' -o '%s'", bvh, cesium, mapf, out);
+        AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
+        AK_CHECK_MSG(strstr(line, mapf) && strstr(line, bad[i].expect), "map %zu: %s", i, line);
+    }
+    snprintf(args, sizeof args, "'%s' '%s' --map '%s/missing.map' -o '%s'", bvh, cesium, dir, out);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
+    AK_CHECK(strstr(line, "missing.map") != NULL);
+    /* a source without a clip */
+    snprintf(args, sizeof args, "'%s' builtin:humanoid -o '%s'", nomotion, out);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
+    AK_CHECK(strstr(line, "MorphPrimitivesTest.glb") && strstr(line, "no clip"));
+    /* usage */
+    snprintf(args, sizeof args, "'%s' builtin:humanoid -o '%s/x.obj'", bvh, dir);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 2);
+    /* GIF */
+    snprintf(out, sizeof out, "%s/side.gif", dir);
+    snprintf(args, sizeof args, "'%s' builtin:humanoid --size 64x64 --fps 10 -o '%s'", bvh, out);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 0);
+    struct stat st;
+    AK_CHECK(stat(out, &st) == 0 && st.st_size > 1000);
+    snprintf(args, sizeof args, "rm -rf '%s'", dir);
+    AK_CHECK_EQ(system(args), 0);
+}
+#endif
+
 int main(void) {
     AK_RUN(cmu_bvh_onto_builtin_and_cesiumman);
+#ifdef AK_CLI_PATH
+    AK_RUN(cli_retarget);
+#endif
     return ak_test_finish();
 }

@@ -19,6 +19,7 @@ static const command commands[] = {
     {"weights", cmd_weights, "compute automatic skin weights (inverse distance or bone heat)"},
     {"skin", cmd_skin, "compare LBS, DQS and CoR skinning: volume and bulge"},
     {"ik", cmd_ik, "solve inverse kinematics for a joint chain"},
+    {"retarget", cmd_retarget, "put a clip (e.g. BVH mocap) on another character; glTF or GIF out"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 
