@@ -441,6 +441,26 @@ AK_TEST(builtin_round_trip) {
     }
 }
 
+/* BVH motion capture (Euler channels, no mesh) written as glTF: the same poses. */
+AK_TEST(bvh_round_trip) {
+    char src[1200];
+    if (!ak_test_asset(src, sizeof src, "bvh/02_01.bvh")) {
+        AK_SKIP("bvh/02_01.bvh absent");
+        return;
+    }
+    ak_scene *a = NULL, *b = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(src, NULL, NULL, &a, &diag), AK_OK);
+    char out[1024];
+    tmp_path(out, sizeof out, "02_01.glb");
+    if (a) AK_CHECK_EQ(ak_io_save(out, a, NULL, &diag), AK_OK);
+    AK_CHECK_EQ(ak_io_load(out, NULL, NULL, &b, &diag), AK_OK);
+    if (a && b) AK_CHECK_EQ(compare_scenes(a, b, "02_01.bvh"), 0);
+    queue_validate(out);
+    ak_scene_destroy(a);
+    ak_scene_destroy(b);
+}
+
 #ifdef AK_CLI_PATH
 AK_TEST(cli_export) {
     char out[1024], cmd[4096];
@@ -485,6 +505,7 @@ int main(void) {
     AK_RUN(interpolation_kept);
     AK_RUN(bad_input);
     AK_RUN(builtin_round_trip);
+    AK_RUN(bvh_round_trip);
 #ifdef AK_CLI_PATH
     AK_RUN(cli_export);
 #endif

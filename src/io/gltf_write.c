@@ -522,7 +522,7 @@ static ak_result write_meshes(w_ctx* c) {
         cJSON* gm = cJSON_CreateObject();
         cJSON* prims = gm ? cJSON_AddArrayToObject(gm, "primitives") : NULL;
         if (!prims || !cJSON_AddItemToArray(c->meshes, gm)) {
-            cJSON_Delete(prims ? NULL : gm);
+            cJSON_Delete(gm);
             r = oom(c);
             break;
         }
