@@ -85,8 +85,9 @@ AK_API ak_result ak_humanoid_bones_of_skeleton(const ak_skeleton* skeleton, ak_i
 /* Source joint for every target joint (-1: unmapped, keeps its rest pose): the same joint name
  * (case-insensitive, anything up to the last ':' dropped) first, then the same humanoid bone
  * (ak_humanoid_bones_of_skeleton on both); a source joint is used once.
- * out_source_of_target.count >= target joint count. Returns AK_ERR_NULL_ARG,
- * AK_ERR_SPAN_SMALL; *out_mapped_count (optional) = target joints mapped. */
+ * out_source_of_target.count >= target joint count. Temporary memory (one bone array per
+ * skeleton) comes from malloc. Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_NO_MEMORY;
+ * *out_mapped_count (optional) = target joints mapped. */
 AK_API ak_result ak_retarget_map_by_name(const ak_skeleton* source, const ak_skeleton* target,
                                          ak_i32_span out_source_of_target, size_t* out_mapped_count);
 
