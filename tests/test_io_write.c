@@ -406,6 +406,10 @@ AK_TEST(bad_input) {
     AK_CHECK_EQ(ak_io_save(tmp_path(out, sizeof out, "x.obj"), a, NULL, &diag), AK_ERR_BAD_ARG);
     AK_CHECK_EQ(ak_io_save("/nonexistent-dir/x.glb", a, NULL, &diag), AK_ERR_IO);
     AK_CHECK(strstr(diag.message, "cannot create") != NULL);
+    /* a mesh naming a skin the scene lacks */
+    a->meshes[0].skin = 3;
+    AK_CHECK_EQ(ak_io_save(tmp_path(out, sizeof out, "badskin.glb"), a, NULL, &diag), AK_ERR_BAD_INDEX);
+    a->meshes[0].skin = 0;
     /* a NaN position: nothing written */
     a->meshes[0].mesh->positions[2].y = NAN;
     tmp_path(out, sizeof out, "nan.glb");

@@ -212,8 +212,8 @@ typedef struct ak_io_save_desc {
  * Returns AK_ERR_NULL_ARG (path or scene NULL, a scene mesh without data), AK_ERR_BAD_ARG
  * (another extension), AK_ERR_BAD_DATA (a non-finite position, normal, UV, colour, morph
  * delta, default weight, rest transform, inverse bind or key), AK_ERR_BAD_WEIGHTS (a
- * negative weight), AK_ERR_BAD_INDEX (a triangle index, skin joint or channel joint out of
- * range), AK_ERR_UNSUPPORTED (an interpolation glTF cannot express: NLERP, SQUAD, LAGRANGE,
+ * negative weight), AK_ERR_BAD_INDEX (a triangle index, skin joint, channel joint, or a
+ * scene mesh's skin or node out of range), AK_ERR_UNSUPPORTED (an interpolation glTF cannot express: NLERP, SQUAD, LAGRANGE,
  * or a cubic mode other than HERMITE on a rotation: bake the clip first; two channels
  * animating one mesh's morph weights; more than 4 GiB in a GLB), AK_ERR_IO (cannot create or
  * write a file: partial files are removed), AK_ERR_NO_MEMORY. diag (optional) names the

@@ -753,8 +753,13 @@ static ak_result build_document(w_ctx* c) {
     if (!c->nodes || !c->meshes || !c->skins || !c->animations || !c->views || !c->accessors ||
         !c->node_of_mesh || !c->group_of_mesh || !c->morph_base)
         return oom(c);
-    for (size_t m = 0; m < s->mesh_count; ++m)
+    for (size_t m = 0; m < s->mesh_count; ++m) {
         if (!s->meshes[m].mesh) return BAD(c, AK_ERR_NULL_ARG, "mesh %zu has no data", m);
+        if (s->meshes[m].skin >= (int32_t)s->skin_count || s->meshes[m].skin < -1 ||
+            s->meshes[m].node >= (int32_t)ak_scene_joint_count(s) || s->meshes[m].node < -1)
+            return BAD(c, AK_ERR_BAD_INDEX, "mesh %zu: skin %d or node %d out of range", m, (int)s->meshes[m].skin,
+                       (int)s->meshes[m].node);
+    }
     WTRY(write_skeleton(c));
     WTRY(write_skins(c));
     WTRY(write_meshes(c));
