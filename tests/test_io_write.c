@@ -99,6 +99,10 @@ static int compare_scenes_n(const ak_scene* a, const ak_scene* b, const char* wh
         AK_CHECK_EQ(a->meshes[m].mesh->vertex_count, b->meshes[m].mesh->vertex_count);
         AK_CHECK_EQ(a->meshes[m].mesh->morph_target_count, b->meshes[m].mesh->morph_target_count);
         AK_CHECK_EQ(a->meshes[m].skin, b->meshes[m].skin);
+        AK_CHECK_EQ(a->meshes[m].has_material, b->meshes[m].has_material);
+        if (a->meshes[m].has_material && b->meshes[m].has_material)
+            AK_CHECK_MSG(!memcmp(&a->meshes[m].base_color, &b->meshes[m].base_color, sizeof(ak_vec4)),
+                         "%s mesh %zu: base colour differs", what, m);
         if (a->meshes[m].mesh->vertex_count != b->meshes[m].mesh->vertex_count ||
             a->meshes[m].mesh->morph_target_count != b->meshes[m].mesh->morph_target_count)
             bad = 1;

@@ -18,7 +18,8 @@
  *   - ak_io_write_obj: Wavefront OBJ of a scene's meshes at positions the caller computed
  *     (one `o` group per scene mesh, vertices in the scene's order, no welding).
  *
- * What it does NOT do: materials, textures, cameras, lights, glTF extensions (a file whose
+ * What it does NOT do: materials beyond a primitive's base colour factor (ak_scene_mesh
+ * base_color), textures, cameras, lights, glTF extensions (a file whose
  * extensionsRequired names one that changes geometry or animation, e.g. Draco, is refused),
  * morph targets through Assimp, posing (scene.h, skin.h, blendshape.h). It never prints;
  * warnings go to desc->logger.
@@ -205,7 +206,10 @@ typedef struct ak_io_save_desc {
  *     CUBICSPLINE keys are written as stored; HERMITE, and CARDINAL/NATURAL/BEZIER on
  *     non-rotation channels, become CUBICSPLINE with the per-second tangents of
  *     ak_track_key (the same curve); SCALAR channels are skipped with a warning.
- * Not written: materials, textures, tangents (the scene holds none), the clip duration (a
+ *   - each distinct base colour of the scene meshes as a material holding only
+ *     pbrMetallicRoughness.baseColorFactor (channels clamped to [0, 1]), named by the
+ *     primitives that have one.
+ * Not written: other material properties and textures, tangents (the scene holds none), the clip duration (a
  * reader takes the last key time), ak_skeleton joint types and limits.
  * Layout: one buffer, one bufferView per accessor (4-byte aligned, zero padded, so no
  * byteStride), GLB JSON chunk padded with spaces and BIN chunk with zeros.

@@ -24,7 +24,7 @@ typedef struct w_ctx {
     const ak_logger* logger;
     uint8_t* bin;
     size_t bin_size, bin_cap;
-    cJSON *root, *views, *accessors, *nodes, *meshes, *skins, *animations;
+    cJSON *root, *views, *accessors, *nodes, *meshes, *skins, *animations, *materials;
     size_t n_nodes; /* written so far (joints, then extra mesh nodes) */
     int32_t* node_of_mesh; /* [mesh_count] glTF node carrying scene mesh m's glTF mesh, -1 none */
     int32_t* group_of_mesh; /* [mesh_count] first scene mesh of m's group (one glTF mesh) */
@@ -482,6 +482,30 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
     return AK_OK;
 }
 
+/* Index of a material with this base colour (made on first use; channels clamped to [0, 1],
+ * the range glTF allows); -1 when out of memory. */
+static int material_index(w_ctx* c, ak_vec4 col) {
+    float v[4] = {col.x, col.y, col.z, col.w};
+    for (int k = 0; k < 4; ++k) v[k] = v[k] < 0.0f ? 0.0f : v[k] > 1.0f ? 1.0f : v[k];
+    int i = 0;
+    for (const cJSON* m = c->materials->child; m; m = m->next, ++i) {
+        const cJSON* f = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness"),
+                                                          "baseColorFactor");
+        int k = 0;
+        for (const cJSON* e = f ? f->child : NULL; e && k < 4 && e->valuedouble == (double)v[k]; e = e->next) ++k;
+        if (k == 4) return i;
+    }
+    cJSON* m = cJSON_CreateObject();
+    cJSON* pbr = m ? cJSON_AddObjectToObject(m, "pbrMetallicRoughness") : NULL;
+    cJSON* f = pbr ? cJSON_AddArrayToObject(pbr, "baseColorFactor") : NULL;
+    if (!f || !cJSON_AddItemToArray(c->materials, m)) {
+        cJSON_Delete(m);
+        return -1;
+    }
+    for (int k = 0; k < 4; ++k) cJSON_AddItemToArray(f, num(v[k]));
+    return i;
+}
+
 /* The glTF mesh name of a group: the reader names primitive p of mesh "M" "M_p", so a group
  * whose first name ends in "_0" takes the name without it. */
 static void group_name(const char* first, size_t members, char out[AK_NAME_SIZE]) {
@@ -533,6 +557,11 @@ static ak_result write_meshes(w_ctx* c) {
             cJSON* prim = cJSON_CreateObject();
             if (!prim || !cJSON_AddItemToArray(prims, prim)) r = oom(c);
             else r = write_primitive(c, k, prim);
+            if (r == AK_OK && s->meshes[k].has_material) {
+                int mi = material_index(c, s->meshes[k].base_color);
+                if (mi < 0) r = oom(c);
+                else add_num(prim, "material", mi);
+            }
             c->node_of_mesh[k] = node;
             c->group_of_mesh[k] = (int32_t)m;
         }
@@ -746,11 +775,12 @@ static ak_result build_document(w_ctx* c) {
     c->animations = cJSON_CreateArray();
     c->views = cJSON_CreateArray();
     c->accessors = cJSON_CreateArray();
+    c->materials = cJSON_CreateArray();
     size_t mc = s->mesh_count ? s->mesh_count : 1;
     c->node_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
     c->group_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
     c->morph_base = (size_t*)calloc(mc, sizeof(size_t));
-    if (!c->nodes || !c->meshes || !c->skins || !c->animations || !c->views || !c->accessors ||
+    if (!c->nodes || !c->meshes || !c->skins || !c->animations || !c->views || !c->accessors || !c->materials ||
         !c->node_of_mesh || !c->group_of_mesh || !c->morph_base)
         return oom(c);
     for (size_t m = 0; m < s->mesh_count; ++m) {
@@ -784,9 +814,9 @@ static ak_result build_document(w_ctx* c) {
         free(child);
         add_num(c->root, "scene", 0);
     }
-    cJSON** arrays[] = {&c->nodes, &c->meshes, &c->skins, &c->animations, &c->accessors, &c->views};
-    const char* names[] = {"nodes", "meshes", "skins", "animations", "accessors", "bufferViews"};
-    for (size_t i = 0; i < 6; ++i) {
+    cJSON** arrays[] = {&c->nodes, &c->meshes, &c->materials, &c->skins, &c->animations, &c->accessors, &c->views};
+    const char* names[] = {"nodes", "meshes", "materials", "skins", "animations", "accessors", "bufferViews"};
+    for (size_t i = 0; i < 7; ++i) {
         cJSON* a = *arrays[i];
         *arrays[i] = NULL;
         if (cJSON_GetArraySize(a) == 0) cJSON_Delete(a);
@@ -877,6 +907,7 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
     cJSON_Delete(c.animations);
     cJSON_Delete(c.views);
     cJSON_Delete(c.accessors);
+    cJSON_Delete(c.materials);
     free(c.bin);
     free(c.node_of_mesh);
     free(c.group_of_mesh);
