@@ -3,6 +3,8 @@
  * (the nominal work V * K of one blend, whatever the storage skips). Fixed seed.
  *
  * Usage: bench_blendshape [vertex_count] [target_count] [moved_percent] */
+#include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,19 +29,44 @@ static void naive_blend(const ak_vec3* base, const ak_vec3* deltas, const float*
     }
 }
 
+/* The same with normals: n = n_0 + sum_k w_k dn_k, renormalised ((0, 1, 0) when it vanishes). */
+static void naive_blend_normals(const ak_vec3* base, const ak_vec3* normals, const ak_vec3* deltas,
+                                const ak_vec3* ndeltas, const float* w, size_t k_count, size_t v, ak_vec3* out,
+                                ak_vec3* out_n) {
+    for (size_t i = 0; i < v; ++i) {
+        ak_vec3 p = base[i], n = normals[i];
+        for (size_t k = 0; k < k_count; ++k) {
+            const ak_vec3 d = deltas[k * v + i], dn = ndeltas[k * v + i];
+            p.x += w[k] * d.x;
+            p.y += w[k] * d.y;
+            p.z += w[k] * d.z;
+            n.x += w[k] * dn.x;
+            n.y += w[k] * dn.y;
+            n.z += w[k] * dn.z;
+        }
+        const float l = sqrtf(n.x * n.x + n.y * n.y + n.z * n.z);
+        out[i] = p;
+        out_n[i] = l > 1e-20f ? ak_vec3_make(n.x / l, n.y / l, n.z / l) : ak_vec3_make(0.0f, 1.0f, 0.0f);
+    }
+}
+
 typedef struct bench_ctx {
     size_t v, k;
-    const ak_vec3 *base, *normals, *deltas;
+    const ak_vec3 *base, *normals, *deltas, *ndeltas;
     const float* w;
     ak_vec3 *out, *out_n;
     const ak_blendshape_set* set;
-    int mode; /* 0 naive, 1 dense job, 2 set (positions), 3 set (positions + normals) */
+    int mode; /* 0 naive, 1 dense job, 2 set (positions), 3 set (positions + normals),
+                 4 naive (positions + normals) */
 } bench_ctx;
 
 static void run_once(const bench_ctx* c) {
     switch (c->mode) {
     case 0:
         naive_blend(c->base, c->deltas, c->w, c->k, c->v, c->out);
+        break;
+    case 4:
+        naive_blend_normals(c->base, c->normals, c->deltas, c->ndeltas, c->w, c->k, c->v, c->out, c->out_n);
         break;
     case 1: {
         ak_blendshape_dense_job j = {.weights = {c->w, c->k}, .base_positions = {c->base, c->v},
@@ -160,31 +187,47 @@ int main(int argc, char** argv) {
         const ak_blendshape_set* set;
     } rows[] = {
         {"naive scalar loop (vertex-major)", 0, NULL},
+        {"naive scalar loop, + normals", 4, NULL},
         {"dense job (raw target-major deltas)", 1, NULL},
         {"set, dense storage", 2, NULL},
         {"set, sparse storage", 2, NULL},
         {"set, dense storage, + normals", 3, NULL},
         {"set, sparse storage, + normals", 3, NULL},
     };
-    rows[2].set = dense, rows[3].set = sparse, rows[4].set = dense, rows[5].set = sparse;
-    bench_ctx c0 = {v, k, base, normals, d, w, ref, out_n, NULL, 0};
-    run_once(&c0); /* reference result for the check below */
+    rows[3].set = dense, rows[4].set = sparse, rows[5].set = dense, rows[6].set = sparse;
+    /* reference results for the check below: positions, and normals from the naive normals loop */
+    ak_vec3* ref_n = malloc(v * sizeof(ak_vec3));
+    if (!ref_n) return 1;
+    bench_ctx c0 = {v, k, base, normals, d, nd, w, ref, ref_n, NULL, 4};
+    run_once(&c0);
     enum { ROWS = sizeof(rows) / sizeof(rows[0]) };
     bench_ctx ctx[ROWS];
     double best[ROWS];
-    for (size_t r = 0; r < ROWS; ++r) ctx[r] = (bench_ctx){v, k, base, normals, d, w, out, out_n, rows[r].set, rows[r].mode};
+    for (size_t r = 0; r < ROWS; ++r)
+        ctx[r] = (bench_ctx){v, k, base, normals, d, nd, w, out, out_n, rows[r].set, rows[r].mode};
     time_blends(ctx, ROWS, 7, best);
-    printf("%-40s %12s %14s %10s %12s\n", "method", "ms/blend", "Mvert*tgt/s", "vs naive", "max |diff|");
+    printf("(\"vs naive\": the naive loop doing the same work, positions or positions + normals, same rounds;\n"
+           " max |diff|: positions, then normals, against the naive loops)\n");
+    printf("%-40s %12s %14s %10s %12s %12s\n", "method", "ms/blend", "Mvert*tgt/s", "vs naive", "max |dp|",
+           "max |dn|");
     for (size_t r = 0; r < ROWS; ++r) {
+        const bool with_n = ctx[r].mode >= 3;
+        memset(out_n, 0, v * sizeof(ak_vec3));
         run_once(&ctx[r]);
-        double err = 0.0;
+        double err = 0.0, err_n = 0.0;
         for (size_t i = 0; i < v; ++i) {
             double e = fabs(out[i].x - ref[i].x) + fabs(out[i].y - ref[i].y) + fabs(out[i].z - ref[i].z);
+            double en = fabs(out_n[i].x - ref_n[i].x) + fabs(out_n[i].y - ref_n[i].y) + fabs(out_n[i].z - ref_n[i].z);
             if (e > err) err = e;
+            if (en > err_n) err_n = en;
         }
-        printf("%-40s %12.3f %14.1f %9.2fx %12.2g\n", rows[r].name, best[r] * 1e3, work / best[r] / 1e6,
-               best[0] / best[r], err);
+        const double naive = with_n ? best[1] : best[0];
+        printf("%-40s %12.3f %14.1f %9.2fx %12.2g", rows[r].name, best[r] * 1e3, work / best[r] / 1e6, naive / best[r],
+               err);
+        if (with_n) printf(" %12.2g", err_n);
+        printf("\n");
     }
+    free(ref_n);
     ak_blendshape_set_destroy(dense);
     ak_blendshape_set_destroy(sparse);
 
@@ -196,7 +239,8 @@ int main(int argc, char** argv) {
         fill_local(d, nd, k, v, (size_t)(v * fractions[f] / 100.0), &rng);
         ak_blendshape_set* sd = make_set(v, k, d, nd, AK_BLENDSHAPE_STORAGE_DENSE);
         ak_blendshape_set* ss = make_set(v, k, d, nd, AK_BLENDSHAPE_STORAGE_SPARSE);
-        bench_ctx pair[2] = {{v, k, base, normals, d, w, out, out_n, sd, 2}, {v, k, base, normals, d, w, out, out_n, ss, 2}};
+        bench_ctx pair[2] = {{v, k, base, normals, d, nd, w, out, out_n, sd, 2},
+                             {v, k, base, normals, d, nd, w, out, out_n, ss, 2}};
         double bt[2];
         time_blends(pair, 2, 5, bt);
         const double td = bt[0], ts = bt[1];

@@ -1,8 +1,10 @@
 /* Math core throughput: quaternion products, vector rotations, normalisations, SLERPs and
  * 4x4 products per second: the compiled array path (SSE2 unless built with AK_NO_SIMD)
- * against plain loops over the inline functions (scalar, and as -O2 auto-vectorises them),
+ * against plain loops over the inline functions (scalar, and as the build's flags compile them:
+ * Release is -O3, which auto-vectorises some of them; the column is labelled with the flags),
  * side by side in one run, plus SLERP, polar and Euler rates. Fixed seed. */
 #include <stdio.h>
+#include <string.h>
 #include <time.h>
 
 #include "bench_clock.h"
@@ -37,7 +39,8 @@ static void time_pair(void (*a)(void), void (*b)(void), int inner, double* ta, d
     }
 }
 
-/* Each plain loop is compiled twice: as -O2 builds it (gcc 12 auto-vectorises some of these
+/* Each plain loop is compiled twice: as the build compiles it (gcc 12 at -O2 and -O3
+ * auto-vectorises some of these
  * loops) and, on gcc, with auto-vectorisation switched off: the true scalar reference. */
 #if defined(__GNUC__) && !defined(__clang__)
 #define AK_BENCH_NOVEC __attribute__((optimize("no-tree-vectorize", "no-tree-slp-vectorize")))
@@ -82,7 +85,7 @@ static void loop_euler(void) {
     sink = acc;
 }
 
-/* Three kernels alternating, best of REPS each: scalar loop, -O2 loop, array function. */
+/* Three kernels alternating, best of REPS each: scalar loop, build-flags loop, array function. */
 static void row(const char* what, void (*scalar)(void), void (*loop)(void), void (*arr)(void), int inner) {
     double t[3] = {1e30, 1e30, 1e30};
     void (*fn[3])(void) = {scalar, loop, arr};
@@ -105,9 +108,19 @@ int main(void) {
         for (int k = 0; k < 16; ++k) ma[i].m[k] = ak_rng_range(&g, -1, 1), mb[i].m[k] = ak_rng_range(&g, -1, 1);
         for (int k = 0; k < 9; ++k) m3[i].m[k] = ak_rng_range(&g, -1, 1);
     }
-    printf("bench_math: %d elements per call, best of %d runs; array path = %s\n", N, REPS, AK_SIMD_NAME);
-    printf("%-20s %13s %13s %13s %8s %8s\n", "operation", "scalar loop", "-O2 loop", "array func",
-           "arr/scl", "arr/O2");
+#ifndef AK_BENCH_C_FLAGS
+#define AK_BENCH_C_FLAGS "unknown"
+#endif
+    /* the column label: the last -O flag the build passed (the one the compiler obeys) */
+    char opt[8] = "-O?";
+    for (const char* f = strstr(AK_BENCH_C_FLAGS, "-O"); f; f = strstr(f + 2, "-O"))
+        snprintf(opt, sizeof opt, "%.3s", f);
+    char col[24], ratio[16];
+    snprintf(col, sizeof col, "%s loop", opt);
+    snprintf(ratio, sizeof ratio, "arr/%s", opt + 1);
+    printf("bench_math: %d elements per call, best of %d runs; array path = %s; C flags \"%s\"\n", N, REPS,
+           AK_SIMD_NAME, AK_BENCH_C_FLAGS);
+    printf("%-20s %13s %13s %13s %8s %8s\n", "operation", "scalar loop", col, "array func", "arr/scl", ratio);
     row("quat products", novec_qmul, loop_qmul, arr_qmul, 200);
     row("vec3 rotations", novec_rot, loop_rot, arr_rot, 200);
     row("quat normalizations", novec_norm, loop_norm, arr_norm, 200);

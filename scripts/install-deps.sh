@@ -13,6 +13,9 @@ PACKAGES=(
   libassimp-dev     # FBX, Collada, BVH, OBJ import (io)
   libcjson-dev      # JSON for the glTF 2.0 reader (io)
   libsuitesparse-dev # CHOLMOD sparse Cholesky for bone-heat weights (skin)
+  libsdl2-dev       # the window of `animkit view` (optional: without it, --headless only)
+  xvfb              # virtual display: tests run the viewer's window under xvfb-run
+  xauth             # xvfb-run needs it
   clang             # the ASan+UBSan CI stage and scripts/fuzz.sh
   libclang-rt-14-dev # clang's sanitizer and libFuzzer runtimes (-fsanitize=fuzzer), Debian 12
 )

@@ -214,6 +214,92 @@ ak_result ak_normals_compute(ak_vec3_cspan positions, ak_u32_cspan indices,
     return AK_OK;
 }
 
+/* Hash-table size for welding n vertices: a power of two >= 2n (>= 16), 0 on overflow. */
+static size_t weld_table_size(size_t n) {
+    size_t t = 16;
+    while (t < 2 * n) {
+        if (t > SIZE_MAX / 4) return 0;
+        t *= 2;
+    }
+    return t;
+}
+
+size_t ak_normals_welded_scratch_count(size_t vertex_count) {
+    if (vertex_count > SIZE_MAX / 8 || vertex_count >= UINT32_MAX) return SIZE_MAX;
+    size_t t = weld_table_size(vertex_count);
+    return t ? vertex_count + t : SIZE_MAX;
+}
+
+/* Coordinate bits with -0 folded onto +0, so both weld. */
+static uint32_t coord_bits(float f) {
+    uint32_t u;
+    if (f == 0.0f) f = 0.0f;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+static bool same_position(ak_vec3 a, ak_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indices,
+                                    ak_u32_span scratch, ak_vec3_span out_normals) {
+    if (!out_normals.ptr || !scratch.ptr || (positions.count && !positions.ptr) ||
+        (indices.count && !indices.ptr))
+        return AK_ERR_NULL_ARG;
+    const size_t n = positions.count;
+    if (out_normals.count < n) return AK_ERR_SPAN_SMALL;
+    size_t need = ak_normals_welded_scratch_count(n);
+    if (need == SIZE_MAX || scratch.count < need) return AK_ERR_SPAN_SMALL;
+    const size_t tri = indices.count / 3;
+    for (size_t i = 0; i < 3 * tri; ++i)
+        if (indices.ptr[i] >= n) return AK_ERR_BAD_INDEX;
+    /* rep[v]: the first vertex at v's position (open addressing, linear probing) */
+    uint32_t* rep = scratch.ptr;
+    uint32_t* table = scratch.ptr + n;
+    const size_t T = need - n, mask = T - 1;
+    for (size_t k = 0; k < T; ++k) table[k] = UINT32_MAX;
+    for (size_t v = 0; v < n; ++v) {
+        ak_vec3 p = positions.ptr[v];
+        rep[v] = (uint32_t)v;
+        if (!ak_vec3_is_finite(p)) continue;
+        uint32_t h = coord_bits(p.x) * 0x9E3779B1u;
+        h = (h ^ (h >> 15) ^ coord_bits(p.y)) * 0x85EBCA77u;
+        h = (h ^ (h >> 13) ^ coord_bits(p.z)) * 0xC2B2AE3Du;
+        h ^= h >> 16;
+        for (size_t k = h & mask;; k = (k + 1) & mask) {
+            if (table[k] == UINT32_MAX) {
+                table[k] = (uint32_t)v;
+                break;
+            }
+            if (same_position(positions.ptr[table[k]], p)) {
+                rep[v] = table[k];
+                break;
+            }
+        }
+    }
+    for (size_t v = 0; v < n; ++v) out_normals.ptr[v] = ak_vec3_zero();
+    for (size_t t = 0; t < tri; ++t) {
+        uint32_t a = indices.ptr[3 * t], b = indices.ptr[3 * t + 1], c = indices.ptr[3 * t + 2];
+        ak_vec3 fn = ak_vec3_cross(ak_vec3_sub(positions.ptr[b], positions.ptr[a]),
+                                   ak_vec3_sub(positions.ptr[c], positions.ptr[a]));
+        if (!ak_vec3_is_finite(fn)) continue;
+        out_normals.ptr[rep[a]] = ak_vec3_add(out_normals.ptr[rep[a]], fn);
+        out_normals.ptr[rep[b]] = ak_vec3_add(out_normals.ptr[rep[b]], fn);
+        out_normals.ptr[rep[c]] = ak_vec3_add(out_normals.ptr[rep[c]], fn);
+    }
+    /* a representative comes before the vertices it stands for: one pass in order */
+    for (size_t v = 0; v < n; ++v) {
+        if (rep[v] != v) {
+            out_normals.ptr[v] = out_normals.ptr[rep[v]];
+            continue;
+        }
+        ak_vec3 nv = out_normals.ptr[v];
+        float len = ak_vec3_length(nv);
+        out_normals.ptr[v] = (len > 1e-30f && ak_finitef(len)) ? ak_vec3_scale(nv, 1.0f / len)
+                                                               : ak_vec3_make(0.0f, 1.0f, 0.0f);
+    }
+    return AK_OK;
+}
+
 ak_result ak_mesh_compute_normals(ak_mesh* mesh) {
     if (!mesh) return AK_ERR_NULL_ARG;
     if (!mesh->normals) return AK_OK;

@@ -2,6 +2,7 @@
 #include <animkit/skeleton.h>
 
 #include "internal.h"
+#include "simd.h" /* SSE2 columns in the FK products */
 
 struct ak_skeleton {
     ak_allocator alloc;
@@ -335,9 +336,129 @@ size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index) 
 
 /* ---- forward kinematics -------------------------------------------------------------- */
 
+/* parent * child for affine matrices (bottom rows (0, 0, 0, 1)): the 4x4 product without the
+ * terms that multiply the child's bottom row (0 or 1), summed in the same order as
+ * ak_mat4_mul, so the result is the same floats (up to the sign of a zero). */
+static inline void affine_mul(const ak_mat4* a, const ak_mat4* b, ak_mat4* out) {
+#if AK_SIMD_SSE2
+    const __m128 a0 = _mm_loadu_ps(a->m), a1 = _mm_loadu_ps(a->m + 4), a2 = _mm_loadu_ps(a->m + 8),
+                 a3 = _mm_loadu_ps(a->m + 12);
+    for (int c = 0; c < 4; ++c) {
+        const float* bc = b->m + 4 * c;
+        __m128 r = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(bc[0])), _mm_mul_ps(a1, _mm_set1_ps(bc[1]))),
+                              _mm_mul_ps(a2, _mm_set1_ps(bc[2])));
+        if (c == 3) r = _mm_add_ps(r, a3);
+        _mm_storeu_ps(out->m + 4 * c, r);
+    }
+#else
+    for (int c = 0; c < 4; ++c)
+        for (int row = 0; row < 4; ++row) {
+            float r = a->m[row] * b->m[c * 4] + a->m[4 + row] * b->m[c * 4 + 1] + a->m[8 + row] * b->m[c * 4 + 2];
+            out->m[c * 4 + row] = c == 3 ? r + a->m[12 + row] : r;
+        }
+#endif
+}
+
+static bool mat4_affine(const ak_mat4* m) {
+    return m->m[3] == 0.0f && m->m[7] == 0.0f && m->m[11] == 0.0f && m->m[15] == 1.0f;
+}
+
+#if AK_SIMD_SSE2 && defined(__GNUC__) && defined(__x86_64__)
+#define AKP_FK_AVX 1
+#include <immintrin.h>
+/* fk for no root or an affine root, with AVX (no FMA: the same roundings as ak_mat4_mul and
+ * ak_transform_to_mat4): the local matrices of 8 joints at a time from their TRS in
+ * structure-of-arrays form (ak_mat3_from_quat's formulas, lane by lane), then the parent
+ * products joint by joint, broadcasting the local entries from memory (loads, not shuffles). */
+__attribute__((target("avx"))) static void fk_affine_avx(const ak_skeleton* sk, const ak_mat4* root,
+                                                         const ak_transform* local, ak_mat4* out) {
+    const size_t n = sk->joint_count;
+    _Alignas(32) float g[10][8];  /* x y z w, sx sy sz, tx ty tz of 8 joints */
+    _Alignas(32) float L[12][8];  /* columns 0..2 (x y z each) and the translation, 8 joints */
+    __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()}; /* out[i - 1] */
+    for (size_t b = 0; b < n; b += 8) {
+        const size_t cnt = n - b < 8 ? n - b : 8;
+        for (size_t v = 0; v < 8; ++v) {
+            const ak_transform* t = &local[b + (v < cnt ? v : 0)];
+            g[0][v] = t->rotation.x, g[1][v] = t->rotation.y, g[2][v] = t->rotation.z, g[3][v] = t->rotation.w;
+            g[4][v] = t->scale.x, g[5][v] = t->scale.y, g[6][v] = t->scale.z;
+            g[7][v] = t->translation.x, g[8][v] = t->translation.y, g[9][v] = t->translation.z;
+        }
+        const __m256 x = _mm256_load_ps(g[0]), y = _mm256_load_ps(g[1]), z = _mm256_load_ps(g[2]),
+                     w = _mm256_load_ps(g[3]);
+        const __m256 xx = _mm256_mul_ps(x, x), yy = _mm256_mul_ps(y, y), zz = _mm256_mul_ps(z, z);
+        const __m256 xy = _mm256_mul_ps(x, y), xz = _mm256_mul_ps(x, z), yz = _mm256_mul_ps(y, z);
+        const __m256 wx = _mm256_mul_ps(w, x), wy = _mm256_mul_ps(w, y), wz = _mm256_mul_ps(w, z);
+        const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+        const __m256 sx = _mm256_load_ps(g[4]), sy = _mm256_load_ps(g[5]), sz = _mm256_load_ps(g[6]);
+#define AKP_TWO(e) _mm256_mul_ps(two, (e))
+        _mm256_store_ps(L[0], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(yy, zz))), sx));
+        _mm256_store_ps(L[1], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xy, wz)), sx));
+        _mm256_store_ps(L[2], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xz, wy)), sx));
+        _mm256_store_ps(L[3], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xy, wz)), sy));
+        _mm256_store_ps(L[4], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, zz))), sy));
+        _mm256_store_ps(L[5], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(yz, wx)), sy));
+        _mm256_store_ps(L[6], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xz, wy)), sz));
+        _mm256_store_ps(L[7], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(yz, wx)), sz));
+        _mm256_store_ps(L[8], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, yy))), sz));
+#undef AKP_TWO
+        memcpy(L[9], g[7], sizeof L[9]), memcpy(L[10], g[8], sizeof L[10]), memcpy(L[11], g[9], sizeof L[11]);
+        for (size_t v = 0; v < cnt; ++v) {
+            const size_t i = b + v;
+            const int p = sk->parents[i];
+            __m128 a0, a1, a2, a3;
+            if (p >= 0 && (size_t)p + 1 == i) { /* a chain: the parent is still in registers */
+                a0 = prev[0], a1 = prev[1], a2 = prev[2], a3 = prev[3];
+            } else if (p >= 0 || root) {
+                const ak_mat4* a = p >= 0 ? &out[p] : root;
+                a0 = _mm_loadu_ps(a->m), a1 = _mm_loadu_ps(a->m + 4), a2 = _mm_loadu_ps(a->m + 8),
+                a3 = _mm_loadu_ps(a->m + 12);
+            } else { /* a root joint without root matrix: the local matrix itself */
+                a0 = _mm_setr_ps(1, 0, 0, 0), a1 = _mm_setr_ps(0, 1, 0, 0), a2 = _mm_setr_ps(0, 0, 1, 0),
+                a3 = _mm_setr_ps(0, 0, 0, 1);
+                for (int c = 0; c < 4; ++c)
+                    prev[c] = _mm_setr_ps(L[3 * c][v], L[3 * c + 1][v], L[3 * c + 2][v], c == 3 ? 1.0f : 0.0f);
+                for (int c = 0; c < 4; ++c) _mm_storeu_ps(out[i].m + 4 * c, prev[c]);
+                continue;
+            }
+            for (int c = 0; c < 4; ++c) { /* ((a0 b0 + a1 b1) + a2 b2) [+ a3]: ak_mat4_mul's order */
+                __m128 r = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, _mm_broadcast_ss(&L[3 * c][v])),
+                                                 _mm_mul_ps(a1, _mm_broadcast_ss(&L[3 * c + 1][v]))),
+                                      _mm_mul_ps(a2, _mm_broadcast_ss(&L[3 * c + 2][v])));
+                if (c == 3) r = _mm_add_ps(r, a3);
+                prev[c] = r;
+                _mm_storeu_ps(out[i].m + 4 * c, r);
+            }
+        }
+    }
+}
+#else
+#define AKP_FK_AVX 0
+#endif
+
+/* Local TRS to model matrices, parents first. Local matrices are affine, so with no root or an
+ * affine root every model matrix is affine and the products skip the bottom row's terms
+ * (affine_mul: a quarter fewer multiplies, SSE2 columns); a projective root keeps the full
+ * 4x4 products. */
 static void fk(const ak_skeleton* sk, const ak_mat4* root, const ak_transform* local,
                ak_mat4* out) {
     const size_t n = sk->joint_count;
+    if (!root || mat4_affine(root)) {
+#if AKP_FK_AVX
+        if (__builtin_cpu_supports("avx")) {
+            fk_affine_avx(sk, root, local, out);
+            return;
+        }
+#endif
+        for (size_t i = 0; i < n; ++i) {
+            const ak_mat4 m = ak_transform_to_mat4(local[i]);
+            const int p = sk->parents[i];
+            if (p >= 0) affine_mul(&out[p], &m, &out[i]);
+            else if (root) affine_mul(root, &m, &out[i]);
+            else out[i] = m;
+        }
+        return;
+    }
     for (size_t i = 0; i < n; ++i) {
         ak_mat4 m = ak_transform_to_mat4(local[i]);
         int p = sk->parents[i];

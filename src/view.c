@@ -19,6 +19,8 @@ static bool vec4_zero(ak_vec4 v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0
 static ak_vec4 or_default(ak_vec4 v, ak_vec4 d) { return vec4_zero(v) ? d : v; }
 static ak_vec4 rgba(float r, float g, float b, float a) { return ak_vec4_make(r, g, b, a); }
 
+#define MIN_KEY_GAP 8.0 /* pixels: average key spacing below which key markers are left out */
+
 static bool span_ok_f32(ak_f32_cspan s) { return s.count == 0 || s.ptr != NULL; }
 
 /* Tick step from {1, 2, 5} x 10^k close to range / target_count. */
@@ -378,7 +380,13 @@ static ak_result plot_layout_make(const ak_view_plot* p, int w, int h, plot_layo
     if (p->y_min != p->y_max) {
         ymin = p->y_min, ymax = p->y_max;
     } else {
-        if (ymax - ymin <= 1e-12 * fmax(1.0, fabs(ymin))) ymin -= 1.0, ymax += 1.0;
+        if (ymax - ymin <= 1e-12 * fmax(1.0, fabs(ymin))) {
+            ymin -= 1.0, ymax += 1.0;
+        } else {
+            /* at least 1% of the magnitude: a scale of 1 +- 1e-6 float noise stays a flat line */
+            double least = 0.01 * fmax(fabs(ymin), fabs(ymax)), mid = 0.5 * (ymin + ymax);
+            if (ymax - ymin < least) ymin = mid - 0.5 * least, ymax = mid + 0.5 * least;
+        }
         double pad = 0.08 * (ymax - ymin);
         ymin -= pad, ymax += pad;
     }
@@ -454,6 +462,30 @@ static void handle(const ak_image* img, const plot_layout* L, ak_vec2 k, float s
     if (b.x == e.x && b.y == e.y) ak_image_draw_disc(img, e, 2.5f, rgba(1, 1, 1, 1), 1.2f, color);
 }
 
+/* Title centred at the top: font scale 2, else 1 when that does not fit, else cut in the
+ * middle ("LeftHandIndex...Rotation") so both ends stay readable. */
+static void draw_title(const ak_image* out, const char* title, ak_vec4 ink) {
+    int room = out->width - 16, tw, th;
+    ak_text_size(title, 2, &tw, &th);
+    if (tw <= room) {
+        ak_image_draw_text(out, (out->width - tw) / 2, 8, title, 2, ink);
+        return;
+    }
+    ak_text_size(title, 1, &tw, &th);
+    char buf[256];
+    size_t len = strlen(title);
+    int max_chars = room / AK_FONT_ADVANCE_X;
+    if (tw > room && max_chars >= 5 && len < sizeof buf) {
+        size_t keep = (size_t)max_chars - 3, head = (keep + 1) / 2, tail = keep - head;
+        memcpy(buf, title, head);
+        memcpy(buf + head, "...", 3);
+        memcpy(buf + head + 3, title + len - tail, tail + 1);
+        title = buf;
+        ak_text_size(title, 1, &tw, &th);
+    }
+    ak_image_draw_text(out, (out->width - tw) / 2, 12, title, 1, ink);
+}
+
 ak_result ak_view_plot_draw(const ak_view_plot* p, const ak_image* out) {
     if (!out || !out->pixels) return AK_ERR_NULL_ARG;
     plot_layout L;
@@ -490,11 +522,7 @@ ak_result ak_view_plot_draw(const ak_view_plot* p, const ak_image* out) {
     ak_image_draw_line(out, ak_vec2_make(L.ax0, L.ay0), ak_vec2_make(L.ax0, L.ay1), 1.5f, ink);
     ak_image_draw_line(out, ak_vec2_make(L.ax0, L.ay1), ak_vec2_make(L.ax1, L.ay1), 1.5f, ink);
     /* labels */
-    if (p->title) {
-        int tw, th;
-        ak_text_size(p->title, 2, &tw, &th);
-        ak_image_draw_text(out, (out->width - tw) / 2, 8, p->title, 2, ink);
-    }
+    if (p->title) draw_title(out, p->title, ink);
     if (p->x_label) {
         int tw, th;
         ak_text_size(p->x_label, 1, &tw, &th);
@@ -514,7 +542,13 @@ ak_result ak_view_plot_draw(const ak_view_plot* p, const ak_image* out) {
             if (clip_seg(&L, &a, &b)) ak_image_draw_line(out, a, b, w, c);
         }
         ak_vec4 hc = rgba(c.x * 0.6f, c.y * 0.6f, c.z * 0.6f, 1);
-        for (size_t k = 0; k < s->key_x.count; ++k) {
+        /* markers only when the keys in view are on average MIN_KEY_GAP pixels apart or more:
+         * denser keys (motion capture) would merge into a band over their own line */
+        size_t in_view = 0;
+        for (size_t k = 0; k < s->key_x.count; ++k)
+            in_view += ak_finitef(s->key_x.ptr[k]) && s->key_x.ptr[k] >= L.xmin && s->key_x.ptr[k] <= L.xmax;
+        bool markers = in_view <= 1 || (double)(L.ax1 - L.ax0) / (double)(in_view - 1) >= MIN_KEY_GAP;
+        for (size_t k = 0; markers && k < s->key_x.count; ++k) {
             float kx = s->key_x.ptr[k], ky = s->key_y.ptr[k];
             if (!ak_finitef(kx) || !ak_finitef(ky)) continue;
             ak_vec2 kp = map_pt(&L, kx, ky);

@@ -3,6 +3,8 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
+#include <gif_lib.h> /* GIF frame delays read straight from the file */
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include "ak_test.h"
@@ -435,6 +437,7 @@ AK_TEST(render_outputs_decode) {
 AK_TEST(demo_writes_its_files) {
     AK_CHECK_EQ(run("demo --size 128x72 -o demo_out", true), 0);
     AK_CHECK(strstr(out_buf, "demo.gif") != NULL);
+    AK_CHECK_MSG(strstr(out_buf, "charts") == NULL, "demo printed curves' own line: %s", out_buf);
     int w = 0, h = 0, frames = 0;
     AK_CHECK_EQ(ak_gif_info("demo_out/demo.gif", &w, &h, &frames), AK_OK);
     AK_CHECK(w == 128 && h == 72);
@@ -524,6 +527,416 @@ AK_TEST(render_scene_with_many_meshes) {
     AK_CHECK(w == 96 && h == 64);
 }
 
+/* ---- issue 22: what a new user trips on ------------------------------------------------------ */
+
+#define M_PI_ 3.14159265358979323846
+
+static bool file_exists(const char* path) {
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+static bool write_text(const char* path, const char* text) {
+    FILE* f = fopen(path, "w");
+    if (!f) return false;
+    fputs(text, f);
+    return fclose(f) == 0;
+}
+
+/* A stick figure (hips, spine, head, two legs; 1.9 units tall) whose root moves +2 in x per
+ * frame for frame_count frames, frame_time seconds apart. */
+static bool write_walk_bvh(const char* path, int frame_count, double frame_time) {
+    FILE* f = fopen(path, "w");
+    if (!f) return false;
+    fputs("HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n"
+          "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+          "  JOINT Spine\n  {\n    OFFSET 0 0.5 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n"
+          "    JOINT Head\n    {\n      OFFSET 0 0.5 0\n      CHANNELS 3 Zrotation Xrotation Yrotation\n"
+          "      End Site\n      {\n        OFFSET 0 0.2 0\n      }\n    }\n  }\n"
+          "  JOINT LeftLeg\n  {\n    OFFSET 0.15 -0.45 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n"
+          "    End Site\n    {\n      OFFSET 0 -0.45 0\n    }\n  }\n"
+          "  JOINT RightLeg\n  {\n    OFFSET -0.15 -0.45 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n"
+          "    End Site\n    {\n      OFFSET 0 -0.45 0\n    }\n  }\n}\n",
+          f);
+    fprintf(f, "MOTION\nFrames: %d\nFrame Time: %g\n", frame_count, frame_time);
+    for (int i = 0; i < frame_count; ++i) fprintf(f, "%d 0.9 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0\n", 2 * i);
+    return fclose(f) == 0;
+}
+
+static bool load_png(const char* path, ak_image* img) {
+    memset(img, 0, sizeof *img);
+    if (ak_png_info(path, &img->width, &img->height) != AK_OK) return false;
+    img->pixels = calloc((size_t)img->width * (size_t)img->height, 4);
+    if (img->pixels && ak_png_read(path, img) == AK_OK) return true;
+    free(img->pixels);
+    img->pixels = NULL;
+    return false;
+}
+
+typedef struct box2 {
+    int x0, y0, x1, y1, count;
+} box2;
+
+/* Bounding box of the skeleton overlay's joint discs: the default joint colour (1.0, 0.78, 0.18)
+ * is the only saturated orange in a render (background and ground are blue-grey, clay is pale). */
+static box2 joint_box(const char* path) {
+    box2 b = {1 << 30, 1 << 30, -1, -1, 0};
+    ak_image img;
+    if (!load_png(path, &img)) return b;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const uint8_t* p = img.pixels + ((size_t)y * (size_t)img.width + (size_t)x) * 4;
+            if (!(p[0] > 200 && p[1] > 140 && p[1] < 230 && p[2] < 110)) continue;
+            b.x0 = x < b.x0 ? x : b.x0, b.x1 = x > b.x1 ? x : b.x1;
+            b.y0 = y < b.y0 ? y : b.y0, b.y1 = y > b.y1 ? y : b.y1;
+            ++b.count;
+        }
+    free(img.pixels);
+    return b;
+}
+
+/* Pixels warmer than blue (clay: r > b + 8); background, ground and shadows are bluish. */
+static box2 warm_box(const char* path) {
+    box2 b = {1 << 30, 1 << 30, -1, -1, 0};
+    ak_image img;
+    if (!load_png(path, &img)) return b;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const uint8_t* p = img.pixels + ((size_t)y * (size_t)img.width + (size_t)x) * 4;
+            if (!(p[0] > p[2] + 8)) continue;
+            b.x0 = x < b.x0 ? x : b.x0, b.x1 = x > b.x1 ? x : b.x1;
+            b.y0 = y < b.y0 ? y : b.y0, b.y1 = y > b.y1 ? y : b.y1;
+            ++b.count;
+        }
+    free(img.pixels);
+    return b;
+}
+
+/* Delays (1/100 s) of a GIF's frames, read with giflib; returns the frame count (-1 on error). */
+static int gif_delays(const char* path, int* delays, int cap) {
+    int err = 0;
+    GifFileType* g = DGifOpenFileName(path, &err);
+    if (!g) return -1;
+    if (DGifSlurp(g) != GIF_OK) {
+        DGifCloseFile(g, &err);
+        return -1;
+    }
+    int n = g->ImageCount;
+    for (int i = 0; i < n && i < cap; ++i) {
+        GraphicsControlBlock gcb;
+        memset(&gcb, 0, sizeof gcb);
+        DGifSavedExtensionToGCB(g, i, &gcb);
+        delays[i] = gcb.DelayTime;
+    }
+    DGifCloseFile(g, &err);
+    return n;
+}
+
+/* Item 9: plurals, names as typed, subnormal numbers, the files a multi-frame PNG run writes. */
+AK_TEST(messages_say_what_happened) {
+    AK_CHECK_EQ(run("export builtin:cylinder -o one.obj", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "(1 mesh)") && !strstr(out_buf, "meshes"), "%s", out_buf);
+    AK_CHECK_EQ(run("curves builtin:cylinder --clip bend -o one.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, ": 1 chart\n") != NULL, "%s", out_buf);
+    AK_CHECK_EQ(run("info builtin:cylinder", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "1 channel\n") && !strstr(out_buf, "1 channels"), "%s", out_buf);
+    AK_CHECK_EQ(run("export builtin:cylinder --clip nope -o x.obj", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "(3 clips)") != NULL, "%s", out_buf);
+    /* an option without its value is named as typed */
+    AK_CHECK_EQ(run("render builtin:cylinder -o", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "'-o' needs a value") != NULL, "%s", out_buf);
+    AK_CHECK_EQ(run("render builtin:cylinder --output", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "'--output' needs a value") != NULL, "%s", out_buf);
+    /* repeatable options are bounded */
+    char many[2048] = "render builtin:cylinder -o x.png";
+    for (int i = 0; i < 70; ++i) strcat(many, " --mesh cylinder");
+    AK_CHECK_EQ(run(many, true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "too many options") != NULL, "%s", out_buf);
+    /* subnormal and underflowing times are numbers (they round to 0 s) */
+    AK_CHECK_EQ(run("export builtin:cylinder --time 1e-320 -o sub.obj", true), 0);
+    AK_CHECK_EQ(run("export builtin:cylinder --time 1e-400 -o sub.obj", true), 0);
+    AK_CHECK_EQ(run("export builtin:cylinder --time 1e400 -o sub.obj", true), 2);
+    /* several frames into a PNG: the message names the files written, not OUT.png */
+    remove("fr.png");
+    AK_CHECK_EQ(run("render builtin:cylinder --clip bend --frames 0:0.5:0.25 --size 64x48 -o fr.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "fr_0000.png") && strstr(out_buf, "fr_0002.png") && strstr(out_buf, "3 frames"), "%s", out_buf);
+    AK_CHECK_MSG(!strstr(out_buf, "wrote fr.png"), "%s", out_buf);
+    AK_CHECK(file_exists("fr_0002.png") && !file_exists("fr.png"));
+}
+
+/* Item 9: MorphStressTest's one weights channel (the loader splits it per primitive) is one
+ * channel in info and one chart in curves, as the file declares. */
+AK_TEST(info_and_curves_count_file_channels) {
+    char path[1100];
+    if (!ak_test_asset(path, sizeof path, "gltf/MorphStressTest/glTF-Binary/MorphStressTest.glb")) {
+        AK_SKIP("MorphStressTest.glb absent (set ANIMKIT_ASSETS)");
+        return;
+    }
+    doc d;
+    AK_CHECK(doc_open(&d, path));
+    int file_channels = jsize(jat(d.root, "animations", 0), "channels");
+    doc_close(&d);
+    char args[1300];
+    snprintf(args, sizeof args, "info '%s' --json", path);
+    cJSON* root = run_json(args);
+    AK_CHECK(root != NULL);
+    int info_channels = root ? cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(root, "clips"), 0), "channels")->valueint : -1;
+    cJSON_Delete(root);
+    snprintf(args, sizeof args, "curves '%s' --clip 0 -o ms.png", path);
+    AK_CHECK_EQ(run(args, true), 0);
+    const char* colon = strstr(out_buf, "ms.png: ");
+    int charts = colon ? atoi(colon + 8) : -1;
+    AK_CHECK_EQ(info_channels, file_channels);
+    AK_CHECK_MSG(charts == file_channels, "curves drew %d charts, the file has %d channels: %s", charts, file_channels, out_buf);
+}
+
+/* Item 9: GIF delays are whole 1/100 s; at 24 fps they must alternate so that 24 frames last
+ * exactly one second (all 4 cs would be 25 fps). */
+AK_TEST(gif_delays_match_the_rate) {
+    int delays[64];
+    AK_CHECK_EQ(run("render builtin:cylinder --clip bend --fps 24 --size 48x32 -o d24.gif", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "24 fps") != NULL, "%s", out_buf);
+    int n = gif_delays("d24.gif", delays, 64);
+    AK_CHECK_EQ(n, 25); /* 0, 1/24, ..., 1 s */
+    int sum = 0;
+    for (int i = 0; i < 24 && i < n; ++i) {
+        AK_CHECK_MSG(delays[i] == 4 || delays[i] == 5, "frame %d delay %d", i, delays[i]);
+        sum += delays[i];
+    }
+    AK_CHECK_EQ(sum, 100);
+    AK_CHECK_EQ(run("render builtin:cylinder --clip bend --frames 0:1:0.1 --size 48x32 -o d10.gif", true), 0);
+    n = gif_delays("d10.gif", delays, 64);
+    AK_CHECK_EQ(n, 11);
+    for (int i = 0; i < n; ++i) AK_CHECK_MSG(delays[i] == 10, "frame %d delay %d", i, delays[i]);
+}
+
+/* Item 10: a clip longer than 10 s gets 12 fps in a GIF by default, and says so. */
+AK_TEST(long_clip_gif_subsampled) {
+    AK_CHECK(write_walk_bvh("long_walk.bvh", 13, 1.0)); /* 12 s */
+    AK_CHECK_EQ(run("render long_walk.bvh --size 48x32 -o long.gif", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "12 fps") != NULL, "%s", out_buf);
+    int delays[256];
+    int n = gif_delays("long.gif", delays, 256);
+    AK_CHECK_EQ(n, 145); /* 0, 1/12, ..., 12 s */
+    int sum = 0;
+    for (int i = 0; i < 12 && i < n; ++i) sum += delays[i];
+    AK_CHECK_EQ(sum, 100);
+    /* --fps alone covers the whole clip at that rate */
+    AK_CHECK_EQ(run("render long_walk.bvh --fps 2 --size 48x32 -o long2.gif", true), 0);
+    AK_CHECK_EQ(gif_delays("long2.gif", delays, 256), 25);
+}
+
+/* Item 5: the size limit holds for the whole image --method all composes. */
+AK_TEST(method_all_size_limit) {
+    remove("wide.png");
+    AK_CHECK_EQ(run("render builtin:cylinder --size 4000x100 --method all -o wide.png", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "8192x8192") != NULL, "%s", out_buf);
+    AK_CHECK(!file_exists("wide.png"));
+    AK_CHECK_EQ(run("render builtin:cylinder --size 8192x8192 --method all -o huge.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:cylinder --size 2600x64 --method all -o wide.png", true), 0);
+    int w = 0, h = 0;
+    AK_CHECK_EQ(ak_png_info("wide.png", &w, &h), AK_OK);
+    AK_CHECK(w > 3 * 2600 && w <= 8192 && h <= 8192);
+}
+
+/* Item 6: nothing to export is an error, not an empty OBJ. */
+AK_TEST(export_without_mesh_fails) {
+    AK_CHECK(write_walk_bvh("nomesh.bvh", 3, 0.5));
+    remove("nomesh.obj");
+    AK_CHECK_EQ(run("export nomesh.bvh -o nomesh.obj", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "no mesh to export") && strstr(out_buf, "nomesh.bvh"), "%s", out_buf);
+    AK_CHECK(!file_exists("nomesh.obj"));
+}
+
+/* Item 4: --camera, --fov, --follow move and scale the picture as a pinhole camera does. */
+AK_TEST(render_camera_options) {
+    const char* base = "render builtin:humanoid --clip walk --time 0 --size 320x320 --skeleton";
+    char a[1400];
+    const char* cams[] = {"--camera 0,0,4", "--camera 180,0,4", "--camera 90,0,4", "--camera 0,0,8",
+                          "--camera 0,0,8 --fov 20", "--camera 0,80,4"};
+    box2 b[6];
+    for (int i = 0; i < 6; ++i) {
+        char out[32];
+        snprintf(out, sizeof out, "cam%d.png", i);
+        snprintf(a, sizeof a, "%s %s -o %s", base, cams[i], out);
+        AK_CHECK_MSG(run(a, true) == 0, "%s: %s", a, out_buf);
+        b[i] = joint_box(out);
+        AK_CHECK_MSG(b[i].count > 20, "%s: no joints seen", cams[i]);
+    }
+    const int W = 320;
+    double hgt[6], wid[6];
+    for (int i = 0; i < 6; ++i) hgt[i] = b[i].y1 - b[i].y0 - 7.0, wid[i] = b[i].x1 - b[i].x0 - 7.0; /* less the disc */
+    /* from behind (yaw 180) the front view mirrors left-right */
+    AK_CHECK_MSG(abs(b[0].x0 - (W - 1 - b[1].x1)) <= 6 && abs(b[0].x1 - (W - 1 - b[1].x0)) <= 6, "front %d..%d back %d..%d",
+                 b[0].x0, b[0].x1, b[1].x0, b[1].x1);
+    AK_CHECK(abs(b[0].y0 - b[1].y0) <= 6 && abs(b[0].y1 - b[1].y1) <= 6);
+    /* from the side the shoulders overlap: narrower */
+    AK_CHECK_MSG(wid[2] < 0.8 * wid[0], "side width %.0f, front %.0f", wid[2], wid[0]);
+    /* twice the distance, half the size (the figure is shallow next to 4 units) */
+    AK_CHECK_MSG(fabs(hgt[0] / hgt[3] - 2.0) < 0.2, "height %.0f at 4, %.0f at 8", hgt[0], hgt[3]);
+    /* field of view 20 instead of 40 degrees: tan(20)/tan(10) = 2.06 times larger */
+    double want = tan(ak_radians(20.0f)) / tan(ak_radians(10.0f));
+    AK_CHECK_MSG(fabs(hgt[4] / hgt[3] - want) < 0.12 * want, "fov ratio %.3f, want %.3f", hgt[4] / hgt[3], want);
+    /* seen from above, the standing figure is short on screen */
+    AK_CHECK_MSG(hgt[5] < 0.5 * hgt[0], "top view height %.0f, front %.0f", hgt[5], hgt[0]);
+    AK_CHECK_EQ(run("render builtin:humanoid --camera 10 -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:humanoid --camera 10,95 -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:humanoid --camera 10,5,-1 -o x.png", true), 2);
+    AK_CHECK_EQ(run("render builtin:humanoid --fov 0 -o x.png", true), 2);
+    /* a walk 20 units long: framed on the whole path the figure is small; --follow keeps it
+     * large and centred at the start and at the end */
+    AK_CHECK(write_walk_bvh("walk20.bvh", 11, 1.0));
+    AK_CHECK_EQ(run("render walk20.bvh --frames 0:10:10 --size 200x200 -o still.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "--follow") != NULL, "no hint to use --follow: %s", out_buf);
+    AK_CHECK_EQ(run("render walk20.bvh --frames 0:10:10 --size 200x200 --follow -o follow.png", true), 0);
+    for (int i = 0; i < 2; ++i) {
+        char p1[32], p2[32];
+        snprintf(p1, sizeof p1, "still_%04d.png", i);
+        snprintf(p2, sizeof p2, "follow_%04d.png", i);
+        box2 s = joint_box(p1), f = joint_box(p2);
+        AK_CHECK_MSG(s.count > 0 && f.count > 0, "frame %d: joints not seen", i);
+        AK_CHECK_MSG(s.y1 - s.y0 < 60, "frame %d: unfollowed figure %d px tall", i, s.y1 - s.y0);
+        AK_CHECK_MSG(f.y1 - f.y0 > 100, "frame %d: followed figure only %d px tall", i, f.y1 - f.y0);
+        double cx = 0.5 * (f.x0 + f.x1), cy = 0.5 * (f.y0 + f.y1);
+        AK_CHECK_MSG(fabs(cx - 100) < 40 && fabs(cy - 100) < 40, "frame %d: followed figure centred at %.0f,%.0f", i, cx, cy);
+    }
+    char walk[1100];
+    if (ak_test_asset(walk, sizeof walk, "bvh/01_01.bvh")) {
+        snprintf(a, sizeof a, "render '%s' --frames 0:22.9:22.9 --size 200x200 --follow -o mocap.png", walk);
+        AK_CHECK_MSG(run(a, true) == 0, "%s", out_buf);
+        for (int i = 0; i < 2; ++i) {
+            char p[32];
+            snprintf(p, sizeof p, "mocap_%04d.png", i);
+            box2 f = joint_box(p);
+            double cx = 0.5 * (f.x0 + f.x1), cy = 0.5 * (f.y0 + f.y1);
+            AK_CHECK_MSG(f.count > 0 && f.y1 - f.y0 > 90 && fabs(cx - 100) < 45 && fabs(cy - 100) < 45,
+                         "01_01 frame %d: %d..%d x %d..%d", i, f.x0, f.x1, f.y0, f.y1);
+        }
+    }
+}
+
+/* Item 7: weights without --bone: every bone's region in its own colour, named. The golden-
+ * angle hues include purples (250-350 degrees) that the blue-to-red heatmap never makes. */
+AK_TEST(weights_png_shows_every_bone) {
+    AK_CHECK_EQ(run("weights builtin:humanoid --method distance -o bones.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "each bone") != NULL, "%s", out_buf);
+    ak_image img;
+    AK_CHECK(load_png("bones.png", &img));
+    if (!img.pixels) return;
+    int bins[12] = {0};
+    for (size_t i = 0; i < (size_t)img.width * (size_t)img.height; ++i) {
+        double r = img.pixels[4 * i] / 255.0, g = img.pixels[4 * i + 1] / 255.0, b = img.pixels[4 * i + 2] / 255.0;
+        double mx = fmax(r, fmax(g, b)), mn = fmin(r, fmin(g, b));
+        if (mx < 0.3 || (mx - mn) / mx < 0.45) continue;
+        double hue = mx == r ? fmod((g - b) / (mx - mn) + 6.0, 6.0) : mx == g ? (b - r) / (mx - mn) + 2.0 : (r - g) / (mx - mn) + 4.0;
+        bins[(int)(hue * 60.0 / 30.0) % 12]++;
+    }
+    free(img.pixels);
+    int busy = 0;
+    for (int k = 0; k < 12; ++k) busy += bins[k] > 100;
+    AK_CHECK_MSG(busy >= 6, "only %d hue bins in use", busy);
+    AK_CHECK_MSG(bins[9] + bins[10] + bins[11] > 300, "no purple or magenta region (%d %d %d)", bins[9], bins[10], bins[11]);
+    /* --bone still gives that bone's heatmap */
+    AK_CHECK_EQ(run("weights builtin:humanoid --method distance --bone left_elbow -o one.png", true), 0);
+}
+
+/* Item 3: curves --channel and --page. */
+AK_TEST(curves_select_and_paginate) {
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel 0,2 -o sel.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "2 charts") != NULL, "%s", out_buf);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel 0-2 -o sel.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "3 charts") != NULL, "%s", out_buf);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel 2-0 -o sel.png", true), 2);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel 9999 -o sel.png", true), 1);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel nobody -o sel.png", true), 1);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --page 0 -o sel.png", true), 2);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --page 99 -o sel.png", true), 1);
+    char path[1100], a[1300];
+    if (!ak_test_asset(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) {
+        AK_SKIP("CesiumMan.glb absent (set ANIMKIT_ASSETS)");
+        return;
+    }
+    /* 57 channels: pages of 24, 24 and 9 */
+    int seen = 0;
+    for (int page = 1; page <= 3; ++page) {
+        snprintf(a, sizeof a, "curves '%s' --clip 0 --page %d -o page.png", path, page);
+        AK_CHECK_MSG(run(a, true) == 0, "%s", out_buf);
+        const char* c = strstr(out_buf, "page.png: ");
+        seen += c ? atoi(c + 10) : 0;
+    }
+    AK_CHECK_EQ(seen, 57);
+    AK_CHECK_MSG(strstr(out_buf, "#48-#56") != NULL, "%s", out_buf);
+    snprintf(a, sizeof a, "curves '%s' --clip 0 --page 4 -o page.png", path);
+    AK_CHECK_EQ(run(a, true), 1);
+    snprintf(a, sizeof a, "curves '%s' --clip 0 --channel Skeleton_torso_joint_1.rotation -o page.png", path);
+    AK_CHECK_EQ(run(a, true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "1 chart\n") != NULL, "%s", out_buf);
+}
+
+/* A UV sphere as an OBJ group with one vertex per triangle corner (unwelded, no normals), as
+ * MakeHuman's base.obj stores its body; *base counts the vertices written so far. */
+static void obj_sphere(FILE* f, const char* group, double cx, double r, int* base) {
+    enum { RINGS = 12, SEGS = 16 };
+    fprintf(f, "g %s\n", group);
+    for (int i = 0; i < RINGS; ++i)
+        for (int j = 0; j < SEGS; ++j) {
+            double p[4][3];
+            for (int k = 0; k < 4; ++k) {
+                int ii = i + (k >= 2), jj = j + (k == 1 || k == 2);
+                double th = M_PI_ * ii / RINGS, ph = 2.0 * M_PI_ * jj / SEGS;
+                p[k][0] = cx + r * sin(th) * cos(ph), p[k][1] = r * cos(th), p[k][2] = -r * sin(th) * sin(ph);
+            }
+            const int tri[2][3] = {{0, 2, 1}, {0, 3, 2}};
+            for (int t = 0; t < 2; ++t) {
+                for (int c = 0; c < 3; ++c) fprintf(f, "v %.6f %.6f %.6f\n", p[tri[t][c]][0], p[tri[t][c]][1], p[tri[t][c]][2]);
+                fprintf(f, "f %d %d %d\n", *base + 1, *base + 2, *base + 3);
+                *base += 3;
+            }
+        }
+}
+
+/* Item 8: an OBJ character with MakeHuman helpers and a rig file beside it. */
+AK_TEST(render_obj_characters) {
+    mkdir("mh", 0777);
+    FILE* f = fopen("mh/base.obj", "w");
+    AK_CHECK(f != NULL);
+    if (!f) return;
+    int base = 0;
+    obj_sphere(f, "body", 0.0, 1.0, &base);
+    obj_sphere(f, "helper-tights", 6.0, 0.5, &base);
+    obj_sphere(f, "joint-pelvis", -6.0, 0.2, &base);
+    fclose(f);
+    AK_CHECK(write_text("mh/rig.mhskel", "{\"name\": \"not read\"}\n"));
+    AK_CHECK_EQ(run("render mh/base.obj --camera 0,0 --size 200x200 -o obj_body.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "rig.mhskel") && strstr(out_buf, "not read"), "%s", out_buf);
+    AK_CHECK_MSG(strstr(out_buf, "2 MakeHuman helper meshes") != NULL, "%s", out_buf);
+    box2 body = warm_box("obj_body.png");
+    /* the helpers hidden and out of the framing: the body fills the picture */
+    AK_CHECK_MSG(body.x1 - body.x0 > 100, "body %d px wide", body.x1 - body.x0);
+    AK_CHECK_EQ(run("render mh/base.obj --camera 0,0 --size 200x200 --mesh body --mesh joint-pelvis -o obj_two.png", true), 0);
+    box2 two = warm_box("obj_two.png");
+    AK_CHECK_MSG(two.count < body.count / 2 && two.x1 - two.x0 > body.x1 - body.x0,
+                 "with the far helper the body should shrink: %d px (was %d)", two.count, body.count);
+    AK_CHECK_EQ(run("render mh/base.obj --mesh nosuch -o x.png", true), 1);
+    AK_CHECK(strstr(out_buf, "nosuch") != NULL);
+    AK_CHECK_EQ(run("info mh/base.obj", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "rig.mhskel") != NULL, "info does not say the rig is not read: %s", out_buf);
+    /* smooth shading across the unwelded seams: along the middle row of the sphere, neighbouring
+     * pixels differ by a little (faceted shading jumps at each of the facet edges) */
+    ak_image img;
+    AK_CHECK(load_png("obj_body.png", &img));
+    if (!img.pixels) return;
+    int y = (body.y0 + body.y1) / 2, worst = 0;
+    int x0 = body.x0 + (body.x1 - body.x0) / 6, x1 = body.x1 - (body.x1 - body.x0) / 6;
+    for (int x = x0; x < x1; ++x) {
+        const uint8_t* p = img.pixels + ((size_t)y * (size_t)img.width + (size_t)x) * 4;
+        int l0 = p[0] + p[1] + p[2], l1 = p[4] + p[5] + p[6];
+        worst = abs(l1 - l0) > worst ? abs(l1 - l0) : worst;
+    }
+    free(img.pixels);
+    AK_CHECK_MSG(worst <= 9, "largest step between neighbouring pixels %d (r+g+b): faceted", worst);
+}
+
 int main(void) {
     AK_RUN(usage_and_help);
     AK_RUN(bad_input_paths);
@@ -537,5 +950,15 @@ int main(void) {
     AK_RUN(demo_writes_its_files);
     AK_RUN(export_bind_reproduces_gltf_positions);
     AK_RUN(render_scene_with_many_meshes);
+    AK_RUN(messages_say_what_happened);
+    AK_RUN(info_and_curves_count_file_channels);
+    AK_RUN(gif_delays_match_the_rate);
+    AK_RUN(long_clip_gif_subsampled);
+    AK_RUN(method_all_size_limit);
+    AK_RUN(export_without_mesh_fails);
+    AK_RUN(render_camera_options);
+    AK_RUN(weights_png_shows_every_bone);
+    AK_RUN(curves_select_and_paginate);
+    AK_RUN(render_obj_characters);
     return ak_test_finish();
 }

@@ -87,6 +87,7 @@ AK_TEST(errors_name_file_path_and_problem) {
         {"[1]", "s.json: the top level is not an object (got an array)"},
         {"{} x", "s.json: unexpected content after the JSON value"},
         {"", "s.json: invalid JSON at line 1, column 1"},
+        {"{\"a\\nb\\u001b\": 1}", "s.json: unknown key \"a?b?\" (allowed: dt, particles, mode)"},
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         cli_json j = {.file = "s.json"};

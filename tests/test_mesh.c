@@ -416,6 +416,76 @@ AK_TEST(weights_normalize_edge_cases) {
     }
 }
 
+/* Welded normals: a roof of two triangles stored unwelded (6 vertices, as an OBJ without
+ * normals gives) shares one normal along the ridge (the normalised area-weighted sum of both
+ * faces, computed here); the eaves keep their face's normal. -0 welds with +0. */
+AK_TEST(normals_welded) {
+    /* two triangles sharing the edge A-B at an angle */
+    ak_vec3 A = ak_vec3_make(0, 0, 0), B = ak_vec3_make(1, 0, 0), C = ak_vec3_make(0.5f, 1, 0), D = ak_vec3_make(0.5f, -1, 2);
+    ak_vec3 pos[6] = {A, B, C, B, A, D};
+    pos[4].x = -0.0f; /* the second copy of A with a negative zero */
+    uint32_t idx[6] = {0, 1, 2, 3, 4, 5};
+    ak_vec3 n[6];
+    uint32_t scratch[64];
+    size_t need = ak_normals_welded_scratch_count(6);
+    AK_CHECK(need >= 6 && need <= 64);
+    AK_CHECK_EQ(ak_normals_compute_welded((ak_vec3_cspan){pos, 6}, (ak_u32_cspan){idx, 6}, (ak_u32_span){scratch, need},
+                                          (ak_vec3_span){n, 6}),
+                AK_OK);
+    /* reference in double: face normals as unnormalised cross products (twice the area) */
+    double f1[3], f2[3], e1[3], e2[3];
+    const ak_vec3 t1[3] = {A, B, C}, t2[3] = {B, A, D};
+    const ak_vec3* t[2] = {t1, t2};
+    double* fn[2] = {f1, f2};
+    for (int k = 0; k < 2; ++k) {
+        e1[0] = t[k][1].x - t[k][0].x, e1[1] = t[k][1].y - t[k][0].y, e1[2] = t[k][1].z - t[k][0].z;
+        e2[0] = t[k][2].x - t[k][0].x, e2[1] = t[k][2].y - t[k][0].y, e2[2] = t[k][2].z - t[k][0].z;
+        fn[k][0] = e1[1] * e2[2] - e1[2] * e2[1];
+        fn[k][1] = e1[2] * e2[0] - e1[0] * e2[2];
+        fn[k][2] = e1[0] * e2[1] - e1[1] * e2[0];
+    }
+    double s[3] = {f1[0] + f2[0], f1[1] + f2[1], f1[2] + f2[2]};
+    double ls = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]), l1 = sqrt(f1[0] * f1[0] + f1[1] * f1[1] + f1[2] * f1[2]),
+           l2 = sqrt(f2[0] * f2[0] + f2[1] * f2[1] + f2[2] * f2[2]);
+    const int ridge[4] = {0, 1, 3, 4};
+    for (int r = 0; r < 4; ++r) {
+        int v = ridge[r];
+        AK_CHECK_NEAR(n[v].x, s[0] / ls, 1e-6);
+        AK_CHECK_NEAR(n[v].y, s[1] / ls, 1e-6);
+        AK_CHECK_NEAR(n[v].z, s[2] / ls, 1e-6);
+    }
+    AK_CHECK_NEAR(n[2].z, f1[2] / l1, 1e-6);
+    AK_CHECK_NEAR(n[2].y, f1[1] / l1, 1e-6);
+    AK_CHECK_NEAR(n[5].y, f2[1] / l2, 1e-6);
+    AK_CHECK_NEAR(n[5].z, f2[2] / l2, 1e-6);
+    /* the unwelded version gives each corner its own face's normal */
+    ak_vec3 m[6];
+    AK_CHECK_EQ(ak_normals_compute((ak_vec3_cspan){pos, 6}, (ak_u32_cspan){idx, 6}, (ak_vec3_span){m, 6}), AK_OK);
+    AK_CHECK(fabsf(m[0].z - n[0].z) > 0.1f);
+    /* a NaN position is not welded with anything and gets the fallback normal */
+    pos[5] = ak_vec3_make(NAN, 0, 0);
+    AK_CHECK_EQ(ak_normals_compute_welded((ak_vec3_cspan){pos, 6}, (ak_u32_cspan){idx, 6}, (ak_u32_span){scratch, need},
+                                          (ak_vec3_span){n, 6}),
+                AK_OK);
+    AK_CHECK(n[5].x == 0.0f && n[5].y == 1.0f && n[5].z == 0.0f);
+    AK_CHECK(ak_vec3_is_finite(n[0]));
+    /* errors */
+    AK_CHECK_EQ(ak_normals_compute_welded((ak_vec3_cspan){pos, 6}, (ak_u32_cspan){idx, 6}, (ak_u32_span){scratch, need - 1},
+                                          (ak_vec3_span){n, 6}),
+                AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_normals_compute_welded((ak_vec3_cspan){pos, 6}, (ak_u32_cspan){idx, 6}, (ak_u32_span){scratch, need},
+                                          (ak_vec3_span){n, 5}),
+                AK_ERR_SPAN_SMALL);
+    idx[2] = 6;
+    AK_CHECK_EQ(ak_normals_compute_welded((ak_vec3_cspan){pos, 6}, (ak_u32_cspan){idx, 6}, (ak_u32_span){scratch, need},
+                                          (ak_vec3_span){n, 6}),
+                AK_ERR_BAD_INDEX);
+    AK_CHECK_EQ(ak_normals_compute_welded((ak_vec3_cspan){pos, 6}, (ak_u32_cspan){idx, 6}, (ak_u32_span){NULL, need},
+                                          (ak_vec3_span){n, 6}),
+                AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_normals_welded_scratch_count(SIZE_MAX / 2), SIZE_MAX);
+}
+
 int main(void) {
     AK_RUN(create_one_allocation_and_zeroed);
     AK_RUN(create_bad_input);
@@ -423,6 +493,7 @@ int main(void) {
     AK_RUN(validate_codes);
     AK_RUN(bounds);
     AK_RUN(normals);
+    AK_RUN(normals_welded);
     AK_RUN(volume_cube_and_sphere);
     AK_RUN(closed_oriented);
     AK_RUN(validate_weights_codes);

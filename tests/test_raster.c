@@ -2,6 +2,7 @@
  * here in double precision, the pinhole projection formula, Lambert's law and the sRGB curve
  * written out here, and libpng/giflib decoding of the files written. */
 #include <animkit/raster.h>
+#include <gif_lib.h> /* delays read back straight from the file */
 
 #include "ak_test.h"
 
@@ -859,6 +860,121 @@ AK_TEST(bad_input_codes) {
     target_free(&t);
 }
 
+/* Frame delays read with giflib (1/100 s); returns the frame count or -1. */
+static int read_delays(const char* path, int* out, int cap) {
+    int err = 0;
+    GifFileType* g = DGifOpenFileName(path, &err);
+    if (!g || DGifSlurp(g) != GIF_OK) {
+        if (g) DGifCloseFile(g, &err);
+        return -1;
+    }
+    int n = g->ImageCount;
+    for (int i = 0; i < n && i < cap; ++i) {
+        GraphicsControlBlock gcb;
+        memset(&gcb, 0, sizeof gcb);
+        DGifSavedExtensionToGCB(g, i, &gcb);
+        out[i] = gcb.DelayTime;
+    }
+    DGifCloseFile(g, &err);
+    return n;
+}
+
+/* frame_rate: whole-centisecond delays whose running sum stays within half a centisecond of
+ * k * 100 / rate (24 fps: 4 and 5 alternate; 24 frames last exactly 1 s). */
+AK_TEST(gif_frame_rate_delays) {
+    uint8_t px[8 * 8 * 4];
+    memset(px, 128, sizeof px);
+    ak_image img = {.pixels = px, .width = 8, .height = 8};
+    const float rates[3] = {24.0f, 12.5f, 30.0f};
+    for (int r = 0; r < 3; ++r) {
+        ak_gif_writer* gw = NULL;
+        AK_CHECK_EQ(ak_gif_writer_create("raster_rate.gif", &(ak_gif_desc){.width = 8, .height = 8, .frame_rate = rates[r]},
+                                         NULL, &gw),
+                    AK_OK);
+        for (int f = 0; f < 48; ++f) {
+            px[(f % 64) * 4] = (uint8_t)(f * 5); /* a change per frame */
+            AK_CHECK_EQ(ak_gif_writer_add_frame(gw, &img), AK_OK);
+        }
+        AK_CHECK_EQ(ak_gif_writer_finish(gw), AK_OK);
+        int d[64];
+        AK_CHECK_EQ(read_delays("raster_rate.gif", d, 64), 48);
+        long sum = 0;
+        for (int k = 0; k < 48; ++k) {
+            sum += d[k];
+            double want = 100.0 * (k + 1) / rates[r];
+            AK_CHECK_MSG(fabs((double)sum - want) <= 0.5 + 1e-9, "%g fps: frame %d ends at %ld cs, want %.2f", (double)rates[r],
+                         k, sum, want);
+            AK_CHECK(d[k] == (int)floor(100.0 / rates[r]) || d[k] == (int)ceil(100.0 / rates[r]));
+        }
+    }
+    /* no rate: delay_cs as before */
+    ak_gif_writer* gw = NULL;
+    AK_CHECK_EQ(ak_gif_writer_create("raster_rate.gif", &(ak_gif_desc){.width = 8, .height = 8, .delay_cs = 7}, NULL, &gw), AK_OK);
+    AK_CHECK_EQ(ak_gif_writer_add_frame(gw, &img), AK_OK);
+    AK_CHECK_EQ(ak_gif_writer_add_frame(gw, &img), AK_OK);
+    AK_CHECK_EQ(ak_gif_writer_finish(gw), AK_OK);
+    int d[4];
+    AK_CHECK_EQ(read_delays("raster_rate.gif", d, 4), 2);
+    AK_CHECK(d[0] == 7 && d[1] == 7);
+}
+
+/* Delta frames: a still gradient with a small square moving over it. The file is a fraction
+ * of the whole-frame one, every decoded frame stays close to its source, and where the square
+ * has left the background is as close as in the first frame (no leftovers, no palette
+ * patchwork). */
+AK_TEST(gif_delta_frames) {
+    enum { W = 96, H = 64, F = 24 };
+    static uint8_t src[F][W * H * 4], dec[W * H * 4];
+    for (int f = 0; f < F; ++f)
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                uint8_t* p = src[f] + ((size_t)y * W + (size_t)x) * 4;
+                bool square = x >= 3 * f && x < 3 * f + 8 && y >= 20 && y < 28;
+                p[0] = square ? 230 : (uint8_t)(60 + x);
+                p[1] = square ? 40 : (uint8_t)(80 + y);
+                p[2] = square ? 30 : (uint8_t)(200 - x / 2);
+                p[3] = 255;
+            }
+    const char* names[2] = {"raster_delta.gif", "raster_whole.gif"};
+    long size[2];
+    for (int v = 0; v < 2; ++v) {
+        ak_gif_writer* gw = NULL;
+        AK_CHECK_EQ(ak_gif_writer_create(names[v], &(ak_gif_desc){.width = W, .height = H, .no_delta = v == 1}, NULL, &gw), AK_OK);
+        for (int f = 0; f < F; ++f) AK_CHECK_EQ(ak_gif_writer_add_frame(gw, &(ak_image){.pixels = src[f], .width = W, .height = H}), AK_OK);
+        AK_CHECK_EQ(ak_gif_writer_finish(gw), AK_OK);
+        FILE* fp = fopen(names[v], "rb");
+        AK_CHECK(fp != NULL);
+        if (!fp) return;
+        fseek(fp, 0, SEEK_END);
+        size[v] = ftell(fp);
+        fclose(fp);
+    }
+    AK_CHECK_MSG(size[0] * 3 < size[1], "delta %ld bytes, whole frames %ld", size[0], size[1]);
+    ak_image out = {.pixels = dec, .width = W, .height = H};
+    double first_bg = 0.0;
+    for (int f = 0; f < F; ++f) {
+        AK_CHECK_EQ(ak_gif_read_frame(names[0], f, &out), AK_OK);
+        double err = 0.0, bg = 0.0;
+        int nbg = 0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                const uint8_t* a = src[f] + ((size_t)y * W + (size_t)x) * 4;
+                const uint8_t* b = dec + ((size_t)y * W + (size_t)x) * 4;
+                double e = (fabs((double)a[0] - b[0]) + fabs((double)a[1] - b[1]) + fabs((double)a[2] - b[2])) / 3.0;
+                err += e;
+                if (y >= 20 && y < 28 && x < 3 * f) bg += e, ++nbg; /* where the square has been */
+                if (f == 0 && y >= 20 && y < 28 && x >= 8) bg += e, ++nbg;
+            }
+        AK_CHECK_MSG(err / (W * H) < 6.0, "frame %d: mean error %.2f", f, err / (W * H));
+        if (nbg) bg /= nbg;
+        if (f == 0) first_bg = bg;
+        else AK_CHECK_MSG(bg <= first_bg + 1.0, "frame %d: the square's trail differs by %.2f (first frame %.2f)", f, bg, first_bg);
+        /* the square itself is exact enough to be seen */
+        const uint8_t* c = dec + ((size_t)24 * W + (size_t)(3 * f + 4)) * 4;
+        AK_CHECK(c[0] > 200 && c[1] < 80 && c[2] < 80);
+    }
+}
+
 int main(void) {
     AK_RUN(coverage_matches_point_in_triangle);
     AK_RUN(shared_edges_quad_and_fan_cover_once);
@@ -876,6 +992,8 @@ int main(void) {
     AK_RUN(text_glyphs_and_size);
     AK_RUN(png_round_trip);
     AK_RUN(gif_round_trip);
+    AK_RUN(gif_frame_rate_delays);
+    AK_RUN(gif_delta_frames);
     AK_RUN(truncated_files_give_errors_not_crashes);
     AK_RUN(bad_input_codes);
     return ak_test_finish();

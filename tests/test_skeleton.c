@@ -304,6 +304,50 @@ static ak_skeleton* random_skeleton(ak_rng* rng, int* parents, ak_transform* res
     return sk;
 }
 
+AK_TEST(fk_affine_products_equal_full_products) {
+    /* FK multiplies affine matrices without the bottom row's terms (and a projective root
+     * through the full product): every model matrix must equal, float for float, the chain of
+     * full 4x4 products in the same order (ak_mat4_mul), with no root, an affine root and a
+     * projective root, and keep the bottom row (0, 0, 0, 1) when affine. */
+    ak_rng rng = ak_rng_make(41);
+    int parents[FK_N];
+    ak_transform rest[FK_N], pose[FK_N];
+    ak_skeleton* sk = random_skeleton(&rng, parents, rest);
+    AK_CHECK(sk != NULL);
+    if (!sk) return;
+    for (int i = 0; i < FK_N; ++i) {
+        pose[i] = random_transform(&rng);
+        pose[i].scale = ak_vec3_make(ak_rng_range(&rng, 0.5f, 2.0f), ak_rng_range(&rng, 0.5f, 2.0f),
+                                     ak_rng_range(&rng, 0.5f, 2.0f)); /* non-uniform */
+    }
+    ak_mat4 roots[3];
+    roots[0] = ak_mat4_identity();
+    roots[1] = ak_transform_to_mat4(random_transform(&rng));
+    roots[2] = roots[1];
+    roots[2].m[3] = 0.25f, roots[2].m[15] = 2.0f; /* projective */
+    for (int r = 0; r < 4; ++r) {
+        ak_mat4 model[FK_N], ref[FK_N];
+        const ak_mat4* root = r == 3 ? NULL : &roots[r];
+        if (root)
+            AK_CHECK_EQ(ak_skeleton_local_to_model_rooted(sk, *root, (ak_transform_cspan){pose, FK_N},
+                                                          (ak_mat4_span){model, FK_N}),
+                        AK_OK);
+        else
+            AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N}, (ak_mat4_span){model, FK_N}),
+                        AK_OK);
+        int differ = 0;
+        for (int i = 0; i < FK_N; ++i) {
+            const ak_mat4 m = ak_transform_to_mat4(pose[i]);
+            ref[i] = parents[i] >= 0 ? ak_mat4_mul(ref[parents[i]], m) : root ? ak_mat4_mul(*root, m) : m;
+            for (int e = 0; e < 16; ++e) differ += model[i].m[e] != ref[i].m[e]; /* -0 == +0 */
+            if (r != 2) AK_CHECK(model[i].m[3] == 0.0f && model[i].m[7] == 0.0f && model[i].m[11] == 0.0f &&
+                                 model[i].m[15] == 1.0f);
+        }
+        AK_CHECK_MSG(differ == 0, "root %d: %d floats differ from the full products", r, differ);
+    }
+    ak_skeleton_destroy(sk);
+}
+
 AK_TEST(fk_matches_naive_double) {
     ak_rng rng = ak_rng_make(3);
     int parents[FK_N];
@@ -663,6 +707,7 @@ AK_TEST(pose_is_finite) {
 
 int main(void) {
     AK_RUN(create_and_query);
+    AK_RUN(fk_affine_products_equal_full_products);
     AK_RUN(create_validation_codes);
     AK_RUN(one_allocation);
     AK_RUN(reorder_shuffled);

@@ -483,6 +483,16 @@ AK_TEST(job_data_screen_catches_faults_everywhere) {
     AK_CHECK_EQ(ak_skin_job_run(&ij), AK_ERR_BAD_DATA);
 }
 
+/* The kernel levels this CPU runs: scalar always, AVX2 and AVX-512 where it has them. */
+static int cpu_simd_levels(ak_skin_simd* out, const char** names) {
+    const char* best = ak_skin_simd_name();
+    int n = 0;
+    out[n] = AK_SKIN_SIMD_SCALAR, names[n++] = "scalar";
+    if (!strcmp(best, "avx2") || !strcmp(best, "avx512")) out[n] = AK_SKIN_SIMD_AVX2, names[n++] = "avx2";
+    if (!strcmp(best, "avx512")) out[n] = AK_SKIN_SIMD_AVX512, names[n++] = "avx512";
+    return n;
+}
+
 AK_TEST(lbs_matches_double_reference) {
     for (int kc = 0; kc < 6; ++kc) {
         enum { N = 1003, J = 20 };
@@ -608,6 +618,176 @@ AK_TEST(dqs_cor_simd_matches_scalar_for_every_influence_count) {
     }
 }
 
+typedef struct wide_vertex { /* interleaved with a stride the kernels cannot shuffle (64 bytes) */
+    float pos[3];
+    uint16_t joints[AK_MAX_INFLUENCES];
+    float nrm[3];
+    float weights[AK_MAX_INFLUENCES];
+    float ctr[3];
+    float pad;
+} wide_vertex;
+
+AK_TEST(every_simd_kernel_matches_scalar) {
+    /* Every kernel this CPU has (scalar, AVX2, AVX-512, picked with simd_limit) against the
+     * scalar code (itself checked against closed forms and a double reference above) and,
+     * for LBS, against the double reference: LBS, DQS, CoR; influence counts 1, 2, 3, 4, 5,
+     * 8; vertex counts below one block, one AVX2 block, blocks plus tails; packed and
+     * interleaved streams; 1 and 3 threads; with and without normals. */
+    ak_skin_simd levels[3];
+    const char* names[3];
+    const int level_count = cpu_simd_levels(levels, names);
+    printf("  kernels run here:");
+    for (int l = 0; l < level_count; ++l) printf(" %s", names[l]);
+    printf("\n");
+    if (level_count < 3) AK_SKIP("no AVX-512 (F, VL, DQ, BW) on this CPU, or an AK_NO_SIMD build: the AVX-512 kernel was not run");
+    if (level_count < 2) AK_SKIP("no AVX2+FMA on this CPU, or an AK_NO_SIMD build: the AVX2 kernel was not run");
+    enum { J = 20, NMAX = 517 };
+    static const int counts[4] = {5, 8, 37, NMAX}; /* 517 = 32 blocks of 16 + 5 */
+    ak_rng rng = ak_rng_make(2026);
+    ak_mat4 pal[J], pal_rigid[J];
+    for (int j = 0; j < J; ++j) pal[j] = rand_matrix(&rng, j % 2 == 1), pal_rigid[j] = rand_matrix(&rng, false);
+    wide_vertex* v = (wide_vertex*)malloc(NMAX * sizeof *v);
+    ak_vec3 *pos = malloc(NMAX * sizeof *pos), *nrm = malloc(NMAX * sizeof *nrm), *ctr = malloc(NMAX * sizeof *ctr);
+    uint16_t* jn = malloc(NMAX * AK_MAX_INFLUENCES * sizeof *jn);
+    float* w = malloc(NMAX * AK_MAX_INFLUENCES * sizeof *w);
+    ak_vec3 *op[3], *on[3];
+    for (int l = 0; l < 3; ++l) op[l] = malloc(NMAX * sizeof(ak_vec3)), on[l] = malloc(NMAX * sizeof(ak_vec3));
+    unsigned char* scratch = malloc(64 + 192 * J);
+    int runs[3] = {0, 0, 0};
+    for (int kc = 0; kc < 6; ++kc) {
+        const uint32_t K = k_counts[kc];
+        for (int i = 0; i < NMAX; ++i) {
+            pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+            nrm[i] = rand_unit(&rng);
+            ctr[i] = ak_vec3_scale(pos[i], 0.6f);
+            rand_influences(&rng, K, J, &jn[K * i], &w[K * i]);
+            memset(&v[i], 0, sizeof v[i]);
+            memcpy(v[i].pos, &pos[i], 12), memcpy(v[i].nrm, &nrm[i], 12), memcpy(v[i].ctr, &ctr[i], 12);
+            memcpy(v[i].joints, &jn[K * i], K * sizeof *jn), memcpy(v[i].weights, &w[K * i], K * sizeof *w);
+        }
+        for (int mi = 0; mi < 4; ++mi) { /* LBS, DQS, CoR, and LBS with a rigid palette */
+            const int method = mi == 3 ? AK_SKIN_LBS : mi;
+            const ak_mat4* pm = mi == 0 ? pal : pal_rigid; /* DQS/CoR SIMD: rigid only */
+            for (int variant = 0; variant < 16; ++variant) {
+                const int N = counts[variant & 3];
+                const bool strided = (variant & 4) != 0, normals = (variant & 8) != 0;
+                for (int l = 0; l < level_count; ++l) {
+                    ak_skin_job job = {
+                        .method = (ak_skin_method)method,
+                        .influence_count = K,
+                        .palette = {pm, J},
+                        .positions = {pos, (size_t)N, 0},
+                        .joints = {jn, (size_t)N, 0},
+                        .weights = {w, (size_t)N, 0},
+                        .cor_centers = {ctr, (size_t)N, 0},
+                        .scratch = {scratch, 64 + 192 * J},
+                        .out_positions = {op[l], (size_t)N, 0},
+                        .simd_limit = levels[l],
+                        .thread_count = (variant & 1) ? 3u : 0u,
+                    };
+                    if (strided) {
+                        job.positions = (ak_cstream){v[0].pos, (size_t)N, sizeof *v};
+                        job.joints = (ak_cstream){v[0].joints, (size_t)N, sizeof *v};
+                        job.weights = (ak_cstream){v[0].weights, (size_t)N, sizeof *v};
+                        job.cor_centers = (ak_cstream){v[0].ctr, (size_t)N, sizeof *v};
+                    }
+                    if (normals) {
+                        job.normals = strided ? (ak_cstream){v[0].nrm, (size_t)N, sizeof *v}
+                                              : (ak_cstream){nrm, (size_t)N, 0};
+                        job.out_normals = (ak_stream){on[l], (size_t)N, 0};
+                    }
+                    memset(op[l], 0xff, NMAX * sizeof(ak_vec3)); /* NaN: a vertex left unwritten shows */
+                    memset(on[l], 0xff, NMAX * sizeof(ak_vec3));
+                    AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+                    ++runs[l];
+                    double worst_p = 0.0, worst_n = 0.0;
+                    for (int i = 0; i < N; ++i) {
+                        double ep = ak_vec3_length(ak_vec3_sub(op[l][i], op[0][i]));
+                        double en = normals ? ak_vec3_length(ak_vec3_sub(on[l][i], on[0][i])) : 0.0;
+                        worst_p = ep == ep ? fmax(worst_p, ep) : INFINITY;
+                        worst_n = en == en ? fmax(worst_n, en) : INFINITY;
+                        if (method == AK_SKIN_LBS && l == 0) { /* the scalar code against doubles */
+                            double rp[3], rn[3];
+                            ref_lbs(pm, &jn[K * i], &w[K * i], K, pos[i], nrm[i], rp, rn);
+                            double e = fabs(rp[0] - op[0][i].x) + fabs(rp[1] - op[0][i].y) + fabs(rp[2] - op[0][i].z);
+                            AK_CHECK_MSG(e <= 1e-4, "LBS scalar K %u vertex %d: %g", K, i, e);
+                        }
+                    }
+                    /* the sentinel past the job's vertices stays (nothing written beyond N) */
+                    if (N < NMAX) AK_CHECK(op[l][N].x != op[l][N].x);
+                    AK_CHECK_MSG(worst_p <= 2e-5 && worst_n <= 2e-5,
+                                 "%s method %d K %u N %d %s %s threads %u: vs scalar %g / %g", names[l], method, K,
+                                 N, strided ? "strided" : "packed", normals ? "normals" : "positions",
+                                 job.thread_count, worst_p, worst_n);
+                }
+            }
+        }
+    }
+    printf("  runs per kernel:");
+    for (int l = 0; l < level_count; ++l) printf(" %s %d", names[l], runs[l]);
+    printf("\n");
+    ak_skin_job bad = {.simd_limit = AK_SKIN_SIMD_COUNT, .influence_count = 1, .palette = {pal, J},
+                       .positions = {pos, 1, 0}, .joints = {jn, 1, 0}, .weights = {w, 1, 0},
+                       .out_positions = {op[0], 1, 0}};
+    AK_CHECK_EQ(ak_skin_job_validate(&bad), AK_ERR_BAD_ARG);
+    free(v), free(pos), free(nrm), free(ctr), free(jn), free(w), free(scratch);
+    for (int l = 0; l < 3; ++l) free(op[l]), free(on[l]);
+}
+
+AK_TEST(lbs_single_influence_rigid_path) {
+    /* LBS with 1 influence, normals and a rigid palette takes a path without the blend and the
+     * normal's renormalisation in the SIMD kernels: against the scalar code for valid weights
+     * (1, and 1 - 5e-4 within the rule's tolerance) and, with skip_data_check, 0 and -1; unit
+     * normals out. A palette that is only nearly rigid (scale 1.001) must not take that path:
+     * its normals are still unit. */
+    enum { N = 45, J = 7 };
+    ak_skin_simd levels[3];
+    const char* names[3];
+    const int level_count = cpu_simd_levels(levels, names);
+    ak_rng rng = ak_rng_make(5);
+    ak_mat4 pal[J];
+    ak_vec3 pos[N], nrm[N], op[3][N], on[3][N];
+    uint16_t jn[N];
+    float w[N];
+    for (int i = 0; i < N; ++i) {
+        pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+        nrm[i] = rand_unit(&rng);
+        jn[i] = (uint16_t)(ak_rng_u32(&rng) % J);
+        w[i] = i % 5 == 1 ? 1.0f - 5e-4f : 1.0f;
+    }
+    for (int variant = 0; variant < 3; ++variant) {
+        for (int j = 0; j < J; ++j) pal[j] = rand_matrix(&rng, false);
+        if (variant == 1) { /* nearly rigid: one joint scaled by 1.001 */
+            for (int e = 0; e < 3; ++e) pal[3].m[e] *= 1.001f, pal[3].m[4 + e] *= 1.001f, pal[3].m[8 + e] *= 1.001f;
+        }
+        if (variant == 2) w[7] = 0.0f, w[20] = -1.0f, w[44] = 0.0f; /* unchecked data */
+        for (int l = 0; l < level_count; ++l) {
+            ak_skin_job job = {
+                .influence_count = 1,
+                .palette = {pal, J},
+                .positions = {pos, N, 0},
+                .normals = {nrm, N, 0},
+                .joints = {jn, N, 0},
+                .weights = {w, N, 0},
+                .out_positions = {op[l], N, 0},
+                .out_normals = {on[l], N, 0},
+                .simd_limit = levels[l],
+                .skip_data_check = variant == 2,
+            };
+            AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+            double worst = 0.0, worst_len = 0.0;
+            for (int i = 0; i < N; ++i) {
+                worst = fmax(worst, ak_vec3_length(ak_vec3_sub(op[l][i], op[0][i])));
+                worst = fmax(worst, ak_vec3_length(ak_vec3_sub(on[l][i], on[0][i])));
+                if (w[i] != 0.0f) worst_len = fmax(worst_len, fabs(ak_vec3_length(on[l][i]) - 1.0));
+                else AK_CHECK(ak_vec3_length(on[l][i]) == 0.0f);
+            }
+            AK_CHECK_MSG(worst <= 2e-5 && worst_len <= 2e-6, "%s variant %d: vs scalar %g, |n| - 1 %g", names[l],
+                         variant, worst, worst_len);
+        }
+    }
+}
+
 AK_TEST(lbs_tangents_and_face_normals) {
     cylinder c = cylinder_make(21, 16);
     ak_mat4 pal[2] = {ak_mat4_identity(),
@@ -677,8 +857,8 @@ AK_TEST(lbs_tangents_and_face_normals) {
 
 AK_TEST(bad_joint_indices_clamp_in_every_kernel) {
     /* With skip_data_check, out-of-range joint indices are documented to be clamped to the
-     * last palette entry. Each kernel (the SIMD one runs blocks of 8 vertices, with its own
-     * clamp for 4 influences, and the scalar code) must give the result of the same job with
+     * last palette entry. Each kernel (AVX2: blocks of 8 vertices, with its own clamp for 4
+     * influences; AVX-512: blocks of 16; the scalar code) must give the result of the same job with
      * those indices replaced by J - 1 and the data validated, for LBS, DQS and CoR. */
     enum { N = 61, J = 6 };
     ak_rng rng = ak_rng_make(23);
@@ -722,8 +902,12 @@ AK_TEST(bad_joint_indices_clamp_in_every_kernel) {
             job.skip_data_check = true;
             job.out_positions.ptr = op;
             job.out_normals.ptr = on;
-            for (int simd = 0; simd < 2; ++simd) {
-                job.skip_simd = simd == 0;
+            ak_skin_simd levels[3];
+            const char* names[3];
+            const int level_count = cpu_simd_levels(levels, names);
+            job.skip_simd = false;
+            for (int l = 0; l < level_count; ++l) { /* every kernel this CPU has */
+                job.simd_limit = levels[l];
                 memset(op, 0, sizeof op);
                 memset(on, 0, sizeof on);
                 AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
@@ -732,7 +916,7 @@ AK_TEST(bad_joint_indices_clamp_in_every_kernel) {
                     worst = fmax(worst, ak_vec3_length(ak_vec3_sub(op[i], ref_p[i])));
                     worst = fmax(worst, ak_vec3_length(ak_vec3_sub(on[i], ref_n[i])));
                 }
-                AK_CHECK(worst < 1e-4); /* a wrong joint moves points by O(1) */
+                AK_CHECK_MSG(worst < 1e-4, "%s method %d K %u: %g", names[l], m, k, worst); /* a wrong joint: O(1) */
             }
         }
     }
@@ -1568,6 +1752,8 @@ int main(void) {
     AK_RUN(job_data_screen_catches_faults_everywhere);
     AK_RUN(lbs_matches_double_reference);
     AK_RUN(dqs_cor_simd_matches_scalar_for_every_influence_count);
+    AK_RUN(every_simd_kernel_matches_scalar);
+    AK_RUN(lbs_single_influence_rigid_path);
     AK_RUN(lbs_tangents_and_face_normals);
     AK_RUN(bad_joint_indices_clamp_in_every_kernel);
     AK_RUN(job_split_matches_whole);

@@ -249,6 +249,60 @@ AK_TEST(scene_render_skeleton_and_gif) {
     ak_raster_destroy(r);
 }
 
+/* Readable charts: dense keys draw no markers (the picture equals the line alone), float noise
+ * on a constant stays flat, a title too long for the chart keeps both ends inside it. */
+AK_TEST(plot_readable_dense_keys_noise_titles) {
+    enum { W = 400, H = 260, N = 1000 };
+    static uint8_t pa[W * H * 4], pb[W * H * 4];
+    ak_image ia = {.pixels = pa, .width = W, .height = H}, ib = {.pixels = pb, .width = W, .height = H};
+    static float x[N], y[N];
+    for (int i = 0; i < N; ++i) x[i] = 0.01f * (float)i, y[i] = sinf(x[i]);
+    ak_view_series line = {.x = {x, N}, .y = {y, N}, .color = {0.2f, 0.3f, 0.9f, 1}};
+    ak_view_series keyed = line;
+    keyed.key_x = (ak_f32_cspan){x, N};
+    keyed.key_y = (ak_f32_cspan){y, N};
+    ak_view_plot plot = {.series = &line, .series_count = 1, .title = "dense"};
+    AK_CHECK_EQ(ak_view_plot_draw(&plot, &ia), AK_OK);
+    plot.series = &keyed;
+    AK_CHECK_EQ(ak_view_plot_draw(&plot, &ib), AK_OK);
+    AK_CHECK_MSG(memcmp(pa, pb, sizeof pa) == 0, "1000 keys in 400 px drew markers");
+    /* 10 keys, 30+ px apart: markers drawn */
+    keyed.key_x.count = keyed.key_y.count = 10;
+    float kx[10], ky[10];
+    for (int i = 0; i < 10; ++i) kx[i] = (float)i, ky[i] = sinf(kx[i]);
+    keyed.key_x.ptr = kx, keyed.key_y.ptr = ky;
+    AK_CHECK_EQ(ak_view_plot_draw(&plot, &ib), AK_OK);
+    AK_CHECK(memcmp(pa, pb, sizeof pa) != 0);
+    /* 1 +- 1e-6: the y range spans at least 1% of 1, so the noise is under a pixel */
+    for (int i = 0; i < N; ++i) y[i] = 1.0f + ((i & 1) ? 1e-6f : -1e-6f);
+    ak_view_plot noise = {.series = &line, .series_count = 1};
+    ak_vec2 lo, hi;
+    AK_CHECK(ak_view_plot_map(&noise, W, H, 1.0f, 1.0f - 1e-6f, &lo));
+    AK_CHECK(ak_view_plot_map(&noise, W, H, 1.0f, 1.0f + 1e-6f, &hi));
+    AK_CHECK_MSG(fabsf(lo.y - hi.y) < 1.0f, "noise spans %.1f px", (double)fabsf(lo.y - hi.y));
+    /* a real change larger than 1% still fills the chart */
+    for (int i = 0; i < N; ++i) y[i] = 1.0f + 0.5f * (float)i / (float)N;
+    AK_CHECK(ak_view_plot_map(&noise, W, H, 1.0f, 1.0f, &lo));
+    AK_CHECK(ak_view_plot_map(&noise, W, H, 1.0f, 1.5f, &hi));
+    AK_CHECK(lo.y - hi.y > 150.0f);
+    /* a long title in a narrow chart: shrunk and cut in the middle, clear of both edges */
+    enum { NW = 200, NH = 120 };
+    static uint8_t pn[NW * NH * 4];
+    ak_image in = {.pixels = pn, .width = NW, .height = NH};
+    ak_view_plot longt = {.series = &line, .series_count = 1,
+                          .title = "MMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMMM rotation (linear)"};
+    AK_CHECK_EQ(ak_view_plot_draw(&longt, &in), AK_OK);
+    int ink_edge = 0, ink = 0;
+    for (int yy = 0; yy < 30; ++yy)
+        for (int xx = 0; xx < NW; ++xx) {
+            const uint8_t* c = ak_image_pixel(&in, xx, yy);
+            if (c[0] > 100) continue;
+            ++ink;
+            ink_edge += xx < 5 || xx >= NW - 5;
+        }
+    AK_CHECK_MSG(ink > 50 && ink_edge == 0, "title ink %d, at the edges %d", ink, ink_edge);
+}
+
 int main(void) {
     AK_RUN(orbit_framing_keeps_box_inside);
     AK_RUN(heatmap_endpoints_and_mapping);
@@ -256,5 +310,6 @@ int main(void) {
     AK_RUN(panels_sizes_and_placement);
     AK_RUN(plot_draws_at_mapped_pixels);
     AK_RUN(scene_render_skeleton_and_gif);
+    AK_RUN(plot_readable_dense_keys_noise_titles);
     return ak_test_finish();
 }

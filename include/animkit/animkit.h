@@ -24,6 +24,12 @@
 #include "io.h"
 #include "raster.h"
 #include "view.h"
+#include "noise.h"
+#include "terrain.h"
+#include "grid.h"
+#include "particles.h"
+#include "boids.h"
+#include "cloth.h"
 #include "retarget.h"
 
 #endif

@@ -89,6 +89,23 @@ AK_API void ak_points_bounds(ak_vec3_cspan points, ak_vec3* out_min, ak_vec3* ou
  * (count >= positions.count). Vertices on no triangle, or on only degenerate ones, get (0,1,0).
  * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX. */
 AK_API ak_result ak_normals_compute(ak_vec3_cspan positions, ak_u32_cspan indices, ak_vec3_span out_normals);
+/* Elements of uint32 scratch ak_normals_compute_welded needs for vertex_count vertices
+ * (vertex_count plus a hash table of twice that, rounded up to a power of two). SIZE_MAX when
+ * that would overflow. */
+AK_API size_t ak_normals_welded_scratch_count(size_t vertex_count);
+/* Area-weighted vertex normals like ak_normals_compute, except that vertices at the same
+ * position (bitwise equal coordinates, -0 equal to +0) share one normal: the normalised sum of
+ * the faces around all of them. This shades an unwelded mesh (one vertex per face corner, as
+ * OBJ files without normals give) smooth instead of faceted; meshes whose hard edges are
+ * meant (split normals) should keep their own. Non-finite positions are never welded.
+ * scratch.count >= ak_normals_welded_scratch_count(positions.count); it is overwritten.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL (out_normals or scratch), AK_ERR_BAD_INDEX.
+ *     uint32_t* scratch = malloc(ak_normals_welded_scratch_count(n) * sizeof(uint32_t));
+ *     ak_normals_compute_welded(positions, indices,
+ *                               (ak_u32_span){scratch, ak_normals_welded_scratch_count(n)},
+ * normals); */
+AK_API ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indices,
+                                           ak_u32_span scratch, ak_vec3_span out_normals);
 /* ak_normals_compute on the mesh's own arrays (no-op when normals == NULL). */
 AK_API ak_result ak_mesh_compute_normals(ak_mesh* mesh);
 

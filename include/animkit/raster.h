@@ -323,14 +323,24 @@ typedef struct ak_gif_desc {
     int delay_cs;       /* delay between frames in 1/100 s; 0 -> 4 (25 fps) */
     int loop_count;     /* 0 -> loop forever (GIF's own meaning of 0); N -> play N+1 times */
     bool no_dither;     /* false -> 4x4 ordered dithering hides palette banding */
+    float frame_rate;   /* > 0 (up to 100): frames per second, delay_cs ignored; GIF delays are whole
+                           1/100 s, so frame k (from 1) ends at round(100 k / frame_rate) and the
+                           delays alternate (24 fps: 4,4,5,4,4,4 cs; average 1/24 s), each at
+                           least 1; 0 or not finite -> delay_cs */
+    bool no_delta;      /* false -> after the first frame, pixels equal to the previous frame's
+                           (source RGB) are written transparent, each frame is cropped to the
+                           rectangle that changed, and its palette is built from the changed
+                           pixels only: a still background costs almost nothing. true -> every
+                           frame whole and opaque */
 } ak_gif_desc;
 
 /* Open path and write the GIF header. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_IO,
  * AK_ERR_NO_MEMORY. The writer owns the open file until ak_gif_writer_finish. */
 AK_API ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const ak_allocator* alloc,
                                       ak_gif_writer** out_writer);
-/* Quantize frame to its own 256-colour palette (median cut) and append it. The frame's size
- * must equal the desc's; alpha is ignored. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_IO,
+/* Quantize frame to its own 256-colour palette (median cut; 255 and a transparent entry for
+ * delta frames, see ak_gif_desc) and append it. The frame's size must equal the desc's; alpha
+ * is ignored. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_IO,
  * AK_ERR_NO_MEMORY (giflib's colour map). */
 AK_API ak_result ak_gif_writer_add_frame(ak_gif_writer* writer, const ak_image* frame);
 /* Close the file and free the writer (always, even on error). AK_ERR_IO when the file could

@@ -7,7 +7,7 @@
  *   - a compact weights file format (encode/decode to memory, thin file wrappers);
  *   - one skinning job for three methods: linear blend (LBS), dual quaternions (DQS, Kavan et
  *     al. 2008) and optimized centers of rotation (CoR, Le & Hodgins 2016), vectorized across
- *     vertices (AVX2+FMA chosen at run time; scalar reference always built, forced by
+ *     vertices (AVX-512 or AVX2+FMA chosen at run time; scalar reference always built, forced by
  *     AK_NO_SIMD or job.skip_simd);
  *   - the CoR precomputation (per-vertex centers), pruned by bone pair and multithreaded, with
  *     a cache format keyed by a hash of the mesh and weights.
@@ -253,13 +253,28 @@ typedef enum ak_skin_method {
     AK_SKIN_METHOD_COUNT
 } ak_skin_method;
 
+/* Upper limit on the SIMD kernel ak_skin_job_run may pick (the fastest this CPU has up to the
+ * limit is used; tests and benchmarks run every path side by side with it). Every kernel gives
+ * the scalar reference's results up to float rounding. */
+typedef enum ak_skin_simd {
+    AK_SKIN_SIMD_DEFAULT = 0, /* -> the fastest kernel this CPU has (AK_SKIN_SIMD_AVX512) */
+    AK_SKIN_SIMD_SCALAR,      /* scalar code (as skip_simd) */
+    AK_SKIN_SIMD_AVX2,        /* AVX2+FMA, 8 vertices per block, where the CPU has it */
+    AK_SKIN_SIMD_AVX512,      /* AVX-512 (F, VL, DQ, BW), 16 vertices per block, where the CPU
+                                 has it, else AVX2 */
+    AK_SKIN_SIMD_COUNT
+} ak_skin_simd;
+
 /* Streams hold float or uint16_t components: positions/normals 3 floats, tangents 4 floats
  * (xyz direction, w handedness copied), joints influence_count uint16_t, weights
  * influence_count floats. A stride of 0 means tightly packed. Pointers need only the natural
- * alignment of their component type. Speed: the AVX2 LBS kernel loads palette matrices in
- * 32-byte halves; palettes of up to 128 joints that are not 64-byte aligned are copied to an
- * aligned stack buffer (8 KiB) for meshes of at least 16 vertices per joint; a larger palette
- * is fastest when the caller aligns it to 64 bytes (about 1.1-1.15x). */
+ * alignment of their component type. Speed: the SIMD LBS kernels load palette matrices in
+ * 32-byte halves (AVX2) or whole (AVX-512); palettes of up to 128 joints that are not 64-byte
+ * aligned are copied to an aligned stack buffer (8 KiB) for meshes of at least 16 vertices per
+ * joint; a larger palette is fastest when the caller aligns it to 64 bytes (about 1.1-1.15x).
+ * LBS with 1 influence skips the blend (p' = w (M p)), and with normals also the normal's
+ * cofactor and renormalisation when every palette matrix is a rotation plus translation
+ * (checked per run, O(palette.count)). */
 typedef struct ak_skin_job {
     ak_skin_method method;      /* 0 -> AK_SKIN_LBS */
     uint32_t influence_count;   /* required: joints per vertex, 1..AK_MAX_INFLUENCES */
@@ -286,6 +301,8 @@ typedef struct ak_skin_job {
     bool skip_simd;             /* false -> fastest kernel for this CPU (tangents, and DQS/CoR
                                    with scaled or sheared joints, always run the scalar code);
                                    true -> scalar code */
+    ak_skin_simd simd_limit;    /* 0 -> no limit (fastest kernel for this CPU); else the
+                                   fastest up to this one (out of range: AK_ERR_BAD_ARG) */
     uint32_t thread_count;      /* 0 or 1 -> calling thread; n (<= 64) -> n contiguous ranges,
                                    n - 1 of them on new pthreads (falls back to the calling
                                    thread when a thread cannot start) */
@@ -303,8 +320,8 @@ AK_API size_t ak_skin_job_scratch_size(const ak_skin_job* job);
 /* Check the job. Rules, in order (the first that fails is returned):
  *  1. AK_ERR_NULL_ARG: job, positions.ptr, palette.ptr, joints.ptr, weights.ptr or
  *     out_positions.ptr is NULL (a zero-initialised job fails here);
- *  2. AK_ERR_BAD_ARG: method out of range, influence_count 0 or > 8, thread_count > 64, a
- *     nonzero stride smaller than its element;
+ *  2. AK_ERR_BAD_ARG: method out of range, influence_count 0 or > 8, thread_count > 64,
+ *     simd_limit out of range, a nonzero stride smaller than its element;
  *  3. AK_ERR_NULL_ARG: normals or normals_from_faces without out_normals.ptr, tangents without
  *     out_tangents.ptr, COR without cor_centers.ptr, normals_from_faces without indices.ptr;
  *  4. AK_ERR_BAD_ARG: indices.count % 3 != 0 (when normals_from_faces);
@@ -329,7 +346,8 @@ AK_API ak_result ak_skin_job_run(const ak_skin_job* job);
 AK_API ak_result ak_skin_job_split(const ak_skin_job* job, size_t first_vertex, size_t vertex_count,
                                    ak_skin_job* out_part);
 
-/* Name of the kernel ak_skin_job_run uses on this CPU: "avx2" or "scalar". */
+/* Name of the fastest kernel ak_skin_job_run can use on this CPU: "avx512", "avx2" or
+ * "scalar" (AK_NO_SIMD builds: "scalar"). */
 AK_API const char* ak_skin_simd_name(void);
 
 #ifdef __cplusplus

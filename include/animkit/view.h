@@ -147,7 +147,9 @@ typedef struct ak_view_series {
     ak_vec4 color;              /* sRGB; zero -> ak_view_palette_color(series index) */
     const char* label;          /* legend entry; NULL -> not listed */
     float width;                /* line width in pixels; 0 -> 2 */
-    ak_f32_cspan key_x;         /* key markers; empty -> none */
+    ak_f32_cspan key_x;         /* key markers; empty -> none. Markers and handles are drawn only
+                                   when the keys in view are on average 8 pixels apart or more
+                                   (denser keys, e.g. motion capture, are their line already) */
     ak_f32_cspan key_y;         /* count == key_x.count */
     ak_f32_cspan key_in_slope;  /* incoming tangent dy/dx per key; empty -> no handles */
     ak_f32_cspan key_out_slope; /* outgoing tangent dy/dx per key; empty -> no handles */
@@ -156,11 +158,13 @@ typedef struct ak_view_series {
 typedef struct ak_view_plot {
     const ak_view_series* series; /* required */
     size_t series_count;          /* required, > 0 */
-    const char* title;            /* NULL -> none */
+    const char* title;            /* NULL -> none; font scale 2, or 1 when too wide, then cut in
+                                     the middle with "..." so both ends show */
     const char* x_label;          /* NULL -> none */
     const char* y_label;          /* NULL -> none */
     float x_min, x_max;           /* equal (e.g. both 0) -> fitted to the data */
-    float y_min, y_max;           /* equal -> fitted to the data with a margin */
+    float y_min, y_max;           /* equal -> fitted to the data with a margin, spanning at least
+                                     1% of the largest |y| (float noise on a constant stays flat) */
     float handle_length;          /* tangent handle length in pixels; 0 -> 28 */
     ak_vec4 background;           /* sRGB; zero -> (0.98, 0.98, 0.97) */
     bool no_legend;               /* false -> legend row above the plot area when labels exist */

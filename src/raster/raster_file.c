@@ -1,5 +1,6 @@
 /* PNG (libpng's simplified API) and animated GIF (giflib) writing and reading. The GIF colour
- * quantizer (median cut over a 15-bit histogram, ordered dithering) is animkit's own. */
+ * quantizer (median cut over a 15-bit histogram, ordered dithering) and the delta frames
+ * (unchanged pixels transparent, palette kept while it fits) are animkit's own. */
 #include <fcntl.h> /* open: GIF files with the usual permissions */
 #include <stdio.h>
 #include <stdlib.h>
@@ -33,6 +34,11 @@ struct ak_gif_writer {
     uint32_t* sum;       /* [HIST_SIZE * 3] sums of the 8-bit channels */
     uint16_t* cells;     /* [HIST_SIZE] non-empty cells */
     uint16_t* map;       /* [HIST_SIZE] cell -> palette index, 0xFFFF unknown */
+    uint8_t* prev;       /* width * height * 4: the previous frame (delta frames), else NULL */
+    GifColorType pal[256]; /* delta frames: the palette in use, kept while it fits the changes */
+    int pal_n;
+    double pal_err;      /* its mean error on the frame it was built from */
+    double shown_cs;     /* frame_rate: hundredths of a second written so far */
 };
 
 /* ---- helpers ------------------------------------------------------------------------------- */
@@ -74,8 +80,8 @@ static void box_extent(const ak_gif_writer* w, const box* bx, int* out_axis, int
     *out_range = hi[axis] - lo[axis];
 }
 
-/* Median cut: at most 256 palette entries from the histogram. Returns the entry count. */
-static int median_cut(ak_gif_writer* w, GifColorType* palette) {
+/* Median cut: at most max_colors palette entries from the histogram. Returns the entry count. */
+static int median_cut(ak_gif_writer* w, GifColorType* palette, int max_colors) {
     size_t ncell = 0;
     for (uint32_t c = 0; c < HIST_SIZE; ++c)
         if (w->hist[c]) w->cells[ncell++] = (uint16_t)c;
@@ -85,7 +91,7 @@ static int median_cut(ak_gif_writer* w, GifColorType* palette) {
     boxes[0].count = ncell;
     boxes[0].pixels = 0;
     for (size_t i = 0; i < ncell; ++i) boxes[0].pixels += w->hist[w->cells[i]];
-    while (nbox < 256) {
+    while (nbox < max_colors) {
         /* split the box with the largest range weighted by its share of pixels */
         int best = -1, best_axis = 0;
         double best_score = 0.0;
@@ -227,7 +233,8 @@ ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const 
     size_t o_sum = o_hist + akp_align16(HIST_SIZE * sizeof(uint32_t));
     size_t o_cells = o_sum + akp_align16(HIST_SIZE * 3 * sizeof(uint32_t));
     size_t o_map = o_cells + akp_align16(HIST_SIZE * sizeof(uint16_t));
-    size_t total = o_map + HIST_SIZE * sizeof(uint16_t);
+    size_t o_prev = o_map + akp_align16(HIST_SIZE * sizeof(uint16_t));
+    size_t total = o_prev + (desc->no_delta ? 0 : npx * 4);
     uint8_t* mem = (uint8_t*)akp_alloc(alloc, total);
     if (!mem) return AK_ERR_NO_MEMORY;
     ak_gif_writer* w = (ak_gif_writer*)mem;
@@ -243,6 +250,8 @@ ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const 
     w->sum = (uint32_t*)(void*)(mem + o_sum);
     w->cells = (uint16_t*)(void*)(mem + o_cells);
     w->map = (uint16_t*)(void*)(mem + o_map);
+    w->prev = desc->no_delta ? NULL : mem + o_prev;
+    if (!(w->desc.frame_rate > 0.0f && w->desc.frame_rate <= 100.0f)) w->desc.frame_rate = 0.0f;
     int err = 0;
     /* Open the file ourselves: EGifOpenFileName creates it with mode 0600; users expect the
      * same permissions as any other output (0666 less the umask, as fopen gives). */
@@ -271,16 +280,41 @@ ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const 
     return AK_OK;
 }
 
-ak_result ak_gif_writer_add_frame(ak_gif_writer* w, const ak_image* frame) {
-    if (!w || !frame || !frame->pixels) return AK_ERR_NULL_ARG;
-    if (!image_valid(frame) || frame->width != w->desc.width || frame->height != w->desc.height) return AK_ERR_BAD_ARG;
-    if (w->failed) return AK_ERR_IO;
-    const int W = frame->width, H = frame->height;
+/* Histogram of 15-bit cells (w->hist, w->sum) over the pixels of rows y0..y1, columns x0..x1;
+ * with skip_unchanged, pixels equal to the previous frame's are left out. */
+static void histogram(ak_gif_writer* w, const ak_image* frame, int x0, int y0, int x1, int y1, bool skip_unchanged);
+
+/* Mean weighted squared distance (nearest's metric) from the histogram's pixels to their
+ * palette entries, through w->map (filled as needed). */
+static double hist_error(ak_gif_writer* w, const GifColorType* pal, int n) {
+    double err = 0.0, count = 0.0;
+    for (uint32_t c = 0; c < HIST_SIZE; ++c) {
+        if (!w->hist[c]) continue;
+        int r = (int)(((c >> 10) & 31) << 3) | 4, g = (int)(((c >> 5) & 31) << 3) | 4, b = (int)((c & 31) << 3) | 4;
+        if (w->map[c] == 0xFFFF) w->map[c] = nearest(pal, n, r, g, b);
+        const GifColorType* q = &pal[w->map[c]];
+        double h = w->hist[c];
+        double mr = w->sum[(size_t)c * 3] / h - q->Red, mg = w->sum[(size_t)c * 3 + 1] / h - q->Green,
+               mb = w->sum[(size_t)c * 3 + 2] / h - q->Blue;
+        err += h * (2.0 * mr * mr + 4.0 * mg * mg + mb * mb);
+        count += h;
+    }
+    return count > 0.0 ? err / count : 0.0;
+}
+
+/* Same source RGB at (x, y) in frame and the writer's copy of the previous frame. */
+static bool unchanged(const ak_gif_writer* w, const uint8_t* p, int x, int y) {
+    const uint8_t* q = w->prev + ((size_t)y * (size_t)w->desc.width + (size_t)x) * 4u;
+    return p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
+}
+
+static void histogram(ak_gif_writer* w, const ak_image* frame, int x0, int y0, int x1, int y1, bool skip_unchanged) {
     memset(w->hist, 0, HIST_SIZE * sizeof(uint32_t));
     memset(w->sum, 0, HIST_SIZE * 3 * sizeof(uint32_t));
-    for (int y = 0; y < H; ++y) {
-        const uint8_t* p = ak_image_pixel(frame, 0, y);
-        for (int x = 0; x < W; ++x, p += 4) {
+    for (int y = y0; y <= y1; ++y) {
+        const uint8_t* p = ak_image_pixel(frame, x0, y);
+        for (int x = x0; x <= x1; ++x, p += 4) {
+            if (skip_unchanged && unchanged(w, p, x, y)) continue;
             uint16_t c = (uint16_t)(((p[0] >> 3) << 10) | ((p[1] >> 3) << 5) | (p[2] >> 3));
             w->hist[c]++;
             w->sum[(size_t)c * 3] += p[0];
@@ -288,14 +322,61 @@ ak_result ak_gif_writer_add_frame(ak_gif_writer* w, const ak_image* frame) {
             w->sum[(size_t)c * 3 + 2] += p[2];
         }
     }
+}
+
+ak_result ak_gif_writer_add_frame(ak_gif_writer* w, const ak_image* frame) {
+    if (!w || !frame || !frame->pixels) return AK_ERR_NULL_ARG;
+    if (!image_valid(frame) || frame->width != w->desc.width || frame->height != w->desc.height) return AK_ERR_BAD_ARG;
+    if (w->failed) return AK_ERR_IO;
+    const int W = frame->width, H = frame->height;
+    const bool delta = w->prev && w->frames > 0;
+    /* the rectangle that changed since the previous frame (all of it for the first) */
+    int x0 = 0, y0 = 0, x1 = W - 1, y1 = H - 1;
+    if (delta) {
+        x0 = W, y0 = H, x1 = -1, y1 = -1;
+        for (int y = 0; y < H; ++y) {
+            const uint8_t* p = ak_image_pixel(frame, 0, y);
+            for (int x = 0; x < W; ++x, p += 4) {
+                if (unchanged(w, p, x, y)) continue;
+                if (x < x0) x0 = x;
+                if (x > x1) x1 = x;
+                if (y < y0) y0 = y;
+                y1 = y;
+            }
+        }
+        if (x1 < 0) x0 = y0 = x1 = y1 = 0; /* nothing changed: one transparent pixel keeps the timing */
+    }
+    const int RW = x1 - x0 + 1, RH = y1 - y0 + 1;
     GifColorType palette[256];
-    memset(palette, 0, sizeof palette);
-    int n = median_cut(w, palette);
-    for (size_t i = 0; i < HIST_SIZE; ++i) w->map[i] = 0xFFFF;
+    int n;
+    const int transparent = delta ? 255 : NO_TRANSPARENT_COLOR;
+    histogram(w, frame, x0, y0, x1, y1, delta);
+    if (delta && hist_error(w, w->pal, w->pal_n) <= 2.0 * w->pal_err + 100.0) {
+        /* the palette in use still fits what changed: keep it, so a pixel that returns to an
+         * earlier colour gets the index it had (no patchwork of palettes on smooth areas) */
+        memcpy(palette, w->pal, sizeof palette);
+        n = w->pal_n;
+    } else {
+        /* a palette for the whole frame (255 entries when later frames need a transparent one) */
+        if (delta) histogram(w, frame, 0, 0, W - 1, H - 1, false);
+        memset(palette, 0, sizeof palette);
+        n = median_cut(w, palette, w->prev ? 255 : 256);
+        for (size_t i = 0; i < HIST_SIZE; ++i) w->map[i] = 0xFFFF;
+        if (w->prev) {
+            memcpy(w->pal, palette, sizeof palette);
+            w->pal_n = n;
+            w->pal_err = hist_error(w, palette, n);
+        }
+    }
     static const int bayer[4][4] = {{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}};
-    for (int y = 0; y < H; ++y) {
-        const uint8_t* p = ak_image_pixel(frame, 0, y);
-        for (int x = 0; x < W; ++x, p += 4) {
+    for (int y = y0; y <= y1; ++y) {
+        const uint8_t* p = ak_image_pixel(frame, x0, y);
+        uint8_t* out = w->indices + (size_t)(y - y0) * (size_t)RW;
+        for (int x = x0; x <= x1; ++x, p += 4) {
+            if (delta && unchanged(w, p, x, y)) {
+                out[x - x0] = (uint8_t)transparent;
+                continue;
+            }
             int d = w->desc.no_dither ? 0 : (bayer[y & 3][x & 3] - 8) / 2; /* -4..3 */
             int r = p[0] + d, g = p[1] + d, b = p[2] + d;
             r = r < 0 ? 0 : (r > 255 ? 255 : r);
@@ -303,21 +384,31 @@ ak_result ak_gif_writer_add_frame(ak_gif_writer* w, const ak_image* frame) {
             b = b < 0 ? 0 : (b > 255 ? 255 : b);
             uint16_t c = (uint16_t)(((r >> 3) << 10) | ((g >> 3) << 5) | (b >> 3));
             if (w->map[c] == 0xFFFF) w->map[c] = nearest(palette, n, (r & ~7) | 4, (g & ~7) | 4, (b & ~7) | 4);
-            w->indices[(size_t)y * (size_t)W + (size_t)x] = (uint8_t)w->map[c];
+            out[x - x0] = (uint8_t)w->map[c];
         }
     }
+    if (w->prev)
+        for (int y = 0; y < H; ++y) memcpy(w->prev + (size_t)y * (size_t)W * 4u, ak_image_pixel(frame, 0, y), (size_t)W * 4u);
     GraphicsControlBlock gcb;
     memset(&gcb, 0, sizeof gcb);
     gcb.DisposalMode = DISPOSE_DO_NOT;
     gcb.DelayTime = w->desc.delay_cs;
-    gcb.TransparentColor = NO_TRANSPARENT_COLOR;
+    if (w->desc.frame_rate > 0.0f) {
+        /* frame k ends at round(100 k / rate): delays alternate around 100 / rate */
+        double end = floor(100.0 * (double)(w->frames + 1) / (double)w->desc.frame_rate + 0.5);
+        int delay = (int)(end - w->shown_cs);
+        if (delay < 1) delay = 1;
+        gcb.DelayTime = delay;
+        w->shown_cs += delay;
+    }
+    gcb.TransparentColor = transparent;
     GifByteType ext[4];
     size_t len = EGifGCBToExtension(&gcb, ext);
     ColorMapObject* cm = GifMakeMapObject(256, palette);
     if (!cm) return AK_ERR_NO_MEMORY;
     bool ok = EGifPutExtension(w->gif, GRAPHICS_EXT_FUNC_CODE, (int)len, ext) == GIF_OK;
-    ok = ok && EGifPutImageDesc(w->gif, 0, 0, W, H, false, cm) == GIF_OK;
-    for (int y = 0; ok && y < H; ++y) ok = EGifPutLine(w->gif, w->indices + (size_t)y * (size_t)W, W) == GIF_OK;
+    ok = ok && EGifPutImageDesc(w->gif, x0, y0, RW, RH, false, cm) == GIF_OK;
+    for (int y = 0; ok && y < RH; ++y) ok = EGifPutLine(w->gif, w->indices + (size_t)y * (size_t)RW, RW) == GIF_OK;
     GifFreeMapObject(cm);
     if (!ok) {
         w->failed = true;

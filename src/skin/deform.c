@@ -1,6 +1,7 @@
 /* The skinning job: validation, per-joint preparation, the scalar reference kernels for LBS,
- * DQS and CoR, thread split and face-normal recomputation. The AVX2 kernel is in
- * deform_avx2.c and is only used for configurations it handles (see akp_skin_range_avx2). */
+ * DQS and CoR, thread split and face-normal recomputation. The AVX-512 and AVX2 kernels are in
+ * deform_avx512.c and deform_avx2.c and are only used for configurations they handle (see
+ * akp_skin_range_avx512 and akp_skin_range_avx2); the job's simd_limit caps the choice. */
 #include <pthread.h> /* thread_count > 1 */
 
 #include "simd.h"
@@ -546,7 +547,8 @@ static ak_result validate_job(const ak_skin_job* job, uint32_t screen_threads) {
         return AK_ERR_NULL_ARG;
     if (job->palette.count == 0) return AK_ERR_NULL_ARG;
     const uint32_t k = job->influence_count;
-    if ((unsigned)job->method >= AK_SKIN_METHOD_COUNT || k == 0 || k > AK_MAX_INFLUENCES || job->thread_count > 64)
+    if ((unsigned)job->method >= AK_SKIN_METHOD_COUNT || k == 0 || k > AK_MAX_INFLUENCES || job->thread_count > 64 ||
+        (unsigned)job->simd_limit >= AK_SKIN_SIMD_COUNT)
         return AK_ERR_BAD_ARG;
     if (!stride_ok(job->positions.stride, 12) || !stride_ok(job->normals.stride, 12) ||
         !stride_ok(job->tangents.stride, 16) || !stride_ok(job->cor_centers.stride, 12) ||
@@ -576,6 +578,21 @@ static ak_result validate_job(const ak_skin_job* job, uint32_t screen_threads) {
 }
 
 ak_result ak_skin_job_validate(const ak_skin_job* job) { return validate_job(job, 1); }
+
+/* True when every palette matrix's linear part is a rotation: columns of unit length and
+ * orthogonal within 1e-5, determinant > 0 (then its cofactor matrix is itself, so a unit
+ * normal maps to a unit normal). */
+static bool palette_rigid(const ak_mat4* pal, size_t count) {
+    for (size_t j = 0; j < count; ++j) {
+        const float* m = pal[j].m;
+        ak_vec3 c[3] = {ak_vec3_make(m[0], m[1], m[2]), ak_vec3_make(m[4], m[5], m[6]), ak_vec3_make(m[8], m[9], m[10])};
+        for (int a = 0; a < 3; ++a)
+            for (int b = a; b < 3; ++b)
+                if (!(fabsf(ak_vec3_dot(c[a], c[b]) - (a == b ? 1.0f : 0.0f)) <= 1e-5f)) return false;
+        if (!(ak_vec3_dot(c[0], ak_vec3_cross(c[1], c[2])) > 0.0f)) return false;
+    }
+    return true;
+}
 
 static akp_skin_ctx make_ctx(const ak_skin_job* job, const akp_skin_joint* prep, bool any_stretch) {
     akp_skin_ctx c;
@@ -612,13 +629,17 @@ static akp_skin_ctx make_ctx(const ak_skin_job* job, const akp_skin_joint* prep,
 typedef struct range_task {
     const akp_skin_ctx* ctx;
     size_t begin, end;
-    bool simd;
+    ak_skin_simd simd; /* the fastest kernel allowed: SCALAR, AVX2 or AVX512 */
 } range_task;
 
+/* Each kernel returns false (writing nothing) for a configuration or CPU it does not handle;
+ * the next slower one then runs. */
 static void* range_thread(void* arg) {
     const range_task* t = (const range_task*)arg;
-    if (t->begin < t->end && !(t->simd && akp_skin_range_avx2(t->ctx, t->begin, t->end)))
-        akp_skin_range_scalar(t->ctx, t->begin, t->end);
+    if (t->begin >= t->end) return NULL;
+    if (t->simd >= AK_SKIN_SIMD_AVX512 && akp_skin_range_avx512(t->ctx, t->begin, t->end)) return NULL;
+    if (t->simd >= AK_SKIN_SIMD_AVX2 && akp_skin_range_avx2(t->ctx, t->begin, t->end)) return NULL;
+    akp_skin_range_scalar(t->ctx, t->begin, t->end);
     return NULL;
 }
 
@@ -672,10 +693,14 @@ ak_result ak_skin_job_run(const ak_skin_job* job) {
         }
     }
     akp_skin_ctx ctx = make_ctx(job, prep, any_stretch);
-    bool simd = !job->skip_simd;
+    ctx.rigid_single = job->method == AK_SKIN_LBS && job->influence_count == 1 && !ctx.do_tangents &&
+                       (!ctx.do_normals || palette_rigid(job->palette.ptr, job->palette.count));
+    ak_skin_simd level = job->simd_limit == AK_SKIN_SIMD_DEFAULT ? AK_SKIN_SIMD_AVX512 : job->simd_limit;
+    if (job->skip_simd) level = AK_SKIN_SIMD_SCALAR;
 #if defined(AK_NO_SIMD)
-    simd = false;
+    level = AK_SKIN_SIMD_SCALAR;
 #endif
+    const bool simd = level != AK_SKIN_SIMD_SCALAR;
     /* The AVX2 LBS blend loads each palette matrix as two 32-byte halves; from an array that is
      * not 64-byte aligned (malloc gives 16) half of those loads split a cache line, which cost
      * 8% (positions + normals) to 15% (positions) at 1M vertices. Small palettes are copied to
@@ -691,7 +716,7 @@ ak_result ak_skin_job_run(const ak_skin_job* job) {
     if (threads > n / 64 + 1) threads = (uint32_t)(n / 64 + 1);
     range_task tasks[64];
     size_t chunk = (n + threads - 1) / threads;
-    chunk = (chunk + 7u) & ~(size_t)7u; /* keep SIMD blocks whole */
+    chunk = (chunk + 15u) & ~(size_t)15u; /* keep SIMD blocks (8 or 16 vertices) whole */
     for (uint32_t t = 0; t < threads; ++t) {
         size_t b = (size_t)t * chunk, e = b + chunk;
         if (b > n) b = n;
@@ -699,7 +724,7 @@ ak_result ak_skin_job_run(const ak_skin_job* job) {
         tasks[t].ctx = &ctx;
         tasks[t].begin = b;
         tasks[t].end = e;
-        tasks[t].simd = simd;
+        tasks[t].simd = level;
     }
     run_tasks(range_thread, tasks, sizeof tasks[0], threads);
     if (job->normals_from_faces) normals_from_faces(job);
@@ -744,4 +769,10 @@ ak_result ak_skin_job_split(const ak_skin_job* job, size_t first_vertex, size_t 
     return AK_OK;
 }
 
-const char* ak_skin_simd_name(void) { return akp_skin_have_avx2() ? "avx2" : "scalar"; }
+const char* ak_skin_simd_name(void) {
+#if defined(AK_NO_SIMD)
+    return "scalar";
+#else
+    return akp_skin_have_avx512() ? "avx512" : akp_skin_have_avx2() ? "avx2" : "scalar";
+#endif
+}

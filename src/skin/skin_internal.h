@@ -42,6 +42,11 @@ typedef struct akp_skin_ctx {
     char *out_pos, *out_nrm, *out_tan;
     size_t out_pos_stride, out_nrm_stride, out_tan_stride;
     bool do_normals, do_tangents;
+    /* LBS with 1 influence, no tangents, and no normals or every palette matrix rigid
+     * (orthonormal linear part, det > 0, within 1e-5): the SIMD kernels may skip the blend
+     * (p' = w (M p)) and the normal's cofactor and renormalisation (n' = sign(w) R n); the
+     * results then differ from the scalar code's by float rounding */
+    bool rigid_single;
 } akp_skin_ctx;
 
 /* Deform vertices [begin, end) with the scalar reference code. */
@@ -51,6 +56,10 @@ void akp_skin_range_scalar(const akp_skin_ctx* c, size_t begin, size_t end);
 bool akp_skin_range_avx2(const akp_skin_ctx* c, size_t begin, size_t end);
 /* True when the AVX2 kernel is compiled in and the CPU supports AVX2 and FMA. */
 bool akp_skin_have_avx2(void);
+/* The same for the AVX-512 kernel (deform_avx512.c: 16 vertices per block, partial blocks
+ * masked, so it handles any range): AVX-512 F, VL, DQ, BW plus AVX2 and FMA. */
+bool akp_skin_range_avx512(const akp_skin_ctx* c, size_t begin, size_t end);
+bool akp_skin_have_avx512(void);
 
 /* Closest-point distance squared from p to the segment [a, b] (a == b allowed). */
 static inline float akp_segment_dist_sq(ak_vec3 p, ak_vec3 a, ak_vec3 b, ak_vec3* out_closest) {

@@ -2,6 +2,7 @@
 #include "cli.h"
 
 #include <ctype.h>
+#include <dirent.h> /* opendir: a rig file beside an OBJ */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -35,11 +36,14 @@ int cli_parse(const char* cmd, int argc, char** argv, const cli_opt* opts, size_
             if (opts[k].has_value) {
                 if (eq) out->values[k] = eq + 1;
                 else if (i + 1 < argc) out->values[k] = argv[++i];
-                else return cli_usage(cmd, "option '%s' needs a value", opts[k].name);
+                else return cli_usage(cmd, "option '%.*s' needs a value", (int)nlen, a);
             } else {
                 if (eq) return cli_usage(cmd, "option '%s' takes no value", opts[k].name);
                 out->values[k] = "1";
             }
+            if (out->all_count == CLI_MAX_ALL) return cli_usage(cmd, "too many options (at most %d)", CLI_MAX_ALL);
+            out->all_opt[out->all_count] = (int)k;
+            out->all_values[out->all_count++] = out->values[k];
             continue;
         }
         if (out->pos_count >= CLI_MAX_POS) return cli_usage(cmd, "too many arguments");
@@ -52,6 +56,15 @@ const char* cli_get(const cli_args* a, const cli_opt* opts, size_t opt_count, co
     for (size_t k = 0; k < opt_count && k < CLI_MAX_OPTS; ++k)
         if (strcmp(opts[k].name, name) == 0) return a->values[k];
     return NULL;
+}
+
+size_t cli_get_all(const cli_args* a, const cli_opt* opts, size_t opt_count, const char* name, const char** out,
+                   size_t cap) {
+    size_t n = 0;
+    for (int i = 0; i < a->all_count; ++i)
+        if ((size_t)a->all_opt[i] < opt_count && strcmp(opts[a->all_opt[i]].name, name) == 0 && n < cap)
+            out[n++] = a->all_values[i];
+    return n;
 }
 
 int cli_fail(const char* cmd, const char* fmt, ...) {
@@ -79,7 +92,8 @@ bool cli_parse_float(const char* s, float* out) {
     char* end = NULL;
     errno = 0;
     double v = strtod(s, &end);
-    if (errno || *end != '\0' || !isfinite(v) || fabs(v) > 3.0e38) return false;
+    /* ERANGE on underflow (a subnormal or a value rounding to 0) is still a number */
+    if ((errno && !(errno == ERANGE && fabs(v) < 1.0)) || *end != '\0' || !isfinite(v) || fabs(v) > 3.0e38) return false;
     *out = (float)v;
     return true;
 }
@@ -151,6 +165,58 @@ int cli_load_scene(const char* cmd, const char* spec, ak_scene** out) {
         return cli_fail(cmd, "%s: %s", spec, diag.message[0] ? diag.message : ak_result_string(r));
     }
     return CLI_OK;
+}
+
+/* Node of the scene mesh whose morph range starts at morph index idx, or -1. */
+static int morph_node(const ak_scene* s, uint32_t idx) {
+    for (size_t m = 0, off = 0; m < s->mesh_count; ++m) {
+        size_t t = s->meshes[m].mesh ? s->meshes[m].mesh->morph_target_count : 0;
+        if (t && off == idx) return s->meshes[m].node;
+        off += t;
+    }
+    return -1;
+}
+
+bool cli_clip_channel_repeats(const ak_scene* s, const ak_clip* clip, size_t i) {
+    if (ak_clip_channel_target(clip, i) != AK_CHANNEL_MORPH_WEIGHTS) return false;
+    int node = morph_node(s, ak_clip_channel_index(clip, i));
+    if (node < 0) return false;
+    for (size_t k = 0; k < i; ++k)
+        if (ak_clip_channel_target(clip, k) == AK_CHANNEL_MORPH_WEIGHTS &&
+            morph_node(s, ak_clip_channel_index(clip, k)) == node)
+            return true;
+    return false;
+}
+
+size_t cli_clip_file_channel_count(const ak_scene* s, const ak_clip* clip) {
+    size_t n = ak_clip_channel_count(clip), count = 0;
+    for (size_t i = 0; i < n; ++i) count += !cli_clip_channel_repeats(s, clip, i);
+    return count;
+}
+
+void cli_obj_rig_note(const char* cmd, const char* path) {
+    /* look for a MakeHuman rig beside the file: FOLDER/x.mhskel */
+    char dir[1024];
+    const char* slash = strrchr(path, '/');
+    size_t n = slash ? (size_t)(slash - path) : 1;
+    if (n >= sizeof dir) return;
+    if (slash) memcpy(dir, path, n);
+    else dir[0] = '.';
+    dir[n] = '\0';
+    char rig[256] = "";
+    DIR* d = opendir(dir);
+    for (struct dirent* e = d ? readdir(d) : NULL; e; e = readdir(d))
+        if (cli_has_ext(e->d_name, ".mhskel") && strlen(e->d_name) < sizeof rig) {
+            strcpy(rig, e->d_name);
+            break;
+        }
+    if (d) closedir(d);
+    if (rig[0])
+        fprintf(stderr, "note: %s: OBJ is geometry only; the MakeHuman rig beside it (%s) is not read, so the model "
+                        "has no skeleton or skin and stays in its rest pose\n", path, rig);
+    else
+        fprintf(stderr, "note: %s: OBJ is geometry only (no skeleton, skin or animation)\n", path);
+    (void)cmd;
 }
 
 void cli_json_string(FILE* f, const char* s) {

@@ -27,14 +27,23 @@ typedef struct cli_args {
     const char* pos[CLI_MAX_POS];     /* positional arguments */
     int pos_count;
     bool help;                        /* --help / -h seen */
+    /* every option occurrence in order (repeatable options such as render --mesh) */
+#define CLI_MAX_ALL 64
+    const char* all_values[CLI_MAX_ALL];
+    int all_opt[CLI_MAX_ALL];
+    int all_count;
 } cli_args;
 
 /* Parse argv (after the command word) against opts. Prints a usage error and returns
- * CLI_BAD_USAGE on an unknown option, a missing value or too many positionals. */
+ * CLI_BAD_USAGE on an unknown option, a missing value (naming the option as typed), too many
+ * positionals or more than CLI_MAX_ALL options. */
 int cli_parse(const char* cmd, int argc, char** argv, const cli_opt* opts, size_t opt_count, cli_args* out);
 /* Value of option name ("--time"), or NULL. */
 const char* cli_get(const cli_args* a, const cli_opt* opts, size_t opt_count, const char* name);
 #define CLI_GET(args, name) cli_get((args), opts, sizeof(opts) / sizeof(opts[0]), (name))
+/* Every value given to a repeatable option, in order (at most cap); returns the count. */
+size_t cli_get_all(const cli_args* a, const cli_opt* opts, size_t opt_count, const char* name, const char** out,
+                   size_t cap);
 
 /* "animkit CMD: message" on stderr; returns CLI_BAD_INPUT. */
 int cli_fail(const char* cmd, const char* fmt, ...)
@@ -62,6 +71,19 @@ bool cli_has_ext(const char* path, const char* ext);
 /* Load FILE or builtin:NAME. On failure prints "animkit CMD: SPEC: problem" and returns
  * CLI_BAD_INPUT. */
 int cli_load_scene(const char* cmd, const char* spec, ak_scene** out);
+
+/* Channels as the file declares them. The glTF reader splits a weights channel on a node whose
+ * mesh has several primitives into one channel per primitive (each writes that primitive's morph
+ * range, with the same keys); cli_clip_channel_repeats is true for the second and later of those,
+ * and cli_clip_file_channel_count counts each file channel once. info and curves use both. */
+bool cli_clip_channel_repeats(const ak_scene* s, const ak_clip* clip, size_t channel_index);
+size_t cli_clip_file_channel_count(const ak_scene* s, const ak_clip* clip);
+/* "s" when n != 1, else "": "%zu chart%s". */
+static inline const char* cli_plural(size_t n) { return n == 1 ? "" : "s"; }
+
+/* "note: PATH: OBJ is geometry only ..." on stderr, naming a MakeHuman .mhskel rig beside the
+ * file when there is one (animkit does not read it). */
+void cli_obj_rig_note(const char* cmd, const char* path);
 
 /* JSON string literal with escapes. */
 void cli_json_string(FILE* f, const char* s);
@@ -97,6 +119,12 @@ typedef struct cli_poser {
     ak_vec3** cor_centers;    /* per mesh, computed on first CoR use; NULL until then */
     uint8_t* skin_scratch;    /* DQS/CoR scratch for the largest skin, allocated once */
     size_t skin_scratch_size;
+    /* Set by the caller after init: unskinned meshes without stored normals get normals shared
+     * by the vertices at one position (ak_normals_compute_welded: smooth across an OBJ's
+     * unwelded seams) instead of per vertex (faceted, glTF's rule for meshes without normals). */
+    bool weld_normals;
+    uint32_t* weld_scratch; /* allocated on first use */
+    size_t weld_scratch_count;
 } cli_poser;
 
 bool cli_method_parse(const char* s, cli_method* out);
@@ -117,9 +145,17 @@ int cmd_info(int argc, char** argv);
 int cmd_export(int argc, char** argv);
 int cmd_render(int argc, char** argv);
 int cmd_curves(int argc, char** argv);
+/* cmd_curves without its "wrote ..." line (demo prints its own list). */
+int cli_curves_run(int argc, char** argv, bool quiet);
 int cmd_weights(int argc, char** argv);
 int cmd_skin(int argc, char** argv);
 int cmd_ik(int argc, char** argv);
+int cmd_noise(int argc, char** argv);
+int cmd_terrain(int argc, char** argv);
+int cmd_particles(int argc, char** argv);
+int cmd_boids(int argc, char** argv);
+int cmd_view(int argc, char** argv);
+int cmd_cloth(int argc, char** argv);
 int cmd_retarget(int argc, char** argv);
 
 #endif

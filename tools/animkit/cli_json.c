@@ -32,6 +32,10 @@ bool cli_json_fail(cli_json* j, const char* path, const char* key, const char* f
         snprintf(j->message, sizeof j->message, "%.150s: %.120s: %.230s", file, where, what);
     else
         snprintf(j->message, sizeof j->message, "%.150s: %.350s", file, what);
+    /* Keys and strings come from the file: a control character in one must not split the
+     * one-line message (or reach a terminal). */
+    for (char* c = j->message; *c; ++c)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = '?';
     return false;
 }
 

@@ -1,4 +1,5 @@
 /* animkit curves: a clip's animation curves as value-versus-time charts (a read-only curve editor). */
+#include <ctype.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -6,11 +7,18 @@
 #include "render.h"
 
 static const char* const usage =
-    "usage: animkit curves FILE|builtin:NAME --clip C [--joint NAME] [--size WxH] -o OUT.png\n"
+    "usage: animkit curves FILE|builtin:NAME --clip C [--joint NAME] [--channel LIST] [--page P]\n"
+    "                      [--size WxH] -o OUT.png\n"
     "Plot clip C's channels: one chart per channel (translation, rotation quaternion x y z w,\n"
     "scale, morph weights), time on x, value on y, one colour per component, with the keys\n"
-    "marked and their in/out tangents drawn as handles. --joint keeps only that joint's\n"
-    "channels. At most 24 charts; --size is the size of one chart (default 420x260).\n";
+    "marked and their in/out tangents drawn as handles (markers only where keys are at least\n"
+    "8 pixels apart; a dense capture is drawn as its line). Charts are numbered #0, #1, ... as\n"
+    "the file declares its channels. A page holds 24 charts; --size is the size of one chart\n"
+    "(default 420x260).\n"
+    "  --joint NAME    only that joint's channels\n"
+    "  --channel LIST  only these charts: numbers and ranges (3,7-9) and joint names, a name\n"
+    "                  with .translation, .rotation or .scale for one channel (Hips.rotation)\n"
+    "  --page P        page P (from 1) of the selected charts; the title says how many pages\n";
 
 #define MAX_CHARTS 24
 #define SAMPLES 240
@@ -25,8 +33,18 @@ static const char* target_name(ak_channel_target t) {
     }
 }
 
-/* Draw channel c of clip into img. */
-static ak_result draw_channel(const ak_scene* s, const ak_clip* clip, size_t c, const ak_image* img) {
+/* Name of the mesh whose morph range starts at morph index idx ("" when none). */
+static const char* morph_mesh_name(const ak_scene* s, uint32_t idx) {
+    for (size_t m = 0, off = 0; m < s->mesh_count; ++m) {
+        size_t t = s->meshes[m].mesh ? s->meshes[m].mesh->morph_target_count : 0;
+        if (t && off == idx) return s->meshes[m].mesh->name;
+        off += t;
+    }
+    return "";
+}
+
+/* Draw channel c of clip (chart number shown_index) into img. */
+static ak_result draw_channel(const ak_scene* s, const ak_clip* clip, size_t c, size_t shown_index, const ak_image* img) {
     const ak_track* tr = ak_clip_channel_track(clip, c);
     uint32_t comps = ak_track_component_count(tr);
     if (comps > 8) comps = 8;
@@ -80,8 +98,11 @@ static ak_result draw_channel(const ak_scene* s, const ak_clip* clip, size_t c, 
     char title[160];
     ak_channel_target tg = ak_clip_channel_target(clip, c);
     uint32_t idx = ak_clip_channel_index(clip, c);
-    const char* who = (tg <= AK_CHANNEL_SCALE && s->skeleton) ? ak_skeleton_joint_name(s->skeleton, idx) : "";
-    snprintf(title, sizeof title, "%s %s (%s)", who, target_name(tg), ak_interp_name(ak_track_interp(tr)));
+    const char* who = (tg <= AK_CHANNEL_SCALE && s->skeleton) ? ak_skeleton_joint_name(s->skeleton, idx)
+                      : tg == AK_CHANNEL_MORPH_WEIGHTS ? morph_mesh_name(s, idx)
+                                                       : "";
+    snprintf(title, sizeof title, "#%zu %s%s%s (%s)", shown_index, who, who[0] ? " " : "", target_name(tg),
+             ak_interp_name(ak_track_interp(tr)));
     ak_view_plot plot = {.series = series, .series_count = comps, .title = title, .x_label = "time (s)"};
     r = ak_view_plot_draw(&plot, img);
 done:
@@ -89,9 +110,59 @@ done:
     return r;
 }
 
-int cmd_curves(int argc, char** argv) {
-    static const cli_opt opts[] = {{"--clip", "-c", true}, {"--joint", "-j", true}, {"--size", NULL, true},
-                                   {"--output", "-o", true}};
+/* Mark the charts LIST names in sel[count] (chart k is file channel chan[k]). Returns CLI_OK,
+ * or prints why not: bad usage for a malformed item, bad input for a number or joint the clip
+ * does not have. */
+static int select_channels(const char* file, const ak_scene* s, const ak_clip* clip, const size_t* chan, size_t count,
+                           const char* list, bool* sel) {
+    char buf[1024];
+    if (strlen(list) >= sizeof buf) return cli_usage("curves", "--channel list is too long");
+    strcpy(buf, list);
+    char* save = NULL;
+    for (char* tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        if (isdigit((unsigned char)tok[0])) {
+            long lo, hi;
+            char* dash = strchr(tok, '-');
+            if (dash) *dash = '\0';
+            if (!cli_parse_int(tok, 0, 1000000000L, &lo) || (dash && !cli_parse_int(dash + 1, 0, 1000000000L, &hi)))
+                return cli_usage("curves", "--channel item '%s%s%s' is not a number or range A-B", tok, dash ? "-" : "",
+                                 dash ? dash + 1 : "");
+            if (!dash) hi = lo;
+            if (hi < lo) return cli_usage("curves", "--channel range %ld-%ld runs backwards", lo, hi);
+            if ((size_t)hi >= count)
+                return cli_fail("curves", "%s: clip '%s' has %zu chart%s (#0-#%zu), no #%ld", file, ak_clip_name(clip), count,
+                                cli_plural(count), count - 1, hi);
+            for (long k = lo; k <= hi; ++k) sel[k] = true;
+            continue;
+        }
+        /* JOINT or JOINT.translation|rotation|scale */
+        int target = -1;
+        char* dot = strrchr(tok, '.');
+        if (dot) {
+            if (strcmp(dot + 1, "translation") == 0) target = AK_CHANNEL_TRANSLATION;
+            else if (strcmp(dot + 1, "rotation") == 0) target = AK_CHANNEL_ROTATION;
+            else if (strcmp(dot + 1, "scale") == 0) target = AK_CHANNEL_SCALE;
+            if (target >= 0) *dot = '\0';
+        }
+        int j = s->skeleton ? ak_skeleton_find_joint(s->skeleton, tok) : -1;
+        if (j < 0) return cli_fail("curves", "%s: --channel: no joint named '%s'", file, tok);
+        bool any = false;
+        for (size_t k = 0; k < count; ++k) {
+            ak_channel_target tg = ak_clip_channel_target(clip, chan[k]);
+            if (tg > AK_CHANNEL_SCALE || (int)ak_clip_channel_index(clip, chan[k]) != j || (target >= 0 && (int)tg != target))
+                continue;
+            sel[k] = any = true;
+        }
+        if (!any)
+            return cli_fail("curves", "%s: clip '%s' does not animate %s%s%s", file, ak_clip_name(clip), tok,
+                            target >= 0 ? "." : "", target >= 0 ? target_name((ak_channel_target)target) : "");
+    }
+    return CLI_OK;
+}
+
+int cli_curves_run(int argc, char** argv, bool quiet) {
+    static const cli_opt opts[] = {{"--clip", "-c", true},    {"--joint", "-j", true}, {"--size", NULL, true},
+                                   {"--output", "-o", true},  {"--channel", NULL, true}, {"--page", NULL, true}};
     cli_args a;
     int rc = cli_parse("curves", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
     if (rc) return rc;
@@ -107,18 +178,24 @@ int cmd_curves(int argc, char** argv) {
     int w = 420, h = 260;
     if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &w, &h))
         return cli_usage("curves", "--size '%s' is not WxH", CLI_GET(&a, "--size"));
+    long page = 0;
+    if (CLI_GET(&a, "--page") && !cli_parse_int(CLI_GET(&a, "--page"), 1, 1000000, &page))
+        return cli_usage("curves", "--page '%s' is not a page number (from 1)", CLI_GET(&a, "--page"));
     ak_scene* s = NULL;
     if ((rc = cli_load_scene("curves", a.pos[0], &s))) return rc;
     ak_image charts[MAX_CHARTS];
     ak_view_panel panels[MAX_CHARTS];
     ak_image composed = {0};
     size_t count = 0;
+    size_t* chan = NULL;
+    bool* sel = NULL;
     memset(charts, 0, sizeof charts);
     int ci = ak_scene_find_clip(s, CLI_GET(&a, "--clip"));
     const char* joint = CLI_GET(&a, "--joint");
+    const char* list = CLI_GET(&a, "--channel");
     int jidx = -1;
     if (ci < 0) {
-        rc = cli_fail("curves", "%s: no clip '%s' (%zu clips)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count);
+        rc = cli_fail("curves", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count, cli_plural(s->clip_count));
         goto done;
     }
     if (joint && (jidx = s->skeleton ? ak_skeleton_find_joint(s->skeleton, joint) : -1) < 0) {
@@ -126,32 +203,60 @@ int cmd_curves(int argc, char** argv) {
         goto done;
     }
     const ak_clip* clip = s->clips[ci];
-    size_t total = 0;
-    for (size_t c = 0; c < ak_clip_channel_count(clip); ++c) {
-        ak_channel_target tg = ak_clip_channel_target(clip, c);
-        if (jidx >= 0 && (tg > AK_CHANNEL_SCALE || (int)ak_clip_channel_index(clip, c) != jidx)) continue;
-        ++total;
-        if (count == MAX_CHARTS) continue;
-        if (cli_image_alloc(&charts[count], w, h)) {
-            rc = cli_fail("curves", "out of memory");
-            goto done;
-        }
-        ak_result r = draw_channel(s, clip, c, &charts[count]);
-        if (r != AK_OK) {
-            rc = cli_fail("curves", "%s: channel %zu: %s", a.pos[0], c, ak_result_string(r));
-            goto done;
-        }
-        panels[count] = (ak_view_panel){&charts[count], NULL};
-        ++count;
+    /* charts: the file's channels (a weights channel the reader split per primitive once) */
+    size_t nch = ak_clip_channel_count(clip), file_count = 0;
+    chan = calloc(nch + 1, sizeof(size_t));
+    sel = calloc(nch + 1, sizeof(bool));
+    if (!chan || !sel) {
+        rc = cli_fail("curves", "out of memory");
+        goto done;
     }
-    if (count == 0) {
+    for (size_t c = 0; c < nch; ++c)
+        if (!cli_clip_channel_repeats(s, clip, c)) chan[file_count++] = c;
+    if (list) {
+        if ((rc = select_channels(a.pos[0], s, clip, chan, file_count, list, sel))) goto done;
+    } else {
+        for (size_t k = 0; k < file_count; ++k) sel[k] = true;
+    }
+    size_t selected = 0;
+    for (size_t k = 0; k < file_count; ++k) {
+        ak_channel_target tg = ak_clip_channel_target(clip, chan[k]);
+        if (jidx >= 0 && (tg > AK_CHANNEL_SCALE || (int)ak_clip_channel_index(clip, chan[k]) != jidx)) sel[k] = false;
+        selected += sel[k];
+    }
+    if (selected == 0) {
         rc = cli_fail("curves", "%s: clip '%s' has no channel%s%s", a.pos[0], ak_clip_name(clip), joint ? " for joint " : "",
                       joint ? joint : "");
         goto done;
     }
-    char title[200];
-    snprintf(title, sizeof title, "%s (%.3f s, %zu channel%s%s)", ak_clip_name(clip), (double)ak_clip_duration(clip),
-             total, total == 1 ? "" : "s", total > count ? ", first 24 shown" : "");
+    size_t pages = (selected + MAX_CHARTS - 1) / MAX_CHARTS;
+    if ((size_t)page > pages) {
+        rc = cli_fail("curves", "%s: --page %ld, but the %zu chart%s fill %zu page%s", a.pos[0], page, selected,
+                      cli_plural(selected), pages, cli_plural(pages));
+        goto done;
+    }
+    size_t first = (page ? (size_t)page - 1 : 0) * MAX_CHARTS, rank = 0, first_shown = 0, last_shown = 0;
+    for (size_t k = 0; k < file_count && count < MAX_CHARTS; ++k) {
+        if (!sel[k] || rank++ < first) continue;
+        if (cli_image_alloc(&charts[count], w, h)) {
+            rc = cli_fail("curves", "out of memory");
+            goto done;
+        }
+        ak_result r = draw_channel(s, clip, chan[k], k, &charts[count]);
+        if (r != AK_OK) {
+            rc = cli_fail("curves", "%s: channel %zu: %s", a.pos[0], k, ak_result_string(r));
+            goto done;
+        }
+        if (count == 0) first_shown = k;
+        last_shown = k;
+        panels[count] = (ak_view_panel){&charts[count], NULL};
+        ++count;
+    }
+    char title[240], pg[96] = "", part[48] = "";
+    if (pages > 1) snprintf(pg, sizeof pg, "; #%zu-#%zu, page %zu of %zu", first_shown, last_shown, page ? (size_t)page : 1, pages);
+    if (selected < file_count) snprintf(part, sizeof part, ", %zu selected", selected);
+    snprintf(title, sizeof title, "%s (%.3f s, %zu channel%s%s%s)", ak_clip_name(clip), (double)ak_clip_duration(clip),
+             file_count, cli_plural(file_count), part, pg);
     ak_view_panels_desc pd = {.columns = count < 3 ? (int)count : 3, .title = title, .label_scale = 1};
     int cw, ch;
     ak_view_panels_size(&pd, count, w, h, &cw, &ch);
@@ -160,10 +265,20 @@ int cmd_curves(int argc, char** argv) {
         rc = cli_fail("curves", "%s: cannot write the image", out);
         goto done;
     }
-    fprintf(stderr, "wrote %s: %zu charts\n", out, count);
+    if (!quiet) {
+        if (pages > 1)
+            fprintf(stderr, "wrote %s: %zu of %zu chart%s (#%zu-#%zu, page %zu of %zu; --page P for the others)\n", out, count,
+                    selected, cli_plural(selected), first_shown, last_shown, page ? (size_t)page : 1, pages);
+        else
+            fprintf(stderr, "wrote %s: %zu chart%s\n", out, count, cli_plural(count));
+    }
 done:
     for (size_t i = 0; i < MAX_CHARTS; ++i) free(charts[i].pixels);
     free(composed.pixels);
+    free(chan);
+    free(sel);
     ak_scene_destroy(s);
     return rc;
 }
+
+int cmd_curves(int argc, char** argv) { return cli_curves_run(argc, argv, false); }

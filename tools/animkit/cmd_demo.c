@@ -433,7 +433,7 @@ int cmd_demo(int argc, char** argv) {
         char a6[1024];
         snprintf(a6, sizeof a6, "%s/demo_curves.png", d.dir);
         char* cv[] = {a0, a1, a2, a3, a4, a5, a6};
-        rc = cmd_curves(7, cv);
+        rc = cli_curves_run(7, cv, true);
     }
     if (rc) return rc;
     printf("animkit demo: wrote to %s/\n", d.dir);

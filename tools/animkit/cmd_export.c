@@ -13,7 +13,8 @@ static const char* const usage =
     "normals: morphed, then skinned, in world space as glTF 2.0 defines it (a skinned vertex is\n"
     "sum_j w_j world(joint_j) inverseBind_j p, the mesh node's own transform ignored; an\n"
     "unskinned mesh is moved by its node's world matrix). One 'o' group per mesh primitive in\n"
-    "file order, vertices in file order. Times outside the clip clamp to its ends.\n"
+    "file order, vertices in file order. Times outside the clip clamp to its ends. A file with\n"
+    "no mesh (a BVH: skeleton and motion only) is an error: exit 1, \"no mesh to export\".\n"
     "  --bind     write every mesh's vertices as stored (bind space: no clip, no skinning,\n"
     "             no morphing, no node transform)\n"
     "  --method   skinning method (default lbs)\n";
@@ -67,12 +68,21 @@ int cmd_export(int argc, char** argv) {
 
     ak_scene* s = NULL;
     if ((rc = cli_load_scene("export", a.pos[0], &s))) return rc;
+    size_t vertices = 0;
+    for (size_t m = 0; m < s->mesh_count; ++m) vertices += s->meshes[m].mesh ? s->meshes[m].mesh->vertex_count : 0;
+    if (vertices == 0) {
+        /* an empty OBJ would look like success: a BVH is a skeleton and motion only */
+        rc = cli_fail("export", "%s: no mesh to export (only a skeleton and %zu clip%s; 'animkit render' draws them)", a.pos[0],
+                      s->clip_count, s->clip_count == 1 ? "" : "s");
+        ak_scene_destroy(s);
+        return rc;
+    }
     int clip = -1;
     const char* cname = CLI_GET(&a, "--clip");
     if (cname) {
         clip = ak_scene_find_clip(s, cname);
         if (clip < 0) {
-            rc = cli_fail("export", "%s: no clip '%s' (%zu clips)", a.pos[0], cname, s->clip_count);
+            rc = cli_fail("export", "%s: no clip '%s' (%zu clip%s)", a.pos[0], cname, s->clip_count, cli_plural(s->clip_count));
             ak_scene_destroy(s);
             return rc;
         }
@@ -93,7 +103,7 @@ int cmd_export(int argc, char** argv) {
     } else {
         rc = cli_fail("export", "%s: cannot pose: %s", a.pos[0], ak_result_string(r));
     }
-    if (!rc) fprintf(stderr, "wrote %s (%zu meshes)\n", out, s->mesh_count);
+    if (!rc) fprintf(stderr, "wrote %s (%zu mesh%s)\n", out, s->mesh_count, s->mesh_count == 1 ? "" : "es");
     cli_poser_free(&p);
     ak_scene_destroy(s);
     return rc;

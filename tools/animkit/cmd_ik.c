@@ -145,7 +145,7 @@ int cmd_ik(int argc, char** argv) {
     if (CLI_GET(&a, "--clip")) {
         clip = ak_scene_find_clip(s, CLI_GET(&a, "--clip"));
         if (clip < 0) {
-            rc = cli_fail("ik", "%s: no clip '%s' (%zu clips)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count);
+            rc = cli_fail("ik", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count, s->clip_count == 1 ? "" : "s");
             goto done;
         }
     }

@@ -52,37 +52,6 @@ static void print_tree(const ak_scene* s, const int* list, const int* parent, si
     }
 }
 
-/* Channels as the file declares them. The glTF reader splits a weights channel on a node
- * whose mesh has several primitives into one channel per primitive (each writes that
- * primitive's morph range); those count once, as the file's one channel. */
-static size_t file_channel_count(const ak_scene* s, const ak_clip* clip) {
-    size_t n = ak_clip_channel_count(clip), count = 0;
-    for (size_t i = 0; i < n; ++i) {
-        if (ak_clip_channel_target(clip, i) != AK_CHANNEL_MORPH_WEIGHTS) {
-            ++count;
-            continue;
-        }
-        /* the node of the scene mesh whose morph range starts at this channel's index */
-        int node = -1;
-        for (size_t m = 0, off = 0; m < s->mesh_count; ++m) {
-            size_t t = s->meshes[m].mesh ? s->meshes[m].mesh->morph_target_count : 0;
-            if (t && off == ak_clip_channel_index(clip, i)) node = s->meshes[m].node;
-            off += t;
-        }
-        bool seen = false;
-        for (size_t k = 0; k < i && node >= 0 && !seen; ++k) {
-            if (ak_clip_channel_target(clip, k) != AK_CHANNEL_MORPH_WEIGHTS) continue;
-            for (size_t m = 0, off = 0; m < s->mesh_count; ++m) {
-                size_t t = s->meshes[m].mesh ? s->meshes[m].mesh->morph_target_count : 0;
-                if (t && off == ak_clip_channel_index(clip, k) && s->meshes[m].node == node) seen = true;
-                off += t;
-            }
-        }
-        if (!seen) ++count;
-    }
-    return count;
-}
-
 int cmd_info(int argc, char** argv) {
     static const cli_opt opts[] = {{"--json", NULL, false}};
     cli_args a;
@@ -95,6 +64,7 @@ int cmd_info(int argc, char** argv) {
     if (a.pos_count != 1) return cli_usage("info", "expected one FILE or builtin:NAME");
     ak_scene* s = NULL;
     if ((rc = cli_load_scene("info", a.pos[0], &s))) return rc;
+    if (cli_has_ext(a.pos[0], ".obj")) cli_obj_rig_note("info", a.pos[0]);
     size_t n = ak_scene_joint_count(s);
     int* list = calloc(n + 1, sizeof(int));
     int* parent = calloc(n + 1, sizeof(int));
@@ -134,12 +104,12 @@ int cmd_info(int argc, char** argv) {
             printf("{\"name\": ");
             cli_json_string(stdout, ak_clip_name(s->clips[c]));
             printf(", \"duration\": %.9g, \"channels\": %zu}", (double)ak_clip_duration(s->clips[c]),
-                   file_channel_count(s, s->clips[c]));
+                   cli_clip_file_channel_count(s, s->clips[c]));
         }
         printf("]}\n");
     } else {
         printf("%s\n", s->name);
-        printf("skeleton: %zu joints (%zu nodes)\n", count, n);
+        printf("skeleton: %zu joint%s (%zu node%s)\n", count, cli_plural(count), n, cli_plural(n));
         print_tree(s, list, parent, count, -1, 0);
         printf("meshes: %zu\n", s->mesh_count);
         for (size_t m = 0; m < s->mesh_count; ++m) {
@@ -154,9 +124,11 @@ int cmd_info(int argc, char** argv) {
             printf("\n");
         }
         printf("clips: %zu\n", s->clip_count);
-        for (size_t c = 0; c < s->clip_count; ++c)
-            printf("  %-24s %8.4f s  %zu channels\n", ak_clip_name(s->clips[c])[0] ? ak_clip_name(s->clips[c]) : "(unnamed)",
-                   (double)ak_clip_duration(s->clips[c]), file_channel_count(s, s->clips[c]));
+        for (size_t c = 0; c < s->clip_count; ++c) {
+            size_t nch = cli_clip_file_channel_count(s, s->clips[c]);
+            printf("  %-24s %8.4f s  %zu channel%s\n", ak_clip_name(s->clips[c])[0] ? ak_clip_name(s->clips[c]) : "(unnamed)",
+                   (double)ak_clip_duration(s->clips[c]), nch, nch == 1 ? "" : "s");
+        }
     }
     free(list);
     free(parent);

@@ -13,7 +13,9 @@ static const char* const usage =
     "heat diffusion (Baran & Popovic 2007). Keeps the k largest influences (default 4).\n"
     "  OUT.json  {\"vertex_count\", \"influence_count\", \"joints\": [names of skin slots],\n"
     "             \"indices\": [...], \"weights\": [...]} vertex-major\n"
-    "  OUT.png   a heatmap of --bone's weights (blue 0 -> red 1) on the model\n"
+    "  OUT.png   with --bone, a heatmap of that bone's weights (blue 0 -> red 1) on the model;\n"
+    "            without, every bone's region (the vertices it weighs most) in its own colour,\n"
+    "            named in a legend\n"
     "  OUT (any other name)  the binary AKWT format documented in skin.h\n"
     "  --power   distance exponent n (default 4)\n";
 
@@ -103,7 +105,8 @@ int cmd_weights(int argc, char** argv) {
     float* weights = NULL;
     ak_skin_bone* bones = NULL;
     if ((size_t)mesh_index >= s->mesh_count) {
-        rc = cli_fail("weights", "%s: no mesh %ld (%zu meshes)", a.pos[0], mesh_index, s->mesh_count);
+        rc = cli_fail("weights", "%s: no mesh %ld (%zu mesh%s)", a.pos[0], mesh_index, s->mesh_count,
+                      s->mesh_count == 1 ? "" : "es");
         goto done;
     }
     const ak_scene_mesh* sm = &s->meshes[mesh_index];
@@ -123,8 +126,6 @@ int cmd_weights(int argc, char** argv) {
             rc = cli_fail("weights", "%s: no joint named '%s' in the skin", a.pos[0], bone_name);
             goto done;
         }
-    } else if (png) {
-        bone_name = ak_skeleton_joint_name(s->skeleton, (size_t)skin->joints[0]);
     }
     const ak_mesh* mesh = sm->mesh;
     size_t vc = mesh->vertex_count;
@@ -151,8 +152,20 @@ int cmd_weights(int argc, char** argv) {
         rc = cli_fail("weights", "%s: %s", a.pos[0], ak_result_string(r));
         goto done;
     }
-    if (png) {
+    if (png && bone_name) {
         rc = cli_render_weights_png(out, s, (size_t)mesh_index, joints, weights, (uint32_t)k, slot, bone_name);
+    } else if (png) {
+        const char** names = calloc(skin->joint_count + 1, sizeof(char*));
+        if (!names) {
+            rc = cli_fail("weights", "out of memory");
+            goto done;
+        }
+        for (size_t q = 0; q < skin->joint_count; ++q) names[q] = ak_skeleton_joint_name(s->skeleton, (size_t)skin->joints[q]);
+        rc = cli_render_bones_png(out, s, (size_t)mesh_index, joints, weights, (uint32_t)k, skin->joint_count, names);
+        free(names);
+        if (rc == CLI_OK)
+            fprintf(stderr, "%s: no --bone: each bone's dominant region in its own colour, named in the legend "
+                            "(--bone NAME shows one bone's weights as a heatmap)\n", out);
     } else if (cli_has_ext(out, ".json")) {
         rc = write_json(out, s, skin, vc, (uint32_t)k, joints, weights);
     } else {

@@ -19,6 +19,12 @@ static const command commands[] = {
     {"weights", cmd_weights, "compute automatic skin weights (inverse distance or bone heat)"},
     {"skin", cmd_skin, "compare LBS, DQS and CoR skinning: volume and bulge"},
     {"ik", cmd_ik, "solve inverse kinematics for a joint chain"},
+    {"noise", cmd_noise, "evaluate Perlin, simplex, value or Worley noise (or a fractal sum) at a point"},
+    {"terrain", cmd_terrain, "generate a fractal terrain: OBJ, 16-bit PNG heightmap, render or GIF flight"},
+    {"particles", cmd_particles, "simulate a particle system (scene file or preset) to JSON, PNG or GIF"},
+    {"boids", cmd_boids, "flocking: Reynolds boids with obstacles and predators (JSON, PNG, GIF)"},
+    {"view", cmd_view, "interactive viewer: play clips, compare skinning, drag IK targets (--headless, --script)"},
+    {"cloth", cmd_cloth, "simulate cloth (XPBD or mass-spring): flag, curtain, drape, cape"},
     {"retarget", cmd_retarget, "put a clip (e.g. BVH mocap) on another character; glTF or GIF out"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))

@@ -89,6 +89,7 @@ void cli_poser_free(cli_poser* p) {
     free(p->morphed);
     free(p->morphed_normals);
     free(p->skin_scratch);
+    free(p->weld_scratch);
     memset(p, 0, sizeof(*p));
 }
 
@@ -122,6 +123,26 @@ static void transform_rigid(const ak_mesh* mesh, ak_mat4 m, const ak_vec3* pos, 
         out_p[v] = ak_mat4_transform_point(m, pos[v]);
         if (nrm) out_n[v] = ak_vec3_normalize(ak_mat3_mul_vec3(nm, nrm[v]));
     }
+}
+
+/* Normals of mesh m from its posed positions: per vertex, or shared by the vertices at one
+ * position when p->weld_normals is set. */
+static ak_result computed_normals(cli_poser* p, size_t m) {
+    const ak_mesh* mesh = p->scene->meshes[m].mesh;
+    size_t n = mesh->vertex_count;
+    ak_vec3_cspan pos = {p->positions[m], n};
+    ak_u32_cspan idx = {mesh->indices, mesh->triangle_count * 3};
+    ak_vec3_span out = {p->normals[m], n};
+    if (!p->weld_normals) return ak_normals_compute(pos, idx, out);
+    size_t need = ak_normals_welded_scratch_count(n);
+    if (need == SIZE_MAX) return AK_ERR_NO_MEMORY;
+    if (need > p->weld_scratch_count) {
+        uint32_t* grown = realloc(p->weld_scratch, need * sizeof(uint32_t));
+        if (!grown) return AK_ERR_NO_MEMORY;
+        p->weld_scratch = grown;
+        p->weld_scratch_count = need;
+    }
+    return ak_normals_compute_welded(pos, idx, (ak_u32_span){p->weld_scratch, p->weld_scratch_count}, out);
 }
 
 ak_result cli_poser_sample(cli_poser* p, int clip, float t, bool bind) {
@@ -174,9 +195,7 @@ ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method) {
         if (bind) {
             memcpy(p->positions[m], pos, n * sizeof(ak_vec3));
             if (nrm) memcpy(p->normals[m], nrm, n * sizeof(ak_vec3));
-            else ak_normals_compute((ak_vec3_cspan){p->positions[m], n},
-                                    (ak_u32_cspan){mesh->indices, mesh->triangle_count * 3},
-                                    (ak_vec3_span){p->normals[m], n});
+            else if ((r = computed_normals(p, m)) != AK_OK) return r;
             continue;
         }
         if (mesh->morph_target_count > 0) {
@@ -222,10 +241,7 @@ ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method) {
             ak_mat4 place = ak_mat4_identity();
             if (sm->node >= 0 && (size_t)sm->node < p->joint_count) place = p->world[sm->node];
             transform_rigid(mesh, place, pos, nrm, p->positions[m], p->normals[m]);
-            if (!nrm)
-                ak_normals_compute((ak_vec3_cspan){p->positions[m], n},
-                                   (ak_u32_cspan){mesh->indices, mesh->triangle_count * 3},
-                                   (ak_vec3_span){p->normals[m], n});
+            if (!nrm && (r = computed_normals(p, m)) != AK_OK) return r;
         }
     }
     return AK_OK;

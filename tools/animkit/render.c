@@ -9,12 +9,14 @@
 
 static ak_vec4 rgba(float r, float g, float b, float a) { return ak_vec4_make(r, g, b, a); }
 
-void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi) {
+void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi) { cli_bounds_add_visible(p, NULL, lo, hi); }
+
+void cli_bounds_add_visible(const cli_poser* p, const bool* hidden, ak_vec3* lo, ak_vec3* hi) {
     const ak_scene* s = p->scene;
     bool any = false;
     for (size_t m = 0; m < s->mesh_count; ++m) {
         const ak_mesh* mesh = s->meshes[m].mesh;
-        if (!mesh || mesh->vertex_count == 0) continue;
+        if (!mesh || mesh->vertex_count == 0 || (hidden && hidden[m])) continue;
         ak_vec3 a, b;
         ak_points_bounds((ak_vec3_cspan){p->positions[m], mesh->vertex_count}, &a, &b);
         *lo = ak_vec3_min(*lo, a);
@@ -32,7 +34,35 @@ void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi) {
     }
 }
 
+void cli_frame_aim(cli_frame* f, ak_vec3 lo, ak_vec3 hi, const cli_camera* cam) {
+    cli_camera c = cam ? *cam : (cli_camera){0};
+    if (!c.has_angles) {
+        c.yaw = ak_degrees(0.55f);
+        c.pitch = ak_degrees(0.22f);
+    }
+    float fovy = c.fov > 0.0f && c.fov < 170.0f ? ak_radians(c.fov) : ak_radians(40.0f);
+    float az = ak_radians(c.yaw), el = ak_radians(ak_clampf(c.pitch, -85.0f, 85.0f));
+    float aspect = (float)f->width / (float)f->height;
+    ak_view_orbit orbit = {.azimuth = az, .elevation = el, .fovy = fovy, .aspect = aspect, .margin = 1.08f};
+    f->camera = ak_view_orbit_camera(lo, hi, &orbit);
+    if (c.distance > 0.0f && ak_finitef(c.distance) && ak_vec3_is_finite(lo) && ak_vec3_is_finite(hi)) {
+        /* the same direction as the orbit camera, at the distance asked for */
+        ak_vec3 centre = ak_vec3_scale(ak_vec3_add(lo, hi), 0.5f);
+        float R = ak_maxf(0.5f * ak_vec3_length(ak_vec3_sub(hi, lo)), 1e-4f);
+        ak_vec3 dir = ak_vec3_make(cosf(el) * sinf(az), sinf(el), cosf(el) * cosf(az));
+        ak_vec3 eye = ak_vec3_madd(centre, dir, c.distance);
+        float near_z = ak_maxf(0.001f * c.distance, ak_minf(0.1f * c.distance, 0.5f * (c.distance - R)));
+        f->camera = ak_raster_camera_perspective(eye, centre, fovy, aspect, near_z, c.distance + 6.0f * R);
+    }
+}
+
 int cli_frame_init(cli_frame* f, const ak_scene* s, int width, int height, ak_vec3 lo, ak_vec3 hi, float azimuth) {
+    cli_camera cam = {.has_angles = true, .yaw = ak_degrees(azimuth), .pitch = ak_degrees(0.22f)};
+    return cli_frame_init_camera(f, s, width, height, lo, hi, &cam);
+}
+
+int cli_frame_init_camera(cli_frame* f, const ak_scene* s, int width, int height, ak_vec3 lo, ak_vec3 hi,
+                          const cli_camera* cam) {
     memset(f, 0, sizeof(*f));
     f->width = width;
     f->height = height;
@@ -40,8 +70,7 @@ int cli_frame_init(cli_frame* f, const ak_scene* s, int width, int height, ak_ve
     f->bmax = hi;
     ak_raster_desc d = {.width = width, .height = height, .supersample = 2, .thread_count = 2};
     if (ak_raster_create(&d, NULL, &f->raster) != AK_OK) return CLI_BAD_INPUT;
-    ak_view_orbit orbit = {.azimuth = azimuth, .elevation = 0.22f, .aspect = (float)width / (float)height, .margin = 1.08f};
-    f->camera = ak_view_orbit_camera(lo, hi, &orbit);
+    cli_frame_aim(f, lo, hi, cam);
     /* skeleton overlay arrays: the skin joints only, parents remapped to listed ancestors */
     size_t n = s ? ak_scene_joint_count(s) : 0;
     f->draw_capacity = (s ? s->mesh_count : 0) + CLI_MAX_EXTRA;
@@ -90,7 +119,7 @@ ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* 
     ak_vec4 clay = rgba(0.80f, 0.74f, 0.68f, 1);
     for (size_t m = 0; s && m < s->mesh_count && mc < f->draw_capacity; ++m) {
         const ak_mesh* mesh = s->meshes[m].mesh;
-        if (!mesh || mesh->triangle_count == 0) continue;
+        if (!mesh || mesh->triangle_count == 0 || (o && o->hidden && o->hidden[m])) continue;
         ak_raster_mesh rm = {
             .positions = {p->positions[m], mesh->vertex_count},
             .normals = {p->normals[m], mesh->vertex_count},
@@ -179,9 +208,21 @@ int cli_weights_colors(const ak_scene* s, const char* bone, ak_vec4** colors, in
     return CLI_OK;
 }
 
-/* Render one still of the scene at its rest pose with heat colours on mesh_index. */
-int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
-                           const float* weights, uint32_t k, int slot, const char* bone_name) {
+ak_vec4 cli_bone_color(size_t slot) {
+    /* hue steps of the golden angle: neighbours in the joint list get far-apart hues */
+    double hue = fmod((double)slot * 137.508, 360.0) / 60.0, s = 0.75, v = 0.95;
+    int sector = (int)hue;
+    double f = hue - sector, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+    double rgb[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
+    const double* c = rgb[sector % 6];
+    return rgba((float)c[0], (float)c[1], (float)c[2], 1);
+}
+
+/* Render one still of the scene at its rest pose with colours on mesh_index; legend: up to
+ * legend_count names with swatches down the left side. */
+static int render_colored_png(const char* path, const ak_scene* s, size_t mesh_index, ak_vec4* mesh_colors,
+                              const char* title, const char* const* legend, const ak_vec4* legend_colors,
+                              size_t legend_count) {
     cli_poser p;
     cli_frame f;
     ak_image img = {0};
@@ -194,21 +235,79 @@ int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_inde
     cli_poser_pose(&p, -1, 0.0f, false, CLI_LBS);
     ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
     cli_bounds_add_pose(&p, &lo, &hi);
-    if (mesh_index < s->mesh_count) rc = heat_colors(s, mesh_index, joints, weights, k, slot, &colors[mesh_index]);
-    if (rc == CLI_OK && cli_frame_init(&f, s, 640, 640, lo, hi, 0.5f) == CLI_OK) {
-        char title[160];
-        snprintf(title, sizeof title, "weights of %s", bone_name ? bone_name : "?");
+    if (mesh_index < s->mesh_count) colors[mesh_index] = mesh_colors;
+    if (cli_frame_init(&f, s, 640, 640, lo, hi, 0.5f) == CLI_OK) {
         cli_draw_opts o = {.colors = colors, .title = title};
-        if (cli_image_alloc(&img, 640, 640) || cli_frame_draw(&f, &p, &o, &img) != AK_OK || ak_png_write(path, &img) != AK_OK)
+        if (cli_image_alloc(&img, 640, 640) || cli_frame_draw(&f, &p, &o, &img) != AK_OK) {
             rc = cli_fail("weights", "%s: cannot write the image", path);
+        } else {
+            /* legend: one row per bone, as many as fit */
+            int rows = (640 - 50) / 12;
+            for (size_t i = 0; i < legend_count && (int)i < rows; ++i) {
+                int y = 40 + 12 * (int)i;
+                const char* name = (int)i == rows - 1 && legend_count > (size_t)rows ? "..." : legend[i];
+                ak_image_fill_rect(&img, 10, (float)y, 9, 9, legend_colors[i]);
+                ak_image_draw_text(&img, 23, y + 1, name, 1, rgba(0.08f, 0.09f, 0.12f, 1));
+            }
+            if (ak_png_write(path, &img) != AK_OK) rc = cli_fail("weights", "%s: cannot write the image", path);
+        }
         cli_frame_free(&f);
     } else {
         rc = cli_fail("weights", "out of memory");
     }
-    for (size_t m = 0; m < s->mesh_count; ++m) free(colors[m]);
     free(colors);
     free(img.pixels);
     cli_poser_free(&p);
+    return rc;
+}
+
+/* Render one still of the scene at its rest pose with heat colours on mesh_index. */
+int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
+                           const float* weights, uint32_t k, int slot, const char* bone_name) {
+    ak_vec4* c = NULL;
+    if (mesh_index < s->mesh_count && heat_colors(s, mesh_index, joints, weights, k, slot, &c))
+        return cli_fail("weights", "out of memory");
+    char title[160];
+    snprintf(title, sizeof title, "weights of %s", bone_name ? bone_name : "?");
+    int rc = render_colored_png(path, s, mesh_index, c, title, NULL, NULL, 0);
+    free(c);
+    return rc;
+}
+
+int cli_render_bones_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
+                         const float* weights, uint32_t k, size_t slot_count, const char* const* slot_names) {
+    const ak_mesh* mesh = s->meshes[mesh_index].mesh;
+    size_t n = mesh->vertex_count;
+    ak_vec4* c = calloc(n + 1, sizeof(ak_vec4));
+    ak_vec4* sw = calloc(slot_count + 1, sizeof(ak_vec4));
+    const char** names = calloc(slot_count + 1, sizeof(char*));
+    size_t* dominant = calloc(slot_count + 1, sizeof(size_t));
+    if (!c || !sw || !names || !dominant) {
+        free(c), free(sw), free(names), free(dominant);
+        return cli_fail("weights", "out of memory");
+    }
+    for (size_t v = 0; v < n; ++v) {
+        float best = 0.0f;
+        size_t top = slot_count;
+        for (uint32_t i = 0; i < k; ++i) {
+            float wi = weights[v * k + i];
+            size_t q = joints[v * k + i];
+            if (wi > best && q < slot_count) best = wi, top = q;
+        }
+        c[v] = top < slot_count ? cli_bone_color(top) : rgba(0.5f, 0.5f, 0.5f, 1);
+        if (top < slot_count) ++dominant[top];
+    }
+    /* legend: the bones that dominate some vertex, in slot order */
+    size_t shown = 0;
+    for (size_t q = 0; q < slot_count; ++q) {
+        if (!dominant[q]) continue;
+        sw[shown] = cli_bone_color(q);
+        names[shown++] = slot_names[q];
+    }
+    char title[160];
+    snprintf(title, sizeof title, "dominant bone per vertex (%zu bone%s)", shown, cli_plural(shown));
+    int rc = render_colored_png(path, s, mesh_index, c, title, names, sw, shown);
+    free(c), free(sw), free(names), free(dominant);
     return rc;
 }
 

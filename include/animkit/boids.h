@@ -1,0 +1,242 @@
+/* animkit boids: Reynolds flocking (1987) with vision, topological neighbours, obstacles and
+ * predators, for crowds of a million agents.
+ *
+ * What it does:
+ *   - one step job that moves N agents (caller-owned SoA arrays: positions, velocities,
+ *     species) by the three rules of Reynolds 1987, each with a weight and a radius:
+ *       separation  F_s = w_s * sum_j (p_i - p_j) / |p_i - p_j|^2   (inverse-distance repulsion)
+ *       alignment   F_a = w_a * (mean_j v_j - v_i)                    (steer to the mean velocity)
+ *       cohesion    F_c = w_c * (mean_j p_j - p_i)                    (steer to the centroid)
+ *     where j runs over the agent's neighbours closer than that rule's radius. Neighbours are
+ *     agents of the same species, other than i, with |p_j - p_i| < the largest of the three
+ *     radii AND inside the field-of-view cone (view_angle degrees around the velocity), then
+ *     optionally capped to the k nearest (topological neighbours; ties broken by the smaller
+ *     agent index). Exactly, in float: d = p_j - p_i, d2 = d.x*d.x + d.y*d.y + d.z*d.z, a rule
+ *     uses j when d2 < radius*radius; with c = cos(view_angle/2), dot = d . v_i, lim =
+ *     c*c * d2 * |v_i|^2, j is in view when (c >= 0) dot > 0 && dot*dot >= lim, (c < 0)
+ *     dot >= 0 || dot*dot <= lim, and always when |v_i| = 0 or d2 = 0. The separation
+ *     distance is clamped below at 1e-3 separation_radius (coincident agents push nothing);
+ *   - extensions, each a weighted steering force: obstacle avoidance (spheres, planes,
+ *     axis-aligned boxes) with a hard projection as the last resort so that no agent ever
+ *     enters an obstacle, bounds (wrap or steer back), goal seeking, leader following, flee
+ *     from predators and pursue prey (species with their own parameters), per-agent wander
+ *     from a seeded ak_rng; 2D (agents on a horizontal plane) and 3D;
+ *   - the neighbour search through a uniform grid, and the naive O(N^2) loop as the reference
+ *     path (job.use_naive): both give exactly the same neighbour sets and bit-identical steps;
+ *   - the neighbour lists themselves (ak_boids_neighbors_run), the flocking order parameter and
+ *     the smallest distance between two agents.
+ *
+ * Integration (per agent, semi-implicit Euler): F = sum of the weighted forces, clamped to
+ * max_force; v' = v + F dt clamped to [min_speed, max_speed]; p' = p + v' dt; then the bounds
+ * wrap and the obstacle projection (below). In 2D (params.planar) every force and velocity has
+ * y = 0 and agents keep their y.
+ *
+ * Obstacles: the avoid force steers away before contact; the hard projection is the last
+ * resort and always runs: a step whose segment p -> p' would enter an obstacle (or end inside
+ * one) stops at the entry point, is pushed 1e-5 m (+ 4e-7 relative) outside along the surface
+ * normal, and loses the inward part of its velocity (out_contact_count counts these agents).
+ * An agent the caller placed inside leaves by the nearest face. Overlapping obstacles are
+ * resolved by up to four passes; agents therefore end every step at distance >= 0 from every
+ * obstacle (tests check this on spheres, planes and boxes in 2D and 3D).
+ *
+ * Determinism: each agent's sums are accumulated in 64-bit fixed point (2^-28 of the
+ * cohesion radius for offsets, of max_speed for velocities; 2^-24 of 1/separation_radius for
+ * separation), which is exact and so independent of the order neighbours are visited in.
+ * Any thread_count, the grid and the naive path give bit-identical results.
+ *
+ * What it does NOT do: rendering (the `animkit boids` command draws flocks with raster.h),
+ * collisions between agents (separation only steers), neighbours across a wrapping bound (the
+ * wrap moves agents; neighbours use the plain Euclidean distance), or vision occlusion.
+ *
+ * Usage:
+ *     ak_boids_species sp = {.max_speed = 2, .max_force = 8, .separation_weight = 1,
+ *                            .alignment_weight = 1, .cohesion_weight = 0.5f, .view_angle = 270};
+ *     ak_boids_params params = {.species = &sp, .species_count = 1};
+ *     ak_boids_step_job job = {
+ *         .params = &params, .dt = 1.0f / 60.0f, .thread_count = 2,
+ *         .positions = {pos, n}, .velocities = {vel, n},
+ *         .out_positions = {pos2, n}, .out_velocities = {vel2, n},
+ *     };
+ *     size_t bytes = ak_boids_step_scratch_size(&job);   // once for a given n and params
+ *     job.scratch = (ak_u8_span){malloc(bytes), bytes};
+ *     for (int s = 0; s < steps; ++s) {
+ *         job.step_index = (uint64_t)s;
+ *         ak_result r = ak_boids_step_run(&job);          // then swap pos/pos2, vel/vel2 (and
+ *     }                                                   // the job's pointers) for the next step
+ *
+ * Ownership and threading: the job reads and writes caller-owned arrays and keeps no pointer.
+ * ak_boids_step_run never allocates (thread_count > 1 starts pthreads). Outputs must not alias
+ * inputs (the wander state is updated in place: each agent touches only its own entry).
+ */
+#ifndef ANIMKIT_BOIDS_H
+#define ANIMKIT_BOIDS_H
+
+#include "math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define AK_BOIDS_MAX_SPECIES 32 /* species indices are < this (flee/pursue masks are 32 bits) */
+#define AK_BOIDS_MAX_K 64       /* largest k_nearest */
+#define AK_BOIDS_MAX_AGENTS 100000000u /* largest agent_count a job accepts */
+
+/* Parameters of one species. Weights are accelerations (m/s^2 per unit of the rule's vector):
+ * a zero weight switches its rule off. */
+typedef struct ak_boids_species {
+    float max_speed;         /* m/s; 0 -> 2 */
+    float min_speed;         /* m/s, <= max_speed; 0 -> none (agents may stop) */
+    float max_force;         /* m/s^2, clamp on the summed steering; 0 -> 8 */
+    float separation_weight; /* m^2/s^2: F_s = w * sum (p_i - p_j)/d^2; 0 -> off */
+    float separation_radius; /* m; 0 -> 1 */
+    float alignment_weight;  /* 1/s: F_a = w * (mean v_j - v_i); 0 -> off */
+    float alignment_radius;  /* m; 0 -> 2 */
+    float cohesion_weight;   /* 1/s^2: F_c = w * (mean p_j - p_i); 0 -> off */
+    float cohesion_radius;   /* m; 0 -> 2 */
+    float view_angle;        /* degrees, full cone angle around the velocity; 0 or >= 360 -> all
+                                around. An agent at rest sees all around. */
+    uint32_t k_nearest;      /* cap on neighbours (the k nearest); 0 -> no cap; <= AK_BOIDS_MAX_K */
+    float goal_weight;       /* 1/s: seek params.goal (desired velocity max_speed toward it); 0 -> off */
+    float leader_weight;     /* 1/s: seek the point leader_distance behind the leader; 0 -> off */
+    float wander_weight;     /* m/s^2: force along the agent's wander direction; 0 -> off */
+    float wander_jitter;     /* radians per sqrt(second) of random walk of that direction; 0 -> 2 */
+    float avoid_weight;      /* m/s^2: F = w * (L - s)/s * n within avoid_distance L of an
+                                obstacle (s = distance, n = outward normal); 0 -> off */
+    float avoid_distance;    /* m: L above; 0 -> 1 */
+    float bounds_weight;     /* 1/s^2: STEER bounds pull back with w * (depth into the margin); 0 -> 4 */
+    uint32_t flee_mask;      /* bit s set: flee from the nearest agent of species s */
+    float flee_weight;       /* 1/s: desired velocity max_speed away from it; 0 -> off */
+    float flee_radius;       /* m: only predators closer than this; 0 -> 4 */
+    uint32_t pursue_mask;    /* bit s set: pursue the nearest agent of species s */
+    float pursue_weight;     /* 1/s: desired velocity max_speed toward its predicted position */
+    float pursue_radius;     /* m: only prey closer than this; 0 -> 4 */
+} ak_boids_species;
+
+typedef enum ak_boids_obstacle_kind {
+    AK_BOIDS_SPHERE = 0, /* center, radius */
+    AK_BOIDS_PLANE,      /* solid half-space behind the plane through center: dot(n, x - c) < 0 */
+    AK_BOIDS_BOX,        /* axis-aligned box: center, half_extents */
+    AK_BOIDS_OBSTACLE_KIND_COUNT
+} ak_boids_obstacle_kind;
+
+/* A solid obstacle; agents are points and stay outside (distance >= 0). In 2D each obstacle
+ * is cut at the agent's height (a sphere becomes a disc of the same radius, a plane's normal
+ * loses its y). */
+typedef struct ak_boids_obstacle {
+    ak_boids_obstacle_kind kind;
+    ak_vec3 center;       /* world m */
+    float radius;         /* m, sphere (> 0) */
+    ak_vec3 normal;       /* plane: outward normal (normalised by the job; non-zero) */
+    ak_vec3 half_extents; /* m, box (each > 0) */
+} ak_boids_obstacle;
+
+typedef enum ak_boids_bounds {
+    AK_BOIDS_BOUNDS_DEFAULT = 0, /* -> STEER when a box is given, else NONE */
+    AK_BOIDS_BOUNDS_NONE,        /* the box is ignored */
+    AK_BOIDS_BOUNDS_STEER,       /* inside the margin, agents are pulled back (force, not a wall) */
+    AK_BOIDS_BOUNDS_WRAP,        /* leaving one side re-enters from the opposite side */
+    AK_BOIDS_BOUNDS_COUNT
+} ak_boids_bounds;
+
+/* What the agents share: species table, obstacles, bounds, goal, leader. */
+typedef struct ak_boids_params {
+    const ak_boids_species* species;     /* required: [species_count] */
+    uint32_t species_count;              /* 1 ..= AK_BOIDS_MAX_SPECIES */
+    const ak_boids_obstacle* obstacles;  /* optional: [obstacle_count] */
+    uint32_t obstacle_count;             /* <= 1024 */
+    ak_vec3 bounds_min, bounds_max;      /* world m; all zero -> no box; else max > min */
+    ak_boids_bounds bounds;              /* see ak_boids_bounds */
+    float bounds_margin;                 /* m, STEER: width of the band that pulls back; 0 -> 1 */
+    bool planar;                         /* 2D: forces and velocities in the XZ plane */
+    ak_vec3 goal;                        /* world m, for species with goal_weight */
+    bool has_leader;                     /* leader following on (species with leader_weight) */
+    uint32_t leader_index;               /* the leader agent (< agent_count when has_leader) */
+    float leader_distance;               /* m behind the leader that followers seek; 0 -> 1 */
+} ak_boids_params;
+
+/* A species with every zero default filled in (NULL -> all defaults); for tests and tools. */
+AK_API void ak_boids_species_resolved(const ak_boids_species* species, ak_boids_species* out_species);
+
+/* ---- the step job --------------------------------------------------------------------- */
+
+typedef struct ak_boids_step_job {
+    const ak_boids_params* params;   /* required */
+    ak_vec3_cspan positions;         /* required: [agent_count] world m; count = agent_count */
+    ak_vec3_cspan velocities;        /* required: >= agent_count, m/s */
+    ak_u8_cspan species;             /* optional: >= agent_count species indices; empty -> all 0 */
+    ak_vec3_span wander;             /* in/out state, required when a species wanders: unit
+                                        directions (zero entries are re-drawn), >= agent_count */
+    float dt;                        /* s, required: > 0 */
+    uint64_t seed;                   /* wander random stream (ak_rng per agent and step) */
+    uint64_t step_index;             /* wander: pass the step number so each step draws anew */
+    uint32_t thread_count;           /* 0 or 1 -> calling thread; <= 64 */
+    bool use_naive;                  /* the O(N^2) reference neighbour search (no scratch) */
+    ak_u8_span scratch;              /* >= ak_boids_step_scratch_size(job) bytes */
+    ak_vec3_span out_positions;      /* >= agent_count; must not alias the inputs */
+    ak_vec3_span out_velocities;     /* >= agent_count; must not alias the inputs */
+    uint64_t* out_interaction_count; /* optional: flock neighbours summed over all agents */
+    uint32_t* out_contact_count;     /* optional: agents the obstacle projection had to stop */
+} ak_boids_step_job;
+
+/* Scratch bytes ak_boids_step_run needs for this job (positions.count, params and use_naive
+ * are read; 0 for the naive path, and 0 when no species looks at neighbours). The grid path
+ * needs about 110 bytes per agent (the grid, velocities in fixed point, a dense cell table).
+ * Returns 0 when the job's params are unusable (validate says why). */
+AK_API size_t ak_boids_step_scratch_size(const ak_boids_step_job* job);
+
+/* Check a step job. Returns, in this order: AK_ERR_NULL_ARG (no job, params, species, arrays
+ * or outputs; a wandering species without the wander span; obstacle_count > 0 without
+ * obstacles), AK_ERR_BAD_ARG (dt not > 0 or not finite, species_count outside 1..32,
+ * thread_count > 64, more than AK_BOIDS_MAX_AGENTS agents or 1024 obstacles, bounds not
+ * max > min on every axis (y is free in 2D), leader_index out of range, a species parameter
+ * negative or not finite, k_nearest > AK_BOIDS_MAX_K, min_speed > max_speed, a bad obstacle:
+ * radius or half extent not > 0, zero plane normal, unknown kind; outputs aliasing inputs),
+ * AK_ERR_EMPTY (no agents), AK_ERR_SPAN_SMALL (an array shorter than agent_count, scratch
+ * too small), AK_ERR_BAD_INDEX (a species index >= species_count), AK_ERR_BAD_DATA (a NaN or
+ * infinite position, velocity or wander entry, or coordinates beyond 1e15 m). */
+AK_API ak_result ak_boids_step_validate(const ak_boids_step_job* job);
+
+/* One step for every agent (see the header block). Validates first and writes nothing on
+ * failure. Output is finite for valid input. */
+AK_API ak_result ak_boids_step_run(const ak_boids_step_job* job);
+
+/* ---- neighbour lists ------------------------------------------------------------------ */
+
+/* The flock neighbours each agent's rules use (same species, radius, view cone, k cap), as
+ * compressed rows: agent i's neighbours are out_indices[out_offsets[i] .. out_offsets[i+1]),
+ * sorted by distance, ties by index. Same inputs as the step job (params, positions,
+ * velocities, species, thread_count, use_naive, scratch as for the step job); dt, wander and
+ * the step outputs are not read. */
+typedef struct ak_boids_neighbors_job {
+    const ak_boids_step_job* step;   /* required: the inputs above */
+    ak_u32_span out_offsets;         /* >= agent_count + 1 */
+    ak_u32_span out_indices;         /* capacity; see out_total */
+    size_t* out_total;               /* required: neighbours in all (written even when the
+                                        indices span is too small, then AK_ERR_SPAN_SMALL) */
+} ak_boids_neighbors_job;
+
+/* Fill the neighbour lists. Returns the step job's validation codes (dt is not checked),
+ * AK_ERR_NULL_ARG (no out_total or offsets), AK_ERR_SPAN_SMALL (offsets shorter than
+ * agent_count + 1, or out_indices shorter than the total: then out_total holds the count
+ * needed and the offsets are written). */
+AK_API ak_result ak_boids_neighbors_run(const ak_boids_neighbors_job* job);
+
+/* ---- measures ------------------------------------------------------------------------- */
+
+/* Flocking order parameter |mean of v_i / |v_i||, in [0, 1] (1: all agents head the same
+ * way). Agents at rest count as zero vectors. Empty span -> 0. Summed in double. */
+AK_API float ak_boids_order(ak_vec3_cspan velocities);
+
+/* Bytes of scratch ak_boids_min_distance needs for count agents. */
+AK_API size_t ak_boids_min_distance_scratch_size(size_t count);
+
+/* Smallest distance between two agents (exact: a sort on x and a sweep, O(N log N) for
+ * spread-out agents). Fewer than two agents -> AK_ERR_EMPTY. Returns AK_ERR_NULL_ARG,
+ * AK_ERR_SPAN_SMALL (scratch), AK_ERR_BAD_DATA (non-finite position). */
+AK_API ak_result ak_boids_min_distance(ak_vec3_cspan positions, ak_u8_span scratch, float* out_distance);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,278 @@
+/* animkit cloth: mass-spring and XPBD cloth, pinned or attached to animated characters.
+ *
+ * What it does:
+ *   - a cloth is a triangle mesh (a generated W x H rectangle of particles, or any triangle mesh,
+ *     plus optional extra edges) with per-vertex mass; particles can be pinned at fixed points
+ *     or attached to target positions the caller gives every step (a skinned mesh's vertices or
+ *     joints), so a cape, skirt or flag follows an animated character;
+ *   - three solvers over the same cloth:
+ *       AK_CLOTH_XPBD (default): extended position-based dynamics (Macklin, Mueller, Chentanez
+ *         2016): distance constraints with compliance alpha = 1/stiffness, alpha~ = alpha/h^2,
+ *         the Lagrange multipliers reset at the start of every substep, dihedral-angle or
+ *         isometric bending (or bending distance constraints), constraint
+ *         damping (their eq. 26), substeps of h = dt/substeps with `iterations` Gauss-Seidel
+ *         sweeps each; optional long-range attachments (Kim, Chentanez, Mueller 2012);
+ *       AK_CLOTH_SPRINGS: the classic mass-spring model: structural, shear and bending springs
+ *         (Hooke plus damping along the spring), semi-implicit (symplectic) Euler, v += h a,
+ *         x += h v; stable only for h below about 2 sqrt(m/k), so it needs small steps;
+ *       AK_CLOTH_PBD: plain position-based dynamics (Mueller et al. 2007): the same constraints
+ *         projected with a per-projection stiffness factor in (0, 1]; its effective stiffness
+ *         depends on the substep and iteration counts (the problem XPBD solves);
+ *   - forces: gravity, wind (drag and lift per triangle from its orientation to the relative
+ *     wind), global damping;
+ *   - collisions with planes, spheres, capsules (a character's limbs) and a triangle mesh (the
+ *     character's skin, through a spatial hash rebuilt each step), with thickness and friction;
+ *   - self-collision between particles through the shared neighbour grid (grid.h), switchable;
+ *   - smooth (area-weighted) vertex normals, max stretch and energy for output and tests;
+ *   - thread_count: threads split each phase over disjoint particles or over constraints of one
+ *     colour (constraints of a colour share no particle), so results are bit-identical for any
+ *     thread count.
+ *
+ * What it does NOT do: continuous collision detection (a particle moving
+ * further than the thickness in one substep can tunnel through a thin collider), tearing,
+ * or moving the colliders inside a step (they are taken at their end-of-step pose).
+ *
+ * Usage (a flag pinned along one edge, flapping in the wind):
+ *     ak_cloth_desc desc = { .grid_width = 32, .grid_height = 20, .spacing = 0.05f,
+ *                            .grid_axis_v = {0, -1, 0} };
+ *     uint32_t pins[2] = {0, 32 * 19};                     // the two corners of the pole edge
+ *     desc.pins = (ak_u32_cspan)AK_SPAN(pins);
+ *     ak_cloth* cloth = NULL;
+ *     if (ak_cloth_create(&desc, NULL, &cloth) != AK_OK) return 1;
+ *     size_t n = ak_cloth_vertex_count(cloth);
+ *     ak_vec3* x = malloc(n * sizeof *x); ak_vec3* v = calloc(n, sizeof *v);
+ *     ak_cloth_rest_positions(cloth, (ak_vec3_span){x, n});
+ *     ak_cloth_step_job job = { .cloth = cloth, .dt = 1.0f / 60, .gravity = {0, -9.81f, 0},
+ *                               .wind = {6, 0, 1}, .drag = 1.0f, .lift = 0.5f,
+ *                               .positions = {x, n}, .velocities = {v, n} };
+ *     size_t size = ak_cloth_step_scratch_size(&job);
+ *     job.scratch = (ak_u8_span){malloc(size), size};
+ *     for (int f = 0; f < 600; ++f) if (ak_cloth_step_run(&job) != AK_OK) break;
+ *     ak_cloth_destroy(cloth);
+ *
+ * Ownership and threading: ak_cloth_create makes one allocation holding the topology, the
+ * rest state and the coloured constraints; the cloth is then read-only and may be shared by any
+ * number of threads. The state (positions, velocities) and scratch belong to the caller.
+ * ak_cloth_step_run never allocates memory of its own (thread_count > 1 starts pthreads for
+ * the duration of the call, whose stacks the C library allocates). Steps of distinct states
+ * may run concurrently.
+ */
+#ifndef ANIMKIT_CLOTH_H
+#define ANIMKIT_CLOTH_H
+
+#include "math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum ak_cloth_solver {
+    AK_CLOTH_XPBD = 0,   /* default: compliant constraints, substeps */
+    AK_CLOTH_SPRINGS,    /* mass-spring, semi-implicit Euler */
+    AK_CLOTH_PBD,        /* plain PBD with a stiffness factor (for comparison) */
+    AK_CLOTH_SOLVER_COUNT
+} ak_cloth_solver;
+
+typedef enum ak_cloth_bending {
+    AK_CLOTH_BEND_DEFAULT = 0, /* -> DIHEDRAL for XPBD and PBD; the spring solver always uses SPRINGS
+                                  (or NONE) */
+    AK_CLOTH_BEND_DIHEDRAL,    /* angle between the two triangles of each interior edge */
+    AK_CLOTH_BEND_SPRINGS,     /* distance between the wing vertices of each interior edge (grid:
+                                  particles two apart along each axis) */
+    AK_CLOTH_BEND_NONE,        /* no bending resistance */
+    AK_CLOTH_BEND_ISOMETRIC,   /* isometric bending (Bergou et al. 2006): the cotangent-weighted
+                                  bending vector b = sum_i K_i x_i of each interior edge's four
+                                  particles, energy 3 k |b|^2 / (2 (A0 + A1)), as one XPBD/PBD
+                                  constraint C = |b| - |b_rest| (exact for a flat rest shape);
+                                  about a third of the dihedral constraint's cost */
+    AK_CLOTH_BENDING_COUNT
+} ak_cloth_bending;
+
+typedef struct ak_cloth_desc {
+    ak_cloth_solver solver;      /* 0 -> AK_CLOTH_XPBD */
+    /* Topology: a generated grid when positions is empty, else the given mesh. */
+    uint32_t grid_width;         /* grid: particles along grid_axis_u, >= 2 (required for a grid) */
+    uint32_t grid_height;        /* grid: particles along grid_axis_v, >= 2 (required for a grid) */
+    float spacing;               /* grid: metres between neighbours; 0 -> 0.05 */
+    ak_vec3 grid_origin;         /* grid: world position of particle (0, 0), index 0 */
+    ak_vec3 grid_axis_u;         /* grid: direction of rows (normalised); zero -> (1, 0, 0) */
+    ak_vec3 grid_axis_v;         /* grid: direction of columns (normalised); zero -> (0, 0, -1)
+                                    (a horizontal sheet whose triangles face +Y: they face
+                                    u x v). Particle (i, j) has index j * grid_width + i */
+    ak_vec3_cspan positions;     /* mesh: rest positions (world); empty -> grid */
+    ak_u32_cspan indices;        /* mesh: 3 per triangle, counter-clockwise (may be empty with edges) */
+    ak_u32_cspan edges;          /* optional: 2 per extra stretch spring/constraint (ropes, the
+                                    single-spring test), in grid or mesh */
+    ak_f32_cspan inverse_masses; /* optional: 1/kg per vertex, >= 0 (0 = pinned); empty -> from
+                                    area_density (a third of each triangle's mass per corner) */
+    float area_density;          /* kg/m^2 when inverse_masses is empty; 0 -> 0.2 */
+    ak_u32_cspan pins;           /* vertices held at pin_positions (or their rest positions) */
+    ak_vec3_cspan pin_positions; /* optional: one per pin, world; empty -> rest positions */
+    ak_u32_cspan attachments;    /* vertices that follow ak_cloth_step_job.attachment_targets */
+    /* Material. Spring constants apply to every spring of the kind whatever its length. */
+    float stretch_stiffness;     /* N/m of structural springs/constraints (XPBD compliance is its
+                                    inverse; INFINITY -> rigid, compliance 0, XPBD/PBD only);
+                                    0 -> 5000 */
+    float shear_stiffness;       /* N/m of grid diagonals; 0 -> stretch_stiffness */
+    float bend_stiffness;        /* N/m of bending springs; 0 -> stretch_stiffness / 100 */
+    float dihedral_stiffness;    /* bending modulus k of dihedral bending (N m/rad: energy k theta^2 / 2,
+                                    XPBD compliance 1/k) and of isometric bending (N m); 0 -> 1e-4
+                                    (cotton-like: a draped sheet folds) */
+    ak_cloth_bending bending;    /* 0 -> see ak_cloth_bending */
+    float spring_damping;        /* SPRINGS: N s/m along each spring; 0 -> none */
+    float constraint_damping;    /* XPBD: beta (s) of the paper's eq. 26, stiffness-proportional
+                                    damping; 0 -> none */
+    float pbd_stiffness;         /* PBD: factor (0, 1] applied to each projection; 0 -> 1 */
+    bool long_range_attachments; /* XPBD/PBD: each free particle stays within (1 + slack) times
+                                    its rest distance of its nearest pinned or attached particle */
+    float long_range_slack;      /* fraction of extra length allowed; 0 -> exactly the rest distance */
+} ak_cloth_desc;
+
+/* The desc with zero defaults filled in (desc NULL -> every default; the topology spans and
+ * the grid size are copied, not checked). */
+AK_API ak_cloth_desc ak_cloth_desc_resolved(const ak_cloth_desc* desc);
+
+typedef struct ak_cloth ak_cloth;
+
+/* Build a cloth: topology, masses, constraints (coloured so that one colour touches each
+ * particle at most once). Returns AK_ERR_NULL_ARG (desc or out_cloth NULL), AK_ERR_EMPTY (no
+ * grid and no positions, or no triangle and no edge), AK_ERR_BAD_ARG (grid side < 2, grid over
+ * 2^24 particles, unknown solver or bending, negative or NaN stiffness, damping, density, slack,
+ * pbd_stiffness > 1, infinite stiffness with the spring solver, indices or edges not a multiple
+ * of 3 or 2, pin_positions count != pins count, an allocator with only one function, a vertex on
+ * no triangle whose mass must come from area_density), AK_ERR_BAD_INDEX (an index, edge, pin or
+ * attachment out of range, an edge or triangle with a repeated vertex, a vertex both pinned and
+ * attached or listed twice), AK_ERR_BAD_DATA (a non-finite position, pin position or inverse
+ * mass, or a negative inverse mass), AK_ERR_NO_MEMORY. *out_cloth is NULL on failure. */
+AK_API ak_result ak_cloth_create(const ak_cloth_desc* desc, const ak_allocator* alloc, ak_cloth** out_cloth);
+/* Free a cloth; NULL is a no-op. */
+AK_API void ak_cloth_destroy(ak_cloth* cloth);
+
+/* Queries (a NULL cloth gives 0 or empty spans). */
+AK_API size_t ak_cloth_vertex_count(const ak_cloth* cloth);
+AK_API size_t ak_cloth_triangle_count(const ak_cloth* cloth);
+/* The triangles (3 indices each): the grid's or a copy of the desc's. */
+AK_API ak_u32_cspan ak_cloth_indices(const ak_cloth* cloth);
+/* Inverse mass per vertex after pins and attachments (those are 0). */
+AK_API ak_f32_cspan ak_cloth_inverse_masses(const ak_cloth* cloth);
+/* Number of attachments (the count attachment_targets must have). */
+AK_API size_t ak_cloth_attachment_count(const ak_cloth* cloth);
+/* The desc the cloth was built with, resolved. Its indices, inverse_masses (after pins and
+ * attachments), pins, pin_positions and attachments point at the cloth's own arrays; positions
+ * and edges are not kept (empty spans; ak_cloth_rest_positions gives the rest state). */
+AK_API ak_cloth_desc ak_cloth_get_desc(const ak_cloth* cloth);
+
+/* Rest positions, with pinned vertices at their pin positions, into out_positions
+ * (count >= vertex count). Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_cloth_rest_positions(const ak_cloth* cloth, ak_vec3_span out_positions);
+
+/* ---- colliders ------------------------------------------------------------------------ */
+
+typedef struct ak_cloth_plane {
+    ak_vec3 normal; /* world, normalised here; points to the free side; zero -> (0, 1, 0) */
+    float offset;   /* the plane is dot(normal, x) = offset */
+} ak_cloth_plane;
+
+typedef struct ak_cloth_sphere {
+    ak_vec3 center; /* world */
+    float radius;   /* metres, >= 0 */
+} ak_cloth_sphere;
+
+typedef struct ak_cloth_capsule {
+    ak_vec3 a, b;   /* world: the segment's ends (a == b -> a sphere) */
+    float radius;   /* metres, >= 0 */
+} ak_cloth_capsule;
+
+/* A closed, outward-facing triangle mesh (counter-clockwise seen from outside), e.g. a skinned
+ * character at this step's pose. Particles closer than the thickness in front of a triangle, or
+ * up to two thicknesses behind it, are pushed out along the triangle's normal. */
+typedef struct ak_cloth_collider_mesh {
+    ak_vec3_cspan positions; /* world; empty -> no mesh collider */
+    ak_u32_cspan indices;    /* 3 per triangle */
+} ak_cloth_collider_mesh;
+
+/* ---- stepping ------------------------------------------------------------------------- */
+
+/* Advance the cloth by dt. Positions and velocities are the caller's state (in and out). */
+typedef struct ak_cloth_step_job {
+    const ak_cloth* cloth;         /* required */
+    float dt;                      /* seconds, > 0 (required) */
+    uint32_t substeps;             /* h = dt / substeps; 0 -> 10 */
+    uint32_t iterations;           /* XPBD/PBD Gauss-Seidel sweeps per substep; 0 -> 1 */
+    ak_vec3 gravity;               /* m/s^2, world; zero -> none */
+    ak_vec3 wind;                  /* m/s, world air velocity; zero -> still air */
+    float drag;                    /* drag coefficient C_d per triangle; 0 -> no drag */
+    float lift;                    /* lift coefficient C_l per triangle; 0 -> no lift */
+    float air_density;             /* kg/m^3; 0 -> 1.2 */
+    float damping;                 /* 1/s: velocities decay by exp(-damping h) per substep; 0 -> none */
+    const ak_cloth_plane* planes;  /* plane_count entries */
+    size_t plane_count;
+    const ak_cloth_sphere* spheres; /* sphere_count entries */
+    size_t sphere_count;
+    const ak_cloth_capsule* capsules; /* capsule_count entries */
+    size_t capsule_count;
+    ak_cloth_collider_mesh mesh;   /* optional character mesh */
+    float thickness;               /* metres kept between particles and colliders; 0 -> 0.01 */
+    float friction;                /* Coulomb coefficient at contacts, >= 0; 0 -> frictionless */
+    bool self_collision;           /* true -> particles keep self_distance apart (pairs closer at
+                                      rest keep their rest distance), found each substep through
+                                      the shared neighbour grid (grid.h), resolved Jacobi-style
+                                      (each particle moves by the mean of its pair corrections,
+                                      at most 32 neighbours) */
+    float self_distance;           /* metres; 0 -> 2 * thickness */
+    ak_vec3_cspan attachment_targets; /* world, one per attachment (required when the cloth has
+                                         attachments): where the attached particles are at the end
+                                         of this step; substeps move them linearly from where
+                                         they are */
+    uint32_t thread_count;         /* 0 or 1 -> the calling thread only; at most 64 */
+    ak_vec3_span positions;        /* required, count == vertex count: in and out */
+    ak_vec3_span velocities;       /* required, count == vertex count: in and out */
+    ak_vec3_span out_normals;      /* optional, count >= vertex count: smooth normals after the step */
+    ak_u8_span scratch;            /* required, size >= ak_cloth_step_scratch_size(job) */
+} ak_cloth_step_job;
+
+/* Scratch bytes a step needs (depends on the cloth and the collider mesh's triangle count);
+ * 0 when job or job->cloth is NULL. */
+AK_API size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job);
+
+/* First failing rule: AK_ERR_NULL_ARG (job, cloth, positions, velocities or scratch empty, a
+ * collider count without its array, attachments without targets), AK_ERR_BAD_ARG (dt <= 0 or
+ * non-finite, thread_count > 64, substeps or iterations > 10000, negative or non-finite drag,
+ * lift, air density, damping, thickness, friction or self_distance, a negative radius, collider mesh indices
+ * not a multiple of 3, positions/velocities count != vertex count, attachment_targets count !=
+ * attachment count), AK_ERR_SPAN_SMALL (out_normals or scratch too small), AK_ERR_BAD_INDEX (a
+ * collider mesh index out of range), AK_ERR_BAD_DATA (a non-finite position, velocity,
+ * gravity, wind, collider or target). A zero-initialised job gives AK_ERR_NULL_ARG. */
+AK_API ak_result ak_cloth_step_validate(const ak_cloth_step_job* job);
+/* Validate, then step (writes nothing on a validation failure). Returns
+ * AK_ERR_NO_CONVERGENCE when the state became non-finite (a blow-up: the spring solver with too
+ * large a step); the state then holds the non-finite values, so keep a copy to go back to. */
+AK_API ak_result ak_cloth_step_run(const ak_cloth_step_job* job);
+
+/* ---- measures ------------------------------------------------------------------------- */
+
+/* Smooth vertex normals (area-weighted sum of the triangle normals, normalised; vertices on no
+ * triangle get (0, 1, 0)). positions.count == vertex count, out_normals.count >= vertex count.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_cloth_normals(const ak_cloth* cloth, ak_vec3_cspan positions, ak_vec3_span out_normals);
+
+/* Largest (edge length / rest length - 1) over the structural constraints (mesh edges, grid rows
+ * and columns, extra edges); 0 for a cloth without any; NaN when a position is not finite. */
+AK_API float ak_cloth_max_stretch(const ak_cloth* cloth, ak_vec3_cspan positions);
+
+typedef struct ak_cloth_energy {
+    double kinetic;   /* J: sum of m |v|^2 / 2 over free particles */
+    double potential; /* J: sum of -m gravity . x over free particles (zero at the origin) */
+    double elastic;   /* J: sum of k C^2 / 2 over the springs/constraints (dihedral: the angle) */
+    double total;     /* kinetic + potential + elastic */
+} ak_cloth_energy;
+
+/* Energy of a state (double precision). positions and velocities: count == vertex count.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG. */
+AK_API ak_result ak_cloth_energy_compute(const ak_cloth* cloth, ak_vec3_cspan positions, ak_vec3_cspan velocities,
+                                         ak_vec3 gravity, ak_cloth_energy* out_energy);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ANIMKIT_CLOTH_H */

@@ -1,0 +1,735 @@
+/* Cloth step: XPBD, PBD and mass-spring solvers, wind, collisions, threads.
+ *
+ * Threads run the whole step together (SPMD): every phase splits its elements (particles,
+ * triangles, or the constraints of one colour) into thread_count contiguous ranges and the
+ * threads meet at a barrier between phases. Every element is computed the same way whatever
+ * range it falls in, and no two threads write the same particle within a phase, so the result
+ * does not depend on the thread count. */
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <animkit/grid.h>
+
+#include "cloth_impl.h"
+#include "internal.h"
+
+#define MAX_THREADS 64u
+
+/* ---- scratch layout --------------------------------------------------------------------- */
+
+typedef struct layout {
+    size_t prev, ext, acc, lambda, tri_force, att_start, hash_start, hash_entry, tri_normal, grid, grid_size, size;
+    size_t buckets, mesh_tris;
+} layout;
+
+static size_t pow2_at_least(size_t x) {
+    size_t p = 1;
+    while (p < x) p <<= 1;
+    return p;
+}
+
+static float self_distance(const ak_cloth_step_job* job) {
+    const float th = job->thickness > 0.0f ? job->thickness : 0.01f;
+    return job->self_distance > 0.0f ? job->self_distance : 2.0f * th;
+}
+
+static layout make_layout(const ak_cloth* c, size_t mesh_tris, const ak_cloth_step_job* job) {
+    layout l;
+    size_t s = 0;
+    l.prev = s, s += akp_align16(c->n * sizeof(ak_vec3));
+    l.ext = s, s += akp_align16(c->n * sizeof(ak_vec3));
+    l.acc = s, s += akp_align16(c->n * sizeof(ak_vec3));
+    l.lambda = s, s += akp_align16((c->dist_count + c->bend_count) * sizeof(float));
+    l.tri_force = s, s += akp_align16(c->tri_count * sizeof(ak_vec3));
+    l.att_start = s, s += akp_align16(c->attach_count * sizeof(ak_vec3));
+    l.mesh_tris = mesh_tris;
+    l.buckets = mesh_tris ? pow2_at_least(2 * mesh_tris) : 0;
+    l.hash_start = s, s += akp_align16(mesh_tris ? (l.buckets + 1) * sizeof(uint32_t) : 0);
+    l.hash_entry = s, s += akp_align16(mesh_tris * 8 * sizeof(uint32_t));
+    l.tri_normal = s, s += akp_align16(mesh_tris * sizeof(ak_vec3));
+    l.grid_size = 0;
+    if (job->self_collision) {
+        const ak_grid_desc gd = {.cell_size = self_distance(job)};
+        l.grid_size = ak_grid_memory_size(c->n, &gd);
+    }
+    l.grid = s, s += akp_align16(l.grid_size);
+    l.size = s + 16; /* room to align the caller's pointer */
+    return l;
+}
+
+size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job) {
+    if (!job || !job->cloth) return 0;
+    return make_layout(job->cloth, job->mesh.indices.count / 3, job).size;
+}
+
+/* ---- validation ------------------------------------------------------------------------- */
+
+static bool bad_nonneg(float x) { return !(x >= 0.0f) || !ak_finitef(x); }
+
+ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) {
+    if (!job || !job->cloth || !job->positions.ptr || !job->velocities.ptr || !job->scratch.ptr) return AK_ERR_NULL_ARG;
+    const ak_cloth* c = job->cloth;
+    if ((job->plane_count && !job->planes) || (job->sphere_count && !job->spheres) ||
+        (job->capsule_count && !job->capsules) || (c->attach_count && !job->attachment_targets.ptr) ||
+        (job->mesh.indices.count && !job->mesh.positions.ptr) || (job->mesh.positions.count && !job->mesh.indices.ptr))
+        return AK_ERR_NULL_ARG;
+    if (!(job->dt > 0.0f) || !ak_finitef(job->dt) || job->thread_count > MAX_THREADS || job->substeps > 10000 ||
+        job->iterations > 10000)
+        return AK_ERR_BAD_ARG;
+    if (bad_nonneg(job->drag) || bad_nonneg(job->lift) || bad_nonneg(job->air_density) || bad_nonneg(job->damping) ||
+        bad_nonneg(job->thickness) || bad_nonneg(job->friction) || bad_nonneg(job->self_distance))
+        return AK_ERR_BAD_ARG;
+    if (job->mesh.indices.count % 3 || job->positions.count != c->n || job->velocities.count != c->n ||
+        job->attachment_targets.count != c->attach_count)
+        return AK_ERR_BAD_ARG;
+    for (size_t k = 0; k < job->sphere_count; ++k)
+        if (job->spheres[k].radius < 0.0f) return AK_ERR_BAD_ARG;
+    for (size_t k = 0; k < job->capsule_count; ++k)
+        if (job->capsules[k].radius < 0.0f) return AK_ERR_BAD_ARG;
+    if (job->out_normals.ptr && job->out_normals.count < c->n) return AK_ERR_SPAN_SMALL;
+    if (job->scratch.count < ak_cloth_step_scratch_size(job)) return AK_ERR_SPAN_SMALL;
+    for (size_t k = 0; k < job->mesh.indices.count; ++k)
+        if (job->mesh.indices.ptr[k] >= job->mesh.positions.count) return AK_ERR_BAD_INDEX;
+    /* data */
+    if (!ak_vec3_is_finite(job->gravity) || !ak_vec3_is_finite(job->wind)) return AK_ERR_BAD_DATA;
+    for (size_t v = 0; v < c->n; ++v)
+        if (!ak_vec3_is_finite(job->positions.ptr[v]) || !ak_vec3_is_finite(job->velocities.ptr[v])) return AK_ERR_BAD_DATA;
+    for (size_t k = 0; k < job->plane_count; ++k)
+        if (!ak_vec3_is_finite(job->planes[k].normal) || !ak_finitef(job->planes[k].offset)) return AK_ERR_BAD_DATA;
+    for (size_t k = 0; k < job->sphere_count; ++k)
+        if (!ak_vec3_is_finite(job->spheres[k].center) || !ak_finitef(job->spheres[k].radius)) return AK_ERR_BAD_DATA;
+    for (size_t k = 0; k < job->capsule_count; ++k)
+        if (!ak_vec3_is_finite(job->capsules[k].a) || !ak_vec3_is_finite(job->capsules[k].b) ||
+            !ak_finitef(job->capsules[k].radius))
+            return AK_ERR_BAD_DATA;
+    for (size_t k = 0; k < job->mesh.positions.count; ++k)
+        if (!ak_vec3_is_finite(job->mesh.positions.ptr[k])) return AK_ERR_BAD_DATA;
+    for (size_t k = 0; k < job->attachment_targets.count; ++k)
+        if (!ak_vec3_is_finite(job->attachment_targets.ptr[k])) return AK_ERR_BAD_DATA;
+    return AK_OK;
+}
+
+/* ---- the shared step context ------------------------------------------------------------ */
+
+typedef struct ctx {
+    const ak_cloth_step_job* job;
+    const ak_cloth* c;
+    unsigned T;          /* threads taking part */
+    uint32_t substeps, iterations;
+    float h, decay, thickness;
+    ak_vec3* x;
+    ak_vec3* v;
+    ak_vec3* prev;
+    ak_vec3* ext;
+    ak_vec3* acc;
+    float* lambda;
+    ak_vec3* tri_force;
+    ak_vec3* att_start;
+    /* mesh collider hash */
+    uint32_t* hash_start;
+    uint32_t* hash_entry;
+    ak_vec3* tri_normal;
+    size_t buckets;
+    float cell;
+    /* self-collision */
+    bool self;
+    float self_dist;
+    ak_u8_span grid_mem;
+    ak_grid grid;
+    ak_result grid_result;
+    /* barrier */
+    pthread_mutex_t m;
+    pthread_cond_t cv;
+    unsigned waiting, generation;
+    bool go;
+} ctx;
+
+typedef struct worker {
+    ctx* c;
+    unsigned t;
+} worker;
+
+static void barrier(ctx* c) {
+    if (c->T == 1) return;
+    pthread_mutex_lock(&c->m);
+    if (++c->waiting == c->T) {
+        c->waiting = 0;
+        c->generation++;
+        pthread_cond_broadcast(&c->cv);
+    } else {
+        const unsigned g = c->generation;
+        while (g == c->generation) pthread_cond_wait(&c->cv, &c->m);
+    }
+    pthread_mutex_unlock(&c->m);
+}
+
+static void range(size_t count, unsigned t, unsigned T, size_t* b, size_t* e) {
+    *b = count * t / T;
+    *e = count * (t + 1) / T;
+}
+
+/* ---- collisions ------------------------------------------------------------------------- */
+
+static uint32_t hash_cell(int32_t x, int32_t y, int32_t z, size_t buckets) {
+    const uint32_t h = ((uint32_t)x * 73856093u) ^ ((uint32_t)y * 19349663u) ^ ((uint32_t)z * 83492791u);
+    return h & (uint32_t)(buckets - 1);
+}
+
+static int32_t cell_of(float x, float cell) {
+    float q = floorf(x / cell);
+    if (q > 1e9f) q = 1e9f;
+    if (q < -1e9f) q = -1e9f;
+    return (int32_t)q;
+}
+
+/* Spatial hash of the collider's triangles (Teschner et al. 2003), each inserted in every cell
+ * its box (grown by the detection distance) overlaps: at most 8, as a cell is as large as the
+ * largest grown box. Counting sort into hash_start/hash_entry. */
+static void build_hash(ctx* c, float reach) {
+    const ak_cloth_collider_mesh* m = &c->job->mesh;
+    const size_t nt = m->indices.count / 3;
+    float cell = 0.0f;
+    for (size_t t = 0; t < nt; ++t) {
+        const ak_vec3 a = m->positions.ptr[m->indices.ptr[3 * t]], b = m->positions.ptr[m->indices.ptr[3 * t + 1]],
+                      d = m->positions.ptr[m->indices.ptr[3 * t + 2]];
+        const ak_vec3 lo = ak_vec3_min(a, ak_vec3_min(b, d)), hi = ak_vec3_max(a, ak_vec3_max(b, d));
+        cell = ak_maxf(cell, ak_maxf(hi.x - lo.x, ak_maxf(hi.y - lo.y, hi.z - lo.z)) + 2.0f * reach);
+        c->tri_normal[t] = ak_vec3_normalize(ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(d, a)));
+    }
+    c->cell = cell > 1e-6f ? cell : 1e-6f;
+    memset(c->hash_start, 0, (c->buckets + 1) * sizeof(uint32_t));
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t t = 0; t < nt; ++t) {
+            const ak_vec3 a = m->positions.ptr[m->indices.ptr[3 * t]], b = m->positions.ptr[m->indices.ptr[3 * t + 1]],
+                          d = m->positions.ptr[m->indices.ptr[3 * t + 2]];
+            const ak_vec3 r = ak_vec3_make(reach, reach, reach);
+            const ak_vec3 lo = ak_vec3_sub(ak_vec3_min(a, ak_vec3_min(b, d)), r);
+            const ak_vec3 hi = ak_vec3_add(ak_vec3_max(a, ak_vec3_max(b, d)), r);
+            const int32_t x0 = cell_of(lo.x, c->cell), x1 = cell_of(hi.x, c->cell), y0 = cell_of(lo.y, c->cell),
+                          y1 = cell_of(hi.y, c->cell), z0 = cell_of(lo.z, c->cell), z1 = cell_of(hi.z, c->cell);
+            uint32_t seen[8];
+            int ns = 0;
+            for (int32_t x = x0; x <= x1 && x <= x0 + 1; ++x)
+                for (int32_t y = y0; y <= y1 && y <= y0 + 1; ++y)
+                    for (int32_t z = z0; z <= z1 && z <= z0 + 1; ++z) {
+                        const uint32_t h = hash_cell(x, y, z, c->buckets);
+                        bool dup = false;
+                        for (int q = 0; q < ns; ++q) dup = dup || seen[q] == h;
+                        if (dup) continue;
+                        seen[ns++] = h;
+                        if (pass == 0) c->hash_start[h + 1]++;
+                        else c->hash_entry[c->hash_start[h]++] = (uint32_t)t;
+                    }
+        }
+        if (pass == 0)
+            for (size_t k = 0; k < c->buckets; ++k) c->hash_start[k + 1] += c->hash_start[k];
+    }
+    /* pass 1 advanced each start to its end: shift back */
+    for (size_t k = c->buckets; k > 0; --k) c->hash_start[k] = c->hash_start[k - 1];
+    c->hash_start[0] = 0;
+}
+
+/* Closest point to p on triangle abc (Ericson, Real-Time Collision Detection, 5.1.5). */
+static ak_vec3 closest_on_triangle(ak_vec3 p, ak_vec3 a, ak_vec3 b, ak_vec3 c) {
+    const ak_vec3 ab = ak_vec3_sub(b, a), ac = ak_vec3_sub(c, a), ap = ak_vec3_sub(p, a);
+    const float d1 = ak_vec3_dot(ab, ap), d2 = ak_vec3_dot(ac, ap);
+    if (d1 <= 0.0f && d2 <= 0.0f) return a;
+    const ak_vec3 bp = ak_vec3_sub(p, b);
+    const float d3 = ak_vec3_dot(ab, bp), d4 = ak_vec3_dot(ac, bp);
+    if (d3 >= 0.0f && d4 <= d3) return b;
+    const float vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return ak_vec3_madd(a, ab, d1 / (d1 - d3));
+    const ak_vec3 cp = ak_vec3_sub(p, c);
+    const float d5 = ak_vec3_dot(ab, cp), d6 = ak_vec3_dot(ac, cp);
+    if (d6 >= 0.0f && d5 <= d6) return c;
+    const float vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return ak_vec3_madd(a, ac, d2 / (d2 - d6));
+    const float va = d3 * d6 - d5 * d4;
+    if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f)
+        return ak_vec3_madd(b, ak_vec3_sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    const float denom = 1.0f / (va + vb + vc);
+    return ak_vec3_add(a, ak_vec3_add(ak_vec3_scale(ab, vb * denom), ak_vec3_scale(ac, vc * denom)));
+}
+
+/* Friction at a contact of normal n and penetration depth: the tangential motion of this
+ * substep shrinks by up to friction * depth (position-level Coulomb friction). */
+static ak_vec3 apply_friction(ak_vec3 x, ak_vec3 prev, ak_vec3 n, float depth, float mu) {
+    if (mu <= 0.0f) return x;
+    const ak_vec3 d = ak_vec3_sub(x, prev);
+    const ak_vec3 t = ak_vec3_madd(d, n, -ak_vec3_dot(d, n));
+    const float lt = ak_vec3_length(t);
+    if (lt <= 1e-12f) return x;
+    return ak_vec3_madd(x, t, -ak_minf(1.0f, mu * depth / lt));
+}
+
+/* Push a point out of a sphere of radius r around center. */
+static bool push_sphere(ak_vec3* x, ak_vec3 center, float r, ak_vec3* n, float* depth) {
+    const ak_vec3 d = ak_vec3_sub(*x, center);
+    const float l2 = ak_vec3_length_sq(d);
+    if (l2 >= r * r) return false;
+    const float l = sqrtf(l2);
+    *n = l > 1e-12f ? ak_vec3_scale(d, 1.0f / l) : ak_vec3_make(0, 1, 0);
+    *depth = r - l;
+    *x = ak_vec3_madd(center, *n, r);
+    return true;
+}
+
+static void collide(const ctx* c, size_t i) {
+    const ak_cloth_step_job* job = c->job;
+    const float th = c->thickness, mu = job->friction;
+    ak_vec3 x = c->x[i];
+    const ak_vec3 prev = c->prev[i];
+    ak_vec3 n;
+    float depth;
+    for (size_t k = 0; k < job->plane_count; ++k) {
+        ak_vec3 pn = job->planes[k].normal;
+        pn = ak_vec3_length_sq(pn) > 0.0f ? ak_vec3_normalize(pn) : ak_vec3_make(0, 1, 0);
+        const float d = ak_vec3_dot(pn, x) - job->planes[k].offset - th;
+        if (d < 0.0f) {
+            x = ak_vec3_madd(x, pn, -d);
+            x = apply_friction(x, prev, pn, -d, mu);
+        }
+    }
+    for (size_t k = 0; k < job->sphere_count; ++k)
+        if (push_sphere(&x, job->spheres[k].center, job->spheres[k].radius + th, &n, &depth))
+            x = apply_friction(x, prev, n, depth, mu);
+    for (size_t k = 0; k < job->capsule_count; ++k) {
+        const ak_cloth_capsule* cap = &job->capsules[k];
+        const ak_vec3 ab = ak_vec3_sub(cap->b, cap->a);
+        const float l2 = ak_vec3_length_sq(ab);
+        const float t = l2 > 0.0f ? ak_clampf(ak_vec3_dot(ak_vec3_sub(x, cap->a), ab) / l2, 0.0f, 1.0f) : 0.0f;
+        if (push_sphere(&x, ak_vec3_madd(cap->a, ab, t), cap->radius + th, &n, &depth))
+            x = apply_friction(x, prev, n, depth, mu);
+    }
+    if (c->buckets) {
+        const ak_cloth_collider_mesh* m = &job->mesh;
+        const uint32_t h = hash_cell(cell_of(x.x, c->cell), cell_of(x.y, c->cell), cell_of(x.z, c->cell), c->buckets);
+        float best = 2.0f * th;
+        ak_vec3 bq = x;
+        uint32_t bt = UINT32_MAX;
+        for (uint32_t k = c->hash_start[h]; k < c->hash_start[h + 1]; ++k) {
+            const uint32_t t = c->hash_entry[k];
+            const uint32_t* o = m->indices.ptr + 3 * t;
+            const ak_vec3 q = closest_on_triangle(x, m->positions.ptr[o[0]], m->positions.ptr[o[1]], m->positions.ptr[o[2]]);
+            const float d = ak_vec3_distance(x, q);
+            if (d < best || (d == best && t < bt)) best = d, bq = q, bt = t;
+        }
+        if (bt != UINT32_MAX) {
+            const ak_vec3 tn = c->tri_normal[bt];
+            const ak_vec3 dx = ak_vec3_sub(x, bq);
+            const float side = ak_vec3_dot(dx, tn);
+            if (side >= 0.0f && best < th) {
+                n = best > 1e-12f ? ak_vec3_scale(dx, 1.0f / best) : tn;
+                x = ak_vec3_madd(bq, n, th);
+                x = apply_friction(x, prev, n, th - best, mu);
+            } else if (side < 0.0f) {
+                x = ak_vec3_madd(bq, tn, th);
+                x = apply_friction(x, prev, tn, th + best, mu);
+            }
+        }
+    }
+    c->x[i] = x;
+}
+
+/* ---- constraints ------------------------------------------------------------------------ */
+
+static void solve_dist(const ctx* c, size_t k, bool first) {
+    const ak_cloth* cl = c->c;
+    const akp_dist* d = &cl->dist[k];
+    const float wi = cl->inv_mass[d->i], wj = cl->inv_mass[d->j], w = wi + wj;
+    if (w == 0.0f) return;
+    ak_vec3 xi = c->x[d->i], xj = c->x[d->j];
+    const ak_vec3 e = ak_vec3_sub(xi, xj);
+    const float len = ak_vec3_length(e);
+    if (len < 1e-12f) return;
+    const ak_vec3 g = ak_vec3_scale(e, 1.0f / len); /* grad_i C; grad_j C = -g */
+    const float C = len - d->rest;
+    float dl;
+    if (cl->desc.solver == AK_CLOTH_PBD) {
+        dl = -cl->desc.pbd_stiffness * C / w;
+    } else {
+        const float h2 = c->h * c->h;
+        const float at = d->alpha / h2;
+        const float lam = first ? 0.0f : c->lambda[k];
+        /* eq. 26: gamma = alpha~ beta~ / h with beta~ = h^2 beta */
+        const float gamma = d->alpha * cl->desc.constraint_damping / c->h;
+        const float vdot = ak_vec3_dot(g, ak_vec3_sub(ak_vec3_sub(xi, c->prev[d->i]), ak_vec3_sub(xj, c->prev[d->j])));
+        dl = (-C - at * lam - gamma * vdot) / ((1.0f + gamma) * w + at);
+        c->lambda[k] = lam + dl;
+    }
+    c->x[d->i] = ak_vec3_madd(xi, g, wi * dl);
+    c->x[d->j] = ak_vec3_madd(xj, g, -wj * dl);
+}
+
+static void solve_bend(const ctx* c, size_t k, bool first) {
+    const ak_cloth* cl = c->c;
+    const akp_bend* b = &cl->bend[k];
+    ak_vec3 x[4], g[4];
+    float w[4], wsum = 0.0f, C, alpha;
+    for (int q = 0; q < 4; ++q) x[q] = c->x[b->p[q]], w[q] = cl->inv_mass[b->p[q]];
+    if (cl->desc.bending == AK_CLOTH_BEND_ISOMETRIC) {
+        /* C = |b| - |b_rest|, grad_i C = K_i b / |b| */
+        ak_vec3 bv = ak_vec3_make(0, 0, 0);
+        for (int q = 0; q < 4; ++q) bv = ak_vec3_madd(bv, x[q], b->K[q]);
+        const float l = ak_vec3_length(bv);
+        if (l < 1e-12f) return;
+        const ak_vec3 n = ak_vec3_scale(bv, 1.0f / l);
+        for (int q = 0; q < 4; ++q) g[q] = ak_vec3_scale(n, b->K[q]), wsum += w[q] * b->K[q] * b->K[q];
+        C = l - b->rest;
+        alpha = b->alpha;
+    } else {
+        C = akp_dihedral(x, g) - b->rest;
+        if (C > AK_PI) C -= 2.0f * AK_PI;
+        if (C < -AK_PI) C += 2.0f * AK_PI;
+        for (int q = 0; q < 4; ++q) wsum += w[q] * ak_vec3_length_sq(g[q]);
+        alpha = 1.0f / cl->desc.dihedral_stiffness; /* 0 when infinite */
+    }
+    if (wsum < 1e-20f) return;
+    float dl;
+    float* lam_slot = c->lambda + cl->dist_count + k;
+    if (cl->desc.solver == AK_CLOTH_PBD) {
+        dl = -cl->desc.pbd_stiffness * C / wsum;
+    } else {
+        const float at = alpha / (c->h * c->h);
+        const float lam = first ? 0.0f : *lam_slot;
+        const float gamma = alpha * cl->desc.constraint_damping / c->h;
+        float vdot = 0.0f;
+        for (int q = 0; q < 4; ++q) vdot += ak_vec3_dot(g[q], ak_vec3_sub(x[q], c->prev[b->p[q]]));
+        dl = (-C - at * lam - gamma * vdot) / ((1.0f + gamma) * wsum + at);
+        *lam_slot = lam + dl;
+    }
+    for (int q = 0; q < 4; ++q)
+        if (w[q] > 0.0f) c->x[b->p[q]] = ak_vec3_madd(x[q], g[q], w[q] * dl);
+}
+
+/* Spring force of spring k added to acc (force accumulators) of its two particles. */
+static void spring_force(const ctx* c, size_t k) {
+    const ak_cloth* cl = c->c;
+    const akp_dist* d = &cl->dist[k];
+    const ak_vec3 e = ak_vec3_sub(c->x[d->j], c->x[d->i]);
+    const float len = ak_vec3_length(e);
+    if (len < 1e-12f) return;
+    const ak_vec3 u = ak_vec3_scale(e, 1.0f / len);
+    const float rel = ak_vec3_dot(ak_vec3_sub(c->v[d->j], c->v[d->i]), u);
+    const ak_vec3 f = ak_vec3_scale(u, d->k * (len - d->rest) + cl->desc.spring_damping * rel); /* on i, towards j */
+    c->acc[d->i] = ak_vec3_add(c->acc[d->i], f);
+    c->acc[d->j] = ak_vec3_sub(c->acc[d->j], f);
+}
+
+/* ---- self-collision ------------------------------------------------------------------- */
+
+#define SELF_MAX_NEIGHBOURS 32u
+
+/* Rebuild the grid over the current positions (one thread). */
+static void self_grid(ctx* c) {
+    const ak_grid_desc gd = {.cell_size = c->self_dist};
+    const ak_result r = ak_grid_build(&gd, (ak_vec3_cspan){c->x, c->c->n}, c->grid_mem, &c->grid);
+    if (r != AK_OK) c->grid_result = r;
+}
+
+/* Jacobi correction of particle i into acc[i]: the mean over its pairs closer than the target
+ * distance (self_distance, or their rest distance when that is smaller) of the move that
+ * separates them, shared by inverse mass. */
+static void self_delta(const ctx* c, size_t i) {
+    const ak_cloth* cl = c->c;
+    ak_vec3 sum = ak_vec3_make(0, 0, 0);
+    c->acc[i] = sum;
+    const float wi = cl->inv_mass[i];
+    if (wi == 0.0f || c->grid_result != AK_OK) return;
+    uint32_t nb[SELF_MAX_NEIGHBOURS];
+    size_t total = ak_grid_query(&c->grid, c->x[i], c->self_dist, (ak_u32_span){nb, SELF_MAX_NEIGHBOURS});
+    if (total > SELF_MAX_NEIGHBOURS) total = SELF_MAX_NEIGHBOURS;
+    /* the grid returns neighbours in its own order: sort them so the sum is the same for any
+     * grid layout (insertion sort of at most 32) */
+    for (size_t a = 1; a < total; ++a)
+        for (size_t b = a; b > 0 && nb[b - 1] > nb[b]; --b) {
+            const uint32_t t = nb[b];
+            nb[b] = nb[b - 1], nb[b - 1] = t;
+        }
+    int count = 0;
+    for (size_t k = 0; k < total; ++k) {
+        const uint32_t j = nb[k];
+        if (j == i) continue;
+        const float target = ak_minf(c->self_dist, ak_vec3_distance(cl->rest[i], cl->rest[j]));
+        const ak_vec3 d = ak_vec3_sub(c->x[i], c->x[j]);
+        const float l = ak_vec3_length(d);
+        if (l >= target || l < 1e-9f) continue;
+        const float wj = cl->inv_mass[j];
+        sum = ak_vec3_madd(sum, d, (target - l) / l * wi / (wi + wj));
+        ++count;
+    }
+    if (count) c->acc[i] = ak_vec3_scale(sum, 1.0f / (float)count);
+}
+
+/* ---- phases ----------------------------------------------------------------------------- */
+
+/* Wind: drag and lift per triangle from the relative air velocity, a third to each corner. */
+static void wind_triangles(const ctx* c, size_t b, size_t e) {
+    const ak_cloth_step_job* job = c->job;
+    const ak_cloth* cl = c->c;
+    const float rho = job->air_density > 0.0f ? job->air_density : 1.2f;
+    for (size_t t = b; t < e; ++t) {
+        const uint32_t* o = cl->indices + 3 * t;
+        const ak_vec3 p0 = c->x[o[0]], p1 = c->x[o[1]], p2 = c->x[o[2]];
+        ak_vec3 f = ak_vec3_make(0, 0, 0);
+        const ak_vec3 cr = ak_vec3_cross(ak_vec3_sub(p1, p0), ak_vec3_sub(p2, p0));
+        const float cl2 = ak_vec3_length(cr);
+        const ak_vec3 vt = ak_vec3_scale(ak_vec3_add(c->v[o[0]], ak_vec3_add(c->v[o[1]], c->v[o[2]])), 1.0f / 3.0f);
+        const ak_vec3 vr = ak_vec3_sub(vt, job->wind); /* triangle velocity relative to the air */
+        const float s = ak_vec3_length(vr);
+        if (cl2 > 1e-20f && s > 1e-9f) {
+            const float area = 0.5f * cl2;
+            ak_vec3 n = ak_vec3_scale(cr, 1.0f / cl2);
+            const ak_vec3 vh = ak_vec3_scale(vr, 1.0f / s);
+            float cosine = ak_vec3_dot(n, vh);
+            if (cosine < 0.0f) n = ak_vec3_neg(n), cosine = -cosine; /* the side facing the motion */
+            const float q = 0.5f * rho * s * s * area;
+            /* drag opposes the relative motion, scaled by the area the air sees */
+            f = ak_vec3_scale(vh, -q * job->drag * cosine);
+            /* lift: across the relative motion, in the plane of v and n, largest at 45 degrees */
+            const ak_vec3 side = ak_vec3_cross(n, vh);
+            const ak_vec3 ldir = ak_vec3_cross(side, vh); /* perpendicular to vh, towards -n */
+            const float ll = ak_vec3_length(ldir);
+            if (ll > 1e-9f) {
+                const float sine = sqrtf(ak_maxf(0.0f, 1.0f - cosine * cosine));
+                f = ak_vec3_madd(f, ldir, q * job->lift * cosine * sine / ll);
+            }
+        }
+        c->tri_force[t] = ak_vec3_scale(f, 1.0f / 3.0f);
+    }
+}
+
+static void gather_wind(const ctx* c, size_t b, size_t e) {
+    const ak_cloth* cl = c->c;
+    for (size_t v = b; v < e; ++v) {
+        ak_vec3 s = ak_vec3_make(0, 0, 0);
+        for (uint32_t k = cl->vt_start[v]; k < cl->vt_start[v + 1]; ++k) s = ak_vec3_add(s, c->tri_force[cl->vt_tri[k]]);
+        c->ext[v] = s;
+    }
+}
+
+/* Move the kinematic particles to where they are at fraction f of the step: attachments on the
+ * line from their start to their target, pins at their pin positions. */
+static void kinematic_targets(const ctx* c, float f, unsigned t) {
+    const ak_cloth* cl = c->c;
+    size_t b, e;
+    range(cl->attach_count, t, c->T, &b, &e);
+    for (size_t k = b; k < e; ++k) {
+        const uint32_t v = cl->attach[k];
+        c->prev[v] = c->x[v];
+        c->x[v] = f >= 1.0f ? c->job->attachment_targets.ptr[k] : ak_vec3_lerp(c->att_start[k], c->job->attachment_targets.ptr[k], f);
+        c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / c->h);
+    }
+    range(cl->pin_count, t, c->T, &b, &e);
+    for (size_t k = b; k < e; ++k) {
+        const uint32_t v = cl->pins[k];
+        c->prev[v] = c->x[v];
+        c->x[v] = cl->pin_pos[k];
+        c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / c->h);
+    }
+}
+
+static bool is_free(const ak_cloth* cl, size_t v) { return cl->inv_mass[v] > 0.0f; }
+
+static void run_spmd(ctx* c, unsigned t) {
+    const ak_cloth* cl = c->c;
+    const ak_cloth_step_job* job = c->job;
+    const size_t n = cl->n;
+    const float h = c->h;
+    size_t b, e;
+    const bool wind = (job->drag > 0.0f || job->lift > 0.0f) && cl->tri_count > 0;
+    size_t tb, te;
+    range(n, t, c->T, &b, &e);
+    range(cl->tri_count, t, c->T, &tb, &te);
+    memset(c->ext + b, 0, (e - b) * sizeof(ak_vec3));
+    barrier(c);
+    const bool springs = cl->desc.solver == AK_CLOTH_SPRINGS;
+    for (uint32_t s = 0; s < c->substeps; ++s) {
+        const float f = (float)(s + 1) / (float)c->substeps;
+        /* wind each substep: drag acts like a damper of rate rho C_d A |v| / m, which an
+         * explicit force only follows stably when that rate times the step is small */
+        if (wind) {
+            wind_triangles(c, tb, te);
+            barrier(c);
+            gather_wind(c, b, e);
+            barrier(c);
+        }
+        if (springs) {
+            for (size_t v = b; v < e; ++v)
+                c->acc[v] = is_free(cl, v) ? ak_vec3_madd(c->ext[v], job->gravity, cl->mass[v]) : ak_vec3_make(0, 0, 0);
+            barrier(c);
+            for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
+                const size_t cb = cl->dist_color[col], ce = cl->dist_color[col + 1];
+                if (cb == ce) continue;
+                size_t kb, ke;
+                if (col == AKP_SERIAL_COLOR) kb = t == 0 ? cb : ce, ke = ce;
+                else range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
+                for (size_t k = kb; k < ke; ++k) spring_force(c, k);
+                barrier(c);
+            }
+            for (size_t v = b; v < e; ++v) {
+                if (!is_free(cl, v)) continue;
+                const ak_vec3 vel = ak_vec3_madd(ak_vec3_scale(c->v[v], c->decay), c->acc[v], h * cl->inv_mass[v]);
+                c->prev[v] = c->x[v];
+                c->v[v] = vel;
+                c->x[v] = ak_vec3_madd(c->x[v], vel, h);
+            }
+            kinematic_targets(c, f, t);
+            barrier(c);
+            if (c->self) {
+                if (t == 0) self_grid(c);
+                barrier(c);
+                for (size_t v = b; v < e; ++v) self_delta(c, v);
+                barrier(c);
+            }
+            for (size_t v = b; v < e; ++v) {
+                if (!is_free(cl, v)) continue;
+                const ak_vec3 before = c->x[v];
+                if (c->self) c->x[v] = ak_vec3_add(c->x[v], c->acc[v]);
+                collide(c, v);
+                if (c->x[v].x != before.x || c->x[v].y != before.y || c->x[v].z != before.z)
+                    c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / h);
+            }
+            barrier(c);
+            continue;
+        }
+        /* XPBD / PBD: predict */
+        for (size_t v = b; v < e; ++v) {
+            if (!is_free(cl, v)) continue;
+            /* damp, then accelerate: at rest (v = 0) damping then leaves the rest point alone */
+            const ak_vec3 vel = ak_vec3_madd(ak_vec3_scale(c->v[v], c->decay),
+                                             ak_vec3_madd(job->gravity, c->ext[v], cl->inv_mass[v]), h);
+            c->prev[v] = c->x[v];
+            c->x[v] = ak_vec3_madd(c->x[v], vel, h);
+        }
+        kinematic_targets(c, f, t);
+        barrier(c);
+        for (uint32_t it = 0; it < c->iterations; ++it) {
+            for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
+                const size_t cb = cl->dist_color[col], ce = cl->dist_color[col + 1];
+                if (cb == ce) continue;
+                size_t kb, ke;
+                if (col == AKP_SERIAL_COLOR) kb = t == 0 ? cb : ce, ke = ce;
+                else range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
+                for (size_t k = kb; k < ke; ++k) solve_dist(c, k, it == 0);
+                barrier(c);
+            }
+            for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
+                const size_t cb = cl->bend_color[col], ce = cl->bend_color[col + 1];
+                if (cb == ce) continue;
+                size_t kb, ke;
+                if (col == AKP_SERIAL_COLOR) kb = t == 0 ? cb : ce, ke = ce;
+                else range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
+                for (size_t k = kb; k < ke; ++k) solve_bend(c, k, it == 0);
+                barrier(c);
+            }
+            if (cl->lra_anchor) {
+                for (size_t v = b; v < e; ++v) {
+                    const uint32_t a = cl->lra_anchor[v];
+                    if (a == UINT32_MAX) continue;
+                    const ak_vec3 d = ak_vec3_sub(c->x[v], c->x[a]);
+                    const float l = ak_vec3_length(d);
+                    if (l > cl->lra_dist[v]) c->x[v] = ak_vec3_madd(c->x[a], d, cl->lra_dist[v] / l);
+                }
+                barrier(c);
+            }
+        }
+        if (c->self) {
+            if (t == 0) self_grid(c);
+            barrier(c);
+            for (size_t v = b; v < e; ++v) self_delta(c, v);
+            barrier(c);
+        }
+        for (size_t v = b; v < e; ++v) {
+            if (is_free(cl, v)) {
+                if (c->self) c->x[v] = ak_vec3_add(c->x[v], c->acc[v]);
+                collide(c, v);
+            }
+            c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / h);
+        }
+        barrier(c);
+    }
+}
+
+static void* worker_main(void* arg) {
+    worker* w = (worker*)arg;
+    ctx* c = w->c;
+    pthread_mutex_lock(&c->m);
+    while (!c->go) pthread_cond_wait(&c->cv, &c->m);
+    pthread_mutex_unlock(&c->m);
+    run_spmd(c, w->t);
+    return NULL;
+}
+
+ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
+    ak_result r = ak_cloth_step_validate(job);
+    if (r != AK_OK) return r;
+    const ak_cloth* cl = job->cloth;
+    const size_t mesh_tris = job->mesh.indices.count / 3;
+    const layout l = make_layout(cl, mesh_tris, job);
+    uint8_t* base = job->scratch.ptr;
+    base += (16u - ((uintptr_t)base & 15u)) & 15u;
+    ctx c;
+    memset(&c, 0, sizeof c);
+    c.job = job;
+    c.c = cl;
+    c.substeps = job->substeps ? job->substeps : 10;
+    c.iterations = job->iterations ? job->iterations : 1;
+    c.h = job->dt / (float)c.substeps;
+    c.decay = expf(-job->damping * c.h);
+    c.thickness = job->thickness > 0.0f ? job->thickness : 0.01f;
+    c.x = job->positions.ptr;
+    c.v = job->velocities.ptr;
+    c.prev = (ak_vec3*)(base + l.prev);
+    c.ext = (ak_vec3*)(base + l.ext);
+    c.acc = (ak_vec3*)(base + l.acc);
+    c.lambda = (float*)(base + l.lambda);
+    c.tri_force = (ak_vec3*)(base + l.tri_force);
+    c.att_start = (ak_vec3*)(base + l.att_start);
+    c.hash_start = (uint32_t*)(base + l.hash_start);
+    c.hash_entry = (uint32_t*)(base + l.hash_entry);
+    c.tri_normal = (ak_vec3*)(base + l.tri_normal);
+    c.buckets = l.buckets;
+    c.self = job->self_collision;
+    c.self_dist = self_distance(job);
+    c.grid_mem = (ak_u8_span){base + l.grid, l.grid_size};
+    memcpy(c.prev, c.x, cl->n * sizeof(ak_vec3));
+    for (size_t k = 0; k < cl->attach_count; ++k) c.att_start[k] = c.x[cl->attach[k]];
+    if (mesh_tris) build_hash(&c, 2.0f * c.thickness);
+    unsigned want = job->thread_count > 1 ? job->thread_count : 1;
+    if ((size_t)want > cl->n) want = cl->n ? (unsigned)cl->n : 1;
+    pthread_t ids[MAX_THREADS];
+    worker ws[MAX_THREADS];
+    unsigned started = 1;
+    if (want > 1) {
+        pthread_mutex_init(&c.m, NULL);
+        pthread_cond_init(&c.cv, NULL);
+        for (unsigned t = 1; t < want; ++t) {
+            ws[t] = (worker){&c, t};
+            if (pthread_create(&ids[t], NULL, worker_main, &ws[t]) != 0) break;
+            started++;
+        }
+        pthread_mutex_lock(&c.m);
+        c.T = started;
+        c.go = true;
+        pthread_cond_broadcast(&c.cv);
+        pthread_mutex_unlock(&c.m);
+    } else {
+        c.T = 1;
+    }
+    run_spmd(&c, 0);
+    if (want > 1) {
+        for (unsigned t = 1; t < started; ++t) pthread_join(ids[t], NULL);
+        pthread_cond_destroy(&c.cv);
+        pthread_mutex_destroy(&c.m);
+    }
+    bool finite = true;
+    for (size_t v = 0; v < cl->n; ++v)
+        finite = finite && ak_vec3_is_finite(c.x[v]) && ak_vec3_is_finite(c.v[v]);
+    if (!finite) return AK_ERR_NO_CONVERGENCE;
+    if (job->out_normals.ptr)
+        ak_cloth_normals(cl, (ak_vec3_cspan){c.x, cl->n}, job->out_normals);
+    return AK_OK;
+}

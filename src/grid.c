@@ -1,0 +1,455 @@
+/* Uniform-grid neighbour search: hashed cell keys, counting sort, exact radius queries. */
+#include <animkit/grid.h>
+
+#include <math.h>
+#include <pthread.h>
+
+#include "internal.h"
+
+#define GRID_COORD_LIMIT 1073741824.0 /* 2^30: clamp for cell coordinates */
+#define GRID_MAX_THREADS 64u
+
+/* ---- helpers ------------------------------------------------------------------------ */
+
+static inline int32_t cell_coord(float p, double inv_cell) {
+    double v = floor((double)p * inv_cell);
+    if (!(v >= -GRID_COORD_LIMIT)) v = -GRID_COORD_LIMIT; /* NaN too */
+    if (v > GRID_COORD_LIMIT) v = GRID_COORD_LIMIT;
+    return (int32_t)v;
+}
+
+static inline ak_grid_cell cell_of(float x, float y, float z, double inv_cell) {
+    ak_grid_cell c = {cell_coord(x, inv_cell), cell_coord(y, inv_cell), cell_coord(z, inv_cell)};
+    return c;
+}
+
+static inline uint32_t cell_hash(ak_grid_cell c) {
+    uint32_t h =
+        (uint32_t)c.x * 0x9E3779B1u ^ (uint32_t)c.y * 0x85EBCA77u ^ (uint32_t)c.z * 0xC2B2AE3Du;
+    h ^= h >> 15;
+    h *= 0x2C1B3C6Du;
+    h ^= h >> 12;
+    return h;
+}
+
+static inline bool cell_eq(ak_grid_cell a, ak_grid_cell b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+
+static inline bool cell_less(ak_grid_cell a, ak_grid_cell b) {
+    if (a.z != b.z) return a.z < b.z;
+    if (a.y != b.y) return a.y < b.y;
+    return a.x < b.x;
+}
+
+static size_t bucket_count_for(size_t n) {
+    size_t b = 16;
+    while (b < 2 * n && b < ((size_t)1 << 31)) b <<= 1;
+    return b;
+}
+
+/* Carves the caller's memory; the same walk sizes it (base NULL). */
+typedef struct layout {
+    uint32_t* order;
+    float *x, *y, *z;
+    uint32_t* cell_start;
+    ak_grid_cell* cell_coord;
+    uint32_t* bucket_start;
+    ak_grid_cell* point_cell; /* temporaries from here on */
+    uint32_t* point_bucket;
+    uint32_t* tmp;
+    uint32_t* bucket_fill;
+} layout;
+
+static size_t carve(uint8_t* base, size_t n, size_t buckets, layout* l) {
+    size_t off = 0;
+#define GRID_TAKE(field, type, count)                                                              \
+    do {                                                                                           \
+        l->field = base ? (type*)(void*)(base + off) : NULL;                                       \
+        off += akp_align16(sizeof(type) * (count));                                                \
+    } while (0)
+    GRID_TAKE(order, uint32_t, n);
+    GRID_TAKE(x, float, n);
+    GRID_TAKE(y, float, n);
+    GRID_TAKE(z, float, n);
+    GRID_TAKE(cell_start, uint32_t, n + 1);
+    GRID_TAKE(cell_coord, ak_grid_cell, n);
+    GRID_TAKE(bucket_start, uint32_t, buckets + 1);
+    GRID_TAKE(point_cell, ak_grid_cell, n);
+    GRID_TAKE(point_bucket, uint32_t, n);
+    GRID_TAKE(tmp, uint32_t, n);
+    GRID_TAKE(bucket_fill, uint32_t, buckets + 1);
+#undef GRID_TAKE
+    return off;
+}
+
+/* Stable bottom-up merge sort of idx[0..n) by the cells of the points. */
+static void sort_by_cell(uint32_t* idx, uint32_t* tmp, size_t n, const ak_grid_cell* pc) {
+    uint32_t *src = idx, *dst = tmp;
+    for (size_t w = 1; w < n; w *= 2) {
+        for (size_t lo = 0; lo < n; lo += 2 * w) {
+            size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+            size_t a = lo, b = mid, o = lo;
+            while (a < mid && b < hi)
+                dst[o++] = cell_less(pc[src[b]], pc[src[a]]) ? src[b++] : src[a++];
+            while (a < mid) dst[o++] = src[a++];
+            while (b < hi) dst[o++] = src[b++];
+        }
+        uint32_t* t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != idx) memcpy(idx, src, n * sizeof *idx);
+}
+
+/* Rings of cells a radius needs: the smallest k with k * cell_size >= radius. */
+static int64_t rings_for(const ak_grid* g, float radius) {
+    double k = ceil((double)radius / (double)g->cell_size);
+    if (k < 1.0) k = 1.0;
+    if (k * (double)g->cell_size < (double)radius) k += 1.0;
+    if (k > 4096.0) k = 4096.0; /* beyond this every query scans all cells anyway */
+    return (int64_t)k;
+}
+
+/* True when visiting a (2k+1)^3 stencil costs more than scanning every cell. */
+static bool scan_all_cells(const ak_grid* g, int64_t k) {
+    int64_t side = 2 * k + 1;
+    return side * side * side > (int64_t)g->cell_count + 27;
+}
+
+static inline int64_t abs64(int64_t v) { return v < 0 ? -v : v; }
+
+static inline bool cells_within(ak_grid_cell a, ak_grid_cell b, int64_t k) {
+    return abs64((int64_t)a.x - b.x) <= k && abs64((int64_t)a.y - b.y) <= k &&
+           abs64((int64_t)a.z - b.z) <= k;
+}
+
+static inline bool coord_offset_ok(int32_t c, int64_t d) {
+    int64_t v = (int64_t)c + d;
+    return v >= -(int64_t)GRID_COORD_LIMIT && v <= (int64_t)GRID_COORD_LIMIT;
+}
+
+/* ---- public: build ------------------------------------------------------------------ */
+
+size_t ak_grid_memory_size(size_t point_count, const ak_grid_desc* desc) {
+    if (!desc || point_count >= ((size_t)1 << 31)) return 0;
+    layout l;
+    return carve(NULL, point_count, bucket_count_for(point_count), &l) + 16;
+}
+
+ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_span memory,
+                        ak_grid* out_grid) {
+    if (out_grid) memset(out_grid, 0, sizeof *out_grid);
+    if (!desc || !out_grid || !memory.ptr || (!points.ptr && points.count > 0))
+        return AK_ERR_NULL_ARG;
+    if (!(desc->cell_size > 0.0f) || !ak_finitef(desc->cell_size) ||
+        points.count >= ((size_t)1 << 31))
+        return AK_ERR_BAD_ARG;
+    const size_t n = points.count;
+    if (memory.count < ak_grid_memory_size(n, desc)) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i) {
+        const ak_vec3 p = points.ptr[i];
+        if (!ak_finitef(p.x) || !ak_finitef(p.y) || !ak_finitef(p.z)) return AK_ERR_BAD_DATA;
+    }
+    const size_t buckets = bucket_count_for(n);
+    const uint32_t mask = (uint32_t)(buckets - 1);
+    uint8_t* base = memory.ptr + ((16u - ((uintptr_t)memory.ptr & 15u)) & 15u);
+    layout l;
+    carve(base, n, buckets, &l);
+
+    /* Cell and bucket of every point, then a counting sort by bucket (stable: by index). */
+    const double inv = 1.0 / (double)desc->cell_size;
+    memset(l.bucket_fill, 0, (buckets + 1) * sizeof(uint32_t));
+    for (size_t i = 0; i < n; ++i) {
+        const ak_vec3 p = points.ptr[i];
+        l.point_cell[i] = cell_of(p.x, p.y, p.z, inv);
+        l.point_bucket[i] = cell_hash(l.point_cell[i]) & mask;
+        l.bucket_fill[l.point_bucket[i] + 1]++;
+    }
+    for (size_t b = 0; b < buckets; ++b) l.bucket_fill[b + 1] += l.bucket_fill[b];
+    for (size_t i = 0; i < n; ++i) l.order[l.bucket_fill[l.point_bucket[i]]++] = (uint32_t)i;
+    /* bucket_fill[b] is now the end of bucket b (= start of b + 1). */
+
+    /* Buckets shared by several cells: group each cell (stable, so indices stay increasing). */
+    size_t start = 0;
+    for (size_t b = 0; b < buckets; ++b) {
+        size_t end = l.bucket_fill[b];
+        for (size_t k = start + 1; k < end; ++k) {
+            if (!cell_eq(l.point_cell[l.order[k]], l.point_cell[l.order[start]])) {
+                sort_by_cell(l.order + start, l.tmp, end - start, l.point_cell);
+                break;
+            }
+        }
+        start = end;
+    }
+
+    /* Cells in sorted order, positions in sorted order, and each bucket's first cell. */
+    uint32_t cells = 0;
+    memset(l.bucket_start, 0, (buckets + 1) * sizeof(uint32_t));
+    for (size_t k = 0; k < n; ++k) {
+        const uint32_t i = l.order[k];
+        if (k == 0 || !cell_eq(l.point_cell[i], l.cell_coord[cells - 1])) {
+            l.cell_start[cells] = (uint32_t)k;
+            l.cell_coord[cells] = l.point_cell[i];
+            l.bucket_start[l.point_bucket[i] + 1]++;
+            ++cells;
+        }
+        l.x[k] = points.ptr[i].x;
+        l.y[k] = points.ptr[i].y;
+        l.z[k] = points.ptr[i].z;
+    }
+    l.cell_start[cells] = (uint32_t)n;
+    for (size_t b = 0; b < buckets; ++b) l.bucket_start[b + 1] += l.bucket_start[b];
+
+    out_grid->cell_size = desc->cell_size;
+    out_grid->point_count = (uint32_t)n;
+    out_grid->cell_count = cells;
+    out_grid->bucket_count = (uint32_t)buckets;
+    out_grid->order = l.order;
+    out_grid->x = l.x;
+    out_grid->y = l.y;
+    out_grid->z = l.z;
+    out_grid->cell_start = l.cell_start;
+    out_grid->cell_coord = l.cell_coord;
+    out_grid->bucket_start = l.bucket_start;
+    return AK_OK;
+}
+
+/* ---- public: cells and point queries ------------------------------------------------ */
+
+ak_grid_cell ak_grid_cell_of(const ak_grid* grid, ak_vec3 p) {
+    ak_grid_cell zero = {0, 0, 0};
+    if (!grid || !(grid->cell_size > 0.0f)) return zero;
+    return cell_of(p.x, p.y, p.z, 1.0 / (double)grid->cell_size);
+}
+
+uint32_t ak_grid_cell_find(const ak_grid* grid, ak_grid_cell cell) {
+    if (!grid || grid->cell_count == 0) return UINT32_MAX;
+    const uint32_t b = cell_hash(cell) & (grid->bucket_count - 1);
+    for (uint32_t m = grid->bucket_start[b]; m < grid->bucket_start[b + 1]; ++m)
+        if (cell_eq(grid->cell_coord[m], cell)) return m;
+    return UINT32_MAX;
+}
+
+/* Points of cell m within radius of q (the module's distance test); returns the new total. */
+static size_t query_cell(const ak_grid* g, uint32_t m, float qx, float qy, float qz, float r2,
+                         ak_u32_span out, size_t total) {
+    for (uint32_t k = g->cell_start[m]; k < g->cell_start[m + 1]; ++k) {
+        const float dx = g->x[k] - qx, dy = g->y[k] - qy, dz = g->z[k] - qz;
+        if (dx * dx + dy * dy + dz * dz < r2) {
+            if (total < out.count) out.ptr[total] = g->order[k];
+            ++total;
+        }
+    }
+    return total;
+}
+
+size_t ak_grid_query(const ak_grid* grid, ak_vec3 q, float radius, ak_u32_span out_indices) {
+    if (!grid || grid->point_count == 0 || !(radius > 0.0f) || !ak_finitef(radius) ||
+        !ak_finitef(q.x) || !ak_finitef(q.y) || !ak_finitef(q.z))
+        return 0;
+    if (!out_indices.ptr) out_indices.count = 0;
+    const float r2 = radius * radius;
+    const int64_t k = rings_for(grid, radius);
+    const ak_grid_cell c = ak_grid_cell_of(grid, q);
+    size_t total = 0;
+    if (scan_all_cells(grid, k)) {
+        for (uint32_t m = 0; m < grid->cell_count; ++m)
+            if (cells_within(grid->cell_coord[m], c, k))
+                total = query_cell(grid, m, q.x, q.y, q.z, r2, out_indices, total);
+        return total;
+    }
+    for (int64_t dz = -k; dz <= k; ++dz) {
+        if (!coord_offset_ok(c.z, dz)) continue;
+        for (int64_t dy = -k; dy <= k; ++dy) {
+            if (!coord_offset_ok(c.y, dy)) continue;
+            for (int64_t dx = -k; dx <= k; ++dx) {
+                if (!coord_offset_ok(c.x, dx)) continue;
+                ak_grid_cell n = {(int32_t)(c.x + dx), (int32_t)(c.y + dy), (int32_t)(c.z + dz)};
+                uint32_t m = ak_grid_cell_find(grid, n);
+                if (m != UINT32_MAX)
+                    total = query_cell(grid, m, q.x, q.y, q.z, r2, out_indices, total);
+            }
+        }
+    }
+    return total;
+}
+
+/* ---- public: all pairs ------------------------------------------------------------------ */
+
+typedef struct pair_task {
+    const ak_grid* grid;
+    float r2;
+    int64_t rings;
+    bool all_cells;
+    uint32_t cell_begin, cell_end;
+    ak_grid_pair* out;
+    size_t capacity;
+    size_t count;
+} pair_task;
+
+static inline void emit(pair_task* t, uint32_t a, uint32_t b) {
+    if (t->count < t->capacity) {
+        ak_grid_pair p = a < b ? (ak_grid_pair){a, b} : (ak_grid_pair){b, a};
+        t->out[t->count] = p;
+    }
+    t->count++;
+}
+
+/* Pairs between cell a and another cell b. */
+static void pairs_between(pair_task* t, uint32_t ca, uint32_t cb) {
+    const ak_grid* g = t->grid;
+    const float* x = g->x;
+    const float* y = g->y;
+    const float* z = g->z;
+    const float r2 = t->r2;
+    const uint32_t b0 = g->cell_start[cb], b1 = g->cell_start[cb + 1];
+    for (uint32_t a = g->cell_start[ca]; a < g->cell_start[ca + 1]; ++a) {
+        const float ax = x[a], ay = y[a], az = z[a];
+        for (uint32_t b = b0; b < b1; ++b) {
+            const float dx = x[b] - ax, dy = y[b] - ay, dz = z[b] - az;
+            if (dx * dx + dy * dy + dz * dz < r2) emit(t, g->order[a], g->order[b]);
+        }
+    }
+}
+
+/* Pairs inside one cell. */
+static void pairs_within(pair_task* t, uint32_t c) {
+    const ak_grid* g = t->grid;
+    const float* x = g->x;
+    const float* y = g->y;
+    const float* z = g->z;
+    const float r2 = t->r2;
+    const uint32_t e = g->cell_start[c + 1];
+    for (uint32_t a = g->cell_start[c]; a < e; ++a) {
+        const float ax = x[a], ay = y[a], az = z[a];
+        for (uint32_t b = a + 1; b < e; ++b) {
+            const float dx = x[b] - ax, dy = y[b] - ay, dz = z[b] - az;
+            if (dx * dx + dy * dy + dz * dz < r2) emit(t, g->order[a], g->order[b]);
+        }
+    }
+}
+
+static void* pair_thread(void* arg) {
+    /* Work on a copy: the tasks sit side by side in one array, and a count updated per pair
+     * in shared cache lines would make the threads slower than one. */
+    pair_task local = *(pair_task*)arg;
+    pair_task* t = &local;
+    const ak_grid* g = t->grid;
+    const int64_t k = t->rings;
+    t->count = 0;
+    for (uint32_t m = t->cell_begin; m < t->cell_end; ++m) {
+        pairs_within(t, m);
+        const ak_grid_cell c = g->cell_coord[m];
+        if (t->all_cells) {
+            for (uint32_t o = m + 1; o < g->cell_count; ++o)
+                if (cells_within(g->cell_coord[o], c, k)) pairs_between(t, m, o);
+            continue;
+        }
+        /* The forward half of the stencil: offsets after (0,0,0) in (dz, dy, dx) order. */
+        for (int64_t dz = 0; dz <= k; ++dz) {
+            if (!coord_offset_ok(c.z, dz)) continue;
+            for (int64_t dy = dz == 0 ? 0 : -k; dy <= k; ++dy) {
+                if (!coord_offset_ok(c.y, dy)) continue;
+                for (int64_t dx = (dz == 0 && dy == 0) ? 1 : -k; dx <= k; ++dx) {
+                    if (!coord_offset_ok(c.x, dx)) continue;
+                    ak_grid_cell n = {(int32_t)(c.x + dx), (int32_t)(c.y + dy),
+                                      (int32_t)(c.z + dz)};
+                    uint32_t o = ak_grid_cell_find(g, n);
+                    if (o != UINT32_MAX) pairs_between(t, m, o);
+                }
+            }
+        }
+    }
+    ((pair_task*)arg)->count = local.count;
+    return NULL;
+}
+
+static void run_tasks(void* (*fn)(void*), pair_task* tasks, uint32_t count) {
+    pthread_t ids[GRID_MAX_THREADS];
+    bool started[GRID_MAX_THREADS];
+    for (uint32_t t = 1; t < count; ++t)
+        started[t] = pthread_create(&ids[t], NULL, fn, &tasks[t]) == 0;
+    fn(&tasks[0]);
+    for (uint32_t t = 1; t < count; ++t) {
+        if (started[t])
+            pthread_join(ids[t], NULL);
+        else
+            fn(&tasks[t]);
+    }
+}
+
+ak_result ak_grid_pairs_validate(const ak_grid_pairs_job* job) {
+    if (!job || !job->grid || !job->out_pair_count ||
+        (!job->out_pairs.ptr && job->out_pairs.count > 0))
+        return AK_ERR_NULL_ARG;
+    if (!(job->radius > 0.0f) || !ak_finitef(job->radius) || job->thread_count > GRID_MAX_THREADS)
+        return AK_ERR_BAD_ARG;
+    return AK_OK;
+}
+
+ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
+    ak_result r = ak_grid_pairs_validate(job);
+    if (r != AK_OK) return r;
+    const ak_grid* g = job->grid;
+    *job->out_pair_count = 0;
+    if (g->cell_count == 0) return AK_OK;
+    uint32_t threads = job->thread_count ? job->thread_count : 1;
+    if (threads > g->cell_count) threads = g->cell_count;
+    const int64_t k = rings_for(g, job->radius);
+    const bool all_cells = scan_all_cells(g, k);
+    pair_task tasks[GRID_MAX_THREADS];
+    /* Contiguous cell ranges with about the same number of points each. */
+    uint32_t m = 0;
+    for (uint32_t t = 0; t < threads; ++t) {
+        uint32_t begin = m;
+        uint64_t target = (uint64_t)g->point_count * (t + 1) / threads;
+        while (m < g->cell_count && (t + 1 == threads || g->cell_start[m] < target)) ++m;
+        tasks[t] = (pair_task){g, job->radius * job->radius, k, all_cells, begin, m, NULL, 0, 0};
+    }
+    /* First try: each thread writes into its share of the output; if one overflows but the
+     * total fits, a second pass writes at exact offsets. The content is the same either way. */
+    const size_t cap = job->out_pairs.count;
+    for (uint32_t t = 0; t < threads; ++t) {
+        size_t lo = cap * t / threads, hi = cap * (t + 1) / threads;
+        tasks[t].out = job->out_pairs.ptr ? job->out_pairs.ptr + lo : NULL;
+        tasks[t].capacity = hi - lo;
+    }
+    run_tasks(pair_thread, tasks, threads);
+    size_t total = 0;
+    bool overflow = false;
+    for (uint32_t t = 0; t < threads; ++t) {
+        total += tasks[t].count;
+        overflow = overflow || tasks[t].count > tasks[t].capacity;
+    }
+    *job->out_pair_count = total;
+    if (total > cap) return AK_ERR_SPAN_SMALL;
+    if (total == 0) return AK_OK;
+    /* Exact offsets; threads that fit move their pairs there (leftward moves in increasing
+     * order, then rightward moves in decreasing order, so no block overwrites one not yet
+     * moved), and threads that overflowed their share run again into their exact place. */
+    size_t offset[GRID_MAX_THREADS];
+    size_t off = 0;
+    for (uint32_t t = 0; t < threads; ++t) offset[t] = off, off += tasks[t].count;
+    for (uint32_t t = 0; t < threads; ++t)
+        if (!(tasks[t].count > tasks[t].capacity) && job->out_pairs.ptr + offset[t] <= tasks[t].out)
+            memmove(job->out_pairs.ptr + offset[t], tasks[t].out,
+                    tasks[t].count * sizeof(ak_grid_pair));
+    for (uint32_t t = threads; t-- > 0;)
+        if (!(tasks[t].count > tasks[t].capacity) && job->out_pairs.ptr + offset[t] > tasks[t].out)
+            memmove(job->out_pairs.ptr + offset[t], tasks[t].out,
+                    tasks[t].count * sizeof(ak_grid_pair));
+    if (overflow) {
+        pair_task again[GRID_MAX_THREADS];
+        uint32_t rerun = 0;
+        for (uint32_t t = 0; t < threads; ++t) {
+            if (!(tasks[t].count > tasks[t].capacity)) continue;
+            again[rerun] = tasks[t];
+            again[rerun].out = job->out_pairs.ptr + offset[t];
+            again[rerun].capacity = tasks[t].count;
+            ++rerun;
+        }
+        run_tasks(pair_thread, again, rerun);
+    }
+    return AK_OK;
+}

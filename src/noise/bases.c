@@ -1,0 +1,208 @@
+/* Simplex noise (Perlin 2001 as formulated by Gustavson 2005, "Simplex noise demystified"),
+ * value noise and Worley cellular noise (Worley 1996, "A cellular texture basis function"). */
+#include <math.h>
+#include <string.h>
+
+#include "noise_internal.h"
+
+static bool all_finite(uint32_t dims, const float* p) {
+    for (uint32_t k = 0; k < dims; ++k)
+        if (!(fabsf(p[k]) < AKP_NOISE_LIMIT)) return false;
+    return true;
+}
+
+static void zero_grad(float* g, uint32_t dims) {
+    if (g)
+        for (uint32_t k = 0; k < dims; ++k) g[k] = 0.0f;
+}
+
+/* ---- simplex ----------------------------------------------------------------------------- */
+
+static const float simplex_g2[8][2] = {{1, 1}, {-1, 1}, {1, -1}, {-1, -1}, {1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+static const float simplex_g3[16][3] = {{1, 1, 0}, {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
+                                        {1, 0, -1}, {-1, 0, -1}, {0, 1, 1}, {0, -1, 1}, {0, 1, -1}, {0, -1, -1},
+                                        {1, 1, 0}, {0, -1, 1}, {-1, 1, 0}, {0, -1, -1}};
+
+/* One corner's kernel (r0 - |d|^2)^4 (g . d) and its gradient t^4 g - 8 t^3 (g . d) d. */
+static float simplex_corner(uint32_t dims, float r0, const float* d, const float* g, float* grad) {
+    float r2 = 0.0f, gd = 0.0f;
+    for (uint32_t k = 0; k < dims; ++k) r2 += d[k] * d[k], gd += g[k] * d[k];
+    const float t = r0 - r2;
+    if (t <= 0.0f) return 0.0f;
+    const float t2 = t * t, t4 = t2 * t2;
+    if (grad)
+        for (uint32_t k = 0; k < dims; ++k) grad[k] += t4 * g[k] - 8.0f * t2 * t * gd * d[k];
+    return t4 * gd;
+}
+
+float ak_noise_simplex2(const ak_noise* noise, float x, float y, float* out_gradient) {
+    const float p[2] = {x, y};
+    zero_grad(out_gradient, 2);
+    if (!noise || !all_finite(2, p)) return 0.0f;
+    const float F2 = 0.36602540378f, G2 = 0.2113248654f; /* (sqrt 3 - 1) / 2, (3 - sqrt 3) / 6 */
+    const float s = (x + y) * F2;
+    const float fi = floorf(x + s), fj = floorf(y + s);
+    const float t = (fi + fj) * G2;
+    const float x0 = x - (fi - t), y0 = y - (fj - t);
+    const int i1 = x0 > y0 ? 1 : 0, j1 = 1 - i1;
+    const int ii = (int)fi & 255, jj = (int)fj & 255;
+    const uint8_t* perm = noise->perm;
+    const int h[3] = {perm[perm[ii] + jj], perm[perm[ii + i1] + jj + j1], perm[perm[ii + 1] + jj + 1]};
+    const float d[3][2] = {{x0, y0}, {x0 - (float)i1 + G2, y0 - (float)j1 + G2}, {x0 - 1.0f + 2.0f * G2, y0 - 1.0f + 2.0f * G2}};
+    float sum = 0.0f, g[2] = {0, 0};
+    for (int c = 0; c < 3; ++c) sum += simplex_corner(2, 0.5f, d[c], simplex_g2[h[c] & 7], out_gradient ? g : NULL);
+    if (out_gradient) out_gradient[0] = 70.0f * g[0], out_gradient[1] = 70.0f * g[1];
+    return 70.0f * sum;
+}
+
+float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
+    const float p[3] = {x, y, z};
+    zero_grad(out_gradient, 3);
+    if (!noise || !all_finite(3, p)) return 0.0f;
+    const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
+    const float s = (x + y + z) * F3;
+    const float fi = floorf(x + s), fj = floorf(y + s), fk = floorf(z + s);
+    const float t = (fi + fj + fk) * G3;
+    const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
+    /* the simplex: the order of x0, y0, z0 from largest to smallest */
+    int o1[3], o2[3];
+    if (x0 >= y0) {
+        if (y0 >= z0) o1[0] = 1, o1[1] = 0, o1[2] = 0, o2[0] = 1, o2[1] = 1, o2[2] = 0;
+        else if (x0 >= z0) o1[0] = 1, o1[1] = 0, o1[2] = 0, o2[0] = 1, o2[1] = 0, o2[2] = 1;
+        else o1[0] = 0, o1[1] = 0, o1[2] = 1, o2[0] = 1, o2[1] = 0, o2[2] = 1;
+    } else {
+        if (y0 < z0) o1[0] = 0, o1[1] = 0, o1[2] = 1, o2[0] = 0, o2[1] = 1, o2[2] = 1;
+        else if (x0 < z0) o1[0] = 0, o1[1] = 1, o1[2] = 0, o2[0] = 0, o2[1] = 1, o2[2] = 1;
+        else o1[0] = 0, o1[1] = 1, o1[2] = 0, o2[0] = 1, o2[1] = 1, o2[2] = 0;
+    }
+    const int ii = (int)fi & 255, jj = (int)fj & 255, kk = (int)fk & 255;
+    const uint8_t* perm = noise->perm;
+    const int offs[4][3] = {{0, 0, 0}, {o1[0], o1[1], o1[2]}, {o2[0], o2[1], o2[2]}, {1, 1, 1}};
+    float sum = 0.0f, g[3] = {0, 0, 0};
+    for (int c = 0; c < 4; ++c) {
+        const int h = perm[perm[perm[ii + offs[c][0]] + jj + offs[c][1]] + kk + offs[c][2]];
+        const float k = (float)c * G3;
+        const float d[3] = {x0 - (float)offs[c][0] + k, y0 - (float)offs[c][1] + k, z0 - (float)offs[c][2] + k};
+        sum += simplex_corner(3, 0.5f, d, simplex_g3[h & 15], out_gradient ? g : NULL);
+    }
+    if (out_gradient)
+        for (int k = 0; k < 3; ++k) out_gradient[k] = 76.0f * g[k];
+    return 76.0f * sum;
+}
+
+/* ---- value noise --------------------------------------------------------------------------- */
+
+static inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+static inline float dfade(float t) { return 30.0f * t * t * (t * (t - 2.0f) + 1.0f); }
+
+float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_gradient) {
+    if (dimensions < 1 || dimensions > 4) return 0.0f;
+    zero_grad(out_gradient, dimensions);
+    if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
+    int lo[4], hi[4];
+    float f[4];
+    for (uint32_t k = 0; k < dimensions; ++k) {
+        const float fl = floorf(point[k]);
+        const int i = (int)fl;
+        f[k] = point[k] - fl;
+        lo[k] = i & 255;
+        hi[k] = (i + 1) & 255;
+    }
+    const uint32_t corners = 1u << dimensions;
+    float val[16], gv[16][4];
+    memset(gv, 0, sizeof gv);
+    for (uint32_t c = 0; c < corners; ++c) {
+        int h = 0;
+        for (uint32_t k = 0; k < dimensions; ++k) h = noise->perm[h + (((c >> k) & 1u) ? hi[k] : lo[k])];
+        val[c] = (float)h / 127.5f - 1.0f;
+    }
+    for (uint32_t k = 0; k < dimensions; ++k) {
+        const float t = fade(f[k]), dt = dfade(f[k]);
+        const uint32_t step = 1u << k;
+        for (uint32_t c = 0; c < corners; c += 2u * step) {
+            const float a = val[c], b = val[c + step];
+            val[c] = a + t * (b - a);
+            for (uint32_t m = 0; m < dimensions; ++m) gv[c][m] = gv[c][m] + t * (gv[c + step][m] - gv[c][m]);
+            gv[c][k] += (b - a) * dt;
+        }
+    }
+    if (out_gradient)
+        for (uint32_t m = 0; m < dimensions; ++m) out_gradient[m] = gv[0][m];
+    return fminf(fmaxf(val[0], -1.0f), 1.0f);
+}
+
+/* ---- Worley ------------------------------------------------------------------------------- */
+
+/* A 32-bit hash of a cell and the seed (murmur3 finaliser over a linear mix). */
+static uint32_t cell_hash(const int* cell, uint32_t dims, uint64_t seed) {
+    uint32_t h = (uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32);
+    static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
+    for (uint32_t k = 0; k < dims; ++k) h ^= (uint32_t)cell[k] * mul[k];
+    h ^= h >> 16;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    h *= 0xC2B2AE35u;
+    h ^= h >> 16;
+    return h;
+}
+
+float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_f2,
+                      float* out_gradient) {
+    if (dimensions < 1 || dimensions > 3) {
+        if (out_f2) *out_f2 = 0.0f;
+        return 0.0f;
+    }
+    zero_grad(out_gradient, dimensions);
+    if (out_f2) *out_f2 = 0.0f;
+    if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
+    int base[3] = {0, 0, 0};
+    float f[3] = {0, 0, 0}, margin = 1.0f;
+    for (uint32_t k = 0; k < dimensions; ++k) {
+        const float fl = floorf(point[k]);
+        base[k] = (int)fl;
+        f[k] = point[k] - fl;
+        margin = fminf(margin, fminf(f[k], 1.0f - f[k]));
+    }
+    float d1 = INFINITY, d2 = INFINITY, near[3] = {0, 0, 0};
+    /* Ring r holds the cells at Chebyshev distance r from the point's cell; their feature
+     * points are at least (r - 1) + margin away, so the search stops once that exceeds F2. */
+    for (int r = 0; r <= 6; ++r) {
+        if (r >= 1) {
+            const float bound = (float)(r - 1) + margin;
+            if (bound * bound >= d2) break;
+        }
+        const int span = 2 * r + 1;
+        const int cells = dimensions == 1 ? span : dimensions == 2 ? span * span : span * span * span;
+        for (int c = 0; c < cells; ++c) {
+            int off[3] = {0, 0, 0}, cc = c, cheb = 0;
+            for (uint32_t k = 0; k < dimensions; ++k) {
+                off[k] = cc % span - r;
+                cc /= span;
+                cheb = off[k] < 0 ? (-off[k] > cheb ? -off[k] : cheb) : (off[k] > cheb ? off[k] : cheb);
+            }
+            if (cheb != r) continue;
+            int cell[3];
+            for (uint32_t k = 0; k < dimensions; ++k) cell[k] = base[k] + off[k];
+            uint32_t h = cell_hash(cell, dimensions, noise->seed);
+            float dist2 = 0.0f, dv[3] = {0, 0, 0};
+            for (uint32_t k = 0; k < dimensions; ++k) {
+                const float fp = (float)(h & 1023u) / 1024.0f + 0.5f / 1024.0f; /* feature point in the cell */
+                h = h >> 10 | h << 22;
+                dv[k] = f[k] - ((float)off[k] + fp);
+                dist2 += dv[k] * dv[k];
+            }
+            if (dist2 < d1) {
+                d2 = d1;
+                d1 = dist2;
+                memcpy(near, dv, sizeof near);
+            } else if (dist2 < d2) {
+                d2 = dist2;
+            }
+        }
+    }
+    const float f1 = sqrtf(d1);
+    if (out_f2) *out_f2 = sqrtf(d2);
+    if (out_gradient && f1 > 0.0f)
+        for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = near[k] / f1;
+    return f1;
+}

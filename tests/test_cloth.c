@@ -1,0 +1,553 @@
+/* Tests of the cloth module: closed forms (a hanging spring's static stretch), properties
+ * (no particle inside a collider, pins and attachments exact, thread-count determinism, finite
+ * state under strong wind), and the XPBD-vs-PBD substep comparison. */
+#include <animkit/cloth.h>
+
+#include "ak_test.h"
+#include "cloth/cloth_impl.h" /* akp_dihedral, for its gradient check */
+
+#define G 9.81f
+
+typedef struct sim {
+    ak_cloth* cloth;
+    size_t n;
+    ak_vec3* x;
+    ak_vec3* v;
+    ak_cloth_step_job job;
+} sim;
+
+static bool sim_init(sim* s, const ak_cloth_desc* d) {
+    memset(s, 0, sizeof *s);
+    if (ak_cloth_create(d, NULL, &s->cloth) != AK_OK) return false;
+    s->n = ak_cloth_vertex_count(s->cloth);
+    s->x = malloc(s->n * sizeof(ak_vec3));
+    s->v = calloc(s->n, sizeof(ak_vec3));
+    ak_cloth_rest_positions(s->cloth, (ak_vec3_span){s->x, s->n});
+    s->job = (ak_cloth_step_job){.cloth = s->cloth, .dt = 1.0f / 60.0f, .gravity = {0, -G, 0},
+                                 .positions = {s->x, s->n}, .velocities = {s->v, s->n}};
+    return true;
+}
+
+/* (Re)size the scratch for the job as configured now. */
+static void sim_scratch(sim* s) {
+    free(s->job.scratch.ptr);
+    size_t size = ak_cloth_step_scratch_size(&s->job);
+    s->job.scratch = (ak_u8_span){malloc(size), size};
+}
+
+static void sim_free(sim* s) {
+    free(s->job.scratch.ptr);
+    free(s->x);
+    free(s->v);
+    ak_cloth_destroy(s->cloth);
+}
+
+/* ---- validity ----------------------------------------------------------------------------- */
+
+AK_TEST(desc_defaults) {
+    ak_cloth_desc d = ak_cloth_desc_resolved(NULL);
+    AK_CHECK_EQ(d.solver, AK_CLOTH_XPBD);
+    AK_CHECK_NEAR(d.spacing, 0.05f, 0);
+    AK_CHECK_NEAR(d.stretch_stiffness, 5000.0f, 0);
+    AK_CHECK_NEAR(d.shear_stiffness, 5000.0f, 0);
+    AK_CHECK_NEAR(d.bend_stiffness, 50.0f, 0);
+    AK_CHECK_NEAR(d.dihedral_stiffness, 1e-4f, 0);
+    AK_CHECK_NEAR(d.area_density, 0.2f, 0);
+    AK_CHECK_NEAR(d.pbd_stiffness, 1.0f, 0);
+    AK_CHECK_EQ(d.bending, AK_CLOTH_BEND_DIHEDRAL);
+    AK_CHECK_NEAR(d.grid_axis_v.z, -1.0f, 0);
+    ak_cloth_desc s = {.solver = AK_CLOTH_SPRINGS};
+    AK_CHECK_EQ(ak_cloth_desc_resolved(&s).bending, AK_CLOTH_BEND_SPRINGS);
+}
+
+AK_TEST(create_rules) {
+    ak_cloth* c = (ak_cloth*)1;
+    AK_CHECK_EQ(ak_cloth_create(NULL, NULL, &c), AK_ERR_NULL_ARG);
+    AK_CHECK(c == NULL);
+    ak_cloth_desc zero = {0};
+    AK_CHECK_EQ(ak_cloth_create(&zero, NULL, &c), AK_ERR_EMPTY);
+    ak_cloth_desc d = {.grid_width = 1, .grid_height = 4};
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d = (ak_cloth_desc){.grid_width = 4, .grid_height = 4, .stretch_stiffness = -1};
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d = (ak_cloth_desc){.grid_width = 4, .grid_height = 4, .solver = AK_CLOTH_SPRINGS, .stretch_stiffness = INFINITY};
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d = (ak_cloth_desc){.grid_width = 4, .grid_height = 4, .pbd_stiffness = 1.5f};
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    uint32_t pins[2] = {3, 16};
+    d = (ak_cloth_desc){.grid_width = 4, .grid_height = 4, .pins = AK_SPAN(pins)};
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_INDEX);
+    uint32_t twice[2] = {3, 3};
+    d = (ak_cloth_desc){.grid_width = 4, .grid_height = 4, .pins = AK_SPAN(twice)};
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_INDEX);
+    ak_vec3 p[3] = {{0, 0, 0}, {1, 0, 0}, {0, NAN, 0}};
+    uint32_t tri[3] = {0, 1, 2};
+    d = (ak_cloth_desc){.positions = AK_SPAN(p), .indices = AK_SPAN(tri)};
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_DATA);
+    p[2].y = 1.0f;
+    uint32_t bad[3] = {0, 1, 3};
+    d.indices = (ak_u32_cspan)AK_SPAN(bad);
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_INDEX);
+    /* a vertex on no triangle needs an explicit mass */
+    uint32_t edge[2] = {0, 1};
+    d = (ak_cloth_desc){.positions = AK_SPAN(p), .edges = AK_SPAN(edge)};
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    /* allocation failures at every point fail cleanly */
+    for (int k = 1; k < 12; ++k) {
+        ak_test_counter cnt = {.fail_from = k};
+        ak_allocator a = ak_test_counting_allocator(&cnt);
+        ak_cloth_desc g = {.grid_width = 5, .grid_height = 5};
+        ak_result r = ak_cloth_create(&g, &a, &c);
+        if (r == AK_OK) ak_cloth_destroy(c);
+        else AK_CHECK_EQ(r, AK_ERR_NO_MEMORY);
+        AK_CHECK_EQ(cnt.live, 0);
+    }
+}
+
+AK_TEST(step_rules) {
+    AK_CHECK_EQ(ak_cloth_step_validate(NULL), AK_ERR_NULL_ARG);
+    ak_cloth_step_job zero = {0};
+    AK_CHECK_EQ(ak_cloth_step_validate(&zero), AK_ERR_NULL_ARG);
+    ak_cloth_desc d = {.grid_width = 4, .grid_height = 3};
+    sim s;
+    AK_CHECK(sim_init(&s, &d));
+    sim_scratch(&s);
+    AK_CHECK_EQ(ak_cloth_step_validate(&s.job), AK_OK);
+    ak_cloth_step_job j = s.job;
+    j.dt = 0;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_ARG);
+    j = s.job, j.thread_count = 65;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_ARG);
+    j = s.job, j.friction = -1;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_ARG);
+    j = s.job, j.positions.count--;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_ARG);
+    j = s.job, j.scratch.count--;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_SPAN_SMALL);
+    j = s.job, j.sphere_count = 1;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_NULL_ARG);
+    ak_cloth_sphere sp = {{0, 0, 0}, -1};
+    j.spheres = &sp;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_ARG);
+    j = s.job, j.gravity.y = NAN;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_DATA);
+    ak_vec3 mp[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    uint32_t mi[3] = {0, 1, 3};
+    j = s.job, j.mesh = (ak_cloth_collider_mesh){AK_SPAN(mp), AK_SPAN(mi)};
+    size_t need = ak_cloth_step_scratch_size(&j);
+    AK_CHECK(need > s.job.scratch.count);
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_SPAN_SMALL);
+    s.x[5].x = INFINITY;
+    AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_ERR_BAD_DATA);
+    AK_CHECK(isinf(s.x[5].x)); /* nothing written */
+    sim_free(&s);
+}
+
+/* ---- closed forms ----------------------------------------------------------------------- */
+
+/* One particle of mass m hanging from a pinned one by a spring of stiffness k settles at
+ * rest + m g / k (both solvers; XPBD with compliance 1/k). */
+static float hanging_spring(ak_cloth_solver solver, float m, float k) {
+    /* hung near the origin: float positions there resolve the per-substep displacement g h^2
+     * (7e-6 m at h = 1/1200) finely; near |x| = 1 its rounding alone biases the rest point by
+     * about 0.5% */
+    ak_vec3 p[2] = {{0, 0.5f, 0}, {0, 0, 0}};
+    uint32_t e[2] = {0, 1};
+    float w[2] = {0.0f, 1.0f / m};
+    ak_cloth_desc d = {.solver = solver, .positions = AK_SPAN(p), .edges = AK_SPAN(e), .inverse_masses = AK_SPAN(w),
+                       .stretch_stiffness = k};
+    sim s;
+    if (!sim_init(&s, &d)) return NAN;
+    s.job.substeps = 20;
+    s.job.damping = 3.0f;
+    sim_scratch(&s);
+    for (int f = 0; f < 600; ++f)
+        if (ak_cloth_step_run(&s.job) != AK_OK) break;
+    const float stretch = ak_vec3_distance(s.x[0], s.x[1]) - 0.5f;
+    AK_CHECK_NEAR(s.x[0].y, 0.5f, 0.0f);
+    sim_free(&s);
+    return stretch;
+}
+
+AK_TEST(single_spring_static_stretch) {
+    const float m = 0.5f, k = 200.0f, expect = m * G / k;
+    const float springs = hanging_spring(AK_CLOTH_SPRINGS, m, k);
+    const float xpbd = hanging_spring(AK_CLOTH_XPBD, m, k);
+    printf("  static stretch mg/k = %.6f: springs %.6f, XPBD %.6f\n", (double)expect, (double)springs, (double)xpbd);
+    AK_CHECK_NEAR(springs, expect, 0.01f * expect);
+    AK_CHECK_NEAR(xpbd, expect, 0.01f * expect);
+    /* a stiffer spring: the stretch follows 1/k */
+    const float stiff = hanging_spring(AK_CLOTH_XPBD, m, 4.0f * k);
+    AK_CHECK_NEAR(stiff, expect / 4.0f, 0.01f * expect / 4.0f);
+}
+
+AK_TEST(dihedral_gradient) {
+    /* the analytic gradient of the dihedral angle against central differences in double-ish
+     * steps, at several folds (including past 90 degrees) */
+    ak_vec3 x[4] = {{0.1f, 0.3f, 0.9f}, {0.2f, -0.4f, -0.8f}, {0, 0, 0}, {1.1f, 0.1f, 0.05f}};
+    float worst = 0.0f;
+    for (int fold = 0; fold < 4; ++fold) {
+        x[0].y = -0.6f + 0.5f * (float)fold;
+        ak_vec3 g[4];
+        akp_dihedral(x, g);
+        for (int q = 0; q < 4; ++q)
+            for (int c = 0; c < 3; ++c) {
+                float* p = &x[q].x + c;
+                const float o = *p;
+                *p = o + 1e-3f;
+                const float hi = akp_dihedral(x, NULL);
+                *p = o - 1e-3f;
+                const float lo = akp_dihedral(x, NULL);
+                *p = o;
+                worst = ak_maxf(worst, fabsf((hi - lo) / 2e-3f - (&g[q].x)[c]));
+            }
+    }
+    AK_CHECK(worst < 2e-3f);
+    /* the angle itself: a pair folded by 0.5 rad about the shared diagonal */
+    ak_vec3 flat[4] = {{0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {1, 0, -1}};
+    uint32_t tris[6] = {0, 1, 3, 0, 3, 2};
+    ak_cloth_desc d = {.positions = AK_SPAN(flat), .indices = AK_SPAN(tris), .dihedral_stiffness = 2.0f};
+    ak_cloth* c = NULL;
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_OK);
+    ak_vec3 v[4] = {{0}};
+    ak_cloth_energy e;
+    AK_CHECK_EQ(ak_cloth_energy_compute(c, (ak_vec3_cspan)AK_SPAN(flat), (ak_vec3_cspan)AK_SPAN(v), ak_vec3_make(0, 0, 0), &e),
+                AK_OK);
+    AK_CHECK_NEAR(e.elastic, 0.0, 1e-9);
+    const ak_quat q = ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(1, 0, -1)), 0.5f);
+    ak_vec3 folded[4] = {flat[0], flat[1], ak_quat_rotate(q, flat[2]), flat[3]};
+    AK_CHECK_EQ(ak_cloth_energy_compute(c, (ak_vec3_cspan)AK_SPAN(folded), (ak_vec3_cspan)AK_SPAN(v), ak_vec3_make(0, 0, 0), &e),
+                AK_OK);
+    /* the springs 0-2 and 2-3 keep their length under a turn about 0-3: only bending, 1/2 k 0.5^2 */
+    AK_CHECK_NEAR(e.elastic, 0.5 * 2.0 * 0.25, 1e-5);
+    ak_cloth_destroy(c);
+}
+
+/* Isometric bending: zero energy for any flat or rigidly moved configuration, k |b|^2 3 / (2 (A0 +
+ * A1)) for a fold, with b computed here from the cotangent weights (Bergou et al. 2006). */
+AK_TEST(isometric_bending) {
+    ak_vec3 flat[4] = {{0, 0, 0}, {1.1f, 0, 0.1f}, {0.2f, 0, -0.9f}, {1, 0, -1.2f}};
+    uint32_t tris[6] = {0, 1, 3, 0, 3, 2};
+    ak_cloth_desc d = {.positions = AK_SPAN(flat), .indices = AK_SPAN(tris), .dihedral_stiffness = 2.0f,
+                       .bending = AK_CLOTH_BEND_ISOMETRIC, .stretch_stiffness = INFINITY, .shear_stiffness = INFINITY};
+    ak_cloth* c = NULL;
+    AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_OK);
+    ak_vec3 v[4] = {{0}}, moved[4];
+    ak_cloth_energy e;
+    const ak_quat q = ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(1, 2, 3)), 0.7f);
+    for (int k = 0; k < 4; ++k) moved[k] = ak_vec3_add(ak_quat_rotate(q, flat[k]), ak_vec3_make(3, -1, 2));
+    AK_CHECK_EQ(ak_cloth_energy_compute(c, (ak_vec3_cspan)AK_SPAN(moved), (ak_vec3_cspan)AK_SPAN(v), ak_vec3_make(0, 0, 0), &e),
+                AK_OK);
+    AK_CHECK_NEAR(e.elastic, 0.0, 1e-9);
+    /* fold vertex 2 about the edge 0-3 by 0.4 rad: b = K2 (x2' - x2) as only x2 moved (the
+     * weights sum to zero), K2 = -(cot of the angles at 0 and 3 in triangle 0-3-2) */
+    const ak_vec3 axis = ak_vec3_normalize(ak_vec3_sub(flat[3], flat[0]));
+    ak_vec3 folded[4] = {flat[0], flat[1], ak_vec3_add(flat[0], ak_quat_rotate(ak_quat_from_axis_angle(axis, 0.4f),
+                                                                                ak_vec3_sub(flat[2], flat[0]))), flat[3]};
+    AK_CHECK_EQ(ak_cloth_energy_compute(c, (ak_vec3_cspan)AK_SPAN(folded), (ak_vec3_cspan)AK_SPAN(v), ak_vec3_make(0, 0, 0), &e),
+                AK_OK);
+    double cot0, cot3, area0, area1;
+    {
+        const ak_vec3 a = flat[0], b = flat[3], w = flat[2], o = flat[1];
+        ak_vec3 u = ak_vec3_sub(b, a), t = ak_vec3_sub(w, a);
+        cot0 = ak_vec3_dot(u, t) / ak_vec3_length(ak_vec3_cross(u, t));
+        u = ak_vec3_sub(a, b), t = ak_vec3_sub(w, b);
+        cot3 = ak_vec3_dot(u, t) / ak_vec3_length(ak_vec3_cross(u, t));
+        area0 = 0.5 * ak_vec3_length(ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(w, a)));
+        area1 = 0.5 * ak_vec3_length(ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(o, a)));
+    }
+    const double db = (cot0 + cot3) * ak_vec3_distance(folded[2], flat[2]);
+    AK_CHECK_NEAR(e.elastic, 3.0 * 2.0 * db * db / (2.0 * (area0 + area1)), 1e-5);
+    ak_cloth_destroy(c);
+    /* a drape with isometric bending stays finite and out of the sphere */
+    ak_cloth_desc g = {.grid_width = 10, .grid_height = 10, .spacing = 0.1f, .grid_origin = {-0.45f, 1, 0.45f},
+                       .bending = AK_CLOTH_BEND_ISOMETRIC};
+    sim s;
+    AK_CHECK(sim_init(&s, &g));
+    const ak_cloth_sphere sp = {{0, 0.5f, 0}, 0.3f};
+    s.job.spheres = &sp, s.job.sphere_count = 1;
+    sim_scratch(&s);
+    for (int f = 0; f < 90; ++f) AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+    for (size_t i = 0; i < s.n; ++i) AK_CHECK(ak_vec3_distance(s.x[i], sp.center) >= sp.radius);
+    sim_free(&s);
+}
+
+/* ---- XPBD vs PBD ------------------------------------------------------------------------ */
+
+/* Mean stretch of the vertical structural edges of a hanging cloth at rest. */
+static float hanging_cloth_stretch(ak_cloth_solver solver, uint32_t substeps, uint32_t iterations) {
+    enum { W = 8, H = 8 };
+    uint32_t pins[W];
+    for (uint32_t i = 0; i < W; ++i) pins[i] = i;
+    ak_cloth_desc d = {.solver = solver, .grid_width = W, .grid_height = H, .spacing = 0.05f,
+                       .grid_axis_v = {0, -1, 0}, .pins = AK_SPAN(pins), .stretch_stiffness = 20.0f,
+                       .shear_stiffness = 20.0f, .bending = AK_CLOTH_BEND_NONE, .pbd_stiffness = 0.05f,
+                       .area_density = 1.0f};
+    sim s;
+    if (!sim_init(&s, &d)) return NAN;
+    s.job.substeps = substeps;
+    s.job.iterations = iterations;
+    s.job.damping = 4.0f;
+    sim_scratch(&s);
+    for (int f = 0; f < 300; ++f)
+        if (ak_cloth_step_run(&s.job) != AK_OK) break;
+    double sum = 0;
+    for (uint32_t j = 0; j + 1 < H; ++j)
+        for (uint32_t i = 0; i < W; ++i) sum += ak_vec3_distance(s.x[j * W + i], s.x[(j + 1) * W + i]) / 0.05f - 1.0f;
+    sim_free(&s);
+    return (float)(sum / ((H - 1) * W));
+}
+
+AK_TEST(xpbd_stretch_independent_of_substeps) {
+    /* 4 Gauss-Seidel sweeps per substep (the paper's solver iterates to convergence; with one
+     * sweep this stiff cloth, h omega > 1, ends 8% stiffer at 20 substeps than at 5:
+     * docs/cloth.md) */
+    const float x5 = hanging_cloth_stretch(AK_CLOTH_XPBD, 5, 4), x20 = hanging_cloth_stretch(AK_CLOTH_XPBD, 20, 4);
+    const float p5 = hanging_cloth_stretch(AK_CLOTH_PBD, 5, 4), p20 = hanging_cloth_stretch(AK_CLOTH_PBD, 20, 4);
+    const float xc = fabsf(x20 - x5) / x20, pc = fabsf(p20 - p5) / p20;
+    printf("  settled mean stretch, 5 -> 20 substeps: XPBD %.4f -> %.4f (%.2f%%), PBD %.4f -> %.4f (%.1f%%)\n",
+           (double)x5, (double)x20, 100.0 * (double)xc, (double)p5, (double)p20, 100.0 * (double)pc);
+    AK_CHECK(x5 > 0.01f);
+    AK_CHECK(xc < 0.02f);
+    AK_CHECK(pc > 0.5f); /* plain PBD: the same parameters, a very different cloth */
+}
+
+
+/* ---- collisions ------------------------------------------------------------------------- */
+
+/* The drape: a 1 m square dropped on a sphere over a floor; no particle may be inside the
+ * sphere, the capsule beside it, or under the floor after any step; then the cloth comes to rest:
+ * kinetic energy below DRAPE_REST_KE (docs/cloth.md). */
+#define DRAPE_REST_KE 1e-3
+AK_TEST(drape_no_penetration_and_rest) {
+    enum { N = 12 };
+    ak_cloth_desc d = {.grid_width = N, .grid_height = N, .spacing = 1.0f / (N - 1),
+                       .grid_origin = {-0.5f, 1.0f, 0.5f}, .stretch_stiffness = 2000.0f};
+    sim s;
+    AK_CHECK(sim_init(&s, &d));
+    const ak_cloth_sphere sphere = {{0, 0.5f, 0}, 0.3f};
+    const ak_cloth_capsule capsule = {{0.35f, 0.15f, -0.3f}, {0.35f, 0.15f, 0.3f}, 0.15f};
+    const ak_cloth_plane floor = {{0, 1, 0}, 0.0f};
+    s.job.spheres = &sphere, s.job.sphere_count = 1;
+    s.job.capsules = &capsule, s.job.capsule_count = 1;
+    s.job.planes = &floor, s.job.plane_count = 1;
+    s.job.friction = 0.5f;
+    s.job.damping = 1.0f;
+    s.job.self_collision = true;
+    sim_scratch(&s);
+    int inside = 0;
+    double ke = 0;
+    for (int f = 0; f < 240; ++f) {
+        AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+        for (size_t v = 0; v < s.n; ++v) {
+            const ak_vec3 x = s.x[v];
+            const ak_vec3 ab = ak_vec3_sub(capsule.b, capsule.a);
+            const float t = ak_clampf(ak_vec3_dot(ak_vec3_sub(x, capsule.a), ab) / ak_vec3_length_sq(ab), 0, 1);
+            if (ak_vec3_distance(x, sphere.center) < sphere.radius || x.y < 0.0f ||
+                ak_vec3_distance(x, ak_vec3_madd(capsule.a, ab, t)) < capsule.radius)
+                ++inside;
+        }
+        ak_cloth_energy e;
+        ak_cloth_energy_compute(s.cloth, (ak_vec3_cspan){s.x, s.n}, (ak_vec3_cspan){s.v, s.n}, s.job.gravity, &e);
+        ke = e.kinetic;
+    }
+    printf("  drape: kinetic energy after 4 s %.3g J (bound %.0e), particles inside: %d\n", ke, DRAPE_REST_KE, inside);
+    AK_CHECK_EQ(inside, 0);
+    AK_CHECK(ke < DRAPE_REST_KE);
+    /* it draped: the centre rests on the sphere's top (radius + thickness) */
+    AK_CHECK_NEAR(s.x[(N / 2) * N + N / 2].y, 0.8f, 0.03f);
+    sim_free(&s);
+}
+
+/* A closed box as a collider mesh (outward triangles): a cloth dropped on it stays outside. */
+AK_TEST(mesh_collider) {
+    const ak_vec3 bp[8] = {{-0.3f, 0, -0.3f}, {0.3f, 0, -0.3f}, {0.3f, 0, 0.3f}, {-0.3f, 0, 0.3f},
+                           {-0.3f, 0.5f, -0.3f}, {0.3f, 0.5f, -0.3f}, {0.3f, 0.5f, 0.3f}, {-0.3f, 0.5f, 0.3f}};
+    const uint32_t bi[36] = {0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6, 0, 4, 5, 0, 5, 1,
+                             1, 5, 6, 1, 6, 2, 2, 6, 7, 2, 7, 3, 3, 7, 4, 3, 4, 0};
+    ak_cloth_desc d = {.grid_width = 12, .grid_height = 12, .spacing = 0.08f, .grid_origin = {-0.44f, 0.8f, 0.44f}};
+    sim s;
+    AK_CHECK(sim_init(&s, &d));
+    s.job.mesh = (ak_cloth_collider_mesh){AK_SPAN(bp), AK_SPAN(bi)};
+    s.job.damping = 1.0f;
+    sim_scratch(&s);
+    int inside = 0;
+    for (int f = 0; f < 120; ++f) {
+        AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+        for (size_t v = 0; v < s.n; ++v) {
+            const ak_vec3 x = s.x[v];
+            if (fabsf(x.x) < 0.3f && fabsf(x.z) < 0.3f && x.y > 0.0f && x.y < 0.5f) ++inside;
+        }
+    }
+    AK_CHECK_EQ(inside, 0);
+    /* the middle rests on the lid */
+    AK_CHECK_NEAR(s.x[6 * 12 + 6].y, 0.51f, 0.01f);
+    sim_free(&s);
+}
+
+/* ---- pins and attachments ------------------------------------------------------------- */
+
+AK_TEST(pins_and_attachments_exact) {
+    uint32_t pins[1] = {0}, att[2] = {9, 99};
+    ak_vec3 pin_at[1] = {{-0.01f, 0.02f, 0}};
+    ak_cloth_desc d = {.grid_width = 10, .grid_height = 10, .grid_axis_v = {0, -1, 0}, .pins = AK_SPAN(pins),
+                       .pin_positions = AK_SPAN(pin_at), .attachments = AK_SPAN(att),
+                       .stretch_stiffness = 500.0f};
+    for (int solver = 0; solver < 3; ++solver) {
+        d.solver = (ak_cloth_solver)solver;
+        sim s;
+        AK_CHECK(sim_init(&s, &d));
+        AK_CHECK(s.x[0].x == -0.01f && s.x[0].y == 0.02f);
+        ak_vec3 targets[2];
+        s.job.attachment_targets = (ak_vec3_cspan)AK_SPAN(targets);
+        s.job.wind = ak_vec3_make(3, 0, 2), s.job.drag = 1, s.job.lift = 1;
+        s.job.substeps = solver == AK_CLOTH_SPRINGS ? 40 : 10;
+        sim_scratch(&s);
+        ak_f32_cspan w = ak_cloth_inverse_masses(s.cloth);
+        AK_CHECK(w.ptr[0] == 0.0f && w.ptr[9] == 0.0f && w.ptr[99] == 0.0f && w.ptr[50] > 0.0f);
+        int bad = 0;
+        for (int f = 0; f < 90; ++f) {
+            const float t = (float)f / 60.0f;
+            /* a skinned vertex and a joint moving on circles */
+            targets[0] = ak_vec3_make(0.45f + 0.2f * sinf(3 * t), 0.1f * cosf(2 * t), 0.1f * t);
+            targets[1] = ak_vec3_make(0.45f, -0.45f + 0.1f * sinf(5 * t), 0.2f * sinf(t));
+            AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+            bad += memcmp(&s.x[9], &targets[0], sizeof(ak_vec3)) != 0;
+            bad += memcmp(&s.x[99], &targets[1], sizeof(ak_vec3)) != 0;
+            bad += s.x[0].x != -0.01f || s.x[0].y != 0.02f || s.x[0].z != 0.0f;
+            bad += s.v[0].x != 0.0f || s.v[0].y != 0.0f || s.v[0].z != 0.0f;
+        }
+        AK_CHECK_EQ(bad, 0);
+        sim_free(&s);
+    }
+}
+
+/* ---- robustness, threads ------------------------------------------------------------- */
+
+/* 10,000 steps of a small flag in strong gusty wind: finite state, bounded stretch. */
+AK_TEST(flag_strong_wind_10000_steps) {
+    enum { W = 8, H = 5 };
+    uint32_t pins[2] = {0, (H - 1) * W};
+    ak_cloth_desc d = {.grid_width = W, .grid_height = H, .spacing = 0.1f, .grid_axis_v = {0, -1, 0},
+                       .pins = AK_SPAN(pins), .long_range_attachments = true, .long_range_slack = 0.1f};
+    sim s;
+    AK_CHECK(sim_init(&s, &d));
+    s.job.drag = 1.2f, s.job.lift = 0.8f;
+    s.job.substeps = 4;
+    sim_scratch(&s);
+    float worst = 0.0f;
+    int finite = 1;
+    for (int f = 0; f < 10000 && finite; ++f) {
+        const float t = (float)f / 60.0f;
+        s.job.wind = ak_vec3_make(15.0f + 5.0f * sinf(1.3f * t), 2.0f * sinf(0.7f * t), 5.0f * sinf(2.1f * t));
+        if (ak_cloth_step_run(&s.job) != AK_OK) finite = 0;
+        const float st = ak_cloth_max_stretch(s.cloth, (ak_vec3_cspan){s.x, s.n});
+        if (!ak_finitef(st)) finite = 0;
+        worst = ak_maxf(worst, st);
+    }
+    printf("  flag in 10-20 m/s gusts: worst max stretch over 10,000 steps %.3f\n", (double)worst);
+    AK_CHECK(finite);
+    AK_CHECK(worst < 0.5f);
+    sim_free(&s);
+}
+
+/* The spring solver with far too large a step blows up; the step says so. */
+AK_TEST(springs_blow_up_reported) {
+    ak_cloth_desc d = {.solver = AK_CLOTH_SPRINGS, .grid_width = 8, .grid_height = 8, .stretch_stiffness = 1e6f};
+    sim s;
+    AK_CHECK(sim_init(&s, &d));
+    s.job.substeps = 1;
+    sim_scratch(&s);
+    s.x[5].y += 0.01f;
+    ak_result r = AK_OK;
+    for (int f = 0; f < 200 && r == AK_OK; ++f) r = ak_cloth_step_run(&s.job);
+    AK_CHECK_EQ(r, AK_ERR_NO_CONVERGENCE);
+    sim_free(&s);
+}
+
+/* Every solver gives bit-identical states on 1, 2 and 3 threads (collisions, wind,
+ * self-collision and attachments on). */
+AK_TEST(deterministic_for_any_thread_count) {
+    uint32_t att[1] = {0};
+    for (int solver = 0; solver < 3; ++solver) {
+        ak_cloth_desc d = {.solver = (ak_cloth_solver)solver, .grid_width = 9, .grid_height = 7,
+                           .grid_origin = {-0.4f, 0.7f, 0.3f}, .attachments = AK_SPAN(att),
+                           .stretch_stiffness = 500.0f};
+        ak_vec3* out[3] = {NULL, NULL, NULL};
+        for (int k = 0; k < 3; ++k) {
+            sim s;
+            AK_CHECK(sim_init(&s, &d));
+            const ak_cloth_sphere sp = {{0, 0.4f, 0}, 0.25f};
+            ak_vec3 target = s.x[0];
+            s.job.spheres = &sp, s.job.sphere_count = 1;
+            s.job.wind = ak_vec3_make(2, 0, 1), s.job.drag = 1, s.job.lift = 0.5f;
+            s.job.self_collision = true;
+            s.job.friction = 0.3f;
+            s.job.attachment_targets = (ak_vec3_cspan){&target, 1};
+            s.job.thread_count = (uint32_t)(k + 1);
+            s.job.substeps = solver == AK_CLOTH_SPRINGS ? 40 : 8;
+            sim_scratch(&s);
+            for (int f = 0; f < 20; ++f) {
+                target.x += 0.01f;
+                AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+            }
+            out[k] = malloc(s.n * sizeof(ak_vec3));
+            memcpy(out[k], s.x, s.n * sizeof(ak_vec3));
+            if (k > 0) AK_CHECK_MSG(memcmp(out[0], out[k], s.n * sizeof(ak_vec3)) == 0, "solver %d: %d threads differ", solver, k + 1);
+            sim_free(&s);
+        }
+        for (int k = 0; k < 3; ++k) free(out[k]);
+    }
+}
+
+/* Smooth normals of a flat sheet are u x v; of a folded one, unit and area-weighted. */
+AK_TEST(normals) {
+    ak_cloth_desc d = {.grid_width = 5, .grid_height = 4, .grid_axis_u = {0, 0, 1}, .grid_axis_v = {0, 1, 0}};
+    sim s;
+    AK_CHECK(sim_init(&s, &d));
+    ak_vec3 nrm[20];
+    AK_CHECK_EQ(ak_cloth_normals(s.cloth, (ak_vec3_cspan){s.x, s.n}, (ak_vec3_span)AK_SPAN(nrm)), AK_OK);
+    for (int v = 0; v < 20; ++v) AK_CHECK_NEAR(nrm[v].x, -1.0f, 1e-6f);
+    AK_CHECK_EQ(ak_cloth_normals(s.cloth, (ak_vec3_cspan){s.x, s.n}, (ak_vec3_span){nrm, 19}), AK_ERR_SPAN_SMALL);
+    sim_free(&s);
+}
+
+/* Wind pushes a free sheet facing it downwind; a sheet edge-on to the wind feels no drag. */
+AK_TEST(wind_drag_direction) {
+    ak_cloth_desc d = {.grid_width = 4, .grid_height = 4, .grid_axis_u = {0, 0, 1}, .grid_axis_v = {0, 1, 0}};
+    sim s;
+    AK_CHECK(sim_init(&s, &d));
+    s.job.gravity = ak_vec3_make(0, 0, 0);
+    s.job.wind = ak_vec3_make(5, 0, 0);
+    s.job.drag = 1.0f;
+    sim_scratch(&s);
+    AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+    /* drag on the sheet: 1/2 rho |w - v|^2 C_d A over its mass 0.2 A is dv/dt = K (w - v)^2 with
+     * K = 0.5 * 1.2 / 0.2 = 3 1/m, so w - v(t) = 1 / (1/w + K t): v(1/60) = 5 - 4 = 1 m/s */
+    AK_CHECK_NEAR(s.v[5].x, 1.0f, 0.03f);
+    AK_CHECK_NEAR(s.v[5].y, 0.0f, 1e-4f);
+    s.job.wind = ak_vec3_make(0, 0, 5);
+    memset(s.v, 0, s.n * sizeof(ak_vec3));
+    AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+    AK_CHECK_NEAR(s.v[5].z, 0.0f, 1e-6f);
+    sim_free(&s);
+}
+
+int main(void) {
+    AK_RUN(desc_defaults);
+    AK_RUN(create_rules);
+    AK_RUN(step_rules);
+    AK_RUN(single_spring_static_stretch);
+    AK_RUN(dihedral_gradient);
+    AK_RUN(isometric_bending);
+    AK_RUN(xpbd_stretch_independent_of_substeps);
+    AK_RUN(drape_no_penetration_and_rest);
+    AK_RUN(mesh_collider);
+    AK_RUN(pins_and_attachments_exact);
+    AK_RUN(flag_strong_wind_10000_steps);
+    AK_RUN(springs_blow_up_reported);
+    AK_RUN(deterministic_for_any_thread_count);
+    AK_RUN(normals);
+    AK_RUN(wind_drag_direction);
+    return ak_test_finish();
+}

@@ -1,0 +1,299 @@
+/* Tests for the neighbour grid: every query against a brute-force loop over all points. */
+#include <animkit/grid.h>
+
+#include "ak_test.h"
+
+/* The module's distance test, written out independently. */
+static int near_brute(ak_vec3 a, ak_vec3 b, float r) {
+    float dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
+    return dx * dx + dy * dy + dz * dz < r * r;
+}
+
+static int pair_cmp(const void* a, const void* b) {
+    const ak_grid_pair *p = (const ak_grid_pair*)a, *q = (const ak_grid_pair*)b;
+    if (p->i != q->i) return p->i < q->i ? -1 : 1;
+    return p->j < q->j ? -1 : (p->j > q->j ? 1 : 0);
+}
+
+static int u32_cmp(const void* a, const void* b) {
+    uint32_t x = *(const uint32_t*)a, y = *(const uint32_t*)b;
+    return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+typedef struct built {
+    ak_grid grid;
+    void* mem;
+} built;
+
+static built build(const ak_vec3* p, size_t n, float cell) {
+    built b;
+    ak_grid_desc d = {.cell_size = cell};
+    size_t bytes = ak_grid_memory_size(n, &d);
+    b.mem = malloc(bytes);
+    ak_result r =
+        ak_grid_build(&d, (ak_vec3_cspan){p, n}, (ak_u8_span){(uint8_t*)b.mem, bytes}, &b.grid);
+    AK_CHECK_EQ(r, AK_OK);
+    return b;
+}
+
+/* Builds the grid with cell size `cell` and checks pairs (on 1, 2 and 3 threads) and point
+ * queries for radius r against brute force. Returns the number of pairs. */
+static size_t check_cloud(const ak_vec3* p, size_t n, float cell, float r) {
+    built b = build(p, n, cell);
+    size_t brute = 0;
+    for (size_t i = 0; i < n; ++i)
+        for (size_t j = i + 1; j < n; ++j) brute += (size_t)near_brute(p[i], p[j], r);
+    ak_grid_pair* want = (ak_grid_pair*)malloc((brute + 1) * sizeof *want);
+    size_t w = 0;
+    for (size_t i = 0; i < n; ++i)
+        for (size_t j = i + 1; j < n; ++j)
+            if (near_brute(p[i], p[j], r)) want[w++] = (ak_grid_pair){(uint32_t)i, (uint32_t)j};
+
+    ak_grid_pair* first = NULL;
+    for (uint32_t threads = 1; threads <= 3; ++threads) {
+        ak_grid_pair* got = (ak_grid_pair*)malloc((brute + 1) * sizeof *got);
+        size_t count = 0;
+        ak_grid_pairs_job job = {.grid = &b.grid,
+                                 .radius = r,
+                                 .thread_count = threads,
+                                 .out_pairs = {got, brute},
+                                 .out_pair_count = &count};
+        AK_CHECK_EQ(ak_grid_pairs_run(&job), AK_OK);
+        AK_CHECK_EQ(count, brute);
+        if (count == brute) {
+            for (size_t k = 0; k < count; ++k) AK_CHECK(got[k].i < got[k].j);
+            if (!first) {
+                first = (ak_grid_pair*)malloc((brute + 1) * sizeof *first);
+                memcpy(first, got, brute * sizeof *got);
+            } else {
+                /* Same pairs in the same order on any thread count. */
+                AK_CHECK(memcmp(first, got, brute * sizeof *got) == 0);
+            }
+            qsort(got, count, sizeof *got, pair_cmp);
+            AK_CHECK(brute == 0 || memcmp(got, want, brute * sizeof *got) == 0);
+        }
+        free(got);
+    }
+    free(first);
+
+    /* Point queries at every 7th point and at points between them. */
+    uint32_t* idx = (uint32_t*)malloc((n + 1) * sizeof *idx);
+    for (size_t i = 0; i < n; i += 7) {
+        ak_vec3 q = p[i];
+        if (i % 2 && i + 1 < n) q = ak_vec3_scale(ak_vec3_add(p[i], p[i + 1]), 0.5f);
+        size_t total = ak_grid_query(&b.grid, q, r, (ak_u32_span){idx, n});
+        size_t expect = 0;
+        for (size_t j = 0; j < n; ++j) expect += (size_t)near_brute(q, p[j], r);
+        AK_CHECK_EQ(total, expect);
+        if (total != expect) break;
+        qsort(idx, total, sizeof *idx, u32_cmp);
+        size_t k = 0;
+        for (size_t j = 0; j < n; ++j)
+            if (near_brute(q, p[j], r)) AK_CHECK_EQ(idx[k++], j);
+    }
+    free(idx);
+    free(want);
+    free(b.mem);
+    return brute;
+}
+
+AK_TEST(random_cloud_matches_brute_force) {
+    ak_rng rng = ak_rng_make(7);
+    const size_t n = 3000;
+    ak_vec3* p = (ak_vec3*)malloc(n * sizeof *p);
+    for (size_t i = 0; i < n; ++i)
+        p[i] = ak_vec3_make(ak_rng_range(&rng, -4, 4), ak_rng_range(&rng, -4, 4),
+                            ak_rng_range(&rng, -4, 4));
+    size_t pairs = check_cloud(p, n, 0.5f, 0.5f);
+    AK_CHECK(pairs > 1000);         /* the cloud is dense enough to test something */
+    check_cloud(p, n, 0.35f, 0.3f); /* r below the cell size */
+    free(p);
+}
+
+AK_TEST(points_on_cell_boundaries) {
+    /* A lattice with spacing = cell = r: every point sits on a cell corner and every axis
+     * neighbour is at exactly r (excluded, strict <); diagonals are further. Then r a hair
+     * above: the six axis neighbours count. */
+    const float h = 0.25f;
+    ak_vec3 p[6 * 6 * 6];
+    size_t n = 0;
+    for (int z = -3; z < 3; ++z)
+        for (int y = -3; y < 3; ++y)
+            for (int x = -3; x < 3; ++x) p[n++] = ak_vec3_make(x * h, y * h, z * h);
+    AK_CHECK_EQ(check_cloud(p, n, h, h), 0);
+    AK_CHECK_EQ(check_cloud(p, n, h, nextafterf(h, 1.0f)), 3 * 6 * 6 * 5);
+    /* Half-cell lattice: points on boundaries and cell centres' faces. */
+    AK_CHECK(check_cloud(p, n, 2 * h, 2 * h) > 0);
+}
+
+AK_TEST(points_far_outside_any_bounds) {
+    ak_rng rng = ak_rng_make(11);
+    ak_vec3 p[600];
+    size_t n = 0;
+    const float centres[5][3] = {
+        {1e6f, 0, 0}, {-3e7f, 2e7f, 1e5f}, {4e9f, -4e9f, 4e9f}, {-1e30f, 1e30f, 0}, {0, 0, 0}};
+    for (int c = 0; c < 5; ++c)
+        for (int k = 0; k < 120; ++k) {
+            float s = fabsf(centres[c][0]) > 1e8f ? 1e-7f * fabsf(centres[c][0])
+                                                  : 1.0f; /* float spacing there */
+            p[n++] = ak_vec3_make(centres[c][0] + s * ak_rng_range(&rng, -2, 2),
+                                  centres[c][1] + s * ak_rng_range(&rng, -2, 2),
+                                  centres[c][2] + s * ak_rng_range(&rng, -2, 2));
+        }
+    /* Small cells: far points clamp into shared cells but pairs stay exact. */
+    AK_CHECK(check_cloud(p, n, 0.5f, 0.5f) > 0);
+    check_cloud(p, n, 0.5f, 5e3f);
+}
+
+AK_TEST(duplicates_and_large_radius) {
+    ak_vec3 p[200];
+    ak_rng rng = ak_rng_make(3);
+    for (int i = 0; i < 200; ++i)
+        p[i] = i < 50 ? ak_vec3_make(1, 2, 3)
+                      : ak_vec3_make(ak_rng_range(&rng, 0, 4), ak_rng_range(&rng, 0, 4), 0);
+    AK_CHECK(check_cloud(p, 200, 0.2f, 0.2f) >= 50 * 49 / 2);
+    check_cloud(p, 200, 0.2f, 0.7f);                               /* r = 3.5 cells: four rings */
+    check_cloud(p, 200, 0.2f, 1.0f);                               /* r = exactly 5 cells */
+    AK_CHECK_EQ(check_cloud(p, 200, 0.2f, 100.0f), 200 * 199 / 2); /* all pairs: scans every cell */
+}
+
+AK_TEST(empty_and_single) {
+    ak_vec3 p = {1, 1, 1};
+    AK_CHECK_EQ(check_cloud(NULL, 0, 1.0f, 1.0f), 0);
+    AK_CHECK_EQ(check_cloud(&p, 1, 1.0f, 1.0f), 0);
+    built b = build(NULL, 0, 1.0f);
+    uint32_t out[4];
+    AK_CHECK_EQ(ak_grid_query(&b.grid, p, 1.0f, (ak_u32_span)AK_SPAN(out)), 0);
+    AK_CHECK_EQ(b.grid.cell_count, 0);
+    free(b.mem);
+}
+
+AK_TEST(sorted_layout_and_cells) {
+    ak_rng rng = ak_rng_make(5);
+    ak_vec3 p[500];
+    for (int i = 0; i < 500; ++i)
+        p[i] = ak_vec3_make(ak_rng_range(&rng, -2, 2), ak_rng_range(&rng, -2, 2),
+                            ak_rng_range(&rng, -2, 2));
+    built b = build(p, 500, 0.5f);
+    const ak_grid* g = &b.grid;
+    int seen[500] = {0};
+    AK_CHECK_EQ(g->cell_start[0], 0);
+    AK_CHECK_EQ(g->cell_start[g->cell_count], 500);
+    for (uint32_t m = 0; m < g->cell_count; ++m) {
+        AK_CHECK_EQ(ak_grid_cell_find(g, g->cell_coord[m]), m);
+        for (uint32_t k = g->cell_start[m]; k < g->cell_start[m + 1]; ++k) {
+            uint32_t i = g->order[k];
+            seen[i]++;
+            AK_CHECK(g->x[k] == p[i].x && g->y[k] == p[i].y && g->z[k] == p[i].z);
+            /* floor(p / cell) computed independently */
+            AK_CHECK_EQ(g->cell_coord[m].x, (int32_t)floor(p[i].x / 0.5));
+            AK_CHECK_EQ(g->cell_coord[m].y, (int32_t)floor(p[i].y / 0.5));
+            AK_CHECK_EQ(g->cell_coord[m].z, (int32_t)floor(p[i].z / 0.5));
+            if (k > g->cell_start[m]) AK_CHECK(g->order[k - 1] < i); /* increasing inside a cell */
+        }
+    }
+    for (int i = 0; i < 500; ++i) AK_CHECK_EQ(seen[i], 1);
+    ak_grid_cell empty = {1000, 1000, 1000};
+    AK_CHECK_EQ(ak_grid_cell_find(g, empty), UINT32_MAX);
+    ak_grid_cell c = ak_grid_cell_of(g, ak_vec3_make(-0.25f, 0.5f, 1.99f));
+    AK_CHECK(c.x == -1 && c.y == 1 && c.z == 3);
+    free(b.mem);
+}
+
+AK_TEST(short_output_reports_count) {
+    ak_rng rng = ak_rng_make(9);
+    ak_vec3 p[400];
+    for (int i = 0; i < 400; ++i)
+        p[i] = ak_vec3_make(ak_rng_range(&rng, 0, 3), ak_rng_range(&rng, 0, 3),
+                            ak_rng_range(&rng, 0, 3));
+    built b = build(p, 400, 0.5f);
+    size_t brute = 0;
+    for (int i = 0; i < 400; ++i)
+        for (int j = i + 1; j < 400; ++j) brute += (size_t)near_brute(p[i], p[j], 0.5f);
+    size_t count = 7;
+    ak_grid_pairs_job job = {.grid = &b.grid, .radius = 0.5f, .out_pair_count = &count};
+    AK_CHECK_EQ(ak_grid_pairs_run(&job), brute ? AK_ERR_SPAN_SMALL : AK_OK);
+    AK_CHECK_EQ(count, brute);
+    ak_grid_pair* got = (ak_grid_pair*)malloc(brute * sizeof *got);
+    job.out_pairs = (ak_grid_pair_span){got, brute - 1};
+    job.thread_count = 2;
+    AK_CHECK_EQ(ak_grid_pairs_run(&job), AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(count, brute);
+    /* Exactly enough room; the threads' equal shares rarely match their counts, so this
+     * usually takes the exact-offset second pass. */
+    for (uint32_t t = 1; t <= 5; ++t) {
+        job.out_pairs = (ak_grid_pair_span){got, brute};
+        job.thread_count = t;
+        AK_CHECK_EQ(ak_grid_pairs_run(&job), AK_OK);
+        qsort(got, brute, sizeof *got, pair_cmp);
+        size_t k = 0, bad = 0;
+        for (uint32_t i = 0; i < 400; ++i)
+            for (uint32_t j = i + 1; j < 400; ++j)
+                if (near_brute(p[i], p[j], 0.5f)) bad += got[k].i != i || got[k].j != j, ++k;
+        AK_CHECK_EQ(bad, 0);
+    }
+    uint32_t few[3];
+    size_t total = ak_grid_query(&b.grid, p[0], 1.5f, (ak_u32_span)AK_SPAN(few));
+    size_t expect = 0;
+    for (int j = 0; j < 400; ++j) expect += (size_t)near_brute(p[0], p[j], 1.5f);
+    AK_CHECK_EQ(total, expect);
+    free(got);
+    free(b.mem);
+}
+
+AK_TEST(validation_codes) {
+    ak_vec3 p[2] = {{0, 0, 0}, {NAN, 0, 0}};
+    uint8_t mem[4096];
+    ak_grid g;
+    ak_grid_desc d = {.cell_size = 1.0f};
+    ak_grid_desc zero = {0};
+    AK_CHECK(ak_grid_memory_size(2, &d) <= sizeof mem);
+    AK_CHECK_EQ(ak_grid_memory_size(2, NULL), 0);
+    AK_CHECK_EQ(ak_grid_build(NULL, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){NULL, 1}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_grid_build(&zero, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_BAD_ARG);
+    ak_grid_desc inf = {.cell_size = INFINITY};
+    AK_CHECK_EQ(ak_grid_build(&inf, (ak_vec3_cspan){p, 1}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 1}, (ak_u8_span){mem, 8}, &g),
+                AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 2}, (ak_u8_span)AK_SPAN(mem), &g),
+                AK_ERR_BAD_DATA);
+    AK_CHECK_EQ(g.point_count, 0);
+    AK_CHECK_EQ(ak_grid_build(&d, (ak_vec3_cspan){p, 1}, (ak_u8_span){mem + 3, sizeof mem - 3}, &g),
+                AK_OK);
+    size_t count;
+    ak_grid_pairs_job zj = {0};
+    AK_CHECK_EQ(ak_grid_pairs_run(&zj), AK_ERR_NULL_ARG);
+    ak_grid_pairs_job job = {.grid = &g, .radius = 1.0f, .out_pair_count = &count};
+    AK_CHECK_EQ(ak_grid_pairs_validate(&job), AK_OK);
+    job.out_pairs.count = 3;
+    AK_CHECK_EQ(ak_grid_pairs_validate(&job), AK_ERR_NULL_ARG);
+    job.out_pairs.count = 0;
+    job.radius = 0.0f;
+    AK_CHECK_EQ(ak_grid_pairs_validate(&job), AK_ERR_BAD_ARG);
+    job.radius = NAN;
+    AK_CHECK_EQ(ak_grid_pairs_validate(&job), AK_ERR_BAD_ARG);
+    job.radius = 1.0f;
+    job.thread_count = 65;
+    AK_CHECK_EQ(ak_grid_pairs_validate(&job), AK_ERR_BAD_ARG);
+    uint32_t out[2];
+    AK_CHECK_EQ(ak_grid_query(&g, p[0], NAN, (ak_u32_span)AK_SPAN(out)), 0);
+    AK_CHECK_EQ(ak_grid_query(&g, p[1], 1.0f, (ak_u32_span)AK_SPAN(out)), 0);
+    AK_CHECK_EQ(ak_grid_query(&g, p[0], 1.0f, (ak_u32_span)AK_SPAN(out)), 1);
+}
+
+int main(void) {
+    AK_RUN(random_cloud_matches_brute_force);
+    AK_RUN(points_on_cell_boundaries);
+    AK_RUN(points_far_outside_any_bounds);
+    AK_RUN(duplicates_and_large_radius);
+    AK_RUN(empty_and_single);
+    AK_RUN(sorted_layout_and_cells);
+    AK_RUN(short_output_reports_count);
+    AK_RUN(validation_codes);
+    return ak_test_finish();
+}

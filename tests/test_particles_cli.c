@@ -1,0 +1,169 @@
+/* animkit particles: the command's contract (exit codes, one-line errors naming file and key
+ * path, the --json keys and order) with results checked against closed forms. */
+#include <animkit/animkit.h>
+#include <cjson/cJSON.h>
+
+#include <sys/wait.h>
+
+#include "ak_test.h"
+
+#ifndef AK_CLI_PATH
+#error "AK_CLI_PATH must name the animkit executable"
+#endif
+
+static char out_buf[1 << 16];
+
+static int run(const char* args) {
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "%s %s 2>&1", AK_CLI_PATH, args);
+    FILE* p = popen(cmd, "r");
+    if (!p) return -1;
+    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
+    out_buf[n] = '\0';
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static void write_file(const char* path, const char* text) {
+    FILE* f = fopen(path, "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+static cJSON* read_json(const char* path) {
+    FILE* f = fopen(path, "rb");
+    if (!f) return NULL;
+    static char buf[1 << 20];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    return cJSON_Parse(buf);
+}
+
+static double num(const cJSON* arr, int i) { return cJSON_GetArrayItem(arr, i)->valuedouble; }
+
+AK_TEST(bad_scenes_exit_1_with_path) {
+    struct {
+        const char* text;
+        const char* expect; /* key path and problem in the one line */
+    } cases[] = {
+        {"{\"particles\": [{\"p\": [0,0,0]}], \"springs\": [{\"i\": 0, \"j\": 5}]}",
+         "springs[0].j"},
+        {"{\"spheres\": [{\"r\": -1}]}", "spheres[0].r"},
+        {"{\"gravty\": [0, 1, 0]}", "unknown key \"gravty\""},
+        {"{\"particles\": [{\"p\": [0, \"x\", 0]}]}", "particles[0].p"},
+        {"{\"dt\": NaN}", "invalid JSON"},
+        {"{\"dt\": 1e999}", "dt"},
+        {"{\"drag\": {\"linear\": -1}}", "drag.linear"},
+        {"{\"integrator\": \"leapfrog\"}", "integrator"},
+        {"{\"emitters\": [{\"speed\": [3, 1]}]}", "emitters[0].speed"},
+        {"{\"planes\": [{\"n\": [0, 0, 0]}]}", "planes[0].n"},
+        {"{\"particles\": [{\"m\": 1, \"m\": 2}]}", "particles[0]"},
+        {"[1, 2]", "top level"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        write_file("particles_bad.json", cases[k].text);
+        int rc = run("particles particles_bad.json --steps 2");
+        AK_CHECK_MSG(rc == 1, "case %zu: exit %d (%s)", k, rc, out_buf);
+        AK_CHECK_MSG(strstr(out_buf, "particles_bad.json") && strstr(out_buf, cases[k].expect),
+                     "case %zu: %s", k, out_buf);
+        int lines = 0;
+        for (const char* p = out_buf; *p; ++p) lines += *p == '\n';
+        AK_CHECK_MSG(lines == 1, "case %zu: %d lines", k, lines);
+    }
+    AK_CHECK_EQ(run("particles missing_file.json"), 1);
+    AK_CHECK_EQ(run("particles"), 2);
+    AK_CHECK_EQ(run("particles --preset nope"), 2);
+    AK_CHECK_EQ(run("particles --preset rain particles_bad.json"), 2);
+    AK_CHECK_EQ(run("particles --preset rain --integrator midpoint"), 2);
+    AK_CHECK_EQ(run("particles --preset rain --dt -1"), 2);
+    AK_CHECK_EQ(run("particles --preset rain -o out.bmp"), 2);
+    AK_CHECK_EQ(run("particles --help"), 0);
+    AK_CHECK(strstr(out_buf, "usage: animkit particles") != NULL);
+}
+
+AK_TEST(json_matches_closed_form) {
+    /* A thrown particle (Verlet: exact for constant gravity) and a pinned one; the file's
+     * dt is overridden on the command line. */
+    write_file(
+        "particles_throw.json",
+        "{\"dt\": 0.5, \"integrator\": \"euler\", \"gravity\": [0, -10, 0],"
+        " \"particles\": [{\"p\": [1, 2, 3], \"v\": [2, 5, 0]}, {\"p\": [0, 1, 0], \"m\": 0}]}");
+    AK_CHECK_EQ(run("particles particles_throw.json --steps 40 --dt 0.025 --integrator verlet "
+                    "--json throw.json"),
+                0);
+    cJSON* j = read_json("throw.json");
+    AK_CHECK(j != NULL);
+    if (!j) return;
+    AK_CHECK_NEAR(cJSON_GetObjectItem(j, "time")->valuedouble, 1.0, 1e-6);
+    AK_CHECK_EQ(cJSON_GetObjectItem(j, "steps")->valueint, 40);
+    const cJSON* ps = cJSON_GetObjectItem(j, "particles");
+    AK_CHECK_EQ(cJSON_GetArraySize(ps), 2);
+    const cJSON* p0 = cJSON_GetObjectItem(cJSON_GetArrayItem(ps, 0), "p");
+    const cJSON* v0 = cJSON_GetObjectItem(cJSON_GetArrayItem(ps, 0), "v");
+    const double t = 40 * (double)0.025f;
+    AK_CHECK_NEAR(num(p0, 0), 1 + 2 * t, 1e-4);
+    AK_CHECK_NEAR(num(p0, 1), 2 + 5 * t - 5 * t * t, 1e-4);
+    AK_CHECK_NEAR(num(p0, 2), 3, 1e-6);
+    AK_CHECK_NEAR(num(v0, 1), 5 - 10 * t, 1e-4);
+    const cJSON* p1 = cJSON_GetObjectItem(cJSON_GetArrayItem(ps, 1), "p");
+    AK_CHECK_NEAR(num(p1, 1), 1.0, 0.0);
+    cJSON_Delete(j);
+
+    /* Emitted particles come after the file's; 2.5/s for 2 s emits exactly 5. */
+    write_file("particles_emit.json",
+               "{\"gravity\": [0, 0, 0], \"particles\": [{\"p\": [9, 9, 9]}],"
+               " \"emitters\": [{\"rate\": 2.5, \"speed\": [0, 0], \"lifetime\": [100, 100]}]}");
+    AK_CHECK_EQ(
+        run("particles particles_emit.json --steps 200 --dt 0.01 --json emit.json --threads 2"), 0);
+    j = read_json("emit.json");
+    AK_CHECK(j != NULL);
+    if (!j) return;
+    ps = cJSON_GetObjectItem(j, "particles");
+    AK_CHECK_EQ(cJSON_GetArraySize(ps), 6);
+    AK_CHECK_NEAR(num(cJSON_GetObjectItem(cJSON_GetArrayItem(ps, 0), "p"), 0), 9.0, 0.0);
+    cJSON_Delete(j);
+}
+
+AK_TEST(presets_run_and_render) {
+    const char* presets[] = {"fountain", "rain", "fireworks", "character"};
+    for (int k = 0; k < 4; ++k) {
+        char args[256];
+        snprintf(
+            args, sizeof args,
+            "particles --preset %s --steps 12 --size 96x72 -o preset_%s.png --json preset_%s.json",
+            presets[k], presets[k], presets[k]);
+        AK_CHECK_MSG(run(args) == 0, "%s: %s", presets[k], out_buf);
+        char path[64];
+        snprintf(path, sizeof path, "preset_%s.png", presets[k]);
+        int w = 0, h = 0;
+        AK_CHECK_EQ(ak_png_info(path, &w, &h), AK_OK);
+        AK_CHECK(w == 96 && h == 72);
+    }
+    AK_CHECK_EQ(run("particles --preset rain --steps 0 --size 64x48 -o zero.gif --json zero.json"), 0);
+    int zw = 0, zh = 0, zf = 0;
+    AK_CHECK_EQ(ak_gif_info("zero.gif", &zw, &zh, &zf), AK_OK);
+    AK_CHECK_EQ(zf, 1);
+    AK_CHECK_EQ(run("particles --preset fireworks --steps 6 --size 64x48 -o fw.gif"), 0);
+    int w = 0, h = 0, frames = 0;
+    AK_CHECK_EQ(ak_gif_info("fw.gif", &w, &h, &frames), AK_OK);
+    AK_CHECK_EQ(frames, 7);
+    /* Same seed, 1 and 2 threads: identical files. */
+    AK_CHECK_EQ(run("particles --preset rain --steps 30 --seed 5 --json r1.json"), 0);
+    AK_CHECK_EQ(run("particles --preset rain --steps 30 --seed 5 --threads 2 --json r2.json"), 0);
+    cJSON* a = read_json("r1.json");
+    char* sa = a ? cJSON_PrintUnformatted(a) : NULL;
+    cJSON* b = read_json("r2.json");
+    char* sb = b ? cJSON_PrintUnformatted(b) : NULL;
+    AK_CHECK(sa && sb && strcmp(sa, sb) == 0);
+    free(sa), free(sb), cJSON_Delete(a), cJSON_Delete(b);
+}
+
+int main(void) {
+    AK_RUN(bad_scenes_exit_1_with_path);
+    AK_RUN(json_matches_closed_form);
+    AK_RUN(presets_run_and_render);
+    return ak_test_finish();
+}

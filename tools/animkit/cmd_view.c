@@ -1,0 +1,146 @@
+/* animkit view: a window on a model (SDL2), or the same loop headless for scripts and CI. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "view_app.h"
+
+#define MAX_SCRIPT_SIZE (4u << 20)
+
+static const char* const usage =
+    "usage: animkit view FILE|builtin:NAME [--clip C] [--size WxH] [--script FILE] [--headless]\n"
+    "                    [--ik-log FILE] [--frames N] [--supersample N] [--threads N] [--stats]\n"
+    "                    [--shot-dir DIR]\n"
+    "Open a window on the model, shaded by animkit's own rasterizer, playing clip C (default the\n"
+    "first). The camera starts framed on the first pose as `animkit render` frames one time.\n"
+    "  --size WxH       window size (default 960x600)\n"
+    "  --script FILE    replay input from FILE, one event a line: key NAME, mouse_down BUTTON X Y,\n"
+    "                   mouse_move X Y, mouse_up BUTTON X Y, wheel DY, wait FRAMES,\n"
+    "                   screenshot PATH, quit ('#' comments); time then steps 1/30 s per frame and\n"
+    "                   the viewer exits at the end of the script. A bad script exits 2 naming the\n"
+    "                   line. BUTTON: left, middle, right; X Y in window pixels.\n"
+    "  --headless       the same loop with no window (no display needed)\n"
+    "  --frames N       headless without a script: run N frames (default 1)\n"
+    "  --ik-log FILE    after each IK solve, one JSON line: {\"frame\": n, \"solver\": s,\n"
+    "                   \"effector\": name, \"target\": [x,y,z], \"reached\": b, \"error\": e}\n"
+    "  --supersample N  anti-aliasing samples per axis, 1..4 (default 1 for speed; render uses 2)\n"
+    "  --threads N      raster threads, 1..64 (default 2)\n"
+    "  --stats          print the frame-time breakdown at exit (stderr)\n"
+    "  --shot-dir DIR   where the P key writes view_NNNN.png (default .)\n"
+    "keys:\n";
+
+static void print_usage(void) {
+    fputs(usage, stdout);
+    for (size_t i = 0; i < view_help_count; ++i) printf("  %-8s %s\n", view_help[i].key, view_help[i].what);
+    printf("mouse: left drag orbits (on a joint: picks the IK effector and drags its target; on the\n"
+           "bottom bar: scrubs); middle or shift+left drag pans; the wheel zooms.\n"
+           "This build %s a window (SDL2).\n",
+           view_window_available() ? "has" : "does not have");
+}
+
+static int load_script(const char* path, view_script* out) {
+    FILE* f = fopen(path, "rb");
+    if (!f) return cli_fail("view", "%s: cannot open the script", path);
+    char* buf = malloc(MAX_SCRIPT_SIZE + 1);
+    size_t n = buf ? fread(buf, 1, MAX_SCRIPT_SIZE + 1, f) : 0;
+    bool err = ferror(f) != 0;
+    fclose(f);
+    if (!buf || err) {
+        free(buf);
+        return cli_fail("view", "%s: cannot read the script", path);
+    }
+    if (n > MAX_SCRIPT_SIZE) {
+        free(buf);
+        return cli_fail("view", "%s: the script is larger than %u bytes", path, MAX_SCRIPT_SIZE);
+    }
+    char msg[256];
+    int rc = view_script_parse(buf, n, out, msg, sizeof msg);
+    free(buf);
+    if (rc == CLI_BAD_USAGE) {
+        fprintf(stderr, "animkit view: %s: %s\n", path, msg);
+        return CLI_BAD_USAGE;
+    }
+    if (rc) return cli_fail("view", "%s: %s", path, msg);
+    return CLI_OK;
+}
+
+int cmd_view(int argc, char** argv) {
+    static const cli_opt opts[] = {
+        {"--clip", "-c", true},    {"--size", NULL, true},    {"--script", NULL, true},      {"--headless", NULL, false},
+        {"--ik-log", NULL, true},  {"--frames", NULL, true},  {"--supersample", NULL, true}, {"--threads", NULL, true},
+        {"--stats", NULL, false},  {"--shot-dir", NULL, true},
+    };
+    cli_args a;
+    int rc = cli_parse("view", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+    if (rc) return rc;
+    if (a.help) {
+        print_usage();
+        return CLI_OK;
+    }
+    if (a.pos_count != 1) return cli_usage("view", "expected one FILE or builtin:NAME");
+    view_options vo = {.width = 960, .height = 600, .clip = -1, .supersample = 1, .threads = 2};
+    if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &vo.width, &vo.height))
+        return cli_usage("view", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
+    long v = 0, frames = 1;
+    if (CLI_GET(&a, "--supersample")) {
+        if (!cli_parse_int(CLI_GET(&a, "--supersample"), 1, 4, &v))
+            return cli_usage("view", "--supersample '%s' is not a whole number in 1..4", CLI_GET(&a, "--supersample"));
+        vo.supersample = (int)v;
+    }
+    if (CLI_GET(&a, "--threads")) {
+        if (!cli_parse_int(CLI_GET(&a, "--threads"), 1, 64, &v))
+            return cli_usage("view", "--threads '%s' is not a whole number in 1..64", CLI_GET(&a, "--threads"));
+        vo.threads = (int)v;
+    }
+    if (CLI_GET(&a, "--frames") && !cli_parse_int(CLI_GET(&a, "--frames"), 0, 100000000, &frames))
+        return cli_usage("view", "--frames '%s' is not a whole number >= 0", CLI_GET(&a, "--frames"));
+    bool headless = CLI_GET(&a, "--headless") != NULL;
+    if (!headless && !view_window_available())
+        return cli_fail("view", "this build has no window (SDL2 was not found at build time); use --headless");
+    vo.shot_dir = CLI_GET(&a, "--shot-dir");
+    if (cli_has_ext(a.pos[0], ".json"))
+        return cli_fail("view", "%s: simulation scenes are not supported yet (no simulation is built into this viewer)",
+                        a.pos[0]);
+
+    view_script script = {0};
+    const char* script_path = CLI_GET(&a, "--script");
+    if (script_path && (rc = load_script(script_path, &script))) return rc;
+    vo.scripted = script_path != NULL;
+
+    ak_scene* s = NULL;
+    view_app app;
+    memset(&app, 0, sizeof app);
+    FILE* log = NULL;
+    if ((rc = cli_load_scene("view", a.pos[0], &s))) goto done;
+    if (CLI_GET(&a, "--clip")) {
+        vo.clip = ak_scene_find_clip(s, CLI_GET(&a, "--clip"));
+        if (vo.clip < 0) {
+            rc = cli_fail("view", "%s: no clip '%s' (%zu clips)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count);
+            goto done;
+        }
+    } else if (s->clip_count) {
+        vo.clip = 0;
+    }
+    if (CLI_GET(&a, "--ik-log") && !(log = fopen(CLI_GET(&a, "--ik-log"), "w"))) {
+        rc = cli_fail("view", "%s: cannot create the IK log", CLI_GET(&a, "--ik-log"));
+        goto done;
+    }
+    vo.ik_log = log;
+    if ((rc = view_app_init(&app, s, &vo))) goto done;
+    rc = headless ? view_app_run(&app, script_path ? &script : NULL, frames, NULL) : view_window_run(&app, script_path ? &script : NULL);
+    if (CLI_GET(&a, "--stats") && app.stats.frames > 0) {
+        double k = 1e3 / (double)app.stats.frames;
+        double total = app.stats.sample + app.stats.skin + app.stats.raster + app.stats.present;
+        fprintf(stderr,
+                "view stats: %ld frames %dx%d supersample %d threads %d: sample+FK %.3f ms, skinning %.3f ms, "
+                "rasterize %.3f ms, present %.3f ms, total %.3f ms (%.1f fps)\n",
+                app.stats.frames, app.width, app.height, vo.supersample, vo.threads, app.stats.sample * k,
+                app.stats.skin * k, app.stats.raster * k, app.stats.present * k, total * k,
+                total > 0 ? (double)app.stats.frames / total : 0.0);
+    }
+done:
+    if (app.scene) view_app_free(&app);
+    if (log && fclose(log) != 0 && rc == CLI_OK) rc = cli_fail("view", "%s: cannot write the IK log", CLI_GET(&a, "--ik-log"));
+    view_script_free(&script);
+    ak_scene_destroy(s);
+    return rc;
+}

@@ -1,0 +1,272 @@
+/* animkit boids: scene file reader (keys and defaults: docs/boids.md). */
+#include "scene_boids.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_json.h"
+
+void cli_boids_scene_defaults(cli_boids_scene* s) {
+    memset(s, 0, sizeof *s);
+    static const ak_vec4 palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
+                                       {0.75f, 0.30f, 0.55f, 1}};
+    for (int k = 0; k < AK_BOIDS_MAX_SPECIES; ++k) {
+        s->species[k] = (ak_boids_species){.max_speed = 4, .max_force = 8, .separation_weight = 1.5f,
+                                           .separation_radius = 1, .alignment_weight = 1, .alignment_radius = 2.5f,
+                                           .cohesion_weight = 0.6f, .cohesion_radius = 2.5f, .view_angle = 270,
+                                           .avoid_weight = 6, .avoid_distance = 2, .bounds_weight = 4};
+        s->color[k] = palette[k % 4];
+    }
+    s->params.species = s->species;
+    s->params.species_count = 1;
+    s->params.bounds_min = ak_vec3_make(-10, -10, -10);
+    s->params.bounds_max = ak_vec3_make(10, 10, 10);
+    s->params.bounds = AK_BOIDS_BOUNDS_STEER;
+    s->params.bounds_margin = 2;
+    s->params.leader_distance = 1;
+    s->count = 500;
+    s->steps = 200;
+    s->dt = 0.02f;
+    s->seed = 1;
+    s->shape_size = 0.5f;
+}
+
+void cli_boids_scene_free(cli_boids_scene* s) {
+    free(s->obstacles);
+    free(s->positions);
+    free(s->velocities);
+    free(s->agent_species);
+    s->obstacles = NULL;
+    s->positions = s->velocities = NULL;
+    s->agent_species = NULL;
+    s->agent_count = 0;
+    s->params.obstacles = NULL;
+    s->params.obstacle_count = 0;
+}
+
+/* An array of species indices -> a bit mask. */
+static bool read_mask(cli_json* j, const cJSON* obj, const char* path, const char* key, uint32_t species_count,
+                      uint32_t* out) {
+    size_t n = 0;
+    const cJSON* e = cli_json_array(j, obj, path, key, AK_BOIDS_MAX_SPECIES, &n);
+    if (j->failed) return false;
+    char p[128];
+    cli_json_key(p, sizeof p, path, key);
+    uint32_t m = 0;
+    for (size_t i = 0; e && i < n; ++i, e = e->next) {
+        /* Range first: the integrality test casts, and a cast of an out-of-range double is UB. */
+        if (!cJSON_IsNumber(e) || !(e->valuedouble >= 0 && e->valuedouble < (double)species_count) ||
+            e->valuedouble != (double)(long)e->valuedouble) {
+            char q[160];
+            return cli_json_fail(j, cli_json_index(q, sizeof q, p, i), NULL,
+                                 "expected a species index in [0, %u]", species_count - 1);
+        }
+        m |= 1u << (uint32_t)e->valuedouble;
+    }
+    if (n > 0) *out = m;
+    return true;
+}
+
+static bool read_species(cli_json* j, const cJSON* o, const char* path, uint32_t species_count, cli_boids_scene* s,
+                         uint32_t k) {
+    static const char* const keys[] = {
+        "max_speed", "min_speed", "max_force", "separation_weight", "separation_radius", "alignment_weight",
+        "alignment_radius", "cohesion_weight", "cohesion_radius", "view_angle", "k_nearest", "goal_weight",
+        "leader_weight", "wander_weight", "wander_jitter", "avoid_weight", "avoid_distance", "bounds_weight",
+        "flee", "flee_weight", "flee_radius", "pursue", "pursue_weight", "pursue_radius", "fraction", "color", NULL};
+    if (!cli_json_object(j, o, path, keys)) return false;
+    ak_boids_species* sp = &s->species[k];
+    const float big = 1e6f;
+    cli_json_float(j, o, path, "max_speed", 1e-6f, big, &sp->max_speed);
+    cli_json_float(j, o, path, "min_speed", 0, big, &sp->min_speed);
+    cli_json_float(j, o, path, "max_force", 1e-6f, big, &sp->max_force);
+    cli_json_float(j, o, path, "separation_weight", 0, big, &sp->separation_weight);
+    cli_json_float(j, o, path, "separation_radius", 1e-4f, big, &sp->separation_radius);
+    cli_json_float(j, o, path, "alignment_weight", 0, big, &sp->alignment_weight);
+    cli_json_float(j, o, path, "alignment_radius", 1e-4f, big, &sp->alignment_radius);
+    cli_json_float(j, o, path, "cohesion_weight", 0, big, &sp->cohesion_weight);
+    cli_json_float(j, o, path, "cohesion_radius", 1e-4f, big, &sp->cohesion_radius);
+    cli_json_float(j, o, path, "view_angle", 0, 360, &sp->view_angle);
+    long kn = (long)sp->k_nearest;
+    cli_json_int(j, o, path, "k_nearest", 0, AK_BOIDS_MAX_K, &kn);
+    sp->k_nearest = (uint32_t)kn;
+    cli_json_float(j, o, path, "goal_weight", 0, big, &sp->goal_weight);
+    cli_json_float(j, o, path, "leader_weight", 0, big, &sp->leader_weight);
+    cli_json_float(j, o, path, "wander_weight", 0, big, &sp->wander_weight);
+    cli_json_float(j, o, path, "wander_jitter", 1e-6f, big, &sp->wander_jitter);
+    cli_json_float(j, o, path, "avoid_weight", 0, big, &sp->avoid_weight);
+    cli_json_float(j, o, path, "avoid_distance", 1e-4f, big, &sp->avoid_distance);
+    cli_json_float(j, o, path, "bounds_weight", 1e-6f, big, &sp->bounds_weight);
+    read_mask(j, o, path, "flee", species_count, &sp->flee_mask);
+    cli_json_float(j, o, path, "flee_weight", 0, big, &sp->flee_weight);
+    cli_json_float(j, o, path, "flee_radius", 1e-4f, big, &sp->flee_radius);
+    read_mask(j, o, path, "pursue", species_count, &sp->pursue_mask);
+    cli_json_float(j, o, path, "pursue_weight", 0, big, &sp->pursue_weight);
+    cli_json_float(j, o, path, "pursue_radius", 1e-4f, big, &sp->pursue_radius);
+    cli_json_float(j, o, path, "fraction", 0, 1, &s->fraction[k]);
+    float rgb[3] = {s->color[k].x, s->color[k].y, s->color[k].z};
+    cli_json_floats(j, o, path, "color", 3, 0, 1, rgb);
+    s->color[k] = ak_vec4_make(rgb[0], rgb[1], rgb[2], 1);
+    if (!j->failed && sp->min_speed > sp->max_speed)
+        cli_json_fail(j, path, "min_speed", "%g is above max_speed %g", (double)sp->min_speed, (double)sp->max_speed);
+    return !j->failed;
+}
+
+static bool read_obstacle(cli_json* j, const cJSON* o, const char* path, ak_boids_obstacle* ob) {
+    static const char* const types[] = {"sphere", "plane", "box", NULL};
+    static const char* const sphere_keys[] = {"type", "center", "radius", NULL};
+    static const char* const plane_keys[] = {"type", "point", "normal", NULL};
+    static const char* const box_keys[] = {"type", "center", "half_extents", NULL};
+    if (!cJSON_IsObject(o)) return cli_json_fail(j, path, NULL, "expected an object");
+    int type = -1;
+    if (!cJSON_GetObjectItemCaseSensitive(o, "type"))
+        return cli_json_fail(j, path, "type", "missing (sphere, plane or box)");
+    if (!cli_json_enum(j, o, path, "type", types, &type)) return false;
+    memset(ob, 0, sizeof *ob);
+    const float big = 1e9f;
+    if (type == 0) {
+        ob->kind = AK_BOIDS_SPHERE;
+        ob->radius = 1;
+        cli_json_object(j, o, path, sphere_keys);
+        cli_json_vec3(j, o, path, "center", &ob->center);
+        cli_json_float(j, o, path, "radius", 1e-4f, big, &ob->radius);
+    } else if (type == 1) {
+        ob->kind = AK_BOIDS_PLANE;
+        ob->normal = ak_vec3_make(0, 1, 0);
+        cli_json_object(j, o, path, plane_keys);
+        cli_json_vec3(j, o, path, "point", &ob->center);
+        cli_json_vec3(j, o, path, "normal", &ob->normal);
+        if (!j->failed && !(ak_vec3_length(ob->normal) > 1e-6f))
+            cli_json_fail(j, path, "normal", "must not be zero");
+    } else {
+        ob->kind = AK_BOIDS_BOX;
+        ob->half_extents = ak_vec3_make(1, 1, 1);
+        cli_json_object(j, o, path, box_keys);
+        cli_json_vec3(j, o, path, "center", &ob->center);
+        float h[3] = {1, 1, 1};
+        cli_json_floats(j, o, path, "half_extents", 3, 1e-4f, big, h);
+        ob->half_extents = ak_vec3_make(h[0], h[1], h[2]);
+    }
+    if (!j->failed && !(fabsf(ob->center.x) <= big && fabsf(ob->center.y) <= big && fabsf(ob->center.z) <= big))
+        cli_json_fail(j, path, type == 1 ? "point" : "center", "a coordinate is beyond +-1e9");
+    return !j->failed;
+}
+
+static bool vec_in(ak_vec3 v, float lim) { return fabsf(v.x) <= lim && fabsf(v.y) <= lim && fabsf(v.z) <= lim; }
+
+int cli_boids_scene_parse(const char* file, const char* text, size_t size, cli_boids_scene* s, char* message,
+                          size_t message_size) {
+    static const char* const keys[] = {"dt",     "steps",  "seed",   "count",  "planar", "bounds", "goal",
+                                       "leader", "species", "obstacles", "agents", "render", NULL};
+    cli_json j = {.file = file};
+    cJSON* root = cli_json_parse(&j, text, size);
+    if (root) {
+        cli_json_object(&j, root, "", keys);
+        cli_json_float(&j, root, "", "dt", 1e-6f, 10.0f, &s->dt);
+        cli_json_int(&j, root, "", "steps", 0, 100000000, &s->steps);
+        cli_json_int(&j, root, "", "seed", 0, 2147483647, &s->seed);
+        long count = (long)s->count;
+        cli_json_int(&j, root, "", "count", 1, CLI_BOIDS_MAX_AGENTS, &count);
+        s->count = (size_t)count;
+        cli_json_bool(&j, root, "", "planar", &s->params.planar);
+        const cJSON* b = cli_json_member(&j, root, "", "bounds");
+        if (b) {
+            static const char* const bkeys[] = {"min", "max", "mode", "margin", NULL};
+            static const char* const modes[] = {"steer", "wrap", "none", NULL};
+            cli_json_object(&j, b, "bounds", bkeys);
+            cli_json_vec3(&j, b, "bounds", "min", &s->params.bounds_min);
+            cli_json_vec3(&j, b, "bounds", "max", &s->params.bounds_max);
+            int mode = 0;
+            cli_json_enum(&j, b, "bounds", "mode", modes, &mode);
+            s->params.bounds = mode == 0 ? AK_BOIDS_BOUNDS_STEER : mode == 1 ? AK_BOIDS_BOUNDS_WRAP : AK_BOIDS_BOUNDS_NONE;
+            cli_json_float(&j, b, "bounds", "margin", 1e-4f, 1e9f, &s->params.bounds_margin);
+            const ak_vec3 lo = s->params.bounds_min, hi = s->params.bounds_max;
+            if (!j.failed && (!vec_in(lo, 1e9f) || !vec_in(hi, 1e9f)))
+                cli_json_fail(&j, "bounds", NULL, "a coordinate is beyond +-1e9");
+            if (!j.failed && !(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+                cli_json_fail(&j, "bounds", "max", "must be above min on every axis");
+        }
+        cli_json_vec3(&j, root, "", "goal", &s->params.goal);
+        if (!j.failed && !vec_in(s->params.goal, 1e9f)) cli_json_fail(&j, "", "goal", "a coordinate is beyond +-1e9");
+        const cJSON* l = cli_json_member(&j, root, "", "leader");
+        if (l) {
+            static const char* const lkeys[] = {"index", "distance", NULL};
+            cli_json_object(&j, l, "leader", lkeys);
+            long idx = 0;
+            if (!j.failed && !cJSON_GetObjectItemCaseSensitive(l, "index"))
+                cli_json_fail(&j, "leader", "index", "missing (the leader agent's index)");
+            cli_json_int(&j, l, "leader", "index", 0, CLI_BOIDS_MAX_AGENTS - 1, &idx);
+            cli_json_float(&j, l, "leader", "distance", 1e-4f, 1e9f, &s->params.leader_distance);
+            s->params.has_leader = true;
+            s->params.leader_index = (uint32_t)idx;
+        }
+        size_t ns = 0;
+        const cJSON* sp = cli_json_array(&j, root, "", "species", AK_BOIDS_MAX_SPECIES, &ns);
+        if (!j.failed && sp == NULL && cJSON_GetObjectItemCaseSensitive(root, "species"))
+            cli_json_fail(&j, "", "species", "needs at least one species");
+        if (ns > 0) s->params.species_count = (uint32_t)ns;
+        for (size_t k = 0; sp && k < ns && !j.failed; ++k, sp = sp->next) {
+            char path[64];
+            cli_json_index(path, sizeof path, "species", k);
+            read_species(&j, sp, path, s->params.species_count, s, (uint32_t)k);
+        }
+        size_t no = 0;
+        const cJSON* ob = cli_json_array(&j, root, "", "obstacles", CLI_BOIDS_MAX_OBSTACLES, &no);
+        if (!j.failed && no > 0) {
+            s->obstacles = calloc(no, sizeof *s->obstacles);
+            if (!s->obstacles) cli_json_fail(&j, "", "obstacles", "out of memory");
+            for (size_t k = 0; ob && k < no && !j.failed; ++k, ob = ob->next) {
+                char path[64];
+                read_obstacle(&j, ob, cli_json_index(path, sizeof path, "obstacles", k), &s->obstacles[k]);
+            }
+            s->params.obstacles = s->obstacles;
+            s->params.obstacle_count = (uint32_t)no;
+        }
+        size_t na = 0;
+        const cJSON* ag = cli_json_array(&j, root, "", "agents", CLI_BOIDS_MAX_AGENTS, &na);
+        if (!j.failed && na > 0) {
+            s->positions = calloc(na, sizeof(ak_vec3));
+            s->velocities = calloc(na, sizeof(ak_vec3));
+            s->agent_species = calloc(na, 1);
+            if (!s->positions || !s->velocities || !s->agent_species) cli_json_fail(&j, "", "agents", "out of memory");
+            s->agent_count = na;
+            static const char* const akeys[] = {"p", "v", "species", NULL};
+            for (size_t k = 0; ag && k < na && !j.failed; ++k, ag = ag->next) {
+                char path[64];
+                cli_json_index(path, sizeof path, "agents", k);
+                if (!cli_json_object(&j, ag, path, akeys)) break;
+                if (!cJSON_GetObjectItemCaseSensitive(ag, "p")) {
+                    cli_json_fail(&j, path, "p", "missing (the agent's position [x, y, z])");
+                    break;
+                }
+                cli_json_vec3(&j, ag, path, "p", &s->positions[k]);
+                cli_json_vec3(&j, ag, path, "v", &s->velocities[k]);
+                long spi = 0;
+                cli_json_int(&j, ag, path, "species", 0, (long)s->params.species_count - 1, &spi);
+                s->agent_species[k] = (uint8_t)spi;
+                if (!j.failed && (!vec_in(s->positions[k], 1e9f) || !vec_in(s->velocities[k], 1e9f)))
+                    cli_json_fail(&j, path, NULL, "a coordinate is beyond +-1e9");
+            }
+        }
+        const cJSON* r = cli_json_member(&j, root, "", "render");
+        if (r) {
+            static const char* const rkeys[] = {"shape", "size", NULL};
+            static const char* const shapes[] = {"bird", "fish", NULL};
+            cli_json_object(&j, r, "render", rkeys);
+            cli_json_enum(&j, r, "render", "shape", shapes, &s->shape);
+            cli_json_float(&j, r, "render", "size", 1e-4f, 1e6f, &s->shape_size);
+        }
+        if (!j.failed && s->params.has_leader && s->agent_count > 0 && s->params.leader_index >= s->agent_count)
+            cli_json_fail(&j, "leader", "index", "%u is not below the %zu agents", s->params.leader_index,
+                          s->agent_count);
+        cJSON_Delete(root);
+    }
+    s->params.species = s->species;
+    if (j.failed) {
+        snprintf(message, message_size, "%s", j.message);
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,359 @@
+/* animkit cloth: scene files (strict JSON through cli_json.h) and the built-in presets.
+ * docs/cloth.md lists every key with its unit and default. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_json.h"
+#include "scene_cloth.h"
+
+void cloth_scene_defaults(cloth_scene* s) {
+    memset(s, 0, sizeof *s);
+    s->desc.grid_width = 20;
+    s->desc.grid_height = 20;
+    s->desc.spacing = 0.05f;
+    s->desc.grid_origin = ak_vec3_make(-0.5f, 1.0f, 0.5f);
+    s->desc.grid_axis_u = ak_vec3_make(1, 0, 0);
+    s->desc.grid_axis_v = ak_vec3_make(0, 0, -1);
+    s->desc.area_density = 0.2f;
+    s->desc.stretch_stiffness = 5000.0f;
+    s->desc.dihedral_stiffness = 1e-4f;
+    s->dt = 1.0f / 60.0f;
+    s->steps = 120;
+    s->substeps = 10;
+    s->iterations = 1;
+    s->gravity = ak_vec3_make(0, -9.81f, 0);
+    s->air_density = 1.2f;
+    s->thickness = 0.01f;
+    s->capsule_scale = 0.8f;
+    s->mesh_collider = true;
+    s->limb_capsules = true;
+    s->thread_count = 1;
+}
+
+void cloth_scene_free(cloth_scene* s) {
+    free(s->pins);
+    free(s->attach);
+    free(s->planes);
+    free(s->spheres);
+    free(s->capsules);
+    s->pins = NULL, s->attach = NULL, s->planes = NULL, s->spheres = NULL, s->capsules = NULL;
+}
+
+static bool set_str(cli_json* j, const cJSON* obj, const char* path, const char* key, char* dst, size_t size) {
+    const char* v = NULL;
+    if (!cli_json_str(j, obj, path, key, &v)) return false;
+    if (!v) return true;
+    if (strlen(v) >= size) return cli_json_fail(j, path, key, "longer than %zu characters", size - 1);
+    snprintf(dst, size, "%s", v);
+    return true;
+}
+
+static void parse_grid(cli_json* j, const cJSON* root, cloth_scene* s) {
+    const cJSON* g = cli_json_member(j, root, "", "grid");
+    if (!g) return;
+    static const char* const keys[] = {"width", "height", "spacing", "origin", "axis_u", "axis_v", NULL};
+    cli_json_object(j, g, "grid", keys);
+    long w = s->desc.grid_width, h = s->desc.grid_height;
+    cli_json_int(j, g, "grid", "width", 2, 4096, &w);
+    cli_json_int(j, g, "grid", "height", 2, 4096, &h);
+    if (!j->failed && (size_t)w * (size_t)h > CLOTH_SCENE_MAX_PARTICLES)
+        cli_json_fail(j, "grid", "", "%ld x %ld particles is over the budget of %zu", w, h, CLOTH_SCENE_MAX_PARTICLES);
+    s->desc.grid_width = (uint32_t)w, s->desc.grid_height = (uint32_t)h;
+    cli_json_float(j, g, "grid", "spacing", 1e-4f, 100.0f, &s->desc.spacing);
+    cli_json_vec3(j, g, "grid", "origin", &s->desc.grid_origin);
+    cli_json_vec3(j, g, "grid", "axis_u", &s->desc.grid_axis_u);
+    cli_json_vec3(j, g, "grid", "axis_v", &s->desc.grid_axis_v);
+    if (!j->failed && ak_vec3_length(s->desc.grid_axis_u) < 1e-6f) cli_json_fail(j, "grid", "axis_u", "is zero");
+    if (!j->failed && ak_vec3_length(s->desc.grid_axis_v) < 1e-6f) cli_json_fail(j, "grid", "axis_v", "is zero");
+    if (!j->failed &&
+        ak_vec3_length(ak_vec3_cross(ak_vec3_normalize(s->desc.grid_axis_u), ak_vec3_normalize(s->desc.grid_axis_v))) < 1e-3f)
+        cli_json_fail(j, "grid", "axis_v", "is parallel to axis_u");
+}
+
+static void parse_material(cli_json* j, const cJSON* root, cloth_scene* s) {
+    const cJSON* m = cli_json_member(j, root, "", "material");
+    if (!m) return;
+    static const char* const keys[] = {"stretch_stiffness", "shear_stiffness", "bend_stiffness", "dihedral_stiffness",
+                                       "bending", "spring_damping", "constraint_damping", "pbd_stiffness",
+                                       "long_range_attachments", "long_range_slack", "area_density", NULL};
+    static const char* const bendings[] = {"default", "dihedral", "springs", "none", "isometric", NULL};
+    ak_cloth_desc* d = &s->desc;
+    cli_json_object(j, m, "material", keys);
+    cli_json_float(j, m, "material", "stretch_stiffness", 1e-3f, 1e9f, &d->stretch_stiffness);
+    cli_json_float(j, m, "material", "shear_stiffness", 1e-3f, 1e9f, &d->shear_stiffness);
+    cli_json_float(j, m, "material", "bend_stiffness", 1e-3f, 1e9f, &d->bend_stiffness);
+    cli_json_float(j, m, "material", "dihedral_stiffness", 1e-9f, 1e6f, &d->dihedral_stiffness);
+    int bend = (int)d->bending;
+    cli_json_enum(j, m, "material", "bending", bendings, &bend);
+    d->bending = (ak_cloth_bending)bend;
+    cli_json_float(j, m, "material", "spring_damping", 0.0f, 1e6f, &d->spring_damping);
+    cli_json_float(j, m, "material", "constraint_damping", 0.0f, 10.0f, &d->constraint_damping);
+    cli_json_float(j, m, "material", "pbd_stiffness", 1e-6f, 1.0f, &d->pbd_stiffness);
+    cli_json_bool(j, m, "material", "long_range_attachments", &d->long_range_attachments);
+    cli_json_float(j, m, "material", "long_range_slack", 0.0f, 10.0f, &d->long_range_slack);
+    cli_json_float(j, m, "material", "area_density", 1e-6f, 1e4f, &d->area_density);
+}
+
+static void parse_pins(cli_json* j, const cJSON* root, cloth_scene* s) {
+    size_t n = 0;
+    const cJSON* e = cli_json_array(j, root, "", "pins", CLOTH_SCENE_MAX_LIST, &n);
+    if (!e || j->failed) return;
+    s->pins = calloc(n, sizeof(uint32_t));
+    if (!s->pins) {
+        cli_json_fail(j, "", "pins", "out of memory");
+        return;
+    }
+    const size_t count = (size_t)s->desc.grid_width * s->desc.grid_height;
+    for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+        char path[32];
+        cli_json_index(path, sizeof path, "pins", k);
+        if (!cJSON_IsNumber(e) || e->valuedouble != floor(e->valuedouble) || e->valuedouble < 0) {
+            cli_json_fail(j, path, "", "expected a particle index (integer >= 0)");
+            break;
+        }
+        if (e->valuedouble >= (double)count) {
+            cli_json_fail(j, path, "", "particle %.0f is out of range (the grid has %zu)", e->valuedouble, count);
+            break;
+        }
+        s->pins[k] = (uint32_t)e->valuedouble;
+        for (size_t q = 0; q < k; ++q)
+            if (s->pins[q] == s->pins[k]) cli_json_fail(j, path, "", "particle %u is pinned twice", s->pins[k]);
+        s->pin_count = k + 1;
+    }
+}
+
+static void parse_attachments(cli_json* j, const cJSON* root, cloth_scene* s) {
+    size_t n = 0;
+    const cJSON* e = cli_json_array(j, root, "", "attachments", CLOTH_SCENE_MAX_LIST, &n);
+    if (!e || j->failed) return;
+    s->attach = calloc(n, sizeof(cloth_attach_spec));
+    if (!s->attach) {
+        cli_json_fail(j, "", "attachments", "out of memory");
+        return;
+    }
+    static const char* const keys[] = {"vertex", "joint", "mesh_vertex", NULL};
+    const long count = (long)s->desc.grid_width * s->desc.grid_height;
+    for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+        char path[40];
+        cli_json_index(path, sizeof path, "attachments", k);
+        if (!cJSON_IsObject(e)) {
+            cli_json_fail(j, path, "", "expected an object {\"vertex\": i, \"joint\": NAME} or {\"vertex\": i, \"mesh_vertex\": k}");
+            break;
+        }
+        cli_json_object(j, e, path, keys);
+        cloth_attach_spec* a = &s->attach[k];
+        long v = -1;
+        a->mesh_vertex = -1;
+        cli_json_int(j, e, path, "vertex", 0, count - 1, &v);
+        set_str(j, e, path, "joint", a->joint, sizeof a->joint);
+        cli_json_int(j, e, path, "mesh_vertex", 0, 100000000L, &a->mesh_vertex);
+        if (j->failed) break;
+        if (v < 0) cli_json_fail(j, path, "vertex", "is required");
+        else if ((a->joint[0] != '\0') == (a->mesh_vertex >= 0)) cli_json_fail(j, path, "", "give exactly one of joint, mesh_vertex");
+        a->vertex = (uint32_t)v;
+        for (size_t q = 0; q < k && !j->failed; ++q)
+            if (s->attach[q].vertex == a->vertex) cli_json_fail(j, path, "vertex", "particle %ld is attached twice", v);
+        for (size_t q = 0; q < s->pin_count && !j->failed; ++q)
+            if (s->pins[q] == a->vertex) cli_json_fail(j, path, "vertex", "particle %ld is also pinned", v);
+        s->attach_count = k + 1;
+    }
+}
+
+static void parse_colliders(cli_json* j, const cJSON* root, cloth_scene* s) {
+    const cJSON* c = cli_json_member(j, root, "", "colliders");
+    if (!c) return;
+    static const char* const keys[] = {"planes", "spheres", "capsules", "thickness", "friction", "self_collision",
+                                       "self_distance", NULL};
+    cli_json_object(j, c, "colliders", keys);
+    cli_json_float(j, c, "colliders", "thickness", 1e-5f, 10.0f, &s->thickness);
+    cli_json_float(j, c, "colliders", "friction", 0.0f, 10.0f, &s->friction);
+    cli_json_bool(j, c, "colliders", "self_collision", &s->self_collision);
+    cli_json_float(j, c, "colliders", "self_distance", 0.0f, 10.0f, &s->self_distance);
+    size_t n = 0;
+    const cJSON* e = cli_json_array(j, c, "colliders", "planes", CLOTH_SCENE_MAX_LIST, &n);
+    if (e && !j->failed && (s->planes = calloc(n, sizeof(ak_cloth_plane))) != NULL) {
+        static const char* const pk[] = {"normal", "offset", NULL};
+        for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+            char path[48];
+            cli_json_index(path, sizeof path, "colliders.planes", k);
+            if (!cJSON_IsObject(e)) { cli_json_fail(j, path, "", "expected an object"); break; }
+            cli_json_object(j, e, path, pk);
+            ak_cloth_plane p = {{0, 1, 0}, 0.0f};
+            cli_json_vec3(j, e, path, "normal", &p.normal);
+            cli_json_float(j, e, path, "offset", -1e6f, 1e6f, &p.offset);
+            if (!j->failed && ak_vec3_length(p.normal) < 1e-6f) cli_json_fail(j, path, "normal", "is zero");
+            s->planes[k] = p;
+            s->plane_count = k + 1;
+        }
+    }
+    e = cli_json_array(j, c, "colliders", "spheres", CLOTH_SCENE_MAX_LIST, &n);
+    if (e && !j->failed && (s->spheres = calloc(n, sizeof(ak_cloth_sphere))) != NULL) {
+        static const char* const sk[] = {"center", "radius", NULL};
+        for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+            char path[48];
+            cli_json_index(path, sizeof path, "colliders.spheres", k);
+            if (!cJSON_IsObject(e)) { cli_json_fail(j, path, "", "expected an object"); break; }
+            cli_json_object(j, e, path, sk);
+            ak_cloth_sphere p = {{0, 0, 0}, 0.5f};
+            cli_json_vec3(j, e, path, "center", &p.center);
+            cli_json_float(j, e, path, "radius", 0.0f, 1e6f, &p.radius);
+            s->spheres[k] = p;
+            s->sphere_count = k + 1;
+        }
+    }
+    e = cli_json_array(j, c, "colliders", "capsules", CLOTH_SCENE_MAX_LIST, &n);
+    if (e && !j->failed && (s->capsules = calloc(n, sizeof(ak_cloth_capsule))) != NULL) {
+        static const char* const ck[] = {"a", "b", "radius", NULL};
+        for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+            char path[48];
+            cli_json_index(path, sizeof path, "colliders.capsules", k);
+            if (!cJSON_IsObject(e)) { cli_json_fail(j, path, "", "expected an object"); break; }
+            cli_json_object(j, e, path, ck);
+            ak_cloth_capsule p = {{0, 0, 0}, {0, 1, 0}, 0.1f};
+            cli_json_vec3(j, e, path, "a", &p.a);
+            cli_json_vec3(j, e, path, "b", &p.b);
+            cli_json_float(j, e, path, "radius", 0.0f, 1e6f, &p.radius);
+            s->capsules[k] = p;
+            s->capsule_count = k + 1;
+        }
+    }
+}
+
+static void parse_character(cli_json* j, const cJSON* root, cloth_scene* s) {
+    const cJSON* c = cli_json_member(j, root, "", "character");
+    if (!c) return;
+    static const char* const keys[] = {"model", "clip", "mesh_collider", "limb_capsules", "capsule_scale", NULL};
+    cli_json_object(j, c, "character", keys);
+    set_str(j, c, "character", "model", s->model, sizeof s->model);
+    set_str(j, c, "character", "clip", s->clip, sizeof s->clip);
+    cli_json_bool(j, c, "character", "mesh_collider", &s->mesh_collider);
+    cli_json_bool(j, c, "character", "limb_capsules", &s->limb_capsules);
+    cli_json_float(j, c, "character", "capsule_scale", 0.0f, 10.0f, &s->capsule_scale);
+    if (!j->failed && s->model[0] == '\0') cli_json_fail(j, "character", "model", "is required");
+}
+
+bool cloth_scene_parse(const char* file, const char* text, size_t size, cloth_scene* out, char* message,
+                       size_t message_size) {
+    cloth_scene_defaults(out);
+    cli_json j = {.file = file ? file : "scene"};
+    cJSON* root = cli_json_parse(&j, text, size);
+    if (root) {
+        static const char* const keys[] = {"solver", "grid", "material", "pins", "attachments", "dt", "steps",
+                                           "substeps", "iterations", "threads", "gravity", "wind", "gust",
+                                           "gust_frequency", "drag", "lift", "air_density", "damping", "colliders",
+                                           "character", NULL};
+        static const char* const solvers[] = {"xpbd", "springs", "pbd", NULL};
+        cli_json_object(&j, root, "", keys);
+        int solver = 0;
+        cli_json_enum(&j, root, "", "solver", solvers, &solver);
+        out->desc.solver = (ak_cloth_solver)solver;
+        parse_grid(&j, root, out);
+        parse_material(&j, root, out);
+        parse_pins(&j, root, out);
+        parse_attachments(&j, root, out);
+        cli_json_float(&j, root, "", "dt", 1e-7f, 1.0f, &out->dt);
+        cli_json_int(&j, root, "", "steps", 0, CLOTH_SCENE_MAX_STEPS, &out->steps);
+        long sub = out->substeps, it = out->iterations, th = out->thread_count;
+        cli_json_int(&j, root, "", "substeps", 1, 10000, &sub);
+        cli_json_int(&j, root, "", "iterations", 1, 10000, &it);
+        cli_json_int(&j, root, "", "threads", 1, 64, &th);
+        out->substeps = (uint32_t)sub, out->iterations = (uint32_t)it, out->thread_count = (int)th;
+        cli_json_vec3(&j, root, "", "gravity", &out->gravity);
+        cli_json_vec3(&j, root, "", "wind", &out->wind);
+        cli_json_float(&j, root, "", "gust", 0.0f, 10.0f, &out->gust);
+        cli_json_float(&j, root, "", "gust_frequency", 0.0f, 100.0f, &out->gust_frequency);
+        cli_json_float(&j, root, "", "drag", 0.0f, 100.0f, &out->drag);
+        cli_json_float(&j, root, "", "lift", 0.0f, 100.0f, &out->lift);
+        cli_json_float(&j, root, "", "air_density", 0.0f, 1000.0f, &out->air_density);
+        cli_json_float(&j, root, "", "damping", 0.0f, 1000.0f, &out->damping);
+        parse_colliders(&j, root, out);
+        parse_character(&j, root, out);
+        if (!j.failed && out->attach_count && out->model[0] == '\0')
+            cli_json_fail(&j, "", "attachments", "need a character (character.model)");
+        cJSON_Delete(root);
+    }
+    if (j.failed) {
+        snprintf(message, message_size, "%s", j.message);
+        cloth_scene_free(out);
+        return false;
+    }
+    out->desc.pins = (ak_u32_cspan){out->pins, out->pin_count};
+    return true;
+}
+
+bool cloth_scene_preset(const char* name, cloth_scene* s) {
+    cloth_scene_defaults(s);
+    ak_cloth_desc* d = &s->desc;
+    if (strcmp(name, "flag") == 0) {
+        /* a 1.6 x 1 m flag on a pole along its left edge, in gusty wind */
+        d->grid_width = 32, d->grid_height = 20, d->spacing = 0.05f;
+        d->grid_origin = ak_vec3_make(0, 2.0f, 0);
+        d->grid_axis_u = ak_vec3_make(1, 0, 0), d->grid_axis_v = ak_vec3_make(0, -1, 0);
+        s->pin_count = 20;
+        s->wind = ak_vec3_make(8, 0, 2);
+        s->gust = 0.4f, s->gust_frequency = 0.5f;
+        s->drag = 1.0f, s->lift = 0.6f;
+        s->steps = 240;
+    } else if (strcmp(name, "curtain") == 0) {
+        /* a 2 x 1.5 m curtain on rings (every third top particle), a breeze through it */
+        d->grid_width = 40, d->grid_height = 30, d->spacing = 0.05f;
+        d->grid_origin = ak_vec3_make(-1.0f, 1.6f, 0);
+        d->grid_axis_u = ak_vec3_make(1, 0, 0), d->grid_axis_v = ak_vec3_make(0, -1, 0);
+        s->pin_count = 14;
+        s->wind = ak_vec3_make(0, 0, 1.5f);
+        s->gust = 1.0f, s->gust_frequency = 0.3f;
+        s->drag = 1.0f, s->lift = 0.5f;
+        s->damping = 0.2f;
+        s->steps = 240;
+    } else if (strcmp(name, "drape") == 0) {
+        /* a 1 m square dropped on a sphere above the floor */
+        d->grid_width = 32, d->grid_height = 32, d->spacing = 1.0f / 31.0f;
+        d->grid_origin = ak_vec3_make(-0.5f, 1.0f, 0.5f);
+        s->sphere_count = 1, s->plane_count = 1;
+        s->friction = 0.4f;
+        s->self_collision = true;
+        s->damping = 0.5f;
+        s->steps = 300;
+    } else if (strcmp(name, "cape") == 0) {
+        /* a 0.4 x 0.9 m cape hung from the humanoid's upper back (spine_02), walking */
+        d->grid_width = 12, d->grid_height = 26, d->spacing = 0.4f / 11.0f;
+        d->grid_origin = ak_vec3_make(-0.2f, 1.43f, -0.13f);
+        d->grid_axis_u = ak_vec3_make(1, 0, 0), d->grid_axis_v = ak_vec3_make(0, -1, 0);
+        d->long_range_attachments = true;
+        d->long_range_slack = 0.05f;
+        s->attach_count = 12;
+        s->damping = 0.5f;
+        s->friction = 0.2f;
+        s->steps = 180;
+        snprintf(s->model, sizeof s->model, "builtin:humanoid");
+        snprintf(s->clip, sizeof s->clip, "walk");
+    } else {
+        return false;
+    }
+    if (s->pin_count) {
+        s->pins = calloc(s->pin_count, sizeof(uint32_t));
+        if (!s->pins) return false;
+        for (size_t k = 0; k < s->pin_count; ++k)
+            s->pins[k] = strcmp(name, "flag") == 0 ? (uint32_t)(k * d->grid_width) : (uint32_t)(k * 3);
+    }
+    if (s->sphere_count) {
+        s->spheres = calloc(1, sizeof(ak_cloth_sphere));
+        s->planes = calloc(1, sizeof(ak_cloth_plane));
+        if (!s->spheres || !s->planes) return false;
+        s->spheres[0] = (ak_cloth_sphere){{0, 0.5f, 0}, 0.3f};
+        s->planes[0] = (ak_cloth_plane){{0, 1, 0}, 0.0f};
+    }
+    if (s->attach_count) {
+        s->attach = calloc(s->attach_count, sizeof(cloth_attach_spec));
+        if (!s->attach) return false;
+        for (size_t k = 0; k < s->attach_count; ++k) {
+            s->attach[k].vertex = (uint32_t)k;
+            s->attach[k].mesh_vertex = -1;
+            snprintf(s->attach[k].joint, sizeof s->attach[k].joint, "spine_02");
+        }
+    }
+    d->pins = (ak_u32_cspan){s->pins, s->pin_count};
+    return true;
+}

@@ -1,0 +1,215 @@
+/* animkit view: the viewer's state machine, shared by the window (view_sdl.c) and the
+ * headless loop (cmd_view.c). Input events go in, a frame comes out as an ak_image; nothing
+ * here knows about SDL, so the same code runs scripted in CI and interactively in a window.
+ *
+ * Frame order (view_app_run): script commands up to the next `wait` are applied, the
+ * platform's own events are polled, time advances by one step (fixed 1/30 s while scripted
+ * or headless, wall time otherwise), the pose is computed (sample, morph overrides, IK,
+ * FK + skinning), drawn, and presented. `screenshot` draws the current state first. */
+#ifndef ANIMKIT_CLI_VIEW_APP_H
+#define ANIMKIT_CLI_VIEW_APP_H
+
+#include <stdio.h>
+
+#include "cli.h"
+#include "render.h"
+
+/* ---- keys and events ---- */
+
+/* Key codes: printable keys are their lowercase ASCII character; the rest are below. */
+enum {
+    VIEW_KEY_ESCAPE = 256,
+    VIEW_KEY_LEFT,
+    VIEW_KEY_RIGHT,
+    VIEW_KEY_UP,
+    VIEW_KEY_DOWN,
+};
+
+typedef enum view_ev_type {
+    VIEW_EV_KEY = 0,
+    VIEW_EV_MOUSE_DOWN,
+    VIEW_EV_MOUSE_MOVE,
+    VIEW_EV_MOUSE_UP,
+    VIEW_EV_WHEEL,
+    VIEW_EV_WAIT,
+    VIEW_EV_SCREENSHOT,
+    VIEW_EV_QUIT,
+} view_ev_type;
+
+enum { VIEW_BUTTON_LEFT = 1, VIEW_BUTTON_MIDDLE = 2, VIEW_BUTTON_RIGHT = 3 };
+
+typedef struct view_event {
+    view_ev_type type;
+    int key;          /* KEY */
+    int button;       /* MOUSE_DOWN / MOUSE_UP: VIEW_BUTTON_* */
+    float x, y;       /* mouse events: window pixels, (0, 0) top-left */
+    float dy;         /* WHEEL: notches, > 0 zooms in */
+    long frames;      /* WAIT */
+    bool shift;       /* mouse down: shift held (left drag pans) */
+    const char* path; /* SCREENSHOT: points into the script's text */
+    int line;         /* script line (1-based), 0 for live events */
+} view_event;
+
+/* Key name as scripts and the help write it ("space", "left", "a", "[" ...); NULL if none. */
+const char* view_key_name(int key);
+/* Key code from a script name; 0 when unknown. */
+int view_key_parse(const char* name);
+
+/* One help line per key: name as a script writes it, and what it does. */
+typedef struct view_help_entry {
+    const char* key;
+    const char* what;
+} view_help_entry;
+extern const view_help_entry view_help[];
+extern const size_t view_help_count;
+
+/* ---- scripts (view_script.c) ---- */
+
+typedef struct view_script {
+    char* text; /* owned copy of the file, NUL-split into paths */
+    view_event* events;
+    size_t count;
+} view_script;
+
+/* Parse a script from memory. On a bad line returns CLI_BAD_USAGE with "LINE: problem" in
+ * err (the caller prefixes the file name); CLI_BAD_INPUT when out of memory. */
+int view_script_parse(const char* text, size_t size, view_script* out, char* err, size_t err_size);
+void view_script_free(view_script* s);
+
+/* ---- simulations: the plug-in point for particles, boids, cloth (none built yet) ---- */
+
+/* A live simulation the viewer steps and draws with the model's camera. The viewer calls
+ * init once, step once per frame while playing (dt in seconds, fixed while scripted), reset
+ * when time restarts (tab), meshes before drawing (extra meshes added to the frame, as props are),
+ * overlay after drawing (2D marks over the image), and destroy at exit. */
+typedef struct view_sim {
+    const char* name;
+    int (*init)(void** state, const char* scene_path, char* err, size_t err_size);
+    void (*step)(void* state, float dt);
+    void (*reset)(void* state);
+    size_t (*meshes)(void* state, ak_raster_mesh* out, size_t capacity);
+    void (*overlay)(void* state, const ak_raster_camera* camera, const ak_image* image);
+    void (*bounds)(void* state, ak_vec3* lo, ak_vec3* hi);
+    void (*destroy)(void* state);
+} view_sim;
+
+/* ---- the app ---- */
+
+typedef struct view_options {
+    int width, height;    /* window size */
+    int clip;             /* first clip to play; -1 -> none */
+    int supersample;      /* 1..4 */
+    int threads;          /* raster threads */
+    bool scripted;        /* fixed time step, deterministic status line */
+    FILE* ik_log;         /* NULL -> none */
+    const char* shot_dir; /* where P writes screenshots; NULL -> "." */
+} view_options;
+
+enum { VIEW_DRAG_NONE = 0, VIEW_DRAG_ORBIT, VIEW_DRAG_PAN, VIEW_DRAG_TARGET, VIEW_DRAG_TIMELINE };
+
+/* Frame-time breakdown accumulated over rendered frames (seconds). */
+typedef struct view_stats {
+    double sample;  /* clip sampling, morph overrides, IK */
+    double skin;    /* FK, morph targets, skinning */
+    double raster;  /* ground, meshes, overlays, HUD */
+    double present; /* handing the image to the window (0 headless) */
+    long frames;
+} view_stats;
+
+typedef struct view_app {
+    const ak_scene* scene;
+    view_options opt;
+    cli_poser poser;
+    cli_frame frame;       /* full-size target */
+    cli_frame panel;       /* side-by-side target (width / 3), created on first use */
+    ak_image image, panel_image;
+    int width, height;
+    /* camera: ak_view_orbit_camera on the framed box, shifted by pan, margin scaled by zoom */
+    ak_view_orbit orbit;
+    ak_vec3 box_lo, box_hi, pan;
+    float zoom;
+    /* time */
+    int clip;
+    double time, speed;
+    bool playing, loop, bind;
+    /* drawing */
+    cli_method method;
+    bool side_by_side, show_normals, show_skeleton, show_help, show_limits;
+    int weight_bone;         /* index into weight_joints, -1 -> off */
+    int* weight_joints;      /* joints some skin uses */
+    size_t weight_joint_count;
+    ak_vec4** colors;        /* per mesh heat colours (NULL entries: clay) */
+    /* IK */
+    int effector, root;      /* joint indices, -1 -> none */
+    ak_ik_solver solver;
+    ak_vec3 target;          /* model space */
+    int16_t* chain;
+    size_t chain_count;
+    ak_transform* ik_solved; /* cached chain transforms of the last solve */
+    bool ik_valid;           /* the cache matches the inputs below */
+    ak_vec3 ik_target_solved;
+    double ik_time_solved;
+    int ik_clip_solved, ik_solver_solved, ik_root_solved;
+    bool ik_bind_solved;
+    uint8_t* ik_scratch;
+    size_t ik_scratch_size;
+    bool ik_reached;
+    float ik_error;
+    const char* ik_problem; /* why no solve happened (two-bone on a short chain) */
+    /* morph weights set by the user (flat index over the scene's meshes) */
+    float* morph_user;
+    bool* morph_set;
+    size_t morph_count;
+    int morph_index;
+    /* mouse */
+    int drag;
+    float mouse_x, mouse_y;
+    /* status */
+    char message[160];
+    long message_frames;
+    double fps;
+    long frame_index;
+    int shot_count;
+    view_stats stats;
+    bool quit;
+    int exit_code;           /* set with quit when the loop must end with an error */
+    /* simulation plug-in (NULL: none) */
+    const view_sim* sim;
+    void* sim_state;
+} view_app;
+
+int view_app_init(view_app* app, const ak_scene* scene, const view_options* opt);
+void view_app_free(view_app* app);
+/* Re-create the targets for a new window size (below 8 pixels: kept as they are). On failure
+ * prints why and sets quit with exit_code CLI_BAD_INPUT. */
+int view_app_resize(view_app* app, int width, int height);
+/* Apply one input event (KEY, MOUSE_*, WHEEL). */
+void view_app_event(view_app* app, const view_event* ev);
+/* Advance time by dt seconds (playing, speed, loop). */
+void view_app_advance(view_app* app, double dt);
+/* Pose and draw the current state into app->image. */
+ak_result view_app_render(view_app* app);
+/* Write the current image as PNG. */
+int view_app_screenshot(view_app* app, const char* path);
+/* Frame the camera on the current pose (key F). */
+void view_app_frame_all(view_app* app);
+
+/* What the loop needs from a window; NULL platform -> headless. */
+typedef struct view_platform {
+    void* user;
+    /* Feed pending window events to the app (view_app_event, view_app_resize, app->quit).
+     * Returns false while the window is minimised (nothing is drawn then). */
+    bool (*poll)(void* user, view_app* app);
+    /* Show app->image; returns CLI_OK or an exit code. */
+    int (*present)(void* user, const view_app* app);
+} view_platform;
+
+/* Run the loop: the script (NULL -> none), or max_frames frames when there is no script and
+ * no platform (headless), or until the window closes. Returns an exit code. */
+int view_app_run(view_app* app, const view_script* script, long max_frames, const view_platform* platform);
+
+/* The window (view_sdl.c). view_window_available is false in builds without SDL2. */
+bool view_window_available(void);
+int view_window_run(view_app* app, const view_script* script);
+
+#endif
