@@ -27,6 +27,19 @@ for p in "${PACKAGES[@]}"; do
   fi
 done
 
+# Optional: the Khronos glTF validator (npm gltf-validator) into build-tools/ (git-ignored),
+# which tests/test_io_write.c runs on the files ak_io_save writes. Never fails the script.
+if command -v npm >/dev/null 2>&1; then
+  ak_root="$(cd "$(dirname "$0")/.." && pwd)"
+  if [ ! -d "$ak_root/build-tools/node_modules/gltf-validator" ]; then
+    (mkdir -p "$ak_root/build-tools" && cd "$ak_root/build-tools" &&
+      npm install --no-audit --no-fund --silent gltf-validator >/dev/null 2>&1) ||
+      echo "animkit: optional npm install of gltf-validator failed; its test will SKIP" >&2
+  fi
+else
+  echo "animkit: npm not found; the glTF validator test will SKIP (optional)" >&2
+fi
+
 if [ ${#missing[@]} -eq 0 ]; then
   exit 0
 fi

@@ -748,6 +748,69 @@ AK_TEST(custom_allocator_is_used_and_balanced) {
     AK_CHECK_EQ(cnt.live, 0);
 }
 
+/* Baking: joint 0 turns about Y at 1 rad/s and moves along X at 2 units/s, joint 1 stays at
+ * its rest pose; 10 frames at 10 fps. Closed forms: at a frame time the pose itself; between
+ * frames lerp gives the exact linear translation and slerp of two rotations about one axis
+ * the rotation by the interpolated angle. */
+AK_TEST(bake_pose_sequence) {
+    enum { F = 10, J = 2 };
+    ak_transform poses[F * J], rest[J];
+    rest[0] = ak_transform_identity();
+    rest[1] = ak_transform_make(ak_vec3_make(0, 1, 0), ak_quat_from_axis_angle(ak_vec3_make(1, 0, 0), 0.5f), ak_vec3_make(1, 1, 1));
+    float wts[F * 2];
+    for (int f = 0; f < F; ++f) {
+        float t = 0.1f * (float)f;
+        poses[f * J] = ak_transform_make(ak_vec3_make(2.0f * t, 0, 0), ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), t), ak_vec3_make(1, 1, 1));
+        poses[f * J + 1] = rest[1];
+        wts[2 * f] = t, wts[2 * f + 1] = 1.0f - t;
+    }
+    ak_clip_bake_desc d = {.poses = poses, .frame_count = F, .joint_count = J, .frame_rate = 10.0f,
+                           .morph_weights = wts, .morph_weight_count = 2, .rest_pose = {rest, J}, .name = "baked"};
+    ak_clip* clip = NULL;
+    AK_CHECK_EQ(ak_clip_bake(&d, NULL, &clip, NULL), AK_OK);
+    if (!clip) return;
+    /* joint 0: translation and rotation move, scale is the rest's; joint 1 no channel; weights */
+    AK_CHECK_EQ(ak_clip_channel_count(clip), 3u);
+    AK_CHECK_STREQ(ak_clip_name(clip), "baked");
+    AK_CHECK_NEAR(ak_clip_duration(clip), 0.9, 1e-6);
+    for (int k = 0; k < 2 * F - 1; ++k) {
+        float t = 0.05f * (float)k;
+        ak_transform local[J] = {rest[0], rest[1]};
+        float w[2] = {0, 0};
+        AK_CHECK_EQ(ak_clip_sample(clip, t, NULL, (ak_transform_span)AK_SPAN(local), (ak_f32_span)AK_SPAN(w), (ak_f32_span){0}), AK_OK);
+        AK_CHECK_NEAR(local[0].translation.x, 2.0 * t, 1e-5);
+        ak_quat e = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), t);
+        AK_CHECK_NEAR(fabs(ak_quat_dot(local[0].rotation, e)), 1.0, 1e-6);
+        AK_CHECK_NEAR(w[0], t, 1e-6);
+        AK_CHECK_NEAR(w[1], 1.0 - t, 1e-6);
+        AK_CHECK_EQ(local[1].rotation.x, rest[1].rotation.x);
+    }
+    ak_clip_destroy(clip);
+    /* without rest_pose every joint gets T, R, S; step keys hold */
+    d.rest_pose = (ak_transform_cspan){0};
+    d.step = true;
+    AK_CHECK_EQ(ak_clip_bake(&d, NULL, &clip, NULL), AK_OK);
+    AK_CHECK_EQ(ak_clip_channel_count(clip), 7u);
+    AK_CHECK_EQ(ak_clip_channel_interp(clip, 0), AK_INTERP_STEP);
+    ak_clip_destroy(clip);
+    /* rules */
+    AK_CHECK_EQ(ak_clip_bake(NULL, NULL, &clip, NULL), AK_ERR_NULL_ARG);
+    ak_clip_bake_desc e = d;
+    e.frame_count = 0;
+    AK_CHECK_EQ(ak_clip_bake(&e, NULL, &clip, NULL), AK_ERR_EMPTY);
+    e = d, e.frame_rate = -1.0f;
+    AK_CHECK_EQ(ak_clip_bake(&e, NULL, &clip, NULL), AK_ERR_BAD_ARG);
+    e = d, e.morph_weights = NULL;
+    AK_CHECK_EQ(ak_clip_bake(&e, NULL, &clip, NULL), AK_ERR_NULL_ARG);
+    e = d, e.rest_pose = (ak_transform_cspan){rest, 1};
+    AK_CHECK_EQ(ak_clip_bake(&e, NULL, &clip, NULL), AK_ERR_SPAN_SMALL);
+    poses[3].translation.y = NAN;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_clip_bake(&d, NULL, &clip, &diag), AK_ERR_BAD_DATA);
+    AK_CHECK(strstr(diag.message, "frame 1 joint 1") != NULL);
+    AK_CHECK(clip == NULL);
+}
+
 int main(void) {
     AK_RUN(build_and_queries);
     AK_RUN(build_rejects_bad_input_with_exact_codes);
@@ -762,5 +825,6 @@ int main(void) {
     AK_RUN(blend_validate_rules);
     AK_RUN(root_motion_extraction);
     AK_RUN(custom_allocator_is_used_and_balanced);
+    AK_RUN(bake_pose_sequence);
     return ak_test_finish();
 }

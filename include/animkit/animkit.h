@@ -30,5 +30,6 @@
 #include "particles.h"
 #include "boids.h"
 #include "cloth.h"
+#include "retarget.h"
 
 #endif

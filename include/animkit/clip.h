@@ -8,7 +8,8 @@
  * scalars, all caller-owned. Sampling through a caller-owned cursor makes forward playback
  * O(1) amortised per channel and stays correct for any jump. The module also blends poses
  * (weighted N-way blend, per-joint masks, additive layers, cross-fade) and extracts root
- * motion (a clip walking in place plus the root's horizontal trajectory).
+ * motion (a clip walking in place plus the root's horizontal trajectory), and bakes a
+ * sequence of computed poses into a clip (ak_clip_bake).
  *
  * glTF: STEP, LINEAR (SLERP for rotations, shortest path) and CUBICSPLINE (tangents scaled by
  * the key interval, rotations renormalised) follow the glTF 2.0 specification, Appendix C.
@@ -254,6 +255,42 @@ typedef struct ak_root_motion_desc {
 AK_API ak_result ak_clip_extract_root_motion(const ak_clip* clip, const ak_root_motion_desc* desc,
                                              const ak_allocator* alloc, ak_clip** out_in_place,
                                              ak_track** out_trajectory);
+
+/* ---- baking ------------------------------------------------------------------------- */
+
+/* A sequence of poses sampled at a fixed rate (IK-solved, blended, simulated, retargeted)
+ * to turn into a clip, e.g. to write it with ak_io_save. */
+typedef struct ak_clip_bake_desc {
+    const ak_transform* poses;    /* required: [frame_count * joint_count] local transforms,
+                                     frame-major (frame f, joint j at f * joint_count + j) */
+    size_t frame_count;           /* required, >= 1 */
+    size_t joint_count;           /* required, >= 1 */
+    float frame_rate;             /* frames per second; 0 -> 30 */
+    float start_time;             /* seconds of frame 0; 0 -> 0 */
+    const float* morph_weights;   /* optional: [frame_count * morph_weight_count], frame-major */
+    size_t morph_weight_count;    /* 0 -> no morph-weight channel */
+    ak_transform_cspan rest_pose; /* optional (count >= joint_count): a joint property equal to
+                                     the rest pose's at every frame (bit for bit; a rotation or
+                                     its negation) gets no channel; empty -> every joint gets
+                                     translation, rotation and scale channels */
+    const char* name;             /* NULL -> "" */
+    bool step;                    /* true -> STEP keys; false (default) -> LINEAR (rotations SLERP) */
+} ak_clip_bake_desc;
+
+/* Build a clip with one key per frame at start_time + f / frame_rate: a translation, rotation
+ * and scale channel per joint (those equal to rest_pose left out), and one morph-weight
+ * channel over [0, morph_weight_count) when weights are given. Sampling the clip at a frame
+ * time gives that frame's pose exactly (rotations up to sign); between frames it
+ * interpolates (lerp / slerp, or holds with step). Neighbouring rotation keys are put in one
+ * hemisphere. When nothing moves, the clip holds joint 0's rotation (a clip needs a channel).
+ * alloc NULL -> malloc/free (temporary arrays and the clip).
+ * Returns AK_ERR_NULL_ARG (desc, poses or out_clip NULL; morph_weights NULL with a count),
+ * AK_ERR_EMPTY (frame_count or joint_count 0), AK_ERR_BAD_ARG (frame_rate negative or not
+ * finite, start_time not finite), AK_ERR_SPAN_SMALL (rest_pose shorter than joint_count),
+ * AK_ERR_BAD_DATA (a non-finite pose or weight, a zero rotation), AK_ERR_NO_MEMORY; diag
+ * (optional) names the frame and joint. *out_clip is NULL on failure. */
+AK_API ak_result ak_clip_bake(const ak_clip_bake_desc* desc, const ak_allocator* alloc, ak_clip** out_clip,
+                              ak_diag* diag);
 
 #ifdef __cplusplus
 }

@@ -1,4 +1,4 @@
-/* animkit io: import of real assets into an ak_scene, and OBJ export of posed meshes.
+/* animkit io: import of real assets into an ak_scene; glTF and OBJ export.
  *
  * What it does:
  *   - glTF 2.0 (.gltf with data: URIs or external .bin files, .glb) through animkit's own
@@ -13,10 +13,13 @@
  *   - Everything else (FBX, Collada, OBJ, ...) through Assimp's C API: the node tree
  *     becomes the skeleton, aiAnimation channels become clips (ticks -> seconds), meshes with
  *     bones get skins.
+ *   - ak_io_save: glTF 2.0 (.glb, or .gltf + .bin) of a whole scene: nodes, skins, meshes,
+ *     morph targets and clips (src/io/gltf_write.c); it passes the Khronos glTF validator.
  *   - ak_io_write_obj: Wavefront OBJ of a scene's meshes at positions the caller computed
  *     (one `o` group per scene mesh, vertices in the scene's order, no welding).
  *
- * What it does NOT do: materials, textures, cameras, lights, glTF extensions (a file whose
+ * What it does NOT do: materials beyond a primitive's base colour factor (ak_scene_mesh
+ * base_color), textures, cameras, lights, glTF extensions (a file whose
  * extensionsRequired names one that changes geometry or animation, e.g. Draco, is refused),
  * morph targets through Assimp, posing (scene.h, skin.h, blendshape.h). It never prints;
  * warnings go to desc->logger.
@@ -172,6 +175,54 @@ AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* na
  * the file is removed), AK_ERR_IO (cannot create or write the file; diag names it). */
 AK_API ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3* const* posed_positions,
                                  const ak_vec3* const* posed_normals, ak_diag* diag);
+
+/* How ak_io_save writes (all fields zero -> defaults). */
+typedef struct ak_io_save_desc {
+    ak_logger logger; /* warnings (scalar channels and clips glTF cannot hold); zero -> silent */
+} ak_io_save_desc;
+
+/* Write a scene as glTF 2.0: a path ending in .glb (any case) gives one binary GLB file; .gltf
+ * gives the JSON file plus "<same name>.bin" beside it (uri relative, percent-encoded).
+ * What is written (docs/io.md "Writing glTF" has every rule):
+ *   - every skeleton joint as a node, in skeleton order (parents before children), named by
+ *     the joint name, with its rest transform as translation/rotation/scale (defaults left out;
+ *     the rotation written normalised), scenes[0] holding the roots;
+ *   - skins with their joints and inverse bind matrices (float MAT4);
+ *   - scene meshes as mesh primitives: POSITION (with min/max), NORMAL (renormalised where a
+ *     normal is off unit length by more than 1e-5; a zero normal -> +Y), TEXCOORD_0, COLOR_0,
+ *     JOINTS_0/WEIGHTS_0 and, above 4 influences, JOINTS_1/WEIGHTS_1 (joints unsigned byte,
+ *     or unsigned short when a slot is above 255; a zero weight's joint written as 0),
+ *     indices (unsigned short below 65535 vertices, else unsigned int), morph targets
+ *     (POSITION deltas with min/max, NORMAL deltas), default weights in mesh.weights and
+ *     target names in mesh.extras.targetNames. Consecutive scene meshes on one node with the
+ *     same skin, morph target count, default weights and morph animation become primitives
+ *     of one glTF mesh (as the reader split them); any other mesh gets its own node with an
+ *     identity transform ("<mesh name>_node"): a root for skinned meshes (their node's
+ *     transform is ignored, and glTF warns about skinned meshes below other nodes), a child
+ *     of the mesh's node otherwise, so posed results are unchanged;
+ *   - each clip as an animation (clips with nothing glTF can hold are skipped with a warning):
+ *     translation/rotation/scale channels per joint and one "weights" channel per glTF mesh
+ *     (targets the clip does not animate hold their default weight); STEP, LINEAR and
+ *     CUBICSPLINE keys are written as stored; HERMITE, and CARDINAL/NATURAL/BEZIER on
+ *     non-rotation channels, become CUBICSPLINE with the per-second tangents of
+ *     ak_track_key (the same curve); SCALAR channels are skipped with a warning.
+ *   - each distinct base colour of the scene meshes as a material holding only
+ *     pbrMetallicRoughness.baseColorFactor (channels clamped to [0, 1]), named by the
+ *     primitives that have one.
+ * Not written: other material properties and textures, tangents (the scene holds none), the clip duration (a
+ * reader takes the last key time), ak_skeleton joint types and limits.
+ * Layout: one buffer, one bufferView per accessor (4-byte aligned, zero padded, so no
+ * byteStride), GLB JSON chunk padded with spaces and BIN chunk with zeros.
+ * Returns AK_ERR_NULL_ARG (path or scene NULL, a scene mesh without data), AK_ERR_BAD_ARG
+ * (another extension), AK_ERR_BAD_DATA (a non-finite position, normal, UV, colour, morph
+ * delta, default weight, rest transform, inverse bind or key), AK_ERR_BAD_WEIGHTS (a
+ * negative weight), AK_ERR_BAD_INDEX (a triangle index, skin joint, channel joint, or a
+ * scene mesh's skin or node out of range), AK_ERR_UNSUPPORTED (an interpolation glTF cannot express: NLERP, SQUAD, LAGRANGE,
+ * or a cubic mode other than HERMITE on a rotation: bake the clip first; two channels
+ * animating one mesh's morph weights; more than 4 GiB in a GLB), AK_ERR_IO (cannot create or
+ * write a file: partial files are removed), AK_ERR_NO_MEMORY. diag (optional) names the
+ * file and the problem. Temporary memory comes from malloc. */
+AK_API ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_desc* desc, ak_diag* diag);
 
 #ifdef __cplusplus
 }

@@ -58,6 +58,9 @@ typedef struct ak_scene_mesh {
     ak_mesh* mesh; /* owned; mesh->joints index skin slots */
     int32_t node;  /* skeleton joint carrying the mesh, -1 -> identity */
     int32_t skin;  /* index into scene->skins, -1 -> unskinned */
+    bool has_material;  /* glTF: the primitive names a material; false -> none */
+    ak_vec4 base_color; /* that material's pbrMetallicRoughness.baseColorFactor (linear RGBA,
+                           (1,1,1,1) when it gives none); unused when has_material is false */
 } ak_scene_mesh;
 
 typedef struct ak_scene {

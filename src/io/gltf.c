@@ -1137,6 +1137,26 @@ static ak_result count_scene_meshes(gl_ctx* c, const gl_table* nodes, const gl_t
     return r;
 }
 
+/* The primitive's material: its base colour factor (materials are otherwise not read). */
+static ak_result read_material(gl_ctx* c, const cJSON* prim, const char* where, ak_scene_mesh* sm) {
+    const cJSON* mats = cJSON_GetObjectItemCaseSensitive(c->root, "materials");
+    size_t n = cJSON_IsArray(mats) ? (size_t)cJSON_GetArraySize(mats) : 0;
+    int64_t mi = -1;
+    TRY(get_opt_index(c, prim, "material", where, n, &mi));
+    if (mi < 0) return AK_OK;
+    const cJSON* m = cJSON_GetArrayItem(mats, (int)mi);
+    const cJSON* pbr = cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness");
+    float col[4] = {1, 1, 1, 1};
+    if (cJSON_IsObject(pbr)) {
+        char mw[64];
+        snprintf(mw, sizeof mw, "materials[%lld].pbrMetallicRoughness", (long long)mi);
+        TRY(get_floats(c, pbr, "baseColorFactor", mw, 4, col, NULL));
+    }
+    sm->has_material = true;
+    sm->base_color = ak_vec4_make(col[0], col[1], col[2], col[3]);
+    return AK_OK;
+}
+
 static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* meshes) {
     ak_scene* scene = c->scene;
     size_t out = 0, base = 0;
@@ -1183,6 +1203,7 @@ static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* m
                 ak_scene_mesh* sm = &scene->meshes[slot];
                 sm->node = node ? c->joint_of_node[ni] : -1;
                 sm->skin = -1;
+                if (r == AK_OK) r = read_material(c, prim, where, sm);
                 if (ns >= 0 && !p.infl)
                     r = fail(c, AK_ERR_PARSE, "%s: nodes[%zu] has a skin but the primitive has no JOINTS_0/WEIGHTS_0",
                              where, ni);

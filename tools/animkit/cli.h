@@ -156,5 +156,6 @@ int cmd_particles(int argc, char** argv);
 int cmd_boids(int argc, char** argv);
 int cmd_view(int argc, char** argv);
 int cmd_cloth(int argc, char** argv);
+int cmd_retarget(int argc, char** argv);
 
 #endif

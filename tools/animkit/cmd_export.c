@@ -1,11 +1,14 @@
-/* animkit export: the scene's meshes posed at a time, as Wavefront OBJ. */
+/* animkit export: the scene's meshes posed at a time, as Wavefront OBJ; or the whole scene
+ * (skeleton, skins, meshes, morph targets, clips) as glTF 2.0 when OUT ends in .glb/.gltf. */
 #include <string.h>
 
 #include "cli.h"
 
 static const char* const usage =
     "usage: animkit export FILE|builtin:NAME [--clip N|NAME] [--time T] [--bind]\n"
-    "                      [--method lbs|dqs|cor] -o OUT.obj\n"
+    "                      [--method lbs|dqs|cor] -o OUT.obj|OUT.glb|OUT.gltf\n"
+    "OUT.glb / OUT.gltf (+ OUT.bin): the whole scene as glTF 2.0 (every node, skin, mesh, morph\n"
+    "target and clip; keys kept as they are); --clip, --time, --bind and --method apply to OBJ.\n"
     "Write the meshes posed at time T (default 0) of a clip (default the first) as OBJ with\n"
     "normals: morphed, then skinned, in world space as glTF 2.0 defines it (a skinned vertex is\n"
     "sum_j w_j world(joint_j) inverseBind_j p, the mesh node's own transform ignored; an\n"
@@ -15,6 +18,30 @@ static const char* const usage =
     "  --bind     write every mesh's vertices as stored (bind space: no clip, no skinning,\n"
     "             no morphing, no node transform)\n"
     "  --method   skinning method (default lbs)\n";
+
+static void export_warn(ak_log_level level, const char* message, void* user) {
+    (void)level;
+    (void)user;
+    fprintf(stderr, "animkit export: warning: %s\n", message);
+}
+
+/* The whole scene as glTF 2.0 (ak_io_save picks .glb or .gltf + .bin by the extension). */
+static int export_gltf(const char* in, const char* out) {
+    ak_scene* s = NULL;
+    int rc = cli_load_scene("export", in, &s);
+    if (rc) return rc;
+    ak_diag diag;
+    memset(&diag, 0, sizeof diag);
+    ak_io_save_desc desc = {.logger = {.func = export_warn}};
+    ak_result r = ak_io_save(out, s, &desc, &diag);
+    if (r != AK_OK)
+        rc = cli_fail("export", "%s: %s", diag.path[0] ? diag.path : out, diag.message[0] ? diag.message : ak_result_string(r));
+    else
+        fprintf(stderr, "wrote %s (%zu joints, %zu meshes, %zu clips)\n", out, ak_scene_joint_count(s), s->mesh_count,
+                s->clip_count);
+    ak_scene_destroy(s);
+    return rc;
+}
 
 int cmd_export(int argc, char** argv) {
     static const cli_opt opts[] = {{"--clip", "-c", true}, {"--time", "-t", true}, {"--bind", NULL, false},
@@ -28,8 +55,9 @@ int cmd_export(int argc, char** argv) {
     }
     if (a.pos_count != 1) return cli_usage("export", "expected one FILE or builtin:NAME");
     const char* out = CLI_GET(&a, "--output");
-    if (!out) return cli_usage("export", "missing -o OUT.obj");
-    if (!cli_has_ext(out, ".obj")) return cli_usage("export", "output '%s' must end in .obj", out);
+    if (!out) return cli_usage("export", "missing -o OUT.obj|OUT.glb|OUT.gltf");
+    if (cli_has_ext(out, ".glb") || cli_has_ext(out, ".gltf")) return export_gltf(a.pos[0], out);
+    if (!cli_has_ext(out, ".obj")) return cli_usage("export", "output '%s' must end in .obj, .glb or .gltf", out);
     float t = 0.0f;
     if (CLI_GET(&a, "--time") && !cli_parse_float(CLI_GET(&a, "--time"), &t))
         return cli_usage("export", "--time '%s' is not a number", CLI_GET(&a, "--time"));

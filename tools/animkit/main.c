@@ -13,7 +13,7 @@ typedef struct command {
 static const command commands[] = {
     {"demo", cmd_demo, "render the built-in characters (no files needed) to DIR/demo.gif and PNGs"},
     {"info", cmd_info, "print a model's skeleton, meshes and clips (--json for scripts)"},
-    {"export", cmd_export, "write the posed meshes as Wavefront OBJ"},
+    {"export", cmd_export, "write the posed meshes as OBJ, or the scene as glTF 2.0"},
     {"render", cmd_render, "render a posed or animated model to PNG or GIF"},
     {"curves", cmd_curves, "plot a clip's animation curves to PNG (a read-only curve editor)"},
     {"weights", cmd_weights, "compute automatic skin weights (inverse distance or bone heat)"},
@@ -25,6 +25,7 @@ static const command commands[] = {
     {"boids", cmd_boids, "flocking: Reynolds boids with obstacles and predators (JSON, PNG, GIF)"},
     {"view", cmd_view, "interactive viewer: play clips, compare skinning, drag IK targets (--headless, --script)"},
     {"cloth", cmd_cloth, "simulate cloth (XPBD or mass-spring): flag, curtain, drape, cape"},
+    {"retarget", cmd_retarget, "put a clip (e.g. BVH mocap) on another character; glTF or GIF out"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 

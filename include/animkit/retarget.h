@@ -1,0 +1,141 @@
+/* animkit retarget: put a clip made for one skeleton onto another (mocap onto a character).
+ *
+ * What it does:
+ *   - maps target joints to source joints by name: the same name (case and "prefix:" such as
+ *     "mixamorig:" ignored) first, then humanoid bones recognised in CMU/BVH, Mixamo, Unreal
+ *     mannequin, VRM humanoid and animkit's builtin humanoid names (ak_humanoid_bone_of_name),
+ *     left/right written as Left/Right/L/R prefixes or _l/_r/.L/.R suffixes; or a caller's map;
+ *   - transfers rotations as deltas from each skeleton's rest pose in the common model
+ *     ("world") frame: for a mapped pair (source j, target k) at time t,
+ *         W_t[k](t) = D_j(t) * C_k * W_t[k](rest),   D_j(t) = W_s[j](t) * W_s[j](rest)^-1,
+ *     where W are model-space rotations and C_k turns the target's rest bone direction (k to
+ *     its first mapped child) onto the source's (j to that child's source joint), so a T-pose
+ *     source drives an A-pose target with the same bone directions (C = identity for the
+ *     root-motion joint and for joints without a mapped child they take their parent's C);
+ *     the target's local rotation follows from its parent's model rotation;
+ *   - keeps the target's own bone lengths (local translations of every joint but the root
+ *     joint stay at its rest pose); moves the root joint (the hips, else the first mapped
+ *     joint) by the source's displacement from its rest position scaled by the ratio of leg
+ *     lengths (target / source, hip to knee to ankle; the root's rest height when legs are
+ *     not mapped), or unscaled;
+ *   - optionally cleans up foot contacts: a source foot is in contact at a frame when its
+ *     height above its lowest point in the clip is below contact_height and its horizontal
+ *     speed below contact_speed; during each run of contact frames the target foot is pinned
+ *     at its mean position over the run with the two-bone IK (upper leg, lower leg, foot; the
+ *     foot keeps its model-space rotation); a pin out of the leg's reach stretches the leg
+ *     towards it (ak_retarget_stats.unreached_frames);
+ *   - bakes the result at frame_rate into a clip for the target (ak_clip_bake).
+ * Both skeletons are assumed to share the up axis and facing direction of their model space.
+ *
+ * What it does NOT do: read files or map files (the CLI parses map files), morph weights,
+ * translation animation of non-root joints (target bone lengths are kept), joint limits.
+ *
+ * Usage:
+ *     int32_t map[128];                                   // >= target joint count
+ *     ak_retarget_map_by_name(src->skeleton, dst->skeleton, (ak_i32_span)AK_SPAN(map));
+ *     ak_retarget_desc d = {
+ *         .source = src->skeleton, .clip = src->clips[0], .target = dst->skeleton,
+ *         .source_of_target = {map, ak_skeleton_joint_count(dst->skeleton)},
+ *     };
+ *     ak_clip* clip = NULL;
+ *     ak_diag diag;
+ *     if (ak_retarget_clip(&d, NULL, &clip, NULL, &diag) != AK_OK) puts(diag.message);
+ *     // sample clip on dst's skeleton, or put it in dst->clips and ak_io_save(...)
+ *     ak_clip_destroy(clip);
+ *
+ * Ownership and threading: nothing is kept after a call; reentrant.
+ */
+#ifndef ANIMKIT_RETARGET_H
+#define ANIMKIT_RETARGET_H
+
+#include "clip.h"
+#include "skeleton.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Humanoid bones recognised by name (each names the joint that rotates that bone). */
+typedef enum ak_humanoid_bone {
+    AK_BONE_NONE = 0,
+    AK_BONE_HIPS,
+    AK_BONE_SPINE, AK_BONE_CHEST, AK_BONE_UPPER_CHEST, AK_BONE_NECK, AK_BONE_HEAD,
+    AK_BONE_LEFT_SHOULDER, AK_BONE_LEFT_UPPER_ARM, AK_BONE_LEFT_LOWER_ARM, AK_BONE_LEFT_HAND,
+    AK_BONE_RIGHT_SHOULDER, AK_BONE_RIGHT_UPPER_ARM, AK_BONE_RIGHT_LOWER_ARM, AK_BONE_RIGHT_HAND,
+    AK_BONE_LEFT_UPPER_LEG, AK_BONE_LEFT_LOWER_LEG, AK_BONE_LEFT_FOOT, AK_BONE_LEFT_TOES,
+    AK_BONE_RIGHT_UPPER_LEG, AK_BONE_RIGHT_LOWER_LEG, AK_BONE_RIGHT_FOOT, AK_BONE_RIGHT_TOES,
+    AK_BONE_COUNT
+} ak_humanoid_bone;
+
+/* VRM-style name of a bone ("hips", "leftUpperArm", ...); "none" out of range; never NULL. */
+AK_API const char* ak_humanoid_bone_name(ak_humanoid_bone bone);
+
+/* Bone a joint name stands for, from the name alone (AK_BONE_NONE when not recognised).
+ * Spine joints give AK_BONE_SPINE; ak_humanoid_bones_of_skeleton numbers them by hierarchy. */
+AK_API ak_humanoid_bone ak_humanoid_bone_of_name(const char* name);
+
+/* Bone of every joint of a skeleton: names (ak_humanoid_bone_of_name), then the hierarchy:
+ * spine joints between the hips and the neck become SPINE, CHEST, UPPER_CHEST in order (the
+ * rest NONE); a SHOULDER whose child is the LOWER_ARM is the UPPER_ARM (animkit's builtin
+ * "left_shoulder" is the shoulder joint of the arm); each bone goes to the first joint (by
+ * index) that claims it. out_bones.count >= joint count.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_humanoid_bones_of_skeleton(const ak_skeleton* skeleton, ak_i32_span out_bones);
+
+/* Source joint for every target joint (-1: unmapped, keeps its rest pose): the same joint name
+ * (case-insensitive, anything up to the last ':' dropped) first, then the same humanoid bone
+ * (ak_humanoid_bones_of_skeleton on both); a source joint is used once.
+ * out_source_of_target.count >= target joint count. Temporary memory (one bone array per
+ * skeleton) comes from malloc. Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_NO_MEMORY;
+ * *out_mapped_count (optional) = target joints mapped. */
+AK_API ak_result ak_retarget_map_by_name(const ak_skeleton* source, const ak_skeleton* target,
+                                         ak_i32_span out_source_of_target, size_t* out_mapped_count);
+
+typedef struct ak_retarget_desc {
+    const ak_skeleton* source;     /* required: the skeleton the clip animates */
+    const ak_clip* clip;           /* required: a clip of source (joint count <= source's) */
+    const ak_skeleton* target;     /* required */
+    ak_i32_cspan source_of_target; /* [target joint count] source joint per target joint, -1
+                                      unmapped; empty -> ak_retarget_map_by_name */
+    float frame_rate;              /* frames per second of the baked result; 0 -> 30 */
+    bool unscaled_root_motion;     /* true -> the root moves by the source's displacement as is;
+                                      false (default) -> scaled by the leg-length ratio */
+    bool skip_foot_contacts;       /* true -> no foot clean-up; false (default) -> pin feet */
+    float contact_height;          /* contact: foot height above its lowest point, in source leg
+                                      lengths; 0 -> 0.08 */
+    float contact_speed;           /* contact: horizontal foot speed, source leg lengths per
+                                      second; 0 -> 0.6 */
+    const char* name;              /* clip name; NULL -> the source clip's name */
+} ak_retarget_desc;
+
+/* What a retarget did. */
+typedef struct ak_retarget_stats {
+    size_t frame_count;     /* frames baked */
+    size_t mapped_count;    /* target joints driven by a source joint */
+    int32_t root_joint;     /* target root-motion joint (-1 none) */
+    float root_scale;       /* factor applied to the root displacement */
+    size_t contact_frames;  /* source foot-frames in contact (both feet counted) */
+    size_t pinned_frames;   /* target foot-frames the IK pinned */
+    size_t unreached_frames; /* of those, frames the pin was out of the leg's reach (the leg is
+                                stretched towards it and the foot slides) */
+} ak_retarget_stats;
+
+/* The desc with zero fields replaced by their defaults (NULL -> all defaults). */
+AK_API ak_retarget_desc ak_retarget_desc_resolved(const ak_retarget_desc* desc);
+
+/* Retarget desc->clip onto desc->target and bake it (frames at 0, 1/rate, ... up to the clip's
+ * duration; the last frame samples the source at its duration). alloc NULL -> malloc/free (temporary arrays and
+ * the clip). Returns AK_ERR_NULL_ARG (desc, source, clip, target or out_clip NULL),
+ * AK_ERR_SPAN_SMALL (source_of_target shorter than the target's joint count),
+ * AK_ERR_BAD_INDEX (a map entry >= the source's joint count or < -1, or the clip addresses
+ * more joints than the source has), AK_ERR_NOT_FOUND (no target joint mapped),
+ * AK_ERR_BAD_ARG (frame_rate, contact_height or contact_speed negative or not finite),
+ * AK_ERR_BAD_DATA (a non-finite pose), AK_ERR_NO_MEMORY. diag (optional) says which.
+ * *out_clip is NULL on failure; out_stats optional. */
+AK_API ak_result ak_retarget_clip(const ak_retarget_desc* desc, const ak_allocator* alloc, ak_clip** out_clip,
+                                  ak_retarget_stats* out_stats, ak_diag* diag);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ANIMKIT_RETARGET_H */

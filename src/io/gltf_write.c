@@ -1,0 +1,916 @@
+/* glTF 2.0 writer: a scene as .glb or as .gltf + .bin (io.h, docs/io.md "Writing glTF").
+ * One bufferView per accessor (so no byteStride is ever needed), every view 4-byte aligned,
+ * one buffer. The JSON is built with cJSON and its own malloc (as the reader does). */
+#include <cjson/cJSON.h> /* Debian libcjson-dev */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "io_internal.h"
+
+/* ---- private types ---------------------------------------------------------------------- */
+
+#define GL_UNSIGNED_BYTE 5121
+#define GL_UNSIGNED_SHORT 5123
+#define GL_UNSIGNED_INT 5125
+#define GL_FLOAT 5126
+#define GL_ARRAY_BUFFER 34962
+#define GL_ELEMENT_ARRAY_BUFFER 34963
+
+typedef struct w_ctx {
+    const ak_scene* scene;
+    const char* path;
+    ak_diag* diag;
+    const ak_logger* logger;
+    uint8_t* bin;
+    size_t bin_size, bin_cap;
+    cJSON *root, *views, *accessors, *nodes, *meshes, *skins, *animations, *materials;
+    size_t n_nodes; /* written so far (joints, then extra mesh nodes) */
+    int32_t* node_of_mesh; /* [mesh_count] glTF node carrying scene mesh m's glTF mesh, -1 none */
+    int32_t* group_of_mesh; /* [mesh_count] first scene mesh of m's group (one glTF mesh) */
+    size_t* morph_base; /* [mesh_count] first morph weight index of scene mesh m */
+} w_ctx;
+
+/* One morph-weight sampler as written: key times, values in glTF layout. */
+typedef struct w_morph {
+    bool present;
+    ak_interp interp;
+    size_t keys;
+    float* times;
+    float* values; /* keys * (cubic ? 3 : 1) * targets */
+} w_morph;
+
+/* ---- static helpers --------------------------------------------------------------------- */
+
+#define WTRY(x)                          \
+    do {                                 \
+        ak_result r_ = (x);              \
+        if (r_ != AK_OK) return r_;      \
+    } while (0)
+
+static ak_result oom(w_ctx* c) {
+    akp_diag_set(c->diag, c->path, "out of memory");
+    return AK_ERR_NO_MEMORY;
+}
+
+static ak_result bin_reserve(w_ctx* c, size_t extra) {
+    if (extra > SIZE_MAX / 2 - c->bin_size) return oom(c);
+    size_t need = c->bin_size + extra;
+    if (need <= c->bin_cap) return AK_OK;
+    size_t cap = c->bin_cap ? c->bin_cap : 4096;
+    while (cap < need) cap *= 2;
+    uint8_t* p = (uint8_t*)realloc(c->bin, cap);
+    if (!p) return oom(c);
+    c->bin = p;
+    c->bin_cap = cap;
+    return AK_OK;
+}
+
+static cJSON* num(double v) { return cJSON_CreateNumber(v); }
+
+static bool add_num(cJSON* obj, const char* key, double v) { return cJSON_AddItemToObject(obj, key, num(v)); }
+
+/* Append data as a new bufferView (4-byte aligned, zero padded); returns its index or -1. */
+static int add_view(w_ctx* c, const void* data, size_t bytes, int target) {
+    size_t padded = (bytes + 3u) & ~(size_t)3u;
+    if (bin_reserve(c, padded) != AK_OK) return -1;
+    size_t offset = c->bin_size;
+    memcpy(c->bin + offset, data, bytes);
+    memset(c->bin + offset + bytes, 0, padded - bytes);
+    c->bin_size += padded;
+    cJSON* v = cJSON_CreateObject();
+    if (!v || !cJSON_AddItemToArray(c->views, v)) return -1;
+    add_num(v, "buffer", 0);
+    if (offset) add_num(v, "byteOffset", (double)offset);
+    add_num(v, "byteLength", (double)bytes);
+    if (target) add_num(v, "target", target);
+    return cJSON_GetArraySize(c->views) - 1;
+}
+
+static size_t ctype_size(int ctype) {
+    return ctype == GL_FLOAT || ctype == GL_UNSIGNED_INT ? 4 : ctype == GL_UNSIGNED_SHORT ? 2 : 1;
+}
+
+static const char* type_name(int comps) {
+    switch (comps) {
+    case 1: return "SCALAR";
+    case 2: return "VEC2";
+    case 3: return "VEC3";
+    case 4: return "VEC4";
+    default: return "MAT4";
+    }
+}
+
+/* Add an accessor over count elements of comps components (float data gets min/max when
+ * minmax is set, as POSITION and animation inputs require). Returns its index or -1. */
+static int add_accessor(w_ctx* c, const void* data, size_t count, int ctype, int comps, int target, bool minmax) {
+    size_t bytes = count * (size_t)comps * ctype_size(ctype);
+    int view = add_view(c, data, bytes, target);
+    if (view < 0) return -1;
+    cJSON* a = cJSON_CreateObject();
+    if (!a || !cJSON_AddItemToArray(c->accessors, a)) return -1;
+    add_num(a, "bufferView", view);
+    add_num(a, "componentType", ctype);
+    add_num(a, "count", (double)count);
+    cJSON_AddStringToObject(a, "type", type_name(comps));
+    if (minmax && ctype == GL_FLOAT && count) {
+        const float* f = (const float*)data;
+        cJSON* mn = cJSON_AddArrayToObject(a, "min");
+        cJSON* mx = cJSON_AddArrayToObject(a, "max");
+        if (!mn || !mx) return -1;
+        for (int k = 0; k < comps; ++k) {
+            float lo = f[k], hi = f[k];
+            for (size_t i = 1; i < count; ++i) {
+                float x = f[i * (size_t)comps + (size_t)k];
+                lo = x < lo ? x : lo;
+                hi = x > hi ? x : hi;
+            }
+            cJSON_AddItemToArray(mn, num(lo));
+            cJSON_AddItemToArray(mx, num(hi));
+        }
+    }
+    return cJSON_GetArraySize(c->accessors) - 1;
+}
+
+static bool finite_floats(const float* f, size_t n) {
+    for (size_t i = 0; i < n; ++i)
+        if (!ak_finitef(f[i])) return false;
+    return true;
+}
+
+#define BAD(c, code, ...) (akp_diag_set((c)->diag, (c)->path, __VA_ARGS__), (code))
+
+/* ---- nodes ------------------------------------------------------------------------------ */
+
+static ak_result write_node_trs(w_ctx* c, cJSON* node, ak_transform t, const char* name) {
+    if (!ak_transform_is_finite(t)) return BAD(c, AK_ERR_BAD_DATA, "joint %s: rest transform is not finite", name);
+    ak_quat q = ak_quat_normalize(t.rotation);
+    if (t.translation.x != 0.0f || t.translation.y != 0.0f || t.translation.z != 0.0f) {
+        cJSON* a = cJSON_AddArrayToObject(node, "translation");
+        if (!a) return oom(c);
+        cJSON_AddItemToArray(a, num(t.translation.x));
+        cJSON_AddItemToArray(a, num(t.translation.y));
+        cJSON_AddItemToArray(a, num(t.translation.z));
+    }
+    if (q.x != 0.0f || q.y != 0.0f || q.z != 0.0f || q.w != 1.0f) {
+        cJSON* a = cJSON_AddArrayToObject(node, "rotation");
+        if (!a) return oom(c);
+        cJSON_AddItemToArray(a, num(q.x));
+        cJSON_AddItemToArray(a, num(q.y));
+        cJSON_AddItemToArray(a, num(q.z));
+        cJSON_AddItemToArray(a, num(q.w));
+    }
+    if (t.scale.x != 1.0f || t.scale.y != 1.0f || t.scale.z != 1.0f) {
+        cJSON* a = cJSON_AddArrayToObject(node, "scale");
+        if (!a) return oom(c);
+        cJSON_AddItemToArray(a, num(t.scale.x));
+        cJSON_AddItemToArray(a, num(t.scale.y));
+        cJSON_AddItemToArray(a, num(t.scale.z));
+    }
+    return AK_OK;
+}
+
+static ak_result add_child(w_ctx* c, int32_t parent, size_t child) {
+    cJSON* p = cJSON_GetArrayItem(c->nodes, parent);
+    cJSON* ch = cJSON_GetObjectItemCaseSensitive(p, "children");
+    if (!ch && !(ch = cJSON_AddArrayToObject(p, "children"))) return oom(c);
+    if (!cJSON_AddItemToArray(ch, num((double)child))) return oom(c);
+    return AK_OK;
+}
+
+static ak_result write_skeleton(w_ctx* c) {
+    const ak_skeleton* sk = c->scene->skeleton;
+    size_t n = sk ? ak_skeleton_joint_count(sk) : 0;
+    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_transform_cspan rest = ak_skeleton_rest_pose(sk);
+    for (size_t j = 0; j < n; ++j) {
+        cJSON* node = cJSON_CreateObject();
+        if (!node || !cJSON_AddItemToArray(c->nodes, node)) return oom(c);
+        const char* name = ak_skeleton_joint_name(sk, j);
+        if (!cJSON_AddStringToObject(node, "name", name)) return oom(c);
+        if (!ak_transform_is_finite(rest.ptr[j])) return BAD(c, AK_ERR_BAD_DATA, "joint %zu: rest transform is not finite", j);
+        WTRY(write_node_trs(c, node, rest.ptr[j], name));
+        if (parents.ptr[j] >= 0) WTRY(add_child(c, parents.ptr[j], j));
+    }
+    c->n_nodes = n;
+    return AK_OK;
+}
+
+/* A new node with identity transform for a mesh (a root unless parent >= 0). */
+static ak_result add_mesh_node(w_ctx* c, const char* mesh_name, int32_t parent, int32_t* out_node) {
+    cJSON* node = cJSON_CreateObject();
+    if (!node || !cJSON_AddItemToArray(c->nodes, node)) return oom(c);
+    char name[AK_NAME_SIZE + 8];
+    snprintf(name, sizeof name, "%s_node", mesh_name[0] ? mesh_name : "mesh");
+    if (!cJSON_AddStringToObject(node, "name", name)) return oom(c);
+    *out_node = (int32_t)c->n_nodes++;
+    if (parent >= 0) WTRY(add_child(c, parent, (size_t)*out_node));
+    return AK_OK;
+}
+
+/* ---- morph-weight samplers ------------------------------------------------------------- */
+
+static void morph_free(w_morph* m) {
+    free(m->times);
+    free(m->values);
+    memset(m, 0, sizeof *m);
+}
+
+static bool is_cubic(ak_interp i) { return i != AK_INTERP_STEP && i != AK_INTERP_LINEAR; }
+
+/* glTF interpolation a track is written with, or AK_INTERP_COUNT when it has none:
+ * HERMITE, CARDINAL, NATURAL and BEZIER are cubic Hermite segments with per-second tangents
+ * (curve.h), written as CUBICSPLINE with those tangents; the curve is the same. */
+static ak_interp gltf_interp(const ak_track* t) {
+    ak_interp i = ak_track_interp(t);
+    switch (i) {
+    case AK_INTERP_STEP:
+    case AK_INTERP_LINEAR: return i;
+    case AK_INTERP_CUBICSPLINE:
+    case AK_INTERP_HERMITE: return AK_INTERP_CUBICSPLINE;
+    case AK_INTERP_CARDINAL:
+    case AK_INTERP_NATURAL:
+    case AK_INTERP_BEZIER: return ak_track_is_rotation(t) ? AK_INTERP_COUNT : AK_INTERP_CUBICSPLINE;
+    default: return AK_INTERP_COUNT;
+    }
+}
+
+/* Output values of a track in glTF layout for interp (cubic: in, value, out per key).
+ * comps components of the track land at [first, first + comps) of stride floats per element,
+ * the rest of the element is filled from fill (NULL -> untouched). */
+static ak_result track_values(w_ctx* c, const ak_track* t, ak_interp interp, float* out, size_t stride,
+                              size_t first, const float* fill) {
+    size_t keys = ak_track_key_count(t);
+    uint32_t comps = ak_track_component_count(t);
+    float v[AK_TRACK_MAX_COMPONENTS], ti[AK_TRACK_MAX_COMPONENTS], to[AK_TRACK_MAX_COMPONENTS];
+    size_t parts = is_cubic(interp) ? 3 : 1;
+    for (size_t k = 0; k < keys; ++k) {
+        ak_result r = ak_track_key(t, k, (ak_f32_span){v, comps}, (ak_f32_span){ti, comps}, (ak_f32_span){to, comps});
+        if (r != AK_OK) return r;
+        for (size_t p = 0; p < parts; ++p) {
+            const float* src = parts == 1 ? v : p == 0 ? ti : p == 1 ? v : to;
+            float* dst = out + (k * parts + p) * stride;
+            if (fill)
+                for (size_t i = 0; i < stride; ++i) dst[i] = (parts == 3 && p != 1) ? 0.0f : fill[i];
+            memcpy(dst + first, src, comps * sizeof(float));
+        }
+    }
+    if (!finite_floats(out, keys * parts * stride)) return BAD(c, AK_ERR_BAD_DATA, "a key value or tangent is not finite");
+    return AK_OK;
+}
+
+/* The morph-weight sampler of scene mesh m in clip: the one channel overlapping its weights,
+ * padded with the default weights for targets the channel does not cover. */
+static ak_result morph_sampler(w_ctx* c, const ak_clip* clip, size_t m, w_morph* out) {
+    memset(out, 0, sizeof *out);
+    const ak_mesh* mesh = c->scene->meshes[m].mesh;
+    size_t base = c->morph_base[m], tc = mesh->morph_target_count;
+    if (!tc) return AK_OK;
+    size_t found = SIZE_MAX;
+    for (size_t ch = 0; ch < ak_clip_channel_count(clip); ++ch) {
+        if (ak_clip_channel_target(clip, ch) != AK_CHANNEL_MORPH_WEIGHTS) continue;
+        size_t lo = ak_clip_channel_index(clip, ch);
+        size_t hi = lo + ak_track_component_count(ak_clip_channel_track(clip, ch));
+        if (hi <= base || lo >= base + tc) continue;
+        if (found != SIZE_MAX) {
+            akp_diag_set(c->diag, c->path,
+                         "clip '%s': two channels animate the morph weights of mesh %zu; glTF has one per mesh",
+                         ak_clip_name(clip), m);
+            return AK_ERR_UNSUPPORTED;
+        }
+        found = ch;
+    }
+    if (found == SIZE_MAX) return AK_OK;
+    const ak_track* t = ak_clip_channel_track(clip, found);
+    size_t lo = ak_clip_channel_index(clip, found);
+    uint32_t comps = ak_track_component_count(t);
+    ak_interp interp = gltf_interp(t);
+    if (interp == AK_INTERP_COUNT) {
+        akp_diag_set(c->diag, c->path, "clip '%s' channel %zu: %s interpolation has no glTF form (bake it first)",
+                     ak_clip_name(clip), found, ak_interp_name(ak_track_interp(t)));
+        return AK_ERR_UNSUPPORTED;
+    }
+    size_t keys = ak_track_key_count(t), parts = is_cubic(interp) ? 3 : 1;
+    /* the channel may start before this mesh or run past it: take the overlap */
+    size_t first = lo > base ? lo - base : 0;
+    size_t skip = base > lo ? base - lo : 0;
+    size_t take = comps - skip < tc - first ? comps - skip : tc - first;
+    float* full = (float*)malloc(keys * parts * comps * sizeof(float));
+    out->times = (float*)malloc(keys * sizeof(float));
+    out->values = (float*)malloc(keys * parts * tc * sizeof(float));
+    if (!full || !out->times || !out->values) {
+        free(full);
+        morph_free(out);
+        return oom(c);
+    }
+    ak_result r = track_values(c, t, interp, full, comps, 0, NULL);
+    if (r == AK_OK) {
+        for (size_t e = 0; e < keys * parts; ++e) {
+            bool tangent = parts == 3 && e % 3 != 1;
+            for (size_t i = 0; i < tc; ++i) out->values[e * tc + i] = tangent ? 0.0f : mesh->morph_weights[i];
+            memcpy(out->values + e * tc + first, full + e * comps + skip, take * sizeof(float));
+        }
+        memcpy(out->times, ak_track_times(t).ptr, keys * sizeof(float));
+        out->present = true;
+        out->interp = interp;
+        out->keys = keys;
+    } else {
+        morph_free(out);
+    }
+    free(full);
+    return r;
+}
+
+static bool morph_equal(const w_morph* a, const w_morph* b, size_t tc) {
+    if (a->present != b->present) return false;
+    if (!a->present) return true;
+    size_t parts = is_cubic(a->interp) ? 3 : 1;
+    return a->interp == b->interp && a->keys == b->keys &&
+           !memcmp(a->times, b->times, a->keys * sizeof(float)) &&
+           !memcmp(a->values, b->values, a->keys * parts * tc * sizeof(float));
+}
+
+/* ---- meshes ------------------------------------------------------------------------------ */
+
+static bool same_group(w_ctx* c, size_t a, size_t b, ak_result* err) {
+    const ak_scene_mesh* ma = &c->scene->meshes[a];
+    const ak_scene_mesh* mb = &c->scene->meshes[b];
+    if (ma->node != mb->node || ma->skin != mb->skin || ma->node < 0) return false;
+    size_t tc = ma->mesh->morph_target_count;
+    if (tc != mb->mesh->morph_target_count) return false;
+    if (tc && memcmp(ma->mesh->morph_weights, mb->mesh->morph_weights, tc * sizeof(float))) return false;
+    if ((ma->mesh->influence_count == 0) != (mb->mesh->influence_count == 0)) return false;
+    for (size_t k = 0; k < c->scene->clip_count && tc; ++k) {
+        w_morph wa, wb;
+        if ((*err = morph_sampler(c, c->scene->clips[k], a, &wa)) != AK_OK) return false;
+        if ((*err = morph_sampler(c, c->scene->clips[k], b, &wb)) != AK_OK) {
+            morph_free(&wa);
+            return false;
+        }
+        bool eq = morph_equal(&wa, &wb, tc);
+        morph_free(&wa);
+        morph_free(&wb);
+        if (!eq) return false;
+    }
+    return true;
+}
+
+static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
+    const ak_mesh* mesh = c->scene->meshes[m].mesh;
+    size_t nv = mesh->vertex_count;
+    char what[AK_NAME_SIZE + 32];
+    snprintf(what, sizeof what, "mesh %zu (%s)", m, mesh->name);
+    if (!finite_floats(&mesh->positions[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: a position is not finite", what);
+    cJSON* attrs = cJSON_AddObjectToObject(prim, "attributes");
+    if (!attrs) return oom(c);
+    int a = add_accessor(c, mesh->positions, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, true);
+    if (a < 0) return oom(c);
+    add_num(attrs, "POSITION", a);
+    if (mesh->normals) {
+        /* glTF requires unit normals: renormalise the ones that are off by more than float
+         * rounding (a zero normal becomes +Y, as ak_normals_compute does) */
+        ak_vec3* n = (ak_vec3*)malloc(nv * sizeof(ak_vec3));
+        if (!n) return oom(c);
+        for (size_t v = 0; v < nv; ++v) {
+            ak_vec3 x = mesh->normals[v];
+            float len = ak_vec3_length(x);
+            if (!ak_vec3_is_finite(x)) {
+                free(n);
+                return BAD(c, AK_ERR_BAD_DATA, "%s: normal %zu is not finite", what, v);
+            }
+            n[v] = fabsf(len - 1.0f) <= 1e-5f ? x : len > 0.0f ? ak_vec3_scale(x, 1.0f / len) : ak_vec3_make(0, 1, 0);
+        }
+        a = add_accessor(c, n, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false);
+        free(n);
+        if (a < 0) return oom(c);
+        add_num(attrs, "NORMAL", a);
+    }
+    if (mesh->uvs) {
+        if (!finite_floats(&mesh->uvs[0].x, nv * 2)) return BAD(c, AK_ERR_BAD_DATA, "%s: a UV is not finite", what);
+        if ((a = add_accessor(c, mesh->uvs, nv, GL_FLOAT, 2, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
+        add_num(attrs, "TEXCOORD_0", a);
+    }
+    if (mesh->colors) {
+        if (!finite_floats(&mesh->colors[0].x, nv * 4)) return BAD(c, AK_ERR_BAD_DATA, "%s: a colour is not finite", what);
+        if ((a = add_accessor(c, mesh->colors, nv, GL_FLOAT, 4, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
+        add_num(attrs, "COLOR_0", a);
+    }
+    if (mesh->influence_count && c->scene->meshes[m].skin >= 0) { /* glTF skins need JOINTS_0 */
+        uint32_t infl = mesh->influence_count, sets = infl > 4 ? 2 : 1;
+        uint16_t maxj = 0;
+        for (size_t i = 0; i < nv * infl; ++i) maxj = mesh->joints[i] > maxj ? mesh->joints[i] : maxj;
+        bool wide = maxj > 255;
+        uint8_t* jb = (uint8_t*)calloc(nv * 4, wide ? 2 : 1);
+        float* wb = (float*)calloc(nv * 4, sizeof(float));
+        if (!jb || !wb) {
+            free(jb);
+            free(wb);
+            return oom(c);
+        }
+        ak_result r = AK_OK;
+        for (uint32_t s = 0; s < sets && r == AK_OK; ++s) {
+            memset(jb, 0, nv * 4 * (wide ? 2 : 1));
+            memset(wb, 0, nv * 4 * sizeof(float));
+            for (size_t v = 0; v < nv; ++v) {
+                for (uint32_t k = 0; k < 4 && s * 4 + k < infl; ++k) {
+                    size_t src = v * infl + s * 4 + k;
+                    float w = mesh->weights[src];
+                    if (!(w >= 0.0f) || !ak_finitef(w)) {
+                        r = BAD(c, AK_ERR_BAD_WEIGHTS, "%s: vertex %zu has a negative or non-finite weight", what, v);
+                        break;
+                    }
+                    /* a zero weight keeps joint 0 (glTF: unused influences are 0/0) */
+                    uint16_t j = w > 0.0f ? mesh->joints[src] : 0;
+                    if (wide) ((uint16_t*)(void*)jb)[v * 4 + k] = j;
+                    else jb[v * 4 + k] = (uint8_t)j;
+                    wb[v * 4 + k] = w > 0.0f ? w : 0.0f;
+                }
+            }
+            if (r != AK_OK) break;
+            int ja = add_accessor(c, jb, nv, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE, 4, GL_ARRAY_BUFFER, false);
+            int wa = add_accessor(c, wb, nv, GL_FLOAT, 4, GL_ARRAY_BUFFER, false);
+            if (ja < 0 || wa < 0) r = oom(c);
+            else {
+                char jk[16], wk[16];
+                snprintf(jk, sizeof jk, "JOINTS_%u", s);
+                snprintf(wk, sizeof wk, "WEIGHTS_%u", s);
+                add_num(attrs, jk, ja);
+                add_num(attrs, wk, wa);
+            }
+        }
+        free(jb);
+        free(wb);
+        if (r != AK_OK) return r;
+    }
+    if (mesh->triangle_count) {
+        size_t ni = mesh->triangle_count * 3;
+        for (size_t i = 0; i < ni; ++i)
+            if (mesh->indices[i] >= nv) return BAD(c, AK_ERR_BAD_INDEX, "%s: index %zu is out of range", what, i);
+        if (nv <= 65535) { /* 65535 is the primitive restart value, never an index */
+            uint16_t* ix = (uint16_t*)malloc(ni * sizeof(uint16_t));
+            if (!ix) return oom(c);
+            for (size_t i = 0; i < ni; ++i) ix[i] = (uint16_t)mesh->indices[i];
+            a = add_accessor(c, ix, ni, GL_UNSIGNED_SHORT, 1, GL_ELEMENT_ARRAY_BUFFER, false);
+            free(ix);
+        } else {
+            a = add_accessor(c, mesh->indices, ni, GL_UNSIGNED_INT, 1, GL_ELEMENT_ARRAY_BUFFER, false);
+        }
+        if (a < 0) return oom(c);
+        add_num(prim, "indices", a);
+        add_num(prim, "mode", 4);
+    } else {
+        add_num(prim, "mode", 0); /* a point cloud */
+    }
+    if (mesh->morph_target_count) {
+        cJSON* targets = cJSON_AddArrayToObject(prim, "targets");
+        if (!targets) return oom(c);
+        for (size_t t = 0; t < mesh->morph_target_count; ++t) {
+            cJSON* tg = cJSON_CreateObject();
+            if (!tg || !cJSON_AddItemToArray(targets, tg)) return oom(c);
+            const ak_vec3* d = mesh->morph_positions + t * nv;
+            if (!finite_floats(&d[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: morph target %zu is not finite", what, t);
+            if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, true)) < 0) return oom(c);
+            add_num(tg, "POSITION", a);
+            if (mesh->morph_normals) {
+                d = mesh->morph_normals + t * nv;
+                if (!finite_floats(&d[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: morph target %zu is not finite", what, t);
+                if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
+                add_num(tg, "NORMAL", a);
+            }
+        }
+    }
+    return AK_OK;
+}
+
+/* Index of a material with this base colour (made on first use; channels clamped to [0, 1],
+ * the range glTF allows); -1 when out of memory. */
+static int material_index(w_ctx* c, ak_vec4 col) {
+    float v[4] = {col.x, col.y, col.z, col.w};
+    for (int k = 0; k < 4; ++k) v[k] = v[k] < 0.0f ? 0.0f : v[k] > 1.0f ? 1.0f : v[k];
+    int i = 0;
+    for (const cJSON* m = c->materials->child; m; m = m->next, ++i) {
+        const cJSON* f = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness"),
+                                                          "baseColorFactor");
+        int k = 0;
+        for (const cJSON* e = f ? f->child : NULL; e && k < 4 && e->valuedouble == (double)v[k]; e = e->next) ++k;
+        if (k == 4) return i;
+    }
+    cJSON* m = cJSON_CreateObject();
+    cJSON* pbr = m ? cJSON_AddObjectToObject(m, "pbrMetallicRoughness") : NULL;
+    cJSON* f = pbr ? cJSON_AddArrayToObject(pbr, "baseColorFactor") : NULL;
+    if (!f || !cJSON_AddItemToArray(c->materials, m)) {
+        cJSON_Delete(m);
+        return -1;
+    }
+    for (int k = 0; k < 4; ++k) cJSON_AddItemToArray(f, num(v[k]));
+    return i;
+}
+
+/* The glTF mesh name of a group: the reader names primitive p of mesh "M" "M_p", so a group
+ * whose first name ends in "_0" takes the name without it. */
+static void group_name(const char* first, size_t members, char out[AK_NAME_SIZE]) {
+    snprintf(out, AK_NAME_SIZE, "%s", first);
+    size_t n = strlen(out);
+    if (members > 1 && n > 2 && out[n - 1] == '0' && out[n - 2] == '_') out[n - 2] = '\0';
+}
+
+static ak_result write_meshes(w_ctx* c) {
+    const ak_scene* s = c->scene;
+    size_t base = 0;
+    for (size_t m = 0; m < s->mesh_count; ++m) {
+        c->morph_base[m] = base;
+        base += s->meshes[m].mesh->morph_target_count;
+        c->node_of_mesh[m] = -1;
+    }
+    bool* used = (bool*)calloc(c->n_nodes ? c->n_nodes : 1, sizeof(bool));
+    if (!used) return oom(c);
+    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    size_t n_joints = c->n_nodes;
+    ak_result r = AK_OK;
+    for (size_t m = 0; m < s->mesh_count && r == AK_OK;) {
+        size_t end = m + 1;
+        while (end < s->mesh_count && same_group(c, m, end, &r)) ++end;
+        if (r != AK_OK) break;
+        const ak_scene_mesh* sm = &s->meshes[m];
+        const ak_mesh* mesh = sm->mesh;
+        /* the node that carries the glTF mesh: the scene's node where glTF allows it, else a new
+         * identity node (a skinned mesh ignores its node's transform, so it gets a root node:
+         * glTF warns about skinned meshes below other nodes) */
+        int32_t node = -1;
+        bool skinned = sm->skin >= 0 && mesh->influence_count > 0;
+        if (sm->node >= 0 && (size_t)sm->node < n_joints && !used[sm->node] && (!skinned || parents.ptr[sm->node] < 0))
+            node = sm->node;
+        else if ((r = add_mesh_node(c, mesh->name, skinned ? -1 : sm->node, &node)) != AK_OK)
+            break;
+        if ((size_t)node < n_joints) used[node] = true;
+        cJSON* gm = cJSON_CreateObject();
+        cJSON* prims = gm ? cJSON_AddArrayToObject(gm, "primitives") : NULL;
+        if (!prims || !cJSON_AddItemToArray(c->meshes, gm)) {
+            cJSON_Delete(gm);
+            r = oom(c);
+            break;
+        }
+        char gname[AK_NAME_SIZE];
+        group_name(mesh->name, end - m, gname);
+        cJSON_AddStringToObject(gm, "name", gname);
+        for (size_t k = m; k < end && r == AK_OK; ++k) {
+            cJSON* prim = cJSON_CreateObject();
+            if (!prim || !cJSON_AddItemToArray(prims, prim)) r = oom(c);
+            else r = write_primitive(c, k, prim);
+            if (r == AK_OK && s->meshes[k].has_material) {
+                int mi = material_index(c, s->meshes[k].base_color);
+                if (mi < 0) r = oom(c);
+                else add_num(prim, "material", mi);
+            }
+            c->node_of_mesh[k] = node;
+            c->group_of_mesh[k] = (int32_t)m;
+        }
+        if (r == AK_OK && mesh->morph_target_count) {
+            cJSON* w = cJSON_AddArrayToObject(gm, "weights");
+            cJSON* ex = cJSON_AddObjectToObject(gm, "extras");
+            cJSON* names = ex ? cJSON_AddArrayToObject(ex, "targetNames") : NULL;
+            if (!w || !names) r = oom(c);
+            for (size_t t = 0; r == AK_OK && t < mesh->morph_target_count; ++t) {
+                if (!ak_finitef(mesh->morph_weights[t])) r = BAD(c, AK_ERR_BAD_DATA, "mesh %s: default weight %zu is not finite", mesh->name, t);
+                cJSON_AddItemToArray(w, num(mesh->morph_weights[t]));
+                cJSON_AddItemToArray(names, cJSON_CreateString(mesh->morph_names ? mesh->morph_names[t] : ""));
+            }
+        }
+        if (r == AK_OK) {
+            cJSON* nj = cJSON_GetArrayItem(c->nodes, node);
+            add_num(nj, "mesh", cJSON_GetArraySize(c->meshes) - 1);
+            if (skinned) add_num(nj, "skin", sm->skin);
+        }
+        m = end;
+    }
+    free(used);
+    return r;
+}
+
+static ak_result write_skins(w_ctx* c) {
+    const ak_scene* s = c->scene;
+    for (size_t i = 0; i < s->skin_count; ++i) {
+        const ak_scene_skin* sk = &s->skins[i];
+        cJSON* js = cJSON_CreateObject();
+        if (!js || !cJSON_AddItemToArray(c->skins, js)) return oom(c);
+        if (sk->name[0]) cJSON_AddStringToObject(js, "name", sk->name);
+        cJSON* joints = cJSON_AddArrayToObject(js, "joints");
+        if (!joints) return oom(c);
+        for (size_t k = 0; k < sk->joint_count; ++k) {
+            if (sk->joints[k] < 0 || (size_t)sk->joints[k] >= ak_scene_joint_count(s))
+                return BAD(c, AK_ERR_BAD_INDEX, "skin %s: slot %zu names no joint", sk->name, k);
+            if (!ak_mat4_is_finite(&sk->inverse_binds[k])) return BAD(c, AK_ERR_BAD_DATA, "skin %s: inverse bind %zu is not finite", sk->name, k);
+            cJSON_AddItemToArray(joints, num(sk->joints[k]));
+        }
+        int a = add_accessor(c, sk->inverse_binds, sk->joint_count, GL_FLOAT, 16, 0, false);
+        if (a < 0) return oom(c);
+        add_num(js, "inverseBindMatrices", a);
+    }
+    return AK_OK;
+}
+
+/* ---- animations ------------------------------------------------------------------------ */
+
+static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t keys, const float* values,
+                             size_t value_count, int comps, ak_interp interp, int* out_index) {
+    cJSON* samplers = cJSON_GetObjectItemCaseSensitive(an, "samplers");
+    int in = add_accessor(c, times, keys, GL_FLOAT, 1, 0, true);
+    int outa = add_accessor(c, values, value_count, GL_FLOAT, comps, 0, false);
+    cJSON* sm = cJSON_CreateObject();
+    if (in < 0 || outa < 0 || !sm || !cJSON_AddItemToArray(samplers, sm)) return oom(c);
+    add_num(sm, "input", in);
+    add_num(sm, "output", outa);
+    cJSON_AddStringToObject(sm, "interpolation", interp == AK_INTERP_STEP ? "STEP"
+                                                 : interp == AK_INTERP_LINEAR ? "LINEAR" : "CUBICSPLINE");
+    *out_index = cJSON_GetArraySize(samplers) - 1;
+    return AK_OK;
+}
+
+static ak_result add_channel(w_ctx* c, cJSON* an, int sampler, int32_t node, const char* path) {
+    cJSON* ch = cJSON_CreateObject();
+    cJSON* chans = cJSON_GetObjectItemCaseSensitive(an, "channels");
+    if (!ch || !cJSON_AddItemToArray(chans, ch)) return oom(c);
+    add_num(ch, "sampler", sampler);
+    cJSON* tg = cJSON_AddObjectToObject(ch, "target");
+    if (!tg) return oom(c);
+    add_num(tg, "node", node);
+    cJSON_AddStringToObject(tg, "path", path);
+    return AK_OK;
+}
+
+static ak_result write_clip(w_ctx* c, const ak_clip* clip, size_t ci) {
+    cJSON* an = cJSON_CreateObject();
+    if (!an) return oom(c);
+    if (!cJSON_AddArrayToObject(an, "channels") || !cJSON_AddArrayToObject(an, "samplers")) {
+        cJSON_Delete(an);
+        return oom(c);
+    }
+    if (ak_clip_name(clip)[0]) cJSON_AddStringToObject(an, "name", ak_clip_name(clip));
+    ak_result r = AK_OK;
+    size_t joints = ak_scene_joint_count(c->scene);
+    for (size_t ch = 0; ch < ak_clip_channel_count(clip) && r == AK_OK; ++ch) {
+        ak_channel_target tgt = ak_clip_channel_target(clip, ch);
+        if (tgt == AK_CHANNEL_MORPH_WEIGHTS) continue; /* per mesh below */
+        if (tgt == AK_CHANNEL_SCALAR) {
+            char msg[200];
+            snprintf(msg, sizeof msg, "glTF writer: clip '%s' channel %zu animates free scalars; not written",
+                     ak_clip_name(clip), ch);
+            akp_log(c->logger, AK_LOG_WARN, msg);
+            continue;
+        }
+        const ak_track* t = ak_clip_channel_track(clip, ch);
+        uint32_t joint = ak_clip_channel_index(clip, ch);
+        if (joint >= joints) {
+            akp_diag_set(c->diag, c->path, "clip '%s' channel %zu: joint %u is not in the skeleton", ak_clip_name(clip), ch, joint);
+            r = AK_ERR_BAD_INDEX;
+            break;
+        }
+        ak_interp interp = gltf_interp(t);
+        if (interp == AK_INTERP_COUNT) {
+            akp_diag_set(c->diag, c->path, "clip '%s' channel %zu: %s interpolation has no glTF form (bake it first)",
+                         ak_clip_name(clip), ch, ak_interp_name(ak_track_interp(t)));
+            r = AK_ERR_UNSUPPORTED;
+            break;
+        }
+        size_t keys = ak_track_key_count(t), parts = is_cubic(interp) ? 3 : 1;
+        uint32_t comps = ak_track_component_count(t);
+        float* v = (float*)malloc(keys * parts * comps * sizeof(float));
+        if (!v) return cJSON_Delete(an), oom(c);
+        r = track_values(c, t, interp, v, comps, 0, NULL);
+        int si = -1;
+        if (r == AK_OK)
+            r = add_sampler(c, an, ak_track_times(t).ptr, keys, v, keys * parts, (int)comps, interp, &si);
+        free(v);
+        if (r == AK_OK)
+            r = add_channel(c, an, si, (int32_t)joint, tgt == AK_CHANNEL_TRANSLATION ? "translation"
+                                                       : tgt == AK_CHANNEL_ROTATION ? "rotation" : "scale");
+    }
+    for (size_t m = 0; m < c->scene->mesh_count && r == AK_OK; ++m) {
+        if (c->group_of_mesh[m] != (int32_t)m) continue; /* one channel per glTF mesh */
+        w_morph w;
+        if ((r = morph_sampler(c, clip, m, &w)) != AK_OK || !w.present) continue;
+        size_t tc = c->scene->meshes[m].mesh->morph_target_count, parts = is_cubic(w.interp) ? 3 : 1;
+        int si = -1;
+        r = add_sampler(c, an, w.times, w.keys, w.values, w.keys * parts * tc, 1, w.interp, &si);
+        if (r == AK_OK) r = add_channel(c, an, si, c->node_of_mesh[m], "weights");
+        morph_free(&w);
+    }
+    if (r == AK_OK && cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(an, "channels")) == 0) {
+        char msg[200];
+        snprintf(msg, sizeof msg, "glTF writer: clip %zu ('%s') has nothing glTF can hold; not written", ci,
+                 ak_clip_name(clip));
+        akp_log(c->logger, AK_LOG_WARN, msg);
+        cJSON_Delete(an);
+        return AK_OK;
+    }
+    if (r != AK_OK || !cJSON_AddItemToArray(c->animations, an)) {
+        cJSON_Delete(an);
+        return r != AK_OK ? r : oom(c);
+    }
+    return AK_OK;
+}
+
+/* ---- output ----------------------------------------------------------------------------- */
+
+static bool ends_with(const char* s, const char* suffix) {
+    size_t n = strlen(s), k = strlen(suffix);
+    if (n < k) return false;
+    for (size_t i = 0; i < k; ++i)
+        if ((s[n - k + i] | 0x20) != suffix[i]) return false;
+    return true;
+}
+
+static void put_u32(uint8_t* p, uint32_t v) {
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+    p[2] = (uint8_t)(v >> 16);
+    p[3] = (uint8_t)(v >> 24);
+}
+
+static ak_result write_bytes(w_ctx* c, const char* path, const void* a, size_t an, const void* b, size_t bn) {
+    FILE* f = fopen(path, "wb");
+    if (!f) {
+        akp_diag_set(c->diag, path, "cannot create file (%s)", strerror(errno));
+        return AK_ERR_IO;
+    }
+    bool ok = fwrite(a, 1, an, f) == an && (!bn || fwrite(b, 1, bn, f) == bn);
+    ok = (fclose(f) == 0) && ok;
+    if (!ok) {
+        remove(path);
+        akp_diag_set(c->diag, path, "cannot write file");
+        return AK_ERR_IO;
+    }
+    return AK_OK;
+}
+
+/* Percent-encode a file name for a URI (RFC 3986 unreserved characters kept). */
+static void uri_encode(const char* s, char* out, size_t cap) {
+    static const char hex[] = "0123456789ABCDEF";
+    size_t o = 0;
+    for (; *s && o + 4 < cap; ++s) {
+        unsigned char ch = (unsigned char)*s;
+        if ((ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '-' ||
+            ch == '_' || ch == '.' || ch == '~') {
+            out[o++] = (char)ch;
+        } else {
+            out[o++] = '%';
+            out[o++] = hex[ch >> 4];
+            out[o++] = hex[ch & 15];
+        }
+    }
+    out[o] = '\0';
+}
+
+static ak_result build_document(w_ctx* c) {
+    const ak_scene* s = c->scene;
+    c->root = cJSON_CreateObject();
+    if (!c->root) return oom(c);
+    cJSON* asset = cJSON_AddObjectToObject(c->root, "asset");
+    if (!asset) return oom(c);
+    cJSON_AddStringToObject(asset, "version", "2.0");
+    cJSON_AddStringToObject(asset, "generator", "animkit");
+    c->nodes = cJSON_CreateArray();
+    c->meshes = cJSON_CreateArray();
+    c->skins = cJSON_CreateArray();
+    c->animations = cJSON_CreateArray();
+    c->views = cJSON_CreateArray();
+    c->accessors = cJSON_CreateArray();
+    c->materials = cJSON_CreateArray();
+    size_t mc = s->mesh_count ? s->mesh_count : 1;
+    c->node_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
+    c->group_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
+    c->morph_base = (size_t*)calloc(mc, sizeof(size_t));
+    if (!c->nodes || !c->meshes || !c->skins || !c->animations || !c->views || !c->accessors || !c->materials ||
+        !c->node_of_mesh || !c->group_of_mesh || !c->morph_base)
+        return oom(c);
+    for (size_t m = 0; m < s->mesh_count; ++m) {
+        if (!s->meshes[m].mesh) return BAD(c, AK_ERR_NULL_ARG, "mesh %zu has no data", m);
+        if (s->meshes[m].skin >= (int32_t)s->skin_count || s->meshes[m].skin < -1 ||
+            s->meshes[m].node >= (int32_t)ak_scene_joint_count(s) || s->meshes[m].node < -1)
+            return BAD(c, AK_ERR_BAD_INDEX, "mesh %zu: skin %d or node %d out of range", m, (int)s->meshes[m].skin,
+                       (int)s->meshes[m].node);
+    }
+    WTRY(write_skeleton(c));
+    WTRY(write_skins(c));
+    WTRY(write_meshes(c));
+    for (size_t k = 0; k < s->clip_count; ++k)
+        if (s->clips[k]) WTRY(write_clip(c, s->clips[k], k));
+    /* attach the arrays in the order readers expect to find them; empty ones are left out */
+    if (c->n_nodes) {
+        cJSON* scenes = cJSON_AddArrayToObject(c->root, "scenes");
+        cJSON* sc = cJSON_CreateObject();
+        if (!scenes || !sc || !cJSON_AddItemToArray(scenes, sc)) return oom(c);
+        cJSON* roots = cJSON_AddArrayToObject(sc, "nodes");
+        if (!roots) return oom(c);
+        size_t i = 0;
+        bool* child = (bool*)calloc(c->n_nodes, sizeof(bool));
+        if (!child) return oom(c);
+        for (cJSON* n = c->nodes->child; n; n = n->next) {
+            cJSON* ch = cJSON_GetObjectItemCaseSensitive(n, "children");
+            for (cJSON* e = ch ? ch->child : NULL; e; e = e->next) child[(size_t)e->valuedouble] = true;
+        }
+        for (i = 0; i < c->n_nodes; ++i)
+            if (!child[i]) cJSON_AddItemToArray(roots, num((double)i));
+        free(child);
+        add_num(c->root, "scene", 0);
+    }
+    cJSON** arrays[] = {&c->nodes, &c->meshes, &c->materials, &c->skins, &c->animations, &c->accessors, &c->views};
+    const char* names[] = {"nodes", "meshes", "materials", "skins", "animations", "accessors", "bufferViews"};
+    for (size_t i = 0; i < 7; ++i) {
+        cJSON* a = *arrays[i];
+        *arrays[i] = NULL;
+        if (cJSON_GetArraySize(a) == 0) cJSON_Delete(a);
+        else if (!cJSON_AddItemToObject(c->root, names[i], a)) return cJSON_Delete(a), oom(c);
+    }
+    return AK_OK;
+}
+
+/* ---- public ---------------------------------------------------------------------------- */
+
+ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_desc* desc, ak_diag* diag) {
+    if (!path || !scene) {
+        akp_diag_set(diag, path, "path and scene are required");
+        return AK_ERR_NULL_ARG;
+    }
+    bool glb = ends_with(path, ".glb");
+    if (!glb && !ends_with(path, ".gltf")) {
+        akp_diag_set(diag, path, "the file name must end in .glb or .gltf");
+        return AK_ERR_BAD_ARG;
+    }
+    ak_logger none = {0};
+    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = desc ? &desc->logger : &none};
+    ak_result r = build_document(&c);
+    /* the file name of the .bin beside a .gltf: the .gltf's name with .bin */
+    char bin_path[4096] = "", bin_uri[4096] = "";
+    if (r == AK_OK && !glb && c.bin_size) {
+        size_t n = strlen(path);
+        if (n + 1 > sizeof bin_path) {
+            akp_diag_set(diag, path, "path is too long");
+            r = AK_ERR_BAD_ARG;
+        } else {
+            memcpy(bin_path, path, n - 5);
+            memcpy(bin_path + n - 5, ".bin", 5);
+            const char* base = strrchr(bin_path, '/');
+            uri_encode(base ? base + 1 : bin_path, bin_uri, sizeof bin_uri);
+        }
+    }
+    if (r == AK_OK && c.bin_size) {
+        cJSON* buffers = cJSON_AddArrayToObject(c.root, "buffers");
+        cJSON* b = cJSON_CreateObject();
+        if (!buffers || !b || !cJSON_AddItemToArray(buffers, b)) r = oom(&c);
+        else {
+            add_num(b, "byteLength", (double)c.bin_size);
+            if (!glb) cJSON_AddStringToObject(b, "uri", bin_uri);
+        }
+    }
+    char* json = NULL;
+    if (r == AK_OK && !(json = glb ? cJSON_PrintUnformatted(c.root) : cJSON_Print(c.root))) r = oom(&c);
+    if (r == AK_OK && glb) {
+        size_t jn = strlen(json), jpad = (jn + 3u) & ~(size_t)3u;
+        size_t total = 12 + 8 + jpad + (c.bin_size ? 8 + c.bin_size : 0);
+        if (total > UINT32_MAX) {
+            akp_diag_set(diag, path, "%zu bytes is more than a GLB file can hold", total);
+            r = AK_ERR_UNSUPPORTED;
+        } else {
+            uint8_t* head = (uint8_t*)malloc(12 + 8 + jpad + 8);
+            if (!head) r = oom(&c);
+            else {
+                put_u32(head, 0x46546C67u); /* "glTF" */
+                put_u32(head + 4, 2);
+                put_u32(head + 8, (uint32_t)total);
+                put_u32(head + 12, (uint32_t)jpad);
+                put_u32(head + 16, 0x4E4F534Au); /* "JSON" */
+                memcpy(head + 20, json, jn);
+                memset(head + 20 + jn, ' ', jpad - jn); /* JSON chunk padding: spaces */
+                size_t hn = 20 + jpad;
+                if (c.bin_size) { /* BIN: views are 4-byte padded with zeros, so is its end */
+                    put_u32(head + hn, (uint32_t)c.bin_size);
+                    put_u32(head + hn + 4, 0x004E4942u); /* "BIN\0" */
+                    hn += 8;
+                }
+                r = write_bytes(&c, path, head, hn, c.bin, c.bin_size);
+                free(head);
+            }
+        }
+    } else if (r == AK_OK) {
+        if (c.bin_size) r = write_bytes(&c, bin_path, c.bin, c.bin_size, NULL, 0);
+        if (r == AK_OK) {
+            r = write_bytes(&c, path, json, strlen(json), "\n", 1);
+            if (r != AK_OK && c.bin_size) remove(bin_path);
+        }
+    }
+    free(json);
+    cJSON_Delete(c.root);
+    cJSON_Delete(c.nodes);
+    cJSON_Delete(c.meshes);
+    cJSON_Delete(c.skins);
+    cJSON_Delete(c.animations);
+    cJSON_Delete(c.views);
+    cJSON_Delete(c.accessors);
+    cJSON_Delete(c.materials);
+    free(c.bin);
+    free(c.node_of_mesh);
+    free(c.group_of_mesh);
+    free(c.morph_base);
+    return r;
+}

@@ -1,0 +1,528 @@
+/* glTF writer (ak_io_save): round trips of every shared glTF asset (same sampled poses,
+ * morph weights and skinned vertices, compared with a double-precision reference skinning
+ * written here), STEP/CUBICSPLINE kept exactly, the Khronos validator on the output, bad
+ * input, and `animkit export -o OUT.glb|.gltf`. */
+#include <animkit/animkit.h>
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "ak_test.h"
+
+static char g_tmp[400];
+
+static const char* tmp_path(char* buf, size_t n, const char* name) {
+    snprintf(buf, n, "%s/%s", g_tmp, name);
+    return buf;
+}
+
+/* |a - b| <= 1e-6 relative (absolute near zero). */
+static bool close_rel(double a, double b, double scale) { return fabs(a - b) <= 1e-6 * (fabs(a) > scale ? fabs(a) : scale); }
+
+/* ---- scene comparison ------------------------------------------------------------------- */
+
+/* Posed vertices of scene mesh m (morphs, then skinning or the node's world matrix), in double. */
+static void pose_mesh(const ak_scene* s, size_t m, const ak_mat4* world, const float* weights, size_t wbase,
+                      double* out) {
+    const ak_scene_mesh* sm = &s->meshes[m];
+    const ak_mesh* mesh = sm->mesh;
+    ak_mat4* pal = NULL;
+    if (sm->skin >= 0) {
+        size_t jc = s->skins[sm->skin].joint_count;
+        pal = malloc(jc * sizeof *pal);
+        ak_scene_skin_palette(s, (size_t)sm->skin, (ak_mat4_cspan){world, ak_scene_joint_count(s)}, (ak_mat4_span){pal, jc});
+    }
+    for (size_t v = 0; v < mesh->vertex_count; ++v) {
+        double p[3] = {mesh->positions[v].x, mesh->positions[v].y, mesh->positions[v].z};
+        for (size_t t = 0; t < mesh->morph_target_count; ++t) {
+            const ak_vec3 d = mesh->morph_positions[t * mesh->vertex_count + v];
+            double w = weights[wbase + t];
+            p[0] += w * d.x, p[1] += w * d.y, p[2] += w * d.z;
+        }
+        double q[3] = {0, 0, 0};
+        if (pal && mesh->influence_count) {
+            for (uint32_t k = 0; k < mesh->influence_count; ++k) {
+                double w = mesh->weights[v * mesh->influence_count + k];
+                if (w == 0.0) continue;
+                const float* M = pal[mesh->joints[v * mesh->influence_count + k]].m;
+                for (int r = 0; r < 3; ++r) q[r] += w * (M[r] * p[0] + M[4 + r] * p[1] + M[8 + r] * p[2] + M[12 + r]);
+            }
+        } else if (sm->node >= 0) {
+            const float* M = world[sm->node].m;
+            for (int r = 0; r < 3; ++r) q[r] = M[r] * p[0] + M[4 + r] * p[1] + M[8 + r] * p[2] + M[12 + r];
+        } else {
+            memcpy(q, p, sizeof q);
+        }
+        memcpy(out + 3 * v, q, sizeof q);
+    }
+    free(pal);
+}
+
+static size_t total_weights(const ak_scene* s) {
+    size_t n = 0;
+    for (size_t m = 0; m < s->mesh_count; ++m) n += s->meshes[m].mesh->morph_target_count;
+    return n;
+}
+
+/* Pose of clip k at time t (rest pose / default weights first). */
+static void sample(const ak_scene* s, size_t k, float t, ak_transform* local, float* weights) {
+    size_t n = ak_scene_joint_count(s);
+    ak_scene_rest_pose(s, (ak_transform_span){local, n});
+    size_t w = 0;
+    for (size_t m = 0; m < s->mesh_count; ++m)
+        for (size_t i = 0; i < s->meshes[m].mesh->morph_target_count; ++i) weights[w++] = s->meshes[m].mesh->morph_weights[i];
+    if (k < s->clip_count)
+        ak_clip_sample(s->clips[k], t, NULL, (ak_transform_span){local, n}, (ak_f32_span){weights, w}, (ak_f32_span){0});
+}
+
+/* Compare scene b (written and read back) with a: every joint of a by name, every clip at
+ * times between keys and outside the range, weights, posed vertices. Returns failures. */
+static int compare_scenes_n(const ak_scene* a, const ak_scene* b, const char* what, size_t time_count) {
+    int bad = 0;
+    size_t na = ak_scene_joint_count(a), nb = ak_scene_joint_count(b);
+    AK_CHECK_MSG(nb >= na, "%s: %zu joints, was %zu", what, nb, na);
+    AK_CHECK_EQ(a->mesh_count, b->mesh_count);
+    AK_CHECK_EQ(a->clip_count, b->clip_count);
+    AK_CHECK_EQ(a->skin_count, b->skin_count);
+    if (nb < na || a->mesh_count != b->mesh_count || a->clip_count != b->clip_count) return 1;
+    int* map = malloc((na ? na : 1) * sizeof *map);
+    for (size_t j = 0; j < na; ++j) {
+        map[j] = ak_skeleton_find_joint(b->skeleton, ak_skeleton_joint_name(a->skeleton, j));
+        AK_CHECK_MSG(map[j] >= 0, "%s: joint %s lost", what, ak_skeleton_joint_name(a->skeleton, j));
+        if (map[j] < 0) bad = 1;
+    }
+    for (size_t m = 0; m < a->mesh_count && !bad; ++m) {
+        AK_CHECK_EQ(a->meshes[m].mesh->vertex_count, b->meshes[m].mesh->vertex_count);
+        AK_CHECK_EQ(a->meshes[m].mesh->morph_target_count, b->meshes[m].mesh->morph_target_count);
+        AK_CHECK_EQ(a->meshes[m].skin, b->meshes[m].skin);
+        AK_CHECK_EQ(a->meshes[m].has_material, b->meshes[m].has_material);
+        if (a->meshes[m].has_material && b->meshes[m].has_material)
+            AK_CHECK_MSG(!memcmp(&a->meshes[m].base_color, &b->meshes[m].base_color, sizeof(ak_vec4)),
+                         "%s mesh %zu: base colour differs", what, m);
+        if (a->meshes[m].mesh->vertex_count != b->meshes[m].mesh->vertex_count ||
+            a->meshes[m].mesh->morph_target_count != b->meshes[m].mesh->morph_target_count)
+            bad = 1;
+    }
+    size_t nw = total_weights(a);
+    ak_transform *la = malloc((na + 1) * sizeof *la), *lb = malloc((nb + 1) * sizeof *lb);
+    ak_mat4 *wa = malloc((na + 1) * sizeof *wa), *wb = malloc((nb + 1) * sizeof *wb);
+    float *ga = malloc((nw + 1) * sizeof(float)), *gb = malloc((nw + 1) * sizeof(float));
+    size_t clips = a->clip_count ? a->clip_count : 1;
+    for (size_t k = 0; k < clips && !bad; ++k) {
+        float d = k < a->clip_count ? ak_clip_duration(a->clips[k]) : 0.0f;
+        if (k < a->clip_count) AK_CHECK_NEAR(ak_clip_duration(b->clips[k]), d, 1e-6 * (d > 1 ? d : 1));
+        const float fr[] = {-0.5f, 0.013f, 0.37f, 0.77f, 1.0f, 1.5f}; /* before, between keys, end, after */
+        for (size_t ti = 0; ti < sizeof fr / sizeof fr[0] && ti < time_count && !bad; ++ti) {
+            float t = fr[ti] < 0 ? fr[ti] : fr[ti] * d + (fr[ti] > 1 ? 0.25f : 0.0f);
+            sample(a, k, t, la, ga);
+            sample(b, k, t, lb, gb);
+            for (size_t j = 0; j < na && !bad; ++j) {
+                ak_transform x = la[j], y = lb[map[j]];
+                float sgn = ak_quat_dot(x.rotation, y.rotation) < 0 ? -1.0f : 1.0f;
+                const float xa[10] = {x.translation.x, x.translation.y, x.translation.z, x.rotation.x, x.rotation.y,
+                                      x.rotation.z, x.rotation.w, x.scale.x, x.scale.y, x.scale.z};
+                const float ya[10] = {y.translation.x, y.translation.y, y.translation.z, sgn * y.rotation.x,
+                                      sgn * y.rotation.y, sgn * y.rotation.z, sgn * y.rotation.w, y.scale.x, y.scale.y, y.scale.z};
+                for (int c = 0; c < 10; ++c)
+                    if (!close_rel(xa[c], ya[c], 1.0)) {
+                        AK_FAIL_("%s clip %zu t=%g joint %s component %d: %.9g vs %.9g", what, k, t,
+                                 ak_skeleton_joint_name(a->skeleton, j), c, xa[c], ya[c]);
+                        bad = 1;
+                        break;
+                    }
+            }
+            for (size_t i = 0; i < nw && !bad; ++i)
+                if (!close_rel(ga[i], gb[i], 1.0)) {
+                    AK_FAIL_("%s clip %zu t=%g morph weight %zu: %.9g vs %.9g", what, k, t, i, ga[i], gb[i]);
+                    bad = 1;
+                }
+            if (na) ak_scene_world_matrices(a, (ak_transform_cspan){la, na}, (ak_mat4_span){wa, na});
+            if (nb) ak_scene_world_matrices(b, (ak_transform_cspan){lb, nb}, (ak_mat4_span){wb, nb});
+            size_t base = 0;
+            for (size_t m = 0; m < a->mesh_count && !bad; ++m) {
+                size_t nv = a->meshes[m].mesh->vertex_count;
+                double *pa = malloc(3 * nv * sizeof(double)), *pb = malloc(3 * nv * sizeof(double));
+                pose_mesh(a, m, wa, ga, base, pa);
+                pose_mesh(b, m, wb, gb, base, pb);
+                double scale = 1e-3;
+                for (size_t i = 0; i < 3 * nv; ++i) scale = fabs(pa[i]) > scale ? fabs(pa[i]) : scale;
+                for (size_t i = 0; i < 3 * nv; ++i)
+                    if (!close_rel(pa[i], pb[i], scale)) {
+                        AK_FAIL_("%s clip %zu t=%g mesh %zu vertex %zu: %.9g vs %.9g", what, k, t, m, i / 3, pa[i], pb[i]);
+                        bad = 1;
+                        break;
+                    }
+                base += a->meshes[m].mesh->morph_target_count;
+                free(pa);
+                free(pb);
+            }
+        }
+    }
+    free(map), free(la), free(lb), free(wa), free(wb), free(ga), free(gb);
+    return bad;
+}
+
+static int compare_scenes(const ak_scene* a, const ak_scene* b, const char* what) { return compare_scenes_n(a, b, what, 6); }
+
+/* ---- the validator ---------------------------------------------------------------------- */
+
+/* Files written by the tests, validated together at the end (node starts once). */
+static char g_written[64][1024];
+static int g_written_count;
+
+static void queue_validate(const char* file) {
+    if (g_written_count < 64) snprintf(g_written[g_written_count++], sizeof g_written[0], "%s", file);
+}
+
+/* Run the validator on every queued file: each must have 0 errors and 0 warnings.
+ * SKIP when node or build-tools/node_modules/gltf-validator is absent. */
+AK_TEST(validator) {
+    char mod[1024];
+    snprintf(mod, sizeof mod, "%s/build-tools/node_modules/gltf-validator", AK_SOURCE_DIR);
+    struct stat st;
+    if (stat(mod, &st) != 0 || system("node --version >/dev/null 2>&1") != 0) {
+        AK_SKIP("glTF validator absent (needs node and %s; scripts/install-deps.sh installs it when npm is "
+                "available): %d written files not validated", mod, g_written_count);
+        return;
+    }
+    AK_CHECK(g_written_count > 0);
+    size_t cap = 1024 + (size_t)g_written_count * 1040;
+    char* cmd = malloc(cap);
+    int o = snprintf(cmd, cap, "NODE_PATH='%s/build-tools/node_modules' node '%s/scripts/gltf_validate.js'",
+                     AK_SOURCE_DIR, AK_SOURCE_DIR);
+    for (int i = 0; i < g_written_count; ++i) o += snprintf(cmd + o, cap - (size_t)o, " '%s'", g_written[i]);
+    snprintf(cmd + o, cap - (size_t)o, " 2>&1");
+    FILE* p = popen(cmd, "r");
+    free(cmd);
+    AK_CHECK(p != NULL);
+    if (!p) return;
+    char line[1024];
+    int files = 0;
+    while (fgets(line, sizeof line, p)) {
+        int errors = -1, warnings = -1;
+        if (line[0] != ' ' && sscanf(line, "%d %d", &errors, &warnings) == 2) {
+            ++files;
+            AK_CHECK_MSG(errors == 0 && warnings == 0, "validator: %s", line);
+        } else {
+            printf("%s", line);
+        }
+    }
+    pclose(p);
+    AK_CHECK_EQ(files, g_written_count);
+    printf("  gltf-validator: %d files, 0 errors, 0 warnings expected each\n", files);
+}
+
+/* ---- tests ------------------------------------------------------------------------------ */
+
+static const ak_io_desc k_load = {.max_influences = 8};
+
+AK_TEST(round_trip_assets) {
+    const char* dir = ak_test_assets_dir();
+    char gdir[1100];
+    if (!dir) {
+        AK_SKIP("no glTF assets (set ANIMKIT_ASSETS or provide ../shared/assets)");
+        return;
+    }
+    snprintf(gdir, sizeof gdir, "%s/gltf", dir);
+    DIR* d = opendir(gdir);
+    if (!d) {
+        AK_SKIP("%s absent", gdir);
+        return;
+    }
+    int done = 0;
+    struct dirent* e;
+    while ((e = readdir(d)) != NULL) {
+        if (e->d_name[0] == '.') continue;
+        const char* variants[] = {"glTF-Binary", "glTF"};
+        const char* exts[] = {"glb", "gltf"};
+        char src[2048] = "";
+        struct stat st;
+        for (int v = 0; v < 2 && !src[0]; ++v) {
+            snprintf(src, sizeof src, "%s/%s/%s/%s.%s", gdir, e->d_name, variants[v], e->d_name, exts[v]);
+            if (stat(src, &st) != 0) src[0] = '\0';
+        }
+        if (!src[0]) continue;
+        ak_scene* a = NULL;
+        ak_diag diag;
+        ak_result r = ak_io_load(src, &k_load, NULL, &a, &diag);
+        AK_CHECK_MSG(r == AK_OK, "%s: %s", src, diag.message);
+        if (r != AK_OK) continue;
+        for (int f = 0; f < 2; ++f) {
+            char out[1024], name[300];
+            snprintf(name, sizeof name, "%s.%s", e->d_name, f ? "gltf" : "glb");
+            tmp_path(out, sizeof out, name);
+            r = ak_io_save(out, a, NULL, &diag);
+            AK_CHECK_MSG(r == AK_OK, "save %s: %s (%s)", out, diag.message, ak_result_string(r));
+            if (r != AK_OK) continue;
+            ak_scene* b = NULL;
+            r = ak_io_load(out, &k_load, NULL, &b, &diag);
+            AK_CHECK_MSG(r == AK_OK, "reload %s: %s", out, diag.message);
+            if (r == AK_OK) {
+                /* .gltf holds the same buffer as .glb: 3 times keep valgrind runs short */
+                AK_CHECK_MSG(compare_scenes_n(a, b, name, f ? 3 : 6) == 0, "%s round trip differs", name);
+                ++done;
+            }
+            ak_scene_destroy(b);
+            queue_validate(out);
+        }
+        ak_scene_destroy(a);
+    }
+    closedir(d);
+    AK_CHECK(done > 0);
+    printf("  %d round trips\n", done);
+}
+
+/* A hand-made scene: 6 joints, one skinned mesh with 6 influences (JOINTS_1) and 2 morph
+ * targets, and a clip with STEP, LINEAR, CUBICSPLINE (translation, rotation, weights) and
+ * HERMITE channels. */
+static ak_scene* make_scene(ak_interp rot_interp) {
+    ak_scene* s = NULL;
+    if (ak_scene_alloc(1, 1, 1, NULL, &s) != AK_OK) return NULL;
+    snprintf(s->name, sizeof s->name, "handmade");
+    ak_joint_desc j[6] = {
+        {.name = "root", .parent = -1, .rest = ak_transform_identity()},
+        {.name = "a", .parent = 0, .rest = ak_transform_make(ak_vec3_make(1, 0, 0), ak_quat_identity(), ak_vec3_make(1, 1, 1))},
+        {.name = "b", .parent = 1, .rest = ak_transform_make(ak_vec3_make(1, 0, 0), ak_quat_identity(), ak_vec3_make(1, 1, 1))},
+        {.name = "c", .parent = 0, .rest = ak_transform_make(ak_vec3_make(-1, 0, 0), ak_quat_identity(), ak_vec3_make(1, 1, 1))},
+        {.name = "mid", .parent = 3, .rest = ak_transform_make(ak_vec3_make(0, 1, 0), ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.3f), ak_vec3_make(1, 1, 1))},
+        {.name = "tip", .parent = 4, .rest = ak_transform_make(ak_vec3_make(0, 1, 0), ak_quat_identity(), ak_vec3_make(1, 2, 1))},
+    };
+    ak_skeleton_create(&(ak_skeleton_desc){.joints = j, .joint_count = 6, .palette_from_skins = true}, NULL, &s->skeleton, NULL);
+    ak_mesh_desc md = {.vertex_count = 4, .triangle_count = 2, .influence_count = 6, .morph_target_count = 2,
+                       .has_normals = true, .has_uvs = true, .has_morph_normals = true, .name = "quad"};
+    ak_mesh_create(&md, NULL, &s->meshes[0].mesh);
+    ak_mesh* m = s->meshes[0].mesh;
+    for (size_t v = 0; v < 4; ++v) {
+        m->positions[v] = ak_vec3_make((float)(v & 1), (float)(v >> 1) * 2.0f, 0.1f * (float)v);
+        m->normals[v] = ak_vec3_make(0, 0, 1);
+        m->uvs[v] = ak_vec2_make((float)(v & 1), (float)(v >> 1));
+        for (uint32_t k = 0; k < 6; ++k) {
+            m->joints[v * 6 + k] = (uint16_t)k;
+            m->weights[v * 6 + k] = k < 3 ? 0.25f : 0.25f / 3.0f;
+        }
+        m->morph_positions[v] = ak_vec3_make(0.5f, 0, 0);
+        m->morph_positions[4 + v] = ak_vec3_make(0, 0, (float)v);
+        m->morph_normals[v] = ak_vec3_make(0, 0.1f, 0);
+    }
+    const uint32_t idx[6] = {0, 1, 3, 0, 3, 2};
+    memcpy(m->indices, idx, sizeof idx);
+    m->morph_weights[0] = 0.25f;
+    snprintf(m->morph_names[0], AK_NAME_SIZE, "wide");
+    snprintf(m->morph_names[1], AK_NAME_SIZE, "deep");
+    s->meshes[0].node = -1;
+    s->meshes[0].skin = 0;
+    ak_scene_skin_alloc(s, 0, 6);
+    ak_mat4_cspan ib = ak_skeleton_inverse_binds(s->skeleton);
+    for (int k = 0; k < 6; ++k) s->skins[0].joints[k] = k, s->skins[0].inverse_binds[k] = ib.ptr[k];
+    static const float t3[3] = {0.0f, 0.4f, 1.0f};
+    static const float step_v[9] = {0, 0, 0, 1, 2, 3, -1, 0.5f, 2};
+    /* CUBICSPLINE: (in, value, out) x 3 keys */
+    static const float cub_v[27] = {0, 0, 0, 0, 1, 0, 1, 0, 0, -2, 0, 0, 0, 2, 0, 0, 0, 3, 1, 1, 1, 0, 0, 0, 0, 0, 0};
+    static float rot_v[36];
+    for (int k = 0; k < 3; ++k) {
+        ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.7f * (float)k);
+        float* o = rot_v + 12 * k;
+        o[0] = 0.1f, o[1] = 0.2f, o[2] = 0, o[3] = 0;             /* in-tangent */
+        o[4] = q.x, o[5] = q.y, o[6] = q.z, o[7] = q.w;            /* value */
+        o[8] = 0, o[9] = -0.3f, o[10] = 0.05f, o[11] = 0;          /* out-tangent */
+    }
+    static float rot_lin[12];
+    for (int k = 0; k < 3; ++k) memcpy(rot_lin + 4 * k, rot_v + 12 * k + 4, 4 * sizeof(float));
+    static const float w_v[18] = {0, 0, 0.2f, 0.8f, 1, -1, 0.5f, 0.5f, 0.7f, 0.1f, 0, 0, 0, 0, 1, 0, 0, 0};
+    static const float sc_v[27] = {0, 0, 0, 1, 1, 1, 0.5f, 0, 0, 0, 0, 0, 2, 1, 1, 0, 0, 0, 0, 0, 0, 1, 1, 3, 0, 1, 0};
+    bool cubic_rot = rot_interp == AK_INTERP_CUBICSPLINE;
+    ak_raw_channel ch[5] = {
+        {.target = AK_CHANNEL_TRANSLATION, .index = 0, .interp = AK_INTERP_STEP, .key_count = 3, .times = t3, .values = step_v},
+        {.target = AK_CHANNEL_TRANSLATION, .index = 4, .interp = AK_INTERP_CUBICSPLINE, .key_count = 3, .times = t3, .values = cub_v},
+        {.target = AK_CHANNEL_ROTATION, .index = 5, .interp = rot_interp, .key_count = 3, .times = t3, .values = cubic_rot ? rot_v : rot_lin},
+        {.target = AK_CHANNEL_MORPH_WEIGHTS, .index = 0, .component_count = 2, .interp = AK_INTERP_CUBICSPLINE, .key_count = 3, .times = t3, .values = w_v},
+        {.target = AK_CHANNEL_SCALE, .index = 5, .interp = AK_INTERP_HERMITE, .key_count = 3, .times = t3, .values = sc_v},
+    };
+    ak_raw_clip raw = {.name = "mix", .channels = ch, .channel_count = 5, .joint_count = 6, .morph_weight_count = 2};
+    if (ak_clip_build(&raw, NULL, &s->clips[0], NULL) != AK_OK) {
+        ak_scene_destroy(s);
+        return NULL;
+    }
+    return s;
+}
+
+AK_TEST(interpolation_kept) {
+    ak_scene* a = make_scene(AK_INTERP_CUBICSPLINE);
+    AK_CHECK(a != NULL);
+    if (!a) return;
+    char out[1024];
+    for (int f = 0; f < 2; ++f) {
+        tmp_path(out, sizeof out, f ? "handmade.gltf" : "handmade.glb");
+        ak_diag diag;
+        ak_result r = ak_io_save(out, a, NULL, &diag);
+        AK_CHECK_MSG(r == AK_OK, "%s", diag.message);
+        ak_scene* b = NULL;
+        r = ak_io_load(out, &k_load, NULL, &b, &diag);
+        AK_CHECK_MSG(r == AK_OK, "%s", diag.message);
+        if (!b) continue;
+        AK_CHECK_EQ(compare_scenes(a, b, out), 0);
+        AK_CHECK(b->meshes[0].mesh->influence_count >= 6u); /* JOINTS_1 read back as 8 slots */
+        AK_CHECK_STREQ(b->meshes[0].mesh->morph_names[1], "deep");
+        AK_CHECK_NEAR(b->meshes[0].mesh->morph_weights[0], 0.25, 0);
+        /* every channel: same interpolation (HERMITE is written as CUBICSPLINE, the same
+         * curve), same key times, values and tangents, bit for bit */
+        const ak_clip* ca = a->clips[0];
+        const ak_clip* cb = b->clips[0];
+        AK_CHECK_EQ(ak_clip_channel_count(cb), ak_clip_channel_count(ca));
+        for (size_t i = 0; i < ak_clip_channel_count(ca); ++i) {
+            size_t jb = SIZE_MAX;
+            for (size_t k = 0; k < ak_clip_channel_count(cb); ++k)
+                if (ak_clip_channel_target(cb, k) == ak_clip_channel_target(ca, i) &&
+                    ak_clip_channel_index(cb, k) == ak_clip_channel_index(ca, i))
+                    jb = k;
+            AK_CHECK(jb != SIZE_MAX);
+            if (jb == SIZE_MAX) continue;
+            ak_interp ia = ak_clip_channel_interp(ca, i);
+            AK_CHECK_EQ(ak_clip_channel_interp(cb, jb), ia == AK_INTERP_HERMITE ? AK_INTERP_CUBICSPLINE : ia);
+            const ak_track* ta = ak_clip_channel_track(ca, i);
+            const ak_track* tb = ak_clip_channel_track(cb, jb);
+            AK_CHECK_EQ(ak_track_key_count(tb), ak_track_key_count(ta));
+            for (size_t k = 0; k < ak_track_key_count(ta) && k < ak_track_key_count(tb); ++k) {
+                float va[3][4], vb[3][4];
+                ak_track_key(ta, k, (ak_f32_span){va[0], 4}, (ak_f32_span){va[1], 4}, (ak_f32_span){va[2], 4});
+                ak_track_key(tb, k, (ak_f32_span){vb[0], 4}, (ak_f32_span){vb[1], 4}, (ak_f32_span){vb[2], 4});
+                AK_CHECK_EQ(ak_track_times(ta).ptr[k], ak_track_times(tb).ptr[k]);
+                for (uint32_t c = 0; c < ak_track_component_count(ta); ++c)
+                    for (int p = 0; p < 3; ++p) AK_CHECK_EQ(va[p][c], vb[p][c]);
+            }
+        }
+        ak_scene_destroy(b);
+        queue_validate(out);
+    }
+    ak_scene_destroy(a);
+}
+
+AK_TEST(bad_input) {
+    ak_scene* a = make_scene(AK_INTERP_CUBICSPLINE);
+    ak_diag diag;
+    char out[1024];
+    AK_CHECK_EQ(ak_io_save(NULL, a, NULL, &diag), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_io_save(tmp_path(out, sizeof out, "x.glb"), NULL, NULL, &diag), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_io_save(tmp_path(out, sizeof out, "x.obj"), a, NULL, &diag), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_io_save("/nonexistent-dir/x.glb", a, NULL, &diag), AK_ERR_IO);
+    AK_CHECK(strstr(diag.message, "cannot create") != NULL);
+    /* a mesh naming a skin the scene lacks */
+    a->meshes[0].skin = 3;
+    AK_CHECK_EQ(ak_io_save(tmp_path(out, sizeof out, "badskin.glb"), a, NULL, &diag), AK_ERR_BAD_INDEX);
+    a->meshes[0].skin = 0;
+    /* a NaN position: nothing written */
+    a->meshes[0].mesh->positions[2].y = NAN;
+    tmp_path(out, sizeof out, "nan.glb");
+    AK_CHECK_EQ(ak_io_save(out, a, NULL, &diag), AK_ERR_BAD_DATA);
+    struct stat st;
+    AK_CHECK(stat(out, &st) != 0);
+    ak_scene_destroy(a);
+    /* NLERP rotations have no glTF form */
+    a = make_scene(AK_INTERP_NLERP);
+    AK_CHECK(a != NULL);
+    if (a) {
+        AK_CHECK_EQ(ak_io_save(tmp_path(out, sizeof out, "nlerp.glb"), a, NULL, &diag), AK_ERR_UNSUPPORTED);
+        AK_CHECK(strstr(diag.message, "nlerp") != NULL);
+    }
+    ak_scene_destroy(a);
+}
+
+AK_TEST(builtin_round_trip) {
+    const char* names[] = {"humanoid", "cylinder"};
+    for (int i = 0; i < 2; ++i) {
+        ak_scene* a = NULL;
+        if (ak_builtin_create(names[i], NULL, NULL, &a) != AK_OK) {
+            AK_FAIL_("builtin %s", names[i]);
+            continue;
+        }
+        char out[1024], name[64];
+        snprintf(name, sizeof name, "builtin_%s.glb", names[i]);
+        ak_diag diag;
+        AK_CHECK_EQ(ak_io_save(tmp_path(out, sizeof out, name), a, NULL, &diag), AK_OK);
+        ak_scene* b = NULL;
+        AK_CHECK_EQ(ak_io_load(out, &k_load, NULL, &b, &diag), AK_OK);
+        if (b) AK_CHECK_EQ(compare_scenes(a, b, name), 0);
+        queue_validate(out);
+        ak_scene_destroy(a);
+        ak_scene_destroy(b);
+    }
+}
+
+/* BVH motion capture (Euler channels, no mesh) written as glTF: the same poses. */
+AK_TEST(bvh_round_trip) {
+    char src[1200];
+    if (!ak_test_asset(src, sizeof src, "bvh/02_01.bvh")) {
+        AK_SKIP("bvh/02_01.bvh absent");
+        return;
+    }
+    ak_scene *a = NULL, *b = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(src, NULL, NULL, &a, &diag), AK_OK);
+    char out[1024];
+    tmp_path(out, sizeof out, "02_01.glb");
+    if (a) AK_CHECK_EQ(ak_io_save(out, a, NULL, &diag), AK_OK);
+    AK_CHECK_EQ(ak_io_load(out, NULL, NULL, &b, &diag), AK_OK);
+    if (a && b) AK_CHECK_EQ(compare_scenes(a, b, "02_01.bvh"), 0);
+    queue_validate(out);
+    ak_scene_destroy(a);
+    ak_scene_destroy(b);
+}
+
+#ifdef AK_CLI_PATH
+AK_TEST(cli_export) {
+    char out[1024], cmd[4096];
+    const char* exts[] = {"glb", "gltf"};
+    for (int f = 0; f < 2; ++f) {
+        char name[64];
+        snprintf(name, sizeof name, "cli_humanoid.%s", exts[f]);
+        tmp_path(out, sizeof out, name);
+        snprintf(cmd, sizeof cmd, "'%s' export builtin:humanoid -o '%s' >/dev/null 2>&1", AK_CLI_PATH, out);
+        AK_CHECK_EQ(system(cmd), 0);
+        ak_scene* b = NULL;
+        ak_diag diag;
+        AK_CHECK_EQ(ak_io_load(out, NULL, NULL, &b, &diag), AK_OK);
+        ak_scene* a = NULL;
+        ak_builtin_create("humanoid", NULL, NULL, &a);
+        if (a && b) {
+            AK_CHECK_EQ(ak_scene_joint_count(b) >= ak_scene_joint_count(a), true);
+            AK_CHECK_EQ(b->clip_count, a->clip_count);
+        }
+        ak_scene_destroy(a);
+        ak_scene_destroy(b);
+        queue_validate(out);
+    }
+    /* OBJ stays OBJ */
+    tmp_path(out, sizeof out, "cli_humanoid.obj");
+    snprintf(cmd, sizeof cmd, "'%s' export builtin:humanoid -o '%s' >/dev/null 2>&1", AK_CLI_PATH, out);
+    AK_CHECK_EQ(system(cmd), 0);
+    FILE* fp = fopen(out, "r");
+    char line[256] = "";
+    AK_CHECK(fp && fgets(line, sizeof line, fp) && strncmp(line, "# animkit OBJ", 13) == 0);
+    if (fp) fclose(fp);
+}
+#endif
+
+int main(void) {
+    snprintf(g_tmp, sizeof g_tmp, "%s/test_io_write.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    if (!mkdtemp(g_tmp)) {
+        perror("mkdtemp");
+        return 1;
+    }
+    AK_RUN(round_trip_assets);
+    AK_RUN(interpolation_kept);
+    AK_RUN(bad_input);
+    AK_RUN(builtin_round_trip);
+    AK_RUN(bvh_round_trip);
+#ifdef AK_CLI_PATH
+    AK_RUN(cli_export);
+#endif
+    AK_RUN(validator);
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_tmp);
+    if (system(cmd) != 0) printf("could not remove %s\n", g_tmp);
+    return ak_test_finish();
+}
