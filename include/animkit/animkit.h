@@ -27,5 +27,6 @@
 #include "noise.h"
 #include "terrain.h"
 #include "grid.h"
+#include "fluid.h"
 
 #endif
