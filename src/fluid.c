@@ -458,7 +458,7 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
     }
 }
 
-/* PBF: v = (x* - x) / dt, then vorticity omega_i = sum_j v_ij x grad_j W_ij. */
+/* PBF: v = (x* - x) / dt; vorticity omega_i = sum_j (m / rho_j) v_ij x grad_j W_ij (1/s). */
 static void ph_velocity(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     const float inv_dt = 1.0f / c->dt;
@@ -475,7 +475,7 @@ static void ph_vorticity(ctx* c, size_t b, size_t e, uint32_t t) {
             ak_vec3 vij = ak_vec3_sub(c->v[j], c->v[i]);
             /* grad_{p_j} W(p_i - p_j) = -grad W(p_i - p_j) */
             ak_vec3 g = ak_vec3_neg(ak_fluid_spiky_grad(ak_vec3_sub(c->xp[i], c->xp[j]), c->h));
-            w = ak_vec3_add(w, ak_vec3_cross(vij, g));
+            if (c->rho[j] > 0.0f) w = ak_vec3_add(w, ak_vec3_scale(ak_vec3_cross(vij, g), c->m / c->rho[j]));
         }
         c->omega[i] = w;
     }
@@ -586,6 +586,20 @@ static void ph_flags(ctx* c, size_t b, size_t e, uint32_t t) {
         else if (boundary_distance(c, c->xp[i]) >= c->h) f |= AK_FLUID_FLAG_FULL;
         c->flags[i] = f;
     }
+}
+
+/* A full neighbourhood also needs every neighbour away from the free surface. */
+static void ph_full(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        if (!(c->flags[i] & AK_FLUID_FLAG_FULL)) continue;
+        const uint32_t* nb = c->nb + i * c->K;
+        bool full = true;
+        for (uint32_t q = 0; q < c->nb_count[i] && full; ++q) full = !(c->flags[nb[q]] & AK_FLUID_FLAG_SURFACE);
+        c->lambda[i] = full ? 1.0f : 0.0f;
+    }
+    for (size_t i = b; i < e; ++i)
+        if ((c->flags[i] & AK_FLUID_FLAG_FULL) && c->lambda[i] == 0.0f) c->flags[i] = 0;
 }
 
 static double now_seconds(void) {
@@ -729,6 +743,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
         if (job->out_pressures.ptr) memcpy(job->out_pressures.ptr, c->pres, n * sizeof(float));
     }
     parallel(c, ph_flags, threads);
+    parallel(c, ph_full, threads);
 
     /* blow-up check, statistics */
     const float limit = 100.0f * c->h;

@@ -159,7 +159,7 @@ AK_TEST(hydrostatic_column_pressure_is_linear) {
 
 static void dam_desc(ak_fluid_desc* d, float* s) {
     *d = (ak_fluid_desc){.solver = AK_FLUID_PBF, .particle_mass = 0.001f, .gravity = {0, -9.81f, 0},
-                         .xsph_c = 0.01f, .vorticity_epsilon = 0.0f, .iterations = 6};
+                         .xsph_c = 0.01f, .vorticity_epsilon = 0.0f, .iterations = 4};
     *s = ak_fluid_rest_spacing(d);
     d->h = 2.0f * *s;
 }
@@ -169,22 +169,23 @@ AK_TEST(pbf_dam_break_settles_and_stays_in_box) {
     float s;
     dam_desc(&d, &s);
     d.box_min = ak_vec3_make(0, 0, 0);
-    d.box_max = ak_vec3_make(16 * s, 20 * s, 8 * s);
-    enum { CAP = 8 * 10 * 8 };
+    d.box_max = ak_vec3_make(10 * s, 24 * s, 8 * s);
+    enum { CAP = 6 * 16 * 8 };
     ak_vec3 pos[CAP], vel[CAP];
-    size_t n = ak_fluid_fill_box(&d, d.box_min, ak_vec3_make(8 * s, 10 * s, 8 * s), (ak_vec3_span)AK_SPAN(pos));
+    size_t n = ak_fluid_fill_box(&d, d.box_min, ak_vec3_make(6 * s, 16 * s, 8 * s), (ak_vec3_span)AK_SPAN(pos));
     AK_CHECK_EQ(n, CAP);
     memset(vel, 0, sizeof vel);
     size_t bytes = ak_fluid_scratch_size(n, &d);
     void* mem = malloc(bytes);
     ak_fluid_stats st = {0};
-    ak_fluid_step_job job = {.desc = &d, .dt = 1.0f / 120.0f, .positions = {pos, n}, .velocities = {vel, n},
+    /* 1 cm particles: 1/400 s steps (a particle falls less than a spacing per step) */
+    ak_fluid_step_job job = {.desc = &d, .dt = 1.0f / 400.0f, .positions = {pos, n}, .velocities = {vel, n},
                              .particle_count = &n, .scratch = {mem, bytes}, .out_stats = &st};
     bool inside = true;
     ak_result r = AK_OK;
-    for (int step = 0; step < 300 && r == AK_OK; ++step) {
+    for (int step = 0; step < 400 && r == AK_OK; ++step) {
         r = ak_fluid_step_run(&job);
-        if (getenv("FLUID_DEBUG")) printf("step %d r %d mean %.4f max %.4f full %zu surf %zu vmax?\n", step, r, st.mean_density_error, st.max_density_error, st.full_count, st.surface_count);
+        if (getenv("FLUID_DEBUG")) printf("step %d r %d mean %.4f max %.4f full %zu surf %zu\n", step, r, st.mean_density_error, st.max_density_error, st.full_count, st.surface_count);
         inside = inside && inside_box(pos, n, d.box_min, d.box_max);
     }
     AK_CHECK_EQ(r, AK_OK);
@@ -192,10 +193,10 @@ AK_TEST(pbf_dam_break_settles_and_stays_in_box) {
     AK_CHECK_MSG(st.full_count > 20, "%zu full particles", st.full_count);
     AK_CHECK_MSG(st.mean_density_error < 0.01f, "mean density error %.4f (max %.4f)", st.mean_density_error,
                  st.max_density_error);
-    /* it spread: the block was 8s wide, the box is 16s */
+    /* it spread: the block was 6s wide, the box is 10s */
     float maxx = 0;
     for (size_t i = 0; i < n; ++i) maxx = fmaxf(maxx, pos[i].x);
-    AK_CHECK(maxx > 12 * s);
+    AK_CHECK(maxx > 9 * s);
     free(mem);
 }
 
@@ -263,7 +264,7 @@ AK_TEST(colliders_never_leak) {
     ak_fluid_collider cols[3] = {
         {.shape = AK_FLUID_SPHERE, .a = {10 * s, 8 * s, 10 * s}, .radius = 4 * s},
         {.shape = AK_FLUID_CAPSULE, .a = {2 * s, 3 * s, 5 * s}, .b = {18 * s, 3 * s, 5 * s}, .radius = 2 * s},
-        {.shape = AK_FLUID_SPHERE, .a = {0, 4 * s, 15 * s}, .radius = 3 * s, .velocity = {0.5f, 0, 0}},
+        {.shape = AK_FLUID_SPHERE, .a = {4 * s, 4 * s, 15 * s}, .radius = 3 * s, .velocity = {0.2f, 0, 0}},
     };
     enum { CAP = 600 };
     ak_vec3 pos[CAP], vel[CAP];
@@ -272,11 +273,11 @@ AK_TEST(colliders_never_leak) {
     memset(vel, 0, sizeof vel);
     size_t bytes = ak_fluid_scratch_size(CAP, &d);
     void* mem = malloc(bytes);
-    const float dt = 1.0f / 120.0f;
+    const float dt = 1.0f / 400.0f;
     ak_fluid_step_job job = {.desc = &d, .dt = dt, .positions = {pos, CAP}, .velocities = {vel, CAP},
                              .particle_count = &n, .colliders = {cols, 3}, .scratch = {mem, bytes}};
     bool ok = true;
-    for (int k = 0; k < 120; ++k) {
+    for (int k = 0; k < 200; ++k) {
         AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
         ok = ok && inside_box(pos, n, d.box_min, d.box_max);
         for (size_t i = 0; i < n; ++i) {
@@ -286,7 +287,10 @@ AK_TEST(colliders_never_leak) {
             t = t < 0 ? 0 : t > 1 ? 1 : t;
             ak_vec3 q = ak_vec3_add(cols[1].a, ak_vec3_scale(ak_vec3_sub(cols[1].b, cols[1].a), t));
             float d1 = ak_vec3_distance(pos[i], q) - cols[1].radius;
-            if (d0 < -1e-4f * s || d1 < -1e-4f * s || d2 < -1e-4f * s) ok = false;
+            if (d0 < -1e-4f * s || d1 < -1e-4f * s || d2 < -1e-4f * s) {
+                if (ok) printf("  step %d particle %zu inside: %g %g %g\n", k, i, d0, d1, d2);
+                ok = false;
+            }
         }
         cols[2].a.x += cols[2].velocity.x * dt;
     }
@@ -301,7 +305,7 @@ AK_TEST(emitter_and_sink) {
     d.gravity = ak_vec3_make(0, 0, 0);
     /* a disc of radius 1.2 s holds the 9 lattice points with a^2 + b^2 <= 1.44: (0,0), 4 axis, 4 diagonal */
     ak_fluid_emitter em = {.position = {0, 0, 0}, .direction = {0, 0, 1}, .radius = 1.5f * s, .speed = 1.0f};
-    ak_fluid_sink sink = {.min = {-1, -1, 20 * s}, .max = {1, 1, 1}};
+    ak_fluid_sink sink = {.min = {-1, -1, 20 * s}, .max = {1, 1, 10}};
     enum { CAP = 2000 };
     static ak_vec3 pos[CAP], vel[CAP];
     size_t n = 0;
@@ -326,7 +330,7 @@ AK_TEST(emitter_and_sink) {
     job.sinks = (ak_fluid_sink_cspan){&sink, 1};
     job.emitters = (ak_fluid_emitter_cspan){NULL, 0};
     size_t removed = 0;
-    for (int k = 0; k < 200; ++k) {
+    for (int k = 0; k < 800; ++k) {
         AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
         removed += st.removed_count;
     }
@@ -348,7 +352,7 @@ static void run_threads(uint32_t threads, ak_fluid_solver solver, ak_vec3* pos, 
     memset(vel, 0, cap * sizeof *vel);
     size_t bytes = ak_fluid_scratch_size(n, &d);
     void* mem = malloc(bytes);
-    ak_fluid_step_job job = {.desc = &d, .dt = solver == AK_FLUID_PBF ? 1.0f / 120.0f : 2e-4f,
+    ak_fluid_step_job job = {.desc = &d, .dt = solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f,
                              .positions = {pos, n}, .velocities = {vel, n}, .particle_count = &n,
                              .thread_count = threads, .scratch = {mem, bytes}};
     for (int k = 0; k < 6; ++k) AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);

@@ -44,8 +44,8 @@
  * lattice neighbourhood) for rendering, and can report density statistics.
  *
  * Density error (ak_fluid_stats): |rho_i / rho_0 - 1| over particles with a full
- * neighbourhood, meaning not flagged as surface and at least h from the box walls and every
- * collider (particles near the free surface or a wall lack neighbours by construction).
+ * neighbourhood, meaning neither it nor any of its neighbours is flagged as surface, and it is
+ * at least h from the box walls and every collider (particles near the free surface or a wall lack neighbours by construction).
  *
  * What it does NOT do: two-way coupling (colliders are driven, never pushed), surface tension,
  * multiple fluids, adaptive time steps, or surface reconstruction (the CLI meshes density).
