@@ -122,5 +122,6 @@ int cmd_skin(int argc, char** argv);
 int cmd_ik(int argc, char** argv);
 int cmd_noise(int argc, char** argv);
 int cmd_terrain(int argc, char** argv);
+int cmd_fluid(int argc, char** argv);
 
 #endif

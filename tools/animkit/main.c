@@ -21,6 +21,7 @@ static const command commands[] = {
     {"ik", cmd_ik, "solve inverse kinematics for a joint chain"},
     {"noise", cmd_noise, "evaluate Perlin, simplex, value or Worley noise (or a fractal sum) at a point"},
     {"terrain", cmd_terrain, "generate a fractal terrain: OBJ, 16-bit PNG heightmap, render or GIF flight"},
+    {"fluid", cmd_fluid, "simulate a particle liquid (PBF, SPH, WCSPH): JSON state, PNG/GIF render, OBJ surface"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 
