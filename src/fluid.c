@@ -243,9 +243,25 @@ typedef struct ctx {
     ak_grid grid;
     float wdq;        /* poly6 at delta q */
     float grad2_rest; /* sum_k |grad_k C|^2 of the rest lattice */
+    float poly6_k;    /* 315 / (64 pi h^9) */
+    float spiky_k;    /* -45 / (pi h^6) */
     /* per-thread results */
     size_t truncated[FLUID_MAX_THREADS];
 } ctx;
+
+/* The public kernels with their constants computed once per step (same float operations). */
+static inline float k_poly6(const ctx* c, float r2) {
+    if (!(r2 < c->h2)) return 0.0f;
+    const float d = c->h2 - r2;
+    return c->poly6_k * d * d * d;
+}
+
+static inline ak_vec3 k_spiky(const ctx* c, ak_vec3 r) {
+    const float r2 = ak_vec3_dot(r, r);
+    if (!(r2 < c->h2) || !(r2 > 0.0f)) return ak_vec3_make(0.0f, 0.0f, 0.0f);
+    const float len = sqrtf(r2), d = c->h - len;
+    return ak_vec3_scale(r, c->spiky_k * d * d / len);
+}
 
 typedef void (*phase_fn)(ctx* c, size_t begin, size_t end, uint32_t t);
 
@@ -264,9 +280,8 @@ static void* task_thread(void* arg) {
 
 /* Runs fn over [0, n) split in equal contiguous chunks; the split never changes a result
  * (every phase writes only its own particles' values). */
-static void parallel(ctx* c, phase_fn fn, uint32_t threads) {
-    const size_t n = c->n;
-    if (threads > 1 && n < 1024) threads = 1;
+static void parallel_n(ctx* c, phase_fn fn, uint32_t threads, size_t n) {
+    if (threads > 1 && c->n < 1024) threads = 1;
     task tasks[FLUID_MAX_THREADS];
     for (uint32_t t = 0; t < threads; ++t)
         tasks[t] = (task){c, fn, n * t / threads, n * (t + 1) / threads, t};
@@ -279,6 +294,8 @@ static void parallel(ctx* c, phase_fn fn, uint32_t threads) {
         else task_thread(&tasks[t]);
     }
 }
+
+static void parallel(ctx* c, phase_fn fn, uint32_t threads) { parallel_n(c, fn, threads, c->n); }
 
 /* Collider projection: moves p outside every collider and inside the box; v (may be NULL)
  * loses its inward normal component relative to the collider, friction scales the rest. */
@@ -377,16 +394,41 @@ static float boundary_distance(const ctx* c, ak_vec3 p) {
     return best;
 }
 
-/* Neighbour lists of the predicted positions xp (grid built beforehand). */
-static void ph_neighbours(ctx* c, size_t b, size_t e, uint32_t t) {
+/* Neighbour lists by cell: for grid cells [b, e), every point of the cell scans the 27 cells
+ * around it (fixed order), each in sorted order, with the grid's distance test. A particle's
+ * list depends only on the grid, never on the split. */
+static void ph_neighbours_cells(ctx* c, size_t b, size_t e, uint32_t t) {
+    const ak_grid* g = &c->grid;
+    const float r2 = c->h * c->h;
     size_t trunc = 0;
-    for (size_t i = b; i < e; ++i) {
-        size_t k = ak_grid_query(&c->grid, c->xp[i], c->h, (ak_u32_span){c->nb + i * c->K, c->K});
-        if (k > c->K) {
-            ++trunc;
-            k = c->K;
+    uint32_t around[27];
+    for (size_t m = b; m < e; ++m) {
+        const ak_grid_cell cc = g->cell_coord[m];
+        int na = 0;
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    uint32_t m2 = ak_grid_cell_find(g, (ak_grid_cell){cc.x + dx, cc.y + dy, cc.z + dz});
+                    if (m2 != UINT32_MAX) around[na++] = m2;
+                }
+        for (uint32_t a = g->cell_start[m]; a < g->cell_start[m + 1]; ++a) {
+            const float qx = g->x[a], qy = g->y[a], qz = g->z[a];
+            const uint32_t i = g->order[a];
+            uint32_t* list = c->nb + (size_t)i * c->K;
+            uint32_t k = 0, total = 0;
+            for (int q = 0; q < na; ++q) {
+                const uint32_t m2 = around[q];
+                for (uint32_t bq = g->cell_start[m2]; bq < g->cell_start[m2 + 1]; ++bq) {
+                    const float ddx = g->x[bq] - qx, ddy = g->y[bq] - qy, ddz = g->z[bq] - qz;
+                    if (ddx * ddx + ddy * ddy + ddz * ddz < r2) {
+                        if (k < c->K) list[k++] = g->order[bq];
+                        ++total;
+                    }
+                }
+            }
+            if (total > c->K) ++trunc;
+            c->nb_count[i] = k;
         }
-        c->nb_count[i] = (uint32_t)k;
     }
     c->truncated[t] = trunc;
 }
@@ -399,7 +441,7 @@ static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
         float rho = 0.0f;
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
             ak_vec3 r = ak_vec3_sub(pi, c->xp[nb[q]]);
-            rho += ak_fluid_poly6(ak_vec3_dot(r, r), c->h);
+            rho += k_poly6(c, ak_vec3_dot(r, r));
         }
         c->rho[i] = rho * c->m;
     }
@@ -415,8 +457,8 @@ static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
         ak_vec3 gi = {0.0f, 0.0f, 0.0f};
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
             ak_vec3 r = ak_vec3_sub(pi, c->xp[nb[q]]);
-            rho += ak_fluid_poly6(ak_vec3_dot(r, r), c->h);
-            ak_vec3 g = ak_vec3_scale(ak_fluid_spiky_grad(r, c->h), c->mr);
+            rho += k_poly6(c, ak_vec3_dot(r, r));
+            ak_vec3 g = ak_vec3_scale(k_spiky(c, r), c->mr);
             gi = ak_vec3_add(gi, g);
             sum_gj2 += ak_vec3_dot(g, g);
         }
@@ -446,11 +488,11 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
             ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
             float s = 0.0f;
             if (scorr) {
-                float w = ak_fluid_poly6(ak_vec3_dot(r, r), c->h) * inv_wdq;
+                float w = k_poly6(c, ak_vec3_dot(r, r)) * inv_wdq;
                 float w2 = w * w;
                 s = -k * (n4 ? w2 * w2 : powf(w, np));
             }
-            acc = ak_vec3_add(acc, ak_vec3_scale(ak_fluid_spiky_grad(r, c->h), li + c->lambda[j] + s));
+            acc = ak_vec3_add(acc, ak_vec3_scale(k_spiky(c, r), li + c->lambda[j] + s));
         }
         ak_vec3 p = ak_vec3_add(pi, ak_vec3_scale(acc, c->mr));
         collide(c, &p, NULL);
@@ -474,7 +516,7 @@ static void ph_vorticity(ctx* c, size_t b, size_t e, uint32_t t) {
             const uint32_t j = nb[q];
             ak_vec3 vij = ak_vec3_sub(c->v[j], c->v[i]);
             /* grad_{p_j} W(p_i - p_j) = -grad W(p_i - p_j) */
-            ak_vec3 g = ak_vec3_neg(ak_fluid_spiky_grad(ak_vec3_sub(c->xp[i], c->xp[j]), c->h));
+            ak_vec3 g = ak_vec3_neg(k_spiky(c, ak_vec3_sub(c->xp[i], c->xp[j])));
             if (c->rho[j] > 0.0f) w = ak_vec3_add(w, ak_vec3_scale(ak_vec3_cross(vij, g), c->m / c->rho[j]));
         }
         c->omega[i] = w;
@@ -495,11 +537,11 @@ static void ph_xsph(ctx* c, size_t b, size_t e, uint32_t t) {
             const uint32_t j = nb[q];
             ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
             if (eps != 0.0f && c->rho[j] > 0.0f)
-                eta = ak_vec3_add(eta, ak_vec3_scale(ak_fluid_spiky_grad(r, c->h),
+                eta = ak_vec3_add(eta, ak_vec3_scale(k_spiky(c, r),
                                                      c->m / c->rho[j] * ak_vec3_length(c->omega[j])));
             if (xc != 0.0f && c->rho[j] > 0.0f)
                 xs = ak_vec3_add(xs, ak_vec3_scale(ak_vec3_sub(c->v[j], c->v[i]),
-                                                   c->m / c->rho[j] * ak_fluid_poly6(ak_vec3_dot(r, r), c->h)));
+                                                   c->m / c->rho[j] * k_poly6(c, ak_vec3_dot(r, r))));
         }
         ak_vec3 vi = ak_vec3_add(c->v[i], ak_vec3_scale(xs, xc));
         if (eps != 0.0f) {
@@ -540,7 +582,7 @@ static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
             const uint32_t j = nb[q];
             if (j == i) continue;
             ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
-            ak_vec3 g = ak_fluid_spiky_grad(r, h);
+            ak_vec3 g = k_spiky(c, r);
             const float rhoj = c->rho[j];
             if (mcg) {
                 /* f_i = -sum m (p_i + p_j) / (2 rho_j) grad W + mu sum m v_ij / rho_j lap W; a = f / rho_i */
@@ -669,6 +711,11 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     c->K = c->d.max_neighbours;
     const float s = cbrtf(c->mr);
     lattice_props(c->h, s, c->mr, &c->full_lattice_count, &c->grad2_rest);
+    {
+        const float h2 = c->h * c->h, h3 = h2 * c->h;
+        c->poly6_k = (float)(315.0 / (64.0 * FLUID_PI)) / (h2 * h2 * h2 * h2 * c->h);
+        c->spiky_k = -(float)(45.0 / FLUID_PI) / (h3 * h3);
+    }
     c->wdq = ak_fluid_poly6(c->d.scorr_dq * c->h * c->d.scorr_dq * c->h, c->h);
 
     ak_fluid_stats st;
@@ -715,7 +762,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     const size_t gbytes = ak_grid_memory_size(n, &gd);
     r = ak_grid_build(&gd, (ak_vec3_cspan){c->xp, n}, (ak_u8_span){base + L.grid, gbytes}, &c->grid);
     if (r != AK_OK) return AK_ERR_NO_CONVERGENCE; /* only non-finite predictions fail here */
-    parallel(c, ph_neighbours, threads);
+    parallel_n(c, ph_neighbours_cells, threads, c->grid.cell_count);
     st.neighbour_seconds = (float)(now_seconds() - t_nb);
 
     if (pbf) {
