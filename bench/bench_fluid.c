@@ -13,6 +13,7 @@
 
 typedef struct result {
     double wall_ms, cpu_ms, nb_ms;
+    size_t count;
 } result;
 
 static result run(ak_fluid_solver solver, uint32_t threads, size_t want, int steps) {
@@ -42,7 +43,7 @@ static result run(ak_fluid_solver solver, uint32_t threads, size_t want, int ste
         if (ak_fluid_step_run(&job) != AK_OK) fprintf(stderr, "step %d failed\n", k);
         nb += st.neighbour_seconds;
     }
-    result r = {(bench_wall_s() - w0) * 1e3 / steps, (bench_proc_s() - c0) * 1e3 / steps, nb * 1e3 / steps};
+    result r = {(bench_wall_s() - w0) * 1e3 / steps, (bench_proc_s() - c0) * 1e3 / steps, nb * 1e3 / steps, n};
     free(pos), free(vel), free(mem);
     return r;
 }
@@ -53,19 +54,20 @@ int main(int argc, char** argv) {
     if (want < 8 || steps < 1) return 2;
     const char* names[] = {"PBF (4 it)", "SPH", "WCSPH"};
     const ak_fluid_solver solvers[] = {AK_FLUID_PBF, AK_FLUID_SPH, AK_FLUID_WCSPH};
-    printf("dam break, ~%zu particles, h = 2 x spacing, %d timed steps\n", want, steps);
-    printf("%-11s %7s %10s %10s %9s %10s %12s\n", "solver", "threads", "wall ms", "cpu ms", "nb ms", "nb share",
-           "particles/s");
+    printf("dam break, at least %zu particles, h = 2 x spacing, %d timed steps (cpu = all threads)\n", want, steps);
+    printf("%-11s %7s %9s %10s %10s %9s %10s %12s\n", "solver", "threads", "particles", "wall ms", "cpu ms", "nb ms",
+           "nb share", "particles/s");
     for (int k = 0; k < 3; ++k) {
         result one = {0}, two = {0};
         for (uint32_t t = 1; t <= 2; ++t) {
             result r = run(solvers[k], t, want, steps);
             if (t == 1) one = r;
             else two = r;
-            printf("%-11s %7u %10.2f %10.2f %9.2f %9.0f%% %12.3g\n", names[k], t, r.wall_ms, r.cpu_ms, r.nb_ms,
-                   100.0 * r.nb_ms / r.wall_ms, (double)want / (r.wall_ms * 1e-3));
+            printf("%-11s %7u %9zu %10.2f %10.2f %9.2f %9.0f%% %12.3g\n", names[k], t, r.count, r.wall_ms, r.cpu_ms,
+                   r.nb_ms, 100.0 * r.nb_ms / r.wall_ms, (double)r.count / (r.wall_ms * 1e-3));
         }
-        printf("%-11s 2 vs 1 thread: wall %.2fx\n", names[k], one.wall_ms / two.wall_ms);
+        printf("%-11s 2 vs 1 thread: wall %.2fx, cpu per particle-step %.0f ns (1 thread)\n", names[k],
+               one.wall_ms / two.wall_ms, one.cpu_ms * 1e6 / (double)one.count);
     }
     return 0;
 }

@@ -1,6 +1,6 @@
 /* fluid_dam_break: a small PBF dam break in a box, with a capsule (a limb) in the flow.
  * Prints the water front, the density error over particles with full neighbourhoods and the
- * number of surface particles every 0.1 s. Runs headless in about a second. */
+ * number of surface particles every 0.1 s. Runs headless in well under a second. */
 #include <animkit/fluid.h>
 
 #include <stdio.h>
@@ -18,15 +18,15 @@ int main(void) {
     const float s = ak_fluid_rest_spacing(&d);
     d.h = 2.0f * s;
     d.box_min = ak_vec3_make(0.0f, 0.0f, 0.0f);
-    d.box_max = ak_vec3_make(40 * s, 30 * s, 8 * s);
+    d.box_max = ak_vec3_make(30 * s, 24 * s, 6 * s);
 
-    enum { CAP = 10 * 20 * 8 };
+    enum { CAP = 8 * 16 * 6 };
     static ak_vec3 pos[CAP], vel[CAP];
     static uint8_t flags[CAP];
-    size_t n = ak_fluid_fill_box(&d, d.box_min, ak_vec3_make(10 * s, 20 * s, 8 * s), (ak_vec3_span){pos, CAP});
+    size_t n = ak_fluid_fill_box(&d, d.box_min, ak_vec3_make(8 * s, 16 * s, 6 * s), (ak_vec3_span){pos, CAP});
 
-    const ak_fluid_collider limb = {.shape = AK_FLUID_CAPSULE, .a = {25 * s, 3 * s, 0.0f},
-                                    .b = {25 * s, 3 * s, 8 * s}, .radius = 2 * s};
+    const ak_fluid_collider limb = {.shape = AK_FLUID_CAPSULE, .a = {18 * s, 3 * s, 0.0f},
+                                    .b = {18 * s, 3 * s, 6 * s}, .radius = 2 * s};
     const size_t bytes = ak_fluid_scratch_size(CAP, &d);
     void* scratch = malloc(bytes);
     if (!scratch) return 1;
@@ -42,7 +42,7 @@ int main(void) {
     };
     printf("%zu particles, spacing %.4f m, h %.4f m\n", n, s, d.h);
     printf("   t     front(m)  mean err  max err  surface\n");
-    for (int step = 1; step <= 400; ++step) {
+    for (int step = 1; step <= 240; ++step) {
         job.time = (float)(step - 1) * job.dt;
         ak_result r = ak_fluid_step_run(&job);
         if (r != AK_OK) {
