@@ -206,7 +206,7 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
         const ak_fluid_emitter* m = &job->emitters.ptr[e];
         if (!(m->speed > 0.0f) || !ak_finitef(m->speed) || !(m->radius >= 0.0f) || !ak_finitef(m->radius) ||
             !vfinite(m->position) || !vfinite(m->direction) || !ak_finitef(m->start_time) ||
-            !ak_finitef(m->stop_time))
+            !ak_finitef(m->stop_time) || m->radius > 4096.0f * ak_fluid_rest_spacing(d))
             return AK_ERR_BAD_ARG;
     }
     for (size_t s = 0; s < job->sinks.count; ++s)
@@ -673,10 +673,18 @@ static void emit(const ak_fluid_step_job* job, float s, size_t* n, ak_fluid_stat
             if (te < t0) continue;
             if (em->stop_time > 0.0f && te >= em->stop_time) break;
             const float ahead = (float)((t1 - te) * em->speed);
-            for (int a = -ring; a <= ring; ++a)
+            const float r2 = em->radius * em->radius + 1e-6f * s * s;
+            for (int a = -ring; a <= ring; ++a) {
+                const float fa = (float)a * s;
+                if (fa * fa > r2) continue;
+                if (*n >= cap) { /* full: count this row's lattice points without visiting them */
+                    const double bmax = floor(sqrt((double)r2 - (double)fa * fa) / s);
+                    if (st) st->emit_dropped_count += (size_t)(2.0 * bmax + 1.0);
+                    continue;
+                }
                 for (int bq = -ring; bq <= ring; ++bq) {
-                    float fa = (float)a * s, fb = (float)bq * s;
-                    if (fa * fa + fb * fb > em->radius * em->radius + 1e-6f * s * s) continue;
+                    const float fb = (float)bq * s;
+                    if (fa * fa + fb * fb > r2) continue;
                     if (*n >= cap) {
                         if (st) ++st->emit_dropped_count;
                         continue;
@@ -689,6 +697,7 @@ static void emit(const ak_fluid_step_job* job, float s, size_t* n, ak_fluid_stat
                     ++*n;
                     if (st) ++st->emitted_count;
                 }
+            }
         }
     }
 }

@@ -159,7 +159,7 @@ typedef struct ak_fluid_collider {
 typedef struct ak_fluid_emitter {
     ak_vec3 position;    /* world: centre of the nozzle disc */
     ak_vec3 direction;   /* flow direction (normalised; zero -> -Y) */
-    float radius;        /* nozzle radius (m); particles on the rest lattice inside the disc */
+    float radius;        /* nozzle radius (m), at most 4096 rest spacings; rest-lattice points inside the disc */
     float speed;         /* exit speed (m/s), > 0; one layer every spacing / speed seconds */
     float start_time;    /* s: first layer */
     float stop_time;     /* s: no layer at or after it; 0 = never stops */
@@ -215,7 +215,8 @@ AK_API size_t ak_fluid_scratch_size(size_t capacity, const ak_fluid_desc* desc);
  * pointers, a non-empty optional span with a NULL pointer), AK_ERR_BAD_ARG (h, mass, dt not >
  * 0 and finite, negative rest density/stiffness/viscosity/relaxation/friction > 1, solver out
  * of range, box_min > box_max, thread_count > 64, iterations > 1000, a collider shape out of
- * range or negative radius, an emitter with speed <= 0 or negative radius), AK_ERR_SPAN_SMALL
+ * range or negative radius, an emitter with speed <= 0, a negative radius or one above 4096 rest
+ * spacings), AK_ERR_SPAN_SMALL
  * (velocities or an optional output shorter than positions, *particle_count > capacity,
  * scratch too small), AK_ERR_BAD_DATA (a live position or velocity is NaN or infinite). */
 AK_API ak_result ak_fluid_step_validate(const ak_fluid_step_job* job);

@@ -79,7 +79,7 @@ static int renderer_init(renderer* r, const fluid_scene* s, size_t cap, const ak
     ak_vec3 eye = ak_vec3_add(r->centre, ak_vec3_scale(ak_vec3_make(0.45f, 0.55f, 1.0f), 1.1f * r->extent));
     r->cam = ak_raster_camera_perspective(eye, r->centre, 0.7f, (float)r->w / (float)r->h, 0.01f * r->extent,
                                           10.0f * r->extent);
-    if (cap > SIZE_MAX / (SPHERE_TRIS * 3 * sizeof(ak_vec4))) return cli_fail("fluid", "too many particles to render");
+    if (cap > 200000) return cli_fail("fluid", "%zu particles: renders take at most 200000 (use --json or OBJ)", cap);
     r->pos = malloc(cap * SPHERE_TRIS * 3 * sizeof(ak_vec3));
     r->nrm = malloc(cap * SPHERE_TRIS * 3 * sizeof(ak_vec3));
     r->col = malloc(cap * SPHERE_TRIS * 3 * sizeof(ak_vec4));
