@@ -96,7 +96,29 @@ static void renderer_free(renderer* r) {
     free(r->pos), free(r->nrm), free(r->col), free(r->px);
 }
 
-static ak_result render_frame(renderer* r, const ak_vec3* p, const uint8_t* flags, size_t n, ak_image* out) {
+/* Spheres and capsules (as spheres along the segment) in grey; planes are not drawn. */
+static ak_result draw_colliders(renderer* r, const fluid_scene* s) {
+    ak_vec3 unit[SPHERE_TRIS * 3], pos[SPHERE_TRIS * 3];
+    unit_sphere(unit);
+    for (size_t c = 0; c < s->collider_count; ++c) {
+        const ak_fluid_collider* k = &s->colliders[c];
+        if (k->shape == AK_FLUID_PLANE || !(k->radius > 0.0f)) continue;
+        const int parts = k->shape == AK_FLUID_CAPSULE ? 16 : 1;
+        for (int q = 0; q < parts; ++q) {
+            const float t = parts > 1 ? (float)q / (float)(parts - 1) : 0.0f;
+            const ak_vec3 centre = ak_vec3_add(k->a, ak_vec3_scale(ak_vec3_sub(k->b, k->a), t));
+            for (int v = 0; v < SPHERE_TRIS * 3; ++v) pos[v] = ak_vec3_add(centre, ak_vec3_scale(unit[v], k->radius));
+            ak_raster_mesh m = {.positions = {pos, SPHERE_TRIS * 3}, .normals = {unit, SPHERE_TRIS * 3},
+                                .material = {.color = ak_vec4_make(0.75f, 0.72f, 0.68f, 1)}, .shading = AK_SHADING_PHONG};
+            ak_result res = ak_raster_draw_mesh(r->raster, &r->cam, &m);
+            if (res != AK_OK) return res;
+        }
+    }
+    return AK_OK;
+}
+
+static ak_result render_frame(renderer* r, const fluid_scene* s, const ak_vec3* p, const uint8_t* flags, size_t n,
+                              ak_image* out) {
     ak_vec3 unit[SPHERE_TRIS * 3];
     unit_sphere(unit);
     const size_t nv = SPHERE_TRIS * 3;
@@ -116,6 +138,7 @@ static ak_result render_frame(renderer* r, const ak_vec3* p, const uint8_t* flag
                           .casters = n ? &m : NULL, .caster_count = n ? 1 : 0};
     ak_result res = ak_raster_draw_ground(r->raster, &r->cam, &g);
     if (res == AK_OK && n) res = ak_raster_draw_mesh(r->raster, &r->cam, &m);
+    if (res == AK_OK) res = draw_colliders(r, s);
     *out = (ak_image){.pixels = r->px, .width = r->w, .height = r->h};
     if (res == AK_OK) res = ak_raster_resolve(r->raster, out);
     return res;
@@ -383,7 +406,7 @@ int cmd_fluid(int argc, char** argv) {
         }
         if (gw && ((k + 1) % frame_every == 0 || k + 1 == s->steps)) {
             ak_image img;
-            res = render_frame(&ren, pos, flags, n, &img);
+            res = render_frame(&ren, s, pos, flags, n, &img);
             if (res == AK_OK) res = ak_gif_writer_add_frame(gw, &img);
             if (res != AK_OK) {
                 rc = cli_fail("fluid", "%s: %s", out, ak_result_string(res));
@@ -404,7 +427,7 @@ int cmd_fluid(int argc, char** argv) {
     }
     if (png) {
         ak_image img;
-        ak_result res = render_frame(&ren, pos, flags, n, &img);
+        ak_result res = render_frame(&ren, s, pos, flags, n, &img);
         if (res == AK_OK) res = ak_png_write(out, &img);
         if (res != AK_OK) {
             rc = cli_fail("fluid", "%s: %s", out, ak_result_string(res));
