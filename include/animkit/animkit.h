@@ -31,5 +31,6 @@
 #include "boids.h"
 #include "cloth.h"
 #include "retarget.h"
+#include "fluid.h"
 
 #endif

@@ -26,6 +26,7 @@ static const command commands[] = {
     {"view", cmd_view, "interactive viewer: play clips, compare skinning, drag IK targets (--headless, --script)"},
     {"cloth", cmd_cloth, "simulate cloth (XPBD or mass-spring): flag, curtain, drape, cape"},
     {"retarget", cmd_retarget, "put a clip (e.g. BVH mocap) on another character; glTF or GIF out"},
+    {"fluid", cmd_fluid, "simulate a particle liquid (PBF, SPH, WCSPH): JSON state, PNG/GIF render, OBJ surface"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 

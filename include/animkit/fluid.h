@@ -1,0 +1,233 @@
+/* animkit fluid: particle liquids, SPH and position-based fluids.
+ *
+ * What it does: advances a particle liquid by one time step with one of three solvers:
+ *  - AK_FLUID_PBF, position-based fluids (Macklin & Mueller 2013, Algorithm 1): predict
+ *    positions, find neighbours once, then `iterations` Jacobi iterations of the density
+ *    constraints C_i = rho_i / rho_0 - 1 (lambda_i = -C_i / (sum_k |grad_k C_i|^2 + epsilon),
+ *    dp_i = (m / rho_0) sum_j (lambda_i + lambda_j + s_corr) grad W_spiky(p_i - p_j), with the
+ *    tensile correction s_corr = -k (W_poly6(r) / W_poly6(dq))^n), collision projection after
+ *    each iteration, v = (x* - x) / dt, vorticity confinement and XSPH viscosity. The paper
+ *    writes its equations for unit mass; here m/rho_0 multiplies the constraint gradient and
+ *    the position update, so any particle mass gives the same motion. Two readings where the
+ *    paper's unit-mass scene units do not carry over (documented in docs/fluid.md): s_corr is
+ *    divided by the rest lattice's sum_k |grad_k C|^2 so k means "a density deficit of k"
+ *    whatever the units (lambda has units of length^2; the paper's k = 0.1 is tied to its
+ *    h = 0.1, rho_0 = 6378 scene, and taken literally in SI units it throws the free surface
+ *    apart), and the density constraint is unilateral by default (C_i clamped at 0: particles
+ *    short of neighbours at the free surface are not pulled inward, the clumping the paper
+ *    fights with s_corr; desc.bilateral restores the paper's equality constraint). XSPH
+ *    carries the volume m / rho_j of Schechter & Bridson's form, as the paper's unit mass hides.
+ *  - AK_FLUID_SPH (Mueller, Charypar, Gross 2003): density by poly6, pressure p = k (rho - rho_0),
+ *    symmetric pressure force -sum_j m (p_i + p_j) / (2 rho_j) grad W_spiky, viscosity force
+ *    mu sum_j m (v_j - v_i) / rho_j lap W_visc, semi-implicit Euler.
+ *  - AK_FLUID_WCSPH, weakly compressible SPH (Becker & Teschner 2007): Tait equation
+ *    p = B ((rho / rho_0)^gamma - 1), B = rho_0 c_s^2 / gamma, pressure acceleration
+ *    -sum_j m (p_i / rho_i^2 + p_j / rho_j^2) grad W, and the paper's artificial viscosity
+ *    Pi_ij = -nu (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2), nu = 2 alpha h c_s / (rho_i + rho_j),
+ *    for approaching pairs. (The paper uses a cubic spline kernel; animkit uses the MCG kernels
+ *    for every solver: poly6 for density, the spiky gradient for forces.)
+ * Neighbours come from the shared uniform grid (grid.h), rebuilt each step with cell = h.
+ *
+ * Boundaries (all solvers): a box container, planes, spheres and capsules, each optionally
+ * moving with a velocity. The method is projection: a particle found inside a collider (or
+ * outside the box) is moved to the nearest surface point, and its velocity loses only the
+ * component into the surface relative to the collider's velocity (the tangential component is
+ * kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so the velocity
+ * update v = (x* - x)/dt inherits the same rule. Nothing leaks (every particle ends each step
+ * outside every collider and inside the box, up to float rounding of the projection) and
+ * nothing sticks (no tangential velocity is removed unless friction > 0, and no attraction to
+ * walls: boundaries add no density).
+ *
+ * Emitters (a nozzle disc shooting layers of particles on the rest lattice) and sinks (boxes
+ * that remove particles) change the particle count; the caller owns arrays with room for the
+ * largest count. Each step also flags surface particles (neighbour count below 3/4 of a full
+ * lattice neighbourhood) for rendering, and can report density statistics.
+ *
+ * Density error (ak_fluid_stats): |rho_i / rho_0 - 1| over particles with a full
+ * neighbourhood, meaning neither it nor any of its neighbours is flagged as surface, and it is
+ * at least h from the box walls and every collider (particles near the free surface or a wall lack neighbours by construction).
+ *
+ * What it does NOT do: two-way coupling (colliders are driven, never pushed), surface tension,
+ * multiple fluids, adaptive time steps, or surface reconstruction (the CLI meshes density).
+ *
+ * Usage:
+ *     ak_fluid_desc d = {.solver = AK_FLUID_PBF, .h = 0.1f, .particle_mass = m,
+ *                        .gravity = {0, -9.81f, 0}, .box_min = {0, 0, 0}, .box_max = {1, 1, 1}};
+ *     size_t n = ak_fluid_fill_box(&d, lo, hi, (ak_vec3_span){pos, cap});
+ *     size_t bytes = ak_fluid_scratch_size(cap, &d);
+ *     void* scratch = malloc(bytes);
+ *     ak_fluid_step_job job = {.desc = &d, .dt = 1.0f / 60, .positions = {pos, cap},
+ *                              .velocities = {vel, cap}, .particle_count = &n,
+ *                              .thread_count = 2, .scratch = {scratch, bytes}};
+ *     for (int s = 0; s < steps; ++s) { job.time = s * job.dt; ak_fluid_step_run(&job); }
+ *
+ * Ownership and threading: jobs keep no pointer after run returns and never allocate (the
+ * caller passes scratch, any alignment). thread_count threads split each phase by particle;
+ * every particle sums over its neighbours in one fixed order, so results are bit-identical
+ * for any thread count.
+ */
+#ifndef ANIMKIT_FLUID_H
+#define ANIMKIT_FLUID_H
+
+#include "math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- kernels (Mueller, Charypar, Gross 2003), 3D, support radius h ----------------- */
+
+/* poly6: 315 / (64 pi h^9) (h^2 - r^2)^3 for r < h, else 0; takes r^2. Integrates to 1. */
+AK_API float ak_fluid_poly6(float r2, float h);
+/* Gradient of poly6 at offset r: -945 / (32 pi h^9) (h^2 - |r|^2)^2 r; 0 outside. */
+AK_API ak_vec3 ak_fluid_poly6_grad(ak_vec3 r, float h);
+/* spiky: 15 / (pi h^6) (h - r)^3 for r < h, else 0. Integrates to 1. */
+AK_API float ak_fluid_spiky(float r, float h);
+/* Gradient of spiky at offset r: -45 / (pi h^6) (h - |r|)^2 r / |r|; 0 at r = 0 and outside. */
+AK_API ak_vec3 ak_fluid_spiky_grad(ak_vec3 r, float h);
+/* viscosity kernel: 15 / (2 pi h^3) (-r^3/(2h^3) + r^2/h^2 + h/(2r) - 1) for 0 < r < h, else 0
+ * (r = 0 -> 0, the kernel is singular there). Integrates to 1. */
+AK_API float ak_fluid_visc(float r, float h);
+/* Laplacian of the viscosity kernel: 45 / (pi h^6) (h - r) for r < h, else 0 (its integral
+ * over the support is 15 / h^2: the paper's kernel is normalised through W, not its Laplacian). */
+AK_API float ak_fluid_visc_laplacian(float r, float h);
+
+/* ---- description ------------------------------------------------------------------ */
+
+typedef enum ak_fluid_solver {
+    AK_FLUID_PBF = 0, /* default: position-based fluids */
+    AK_FLUID_SPH,     /* MCG 2003 equation of state */
+    AK_FLUID_WCSPH,   /* Becker & Teschner 2007 Tait equation */
+    AK_FLUID_SOLVER_COUNT
+} ak_fluid_solver;
+
+typedef struct ak_fluid_desc {
+    ak_fluid_solver solver;    /* 0 -> PBF */
+    float h;                   /* required, > 0: kernel support radius (m) */
+    float particle_mass;       /* required, > 0 (kg); rest spacing = cbrt(mass / rest_density) */
+    float rest_density;        /* kg/m^3; 0 -> 1000 */
+    ak_vec3 gravity;           /* m/s^2, world; zero = no gravity */
+    /* PBF */
+    uint32_t iterations;       /* Jacobi iterations per step; 0 -> 4 */
+    float relaxation;          /* epsilon in 1/m^2 (|grad C|^2 units); 0 -> 0.01 * |grad C|^2 of the rest lattice */
+    bool bilateral;            /* false: C_i = max(rho_i/rho_0 - 1, 0) (unilateral, see above); true: the paper's C_i */
+    bool disable_scorr;        /* false: tensile correction on */
+    float scorr_k;             /* 0 -> 0.1 */
+    float scorr_n;             /* 0 -> 4 */
+    float scorr_dq;            /* |delta q| as a fraction of h; 0 -> 0.2 */
+    float xsph_c;              /* XSPH coefficient; 0 = none (the paper uses 0.01) */
+    float vorticity_epsilon;   /* vorticity confinement strength (m/s^2 per 1/s); 0 = none */
+    /* SPH and WCSPH */
+    float stiffness;           /* SPH gas constant k (J/kg); 0 -> 20 */
+    float viscosity;           /* SPH mu (Pa s); WCSPH alpha (dimensionless); 0 = none */
+    float sound_speed;         /* WCSPH c_s (m/s); 0 -> 20 (about 10x the speed of a 0.2 m fall) */
+    float tait_gamma;          /* WCSPH gamma; 0 -> 7 */
+    /* boundaries */
+    ak_vec3 box_min, box_max;  /* box container (world); box_min == box_max -> no box */
+    float friction;            /* 0..1: fraction of tangential velocity removed on contact; 0 = free slip */
+    uint32_t max_neighbours;   /* per particle, self included; 0 -> 96; more are dropped (counted) */
+} ak_fluid_desc;
+
+/* desc with every zero default filled in (relaxation 0 -> 1% of the rest lattice's
+ * sum_k |grad_k C|^2). */
+AK_API ak_fluid_desc ak_fluid_desc_resolved(const ak_fluid_desc* desc);
+
+/* Rest spacing cbrt(particle_mass / rest_density) (0 for an invalid desc). */
+AK_API float ak_fluid_rest_spacing(const ak_fluid_desc* desc);
+
+/* Positions of a cubic lattice at rest spacing filling [lo, hi] (first point at lo + s/2,
+ * x fastest). Writes min(total, out_positions.count) points and returns the total. */
+AK_API size_t ak_fluid_fill_box(const ak_fluid_desc* desc, ak_vec3 lo, ak_vec3 hi, ak_vec3_span out_positions);
+
+/* ---- colliders, emitters, sinks ---------------------------------------------------- */
+
+typedef enum ak_fluid_shape {
+    AK_FLUID_PLANE = 0, /* point a, unit normal n: the liquid stays on the +n side */
+    AK_FLUID_SPHERE,    /* centre a, radius: the liquid stays outside */
+    AK_FLUID_CAPSULE,   /* segment a-b, radius: the liquid stays outside (a limb) */
+    AK_FLUID_SHAPE_COUNT
+} ak_fluid_shape;
+
+typedef struct ak_fluid_collider {
+    ak_fluid_shape shape; /* 0 -> plane */
+    ak_vec3 a, b;         /* world: plane point / sphere centre / capsule ends */
+    ak_vec3 normal;       /* plane normal (normalised by the solver; zero -> +Y) */
+    float radius;         /* sphere and capsule radius (m), >= 0 */
+    ak_vec3 velocity;     /* world m/s: a moving collider (the caller moves a, b each step) */
+} ak_fluid_collider;
+
+typedef struct ak_fluid_emitter {
+    ak_vec3 position;    /* world: centre of the nozzle disc */
+    ak_vec3 direction;   /* flow direction (normalised; zero -> -Y) */
+    float radius;        /* nozzle radius (m), at most 4096 rest spacings; rest-lattice points inside the disc */
+    float speed;         /* exit speed (m/s), > 0; one layer every spacing / speed seconds */
+    float start_time;    /* s: first layer */
+    float stop_time;     /* s: no layer at or after it; 0 = never stops */
+} ak_fluid_emitter;
+
+typedef struct ak_fluid_sink {
+    ak_vec3 min, max; /* world box; particles inside at the end of a step are removed */
+} ak_fluid_sink;
+
+AK_DEFINE_SPAN(fluid_collider, ak_fluid_collider)
+AK_DEFINE_SPAN(fluid_emitter, ak_fluid_emitter)
+AK_DEFINE_SPAN(fluid_sink, ak_fluid_sink)
+
+/* Particle flags (out_flags). */
+enum { AK_FLUID_FLAG_SURFACE = 1, AK_FLUID_FLAG_FULL = 2 /* counted in the density error */ };
+
+typedef struct ak_fluid_stats {
+    float max_density_error;     /* max |rho/rho_0 - 1| over full-neighbourhood particles (0 if none) */
+    float mean_density_error;    /* mean of the same (0 if none) */
+    size_t full_count;           /* particles counted */
+    size_t surface_count;        /* particles flagged surface */
+    size_t truncated_count;      /* particles with more than max_neighbours neighbours */
+    size_t emitted_count;        /* added this step */
+    size_t emit_dropped_count;   /* emitter particles that found no room (capacity) */
+    size_t removed_count;        /* removed by sinks this step */
+    float neighbour_seconds;     /* wall time of grid build + neighbour lists this step */
+} ak_fluid_stats;
+
+/* ---- the step job ------------------------------------------------------------------ */
+
+typedef struct ak_fluid_step_job {
+    const ak_fluid_desc* desc;         /* required */
+    float dt;                          /* required, > 0 (s) */
+    float time;                        /* s: simulation time at the start of the step (emitters) */
+    ak_vec3_span positions;            /* required: world m; count = capacity; [0, *particle_count) live */
+    ak_vec3_span velocities;           /* required: m/s; count >= positions.count */
+    size_t* particle_count;            /* required, in/out: live particles (emitters and sinks change it) */
+    ak_fluid_collider_cspan colliders; /* optional */
+    ak_fluid_emitter_cspan emitters;   /* optional */
+    ak_fluid_sink_cspan sinks;         /* optional */
+    uint32_t thread_count;             /* 0 -> 1; at most 64 */
+    ak_u8_span scratch;                /* required: >= ak_fluid_scratch_size(capacity, desc) */
+    ak_f32_span out_densities;         /* optional (count >= capacity): rho per particle (kg/m^3) */
+    ak_f32_span out_pressures;         /* optional: SPH/WCSPH pressure (Pa); PBF writes 0 */
+    ak_u8_span out_flags;              /* optional: AK_FLUID_FLAG_* per particle */
+    ak_fluid_stats* out_stats;         /* optional */
+} ak_fluid_step_job;
+
+/* Scratch bytes for up to capacity particles (0 when desc is invalid or capacity >= 2^31). */
+AK_API size_t ak_fluid_scratch_size(size_t capacity, const ak_fluid_desc* desc);
+
+/* First failing rule: AK_ERR_NULL_ARG (job, desc, particle_count, positions/velocities/scratch
+ * pointers, a non-empty optional span with a NULL pointer), AK_ERR_BAD_ARG (h, mass, dt not >
+ * 0 and finite, negative rest density/stiffness/viscosity/relaxation/friction > 1, solver out
+ * of range, box_min > box_max, thread_count > 64, iterations > 1000, a collider shape out of
+ * range or negative radius, an emitter with speed <= 0, a negative radius or one above 4096 rest
+ * spacings), AK_ERR_SPAN_SMALL
+ * (velocities or an optional output shorter than positions, *particle_count > capacity,
+ * scratch too small), AK_ERR_BAD_DATA (a live position or velocity is NaN or infinite). */
+AK_API ak_result ak_fluid_step_validate(const ak_fluid_step_job* job);
+
+/* One time step of the chosen solver. Returns the validate codes (nothing written), AK_OK, or
+ * AK_ERR_NO_CONVERGENCE when the step blew up (a position or velocity became non-finite or a
+ * particle moved more than 100 h in one step): the arrays then hold that step's values and
+ * the caller should stop. */
+AK_API ak_result ak_fluid_step_run(const ak_fluid_step_job* job);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ANIMKIT_FLUID_H */

@@ -1,0 +1,853 @@
+/* Particle liquids: MCG 2003 kernels, PBF (Macklin & Mueller 2013), SPH (MCG 2003) and WCSPH
+ * (Becker & Teschner 2007) on the shared neighbour grid. See include/animkit/fluid.h. */
+#include <animkit/fluid.h>
+#include <animkit/grid.h>
+
+#include <math.h>
+#include <pthread.h>
+#include <string.h>
+#include <time.h>
+
+#define FLUID_PI 3.14159265358979323846
+#define FLUID_MAX_THREADS 64u
+
+/* ---- kernels ---------------------------------------------------------------------- */
+
+float ak_fluid_poly6(float r2, float h) {
+    const float h2 = h * h;
+    if (!(r2 < h2) || !(h > 0.0f)) return 0.0f;
+    const float d = h2 - r2;
+    const float h9 = h2 * h2 * h2 * h2 * h;
+    return (float)(315.0 / (64.0 * FLUID_PI)) / h9 * d * d * d;
+}
+
+ak_vec3 ak_fluid_poly6_grad(ak_vec3 r, float h) {
+    const float h2 = h * h, r2 = ak_vec3_dot(r, r);
+    if (!(r2 < h2) || !(h > 0.0f)) return ak_vec3_make(0.0f, 0.0f, 0.0f);
+    const float d = h2 - r2;
+    const float h9 = h2 * h2 * h2 * h2 * h;
+    return ak_vec3_scale(r, -(float)(945.0 / (32.0 * FLUID_PI)) / h9 * d * d);
+}
+
+float ak_fluid_spiky(float r, float h) {
+    if (!(r < h) || !(h > 0.0f) || r < 0.0f) return 0.0f;
+    const float d = h - r, h3 = h * h * h;
+    return (float)(15.0 / FLUID_PI) / (h3 * h3) * d * d * d;
+}
+
+ak_vec3 ak_fluid_spiky_grad(ak_vec3 r, float h) {
+    const float r2 = ak_vec3_dot(r, r);
+    if (!(r2 < h * h) || !(r2 > 0.0f) || !(h > 0.0f)) return ak_vec3_make(0.0f, 0.0f, 0.0f);
+    const float len = sqrtf(r2), d = h - len, h3 = h * h * h;
+    return ak_vec3_scale(r, -(float)(45.0 / FLUID_PI) / (h3 * h3) * d * d / len);
+}
+
+float ak_fluid_visc(float r, float h) {
+    if (!(r < h) || !(r > 0.0f) || !(h > 0.0f)) return 0.0f;
+    const float q = r / h;
+    return (float)(15.0 / (2.0 * FLUID_PI)) / (h * h * h) * (-0.5f * q * q * q + q * q + 0.5f / q - 1.0f);
+}
+
+float ak_fluid_visc_laplacian(float r, float h) {
+    if (!(r < h) || r < 0.0f || !(h > 0.0f)) return 0.0f;
+    const float h3 = h * h * h;
+    return (float)(45.0 / FLUID_PI) / (h3 * h3) * (h - r);
+}
+
+/* ---- description ------------------------------------------------------------------ */
+
+static bool desc_ok(const ak_fluid_desc* d) {
+    return d && d->h > 0.0f && ak_finitef(d->h) && d->particle_mass > 0.0f && ak_finitef(d->particle_mass) &&
+           d->rest_density >= 0.0f && ak_finitef(d->rest_density);
+}
+
+/* Neighbour count of a lattice point at rest spacing s (self included) and the PBF constraint
+ * gradient norm sum_k |grad_k C|^2 there. */
+static void lattice_props(float h, float s, float m_over_rho, uint32_t* out_count, float* out_grad2) {
+    const int reach = (int)ceilf(h / s) + 1;
+    uint32_t count = 0;
+    ak_vec3 gi = {0.0f, 0.0f, 0.0f};
+    float sum_gj2 = 0.0f;
+    for (int z = -reach; z <= reach; ++z)
+        for (int y = -reach; y <= reach; ++y)
+            for (int x = -reach; x <= reach; ++x) {
+                ak_vec3 r = ak_vec3_make((float)x * s, (float)y * s, (float)z * s);
+                if (ak_vec3_dot(r, r) >= h * h) continue;
+                ++count;
+                ak_vec3 g = ak_vec3_scale(ak_fluid_spiky_grad(r, h), m_over_rho);
+                gi = ak_vec3_add(gi, g);
+                sum_gj2 += ak_vec3_dot(g, g);
+            }
+    *out_count = count;
+    *out_grad2 = ak_vec3_dot(gi, gi) + sum_gj2;
+}
+
+ak_fluid_desc ak_fluid_desc_resolved(const ak_fluid_desc* desc) {
+    ak_fluid_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc) d = *desc;
+    if (d.rest_density == 0.0f) d.rest_density = 1000.0f;
+    if (d.iterations == 0) d.iterations = 4;
+    if (d.scorr_k == 0.0f) d.scorr_k = 0.1f;
+    if (d.scorr_n == 0.0f) d.scorr_n = 4.0f;
+    if (d.scorr_dq == 0.0f) d.scorr_dq = 0.2f;
+    if (d.stiffness == 0.0f) d.stiffness = 20.0f;
+    if (d.sound_speed == 0.0f) d.sound_speed = 20.0f;
+    if (d.tait_gamma == 0.0f) d.tait_gamma = 7.0f;
+    if (d.max_neighbours == 0) d.max_neighbours = 96;
+    if (d.relaxation == 0.0f && desc_ok(&d)) {
+        const float s = cbrtf(d.particle_mass / d.rest_density);
+        uint32_t c;
+        float g2;
+        lattice_props(d.h, s, s * s * s, &c, &g2);
+        d.relaxation = 0.01f * g2;
+    }
+    return d;
+}
+
+float ak_fluid_rest_spacing(const ak_fluid_desc* desc) {
+    if (!desc || !(desc->particle_mass > 0.0f) || !ak_finitef(desc->particle_mass) || !(desc->rest_density >= 0.0f) ||
+        !ak_finitef(desc->rest_density))
+        return 0.0f;
+    const float rho0 = desc->rest_density > 0.0f ? desc->rest_density : 1000.0f;
+    return cbrtf(desc->particle_mass / rho0);
+}
+
+size_t ak_fluid_fill_box(const ak_fluid_desc* desc, ak_vec3 lo, ak_vec3 hi, ak_vec3_span out_positions) {
+    const float s = ak_fluid_rest_spacing(desc);
+    if (!(s > 0.0f)) return 0;
+    if (!ak_finitef(lo.x) || !ak_finitef(lo.y) || !ak_finitef(lo.z) || !ak_finitef(hi.x) || !ak_finitef(hi.y) ||
+        !ak_finitef(hi.z))
+        return 0;
+    const double ex = floor(((double)hi.x - lo.x) / s + 1e-4), ey = floor(((double)hi.y - lo.y) / s + 1e-4),
+                 ez = floor(((double)hi.z - lo.z) / s + 1e-4);
+    if (!(ex >= 1.0 && ey >= 1.0 && ez >= 1.0) || ex * ey * ez > 1e9) return 0;
+    const size_t nx = (size_t)ex, ny = (size_t)ey, nz = (size_t)ez;
+    size_t k = 0;
+    for (size_t z = 0; z < nz; ++z)
+        for (size_t y = 0; y < ny; ++y)
+            for (size_t x = 0; x < nx; ++x, ++k)
+                if (out_positions.ptr && k < out_positions.count)
+                    out_positions.ptr[k] = ak_vec3_make(lo.x + s * (0.5f + (float)x), lo.y + s * (0.5f + (float)y),
+                                                        lo.z + s * (0.5f + (float)z));
+    return k;
+}
+
+/* ---- scratch ---------------------------------------------------------------------- */
+
+typedef struct layout {
+    size_t grid, nb_count, nb, xp, dp, lambda, rho, pres, omega, vnew, flags, total;
+} layout;
+
+static size_t align16(size_t x) { return (x + 15u) & ~(size_t)15u; }
+
+static bool make_layout(size_t cap, const ak_fluid_desc* d, layout* L) {
+    if (cap >= ((size_t)1 << 31)) return false;
+    ak_grid_desc gd = {.cell_size = d->h};
+    size_t gs = ak_grid_memory_size(cap, &gd);
+    if (gs == 0) return false;
+    const size_t K = d->max_neighbours;
+    if (K > ((size_t)1 << 16)) return false;
+    size_t o = 0;
+    L->grid = o; o = align16(o + gs);
+    L->nb_count = o; o = align16(o + cap * 4);
+    L->nb = o; o = align16(o + cap * K * 4);
+    L->xp = o; o = align16(o + cap * sizeof(ak_vec3));
+    L->dp = o; o = align16(o + cap * sizeof(ak_vec3));
+    L->lambda = o; o = align16(o + cap * 4);
+    L->rho = o; o = align16(o + cap * 4);
+    L->pres = o; o = align16(o + cap * 4);
+    L->omega = o; o = align16(o + cap * sizeof(ak_vec3));
+    L->vnew = o; o = align16(o + cap * sizeof(ak_vec3));
+    L->flags = o; o = align16(o + cap);
+    L->total = o + 16; /* slack to align the base */
+    return true;
+}
+
+size_t ak_fluid_scratch_size(size_t capacity, const ak_fluid_desc* desc) {
+    if (!desc_ok(desc)) return 0;
+    ak_fluid_desc d = ak_fluid_desc_resolved(desc);
+    layout L;
+    if (!make_layout(capacity, &d, &L)) return 0;
+    return L.total;
+}
+
+/* ---- validation ------------------------------------------------------------------- */
+
+static bool vfinite(ak_vec3 v) { return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z); }
+
+ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
+    if (!job || !job->desc || !job->particle_count || !job->positions.ptr || !job->velocities.ptr ||
+        !job->scratch.ptr)
+        return AK_ERR_NULL_ARG;
+    if ((job->colliders.count && !job->colliders.ptr) || (job->emitters.count && !job->emitters.ptr) ||
+        (job->sinks.count && !job->sinks.ptr) || (job->out_densities.count && !job->out_densities.ptr) ||
+        (job->out_pressures.count && !job->out_pressures.ptr) || (job->out_flags.count && !job->out_flags.ptr))
+        return AK_ERR_NULL_ARG;
+    const ak_fluid_desc* d = job->desc;
+    if (!desc_ok(d) || !(job->dt > 0.0f) || !ak_finitef(job->dt) || !ak_finitef(job->time) ||
+        (unsigned)d->solver >= AK_FLUID_SOLVER_COUNT || job->thread_count > FLUID_MAX_THREADS ||
+        d->iterations > 1000 || !(d->relaxation >= 0.0f) || !ak_finitef(d->relaxation) || !(d->stiffness >= 0.0f) ||
+        !ak_finitef(d->stiffness) || !(d->viscosity >= 0.0f) || !ak_finitef(d->viscosity) ||
+        !(d->sound_speed >= 0.0f) || !ak_finitef(d->sound_speed) || !(d->tait_gamma >= 0.0f) ||
+        !(d->tait_gamma <= 100.0f) || !(d->friction >= 0.0f) || !(d->friction <= 1.0f) ||
+        !ak_finitef(d->scorr_k) || !(d->scorr_n >= 0.0f) || !(d->scorr_n <= 16.0f) || !(d->scorr_dq >= 0.0f) ||
+        !(d->scorr_dq < 1.0f) || !(d->xsph_c >= 0.0f) || !(d->xsph_c <= 1.0f) || !ak_finitef(d->vorticity_epsilon) ||
+        !vfinite(d->gravity) || !vfinite(d->box_min) || !vfinite(d->box_max) || d->box_min.x > d->box_max.x ||
+        d->box_min.y > d->box_max.y || d->box_min.z > d->box_max.z || d->max_neighbours > 65536)
+        return AK_ERR_BAD_ARG;
+    for (size_t c = 0; c < job->colliders.count; ++c) {
+        const ak_fluid_collider* k = &job->colliders.ptr[c];
+        if ((unsigned)k->shape >= AK_FLUID_SHAPE_COUNT || !(k->radius >= 0.0f) || !ak_finitef(k->radius) ||
+            !vfinite(k->a) || !vfinite(k->b) || !vfinite(k->normal) || !vfinite(k->velocity))
+            return AK_ERR_BAD_ARG;
+    }
+    for (size_t e = 0; e < job->emitters.count; ++e) {
+        const ak_fluid_emitter* m = &job->emitters.ptr[e];
+        if (!(m->speed > 0.0f) || !ak_finitef(m->speed) || !(m->radius >= 0.0f) || !ak_finitef(m->radius) ||
+            !vfinite(m->position) || !vfinite(m->direction) || !ak_finitef(m->start_time) ||
+            !ak_finitef(m->stop_time) || m->radius > 4096.0f * ak_fluid_rest_spacing(d))
+            return AK_ERR_BAD_ARG;
+    }
+    for (size_t s = 0; s < job->sinks.count; ++s)
+        if (!vfinite(job->sinks.ptr[s].min) || !vfinite(job->sinks.ptr[s].max)) return AK_ERR_BAD_ARG;
+    const size_t cap = job->positions.count, n = *job->particle_count;
+    if (job->velocities.count < cap || n > cap || (job->out_densities.ptr && job->out_densities.count < cap) ||
+        (job->out_pressures.ptr && job->out_pressures.count < cap) || (job->out_flags.ptr && job->out_flags.count < cap))
+        return AK_ERR_SPAN_SMALL;
+    const size_t need = ak_fluid_scratch_size(cap, d);
+    if (need == 0) return AK_ERR_BAD_ARG;
+    if (job->scratch.count < need) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i)
+        if (!vfinite(job->positions.ptr[i]) || !vfinite(job->velocities.ptr[i])) return AK_ERR_BAD_DATA;
+    return AK_OK;
+}
+
+/* ---- the solver ------------------------------------------------------------------- */
+
+typedef struct ctx {
+    ak_fluid_desc d;
+    const ak_fluid_step_job* job;
+    size_t n;
+    float dt, h, h2, rho0, m, mr; /* mr = m / rho0 */
+    uint32_t K, full_lattice_count;
+    ak_vec3* x;  /* positions (start of step, then final) */
+    ak_vec3* v;  /* velocities */
+    ak_vec3* xp; /* predicted positions */
+    ak_vec3* dp; /* position deltas / accelerations */
+    ak_vec3* omega;
+    ak_vec3* vnew;
+    float *lambda, *rho, *pres;
+    uint32_t *nb_count, *nb;
+    uint8_t* flags;
+    ak_grid grid;
+    float wdq;        /* poly6 at delta q */
+    float grad2_rest; /* sum_k |grad_k C|^2 of the rest lattice */
+    float poly6_k;    /* 315 / (64 pi h^9) */
+    float spiky_k;    /* -45 / (pi h^6) */
+    /* per-thread results */
+    size_t truncated[FLUID_MAX_THREADS];
+} ctx;
+
+/* The public kernels with their constants computed once per step (same float operations). */
+static inline float k_poly6(const ctx* c, float r2) {
+    if (!(r2 < c->h2)) return 0.0f;
+    const float d = c->h2 - r2;
+    return c->poly6_k * d * d * d;
+}
+
+static inline ak_vec3 k_spiky(const ctx* c, ak_vec3 r) {
+    const float r2 = ak_vec3_dot(r, r);
+    if (!(r2 < c->h2) || !(r2 > 0.0f)) return ak_vec3_make(0.0f, 0.0f, 0.0f);
+    const float len = sqrtf(r2), d = c->h - len;
+    return ak_vec3_scale(r, c->spiky_k * d * d / len);
+}
+
+typedef void (*phase_fn)(ctx* c, size_t begin, size_t end, uint32_t t);
+
+typedef struct task {
+    ctx* c;
+    phase_fn fn;
+    size_t begin, end;
+    uint32_t t;
+} task;
+
+static void* task_thread(void* arg) {
+    task* t = (task*)arg;
+    t->fn(t->c, t->begin, t->end, t->t);
+    return NULL;
+}
+
+/* Runs fn over [0, n) split in equal contiguous chunks; the split never changes a result
+ * (every phase writes only its own particles' values). */
+static void parallel_n(ctx* c, phase_fn fn, uint32_t threads, size_t n) {
+    if (threads > 1 && c->n < 1024) threads = 1;
+    task tasks[FLUID_MAX_THREADS];
+    for (uint32_t t = 0; t < threads; ++t)
+        tasks[t] = (task){c, fn, n * t / threads, n * (t + 1) / threads, t};
+    pthread_t ids[FLUID_MAX_THREADS];
+    bool started[FLUID_MAX_THREADS];
+    for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, task_thread, &tasks[t]) == 0;
+    task_thread(&tasks[0]);
+    for (uint32_t t = 1; t < threads; ++t) {
+        if (started[t]) pthread_join(ids[t], NULL);
+        else task_thread(&tasks[t]);
+    }
+}
+
+static void parallel(ctx* c, phase_fn fn, uint32_t threads) { parallel_n(c, fn, threads, c->n); }
+
+/* Collider projection: moves p outside every collider and inside the box; v (may be NULL)
+ * loses its inward normal component relative to the collider, friction scales the rest. */
+static void collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
+    const ak_fluid_desc* d = &c->d;
+    const ak_fluid_step_job* job = c->job;
+    for (size_t k = 0; k < job->colliders.count; ++k) {
+        const ak_fluid_collider* col = &job->colliders.ptr[k];
+        ak_vec3 n;
+        float depth;
+        if (col->shape == AK_FLUID_PLANE) {
+            n = ak_vec3_length_sq(col->normal) > 0.0f ? ak_vec3_normalize(col->normal) : ak_vec3_make(0, 1, 0);
+            depth = -ak_vec3_dot(ak_vec3_sub(*p, col->a), n);
+        } else {
+            ak_vec3 q = col->a;
+            if (col->shape == AK_FLUID_CAPSULE) {
+                ak_vec3 ab = ak_vec3_sub(col->b, col->a);
+                float l2 = ak_vec3_dot(ab, ab);
+                float t = l2 > 0.0f ? ak_vec3_dot(ak_vec3_sub(*p, col->a), ab) / l2 : 0.0f;
+                t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+                q = ak_vec3_add(col->a, ak_vec3_scale(ab, t));
+            }
+            ak_vec3 r = ak_vec3_sub(*p, q);
+            float len = ak_vec3_length(r);
+            if (len >= col->radius) continue;
+            n = len > 1e-12f ? ak_vec3_scale(r, 1.0f / len) : ak_vec3_make(0, 1, 0);
+            depth = col->radius - len;
+        }
+        if (!(depth > 0.0f)) continue;
+        *p = ak_vec3_add(*p, ak_vec3_scale(n, depth));
+        if (v) {
+            ak_vec3 rel = ak_vec3_sub(*v, col->velocity);
+            float vn = ak_vec3_dot(rel, n);
+            if (vn < 0.0f) {
+                ak_vec3 vt = ak_vec3_sub(rel, ak_vec3_scale(n, vn));
+                *v = ak_vec3_add(col->velocity, ak_vec3_scale(vt, 1.0f - d->friction));
+            }
+        }
+    }
+    if (d->box_min.x < d->box_max.x || d->box_min.y < d->box_max.y || d->box_min.z < d->box_max.z) {
+        float* pc = &p->x;
+        float* vc = v ? &v->x : NULL;
+        const float* lo = &d->box_min.x;
+        const float* hi = &d->box_max.x;
+        bool hit = false;
+        for (int a = 0; a < 3; ++a) {
+            if (pc[a] < lo[a]) {
+                pc[a] = lo[a];
+                if (vc && vc[a] < 0.0f) vc[a] = 0.0f;
+                hit = true;
+            } else if (pc[a] > hi[a]) {
+                pc[a] = hi[a];
+                if (vc && vc[a] > 0.0f) vc[a] = 0.0f;
+                hit = true;
+            }
+        }
+        if (hit && vc && d->friction > 0.0f) {
+            for (int a = 0; a < 3; ++a)
+                if (pc[a] > lo[a] && pc[a] < hi[a]) vc[a] *= 1.0f - d->friction;
+        }
+    }
+}
+
+/* Distance from p to the nearest boundary surface (box walls and colliders). */
+static float boundary_distance(const ctx* c, ak_vec3 p) {
+    const ak_fluid_desc* d = &c->d;
+    float best = INFINITY;
+    if (d->box_min.x < d->box_max.x || d->box_min.y < d->box_max.y || d->box_min.z < d->box_max.z) {
+        const float* pc = &p.x;
+        const float* lo = &d->box_min.x;
+        const float* hi = &d->box_max.x;
+        for (int a = 0; a < 3; ++a) {
+            float e = fminf(pc[a] - lo[a], hi[a] - pc[a]);
+            if (e < best) best = e;
+        }
+    }
+    for (size_t k = 0; k < c->job->colliders.count; ++k) {
+        const ak_fluid_collider* col = &c->job->colliders.ptr[k];
+        float e;
+        if (col->shape == AK_FLUID_PLANE) {
+            ak_vec3 n = ak_vec3_length_sq(col->normal) > 0.0f ? ak_vec3_normalize(col->normal) : ak_vec3_make(0, 1, 0);
+            e = ak_vec3_dot(ak_vec3_sub(p, col->a), n);
+        } else {
+            ak_vec3 q = col->a;
+            if (col->shape == AK_FLUID_CAPSULE) {
+                ak_vec3 ab = ak_vec3_sub(col->b, col->a);
+                float l2 = ak_vec3_dot(ab, ab);
+                float t = l2 > 0.0f ? ak_vec3_dot(ak_vec3_sub(p, col->a), ab) / l2 : 0.0f;
+                t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+                q = ak_vec3_add(col->a, ak_vec3_scale(ab, t));
+            }
+            e = ak_vec3_distance(p, q) - col->radius;
+        }
+        if (e < best) best = e;
+    }
+    return best;
+}
+
+/* Neighbour lists by cell: for grid cells [b, e), every point of the cell scans the 27 cells
+ * around it (fixed order), each in sorted order, with the grid's distance test. A particle's
+ * list depends only on the grid, never on the split. */
+static void ph_neighbours_cells(ctx* c, size_t b, size_t e, uint32_t t) {
+    const ak_grid* g = &c->grid;
+    const float r2 = c->h * c->h;
+    size_t trunc = 0;
+    uint32_t around[27];
+    for (size_t m = b; m < e; ++m) {
+        const ak_grid_cell cc = g->cell_coord[m];
+        int na = 0;
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    uint32_t m2 = ak_grid_cell_find(g, (ak_grid_cell){cc.x + dx, cc.y + dy, cc.z + dz});
+                    if (m2 != UINT32_MAX) around[na++] = m2;
+                }
+        for (uint32_t a = g->cell_start[m]; a < g->cell_start[m + 1]; ++a) {
+            const float qx = g->x[a], qy = g->y[a], qz = g->z[a];
+            const uint32_t i = g->order[a];
+            uint32_t* list = c->nb + (size_t)i * c->K;
+            uint32_t k = 0, total = 0;
+            for (int q = 0; q < na; ++q) {
+                const uint32_t m2 = around[q];
+                for (uint32_t bq = g->cell_start[m2]; bq < g->cell_start[m2 + 1]; ++bq) {
+                    const float ddx = g->x[bq] - qx, ddy = g->y[bq] - qy, ddz = g->z[bq] - qz;
+                    if (ddx * ddx + ddy * ddy + ddz * ddz < r2) {
+                        if (k < c->K) list[k++] = g->order[bq];
+                        ++total;
+                    }
+                }
+            }
+            if (total > c->K) ++trunc;
+            c->nb_count[i] = k;
+        }
+    }
+    c->truncated[t] = trunc;
+}
+
+static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        const uint32_t* nb = c->nb + i * c->K;
+        const ak_vec3 pi = c->xp[i];
+        float rho = 0.0f;
+        for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
+            ak_vec3 r = ak_vec3_sub(pi, c->xp[nb[q]]);
+            rho += k_poly6(c, ak_vec3_dot(r, r));
+        }
+        c->rho[i] = rho * c->m;
+    }
+}
+
+/* PBF: density and lambda_i = -C_i / (sum_k |grad_k C_i|^2 + epsilon). */
+static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        const uint32_t* nb = c->nb + i * c->K;
+        const ak_vec3 pi = c->xp[i];
+        float rho = 0.0f, sum_gj2 = 0.0f;
+        ak_vec3 gi = {0.0f, 0.0f, 0.0f};
+        for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
+            ak_vec3 r = ak_vec3_sub(pi, c->xp[nb[q]]);
+            rho += k_poly6(c, ak_vec3_dot(r, r));
+            ak_vec3 g = ak_vec3_scale(k_spiky(c, r), c->mr);
+            gi = ak_vec3_add(gi, g);
+            sum_gj2 += ak_vec3_dot(g, g);
+        }
+        rho *= c->m;
+        c->rho[i] = rho;
+        float C = rho / c->rho0 - 1.0f;
+        if (!c->d.bilateral && C < 0.0f) C = 0.0f;
+        c->lambda[i] = -C / (ak_vec3_dot(gi, gi) + sum_gj2 + c->d.relaxation);
+    }
+}
+
+/* PBF: dp_i = (m/rho0) sum_j (lambda_i + lambda_j + s_corr) grad W(p_i - p_j), then the
+ * collision response on p_i + dp_i (written to dp as the new predicted position). */
+static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
+    const float k = c->d.scorr_k / c->grad2_rest, np = c->d.scorr_n, inv_wdq = scorr ? 1.0f / c->wdq : 0.0f;
+    const bool n4 = np == 4.0f;
+    for (size_t i = b; i < e; ++i) {
+        const uint32_t* nb = c->nb + i * c->K;
+        const ak_vec3 pi = c->xp[i];
+        const float li = c->lambda[i];
+        ak_vec3 acc = {0.0f, 0.0f, 0.0f};
+        for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
+            const uint32_t j = nb[q];
+            if (j == i) continue;
+            ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
+            float s = 0.0f;
+            if (scorr) {
+                float w = k_poly6(c, ak_vec3_dot(r, r)) * inv_wdq;
+                float w2 = w * w;
+                s = -k * (n4 ? w2 * w2 : powf(w, np));
+            }
+            acc = ak_vec3_add(acc, ak_vec3_scale(k_spiky(c, r), li + c->lambda[j] + s));
+        }
+        ak_vec3 p = ak_vec3_add(pi, ak_vec3_scale(acc, c->mr));
+        collide(c, &p, NULL);
+        c->dp[i] = p;
+    }
+}
+
+/* PBF: v = (x* - x) / dt; vorticity omega_i = sum_j (m / rho_j) v_ij x grad_j W_ij (1/s). */
+static void ph_velocity(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const float inv_dt = 1.0f / c->dt;
+    for (size_t i = b; i < e; ++i) c->v[i] = ak_vec3_scale(ak_vec3_sub(c->xp[i], c->x[i]), inv_dt);
+}
+
+static void ph_vorticity(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        const uint32_t* nb = c->nb + i * c->K;
+        ak_vec3 w = {0.0f, 0.0f, 0.0f};
+        for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
+            const uint32_t j = nb[q];
+            ak_vec3 vij = ak_vec3_sub(c->v[j], c->v[i]);
+            /* grad_{p_j} W(p_i - p_j) = -grad W(p_i - p_j) */
+            ak_vec3 g = ak_vec3_neg(k_spiky(c, ak_vec3_sub(c->xp[i], c->xp[j])));
+            if (c->rho[j] > 0.0f) w = ak_vec3_add(w, ak_vec3_scale(ak_vec3_cross(vij, g), c->m / c->rho[j]));
+        }
+        c->omega[i] = w;
+    }
+}
+
+/* PBF: vorticity confinement f = eps (N x omega), N = eta / |eta|, eta = grad |omega|, and
+ * XSPH v_i += c sum_j (m / rho_j) v_ij W_ij (the paper drops m / rho_j with its unit mass),
+ * both from the same velocity snapshot. */
+static void ph_xsph(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const float eps = c->d.vorticity_epsilon, xc = c->d.xsph_c;
+    for (size_t i = b; i < e; ++i) {
+        const uint32_t* nb = c->nb + i * c->K;
+        const ak_vec3 pi = c->xp[i];
+        ak_vec3 eta = {0.0f, 0.0f, 0.0f}, xs = {0.0f, 0.0f, 0.0f};
+        for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
+            const uint32_t j = nb[q];
+            ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
+            if (eps != 0.0f && c->rho[j] > 0.0f)
+                eta = ak_vec3_add(eta, ak_vec3_scale(k_spiky(c, r),
+                                                     c->m / c->rho[j] * ak_vec3_length(c->omega[j])));
+            if (xc != 0.0f && c->rho[j] > 0.0f)
+                xs = ak_vec3_add(xs, ak_vec3_scale(ak_vec3_sub(c->v[j], c->v[i]),
+                                                   c->m / c->rho[j] * k_poly6(c, ak_vec3_dot(r, r))));
+        }
+        ak_vec3 vi = ak_vec3_add(c->v[i], ak_vec3_scale(xs, xc));
+        if (eps != 0.0f) {
+            float el = ak_vec3_length(eta);
+            if (el > 1e-20f) {
+                ak_vec3 N = ak_vec3_scale(eta, 1.0f / el);
+                vi = ak_vec3_add(vi, ak_vec3_scale(ak_vec3_cross(N, c->omega[i]), eps * c->dt));
+            }
+        }
+        c->vnew[i] = vi;
+    }
+}
+
+/* SPH / WCSPH: pressure from density. */
+static void ph_pressure(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const ak_fluid_desc* d = &c->d;
+    if (d->solver == AK_FLUID_SPH) {
+        for (size_t i = b; i < e; ++i) c->pres[i] = d->stiffness * (c->rho[i] - c->rho0);
+    } else {
+        const float B = c->rho0 * d->sound_speed * d->sound_speed / d->tait_gamma;
+        for (size_t i = b; i < e; ++i) c->pres[i] = B * (powf(c->rho[i] / c->rho0, d->tait_gamma) - 1.0f);
+    }
+}
+
+/* SPH / WCSPH: accelerations into dp. */
+static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const ak_fluid_desc* d = &c->d;
+    const bool mcg = d->solver == AK_FLUID_SPH;
+    const float mu = d->viscosity, m = c->m, h = c->h;
+    for (size_t i = b; i < e; ++i) {
+        const uint32_t* nb = c->nb + i * c->K;
+        const ak_vec3 pi = c->xp[i], vi = c->v[i];
+        const float rhoi = c->rho[i], pri = c->pres[i];
+        ak_vec3 a = {0.0f, 0.0f, 0.0f};
+        for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
+            const uint32_t j = nb[q];
+            if (j == i) continue;
+            ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
+            ak_vec3 g = k_spiky(c, r);
+            const float rhoj = c->rho[j];
+            if (mcg) {
+                /* f_i = -sum m (p_i + p_j) / (2 rho_j) grad W + mu sum m v_ij / rho_j lap W; a = f / rho_i */
+                a = ak_vec3_add(a, ak_vec3_scale(g, -m * (pri + c->pres[j]) / (2.0f * rhoj)));
+                if (mu != 0.0f)
+                    a = ak_vec3_add(a, ak_vec3_scale(ak_vec3_sub(c->v[j], vi),
+                                                     mu * m / rhoj * ak_fluid_visc_laplacian(ak_vec3_length(r), h)));
+            } else {
+                float coef = pri / (rhoi * rhoi) + c->pres[j] / (rhoj * rhoj);
+                if (mu != 0.0f) {
+                    ak_vec3 vij = ak_vec3_sub(vi, c->v[j]);
+                    float vx = ak_vec3_dot(vij, r);
+                    if (vx < 0.0f) {
+                        float nu = 2.0f * mu * h * d->sound_speed / (rhoi + rhoj);
+                        coef += -nu * vx / (ak_vec3_dot(r, r) + 0.01f * h * h);
+                    }
+                }
+                a = ak_vec3_add(a, ak_vec3_scale(g, -m * coef));
+            }
+        }
+        if (mcg) a = ak_vec3_scale(a, 1.0f / rhoi);
+        c->dp[i] = ak_vec3_add(a, d->gravity);
+    }
+}
+
+static void ph_integrate(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        ak_vec3 v = ak_vec3_add(c->v[i], ak_vec3_scale(c->dp[i], c->dt));
+        ak_vec3 p = ak_vec3_add(c->xp[i], ak_vec3_scale(v, c->dt));
+        collide(c, &p, &v);
+        c->x[i] = p;
+        c->v[i] = v;
+    }
+}
+
+static void ph_flags(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const uint32_t surf = (c->full_lattice_count * 3u) / 4u;
+    for (size_t i = b; i < e; ++i) {
+        uint8_t f = 0;
+        if (c->nb_count[i] < surf) f |= AK_FLUID_FLAG_SURFACE;
+        else if (boundary_distance(c, c->xp[i]) >= c->h) f |= AK_FLUID_FLAG_FULL;
+        c->flags[i] = f;
+    }
+}
+
+/* A full neighbourhood also needs every neighbour away from the free surface. */
+static void ph_full(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        if (!(c->flags[i] & AK_FLUID_FLAG_FULL)) continue;
+        const uint32_t* nb = c->nb + i * c->K;
+        bool full = true;
+        for (uint32_t q = 0; q < c->nb_count[i] && full; ++q) full = !(c->flags[nb[q]] & AK_FLUID_FLAG_SURFACE);
+        c->lambda[i] = full ? 1.0f : 0.0f;
+    }
+    for (size_t i = b; i < e; ++i)
+        if ((c->flags[i] & AK_FLUID_FLAG_FULL) && c->lambda[i] == 0.0f) c->flags[i] = 0;
+}
+
+static double now_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Emitters: layer k of an emitter leaves the nozzle at start + k * s / speed; every layer due
+ * in [time, time + dt) is added, advanced along the flow by the time left in the step. */
+static void emit(const ak_fluid_step_job* job, float s, size_t* n, ak_fluid_stats* st) {
+    const size_t cap = job->positions.count;
+    const float t0 = job->time, t1 = job->time + job->dt;
+    for (size_t e = 0; e < job->emitters.count; ++e) {
+        const ak_fluid_emitter* em = &job->emitters.ptr[e];
+        ak_vec3 dir = ak_vec3_length_sq(em->direction) > 0.0f ? ak_vec3_normalize(em->direction)
+                                                               : ak_vec3_make(0.0f, -1.0f, 0.0f);
+        /* an orthonormal basis of the nozzle plane */
+        ak_vec3 helper = fabsf(dir.y) < 0.9f ? ak_vec3_make(0, 1, 0) : ak_vec3_make(1, 0, 0);
+        ak_vec3 u = ak_vec3_normalize(ak_vec3_cross(helper, dir));
+        ak_vec3 w = ak_vec3_cross(dir, u);
+        const double period = (double)s / em->speed;
+        double kf = ceil(((double)t0 - em->start_time) / period);
+        if (kf < 0.0) kf = 0.0;
+        const int ring = (int)floorf(em->radius / s);
+        for (int guard = 0; guard < 100000; ++guard, kf += 1.0) {
+            const double te = em->start_time + kf * period;
+            if (te >= t1) break;
+            if (te < t0) continue;
+            if (em->stop_time > 0.0f && te >= em->stop_time) break;
+            const float ahead = (float)((t1 - te) * em->speed);
+            const float r2 = em->radius * em->radius + 1e-6f * s * s;
+            for (int a = -ring; a <= ring; ++a) {
+                const float fa = (float)a * s;
+                if (fa * fa > r2) continue;
+                if (*n >= cap) { /* full: count this row's lattice points without visiting them */
+                    const double bmax = floor(sqrt((double)r2 - (double)fa * fa) / s);
+                    if (st) st->emit_dropped_count += (size_t)(2.0 * bmax + 1.0);
+                    continue;
+                }
+                for (int bq = -ring; bq <= ring; ++bq) {
+                    const float fb = (float)bq * s;
+                    if (fa * fa + fb * fb > r2) continue;
+                    if (*n >= cap) {
+                        if (st) ++st->emit_dropped_count;
+                        continue;
+                    }
+                    ak_vec3 p = ak_vec3_add(em->position,
+                                            ak_vec3_add(ak_vec3_add(ak_vec3_scale(u, fa), ak_vec3_scale(w, fb)),
+                                                        ak_vec3_scale(dir, ahead)));
+                    job->positions.ptr[*n] = p;
+                    job->velocities.ptr[*n] = ak_vec3_scale(dir, em->speed);
+                    ++*n;
+                    if (st) ++st->emitted_count;
+                }
+            }
+        }
+    }
+}
+
+ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
+    ak_result r = ak_fluid_step_validate(job);
+    if (r != AK_OK) return r;
+    ctx* c = NULL;
+    ctx cstore;
+    c = &cstore;
+    memset(c, 0, sizeof *c);
+    c->d = ak_fluid_desc_resolved(job->desc);
+    c->job = job;
+    c->dt = job->dt;
+    c->h = c->d.h;
+    c->h2 = c->h * c->h;
+    c->rho0 = c->d.rest_density;
+    c->m = c->d.particle_mass;
+    c->mr = c->m / c->rho0;
+    c->K = c->d.max_neighbours;
+    const float s = cbrtf(c->mr);
+    lattice_props(c->h, s, c->mr, &c->full_lattice_count, &c->grad2_rest);
+    {
+        const float h2 = c->h * c->h, h3 = h2 * c->h;
+        c->poly6_k = (float)(315.0 / (64.0 * FLUID_PI)) / (h2 * h2 * h2 * h2 * c->h);
+        c->spiky_k = -(float)(45.0 / FLUID_PI) / (h3 * h3);
+    }
+    c->wdq = ak_fluid_poly6(c->d.scorr_dq * c->h * c->d.scorr_dq * c->h, c->h);
+
+    ak_fluid_stats st;
+    memset(&st, 0, sizeof st);
+    const size_t cap = job->positions.count;
+    layout L;
+    memset(&L, 0, sizeof L);
+    if (!make_layout(cap, &c->d, &L)) return AK_ERR_BAD_ARG;
+    uint8_t* base = job->scratch.ptr;
+    base += (16u - ((uintptr_t)base & 15u)) & 15u;
+    c->nb_count = (uint32_t*)(void*)(base + L.nb_count);
+    c->nb = (uint32_t*)(void*)(base + L.nb);
+    c->xp = (ak_vec3*)(void*)(base + L.xp);
+    c->dp = (ak_vec3*)(void*)(base + L.dp);
+    c->lambda = (float*)(void*)(base + L.lambda);
+    c->rho = (float*)(void*)(base + L.rho);
+    c->pres = (float*)(void*)(base + L.pres);
+    c->omega = (ak_vec3*)(void*)(base + L.omega);
+    c->vnew = (ak_vec3*)(void*)(base + L.vnew);
+    c->flags = base + L.flags;
+    c->x = job->positions.ptr;
+    c->v = job->velocities.ptr;
+
+    size_t n = *job->particle_count;
+    emit(job, s, &n, &st);
+    c->n = n;
+    const uint32_t threads = job->thread_count ? job->thread_count : 1;
+    const float dt = c->dt;
+    const bool pbf = c->d.solver == AK_FLUID_PBF;
+
+    /* predict (PBF) or take the current positions (SPH) */
+    for (size_t i = 0; i < n; ++i) {
+        if (pbf) {
+            c->v[i] = ak_vec3_add(c->v[i], ak_vec3_scale(c->d.gravity, dt));
+            ak_vec3 p = ak_vec3_add(c->x[i], ak_vec3_scale(c->v[i], dt));
+            collide(c, &p, NULL);
+            c->xp[i] = p;
+        } else {
+            c->xp[i] = c->x[i];
+        }
+    }
+    const double t_nb = now_seconds();
+    ak_grid_desc gd = {.cell_size = c->h};
+    const size_t gbytes = ak_grid_memory_size(n, &gd);
+    r = ak_grid_build(&gd, (ak_vec3_cspan){c->xp, n}, (ak_u8_span){base + L.grid, gbytes}, &c->grid);
+    if (r != AK_OK) return AK_ERR_NO_CONVERGENCE; /* only non-finite predictions fail here */
+    parallel_n(c, ph_neighbours_cells, threads, c->grid.cell_count);
+    st.neighbour_seconds = (float)(now_seconds() - t_nb);
+
+    if (pbf) {
+        for (uint32_t it = 0; it < c->d.iterations; ++it) {
+            parallel(c, ph_lambda, threads);
+            parallel(c, ph_delta, threads);
+            ak_vec3* tmp = c->xp;
+            c->xp = c->dp;
+            c->dp = tmp;
+        }
+        parallel(c, ph_velocity, threads);
+        parallel(c, ph_density, threads);
+        if (c->d.vorticity_epsilon != 0.0f) parallel(c, ph_vorticity, threads);
+        if (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f) {
+            parallel(c, ph_xsph, threads);
+            memcpy(c->v, c->vnew, n * sizeof(ak_vec3));
+        }
+        for (size_t i = 0; i < n; ++i) c->x[i] = c->xp[i];
+        if (job->out_pressures.ptr) memset(job->out_pressures.ptr, 0, n * sizeof(float));
+    } else {
+        parallel(c, ph_density, threads);
+        parallel(c, ph_pressure, threads);
+        parallel(c, ph_forces, threads);
+        parallel(c, ph_integrate, threads);
+        if (job->out_pressures.ptr) memcpy(job->out_pressures.ptr, c->pres, n * sizeof(float));
+    }
+    parallel(c, ph_flags, threads);
+    parallel(c, ph_full, threads);
+
+    /* blow-up check, statistics */
+    const float limit = 100.0f * c->h;
+    bool blown = false;
+    double sum = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        ak_vec3 v = c->v[i];
+        if (!vfinite(c->x[i]) || !vfinite(v) || !(ak_vec3_length(v) * dt <= limit)) blown = true;
+        if (c->flags[i] & AK_FLUID_FLAG_SURFACE) ++st.surface_count;
+        if (c->flags[i] & AK_FLUID_FLAG_FULL) {
+            float err = fabsf(c->rho[i] / c->rho0 - 1.0f);
+            if (err > st.max_density_error) st.max_density_error = err;
+            sum += err;
+            ++st.full_count;
+        }
+    }
+    st.mean_density_error = st.full_count ? (float)(sum / (double)st.full_count) : 0.0f;
+    for (uint32_t t = 0; t < FLUID_MAX_THREADS; ++t) st.truncated_count += c->truncated[t];
+    if (job->out_densities.ptr) memcpy(job->out_densities.ptr, c->rho, n * sizeof(float));
+    if (job->out_flags.ptr) memcpy(job->out_flags.ptr, c->flags, n);
+
+    /* sinks: stable compaction (order of the survivors kept) */
+    if (job->sinks.count) {
+        size_t w = 0;
+        for (size_t i = 0; i < n; ++i) {
+            ak_vec3 p = c->x[i];
+            bool gone = false;
+            for (size_t k = 0; k < job->sinks.count && !gone; ++k) {
+                const ak_fluid_sink* sk = &job->sinks.ptr[k];
+                gone = p.x >= sk->min.x && p.x <= sk->max.x && p.y >= sk->min.y && p.y <= sk->max.y &&
+                       p.z >= sk->min.z && p.z <= sk->max.z;
+            }
+            if (gone) {
+                ++st.removed_count;
+                continue;
+            }
+            if (w != i) {
+                c->x[w] = c->x[i];
+                c->v[w] = c->v[i];
+                if (job->out_densities.ptr) job->out_densities.ptr[w] = job->out_densities.ptr[i];
+                if (job->out_pressures.ptr) job->out_pressures.ptr[w] = job->out_pressures.ptr[i];
+                if (job->out_flags.ptr) job->out_flags.ptr[w] = job->out_flags.ptr[i];
+            }
+            ++w;
+        }
+        n = w;
+    }
+    *job->particle_count = n;
+    if (job->out_stats) *job->out_stats = st;
+    return blown ? AK_ERR_NO_CONVERGENCE : AK_OK;
+}

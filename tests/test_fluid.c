@@ -1,0 +1,420 @@
+/* Fluids: MCG kernels, lattice density, hydrostatic SPH column, PBF dam break, free fall,
+ * colliders, emitters and sinks, thread-count independence. */
+#include <animkit/fluid.h>
+
+#include "ak_test.h"
+
+#define PI_D 3.14159265358979323846
+
+typedef float (*radial_fn)(float r, float h);
+static float poly6_r(float r, float h) { return ak_fluid_poly6(r * r, h); }
+
+/* int_0^h f(r) 4 pi r^2 dr by the midpoint rule in double. */
+static double integrate(radial_fn f, float h) {
+    const int steps = 20000;
+    double sum = 0.0, dr = (double)h / steps;
+    for (int k = 0; k < steps; ++k) {
+        double r = (k + 0.5) * dr;
+        sum += (double)f((float)r, h) * 4.0 * PI_D * r * r * dr;
+    }
+    return sum;
+}
+
+AK_TEST(kernels_integrate_to_one) {
+    const float hs[] = {0.05f, 0.1f, 1.0f};
+    for (int k = 0; k < 3; ++k) {
+        float h = hs[k];
+        AK_CHECK_NEAR(integrate(poly6_r, h), 1.0, 1e-3);
+        AK_CHECK_NEAR(integrate(ak_fluid_spiky, h), 1.0, 1e-3);
+        AK_CHECK_NEAR(integrate(ak_fluid_visc, h), 1.0, 2e-3);
+        /* the Laplacian's regular part integrates to 15 / h^2 (see fluid.h) */
+        AK_CHECK_NEAR(integrate(ak_fluid_visc_laplacian, h) * h * h, 15.0, 1e-2);
+    }
+}
+
+AK_TEST(kernels_support) {
+    const float h = 0.1f;
+    const float rs[] = {0.1f, 0.10001f, 0.2f, 5.0f};
+    for (int k = 0; k < 4; ++k) {
+        float r = rs[k];
+        AK_CHECK(ak_fluid_poly6(r * r, h) == 0.0f);
+        AK_CHECK(ak_fluid_spiky(r, h) == 0.0f);
+        AK_CHECK(ak_fluid_visc(r, h) == 0.0f);
+        AK_CHECK(ak_fluid_visc_laplacian(r, h) == 0.0f);
+        ak_vec3 g = ak_fluid_spiky_grad(ak_vec3_make(r, 0, 0), h);
+        AK_CHECK(g.x == 0.0f && g.y == 0.0f && g.z == 0.0f);
+        g = ak_fluid_poly6_grad(ak_vec3_make(0, 0, r), h);
+        AK_CHECK(g.x == 0.0f && g.y == 0.0f && g.z == 0.0f);
+    }
+    AK_CHECK(ak_fluid_poly6(0.0099f * 0.0099f, 0.1f) > 0.0f);
+    AK_CHECK(ak_fluid_spiky(0.099f, 0.1f) > 0.0f);
+}
+
+AK_TEST(kernel_gradients_match_finite_differences) {
+    const float h = 1.0f, e = 1e-3f;
+    const ak_vec3 pts[] = {{0.3f, 0.2f, -0.1f}, {0.05f, -0.6f, 0.4f}, {-0.5f, 0.5f, 0.5f}};
+    for (int k = 0; k < 3; ++k) {
+        ak_vec3 r = pts[k];
+        ak_vec3 gs = ak_fluid_spiky_grad(r, h), gp = ak_fluid_poly6_grad(r, h);
+        float fs[3], fp[3];
+        for (int a = 0; a < 3; ++a) {
+            ak_vec3 rp = r, rm = r;
+            (&rp.x)[a] += e;
+            (&rm.x)[a] -= e;
+            fs[a] = (ak_fluid_spiky(ak_vec3_length(rp), h) - ak_fluid_spiky(ak_vec3_length(rm), h)) / (2 * e);
+            fp[a] = (ak_fluid_poly6(ak_vec3_length_sq(rp), h) - ak_fluid_poly6(ak_vec3_length_sq(rm), h)) / (2 * e);
+        }
+        AK_CHECK_NEAR(gs.x, fs[0], 2e-3 * fabs(fs[0]) + 2e-3);
+        AK_CHECK_NEAR(gs.y, fs[1], 2e-3 * fabs(fs[1]) + 2e-3);
+        AK_CHECK_NEAR(gs.z, fs[2], 2e-3 * fabs(fs[2]) + 2e-3);
+        AK_CHECK_NEAR(gp.x, fp[0], 2e-3 * fabs(fp[0]) + 2e-3);
+        AK_CHECK_NEAR(gp.y, fp[1], 2e-3 * fabs(fp[1]) + 2e-3);
+        AK_CHECK_NEAR(gp.z, fp[2], 2e-3 * fabs(fp[2]) + 2e-3);
+    }
+    /* viscosity: lap W = W'' + 2 W' / r by central differences in double */
+    for (double r = 0.2; r < 0.95; r += 0.15) {
+        const double d = 1e-2;
+        double w0 = ak_fluid_visc((float)r, 1.0f), wp = ak_fluid_visc((float)(r + d), 1.0f),
+               wm = ak_fluid_visc((float)(r - d), 1.0f);
+        double lap = (wp - 2 * w0 + wm) / (d * d) + 2.0 / r * (wp - wm) / (2 * d);
+        AK_CHECK_NEAR(ak_fluid_visc_laplacian((float)r, 1.0f), lap, 0.02 * fabs(lap) + 0.05);
+    }
+}
+
+/* Density of the centre of a lattice block at rest spacing, through the solver (SPH, zero
+ * dt effect measured by out_densities before motion matters). The discretisation error of
+ * poly6 on a cubic lattice (closed-form sums, double): +0.98% at h = 2s, -0.46% at h = 2.5s,
+ * -0.0002% at h = 4s. */
+AK_TEST(lattice_density_is_rest_density) {
+    const float ratios[] = {2.0f, 2.5f, 4.0f};
+    const double bounds[] = {0.012, 0.006, 1e-4};
+    for (int k = 0; k < 3; ++k) {
+        ak_fluid_desc d = {.solver = AK_FLUID_SPH, .particle_mass = 0.001f, .rest_density = 1000.0f};
+        const float s = ak_fluid_rest_spacing(&d);
+        d.h = ratios[k] * s;
+        d.max_neighbours = 400;
+        const int side = 11;
+        ak_vec3 pos[11 * 11 * 11], vel[11 * 11 * 11];
+        float rho[11 * 11 * 11];
+        size_t n = ak_fluid_fill_box(&d, ak_vec3_make(0, 0, 0), ak_vec3_make(side * s, side * s, side * s),
+                                     (ak_vec3_span)AK_SPAN(pos));
+        AK_CHECK_EQ(n, side * side * side);
+        memset(vel, 0, sizeof vel);
+        size_t bytes = ak_fluid_scratch_size(n, &d);
+        void* mem = malloc(bytes);
+        ak_fluid_step_job job = {.desc = &d, .dt = 1e-6f, .positions = {pos, n}, .velocities = {vel, n},
+                                 .particle_count = &n, .scratch = {mem, bytes}, .out_densities = {rho, n}};
+        AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+        size_t centre = (size_t)(5 * side * side + 5 * side + 5);
+        double err = rho[centre] / 1000.0 - 1.0;
+        AK_CHECK_MSG(fabs(err) < bounds[k], "h = %.1fs: density error %.5f", ratios[k], err);
+        free(mem);
+    }
+}
+
+static bool inside_box(const ak_vec3* p, size_t n, ak_vec3 lo, ak_vec3 hi) {
+    for (size_t i = 0; i < n; ++i)
+        if (p[i].x < lo.x || p[i].y < lo.y || p[i].z < lo.z || p[i].x > hi.x || p[i].y > hi.y || p[i].z > hi.z)
+            return false;
+    return true;
+}
+
+/* SPH column at rest in a box: fitted slope of pressure against depth ~ rho0 g. */
+AK_TEST(hydrostatic_column_pressure_is_linear) {
+    ak_fluid_desc d = {.solver = AK_FLUID_WCSPH, .particle_mass = 0.001f, .gravity = {0, -9.81f, 0},
+                       .viscosity = 0.2f, .sound_speed = 15.0f};
+    const float s = ak_fluid_rest_spacing(&d);
+    d.h = 2.0f * s;
+    const int w = 6, ht = 16;
+    d.box_min = ak_vec3_make(0, 0, 0);
+    d.box_max = ak_vec3_make(w * s, 3 * ht * s, w * s);
+    ak_vec3 pos[6 * 6 * 16], vel[6 * 6 * 16];
+    float pres[6 * 6 * 16];
+    uint8_t flags[6 * 6 * 16];
+    size_t n = ak_fluid_fill_box(&d, d.box_min, ak_vec3_make(w * s, ht * s, w * s), (ak_vec3_span)AK_SPAN(pos));
+    memset(vel, 0, sizeof vel);
+    size_t bytes = ak_fluid_scratch_size(n, &d);
+    void* mem = malloc(bytes);
+    ak_fluid_step_job job = {.desc = &d, .dt = 3e-4f, .positions = {pos, n}, .velocities = {vel, n},
+                             .particle_count = &n, .scratch = {mem, bytes}, .out_pressures = {pres, n},
+                             .out_flags = {flags, n}};
+    ak_result r = AK_OK;
+    for (int step = 0; step < 900 && r == AK_OK; ++step) r = ak_fluid_step_run(&job);
+    AK_CHECK_EQ(r, AK_OK);
+    /* free surface: the highest particle; fit p = a + b * depth over particles >= h below it */
+    float top = 0.0f;
+    for (size_t i = 0; i < n; ++i) top = fmaxf(top, pos[i].y);
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int cnt = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double depth = top - pos[i].y;
+        if (depth < d.h || pos[i].y < d.h) continue;
+        sx += depth, sy += pres[i], sxx += depth * depth, sxy += depth * pres[i], ++cnt;
+    }
+    double slope = (cnt * sxy - sx * sy) / (cnt * sxx - sx * sx);
+    double want = 1000.0 * 9.81;
+    printf("  hydrostatic: fitted slope %.1f Pa/m vs rho g %.1f (%d particles)\n", slope, want, cnt);
+    AK_CHECK_MSG(fabs(slope / want - 1.0) < 0.1, "slope %.1f vs rho g %.1f (%d particles)", slope, want, cnt);
+    free(mem);
+}
+
+static void dam_desc(ak_fluid_desc* d, float* s) {
+    *d = (ak_fluid_desc){.solver = AK_FLUID_PBF, .particle_mass = 0.001f, .gravity = {0, -9.81f, 0},
+                         .xsph_c = 0.01f, .vorticity_epsilon = 0.0f, .iterations = 4};
+    *s = ak_fluid_rest_spacing(d);
+    d->h = 2.0f * *s;
+}
+
+AK_TEST(pbf_dam_break_settles_and_stays_in_box) {
+    ak_fluid_desc d;
+    float s;
+    dam_desc(&d, &s);
+    d.box_min = ak_vec3_make(0, 0, 0);
+    d.box_max = ak_vec3_make(10 * s, 24 * s, 8 * s);
+    enum { CAP = 6 * 16 * 8 };
+    ak_vec3 pos[CAP], vel[CAP];
+    size_t n = ak_fluid_fill_box(&d, d.box_min, ak_vec3_make(6 * s, 16 * s, 8 * s), (ak_vec3_span)AK_SPAN(pos));
+    AK_CHECK_EQ(n, CAP);
+    memset(vel, 0, sizeof vel);
+    size_t bytes = ak_fluid_scratch_size(n, &d);
+    void* mem = malloc(bytes);
+    ak_fluid_stats st = {0};
+    /* 1 cm particles: 1/400 s steps (a particle falls less than a spacing per step) */
+    ak_fluid_step_job job = {.desc = &d, .dt = 1.0f / 400.0f, .positions = {pos, n}, .velocities = {vel, n},
+                             .particle_count = &n, .scratch = {mem, bytes}, .out_stats = &st};
+    bool inside = true;
+    ak_result r = AK_OK;
+    for (int step = 0; step < 300 && r == AK_OK; ++step) {
+        r = ak_fluid_step_run(&job);
+        if (getenv("FLUID_DEBUG")) printf("step %d r %d mean %.4f max %.4f full %zu surf %zu\n", step, r, st.mean_density_error, st.max_density_error, st.full_count, st.surface_count);
+        inside = inside && inside_box(pos, n, d.box_min, d.box_max);
+    }
+    AK_CHECK_EQ(r, AK_OK);
+    AK_CHECK(inside);
+    printf("  dam break: mean density error %.4f, max %.4f over %zu full particles\n", st.mean_density_error,
+           st.max_density_error, st.full_count);
+    AK_CHECK_MSG(st.full_count > 20, "%zu full particles", st.full_count);
+    AK_CHECK_MSG(st.mean_density_error < 0.01f, "mean density error %.4f (max %.4f)", st.mean_density_error,
+                 st.max_density_error);
+    /* it spread: the block was 6s wide, the box is 10s */
+    float maxx = 0;
+    for (size_t i = 0; i < n; ++i) maxx = fmaxf(maxx, pos[i].x);
+    AK_CHECK(maxx > 9 * s);
+    free(mem);
+}
+
+static void free_fall(ak_fluid_solver solver) {
+    ak_fluid_desc d;
+    float s;
+    dam_desc(&d, &s);
+    d.solver = solver;
+    d.viscosity = solver == AK_FLUID_PBF ? 0.0f : 0.01f;
+    enum { CAP = 6 * 6 * 6 };
+    ak_vec3 pos[CAP], vel[CAP];
+    /* slightly compressed so internal forces are busy */
+    size_t n = ak_fluid_fill_box(&d, ak_vec3_make(0, 0, 0), ak_vec3_make(6 * s, 6 * s, 6 * s), (ak_vec3_span)AK_SPAN(pos));
+    for (size_t i = 0; i < n; ++i) pos[i] = ak_vec3_scale(pos[i], 0.9f);
+    memset(vel, 0, sizeof vel);
+    size_t bytes = ak_fluid_scratch_size(n, &d);
+    void* mem = malloc(bytes);
+    const float dt = solver == AK_FLUID_PBF ? 1.0f / 240.0f : 1e-4f;
+    ak_fluid_step_job job = {.desc = &d, .dt = dt, .positions = {pos, n}, .velocities = {vel, n},
+                             .particle_count = &n, .scratch = {mem, bytes}};
+    const int steps = 40;
+    for (int k = 0; k < steps; ++k) AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+    double px = 0, py = 0, pz = 0;
+    for (size_t i = 0; i < n; ++i) px += vel[i].x, py += vel[i].y, pz += vel[i].z;
+    const double M = (double)n * d.particle_mass, t = steps * (double)dt;
+    const double want = M * -9.81 * t;
+    AK_CHECK_NEAR(py * d.particle_mass, want, 1e-3 * fabs(want));
+    AK_CHECK_NEAR(px * d.particle_mass, 0.0, 1e-3 * fabs(want));
+    AK_CHECK_NEAR(pz * d.particle_mass, 0.0, 1e-3 * fabs(want));
+    free(mem);
+}
+
+AK_TEST(free_fall_momentum_is_mgt) {
+    free_fall(AK_FLUID_PBF);
+    free_fall(AK_FLUID_SPH);
+    free_fall(AK_FLUID_WCSPH);
+}
+
+/* A particle on a 30-degree plane slides with a = g sin(30): free slip, no sticking. */
+AK_TEST(plane_free_slip_no_sticking) {
+    ak_fluid_desc d = {.solver = AK_FLUID_SPH, .particle_mass = 0.001f, .h = 0.02f, .gravity = {0, -9.81f, 0}};
+    const float c = cosf(0.5235988f), sn = sinf(0.5235988f);
+    ak_fluid_collider plane = {.shape = AK_FLUID_PLANE, .normal = {sn, c, 0}};
+    ak_vec3 pos[1] = {{0, 0, 0}}, vel[1] = {{0, 0, 0}};
+    size_t n = 1;
+    size_t bytes = ak_fluid_scratch_size(1, &d);
+    void* mem = malloc(bytes);
+    ak_fluid_step_job job = {.desc = &d, .dt = 1e-3f, .positions = {pos, 1}, .velocities = {vel, 1},
+                             .particle_count = &n, .colliders = {&plane, 1}, .scratch = {mem, bytes}};
+    for (int k = 0; k < 500; ++k) AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+    float speed = ak_vec3_length(vel[0]);
+    AK_CHECK_NEAR(speed, 9.81f * sn * 0.5f, 0.01f * 9.81f * sn * 0.5f);
+    AK_CHECK(ak_vec3_dot(pos[0], plane.normal) >= -1e-5f);
+    free(mem);
+}
+
+/* Liquid poured on a sphere and a capsule, with a moving sphere sweeping through: no particle
+ * ever ends a step inside a collider or outside the box. */
+AK_TEST(colliders_never_leak) {
+    ak_fluid_desc d;
+    float s;
+    dam_desc(&d, &s);
+    d.box_min = ak_vec3_make(0, 0, 0);
+    d.box_max = ak_vec3_make(20 * s, 30 * s, 20 * s);
+    ak_fluid_collider cols[3] = {
+        {.shape = AK_FLUID_SPHERE, .a = {10 * s, 8 * s, 10 * s}, .radius = 4 * s},
+        {.shape = AK_FLUID_CAPSULE, .a = {2 * s, 3 * s, 5 * s}, .b = {18 * s, 3 * s, 5 * s}, .radius = 2 * s},
+        {.shape = AK_FLUID_SPHERE, .a = {4 * s, 4 * s, 15 * s}, .radius = 3 * s, .velocity = {0.2f, 0, 0}},
+    };
+    enum { CAP = 600 };
+    ak_vec3 pos[CAP], vel[CAP];
+    size_t n = ak_fluid_fill_box(&d, ak_vec3_make(6 * s, 14 * s, 6 * s), ak_vec3_make(14 * s, 20 * s, 14 * s),
+                                 (ak_vec3_span)AK_SPAN(pos));
+    memset(vel, 0, sizeof vel);
+    size_t bytes = ak_fluid_scratch_size(CAP, &d);
+    void* mem = malloc(bytes);
+    const float dt = 1.0f / 400.0f;
+    ak_fluid_step_job job = {.desc = &d, .dt = dt, .positions = {pos, CAP}, .velocities = {vel, CAP},
+                             .particle_count = &n, .colliders = {cols, 3}, .scratch = {mem, bytes}};
+    bool ok = true;
+    for (int k = 0; k < 200; ++k) {
+        AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+        ok = ok && inside_box(pos, n, d.box_min, d.box_max);
+        for (size_t i = 0; i < n; ++i) {
+            float d0 = ak_vec3_distance(pos[i], cols[0].a) - cols[0].radius;
+            float d2 = ak_vec3_distance(pos[i], cols[2].a) - cols[2].radius;
+            float t = (pos[i].x - cols[1].a.x) / (cols[1].b.x - cols[1].a.x);
+            t = t < 0 ? 0 : t > 1 ? 1 : t;
+            ak_vec3 q = ak_vec3_add(cols[1].a, ak_vec3_scale(ak_vec3_sub(cols[1].b, cols[1].a), t));
+            float d1 = ak_vec3_distance(pos[i], q) - cols[1].radius;
+            if (d0 < -1e-4f * s || d1 < -1e-4f * s || d2 < -1e-4f * s) {
+                if (ok) printf("  step %d particle %zu inside: %g %g %g\n", k, i, d0, d1, d2);
+                ok = false;
+            }
+        }
+        cols[2].a.x += cols[2].velocity.x * dt;
+    }
+    AK_CHECK(ok);
+    free(mem);
+}
+
+AK_TEST(emitter_and_sink) {
+    ak_fluid_desc d;
+    float s;
+    dam_desc(&d, &s);
+    d.gravity = ak_vec3_make(0, 0, 0);
+    /* a disc of radius 1.2 s holds the 9 lattice points with a^2 + b^2 <= 1.44: (0,0), 4 axis, 4 diagonal */
+    ak_fluid_emitter em = {.position = {0, 0, 0}, .direction = {0, 0, 1}, .radius = 1.5f * s, .speed = 1.0f};
+    ak_fluid_sink sink = {.min = {-1, -1, 20 * s}, .max = {1, 1, 10}};
+    enum { CAP = 2000 };
+    static ak_vec3 pos[CAP], vel[CAP];
+    size_t n = 0;
+    size_t bytes = ak_fluid_scratch_size(CAP, &d);
+    void* mem = malloc(bytes);
+    ak_fluid_stats st;
+    const float dt = 1.0f / 240.0f;
+    ak_fluid_step_job job = {.desc = &d, .dt = dt, .positions = {pos, CAP}, .velocities = {vel, CAP},
+                             .particle_count = &n, .emitters = {&em, 1}, .scratch = {mem, bytes}, .out_stats = &st};
+    size_t emitted = 0;
+    const int steps = 24;
+    for (int k = 0; k < steps; ++k) {
+        job.time = k * dt;
+        AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+        emitted += st.emitted_count;
+    }
+    /* layers at t = k s / speed for t < steps dt */
+    size_t layers = (size_t)ceil(steps * dt / s);
+    AK_CHECK_EQ(emitted, layers * 9);
+    AK_CHECK_EQ(n, emitted);
+    /* a sink across the stream removes what flows into it */
+    job.sinks = (ak_fluid_sink_cspan){&sink, 1};
+    job.emitters = (ak_fluid_emitter_cspan){NULL, 0};
+    size_t removed = 0;
+    for (int k = 0; k < 800; ++k) {
+        AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+        removed += st.removed_count;
+    }
+    AK_CHECK_EQ(n, 0);
+    AK_CHECK_EQ(removed, emitted);
+    free(mem);
+}
+
+static void run_threads(uint32_t threads, ak_fluid_solver solver, ak_vec3* pos, ak_vec3* vel, size_t cap) {
+    ak_fluid_desc d;
+    float s;
+    dam_desc(&d, &s);
+    d.solver = solver;
+    d.vorticity_epsilon = 0.5f;
+    d.viscosity = 0.01f;
+    d.box_min = ak_vec3_make(0, 0, 0);
+    d.box_max = ak_vec3_make(24 * s, 20 * s, 12 * s);
+    size_t n = ak_fluid_fill_box(&d, d.box_min, ak_vec3_make(12 * s, 12 * s, 10 * s), (ak_vec3_span){pos, cap});
+    memset(vel, 0, cap * sizeof *vel);
+    size_t bytes = ak_fluid_scratch_size(n, &d);
+    void* mem = malloc(bytes);
+    ak_fluid_step_job job = {.desc = &d, .dt = solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f,
+                             .positions = {pos, n}, .velocities = {vel, n}, .particle_count = &n,
+                             .thread_count = threads, .scratch = {mem, bytes}};
+    for (int k = 0; k < 6; ++k) AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+    free(mem);
+}
+
+AK_TEST(thread_count_gives_identical_results) {
+    enum { CAP = 12 * 12 * 10 };
+    static ak_vec3 p1[CAP], v1[CAP], p2[CAP], v2[CAP];
+    const ak_fluid_solver solvers[] = {AK_FLUID_PBF, AK_FLUID_SPH};
+    for (int k = 0; k < 2; ++k) {
+        run_threads(1, solvers[k], p1, v1, CAP);
+        run_threads(2, solvers[k], p2, v2, CAP);
+        AK_CHECK(memcmp(p1, p2, sizeof p1) == 0 && memcmp(v1, v2, sizeof v1) == 0);
+        run_threads(3, solvers[k], p2, v2, CAP);
+        AK_CHECK(memcmp(p1, p2, sizeof p1) == 0 && memcmp(v1, v2, sizeof v1) == 0);
+    }
+}
+
+AK_TEST(validation_and_blow_up) {
+    ak_fluid_desc d = {.particle_mass = 0.001f, .h = 0.02f};
+    ak_vec3 pos[4] = {{0, 0, 0}, {0.01f, 0, 0}}, vel[4] = {{0}};
+    size_t n = 2;
+    unsigned char mem[1];
+    ak_fluid_step_job job = {.desc = &d, .dt = 0.01f, .positions = {pos, 4}, .velocities = {vel, 4},
+                             .particle_count = &n, .scratch = {mem, 1}};
+    AK_CHECK_EQ(ak_fluid_step_run(&job), AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_fluid_step_validate(NULL), AK_ERR_NULL_ARG);
+    size_t bytes = ak_fluid_scratch_size(4, &d);
+    void* big = malloc(bytes);
+    job.scratch = (ak_u8_span){big, bytes};
+    job.dt = 0.0f;
+    AK_CHECK_EQ(ak_fluid_step_run(&job), AK_ERR_BAD_ARG);
+    job.dt = 0.01f;
+    pos[1].x = NAN;
+    AK_CHECK_EQ(ak_fluid_step_run(&job), AK_ERR_BAD_DATA);
+    AK_CHECK(isnan(pos[1].x)); /* nothing written */
+    pos[1].x = 0.01f;
+    d.solver = AK_FLUID_SPH;
+    d.stiffness = 1e9f; /* absurdly stiff at a huge step: blows up */
+    pos[1].x = 0.001f;
+    ak_result r = AK_OK;
+    for (int k = 0; k < 50 && r == AK_OK; ++k) r = ak_fluid_step_run(&job);
+    AK_CHECK_EQ(r, AK_ERR_NO_CONVERGENCE);
+    free(big);
+}
+
+int main(void) {
+    AK_RUN(kernels_integrate_to_one);
+    AK_RUN(kernels_support);
+    AK_RUN(kernel_gradients_match_finite_differences);
+    AK_RUN(lattice_density_is_rest_density);
+    AK_RUN(hydrostatic_column_pressure_is_linear);
+    AK_RUN(pbf_dam_break_settles_and_stays_in_box);
+    AK_RUN(free_fall_momentum_is_mgt);
+    AK_RUN(plane_free_slip_no_sticking);
+    AK_RUN(colliders_never_leak);
+    AK_RUN(emitter_and_sink);
+    AK_RUN(thread_count_gives_identical_results);
+    AK_RUN(validation_and_blow_up);
+    return ak_test_finish();
+}
