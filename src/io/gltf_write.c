@@ -385,6 +385,32 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
         if (a < 0) return oom(c);
         add_num(attrs, "NORMAL", a);
     }
+    const bool tangents = mesh->tangents && mesh->normals; /* glTF: TANGENT needs NORMAL */
+    if (mesh->tangents && !mesh->normals) {
+        char msg[AK_NAME_SIZE + 96];
+        snprintf(msg, sizeof msg, "%s: tangents without normals are not written", what);
+        akp_log(c->logger, AK_LOG_WARN, msg);
+    }
+    if (tangents) {
+        /* xyz unit (renormalised as normals are; a zero one becomes +X), w exactly +1 or -1 */
+        ak_vec4* tg = (ak_vec4*)malloc(nv * sizeof(ak_vec4));
+        if (!tg) return oom(c);
+        for (size_t v = 0; v < nv; ++v) {
+            ak_vec4 x = mesh->tangents[v];
+            if (!finite_floats(&x.x, 4)) {
+                free(tg);
+                return BAD(c, AK_ERR_BAD_DATA, "%s: tangent %zu is not finite", what, v);
+            }
+            ak_vec3 d = ak_vec3_make(x.x, x.y, x.z);
+            float len = ak_vec3_length(d);
+            d = fabsf(len - 1.0f) <= 1e-5f ? d : len > 0.0f ? ak_vec3_scale(d, 1.0f / len) : ak_vec3_make(1, 0, 0);
+            tg[v] = ak_vec4_make(d.x, d.y, d.z, x.w < 0.0f ? -1.0f : 1.0f);
+        }
+        a = add_accessor(c, tg, nv, GL_FLOAT, 4, GL_ARRAY_BUFFER, false);
+        free(tg);
+        if (a < 0) return oom(c);
+        add_num(attrs, "TANGENT", a);
+    }
     if (mesh->uvs) {
         if (!finite_floats(&mesh->uvs[0].x, nv * 2)) return BAD(c, AK_ERR_BAD_DATA, "%s: a UV is not finite", what);
         if ((a = add_accessor(c, mesh->uvs, nv, GL_FLOAT, 2, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
@@ -476,6 +502,12 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
                 if (!finite_floats(&d[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: morph target %zu is not finite", what, t);
                 if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
                 add_num(tg, "NORMAL", a);
+            }
+            if (tangents && mesh->morph_tangents) {
+                d = mesh->morph_tangents + t * nv;
+                if (!finite_floats(&d[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: morph target %zu is not finite", what, t);
+                if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
+                add_num(tg, "TANGENT", a);
             }
         }
     }
