@@ -149,7 +149,7 @@ AK_API void ak_scene_bounds(const ak_scene* scene, ak_vec3* out_min, ak_vec3* ou
  * with the numbers in diag; nothing is allocated. */
 #define AK_SCENE_BAKE_TARGETS_PER_MESH 64u
 #define AK_SCENE_BAKE_MAX_FRAMES 4096u
-#define AK_SCENE_BAKE_MAX_POINTS 4096u
+#define AK_SCENE_BAKE_MAX_POINTS 16384u
 #define AK_SCENE_BAKE_DEFAULT_BUDGET ((size_t)512 << 20)
 
 /* A deforming mesh over frames (frame-major arrays). */

@@ -48,6 +48,7 @@ int sim_bake_mesh_write(sim_bake* b, const char* name, float dt, ak_u32_cspan in
     ak_result r = ak_scene_bake_mesh_frames(&d, NULL, &s, &diag);
     if (r == AK_OK) r = ak_io_save(b->out, s, NULL, &diag);
     ak_scene_destroy(s);
+    if (r == AK_ERR_UNSUPPORTED) return cli_fail(b->cmd, "%s: %s; use fewer --steps", b->out, diag.message);
     if (r != AK_OK) return cli_fail(b->cmd, "%s: %s (%s)", b->out, diag.message, ak_result_string(r));
     return CLI_OK;
 }
@@ -93,6 +94,7 @@ int sim_bake_points_write(sim_bake* b, const char* name, float dt) {
     ak_result r = ak_scene_bake_point_frames(&d, NULL, &s, &diag);
     if (r == AK_OK) r = ak_io_save(b->out, s, NULL, &diag);
     ak_scene_destroy(s);
+    if (r == AK_ERR_UNSUPPORTED) return cli_fail(b->cmd, "%s: %s; use fewer --steps", b->out, diag.message);
     if (r != AK_OK) return cli_fail(b->cmd, "%s: %s (%s)", b->out, diag.message, ak_result_string(r));
     return CLI_OK;
 }
