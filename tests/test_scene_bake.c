@@ -324,6 +324,20 @@ AK_TEST(bounds_and_bad_input) {
     AK_CHECK(s && ak_scene_joint_count(s) == 5 && s->mesh_count == 0);
     ak_scene_destroy(s);
     s = NULL;
+    /* an empty frame may have NULL arrays; the two points then start hidden (scale 0 at t=0) */
+    ak_scene_bake_points f2[2] = {{NULL, NULL, 0}, {pts, id1, 2}};
+    ak_scene_bake_points_desc pe = {.frames = f2, .frame_count = 2, .frame_time = 0.1f};
+    AK_CHECK_EQ(ak_scene_bake_point_frames(&pe, NULL, &s, &diag), AK_OK);
+    if (s) {
+        ak_transform loc[3];
+        ak_scene_rest_pose(s, (ak_transform_span)AK_SPAN(loc));
+        ak_clip_sample(s->clips[0], 0.0f, NULL, (ak_transform_span)AK_SPAN(loc), (ak_f32_span){0}, (ak_f32_span){0});
+        AK_CHECK(loc[1].scale.x == 0.0f && loc[2].scale.x == 0.0f);
+        ak_clip_sample(s->clips[0], 0.1f, NULL, (ak_transform_span)AK_SPAN(loc), (ak_f32_span){0}, (ak_f32_span){0});
+        AK_CHECK(loc[1].scale.x == 1.0f && loc[2].translation.x == 1.0f);
+    }
+    ak_scene_destroy(s);
+    s = NULL;
     pd.max_points = 3;
     AK_CHECK_EQ(ak_scene_bake_point_frames(&pd, NULL, &s, &diag), AK_ERR_UNSUPPORTED);
     pd.max_points = 40000;

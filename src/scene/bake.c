@@ -274,7 +274,7 @@ ak_result ak_scene_bake_point_frames(const ak_scene_bake_points_desc* desc, cons
         r = fail(diag, AK_ERR_BAD_ARG, "bake: %zu frames of this frame_time do not give distinct finite times%.0zu", nf, 0);
     size_t o = 0;
     for (size_t k = 0; k < nf; ++k) {
-        memcpy(ids + o, desc->frames[k].ids, desc->frames[k].count * sizeof(uint32_t));
+        if (desc->frames[k].count) memcpy(ids + o, desc->frames[k].ids, desc->frames[k].count * sizeof(uint32_t));
         o += desc->frames[k].count;
     }
     qsort(ids, total, sizeof(uint32_t), cmp_u32);
