@@ -61,7 +61,9 @@ ak_result ak_mesh_create(const ak_mesh_desc* desc, const ak_allocator* alloc, ak
               add_array(&total, infl_count, sizeof(float)) &&
               add_array(&total, morph_count, sizeof(ak_vec3)) &&
               add_array(&total, desc->has_morph_normals ? morph_count : 0, sizeof(ak_vec3)) &&
-              add_array(&total, m, sizeof(float)) && add_array(&total, m, AK_NAME_SIZE);
+              add_array(&total, m, sizeof(float)) && add_array(&total, m, AK_NAME_SIZE) &&
+              add_array(&total, desc->has_tangents ? v : 0, sizeof(ak_vec4)) &&
+              add_array(&total, desc->has_morph_tangents ? morph_count : 0, sizeof(ak_vec3));
     if (!ok) return AK_ERR_BAD_ARG;
 
     unsigned char* base = (unsigned char*)akp_calloc(alloc, total);
@@ -88,6 +90,9 @@ ak_result ak_mesh_create(const ak_mesh_desc* desc, const ak_allocator* alloc, ak
         (ak_vec3*)carve(base, &off, desc->has_morph_normals ? morph_count : 0, sizeof(ak_vec3));
     mesh->morph_weights = (float*)carve(base, &off, m, sizeof(float));
     mesh->morph_names = (char(*)[AK_NAME_SIZE])carve(base, &off, m, AK_NAME_SIZE);
+    mesh->tangents = (ak_vec4*)carve(base, &off, desc->has_tangents ? v : 0, sizeof(ak_vec4));
+    mesh->morph_tangents =
+        (ak_vec3*)carve(base, &off, desc->has_morph_tangents ? morph_count : 0, sizeof(ak_vec3));
     AK_ASSERT(off <= total);
     *out_mesh = mesh;
     return AK_OK;
@@ -113,6 +118,8 @@ ak_result ak_mesh_clone(const ak_mesh* mesh, const ak_allocator* alloc, ak_mesh*
         .has_colors = mesh->colors != NULL,
         .has_morph_normals = mesh->morph_normals != NULL,
         .name = mesh->name,
+        .has_tangents = mesh->tangents != NULL,
+        .has_morph_tangents = mesh->morph_tangents != NULL,
     };
     ak_mesh* c = NULL;
     ak_result r = ak_mesh_create(&d, alloc, &c);
@@ -135,6 +142,9 @@ ak_result ak_mesh_clone(const ak_mesh* mesh, const ak_allocator* alloc, ak_mesh*
         memcpy(c->morph_weights, mesh->morph_weights, mesh->morph_target_count * sizeof(float));
     if (mesh->morph_target_count && mesh->morph_names)
         memcpy(c->morph_names, mesh->morph_names, mesh->morph_target_count * AK_NAME_SIZE);
+    if (mesh->tangents) memcpy(c->tangents, mesh->tangents, v * sizeof(ak_vec4));
+    if (morph && mesh->morph_tangents)
+        memcpy(c->morph_tangents, mesh->morph_tangents, morph * sizeof(ak_vec3));
     *out_mesh = c;
     return AK_OK;
 }

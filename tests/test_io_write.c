@@ -106,6 +106,33 @@ static int compare_scenes_n(const ak_scene* a, const ak_scene* b, const char* wh
         if (a->meshes[m].mesh->vertex_count != b->meshes[m].mesh->vertex_count ||
             a->meshes[m].mesh->morph_target_count != b->meshes[m].mesh->morph_target_count)
             bad = 1;
+        /* tangents (TANGENT, and morph TANGENT deltas) kept: xyz within 1e-6, w the same sign */
+        const ak_mesh *ma = a->meshes[m].mesh, *mb = b->meshes[m].mesh;
+        if (!bad && ma->normals) {
+            AK_CHECK_MSG((ma->tangents != NULL) == (mb->tangents != NULL), "%s mesh %zu: tangents %s", what, m,
+                         ma->tangents ? "lost" : "appeared");
+            AK_CHECK_MSG((ma->morph_tangents != NULL) == (mb->morph_tangents != NULL), "%s mesh %zu: morph tangents %s",
+                         what, m, ma->morph_tangents ? "lost" : "appeared");
+            for (size_t v = 0; ma->tangents && mb->tangents && v < ma->vertex_count; ++v) {
+                const ak_vec4 x = ma->tangents[v], y = mb->tangents[v];
+                if (!close_rel(x.x, y.x, 1.0) || !close_rel(x.y, y.y, 1.0) || !close_rel(x.z, y.z, 1.0) ||
+                    (x.w < 0) != (y.w < 0) || fabsf(y.w) != 1.0f) {
+                    AK_FAIL_("%s mesh %zu tangent %zu: (%g %g %g %g) vs (%g %g %g %g)", what, m, v, x.x, x.y, x.z, x.w,
+                             y.x, y.y, y.z, y.w);
+                    bad = 1;
+                    break;
+                }
+            }
+            size_t nmt = ma->vertex_count * ma->morph_target_count;
+            for (size_t i = 0; ma->morph_tangents && mb->morph_tangents && i < nmt; ++i)
+                if (!close_rel(ma->morph_tangents[i].x, mb->morph_tangents[i].x, 1.0) ||
+                    !close_rel(ma->morph_tangents[i].y, mb->morph_tangents[i].y, 1.0) ||
+                    !close_rel(ma->morph_tangents[i].z, mb->morph_tangents[i].z, 1.0)) {
+                    AK_FAIL_("%s mesh %zu morph tangent %zu differs", what, m, i);
+                    bad = 1;
+                    break;
+                }
+        }
     }
     size_t nw = total_weights(a);
     ak_transform *la = malloc((na + 1) * sizeof *la), *lb = malloc((nb + 1) * sizeof *lb);
@@ -293,7 +320,8 @@ static ak_scene* make_scene(ak_interp rot_interp) {
     };
     ak_skeleton_create(&(ak_skeleton_desc){.joints = j, .joint_count = 6, .palette_from_skins = true}, NULL, &s->skeleton, NULL);
     ak_mesh_desc md = {.vertex_count = 4, .triangle_count = 2, .influence_count = 6, .morph_target_count = 2,
-                       .has_normals = true, .has_uvs = true, .has_morph_normals = true, .name = "quad"};
+                       .has_normals = true, .has_uvs = true, .has_morph_normals = true, .name = "quad",
+                       .has_tangents = true, .has_morph_tangents = true};
     ak_mesh_create(&md, NULL, &s->meshes[0].mesh);
     ak_mesh* m = s->meshes[0].mesh;
     for (size_t v = 0; v < 4; ++v) {
@@ -307,6 +335,10 @@ static ak_scene* make_scene(ak_interp rot_interp) {
         m->morph_positions[v] = ak_vec3_make(0.5f, 0, 0);
         m->morph_positions[4 + v] = ak_vec3_make(0, 0, (float)v);
         m->morph_normals[v] = ak_vec3_make(0, 0.1f, 0);
+        /* unit tangents in the quad's plane, two of each handedness */
+        float ang = 0.4f * (float)v;
+        m->tangents[v] = ak_vec4_make(cosf(ang), sinf(ang), 0, v < 2 ? 1.0f : -1.0f);
+        m->morph_tangents[4 + v] = ak_vec3_make(0.05f * (float)v, 0, -0.02f);
     }
     const uint32_t idx[6] = {0, 1, 3, 0, 3, 2};
     memcpy(m->indices, idx, sizeof idx);
@@ -431,6 +463,79 @@ AK_TEST(bad_input) {
     ak_scene_destroy(a);
 }
 
+/* TANGENT read from a real asset (AnimatedMorphCube has TANGENT and morph TANGENT deltas):
+ * VEC4, w = +1 or -1, xyz unit; and a tangent whose w is not +-1, or a VEC3 TANGENT, refused. */
+static void b64(const unsigned char* in, size_t n, char* out) {
+    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
+        out[o++] = t[v >> 18 & 63];
+        out[o++] = t[v >> 12 & 63];
+        out[o++] = i + 1 < n ? t[v >> 6 & 63] : '=';
+        out[o++] = i + 2 < n ? t[v & 63] : '=';
+    }
+    out[o] = '\0';
+}
+
+static ak_result load_tangent_doc(float w, int comps, ak_scene** out, ak_diag* diag) {
+    float data[9 + 3 * 4 + 3 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    for (int v = 0; v < 3; ++v) {
+        data[9 + 3 * v] = 0, data[10 + 3 * v] = 0, data[11 + 3 * v] = 1; /* normals +Z */
+        float* t = data + 18 + comps * v;
+        t[0] = 1, t[1] = 0, t[2] = 0;
+        if (comps == 4) t[3] = w;
+    }
+    size_t bytes = (size_t)(18 + 3 * comps) * sizeof(float);
+    char enc[400], doc[2000];
+    b64((const unsigned char*)data, bytes, enc);
+    snprintf(doc, sizeof doc,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,\"uri\":\"data:application/"
+             "octet-stream;base64,%s\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,"
+             "\"byteOffset\":36,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":%d}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],"
+             "\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},{\"bufferView\":2,"
+             "\"componentType\":5126,\"count\":3,\"type\":\"%s\"}],\"meshes\":[{\"primitives\":[{\"attributes\":"
+             "{\"POSITION\":0,\"NORMAL\":1,\"TANGENT\":2}}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}",
+             bytes, enc, 12 * comps, comps == 4 ? "VEC4" : "VEC3");
+    return ak_io_load_memory(doc, strlen(doc), "tangents.gltf", NULL, NULL, NULL, out, diag);
+}
+
+AK_TEST(tangents) {
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_tangent_doc(-1.0f, 4, &s, &diag), AK_OK);
+    if (s) {
+        AK_CHECK(s->meshes[0].mesh->tangents != NULL);
+        if (s->meshes[0].mesh->tangents) AK_CHECK_EQ(s->meshes[0].mesh->tangents[2].w, -1.0f);
+        ak_scene_destroy(s);
+        s = NULL;
+    }
+    AK_CHECK_EQ(load_tangent_doc(0.5f, 4, &s, &diag), AK_ERR_BAD_DATA);
+    AK_CHECK_MSG(strstr(diag.message, "TANGENT") != NULL, "%s", diag.message);
+    AK_CHECK_EQ(load_tangent_doc(1.0f, 3, &s, &diag), AK_ERR_PARSE);
+    AK_CHECK(s == NULL);
+    char src[1200];
+    if (!ak_test_asset(src, sizeof src, "gltf/AnimatedMorphCube/glTF/AnimatedMorphCube.gltf")) {
+        AK_SKIP("AnimatedMorphCube absent");
+        return;
+    }
+    AK_CHECK_EQ(ak_io_load(src, &k_load, NULL, &s, &diag), AK_OK);
+    if (!s) return;
+    const ak_mesh* m = s->meshes[0].mesh;
+    AK_CHECK(m->tangents != NULL && m->morph_tangents != NULL);
+    size_t flips = 0;
+    for (size_t v = 0; m->tangents && v < m->vertex_count; ++v) {
+        ak_vec4 t = m->tangents[v];
+        AK_CHECK(fabsf(t.w) == 1.0f);
+        AK_CHECK_NEAR(sqrt((double)t.x * t.x + (double)t.y * t.y + (double)t.z * t.z), 1.0, 1e-3);
+        flips += t.w < 0;
+    }
+    printf("  AnimatedMorphCube: %zu tangents (%zu with w = -1), %zu morph targets with TANGENT deltas\n",
+           m->vertex_count, flips, m->morph_target_count);
+    ak_scene_destroy(s);
+}
+
 AK_TEST(builtin_round_trip) {
     const char* names[] = {"humanoid", "cylinder"};
     for (int i = 0; i < 2; ++i) {
@@ -515,6 +620,7 @@ int main(void) {
     AK_RUN(round_trip_assets);
     AK_RUN(interpolation_kept);
     AK_RUN(bad_input);
+    AK_RUN(tangents);
     AK_RUN(builtin_round_trip);
     AK_RUN(bvh_round_trip);
 #ifdef AK_CLI_PATH

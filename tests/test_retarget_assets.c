@@ -176,6 +176,9 @@ AK_TEST(cmu_bvh_onto_builtin_and_cesiumman) {
 
 
 #ifdef AK_CLI_PATH
+/* Lines the last run_cli printed on stderr. */
+static int g_cli_lines;
+
 /* Run the CLI; returns the exit status and the first line of stderr in line. */
 static int run_cli(const char* args, char* line, size_t n) {
     char cmd[4096];
@@ -187,6 +190,7 @@ static int run_cli(const char* args, char* line, size_t n) {
     int lines = 0;
     while (fgets(buf, sizeof buf, p))
         if (lines++ == 0) snprintf(line, n, "%s", buf);
+    g_cli_lines = lines;
     int st = pclose(p);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
@@ -252,13 +256,16 @@ AK_TEST(cli_retarget) {
         snprintf(args, sizeof args, "'%s' '%s' --map '%s' -o '%s'", bvh, cesium, mapf, out);
         AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
         AK_CHECK_MSG(strstr(line, mapf) && strstr(line, bad[i].expect), "map %zu: %s", i, line);
+        AK_CHECK_MSG(g_cli_lines == 1, "map %zu: %d lines on stderr, one expected", i, g_cli_lines);
     }
     snprintf(args, sizeof args, "'%s' '%s' --map '%s/missing.map' -o '%s'", bvh, cesium, dir, out);
     AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
     AK_CHECK(strstr(line, "missing.map") != NULL);
+    AK_CHECK_EQ(g_cli_lines, 1);
     /* a source without a clip */
     snprintf(args, sizeof args, "'%s' builtin:humanoid -o '%s'", nomotion, out);
     AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
+    AK_CHECK_EQ(g_cli_lines, 1);
     AK_CHECK(strstr(line, "MorphPrimitivesTest.glb") && strstr(line, "no clip"));
     /* usage */
     snprintf(args, sizeof args, "'%s' builtin:humanoid -o '%s/x.obj'", bvh, dir);

@@ -7,7 +7,8 @@
  *     rotation and scale channels into one, and adds synthetic root nodes; glTF is judged
  *     exactly, so it gets a reader that keeps the file's data as the specification defines
  *     it (accessors with byteStride, sparse accessors, normalized integers, every component
- *     type, matrix or TRS nodes, skins, morph targets, STEP/LINEAR/CUBICSPLINE samplers).
+ *     type, matrix or TRS nodes, skins, morph targets, TANGENT (VEC4, w = +1 or -1, else
+ *     AK_ERR_BAD_DATA), STEP/LINEAR/CUBICSPLINE samplers).
  *   - BVH through animkit's own streaming reader (src/io/bvh.c): bounded nesting, the frame
  *     count checked against the data present, the same scene layout Assimp gave (docs/io.md).
  *   - Everything else (FBX, Collada, OBJ, ...) through Assimp's C API: the node tree
@@ -189,11 +190,13 @@ typedef struct ak_io_save_desc {
  *     the rotation written normalised), scenes[0] holding the roots;
  *   - skins with their joints and inverse bind matrices (float MAT4);
  *   - scene meshes as mesh primitives: POSITION (with min/max), NORMAL (renormalised where a
- *     normal is off unit length by more than 1e-5; a zero normal -> +Y), TEXCOORD_0, COLOR_0,
+ *     normal is off unit length by more than 1e-5; a zero normal -> +Y), TANGENT (only with
+ *     NORMAL, as glTF requires: xyz renormalised the same way, a zero one -> +X, w = the sign
+ *     of the stored w as exactly +1 or -1), TEXCOORD_0, COLOR_0,
  *     JOINTS_0/WEIGHTS_0 and, above 4 influences, JOINTS_1/WEIGHTS_1 (joints unsigned byte,
  *     or unsigned short when a slot is above 255; a zero weight's joint written as 0),
  *     indices (unsigned short below 65535 vertices, else unsigned int), morph targets
- *     (POSITION deltas with min/max, NORMAL deltas), default weights in mesh.weights and
+ *     (POSITION deltas with min/max, NORMAL and TANGENT deltas), default weights in mesh.weights and
  *     target names in mesh.extras.targetNames. Consecutive scene meshes on one node with the
  *     same skin, morph target count, default weights and morph animation become primitives
  *     of one glTF mesh (as the reader split them); any other mesh gets its own node with an
@@ -209,7 +212,9 @@ typedef struct ak_io_save_desc {
  *   - each distinct base colour of the scene meshes as a material holding only
  *     pbrMetallicRoughness.baseColorFactor (channels clamped to [0, 1]), named by the
  *     primitives that have one.
- * Not written: other material properties and textures, tangents (the scene holds none), the clip duration (a
+ * Simulations: scene.h's ak_scene_bake_mesh_frames (a cloth as morph-target animation) and
+ * ak_scene_bake_point_frames (particles as one animated node each) build the scene to write.
+ * Not written: other material properties and textures, the clip duration (a
  * reader takes the last key time), ak_skeleton joint types and limits.
  * Layout: one buffer, one bufferView per accessor (4-byte aligned, zero padded, so no
  * byteStride), GLB JSON chunk padded with spaces and BIN chunk with zeros.

@@ -43,6 +43,8 @@ typedef struct ak_mesh_desc {
     bool has_colors;           /* false -> colors == NULL */
     bool has_morph_normals;    /* false -> morph_normals == NULL */
     const char* name;          /* NULL -> "" ; copied, truncated to AK_NAME_SIZE-1 */
+    bool has_tangents;         /* false -> tangents == NULL */
+    bool has_morph_tangents;   /* false -> morph_tangents == NULL */
 } ak_mesh_desc;
 
 typedef struct ak_mesh {
@@ -63,6 +65,11 @@ typedef struct ak_mesh {
     ak_vec3* morph_normals;     /* same layout, or NULL */
     float* morph_weights;       /* [morph_target_count] default weights (glTF mesh.weights) */
     char (*morph_names)[AK_NAME_SIZE]; /* [morph_target_count], "" when unnamed */
+    ak_vec4* tangents;          /* [vertex_count] (xyz unit, w = +1 or -1: bitangent =
+                                   w * cross(normal, tangent), glTF's TANGENT), or NULL.
+                                   Carried through import, copy and export; the deformers
+                                   (skin.h, blendshape.h) do not move them */
+    ak_vec3* morph_tangents;    /* [morph_target_count * vertex_count] xyz deltas, or NULL */
 } ak_mesh;
 
 /* Allocate a mesh with every array zeroed (weights zero, joints zero, indices zero).

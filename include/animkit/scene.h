@@ -14,6 +14,9 @@
  * target t of scene mesh m has index sum_{k<m} meshes[k].mesh->morph_target_count + t; its
  * default is meshes[m].mesh->morph_weights[t].
  *
+ * Also bakes per-frame results (a cloth's vertices, particles) into an animated scene that io.h
+ * writes (ak_scene_bake_mesh_frames, ak_scene_bake_point_frames).
+ *
  * What it does NOT do: read files (io.h), make models (builtin.h), deform (skin.h, blendshape.h).
  *
  * Usage:
@@ -114,6 +117,93 @@ AK_API ak_result ak_scene_skin_palette(const ak_scene* scene, size_t skin_index,
  * unskinned moved by their node's rest world matrix). No meshes: the joints' positions.
  * Temporary memory comes from the scene's allocator; NULL scene or no data -> zeros. */
 AK_API void ak_scene_bounds(const ak_scene* scene, ak_vec3* out_min, ak_vec3* out_max);
+
+/* ---- baking computed motion (simulations) into a scene -------------------------------------
+ * Two ways to turn per-frame results into an animated scene that io.h's ak_io_save writes as
+ * glTF (docs/io.md "Baking simulations"); neither knows a file format, and the simulation
+ * modules know neither:
+ *   - ak_scene_bake_mesh_frames, for a deforming mesh (cloth): MORPH-TARGET animation. The
+ *     frames are cut into blocks of up to AK_SCENE_BAKE_TARGETS_PER_MESH frames (the most
+ *     components a clip channel holds): block b is one scene mesh on its own node, its base
+ *     positions are frame s = 64 b and its targets t = 0..63 hold frames s+1+t as deltas from
+ *     frame s; a weights channel keys frame s at weights 0 and frame s+1+t at weight 1 on target
+ *     t (0 elsewhere), so frame k shows exactly frame k, and between frames LINEAR weights give
+ *     the linear blend of the two frames (STEP holds the earlier one). Block b's node has a STEP
+ *     scale channel: 1 from time s to the time of its last frame (exclusive, except for the
+ *     last block), 0 elsewhere, so exactly one block is visible at any time. One block (65
+ *     frames or fewer) has no scale channel. Nodes: a root named desc->name with one child
+ *     "<name>_<b>" per block, all with identity rest transforms.
+ *   - ak_scene_bake_point_frames, for particles: PER-NODE animation. One root node named
+ *     desc->name and one child node "<name>_<id>" per distinct particle id (ascending id), with
+ *     a translation channel keyed at the frames where the particle exists (LINEAR or STEP) and,
+ *     when it is missing from some frame, a STEP scale channel that is 0 while it is missing
+ *     (before its birth, after its death) and 1 while it exists. Rest translation = its first
+ *     position. With marker_size > 0 every particle node carries a small octahedron mesh
+ *     (6 vertices, radius marker_size) so engines draw it; 0 -> bare nodes.
+ * Frame k is at time k * frame_time; the clip (named desc->name) lasts
+ * (frame_count - 1) * frame_time. One frame gives the scene without a clip.
+ * Bounds: at most max_frames frames (0 -> AK_SCENE_BAKE_MAX_FRAMES) and, for points, at most
+ * max_points distinct ids (0 -> AK_SCENE_BAKE_MAX_POINTS, never above 32000); the bytes the
+ * scene and its temporaries need are estimated before anything is allocated and must fit
+ * memory_budget (0 -> AK_SCENE_BAKE_DEFAULT_BUDGET). Over any bound: AK_ERR_UNSUPPORTED
+ * with the numbers in diag; nothing is allocated. */
+#define AK_SCENE_BAKE_TARGETS_PER_MESH 64u
+#define AK_SCENE_BAKE_MAX_FRAMES 4096u
+#define AK_SCENE_BAKE_MAX_POINTS 16384u
+#define AK_SCENE_BAKE_DEFAULT_BUDGET ((size_t)512 << 20)
+
+/* A deforming mesh over frames (frame-major arrays). */
+typedef struct ak_scene_bake_mesh_desc {
+    const char* name;            /* scene, root node, mesh and clip name; NULL -> "bake" */
+    size_t vertex_count;         /* required, > 0 */
+    size_t frame_count;          /* required, 1 .. max_frames */
+    const ak_vec3* positions;    /* required, [frame_count * vertex_count], frame k first */
+    const ak_vec3* normals;      /* optional, same layout: base NORMAL + morph NORMAL deltas */
+    ak_u32_cspan indices;        /* triangle list (count a multiple of 3, each < vertex_count);
+                                    empty -> a point cloud */
+    float frame_time;            /* required, > 0 seconds between frames */
+    ak_interp interp;            /* weights: 0 or LINEAR (blend between frames) or STEP */
+    ak_vec4 base_color;          /* material base colour; all zero -> no material */
+    size_t max_frames;           /* 0 -> AK_SCENE_BAKE_MAX_FRAMES */
+    size_t memory_budget;        /* 0 -> AK_SCENE_BAKE_DEFAULT_BUDGET */
+} ak_scene_bake_mesh_desc;
+
+/* Build a scene (*out_scene, freed with ak_scene_destroy) as described above. The inputs are
+ * read only during the call. Returns AK_ERR_NULL_ARG (desc, out_scene or positions NULL, or
+ * indices.ptr NULL with a count), AK_ERR_EMPTY (vertex_count or frame_count 0), AK_ERR_BAD_ARG
+ * (frame_time not > 0 or not finite, interp other than LINEAR/STEP, an index count not a
+ * multiple of 3, (frame_count - 1) * frame_time not finite), AK_ERR_BAD_INDEX (an index out of
+ * range), AK_ERR_BAD_DATA (a non-finite position or normal: diag names frame and vertex),
+ * AK_ERR_UNSUPPORTED (over a bound), AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_scene_bake_mesh_frames(const ak_scene_bake_mesh_desc* desc, const ak_allocator* alloc,
+                                           ak_scene** out_scene, ak_diag* diag);
+
+/* One frame of a point set: count points with their ids (unique within the frame). */
+typedef struct ak_scene_bake_points {
+    const ak_vec3* positions; /* [count] */
+    const uint32_t* ids;      /* [count]: the same id in two frames is the same point */
+    size_t count;             /* 0 -> no point in this frame (pointers may be NULL) */
+} ak_scene_bake_points;
+
+typedef struct ak_scene_bake_points_desc {
+    const char* name;                    /* NULL -> "particles" */
+    const ak_scene_bake_points* frames;  /* required, [frame_count] */
+    size_t frame_count;                  /* required, 1 .. max_frames */
+    float frame_time;                    /* required, > 0 */
+    ak_interp interp;                    /* translations: 0 or LINEAR, or STEP */
+    float marker_size;                   /* >= 0: octahedron radius per node, 0 -> no mesh */
+    size_t max_frames;                   /* 0 -> AK_SCENE_BAKE_MAX_FRAMES */
+    size_t max_points;                   /* 0 -> AK_SCENE_BAKE_MAX_POINTS; at most 32000 */
+    size_t memory_budget;                /* 0 -> AK_SCENE_BAKE_DEFAULT_BUDGET */
+} ak_scene_bake_points_desc;
+
+/* Build a scene of per-particle nodes as described above. No point in any frame gives the
+ * root node alone and no clip. Returns the codes of ak_scene_bake_mesh_frames, plus
+ * AK_ERR_NULL_ARG (frames NULL, or a frame with a count and a NULL array), AK_ERR_DUPLICATE
+ * (an id twice in one frame), AK_ERR_BAD_ARG (marker_size negative or not finite, max_points
+ * above 32000). */
+AK_API ak_result ak_scene_bake_point_frames(const ak_scene_bake_points_desc* desc, const ak_allocator* alloc,
+                                            ak_scene** out_scene, ak_diag* diag);
 
 #ifdef __cplusplus
 }

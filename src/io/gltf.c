@@ -842,7 +842,7 @@ static ak_result attribute(gl_ctx* c, const cJSON* attrs, const char* key, const
 
 typedef struct prim_data {
     size_t vertex_count;
-    float *pos, *nrm, *uv, *col;
+    float *pos, *nrm, *uv, *col, *tan; /* tan: [vertex_count * 4] */
     uint32_t col_comps;
     uint32_t* idx;
     size_t idx_count;
@@ -850,8 +850,8 @@ typedef struct prim_data {
     float* weights;
     uint32_t infl;    /* 0, 4 or 8 */
     size_t targets;
-    float *mpos, *mnrm; /* [targets * vertex_count * 3] */
-    bool has_mnrm;
+    float *mpos, *mnrm, *mtan; /* [targets * vertex_count * 3] */
+    bool has_mnrm, has_mtan;
 } prim_data;
 
 static void prim_free(gl_ctx* c, prim_data* p) {
@@ -864,6 +864,8 @@ static void prim_free(gl_ctx* c, prim_data* p) {
     akp_free(c->alloc, p->weights);
     akp_free(c->alloc, p->mpos);
     akp_free(c->alloc, p->mnrm);
+    akp_free(c->alloc, p->tan);
+    akp_free(c->alloc, p->mtan);
     memset(p, 0, sizeof *p);
 }
 
@@ -902,6 +904,12 @@ static ak_result read_primitive(gl_ctx* c, const cJSON* prim, const char* where,
     TRY(read_vertex_floats(c, attrs, "NORMAL", where, v3, nv, &p->nrm, NULL));
     TRY(read_vertex_floats(c, attrs, "TEXCOORD_0", where, v2, nv, &p->uv, NULL));
     TRY(read_vertex_floats(c, attrs, "COLOR_0", where, v34, nv, &p->col, &p->col_comps));
+    /* TANGENT: VEC4 (xyz, handedness w), w must be +1 or -1 (glTF 2.0 section 3.7.2.1) */
+    TRY(read_vertex_floats(c, attrs, "TANGENT", where, v4, nv, &p->tan, NULL));
+    for (size_t v = 0; p->tan && v < nv; ++v)
+        if (fabsf(fabsf(p->tan[4 * v + 3]) - 1.0f) > 1e-3f)
+            return fail(c, AK_ERR_BAD_DATA, "%s TANGENT: vertex %zu has w = %g, not +1 or -1", where, v,
+                        (double)p->tan[4 * v + 3]);
 
     /* Skin influences: JOINTS_0/WEIGHTS_0 and, when present, JOINTS_1/WEIGHTS_1 merged. */
     int64_t ja[2], wa[2];
@@ -1014,10 +1022,11 @@ static ak_result read_primitive(gl_ctx* c, const cJSON* prim, const char* where,
     cJSON* targets = NULL;
     TRY(opt_array(c, prim, "targets", where, &targets, &p->targets));
     if (p->targets) {
-        TRY(charge(c, p->targets * nv, 6 * sizeof(float), where));
+        TRY(charge(c, p->targets * nv, 9 * sizeof(float), where));
         p->mpos = (float*)akp_calloc(c->alloc, p->targets * nv * 3 * sizeof(float));
         p->mnrm = (float*)akp_calloc(c->alloc, p->targets * nv * 3 * sizeof(float));
-        if (!p->mpos || !p->mnrm) return fail(c, AK_ERR_NO_MEMORY, "%s: out of memory for morph targets", where);
+        p->mtan = (float*)akp_calloc(c->alloc, p->targets * nv * 3 * sizeof(float));
+        if (!p->mpos || !p->mnrm || !p->mtan) return fail(c, AK_ERR_NO_MEMORY, "%s: out of memory for morph targets", where);
         size_t t = 0;
         for (const cJSON* tg = targets->child; tg; tg = tg->next, ++t) {
             char tw[256];
@@ -1032,6 +1041,13 @@ static ak_result read_primitive(gl_ctx* c, const cJSON* prim, const char* where,
             if (f) {
                 memcpy(p->mnrm + t * nv * 3, f, nv * 3 * sizeof(float));
                 p->has_mnrm = true;
+            }
+            akp_free(c->alloc, f);
+            f = NULL;
+            TRY(read_vertex_floats(c, tg, "TANGENT", tw, v3, nv, &f, NULL));
+            if (f) {
+                memcpy(p->mtan + t * nv * 3, f, nv * 3 * sizeof(float));
+                p->has_mtan = true;
             }
             akp_free(c->alloc, f);
         }
@@ -1052,9 +1068,11 @@ static ak_result make_mesh(gl_ctx* c, prim_data* p, const char* name, const cJSO
         .has_colors = p->col != NULL,
         .has_morph_normals = p->has_mnrm,
         .name = name,
+        .has_tangents = p->tan != NULL,
+        .has_morph_tangents = p->has_mtan,
     };
     /* every instance is a full copy: charge what ak_mesh_create will allocate */
-    size_t per_vertex = sizeof(ak_vec3) * (2 + 2 * p->targets) + sizeof(ak_vec2) + sizeof(ak_vec4) +
+    size_t per_vertex = sizeof(ak_vec3) * (2 + 3 * p->targets) + sizeof(ak_vec2) + 2 * sizeof(ak_vec4) +
                         d.influence_count * (sizeof(uint16_t) + sizeof(float));
     TRY(charge(c, p->vertex_count, per_vertex, where));
     TRY(charge(c, p->idx_count, sizeof(uint32_t), where));
@@ -1066,6 +1084,7 @@ static ak_result make_mesh(gl_ctx* c, prim_data* p, const char* name, const cJSO
         m->positions[v] = ak_vec3_make(p->pos[3 * v], p->pos[3 * v + 1], p->pos[3 * v + 2]);
         if (p->nrm) m->normals[v] = ak_vec3_make(p->nrm[3 * v], p->nrm[3 * v + 1], p->nrm[3 * v + 2]);
         if (p->uv) m->uvs[v] = ak_vec2_make(p->uv[2 * v], p->uv[2 * v + 1]);
+        if (p->tan) m->tangents[v] = ak_vec4_make(p->tan[4 * v], p->tan[4 * v + 1], p->tan[4 * v + 2], p->tan[4 * v + 3]);
         if (p->col) {
             const float* s = p->col + v * p->col_comps;
             m->colors[v] = ak_vec4_make(s[0], s[1], s[2], p->col_comps == 4 ? s[3] : 1.0f);
@@ -1075,6 +1094,7 @@ static ak_result make_mesh(gl_ctx* c, prim_data* p, const char* name, const cJSO
     for (size_t i = 0; i < p->targets * nv; ++i) {
         m->morph_positions[i] = ak_vec3_make(p->mpos[3 * i], p->mpos[3 * i + 1], p->mpos[3 * i + 2]);
         if (p->has_mnrm) m->morph_normals[i] = ak_vec3_make(p->mnrm[3 * i], p->mnrm[3 * i + 1], p->mnrm[3 * i + 2]);
+        if (p->has_mtan) m->morph_tangents[i] = ak_vec3_make(p->mtan[3 * i], p->mtan[3 * i + 1], p->mtan[3 * i + 2]);
     }
     if (p->targets) {
         const cJSON* wt = cJSON_GetObjectItemCaseSensitive(mesh_json, "weights");

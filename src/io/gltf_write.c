@@ -26,6 +26,11 @@ typedef struct w_ctx {
     size_t bin_size, bin_cap;
     cJSON *root, *views, *accessors, *nodes, *meshes, *skins, *animations, *materials;
     size_t n_nodes; /* written so far (joints, then extra mesh nodes) */
+    /* counts and a node table: cJSON arrays are linked lists, and asking their size or
+     * item i walks them (quadratic for scenes of thousands of nodes and accessors) */
+    int n_views, n_accessors, n_meshes, n_samplers;
+    cJSON** node_tab;
+    size_t node_tab_count, node_tab_cap;
     int32_t* node_of_mesh; /* [mesh_count] glTF node carrying scene mesh m's glTF mesh, -1 none */
     int32_t* group_of_mesh; /* [mesh_count] first scene mesh of m's group (one glTF mesh) */
     size_t* morph_base; /* [mesh_count] first morph weight index of scene mesh m */
@@ -84,7 +89,7 @@ static int add_view(w_ctx* c, const void* data, size_t bytes, int target) {
     if (offset) add_num(v, "byteOffset", (double)offset);
     add_num(v, "byteLength", (double)bytes);
     if (target) add_num(v, "target", target);
-    return cJSON_GetArraySize(c->views) - 1;
+    return c->n_views++;
 }
 
 static size_t ctype_size(int ctype) {
@@ -109,6 +114,7 @@ static int add_accessor(w_ctx* c, const void* data, size_t count, int ctype, int
     if (view < 0) return -1;
     cJSON* a = cJSON_CreateObject();
     if (!a || !cJSON_AddItemToArray(c->accessors, a)) return -1;
+    const int index = c->n_accessors++;
     add_num(a, "bufferView", view);
     add_num(a, "componentType", ctype);
     add_num(a, "count", (double)count);
@@ -129,7 +135,7 @@ static int add_accessor(w_ctx* c, const void* data, size_t count, int ctype, int
             cJSON_AddItemToArray(mx, num(hi));
         }
     }
-    return cJSON_GetArraySize(c->accessors) - 1;
+    return index;
 }
 
 static bool finite_floats(const float* f, size_t n) {
@@ -170,8 +176,33 @@ static ak_result write_node_trs(w_ctx* c, cJSON* node, ak_transform t, const cha
     return AK_OK;
 }
 
+/* Append a node to nodes and to the node table; false when out of memory (node then freed). */
+static bool push_node(w_ctx* c, cJSON* node) {
+    if (!node) return false;
+    if (c->node_tab_count == c->node_tab_cap) {
+        size_t cap = c->node_tab_cap ? 2 * c->node_tab_cap : 64;
+        cJSON** t = (cJSON**)realloc(c->node_tab, cap * sizeof *t);
+        if (!t) {
+            cJSON_Delete(node);
+            return false;
+        }
+        c->node_tab = t, c->node_tab_cap = cap;
+    }
+    if (!cJSON_AddItemToArray(c->nodes, node)) {
+        cJSON_Delete(node);
+        return false;
+    }
+    c->node_tab[c->node_tab_count++] = node;
+    return true;
+}
+
+static cJSON* node_at(const w_ctx* c, int32_t i) {
+    return i >= 0 && (size_t)i < c->node_tab_count ? c->node_tab[i] : NULL;
+}
+
 static ak_result add_child(w_ctx* c, int32_t parent, size_t child) {
-    cJSON* p = cJSON_GetArrayItem(c->nodes, parent);
+    cJSON* p = node_at(c, parent);
+    if (!p) return BAD(c, AK_ERR_BAD_INDEX, "node %d is out of range", (int)parent);
     cJSON* ch = cJSON_GetObjectItemCaseSensitive(p, "children");
     if (!ch && !(ch = cJSON_AddArrayToObject(p, "children"))) return oom(c);
     if (!cJSON_AddItemToArray(ch, num((double)child))) return oom(c);
@@ -185,7 +216,7 @@ static ak_result write_skeleton(w_ctx* c) {
     ak_transform_cspan rest = ak_skeleton_rest_pose(sk);
     for (size_t j = 0; j < n; ++j) {
         cJSON* node = cJSON_CreateObject();
-        if (!node || !cJSON_AddItemToArray(c->nodes, node)) return oom(c);
+        if (!push_node(c, node)) return oom(c);
         const char* name = ak_skeleton_joint_name(sk, j);
         if (!cJSON_AddStringToObject(node, "name", name)) return oom(c);
         if (!ak_transform_is_finite(rest.ptr[j])) return BAD(c, AK_ERR_BAD_DATA, "joint %zu: rest transform is not finite", j);
@@ -199,7 +230,7 @@ static ak_result write_skeleton(w_ctx* c) {
 /* A new node with identity transform for a mesh (a root unless parent >= 0). */
 static ak_result add_mesh_node(w_ctx* c, const char* mesh_name, int32_t parent, int32_t* out_node) {
     cJSON* node = cJSON_CreateObject();
-    if (!node || !cJSON_AddItemToArray(c->nodes, node)) return oom(c);
+    if (!push_node(c, node)) return oom(c);
     char name[AK_NAME_SIZE + 8];
     snprintf(name, sizeof name, "%s_node", mesh_name[0] ? mesh_name : "mesh");
     if (!cJSON_AddStringToObject(node, "name", name)) return oom(c);
@@ -385,6 +416,32 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
         if (a < 0) return oom(c);
         add_num(attrs, "NORMAL", a);
     }
+    const bool tangents = mesh->tangents && mesh->normals; /* glTF: TANGENT needs NORMAL */
+    if (mesh->tangents && !mesh->normals) {
+        char msg[AK_NAME_SIZE + 96];
+        snprintf(msg, sizeof msg, "%s: tangents without normals are not written", what);
+        akp_log(c->logger, AK_LOG_WARN, msg);
+    }
+    if (tangents) {
+        /* xyz unit (renormalised as normals are; a zero one becomes +X), w exactly +1 or -1 */
+        ak_vec4* tg = (ak_vec4*)malloc(nv * sizeof(ak_vec4));
+        if (!tg) return oom(c);
+        for (size_t v = 0; v < nv; ++v) {
+            ak_vec4 x = mesh->tangents[v];
+            if (!finite_floats(&x.x, 4)) {
+                free(tg);
+                return BAD(c, AK_ERR_BAD_DATA, "%s: tangent %zu is not finite", what, v);
+            }
+            ak_vec3 d = ak_vec3_make(x.x, x.y, x.z);
+            float len = ak_vec3_length(d);
+            d = fabsf(len - 1.0f) <= 1e-5f ? d : len > 0.0f ? ak_vec3_scale(d, 1.0f / len) : ak_vec3_make(1, 0, 0);
+            tg[v] = ak_vec4_make(d.x, d.y, d.z, x.w < 0.0f ? -1.0f : 1.0f);
+        }
+        a = add_accessor(c, tg, nv, GL_FLOAT, 4, GL_ARRAY_BUFFER, false);
+        free(tg);
+        if (a < 0) return oom(c);
+        add_num(attrs, "TANGENT", a);
+    }
     if (mesh->uvs) {
         if (!finite_floats(&mesh->uvs[0].x, nv * 2)) return BAD(c, AK_ERR_BAD_DATA, "%s: a UV is not finite", what);
         if ((a = add_accessor(c, mesh->uvs, nv, GL_FLOAT, 2, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
@@ -477,6 +534,12 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
                 if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
                 add_num(tg, "NORMAL", a);
             }
+            if (tangents && mesh->morph_tangents) {
+                d = mesh->morph_tangents + t * nv;
+                if (!finite_floats(&d[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: morph target %zu is not finite", what, t);
+                if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
+                add_num(tg, "TANGENT", a);
+            }
         }
     }
     return AK_OK;
@@ -550,6 +613,7 @@ static ak_result write_meshes(w_ctx* c) {
             r = oom(c);
             break;
         }
+        ++c->n_meshes;
         char gname[AK_NAME_SIZE];
         group_name(mesh->name, end - m, gname);
         cJSON_AddStringToObject(gm, "name", gname);
@@ -577,8 +641,8 @@ static ak_result write_meshes(w_ctx* c) {
             }
         }
         if (r == AK_OK) {
-            cJSON* nj = cJSON_GetArrayItem(c->nodes, node);
-            add_num(nj, "mesh", cJSON_GetArraySize(c->meshes) - 1);
+            cJSON* nj = node_at(c, node);
+            add_num(nj, "mesh", c->n_meshes - 1);
             if (skinned) add_num(nj, "skin", sm->skin);
         }
         m = end;
@@ -622,7 +686,7 @@ static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t key
     add_num(sm, "output", outa);
     cJSON_AddStringToObject(sm, "interpolation", interp == AK_INTERP_STEP ? "STEP"
                                                  : interp == AK_INTERP_LINEAR ? "LINEAR" : "CUBICSPLINE");
-    *out_index = cJSON_GetArraySize(samplers) - 1;
+    *out_index = c->n_samplers++;
     return AK_OK;
 }
 
@@ -641,6 +705,7 @@ static ak_result add_channel(w_ctx* c, cJSON* an, int sampler, int32_t node, con
 static ak_result write_clip(w_ctx* c, const ak_clip* clip, size_t ci) {
     cJSON* an = cJSON_CreateObject();
     if (!an) return oom(c);
+    c->n_samplers = 0;
     if (!cJSON_AddArrayToObject(an, "channels") || !cJSON_AddArrayToObject(an, "samplers")) {
         cJSON_Delete(an);
         return oom(c);
@@ -910,6 +975,7 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
     cJSON_Delete(c.materials);
     free(c.bin);
     free(c.node_of_mesh);
+    free(c.node_tab);
     free(c.group_of_mesh);
     free(c.morph_base);
     return r;

@@ -8,17 +8,19 @@
 #include "render.h"
 #include "cloth_run.h"
 #include "scene_cloth.h"
+#include "sim_bake.h"
 
 static const char* const usage =
     "usage: animkit cloth [SCENE.json | --preset flag|curtain|drape|cape] [--solver springs|xpbd]\n"
     "                     [--steps N] [--dt DT] [--substeps S] [--threads T] [--json OUT.json]\n"
-    "                     [-o OUT.gif|OUT.png|OUT.obj]\n"
+    "                     [-o OUT.gif|OUT.png|OUT.obj|OUT.glb|OUT.gltf]\n"
     "Simulate a cloth: a flag in gusty wind, a curtain on rings, a square draped on a sphere, or a\n"
     "cape on builtin:humanoid walking; or the scene a JSON file describes (docs/cloth.md lists\n"
     "every key). The solver is XPBD (compliant constraints, substeps) or the classic mass-spring\n"
     "model (semi-implicit Euler, which needs small steps: raise --substeps if it blows up).\n"
     "--json writes {\"time\", \"positions\", \"max_stretch\", \"energy\"} of the final state;\n"
-    "-o renders the run (GIF), its last frame (PNG) or writes the last state as OBJ.\n"
+    "-o renders the run (GIF), its last frame (PNG), writes the last state as OBJ, or the whole run\n"
+    "as glTF (.glb, or .gltf + .bin): morph-target animation of the cloth (docs/io.md).\n"
     "Exit status: 0 success, 1 bad scene or a blow-up (named by its step), 2 bad usage.\n";
 
 /* ---- output ------------------------------------------------------------------------------ */
@@ -81,8 +83,8 @@ int cmd_cloth(int argc, char** argv) {
     if ((a.pos_count == 1) == (preset != NULL)) return cli_usage("cloth", "give either SCENE.json or --preset NAME");
     const char* out = CLI_GET(&a, "--output");
     const char* json = CLI_GET(&a, "--json");
-    if (out && !cli_has_ext(out, ".gif") && !cli_has_ext(out, ".png") && !cli_has_ext(out, ".obj"))
-        return cli_usage("cloth", "output '%s' must end in .gif, .png or .obj", out);
+    if (out && !cli_has_ext(out, ".gif") && !cli_has_ext(out, ".png") && !cli_has_ext(out, ".obj") && !sim_bake_wanted(out))
+        return cli_usage("cloth", "output '%s' must end in .gif, .png, .obj, .glb or .gltf", out);
     cloth_scene sc;
     const char* name = preset ? preset : a.pos[0];
     if (preset) {
@@ -139,9 +141,12 @@ int cmd_cloth(int argc, char** argv) {
     memset(&frame, 0, sizeof frame);
     ak_image img = {0};
     ak_gif_writer* gw = NULL;
+    sim_bake bake;
+    memset(&bake, 0, sizeof bake);
 
     rc = cloth_run_init(&run, &sc, "cloth", name);
     if (rc) goto done;
+    if (sim_bake_wanted(out) && (rc = sim_bake_mesh_init(&bake, "cloth", out, run.n, sc.steps))) goto done;
     cloth_character* const ch = &run.ch;
     ak_cloth* const cloth = run.cloth;
     ak_vec3* const x = run.x;
@@ -209,6 +214,7 @@ int cmd_cloth(int argc, char** argv) {
             }
             ++frames;
         }
+        if (bake.cap) sim_bake_mesh_add(&bake, step, x, nrm);
         if (step == sc.steps) break;
         if ((rc = cloth_run_step(&run, "cloth", name))) {
             free(props);
@@ -232,15 +238,20 @@ int cmd_cloth(int argc, char** argv) {
     ak_cloth_energy_compute(cloth, (ak_vec3_cspan){x, n}, (ak_vec3_cspan){vel, n}, sc.gravity, &e);
     if (json && (rc = write_json(json, time, x, n, stretch, e.total))) goto done;
     if (out && cli_has_ext(out, ".obj") && (rc = write_obj(out, cloth, x, nrm))) goto done;
+    if (bake.cap && (rc = sim_bake_mesh_write(&bake, preset ? preset : "cloth", sc.dt, ak_cloth_indices(cloth),
+                                              ak_vec4_make(0.72f, 0.16f, 0.18f, 1))))
+        goto done;
     printf("cloth %s: %s, %zu particles, %ld steps of %.4g s (%u substeps): t = %.3g s, max stretch %.4f, energy %.6g J"
            " (kinetic %.3g)\n",
            name, sc.desc.solver == AK_CLOTH_SPRINGS ? "mass-spring" : sc.desc.solver == AK_CLOTH_PBD ? "PBD" : "XPBD", n,
            sc.steps, (double)sc.dt, sc.substeps, (double)time, (double)stretch, e.total, e.kinetic);
     if (gif) fprintf(stderr, "wrote %s: %d frames\n", out, frames);
+    else if (bake.cap) fprintf(stderr, "wrote %s: %zu frames, %.4g s apart\n", out, bake.frames, (double)sc.dt * (double)bake.every);
     else if (out) fprintf(stderr, "wrote %s\n", out);
     if (sc.steps > 0) fprintf(stderr, "%.3f ms per step (including rendering)\n", 1e3 * elapsed / (double)sc.steps);
 
 done:
+    sim_bake_free(&bake);
     if (gw) ak_gif_writer_finish(gw);
     free(img.pixels);
     cli_frame_free(&frame);

@@ -8,12 +8,14 @@
 #include "render.h"
 #include "particles_run.h"
 #include "scene_particles.h"
+#include "sim_bake.h"
 
 static const char* const usage =
     "usage: animkit particles [SCENE.json | --preset fountain|rain|fireworks|character] [--steps "
     "N]\n"
     "                         [--dt DT] [--integrator euler|symplectic|verlet|rk4] [--seed K]\n"
-    "                         [--threads T] [--json OUT.json] [-o OUT.gif|OUT.png] [--size WxH]\n"
+    "                         [--threads T] [--json OUT.json] [-o OUT.gif|OUT.png|OUT.glb|OUT.gltf]\n"
+    "                         [--size WxH]\n"
     "Simulate a particle system (docs/particles.md describes the scene format).\n"
     "  --preset     a built-in scene instead of a file (character: rain and sparks on the walking\n"
     "               builtin:humanoid, which the particles collide with)\n"
@@ -25,7 +27,8 @@ static const char* const usage =
     "  --json       write {\"time\", \"steps\", \"particles\": [{\"p\", \"v\"}]} after the last "
     "step,\n"
     "               the file's particles first, emitted ones after them\n"
-    "  -o           render: a GIF of the run (up to 100 frames) or a PNG of the last step\n"
+    "  -o           render: a GIF of the run (up to 100 frames) or a PNG of the last step; or\n"
+    "               the run as glTF (.glb, or .gltf + .bin): one animated node per particle\n"
     "  --size       image size, 8x8 to 8192x8192 (default 480x360)\n";
 
 typedef struct renderer {
@@ -151,8 +154,9 @@ int cmd_particles(int argc, char** argv) {
     }
     const char* out = CLI_GET(&a, "--output");
     bool gif = out && cli_has_ext(out, ".gif");
-    if (out && !gif && !cli_has_ext(out, ".png"))
-        return cli_usage("particles", "output '%s' must end in .gif or .png", out);
+    const bool glb = sim_bake_wanted(out);
+    if (out && !gif && !glb && !cli_has_ext(out, ".png"))
+        return cli_usage("particles", "output '%s' must end in .gif, .png, .glb or .gltf", out);
     int width = 480, height = 360;
     if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &width, &height))
         return cli_usage("particles", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
@@ -198,10 +202,13 @@ int cmd_particles(int argc, char** argv) {
     renderer rd;
     memset(&rd, 0, sizeof rd);
     ak_gif_writer* gw = NULL;
+    sim_bake bake;
+    memset(&bake, 0, sizeof bake);
     if (use_char && particles_character_init(&ch, &rc)) goto done;
+    if (glb && (rc = sim_bake_points_init(&bake, "particles", out, steps))) goto done;
     const int frames = gif ? (int)(steps < 100 ? steps : 100) : 1;
     const long every = gif && frames > 0 ? (steps + frames - 1) / frames : (steps > 0 ? steps : 1);
-    if (out) {
+    if (out && !glb) {
         /* A dry run finds the bounds for a camera fixed over the whole animation. */
         if ((rc = particles_run_init(&r, &scene, use_char ? &ch : NULL, (uint64_t)seed, (uint32_t)threads)))
             goto done;
@@ -274,6 +281,10 @@ int cmd_particles(int argc, char** argv) {
     for (long s = 0; s <= steps; ++s) {
         if (s > 0 && (rc = particles_run_step(&r, (int)s - 1))) goto done;
         cli_progress("particles", (size_t)s, (size_t)steps);
+        if (glb) {
+            ak_particles_state st = ak_particles_get_state(r.ps);
+            if ((rc = sim_bake_points_add(&bake, s, st.position, st.id, st.count))) goto done;
+        }
         if (gw && (s % every == 0 || s == steps)) {
             if ((rc = render_frame(&rd, &r, &rd.image))) goto done;
             ak_result res = ak_gif_writer_add_frame(gw, &rd.image);
@@ -284,7 +295,10 @@ int cmd_particles(int argc, char** argv) {
         }
     }
     if (json && (rc = write_json(json, &r, (int)steps))) goto done;
-    if (out && !gif) {
+    if (glb) {
+        if ((rc = sim_bake_points_write(&bake, preset ? preset : "particles", scene.dt))) goto done;
+        fprintf(stderr, "wrote %s: %zu frames, %.4g s apart\n", out, bake.frames, (double)scene.dt * (double)bake.every);
+    } else if (out && !gif) {
         if ((rc = render_frame(&rd, &r, &rd.image))) goto done;
         ak_result res = ak_png_write(out, &rd.image);
         if (res != AK_OK) rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
@@ -295,6 +309,7 @@ done:
         if (rc == CLI_OK && res != AK_OK)
             rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
     }
+    sim_bake_free(&bake);
     particles_run_free(&r);
     if (rd.framed) cli_frame_free(&rd.frame);
     free(rd.image.pixels);
