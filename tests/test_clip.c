@@ -170,7 +170,7 @@ AK_TEST(sample_rejects_bad_spans) {
                 AK_ERR_NULL_ARG);
     uint32_t st[1];
     ak_clip_cursor cur;
-    AK_CHECK_EQ(ak_clip_cursor_storage_count(a), 1);
+    AK_CHECK(ak_clip_cursor_storage_count(a) >= 1); /* 1 segment (+ the key cache in SIMD builds) */
     AK_CHECK_EQ(ak_clip_cursor_init(&cur, a, (ak_u32_span){st, 0}), AK_ERR_SPAN_SMALL);
     AK_CHECK_EQ(ak_clip_cursor_init(&cur, a, (ak_u32_span)AK_SPAN(st)), AK_OK);
     AK_CHECK_EQ(ak_clip_sample(b, 0.5f, &cur, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0}, (ak_f32_span){0}),
@@ -310,25 +310,41 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
     ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0]);
     AK_CHECK(c != NULL);
     if (!c) return;
-    uint32_t seg[3 * CJ + 2];
-    ak_clip_cursor cur;
-    AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg)), AK_OK);
-    enum { T = 10000 };
-    static float times[T];
-    float dur = ak_clip_duration(c);
-    /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
-    for (int i = 0; i < T; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)T;
-    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-    for (int i = 0; i < T; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)T;
-    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-    for (int i = 0; i < T; ++i) times[i] = ak_time_wrap(3.3f * dur * (float)i / (float)T, dur, AK_WRAP_LOOP);
-    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-    for (int i = 0; i < T; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
-    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-    for (size_t ci = 0; ci < ak_clip_channel_count(c); ++ci) {
-        ak_f32_cspan kt = ak_track_times(ak_clip_channel_track(c, ci));
-        AK_CHECK_EQ(compare_run(c, &cur, kt.ptr, kt.count), 0);
+    /* Two cursors: the full storage (segments and the key cache, SIMD lanes) and the minimum
+     * (segments only, one channel at a time); the storage starts at an odd element so the cache
+     * has to align itself. */
+    size_t full = ak_clip_cursor_storage_count(c);
+    AK_CHECK(full >= ak_clip_channel_count(c));
+    uint32_t* seg = (uint32_t*)calloc(full + 1, sizeof *seg);
+    for (int pass = 0; pass < 2; ++pass) {
+        ak_clip_cursor cur;
+        ak_u32_span st = pass == 0 ? (ak_u32_span){seg + 1, full} : (ak_u32_span){seg, ak_clip_channel_count(c)};
+        AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, st), AK_OK);
+        enum { T = 10000 };
+        static float times[T];
+        float dur = ak_clip_duration(c);
+        /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
+        for (int i = 0; i < T; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)T;
+        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        for (int i = 0; i < T; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)T;
+        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        for (int i = 0; i < T; ++i) times[i] = ak_time_wrap(3.3f * dur * (float)i / (float)T, dur, AK_WRAP_LOOP);
+        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        for (int i = 0; i < T; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
+        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        /* on keys, next to keys, infinities and NaN */
+        for (size_t ci = 0; ci < ak_clip_channel_count(c); ++ci) {
+            ak_f32_cspan kt = ak_track_times(ak_clip_channel_track(c, ci));
+            AK_CHECK_EQ(compare_run(c, &cur, kt.ptr, kt.count), 0);
+            for (size_t k = 0; k < kt.count; ++k) {
+                float near[2] = {nextafterf(kt.ptr[k], -INFINITY), nextafterf(kt.ptr[k], INFINITY)};
+                AK_CHECK_EQ(compare_run(c, &cur, near, 2), 0);
+            }
+        }
+        float odd[5] = {INFINITY, -INFINITY, NAN, 0.5f, -0.0f};
+        AK_CHECK_EQ(compare_run(c, &cur, odd, 5), 0);
     }
+    free(seg);
     ak_clip_destroy(c);
 }
 
@@ -411,8 +427,9 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
         ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0]);
         AK_CHECK(c != NULL);
         if (!c) return;
-        uint32_t seg[3 * CJ + 2];
+        uint32_t seg[4096];
         ak_clip_cursor cur;
+        AK_CHECK(ak_clip_cursor_storage_count(c) <= 4096);
         AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg)), AK_OK);
         enum { T = 3000 };
         static float times[T];
@@ -447,8 +464,9 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
     ak_clip* c = build(&raw);
     AK_CHECK(c != NULL);
     if (c) {
-        uint32_t seg[1];
+        uint32_t seg[128];
         ak_clip_cursor cur;
+        AK_CHECK(ak_clip_cursor_storage_count(c) <= 128);
         ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg));
         enum { T = 20000 };
         static float times[T];
