@@ -373,9 +373,7 @@ static inline __m128 load3(const float* p) {
     return _mm_movelh_ps(_mm_loadl_pi(_mm_setzero_ps(), (const __m64*)(const void*)p), _mm_load_ss(p + 2));
 }
 
-/* Refresh the lanes of group G set in mask for time t (not NaN): per lane, in scalar code, the
- * segment (usually the next one) or the key it holds outside the keys; then the keys of the
- * four lanes are transposed in SIMD registers and the refreshed lanes written into the cache. */
+/* One lane's refreshed state. */
 typedef struct lane_keys {
     float lo, hi, t0, dt;
     int hold; /* -1 or 0 */
@@ -409,14 +407,21 @@ static inline lane_keys lane_refresh(const ak_clip* clip, const akp_clip_group* 
     return r;
 }
 
-static void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
-    const lane_keys k0 = lane_refresh(clip, G, segs, 0, mask & 1, t), k1 = lane_refresh(clip, G, segs, 1, mask & 2, t),
-                    k2 = lane_refresh(clip, G, segs, 2, mask & 4, t), k3 = lane_refresh(clip, G, segs, 3, mask & 8, t);
+#if defined(__GNUC__)
+#define AKP_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define AKP_ALWAYS_INLINE inline
+#endif
+
+/* Write the keys k0..k3 of the lanes in mask into the cache (full: all four, no blend). */
+static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int mask, bool full, lane_keys k0,
+                                          lane_keys k1, lane_keys k2, lane_keys k3) {
     const float* pa[4] = {k0.pa, k1.pa, k2.pa, k3.pa};
     const float* pb[4] = {k0.pb, k1.pb, k2.pb, k3.pb};
     const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
     const __m128 m = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(mask), bits), bits));
-#define AKP_PUT(field, v) _mm_store_ps(f + 4 * (field), akp_simd_select(m, (v), _mm_load_ps(f + 4 * (field))))
+#define AKP_PUT(field, v)                                                                                        \
+    _mm_store_ps(f + 4 * (field), full ? (v) : akp_simd_select(m, (v), _mm_load_ps(f + 4 * (field))))
     AKP_PUT(F_LO, _mm_setr_ps(k0.lo, k1.lo, k2.lo, k3.lo));
     AKP_PUT(F_HI, _mm_setr_ps(k0.hi, k1.hi, k2.hi, k3.hi));
     AKP_PUT(F_T0, _mm_setr_ps(k0.t0, k1.t0, k2.t0, k3.t0));
@@ -461,6 +466,31 @@ static void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t
 #undef AKP_PUT
 }
 
+/* Refresh the lanes of group G set in mask for time t (not NaN): per lane, in scalar code, the
+ * segment (usually the next one) or the key it holds outside the keys; then the keys of the
+ * four lanes are transposed in SIMD registers and the refreshed lanes written into the cache.
+ * A group whose channels share their key times (G->shared) refreshes all four lanes together,
+ * so lane 0's segment serves all four. */
+static void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
+    if (mask == 15 && G->shared) {
+        lane_keys k[4];
+        k[0] = lane_refresh(clip, G, segs, 0, true, t);
+        const float* v0 = clip->channels[G->ch[0]].track.values;
+        for (int l = 1; l < 4; ++l) {
+            const float* v = clip->channels[G->ch[l]].track.values;
+            k[l] = k[0];
+            k[l].pa = v + (k[0].pa - v0), k[l].pb = v + (k[0].pb - v0);
+            segs[G->ch[l]] = segs[G->ch[0]];
+        }
+        cache_write(G, f, 15, true, k[0], k[1], k[2], k[3]);
+        return;
+    }
+    const lane_keys k0 = lane_refresh(clip, G, segs, 0, mask & 1, t), k1 = lane_refresh(clip, G, segs, 1, mask & 2, t),
+                    k2 = lane_refresh(clip, G, segs, 2, mask & 4, t), k3 = lane_refresh(clip, G, segs, 3, mask & 8, t);
+    if (mask == 15) cache_write(G, f, 15, true, k0, k1, k2, k3);
+    else cache_write(G, f, mask, false, k0, k1, k2, k3);
+}
+
 /* Sample every group through the cache (time not NaN). */
 static void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache, float* pose) {
     const __m128 T = _mm_set1_ps(time), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f),
@@ -480,9 +510,11 @@ static void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint3
             __m128 x = _mm_add_ps(ax, _mm_mul_ps(_mm_load_ps(f + 4 * F_B), u));
             __m128 y = _mm_add_ps(ay, _mm_mul_ps(_mm_load_ps(f + 4 * (F_B + 1)), u));
             __m128 z = _mm_add_ps(az, _mm_mul_ps(_mm_load_ps(f + 4 * (F_B + 2)), u));
-            x = akp_simd_select(hold, ax, x);
-            y = akp_simd_select(hold, ay, y);
-            z = akp_simd_select(hold, az, z);
+            if (_mm_movemask_ps(hold)) {
+                x = akp_simd_select(hold, ax, x);
+                y = akp_simd_select(hold, ay, y);
+                z = akp_simd_select(hold, az, z);
+            }
             __m128 w = _mm_setzero_ps();
             AKP_SIMD_TRANSPOSE4(x, y, z, w);
             const __m128 r[4] = {x, y, z, w};
@@ -551,6 +583,16 @@ static void make_groups(ak_clip* clip) {
             g->ch[lane] = (uint32_t)i;
             g->dst[lane] = clip->channels[i].dst;
             ++lane;
+        }
+    }
+    for (size_t g = 0; g < clip->group_count; ++g) {
+        akp_clip_group* G = &clip->groups[g];
+        const ak_track* t0 = &clip->channels[G->ch[0]].track;
+        G->shared = true;
+        for (int l = 1; l < 4; ++l) {
+            const ak_track* tl = &clip->channels[G->ch[l]].track;
+            G->shared = G->shared && tl->key_count == t0->key_count && tl->stride == t0->stride &&
+                        (tl->times == t0->times || !memcmp(tl->times, t0->times, t0->key_count * sizeof(float)));
         }
     }
     for (size_t i = 0; i < clip->channel_count; ++i)

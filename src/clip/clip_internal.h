@@ -29,6 +29,7 @@ typedef struct akp_clip_group {
     akp_clip_fast kind; /* VEC3, SLERP or NLERP */
     uint32_t ch[4];     /* channel indices */
     uint32_t dst[4];    /* their akp_clip_channel.dst */
+    bool shared;        /* the four tracks have the same key times (bit for bit) */
 } akp_clip_group;
 
 /* One allocation: this header, the channel array, the groups and the slow channel list, then
