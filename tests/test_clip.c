@@ -250,7 +250,9 @@ AK_TEST(gltf_interpolation_matches_spec_formulas) {
 
 enum { CJ = 24 };
 
-static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
+/* A random clip over CJ joints (every mode, 1-key channels, weights and scalars); common: every
+ * channel with the same key times (as baked clips have), else each with its own. */
+static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count, bool common) {
     static const ak_interp tmodes[] = {AK_INTERP_STEP, AK_INTERP_LINEAR, AK_INTERP_CUBICSPLINE, AK_INTERP_CARDINAL,
                                        AK_INTERP_NATURAL};
     static const ak_interp rmodes[] = {AK_INTERP_STEP, AK_INTERP_LINEAR, AK_INTERP_NLERP, AK_INTERP_SQUAD,
@@ -270,7 +272,7 @@ static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
         bool rot = r->target == AK_CHANNEL_ROTATION;
         r->interp = rot ? rmodes[ak_rng_u32(rng) % 5] : tmodes[ak_rng_u32(rng) % 5];
         uint32_t cc = rot ? 4 : 3;
-        size_t n = c % 17 == 5 ? 1 : 2 + ak_rng_u32(rng) % 40;
+        size_t n = common ? 23 : c % 17 == 5 ? 1 : 2 + ak_rng_u32(rng) % 40;
         size_t stride = r->interp == AK_INTERP_CUBICSPLINE ? 3 * cc : cc;
         float* times = store + used;
         used += n;
@@ -278,9 +280,11 @@ static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
         used += n * stride;
         if (used > store_count) return NULL;
         float t = ak_rng_range(rng, -0.5f, 1.0f);
+        ak_rng trng = ak_rng_make(77); /* common: the same time sequence for every channel */
+        if (common) t = -0.25f;
         for (size_t k = 0; k < n; ++k) {
             times[k] = t;
-            t += ak_rng_range(rng, 0.01f, 0.5f);
+            t += ak_rng_range(common ? &trng : rng, 0.01f, 0.5f);
             for (size_t j = 0; j < stride; ++j) vals[k * stride + j] = ak_rng_range(rng, -1, 1);
         }
         r->key_count = n;
@@ -290,6 +294,7 @@ static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
     ak_raw_clip raw = {.channels = ch, .channel_count = nch, .joint_count = CJ, .morph_weight_count = 3, .scalar_count = 3};
     return build(&raw);
 }
+
 
 static int compare_run(const ak_clip* c, ak_clip_cursor* cur, const float* times, size_t count) {
     int mismatches = 0;
@@ -307,7 +312,8 @@ static int compare_run(const ak_clip* c, ak_clip_cursor* cur, const float* times
 AK_TEST(cursor_is_bit_identical_to_binary_search) {
     ak_rng rng = ak_rng_make(12);
     static float store[200000];
-    ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0]);
+    for (int common = 0; common < 2; ++common) {
+    ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0], common == 1);
     AK_CHECK(c != NULL);
     if (!c) return;
     /* Two cursors: the full storage (segments and the key cache, SIMD lanes) and the minimum
@@ -346,6 +352,7 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
     }
     free(seg);
     ak_clip_destroy(c);
+    }
 }
 
 
@@ -423,8 +430,8 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
     ak_rng rng = ak_rng_make(21);
     static float store[200000];
     double worst = 0.0;
-    for (int rep = 0; rep < 4; ++rep) {
-        ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0]);
+    for (int rep = 0; rep < 6; ++rep) {
+        ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0], rep >= 4);
         AK_CHECK(c != NULL);
         if (!c) return;
         uint32_t seg[4096];
