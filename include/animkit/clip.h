@@ -21,9 +21,10 @@
  * Usage:
  *     ak_clip* clip = NULL;
  *     if (ak_clip_build(&raw, NULL, &clip, &diag) != AK_OK) fprintf(stderr, "%s\n", diag.message);
- *     uint32_t keys[64];                                   // >= ak_clip_cursor_storage_count
+ *     size_t cn = ak_clip_cursor_storage_count(clip);      // segments + key cache
+ *     uint32_t* keys = calloc(cn, sizeof *keys);
  *     ak_clip_cursor cursor;
- *     ak_clip_cursor_init(&cursor, clip, (ak_u32_span)AK_SPAN(keys));
+ *     ak_clip_cursor_init(&cursor, clip, (ak_u32_span){keys, cn});
  *     ak_transform local[32];                              // start from the rest pose
  *     for (int j = 0; j < 32; ++j) local[j] = rest[j];
  *     for (float t = 0.0f; t < 10.0f; t += 1.0f / 60.0f) {
@@ -32,6 +33,7 @@
  *                        (ak_f32_span){0}, (ak_f32_span){0});
  *         // ... skeleton local-to-model, skinning ...
  *     }
+ *     free(keys);
  *     ak_clip_destroy(clip);
  *
  * Ownership and threading: a built clip is one allocation, immutable, and may be sampled
@@ -136,20 +138,31 @@ AK_API const ak_track* ak_clip_channel_track(const ak_clip* clip, size_t channel
 /* ---- sampling ----------------------------------------------------------------------- */
 
 /* Playback state: the last key segment of every channel, so the next sample near the last
- * one finds its keys without a search. Caller-owned; initialise with ak_clip_cursor_init.
- * One cursor per playing instance (and per thread). */
+ * one finds its keys without a search, and (with the full storage) a key cache: the keys
+ * around the current time of every LINEAR translation/scale and LINEAR/NLERP rotation channel
+ * with two or more keys, laid out four channels per SIMD vector (structure of arrays). A
+ * sample then checks four channels' key intervals in one operation, interpolates four
+ * channels per operation, and reloads only the channels whose interval the time has left
+ * (once per group when the four channels share their key times, as baked clips do).
+ * Caller-owned; initialise with ak_clip_cursor_init. One cursor per playing instance (and per
+ * thread). */
 typedef struct ak_clip_cursor {
     const ak_clip* clip;   /* the clip the cursor was initialised for */
-    uint32_t* segments;    /* caller storage, [ak_clip_cursor_storage_count(clip)] */
+    uint32_t* segments;    /* caller storage: [channel count] segments, then the key cache */
     size_t segment_count;  /* storage elements */
 } ak_clip_cursor;
 
-/* Elements of uint32_t storage a cursor for this clip needs (= channel count). NULL -> 0. */
+/* Elements of uint32_t storage for a cursor with its key cache: the channel count, plus 3 +
+ * 68 per group of four cached channels in SIMD builds (about 18 per joint with T, R and S
+ * channels; 72 bytes). NULL -> 0. The minimum a cursor accepts is ak_clip_channel_count
+ * (segments only, no key cache: slower, same results). */
 AK_API size_t ak_clip_cursor_storage_count(const ak_clip* clip);
 
-/* Bind a cursor to a clip and storage, positioned at the start. The cursor keeps both
- * pointers. Returns AK_ERR_NULL_ARG (cursor or clip NULL, storage.ptr NULL with a non-zero
- * requirement) or AK_ERR_SPAN_SMALL (storage.count < ak_clip_cursor_storage_count). */
+/* Bind a cursor to a clip and storage (any uint32_t alignment), positioned at the start. The
+ * cursor keeps both pointers. storage.count >= ak_clip_cursor_storage_count enables the key
+ * cache; between ak_clip_channel_count and that, the cursor keeps segments only.
+ * Returns AK_ERR_NULL_ARG (cursor or clip NULL, storage.ptr NULL with a non-zero
+ * requirement) or AK_ERR_SPAN_SMALL (storage.count < ak_clip_channel_count). */
 AK_API ak_result ak_clip_cursor_init(ak_clip_cursor* cursor, const ak_clip* clip,
                                      ak_u32_span storage);
 
@@ -160,7 +173,8 @@ AK_API ak_result ak_clip_cursor_init(ak_clip_cursor* cursor, const ak_clip* clip
  * own keys. A NaN time samples the first keys.
  * cursor: NULL -> binary search per channel (fine for one-off samples); else a cursor from
  * ak_clip_cursor_init for this clip (O(1) amortised per channel when time moves forward by
- * less than a key interval; any jump is still exact). Results are bit-identical either way.
+ * less than a key interval; any jump is still exact). Results are bit-identical either way
+ * (the key cache's SIMD lanes run the scalar evaluator's operations in its order).
  * inout_local.count >= ak_clip_joint_count when the clip has joint channels (may be empty
  * otherwise); inout_morph_weights / inout_scalars: empty -> those channels are skipped, else
  * count >= ak_clip_morph_weight_count / ak_clip_scalar_count.
