@@ -326,7 +326,7 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
         ak_clip_cursor cur;
         ak_u32_span st = pass == 0 ? (ak_u32_span){seg + 1, full} : (ak_u32_span){seg, ak_clip_channel_count(c)};
         AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, st), AK_OK);
-        enum { T = 10000 };
+        enum { T = 6000 };
         static float times[T];
         float dur = ak_clip_duration(c);
         /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
