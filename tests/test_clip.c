@@ -485,6 +485,140 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
     AK_CHECK(worst < 1e-6);
 }
 
+/* ---- keyframe reduction ---------------------------------------------------------------- */
+
+/* Largest model-space distance between the two clips' joint origins and axis points at r. */
+static double reduce_model_error(const ak_clip* a, const ak_clip* b, float t, const int16_t* parents,
+                                 const ak_transform* rest, size_t n, float r) {
+    ak_transform pa[8], pb[8];
+    ak_mat4 ma[8], mb[8];
+    memcpy(pa, rest, n * sizeof *pa);
+    memcpy(pb, rest, n * sizeof *pb);
+    ak_clip_sample(a, t, NULL, (ak_transform_span){pa, n}, (ak_f32_span){0}, (ak_f32_span){0});
+    ak_clip_sample(b, t, NULL, (ak_transform_span){pb, n}, (ak_f32_span){0}, (ak_f32_span){0});
+    double worst = 0.0;
+    for (size_t j = 0; j < n; ++j) {
+        ma[j] = ak_transform_to_mat4(pa[j]);
+        mb[j] = ak_transform_to_mat4(pb[j]);
+        if (parents[j] >= 0) ma[j] = ak_mat4_mul(ma[parents[j]], ma[j]), mb[j] = ak_mat4_mul(mb[parents[j]], mb[j]);
+        const ak_vec3 pts[4] = {{0, 0, 0}, {r, 0, 0}, {0, r, 0}, {0, 0, r}};
+        for (int p = 0; p < 4; ++p)
+            worst = fmax(worst, ak_vec3_distance(ak_mat4_transform_point(ma[j], pts[p]),
+                                                 ak_mat4_transform_point(mb[j], pts[p])));
+    }
+    return worst;
+}
+
+AK_TEST(reduce_keeps_model_error_within_tolerance) {
+    /* A 6-joint chain with smooth T/R/S motion at 60 keys/s over 4 s (LINEAR, NLERP on one
+     * joint, non-uniform key times), a STEP channel and morph weights (copied unchanged). */
+    enum { NJ = 6, K = 241 };
+    const int16_t parents[NJ] = {-1, 0, 1, 2, 1, 4};
+    ak_transform rest[NJ];
+    for (int j = 0; j < NJ; ++j) rest[j] = ak_transform_identity(), rest[j].translation = ak_vec3_make(0, 0.4f, 0);
+    static float kt[K], tv[NJ][K * 3], rv[NJ][K * 4], sv[NJ][K * 3], wv[K * 2];
+    for (int k = 0; k < K; ++k) kt[k] = (float)k / 60.0f + (k % 3 == 1 ? 0.004f : 0.0f);
+    ak_raw_channel ch[3 * NJ + 1];
+    size_t nch = 0;
+    for (int j = 0; j < NJ; ++j) {
+        for (int k = 0; k < K; ++k) {
+            float t = kt[k], ph = (float)j;
+            tv[j][3 * k] = 0.05f * sinf(2.0f * t + ph), tv[j][3 * k + 1] = 0.4f, tv[j][3 * k + 2] = 0.02f * t;
+            ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(1, 0.3f * ph, 0.2f), 0.9f * sinf(3.0f * t + ph));
+            rv[j][4 * k] = q.x, rv[j][4 * k + 1] = q.y, rv[j][4 * k + 2] = q.z, rv[j][4 * k + 3] = q.w;
+            sv[j][3 * k] = sv[j][3 * k + 1] = sv[j][3 * k + 2] = 1.0f + 0.1f * sinf(1.5f * t + ph);
+        }
+        ak_interp rot = j == 3 ? AK_INTERP_NLERP : j == 4 ? AK_INTERP_STEP : AK_INTERP_LINEAR;
+        ch[nch++] = (ak_raw_channel){.target = AK_CHANNEL_TRANSLATION, .index = (uint32_t)j, .key_count = K, .times = kt,
+                                     .values = tv[j]};
+        ch[nch++] = (ak_raw_channel){.target = AK_CHANNEL_ROTATION, .index = (uint32_t)j, .interp = rot, .key_count = K,
+                                     .times = kt, .values = rv[j]};
+        ch[nch++] = (ak_raw_channel){.target = AK_CHANNEL_SCALE, .index = (uint32_t)j, .key_count = K, .times = kt,
+                                     .values = sv[j]};
+    }
+    for (int k = 0; k < K; ++k) wv[2 * k] = 0.5f, wv[2 * k + 1] = (float)k / K;
+    ch[nch++] = (ak_raw_channel){.target = AK_CHANNEL_MORPH_WEIGHTS, .component_count = 2, .key_count = K, .times = kt,
+                                 .values = wv};
+    ak_raw_clip raw = {.channels = ch, .channel_count = nch, .joint_count = NJ, .morph_weight_count = 2};
+    ak_clip* c = build(&raw);
+    AK_CHECK(c != NULL);
+    if (!c) return;
+    const float tols[3] = {1e-2f, 1e-3f, 1e-4f};
+    size_t last_keys = 0;
+    for (int ti = 0; ti < 3; ++ti) {
+        ak_clip_reduce_desc d = {.parents = parents, .rest_pose = {rest, NJ}, .tolerance = tols[ti], .distance = 0.1f};
+        ak_clip* r = NULL;
+        double err = -1.0;
+        AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &r, &err, NULL), AK_OK);
+        if (!r) continue;
+        size_t before = 0, after = 0;
+        for (size_t i = 0; i < nch; ++i) {
+            before += ak_clip_channel_key_count(c, i), after += ak_clip_channel_key_count(r, i);
+            ak_interp in = ak_clip_channel_interp(c, i);
+            bool copied = in == AK_INTERP_STEP || ak_clip_channel_target(c, i) == AK_CHANNEL_MORPH_WEIGHTS;
+            if (copied) AK_CHECK_EQ(ak_clip_channel_key_count(r, i), K);
+            AK_CHECK_EQ(ak_clip_channel_interp(r, i), in);
+        }
+        /* the promise: within tolerance at every key time and key-interval midpoint */
+        double at_keys = 0.0, dense = 0.0;
+        for (int k = 0; k < K; ++k) {
+            at_keys = fmax(at_keys, reduce_model_error(c, r, kt[k], parents, rest, NJ, 0.1f));
+            if (k + 1 < K)
+                at_keys = fmax(at_keys, reduce_model_error(c, r, 0.5f * (kt[k] + kt[k + 1]), parents, rest, NJ, 0.1f));
+        }
+        for (int i = 0; i <= 4000; ++i) dense = fmax(dense, reduce_model_error(c, r, -0.5f + 5.0f * (float)i / 4000.0f,
+                                                                               parents, rest, NJ, 0.1f));
+        printf("  tolerance %g: %zu -> %zu keys, model error %.3g at keys (reported %.3g), %.3g on 4001 times\n",
+               (double)tols[ti], before, after, at_keys, err, dense);
+        AK_CHECK(at_keys <= tols[ti]);
+        AK_CHECK(fabs(at_keys - err) <= 1e-9 + 1e-6 * err);
+        AK_CHECK(dense <= 2.0 * tols[ti]);
+        AK_CHECK(after < before);
+        AK_CHECK(after > last_keys); /* a tighter tolerance keeps more keys */
+        last_keys = after;
+        ak_clip_destroy(r);
+    }
+    /* Keys on a straight line reduce to the two ends, exactly. */
+    {
+        float lt[5] = {0, 1, 2, 3, 4}, lv[15];
+        for (int k = 0; k < 5; ++k) lv[3 * k] = 2.0f * (float)k, lv[3 * k + 1] = -1.0f, lv[3 * k + 2] = 0.5f * (float)k;
+        ak_raw_channel lc = {.target = AK_CHANNEL_TRANSLATION, .key_count = 5, .times = lt, .values = lv};
+        ak_raw_clip lr = {.channels = &lc, .channel_count = 1, .joint_count = 1};
+        ak_clip* l = build(&lr);
+        const int16_t p1[1] = {-1};
+        ak_transform r1 = ak_transform_identity();
+        ak_clip_reduce_desc d = {.parents = p1, .rest_pose = {&r1, 1}};
+        ak_clip* out = NULL;
+        AK_CHECK_EQ(ak_clip_reduce(l, &d, NULL, &out, NULL, NULL), AK_OK);
+        AK_CHECK_EQ(ak_clip_channel_key_count(out, 0), 2);
+        ak_clip_destroy(out);
+        ak_clip_destroy(l);
+    }
+    /* Errors. */
+    ak_clip* out = (ak_clip*)&out;
+    ak_clip_reduce_desc d = {.parents = parents, .rest_pose = {rest, NJ}};
+    AK_CHECK_EQ(ak_clip_reduce(c, NULL, NULL, &out, NULL, NULL), AK_ERR_NULL_ARG);
+    AK_CHECK(out == NULL);
+    d.tolerance = -1.0f;
+    AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &out, NULL, NULL), AK_ERR_BAD_ARG);
+    d.tolerance = 0.0f;
+    d.rest_pose.count = NJ - 1;
+    AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &out, NULL, NULL), AK_ERR_SPAN_SMALL);
+    d.rest_pose.count = NJ;
+    const int16_t bad[NJ] = {-1, 0, 3, 2, 1, 4};
+    d.parents = bad;
+    AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &out, NULL, NULL), AK_ERR_BAD_INDEX);
+    ak_raw_channel card = ch[0];
+    card.interp = AK_INTERP_CARDINAL;
+    ak_raw_clip craw = {.channels = &card, .channel_count = 1, .joint_count = NJ};
+    ak_clip* cc = build(&craw);
+    d.parents = parents;
+    AK_CHECK_EQ(ak_clip_reduce(cc, &d, NULL, &out, NULL, NULL), AK_ERR_UNSUPPORTED);
+    AK_CHECK(out == NULL);
+    ak_clip_destroy(cc);
+    ak_clip_destroy(c);
+}
+
 /* ---- blending ----------------------------------------------------------------------- */
 
 AK_TEST(blend_properties) {
@@ -851,5 +985,6 @@ int main(void) {
     AK_RUN(root_motion_extraction);
     AK_RUN(custom_allocator_is_used_and_balanced);
     AK_RUN(bake_pose_sequence);
+    AK_RUN(reduce_keeps_model_error_within_tolerance);
     return ak_test_finish();
 }

@@ -8,8 +8,9 @@
  * scalars, all caller-owned. Sampling through a caller-owned cursor makes forward playback
  * O(1) amortised per channel and stays correct for any jump. The module also blends poses
  * (weighted N-way blend, per-joint masks, additive layers, cross-fade) and extracts root
- * motion (a clip walking in place plus the root's horizontal trajectory), and bakes a
- * sequence of computed poses into a clip (ak_clip_bake).
+ * motion (a clip walking in place plus the root's horizontal trajectory), bakes a
+ * sequence of computed poses into a clip (ak_clip_bake) and removes keys within a model-space
+ * tolerance (ak_clip_reduce).
  *
  * glTF: STEP, LINEAR (SLERP for rotations, shortest path) and CUBICSPLINE (tangents scaled by
  * the key interval, rotations renormalised) follow the glTF 2.0 specification, Appendix C.
@@ -305,6 +306,39 @@ typedef struct ak_clip_bake_desc {
  * (optional) names the frame and joint. *out_clip is NULL on failure. */
 AK_API ak_result ak_clip_bake(const ak_clip_bake_desc* desc, const ak_allocator* alloc, ak_clip** out_clip,
                               ak_diag* diag);
+
+/* ---- keyframe reduction ------------------------------------------------------------- */
+
+/* What ak_clip_reduce measures the error against. */
+typedef struct ak_clip_reduce_desc {
+    const int16_t* parents;       /* required: [ak_clip_joint_count] parent of each joint, -1 for
+                                     a root, parents before children (ak_skeleton_parents) */
+    ak_transform_cspan rest_pose; /* required: count >= ak_clip_joint_count; the local transform
+                                     of joints and properties the clip does not animate */
+    float tolerance;              /* largest model-space error, in model units; 0 -> 1e-3 */
+    float distance;               /* the error is measured at each joint's origin and at points
+                                     this far along its axes (a skin vertex near the joint);
+                                     model units, 0 -> 0.1 */
+} ak_clip_reduce_desc;
+
+/* Offline: a copy of clip with keys removed where the interpolation of the remaining keys
+ * stays within the tolerance in model space. Reduced: translation, rotation and scale
+ * channels with LINEAR (rotations: slerp) or NLERP keys and at least three keys; every other
+ * channel is copied unchanged. Each channel is simplified by Douglas-Peucker with a local
+ * error (translation distance; rotation angle and scale change times the joint's radius:
+ * distance plus its farthest descendant in the rest pose); then the result is checked in
+ * model space (forward kinematics of both clips over parents and rest_pose, error = the
+ * largest distance between the two clips' positions of every joint's origin and its three
+ * axis points at distance) at every key time of the clip and the midpoint of every key
+ * interval, and the local tolerance is halved until the check passes (the last of 17 tries
+ * keeps every key off its neighbours' interpolation). out_error (optional) gets that checked
+ * error. alloc (NULL -> malloc/free) allocates scratch and the clip.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (tolerance or distance negative or not finite),
+ * AK_ERR_SPAN_SMALL (rest_pose shorter than the joint count), AK_ERR_BAD_INDEX (a parent not
+ * before its child), AK_ERR_UNSUPPORTED (a channel with CARDINAL, BEZIER, NATURAL, LAGRANGE or
+ * SQUAD keys), AK_ERR_NO_MEMORY. *out_clip is NULL on failure. */
+AK_API ak_result ak_clip_reduce(const ak_clip* clip, const ak_clip_reduce_desc* desc, const ak_allocator* alloc,
+                                ak_clip** out_clip, double* out_error, ak_diag* diag);
 
 #ifdef __cplusplus
 }
