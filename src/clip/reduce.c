@@ -116,6 +116,11 @@ static double model_error(const ak_clip* a, const ak_clip* b, float t, const ak_
     return worst;
 }
 
+static int cmp_float(const void* a, const void* b) {
+    float x = *(const float*)a, y = *(const float*)b;
+    return (x > y) - (x < y);
+}
+
 /* The next 16-aligned piece of scratch. */
 static void* take(char** p, size_t bytes) {
     void* r = *p;
@@ -208,16 +213,21 @@ ak_result ak_clip_reduce(const ak_clip* clip, const ak_clip_reduce_desc* desc, c
             if (k + 1 < tr->key_count) checks[nchecks++] = 0.5f * (tr->times[k] + tr->times[k + 1]);
         }
     }
+    qsort(checks, nchecks, sizeof *checks, cmp_float); /* channels usually share their times */
+    size_t unique = 0;
+    for (size_t i = 0; i < nchecks; ++i)
+        if (unique == 0 || checks[i] != checks[unique - 1]) checks[unique++] = checks[i];
+    nchecks = unique;
 
-    /* Reduce with a local tolerance, check in model space, halve the local tolerance until the
-     * check passes (at most 16 times; the last try keeps every key that is not exactly on the
-     * interpolation of its neighbours). */
+    /* Reduce with a local tolerance (the model tolerance, then 0.7x smaller each try), check in
+     * model space, until the check passes (the 25th and last try keeps every key that is not
+     * exactly on the interpolation of its neighbours). */
     ak_result r = AK_OK;
     ak_clip* best = NULL;
     double err = 0.0;
-    double scale = 0.5;
-    for (int attempt = 0; attempt < 17 && !best; ++attempt, scale *= 0.5) {
-        double tol = attempt == 16 ? 0.0 : scale * d.tolerance;
+    double scale = 1.0;
+    for (int attempt = 0; attempt < 25 && !best; ++attempt, scale *= 0.7) {
+        double tol = attempt == 24 ? 0.0 : scale * d.tolerance;
         size_t tk = 0, tv = 0;
         for (size_t c = 0; c < nch; ++c) {
             const akp_clip_channel* ch = &clip->channels[c];
@@ -256,7 +266,7 @@ ak_result ak_clip_reduce(const ak_clip* clip, const ak_clip_reduce_desc* desc, c
         if (r != AK_OK) break;
         err = 0.0;
         for (size_t i = 0; i < nchecks; ++i) err = fmax(err, model_error(clip, cand, checks[i], &d, n, pa, pb, ma, mb));
-        if (err <= d.tolerance || attempt == 16) best = cand;
+        if (err <= d.tolerance || attempt == 24) best = cand;
         else ak_clip_destroy(cand);
     }
     akp_free(alloc, mem);
