@@ -1,7 +1,9 @@
 /* Clip sampling throughput: a 64-joint clip (translation, rotation, scale per joint) with
  * 30 keys per second over 10 s, sampled sequentially (60 Hz playback, looping) and at random
- * times, with the cursor and with the per-channel binary search (cursor = NULL), side by
- * side in the same run. Fixed seeds. Prints joints sampled per second and the ratios. */
+ * times, with a cursor and its key cache (ak_clip_cursor_storage_count elements), a cursor
+ * with segments only (ak_clip_channel_count elements) and the per-channel binary search
+ * (cursor = NULL), interleaved in the same run. Fixed seeds. Prints joints sampled per
+ * second and the ratios. */
 #include <animkit/clip.h>
 
 #include <stdio.h>
@@ -46,35 +48,36 @@ static ak_clip* make_clip(ak_interp interp, ak_rng* rng) {
     return r == AK_OK ? clip : NULL;
 }
 
-/* One timed pass of FRAMES samples; returns seconds. */
-static double run_once(const ak_clip* clip, const float* times, bool use_cursor, float* checksum) {
+/* One timed pass of FRAMES samples; mode 0 key cache, 1 segments-only cursor, 2 binary
+ * search. Returns seconds. */
+static double run_once(const ak_clip* clip, const float* times, int mode, float* checksum) {
     ak_transform pose[JOINTS];
-    uint32_t seg[3 * JOINTS];
+    size_t n = mode == 0 ? ak_clip_cursor_storage_count(clip) : ak_clip_channel_count(clip);
+    uint32_t* seg = calloc(n, sizeof *seg);
     ak_clip_cursor cursor;
-    ak_clip_cursor_init(&cursor, clip, (ak_u32_span)AK_SPAN(seg));
+    ak_clip_cursor_init(&cursor, clip, (ak_u32_span){seg, n});
     for (int j = 0; j < JOINTS; ++j) pose[j] = ak_transform_identity();
     double t0 = bench_cpu_s();
     for (int f = 0; f < FRAMES; ++f)
-        ak_clip_sample(clip, times[f], use_cursor ? &cursor : NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0},
+        ak_clip_sample(clip, times[f], mode < 2 ? &cursor : NULL, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0},
                        (ak_f32_span){0});
     double dt = bench_cpu_s() - t0;
     *checksum += pose[JOINTS / 2].translation.x;
+    free(seg);
     return dt;
 }
 
-/* Cursor and binary search alternate, best of REPS each, so both see the same machine load.
- * Writes joints per second. */
-static void run_pair(const ak_clip* clip, const float* times, float* checksum, double* cursor_jps, double* bsearch_jps) {
+/* The three modes alternate, best of REPS each, so all see the same machine load. Writes
+ * joints per second. */
+static void run_modes(const ak_clip* clip, const float* times, float* checksum, double jps[3]) {
     enum { REPS = 11 };
-    double bc = 1e30, bb = 1e30;
-    for (int rep = 0; rep < REPS; ++rep) {
-        double c = run_once(clip, times, true, checksum);
-        double b = run_once(clip, times, false, checksum);
-        bc = c < bc ? c : bc;
-        bb = b < bb ? b : bb;
-    }
-    *cursor_jps = (double)FRAMES * JOINTS / bc;
-    *bsearch_jps = (double)FRAMES * JOINTS / bb;
+    double best[3] = {1e30, 1e30, 1e30};
+    for (int rep = 0; rep < REPS; ++rep)
+        for (int m = 0; m < 3; ++m) {
+            double d = run_once(clip, times, m, checksum);
+            best[m] = d < best[m] ? d : best[m];
+        }
+    for (int m = 0; m < 3; ++m) jps[m] = (double)FRAMES * JOINTS / best[m];
 }
 
 int main(void) {
@@ -86,7 +89,8 @@ int main(void) {
     }
     printf("bench_clip: %d joints (T, R, S channels), %d keys per channel (30 keys/s over 10 s), %d samples\n",
            JOINTS, KEYS, FRAMES);
-    printf("%-12s %-10s %16s %16s %8s\n", "interp", "access", "cursor j/s", "bsearch j/s", "ratio");
+    printf("%-12s %-10s %14s %14s %14s %11s %11s\n", "interp", "access", "cache j/s", "segments j/s", "bsearch j/s",
+           "cache/bs", "segments/bs");
     const ak_interp modes[2] = {AK_INTERP_LINEAR, AK_INTERP_CUBICSPLINE};
     float checksum = 0.0f;
     for (int m = 0; m < 2; ++m) {
@@ -98,9 +102,10 @@ int main(void) {
         const float* sets[2] = {seq, rnd};
         const char* names[2] = {"sequential", "random"};
         for (int s = 0; s < 2; ++s) {
-            double c, b;
-            run_pair(clip, sets[s], &checksum, &c, &b);
-            printf("%-12s %-10s %16.3e %16.3e %8.2f\n", ak_interp_name(modes[m]), names[s], c, b, c / b);
+            double j[3];
+            run_modes(clip, sets[s], &checksum, j);
+            printf("%-12s %-10s %14.3e %14.3e %14.3e %11.2f %11.2f\n", ak_interp_name(modes[m]), names[s], j[0], j[1],
+                   j[2], j[0] / j[2], j[1] / j[2]);
         }
         ak_clip_destroy(clip);
     }

@@ -246,16 +246,18 @@ static void slerp4(const slerp_lane* L, float t, float* pose) {
 }
 #endif
 
-/* Sample every channel at segments segs (NULL: binary search; else the cursor's, updated). */
-static void sample_channels(const ak_clip* clip, float time, uint32_t* segs, ak_transform* local, float* w,
-                            float* s) {
+/* Sample channels (list: [count] channel indices; NULL: every channel) at segments segs (NULL:
+ * binary search; else the cursor's, updated). */
+static void sample_channels(const ak_clip* clip, const uint32_t* list, size_t count, float time, uint32_t* segs,
+                            ak_transform* local, float* w, float* s) {
     const akp_clip_channel* ch = clip->channels;
     float* pose = local ? &local[0].translation.x : NULL;
 #if AK_SIMD_SSE2
     slerp_lane batch[4];
     int nb = 0;
 #endif
-    for (size_t i = 0; i < clip->channel_count; ++i) {
+    for (size_t li = 0; li < count; ++li) {
+        const size_t i = list ? list[li] : li;
         const ak_track* tr = &ch[i].track;
         size_t seg;
         if (segs) {
@@ -304,6 +306,302 @@ static void sample_channels(const ak_clip* clip, float time, uint32_t* segs, ak_
 #endif
 }
 
+
+/* ---- key cache ------------------------------------------------------------------------- */
+
+/* A cursor with the full storage (ak_clip_cursor_storage_count) keeps, after its segment
+ * indices, a key cache: for every group of four FAST channels (akp_clip_group) the keys of the
+ * segment each lane is in, already transposed to lanes (structure of arrays), and the time
+ * interval [lo, hi) over which they stay valid. A sample compares the time with the four
+ * intervals in one SIMD operation and interpolates the four channels in lanes; only lanes whose
+ * interval the time has left are refreshed, one scalar lane at a time, from the channel's
+ * track. The lanes compute the scalar evaluator's operations in its order (division for u,
+ * no fused multiply-add), so the values are the same floats as eval_fast / akp_track_eval.
+ * Per group, CACHE_FIELDS x 4 floats, field f of lane l at f * 4 + l: */
+enum {
+    F_LO = 0,   /* the lane is valid for lo <= t < hi */
+    F_HI = 1,
+    F_T0 = 2,   /* u = (t - t0) / dt, clamped to [0, 1] */
+    F_DT = 3,
+    F_HOLD = 4, /* all ones: t is outside the keys, the value is a */
+    F_FIX = 5,  /* all ones: recompute the lane with eval_fast (slerp of a degenerate segment) */
+    F_A = 6,    /* a.x .. a.w */
+    F_B = 10,   /* VEC3, NLERP: b - a (b on a's hemisphere for NLERP); SLERP: b */
+    F_TH = 14,  /* SLERP: the segment's angle, 1 / sin, sign of b */
+    F_IS = 15,
+    F_SG = 16,
+    CACHE_FIELDS = 17
+};
+#define CACHE_GROUP_U32 ((size_t)CACHE_FIELDS * 4u)
+
+/* Elements of storage for the segment indices plus the cache (with room to align it to 16). */
+static size_t cursor_full_count(const ak_clip* clip) {
+    return clip->channel_count + (clip->group_count ? 3u + clip->group_count * CACHE_GROUP_U32 : 0u);
+}
+
+static uint32_t* cursor_cache(const ak_clip_cursor* cur) {
+    const ak_clip* clip = cur->clip;
+    if (!clip->group_count || cur->segment_count < cursor_full_count(clip)) return NULL;
+    uint32_t* base = cur->segments + clip->channel_count;
+    return base + ((16u - ((uintptr_t)base & 15u)) & 15u) / 4u;
+}
+
+static inline void put_f(uint32_t* c, size_t field, int lane, float v) { memcpy(&c[field * 4 + (size_t)lane], &v, 4); }
+
+/* Empty intervals: every lane refreshes at its first sample. */
+static void cache_reset(const ak_clip* clip, uint32_t* cache) {
+    for (size_t g = 0; g < clip->group_count; ++g)
+        for (int l = 0; l < 4; ++l) {
+            put_f(cache + g * CACHE_GROUP_U32, F_LO, l, INFINITY);
+            put_f(cache + g * CACHE_GROUP_U32, F_HI, l, -INFINITY);
+        }
+}
+
+#if AK_SIMD_SSE2
+/* The smallest float above x (x finite or -inf). */
+static float next_up(float x) {
+    if (x == 0.0f) return FLT_TRUE_MIN;
+    uint32_t b;
+    memcpy(&b, &x, 4);
+    b = x > 0.0f ? b + 1u : b - 1u;
+    memcpy(&x, &b, 4);
+    return x;
+}
+
+/* Three floats at p into lanes 0..2 (lane 3 zero), reading nothing past p[2]. */
+static inline __m128 load3(const float* p) {
+    return _mm_movelh_ps(_mm_loadl_pi(_mm_setzero_ps(), (const __m64*)(const void*)p), _mm_load_ss(p + 2));
+}
+
+/* One lane's refreshed state. */
+typedef struct lane_keys {
+    float lo, hi, t0, dt;
+    int hold; /* -1 or 0 */
+    const float* pa;
+    const float* pb;
+} lane_keys;
+
+/* Lane l's new interval and key pointers (refresh true), or harmless fillers. */
+static inline lane_keys lane_refresh(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, int l, bool refresh,
+                                     float t) {
+    const ak_track* tr = &clip->channels[G->ch[l]].track;
+    const float* times = tr->times;
+    const size_t n = tr->key_count, stride = tr->stride;
+    lane_keys r = {0.0f, 0.0f, 0.0f, 1.0f, -1, tr->values, tr->values};
+    if (!refresh) return r;
+    if (!(t > times[0])) {
+        r.lo = -INFINITY, r.hi = next_up(times[0]);
+    } else if (t >= times[n - 1]) {
+        r.lo = times[n - 1], r.hi = INFINITY;
+        r.pa = r.pb = tr->values + (n - 1) * stride;
+    } else {
+        uint32_t* slot = &segs[G->ch[l]];
+        size_t k = *slot;
+        if (k + 2 < n && times[k + 1] <= t && t < times[k + 2]) ++k; /* the next segment */
+        else k = akp_track_find_from(tr, t, k);
+        *slot = (uint32_t)k;
+        r.lo = k == 0 ? next_up(times[0]) : times[k], r.hi = times[k + 1];
+        r.t0 = times[k], r.dt = times[k + 1] - times[k], r.hold = 0;
+        r.pa = tr->values + k * stride, r.pb = r.pa + stride;
+    }
+    return r;
+}
+
+#if defined(__GNUC__)
+#define AKP_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define AKP_ALWAYS_INLINE inline
+#endif
+
+/* Write the keys k0..k3 of the lanes in mask into the cache (full: all four, no blend). */
+static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int mask, bool full, lane_keys k0,
+                                          lane_keys k1, lane_keys k2, lane_keys k3) {
+    const float* pa[4] = {k0.pa, k1.pa, k2.pa, k3.pa};
+    const float* pb[4] = {k0.pb, k1.pb, k2.pb, k3.pb};
+    const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
+    const __m128 m = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(mask), bits), bits));
+#define AKP_PUT(field, v)                                                                                        \
+    _mm_store_ps(f + 4 * (field), full ? (v) : akp_simd_select(m, (v), _mm_load_ps(f + 4 * (field))))
+    AKP_PUT(F_LO, _mm_setr_ps(k0.lo, k1.lo, k2.lo, k3.lo));
+    AKP_PUT(F_HI, _mm_setr_ps(k0.hi, k1.hi, k2.hi, k3.hi));
+    AKP_PUT(F_T0, _mm_setr_ps(k0.t0, k1.t0, k2.t0, k3.t0));
+    AKP_PUT(F_DT, _mm_setr_ps(k0.dt, k1.dt, k2.dt, k3.dt));
+    const __m128 hm = _mm_castsi128_ps(_mm_setr_epi32(k0.hold, k1.hold, k2.hold, k3.hold));
+    AKP_PUT(F_HOLD, hm);
+    if (G->kind == AKP_CLIP_FAST_VEC3) {
+        __m128 ax = load3(pa[0]), ay = load3(pa[1]), az = load3(pa[2]), aw = load3(pa[3]);
+        __m128 bx = load3(pb[0]), by = load3(pb[1]), bz = load3(pb[2]), bw = load3(pb[3]);
+        AKP_SIMD_TRANSPOSE4(ax, ay, az, aw);
+        AKP_SIMD_TRANSPOSE4(bx, by, bz, bw);
+        (void)aw, (void)bw;
+        /* hold lanes: b = a, so b - a = 0 */
+        AKP_PUT(F_A, ax), AKP_PUT(F_A + 1, ay), AKP_PUT(F_A + 2, az);
+        AKP_PUT(F_B, _mm_sub_ps(bx, ax)), AKP_PUT(F_B + 1, _mm_sub_ps(by, ay)), AKP_PUT(F_B + 2, _mm_sub_ps(bz, az));
+        return;
+    }
+    __m128 ax = _mm_loadu_ps(pa[0]), ay = _mm_loadu_ps(pa[1]), az = _mm_loadu_ps(pa[2]), aw = _mm_loadu_ps(pa[3]);
+    __m128 bx = _mm_loadu_ps(pb[0]), by = _mm_loadu_ps(pb[1]), bz = _mm_loadu_ps(pb[2]), bw = _mm_loadu_ps(pb[3]);
+    AKP_SIMD_TRANSPOSE4(ax, ay, az, aw);
+    AKP_SIMD_TRANSPOSE4(bx, by, bz, bw);
+    AKP_PUT(F_A, ax), AKP_PUT(F_A + 1, ay), AKP_PUT(F_A + 2, az), AKP_PUT(F_A + 3, aw);
+    if (G->kind == AKP_CLIP_FAST_NLERP) {
+        /* ak_quat_nlerp: b on a's hemisphere (dot summed in ak_quat_dot's order), then b - a */
+        __m128 dot = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz)),
+                                _mm_mul_ps(aw, bw));
+        __m128 flip = _mm_and_ps(_mm_cmplt_ps(dot, _mm_setzero_ps()), _mm_set1_ps(-0.0f));
+        AKP_PUT(F_B, _mm_sub_ps(_mm_xor_ps(bx, flip), ax));
+        AKP_PUT(F_B + 1, _mm_sub_ps(_mm_xor_ps(by, flip), ay));
+        AKP_PUT(F_B + 2, _mm_sub_ps(_mm_xor_ps(bz, flip), az));
+        AKP_PUT(F_B + 3, _mm_sub_ps(_mm_xor_ps(bw, flip), aw));
+        AKP_PUT(F_FIX, _mm_setzero_ps());
+        return;
+    }
+    __m128 th = _mm_loadu_ps(pa[0] + 4), is = _mm_loadu_ps(pa[1] + 4), sg = _mm_loadu_ps(pa[2] + 4),
+           z3 = _mm_loadu_ps(pa[3] + 4);
+    AKP_SIMD_TRANSPOSE4(th, is, sg, z3);
+    (void)z3;
+    AKP_PUT(F_B, bx), AKP_PUT(F_B + 1, by), AKP_PUT(F_B + 2, bz), AKP_PUT(F_B + 3, bw);
+    AKP_PUT(F_TH, th), AKP_PUT(F_IS, is), AKP_PUT(F_SG, sg);
+    AKP_PUT(F_FIX, _mm_andnot_ps(hm, _mm_cmpeq_ps(is, _mm_setzero_ps())));
+#undef AKP_PUT
+}
+
+/* Refresh the lanes of group G set in mask for time t (not NaN): per lane, in scalar code, the
+ * segment (usually the next one) or the key it holds outside the keys; then the keys of the
+ * four lanes are transposed in SIMD registers and the refreshed lanes written into the cache.
+ * A group whose channels share their key times (G->shared) refreshes all four lanes together,
+ * so lane 0's segment serves all four. */
+static void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
+    if (mask == 15 && G->shared) {
+        lane_keys k[4];
+        k[0] = lane_refresh(clip, G, segs, 0, true, t);
+        const float* v0 = clip->channels[G->ch[0]].track.values;
+        for (int l = 1; l < 4; ++l) {
+            const float* v = clip->channels[G->ch[l]].track.values;
+            k[l] = k[0];
+            k[l].pa = v + (k[0].pa - v0), k[l].pb = v + (k[0].pb - v0);
+            segs[G->ch[l]] = segs[G->ch[0]];
+        }
+        cache_write(G, f, 15, true, k[0], k[1], k[2], k[3]);
+        return;
+    }
+    const lane_keys k0 = lane_refresh(clip, G, segs, 0, mask & 1, t), k1 = lane_refresh(clip, G, segs, 1, mask & 2, t),
+                    k2 = lane_refresh(clip, G, segs, 2, mask & 4, t), k3 = lane_refresh(clip, G, segs, 3, mask & 8, t);
+    if (mask == 15) cache_write(G, f, 15, true, k0, k1, k2, k3);
+    else cache_write(G, f, mask, false, k0, k1, k2, k3);
+}
+
+/* Sample every group through the cache (time not NaN). */
+static void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache, float* pose) {
+    const __m128 T = _mm_set1_ps(time), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f),
+                 ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (size_t g = 0; g < clip->group_count; ++g) {
+        const akp_clip_group* G = &clip->groups[g];
+        uint32_t* c = cache + g * CACHE_GROUP_U32;
+        const float* f = (const float*)(const void*)c;
+        int in = _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(T, _mm_load_ps(f + 4 * F_LO)),
+                                            _mm_cmplt_ps(T, _mm_load_ps(f + 4 * F_HI))));
+        if (in != 15) refresh_group(clip, G, segs, (float*)(void*)c, ~in & 15, time);
+        __m128 u = _mm_div_ps(_mm_sub_ps(T, _mm_load_ps(f + 4 * F_T0)), _mm_load_ps(f + 4 * F_DT));
+        u = _mm_min_ps(one, _mm_max_ps(zero, u)); /* u < 0 ? 0 : (u > 1 ? 1 : u), NaN kept */
+        const __m128 hold = _mm_load_ps(f + 4 * F_HOLD);
+        __m128 ax = _mm_load_ps(f + 4 * F_A), ay = _mm_load_ps(f + 4 * (F_A + 1)), az = _mm_load_ps(f + 4 * (F_A + 2));
+        if (G->kind == AKP_CLIP_FAST_VEC3) {
+            __m128 x = _mm_add_ps(ax, _mm_mul_ps(_mm_load_ps(f + 4 * F_B), u));
+            __m128 y = _mm_add_ps(ay, _mm_mul_ps(_mm_load_ps(f + 4 * (F_B + 1)), u));
+            __m128 z = _mm_add_ps(az, _mm_mul_ps(_mm_load_ps(f + 4 * (F_B + 2)), u));
+            if (_mm_movemask_ps(hold)) {
+                x = akp_simd_select(hold, ax, x);
+                y = akp_simd_select(hold, ay, y);
+                z = akp_simd_select(hold, az, z);
+            }
+            __m128 w = _mm_setzero_ps();
+            AKP_SIMD_TRANSPOSE4(x, y, z, w);
+            const __m128 r[4] = {x, y, z, w};
+            for (int l = 0; l < 4; ++l) {
+                float* o = pose + G->dst[l];
+                _mm_storel_pi((__m64*)(void*)o, r[l]);
+                _mm_store_ss(o + 2, _mm_movehl_ps(r[l], r[l]));
+            }
+            continue;
+        }
+        __m128 aw = _mm_load_ps(f + 4 * (F_A + 3));
+        __m128 qx, qy, qz, qw;
+        const __m128 bx = _mm_load_ps(f + 4 * F_B), by = _mm_load_ps(f + 4 * (F_B + 1)),
+                     bz = _mm_load_ps(f + 4 * (F_B + 2)), bw = _mm_load_ps(f + 4 * (F_B + 3));
+        if (G->kind == AKP_CLIP_FAST_NLERP) {
+            qx = _mm_add_ps(ax, _mm_mul_ps(bx, u));
+            qy = _mm_add_ps(ay, _mm_mul_ps(by, u));
+            qz = _mm_add_ps(az, _mm_mul_ps(bz, u));
+            qw = _mm_add_ps(aw, _mm_mul_ps(bw, u));
+        } else {
+            const __m128 th = _mm_load_ps(f + 4 * F_TH), is = _mm_load_ps(f + 4 * F_IS);
+            __m128 wa = _mm_mul_ps(sin4_half_pi(_mm_mul_ps(_mm_sub_ps(one, u), th)), is);
+            __m128 wb = _mm_mul_ps(_mm_mul_ps(sin4_half_pi(_mm_mul_ps(u, th)), is), _mm_load_ps(f + 4 * F_SG));
+            qx = _mm_add_ps(_mm_mul_ps(wa, ax), _mm_mul_ps(wb, bx));
+            qy = _mm_add_ps(_mm_mul_ps(wa, ay), _mm_mul_ps(wb, by));
+            qz = _mm_add_ps(_mm_mul_ps(wa, az), _mm_mul_ps(wb, bz));
+            qw = _mm_add_ps(_mm_mul_ps(wa, aw), _mm_mul_ps(wb, bw));
+        }
+        __m128 n2 = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(qx, qx), _mm_mul_ps(qy, qy)), _mm_mul_ps(qz, qz)),
+                               _mm_mul_ps(qw, qw));
+        __m128 ok = _mm_and_ps(_mm_cmpgt_ps(n2, _mm_set1_ps(1e-30f)), _mm_cmple_ps(n2, _mm_set1_ps(FLT_MAX)));
+        __m128 sc = _mm_div_ps(one, _mm_sqrt_ps(n2));
+        qx = akp_simd_select(hold, ax, _mm_mul_ps(qx, sc));
+        qy = akp_simd_select(hold, ay, _mm_mul_ps(qy, sc));
+        qz = akp_simd_select(hold, az, _mm_mul_ps(qz, sc));
+        qw = akp_simd_select(hold, aw, _mm_mul_ps(qw, sc));
+        AKP_SIMD_TRANSPOSE4(qx, qy, qz, qw);
+        const __m128 r[4] = {qx, qy, qz, qw};
+        /* lanes to redo in scalar code: rescue normalisations and degenerate slerp segments */
+        int redo = _mm_movemask_ps(_mm_andnot_ps(hold, _mm_or_ps(_mm_andnot_ps(ok, ones), _mm_load_ps(f + 4 * F_FIX))));
+        for (int l = 0; l < 4; ++l) _mm_storeu_ps(pose + G->dst[l], r[l]);
+        if (redo)
+            for (int l = 0; l < 4; ++l)
+                if (redo >> l & 1) eval_fast(&clip->channels[G->ch[l]], segs[G->ch[l]], time, pose);
+    }
+}
+#endif
+
+/* Group the FAST channels four by four per kind (SIMD builds); the rest go to the slow list. */
+static void make_groups(ak_clip* clip) {
+    clip->group_count = 0;
+    clip->slow_count = 0;
+#if AK_SIMD_SSE2
+    static const akp_clip_fast kinds[3] = {AKP_CLIP_FAST_VEC3, AKP_CLIP_FAST_SLERP, AKP_CLIP_FAST_NLERP};
+    for (int k = 0; k < 3; ++k) {
+        int lane = 4;
+        for (size_t i = 0; i < clip->channel_count; ++i) {
+            if (clip->channels[i].fast != kinds[k]) continue;
+            if (lane == 4) {
+                akp_clip_group* g = &clip->groups[clip->group_count++];
+                g->kind = kinds[k];
+                for (int l = 0; l < 4; ++l) g->ch[l] = (uint32_t)i, g->dst[l] = clip->channels[i].dst;
+                lane = 0;
+            }
+            akp_clip_group* g = &clip->groups[clip->group_count - 1];
+            g->ch[lane] = (uint32_t)i;
+            g->dst[lane] = clip->channels[i].dst;
+            ++lane;
+        }
+    }
+    for (size_t g = 0; g < clip->group_count; ++g) {
+        akp_clip_group* G = &clip->groups[g];
+        const ak_track* t0 = &clip->channels[G->ch[0]].track;
+        G->shared = true;
+        for (int l = 1; l < 4; ++l) {
+            const ak_track* tl = &clip->channels[G->ch[l]].track;
+            G->shared = G->shared && tl->key_count == t0->key_count && tl->stride == t0->stride &&
+                        (tl->times == t0->times || !memcmp(tl->times, t0->times, t0->key_count * sizeof(float)));
+        }
+    }
+    for (size_t i = 0; i < clip->channel_count; ++i)
+        if (clip->channels[i].fast == AKP_CLIP_FAST_NONE) clip->slow[clip->slow_count++] = (uint32_t)i;
+#else
+    for (size_t i = 0; i < clip->channel_count; ++i) clip->slow[clip->slow_count++] = (uint32_t)i;
+#endif
+}
+
 /* ---- build and query ---------------------------------------------------------------- */
 
 ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_clip** out_clip, ak_diag* diag) {
@@ -329,7 +627,10 @@ ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_cl
         return AK_ERR_BAD_ARG;
     }
     size_t nch = raw->channel_count;
-    size_t size = akp_align16(sizeof(ak_clip)) + akp_align16(nch * sizeof(akp_clip_channel));
+    const size_t max_groups = nch / 4u + 3u; /* four per group, one partial group per kind */
+    const size_t head = akp_align16(sizeof(ak_clip)) + akp_align16(nch * sizeof(akp_clip_channel)) +
+                        akp_align16(max_groups * sizeof(akp_clip_group)) + akp_align16(nch * sizeof(uint32_t));
+    size_t size = head;
     bool joints = false;
     for (size_t i = 0; i < nch; ++i) {
         char prefix[64];
@@ -364,7 +665,9 @@ ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_cl
     clip->scalar_count = raw->scalar_count;
     clip->has_joint_channels = joints;
     snprintf(clip->name, sizeof clip->name, "%s", raw->name ? raw->name : "");
-    char* data = mem + akp_align16(sizeof(ak_clip)) + akp_align16(nch * sizeof(akp_clip_channel));
+    clip->groups = (akp_clip_group*)(void*)(mem + akp_align16(sizeof(ak_clip)) + akp_align16(nch * sizeof(akp_clip_channel)));
+    clip->slow = (uint32_t*)(void*)((char*)clip->groups + akp_align16(max_groups * sizeof(akp_clip_group)));
+    char* data = mem + head;
     float last = 0.0f;
     for (size_t i = 0; i < nch; ++i) {
         char prefix[64];
@@ -385,6 +688,7 @@ ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_cl
         if (end > last) last = end;
     }
     clip->duration = raw->duration > 0.0f ? raw->duration : last;
+    make_groups(clip);
     *out_clip = clip;
     return AK_OK;
 }
@@ -420,7 +724,7 @@ const ak_track* ak_clip_channel_track(const ak_clip* clip, size_t i) {
 
 /* ---- sampling ----------------------------------------------------------------------- */
 
-size_t ak_clip_cursor_storage_count(const ak_clip* clip) { return clip ? clip->channel_count : 0u; }
+size_t ak_clip_cursor_storage_count(const ak_clip* clip) { return clip ? cursor_full_count(clip) : 0u; }
 
 ak_result ak_clip_cursor_init(ak_clip_cursor* cursor, const ak_clip* clip, ak_u32_span storage) {
     if (!cursor || !clip) return AK_ERR_NULL_ARG;
@@ -431,6 +735,8 @@ ak_result ak_clip_cursor_init(ak_clip_cursor* cursor, const ak_clip* clip, ak_u3
     cursor->clip = clip;
     cursor->segments = storage.ptr;
     cursor->segment_count = storage.count;
+    uint32_t* cache = cursor_cache(cursor);
+    if (cache) cache_reset(clip, cache);
     return AK_OK;
 }
 
@@ -445,6 +751,15 @@ ak_result ak_clip_sample(const ak_clip* clip, float time, ak_clip_cursor* cursor
     float* s = scalars.ptr && scalars.count ? scalars.ptr : NULL;
     if (w && weights.count < clip->morph_weight_count) return AK_ERR_SPAN_SMALL;
     if (s && scalars.count < clip->scalar_count) return AK_ERR_SPAN_SMALL;
-    sample_channels(clip, time, cursor ? cursor->segments : NULL, local.ptr, w, s);
+    uint32_t* cache = cursor && time == time ? cursor_cache(cursor) : NULL; /* NaN: the plain path */
+#if AK_SIMD_SSE2
+    if (cache) {
+        if (clip->has_joint_channels) sample_groups(clip, time, cursor->segments, cache, &local.ptr[0].translation.x);
+        sample_channels(clip, clip->slow, clip->slow_count, time, cursor->segments, local.ptr, w, s);
+        return AK_OK;
+    }
+#endif
+    (void)cache;
+    sample_channels(clip, NULL, clip->channel_count, time, cursor ? cursor->segments : NULL, local.ptr, w, s);
     return AK_OK;
 }

@@ -366,31 +366,50 @@ static bool mat4_affine(const ak_mat4* m) {
 #if AK_SIMD_SSE2 && defined(__GNUC__) && defined(__x86_64__)
 #define AKP_FK_AVX 1
 #include <immintrin.h>
+/* The TRS of joints b .. b + 7 (joints past cnt repeat joint b) as four-joint SSE vectors:
+ * t[h] = tx ty tz qx, q[h] = qx qy qz qw, s[h] = qw sx sy sz of joints b + 4h .. b + 4h + 3,
+ * transposed to lanes (t[h][0] = the four tx, ...). Loads stay inside each ak_transform. */
+static inline void gather8(const ak_transform* local, size_t b, size_t cnt, __m128 q[2][4], __m128 t[2][4],
+                           __m128 s[2][4]) {
+    for (int h = 0; h < 2; ++h) {
+        for (int v = 0; v < 4; ++v) {
+            size_t j = (size_t)(4 * h + v);
+            const float* f = &local[b + (j < cnt ? j : 0)].translation.x;
+            t[h][v] = _mm_loadu_ps(f);     /* tx ty tz qx */
+            q[h][v] = _mm_loadu_ps(f + 3); /* qx qy qz qw */
+            s[h][v] = _mm_loadu_ps(f + 6); /* qw sx sy sz */
+        }
+        _MM_TRANSPOSE4_PS(t[h][0], t[h][1], t[h][2], t[h][3]);
+        _MM_TRANSPOSE4_PS(q[h][0], q[h][1], q[h][2], q[h][3]);
+        _MM_TRANSPOSE4_PS(s[h][0], s[h][1], s[h][2], s[h][3]);
+    }
+}
+
 /* fk for no root or an affine root, with AVX (no FMA: the same roundings as ak_mat4_mul and
- * ak_transform_to_mat4): the local matrices of 8 joints at a time from their TRS in
- * structure-of-arrays form (ak_mat3_from_quat's formulas, lane by lane), then the parent
- * products joint by joint, broadcasting the local entries from memory (loads, not shuffles). */
+ * ak_transform_to_mat4): the local matrices of 8 joints at a time from their TRS (loaded as
+ * vectors and transposed, gather8) in structure-of-arrays form (ak_mat3_from_quat's formulas,
+ * lane by lane), then the parent products joint by joint, broadcasting the local entries from
+ * memory (loads, not shuffles). */
 __attribute__((target("avx"))) static void fk_affine_avx(const ak_skeleton* sk, const ak_mat4* root,
                                                          const ak_transform* local, ak_mat4* out) {
     const size_t n = sk->joint_count;
-    _Alignas(32) float g[10][8];  /* x y z w, sx sy sz, tx ty tz of 8 joints */
     _Alignas(32) float L[12][8];  /* columns 0..2 (x y z each) and the translation, 8 joints */
     __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()}; /* out[i - 1] */
     for (size_t b = 0; b < n; b += 8) {
         const size_t cnt = n - b < 8 ? n - b : 8;
-        for (size_t v = 0; v < 8; ++v) {
-            const ak_transform* t = &local[b + (v < cnt ? v : 0)];
-            g[0][v] = t->rotation.x, g[1][v] = t->rotation.y, g[2][v] = t->rotation.z, g[3][v] = t->rotation.w;
-            g[4][v] = t->scale.x, g[5][v] = t->scale.y, g[6][v] = t->scale.z;
-            g[7][v] = t->translation.x, g[8][v] = t->translation.y, g[9][v] = t->translation.z;
-        }
-        const __m256 x = _mm256_load_ps(g[0]), y = _mm256_load_ps(g[1]), z = _mm256_load_ps(g[2]),
-                     w = _mm256_load_ps(g[3]);
+        __m128 q[2][4], t[2][4], s[2][4];
+        gather8(local, b, cnt, q, t, s);
+#define AKP_W8(a, k) _mm256_insertf128_ps(_mm256_castps128_ps256(a[0][k]), a[1][k], 1)
+        const __m256 x = AKP_W8(q, 0), y = AKP_W8(q, 1), z = AKP_W8(q, 2), w = AKP_W8(q, 3);
+        const __m256 sx = AKP_W8(s, 1), sy = AKP_W8(s, 2), sz = AKP_W8(s, 3);
+        _mm256_store_ps(L[9], AKP_W8(t, 0));
+        _mm256_store_ps(L[10], AKP_W8(t, 1));
+        _mm256_store_ps(L[11], AKP_W8(t, 2));
+#undef AKP_W8
         const __m256 xx = _mm256_mul_ps(x, x), yy = _mm256_mul_ps(y, y), zz = _mm256_mul_ps(z, z);
         const __m256 xy = _mm256_mul_ps(x, y), xz = _mm256_mul_ps(x, z), yz = _mm256_mul_ps(y, z);
         const __m256 wx = _mm256_mul_ps(w, x), wy = _mm256_mul_ps(w, y), wz = _mm256_mul_ps(w, z);
         const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
-        const __m256 sx = _mm256_load_ps(g[4]), sy = _mm256_load_ps(g[5]), sz = _mm256_load_ps(g[6]);
 #define AKP_TWO(e) _mm256_mul_ps(two, (e))
         _mm256_store_ps(L[0], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(yy, zz))), sx));
         _mm256_store_ps(L[1], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xy, wz)), sx));
@@ -402,7 +421,6 @@ __attribute__((target("avx"))) static void fk_affine_avx(const ak_skeleton* sk, 
         _mm256_store_ps(L[7], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(yz, wx)), sz));
         _mm256_store_ps(L[8], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, yy))), sz));
 #undef AKP_TWO
-        memcpy(L[9], g[7], sizeof L[9]), memcpy(L[10], g[8], sizeof L[10]), memcpy(L[11], g[9], sizeof L[11]);
         for (size_t v = 0; v < cnt; ++v) {
             const size_t i = b + v;
             const int p = sk->parents[i];
@@ -432,6 +450,70 @@ __attribute__((target("avx"))) static void fk_affine_avx(const ak_skeleton* sk, 
         }
     }
 }
+
+/* fk_affine_avx with fused multiply-adds (AVX2 + FMA CPUs, chosen at run time): the same
+ * structure-of-arrays local matrices, and each model column is one multiply and two fused
+ * multiply-adds. The floats differ from ak_mat4_mul's within rounding (each fused step
+ * rounds once instead of twice); tests/test_skeleton.c bounds them against double. */
+__attribute__((target("avx2,fma"))) static void fk_affine_fma(const ak_skeleton* sk, const ak_mat4* root,
+                                                              const ak_transform* local, ak_mat4* out) {
+    const size_t n = sk->joint_count;
+    _Alignas(32) float L[12][8]; /* columns 0..2 (x y z each) and the translation, 8 joints */
+    __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()}; /* out[i - 1] */
+    for (size_t b = 0; b < n; b += 8) {
+        const size_t cnt = n - b < 8 ? n - b : 8;
+        __m128 q[2][4], t[2][4], s[2][4];
+        gather8(local, b, cnt, q, t, s);
+#define AKP_W8(a, k) _mm256_insertf128_ps(_mm256_castps128_ps256(a[0][k]), a[1][k], 1)
+        const __m256 x = AKP_W8(q, 0), y = AKP_W8(q, 1), z = AKP_W8(q, 2), w = AKP_W8(q, 3);
+        const __m256 sx = AKP_W8(s, 1), sy = AKP_W8(s, 2), sz = AKP_W8(s, 3);
+        _mm256_store_ps(L[9], AKP_W8(t, 0));
+        _mm256_store_ps(L[10], AKP_W8(t, 1));
+        _mm256_store_ps(L[11], AKP_W8(t, 2));
+#undef AKP_W8
+        const __m256 xx = _mm256_mul_ps(x, x), yy = _mm256_mul_ps(y, y), zz = _mm256_mul_ps(z, z);
+        const __m256 xy = _mm256_mul_ps(x, y), xz = _mm256_mul_ps(x, z), yz = _mm256_mul_ps(y, z);
+        const __m256 wx = _mm256_mul_ps(w, x), wy = _mm256_mul_ps(w, y), wz = _mm256_mul_ps(w, z);
+        const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+#define AKP_TWO(e) _mm256_mul_ps(two, (e))
+        _mm256_store_ps(L[0], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(yy, zz))), sx));
+        _mm256_store_ps(L[1], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xy, wz)), sx));
+        _mm256_store_ps(L[2], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xz, wy)), sx));
+        _mm256_store_ps(L[3], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xy, wz)), sy));
+        _mm256_store_ps(L[4], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, zz))), sy));
+        _mm256_store_ps(L[5], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(yz, wx)), sy));
+        _mm256_store_ps(L[6], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xz, wy)), sz));
+        _mm256_store_ps(L[7], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(yz, wx)), sz));
+        _mm256_store_ps(L[8], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, yy))), sz));
+#undef AKP_TWO
+        for (size_t v = 0; v < cnt; ++v) {
+            const size_t i = b + v;
+            const int p = sk->parents[i];
+            __m128 a0, a1, a2, a3;
+            if (p >= 0 && (size_t)p + 1 == i) { /* a chain: the parent is still in registers */
+                a0 = prev[0], a1 = prev[1], a2 = prev[2], a3 = prev[3];
+            } else if (p >= 0 || root) {
+                const ak_mat4* a = p >= 0 ? &out[p] : root;
+                a0 = _mm_loadu_ps(a->m), a1 = _mm_loadu_ps(a->m + 4), a2 = _mm_loadu_ps(a->m + 8),
+                a3 = _mm_loadu_ps(a->m + 12);
+            } else { /* a root joint without root matrix: the local matrix itself */
+                for (int c = 0; c < 4; ++c)
+                    prev[c] = _mm_setr_ps(L[3 * c][v], L[3 * c + 1][v], L[3 * c + 2][v], c == 3 ? 1.0f : 0.0f);
+                for (int c = 0; c < 4; ++c) _mm_storeu_ps(out[i].m + 4 * c, prev[c]);
+                continue;
+            }
+            for (int c = 0; c < 3; ++c) {
+                __m128 r = _mm_mul_ps(a0, _mm_broadcast_ss(&L[3 * c][v]));
+                r = _mm_fmadd_ps(a1, _mm_broadcast_ss(&L[3 * c + 1][v]), r);
+                prev[c] = _mm_fmadd_ps(a2, _mm_broadcast_ss(&L[3 * c + 2][v]), r);
+            }
+            __m128 r = _mm_fmadd_ps(a0, _mm_broadcast_ss(&L[9][v]), a3);
+            r = _mm_fmadd_ps(a1, _mm_broadcast_ss(&L[10][v]), r);
+            prev[3] = _mm_fmadd_ps(a2, _mm_broadcast_ss(&L[11][v]), r);
+            for (int c = 0; c < 4; ++c) _mm_storeu_ps(out[i].m + 4 * c, prev[c]);
+        }
+    }
+}
 #else
 #define AKP_FK_AVX 0
 #endif
@@ -445,6 +527,10 @@ static void fk(const ak_skeleton* sk, const ak_mat4* root, const ak_transform* l
     const size_t n = sk->joint_count;
     if (!root || mat4_affine(root)) {
 #if AKP_FK_AVX
+        if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+            fk_affine_fma(sk, root, local, out);
+            return;
+        }
         if (__builtin_cpu_supports("avx")) {
             fk_affine_avx(sk, root, local, out);
             return;

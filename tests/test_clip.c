@@ -170,7 +170,7 @@ AK_TEST(sample_rejects_bad_spans) {
                 AK_ERR_NULL_ARG);
     uint32_t st[1];
     ak_clip_cursor cur;
-    AK_CHECK_EQ(ak_clip_cursor_storage_count(a), 1);
+    AK_CHECK(ak_clip_cursor_storage_count(a) >= 1); /* 1 segment (+ the key cache in SIMD builds) */
     AK_CHECK_EQ(ak_clip_cursor_init(&cur, a, (ak_u32_span){st, 0}), AK_ERR_SPAN_SMALL);
     AK_CHECK_EQ(ak_clip_cursor_init(&cur, a, (ak_u32_span)AK_SPAN(st)), AK_OK);
     AK_CHECK_EQ(ak_clip_sample(b, 0.5f, &cur, (ak_transform_span)AK_SPAN(pose), (ak_f32_span){0}, (ak_f32_span){0}),
@@ -250,7 +250,9 @@ AK_TEST(gltf_interpolation_matches_spec_formulas) {
 
 enum { CJ = 24 };
 
-static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
+/* A random clip over CJ joints (every mode, 1-key channels, weights and scalars); common: every
+ * channel with the same key times (as baked clips have), else each with its own. */
+static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count, bool common) {
     static const ak_interp tmodes[] = {AK_INTERP_STEP, AK_INTERP_LINEAR, AK_INTERP_CUBICSPLINE, AK_INTERP_CARDINAL,
                                        AK_INTERP_NATURAL};
     static const ak_interp rmodes[] = {AK_INTERP_STEP, AK_INTERP_LINEAR, AK_INTERP_NLERP, AK_INTERP_SQUAD,
@@ -270,7 +272,7 @@ static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
         bool rot = r->target == AK_CHANNEL_ROTATION;
         r->interp = rot ? rmodes[ak_rng_u32(rng) % 5] : tmodes[ak_rng_u32(rng) % 5];
         uint32_t cc = rot ? 4 : 3;
-        size_t n = c % 17 == 5 ? 1 : 2 + ak_rng_u32(rng) % 40;
+        size_t n = common ? 23 : c % 17 == 5 ? 1 : 2 + ak_rng_u32(rng) % 40;
         size_t stride = r->interp == AK_INTERP_CUBICSPLINE ? 3 * cc : cc;
         float* times = store + used;
         used += n;
@@ -278,9 +280,11 @@ static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
         used += n * stride;
         if (used > store_count) return NULL;
         float t = ak_rng_range(rng, -0.5f, 1.0f);
+        ak_rng trng = ak_rng_make(77); /* common: the same time sequence for every channel */
+        if (common) t = -0.25f;
         for (size_t k = 0; k < n; ++k) {
             times[k] = t;
-            t += ak_rng_range(rng, 0.01f, 0.5f);
+            t += ak_rng_range(common ? &trng : rng, 0.01f, 0.5f);
             for (size_t j = 0; j < stride; ++j) vals[k * stride + j] = ak_rng_range(rng, -1, 1);
         }
         r->key_count = n;
@@ -290,6 +294,7 @@ static ak_clip* random_clip(ak_rng* rng, float* store, size_t store_count) {
     ak_raw_clip raw = {.channels = ch, .channel_count = nch, .joint_count = CJ, .morph_weight_count = 3, .scalar_count = 3};
     return build(&raw);
 }
+
 
 static int compare_run(const ak_clip* c, ak_clip_cursor* cur, const float* times, size_t count) {
     int mismatches = 0;
@@ -307,29 +312,47 @@ static int compare_run(const ak_clip* c, ak_clip_cursor* cur, const float* times
 AK_TEST(cursor_is_bit_identical_to_binary_search) {
     ak_rng rng = ak_rng_make(12);
     static float store[200000];
-    ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0]);
+    for (int common = 0; common < 2; ++common) {
+    ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0], common == 1);
     AK_CHECK(c != NULL);
     if (!c) return;
-    uint32_t seg[3 * CJ + 2];
-    ak_clip_cursor cur;
-    AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg)), AK_OK);
-    enum { T = 10000 };
-    static float times[T];
-    float dur = ak_clip_duration(c);
-    /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
-    for (int i = 0; i < T; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)T;
-    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-    for (int i = 0; i < T; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)T;
-    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-    for (int i = 0; i < T; ++i) times[i] = ak_time_wrap(3.3f * dur * (float)i / (float)T, dur, AK_WRAP_LOOP);
-    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-    for (int i = 0; i < T; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
-    AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-    for (size_t ci = 0; ci < ak_clip_channel_count(c); ++ci) {
-        ak_f32_cspan kt = ak_track_times(ak_clip_channel_track(c, ci));
-        AK_CHECK_EQ(compare_run(c, &cur, kt.ptr, kt.count), 0);
+    /* Two cursors: the full storage (segments and the key cache, SIMD lanes) and the minimum
+     * (segments only, one channel at a time); the storage starts at an odd element so the cache
+     * has to align itself. */
+    size_t full = ak_clip_cursor_storage_count(c);
+    AK_CHECK(full >= ak_clip_channel_count(c));
+    uint32_t* seg = (uint32_t*)calloc(full + 1, sizeof *seg);
+    for (int pass = 0; pass < 2; ++pass) {
+        ak_clip_cursor cur;
+        ak_u32_span st = pass == 0 ? (ak_u32_span){seg + 1, full} : (ak_u32_span){seg, ak_clip_channel_count(c)};
+        AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, st), AK_OK);
+        enum { T = 6000 };
+        static float times[T];
+        float dur = ak_clip_duration(c);
+        /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
+        for (int i = 0; i < T; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)T;
+        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        for (int i = 0; i < T; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)T;
+        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        for (int i = 0; i < T; ++i) times[i] = ak_time_wrap(3.3f * dur * (float)i / (float)T, dur, AK_WRAP_LOOP);
+        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        for (int i = 0; i < T; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
+        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        /* on keys, next to keys, infinities and NaN */
+        for (size_t ci = 0; ci < ak_clip_channel_count(c); ++ci) {
+            ak_f32_cspan kt = ak_track_times(ak_clip_channel_track(c, ci));
+            AK_CHECK_EQ(compare_run(c, &cur, kt.ptr, kt.count), 0);
+            for (size_t k = 0; k < kt.count; ++k) {
+                float near[2] = {nextafterf(kt.ptr[k], -INFINITY), nextafterf(kt.ptr[k], INFINITY)};
+                AK_CHECK_EQ(compare_run(c, &cur, near, 2), 0);
+            }
+        }
+        float odd[5] = {INFINITY, -INFINITY, NAN, 0.5f, -0.0f};
+        AK_CHECK_EQ(compare_run(c, &cur, odd, 5), 0);
     }
+    free(seg);
     ak_clip_destroy(c);
+    }
 }
 
 
@@ -407,12 +430,13 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
     ak_rng rng = ak_rng_make(21);
     static float store[200000];
     double worst = 0.0;
-    for (int rep = 0; rep < 4; ++rep) {
-        ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0]);
+    for (int rep = 0; rep < 6; ++rep) {
+        ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0], rep >= 4);
         AK_CHECK(c != NULL);
         if (!c) return;
-        uint32_t seg[3 * CJ + 2];
+        uint32_t seg[4096];
         ak_clip_cursor cur;
+        AK_CHECK(ak_clip_cursor_storage_count(c) <= 4096);
         AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg)), AK_OK);
         enum { T = 3000 };
         static float times[T];
@@ -447,8 +471,9 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
     ak_clip* c = build(&raw);
     AK_CHECK(c != NULL);
     if (c) {
-        uint32_t seg[1];
+        uint32_t seg[128];
         ak_clip_cursor cur;
+        AK_CHECK(ak_clip_cursor_storage_count(c) <= 128);
         ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg));
         enum { T = 20000 };
         static float times[T];
@@ -458,6 +483,140 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
     }
     printf("  max |component| error of LINEAR rotations vs double-precision slerp: %.2e\n", worst);
     AK_CHECK(worst < 1e-6);
+}
+
+/* ---- keyframe reduction ---------------------------------------------------------------- */
+
+/* Largest model-space distance between the two clips' joint origins and axis points at r. */
+static double reduce_model_error(const ak_clip* a, const ak_clip* b, float t, const int16_t* parents,
+                                 const ak_transform* rest, size_t n, float r) {
+    ak_transform pa[8], pb[8];
+    ak_mat4 ma[8], mb[8];
+    memcpy(pa, rest, n * sizeof *pa);
+    memcpy(pb, rest, n * sizeof *pb);
+    ak_clip_sample(a, t, NULL, (ak_transform_span){pa, n}, (ak_f32_span){0}, (ak_f32_span){0});
+    ak_clip_sample(b, t, NULL, (ak_transform_span){pb, n}, (ak_f32_span){0}, (ak_f32_span){0});
+    double worst = 0.0;
+    for (size_t j = 0; j < n; ++j) {
+        ma[j] = ak_transform_to_mat4(pa[j]);
+        mb[j] = ak_transform_to_mat4(pb[j]);
+        if (parents[j] >= 0) ma[j] = ak_mat4_mul(ma[parents[j]], ma[j]), mb[j] = ak_mat4_mul(mb[parents[j]], mb[j]);
+        const ak_vec3 pts[4] = {{0, 0, 0}, {r, 0, 0}, {0, r, 0}, {0, 0, r}};
+        for (int p = 0; p < 4; ++p)
+            worst = fmax(worst, ak_vec3_distance(ak_mat4_transform_point(ma[j], pts[p]),
+                                                 ak_mat4_transform_point(mb[j], pts[p])));
+    }
+    return worst;
+}
+
+AK_TEST(reduce_keeps_model_error_within_tolerance) {
+    /* A 6-joint chain with smooth T/R/S motion at 60 keys/s over 4 s (LINEAR, NLERP on one
+     * joint, non-uniform key times), a STEP channel and morph weights (copied unchanged). */
+    enum { NJ = 6, K = 241 };
+    const int16_t parents[NJ] = {-1, 0, 1, 2, 1, 4};
+    ak_transform rest[NJ];
+    for (int j = 0; j < NJ; ++j) rest[j] = ak_transform_identity(), rest[j].translation = ak_vec3_make(0, 0.4f, 0);
+    static float kt[K], tv[NJ][K * 3], rv[NJ][K * 4], sv[NJ][K * 3], wv[K * 2];
+    for (int k = 0; k < K; ++k) kt[k] = (float)k / 60.0f + (k % 3 == 1 ? 0.004f : 0.0f);
+    ak_raw_channel ch[3 * NJ + 1];
+    size_t nch = 0;
+    for (int j = 0; j < NJ; ++j) {
+        for (int k = 0; k < K; ++k) {
+            float t = kt[k], ph = (float)j;
+            tv[j][3 * k] = 0.05f * sinf(2.0f * t + ph), tv[j][3 * k + 1] = 0.4f, tv[j][3 * k + 2] = 0.02f * t;
+            ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(1, 0.3f * ph, 0.2f), 0.9f * sinf(3.0f * t + ph));
+            rv[j][4 * k] = q.x, rv[j][4 * k + 1] = q.y, rv[j][4 * k + 2] = q.z, rv[j][4 * k + 3] = q.w;
+            sv[j][3 * k] = sv[j][3 * k + 1] = sv[j][3 * k + 2] = 1.0f + 0.1f * sinf(1.5f * t + ph);
+        }
+        ak_interp rot = j == 3 ? AK_INTERP_NLERP : j == 4 ? AK_INTERP_STEP : AK_INTERP_LINEAR;
+        ch[nch++] = (ak_raw_channel){.target = AK_CHANNEL_TRANSLATION, .index = (uint32_t)j, .key_count = K, .times = kt,
+                                     .values = tv[j]};
+        ch[nch++] = (ak_raw_channel){.target = AK_CHANNEL_ROTATION, .index = (uint32_t)j, .interp = rot, .key_count = K,
+                                     .times = kt, .values = rv[j]};
+        ch[nch++] = (ak_raw_channel){.target = AK_CHANNEL_SCALE, .index = (uint32_t)j, .key_count = K, .times = kt,
+                                     .values = sv[j]};
+    }
+    for (int k = 0; k < K; ++k) wv[2 * k] = 0.5f, wv[2 * k + 1] = (float)k / K;
+    ch[nch++] = (ak_raw_channel){.target = AK_CHANNEL_MORPH_WEIGHTS, .component_count = 2, .key_count = K, .times = kt,
+                                 .values = wv};
+    ak_raw_clip raw = {.channels = ch, .channel_count = nch, .joint_count = NJ, .morph_weight_count = 2};
+    ak_clip* c = build(&raw);
+    AK_CHECK(c != NULL);
+    if (!c) return;
+    const float tols[3] = {1e-2f, 1e-3f, 1e-4f};
+    size_t last_keys = 0;
+    for (int ti = 0; ti < 3; ++ti) {
+        ak_clip_reduce_desc d = {.parents = parents, .rest_pose = {rest, NJ}, .tolerance = tols[ti], .distance = 0.1f};
+        ak_clip* r = NULL;
+        double err = -1.0;
+        AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &r, &err, NULL), AK_OK);
+        if (!r) continue;
+        size_t before = 0, after = 0;
+        for (size_t i = 0; i < nch; ++i) {
+            before += ak_clip_channel_key_count(c, i), after += ak_clip_channel_key_count(r, i);
+            ak_interp in = ak_clip_channel_interp(c, i);
+            bool copied = in == AK_INTERP_STEP || ak_clip_channel_target(c, i) == AK_CHANNEL_MORPH_WEIGHTS;
+            if (copied) AK_CHECK_EQ(ak_clip_channel_key_count(r, i), K);
+            AK_CHECK_EQ(ak_clip_channel_interp(r, i), in);
+        }
+        /* the promise: within tolerance at every key time and key-interval midpoint */
+        double at_keys = 0.0, dense = 0.0;
+        for (int k = 0; k < K; ++k) {
+            at_keys = fmax(at_keys, reduce_model_error(c, r, kt[k], parents, rest, NJ, 0.1f));
+            if (k + 1 < K)
+                at_keys = fmax(at_keys, reduce_model_error(c, r, 0.5f * (kt[k] + kt[k + 1]), parents, rest, NJ, 0.1f));
+        }
+        for (int i = 0; i <= 4000; ++i) dense = fmax(dense, reduce_model_error(c, r, -0.5f + 5.0f * (float)i / 4000.0f,
+                                                                               parents, rest, NJ, 0.1f));
+        printf("  tolerance %g: %zu -> %zu keys, model error %.3g at keys (reported %.3g), %.3g on 4001 times\n",
+               (double)tols[ti], before, after, at_keys, err, dense);
+        AK_CHECK(at_keys <= tols[ti]);
+        AK_CHECK(fabs(at_keys - err) <= 1e-9 + 1e-6 * err);
+        AK_CHECK(dense <= 2.0 * tols[ti]);
+        AK_CHECK(after < before);
+        AK_CHECK(after > last_keys); /* a tighter tolerance keeps more keys */
+        last_keys = after;
+        ak_clip_destroy(r);
+    }
+    /* Keys on a straight line reduce to the two ends, exactly. */
+    {
+        float lt[5] = {0, 1, 2, 3, 4}, lv[15];
+        for (int k = 0; k < 5; ++k) lv[3 * k] = 2.0f * (float)k, lv[3 * k + 1] = -1.0f, lv[3 * k + 2] = 0.5f * (float)k;
+        ak_raw_channel lc = {.target = AK_CHANNEL_TRANSLATION, .key_count = 5, .times = lt, .values = lv};
+        ak_raw_clip lr = {.channels = &lc, .channel_count = 1, .joint_count = 1};
+        ak_clip* l = build(&lr);
+        const int16_t p1[1] = {-1};
+        ak_transform r1 = ak_transform_identity();
+        ak_clip_reduce_desc d = {.parents = p1, .rest_pose = {&r1, 1}};
+        ak_clip* out = NULL;
+        AK_CHECK_EQ(ak_clip_reduce(l, &d, NULL, &out, NULL, NULL), AK_OK);
+        AK_CHECK_EQ(ak_clip_channel_key_count(out, 0), 2);
+        ak_clip_destroy(out);
+        ak_clip_destroy(l);
+    }
+    /* Errors. */
+    ak_clip* out = (ak_clip*)&out;
+    ak_clip_reduce_desc d = {.parents = parents, .rest_pose = {rest, NJ}};
+    AK_CHECK_EQ(ak_clip_reduce(c, NULL, NULL, &out, NULL, NULL), AK_ERR_NULL_ARG);
+    AK_CHECK(out == NULL);
+    d.tolerance = -1.0f;
+    AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &out, NULL, NULL), AK_ERR_BAD_ARG);
+    d.tolerance = 0.0f;
+    d.rest_pose.count = NJ - 1;
+    AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &out, NULL, NULL), AK_ERR_SPAN_SMALL);
+    d.rest_pose.count = NJ;
+    const int16_t bad[NJ] = {-1, 0, 3, 2, 1, 4};
+    d.parents = bad;
+    AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &out, NULL, NULL), AK_ERR_BAD_INDEX);
+    ak_raw_channel card = ch[0];
+    card.interp = AK_INTERP_CARDINAL;
+    ak_raw_clip craw = {.channels = &card, .channel_count = 1, .joint_count = NJ};
+    ak_clip* cc = build(&craw);
+    d.parents = parents;
+    AK_CHECK_EQ(ak_clip_reduce(cc, &d, NULL, &out, NULL, NULL), AK_ERR_UNSUPPORTED);
+    AK_CHECK(out == NULL);
+    ak_clip_destroy(cc);
+    ak_clip_destroy(c);
 }
 
 /* ---- blending ----------------------------------------------------------------------- */
@@ -826,5 +985,6 @@ int main(void) {
     AK_RUN(root_motion_extraction);
     AK_RUN(custom_allocator_is_used_and_balanced);
     AK_RUN(bake_pose_sequence);
+    AK_RUN(reduce_keeps_model_error_within_tolerance);
     return ak_test_finish();
 }

@@ -8,8 +8,9 @@
  * scalars, all caller-owned. Sampling through a caller-owned cursor makes forward playback
  * O(1) amortised per channel and stays correct for any jump. The module also blends poses
  * (weighted N-way blend, per-joint masks, additive layers, cross-fade) and extracts root
- * motion (a clip walking in place plus the root's horizontal trajectory), and bakes a
- * sequence of computed poses into a clip (ak_clip_bake).
+ * motion (a clip walking in place plus the root's horizontal trajectory), bakes a
+ * sequence of computed poses into a clip (ak_clip_bake) and removes keys within a model-space
+ * tolerance (ak_clip_reduce).
  *
  * glTF: STEP, LINEAR (SLERP for rotations, shortest path) and CUBICSPLINE (tangents scaled by
  * the key interval, rotations renormalised) follow the glTF 2.0 specification, Appendix C.
@@ -21,9 +22,10 @@
  * Usage:
  *     ak_clip* clip = NULL;
  *     if (ak_clip_build(&raw, NULL, &clip, &diag) != AK_OK) fprintf(stderr, "%s\n", diag.message);
- *     uint32_t keys[64];                                   // >= ak_clip_cursor_storage_count
+ *     size_t cn = ak_clip_cursor_storage_count(clip);      // segments + key cache
+ *     uint32_t* keys = calloc(cn, sizeof *keys);
  *     ak_clip_cursor cursor;
- *     ak_clip_cursor_init(&cursor, clip, (ak_u32_span)AK_SPAN(keys));
+ *     ak_clip_cursor_init(&cursor, clip, (ak_u32_span){keys, cn});
  *     ak_transform local[32];                              // start from the rest pose
  *     for (int j = 0; j < 32; ++j) local[j] = rest[j];
  *     for (float t = 0.0f; t < 10.0f; t += 1.0f / 60.0f) {
@@ -32,6 +34,7 @@
  *                        (ak_f32_span){0}, (ak_f32_span){0});
  *         // ... skeleton local-to-model, skinning ...
  *     }
+ *     free(keys);
  *     ak_clip_destroy(clip);
  *
  * Ownership and threading: a built clip is one allocation, immutable, and may be sampled
@@ -136,20 +139,31 @@ AK_API const ak_track* ak_clip_channel_track(const ak_clip* clip, size_t channel
 /* ---- sampling ----------------------------------------------------------------------- */
 
 /* Playback state: the last key segment of every channel, so the next sample near the last
- * one finds its keys without a search. Caller-owned; initialise with ak_clip_cursor_init.
- * One cursor per playing instance (and per thread). */
+ * one finds its keys without a search, and (with the full storage) a key cache: the keys
+ * around the current time of every LINEAR translation/scale and LINEAR/NLERP rotation channel
+ * with two or more keys, laid out four channels per SIMD vector (structure of arrays). A
+ * sample then checks four channels' key intervals in one operation, interpolates four
+ * channels per operation, and reloads only the channels whose interval the time has left
+ * (once per group when the four channels share their key times, as baked clips do).
+ * Caller-owned; initialise with ak_clip_cursor_init. One cursor per playing instance (and per
+ * thread). */
 typedef struct ak_clip_cursor {
     const ak_clip* clip;   /* the clip the cursor was initialised for */
-    uint32_t* segments;    /* caller storage, [ak_clip_cursor_storage_count(clip)] */
+    uint32_t* segments;    /* caller storage: [channel count] segments, then the key cache */
     size_t segment_count;  /* storage elements */
 } ak_clip_cursor;
 
-/* Elements of uint32_t storage a cursor for this clip needs (= channel count). NULL -> 0. */
+/* Elements of uint32_t storage for a cursor with its key cache: the channel count, plus 3 +
+ * 68 per group of four cached channels in SIMD builds (about 54 per joint with T, R and S
+ * channels: 216 bytes, 13 KB for 60 joints). NULL -> 0. The minimum a cursor accepts is
+ * ak_clip_channel_count (segments only, no key cache: slower, same results). */
 AK_API size_t ak_clip_cursor_storage_count(const ak_clip* clip);
 
-/* Bind a cursor to a clip and storage, positioned at the start. The cursor keeps both
- * pointers. Returns AK_ERR_NULL_ARG (cursor or clip NULL, storage.ptr NULL with a non-zero
- * requirement) or AK_ERR_SPAN_SMALL (storage.count < ak_clip_cursor_storage_count). */
+/* Bind a cursor to a clip and storage (any uint32_t alignment), positioned at the start. The
+ * cursor keeps both pointers. storage.count >= ak_clip_cursor_storage_count enables the key
+ * cache; between ak_clip_channel_count and that, the cursor keeps segments only.
+ * Returns AK_ERR_NULL_ARG (cursor or clip NULL, storage.ptr NULL with a non-zero
+ * requirement) or AK_ERR_SPAN_SMALL (storage.count < ak_clip_channel_count). */
 AK_API ak_result ak_clip_cursor_init(ak_clip_cursor* cursor, const ak_clip* clip,
                                      ak_u32_span storage);
 
@@ -160,7 +174,8 @@ AK_API ak_result ak_clip_cursor_init(ak_clip_cursor* cursor, const ak_clip* clip
  * own keys. A NaN time samples the first keys.
  * cursor: NULL -> binary search per channel (fine for one-off samples); else a cursor from
  * ak_clip_cursor_init for this clip (O(1) amortised per channel when time moves forward by
- * less than a key interval; any jump is still exact). Results are bit-identical either way.
+ * less than a key interval; any jump is still exact). Results are bit-identical either way
+ * (the key cache's SIMD lanes run the scalar evaluator's operations in its order).
  * inout_local.count >= ak_clip_joint_count when the clip has joint channels (may be empty
  * otherwise); inout_morph_weights / inout_scalars: empty -> those channels are skipped, else
  * count >= ak_clip_morph_weight_count / ak_clip_scalar_count.
@@ -291,6 +306,42 @@ typedef struct ak_clip_bake_desc {
  * (optional) names the frame and joint. *out_clip is NULL on failure. */
 AK_API ak_result ak_clip_bake(const ak_clip_bake_desc* desc, const ak_allocator* alloc, ak_clip** out_clip,
                               ak_diag* diag);
+
+/* ---- keyframe reduction ------------------------------------------------------------- */
+
+/* What ak_clip_reduce measures the error against. */
+typedef struct ak_clip_reduce_desc {
+    const int16_t* parents;       /* required: [ak_clip_joint_count] parent of each joint, -1 for
+                                     a root, parents before children (ak_skeleton_parents) */
+    ak_transform_cspan rest_pose; /* required: count >= ak_clip_joint_count; the local transform
+                                     of joints and properties the clip does not animate */
+    float tolerance;              /* largest model-space error, in model units; 0 -> 1e-3 */
+    float distance;               /* the error is measured at each joint's origin and at points
+                                     this far along its axes (a skin vertex near the joint);
+                                     model units, 0 -> 0.1 */
+} ak_clip_reduce_desc;
+
+/* Offline: a copy of clip with keys removed where the interpolation of the remaining keys
+ * stays within the tolerance in model space. Reduced: translation, rotation and scale
+ * channels with LINEAR (rotations: slerp) or NLERP keys and at least three keys; every other
+ * channel is copied unchanged. Each channel is simplified by Douglas-Peucker with a local
+ * error (translation distance; rotation angle and scale change times the joint's radius:
+ * distance plus its farthest descendant in the rest pose); then the result is checked in
+ * model space (forward kinematics of both clips over parents and rest_pose, error = the
+ * largest distance between the two clips' positions of every joint's origin and its three
+ * axis points at distance) at every key time of the clip and the midpoint of every key
+ * interval; the local tolerance starts at the tolerance and shrinks by 0.7 until the check
+ * passes (the last of 25 tries keeps every key off its neighbours' interpolation).
+ * out_error (optional) gets that checked error. Cost: one clip build and check per try
+ * (60 joints x 301 keys: about 50 ms). alloc (NULL -> malloc/free) allocates scratch and the
+ * clip. Removing keys can make playback slower when the channels then no longer share their
+ * key times (the cursor's key cache refreshes such channels one by one).
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (tolerance or distance negative or not finite),
+ * AK_ERR_SPAN_SMALL (rest_pose shorter than the joint count), AK_ERR_BAD_INDEX (a parent not
+ * before its child), AK_ERR_UNSUPPORTED (a channel with CARDINAL, BEZIER, NATURAL, LAGRANGE or
+ * SQUAD keys), AK_ERR_NO_MEMORY. *out_clip is NULL on failure. */
+AK_API ak_result ak_clip_reduce(const ak_clip* clip, const ak_clip_reduce_desc* desc, const ak_allocator* alloc,
+                                ak_clip** out_clip, double* out_error, ak_diag* diag);
 
 #ifdef __cplusplus
 }

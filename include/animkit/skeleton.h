@@ -126,7 +126,11 @@ AK_API size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_
 
 /* Forward kinematics: local[i] -> model[i] = model[parent] * local[i] (model[root] = local).
  * Needs local.count >= joint_count, out_model.count >= joint_count. Returns AK_ERR_NULL_ARG,
- * AK_ERR_SPAN_SMALL. Non-finite input propagates (validate poses with ak_pose_is_finite). */
+ * AK_ERR_SPAN_SMALL. Non-finite input propagates (validate poses with ak_pose_is_finite).
+ * Local matrices are built eight joints at a time (structure of arrays) and multiplied as
+ * affine matrices; on x86-64 CPUs with AVX2 and FMA (checked at run time) the products use
+ * fused multiply-adds, so the floats may differ from ak_mat4_mul chains by a rounding per
+ * product (elsewhere they are the same floats). */
 AK_API ak_result ak_skeleton_local_to_model(const ak_skeleton* skeleton, ak_transform_cspan local,
                                             ak_mat4_span out_model);
 /* Same, with an extra root transform (e.g. the node above the skeleton) applied to every root. */

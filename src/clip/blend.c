@@ -34,6 +34,8 @@ static void relocate_clip(ak_clip* c, const char* old_base) {
     char* base = (char*)c;
 #define AKP_RELOC(ptr, type) ((ptr) = (type)(void*)(base + ((const char*)(ptr) - old_base)))
     AKP_RELOC(c->channels, akp_clip_channel*);
+    AKP_RELOC(c->groups, akp_clip_group*);
+    AKP_RELOC(c->slow, uint32_t*);
     for (size_t i = 0; i < c->channel_count; ++i) {
         ak_track* t = &c->channels[i].track;
         AKP_RELOC(t->times, const float*);

@@ -23,11 +23,25 @@ typedef struct akp_clip_channel {
     uint32_t dst; /* FAST_*: float offset of the value in the pose (index * transform + field) */
 } akp_clip_channel;
 
-/* One allocation: this header, the channel array, then every track's data. */
+/* Four FAST channels of one kind, sampled together in SIMD lanes through a cursor's key cache
+ * (src/clip.c, "key cache"). A group with fewer channels repeats its first lane's channel. */
+typedef struct akp_clip_group {
+    akp_clip_fast kind; /* VEC3, SLERP or NLERP */
+    uint32_t ch[4];     /* channel indices */
+    uint32_t dst[4];    /* their akp_clip_channel.dst */
+    bool shared;        /* the four tracks have the same key times (bit for bit) */
+} akp_clip_group;
+
+/* One allocation: this header, the channel array, the groups and the slow channel list, then
+ * every track's data. */
 struct ak_clip {
     ak_allocator alloc;
     akp_clip_channel* channels; /* [channel_count] */
     size_t channel_count;
+    akp_clip_group* groups; /* [group_count]: FAST channels four by four (SIMD builds; else 0) */
+    size_t group_count;
+    uint32_t* slow;         /* [slow_count]: channels in no group, in channel order */
+    size_t slow_count;
     size_t size; /* bytes of the whole block (for copies) */
     size_t joint_count;
     size_t morph_weight_count;
