@@ -176,6 +176,8 @@ typedef struct ak_boids_step_job {
     ak_vec3_span out_velocities;     /* >= agent_count; must not alias the inputs */
     uint64_t* out_interaction_count; /* optional: flock neighbours summed over all agents */
     uint32_t* out_contact_count;     /* optional: agents the obstacle projection had to stop */
+    bool skip_simd;                  /* false -> fastest kernels for this CPU; true -> the
+                                        scalar/SSE2 code (same results, bit for bit: tests) */
 } ak_boids_step_job;
 
 /* Scratch bytes ak_boids_step_run needs for this job (positions.count, params and use_naive

@@ -30,6 +30,14 @@ typedef struct akp_boids_sp {
     float sep_scale, ali_scale, coh_scale;
 } akp_boids_sp;
 
+/* Neighbour sums an agent received in the symmetric pair pass (spatial order): the same
+ * fixed-point sums as akp_boids_gather, counts packed two per word (ns | na << 32,
+ * nc | nflock << 32). */
+typedef struct akp_boids_acc {
+    int64_t sep[3], ali[3], coh[3];
+    uint64_t n01, n23;
+} akp_boids_acc;
+
 /* Per-step context: the job, resolved species, the search state. */
 typedef struct akp_boids_ctx {
     const ak_boids_step_job* job;
@@ -57,6 +65,10 @@ typedef struct akp_boids_ctx {
     const uint32_t* sj;        /* [n] the agent's index in the caller's arrays */
     bool avx512;               /* the spatial path runs the AVX-512 kernels */
     bool one_species;          /* species_count == 1 */
+    /* Symmetric pair pass (dense layout, one species, no k cap, flee or pursue, one ring):
+     * acc[n] holds what each agent received from the pairs found by agents before it. */
+    bool sym;
+    akp_boids_acc* acc;
 } akp_boids_ctx;
 
 /* What one agent gathers from its neighbours. */
@@ -104,6 +116,13 @@ uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z,
                                  float q2, akp_boids_hits* h, uint32_t at);
 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count);
 
+/* The symmetric pair kernel: agent g (spatial slot g->self_k) against its forward hits
+ * [0, count) (all of them other agents): g's own sums in g, what each hit j receives added to
+ * acc[j] (atomically when j < atomic_end or j >= atomic_begin). Same tests and integer sums as
+ * the scalar sym_hits in search.c. */
+void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
+                          uint32_t atomic_end, uint32_t atomic_begin);
+
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);
 /* Build the grid (unless use_naive) into scratch. */
@@ -116,5 +135,13 @@ void akp_boids_list_agent(const akp_boids_ctx* c, size_t i, uint32_t* out, uint3
  * cells so each cell's neighbour cells are looked up once. */
 typedef void (*akp_boids_agent_fn)(const akp_boids_ctx* c, size_t i, const akp_boids_gather* g, void* user);
 void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
+/* The symmetric pass (c->sym): akp_boids_sym_clear once before the threads start;
+ * akp_boids_sym_range(part, parts) on each thread finds every pair once and calls fn for
+ * each agent whose sums are complete; after all of them returned, akp_boids_sym_finish
+ * (part, parts) calls fn for the rest (the agents of each part's first z slab, which the part
+ * before also credits). */
+void akp_boids_sym_clear(const akp_boids_ctx* c, size_t parts);
+void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
+void akp_boids_sym_finish(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
 
 #endif
