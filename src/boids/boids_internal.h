@@ -115,6 +115,11 @@ bool akp_boids_have_avx512(void);
 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end, ak_vec3 p,
                                  float q2, akp_boids_hits* h, uint32_t at);
 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count);
+/* filter over the rows [begin[r], end[r]), r < rows, in one call; h needs room for all their
+ * candidates and 16 more. */
+uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                      const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
+                                      uint32_t at);
 
 /* The symmetric pair kernel: agent g (spatial slot g->self_k) against its forward hits
  * [0, count) (all of them other agents): g's own sums in g, what each hit j receives added to

@@ -706,20 +706,26 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
                     re[nr] = ds[rr + (size_t)xb + 1];
                     if (rb[nr] < re[nr]) ++nr;
                 }
+                uint32_t span = 0; /* candidates of the forward rows (row 0 from k0 + 1) */
+                for (uint32_t a = 1; a < nr; ++a) span += re[a] - rb[a];
+                span += re[0] - k0;
                 for (uint32_t k = k0; k < k1; ++k) {
                     gather_begin_spatial(c, k, &g);
                     rb[0] = k + 1;
                     uint32_t h = 0;
-                    for (uint32_t a = 0; a < nr; ++a)
-                        for (uint32_t t = rb[a]; t < re[a]; t += HIT_PIECE) {
-                            const uint32_t e = re[a] - t > HIT_PIECE ? t + HIT_PIECE : re[a];
-                            if (h + HIT_PIECE + 16 > HIT_CAP) {
-                                sym_hits(c, &g, &hb, h, atomic_end, atomic_begin);
-                                h = 0;
+                    if (c->avx512 && span + 16 <= HIT_CAP) /* the common case: all rows in one call */
+                        h = akp_boids_filter_rows_avx512(X, Y, Z, rb, re, nr, g.p, q2, &hb, 0);
+                    else
+                        for (uint32_t a = 0; a < nr; ++a)
+                            for (uint32_t t = rb[a]; t < re[a]; t += HIT_PIECE) {
+                                const uint32_t e = re[a] - t > HIT_PIECE ? t + HIT_PIECE : re[a];
+                                if (h + HIT_PIECE + 16 > HIT_CAP) {
+                                    sym_hits(c, &g, &hb, h, atomic_end, atomic_begin);
+                                    h = 0;
+                                }
+                                h += c->avx512 ? akp_boids_filter_avx512(X, Y, Z, t, e, g.p, q2, &hb, h)
+                                               : filter_sse2(X, Y, Z, t, e, g.p, q2, &hb, h);
                             }
-                            h += c->avx512 ? akp_boids_filter_avx512(X, Y, Z, t, e, g.p, q2, &hb, h)
-                                           : filter_sse2(X, Y, Z, t, e, g.p, q2, &hb, h);
-                        }
                     sym_hits(c, &g, &hb, h, atomic_end, atomic_begin);
                     if (k < atomic_end) {
                         /* First slab of a later part: the part before credits it too. */

@@ -17,12 +17,13 @@
 
 bool akp_boids_have_avx512(void) { return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq"); }
 
-AKP_AVX512 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin,
-                                            uint32_t end, ak_vec3 p, float q2, akp_boids_hits* h, uint32_t at) {
-    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
-    const __m512 vq = _mm512_set1_ps(q2);
+/* One row of the filter: hits appended at h->...[n], the new n returned. No branch on the hit
+ * mask (a row's tail has few lanes, and whether it hits is a coin toss): an empty mask stores
+ * 16 entries that the next store overwrites. */
+AKP_AVX512 static inline uint32_t filter_row(const float* X, const float* Y, const float* Z, uint32_t begin,
+                                             uint32_t end, __m512 vx, __m512 vy, __m512 vz, __m512 vq,
+                                             akp_boids_hits* h, uint32_t n) {
     const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    uint32_t n = at;
     for (uint32_t t = begin; t < end; t += 16) {
         const uint32_t left = end - t;
         const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
@@ -31,7 +32,6 @@ AKP_AVX512 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, cons
         const __m512 dz = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, Z + t), vz);
         const __m512 dd = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
         const __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, vq, _CMP_LT_OQ);
-        if (!m) continue;
         const __m512i k = _mm512_add_epi32(_mm512_set1_epi32((int)t), lane);
         _mm512_storeu_si512((void*)(h->k + n), _mm512_maskz_compress_epi32(m, k));
         _mm512_storeu_ps(h->d2 + n, _mm512_maskz_compress_ps(m, dd));
@@ -40,6 +40,22 @@ AKP_AVX512 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, cons
         _mm512_storeu_ps(h->dz + n, _mm512_maskz_compress_ps(m, dz));
         n += (uint32_t)__builtin_popcount(m);
     }
+    return n;
+}
+
+AKP_AVX512 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin,
+                                            uint32_t end, ak_vec3 p, float q2, akp_boids_hits* h, uint32_t at) {
+    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
+    return filter_row(X, Y, Z, begin, end, vx, vy, vz, _mm512_set1_ps(q2), h, at) - at;
+}
+
+AKP_AVX512 uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                                 const uint32_t* end, uint32_t rows, ak_vec3 p, float q2,
+                                                 akp_boids_hits* h, uint32_t at) {
+    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
+    const __m512 vq = _mm512_set1_ps(q2);
+    uint32_t n = at;
+    for (uint32_t r = 0; r < rows; ++r) n = filter_row(X, Y, Z, begin[r], end[r], vx, vy, vz, vq, h, n);
     return n - at;
 }
 
@@ -318,6 +334,13 @@ bool akp_boids_have_avx512(void) { return false; }
 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end, ak_vec3 p,
                                  float q2, akp_boids_hits* h, uint32_t at) {
     (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)p, (void)q2, (void)h, (void)at;
+    return 0;
+}
+
+uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                      const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
+                                      uint32_t at) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)rows, (void)p, (void)q2, (void)h, (void)at;
     return 0;
 }
 
