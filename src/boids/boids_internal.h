@@ -69,6 +69,9 @@ typedef struct akp_boids_ctx {
      * acc[n] holds what each agent received from the pairs found by agents before it. */
     bool sym;
     akp_boids_acc* acc;
+    akp_boids_acc* spill;    /* credits across thread boundaries (in the grid's unused memory) */
+    size_t spill_cap;        /* entries spill holds */
+    bool use_spill;          /* set by akp_boids_sym_clear: the boundary slabs fit spill */
 } akp_boids_ctx;
 
 /* What one agent gathers from its neighbours. */
@@ -121,12 +124,22 @@ uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y, const floa
                                       const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
                                       uint32_t at);
 
+/* Where the symmetric pass credits agent t (spatial slot): acc[t], except
+ * - t >= far_begin (the next part's first slab, which that part also credits): spill[t -
+ *   far_begin] when spill is set, else acc[t] by atomic adds;
+ * - t < atomic_end (this part's own first slab when the part before credits it in acc): acc[t]
+ *   by atomic adds (atomic_end is 0 when spill is used). */
+typedef struct akp_boids_sink {
+    akp_boids_acc* acc;
+    akp_boids_acc* spill;
+    uint32_t atomic_end, far_begin;
+} akp_boids_sink;
+
 /* The symmetric pair kernel: agent g (spatial slot g->self_k) against its forward hits
- * [0, count) (all of them other agents): g's own sums in g, what each hit j receives added to
- * acc[j] (atomically when j < atomic_end or j >= atomic_begin). Same tests and integer sums as
- * the scalar sym_hits in search.c. */
+ * [0, count) (all of them other agents): g's own sums in g, what each hit receives credited
+ * through sink. Same tests and integer sums as the scalar sym_hits in search.c. */
 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
-                          uint32_t atomic_end, uint32_t atomic_begin);
+                          const akp_boids_sink* sink);
 
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);
@@ -145,7 +158,7 @@ void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, a
  * each agent whose sums are complete; after all of them returned, akp_boids_sym_finish
  * (part, parts) calls fn for the rest (the agents of each part's first z slab, which the part
  * before also credits). */
-void akp_boids_sym_clear(const akp_boids_ctx* c, size_t parts);
+void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts);
 void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
 void akp_boids_sym_finish(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
 

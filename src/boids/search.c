@@ -519,10 +519,12 @@ static void gather_rows(const akp_boids_ctx* c, const row_ranges* r, akp_boids_g
  * j - i is exactly -(i - j) in floats, fix() is odd, so what j receives from the pair is
  * bit for bit what j's own walk over its neighbourhood would have summed. Every agent's sums
  * are complete once the agents before it are done, so integration follows at once; only the
- * first z slab of each thread after the first waits (its agents also receive from the slab
- * before, on the other thread: those credits are atomic adds, the slab integrates after). */
+ * first z slab of each thread after the first waits: its agents also receive from the slab
+ * before, on the other thread, which credits them in a spill buffer (or, when the boundary
+ * slabs hold more agents than it has room for, by atomic adds); the slab integrates after
+ * both are done. Integer sums: the same bits in any order. */
 
-/* acc += the credits of one pair, atomically when another thread may touch acc. */
+/* A += the credits of one pair, atomically when another thread may touch A. */
 static inline void credit(akp_boids_acc* A, const int64_t v[9], uint64_t n01, uint64_t n23, bool atomic) {
     if (!atomic) {
         for (int a = 0; a < 3; ++a) {
@@ -545,9 +547,9 @@ static inline void credit(akp_boids_acc* A, const int64_t v[9], uint64_t n01, ui
 
 /* Agent g against its forward hits [0, h): g's sums in g, the hits' credits in c->acc. */
 static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* hb, uint32_t h,
-                     uint32_t atomic_end, uint32_t atomic_begin) {
+                     const akp_boids_sink* sink) {
     if (c->avx512) {
-        akp_boids_sym_avx512(c, g, hb, h, atomic_end, atomic_begin);
+        akp_boids_sym_avx512(c, g, hb, h, sink);
         return;
     }
     const akp_boids_sp* S = g->sp;
@@ -588,8 +590,9 @@ static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boid
         if (see_j) {
             const int64_t v[9] = {-e[0], -e[1], -e[2], ba ? qi[0] : 0, ba ? qi[1] : 0, ba ? qi[2] : 0,
                                   -f[0], -f[1], -f[2]};
-            credit(&c->acc[t], v, (uint64_t)bs | (uint64_t)ba << 32, (uint64_t)bc | (uint64_t)1 << 32,
-                   t < atomic_end || t >= atomic_begin);
+            const uint64_t n01 = (uint64_t)bs | (uint64_t)ba << 32, n23 = (uint64_t)bc | (uint64_t)1 << 32;
+            if (t >= sink->far_begin && sink->spill) credit(&sink->spill[t - sink->far_begin], v, n01, n23, false);
+            else credit(&sink->acc[t], v, n01, n23, t < sink->atomic_end || t >= sink->far_begin);
         }
     }
     g->sep[0] += s0;
@@ -654,10 +657,29 @@ static void acc_zero(const akp_boids_ctx* c, size_t z) {
     memset(c->acc + b, 0, (size_t)(e - b) * sizeof(akp_boids_acc));
 }
 
-void akp_boids_sym_clear(const akp_boids_ctx* c, size_t parts) {
+/* First spill entry of deferred slab z: the deferred slabs (first slabs of the parts after the
+ * first) before it, in order, side by side. */
+static size_t spill_base(const akp_boids_ctx* c, size_t parts, size_t z) {
+    size_t base = 0, prev = 0;
+    for (size_t t = 1; t < parts; ++t) {
+        const size_t s = slab_of(c, t, parts);
+        if (s >= z || s >= (size_t)c->dense_dim[2]) break;
+        if (s != prev) base += slab_start(c, s + 1) - slab_start(c, s);
+        prev = s;
+    }
+    return base;
+}
+
+void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts) {
+    const size_t need = spill_base(c, parts, (size_t)c->dense_dim[2] + 1);
+    c->use_spill = need <= c->spill_cap;
+    if (c->use_spill) {
+        memset(c->spill, 0, need * sizeof(akp_boids_acc));
+        return;
+    }
     for (size_t t = 1; t < parts; ++t) {
         const size_t z = slab_of(c, t, parts);
-        if (z < (size_t)c->dense_dim[2]) acc_zero(c, z);
+        if (z > 0 && z < (size_t)c->dense_dim[2]) acc_zero(c, z);
     }
 }
 
@@ -679,12 +701,15 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
     if (z0 == z1) return;
     const int64_t dimx = c->dense_dim[0], dimy = c->dense_dim[1], dimz = c->dense_dim[2];
     const uint32_t* ds = c->dstart;
-    const uint32_t atomic_end = part > 0 ? slab_start(c, z0 + 1) : 0, atomic_begin = slab_start(c, z1);
+    /* Slab z0 waits when a part before this one credits it (z0 > 0 means one does). */
+    const uint32_t first_end = z0 > 0 ? slab_start(c, z0 + 1) : 0;
+    akp_boids_sink sink = {c->acc, NULL, c->use_spill ? 0 : first_end, slab_start(c, z1)};
+    if (c->use_spill && z1 < (size_t)dimz) sink.spill = c->spill + spill_base(c, parts, z1);
     const float q2 = c->sp[0].query_radius * c->sp[0].query_radius;
     const float *X = c->sx, *Y = c->sy, *Z = c->sz;
     akp_boids_gather g;
     akp_boids_hits hb;
-    if (part == 0) acc_zero(c, z0);
+    if (z0 == 0 || c->use_spill) acc_zero(c, z0); /* else akp_boids_sym_clear did */
     for (int64_t z = (int64_t)z0; z < (int64_t)z1; ++z) {
         if (z + 1 < (int64_t)z1) acc_zero(c, (size_t)z + 1);
         for (int64_t y = 0; y < dimy; ++y) {
@@ -720,19 +745,19 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
                             for (uint32_t t = rb[a]; t < re[a]; t += HIT_PIECE) {
                                 const uint32_t e = re[a] - t > HIT_PIECE ? t + HIT_PIECE : re[a];
                                 if (h + HIT_PIECE + 16 > HIT_CAP) {
-                                    sym_hits(c, &g, &hb, h, atomic_end, atomic_begin);
+                                    sym_hits(c, &g, &hb, h, &sink);
                                     h = 0;
                                 }
                                 h += c->avx512 ? akp_boids_filter_avx512(X, Y, Z, t, e, g.p, q2, &hb, h)
                                                : filter_sse2(X, Y, Z, t, e, g.p, q2, &hb, h);
                             }
-                    sym_hits(c, &g, &hb, h, atomic_end, atomic_begin);
-                    if (k < atomic_end) {
+                    sym_hits(c, &g, &hb, h, &sink);
+                    if (k < first_end) {
                         /* First slab of a later part: the part before credits it too. */
                         const int64_t v[9] = {g.sep[0], g.sep[1], g.sep[2], g.ali[0], g.ali[1],
                                               g.ali[2], g.coh[0], g.coh[1], g.coh[2]};
                         credit(&c->acc[k], v, (uint64_t)g.ns | (uint64_t)g.na << 32,
-                               (uint64_t)g.nc | (uint64_t)g.nflock << 32, true);
+                               (uint64_t)g.nc | (uint64_t)g.nflock << 32, !c->use_spill);
                         continue;
                     }
                     add_received(&c->acc[k], &g);
@@ -745,11 +770,14 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
 
 void akp_boids_sym_finish(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user) {
     const size_t z0 = slab_of(c, part, parts), z1 = slab_of(c, part + 1, parts);
-    if (part == 0 || z0 == z1) return;
+    if (z0 == 0 || z0 == z1) return;
     akp_boids_gather g;
-    for (uint32_t k = slab_start(c, z0); k < slab_start(c, z0 + 1); ++k) {
+    const uint32_t b = slab_start(c, z0);
+    const akp_boids_acc* spill = c->use_spill ? c->spill + spill_base(c, parts, z0) : NULL;
+    for (uint32_t k = b; k < slab_start(c, z0 + 1); ++k) {
         gather_begin_spatial(c, k, &g);
         add_received(&c->acc[k], &g);
+        if (spill) add_received(&spill[k - b], &g);
         fn(c, g.i, &g, user);
     }
 }
@@ -949,6 +977,9 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     c->avx512 = !c->job->skip_simd && akp_boids_have_avx512();
     c->one_species = c->params->species_count == 1;
     c->sym = sym_ok && c->rings == 1;
+    /* The grid's memory is free on this path (the cell coordinates are done with). */
+    c->spill = (akp_boids_acc*)(void*)base;
+    c->spill_cap = gbytes / sizeof(akp_boids_acc);
     return AK_OK;
 }
 

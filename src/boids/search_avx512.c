@@ -170,27 +170,30 @@ AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather*
     g->nflock += nf;
 }
 
-/* j's credits of the lanes of m into acc (see akp_boids_sym_avx512). */
-static inline void credit_lanes(akp_boids_acc* acc, __mmask16 m, const uint32_t* k, const int64_t* e,
-                                const int64_t* f, __mmask16 ms, __mmask16 ma, __mmask16 mc, const int64_t* qi,
-                                uint32_t atomic_end, uint32_t atomic_begin) {
+/* j's credits of the lanes of m through sink (see akp_boids_sym_avx512). */
+static inline void credit_lanes(const akp_boids_sink* sink, __mmask16 m, const uint32_t* k, const int64_t* e,
+                                const int64_t* f, __mmask16 ms, __mmask16 ma, __mmask16 mc, const int64_t* qi) {
     while (m) {
         const unsigned l = (unsigned)__builtin_ctz(m);
         m &= (__mmask16)(m - 1);
         const uint32_t t = k[l];
-        akp_boids_acc* A = &acc[t];
         const uint64_t bs = (ms >> l) & 1u, ba = (ma >> l) & 1u, bc = (mc >> l) & 1u;
         const int64_t am = -(int64_t)ba;
         const uint64_t n01 = bs | ba << 32, n23 = bc | (uint64_t)1 << 32;
-        if (t < atomic_end || t >= atomic_begin) {
-            for (int a = 0; a < 3; ++a) {
-                __atomic_fetch_sub(&A->sep[a], e[16 * a + l], __ATOMIC_RELAXED);
-                __atomic_fetch_add(&A->ali[a], qi[a] & am, __ATOMIC_RELAXED);
-                __atomic_fetch_sub(&A->coh[a], f[16 * a + l], __ATOMIC_RELAXED);
+        akp_boids_acc* A = &sink->acc[t];
+        if (t < sink->atomic_end || t >= sink->far_begin) {
+            if (t >= sink->far_begin && sink->spill) {
+                A = &sink->spill[t - sink->far_begin];
+            } else {
+                for (int a = 0; a < 3; ++a) {
+                    __atomic_fetch_sub(&A->sep[a], e[16 * a + l], __ATOMIC_RELAXED);
+                    __atomic_fetch_add(&A->ali[a], qi[a] & am, __ATOMIC_RELAXED);
+                    __atomic_fetch_sub(&A->coh[a], f[16 * a + l], __ATOMIC_RELAXED);
+                }
+                __atomic_fetch_add(&A->n01, n01, __ATOMIC_RELAXED);
+                __atomic_fetch_add(&A->n23, n23, __ATOMIC_RELAXED);
+                continue;
             }
-            __atomic_fetch_add(&A->n01, n01, __ATOMIC_RELAXED);
-            __atomic_fetch_add(&A->n23, n23, __ATOMIC_RELAXED);
-            continue;
         }
         A->sep[0] -= e[l];
         A->sep[1] -= e[16 + l];
@@ -237,7 +240,7 @@ AKP_AVX512 static inline __mmask16 cone16(const akp_boids_sp* S, __m512 dx, __m5
 }
 
 AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h,
-                                     uint32_t count, uint32_t atomic_end, uint32_t atomic_begin) {
+                                     uint32_t count, const akp_boids_sink* sink) {
     const akp_boids_sp* S = g->sp;
     const __m512 rn2 = _mm512_set1_ps(S->rn2), rs2 = _mm512_set1_ps(S->rs2), ra2 = _mm512_set1_ps(S->ra2),
                  rc2 = _mm512_set1_ps(S->rc2), dmin2 = _mm512_set1_ps(S->dmin2), sep = _mm512_set1_ps(S->sep_scale),
@@ -310,7 +313,7 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
         if (mj) {
             uint32_t kt[16];
             _mm512_storeu_si512((void*)kt, kk);
-            credit_lanes(c->acc, mj, kt, e, f, bs, ba, bc, qi, atomic_end, atomic_begin);
+            credit_lanes(sink, mj, kt, e, f, bs, ba, bc, qi);
         }
     }
     g->sep[0] += _mm512_reduce_add_epi64(s0);
@@ -349,7 +352,7 @@ void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const a
 }
 
 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
-                          uint32_t atomic_end, uint32_t atomic_begin) {
-    (void)c, (void)g, (void)h, (void)count, (void)atomic_end, (void)atomic_begin;
+                          const akp_boids_sink* sink) {
+    (void)c, (void)g, (void)h, (void)count, (void)sink;
 }
 #endif
