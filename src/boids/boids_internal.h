@@ -72,6 +72,11 @@ typedef struct akp_boids_ctx {
     akp_boids_acc* spill;    /* credits across thread boundaries (in the grid's unused memory) */
     size_t spill_cap;        /* entries spill holds */
     bool use_spill;          /* set by akp_boids_sym_clear: the boundary slabs fit spill */
+    /* The spatial arrays, writable, for akp_boids_search_fill. */
+    float *fill_sx, *fill_sy, *fill_sz;
+    ak_vec3* fill_sv;
+    uint8_t* fill_sp;
+    int64_t* fill_qv;
 } akp_boids_ctx;
 
 /* What one agent gathers from its neighbours. */
@@ -143,6 +148,13 @@ void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp
 
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);
+/* Spatial slots [n part / parts, n (part + 1) / parts) of the dense layout filled from the
+ * caller's arrays through sj (prepare runs it, over threads for large steps). */
+typedef struct akp_boids_fill_task {
+    const akp_boids_ctx* c;
+    size_t part, parts;
+} akp_boids_fill_task;
+void akp_boids_search_fill(const akp_boids_ctx* c, size_t part, size_t parts);
 /* Build the grid (unless use_naive) into scratch. */
 ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch);
 /* Gather agent i's neighbour sums (either path; identical results). */

@@ -880,6 +880,33 @@ static bool dense_direct(akp_boids_ctx* c, int32_t* cells) {
     return true;
 }
 
+void akp_boids_search_fill(const akp_boids_ctx* c, size_t part, size_t parts) {
+    const size_t b = c->n * part / parts, e = c->n * (part + 1) / parts;
+    const ak_vec3* P = c->job->positions.ptr;
+    const ak_vec3* V = c->job->velocities.ptr;
+    const uint8_t* S = c->job->species.ptr;
+    for (size_t d = b; d < e; ++d) {
+        const uint32_t i = c->sj[d];
+        const uint8_t s = S ? S[i] : 0;
+        const float as = c->sp[s].ali_scale;
+        const ak_vec3 v = V[i];
+        c->fill_sx[d] = P[i].x;
+        c->fill_sy[d] = P[i].y;
+        c->fill_sz[d] = P[i].z;
+        c->fill_sv[d] = v;
+        c->fill_sp[d] = s;
+        c->fill_qv[3 * d] = fix(v.x * as);
+        c->fill_qv[3 * d + 1] = fix(v.y * as);
+        c->fill_qv[3 * d + 2] = fix(v.z * as);
+    }
+}
+
+static void* fill_thread(void* arg) {
+    const akp_boids_fill_task* t = (const akp_boids_fill_task*)arg;
+    akp_boids_search_fill(t->c, t->part, t->parts);
+    return NULL;
+}
+
 ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     float search;
     const float cs = cell_size_for(c->params, &search);
@@ -911,7 +938,6 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     q += align64(n * sizeof(uint32_t));
     const bool sym_ok = sym_params(c->params);
     c->acc = sym_ok ? (akp_boids_acc*)(void*)q : NULL;
-    const ak_vec3* P = c->job->positions.ptr;
     const ak_vec3* V = c->job->velocities.ptr;
     const uint8_t* S = c->job->species.ptr;
     c->sqv = qv;
@@ -950,21 +976,7 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
         dstart[b + 1]++;
     }
     for (size_t b = 0; b < volume; ++b) dstart[b + 1] += dstart[b];
-    for (size_t i = 0; i < n; ++i) {
-        const uint32_t d = dstart[idx[i]]++;
-        const uint8_t s = S ? S[i] : 0;
-        const float as = c->sp[s].ali_scale;
-        const ak_vec3 v = V[i];
-        sx[d] = P[i].x;
-        sy[d] = P[i].y;
-        sz[d] = P[i].z;
-        sv[d] = v;
-        sj[d] = (uint32_t)i;
-        sp[d] = s;
-        qv[3 * d] = fix(v.x * as);
-        qv[3 * d + 1] = fix(v.y * as);
-        qv[3 * d + 2] = fix(v.z * as);
-    }
+    for (size_t i = 0; i < n; ++i) sj[dstart[idx[i]]++] = (uint32_t)i;
     /* dstart[b] is now the end of cell b: shift back to starts. */
     memmove(dstart + 1, dstart, volume * sizeof(uint32_t));
     dstart[0] = 0;
@@ -974,6 +986,21 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     c->sv = sv;
     c->sj = sj;
     c->dstart = dstart;
+    c->fill_sx = sx;
+    c->fill_sy = sy;
+    c->fill_sz = sz;
+    c->fill_sv = sv;
+    c->fill_sp = sp;
+    c->fill_qv = qv;
+    /* The agents' data in spatial order: read through sj (in order), written in order, so it
+     * splits over threads (akp_boids_search_fill); small steps fill here. */
+    const uint32_t parts = akp_boids_threads(c->job->thread_count, n);
+    if (parts <= 1 || n < 2048) akp_boids_search_fill(c, 0, 1);
+    else {
+        akp_boids_fill_task tasks[64];
+        for (uint32_t t = 0; t < parts; ++t) tasks[t] = (akp_boids_fill_task){c, t, parts};
+        akp_boids_run_tasks(fill_thread, tasks, sizeof tasks[0], parts);
+    }
     c->avx512 = !c->job->skip_simd && akp_boids_have_avx512();
     c->one_species = c->params->species_count == 1;
     c->sym = sym_ok && c->rings == 1;
