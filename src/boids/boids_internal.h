@@ -129,6 +129,24 @@ uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y, const floa
                                       const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
                                       uint32_t at);
 
+/* A cell's forward candidates packed side by side (positions and spatial index), so the
+ * 16-lane filter runs full instead of over short rows; 16 entries of slack after count. */
+#define AKP_BOIDS_PACK_CAP 384
+typedef struct akp_boids_packed {
+    float x[AKP_BOIDS_PACK_CAP + 16], y[AKP_BOIDS_PACK_CAP + 16], z[AKP_BOIDS_PACK_CAP + 16];
+    uint32_t k[AKP_BOIDS_PACK_CAP + 16];
+} akp_boids_packed;
+/* Packs the rows [begin[r], end[r]) (at most AKP_BOIDS_PACK_CAP candidates in all) into b;
+ * returns the count. */
+uint32_t akp_boids_pack_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                    const uint32_t* end, uint32_t rows, akp_boids_packed* b);
+/* The filter over the row [begin, end) of the spatial arrays, then the packed candidates
+ * [0, count): hits appended at `at`, their number returned (h needs room for all of them
+ * and 32 more). */
+uint32_t akp_boids_filter_packed_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end,
+                                        const akp_boids_packed* b, uint32_t count, ak_vec3 p, float q2,
+                                        akp_boids_hits* h, uint32_t at);
+
 /* Where the symmetric pass credits agent t (spatial slot): acc[t], except
  * - t >= far_begin (the next part's first slab, which that part also credits): spill[t -
  *   far_begin] when spill is set, else acc[t] by atomic adds;

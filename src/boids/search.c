@@ -709,6 +709,8 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
     const float *X = c->sx, *Y = c->sy, *Z = c->sz;
     akp_boids_gather g;
     akp_boids_hits hb;
+    akp_boids_packed pkv; /* 6 KiB */
+    akp_boids_packed* pk = &pkv;
     if (z0 == 0 || c->use_spill) acc_zero(c, z0); /* else akp_boids_sym_clear did */
     for (int64_t z = (int64_t)z0; z < (int64_t)z1; ++z) {
         if (z + 1 < (int64_t)z1) acc_zero(c, (size_t)z + 1);
@@ -734,11 +736,22 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
                 uint32_t span = 0; /* candidates of the forward rows (row 0 from k0 + 1) */
                 for (uint32_t a = 1; a < nr; ++a) span += re[a] - rb[a];
                 span += re[0] - k0;
+                /* Several agents share the cell's candidates: pack them once (all but the
+                 * cell's own, which each agent takes from k + 1). */
+                uint32_t packed = 0;
+                const bool pack = c->avx512 && k1 - k0 > 1 && span + 32 <= HIT_CAP &&
+                                  span - (k1 - k0 - 1) <= AKP_BOIDS_PACK_CAP;
+                if (pack) {
+                    rb[0] = k1;
+                    packed = akp_boids_pack_rows_avx512(X, Y, Z, rb, re, nr, pk);
+                }
                 for (uint32_t k = k0; k < k1; ++k) {
                     gather_begin_spatial(c, k, &g);
                     rb[0] = k + 1;
                     uint32_t h = 0;
-                    if (c->avx512 && span + 16 <= HIT_CAP) /* the common case: all rows in one call */
+                    if (pack)
+                        h = akp_boids_filter_packed_avx512(X, Y, Z, k + 1, k1, pk, packed, g.p, q2, &hb, 0);
+                    else if (c->avx512 && span + 16 <= HIT_CAP) /* all rows in one call */
                         h = akp_boids_filter_rows_avx512(X, Y, Z, rb, re, nr, g.p, q2, &hb, 0);
                     else
                         for (uint32_t a = 0; a < nr; ++a)

@@ -59,6 +59,48 @@ AKP_AVX512 uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y,
     return n - at;
 }
 
+AKP_AVX512 uint32_t akp_boids_pack_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                               const uint32_t* end, uint32_t rows, akp_boids_packed* b) {
+    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    uint32_t n = 0;
+    for (uint32_t r = 0; r < rows; ++r)
+        for (uint32_t t = begin[r]; t < end[r]; t += 16) {
+            const uint32_t left = end[r] - t;
+            const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
+            _mm512_storeu_ps(b->x + n, _mm512_maskz_loadu_ps(live, X + t));
+            _mm512_storeu_ps(b->y + n, _mm512_maskz_loadu_ps(live, Y + t));
+            _mm512_storeu_ps(b->z + n, _mm512_maskz_loadu_ps(live, Z + t));
+            _mm512_storeu_si512((void*)(b->k + n), _mm512_add_epi32(_mm512_set1_epi32((int)t), lane));
+            n += left >= 16 ? 16u : left;
+        }
+    return n;
+}
+
+AKP_AVX512 uint32_t akp_boids_filter_packed_avx512(const float* X, const float* Y, const float* Z, uint32_t begin,
+                                                   uint32_t end, const akp_boids_packed* b, uint32_t count, ak_vec3 p,
+                                                   float q2, akp_boids_hits* h, uint32_t at) {
+    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
+    const __m512 vq = _mm512_set1_ps(q2);
+    uint32_t n = filter_row(X, Y, Z, begin, end, vx, vy, vz, vq, h, at);
+    for (uint32_t u = 0; u < count; u += 16) {
+        const uint32_t left = count - u;
+        const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
+        const __m512 dx = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, b->x + u), vx);
+        const __m512 dy = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, b->y + u), vy);
+        const __m512 dz = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, b->z + u), vz);
+        const __m512 dd = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+        const __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, vq, _CMP_LT_OQ);
+        const __m512i k = _mm512_maskz_loadu_epi32(live, b->k + u);
+        _mm512_storeu_si512((void*)(h->k + n), _mm512_maskz_compress_epi32(m, k));
+        _mm512_storeu_ps(h->d2 + n, _mm512_maskz_compress_ps(m, dd));
+        _mm512_storeu_ps(h->dx + n, _mm512_maskz_compress_ps(m, dx));
+        _mm512_storeu_ps(h->dy + n, _mm512_maskz_compress_ps(m, dy));
+        _mm512_storeu_ps(h->dz + n, _mm512_maskz_compress_ps(m, dz));
+        n += (uint32_t)__builtin_popcount(m);
+    }
+    return n - at;
+}
+
 /* fix() of search.c on 16 lanes: clamp to +-AKP_BOIDS_FIX_CLAMP, truncate to int64 (lo, hi). */
 AKP_AVX512 static inline void fix16(__m512 x, __m512i* lo, __m512i* hi) {
     x = _mm512_max_ps(x, _mm512_set1_ps(-AKP_BOIDS_FIX_CLAMP));
@@ -354,5 +396,18 @@ void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const a
 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
                           const akp_boids_sink* sink) {
     (void)c, (void)g, (void)h, (void)count, (void)sink;
+}
+
+uint32_t akp_boids_pack_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                    const uint32_t* end, uint32_t rows, akp_boids_packed* b) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)rows, (void)b;
+    return 0;
+}
+
+uint32_t akp_boids_filter_packed_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end,
+                                        const akp_boids_packed* b, uint32_t count, ak_vec3 p, float q2,
+                                        akp_boids_hits* h, uint32_t at) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)b, (void)count, (void)p, (void)q2, (void)h, (void)at;
+    return 0;
 }
 #endif
