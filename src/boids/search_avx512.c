@@ -294,7 +294,7 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
     const float* svf = (const float*)(const void*)c->sv; /* ak_vec3: 3 packed floats */
     __m512i s0 = _mm512_setzero_si512(), s1 = s0, s2 = s0, a0 = s0, a1 = s0, a2 = s0, c0 = s0, c1 = s0, c2 = s0;
     uint32_t ns = 0, na = 0, nc = 0, nf = 0;
-    int64_t e[48], f[48];
+    int64_t e[48], f[48], ai[3] = {0, 0, 0};
     for (uint32_t u = 0; u < count; u += 16) {
         const uint32_t left = count - u;
         const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
@@ -342,7 +342,7 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
             add_stored(&c1, mi, f + 16);
             add_stored(&c2, mi, f + 32);
             const __mmask16 mai = mi & ba;
-            if (mai) {
+            if (mai && (cone || mj != mi)) { /* else the partner loop below sums them */
                 const __m512i k3 = _mm512_add_epi32(_mm512_add_epi32(kk, kk), kk);
                 add_gathered(&a0, mai, k3, c->sqv);
                 add_gathered(&a1, mai, k3, c->sqv + 1);
@@ -356,14 +356,21 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
             uint32_t kt[16];
             _mm512_storeu_si512((void*)kt, kk);
             credit_lanes(sink, mj, kt, e, f, bs, ba, bc, qi);
+            if (!cone && mj == mi) /* both directions see each other: i's alignment sums here */
+                for (__mmask16 r = mi & ba; r; r &= (__mmask16)(r - 1)) {
+                    const int64_t* q = c->sqv + 3 * (size_t)kt[__builtin_ctz(r)];
+                    ai[0] += q[0];
+                    ai[1] += q[1];
+                    ai[2] += q[2];
+                }
         }
     }
     g->sep[0] += _mm512_reduce_add_epi64(s0);
     g->sep[1] += _mm512_reduce_add_epi64(s1);
     g->sep[2] += _mm512_reduce_add_epi64(s2);
-    g->ali[0] += _mm512_reduce_add_epi64(a0);
-    g->ali[1] += _mm512_reduce_add_epi64(a1);
-    g->ali[2] += _mm512_reduce_add_epi64(a2);
+    g->ali[0] += _mm512_reduce_add_epi64(a0) + ai[0];
+    g->ali[1] += _mm512_reduce_add_epi64(a1) + ai[1];
+    g->ali[2] += _mm512_reduce_add_epi64(a2) + ai[2];
     g->coh[0] += _mm512_reduce_add_epi64(c0);
     g->coh[1] += _mm512_reduce_add_epi64(c1);
     g->coh[2] += _mm512_reduce_add_epi64(c2);
