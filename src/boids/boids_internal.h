@@ -46,7 +46,8 @@ typedef struct akp_boids_ctx {
     ak_boids_bounds bounds; /* resolved mode */
     akp_boids_sp sp[AK_BOIDS_MAX_SPECIES];
     float search_radius;    /* largest query radius over species (0: nobody looks) */
-    /* Grid path (use_naive false). */
+    /* Grid path (use_naive false). The hashed grid is built only for sparse flocks; on the
+     * dense path grid.cell_size alone is set (ak_grid_cell_of). */
     ak_grid grid;
     int rings;              /* cells visited on each side of an agent's cell */
     const int64_t* sqv;     /* [3n] velocities, fixed point (alignment sums), in sorted order */
@@ -173,7 +174,8 @@ typedef struct akp_boids_fill_task {
     size_t part, parts;
 } akp_boids_fill_task;
 void akp_boids_search_fill(const akp_boids_ctx* c, size_t part, size_t parts);
-/* Build the grid (unless use_naive) into scratch. */
+/* The search structures (unless use_naive) in scratch: the dense spatial layout straight from
+ * the positions, or, for sparse flocks, the hashed grid. */
 ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch);
 /* Gather agent i's neighbour sums (either path; identical results). */
 void akp_boids_gather_agent(const akp_boids_ctx* c, size_t i, akp_boids_gather* g);
