@@ -723,6 +723,78 @@ AK_TEST(threads_and_paths_bit_identical) {
     flock_free(&base);
 }
 
+/* The plain flock takes the symmetric pair pass: each pair's distance test runs once and both
+ * agents are credited, with their own view cones; threads meet at z-slab boundaries, through
+ * a spill buffer when the boundary slabs are few, by atomic adds when most slabs are boundary
+ * slabs (the flat box below: 6 slabs, 6 threads). Every thread count, with and without the
+ * SIMD kernels (skip_simd), must give the naive loop's bits, and the same interaction count.
+ * (Dense clumps, whose hits are taken in batches, are in the test above.) */
+AK_TEST(symmetric_pass_threads_and_kernels) {
+    ak_boids_species plain = {.max_speed = 2, .separation_weight = 2, .separation_radius = 0.6f,
+                              .alignment_weight = 1, .alignment_radius = 1.4f, .cohesion_weight = 1,
+                              .cohesion_radius = 1.6f};
+    ak_boids_params pp = {.species = &plain, .species_count = 1};
+    const struct {
+        bool column;
+        float view;
+    } cases[] = {{false, 250}, {false, 120}, {true, 360}, {true, 200}};
+    const uint32_t threads[4] = {1, 2, 3, 6};
+    const size_t n = 3072; /* 6 threads at most: one per 512 agents */
+    for (size_t cs = 0; cs < sizeof cases / sizeof cases[0]; ++cs) {
+        plain.view_angle = cases[cs].view;
+        flock base = flock_make(n);
+        ak_rng r = ak_rng_make(500 + cs);
+        for (size_t i = 0; i < n; ++i) {
+            if (cases[cs].column) /* cells of 1.6 m: 6 slabs */
+                base.p[i] = ak_vec3_make(ak_rng_range(&r, 0.0f, 16.0f), ak_rng_range(&r, 0.0f, 16.0f),
+                                         ak_rng_range(&r, 0.0f, 9.5f));
+            else
+                base.p[i] = ak_vec3_make(ak_rng_range(&r, -7, 7), ak_rng_range(&r, -7, 7), ak_rng_range(&r, -7, 7));
+            base.v[i] = ak_vec3_make(ak_rng_range(&r, -1.5f, 1.5f), ak_rng_range(&r, -1.5f, 1.5f),
+                                     ak_rng_range(&r, -1.5f, 1.5f));
+        }
+        base.v[5] = ak_vec3_zero(); /* a viewer without a heading sees all around */
+        base.p[7] = base.p[6];      /* coincident agents */
+        flock ref = flock_make(n);
+        memcpy(ref.p, base.p, n * sizeof(ak_vec3));
+        memcpy(ref.v, base.v, n * sizeof(ak_vec3));
+        uint64_t ref_inter = 0;
+        for (int s = 0; s < 2; ++s) {
+            ak_boids_step_job j = job_for(&ref, &pp, 0.05f);
+            j.use_naive = true;
+            j.out_interaction_count = &ref_inter;
+            AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
+            memcpy(ref.p, ref.p2, n * sizeof(ak_vec3));
+            memcpy(ref.v, ref.v2, n * sizeof(ak_vec3));
+        }
+        printf("  case %zu: %.1f neighbours per agent\n", cs, (double)ref_inter / (double)n);
+        AK_CHECK(ref_inter > 3u * n);
+        for (int t = 0; t < 4; ++t)
+            for (int simd = 0; simd < 2; ++simd) {
+                flock f = flock_make(n);
+                memcpy(f.p, base.p, n * sizeof(ak_vec3));
+                memcpy(f.v, base.v, n * sizeof(ak_vec3));
+                uint64_t inter = 0;
+                for (int s = 0; s < 2; ++s) {
+                    ak_boids_step_job j = job_for(&f, &pp, 0.05f);
+                    j.thread_count = threads[t];
+                    j.skip_simd = simd == 1;
+                    j.out_interaction_count = &inter;
+                    AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
+                    memcpy(f.p, f.p2, n * sizeof(ak_vec3));
+                    memcpy(f.v, f.v2, n * sizeof(ak_vec3));
+                }
+                AK_CHECK_MSG(memcmp(f.p, ref.p, n * sizeof(ak_vec3)) == 0 &&
+                                 memcmp(f.v, ref.v, n * sizeof(ak_vec3)) == 0 && inter == ref_inter,
+                             "case %zu, %u threads, %s: differs from the naive loop", cs, threads[t],
+                             simd ? "scalar" : ak_boids_simd_name());
+                flock_free(&f);
+            }
+        flock_free(&ref);
+        flock_free(&base);
+    }
+}
+
 /* ---- measures ---------------------------------------------------------------------------- */
 
 AK_TEST(order_and_min_distance) {
@@ -759,6 +831,7 @@ int main(void) {
     AK_RUN(no_agent_enters_an_obstacle);
     AK_RUN(bounds_wrap_and_steer);
     AK_RUN(threads_and_paths_bit_identical);
+    AK_RUN(symmetric_pass_threads_and_kernels);
     AK_RUN(order_and_min_distance);
     return ak_test_finish();
 }

@@ -65,8 +65,14 @@
  *     }                                                   // the job's pointers) for the next step
  *
  * Ownership and threading: the job reads and writes caller-owned arrays and keeps no pointer.
- * ak_boids_step_run never allocates (thread_count > 1 starts pthreads). Outputs must not alias
- * inputs (the wander state is updated in place: each agent touches only its own entry).
+ * ak_boids_step_run never allocates (thread_count > 1 starts pthreads: z slabs of the flock
+ * per thread). Outputs must not alias inputs (the wander state is updated in place: each agent
+ * touches only its own entry).
+ *
+ * Speed (docs/boids.md, docs/BENCHMARKS.md): agents re-sorted by cell; for one species that
+ * only flocks, each pair's distance test runs once and credits both agents (each with its own
+ * view cone); AVX-512 kernels chosen at run time (job.skip_simd forces the scalar/SSE2 code,
+ * which gives the same bits).
  */
 #ifndef ANIMKIT_BOIDS_H
 #define ANIMKIT_BOIDS_H
@@ -176,12 +182,15 @@ typedef struct ak_boids_step_job {
     ak_vec3_span out_velocities;     /* >= agent_count; must not alias the inputs */
     uint64_t* out_interaction_count; /* optional: flock neighbours summed over all agents */
     uint32_t* out_contact_count;     /* optional: agents the obstacle projection had to stop */
+    bool skip_simd;                  /* false -> fastest kernels for this CPU; true -> the
+                                        scalar/SSE2 code (same results, bit for bit: tests) */
 } ak_boids_step_job;
 
 /* Scratch bytes ak_boids_step_run needs for this job (positions.count, params and use_naive
  * are read; 0 for the naive path, and 0 when no species looks at neighbours). The grid path
  * needs about 140 bytes per agent (the grid, the agents re-sorted by cell, velocities in fixed
- * point, a cell table).
+ * point, a cell table), plus 88 when one species only flocks (no k cap, flee or pursue: the
+ * neighbour sums of the symmetric pair pass).
  * Returns 0 when the job's params are unusable (validate says why). */
 AK_API size_t ak_boids_step_scratch_size(const ak_boids_step_job* job);
 

@@ -476,7 +476,14 @@ static void step_agent(const akp_boids_ctx* c, size_t i, const akp_boids_gather*
 
 static void* step_thread(void* arg) {
     step_task* t = (step_task*)arg;
-    akp_boids_gather_range(t->c, t->part, t->parts, step_agent, t);
+    if (t->c->sym) akp_boids_sym_range(t->c, t->part, t->parts, step_agent, t);
+    else akp_boids_gather_range(t->c, t->part, t->parts, step_agent, t);
+    return NULL;
+}
+
+static void* step_finish_thread(void* arg) {
+    step_task* t = (step_task*)arg;
+    akp_boids_sym_finish(t->c, t->part, t->parts, step_agent, t);
     return NULL;
 }
 
@@ -519,7 +526,9 @@ ak_result ak_boids_step_run(const ak_boids_step_job* job) {
     const uint32_t threads = akp_boids_threads(job->thread_count, c.n);
     step_task tasks[64];
     for (uint32_t t = 0; t < threads; ++t) tasks[t] = (step_task){&c, t, threads, 0, 0};
+    if (c.sym) akp_boids_sym_clear(&c, threads);
     akp_boids_run_tasks(step_thread, tasks, sizeof tasks[0], threads);
+    if (c.sym && threads > 1) akp_boids_run_tasks(step_finish_thread, tasks, sizeof tasks[0], threads);
     uint64_t inter = 0;
     uint32_t contacts = 0;
     for (uint32_t t = 0; t < threads; ++t) {

@@ -30,6 +30,14 @@ typedef struct akp_boids_sp {
     float sep_scale, ali_scale, coh_scale;
 } akp_boids_sp;
 
+/* Neighbour sums an agent received in the symmetric pair pass (spatial order): the same
+ * fixed-point sums as akp_boids_gather, counts packed two per word (ns | na << 32,
+ * nc | nflock << 32). */
+typedef struct akp_boids_acc {
+    int64_t sep[3], ali[3], coh[3];
+    uint64_t n01, n23;
+} akp_boids_acc;
+
 /* Per-step context: the job, resolved species, the search state. */
 typedef struct akp_boids_ctx {
     const ak_boids_step_job* job;
@@ -38,7 +46,8 @@ typedef struct akp_boids_ctx {
     ak_boids_bounds bounds; /* resolved mode */
     akp_boids_sp sp[AK_BOIDS_MAX_SPECIES];
     float search_radius;    /* largest query radius over species (0: nobody looks) */
-    /* Grid path (use_naive false). */
+    /* Grid path (use_naive false). The hashed grid is built only for sparse flocks; on the
+     * dense path grid.cell_size alone is set (ak_grid_cell_of). */
     ak_grid grid;
     int rings;              /* cells visited on each side of an agent's cell */
     const int64_t* sqv;     /* [3n] velocities, fixed point (alignment sums), in sorted order */
@@ -57,6 +66,18 @@ typedef struct akp_boids_ctx {
     const uint32_t* sj;        /* [n] the agent's index in the caller's arrays */
     bool avx512;               /* the spatial path runs the AVX-512 kernels */
     bool one_species;          /* species_count == 1 */
+    /* Symmetric pair pass (dense layout, one species, no k cap, flee or pursue, one ring):
+     * acc[n] holds what each agent received from the pairs found by agents before it. */
+    bool sym;
+    akp_boids_acc* acc;
+    akp_boids_acc* spill;    /* credits across thread boundaries (in the grid's unused memory) */
+    size_t spill_cap;        /* entries spill holds */
+    bool use_spill;          /* set by akp_boids_sym_clear: the boundary slabs fit spill */
+    /* The spatial arrays, writable, for akp_boids_search_fill. */
+    float *fill_sx, *fill_sy, *fill_sz;
+    ak_vec3* fill_sv;
+    uint8_t* fill_sp;
+    int64_t* fill_qv;
 } akp_boids_ctx;
 
 /* What one agent gathers from its neighbours. */
@@ -103,10 +124,58 @@ bool akp_boids_have_avx512(void);
 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end, ak_vec3 p,
                                  float q2, akp_boids_hits* h, uint32_t at);
 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count);
+/* filter over the rows [begin[r], end[r]), r < rows, in one call; h needs room for all their
+ * candidates and 16 more. */
+uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                      const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
+                                      uint32_t at);
+
+/* A cell's forward candidates packed side by side (positions and spatial index), so the
+ * 16-lane filter runs full instead of over short rows; 16 entries of slack after count. */
+#define AKP_BOIDS_PACK_CAP 384
+typedef struct akp_boids_packed {
+    float x[AKP_BOIDS_PACK_CAP + 16], y[AKP_BOIDS_PACK_CAP + 16], z[AKP_BOIDS_PACK_CAP + 16];
+    uint32_t k[AKP_BOIDS_PACK_CAP + 16];
+} akp_boids_packed;
+/* Packs the rows [begin[r], end[r]) (at most AKP_BOIDS_PACK_CAP candidates in all) into b;
+ * returns the count. */
+uint32_t akp_boids_pack_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                    const uint32_t* end, uint32_t rows, akp_boids_packed* b);
+/* The filter over the row [begin, end) of the spatial arrays, then the packed candidates
+ * [0, count): hits appended at `at`, their number returned (h needs room for all of them
+ * and 32 more). */
+uint32_t akp_boids_filter_packed_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end,
+                                        const akp_boids_packed* b, uint32_t count, ak_vec3 p, float q2,
+                                        akp_boids_hits* h, uint32_t at);
+
+/* Where the symmetric pass credits agent t (spatial slot): acc[t], except
+ * - t >= far_begin (the next part's first slab, which that part also credits): spill[t -
+ *   far_begin] when spill is set, else acc[t] by atomic adds;
+ * - t < atomic_end (this part's own first slab when the part before credits it in acc): acc[t]
+ *   by atomic adds (atomic_end is 0 when spill is used). */
+typedef struct akp_boids_sink {
+    akp_boids_acc* acc;
+    akp_boids_acc* spill;
+    uint32_t atomic_end, far_begin;
+} akp_boids_sink;
+
+/* The symmetric pair kernel: agent g (spatial slot g->self_k) against its forward hits
+ * [0, count) (all of them other agents): g's own sums in g, what each hit receives credited
+ * through sink. Same tests and integer sums as the scalar sym_hits in search.c. */
+void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
+                          const akp_boids_sink* sink);
 
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);
-/* Build the grid (unless use_naive) into scratch. */
+/* Spatial slots [n part / parts, n (part + 1) / parts) of the dense layout filled from the
+ * caller's arrays through sj (prepare runs it, over threads for large steps). */
+typedef struct akp_boids_fill_task {
+    const akp_boids_ctx* c;
+    size_t part, parts;
+} akp_boids_fill_task;
+void akp_boids_search_fill(const akp_boids_ctx* c, size_t part, size_t parts);
+/* The search structures (unless use_naive) in scratch: the dense spatial layout straight from
+ * the positions, or, for sparse flocks, the hashed grid. */
 ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch);
 /* Gather agent i's neighbour sums (either path; identical results). */
 void akp_boids_gather_agent(const akp_boids_ctx* c, size_t i, akp_boids_gather* g);
@@ -116,5 +185,13 @@ void akp_boids_list_agent(const akp_boids_ctx* c, size_t i, uint32_t* out, uint3
  * cells so each cell's neighbour cells are looked up once. */
 typedef void (*akp_boids_agent_fn)(const akp_boids_ctx* c, size_t i, const akp_boids_gather* g, void* user);
 void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
+/* The symmetric pass (c->sym): akp_boids_sym_clear once before the threads start;
+ * akp_boids_sym_range(part, parts) on each thread finds every pair once and calls fn for
+ * each agent whose sums are complete; after all of them returned, akp_boids_sym_finish
+ * (part, parts) calls fn for the rest (the agents of each part's first z slab, which the part
+ * before also credits). */
+void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts);
+void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
+void akp_boids_sym_finish(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
 
 #endif

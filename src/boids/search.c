@@ -36,13 +36,19 @@ static inline int64_t fix(float x) {
     return (int64_t)x;
 }
 
-static inline bool in_view(const akp_boids_sp* S, const akp_boids_gather* g, float dx, float dy, float dz,
-                           float d2) {
-    if (S->fov == 0 || g->v2 == 0.0f || d2 == 0.0f) return true;
-    const float dot = dx * g->v.x + dy * g->v.y + dz * g->v.z;
-    const float lim = S->cos2 * d2 * g->v2;
+/* Whether offset d (squared length d2) lies in the view cone of an agent with velocity v
+ * (v2 = its squared length). */
+static inline bool in_view_v(const akp_boids_sp* S, ak_vec3 v, float v2, float dx, float dy, float dz, float d2) {
+    if (S->fov == 0 || v2 == 0.0f || d2 == 0.0f) return true;
+    const float dot = dx * v.x + dy * v.y + dz * v.z;
+    const float lim = S->cos2 * d2 * v2;
     if (S->fov == 1) return dot > 0.0f && dot * dot >= lim;
     return dot >= 0.0f || dot * dot <= lim;
+}
+
+static inline bool in_view(const akp_boids_sp* S, const akp_boids_gather* g, float dx, float dy, float dz,
+                           float d2) {
+    return in_view_v(S, g->v, g->v2, dx, dy, dz, d2);
 }
 
 /* Add one flock neighbour to the rule sums. */
@@ -503,6 +509,292 @@ static void gather_rows(const akp_boids_ctx* c, const row_ranges* r, akp_boids_g
     visit_hits(c, g, &hb, h);
 }
 
+/* ---- symmetric pair pass ---------------------------------------------------------------- */
+
+/* The distance test for every pair (i, j) with d2 < q2 runs once, from the agent that comes
+ * first in the (z, y, x) cell order (in the same cell: the lower spatial index), over the
+ * forward half of its neighbourhood: the rest of its own cell and the next cell of its row,
+ * the three cells of the next row, the nine of the next slab. Each direction then applies its
+ * own tests (view cone with its own velocity; the radii are symmetric) to the same values:
+ * j - i is exactly -(i - j) in floats, fix() is odd, so what j receives from the pair is
+ * bit for bit what j's own walk over its neighbourhood would have summed. Every agent's sums
+ * are complete once the agents before it are done, so integration follows at once; only the
+ * first z slab of each thread after the first waits: its agents also receive from the slab
+ * before, on the other thread, which credits them in a spill buffer (or, when the boundary
+ * slabs hold more agents than it has room for, by atomic adds); the slab integrates after
+ * both are done. Integer sums: the same bits in any order. */
+
+/* A += the credits of one pair, atomically when another thread may touch A. */
+static inline void credit(akp_boids_acc* A, const int64_t v[9], uint64_t n01, uint64_t n23, bool atomic) {
+    if (!atomic) {
+        for (int a = 0; a < 3; ++a) {
+            A->sep[a] += v[a];
+            A->ali[a] += v[3 + a];
+            A->coh[a] += v[6 + a];
+        }
+        A->n01 += n01;
+        A->n23 += n23;
+        return;
+    }
+    for (int a = 0; a < 3; ++a) {
+        __atomic_fetch_add(&A->sep[a], v[a], __ATOMIC_RELAXED);
+        __atomic_fetch_add(&A->ali[a], v[3 + a], __ATOMIC_RELAXED);
+        __atomic_fetch_add(&A->coh[a], v[6 + a], __ATOMIC_RELAXED);
+    }
+    __atomic_fetch_add(&A->n01, n01, __ATOMIC_RELAXED);
+    __atomic_fetch_add(&A->n23, n23, __ATOMIC_RELAXED);
+}
+
+/* Agent g against its forward hits [0, h): g's sums in g, the hits' credits in c->acc. */
+static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* hb, uint32_t h,
+                     const akp_boids_sink* sink) {
+    if (c->avx512) {
+        akp_boids_sym_avx512(c, g, hb, h, sink);
+        return;
+    }
+    const akp_boids_sp* S = g->sp;
+    const float *X = c->sx, *Y = c->sy, *Z = c->sz;
+    const int64_t* qv = c->sqv;
+    const int64_t* qi = qv + 3 * (size_t)g->self_k;
+    const float px = g->p.x, py = g->p.y, pz = g->p.z;
+    int64_t s0 = 0, s1 = 0, s2 = 0, a0 = 0, a1 = 0, a2 = 0, c0 = 0, c1 = 0, c2 = 0;
+    uint32_t ns = 0, na = 0, nc = 0, nf = 0;
+    for (uint32_t u = 0; u < h; ++u) {
+        const uint32_t t = hb->k[u];
+        const float dd = hb->d2[u];
+        if (!(dd < S->rn2)) continue;
+        const float dx = X[t] - px, dy = Y[t] - py, dz = Z[t] - pz;
+        const bool see_i = in_view(S, g, dx, dy, dz, dd);
+        const ak_vec3 vj = c->sv[t];
+        const bool see_j = in_view_v(S, vj, ak_vec3_length_sq(vj), -dx, -dy, -dz, dd);
+        if (!see_i && !see_j) continue;
+        const bool bs = dd < S->rs2, ba = dd < S->ra2, bc = dd < S->rc2;
+        int64_t e[3] = {0, 0, 0}, f[3] = {0, 0, 0};
+        if (bs) {
+            const float inv = S->sep_scale / (dd > S->dmin2 ? dd : S->dmin2);
+            e[0] = fix(-dx * inv);
+            e[1] = fix(-dy * inv);
+            e[2] = fix(-dz * inv);
+        }
+        if (bc) {
+            f[0] = fix(dx * S->coh_scale);
+            f[1] = fix(dy * S->coh_scale);
+            f[2] = fix(dz * S->coh_scale);
+        }
+        if (see_i) {
+            ++nf;
+            s0 += e[0], s1 += e[1], s2 += e[2], ns += bs;
+            c0 += f[0], c1 += f[1], c2 += f[2], nc += bc;
+            if (ba) a0 += qv[3 * t], a1 += qv[3 * t + 1], a2 += qv[3 * t + 2], ++na;
+        }
+        if (see_j) {
+            const int64_t v[9] = {-e[0], -e[1], -e[2], ba ? qi[0] : 0, ba ? qi[1] : 0, ba ? qi[2] : 0,
+                                  -f[0], -f[1], -f[2]};
+            const uint64_t n01 = (uint64_t)bs | (uint64_t)ba << 32, n23 = (uint64_t)bc | (uint64_t)1 << 32;
+            if (t >= sink->far_begin && sink->spill) credit(&sink->spill[t - sink->far_begin], v, n01, n23, false);
+            else credit(&sink->acc[t], v, n01, n23, t < sink->atomic_end || t >= sink->far_begin);
+        }
+    }
+    g->sep[0] += s0;
+    g->sep[1] += s1;
+    g->sep[2] += s2;
+    g->ali[0] += a0;
+    g->ali[1] += a1;
+    g->ali[2] += a2;
+    g->coh[0] += c0;
+    g->coh[1] += c1;
+    g->coh[2] += c2;
+    g->ns += ns;
+    g->na += na;
+    g->nc += nc;
+    g->nflock += nf;
+}
+
+/* The distance filter of the scalar/SSE2 path: appends the t in [begin, end) with d2 < q2 (k
+ * and d2 only) to h at `at`; returns how many (h needs room for end - begin more). */
+static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, const float* restrict Z,
+                            uint32_t begin, uint32_t end, ak_vec3 p, float q2, akp_boids_hits* hb, uint32_t at) {
+    uint32_t h = at, t = begin;
+#if AK_SIMD_SSE2
+    const __m128 vx = _mm_set1_ps(p.x), vy = _mm_set1_ps(p.y), vz = _mm_set1_ps(p.z), vq = _mm_set1_ps(q2);
+    for (; t + 4 <= end; t += 4) {
+        const __m128 dx = _mm_sub_ps(_mm_loadu_ps(X + t), vx), dy = _mm_sub_ps(_mm_loadu_ps(Y + t), vy),
+                     dz = _mm_sub_ps(_mm_loadu_ps(Z + t), vz);
+        const __m128 dd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+        const unsigned m = (unsigned)_mm_movemask_ps(_mm_cmplt_ps(dd, vq));
+        if (!m) continue;
+        float d4[4];
+        _mm_storeu_ps(d4, dd);
+        for (unsigned l = 0; l < 4; ++l) {
+            hb->k[h] = t + l;
+            hb->d2[h] = d4[l];
+            h += (m >> l) & 1u;
+        }
+    }
+#endif
+    for (; t < end; ++t) {
+        const float dx = X[t] - p.x, dy = Y[t] - p.y, dz = Z[t] - p.z;
+        const float dd = dx * dx + dy * dy + dz * dz;
+        hb->k[h] = t;
+        hb->d2[h] = dd;
+        h += dd < q2;
+    }
+    return h - at;
+}
+
+/* First slab of part `part` of `parts` (the slabs of part p: [slab_of(p), slab_of(p + 1))). */
+static size_t slab_of(const akp_boids_ctx* c, size_t part, size_t parts) {
+    return (size_t)c->dense_dim[2] * part / parts;
+}
+
+/* Spatial index of the first agent of slab z (z <= dim[2]). */
+static uint32_t slab_start(const akp_boids_ctx* c, size_t z) {
+    return c->dstart[z * (size_t)c->dense_dim[0] * (size_t)c->dense_dim[1]];
+}
+
+static void acc_zero(const akp_boids_ctx* c, size_t z) {
+    const uint32_t b = slab_start(c, z), e = slab_start(c, z + 1);
+    memset(c->acc + b, 0, (size_t)(e - b) * sizeof(akp_boids_acc));
+}
+
+/* First spill entry of deferred slab z: the deferred slabs (first slabs of the parts after the
+ * first) before it, in order, side by side. */
+static size_t spill_base(const akp_boids_ctx* c, size_t parts, size_t z) {
+    size_t base = 0, prev = 0;
+    for (size_t t = 1; t < parts; ++t) {
+        const size_t s = slab_of(c, t, parts);
+        if (s >= z || s >= (size_t)c->dense_dim[2]) break;
+        if (s != prev) base += slab_start(c, s + 1) - slab_start(c, s);
+        prev = s;
+    }
+    return base;
+}
+
+void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts) {
+    const size_t need = spill_base(c, parts, (size_t)c->dense_dim[2] + 1);
+    c->use_spill = need <= c->spill_cap;
+    if (c->use_spill) {
+        memset(c->spill, 0, need * sizeof(akp_boids_acc));
+        return;
+    }
+    for (size_t t = 1; t < parts; ++t) {
+        const size_t z = slab_of(c, t, parts);
+        if (z > 0 && z < (size_t)c->dense_dim[2]) acc_zero(c, z);
+    }
+}
+
+/* What the agent received, added to its own sums. */
+static void add_received(const akp_boids_acc* A, akp_boids_gather* g) {
+    for (int a = 0; a < 3; ++a) {
+        g->sep[a] += A->sep[a];
+        g->ali[a] += A->ali[a];
+        g->coh[a] += A->coh[a];
+    }
+    g->ns += (uint32_t)A->n01;
+    g->na += (uint32_t)(A->n01 >> 32);
+    g->nc += (uint32_t)A->n23;
+    g->nflock += (uint32_t)(A->n23 >> 32);
+}
+
+void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user) {
+    const size_t z0 = slab_of(c, part, parts), z1 = slab_of(c, part + 1, parts);
+    if (z0 == z1) return;
+    const int64_t dimx = c->dense_dim[0], dimy = c->dense_dim[1], dimz = c->dense_dim[2];
+    const uint32_t* ds = c->dstart;
+    /* Slab z0 waits when a part before this one credits it (z0 > 0 means one does). */
+    const uint32_t first_end = z0 > 0 ? slab_start(c, z0 + 1) : 0;
+    akp_boids_sink sink = {c->acc, NULL, c->use_spill ? 0 : first_end, slab_start(c, z1)};
+    if (c->use_spill && z1 < (size_t)dimz) sink.spill = c->spill + spill_base(c, parts, z1);
+    const float q2 = c->sp[0].query_radius * c->sp[0].query_radius;
+    const float *X = c->sx, *Y = c->sy, *Z = c->sz;
+    akp_boids_gather g;
+    akp_boids_hits hb;
+    akp_boids_packed pkv; /* 6 KiB */
+    akp_boids_packed* pk = &pkv;
+    if (z0 == 0 || c->use_spill) acc_zero(c, z0); /* else akp_boids_sym_clear did */
+    for (int64_t z = (int64_t)z0; z < (int64_t)z1; ++z) {
+        if (z + 1 < (int64_t)z1) acc_zero(c, (size_t)z + 1);
+        for (int64_t y = 0; y < dimy; ++y) {
+            const size_t row = ((size_t)z * (size_t)dimy + (size_t)y) * (size_t)dimx;
+            for (int64_t x = 0; x < dimx; ++x) {
+                const uint32_t k0 = ds[row + (size_t)x], k1 = ds[row + (size_t)x + 1];
+                if (k0 == k1) continue;
+                /* The forward rows: [0] the rest of this row up to x + 1 (its begin is per
+                 * agent), then (z, y + 1) and (z + 1, y - 1 .. y + 1), each x - 1 .. x + 1. */
+                uint32_t rb[5], re[5], nr = 1;
+                const int64_t xa = x > 0 ? x - 1 : 0, xb = x + 1 < dimx ? x + 1 : dimx - 1;
+                re[0] = ds[row + (size_t)xb + 1];
+                rb[0] = 0;
+                for (int r = 0; r < 4; ++r) {
+                    const int64_t zz = r == 0 ? z : z + 1, yy = r == 0 ? y + 1 : y + r - 2;
+                    if (zz >= dimz || yy < 0 || yy >= dimy) continue;
+                    const size_t rr = ((size_t)zz * (size_t)dimy + (size_t)yy) * (size_t)dimx;
+                    rb[nr] = ds[rr + (size_t)xa];
+                    re[nr] = ds[rr + (size_t)xb + 1];
+                    if (rb[nr] < re[nr]) ++nr;
+                }
+                uint32_t span = 0; /* candidates of the forward rows (row 0 from k0 + 1) */
+                for (uint32_t a = 1; a < nr; ++a) span += re[a] - rb[a];
+                span += re[0] - k0;
+                /* Several agents share the cell's candidates: pack them once (all but the
+                 * cell's own, which each agent takes from k + 1). */
+                uint32_t packed = 0;
+                const bool pack = c->avx512 && k1 - k0 > 1 && span + 32 <= HIT_CAP &&
+                                  span - (k1 - k0 - 1) <= AKP_BOIDS_PACK_CAP;
+                if (pack) {
+                    rb[0] = k1;
+                    packed = akp_boids_pack_rows_avx512(X, Y, Z, rb, re, nr, pk);
+                }
+                for (uint32_t k = k0; k < k1; ++k) {
+                    gather_begin_spatial(c, k, &g);
+                    rb[0] = k + 1;
+                    uint32_t h = 0;
+                    if (pack)
+                        h = akp_boids_filter_packed_avx512(X, Y, Z, k + 1, k1, pk, packed, g.p, q2, &hb, 0);
+                    else if (c->avx512 && span + 16 <= HIT_CAP) /* all rows in one call */
+                        h = akp_boids_filter_rows_avx512(X, Y, Z, rb, re, nr, g.p, q2, &hb, 0);
+                    else
+                        for (uint32_t a = 0; a < nr; ++a)
+                            for (uint32_t t = rb[a]; t < re[a]; t += HIT_PIECE) {
+                                const uint32_t e = re[a] - t > HIT_PIECE ? t + HIT_PIECE : re[a];
+                                if (h + HIT_PIECE + 16 > HIT_CAP) {
+                                    sym_hits(c, &g, &hb, h, &sink);
+                                    h = 0;
+                                }
+                                h += c->avx512 ? akp_boids_filter_avx512(X, Y, Z, t, e, g.p, q2, &hb, h)
+                                               : filter_sse2(X, Y, Z, t, e, g.p, q2, &hb, h);
+                            }
+                    sym_hits(c, &g, &hb, h, &sink);
+                    if (k < first_end) {
+                        /* First slab of a later part: the part before credits it too. */
+                        const int64_t v[9] = {g.sep[0], g.sep[1], g.sep[2], g.ali[0], g.ali[1],
+                                              g.ali[2], g.coh[0], g.coh[1], g.coh[2]};
+                        credit(&c->acc[k], v, (uint64_t)g.ns | (uint64_t)g.na << 32,
+                               (uint64_t)g.nc | (uint64_t)g.nflock << 32, !c->use_spill);
+                        continue;
+                    }
+                    add_received(&c->acc[k], &g);
+                    fn(c, g.i, &g, user);
+                }
+            }
+        }
+    }
+}
+
+void akp_boids_sym_finish(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user) {
+    const size_t z0 = slab_of(c, part, parts), z1 = slab_of(c, part + 1, parts);
+    if (z0 == 0 || z0 == z1) return;
+    akp_boids_gather g;
+    const uint32_t b = slab_start(c, z0);
+    const akp_boids_acc* spill = c->use_spill ? c->spill + spill_base(c, parts, z0) : NULL;
+    for (uint32_t k = b; k < slab_start(c, z0 + 1); ++k) {
+        gather_begin_spatial(c, k, &g);
+        add_received(&c->acc[k], &g);
+        if (spill) add_received(&spill[k - b], &g);
+        fn(c, g.i, &g, user);
+    }
+}
+
 /* Box coordinates of p's cell (p is an agent of the step, so its cell is in the box). */
 static void box_cell(const akp_boids_ctx* c, ak_vec3 p, int64_t* x, int64_t* y, int64_t* z) {
     const ak_grid_cell q = ak_grid_cell_of(&c->grid, p);
@@ -540,34 +832,15 @@ static size_t align64(size_t n) { return (n + 63u) & ~(size_t)63u; }
 /* Entries of the dense cell table (4 per agent: a flock fills a fair part of its box). */
 static size_t dense_cap(size_t n) { return 4 * n + 4096; }
 
-/* Bounding box of the occupied cells; true when its cell count fits dense_cap. */
-static bool dense_box(akp_boids_ctx* c) {
-    const ak_grid* gr = &c->grid;
-    if (gr->cell_count == 0) return false;
-    int64_t lo[3] = {INT64_MAX, INT64_MAX, INT64_MAX}, hi[3] = {INT64_MIN, INT64_MIN, INT64_MIN};
-    for (uint32_t m = 0; m < gr->cell_count; ++m) {
-        const int64_t v[3] = {gr->cell_coord[m].x, gr->cell_coord[m].y, gr->cell_coord[m].z};
-        for (int a = 0; a < 3; ++a) {
-            if (v[a] < lo[a]) lo[a] = v[a];
-            if (v[a] > hi[a]) hi[a] = v[a];
-        }
-    }
-    const int64_t dx = hi[0] - lo[0] + 1, dy = hi[1] - lo[1] + 1, dz = hi[2] - lo[2] + 1;
-    const size_t cap = dense_cap(c->n);
-    if (dx > (int64_t)cap || dy > (int64_t)cap || dz > (int64_t)cap || dx * dy > (int64_t)cap ||
-        dx * dy * dz > (int64_t)cap)
-        return false;
-    for (int a = 0; a < 3; ++a) c->dense_min[a] = (int32_t)lo[a];
-    c->dense_dim[0] = (int32_t)dx;
-    c->dense_dim[1] = (int32_t)dy;
-    c->dense_dim[2] = (int32_t)dz;
-    return true;
-}
-
-static size_t box_index(const akp_boids_ctx* c, ak_grid_cell q) {
-    return ((size_t)(q.z - c->dense_min[2]) * (size_t)c->dense_dim[1] + (size_t)(q.y - c->dense_min[1])) *
-               (size_t)c->dense_dim[0] +
-           (size_t)(q.x - c->dense_min[0]);
+/* Whether the step can take the symmetric pair pass (see akp_boids_sym_range): one species
+ * that only flocks (no k cap, no flee or pursue), so neighbour sums are the only thing a
+ * pair contributes, and each pair can be found once and credited in both directions. */
+static bool sym_params(const ak_boids_params* p) {
+    if (p->species_count != 1) return false;
+    ak_boids_species s;
+    ak_boids_species_resolved(&p->species[0], &s);
+    return s.k_nearest == 0 && !((s.flee_mask & 1u) && s.flee_weight > 0.0f) &&
+           !((s.pursue_mask & 1u) && s.pursue_weight > 0.0f);
 }
 
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job) {
@@ -578,8 +851,73 @@ size_t akp_boids_search_scratch_size(const ak_boids_step_job* job) {
     const ak_grid_desc gd = {.cell_size = cs};
     const size_t g = ak_grid_memory_size(n, &gd);
     if (g == 0) return 0;
+    const size_t acc = sym_params(job->params) ? align64(n * sizeof(akp_boids_acc)) : 0;
     return align64(g) + align64(3 * n * sizeof(int64_t)) + align64(n) + align64((dense_cap(n) + 1) * sizeof(uint32_t)) +
-           3 * align64(n * sizeof(float)) + align64(n * sizeof(ak_vec3)) + align64(n * sizeof(uint32_t)) + 64;
+           3 * align64(n * sizeof(float)) + align64(n * sizeof(ak_vec3)) + align64(n * sizeof(uint32_t)) + acc + 64;
+}
+
+/* The grid's cell coordinate (ak_grid_cell_of: floor(p / cell_size) in double, clamped). */
+static inline int32_t cell_axis(float p, double inv) {
+    double v = floor((double)p * inv);
+    if (!(v >= -1073741824.0)) v = -1073741824.0;
+    if (v > 1073741824.0) v = 1073741824.0;
+    return (int32_t)v;
+}
+
+/* The spatial layout straight from the positions, without the hashed grid: the box of the
+ * occupied cells, then a counting sort by box cell, stable (agents of a cell in increasing
+ * index, the order the grid gives its cells). cells: [3n] temporary. False when the box does
+ * not fit dense_cap (the caller builds the grid). */
+static bool dense_direct(akp_boids_ctx* c, int32_t* cells) {
+    const size_t n = c->n;
+    const ak_vec3* P = c->job->positions.ptr;
+    const double inv = 1.0 / (double)c->grid.cell_size;
+    int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+    for (size_t i = 0; i < n; ++i) {
+        const int32_t q[3] = {cell_axis(P[i].x, inv), cell_axis(P[i].y, inv), cell_axis(P[i].z, inv)};
+        for (int a = 0; a < 3; ++a) {
+            cells[3 * i + (size_t)a] = q[a];
+            lo[a] = q[a] < lo[a] ? q[a] : lo[a];
+            hi[a] = q[a] > hi[a] ? q[a] : hi[a];
+        }
+    }
+    const int64_t dx = (int64_t)hi[0] - lo[0] + 1, dy = (int64_t)hi[1] - lo[1] + 1, dz = (int64_t)hi[2] - lo[2] + 1;
+    const size_t cap = dense_cap(n);
+    if (n == 0 || dx > (int64_t)cap || dy > (int64_t)cap || dz > (int64_t)cap || dx * dy > (int64_t)cap ||
+        dx * dy * dz > (int64_t)cap)
+        return false;
+    for (int a = 0; a < 3; ++a) c->dense_min[a] = lo[a];
+    c->dense_dim[0] = (int32_t)dx;
+    c->dense_dim[1] = (int32_t)dy;
+    c->dense_dim[2] = (int32_t)dz;
+    return true;
+}
+
+void akp_boids_search_fill(const akp_boids_ctx* c, size_t part, size_t parts) {
+    const size_t b = c->n * part / parts, e = c->n * (part + 1) / parts;
+    const ak_vec3* P = c->job->positions.ptr;
+    const ak_vec3* V = c->job->velocities.ptr;
+    const uint8_t* S = c->job->species.ptr;
+    for (size_t d = b; d < e; ++d) {
+        const uint32_t i = c->sj[d];
+        const uint8_t s = S ? S[i] : 0;
+        const float as = c->sp[s].ali_scale;
+        const ak_vec3 v = V[i];
+        c->fill_sx[d] = P[i].x;
+        c->fill_sy[d] = P[i].y;
+        c->fill_sz[d] = P[i].z;
+        c->fill_sv[d] = v;
+        c->fill_sp[d] = s;
+        c->fill_qv[3 * d] = fix(v.x * as);
+        c->fill_qv[3 * d + 1] = fix(v.y * as);
+        c->fill_qv[3 * d + 2] = fix(v.z * as);
+    }
+}
+
+static void* fill_thread(void* arg) {
+    const akp_boids_fill_task* t = (const akp_boids_fill_task*)arg;
+    akp_boids_search_fill(t->c, t->part, t->parts);
+    return NULL;
 }
 
 ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
@@ -591,8 +929,6 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     const ak_grid_desc gd = {.cell_size = cs};
     const size_t gbytes = ak_grid_memory_size(n, &gd);
     uint8_t* base = (uint8_t*)(((uintptr_t)scratch.ptr + 63u) & ~(uintptr_t)63u);
-    ak_result r = ak_grid_build(&gd, c->job->positions, (ak_u8_span){base, gbytes}, &c->grid);
-    if (r != AK_OK) return r;
     c->rings = (int)ceilf(search / cs - 1e-6f);
     if (c->rings < 1) c->rings = 1;
     if (c->rings > MAX_RINGS) c->rings = MAX_RINGS;
@@ -612,14 +948,24 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     ak_vec3* sv = (ak_vec3*)(void*)q;
     q += align64(n * sizeof(ak_vec3));
     uint32_t* sj = (uint32_t*)(void*)q;
+    q += align64(n * sizeof(uint32_t));
+    const bool sym_ok = sym_params(c->params);
+    c->acc = sym_ok ? (akp_boids_acc*)(void*)q : NULL;
     const ak_vec3* V = c->job->velocities.ptr;
     const uint8_t* S = c->job->species.ptr;
-    const ak_grid* gr = &c->grid;
     c->sqv = qv;
     c->ssp = sp;
     c->dstart = NULL;
-    if (!dense_box(c)) {
+    c->sym = false;
+    memset(&c->grid, 0, sizeof c->grid);
+    c->grid.cell_size = cs; /* what box_cell needs; the hashed grid is built only when sparse */
+    /* The grid's memory holds the cell coordinates meanwhile (3n int32 fit: it has 4n + more). */
+    int32_t* cells = (int32_t*)(void*)base;
+    if (!dense_direct(c, cells)) {
+        ak_result r = ak_grid_build(&gd, c->job->positions, (ak_u8_span){base, gbytes}, &c->grid);
+        if (r != AK_OK) return r;
         /* Sparse flock: the grid's order, cells found through its hash. */
+        const ak_grid* gr = &c->grid;
         for (size_t k = 0; k < n; ++k) {
             const uint32_t j = gr->order[k];
             const uint8_t s = S ? S[j] : 0;
@@ -631,39 +977,49 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
         }
         return AK_OK;
     }
-    /* Counting sort of the grid's cells into the box's (z, y, x) order. */
+    /* Counting sort of the agents into the box's (z, y, x) cell order, stable. */
     const size_t volume = (size_t)c->dense_dim[0] * (size_t)c->dense_dim[1] * (size_t)c->dense_dim[2];
+    const size_t dimx = (size_t)c->dense_dim[0], dimxy = dimx * (size_t)c->dense_dim[1];
+    uint32_t* idx = (uint32_t*)(void*)cells; /* overwrites cells[i] with i's box index: i <= 3i */
     memset(dstart, 0, (volume + 1) * sizeof(uint32_t));
-    for (uint32_t m = 0; m < gr->cell_count; ++m)
-        dstart[box_index(c, gr->cell_coord[m]) + 1] = gr->cell_start[m + 1] - gr->cell_start[m];
-    for (size_t b = 0; b < volume; ++b) dstart[b + 1] += dstart[b];
-    for (uint32_t m = 0; m < gr->cell_count; ++m) {
-        const uint32_t k0 = gr->cell_start[m], k1 = gr->cell_start[m + 1];
-        uint32_t d = dstart[box_index(c, gr->cell_coord[m])];
-        for (uint32_t k = k0; k < k1; ++k, ++d) {
-            const uint32_t j = gr->order[k];
-            const uint8_t s = S ? S[j] : 0;
-            const float as = c->sp[s].ali_scale;
-            const ak_vec3 v = V[j];
-            sx[d] = gr->x[k];
-            sy[d] = gr->y[k];
-            sz[d] = gr->z[k];
-            sv[d] = v;
-            sj[d] = j;
-            sp[d] = s;
-            qv[3 * d] = fix(v.x * as);
-            qv[3 * d + 1] = fix(v.y * as);
-            qv[3 * d + 2] = fix(v.z * as);
-        }
+    for (size_t i = 0; i < n; ++i) {
+        const size_t b = (size_t)(cells[3 * i + 2] - c->dense_min[2]) * dimxy +
+                         (size_t)(cells[3 * i + 1] - c->dense_min[1]) * dimx + (size_t)(cells[3 * i] - c->dense_min[0]);
+        idx[i] = (uint32_t)b;
+        dstart[b + 1]++;
     }
+    for (size_t b = 0; b < volume; ++b) dstart[b + 1] += dstart[b];
+    for (size_t i = 0; i < n; ++i) sj[dstart[idx[i]]++] = (uint32_t)i;
+    /* dstart[b] is now the end of cell b: shift back to starts. */
+    memmove(dstart + 1, dstart, volume * sizeof(uint32_t));
+    dstart[0] = 0;
     c->sx = sx;
     c->sy = sy;
     c->sz = sz;
     c->sv = sv;
     c->sj = sj;
     c->dstart = dstart;
-    c->avx512 = akp_boids_have_avx512();
+    c->fill_sx = sx;
+    c->fill_sy = sy;
+    c->fill_sz = sz;
+    c->fill_sv = sv;
+    c->fill_sp = sp;
+    c->fill_qv = qv;
+    /* The agents' data in spatial order: read through sj (in order), written in order, so it
+     * splits over threads (akp_boids_search_fill); small steps fill here. */
+    const uint32_t parts = akp_boids_threads(c->job->thread_count, n);
+    if (parts <= 1 || n < 2048) akp_boids_search_fill(c, 0, 1);
+    else {
+        akp_boids_fill_task tasks[64];
+        for (uint32_t t = 0; t < parts; ++t) tasks[t] = (akp_boids_fill_task){c, t, parts};
+        akp_boids_run_tasks(fill_thread, tasks, sizeof tasks[0], parts);
+    }
+    c->avx512 = !c->job->skip_simd && akp_boids_have_avx512();
     c->one_species = c->params->species_count == 1;
+    c->sym = sym_ok && c->rings == 1;
+    /* The grid's memory is free on this path (the cell coordinates are done with). */
+    c->spill = (akp_boids_acc*)(void*)base;
+    c->spill_cap = gbytes / sizeof(akp_boids_acc);
     return AK_OK;
 }
 

@@ -17,12 +17,13 @@
 
 bool akp_boids_have_avx512(void) { return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq"); }
 
-AKP_AVX512 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin,
-                                            uint32_t end, ak_vec3 p, float q2, akp_boids_hits* h, uint32_t at) {
-    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
-    const __m512 vq = _mm512_set1_ps(q2);
+/* One row of the filter: hits appended at h->...[n], the new n returned. No branch on the hit
+ * mask (a row's tail has few lanes, and whether it hits is a coin toss): an empty mask stores
+ * 16 entries that the next store overwrites. */
+AKP_AVX512 static inline uint32_t filter_row(const float* X, const float* Y, const float* Z, uint32_t begin,
+                                             uint32_t end, __m512 vx, __m512 vy, __m512 vz, __m512 vq,
+                                             akp_boids_hits* h, uint32_t n) {
     const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    uint32_t n = at;
     for (uint32_t t = begin; t < end; t += 16) {
         const uint32_t left = end - t;
         const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
@@ -31,8 +32,65 @@ AKP_AVX512 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, cons
         const __m512 dz = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, Z + t), vz);
         const __m512 dd = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
         const __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, vq, _CMP_LT_OQ);
-        if (!m) continue;
         const __m512i k = _mm512_add_epi32(_mm512_set1_epi32((int)t), lane);
+        _mm512_storeu_si512((void*)(h->k + n), _mm512_maskz_compress_epi32(m, k));
+        _mm512_storeu_ps(h->d2 + n, _mm512_maskz_compress_ps(m, dd));
+        _mm512_storeu_ps(h->dx + n, _mm512_maskz_compress_ps(m, dx));
+        _mm512_storeu_ps(h->dy + n, _mm512_maskz_compress_ps(m, dy));
+        _mm512_storeu_ps(h->dz + n, _mm512_maskz_compress_ps(m, dz));
+        n += (uint32_t)__builtin_popcount(m);
+    }
+    return n;
+}
+
+AKP_AVX512 uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z, uint32_t begin,
+                                            uint32_t end, ak_vec3 p, float q2, akp_boids_hits* h, uint32_t at) {
+    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
+    return filter_row(X, Y, Z, begin, end, vx, vy, vz, _mm512_set1_ps(q2), h, at) - at;
+}
+
+AKP_AVX512 uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                                 const uint32_t* end, uint32_t rows, ak_vec3 p, float q2,
+                                                 akp_boids_hits* h, uint32_t at) {
+    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
+    const __m512 vq = _mm512_set1_ps(q2);
+    uint32_t n = at;
+    for (uint32_t r = 0; r < rows; ++r) n = filter_row(X, Y, Z, begin[r], end[r], vx, vy, vz, vq, h, n);
+    return n - at;
+}
+
+AKP_AVX512 uint32_t akp_boids_pack_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                               const uint32_t* end, uint32_t rows, akp_boids_packed* b) {
+    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    uint32_t n = 0;
+    for (uint32_t r = 0; r < rows; ++r)
+        for (uint32_t t = begin[r]; t < end[r]; t += 16) {
+            const uint32_t left = end[r] - t;
+            const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
+            _mm512_storeu_ps(b->x + n, _mm512_maskz_loadu_ps(live, X + t));
+            _mm512_storeu_ps(b->y + n, _mm512_maskz_loadu_ps(live, Y + t));
+            _mm512_storeu_ps(b->z + n, _mm512_maskz_loadu_ps(live, Z + t));
+            _mm512_storeu_si512((void*)(b->k + n), _mm512_add_epi32(_mm512_set1_epi32((int)t), lane));
+            n += left >= 16 ? 16u : left;
+        }
+    return n;
+}
+
+AKP_AVX512 uint32_t akp_boids_filter_packed_avx512(const float* X, const float* Y, const float* Z, uint32_t begin,
+                                                   uint32_t end, const akp_boids_packed* b, uint32_t count, ak_vec3 p,
+                                                   float q2, akp_boids_hits* h, uint32_t at) {
+    const __m512 vx = _mm512_set1_ps(p.x), vy = _mm512_set1_ps(p.y), vz = _mm512_set1_ps(p.z);
+    const __m512 vq = _mm512_set1_ps(q2);
+    uint32_t n = filter_row(X, Y, Z, begin, end, vx, vy, vz, vq, h, at);
+    for (uint32_t u = 0; u < count; u += 16) {
+        const uint32_t left = count - u;
+        const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
+        const __m512 dx = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, b->x + u), vx);
+        const __m512 dy = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, b->y + u), vy);
+        const __m512 dz = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, b->z + u), vz);
+        const __m512 dd = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+        const __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, vq, _CMP_LT_OQ);
+        const __m512i k = _mm512_maskz_loadu_epi32(live, b->k + u);
         _mm512_storeu_si512((void*)(h->k + n), _mm512_maskz_compress_epi32(m, k));
         _mm512_storeu_ps(h->d2 + n, _mm512_maskz_compress_ps(m, dd));
         _mm512_storeu_ps(h->dx + n, _mm512_maskz_compress_ps(m, dx));
@@ -154,6 +212,174 @@ AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather*
     g->nflock += nf;
 }
 
+/* j's credits of the lanes of m through sink (see akp_boids_sym_avx512). */
+static inline void credit_lanes(const akp_boids_sink* sink, __mmask16 m, const uint32_t* k, const int64_t* e,
+                                const int64_t* f, __mmask16 ms, __mmask16 ma, __mmask16 mc, const int64_t* qi) {
+    while (m) {
+        const unsigned l = (unsigned)__builtin_ctz(m);
+        m &= (__mmask16)(m - 1);
+        const uint32_t t = k[l];
+        const uint64_t bs = (ms >> l) & 1u, ba = (ma >> l) & 1u, bc = (mc >> l) & 1u;
+        const int64_t am = -(int64_t)ba;
+        const uint64_t n01 = bs | ba << 32, n23 = bc | (uint64_t)1 << 32;
+        akp_boids_acc* A = &sink->acc[t];
+        if (t < sink->atomic_end || t >= sink->far_begin) {
+            if (t >= sink->far_begin && sink->spill) {
+                A = &sink->spill[t - sink->far_begin];
+            } else {
+                for (int a = 0; a < 3; ++a) {
+                    __atomic_fetch_sub(&A->sep[a], e[16 * a + l], __ATOMIC_RELAXED);
+                    __atomic_fetch_add(&A->ali[a], qi[a] & am, __ATOMIC_RELAXED);
+                    __atomic_fetch_sub(&A->coh[a], f[16 * a + l], __ATOMIC_RELAXED);
+                }
+                __atomic_fetch_add(&A->n01, n01, __ATOMIC_RELAXED);
+                __atomic_fetch_add(&A->n23, n23, __ATOMIC_RELAXED);
+                continue;
+            }
+        }
+        A->sep[0] -= e[l];
+        A->sep[1] -= e[16 + l];
+        A->sep[2] -= e[32 + l];
+        A->ali[0] += qi[0] & am;
+        A->ali[1] += qi[1] & am;
+        A->ali[2] += qi[2] & am;
+        A->coh[0] -= f[l];
+        A->coh[1] -= f[16 + l];
+        A->coh[2] -= f[32 + l];
+        A->n01 += n01;
+        A->n23 += n23;
+    }
+}
+
+/* fix(x) on the lanes of m (zero elsewhere) stored as 16 int64 at out. */
+AKP_AVX512 static inline void store_fixed(int64_t* out, __mmask16 m, __m512 x) {
+    __m512i lo, hi;
+    fix16(x, &lo, &hi);
+    _mm512_storeu_si512((void*)out, _mm512_maskz_mov_epi64((__mmask8)(m & 0xFF), lo));
+    _mm512_storeu_si512((void*)(out + 8), _mm512_maskz_mov_epi64((__mmask8)(m >> 8), hi));
+}
+
+/* sum += v on the lanes of m, v given as 16 int64 at in. */
+AKP_AVX512 static inline void add_stored(__m512i* sum, __mmask16 m, const int64_t* in) {
+    *sum = _mm512_mask_add_epi64(*sum, (__mmask8)(m & 0xFF), *sum, _mm512_loadu_si512((const void*)in));
+    *sum = _mm512_mask_add_epi64(*sum, (__mmask8)(m >> 8), *sum, _mm512_loadu_si512((const void*)(in + 8)));
+}
+
+/* The view-cone test of in_view_v() on 16 lanes: offsets d, squared lengths dd, viewer
+ * velocity v (squared length v2). */
+AKP_AVX512 static inline __mmask16 cone16(const akp_boids_sp* S, __m512 dx, __m512 dy, __m512 dz, __m512 dd,
+                                          __m512 vx, __m512 vy, __m512 vz, __m512 v2) {
+    const __m512 zero = _mm512_setzero_ps();
+    const __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, vx), _mm512_mul_ps(dy, vy)), _mm512_mul_ps(dz, vz));
+    const __m512 lim = _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(S->cos2), dd), v2);
+    const __m512 dot2 = _mm512_mul_ps(dot, dot);
+    __mmask16 ok;
+    if (S->fov == 1)
+        ok = _mm512_cmp_ps_mask(dot, zero, _CMP_GT_OQ) & _mm512_cmp_ps_mask(dot2, lim, _CMP_GE_OQ);
+    else
+        ok = _mm512_cmp_ps_mask(dot, zero, _CMP_GE_OQ) | _mm512_cmp_ps_mask(dot2, lim, _CMP_LE_OQ);
+    return ok | _mm512_cmp_ps_mask(dd, zero, _CMP_EQ_OQ) | _mm512_cmp_ps_mask(v2, zero, _CMP_EQ_OQ);
+}
+
+AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h,
+                                     uint32_t count, const akp_boids_sink* sink) {
+    const akp_boids_sp* S = g->sp;
+    const __m512 rn2 = _mm512_set1_ps(S->rn2), rs2 = _mm512_set1_ps(S->rs2), ra2 = _mm512_set1_ps(S->ra2),
+                 rc2 = _mm512_set1_ps(S->rc2), dmin2 = _mm512_set1_ps(S->dmin2), sep = _mm512_set1_ps(S->sep_scale),
+                 coh = _mm512_set1_ps(S->coh_scale), sign = _mm512_set1_ps(-0.0f);
+    const __m512 vx = _mm512_set1_ps(g->v.x), vy = _mm512_set1_ps(g->v.y), vz = _mm512_set1_ps(g->v.z);
+    const __m512 v2 = _mm512_set1_ps(g->v2);
+    const bool cone = S->fov != 0;
+    const int64_t* qi = c->sqv + 3 * (size_t)g->self_k;
+    const float* svf = (const float*)(const void*)c->sv; /* ak_vec3: 3 packed floats */
+    __m512i s0 = _mm512_setzero_si512(), s1 = s0, s2 = s0, a0 = s0, a1 = s0, a2 = s0, c0 = s0, c1 = s0, c2 = s0;
+    uint32_t ns = 0, na = 0, nc = 0, nf = 0;
+    int64_t e[48], f[48], ai[3] = {0, 0, 0};
+    for (uint32_t u = 0; u < count; u += 16) {
+        const uint32_t left = count - u;
+        const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
+        const __m512 dd = _mm512_maskz_loadu_ps(live, h->d2 + u);
+        const __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, rn2, _CMP_LT_OQ);
+        if (!m) continue;
+        const __m512 dx = _mm512_maskz_loadu_ps(live, h->dx + u);
+        const __m512 dy = _mm512_maskz_loadu_ps(live, h->dy + u);
+        const __m512 dz = _mm512_maskz_loadu_ps(live, h->dz + u);
+        const __m512i kk = _mm512_maskz_loadu_epi32(live, h->k + u);
+        __mmask16 mi = m, mj = m;
+        if (cone) {
+            if (g->v2 != 0.0f) mi &= cone16(S, dx, dy, dz, dd, vx, vy, vz, v2);
+            /* j looks back along -d with its own velocity. */
+            const __m512i k3 = _mm512_add_epi32(_mm512_add_epi32(kk, kk), kk);
+            const __m512 z = _mm512_setzero_ps();
+            const __m512 jx = _mm512_mask_i32gather_ps(z, m, k3, svf, 4);
+            const __m512 jy = _mm512_mask_i32gather_ps(z, m, k3, svf + 1, 4);
+            const __m512 jz = _mm512_mask_i32gather_ps(z, m, k3, svf + 2, 4);
+            const __m512 j2 =
+                _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(jx, jx), _mm512_mul_ps(jy, jy)), _mm512_mul_ps(jz, jz));
+            mj &= cone16(S, _mm512_xor_ps(dx, sign), _mm512_xor_ps(dy, sign), _mm512_xor_ps(dz, sign), dd, jx, jy, jz,
+                         j2);
+        }
+        const __mmask16 mb = mi | mj;
+        if (!mb) continue;
+        nf += (uint32_t)__builtin_popcount(mi);
+        const __mmask16 bs = _mm512_mask_cmp_ps_mask(mb, dd, rs2, _CMP_LT_OQ);
+        const __mmask16 ba = _mm512_mask_cmp_ps_mask(mb, dd, ra2, _CMP_LT_OQ);
+        const __mmask16 bc = _mm512_mask_cmp_ps_mask(mb, dd, rc2, _CMP_LT_OQ);
+        /* e = fix(-d * inv) where separating (zero elsewhere), f = fix(d * coh) where cohering. */
+        const __m512 den = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(dd, dmin2, _CMP_GT_OQ), dmin2, dd);
+        const __m512 inv = _mm512_maskz_div_ps(bs, sep, den);
+        store_fixed(e, bs, _mm512_mul_ps(_mm512_xor_ps(dx, sign), inv));
+        store_fixed(e + 16, bs, _mm512_mul_ps(_mm512_xor_ps(dy, sign), inv));
+        store_fixed(e + 32, bs, _mm512_mul_ps(_mm512_xor_ps(dz, sign), inv));
+        store_fixed(f, bc, _mm512_mul_ps(dx, coh));
+        store_fixed(f + 16, bc, _mm512_mul_ps(dy, coh));
+        store_fixed(f + 32, bc, _mm512_mul_ps(dz, coh));
+        if (mi) {
+            add_stored(&s0, mi, e);
+            add_stored(&s1, mi, e + 16);
+            add_stored(&s2, mi, e + 32);
+            add_stored(&c0, mi, f);
+            add_stored(&c1, mi, f + 16);
+            add_stored(&c2, mi, f + 32);
+            const __mmask16 mai = mi & ba;
+            if (mai && (cone || mj != mi)) { /* else the partner loop below sums them */
+                const __m512i k3 = _mm512_add_epi32(_mm512_add_epi32(kk, kk), kk);
+                add_gathered(&a0, mai, k3, c->sqv);
+                add_gathered(&a1, mai, k3, c->sqv + 1);
+                add_gathered(&a2, mai, k3, c->sqv + 2);
+            }
+            ns += (uint32_t)__builtin_popcount(mi & bs);
+            na += (uint32_t)__builtin_popcount(mai);
+            nc += (uint32_t)__builtin_popcount(mi & bc);
+        }
+        if (mj) {
+            uint32_t kt[16];
+            _mm512_storeu_si512((void*)kt, kk);
+            credit_lanes(sink, mj, kt, e, f, bs, ba, bc, qi);
+            if (!cone && mj == mi) /* both directions see each other: i's alignment sums here */
+                for (__mmask16 r = mi & ba; r; r &= (__mmask16)(r - 1)) {
+                    const int64_t* q = c->sqv + 3 * (size_t)kt[__builtin_ctz(r)];
+                    ai[0] += q[0];
+                    ai[1] += q[1];
+                    ai[2] += q[2];
+                }
+        }
+    }
+    g->sep[0] += _mm512_reduce_add_epi64(s0);
+    g->sep[1] += _mm512_reduce_add_epi64(s1);
+    g->sep[2] += _mm512_reduce_add_epi64(s2);
+    g->ali[0] += _mm512_reduce_add_epi64(a0) + ai[0];
+    g->ali[1] += _mm512_reduce_add_epi64(a1) + ai[1];
+    g->ali[2] += _mm512_reduce_add_epi64(a2) + ai[2];
+    g->coh[0] += _mm512_reduce_add_epi64(c0);
+    g->coh[1] += _mm512_reduce_add_epi64(c1);
+    g->coh[2] += _mm512_reduce_add_epi64(c2);
+    g->ns += ns;
+    g->na += na;
+    g->nc += nc;
+    g->nflock += nf;
+}
+
 #else
 bool akp_boids_have_avx512(void) { return false; }
 
@@ -163,7 +389,32 @@ uint32_t akp_boids_filter_avx512(const float* X, const float* Y, const float* Z,
     return 0;
 }
 
+uint32_t akp_boids_filter_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                      const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
+                                      uint32_t at) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)rows, (void)p, (void)q2, (void)h, (void)at;
+    return 0;
+}
+
 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count) {
     (void)c, (void)g, (void)h, (void)count;
+}
+
+void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
+                          const akp_boids_sink* sink) {
+    (void)c, (void)g, (void)h, (void)count, (void)sink;
+}
+
+uint32_t akp_boids_pack_rows_avx512(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                    const uint32_t* end, uint32_t rows, akp_boids_packed* b) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)rows, (void)b;
+    return 0;
+}
+
+uint32_t akp_boids_filter_packed_avx512(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end,
+                                        const akp_boids_packed* b, uint32_t count, ak_vec3 p, float q2,
+                                        akp_boids_hits* h, uint32_t at) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)b, (void)count, (void)p, (void)q2, (void)h, (void)at;
+    return 0;
 }
 #endif
