@@ -485,6 +485,7 @@ AK_TEST(deterministic_for_any_thread_count) {
             s.job.friction = 0.3f;
             s.job.attachment_targets = (ak_vec3_cspan){&target, 1};
             s.job.thread_count = (uint32_t)(k + 1);
+            s.job.exact_thread_count = true; /* a 9 x 7 cloth would otherwise run on one thread */
             s.job.substeps = solver == AK_CLOTH_SPRINGS ? 40 : 8;
             sim_scratch(&s);
             for (int f = 0; f < 20; ++f) {
@@ -533,6 +534,137 @@ AK_TEST(wind_drag_direction) {
     sim_free(&s);
 }
 
+/* ---- SIMD paths -------------------------------------------------------------------------- */
+
+static uint32_t rng_next(uint32_t* s) {
+    *s ^= *s << 13, *s ^= *s >> 17, *s ^= *s << 5;
+    return *s;
+}
+static float rng_unit(uint32_t* s) { return (float)(rng_next(s) >> 8) / 16777216.0f; } /* [0, 1) */
+
+/* One random cloth case: a jittered mesh or a generated grid, with its bending kind, solver and
+ * damping; its start state is disturbed (random velocities, a collapsed edge and a collapsed
+ * triangle so the solves' degenerate-lane masks are exercised). Runs `frames` frames with the
+ * given SIMD limit and threads, and returns positions then velocities (2 n vec3, malloc'd). */
+typedef struct simd_case {
+    bool mesh;
+    ak_cloth_bending bending;
+    ak_cloth_solver solver;
+    float damping;
+    uint32_t seed;
+} simd_case;
+
+static ak_vec3* run_simd_case(const simd_case* sc, ak_cloth_simd simd, uint32_t threads, size_t* out_n) {
+    enum { W = 14, H = 12 };
+    ak_vec3 pos[W * H];
+    uint32_t tris[(W - 1) * (H - 1) * 6];
+    uint32_t rng = sc->seed;
+    size_t t = 0;
+    for (uint32_t j = 0; j < H; ++j)
+        for (uint32_t i = 0; i < W; ++i)
+            pos[j * W + i] = ak_vec3_make(0.05f * ((float)i + 0.3f * rng_unit(&rng)), 0.6f + 0.02f * rng_unit(&rng),
+                                          -0.05f * ((float)j + 0.3f * rng_unit(&rng)));
+    for (uint32_t j = 0; j + 1 < H; ++j)
+        for (uint32_t i = 0; i + 1 < W; ++i) {
+            const uint32_t a = j * W + i, b = a + 1, c = a + W, d = c + 1;
+            if (rng_next(&rng) & 1) {
+                const uint32_t o[6] = {a, b, c, b, d, c};
+                memcpy(tris + 6 * t++, o, sizeof o);
+            } else {
+                const uint32_t o[6] = {a, b, d, a, d, c};
+                memcpy(tris + 6 * t++, o, sizeof o);
+            }
+        }
+    uint32_t pins[3] = {0, W - 1, 7 * W + 3};
+    ak_cloth_desc d = {.solver = sc->solver, .bending = sc->bending, .constraint_damping = sc->damping,
+                       .pins = AK_SPAN(pins), .stretch_stiffness = 800.0f, .dihedral_stiffness = 2e-3f,
+                       .pbd_stiffness = 0.7f};
+    if (sc->mesh) {
+        d.positions = (ak_vec3_cspan)AK_SPAN(pos);
+        d.indices = (ak_u32_cspan)AK_SPAN(tris);
+    } else {
+        d.grid_width = W, d.grid_height = H, d.grid_origin = ak_vec3_make(-0.3f, 0.6f, 0.2f);
+    }
+    sim s;
+    if (!sim_init(&s, &d)) return NULL;
+    for (size_t v = 0; v < s.n; ++v)
+        s.v[v] = ak_vec3_make(rng_unit(&rng) - 0.5f, rng_unit(&rng) - 0.5f, rng_unit(&rng) - 0.5f);
+    s.x[2 * W + 5] = s.x[2 * W + 6];                     /* a collapsed edge */
+    s.x[5 * W + 8] = s.x[5 * W + 9] = s.x[6 * W + 8];    /* a collapsed triangle */
+    const ak_cloth_sphere sp = {{0.3f, 0.35f, -0.25f}, 0.2f};
+    s.job.spheres = &sp, s.job.sphere_count = 1;
+    s.job.friction = 0.2f;
+    s.job.substeps = 6;
+    s.job.iterations = 2;
+    s.job.simd_limit = simd;
+    s.job.thread_count = threads;
+    s.job.exact_thread_count = true;
+    sim_scratch(&s);
+    bool ok = true;
+    for (int f = 0; f < 12 && ok; ++f) ok = ak_cloth_step_run(&s.job) == AK_OK;
+    ak_vec3* out = ok ? malloc(2 * s.n * sizeof(ak_vec3)) : NULL;
+    if (out) {
+        memcpy(out, s.x, s.n * sizeof(ak_vec3));
+        memcpy(out + s.n, s.v, s.n * sizeof(ak_vec3));
+    }
+    *out_n = s.n;
+    sim_free(&s);
+    return out;
+}
+
+/* The SIMD constraint solves give the scalar solve's bits: every path this CPU has, on random
+ * cloths with every constraint kind (stretch, shear, bending distance constraints, dihedral,
+ * isometric), XPBD with and without damping and PBD, on 1 to 3 threads. */
+AK_TEST(simd_paths_bit_identical) {
+    const char* widest = ak_cloth_simd_name();
+    const bool have512 = strcmp(widest, "avx512") == 0, have2 = have512 || strcmp(widest, "avx2") == 0;
+    printf("  widest constraint solve on this CPU: %s\n", widest);
+    if (!have2) printf("  SKIP: AVX2 path (this CPU or build has none)\n");
+    if (!have512) printf("  SKIP: AVX-512 path (this CPU or build has none)\n");
+    const simd_case cases[] = {
+        {false, AK_CLOTH_BEND_DIHEDRAL, AK_CLOTH_XPBD, 0.0f, 11u},   {false, AK_CLOTH_BEND_ISOMETRIC, AK_CLOTH_XPBD, 0.0f, 12u},
+        {false, AK_CLOTH_BEND_SPRINGS, AK_CLOTH_XPBD, 0.01f, 13u},   {false, AK_CLOTH_BEND_NONE, AK_CLOTH_PBD, 0.0f, 14u},
+        {true, AK_CLOTH_BEND_DIHEDRAL, AK_CLOTH_XPBD, 0.01f, 15u},   {true, AK_CLOTH_BEND_ISOMETRIC, AK_CLOTH_XPBD, 0.01f, 16u},
+        {true, AK_CLOTH_BEND_SPRINGS, AK_CLOTH_XPBD, 0.0f, 17u},     {true, AK_CLOTH_BEND_DIHEDRAL, AK_CLOTH_PBD, 0.0f, 18u},
+        {true, AK_CLOTH_BEND_ISOMETRIC, AK_CLOTH_PBD, 0.0f, 19u},
+    };
+    const ak_cloth_simd paths[2] = {AK_CLOTH_SIMD_AVX2, AK_CLOTH_SIMD_AVX512};
+    const bool have[2] = {have2, have512};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        size_t n = 0;
+        ak_vec3* ref = run_simd_case(&cases[c], AK_CLOTH_SIMD_SCALAR, 1, &n);
+        AK_CHECK_MSG(ref != NULL, "case %zu: scalar run failed", c);
+        if (!ref) continue;
+        /* the state moved, and stayed finite */
+        bool finite = true;
+        for (size_t v = 0; v < 2 * n; ++v) finite = finite && ak_vec3_is_finite(ref[v]);
+        AK_CHECK_MSG(finite, "case %zu: non-finite state", c);
+        for (int p = 0; p < 2; ++p) {
+            if (!have[p]) continue;
+            for (uint32_t th = 1; th <= 3; th += 2) {
+                size_t m = 0;
+                ak_vec3* got = run_simd_case(&cases[c], paths[p], th, &m);
+                AK_CHECK_MSG(got && m == n && memcmp(ref, got, 2 * n * sizeof(ak_vec3)) == 0,
+                             "case %zu: %s path on %u threads differs from the scalar path", c, p ? "AVX-512" : "AVX2", th);
+                free(got);
+            }
+        }
+        size_t m = 0;
+        ak_vec3* got = run_simd_case(&cases[c], AK_CLOTH_SIMD_SCALAR, 2, &m);
+        AK_CHECK_MSG(got && memcmp(ref, got, 2 * n * sizeof(ak_vec3)) == 0, "case %zu: scalar path on 2 threads differs", c);
+        free(got);
+        free(ref);
+    }
+    /* simd_limit out of range */
+    ak_cloth_desc d = {.grid_width = 4, .grid_height = 4};
+    sim s;
+    AK_CHECK(sim_init(&s, &d));
+    sim_scratch(&s);
+    s.job.simd_limit = AK_CLOTH_SIMD_COUNT;
+    AK_CHECK_EQ(ak_cloth_step_validate(&s.job), AK_ERR_BAD_ARG);
+    sim_free(&s);
+}
+
 int main(void) {
     AK_RUN(desc_defaults);
     AK_RUN(create_rules);
@@ -549,5 +681,6 @@ int main(void) {
     AK_RUN(deterministic_for_any_thread_count);
     AK_RUN(normals);
     AK_RUN(wind_drag_direction);
+    AK_RUN(simd_paths_bit_identical);
     return ak_test_finish();
 }

@@ -26,7 +26,9 @@
  *   - smooth (area-weighted) vertex normals, max stretch and energy for output and tests;
  *   - thread_count: threads split each phase over disjoint particles or over constraints of one
  *     colour (constraints of a colour share no particle), so results are bit-identical for any
- *     thread count.
+ *     thread count; small cloths run on fewer threads than asked (see thread_count);
+ *   - SIMD: the XPBD/PBD constraint solves run 16 (AVX-512F) or 8 (AVX2) constraints of a colour
+ *     at a time, chosen at run time, with the scalar path's exact bits (see ak_cloth_simd).
  *
  * What it does NOT do: continuous collision detection (a particle moving
  * further than the thickness in one substep can tunnel through a thin collider), tearing,
@@ -193,6 +195,18 @@ typedef struct ak_cloth_collider_mesh {
 
 /* ---- stepping ------------------------------------------------------------------------- */
 
+/* Upper limit on the SIMD width the XPBD/PBD constraint solves may use (the widest this CPU
+ * has up to the limit is used; tests and benchmarks run every path side by side with it).
+ * Every path gives the scalar code's bits: the same float operations in the same order, no
+ * fused multiply-add. The mass-spring solver and the other phases are scalar. */
+typedef enum ak_cloth_simd {
+    AK_CLOTH_SIMD_DEFAULT = 0, /* -> the widest this CPU has (AK_CLOTH_SIMD_AVX512) */
+    AK_CLOTH_SIMD_SCALAR,      /* one constraint at a time */
+    AK_CLOTH_SIMD_AVX2,        /* 8 constraints of a colour per block, where the CPU has AVX2 */
+    AK_CLOTH_SIMD_AVX512,      /* 16 per block where the CPU has AVX-512F, else AVX2 */
+    AK_CLOTH_SIMD_COUNT
+} ak_cloth_simd;
+
 /* Advance the cloth by dt. Positions and velocities are the caller's state (in and out). */
 typedef struct ak_cloth_step_job {
     const ak_cloth* cloth;         /* required */
@@ -224,7 +238,15 @@ typedef struct ak_cloth_step_job {
                                          attachments): where the attached particles are at the end
                                          of this step; substeps move them linearly from where
                                          they are */
-    uint32_t thread_count;         /* 0 or 1 -> the calling thread only; at most 64 */
+    uint32_t thread_count;         /* 0 or 1 -> the calling thread only; at most 64. An upper
+                                      bound: XPBD/PBD use at most one thread per 8192 constraints
+                                      in an average colour (the threads meet after each colour;
+                                      smaller shares cost more in meetings than they save), so a
+                                      64 x 64 cloth runs on one thread, 256 x 256 on up to 2 */
+    bool exact_thread_count;       /* false -> the rule above; true -> thread_count threads
+                                      whatever the cloth's size (tests, measurements) */
+    ak_cloth_simd simd_limit;      /* 0 -> the widest constraint solve this CPU has; else at most
+                                      this one (out of range: AK_ERR_BAD_ARG) */
     ak_vec3_span positions;        /* required, count == vertex count: in and out */
     ak_vec3_span velocities;       /* required, count == vertex count: in and out */
     ak_vec3_span out_normals;      /* optional, count >= vertex count: smooth normals after the step */
@@ -237,7 +259,7 @@ AK_API size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job);
 
 /* First failing rule: AK_ERR_NULL_ARG (job, cloth, positions, velocities or scratch empty, a
  * collider count without its array, attachments without targets), AK_ERR_BAD_ARG (dt <= 0 or
- * non-finite, thread_count > 64, substeps or iterations > 10000, negative or non-finite drag,
+ * non-finite, thread_count > 64, substeps or iterations > 10000, simd_limit out of range, negative or non-finite drag,
  * lift, air density, damping, thickness, friction or self_distance, a negative radius, collider mesh indices
  * not a multiple of 3, positions/velocities count != vertex count, attachment_targets count !=
  * attachment count), AK_ERR_SPAN_SMALL (out_normals or scratch too small), AK_ERR_BAD_INDEX (a
@@ -248,6 +270,10 @@ AK_API ak_result ak_cloth_step_validate(const ak_cloth_step_job* job);
  * AK_ERR_NO_CONVERGENCE when the state became non-finite (a blow-up: the spring solver with too
  * large a step); the state then holds the non-finite values, so keep a copy to go back to. */
 AK_API ak_result ak_cloth_step_run(const ak_cloth_step_job* job);
+
+/* Name of the widest constraint solve ak_cloth_step_run can use on this CPU: "avx512", "avx2"
+ * or "scalar" (AK_NO_SIMD builds: "scalar"). */
+AK_API const char* ak_cloth_simd_name(void);
 
 /* ---- measures ------------------------------------------------------------------------- */
 

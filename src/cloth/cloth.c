@@ -51,47 +51,6 @@ static bool buf_push(vec_buf* b, const ak_allocator* a, const void* item) {
 
 static bool nonneg_finite(float x) { return x >= 0.0f && ak_finitef(x); }
 
-/* atan2 to about 1e-5 rad: odd minimax polynomial of atan on [0, 1] after folding the octant
- * (libm's atan2f was a quarter of the XPBD step with dihedral bending). */
-static float fast_atan2(float y, float x) {
-    const float ax = fabsf(x), ay = fabsf(y);
-    const float mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
-    if (mx == 0.0f) return 0.0f;
-    const float z = mn / mx, z2 = z * z;
-    float r = z * (0.99997726f +
-                   z2 * (-0.33262347f + z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f + z2 * -0.01172120f)))));
-    if (ay > ax) r = 1.57079633f - r;
-    if (x < 0.0f) r = 3.14159265f - r;
-    return y < 0.0f ? -r : r;
-}
-
-float akp_dihedral(const ak_vec3 x[4], ak_vec3 grad[4]) {
-    /* Bridson, Marino, Fedkiw 2003: wings x0, x1, edge x2 -> x3; the signed angle between the
-     * triangle normals about the edge, from unnormalised normals (atan2 ignores a common
-     * positive scale) */
-    const ak_vec3 e = ak_vec3_sub(x[3], x[2]);
-    const ak_vec3 n1 = ak_vec3_cross(e, ak_vec3_sub(x[0], x[2]));
-    const ak_vec3 n2 = ak_vec3_cross(ak_vec3_sub(x[1], x[2]), e);
-    const float l1 = ak_vec3_length_sq(n1), l2 = ak_vec3_length_sq(n2), le2 = ak_vec3_length_sq(e);
-    if (l1 < 1e-24f || l2 < 1e-24f || le2 < 1e-24f) {
-        if (grad)
-            for (int k = 0; k < 4; ++k) grad[k] = ak_vec3_make(0, 0, 0);
-        return 0.0f;
-    }
-    const float le = sqrtf(le2), inv = 1.0f / le;
-    const float theta = fast_atan2(ak_vec3_dot(ak_vec3_cross(n1, n2), e) * inv, ak_vec3_dot(n1, n2));
-    if (grad) {
-        const ak_vec3 u1 = ak_vec3_scale(n1, 1.0f / l1), u2 = ak_vec3_scale(n2, 1.0f / l2);
-        grad[0] = ak_vec3_scale(u1, -le);
-        grad[1] = ak_vec3_scale(u2, -le);
-        const float a0 = ak_vec3_dot(ak_vec3_sub(x[0], x[3]), e) * inv, a1 = ak_vec3_dot(ak_vec3_sub(x[1], x[3]), e) * inv;
-        const float b0 = ak_vec3_dot(ak_vec3_sub(x[0], x[2]), e) * inv, b1 = ak_vec3_dot(ak_vec3_sub(x[1], x[2]), e) * inv;
-        grad[2] = ak_vec3_add(ak_vec3_scale(u1, -a0), ak_vec3_scale(u2, -a1));
-        grad[3] = ak_vec3_add(ak_vec3_scale(u1, b0), ak_vec3_scale(u2, b1));
-    }
-    return theta;
-}
-
 static float cot_at(ak_vec3 apex, ak_vec3 a, ak_vec3 b) {
     const ak_vec3 u = ak_vec3_sub(a, apex), v = ak_vec3_sub(b, apex);
     const float s = ak_vec3_length(ak_vec3_cross(u, v));
@@ -404,6 +363,9 @@ ak_result ak_cloth_create(const ak_cloth_desc* desc_in, const ak_allocator* allo
     const size_t s_att = size; size += akp_align16(na * sizeof(uint32_t));
     const size_t s_dist = size; size += akp_align16(nd * sizeof(akp_dist));
     const size_t s_bend = size; size += akp_align16(nb * sizeof(akp_bend));
+    const bool iso = d.bending == AK_CLOTH_BEND_ISOMETRIC;
+    const size_t s_dsoa = size; size += 4 * akp_align16(nd * sizeof(float));
+    const size_t s_bsoa = size; size += (iso ? 10 : 5) * akp_align16(nb * sizeof(float));
     const size_t s_lra = size; size += lra ? akp_align16(n * sizeof(uint32_t)) : 0;
     const size_t s_lrad = size; size += lra ? akp_align16(n * sizeof(float)) : 0;
     const size_t s_vts = size; size += akp_align16((n + 1) * sizeof(uint32_t));
@@ -453,6 +415,32 @@ ak_result ak_cloth_create(const ak_cloth_desc* desc_in, const ak_allocator* allo
     for (size_t k = 0; k < nb; ++k) memcpy(parts + 4 * k, bs[k].p, 4 * sizeof(uint32_t));
     color_constraints(parts, 4, nb, n, used, color);
     sort_by_color(bs, c->bend, sizeof(akp_bend), nb, color, c->bend_color);
+    /* the solvers' structure-of-arrays copies, in the same (colour) order */
+    {
+        const size_t sd = akp_align16(nd * sizeof(float)), sb = akp_align16(nb * sizeof(float));
+        c->dist_i = (uint32_t*)(mem + s_dsoa);
+        c->dist_j = (uint32_t*)(mem + s_dsoa + sd);
+        c->dist_rest = (float*)(mem + s_dsoa + 2 * sd);
+        c->dist_alpha = (float*)(mem + s_dsoa + 3 * sd);
+        for (size_t k = 0; k < nd; ++k) {
+            c->dist_i[k] = c->dist[k].i, c->dist_j[k] = c->dist[k].j;
+            c->dist_rest[k] = c->dist[k].rest, c->dist_alpha[k] = c->dist[k].alpha;
+        }
+        for (int q = 0; q < 4; ++q) {
+            c->bend_p[q] = (uint32_t*)(mem + s_bsoa + (size_t)q * sb);
+            c->bend_K[q] = iso ? (float*)(mem + s_bsoa + (size_t)(5 + q) * sb) : NULL;
+        }
+        c->bend_rest = (float*)(mem + s_bsoa + 4 * sb);
+        c->bend_alpha = iso ? (float*)(mem + s_bsoa + 9 * sb) : NULL;
+        for (size_t k = 0; k < nb; ++k) {
+            for (int q = 0; q < 4; ++q) {
+                c->bend_p[q][k] = c->bend[k].p[q];
+                if (iso) c->bend_K[q][k] = c->bend[k].K[q];
+            }
+            c->bend_rest[k] = c->bend[k].rest;
+            if (iso) c->bend_alpha[k] = c->bend[k].alpha;
+        }
+    }
     /* long-range attachments: the nearest kinematic particle at rest */
     if (lra) {
         for (size_t v = 0; v < n; ++v) {

@@ -44,13 +44,54 @@ struct ak_cloth {
     uint32_t dist_color[AKP_MAX_COLORS + 2];
     akp_bend* bend;     /* [bend_count], by colour */
     uint32_t bend_color[AKP_MAX_COLORS + 2];
+    /* the same constraints as structures of arrays (the solvers' layout, cloth_kernel.h) */
+    uint32_t *dist_i, *dist_j;  /* [dist_count] */
+    float *dist_rest, *dist_alpha;
+    uint32_t* bend_p[4];        /* [bend_count] each */
+    float* bend_K[4];           /* isometric weights; NULL unless isometric */
+    float *bend_rest, *bend_alpha; /* bend_alpha: isometric compliance; NULL unless isometric */
     uint32_t* lra_anchor; /* [n] nearest kinematic particle, UINT32_MAX -> none; NULL when off */
     float* lra_dist;      /* [n] allowed distance */
     uint32_t* vt_start;   /* [n + 1] CSR: triangles around each vertex */
     uint32_t* vt_tri;     /* [3 tri_count] */
 };
 
-/* Dihedral angle of a bending element and its gradient (grad NULL -> angle only). */
+/* Dihedral angle of a bending element (wings x0, x1, edge x2 -> x3) and its gradient (grad NULL
+ * -> angle only); 0 and a zero gradient for a degenerate element. The step's own formula. */
 float akp_dihedral(const ak_vec3 x[4], ak_vec3 grad[4]);
+
+/* A particle in the step's working copy: position and inverse mass in 16 bytes, so that a SIMD
+ * solve loads or stores one particle with one 128-bit access. */
+typedef struct akp_px {
+    ak_vec3 p;
+    float w;
+} akp_px;
+
+/* What the constraint solves (cloth_kernel.h) read besides the cloth. */
+typedef struct akp_solve {
+    const ak_cloth* cl;
+    akp_px* x;
+    const akp_px* prev;   /* positions at the start of the substep (read when damped) */
+    float* lambda;        /* [dist_count + bend_count] multipliers */
+    float h, h2, beta;    /* substep, its square, constraint damping (s) */
+    float pbd_stiffness;  /* PBD factor */
+    float bend_alpha;     /* dihedral compliance 1 / dihedral_stiffness */
+    bool pbd, damped, iso;
+} akp_solve;
+
+/* SIMD solves of the constraints of one colour from b on, in whole blocks (8 or 16): return
+ * where they stopped (the rest, fewer than a block, is the caller's). Only built for x86-64
+ * GCC/clang without AK_NO_SIMD; the have_ functions say whether this CPU runs them. */
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
+#define AKP_CLOTH_SIMD 1
+bool akp_cloth_have_avx2(void);
+bool akp_cloth_have_avx512(void);
+size_t akp_cloth_dist_avx2(const akp_solve* s, size_t b, size_t e, bool first);
+size_t akp_cloth_bend_avx2(const akp_solve* s, size_t b, size_t e, bool first);
+size_t akp_cloth_dist_avx512(const akp_solve* s, size_t b, size_t e, bool first);
+size_t akp_cloth_bend_avx512(const akp_solve* s, size_t b, size_t e, bool first);
+#else
+#define AKP_CLOTH_SIMD 0
+#endif
 
 #endif

@@ -4,9 +4,13 @@
  * triangles, or the constraints of one colour) into thread_count contiguous ranges and the
  * threads meet at a barrier between phases. Every element is computed the same way whatever
  * range it falls in, and no two threads write the same particle within a phase, so the result
- * does not depend on the thread count. */
+ * does not depend on the thread count. The XPBD/PBD constraint solves are cloth_kernel.h's,
+ * here in their scalar variant and in cloth_avx2.c / cloth_avx512.c in SIMD ones (chosen at run
+ * time; the same bits). The step works on a copy of the positions as 16-byte (position, inverse
+ * mass) records, copied back at the end. */
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -16,11 +20,18 @@
 #include "internal.h"
 
 #define MAX_THREADS 64u
+/* Threads meet at a barrier after every constraint colour (about 29 meetings per substep of a
+ * grid with dihedral bending: 8 distance and 18 bending colours, 3 other phases). With the SIMD solves a constraint costs 2-5 ns, so a thread's
+ * share of a colour must be thousands of constraints to outweigh a meeting (about a microsecond
+ * between two running threads, a scheduler time slice when the partner was descheduled): XPBD
+ * and PBD use at most one thread per this many constraints of an average colour, unless the job
+ * asks for exact_thread_count. */
+#define THREAD_MIN_PER_COLOR 8192u
 
 /* ---- scratch layout --------------------------------------------------------------------- */
 
 typedef struct layout {
-    size_t prev, ext, acc, lambda, tri_force, att_start, hash_start, hash_entry, tri_normal, grid, grid_size, size;
+    size_t xw, xs, prev, ext, acc, lambda, tri_force, att_start, hash_start, hash_entry, tri_normal, grid, grid_size, size;
     size_t buckets, mesh_tris;
 } layout;
 
@@ -38,7 +49,9 @@ static float self_distance(const ak_cloth_step_job* job) {
 static layout make_layout(const ak_cloth* c, size_t mesh_tris, const ak_cloth_step_job* job) {
     layout l;
     size_t s = 0;
-    l.prev = s, s += akp_align16(c->n * sizeof(ak_vec3));
+    l.xw = s, s += akp_align16(c->n * sizeof(akp_px));
+    l.xs = s, s += job->self_collision ? akp_align16(c->n * sizeof(ak_vec3)) : 0;
+    l.prev = s, s += akp_align16(c->n * sizeof(akp_px));
     l.ext = s, s += akp_align16(c->n * sizeof(ak_vec3));
     l.acc = s, s += akp_align16(c->n * sizeof(ak_vec3));
     l.lambda = s, s += akp_align16((c->dist_count + c->bend_count) * sizeof(float));
@@ -76,7 +89,7 @@ ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) {
         (job->mesh.indices.count && !job->mesh.positions.ptr) || (job->mesh.positions.count && !job->mesh.indices.ptr))
         return AK_ERR_NULL_ARG;
     if (!(job->dt > 0.0f) || !ak_finitef(job->dt) || job->thread_count > MAX_THREADS || job->substeps > 10000 ||
-        job->iterations > 10000)
+        job->iterations > 10000 || (unsigned)job->simd_limit >= AK_CLOTH_SIMD_COUNT)
         return AK_ERR_BAD_ARG;
     if (bad_nonneg(job->drag) || bad_nonneg(job->lift) || bad_nonneg(job->air_density) || bad_nonneg(job->damping) ||
         bad_nonneg(job->thickness) || bad_nonneg(job->friction) || bad_nonneg(job->self_distance))
@@ -119,9 +132,10 @@ typedef struct ctx {
     unsigned T;          /* threads taking part */
     uint32_t substeps, iterations;
     float h, decay, thickness;
-    ak_vec3* x;
+    akp_px* x;       /* working copy of the positions, with inverse masses */
+    ak_vec3* xs;     /* plain copy for the self-collision grid */
     ak_vec3* v;
-    ak_vec3* prev;
+    akp_px* prev;
     ak_vec3* ext;
     ak_vec3* acc;
     float* lambda;
@@ -139,10 +153,12 @@ typedef struct ctx {
     ak_u8_span grid_mem;
     ak_grid grid;
     ak_result grid_result;
+    akp_solve solve;
+    int simd;            /* 0 scalar, 1 AVX2, 2 AVX-512 */
     /* barrier */
     pthread_mutex_t m;
     pthread_cond_t cv;
-    unsigned waiting, generation;
+    atomic_uint arrived, generation, sleepers;
     bool go;
 } ctx;
 
@@ -151,23 +167,58 @@ typedef struct worker {
     unsigned t;
 } worker;
 
+/* Spin, then sleep: a thread that arrives first spins up to BARRIER_SPIN pauses (about 11 us on
+ * the Zen 5 test machine, 22 ns each; most meetings of two busy threads end within a few
+ * microseconds) and then waits on the condition variable (a descheduled partner on a loaded
+ * machine would make spinning burn its core). The last to
+ * arrive bumps the generation, and wakes sleepers through the mutex; sequentially consistent
+ * atomics order "bump, then look for sleepers" against "announce sleeping, then look at the
+ * generation", so no wake-up is lost. */
+#define BARRIER_SPIN 512
+
+static void cpu_relax(void) {
+#if defined(__x86_64__) || defined(__i386__)
+    __asm__ __volatile__("pause");
+#endif
+}
+
 static void barrier(ctx* c) {
     if (c->T == 1) return;
-    pthread_mutex_lock(&c->m);
-    if (++c->waiting == c->T) {
-        c->waiting = 0;
-        c->generation++;
-        pthread_cond_broadcast(&c->cv);
-    } else {
-        const unsigned g = c->generation;
-        while (g == c->generation) pthread_cond_wait(&c->cv, &c->m);
+    const unsigned g = atomic_load(&c->generation);
+    if (atomic_fetch_add(&c->arrived, 1) + 1 == c->T) {
+        atomic_store(&c->arrived, 0);
+        atomic_fetch_add(&c->generation, 1);
+        if (atomic_load(&c->sleepers)) {
+            pthread_mutex_lock(&c->m);
+            pthread_cond_broadcast(&c->cv);
+            pthread_mutex_unlock(&c->m);
+        }
+        return;
     }
+    for (int k = 0; k < BARRIER_SPIN; ++k) {
+        if (atomic_load_explicit(&c->generation, memory_order_acquire) != g) return;
+        cpu_relax();
+    }
+    pthread_mutex_lock(&c->m);
+    atomic_fetch_add(&c->sleepers, 1);
+    while (atomic_load(&c->generation) == g) pthread_cond_wait(&c->cv, &c->m);
+    atomic_fetch_sub(&c->sleepers, 1);
     pthread_mutex_unlock(&c->m);
 }
 
 static void range(size_t count, unsigned t, unsigned T, size_t* b, size_t* e) {
     *b = count * t / T;
     *e = count * (t + 1) / T;
+}
+
+/* range() with the inner boundaries on multiples of 16, so that each thread's share of a
+ * colour is whole SIMD blocks but for the last one's tail. */
+static void block_range(size_t count, unsigned t, unsigned T, size_t* b, size_t* e) {
+    const size_t blocks = (count + 15) / 16;
+    *b = t == 0 ? 0 : blocks * t / T * 16;
+    *e = t + 1 == T ? count : blocks * (t + 1) / T * 16;
+    if (*b > count) *b = count;
+    if (*e > count) *e = count;
 }
 
 /* ---- collisions ------------------------------------------------------------------------- */
@@ -279,8 +330,8 @@ static bool push_sphere(ak_vec3* x, ak_vec3 center, float r, ak_vec3* n, float* 
 static void collide(const ctx* c, size_t i) {
     const ak_cloth_step_job* job = c->job;
     const float th = c->thickness, mu = job->friction;
-    ak_vec3 x = c->x[i];
-    const ak_vec3 prev = c->prev[i];
+    ak_vec3 x = c->x[i].p;
+    const ak_vec3 prev = c->prev[i].p;
     ak_vec3 n;
     float depth;
     for (size_t k = 0; k < job->plane_count; ++k) {
@@ -330,85 +381,78 @@ static void collide(const ctx* c, size_t i) {
             }
         }
     }
-    c->x[i] = x;
+    c->x[i].p = x;
 }
 
 /* ---- constraints ------------------------------------------------------------------------ */
 
-static void solve_dist(const ctx* c, size_t k, bool first) {
-    const ak_cloth* cl = c->c;
-    const akp_dist* d = &cl->dist[k];
-    const float wi = cl->inv_mass[d->i], wj = cl->inv_mass[d->j], w = wi + wj;
-    if (w == 0.0f) return;
-    ak_vec3 xi = c->x[d->i], xj = c->x[d->j];
-    const ak_vec3 e = ak_vec3_sub(xi, xj);
-    const float len = ak_vec3_length(e);
-    if (len < 1e-12f) return;
-    const ak_vec3 g = ak_vec3_scale(e, 1.0f / len); /* grad_i C; grad_j C = -g */
-    const float C = len - d->rest;
-    float dl;
-    if (cl->desc.solver == AK_CLOTH_PBD) {
-        dl = -cl->desc.pbd_stiffness * C / w;
-    } else {
-        const float h2 = c->h * c->h;
-        const float at = d->alpha / h2;
-        const float lam = first ? 0.0f : c->lambda[k];
-        /* eq. 26: gamma = alpha~ beta~ / h with beta~ = h^2 beta */
-        const float gamma = d->alpha * cl->desc.constraint_damping / c->h;
-        const float vdot = ak_vec3_dot(g, ak_vec3_sub(ak_vec3_sub(xi, c->prev[d->i]), ak_vec3_sub(xj, c->prev[d->j])));
-        dl = (-C - at * lam - gamma * vdot) / ((1.0f + gamma) * w + at);
-        c->lambda[k] = lam + dl;
-    }
-    c->x[d->i] = ak_vec3_madd(xi, g, wi * dl);
-    c->x[d->j] = ak_vec3_madd(xj, g, -wj * dl);
+/* The scalar variant of cloth_kernel.h: one constraint per call, the reference for the SIMD
+ * variants (cloth_avx2.c, cloth_avx512.c), which give the same bits. */
+#define KW 1
+#define KFN static inline
+typedef float KV;
+typedef bool KM;
+#define K_SET1(f) (f)
+#define K_LOAD(p) (*(p))
+#define K_STORE(p, v) (*(p) = (v))
+#define K_ADD(a, b) ((a) + (b))
+#define K_SUB(a, b) ((a) - (b))
+#define K_MUL(a, b) ((a) * (b))
+#define K_DIV(a, b) ((a) / (b))
+#define K_SQRT sqrtf
+#define K_ABS fabsf
+#define K_NEG(a) (-(a))
+#define K_LT(a, b) ((a) < (b))
+#define K_GT(a, b) ((a) > (b))
+#define K_NE(a, b) ((a) != (b))
+#define K_EQ(a, b) ((a) == (b))
+#define K_NLT(a, b) (!((a) < (b)))
+#define K_MAND(m, n) ((m) && (n))
+#define K_SEL(m, a, b) ((m) ? (a) : (b))
+#define K_GATHER(xs, idx, v, wv)                                                                  \
+    do {                                                                                          \
+        const akp_px* p_ = &(xs)[*(idx)];                                                         \
+        (v) = (kv3){p_->p.x, p_->p.y, p_->p.z};                                                   \
+        (wv) = p_->w;                                                                             \
+    } while (0)
+#define K_SCATTER(xs, idx, v, wv) ((xs)[*(idx)].p = ak_vec3_make((v).x, (v).y, (v).z), (void)(wv))
+#define KN(name) scalar_##name
+#include "cloth_kernel.h"
+
+float akp_dihedral(const ak_vec3 x[4], ak_vec3 grad[4]) {
+    kv3 xv[4], g[4];
+    for (int q = 0; q < 4; ++q) xv[q] = (kv3){x[q].x, x[q].y, x[q].z};
+    KM ok;
+    const float theta = scalar_dihedral(xv, g, &ok);
+    if (grad)
+        for (int q = 0; q < 4; ++q) grad[q] = ok ? ak_vec3_make(g[q].x, g[q].y, g[q].z) : ak_vec3_make(0, 0, 0);
+    return ok ? theta : 0.0f;
 }
 
-static void solve_bend(const ctx* c, size_t k, bool first) {
-    const ak_cloth* cl = c->c;
-    const akp_bend* b = &cl->bend[k];
-    ak_vec3 x[4], g[4];
-    float w[4], wsum = 0.0f, C, alpha;
-    for (int q = 0; q < 4; ++q) x[q] = c->x[b->p[q]], w[q] = cl->inv_mass[b->p[q]];
-    if (cl->desc.bending == AK_CLOTH_BEND_ISOMETRIC) {
-        /* C = |b| - |b_rest|, grad_i C = K_i b / |b| */
-        ak_vec3 bv = ak_vec3_make(0, 0, 0);
-        for (int q = 0; q < 4; ++q) bv = ak_vec3_madd(bv, x[q], b->K[q]);
-        const float l = ak_vec3_length(bv);
-        if (l < 1e-12f) return;
-        const ak_vec3 n = ak_vec3_scale(bv, 1.0f / l);
-        for (int q = 0; q < 4; ++q) g[q] = ak_vec3_scale(n, b->K[q]), wsum += w[q] * b->K[q] * b->K[q];
-        C = l - b->rest;
-        alpha = b->alpha;
-    } else {
-        C = akp_dihedral(x, g) - b->rest;
-        if (C > AK_PI) C -= 2.0f * AK_PI;
-        if (C < -AK_PI) C += 2.0f * AK_PI;
-        for (int q = 0; q < 4; ++q) wsum += w[q] * ak_vec3_length_sq(g[q]);
-        alpha = 1.0f / cl->desc.dihedral_stiffness; /* 0 when infinite */
-    }
-    if (wsum < 1e-20f) return;
-    float dl;
-    float* lam_slot = c->lambda + cl->dist_count + k;
-    if (cl->desc.solver == AK_CLOTH_PBD) {
-        dl = -cl->desc.pbd_stiffness * C / wsum;
-    } else {
-        const float at = alpha / (c->h * c->h);
-        const float lam = first ? 0.0f : *lam_slot;
-        const float gamma = alpha * cl->desc.constraint_damping / c->h;
-        float vdot = 0.0f;
-        for (int q = 0; q < 4; ++q) vdot += ak_vec3_dot(g[q], ak_vec3_sub(x[q], c->prev[b->p[q]]));
-        dl = (-C - at * lam - gamma * vdot) / ((1.0f + gamma) * wsum + at);
-        *lam_slot = lam + dl;
-    }
-    for (int q = 0; q < 4; ++q)
-        if (w[q] > 0.0f) c->x[b->p[q]] = ak_vec3_madd(x[q], g[q], w[q] * dl);
+/* The constraints [kb, ke) of one colour (widest blocks first, the rest one by one). */
+static void solve_dist_range(const ctx* c, size_t kb, size_t ke, bool first) {
+    size_t k = kb;
+#if AKP_CLOTH_SIMD
+    if (c->simd >= 2) k = akp_cloth_dist_avx512(&c->solve, k, ke, first);
+    if (c->simd >= 1) k = akp_cloth_dist_avx2(&c->solve, k, ke, first);
+#endif
+    for (; k < ke; ++k) scalar_dist(&c->solve, k, first);
+}
+
+static void solve_bend_range(const ctx* c, size_t kb, size_t ke, bool first) {
+    size_t k = kb;
+#if AKP_CLOTH_SIMD
+    if (c->simd >= 2) k = akp_cloth_bend_avx512(&c->solve, k, ke, first);
+    if (c->simd >= 1) k = akp_cloth_bend_avx2(&c->solve, k, ke, first);
+#endif
+    for (; k < ke; ++k) scalar_bend(&c->solve, k, first);
 }
 
 /* Spring force of spring k added to acc (force accumulators) of its two particles. */
 static void spring_force(const ctx* c, size_t k) {
     const ak_cloth* cl = c->c;
     const akp_dist* d = &cl->dist[k];
-    const ak_vec3 e = ak_vec3_sub(c->x[d->j], c->x[d->i]);
+    const ak_vec3 e = ak_vec3_sub(c->x[d->j].p, c->x[d->i].p);
     const float len = ak_vec3_length(e);
     if (len < 1e-12f) return;
     const ak_vec3 u = ak_vec3_scale(e, 1.0f / len);
@@ -425,7 +469,8 @@ static void spring_force(const ctx* c, size_t k) {
 /* Rebuild the grid over the current positions (one thread). */
 static void self_grid(ctx* c) {
     const ak_grid_desc gd = {.cell_size = c->self_dist};
-    const ak_result r = ak_grid_build(&gd, (ak_vec3_cspan){c->x, c->c->n}, c->grid_mem, &c->grid);
+    for (size_t v = 0; v < c->c->n; ++v) c->xs[v] = c->x[v].p;
+    const ak_result r = ak_grid_build(&gd, (ak_vec3_cspan){c->xs, c->c->n}, c->grid_mem, &c->grid);
     if (r != AK_OK) c->grid_result = r;
 }
 
@@ -439,7 +484,7 @@ static void self_delta(const ctx* c, size_t i) {
     const float wi = cl->inv_mass[i];
     if (wi == 0.0f || c->grid_result != AK_OK) return;
     uint32_t nb[SELF_MAX_NEIGHBOURS];
-    size_t total = ak_grid_query(&c->grid, c->x[i], c->self_dist, (ak_u32_span){nb, SELF_MAX_NEIGHBOURS});
+    size_t total = ak_grid_query(&c->grid, c->x[i].p, c->self_dist, (ak_u32_span){nb, SELF_MAX_NEIGHBOURS});
     if (total > SELF_MAX_NEIGHBOURS) total = SELF_MAX_NEIGHBOURS;
     /* the grid returns neighbours in its own order: sort them so the sum is the same for any
      * grid layout (insertion sort of at most 32) */
@@ -453,7 +498,7 @@ static void self_delta(const ctx* c, size_t i) {
         const uint32_t j = nb[k];
         if (j == i) continue;
         const float target = ak_minf(c->self_dist, ak_vec3_distance(cl->rest[i], cl->rest[j]));
-        const ak_vec3 d = ak_vec3_sub(c->x[i], c->x[j]);
+        const ak_vec3 d = ak_vec3_sub(c->x[i].p, c->x[j].p);
         const float l = ak_vec3_length(d);
         if (l >= target || l < 1e-9f) continue;
         const float wj = cl->inv_mass[j];
@@ -472,7 +517,7 @@ static void wind_triangles(const ctx* c, size_t b, size_t e) {
     const float rho = job->air_density > 0.0f ? job->air_density : 1.2f;
     for (size_t t = b; t < e; ++t) {
         const uint32_t* o = cl->indices + 3 * t;
-        const ak_vec3 p0 = c->x[o[0]], p1 = c->x[o[1]], p2 = c->x[o[2]];
+        const ak_vec3 p0 = c->x[o[0]].p, p1 = c->x[o[1]].p, p2 = c->x[o[2]].p;
         ak_vec3 f = ak_vec3_make(0, 0, 0);
         const ak_vec3 cr = ak_vec3_cross(ak_vec3_sub(p1, p0), ak_vec3_sub(p2, p0));
         const float cl2 = ak_vec3_length(cr);
@@ -518,16 +563,16 @@ static void kinematic_targets(const ctx* c, float f, unsigned t) {
     range(cl->attach_count, t, c->T, &b, &e);
     for (size_t k = b; k < e; ++k) {
         const uint32_t v = cl->attach[k];
-        c->prev[v] = c->x[v];
-        c->x[v] = f >= 1.0f ? c->job->attachment_targets.ptr[k] : ak_vec3_lerp(c->att_start[k], c->job->attachment_targets.ptr[k], f);
-        c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / c->h);
+        c->prev[v].p = c->x[v].p;
+        c->x[v].p = f >= 1.0f ? c->job->attachment_targets.ptr[k] : ak_vec3_lerp(c->att_start[k], c->job->attachment_targets.ptr[k], f);
+        c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / c->h);
     }
     range(cl->pin_count, t, c->T, &b, &e);
     for (size_t k = b; k < e; ++k) {
         const uint32_t v = cl->pins[k];
-        c->prev[v] = c->x[v];
-        c->x[v] = cl->pin_pos[k];
-        c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / c->h);
+        c->prev[v].p = c->x[v].p;
+        c->x[v].p = cl->pin_pos[k];
+        c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / c->h);
     }
 }
 
@@ -572,9 +617,9 @@ static void run_spmd(ctx* c, unsigned t) {
             for (size_t v = b; v < e; ++v) {
                 if (!is_free(cl, v)) continue;
                 const ak_vec3 vel = ak_vec3_madd(ak_vec3_scale(c->v[v], c->decay), c->acc[v], h * cl->inv_mass[v]);
-                c->prev[v] = c->x[v];
+                c->prev[v].p = c->x[v].p;
                 c->v[v] = vel;
-                c->x[v] = ak_vec3_madd(c->x[v], vel, h);
+                c->x[v].p = ak_vec3_madd(c->x[v].p, vel, h);
             }
             kinematic_targets(c, f, t);
             barrier(c);
@@ -586,11 +631,11 @@ static void run_spmd(ctx* c, unsigned t) {
             }
             for (size_t v = b; v < e; ++v) {
                 if (!is_free(cl, v)) continue;
-                const ak_vec3 before = c->x[v];
-                if (c->self) c->x[v] = ak_vec3_add(c->x[v], c->acc[v]);
+                const ak_vec3 before = c->x[v].p;
+                if (c->self) c->x[v].p = ak_vec3_add(c->x[v].p, c->acc[v]);
                 collide(c, v);
-                if (c->x[v].x != before.x || c->x[v].y != before.y || c->x[v].z != before.z)
-                    c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / h);
+                if (c->x[v].p.x != before.x || c->x[v].p.y != before.y || c->x[v].p.z != before.z)
+                    c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / h);
             }
             barrier(c);
             continue;
@@ -601,8 +646,8 @@ static void run_spmd(ctx* c, unsigned t) {
             /* damp, then accelerate: at rest (v = 0) damping then leaves the rest point alone */
             const ak_vec3 vel = ak_vec3_madd(ak_vec3_scale(c->v[v], c->decay),
                                              ak_vec3_madd(job->gravity, c->ext[v], cl->inv_mass[v]), h);
-            c->prev[v] = c->x[v];
-            c->x[v] = ak_vec3_madd(c->x[v], vel, h);
+            c->prev[v].p = c->x[v].p;
+            c->x[v].p = ak_vec3_madd(c->x[v].p, vel, h);
         }
         kinematic_targets(c, f, t);
         barrier(c);
@@ -612,8 +657,11 @@ static void run_spmd(ctx* c, unsigned t) {
                 if (cb == ce) continue;
                 size_t kb, ke;
                 if (col == AKP_SERIAL_COLOR) kb = t == 0 ? cb : ce, ke = ce;
-                else range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
-                for (size_t k = kb; k < ke; ++k) solve_dist(c, k, it == 0);
+                else block_range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
+                if (col == AKP_SERIAL_COLOR)
+                    for (size_t k = kb; k < ke; ++k) scalar_dist(&c->solve, k, it == 0);
+                else
+                    solve_dist_range(c, kb, ke, it == 0);
                 barrier(c);
             }
             for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
@@ -621,17 +669,20 @@ static void run_spmd(ctx* c, unsigned t) {
                 if (cb == ce) continue;
                 size_t kb, ke;
                 if (col == AKP_SERIAL_COLOR) kb = t == 0 ? cb : ce, ke = ce;
-                else range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
-                for (size_t k = kb; k < ke; ++k) solve_bend(c, k, it == 0);
+                else block_range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
+                if (col == AKP_SERIAL_COLOR)
+                    for (size_t k = kb; k < ke; ++k) scalar_bend(&c->solve, k, it == 0);
+                else
+                    solve_bend_range(c, kb, ke, it == 0);
                 barrier(c);
             }
             if (cl->lra_anchor) {
                 for (size_t v = b; v < e; ++v) {
                     const uint32_t a = cl->lra_anchor[v];
                     if (a == UINT32_MAX) continue;
-                    const ak_vec3 d = ak_vec3_sub(c->x[v], c->x[a]);
+                    const ak_vec3 d = ak_vec3_sub(c->x[v].p, c->x[a].p);
                     const float l = ak_vec3_length(d);
-                    if (l > cl->lra_dist[v]) c->x[v] = ak_vec3_madd(c->x[a], d, cl->lra_dist[v] / l);
+                    if (l > cl->lra_dist[v]) c->x[v].p = ak_vec3_madd(c->x[a].p, d, cl->lra_dist[v] / l);
                 }
                 barrier(c);
             }
@@ -644,13 +695,21 @@ static void run_spmd(ctx* c, unsigned t) {
         }
         for (size_t v = b; v < e; ++v) {
             if (is_free(cl, v)) {
-                if (c->self) c->x[v] = ak_vec3_add(c->x[v], c->acc[v]);
+                if (c->self) c->x[v].p = ak_vec3_add(c->x[v].p, c->acc[v]);
                 collide(c, v);
             }
-            c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v], c->prev[v]), 1.0f / h);
+            c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / h);
         }
         barrier(c);
     }
+}
+
+const char* ak_cloth_simd_name(void) {
+#if AKP_CLOTH_SIMD
+    if (akp_cloth_have_avx512()) return "avx512";
+    if (akp_cloth_have_avx2()) return "avx2";
+#endif
+    return "scalar";
 }
 
 static void* worker_main(void* arg) {
@@ -680,9 +739,10 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.h = job->dt / (float)c.substeps;
     c.decay = expf(-job->damping * c.h);
     c.thickness = job->thickness > 0.0f ? job->thickness : 0.01f;
-    c.x = job->positions.ptr;
+    c.x = (akp_px*)(base + l.xw);
+    c.xs = (ak_vec3*)(base + l.xs);
     c.v = job->velocities.ptr;
-    c.prev = (ak_vec3*)(base + l.prev);
+    c.prev = (akp_px*)(base + l.prev);
     c.ext = (ak_vec3*)(base + l.ext);
     c.acc = (ak_vec3*)(base + l.acc);
     c.lambda = (float*)(base + l.lambda);
@@ -695,14 +755,42 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.self = job->self_collision;
     c.self_dist = self_distance(job);
     c.grid_mem = (ak_u8_span){base + l.grid, l.grid_size};
-    memcpy(c.prev, c.x, cl->n * sizeof(ak_vec3));
-    for (size_t k = 0; k < cl->attach_count; ++k) c.att_start[k] = c.x[cl->attach[k]];
+    for (size_t v = 0; v < cl->n; ++v) {
+        c.x[v] = (akp_px){job->positions.ptr[v], cl->inv_mass[v]};
+        c.prev[v] = (akp_px){job->positions.ptr[v], 0.0f};
+    }
+    for (size_t k = 0; k < cl->attach_count; ++k) c.att_start[k] = job->positions.ptr[cl->attach[k]];
+    c.solve = (akp_solve){.cl = cl, .x = c.x, .prev = c.prev, .lambda = c.lambda, .h = c.h, .h2 = c.h * c.h,
+                          .beta = cl->desc.constraint_damping, .pbd_stiffness = cl->desc.pbd_stiffness,
+                          .bend_alpha = 1.0f / cl->desc.dihedral_stiffness, .pbd = cl->desc.solver == AK_CLOTH_PBD,
+                          .damped = cl->desc.constraint_damping > 0.0f,
+                          .iso = cl->desc.bending == AK_CLOTH_BEND_ISOMETRIC};
+    c.simd = 0;
+#if AKP_CLOTH_SIMD
+    {
+        const ak_cloth_simd limit = job->simd_limit == AK_CLOTH_SIMD_DEFAULT ? AK_CLOTH_SIMD_AVX512 : job->simd_limit;
+        if (limit >= AK_CLOTH_SIMD_AVX512 && akp_cloth_have_avx512()) c.simd = 2;
+        else if (limit >= AK_CLOTH_SIMD_AVX2 && akp_cloth_have_avx2()) c.simd = 1;
+    }
+#endif
     if (mesh_tris) build_hash(&c, 2.0f * c.thickness);
     unsigned want = job->thread_count > 1 ? job->thread_count : 1;
+    if (want > 1 && !job->exact_thread_count && cl->desc.solver != AK_CLOTH_SPRINGS) {
+        /* one thread per THREAD_MIN_PER_COLOR constraints of an average colour */
+        size_t colors = 0;
+        for (int k = 0; k <= AKP_MAX_COLORS; ++k)
+            colors += (cl->dist_color[k + 1] > cl->dist_color[k]) + (cl->bend_color[k + 1] > cl->bend_color[k]);
+        const size_t per_color = colors ? (cl->dist_count + cl->bend_count) / colors : 0;
+        const size_t fit = per_color / THREAD_MIN_PER_COLOR;
+        if (fit < want) want = fit > 1 ? (unsigned)fit : 1;
+    }
     if ((size_t)want > cl->n) want = cl->n ? (unsigned)cl->n : 1;
     pthread_t ids[MAX_THREADS];
     worker ws[MAX_THREADS];
     unsigned started = 1;
+    atomic_init(&c.arrived, 0u);
+    atomic_init(&c.generation, 0u);
+    atomic_init(&c.sleepers, 0u);
     if (want > 1) {
         pthread_mutex_init(&c.m, NULL);
         pthread_cond_init(&c.cv, NULL);
@@ -726,10 +814,12 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
         pthread_mutex_destroy(&c.m);
     }
     bool finite = true;
-    for (size_t v = 0; v < cl->n; ++v)
-        finite = finite && ak_vec3_is_finite(c.x[v]) && ak_vec3_is_finite(c.v[v]);
+    for (size_t v = 0; v < cl->n; ++v) {
+        job->positions.ptr[v] = c.x[v].p;
+        finite = finite && ak_vec3_is_finite(c.x[v].p) && ak_vec3_is_finite(c.v[v]);
+    }
     if (!finite) return AK_ERR_NO_CONVERGENCE;
     if (job->out_normals.ptr)
-        ak_cloth_normals(cl, (ak_vec3_cspan){c.x, cl->n}, job->out_normals);
+        ak_cloth_normals(cl, (ak_vec3_cspan){job->positions.ptr, cl->n}, job->out_normals);
     return AK_OK;
 }
