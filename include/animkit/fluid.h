@@ -206,7 +206,15 @@ typedef struct ak_fluid_step_job {
     ak_f32_span out_pressures;         /* optional: SPH/WCSPH pressure (Pa); PBF writes 0 */
     ak_u8_span out_flags;              /* optional: AK_FLUID_FLAG_* per particle */
     ak_fluid_stats* out_stats;         /* optional */
+    bool use_scalar;                   /* true: the scalar reference kernels even where AVX-512 runs */
 } ak_fluid_step_job;
+
+/* The kernel set ak_fluid_step_run picks on this CPU: "avx512" (AVX-512 F and DQ, chosen at run
+ * time) or "scalar" (AK_NO_SIMD builds, other CPUs, or job.use_scalar). The AVX-512 kernels
+ * sum each particle's neighbours in 16 lanes: the same terms in another order, so results agree
+ * with the scalar kernels to float rounding (relative 1e-5 on one step's densities, tested),
+ * not bit for bit; either way they are bit-identical for any thread count. */
+AK_API const char* ak_fluid_simd_name(void);
 
 /* Scratch bytes for up to capacity particles (0 when desc is invalid or capacity >= 2^31). */
 AK_API size_t ak_fluid_scratch_size(size_t capacity, const ak_fluid_desc* desc);
