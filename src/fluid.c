@@ -138,7 +138,7 @@ size_t ak_fluid_fill_box(const ak_fluid_desc* desc, ak_vec3 lo, ak_vec3 hi, ak_v
 /* ---- scratch ---------------------------------------------------------------------- */
 
 typedef struct layout {
-    size_t grid, dstart, nb_count, nb, tbuf, order, cell, pred, px, py, pz, qx, qy, qz, x0, v, acc, omega, omega_len, vnew,
+    size_t grid, dstart, nb_count, nb, tbuf, order, cell, pred, px, py, pz, qx, qy, qz, p4, q4, x0, v, acc, omega, omega_len, vnew,
         lambda, rho, pres, flags, total;
 } layout;
 
@@ -171,6 +171,8 @@ static bool make_layout(size_t cap, const ak_fluid_desc* d, layout* L) {
     TAKE(qx, cap * 4);
     TAKE(qy, cap * 4);
     TAKE(qz, cap * 4);
+    TAKE(p4, cap * 16);
+    TAKE(q4, cap * 16);
     TAKE(x0, cap * sizeof(ak_vec3));
     TAKE(v, cap * sizeof(ak_vec3));
     TAKE(acc, cap * sizeof(ak_vec3));
@@ -540,6 +542,7 @@ static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t ca
     for (size_t a = 0; a < n; ++a) {
         const ak_vec3 p = c->pred[c->order[a]];
         c->px[a] = p.x, c->py[a] = p.y, c->pz[a] = p.z;
+        if (c->simd) c->p4[4 * a] = p.x, c->p4[4 * a + 1] = p.y, c->p4[4 * a + 2] = p.z, c->p4[4 * a + 3] = 0.0f;
     }
     return true;
 }
@@ -647,6 +650,7 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
         ak_vec3 p = ak_vec3_add(pi, ak_vec3_scale(acc, c->mr));
         akp_fluid_collide(c, &p, NULL);
         c->qx[i] = p.x, c->qy[i] = p.y, c->qz[i] = p.z;
+        if (c->simd) c->q4[4 * i] = p.x, c->q4[4 * i + 1] = p.y, c->q4[4 * i + 2] = p.z, c->q4[4 * i + 3] = 0.0f;
     }
 }
 
@@ -655,6 +659,13 @@ static void ph_velocity(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     const float inv_dt = 1.0f / c->dt;
     for (size_t i = b; i < e; ++i) c->v[i] = ak_vec3_scale(ak_vec3_sub(P(c, (uint32_t)i), c->x0[i]), inv_dt);
+}
+
+/* AVX-512 PBF: (v, rho) records into q4 for the vorticity and XSPH kernels. */
+static void ph_pack_v(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i)
+        c->q4[4 * i] = c->v[i].x, c->q4[4 * i + 1] = c->v[i].y, c->q4[4 * i + 2] = c->v[i].z, c->q4[4 * i + 3] = c->rho[i];
 }
 
 /* PBF: vorticity omega_i = sum_j (m / rho_j) v_ij x grad_j W_ij (1/s). */
@@ -924,6 +935,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     c->pred = AT(ak_vec3, pred);
     c->px = AT(float, px), c->py = AT(float, py), c->pz = AT(float, pz);
     c->qx = AT(float, qx), c->qy = AT(float, qy), c->qz = AT(float, qz);
+    c->p4 = AT(float, p4), c->q4 = AT(float, q4);
     c->x0 = AT(ak_vec3, x0);
     c->v = AT(ak_vec3, v);
     c->acc = AT(ak_vec3, acc);
@@ -964,9 +976,11 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
             tmp = c->px, c->px = c->qx, c->qx = tmp;
             tmp = c->py, c->py = c->qy, c->qy = tmp;
             tmp = c->pz, c->pz = c->qz, c->qz = tmp;
+            tmp = c->p4, c->p4 = c->q4, c->q4 = tmp;
         }
         parallel(c, ph_velocity, threads);
         parallel(c, ph_density, threads);
+        if (c->simd && (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f)) parallel(c, ph_pack_v, threads);
         if (c->d.vorticity_epsilon != 0.0f) parallel(c, ph_vorticity, threads);
         if (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f) {
             parallel(c, ph_xsph, threads);
