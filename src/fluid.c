@@ -492,6 +492,23 @@ static void ph_neighbours_hashed(ctx* c, size_t b, size_t e, uint32_t t) {
     c->truncated[t] = trunc;
 }
 
+/* Pads every list of blocks [b, e) (16-aligned) up to its block's longest list with index 0,
+ * and the lists of lanes past n likewise, so the AVX-512 kernels may read the 16 entries of any
+ * slot below the block's longest count (the pads are masked out of every sum). */
+static void ph_pad_lists(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t blk = b; blk < e; blk += 16) {
+        uint32_t top = 0, cnt[16];
+        for (uint32_t u = 0; u < 16; ++u) {
+            cnt[u] = blk + u < c->n ? c->nb_count[blk + u] : 0u;
+            top = cnt[u] > top ? cnt[u] : top;
+        }
+        uint32_t* base = c->nb + (blk >> 4) * c->K * 16;
+        for (uint32_t u = 0; u < 16; ++u)
+            for (uint32_t q = cnt[u]; q < top; ++q) base[(size_t)q * 16 + u] = 0;
+    }
+}
+
 /* Sorts the predicted positions c->pred by cell into c->order / px, py, pz. Dense (z, y, x)
  * cells when the bounding box holds at most dense_cells(cap) cells, else the shared grid.
  * Returns false on a non-finite prediction. Sets *dense. */
@@ -965,6 +982,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
         return AK_ERR_NO_CONVERGENCE; /* only non-finite predictions fail here */
     if (dense) parallel(c, ph_neighbours_dense, threads);
     else parallel_n(c, ph_neighbours_hashed, threads, c->grid.cell_count);
+    if (c->simd) parallel(c, ph_pad_lists, threads);
     st.neighbour_seconds = (float)(now_seconds() - t_nb);
     parallel(c, ph_gather, threads);
 

@@ -59,6 +59,7 @@ AKP_AVX512 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t beg
 /* One slot q of a block's 16 lists: neighbour indices, offsets r = p_i - p_j, r^2, masks. */
 typedef struct pairs16 {
     __m512i idx;
+    const uint32_t* id; /* the slot's 16 entries */
     __m512 rx, ry, rz, r2;
     __mmask16 m;  /* lanes whose list has a slot q */
     __mmask16 in; /* and r^2 < h^2 */
@@ -86,11 +87,9 @@ AKP_AVX512 static inline void block_begin(const akp_fluid_ctx* c, size_t blk, si
     o->pz = _mm512_maskz_loadu_ps(o->lanes, c->pz + blk);
 }
 
-/* The (x, y, z, w) records p4[4 idx] of 16 particles as x, y, z (and w) lanes: 16 loads and a
+/* The (x, y, z, w) records p4[4 id[k]] of 16 particles as x, y, z (and w) lanes: 16 loads and a
  * 4 x 4 transpose in each 128-bit lane (cheaper than three or four 16-element gathers). */
-AKP_AVX512 static inline void load4(const float* p4, __m512i idx, __m512* x, __m512* y, __m512* z, __m512* w) {
-    uint32_t id[16];
-    _mm512_storeu_si512((void*)id, idx);
+AKP_AVX512 static inline void load4(const float* p4, const uint32_t* id, __m512* x, __m512* y, __m512* z, __m512* w) {
 #define R(k) _mm_load_ps(p4 + 4 * (size_t)id[k])
 #define ROW(a, b2, c2, d2) \
     _mm512_insertf32x4(_mm512_insertf32x4(_mm512_insertf32x4(_mm512_castps128_ps512(R(a)), R(b2), 1), R(c2), 2), R(d2), 3)
@@ -109,7 +108,8 @@ AKP_AVX512 static inline void load_pairs(const akp_fluid_ctx* c, const block16* 
     o->m = _mm512_mask_cmplt_epu32_mask(B->lanes, _mm512_set1_epi32((int)q), B->cnt);
     o->idx = _mm512_maskz_loadu_epi32(o->m, B->nb + (size_t)q * 16);
     __m512 x, y, z;
-    load4(c->p4, o->idx, &x, &y, &z, NULL);
+    o->id = B->nb + (size_t)q * 16; /* every entry valid: lists are padded (pad_lists in fluid.c) */
+    load4(c->p4, o->id, &x, &y, &z, NULL);
     o->rx = _mm512_sub_ps(B->px, x);
     o->ry = _mm512_sub_ps(B->py, y);
     o->rz = _mm512_sub_ps(B->pz, z);
@@ -221,7 +221,7 @@ AKP_AVX512 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
 /* Neighbour velocities and densities of p's lanes from the (v, rho) records in q4. */
 AKP_AVX512 static inline void gather_v(const akp_fluid_ctx* c, const pairs16* p, __m512* vx, __m512* vy, __m512* vz,
                                        __m512* rho) {
-    load4(c->q4, p->idx, vx, vy, vz, rho);
+    load4(c->q4, p->id, vx, vy, vz, rho);
 }
 
 /* The block's own velocities. */
