@@ -409,8 +409,12 @@ static float boundary_distance(const ctx* c, ak_vec3 p) {
 
 /* ---- neighbour search ------------------------------------------------------------- */
 
-/* The grid's cell formula: floor(p / h) in double. */
-static inline int64_t cell_coord(const ctx* c, float p) { return (int64_t)floor((double)p * c->inv_cell); }
+/* The grid's cell formula: floor(p / h) in double, clamped to +-2^30 as grid.h does. */
+static inline int64_t cell_coord(const ctx* c, float p) {
+    double v = floor((double)p * c->inv_cell);
+    v = v < -1073741824.0 ? -1073741824.0 : v > 1073741824.0 ? 1073741824.0 : v;
+    return (int64_t)v;
+}
 
 /* Appends the candidates [begin, end) within h of q to list (capacity K, index order). */
 static inline uint32_t filter_scalar(const ctx* c, uint32_t begin, uint32_t end, float qx, float qy, float qz,
@@ -529,7 +533,7 @@ static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t ca
         c->dim[a] = cell_coord(c, hi[a]) - c->cmin[a] + 1;
         volume *= (double)c->dim[a];
     }
-    *dense = n > 0 && volume <= (double)dense_cells(cap);
+    *dense = n > 0 && volume <= (double)dense_cells(cap) && volume < 4294967295.0;
     if (*dense) {
         const size_t cells = (size_t)volume;
         uint32_t* start = c->dstart;

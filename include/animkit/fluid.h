@@ -26,7 +26,12 @@
  *    Pi_ij = -nu (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2), nu = 2 alpha h c_s / (rho_i + rho_j),
  *    for approaching pairs. (The paper uses a cubic spline kernel; animkit uses the MCG kernels
  *    for every solver: poly6 for density, the spiky gradient for forces.)
- * Neighbours come from the shared uniform grid (grid.h), rebuilt each step with cell = h.
+ * Neighbours: each step re-sorts the particles by cell of size h (a counting sort into
+ * (z, y, x) cells when the liquid's bounding box holds at most 4 cells per particle of capacity,
+ * else the shared hashed grid of grid.h) and builds one list per particle, used by every pass
+ * of the step; the solver works on the sorted copy (SoA positions) and writes results back in
+ * the caller's order. Each list holds the particles closer than h in a fixed order (cells z,
+ * then y, then x, each in index order), the same on both paths.
  *
  * Boundaries (all solvers): a box container, planes, spheres and capsules, each optionally
  * moving with a velocity. The method is projection: a particle found inside a collider (or
@@ -64,7 +69,10 @@
  * Ownership and threading: jobs keep no pointer after run returns and never allocate (the
  * caller passes scratch, any alignment). thread_count threads split each phase by particle;
  * every particle sums over its neighbours in one fixed order, so results are bit-identical
- * for any thread count.
+ * for any thread count. SIMD: on CPUs with AVX-512 (chosen at run time) the neighbour filter
+ * and the PBF/density passes run 16 particles per instruction with the scalar code's float
+ * operations in the same order, so results are also bit-identical to the scalar kernels
+ * (job.use_scalar; AK_NO_SIMD builds have only those).
  */
 #ifndef ANIMKIT_FLUID_H
 #define ANIMKIT_FLUID_H
@@ -210,10 +218,8 @@ typedef struct ak_fluid_step_job {
 } ak_fluid_step_job;
 
 /* The kernel set ak_fluid_step_run picks on this CPU: "avx512" (AVX-512 F and DQ, chosen at run
- * time) or "scalar" (AK_NO_SIMD builds, other CPUs, or job.use_scalar). The AVX-512 kernels
- * sum each particle's neighbours in 16 lanes: the same terms in another order, so results agree
- * with the scalar kernels to float rounding (relative 1e-5 on one step's densities, tested),
- * not bit for bit; either way they are bit-identical for any thread count. */
+ * time) or "scalar" (AK_NO_SIMD builds, other CPUs; job.use_scalar also forces it). Both give
+ * bit-identical results (tested). */
 AK_API const char* ak_fluid_simd_name(void);
 
 /* Scratch bytes for up to capacity particles (0 when desc is invalid or capacity >= 2^31). */
