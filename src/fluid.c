@@ -671,7 +671,7 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
         ak_vec3 p = ak_vec3_add(pi, ak_vec3_scale(acc, c->mr));
         akp_fluid_collide(c, &p, NULL);
         c->qx[i] = p.x, c->qy[i] = p.y, c->qz[i] = p.z;
-        if (c->simd) c->q4[4 * i] = p.x, c->q4[4 * i + 1] = p.y, c->q4[4 * i + 2] = p.z, c->q4[4 * i + 3] = 0.0f;
+        if (c->simd) c->p4[4 * i] = p.x, c->p4[4 * i + 1] = p.y, c->p4[4 * i + 2] = p.z, c->p4[4 * i + 3] = 0.0f;
     }
 }
 
@@ -998,7 +998,6 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
             tmp = c->px, c->px = c->qx, c->qx = tmp;
             tmp = c->py, c->py = c->qy, c->qy = tmp;
             tmp = c->pz, c->pz = c->qz, c->qz = tmp;
-            tmp = c->p4, c->p4 = c->q4, c->q4 = tmp;
         }
         parallel(c, ph_velocity, threads);
         parallel(c, ph_density, threads);

@@ -104,18 +104,25 @@ AKP_AVX512 static inline void load4(const float* p4, const uint32_t* id, __m512*
     if (w) *w = _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
 }
 
-AKP_AVX512 static inline void load_pairs(const akp_fluid_ctx* c, const block16* B, uint32_t q, pairs16* o) {
+/* Slot q of block B: neighbours from the records rec (p4, or q4 = (x, y, z, lambda) in the
+ * correction pass, whose w lands in *w when w is not NULL). */
+AKP_AVX512 static inline void load_pairs_from(const akp_fluid_ctx* c, const block16* B, uint32_t q, const float* rec,
+                                              __m512* w, pairs16* o) {
     o->m = _mm512_mask_cmplt_epu32_mask(B->lanes, _mm512_set1_epi32((int)q), B->cnt);
     o->idx = _mm512_maskz_loadu_epi32(o->m, B->nb + (size_t)q * 16);
     __m512 x, y, z;
     o->id = B->nb + (size_t)q * 16; /* every entry valid: lists are padded (pad_lists in fluid.c) */
-    load4(c->p4, o->id, &x, &y, &z, NULL);
+    load4(rec, o->id, &x, &y, &z, w);
     o->rx = _mm512_sub_ps(B->px, x);
     o->ry = _mm512_sub_ps(B->py, y);
     o->rz = _mm512_sub_ps(B->pz, z);
     o->r2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(o->rx, o->rx), _mm512_mul_ps(o->ry, o->ry)),
                           _mm512_mul_ps(o->rz, o->rz));
     o->in = _mm512_mask_cmp_ps_mask(o->m, o->r2, _mm512_set1_ps(c->h2), _CMP_LT_OQ);
+}
+
+AKP_AVX512 static inline void load_pairs(const akp_fluid_ctx* c, const block16* B, uint32_t q, pairs16* o) {
+    load_pairs_from(c, B, q, c->p4, NULL, o);
 }
 
 /* k_poly6: poly6_k d d d, d = h^2 - r^2 (+0 outside). */
@@ -173,7 +180,16 @@ AKP_AVX512 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
         if (!c->d.bilateral) C = _mm512_mask_mov_ps(C, _mm512_cmp_ps_mask(C, zero, _CMP_LT_OQ), zero);
         const __m512 gg = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(gx, gx), _mm512_mul_ps(gy, gy)), _mm512_mul_ps(gz, gz));
         const __m512 den = _mm512_add_ps(_mm512_add_ps(gg, g2), _mm512_set1_ps(c->d.relaxation));
-        _mm512_mask_storeu_ps(c->lambda + blk, B.lanes, _mm512_maskz_div_ps(B.lanes, neg16(C), den));
+        const __m512 lam = _mm512_maskz_div_ps(B.lanes, neg16(C), den);
+        _mm512_mask_storeu_ps(c->lambda + blk, B.lanes, lam);
+        /* (x, y, z, lambda) records for the correction pass */
+        float x[16], y[16], z[16], l[16];
+        _mm512_storeu_ps(x, B.px), _mm512_storeu_ps(y, B.py), _mm512_storeu_ps(z, B.pz), _mm512_storeu_ps(l, lam);
+        for (uint32_t u = 0; u < 16; ++u) {
+            if (!(B.lanes >> u & 1u)) continue;
+            float* r = c->q4 + 4 * (blk + u);
+            r[0] = x[u], r[1] = y[u], r[2] = z[u], r[3] = l[u];
+        }
     }
 }
 
@@ -190,9 +206,9 @@ AKP_AVX512 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
         __m512 ax = zero, ay = zero, az = zero;
         for (uint32_t q = 0; q < B.max_count; ++q) {
             pairs16 p;
-            load_pairs(c, &B, q, &p);
+            __m512 lj;
+            load_pairs_from(c, &B, q, c->q4, &lj, &p);
             const __mmask16 other = _mm512_mask_cmpneq_epi32_mask(p.m, p.idx, self); /* j != i */
-            const __m512 lj = _mm512_mask_i32gather_ps(zero, other, p.idx, c->lambda, 4);
             __m512 l = _mm512_add_ps(li, lj);
             if (scorr) {
                 const __m512 w = _mm512_mul_ps(poly6_16(c, &p), inv_wdq), w2 = _mm512_mul_ps(w, w);
@@ -212,8 +228,8 @@ AKP_AVX512 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
             ak_vec3 pos = ak_vec3_make(x[u], y[u], z[u]);
             akp_fluid_collide(c, &pos, NULL);
             c->qx[blk + u] = pos.x, c->qy[blk + u] = pos.y, c->qz[blk + u] = pos.z;
-            float* q4 = c->q4 + 4 * (blk + u);
-            q4[0] = pos.x, q4[1] = pos.y, q4[2] = pos.z, q4[3] = 0.0f;
+            float* r = c->p4 + 4 * (blk + u); /* no pass reads p4 until the next lambda pass */
+            r[0] = pos.x, r[1] = pos.y, r[2] = pos.z, r[3] = 0.0f;
         }
     }
 }

@@ -28,8 +28,10 @@ typedef struct akp_fluid_ctx {
     uint32_t* cell;   /* [n]: dense cell of original particle i (counting sort) */
     float *px, *py, *pz; /* predicted positions (PBF: the current Jacobi iterate) */
     float *qx, *qy, *qz; /* the next Jacobi iterate (PBF) / the integrated positions (SPH) */
-    float *p4, *q4;   /* AVX-512 kernels: p and q again as (x, y, z, 0) records (one load each);
-                         after the PBF iterations q4 holds (v, rho) records for vorticity and XSPH */
+    float *p4, *q4;   /* AVX-512 kernels, 16-byte records (one load each): p4 = (p, 0), the
+                         current iterate (the correction pass writes the next one there, reading
+                         none); q4 = (p, lambda) from the lambda pass for the correction pass,
+                         then (v, rho) for vorticity and XSPH */
     ak_vec3* x0;      /* start-of-step positions */
     ak_vec3* v;       /* velocities */
     ak_vec3* acc;     /* SPH accelerations */
