@@ -196,7 +196,22 @@ size_t ak_fluid_scratch_size(size_t capacity, const ak_fluid_desc* desc) {
     return L.total;
 }
 
-const char* ak_fluid_simd_name(void) { return akp_fluid_have_avx512() ? "avx512" : "scalar"; }
+ak_fluid_kernels ak_fluid_kernels_resolved(ak_fluid_kernels want) {
+    if ((unsigned)want >= AK_FLUID_KERNELS_COUNT) return AK_FLUID_KERNELS_SCALAR;
+    if (want == AK_FLUID_KERNELS_BEST) want = AK_FLUID_KERNELS_AVX512;
+    if (want == AK_FLUID_KERNELS_AVX512 && !akp_fluid_have_avx512()) want = AK_FLUID_KERNELS_AVX2;
+    if (want == AK_FLUID_KERNELS_AVX2 && !akp_fluid_have_avx2()) want = AK_FLUID_KERNELS_SCALAR;
+    return want;
+}
+
+const char* ak_fluid_kernels_name(ak_fluid_kernels k) {
+    switch (k) {
+    case AK_FLUID_KERNELS_SCALAR: return "scalar";
+    case AK_FLUID_KERNELS_AVX2: return "avx2";
+    case AK_FLUID_KERNELS_AVX512: return "avx512";
+    default: return "best";
+    }
+}
 
 /* ---- validation ------------------------------------------------------------------- */
 
@@ -212,7 +227,7 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
         return AK_ERR_NULL_ARG;
     const ak_fluid_desc* d = job->desc;
     if (!desc_ok(d) || !(job->dt > 0.0f) || !ak_finitef(job->dt) || !ak_finitef(job->time) ||
-        (unsigned)d->solver >= AK_FLUID_SOLVER_COUNT || job->thread_count > FLUID_MAX_THREADS ||
+        (unsigned)d->solver >= AK_FLUID_SOLVER_COUNT || (unsigned)job->kernels >= AK_FLUID_KERNELS_COUNT || job->thread_count > FLUID_MAX_THREADS ||
         d->iterations > 1000 || !(d->relaxation >= 0.0f) || !ak_finitef(d->relaxation) || !(d->stiffness >= 0.0f) ||
         !ak_finitef(d->stiffness) || !(d->viscosity >= 0.0f) || !ak_finitef(d->viscosity) ||
         !(d->sound_speed >= 0.0f) || !ak_finitef(d->sound_speed) || !(d->tait_gamma >= 0.0f) ||
@@ -458,8 +473,9 @@ static void ph_neighbours_dense(ctx* c, size_t b, size_t e, uint32_t t) {
                 const size_t row = (size_t)((zz * Y + yy) * X);
                 const uint32_t rb = c->dstart[row + (size_t)xa], re = c->dstart[row + (size_t)xb + 1];
                 if (rb == re) continue;
-                total += c->simd ? akp_fluid_filter_avx512(c, rb, re, qx, qy, qz, list, &k)
-                                 : filter_scalar(c, rb, re, qx, qy, qz, list, &k);
+                total += c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_filter_avx512(c, rb, re, qx, qy, qz, list, &k)
+                         : c->kernels == AK_FLUID_KERNELS_AVX2   ? akp_fluid_filter_avx2(c, rb, re, qx, qy, qz, list, &k)
+                                                                 : filter_scalar(c, rb, re, qx, qy, qz, list, &k);
             }
         }
         if (total > c->K) ++trunc;
@@ -598,7 +614,7 @@ static void ph_gather(ctx* c, size_t b, size_t e, uint32_t t) {
 static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     if (c->simd) {
-        akp_fluid_density_avx512(c, b, e);
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_density_avx512 : akp_fluid_density_avx2)(c, b, e);
         return;
     }
     for (size_t i = b; i < e; ++i) {
@@ -617,7 +633,7 @@ static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
 static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     if (c->simd) {
-        akp_fluid_lambda_avx512(c, b, e);
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_lambda_avx512 : akp_fluid_lambda_avx2)(c, b, e);
         return;
     }
     for (size_t i = b; i < e; ++i) {
@@ -648,7 +664,7 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
     const float k = c->d.scorr_k / c->grad2_rest, np = c->d.scorr_n, inv_wdq = scorr ? 1.0f / c->wdq : 0.0f;
     const bool n4 = np == 4.0f;
     if (c->simd && (n4 || !scorr)) {
-        akp_fluid_delta_avx512(c, b, e);
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_delta_avx512 : akp_fluid_delta_avx2)(c, b, e);
         return;
     }
     for (size_t i = b; i < e; ++i) {
@@ -668,11 +684,16 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
             }
             acc = ak_vec3_add(acc, ak_vec3_scale(k_spiky(c, r), li + c->lambda[j] + s));
         }
-        ak_vec3 p = ak_vec3_add(pi, ak_vec3_scale(acc, c->mr));
-        akp_fluid_collide(c, &p, NULL);
-        c->qx[i] = p.x, c->qy[i] = p.y, c->qz[i] = p.z;
-        if (c->simd) c->p4[4 * i] = p.x, c->p4[4 * i + 1] = p.y, c->p4[4 * i + 2] = p.z, c->p4[4 * i + 3] = 0.0f;
+        akp_fluid_delta_finish(c, i, ak_vec3_add(pi, ak_vec3_scale(acc, c->mr)));
     }
+}
+
+void akp_fluid_delta_finish(akp_fluid_ctx* c, size_t i, ak_vec3 p) {
+    akp_fluid_collide(c, &p, NULL);
+    c->qx[i] = p.x, c->qy[i] = p.y, c->qz[i] = p.z;
+    /* the SIMD kernels' next iterate as (x, y, z, 0) records: no pass reads p4 until the next
+     * lambda pass (the correction pass reads q4) */
+    if (c->simd) c->p4[4 * i] = p.x, c->p4[4 * i + 1] = p.y, c->p4[4 * i + 2] = p.z, c->p4[4 * i + 3] = 0.0f;
 }
 
 /* PBF: v = (x* - x) / dt. */
@@ -693,7 +714,7 @@ static void ph_pack_v(ctx* c, size_t b, size_t e, uint32_t t) {
 static void ph_vorticity(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     if (c->simd) {
-        akp_fluid_vorticity_avx512(c, b, e);
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_vorticity_avx512 : akp_fluid_vorticity_avx2)(c, b, e);
         return;
     }
     for (size_t i = b; i < e; ++i) {
@@ -717,7 +738,7 @@ static void ph_vorticity(ctx* c, size_t b, size_t e, uint32_t t) {
 static void ph_xsph(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     if (c->simd) {
-        akp_fluid_xsph_avx512(c, b, e);
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_xsph_avx512 : akp_fluid_xsph_avx2)(c, b, e);
         return;
     }
     const float eps = c->d.vorticity_epsilon, xc = c->d.xsph_c;
@@ -734,16 +755,21 @@ static void ph_xsph(ctx* c, size_t b, size_t e, uint32_t t) {
                 xs = ak_vec3_add(xs, ak_vec3_scale(ak_vec3_sub(c->v[j], c->v[i]),
                                                    c->m / c->rho[j] * k_poly6(c, ak_vec3_dot(r, r))));
         }
-        ak_vec3 vi = ak_vec3_add(c->v[i], ak_vec3_scale(xs, xc));
-        if (eps != 0.0f) {
-            float el = ak_vec3_length(eta);
-            if (el > 1e-20f) {
-                ak_vec3 N = ak_vec3_scale(eta, 1.0f / el);
-                vi = ak_vec3_add(vi, ak_vec3_scale(ak_vec3_cross(N, c->omega[i]), eps * c->dt));
-            }
-        }
-        c->vnew[i] = vi;
+        akp_fluid_xsph_finish(c, i, eta, xs);
     }
+}
+
+void akp_fluid_xsph_finish(akp_fluid_ctx* c, size_t i, ak_vec3 eta, ak_vec3 xs) {
+    const float eps = c->d.vorticity_epsilon;
+    ak_vec3 vi = ak_vec3_add(c->v[i], ak_vec3_scale(xs, c->d.xsph_c));
+    if (eps != 0.0f) {
+        float el = ak_vec3_length(eta);
+        if (el > 1e-20f) {
+            ak_vec3 N = ak_vec3_scale(eta, 1.0f / el);
+            vi = ak_vec3_add(vi, ak_vec3_scale(ak_vec3_cross(N, c->omega[i]), eps * c->dt));
+        }
+    }
+    c->vnew[i] = vi;
 }
 
 /* SPH / WCSPH: pressure from density. */
@@ -928,7 +954,8 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     c->mr = c->m / c->rho0;
     c->K = c->d.max_neighbours;
     c->inv_cell = 1.0 / (double)c->h;
-    c->simd = !job->use_scalar && akp_fluid_have_avx512();
+    c->kernels = ak_fluid_kernels_resolved(job->kernels);
+    c->simd = c->kernels != AK_FLUID_KERNELS_SCALAR;
     const float s = cbrtf(c->mr);
     lattice_props(c->h, s, c->mr, &c->full_lattice_count, &c->grad2_rest);
     {

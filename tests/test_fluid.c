@@ -409,8 +409,9 @@ static double naive_density(const ak_fluid_desc* d, const ak_vec3* pos, size_t n
 }
 
 /* One SPH step reports the densities at the input positions: on both neighbour paths (dense
- * cells, hashed grid), both kernel sets and 1 or 3 threads they match the naive double sum
- * within float rounding (relative 2e-5), and all runs give the same bits. */
+ * cells, hashed grid), every kernel set (scalar, AVX2, AVX-512, each where the CPU has it) and 1
+ * or 3 threads they match the naive double sum within float rounding (relative 2e-5), and all
+ * runs give the same bits. */
 AK_TEST(densities_match_naive_sum_on_every_path) {
     ak_fluid_desc d;
     float s;
@@ -421,7 +422,7 @@ AK_TEST(densities_match_naive_sum_on_every_path) {
     for (int far = 0; far < 2; ++far) {
         const size_t n0 = jittered_block(&d, s, pos0, far == 1);
         double worst = 0.0;
-        for (int run = 0; run < 4; ++run) {
+        for (int run = 0; run < 6; ++run) {
             size_t n = n0;
             memcpy(pos, pos0, n * sizeof *pos);
             memset(vel, 0, sizeof vel);
@@ -429,7 +430,7 @@ AK_TEST(densities_match_naive_sum_on_every_path) {
             void* mem = malloc(bytes);
             ak_fluid_step_job job = {.desc = &d, .dt = 1e-5f, .positions = {pos, n}, .velocities = {vel, n},
                                      .particle_count = &n, .thread_count = run & 1 ? 3u : 1u,
-                                     .use_scalar = run >= 2, .scratch = {mem, bytes}, .out_densities = {rho, n}};
+                                     .kernels = (ak_fluid_kernels)(AK_FLUID_KERNELS_SCALAR + run / 2), .scratch = {mem, bytes}, .out_densities = {rho, n}};
             AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
             free(mem);
             for (size_t i = 0; i < n0; ++i) {
@@ -454,7 +455,7 @@ typedef struct simd_case {
     uint32_t max_neighbours;
 } simd_case;
 
-static void run_case(const simd_case* k, bool scalar, ak_vec3* pos, ak_vec3* vel, float* rho, uint8_t* flags,
+static void run_case(const simd_case* k, ak_fluid_kernels kernels, ak_vec3* pos, ak_vec3* vel, float* rho, uint8_t* flags,
                      ak_fluid_stats* st) {
     ak_fluid_desc d;
     float s;
@@ -474,15 +475,15 @@ static void run_case(const simd_case* k, bool scalar, ak_vec3* pos, ak_vec3* vel
     void* mem = malloc(bytes);
     ak_fluid_step_job job = {.desc = &d, .dt = k->solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f,
                              .positions = {pos, n}, .velocities = {vel, n}, .particle_count = &n,
-                             .colliders = {cols, 2}, .thread_count = 2, .use_scalar = scalar,
+                             .colliders = {cols, 2}, .thread_count = 2, .kernels = kernels,
                              .scratch = {mem, bytes}, .out_densities = {rho, n}, .out_flags = {flags, n},
                              .out_stats = st};
     for (int step = 0; step < 8; ++step) AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
     free(mem);
 }
 
-/* The AVX-512 kernels (where this CPU has them) against job.use_scalar: the same bits for
- * positions, velocities, densities, flags and statistics after 8 steps, for PBF (with the
+/* The AVX2 and AVX-512 kernels (where this CPU has them) against the scalar ones: the same bits
+ * for positions, velocities, densities, flags and statistics after 8 steps, for PBF (with the
  * tensile term's n = 4 fast path, a general n, and lists truncated at 12 neighbours), SPH and
  * WCSPH, with moving colliders and 2 threads. */
 AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
@@ -494,19 +495,27 @@ AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
                                {"pbf 12 neighbours", AK_FLUID_PBF, 0.0f, 12},
                                {"sph", AK_FLUID_SPH, 0.0f, 0},
                                {"wcsph", AK_FLUID_WCSPH, 0.0f, 0}};
-    printf("  kernels on this CPU: %s%s\n", ak_fluid_simd_name(),
-           strcmp(ak_fluid_simd_name(), "scalar") == 0 ? " (both runs scalar: the comparison is trivial here)" : "");
+    const ak_fluid_kernels sets[] = {AK_FLUID_KERNELS_AVX2, AK_FLUID_KERNELS_AVX512};
+    for (int s = 0; s < 2; ++s) {
+        const ak_fluid_kernels got = ak_fluid_kernels_resolved(sets[s]);
+        if (got != sets[s]) {
+            printf("  %s: not on this CPU or build (runs %s; nothing to compare)\n", ak_fluid_kernels_name(sets[s]),
+                   ak_fluid_kernels_name(got));
+            continue;
+        }
+        printf("  %s against scalar\n", ak_fluid_kernels_name(sets[s]));
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         ak_fluid_stats s1, s2;
-        run_case(&cases[k], false, p1, v1, r1, f1, &s1);
-        run_case(&cases[k], true, p2, v2, r2, f2, &s2);
+        run_case(&cases[k], sets[s], p1, v1, r1, f1, &s1);
+        run_case(&cases[k], AK_FLUID_KERNELS_SCALAR, p2, v2, r2, f2, &s2);
         const size_t n = 13 * 11 * 9;
         const bool same = memcmp(p1, p2, n * sizeof *p1) == 0 && memcmp(v1, v2, n * sizeof *v1) == 0 &&
                           memcmp(r1, r2, n * sizeof *r1) == 0 && memcmp(f1, f2, n) == 0 &&
                           s1.max_density_error == s2.max_density_error && s1.full_count == s2.full_count &&
                           s1.surface_count == s2.surface_count && s1.truncated_count == s2.truncated_count;
-        AK_CHECK_MSG(same, "%s: AVX-512 and scalar kernels differ", cases[k].name);
+        AK_CHECK_MSG(same, "%s: %s and scalar kernels differ", cases[k].name, ak_fluid_kernels_name(sets[s]));
         if (cases[k].max_neighbours) AK_CHECK_MSG(s1.truncated_count > 0, "%s: nothing truncated", cases[k].name);
+    }
     }
 }
 
@@ -525,6 +534,11 @@ AK_TEST(validation_and_blow_up) {
     job.dt = 0.0f;
     AK_CHECK_EQ(ak_fluid_step_run(&job), AK_ERR_BAD_ARG);
     job.dt = 0.01f;
+    job.kernels = AK_FLUID_KERNELS_COUNT;
+    AK_CHECK_EQ(ak_fluid_step_run(&job), AK_ERR_BAD_ARG);
+    job.kernels = AK_FLUID_KERNELS_BEST;
+    AK_CHECK_EQ(ak_fluid_kernels_resolved(AK_FLUID_KERNELS_SCALAR), AK_FLUID_KERNELS_SCALAR);
+    AK_CHECK(ak_fluid_kernels_resolved(AK_FLUID_KERNELS_BEST) != AK_FLUID_KERNELS_BEST);
     pos[1].x = NAN;
     AK_CHECK_EQ(ak_fluid_step_run(&job), AK_ERR_BAD_DATA);
     AK_CHECK(isnan(pos[1].x)); /* nothing written */

@@ -223,14 +223,8 @@ AKP_AVX512 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
         _mm512_storeu_ps(x, _mm512_add_ps(B.px, _mm512_mul_ps(ax, mr)));
         _mm512_storeu_ps(y, _mm512_add_ps(B.py, _mm512_mul_ps(ay, mr)));
         _mm512_storeu_ps(z, _mm512_add_ps(B.pz, _mm512_mul_ps(az, mr)));
-        for (uint32_t u = 0; u < 16; ++u) {
-            if (!(B.lanes >> u & 1u)) continue;
-            ak_vec3 pos = ak_vec3_make(x[u], y[u], z[u]);
-            akp_fluid_collide(c, &pos, NULL);
-            c->qx[blk + u] = pos.x, c->qy[blk + u] = pos.y, c->qz[blk + u] = pos.z;
-            float* r = c->p4 + 4 * (blk + u); /* no pass reads p4 until the next lambda pass */
-            r[0] = pos.x, r[1] = pos.y, r[2] = pos.z, r[3] = 0.0f;
-        }
+        for (uint32_t u = 0; u < 16; ++u)
+            if (B.lanes >> u & 1u) akp_fluid_delta_finish(c, blk + u, ak_vec3_make(x[u], y[u], z[u]));
     }
 }
 
@@ -321,21 +315,10 @@ AKP_AVX512 void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
         float e3[3][16], s3[3][16];
         _mm512_storeu_ps(e3[0], ex), _mm512_storeu_ps(e3[1], ey), _mm512_storeu_ps(e3[2], ez);
         _mm512_storeu_ps(s3[0], sx), _mm512_storeu_ps(s3[1], sy), _mm512_storeu_ps(s3[2], sz);
-        for (uint32_t u = 0; u < 16; ++u) {
-            if (!(B.lanes >> u & 1u)) continue;
-            const size_t i = blk + u;
-            const ak_vec3 eta = ak_vec3_make(e3[0][u], e3[1][u], e3[2][u]);
-            const ak_vec3 xs = ak_vec3_make(s3[0][u], s3[1][u], s3[2][u]);
-            ak_vec3 vi = ak_vec3_add(c->v[i], ak_vec3_scale(xs, xc));
-            if (eps != 0.0f) {
-                const float el = ak_vec3_length(eta);
-                if (el > 1e-20f) {
-                    const ak_vec3 N = ak_vec3_scale(eta, 1.0f / el);
-                    vi = ak_vec3_add(vi, ak_vec3_scale(ak_vec3_cross(N, c->omega[i]), eps * c->dt));
-                }
-            }
-            c->vnew[i] = vi;
-        }
+        for (uint32_t u = 0; u < 16; ++u)
+            if (B.lanes >> u & 1u)
+                akp_fluid_xsph_finish(c, blk + u, ak_vec3_make(e3[0][u], e3[1][u], e3[2][u]),
+                                      ak_vec3_make(s3[0][u], s3[1][u], s3[2][u]));
     }
 }
 

@@ -18,7 +18,8 @@ typedef struct akp_fluid_ctx {
     size_t n;
     float dt, h, h2, rho0, m, mr; /* mr = m / rho0 */
     uint32_t K, full_lattice_count;
-    bool simd;        /* the AVX-512 kernels run this step */
+    ak_fluid_kernels kernels; /* the kernel set of this step (never BEST) */
+    bool simd;        /* kernels is AVX2 or AVX-512: records p4/q4 and padded lists kept */
     /* original order (the caller's arrays) */
     ak_vec3* xo;      /* positions */
     ak_vec3* vo;      /* velocities */
@@ -78,7 +79,21 @@ void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_vorticity_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 
-/* fluid.c: the collision projection of every solver (v may be NULL). */
+/* avx2.c: the same kernels on 8 lanes (each block of 16 as two halves), bit-identical too. */
+bool akp_fluid_have_avx2(void);
+uint32_t akp_fluid_filter_avx2(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx, float qy, float qz,
+                               uint32_t* list, uint32_t* k);
+void akp_fluid_density_avx2(akp_fluid_ctx* c, size_t b, size_t e);
+void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e);
+void akp_fluid_delta_avx2(akp_fluid_ctx* c, size_t b, size_t e);
+void akp_fluid_vorticity_avx2(akp_fluid_ctx* c, size_t b, size_t e);
+void akp_fluid_xsph_avx2(akp_fluid_ctx* c, size_t b, size_t e);
+
+/* fluid.c: the collision projection of every solver (v may be NULL); the scalar tails shared
+ * by every kernel set: the corrected position p of particle i collided and stored as the next
+ * iterate, and particle i's XSPH and vorticity-confinement velocity from its sums. */
 void akp_fluid_collide(const akp_fluid_ctx* c, ak_vec3* p, ak_vec3* v);
+void akp_fluid_delta_finish(akp_fluid_ctx* c, size_t i, ak_vec3 p);
+void akp_fluid_xsph_finish(akp_fluid_ctx* c, size_t i, ak_vec3 eta, ak_vec3 xs);
 
 #endif
