@@ -19,9 +19,14 @@ typedef struct result {
     size_t count;
 } result;
 
-static result run(ak_fluid_solver solver, uint32_t threads, ak_fluid_kernels kernels, size_t want, int steps) {
-    ak_fluid_desc d = {.solver = solver, .particle_mass = 0.001f, .gravity = {0, -9.81f, 0}, .xsph_c = 0.01f,
-                       .vorticity_epsilon = solver == AK_FLUID_PBF ? 0.1f : 0.0f, .iterations = 4,
+static result run(ak_fluid_solver solver, uint32_t threads, ak_fluid_kernels kernels, size_t want,
+                  int steps) {
+    ak_fluid_desc d = {.solver = solver,
+                       .particle_mass = 0.001f,
+                       .gravity = {0, -9.81f, 0},
+                       .xsph_c = 0.01f,
+                       .vorticity_epsilon = solver == AK_FLUID_PBF ? 0.1f : 0.0f,
+                       .iterations = 4,
                        .viscosity = solver == AK_FLUID_WCSPH ? 0.05f : 0.02f};
     const float s = ak_fluid_rest_spacing(&d);
     d.h = 2.0f * s;
@@ -37,9 +42,14 @@ static result run(ak_fluid_solver solver, uint32_t threads, ak_fluid_kernels ker
     size_t bytes = ak_fluid_scratch_size(n, &d);
     void* mem = malloc(bytes);
     ak_fluid_stats st;
-    ak_fluid_step_job job = {.desc = &d, .dt = solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f,
-                             .positions = {pos, n}, .velocities = {vel, n}, .particle_count = &n,
-                             .thread_count = threads, .scratch = {mem, bytes}, .out_stats = &st,
+    ak_fluid_step_job job = {.desc = &d,
+                             .dt = solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f,
+                             .positions = {pos, n},
+                             .velocities = {vel, n},
+                             .particle_count = &n,
+                             .thread_count = threads,
+                             .scratch = {mem, bytes},
+                             .out_stats = &st,
                              .kernels = kernels};
     for (int k = 0; k < 5; ++k) ak_fluid_step_run(&job);
     double nb = 0.0, w0 = bench_wall_s(), c0 = bench_proc_s();
@@ -47,7 +57,8 @@ static result run(ak_fluid_solver solver, uint32_t threads, ak_fluid_kernels ker
         if (ak_fluid_step_run(&job) != AK_OK) fprintf(stderr, "step %d failed\n", k);
         nb += st.neighbour_seconds;
     }
-    result r = {(bench_wall_s() - w0) * 1e3 / steps, (bench_proc_s() - c0) * 1e3 / steps, nb * 1e3 / steps, n};
+    result r = {(bench_wall_s() - w0) * 1e3 / steps, (bench_proc_s() - c0) * 1e3 / steps,
+                nb * 1e3 / steps, n};
     free(pos), free(vel), free(mem);
     return r;
 }
@@ -64,12 +75,15 @@ int main(int argc, char** argv) {
     const char* keys[] = {"pbf", "sph", "wcsph"};
     const ak_fluid_solver solvers[] = {AK_FLUID_PBF, AK_FLUID_SPH, AK_FLUID_WCSPH};
     /* the kernel sets this CPU runs, fastest first; scalar last */
-    const ak_fluid_kernels sets[SETS] = {AK_FLUID_KERNELS_AVX512, AK_FLUID_KERNELS_AVX2, AK_FLUID_KERNELS_SCALAR};
+    const ak_fluid_kernels sets[SETS] = {AK_FLUID_KERNELS_AVX512, AK_FLUID_KERNELS_AVX2,
+                                         AK_FLUID_KERNELS_SCALAR};
     bool have[SETS];
     for (int k = 0; k < SETS; ++k) have[k] = ak_fluid_kernels_resolved(sets[k]) == sets[k];
-    printf("dam break, at least %zu particles, h = 2 x spacing, %d timed steps, best of %d interleaved rounds\n"
+    printf("dam break, at least %zu particles, h = 2 x spacing, %d timed steps, best of %d "
+           "interleaved rounds\n"
            "(cpu = all threads; default kernels here: %s)\n",
-           want, steps, rounds, ak_fluid_kernels_name(ak_fluid_kernels_resolved(AK_FLUID_KERNELS_BEST)));
+           want, steps, rounds,
+           ak_fluid_kernels_name(ak_fluid_kernels_resolved(AK_FLUID_KERNELS_BEST)));
     result best[CONFIGS];
     bool used[CONFIGS] = {false};
     for (int r = 0; r < rounds; ++r)
@@ -90,8 +104,8 @@ int main(int argc, char** argv) {
                 }
             }
         }
-    printf("%-11s %-7s %7s %9s %10s %10s %9s %10s %12s\n", "solver", "kernels", "threads", "particles", "wall ms",
-           "cpu ms", "nb ms", "nb share", "particles/s");
+    printf("%-11s %-7s %7s %9s %10s %10s %9s %10s %12s\n", "solver", "kernels", "threads",
+           "particles", "wall ms", "cpu ms", "nb ms", "nb share", "particles/s");
     for (int k = 0; k < 3; ++k) {
         for (int sc = 0; sc < SETS; ++sc)
             for (int t = 0; t < 2; ++t) {
@@ -99,18 +113,23 @@ int main(int argc, char** argv) {
                 if (!used[id]) continue;
                 const result* x = &best[id];
                 printf("%-11s %-7s %7d %9zu %10.2f %10.2f %9.2f %9.0f%% %12.3g\n", names[k],
-                       ak_fluid_kernels_name(sets[sc]), t + 1, x->count, x->wall_ms, x->cpu_ms, x->nb_ms,
-                       100.0 * x->nb_ms / x->wall_ms, (double)x->count / (x->wall_ms * 1e-3));
+                       ak_fluid_kernels_name(sets[sc]), t + 1, x->count, x->wall_ms, x->cpu_ms,
+                       x->nb_ms, 100.0 * x->nb_ms / x->wall_ms,
+                       (double)x->count / (x->wall_ms * 1e-3));
             }
         const int scalar1 = (k * SETS + SETS - 1) * 2;
         for (int sc = 0; sc < SETS; ++sc) {
             const int one = (k * SETS + sc) * 2;
             if (!used[one] || !used[one + 1]) continue;
-            printf("%-11s %-7s 2 vs 1 thread: wall %.2fx, cpu %.2fx; cpu per particle-step %.0f ns (1 thread)",
-                   names[k], ak_fluid_kernels_name(sets[sc]), best[one].wall_ms / best[one + 1].wall_ms,
-                   best[one].cpu_ms / best[one + 1].cpu_ms, best[one].cpu_ms * 1e6 / (double)best[one].count);
+            printf("%-11s %-7s 2 vs 1 thread: wall %.2fx, cpu %.2fx; cpu per particle-step %.0f ns "
+                   "(1 thread)",
+                   names[k], ak_fluid_kernels_name(sets[sc]),
+                   best[one].wall_ms / best[one + 1].wall_ms,
+                   best[one].cpu_ms / best[one + 1].cpu_ms,
+                   best[one].cpu_ms * 1e6 / (double)best[one].count);
             if (sc != SETS - 1 && used[scalar1])
-                printf("; vs scalar (1 thread): cpu %.2fx", best[scalar1].cpu_ms / best[one].cpu_ms);
+                printf("; vs scalar (1 thread): cpu %.2fx",
+                       best[scalar1].cpu_ms / best[one].cpu_ms);
             printf("\n");
         }
     }

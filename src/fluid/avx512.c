@@ -19,14 +19,17 @@
 
 #define AKP_AVX512 __attribute__((target("avx512f,avx512dq")))
 
-bool akp_fluid_have_avx512(void) { return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq"); }
+bool akp_fluid_have_avx512(void) {
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+}
 
 static inline __mmask16 live_mask(uint32_t left) {
     return left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
 }
 
-AKP_AVX512 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx, float qy,
-                                            float qz, uint32_t* list, uint32_t* k) {
+AKP_AVX512 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end,
+                                            float qx, float qy, float qz, uint32_t* list,
+                                            uint32_t* k) {
     const __m512 vx = _mm512_set1_ps(qx), vy = _mm512_set1_ps(qy), vz = _mm512_set1_ps(qz);
     const __m512 vr = _mm512_set1_ps(c->h2);
     const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -37,12 +40,14 @@ AKP_AVX512 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t beg
         const __m512 dx = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, c->px + t), vx);
         const __m512 dy = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, c->py + t), vy);
         const __m512 dz = _mm512_sub_ps(_mm512_maskz_loadu_ps(live, c->pz + t), vz);
-        const __m512 dd = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+        const __m512 dd = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
+                                        _mm512_mul_ps(dz, dz));
         const __mmask16 m = _mm512_mask_cmp_ps_mask(live, dd, vr, _CMP_LT_OQ);
         if (!m) continue;
         const uint32_t cnt = (uint32_t)__builtin_popcount(m);
         found += cnt;
-        const __m512i packed = _mm512_maskz_compress_epi32(m, _mm512_add_epi32(_mm512_set1_epi32((int)t), lane));
+        const __m512i packed =
+            _mm512_maskz_compress_epi32(m, _mm512_add_epi32(_mm512_set1_epi32((int)t), lane));
         if (kk + 16 <= K) {
             _mm512_storeu_si512((void*)(list + kk), packed);
             kk += cnt;
@@ -75,8 +80,10 @@ typedef struct block16 {
     __m512 px, py, pz;
 } block16;
 
-AKP_AVX512 static inline void block_begin(const akp_fluid_ctx* c, size_t blk, size_t b, size_t e, block16* o) {
-    const uint32_t lo = blk < b ? (uint32_t)(b - blk) : 0u, hi = e - blk >= 16 ? 16u : (uint32_t)(e - blk);
+AKP_AVX512 static inline void block_begin(const akp_fluid_ctx* c, size_t blk, size_t b, size_t e,
+                                          block16* o) {
+    const uint32_t lo = blk < b ? (uint32_t)(b - blk) : 0u,
+                   hi = e - blk >= 16 ? 16u : (uint32_t)(e - blk);
     o->blk = blk;
     o->lanes = (__mmask16)(((1u << hi) - 1u) & ~((1u << lo) - 1u));
     o->cnt = _mm512_maskz_loadu_epi32(o->lanes, c->nb_count + blk);
@@ -89,14 +96,19 @@ AKP_AVX512 static inline void block_begin(const akp_fluid_ctx* c, size_t blk, si
 
 /* The (x, y, z, w) records p4[4 id[k]] of 16 particles as x, y, z (and w) lanes: 16 loads and a
  * 4 x 4 transpose in each 128-bit lane (cheaper than three or four 16-element gathers). */
-AKP_AVX512 static inline void load4(const float* p4, const uint32_t* id, __m512* x, __m512* y, __m512* z, __m512* w) {
+AKP_AVX512 static inline void load4(const float* p4, const uint32_t* id, __m512* x, __m512* y,
+                                    __m512* z, __m512* w) {
 #define R(k) _mm_load_ps(p4 + 4 * (size_t)id[k])
-#define ROW(a, b2, c2, d2) \
-    _mm512_insertf32x4(_mm512_insertf32x4(_mm512_insertf32x4(_mm512_castps128_ps512(R(a)), R(b2), 1), R(c2), 2), R(d2), 3)
-    const __m512 A = ROW(0, 4, 8, 12), B = ROW(1, 5, 9, 13), C = ROW(2, 6, 10, 14), D = ROW(3, 7, 11, 15);
+#define ROW(a, b2, c2, d2)                                                                         \
+    _mm512_insertf32x4(                                                                            \
+        _mm512_insertf32x4(_mm512_insertf32x4(_mm512_castps128_ps512(R(a)), R(b2), 1), R(c2), 2),  \
+        R(d2), 3)
+    const __m512 A = ROW(0, 4, 8, 12), B = ROW(1, 5, 9, 13), C = ROW(2, 6, 10, 14),
+                 D = ROW(3, 7, 11, 15);
 #undef ROW
 #undef R
-    const __m512 t0 = _mm512_unpacklo_ps(A, B), t1 = _mm512_unpackhi_ps(A, B); /* a0 b0 a1 b1, a2 b2 a3 b3 */
+    const __m512 t0 = _mm512_unpacklo_ps(A, B),
+                 t1 = _mm512_unpackhi_ps(A, B); /* a0 b0 a1 b1, a2 b2 a3 b3 */
     const __m512 t2 = _mm512_unpacklo_ps(C, D), t3 = _mm512_unpackhi_ps(C, D);
     *x = _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
     *y = _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
@@ -106,8 +118,8 @@ AKP_AVX512 static inline void load4(const float* p4, const uint32_t* id, __m512*
 
 /* Slot q of block B: neighbours from the records rec (p4, or q4 = (x, y, z, lambda) in the
  * correction pass, whose w lands in *w when w is not NULL). */
-AKP_AVX512 static inline void load_pairs_from(const akp_fluid_ctx* c, const block16* B, uint32_t q, const float* rec,
-                                              __m512* w, pairs16* o) {
+AKP_AVX512 static inline void load_pairs_from(const akp_fluid_ctx* c, const block16* B, uint32_t q,
+                                              const float* rec, __m512* w, pairs16* o) {
     o->m = _mm512_mask_cmplt_epu32_mask(B->lanes, _mm512_set1_epi32((int)q), B->cnt);
     o->idx = _mm512_maskz_loadu_epi32(o->m, B->nb + (size_t)q * 16);
     __m512 x, y, z;
@@ -121,14 +133,16 @@ AKP_AVX512 static inline void load_pairs_from(const akp_fluid_ctx* c, const bloc
     o->in = _mm512_mask_cmp_ps_mask(o->m, o->r2, _mm512_set1_ps(c->h2), _CMP_LT_OQ);
 }
 
-AKP_AVX512 static inline void load_pairs(const akp_fluid_ctx* c, const block16* B, uint32_t q, pairs16* o) {
+AKP_AVX512 static inline void load_pairs(const akp_fluid_ctx* c, const block16* B, uint32_t q,
+                                         pairs16* o) {
     load_pairs_from(c, B, q, c->p4, NULL, o);
 }
 
 /* k_poly6: poly6_k d d d, d = h^2 - r^2 (+0 outside). */
 AKP_AVX512 static inline __m512 poly6_16(const akp_fluid_ctx* c, const pairs16* p) {
     const __m512 d = _mm512_sub_ps(_mm512_set1_ps(c->h2), p->r2);
-    return _mm512_maskz_mul_ps(p->in, _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(c->poly6_k), d), d), d);
+    return _mm512_maskz_mul_ps(p->in,
+                               _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(c->poly6_k), d), d), d);
 }
 
 /* k_spiky's factor spiky_k d d / |r|, d = h - |r| (+0 outside and at r = 0). */
@@ -136,7 +150,8 @@ AKP_AVX512 static inline __m512 spiky_16(const akp_fluid_ctx* c, const pairs16* 
     const __mmask16 pos = _mm512_mask_cmp_ps_mask(p->in, p->r2, _mm512_setzero_ps(), _CMP_GT_OQ);
     const __m512 len = _mm512_maskz_sqrt_ps(pos, p->r2);
     const __m512 d = _mm512_sub_ps(_mm512_set1_ps(c->h), len);
-    return _mm512_maskz_div_ps(pos, _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(c->spiky_k), d), d), len);
+    return _mm512_maskz_div_ps(pos, _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(c->spiky_k), d), d),
+                               len);
 }
 
 AKP_AVX512 static inline __m512 neg16(__m512 x) { return _mm512_xor_ps(x, _mm512_set1_ps(-0.0f)); }
@@ -166,25 +181,31 @@ AKP_AVX512 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
             load_pairs(c, &B, q, &p);
             rho = _mm512_mask_add_ps(rho, p.m, rho, poly6_16(c, &p));
             const __m512 f = spiky_16(c, &p);
-            const __m512 x = _mm512_mul_ps(_mm512_mul_ps(p.rx, f), mr), y = _mm512_mul_ps(_mm512_mul_ps(p.ry, f), mr),
+            const __m512 x = _mm512_mul_ps(_mm512_mul_ps(p.rx, f), mr),
+                         y = _mm512_mul_ps(_mm512_mul_ps(p.ry, f), mr),
                          z = _mm512_mul_ps(_mm512_mul_ps(p.rz, f), mr);
             gx = _mm512_mask_add_ps(gx, p.m, gx, x);
             gy = _mm512_mask_add_ps(gy, p.m, gy, y);
             gz = _mm512_mask_add_ps(gz, p.m, gz, z);
             g2 = _mm512_mask_add_ps(
-                g2, p.m, g2, _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(x, x), _mm512_mul_ps(y, y)), _mm512_mul_ps(z, z)));
+                g2, p.m, g2,
+                _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(x, x), _mm512_mul_ps(y, y)),
+                              _mm512_mul_ps(z, z)));
         }
         rho = _mm512_mul_ps(rho, _mm512_set1_ps(c->m));
         _mm512_mask_storeu_ps(c->rho + blk, B.lanes, rho);
         __m512 C = _mm512_sub_ps(_mm512_div_ps(rho, _mm512_set1_ps(c->rho0)), _mm512_set1_ps(1.0f));
-        if (!c->d.bilateral) C = _mm512_mask_mov_ps(C, _mm512_cmp_ps_mask(C, zero, _CMP_LT_OQ), zero);
-        const __m512 gg = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(gx, gx), _mm512_mul_ps(gy, gy)), _mm512_mul_ps(gz, gz));
+        if (!c->d.bilateral)
+            C = _mm512_mask_mov_ps(C, _mm512_cmp_ps_mask(C, zero, _CMP_LT_OQ), zero);
+        const __m512 gg = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(gx, gx), _mm512_mul_ps(gy, gy)),
+                                        _mm512_mul_ps(gz, gz));
         const __m512 den = _mm512_add_ps(_mm512_add_ps(gg, g2), _mm512_set1_ps(c->d.relaxation));
         const __m512 lam = _mm512_maskz_div_ps(B.lanes, neg16(C), den);
         _mm512_mask_storeu_ps(c->lambda + blk, B.lanes, lam);
         /* (x, y, z, lambda) records for the correction pass */
         float x[16], y[16], z[16], l[16];
-        _mm512_storeu_ps(x, B.px), _mm512_storeu_ps(y, B.py), _mm512_storeu_ps(z, B.pz), _mm512_storeu_ps(l, lam);
+        _mm512_storeu_ps(x, B.px), _mm512_storeu_ps(y, B.py), _mm512_storeu_ps(z, B.pz),
+            _mm512_storeu_ps(l, lam);
         for (uint32_t u = 0; u < 16; ++u) {
             if (!(B.lanes >> u & 1u)) continue;
             float* r = c->q4 + 4 * (blk + u);
@@ -195,7 +216,8 @@ AKP_AVX512 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
 
 AKP_AVX512 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
     const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
-    const __m512 negk = _mm512_set1_ps(-(c->d.scorr_k / c->grad2_rest)), inv_wdq = _mm512_set1_ps(scorr ? 1.0f / c->wdq : 0.0f);
+    const __m512 negk = _mm512_set1_ps(-(c->d.scorr_k / c->grad2_rest)),
+                 inv_wdq = _mm512_set1_ps(scorr ? 1.0f / c->wdq : 0.0f);
     const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     const __m512 zero = _mm512_setzero_ps(), mr = _mm512_set1_ps(c->mr);
     for (size_t blk = b & ~(size_t)15; blk < e; blk += 16) {
@@ -224,20 +246,23 @@ AKP_AVX512 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
         _mm512_storeu_ps(y, _mm512_add_ps(B.py, _mm512_mul_ps(ay, mr)));
         _mm512_storeu_ps(z, _mm512_add_ps(B.pz, _mm512_mul_ps(az, mr)));
         for (uint32_t u = 0; u < 16; ++u)
-            if (B.lanes >> u & 1u) akp_fluid_delta_finish(c, blk + u, ak_vec3_make(x[u], y[u], z[u]));
+            if (B.lanes >> u & 1u)
+                akp_fluid_delta_finish(c, blk + u, ak_vec3_make(x[u], y[u], z[u]));
     }
 }
 
 /* Neighbour velocities and densities of p's lanes from the (v, rho) records in q4. */
-AKP_AVX512 static inline void gather_v(const akp_fluid_ctx* c, const pairs16* p, __m512* vx, __m512* vy, __m512* vz,
-                                       __m512* rho) {
+AKP_AVX512 static inline void gather_v(const akp_fluid_ctx* c, const pairs16* p, __m512* vx,
+                                       __m512* vy, __m512* vz, __m512* rho) {
     load4(c->q4, p->id, vx, vy, vz, rho);
 }
 
 /* The block's own velocities. */
-AKP_AVX512 static inline void own_v(const akp_fluid_ctx* c, const block16* B, __m512* vx, __m512* vy, __m512* vz) {
-    const __m512i i3 = _mm512_mullo_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
-                                          _mm512_set1_epi32(3));
+AKP_AVX512 static inline void own_v(const akp_fluid_ctx* c, const block16* B, __m512* vx,
+                                    __m512* vy, __m512* vz) {
+    const __m512i i3 =
+        _mm512_mullo_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
+                           _mm512_set1_epi32(3));
     const float* v = &c->v[B->blk].x;
     const __m512 zero = _mm512_setzero_ps();
     *vx = _mm512_mask_i32gather_ps(zero, B->lanes, i3, v, 4);
@@ -264,10 +289,17 @@ AKP_AVX512 void akp_fluid_vorticity_avx512(akp_fluid_ctx* c, size_t b, size_t e)
             const __m512 f = spiky_16(c, &p);
             const __m512 gx = neg16(_mm512_mul_ps(p.rx, f)), gy = neg16(_mm512_mul_ps(p.ry, f)),
                          gz = neg16(_mm512_mul_ps(p.rz, f));
-            const __m512 ux = _mm512_sub_ps(vx, vix), uy = _mm512_sub_ps(vy, viy), uz = _mm512_sub_ps(vz, viz);
-            wx = _mm512_mask_add_ps(wx, ok, wx, _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(uy, gz), _mm512_mul_ps(uz, gy)), vol));
-            wy = _mm512_mask_add_ps(wy, ok, wy, _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(uz, gx), _mm512_mul_ps(ux, gz)), vol));
-            wz = _mm512_mask_add_ps(wz, ok, wz, _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(ux, gy), _mm512_mul_ps(uy, gx)), vol));
+            const __m512 ux = _mm512_sub_ps(vx, vix), uy = _mm512_sub_ps(vy, viy),
+                         uz = _mm512_sub_ps(vz, viz);
+            wx = _mm512_mask_add_ps(
+                wx, ok, wx,
+                _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(uy, gz), _mm512_mul_ps(uz, gy)), vol));
+            wy = _mm512_mask_add_ps(
+                wy, ok, wy,
+                _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(uz, gx), _mm512_mul_ps(ux, gz)), vol));
+            wz = _mm512_mask_add_ps(
+                wz, ok, wz,
+                _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(ux, gy), _mm512_mul_ps(uy, gx)), vol));
         }
         float x[16], y[16], z[16];
         _mm512_storeu_ps(x, wx);
@@ -325,8 +357,8 @@ AKP_AVX512 void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
 #else
 
 bool akp_fluid_have_avx512(void) { return false; }
-uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx, float qy, float qz,
-                                 uint32_t* list, uint32_t* k) {
+uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
+                                 float qy, float qz, uint32_t* list, uint32_t* k) {
     (void)c, (void)begin, (void)end, (void)qx, (void)qy, (void)qz, (void)list, (void)k;
     return 0;
 }

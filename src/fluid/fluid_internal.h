@@ -19,29 +19,29 @@ typedef struct akp_fluid_ctx {
     float dt, h, h2, rho0, m, mr; /* mr = m / rho0 */
     uint32_t K, full_lattice_count;
     ak_fluid_kernels kernels; /* the kernel set of this step (never BEST) */
-    bool simd;        /* kernels is AVX2 or AVX-512: records p4/q4 and padded lists kept */
+    bool simd;                /* kernels is AVX2 or AVX-512: records p4/q4 and padded lists kept */
     /* original order (the caller's arrays) */
-    ak_vec3* xo;      /* positions */
-    ak_vec3* vo;      /* velocities */
-    ak_vec3* pred;    /* predicted positions, original order */
+    ak_vec3* xo;   /* positions */
+    ak_vec3* vo;   /* velocities */
+    ak_vec3* pred; /* predicted positions, original order */
     /* sorted space */
-    uint32_t* order;  /* [n]: original index of sorted particle a */
-    uint32_t* cell;   /* [n]: dense cell of original particle i (counting sort) */
+    uint32_t* order;     /* [n]: original index of sorted particle a */
+    uint32_t* cell;      /* [n]: dense cell of original particle i (counting sort) */
     float *px, *py, *pz; /* predicted positions (PBF: the current Jacobi iterate) */
     float *qx, *qy, *qz; /* the next Jacobi iterate (PBF) / the integrated positions (SPH) */
-    float *p4, *q4;   /* AVX-512 kernels, 16-byte records (one load each): p4 = (p, 0), the
-                         current iterate (the correction pass writes the next one there, reading
-                         none); q4 = (p, lambda) from the lambda pass for the correction pass,
-                         then (v, rho) for vorticity and XSPH */
-    ak_vec3* x0;      /* start-of-step positions */
-    ak_vec3* v;       /* velocities */
-    ak_vec3* acc;     /* SPH accelerations */
-    ak_vec3* omega;   /* vorticity */
-    float* omega_len; /* |omega| */
+    float *p4, *q4;      /* SIMD kernels, 16-byte records (one load each): p4 = (p, 0), the
+                            current iterate (the correction pass writes the next one there, reading
+                            none); q4 = (p, lambda) from the lambda pass for the correction pass,
+                            then (v, rho) for vorticity and XSPH */
+    ak_vec3* x0;         /* start-of-step positions */
+    ak_vec3* v;          /* velocities */
+    ak_vec3* acc;        /* SPH accelerations */
+    ak_vec3* omega;      /* vorticity */
+    float* omega_len;    /* |omega| */
     ak_vec3* vnew;
     float *lambda, *rho, *pres;
     uint32_t *nb_count, *nb; /* lists of sorted indices, slot-major blocks (akp_fluid_nb) */
-    uint32_t* tbuf;   /* [threads][K + 16]: a list being built */
+    uint32_t* tbuf;          /* [threads][K + 16]: a list being built */
     uint8_t* flags;
     /* neighbour search */
     ak_grid grid;     /* hashed fallback */
@@ -71,8 +71,8 @@ static inline const uint32_t* akp_fluid_nb(const akp_fluid_ctx* c, size_t a) {
 bool akp_fluid_have_avx512(void);
 /* Appends to list[*k] (capacity K) the candidates [begin, end) closer than sqrt(r2) to
  * (qx, qy, qz), in index order; returns the number found (also those beyond K). */
-uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx, float qy, float qz,
-                                 uint32_t* list, uint32_t* k);
+uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
+                                 float qy, float qz, uint32_t* list, uint32_t* k);
 void akp_fluid_density_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e);
@@ -81,8 +81,8 @@ void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 
 /* avx2.c: the same kernels on 8 lanes (each block of 16 as two halves), bit-identical too. */
 bool akp_fluid_have_avx2(void);
-uint32_t akp_fluid_filter_avx2(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx, float qy, float qz,
-                               uint32_t* list, uint32_t* k);
+uint32_t akp_fluid_filter_avx2(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
+                               float qy, float qz, uint32_t* list, uint32_t* k);
 void akp_fluid_density_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_delta_avx2(akp_fluid_ctx* c, size_t b, size_t e);
