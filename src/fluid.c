@@ -3,6 +3,8 @@
 #include <animkit/fluid.h>
 #include <animkit/grid.h>
 
+#include "fluid/fluid_internal.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <string.h>
@@ -136,10 +138,15 @@ size_t ak_fluid_fill_box(const ak_fluid_desc* desc, ak_vec3 lo, ak_vec3 hi, ak_v
 /* ---- scratch ---------------------------------------------------------------------- */
 
 typedef struct layout {
-    size_t grid, nb_count, nb, xp, dp, lambda, rho, pres, omega, vnew, flags, total;
+    size_t grid, dstart, nb_count, nb, tbuf, order, cell, pred, px, py, pz, qx, qy, qz, p4, q4, x0, v, acc, omega, omega_len, vnew,
+        lambda, rho, pres, flags, total;
 } layout;
 
-static size_t align16(size_t x) { return (x + 15u) & ~(size_t)15u; }
+static size_t align64(size_t x) { return (x + 63u) & ~(size_t)63u; }
+
+/* Cells the dense (z, y, x) neighbour search may use for cap particles; a liquid whose
+ * bounding box holds more cells of size h takes the shared grid's hashed path. */
+static size_t dense_cells(size_t cap) { return 4 * cap + 4096; }
 
 static bool make_layout(size_t cap, const ak_fluid_desc* d, layout* L) {
     if (cap >= ((size_t)1 << 31)) return false;
@@ -149,18 +156,35 @@ static bool make_layout(size_t cap, const ak_fluid_desc* d, layout* L) {
     const size_t K = d->max_neighbours;
     if (K > ((size_t)1 << 16)) return false;
     size_t o = 0;
-    L->grid = o; o = align16(o + gs);
-    L->nb_count = o; o = align16(o + cap * 4);
-    L->nb = o; o = align16(o + cap * K * 4);
-    L->xp = o; o = align16(o + cap * sizeof(ak_vec3));
-    L->dp = o; o = align16(o + cap * sizeof(ak_vec3));
-    L->lambda = o; o = align16(o + cap * 4);
-    L->rho = o; o = align16(o + cap * 4);
-    L->pres = o; o = align16(o + cap * 4);
-    L->omega = o; o = align16(o + cap * sizeof(ak_vec3));
-    L->vnew = o; o = align16(o + cap * sizeof(ak_vec3));
-    L->flags = o; o = align16(o + cap);
-    L->total = o + 16; /* slack to align the base */
+#define TAKE(field, bytes) (L->field = o, o = align64(o + (bytes)))
+    TAKE(grid, gs);
+    TAKE(dstart, (dense_cells(cap) + 1) * 4);
+    TAKE(nb_count, cap * 4);
+    TAKE(nb, ((cap + 15) & ~(size_t)15) * K * 4); /* blocks of 16 particles, slot-major */
+    TAKE(tbuf, AKP_FLUID_MAX_THREADS * (K + 16) * 4);
+    TAKE(order, cap * 4);
+    TAKE(cell, cap * 4);
+    TAKE(pred, cap * sizeof(ak_vec3));
+    TAKE(px, cap * 4);
+    TAKE(py, cap * 4);
+    TAKE(pz, cap * 4);
+    TAKE(qx, cap * 4);
+    TAKE(qy, cap * 4);
+    TAKE(qz, cap * 4);
+    TAKE(p4, cap * 16);
+    TAKE(q4, cap * 16);
+    TAKE(x0, cap * sizeof(ak_vec3));
+    TAKE(v, cap * sizeof(ak_vec3));
+    TAKE(acc, cap * sizeof(ak_vec3));
+    TAKE(omega, cap * sizeof(ak_vec3));
+    TAKE(omega_len, cap * 4);
+    TAKE(vnew, cap * sizeof(ak_vec3));
+    TAKE(lambda, cap * 4);
+    TAKE(rho, cap * 4);
+    TAKE(pres, cap * 4);
+    TAKE(flags, cap);
+#undef TAKE
+    L->total = o + 64; /* slack to align the base */
     return true;
 }
 
@@ -170,6 +194,23 @@ size_t ak_fluid_scratch_size(size_t capacity, const ak_fluid_desc* desc) {
     layout L;
     if (!make_layout(capacity, &d, &L)) return 0;
     return L.total;
+}
+
+ak_fluid_kernels ak_fluid_kernels_resolved(ak_fluid_kernels want) {
+    if ((unsigned)want >= AK_FLUID_KERNELS_COUNT) return AK_FLUID_KERNELS_SCALAR;
+    if (want == AK_FLUID_KERNELS_BEST) want = AK_FLUID_KERNELS_AVX512;
+    if (want == AK_FLUID_KERNELS_AVX512 && !akp_fluid_have_avx512()) want = AK_FLUID_KERNELS_AVX2;
+    if (want == AK_FLUID_KERNELS_AVX2 && !akp_fluid_have_avx2()) want = AK_FLUID_KERNELS_SCALAR;
+    return want;
+}
+
+const char* ak_fluid_kernels_name(ak_fluid_kernels k) {
+    switch (k) {
+    case AK_FLUID_KERNELS_SCALAR: return "scalar";
+    case AK_FLUID_KERNELS_AVX2: return "avx2";
+    case AK_FLUID_KERNELS_AVX512: return "avx512";
+    default: return "best";
+    }
 }
 
 /* ---- validation ------------------------------------------------------------------- */
@@ -186,7 +227,7 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
         return AK_ERR_NULL_ARG;
     const ak_fluid_desc* d = job->desc;
     if (!desc_ok(d) || !(job->dt > 0.0f) || !ak_finitef(job->dt) || !ak_finitef(job->time) ||
-        (unsigned)d->solver >= AK_FLUID_SOLVER_COUNT || job->thread_count > FLUID_MAX_THREADS ||
+        (unsigned)d->solver >= AK_FLUID_SOLVER_COUNT || (unsigned)job->kernels >= AK_FLUID_KERNELS_COUNT || job->thread_count > FLUID_MAX_THREADS ||
         d->iterations > 1000 || !(d->relaxation >= 0.0f) || !ak_finitef(d->relaxation) || !(d->stiffness >= 0.0f) ||
         !ak_finitef(d->stiffness) || !(d->viscosity >= 0.0f) || !ak_finitef(d->viscosity) ||
         !(d->sound_speed >= 0.0f) || !ak_finitef(d->sound_speed) || !(d->tait_gamma >= 0.0f) ||
@@ -224,30 +265,9 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
 }
 
 /* ---- the solver ------------------------------------------------------------------- */
+/* ---- the solver ------------------------------------------------------------------- */
 
-typedef struct ctx {
-    ak_fluid_desc d;
-    const ak_fluid_step_job* job;
-    size_t n;
-    float dt, h, h2, rho0, m, mr; /* mr = m / rho0 */
-    uint32_t K, full_lattice_count;
-    ak_vec3* x;  /* positions (start of step, then final) */
-    ak_vec3* v;  /* velocities */
-    ak_vec3* xp; /* predicted positions */
-    ak_vec3* dp; /* position deltas / accelerations */
-    ak_vec3* omega;
-    ak_vec3* vnew;
-    float *lambda, *rho, *pres;
-    uint32_t *nb_count, *nb;
-    uint8_t* flags;
-    ak_grid grid;
-    float wdq;        /* poly6 at delta q */
-    float grad2_rest; /* sum_k |grad_k C|^2 of the rest lattice */
-    float poly6_k;    /* 315 / (64 pi h^9) */
-    float spiky_k;    /* -45 / (pi h^6) */
-    /* per-thread results */
-    size_t truncated[FLUID_MAX_THREADS];
-} ctx;
+typedef akp_fluid_ctx ctx;
 
 /* The public kernels with their constants computed once per step (same float operations). */
 static inline float k_poly6(const ctx* c, float r2) {
@@ -263,7 +283,15 @@ static inline ak_vec3 k_spiky(const ctx* c, ak_vec3 r) {
     return ak_vec3_scale(r, c->spiky_k * d * d / len);
 }
 
+/* Predicted position of sorted particle a. */
+static inline ak_vec3 P(const ctx* c, uint32_t a) { return ak_vec3_make(c->px[a], c->py[a], c->pz[a]); }
+
 typedef void (*phase_fn)(ctx* c, size_t begin, size_t end, uint32_t t);
+
+/* Start of thread t's share of [0, n): a multiple of 16 (whole blocks of neighbour lists). */
+static size_t split(size_t n, uint32_t t, uint32_t threads) {
+    return t >= threads ? n : (n * t / threads) & ~(size_t)15;
+}
 
 typedef struct task {
     ctx* c;
@@ -282,11 +310,11 @@ static void* task_thread(void* arg) {
  * (every phase writes only its own particles' values). */
 static void parallel_n(ctx* c, phase_fn fn, uint32_t threads, size_t n) {
     if (threads > 1 && c->n < 1024) threads = 1;
-    task tasks[FLUID_MAX_THREADS];
+    task tasks[AKP_FLUID_MAX_THREADS];
     for (uint32_t t = 0; t < threads; ++t)
-        tasks[t] = (task){c, fn, n * t / threads, n * (t + 1) / threads, t};
-    pthread_t ids[FLUID_MAX_THREADS];
-    bool started[FLUID_MAX_THREADS];
+        tasks[t] = (task){c, fn, split(n, t, threads), split(n, t + 1, threads), t};
+    pthread_t ids[AKP_FLUID_MAX_THREADS];
+    bool started[AKP_FLUID_MAX_THREADS];
     for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, task_thread, &tasks[t]) == 0;
     task_thread(&tasks[0]);
     for (uint32_t t = 1; t < threads; ++t) {
@@ -299,7 +327,7 @@ static void parallel(ctx* c, phase_fn fn, uint32_t threads) { parallel_n(c, fn, 
 
 /* Collider projection: moves p outside every collider and inside the box; v (may be NULL)
  * loses its inward normal component relative to the collider, friction scales the rest. */
-static void collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
+void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
     const ak_fluid_desc* d = &c->d;
     const ak_fluid_step_job* job = c->job;
     for (size_t k = 0; k < job->colliders.count; ++k) {
@@ -394,12 +422,72 @@ static float boundary_distance(const ctx* c, ak_vec3 p) {
     return best;
 }
 
-/* Neighbour lists by cell: for grid cells [b, e), every point of the cell scans the 27 cells
- * around it (fixed order), each in sorted order, with the grid's distance test. A particle's
- * list depends only on the grid, never on the split. */
-static void ph_neighbours_cells(ctx* c, size_t b, size_t e, uint32_t t) {
+/* ---- neighbour search ------------------------------------------------------------- */
+
+/* The grid's cell formula: floor(p / h) in double, clamped to +-2^30 as grid.h does. */
+static inline int64_t cell_coord(const ctx* c, float p) {
+    double v = floor((double)p * c->inv_cell);
+    v = v < -1073741824.0 ? -1073741824.0 : v > 1073741824.0 ? 1073741824.0 : v;
+    return (int64_t)v;
+}
+
+/* Appends the candidates [begin, end) within h of q to list (capacity K, index order). */
+static inline uint32_t filter_scalar(const ctx* c, uint32_t begin, uint32_t end, float qx, float qy, float qz,
+                                     uint32_t* list, uint32_t* k) {
+    const float r2 = c->h2;
+    uint32_t found = 0;
+    for (uint32_t bq = begin; bq < end; ++bq) {
+        const float ddx = c->px[bq] - qx, ddy = c->py[bq] - qy, ddz = c->pz[bq] - qz;
+        if (ddx * ddx + ddy * ddy + ddz * ddz < r2) {
+            if (*k < c->K) list[(*k)++] = bq;
+            ++found;
+        }
+    }
+    return found;
+}
+
+/* Copies particle a's list into the slot-major layout (see akp_fluid_nb). */
+static void store_list(ctx* c, size_t a, const uint32_t* list, uint32_t k) {
+    uint32_t* dst = c->nb + (a >> 4) * c->K * 16 + (a & 15);
+    for (uint32_t q = 0; q < k; ++q) dst[(size_t)q * 16] = list[q];
+    c->nb_count[a] = k;
+}
+
+/* Dense path, sorted particles [b, e): the 3 x 3 rows of cells around a particle's cell, each
+ * a contiguous range of sorted indices (cells in (z, y, x) order), scanned z, then y, then x,
+ * each cell in index order: the order of the hashed path's 27 cell lookups. */
+static void ph_neighbours_dense(ctx* c, size_t b, size_t e, uint32_t t) {
+    size_t trunc = 0;
+    const int64_t X = c->dim[0], Y = c->dim[1], Z = c->dim[2];
+    for (size_t a = b; a < e; ++a) {
+        const float qx = c->px[a], qy = c->py[a], qz = c->pz[a];
+        const int64_t cx = cell_coord(c, qx) - c->cmin[0], cy = cell_coord(c, qy) - c->cmin[1],
+                      cz = cell_coord(c, qz) - c->cmin[2];
+        const int64_t xa = cx > 0 ? cx - 1 : 0, xb = cx + 1 < X ? cx + 1 : X - 1;
+        uint32_t* list = c->tbuf + (size_t)t * (c->K + 16);
+        uint32_t k = 0, total = 0;
+        for (int64_t zz = cz - 1; zz <= cz + 1; ++zz) {
+            if (zz < 0 || zz >= Z) continue;
+            for (int64_t yy = cy - 1; yy <= cy + 1; ++yy) {
+                if (yy < 0 || yy >= Y) continue;
+                const size_t row = (size_t)((zz * Y + yy) * X);
+                const uint32_t rb = c->dstart[row + (size_t)xa], re = c->dstart[row + (size_t)xb + 1];
+                if (rb == re) continue;
+                total += c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_filter_avx512(c, rb, re, qx, qy, qz, list, &k)
+                         : c->kernels == AK_FLUID_KERNELS_AVX2   ? akp_fluid_filter_avx2(c, rb, re, qx, qy, qz, list, &k)
+                                                                 : filter_scalar(c, rb, re, qx, qy, qz, list, &k);
+            }
+        }
+        if (total > c->K) ++trunc;
+        store_list(c, a, list, k);
+    }
+    c->truncated[t] = trunc;
+}
+
+/* Hashed path, grid cells [b, e): every point of a cell scans the 27 cells around it (fixed
+ * order z, y, x), each in sorted order. */
+static void ph_neighbours_hashed(ctx* c, size_t b, size_t e, uint32_t t) {
     const ak_grid* g = &c->grid;
-    const float r2 = c->h * c->h;
     size_t trunc = 0;
     uint32_t around[27];
     for (size_t m = b; m < e; ++m) {
@@ -412,35 +500,129 @@ static void ph_neighbours_cells(ctx* c, size_t b, size_t e, uint32_t t) {
                     if (m2 != UINT32_MAX) around[na++] = m2;
                 }
         for (uint32_t a = g->cell_start[m]; a < g->cell_start[m + 1]; ++a) {
-            const float qx = g->x[a], qy = g->y[a], qz = g->z[a];
-            const uint32_t i = g->order[a];
-            uint32_t* list = c->nb + (size_t)i * c->K;
+            const float qx = c->px[a], qy = c->py[a], qz = c->pz[a];
+            uint32_t* list = c->tbuf + (size_t)t * (c->K + 16);
             uint32_t k = 0, total = 0;
-            for (int q = 0; q < na; ++q) {
-                const uint32_t m2 = around[q];
-                for (uint32_t bq = g->cell_start[m2]; bq < g->cell_start[m2 + 1]; ++bq) {
-                    const float ddx = g->x[bq] - qx, ddy = g->y[bq] - qy, ddz = g->z[bq] - qz;
-                    if (ddx * ddx + ddy * ddy + ddz * ddz < r2) {
-                        if (k < c->K) list[k++] = g->order[bq];
-                        ++total;
-                    }
-                }
-            }
+            for (int q = 0; q < na; ++q)
+                total += filter_scalar(c, g->cell_start[around[q]], g->cell_start[around[q] + 1], qx, qy, qz, list, &k);
             if (total > c->K) ++trunc;
-            c->nb_count[i] = k;
+            store_list(c, a, list, k);
         }
     }
     c->truncated[t] = trunc;
 }
 
+/* Pads every list of blocks [b, e) (16-aligned) up to its block's longest list with index 0,
+ * and the lists of lanes past n likewise, so the AVX-512 kernels may read the 16 entries of any
+ * slot below the block's longest count (the pads are masked out of every sum). */
+static void ph_pad_lists(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t blk = b; blk < e; blk += 16) {
+        uint32_t top = 0, cnt[16];
+        for (uint32_t u = 0; u < 16; ++u) {
+            cnt[u] = blk + u < c->n ? c->nb_count[blk + u] : 0u;
+            top = cnt[u] > top ? cnt[u] : top;
+        }
+        uint32_t* base = c->nb + (blk >> 4) * c->K * 16;
+        for (uint32_t u = 0; u < 16; ++u)
+            for (uint32_t q = cnt[u]; q < top; ++q) base[(size_t)q * 16 + u] = 0;
+    }
+}
+
+/* Sorts the predicted positions c->pred by cell into c->order / px, py, pz. Dense (z, y, x)
+ * cells when the bounding box holds at most dense_cells(cap) cells, else the shared grid.
+ * Returns false on a non-finite prediction. Sets *dense. */
+static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t cap, bool* dense) {
+    const size_t n = c->n;
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < n; ++i) {
+        const float* p = &c->pred[i].x;
+        for (int a = 0; a < 3; ++a) {
+            if (!ak_finitef(p[a])) return false;
+            lo[a] = p[a] < lo[a] ? p[a] : lo[a];
+            hi[a] = p[a] > hi[a] ? p[a] : hi[a];
+        }
+    }
+    double volume = n ? 1.0 : 0.0;
+    for (int a = 0; a < 3 && n; ++a) {
+        c->cmin[a] = cell_coord(c, lo[a]);
+        c->dim[a] = cell_coord(c, hi[a]) - c->cmin[a] + 1;
+        volume *= (double)c->dim[a];
+    }
+    *dense = n > 0 && volume <= (double)dense_cells(cap) && volume < 4294967295.0;
+    if (*dense) {
+        const size_t cells = (size_t)volume;
+        uint32_t* start = c->dstart;
+        memset(start, 0, (cells + 1) * sizeof(uint32_t));
+        for (size_t i = 0; i < n; ++i) {
+            const ak_vec3 p = c->pred[i];
+            const int64_t x = cell_coord(c, p.x) - c->cmin[0], y = cell_coord(c, p.y) - c->cmin[1],
+                          z = cell_coord(c, p.z) - c->cmin[2];
+            const uint32_t m = (uint32_t)((z * c->dim[1] + y) * c->dim[0] + x);
+            c->cell[i] = m;
+            ++start[m + 1];
+        }
+        for (size_t m = 0; m < cells; ++m) start[m + 1] += start[m];
+        /* stable scatter (index order within a cell), then start[m] is back at cell m's start */
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t a = start[c->cell[i]]++;
+            c->order[a] = (uint32_t)i;
+        }
+        for (size_t m = cells; m > 0; --m) start[m] = start[m - 1];
+        start[0] = 0;
+    } else {
+        ak_grid_desc gd = {.cell_size = c->h};
+        if (ak_grid_build(&gd, (ak_vec3_cspan){c->pred, n}, (ak_u8_span){grid_mem, grid_bytes}, &c->grid) != AK_OK)
+            return false;
+        memcpy(c->order, c->grid.order, n * sizeof(uint32_t));
+    }
+    for (size_t a = 0; a < n; ++a) {
+        const ak_vec3 p = c->pred[c->order[a]];
+        c->px[a] = p.x, c->py[a] = p.y, c->pz[a] = p.z;
+        if (c->simd) c->p4[4 * a] = p.x, c->p4[4 * a + 1] = p.y, c->p4[4 * a + 2] = p.z, c->p4[4 * a + 3] = 0.0f;
+    }
+    return true;
+}
+
+/* ---- phases (sorted particles [b, e)) ---------------------------------------------- */
+
+static void ph_predict(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const float dt = c->dt;
+    for (size_t i = b; i < e; ++i) {
+        if (c->d.solver == AK_FLUID_PBF) {
+            c->vo[i] = ak_vec3_add(c->vo[i], ak_vec3_scale(c->d.gravity, dt));
+            ak_vec3 p = ak_vec3_add(c->xo[i], ak_vec3_scale(c->vo[i], dt));
+            akp_fluid_collide(c, &p, NULL);
+            c->pred[i] = p;
+        } else {
+            c->pred[i] = c->xo[i];
+        }
+    }
+}
+
+/* Start positions and velocities into sorted order. */
+static void ph_gather(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t a = b; a < e; ++a) {
+        const uint32_t i = c->order[a];
+        c->x0[a] = c->xo[i];
+        c->v[a] = c->vo[i];
+    }
+}
+
 static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
+    if (c->simd) {
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_density_avx512 : akp_fluid_density_avx2)(c, b, e);
+        return;
+    }
     for (size_t i = b; i < e; ++i) {
-        const uint32_t* nb = c->nb + i * c->K;
-        const ak_vec3 pi = c->xp[i];
+        const uint32_t* nb = akp_fluid_nb(c, i);
+        const ak_vec3 pi = P(c, (uint32_t)i);
         float rho = 0.0f;
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
-            ak_vec3 r = ak_vec3_sub(pi, c->xp[nb[q]]);
+            ak_vec3 r = ak_vec3_sub(pi, P(c, nb[(size_t)q * 16]));
             rho += k_poly6(c, ak_vec3_dot(r, r));
         }
         c->rho[i] = rho * c->m;
@@ -450,13 +632,17 @@ static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
 /* PBF: density and lambda_i = -C_i / (sum_k |grad_k C_i|^2 + epsilon). */
 static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
+    if (c->simd) {
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_lambda_avx512 : akp_fluid_lambda_avx2)(c, b, e);
+        return;
+    }
     for (size_t i = b; i < e; ++i) {
-        const uint32_t* nb = c->nb + i * c->K;
-        const ak_vec3 pi = c->xp[i];
+        const uint32_t* nb = akp_fluid_nb(c, i);
+        const ak_vec3 pi = P(c, (uint32_t)i);
         float rho = 0.0f, sum_gj2 = 0.0f;
         ak_vec3 gi = {0.0f, 0.0f, 0.0f};
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
-            ak_vec3 r = ak_vec3_sub(pi, c->xp[nb[q]]);
+            ak_vec3 r = ak_vec3_sub(pi, P(c, nb[(size_t)q * 16]));
             rho += k_poly6(c, ak_vec3_dot(r, r));
             ak_vec3 g = ak_vec3_scale(k_spiky(c, r), c->mr);
             gi = ak_vec3_add(gi, g);
@@ -471,21 +657,25 @@ static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
 }
 
 /* PBF: dp_i = (m/rho0) sum_j (lambda_i + lambda_j + s_corr) grad W(p_i - p_j), then the
- * collision response on p_i + dp_i (written to dp as the new predicted position). */
+ * collision response on p_i + dp_i, written to q (the next iterate). */
 static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
     const float k = c->d.scorr_k / c->grad2_rest, np = c->d.scorr_n, inv_wdq = scorr ? 1.0f / c->wdq : 0.0f;
     const bool n4 = np == 4.0f;
+    if (c->simd && (n4 || !scorr)) {
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_delta_avx512 : akp_fluid_delta_avx2)(c, b, e);
+        return;
+    }
     for (size_t i = b; i < e; ++i) {
-        const uint32_t* nb = c->nb + i * c->K;
-        const ak_vec3 pi = c->xp[i];
+        const uint32_t* nb = akp_fluid_nb(c, i);
+        const ak_vec3 pi = P(c, (uint32_t)i);
         const float li = c->lambda[i];
         ak_vec3 acc = {0.0f, 0.0f, 0.0f};
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
-            const uint32_t j = nb[q];
+            const uint32_t j = nb[(size_t)q * 16];
             if (j == i) continue;
-            ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
+            ak_vec3 r = ak_vec3_sub(pi, P(c, j));
             float s = 0.0f;
             if (scorr) {
                 float w = k_poly6(c, ak_vec3_dot(r, r)) * inv_wdq;
@@ -494,32 +684,51 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
             }
             acc = ak_vec3_add(acc, ak_vec3_scale(k_spiky(c, r), li + c->lambda[j] + s));
         }
-        ak_vec3 p = ak_vec3_add(pi, ak_vec3_scale(acc, c->mr));
-        collide(c, &p, NULL);
-        c->dp[i] = p;
+        akp_fluid_delta_finish(c, i, ak_vec3_add(pi, ak_vec3_scale(acc, c->mr)));
     }
 }
 
-/* PBF: v = (x* - x) / dt; vorticity omega_i = sum_j (m / rho_j) v_ij x grad_j W_ij (1/s). */
+void akp_fluid_delta_finish(akp_fluid_ctx* c, size_t i, ak_vec3 p) {
+    akp_fluid_collide(c, &p, NULL);
+    c->qx[i] = p.x, c->qy[i] = p.y, c->qz[i] = p.z;
+    /* the SIMD kernels' next iterate as (x, y, z, 0) records: no pass reads p4 until the next
+     * lambda pass (the correction pass reads q4) */
+    if (c->simd) c->p4[4 * i] = p.x, c->p4[4 * i + 1] = p.y, c->p4[4 * i + 2] = p.z, c->p4[4 * i + 3] = 0.0f;
+}
+
+/* PBF: v = (x* - x) / dt. */
 static void ph_velocity(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     const float inv_dt = 1.0f / c->dt;
-    for (size_t i = b; i < e; ++i) c->v[i] = ak_vec3_scale(ak_vec3_sub(c->xp[i], c->x[i]), inv_dt);
+    for (size_t i = b; i < e; ++i) c->v[i] = ak_vec3_scale(ak_vec3_sub(P(c, (uint32_t)i), c->x0[i]), inv_dt);
 }
 
+/* AVX-512 PBF: (v, rho) records into q4 for the vorticity and XSPH kernels. */
+static void ph_pack_v(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i)
+        c->q4[4 * i] = c->v[i].x, c->q4[4 * i + 1] = c->v[i].y, c->q4[4 * i + 2] = c->v[i].z, c->q4[4 * i + 3] = c->rho[i];
+}
+
+/* PBF: vorticity omega_i = sum_j (m / rho_j) v_ij x grad_j W_ij (1/s). */
 static void ph_vorticity(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
+    if (c->simd) {
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_vorticity_avx512 : akp_fluid_vorticity_avx2)(c, b, e);
+        return;
+    }
     for (size_t i = b; i < e; ++i) {
-        const uint32_t* nb = c->nb + i * c->K;
+        const uint32_t* nb = akp_fluid_nb(c, i);
         ak_vec3 w = {0.0f, 0.0f, 0.0f};
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
-            const uint32_t j = nb[q];
+            const uint32_t j = nb[(size_t)q * 16];
             ak_vec3 vij = ak_vec3_sub(c->v[j], c->v[i]);
             /* grad_{p_j} W(p_i - p_j) = -grad W(p_i - p_j) */
-            ak_vec3 g = ak_vec3_neg(k_spiky(c, ak_vec3_sub(c->xp[i], c->xp[j])));
+            ak_vec3 g = ak_vec3_neg(k_spiky(c, ak_vec3_sub(P(c, (uint32_t)i), P(c, j))));
             if (c->rho[j] > 0.0f) w = ak_vec3_add(w, ak_vec3_scale(ak_vec3_cross(vij, g), c->m / c->rho[j]));
         }
         c->omega[i] = w;
+        c->omega_len[i] = ak_vec3_length(w);
     }
 }
 
@@ -528,31 +737,39 @@ static void ph_vorticity(ctx* c, size_t b, size_t e, uint32_t t) {
  * both from the same velocity snapshot. */
 static void ph_xsph(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
+    if (c->simd) {
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_xsph_avx512 : akp_fluid_xsph_avx2)(c, b, e);
+        return;
+    }
     const float eps = c->d.vorticity_epsilon, xc = c->d.xsph_c;
     for (size_t i = b; i < e; ++i) {
-        const uint32_t* nb = c->nb + i * c->K;
-        const ak_vec3 pi = c->xp[i];
+        const uint32_t* nb = akp_fluid_nb(c, i);
+        const ak_vec3 pi = P(c, (uint32_t)i);
         ak_vec3 eta = {0.0f, 0.0f, 0.0f}, xs = {0.0f, 0.0f, 0.0f};
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
-            const uint32_t j = nb[q];
-            ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
+            const uint32_t j = nb[(size_t)q * 16];
+            ak_vec3 r = ak_vec3_sub(pi, P(c, j));
             if (eps != 0.0f && c->rho[j] > 0.0f)
-                eta = ak_vec3_add(eta, ak_vec3_scale(k_spiky(c, r),
-                                                     c->m / c->rho[j] * ak_vec3_length(c->omega[j])));
+                eta = ak_vec3_add(eta, ak_vec3_scale(k_spiky(c, r), c->m / c->rho[j] * c->omega_len[j]));
             if (xc != 0.0f && c->rho[j] > 0.0f)
                 xs = ak_vec3_add(xs, ak_vec3_scale(ak_vec3_sub(c->v[j], c->v[i]),
                                                    c->m / c->rho[j] * k_poly6(c, ak_vec3_dot(r, r))));
         }
-        ak_vec3 vi = ak_vec3_add(c->v[i], ak_vec3_scale(xs, xc));
-        if (eps != 0.0f) {
-            float el = ak_vec3_length(eta);
-            if (el > 1e-20f) {
-                ak_vec3 N = ak_vec3_scale(eta, 1.0f / el);
-                vi = ak_vec3_add(vi, ak_vec3_scale(ak_vec3_cross(N, c->omega[i]), eps * c->dt));
-            }
-        }
-        c->vnew[i] = vi;
+        akp_fluid_xsph_finish(c, i, eta, xs);
     }
+}
+
+void akp_fluid_xsph_finish(akp_fluid_ctx* c, size_t i, ak_vec3 eta, ak_vec3 xs) {
+    const float eps = c->d.vorticity_epsilon;
+    ak_vec3 vi = ak_vec3_add(c->v[i], ak_vec3_scale(xs, c->d.xsph_c));
+    if (eps != 0.0f) {
+        float el = ak_vec3_length(eta);
+        if (el > 1e-20f) {
+            ak_vec3 N = ak_vec3_scale(eta, 1.0f / el);
+            vi = ak_vec3_add(vi, ak_vec3_scale(ak_vec3_cross(N, c->omega[i]), eps * c->dt));
+        }
+    }
+    c->vnew[i] = vi;
 }
 
 /* SPH / WCSPH: pressure from density. */
@@ -567,21 +784,21 @@ static void ph_pressure(ctx* c, size_t b, size_t e, uint32_t t) {
     }
 }
 
-/* SPH / WCSPH: accelerations into dp. */
+/* SPH / WCSPH: accelerations into acc. */
 static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     const ak_fluid_desc* d = &c->d;
     const bool mcg = d->solver == AK_FLUID_SPH;
     const float mu = d->viscosity, m = c->m, h = c->h;
     for (size_t i = b; i < e; ++i) {
-        const uint32_t* nb = c->nb + i * c->K;
-        const ak_vec3 pi = c->xp[i], vi = c->v[i];
+        const uint32_t* nb = akp_fluid_nb(c, i);
+        const ak_vec3 pi = P(c, (uint32_t)i), vi = c->v[i];
         const float rhoi = c->rho[i], pri = c->pres[i];
         ak_vec3 a = {0.0f, 0.0f, 0.0f};
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
-            const uint32_t j = nb[q];
+            const uint32_t j = nb[(size_t)q * 16];
             if (j == i) continue;
-            ak_vec3 r = ak_vec3_sub(pi, c->xp[j]);
+            ak_vec3 r = ak_vec3_sub(pi, P(c, j));
             ak_vec3 g = k_spiky(c, r);
             const float rhoj = c->rho[j];
             if (mcg) {
@@ -604,17 +821,18 @@ static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
             }
         }
         if (mcg) a = ak_vec3_scale(a, 1.0f / rhoi);
-        c->dp[i] = ak_vec3_add(a, d->gravity);
+        c->acc[i] = ak_vec3_add(a, d->gravity);
     }
 }
 
+/* SPH / WCSPH: semi-implicit Euler into q (positions) and v. */
 static void ph_integrate(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     for (size_t i = b; i < e; ++i) {
-        ak_vec3 v = ak_vec3_add(c->v[i], ak_vec3_scale(c->dp[i], c->dt));
-        ak_vec3 p = ak_vec3_add(c->xp[i], ak_vec3_scale(v, c->dt));
-        collide(c, &p, &v);
-        c->x[i] = p;
+        ak_vec3 v = ak_vec3_add(c->v[i], ak_vec3_scale(c->acc[i], c->dt));
+        ak_vec3 p = ak_vec3_add(P(c, (uint32_t)i), ak_vec3_scale(v, c->dt));
+        akp_fluid_collide(c, &p, &v);
+        c->qx[i] = p.x, c->qy[i] = p.y, c->qz[i] = p.z;
         c->v[i] = v;
     }
 }
@@ -625,7 +843,7 @@ static void ph_flags(ctx* c, size_t b, size_t e, uint32_t t) {
     for (size_t i = b; i < e; ++i) {
         uint8_t f = 0;
         if (c->nb_count[i] < surf) f |= AK_FLUID_FLAG_SURFACE;
-        else if (boundary_distance(c, c->xp[i]) >= c->h) f |= AK_FLUID_FLAG_FULL;
+        else if (boundary_distance(c, P(c, (uint32_t)i)) >= c->h) f |= AK_FLUID_FLAG_FULL;
         c->flags[i] = f;
     }
 }
@@ -635,13 +853,30 @@ static void ph_full(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     for (size_t i = b; i < e; ++i) {
         if (!(c->flags[i] & AK_FLUID_FLAG_FULL)) continue;
-        const uint32_t* nb = c->nb + i * c->K;
+        const uint32_t* nb = akp_fluid_nb(c, i);
         bool full = true;
-        for (uint32_t q = 0; q < c->nb_count[i] && full; ++q) full = !(c->flags[nb[q]] & AK_FLUID_FLAG_SURFACE);
+        for (uint32_t q = 0; q < c->nb_count[i] && full; ++q) full = !(c->flags[nb[(size_t)q * 16]] & AK_FLUID_FLAG_SURFACE);
         c->lambda[i] = full ? 1.0f : 0.0f;
     }
     for (size_t i = b; i < e; ++i)
         if ((c->flags[i] & AK_FLUID_FLAG_FULL) && c->lambda[i] == 0.0f) c->flags[i] = 0;
+}
+
+/* Final positions (PBF: p; SPH: q), velocities, densities, pressures, flags back to the
+ * caller's order. */
+static void ph_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const ak_fluid_step_job* job = c->job;
+    const bool pbf = c->d.solver == AK_FLUID_PBF;
+    const float *fx = pbf ? c->px : c->qx, *fy = pbf ? c->py : c->qy, *fz = pbf ? c->pz : c->qz;
+    for (size_t a = b; a < e; ++a) {
+        const uint32_t i = c->order[a];
+        c->xo[i] = ak_vec3_make(fx[a], fy[a], fz[a]);
+        c->vo[i] = c->v[a];
+        if (job->out_densities.ptr) job->out_densities.ptr[i] = c->rho[a];
+        if (job->out_pressures.ptr) job->out_pressures.ptr[i] = pbf ? 0.0f : c->pres[a];
+        if (job->out_flags.ptr) job->out_flags.ptr[i] = c->flags[a];
+    }
 }
 
 static double now_seconds(void) {
@@ -702,12 +937,12 @@ static void emit(const ak_fluid_step_job* job, float s, size_t* n, ak_fluid_stat
     }
 }
 
+
 ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     ak_result r = ak_fluid_step_validate(job);
     if (r != AK_OK) return r;
-    ctx* c = NULL;
     ctx cstore;
-    c = &cstore;
+    ctx* c = &cstore;
     memset(c, 0, sizeof *c);
     c->d = ak_fluid_desc_resolved(job->desc);
     c->job = job;
@@ -718,6 +953,9 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     c->m = c->d.particle_mass;
     c->mr = c->m / c->rho0;
     c->K = c->d.max_neighbours;
+    c->inv_cell = 1.0 / (double)c->h;
+    c->kernels = ak_fluid_kernels_resolved(job->kernels);
+    c->simd = c->kernels != AK_FLUID_KERNELS_SCALAR;
     const float s = cbrtf(c->mr);
     lattice_props(c->h, s, c->mr, &c->full_lattice_count, &c->grad2_rest);
     {
@@ -734,98 +972,102 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     memset(&L, 0, sizeof L);
     if (!make_layout(cap, &c->d, &L)) return AK_ERR_BAD_ARG;
     uint8_t* base = job->scratch.ptr;
-    base += (16u - ((uintptr_t)base & 15u)) & 15u;
-    c->nb_count = (uint32_t*)(void*)(base + L.nb_count);
-    c->nb = (uint32_t*)(void*)(base + L.nb);
-    c->xp = (ak_vec3*)(void*)(base + L.xp);
-    c->dp = (ak_vec3*)(void*)(base + L.dp);
-    c->lambda = (float*)(void*)(base + L.lambda);
-    c->rho = (float*)(void*)(base + L.rho);
-    c->pres = (float*)(void*)(base + L.pres);
-    c->omega = (ak_vec3*)(void*)(base + L.omega);
-    c->vnew = (ak_vec3*)(void*)(base + L.vnew);
-    c->flags = base + L.flags;
-    c->x = job->positions.ptr;
-    c->v = job->velocities.ptr;
+    base += (64u - ((uintptr_t)base & 63u)) & 63u;
+#define AT(type, field) ((type*)(void*)(base + L.field))
+    c->dstart = AT(uint32_t, dstart);
+    c->nb_count = AT(uint32_t, nb_count);
+    c->nb = AT(uint32_t, nb);
+    c->tbuf = AT(uint32_t, tbuf);
+    c->order = AT(uint32_t, order);
+    c->cell = AT(uint32_t, cell);
+    c->pred = AT(ak_vec3, pred);
+    c->px = AT(float, px), c->py = AT(float, py), c->pz = AT(float, pz);
+    c->qx = AT(float, qx), c->qy = AT(float, qy), c->qz = AT(float, qz);
+    c->p4 = AT(float, p4), c->q4 = AT(float, q4);
+    c->x0 = AT(ak_vec3, x0);
+    c->v = AT(ak_vec3, v);
+    c->acc = AT(ak_vec3, acc);
+    c->omega = AT(ak_vec3, omega);
+    c->omega_len = AT(float, omega_len);
+    c->vnew = AT(ak_vec3, vnew);
+    c->lambda = AT(float, lambda);
+    c->rho = AT(float, rho);
+    c->pres = AT(float, pres);
+    c->flags = AT(uint8_t, flags);
+#undef AT
+    c->xo = job->positions.ptr;
+    c->vo = job->velocities.ptr;
 
     size_t n = *job->particle_count;
     emit(job, s, &n, &st);
     c->n = n;
     const uint32_t threads = job->thread_count ? job->thread_count : 1;
-    const float dt = c->dt;
     const bool pbf = c->d.solver == AK_FLUID_PBF;
 
-    /* predict (PBF) or take the current positions (SPH) */
-    for (size_t i = 0; i < n; ++i) {
-        if (pbf) {
-            c->v[i] = ak_vec3_add(c->v[i], ak_vec3_scale(c->d.gravity, dt));
-            ak_vec3 p = ak_vec3_add(c->x[i], ak_vec3_scale(c->v[i], dt));
-            collide(c, &p, NULL);
-            c->xp[i] = p;
-        } else {
-            c->xp[i] = c->x[i];
-        }
-    }
+    /* predict (PBF) or take the current positions (SPH), sort by cell, neighbour lists */
+    parallel(c, ph_predict, threads);
     const double t_nb = now_seconds();
     ak_grid_desc gd = {.cell_size = c->h};
-    const size_t gbytes = ak_grid_memory_size(n, &gd);
-    r = ak_grid_build(&gd, (ak_vec3_cspan){c->xp, n}, (ak_u8_span){base + L.grid, gbytes}, &c->grid);
-    if (r != AK_OK) return AK_ERR_NO_CONVERGENCE; /* only non-finite predictions fail here */
-    parallel_n(c, ph_neighbours_cells, threads, c->grid.cell_count);
+    bool dense = false;
+    if (!sort_by_cell(c, base + L.grid, ak_grid_memory_size(n, &gd), cap, &dense))
+        return AK_ERR_NO_CONVERGENCE; /* only non-finite predictions fail here */
+    if (dense) parallel(c, ph_neighbours_dense, threads);
+    else parallel_n(c, ph_neighbours_hashed, threads, c->grid.cell_count);
+    if (c->simd) parallel(c, ph_pad_lists, threads);
     st.neighbour_seconds = (float)(now_seconds() - t_nb);
+    parallel(c, ph_gather, threads);
 
     if (pbf) {
         for (uint32_t it = 0; it < c->d.iterations; ++it) {
             parallel(c, ph_lambda, threads);
             parallel(c, ph_delta, threads);
-            ak_vec3* tmp = c->xp;
-            c->xp = c->dp;
-            c->dp = tmp;
+            float* tmp;
+            tmp = c->px, c->px = c->qx, c->qx = tmp;
+            tmp = c->py, c->py = c->qy, c->qy = tmp;
+            tmp = c->pz, c->pz = c->qz, c->qz = tmp;
         }
         parallel(c, ph_velocity, threads);
         parallel(c, ph_density, threads);
+        if (c->simd && (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f)) parallel(c, ph_pack_v, threads);
         if (c->d.vorticity_epsilon != 0.0f) parallel(c, ph_vorticity, threads);
         if (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f) {
             parallel(c, ph_xsph, threads);
             memcpy(c->v, c->vnew, n * sizeof(ak_vec3));
         }
-        for (size_t i = 0; i < n; ++i) c->x[i] = c->xp[i];
-        if (job->out_pressures.ptr) memset(job->out_pressures.ptr, 0, n * sizeof(float));
     } else {
         parallel(c, ph_density, threads);
         parallel(c, ph_pressure, threads);
         parallel(c, ph_forces, threads);
         parallel(c, ph_integrate, threads);
-        if (job->out_pressures.ptr) memcpy(job->out_pressures.ptr, c->pres, n * sizeof(float));
     }
     parallel(c, ph_flags, threads);
     parallel(c, ph_full, threads);
+    parallel(c, ph_scatter, threads);
 
-    /* blow-up check, statistics */
+    /* blow-up check, statistics (sorted order: the same for any thread count) */
     const float limit = 100.0f * c->h;
     bool blown = false;
     double sum = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        ak_vec3 v = c->v[i];
-        if (!vfinite(c->x[i]) || !vfinite(v) || !(ak_vec3_length(v) * dt <= limit)) blown = true;
-        if (c->flags[i] & AK_FLUID_FLAG_SURFACE) ++st.surface_count;
-        if (c->flags[i] & AK_FLUID_FLAG_FULL) {
-            float err = fabsf(c->rho[i] / c->rho0 - 1.0f);
+    for (size_t a = 0; a < n; ++a) {
+        const uint32_t i = c->order[a];
+        const ak_vec3 v = c->vo[i];
+        if (!vfinite(c->xo[i]) || !vfinite(v) || !(ak_vec3_length(v) * c->dt <= limit)) blown = true;
+        if (c->flags[a] & AK_FLUID_FLAG_SURFACE) ++st.surface_count;
+        if (c->flags[a] & AK_FLUID_FLAG_FULL) {
+            float err = fabsf(c->rho[a] / c->rho0 - 1.0f);
             if (err > st.max_density_error) st.max_density_error = err;
             sum += err;
             ++st.full_count;
         }
     }
     st.mean_density_error = st.full_count ? (float)(sum / (double)st.full_count) : 0.0f;
-    for (uint32_t t = 0; t < FLUID_MAX_THREADS; ++t) st.truncated_count += c->truncated[t];
-    if (job->out_densities.ptr) memcpy(job->out_densities.ptr, c->rho, n * sizeof(float));
-    if (job->out_flags.ptr) memcpy(job->out_flags.ptr, c->flags, n);
+    for (uint32_t t = 0; t < AKP_FLUID_MAX_THREADS; ++t) st.truncated_count += c->truncated[t];
 
     /* sinks: stable compaction (order of the survivors kept) */
     if (job->sinks.count) {
         size_t w = 0;
         for (size_t i = 0; i < n; ++i) {
-            ak_vec3 p = c->x[i];
+            ak_vec3 p = c->xo[i];
             bool gone = false;
             for (size_t k = 0; k < job->sinks.count && !gone; ++k) {
                 const ak_fluid_sink* sk = &job->sinks.ptr[k];
@@ -837,8 +1079,8 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
                 continue;
             }
             if (w != i) {
-                c->x[w] = c->x[i];
-                c->v[w] = c->v[i];
+                c->xo[w] = c->xo[i];
+                c->vo[w] = c->vo[i];
                 if (job->out_densities.ptr) job->out_densities.ptr[w] = job->out_densities.ptr[i];
                 if (job->out_pressures.ptr) job->out_pressures.ptr[w] = job->out_pressures.ptr[i];
                 if (job->out_flags.ptr) job->out_flags.ptr[w] = job->out_flags.ptr[i];

@@ -26,7 +26,12 @@
  *    Pi_ij = -nu (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2), nu = 2 alpha h c_s / (rho_i + rho_j),
  *    for approaching pairs. (The paper uses a cubic spline kernel; animkit uses the MCG kernels
  *    for every solver: poly6 for density, the spiky gradient for forces.)
- * Neighbours come from the shared uniform grid (grid.h), rebuilt each step with cell = h.
+ * Neighbours: each step re-sorts the particles by cell of size h (a counting sort into
+ * (z, y, x) cells when the liquid's bounding box holds at most 4 cells per particle of capacity,
+ * else the shared hashed grid of grid.h) and builds one list per particle, used by every pass
+ * of the step; the solver works on the sorted copy (SoA positions) and writes results back in
+ * the caller's order. Each list holds the particles closer than h in a fixed order (cells z,
+ * then y, then x, each in index order), the same on both paths.
  *
  * Boundaries (all solvers): a box container, planes, spheres and capsules, each optionally
  * moving with a velocity. The method is projection: a particle found inside a collider (or
@@ -64,7 +69,10 @@
  * Ownership and threading: jobs keep no pointer after run returns and never allocate (the
  * caller passes scratch, any alignment). thread_count threads split each phase by particle;
  * every particle sums over its neighbours in one fixed order, so results are bit-identical
- * for any thread count.
+ * for any thread count. SIMD: on CPUs with AVX-512 or AVX2 (chosen at run time) the neighbour
+ * filter and the density/PBF passes run 16 or 8 particles per instruction with the scalar
+ * code's float operations in the same order, so results are also bit-identical to the scalar
+ * kernels (job.kernels picks a set; AK_NO_SIMD builds have only the scalar one).
  */
 #ifndef ANIMKIT_FLUID_H
 #define ANIMKIT_FLUID_H
@@ -190,6 +198,15 @@ typedef struct ak_fluid_stats {
 
 /* ---- the step job ------------------------------------------------------------------ */
 
+/* Kernel sets of the neighbour filter and the density/PBF passes, chosen at run time. */
+typedef enum ak_fluid_kernels {
+    AK_FLUID_KERNELS_BEST = 0, /* the fastest this CPU runs */
+    AK_FLUID_KERNELS_SCALAR,   /* the reference loops */
+    AK_FLUID_KERNELS_AVX2,     /* 8 particles per instruction (AVX2) */
+    AK_FLUID_KERNELS_AVX512,   /* 16 particles per instruction (AVX-512 F and DQ) */
+    AK_FLUID_KERNELS_COUNT
+} ak_fluid_kernels;
+
 typedef struct ak_fluid_step_job {
     const ak_fluid_desc* desc;         /* required */
     float dt;                          /* required, > 0 (s) */
@@ -206,14 +223,22 @@ typedef struct ak_fluid_step_job {
     ak_f32_span out_pressures;         /* optional: SPH/WCSPH pressure (Pa); PBF writes 0 */
     ak_u8_span out_flags;              /* optional: AK_FLUID_FLAG_* per particle */
     ak_fluid_stats* out_stats;         /* optional */
+    ak_fluid_kernels kernels;          /* 0 = the fastest this CPU runs; see ak_fluid_kernels_resolved */
 } ak_fluid_step_job;
+
+/* The kernel set a job with kernels = want runs on this CPU: BEST means the fastest, and a set
+ * the CPU (or an AK_NO_SIMD build) lacks falls back to the next one down (AVX-512 -> AVX2 ->
+ * scalar); out of range -> scalar. Every set gives bit-identical results (tested). */
+AK_API ak_fluid_kernels ak_fluid_kernels_resolved(ak_fluid_kernels want);
+/* "best", "scalar", "avx2" or "avx512". */
+AK_API const char* ak_fluid_kernels_name(ak_fluid_kernels kernels);
 
 /* Scratch bytes for up to capacity particles (0 when desc is invalid or capacity >= 2^31). */
 AK_API size_t ak_fluid_scratch_size(size_t capacity, const ak_fluid_desc* desc);
 
 /* First failing rule: AK_ERR_NULL_ARG (job, desc, particle_count, positions/velocities/scratch
  * pointers, a non-empty optional span with a NULL pointer), AK_ERR_BAD_ARG (h, mass, dt not >
- * 0 and finite, negative rest density/stiffness/viscosity/relaxation/friction > 1, solver out
+ * 0 and finite, negative rest density/stiffness/viscosity/relaxation/friction > 1, solver or kernels out
  * of range, box_min > box_max, thread_count > 64, iterations > 1000, a collider shape out of
  * range or negative radius, an emitter with speed <= 0, a negative radius or one above 4096 rest
  * spacings), AK_ERR_SPAN_SMALL
