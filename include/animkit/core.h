@@ -149,6 +149,7 @@ typedef struct ak_rng {
     uint32_t s[4];
 } ak_rng;
 
+/* Internal to ak_rng_u32: rotate x left by k bits (0 < k < 32). */
 static inline uint32_t ak_rng_rotl_(uint32_t x, int k) { return (x << k) | (x >> (32 - k)); }
 
 /* Seed a generator (splitmix64 expansion; every seed, including 0, is valid). */

@@ -103,8 +103,8 @@ static inline float ak_degrees(float radians) { return radians * (180.0f / AK_PI
 
 /* ---- vec2 / vec3 / vec4 -------------------------------------------------------------- */
 
-static inline ak_vec2 ak_vec2_make(float x, float y) { ak_vec2 r = {x, y}; return r; }
 /* Constructors and constants. */
+static inline ak_vec2 ak_vec2_make(float x, float y) { ak_vec2 r = {x, y}; return r; }
 static inline ak_vec3 ak_vec3_make(float x, float y, float z) { ak_vec3 r = {x, y, z}; return r; }
 static inline ak_vec4 ak_vec4_make(float x, float y, float z, float w) { ak_vec4 r = {x, y, z, w}; return r; }
 static inline ak_vec3 ak_vec3_zero(void) { ak_vec3 r = {0.0f, 0.0f, 0.0f}; return r; }
@@ -164,7 +164,6 @@ static inline ak_vec2 ak_vec2_scale(ak_vec2 a, float s) { return ak_vec2_make(a.
 static inline float ak_vec2_dot(ak_vec2 a, ak_vec2 b) { return a.x * b.x + a.y * b.y; }
 static inline float ak_vec2_cross(ak_vec2 a, ak_vec2 b) { return a.x * b.y - a.y * b.x; }
 static inline float ak_vec2_length(ak_vec2 a) { return sqrtf(a.x * a.x + a.y * a.y); }
-
 static inline ak_vec4 ak_vec4_add(ak_vec4 a, ak_vec4 b) { return ak_vec4_make(a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w); }
 static inline ak_vec4 ak_vec4_scale(ak_vec4 a, float s) { return ak_vec4_make(a.x * s, a.y * s, a.z * s, a.w * s); }
 static inline float ak_vec4_dot(ak_vec4 a, ak_vec4 b) { return a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w; }
@@ -543,6 +542,7 @@ AK_API ak_mat4 ak_mat4_inverse(ak_mat4 m);
 AK_API ak_mat4 ak_mat4_inverse_affine(ak_mat4 m);
 /* Transpose of the inverse of the upper 3x3 block: transforms normals. Singular -> identity. */
 AK_API ak_mat3 ak_mat4_normal_matrix(ak_mat4 m);
+/* Determinant of the full 4x4 matrix (0 for a singular matrix). */
 AK_API float ak_mat4_determinant(ak_mat4 m);
 /* True when every element is finite. */
 AK_API bool ak_mat4_is_finite(const ak_mat4* m);
