@@ -33,7 +33,7 @@ static const command commands[] = {
 static void print_help(FILE* f) {
     fprintf(f, "animkit %s: character animation and deformation\n\n", ak_version_string());
     fprintf(f, "usage: animkit COMMAND [ARGS]   (animkit COMMAND --help for details)\n\n");
-    for (size_t i = 0; i < COMMAND_COUNT; ++i) fprintf(f, "  %-8s %s\n", commands[i].name, commands[i].summary);
+    for (size_t i = 0; i < COMMAND_COUNT; ++i) fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].summary);
     fprintf(f, "\nMODEL arguments are a file (glTF/GLB, BVH, FBX, Collada, OBJ) or builtin:humanoid,\n"
                "builtin:cylinder. Exit status: 0 success, 1 bad input, 2 bad usage.\n");
 }
