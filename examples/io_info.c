@@ -45,8 +45,9 @@ int main(int argc, char** argv) {
         return 1;
     }
     size_t joints = ak_scene_joint_count(scene);
-    printf("%s: %zu joints, %zu meshes, %zu skins, %zu clips\n", scene->name, joints, scene->mesh_count,
-           scene->skin_count, scene->clip_count);
+    printf("%s: %zu joint%s, %zu mesh%s, %zu skin%s, %zu clip%s\n", scene->name, joints, joints == 1 ? "" : "s",
+           scene->mesh_count, scene->mesh_count == 1 ? "" : "es", scene->skin_count, scene->skin_count == 1 ? "" : "s",
+           scene->clip_count, scene->clip_count == 1 ? "" : "s");
     for (size_t j = 0; j < joints && j < 8; ++j) {
         int parent = ak_skeleton_parents(scene->skeleton).ptr[j];
         printf("  joint %zu %-24s parent %d%s\n", j, ak_skeleton_joint_name(scene->skeleton, j), parent,

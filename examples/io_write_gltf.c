@@ -85,8 +85,8 @@ int main(void) {
         ak_vec3 d = ak_vec3_sub(ak_mat4_get_translation(mb[wb]), ak_mat4_get_translation(model[wrist]));
         worst = fmax(worst, ak_vec3_length(d));
     }
-    printf("wrote io_write_gltf.glb: %zu joints, %zu meshes, 1 clip; hand after reload within %.2g m\n", nb,
-           back->mesh_count, worst);
+    printf("wrote io_write_gltf.glb: %zu joints, %zu mesh%s, 1 clip; hand after reload within %.2g m\n", nb,
+           back->mesh_count, back->mesh_count == 1 ? "" : "es", worst);
     free(lb);
     free(mb);
     free(poses);

@@ -316,9 +316,13 @@ ak_result ak_view_panels_compose(const ak_view_panels_desc* desc, const ak_view_
     ak_result r = ak_image_fill(out, bg);
     if (r != AK_OK) return r;
     if (desc && desc->title) {
-        int tw, th;
-        ak_text_size(desc->title, g.label_scale + 1, &tw, &th);
-        ak_image_draw_text(out, (W - tw) / 2, 6 + g.gap / 2, desc->title, g.label_scale + 1, fg);
+        /* one scale above the labels; smaller when that is wider than the image (one narrow
+         * panel), centred in the strip sized for the larger scale */
+        int scale = g.label_scale + 1, tw, th;
+        ak_text_size(desc->title, scale, &tw, &th);
+        while (tw > W - 2 * g.gap && scale > 1) ak_text_size(desc->title, --scale, &tw, &th);
+        int dy = (g.label_scale + 1 - scale) * AK_FONT_GLYPH_HEIGHT / 2;
+        ak_image_draw_text(out, (W - tw) / 2, 6 + g.gap / 2 + dy, desc->title, scale, fg);
     }
     for (size_t i = 0; i < panel_count; ++i) {
         int c = (int)(i % (size_t)g.cols), row = (int)(i / (size_t)g.cols);

@@ -125,7 +125,8 @@ typedef struct ak_view_panels_desc {
     int columns;          /* panels per row; 0 -> all in one row */
     int gap;              /* pixels between and around panels; 0 -> 6 */
     int label_scale;      /* font scale of labels; 0 -> 2 */
-    const char* title;    /* drawn in a strip across the top; NULL -> no strip */
+    const char* title;    /* drawn in a strip across the top at label_scale + 1 (smaller
+                             when too wide for the image); NULL -> no strip */
     ak_vec4 background;   /* sRGB; zero -> (0.14, 0.15, 0.18) */
     ak_vec4 text_color;   /* sRGB; zero -> (0.95, 0.95, 0.95) */
 } ak_view_panels_desc;
