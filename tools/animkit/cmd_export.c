@@ -37,8 +37,9 @@ static int export_gltf(const char* in, const char* out) {
     if (r != AK_OK)
         rc = cli_fail("export", "%s: %s", diag.path[0] ? diag.path : out, diag.message[0] ? diag.message : ak_result_string(r));
     else
-        fprintf(stderr, "wrote %s (%zu joints, %zu meshes, %zu clips)\n", out, ak_scene_joint_count(s), s->mesh_count,
-                s->clip_count);
+        fprintf(stderr, "wrote %s (%zu joint%s, %zu mesh%s, %zu clip%s)\n", out, ak_scene_joint_count(s),
+                cli_plural(ak_scene_joint_count(s)), s->mesh_count, s->mesh_count == 1 ? "" : "es", s->clip_count,
+                cli_plural(s->clip_count));
     ak_scene_destroy(s);
     return rc;
 }

@@ -10,12 +10,16 @@ static const char* const usage =
     "Compare linear blend (LBS), dual quaternion (DQS) and optimized-center (CoR) skinning.\n"
     "On builtin:cylinder (the default) the middle joint is bent 90 degrees and twisted 90 and\n"
     "180 degrees (179.8, so the turn has a defined direction); for each pose and method it\n"
-    "prints the volume of the deformed closed mesh\n"
-    "relative to rest and the maximum bulge: the largest distance of a vertex from the posed\n"
-    "bone axis beyond the rest radius, as a fraction of that radius, and the minimum radius\n"
-    "(the narrowest cross-section: the candy-wrapper collapse).\n"
+    "prints the volume of the deformed closed mesh relative to rest and the maximum bulge: the\n"
+    "largest distance of a vertex from the posed bone axis beyond the rest radius, as a\n"
+    "fraction of that radius, and the minimum radius (the narrowest cross-section: the\n"
+    "candy-wrapper collapse).\n"
     "On another model it samples every clip at 24 times and prints, per method, the range of\n"
-    "the volume ratio (closed meshes only) and the largest distance from the LBS result.\n";
+    "the volume ratio (closed meshes only) and the largest distance from the LBS result.\n"
+    "  --json  one JSON object instead: {\"model\", \"rest_volume\", \"rest_radius\", \"poses\":\n"
+    "          [{\"pose\", \"LBS\"|\"DQS\"|\"CoR\": {\"volume_ratio\", \"max_bulge\", \"min_radius\"}}]}\n"
+    "          for the cylinder; {\"model\", \"methods\": [{\"method\", \"max_distance_from_lbs\",\n"
+    "          \"volume_min\", \"volume_max\"}]} for another model (volumes for closed meshes)\n";
 
 static const cli_method methods[3] = {CLI_LBS, CLI_DQS, CLI_COR};
 
@@ -154,7 +158,7 @@ static int compare_generic(ak_scene* s, bool json) {
         if (json) printf("{\"model\": ");
         if (json) cli_json_string(stdout, s->name);
         if (json) printf(", \"methods\": [");
-        else printf("%s: %zu clips x 24 frames\n%-5s %22s %18s\n", s->name, s->clip_count, "", "volume/rest (min..max)",
+        else printf("%s: %zu clip%s x 24 frames\n%-5s %22s %18s\n", s->name, s->clip_count, cli_plural(s->clip_count), "", "volume/rest (min..max)",
                     "max dist from LBS");
         for (int mi = 0; mi < 3; ++mi) {
             if (json) {
