@@ -616,6 +616,31 @@ AK_TEST(reduce_keeps_model_error_within_tolerance) {
     AK_CHECK_EQ(ak_clip_reduce(cc, &d, NULL, &out, NULL, NULL), AK_ERR_UNSUPPORTED);
     AK_CHECK(out == NULL);
     ak_clip_destroy(cc);
+    /* A non-finite rest pose is bad data; one whose model positions overflow float (scales of
+     * 1e30 on a parent and a child: 1e60) must not pass the check with a NaN error. */
+    ak_transform nrest[NJ];
+    for (int j = 0; j < NJ; ++j) nrest[j] = rest[j];
+    nrest[2].scale.y = NAN;
+    d.rest_pose = (ak_transform_cspan){nrest, NJ};
+    AK_CHECK_EQ(ak_clip_reduce(c, &d, NULL, &out, NULL, NULL), AK_ERR_BAD_DATA);
+    AK_CHECK(out == NULL);
+    {
+        float lt[5] = {0, 1, 2, 3, 4}, lv[15];
+        for (int k = 0; k < 5; ++k) lv[3 * k] = (float)k, lv[3 * k + 1] = (float)(k * k), lv[3 * k + 2] = 0.0f;
+        ak_raw_channel lc = {.target = AK_CHANNEL_TRANSLATION, .index = 1, .key_count = 5, .times = lt, .values = lv};
+        ak_raw_clip lr = {.channels = &lc, .channel_count = 1, .joint_count = 2};
+        ak_clip* l = build(&lr);
+        const int16_t p2[2] = {-1, 0};
+        ak_transform r2[2] = {ak_transform_identity(), ak_transform_identity()};
+        r2[0].scale = r2[1].scale = ak_vec3_splat(1e30f);
+        ak_clip_reduce_desc od = {.parents = p2, .rest_pose = {r2, 2}};
+        double err = 0.0;
+        AK_CHECK_EQ(ak_clip_reduce(l, &od, NULL, &out, &err, NULL), AK_OK);
+        AK_CHECK_MSG(isinf(err), "overflowing model positions: error %g, expected infinity", err);
+        AK_CHECK(out != NULL && ak_clip_channel_key_count(out, 0) == 5);
+        ak_clip_destroy(out);
+        ak_clip_destroy(l);
+    }
     ak_clip_destroy(c);
 }
 

@@ -332,13 +332,14 @@ typedef struct ak_clip_reduce_desc {
  * axis points at distance) at every key time of the clip and the midpoint of every key
  * interval; the local tolerance starts at the tolerance and shrinks by 0.7 until the check
  * passes (the last of 25 tries keeps every key off its neighbours' interpolation).
- * out_error (optional) gets that checked error. Cost: one clip build and check per try
+ * out_error (optional) gets that checked error (infinite when the model-space positions
+ * overflow float, e.g. for scales near 1e30: the result is then the last try's). Cost: one clip build and check per try
  * (60 joints x 301 keys: about 50 ms). alloc (NULL -> malloc/free) allocates scratch and the
  * clip. Removing keys can make playback slower when the channels then no longer share their
  * key times (the cursor's key cache refreshes such channels one by one).
  * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (tolerance or distance negative or not finite),
- * AK_ERR_SPAN_SMALL (rest_pose shorter than the joint count), AK_ERR_BAD_INDEX (a parent not
- * before its child), AK_ERR_UNSUPPORTED (a channel with CARDINAL, BEZIER, NATURAL, LAGRANGE or
+ * AK_ERR_SPAN_SMALL (rest_pose shorter than the joint count), AK_ERR_BAD_DATA (a rest_pose
+ * transform not finite), AK_ERR_BAD_INDEX (a parent not before its child), AK_ERR_UNSUPPORTED (a channel with CARDINAL, BEZIER, NATURAL, LAGRANGE or
  * SQUAD keys), AK_ERR_NO_MEMORY. *out_clip is NULL on failure. */
 AK_API ak_result ak_clip_reduce(const ak_clip* clip, const ak_clip_reduce_desc* desc, const ak_allocator* alloc,
                                 ak_clip** out_clip, double* out_error, ak_diag* diag);

@@ -111,7 +111,8 @@ static double model_error(const ak_clip* a, const ak_clip* b, float t, const ak_
     for (size_t j = 0; j < n; ++j)
         for (int p = 0; p < 4; ++p) {
             ak_vec3 x = ak_mat4_transform_point(ma[j], pts[p]), y = ak_mat4_transform_point(mb[j], pts[p]);
-            worst = fmax(worst, (double)ak_vec3_length(ak_vec3_sub(x, y)));
+            double e = (double)ak_vec3_length(ak_vec3_sub(x, y));
+            worst = e <= worst ? worst : (e == e ? e : INFINITY); /* overflow (NaN) never passes */
         }
     return worst;
 }
@@ -149,6 +150,14 @@ ak_result ak_clip_reduce(const ak_clip* clip, const ak_clip_reduce_desc* desc, c
     if (d.rest_pose.count < n) {
         akp_diag_set(diag, NULL, "rest_pose has %zu transforms, the clip addresses %zu joints", d.rest_pose.count, n);
         return AK_ERR_SPAN_SMALL;
+    }
+    for (size_t j = 0; j < n; ++j) {
+        const ak_transform* t = &d.rest_pose.ptr[j];
+        if (!ak_vec3_is_finite(t->translation) || !ak_vec3_is_finite(t->scale) || !ak_finitef(t->rotation.x) ||
+            !ak_finitef(t->rotation.y) || !ak_finitef(t->rotation.z) || !ak_finitef(t->rotation.w)) {
+            akp_diag_set(diag, NULL, "rest_pose[%zu] is not finite", j);
+            return AK_ERR_BAD_DATA;
+        }
     }
     for (size_t j = 0; j < n; ++j) {
         if (d.parents[j] >= (int16_t)j || d.parents[j] < -1) {
