@@ -760,6 +760,10 @@ ak_result ak_clip_sample(const ak_clip* clip, float time, ak_clip_cursor* cursor
     }
 #endif
     (void)cache;
-    sample_channels(clip, NULL, clip->channel_count, time, cursor ? cursor->segments : NULL, local.ptr, w, s);
+    /* A NaN time with a key cache: binary search, leaving the cursor's segments alone. The
+     * cache's lanes keep their keys through the NaN sample and redo degenerate slerp segments
+     * (equal keys) from those segments, so they must still match the cache. */
+    uint32_t* segs = cursor && !(time != time && cursor_cache(cursor)) ? cursor->segments : NULL;
+    sample_channels(clip, NULL, clip->channel_count, time, segs, local.ptr, w, s);
     return AK_OK;
 }

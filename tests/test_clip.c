@@ -355,6 +355,41 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
     }
 }
 
+/* A NaN sample between two samples in one key interval, on rotation channels with equal
+ * neighbouring keys (motion capture holds a pose: the key cache redoes such slerp segments in
+ * scalar code, from the cursor's segments, which the NaN sample must not move). */
+AK_TEST(cursor_nan_sample_keeps_degenerate_segments_exact) {
+    enum { K = 6, NC = 6 };
+    static const float kt[K] = {0, 1, 2, 3, 4, 5}, ang[K] = {0.0f, 0.3f, 0.3f, 0.9f, 0.9f, 1.4f};
+    static float rv[NC][K * 4];
+    ak_raw_channel ch[NC];
+    for (int c = 0; c < NC; ++c) {
+        for (int k = 0; k < K; ++k) {
+            ak_quat q = ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(1, 0.2f * (float)c, 0.1f)),
+                                                ang[k] * (1.0f + 0.1f * (float)c));
+            rv[c][4 * k] = q.x, rv[c][4 * k + 1] = q.y, rv[c][4 * k + 2] = q.z, rv[c][4 * k + 3] = q.w;
+        }
+        ch[c] = (ak_raw_channel){.target = AK_CHANNEL_ROTATION, .index = (uint32_t)c, .key_count = K, .times = kt,
+                                 .values = rv[c]};
+    }
+    ak_raw_clip raw = {.channels = ch, .channel_count = NC, .joint_count = CJ};
+    ak_clip* c = build(&raw);
+    AK_CHECK(c != NULL);
+    if (!c) return;
+    size_t full = ak_clip_cursor_storage_count(c);
+    uint32_t* st = (uint32_t*)calloc(full, sizeof *st);
+    int bad = 0;
+    for (int x = 0; x < 4 * K; ++x)
+        for (int y = 0; y < 4 * K; ++y) {
+            ak_clip_cursor cur;
+            AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span){st, full}), AK_OK);
+            const float seq[3] = {0.25f * (float)x - 0.6f, NAN, 0.25f * (float)y - 0.4f};
+            bad += compare_run(c, &cur, seq, 3);
+        }
+    AK_CHECK_MSG(bad == 0, "%d samples after a NaN differ from binary search", bad);
+    free(st);
+    ak_clip_destroy(c);
+}
 
 /* ---- inline sampler against the per-track evaluator and double-precision slerp -------- */
 
@@ -1001,6 +1036,7 @@ int main(void) {
     AK_RUN(sample_rejects_bad_spans);
     AK_RUN(gltf_interpolation_matches_spec_formulas);
     AK_RUN(cursor_is_bit_identical_to_binary_search);
+    AK_RUN(cursor_nan_sample_keeps_degenerate_segments_exact);
     AK_RUN(inline_sampler_matches_track_eval_and_double_slerp);
     AK_RUN(blend_properties);
     AK_RUN(blend_huge_weights_stay_finite);
