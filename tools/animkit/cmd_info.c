@@ -117,7 +117,7 @@ int cmd_info(int argc, char** argv) {
             printf("  %-24s %7zu vertices %7zu triangles  ", mesh->name[0] ? mesh->name : "(unnamed)",
                    mesh->vertex_count, mesh->triangle_count);
             if (s->meshes[m].skin >= 0 && mesh->influence_count > 0)
-                printf("skinned (%u influences/vertex)", mesh->influence_count);
+                printf("skinned (%u influence%s/vertex)", mesh->influence_count, mesh->influence_count == 1 ? "" : "s");
             else
                 printf("not skinned");
             if (mesh->morph_target_count) printf(", %zu morph targets", mesh->morph_target_count);

@@ -177,7 +177,8 @@ int cmd_retarget(int argc, char** argv) {
     if (CLI_GET(&a, "--clip")) ci = ak_scene_find_clip(src, CLI_GET(&a, "--clip"));
     if (ci < 0) {
         if (CLI_GET(&a, "--clip"))
-            rc = cli_fail("retarget", "%s: no clip '%s' (%zu clips)", a.pos[0], CLI_GET(&a, "--clip"), src->clip_count);
+            rc = cli_fail("retarget", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), src->clip_count,
+                          cli_plural(src->clip_count));
         else
             rc = cli_fail("retarget", "%s: the source has no clip", a.pos[0]);
         goto done;
@@ -209,10 +210,10 @@ int cmd_retarget(int argc, char** argv) {
         rc = cli_fail("retarget", "%s -> %s: %s", a.pos[0], a.pos[1], diag.message[0] ? diag.message : ak_result_string(r));
         goto done;
     }
-    fprintf(stderr, "retargeted '%s': %zu frames, %zu of %zu target joints driven, root motion x%.4g, %zu foot frames "
+    fprintf(stderr, "retargeted '%s': %zu frame%s, %zu of %zu target joint%s driven, root motion x%.4g, %zu foot frame%s "
                     "in contact, %zu pinned (%zu out of reach)\n",
-            ak_clip_name(clip), st.frame_count, st.mapped_count, nt, (double)st.root_scale, st.contact_frames,
-            st.pinned_frames, st.unreached_frames);
+            ak_clip_name(clip), st.frame_count, cli_plural(st.frame_count), st.mapped_count, nt, cli_plural(nt),
+            (double)st.root_scale, st.contact_frames, cli_plural(st.contact_frames), st.pinned_frames, st.unreached_frames);
     /* the target with this one clip (a shallow copy: the scene keeps its own clips) */
     ak_scene view = *dst;
     view.clips = &clip;

@@ -282,8 +282,9 @@ int cmd_terrain(int argc, char** argv) {
         rc = render_decimated(&t, out, gif);
     }
     if (rc == CLI_OK)
-        printf("terrain %ux%u, %g m wide, heights [%.3f, %.3f] m, %ld droplets: wrote %s (%s) in %.2f s\n", d->width,
-               d->height, (double)d->world_size, (double)lo, (double)hi, droplets, out, what, cli_now() - t0);
+        printf("terrain %ux%u, %g m wide, heights [%.3f, %.3f] m, %ld droplet%s: wrote %s (%s) in %.2f s\n", d->width,
+               d->height, (double)d->world_size, (double)lo, (double)hi, droplets, droplets == 1 ? "" : "s", out, what,
+               cli_now() - t0);
     free(t.heights), free(t.normals);
     return rc;
 }
