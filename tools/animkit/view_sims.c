@@ -1,7 +1,8 @@
 /* animkit view: the simulations it runs live (view_sim plug-ins). `animkit view KIND:SPEC`
  * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json], cloth:SCENE.json,
- * cloth:preset:NAME. Each reuses its command's scene parser and drawing (particles_run.c,
- * boids_run.c, cloth_run.c), so the viewer shows what the command renders. */
+ * cloth:preset:NAME, terrain[:preset:NAME] (view_terrain.c). Each reuses its command's scene
+ * parser and drawing (particles_run.c, boids_run.c, cloth_run.c), so the viewer shows what the
+ * command renders. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
