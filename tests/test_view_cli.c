@@ -663,14 +663,14 @@ AK_TEST(sim_help_keys_do_something) {
 }
 
 /* The terrain is framed by the model's camera: ak_view_orbit_camera on the bounds of the
- * library's own mesh of `animkit terrain`'s default heightfield (seed 0). Eroding changes the
+ * library's own mesh of `animkit terrain`'s default heightfield (seed 0) at 129 x 129 samples. Eroding changes the
  * image only inside the terrain's projected box (the ground and its shadow lie at its floor);
  * G, T and E change it, R gives the first terrain back, and --seed 3 is G pressed three times. */
 static bool terrain_box(uint64_t seed, ak_vec3* lo, ak_vec3* hi) {
     ak_noise nz = ak_noise_make(seed);
-    ak_terrain_desc d = {.noise = &nz, .width = 257, .height = 257, .world_size = 100, .height_scale = 20,
+    ak_terrain_desc d = {.noise = &nz, .width = 129, .height = 129, .world_size = 100, .height_scale = 20,
                          .fractal = {.type = AK_FRACTAL_FBM, .octaves = 8}};
-    size_t n = 257u * 257u;
+    size_t n = 129u * 129u;
     float* h = malloc(n * sizeof *h);
     ak_vec3* p = malloc(n * sizeof *p);
     bool ok = h && p && ak_terrain_generate(&d, (ak_f32_span){h, n}, (ak_vec3_span){0}) == AK_OK &&

@@ -8,7 +8,7 @@
 
 #include "view_app.h"
 
-#define ERODE_DROPLETS 4000u /* per press of E: about 6% of the 257 x 257 cells get a droplet */
+#define ERODE_DROPLETS 2000u /* per press of E: about 12% of the 129 x 129 cells get a droplet */
 #define ERODE_THERMAL 2u
 
 typedef struct tsim {
@@ -65,8 +65,9 @@ static bool tsim_generate(tsim* t) {
 }
 
 static int tsim_init(void** state, const char* spec, const view_sim_opts* o, char* err, size_t err_size) {
-    /* the defaults of `animkit terrain` */
-    ak_terrain_desc d = {.width = 257, .height = 257, .world_size = 100, .height_scale = 20,
+    /* the defaults of `animkit terrain` but for the grid: 129 x 129 samples rather than 257 x 257
+     * (a quarter of the triangles: 21 fps at 960 x 600 on 2 threads for 257, 50+ for 129) */
+    ak_terrain_desc d = {.width = 129, .height = 129, .world_size = 100, .height_scale = 20,
                          .fractal = {.type = AK_FRACTAL_FBM, .octaves = 8}};
     const char* name = "hills";
     if (strncmp(spec, "preset:", 7) == 0) {
@@ -183,7 +184,7 @@ static void tsim_status(void* state, char* out, size_t n) {
 static const view_help_entry tsim_keys[] = {
     {"g", "new terrain (next seed)"},
     {"t", "next fractal (fbm, ridged, turbulence)"},
-    {"e", "erode (4000 droplets, 2 thermal passes)"},
+    {"e", "erode (2000 droplets, 2 thermal passes)"},
     {"r", "back to the first terrain (also tab)"},
 };
 
