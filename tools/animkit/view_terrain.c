@@ -66,7 +66,7 @@ static bool tsim_generate(tsim* t) {
 
 static int tsim_init(void** state, const char* spec, const view_sim_opts* o, char* err, size_t err_size) {
     /* the defaults of `animkit terrain` but for the grid: 129 x 129 samples rather than 257 x 257
-     * (a quarter of the triangles: 21 fps at 960 x 600 on 2 threads for 257, 50+ for 129) */
+     * (a quarter of the triangles, about half the CPU time of a 960 x 600 frame; docs/view.md) */
     ak_terrain_desc d = {.width = 129, .height = 129, .world_size = 100, .height_scale = 20,
                          .fractal = {.type = AK_FRACTAL_FBM, .octaves = 8}};
     const char* name = "hills";
