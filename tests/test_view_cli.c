@@ -590,24 +590,298 @@ AK_TEST(sim_drag_sphere) {
     drag_sphere("boids:sim_flock.json", ak_vec3_make(-2, 0, -2), ak_vec3_make(2, 2, 2), ak_vec3_make(0, 1, 0));
 }
 
-/* 300 frames of a live simulation with every simulation key and a drag; under the ASan build a
- * leak fails the child's exit code. */
+/* Every key each simulation's help lists does something: a screenshot taken right after the
+ * key differs from the one right before it (no frame runs in between; the status line is
+ * part of the image), P writes a file, and escape quits. Keys are read from the "keys with
+ * KIND:" blocks of `animkit view --help`, which the overlay lists too. */
+AK_TEST(sim_help_keys_do_something) {
+    static const struct {
+        const char* kind;
+        const char* spec;
+    } kinds[] = {{"particles", "particles:preset:fountain"}, {"boids", "boids"}, {"cloth", "cloth:preset:flag"},
+                 {"terrain", "terrain"}};
+    AK_CHECK_EQ(run("view --help"), 0);
+    static char help[sizeof out_buf];
+    memcpy(help, out_buf, sizeof help);
+    for (size_t s = 0; s < sizeof kinds / sizeof kinds[0]; ++s) {
+        char head[64];
+        snprintf(head, sizeof head, "\nkeys with %s:\n", kinds[s].kind);
+        const char* k = strstr(help, head);
+        AK_CHECK_MSG(k != NULL, "--help lists no keys for %s", kinds[s].kind);
+        if (!k) continue;
+        k += strlen(head);
+        char keys[32][16];
+        int nk = 0;
+        while (*k == ' ' && nk < 32) {
+            if (sscanf(k, " %15s", keys[nk]) != 1) break;
+            ++nk;
+            k = strchr(k, '\n');
+            if (!k) break;
+            ++k;
+        }
+        AK_CHECK_MSG(nk >= 6, "%s: only %d keys", kinds[s].kind, nk);
+        char* script = calloc(1, 1 << 16);
+        if (!script) return;
+        size_t o = 0;
+        bool terrain = strcmp(kinds[s].kind, "terrain") == 0, escape = false;
+        for (int i = 0; i < nk; ++i) {
+            if (strcmp(keys[i], "escape") == 0) {
+                escape = true; /* last: it ends the session */
+                continue;
+            }
+            const char* pre = "";
+            if (strcmp(keys[i], "r") == 0) pre = terrain ? "key g\nkey e\n" : "wait 3\n";
+            if (strcmp(keys[i], "f") == 0) pre = "wheel 2\n";
+            o += (size_t)snprintf(script + o, 65536 - o, "%sscreenshot skey_%02d_a.png\nkey %s\nscreenshot skey_%02d_b.png\n",
+                                  pre, i, keys[i], i);
+        }
+        AK_CHECK_MSG(escape, "%s: escape is not listed", kinds[s].kind);
+        snprintf(script + o, 65536 - o, "key escape\nscreenshot skey_after_escape.png\n");
+        write_text("skeys.txt", script);
+        free(script);
+        remove("./view_0000.png");
+        remove("skey_after_escape.png");
+        char args[256];
+        snprintf(args, sizeof args, "view %s --headless --size 240x180 --script skeys.txt --shot-dir .", kinds[s].spec);
+        int rc = run(args);
+        AK_CHECK_MSG(rc == 0, "%s: exit %d: %s", kinds[s].spec, rc, out_buf);
+        for (int i = 0; i < nk; ++i) {
+            if (strcmp(keys[i], "escape") == 0) continue;
+            char pa[64], pb[64];
+            snprintf(pa, sizeof pa, "skey_%02d_a.png", i);
+            snprintf(pb, sizeof pb, "skey_%02d_b.png", i);
+            long d = count_diff(pa, pb, 240, 180, 0, 180, NULL);
+            AK_CHECK_MSG(d > 0, "%s: key '%s' changed nothing (%ld)", kinds[s].kind, keys[i], d);
+        }
+        FILE* f = fopen("./view_0000.png", "rb");
+        AK_CHECK_MSG(f != NULL, "%s: key p wrote no view_0000.png", kinds[s].kind);
+        if (f) fclose(f);
+        f = fopen("skey_after_escape.png", "rb");
+        AK_CHECK_MSG(f == NULL, "%s: the script went on after escape", kinds[s].kind);
+        if (f) fclose(f);
+    }
+}
+
+/* The terrain is framed by the model's camera: ak_view_orbit_camera on the bounds of the
+ * library's own mesh of `animkit terrain`'s default heightfield (seed 0) at 129 x 129 samples. Eroding changes the
+ * image only inside the terrain's projected box (the ground and its shadow lie at its floor);
+ * G, T and E change it, R gives the first terrain back, and --seed 3 is G pressed three times. */
+static bool terrain_box(uint64_t seed, ak_vec3* lo, ak_vec3* hi) {
+    ak_noise nz = ak_noise_make(seed);
+    ak_terrain_desc d = {.noise = &nz, .width = 129, .height = 129, .world_size = 100, .height_scale = 20,
+                         .fractal = {.type = AK_FRACTAL_FBM, .octaves = 8}};
+    size_t n = 129u * 129u;
+    float* h = malloc(n * sizeof *h);
+    ak_vec3* p = malloc(n * sizeof *p);
+    bool ok = h && p && ak_terrain_generate(&d, (ak_f32_span){h, n}, (ak_vec3_span){0}) == AK_OK &&
+              ak_terrain_mesh(&d, (ak_f32_cspan){h, n}, (ak_vec3_span){p, n}, (ak_vec2_span){0}, (ak_u32_span){0}) == AK_OK;
+    if (ok) ak_points_bounds((ak_vec3_cspan){p, n}, lo, hi);
+    free(h);
+    free(p);
+    return ok;
+}
+
+AK_TEST(terrain_view) {
+    const int w = 320, h = 240;
+    write_text("terrain.txt", "screenshot ter0.png\nkey e\nscreenshot ter1.png\nkey r\nscreenshot ter2.png\nkey g\nkey g\n"
+                              "key g\nkey f\nscreenshot ter3.png\nkey t\nscreenshot ter4.png\nkey r\nkey f\nscreenshot ter5.png\n");
+    AK_CHECK_EQ(run("view terrain --headless --size 320x240 --script terrain.txt"), 0);
+    write_text("terrain3.txt", "screenshot ter_seed3.png\n");
+    AK_CHECK_EQ(run("view terrain --seed 3 --headless --size 320x240 --script terrain3.txt"), 0);
+    int y0 = HUD_TOP, y1 = h - HUD_BOTTOM;
+    AK_CHECK(count_diff("ter0.png", "ter1.png", w, h, y0, y1, NULL) > 500);  /* erosion shows */
+    AK_CHECK_EQ(count_diff("ter0.png", "ter2.png", w, h, y0, y1, NULL), 0);   /* R: the first terrain */
+    AK_CHECK(count_diff("ter0.png", "ter3.png", w, h, y0, y1, NULL) > 2000); /* a new seed */
+    AK_CHECK(count_diff("ter3.png", "ter4.png", w, h, y0, y1, NULL) > 2000); /* ridged */
+    AK_CHECK_EQ(count_diff("ter0.png", "ter5.png", w, h, y0, y1, NULL), 0);
+    AK_CHECK_EQ(count_diff("ter3.png", "ter_seed3.png", w, h, y0, y1, NULL), 0);
+    /* the changed pixels of the erosion lie in the projected box of the library's terrain (give
+     * or take the shadow's 3-pixel blur on the ground) */
+    ak_vec3 lo, hi;
+    AK_CHECK(terrain_box(0, &lo, &hi));
+    ak_view_orbit orb = {.azimuth = 0.55f, .elevation = 0.22f, .aspect = (float)w / (float)h, .margin = 1.08f};
+    ak_raster_camera cam = ak_view_orbit_camera(lo, hi, &orb);
+    float bx0 = INFINITY, by0 = INFINITY, bx1 = -INFINITY, by1 = -INFINITY;
+    for (int c = 0; c < 8; ++c) {
+        ak_vec3 q = {0, 0, 0};
+        AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z), &q));
+        bx0 = fminf(bx0, q.x), by0 = fminf(by0, q.y), bx1 = fmaxf(bx1, q.x), by1 = fmaxf(by1, q.y);
+    }
+    AK_CHECK(bx0 > 0 && by0 > HUD_TOP && bx1 < (float)w && by1 < (float)(h - HUD_BOTTOM)); /* all of it in view */
+    ak_image a = {0}, b = {0};
+    if (load_png("ter0.png", &a, w, h) && load_png("ter1.png", &b, w, h)) {
+        long in = 0, out = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) {
+                if (channel_diff(&a, &b, x, y) <= 4) continue; /* the shadow shifts by a level or two */
+                bool inside = (float)x + 0.5f >= bx0 - 3 && (float)x + 0.5f <= bx1 + 3 && (float)y + 0.5f >= by0 - 3 &&
+                              (float)y + 0.5f <= by1 + 3;
+                if (inside) ++in;
+                else ++out;
+            }
+        AK_CHECK_MSG(in > 500 && out == 0, "erosion changed %ld pixels inside the terrain's box, %ld outside", in, out);
+    } else {
+        AK_CHECK_MSG(false, "cannot read the terrain screenshots");
+    }
+    free(a.pixels);
+    free(b.pixels);
+    AK_CHECK_EQ(run("view terrain:preset:volcano --headless"), 2);
+    AK_CHECK(strstr(out_buf, "hills, mountains, dunes") != NULL);
+    AK_CHECK_EQ(run("view terrain:land.json --headless"), 2);
+    AK_CHECK_EQ(run("view terrain --seed -1 --headless"), 2);
+    AK_CHECK_EQ(run("view builtin:cylinder --seed 1 --headless"), 2);
+    AK_CHECK_EQ(run("view terrain:preset:mountains --headless --frames 2"), 0);
+    AK_CHECK_EQ(run("view terrain:preset:dunes --headless --frames 2 --threads 3"), 0);
+}
+
+/* Dragging the drape's sphere out from under the cloth before it lands: the cloth falls to
+ * the floor instead of hanging on the sphere, so its red pixels end lower in the image. The
+ * preset frames the box [-0.5, 0, -0.5]..[0.5, 1, 0.5] (cloth at rest and the sphere, floor). */
+static bool red(const ak_image* im, int x, int y) {
+    const uint8_t* p = ak_image_pixel(im, x, y);
+    return p[0] > 60 && p[0] > 2 * p[1] && p[0] > 2 * p[2];
+}
+
+static double red_mean_y(const char* path, int w, int h, long* count) {
+    ak_image im = {0};
+    double sy = 0;
+    long n = 0;
+    if (load_png(path, &im, w, h))
+        for (int y = HUD_TOP; y < h - HUD_BOTTOM; ++y)
+            for (int x = 0; x < w; ++x)
+                if (red(&im, x, y)) sy += y, ++n;
+    free(im.pixels);
+    *count = n;
+    return n ? sy / (double)n : -1;
+}
+
+AK_TEST(sim_cloth_drag_sphere) {
+    const int w = 320, h = 240;
+    ak_view_orbit o = {.azimuth = 0.55f, .elevation = 0.22f, .aspect = (float)w / (float)h, .margin = 1.08f};
+    ak_raster_camera cam = ak_view_orbit_camera(ak_vec3_make(-0.5f, 0, -0.5f), ak_vec3_make(0.5f, 1, 0.5f), &o);
+    ak_vec3 c = {0, 0, 0}, e = {0, 0, 0};
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(0, 0.5f, 0), &c));
+    /* 1.2 m along the camera's right: the sphere (radius 0.3) leaves the 1 m cloth's shadow */
+    const float* v = cam.view.m;
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_madd(ak_vec3_make(0, 0.5f, 0), ak_vec3_make(v[0], v[4], v[8]), 1.2f), &e));
+    char script[512];
+    snprintf(script, sizeof script, "wait 30\nscreenshot drape_still.png\n");
+    write_text("drape_a.txt", script);
+    snprintf(script, sizeof script,
+             "mouse_down left %.2f %.2f\nmouse_move %.2f %.2f\nmouse_move %.2f %.2f\nmouse_up left %.2f %.2f\n"
+             "wait 30\nscreenshot drape_moved.png\n",
+             (double)c.x, (double)c.y, (double)(0.5f * (c.x + e.x)), (double)(0.5f * (c.y + e.y)), (double)e.x, (double)e.y,
+             (double)e.x, (double)e.y);
+    write_text("drape_b.txt", script);
+    AK_CHECK_EQ(run("view cloth:preset:drape --headless --size 320x240 --script drape_a.txt"), 0);
+    AK_CHECK_EQ(run("view cloth:preset:drape --headless --size 320x240 --script drape_b.txt"), 0);
+    long na = 0, nb = 0;
+    double ya = red_mean_y("drape_still.png", w, h, &na), yb = red_mean_y("drape_moved.png", w, h, &nb);
+    printf("  drape: %ld cloth pixels, mean row %.1f; sphere dragged away: %ld, mean row %.1f\n", na, ya, nb, yb);
+    AK_CHECK_MSG(na > 300 && nb > 300, "cloth pixels: %ld, %ld", na, nb);
+    AK_CHECK_MSG(yb > ya + 10.0, "the cloth did not fall lower with the sphere dragged away (mean row %.1f -> %.1f)", ya, yb);
+}
+
+/* A jet of particles (no gravity) towards a sphere that stops it (friction 1, no bounce): none
+ * get past it, until a script drags the sphere up out of the jet; then particles fly on
+ * beyond where the sphere was. Two small spheres at the corners pin the framed box to
+ * [-1.25, 0, -0.65]..[1.25, 1.2, 0.65] (the dry run's particles stay inside it). */
+AK_TEST(sim_particles_drag_deflects) {
+    const int w = 320, h = 240;
+    write_text("jet.json",
+               "{\"gravity\": [0, 0, 0], \"planes\": [{\"n\": [0, 1, 0], \"d\": 0}],\n"
+               " \"spheres\": [{\"c\": [0, 0.5, 0], \"r\": 0.3, \"restitution\": 0, \"friction\": 1},\n"
+               "   {\"c\": [-1.2, 0.05, -0.6], \"r\": 0.05}, {\"c\": [1.2, 1.15, 0.6], \"r\": 0.05}],\n"
+               " \"emitters\": [{\"shape\": \"point\", \"center\": [-1, 0.5, 0], \"direction\": [1, 0, 0], \"cone_angle\": 0.02,\n"
+               "   \"speed\": [3, 3], \"lifetime\": [4, 4], \"size\": [0.04, 0.04], \"colour\": [1, 0.2, 0.1, 1], \"rate\": 400}]}\n");
+    ak_view_orbit o = {.azimuth = 0.55f, .elevation = 0.22f, .aspect = (float)w / (float)h, .margin = 1.08f};
+    ak_raster_camera cam = ak_view_orbit_camera(ak_vec3_make(-1.25f, 0, -0.65f), ak_vec3_make(1.25f, 1.2f, 0.65f), &o);
+    ak_vec3 c = {0, 0, 0}, up = {0, 0, 0}, p0 = {0, 0, 0}, p1 = {0, 0, 0};
+    const float* v = cam.view.m;
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(0, 0.5f, 0), &c));
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_madd(ak_vec3_make(0, 0.5f, 0), ak_vec3_make(v[1], v[5], v[9]), 0.7f), &up));
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(0.55f, 0.5f, 0), &p0));
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(1.1f, 0.5f, 0), &p1));
+    char script[512];
+    write_text("jet_a.txt", "screenshot jet0.png\nwait 40\nscreenshot jet_still.png\n");
+    snprintf(script, sizeof script,
+             "mouse_down left %.2f %.2f\nmouse_move %.2f %.2f\nmouse_up left %.2f %.2f\nwait 40\nscreenshot jet_moved.png\n",
+             (double)c.x, (double)c.y, (double)up.x, (double)up.y, (double)up.x, (double)up.y);
+    write_text("jet_b.txt", script);
+    AK_CHECK_EQ(run("view particles:jet.json --headless --size 320x240 --script jet_a.txt"), 0);
+    AK_CHECK_EQ(run("view particles:jet.json --headless --size 320x240 --script jet_b.txt"), 0);
+    /* pixels along the jet's line beyond the sphere (x from 0.55 to 1.1 m), 5 rows each side */
+    ak_image i0 = {0}, ia = {0}, ib = {0};
+    if (load_png("jet0.png", &i0, w, h) && load_png("jet_still.png", &ia, w, h) && load_png("jet_moved.png", &ib, w, h)) {
+        long still = 0, moved = 0;
+        for (int s = 0; s <= 40; ++s) {
+            float t = (float)s / 40.0f;
+            int x = (int)(p0.x + t * (p1.x - p0.x)), y = (int)(p0.y + t * (p1.y - p0.y));
+            for (int dy = -5; dy <= 5; ++dy) {
+                if (channel_diff(&i0, &ia, x, y + dy) > 24) ++still;
+                if (channel_diff(&i0, &ib, x, y + dy) > 24) ++moved;
+            }
+        }
+        AK_CHECK_MSG(still == 0, "%ld pixels changed beyond the sphere while it blocked the jet", still);
+        AK_CHECK_MSG(moved > 40, "only %ld pixels changed beyond the sphere once it was dragged away", moved);
+    } else {
+        AK_CHECK_MSG(false, "cannot read the jet screenshots");
+    }
+    free(i0.pixels);
+    free(ia.pixels);
+    free(ib.pixels);
+}
+
+/* --threads gives the same images for any count (the simulations and the rasterizer);
+ * --seed changes where particles go. */
+AK_TEST(sim_threads_and_seed) {
+    const int w = 200, h = 150;
+    write_text("thr.txt", "wait 20\nscreenshot thr.png\n");
+    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --threads 1 --script thr.txt"), 0);
+    rename("thr.png", "thr1.png");
+    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --threads 3 --script thr.txt"), 0);
+    rename("thr.png", "thr3.png");
+    AK_CHECK_EQ(count_diff("thr1.png", "thr3.png", w, h, 0, h, NULL), 0);
+    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --seed 2 --script thr.txt"), 0);
+    AK_CHECK(count_diff("thr1.png", "thr.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 20);
+    AK_CHECK_EQ(run("view boids --headless --size 200x150 --threads 1 --script thr.txt"), 0);
+    rename("thr.png", "bthr1.png");
+    AK_CHECK_EQ(run("view boids --headless --size 200x150 --threads 2 --script thr.txt"), 0);
+    AK_CHECK_EQ(count_diff("bthr1.png", "thr.png", w, h, 0, h, NULL), 0);
+    AK_CHECK_EQ(run("view boids --headless --size 200x150 --seed 9 --script thr.txt"), 0);
+    AK_CHECK(count_diff("bthr1.png", "thr.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 20);
+}
+
+/* Long sessions of each simulation with every simulation key and a drag (1,000 frames of the
+ * fountain, 300 of the flock, fewer of the costly character rain, drape and terrain);
+ * under the ASan build a leak fails the child's exit code. */
 AK_TEST(sim_long_session) {
-    char* script = calloc(1, 1 << 16);
-    if (!script) return;
-    size_t o = 0;
     static const char* const steps[] = {"key a", "key e", "mouse_down left 120 90", "mouse_move 140 95", "mouse_up left 140 95",
                                         "key space", "key right", "key space", "key h", "key h", "key r", "key q",
-                                        "key tab", "key f", "wheel 1"};
-    for (int i = 0; i < 30; ++i)
-        o += (size_t)snprintf(script + o, 65536 - o, "%s\nwait 10\n", steps[i % (sizeof steps / sizeof steps[0])]);
-    snprintf(script + o, 65536 - o, "screenshot sim_long.png\n");
-    write_text("sim_long.txt", script);
-    free(script);
-    int rc = run("view particles:preset:character --headless --size 160x120 --script sim_long.txt");
-    AK_CHECK_MSG(rc == 0, "exit %d: %s", rc, out_buf);
-    rc = run("view boids:" AK_SOURCE_DIR "/examples/boids_flock.json --headless --size 160x120 --script sim_long.txt");
-    AK_CHECK_MSG(rc == 0, "boids: exit %d: %s", rc, out_buf);
+                                        "key tab", "key f", "wheel 1", "key g", "key t", "key p"};
+    static const struct {
+        const char* spec;
+        int rounds, wait;
+    } runs[] = {{"particles:preset:fountain", 100, 10},
+                {"particles:preset:character", 10, 10}, /* slow under ASan: 100 frames */
+                {"boids:" AK_SOURCE_DIR "/examples/boids_flock.json", 30, 10},
+                {"cloth:preset:drape", 18, 1}, /* the costly ones: every key once, fewer frames */
+                {"terrain", 18, 1}};
+    for (size_t r = 0; r < sizeof runs / sizeof runs[0]; ++r) {
+        char* script = calloc(1, 1 << 16);
+        if (!script) return;
+        size_t o = 0;
+        for (int i = 0; i < runs[r].rounds; ++i)
+            o += (size_t)snprintf(script + o, 65536 - o, "%s\nwait %d\n", steps[i % (int)(sizeof steps / sizeof steps[0])],
+                                  runs[r].wait);
+        snprintf(script + o, 65536 - o, "screenshot sim_long.png\n");
+        write_text("sim_long.txt", script);
+        free(script);
+        char args[512];
+        snprintf(args, sizeof args, "view %s --headless --size 160x120 --script sim_long.txt --shot-dir .", runs[r].spec);
+        int rc = run(args);
+        AK_CHECK_MSG(rc == 0, "%s: exit %d: %s", runs[r].spec, rc, out_buf);
+    }
 }
 
 int main(void) {
@@ -625,6 +899,11 @@ int main(void) {
     AK_RUN(sim_boids_play_pause_reset);
     AK_RUN(sim_cloth_play_pause_reset);
     AK_RUN(sim_drag_sphere);
+    AK_RUN(sim_help_keys_do_something);
+    AK_RUN(terrain_view);
+    AK_RUN(sim_cloth_drag_sphere);
+    AK_RUN(sim_particles_drag_deflects);
+    AK_RUN(sim_threads_and_seed);
     AK_RUN(sim_long_session);
     return ak_test_finish();
 }

@@ -9,13 +9,14 @@
 static const char* const usage =
     "usage: animkit view FILE|builtin:NAME|SIM [--clip C] [--size WxH] [--script FILE] [--headless]\n"
     "                    [--ik-log FILE] [--frames N] [--supersample N] [--threads N] [--stats]\n"
-    "                    [--shot-dir DIR]\n"
+    "                    [--shot-dir DIR] [--seed K]\n"
     "Open a window on the model, shaded by animkit's own rasterizer, playing clip C (default the\n"
     "first). The camera starts framed on the first pose as `animkit render` frames one time.\n"
     "SIM runs a simulation live: particles:SCENE.json, particles:preset:fountain|rain|fireworks|\n"
     "character, boids[:SCENE.json], cloth:SCENE.json, cloth:preset:flag|curtain|drape|cape (space\n"
     "pauses, right steps one frame, r restarts, left drag on a sphere collider moves it, a/d/q/e\n"
-    "change the wind of particles and cloth; docs/view.md).\n"
+    "change the wind of particles and cloth), or shows terrain[:preset:hills|mountains|dunes] (g new\n"
+    "seed, t next fractal, e erodes, r the first terrain); docs/view.md.\n"
     "  --size WxH       window size (default 960x600)\n"
     "  --script FILE    replay input from FILE, one event a line: key NAME, mouse_down BUTTON X Y,\n"
     "                   mouse_move X Y, mouse_up BUTTON X Y, wheel DY, wait FRAMES,\n"
@@ -27,7 +28,10 @@ static const char* const usage =
     "  --ik-log FILE    after each IK solve, one JSON line: {\"frame\": n, \"solver\": s,\n"
     "                   \"effector\": name, \"target\": [x,y,z], \"reached\": b, \"error\": e}\n"
     "  --supersample N  anti-aliasing samples per axis, 1..4 (default 1 for speed; render uses 2)\n"
-    "  --threads N      raster threads, 1..64 (default 2)\n"
+    "  --threads N      raster threads, 1..64 (default 2); given, also the simulation's threads\n"
+    "                   (default 1; the results are the same for any count)\n"
+    "  --seed K         simulation seed, 0..18446744073709551615 (default: particles 1, boids the\n"
+    "                   scene's seed (K modulo 2^31), terrain 0; the cloth has no randomness)\n"
     "  --stats          print the frame-time breakdown at exit (stderr)\n"
     "  --shot-dir DIR   where the P key writes view_NNNN.png (default .)\n"
     "keys:\n";
@@ -36,9 +40,15 @@ static void print_usage(void) {
     fputs(usage, stdout);
     for (size_t i = 0; i < view_help_count; ++i) printf("  %-8s %s\n", view_help[i].key, view_help[i].what);
     printf("mouse: left drag orbits (on a joint: picks the IK effector and drags its target; on the\n"
-           "bottom bar: scrubs); middle or shift+left drag pans; the wheel zooms.\n"
-           "This build %s a window (SDL2).\n",
-           view_window_available() ? "has" : "does not have");
+           "bottom bar: scrubs); middle or shift+left drag pans; the wheel zooms.\n");
+    const view_sim* sim;
+    for (size_t k = 0; (sim = view_sim_at(k)) != NULL; ++k) {
+        const view_help_entry* list[64];
+        size_t n = view_help_list(sim, list, 64);
+        printf("keys with %s:\n", sim->name);
+        for (size_t i = 0; i < n; ++i) printf("  %-8s %s\n", list[i]->key, list[i]->what);
+    }
+    printf("This build %s a window (SDL2).\n", view_window_available() ? "has" : "does not have");
 }
 
 static int load_script(const char* path, view_script* out) {
@@ -71,7 +81,7 @@ int cmd_view(int argc, char** argv) {
     static const cli_opt opts[] = {
         {"--clip", "-c", true},    {"--size", NULL, true},    {"--script", NULL, true},      {"--headless", NULL, false},
         {"--ik-log", NULL, true},  {"--frames", NULL, true},  {"--supersample", NULL, true}, {"--threads", NULL, true},
-        {"--stats", NULL, false},  {"--shot-dir", NULL, true},
+        {"--stats", NULL, false},  {"--shot-dir", NULL, true},  {"--seed", NULL, true},
     };
     cli_args a;
     int rc = cli_parse("view", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
@@ -94,6 +104,16 @@ int cmd_view(int argc, char** argv) {
         if (!cli_parse_int(CLI_GET(&a, "--threads"), 1, 64, &v))
             return cli_usage("view", "--threads '%s' is not a whole number in 1..64", CLI_GET(&a, "--threads"));
         vo.threads = (int)v;
+        vo.sim_opts.threads = (int)v;
+    }
+    if (CLI_GET(&a, "--seed")) {
+        const char* s = CLI_GET(&a, "--seed");
+        char* end = NULL;
+        unsigned long long k = strtoull(s, &end, 10);
+        if (!s[0] || s[0] == '-' || s[0] == '+' || *end || (k == ~0ull && strcmp(s, "18446744073709551615") != 0))
+            return cli_usage("view", "--seed '%s' is not a whole number in 0..18446744073709551615", s);
+        vo.sim_opts.seed = (uint64_t)k;
+        vo.sim_opts.has_seed = true;
     }
     if (CLI_GET(&a, "--frames") && !cli_parse_int(CLI_GET(&a, "--frames"), 0, 100000000, &frames))
         return cli_usage("view", "--frames '%s' is not a whole number >= 0", CLI_GET(&a, "--frames"));
@@ -134,6 +154,9 @@ int cmd_view(int argc, char** argv) {
             rc = cli_usage("view", "--clip and --ik-log are for models, not simulations");
             goto done;
         }
+    } else if (CLI_GET(&a, "--seed")) {
+        rc = cli_usage("view", "--seed is for simulations, not models");
+        goto done;
     } else if ((rc = cli_load_scene("view", a.pos[0], &s))) {
         goto done;
     }

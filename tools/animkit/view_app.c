@@ -360,7 +360,18 @@ static const char* morph_name(const view_app* a, size_t k) {
 
 /* The viewer's keys that still apply with a simulation (the rest are about the model). */
 static bool sim_help_key(const char* k) {
-    return !strcmp(k, "space") || !strcmp(k, "f") || !strcmp(k, "escape") || !strcmp(k, "p") || !strcmp(k, "h");
+    return !strcmp(k, "space") || !strcmp(k, "f") || !strcmp(k, "p") || !strcmp(k, "h");
+}
+
+size_t view_help_list(const view_sim* sim, const view_help_entry** out, size_t capacity) {
+    static const view_help_entry sim_escape = {"escape", "quit"};
+    size_t n = 0;
+    for (size_t i = 0; sim && i < sim->key_count && n < capacity; ++i) out[n++] = &sim->keys[i];
+    for (size_t i = 0; i < view_help_count && n < capacity; ++i) {
+        if (sim && !strcmp(view_help[i].key, "escape")) out[n++] = &sim_escape; /* there is no IK effector */
+        else if (!sim || sim_help_key(view_help[i].key)) out[n++] = &view_help[i];
+    }
+    return n;
 }
 
 static void draw_hud(view_app* a) {
@@ -450,10 +461,7 @@ static void draw_hud(view_app* a) {
         float top = 2.0f * lh + 8.0f, avail = (float)a->height - top - 24.0f * (float)sc;
         /* a simulation's keys, then the viewer's that apply to it; else the viewer's */
         const view_help_entry* list[64];
-        size_t nkeys = 0;
-        for (size_t i = 0; a->sim && i < a->sim->key_count && nkeys < 64; ++i) list[nkeys++] = &a->sim->keys[i];
-        for (size_t i = 0; i < view_help_count && nkeys < 64; ++i)
-            if (!a->sim || sim_help_key(view_help[i].key)) list[nkeys++] = &view_help[i];
+        size_t nkeys = view_help_list(a->sim, list, 64);
         int cols = ((float)(nkeys + MOUSE_HELP_COUNT + 2) * lh + 16.0f <= avail) ? 1 : 2;
         size_t rows = (nkeys + (size_t)cols - 1) / (size_t)cols;
         float cw = (float)(41 * AK_FONT_ADVANCE_X * sc);
@@ -472,7 +480,7 @@ static void draw_hud(view_app* a) {
         }
         ty += (int)((float)(rows + 1) * lh);
         for (size_t i = 0; i < MOUSE_HELP_COUNT; ++i, ty += (int)lh)
-            ak_image_draw_text(img, (int)bx + 8, ty, a->sim && i == 1 ? "left on a sphere: drag the collider" : mouse_help[i],
+            ak_image_draw_text(img, (int)bx + 8, ty, a->sim && i == 1 ? (a->sim->grab ? "left on a sphere: drag the collider" : "") : mouse_help[i],
                                sc, rgba(0.8f, 0.9f, 1, 1));
     }
 }
@@ -855,7 +863,7 @@ int view_app_init(view_app* a, const ak_scene* s, const view_options* opt) {
     if (opt->sim) {
         char err[640];
         err[0] = '\0';
-        int rc = opt->sim->init(&a->sim_state, opt->sim_spec ? opt->sim_spec : "", err, sizeof err);
+        int rc = opt->sim->init(&a->sim_state, opt->sim_spec ? opt->sim_spec : "", &opt->sim_opts, err, sizeof err);
         if (rc) {
             fprintf(stderr, "animkit view: %s\n", err[0] ? err : "cannot start the simulation");
             memset(a, 0, sizeof(*a));

@@ -88,10 +88,19 @@ void view_script_free(view_script* s);
  * goes down (true when a collider is under the pixel: *anchor is its centre) and drag with the
  * world-space move of the anchor, status for the second status line, destroy at exit. Any
  * hook but init may be NULL. */
+/* What the command line sets for a simulation: --seed (has_seed false -> the scene's own seed,
+ * or 1 where the scene has none) and --threads (the simulation's worker threads; results are
+ * the same for any count). */
+typedef struct view_sim_opts {
+    uint64_t seed;
+    bool has_seed;
+    int threads;
+} view_sim_opts;
+
 typedef struct view_sim {
     const char* name;
     /* Returns CLI_OK, CLI_BAD_INPUT (bad file: message in err) or CLI_BAD_USAGE (bad spec). */
-    int (*init)(void** state, const char* spec, char* err, size_t err_size);
+    int (*init)(void** state, const char* spec, const view_sim_opts* opts, char* err, size_t err_size);
     void (*step)(void* state, float dt);
     void (*reset)(void* state);
     size_t (*meshes)(void* state, ak_raster_mesh* out, size_t capacity);
@@ -107,10 +116,18 @@ typedef struct view_sim {
     size_t key_count;
 } view_sim;
 
-/* The simulation a `animkit view` argument names ("particles:...", "boids", "boids:...", "cloth:..."), with *spec the text after the colon ("" when none); NULL when the argument
+/* The simulation a `animkit view` argument names ("particles:...", "boids", "boids:...", "cloth:...",
+ * "terrain", "terrain:..."), with *spec the text after the colon ("" when none); NULL when the argument
  * names no simulation (a model path or builtin:NAME). */
 const view_sim* view_sim_find(const char* arg, const char** spec);
-/* The kinds, for messages ("particles, boids, cloth"). */
+/* The simulation kinds in order (NULL past the last), for the help. */
+const view_sim* view_sim_at(size_t index);
+/* The keys the help overlay lists: a simulation's own keys, then the viewer's that apply to it
+ * (space, f, escape, p, h); sim NULL -> the viewer's keys (view_help). Returns the count. */
+size_t view_help_list(const view_sim* sim, const view_help_entry** out, size_t capacity);
+/* The terrain plug-in (view_terrain.c). */
+extern const view_sim view_terrain_sim;
+/* The kinds, for messages ("particles, boids, cloth, terrain"). */
 extern const char* const view_sim_kinds;
 
 /* ---- the app ---- */
@@ -125,6 +142,7 @@ typedef struct view_options {
     const char* shot_dir; /* where P writes screenshots; NULL -> "." */
     const view_sim* sim;  /* NULL -> none; else initialised by view_app_init with sim_spec */
     const char* sim_spec;
+    view_sim_opts sim_opts;
 } view_options;
 
 enum { VIEW_DRAG_NONE = 0, VIEW_DRAG_ORBIT, VIEW_DRAG_PAN, VIEW_DRAG_TARGET, VIEW_DRAG_TIMELINE, VIEW_DRAG_SIM };

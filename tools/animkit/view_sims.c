@@ -1,7 +1,8 @@
 /* animkit view: the simulations it runs live (view_sim plug-ins). `animkit view KIND:SPEC`
  * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json], cloth:SCENE.json,
- * cloth:preset:NAME. Each reuses its command's scene parser and drawing (particles_run.c,
- * boids_run.c, cloth_run.c), so the viewer shows what the command renders. */
+ * cloth:preset:NAME, terrain[:preset:NAME] (view_terrain.c). Each reuses its command's scene
+ * parser and drawing (particles_run.c, boids_run.c, cloth_run.c), so the viewer shows what the
+ * command renders. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,7 +13,7 @@
 #include "particles_run.h"
 #include "view_app.h"
 
-const char* const view_sim_kinds = "particles, boids, cloth";
+const char* const view_sim_kinds = "particles, boids, cloth, terrain";
 
 #define MAX_STEPS_PER_FRAME 64
 #define WIND_STEP 0.5f
@@ -73,6 +74,8 @@ typedef struct psim {
     double carry; /* simulated time owed to the next step */
     ak_vec3 lo, hi;
     int grabbed;
+    uint64_t seed;
+    uint32_t threads;
 } psim;
 
 static void psim_destroy(void* state) {
@@ -98,7 +101,7 @@ static int psim_restart(psim* p) {
     p->failed = false;
     if (p->use_char && particles_character_pose(&p->ch, 0.0f, 0.0f) != AK_OK)
         return cli_fail("view", "cannot pose the character");
-    int rc = particles_run_init(&p->run, &p->scene, p->use_char ? &p->ch : NULL, 1, 1);
+    int rc = particles_run_init(&p->run, &p->scene, p->use_char ? &p->ch : NULL, p->seed, p->threads);
     p->run_ready = true;
     if (rc) return rc;
     particles_shapes_free(&p->sh);
@@ -142,13 +145,15 @@ static int psim_bounds_run(psim* p) {
     return psim_restart(p);
 }
 
-static int psim_init(void** state, const char* spec, char* err, size_t err_size) {
+static int psim_init(void** state, const char* spec, const view_sim_opts* o, char* err, size_t err_size) {
     psim* p = calloc(1, sizeof *p);
     if (!p) {
         snprintf(err, err_size, "out of memory");
         return CLI_BAD_INPUT;
     }
     p->grabbed = -1;
+    p->seed = o->has_seed ? o->seed : 1; /* `animkit particles` seeds its runs with 1 */
+    p->threads = o->threads > 0 ? (uint32_t)o->threads : 1;
     int rc = CLI_OK;
     if (strncmp(spec, "preset:", 7) == 0) {
         const char* name = spec + 7;
@@ -341,6 +346,7 @@ typedef struct bsim {
     ak_vec3 lo, hi;
     float extent;
     int grabbed;
+    uint32_t threads;
 } bsim;
 
 static void bsim_destroy(void* state) {
@@ -360,18 +366,19 @@ static int bsim_restart(bsim* b) {
     b->step_index = 0;
     b->carry = 0.0;
     b->failed = false;
-    int rc = boids_run_init(&b->run, &b->sc, "view", b->file, 1);
+    int rc = boids_run_init(&b->run, &b->sc, "view", b->file, b->threads);
     if (rc) return rc;
     return boids_shapes_obstacles(&b->sh, &b->sc.params, b->extent) ? CLI_OK : cli_fail("view", "out of memory");
 }
 
-static int bsim_init(void** state, const char* spec, char* err, size_t err_size) {
+static int bsim_init(void** state, const char* spec, const view_sim_opts* o, char* err, size_t err_size) {
     bsim* b = calloc(1, sizeof *b);
     if (!b) {
         snprintf(err, err_size, "out of memory");
         return CLI_BAD_INPUT;
     }
     b->grabbed = -1;
+    b->threads = o->threads > 0 ? (uint32_t)o->threads : 1;
     b->file = spec[0] ? spec : "boids (default scene)";
     cli_boids_scene_defaults(&b->sc);
     if (spec[0]) {
@@ -384,6 +391,7 @@ static int bsim_init(void** state, const char* spec, char* err, size_t err_size)
             return CLI_BAD_INPUT;
         }
     }
+    if (o->has_seed) b->sc.seed = (long)(o->seed % 2147483648u); /* the scene's seed is 0..2^31-1 */
     /* the box the command's camera looks at, down to its ground */
     const ak_boids_params* prm = &b->sc.params;
     b->lo = prm->bounds_min;
@@ -548,7 +556,7 @@ static int csim_restart(csim* c) {
     return cloth_run_init(&c->run, &c->sc, "view", c->name);
 }
 
-static int csim_init(void** state, const char* spec, char* err, size_t err_size) {
+static int csim_init(void** state, const char* spec, const view_sim_opts* o, char* err, size_t err_size) {
     csim* c = calloc(1, sizeof *c);
     if (!c) {
         snprintf(err, err_size, "out of memory");
@@ -580,6 +588,7 @@ static int csim_init(void** state, const char* spec, char* err, size_t err_size)
         }
     }
     c->wind0 = c->sc.wind;
+    if (o->threads > 0) c->sc.thread_count = o->threads; /* the cloth has no random numbers: --seed does nothing */
     c->prop_count = c->sc.sphere_count + c->sc.capsule_count;
     if (c->prop_count > CLI_MAX_EXTRA - 1) c->prop_count = CLI_MAX_EXTRA - 1;
     c->spheres0 = calloc(c->sc.sphere_count + 1, sizeof *c->spheres0);
@@ -730,7 +739,10 @@ static const struct {
     {"particles", &particles_sim},
     {"boids", &boids_sim},
     {"cloth", &cloth_sim},
+    {"terrain", &view_terrain_sim},
 };
+
+const view_sim* view_sim_at(size_t index) { return index < sizeof sims / sizeof sims[0] ? sims[index].sim : NULL; }
 
 const view_sim* view_sim_find(const char* arg, const char** spec) {
     for (size_t k = 0; k < sizeof sims / sizeof sims[0]; ++k) {
