@@ -248,7 +248,9 @@ int cmd_cloth(int argc, char** argv) {
     if (gif) fprintf(stderr, "wrote %s: %d frames\n", out, frames);
     else if (bake.cap) fprintf(stderr, "wrote %s: %zu frames, %.4g s apart\n", out, bake.frames, (double)sc.dt * (double)bake.every);
     else if (out) fprintf(stderr, "wrote %s\n", out);
-    if (sc.steps > 0) fprintf(stderr, "%.3f ms per step (including rendering)\n", 1e3 * elapsed / (double)sc.steps);
+    if (sc.steps > 0)
+        fprintf(stderr, "%.3f ms per step%s\n", 1e3 * elapsed / (double)sc.steps,
+                gif ? " (including rendering)" : bake.cap ? " (including recording)" : "");
 
 done:
     sim_bake_free(&bake);

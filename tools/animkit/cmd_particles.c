@@ -29,7 +29,8 @@ static const char* const usage =
     "               the file's particles first, emitted ones after them\n"
     "  -o           render: a GIF of the run (up to 100 frames) or a PNG of the last step; or\n"
     "               the run as glTF (.glb, or .gltf + .bin): one animated node per particle\n"
-    "  --size       image size, 8x8 to 8192x8192 (default 480x360)\n";
+    "  --size       image size, 8x8 to 8192x8192 (default 480x360)\n"
+    "Without --json or -o prints a summary line.\n";
 
 typedef struct renderer {
     cli_frame frame;
@@ -278,6 +279,7 @@ int cmd_particles(int argc, char** argv) {
     }
     if ((rc = particles_run_init(&r, &scene, use_char ? &ch : NULL, (uint64_t)seed, (uint32_t)threads)))
         goto done;
+    const double t0 = cli_now();
     for (long s = 0; s <= steps; ++s) {
         if (s > 0 && (rc = particles_run_step(&r, (int)s - 1))) goto done;
         cli_progress("particles", (size_t)s, (size_t)steps);
@@ -294,7 +296,16 @@ int cmd_particles(int argc, char** argv) {
             }
         }
     }
+    const double elapsed = cli_now() - t0;
     if (json && (rc = write_json(json, &r, (int)steps))) goto done;
+    if (!json && !out) {
+        const size_t alive = ak_particles_count(r.ps);
+        printf("particles %s: %ld step%s of %.4g s (t = %.3g s) in %.3f s (%.3f ms/step), %zu particle%s alive"
+               " (capacity %zu)\n",
+               preset ? preset : a.pos[0], steps, cli_plural((size_t)steps), (double)scene.dt,
+               (double)ak_particles_time(r.ps), elapsed, steps ? 1e3 * elapsed / (double)steps : 0.0, alive,
+               cli_plural(alive), ak_particles_capacity(r.ps));
+    }
     if (glb) {
         if ((rc = sim_bake_points_write(&bake, preset ? preset : "particles", scene.dt))) goto done;
         fprintf(stderr, "wrote %s: %zu frames, %.4g s apart\n", out, bake.frames, (double)scene.dt * (double)bake.every);
