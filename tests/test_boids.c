@@ -734,14 +734,22 @@ AK_TEST(symmetric_pass_threads_and_kernels) {
                               .alignment_weight = 1, .alignment_radius = 1.4f, .cohesion_weight = 1,
                               .cohesion_radius = 1.6f};
     ak_boids_params pp = {.species = &plain, .species_count = 1};
+    /* wrap: a wrapping box through the flock, a min_speed and a force limit that bind (the
+     * batched integration hands such agents to the scalar code). */
     const struct {
         bool column;
         float view;
-    } cases[] = {{false, 250}, {false, 120}, {true, 360}, {true, 200}};
+        bool wrap;
+    } cases[] = {{false, 250, false}, {false, 120, false}, {true, 360, false}, {true, 200, false}, {false, 360, true}};
     const uint32_t threads[4] = {1, 2, 3, 6};
     const size_t n = 3072; /* 6 threads at most: one per 512 agents */
     for (size_t cs = 0; cs < sizeof cases / sizeof cases[0]; ++cs) {
         plain.view_angle = cases[cs].view;
+        plain.min_speed = cases[cs].wrap ? 1.2f : 0.0f;
+        plain.max_force = cases[cs].wrap ? 3.0f : 0.0f;
+        pp.bounds = cases[cs].wrap ? AK_BOIDS_BOUNDS_WRAP : AK_BOIDS_BOUNDS_DEFAULT;
+        pp.bounds_min = cases[cs].wrap ? ak_vec3_make(-6.9f, -6.9f, -6.9f) : ak_vec3_zero();
+        pp.bounds_max = cases[cs].wrap ? ak_vec3_make(6.9f, 6.9f, 6.9f) : ak_vec3_zero();
         flock base = flock_make(n);
         ak_rng r = ak_rng_make(500 + cs);
         for (size_t i = 0; i < n; ++i) {

@@ -165,6 +165,23 @@ typedef struct akp_boids_sink {
 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
                           const akp_boids_sink* sink);
 
+/* integrate_avx512.c: the step's integration, 8 agents at a time, for the common case
+ * (akp_boids_batch_ok: the symmetric pass, no goal, leader, wander, obstacles, steer-back
+ * bounds or planar flock). The agents' sums, counts, positions and velocities are copied into
+ * a batch; akp_boids_integrate_avx512 writes each lane's new position and velocity to the
+ * job's outputs, bit-identical to integrate() in boids.c, and returns the mask of the lanes
+ * it left to the scalar code (speed below min_speed, non-finite force, wrapped position).
+ * Lanes at and past n are ignored (zero them: they are computed). */
+#define AKP_BOIDS_BATCH 8
+typedef struct akp_boids_batch {
+    uint32_t n;
+    uint32_t idx[AKP_BOIDS_BATCH];
+    int64_t q[9][AKP_BOIDS_BATCH]; /* sep x y z, ali x y z, coh x y z */
+    uint32_t ns[AKP_BOIDS_BATCH], na[AKP_BOIDS_BATCH], nc[AKP_BOIDS_BATCH];
+    float p[3][AKP_BOIDS_BATCH], v[3][AKP_BOIDS_BATCH];
+} akp_boids_batch;
+uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b);
+
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);
 /* Spatial slots [n part / parts, n (part + 1) / parts) of the dense layout filled from the
