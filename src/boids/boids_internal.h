@@ -36,6 +36,7 @@ typedef struct akp_boids_sp {
 typedef struct akp_boids_acc {
     int64_t sep[3], ali[3], coh[3];
     uint64_t n01, n23;
+    int64_t pad; /* 96 bytes: the AVX-512 kernel adds a pair's credits as 8 + 4 int64 lanes */
 } akp_boids_acc;
 
 /* Per-step context: the job, resolved species, the search state. */
