@@ -66,6 +66,7 @@ typedef struct akp_boids_ctx {
     const ak_vec3* sv;         /* [n] velocities in spatial order */
     const uint32_t* sj;        /* [n] the agent's index in the caller's arrays */
     bool avx512;               /* the spatial path runs the AVX-512 kernels */
+    bool avx2;                 /* else the symmetric pass runs the AVX2 pair kernel */
     bool one_species;          /* species_count == 1 */
     /* Symmetric pair pass (dense layout, one species, no k cap, flee or pursue, one ring):
      * acc[n] holds what each agent received from the pairs found by agents before it. */
@@ -182,6 +183,34 @@ typedef struct akp_boids_batch {
     float p[3][AKP_BOIDS_BATCH], v[3][AKP_BOIDS_BATCH];
 } akp_boids_batch;
 uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b);
+
+/* search_avx2.c (x86-64 GCC/Clang without AK_NO_SIMD; elsewhere have_avx2 is false): the
+ * symmetric pair kernel for CPUs with AVX2 but not AVX-512, over the SSE2 filter's hits (k and
+ * d2); same tests and integer sums as the scalar sym_hits in search.c. */
+bool akp_boids_have_avx2(void);
+void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
+                        const akp_boids_sink* sink);
+
+/* A += the credits of one pair, atomically when another thread may touch A. */
+static inline void akp_boids_credit(akp_boids_acc* A, const int64_t v[9], uint64_t n01, uint64_t n23, bool atomic) {
+    if (!atomic) {
+        for (int a = 0; a < 3; ++a) {
+            A->sep[a] += v[a];
+            A->ali[a] += v[3 + a];
+            A->coh[a] += v[6 + a];
+        }
+        A->n01 += n01;
+        A->n23 += n23;
+        return;
+    }
+    for (int a = 0; a < 3; ++a) {
+        __atomic_fetch_add(&A->sep[a], v[a], __ATOMIC_RELAXED);
+        __atomic_fetch_add(&A->ali[a], v[3 + a], __ATOMIC_RELAXED);
+        __atomic_fetch_add(&A->coh[a], v[6 + a], __ATOMIC_RELAXED);
+    }
+    __atomic_fetch_add(&A->n01, n01, __ATOMIC_RELAXED);
+    __atomic_fetch_add(&A->n23, n23, __ATOMIC_RELAXED);
+}
 
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);
