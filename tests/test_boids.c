@@ -743,8 +743,9 @@ AK_TEST(symmetric_pass_threads_and_kernels) {
         bool wrap;
     } cases[] = {{false, 250, false}, {false, 120, false}, {true, 360, false}, {true, 200, false}, {false, 360, true}};
     const uint32_t threads[4] = {1, 2, 3, 6};
-    const size_t n = 3072; /* 6 threads at most: one per 512 agents */
     for (size_t cs = 0; cs < sizeof cases / sizeof cases[0]; ++cs) {
+        /* 6 threads at most: one per 512 agents (the wrap case, 2: it keeps valgrind runs short) */
+        const size_t n = cases[cs].wrap ? 1024 : 3072;
         plain.view_angle = cases[cs].view;
         plain.min_speed = cases[cs].wrap ? 1.2f : 0.0f;
         plain.max_force = cases[cs].wrap ? 3.0f : 0.0f;
@@ -780,6 +781,7 @@ AK_TEST(symmetric_pass_threads_and_kernels) {
         AK_CHECK(ref_inter > 3u * n);
         for (int t = 0; t < 4; ++t)
             for (int simd = 0; simd < 3; ++simd) { /* fastest, AVX2 instead of AVX-512, scalar */
+                if (simd == 1 && strcmp(ak_boids_simd_name(), "avx512") != 0) continue; /* same as fastest */
                 flock f = flock_make(n);
                 memcpy(f.p, base.p, n * sizeof(ak_vec3));
                 memcpy(f.v, base.v, n * sizeof(ak_vec3));

@@ -251,20 +251,6 @@ static inline void credit_lanes(const akp_boids_sink* sink, __mmask16 m, const u
     }
 }
 
-/* fix(x) on the lanes of m (zero elsewhere) stored as 16 int64 at out. */
-AKP_AVX512 static inline void store_fixed(int64_t* out, __mmask16 m, __m512 x) {
-    __m512i lo, hi;
-    fix16(x, &lo, &hi);
-    _mm512_storeu_si512((void*)out, _mm512_maskz_mov_epi64((__mmask8)(m & 0xFF), lo));
-    _mm512_storeu_si512((void*)(out + 8), _mm512_maskz_mov_epi64((__mmask8)(m >> 8), hi));
-}
-
-/* sum += v on the lanes of m, v given as 16 int64 at in. */
-AKP_AVX512 static inline void add_stored(__m512i* sum, __mmask16 m, const int64_t* in) {
-    *sum = _mm512_mask_add_epi64(*sum, (__mmask8)(m & 0xFF), *sum, _mm512_loadu_si512((const void*)in));
-    *sum = _mm512_mask_add_epi64(*sum, (__mmask8)(m >> 8), *sum, _mm512_loadu_si512((const void*)(in + 8)));
-}
-
 /* 8x8 transpose of int64 lanes: row l of out is lane l of r[0..7]. */
 AKP_AVX512 static inline void transpose8(const __m512i r[8], __m512i out[8]) {
     __m512i a[8], b[8];
