@@ -55,11 +55,13 @@ static void world_free(world* w) {
  * *out_cpu: on a machine other jobs load, CPU time is what an idle core would take);
  * interactions of the last step. */
 static double cpu_ms_last;
+static int kernels_mode; /* 0 fastest, 1 AVX2 in place of AVX-512 (skip_avx512), 2 skip_simd */
 static double run(world* w, uint32_t threads, bool naive, int steps, uint64_t* out_inter) {
     ak_boids_step_job j = {.params = &w->prm, .positions = {w->p, w->n}, .velocities = {w->v, w->n},
                            .dt = 1.0f / 60.0f, .thread_count = threads, .use_naive = naive,
                            .out_positions = {w->p2, w->n}, .out_velocities = {w->v2, w->n},
-                           .out_interaction_count = out_inter};
+                           .out_interaction_count = out_inter, .skip_avx512 = kernels_mode == 1,
+                           .skip_simd = kernels_mode == 2};
     const size_t need = ak_boids_step_scratch_size(&j);
     if (need > w->scratch_size) {
         free(w->scratch);
@@ -128,6 +130,16 @@ int main(int argc, char** argv) {
     printf("  step, 2 threads      %.2f ms wall (x%.2f), %.2f ms CPU in all (%.2f per thread)\n", ms2, ms1 / ms2,
            cpu2, cpu2 / 2);
     printf("  interactions/s       %.0f M per CPU second (1 thread)\n", (double)inter / cpu1 * 1e-3);
+    if (strcmp(ak_boids_simd_name(), "avx512") == 0) { /* the other kernels, side by side */
+        kernels_mode = 1;
+        run(&w, 1, false, steps, &inter);
+        const double cpu_avx2 = cpu_ms_last;
+        kernels_mode = 2;
+        run(&w, 1, false, steps, &inter);
+        kernels_mode = 0;
+        printf("  other kernels        1 thread: avx2 %.2f ms CPU (x%.2f of avx512), sse2 %.2f ms CPU (x%.2f)\n",
+               cpu_avx2, cpu_avx2 / cpu1, cpu_ms_last, cpu_ms_last / cpu1);
+    }
     printf("  grid build           %.2f ms (ak_grid_build alone; a step builds the grid only for sparse flocks)\n",
            grid_build_ms(&w, 1.0f));
     world_free(&w);

@@ -184,12 +184,14 @@ typedef struct ak_boids_step_job {
     uint32_t* out_contact_count;     /* optional: agents the obstacle projection had to stop */
     bool skip_simd;                  /* false -> fastest kernels for this CPU; true -> the
                                         scalar/SSE2 code (same results, bit for bit: tests) */
+    bool skip_avx512;                /* true -> the AVX2 kernel where AVX-512 would run (same
+                                        results: tests, benchmarks); false -> fastest */
 } ak_boids_step_job;
 
 /* Scratch bytes ak_boids_step_run needs for this job (positions.count, params and use_naive
  * are read; 0 for the naive path, and 0 when no species looks at neighbours). The grid path
  * needs about 140 bytes per agent (the grid, the agents re-sorted by cell, velocities in fixed
- * point, a cell table), plus 88 when one species only flocks (no k cap, flee or pursue: the
+ * point, a cell table), plus 96 when one species only flocks (no k cap, flee or pursue: the
  * neighbour sums of the symmetric pair pass).
  * Returns 0 when the job's params are unusable (validate says why). */
 AK_API size_t ak_boids_step_scratch_size(const ak_boids_step_job* job);
@@ -246,8 +248,9 @@ AK_API size_t ak_boids_min_distance_scratch_size(size_t count);
 AK_API ak_result ak_boids_min_distance(ak_vec3_cspan positions, ak_u8_span scratch, float* out_distance);
 
 /* Name of the grid-path kernels ak_boids_step_run uses on this CPU (chosen at run time):
- * "avx512" (AVX-512 F+DQ distance filter and, for one species, neighbour rules), "sse2" or
- * "scalar" (AK_NO_SIMD builds). Every kernel gives bit-identical results. */
+ * "avx512" (AVX-512 F+DQ distance filter and, for one species, neighbour rules and the
+ * integration), "avx2" (SSE2 filter, AVX2 symmetric pair kernel), "sse2" or "scalar"
+ * (AK_NO_SIMD builds). Every kernel gives bit-identical results. */
 AK_API const char* ak_boids_simd_name(void);
 
 #ifdef __cplusplus

@@ -463,6 +463,7 @@ typedef struct step_task {
     size_t part, parts;
     uint64_t interactions;
     uint32_t contacts;
+    akp_boids_batch* batch; /* the thread's batch when integrating 8 at a time, else NULL */
 } step_task;
 
 static void step_agent(const akp_boids_ctx* c, size_t i, const akp_boids_gather* g, void* user) {
@@ -474,16 +475,92 @@ static void step_agent(const akp_boids_ctx* c, size_t i, const akp_boids_gather*
     c->job->out_velocities.ptr[i] = nv;
 }
 
+/* Whether the step integrates 8 agents at a time (akp_boids_integrate_avx512): the common
+ * case only, where integrate() reduces to the three flock rules, the limits and wrapping. */
+static bool batch_ok(const akp_boids_ctx* c) {
+    const ak_boids_params* prm = c->params;
+    if (!c->sym || !c->avx512 || prm->planar || prm->obstacle_count > 0 || c->bounds == AK_BOIDS_BOUNDS_STEER)
+        return false;
+    const ak_boids_species* s = &c->sp[0].s;
+    return !(s->goal_weight > 0.0f) && !(s->leader_weight > 0.0f && prm->has_leader) &&
+           !(s->wander_weight > 0.0f && c->job->wander.ptr) && !(s->avoid_weight > 0.0f && prm->obstacle_count > 0);
+}
+
+/* Integrate the batch; the lanes it leaves go through integrate() (agents already copied). */
+static void batch_flush(const akp_boids_ctx* c, step_task* t) {
+    akp_boids_batch* b = t->batch;
+    if (!b->n) return;
+    for (uint32_t l = b->n; l < AKP_BOIDS_BATCH; ++l) { /* defined values in the unused lanes */
+        b->idx[l] = 0;
+        for (int a = 0; a < 9; ++a) b->q[a][l] = 0;
+        b->ns[l] = b->na[l] = b->nc[l] = 0;
+        for (int a = 0; a < 3; ++a) b->p[a][l] = b->v[a][l] = 0.0f;
+    }
+    for (uint32_t redo = akp_boids_integrate_avx512(c, &c->sp[0], b); redo; redo &= redo - 1u) {
+        const unsigned l = (unsigned)__builtin_ctz(redo);
+        akp_boids_gather g;
+        g.sp = &c->sp[0];
+        g.p = ak_vec3_make(b->p[0][l], b->p[1][l], b->p[2][l]);
+        g.v = ak_vec3_make(b->v[0][l], b->v[1][l], b->v[2][l]);
+        for (int a = 0; a < 3; ++a) {
+            g.sep[a] = b->q[a][l];
+            g.ali[a] = b->q[3 + a][l];
+            g.coh[a] = b->q[6 + a][l];
+        }
+        g.ns = b->ns[l];
+        g.na = b->na[l];
+        g.nc = b->nc[l];
+        g.flee_j = g.prey_j = UINT32_MAX;
+        ak_vec3 np, nv;
+        t->contacts += integrate(c, &g, b->idx[l], &np, &nv) ? 1u : 0u;
+        c->job->out_positions.ptr[b->idx[l]] = np;
+        c->job->out_velocities.ptr[b->idx[l]] = nv;
+    }
+    b->n = 0;
+}
+
+static void batch_agent(const akp_boids_ctx* c, size_t i, const akp_boids_gather* g, void* user) {
+    step_task* t = (step_task*)user;
+    t->interactions += g->nflock;
+    akp_boids_batch* b = t->batch;
+    const uint32_t l = b->n++;
+    b->idx[l] = (uint32_t)i;
+    for (int a = 0; a < 3; ++a) {
+        b->q[a][l] = g->sep[a];
+        b->q[3 + a][l] = g->ali[a];
+        b->q[6 + a][l] = g->coh[a];
+    }
+    b->ns[l] = g->ns;
+    b->na[l] = g->na;
+    b->nc[l] = g->nc;
+    b->p[0][l] = g->p.x, b->p[1][l] = g->p.y, b->p[2][l] = g->p.z;
+    b->v[0][l] = g->v.x, b->v[1][l] = g->v.y, b->v[2][l] = g->v.z;
+    if (b->n == AKP_BOIDS_BATCH) batch_flush(c, t);
+}
+
 static void* step_thread(void* arg) {
     step_task* t = (step_task*)arg;
-    if (t->c->sym) akp_boids_sym_range(t->c, t->part, t->parts, step_agent, t);
-    else akp_boids_gather_range(t->c, t->part, t->parts, step_agent, t);
+    akp_boids_batch batch;
+    if (t->c->sym) {
+        batch.n = 0;
+        t->batch = batch_ok(t->c) ? &batch : NULL;
+        akp_boids_sym_range(t->c, t->part, t->parts, t->batch ? batch_agent : step_agent, t);
+        if (t->batch) batch_flush(t->c, t);
+        t->batch = NULL;
+    } else {
+        akp_boids_gather_range(t->c, t->part, t->parts, step_agent, t);
+    }
     return NULL;
 }
 
 static void* step_finish_thread(void* arg) {
     step_task* t = (step_task*)arg;
-    akp_boids_sym_finish(t->c, t->part, t->parts, step_agent, t);
+    akp_boids_batch batch;
+    batch.n = 0;
+    t->batch = batch_ok(t->c) ? &batch : NULL;
+    akp_boids_sym_finish(t->c, t->part, t->parts, t->batch ? batch_agent : step_agent, t);
+    if (t->batch) batch_flush(t->c, t);
+    t->batch = NULL;
     return NULL;
 }
 
@@ -525,7 +602,7 @@ ak_result ak_boids_step_run(const ak_boids_step_job* job) {
     if (r != AK_OK) return r;
     const uint32_t threads = akp_boids_threads(job->thread_count, c.n);
     step_task tasks[64];
-    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (step_task){&c, t, threads, 0, 0};
+    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (step_task){&c, t, threads, 0, 0, NULL};
     if (c.sym) akp_boids_sym_clear(&c, threads);
     akp_boids_run_tasks(step_thread, tasks, sizeof tasks[0], threads);
     if (c.sym && threads > 1) akp_boids_run_tasks(step_finish_thread, tasks, sizeof tasks[0], threads);

@@ -36,6 +36,7 @@ typedef struct akp_boids_sp {
 typedef struct akp_boids_acc {
     int64_t sep[3], ali[3], coh[3];
     uint64_t n01, n23;
+    int64_t pad; /* 96 bytes: the AVX-512 kernel adds a pair's credits as 8 + 4 int64 lanes */
 } akp_boids_acc;
 
 /* Per-step context: the job, resolved species, the search state. */
@@ -65,6 +66,7 @@ typedef struct akp_boids_ctx {
     const ak_vec3* sv;         /* [n] velocities in spatial order */
     const uint32_t* sj;        /* [n] the agent's index in the caller's arrays */
     bool avx512;               /* the spatial path runs the AVX-512 kernels */
+    bool avx2;                 /* else the symmetric pass runs the AVX2 pair kernel */
     bool one_species;          /* species_count == 1 */
     /* Symmetric pair pass (dense layout, one species, no k cap, flee or pursue, one ring):
      * acc[n] holds what each agent received from the pairs found by agents before it. */
@@ -164,6 +166,51 @@ typedef struct akp_boids_sink {
  * through sink. Same tests and integer sums as the scalar sym_hits in search.c. */
 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
                           const akp_boids_sink* sink);
+
+/* integrate_avx512.c: the step's integration, 8 agents at a time, for the common case
+ * (akp_boids_batch_ok: the symmetric pass, no goal, leader, wander, obstacles, steer-back
+ * bounds or planar flock). The agents' sums, counts, positions and velocities are copied into
+ * a batch; akp_boids_integrate_avx512 writes each lane's new position and velocity to the
+ * job's outputs, bit-identical to integrate() in boids.c, and returns the mask of the lanes
+ * it left to the scalar code (speed below min_speed, non-finite force, wrapped position).
+ * Lanes at and past n are ignored (zero them: they are computed). */
+#define AKP_BOIDS_BATCH 8
+typedef struct akp_boids_batch {
+    uint32_t n;
+    uint32_t idx[AKP_BOIDS_BATCH];
+    int64_t q[9][AKP_BOIDS_BATCH]; /* sep x y z, ali x y z, coh x y z */
+    uint32_t ns[AKP_BOIDS_BATCH], na[AKP_BOIDS_BATCH], nc[AKP_BOIDS_BATCH];
+    float p[3][AKP_BOIDS_BATCH], v[3][AKP_BOIDS_BATCH];
+} akp_boids_batch;
+uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b);
+
+/* search_avx2.c (x86-64 GCC/Clang without AK_NO_SIMD; elsewhere have_avx2 is false): the
+ * symmetric pair kernel for CPUs with AVX2 but not AVX-512, over the SSE2 filter's hits (k and
+ * d2); same tests and integer sums as the scalar sym_hits in search.c. */
+bool akp_boids_have_avx2(void);
+void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
+                        const akp_boids_sink* sink);
+
+/* A += the credits of one pair, atomically when another thread may touch A. */
+static inline void akp_boids_credit(akp_boids_acc* A, const int64_t v[9], uint64_t n01, uint64_t n23, bool atomic) {
+    if (!atomic) {
+        for (int a = 0; a < 3; ++a) {
+            A->sep[a] += v[a];
+            A->ali[a] += v[3 + a];
+            A->coh[a] += v[6 + a];
+        }
+        A->n01 += n01;
+        A->n23 += n23;
+        return;
+    }
+    for (int a = 0; a < 3; ++a) {
+        __atomic_fetch_add(&A->sep[a], v[a], __ATOMIC_RELAXED);
+        __atomic_fetch_add(&A->ali[a], v[3 + a], __ATOMIC_RELAXED);
+        __atomic_fetch_add(&A->coh[a], v[6 + a], __ATOMIC_RELAXED);
+    }
+    __atomic_fetch_add(&A->n01, n01, __ATOMIC_RELAXED);
+    __atomic_fetch_add(&A->n23, n23, __ATOMIC_RELAXED);
+}
 
 /* search.c */
 size_t akp_boids_search_scratch_size(const ak_boids_step_job* job);

@@ -524,32 +524,15 @@ static void gather_rows(const akp_boids_ctx* c, const row_ranges* r, akp_boids_g
  * slabs hold more agents than it has room for, by atomic adds); the slab integrates after
  * both are done. Integer sums: the same bits in any order. */
 
-/* A += the credits of one pair, atomically when another thread may touch A. */
-static inline void credit(akp_boids_acc* A, const int64_t v[9], uint64_t n01, uint64_t n23, bool atomic) {
-    if (!atomic) {
-        for (int a = 0; a < 3; ++a) {
-            A->sep[a] += v[a];
-            A->ali[a] += v[3 + a];
-            A->coh[a] += v[6 + a];
-        }
-        A->n01 += n01;
-        A->n23 += n23;
-        return;
-    }
-    for (int a = 0; a < 3; ++a) {
-        __atomic_fetch_add(&A->sep[a], v[a], __ATOMIC_RELAXED);
-        __atomic_fetch_add(&A->ali[a], v[3 + a], __ATOMIC_RELAXED);
-        __atomic_fetch_add(&A->coh[a], v[6 + a], __ATOMIC_RELAXED);
-    }
-    __atomic_fetch_add(&A->n01, n01, __ATOMIC_RELAXED);
-    __atomic_fetch_add(&A->n23, n23, __ATOMIC_RELAXED);
-}
-
 /* Agent g against its forward hits [0, h): g's sums in g, the hits' credits in c->acc. */
 static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* hb, uint32_t h,
                      const akp_boids_sink* sink) {
     if (c->avx512) {
         akp_boids_sym_avx512(c, g, hb, h, sink);
+        return;
+    }
+    if (c->avx2) {
+        akp_boids_sym_avx2(c, g, hb, h, sink);
         return;
     }
     const akp_boids_sp* S = g->sp;
@@ -591,8 +574,10 @@ static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boid
             const int64_t v[9] = {-e[0], -e[1], -e[2], ba ? qi[0] : 0, ba ? qi[1] : 0, ba ? qi[2] : 0,
                                   -f[0], -f[1], -f[2]};
             const uint64_t n01 = (uint64_t)bs | (uint64_t)ba << 32, n23 = (uint64_t)bc | (uint64_t)1 << 32;
-            if (t >= sink->far_begin && sink->spill) credit(&sink->spill[t - sink->far_begin], v, n01, n23, false);
-            else credit(&sink->acc[t], v, n01, n23, t < sink->atomic_end || t >= sink->far_begin);
+            if (t >= sink->far_begin && sink->spill)
+                akp_boids_credit(&sink->spill[t - sink->far_begin], v, n01, n23, false);
+            else
+                akp_boids_credit(&sink->acc[t], v, n01, n23, t < sink->atomic_end || t >= sink->far_begin);
         }
     }
     g->sep[0] += s0;
@@ -769,7 +754,7 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
                         /* First slab of a later part: the part before credits it too. */
                         const int64_t v[9] = {g.sep[0], g.sep[1], g.sep[2], g.ali[0], g.ali[1],
                                               g.ali[2], g.coh[0], g.coh[1], g.coh[2]};
-                        credit(&c->acc[k], v, (uint64_t)g.ns | (uint64_t)g.na << 32,
+                        akp_boids_credit(&c->acc[k], v, (uint64_t)g.ns | (uint64_t)g.na << 32,
                                (uint64_t)g.nc | (uint64_t)g.nflock << 32, !c->use_spill);
                         continue;
                     }
@@ -1014,7 +999,8 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
         for (uint32_t t = 0; t < parts; ++t) tasks[t] = (akp_boids_fill_task){c, t, parts};
         akp_boids_run_tasks(fill_thread, tasks, sizeof tasks[0], parts);
     }
-    c->avx512 = !c->job->skip_simd && akp_boids_have_avx512();
+    c->avx512 = !c->job->skip_simd && !c->job->skip_avx512 && akp_boids_have_avx512();
+    c->avx2 = !c->job->skip_simd && !c->avx512 && akp_boids_have_avx2();
     c->one_species = c->params->species_count == 1;
     c->sym = sym_ok && c->rings == 1;
     /* The grid's memory is free on this path (the cell coordinates are done with). */
@@ -1025,7 +1011,7 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
 
 const char* ak_boids_simd_name(void) {
 #if AK_SIMD_SSE2
-    return akp_boids_have_avx512() ? "avx512" : "sse2";
+    return akp_boids_have_avx512() ? "avx512" : akp_boids_have_avx2() ? "avx2" : "sse2";
 #else
     return "scalar";
 #endif

@@ -251,18 +251,87 @@ static inline void credit_lanes(const akp_boids_sink* sink, __mmask16 m, const u
     }
 }
 
-/* fix(x) on the lanes of m (zero elsewhere) stored as 16 int64 at out. */
-AKP_AVX512 static inline void store_fixed(int64_t* out, __mmask16 m, __m512 x) {
-    __m512i lo, hi;
-    fix16(x, &lo, &hi);
-    _mm512_storeu_si512((void*)out, _mm512_maskz_mov_epi64((__mmask8)(m & 0xFF), lo));
-    _mm512_storeu_si512((void*)(out + 8), _mm512_maskz_mov_epi64((__mmask8)(m >> 8), hi));
+/* 8x8 transpose of int64 lanes: row l of out is lane l of r[0..7]. */
+AKP_AVX512 static inline void transpose8(const __m512i r[8], __m512i out[8]) {
+    __m512i a[8], b[8];
+    for (int k = 0; k < 4; ++k) {
+        a[2 * k] = _mm512_unpacklo_epi64(r[2 * k], r[2 * k + 1]);     /* k-pair, lanes 0 2 4 6 */
+        a[2 * k + 1] = _mm512_unpackhi_epi64(r[2 * k], r[2 * k + 1]); /* k-pair, lanes 1 3 5 7 */
+    }
+    for (int k = 0; k < 2; ++k)
+        for (int o = 0; o < 2; ++o) {
+            b[4 * k + 2 * o] = _mm512_shuffle_i64x2(a[4 * k + o], a[4 * k + 2 + o], _MM_SHUFFLE(2, 0, 2, 0));
+            b[4 * k + 2 * o + 1] = _mm512_shuffle_i64x2(a[4 * k + o], a[4 * k + 2 + o], _MM_SHUFFLE(3, 1, 3, 1));
+        }
+    /* b[0]: lanes 0, 4; b[1]: 2, 6; b[2]: 1, 5; b[3]: 3, 7 (rows 0-3), b[4..7] the same for rows 4-7 */
+    const int lo[4] = {0, 2, 1, 3};
+    for (int k = 0; k < 4; ++k) {
+        out[lo[k]] = _mm512_shuffle_i64x2(b[k], b[4 + k], _MM_SHUFFLE(2, 0, 2, 0));
+        out[lo[k] + 4] = _mm512_shuffle_i64x2(b[k], b[4 + k], _MM_SHUFFLE(3, 1, 3, 1));
+    }
 }
 
-/* sum += v on the lanes of m, v given as 16 int64 at in. */
-AKP_AVX512 static inline void add_stored(__m512i* sum, __mmask16 m, const int64_t* in) {
-    *sum = _mm512_mask_add_epi64(*sum, (__mmask8)(m & 0xFF), *sum, _mm512_loadu_si512((const void*)in));
-    *sum = _mm512_mask_add_epi64(*sum, (__mmask8)(m >> 8), *sum, _mm512_loadu_si512((const void*)(in + 8)));
+/* 4x8 transpose: row l (4 int64) is lane l of r[0..3]; out[0] holds rows 0 | 2 (low | high
+ * 256 bits), out[1] rows 1 | 3, out[2] rows 4 | 6, out[3] rows 5 | 7. */
+AKP_AVX512 static inline void transpose4(const __m512i r[4], __m512i out[4]) {
+    const __m512i a0 = _mm512_unpacklo_epi64(r[0], r[1]), a1 = _mm512_unpackhi_epi64(r[0], r[1]);
+    const __m512i a2 = _mm512_unpacklo_epi64(r[2], r[3]), a3 = _mm512_unpackhi_epi64(r[2], r[3]);
+    const __m512i b0 = _mm512_shuffle_i64x2(a0, a2, _MM_SHUFFLE(1, 0, 1, 0)); /* lanes 0, 2 */
+    const __m512i b1 = _mm512_shuffle_i64x2(a0, a2, _MM_SHUFFLE(3, 2, 3, 2)); /* lanes 4, 6 */
+    const __m512i b2 = _mm512_shuffle_i64x2(a1, a3, _MM_SHUFFLE(1, 0, 1, 0)); /* lanes 1, 3 */
+    const __m512i b3 = _mm512_shuffle_i64x2(a1, a3, _MM_SHUFFLE(3, 2, 3, 2)); /* lanes 5, 7 */
+    out[0] = _mm512_shuffle_i64x2(b0, b0, _MM_SHUFFLE(3, 1, 2, 0)); /* rows 0 | 2 */
+    out[1] = _mm512_shuffle_i64x2(b2, b2, _MM_SHUFFLE(3, 1, 2, 0)); /* rows 1 | 3 */
+    out[2] = _mm512_shuffle_i64x2(b1, b1, _MM_SHUFFLE(3, 1, 2, 0)); /* rows 4 | 6 */
+    out[3] = _mm512_shuffle_i64x2(b3, b3, _MM_SHUFFLE(3, 1, 2, 0)); /* rows 5 | 7 */
+}
+
+/* The partners' credits of the lanes of mj, none of them at a thread boundary: acc[t] += the
+ * pair's row (-e, q_i where aligning, -f, the counts) as 8 + 4 int64 lanes, the same integer
+ * additions as credit_lanes. E and F: fix() of the separation and cohesion terms, zero where
+ * the rule is off, [2 axis + half]. */
+AKP_AVX512 static inline void credit_rows(akp_boids_acc* acc, __mmask16 mj, const uint32_t* kt, const __m512i E[6],
+                                          const __m512i F[6], __mmask16 bs, __mmask16 ba, __mmask16 bc,
+                                          const int64_t* qi) {
+    const __m512i zero = _mm512_setzero_si512(), one = _mm512_set1_epi64(1);
+    const __m512i hi1 = _mm512_set1_epi64((int64_t)1 << 32);
+    for (int h = 0; h < 2; ++h) {
+        unsigned m8 = (unsigned)(mj >> (8 * h)) & 0xFFu;
+        if (!m8) continue;
+        const __mmask8 s8 = (__mmask8)(bs >> (8 * h)), a8 = (__mmask8)(ba >> (8 * h)), c8 = (__mmask8)(bc >> (8 * h));
+        __m512i r[8], q[4], rows[8], tail[4];
+        r[0] = _mm512_sub_epi64(zero, E[h]);
+        r[1] = _mm512_sub_epi64(zero, E[2 + h]);
+        r[2] = _mm512_sub_epi64(zero, E[4 + h]);
+        r[3] = _mm512_maskz_mov_epi64(a8, _mm512_set1_epi64(qi[0]));
+        r[4] = _mm512_maskz_mov_epi64(a8, _mm512_set1_epi64(qi[1]));
+        r[5] = _mm512_maskz_mov_epi64(a8, _mm512_set1_epi64(qi[2]));
+        r[6] = _mm512_sub_epi64(zero, F[h]);
+        r[7] = _mm512_sub_epi64(zero, F[2 + h]);
+        q[0] = _mm512_sub_epi64(zero, F[4 + h]);
+        q[1] = _mm512_add_epi64(_mm512_maskz_mov_epi64(s8, one), _mm512_maskz_mov_epi64(a8, hi1)); /* n01 */
+        q[2] = _mm512_add_epi64(_mm512_maskz_mov_epi64(c8, one), hi1);                             /* n23 */
+        q[3] = zero;
+        transpose8(r, rows);
+        transpose4(q, tail);
+        int64_t buf[8][12];
+        for (int l = 0; l < 8; ++l) _mm512_storeu_si512((void*)buf[l], rows[l]);
+        for (int l = 0; l < 4; ++l) {
+            const int low = (l & 1) + 4 * (l >> 1); /* tail[l]: rows low | low + 2 */
+            _mm256_storeu_si256((__m256i*)(void*)(buf[low] + 8), _mm512_castsi512_si256(tail[l]));
+            _mm256_storeu_si256((__m256i*)(void*)(buf[low + 2] + 8), _mm512_extracti64x4_epi64(tail[l], 1));
+        }
+        while (m8) {
+            const unsigned l = (unsigned)__builtin_ctz(m8);
+            m8 &= m8 - 1u;
+            int64_t* A = (int64_t*)(void*)&acc[kt[8 * h + l]];
+            _mm512_storeu_si512((void*)A, _mm512_add_epi64(_mm512_loadu_si512((const void*)A),
+                                                           _mm512_loadu_si512((const void*)buf[l])));
+            _mm256_storeu_si256((__m256i*)(void*)(A + 8),
+                                _mm256_add_epi64(_mm256_loadu_si256((const __m256i*)(const void*)(A + 8)),
+                                                 _mm256_loadu_si256((const __m256i*)(const void*)(buf[l] + 8))));
+        }
+    }
 }
 
 /* The view-cone test of in_view_v() on 16 lanes: offsets d, squared lengths dd, viewer
@@ -328,19 +397,25 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
         /* e = fix(-d * inv) where separating (zero elsewhere), f = fix(d * coh) where cohering. */
         const __m512 den = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(dd, dmin2, _CMP_GT_OQ), dmin2, dd);
         const __m512 inv = _mm512_maskz_div_ps(bs, sep, den);
-        store_fixed(e, bs, _mm512_mul_ps(_mm512_xor_ps(dx, sign), inv));
-        store_fixed(e + 16, bs, _mm512_mul_ps(_mm512_xor_ps(dy, sign), inv));
-        store_fixed(e + 32, bs, _mm512_mul_ps(_mm512_xor_ps(dz, sign), inv));
-        store_fixed(f, bc, _mm512_mul_ps(dx, coh));
-        store_fixed(f + 16, bc, _mm512_mul_ps(dy, coh));
-        store_fixed(f + 32, bc, _mm512_mul_ps(dz, coh));
+        __m512i E[6], F[6]; /* [2 axis + half] */
+        fix16(_mm512_mul_ps(_mm512_xor_ps(dx, sign), inv), &E[0], &E[1]);
+        fix16(_mm512_mul_ps(_mm512_xor_ps(dy, sign), inv), &E[2], &E[3]);
+        fix16(_mm512_mul_ps(_mm512_xor_ps(dz, sign), inv), &E[4], &E[5]);
+        fix16(_mm512_mul_ps(dx, coh), &F[0], &F[1]);
+        fix16(_mm512_mul_ps(dy, coh), &F[2], &F[3]);
+        fix16(_mm512_mul_ps(dz, coh), &F[4], &F[5]);
+        for (int a = 0; a < 6; ++a) {
+            E[a] = _mm512_maskz_mov_epi64((__mmask8)(bs >> (8 * (a & 1))), E[a]);
+            F[a] = _mm512_maskz_mov_epi64((__mmask8)(bc >> (8 * (a & 1))), F[a]);
+        }
         if (mi) {
-            add_stored(&s0, mi, e);
-            add_stored(&s1, mi, e + 16);
-            add_stored(&s2, mi, e + 32);
-            add_stored(&c0, mi, f);
-            add_stored(&c1, mi, f + 16);
-            add_stored(&c2, mi, f + 32);
+            const __mmask8 lo = (__mmask8)(mi & 0xFF), hi = (__mmask8)(mi >> 8);
+            __m512i* sums[6] = {&s0, &s1, &s2, &c0, &c1, &c2};
+            for (int a = 0; a < 6; ++a) {
+                const __m512i* X = a < 3 ? &E[2 * a] : &F[2 * (a - 3)];
+                *sums[a] = _mm512_mask_add_epi64(*sums[a], lo, *sums[a], X[0]);
+                *sums[a] = _mm512_mask_add_epi64(*sums[a], hi, *sums[a], X[1]);
+            }
             const __mmask16 mai = mi & ba;
             if (mai && (cone || mj != mi)) { /* else the partner loop below sums them */
                 const __m512i k3 = _mm512_add_epi32(_mm512_add_epi32(kk, kk), kk);
@@ -355,7 +430,20 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
         if (mj) {
             uint32_t kt[16];
             _mm512_storeu_si512((void*)kt, kk);
-            credit_lanes(sink, mj, kt, e, f, bs, ba, bc, qi);
+            /* Partners at a thread boundary (spill or atomic adds) take the lane-by-lane path. */
+            const __mmask16 edge = _mm512_mask_cmplt_epu32_mask(mj, kk, _mm512_set1_epi32((int)sink->atomic_end)) |
+                                   _mm512_mask_cmpge_epu32_mask(mj, kk, _mm512_set1_epi32((int)sink->far_begin));
+            if (edge) {
+                for (int a = 0; a < 3; ++a) {
+                    _mm512_storeu_si512((void*)(e + 16 * a), E[2 * a]);
+                    _mm512_storeu_si512((void*)(e + 16 * a + 8), E[2 * a + 1]);
+                    _mm512_storeu_si512((void*)(f + 16 * a), F[2 * a]);
+                    _mm512_storeu_si512((void*)(f + 16 * a + 8), F[2 * a + 1]);
+                }
+                credit_lanes(sink, mj, kt, e, f, bs, ba, bc, qi);
+            } else {
+                credit_rows(sink->acc, mj, kt, E, F, bs, ba, bc, qi);
+            }
             if (!cone && mj == mi) /* both directions see each other: i's alignment sums here */
                 for (__mmask16 r = mi & ba; r; r &= (__mmask16)(r - 1)) {
                     const int64_t* q = c->sqv + 3 * (size_t)kt[__builtin_ctz(r)];

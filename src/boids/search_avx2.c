@@ -1,0 +1,186 @@
+/* AVX2 symmetric pair kernel of the boids grid path, for CPUs without AVX-512 (8 hits at a
+ * time; the distance filter before it is the SSE2 one, which keeps index and d2 only, so
+ * positions and partner velocities come by gathers). Every float operation is the scalar
+ * sym_hits's in search.c, in the same order, each rounded (intrinsics only, no FMA), and
+ * fix() is rebuilt exactly: clamp, widen to double (exact), truncate, then the 1.5 * 2^52
+ * bias turns the integer (|x| <= 2^34) into int64 bits. The partners' credits go lane by
+ * lane through akp_boids_credit. So the sums are bit-identical to the scalar and naive
+ * paths (tested with job.skip_avx512 on CPUs that have both).
+ *
+ * Compiled only for GCC/Clang on x86-64 without AK_NO_SIMD; selected at run time with
+ * __builtin_cpu_supports. */
+#include "boids_internal.h"
+
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
+#include <immintrin.h>
+
+#define AKP_AVX2 __attribute__((target("avx2")))
+
+bool akp_boids_have_avx2(void) { return __builtin_cpu_supports("avx2"); }
+
+/* fix() of search.c on 4 lanes. */
+AKP_AVX2 static inline __m256i fix4(__m128 x) {
+    x = _mm_max_ps(x, _mm_set1_ps(-AKP_BOIDS_FIX_CLAMP)); /* NaN -> -clamp, as fix() */
+    x = _mm_min_ps(x, _mm_set1_ps(AKP_BOIDS_FIX_CLAMP));
+    const __m256d t = _mm256_round_pd(_mm256_cvtps_pd(x), _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
+    const __m256d bias = _mm256_set1_pd(6755399441055744.0); /* 2^52 + 2^51 */
+    return _mm256_sub_epi64(_mm256_castpd_si256(_mm256_add_pd(t, bias)), _mm256_castpd_si256(bias));
+}
+
+/* fix(x) on 8 lanes as two int64 quads, zero outside the 64-bit masks lo / hi. */
+AKP_AVX2 static inline void fix8(__m256 x, __m256i lo, __m256i hi, __m256i out[2]) {
+    out[0] = _mm256_and_si256(fix4(_mm256_castps256_ps128(x)), lo);
+    out[1] = _mm256_and_si256(fix4(_mm256_extractf128_ps(x, 1)), hi);
+}
+
+/* in_view_v() on 8 lanes (all-ones where in view). */
+AKP_AVX2 static inline __m256 cone8(const akp_boids_sp* S, __m256 dx, __m256 dy, __m256 dz, __m256 dd, __m256 vx,
+                                    __m256 vy, __m256 vz, __m256 v2) {
+    const __m256 zero = _mm256_setzero_ps();
+    const __m256 dot = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, vx), _mm256_mul_ps(dy, vy)), _mm256_mul_ps(dz, vz));
+    const __m256 lim = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(S->cos2), dd), v2);
+    const __m256 dot2 = _mm256_mul_ps(dot, dot);
+    __m256 ok;
+    if (S->fov == 1)
+        ok = _mm256_and_ps(_mm256_cmp_ps(dot, zero, _CMP_GT_OQ), _mm256_cmp_ps(dot2, lim, _CMP_GE_OQ));
+    else
+        ok = _mm256_or_ps(_mm256_cmp_ps(dot, zero, _CMP_GE_OQ), _mm256_cmp_ps(dot2, lim, _CMP_LE_OQ));
+    return _mm256_or_ps(_mm256_or_ps(ok, _mm256_cmp_ps(dd, zero, _CMP_EQ_OQ)), _mm256_cmp_ps(v2, zero, _CMP_EQ_OQ));
+}
+
+/* 8 lane mask (32-bit lanes) -> two 64-bit lane masks. */
+AKP_AVX2 static inline void widen(__m256 m, __m256i out[2]) {
+    const __m256i mi = _mm256_castps_si256(m);
+    out[0] = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(mi));
+    out[1] = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(mi, 1));
+}
+
+AKP_AVX2 static inline int64_t hsum(__m256i v) {
+    int64_t t[4];
+    _mm256_storeu_si256((__m256i*)(void*)t, v);
+    return t[0] + t[1] + t[2] + t[3];
+}
+
+AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h,
+                                 uint32_t count, const akp_boids_sink* sink) {
+    const akp_boids_sp* S = g->sp;
+    const __m256 rn2 = _mm256_set1_ps(S->rn2), rs2 = _mm256_set1_ps(S->rs2), ra2 = _mm256_set1_ps(S->ra2),
+                 rc2 = _mm256_set1_ps(S->rc2), dmin2 = _mm256_set1_ps(S->dmin2), sep = _mm256_set1_ps(S->sep_scale),
+                 coh = _mm256_set1_ps(S->coh_scale), sign = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps();
+    const __m256 px = _mm256_set1_ps(g->p.x), py = _mm256_set1_ps(g->p.y), pz = _mm256_set1_ps(g->p.z);
+    const __m256 vx = _mm256_set1_ps(g->v.x), vy = _mm256_set1_ps(g->v.y), vz = _mm256_set1_ps(g->v.z);
+    const __m256 v2 = _mm256_set1_ps(g->v2);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const bool cone = S->fov != 0;
+    const int64_t* qv = c->sqv;
+    const int64_t* qi = qv + 3 * (size_t)g->self_k;
+    const float* svf = (const float*)(const void*)c->sv; /* ak_vec3: 3 packed floats */
+    __m256i s[3], cs[3];
+    for (int a = 0; a < 3; ++a) s[a] = cs[a] = _mm256_setzero_si256();
+    int64_t al[3] = {0, 0, 0};
+    uint32_t ns = 0, na = 0, nc = 0, nf = 0;
+    for (uint32_t u = 0; u < count; u += 8) {
+        const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)(count - u < 8 ? count - u : 8)), lane);
+        const __m256 dd = _mm256_maskload_ps(h->d2 + u, live);
+        const __m256 m = _mm256_and_ps(_mm256_castsi256_ps(live), _mm256_cmp_ps(dd, rn2, _CMP_LT_OQ));
+        if (!_mm256_movemask_ps(m)) continue;
+        const __m256i kk = _mm256_maskload_epi32((const int*)(const void*)(h->k + u), live);
+        /* dx = X[t] - px, as sym_hits */
+        const __m256 dx = _mm256_sub_ps(_mm256_mask_i32gather_ps(zero, c->sx, kk, m, 4), px);
+        const __m256 dy = _mm256_sub_ps(_mm256_mask_i32gather_ps(zero, c->sy, kk, m, 4), py);
+        const __m256 dz = _mm256_sub_ps(_mm256_mask_i32gather_ps(zero, c->sz, kk, m, 4), pz);
+        __m256 mi = m, mj = m;
+        if (cone) {
+            mi = _mm256_and_ps(mi, cone8(S, dx, dy, dz, dd, vx, vy, vz, v2));
+            const __m256i k3 = _mm256_add_epi32(_mm256_add_epi32(kk, kk), kk);
+            const __m256 jx = _mm256_mask_i32gather_ps(zero, svf, k3, m, 4);
+            const __m256 jy = _mm256_mask_i32gather_ps(zero, svf + 1, k3, m, 4);
+            const __m256 jz = _mm256_mask_i32gather_ps(zero, svf + 2, k3, m, 4);
+            const __m256 j2 =
+                _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(jx, jx), _mm256_mul_ps(jy, jy)), _mm256_mul_ps(jz, jz));
+            mj = _mm256_and_ps(mj, cone8(S, _mm256_xor_ps(dx, sign), _mm256_xor_ps(dy, sign), _mm256_xor_ps(dz, sign),
+                                         dd, jx, jy, jz, j2));
+        }
+        const __m256 mb = _mm256_or_ps(mi, mj);
+        if (!_mm256_movemask_ps(mb)) continue;
+        const __m256 bs = _mm256_and_ps(mb, _mm256_cmp_ps(dd, rs2, _CMP_LT_OQ));
+        const __m256 ba = _mm256_and_ps(mb, _mm256_cmp_ps(dd, ra2, _CMP_LT_OQ));
+        const __m256 bc = _mm256_and_ps(mb, _mm256_cmp_ps(dd, rc2, _CMP_LT_OQ));
+        /* inv = sep_scale / (d2 > dmin2 ? d2 : dmin2); e = fix(-d inv), f = fix(d coh) */
+        const __m256 den = _mm256_blendv_ps(dmin2, dd, _mm256_cmp_ps(dd, dmin2, _CMP_GT_OQ));
+        const __m256 inv = _mm256_div_ps(sep, den);
+        __m256i ws[2], wc[2], wi[2], e[3][2], f[3][2];
+        widen(bs, ws);
+        widen(bc, wc);
+        widen(mi, wi);
+        fix8(_mm256_mul_ps(_mm256_xor_ps(dx, sign), inv), ws[0], ws[1], e[0]);
+        fix8(_mm256_mul_ps(_mm256_xor_ps(dy, sign), inv), ws[0], ws[1], e[1]);
+        fix8(_mm256_mul_ps(_mm256_xor_ps(dz, sign), inv), ws[0], ws[1], e[2]);
+        fix8(_mm256_mul_ps(dx, coh), wc[0], wc[1], f[0]);
+        fix8(_mm256_mul_ps(dy, coh), wc[0], wc[1], f[1]);
+        fix8(_mm256_mul_ps(dz, coh), wc[0], wc[1], f[2]);
+        const unsigned bi = (unsigned)_mm256_movemask_ps(mi), bj = (unsigned)_mm256_movemask_ps(mj);
+        const unsigned bsb = (unsigned)_mm256_movemask_ps(bs), bab = (unsigned)_mm256_movemask_ps(ba),
+                       bcb = (unsigned)_mm256_movemask_ps(bc);
+        uint32_t kt[8];
+        _mm256_storeu_si256((__m256i*)(void*)kt, kk);
+        if (bi) {
+            for (int a = 0; a < 3; ++a) {
+                s[a] = _mm256_add_epi64(s[a], _mm256_add_epi64(_mm256_and_si256(e[a][0], wi[0]),
+                                                               _mm256_and_si256(e[a][1], wi[1])));
+                cs[a] = _mm256_add_epi64(cs[a], _mm256_add_epi64(_mm256_and_si256(f[a][0], wi[0]),
+                                                                 _mm256_and_si256(f[a][1], wi[1])));
+            }
+            nf += (uint32_t)__builtin_popcount(bi);
+            ns += (uint32_t)__builtin_popcount(bi & bsb);
+            nc += (uint32_t)__builtin_popcount(bi & bcb);
+            na += (uint32_t)__builtin_popcount(bi & bab);
+            for (unsigned r = bi & bab; r; r &= r - 1u) {
+                const int64_t* q = qv + 3 * (size_t)kt[__builtin_ctz(r)];
+                al[0] += q[0];
+                al[1] += q[1];
+                al[2] += q[2];
+            }
+        }
+        if (bj) {
+            int64_t es[3][8], fs[3][8];
+            for (int a = 0; a < 3; ++a) {
+                _mm256_storeu_si256((__m256i*)(void*)es[a], e[a][0]);
+                _mm256_storeu_si256((__m256i*)(void*)(es[a] + 4), e[a][1]);
+                _mm256_storeu_si256((__m256i*)(void*)fs[a], f[a][0]);
+                _mm256_storeu_si256((__m256i*)(void*)(fs[a] + 4), f[a][1]);
+            }
+            for (unsigned r = bj; r; r &= r - 1u) {
+                const unsigned l = (unsigned)__builtin_ctz(r);
+                const uint32_t t = kt[l];
+                const bool ia = (bab >> l) & 1u;
+                const int64_t v[9] = {-es[0][l], -es[1][l], -es[2][l], ia ? qi[0] : 0, ia ? qi[1] : 0,
+                                      ia ? qi[2] : 0,   -fs[0][l], -fs[1][l], -fs[2][l]};
+                const uint64_t n01 = (uint64_t)((bsb >> l) & 1u) | (uint64_t)ia << 32;
+                const uint64_t n23 = (uint64_t)((bcb >> l) & 1u) | (uint64_t)1 << 32;
+                if (t >= sink->far_begin && sink->spill)
+                    akp_boids_credit(&sink->spill[t - sink->far_begin], v, n01, n23, false);
+                else
+                    akp_boids_credit(&sink->acc[t], v, n01, n23, t < sink->atomic_end || t >= sink->far_begin);
+            }
+        }
+    }
+    for (int a = 0; a < 3; ++a) {
+        g->sep[a] += hsum(s[a]);
+        g->ali[a] += al[a];
+        g->coh[a] += hsum(cs[a]);
+    }
+    g->ns += ns;
+    g->na += na;
+    g->nc += nc;
+    g->nflock += nf;
+}
+
+#else
+bool akp_boids_have_avx2(void) { return false; }
+
+void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
+                        const akp_boids_sink* sink) {
+    (void)c, (void)g, (void)h, (void)count, (void)sink;
+}
+#endif
