@@ -56,6 +56,23 @@ float ak_fluid_visc_laplacian(float r, float h) {
     return (float)(45.0 / FLUID_PI) / (h3 * h3) * (h - r);
 }
 
+float ak_fluid_cubic(float r, float h) {
+    if (!(r < h) || !(h > 0.0f) || r < 0.0f) return 0.0f;
+    const float q = r / h, k = (float)(8.0 / FLUID_PI) / (h * h * h);
+    if (q <= 0.5f) return k * (6.0f * (q * q * q - q * q) + 1.0f);
+    const float u = 1.0f - q;
+    return k * 2.0f * u * u * u;
+}
+
+ak_vec3 ak_fluid_cubic_grad(ak_vec3 r, float h) {
+    const float r2 = ak_vec3_dot(r, r);
+    if (!(r2 < h * h) || !(r2 > 0.0f) || !(h > 0.0f)) return ak_vec3_make(0.0f, 0.0f, 0.0f);
+    const float len = sqrtf(r2), q = len / h, k = (float)(48.0 / FLUID_PI) / (h * h * h * h);
+    const float u = 1.0f - q;
+    const float dw = q <= 0.5f ? k * (3.0f * q * q - 2.0f * q) : -k * u * u;
+    return ak_vec3_scale(r, dw / len);
+}
+
 /* ---- description ------------------------------------------------------------------ */
 
 static bool desc_ok(const ak_fluid_desc* d) {
@@ -613,7 +630,8 @@ static void ph_gather(ctx* c, size_t b, size_t e, uint32_t t) {
 
 static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
-    if (c->simd) {
+    const bool cubic = c->d.solver == AK_FLUID_WCSPH;
+    if (c->simd && !cubic) {
         (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_density_avx512 : akp_fluid_density_avx2)(c, b, e);
         return;
     }
@@ -623,7 +641,7 @@ static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
         float rho = 0.0f;
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
             ak_vec3 r = ak_vec3_sub(pi, P(c, nb[(size_t)q * 16]));
-            rho += k_poly6(c, ak_vec3_dot(r, r));
+            rho += cubic ? ak_fluid_cubic(ak_vec3_length(r), c->h) : k_poly6(c, ak_vec3_dot(r, r));
         }
         c->rho[i] = rho * c->m;
     }
@@ -799,7 +817,7 @@ static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
             const uint32_t j = nb[(size_t)q * 16];
             if (j == i) continue;
             ak_vec3 r = ak_vec3_sub(pi, P(c, j));
-            ak_vec3 g = k_spiky(c, r);
+            ak_vec3 g = mcg ? k_spiky(c, r) : ak_fluid_cubic_grad(r, c->h);
             const float rhoj = c->rho[j];
             if (mcg) {
                 /* f_i = -sum m (p_i + p_j) / (2 rho_j) grad W + mu sum m v_ij / rho_j lap W; a = f / rho_i */
