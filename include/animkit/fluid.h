@@ -69,8 +69,10 @@
  *     for (int s = 0; s < steps; ++s) { job.time = s * job.dt; ak_fluid_step_run(&job); }
  *
  * Ownership and threading: jobs keep no pointer after run returns and never allocate (the
- * caller passes scratch, any alignment). thread_count threads split each phase by particle;
- * every particle sums over its neighbours in one fixed order, so results are bit-identical
+ * caller passes scratch, any alignment). thread_count threads split each phase by particle
+ * (the step starts thread_count - 1 workers once, runs every phase with them, and joins them
+ * before it returns; steps of fewer than 1024 particles use the caller's thread only); every
+ * particle sums over its neighbours in one fixed order, so results are bit-identical
  * for any thread count. SIMD: on CPUs with AVX-512 or AVX2 (chosen at run time) the neighbour
  * filter and the density/PBF passes run 16 or 8 particles per instruction with the scalar
  * code's float operations in the same order, so results are also bit-identical to the scalar
