@@ -181,12 +181,14 @@ static double column_slope(int w, int ht, float jitter, uint32_t seed, int steps
     return fits == window ? sum / fits : NAN;
 }
 
-/* Hydrostatic column: the fitted slope of p against depth, averaged over the last 500 of 1500
- * steps (0.45 s; the column settles in about 0.15 s), within 10% of rho0 g, also for a column
- * one particle wider with its lattice jittered by 10% of the spacing. */
+/* Hydrostatic column: the fitted slope of p against depth, averaged over the last 500 of 1300
+ * steps (0.39 s; the column settles in about 0.15 s), within 10% of rho0 g, also for a column
+ * one particle wider with its lattice jittered by 10% of the spacing. Measured 1.012 and 1.046
+ * rho0 g (jitter seeds 2-5: 1.016-1.055); MCG's poly6/spiky pair in place of the cubic spline
+ * gives 1.13 and 1.24 (fails). */
 AK_TEST(hydrostatic_column_pressure_is_linear) {
     const double want = 1000.0 * 9.81;
-    const double a = column_slope(6, 16, 0.0f, 1u, 1500, 500), b = column_slope(7, 16, 0.1f, 7u, 1500, 500);
+    const double a = column_slope(6, 16, 0.0f, 1u, 1300, 500), b = column_slope(7, 16, 0.1f, 7u, 1300, 500);
     printf("  hydrostatic: mean fitted slope %.1f and %.1f (jittered) Pa/m vs rho g %.1f\n", a, b, want);
     AK_CHECK_MSG(fabs(a / want - 1.0) < 0.1, "slope %.1f vs rho g %.1f", a, want);
     AK_CHECK_MSG(fabs(b / want - 1.0) < 0.1, "jittered: slope %.1f vs rho g %.1f", b, want);
