@@ -1,5 +1,11 @@
 /* Particle liquids: MCG 2003 kernels, PBF (Macklin & Mueller 2013), SPH (MCG 2003) and WCSPH
  * (Becker & Teschner 2007) on the shared neighbour grid. See include/animkit/fluid.h. */
+
+/* The SIMD kernels give the scalar code's bits only if nothing fuses a * b + c: clang contracts
+ * within an expression by default (and avx512f implies FMA); gcc's C11 mode does not. */
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
 #include <animkit/fluid.h>
 #include <animkit/grid.h>
 
