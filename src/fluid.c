@@ -975,8 +975,7 @@ static void ph_full(ctx* c, size_t b, size_t e, uint32_t t) {
         for (uint32_t q = 0; q < c->nb_count[i] && full; ++q) full = !(c->flags[nb[(size_t)q * 16]] & AK_FLUID_FLAG_SURFACE);
         c->lambda[i] = full ? 1.0f : 0.0f;
     }
-    for (size_t i = b; i < e; ++i)
-        if ((c->flags[i] & AK_FLUID_FLAG_FULL) && c->lambda[i] == 0.0f) c->flags[i] = 0;
+    /* the flags of [b, e) are dropped by ph_scatter: other threads still read them here */
 }
 
 /* Final positions (PBF: p; SPH: q), velocities, densities, pressures, flags back to the
@@ -988,6 +987,7 @@ static void ph_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
     const float *fx = pbf ? c->px : c->qx, *fy = pbf ? c->py : c->qy, *fz = pbf ? c->pz : c->qz;
     for (size_t a = b; a < e; ++a) {
         const uint32_t i = c->order[a];
+        if ((c->flags[a] & AK_FLUID_FLAG_FULL) && c->lambda[a] == 0.0f) c->flags[a] = 0; /* see ph_full */
         c->xo[i] = ak_vec3_make(fx[a], fy[a], fz[a]);
         c->vo[i] = c->v[a];
         if (job->out_densities.ptr) job->out_densities.ptr[i] = c->rho[a];
