@@ -307,6 +307,24 @@ static inline ak_vec3 k_spiky(const ctx* c, ak_vec3 r) {
     return ak_vec3_scale(r, c->spiky_k * d * d / len);
 }
 
+/* The cubic spline and its gradient (ak_fluid_cubic, ak_fluid_cubic_grad) with the step's
+ * constants: the same formulas, not the same bits. */
+static inline float k_cubic(const ctx* c, float r2) {
+    if (!(r2 < c->h2)) return 0.0f;
+    const float q = sqrtf(r2) * c->inv_h;
+    if (q <= 0.5f) return c->cubic_k * (6.0f * (q * q * q - q * q) + 1.0f);
+    const float u = 1.0f - q;
+    return c->cubic_k * 2.0f * u * u * u;
+}
+
+static inline ak_vec3 k_cubic_grad(const ctx* c, ak_vec3 r) {
+    const float r2 = ak_vec3_dot(r, r);
+    if (!(r2 < c->h2) || !(r2 > 0.0f)) return ak_vec3_make(0.0f, 0.0f, 0.0f);
+    const float len = sqrtf(r2), q = len * c->inv_h, u = 1.0f - q;
+    const float dw = q <= 0.5f ? c->cubic_gk * (3.0f * q * q - 2.0f * q) : -c->cubic_gk * u * u;
+    return ak_vec3_scale(r, dw / len);
+}
+
 /* Predicted position of sorted particle a. */
 static inline ak_vec3 P(const ctx* c, uint32_t a) { return ak_vec3_make(c->px[a], c->py[a], c->pz[a]); }
 
@@ -740,7 +758,7 @@ static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
         float rho = 0.0f;
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
             ak_vec3 r = ak_vec3_sub(pi, P(c, nb[(size_t)q * 16]));
-            rho += cubic ? ak_fluid_cubic(ak_vec3_length(r), c->h) : k_poly6(c, ak_vec3_dot(r, r));
+            rho += cubic ? k_cubic(c, ak_vec3_dot(r, r)) : k_poly6(c, ak_vec3_dot(r, r));
         }
         c->rho[i] = rho * c->m;
     }
@@ -916,7 +934,7 @@ static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
             const uint32_t j = nb[(size_t)q * 16];
             if (j == i) continue;
             ak_vec3 r = ak_vec3_sub(pi, P(c, j));
-            ak_vec3 g = mcg ? k_spiky(c, r) : ak_fluid_cubic_grad(r, c->h);
+            ak_vec3 g = mcg ? k_spiky(c, r) : k_cubic_grad(c, r);
             const float rhoj = c->rho[j];
             if (mcg) {
                 /* f_i = -sum m (p_i + p_j) / (2 rho_j) grad W + mu sum m v_ij / rho_j lap W; a = f / rho_i */
@@ -1079,6 +1097,9 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
         const float h2 = c->h * c->h, h3 = h2 * c->h;
         c->poly6_k = (float)(315.0 / (64.0 * FLUID_PI)) / (h2 * h2 * h2 * h2 * c->h);
         c->spiky_k = -(float)(45.0 / FLUID_PI) / (h3 * h3);
+        c->inv_h = 1.0f / c->h;
+        c->cubic_k = (float)(8.0 / FLUID_PI) / h3;
+        c->cubic_gk = (float)(48.0 / FLUID_PI) / (h3 * c->h);
     }
     c->wdq = ak_fluid_poly6(c->d.scorr_dq * c->h * c->d.scorr_dq * c->h, c->h);
 

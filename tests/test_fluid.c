@@ -183,7 +183,7 @@ static double column_slope(int w, int ht, float jitter, uint32_t seed, int steps
 
 /* Hydrostatic column: the fitted slope of p against depth, averaged over the last 500 of 1300
  * steps (0.39 s; the column settles in about 0.15 s), within 10% of rho0 g, also for a column
- * one particle wider with its lattice jittered by 10% of the spacing. Measured 1.012 and 1.046
+ * one particle wider with its lattice jittered by 10% of the spacing. Measured 1.002 and 1.046
  * rho0 g (jitter seeds 2-5: 1.016-1.055); MCG's poly6/spiky pair in place of the cubic spline
  * gives 1.13 and 1.24 (fails). */
 AK_TEST(hydrostatic_column_pressure_is_linear) {
