@@ -1,5 +1,11 @@
 /* Particle liquids: MCG 2003 kernels, PBF (Macklin & Mueller 2013), SPH (MCG 2003) and WCSPH
  * (Becker & Teschner 2007) on the shared neighbour grid. See include/animkit/fluid.h. */
+
+/* The SIMD kernels give the scalar code's bits only if nothing fuses a * b + c: clang contracts
+ * within an expression by default (and avx512f implies FMA); gcc's C11 mode does not. */
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
 #include <animkit/fluid.h>
 #include <animkit/grid.h>
 
@@ -7,6 +13,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <string.h>
 #include <time.h>
 
@@ -54,6 +61,23 @@ float ak_fluid_visc_laplacian(float r, float h) {
     if (!(r < h) || r < 0.0f || !(h > 0.0f)) return 0.0f;
     const float h3 = h * h * h;
     return (float)(45.0 / FLUID_PI) / (h3 * h3) * (h - r);
+}
+
+float ak_fluid_cubic(float r, float h) {
+    if (!(r < h) || !(h > 0.0f) || r < 0.0f) return 0.0f;
+    const float q = r / h, k = (float)(8.0 / FLUID_PI) / (h * h * h);
+    if (q <= 0.5f) return k * (6.0f * (q * q * q - q * q) + 1.0f);
+    const float u = 1.0f - q;
+    return k * 2.0f * u * u * u;
+}
+
+ak_vec3 ak_fluid_cubic_grad(ak_vec3 r, float h) {
+    const float r2 = ak_vec3_dot(r, r);
+    if (!(r2 < h * h) || !(r2 > 0.0f) || !(h > 0.0f)) return ak_vec3_make(0.0f, 0.0f, 0.0f);
+    const float len = sqrtf(r2), q = len / h, k = (float)(48.0 / FLUID_PI) / (h * h * h * h);
+    const float u = 1.0f - q;
+    const float dw = q <= 0.5f ? k * (3.0f * q * q - 2.0f * q) : -k * u * u;
+    return ak_vec3_scale(r, dw / len);
 }
 
 /* ---- description ------------------------------------------------------------------ */
@@ -283,6 +307,24 @@ static inline ak_vec3 k_spiky(const ctx* c, ak_vec3 r) {
     return ak_vec3_scale(r, c->spiky_k * d * d / len);
 }
 
+/* The cubic spline and its gradient (ak_fluid_cubic, ak_fluid_cubic_grad) with the step's
+ * constants: the same formulas, not the same bits. */
+static inline float k_cubic(const ctx* c, float r2) {
+    if (!(r2 < c->h2)) return 0.0f;
+    const float q = sqrtf(r2) * c->inv_h;
+    if (q <= 0.5f) return c->cubic_k * (6.0f * (q * q * q - q * q) + 1.0f);
+    const float u = 1.0f - q;
+    return c->cubic_k * 2.0f * u * u * u;
+}
+
+static inline ak_vec3 k_cubic_grad(const ctx* c, ak_vec3 r) {
+    const float r2 = ak_vec3_dot(r, r);
+    if (!(r2 < c->h2) || !(r2 > 0.0f)) return ak_vec3_make(0.0f, 0.0f, 0.0f);
+    const float len = sqrtf(r2), q = len * c->inv_h, u = 1.0f - q;
+    const float dw = q <= 0.5f ? c->cubic_gk * (3.0f * q * q - 2.0f * q) : -c->cubic_gk * u * u;
+    return ak_vec3_scale(r, dw / len);
+}
+
 /* Predicted position of sorted particle a. */
 static inline ak_vec3 P(const ctx* c, uint32_t a) { return ak_vec3_make(c->px[a], c->py[a], c->pz[a]); }
 
@@ -293,37 +335,129 @@ static size_t split(size_t n, uint32_t t, uint32_t threads) {
     return t >= threads ? n : (n * t / threads) & ~(size_t)15;
 }
 
-typedef struct task {
-    ctx* c;
-    phase_fn fn;
-    size_t begin, end;
-    uint32_t t;
-} task;
+/* The step's worker team: thread_count - 1 workers started once per step (not once per
+ * phase: a PBF step has about 20 phases) that run each phase's share and meet the caller at a
+ * barrier. A thread that arrives first spins up to TEAM_SPIN pauses, then sleeps on the
+ * condition variable (a descheduled partner on a loaded machine would make spinning burn its
+ * core); the last to arrive bumps the generation and wakes sleepers through the mutex.
+ * Sequentially consistent atomics order "bump, then look for sleepers" against "announce
+ * sleeping, then look at the generation", so no wake-up is lost (the cloth barrier's scheme). */
+#define TEAM_SPIN 512
 
-static void* task_thread(void* arg) {
-    task* t = (task*)arg;
-    t->fn(t->c, t->begin, t->end, t->t);
-    return NULL;
+typedef struct akp_fluid_team {
+    pthread_mutex_t m;
+    pthread_cond_t cv;
+    atomic_uint arrived, generation, sleepers;
+    uint32_t size; /* threads meeting at the barrier, the caller included */
+    /* the phase being run (written by the caller before the start barrier) */
+    phase_fn fn;
+    size_t n;
+    bool quit, go;
+} team;
+
+typedef struct worker {
+    ctx* c;
+    uint32_t t;
+} worker;
+
+static void cpu_relax(void) {
+#if defined(__x86_64__) || defined(__i386__)
+    __asm__ __volatile__("pause");
+#endif
 }
 
-/* Runs fn over [0, n) split in equal contiguous chunks; the split never changes a result
- * (every phase writes only its own particles' values). */
-static void parallel_n(ctx* c, phase_fn fn, uint32_t threads, size_t n) {
-    if (threads > 1 && c->n < 1024) threads = 1;
-    task tasks[AKP_FLUID_MAX_THREADS];
-    for (uint32_t t = 0; t < threads; ++t)
-        tasks[t] = (task){c, fn, split(n, t, threads), split(n, t + 1, threads), t};
-    pthread_t ids[AKP_FLUID_MAX_THREADS];
-    bool started[AKP_FLUID_MAX_THREADS];
-    for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, task_thread, &tasks[t]) == 0;
-    task_thread(&tasks[0]);
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else task_thread(&tasks[t]);
+static void team_barrier(team* tm) {
+    const unsigned g = atomic_load(&tm->generation);
+    if (atomic_fetch_add(&tm->arrived, 1) + 1 == tm->size) {
+        atomic_store(&tm->arrived, 0);
+        atomic_fetch_add(&tm->generation, 1);
+        if (atomic_load(&tm->sleepers)) {
+            pthread_mutex_lock(&tm->m);
+            pthread_cond_broadcast(&tm->cv);
+            pthread_mutex_unlock(&tm->m);
+        }
+        return;
+    }
+    for (int k = 0; k < TEAM_SPIN; ++k) {
+        if (atomic_load_explicit(&tm->generation, memory_order_acquire) != g) return;
+        cpu_relax();
+    }
+    pthread_mutex_lock(&tm->m);
+    atomic_fetch_add(&tm->sleepers, 1);
+    while (atomic_load(&tm->generation) == g) pthread_cond_wait(&tm->cv, &tm->m);
+    atomic_fetch_sub(&tm->sleepers, 1);
+    pthread_mutex_unlock(&tm->m);
+}
+
+static void* worker_main(void* arg) {
+    const worker* w = (const worker*)arg;
+    team* tm = w->c->team;
+    pthread_mutex_lock(&tm->m);
+    while (!tm->go) pthread_cond_wait(&tm->cv, &tm->m);
+    pthread_mutex_unlock(&tm->m);
+    for (;;) {
+        team_barrier(tm); /* start of a phase (or quit) */
+        if (tm->quit) return NULL;
+        tm->fn(w->c, split(tm->n, w->t, tm->size), split(tm->n, w->t + 1, tm->size), w->t);
+        team_barrier(tm); /* end of the phase */
     }
 }
 
-static void parallel(ctx* c, phase_fn fn, uint32_t threads) { parallel_n(c, fn, threads, c->n); }
+/* Starts up to threads - 1 workers; c->team stays NULL when none starts. */
+static void team_start(ctx* c, team* tm, worker* ws, pthread_t* ids, uint32_t threads) {
+    memset(tm, 0, sizeof *tm);
+    if (threads < 2) return;
+    pthread_mutex_init(&tm->m, NULL);
+    pthread_cond_init(&tm->cv, NULL);
+    atomic_init(&tm->arrived, 0u);
+    atomic_init(&tm->generation, 0u);
+    atomic_init(&tm->sleepers, 0u);
+    c->team = tm;
+    uint32_t started = 1;
+    for (uint32_t t = 1; t < threads; ++t) {
+        ws[t] = (worker){c, t};
+        if (pthread_create(&ids[t], NULL, worker_main, &ws[t]) != 0) break;
+        ++started;
+    }
+    /* the workers wait for go, so none meets the barrier before size is final */
+    pthread_mutex_lock(&tm->m);
+    tm->size = started;
+    tm->go = true;
+    pthread_cond_broadcast(&tm->cv);
+    pthread_mutex_unlock(&tm->m);
+    if (started == 1) { /* no worker: run alone */
+        pthread_cond_destroy(&tm->cv);
+        pthread_mutex_destroy(&tm->m);
+        c->team = NULL;
+    }
+}
+
+static void team_stop(ctx* c, pthread_t* ids) {
+    team* tm = c->team;
+    if (!tm) return;
+    tm->quit = true;
+    team_barrier(tm);
+    for (uint32_t t = 1; t < tm->size; ++t) pthread_join(ids[t], NULL);
+    pthread_cond_destroy(&tm->cv);
+    pthread_mutex_destroy(&tm->m);
+    c->team = NULL;
+}
+
+/* Runs fn over [0, n) split in equal contiguous chunks over the team; the split never changes
+ * a result (every phase writes only its own particles' values). */
+static void parallel_n(ctx* c, phase_fn fn, size_t n) {
+    team* tm = c->team;
+    if (!tm) {
+        fn(c, 0, n, 0);
+        return;
+    }
+    tm->fn = fn, tm->n = n;
+    team_barrier(tm);
+    fn(c, split(n, 0, tm->size), split(n, 1, tm->size), 0);
+    team_barrier(tm);
+}
+
+static void parallel(ctx* c, phase_fn fn) { parallel_n(c, fn, c->n); }
 
 /* Collider projection: moves p outside every collider and inside the box; v (may be NULL)
  * loses its inward normal component relative to the collider, friction scales the rest. */
@@ -613,7 +747,8 @@ static void ph_gather(ctx* c, size_t b, size_t e, uint32_t t) {
 
 static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
-    if (c->simd) {
+    const bool cubic = c->d.solver == AK_FLUID_WCSPH;
+    if (c->simd && !cubic) {
         (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_density_avx512 : akp_fluid_density_avx2)(c, b, e);
         return;
     }
@@ -623,7 +758,7 @@ static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
         float rho = 0.0f;
         for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
             ak_vec3 r = ak_vec3_sub(pi, P(c, nb[(size_t)q * 16]));
-            rho += k_poly6(c, ak_vec3_dot(r, r));
+            rho += cubic ? k_cubic(c, ak_vec3_dot(r, r)) : k_poly6(c, ak_vec3_dot(r, r));
         }
         c->rho[i] = rho * c->m;
     }
@@ -799,7 +934,7 @@ static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
             const uint32_t j = nb[(size_t)q * 16];
             if (j == i) continue;
             ak_vec3 r = ak_vec3_sub(pi, P(c, j));
-            ak_vec3 g = k_spiky(c, r);
+            ak_vec3 g = mcg ? k_spiky(c, r) : k_cubic_grad(c, r);
             const float rhoj = c->rho[j];
             if (mcg) {
                 /* f_i = -sum m (p_i + p_j) / (2 rho_j) grad W + mu sum m v_ij / rho_j lap W; a = f / rho_i */
@@ -858,8 +993,7 @@ static void ph_full(ctx* c, size_t b, size_t e, uint32_t t) {
         for (uint32_t q = 0; q < c->nb_count[i] && full; ++q) full = !(c->flags[nb[(size_t)q * 16]] & AK_FLUID_FLAG_SURFACE);
         c->lambda[i] = full ? 1.0f : 0.0f;
     }
-    for (size_t i = b; i < e; ++i)
-        if ((c->flags[i] & AK_FLUID_FLAG_FULL) && c->lambda[i] == 0.0f) c->flags[i] = 0;
+    /* the flags of [b, e) are dropped by ph_scatter: other threads still read them here */
 }
 
 /* Final positions (PBF: p; SPH: q), velocities, densities, pressures, flags back to the
@@ -871,6 +1005,7 @@ static void ph_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
     const float *fx = pbf ? c->px : c->qx, *fy = pbf ? c->py : c->qy, *fz = pbf ? c->pz : c->qz;
     for (size_t a = b; a < e; ++a) {
         const uint32_t i = c->order[a];
+        if ((c->flags[a] & AK_FLUID_FLAG_FULL) && c->lambda[a] == 0.0f) c->flags[a] = 0; /* see ph_full */
         c->xo[i] = ak_vec3_make(fx[a], fy[a], fz[a]);
         c->vo[i] = c->v[a];
         if (job->out_densities.ptr) job->out_densities.ptr[i] = c->rho[a];
@@ -962,6 +1097,9 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
         const float h2 = c->h * c->h, h3 = h2 * c->h;
         c->poly6_k = (float)(315.0 / (64.0 * FLUID_PI)) / (h2 * h2 * h2 * h2 * c->h);
         c->spiky_k = -(float)(45.0 / FLUID_PI) / (h3 * h3);
+        c->inv_h = 1.0f / c->h;
+        c->cubic_k = (float)(8.0 / FLUID_PI) / h3;
+        c->cubic_gk = (float)(48.0 / FLUID_PI) / (h3 * c->h);
     }
     c->wdq = ak_fluid_poly6(c->d.scorr_dq * c->h * c->d.scorr_dq * c->h, c->h);
 
@@ -1004,45 +1142,53 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     const uint32_t threads = job->thread_count ? job->thread_count : 1;
     const bool pbf = c->d.solver == AK_FLUID_PBF;
 
+    team tm;
+    worker ws[AKP_FLUID_MAX_THREADS];
+    pthread_t ids[AKP_FLUID_MAX_THREADS];
+    team_start(c, &tm, ws, ids, n >= 1024 ? threads : 1u); /* small steps: the caller alone */
+
     /* predict (PBF) or take the current positions (SPH), sort by cell, neighbour lists */
-    parallel(c, ph_predict, threads);
+    parallel(c, ph_predict);
     const double t_nb = now_seconds();
     ak_grid_desc gd = {.cell_size = c->h};
     bool dense = false;
-    if (!sort_by_cell(c, base + L.grid, ak_grid_memory_size(n, &gd), cap, &dense))
+    if (!sort_by_cell(c, base + L.grid, ak_grid_memory_size(n, &gd), cap, &dense)) {
+        team_stop(c, ids);
         return AK_ERR_NO_CONVERGENCE; /* only non-finite predictions fail here */
-    if (dense) parallel(c, ph_neighbours_dense, threads);
-    else parallel_n(c, ph_neighbours_hashed, threads, c->grid.cell_count);
-    if (c->simd) parallel(c, ph_pad_lists, threads);
+    }
+    if (dense) parallel(c, ph_neighbours_dense);
+    else parallel_n(c, ph_neighbours_hashed, c->grid.cell_count);
+    if (c->simd) parallel(c, ph_pad_lists);
     st.neighbour_seconds = (float)(now_seconds() - t_nb);
-    parallel(c, ph_gather, threads);
+    parallel(c, ph_gather);
 
     if (pbf) {
         for (uint32_t it = 0; it < c->d.iterations; ++it) {
-            parallel(c, ph_lambda, threads);
-            parallel(c, ph_delta, threads);
+            parallel(c, ph_lambda);
+            parallel(c, ph_delta);
             float* tmp;
             tmp = c->px, c->px = c->qx, c->qx = tmp;
             tmp = c->py, c->py = c->qy, c->qy = tmp;
             tmp = c->pz, c->pz = c->qz, c->qz = tmp;
         }
-        parallel(c, ph_velocity, threads);
-        parallel(c, ph_density, threads);
-        if (c->simd && (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f)) parallel(c, ph_pack_v, threads);
-        if (c->d.vorticity_epsilon != 0.0f) parallel(c, ph_vorticity, threads);
+        parallel(c, ph_velocity);
+        parallel(c, ph_density);
+        if (c->simd && (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f)) parallel(c, ph_pack_v);
+        if (c->d.vorticity_epsilon != 0.0f) parallel(c, ph_vorticity);
         if (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f) {
-            parallel(c, ph_xsph, threads);
+            parallel(c, ph_xsph);
             memcpy(c->v, c->vnew, n * sizeof(ak_vec3));
         }
     } else {
-        parallel(c, ph_density, threads);
-        parallel(c, ph_pressure, threads);
-        parallel(c, ph_forces, threads);
-        parallel(c, ph_integrate, threads);
+        parallel(c, ph_density);
+        parallel(c, ph_pressure);
+        parallel(c, ph_forces);
+        parallel(c, ph_integrate);
     }
-    parallel(c, ph_flags, threads);
-    parallel(c, ph_full, threads);
-    parallel(c, ph_scatter, threads);
+    parallel(c, ph_flags);
+    parallel(c, ph_full);
+    parallel(c, ph_scatter);
+    team_stop(c, ids);
 
     /* blow-up check, statistics (sorted order: the same for any thread count) */
     const float limit = 100.0f * c->h;

@@ -24,8 +24,10 @@
  *    p = B ((rho / rho_0)^gamma - 1), B = rho_0 c_s^2 / gamma, pressure acceleration
  *    -sum_j m (p_i / rho_i^2 + p_j / rho_j^2) grad W, and the paper's artificial viscosity
  *    Pi_ij = -nu (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2), nu = 2 alpha h c_s / (rho_i + rho_j),
- *    for approaching pairs. (The paper uses a cubic spline kernel; animkit uses the MCG kernels
- *    for every solver: poly6 for density, the spiky gradient for forces.)
+ *    for approaching pairs, with the paper's kernel: the cubic spline (ak_fluid_cubic) for both
+ *    density and gradient. (MCG's pair, poly6 density with the spiky gradient, is not the
+ *    gradient of the density kernel: a column at rest needed a pressure gradient 13-30% above
+ *    rho g to stand; with the cubic spline it is within 6%, see docs/fluid.md.)
  * Neighbours: each step re-sorts the particles by cell of size h (a counting sort into
  * (z, y, x) cells when the liquid's bounding box holds at most 4 cells per particle of capacity,
  * else the shared hashed grid of grid.h) and builds one list per particle, used by every pass
@@ -67,8 +69,10 @@
  *     for (int s = 0; s < steps; ++s) { job.time = s * job.dt; ak_fluid_step_run(&job); }
  *
  * Ownership and threading: jobs keep no pointer after run returns and never allocate (the
- * caller passes scratch, any alignment). thread_count threads split each phase by particle;
- * every particle sums over its neighbours in one fixed order, so results are bit-identical
+ * caller passes scratch, any alignment). thread_count threads split each phase by particle
+ * (the step starts thread_count - 1 workers once, runs every phase with them, and joins them
+ * before it returns; steps of fewer than 1024 particles use the caller's thread only); every
+ * particle sums over its neighbours in one fixed order, so results are bit-identical
  * for any thread count. SIMD: on CPUs with AVX-512 or AVX2 (chosen at run time) the neighbour
  * filter and the density/PBF passes run 16 or 8 particles per instruction with the scalar
  * code's float operations in the same order, so results are also bit-identical to the scalar
@@ -99,6 +103,14 @@ AK_API float ak_fluid_visc(float r, float h);
 /* Laplacian of the viscosity kernel: 45 / (pi h^6) (h - r) for r < h, else 0 (its integral
  * over the support is 15 / h^2: the paper's kernel is normalised through W, not its Laplacian). */
 AK_API float ak_fluid_visc_laplacian(float r, float h);
+
+/* cubic B-spline (Monaghan 1992), the WCSPH kernel of Becker & Teschner 2007, written with
+ * support h (their smoothing length is h/2): with q = r/h, 8/(pi h^3) (6 (q^3 - q^2) + 1) for
+ * q <= 1/2, 16/(pi h^3) (1 - q)^3 for 1/2 < q < 1, else 0. Integrates to 1. */
+AK_API float ak_fluid_cubic(float r, float h);
+/* Gradient of the cubic spline at offset r: W'(|r|) r / |r|, W' = 48/(pi h^4) (3 q^2 - 2 q) for
+ * q <= 1/2, -48/(pi h^4) (1 - q)^2 below 1; 0 at r = 0 and outside. */
+AK_API ak_vec3 ak_fluid_cubic_grad(ak_vec3 r, float h);
 
 /* ---- description ------------------------------------------------------------------ */
 

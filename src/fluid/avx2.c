@@ -9,6 +9,12 @@
  *
  * Compiled only for GCC/Clang on x86-64 without AK_NO_SIMD; selected at run time with
  * __builtin_cpu_supports. */
+
+/* The SIMD kernels give the scalar code's bits only if nothing fuses a * b + c: clang contracts
+ * within an expression by default (and avx512f implies FMA); gcc's C11 mode does not. */
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
 #include "fluid_internal.h"
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)

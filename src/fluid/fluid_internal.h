@@ -53,6 +53,10 @@ typedef struct akp_fluid_ctx {
     float grad2_rest; /* sum_k |grad_k C|^2 of the rest lattice */
     float poly6_k;    /* 315 / (64 pi h^9) */
     float spiky_k;    /* -45 / (pi h^6) */
+    float inv_h;      /* 1 / h */
+    float cubic_k;    /* 8 / (pi h^3) */
+    float cubic_gk;   /* 48 / (pi h^4) */
+    struct akp_fluid_team* team; /* fluid.c: the step's worker team (NULL: the caller alone) */
     /* per-thread results */
     size_t truncated[AKP_FLUID_MAX_THREADS];
 } akp_fluid_ctx;
