@@ -99,6 +99,12 @@ run_one() {
   fi
   echo "fuzz_$name: FAILED (log $log, reproducer in $OUT/artifacts/)"
   grep -E "ERROR|SUMMARY|runtime error|Test unit written" "$log" | head -20
+  # The grep misses the cause of a bare abort() or an uncaught C++ exception (the harness's
+  # own message, "terminate called ...") and the stack of a deadly signal: show the end of
+  # the log without libFuzzer's progress lines (it ends with the input in Base64 when small).
+  echo "---- fuzz_$name: last 60 lines of the log, progress lines left out:"
+  grep -vE '^#[0-9]+[[:space:]]+(INITED|NEW|REDUCE|pulse|RELOAD)' "$log" | tail -60 | cut -c1-300
+  echo "---- reproduce with: $OUT/bin/fuzz_$name <the artifact above>"
   return 1
 }
 

@@ -2095,6 +2095,51 @@ AK_TEST(assimp_prechecks) {
     remove("tri.obj");
 }
 
+/* OBJ through Assimp: a number that overflows float ("1e39") is infinity, and "nan" parses
+ * as NaN; a position or normal that is not finite is AK_ERR_BAD_DATA naming the vertex and
+ * the attribute (fuzz_obj found "vn 0 0 1e39" loading with an infinite normal). Assimp
+ * itself replaces a non-finite OBJ "vt" by 0, so UVs are not tried here. */
+AK_TEST(assimp_non_finite_attributes) {
+    static const struct {
+        const char* text;
+        const char* message;
+    } cases[] = {
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1e39\nf 1//1 2//1 3//1\n", "vertex 0: the normal is not finite"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 nan 1\nf 1//1 2//1 3//2\n", "vertex 2: the normal is not finite"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1e39 0\nf 1 2 3\n", "vertex 2: the position is not finite"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        write_file("nonfinite.obj", cases[i].text, strlen(cases[i].text));
+        ak_scene* s = NULL;
+        ak_diag diag;
+        memset(&diag, 0, sizeof diag);
+        AK_CHECK_EQ(ak_io_load("nonfinite.obj", NULL, NULL, &s, &diag), AK_ERR_BAD_DATA);
+        AK_CHECK(s == NULL);
+        AK_CHECK(strstr(diag.message, cases[i].message) != NULL);
+        if (!strstr(diag.message, cases[i].message)) printf("  case %zu: '%s'\n", i, diag.message);
+        ak_scene_destroy(s);
+    }
+    /* the same files with finite values load, normals and UVs as written */
+    const char* ok = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.25 0.5\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n";
+    write_file("nonfinite.obj", ok, strlen(ok));
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load("nonfinite.obj", NULL, NULL, &s, &diag), AK_OK);
+    if (s && s->mesh_count == 1) {
+        const ak_mesh* m = s->meshes[0].mesh;
+        AK_CHECK_EQ(ak_mesh_validate(m, NULL), AK_OK);
+        AK_CHECK(m->normals != NULL && m->uvs != NULL);
+        for (size_t v = 0; m->normals && m->uvs && v < m->vertex_count; ++v) {
+            AK_CHECK_NEAR(m->normals[v].z, 1.0, 0);
+            AK_CHECK_NEAR(m->uvs[v].x, 0.25, 0);
+        }
+    } else {
+        AK_CHECK(s != NULL && s->mesh_count == 1);
+    }
+    ak_scene_destroy(s);
+    remove("nonfinite.obj");
+}
+
 /* ---- clip sampler on real clips (the inline path of ak_clip_sample, see test_clip.c) ---- */
 
 /* Double-precision glTF slerp (shortest arc) of a LINEAR rotation track at t: the spec's
@@ -2232,6 +2277,7 @@ int main(void) {
     AK_RUN(bvh_reader_matches_assimp);
     AK_RUN(bvh_truncated_prefixes_fail);
     AK_RUN(assimp_prechecks);
+    AK_RUN(assimp_non_finite_attributes);
     AK_RUN(inline_sampler_on_gltf_assets);
     return ak_test_finish();
 }

@@ -139,15 +139,26 @@ static ak_result make_mesh(as_ctx* c, const struct aiMesh* am, size_t mi, ak_mes
     for (size_t v = 0; v < nv; ++v) {
         const struct aiVector3D* p = &am->mVertices[v];
         m->positions[v] = ak_vec3_make(p->x, p->y, p->z);
-        if (!ak_vec3_is_finite(m->positions[v])) {
-            akp_diag_set(c->diag, c->path, "mesh %zu vertex %zu is not finite", mi, v);
-            r = AK_ERR_BAD_DATA;
+        const char* bad = ak_vec3_is_finite(m->positions[v]) ? NULL : "position";
+        if (am->mNormals) {
+            m->normals[v] = ak_vec3_make(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
+            if (!bad && !ak_vec3_is_finite(m->normals[v])) bad = "normal";
         }
-        if (am->mNormals) m->normals[v] = ak_vec3_make(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
-        if (am->mTextureCoords[0]) m->uvs[v] = ak_vec2_make(am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y);
+        if (am->mTextureCoords[0]) {
+            m->uvs[v] = ak_vec2_make(am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y);
+            if (!bad && !(ak_finitef(m->uvs[v].x) && ak_finitef(m->uvs[v].y))) bad = "UV";
+        }
         if (am->mColors[0]) {
             const struct aiColor4D* col = &am->mColors[0][v];
             m->colors[v] = ak_vec4_make(col->r, col->g, col->b, col->a);
+            if (!bad && !(ak_finitef(col->r) && ak_finitef(col->g) && ak_finitef(col->b) && ak_finitef(col->a)))
+                bad = "colour";
+        }
+        /* Like the glTF reader: a non-finite attribute (an OBJ "vn 0 0 1e39" overflows to
+         * infinity) is bad data, not something to pass on to skinning or the writers. */
+        if (bad && r == AK_OK) {
+            akp_diag_set(c->diag, c->path, "mesh %zu vertex %zu: the %s is not finite", mi, v, bad);
+            r = AK_ERR_BAD_DATA;
         }
     }
     size_t t = 0;
