@@ -5,28 +5,10 @@
 
 #include <gif_lib.h> /* GIF frame delays read straight from the file */
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include "ak_test.h"
+#include "cli_test.h"
 #include "ref/ref_gltf.h"
-
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 20];
-
-/* Run "animkit ARGS", capture stdout (stderr appended when merge), return the exit status. */
-static int run(const char* args, bool merge) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s %s", AK_CLI_PATH, args, merge ? "2>&1" : "2>/dev/null");
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
 static cJSON* run_json(const char* args) {
     if (run(args, false) != 0) return NULL;
@@ -536,13 +518,6 @@ static bool file_exists(const char* path) {
     return stat(path, &st) == 0;
 }
 
-static bool write_text(const char* path, const char* text) {
-    FILE* f = fopen(path, "w");
-    if (!f) return false;
-    fputs(text, f);
-    return fclose(f) == 0;
-}
-
 /* A stick figure (hips, spine, head, two legs; 1.9 units tall) whose root moves +2 in x per
  * frame for frame_count frames, frame_time seconds apart. */
 static bool write_walk_bvh(const char* path, int frame_count, double frame_time) {
@@ -919,7 +894,7 @@ AK_TEST(render_obj_characters) {
     obj_sphere(f, "helper-tights", 6.0, 0.5, &base);
     obj_sphere(f, "joint-pelvis", -6.0, 0.2, &base);
     fclose(f);
-    AK_CHECK(write_text("mh/rig.mhskel", "{\"name\": \"not read\"}\n"));
+    AK_CHECK(write_file("mh/rig.mhskel", "{\"name\": \"not read\"}\n"));
     AK_CHECK_EQ(run("render mh/base.obj --camera 0,0 --size 200x200 -o obj_body.png", true), 0);
     AK_CHECK_MSG(strstr(out_buf, "rig.mhskel") && strstr(out_buf, "not read"), "%s", out_buf);
     AK_CHECK_MSG(strstr(out_buf, "2 MakeHuman helper meshes") != NULL, "%s", out_buf);
