@@ -2140,6 +2140,49 @@ AK_TEST(assimp_non_finite_attributes) {
     remove("nonfinite.obj");
 }
 
+/* Files an Assimp model names itself (an OBJ's mtllib) open only inside the model's folder:
+ * "../secret.mtl" and a symlink out are refused with one warning (the mesh still loads),
+ * a material file beside the model opens without one, and allow_any_path lets the outside
+ * one through. */
+static void count_warnings(ak_log_level level, const char* message, void* user) {
+    if (level == AK_LOG_WARN && strstr(message, "not opening")) ++*(int*)user;
+}
+
+static int load_obj_warnings(const char* path, bool any_path) {
+    int warnings = 0;
+    ak_io_desc desc = {.logger = {count_warnings, &warnings}, .allow_any_path = any_path};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(path, &desc, NULL, &s, &diag), AK_OK);
+    if (s) AK_CHECK_EQ(s->mesh_count, 1);
+    ak_scene_destroy(s);
+    return warnings;
+}
+
+AK_TEST(assimp_companion_files_stay_inside_model_dir) {
+    mkdir("mtl", 0755);
+    mkdir("mtl/model", 0755);
+    write_file("mtl/secret.mtl", "newmtl red\nKd 1 0 0\n", 20);
+    write_file("mtl/model/inside.mtl", "newmtl red\nKd 1 0 0\n", 20);
+    remove("mtl/model/link.mtl");
+    AK_CHECK_EQ(symlink("../secret.mtl", "mtl/model/link.mtl"), 0);
+    const char* tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    char text[256];
+    snprintf(text, sizeof text, "mtllib ../secret.mtl\n%s", tri);
+    write_file("mtl/model/out.obj", text, strlen(text));
+    snprintf(text, sizeof text, "mtllib link.mtl\n%s", tri);
+    write_file("mtl/model/link.obj", text, strlen(text));
+    snprintf(text, sizeof text, "mtllib inside.mtl\n%s", tri);
+    write_file("mtl/model/in.obj", text, strlen(text));
+    AK_CHECK_EQ(load_obj_warnings("mtl/model/out.obj", false), 1);
+    AK_CHECK_EQ(load_obj_warnings("mtl/model/link.obj", false), 1);
+    AK_CHECK_EQ(load_obj_warnings("mtl/model/in.obj", false), 0);
+    AK_CHECK_EQ(load_obj_warnings("mtl/model/out.obj", true), 0);
+    const char* files[] = {"mtl/model/out.obj", "mtl/model/link.obj", "mtl/model/in.obj", "mtl/model/link.mtl",
+                           "mtl/model/inside.mtl", "mtl/secret.mtl", "mtl/model", "mtl"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) remove(files[i]);
+}
+
 /* ---- clip sampler on real clips (the inline path of ak_clip_sample, see test_clip.c) ---- */
 
 /* Double-precision glTF slerp (shortest arc) of a LINEAR rotation track at t: the spec's
@@ -2278,6 +2321,7 @@ int main(void) {
     AK_RUN(bvh_truncated_prefixes_fail);
     AK_RUN(assimp_prechecks);
     AK_RUN(assimp_non_finite_attributes);
+    AK_RUN(assimp_companion_files_stay_inside_model_dir);
     AK_RUN(inline_sampler_on_gltf_assets);
     return ak_test_finish();
 }
