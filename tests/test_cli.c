@@ -3,11 +3,11 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
-#include <gif_lib.h> /* GIF frame delays read straight from the file */
 #include <sys/stat.h>
 
 #include "ak_test.h"
 #include "cli_test.h"
+#include "ref/ref_gif.h" /* GIF frame delays read straight from the file */
 #include "ref/ref_gltf.h"
 
 static cJSON* run_json(const char* args) {
@@ -587,26 +587,6 @@ static box2 warm_box(const char* path) {
     return b;
 }
 
-/* Delays (1/100 s) of a GIF's frames, read with giflib; returns the frame count (-1 on error). */
-static int gif_delays(const char* path, int* delays, int cap) {
-    int err = 0;
-    GifFileType* g = DGifOpenFileName(path, &err);
-    if (!g) return -1;
-    if (DGifSlurp(g) != GIF_OK) {
-        DGifCloseFile(g, &err);
-        return -1;
-    }
-    int n = g->ImageCount;
-    for (int i = 0; i < n && i < cap; ++i) {
-        GraphicsControlBlock gcb;
-        memset(&gcb, 0, sizeof gcb);
-        DGifSavedExtensionToGCB(g, i, &gcb);
-        delays[i] = gcb.DelayTime;
-    }
-    DGifCloseFile(g, &err);
-    return n;
-}
-
 /* Item 9: plurals, names as typed, subnormal numbers, the files a multi-frame PNG run writes. */
 AK_TEST(messages_say_what_happened) {
     AK_CHECK_EQ(run("export builtin:cylinder -o one.obj", true), 0);
@@ -671,7 +651,7 @@ AK_TEST(gif_delays_match_the_rate) {
     int delays[64];
     AK_CHECK_EQ(run("render builtin:cylinder --clip bend --fps 24 --size 48x32 -o d24.gif", true), 0);
     AK_CHECK_MSG(strstr(out_buf, "24 fps") != NULL, "%s", out_buf);
-    int n = gif_delays("d24.gif", delays, 64);
+    int n = ref_gif_delays("d24.gif", delays, 64);
     AK_CHECK_EQ(n, 25); /* 0, 1/24, ..., 1 s */
     int sum = 0;
     for (int i = 0; i < 24 && i < n; ++i) {
@@ -680,7 +660,7 @@ AK_TEST(gif_delays_match_the_rate) {
     }
     AK_CHECK_EQ(sum, 100);
     AK_CHECK_EQ(run("render builtin:cylinder --clip bend --frames 0:1:0.1 --size 48x32 -o d10.gif", true), 0);
-    n = gif_delays("d10.gif", delays, 64);
+    n = ref_gif_delays("d10.gif", delays, 64);
     AK_CHECK_EQ(n, 11);
     for (int i = 0; i < n; ++i) AK_CHECK_MSG(delays[i] == 10, "frame %d delay %d", i, delays[i]);
 }
@@ -691,14 +671,14 @@ AK_TEST(long_clip_gif_subsampled) {
     AK_CHECK_EQ(run("render long_walk.bvh --size 48x32 -o long.gif", true), 0);
     AK_CHECK_MSG(strstr(out_buf, "12 fps") != NULL, "%s", out_buf);
     int delays[256];
-    int n = gif_delays("long.gif", delays, 256);
+    int n = ref_gif_delays("long.gif", delays, 256);
     AK_CHECK_EQ(n, 145); /* 0, 1/12, ..., 12 s */
     int sum = 0;
     for (int i = 0; i < 12 && i < n; ++i) sum += delays[i];
     AK_CHECK_EQ(sum, 100);
     /* --fps alone covers the whole clip at that rate */
     AK_CHECK_EQ(run("render long_walk.bvh --fps 2 --size 48x32 -o long2.gif", true), 0);
-    AK_CHECK_EQ(gif_delays("long2.gif", delays, 256), 25);
+    AK_CHECK_EQ(ref_gif_delays("long2.gif", delays, 256), 25);
 }
 
 /* Item 5: the size limit holds for the whole image --method all composes. */
