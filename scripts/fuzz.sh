@@ -99,6 +99,18 @@ run_one() {
   fi
   echo "fuzz_$name: FAILED (log $log, reproducer in $OUT/artifacts/)"
   grep -E "ERROR|SUMMARY|runtime error|Test unit written" "$log" | head -20
+  # The grep misses the cause of a bare abort() or an uncaught C++ exception (the harness's
+  # own message, "terminate called ...") and the stack of a deadly signal: show the end of
+  # the log without libFuzzer's progress lines, and the input itself, since CI keeps no files.
+  echo "---- fuzz_$name: last 60 lines of the log, progress lines left out:"
+  grep -vE '^#[0-9]+[[:space:]]+(INITED|NEW|REDUCE|pulse|RELOAD)' "$log" | tail -60 | cut -c1-300
+  local art
+  art=$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "$log" | tail -1)
+  if [ -n "$art" ] && [ -f "$art" ]; then
+    echo "---- the input, $(wc -c < "$art") bytes (first 4096), base64 (decode with base64 -d > x):"
+    head -c 4096 "$art" | base64 -w 100
+    echo "---- reproduce with: $OUT/bin/fuzz_$name $art"
+  fi
   return 1
 }
 

@@ -888,6 +888,12 @@ static inline bool any_colliders(const ak_particles_world* w) {
 
 /* ---- integration passes ------------------------------------------------------------- */
 
+/* A particle's new state is finite: the sum is NaN or inf when any component is. */
+static inline bool state_finite(ak_vec3 x, ak_vec3 v) {
+    const float sum = x.x + x.y + x.z + v.x + v.y + v.z;
+    return sum - sum == 0.0f;
+}
+
 /* Symplectic Euler without pair forces, one particle: returns true when it is now dead. */
 static inline bool fused_one(const step_ctx* c, size_t i, bool coll) {
     ak_particles* ps = c->ps;
@@ -902,8 +908,7 @@ static inline bool fused_one(const step_ctx* c, size_t i, bool coll) {
     if (coll) collide_one(c, x0, v0, &x1, &v1, dt);
     ps->pos[i] = x1;
     ps->vel[i] = v1;
-    const float sum = x1.x + x1.y + x1.z + v1.x + v1.y + v1.z; /* NaN or inf when any is */
-    return dead || !(sum - sum == 0.0f);
+    return dead || !state_finite(x1, v1);
 }
 
 #if AK_SIMD_SSE2
@@ -914,6 +919,18 @@ static inline bool fused_one(const step_ctx* c, size_t i, bool coll) {
 static bool simple_world(const ak_particles_world* w) {
     return w->attractors.count == 0 && w->vortices.count == 0 && w->spheres.count == 0 &&
            w->boxes.count == 0 && w->meshes.count == 0 && w->planes.count <= PS_CACHE;
+}
+
+/* Lanes l of a SIMD block at particle i with bit l set in hits went behind a plane: finish
+ * them from their start-of-step state (x0, v0) through the scalar contact code. */
+static void collide_lanes(const step_ctx* c, size_t i, int hits, const ak_vec3* x0, const ak_vec3* v0,
+                          int lanes, bool* out_dead) {
+    ak_particles* ps = c->ps;
+    for (int l = 0; l < lanes; ++l) {
+        if (!(hits & (1 << l))) continue;
+        collide_one(c, x0[l], v0[l], &ps->pos[i + (size_t)l], &ps->vel[i + (size_t)l], c->dt);
+        if (!state_finite(ps->pos[i + (size_t)l], ps->vel[i + (size_t)l])) *out_dead = true;
+    }
 }
 
 static size_t fused_sse2(step_ctx* c, size_t begin, size_t end, bool* out_dead) {
@@ -977,14 +994,7 @@ static size_t fused_sse2(step_ctx* c, size_t begin, size_t end, bool* out_dead) 
             memcpy(v0, &ps->vel[i], sizeof v0);
             akp_simd_store_vec3x4(&ps->pos[i].x, nx, ny, nz);
             akp_simd_store_vec3x4(&ps->vel[i].x, nvx, nvy, nvz);
-            for (int l = 0; l < 4; ++l) {
-                if (!(hits & (1 << l))) continue;
-                collide_one(c, x0[l], v0[l], &ps->pos[i + (size_t)l], &ps->vel[i + (size_t)l],
-                            c->dt);
-                const ak_vec3 p = ps->pos[i + (size_t)l], v = ps->vel[i + (size_t)l];
-                const float sm = p.x + p.y + p.z + v.x + v.y + v.z;
-                if (!(sm - sm == 0.0f)) *out_dead = true;
-            }
+            collide_lanes(c, i, hits, x0, v0, 4, out_dead);
         } else {
             akp_simd_store_vec3x4(&ps->pos[i].x, nx, ny, nz);
             akp_simd_store_vec3x4(&ps->vel[i].x, nvx, nvy, nvz);
@@ -1078,13 +1088,7 @@ __attribute__((target("avx2"))) static size_t fused_avx2(step_ctx* c, size_t beg
                               _mm256_castps256_ps128(nvy), _mm256_castps256_ps128(nvz));
         akp_simd_store_vec3x4(&ps->vel[i + 4].x, _mm256_extractf128_ps(nvx, 1),
                               _mm256_extractf128_ps(nvy, 1), _mm256_extractf128_ps(nvz, 1));
-        for (int l = 0; hits && l < 8; ++l) {
-            if (!(hits & (1 << l))) continue;
-            collide_one(c, xs0[l], vs0[l], &ps->pos[i + (size_t)l], &ps->vel[i + (size_t)l], c->dt);
-            const ak_vec3 p = ps->pos[i + (size_t)l], v = ps->vel[i + (size_t)l];
-            const float sm = p.x + p.y + p.z + v.x + v.y + v.z;
-            if (!(sm - sm == 0.0f)) *out_dead = true;
-        }
+        if (hits) collide_lanes(c, i, hits, xs0, vs0, 8, out_dead);
     }
     if (_mm256_movemask_ps(dead)) *out_dead = true;
     return i;
@@ -1120,25 +1124,25 @@ static bool save_state(void* arg, size_t begin, size_t end) {
     return false;
 }
 
-static bool pass_euler(void* arg, size_t begin, size_t end) {
-    step_ctx* c = (step_ctx*)arg;
+/* One Euler step from (x0, v0) with acc: explicit Euler moves with the old velocity,
+ * symplectic Euler with the new one. */
+static void euler_range(const step_ctx* c, size_t begin, size_t end, bool symplectic) {
     ak_particles* ps = c->ps;
     for (size_t i = begin; i < end; ++i) {
         if (ps->inv_mass[i] == 0.0f) continue;
-        ps->pos[i] = ak_vec3_madd(ps->x0[i], ps->v0[i], c->dt);
-        ps->vel[i] = ak_vec3_madd(ps->v0[i], ps->acc[i], c->dt);
+        const ak_vec3 v1 = ak_vec3_madd(ps->v0[i], ps->acc[i], c->dt);
+        ps->pos[i] = ak_vec3_madd(ps->x0[i], symplectic ? v1 : ps->v0[i], c->dt);
+        ps->vel[i] = v1;
     }
+}
+
+static bool pass_euler(void* arg, size_t begin, size_t end) {
+    euler_range((const step_ctx*)arg, begin, end, false);
     return false;
 }
 
 static bool pass_symplectic(void* arg, size_t begin, size_t end) {
-    step_ctx* c = (step_ctx*)arg;
-    ak_particles* ps = c->ps;
-    for (size_t i = begin; i < end; ++i) {
-        if (ps->inv_mass[i] == 0.0f) continue;
-        ps->vel[i] = ak_vec3_madd(ps->v0[i], ps->acc[i], c->dt);
-        ps->pos[i] = ak_vec3_madd(ps->x0[i], ps->vel[i], c->dt);
-    }
+    euler_range((const step_ctx*)arg, begin, end, true);
     return false;
 }
 
@@ -1213,9 +1217,7 @@ static bool pass_collide_age(void* arg, size_t begin, size_t end) {
         dead |= !(ps->age[i] < ps->life[i]);
         if (coll && ps->inv_mass[i] != 0.0f)
             collide_one(c, ps->x0[i], ps->v0[i], &ps->pos[i], &ps->vel[i], c->dt);
-        const ak_vec3 x1 = ps->pos[i], v1 = ps->vel[i];
-        const float sum = x1.x + x1.y + x1.z + v1.x + v1.y + v1.z;
-        dead |= !(sum - sum == 0.0f);
+        dead |= !state_finite(ps->pos[i], ps->vel[i]);
     }
     return dead;
 }

@@ -3,61 +3,25 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
-#include <sys/wait.h>
-
 #include "ak_test.h"
-
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 20];
-
-/* Run "animkit ARGS" with stderr merged into the captured output; return the exit status. */
-static int run(const char* args) {
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", AK_CLI_PATH, args);
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static void write_file(const char* path, const char* text) {
-    FILE* f = fopen(path, "w");
-    if (!f) return;
-    fputs(text, f);
-    fclose(f);
-}
-
-static char* read_file(const char* path) {
-    FILE* f = fopen(path, "rb");
-    if (!f) return NULL;
-    static char buf[1 << 20];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = '\0';
-    fclose(f);
-    return buf;
-}
+#include "cli_test.h"
 
 AK_TEST(usage) {
-    AK_CHECK_EQ(run("boids --help"), 0);
+    AK_CHECK_EQ(run("boids --help", true), 0);
     AK_CHECK(strstr(out_buf, "usage: animkit boids") != NULL);
-    AK_CHECK_EQ(run("help"), 0);
+    AK_CHECK_EQ(run("help", true), 0);
     AK_CHECK(strstr(out_buf, "boids") != NULL);
-    AK_CHECK_EQ(run("boids --frobnicate"), 2);
-    AK_CHECK_EQ(run("boids --count abc"), 2);
-    AK_CHECK_EQ(run("boids --count 0"), 2);
-    AK_CHECK_EQ(run("boids --dt 0"), 2);
-    AK_CHECK_EQ(run("boids --threads 65"), 2);
-    AK_CHECK_EQ(run("boids -o out.txt"), 2);
-    AK_CHECK_EQ(run("boids --size 10"), 2);
-    AK_CHECK_EQ(run("boids a.json b.json"), 2);
-    AK_CHECK_EQ(run("boids no_such_scene.json"), 1);
+    AK_CHECK_EQ(run("boids --frobnicate", true), 2);
+    AK_CHECK_EQ(run("boids --count abc", true), 2);
+    AK_CHECK_EQ(run("boids --count 0", true), 2);
+    AK_CHECK_EQ(run("boids --dt 0", true), 2);
+    AK_CHECK_EQ(run("boids --threads 65", true), 2);
+    AK_CHECK_EQ(run("boids -o out.txt", true), 2);
+    AK_CHECK_EQ(run("boids --size 10", true), 2);
+    AK_CHECK_EQ(run("boids a.json b.json", true), 2);
+    AK_CHECK_EQ(run("boids no_such_scene.json", true), 1);
     AK_CHECK(strstr(out_buf, "no_such_scene.json") != NULL);
-    AK_CHECK_EQ(run("boids --count 50 --steps 3"), 0);
+    AK_CHECK_EQ(run("boids --count 50 --steps 3", true), 0);
     AK_CHECK(strstr(out_buf, "50 agents") != NULL);
 }
 
@@ -92,14 +56,14 @@ AK_TEST(bad_scenes_name_the_key) {
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         write_file("bad_boids.json", cases[i].text);
-        const int rc = run("boids bad_boids.json --steps 1");
+        const int rc = run("boids bad_boids.json --steps 1", true);
         AK_CHECK_MSG(rc == 1, "case %zu: exit %d (%s)", i, rc, out_buf);
         AK_CHECK_MSG(strstr(out_buf, "bad_boids.json") && strstr(out_buf, cases[i].expect),
                      "case %zu: message '%s' lacks '%s'", i, out_buf, cases[i].expect);
     }
     /* --count with listed agents is a usage error. */
     write_file("agents_boids.json", "{\"agents\": [{\"p\": [0, 0, 0]}, {\"p\": [1, 0, 0]}]}");
-    AK_CHECK_EQ(run("boids agents_boids.json --count 5"), 2);
+    AK_CHECK_EQ(run("boids agents_boids.json --count 5", true), 2);
 }
 
 static double len3d(double x, double y, double z) { return sqrt(x * x + y * y + z * z); }
@@ -109,7 +73,7 @@ AK_TEST(json_contract) {
     write_file("three_boids.json",
                "{\"agents\": [{\"p\": [0, 0, 0], \"v\": [1, 0, 0]}, {\"p\": [3, 4, 0], \"v\": [0, 2, 0]},"
                " {\"p\": [0, 0.5, 0], \"v\": [0, 0, 0]}]}");
-    AK_CHECK_EQ(run("boids three_boids.json --steps 0 --json three_out.json"), 0);
+    AK_CHECK_EQ(run("boids three_boids.json --steps 0 --json three_out.json", true), 0);
     cJSON* root = cJSON_Parse(read_file("three_out.json"));
     AK_CHECK(root != NULL);
     if (!root) return;
@@ -125,7 +89,7 @@ AK_TEST(json_contract) {
     cJSON_Delete(root);
 
     /* A real run: order and min distance recomputed from the written agents. */
-    AK_CHECK_EQ(run("boids --count 300 --steps 40 --seed 3 --json run1.json --threads 1"), 0);
+    AK_CHECK_EQ(run("boids --count 300 --steps 40 --seed 3 --json run1.json --threads 1", true), 0);
     char* t1 = read_file("run1.json");
     root = cJSON_Parse(t1);
     AK_CHECK(root != NULL);
@@ -158,9 +122,9 @@ AK_TEST(json_contract) {
     cJSON_Delete(root);
     /* Two threads: byte-identical output. */
     char* copy = strdup(t1);
-    AK_CHECK_EQ(run("boids --count 300 --steps 40 --seed 3 --json run2.json --threads 2"), 0);
+    AK_CHECK_EQ(run("boids --count 300 --steps 40 --seed 3 --json run2.json --threads 2", true), 0);
     AK_CHECK(strcmp(copy, read_file("run2.json")) == 0);
-    AK_CHECK_EQ(run("boids --count 300 --steps 40 --seed 4 --json run3.json"), 0);
+    AK_CHECK_EQ(run("boids --count 300 --steps 40 --seed 4 --json run3.json", true), 0);
     AK_CHECK(strcmp(copy, read_file("run3.json")) != 0); /* the seed matters */
     free(copy);
 }
@@ -181,21 +145,21 @@ static void json_extent(const char* path, double ext[3]) {
 AK_TEST(default_box_grows_with_count) {
     double e[3];
     /* Up to 500 agents: the documented 20 m box. */
-    AK_CHECK_EQ(run("boids --count 500 --steps 0 --json box500.json"), 0);
+    AK_CHECK_EQ(run("boids --count 500 --steps 0 --json box500.json", true), 0);
     json_extent("box500.json", e);
     for (int a = 0; a < 3; ++a) AK_CHECK(e[a] > 9.0 && e[a] <= 10.0);
     /* 4,000 agents in 3D: 8x the agents, 2x the side (the same density). */
-    AK_CHECK_EQ(run("boids --count 4000 --steps 0 --json box4000.json"), 0);
+    AK_CHECK_EQ(run("boids --count 4000 --steps 0 --json box4000.json", true), 0);
     json_extent("box4000.json", e);
     for (int a = 0; a < 3; ++a) AK_CHECK(e[a] > 19.0 && e[a] <= 20.0);
     /* 2,000 agents in 2D: 4x the agents, 2x the side of the plane. */
-    AK_CHECK_EQ(run("boids --count 2000 --2d --steps 0 --json box2d.json"), 0);
+    AK_CHECK_EQ(run("boids --count 2000 --2d --steps 0 --json box2d.json", true), 0);
     json_extent("box2d.json", e);
     AK_CHECK(e[0] > 19.0 && e[0] <= 20.0 && e[2] > 19.0 && e[2] <= 20.0);
     AK_CHECK_EQ(e[1], 0.0);
     /* Bounds from the scene are kept. */
     write_file("box_given.json", "{\"bounds\": {\"min\": [-5, -5, -5], \"max\": [5, 5, 5]}}");
-    AK_CHECK_EQ(run("boids box_given.json --count 4000 --steps 0 --json box_given_out.json"), 0);
+    AK_CHECK_EQ(run("boids box_given.json --count 4000 --steps 0 --json box_given_out.json", true), 0);
     json_extent("box_given_out.json", e);
     for (int a = 0; a < 3; ++a) AK_CHECK(e[a] > 4.5 && e[a] <= 5.0);
 }
@@ -204,14 +168,14 @@ AK_TEST(render_and_example_scene) {
     char args[1024];
     snprintf(args, sizeof args, "boids %s/examples/boids_flock.json --steps 20 --count 100 -o boids.png --size 160x120",
              AK_SOURCE_DIR);
-    AK_CHECK_EQ(run(args), 0);
+    AK_CHECK_EQ(run(args, true), 0);
     int w = 0, h = 0;
     AK_CHECK_EQ(ak_png_info("boids.png", &w, &h), AK_OK);
     AK_CHECK_EQ(w, 160);
     AK_CHECK_EQ(h, 120);
     snprintf(args, sizeof args, "boids %s/examples/boids_flock.json --steps 6 --2d -o boids.gif --size 96x64",
              AK_SOURCE_DIR);
-    AK_CHECK_EQ(run(args), 0);
+    AK_CHECK_EQ(run(args, true), 0);
     int frames = 0;
     AK_CHECK_EQ(ak_gif_info("boids.gif", &w, &h, &frames), AK_OK);
     AK_CHECK_EQ(frames, 7);

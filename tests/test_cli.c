@@ -3,30 +3,12 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
-#include <gif_lib.h> /* GIF frame delays read straight from the file */
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include "ak_test.h"
+#include "cli_test.h"
+#include "ref/ref_gif.h" /* GIF frame delays read straight from the file */
 #include "ref/ref_gltf.h"
-
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 20];
-
-/* Run "animkit ARGS", capture stdout (stderr appended when merge), return the exit status. */
-static int run(const char* args, bool merge) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s %s", AK_CLI_PATH, args, merge ? "2>&1" : "2>/dev/null");
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
 static cJSON* run_json(const char* args) {
     if (run(args, false) != 0) return NULL;
@@ -536,13 +518,6 @@ static bool file_exists(const char* path) {
     return stat(path, &st) == 0;
 }
 
-static bool write_text(const char* path, const char* text) {
-    FILE* f = fopen(path, "w");
-    if (!f) return false;
-    fputs(text, f);
-    return fclose(f) == 0;
-}
-
 /* A stick figure (hips, spine, head, two legs; 1.9 units tall) whose root moves +2 in x per
  * frame for frame_count frames, frame_time seconds apart. */
 static bool write_walk_bvh(const char* path, int frame_count, double frame_time) {
@@ -612,26 +587,6 @@ static box2 warm_box(const char* path) {
     return b;
 }
 
-/* Delays (1/100 s) of a GIF's frames, read with giflib; returns the frame count (-1 on error). */
-static int gif_delays(const char* path, int* delays, int cap) {
-    int err = 0;
-    GifFileType* g = DGifOpenFileName(path, &err);
-    if (!g) return -1;
-    if (DGifSlurp(g) != GIF_OK) {
-        DGifCloseFile(g, &err);
-        return -1;
-    }
-    int n = g->ImageCount;
-    for (int i = 0; i < n && i < cap; ++i) {
-        GraphicsControlBlock gcb;
-        memset(&gcb, 0, sizeof gcb);
-        DGifSavedExtensionToGCB(g, i, &gcb);
-        delays[i] = gcb.DelayTime;
-    }
-    DGifCloseFile(g, &err);
-    return n;
-}
-
 /* Item 9: plurals, names as typed, subnormal numbers, the files a multi-frame PNG run writes. */
 AK_TEST(messages_say_what_happened) {
     AK_CHECK_EQ(run("export builtin:cylinder -o one.obj", true), 0);
@@ -696,7 +651,7 @@ AK_TEST(gif_delays_match_the_rate) {
     int delays[64];
     AK_CHECK_EQ(run("render builtin:cylinder --clip bend --fps 24 --size 48x32 -o d24.gif", true), 0);
     AK_CHECK_MSG(strstr(out_buf, "24 fps") != NULL, "%s", out_buf);
-    int n = gif_delays("d24.gif", delays, 64);
+    int n = ref_gif_delays("d24.gif", delays, 64);
     AK_CHECK_EQ(n, 25); /* 0, 1/24, ..., 1 s */
     int sum = 0;
     for (int i = 0; i < 24 && i < n; ++i) {
@@ -705,7 +660,7 @@ AK_TEST(gif_delays_match_the_rate) {
     }
     AK_CHECK_EQ(sum, 100);
     AK_CHECK_EQ(run("render builtin:cylinder --clip bend --frames 0:1:0.1 --size 48x32 -o d10.gif", true), 0);
-    n = gif_delays("d10.gif", delays, 64);
+    n = ref_gif_delays("d10.gif", delays, 64);
     AK_CHECK_EQ(n, 11);
     for (int i = 0; i < n; ++i) AK_CHECK_MSG(delays[i] == 10, "frame %d delay %d", i, delays[i]);
 }
@@ -716,14 +671,14 @@ AK_TEST(long_clip_gif_subsampled) {
     AK_CHECK_EQ(run("render long_walk.bvh --size 48x32 -o long.gif", true), 0);
     AK_CHECK_MSG(strstr(out_buf, "12 fps") != NULL, "%s", out_buf);
     int delays[256];
-    int n = gif_delays("long.gif", delays, 256);
+    int n = ref_gif_delays("long.gif", delays, 256);
     AK_CHECK_EQ(n, 145); /* 0, 1/12, ..., 12 s */
     int sum = 0;
     for (int i = 0; i < 12 && i < n; ++i) sum += delays[i];
     AK_CHECK_EQ(sum, 100);
     /* --fps alone covers the whole clip at that rate */
     AK_CHECK_EQ(run("render long_walk.bvh --fps 2 --size 48x32 -o long2.gif", true), 0);
-    AK_CHECK_EQ(gif_delays("long2.gif", delays, 256), 25);
+    AK_CHECK_EQ(ref_gif_delays("long2.gif", delays, 256), 25);
 }
 
 /* Item 5: the size limit holds for the whole image --method all composes. */
@@ -919,7 +874,7 @@ AK_TEST(render_obj_characters) {
     obj_sphere(f, "helper-tights", 6.0, 0.5, &base);
     obj_sphere(f, "joint-pelvis", -6.0, 0.2, &base);
     fclose(f);
-    AK_CHECK(write_text("mh/rig.mhskel", "{\"name\": \"not read\"}\n"));
+    AK_CHECK(write_file("mh/rig.mhskel", "{\"name\": \"not read\"}\n"));
     AK_CHECK_EQ(run("render mh/base.obj --camera 0,0 --size 200x200 -o obj_body.png", true), 0);
     AK_CHECK_MSG(strstr(out_buf, "rig.mhskel") && strstr(out_buf, "not read"), "%s", out_buf);
     AK_CHECK_MSG(strstr(out_buf, "2 MakeHuman helper meshes") != NULL, "%s", out_buf);

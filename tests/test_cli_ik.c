@@ -6,27 +6,8 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
-#include <sys/wait.h>
-
 #include "ak_test.h"
-
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 20];
-
-/* Run "animkit ARGS", capture stdout (stderr appended when merge), return the exit status. */
-static int run(const char* args, bool merge) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s %s", AK_CLI_PATH, args, merge ? "2>&1" : "2>/dev/null");
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+#include "cli_test.h"
 
 /* Run with --json; the output must parse (NULL otherwise, with a failed check). */
 static cJSON* run_json(const char* args) {

@@ -4,45 +4,8 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
-#include <sys/wait.h>
-
 #include "ak_test.h"
-
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 16];
-
-/* Run "animkit ARGS" with stderr merged into the captured output; the exit status. */
-static int run(const char* args) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", AK_CLI_PATH, args);
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static cJSON* load_json(const char* path) {
-    FILE* f = fopen(path, "rb");
-    if (!f) return NULL;
-    static char buf[1 << 20];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = '\0';
-    return cJSON_Parse(buf);
-}
-
-static void write_file(const char* path, const char* text) {
-    FILE* f = fopen(path, "w");
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
-}
+#include "cli_test.h"
 
 /* positions[k] of a parsed output */
 static ak_vec3 pos(const cJSON* ps, int k) {
@@ -52,20 +15,20 @@ static ak_vec3 pos(const cJSON* ps, int k) {
 }
 
 AK_TEST(usage) {
-    AK_CHECK_EQ(run("cloth --help"), 0);
+    AK_CHECK_EQ(run("cloth --help", true), 0);
     AK_CHECK(strstr(out_buf, "usage: animkit cloth") != NULL);
-    AK_CHECK_EQ(run("help cloth"), 0);
-    AK_CHECK_EQ(run("cloth"), 2);
-    AK_CHECK_EQ(run("cloth --preset nope"), 2);
-    AK_CHECK_EQ(run("cloth --preset flag --solver verlet"), 2);
-    AK_CHECK_EQ(run("cloth --preset flag --steps -3"), 2);
-    AK_CHECK_EQ(run("cloth --preset flag -o out.txt"), 2);
-    AK_CHECK_EQ(run("cloth --preset flag x.json"), 2);
+    AK_CHECK_EQ(run("help cloth", true), 0);
+    AK_CHECK_EQ(run("cloth", true), 2);
+    AK_CHECK_EQ(run("cloth --preset nope", true), 2);
+    AK_CHECK_EQ(run("cloth --preset flag --solver verlet", true), 2);
+    AK_CHECK_EQ(run("cloth --preset flag --steps -3", true), 2);
+    AK_CHECK_EQ(run("cloth --preset flag -o out.txt", true), 2);
+    AK_CHECK_EQ(run("cloth --preset flag x.json", true), 2);
 }
 
 AK_TEST(drape_json_contract) {
-    AK_CHECK_EQ(run("cloth --preset drape --steps 60 --threads 2 --json drape.json"), 0);
-    cJSON* j = load_json("drape.json");
+    AK_CHECK_EQ(run("cloth --preset drape --steps 60 --threads 2 --json drape.json", true), 0);
+    cJSON* j = read_json("drape.json");
     AK_CHECK(j != NULL);
     if (!j) return;
     int keys = 0;
@@ -100,8 +63,8 @@ AK_TEST(drape_json_contract) {
 }
 
 AK_TEST(flag_pins_and_outputs) {
-    AK_CHECK_EQ(run("cloth --preset flag --steps 30 --substeps 5 --json flag.json -o flag.obj"), 0);
-    cJSON* j = load_json("flag.json");
+    AK_CHECK_EQ(run("cloth --preset flag --steps 30 --substeps 5 --json flag.json -o flag.obj", true), 0);
+    cJSON* j = read_json("flag.json");
     AK_CHECK(j != NULL);
     if (j) {
         const cJSON* ps = cJSON_GetObjectItemCaseSensitive(j, "positions");
@@ -146,14 +109,14 @@ AK_TEST(bad_scenes_and_blow_up) {
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         write_file("bad.json", cases[k].text);
-        AK_CHECK_MSG(run("cloth bad.json --steps 1") == 1 && strstr(out_buf, cases[k].needle) && strstr(out_buf, "bad.json"),
+        AK_CHECK_MSG(run("cloth bad.json --steps 1", true) == 1 && strstr(out_buf, cases[k].needle) && strstr(out_buf, "bad.json"),
                      "case %zu: %s", k, out_buf);
     }
-    AK_CHECK_EQ(run("cloth missing.json"), 1);
+    AK_CHECK_EQ(run("cloth missing.json", true), 1);
     /* the spring solver with a tenth of the step it needs: a blow-up, named by its step, and
      * no JSON written */
     remove("blow.json");
-    AK_CHECK_EQ(run("cloth --preset drape --solver springs --substeps 1 --steps 100 --json blow.json"), 1);
+    AK_CHECK_EQ(run("cloth --preset drape --solver springs --substeps 1 --steps 100 --json blow.json", true), 1);
     AK_CHECK(strstr(out_buf, "blow-up") && strstr(out_buf, "at step"));
     AK_CHECK(fopen("blow.json", "r") == NULL);
 }

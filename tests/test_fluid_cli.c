@@ -5,34 +5,9 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
-#include <sys/wait.h>
-
 #include "ak_test.h"
-
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 22];
-
-static int run(const char* args, bool merge) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s %s", AK_CLI_PATH, args, merge ? "2>&1" : "2>/dev/null");
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static void write_file(const char* path, const char* text) {
-    FILE* f = fopen(path, "w");
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
-}
+#define CLI_TEST_OUT_SIZE (1 << 22)
+#include "cli_test.h"
 
 static void check_state(const char* args, int want_count, float box_x) {
     int rc = run(args, false);

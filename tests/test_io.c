@@ -2095,6 +2095,94 @@ AK_TEST(assimp_prechecks) {
     remove("tri.obj");
 }
 
+/* OBJ through Assimp: a number that overflows float ("1e39") is infinity, and "nan" parses
+ * as NaN; a position or normal that is not finite is AK_ERR_BAD_DATA naming the vertex and
+ * the attribute (fuzz_obj found "vn 0 0 1e39" loading with an infinite normal). Assimp
+ * itself replaces a non-finite OBJ "vt" by 0, so UVs are not tried here. */
+AK_TEST(assimp_non_finite_attributes) {
+    static const struct {
+        const char* text;
+        const char* message;
+    } cases[] = {
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1e39\nf 1//1 2//1 3//1\n", "vertex 0: the normal is not finite"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 nan 1\nf 1//1 2//1 3//2\n", "vertex 2: the normal is not finite"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1e39 0\nf 1 2 3\n", "vertex 2: the position is not finite"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        write_file("nonfinite.obj", cases[i].text, strlen(cases[i].text));
+        ak_scene* s = NULL;
+        ak_diag diag;
+        memset(&diag, 0, sizeof diag);
+        AK_CHECK_EQ(ak_io_load("nonfinite.obj", NULL, NULL, &s, &diag), AK_ERR_BAD_DATA);
+        AK_CHECK(s == NULL);
+        AK_CHECK(strstr(diag.message, cases[i].message) != NULL);
+        if (!strstr(diag.message, cases[i].message)) printf("  case %zu: '%s'\n", i, diag.message);
+        ak_scene_destroy(s);
+    }
+    /* the same files with finite values load, normals and UVs as written */
+    const char* ok = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.25 0.5\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n";
+    write_file("nonfinite.obj", ok, strlen(ok));
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load("nonfinite.obj", NULL, NULL, &s, &diag), AK_OK);
+    if (s && s->mesh_count == 1) {
+        const ak_mesh* m = s->meshes[0].mesh;
+        AK_CHECK_EQ(ak_mesh_validate(m, NULL), AK_OK);
+        AK_CHECK(m->normals != NULL && m->uvs != NULL);
+        for (size_t v = 0; m->normals && m->uvs && v < m->vertex_count; ++v) {
+            AK_CHECK_NEAR(m->normals[v].z, 1.0, 0);
+            AK_CHECK_NEAR(m->uvs[v].x, 0.25, 0);
+        }
+    } else {
+        AK_CHECK(s != NULL && s->mesh_count == 1);
+    }
+    ak_scene_destroy(s);
+    remove("nonfinite.obj");
+}
+
+/* Files an Assimp model names itself (an OBJ's mtllib) open only inside the model's folder:
+ * "../secret.mtl" and a symlink out are refused with one warning (the mesh still loads),
+ * a material file beside the model opens without one, and allow_any_path lets the outside
+ * one through. */
+static void count_warnings(ak_log_level level, const char* message, void* user) {
+    if (level == AK_LOG_WARN && strstr(message, "not opening")) ++*(int*)user;
+}
+
+static int load_obj_warnings(const char* path, bool any_path) {
+    int warnings = 0;
+    ak_io_desc desc = {.logger = {count_warnings, &warnings}, .allow_any_path = any_path};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(path, &desc, NULL, &s, &diag), AK_OK);
+    if (s) AK_CHECK_EQ(s->mesh_count, 1);
+    ak_scene_destroy(s);
+    return warnings;
+}
+
+AK_TEST(assimp_companion_files_stay_inside_model_dir) {
+    mkdir("mtl", 0755);
+    mkdir("mtl/model", 0755);
+    write_file("mtl/secret.mtl", "newmtl red\nKd 1 0 0\n", 20);
+    write_file("mtl/model/inside.mtl", "newmtl red\nKd 1 0 0\n", 20);
+    remove("mtl/model/link.mtl");
+    AK_CHECK_EQ(symlink("../secret.mtl", "mtl/model/link.mtl"), 0);
+    const char* tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    char text[256];
+    snprintf(text, sizeof text, "mtllib ../secret.mtl\n%s", tri);
+    write_file("mtl/model/out.obj", text, strlen(text));
+    snprintf(text, sizeof text, "mtllib link.mtl\n%s", tri);
+    write_file("mtl/model/link.obj", text, strlen(text));
+    snprintf(text, sizeof text, "mtllib inside.mtl\n%s", tri);
+    write_file("mtl/model/in.obj", text, strlen(text));
+    AK_CHECK_EQ(load_obj_warnings("mtl/model/out.obj", false), 1);
+    AK_CHECK_EQ(load_obj_warnings("mtl/model/link.obj", false), 1);
+    AK_CHECK_EQ(load_obj_warnings("mtl/model/in.obj", false), 0);
+    AK_CHECK_EQ(load_obj_warnings("mtl/model/out.obj", true), 0);
+    const char* files[] = {"mtl/model/out.obj", "mtl/model/link.obj", "mtl/model/in.obj", "mtl/model/link.mtl",
+                           "mtl/model/inside.mtl", "mtl/secret.mtl", "mtl/model", "mtl"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) remove(files[i]);
+}
+
 /* ---- clip sampler on real clips (the inline path of ak_clip_sample, see test_clip.c) ---- */
 
 /* Double-precision glTF slerp (shortest arc) of a LINEAR rotation track at t: the spec's
@@ -2232,6 +2320,8 @@ int main(void) {
     AK_RUN(bvh_reader_matches_assimp);
     AK_RUN(bvh_truncated_prefixes_fail);
     AK_RUN(assimp_prechecks);
+    AK_RUN(assimp_non_finite_attributes);
+    AK_RUN(assimp_companion_files_stay_inside_model_dir);
     AK_RUN(inline_sampler_on_gltf_assets);
     return ak_test_finish();
 }

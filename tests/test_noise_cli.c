@@ -3,26 +3,8 @@
  * parameters, and the files terrain writes (16-bit PNG read back, OBJ counts, GIF frames). */
 #include <animkit/animkit.h>
 
-#include <sys/wait.h>
-
 #include "ak_test.h"
-
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 16];
-
-static int run(const char* args, bool merge) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s %s", AK_CLI_PATH, args, merge ? "2>&1" : "2>/dev/null");
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+#include "cli_test.h"
 
 /* One line of space-separated numbers, each printed with %.9g (so it reads back exactly). */
 static int parse_line(float* v, int cap) {

@@ -3,44 +3,8 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
-#include <sys/wait.h>
-
 #include "ak_test.h"
-
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 16];
-
-static int run(const char* args) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", AK_CLI_PATH, args);
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static void write_file(const char* path, const char* text) {
-    FILE* f = fopen(path, "w");
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
-}
-
-static cJSON* read_json(const char* path) {
-    FILE* f = fopen(path, "rb");
-    if (!f) return NULL;
-    static char buf[1 << 20];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = '\0';
-    return cJSON_Parse(buf);
-}
+#include "cli_test.h"
 
 static double num(const cJSON* arr, int i) { return cJSON_GetArrayItem(arr, i)->valuedouble; }
 
@@ -65,7 +29,7 @@ AK_TEST(bad_scenes_exit_1_with_path) {
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         write_file("particles_bad.json", cases[k].text);
-        int rc = run("particles particles_bad.json --steps 2");
+        int rc = run("particles particles_bad.json --steps 2", true);
         AK_CHECK_MSG(rc == 1, "case %zu: exit %d (%s)", k, rc, out_buf);
         AK_CHECK_MSG(strstr(out_buf, "particles_bad.json") && strstr(out_buf, cases[k].expect),
                      "case %zu: %s", k, out_buf);
@@ -73,17 +37,17 @@ AK_TEST(bad_scenes_exit_1_with_path) {
         for (const char* p = out_buf; *p; ++p) lines += *p == '\n';
         AK_CHECK_MSG(lines == 1, "case %zu: %d lines", k, lines);
     }
-    AK_CHECK_EQ(run("particles missing_file.json"), 1);
-    AK_CHECK_EQ(run("particles"), 2);
-    AK_CHECK_EQ(run("particles --preset nope"), 2);
-    AK_CHECK_EQ(run("particles --preset rain particles_bad.json"), 2);
-    AK_CHECK_EQ(run("particles --preset rain --integrator midpoint"), 2);
-    AK_CHECK_EQ(run("particles --preset rain --dt -1"), 2);
-    AK_CHECK_EQ(run("particles --preset rain -o out.bmp"), 2);
+    AK_CHECK_EQ(run("particles missing_file.json", true), 1);
+    AK_CHECK_EQ(run("particles", true), 2);
+    AK_CHECK_EQ(run("particles --preset nope", true), 2);
+    AK_CHECK_EQ(run("particles --preset rain particles_bad.json", true), 2);
+    AK_CHECK_EQ(run("particles --preset rain --integrator midpoint", true), 2);
+    AK_CHECK_EQ(run("particles --preset rain --dt -1", true), 2);
+    AK_CHECK_EQ(run("particles --preset rain -o out.bmp", true), 2);
     /* out-of-range flags name the allowed range */
-    AK_CHECK(run("particles --preset rain --steps 100000001") == 2 && strstr(out_buf, "0..100000000"));
-    AK_CHECK(run("particles --preset rain --size 100000x100000 -o big.png") == 2 && strstr(out_buf, "8..8192"));
-    AK_CHECK_EQ(run("particles --help"), 0);
+    AK_CHECK(run("particles --preset rain --steps 100000001", true) == 2 && strstr(out_buf, "0..100000000"));
+    AK_CHECK(run("particles --preset rain --size 100000x100000 -o big.png", true) == 2 && strstr(out_buf, "8..8192"));
+    AK_CHECK_EQ(run("particles --help", true), 0);
     AK_CHECK(strstr(out_buf, "usage: animkit particles") != NULL);
 }
 
@@ -95,7 +59,7 @@ AK_TEST(json_matches_closed_form) {
         "{\"dt\": 0.5, \"integrator\": \"euler\", \"gravity\": [0, -10, 0],"
         " \"particles\": [{\"p\": [1, 2, 3], \"v\": [2, 5, 0]}, {\"p\": [0, 1, 0], \"m\": 0}]}");
     AK_CHECK_EQ(run("particles particles_throw.json --steps 40 --dt 0.025 --integrator verlet "
-                    "--json throw.json"),
+                    "--json throw.json", true),
                 0);
     cJSON* j = read_json("throw.json");
     AK_CHECK(j != NULL);
@@ -120,7 +84,7 @@ AK_TEST(json_matches_closed_form) {
                "{\"gravity\": [0, 0, 0], \"particles\": [{\"p\": [9, 9, 9]}],"
                " \"emitters\": [{\"rate\": 2.5, \"speed\": [0, 0], \"lifetime\": [100, 100]}]}");
     AK_CHECK_EQ(
-        run("particles particles_emit.json --steps 200 --dt 0.01 --json emit.json --threads 2"), 0);
+        run("particles particles_emit.json --steps 200 --dt 0.01 --json emit.json --threads 2", true), 0);
     j = read_json("emit.json");
     AK_CHECK(j != NULL);
     if (!j) return;
@@ -139,7 +103,7 @@ AK_TEST(springs_survive_a_death) {
                "{\"dt\": 0.0005, \"gravity\": [0, 0, 0],"
                " \"particles\": [{\"p\": [1, 5, 0], \"lifetime\": 0.01}, {\"p\": [0, 0, 0]}, {\"p\": [2, 0, 0]}],"
                " \"springs\": [{\"i\": 1, \"j\": 2, \"rest\": 1, \"k\": 100}, {\"i\": 0, \"j\": 2, \"k\": 0}]}");
-    AK_CHECK_EQ(run("particles particles_die.json --steps 400 --json die.json"), 0);
+    AK_CHECK_EQ(run("particles particles_die.json --steps 400 --json die.json", true), 0);
     cJSON* j = read_json("die.json");
     AK_CHECK(j != NULL);
     if (!j) return;
@@ -159,7 +123,7 @@ AK_TEST(springs_survive_a_death) {
      * used to call the emitter 10^7 times per step, and its 32-bit count wrapped and spun) */
     write_file("particles_bursts.json", "{\"capacity\": 10, \"emitters\": [{\"burst\": 4, \"burst_interval\": 1e-12,"
                                         " \"lifetime\": [0, 0]}]}");
-    AK_CHECK_EQ(run("particles particles_bursts.json --steps 3 --json bursts.json"), 0);
+    AK_CHECK_EQ(run("particles particles_bursts.json --steps 3 --json bursts.json", true), 0);
     j = read_json("bursts.json");
     AK_CHECK(j != NULL && cJSON_GetArraySize(cJSON_GetObjectItem(j, "particles")) == 10);
     cJSON_Delete(j);
@@ -170,7 +134,7 @@ AK_TEST(springs_survive_a_death) {
  * it: the image showed only the ground); the title says "1 particle". */
 AK_TEST(single_particle_is_framed) {
     write_file("particles_one.json", "{\"particles\": [{\"m\": 0, \"p\": [0, 5, 0], \"colour\": [1, 0, 0, 1]}]}");
-    AK_CHECK_EQ(run("particles particles_one.json --steps 0 --size 160x120 -o one.png"), 0);
+    AK_CHECK_EQ(run("particles particles_one.json --steps 0 --size 160x120 -o one.png", true), 0);
     int w = 0, h = 0, red = 0;
     AK_CHECK(ak_png_info("one.png", &w, &h) == AK_OK && w == 160 && h == 120);
     static uint8_t px[160 * 120 * 4];
@@ -189,24 +153,24 @@ AK_TEST(presets_run_and_render) {
             args, sizeof args,
             "particles --preset %s --steps 12 --size 96x72 -o preset_%s.png --json preset_%s.json",
             presets[k], presets[k], presets[k]);
-        AK_CHECK_MSG(run(args) == 0, "%s: %s", presets[k], out_buf);
+        AK_CHECK_MSG(run(args, true) == 0, "%s: %s", presets[k], out_buf);
         char path[64];
         snprintf(path, sizeof path, "preset_%s.png", presets[k]);
         int w = 0, h = 0;
         AK_CHECK_EQ(ak_png_info(path, &w, &h), AK_OK);
         AK_CHECK(w == 96 && h == 72);
     }
-    AK_CHECK_EQ(run("particles --preset rain --steps 0 --size 64x48 -o zero.gif --json zero.json"), 0);
+    AK_CHECK_EQ(run("particles --preset rain --steps 0 --size 64x48 -o zero.gif --json zero.json", true), 0);
     int zw = 0, zh = 0, zf = 0;
     AK_CHECK_EQ(ak_gif_info("zero.gif", &zw, &zh, &zf), AK_OK);
     AK_CHECK_EQ(zf, 1);
-    AK_CHECK_EQ(run("particles --preset fireworks --steps 6 --size 64x48 -o fw.gif"), 0);
+    AK_CHECK_EQ(run("particles --preset fireworks --steps 6 --size 64x48 -o fw.gif", true), 0);
     int w = 0, h = 0, frames = 0;
     AK_CHECK_EQ(ak_gif_info("fw.gif", &w, &h, &frames), AK_OK);
     AK_CHECK_EQ(frames, 7);
     /* Same seed, 1 and 2 threads: identical files. */
-    AK_CHECK_EQ(run("particles --preset rain --steps 30 --seed 5 --json r1.json"), 0);
-    AK_CHECK_EQ(run("particles --preset rain --steps 30 --seed 5 --threads 2 --json r2.json"), 0);
+    AK_CHECK_EQ(run("particles --preset rain --steps 30 --seed 5 --json r1.json", true), 0);
+    AK_CHECK_EQ(run("particles --preset rain --steps 30 --seed 5 --threads 2 --json r2.json", true), 0);
     cJSON* a = read_json("r1.json");
     char* sa = a ? cJSON_PrintUnformatted(a) : NULL;
     cJSON* b = read_json("r2.json");

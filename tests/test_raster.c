@@ -2,9 +2,9 @@
  * here in double precision, the pinhole projection formula, Lambert's law and the sRGB curve
  * written out here, and libpng/giflib decoding of the files written. */
 #include <animkit/raster.h>
-#include <gif_lib.h> /* delays read back straight from the file */
 
 #include "ak_test.h"
+#include "ref/ref_gif.h" /* delays read back straight from the file */
 
 #include <stdint.h>
 
@@ -860,25 +860,6 @@ AK_TEST(bad_input_codes) {
     target_free(&t);
 }
 
-/* Frame delays read with giflib (1/100 s); returns the frame count or -1. */
-static int read_delays(const char* path, int* out, int cap) {
-    int err = 0;
-    GifFileType* g = DGifOpenFileName(path, &err);
-    if (!g || DGifSlurp(g) != GIF_OK) {
-        if (g) DGifCloseFile(g, &err);
-        return -1;
-    }
-    int n = g->ImageCount;
-    for (int i = 0; i < n && i < cap; ++i) {
-        GraphicsControlBlock gcb;
-        memset(&gcb, 0, sizeof gcb);
-        DGifSavedExtensionToGCB(g, i, &gcb);
-        out[i] = gcb.DelayTime;
-    }
-    DGifCloseFile(g, &err);
-    return n;
-}
-
 /* frame_rate: whole-centisecond delays whose running sum stays within half a centisecond of
  * k * 100 / rate (24 fps: 4 and 5 alternate; 24 frames last exactly 1 s). */
 AK_TEST(gif_frame_rate_delays) {
@@ -897,7 +878,7 @@ AK_TEST(gif_frame_rate_delays) {
         }
         AK_CHECK_EQ(ak_gif_writer_finish(gw), AK_OK);
         int d[64];
-        AK_CHECK_EQ(read_delays("raster_rate.gif", d, 64), 48);
+        AK_CHECK_EQ(ref_gif_delays("raster_rate.gif", d, 64), 48);
         long sum = 0;
         for (int k = 0; k < 48; ++k) {
             sum += d[k];
@@ -914,7 +895,7 @@ AK_TEST(gif_frame_rate_delays) {
     AK_CHECK_EQ(ak_gif_writer_add_frame(gw, &img), AK_OK);
     AK_CHECK_EQ(ak_gif_writer_finish(gw), AK_OK);
     int d[4];
-    AK_CHECK_EQ(read_delays("raster_rate.gif", d, 4), 2);
+    AK_CHECK_EQ(ref_gif_delays("raster_rate.gif", d, 4), 2);
     AK_CHECK(d[0] == 7 && d[1] == 7);
 }
 

@@ -61,7 +61,9 @@
  * nesting levels, the BVH reader does not recurse); external glTF
  * buffers only inside the model's directory unless desc->extra_roots/allow_any_path say
  * otherwise; images never opened). Assimp formats (FBX, Collada, OBJ, ...) are NOT: animkit
- * only pre-checks their size and nesting depth. docs/io.md lists every limit and its default.
+ * only pre-checks their size and nesting depth, and lets Assimp open the files a model names
+ * (an OBJ's mtllib) only inside the model's directory (or extra_roots / allow_any_path).
+ * docs/io.md lists every limit and its default.
  *
  * Ownership and threading: the scene returned belongs to the caller (ak_scene_destroy).
  * The library keeps no pointer to the caller's data. The glTF and BVH paths are reentrant: the JSON
@@ -117,13 +119,15 @@ typedef struct ak_io_desc {
                                 the peak is lower); over it -> AK_ERR_UNSUPPORTED.
                                 0 -> max(AK_IO_DEFAULT_BUDGET, AK_IO_BUDGET_INPUT_FACTOR x input
                                 size). Assimp formats: the file size must fit it */
-    const char* const* extra_roots; /* directories that external glTF buffer URIs may also
-                                resolve into (after percent-decoding, normalising and resolving
-                                symlinks); NULL -> only the model's own directory */
+    const char* const* extra_roots; /* directories that external glTF buffer URIs (and files
+                                an Assimp model names) may also resolve into (after
+                                percent-decoding, normalising and resolving symlinks);
+                                NULL -> only the model's own directory */
     size_t extra_root_count;
     bool allow_any_path;     /* true -> external buffer URIs may resolve anywhere (only for
                                 trusted files); false (default) -> outside the model's directory
-                                and extra_roots is AK_ERR_IO */
+                                and extra_roots is AK_ERR_IO (an Assimp model's own files: not
+                                opened, a warning) */
 } ak_io_desc;
 
 /* The desc with its zero fields replaced by their defaults (NULL -> all defaults).

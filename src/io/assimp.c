@@ -1,11 +1,17 @@
 /* Everything but glTF (BVH, FBX, Collada, OBJ, ...) through Assimp's C API: the node tree
  * becomes the skeleton (depth-first, so parents come first), aiAnimation channels become
  * clips (ticks -> seconds), meshes with bones get one skin each. */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h> /* Debian libassimp-dev (5.2.5) */
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <ctype.h>
+#include <limits.h>
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/stat.h>
 
 #include "io_internal.h"
 
@@ -139,15 +145,26 @@ static ak_result make_mesh(as_ctx* c, const struct aiMesh* am, size_t mi, ak_mes
     for (size_t v = 0; v < nv; ++v) {
         const struct aiVector3D* p = &am->mVertices[v];
         m->positions[v] = ak_vec3_make(p->x, p->y, p->z);
-        if (!ak_vec3_is_finite(m->positions[v])) {
-            akp_diag_set(c->diag, c->path, "mesh %zu vertex %zu is not finite", mi, v);
-            r = AK_ERR_BAD_DATA;
+        const char* bad = ak_vec3_is_finite(m->positions[v]) ? NULL : "position";
+        if (am->mNormals) {
+            m->normals[v] = ak_vec3_make(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
+            if (!bad && !ak_vec3_is_finite(m->normals[v])) bad = "normal";
         }
-        if (am->mNormals) m->normals[v] = ak_vec3_make(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
-        if (am->mTextureCoords[0]) m->uvs[v] = ak_vec2_make(am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y);
+        if (am->mTextureCoords[0]) {
+            m->uvs[v] = ak_vec2_make(am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y);
+            if (!bad && !(ak_finitef(m->uvs[v].x) && ak_finitef(m->uvs[v].y))) bad = "UV";
+        }
         if (am->mColors[0]) {
             const struct aiColor4D* col = &am->mColors[0][v];
             m->colors[v] = ak_vec4_make(col->r, col->g, col->b, col->a);
+            if (!bad && !(ak_finitef(col->r) && ak_finitef(col->g) && ak_finitef(col->b) && ak_finitef(col->a)))
+                bad = "colour";
+        }
+        /* Like the glTF reader: a non-finite attribute (an OBJ "vn 0 0 1e39" overflows to
+         * infinity) is bad data, not something to pass on to skinning or the writers. */
+        if (bad && r == AK_OK) {
+            akp_diag_set(c->diag, c->path, "mesh %zu vertex %zu: the %s is not finite", mi, v, bad);
+            r = AK_ERR_BAD_DATA;
         }
     }
     size_t t = 0;
@@ -485,6 +502,121 @@ static ak_result precheck(FILE* f, const char* path, const ak_io_desc* desc, ak_
     return AK_OK;
 }
 
+/* ---- the files Assimp may open ----------------------------------------------------------- */
+
+/* Assimp opens the files a model names itself (an OBJ's "mtllib ../../x.mtl", ...) through its
+ * default file system, anywhere. Every open goes through these callbacks instead: the model
+ * file itself, or a regular file whose canonical path (symlinks resolved) lies inside the
+ * model's directory or desc->extra_roots (anywhere with desc->allow_any_path), and whose size
+ * fits the memory budget as the model's must (AK_IO_BUDGET_INPUT_FACTOR x its size; each file
+ * alone, since Assimp opens some files more than once). A refused file is reported to Assimp
+ * as missing (an OBJ then loads without its materials) and logged as a warning. */
+typedef struct as_fs {
+    const ak_io_desc* desc;
+    const char* path;     /* the model, as given */
+    char self[PATH_MAX];  /* its canonical path */
+    char root[PATH_MAX];  /* its canonical directory */
+    akp_budget budget;    /* the load's, nothing taken */
+    char refused[PATH_MAX]; /* the last file refused (Assimp retries a name; warn once) */
+} as_fs;
+
+typedef struct as_file {
+    FILE* f;
+    size_t size;
+} as_file;
+
+static bool path_inside(const char* p, const char* root) {
+    size_t n = strlen(root);
+    if (n == 1 && root[0] == '/') return p[0] == '/';
+    return strncmp(p, root, n) == 0 && (p[n] == '/' || p[n] == 0);
+}
+
+static size_t fs_read(struct aiFile* file, char* buf, size_t size, size_t count) {
+    return fread(buf, size, count, ((as_file*)(void*)file->UserData)->f);
+}
+
+static size_t fs_write(struct aiFile* file, const char* buf, size_t size, size_t count) {
+    (void)file, (void)buf, (void)size, (void)count;
+    return 0;
+}
+
+static size_t fs_tell(struct aiFile* file) {
+    long at = ftell(((as_file*)(void*)file->UserData)->f);
+    return at < 0 ? 0 : (size_t)at;
+}
+
+static size_t fs_size(struct aiFile* file) { return ((as_file*)(void*)file->UserData)->size; }
+
+static enum aiReturn fs_seek(struct aiFile* file, size_t offset, enum aiOrigin origin) {
+    int whence = origin == aiOrigin_CUR ? SEEK_CUR : origin == aiOrigin_END ? SEEK_END : SEEK_SET;
+    if (offset > LONG_MAX) return aiReturn_FAILURE;
+    return fseek(((as_file*)(void*)file->UserData)->f, (long)offset, whence) == 0 ? aiReturn_SUCCESS
+                                                                                 : aiReturn_FAILURE;
+}
+
+static void fs_flush(struct aiFile* file) { (void)file; }
+
+static void fs_refuse(as_fs* fs, const char* real, const char* name, const char* why) {
+    if (strcmp(real, fs->refused) == 0) return;
+    snprintf(fs->refused, sizeof fs->refused, "%s", real);
+    char msg[PATH_MAX + 200];
+    snprintf(msg, sizeof msg, "%s: not opening '%.*s' for Assimp: %s", fs->path, PATH_MAX, name, why);
+    akp_log(&fs->desc->logger, AK_LOG_WARN, msg);
+}
+
+static struct aiFile* fs_open(struct aiFileIO* io, const char* name, const char* mode) {
+    as_fs* fs = (as_fs*)(void*)io->UserData;
+    char real[PATH_MAX];
+    struct stat st;
+    if (!name || !mode || mode[0] != 'r' || !realpath(name, real) || stat(real, &st) != 0) return NULL;
+    bool allowed = strcmp(real, fs->self) == 0 || fs->desc->allow_any_path || path_inside(real, fs->root);
+    for (size_t i = 0; !allowed && fs->desc->extra_roots && i < fs->desc->extra_root_count; ++i) {
+        char root[PATH_MAX];
+        allowed = fs->desc->extra_roots[i] && realpath(fs->desc->extra_roots[i], root) && path_inside(real, root);
+    }
+    if (!allowed) {
+        fs_refuse(fs, real, name, "outside the model's directory (ak_io_desc.extra_roots, allow_any_path)");
+        return NULL;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        fs_refuse(fs, real, name, "not a regular file");
+        return NULL;
+    }
+    akp_budget b = fs->budget;
+    if (strcmp(real, fs->self) != 0 && !akp_budget_take(&b, (size_t)st.st_size, AK_IO_BUDGET_INPUT_FACTOR)) {
+        fs_refuse(fs, real, name, "over the memory budget");
+        return NULL;
+    }
+    struct aiFile* file = (struct aiFile*)calloc(1, sizeof *file);
+    as_file* af = (as_file*)calloc(1, sizeof *af);
+    FILE* f = fopen(real, "rb");
+    if (!file || !af || !f) {
+        if (f) fclose(f);
+        free(af);
+        free(file);
+        return NULL;
+    }
+    af->f = f;
+    af->size = (size_t)st.st_size;
+    file->ReadProc = fs_read;
+    file->WriteProc = fs_write;
+    file->TellProc = fs_tell;
+    file->FileSizeProc = fs_size;
+    file->SeekProc = fs_seek;
+    file->FlushProc = fs_flush;
+    file->UserData = (aiUserData)(void*)af;
+    return file;
+}
+
+static void fs_close(struct aiFileIO* io, struct aiFile* file) {
+    (void)io;
+    if (!file) return;
+    as_file* af = (as_file*)(void*)file->UserData;
+    if (af) fclose(af->f);
+    free(af);
+    free(file);
+}
+
 /* ---- the reader ------------------------------------------------------------------------ */
 
 ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
@@ -497,7 +629,21 @@ ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_
     ak_result pr = precheck(f, path, desc, diag);
     fclose(f);
     if (pr != AK_OK) return pr;
-    const struct aiScene* ai = aiImportFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+    as_fs fs;
+    memset(&fs, 0, sizeof fs);
+    fs.desc = desc;
+    fs.path = path;
+    struct stat st;
+    fs.budget = akp_io_budget(desc, stat(path, &st) == 0 && st.st_size > 0 ? (size_t)st.st_size : 0);
+    char dir[PATH_MAX];
+    const char* slash = strrchr(path, '/');
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + (slash == path) : 1, slash ? path : ".");
+    if (!realpath(path, fs.self) || !realpath(dir, fs.root)) {
+        akp_diag_set(diag, path, "cannot resolve the file's directory");
+        return AK_ERR_IO;
+    }
+    struct aiFileIO io = {fs_open, fs_close, (aiUserData)(void*)&fs};
+    const struct aiScene* ai = aiImportFileEx(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure, &io);
     if (!ai) {
         akp_diag_set(diag, path, "Assimp: %s", aiGetErrorString());
         return AK_ERR_PARSE;

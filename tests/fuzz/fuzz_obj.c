@@ -1,8 +1,10 @@
 /* libFuzzer target for the OBJ path (ak_io_load -> the Assimp pre-checks -> Assimp's OBJ
  * importer -> animkit's conversion); built and run by scripts/fuzz.sh.
  *
- * Assimp reads files only, so each input is written to one temporary .obj file (in $TMPDIR or
- * /tmp, removed at exit) and loaded from there. Assimp is not built with the sanitizers, so
+ * Assimp reads files only, so each input is written to one temporary .obj file, alone in a
+ * private directory (mkdtemp in $TMPDIR or /tmp, removed at exit), and loaded from there: an
+ * input's "mtllib" can then name no file but itself, so a run does not depend on what other
+ * processes leave in /tmp. Assimp is not built with the sanitizers, so
  * this finds crashes in it but not its silent memory errors; its one known leak on failed
  * imports is suppressed through tests/fuzz/lsan.supp. A loaded scene's meshes must validate. */
 #include <animkit/io.h>
@@ -13,16 +15,19 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
-static char g_path[4096];
+static char g_dir[4096], g_path[4096 + 16];
 
 static void remove_tmp(void) {
-    if (g_path[0]) unlink(g_path);
+    unlink(g_path);
+    rmdir(g_dir);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!g_path[0]) {
         const char* tmp = getenv("TMPDIR");
-        snprintf(g_path, sizeof g_path, "%s/animkit_fuzz_%ld.obj", tmp && tmp[0] ? tmp : "/tmp", (long)getpid());
+        snprintf(g_dir, sizeof g_dir, "%s/animkit_fuzz_XXXXXX", tmp && tmp[0] ? tmp : "/tmp");
+        if (!mkdtemp(g_dir)) abort();
+        snprintf(g_path, sizeof g_path, "%s/in.obj", g_dir);
         atexit(remove_tmp);
     }
     FILE* f = fopen(g_path, "wb");
@@ -33,8 +38,13 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     ak_diag diag;
     ak_io_desc desc = {.format = AK_IO_FORMAT_ASSIMP, .memory_budget = 64u << 20};
     if (ak_io_load(g_path, &desc, NULL, &scene, &diag) == AK_OK) {
-        for (size_t m = 0; m < scene->mesh_count; ++m)
-            if (ak_mesh_validate(scene->meshes[m].mesh, NULL) != AK_OK) abort();
+        for (size_t m = 0; m < scene->mesh_count; ++m) {
+            ak_diag bad = {0};
+            if (ak_mesh_validate(scene->meshes[m].mesh, &bad) != AK_OK) {
+                fprintf(stderr, "fuzz_obj: loaded mesh %zu fails ak_mesh_validate: %s\n", m, bad.message);
+                abort();
+            }
+        }
     }
     ak_scene_destroy(scene);
     return 0;
