@@ -1048,7 +1048,7 @@ static void emit(const ak_fluid_step_job* job, float s, size_t* n, ak_fluid_stat
                 const float fa = (float)a * s;
                 if (fa * fa > r2) continue;
                 if (*n >= cap) { /* full: count this row's lattice points without visiting them */
-                    const double bmax = floor(sqrt((double)r2 - (double)fa * fa) / s);
+                    const double bmax = floor(sqrt(fmax(0.0, (double)r2 - (double)fa * fa)) / s);
                     if (st) st->emit_dropped_count += (size_t)(2.0 * bmax + 1.0);
                     continue;
                 }
