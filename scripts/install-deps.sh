@@ -16,6 +16,7 @@ PACKAGES=(
   libsdl2-dev       # the window of `animkit view` (optional: without it, --headless only)
   xvfb              # virtual display: tests run the viewer's window under xvfb-run
   xauth             # xvfb-run needs it
+  libx11-dev        # the X11 client that resizes and closes the viewer's window in test_view_window
   clang             # the ASan+UBSan CI stage and scripts/fuzz.sh
   libclang-rt-14-dev # clang's sanitizer and libFuzzer runtimes (-fsanitize=fuzzer), Debian 12
 )
