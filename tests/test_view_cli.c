@@ -10,29 +10,9 @@
 
 #include "ak_test.h"
 
-#ifndef AK_CLI_PATH
-#error "AK_CLI_PATH must name the animkit executable"
-#endif
-
-static char out_buf[1 << 16];
-
-static int run(const char* args) {
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", AK_CLI_PATH, args);
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
-    out_buf[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static void write_text(const char* path, const char* text) {
-    FILE* f = fopen(path, "wb");
-    if (!f) return;
-    fputs(text, f);
-    fclose(f);
-}
+/* out_buf keeps the 64 KiB this test has always read; every run merges stderr. */
+#define CLI_TEST_OUT_SIZE (1 << 16)
+#include "cli_test.h"
 
 static bool load_png(const char* path, ak_image* img, int w, int h) {
     img->width = w;
@@ -92,20 +72,20 @@ AK_TEST(bad_scripts_exit_2_naming_the_line) {
         {"wait 1 2\n", 1},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-        write_text("bad_script.txt", cases[i].text);
-        int rc = run("view builtin:cylinder --headless --size 64x48 --script bad_script.txt");
+        write_file("bad_script.txt", cases[i].text);
+        int rc = run("view builtin:cylinder --headless --size 64x48 --script bad_script.txt", true);
         char want[32];
         snprintf(want, sizeof want, "line %d", cases[i].line);
         AK_CHECK_MSG(rc == 2, "case %zu: exit %d (want 2): %s", i, rc, out_buf);
         AK_CHECK_MSG(strstr(out_buf, want) && strstr(out_buf, "bad_script.txt"), "case %zu: '%s' not named: %s", i, want,
                      out_buf);
     }
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --script no_such_script.txt"), 1);
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 12"), 2);
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --supersample 9"), 2);
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --clip nope"), 1);
-    AK_CHECK_EQ(run("view no_such_model.glb --headless"), 1);
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --frames 3"), 0);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --script no_such_script.txt", true), 1);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 12", true), 2);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --supersample 9", true), 2);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --clip nope", true), 1);
+    AK_CHECK_EQ(run("view no_such_model.glb --headless", true), 1);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --frames 3", true), 0);
 }
 
 /* Keys 1/2/3 give `animkit render --method` images at the same time, size and camera: the
@@ -114,9 +94,9 @@ AK_TEST(bad_scripts_exit_2_naming_the_line) {
  * HUD bands. */
 AK_TEST(methods_match_render) {
     const int w = 320, h = 240;
-    write_text("methods.txt", "wait 15\nkey space\nkey 1\nkey f\nscreenshot view_lbs.png\nkey 2\n"
+    write_file("methods.txt", "wait 15\nkey space\nkey 1\nkey f\nscreenshot view_lbs.png\nkey 2\n"
                               "screenshot view_dqs.png\nkey 3\nscreenshot view_cor.png\nquit\n");
-    AK_CHECK_EQ(run("view builtin:cylinder --clip bend_twist --headless --size 320x240 --supersample 2 --script methods.txt"), 0);
+    AK_CHECK_EQ(run("view builtin:cylinder --clip bend_twist --headless --size 320x240 --supersample 2 --script methods.txt", true), 0);
     const char* m[3] = {"lbs", "dqs", "cor"};
     for (int k = 0; k < 3; ++k) {
         char args[256], va[64], ra[64];
@@ -124,7 +104,7 @@ AK_TEST(methods_match_render) {
         snprintf(va, sizeof va, "view_%s.png", m[k]);
         snprintf(args, sizeof args, "render builtin:cylinder --clip bend_twist --time 0.5 --size 320x240 --method %s -o %s",
                  m[k], ra);
-        AK_CHECK_EQ(run(args), 0);
+        AK_CHECK_EQ(run(args, true), 0);
         int mx = 0;
         long d = count_diff(va, ra, w, h, HUD_TOP, h - HUD_BOTTOM, &mx);
         AK_CHECK_MSG(d == 0, "%s: %ld pixels differ from render (max %d)", m[k], d, mx);
@@ -139,21 +119,21 @@ AK_TEST(methods_match_render) {
  * playing 15 fixed steps (0.5 s of the 1 s clip) and pausing gives. */
 AK_TEST(camera_and_scrub) {
     const int w = 320, h = 240;
-    write_text("cam.txt", "screenshot cam0.png\nmouse_down left 30 50\nmouse_move 90 80\nmouse_up left 90 80\n"
+    write_file("cam.txt", "screenshot cam0.png\nmouse_down left 30 50\nmouse_move 90 80\nmouse_up left 90 80\n"
                           "screenshot cam1.png\nkey f\nscreenshot cam2.png\nmouse_down middle 100 100\nmouse_move 140 120\n"
                           "mouse_up middle 140 120\nscreenshot cam3.png\nwheel 3\nscreenshot cam4.png\nkey f\n"
                           "screenshot cam5.png\nquit\n");
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script cam.txt"), 0);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script cam.txt", true), 0);
     AK_CHECK(count_diff("cam0.png", "cam1.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 500);
     AK_CHECK_EQ(count_diff("cam0.png", "cam2.png", w, h, 0, h, NULL), 0);
     AK_CHECK(count_diff("cam2.png", "cam3.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 500);
     AK_CHECK(count_diff("cam3.png", "cam4.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 500);
     AK_CHECK_EQ(count_diff("cam0.png", "cam5.png", w, h, 0, h, NULL), 0);
     /* the bar spans x in [8, w - 8] at the bottom: its middle is x = w / 2 */
-    write_text("play.txt", "wait 15\nkey space\nscreenshot played.png\nquit\n");
-    write_text("scrub.txt", "mouse_down left 100 230\nmouse_move 160 231\nmouse_up left 160 231\nscreenshot scrubbed.png\nquit\n");
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script play.txt"), 0);
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script scrub.txt"), 0);
+    write_file("play.txt", "wait 15\nkey space\nscreenshot played.png\nquit\n");
+    write_file("scrub.txt", "mouse_down left 100 230\nmouse_move 160 231\nmouse_up left 160 231\nscreenshot scrubbed.png\nquit\n");
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script play.txt", true), 0);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 320x240 --script scrub.txt", true), 0);
     AK_CHECK_EQ(count_diff("played.png", "scrubbed.png", w, h, 0, h, NULL), 0);
     AK_CHECK(count_diff("played.png", "cam0.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 100);
 }
@@ -213,9 +193,9 @@ AK_TEST(ik_drag_wrist) {
              "mouse_move %.3f %.3f\nmouse_up left %.3f %.3f\nwait 1\nscreenshot ik_after.png\nquit\n",
              (double)pw.x, (double)pw.y, (double)(0.5f * (pw.x + pg.x)), (double)(0.5f * (pw.y + pg.y)), (double)pg.x,
              (double)pg.y, (double)pg.x, (double)pg.y);
-    write_text("ik.txt", script);
+    write_file("ik.txt", script);
     remove("ik_log.jsonl");
-    AK_CHECK_EQ(run("view builtin:humanoid --headless --size 480x360 --script ik.txt --ik-log ik_log.jsonl"), 0);
+    AK_CHECK_EQ(run("view builtin:humanoid --headless --size 480x360 --script ik.txt --ik-log ik_log.jsonl", true), 0);
     /* the last log line is the solve for the final target */
     FILE* f = fopen("ik_log.jsonl", "r");
     AK_CHECK(f != NULL);
@@ -256,7 +236,7 @@ AK_TEST(ik_drag_wrist) {
     char args[512];
     snprintf(args, sizeof args, "ik builtin:humanoid --effector left_wrist --root left_shoulder --target %.9g,%.9g,%.9g --json",
              (double)t.x, (double)t.y, (double)t.z);
-    AK_CHECK_EQ(run(args), 0);
+    AK_CHECK_EQ(run(args, true), 0);
     cJSON* k = cJSON_Parse(out_buf);
     cJSON* joints = k ? cJSON_GetObjectItem(k, "joints") : NULL;
     AK_CHECK(cJSON_GetArraySize(joints) == 3);
@@ -300,7 +280,7 @@ AK_TEST(ik_drag_wrist) {
 /* Every key the help lists changes a screenshot (the status line is part of it). Keys are
  * read from `animkit view --help`, so a new key is tested as soon as it is listed. */
 AK_TEST(every_help_key_does_something) {
-    AK_CHECK_EQ(run("view --help"), 0);
+    AK_CHECK_EQ(run("view --help", true), 0);
     const char* k = strstr(out_buf, "\nkeys:\n");
     AK_CHECK(k != NULL);
     if (!k) return;
@@ -342,10 +322,10 @@ AK_TEST(every_help_key_does_something) {
         memcpy(names[tested++], keys[i], 16);
     }
     snprintf(script + o, 65536 - o, "quit\n");
-    write_text("keys.txt", script);
+    write_file("keys.txt", script);
     free(script);
     remove("./view_0000.png");
-    AK_CHECK_EQ(run("view builtin:humanoid --headless --size 320x240 --script keys.txt --shot-dir ."), 0);
+    AK_CHECK_EQ(run("view builtin:humanoid --headless --size 320x240 --script keys.txt --shot-dir .", true), 0);
     for (int i = 0; i < tested; ++i) {
         char pa[64], pb[64];
         snprintf(pa, sizeof pa, "key_%02d_a.png", i);
@@ -373,11 +353,11 @@ AK_TEST(morph_keys) {
         return;
     }
     fclose(f);
-    write_text("morph.txt", "key space\nkey b\nscreenshot m0.png\nkey ]\nkey ]\nkey ]\nkey ]\nkey ]\nscreenshot m1.png\n"
+    write_file("morph.txt", "key space\nkey b\nscreenshot m0.png\nkey ]\nkey ]\nkey ]\nkey ]\nkey ]\nscreenshot m1.png\n"
                             "key [\nkey [\nscreenshot m2.png\nkey m\nscreenshot m3.png\nquit\n");
     char args[1200];
     snprintf(args, sizeof args, "view %s --headless --size 160x120 --script morph.txt", path);
-    AK_CHECK_EQ(run(args), 0);
+    AK_CHECK_EQ(run(args, true), 0);
     AK_CHECK(count_diff("m0.png", "m1.png", 160, 120, HUD_TOP, 120 - HUD_BOTTOM, NULL) > 20);
     AK_CHECK(count_diff("m1.png", "m2.png", 160, 120, HUD_TOP, 120 - HUD_BOTTOM, NULL) > 20);
     AK_CHECK(count_diff("m2.png", "m3.png", 160, 120, 0, HUD_TOP, NULL) > 0);
@@ -397,9 +377,9 @@ AK_TEST(long_session) {
     for (int i = 0; i < 100; ++i)
         o += (size_t)snprintf(script + o, 65536 - o, "%s\nwait 10\n", steps[i % (sizeof steps / sizeof steps[0])]);
     snprintf(script + o, 65536 - o, "screenshot long.png\n");
-    write_text("long.txt", script);
+    write_file("long.txt", script);
     free(script);
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 160x120 --supersample 1 --script long.txt --ik-log long.jsonl"), 0);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 160x120 --supersample 1 --script long.txt --ik-log long.jsonl", true), 0);
     FILE* f = fopen("long.png", "rb");
     AK_CHECK(f != NULL);
     if (f) fclose(f);
@@ -414,7 +394,7 @@ AK_TEST(assets_session) {
     static const char* const models[] = {"gltf/CesiumMan/glTF-Binary/CesiumMan.glb", "gltf/Fox/glTF-Binary/Fox.glb",
                                          "gltf/MorphStressTest/glTF-Binary/MorphStressTest.glb", "bvh/01_01.bvh",
                                          "obj/makehuman/base.obj"};
-    write_text("assets.txt", "key w\nkey j\nkey n\nmouse_down left 60 45\nmouse_move 70 50\nmouse_up left 70 50\nkey a\n"
+    write_file("assets.txt", "key w\nkey j\nkey n\nmouse_down left 60 45\nmouse_move 70 50\nmouse_up left 70 50\nkey a\n"
                              "key i\nkey r\nkey tab\nkey 4\nwait 3\nkey ]\nkey 4\nkey k\nkey f\nwait 2\nscreenshot assets.png\n");
     int ran = 0;
     for (size_t i = 0; i < sizeof models / sizeof models[0]; ++i) {
@@ -424,7 +404,7 @@ AK_TEST(assets_session) {
         if (!f) continue;
         fclose(f);
         snprintf(args, sizeof args, "view %s --headless --size 120x90 --script assets.txt", path);
-        int rc = run(args);
+        int rc = run(args, true);
         AK_CHECK_MSG(rc == 0, "%s: exit %d: %s", models[i], rc, out_buf);
         ++ran;
     }
@@ -433,7 +413,7 @@ AK_TEST(assets_session) {
 
 /* The real window under a virtual X display gives the headless images. */
 AK_TEST(window_under_xvfb) {
-    AK_CHECK_EQ(run("view --help"), 0);
+    AK_CHECK_EQ(run("view --help", true), 0);
     if (!strstr(out_buf, "This build has a window")) {
         AK_SKIP("this build has no SDL2 window");
         return;
@@ -442,8 +422,8 @@ AK_TEST(window_under_xvfb) {
         AK_SKIP("xvfb-run not found (Debian xvfb, xauth)");
         return;
     }
-    write_text("win_x.txt", "wait 10\nkey space\nkey w\nscreenshot win_x.png\nquit\n");
-    write_text("win_h.txt", "wait 10\nkey space\nkey w\nscreenshot win_h.png\nquit\n");
+    write_file("win_x.txt", "wait 10\nkey space\nkey w\nscreenshot win_x.png\nquit\n");
+    write_file("win_h.txt", "wait 10\nkey space\nkey w\nscreenshot win_h.png\nquit\n");
     char cmd[1024];
     /* leak checks off for this child only: the display stack SDL loads (libdbus, X11 modules it
      * dlcloses) keeps allocations LeakSanitizer reports and cannot name; the viewer's own
@@ -451,7 +431,7 @@ AK_TEST(window_under_xvfb) {
     snprintf(cmd, sizeof cmd, "ASAN_OPTIONS=detect_leaks=0 timeout 120 xvfb-run -a %s view builtin:cylinder --size 200x150 --script win_x.txt 2>&1", AK_CLI_PATH);
     int st = system(cmd);
     AK_CHECK_MSG(WIFEXITED(st) && WEXITSTATUS(st) == 0, "windowed run failed (%d)", st);
-    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 200x150 --script win_h.txt"), 0);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 200x150 --script win_h.txt", true), 0);
     int mx = 0;
     AK_CHECK_EQ(count_diff("win_x.png", "win_h.png", 200, 150, 0, 150, &mx), 0);
 }
@@ -460,7 +440,7 @@ AK_TEST(window_under_xvfb) {
 
 /* Bad simulation arguments: exit 2 for a bad spec, 1 for a bad or missing scene file. */
 AK_TEST(sim_bad_specs) {
-    write_text("sim_bad.json", "{\"spheres\": 3}\n");
+    write_file("sim_bad.json", "{\"spheres\": 3}\n");
     struct {
         const char* args;
         int rc;
@@ -480,7 +460,7 @@ AK_TEST(sim_bad_specs) {
         {"view boids:sim_bad.json --headless", 1, "sim_bad.json"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-        int rc = run(cases[i].args);
+        int rc = run(cases[i].args, true);
         AK_CHECK_MSG(rc == cases[i].rc, "%s: exit %d (want %d): %s", cases[i].args, rc, cases[i].rc, out_buf);
         AK_CHECK_MSG(strstr(out_buf, cases[i].says) != NULL, "%s: '%s' not said: %s", cases[i].args, cases[i].says, out_buf);
     }
@@ -497,9 +477,9 @@ static void sim_play_pause_reset(const char* spec, const char* tag, int w, int h
              "key right\nscreenshot %s\nkey space\nkey r\nscreenshot %s\nwait 12\nscreenshot %s\n"
              "key r\nkey d\nkey d\nkey d\nkey d\nkey q\nwait 12\nscreenshot %s\n",
              a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7]);
-    write_text("sim_play.txt", script);
+    write_file("sim_play.txt", script);
     snprintf(args, sizeof args, "view %s --headless --size %dx%d --script sim_play.txt", spec, w, h);
-    AK_CHECK_MSG(run(args) == 0, "%s: %s", spec, out_buf);
+    AK_CHECK_MSG(run(args, true) == 0, "%s: %s", spec, out_buf);
     int y0 = HUD_TOP, y1 = h - HUD_BOTTOM;
     AK_CHECK_MSG(count_diff(a[0], a[1], w, h, y0, y1, NULL) > 50, "%s: playing did not change the view", spec);
     AK_CHECK_MSG(count_diff(a[2], a[3], w, h, 0, h, NULL) == 0, "%s: paused but the view changed", spec);
@@ -554,9 +534,9 @@ static void drag_sphere(const char* spec, ak_vec3 lo, ak_vec3 hi, ak_vec3 centre
              "screenshot drag0.png\nmouse_down left %d %d\nmouse_move %d %d\nmouse_move %d %d\nmouse_up left %d %d\n"
              "screenshot drag1.png\nkey r\nscreenshot drag2.png\n",
              cx, cy, cx + 30, cy, nx, cy, nx, cy);
-    write_text("sim_drag.txt", script);
+    write_file("sim_drag.txt", script);
     snprintf(args, sizeof args, "view %s --headless --size 320x240 --script sim_drag.txt", spec);
-    AK_CHECK_MSG(run(args) == 0, "%s: %s", spec, out_buf);
+    AK_CHECK_MSG(run(args, true) == 0, "%s: %s", spec, out_buf);
     ak_image a = {0}, b = {0};
     if (load_png("drag0.png", &a, w, h) && load_png("drag1.png", &b, w, h)) {
         AK_CHECK_MSG(window_diff(&a, &b, cx, cy) >= 40, "%s: nothing changed where the sphere was (%d, %d)", spec, cx, cy);
@@ -572,18 +552,18 @@ static void drag_sphere(const char* spec, ak_vec3 lo, ak_vec3 hi, ak_vec3 centre
     /* pressing on the sky orbits the camera: the whole view turns, the sphere stays centred */
     snprintf(script, sizeof script, "mouse_down left 10 %d\nmouse_move 80 %d\nmouse_up left 80 %d\nkey f\nscreenshot drag3.png\n",
              HUD_TOP + 5, HUD_TOP + 5, HUD_TOP + 5);
-    write_text("sim_drag2.txt", script);
+    write_file("sim_drag2.txt", script);
     snprintf(args, sizeof args, "view %s --headless --size 320x240 --script sim_drag2.txt", spec);
-    AK_CHECK_MSG(run(args) == 0, "%s: %s", spec, out_buf);
+    AK_CHECK_MSG(run(args, true) == 0, "%s: %s", spec, out_buf);
     AK_CHECK_EQ(count_diff("drag0.png", "drag3.png", w, h, 0, h, NULL), 0); /* F frames it as at the start */
 }
 
 AK_TEST(sim_drag_sphere) {
-    write_text("sim_ball.json", "{\"planes\": [{\"n\": [0, 1, 0], \"d\": 0}], \"spheres\": [{\"c\": [0, 0.5, 0], \"r\": 0.5}]}\n");
+    write_file("sim_ball.json", "{\"planes\": [{\"n\": [0, 1, 0], \"d\": 0}], \"spheres\": [{\"c\": [0, 0.5, 0], \"r\": 0.5}]}\n");
     drag_sphere("particles:sim_ball.json", ak_vec3_make(-0.5f, 0, -0.5f), ak_vec3_make(0.5f, 1, 0.5f), ak_vec3_make(0, 0.5f, 0));
     /* a flock of one small bird in [-2, 2]^3 over a floor plane at 0: the viewer frames the
      * bounds down to the floor */
-    write_text("sim_flock.json", "{\"count\": 1, \"bounds\": {\"min\": [-2, 0, -2], \"max\": [2, 2, 2]}, "
+    write_file("sim_flock.json", "{\"count\": 1, \"bounds\": {\"min\": [-2, 0, -2], \"max\": [2, 2, 2]}, "
                                  "\"obstacles\": [{\"type\": \"sphere\", \"center\": [0, 1, 0], \"radius\": 0.5}, "
                                  "{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0]}], "
                                  "\"render\": {\"size\": 0.05}}\n");
@@ -600,7 +580,7 @@ AK_TEST(sim_help_keys_do_something) {
         const char* spec;
     } kinds[] = {{"particles", "particles:preset:fountain"}, {"boids", "boids"}, {"cloth", "cloth:preset:flag"},
                  {"terrain", "terrain"}};
-    AK_CHECK_EQ(run("view --help"), 0);
+    AK_CHECK_EQ(run("view --help", true), 0);
     static char help[sizeof out_buf];
     memcpy(help, out_buf, sizeof help);
     for (size_t s = 0; s < sizeof kinds / sizeof kinds[0]; ++s) {
@@ -637,13 +617,13 @@ AK_TEST(sim_help_keys_do_something) {
         }
         AK_CHECK_MSG(escape, "%s: escape is not listed", kinds[s].kind);
         snprintf(script + o, 65536 - o, "key escape\nscreenshot skey_after_escape.png\n");
-        write_text("skeys.txt", script);
+        write_file("skeys.txt", script);
         free(script);
         remove("./view_0000.png");
         remove("skey_after_escape.png");
         char args[256];
         snprintf(args, sizeof args, "view %s --headless --size 240x180 --script skeys.txt --shot-dir .", kinds[s].spec);
-        int rc = run(args);
+        int rc = run(args, true);
         AK_CHECK_MSG(rc == 0, "%s: exit %d: %s", kinds[s].spec, rc, out_buf);
         for (int i = 0; i < nk; ++i) {
             if (strcmp(keys[i], "escape") == 0) continue;
@@ -683,11 +663,11 @@ static bool terrain_box(uint64_t seed, ak_vec3* lo, ak_vec3* hi) {
 
 AK_TEST(terrain_view) {
     const int w = 320, h = 240;
-    write_text("terrain.txt", "screenshot ter0.png\nkey e\nscreenshot ter1.png\nkey r\nscreenshot ter2.png\nkey g\nkey g\n"
+    write_file("terrain.txt", "screenshot ter0.png\nkey e\nscreenshot ter1.png\nkey r\nscreenshot ter2.png\nkey g\nkey g\n"
                               "key g\nkey f\nscreenshot ter3.png\nkey t\nscreenshot ter4.png\nkey r\nkey f\nscreenshot ter5.png\n");
-    AK_CHECK_EQ(run("view terrain --headless --size 320x240 --script terrain.txt"), 0);
-    write_text("terrain3.txt", "screenshot ter_seed3.png\n");
-    AK_CHECK_EQ(run("view terrain --seed 3 --headless --size 320x240 --script terrain3.txt"), 0);
+    AK_CHECK_EQ(run("view terrain --headless --size 320x240 --script terrain.txt", true), 0);
+    write_file("terrain3.txt", "screenshot ter_seed3.png\n");
+    AK_CHECK_EQ(run("view terrain --seed 3 --headless --size 320x240 --script terrain3.txt", true), 0);
     int y0 = HUD_TOP, y1 = h - HUD_BOTTOM;
     AK_CHECK(count_diff("ter0.png", "ter1.png", w, h, y0, y1, NULL) > 500);  /* erosion shows */
     AK_CHECK_EQ(count_diff("ter0.png", "ter2.png", w, h, y0, y1, NULL), 0);   /* R: the first terrain */
@@ -725,13 +705,13 @@ AK_TEST(terrain_view) {
     }
     free(a.pixels);
     free(b.pixels);
-    AK_CHECK_EQ(run("view terrain:preset:volcano --headless"), 2);
+    AK_CHECK_EQ(run("view terrain:preset:volcano --headless", true), 2);
     AK_CHECK(strstr(out_buf, "hills, mountains, dunes") != NULL);
-    AK_CHECK_EQ(run("view terrain:land.json --headless"), 2);
-    AK_CHECK_EQ(run("view terrain --seed -1 --headless"), 2);
-    AK_CHECK_EQ(run("view builtin:cylinder --seed 1 --headless"), 2);
-    AK_CHECK_EQ(run("view terrain:preset:mountains --headless --frames 2"), 0);
-    AK_CHECK_EQ(run("view terrain:preset:dunes --headless --frames 2 --threads 3"), 0);
+    AK_CHECK_EQ(run("view terrain:land.json --headless", true), 2);
+    AK_CHECK_EQ(run("view terrain --seed -1 --headless", true), 2);
+    AK_CHECK_EQ(run("view builtin:cylinder --seed 1 --headless", true), 2);
+    AK_CHECK_EQ(run("view terrain:preset:mountains --headless --frames 2", true), 0);
+    AK_CHECK_EQ(run("view terrain:preset:dunes --headless --frames 2 --threads 3", true), 0);
 }
 
 /* Dragging the drape's sphere out from under the cloth before it lands: the cloth falls to
@@ -766,15 +746,15 @@ AK_TEST(sim_cloth_drag_sphere) {
     AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_madd(ak_vec3_make(0, 0.5f, 0), ak_vec3_make(v[0], v[4], v[8]), 1.2f), &e));
     char script[512];
     snprintf(script, sizeof script, "wait 30\nscreenshot drape_still.png\n");
-    write_text("drape_a.txt", script);
+    write_file("drape_a.txt", script);
     snprintf(script, sizeof script,
              "mouse_down left %.2f %.2f\nmouse_move %.2f %.2f\nmouse_move %.2f %.2f\nmouse_up left %.2f %.2f\n"
              "wait 30\nscreenshot drape_moved.png\n",
              (double)c.x, (double)c.y, (double)(0.5f * (c.x + e.x)), (double)(0.5f * (c.y + e.y)), (double)e.x, (double)e.y,
              (double)e.x, (double)e.y);
-    write_text("drape_b.txt", script);
-    AK_CHECK_EQ(run("view cloth:preset:drape --headless --size 320x240 --script drape_a.txt"), 0);
-    AK_CHECK_EQ(run("view cloth:preset:drape --headless --size 320x240 --script drape_b.txt"), 0);
+    write_file("drape_b.txt", script);
+    AK_CHECK_EQ(run("view cloth:preset:drape --headless --size 320x240 --script drape_a.txt", true), 0);
+    AK_CHECK_EQ(run("view cloth:preset:drape --headless --size 320x240 --script drape_b.txt", true), 0);
     long na = 0, nb = 0;
     double ya = red_mean_y("drape_still.png", w, h, &na), yb = red_mean_y("drape_moved.png", w, h, &nb);
     printf("  drape: %ld cloth pixels, mean row %.1f; sphere dragged away: %ld, mean row %.1f\n", na, ya, nb, yb);
@@ -788,7 +768,7 @@ AK_TEST(sim_cloth_drag_sphere) {
  * [-1.25, 0, -0.65]..[1.25, 1.2, 0.65] (the dry run's particles stay inside it). */
 AK_TEST(sim_particles_drag_deflects) {
     const int w = 320, h = 240;
-    write_text("jet.json",
+    write_file("jet.json",
                "{\"gravity\": [0, 0, 0], \"planes\": [{\"n\": [0, 1, 0], \"d\": 0}],\n"
                " \"spheres\": [{\"c\": [0, 0.5, 0], \"r\": 0.3, \"restitution\": 0, \"friction\": 1},\n"
                "   {\"c\": [-1.2, 0.05, -0.6], \"r\": 0.05}, {\"c\": [1.2, 1.15, 0.6], \"r\": 0.05}],\n"
@@ -803,13 +783,13 @@ AK_TEST(sim_particles_drag_deflects) {
     AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(0.55f, 0.5f, 0), &p0));
     AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(1.1f, 0.5f, 0), &p1));
     char script[512];
-    write_text("jet_a.txt", "screenshot jet0.png\nwait 40\nscreenshot jet_still.png\n");
+    write_file("jet_a.txt", "screenshot jet0.png\nwait 40\nscreenshot jet_still.png\n");
     snprintf(script, sizeof script,
              "mouse_down left %.2f %.2f\nmouse_move %.2f %.2f\nmouse_up left %.2f %.2f\nwait 40\nscreenshot jet_moved.png\n",
              (double)c.x, (double)c.y, (double)up.x, (double)up.y, (double)up.x, (double)up.y);
-    write_text("jet_b.txt", script);
-    AK_CHECK_EQ(run("view particles:jet.json --headless --size 320x240 --script jet_a.txt"), 0);
-    AK_CHECK_EQ(run("view particles:jet.json --headless --size 320x240 --script jet_b.txt"), 0);
+    write_file("jet_b.txt", script);
+    AK_CHECK_EQ(run("view particles:jet.json --headless --size 320x240 --script jet_a.txt", true), 0);
+    AK_CHECK_EQ(run("view particles:jet.json --headless --size 320x240 --script jet_b.txt", true), 0);
     /* pixels along the jet's line beyond the sphere (x from 0.55 to 1.1 m), 5 rows each side */
     ak_image i0 = {0}, ia = {0}, ib = {0};
     if (load_png("jet0.png", &i0, w, h) && load_png("jet_still.png", &ia, w, h) && load_png("jet_moved.png", &ib, w, h)) {
@@ -836,19 +816,19 @@ AK_TEST(sim_particles_drag_deflects) {
  * --seed changes where particles go. */
 AK_TEST(sim_threads_and_seed) {
     const int w = 200, h = 150;
-    write_text("thr.txt", "wait 20\nscreenshot thr.png\n");
-    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --threads 1 --script thr.txt"), 0);
+    write_file("thr.txt", "wait 20\nscreenshot thr.png\n");
+    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --threads 1 --script thr.txt", true), 0);
     rename("thr.png", "thr1.png");
-    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --threads 3 --script thr.txt"), 0);
+    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --threads 3 --script thr.txt", true), 0);
     rename("thr.png", "thr3.png");
     AK_CHECK_EQ(count_diff("thr1.png", "thr3.png", w, h, 0, h, NULL), 0);
-    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --seed 2 --script thr.txt"), 0);
+    AK_CHECK_EQ(run("view particles:preset:fountain --headless --size 200x150 --seed 2 --script thr.txt", true), 0);
     AK_CHECK(count_diff("thr1.png", "thr.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 20);
-    AK_CHECK_EQ(run("view boids --headless --size 200x150 --threads 1 --script thr.txt"), 0);
+    AK_CHECK_EQ(run("view boids --headless --size 200x150 --threads 1 --script thr.txt", true), 0);
     rename("thr.png", "bthr1.png");
-    AK_CHECK_EQ(run("view boids --headless --size 200x150 --threads 2 --script thr.txt"), 0);
+    AK_CHECK_EQ(run("view boids --headless --size 200x150 --threads 2 --script thr.txt", true), 0);
     AK_CHECK_EQ(count_diff("bthr1.png", "thr.png", w, h, 0, h, NULL), 0);
-    AK_CHECK_EQ(run("view boids --headless --size 200x150 --seed 9 --script thr.txt"), 0);
+    AK_CHECK_EQ(run("view boids --headless --size 200x150 --seed 9 --script thr.txt", true), 0);
     AK_CHECK(count_diff("bthr1.png", "thr.png", w, h, HUD_TOP, h - HUD_BOTTOM, NULL) > 20);
 }
 
@@ -875,11 +855,11 @@ AK_TEST(sim_long_session) {
             o += (size_t)snprintf(script + o, 65536 - o, "%s\nwait %d\n", steps[i % (int)(sizeof steps / sizeof steps[0])],
                                   runs[r].wait);
         snprintf(script + o, 65536 - o, "screenshot sim_long.png\n");
-        write_text("sim_long.txt", script);
+        write_file("sim_long.txt", script);
         free(script);
         char args[512];
         snprintf(args, sizeof args, "view %s --headless --size 160x120 --script sim_long.txt --shot-dir .", runs[r].spec);
-        int rc = run(args);
+        int rc = run(args, true);
         AK_CHECK_MSG(rc == 0, "%s: exit %d: %s", runs[r].spec, rc, out_buf);
     }
 }

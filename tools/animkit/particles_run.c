@@ -21,6 +21,14 @@ static ak_particle_emitter emitter_base(void) {
     return e;
 }
 
+/* Rain: emitter_base falling straight down (a narrow cone) from a flat box. */
+static ak_particle_emitter rain_base(ak_vec3 center, ak_vec3 half_extents) {
+    ak_particle_emitter e = emitter_base();
+    e.shape = AK_EMITTER_BOX, e.center = center, e.half_extents = half_extents;
+    e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f;
+    return e;
+}
+
 /* Fills s for a preset; false when out of memory. */
 bool particles_preset(const char* name, particles_scene* s) {
     memset(s, 0, sizeof *s);
@@ -48,10 +56,8 @@ bool particles_preset(const char* name, particles_scene* s) {
         s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
         s->world.drag_linear = 0.02f;
     } else if (strcmp(name, "rain") == 0) {
-        e.shape = AK_EMITTER_BOX, e.center = ak_vec3_make(0, 4, 0),
-        e.half_extents = ak_vec3_make(2, 0.1f, 2);
-        e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f, e.speed_min = 3,
-        e.speed_max = 4;
+        e = rain_base(ak_vec3_make(0, 4, 0), ak_vec3_make(2, 0.1f, 2));
+        e.speed_min = 3, e.speed_max = 4;
         e.lifetime_min = 2.5f, e.lifetime_max = 3.0f, e.size_min = 0.015f, e.size_max = 0.02f;
         e.colour = ak_vec4_make(0.55f, 0.7f, 1.0f, 1), e.rate = 3000.0f;
         s->emitters[0] = e;
@@ -82,10 +88,8 @@ bool particles_preset(const char* name, particles_scene* s) {
         s->world.gravity = ak_vec3_make(0, -3.0f, 0);
     } else if (strcmp(name, "character") == 0) {
         /* Rain on the character (collides with its posed mesh) and sparks from its surface. */
-        e.shape = AK_EMITTER_BOX, e.center = ak_vec3_make(0, 2.6f, 0),
-        e.half_extents = ak_vec3_make(0.7f, 0.05f, 0.7f);
-        e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f, e.speed_min = 2,
-        e.speed_max = 2.5f;
+        e = rain_base(ak_vec3_make(0, 2.6f, 0), ak_vec3_make(0.7f, 0.05f, 0.7f));
+        e.speed_min = 2, e.speed_max = 2.5f;
         e.lifetime_min = 2, e.lifetime_max = 2.5f, e.size_min = 0.012f, e.size_max = 0.016f;
         e.colour = ak_vec4_make(0.45f, 0.65f, 1.0f, 1), e.rate = 2500.0f;
         s->emitters[0] = e;

@@ -4,6 +4,7 @@
  * parser and drawing (particles_run.c, boids_run.c, cloth_run.c), so the viewer shows what the
  * command renders. */
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -57,6 +58,71 @@ static bool project_sphere(const ak_raster_camera* cam, int w, int h, ak_vec3 c,
         return false;
     *pr = hypotf(top.x - px->x, top.y - px->y);
     return true;
+}
+
+/* True when the cursor (x, y) is on the sphere (c, r) and it is nearer than *best (which it
+ * then becomes): the grab test the simulations run over their spheres. */
+static bool sphere_under_cursor(const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3 c, float r,
+                                float* best) {
+    ak_vec3 px;
+    float pr;
+    if (!project_sphere(cam, w, h, c, r, &px, &pr)) return false;
+    if (!(hypotf(px.x - x, px.y - y) <= pr && px.z < *best)) return false;
+    *best = px.z;
+    return true;
+}
+
+/* Advance a simulation of fixed step sdt by a frame of dt: steps while the owed time covers
+ * one (at most MAX_STEPS_PER_FRAME), dropping the debt when it falls behind. step_once returns
+ * false on failure, which sets *failed and stops. */
+static void run_steps(double* carry, bool* failed, float dt, float sdt, bool (*step_once)(void* state), void* state) {
+    if (*failed) return;
+    *carry += (double)dt;
+    for (int n = 0; *carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
+        if (!step_once(state)) {
+            *failed = true;
+            return;
+        }
+        *carry -= (double)sdt;
+    }
+    if (*carry > (double)sdt) *carry = 0.0; /* fell behind: drop the debt */
+}
+
+/* Grow the box [lo, hi] to hold [blo, bhi]. */
+static void box_union(ak_vec3* lo, ak_vec3* hi, ak_vec3 blo, ak_vec3 bhi) {
+    *lo = ak_vec3_min(*lo, blo);
+    *hi = ak_vec3_max(*hi, bhi);
+}
+
+/* The wind keys (a/d: -x/+x, q/e: -z/+z, WIND_STEP m/s each): add to *wind and say the new
+ * wind in msg; false for any other key. */
+static bool wind_key(int key, ak_vec3* wind, char* msg, size_t msg_size) {
+    ak_vec3 d;
+    switch (key) {
+    case 'a': d = ak_vec3_make(-WIND_STEP, 0, 0); break;
+    case 'd': d = ak_vec3_make(WIND_STEP, 0, 0); break;
+    case 'q': d = ak_vec3_make(0, 0, -WIND_STEP); break;
+    case 'e': d = ak_vec3_make(0, 0, WIND_STEP); break;
+    default: return false;
+    }
+    *wind = ak_vec3_add(*wind, d);
+    snprintf(msg, msg_size, "wind %.2g %.2g %.2g m/s", (double)wind->x, (double)wind->y, (double)wind->z);
+    return true;
+}
+
+/* An init that fails: the message into err, the half-built state destroyed; returns rc. */
+static int init_fail(void (*destroy)(void*), void* state, int rc, char* err, size_t err_size, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 6, 7)))
+#endif
+    ;
+static int init_fail(void (*destroy)(void*), void* state, int rc, char* err, size_t err_size, const char* fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, err_size, fmt, ap);
+    va_end(ap);
+    destroy(state);
+    return rc;
 }
 
 /* ---- particles ---------------------------------------------------------------------------- */
@@ -157,21 +223,15 @@ static int psim_init(void** state, const char* spec, const view_sim_opts* o, cha
     int rc = CLI_OK;
     if (strncmp(spec, "preset:", 7) == 0) {
         const char* name = spec + 7;
-        if (strcmp(name, "fountain") && strcmp(name, "rain") && strcmp(name, "fireworks") && strcmp(name, "character")) {
-            snprintf(err, err_size, "particles:preset:%s: the presets are fountain, rain, fireworks, character", name);
-            psim_destroy(p);
-            return CLI_BAD_USAGE;
-        }
-        if (!particles_preset(name, &p->scene)) {
-            snprintf(err, err_size, "out of memory");
-            psim_destroy(p);
-            return CLI_BAD_INPUT;
-        }
+        if (strcmp(name, "fountain") && strcmp(name, "rain") && strcmp(name, "fireworks") && strcmp(name, "character"))
+            return init_fail(psim_destroy, p, CLI_BAD_USAGE, err, err_size,
+                             "particles:preset:%s: the presets are fountain, rain, fireworks, character", name);
+        if (!particles_preset(name, &p->scene))
+            return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "out of memory");
         p->use_char = strcmp(name, "character") == 0;
     } else if (!spec[0]) {
-        snprintf(err, err_size, "particles: give a scene file (particles:SCENE.json) or a preset (particles:preset:NAME)");
-        psim_destroy(p);
-        return CLI_BAD_USAGE;
+        return init_fail(psim_destroy, p, CLI_BAD_USAGE, err, err_size,
+                         "particles: give a scene file (particles:SCENE.json) or a preset (particles:preset:NAME)");
     } else {
         size_t size = 0;
         char* text = read_scene(spec, &size, err, err_size);
@@ -185,40 +245,30 @@ static int psim_init(void** state, const char* spec, const view_sim_opts* o, cha
     size_t ns = p->scene.world.spheres.count;
     p->spheres0 = calloc(ns + 1, sizeof *p->spheres0);
     p->colours = calloc((size_t)p->scene.capacity + 1, sizeof(ak_vec4));
-    if (!p->spheres0 || !p->colours) {
-        snprintf(err, err_size, "out of memory");
-        psim_destroy(p);
-        return CLI_BAD_INPUT;
-    }
+    if (!p->spheres0 || !p->colours)
+        return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "out of memory");
     if (ns) memcpy(p->spheres0, p->scene.spheres, ns * sizeof *p->spheres0);
     if (p->use_char) {
         particles_character_init(&p->ch, &rc);
         p->char_ready = true; /* freed at the end whatever init made */
     }
     if (rc == CLI_OK) rc = psim_bounds_run(p);
-    if (rc) {
-        snprintf(err, err_size, "cannot start the particle simulation");
-        psim_destroy(p);
-        return CLI_BAD_INPUT;
-    }
+    if (rc)
+        return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "cannot start the particle simulation");
     *state = p;
     return CLI_OK;
 }
 
+static bool psim_step_once(void* state) {
+    psim* p = state;
+    if (particles_run_step(&p->run, (int)p->step_index) != CLI_OK) return false;
+    ++p->step_index;
+    return true;
+}
+
 static void psim_step(void* state, float dt) {
     psim* p = state;
-    if (p->failed) return;
-    const float sdt = p->scene.dt;
-    p->carry += (double)dt;
-    for (int n = 0; p->carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
-        if (particles_run_step(&p->run, (int)p->step_index) != CLI_OK) {
-            p->failed = true;
-            return;
-        }
-        ++p->step_index;
-        p->carry -= (double)sdt;
-    }
-    if (p->carry > (double)sdt) p->carry = 0.0; /* fell behind: drop the debt */
+    run_steps(&p->carry, &p->failed, dt, p->scene.dt, psim_step_once, p);
 }
 
 static void psim_reset(void* state) {
@@ -248,25 +298,13 @@ static ak_result psim_draw(void* state, ak_raster* ras, const ak_raster_camera* 
 }
 
 static void psim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
-    psim* p = state;
-    *lo = ak_vec3_min(*lo, p->lo);
-    *hi = ak_vec3_max(*hi, p->hi);
+    const psim* p = state;
+    box_union(lo, hi, p->lo, p->hi);
 }
 
 static bool psim_key(void* state, int key, char* msg, size_t msg_size) {
     psim* p = state;
-    ak_vec3 d;
-    switch (key) {
-    case 'a': d = ak_vec3_make(-WIND_STEP, 0, 0); break;
-    case 'd': d = ak_vec3_make(WIND_STEP, 0, 0); break;
-    case 'q': d = ak_vec3_make(0, 0, -WIND_STEP); break;
-    case 'e': d = ak_vec3_make(0, 0, WIND_STEP); break;
-    default: return false;
-    }
-    p->run.world.wind = ak_vec3_add(p->run.world.wind, d);
-    ak_vec3 w = p->run.world.wind;
-    snprintf(msg, msg_size, "wind %.2g %.2g %.2g m/s", (double)w.x, (double)w.y, (double)w.z);
-    return true;
+    return wind_key(key, &p->run.world.wind, msg, msg_size);
 }
 
 static bool psim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
@@ -275,11 +313,7 @@ static bool psim_grab(void* state, const ak_raster_camera* cam, int w, int h, fl
     float best = INFINITY;
     for (size_t k = 0; k < p->scene.world.spheres.count; ++k) {
         const ak_particle_sphere* s = &p->scene.spheres[k];
-        ak_vec3 c;
-        float r;
-        if (!project_sphere(cam, w, h, s->center, s->radius, &c, &r)) continue;
-        float d = hypotf(c.x - x, c.y - y);
-        if (d <= r && c.z < best) best = c.z, p->grabbed = (int)k;
+        if (sphere_under_cursor(cam, w, h, x, y, s->center, s->radius, &best)) p->grabbed = (int)k;
     }
     if (p->grabbed < 0) return false;
     *anchor = p->scene.spheres[p->grabbed].center;
@@ -404,35 +438,25 @@ static int bsim_init(void** state, const char* spec, const view_sim_opts* o, cha
     b->lo.y = ak_minf(b->lo.y, ground);
     size_t n = b->sc.agent_count > 0 ? b->sc.agent_count : b->sc.count;
     b->obstacles0 = calloc(prm->obstacle_count + 1u, sizeof *b->obstacles0);
-    if (!b->obstacles0 || !boids_shapes_init(&b->sh, &b->sc, n, b->extent)) {
-        snprintf(err, err_size, "out of memory");
-        bsim_destroy(b);
-        return CLI_BAD_INPUT;
-    }
+    if (!b->obstacles0 || !boids_shapes_init(&b->sh, &b->sc, n, b->extent))
+        return init_fail(bsim_destroy, b, CLI_BAD_INPUT, err, err_size, "out of memory");
     if (prm->obstacle_count) memcpy(b->obstacles0, b->sc.obstacles, prm->obstacle_count * sizeof *b->obstacles0);
-    if (bsim_restart(b)) {
-        snprintf(err, err_size, "cannot start the flock");
-        bsim_destroy(b);
-        return CLI_BAD_INPUT;
-    }
+    if (bsim_restart(b))
+        return init_fail(bsim_destroy, b, CLI_BAD_INPUT, err, err_size, "cannot start the flock");
     *state = b;
     return CLI_OK;
 }
 
+static bool bsim_step_once(void* state) {
+    bsim* b = state;
+    if (boids_run_step(&b->run, b->step_index) != AK_OK) return false;
+    ++b->step_index;
+    return true;
+}
+
 static void bsim_step(void* state, float dt) {
     bsim* b = state;
-    if (b->failed) return;
-    const float sdt = b->sc.dt;
-    b->carry += (double)dt;
-    for (int n = 0; b->carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
-        if (boids_run_step(&b->run, b->step_index) != AK_OK) {
-            b->failed = true;
-            return;
-        }
-        ++b->step_index;
-        b->carry -= (double)sdt;
-    }
-    if (b->carry > (double)sdt) b->carry = 0.0;
+    run_steps(&b->carry, &b->failed, dt, b->sc.dt, bsim_step_once, b);
 }
 
 static void bsim_reset(void* state) {
@@ -451,9 +475,8 @@ static size_t bsim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
 }
 
 static void bsim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
-    bsim* b = state;
-    *lo = ak_vec3_min(*lo, b->lo);
-    *hi = ak_vec3_max(*hi, b->hi);
+    const bsim* b = state;
+    box_union(lo, hi, b->lo, b->hi);
 }
 
 static bool bsim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
@@ -462,11 +485,8 @@ static bool bsim_grab(void* state, const ak_raster_camera* cam, int w, int h, fl
     float best = INFINITY;
     for (uint32_t k = 0; k < b->sc.params.obstacle_count; ++k) {
         const ak_boids_obstacle* o = &b->sc.obstacles[k];
-        ak_vec3 c;
-        float r;
-        if (o->kind != AK_BOIDS_SPHERE || !project_sphere(cam, w, h, o->center, o->radius, &c, &r)) continue;
-        float d = hypotf(c.x - x, c.y - y);
-        if (d <= r && c.z < best) best = c.z, b->grabbed = (int)k;
+        if (o->kind == AK_BOIDS_SPHERE && sphere_under_cursor(cam, w, h, x, y, o->center, o->radius, &best))
+            b->grabbed = (int)k;
     }
     if (b->grabbed < 0) return false;
     *anchor = b->sc.obstacles[b->grabbed].center;
@@ -566,16 +586,13 @@ static int csim_init(void** state, const char* spec, const view_sim_opts* o, cha
     snprintf(c->name, sizeof c->name, "%s", spec);
     if (strncmp(spec, "preset:", 7) == 0) {
         c->sc_ready = true;
-        if (!cloth_scene_preset(spec + 7, &c->sc)) {
-            snprintf(err, err_size, "cloth:%s: the presets are flag, curtain, drape, cape", spec);
-            csim_destroy(c);
-            return CLI_BAD_USAGE;
-        }
+        if (!cloth_scene_preset(spec + 7, &c->sc))
+            return init_fail(csim_destroy, c, CLI_BAD_USAGE, err, err_size,
+                             "cloth:%s: the presets are flag, curtain, drape, cape", spec);
         snprintf(c->name, sizeof c->name, "%s", spec + 7);
     } else if (!spec[0]) {
-        snprintf(err, err_size, "cloth: give a scene file (cloth:SCENE.json) or a preset (cloth:preset:NAME)");
-        csim_destroy(c);
-        return CLI_BAD_USAGE;
+        return init_fail(csim_destroy, c, CLI_BAD_USAGE, err, err_size,
+                         "cloth: give a scene file (cloth:SCENE.json) or a preset (cloth:preset:NAME)");
     } else {
         size_t size = 0;
         char* text = read_scene(spec, &size, err, err_size);
@@ -593,35 +610,24 @@ static int csim_init(void** state, const char* spec, const view_sim_opts* o, cha
     if (c->prop_count > CLI_MAX_EXTRA - 1) c->prop_count = CLI_MAX_EXTRA - 1;
     c->spheres0 = calloc(c->sc.sphere_count + 1, sizeof *c->spheres0);
     c->props = calloc(c->prop_count + 1, sizeof *c->props);
-    if (!c->spheres0 || !c->props) {
-        snprintf(err, err_size, "out of memory");
-        csim_destroy(c);
-        return CLI_BAD_INPUT;
-    }
+    if (!c->spheres0 || !c->props)
+        return init_fail(csim_destroy, c, CLI_BAD_INPUT, err, err_size, "out of memory");
     if (c->sc.sphere_count) memcpy(c->spheres0, c->sc.spheres, c->sc.sphere_count * sizeof *c->spheres0);
-    if (csim_restart(c)) {
-        snprintf(err, err_size, "cannot start the cloth");
-        csim_destroy(c);
-        return CLI_BAD_INPUT;
-    }
+    if (csim_restart(c))
+        return init_fail(csim_destroy, c, CLI_BAD_INPUT, err, err_size, "cannot start the cloth");
     cloth_run_bounds(&c->run, &c->lo, &c->hi);
     *state = c;
     return CLI_OK;
 }
 
+static bool csim_step_once(void* state) {
+    csim* c = state;
+    return cloth_run_step(&c->run, "view", c->name) == CLI_OK;
+}
+
 static void csim_step(void* state, float dt) {
     csim* c = state;
-    if (c->failed) return;
-    const float sdt = c->sc.dt;
-    c->carry += (double)dt;
-    for (int n = 0; c->carry >= 0.999999 * (double)sdt && n < MAX_STEPS_PER_FRAME; ++n) {
-        if (cloth_run_step(&c->run, "view", c->name) != CLI_OK) {
-            c->failed = true;
-            return;
-        }
-        c->carry -= (double)sdt;
-    }
-    if (c->carry > (double)sdt) c->carry = 0.0;
+    run_steps(&c->carry, &c->failed, dt, c->sc.dt, csim_step_once, c);
 }
 
 static void csim_reset(void* state) {
@@ -654,25 +660,13 @@ static size_t csim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
 }
 
 static void csim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
-    csim* c = state;
-    *lo = ak_vec3_min(*lo, c->lo);
-    *hi = ak_vec3_max(*hi, c->hi);
+    const csim* c = state;
+    box_union(lo, hi, c->lo, c->hi);
 }
 
 static bool csim_key(void* state, int key, char* msg, size_t msg_size) {
     csim* c = state;
-    ak_vec3 d;
-    switch (key) {
-    case 'a': d = ak_vec3_make(-WIND_STEP, 0, 0); break;
-    case 'd': d = ak_vec3_make(WIND_STEP, 0, 0); break;
-    case 'q': d = ak_vec3_make(0, 0, -WIND_STEP); break;
-    case 'e': d = ak_vec3_make(0, 0, WIND_STEP); break;
-    default: return false;
-    }
-    c->sc.wind = ak_vec3_add(c->sc.wind, d);
-    ak_vec3 w = c->sc.wind;
-    snprintf(msg, msg_size, "wind %.2g %.2g %.2g m/s", (double)w.x, (double)w.y, (double)w.z);
-    return true;
+    return wind_key(key, &c->sc.wind, msg, msg_size);
 }
 
 static bool csim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
@@ -680,10 +674,8 @@ static bool csim_grab(void* state, const ak_raster_camera* cam, int w, int h, fl
     c->grabbed = -1;
     float best = INFINITY;
     for (size_t k = 0; k < c->sc.sphere_count; ++k) {
-        ak_vec3 p;
-        float r;
-        if (!project_sphere(cam, w, h, c->sc.spheres[k].center, c->sc.spheres[k].radius, &p, &r)) continue;
-        if (hypotf(p.x - x, p.y - y) <= r && p.z < best) best = p.z, c->grabbed = (int)k;
+        if (sphere_under_cursor(cam, w, h, x, y, c->sc.spheres[k].center, c->sc.spheres[k].radius, &best))
+            c->grabbed = (int)k;
     }
     if (c->grabbed < 0) return false;
     *anchor = c->sc.spheres[c->grabbed].center;
