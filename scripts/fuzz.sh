@@ -14,7 +14,10 @@
 #   tests/fuzz/<name>.dict   libFuzzer dictionary (optional)
 #   tests/fuzz/<name>.options extra libFuzzer flags on one line (optional)
 # The corpus grows in build-fuzz/corpus/<name> and is kept between runs. Environment:
-# FUZZ_JOBS (parallel targets, default 1), FUZZ_MAX_LEN (default 65536), CC (default clang).
+# FUZZ_JOBS (parallel targets, default 1), FUZZ_MAX_LEN (default 65536), CC (default clang),
+# FUZZ_SEED (libFuzzer's -seed, default 1, so that a run from the seed corpus is reproducible and
+# CI's short run repeats the sequence that was checked before committing; 0 = a random seed per
+# run, for long exploratory runs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -87,6 +90,7 @@ export LSAN_OPTIONS=suppressions=$ROOT/tests/fuzz/lsan.supp:print_suppressions=0
 run_one() {
   local name=$1 log=$OUT/logs/$1.log
   local args=(-max_total_time="$SECS" -max_len="$MAX_LEN" -timeout=20 -rss_limit_mb=2560
+              -seed="${FUZZ_SEED:-1}"
               -print_final_stats=1 -artifact_prefix="$OUT/artifacts/$name-")
   [ -f "tests/fuzz/$name.dict" ] && args+=(-dict="tests/fuzz/$name.dict")
   [ -f "tests/fuzz/$name.options" ] && read -r -a extra < "tests/fuzz/$name.options" && args+=("${extra[@]}")
