@@ -385,6 +385,37 @@ static inline void gather8(const ak_transform* local, size_t b, size_t cnt, __m1
     }
 }
 
+/* The local matrices of joints b .. b + cnt - 1 (cnt <= 8) in structure-of-arrays form, for
+ * fk_affine_avx and fk_affine_fma: L[0..8] the 3x3 part column by column (ak_mat3_from_quat's
+ * formulas times the scale, lane by lane, no FMA), L[9..11] the translation. */
+__attribute__((target("avx"), always_inline)) static inline void local_soa8(const ak_transform* local, size_t b,
+                                                                            size_t cnt, float L[12][8]) {
+    __m128 q[2][4], t[2][4], s[2][4];
+    gather8(local, b, cnt, q, t, s);
+#define AKP_W8(a, k) _mm256_insertf128_ps(_mm256_castps128_ps256(a[0][k]), a[1][k], 1)
+    const __m256 x = AKP_W8(q, 0), y = AKP_W8(q, 1), z = AKP_W8(q, 2), w = AKP_W8(q, 3);
+    const __m256 sx = AKP_W8(s, 1), sy = AKP_W8(s, 2), sz = AKP_W8(s, 3);
+    _mm256_store_ps(L[9], AKP_W8(t, 0));
+    _mm256_store_ps(L[10], AKP_W8(t, 1));
+    _mm256_store_ps(L[11], AKP_W8(t, 2));
+#undef AKP_W8
+    const __m256 xx = _mm256_mul_ps(x, x), yy = _mm256_mul_ps(y, y), zz = _mm256_mul_ps(z, z);
+    const __m256 xy = _mm256_mul_ps(x, y), xz = _mm256_mul_ps(x, z), yz = _mm256_mul_ps(y, z);
+    const __m256 wx = _mm256_mul_ps(w, x), wy = _mm256_mul_ps(w, y), wz = _mm256_mul_ps(w, z);
+    const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+#define AKP_TWO(e) _mm256_mul_ps(two, (e))
+    _mm256_store_ps(L[0], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(yy, zz))), sx));
+    _mm256_store_ps(L[1], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xy, wz)), sx));
+    _mm256_store_ps(L[2], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xz, wy)), sx));
+    _mm256_store_ps(L[3], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xy, wz)), sy));
+    _mm256_store_ps(L[4], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, zz))), sy));
+    _mm256_store_ps(L[5], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(yz, wx)), sy));
+    _mm256_store_ps(L[6], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xz, wy)), sz));
+    _mm256_store_ps(L[7], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(yz, wx)), sz));
+    _mm256_store_ps(L[8], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, yy))), sz));
+#undef AKP_TWO
+}
+
 /* fk for no root or an affine root, with AVX (no FMA: the same roundings as ak_mat4_mul and
  * ak_transform_to_mat4): the local matrices of 8 joints at a time from their TRS (loaded as
  * vectors and transposed, gather8) in structure-of-arrays form (ak_mat3_from_quat's formulas,
@@ -397,30 +428,7 @@ __attribute__((target("avx"))) static void fk_affine_avx(const ak_skeleton* sk, 
     __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()}; /* out[i - 1] */
     for (size_t b = 0; b < n; b += 8) {
         const size_t cnt = n - b < 8 ? n - b : 8;
-        __m128 q[2][4], t[2][4], s[2][4];
-        gather8(local, b, cnt, q, t, s);
-#define AKP_W8(a, k) _mm256_insertf128_ps(_mm256_castps128_ps256(a[0][k]), a[1][k], 1)
-        const __m256 x = AKP_W8(q, 0), y = AKP_W8(q, 1), z = AKP_W8(q, 2), w = AKP_W8(q, 3);
-        const __m256 sx = AKP_W8(s, 1), sy = AKP_W8(s, 2), sz = AKP_W8(s, 3);
-        _mm256_store_ps(L[9], AKP_W8(t, 0));
-        _mm256_store_ps(L[10], AKP_W8(t, 1));
-        _mm256_store_ps(L[11], AKP_W8(t, 2));
-#undef AKP_W8
-        const __m256 xx = _mm256_mul_ps(x, x), yy = _mm256_mul_ps(y, y), zz = _mm256_mul_ps(z, z);
-        const __m256 xy = _mm256_mul_ps(x, y), xz = _mm256_mul_ps(x, z), yz = _mm256_mul_ps(y, z);
-        const __m256 wx = _mm256_mul_ps(w, x), wy = _mm256_mul_ps(w, y), wz = _mm256_mul_ps(w, z);
-        const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
-#define AKP_TWO(e) _mm256_mul_ps(two, (e))
-        _mm256_store_ps(L[0], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(yy, zz))), sx));
-        _mm256_store_ps(L[1], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xy, wz)), sx));
-        _mm256_store_ps(L[2], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xz, wy)), sx));
-        _mm256_store_ps(L[3], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xy, wz)), sy));
-        _mm256_store_ps(L[4], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, zz))), sy));
-        _mm256_store_ps(L[5], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(yz, wx)), sy));
-        _mm256_store_ps(L[6], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xz, wy)), sz));
-        _mm256_store_ps(L[7], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(yz, wx)), sz));
-        _mm256_store_ps(L[8], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, yy))), sz));
-#undef AKP_TWO
+        local_soa8(local, b, cnt, L);
         for (size_t v = 0; v < cnt; ++v) {
             const size_t i = b + v;
             const int p = sk->parents[i];
@@ -432,8 +440,6 @@ __attribute__((target("avx"))) static void fk_affine_avx(const ak_skeleton* sk, 
                 a0 = _mm_loadu_ps(a->m), a1 = _mm_loadu_ps(a->m + 4), a2 = _mm_loadu_ps(a->m + 8),
                 a3 = _mm_loadu_ps(a->m + 12);
             } else { /* a root joint without root matrix: the local matrix itself */
-                a0 = _mm_setr_ps(1, 0, 0, 0), a1 = _mm_setr_ps(0, 1, 0, 0), a2 = _mm_setr_ps(0, 0, 1, 0),
-                a3 = _mm_setr_ps(0, 0, 0, 1);
                 for (int c = 0; c < 4; ++c)
                     prev[c] = _mm_setr_ps(L[3 * c][v], L[3 * c + 1][v], L[3 * c + 2][v], c == 3 ? 1.0f : 0.0f);
                 for (int c = 0; c < 4; ++c) _mm_storeu_ps(out[i].m + 4 * c, prev[c]);
@@ -462,30 +468,7 @@ __attribute__((target("avx2,fma"))) static void fk_affine_fma(const ak_skeleton*
     __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()}; /* out[i - 1] */
     for (size_t b = 0; b < n; b += 8) {
         const size_t cnt = n - b < 8 ? n - b : 8;
-        __m128 q[2][4], t[2][4], s[2][4];
-        gather8(local, b, cnt, q, t, s);
-#define AKP_W8(a, k) _mm256_insertf128_ps(_mm256_castps128_ps256(a[0][k]), a[1][k], 1)
-        const __m256 x = AKP_W8(q, 0), y = AKP_W8(q, 1), z = AKP_W8(q, 2), w = AKP_W8(q, 3);
-        const __m256 sx = AKP_W8(s, 1), sy = AKP_W8(s, 2), sz = AKP_W8(s, 3);
-        _mm256_store_ps(L[9], AKP_W8(t, 0));
-        _mm256_store_ps(L[10], AKP_W8(t, 1));
-        _mm256_store_ps(L[11], AKP_W8(t, 2));
-#undef AKP_W8
-        const __m256 xx = _mm256_mul_ps(x, x), yy = _mm256_mul_ps(y, y), zz = _mm256_mul_ps(z, z);
-        const __m256 xy = _mm256_mul_ps(x, y), xz = _mm256_mul_ps(x, z), yz = _mm256_mul_ps(y, z);
-        const __m256 wx = _mm256_mul_ps(w, x), wy = _mm256_mul_ps(w, y), wz = _mm256_mul_ps(w, z);
-        const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
-#define AKP_TWO(e) _mm256_mul_ps(two, (e))
-        _mm256_store_ps(L[0], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(yy, zz))), sx));
-        _mm256_store_ps(L[1], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xy, wz)), sx));
-        _mm256_store_ps(L[2], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xz, wy)), sx));
-        _mm256_store_ps(L[3], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(xy, wz)), sy));
-        _mm256_store_ps(L[4], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, zz))), sy));
-        _mm256_store_ps(L[5], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(yz, wx)), sy));
-        _mm256_store_ps(L[6], _mm256_mul_ps(AKP_TWO(_mm256_add_ps(xz, wy)), sz));
-        _mm256_store_ps(L[7], _mm256_mul_ps(AKP_TWO(_mm256_sub_ps(yz, wx)), sz));
-        _mm256_store_ps(L[8], _mm256_mul_ps(_mm256_sub_ps(one, AKP_TWO(_mm256_add_ps(xx, yy))), sz));
-#undef AKP_TWO
+        local_soa8(local, b, cnt, L);
         for (size_t v = 0; v < cnt; ++v) {
             const size_t i = b + v;
             const int p = sk->parents[i];

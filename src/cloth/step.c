@@ -221,6 +221,21 @@ static void block_range(size_t count, unsigned t, unsigned T, size_t* b, size_t*
     if (*e > count) *e = count;
 }
 
+/* Thread t's share [*kb, *ke) of colour col of a constraint list whose colours start at
+ * starts[0..AKP_MAX_COLORS + 1]: the serial colour all on thread 0, the others in blocks of 16
+ * (block_range). False when the colour is empty (every thread skips it, barrier included). */
+static bool color_share(const uint32_t* starts, int col, unsigned t, unsigned T, size_t* kb, size_t* ke) {
+    const size_t cb = starts[col], ce = starts[col + 1];
+    if (cb == ce) return false;
+    if (col == AKP_SERIAL_COLOR) {
+        *kb = t == 0 ? cb : ce, *ke = ce;
+    } else {
+        block_range(ce - cb, t, T, kb, ke);
+        *kb += cb, *ke += cb;
+    }
+    return true;
+}
+
 /* ---- collisions ------------------------------------------------------------------------- */
 
 static uint32_t hash_cell(int32_t x, int32_t y, int32_t z, size_t buckets) {
@@ -653,11 +668,8 @@ static void run_spmd(ctx* c, unsigned t) {
         barrier(c);
         for (uint32_t it = 0; it < c->iterations; ++it) {
             for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
-                const size_t cb = cl->dist_color[col], ce = cl->dist_color[col + 1];
-                if (cb == ce) continue;
                 size_t kb, ke;
-                if (col == AKP_SERIAL_COLOR) kb = t == 0 ? cb : ce, ke = ce;
-                else block_range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
+                if (!color_share(cl->dist_color, col, t, c->T, &kb, &ke)) continue;
                 if (col == AKP_SERIAL_COLOR)
                     for (size_t k = kb; k < ke; ++k) scalar_dist(&c->solve, k, it == 0);
                 else
@@ -665,11 +677,8 @@ static void run_spmd(ctx* c, unsigned t) {
                 barrier(c);
             }
             for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
-                const size_t cb = cl->bend_color[col], ce = cl->bend_color[col + 1];
-                if (cb == ce) continue;
                 size_t kb, ke;
-                if (col == AKP_SERIAL_COLOR) kb = t == 0 ? cb : ce, ke = ce;
-                else block_range(ce - cb, t, c->T, &kb, &ke), kb += cb, ke += cb;
+                if (!color_share(cl->bend_color, col, t, c->T, &kb, &ke)) continue;
                 if (col == AKP_SERIAL_COLOR)
                     for (size_t k = kb; k < ke; ++k) scalar_bend(&c->solve, k, it == 0);
                 else
