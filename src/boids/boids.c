@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../simd.h"
 #include "boids_internal.h"
 
 /* ---- species ------------------------------------------------------------------------- */
@@ -75,6 +76,32 @@ static bool vec_ok(ak_vec3 v) {
     return ak_vec3_is_finite(v) && fabsf(v.x) <= 1e15f && fabsf(v.y) <= 1e15f && fabsf(v.z) <= 1e15f;
 }
 
+/* vec_ok over count floats (a span of ak_vec3 as 3 count floats): |x| <= 1e15 on the bits,
+ * which also rejects NaN and infinities (their magnitude bits are larger). */
+_Static_assert(sizeof(ak_vec3) == 3 * sizeof(float), "ak_vec3 is three packed floats");
+static bool floats_ok(const float* f, size_t count) {
+    const float lf = 1e15f;
+    uint32_t lim;
+    memcpy(&lim, &lf, sizeof lim);
+    size_t i = 0;
+#if AK_SIMD_SSE2
+    const __m128i mag = _mm_set1_epi32(0x7fffffff), vl = _mm_set1_epi32((int)lim);
+    __m128i bad = _mm_setzero_si128();
+    for (; i + 16 <= count; i += 16)
+        for (size_t k = 0; k < 16; k += 4) {
+            const __m128i w = _mm_loadu_si128((const __m128i*)(const void*)(f + i + k));
+            bad = _mm_or_si128(bad, _mm_cmpgt_epi32(_mm_and_si128(w, mag), vl));
+        }
+    if (_mm_movemask_epi8(bad)) return false;
+#endif
+    for (; i < count; ++i) {
+        uint32_t w;
+        memcpy(&w, f + i, sizeof w);
+        if ((w & 0x7fffffffu) > lim) return false;
+    }
+    return true;
+}
+
 static bool overlaps(const void* a, size_t an, const void* b, size_t bn) {
     const char *pa = (const char*)a, *pb = (const char*)b;
     if (!pa || !pb || an == 0 || bn == 0) return false;
@@ -137,8 +164,8 @@ ak_result akp_boids_validate_inputs(const ak_boids_step_job* job, bool need_wand
     if (job->species.ptr)
         for (size_t i = 0; i < n; ++i)
             if (job->species.ptr[i] >= p->species_count) return AK_ERR_BAD_INDEX;
-    for (size_t i = 0; i < n; ++i)
-        if (!vec_ok(job->positions.ptr[i]) || !vec_ok(job->velocities.ptr[i])) return AK_ERR_BAD_DATA;
+    if (!floats_ok(&job->positions.ptr[0].x, 3 * n) || !floats_ok(&job->velocities.ptr[0].x, 3 * n))
+        return AK_ERR_BAD_DATA;
     if (need_wander && job->wander.ptr)
         for (size_t i = 0; i < n; ++i)
             if (!vec_ok(job->wander.ptr[i])) return AK_ERR_BAD_DATA;

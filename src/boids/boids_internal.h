@@ -236,7 +236,7 @@ void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, a
  * akp_boids_sym_range(part, parts) on each thread finds every pair once and calls fn for
  * each agent whose sums are complete; after all of them returned, akp_boids_sym_finish
  * (part, parts) calls fn for the rest (the agents of each part's first z slab, which the part
- * before also credits). */
+ * before also credits), a 1/parts share of them each. */
 void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts);
 void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
 void akp_boids_sym_finish(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);

@@ -767,16 +767,37 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
 }
 
 void akp_boids_sym_finish(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user) {
-    const size_t z0 = slab_of(c, part, parts), z1 = slab_of(c, part + 1, parts);
-    if (z0 == 0 || z0 == z1) return;
+    /* The deferred agents (the first slabs of the parts after the first, in order, as in
+     * spill) split evenly over the parts. */
+    size_t total = 0, prev = 0;
+    for (size_t t = 1; t < parts; ++t) {
+        const size_t z = slab_of(c, t, parts);
+        if (z != prev && z < (size_t)c->dense_dim[2]) total += slab_start(c, z + 1) - slab_start(c, z);
+        prev = z;
+    }
+    const size_t mine0 = total * part / parts, mine1 = total * (part + 1) / parts;
     akp_boids_gather g;
-    const uint32_t b = slab_start(c, z0);
-    const akp_boids_acc* spill = c->use_spill ? c->spill + spill_base(c, parts, z0) : NULL;
-    for (uint32_t k = b; k < slab_start(c, z0 + 1); ++k) {
-        gather_begin_spatial(c, k, &g);
-        add_received(&c->acc[k], &g);
-        if (spill) add_received(&spill[k - b], &g);
-        fn(c, g.i, &g, user);
+    size_t base = 0;
+    prev = 0;
+    for (size_t t = 1; t < parts && base < mine1; ++t) {
+        const size_t z = slab_of(c, t, parts);
+        if (z == prev || z >= (size_t)c->dense_dim[2]) {
+            prev = z;
+            continue;
+        }
+        prev = z;
+        const uint32_t b = slab_start(c, z), e = slab_start(c, z + 1);
+        const akp_boids_acc* spill = c->use_spill ? c->spill + base : NULL;
+        /* This slab's deferred positions [base, base + e - b) against [mine0, mine1). */
+        const size_t from = mine0 > base ? mine0 - base : 0, to = mine1 - base < e - b ? mine1 - base : e - b;
+        for (size_t d = from; d < to; ++d) {
+            const uint32_t k = b + (uint32_t)d;
+            gather_begin_spatial(c, k, &g);
+            add_received(&c->acc[k], &g);
+            if (spill) add_received(&spill[d], &g);
+            fn(c, g.i, &g, user);
+        }
+        base += e - b;
     }
 }
 
@@ -841,24 +862,32 @@ size_t akp_boids_search_scratch_size(const ak_boids_step_job* job) {
            3 * align64(n * sizeof(float)) + align64(n * sizeof(ak_vec3)) + align64(n * sizeof(uint32_t)) + acc + 64;
 }
 
-/* The grid's cell coordinate (ak_grid_cell_of: floor(p / cell_size) in double, clamped). */
+/* The grid's cell coordinate (ak_grid_cell_of: floor(p / cell_size) in double, clamped to
+ * +-2^30), with the floor as a truncation and a step down (the same integer, no libm call). */
 static inline int32_t cell_axis(float p, double inv) {
-    double v = floor((double)p * inv);
-    if (!(v >= -1073741824.0)) v = -1073741824.0;
-    if (v > 1073741824.0) v = 1073741824.0;
-    return (int32_t)v;
+    const double v = (double)p * inv;
+    if (!(v >= -1073741824.0)) return -1073741824;
+    if (v > 1073741824.0) return 1073741824;
+    const int32_t t = (int32_t)v;
+    return (double)t > v ? t - 1 : t;
 }
 
-/* The spatial layout straight from the positions, without the hashed grid: the box of the
- * occupied cells, then a counting sort by box cell, stable (agents of a cell in increasing
- * index, the order the grid gives its cells). cells: [3n] temporary. False when the box does
- * not fit dense_cap (the caller builds the grid). */
-static bool dense_direct(akp_boids_ctx* c, int32_t* cells) {
-    const size_t n = c->n;
-    const ak_vec3* P = c->job->positions.ptr;
-    const double inv = 1.0 / (double)c->grid.cell_size;
+/* The cells of agents [n part / parts, n (part + 1) / parts) and their bounds. */
+typedef struct cells_task {
+    const akp_boids_ctx* c;
+    int32_t* cells;
+    size_t part, parts;
+    int32_t lo[3], hi[3];
+} cells_task;
+
+static void* cells_thread(void* arg) {
+    cells_task* t = (cells_task*)arg;
+    const ak_vec3* P = t->c->job->positions.ptr;
+    const double inv = 1.0 / (double)t->c->grid.cell_size;
+    const size_t b = t->c->n * t->part / t->parts, e = t->c->n * (t->part + 1) / t->parts;
     int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-    for (size_t i = 0; i < n; ++i) {
+    int32_t* cells = t->cells;
+    for (size_t i = b; i < e; ++i) {
         const int32_t q[3] = {cell_axis(P[i].x, inv), cell_axis(P[i].y, inv), cell_axis(P[i].z, inv)};
         for (int a = 0; a < 3; ++a) {
             cells[3 * i + (size_t)a] = q[a];
@@ -866,6 +895,30 @@ static bool dense_direct(akp_boids_ctx* c, int32_t* cells) {
             hi[a] = q[a] > hi[a] ? q[a] : hi[a];
         }
     }
+    memcpy(t->lo, lo, sizeof lo);
+    memcpy(t->hi, hi, sizeof hi);
+    return NULL;
+}
+
+/* The spatial layout straight from the positions, without the hashed grid: the box of the
+ * occupied cells (the cells found over threads for large steps), then a counting sort by box
+ * cell, stable (agents of a cell in increasing index, the order the grid gives its cells).
+ * cells: [3n] temporary. False when the box does not fit dense_cap (the caller builds the
+ * grid). */
+static bool dense_direct(akp_boids_ctx* c, int32_t* cells) {
+    const size_t n = c->n;
+    uint32_t parts = akp_boids_threads(c->job->thread_count, n);
+    if (n < 2048) parts = 1; /* as the fill below: smaller steps are not worth a thread */
+    cells_task tasks[64];
+    for (uint32_t t = 0; t < parts; ++t) tasks[t] = (cells_task){.c = c, .cells = cells, .part = t, .parts = parts};
+    if (parts == 1) cells_thread(&tasks[0]);
+    else akp_boids_run_tasks(cells_thread, tasks, sizeof tasks[0], parts);
+    int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+    for (uint32_t t = 0; t < parts; ++t)
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = tasks[t].lo[a] < lo[a] ? tasks[t].lo[a] : lo[a];
+            hi[a] = tasks[t].hi[a] > hi[a] ? tasks[t].hi[a] : hi[a];
+        }
     const int64_t dx = (int64_t)hi[0] - lo[0] + 1, dy = (int64_t)hi[1] - lo[1] + 1, dz = (int64_t)hi[2] - lo[2] + 1;
     const size_t cap = dense_cap(n);
     if (n == 0 || dx > (int64_t)cap || dy > (int64_t)cap || dz > (int64_t)cap || dx * dy > (int64_t)cap ||
