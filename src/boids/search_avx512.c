@@ -296,7 +296,7 @@ AKP_AVX512 static inline void credit_rows(akp_boids_acc* acc, __mmask16 mj, cons
     const __m512i zero = _mm512_setzero_si512(), one = _mm512_set1_epi64(1);
     const __m512i hi1 = _mm512_set1_epi64((int64_t)1 << 32);
     for (int h = 0; h < 2; ++h) {
-        unsigned m8 = (unsigned)(mj >> (8 * h)) & 0xFFu;
+        const unsigned m8 = (unsigned)(mj >> (8 * h)) & 0xFFu;
         if (!m8) continue;
         const __mmask8 s8 = (__mmask8)(bs >> (8 * h)), a8 = (__mmask8)(ba >> (8 * h)), c8 = (__mmask8)(bc >> (8 * h));
         __m512i r[8], q[4], rows[8], tail[4];
@@ -314,22 +314,16 @@ AKP_AVX512 static inline void credit_rows(akp_boids_acc* acc, __mmask16 mj, cons
         q[3] = zero;
         transpose8(r, rows);
         transpose4(q, tail);
-        int64_t buf[8][12];
-        for (int l = 0; l < 8; ++l) _mm512_storeu_si512((void*)buf[l], rows[l]);
-        for (int l = 0; l < 4; ++l) {
-            const int low = (l & 1) + 4 * (l >> 1); /* tail[l]: rows low | low + 2 */
-            _mm256_storeu_si256((__m256i*)(void*)(buf[low] + 8), _mm512_castsi512_si256(tail[l]));
-            _mm256_storeu_si256((__m256i*)(void*)(buf[low + 2] + 8), _mm512_extracti64x4_epi64(tail[l], 1));
-        }
-        while (m8) {
-            const unsigned l = (unsigned)__builtin_ctz(m8);
-            m8 &= m8 - 1u;
+        /* Lane by lane from the registers (unrolled: no spill of the rows to memory). */
+#pragma GCC unroll 8
+        for (int l = 0; l < 8; ++l) {
+            if (!((m8 >> l) & 1u)) continue;
             int64_t* A = (int64_t*)(void*)&acc[kt[8 * h + l]];
-            _mm512_storeu_si512((void*)A, _mm512_add_epi64(_mm512_loadu_si512((const void*)A),
-                                                           _mm512_loadu_si512((const void*)buf[l])));
+            const __m512i t4 = tail[(l & 1) + 2 * (l >> 2)];
+            const __m256i tl = (l & 2) ? _mm512_extracti64x4_epi64(t4, 1) : _mm512_castsi512_si256(t4);
+            _mm512_storeu_si512((void*)A, _mm512_add_epi64(_mm512_loadu_si512((const void*)A), rows[l]));
             _mm256_storeu_si256((__m256i*)(void*)(A + 8),
-                                _mm256_add_epi64(_mm256_loadu_si256((const __m256i*)(const void*)(A + 8)),
-                                                 _mm256_loadu_si256((const __m256i*)(const void*)(buf[l] + 8))));
+                                _mm256_add_epi64(_mm256_loadu_si256((const __m256i*)(const void*)(A + 8)), tl));
         }
     }
 }
