@@ -486,7 +486,7 @@ static bool integrate(const akp_boids_ctx* c, const akp_boids_gather* g, size_t 
 /* ---- threads ------------------------------------------------------------------------- */
 
 typedef struct step_task {
-    const akp_boids_ctx* c;
+    _Alignas(64) const akp_boids_ctx* c; /* one cache line per task: each thread counts in its own */
     size_t part, parts;
     uint64_t interactions;
     uint32_t contacts;
