@@ -83,6 +83,35 @@ static double len3(ak_vec3 a) { return sqrt((double)a.x * a.x + (double)a.y * a.
 
 /* ---- validity ---------------------------------------------------------------------------- */
 
+/* Every coordinate of every agent, in the vector part of the check and in its tail: NaN,
+ * infinities and magnitudes beyond 1e15 m are AK_ERR_BAD_DATA; +-1e15 itself is accepted. */
+AK_TEST(validate_every_coordinate) {
+    flock f = flock_make(41); /* 123 floats: 7 blocks of 16 and a tail of 11 */
+    flock_random(&f, 3, 1.0f, 1.0f, false);
+    ak_boids_species sp = {.separation_weight = 1};
+    ak_boids_params prm = {.species = &sp, .species_count = 1};
+    ak_boids_step_job j = job_for(&f, &prm, 0.1f);
+    AK_CHECK_EQ(ak_boids_step_validate(&j), AK_OK);
+    const float bad[5] = {NAN, INFINITY, -INFINITY, 1.0001e15f, -2e15f}, good[2] = {1e15f, -1e15f};
+    int wrong = 0;
+    for (int arr = 0; arr < 2; ++arr)
+        for (size_t k = 0; k < 3 * f.n; ++k) {
+            float* x = (float*)(void*)(arr ? f.v : f.p) + k;
+            const float keep = *x;
+            for (int b = 0; b < 5; ++b) {
+                *x = bad[b];
+                wrong += ak_boids_step_validate(&j) != AK_ERR_BAD_DATA;
+            }
+            for (int g = 0; g < 2; ++g) {
+                *x = good[g];
+                wrong += ak_boids_step_validate(&j) != AK_OK;
+            }
+            *x = keep;
+        }
+    AK_CHECK_EQ(wrong, 0);
+    flock_free(&f);
+}
+
 AK_TEST(validate_rules) {
     ak_boids_step_job zero = {0};
     AK_CHECK_EQ(ak_boids_step_validate(&zero), AK_ERR_NULL_ARG);
@@ -832,6 +861,7 @@ AK_TEST(order_and_min_distance) {
 
 int main(void) {
     AK_RUN(validate_rules);
+    AK_RUN(validate_every_coordinate);
     AK_RUN(neighbors_random_flocks);
     AK_RUN(neighbors_cell_boundaries_and_far_agents);
     AK_RUN(rule_separation_two_agents);
