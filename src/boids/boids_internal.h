@@ -185,9 +185,17 @@ typedef struct akp_boids_batch {
 uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b);
 
 /* search_avx2.c (x86-64 GCC/Clang without AK_NO_SIMD; elsewhere have_avx2 is false): the
- * symmetric pair kernel for CPUs with AVX2 but not AVX-512, over the SSE2 filter's hits (k and
- * d2); same tests and integer sums as the scalar sym_hits in search.c. */
+ * symmetric pair kernel for CPUs with AVX2 but not AVX-512, over hits with their offsets (the
+ * AVX2 or SSE2 filter's); same tests and integer sums as the scalar sym_hits in search.c. */
 bool akp_boids_have_avx2(void);
+/* The AVX2 distance filters, as their AVX-512 namesakes (hits with k, d2 and the offsets; h
+ * needs room for 8 more than the hits). */
+uint32_t akp_boids_filter_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                    const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
+                                    uint32_t at);
+uint32_t akp_boids_filter_packed_avx2(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end,
+                                      const akp_boids_packed* b, uint32_t count, ak_vec3 p, float q2,
+                                      akp_boids_hits* h, uint32_t at);
 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
                         const akp_boids_sink* sink);
 

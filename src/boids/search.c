@@ -595,8 +595,8 @@ static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boid
     g->nflock += nf;
 }
 
-/* The distance filter of the scalar/SSE2 path: appends the t in [begin, end) with d2 < q2 (k
- * and d2 only) to h at `at`; returns how many (h needs room for end - begin more). */
+/* The distance filter of the scalar/SSE2 path: appends the t in [begin, end) with d2 < q2 (k,
+ * d2 and the offsets) to h at `at`; returns how many (h needs room for end - begin more). */
 static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, const float* restrict Z,
                             uint32_t begin, uint32_t end, ak_vec3 p, float q2, akp_boids_hits* hb, uint32_t at) {
     uint32_t h = at, t = begin;
@@ -608,11 +608,17 @@ static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, co
         const __m128 dd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
         const unsigned m = (unsigned)_mm_movemask_ps(_mm_cmplt_ps(dd, vq));
         if (!m) continue;
-        float d4[4];
+        float d4[4], x4[4], y4[4], z4[4];
         _mm_storeu_ps(d4, dd);
+        _mm_storeu_ps(x4, dx);
+        _mm_storeu_ps(y4, dy);
+        _mm_storeu_ps(z4, dz);
         for (unsigned l = 0; l < 4; ++l) {
             hb->k[h] = t + l;
             hb->d2[h] = d4[l];
+            hb->dx[h] = x4[l];
+            hb->dy[h] = y4[l];
+            hb->dz[h] = z4[l];
             h += (m >> l) & 1u;
         }
     }
@@ -622,9 +628,28 @@ static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, co
         const float dd = dx * dx + dy * dy + dz * dz;
         hb->k[h] = t;
         hb->d2[h] = dd;
+        hb->dx[h] = dx;
+        hb->dy[h] = dy;
+        hb->dz[h] = dz;
         h += dd < q2;
     }
     return h - at;
+}
+
+/* akp_boids_pack_rows_avx512 in plain C, for the AVX2 filter (8 zeroed entries after count). */
+static uint32_t pack_rows(const float* X, const float* Y, const float* Z, const uint32_t* begin, const uint32_t* end,
+                          uint32_t rows, akp_boids_packed* b) {
+    uint32_t n = 0;
+    for (uint32_t r = 0; r < rows; ++r) {
+        const uint32_t len = end[r] - begin[r];
+        memcpy(b->x + n, X + begin[r], len * sizeof(float));
+        memcpy(b->y + n, Y + begin[r], len * sizeof(float));
+        memcpy(b->z + n, Z + begin[r], len * sizeof(float));
+        for (uint32_t u = 0; u < len; ++u) b->k[n + u] = begin[r] + u;
+        n += len;
+    }
+    for (uint32_t u = n; u < n + 8; ++u) b->x[u] = b->y[u] = b->z[u] = 0.0f, b->k[u] = 0;
+    return n;
 }
 
 /* First slab of part `part` of `parts` (the slabs of part p: [slab_of(p), slab_of(p + 1))). */
@@ -724,20 +749,25 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
                 /* Several agents share the cell's candidates: pack them once (all but the
                  * cell's own, which each agent takes from k + 1). */
                 uint32_t packed = 0;
-                const bool pack = c->avx512 && k1 - k0 > 1 && span + 32 <= HIT_CAP &&
+                const bool pack = (c->avx512 || c->avx2) && k1 - k0 > 1 && span + 32 <= HIT_CAP &&
                                   span - (k1 - k0 - 1) <= AKP_BOIDS_PACK_CAP;
                 if (pack) {
                     rb[0] = k1;
-                    packed = akp_boids_pack_rows_avx512(X, Y, Z, rb, re, nr, pk);
+                    packed = c->avx512 ? akp_boids_pack_rows_avx512(X, Y, Z, rb, re, nr, pk)
+                                       : pack_rows(X, Y, Z, rb, re, nr, pk);
                 }
                 for (uint32_t k = k0; k < k1; ++k) {
                     gather_begin_spatial(c, k, &g);
                     rb[0] = k + 1;
                     uint32_t h = 0;
-                    if (pack)
+                    if (pack && c->avx512)
                         h = akp_boids_filter_packed_avx512(X, Y, Z, k + 1, k1, pk, packed, g.p, q2, &hb, 0);
+                    else if (pack)
+                        h = akp_boids_filter_packed_avx2(X, Y, Z, k + 1, k1, pk, packed, g.p, q2, &hb, 0);
                     else if (c->avx512 && span + 16 <= HIT_CAP) /* all rows in one call */
                         h = akp_boids_filter_rows_avx512(X, Y, Z, rb, re, nr, g.p, q2, &hb, 0);
+                    else if (c->avx2 && span + 16 <= HIT_CAP)
+                        h = akp_boids_filter_rows_avx2(X, Y, Z, rb, re, nr, g.p, q2, &hb, 0);
                     else
                         for (uint32_t a = 0; a < nr; ++a)
                             for (uint32_t t = rb[a]; t < re[a]; t += HIT_PIECE) {

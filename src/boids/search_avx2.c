@@ -1,6 +1,7 @@
-/* AVX2 symmetric pair kernel of the boids grid path, for CPUs without AVX-512 (8 hits at a
- * time; the distance filter before it is the SSE2 one, which keeps index and d2 only, so
- * positions and partner velocities come by gathers). Every float operation is the scalar
+/* AVX2 kernels of the boids grid path, for CPUs without AVX-512: the distance filter (8
+ * candidates at a time, the hits left-packed 4 lanes at a time through a 16-entry table, no
+ * branch on the hit masks) and
+ * the symmetric pair kernel (8 hits at a time; partner velocities come by gathers). Every float operation is the scalar
  * sym_hits's in search.c, in the same order, each rounded (intrinsics only, no FMA), and
  * fix() is rebuilt exactly: clamp, widen to double (exact), truncate, then the 1.5 * 2^52
  * bias turns the integer (|x| <= 2^34) into int64 bits. The partners' credits go lane by
@@ -61,13 +62,81 @@ AKP_AVX2 static inline int64_t hsum(__m256i v) {
     return t[0] + t[1] + t[2] + t[3];
 }
 
+/* The set lanes of a 4-bit mask, in order (the rest 0): vpermilps controls that left-pack. */
+static const int32_t left_pack4[16][4] = {
+    {0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0}, {1, 2, 0, 0}, {0, 1, 2, 0},
+    {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0}, {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+
+/* Candidates t0 + [0, 8) at x, y, z (lanes at and past `live` ignored): those with d2 < q2
+ * appended to h at n (k, d2 and the offsets, 4 entries stored per half, so h needs room for
+ * 8 more); returns the new n. The same float operations as filter_sse2 and the scalar test. */
+AKP_AVX2 static inline uint32_t filter8(__m256 x, __m256 y, __m256 z, __m256i k, unsigned live, __m256 px, __m256 py,
+                                        __m256 pz, __m256 vq, akp_boids_hits* h, uint32_t n) {
+    const __m256 dx = _mm256_sub_ps(x, px), dy = _mm256_sub_ps(y, py), dz = _mm256_sub_ps(z, pz);
+    const __m256 dd = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+    const unsigned m = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(dd, vq, _CMP_LT_OQ)) & live;
+    const __m256 kf = _mm256_castsi256_ps(k);
+    /* No branch on the masks (whether 4 candidates hit is a coin toss): an empty half stores 4
+     * entries that the next store overwrites. */
+    for (int half = 0; half < 2; ++half) {
+        const unsigned m4 = (m >> (4 * half)) & 15u;
+        const __m128i ctl = _mm_loadu_si128((const __m128i*)(const void*)left_pack4[m4]);
+#define AKP_PACK4(v, dst)                                                                                       \
+    _mm_storeu_ps((dst) + n, _mm_permutevar_ps(half ? _mm256_extractf128_ps(v, 1) : _mm256_castps256_ps128(v), ctl))
+        AKP_PACK4(dd, h->d2);
+        AKP_PACK4(dx, h->dx);
+        AKP_PACK4(dy, h->dy);
+        AKP_PACK4(dz, h->dz);
+        AKP_PACK4(kf, (float*)(void*)h->k);
+#undef AKP_PACK4
+        n += (uint32_t)__builtin_popcount(m4);
+    }
+    return n;
+}
+
+/* filter8 over the row [begin, end) of the spatial arrays (the tail through masked loads). */
+AKP_AVX2 static inline uint32_t filter_row8(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end,
+                                            __m256 px, __m256 py, __m256 pz, __m256 vq, akp_boids_hits* h, uint32_t n) {
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    uint32_t t = begin;
+    for (; t + 8 <= end; t += 8)
+        n = filter8(_mm256_loadu_ps(X + t), _mm256_loadu_ps(Y + t), _mm256_loadu_ps(Z + t),
+                    _mm256_add_epi32(_mm256_set1_epi32((int)t), lane), 0xFFu, px, py, pz, vq, h, n);
+    if (t < end) {
+        const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)(end - t)), lane);
+        n = filter8(_mm256_maskload_ps(X + t, live), _mm256_maskload_ps(Y + t, live), _mm256_maskload_ps(Z + t, live),
+                    _mm256_add_epi32(_mm256_set1_epi32((int)t), lane), (1u << (end - t)) - 1u, px, py, pz, vq, h, n);
+    }
+    return n;
+}
+
+AKP_AVX2 uint32_t akp_boids_filter_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                             const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
+                                             uint32_t at) {
+    const __m256 px = _mm256_set1_ps(p.x), py = _mm256_set1_ps(p.y), pz = _mm256_set1_ps(p.z), vq = _mm256_set1_ps(q2);
+    uint32_t n = at;
+    for (uint32_t r = 0; r < rows; ++r) n = filter_row8(X, Y, Z, begin[r], end[r], px, py, pz, vq, h, n);
+    return n - at;
+}
+
+AKP_AVX2 uint32_t akp_boids_filter_packed_avx2(const float* X, const float* Y, const float* Z, uint32_t begin,
+                                               uint32_t end, const akp_boids_packed* b, uint32_t count, ak_vec3 p,
+                                               float q2, akp_boids_hits* h, uint32_t at) {
+    const __m256 px = _mm256_set1_ps(p.x), py = _mm256_set1_ps(p.y), pz = _mm256_set1_ps(p.z), vq = _mm256_set1_ps(q2);
+    uint32_t n = filter_row8(X, Y, Z, begin, end, px, py, pz, vq, h, at);
+    for (uint32_t u = 0; u < count; u += 8) /* (the packed arrays have 16 entries of slack) */
+        n = filter8(_mm256_loadu_ps(b->x + u), _mm256_loadu_ps(b->y + u), _mm256_loadu_ps(b->z + u),
+                    _mm256_loadu_si256((const __m256i*)(const void*)(b->k + u)),
+                    count - u >= 8 ? 0xFFu : (1u << (count - u)) - 1u, px, py, pz, vq, h, n);
+    return n - at;
+}
+
 AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h,
                                  uint32_t count, const akp_boids_sink* sink) {
     const akp_boids_sp* S = g->sp;
     const __m256 rn2 = _mm256_set1_ps(S->rn2), rs2 = _mm256_set1_ps(S->rs2), ra2 = _mm256_set1_ps(S->ra2),
                  rc2 = _mm256_set1_ps(S->rc2), dmin2 = _mm256_set1_ps(S->dmin2), sep = _mm256_set1_ps(S->sep_scale),
                  coh = _mm256_set1_ps(S->coh_scale), sign = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps();
-    const __m256 px = _mm256_set1_ps(g->p.x), py = _mm256_set1_ps(g->p.y), pz = _mm256_set1_ps(g->p.z);
     const __m256 vx = _mm256_set1_ps(g->v.x), vy = _mm256_set1_ps(g->v.y), vz = _mm256_set1_ps(g->v.z);
     const __m256 v2 = _mm256_set1_ps(g->v2);
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -85,10 +154,10 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
         const __m256 m = _mm256_and_ps(_mm256_castsi256_ps(live), _mm256_cmp_ps(dd, rn2, _CMP_LT_OQ));
         if (!_mm256_movemask_ps(m)) continue;
         const __m256i kk = _mm256_maskload_epi32((const int*)(const void*)(h->k + u), live);
-        /* dx = X[t] - px, as sym_hits */
-        const __m256 dx = _mm256_sub_ps(_mm256_mask_i32gather_ps(zero, c->sx, kk, m, 4), px);
-        const __m256 dy = _mm256_sub_ps(_mm256_mask_i32gather_ps(zero, c->sy, kk, m, 4), py);
-        const __m256 dz = _mm256_sub_ps(_mm256_mask_i32gather_ps(zero, c->sz, kk, m, 4), pz);
+        /* dx = X[t] - px, as sym_hits: the filter's offsets */
+        const __m256 dx = _mm256_maskload_ps(h->dx + u, live);
+        const __m256 dy = _mm256_maskload_ps(h->dy + u, live);
+        const __m256 dz = _mm256_maskload_ps(h->dz + u, live);
         __m256 mi = m, mj = m;
         if (cone) {
             mi = _mm256_and_ps(mi, cone8(S, dx, dy, dz, dd, vx, vy, vz, v2));
@@ -178,6 +247,20 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
 
 #else
 bool akp_boids_have_avx2(void) { return false; }
+
+uint32_t akp_boids_filter_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                    const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
+                                    uint32_t at) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)rows, (void)p, (void)q2, (void)h, (void)at;
+    return 0;
+}
+
+uint32_t akp_boids_filter_packed_avx2(const float* X, const float* Y, const float* Z, uint32_t begin, uint32_t end,
+                                      const akp_boids_packed* b, uint32_t count, ak_vec3 p, float q2,
+                                      akp_boids_hits* h, uint32_t at) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)b, (void)count, (void)p, (void)q2, (void)h, (void)at;
+    return 0;
+}
 
 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
                         const akp_boids_sink* sink) {
