@@ -76,9 +76,10 @@ static bool vec_ok(ak_vec3 v) {
     return ak_vec3_is_finite(v) && fabsf(v.x) <= 1e15f && fabsf(v.y) <= 1e15f && fabsf(v.z) <= 1e15f;
 }
 
+_Static_assert(sizeof(ak_vec3) == 3 * sizeof(float), "ak_vec3 is three packed floats");
+
 /* vec_ok over count floats (a span of ak_vec3 as 3 count floats): |x| <= 1e15 on the bits,
  * which also rejects NaN and infinities (their magnitude bits are larger). */
-_Static_assert(sizeof(ak_vec3) == 3 * sizeof(float), "ak_vec3 is three packed floats");
 static bool floats_ok(const float* f, size_t count) {
     const float lf = 1e15f;
     uint32_t lim;
@@ -164,7 +165,8 @@ ak_result akp_boids_validate_inputs(const ak_boids_step_job* job, bool need_wand
     if (job->species.ptr)
         for (size_t i = 0; i < n; ++i)
             if (job->species.ptr[i] >= p->species_count) return AK_ERR_BAD_INDEX;
-    if (!floats_ok(&job->positions.ptr[0].x, 3 * n) || !floats_ok(&job->velocities.ptr[0].x, 3 * n))
+    if (!floats_ok((const float*)(const void*)job->positions.ptr, 3 * n) ||
+        !floats_ok((const float*)(const void*)job->velocities.ptr, 3 * n))
         return AK_ERR_BAD_DATA;
     if (need_wander && job->wander.ptr)
         for (size_t i = 0; i < n; ++i)

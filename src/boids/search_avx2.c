@@ -1,12 +1,12 @@
 /* AVX2 kernels of the boids grid path, for CPUs without AVX-512: the distance filter (8
  * candidates at a time, the hits left-packed 4 lanes at a time through a 16-entry table, no
- * branch on the hit masks) and
- * the symmetric pair kernel (8 hits at a time; partner velocities come by gathers). Every float operation is the scalar
- * sym_hits's in search.c, in the same order, each rounded (intrinsics only, no FMA), and
- * fix() is rebuilt exactly: clamp, widen to double (exact), truncate, then the 1.5 * 2^52
- * bias turns the integer (|x| <= 2^34) into int64 bits. The partners' credits go lane by
- * lane through akp_boids_credit. So the sums are bit-identical to the scalar and naive
- * paths (tested with job.skip_avx512 on CPUs that have both).
+ * branch on the hit masks) and the symmetric pair kernel (8 hits at a time; partner velocities
+ * come by gathers in the cone case). Every float operation is the scalar sym_hits's in
+ * search.c, in the same order, each rounded (intrinsics only, no FMA), and fix() is rebuilt
+ * exactly: clamp, widen to double (exact), truncate, then the 1.5 * 2^52 bias turns the
+ * integer (|x| <= 2^34) into int64 bits. The partners' credits go lane by lane through
+ * akp_boids_credit. So the sums are bit-identical to the scalar and naive paths (tested with
+ * job.skip_avx512 on CPUs that have both).
  *
  * Compiled only for GCC/Clang on x86-64 without AK_NO_SIMD; selected at run time with
  * __builtin_cpu_supports. */
