@@ -131,6 +131,50 @@ AKP_AVX2 uint32_t akp_boids_filter_packed_avx2(const float* X, const float* Y, c
     return n - at;
 }
 
+/* 4x4 transpose of int64 lanes: out[l] is lane l of r[0..3]. */
+AKP_AVX2 static inline void transpose4x4(const __m256i r[4], __m256i out[4]) {
+    const __m256i a0 = _mm256_unpacklo_epi64(r[0], r[1]), a1 = _mm256_unpackhi_epi64(r[0], r[1]);
+    const __m256i a2 = _mm256_unpacklo_epi64(r[2], r[3]), a3 = _mm256_unpackhi_epi64(r[2], r[3]);
+    out[0] = _mm256_permute2x128_si256(a0, a2, 0x20);
+    out[1] = _mm256_permute2x128_si256(a1, a3, 0x20);
+    out[2] = _mm256_permute2x128_si256(a0, a2, 0x31);
+    out[3] = _mm256_permute2x128_si256(a1, a3, 0x31);
+}
+
+/* The partners' credits of the lanes of bj, none of them at a thread boundary: acc[t] += the
+ * pair's row (-e, q_i where aligning, -f, the counts) as three 4-lane vectors, the same integer
+ * additions as akp_boids_credit. e, f: fix() of the terms, zero where the rule is off, [axis]
+ * [quad]; ws, wa, wc: the rule masks as 64-bit lanes [quad]. */
+AKP_AVX2 static inline void credit_rows4(akp_boids_acc* acc, unsigned bj, const uint32_t* kt, __m256i e[3][2],
+                                         __m256i f[3][2], const __m256i ws[2], const __m256i wa[2],
+                                         const __m256i wc[2], const int64_t* qi) {
+    const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi64x(1), hi1 = _mm256_set1_epi64x((int64_t)1 << 32);
+    for (int q = 0; q < 2; ++q) {
+        const unsigned m4 = (bj >> (4 * q)) & 15u;
+        if (!m4) continue;
+        __m256i r[12], rows[12];
+        for (int a = 0; a < 3; ++a) {
+            r[a] = _mm256_sub_epi64(zero, e[a][q]);
+            r[3 + a] = _mm256_and_si256(_mm256_set1_epi64x(qi[a]), wa[q]);
+            r[6 + a] = _mm256_sub_epi64(zero, f[a][q]);
+        }
+        r[9] = _mm256_or_si256(_mm256_and_si256(ws[q], one), _mm256_and_si256(wa[q], hi1)); /* n01 */
+        r[10] = _mm256_or_si256(_mm256_and_si256(wc[q], one), hi1);                          /* n23 */
+        r[11] = zero;
+        transpose4x4(r, rows);
+        transpose4x4(r + 4, rows + 4);
+        transpose4x4(r + 8, rows + 8);
+        /* Lane by lane from the registers (unrolled: no spill of the rows to memory). */
+#pragma GCC unroll 4
+        for (int l = 0; l < 4; ++l) {
+            if (!((m4 >> l) & 1u)) continue;
+            __m256i* A = (__m256i*)(void*)&acc[kt[4 * q + l]];
+            for (int v = 0; v < 3; ++v)
+                _mm256_storeu_si256(A + v, _mm256_add_epi64(_mm256_loadu_si256(A + v), rows[4 * v + l]));
+        }
+    }
+}
+
 AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h,
                                  uint32_t count, const akp_boids_sink* sink) {
     const akp_boids_sp* S = g->sp;
@@ -211,7 +255,17 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
                 al[2] += q[2];
             }
         }
-        if (bj) {
+        /* Partners at a thread boundary (spill or atomic adds) take the lane-by-lane path. */
+        const __m256i kb = _mm256_xor_si256(kk, _mm256_set1_epi32(INT32_MIN)); /* unsigned compares */
+        const unsigned edge =
+            bj & (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(
+                     _mm256_cmpgt_epi32(_mm256_set1_epi32((int)(sink->atomic_end ^ 0x80000000u)), kb),
+                     _mm256_cmpgt_epi32(kb, _mm256_set1_epi32((int)((sink->far_begin - 1u) ^ 0x80000000u))))));
+        if (bj && !edge && sink->far_begin > 0) {
+            __m256i wa[2];
+            widen(ba, wa);
+            credit_rows4(sink->acc, bj, kt, e, f, ws, wa, wc, qi);
+        } else if (bj) {
             int64_t es[3][8], fs[3][8];
             for (int a = 0; a < 3; ++a) {
                 _mm256_storeu_si256((__m256i*)(void*)es[a], e[a][0]);
