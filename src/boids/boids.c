@@ -504,11 +504,11 @@ static void step_agent(const akp_boids_ctx* c, size_t i, const akp_boids_gather*
     c->job->out_velocities.ptr[i] = nv;
 }
 
-/* Whether the step integrates 8 agents at a time (akp_boids_integrate_avx512): the common
+/* Whether the step integrates 8 agents at a time (akp_boids_integrate_avx512 / _avx2): the common
  * case only, where integrate() reduces to the three flock rules, the limits and wrapping. */
 static bool batch_ok(const akp_boids_ctx* c) {
     const ak_boids_params* prm = c->params;
-    if (!c->sym || !c->avx512 || prm->planar || prm->obstacle_count > 0 || c->bounds == AK_BOIDS_BOUNDS_STEER)
+    if (!c->sym || !(c->avx512 || c->avx2) || prm->planar || prm->obstacle_count > 0 || c->bounds == AK_BOIDS_BOUNDS_STEER)
         return false;
     const ak_boids_species* s = &c->sp[0].s;
     return !(s->goal_weight > 0.0f) && !(s->leader_weight > 0.0f && prm->has_leader) &&
@@ -525,7 +525,8 @@ static void batch_flush(const akp_boids_ctx* c, step_task* t) {
         b->ns[l] = b->na[l] = b->nc[l] = 0;
         for (int a = 0; a < 3; ++a) b->p[a][l] = b->v[a][l] = 0.0f;
     }
-    for (uint32_t redo = akp_boids_integrate_avx512(c, &c->sp[0], b); redo; redo &= redo - 1u) {
+    uint32_t redo = c->avx512 ? akp_boids_integrate_avx512(c, &c->sp[0], b) : akp_boids_integrate_avx2(c, &c->sp[0], b);
+    for (; redo; redo &= redo - 1u) {
         const unsigned l = (unsigned)__builtin_ctz(redo);
         akp_boids_gather g;
         g.sp = &c->sp[0];

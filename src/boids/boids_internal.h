@@ -183,6 +183,8 @@ typedef struct akp_boids_batch {
     float p[3][AKP_BOIDS_BATCH], v[3][AKP_BOIDS_BATCH];
 } akp_boids_batch;
 uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b);
+/* The same with AVX2 (int64 -> double in two exact halves), for CPUs without AVX-512. */
+uint32_t akp_boids_integrate_avx2(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b);
 
 /* search_avx2.c (x86-64 GCC/Clang without AK_NO_SIMD; elsewhere have_avx2 is false): the
  * symmetric pair kernel for CPUs with AVX2 but not AVX-512, over hits with their offsets (the

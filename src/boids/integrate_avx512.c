@@ -14,51 +14,57 @@
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
 #include <immintrin.h>
 
+
+#define AKP_AVX __attribute__((target("avx")))
+#define AKP_AVX2 __attribute__((target("avx2")))
 #define AKP_AVX512 __attribute__((target("avx512f,avx512dq")))
 
-/* (float)((double)q / div) on 8 lanes. */
-AKP_AVX512 static inline __m256 dequant8(const int64_t* q, __m512d div) {
-    return _mm512_cvtpd_ps(_mm512_div_pd(_mm512_cvtepi64_pd(_mm512_loadu_si512((const void*)q)), div));
-}
-
 /* a where keep lanes are all ones, else b. */
-AKP_AVX512 static inline __m256 pick(__m256 keep, __m256 a, __m256 b) { return _mm256_blendv_ps(b, a, keep); }
+AKP_AVX static inline __m256 pick(__m256 keep, __m256 a, __m256 b) { return _mm256_blendv_ps(b, a, keep); }
 
-AKP_AVX512 uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b) {
+/* The rest of integrate() on 8 lanes, from the dequantised sums d (sep x y z, ali x y z, coh
+ * x y z: (float)((double)q / div), the alignment and cohesion ones divided by the count too,
+ * each used only where its count is not zero). Shared by the AVX-512 and AVX2 entries, which
+ * differ only in how they dequantise. */
+AKP_AVX static inline __attribute__((always_inline)) uint32_t integrate8(const akp_boids_ctx* c, const akp_boids_sp* S,
+                                                                       const akp_boids_batch* b, const __m256 d[9]) {
     const ak_boids_step_job* job = c->job;
     const ak_boids_species* s = &S->s;
     const uint32_t live = (1u << b->n) - 1u;
-    const __m256i zi = _mm256_setzero_si256();
     const __m256 zero = _mm256_setzero_ps();
     const __m256 px = _mm256_loadu_ps(b->p[0]), py = _mm256_loadu_ps(b->p[1]), pz = _mm256_loadu_ps(b->p[2]);
     const __m256 vx = _mm256_loadu_ps(b->v[0]), vy = _mm256_loadu_ps(b->v[1]), vz = _mm256_loadu_ps(b->v[2]);
-    const __m256i ns = _mm256_loadu_si256((const __m256i*)(const void*)b->ns);
-    const __m256i na = _mm256_loadu_si256((const __m256i*)(const void*)b->na);
-    const __m256i nc = _mm256_loadu_si256((const __m256i*)(const void*)b->nc);
+    /* count != 0, as float lane masks (the counts are below 2^31: they fit the signed compare) */
+    const __m256i zi = _mm256_setzero_si256();
+    const __m256i ones = _mm256_set1_epi32(-1);
+    __m256 on[3];
+    const uint32_t* cnt[3] = {b->ns, b->na, b->nc};
+    for (int r = 0; r < 3; ++r) {
+        const __m128i lo = _mm_loadu_si128((const __m128i*)(const void*)cnt[r]);
+        const __m128i hi = _mm_loadu_si128((const __m128i*)(const void*)(cnt[r] + 4));
+        const __m128i zl = _mm_cmpeq_epi32(lo, _mm_setzero_si128()), zh = _mm_cmpeq_epi32(hi, _mm_setzero_si128());
+        on[r] = _mm256_xor_ps(_mm256_castsi256_ps(_mm256_insertf128_si256(_mm256_castsi128_si256(zl), zh, 1)),
+                              _mm256_castsi256_ps(ones));
+    }
+    (void)zi;
     __m256 fx = zero, fy = zero, fz = zero;
     {   /* if (ns) f += dequant(sep, sep_scale) * separation_weight */
-        const __m512d div = _mm512_set1_pd((double)S->sep_scale);
         const __m256 w = _mm256_set1_ps(s->separation_weight);
-        const __m256 on = _mm256_xor_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(ns, zi)), _mm256_castsi256_ps(_mm256_set1_epi32(-1)));
-        fx = pick(on, _mm256_add_ps(fx, _mm256_mul_ps(dequant8(b->q[0], div), w)), fx);
-        fy = pick(on, _mm256_add_ps(fy, _mm256_mul_ps(dequant8(b->q[1], div), w)), fy);
-        fz = pick(on, _mm256_add_ps(fz, _mm256_mul_ps(dequant8(b->q[2], div), w)), fz);
+        fx = pick(on[0], _mm256_add_ps(fx, _mm256_mul_ps(d[0], w)), fx);
+        fy = pick(on[0], _mm256_add_ps(fy, _mm256_mul_ps(d[1], w)), fy);
+        fz = pick(on[0], _mm256_add_ps(fz, _mm256_mul_ps(d[2], w)), fz);
     }
     {   /* if (na) f += (dequant(ali, ali_scale * na) - v) * alignment_weight */
-        const __m512d div = _mm512_mul_pd(_mm512_set1_pd((double)S->ali_scale), _mm512_cvtepu32_pd(na));
         const __m256 w = _mm256_set1_ps(s->alignment_weight);
-        const __m256 on = _mm256_xor_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(na, zi)), _mm256_castsi256_ps(_mm256_set1_epi32(-1)));
-        fx = pick(on, _mm256_add_ps(fx, _mm256_mul_ps(_mm256_sub_ps(dequant8(b->q[3], div), vx), w)), fx);
-        fy = pick(on, _mm256_add_ps(fy, _mm256_mul_ps(_mm256_sub_ps(dequant8(b->q[4], div), vy), w)), fy);
-        fz = pick(on, _mm256_add_ps(fz, _mm256_mul_ps(_mm256_sub_ps(dequant8(b->q[5], div), vz), w)), fz);
+        fx = pick(on[1], _mm256_add_ps(fx, _mm256_mul_ps(_mm256_sub_ps(d[3], vx), w)), fx);
+        fy = pick(on[1], _mm256_add_ps(fy, _mm256_mul_ps(_mm256_sub_ps(d[4], vy), w)), fy);
+        fz = pick(on[1], _mm256_add_ps(fz, _mm256_mul_ps(_mm256_sub_ps(d[5], vz), w)), fz);
     }
     {   /* if (nc) f += dequant(coh, coh_scale * nc) * cohesion_weight */
-        const __m512d div = _mm512_mul_pd(_mm512_set1_pd((double)S->coh_scale), _mm512_cvtepu32_pd(nc));
         const __m256 w = _mm256_set1_ps(s->cohesion_weight);
-        const __m256 on = _mm256_xor_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(nc, zi)), _mm256_castsi256_ps(_mm256_set1_epi32(-1)));
-        fx = pick(on, _mm256_add_ps(fx, _mm256_mul_ps(dequant8(b->q[6], div), w)), fx);
-        fy = pick(on, _mm256_add_ps(fy, _mm256_mul_ps(dequant8(b->q[7], div), w)), fy);
-        fz = pick(on, _mm256_add_ps(fz, _mm256_mul_ps(dequant8(b->q[8], div), w)), fz);
+        fx = pick(on[2], _mm256_add_ps(fx, _mm256_mul_ps(d[6], w)), fx);
+        fy = pick(on[2], _mm256_add_ps(fy, _mm256_mul_ps(d[7], w)), fy);
+        fz = pick(on[2], _mm256_add_ps(fz, _mm256_mul_ps(d[8], w)), fz);
     }
     {   /* fl = |f|; if (fl > max_force) f *= max_force / fl */
         const __m256 fl = _mm256_sqrt_ps(
@@ -120,8 +126,73 @@ AKP_AVX512 uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp
     return redo;
 }
 
+
+/* (float)((double)q / div) on 8 lanes. */
+AKP_AVX512 static inline __m256 dequant8(const int64_t* q, __m512d div) {
+    return _mm512_cvtpd_ps(_mm512_div_pd(_mm512_cvtepi64_pd(_mm512_loadu_si512((const void*)q)), div));
+}
+
+AKP_AVX512 uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b) {
+    const __m512d dsep = _mm512_set1_pd((double)S->sep_scale);
+    const __m512d dali = _mm512_mul_pd(_mm512_set1_pd((double)S->ali_scale),
+                                       _mm512_cvtepu32_pd(_mm256_loadu_si256((const __m256i*)(const void*)b->na)));
+    const __m512d dcoh = _mm512_mul_pd(_mm512_set1_pd((double)S->coh_scale),
+                                       _mm512_cvtepu32_pd(_mm256_loadu_si256((const __m256i*)(const void*)b->nc)));
+    __m256 d[9];
+    for (int a = 0; a < 3; ++a) {
+        d[a] = dequant8(b->q[a], dsep);
+        d[3 + a] = dequant8(b->q[3 + a], dali);
+        d[6 + a] = dequant8(b->q[6 + a], dcoh);
+    }
+    return integrate8(c, S, b, d);
+}
+
+/* (double) of 4 int64 lanes, rounded once like the C cast: the high half (exact, times 2^32)
+ * plus the low half (exact, unsigned). */
+AKP_AVX2 static inline __m256d i64_to_pd4(__m256i v) {
+    const __m256i s = _mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
+    const __m256d hi = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(s, 1)), _mm256_set1_pd(4294967296.0));
+    const __m256d lo = _mm256_add_pd(_mm256_cvtepi32_pd(_mm_xor_si128(_mm256_castsi256_si128(s), _mm_set1_epi32(INT32_MIN))),
+                                     _mm256_set1_pd(2147483648.0));
+    return _mm256_add_pd(hi, lo);
+}
+
+/* (double) of 4 uint32 lanes (exact). */
+AKP_AVX2 static inline __m256d u32_to_pd4(__m128i v) {
+    return _mm256_add_pd(_mm256_cvtepi32_pd(_mm_xor_si128(v, _mm_set1_epi32(INT32_MIN))), _mm256_set1_pd(2147483648.0));
+}
+
+/* (float)((double)q / div) on 8 lanes, 4 at a time. */
+AKP_AVX2 static inline __m256 dequant8_avx2(const int64_t* q, __m256d div_lo, __m256d div_hi) {
+    const __m128 lo = _mm256_cvtpd_ps(_mm256_div_pd(i64_to_pd4(_mm256_loadu_si256((const __m256i*)(const void*)q)), div_lo));
+    const __m128 hi =
+        _mm256_cvtpd_ps(_mm256_div_pd(i64_to_pd4(_mm256_loadu_si256((const __m256i*)(const void*)(q + 4))), div_hi));
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1);
+}
+
+AKP_AVX2 uint32_t akp_boids_integrate_avx2(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b) {
+    const __m256d dsep = _mm256_set1_pd((double)S->sep_scale);
+    const __m256d as = _mm256_set1_pd((double)S->ali_scale), cs = _mm256_set1_pd((double)S->coh_scale);
+    const __m256d dali_lo = _mm256_mul_pd(as, u32_to_pd4(_mm_loadu_si128((const __m128i*)(const void*)b->na)));
+    const __m256d dali_hi = _mm256_mul_pd(as, u32_to_pd4(_mm_loadu_si128((const __m128i*)(const void*)(b->na + 4))));
+    const __m256d dcoh_lo = _mm256_mul_pd(cs, u32_to_pd4(_mm_loadu_si128((const __m128i*)(const void*)b->nc)));
+    const __m256d dcoh_hi = _mm256_mul_pd(cs, u32_to_pd4(_mm_loadu_si128((const __m128i*)(const void*)(b->nc + 4))));
+    __m256 d[9];
+    for (int a = 0; a < 3; ++a) {
+        d[a] = dequant8_avx2(b->q[a], dsep, dsep);
+        d[3 + a] = dequant8_avx2(b->q[3 + a], dali_lo, dali_hi);
+        d[6 + a] = dequant8_avx2(b->q[6 + a], dcoh_lo, dcoh_hi);
+    }
+    return integrate8(c, S, b, d);
+}
+
 #else
 uint32_t akp_boids_integrate_avx512(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b) {
+    (void)c, (void)S;
+    return (1u << b->n) - 1u;
+}
+
+uint32_t akp_boids_integrate_avx2(const akp_boids_ctx* c, const akp_boids_sp* S, const akp_boids_batch* b) {
     (void)c, (void)S;
     return (1u << b->n) - 1u;
 }
