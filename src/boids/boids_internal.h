@@ -190,8 +190,11 @@ uint32_t akp_boids_integrate_avx2(const akp_boids_ctx* c, const akp_boids_sp* S,
  * symmetric pair kernel for CPUs with AVX2 but not AVX-512, over hits with their offsets (the
  * AVX2 or SSE2 filter's); same tests and integer sums as the scalar sym_hits in search.c. */
 bool akp_boids_have_avx2(void);
-/* The AVX2 distance filters, as their AVX-512 namesakes (hits with k, d2 and the offsets; h
- * needs room for 8 more than the hits). */
+/* The AVX2 packing and distance filters, as their AVX-512 namesakes (hits with k, d2 and the
+ * offsets; h needs room for 8 more than the hits; the packed arrays are zero from count to
+ * the next multiple of 8). */
+uint32_t akp_boids_pack_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                  const uint32_t* end, uint32_t rows, akp_boids_packed* b);
 uint32_t akp_boids_filter_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
                                     const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
                                     uint32_t at);

@@ -636,22 +636,6 @@ static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, co
     return h - at;
 }
 
-/* akp_boids_pack_rows_avx512 in plain C, for the AVX2 filter (8 zeroed entries after count). */
-static uint32_t pack_rows(const float* X, const float* Y, const float* Z, const uint32_t* begin, const uint32_t* end,
-                          uint32_t rows, akp_boids_packed* b) {
-    uint32_t n = 0;
-    for (uint32_t r = 0; r < rows; ++r) {
-        const uint32_t len = end[r] - begin[r];
-        memcpy(b->x + n, X + begin[r], len * sizeof(float));
-        memcpy(b->y + n, Y + begin[r], len * sizeof(float));
-        memcpy(b->z + n, Z + begin[r], len * sizeof(float));
-        for (uint32_t u = 0; u < len; ++u) b->k[n + u] = begin[r] + u;
-        n += len;
-    }
-    for (uint32_t u = n; u < n + 8; ++u) b->x[u] = b->y[u] = b->z[u] = 0.0f, b->k[u] = 0;
-    return n;
-}
-
 /* First slab of part `part` of `parts` (the slabs of part p: [slab_of(p), slab_of(p + 1))). */
 static size_t slab_of(const akp_boids_ctx* c, size_t part, size_t parts) {
     return (size_t)c->dense_dim[2] * part / parts;
@@ -754,7 +738,7 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
                 if (pack) {
                     rb[0] = k1;
                     packed = c->avx512 ? akp_boids_pack_rows_avx512(X, Y, Z, rb, re, nr, pk)
-                                       : pack_rows(X, Y, Z, rb, re, nr, pk);
+                                       : akp_boids_pack_rows_avx2(X, Y, Z, rb, re, nr, pk);
                 }
                 for (uint32_t k = k0; k < k1; ++k) {
                     gather_begin_spatial(c, k, &g);

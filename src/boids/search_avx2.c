@@ -110,6 +110,23 @@ AKP_AVX2 static inline uint32_t filter_row8(const float* X, const float* Y, cons
     return n;
 }
 
+AKP_AVX2 uint32_t akp_boids_pack_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                           const uint32_t* end, uint32_t rows, akp_boids_packed* b) {
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    uint32_t n = 0;
+    for (uint32_t r = 0; r < rows; ++r)
+        for (uint32_t t = begin[r]; t < end[r]; t += 8) {
+            const uint32_t left = end[r] - t;
+            const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(left >= 8 ? 8 : (int)left), lane);
+            _mm256_storeu_ps(b->x + n, _mm256_maskload_ps(X + t, live));
+            _mm256_storeu_ps(b->y + n, _mm256_maskload_ps(Y + t, live));
+            _mm256_storeu_ps(b->z + n, _mm256_maskload_ps(Z + t, live));
+            _mm256_storeu_si256((__m256i*)(void*)(b->k + n), _mm256_add_epi32(_mm256_set1_epi32((int)t), lane));
+            n += left >= 8 ? 8u : left;
+        }
+    return n;
+}
+
 AKP_AVX2 uint32_t akp_boids_filter_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
                                              const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
                                              uint32_t at) {
@@ -301,6 +318,12 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
 
 #else
 bool akp_boids_have_avx2(void) { return false; }
+
+uint32_t akp_boids_pack_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
+                                  const uint32_t* end, uint32_t rows, akp_boids_packed* b) {
+    (void)X, (void)Y, (void)Z, (void)begin, (void)end, (void)rows, (void)b;
+    return 0;
+}
 
 uint32_t akp_boids_filter_rows_avx2(const float* X, const float* Y, const float* Z, const uint32_t* begin,
                                     const uint32_t* end, uint32_t rows, ak_vec3 p, float q2, akp_boids_hits* h,
