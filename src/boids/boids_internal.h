@@ -167,7 +167,7 @@ typedef struct akp_boids_sink {
 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
                           const akp_boids_sink* sink);
 
-/* integrate_avx512.c: the step's integration, 8 agents at a time, for the common case
+/* integrate_simd.c: the step's integration, 8 agents at a time, for the common case
  * (akp_boids_batch_ok: the symmetric pass, no goal, leader, wander, obstacles, steer-back
  * bounds or planar flock). The agents' sums, counts, positions and velocities are copied into
  * a batch; akp_boids_integrate_avx512 writes each lane's new position and velocity to the

@@ -1,19 +1,20 @@
-/* AVX-512 integration of the boids step's common case, 8 agents at a time (see
- * akp_boids_integrate_avx512 in boids_internal.h). Every float and double operation is the
- * scalar integrate()'s in boids.c, in the same order, each rounded (intrinsics, no FMA, no
- * reciprocal approximations): int64 -> double and double -> float conversions round to
- * nearest like the C casts, and the divisions and square roots are IEEE-exact, so each lane
- * is bit-identical to the scalar code (tested). Lanes that leave the common case (a speed
- * below min_speed, a non-finite force, a position that wraps) are handed back to the scalar
- * code, which redoes them from the start.
+/* AVX-512 and AVX2 integration of the boids step's common case, 8 agents at a time (see
+ * akp_boids_integrate_avx512 in boids_internal.h): one AVX body (integrate8) after each
+ * entry's own dequantisation of the fixed-point sums (AVX-512: int64 -> double in one
+ * instruction; AVX2: in two exact halves and one rounding). Every float and double operation
+ * is the scalar integrate()'s in boids.c, in the same order, each rounded (intrinsics, no
+ * FMA, no reciprocal approximations): int64 -> double and double -> float conversions round
+ * to nearest like the C casts, and the divisions and square roots are IEEE-exact, so each
+ * lane is bit-identical to the scalar code (tested). Lanes that leave the common case (a
+ * speed below min_speed, a non-finite force, a position that wraps) are handed back to the
+ * scalar code, which redoes them from the start.
  *
  * Compiled only for GCC/Clang on x86-64 without AK_NO_SIMD; chosen at run time with the
- * search kernels (c->avx512). */
+ * search kernels (c->avx512, c->avx2). */
 #include "boids_internal.h"
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
 #include <immintrin.h>
-
 
 #define AKP_AVX __attribute__((target("avx")))
 #define AKP_AVX2 __attribute__((target("avx2")))
@@ -34,8 +35,7 @@ AKP_AVX static inline __attribute__((always_inline)) uint32_t integrate8(const a
     const __m256 zero = _mm256_setzero_ps();
     const __m256 px = _mm256_loadu_ps(b->p[0]), py = _mm256_loadu_ps(b->p[1]), pz = _mm256_loadu_ps(b->p[2]);
     const __m256 vx = _mm256_loadu_ps(b->v[0]), vy = _mm256_loadu_ps(b->v[1]), vz = _mm256_loadu_ps(b->v[2]);
-    /* count != 0, as float lane masks (the counts are below 2^31: they fit the signed compare) */
-    const __m256i zi = _mm256_setzero_si256();
+    /* count != 0, as float lane masks (128-bit integer compares: AVX has no 256-bit ones) */
     const __m256i ones = _mm256_set1_epi32(-1);
     __m256 on[3];
     const uint32_t* cnt[3] = {b->ns, b->na, b->nc};
@@ -46,7 +46,6 @@ AKP_AVX static inline __attribute__((always_inline)) uint32_t integrate8(const a
         on[r] = _mm256_xor_ps(_mm256_castsi256_ps(_mm256_insertf128_si256(_mm256_castsi128_si256(zl), zh, 1)),
                               _mm256_castsi256_ps(ones));
     }
-    (void)zi;
     __m256 fx = zero, fy = zero, fz = zero;
     {   /* if (ns) f += dequant(sep, sep_scale) * separation_weight */
         const __m256 w = _mm256_set1_ps(s->separation_weight);
