@@ -204,6 +204,21 @@ uint32_t akp_boids_filter_packed_avx2(const float* X, const float* Y, const floa
 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h, uint32_t count,
                         const akp_boids_sink* sink);
 
+/* g += a kernel's neighbour sums v (sep x y z, ali x y z, coh x y z) and counts. (The AVX-512
+ * kernels add their lane reductions to g directly: building v there cost 3-4% of a step.) */
+static inline void akp_boids_gather_add(akp_boids_gather* g, const int64_t v[9], uint32_t ns, uint32_t na, uint32_t nc,
+                                        uint32_t nf) {
+    for (int a = 0; a < 3; ++a) {
+        g->sep[a] += v[a];
+        g->ali[a] += v[3 + a];
+        g->coh[a] += v[6 + a];
+    }
+    g->ns += ns;
+    g->na += na;
+    g->nc += nc;
+    g->nflock += nf;
+}
+
 /* A += the credits of one pair, atomically when another thread may touch A. */
 static inline void akp_boids_credit(akp_boids_acc* A, const int64_t v[9], uint64_t n01, uint64_t n23, bool atomic) {
     if (!atomic) {

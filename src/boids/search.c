@@ -309,19 +309,8 @@ static void gather_buffered(cand_buf* b, akp_boids_gather* g) {
             ++nc;
         }
     }
-    g->sep[0] += s0;
-    g->sep[1] += s1;
-    g->sep[2] += s2;
-    g->ali[0] += a0;
-    g->ali[1] += a1;
-    g->ali[2] += a2;
-    g->coh[0] += c0;
-    g->coh[1] += c1;
-    g->coh[2] += c2;
-    g->ns += ns;
-    g->na += na;
-    g->nc += nc;
-    g->nflock += nf;
+    const int64_t v[9] = {s0, s1, s2, a0, a1, a2, c0, c1, c2};
+    akp_boids_gather_add(g, v, ns, na, nc, nf);
 }
 
 /* ---- spatial path ------------------------------------------------------------------------ */
@@ -429,19 +418,8 @@ static void visit_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_bo
             ++nc;
         }
     }
-    g->sep[0] += s0;
-    g->sep[1] += s1;
-    g->sep[2] += s2;
-    g->ali[0] += a0;
-    g->ali[1] += a1;
-    g->ali[2] += a2;
-    g->coh[0] += c0;
-    g->coh[1] += c1;
-    g->coh[2] += c2;
-    g->ns += ns;
-    g->na += na;
-    g->nc += nc;
-    g->nflock += nf;
+    const int64_t v[9] = {s0, s1, s2, a0, a1, a2, c0, c1, c2};
+    akp_boids_gather_add(g, v, ns, na, nc, nf);
 }
 
 /* The candidates of the rows straight from the spatial arrays: distances (the same operations
@@ -580,19 +558,8 @@ static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boid
                 akp_boids_credit(&sink->acc[t], v, n01, n23, t < sink->atomic_end || t >= sink->far_begin);
         }
     }
-    g->sep[0] += s0;
-    g->sep[1] += s1;
-    g->sep[2] += s2;
-    g->ali[0] += a0;
-    g->ali[1] += a1;
-    g->ali[2] += a2;
-    g->coh[0] += c0;
-    g->coh[1] += c1;
-    g->coh[2] += c2;
-    g->ns += ns;
-    g->na += na;
-    g->nc += nc;
-    g->nflock += nf;
+    const int64_t v[9] = {s0, s1, s2, a0, a1, a2, c0, c1, c2};
+    akp_boids_gather_add(g, v, ns, na, nc, nf);
 }
 
 /* The distance filter of the scalar/SSE2 path: appends the t in [begin, end) with d2 < q2 (k,
@@ -679,15 +646,8 @@ void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts) {
 
 /* What the agent received, added to its own sums. */
 static void add_received(const akp_boids_acc* A, akp_boids_gather* g) {
-    for (int a = 0; a < 3; ++a) {
-        g->sep[a] += A->sep[a];
-        g->ali[a] += A->ali[a];
-        g->coh[a] += A->coh[a];
-    }
-    g->ns += (uint32_t)A->n01;
-    g->na += (uint32_t)(A->n01 >> 32);
-    g->nc += (uint32_t)A->n23;
-    g->nflock += (uint32_t)(A->n23 >> 32);
+    const int64_t v[9] = {A->sep[0], A->sep[1], A->sep[2], A->ali[0], A->ali[1], A->ali[2], A->coh[0], A->coh[1], A->coh[2]};
+    akp_boids_gather_add(g, v, (uint32_t)A->n01, (uint32_t)(A->n01 >> 32), (uint32_t)A->n23, (uint32_t)(A->n23 >> 32));
 }
 
 void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user) {

@@ -305,15 +305,8 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
             }
         }
     }
-    for (int a = 0; a < 3; ++a) {
-        g->sep[a] += hsum(s[a]);
-        g->ali[a] += al[a];
-        g->coh[a] += hsum(cs[a]);
-    }
-    g->ns += ns;
-    g->na += na;
-    g->nc += nc;
-    g->nflock += nf;
+    const int64_t v[9] = {hsum(s[0]), hsum(s[1]), hsum(s[2]), al[0], al[1], al[2], hsum(cs[0]), hsum(cs[1]), hsum(cs[2])};
+    akp_boids_gather_add(g, v, ns, na, nc, nf);
 }
 
 #else
