@@ -562,10 +562,12 @@ static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boid
     akp_boids_gather_add(g, v, ns, na, nc, nf);
 }
 
-/* The distance filter of the scalar/SSE2 path: appends the t in [begin, end) with d2 < q2 (k,
- * d2 and the offsets) to h at `at`; returns how many (h needs room for end - begin more). */
+/* The distance filter of the scalar/SSE2 path: appends the t in [begin, end) with d2 < q2 (k
+ * and d2, and the offsets when `offsets`: the AVX2 pair kernel reads them, the scalar one
+ * recomputes them) to h at `at`; returns how many (h needs room for end - begin more). */
 static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, const float* restrict Z,
-                            uint32_t begin, uint32_t end, ak_vec3 p, float q2, akp_boids_hits* hb, uint32_t at) {
+                            uint32_t begin, uint32_t end, ak_vec3 p, float q2, bool offsets, akp_boids_hits* hb,
+                            uint32_t at) {
     uint32_t h = at, t = begin;
 #if AK_SIMD_SSE2
     const __m128 vx = _mm_set1_ps(p.x), vy = _mm_set1_ps(p.y), vz = _mm_set1_ps(p.z), vq = _mm_set1_ps(q2);
@@ -583,9 +585,11 @@ static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, co
         for (unsigned l = 0; l < 4; ++l) {
             hb->k[h] = t + l;
             hb->d2[h] = d4[l];
-            hb->dx[h] = x4[l];
-            hb->dy[h] = y4[l];
-            hb->dz[h] = z4[l];
+            if (offsets) {
+                hb->dx[h] = x4[l];
+                hb->dy[h] = y4[l];
+                hb->dz[h] = z4[l];
+            }
             h += (m >> l) & 1u;
         }
     }
@@ -595,9 +599,11 @@ static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, co
         const float dd = dx * dx + dy * dy + dz * dz;
         hb->k[h] = t;
         hb->d2[h] = dd;
-        hb->dx[h] = dx;
-        hb->dy[h] = dy;
-        hb->dz[h] = dz;
+        if (offsets) {
+            hb->dx[h] = dx;
+            hb->dy[h] = dy;
+            hb->dz[h] = dz;
+        }
         h += dd < q2;
     }
     return h - at;
@@ -721,7 +727,7 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
                                     h = 0;
                                 }
                                 h += c->avx512 ? akp_boids_filter_avx512(X, Y, Z, t, e, g.p, q2, &hb, h)
-                                               : filter_sse2(X, Y, Z, t, e, g.p, q2, &hb, h);
+                                               : filter_sse2(X, Y, Z, t, e, g.p, q2, c->avx2, &hb, h);
                             }
                     sym_hits(c, &g, &hb, h, &sink);
                     if (k < first_end) {
