@@ -1,11 +1,26 @@
 /* Strict JSON scene reading for the command line: see cli_json.h. */
 #include "cli_json.h"
 
+
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+size_t cli_utf8_char(const unsigned char* p, size_t avail) {
+    if (!avail) return 0;
+    const unsigned char c = p[0];
+    if (c < 0x80) return 1;
+    const size_t len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+    if (!len || len > avail) return 0;
+    for (size_t k = 1; k < len; ++k) /* stops at a NUL too: it is no continuation byte */
+        if ((p[k] & 0xC0) != 0x80) return 0;
+    if (len == 3 && ((c == 0xE0 && p[1] < 0xA0) || (c == 0xED && p[1] >= 0xA0))) return 0; /* overlong, surrogate */
+    if (len == 4 && ((c == 0xF0 && p[1] < 0x90) || (c == 0xF4 && p[1] >= 0x90))) return 0; /* overlong, > U+10FFFF */
+    return len;
+}
 
 static const char* type_name(const cJSON* v) {
     if (cJSON_IsNumber(v)) return "a number";
@@ -57,31 +72,137 @@ const char* cli_json_key(char* buf, size_t size, const char* base, const char* k
     return buf;
 }
 
-/* Where a string in text[0, size) holds the escape \u0000, or NULL. cJSON decodes it into a
- * NUL that ends the C string early, so "rk4\u0000junk" would read as "rk4" and a key
- * "dt\u0000" as "dt". Other escapes are skipped whole ("\\u0000" is a backslash and text). */
-static const char* nul_escape(const char* text, size_t size) {
-    bool in_string = false;
-    for (size_t i = 0; i < size; ++i) {
-        if (!in_string) {
-            in_string = text[i] == '"';
-        } else if (text[i] == '"') {
-            in_string = false;
-        } else if (text[i] == '\\' && i + 1 < size) {
-            if (text[i + 1] == 'u' && i + 5 < size && memcmp(text + i + 2, "0000", 4) == 0) return text + i;
-            ++i;
-        }
+/* Where text[0, size) breaks strict JSON (RFC 8259) at the lexical level, or NULL; *what says how.
+ * cJSON is lenient where a scene reader must not be: it skips a leading byte-order mark, reads
+ * numbers with strtod ("01", "1.", "1e" pass), stops at a raw NUL (so `{"dt":0.1}\0junk` and
+ * "rk4<NUL>junk" pass as "rk4"), and copies invalid UTF-8 and raw control bytes into strings.
+ * This pass checks the bytes; cJSON then checks the structure. "\u0000" is refused too: cJSON
+ * decodes it into a NUL that ends the C string early, so "dt\u0000" would read as "dt". */
+static const char* strict_json_error(const char* text, size_t size, const char** what) {
+    const unsigned char* s = (const unsigned char*)text;
+    if (size >= 3 && s[0] == 0xEF && s[1] == 0xBB && s[2] == 0xBF) {
+        *what = "the file starts with a byte-order mark (JSON text has none)";
+        return text;
     }
+    size_t i = 0;
+    while (i < size) {
+        unsigned char c = s[i];
+        if (c == '\0') {
+            *what = "a NUL byte";
+            return text + i;
+        }
+        if (c == '"') { /* a string: escapes, no control bytes, valid UTF-8 */
+            ++i;
+            for (;;) {
+                if (i >= size) { /* unterminated: cJSON says where */
+                    *what = NULL;
+                    return NULL;
+                }
+                c = s[i];
+                if (c == '"') {
+                    ++i;
+                    break;
+                }
+                if (c == '\0') {
+                    *what = "a NUL byte in a string";
+                    return text + i;
+                }
+                if (c < 0x20) {
+                    *what = "a control byte in a string (write it as an escape)";
+                    return text + i;
+                }
+                if (c == '\\') {
+                    if (i + 1 >= size) break; /* unterminated: cJSON says where */
+                    unsigned char e = s[i + 1];
+                    if (e == 'u') {
+                        if (i + 5 >= size) break;
+                        unsigned v = 0;
+                        for (int k = 2; k < 6; ++k) {
+                            unsigned char h = s[i + k];
+                            unsigned d = h >= '0' && h <= '9'   ? (unsigned)(h - '0')
+                                         : h >= 'a' && h <= 'f' ? (unsigned)(h - 'a' + 10)
+                                         : h >= 'A' && h <= 'F' ? (unsigned)(h - 'A' + 10)
+                                                                : 16u;
+                            if (d == 16u) {
+                                *what = "a \\u escape without four hex digits";
+                                return text + i;
+                            }
+                            v = v * 16u + d;
+                        }
+                        if (v == 0) {
+                            *what = "a string holds \\u0000 (NUL)";
+                            return text + i;
+                        }
+                        i += 6;
+                    } else if (strchr("\"\\/bfnrt", e) && e) {
+                        i += 2;
+                    } else {
+                        *what = "an unknown escape in a string";
+                        return text + i;
+                    }
+                    continue;
+                }
+                if (c < 0x80) {
+                    ++i;
+                    continue;
+                }
+                const size_t n = cli_utf8_char(s + i, size - i);
+                if (!n) {
+                    *what = "invalid UTF-8 in a string";
+                    return text + i;
+                }
+                i += n;
+            }
+            continue;
+        }
+        if (c == '-' || (c >= '0' && c <= '9')) { /* a number: -?(0|[1-9]\d*)(\.\d+)?([eE][+-]?\d+)? */
+            size_t at = i;
+            if (c == '-') ++i;
+            if (i < size && s[i] == '0') {
+                ++i;
+                if (i < size && s[i] >= '0' && s[i] <= '9') {
+                    *what = "a number with a leading zero";
+                    return text + at;
+                }
+            } else if (i < size && s[i] >= '1' && s[i] <= '9') {
+                while (i < size && s[i] >= '0' && s[i] <= '9') ++i;
+            } else {
+                *what = "a malformed number";
+                return text + at;
+            }
+            if (i < size && s[i] == '.') {
+                ++i;
+                if (!(i < size && s[i] >= '0' && s[i] <= '9')) {
+                    *what = "a malformed number (a digit must follow the '.')";
+                    return text + at;
+                }
+                while (i < size && s[i] >= '0' && s[i] <= '9') ++i;
+            }
+            if (i < size && (s[i] == 'e' || s[i] == 'E')) {
+                ++i;
+                if (i < size && (s[i] == '+' || s[i] == '-')) ++i;
+                if (!(i < size && s[i] >= '0' && s[i] <= '9')) {
+                    *what = "a malformed number (a digit must follow the exponent)";
+                    return text + at;
+                }
+                while (i < size && s[i] >= '0' && s[i] <= '9') ++i;
+            }
+            continue;
+        }
+        ++i;
+    }
+    *what = NULL;
     return NULL;
 }
 
 cJSON* cli_json_parse(cli_json* j, const char* text, size_t size) {
     if (j->failed) return NULL;
-    const char* nul = nul_escape(text, size);
-    if (nul) {
+    const char* what = NULL;
+    const char* bad = strict_json_error(text, size, &what);
+    if (bad) {
         size_t line = 1, col = 1;
-        for (const char* p = text; p < nul; ++p) line += *p == '\n', col = *p == '\n' ? 1 : col + 1;
-        cli_json_fail(j, "", NULL, "a string holds \\u0000 (NUL) at line %zu, column %zu", line, col);
+        for (const char* p = text; p < bad; ++p) line += *p == '\n', col = *p == '\n' ? 1 : col + 1;
+        cli_json_fail(j, "", NULL, "%s at line %zu, column %zu", what, line, col);
         return NULL;
     }
     const char* end = NULL;
@@ -104,7 +225,6 @@ cJSON* cli_json_parse(cli_json* j, const char* text, size_t size) {
     /* Trailing content other than whitespace is an error, as in any strict reader. */
     if (end) {
         for (const char* p = end; p < text + size; ++p) {
-            if (*p == '\0') break;
             if (*p != ' ' && *p != '\t' && *p != '\n' && *p != '\r') {
                 cJSON_Delete(root);
                 cli_json_fail(j, "", NULL, "unexpected content after the JSON value");
@@ -220,11 +340,23 @@ bool cli_json_number(cli_json* j, const cJSON* obj, const char* path, const char
     return number_value(j, v, path, key, lo, hi, inout);
 }
 
+/* The value is rounded to float before the bounds are compared, so a documented minimum such as
+ * 1e-7 (which is not a float: 1e-7f is slightly above it) is accepted when written as 1e-7, and a
+ * number beyond the float range fails here, naming its key, instead of turning into an infinity
+ * that fails later without one. */
 bool cli_json_float(cli_json* j, const cJSON* obj, const char* path, const char* key, float lo, float hi,
                     float* inout) {
-    double x = *inout;
-    if (!cli_json_number(j, obj, path, key, lo, hi, &x)) return false;
-    *inout = (float)x;
+    bool ok;
+    const cJSON* v = member(j, obj, path, key, &ok);
+    if (!ok || !v) return ok;
+    double x = 0.0;
+    if (!number_value(j, v, path, key, -HUGE_VAL, HUGE_VAL, &x)) return false;
+    if (fabs(x) > (double)FLT_MAX)
+        return cli_json_fail(j, path, key, "%.9g is beyond the range of a float (magnitude at most %.9g)", x,
+                             (double)FLT_MAX);
+    float f = (float)x;
+    if (f < lo || f > hi) return cli_json_fail(j, path, key, "%.9g is outside [%g, %g]", x, (double)lo, (double)hi);
+    *inout = f;
     return true;
 }
 
