@@ -9,12 +9,16 @@
  *     ./fuzz_scene_particles -dict=tests/fuzz/scene_particles.dict examples/particles_fountain.json
  *
  * Each input is parsed from memory; an accepted scene (capacity cut to 2000) is stepped three
- * times with every emitter firing, and every particle left must be finite. A rejected one must
- * come with a one-line message. Any crash, leak or sanitizer report is a bug. */
+ * times by the command's own runner (particles_run_step: emitters, the burst schedule, springs
+ * re-indexed as particles die), so the fuzzer reaches the per-step loops whose counts come from
+ * the file (a 1e-30 s burst_interval once hung there). Every particle left must be finite. A
+ * rejected scene must come with a one-line message. Any crash, hang, leak or sanitizer report
+ * is a bug. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "particles_run.h"
 #include "scene_particles.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
@@ -26,27 +30,19 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (err[0] == '\0' || strchr(err, '\n')) abort();
         return 0;
     }
-    ak_particles_desc d = {
-        .capacity = s.capacity < 2000 ? s.capacity : 2000, .integrator = s.integrator, .seed = 1};
-    ak_particles* ps = NULL;
-    if (ak_particles_create(&d, NULL, &ps) == AK_OK) {
-        for (size_t i = 0; i < s.particle_count; ++i) ak_particles_add(ps, &s.particles[i], NULL);
-        for (int step = 0; step < 3; ++step) {
-            for (size_t e = 0; e < s.emitter_count; ++e) {
-                ak_particles_emit(ps, &s.emitters[e], s.dt, NULL);
-                ak_particles_burst(ps, &s.emitters[e],
-                                   s.bursts[e].count < 500 ? s.bursts[e].count : 500, NULL);
-            }
-            ak_particles_step(ps, &s.world, s.dt);
-        }
-        ak_particles_state st = ak_particles_get_state(ps);
+    if (s.capacity > 2000) s.capacity = s.particle_count > 2000 ? (uint32_t)s.particle_count : 2000;
+    particles_run run;
+    if (particles_run_init(&run, &s, NULL, 1, 1) == CLI_OK) {
+        for (int step = 0; step < 3; ++step)
+            if (particles_run_step(&run, step) != CLI_OK) break;
+        ak_particles_state st = ak_particles_get_state(run.ps);
         for (size_t i = 0; i < st.count; ++i)
             if (!ak_finitef(st.position[i].x) || !ak_finitef(st.position[i].y) ||
                 !ak_finitef(st.position[i].z) || !ak_finitef(st.velocity[i].x) ||
                 !ak_finitef(st.velocity[i].y) || !ak_finitef(st.velocity[i].z))
                 abort();
     }
-    ak_particles_destroy(ps);
+    particles_run_free(&run);
     particles_scene_free(&s);
     return 0;
 }

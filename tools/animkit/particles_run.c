@@ -215,6 +215,19 @@ int particles_run_init(particles_run* r, particles_scene* s, particles_character
     return CLI_OK;
 }
 
+/* How many bursts (start + k interval, k = 0, 1, ...) are due before t1: the smallest k >= fired
+ * with start + k interval >= t1, saturating at 2^53 (where a double stops counting by one).
+ * A bounded number of operations whatever the interval. */
+static uint64_t bursts_due(float start, float interval, double t1, uint64_t fired) {
+    const double limit = 9007199254740992.0; /* 2^53 */
+    double k = ceil((t1 - (double)start) / (double)interval);
+    if (!(k < limit)) k = limit;
+    if (k < (double)fired) k = (double)fired;
+    for (int i = 0; i < 4 && k > (double)fired && (double)start + (k - 1.0) * (double)interval >= t1; ++i) k -= 1.0;
+    for (int i = 0; i < 4 && k < limit && (double)start + k * (double)interval < t1; ++i) k += 1.0;
+    return (uint64_t)k;
+}
+
 /* One step: pose the character for the end of the step, emit, step. */
 int particles_run_step(particles_run* r, int step) {
     particles_scene* s = r->scene;
@@ -224,26 +237,36 @@ int particles_run_step(particles_run* r, int step) {
     if (r->ch) res = particles_character_pose(r->ch, (float)t1, dt);
     for (size_t e = 0; e < s->emitter_count && res == AK_OK; ++e) {
         res = ak_particles_emit(r->ps, &s->emitters[e], dt, NULL);
-        /* Bursts due before the end of this step (start, start + interval, ...). */
+        /* Bursts due before the end of this step (start, start + interval, ...). The loop is
+         * bounded by integers: at most capacity + 1 calls per emitter and step (each call adds
+         * a particle until the system is full); the bursts still due after that are counted,
+         * not fired, in a bounded number of operations. A 1e-30 s interval used to hang here:
+         * the count was stepped with k -= 1.0 on a double near 1e28, which no longer changes. */
         const particles_burst* b = &s->bursts[e];
+        const uint64_t max_calls = (uint64_t)ak_particles_capacity(r->ps) + 1u;
+        uint64_t calls = 0;
         while (res == AK_OK && b->count > 0 && (b->interval > 0.0f || r->fired[e] == 0)) {
             if ((double)b->start + (double)r->fired[e] * (double)b->interval >= t1) break;
-            if (b->interval > 0.0f && ak_particles_count(r->ps) >= ak_particles_capacity(r->ps)) {
+            if (b->interval > 0.0f && (ak_particles_count(r->ps) >= ak_particles_capacity(r->ps) || calls >= max_calls)) {
                 /* full: every burst still due this step would be dropped (a full system emits
-                 * nothing and draws no random numbers), so count them without calling; a tiny
-                 * burst_interval used to make millions of calls per step */
-                double k = ceil((t1 - (double)b->start) / (double)b->interval);
-                if (k < (double)r->fired[e]) k = (double)r->fired[e];
-                while (k > (double)r->fired[e] && (double)b->start + (k - 1.0) * (double)b->interval >= t1) k -= 1.0;
-                while ((double)b->start + k * (double)b->interval < t1) k += 1.0;
-                r->fired[e] = (uint64_t)k;
+                 * nothing and draws no random numbers), so count them without calling */
+                r->fired[e] = bursts_due(b->start, b->interval, t1, r->fired[e]);
                 break;
             }
             res = ak_particles_burst(r->ps, &s->emitters[e], b->count, NULL);
             ++r->fired[e];
+            ++calls;
         }
     }
     if (res == AK_OK) res = ak_particles_step(r->ps, &r->world, dt);
+    if (res == AK_ERR_BUDGET)
+        return cli_fail("particles",
+                        "step %d: Lennard-Jones needs more than %.3g distance tests per force evaluation (particles "
+                        "packed into few cells of the %g m cut-off); lower lennard_jones.cutoff or sigma, or spread "
+                        "the particles out",
+                        step, (double)AK_PARTICLES_LJ_DEFAULT_PAIR_TESTS,
+                        (double)(r->world.lennard_jones.cutoff > 0.0f ? r->world.lennard_jones.cutoff
+                                                                       : 2.5f * r->world.lennard_jones.sigma));
     if (res != AK_OK) return cli_fail("particles", "step %d: %s", step, ak_result_string(res));
     /* File particles come first and keep their order (ids 0.. in file order); when some die
      * (a lifetime, or a state that stopped being finite) the springs follow the survivors'
