@@ -453,3 +453,36 @@ ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
     }
     return AK_OK;
 }
+
+/* ---- public: work estimate ---------------------------------------------------------- */
+
+uint64_t ak_grid_candidate_count(const ak_grid* grid, float radius) {
+    if (!grid || grid->cell_count == 0 || !(radius > 0.0f) || !ak_finitef(radius)) return 0;
+    const ak_grid* g = grid;
+    const int64_t k = rings_for(g, radius);
+    const bool all_cells = scan_all_cells(g, k);
+    uint64_t total = 0;
+    for (uint32_t m = 0; m < g->cell_count; ++m) {
+        const uint64_t na = g->cell_start[m + 1] - g->cell_start[m];
+        total += na * (na - 1) / 2;
+        const ak_grid_cell c = g->cell_coord[m];
+        if (all_cells) {
+            for (uint32_t o = m + 1; o < g->cell_count; ++o)
+                if (cells_within(g->cell_coord[o], c, k)) total += na * (g->cell_start[o + 1] - g->cell_start[o]);
+            continue;
+        }
+        for (int64_t dz = 0; dz <= k; ++dz) { /* the forward half of the stencil, as pair_thread */
+            if (!coord_offset_ok(c.z, dz)) continue;
+            for (int64_t dy = dz == 0 ? 0 : -k; dy <= k; ++dy) {
+                if (!coord_offset_ok(c.y, dy)) continue;
+                for (int64_t dx = (dz == 0 && dy == 0) ? 1 : -k; dx <= k; ++dx) {
+                    if (!coord_offset_ok(c.x, dx)) continue;
+                    ak_grid_cell n = {(int32_t)(c.x + dx), (int32_t)(c.y + dy), (int32_t)(c.z + dz)};
+                    uint32_t o = ak_grid_cell_find(g, n);
+                    if (o != UINT32_MAX) total += na * (g->cell_start[o + 1] - g->cell_start[o]);
+                }
+            }
+        }
+    }
+    return total;
+}

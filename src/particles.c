@@ -1330,6 +1330,16 @@ ak_result ak_particles_step(ak_particles* ps, const ak_particles_world* w, float
     const size_t n = ps->count;
     const uint32_t th = ps->thread_count;
     const double t = ps->time;
+    if (w->lennard_jones.epsilon != 0.0f && n > 1) { /* the work budget, before anything moves */
+        ak_grid_desc gd = {.cell_size = c.lj_cutoff};
+        ak_grid g;
+        const uint64_t budget = w->lennard_jones.max_pair_tests ? w->lennard_jones.max_pair_tests
+                                                                : AK_PARTICLES_LJ_DEFAULT_PAIR_TESTS;
+        if (ak_grid_build(&gd, (ak_vec3_cspan){ps->pos, n}, (ak_u8_span){ps->grid_mem, ps->grid_mem_size}, &g) ==
+                AK_OK &&
+            ak_grid_candidate_count(&g, c.lj_cutoff) > budget)
+            return AK_ERR_BUDGET;
+    }
 
     bool dead;
     if (ps->integrator == AK_INTEGRATOR_SYMPLECTIC && !c.pair_forces) {

@@ -286,6 +286,51 @@ AK_TEST(validation_codes) {
     AK_CHECK_EQ(ak_grid_query(&g, p[0], 1.0f, (ak_u32_span)AK_SPAN(out)), 1);
 }
 
+/* ak_grid_candidate_count against a brute-force count of the pairs whose cells (floor(p / cell)
+ * in double, as the header says) are within k = ceil(r / cell) of each other on every axis. */
+AK_TEST(candidate_count_matches_brute_force) {
+    enum { N = 700 };
+    ak_vec3 p[N];
+    ak_rng rng = ak_rng_make(99);
+    for (size_t i = 0; i < N; ++i) /* a clump, a sparse cloud and duplicates */
+        p[i] = i < 200   ? ak_vec3_make(ak_rng_range(&rng, 0, 0.3f), ak_rng_range(&rng, 0, 0.3f), ak_rng_range(&rng, 0, 0.3f))
+               : i < 650 ? ak_vec3_make(ak_rng_range(&rng, -5, 5), ak_rng_range(&rng, -5, 5), ak_rng_range(&rng, -5, 5))
+                         : ak_vec3_make(2.0f, 2.0f, 2.0f);
+    const float cells[] = {0.5f, 0.5f, 0.25f, 3.0f};
+    const float radii[] = {0.5f, 1.2f, 0.5f, 0.1f};
+    for (int c = 0; c < 4; ++c) {
+        built b = build(p, N, cells[c]);
+        double kd = ceil((double)radii[c] / (double)cells[c]);
+        if (kd < 1.0) kd = 1.0;
+        const int64_t k = (int64_t)kd;
+        uint64_t want = 0;
+        for (size_t i = 0; i < N; ++i)
+            for (size_t j = i + 1; j < N; ++j) {
+                bool in = true;
+                const float a[3] = {p[i].x, p[i].y, p[i].z}, q[3] = {p[j].x, p[j].y, p[j].z};
+                for (int ax = 0; ax < 3; ++ax) {
+                    int64_t ca = (int64_t)floor((double)a[ax] / (double)cells[c]);
+                    int64_t cb = (int64_t)floor((double)q[ax] / (double)cells[c]);
+                    if (ca - cb > k || cb - ca > k) in = false;
+                }
+                want += in;
+            }
+        AK_CHECK_MSG(ak_grid_candidate_count(&b.grid, radii[c]) == want, "cell %g radius %g: %llu vs %llu",
+                     (double)cells[c], (double)radii[c], (unsigned long long)ak_grid_candidate_count(&b.grid, radii[c]),
+                     (unsigned long long)want);
+        AK_CHECK_EQ(ak_grid_candidate_count(&b.grid, 0.0f), 0u);
+        AK_CHECK_EQ(ak_grid_candidate_count(&b.grid, NAN), 0u);
+        free(b.mem);
+    }
+    AK_CHECK_EQ(ak_grid_candidate_count(NULL, 1.0f), 0u);
+    /* everything at one point: n (n - 1) / 2, the quadratic case a budget must catch */
+    static ak_vec3 same[1000];
+    for (size_t i = 0; i < 1000; ++i) same[i] = ak_vec3_make(1, 2, 3);
+    built s = build(same, 1000, 0.1f);
+    AK_CHECK_EQ(ak_grid_candidate_count(&s.grid, 0.1f), 1000u * 999u / 2u);
+    free(s.mem);
+}
+
 int main(void) {
     AK_RUN(random_cloud_matches_brute_force);
     AK_RUN(points_on_cell_boundaries);
@@ -295,5 +340,6 @@ int main(void) {
     AK_RUN(sorted_layout_and_cells);
     AK_RUN(short_output_reports_count);
     AK_RUN(validation_codes);
+    AK_RUN(candidate_count_matches_brute_force);
     return ak_test_finish();
 }

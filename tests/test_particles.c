@@ -682,6 +682,34 @@ AK_TEST(validation_codes) {
     ak_particle_mesh_destroy(NULL);
 }
 
+/* The Lennard-Jones work budget: 600 particles in one cell are 179,700 distance tests per
+ * evaluation; under a budget of 100,000 the step refuses and changes nothing (positions,
+ * velocities, time), at 179,700 it runs; spread out (cells of the cut-off) they pass a budget
+ * that the clump does not. */
+AK_TEST(lennard_jones_work_budget) {
+    ak_particles* ps = make(600, AK_INTEGRATOR_SYMPLECTIC, 1, 1);
+    ak_rng rng = ak_rng_make(8);
+    for (int i = 0; i < 600; ++i)
+        add(ps, ak_vec3_make(ak_rng_range(&rng, 0, 1), ak_rng_range(&rng, 0, 1), ak_rng_range(&rng, 0, 1)),
+            ak_vec3_zero(), 1.0f);
+    ak_particles_state st = ak_particles_get_state(ps);
+    static ak_vec3 before[600];
+    memcpy(before, st.position, sizeof before);
+    ak_particles_world w = {.gravity = {0, -9.81f, 0},
+                            .lennard_jones = {.epsilon = 1e-6f, .sigma = 0.01f, .cutoff = 10.0f, .max_pair_tests = 100000}};
+    AK_CHECK_EQ(ak_particles_step(ps, &w, 1e-3f), AK_ERR_BUDGET);
+    st = ak_particles_get_state(ps);
+    AK_CHECK(memcmp(before, st.position, sizeof before) == 0);
+    AK_CHECK_EQ(ak_particles_time(ps), 0.0);
+    w.lennard_jones.max_pair_tests = 600u * 599u / 2u; /* exactly the tests: allowed */
+    AK_CHECK_EQ(ak_particles_step(ps, &w, 1e-3f), AK_OK);
+    /* the same particles with a 0.05 m cut-off: cells of 0.05 m, far fewer tests */
+    w.lennard_jones.cutoff = 0.05f;
+    w.lennard_jones.max_pair_tests = 100000;
+    AK_CHECK_EQ(ak_particles_step(ps, &w, 1e-3f), AK_OK);
+    ak_particles_destroy(ps);
+}
+
 int main(void) {
     AK_RUN(projectile_closed_forms);
     AK_RUN(convergence_orders);
@@ -689,6 +717,7 @@ int main(void) {
     AK_RUN(drag_wind_attractor_vortex);
     AK_RUN(spring_damping_and_callback);
     AK_RUN(lennard_jones_matches_brute_force);
+    AK_RUN(lennard_jones_work_budget);
     AK_RUN(floor_touch_time_and_no_tunnelling);
     AK_RUN(restitution_rebound_ratio);
     AK_RUN(friction_stopping_distance);

@@ -186,7 +186,18 @@ typedef struct ak_boids_step_job {
                                         scalar/SSE2 code (same results, bit for bit: tests) */
     bool skip_avx512;                /* true -> the AVX2 kernel where AVX-512 would run (same
                                         results: tests, benchmarks); false -> fastest */
+    uint64_t max_cell_load;          /* work budget of the grid path: sum over the grid's cells
+                                        of (agents in the cell)^2; 0 -> AK_BOIDS_DEFAULT_CELL_LOAD */
 } ak_boids_step_job;
+
+/* The grid path's cost is about (2 rings + 1)^3 / 2 distance tests per unit of cell load
+ * (sum over cells of n_c^2, cells as large as the largest rule radius, so rings = 1): a flock
+ * at the usual density (about 8 agents per cell) has a load of about 8 per agent, 100,000
+ * agents at one point have 1e10 (a quadratic step of hours). Above max_cell_load the step
+ * returns AK_ERR_BUDGET and writes nothing; the default, 2e7, passes flocks of a few million
+ * agents at the usual density and about 4,500 agents stacked in one cell. The naive path
+ * (use_naive) has no budget: it is quadratic by definition. */
+#define AK_BOIDS_DEFAULT_CELL_LOAD 20000000u
 
 /* Scratch bytes ak_boids_step_run needs for this job (positions.count, params and use_naive
  * are read; 0 for the naive path, and 0 when no species looks at neighbours). The grid path
@@ -209,7 +220,8 @@ AK_API size_t ak_boids_step_scratch_size(const ak_boids_step_job* job);
 AK_API ak_result ak_boids_step_validate(const ak_boids_step_job* job);
 
 /* One step for every agent (see the header block). Validates first and writes nothing on
- * failure. Output is finite for valid input. */
+ * failure. Output is finite for valid input. Besides the validation codes: AK_ERR_BUDGET when
+ * the agents are packed so densely that the grid's cell load exceeds max_cell_load (above). */
 AK_API ak_result ak_boids_step_run(const ak_boids_step_job* job);
 
 /* ---- neighbour lists ------------------------------------------------------------------ */
@@ -228,6 +240,7 @@ typedef struct ak_boids_neighbors_job {
 } ak_boids_neighbors_job;
 
 /* Fill the neighbour lists. Returns the step job's validation codes (dt is not checked),
+ * AK_ERR_BUDGET as the step (the step job's max_cell_load),
  * AK_ERR_NULL_ARG (no out_total or offsets), AK_ERR_SPAN_SMALL (offsets shorter than
  * agent_count + 1, or out_indices shorter than the total: then out_total holds the count
  * needed and the offsets are written). */

@@ -63,7 +63,8 @@ extern "C" {
     X(ERR_PARSE, "a file is malformed")                                                    \
     X(ERR_UNSUPPORTED, "the input uses a feature animkit does not support")                \
     X(ERR_NOT_FOUND, "a named item (joint, clip, mesh) was not found")                     \
-    X(ERR_NO_CONVERGENCE, "an iterative solver did not converge")
+    X(ERR_NO_CONVERGENCE, "an iterative solver did not converge")                          \
+    X(ERR_BUDGET, "the input asks for more work than the documented budget")
 
 typedef enum ak_result {
 #define AK_RESULT_ENUM_(name, msg) AK_##name,

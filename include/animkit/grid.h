@@ -114,6 +114,15 @@ AK_API uint32_t ak_grid_cell_find(const ak_grid* grid, ak_grid_cell cell);
  * > 0, NaN/infinite q or radius, or an empty grid -> 0. */
 AK_API size_t ak_grid_query(const ak_grid* grid, ak_vec3 q, float radius, ak_u32_span out_indices);
 
+/* The work a radius search over the whole grid does: the number of unordered point pairs
+ * (i < j) that share a cell or lie in cells within reach of radius, i.e. the distance tests
+ * ak_grid_pairs_run makes (the pairs it returns are a subset). Points spread at a density of
+ * D per cell give about 13.5 D^2 per cell; N points in one cell give N (N - 1) / 2, the
+ * quadratic cliff. Use it to check a work budget before a pass whose points come from
+ * untrusted input. NULL, an empty grid or a radius not > 0 and finite -> 0. Cost: one visit
+ * of the stencil per occupied cell, no distance test. */
+AK_API uint64_t ak_grid_candidate_count(const ak_grid* grid, float radius);
+
 /* All pairs closer than a radius. */
 typedef struct ak_grid_pairs_job {
     const ak_grid* grid;         /* required */

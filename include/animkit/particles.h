@@ -233,12 +233,19 @@ typedef struct ak_particle_spring {
 } ak_particle_spring;
 
 /* Lennard-Jones between every pair closer than cutoff: V(r) = 4 epsilon ((sigma/r)^12 -
- * (sigma/r)^6), F_i = 24 epsilon (2 (sigma/r)^12 - (sigma/r)^6) (p_i - p_j) / r^2. Pairs are
- * found with the neighbour grid (cells of size cutoff). Coincident particles feel nothing. */
+ * (sigma/r)^6), F_i = 24 epsilon (2 (sigma/r)^12 - (sigma/r)^6) (p_i - p_j) / r^2, the plain
+ * truncated potential (not shifted: the force jumps from F(cutoff) to 0 at the cut-off). Pairs
+ * are found with the neighbour grid (cells of size cutoff). Coincident particles feel nothing.
+ * Work budget: the distance tests of one force evaluation (ak_grid_candidate_count of the
+ * particles at the start of the step) must not exceed max_pair_tests, or the step returns
+ * AK_ERR_BUDGET and changes nothing: particles packed into a few cells (or a cut-off spanning
+ * the whole system) make the pass quadratic, 5e9 tests for 100,000 particles in one cell. */
+#define AK_PARTICLES_LJ_DEFAULT_PAIR_TESTS 50000000u
 typedef struct ak_particle_lennard_jones {
-    float epsilon; /* joules; 0 = off */
-    float sigma;   /* metres */
-    float cutoff;  /* metres; 0 -> 2.5 sigma */
+    float epsilon;           /* joules; 0 = off */
+    float sigma;             /* metres */
+    float cutoff;            /* metres; 0 -> 2.5 sigma */
+    uint64_t max_pair_tests; /* 0 -> AK_PARTICLES_LJ_DEFAULT_PAIR_TESTS (5e7, about 0.1-0.5 s) */
 } ak_particle_lennard_jones;
 
 /* Caller forces: add newtons to force[0 .. count) for the given state (which may be an
@@ -357,7 +364,8 @@ typedef struct ak_particles_world {
  * Returns AK_ERR_NULL_ARG (particles, world, or a span with count > 0 and a NULL pointer),
  * AK_ERR_BAD_ARG (dt not > 0 and finite, restitution outside [0, 1], negative friction,
  * radius or drag, box min > max, LJ sigma <= 0 with epsilon != 0), AK_ERR_BAD_INDEX (a spring
- * index >= count), AK_ERR_BAD_DATA (non-finite world values). On error nothing changes.
+ * index >= count), AK_ERR_BAD_DATA (non-finite world values), AK_ERR_BUDGET (Lennard-Jones
+ * pairs over lennard_jones.max_pair_tests). On error nothing changes.
  * A particle whose state becomes non-finite (e.g. an exploding stiff spring) is removed at
  * the end of the step rather than poisoning the output. */
 AK_API ak_result ak_particles_step(ak_particles* particles, const ak_particles_world* world,

@@ -938,6 +938,11 @@ static void* fill_thread(void* arg) {
     return NULL;
 }
 
+/* The job's budget on the sum over cells of (agents in the cell)^2 (boids.h). */
+static uint64_t cell_budget(const akp_boids_ctx* c) {
+    return c->job->max_cell_load ? c->job->max_cell_load : AK_BOIDS_DEFAULT_CELL_LOAD;
+}
+
 ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     float search;
     const float cs = cell_size_for(c->params, &search);
@@ -984,6 +989,12 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
         if (r != AK_OK) return r;
         /* Sparse flock: the grid's order, cells found through its hash. */
         const ak_grid* gr = &c->grid;
+        uint64_t load = 0;
+        for (uint32_t m = 0; m < gr->cell_count; ++m) {
+            const uint64_t k = gr->cell_start[m + 1] - gr->cell_start[m];
+            load += k * k;
+        }
+        if (load > cell_budget(c)) return AK_ERR_BUDGET;
         for (size_t k = 0; k < n; ++k) {
             const uint32_t j = gr->order[k];
             const uint8_t s = S ? S[j] : 0;
@@ -1006,7 +1017,12 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
         idx[i] = (uint32_t)b;
         dstart[b + 1]++;
     }
-    for (size_t b = 0; b < volume; ++b) dstart[b + 1] += dstart[b];
+    uint64_t load = 0;
+    for (size_t b = 0; b < volume; ++b) {
+        load += (uint64_t)dstart[b + 1] * dstart[b + 1];
+        dstart[b + 1] += dstart[b];
+    }
+    if (load > cell_budget(c)) return AK_ERR_BUDGET;
     for (size_t i = 0; i < n; ++i) sj[dstart[idx[i]]++] = (uint32_t)i;
     /* dstart[b] is now the end of cell b: shift back to starts. */
     memmove(dstart + 1, dstart, volume * sizeof(uint32_t));

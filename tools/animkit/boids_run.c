@@ -74,6 +74,14 @@ ak_result boids_run_step(boids_run* st, long step) {
     return res;
 }
 
+const char* boids_run_error(ak_result res) {
+    if (res == AK_ERR_BUDGET)
+        return "the agents are packed too densely: the grid's cell load (sum over cells of agents^2) is above the "
+               "work budget of 2e7 (a quadratic step); spread them out (a larger bounds box, fewer agents) or "
+               "lower the rule radii";
+    return ak_result_string(res);
+}
+
 void boids_run_free(boids_run* r) {
     free(r->p);
     free(r->v);

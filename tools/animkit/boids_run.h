@@ -23,6 +23,8 @@ typedef struct boids_run {
 int boids_run_init(boids_run* r, const cli_boids_scene* sc, const char* cmd, const char* file, uint32_t threads);
 /* Step number `step` (0-based; the wander noise depends on it). */
 ak_result boids_run_step(boids_run* r, long step);
+/* What a failed step's result means for a user (AK_ERR_BUDGET says what to lower). */
+const char* boids_run_error(ak_result res);
 void boids_run_free(boids_run* r);
 
 /* Triangles of the agents (5 vertices, 4 triangles each) and obstacles. */

@@ -1,11 +1,13 @@
 /* Shared CLI glue: parsing, errors, loading, JSON, progress. */
 #include "cli.h"
+#include "cli_json.h" /* cli_utf8_char */
 
 #include <ctype.h>
 #include <dirent.h> /* opendir: a rig file beside an OBJ */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -67,12 +69,48 @@ size_t cli_get_all(const cli_args* a, const cli_opt* opts, size_t opt_count, con
     return n;
 }
 
+size_t cli_escape(char* out, size_t cap, const char* s) {
+    size_t n = 0;
+    if (!cap) return 0;
+#define CLI_PUT_(c) (n + 1 < cap ? (void)(out[n++] = (c)) : (void)0)
+    const unsigned char* p = (const unsigned char*)(s ? s : "");
+    while (*p) {
+        unsigned char c = *p;
+        const size_t len = cli_utf8_char(p, SIZE_MAX);
+        const bool ok = len > 0;
+        const bool c1 = ok && len == 2 && c == 0xC2 && p[1] < 0xA0; /* U+0080..U+009F: C1 controls */
+        if (!ok || c < 0x20 || c == 0x7f || c1) {
+            char hex[8];
+            snprintf(hex, sizeof hex, "\\x%02x", c1 ? p[1] : c);
+            if (c1) snprintf(hex, sizeof hex, "\\u%04x", p[1]);
+            if (n + strlen(hex) + 1 > cap) break;
+            for (const char* h = hex; *h; ++h) CLI_PUT_(*h);
+            p += c1 ? 2 : 1;
+            continue;
+        }
+        if (n + len + 1 > cap) break;
+        for (size_t k = 0; k < len; ++k) CLI_PUT_((char)p[k]);
+        p += len;
+    }
+#undef CLI_PUT_
+    out[n] = '\0';
+    return n;
+}
+
+/* Format, escape control bytes and invalid UTF-8 (names and paths quoted from files must not
+ * reach the terminal raw: an ESC sequence in a BVH joint name would retitle it or clear it),
+ * print one line. */
+static void print_escaped(const char* cmd, const char* fmt, va_list ap) {
+    char raw[2048], safe[4096];
+    vsnprintf(raw, sizeof raw, fmt, ap);
+    cli_escape(safe, sizeof safe, raw);
+    fprintf(stderr, "animkit %s: %s\n", cmd, safe);
+}
+
 int cli_fail(const char* cmd, const char* fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "animkit %s: ", cmd);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    print_escaped(cmd, fmt, ap);
     va_end(ap);
     return CLI_BAD_INPUT;
 }
@@ -80,11 +118,25 @@ int cli_fail(const char* cmd, const char* fmt, ...) {
 int cli_usage(const char* cmd, const char* fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "animkit %s: ", cmd);
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\ntry 'animkit %s --help'\n", cmd);
+    print_escaped(cmd, fmt, ap);
+    fprintf(stderr, "try 'animkit %s --help'\n", cmd);
     va_end(ap);
     return CLI_BAD_USAGE;
+}
+
+int cli_work_check(const char* cmd, double work, const char* what, const char* lower) {
+    double budget = CLI_WORK_BUDGET;
+    const char* env = getenv("ANIMKIT_MAX_WORK");
+    if (env && *env) {
+        char* end = NULL;
+        double v = strtod(env, &end);
+        if (*end || !(v > 0.0) || !isfinite(v)) return cli_fail(cmd, "ANIMKIT_MAX_WORK='%.40s' is not a positive number", env);
+        budget = v;
+    }
+    if (!(work <= budget))
+        return cli_fail(cmd, "the run asks for %.3g %s, above the work budget of %.3g; lower %s (or raise the budget "
+                        "with the environment variable ANIMKIT_MAX_WORK)", work, what, budget, lower);
+    return CLI_OK;
 }
 
 bool cli_parse_float(const char* s, float* out) {
@@ -223,17 +275,25 @@ void cli_obj_rig_note(const char* cmd, const char* path) {
 
 void cli_json_string(FILE* f, const char* s) {
     fputc('"', f);
-    for (const unsigned char* p = (const unsigned char*)(s ? s : ""); *p; ++p) {
-        switch (*p) {
+    for (const unsigned char* p = (const unsigned char*)(s ? s : ""); *p;) {
+        const unsigned char c = *p;
+        if (c >= 0x80) { /* copy a valid UTF-8 character; an invalid byte becomes U+FFFD */
+            const size_t len = cli_utf8_char(p, SIZE_MAX);
+            if (len) fwrite(p, 1, len, f), p += len;
+            else fputs("\\ufffd", f), ++p;
+            continue;
+        }
+        switch (c) {
         case '"': fputs("\\\"", f); break;
         case '\\': fputs("\\\\", f); break;
         case '\n': fputs("\\n", f); break;
         case '\r': fputs("\\r", f); break;
         case '\t': fputs("\\t", f); break;
         default:
-            if (*p < 0x20) fprintf(f, "\\u%04x", *p);
-            else fputc(*p, f);
+            if (c < 0x20 || c == 0x7f) fprintf(f, "\\u%04x", c);
+            else fputc(c, f);
         }
+        ++p;
     }
     fputc('"', f);
 }

@@ -45,13 +45,27 @@ const char* cli_get(const cli_args* a, const cli_opt* opts, size_t opt_count, co
 size_t cli_get_all(const cli_args* a, const cli_opt* opts, size_t opt_count, const char* name, const char** out,
                    size_t cap);
 
-/* "animkit CMD: message" on stderr; returns CLI_BAD_INPUT. */
+/* s with control bytes (< 0x20, 0x7f), C1 controls (U+0080..U+009F) and invalid UTF-8 bytes
+ * written as \xHH / \u00HH into out (cap bytes, always NUL-terminated, cut at a whole
+ * character); returns the length. Every message quoting input goes through it. */
+size_t cli_escape(char* out, size_t cap, const char* s);
+
+/* The documented work budget of a simulation command (docs/cli.md, "Work budgets"): the run's
+ * work in "particle updates" (cloth: particles x steps x substeps x iterations; fluid: particles
+ * x steps x solver iterations; particles: capacity x steps; boids: agents x steps), refused above
+ * CLI_WORK_BUDGET (2e10, a few minutes on one core) unless the environment variable
+ * ANIMKIT_MAX_WORK sets another. Returns CLI_OK, or CLI_BAD_INPUT after printing
+ * "the run asks for W WHAT, above the work budget of B; lower LOWER". */
+#define CLI_WORK_BUDGET 2e10
+int cli_work_check(const char* cmd, double work, const char* what, const char* lower);
+
+/* "animkit CMD: message" on stderr (control bytes escaped: cli_escape); returns CLI_BAD_INPUT. */
 int cli_fail(const char* cmd, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
-/* "animkit CMD: message" + "try 'animkit CMD --help'" on stderr; returns CLI_BAD_USAGE. */
+/* "animkit CMD: message" (escaped) + "try 'animkit CMD --help'" on stderr; returns CLI_BAD_USAGE. */
 int cli_usage(const char* cmd, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))

@@ -186,7 +186,10 @@ int cmd_boids(int argc, char** argv) {
     if (sc.agent_count == 0) cli_boids_scene_scale_bounds(&sc, sc.count);
 
     boids_run st;
-    if ((rc = boids_run_init(&st, &sc, "boids", a.pos_count ? a.pos[0] : "scene", (uint32_t)threads))) {
+    memset(&st, 0, sizeof st);
+    if ((rc = cli_work_check("boids", (double)(sc.agent_count > 0 ? sc.agent_count : sc.count) * (double)sc.steps,
+                             "agent updates (agents x steps)", "--steps or --count")) ||
+        (rc = boids_run_init(&st, &sc, "boids", a.pos_count ? a.pos[0] : "scene", (uint32_t)threads))) {
         boids_run_free(&st);
         cli_boids_scene_free(&sc);
         return rc;
@@ -215,13 +218,14 @@ int cmd_boids(int argc, char** argv) {
     }
     const long every = sc.steps > 150 ? (sc.steps + 149) / 150 : 1;
     const double t0 = cli_now();
+    long failed_step = -1;
     for (long s = 0; s <= sc.steps && res == AK_OK; ++s) {
         if (gif && s % every == 0) {
             res = draw_frame(&rd, &sc, &st, (float)s * sc.dt, &img);
             if (res == AK_OK) res = ak_gif_writer_add_frame(gif, &img);
         }
         if (s == sc.steps) break;
-        if (res == AK_OK) res = boids_run_step(&st, s);
+        if (res == AK_OK && (res = boids_run_step(&st, s)) != AK_OK) failed_step = s;
         cli_progress("boids", (size_t)s + 1, (size_t)sc.steps);
     }
     const double elapsed = cli_now() - t0;
@@ -235,7 +239,8 @@ int cmd_boids(int argc, char** argv) {
     }
     if (rendering) renderer_free(&rd);
     rc = CLI_OK;
-    if (res != AK_OK) rc = cli_fail("boids", "%s", ak_result_string(res));
+    if (res != AK_OK && failed_step >= 0) rc = cli_fail("boids", "step %ld: %s", failed_step, boids_run_error(res));
+    else if (res != AK_OK) rc = cli_fail("boids", "%s", ak_result_string(res));
     if (rc == CLI_OK && json) rc = write_json(json, sc.steps, &st);
     if (rc == CLI_OK && !json && !out) {
         float dmin = 0.0f;

@@ -144,7 +144,13 @@ int cmd_cloth(int argc, char** argv) {
     sim_bake bake;
     memset(&bake, 0, sizeof bake);
 
-    rc = cloth_run_init(&run, &sc, "cloth", name);
+    memset(&run, 0, sizeof run);
+    rc = cli_work_check("cloth",
+                        (double)sc.desc.grid_width * (double)sc.desc.grid_height * (double)sc.steps *
+                            (double)sc.substeps * (double)sc.iterations,
+                        "particle updates (particles x steps x substeps x iterations)",
+                        "--steps, --substeps, the scene's \"iterations\" or the grid size");
+    if (!rc) rc = cloth_run_init(&run, &sc, "cloth", name);
     if (rc) goto done;
     if (sim_bake_wanted(out) && (rc = sim_bake_mesh_init(&bake, "cloth", out, run.n, sc.steps))) goto done;
     cloth_character* const ch = &run.ch;

@@ -354,6 +354,16 @@ int cmd_fluid(int argc, char** argv) {
     if (steps >= 0) s->steps = steps;
 
     const size_t cap = fluid_scene_capacity(s);
+    {
+        const double iters = s->desc.solver == AK_FLUID_PBF ? (s->desc.iterations ? s->desc.iterations : 4) : 1;
+        int wrc = cli_work_check("fluid", (double)cap * (double)s->steps * iters,
+                                 "particle updates (particles x steps x solver iterations)",
+                                 "--steps, --count or the scene's \"iterations\"");
+        if (wrc) {
+            free(s);
+            return wrc;
+        }
+    }
     ak_vec3* pos = calloc(cap ? cap : 1, sizeof *pos);
     ak_vec3* vel = calloc(cap ? cap : 1, sizeof *vel);
     uint8_t* flags = calloc(cap ? cap : 1, 1);

@@ -205,6 +205,9 @@ int cmd_particles(int argc, char** argv) {
     ak_gif_writer* gw = NULL;
     sim_bake bake;
     memset(&bake, 0, sizeof bake);
+    if ((rc = cli_work_check("particles", (double)scene.capacity * (double)steps,
+                             "particle updates (capacity x steps)", "--steps or the scene's \"capacity\"")))
+        goto done;
     if (use_char && particles_character_init(&ch, &rc)) goto done;
     if (glb && (rc = sim_bake_points_init(&bake, "particles", out, steps))) goto done;
     const int frames = gif ? (int)(steps < 100 ? steps : 100) : 1;
