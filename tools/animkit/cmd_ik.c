@@ -204,8 +204,11 @@ int cmd_ik(int argc, char** argv) {
     } else {
         printf("solver %s, chain (%zu joint%s%s):", ak_ik_solver_name(solver), chain_count, chain_count == 1 ? "" : "s",
                CLI_GET(&a, "--root") ? "" : ", default root; --root to change");
-        for (size_t i = 0; i < chain_count; ++i)
-            printf("%s %s", i ? " ->" : "", ak_skeleton_joint_name(s->skeleton, (size_t)chain[i]));
+        for (size_t i = 0; i < chain_count; ++i) {
+            char name[512];
+            cli_escape(name, sizeof name, ak_skeleton_joint_name(s->skeleton, (size_t)chain[i]));
+            printf("%s %s", i ? " ->" : "", name);
+        }
         printf("\n");
         printf("reached %s, error %.6g, iterations %zu, time %.3f ms\n", reached ? "yes" : "no", (double)error, used,
                elapsed * 1e3);

@@ -46,7 +46,9 @@ static void print_tree(const ak_scene* s, const int* list, const int* parent, si
     for (size_t i = 0; i < count; ++i) {
         if (parent[i] != root) continue;
         int j = list[i];
-        printf("  %*s%s (%s)\n", depth * 2, "", ak_skeleton_joint_name(s->skeleton, (size_t)j),
+        char name[512];
+        cli_escape(name, sizeof name, ak_skeleton_joint_name(s->skeleton, (size_t)j));
+        printf("  %*s%s (%s)\n", depth * 2, "", name,
                joint_type_name(ak_skeleton_joint_type(s->skeleton, (size_t)j)));
         print_tree(s, list, parent, count, (int)i, depth + 1);
     }
@@ -108,13 +110,16 @@ int cmd_info(int argc, char** argv) {
         }
         printf("]}\n");
     } else {
-        printf("%s\n", s->name);
+        char text[512];
+        cli_escape(text, sizeof text, s->name);
+        printf("%s\n", text);
         printf("skeleton: %zu joint%s (%zu node%s)\n", count, cli_plural(count), n, cli_plural(n));
         print_tree(s, list, parent, count, -1, 0);
         printf("meshes: %zu\n", s->mesh_count);
         for (size_t m = 0; m < s->mesh_count; ++m) {
             const ak_mesh* mesh = s->meshes[m].mesh;
-            printf("  %-24s %7zu vertices %7zu triangles  ", mesh->name[0] ? mesh->name : "(unnamed)",
+            cli_escape(text, sizeof text, mesh->name[0] ? mesh->name : "(unnamed)");
+            printf("  %-24s %7zu vertices %7zu triangles  ", text,
                    mesh->vertex_count, mesh->triangle_count);
             if (s->meshes[m].skin >= 0 && mesh->influence_count > 0)
                 printf("skinned (%u influence%s/vertex)", mesh->influence_count, mesh->influence_count == 1 ? "" : "s");
@@ -126,7 +131,8 @@ int cmd_info(int argc, char** argv) {
         printf("clips: %zu\n", s->clip_count);
         for (size_t c = 0; c < s->clip_count; ++c) {
             size_t nch = cli_clip_file_channel_count(s, s->clips[c]);
-            printf("  %-24s %8.4f s  %zu channel%s\n", ak_clip_name(s->clips[c])[0] ? ak_clip_name(s->clips[c]) : "(unnamed)",
+            cli_escape(text, sizeof text, ak_clip_name(s->clips[c])[0] ? ak_clip_name(s->clips[c]) : "(unnamed)");
+            printf("  %-24s %8.4f s  %zu channel%s\n", text,
                    (double)ak_clip_duration(s->clips[c]), nch, nch == 1 ? "" : "s");
         }
     }
