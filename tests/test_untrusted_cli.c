@@ -210,6 +210,32 @@ AK_TEST(scene_json_is_strict) {
     AK_CHECK_MSG(run("particles u_ok.json --steps 1", true) == 0, "%s", out_buf);
 }
 
+AK_TEST(documented_minimums_and_advice) {
+    /* --dt takes the scene files' minimum (a denormal step used to run and then advise a
+     * smaller --dt) */
+    AK_CHECK_EQ(run("particles --preset rain --dt 1e-20 --steps 2", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "--dt '1e-20' is not a number in [1e-07, 10]") != NULL, "%s", out_buf);
+    AK_CHECK_EQ(run("boids --dt 1e-20 --steps 2", true), 2);
+    AK_CHECK_EQ(run("cloth --dt 1e-20 --steps 2", true), 2);
+    AK_CHECK_EQ(run("fluid --dt 1e-20 --steps 2", true), 2);
+    AK_CHECK_EQ(run("particles --preset rain --dt 1e-7 --steps 2", true), 0);
+    /* a sink box with min above max is an error naming it */
+    AK_CHECK(write_file("u_sink.json", "{\"sinks\":[{\"min\":[0,0,0],\"max\":[1,1,1]},{\"min\":[1,0,0],\"max\":[0,1,1]}]}"));
+    AK_CHECK_EQ(run("fluid u_sink.json --steps 1", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "u_sink.json: sinks[1]: min [1, 0, 0] is above max [0, 1, 1]") != NULL, "%s", out_buf);
+    /* too many particles for a .glb: the advice is about particles, not steps */
+    FILE* f = fopen("u_20k.json", "w");
+    AK_CHECK(f != NULL);
+    if (!f) return;
+    fprintf(f, "{\"gravity\":[0,0,0],\"particles\":[");
+    for (int i = 0; i < 20000; ++i) fprintf(f, "%s{\"p\":[%d,0,0]}", i ? "," : "", i);
+    fprintf(f, "]}");
+    fclose(f);
+    AK_CHECK_EQ(run("particles u_20k.json --steps 2 -o u_20k.glb", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "lower the particle count") != NULL && strstr(out_buf, "fewer --steps") == NULL, "%s",
+                 out_buf);
+}
+
 int main(void) {
     AK_RUN(tiny_burst_interval_does_not_hang);
     AK_RUN(lennard_jones_budget);
@@ -218,5 +244,6 @@ int main(void) {
     AK_RUN(escapes_never_reach_the_terminal);
     AK_RUN(invalid_utf8_never_reaches_json);
     AK_RUN(scene_json_is_strict);
+    AK_RUN(documented_minimums_and_advice);
     return ak_test_finish();
 }

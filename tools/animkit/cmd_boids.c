@@ -130,8 +130,8 @@ int cmd_boids(int argc, char** argv) {
         return cli_usage("boids", "--seed '%s' is not a whole number >= 0", CLI_GET(&a, "--seed"));
     if (CLI_GET(&a, "--threads") && !cli_parse_int(CLI_GET(&a, "--threads"), 1, 64, &threads))
         return cli_usage("boids", "--threads '%s' is not a whole number in [1, 64]", CLI_GET(&a, "--threads"));
-    if (CLI_GET(&a, "--dt") && (!cli_parse_float(CLI_GET(&a, "--dt"), &dt) || !(dt > 0.0f) || dt > 10.0f))
-        return cli_usage("boids", "--dt '%s' is not a number in (0, 10]", CLI_GET(&a, "--dt"));
+    if (CLI_GET(&a, "--dt") && (!cli_parse_float(CLI_GET(&a, "--dt"), &dt) || !(dt >= 1e-6f) || dt > 10.0f))
+        return cli_usage("boids", "--dt '%s' is not a number in [1e-06, 10] (seconds)", CLI_GET(&a, "--dt"));
     if (CLI_GET(&a, "--size") && (!cli_parse_size(CLI_GET(&a, "--size"), &w, &h) || w > 4096 || h > 4096))
         return cli_usage("boids", "--size '%s' is not WxH (at most 4096x4096)", CLI_GET(&a, "--size"));
     const char* out = CLI_GET(&a, "--output");

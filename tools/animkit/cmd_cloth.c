@@ -119,7 +119,7 @@ int cmd_cloth(int argc, char** argv) {
     }
     if (!rc && (v = CLI_GET(&a, "--dt"))) {
         float dt;
-        if (!cli_parse_float(v, &dt) || !(dt > 0.0f) || dt > 1.0f) rc = cli_usage("cloth", "--dt must be in (0, 1] seconds");
+        if (!cli_parse_float(v, &dt) || !(dt >= 1e-7f) || dt > 1.0f) rc = cli_usage("cloth", "--dt must be in [1e-07, 1] seconds");
         else sc.dt = dt;
     }
     if (!rc && (v = CLI_GET(&a, "--substeps"))) {

@@ -316,8 +316,8 @@ int cmd_fluid(int argc, char** argv) {
     if (sv && !cli_parse_int(sv, 0, FLUID_SCENE_MAX_STEPS, &steps))
         return cli_usage("fluid", "--steps '%s': allowed 0 to %ld", sv, FLUID_SCENE_MAX_STEPS);
     sv = CLI_GET(&a, "--dt");
-    if (sv && (!cli_parse_float(sv, &dt) || !(dt > 0.0f) || dt > 1.0f))
-        return cli_usage("fluid", "--dt '%s': allowed (0, 1] seconds", sv);
+    if (sv && (!cli_parse_float(sv, &dt) || !(dt >= 1e-7f) || dt > 1.0f))
+        return cli_usage("fluid", "--dt '%s': allowed [1e-07, 1] seconds", sv);
     sv = CLI_GET(&a, "--threads");
     if (sv && !cli_parse_int(sv, 1, 64, &threads)) return cli_usage("fluid", "--threads '%s': allowed 1 to 64", sv);
     const char* solver = CLI_GET(&a, "--solver");

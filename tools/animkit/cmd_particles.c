@@ -136,8 +136,8 @@ int cmd_particles(int argc, char** argv) {
                          CLI_GET(&a, "--threads"));
     float dt = 0.0f;
     if (CLI_GET(&a, "--dt") &&
-        (!cli_parse_float(CLI_GET(&a, "--dt"), &dt) || !(dt > 0.0f) || dt > 10.0f))
-        return cli_usage("particles", "--dt '%s' is not a number in (0, 10]", CLI_GET(&a, "--dt"));
+        (!cli_parse_float(CLI_GET(&a, "--dt"), &dt) || !(dt >= 1e-7f) || dt > 10.0f))
+        return cli_usage("particles", "--dt '%s' is not a number in [1e-07, 10] (seconds)", CLI_GET(&a, "--dt"));
     ak_particles_integrator integ = AK_INTEGRATOR_DEFAULT;
     const char* in = CLI_GET(&a, "--integrator");
     if (in) {

@@ -186,6 +186,9 @@ bool fluid_scene_parse(cli_json* j, const char* text, size_t size, fluid_scene* 
         if (!cli_json_object(j, e, path, kk)) break;
         parse_vec_in(j, e, path, "min", &sk->min);
         parse_vec_in(j, e, path, "max", &sk->max);
+        if (!j->failed && (sk->min.x > sk->max.x || sk->min.y > sk->max.y || sk->min.z > sk->max.z))
+            cli_json_fail(j, path, NULL, "min [%g, %g, %g] is above max [%g, %g, %g] on some axis", (double)sk->min.x,
+                          (double)sk->min.y, (double)sk->min.z, (double)sk->max.x, (double)sk->max.y, (double)sk->max.z);
         s->sink_count = k + 1;
     }
     cJSON_Delete(root);

@@ -94,7 +94,10 @@ int sim_bake_points_write(sim_bake* b, const char* name, float dt) {
     ak_result r = ak_scene_bake_point_frames(&d, NULL, &s, &diag);
     if (r == AK_OK) r = ak_io_save(b->out, s, NULL, &diag);
     ak_scene_destroy(s);
-    if (r == AK_ERR_UNSUPPORTED) return cli_fail(b->cmd, "%s: %s; use fewer --steps", b->out, diag.message);
+    /* one animated node per distinct particle: fewer steps cannot help, fewer particles can */
+    if (r == AK_ERR_UNSUPPORTED)
+        return cli_fail(b->cmd, "%s: %s; lower the particle count (the scene's particles, capacity or emitters) "
+                        "or write --json instead", b->out, diag.message);
     if (r != AK_OK) return cli_fail(b->cmd, "%s: %s (%s)", b->out, diag.message, ak_result_string(r));
     return CLI_OK;
 }
