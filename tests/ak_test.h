@@ -1,10 +1,18 @@
 /* Tiny test harness: one executable per module, one ctest entry each.
  *
  *     AK_TEST(quat_identity) { AK_CHECK_NEAR(ak_quat_norm(ak_quat_identity()), 1.0f, 1e-7); }
- *     int main(void) { AK_RUN(quat_identity); return ak_test_finish(); }
+ *     int main(void) { AK_RUN(quat_identity); AK_RUN_SLOW(long_soak); return ak_test_finish(); }
  *
- * Every check prints file:line and both values when it fails. ak_test_finish() prints
- * "N passed, N failed" (the line CI reads) and returns the process exit code. */
+ * Every check prints file:line and both values when it fails. Each case prints "ok NAME
+ * (seconds)" or "FAIL NAME". ak_test_finish() prints "N passed, N failed" (the line CI reads)
+ * and returns the process exit code.
+ *
+ * Fast and slow cases: AK_RUN_SLOW marks a case that takes more than a few seconds (long
+ * end-to-end runs, real assets at full length). The environment variable AK_TEST_SELECT picks
+ * what runs: "fast" (the cases of AK_RUN only), "slow" (AK_RUN_SLOW only), unset or anything
+ * else: all. tests/CMakeLists.txt registers every program as TEST (AK_TEST_SELECT=fast) and,
+ * when its source holds AK_RUN_SLOW, also as TEST_slow (AK_TEST_SELECT=slow, ctest label
+ * "slow"): `make test` runs ctest -LE slow (under a minute on 2 cores), .ci/run runs both. */
 #ifndef ANIMKIT_TEST_H
 #define ANIMKIT_TEST_H
 
@@ -13,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 
 #include <animkit/core.h>
 
@@ -22,20 +31,42 @@ static const char* ak_test_cur_name_ = "";
 
 #define AK_TEST(name) static void ak_test_##name(void)
 
-#define AK_RUN(name)                                                                       \
+/* 0: run every case; 1: only AK_RUN (fast); 2: only AK_RUN_SLOW. */
+static inline int ak_test_select_(void) {
+    static int sel = -1;
+    if (sel < 0) {
+        const char* s = getenv("AK_TEST_SELECT");
+        sel = s && strcmp(s, "fast") == 0 ? 1 : s && strcmp(s, "slow") == 0 ? 2 : 0;
+    }
+    return sel;
+}
+
+static inline double ak_test_now_(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+#define AK_RUN_AS_(name, slow)                                                             \
     do {                                                                                   \
+        if (ak_test_select_() == ((slow) ? 1 : 2)) break;                                  \
         ak_test_cur_failed_ = 0;                                                           \
         ak_test_cur_name_ = #name;                                                         \
+        const double ak_t0_ = ak_test_now_();                                              \
         ak_test_##name();                                                                  \
+        const double ak_dt_ = ak_test_now_() - ak_t0_;                                     \
         if (ak_test_cur_failed_) {                                                         \
             ++ak_test_failed_;                                                             \
-            printf("FAIL %s\n", #name);                                                    \
+            printf("FAIL %s (%.2f s)\n", #name, ak_dt_);                                   \
         } else {                                                                           \
             ++ak_test_passed_;                                                             \
-            printf("ok   %s\n", #name);                                                    \
+            printf("ok   %s (%.2f s)\n", #name, ak_dt_);                                   \
         }                                                                                  \
         fflush(stdout);                                                                    \
     } while (0)
+
+#define AK_RUN(name) AK_RUN_AS_(name, 0)
+#define AK_RUN_SLOW(name) AK_RUN_AS_(name, 1)
 
 #define AK_FAIL_(...)                                                                      \
     do {                                                                                   \

@@ -914,8 +914,8 @@ int main(void) {
     AK_RUN(ik_json_contract);
     AK_RUN(skin_compare_orders_methods);
     AK_RUN(weights_json_sum_to_one);
-    AK_RUN(render_outputs_decode);
-    AK_RUN(demo_writes_its_files);
+    AK_RUN_SLOW(render_outputs_decode);
+    AK_RUN_SLOW(demo_writes_its_files);
     AK_RUN(export_bind_reproduces_gltf_positions);
     AK_RUN(render_scene_with_many_meshes);
     AK_RUN(messages_say_what_happened);
@@ -924,9 +924,9 @@ int main(void) {
     AK_RUN(long_clip_gif_subsampled);
     AK_RUN(method_all_size_limit);
     AK_RUN(export_without_mesh_fails);
-    AK_RUN(render_camera_options);
+    AK_RUN_SLOW(render_camera_options);
     AK_RUN(weights_png_shows_every_bone);
-    AK_RUN(curves_select_and_paginate);
+    AK_RUN_SLOW(curves_select_and_paginate);
     AK_RUN(render_obj_characters);
     return ak_test_finish();
 }

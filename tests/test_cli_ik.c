@@ -212,8 +212,8 @@ AK_TEST(ik_target_and_iterations_usage) {
 }
 
 int main(void) {
-    AK_RUN(ik_default_chain_is_the_limb);
-    AK_RUN(ik_straight_arm_targets_on_its_line);
+    AK_RUN_SLOW(ik_default_chain_is_the_limb);
+    AK_RUN_SLOW(ik_straight_arm_targets_on_its_line);
     AK_RUN(ik_json_valid_at_extreme_scales);
     AK_RUN(ik_target_and_iterations_usage);
     return ak_test_finish();

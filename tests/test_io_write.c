@@ -624,7 +624,7 @@ int main(void) {
     AK_RUN(builtin_round_trip);
     AK_RUN(bvh_round_trip);
 #ifdef AK_CLI_PATH
-    AK_RUN(cli_export);
+    AK_RUN_SLOW(cli_export);
 #endif
     AK_RUN(validator);
     char cmd[600];

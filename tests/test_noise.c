@@ -748,7 +748,7 @@ int main(void) {
     AK_RUN(curl_noise_is_divergence_free);
     AK_RUN(wind);
     AK_RUN(sway_layer);
-    AK_RUN(documented_ranges_hold);
+    AK_RUN_SLOW(documented_ranges_hold);
     AK_RUN(other_bases_ranges);
     return ak_test_finish();
 }

@@ -284,7 +284,7 @@ AK_TEST(cli_retarget) {
 int main(void) {
     AK_RUN(cmu_bvh_onto_builtin_and_cesiumman);
 #ifdef AK_CLI_PATH
-    AK_RUN(cli_retarget);
+    AK_RUN_SLOW(cli_retarget);
 #endif
     return ak_test_finish();
 }

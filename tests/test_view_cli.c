@@ -868,22 +868,22 @@ int main(void) {
     AK_RUN(bad_scripts_exit_2_naming_the_line);
     AK_RUN(methods_match_render);
     AK_RUN(camera_and_scrub);
-    AK_RUN(ik_drag_wrist);
-    AK_RUN(every_help_key_does_something);
+    AK_RUN_SLOW(ik_drag_wrist);
+    AK_RUN_SLOW(every_help_key_does_something);
     AK_RUN(morph_keys);
-    AK_RUN(long_session);
+    AK_RUN_SLOW(long_session);
     AK_RUN(assets_session);
     AK_RUN(window_under_xvfb);
     AK_RUN(sim_bad_specs);
     AK_RUN(sim_particles_play_pause_reset);
     AK_RUN(sim_boids_play_pause_reset);
-    AK_RUN(sim_cloth_play_pause_reset);
+    AK_RUN_SLOW(sim_cloth_play_pause_reset);
     AK_RUN(sim_drag_sphere);
     AK_RUN(sim_help_keys_do_something);
     AK_RUN(terrain_view);
-    AK_RUN(sim_cloth_drag_sphere);
+    AK_RUN_SLOW(sim_cloth_drag_sphere);
     AK_RUN(sim_particles_drag_deflects);
     AK_RUN(sim_threads_and_seed);
-    AK_RUN(sim_long_session);
+    AK_RUN_SLOW(sim_long_session);
     return ak_test_finish();
 }
