@@ -176,8 +176,11 @@ AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* na
  * positions (NULL entry -> that mesh's own bind-space positions, as stored).
  * posed_normals: same shape; NULL or a NULL entry -> the mesh's own normals when it has them,
  * else no "vn" for that mesh. Point clouds (no triangles) write only vertices.
+ * The file is written whole or not at all: to a temporary ".NAME.XXXXXX" beside path, renamed
+ * over path once complete (a symlink at path is replaced, not followed); on any failure the
+ * temporary is removed and whatever path named is left untouched.
  * Returns AK_ERR_NULL_ARG (path or scene NULL), AK_ERR_BAD_DATA (a non-finite coordinate:
- * the file is removed), AK_ERR_IO (cannot create or write the file; diag names it). */
+ * nothing is written), AK_ERR_IO (cannot create or write the file; diag names it). */
 AK_API ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3* const* posed_positions,
                                  const ak_vec3* const* posed_normals, ak_diag* diag);
 
@@ -229,8 +232,12 @@ typedef struct ak_io_save_desc {
  * scene mesh's skin or node out of range), AK_ERR_UNSUPPORTED (an interpolation glTF cannot express: NLERP, SQUAD, LAGRANGE,
  * or a cubic mode other than HERMITE on a rotation: bake the clip first; two channels
  * animating one mesh's morph weights; more than 4 GiB in a GLB), AK_ERR_IO (cannot create or
- * write a file: partial files are removed), AK_ERR_NO_MEMORY. diag (optional) names the
- * file and the problem. Temporary memory comes from malloc. */
+ * write a file), AK_ERR_NO_MEMORY. diag (optional) names the file and the problem. Temporary
+ * memory comes from malloc. Files are written whole or not at all: each to a temporary
+ * ".NAME.XXXXXX" beside it, renamed into place (a symlink there is replaced, not followed)
+ * only once both a .gltf and its .bin are complete (the .bin first); on a failure the
+ * temporaries are removed and the named files are left untouched (only a failed rename of
+ * the .gltf after its .bin's can leave a new .bin beside the old .gltf). */
 AK_API ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_desc* desc, ak_diag* diag);
 
 #ifdef __cplusplus
