@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "view_app.h"
+#include "outfile.h"
 
 #define MAX_SCRIPT_SIZE (4u << 20)
 
@@ -142,7 +143,8 @@ int cmd_view(int argc, char** argv) {
     ak_scene* s = NULL;
     view_app app;
     memset(&app, 0, sizeof app);
-    FILE* log = NULL;
+    cli_outfile log; /* --ik-log: a temporary renamed into place when the run succeeds */
+    memset(&log, 0, sizeof log);
     if (vo.sim) {
         /* a simulation draws on an empty model scene (no meshes, joints or clips) */
         if (ak_scene_alloc(0, 0, 0, NULL, &s) != AK_OK) {
@@ -169,11 +171,8 @@ int cmd_view(int argc, char** argv) {
     } else if (s->clip_count) {
         vo.clip = 0;
     }
-    if (CLI_GET(&a, "--ik-log") && !(log = fopen(CLI_GET(&a, "--ik-log"), "w"))) {
-        rc = cli_fail("view", "%s: cannot create the IK log", CLI_GET(&a, "--ik-log"));
-        goto done;
-    }
-    vo.ik_log = log;
+    if (CLI_GET(&a, "--ik-log") && (rc = cli_outfile_open(&log, "view", CLI_GET(&a, "--ik-log")))) goto done;
+    vo.ik_log = log.f;
     if ((rc = view_app_init(&app, s, &vo))) goto done;
     rc = headless ? view_app_run(&app, script_path ? &script : NULL, frames, NULL) : view_window_run(&app, script_path ? &script : NULL);
     if (CLI_GET(&a, "--stats") && app.stats.frames > 0) {
@@ -188,7 +187,8 @@ int cmd_view(int argc, char** argv) {
     }
 done:
     if (app.scene) view_app_free(&app);
-    if (log && fclose(log) != 0 && rc == CLI_OK) rc = cli_fail("view", "%s: cannot write the IK log", CLI_GET(&a, "--ik-log"));
+    if (log.f && rc == CLI_OK) rc = cli_outfile_commit(&log, "view");
+    cli_outfile_abort(&log);
     view_script_free(&script);
     ak_scene_destroy(s);
     return rc;
