@@ -88,17 +88,23 @@ extern "C" {
 #define AK_IO_BUDGET_INPUT_FACTOR 16u
 /* Deepest ROOT/JOINT nesting animkit's BVH reader accepts. */
 #define AK_IO_BVH_MAX_DEPTH 256u
+/* CPU seconds Assimp may spend on one file, in its child process (the parent waits 5 s of
+ * wall time more, then kills it). */
+#define AK_IO_ASSIMP_SECONDS 60
 /* Deepest element/brace nesting the pre-check lets through to Assimp (Collada, ASCII FBX). */
 #define AK_IO_ASSIMP_MAX_DEPTH 1024u
 
 /* Which reader handles a file. */
 typedef enum ak_io_format {
-    AK_IO_FORMAT_AUTO = 0, /* default: a .gltf/.glb extension or the GLB magic -> GLTF, else ASSIMP */
+    AK_IO_FORMAT_AUTO = 0, /* default: a .gltf/.glb extension or the GLB magic -> GLTF, .bvh -> BVH,
+                              .obj -> OBJ, else ASSIMP */
     AK_IO_FORMAT_GLTF,     /* animkit's glTF 2.0 reader (.gltf or .glb, decided by the bytes) */
     AK_IO_FORMAT_ASSIMP,   /* Assimp's importer (FBX, Collada, OBJ, ...; BVH only when named
                               explicitly: Assimp's BVH importer is not safe on untrusted files) */
     AK_IO_FORMAT_BVH,      /* animkit's BVH reader (AUTO picks it for .bvh and for data that
                               starts with HIERARCHY) */
+    AK_IO_FORMAT_OBJ,      /* animkit's Wavefront OBJ reader, with the .mtl files it names
+                              (base colours only); AUTO picks it for .obj */
     AK_IO_FORMAT_COUNT
 } ak_io_format;
 
