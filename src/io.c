@@ -255,6 +255,11 @@ void akp_io_sanitize(char* msg, size_t size) {
 
 void akp_io_copy_name(char dst[AK_NAME_SIZE], const char* src) {
     snprintf(dst, AK_NAME_SIZE, "%s", src ? src : "");
+    size_t n = strlen(dst);
+    if (src && n == AK_NAME_SIZE - 1 && ((unsigned char)src[n] & 0xC0) == 0x80) { /* cut inside a character */
+        while (n > 0 && ((unsigned char)src[n] & 0xC0) == 0x80) --n;
+        dst[n] = 0;
+    }
 }
 
 akp_budget akp_io_budget(const ak_io_desc* desc, size_t input_size) {

@@ -2098,6 +2098,32 @@ AK_TEST(bvh_truncated_prefixes_fail) {
     }
     printf("  %d truncated BVH copies, %d loaded\n", cuts, loaded);
     AK_CHECK_EQ(loaded, 0);
+    /* issue 26 item 11a: cut inside the last number ("-19.3215" -> "-19.3" or "-1"), or just
+     * before the final newline: the last frame line has no newline, refused naming the frame */
+    size_t nl_at = n;
+    while (nl_at > 0 && (small[nl_at - 1] == '\n' || small[nl_at - 1] == '\r')) --nl_at;
+    AK_CHECK(nl_at > last + 1);
+    for (size_t l = last + 1; l <= nl_at; ++l) {
+        ak_io_desc as_bvh = {.format = AK_IO_FORMAT_BVH};
+        ak_diag diag;
+        s = NULL;
+        ak_result r = ak_io_load_memory(small, l, "cut.bvh", NULL, &as_bvh, NULL, &s, &diag);
+        AK_CHECK_MSG(r == AK_ERR_PARSE, "cut at %zu of %zu: %s", l, n, ak_result_name(r));
+        if (r != AK_OK)
+            AK_CHECK_MSG(strstr(diag.message, "the file ends inside frame 20 (truncated?)") != NULL, "%s", diag.message);
+        ak_scene_destroy(s);
+    }
+    /* with its newline (LF or CRLF) the same text loads */
+    char* crlf = (char*)malloc(nl_at + 3);
+    memcpy(crlf, small, nl_at);
+    memcpy(crlf + nl_at, "\r\n", 3);
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(crlf, nl_at + 2, "cut.bvh", NULL, NULL, NULL, &s, NULL), AK_OK);
+    ak_scene_destroy(s);
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(crlf, nl_at + 1, "cut.bvh", NULL, NULL, NULL, &s, NULL), AK_ERR_PARSE); /* a lone CR */
+    ak_scene_destroy(s);
+    free(crlf);
     free(small);
     free(text);
 }
@@ -2624,6 +2650,101 @@ AK_TEST(assimp_child_crash_and_hang) {
     remove("child.obj");
 }
 
+/* Issue 26 item 7c: a glTF uri that leaves the model's folder gets one message whether or not
+ * its target exists (here: an existing and a missing file, a symlink to each, and an absolute
+ * path to each), naming the uri but never the resolved path. */
+static void uri_message_without_uri(const char* message, const char* uri, char* out, size_t cap) {
+    const char* at = strstr(message, uri);
+    if (!at) {
+        snprintf(out, cap, "%s", message);
+        return;
+    }
+    snprintf(out, cap, "%.*s<uri>%s", (int)(at - message), message, at + strlen(uri));
+}
+
+AK_TEST(gltf_outside_uri_reveals_nothing) {
+    mkdir("leak", 0755);
+    mkdir("leak/model", 0755);
+    write_file("leak/secret.bin", &k_tri, sizeof k_tri);
+    remove("leak/model/l1.bin");
+    remove("leak/model/l2.bin");
+    AK_CHECK_EQ(symlink("../secret.bin", "leak/model/l1.bin"), 0);
+    AK_CHECK_EQ(symlink("../missing.bin", "leak/model/l2.bin"), 0);
+    char cwd[2048], a1[2300], a2[2300];
+    AK_CHECK(getcwd(cwd, sizeof cwd) != NULL);
+    snprintf(a1, sizeof a1, "%s/leak/secret.bin", cwd);
+    snprintf(a2, sizeof a2, "%s/leak/missing.bin", cwd);
+    const char* pairs[][2] = {{"../secret.bin", "../missing.bin"}, {"l1.bin", "l2.bin"}, {a1, a2},
+                              {"../../leak/secret.bin", "../../leak/missing.bin"}, {"/etc/passwd", "/etc/no_such_file_x"}};
+    for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; ++i) {
+        char m[2][700];
+        for (int k = 0; k < 2; ++k) {
+            ak_diag diag;
+            AK_CHECK_EQ(load_tri_file("leak/model/m.gltf", pairs[i][k], NULL, &diag), AK_ERR_IO);
+            AK_CHECK_MSG(strstr(diag.message, "leaves the model's folder") != NULL, "%s", diag.message);
+            AK_CHECK_MSG(!strstr(diag.message, "resolves") && (!strstr(diag.message, cwd) || strstr(pairs[i][k], cwd)),
+                         "%s", diag.message);
+            uri_message_without_uri(diag.message, pairs[i][k], m[k], sizeof m[k]);
+        }
+        AK_CHECK_MSG(strcmp(m[0], m[1]) == 0, "'%s' vs '%s'", m[0], m[1]);
+    }
+    remove("leak/model/l1.bin");
+    remove("leak/model/l2.bin");
+    remove("leak/model/m.gltf");
+    remove("leak/secret.bin");
+    rmdir("leak/model");
+    rmdir("leak");
+}
+
+/* Issue 26 item 4: names with invalid UTF-8 or control bytes are refused (BVH: naming the
+ * line; glTF: naming the element), and error messages never carry a raw byte of the file. */
+AK_TEST(names_valid_utf8) {
+    static const char* bad_names[] = {"bad\xff\xfe", "esc\x1b[31m", "over\xc0\xaf", "sur\xed\xa0\x80"};
+    for (size_t i = 0; i < sizeof bad_names / sizeof bad_names[0]; ++i) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "HIERARCHY\nROOT a\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nJOINT %s\n{\nOFFSET 0 1 0\n"
+                 "End Site\n{\nOFFSET 0 1 0\n}\n}\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n",
+                 bad_names[i]);
+        ak_scene* s = NULL;
+        ak_diag diag;
+        ak_result r = ak_io_load_memory(text, strlen(text), "n.bvh", NULL, NULL, NULL, &s, &diag);
+        AK_CHECK_MSG(r == AK_ERR_PARSE, "bvh name %zu: %s", i, ak_result_name(r));
+        AK_CHECK_MSG(strstr(diag.message, "line 6: the joint name") != NULL, "%s", diag.message);
+        for (const char* c = diag.message; *c; ++c) AK_CHECK((unsigned char)*c >= 0x20 && (unsigned char)*c < 0x7F);
+        ak_scene_destroy(s);
+    }
+    /* a valid non-ASCII name loads and is kept */
+    const char* ok = "HIERARCHY\nROOT h\xc3\xbc" "fte\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nEnd Site\n{\n"
+                     "OFFSET 0 1 0\n}\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n";
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(ok, strlen(ok), "ok.bvh", NULL, NULL, NULL, &s, NULL), AK_OK);
+    if (s) AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 0), "h\xc3\xbc" "fte");
+    ak_scene_destroy(s);
+    /* glTF: raw bytes and \u escapes to control characters, in node, mesh and animation names */
+    static const char* gl[] = {
+        "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"name\":\"a\xff\xfe\"}]}",
+        "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"name\":\"ok\"},{\"name\":\"a\\u001b[2J\"}]}",
+        "{\"asset\":{\"version\":\"2.0\"},\"meshes\":[{\"name\":\"m\\u0007\",\"primitives\":[]}]}",
+        "{\"asset\":{\"version\":\"2.0\"},\"meshes\":[{\"primitives\":[],\"extras\":{\"targetNames\":[\"t\\u0001\"]}}]}",
+    };
+    static const char* where[] = {"nodes[0].name is not valid UTF-8", "nodes[1].name holds a control character",
+                                  "meshes[0].name holds", "meshes[0].extras.targetNames holds"};
+    for (size_t i = 0; i < sizeof gl / sizeof gl[0]; ++i) {
+        ak_diag diag;
+        s = NULL;
+        ak_result r = ak_io_load_memory(gl[i], strlen(gl[i]), "n.gltf", NULL, NULL, NULL, &s, &diag);
+        AK_CHECK_MSG(r == AK_ERR_PARSE, "gltf %zu: %s (%s)", i, ak_result_name(r), diag.message);
+        AK_CHECK_MSG(strstr(diag.message, where[i]) != NULL, "%s", diag.message);
+        ak_scene_destroy(s);
+    }
+    const char* fine = "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"name\":\"\\u00fc\xc3\xbc\"}]}";
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(fine, strlen(fine), "n.gltf", NULL, NULL, NULL, &s, NULL), AK_OK);
+    if (s) AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 0), "\xc3\xbc\xc3\xbc");
+    ak_scene_destroy(s);
+}
+
 int main(void) {
     AK_RUN(desc_defaults);
     AK_RUN(gltf_assets_match_their_json);
@@ -2663,5 +2784,7 @@ int main(void) {
     AK_RUN(obj_mtllib_stays_inside_model_dir);
     AK_RUN(obj_from_memory);
     AK_RUN(assimp_child_crash_and_hang);
+    AK_RUN(gltf_outside_uri_reveals_nothing);
+    AK_RUN(names_valid_utf8);
     return ak_test_finish();
 }
