@@ -112,10 +112,11 @@ __attribute__((format(printf, 2, 3)))
 static void warn(ob_ctx* c, const char* fmt, ...) {
     if (!c->desc->logger.func) return;
     char msg[700];
-    int n = snprintf(msg, sizeof msg, "%s: ", c->name);
+    int n = snprintf(msg, sizeof msg, "%.300s: ", c->name);
+    size_t at = n > 0 && (size_t)n < sizeof msg ? (size_t)n : 0;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg + (n > 0 && (size_t)n < sizeof msg ? (size_t)n : 0), sizeof msg - (size_t)(n > 0 ? n : 0), fmt, ap);
+    vsnprintf(msg + at, sizeof msg - at, fmt, ap);
     va_end(ap);
     akp_io_sanitize(msg, sizeof msg);
     akp_log(&c->desc->logger, AK_LOG_WARN, msg);
