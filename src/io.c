@@ -1,9 +1,15 @@
 /* io: format dispatch, file reading and the pieces both readers share (skeleton building,
  * matrix decomposition, skin weight clean-up). The readers are in src/io/. */
+#ifndef _XOPEN_SOURCE
+#define _XOPEN_SOURCE 700 /* realpath */
+#endif
 #include "io/io_internal.h"
 
 #include <ctype.h>
+#include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
+#include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -43,10 +49,217 @@ static bool has_extension(const char* path, const char* ext) {
     return true;
 }
 
+/* Is the canonical path p inside (or equal to) the canonical directory root? */
+static bool path_inside(const char* p, const char* root) {
+    size_t n = strlen(root);
+    if (n == 1 && root[0] == '/') return p[0] == '/';
+    return strncmp(p, root, n) == 0 && (p[n] == '/' || p[n] == 0);
+}
+
+/* Is p a proper ancestor directory of root (so it exists and is no symlink)? */
+static bool path_above(const char* p, const char* root) {
+    size_t n = strlen(p);
+    if (n == 1 && p[0] == '/') return root[1] != 0;
+    return strncmp(root, p, n) == 0 && root[n] == '/';
+}
+
+/* Does dir (canonical) followed by the components of rest, ".." taken lexically, end
+ * outside every root? */
+static bool lexically_leaves(const char* dir, const char* rest, const char (*roots)[PATH_MAX], size_t root_count) {
+    char p[PATH_MAX];
+    snprintf(p, sizeof p, "%s", dir);
+    for (const char* r = rest; *r;) {
+        while (*r == '/') ++r;
+        const char* e = r;
+        while (*e && *e != '/') ++e;
+        size_t len = (size_t)(e - r), pl = strlen(p);
+        if (len == 2 && r[0] == '.' && r[1] == '.') {
+            char* slash = strrchr(p, '/');
+            if (slash == p) p[1] = 0;
+            else if (slash) *slash = 0;
+        } else if (len > 0 && !(len == 1 && r[0] == '.')) {
+            if (pl + 1 + len >= sizeof p) return false;
+            if (pl != 1) p[pl++] = '/';
+            memcpy(p + pl, r, len);
+            p[pl + len] = 0;
+        }
+        r = e;
+    }
+    for (size_t i = 0; i < root_count; ++i)
+        if (path_inside(p, roots[i])) return false;
+    return true;
+}
+
 /* ---- shared internals ---------------------------------------------------------------- */
+
+ak_result akp_io_resolve_inside(const char* base_dir, const char* path, const ak_io_desc* desc, char* out,
+                                size_t out_size, bool* out_leaves) {
+    *out_leaves = false;
+    if (out_size) out[0] = 0;
+    size_t n_roots = 1 + (desc->extra_roots ? desc->extra_root_count : 0);
+    if (n_roots > 64) n_roots = 64;
+    char(*roots)[PATH_MAX] = (char(*)[PATH_MAX])malloc(n_roots * PATH_MAX);
+    char* rest = (char*)malloc(2 * PATH_MAX);
+    char* cur = (char*)malloc(PATH_MAX);
+    char* link = (char*)malloc(PATH_MAX);
+    ak_result r = AK_ERR_IO;
+    if (!roots || !rest || !cur || !link) goto done;
+    size_t have = 0;
+    if (realpath(base_dir && base_dir[0] ? base_dir : ".", roots[0])) have = 1;
+    for (size_t i = 1; i < n_roots; ++i)
+        if (desc->extra_roots[i - 1] && realpath(desc->extra_roots[i - 1], roots[have])) ++have;
+    if (have == 0 || strlen(path) >= PATH_MAX) goto done;
+    if (desc->allow_any_path) { /* anywhere: the ordinary resolution */
+        snprintf(rest, 2 * PATH_MAX, "%s%s%s", path[0] == '/' ? "" : base_dir && base_dir[0] ? base_dir : ".",
+                 path[0] == '/' ? "" : "/", path);
+        if (realpath(rest, cur) && strlen(cur) < out_size) {
+            snprintf(out, out_size, "%s", cur);
+            r = AK_OK;
+        }
+        goto done;
+    }
+    snprintf(cur, PATH_MAX, "%s", path[0] == '/' ? "/" : roots[0]);
+    snprintf(rest, 2 * PATH_MAX, "%s", path);
+    unsigned links = 0;
+    for (;;) {
+        char* p = rest;
+        while (*p == '/') ++p;
+        if (!*p) break;
+        char* e = strchr(p, '/');
+        size_t len = e ? (size_t)(e - p) : strlen(p);
+        char comp[NAME_MAX + 1];
+        if (len > NAME_MAX) goto done;
+        memcpy(comp, p, len);
+        comp[len] = 0;
+        memmove(rest, p + len, strlen(p + len) + 1);
+        if (strcmp(comp, ".") == 0) continue;
+        if (strcmp(comp, "..") == 0) { /* cur is canonical: its parent is lexical */
+            char* slash = strrchr(cur, '/');
+            if (slash == cur) cur[1] = 0;
+            else if (slash) *slash = 0;
+            continue;
+        }
+        size_t cl = strlen(cur);
+        if (cl + 1 + len >= PATH_MAX) goto done;
+        char* cand = link; /* reuse: cand is consumed before link is read into */
+        memcpy(cand, cur, cl);
+        if (cl != 1) cand[cl++] = '/';
+        memcpy(cand + cl, comp, len + 1);
+        bool inside = false, above = false;
+        for (size_t i = 0; i < have; ++i) {
+            inside = inside || path_inside(cand, roots[i]);
+            above = above || path_above(cand, roots[i]);
+        }
+        if (!inside && !above) {
+            *out_leaves = true;
+            goto done;
+        }
+        struct stat st;
+        if (above || lstat(cand, &st) != 0) {
+            if (!above) { /* missing, inside the folder; "missing/../../x" still leaves it */
+                *out_leaves = lexically_leaves(cand, rest, (const char(*)[PATH_MAX])roots, have);
+                goto done;
+            }
+            snprintf(cur, PATH_MAX, "%s", cand);
+            continue;
+        }
+        if (S_ISLNK(st.st_mode)) {
+            char target[PATH_MAX];
+            if (++links > 40) goto done;
+            ssize_t tl = readlink(cand, target, sizeof target - 1);
+            if (tl <= 0) goto done;
+            target[tl] = 0;
+            if (strlen(rest) + (size_t)tl + 2 >= 2 * PATH_MAX) goto done;
+            memmove(rest + tl + 1, rest, strlen(rest) + 1);
+            memcpy(rest, target, (size_t)tl);
+            rest[tl] = '/';
+            if (target[0] == '/') snprintf(cur, PATH_MAX, "/");
+            continue;
+        }
+        snprintf(cur, PATH_MAX, "%s", cand);
+        const char* more = rest;
+        while (*more == '/') ++more;
+        if (*more && !S_ISDIR(st.st_mode)) goto done;
+    }
+    bool inside = false;
+    for (size_t i = 0; i < have; ++i) inside = inside || path_inside(cur, roots[i]);
+    if (!inside) {
+        *out_leaves = true;
+        goto done;
+    }
+    if (strlen(cur) >= out_size) goto done;
+    snprintf(out, out_size, "%s", cur);
+    r = AK_OK;
+done:
+    free(roots);
+    free(rest);
+    free(cur);
+    free(link);
+    return r;
+}
+
+/* Length of the valid UTF-8 sequence at s (n bytes left), 0 when invalid. */
+static size_t utf8_seq(const unsigned char* s, size_t n) {
+    unsigned char c = s[0];
+    if (c < 0x80) return 1;
+    size_t len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+    if (len == 0 || len > n) return 0;
+    for (size_t i = 1; i < len; ++i)
+        if ((s[i] & 0xC0) != 0x80) return 0;
+    if (c == 0xE0 && s[1] < 0xA0) return 0; /* overlong */
+    if (c == 0xED && s[1] > 0x9F) return 0; /* surrogates */
+    if (c == 0xF0 && s[1] < 0x90) return 0; /* overlong */
+    if (c == 0xF4 && s[1] > 0x8F) return 0; /* above U+10FFFF */
+    return len;
+}
+
+bool akp_io_utf8_valid(const char* s, size_t n) {
+    const unsigned char* u = (const unsigned char*)s;
+    for (size_t i = 0; i < n;) {
+        size_t l = utf8_seq(u + i, n - i);
+        if (l == 0) return false;
+        i += l;
+    }
+    return true;
+}
+
+void akp_io_sanitize(char* msg, size_t size) {
+    if (!msg || size == 0) return;
+    char tmp[2048];
+    size_t n = strlen(msg), o = 0;
+    bool changed = false;
+    for (size_t i = 0; i < n && o + 1 < sizeof tmp;) {
+        const unsigned char c = (unsigned char)msg[i];
+        size_t l = c < 0x20 || c == 0x7F ? 0 : utf8_seq((const unsigned char*)msg + i, n - i);
+        if (l == 0) {
+            if (o + 5 >= sizeof tmp) break;
+            snprintf(tmp + o, 5, "\\x%02X", c);
+            o += 4;
+            ++i;
+            changed = true;
+        } else {
+            if (o + l >= sizeof tmp) break;
+            memcpy(tmp + o, msg + i, l);
+            o += l;
+            i += l;
+        }
+    }
+    if (!changed) return;
+    tmp[o] = 0;
+    /* truncate on a character boundary */
+    size_t keep = o < size - 1 ? o : size - 1;
+    while (keep > 0 && keep < o && ((unsigned char)tmp[keep] & 0xC0) == 0x80) --keep;
+    memcpy(msg, tmp, keep);
+    msg[keep] = 0;
+}
 
 void akp_io_copy_name(char dst[AK_NAME_SIZE], const char* src) {
     snprintf(dst, AK_NAME_SIZE, "%s", src ? src : "");
+    size_t n = strlen(dst);
+    if (src && n == AK_NAME_SIZE - 1 && ((unsigned char)src[n] & 0xC0) == 0x80) { /* cut inside a character */
+        while (n > 0 && ((unsigned char)src[n] & 0xC0) == 0x80) --n;
+        dst[n] = 0;
+    }
 }
 
 akp_budget akp_io_budget(const ak_io_desc* desc, size_t input_size) {
@@ -281,6 +494,7 @@ ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocato
     if (fmt == AK_IO_FORMAT_AUTO) {
         fmt = (has_extension(path, ".gltf") || has_extension(path, ".glb")) ? AK_IO_FORMAT_GLTF
               : has_extension(path, ".bvh")                                 ? AK_IO_FORMAT_BVH
+              : has_extension(path, ".obj")                                 ? AK_IO_FORMAT_OBJ
                                                                             : AK_IO_FORMAT_ASSIMP;
         char magic[4] = {0};
         FILE* f = fmt == AK_IO_FORMAT_ASSIMP ? fopen(path, "rb") : NULL;
@@ -303,7 +517,8 @@ ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_allocato
     if (base && base == path) snprintf(dir, sizeof dir, "/");
     else if (base) snprintf(dir, sizeof dir, "%.*s", (int)(base - path), path);
     else snprintf(dir, sizeof dir, ".");
-    r = akp_io_load_gltf(data, size, base ? base + 1 : path, dir, &d, alloc, out_scene, diag);
+    if (fmt == AK_IO_FORMAT_OBJ) r = akp_io_load_obj(data, size, path, dir, &d, alloc, out_scene, diag);
+    else r = akp_io_load_gltf(data, size, base ? base + 1 : path, dir, &d, alloc, out_scene, diag);
     if (r != AK_OK && diag) snprintf(diag->path, sizeof diag->path, "%s", path);
     akp_free(alloc, data);
     return r;
@@ -319,9 +534,26 @@ ak_result ak_io_load_memory(const void* data, size_t size, const char* name, con
     }
     ak_io_desc d = ak_io_desc_resolved(desc);
     if (desc && desc->format != AK_IO_FORMAT_AUTO && desc->format != AK_IO_FORMAT_GLTF &&
-        desc->format != AK_IO_FORMAT_BVH) {
-        akp_diag_set(diag, name, "ak_io_load_memory reads glTF and BVH only");
+        desc->format != AK_IO_FORMAT_BVH && desc->format != AK_IO_FORMAT_OBJ) {
+        akp_diag_set(diag, name, "ak_io_load_memory reads glTF, BVH and OBJ only");
         return AK_ERR_UNSUPPORTED;
+    }
+    if (d.format == AK_IO_FORMAT_OBJ) { /* the reader wants the text NUL-terminated */
+        akp_budget b = akp_io_budget(&d, size);
+        if (!akp_budget_take(&b, 1, size + 1)) {
+            akp_diag_set(diag, name, "%zu bytes exceed the memory budget of %zu bytes", size, b.limit);
+            return AK_ERR_UNSUPPORTED;
+        }
+        uint8_t* copy = (uint8_t*)akp_alloc(alloc, size + 1);
+        if (!copy) {
+            akp_diag_set(diag, name, "out of memory");
+            return AK_ERR_NO_MEMORY;
+        }
+        if (size) memcpy(copy, data, size);
+        copy[size] = 0;
+        ak_result r = akp_io_load_obj(copy, size, name, base_dir, &d, alloc, out_scene, diag);
+        akp_free(alloc, copy);
+        return r;
     }
     static const uint8_t empty[1] = {0};
     bool bvh = d.format == AK_IO_FORMAT_BVH;

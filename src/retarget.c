@@ -210,6 +210,83 @@ ak_result ak_retarget_map_by_name(const ak_skeleton* source, const ak_skeleton* 
     return AK_OK;
 }
 
+/* A name of a map line, trimmed, copied NUL-terminated into out; false when empty or too long. */
+static bool map_name(const char* s, size_t n, char out[AK_NAME_SIZE]) {
+    while (n && (*s == ' ' || *s == '\t')) ++s, --n;
+    while (n && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\r')) --n;
+    if (n == 0 || n >= AK_NAME_SIZE) return false;
+    memcpy(out, s, n);
+    out[n] = '\0';
+    return true;
+}
+
+/* Fail with "line N: ..." in the diag. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+static ak_result map_fail(ak_diag* diag, ak_result r, long line, const char* fmt, ...) {
+    if (diag) {
+        char msg[sizeof diag->message];
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, sizeof msg, fmt, ap);
+        va_end(ap);
+        akp_diag_set(diag, NULL, "%s", msg);
+        diag->line = line;
+    }
+    return r;
+}
+
+ak_result ak_retarget_map_parse(const char* text, size_t text_size, const ak_skeleton* source,
+                                const ak_skeleton* target, ak_i32_span out, size_t* out_mapped_count, ak_diag* diag) {
+    if (out_mapped_count) *out_mapped_count = 0;
+    if (!source || !target || !out.ptr || (!text && text_size > 0))
+        return map_fail(diag, AK_ERR_NULL_ARG, 0, "a skeleton, the map span or the text is NULL");
+    const size_t nt = ak_skeleton_joint_count(target);
+    if (out.count < nt) return map_fail(diag, AK_ERR_SPAN_SMALL, 0, "the map span holds %zu entries, fewer than the "
+                                        "target's %zu joints", out.count, nt);
+    for (size_t k = 0; k < nt; ++k) out.ptr[k] = -1;
+    size_t mapped = 0;
+    long line = 1;
+    for (size_t at = 0; at < text_size; ++line) {
+        const char* s = text + at;
+        const char* nl = (const char*)memchr(s, '\n', text_size - at);
+        size_t n = nl ? (size_t)(nl - s) : text_size - at;
+        at += n + (nl ? 1 : 0);
+        if (memchr(s, '\0', n)) {
+            for (size_t k = 0; k < nt; ++k) out.ptr[k] = -1;
+            return map_fail(diag, AK_ERR_PARSE, line, "line %ld holds a NUL byte", line);
+        }
+        const char* hash = (const char*)memchr(s, '#', n);
+        if (hash) n = (size_t)(hash - s);
+        size_t blank = 0;
+        while (blank < n && (s[blank] == ' ' || s[blank] == '\t' || s[blank] == '\r')) ++blank;
+        if (blank == n) continue;
+        const char* eq = (const char*)memchr(s, '=', n);
+        char tn[AK_NAME_SIZE], sn[AK_NAME_SIZE];
+        ak_result r = AK_OK;
+        if (!eq || !map_name(s, (size_t)(eq - s), tn) || !map_name(eq + 1, n - (size_t)(eq - s) - 1, sn)) {
+            r = map_fail(diag, AK_ERR_PARSE, line,
+                         "line %ld: expected 'TARGET_JOINT = SOURCE_JOINT' (names of 1 to %d bytes)", line,
+                         AK_NAME_SIZE - 1);
+        } else {
+            const int tj = ak_skeleton_find_joint(target, tn), sj = ak_skeleton_find_joint(source, sn);
+            if (tj < 0) r = map_fail(diag, AK_ERR_NOT_FOUND, line, "line %ld: the target has no joint '%s'", line, tn);
+            else if (sj < 0) r = map_fail(diag, AK_ERR_NOT_FOUND, line, "line %ld: the source has no joint '%s'", line, sn);
+            else if (out.ptr[tj] >= 0)
+                r = map_fail(diag, AK_ERR_DUPLICATE, line, "line %ld: target joint '%s' is mapped twice", line, tn);
+            else out.ptr[tj] = sj, ++mapped;
+        }
+        if (r != AK_OK) {
+            for (size_t k = 0; k < nt; ++k) out.ptr[k] = -1;
+            return r;
+        }
+    }
+    if (mapped == 0) return map_fail(diag, AK_ERR_EMPTY, 0, "the map maps no joint");
+    if (out_mapped_count) *out_mapped_count = mapped;
+    return AK_OK;
+}
+
 ak_retarget_desc ak_retarget_desc_resolved(const ak_retarget_desc* desc) {
     ak_retarget_desc d;
     memset(&d, 0, sizeof d);

@@ -9,6 +9,8 @@
 
 #include <animkit/terrain.h>
 
+#include "internal.h" /* akp_file_atomic: outputs written whole or not at all */
+
 #define AKP_TERRAIN_MAX_SIDE 16384u
 
 /* ---- desc -------------------------------------------------------------------------------- */
@@ -399,8 +401,9 @@ ak_result ak_terrain_write_obj(const char* path, const ak_terrain_desc* desc, ak
     const ak_terrain_desc d = ak_terrain_desc_resolved(desc);
     const size_t n = sample_count(&d);
     if (heights.count < n || normals.count < n) return AK_ERR_SPAN_SMALL;
-    FILE* f = fopen(path, "w");
-    if (!f) return AK_ERR_IO;
+    akp_file_atomic out; /* a temporary renamed over path once complete (internal.h) */
+    if (akp_file_atomic_open(&out, path) != AK_OK) return AK_ERR_IO;
+    FILE* f = out.f;
     const uint32_t w = d.width, h = d.height;
     fprintf(f, "# animkit terrain %ux%u, world %g m\no terrain\n", w, h, (double)d.world_size);
     for (uint32_t j = 0; j < h; ++j)
@@ -419,8 +422,7 @@ ak_result ak_terrain_write_obj(const char* path, const ak_terrain_desc* desc, ak
             fprintf(f, "f %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu\n", a, a, a, c, c, c, b, b, b);
             fprintf(f, "f %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu\n", b, b, b, c, c, c, e, e, e);
         }
-    const bool ok = !ferror(f);
-    return (fclose(f) == 0 && ok) ? AK_OK : AK_ERR_IO;
+    return akp_file_atomic_commit(&out);
 }
 
 typedef struct png_jmp {
@@ -486,9 +488,11 @@ ak_result ak_terrain_write_png16(const char* path, const ak_terrain_desc* desc, 
         }
     }
     const double scale = hi > lo ? 65535.0 / ((double)hi - lo) : 0.0;
-    FILE* f = fopen(path, "wb");
-    if (!f) return AK_ERR_IO;
-    const bool ok = write_png16_rows(f, heights.ptr, d.width, d.height, lo, scale);
-    const bool closed = fclose(f) == 0;
-    return ok && closed ? AK_OK : AK_ERR_IO;
+    akp_file_atomic out; /* a temporary renamed over path once complete (internal.h) */
+    if (akp_file_atomic_open(&out, path) != AK_OK) return AK_ERR_IO;
+    if (!write_png16_rows(out.f, heights.ptr, d.width, d.height, lo, scale)) {
+        akp_file_atomic_abort(&out);
+        return AK_ERR_IO;
+    }
+    return akp_file_atomic_commit(&out);
 }

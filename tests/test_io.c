@@ -669,18 +669,52 @@ AK_TEST(obj_through_assimp) {
         line = nl ? nl + 1 : NULL;
     }
     free(text);
-    ak_scene* s = load(path, NULL);
-    AK_CHECK(s != NULL);
-    if (!s) return;
-    size_t v = 0, t = 0;
-    for (size_t m = 0; m < s->mesh_count; ++m) {
-        v += s->meshes[m].mesh->vertex_count;
-        t += s->meshes[m].mesh->triangle_count;
+    /* animkit's own reader (AUTO for .obj) and Assimp (in its child process) give the same
+     * counts, and the same meshes vertex for vertex */
+    ak_scene* both[2] = {NULL, NULL};
+    for (int k = 0; k < 2; ++k) {
+        ak_io_desc desc = {.format = k ? AK_IO_FORMAT_ASSIMP : AK_IO_FORMAT_AUTO};
+        ak_diag diag;
+        AK_CHECK_EQ(ak_io_load(path, &desc, NULL, &both[k], &diag), AK_OK);
+        ak_scene* s = both[k];
+        AK_CHECK(s != NULL);
+        if (!s) continue;
+        size_t v = 0, t = 0;
+        for (size_t m = 0; m < s->mesh_count; ++m) {
+            v += s->meshes[m].mesh->vertex_count;
+            t += s->meshes[m].mesh->triangle_count;
+        }
+        AK_CHECK_EQ(v, corners);
+        AK_CHECK_EQ(t, tris);
+        AK_CHECK_EQ(s->clip_count, 0);
     }
-    AK_CHECK_EQ(v, corners);
-    AK_CHECK_EQ(t, tris);
-    AK_CHECK_EQ(s->clip_count, 0);
-    ak_scene_destroy(s);
+    if (both[0] && both[1]) {
+        AK_CHECK_EQ(both[0]->mesh_count, both[1]->mesh_count);
+        AK_CHECK_EQ(ak_scene_joint_count(both[0]), ak_scene_joint_count(both[1]));
+        for (size_t j = 0; j < ak_scene_joint_count(both[0]) && j < ak_scene_joint_count(both[1]); ++j)
+            AK_CHECK_STREQ(ak_skeleton_joint_name(both[0]->skeleton, j), ak_skeleton_joint_name(both[1]->skeleton, j));
+        for (size_t m = 0; m < both[0]->mesh_count && m < both[1]->mesh_count; ++m) {
+            const ak_mesh *a = both[0]->meshes[m].mesh, *b = both[1]->meshes[m].mesh;
+            AK_CHECK_STREQ(a->name, b->name);
+            AK_CHECK_EQ(both[0]->meshes[m].node, both[1]->meshes[m].node);
+            AK_CHECK_EQ(a->vertex_count, b->vertex_count);
+            AK_CHECK_EQ(a->uvs != NULL, b->uvs != NULL);
+            if (a->vertex_count != b->vertex_count) continue;
+            /* Assimp's fast_atof is not correctly rounded: the last bit may differ */
+            double worst = 0.0;
+            for (size_t i = 0; i < a->vertex_count; ++i) {
+                const float* pa = &a->positions[i].x;
+                const float* pb = &b->positions[i].x;
+                for (int k = 0; k < 3; ++k) worst = fmax(worst, fabs((double)pa[k] - pb[k]) / fmax(1.0, fabs(pb[k])));
+                if (a->uvs && b->uvs)
+                    worst = fmax(worst, fmax(fabs((double)a->uvs[i].x - b->uvs[i].x), fabs((double)a->uvs[i].y - b->uvs[i].y)));
+            }
+            AK_CHECK_MSG(worst < 1e-6, "mesh %zu differs by %g", m, worst);
+            AK_CHECK(memcmp(a->indices, b->indices, 3 * a->triangle_count * sizeof(uint32_t)) == 0);
+        }
+    }
+    ak_scene_destroy(both[0]);
+    ak_scene_destroy(both[1]);
 }
 
 /* BVH headers the Assimp path must not turn into nonsense: "Frames: 0" (Assimp's duration
@@ -2064,6 +2098,32 @@ AK_TEST(bvh_truncated_prefixes_fail) {
     }
     printf("  %d truncated BVH copies, %d loaded\n", cuts, loaded);
     AK_CHECK_EQ(loaded, 0);
+    /* issue 26 item 11a: cut inside the last number ("-19.3215" -> "-19.3" or "-1"), or just
+     * before the final newline: the last frame line has no newline, refused naming the frame */
+    size_t nl_at = n;
+    while (nl_at > 0 && (small[nl_at - 1] == '\n' || small[nl_at - 1] == '\r')) --nl_at;
+    AK_CHECK(nl_at > last + 1);
+    for (size_t l = last + 1; l <= nl_at; ++l) {
+        ak_io_desc as_bvh = {.format = AK_IO_FORMAT_BVH};
+        ak_diag diag;
+        s = NULL;
+        ak_result r = ak_io_load_memory(small, l, "cut.bvh", NULL, &as_bvh, NULL, &s, &diag);
+        AK_CHECK_MSG(r == AK_ERR_PARSE, "cut at %zu of %zu: %s", l, n, ak_result_name(r));
+        if (r != AK_OK)
+            AK_CHECK_MSG(strstr(diag.message, "the file ends inside frame 20 (truncated?)") != NULL, "%s", diag.message);
+        ak_scene_destroy(s);
+    }
+    /* with its newline (LF or CRLF) the same text loads */
+    char* crlf = (char*)malloc(nl_at + 3);
+    memcpy(crlf, small, nl_at);
+    memcpy(crlf + nl_at, "\r\n", 3);
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(crlf, nl_at + 2, "cut.bvh", NULL, NULL, NULL, &s, NULL), AK_OK);
+    ak_scene_destroy(s);
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(crlf, nl_at + 1, "cut.bvh", NULL, NULL, NULL, &s, NULL), AK_ERR_PARSE); /* a lone CR */
+    ak_scene_destroy(s);
+    free(crlf);
     free(small);
     free(text);
 }
@@ -2101,6 +2161,7 @@ AK_TEST(assimp_prechecks) {
  * the attribute (fuzz_obj found "vn 0 0 1e39" loading with an infinite normal). Assimp
  * itself replaces a non-finite OBJ "vt" by 0, so UVs are not tried here. */
 AK_TEST(assimp_non_finite_attributes) {
+    const ak_io_desc as_assimp = {.format = AK_IO_FORMAT_ASSIMP}; /* .obj is animkit's own reader now */
     static const struct {
         const char* text;
         const char* message;
@@ -2114,7 +2175,7 @@ AK_TEST(assimp_non_finite_attributes) {
         ak_scene* s = NULL;
         ak_diag diag;
         memset(&diag, 0, sizeof diag);
-        AK_CHECK_EQ(ak_io_load("nonfinite.obj", NULL, NULL, &s, &diag), AK_ERR_BAD_DATA);
+        AK_CHECK_EQ(ak_io_load("nonfinite.obj", &as_assimp, NULL, &s, &diag), AK_ERR_BAD_DATA);
         AK_CHECK(s == NULL);
         AK_CHECK(strstr(diag.message, cases[i].message) != NULL);
         if (!strstr(diag.message, cases[i].message)) printf("  case %zu: '%s'\n", i, diag.message);
@@ -2125,7 +2186,7 @@ AK_TEST(assimp_non_finite_attributes) {
     write_file("nonfinite.obj", ok, strlen(ok));
     ak_scene* s = NULL;
     ak_diag diag;
-    AK_CHECK_EQ(ak_io_load("nonfinite.obj", NULL, NULL, &s, &diag), AK_OK);
+    AK_CHECK_EQ(ak_io_load("nonfinite.obj", &as_assimp, NULL, &s, &diag), AK_OK);
     if (s && s->mesh_count == 1) {
         const ak_mesh* m = s->meshes[0].mesh;
         AK_CHECK_EQ(ak_mesh_validate(m, NULL), AK_OK);
@@ -2151,7 +2212,7 @@ static void count_warnings(ak_log_level level, const char* message, void* user) 
 
 static int load_obj_warnings(const char* path, bool any_path) {
     int warnings = 0;
-    ak_io_desc desc = {.logger = {count_warnings, &warnings}, .allow_any_path = any_path};
+    ak_io_desc desc = {.logger = {count_warnings, &warnings}, .allow_any_path = any_path, .format = AK_IO_FORMAT_ASSIMP};
     ak_scene* s = NULL;
     ak_diag diag;
     AK_CHECK_EQ(ak_io_load(path, &desc, NULL, &s, &diag), AK_OK);
@@ -2225,6 +2286,465 @@ AK_TEST(inline_sampler_on_gltf_assets) {
     AK_CHECK(worst < 1e-6);
 }
 
+/* ---- animkit's own OBJ reader ------------------------------------------------------------ */
+
+static ak_result load_obj_text(const char* path, const char* text, const ak_io_desc* desc, ak_scene** out,
+                               ak_diag* diag) {
+    write_file(path, text, strlen(text));
+    *out = NULL;
+    memset(diag, 0, sizeof *diag);
+    return ak_io_load(path, desc, NULL, out, diag);
+}
+
+/* Issue 26 item 2: Assimp 5.2.5 crashes (SIGSEGV) on this four-line OBJ whose .mtl has
+ * map_Kd before any newmtl. animkit's reader loads it: one triangle, no material. */
+AK_TEST(obj_four_line_crash_file) {
+    write_file("s.mtl", "map_Kd t.png\n", 13);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_obj_text("crash4.obj", "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL, &s, &diag), AK_OK);
+    AK_CHECK(s != NULL && s->mesh_count == 1);
+    if (s && s->mesh_count == 1) {
+        const ak_mesh* m = s->meshes[0].mesh;
+        AK_CHECK_EQ(m->vertex_count, 3);
+        AK_CHECK_EQ(m->triangle_count, 1);
+        AK_CHECK_NEAR(m->positions[1].x, 1.0, 0);
+        AK_CHECK_NEAR(m->positions[2].y, 1.0, 0);
+        AK_CHECK(!s->meshes[0].has_material);
+        AK_CHECK_EQ(s->skin_count, 0);
+        AK_CHECK_EQ(s->clip_count, 0);
+    }
+    ak_scene_destroy(s);
+    /* Assimp on the same file, named explicitly: its crash stays in the child process and
+     * comes back as an error naming the signal */
+    ak_io_desc as_assimp = {.format = AK_IO_FORMAT_ASSIMP};
+    s = NULL;
+    ak_result r = ak_io_load("crash4.obj", &as_assimp, NULL, &s, &diag);
+    AK_CHECK(s == NULL);
+    if (r != AK_OK) {
+        AK_CHECK_EQ(r, AK_ERR_IO);
+        AK_CHECK_MSG(strstr(diag.message, "Assimp crashed reading") != NULL && strstr(diag.message, "signal 11"), "%s",
+                     diag.message);
+    } else {
+        printf("  (this Assimp does not crash on the file)\n");
+    }
+    ak_scene_destroy(s);
+    remove("crash4.obj");
+    remove("s.mtl");
+}
+
+/* A unit cube written as 8 positions, 6 normals and 6 quads (CCW from outside): 24 vertices
+ * (no welding), 12 triangles, each corner at the position and with the normal the test
+ * computed, and each triangle's winding agreeing with its face normal. */
+AK_TEST(obj_cube_geometry) {
+    float p[8][3];
+    for (int i = 0; i < 8; ++i) p[i][0] = (float)(i & 1), p[i][1] = (float)((i >> 1) & 1), p[i][2] = (float)((i >> 2) & 1);
+    /* faces: axis, sign, four corners CCW seen from outside */
+    static const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    static const float normals[6][3] = {{0, 0, -1}, {0, 0, 1}, {0, -1, 0}, {0, 1, 0}, {-1, 0, 0}, {1, 0, 0}};
+    char text[2048];
+    size_t o = 0;
+    for (int i = 0; i < 8; ++i) o += (size_t)snprintf(text + o, sizeof text - o, "v %g %g %g\n", p[i][0], p[i][1], p[i][2]);
+    for (int f = 0; f < 6; ++f)
+        o += (size_t)snprintf(text + o, sizeof text - o, "vn %g %g %g\n", normals[f][0], normals[f][1], normals[f][2]);
+    o += (size_t)snprintf(text + o, sizeof text - o, "o cube\ns 1\n");
+    for (int f = 0; f < 6; ++f)
+        o += (size_t)snprintf(text + o, sizeof text - o, "f %d//%d %d//%d %d//%d %d//%d\n", quads[f][0] + 1, f + 1,
+                              quads[f][1] + 1, f + 1, quads[f][2] + 1, f + 1, quads[f][3] + 1, f + 1);
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_obj_text("cube.obj", text, NULL, &s, &diag), AK_OK);
+    AK_CHECK(s != NULL && s->mesh_count == 1);
+    if (s && s->mesh_count == 1) {
+        const ak_mesh* m = s->meshes[0].mesh;
+        AK_CHECK_STREQ(m->name, "cube");
+        AK_CHECK_EQ(m->vertex_count, 24);
+        AK_CHECK_EQ(m->triangle_count, 12);
+        AK_CHECK(m->normals != NULL && m->uvs == NULL);
+        AK_CHECK_EQ(ak_mesh_validate(m, NULL), AK_OK);
+        for (int f = 0; f < 6 && m->vertex_count == 24 && m->normals; ++f)
+            for (int k = 0; k < 4; ++k) {
+                const ak_vec3 v = m->positions[4 * f + k], n = m->normals[4 * f + k];
+                AK_CHECK(v.x == p[quads[f][k]][0] && v.y == p[quads[f][k]][1] && v.z == p[quads[f][k]][2]);
+                AK_CHECK(n.x == normals[f][0] && n.y == normals[f][1] && n.z == normals[f][2]);
+            }
+        for (size_t t = 0; t < m->triangle_count && m->normals; ++t) {
+            const uint32_t* tri = m->indices + 3 * t;
+            ak_vec3 e1 = ak_vec3_sub(m->positions[tri[1]], m->positions[tri[0]]);
+            ak_vec3 e2 = ak_vec3_sub(m->positions[tri[2]], m->positions[tri[0]]);
+            AK_CHECK(ak_vec3_dot(ak_vec3_cross(e1, e2), m->normals[tri[0]]) > 0.5f);
+        }
+        /* quads are fans: (0,1,2) and (0,2,3) of each face's four vertices */
+        static const uint32_t fan[6] = {0, 1, 2, 0, 2, 3};
+        for (size_t i = 0; i < 6 && m->triangle_count == 12; ++i) AK_CHECK_EQ(m->indices[i], fan[i]);
+        for (size_t i = 0; i < 6 && m->triangle_count == 12; ++i) AK_CHECK_EQ(m->indices[6 * 5 + i], 20 + fan[i]);
+        /* the scene: a root named by the file, one node per object, plain nodes */
+        AK_CHECK_EQ(ak_scene_joint_count(s), 2);
+        AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 0), "cube.obj");
+        AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 1), "cube");
+        AK_CHECK_EQ(s->meshes[0].node, 1);
+        AK_CHECK(s->is_joint && !s->is_joint[0] && !s->is_joint[1]);
+    }
+    ak_scene_destroy(s);
+    remove("cube.obj");
+}
+
+/* Negative (relative) indices name the same corners as positive ones; v/vt, v/vt/vn forms;
+ * a pentagon becomes 3 triangles; "v x y z w" and vertex colours are ignored. */
+AK_TEST(obj_negative_indices_and_forms) {
+    const char* pos = "v 0 0 0 1\nv 2 0 0 1\nv 2 2 0 0.5 0.5 0.5\nv 0 2 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0.5\n"
+                      "vn 0 0 1\n";
+    char a[1024], b[1024];
+    snprintf(a, sizeof a, "%sf 1/1/1 2/2/1 3/3/1 4/4/1 5/5/1\n", pos);
+    snprintf(b, sizeof b, "%sf -5/-5/-1 -4/-4/-1 -3/-3/-1 -2/-2/-1 -1/-1/-1\n", pos);
+    ak_scene *sa = NULL, *sb = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_obj_text("pos.obj", a, NULL, &sa, &diag), AK_OK);
+    AK_CHECK_EQ(load_obj_text("neg.obj", b, NULL, &sb, &diag), AK_OK);
+    if (sa && sb && sa->mesh_count == 1 && sb->mesh_count == 1) {
+        const ak_mesh *ma = sa->meshes[0].mesh, *mb = sb->meshes[0].mesh;
+        AK_CHECK_EQ(ma->vertex_count, 5);
+        AK_CHECK_EQ(ma->triangle_count, 3);
+        AK_CHECK(ma->uvs && ma->normals && mb->uvs && mb->normals);
+        AK_CHECK_EQ(mb->vertex_count, 5);
+        for (size_t v = 0; v < 5 && mb->vertex_count == 5 && ma->uvs && mb->uvs; ++v) {
+            AK_CHECK(memcmp(&ma->positions[v], &mb->positions[v], sizeof(ak_vec3)) == 0);
+            AK_CHECK(memcmp(&ma->uvs[v], &mb->uvs[v], sizeof(ak_vec2)) == 0);
+        }
+        AK_CHECK_NEAR(ma->positions[2].x, 2.0, 0);
+        AK_CHECK_NEAR(ma->positions[4].x, -1.0, 0);
+        AK_CHECK_NEAR(ma->uvs[4].x, 0.5, 0);
+    } else {
+        AK_CHECK(!"both files load with one mesh");
+    }
+    ak_scene_destroy(sa);
+    ak_scene_destroy(sb);
+    /* a corner without vt drops the mesh's UVs (no invented values) */
+    snprintf(a, sizeof a, "%sf 1/1 2/2 3\n", pos);
+    AK_CHECK_EQ(load_obj_text("pos.obj", a, NULL, &sa, &diag), AK_OK);
+    if (sa && sa->mesh_count == 1) AK_CHECK(sa->meshes[0].mesh->uvs == NULL && sa->meshes[0].mesh->normals == NULL);
+    ak_scene_destroy(sa);
+    remove("pos.obj");
+    remove("neg.obj");
+}
+
+/* Errors: the file, the line, the reason; never a raw byte of the file. */
+AK_TEST(obj_errors_name_the_line) {
+    static const struct {
+        const char* text;
+        ak_result r;
+        long line;
+        const char* message;
+    } cases[] = {
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\n# comment\nf 1 2 4\n", AK_ERR_BAD_INDEX, 5, "position index 4 is out of range (3 positions)"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", AK_ERR_BAD_INDEX, 4, "index -4 is out of range"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", AK_ERR_BAD_INDEX, 4, "index is 0"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n", AK_ERR_BAD_INDEX, 5, "normal index 2"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/7 2 3\n", AK_ERR_BAD_INDEX, 4, "UV index 7"},
+        {"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", AK_ERR_BAD_DATA, 2, "'nan' is not finite"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1e39 0\nf 1 2 3\n", AK_ERR_BAD_DATA, 3, "not finite"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 inf\n", AK_ERR_BAD_DATA, 4, "not finite"},
+        {"v 0 0 0\nv 1 0\n", AK_ERR_PARSE, 2, "v has 2 values, 3 expected"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3x\n", AK_ERR_PARSE, 4, "'3x' is not v, v/vt, v//vn or v/vt/vn"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \x1b[31m\n", AK_ERR_PARSE, 4, "\\x1B[31m"},
+        {"v 0 0 0\r\ng bad\xff\xfe\r\n", AK_ERR_PARSE, 2, "group name is not valid UTF-8"},
+        {"v 0 0 0\ng a\x01z\n", AK_ERR_PARSE, 2, "control byte"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        ak_scene* s = NULL;
+        ak_diag diag;
+        ak_result r = load_obj_text("bad.obj", cases[i].text, NULL, &s, &diag);
+        AK_CHECK_MSG(r == cases[i].r, "case %zu: %s (%s)", i, ak_result_name(r), diag.message);
+        AK_CHECK(s == NULL);
+        AK_CHECK_MSG(diag.line == cases[i].line, "case %zu: line %ld", i, diag.line);
+        char want[32];
+        snprintf(want, sizeof want, "line %ld:", cases[i].line);
+        AK_CHECK_MSG(strstr(diag.message, want) && strstr(diag.message, cases[i].message), "case %zu: '%s'", i, diag.message);
+        AK_CHECK_MSG(strstr(diag.path, "bad.obj") != NULL, "case %zu: path '%s'", i, diag.path);
+        for (const char* c = diag.message; *c; ++c) AK_CHECK((unsigned char)*c >= 0x20 && (unsigned char)*c < 0x7F);
+        ak_scene_destroy(s);
+    }
+    /* a tight budget is refused before the arrays are allocated */
+    ak_io_desc tight = {.memory_budget = 200};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_obj_text("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 3\nf 1 2 3\n", &tight, &s, &diag),
+                AK_ERR_UNSUPPORTED);
+    remove("bad.obj");
+}
+
+/* Objects, groups and materials split meshes as Assimp's importer did (compared with Assimp
+ * in its child process), and a .mtl beside the model gives the base colours. */
+AK_TEST(obj_groups_and_materials) {
+    mkdir("objm", 0755);
+    write_file("objm/s.mtl", "# c\nnewmtl red\nKd 1 0 0\nd 0.5\nnewmtl blue\nKd 0 0 1\nmap_Kd x.png\n", 62);
+    const char* text = "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nvt 0.5 0.25\nf 1 2 3\ng grp\n"
+                       "usemtl red\nf 1/1/1 2/1/1 3/1/1 4/1/1\nusemtl blue\nf 1 2 3\ng grp\nf 2 3 4\no obj\n"
+                       "usemtl nomat\nf -1 -2 -3\n";
+    ak_scene *mine = NULL, *theirs = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_obj_text("objm/m.obj", text, NULL, &mine, &diag), AK_OK);
+    ak_io_desc as_assimp = {.format = AK_IO_FORMAT_ASSIMP};
+    AK_CHECK_EQ(ak_io_load("objm/m.obj", &as_assimp, NULL, &theirs, &diag), AK_OK);
+    static const char* names[4] = {"defaultobject", "grp", "blue", "obj"};
+    static const size_t verts[4] = {3, 4, 6, 3};
+    if (mine && theirs && mine->mesh_count == 4 && theirs->mesh_count == 4) {
+        for (size_t m = 0; m < 4; ++m) {
+            AK_CHECK_STREQ(mine->meshes[m].mesh->name, names[m]);
+            AK_CHECK_STREQ(theirs->meshes[m].mesh->name, names[m]);
+            AK_CHECK_EQ(mine->meshes[m].mesh->vertex_count, verts[m]);
+            AK_CHECK_EQ(theirs->meshes[m].mesh->vertex_count, verts[m]);
+            AK_CHECK_EQ(mine->meshes[m].node, theirs->meshes[m].node);
+            if (mine->meshes[m].mesh->vertex_count == verts[m] && theirs->meshes[m].mesh->vertex_count == verts[m])
+                AK_CHECK(memcmp(mine->meshes[m].mesh->positions, theirs->meshes[m].mesh->positions,
+                                verts[m] * sizeof(ak_vec3)) == 0);
+        }
+        AK_CHECK(!mine->meshes[0].has_material);
+        AK_CHECK(mine->meshes[1].has_material && mine->meshes[1].base_color.x == 1.0f &&
+                 mine->meshes[1].base_color.z == 0.0f && mine->meshes[1].base_color.w == 0.5f);
+        AK_CHECK(mine->meshes[2].has_material && mine->meshes[2].base_color.z == 1.0f &&
+                 mine->meshes[2].base_color.w == 1.0f);
+        AK_CHECK(!mine->meshes[3].has_material); /* "nomat" is in no library */
+    } else {
+        AK_CHECK_MSG(0, "mesh counts %zu and %zu, 4 expected", mine ? mine->mesh_count : 0,
+                     theirs ? theirs->mesh_count : 0);
+    }
+    ak_scene_destroy(mine);
+    ak_scene_destroy(theirs);
+    /* a file of vertices only is one point mesh (ak_io_write_obj writes point clouds so) */
+    AK_CHECK_EQ(load_obj_text("objm/p.obj", "v 0 0 0\nv 1 2 3\n", NULL, &mine, &diag), AK_OK);
+    if (mine && mine->mesh_count == 1) {
+        AK_CHECK_EQ(mine->meshes[0].mesh->vertex_count, 2);
+        AK_CHECK_EQ(mine->meshes[0].mesh->triangle_count, 0);
+        AK_CHECK_NEAR(mine->meshes[0].mesh->positions[1].z, 3.0, 0);
+    } else {
+        AK_CHECK(mine && mine->mesh_count == 1);
+    }
+    ak_scene_destroy(mine);
+    remove("objm/p.obj");
+    remove("objm/m.obj");
+    remove("objm/s.mtl");
+    rmdir("objm");
+}
+
+/* mtllib stays inside the model's folder: "../x.mtl", an absolute path and a symlink out are
+ * not read (the model loads without materials, one warning saying only that the path leaves
+ * the folder: the same words whether or not the target exists); a FIFO is not waited on. */
+typedef struct warn_log {
+    int count;
+    char last[700];
+} warn_log;
+
+static void log_warning(ak_log_level level, const char* message, void* user) {
+    warn_log* w = (warn_log*)user;
+    if (level != AK_LOG_WARN) return;
+    ++w->count;
+    snprintf(w->last, sizeof w->last, "%s", message);
+}
+
+static bool obj_mtl_red(const char* path, const char* mtllib, warn_log* w) {
+    char text[2048];
+    snprintf(text, sizeof text, "mtllib %s\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n", mtllib);
+    memset(w, 0, sizeof *w);
+    ak_io_desc desc = {.logger = {log_warning, w}};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_obj_text(path, text, &desc, &s, &diag), AK_OK);
+    bool red = s && s->mesh_count == 1 && s->meshes[0].has_material && s->meshes[0].base_color.x == 1.0f;
+    ak_scene_destroy(s);
+    return red;
+}
+
+AK_TEST(obj_mtllib_stays_inside_model_dir) {
+    mkdir("omtl", 0755);
+    mkdir("omtl/model", 0755);
+    write_file("omtl/secret.mtl", "newmtl red\nKd 1 0 0\n", 20);
+    write_file("omtl/model/inside.mtl", "newmtl red\nKd 1 0 0\n", 20);
+    remove("omtl/model/link.mtl");
+    remove("omtl/model/dangling.mtl");
+    AK_CHECK_EQ(symlink("../secret.mtl", "omtl/model/link.mtl"), 0);
+    AK_CHECK_EQ(symlink("../nothing_here.mtl", "omtl/model/dangling.mtl"), 0);
+    char cwd[2048], abs_secret[2300], abs_missing[2300];
+    AK_CHECK(getcwd(cwd, sizeof cwd) != NULL);
+    snprintf(abs_secret, sizeof abs_secret, "%s/omtl/secret.mtl", cwd);
+    snprintf(abs_missing, sizeof abs_missing, "%s/omtl/missing.mtl", cwd);
+    warn_log w;
+    AK_CHECK(obj_mtl_red("omtl/model/m.obj", "inside.mtl", &w));
+    AK_CHECK_EQ(w.count, 0);
+    const char* out[] = {"../secret.mtl", abs_secret, "link.mtl", "sub/../../secret.mtl", "../missing.mtl", abs_missing,
+                         "dangling.mtl"};
+    for (size_t i = 0; i < sizeof out / sizeof out[0]; ++i) {
+        AK_CHECK_MSG(!obj_mtl_red("omtl/model/m.obj", out[i], &w), "mtllib %s was read", out[i]);
+        AK_CHECK_EQ(w.count, 1);
+        AK_CHECK_MSG(strstr(w.last, "the path leaves the model's folder") != NULL, "%s: %s", out[i], w.last);
+        AK_CHECK_MSG(!strstr(w.last, "cannot open") && !strstr(w.last, "No such"), "%s: %s", out[i], w.last);
+    }
+    /* a missing file inside the folder: not fatal either */
+    AK_CHECK(!obj_mtl_red("omtl/model/m.obj", "nope.mtl", &w));
+    AK_CHECK_EQ(w.count, 1);
+    /* explicit permission */
+    ak_io_desc any = {.allow_any_path = true};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(load_obj_text("omtl/model/m.obj", "mtllib ../secret.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n",
+                              &any, &s, &diag), AK_OK);
+    AK_CHECK(s && s->mesh_count == 1 && s->meshes[0].has_material);
+    ak_scene_destroy(s);
+    remove("omtl/model/fifo.mtl");
+    if (mkfifo("omtl/model/fifo.mtl", 0600) == 0) {
+        alarm(30);
+        AK_CHECK(!obj_mtl_red("omtl/model/m.obj", "fifo.mtl", &w));
+        alarm(0);
+        AK_CHECK_MSG(strstr(w.last, "not a regular file") != NULL, "%s", w.last);
+        remove("omtl/model/fifo.mtl");
+    }
+    mkdir("omtl/model/dir.mtl", 0755);
+    AK_CHECK(!obj_mtl_red("omtl/model/m.obj", "dir.mtl", &w));
+    AK_CHECK_MSG(strstr(w.last, "directory") != NULL, "%s", w.last);
+    rmdir("omtl/model/dir.mtl");
+    const char* files[] = {"omtl/model/m.obj", "omtl/model/link.mtl", "omtl/model/dangling.mtl", "omtl/model/inside.mtl",
+                           "omtl/secret.mtl"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) remove(files[i]);
+    rmdir("omtl/model");
+    rmdir("omtl");
+}
+
+/* The same reader from memory (mtllib relative to base_dir; none without one). */
+AK_TEST(obj_from_memory) {
+    const char* text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n";
+    ak_io_desc desc = {.format = AK_IO_FORMAT_OBJ};
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load_memory(text, strlen(text), "quad.obj", NULL, &desc, NULL, &s, &diag), AK_OK);
+    if (s && s->mesh_count == 1) {
+        AK_CHECK_EQ(s->meshes[0].mesh->vertex_count, 4);
+        AK_CHECK_EQ(s->meshes[0].mesh->triangle_count, 2);
+    } else {
+        AK_CHECK(s && s->mesh_count == 1);
+    }
+    ak_scene_destroy(s);
+}
+
+/* The Assimp child's limits through the test hook (AK_IO_TEST_ASSIMP_CHILD): a crash and a
+ * hang (the parent's wall clock, shortened to 1 s by the hook) come back as errors. */
+AK_TEST(assimp_child_crash_and_hang) {
+    write_file("child.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 32);
+    ak_io_desc as_assimp = {.format = AK_IO_FORMAT_ASSIMP};
+    static const char* hooks[2] = {"segv", "hang"};
+    static const char* want[2] = {"Assimp crashed reading child.obj (signal 11", "Assimp ran out of its time limit"};
+    for (int i = 0; i < 2; ++i) {
+        setenv("AK_IO_TEST_ASSIMP_CHILD", hooks[i], 1);
+        ak_scene* s = NULL;
+        ak_diag diag;
+        ak_result r = ak_io_load("child.obj", &as_assimp, NULL, &s, &diag);
+        unsetenv("AK_IO_TEST_ASSIMP_CHILD");
+        AK_CHECK_EQ(r, AK_ERR_IO);
+        AK_CHECK(s == NULL);
+        AK_CHECK_MSG(strstr(diag.message, want[i]) != NULL, "%s", diag.message);
+        ak_scene_destroy(s);
+    }
+    ak_scene* s = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load("child.obj", &as_assimp, NULL, &s, &diag), AK_OK); /* and without the hook it loads */
+    ak_scene_destroy(s);
+    remove("child.obj");
+}
+
+/* Issue 26 item 7c: a glTF uri that leaves the model's folder gets one message whether or not
+ * its target exists (here: an existing and a missing file, a symlink to each, and an absolute
+ * path to each), naming the uri but never the resolved path. */
+static void uri_message_without_uri(const char* message, const char* uri, char* out, size_t cap) {
+    const char* at = strstr(message, uri);
+    if (!at) {
+        snprintf(out, cap, "%s", message);
+        return;
+    }
+    snprintf(out, cap, "%.*s<uri>%s", (int)(at - message), message, at + strlen(uri));
+}
+
+AK_TEST(gltf_outside_uri_reveals_nothing) {
+    mkdir("leak", 0755);
+    mkdir("leak/model", 0755);
+    write_file("leak/secret.bin", &k_tri, sizeof k_tri);
+    remove("leak/model/l1.bin");
+    remove("leak/model/l2.bin");
+    AK_CHECK_EQ(symlink("../secret.bin", "leak/model/l1.bin"), 0);
+    AK_CHECK_EQ(symlink("../missing.bin", "leak/model/l2.bin"), 0);
+    char cwd[2048], a1[2300], a2[2300];
+    AK_CHECK(getcwd(cwd, sizeof cwd) != NULL);
+    snprintf(a1, sizeof a1, "%s/leak/secret.bin", cwd);
+    snprintf(a2, sizeof a2, "%s/leak/missing.bin", cwd);
+    const char* pairs[][2] = {{"../secret.bin", "../missing.bin"}, {"l1.bin", "l2.bin"}, {a1, a2},
+                              {"../../leak/secret.bin", "../../leak/missing.bin"}, {"/etc/passwd", "/etc/no_such_file_x"}};
+    for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; ++i) {
+        char m[2][700];
+        for (int k = 0; k < 2; ++k) {
+            ak_diag diag;
+            AK_CHECK_EQ(load_tri_file("leak/model/m.gltf", pairs[i][k], NULL, &diag), AK_ERR_IO);
+            AK_CHECK_MSG(strstr(diag.message, "leaves the model's folder") != NULL, "%s", diag.message);
+            AK_CHECK_MSG(!strstr(diag.message, "resolves") && (!strstr(diag.message, cwd) || strstr(pairs[i][k], cwd)),
+                         "%s", diag.message);
+            uri_message_without_uri(diag.message, pairs[i][k], m[k], sizeof m[k]);
+        }
+        AK_CHECK_MSG(strcmp(m[0], m[1]) == 0, "'%s' vs '%s'", m[0], m[1]);
+    }
+    remove("leak/model/l1.bin");
+    remove("leak/model/l2.bin");
+    remove("leak/model/m.gltf");
+    remove("leak/secret.bin");
+    rmdir("leak/model");
+    rmdir("leak");
+}
+
+/* Issue 26 item 4: names with invalid UTF-8 or control bytes are refused (BVH: naming the
+ * line; glTF: naming the element), and error messages never carry a raw byte of the file. */
+AK_TEST(names_valid_utf8) {
+    static const char* bad_names[] = {"bad\xff\xfe", "esc\x1b[31m", "over\xc0\xaf", "sur\xed\xa0\x80"};
+    for (size_t i = 0; i < sizeof bad_names / sizeof bad_names[0]; ++i) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "HIERARCHY\nROOT a\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nJOINT %s\n{\nOFFSET 0 1 0\n"
+                 "End Site\n{\nOFFSET 0 1 0\n}\n}\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n",
+                 bad_names[i]);
+        ak_scene* s = NULL;
+        ak_diag diag;
+        ak_result r = ak_io_load_memory(text, strlen(text), "n.bvh", NULL, NULL, NULL, &s, &diag);
+        AK_CHECK_MSG(r == AK_ERR_PARSE, "bvh name %zu: %s", i, ak_result_name(r));
+        AK_CHECK_MSG(strstr(diag.message, "line 6: the joint name") != NULL, "%s", diag.message);
+        for (const char* c = diag.message; *c; ++c) AK_CHECK((unsigned char)*c >= 0x20 && (unsigned char)*c < 0x7F);
+        ak_scene_destroy(s);
+    }
+    /* a valid non-ASCII name loads and is kept */
+    const char* ok = "HIERARCHY\nROOT h\xc3\xbc" "fte\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nEnd Site\n{\n"
+                     "OFFSET 0 1 0\n}\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n";
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(ok, strlen(ok), "ok.bvh", NULL, NULL, NULL, &s, NULL), AK_OK);
+    if (s) AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 0), "h\xc3\xbc" "fte");
+    ak_scene_destroy(s);
+    /* glTF: raw bytes and \u escapes to control characters, in node, mesh and animation names */
+    static const char* gl[] = {
+        "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"name\":\"a\xff\xfe\"}]}",
+        "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"name\":\"ok\"},{\"name\":\"a\\u001b[2J\"}]}",
+        "{\"asset\":{\"version\":\"2.0\"},\"meshes\":[{\"name\":\"m\\u0007\",\"primitives\":[]}]}",
+        "{\"asset\":{\"version\":\"2.0\"},\"meshes\":[{\"primitives\":[],\"extras\":{\"targetNames\":[\"t\\u0001\"]}}]}",
+    };
+    static const char* where[] = {"nodes[0].name is not valid UTF-8", "nodes[1].name holds a control character",
+                                  "meshes[0].name holds", "meshes[0].extras.targetNames holds"};
+    for (size_t i = 0; i < sizeof gl / sizeof gl[0]; ++i) {
+        ak_diag diag;
+        s = NULL;
+        ak_result r = ak_io_load_memory(gl[i], strlen(gl[i]), "n.gltf", NULL, NULL, NULL, &s, &diag);
+        AK_CHECK_MSG(r == AK_ERR_PARSE, "gltf %zu: %s (%s)", i, ak_result_name(r), diag.message);
+        AK_CHECK_MSG(strstr(diag.message, where[i]) != NULL, "%s", diag.message);
+        ak_scene_destroy(s);
+    }
+    const char* fine = "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"name\":\"\\u00fc\xc3\xbc\"}]}";
+    s = NULL;
+    AK_CHECK_EQ(ak_io_load_memory(fine, strlen(fine), "n.gltf", NULL, NULL, NULL, &s, NULL), AK_OK);
+    if (s) AK_CHECK_STREQ(ak_skeleton_joint_name(s->skeleton, 0), "\xc3\xbc\xc3\xbc");
+    ak_scene_destroy(s);
+}
+
 int main(void) {
     AK_RUN(desc_defaults);
     AK_RUN(gltf_assets_match_their_json);
@@ -2256,5 +2776,15 @@ int main(void) {
     AK_RUN(assimp_non_finite_attributes);
     AK_RUN(assimp_companion_files_stay_inside_model_dir);
     AK_RUN(inline_sampler_on_gltf_assets);
+    AK_RUN(obj_four_line_crash_file);
+    AK_RUN(obj_cube_geometry);
+    AK_RUN(obj_negative_indices_and_forms);
+    AK_RUN(obj_errors_name_the_line);
+    AK_RUN(obj_groups_and_materials);
+    AK_RUN(obj_mtllib_stays_inside_model_dir);
+    AK_RUN(obj_from_memory);
+    AK_RUN(assimp_child_crash_and_hang);
+    AK_RUN(gltf_outside_uri_reveals_nothing);
+    AK_RUN(names_valid_utf8);
     return ak_test_finish();
 }

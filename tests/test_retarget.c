@@ -239,11 +239,63 @@ AK_TEST(desc_rules) {
     ak_skeleton_destroy(sk);
 }
 
+/* Map files: each rule of ak_retarget_map_parse with its exact code and the line named. */
+AK_TEST(map_parse) {
+    ak_skeleton* sk = make_skeleton(1.0f, 0.0f);
+    int32_t map[NJ + 1];
+    size_t mapped = 99;
+    ak_diag diag;
+    const char ok[] = "# target = source\n\n  pelvis\t=  pelvis  # the root\r\nleft_knee=right_knee\nneck = head";
+    AK_CHECK_EQ(ak_retarget_map_parse(ok, sizeof ok - 1, sk, sk, (ak_i32_span){map, NJ}, &mapped, &diag), AK_OK);
+    AK_CHECK_EQ(mapped, (size_t)3);
+    AK_CHECK_EQ(map[0], 0);
+    AK_CHECK_EQ(map[11], 14);
+    AK_CHECK_EQ(map[2], 3);
+    AK_CHECK_EQ(map[1], -1);
+    const struct {
+        const char* text;
+        size_t size; /* 0: strlen */
+        ak_result code;
+        long line;
+        const char* says;
+    } bad[] = {
+        {"pelvis = pelvis\nneck head\n", 0, AK_ERR_PARSE, 2, "line 2: expected"},
+        {"pelvis =\n", 0, AK_ERR_PARSE, 1, "expected"},
+        {" = pelvis\n", 0, AK_ERR_PARSE, 1, "expected"},
+        {"pelvis = pelvis\nneck = head\0\n", 28, AK_ERR_PARSE, 2, "line 2 holds a NUL byte"},
+        {"tail = pelvis\n", 0, AK_ERR_NOT_FOUND, 1, "target has no joint 'tail'"},
+        {"pelvis = tail\n", 0, AK_ERR_NOT_FOUND, 1, "source has no joint 'tail'"},
+        {"neck = head\n# x\nneck = pelvis\n", 0, AK_ERR_DUPLICATE, 3, "mapped twice"},
+        {"# nothing\n\n", 0, AK_ERR_EMPTY, 0, "maps no joint"},
+        {"", 0, AK_ERR_EMPTY, 0, "maps no joint"},
+        {"pelvis = aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n", 0, AK_ERR_PARSE, 1,
+         "expected"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        size_t n = bad[i].size ? bad[i].size : strlen(bad[i].text);
+        mapped = 99;
+        ak_result r = ak_retarget_map_parse(bad[i].text, n, sk, sk, (ak_i32_span){map, NJ}, &mapped, &diag);
+        AK_CHECK_MSG(r == bad[i].code, "case %zu: %s, want %s", i, ak_result_name(r), ak_result_name(bad[i].code));
+        AK_CHECK_MSG(diag.line == bad[i].line && strstr(diag.message, bad[i].says), "case %zu: line %ld: %s", i,
+                     diag.line, diag.message);
+        AK_CHECK_EQ(mapped, (size_t)0);
+        bool cleared = true;
+        for (int k = 0; k < NJ; ++k) cleared = cleared && map[k] == -1;
+        AK_CHECK_MSG(cleared, "case %zu: the map is not left all -1", i);
+    }
+    AK_CHECK_EQ(ak_retarget_map_parse(ok, sizeof ok - 1, sk, sk, (ak_i32_span){map, NJ - 1}, NULL, NULL), AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_retarget_map_parse(ok, sizeof ok - 1, NULL, sk, (ak_i32_span){map, NJ}, NULL, NULL), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_retarget_map_parse(NULL, 3, sk, sk, (ak_i32_span){map, NJ}, NULL, NULL), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_retarget_map_parse(NULL, 0, sk, sk, (ak_i32_span){map, NJ}, NULL, NULL), AK_ERR_EMPTY);
+    ak_skeleton_destroy(sk);
+}
+
 int main(void) {
     AK_RUN(identity_on_same_skeleton);
     AK_RUN(uniformly_scaled_copy);
     AK_RUN(rest_pose_arms_turned_45_degrees);
     AK_RUN(bone_names);
     AK_RUN(desc_rules);
+    AK_RUN(map_parse);
     return ak_test_finish();
 }

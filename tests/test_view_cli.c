@@ -5,6 +5,7 @@
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -68,6 +69,10 @@ AK_TEST(bad_scripts_exit_2_naming_the_line) {
         {"key nosuchkey\n", 1},
         {"wheel nan\n", 1},
         {"key space\nkey space\nscreenshot out.txt\n", 3},
+        {"screenshot ../out.png\n", 1},
+        {"key space\nscreenshot /tmp/out.png\n", 2},
+        {"# x\nscreenshot a/../../out.png\n", 2},
+        {"screenshot sub/..\n", 1}, /* not .png either: the first rule that fails is named */
         {"quit now\n", 1},
         {"wait 1 2\n", 1},
     };
@@ -86,6 +91,38 @@ AK_TEST(bad_scripts_exit_2_naming_the_line) {
     AK_CHECK_EQ(run("view builtin:cylinder --headless --clip nope", true), 1);
     AK_CHECK_EQ(run("view no_such_model.glb --headless", true), 1);
     AK_CHECK_EQ(run("view builtin:cylinder --headless --frames 3", true), 0);
+    /* an integer out of range says so, with the range; one that is no integer says that */
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --frames 99999999999", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "--frames 99999999999 is out of range") && strstr(out_buf, "0..100000000"), "%s", out_buf);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --frames 12x", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "'12x' is not a whole number"), "%s", out_buf);
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --supersample 5", true), 2);
+    AK_CHECK_MSG(strstr(out_buf, "out of range") && strstr(out_buf, "1..4"), "%s", out_buf);
+}
+
+/* A script's screenshots go under --shot-dir (default .): absolute paths and '..' are refused
+ * when the script is read (above); a symlink under the shot directory, in the middle of the
+ * path or at its end, is refused when the line runs: exit 1 naming the line, nothing written
+ * through the link, the earlier screenshots kept. */
+AK_TEST(script_screenshots_stay_in_shot_dir) {
+    AK_CHECK_EQ(system("rm -rf shots_sd shots_victim.png shots_out_b.png && mkdir -p shots_sd/sub"), 0);
+    AK_CHECK_EQ(symlink("..", "shots_sd/up"), 0);                     /* a folder link leading out */
+    AK_CHECK_EQ(symlink("../shots_victim.png", "shots_sd/c.png"), 0); /* a file link leading out */
+    AK_CHECK(write_file("shots_victim.png", "victim\n"));
+    write_file("shots.txt", "screenshot sub/a.png\nscreenshot ./b.png\nscreenshot up/shots_out_b.png\n");
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 64x48 --script shots.txt --shot-dir shots_sd", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "shots.txt: line 3") && strstr(out_buf, "symlink"), "%s", out_buf);
+    AK_CHECK(read_file("shots_sd/sub/a.png") != NULL);
+    AK_CHECK(read_file("shots_sd/b.png") != NULL);
+    AK_CHECK(read_file("shots_out_b.png") == NULL);
+    write_file("shots2.txt", "wait 1\nscreenshot c.png\n");
+    AK_CHECK_EQ(run("view builtin:cylinder --headless --size 64x48 --script shots2.txt --shot-dir shots_sd", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "shots2.txt: line 2") && strstr(out_buf, "symlink"), "%s", out_buf);
+    const char* v = read_file("shots_victim.png");
+    AK_CHECK(v && strcmp(v, "victim\n") == 0);
+    struct stat st;
+    AK_CHECK(lstat("shots_sd/c.png", &st) == 0 && S_ISLNK(st.st_mode));
+    AK_CHECK_EQ(system("rm -rf shots_sd shots_victim.png"), 0);
 }
 
 /* Keys 1/2/3 give `animkit render --method` images at the same time, size and camera: the
@@ -464,6 +501,23 @@ AK_TEST(sim_bad_specs) {
         AK_CHECK_MSG(rc == cases[i].rc, "%s: exit %d (want %d): %s", cases[i].args, rc, cases[i].rc, out_buf);
         AK_CHECK_MSG(strstr(out_buf, cases[i].says) != NULL, "%s: '%s' not said: %s", cases[i].args, cases[i].says, out_buf);
     }
+}
+
+/* A simulation step that fails (here a cloth blowing up at its second step, the scene's
+ * dt being 1 s) ends the viewer with exit 1 and its message, and writes no later screenshot;
+ * `animkit view particles:` behaved so already, cloth went on with exit 0. */
+AK_TEST(sim_failure_exits_1) {
+    write_file("sim_nan.json", "{\"gravity\": [0, -3e38, 0], \"dt\": 1}\n");
+    write_file("sim_nan.txt", "screenshot sim_nan0.png\nwait 90\nscreenshot sim_nan1.png\n");
+    remove("sim_nan0.png");
+    remove("sim_nan1.png");
+    AK_CHECK_EQ(run("view cloth:sim_nan.json --headless --size 64x48 --script sim_nan.txt", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "sim_nan.json") && strstr(out_buf, "step 2"), "%s", out_buf);
+    AK_CHECK(read_file("sim_nan0.png") != NULL);
+    AK_CHECK(read_file("sim_nan1.png") == NULL);
+    AK_CHECK_EQ(run("view cloth:sim_nan.json --headless --size 64x48 --frames 90", true), 1);
+    AK_CHECK(strstr(out_buf, "step 2") != NULL);
+    AK_CHECK_EQ(run("view cloth:sim_nan.json --headless --size 64x48 --frames 20", true), 0); /* before it */
 }
 
 /* Playing changes the picture, paused it does not, the right arrow steps one frame, R gives
@@ -875,6 +929,8 @@ int main(void) {
     AK_RUN(assets_session);
     AK_RUN(window_under_xvfb);
     AK_RUN(sim_bad_specs);
+    AK_RUN(sim_failure_exits_1);
+    AK_RUN(script_screenshots_stay_in_shot_dir);
     AK_RUN(sim_particles_play_pause_reset);
     AK_RUN(sim_boids_play_pause_reset);
     AK_RUN_SLOW(sim_cloth_play_pause_reset);

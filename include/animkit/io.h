@@ -11,7 +11,10 @@
  *     AK_ERR_BAD_DATA), STEP/LINEAR/CUBICSPLINE samplers).
  *   - BVH through animkit's own streaming reader (src/io/bvh.c): bounded nesting, the frame
  *     count checked against the data present, the same scene layout Assimp gave (docs/io.md).
- *   - Everything else (FBX, Collada, OBJ, ...) through Assimp's C API: the node tree
+ *   - Wavefront OBJ (+ the .mtl files it names, for base colours) through animkit's own
+ *     reader (src/io/obj.c), with the scene layout Assimp gave (docs/io.md).
+ *   - Everything else (FBX, Collada, ...) through Assimp's C API, run in a forked child
+ *     process under resource limits (a crash there is AK_ERR_IO): the node tree
  *     becomes the skeleton, aiAnimation channels become clips (ticks -> seconds), meshes with
  *     bones get skins.
  *   - ak_io_save: glTF 2.0 (.glb, or .gltf + .bin) of a whole scene: nodes, skins, meshes,
@@ -56,20 +59,22 @@
  *     ak_io_write_obj("mesh.obj", scene, NULL, NULL, &diag);  // NULL: positions as stored
  *     ak_scene_destroy(scene);
  *
- * Untrusted input: glTF and BVH are safe to load from untrusted sources (memory bounded by
+ * Untrusted input: glTF, BVH and OBJ are safe to load from untrusted sources (memory bounded by
  * desc->memory_budget, checked before allocating; recursion bounded (cJSON stops at 1000
- * nesting levels, the BVH reader does not recurse); external glTF
- * buffers only inside the model's directory unless desc->extra_roots/allow_any_path say
- * otherwise; images never opened). Assimp formats (FBX, Collada, OBJ, ...) are NOT: animkit
- * only pre-checks their size and nesting depth, and lets Assimp open the files a model names
- * (an OBJ's mtllib) only inside the model's directory (or extra_roots / allow_any_path).
- * docs/io.md lists every limit and its default.
+ * nesting levels, the BVH and OBJ readers do not recurse); external glTF buffers and OBJ
+ * mtllib files only inside the model's directory unless desc->extra_roots/allow_any_path say
+ * otherwise, and a path that leaves it is refused without looking at what is there; images
+ * never opened; names must be valid UTF-8 without control bytes; error messages escape raw
+ * bytes). Assimp formats (FBX, Collada, ...) are contained, not hardened: Assimp runs in a
+ * child process with RLIMIT_AS/CPU/FSIZE/NOFILE limits and a wall-clock limit
+ * (AK_IO_ASSIMP_SECONDS); a crash or a timeout there is AK_ERR_IO, and the scene it sends
+ * back is checked before use. docs/io.md lists every limit and its default.
  *
  * Ownership and threading: the scene returned belongs to the caller (ak_scene_destroy).
  * The library keeps no pointer to the caller's data. The glTF and BVH paths are reentrant: the JSON
  * parse tree comes from cJSON's own malloc (animkit never sets cJSON's global hooks) and
- * animkit never reads cJSON's global last-error pointer. The Assimp path must not run on
- * several threads at once: Assimp keeps its last error message in a global.
+ * animkit never reads cJSON's global last-error pointer. The Assimp path forks a child
+ * process per load (Assimp's global error message lives there).
  */
 #ifndef ANIMKIT_IO_H
 #define ANIMKIT_IO_H
@@ -88,17 +93,23 @@ extern "C" {
 #define AK_IO_BUDGET_INPUT_FACTOR 16u
 /* Deepest ROOT/JOINT nesting animkit's BVH reader accepts. */
 #define AK_IO_BVH_MAX_DEPTH 256u
+/* CPU seconds Assimp may spend on one file, in its child process (the parent waits 5 s of
+ * wall time more, then kills it). */
+#define AK_IO_ASSIMP_SECONDS 60
 /* Deepest element/brace nesting the pre-check lets through to Assimp (Collada, ASCII FBX). */
 #define AK_IO_ASSIMP_MAX_DEPTH 1024u
 
 /* Which reader handles a file. */
 typedef enum ak_io_format {
-    AK_IO_FORMAT_AUTO = 0, /* default: a .gltf/.glb extension or the GLB magic -> GLTF, else ASSIMP */
+    AK_IO_FORMAT_AUTO = 0, /* default: a .gltf/.glb extension or the GLB magic -> GLTF, .bvh -> BVH,
+                              .obj -> OBJ, else ASSIMP */
     AK_IO_FORMAT_GLTF,     /* animkit's glTF 2.0 reader (.gltf or .glb, decided by the bytes) */
-    AK_IO_FORMAT_ASSIMP,   /* Assimp's importer (FBX, Collada, OBJ, ...; BVH only when named
-                              explicitly: Assimp's BVH importer is not safe on untrusted files) */
+    AK_IO_FORMAT_ASSIMP,   /* Assimp's importer in a child process (FBX, Collada, ...; OBJ and
+                              BVH only when named explicitly) */
     AK_IO_FORMAT_BVH,      /* animkit's BVH reader (AUTO picks it for .bvh and for data that
                               starts with HIERARCHY) */
+    AK_IO_FORMAT_OBJ,      /* animkit's Wavefront OBJ reader, with the .mtl files it names
+                              (base colours only); AUTO picks it for .obj */
     AK_IO_FORMAT_COUNT
 } ak_io_format;
 
@@ -139,7 +150,7 @@ AK_API ak_io_desc ak_io_desc_resolved(const ak_io_desc* desc);
  * the temporary arrays; only cJSON's parse tree and Assimp's scene use their own malloc). diag (optional) names the file and the problem.
  * Returns AK_ERR_NULL_ARG (path or out_scene NULL), AK_ERR_IO (cannot open or read the file
  * or an external buffer, or an external buffer URI that resolves outside the model's directory:
- * diag names the uri), AK_ERR_PARSE (malformed JSON/GLB, a glTF rule broken, an Assimp
+ * diag names the uri; Assimp crashed or ran out of its time limit in its child process), AK_ERR_PARSE (malformed JSON/GLB, a glTF rule broken, an Assimp
  * failure: diag holds Assimp's message), AK_ERR_BAD_INDEX (an index out of range: accessor,
  * node, vertex index, joint slot), AK_ERR_BAD_DATA (NaN or infinity in positions, transforms,
  * inverse binds or key values), AK_ERR_BAD_WEIGHTS (a negative skin weight),
@@ -160,7 +171,8 @@ AK_API ak_result ak_io_load(const char* path, const ak_io_desc* desc, const ak_a
  * buffers are refused with AK_ERR_IO) is the directory external buffer URIs are relative to
  * and must stay inside (see ak_io_desc.extra_roots). data is read only during the call.
  * Returns the codes of ak_io_load, and AK_ERR_NULL_ARG when data is NULL with size > 0.
- * desc->format must be AUTO, GLTF or BVH (AK_ERR_UNSUPPORTED otherwise). */
+ * desc->format must be AUTO, GLTF, BVH or OBJ (OBJ only when named; its mtllib files are read
+ * relative to base_dir, none without one); AK_ERR_UNSUPPORTED otherwise. */
 AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* name, const char* base_dir,
                                    const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
                                    ak_diag* diag);
@@ -176,8 +188,11 @@ AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* na
  * positions (NULL entry -> that mesh's own bind-space positions, as stored).
  * posed_normals: same shape; NULL or a NULL entry -> the mesh's own normals when it has them,
  * else no "vn" for that mesh. Point clouds (no triangles) write only vertices.
+ * The file is written whole or not at all: to a temporary ".NAME.XXXXXX" beside path, renamed
+ * over path once complete (a symlink at path is replaced, not followed); on any failure the
+ * temporary is removed and whatever path named is left untouched.
  * Returns AK_ERR_NULL_ARG (path or scene NULL), AK_ERR_BAD_DATA (a non-finite coordinate:
- * the file is removed), AK_ERR_IO (cannot create or write the file; diag names it). */
+ * nothing is written), AK_ERR_IO (cannot create or write the file; diag names it). */
 AK_API ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3* const* posed_positions,
                                  const ak_vec3* const* posed_normals, ak_diag* diag);
 
@@ -229,8 +244,12 @@ typedef struct ak_io_save_desc {
  * scene mesh's skin or node out of range), AK_ERR_UNSUPPORTED (an interpolation glTF cannot express: NLERP, SQUAD, LAGRANGE,
  * or a cubic mode other than HERMITE on a rotation: bake the clip first; two channels
  * animating one mesh's morph weights; more than 4 GiB in a GLB), AK_ERR_IO (cannot create or
- * write a file: partial files are removed), AK_ERR_NO_MEMORY. diag (optional) names the
- * file and the problem. Temporary memory comes from malloc. */
+ * write a file), AK_ERR_NO_MEMORY. diag (optional) names the file and the problem. Temporary
+ * memory comes from malloc. Files are written whole or not at all: each to a temporary
+ * ".NAME.XXXXXX" beside it, renamed into place (a symlink there is replaced, not followed)
+ * only once both a .gltf and its .bin are complete (the .bin first); on a failure the
+ * temporaries are removed and the named files are left untouched (only a failed rename of
+ * the .gltf after its .bin's can leave a new .bin beside the old .gltf). */
 AK_API ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_desc* desc, ak_diag* diag);
 
 #ifdef __cplusplus

@@ -307,7 +307,10 @@ AK_API bool ak_image_format_available(ak_image_format format);
 /* Space-separated list of writable formats, e.g. "png gif"; never NULL. */
 AK_API const char* ak_image_formats_string(void);
 
-/* Write an RGBA8 PNG. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (size <= 0), AK_ERR_IO. */
+/* Write an RGBA8 PNG, whole or not at all: to a temporary ".NAME.XXXXXX" beside path, renamed
+ * over path once complete (a symlink at path is replaced, not followed); on a failure the
+ * temporary is removed and path is left untouched. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG
+ * (size <= 0), AK_ERR_IO. */
 AK_API ak_result ak_png_write(const char* path, const ak_image* image);
 /* Size of a PNG file. AK_ERR_NULL_ARG, AK_ERR_IO (cannot open), AK_ERR_PARSE (not a PNG). */
 AK_API ak_result ak_png_info(const char* path, int* out_width, int* out_height);
@@ -334,8 +337,9 @@ typedef struct ak_gif_desc {
                            frame whole and opaque */
 } ak_gif_desc;
 
-/* Open path and write the GIF header. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_IO,
- * AK_ERR_NO_MEMORY. The writer owns the open file until ak_gif_writer_finish. */
+/* Start a GIF for path and write its header. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_IO,
+ * AK_ERR_NO_MEMORY. The frames go to a temporary ".NAME.XXXXXX" beside path, which the writer
+ * owns until ak_gif_writer_finish; path itself is not touched before then. */
 AK_API ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const ak_allocator* alloc,
                                       ak_gif_writer** out_writer);
 /* Quantize frame to its own 256-colour palette (median cut; 255 and a transparent entry for
@@ -343,9 +347,11 @@ AK_API ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc,
  * is ignored. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG, AK_ERR_IO,
  * AK_ERR_NO_MEMORY (giflib's colour map). */
 AK_API ak_result ak_gif_writer_add_frame(ak_gif_writer* writer, const ak_image* frame);
-/* Close the file and free the writer (always, even on error). AK_ERR_IO when the file could
- * not be completed, AK_ERR_EMPTY when no frame was added (the file is still valid-ish: one
- * blank frame is written). NULL -> AK_ERR_NULL_ARG. */
+/* Close the file and free the writer (always, even on error). A complete file is renamed over
+ * path (a symlink there is replaced, not followed); otherwise the temporary is removed and
+ * path is left untouched. AK_ERR_IO when the file could not be completed (a write failed
+ * earlier, or now), AK_ERR_EMPTY when no frame was added (the file is still valid-ish: one
+ * blank frame is written, and it is renamed into place). NULL -> AK_ERR_NULL_ARG. */
 AK_API ak_result ak_gif_writer_finish(ak_gif_writer* writer);
 /* Size and frame count of a GIF file. AK_ERR_NULL_ARG, AK_ERR_IO, AK_ERR_PARSE. */
 AK_API ak_result ak_gif_info(const char* path, int* out_width, int* out_height, int* out_frame_count);

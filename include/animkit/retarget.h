@@ -27,7 +27,9 @@
  *   - bakes the result at frame_rate into a clip for the target (ak_clip_bake).
  * Both skeletons are assumed to share the up axis and facing direction of their model space.
  *
- * What it does NOT do: read files or map files (the CLI parses map files), morph weights,
+ *   - parses map files ("TARGET_JOINT = SOURCE_JOINT" lines, ak_retarget_map_parse) from
+ *     memory, with the line of the first problem in an ak_diag.
+ * What it does NOT do: read files (the CLI reads map files, refusing FIFOs), morph weights,
  * translation animation of non-root joints (target bone lengths are kept), joint limits.
  *
  * Usage:
@@ -90,6 +92,22 @@ AK_API ak_result ak_humanoid_bones_of_skeleton(const ak_skeleton* skeleton, ak_i
  * *out_mapped_count (optional) = target joints mapped. */
 AK_API ak_result ak_retarget_map_by_name(const ak_skeleton* source, const ak_skeleton* target,
                                          ak_i32_span out_source_of_target, size_t* out_mapped_count);
+
+/* Parse a map file's text into out_source_of_target (every entry -1 first, then
+ * out[target joint] = source joint for each line). Format: one "TARGET_JOINT = SOURCE_JOINT" a
+ * line; '#' starts a comment; blank lines are skipped; spaces and tabs around the names and a
+ * CR before the newline are dropped; names are matched exactly (ak_skeleton_find_joint). The
+ * text need not end in a newline. out_source_of_target.count >= target joint count.
+ * Returns AK_ERR_NULL_ARG (a skeleton or the span NULL, or text NULL with text_size > 0),
+ * AK_ERR_SPAN_SMALL, AK_ERR_PARSE (a line holds a NUL byte, has no '=', an empty name or a name
+ * of AK_NAME_SIZE bytes or more), AK_ERR_NOT_FOUND (a name is not a joint of its skeleton),
+ * AK_ERR_DUPLICATE (a target joint mapped twice), AK_ERR_EMPTY (no line maps a joint). diag
+ * (optional; its path is left empty) gets "line N: problem" ("line N holds a NUL byte") with
+ * diag->line = N (0 for AK_ERR_EMPTY). *out_mapped_count (optional) = lines mapped, 0 on error.
+ * Allocates nothing; reentrant. */
+AK_API ak_result ak_retarget_map_parse(const char* text, size_t text_size, const ak_skeleton* source,
+                                       const ak_skeleton* target, ak_i32_span out_source_of_target,
+                                       size_t* out_mapped_count, ak_diag* diag);
 
 typedef struct ak_retarget_desc {
     const ak_skeleton* source;     /* required: the skeleton the clip animates */

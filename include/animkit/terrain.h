@@ -122,7 +122,9 @@ AK_API ak_result ak_terrain_mesh(const ak_terrain_desc* desc, ak_f32_cspan heigh
                                  ak_vec2_span out_uvs, ak_u32_span out_indices);
 
 /* Write the heightfield as Wavefront OBJ (v, vt, vn, f v/vt/vn). AK_ERR_IO on a write error,
- * AK_ERR_NULL_ARG / AK_ERR_BAD_ARG / AK_ERR_SPAN_SMALL for bad arguments. */
+ * AK_ERR_NULL_ARG / AK_ERR_BAD_ARG / AK_ERR_SPAN_SMALL for bad arguments. Both writers here
+ * write whole files or nothing: a temporary ".NAME.XXXXXX" beside path is renamed over it
+ * once complete; on a failure it is removed and path is left untouched. */
 AK_API ak_result ak_terrain_write_obj(const char* path, const ak_terrain_desc* desc, ak_f32_cspan heights,
                                       ak_vec3_cspan normals);
 

@@ -7,11 +7,18 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <ctype.h>
+#include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <poll.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "io_internal.h"
 
@@ -27,7 +34,54 @@ typedef struct as_ctx {
     size_t node_count;
     int32_t* joint_of_node;
     ak_scene* scene;
+    struct as_wbuf* clip_sink; /* in the child: each raw clip, serialised for the parent */
 } as_ctx;
+
+/* A growing byte buffer (the child's message to the parent). */
+typedef struct as_wbuf {
+    uint8_t* p;
+    size_t n, cap;
+    bool oom;
+} as_wbuf;
+
+static void wb_put(as_wbuf* b, const void* data, size_t size) {
+    if (b->oom || size == 0) return;
+    if (size > SIZE_MAX / 2 - b->n) {
+        b->oom = true;
+        return;
+    }
+    if (b->n + size > b->cap) {
+        size_t cap = b->cap ? b->cap : 4096;
+        while (cap < b->n + size) cap *= 2;
+        uint8_t* q = (uint8_t*)realloc(b->p, cap);
+        if (!q) {
+            b->oom = true;
+            return;
+        }
+        b->p = q;
+        b->cap = cap;
+    }
+    memcpy(b->p + b->n, data, size);
+    b->n += size;
+}
+
+static void wb_u64(as_wbuf* b, uint64_t v) { wb_put(b, &v, sizeof v); }
+
+static void put_raw_clip(as_wbuf* b, const ak_raw_clip* raw) {
+    char name[AK_NAME_SIZE];
+    akp_io_copy_name(name, raw->name);
+    wb_put(b, name, sizeof name);
+    wb_put(b, &raw->duration, sizeof raw->duration);
+    wb_u64(b, raw->channel_count);
+    for (size_t i = 0; i < raw->channel_count; ++i) {
+        const ak_raw_channel* ch = &raw->channels[i];
+        uint32_t head[4] = {(uint32_t)ch->target, ch->index, ch->component_count, (uint32_t)ch->interp};
+        wb_put(b, head, sizeof head);
+        wb_u64(b, ch->key_count);
+        wb_put(b, ch->times, ch->key_count * sizeof(float));
+        wb_put(b, ch->values, ch->key_count * ch->component_count * sizeof(float));
+    }
+}
 
 /* ---- static helpers ------------------------------------------------------------------ */
 
@@ -332,6 +386,7 @@ static ak_result build_clip(as_ctx* c, const struct aiAnimation* an, size_t ai) 
         ak_diag sub;
         r = ak_clip_build(&raw, c->alloc, &c->scene->clips[ai], &sub);
         if (r != AK_OK) akp_diag_set(c->diag, c->path, "animation %zu: %s", ai, sub.message);
+        else if (c->clip_sink) put_raw_clip(c->clip_sink, &raw);
     }
     for (size_t i = 0; i < nbuf; ++i) akp_free(c->alloc, bufs[i]);
     akp_free(c->alloc, bufs);
@@ -619,16 +674,9 @@ static void fs_close(struct aiFileIO* io, struct aiFile* file) {
 
 /* ---- the reader ------------------------------------------------------------------------ */
 
-ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
+/* Assimp's import and the conversion, in the calling process (the child's work). */
+static ak_result import_here(const char* path, const ak_io_desc* desc, const ak_allocator* alloc, as_wbuf* clip_sink,
                              ak_scene** out_scene, ak_diag* diag) {
-    FILE* f = fopen(path, "rb");
-    if (!f) {
-        akp_diag_set(diag, path, "cannot open file");
-        return AK_ERR_IO;
-    }
-    ak_result pr = precheck(f, path, desc, diag);
-    fclose(f);
-    if (pr != AK_OK) return pr;
     as_fs fs;
     memset(&fs, 0, sizeof fs);
     fs.desc = desc;
@@ -660,6 +708,7 @@ ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_
     c.path = path;
     c.diag = diag;
     c.ai = ai;
+    c.clip_sink = clip_sink;
     ak_result r = convert(&c);
     aiReleaseImport(ai);
     akp_free(alloc, (void*)c.nodes);
@@ -670,4 +719,503 @@ ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_
     }
     *out_scene = c.scene;
     return AK_OK;
+}
+
+/* ---- Assimp in a child process ------------------------------------------------------------
+ * Assimp is not safe on untrusted files (5.2.5 dies of SIGSEGV on a four-line OBJ whose .mtl
+ * has map_Kd before newmtl), so it runs in a forked child under resource limits: address
+ * space (RLIMIT_AS, the memory budget plus AS_HEADROOM; not under the sanitizers, whose
+ * shadow memory needs terabytes of address space), CPU time (RLIMIT_CPU,
+ * AK_IO_ASSIMP_SECONDS), no file writes (RLIMIT_FSIZE 0), few descriptors (RLIMIT_NOFILE),
+ * no core dumps. The parent waits at most AK_IO_ASSIMP_SECONDS + AS_GRACE seconds of wall
+ * time, then kills it. The child converts the scene as before and sends it back over a pipe
+ * (warnings first, then the scene or the error); the parent checks every count and index
+ * while it rebuilds the scene with its own allocator, so a child that went wrong cannot make
+ * the parent read out of bounds. */
+
+#define AS_MAGIC 0x53414b41u /* "AKAS" */
+#define AS_HEADROOM ((size_t)768 << 20) /* the program's own mappings and Assimp's code */
+#define AS_GRACE 5
+enum { AS_REC_LOG = 1, AS_REC_ERROR = 2, AS_REC_SCENE = 3 };
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define AS_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer) || __has_feature(thread_sanitizer)
+#define AS_SANITIZED 1
+#endif
+#endif
+#ifndef AS_SANITIZED
+#define AS_SANITIZED 0
+#endif
+
+static void write_all(int fd, const void* data, size_t size) {
+    const uint8_t* p = (const uint8_t*)data;
+    while (size > 0) {
+        ssize_t w = write(fd, p, size);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) _exit(3);
+        p += w;
+        size -= (size_t)w;
+    }
+}
+
+static void put_record(int fd, uint8_t tag, const void* data, size_t size) {
+    uint8_t head[9];
+    uint64_t n = size;
+    head[0] = tag;
+    memcpy(head + 1, &n, sizeof n);
+    write_all(fd, head, sizeof head);
+    if (size) write_all(fd, data, size);
+}
+
+static void child_log(ak_log_level level, const char* message, void* user) {
+    char buf[1024];
+    buf[0] = (char)level;
+    size_t n = strlen(message);
+    if (n > sizeof buf - 2) n = sizeof buf - 2;
+    memcpy(buf + 1, message, n);
+    put_record(*(const int*)user, AS_REC_LOG, buf, n + 1);
+}
+
+static void put_scene(as_wbuf* b, const ak_scene* s, const as_wbuf* clips) {
+    uint32_t magic = AS_MAGIC;
+    wb_put(b, &magic, sizeof magic);
+    wb_put(b, s->name, AK_NAME_SIZE);
+    size_t nj = ak_scene_joint_count(s);
+    uint64_t counts[4] = {nj, s->mesh_count, s->skin_count, s->clip_count};
+    wb_put(b, counts, sizeof counts);
+    uint8_t has_is_joint = s->is_joint != NULL;
+    wb_put(b, &has_is_joint, 1);
+    ak_i16_cspan parents = nj ? ak_skeleton_parents(s->skeleton) : (ak_i16_cspan){NULL, 0};
+    ak_transform_cspan rest = nj ? ak_skeleton_rest_pose(s->skeleton) : (ak_transform_cspan){NULL, 0};
+    ak_mat4_cspan ibind = nj ? ak_skeleton_inverse_binds(s->skeleton) : (ak_mat4_cspan){NULL, 0};
+    for (size_t j = 0; j < nj; ++j) {
+        char name[AK_NAME_SIZE];
+        akp_io_copy_name(name, ak_skeleton_joint_name(s->skeleton, j));
+        int32_t parent = parents.ptr[j];
+        wb_put(b, name, sizeof name);
+        wb_put(b, &parent, sizeof parent);
+        wb_put(b, &rest.ptr[j], sizeof(ak_transform));
+        wb_put(b, &ibind.ptr[j], sizeof(ak_mat4));
+    }
+    for (size_t j = 0; has_is_joint && j < nj; ++j) {
+        uint8_t v = s->is_joint[j];
+        wb_put(b, &v, 1);
+    }
+    for (size_t k = 0; k < s->skin_count; ++k) {
+        const ak_scene_skin* sk = &s->skins[k];
+        wb_put(b, sk->name, AK_NAME_SIZE);
+        wb_u64(b, sk->joint_count);
+        wb_put(b, sk->joints, sk->joint_count * sizeof(int32_t));
+        wb_put(b, sk->inverse_binds, sk->joint_count * sizeof(ak_mat4));
+    }
+    for (size_t m = 0; m < s->mesh_count; ++m) {
+        const ak_scene_mesh* sm = &s->meshes[m];
+        const ak_mesh* me = sm->mesh;
+        int32_t ns[2] = {sm->node, sm->skin};
+        uint8_t flags[4] = {sm->has_material, me->normals != NULL, me->uvs != NULL, me->colors != NULL};
+        uint64_t sizes[2] = {me->vertex_count, me->triangle_count};
+        wb_put(b, ns, sizeof ns);
+        wb_put(b, flags, sizeof flags);
+        wb_put(b, &sm->base_color, sizeof sm->base_color);
+        wb_put(b, me->name, AK_NAME_SIZE);
+        wb_put(b, sizes, sizeof sizes);
+        wb_put(b, &me->influence_count, sizeof me->influence_count);
+        size_t v = me->vertex_count;
+        wb_put(b, me->positions, v * sizeof(ak_vec3));
+        if (me->normals) wb_put(b, me->normals, v * sizeof(ak_vec3));
+        if (me->uvs) wb_put(b, me->uvs, v * sizeof(ak_vec2));
+        if (me->colors) wb_put(b, me->colors, v * sizeof(ak_vec4));
+        wb_put(b, me->indices, 3 * me->triangle_count * sizeof(uint32_t));
+        wb_put(b, me->joints, v * me->influence_count * sizeof(uint16_t));
+        wb_put(b, me->weights, v * me->influence_count * sizeof(float));
+    }
+    wb_put(b, clips->p, clips->n);
+}
+
+/* The child: limits, import, one message, _exit (no atexit handlers, no leak checks). */
+static void child_main(int fd, const char* path, const ak_io_desc* desc, size_t memory) {
+    struct rlimit lim;
+    lim.rlim_cur = lim.rlim_max = 0;
+    setrlimit(RLIMIT_CORE, &lim);
+    setrlimit(RLIMIT_FSIZE, &lim);
+    lim.rlim_cur = lim.rlim_max = AK_IO_ASSIMP_SECONDS;
+    setrlimit(RLIMIT_CPU, &lim);
+    lim.rlim_cur = lim.rlim_max = 64;
+    setrlimit(RLIMIT_NOFILE, &lim);
+    if (!AS_SANITIZED) {
+        lim.rlim_cur = lim.rlim_max = (rlim_t)memory;
+        setrlimit(RLIMIT_AS, &lim);
+    }
+    signal(SIGPIPE, SIG_DFL);
+    const char* hook = getenv("AK_IO_TEST_ASSIMP_CHILD"); /* tests only: fake a crash or a hang */
+    if (hook && strcmp(hook, "segv") == 0) raise(SIGSEGV);
+    if (hook && strcmp(hook, "hang") == 0)
+        for (volatile unsigned long i = 0;; i = i + 1) {
+        }
+    ak_io_desc d = *desc;
+    int log_fd = fd;
+    if (desc->logger.func) d.logger = (ak_logger){child_log, &log_fd};
+    as_wbuf clips = {0}, out = {0};
+    ak_scene* scene = NULL;
+    ak_diag diag;
+    memset(&diag, 0, sizeof diag);
+    ak_result r = import_here(path, &d, NULL, &clips, &scene, &diag);
+    if (r == AK_OK) {
+        put_scene(&out, scene, &clips);
+        if (out.oom || clips.oom) {
+            r = AK_ERR_NO_MEMORY;
+            akp_diag_set(&diag, path, "out of memory sending the scene to the parent process");
+        }
+    }
+    if (r == AK_OK) {
+        put_record(fd, AS_REC_SCENE, out.p, out.n);
+    } else {
+        int32_t code = (int32_t)r;
+        uint8_t msg[sizeof code + sizeof diag];
+        memcpy(msg, &code, sizeof code);
+        memcpy(msg + sizeof code, &diag, sizeof diag);
+        put_record(fd, AS_REC_ERROR, msg, sizeof msg);
+    }
+    _exit(0);
+}
+
+/* ---- the parent: reading the child's message back ---------------------------------------- */
+
+typedef struct as_rbuf {
+    const uint8_t* p;
+    size_t n, at;
+    bool bad;
+} as_rbuf;
+
+static bool rb_get(as_rbuf* b, void* out, size_t size) {
+    if (b->bad || size > b->n - b->at) {
+        b->bad = true;
+        memset(out, 0, size);
+        return false;
+    }
+    memcpy(out, b->p + b->at, size);
+    b->at += size;
+    return true;
+}
+
+/* Room for count elements of size bytes left in the message? */
+static bool rb_has(as_rbuf* b, uint64_t count, size_t size) {
+    if (b->bad || (size && count > (b->n - b->at) / size)) b->bad = true;
+    return !b->bad;
+}
+
+static void rb_name(as_rbuf* b, char name[AK_NAME_SIZE]) {
+    rb_get(b, name, AK_NAME_SIZE);
+    name[AK_NAME_SIZE - 1] = 0;
+}
+
+static ak_result read_clip(as_rbuf* b, ak_scene* s, size_t index, size_t joint_count, const ak_allocator* alloc,
+                           ak_diag* diag, const char* path) {
+    char name[AK_NAME_SIZE];
+    float duration = 0.0f;
+    uint64_t nch = 0;
+    rb_name(b, name);
+    rb_get(b, &duration, sizeof duration);
+    rb_get(b, &nch, sizeof nch);
+    if (!rb_has(b, nch, 4 * sizeof(uint32_t) + sizeof(uint64_t))) return AK_ERR_PARSE;
+    ak_raw_channel* ch = (ak_raw_channel*)akp_calloc(alloc, (nch ? nch : 1) * sizeof(ak_raw_channel));
+    if (!ch) return AK_ERR_NO_MEMORY;
+    ak_result r = AK_OK;
+    size_t done = 0;
+    for (; done < nch && r == AK_OK; ++done) {
+        uint32_t head[4];
+        uint64_t keys = 0;
+        rb_get(b, head, sizeof head);
+        rb_get(b, &keys, sizeof keys);
+        if (head[2] == 0 || head[2] > AK_TRACK_MAX_COMPONENTS || !rb_has(b, keys, sizeof(float) * (1 + head[2]))) {
+            r = AK_ERR_PARSE;
+            break;
+        }
+        float* times = (float*)akp_alloc(alloc, (keys ? keys : 1) * sizeof(float));
+        float* values = (float*)akp_alloc(alloc, (keys ? keys : 1) * head[2] * sizeof(float));
+        ch[done] = (ak_raw_channel){.target = (ak_channel_target)head[0], .index = head[1], .component_count = head[2],
+                                    .interp = (ak_interp)head[3], .key_count = keys, .times = times, .values = values};
+        if (!times || !values) {
+            r = AK_ERR_NO_MEMORY;
+            ++done;
+            break;
+        }
+        rb_get(b, times, keys * sizeof(float));
+        rb_get(b, values, keys * head[2] * sizeof(float));
+    }
+    if (r == AK_OK) {
+        ak_raw_clip raw = {.name = name, .duration = duration, .channels = ch, .channel_count = nch,
+                           .joint_count = joint_count};
+        ak_diag sub;
+        r = ak_clip_build(&raw, alloc, &s->clips[index], &sub);
+        if (r != AK_OK) akp_diag_set(diag, path, "animation %zu: %s", index, sub.message);
+    }
+    for (size_t i = 0; i < done; ++i) {
+        akp_free(alloc, (void*)ch[i].times);
+        akp_free(alloc, (void*)ch[i].values);
+    }
+    akp_free(alloc, ch);
+    return r;
+}
+
+static ak_result read_scene(as_rbuf* b, const char* path, const ak_allocator* alloc, ak_scene** out_scene,
+                            ak_diag* diag) {
+    uint32_t magic = 0;
+    uint64_t counts[4] = {0, 0, 0, 0};
+    char name[AK_NAME_SIZE];
+    uint8_t has_is_joint = 0;
+    rb_get(b, &magic, sizeof magic);
+    rb_name(b, name);
+    rb_get(b, counts, sizeof counts);
+    rb_get(b, &has_is_joint, 1);
+    const size_t joint_rec = AK_NAME_SIZE + sizeof(int32_t) + sizeof(ak_transform) + sizeof(ak_mat4);
+    if (magic != AS_MAGIC || counts[0] > AKP_IO_MAX_NODES || !rb_has(b, counts[0], joint_rec) ||
+        !rb_has(b, counts[1], 8) || !rb_has(b, counts[2], 8) || !rb_has(b, counts[3], 8)) {
+        akp_diag_set(diag, path, "the Assimp process sent a malformed scene");
+        return AK_ERR_IO;
+    }
+    size_t nj = counts[0];
+    ak_scene* s = NULL;
+    ak_result r = ak_scene_alloc(counts[1], counts[2], counts[3], alloc, &s);
+    if (r != AK_OK) {
+        akp_diag_set(diag, path, "out of memory");
+        return r;
+    }
+    memcpy(s->name, name, sizeof name);
+    ak_joint_desc* joints = (ak_joint_desc*)akp_calloc(alloc, (nj ? nj : 1) * sizeof(ak_joint_desc));
+    char(*names)[AK_NAME_SIZE] = (char(*)[AK_NAME_SIZE])akp_alloc(alloc, (nj ? nj : 1) * AK_NAME_SIZE);
+    ak_mat4* ibind = (ak_mat4*)akp_alloc(alloc, (nj ? nj : 1) * sizeof(ak_mat4));
+    if (!joints || !names || !ibind) r = AK_ERR_NO_MEMORY;
+    for (size_t j = 0; r == AK_OK && j < nj; ++j) {
+        int32_t parent = 0;
+        rb_name(b, names[j]);
+        rb_get(b, &parent, sizeof parent);
+        rb_get(b, &joints[j].rest, sizeof(ak_transform));
+        rb_get(b, &ibind[j], sizeof(ak_mat4));
+        joints[j].name = names[j];
+        joints[j].parent = parent;
+        joints[j].inverse_bind = &ibind[j];
+    }
+    if (r == AK_OK && nj) {
+        ak_skeleton_desc sd = {.joints = joints, .joint_count = nj, .name = s->name, .palette_from_skins = true};
+        ak_diag sub;
+        r = ak_skeleton_create(&sd, alloc, &s->skeleton, &sub);
+        if (r != AK_OK) akp_diag_set(diag, path, "skeleton from the Assimp process: %.400s", sub.message);
+    }
+    akp_free(alloc, joints);
+    akp_free(alloc, names);
+    akp_free(alloc, ibind);
+    if (r == AK_OK && has_is_joint) {
+        s->is_joint = (bool*)akp_calloc(alloc, (nj ? nj : 1) * sizeof(bool));
+        if (!s->is_joint) r = AK_ERR_NO_MEMORY;
+        for (size_t j = 0; r == AK_OK && j < nj; ++j) {
+            uint8_t v = 0;
+            rb_get(b, &v, 1);
+            s->is_joint[j] = v != 0;
+        }
+    }
+    for (size_t k = 0; r == AK_OK && k < s->skin_count; ++k) {
+        char sk_name[AK_NAME_SIZE];
+        uint64_t jc = 0;
+        rb_name(b, sk_name);
+        rb_get(b, &jc, sizeof jc);
+        if (!rb_has(b, jc, sizeof(int32_t) + sizeof(ak_mat4)) || jc == 0) break;
+        r = ak_scene_skin_alloc(s, k, jc);
+        if (r != AK_OK) break;
+        ak_scene_skin* sk = &s->skins[k];
+        memcpy(sk->name, sk_name, sizeof sk_name);
+        rb_get(b, sk->joints, jc * sizeof(int32_t));
+        rb_get(b, sk->inverse_binds, jc * sizeof(ak_mat4));
+        for (size_t i = 0; i < jc; ++i)
+            if (sk->joints[i] < 0 || (size_t)sk->joints[i] >= nj) b->bad = true;
+    }
+    for (size_t m = 0; r == AK_OK && !b->bad && m < s->mesh_count; ++m) {
+        ak_scene_mesh* sm = &s->meshes[m];
+        int32_t ns[2];
+        uint8_t flags[4];
+        uint64_t sizes[2];
+        uint32_t infl = 0;
+        char me_name[AK_NAME_SIZE];
+        rb_get(b, ns, sizeof ns);
+        rb_get(b, flags, sizeof flags);
+        rb_get(b, &sm->base_color, sizeof sm->base_color);
+        rb_name(b, me_name);
+        rb_get(b, sizes, sizeof sizes);
+        rb_get(b, &infl, sizeof infl);
+        size_t per_vertex = sizeof(ak_vec3) * (1 + (flags[1] != 0)) + (flags[2] ? sizeof(ak_vec2) : 0) +
+                            (flags[3] ? sizeof(ak_vec4) : 0) + (size_t)infl * (sizeof(uint16_t) + sizeof(float));
+        if (ns[0] < -1 || ns[0] >= (int64_t)nj || ns[1] < -1 || ns[1] >= (int64_t)s->skin_count ||
+            infl > AK_MAX_INFLUENCES || (infl && ns[1] < 0) || sizes[0] == 0 || !rb_has(b, sizes[0], per_vertex) ||
+            !rb_has(b, sizes[1], 3 * sizeof(uint32_t))) {
+            b->bad = true;
+            break;
+        }
+        sm->node = ns[0];
+        sm->skin = ns[1];
+        sm->has_material = flags[0] != 0;
+        ak_mesh_desc d = {.vertex_count = sizes[0], .triangle_count = sizes[1], .influence_count = infl,
+                          .has_normals = flags[1], .has_uvs = flags[2], .has_colors = flags[3], .name = me_name};
+        r = ak_mesh_create(&d, alloc, &sm->mesh);
+        if (r != AK_OK) break;
+        ak_mesh* me = sm->mesh;
+        size_t v = me->vertex_count;
+        rb_get(b, me->positions, v * sizeof(ak_vec3));
+        if (me->normals) rb_get(b, me->normals, v * sizeof(ak_vec3));
+        if (me->uvs) rb_get(b, me->uvs, v * sizeof(ak_vec2));
+        if (me->colors) rb_get(b, me->colors, v * sizeof(ak_vec4));
+        rb_get(b, me->indices, 3 * me->triangle_count * sizeof(uint32_t));
+        rb_get(b, me->joints, v * infl * sizeof(uint16_t));
+        rb_get(b, me->weights, v * infl * sizeof(float));
+        if (!b->bad && ak_mesh_validate(me, NULL) != AK_OK) b->bad = true;
+        size_t slots = ns[1] >= 0 ? s->skins[ns[1]].joint_count : 0;
+        for (size_t i = 0; !b->bad && i < v * infl; ++i)
+            if (me->joints[i] >= slots) b->bad = true;
+    }
+    for (size_t a = 0; r == AK_OK && !b->bad && a < s->clip_count; ++a) {
+        r = read_clip(b, s, a, nj, alloc, diag, path);
+        if (r == AK_ERR_PARSE) b->bad = true, r = AK_OK;
+    }
+    if (r == AK_OK && (b->bad || b->at != b->n)) {
+        akp_diag_set(diag, path, "the Assimp process sent a malformed scene");
+        r = AK_ERR_IO;
+    } else if (r == AK_ERR_NO_MEMORY) {
+        akp_diag_set(diag, path, "out of memory");
+    }
+    if (r != AK_OK) {
+        ak_scene_destroy(s);
+        return r;
+    }
+    *out_scene = s;
+    return AK_OK;
+}
+
+static double now_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
+                             ak_scene** out_scene, ak_diag* diag) {
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        akp_diag_set(diag, path, "cannot open file");
+        return AK_ERR_IO;
+    }
+    ak_result pr = precheck(f, path, desc, diag);
+    fclose(f);
+    if (pr != AK_OK) return pr;
+    struct stat st;
+    akp_budget budget = akp_io_budget(desc, stat(path, &st) == 0 && st.st_size > 0 ? (size_t)st.st_size : 0);
+    size_t memory = budget.limit > SIZE_MAX / 4 ? SIZE_MAX / 2 : 2 * budget.limit + AS_HEADROOM;
+    const char* hook = getenv("AK_IO_TEST_ASSIMP_CHILD");
+    double limit = hook && strcmp(hook, "hang") == 0 ? 1.0 : (double)(AK_IO_ASSIMP_SECONDS + AS_GRACE);
+    int fds[2];
+    if (pipe(fds) != 0) {
+        akp_diag_set(diag, path, "cannot create a pipe for the Assimp process");
+        return AK_ERR_IO;
+    }
+    fflush(NULL); /* the child must not write the parent's buffered output a second time */
+    pid_t pid = fork();
+    if (pid < 0) {
+        close(fds[0]);
+        close(fds[1]);
+        akp_diag_set(diag, path, "cannot start the Assimp process");
+        return AK_ERR_IO;
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        child_main(fds[1], path, desc, memory);
+    }
+    close(fds[1]);
+    /* read everything the child sends, within the wall-clock limit and the memory budget */
+    as_wbuf msg = {0};
+    const double deadline = now_seconds() + limit;
+    bool timed_out = false, too_big = false;
+    for (;;) {
+        double left = deadline - now_seconds();
+        if (left <= 0.0) {
+            timed_out = true;
+            break;
+        }
+        struct pollfd pfd = {fds[0], POLLIN, 0};
+        int pr2 = poll(&pfd, 1, (int)(left * 1000.0) + 1);
+        if (pr2 < 0 && errno == EINTR) continue;
+        if (pr2 == 0) continue;
+        uint8_t buf[65536];
+        ssize_t got = read(fds[0], buf, sizeof buf);
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) break;
+        if (msg.n + (size_t)got > budget.limit) {
+            too_big = true;
+            break;
+        }
+        wb_put(&msg, buf, (size_t)got);
+        if (msg.oom) break;
+    }
+    close(fds[0]);
+    if (timed_out || too_big || msg.oom) kill(pid, SIGKILL);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    ak_result r = AK_OK;
+    if (timed_out || (WIFSIGNALED(status) && WTERMSIG(status) == SIGXCPU)) {
+        akp_diag_set(diag, path, "Assimp ran out of its time limit (%d s, AK_IO_ASSIMP_SECONDS) reading %s",
+                     AK_IO_ASSIMP_SECONDS, path);
+        r = AK_ERR_IO;
+    } else if (too_big || msg.oom) {
+        akp_diag_set(diag, path, "the scene Assimp read from %s exceeds the memory budget of %zu bytes", path,
+                     budget.limit);
+        r = AK_ERR_UNSUPPORTED;
+    } else if (WIFSIGNALED(status)) {
+        akp_diag_set(diag, path, "Assimp crashed reading %s (signal %d%s)", path, WTERMSIG(status),
+                     AS_SANITIZED ? "" : "; or it ran out of its memory limit");
+        r = AK_ERR_IO;
+    }
+    /* the records: log lines (passed on in order), then the scene or the error */
+    as_rbuf rb = {msg.p, msg.n, 0, false};
+    bool answered = false;
+    while (r == AK_OK && rb.at < rb.n && !answered) {
+        uint8_t tag = 0;
+        uint64_t len = 0;
+        rb_get(&rb, &tag, 1);
+        rb_get(&rb, &len, sizeof len);
+        if (rb.bad || len > rb.n - rb.at) break;
+        as_rbuf rec = {rb.p + rb.at, (size_t)len, 0, false};
+        rb.at += (size_t)len;
+        if (tag == AS_REC_LOG && len >= 1) {
+            char line[1024];
+            size_t n = len - 1 < sizeof line - 1 ? (size_t)len - 1 : sizeof line - 1;
+            memcpy(line, rec.p + 1, n);
+            line[n] = 0;
+            akp_io_sanitize(line, sizeof line);
+            akp_log(&desc->logger, (ak_log_level)rec.p[0] <= AK_LOG_ERROR ? (ak_log_level)rec.p[0] : AK_LOG_WARN, line);
+        } else if (tag == AS_REC_ERROR && len == sizeof(int32_t) + sizeof(ak_diag)) {
+            int32_t code = 0;
+            ak_diag d;
+            rb_get(&rec, &code, sizeof code);
+            rb_get(&rec, &d, sizeof d);
+            d.path[sizeof d.path - 1] = 0;
+            d.message[sizeof d.message - 1] = 0;
+            akp_io_sanitize(d.path, sizeof d.path);
+            akp_io_sanitize(d.message, sizeof d.message);
+            if (diag) *diag = d;
+            r = code > 0 && code < (int32_t)AK_RESULT_COUNT ? (ak_result)code : AK_ERR_IO;
+            answered = true;
+        } else if (tag == AS_REC_SCENE) {
+            r = read_scene(&rec, path, alloc, out_scene, diag);
+            answered = true;
+        } else {
+            break;
+        }
+    }
+    if (r == AK_OK && !answered) {
+        akp_diag_set(diag, path, "the Assimp process ended without an answer reading %s (exit status %d)", path,
+                     WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+        r = AK_ERR_IO;
+    }
+    free(msg.p);
+    return r;
 }

@@ -88,6 +88,8 @@ static ak_result fail(bv_ctx* c, ak_result r, const char* fmt, ...) {
         va_start(ap, fmt);
         vsnprintf(c->diag->message, sizeof c->diag->message, fmt, ap);
         va_end(ap);
+        akp_io_sanitize(c->diag->path, sizeof c->diag->path);
+        akp_io_sanitize(c->diag->message, sizeof c->diag->message);
     }
     return r;
 }
@@ -184,6 +186,12 @@ static ak_result next_number(bv_ctx* c, const char* what, double* out) {
 /* ---- static helpers: hierarchy -------------------------------------------------------- */
 
 static ak_result add_node(bv_ctx* c, const char* name, int32_t parent, bool end_site, size_t* out) {
+    /* a joint name reaches terminals, JSON reports and glTF files: valid UTF-8, no control bytes */
+    if (!end_site && !akp_io_utf8_valid(name, strlen(name)))
+        return fail(c, AK_ERR_PARSE, "line %ld: the joint name is not valid UTF-8", c->token_line);
+    for (const char* p = name; !end_site && *p; ++p)
+        if ((unsigned char)*p < 0x20 || *p == 0x7F)
+            return fail(c, AK_ERR_PARSE, "line %ld: the joint name holds a control byte", c->token_line);
     if (c->node_count >= AKP_IO_MAX_NODES)
         return fail(c, AK_ERR_UNSUPPORTED, "line %ld: more than %u nodes", c->token_line, AKP_IO_MAX_NODES);
     if (c->node_count == c->node_cap) {
@@ -363,9 +371,20 @@ static ak_result read_motion(bv_ctx* c) {
             return fail(c, AK_ERR_BAD_DATA, "line %ld: channel value '%.60s' overflows a float", c->token_line, tok);
         c->values[c->value_count++] = f;
     }
+    /* A file cut inside its last number ("-19.3215" cut to "-19.3") would parse: the last
+     * line of the motion must end with a newline (every exporter writes one). */
+    const long last_line = c->line;
     TRY(next_token(c, tok));
     if (tok[0])
         return fail(c, AK_ERR_PARSE, "line %ld: '%.60s' after the %zu declared frames", c->token_line, tok, c->frames);
+    if (c->line == last_line) {
+        c->token_line = c->line;
+        if (c->frames > 0)
+            return fail(c, AK_ERR_PARSE, "line %ld: the file ends inside frame %zu (truncated?): the last line has no newline",
+                        c->line, c->frames);
+        return fail(c, AK_ERR_PARSE, "line %ld: the file ends inside the Frame Time line (truncated?): no newline",
+                    c->line);
+    }
     if (!c->mem && ferror(c->file)) return fail(c, AK_ERR_IO, "read error");
     return AK_OK;
 }

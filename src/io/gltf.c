@@ -87,6 +87,8 @@ static ak_result fail(gl_ctx* c, ak_result r, const char* fmt, ...) {
         va_start(ap, fmt);
         vsnprintf(c->diag->message, sizeof c->diag->message, fmt, ap);
         va_end(ap);
+        akp_io_sanitize(c->diag->path, sizeof c->diag->path);
+        akp_io_sanitize(c->diag->message, sizeof c->diag->message);
     }
     return r;
 }
@@ -187,6 +189,32 @@ static const char* get_string(const cJSON* obj, const char* key) {
 }
 
 
+/* A name that becomes a joint, mesh, skin, clip or morph target name must be valid UTF-8
+ * without control bytes (cJSON passes both through: raw bytes, and \u escapes such as
+ * \u001b): it reaches terminals, JSON reports and the glTF writer. */
+static ak_result check_name(gl_ctx* c, const char* name, const char* what, size_t i, const char* field) {
+    if (!name) return AK_OK;
+    size_t n = strlen(name);
+    if (!akp_io_utf8_valid(name, n))
+        return fail(c, AK_ERR_PARSE, "%s[%zu].%s is not valid UTF-8", what, i, field);
+    for (size_t k = 0; k < n; ++k)
+        if ((unsigned char)name[k] < 0x20 || name[k] == 0x7F)
+            return fail(c, AK_ERR_PARSE, "%s[%zu].%s holds a control character (byte %zu)", what, i, field, k);
+    return AK_OK;
+}
+
+static ak_result check_names(gl_ctx* c, const cJSON* a, const char* what) {
+    size_t i = 0;
+    for (const cJSON* e = a ? a->child : NULL; e; e = e->next, ++i) {
+        TRY(check_name(c, get_string(e, "name"), what, i, "name"));
+        const cJSON* extras = cJSON_GetObjectItemCaseSensitive(e, "extras");
+        const cJSON* names = cJSON_IsObject(extras) ? cJSON_GetObjectItemCaseSensitive(extras, "targetNames") : NULL;
+        for (const cJSON* t = cJSON_IsArray(names) ? names->child : NULL; t; t = t->next)
+            if (cJSON_IsString(t)) TRY(check_name(c, t->valuestring, what, i, "extras.targetNames"));
+    }
+    return AK_OK;
+}
+
 /* Elements of a top-level array must be objects. */
 static ak_result check_objects(gl_ctx* c, const cJSON* a, const char* what) {
     size_t i = 0;
@@ -256,20 +284,13 @@ static int hex_value(char ch) {
     return -1;
 }
 
-/* Is the resolved path p inside directory root (both canonical)? */
-static bool path_inside(const char* p, const char* root) {
-    size_t n = strlen(root);
-    if (n == 1 && root[0] == '/') return p[0] == '/';
-    return strncmp(p, root, n) == 0 && (p[n] == '/' || p[n] == 0);
-}
-
 /* An external URI -> a canonical path (percent-decoded, relative to base_dir, "..", "." and
- * symlinks resolved by realpath) that must lie inside base_dir or one of desc->extra_roots
- * unless desc->allow_any_path. */
+ * symlinks resolved) that must lie inside base_dir or one of desc->extra_roots unless
+ * desc->allow_any_path. A URI that leaves them gets one message, whatever exists there
+ * (akp_io_resolve_inside looks at nothing outside), and never the resolved path. */
 static ak_result resolve_uri(gl_ctx* c, const char* uri, const char* where, char out[PATH_MAX]) {
     char path[PATH_MAX];
-    int n = snprintf(path, sizeof path, "%s/", c->base_dir);
-    size_t o = (size_t)(n > 0 ? n : 0);
+    size_t o = 0;
     for (const char* p = uri; *p; ++p) {
         char ch = *p;
         if (*p == '%' && hex_value(p[1]) >= 0 && hex_value(p[2]) >= 0) {
@@ -281,16 +302,14 @@ static ak_result resolve_uri(gl_ctx* c, const char* uri, const char* where, char
         path[o++] = ch;
     }
     path[o] = 0;
-    if (!realpath(path, out)) return fail(c, AK_ERR_IO, "%s: uri '%.200s': cannot open '%s'", where, uri, path);
-    if (c->desc->allow_any_path) return AK_OK;
-    char root[PATH_MAX];
-    if (realpath(c->base_dir, root) && path_inside(out, root)) return AK_OK;
-    for (size_t i = 0; c->desc->extra_roots && i < c->desc->extra_root_count; ++i)
-        if (c->desc->extra_roots[i] && realpath(c->desc->extra_roots[i], root) && path_inside(out, root)) return AK_OK;
-    return fail(c, AK_ERR_IO,
-                "%s: uri '%.200s' resolves to '%s', outside the model's directory (allow it with "
-                "ak_io_desc.extra_roots or allow_any_path)",
-                where, uri, out);
+    bool leaves = false;
+    if (akp_io_resolve_inside(c->base_dir, path, c->desc, out, PATH_MAX, &leaves) == AK_OK) return AK_OK;
+    if (leaves)
+        return fail(c, AK_ERR_IO,
+                    "%s: uri '%.200s' leaves the model's folder (allow it with ak_io_desc.extra_roots or "
+                    "allow_any_path)",
+                    where, uri);
+    return fail(c, AK_ERR_IO, "%s: uri '%.200s': cannot open '%.200s' in the model's folder", where, uri, path);
 }
 
 static ak_result load_buffer(gl_ctx* c, size_t bi) {
@@ -322,7 +341,7 @@ static ak_result load_buffer(gl_ctx* c, size_t bi) {
             TRY(resolve_uri(c, uri, where, path));
             ak_diag sub;
             ak_result r = akp_io_read_file(path, c->alloc, len, &c->budget, &gb->owned, &gb->size, &sub);
-            if (r != AK_OK) return fail(c, r, "%s: uri '%.200s': %s '%s'", where, uri, sub.message, path);
+            if (r != AK_OK) return fail(c, r, "%s: uri '%.200s': %s", where, uri, sub.message);
         }
         gb->data = gb->owned;
     }
@@ -658,6 +677,7 @@ static ak_result check_header(gl_ctx* c) {
     for (size_t i = 0; i < sizeof tops / sizeof tops[0]; ++i) {
         TRY(opt_array(c, c->root, tops[i].key, "", tops[i].arr, tops[i].n));
         TRY(check_objects(c, *tops[i].arr, tops[i].key));
+        if (i >= 3) TRY(check_names(c, *tops[i].arr, tops[i].key));
     }
     /* scene / scenes: validated, not used to filter (every node is loaded). */
     cJSON* scenes = NULL;

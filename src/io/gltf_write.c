@@ -792,20 +792,29 @@ static void put_u32(uint8_t* p, uint32_t v) {
     p[3] = (uint8_t)(v >> 24);
 }
 
-static ak_result write_bytes(w_ctx* c, const char* path, const void* a, size_t an, const void* b, size_t bn) {
-    FILE* f = fopen(path, "wb");
-    if (!f) {
-        akp_diag_set(c->diag, path, "cannot create file (%s)", strerror(errno));
+/* Write a then b to a temporary beside path and close it (internal.h); out keeps it for
+ * akp_file_atomic_rename. On failure nothing is left and path is untouched. */
+static ak_result write_bytes(w_ctx* c, const char* path, const void* a, size_t an, const void* b, size_t bn,
+                             akp_file_atomic* out) {
+    if (akp_file_atomic_open(out, path) != AK_OK) {
+        akp_diag_set(c->diag, path, "cannot create file (%s)", strerror(out->err));
         return AK_ERR_IO;
     }
-    bool ok = fwrite(a, 1, an, f) == an && (!bn || fwrite(b, 1, bn, f) == bn);
-    ok = (fclose(f) == 0) && ok;
-    if (!ok) {
-        remove(path);
-        akp_diag_set(c->diag, path, "cannot write file");
+    bool ok = fwrite(a, 1, an, out->f) == an && (!bn || fwrite(b, 1, bn, out->f) == bn);
+    if (!ok) out->err = errno;
+    if (!ok || akp_file_atomic_close(out) != AK_OK) {
+        akp_file_atomic_abort(out);
+        akp_diag_set(c->diag, path, "cannot write file (%s)", strerror(out->err ? out->err : EIO));
         return AK_ERR_IO;
     }
     return AK_OK;
+}
+
+/* Put a closed temporary in place; the diag names path when that fails. */
+static ak_result rename_into_place(w_ctx* c, akp_file_atomic* out) {
+    if (akp_file_atomic_rename(out) == AK_OK) return AK_OK;
+    akp_diag_set(c->diag, out->path, "cannot write file (%s)", strerror(out->err ? out->err : EIO));
+    return AK_ERR_IO;
 }
 
 /* Percent-encode a file name for a URI (RFC 3986 unreserved characters kept). */
@@ -928,6 +937,9 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
             if (!glb) cJSON_AddStringToObject(b, "uri", bin_uri);
         }
     }
+    /* the temporaries of the file and its .bin (16 KiB: kept off the stack) */
+    akp_file_atomic* out = NULL;
+    if (r == AK_OK && !(out = (akp_file_atomic*)calloc(2, sizeof *out))) r = oom(&c);
     char* json = NULL;
     if (r == AK_OK && !(json = glb ? cJSON_PrintUnformatted(c.root) : cJSON_Print(c.root))) r = oom(&c);
     if (r == AK_OK && glb) {
@@ -953,17 +965,22 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
                     put_u32(head + hn + 4, 0x004E4942u); /* "BIN\0" */
                     hn += 8;
                 }
-                r = write_bytes(&c, path, head, hn, c.bin, c.bin_size);
+                r = write_bytes(&c, path, head, hn, c.bin, c.bin_size, out);
+                if (r == AK_OK) r = rename_into_place(&c, out);
                 free(head);
             }
         }
     } else if (r == AK_OK) {
-        if (c.bin_size) r = write_bytes(&c, bin_path, c.bin, c.bin_size, NULL, 0);
-        if (r == AK_OK) {
-            r = write_bytes(&c, path, json, strlen(json), "\n", 1);
-            if (r != AK_OK && c.bin_size) remove(bin_path);
-        }
+        /* both files are written in full before either is renamed into place: the .bin first,
+         * so a reader never sees a new .gltf beside an old .bin */
+        if (c.bin_size) r = write_bytes(&c, bin_path, c.bin, c.bin_size, NULL, 0, &out[1]);
+        if (r == AK_OK) r = write_bytes(&c, path, json, strlen(json), "\n", 1, out);
+        if (r == AK_OK && c.bin_size) r = rename_into_place(&c, &out[1]);
+        if (r == AK_OK) r = rename_into_place(&c, out);
+        akp_file_atomic_abort(&out[1]);
+        akp_file_atomic_abort(out);
     }
+    free(out);
     free(json);
     cJSON_Delete(c.root);
     cJSON_Delete(c.nodes);

@@ -1,4 +1,5 @@
-/* Helpers shared by the io readers (src/io.c, src/io/gltf.c, src/io/assimp.c); never installed. */
+/* Helpers shared by the io readers (src/io.c, src/io/gltf.c, src/io/bvh.c, src/io/obj.c,
+ * src/io/assimp.c); never installed. */
 #ifndef ANIMKIT_IO_INTERNAL_H
 #define ANIMKIT_IO_INTERNAL_H
 
@@ -56,6 +57,23 @@ ak_transform akp_io_decompose(ak_mat4 m);
 void akp_io_store_weights(ak_mesh* mesh, uint16_t* joints, float* weights, uint32_t src_influences,
                           const ak_io_desc* desc);
 
+/* Resolve path (relative to base_dir, or absolute) to a canonical path in out, following
+ * "..", "." and symlinks component by component, and looking at nothing outside base_dir and
+ * desc->extra_roots (unless desc->allow_any_path): a path that leaves them is refused before
+ * anything there is stat'ed or opened, so the answer does not depend on what exists outside.
+ * Returns AK_OK, AK_ERR_IO with *out_leaves true (the path leaves the model's folder) or
+ * false (missing inside the folder, a symlink loop, too long). */
+ak_result akp_io_resolve_inside(const char* base_dir, const char* path, const ak_io_desc* desc, char* out,
+                                size_t out_size, bool* out_leaves);
+
+/* Rewrite a message in place so that it holds only printable ASCII and valid UTF-8 (other
+ * bytes become "\xNN", truncated to size): messages quote the file's own words, and a
+ * file's raw bytes must never reach a terminal or a JSON report. */
+void akp_io_sanitize(char* msg, size_t size);
+
+/* Is s (n bytes) valid UTF-8 (no overlong forms, no surrogates, at most U+10FFFF)? */
+bool akp_io_utf8_valid(const char* s, size_t n);
+
 /* Copy a name into a fixed buffer, truncating. */
 void akp_io_copy_name(char dst[AK_NAME_SIZE], const char* src);
 
@@ -63,6 +81,9 @@ ak_result akp_io_load_gltf(const uint8_t* data, size_t size, const char* name, c
                            const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene, ak_diag* diag);
 /* BVH from a file (streamed, path != NULL) or from memory (data, size). */
 ak_result akp_io_load_bvh(const char* path, const uint8_t* data, size_t size, const char* name,
+                          const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene, ak_diag* diag);
+/* OBJ (+ MTL) from memory (data[size] must be 0); base_dir NULL -> mtllib not read. */
+ak_result akp_io_load_obj(const uint8_t* data, size_t size, const char* name, const char* base_dir,
                           const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene, ak_diag* diag);
 ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
                              ak_scene** out_scene, ak_diag* diag);

@@ -29,11 +29,12 @@ ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3
             }
         }
     }
-    FILE* f = fopen(path, "w");
-    if (!f) {
-        akp_diag_set(diag, path, "cannot create file (%s)", strerror(errno));
+    akp_file_atomic out; /* a temporary renamed over path once complete (internal.h) */
+    if (akp_file_atomic_open(&out, path) != AK_OK) {
+        akp_diag_set(diag, path, "cannot create file (%s)", strerror(out.err));
         return AK_ERR_IO;
     }
+    FILE* f = out.f;
     fprintf(f, "# animkit OBJ export: %s, %zu meshes\n", scene->name, scene->mesh_count);
     size_t base = 1, base_t = 1, base_n = 1; /* 1-based running offsets of v, vt, vn */
     for (size_t m = 0; m < scene->mesh_count; ++m) {
@@ -71,10 +72,8 @@ ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3
         if (mesh->uvs) base_t += mesh->vertex_count;
         if (n) base_n += mesh->vertex_count;
     }
-    bool bad = ferror(f) != 0;
-    if (fclose(f) != 0) bad = true;
-    if (bad) {
-        akp_diag_set(diag, path, "write failed");
+    if (akp_file_atomic_commit(&out) != AK_OK) {
+        akp_diag_set(diag, path, "cannot write file (%s)", strerror(out.err ? out.err : EIO));
         return AK_ERR_IO;
     }
     return AK_OK;

@@ -1,7 +1,6 @@
 /* PNG (libpng's simplified API) and animated GIF (giflib) writing and reading. The GIF colour
  * quantizer (median cut over a 15-bit histogram, ordered dithering) and the delta frames
  * (unchanged pixels transparent, palette kept while it fits) are animkit's own. */
-#include <fcntl.h> /* open: GIF files with the usual permissions */
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h> /* close */
@@ -39,6 +38,7 @@ struct ak_gif_writer {
     int pal_n;
     double pal_err;      /* its mean error on the frame it was built from */
     double shown_cs;     /* frame_rate: hundredths of a second written so far */
+    akp_file_atomic out; /* the temporary giflib writes; renamed over the path by finish */
 };
 
 /* ---- helpers ------------------------------------------------------------------------------- */
@@ -172,9 +172,17 @@ ak_result ak_png_write(const char* path, const ak_image* image) {
     pi.width = (png_uint_32)image->width;
     pi.height = (png_uint_32)image->height;
     pi.format = PNG_FORMAT_RGBA;
-    int ok = png_image_write_to_file(&pi, path, 0, image->pixels, (png_int_32)image_stride(image), NULL);
+    /* to a temporary renamed into place (internal.h): png_image_write_to_file would leave a
+     * partial file, or remove whatever path named (a symlink included) when it fails */
+    akp_file_atomic out;
+    if (akp_file_atomic_open(&out, path) != AK_OK) return AK_ERR_IO;
+    int ok = png_image_write_to_stdio(&pi, out.f, 0, image->pixels, (png_int_32)image_stride(image), NULL);
     png_image_free(&pi);
-    return ok ? AK_OK : AK_ERR_IO;
+    if (!ok) {
+        akp_file_atomic_abort(&out);
+        return AK_ERR_IO;
+    }
+    return akp_file_atomic_commit(&out);
 }
 
 static ak_result png_open(const char* path, png_image* pi) {
@@ -254,11 +262,14 @@ ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const 
     if (!(w->desc.frame_rate > 0.0f && w->desc.frame_rate <= 100.0f)) w->desc.frame_rate = 0.0f;
     int err = 0;
     /* Open the file ourselves: EGifOpenFileName creates it with mode 0600; users expect the
-     * same permissions as any other output (0666 less the umask, as fopen gives). */
-    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0666);
+     * same permissions as any other output (0666 less the umask, as fopen gives). giflib
+     * writes a temporary that finish renames over path (internal.h), so a failed run leaves
+     * no partial GIF and never touches what path names. */
+    int fd = akp_file_atomic_open_fd(&w->out, path);
     w->gif = fd >= 0 ? EGifOpenFileHandle(fd, &err) : NULL;
     if (!w->gif && fd >= 0) close(fd);
     if (!w->gif) {
+        akp_file_atomic_abort(&w->out);
         akp_free(w->has_alloc ? &w->alloc : NULL, mem);
         return AK_ERR_IO;
     }
@@ -273,6 +284,7 @@ ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const 
     ok = ok && EGifPutExtensionTrailer(w->gif) == GIF_OK;
     if (!ok) {
         EGifCloseFile(w->gif, &err);
+        akp_file_atomic_abort(&w->out);
         akp_free(w->has_alloc ? &w->alloc : NULL, mem);
         return AK_ERR_IO;
     }
@@ -431,11 +443,15 @@ ak_result ak_gif_writer_finish(ak_gif_writer* w) {
         for (int y = 0; ok && y < w->desc.height; ++y)
             ok = EGifPutLine(w->gif, w->indices + (size_t)y * (size_t)w->desc.width, w->desc.width) == GIF_OK;
         if (cm) GifFreeMapObject(cm);
+        if (!ok) w->failed = true;
         res = AK_ERR_EMPTY;
     }
     int err = 0;
-    if (EGifCloseFile(w->gif, &err) != GIF_OK && res == AK_OK) res = AK_ERR_IO;
-    if (w->failed && res == AK_OK) res = AK_ERR_IO;
+    bool complete = EGifCloseFile(w->gif, &err) == GIF_OK && !w->failed;
+    if (!complete) res = AK_ERR_IO;
+    /* a complete file (the blank one of AK_ERR_EMPTY too) goes into place; the rest is removed */
+    if (complete && akp_file_atomic_rename(&w->out) != AK_OK) res = AK_ERR_IO;
+    akp_file_atomic_abort(&w->out);
     ak_allocator a = w->alloc;
     akp_free(w->has_alloc ? &a : NULL, w);
     return res;

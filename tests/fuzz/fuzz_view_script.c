@@ -3,8 +3,9 @@
  *
  * Each input is parsed as a script; a parse must either fail with CLI_BAD_USAGE and an error
  * naming a line ("line N: ..."), or succeed with events whose fields are in range (known key,
- * button 1..3, finite coordinates, wait 0..1e6, a .png screenshot path inside the text). Any
- * crash, leak or sanitizer report is a bug. */
+ * button 1..3, finite coordinates, wait 0..1e6, a .png screenshot path inside the text that
+ * stays inside the shot directory: relative, no ".." component). Any crash, leak or sanitizer
+ * report is a bug. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,14 @@
 #include "view_app.h" /* tools/animkit, on the include path of scripts/fuzz.sh */
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
+
+/* An independent check of the parser's rule: absolute, or a ".." component anywhere. */
+static bool leaves_dir(const char* p) {
+    if (p[0] == '/') return true;
+    for (const char* c = p; (c = strstr(c, "..")); ++c)
+        if ((c == p || c[-1] == '/') && (c[2] == '\0' || c[2] == '/')) return true;
+    return false;
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     view_script s;
@@ -43,6 +52,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             break;
         case VIEW_EV_SCREENSHOT:
             if (!e->path || e->path < s.text || e->path >= s.text + size || !cli_has_ext(e->path, ".png")) abort();
+            if (leaves_dir(e->path)) abort();
             break;
         default: break;
         }

@@ -336,3 +336,12 @@ bool cli_mkdir_p(const char* path) {
     struct stat st;
     return stat(buf, &st) == 0 && S_ISDIR(st.st_mode);
 }
+
+int cli_usage_int(const char* cmd, const char* flag, const char* value, long lo, long hi) {
+    const char* s = value ? value : "";
+    size_t i = s[0] == '-' || s[0] == '+';
+    bool digits = s[i] != '\0';
+    for (; s[i]; ++i) digits = digits && s[i] >= '0' && s[i] <= '9';
+    if (digits) return cli_usage(cmd, "%s %s is out of range: expected a whole number in %ld..%ld", flag, s, lo, hi);
+    return cli_usage(cmd, "%s '%s' is not a whole number (expected %ld..%ld)", flag, s, lo, hi);
+}

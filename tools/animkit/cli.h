@@ -75,6 +75,10 @@ int cli_usage(const char* cmd, const char* fmt, ...)
 /* Strict number parsing: the whole string, finite. */
 bool cli_parse_float(const char* s, float* out);
 bool cli_parse_int(const char* s, long lo, long hi, long* out);
+/* The usage error for an integer flag cli_parse_int refused: "FLAG VALUE is out of range:
+ * expected a whole number in LO..HI" when VALUE is written as a whole number, else "FLAG
+ * 'VALUE' is not a whole number (expected LO..HI)". Returns CLI_BAD_USAGE. */
+int cli_usage_int(const char* cmd, const char* flag, const char* value, long lo, long hi);
 /* "X,Y,Z" */
 bool cli_parse_vec3(const char* s, ak_vec3* out);
 /* "WxH" */

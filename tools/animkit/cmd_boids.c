@@ -6,6 +6,7 @@
 #include "cli.h"
 #include "cli_json.h"
 #include "boids_run.h"
+#include "outfile.h"
 #include "scene_boids.h"
 
 static const char* const usage =
@@ -84,8 +85,9 @@ static ak_result draw_frame(renderer* r, const cli_boids_scene* sc, const boids_
 /* ---- the command -------------------------------------------------------------------------- */
 
 static int write_json(const char* path, long steps, const boids_run* st) {
-    FILE* f = fopen(path, "w");
-    if (!f) return cli_fail("boids", "%s: cannot write", path);
+    cli_outfile out; /* a temporary renamed over path once complete */
+    if (cli_outfile_open(&out, "boids", path)) return CLI_BAD_INPUT;
+    FILE* f = out.f;
     const float order = ak_boids_order((ak_vec3_cspan){st->v, st->n});
     float dmin = 0.0f;
     if (st->n >= 2) {
@@ -100,8 +102,7 @@ static int write_json(const char* path, long steps, const boids_run* st) {
         fprintf(f, "%s{\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g]}", i ? ", " : "", (double)st->p[i].x,
                 (double)st->p[i].y, (double)st->p[i].z, (double)st->v[i].x, (double)st->v[i].y, (double)st->v[i].z);
     fprintf(f, "], \"order\": %.9g, \"min_distance\": %.9g}\n", (double)order, (double)dmin);
-    if (fclose(f) != 0) return cli_fail("boids", "%s: cannot write", path);
-    return CLI_OK;
+    return cli_outfile_commit(&out, "boids");
 }
 
 int cmd_boids(int argc, char** argv) {
@@ -213,16 +214,17 @@ int cmd_boids(int argc, char** argv) {
             renderer_free(&rd);
             boids_run_free(&st);
             cli_boids_scene_free(&sc);
-            return cli_fail("boids", "%s: cannot write", out);
+            return cli_fail("boids", "%s: cannot create the file", out);
         }
     }
     const long every = sc.steps > 150 ? (sc.steps + 149) / 150 : 1;
     const double t0 = cli_now();
     long failed_step = -1;
-    for (long s = 0; s <= sc.steps && res == AK_OK; ++s) {
+    ak_result wres = AK_OK; /* writing -o: its failures name the file */
+    for (long s = 0; s <= sc.steps && res == AK_OK && wres == AK_OK; ++s) {
         if (gif && s % every == 0) {
             res = draw_frame(&rd, &sc, &st, (float)s * sc.dt, &img);
-            if (res == AK_OK) res = ak_gif_writer_add_frame(gif, &img);
+            if (res == AK_OK) wres = ak_gif_writer_add_frame(gif, &img);
         }
         if (s == sc.steps) break;
         if (res == AK_OK && (res = boids_run_step(&st, s)) != AK_OK) failed_step = s;
@@ -231,16 +233,17 @@ int cmd_boids(int argc, char** argv) {
     const double elapsed = cli_now() - t0;
     if (res == AK_OK && rendering && !is_gif) {
         res = draw_frame(&rd, &sc, &st, (float)sc.steps * sc.dt, &img);
-        if (res == AK_OK) res = ak_png_write(out, &img);
+        if (res == AK_OK) wres = ak_png_write(out, &img);
     }
     if (gif) {
         const ak_result fr = ak_gif_writer_finish(gif);
-        if (res == AK_OK) res = fr;
+        if (res == AK_OK && wres == AK_OK) wres = fr;
     }
     if (rendering) renderer_free(&rd);
     rc = CLI_OK;
     if (res != AK_OK && failed_step >= 0) rc = cli_fail("boids", "step %ld: %s", failed_step, boids_run_error(res));
     else if (res != AK_OK) rc = cli_fail("boids", "%s", ak_result_string(res));
+    else if (wres != AK_OK) rc = cli_fail("boids", "%s: cannot write the file: %s", out, ak_result_string(wres));
     if (rc == CLI_OK && json) rc = write_json(json, sc.steps, &st);
     if (rc == CLI_OK && !json && !out) {
         float dmin = 0.0f;

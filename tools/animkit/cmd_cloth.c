@@ -7,6 +7,7 @@
 #include "cli_json.h"
 #include "render.h"
 #include "cloth_run.h"
+#include "outfile.h"
 #include "scene_cloth.h"
 #include "sim_bake.h"
 
@@ -26,19 +27,20 @@ static const char* const usage =
 /* ---- output ------------------------------------------------------------------------------ */
 
 static int write_json(const char* path, float time, const ak_vec3* x, size_t n, float stretch, double energy) {
-    FILE* f = fopen(path, "w");
-    if (!f) return cli_fail("cloth", "%s: cannot open for writing", path);
+    cli_outfile out; /* a temporary renamed over path once complete */
+    if (cli_outfile_open(&out, "cloth", path)) return CLI_BAD_INPUT;
+    FILE* f = out.f;
     fprintf(f, "{\"time\": %.9g, \"positions\": [", (double)time);
     for (size_t v = 0; v < n; ++v)
         fprintf(f, "%s[%.9g, %.9g, %.9g]", v ? ", " : "", (double)x[v].x, (double)x[v].y, (double)x[v].z);
     fprintf(f, "], \"max_stretch\": %.9g, \"energy\": %.9g}\n", (double)stretch, energy);
-    if (fclose(f) != 0) return cli_fail("cloth", "%s: cannot write", path);
-    return CLI_OK;
+    return cli_outfile_commit(&out, "cloth");
 }
 
 static int write_obj(const char* path, const ak_cloth* cloth, const ak_vec3* x, const ak_vec3* nrm) {
-    FILE* f = fopen(path, "w");
-    if (!f) return cli_fail("cloth", "%s: cannot open for writing", path);
+    cli_outfile out; /* a temporary renamed over path once complete */
+    if (cli_outfile_open(&out, "cloth", path)) return CLI_BAD_INPUT;
+    FILE* f = out.f;
     const size_t n = ak_cloth_vertex_count(cloth);
     ak_u32_cspan idx = ak_cloth_indices(cloth);
     fprintf(f, "# animkit cloth: %zu vertices, %zu triangles\no cloth\n", n, idx.count / 3);
@@ -47,8 +49,7 @@ static int write_obj(const char* path, const ak_cloth* cloth, const ak_vec3* x, 
     for (size_t t = 0; t + 2 < idx.count; t += 3)
         fprintf(f, "f %u//%u %u//%u %u//%u\n", idx.ptr[t] + 1, idx.ptr[t] + 1, idx.ptr[t + 1] + 1, idx.ptr[t + 1] + 1,
                 idx.ptr[t + 2] + 1, idx.ptr[t + 2] + 1);
-    if (fclose(f) != 0) return cli_fail("cloth", "%s: cannot write", path);
-    return CLI_OK;
+    return cli_outfile_commit(&out, "cloth");
 }
 
 /* ---- the command -------------------------------------------------------------------------- */

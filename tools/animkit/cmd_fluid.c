@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "outfile.h"
 #include "scene_fluid.h"
 
 static const char* const usage =
@@ -235,11 +236,12 @@ static int write_obj(const char* path, const fluid_scene* s, const ak_vec3* p, s
                 for (size_t m = 0; m < k; ++m) sum += ak_fluid_poly6(ak_vec3_length_sq(ak_vec3_sub(q, p[near[m]])), h);
                 field[(z * ny + y) * nx + x] = sum * scale;
             }
-    FILE* f = fopen(path, "w");
-    if (!f) {
+    cli_outfile out; /* a temporary renamed over path once complete */
+    if (cli_outfile_open(&out, "fluid", path)) {
         free(field), free(gmem);
-        return cli_fail("fluid", "%s: cannot open for writing", path);
+        return CLI_BAD_INPUT;
     }
+    FILE* f = out.f;
     fprintf(f, "# animkit fluid: surface of the smoothed density at half the rest density\n");
     mesh_out o = {f, 0};
     /* six tetrahedra around the cube diagonal 0-7 */
@@ -261,18 +263,19 @@ static int write_obj(const char* path, const fluid_scene* s, const ak_vec3* p, s
                     tet(&o, tp, tf, 0.5f);
                 }
             }
-    bool bad = ferror(f) != 0;
-    bad = fclose(f) != 0 || bad;
     free(field), free(gmem);
-    if (bad) return cli_fail("fluid", "%s: write error", path);
-    return CLI_OK;
+    return cli_outfile_commit(&out, "fluid");
 }
 
 /* ---- the command ------------------------------------------------------------------------- */
 
 static int write_json(const char* path, float t, const ak_vec3* p, const ak_vec3* v, size_t n, const ak_fluid_stats* st) {
-    FILE* f = strcmp(path, "-") == 0 ? stdout : fopen(path, "w");
-    if (!f) return cli_fail("fluid", "%s: cannot open for writing", path);
+    /* "-": stdout; a file: a temporary renamed over path once complete */
+    cli_outfile out;
+    memset(&out, 0, sizeof out);
+    const bool to_stdout = strcmp(path, "-") == 0;
+    if (!to_stdout && cli_outfile_open(&out, "fluid", path)) return CLI_BAD_INPUT;
+    FILE* f = to_stdout ? stdout : out.f;
     fprintf(f, "{\"time\": ");
     cli_json_write_number(f, t);
     fprintf(f, ", \"particles\": [");
@@ -285,9 +288,8 @@ static int write_json(const char* path, float t, const ak_vec3* p, const ak_vec3
     fprintf(f, ", \"mean_density_error\": ");
     cli_json_write_number(f, st->mean_density_error);
     fprintf(f, "}\n");
-    bool bad = ferror(f) != 0;
-    if (f != stdout) bad = fclose(f) != 0 || bad;
-    if (bad) return cli_fail("fluid", "%s: write error", path);
+    if (!to_stdout) return cli_outfile_commit(&out, "fluid");
+    if (fflush(stdout) != 0 || ferror(stdout)) return cli_fail("fluid", "-: cannot write to stdout");
     return CLI_OK;
 }
 

@@ -7,6 +7,7 @@
 #include "cli_json.h"
 #include "render.h"
 #include "particles_run.h"
+#include "outfile.h"
 #include "scene_particles.h"
 #include "sim_bake.h"
 
@@ -88,8 +89,9 @@ static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
 /* ---- output --------------------------------------------------------------------------- */
 
 static int write_json(const char* path, particles_run* r, int steps) {
-    FILE* f = fopen(path, "w");
-    if (!f) return cli_fail("particles", "%s: cannot open for writing", path);
+    cli_outfile out; /* a temporary renamed over path once complete */
+    if (cli_outfile_open(&out, "particles", path)) return CLI_BAD_INPUT;
+    FILE* f = out.f;
     ak_particles_state st = ak_particles_get_state(r->ps);
     fprintf(f, "{\"time\": %.9g, \"steps\": %d, \"particles\": [", ak_particles_time(r->ps), steps);
     for (size_t i = 0; i < st.count; ++i) {
@@ -98,8 +100,7 @@ static int write_json(const char* path, particles_run* r, int steps) {
                 (double)p.x, (double)p.y, (double)p.z, (double)v.x, (double)v.y, (double)v.z);
     }
     fprintf(f, "%s]}\n", st.count ? "\n" : "");
-    if (fclose(f) != 0) return cli_fail("particles", "%s: write failed", path);
-    return CLI_OK;
+    return cli_outfile_commit(&out, "particles");
 }
 
 int cmd_particles(int argc, char** argv) {

@@ -1,9 +1,12 @@
 /* animkit retarget: put a source clip (motion capture) on a target character and write the
  * target as glTF, or a GIF of source and target side by side. */
 #include <errno.h>
+#include <fcntl.h> /* open: O_NONBLOCK for the map file */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h> /* read, close */
 
 #include "render.h"
 
@@ -23,55 +26,50 @@ static const char* const usage =
 
 /* ---- map files ---------------------------------------------------------------------------- */
 
-static char* trim(char* s) {
-    while (*s == ' ' || *s == '\t') ++s;
-    size_t n = strlen(s);
-    while (n && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\r' || s[n - 1] == '\n')) s[--n] = '\0';
-    return s;
-}
+#define MAX_MAP_SIZE (1u << 20)
 
-/* Parse a map file into map[target joint] = source joint (-1 elsewhere). One line on error. */
+/* Read a map file and parse it (ak_retarget_map_parse) into map[target joint] = source joint.
+ * Only a regular file is read: a FIFO would block the open (and a read) forever, a directory
+ * or a device is no map. One line on error. */
 static int read_map(const char* path, const ak_scene* src, const char* src_name, const ak_scene* dst,
                     const char* dst_name, int32_t* map) {
-    size_t nt = ak_scene_joint_count(dst);
-    for (size_t k = 0; k < nt; ++k) map[k] = -1;
-    FILE* f = fopen(path, "r");
-    if (!f) return cli_fail("retarget", "%s: cannot read the map file (%s)", path, strerror(errno));
-    char line[1024];
-    int rc = CLI_OK;
-    size_t entries = 0;
-    for (long ln = 1; rc == CLI_OK && fgets(line, sizeof line, f); ++ln) {
-        if (!strchr(line, '\n') && !feof(f)) {
-            rc = cli_fail("retarget", "%s:%ld: line longer than %zu bytes", path, ln, sizeof line - 2);
-            break;
-        }
-        char* hash = strchr(line, '#');
-        if (hash) *hash = '\0';
-        char* s = trim(line);
-        if (!*s) continue;
-        char* eq = strchr(s, '=');
-        if (!eq) {
-            rc = cli_fail("retarget", "%s:%ld: expected 'TARGET_JOINT = SOURCE_JOINT'", path, ln);
-            break;
-        }
-        *eq = '\0';
-        char* t = trim(s);
-        char* so = trim(eq + 1);
-        if (!*t || !*so) {
-            rc = cli_fail("retarget", "%s:%ld: expected 'TARGET_JOINT = SOURCE_JOINT'", path, ln);
-            break;
-        }
-        int tj = dst->skeleton ? ak_skeleton_find_joint(dst->skeleton, t) : -1;
-        int sj = src->skeleton ? ak_skeleton_find_joint(src->skeleton, so) : -1;
-        if (tj < 0) rc = cli_fail("retarget", "%s:%ld: target %s has no joint '%s'", path, ln, dst_name, t);
-        else if (sj < 0) rc = cli_fail("retarget", "%s:%ld: source %s has no joint '%s'", path, ln, src_name, so);
-        else if (map[tj] >= 0) rc = cli_fail("retarget", "%s:%ld: target joint '%s' is mapped twice", path, ln, t);
-        else map[tj] = sj, ++entries;
+    struct stat st;
+    if (stat(path, &st) != 0) return cli_fail("retarget", "%s: cannot read the map file (%s)", path, strerror(errno));
+    if (!S_ISREG(st.st_mode)) return cli_fail("retarget", "%s: the map file is not a regular file", path);
+    /* O_NONBLOCK: the path may have become a FIFO since the stat; fstat decides */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return cli_fail("retarget", "%s: cannot read the map file (%s)", path, strerror(errno));
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return cli_fail("retarget", "%s: the map file is not a regular file", path);
     }
-    if (rc == CLI_OK && ferror(f)) rc = cli_fail("retarget", "%s: read error", path);
-    fclose(f);
-    if (rc == CLI_OK && entries == 0) rc = cli_fail("retarget", "%s: the map file maps no joint", path);
-    return rc;
+    if ((unsigned long long)st.st_size > MAX_MAP_SIZE) {
+        close(fd);
+        return cli_fail("retarget", "%s: the map file is larger than %u bytes", path, MAX_MAP_SIZE);
+    }
+    char* text = malloc((size_t)st.st_size + 1);
+    size_t n = 0;
+    bool err = !text;
+    while (!err && n <= (size_t)st.st_size) { /* one byte past the size: the file may have grown */
+        ssize_t got = read(fd, text + n, (size_t)st.st_size + 1 - n);
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) err = true;
+        if (got <= 0) break;
+        n += (size_t)got;
+    }
+    close(fd);
+    if (err || n > (size_t)st.st_size) {
+        free(text);
+        return cli_fail("retarget", "%s: cannot read the map file%s", path, err ? "" : " (it changed while read)");
+    }
+    size_t nt = ak_scene_joint_count(dst), mapped = 0;
+    ak_diag diag;
+    ak_result r = ak_retarget_map_parse(text, n, src->skeleton, dst->skeleton, (ak_i32_span){map, nt}, &mapped, &diag);
+    free(text);
+    if (r == AK_ERR_NOT_FOUND)
+        return cli_fail("retarget", "%s: %s (target %s, source %s)", path, diag.message, dst_name, src_name);
+    if (r != AK_OK) return cli_fail("retarget", "%s: %s", path, diag.message);
+    return CLI_OK;
 }
 
 /* ---- GIF ------------------------------------------------------------------------------------ */

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "view_app.h"
+#include "outfile.h"
 
 #define MAX_SCRIPT_SIZE (4u << 20)
 
@@ -33,7 +34,8 @@ static const char* const usage =
     "  --seed K         simulation seed, 0..18446744073709551615 (default: particles 1, boids the\n"
     "                   scene's seed (K modulo 2^31), terrain 0; the cloth has no randomness)\n"
     "  --stats          print the frame-time breakdown at exit (stderr)\n"
-    "  --shot-dir DIR   where the P key writes view_NNNN.png (default .)\n"
+    "  --shot-dir DIR   where the P key writes view_NNNN.png and a script's screenshot PATH goes\n"
+    "                   (default .); PATH stays inside it: no absolute path, no '..', no symlink\n"
     "keys:\n";
 
 static void print_usage(void) {
@@ -97,12 +99,12 @@ int cmd_view(int argc, char** argv) {
     long v = 0, frames = 1;
     if (CLI_GET(&a, "--supersample")) {
         if (!cli_parse_int(CLI_GET(&a, "--supersample"), 1, 4, &v))
-            return cli_usage("view", "--supersample '%s' is not a whole number in 1..4", CLI_GET(&a, "--supersample"));
+            return cli_usage_int("view", "--supersample", CLI_GET(&a, "--supersample"), 1, 4);
         vo.supersample = (int)v;
     }
     if (CLI_GET(&a, "--threads")) {
         if (!cli_parse_int(CLI_GET(&a, "--threads"), 1, 64, &v))
-            return cli_usage("view", "--threads '%s' is not a whole number in 1..64", CLI_GET(&a, "--threads"));
+            return cli_usage_int("view", "--threads", CLI_GET(&a, "--threads"), 1, 64);
         vo.threads = (int)v;
         vo.sim_opts.threads = (int)v;
     }
@@ -116,7 +118,7 @@ int cmd_view(int argc, char** argv) {
         vo.sim_opts.has_seed = true;
     }
     if (CLI_GET(&a, "--frames") && !cli_parse_int(CLI_GET(&a, "--frames"), 0, 100000000, &frames))
-        return cli_usage("view", "--frames '%s' is not a whole number >= 0", CLI_GET(&a, "--frames"));
+        return cli_usage_int("view", "--frames", CLI_GET(&a, "--frames"), 0, 100000000);
     bool headless = CLI_GET(&a, "--headless") != NULL;
     if (!headless && !view_window_available())
         return cli_fail("view", "this build has no window (SDL2 was not found at build time); use --headless");
@@ -138,11 +140,13 @@ int cmd_view(int argc, char** argv) {
     const char* script_path = CLI_GET(&a, "--script");
     if (script_path && (rc = load_script(script_path, &script))) return rc;
     vo.scripted = script_path != NULL;
+    vo.script_name = script_path;
 
     ak_scene* s = NULL;
     view_app app;
     memset(&app, 0, sizeof app);
-    FILE* log = NULL;
+    cli_outfile log; /* --ik-log: a temporary renamed into place when the run succeeds */
+    memset(&log, 0, sizeof log);
     if (vo.sim) {
         /* a simulation draws on an empty model scene (no meshes, joints or clips) */
         if (ak_scene_alloc(0, 0, 0, NULL, &s) != AK_OK) {
@@ -169,11 +173,8 @@ int cmd_view(int argc, char** argv) {
     } else if (s->clip_count) {
         vo.clip = 0;
     }
-    if (CLI_GET(&a, "--ik-log") && !(log = fopen(CLI_GET(&a, "--ik-log"), "w"))) {
-        rc = cli_fail("view", "%s: cannot create the IK log", CLI_GET(&a, "--ik-log"));
-        goto done;
-    }
-    vo.ik_log = log;
+    if (CLI_GET(&a, "--ik-log") && (rc = cli_outfile_open(&log, "view", CLI_GET(&a, "--ik-log")))) goto done;
+    vo.ik_log = log.f;
     if ((rc = view_app_init(&app, s, &vo))) goto done;
     rc = headless ? view_app_run(&app, script_path ? &script : NULL, frames, NULL) : view_window_run(&app, script_path ? &script : NULL);
     if (CLI_GET(&a, "--stats") && app.stats.frames > 0) {
@@ -188,7 +189,8 @@ int cmd_view(int argc, char** argv) {
     }
 done:
     if (app.scene) view_app_free(&app);
-    if (log && fclose(log) != 0 && rc == CLI_OK) rc = cli_fail("view", "%s: cannot write the IK log", CLI_GET(&a, "--ik-log"));
+    if (log.f && rc == CLI_OK) rc = cli_outfile_commit(&log, "view");
+    cli_outfile_abort(&log);
     view_script_free(&script);
     ak_scene_destroy(s);
     return rc;

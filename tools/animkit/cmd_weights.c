@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "outfile.h"
 #include "render.h"
 
 static const char* const usage =
@@ -53,8 +54,9 @@ done:
 
 static int write_json(const char* path, const ak_scene* s, const ak_scene_skin* skin, size_t vc, uint32_t k,
                       const uint16_t* joints, const float* weights) {
-    FILE* f = fopen(path, "w");
-    if (!f) return cli_fail("weights", "%s: cannot create the file", path);
+    cli_outfile out; /* a temporary renamed over path once complete */
+    if (cli_outfile_open(&out, "weights", path)) return CLI_BAD_INPUT;
+    FILE* f = out.f;
     fprintf(f, "{\"vertex_count\": %zu, \"influence_count\": %u, \"joints\": [", vc, k);
     for (size_t q = 0; q < skin->joint_count; ++q) {
         fprintf(f, q ? ", " : "");
@@ -65,8 +67,7 @@ static int write_json(const char* path, const ak_scene* s, const ak_scene_skin* 
     fprintf(f, "],\n\"weights\": [");
     for (size_t i = 0; i < vc * k; ++i) fprintf(f, "%s%.7g", i ? "," : "", (double)weights[i]);
     fprintf(f, "]}\n");
-    if (fclose(f) != 0) return cli_fail("weights", "%s: write failed", path);
-    return CLI_OK;
+    return cli_outfile_commit(&out, "weights");
 }
 
 int cmd_weights(int argc, char** argv) {

@@ -1,4 +1,5 @@
 /* animkit: the command-line tool. Each subcommand lives in its own cmd_*.c file. */
+#include <signal.h> /* SIGXFSZ */
 #include <stdio.h>
 #include <string.h>
 
@@ -39,6 +40,10 @@ static void print_help(FILE* f) {
 }
 
 int main(int argc, char** argv) {
+    /* Past a file size limit (ulimit -f) a write then fails with EFBIG, which every writer
+     * reports (naming the file) and cleans up after, instead of the signal killing the
+     * process and leaving a temporary file behind. */
+    signal(SIGXFSZ, SIG_IGN);
     if (argc < 2) {
         print_help(stderr);
         return CLI_BAD_USAGE;

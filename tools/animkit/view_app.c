@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h> /* lstat: a script's screenshot path must not pass a symlink */
 
 #include "view_app.h"
 
@@ -549,6 +550,32 @@ int view_app_screenshot(view_app* a, const char* path) {
     return CLI_OK;
 }
 
+int view_app_script_screenshot(view_app* a, const view_event* ev) {
+    const char* dir = a->opt.shot_dir ? a->opt.shot_dir : ".";
+    const char* script = a->opt.script_name ? a->opt.script_name : "script";
+    char full[4096];
+    int n = snprintf(full, sizeof full, "%s/%s", dir, ev->path);
+    if (n < 0 || (size_t)n >= sizeof full)
+        return cli_fail("view", "%s: line %d: screenshot path '%s' is too long", script, ev->line, ev->path);
+    /* The parser refused absolute paths and '..'; what is left is a symlink under the shot
+     * directory that leads elsewhere. Each component is checked without following it (the
+     * PNG writer renames a temporary over the last one, which never follows a link either). */
+    for (size_t i = strlen(dir) + 1;; ++i) {
+        if (full[i] != '/' && full[i] != '\0') continue;
+        const char c = full[i];
+        full[i] = '\0';
+        struct stat st;
+        const bool link = lstat(full, &st) == 0 && S_ISLNK(st.st_mode);
+        if (link)
+            return cli_fail("view", "%s: line %d: screenshot '%s': %s is a symlink; screenshots stay inside the shot "
+                                    "directory %s",
+                            script, ev->line, ev->path, full, dir);
+        full[i] = c;
+        if (!c) break;
+    }
+    return view_app_screenshot(a, full);
+}
+
 void view_app_frame_all(view_app* a) {
     ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
     if (pose_sample(a) == AK_OK && cli_poser_deform(&a->poser, false, a->method) == AK_OK) cli_bounds_add_pose(&a->poser, &lo, &hi);
@@ -929,6 +956,10 @@ void view_app_free(view_app* a) {
 
 /* ---- the loop ---- */
 
+/* A simulation whose step or reset failed (it printed why) ends the run with exit status 1
+ * before anything else is drawn or written. */
+static bool sim_failed(const view_app* a) { return a->sim && a->sim->failed && a->sim->failed(a->sim_state); }
+
 int view_app_run(view_app* a, const view_script* script, long max_frames, const view_platform* pl) {
     size_t next = 0;
     long pending = 0, done = 0;
@@ -938,9 +969,10 @@ int view_app_run(view_app* a, const view_script* script, long max_frames, const 
         while (script && pending == 0 && next < script->count && !a->quit && rc == CLI_OK) {
             const view_event* ev = &script->events[next++];
             if (ev->type == VIEW_EV_WAIT) pending = ev->frames;
-            else if (ev->type == VIEW_EV_SCREENSHOT) rc = view_app_screenshot(a, ev->path);
+            else if (ev->type == VIEW_EV_SCREENSHOT) rc = view_app_script_screenshot(a, ev);
             else if (ev->type == VIEW_EV_QUIT) a->quit = true;
             else view_app_event(a, ev);
+            if (sim_failed(a)) rc = CLI_BAD_INPUT; /* a key stepped or reset it */
         }
         if (rc != CLI_OK || a->quit) break;
         if (script && pending == 0) break; /* the script ran out */
@@ -955,6 +987,10 @@ int view_app_run(view_app* a, const view_script* script, long max_frames, const 
         if (wall > 0) a->fps = a->fps > 0 ? 0.9 * a->fps + 0.1 / wall : 1.0 / wall;
         double dt = (a->opt.scripted || !pl) ? FIXED_STEP : (wall < 0.1 ? wall : 0.1);
         view_app_advance(a, dt);
+        if (sim_failed(a)) {
+            rc = CLI_BAD_INPUT;
+            break;
+        }
         if (visible) {
             ak_result r = view_app_render(a);
             if (r != AK_OK) {

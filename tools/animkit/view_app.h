@@ -86,8 +86,10 @@ void view_script_free(view_script* s);
  * raster, depth tested), overlay after the resolve (2D marks), bounds for F, key for the
  * simulation's own keys (true when used; msg gets a status message), grab when the left button
  * goes down (true when a collider is under the pixel: *anchor is its centre) and drag with the
- * world-space move of the anchor, status for the second status line, destroy at exit. Any
- * hook but init may be NULL. */
+ * world-space move of the anchor, status for the second status line, destroy at exit, failed
+ * after every step and reset: true once one failed (the simulation printed why), and the
+ * viewer then ends with exit status 1 and writes no further screenshot. Any hook but init may
+ * be NULL. */
 /* What the command line sets for a simulation: --seed (has_seed false -> the scene's own seed,
  * or 1 where the scene has none) and --threads (the simulation's worker threads; results are
  * the same for any count). */
@@ -112,6 +114,7 @@ typedef struct view_sim {
     void (*drag)(void* state, ak_vec3 delta);
     void (*status)(void* state, char* out, size_t out_size);
     void (*destroy)(void* state);
+    bool (*failed)(void* state);
     const view_help_entry* keys; /* the simulation's keys for the help overlay */
     size_t key_count;
 } view_sim;
@@ -139,7 +142,8 @@ typedef struct view_options {
     int threads;          /* raster threads */
     bool scripted;        /* fixed time step, deterministic status line */
     FILE* ik_log;         /* NULL -> none */
-    const char* shot_dir; /* where P writes screenshots; NULL -> "." */
+    const char* shot_dir; /* where P and a script's screenshots write; NULL -> "." */
+    const char* script_name; /* the --script file, for messages; NULL -> "script" */
     const view_sim* sim;  /* NULL -> none; else initialised by view_app_init with sim_spec */
     const char* sim_spec;
     view_sim_opts sim_opts;
@@ -232,6 +236,10 @@ void view_app_advance(view_app* app, double dt);
 ak_result view_app_render(view_app* app);
 /* Write the current image as PNG. */
 int view_app_screenshot(view_app* app, const char* path);
+/* A script's `screenshot PATH` (ev): the image written to PATH under the shot directory.
+ * A component of PATH that is a symlink (which could lead out of the directory) is refused:
+ * exit status 1 with "SCRIPT: line N: ..." on stderr. */
+int view_app_script_screenshot(view_app* app, const view_event* ev);
 /* Frame the camera on the current pose (key F). */
 void view_app_frame_all(view_app* app);
 

@@ -2,7 +2,9 @@
  *   key NAME | mouse_down BUTTON X Y | mouse_move X Y | mouse_up BUTTON X Y | wheel DY |
  *   wait FRAMES | screenshot PATH | quit
  * Blank lines and lines starting with '#' are skipped. BUTTON is left, middle or right (or
- * 1, 2, 3). Numbers are strict (the whole token, finite). */
+ * 1, 2, 3). Numbers are strict (the whole token, finite). A screenshot PATH is relative to the
+ * shot directory and stays inside it: not absolute, no ".." component (the viewer also
+ * refuses a symlink on the way when it writes, view_app.c). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -58,6 +60,20 @@ void view_script_free(view_script* s) {
     free(s->text);
     free(s->events);
     memset(s, 0, sizeof(*s));
+}
+
+/* Relative, without a ".." component: a path that stays inside the directory it is joined to
+ * (as far as the text goes; symlinks are the writer's check). */
+static bool path_stays_inside(const char* path) {
+    if (path[0] == '/') return false;
+    for (const char* c = path; *c;) {
+        const char* end = strchr(c, '/');
+        size_t n = end ? (size_t)(end - c) : strlen(c);
+        if (n == 2 && c[0] == '.' && c[1] == '.') return false;
+        c += n;
+        if (*c == '/') ++c;
+    }
+    return true;
 }
 
 static int bad(char* err, size_t n, int line, const char* what, const char* tok) {
@@ -145,6 +161,11 @@ int view_script_parse(const char* text, size_t size, view_script* out, char* err
             ev.type = VIEW_EV_SCREENSHOT;
             ev.path = n == want ? tok[1] : NULL;
             if (n == want && !cli_has_ext(tok[1], ".png")) rc = bad(err, err_size, line, "screenshot path must end in .png", tok[1]);
+            else if (n == want && !path_stays_inside(tok[1]))
+                rc = bad(err, err_size, line,
+                         "screenshot path must stay inside the shot directory (--shot-dir, default .): "
+                         "no absolute path, no '..'",
+                         tok[1]);
         } else if (strcmp(cmd, "quit") == 0) {
             want = 1;
             ev.type = VIEW_EV_QUIT;

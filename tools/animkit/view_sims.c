@@ -276,6 +276,8 @@ static void psim_reset(void* state) {
     if (psim_restart(p) != CLI_OK) p->failed = true;
 }
 
+static bool psim_failed(void* state) { return ((const psim*)state)->failed; }
+
 static size_t psim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
     psim* p = state;
     size_t n = 0;
@@ -362,6 +364,7 @@ static const view_sim particles_sim = {
     .drag = psim_drag,
     .status = psim_status,
     .destroy = psim_destroy,
+    .failed = psim_failed,
     .keys = psim_keys,
     .key_count = sizeof psim_keys / sizeof psim_keys[0],
 };
@@ -449,7 +452,11 @@ static int bsim_init(void** state, const char* spec, const view_sim_opts* o, cha
 
 static bool bsim_step_once(void* state) {
     bsim* b = state;
-    if (boids_run_step(&b->run, b->step_index) != AK_OK) return false;
+    ak_result r = boids_run_step(&b->run, b->step_index);
+    if (r != AK_OK) {
+        cli_fail("view", "%s: step %ld: %s", b->file ? b->file : "boids", b->step_index + 1, ak_result_string(r));
+        return false;
+    }
     ++b->step_index;
     return true;
 }
@@ -463,6 +470,8 @@ static void bsim_reset(void* state) {
     bsim* b = state;
     if (bsim_restart(b) != CLI_OK) b->failed = true;
 }
+
+static bool bsim_failed(void* state) { return ((const bsim*)state)->failed; }
 
 static size_t bsim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
     bsim* b = state;
@@ -524,6 +533,7 @@ static const view_sim boids_sim = {
     .drag = bsim_drag,
     .status = bsim_status,
     .destroy = bsim_destroy,
+    .failed = bsim_failed,
     .keys = bsim_keys,
     .key_count = sizeof bsim_keys / sizeof bsim_keys[0],
 };
@@ -635,6 +645,8 @@ static void csim_reset(void* state) {
     if (csim_restart(c) != CLI_OK) c->failed = true;
 }
 
+static bool csim_failed(void* state) { return ((const csim*)state)->failed; }
+
 /* The cloth, the collider props and the character's posed meshes, as `animkit cloth` draws them. */
 static size_t csim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
     csim* c = state;
@@ -718,6 +730,7 @@ static const view_sim cloth_sim = {
     .drag = csim_drag,
     .status = csim_status,
     .destroy = csim_destroy,
+    .failed = csim_failed,
     .keys = csim_keys,
     .key_count = sizeof csim_keys / sizeof csim_keys[0],
 };
