@@ -144,15 +144,21 @@ AK_TEST(failed_write_keeps_symlink_and_existing_file) {
     AK_CHECK(write_file(target, "keep\n"));
     AK_CHECK(write_file(old, "old\n"));
     AK_CHECK_EQ(symlink("target.txt", link), 0);
-    /* a library writer (PNG) and a command's own (JSON: --json takes any name) */
-    const char* outs[] = {"render builtin:humanoid --size 160x120 -o %s", "particles --preset fountain --steps 60 --json %s"};
-    for (size_t i = 0; i < 2; ++i) {
-        snprintf(args, sizeof args, outs[i], link);
+    char link_glb[256];
+    snprintf(link_glb, sizeof link_glb, "%s/link.glb", dir);
+    AK_CHECK_EQ(symlink("target.txt", link_glb), 0);
+    /* library writers (PNG, glTF: both used to remove the link) and a command's own (JSON:
+     * --json takes any name) */
+    const char* outs[] = {"render builtin:humanoid --size 160x120 -o %s", "particles --preset fountain --steps 60 --json %s",
+                          "export builtin:humanoid -o %s"};
+    for (size_t i = 0; i < 3; ++i) {
+        const char* link_i = i == 2 ? link_glb : link;
+        snprintf(args, sizeof args, outs[i], link_i);
         int rc = run_limited(args, LIMIT_BYTES, false);
         AK_CHECK_MSG(rc == 1, "%s: exit %d: %s", args, rc, out_buf);
-        AK_CHECK_MSG(strstr(out_buf, "link.png") != NULL, "%s: %s", args, out_buf);
+        AK_CHECK_MSG(strstr(out_buf, i == 2 ? "link.glb" : "link.png") != NULL, "%s: %s", args, out_buf);
         struct stat st;
-        AK_CHECK_MSG(lstat(link, &st) == 0 && S_ISLNK(st.st_mode), "%s: the symlink is gone", args);
+        AK_CHECK_MSG(lstat(link_i, &st) == 0 && S_ISLNK(st.st_mode), "%s: the symlink is gone", args);
         const char* t = read_file(target);
         AK_CHECK_MSG(t && strcmp(t, "keep\n") == 0, "%s: the link's target changed", args);
     }
@@ -160,7 +166,7 @@ AK_TEST(failed_write_keeps_symlink_and_existing_file) {
     AK_CHECK_EQ(run_limited(args, LIMIT_BYTES, false), 1);
     const char* o = read_file(old);
     AK_CHECK_MSG(o && strcmp(o, "old\n") == 0, "the existing output changed: %.40s", o ? o : "(gone)");
-    AK_CHECK_EQ(dir_entries(dir, list, sizeof list), 3);
+    AK_CHECK_EQ(dir_entries(dir, list, sizeof list), 4);
     AK_CHECK_MSG(!strstr(list, ".link") && !strstr(list, ".old"), "temporaries left: %s", list);
     /* success: the link is replaced by the new file, its target untouched */
     snprintf(args, sizeof args, "render builtin:humanoid --size 64x64 -o %s", link);
