@@ -110,6 +110,12 @@ AK_TEST(boids_stacked_at_one_point) {
     AK_CHECK_MSG(rc == 1, "rc %d: %s", rc, out_buf);
     AK_CHECK_MSG(strstr(out_buf, "step 0: the agents are packed too densely") != NULL, "%s", out_buf);
     AK_CHECK_MSG(now_s() - t0 < 20.0, "took %.1f s", now_s() - t0);
+    /* the first frame was drawn before the failed step: no partial GIF takes the output's place */
+    remove("u_boids.gif");
+    AK_CHECK_EQ(run("boids u_boids.json --steps 2 -o u_boids.gif", true), 1);
+    FILE* g = fopen("u_boids.gif", "rb");
+    AK_CHECK_MSG(g == NULL, "a partial u_boids.gif was left");
+    if (g) fclose(g);
 }
 
 AK_TEST(work_budget_refuses_before_running) {

@@ -353,6 +353,10 @@ AK_API ak_result ak_gif_writer_add_frame(ak_gif_writer* writer, const ak_image* 
  * earlier, or now), AK_ERR_EMPTY when no frame was added (the file is still valid-ish: one
  * blank frame is written, and it is renamed into place). NULL -> AK_ERR_NULL_ARG. */
 AK_API ak_result ak_gif_writer_finish(ak_gif_writer* writer);
+/* Abandon the file: close it, remove the temporary and free the writer; path is left untouched
+ * (for a run that failed after some frames: a partial animation must not take the output's
+ * place). NULL is a no-op. */
+AK_API void ak_gif_writer_discard(ak_gif_writer* writer);
 /* Size and frame count of a GIF file. AK_ERR_NULL_ARG, AK_ERR_IO, AK_ERR_PARSE. */
 AK_API ak_result ak_gif_info(const char* path, int* out_width, int* out_height, int* out_frame_count);
 /* Decode frame frame_index (composited over the earlier frames as a viewer shows it) into out

@@ -457,6 +457,15 @@ ak_result ak_gif_writer_finish(ak_gif_writer* w) {
     return res;
 }
 
+void ak_gif_writer_discard(ak_gif_writer* w) {
+    if (!w) return;
+    int err = 0;
+    EGifCloseFile(w->gif, &err);
+    akp_file_atomic_abort(&w->out);
+    ak_allocator a = w->alloc;
+    akp_free(w->has_alloc ? &a : NULL, w);
+}
+
 /* ---- public: GIF reader -------------------------------------------------------------------- */
 
 static ak_result gif_slurp(const char* path, GifFileType** out) {

@@ -235,10 +235,8 @@ int cmd_boids(int argc, char** argv) {
         res = draw_frame(&rd, &sc, &st, (float)sc.steps * sc.dt, &img);
         if (res == AK_OK) wres = ak_png_write(out, &img);
     }
-    if (gif) {
-        const ak_result fr = ak_gif_writer_finish(gif);
-        if (res == AK_OK && wres == AK_OK) wres = fr;
-    }
+    if (gif && (res != AK_OK || wres != AK_OK)) ak_gif_writer_discard(gif); /* no partial GIF */
+    else if (gif) wres = ak_gif_writer_finish(gif);
     if (rendering) renderer_free(&rd);
     rc = CLI_OK;
     if (res != AK_OK && failed_step >= 0) rc = cli_fail("boids", "step %ld: %s", failed_step, boids_run_error(res));

@@ -261,7 +261,7 @@ int cmd_cloth(int argc, char** argv) {
 
 done:
     sim_bake_free(&bake);
-    if (gw) ak_gif_writer_finish(gw);
+    ak_gif_writer_discard(gw); /* a failed run leaves no partial GIF */
     free(img.pixels);
     cli_frame_free(&frame);
     cloth_run_free(&run);

@@ -424,7 +424,8 @@ int cmd_demo(int argc, char** argv) {
     rc = humanoid_part(&d, &th);
     if (!rc) rc = cylinder_part(&d, &tc);
     if (!rc) rc = ball_part(&d, &tb);
-    r = ak_gif_writer_finish(d.gif);
+    if (rc) ak_gif_writer_discard(d.gif); /* a failed demo leaves no partial GIF */
+    r = rc ? AK_OK : ak_gif_writer_finish(d.gif);
     if (!rc && r != AK_OK) rc = fail(out_path(&d, "demo.gif"), r);
     free(d.frame.pixels);
     if (!rc) rc = easing_png(&d);

@@ -463,7 +463,7 @@ int cmd_fluid(int argc, char** argv) {
             names[s->desc.solver], n, s->steps, (double)s->dt, (double)t_end, wall, (double)st.mean_density_error,
             (double)st.max_density_error, st.full_count);
 done:
-    if (gw) ak_gif_writer_finish(gw);
+    ak_gif_writer_discard(gw); /* a failed run leaves no partial GIF */
     renderer_free(&ren);
     free(pos), free(vel), free(flags), free(scratch), free(s);
     return rc;

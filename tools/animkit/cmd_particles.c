@@ -319,10 +319,10 @@ int cmd_particles(int argc, char** argv) {
         if (res != AK_OK) rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
     }
 done:
-    if (gw) {
+    if (gw && rc != CLI_OK) ak_gif_writer_discard(gw); /* a failed run leaves no partial GIF */
+    else if (gw) {
         ak_result res = ak_gif_writer_finish(gw);
-        if (rc == CLI_OK && res != AK_OK)
-            rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
+        if (res != AK_OK) rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
     }
     sim_bake_free(&bake);
     particles_run_free(&r);

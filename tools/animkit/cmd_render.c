@@ -394,7 +394,7 @@ int cmd_render(int argc, char** argv) {
         fprintf(stderr, "wrote %.*s_0000.png .. %.*s_%04zu.png: %zu frames %dx%d in %.2f s\n", (int)(strlen(out) - 4), out,
                 (int)(strlen(out) - 4), out, ft.count - 1, ft.count, frame_img->width, frame_img->height, secs);
 done:
-    if (gw) ak_gif_writer_finish(gw);
+    ak_gif_writer_discard(gw); /* a failed run leaves no partial GIF */
     for (size_t m = 0; colors && m < s->mesh_count; ++m) free(colors[m]);
     free(colors);
     free(hidden);

@@ -122,9 +122,10 @@ static int write_gif(const char* out, const ak_scene* src, int clip, const ak_sc
         if (rc == CLI_OK && ak_view_panels_compose(&pd, panels, 2, &composed) != AK_OK) rc = cli_fail("retarget", "cannot compose panels");
         if (rc == CLI_OK && ak_gif_writer_add_frame(gw, &composed) != AK_OK) rc = cli_fail("retarget", "%s: cannot write", out);
     }
-    if (gw) {
+    if (gw && rc != CLI_OK) ak_gif_writer_discard(gw); /* a failed run leaves no partial GIF */
+    else if (gw) {
         ak_result wr = ak_gif_writer_finish(gw);
-        if (rc == CLI_OK && wr != AK_OK) rc = cli_fail("retarget", "%s: cannot write: %s", out, ak_result_string(wr));
+        if (wr != AK_OK) rc = cli_fail("retarget", "%s: cannot write: %s", out, ak_result_string(wr));
     }
     for (int k = 0; k < 2; ++k) {
         cli_frame_free(&fr[k]);

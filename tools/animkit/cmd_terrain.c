@@ -144,9 +144,10 @@ static int render_frames(const terrain_data* t, const char* path, bool gif) {
         cli_progress(gif ? "render" : "render", (size_t)f + 1, (size_t)frames);
     }
 done:
-    if (gw) {
+    if (gw && rc != CLI_OK) ak_gif_writer_discard(gw); /* a failed run leaves no partial GIF */
+    else if (gw) {
         res = ak_gif_writer_finish(gw);
-        if (rc == CLI_OK && res != AK_OK) rc = cli_fail("terrain", "%s: %s", path, ak_result_string(res));
+        if (res != AK_OK) rc = cli_fail("terrain", "%s: %s", path, ak_result_string(res));
     }
     ak_raster_destroy(r);
     free(pos), free(col), free(idx), free(px);
