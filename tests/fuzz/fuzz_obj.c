@@ -1,12 +1,18 @@
-/* libFuzzer target for the OBJ path (ak_io_load -> the Assimp pre-checks -> Assimp's OBJ
- * importer -> animkit's conversion); built and run by scripts/fuzz.sh.
+/* libFuzzer target for the Assimp path on OBJ input (ak_io_load with AK_IO_FORMAT_ASSIMP -> the
+ * Assimp pre-checks -> Assimp's OBJ importer in a forked, rlimited child -> the scene sent back
+ * over a pipe -> the parent's checks while rebuilding it); built and run by scripts/fuzz.sh.
+ * animkit's own OBJ reader, which AUTO picks for .obj, has its own target (fuzz_obj_mtl).
+ *
+ * Since Assimp runs in a child process, a crash in it is a reported error (AK_ERR_IO naming the
+ * signal), not a finding here: what this target can still find is a bug in animkit's
+ * conversion or in the parent's reading of the child's message. (Coverage gathered in the
+ * child does not reach libFuzzer, so the corpus grows from the parent's side only.)
  *
  * Assimp reads files only, so each input is written to one temporary .obj file, alone in a
  * private directory (mkdtemp in $TMPDIR or /tmp, removed at exit), and loaded from there: an
  * input's "mtllib" can then name no file but itself, so a run does not depend on what other
- * processes leave in /tmp. Assimp is not built with the sanitizers, so
- * this finds crashes in it but not its silent memory errors; its one known leak on failed
- * imports is suppressed through tests/fuzz/lsan.supp. A loaded scene's meshes must validate. */
+ * processes leave in /tmp. Its one known leak on failed imports is suppressed through
+ * tests/fuzz/lsan.supp. A loaded scene's meshes must validate. */
 #include <animkit/io.h>
 #include <stdint.h>
 #include <stdio.h>
