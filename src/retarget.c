@@ -189,6 +189,9 @@ ak_result ak_retarget_map_by_name(const ak_skeleton* source, const ak_skeleton* 
         char a[AK_NAME_SIZE], b[AK_NAME_SIZE];
         normalise(ak_skeleton_joint_name(target, k), a);
         for (size_t j = 0; j < ns && a[0]; ++j) {
+            /* the same name for two different bones is no match: builtin:humanoid's
+             * left_shoulder is its upper arm, a CMU LeftShoulder is the collarbone */
+            if (tb[k] != AK_BONE_NONE && sb[j] != AK_BONE_NONE && tb[k] != sb[j]) continue;
             normalise(ak_skeleton_joint_name(source, j), b);
             if (!used[j] && strcmp(a, b) == 0) {
                 out.ptr[k] = (int32_t)j;
@@ -487,6 +490,34 @@ ak_result ak_retarget_clip(const ak_retarget_desc* desc_in, const ak_allocator* 
             foot_pos[2 * f + (size_t)s] = feet[s] >= 0 && map[feet[s]] >= 0 ? model_position(&s_m[map[feet[s]]]) : ak_vec3_make(0, 0, 0);
     }
     if (r != AK_OK) goto done;
+
+    /* Ground the clip: the root's height is not measured from the source's rest pose (a BVH's
+     * rest pose has the hips at the origin while its motion carries them at hip height, so the
+     * rest displacement counted that height twice and the target floated above the floor).
+     * With both feet mapped, the whole clip moves up or down by the one offset that brings the
+     * target's lowest ankle over the clip to its lowest ankle at rest: the feet reach the floor
+     * when the source's get lowest, and no lower. */
+    if (feet[0] >= 0 && feet[1] >= 0 && map[feet[0]] >= 0 && map[feet[1]] >= 0) {
+        float low = HUGE_VALF;
+        for (size_t f = 0; f < nf; ++f) {
+            ak_skeleton_local_to_model(dst, (ak_transform_cspan){poses + f * nt, nt}, (ak_mat4_span){t_m, nt});
+            low = fminf(low, fminf(model_position(&t_m[feet[0]]).y, model_position(&t_m[feet[1]]).y));
+        }
+        const float rest_low = fminf(model_position(&t_rest_m[feet[0]]).y, model_position(&t_rest_m[feet[1]]).y);
+        const float dy = rest_low - low;
+        for (size_t f = 0; f < nf && ak_finitef(dy); ++f) {
+            ak_transform* out = poses + f * nt;
+            if (tpar.ptr[root] < 0) {
+                out[root].translation.y += dy;
+                continue;
+            }
+            /* a root under other joints (CesiumMan's): the model-space offset into the parent's space */
+            ak_skeleton_local_to_model(dst, (ak_transform_cspan){out, nt}, (ak_mat4_span){t_m, nt});
+            ak_vec3 want = model_position(&t_m[root]);
+            want.y += dy;
+            out[root].translation = ak_mat4_transform_point(ak_mat4_inverse_affine(t_m[tpar.ptr[root]]), want);
+        }
+    }
 
     /* foot contacts on the source, pinned on the target */
     size_t contact_frames = 0, pinned = 0, unreached = 0;

@@ -35,6 +35,9 @@ typedef struct run_result {
     double bone_error;  /* largest |bone length - rest length| / rest length */
     double slide;       /* target foot horizontal travel over source contact frame pairs */
     size_t contact_pairs;
+    double floor_gap;   /* lowest target ankle over the clip minus its lowest at rest (m) */
+    double arm_angle;   /* largest angle (degrees) between the target's and the source's
+                           left upper-arm directions in model space over the clip */
 } run_result;
 
 static ak_vec3 joint_pos(const ak_mat4* m) { return ak_mat4_get_translation(*m); }
@@ -42,7 +45,7 @@ static ak_vec3 joint_pos(const ak_mat4* m) { return ak_mat4_get_translation(*m);
 /* Retarget, then measure on the baked clip. feet: target joint of the left/right foot and
  * the source joints they follow. */
 static run_result run(const ak_scene* src, const ak_scene* dst, const int32_t* map, bool clean, const int* tfeet,
-                      const int* sfeet, ak_retarget_stats* st) {
+                      const int* sfeet, const int* tarm, const int* sarm, ak_retarget_stats* st) {
     run_result out = {.finite = false};
     const ak_skeleton *ss = src->skeleton, *ts = dst->skeleton;
     size_t ns = ak_skeleton_joint_count(ss), nt = ak_skeleton_joint_count(ts);
@@ -72,6 +75,7 @@ static run_result run(const ak_scene* src, const ak_scene* dst, const int32_t* m
               ak_vec3_length(ak_vec3_sub(joint_pos(&ms_rest[foot]), joint_pos(&ms_rest[knee])));
     }
     out.finite = true;
+    double rest_floor = fmin(joint_pos(&mt_rest[tfeet[0]]).y, joint_pos(&mt_rest[tfeet[1]]).y), floor = 1e30;
     float dur = ak_clip_duration(src->clips[0]);
     for (size_t f = 0; f < nf; ++f) {
         float t = (float)f / 30.0f;
@@ -89,8 +93,15 @@ static run_result run(const ak_scene* src, const ak_scene* dst, const int32_t* m
             double now = ak_vec3_length(ak_vec3_sub(joint_pos(&mt[j]), joint_pos(&mt[tp.ptr[j]])));
             if (rest > 1e-6) out.bone_error = fmax(out.bone_error, fabs(now - rest) / rest);
         }
+        {
+            ak_vec3 a = ak_vec3_sub(joint_pos(&mt[tarm[1]]), joint_pos(&mt[tarm[0]]));
+            ak_vec3 b = ak_vec3_sub(joint_pos(&ms[sarm[1]]), joint_pos(&ms[sarm[0]]));
+            double c = ak_vec3_dot(a, b) / ((double)ak_vec3_length(a) * (double)ak_vec3_length(b));
+            out.arm_angle = fmax(out.arm_angle, acos(fmax(-1.0, fmin(1.0, c))) * (180.0 / 3.14159265358979323846));
+        }
         for (int s = 0; s < 2; ++s) {
             ak_vec3 p = joint_pos(&ms[sfeet[s]]), q = joint_pos(&mt[tfeet[s]]);
+            floor = fmin(floor, q.y);
             sy[2 * f + (size_t)s] = p.y;
             sxz[4 * f + 2 * (size_t)s] = p.x, sxz[4 * f + 2 * (size_t)s + 1] = p.z;
             txz[4 * f + 2 * (size_t)s] = q.x, txz[4 * f + 2 * (size_t)s + 1] = q.z;
@@ -115,20 +126,34 @@ static run_result run(const ak_scene* src, const ak_scene* dst, const int32_t* m
             prev = c;
         }
     }
+    out.floor_gap = floor - rest_floor;
     free(ls), free(lt), free(ms), free(mt), free(mt_rest), free(sy), free(sxz), free(txz), free(ms_rest);
     ak_clip_destroy(clip);
     return out;
 }
 
+/* tl, tr: the target's ankles; tua, tla: its left upper arm and the joint below (elbow). */
 static void check_target(const char* what, const ak_scene* src, const ak_scene* dst, const int32_t* map,
-                         const char* tl, const char* tr) {
+                         const char* tl, const char* tr, const char* tua, const char* tla) {
     int tfeet[2] = {ak_skeleton_find_joint(dst->skeleton, tl), ak_skeleton_find_joint(dst->skeleton, tr)};
     int sfeet[2] = {ak_skeleton_find_joint(src->skeleton, "LeftFoot"), ak_skeleton_find_joint(src->skeleton, "RightFoot")};
+    int tarm[2] = {ak_skeleton_find_joint(dst->skeleton, tua), ak_skeleton_find_joint(dst->skeleton, tla)};
+    int sarm[2] = {ak_skeleton_find_joint(src->skeleton, "LeftArm"), ak_skeleton_find_joint(src->skeleton, "LeftForeArm")};
     AK_CHECK(tfeet[0] >= 0 && tfeet[1] >= 0 && sfeet[0] >= 0 && sfeet[1] >= 0);
-    if (tfeet[0] < 0 || tfeet[1] < 0 || sfeet[0] < 0 || sfeet[1] < 0) return;
+    AK_CHECK(tarm[0] >= 0 && tarm[1] >= 0 && sarm[0] >= 0 && sarm[1] >= 0);
+    if (tfeet[0] < 0 || tfeet[1] < 0 || sfeet[0] < 0 || sfeet[1] < 0 || tarm[0] < 0 || tarm[1] < 0 || sarm[0] < 0 ||
+        sarm[1] < 0)
+        return;
     ak_retarget_stats s0, s1;
-    run_result raw = run(src, dst, map, false, tfeet, sfeet, &s0);
-    run_result fixed = run(src, dst, map, true, tfeet, sfeet, &s1);
+    run_result raw = run(src, dst, map, false, tfeet, sfeet, tarm, sarm, &s0);
+    run_result fixed = run(src, dst, map, true, tfeet, sfeet, tarm, sarm, &s1);
+    printf("  %s: lowest ankle %.4f m from its rest height (%.4f with the clean-up), upper arm within %.2f deg of the "
+           "source's\n", what, raw.floor_gap, fixed.floor_gap, raw.arm_angle);
+    /* the feet reach the floor and no lower: the root's height is not counted twice */
+    AK_CHECK_MSG(fabs(raw.floor_gap) < 0.01 && fabs(fixed.floor_gap) < 0.02, "%s: lowest ankle %.4f / %.4f m off its rest height",
+                 what, raw.floor_gap, fixed.floor_gap);
+    /* the upper arm follows the source's upper arm, not its collarbone */
+    AK_CHECK_MSG(raw.arm_angle < 1.0, "%s: the upper arm strays %.2f deg from the source's", what, raw.arm_angle);
     printf("  %s: %zu frames, %zu joints mapped, root scale %.4f, %zu contact frame pairs, foot slide %.4g -> %.4g "
            "(%.2f%%), %zu frames pinned (%zu out of reach), bone length error %.2g\n",
            what, s1.frame_count, s1.mapped_count, (double)s1.root_scale, fixed.contact_pairs, raw.slide, fixed.slide,
@@ -151,7 +176,8 @@ AK_TEST(cmu_bvh_onto_builtin_and_cesiumman) {
     ak_diag diag;
     AK_CHECK_EQ(ak_io_load(path, NULL, NULL, &src, &diag), AK_OK);
     AK_CHECK_EQ(ak_builtin_create("humanoid", NULL, NULL, &human), AK_OK);
-    if (src && human) check_target("02_01.bvh -> builtin:humanoid", src, human, NULL, "left_ankle", "right_ankle");
+    if (src && human) check_target("02_01.bvh -> builtin:humanoid", src, human, NULL, "left_ankle", "right_ankle", "left_shoulder",
+                                    "left_elbow");
     char cpath[1200];
     if (src && ak_test_asset(cpath, sizeof cpath, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb") &&
         ak_io_load(cpath, NULL, NULL, &cesium, &diag) == AK_OK) {
@@ -164,7 +190,8 @@ AK_TEST(cmu_bvh_onto_builtin_and_cesiumman) {
             AK_CHECK_MSG(t >= 0 && s >= 0, "map %s -> %s", k_cesium_map[i][0], k_cesium_map[i][1]);
             if (t >= 0) map[t] = s;
         }
-        check_target("02_01.bvh -> CesiumMan", src, cesium, map, "leg_joint_L_3", "leg_joint_R_3");
+        check_target("02_01.bvh -> CesiumMan", src, cesium, map, "leg_joint_L_3", "leg_joint_R_3",
+                     "Skeleton_arm_joint_L__4_", "Skeleton_arm_joint_L__3_");
         free(map);
     } else {
         AK_SKIP("CesiumMan.glb absent");
@@ -193,6 +220,75 @@ static int run_cli(const char* args, char* line, size_t n) {
     g_cli_lines = lines;
     int st = pclose(p);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* The exported file stands on the floor: `animkit retarget` of a CMU walk onto builtin:humanoid
+ * and onto CesiumMan, the .glb loaded back and sampled at 30 fps; the lowest ankle over the
+ * clip is within 1 cm of the lowest ankle at rest, and the hips stay between 0.8 and 1.1 of
+ * their rest height above it (the hip height used to be counted twice: 1.86 m for 0.95). */
+AK_TEST(cli_exports_stand_on_the_floor) {
+    char bvh[1200], cesium[1200];
+    if (!ak_test_asset(bvh, sizeof bvh, "bvh/02_01.bvh") ||
+        !ak_test_asset(cesium, sizeof cesium, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) {
+        AK_SKIP("assets absent (set ANIMKIT_ASSETS)");
+        return;
+    }
+    static const struct {
+        const char *target, *out, *ankles[2], *hips;
+        bool needs_map;
+    } cases[] = {{"builtin:humanoid", "floor_human.glb", {"left_ankle", "right_ankle"}, "pelvis", false},
+                 {NULL, "floor_cesium.glb", {"leg_joint_L_3", "leg_joint_R_3"}, "Skeleton_torso_joint_1", true}};
+    for (int c = 0; c < 2; ++c) {
+        char args[4096], line[1024];
+        if (cases[c].needs_map) {
+            FILE* m = fopen("floor_cesium.map", "w");
+            AK_CHECK(m != NULL);
+            if (!m) return;
+            for (size_t i = 0; i < sizeof k_cesium_map / sizeof k_cesium_map[0]; ++i)
+                fprintf(m, "%s = %s\n", k_cesium_map[i][0], k_cesium_map[i][1]);
+            fclose(m);
+            snprintf(args, sizeof args, "'%s' '%s' --map floor_cesium.map -o %s", bvh, cesium, cases[c].out);
+        } else {
+            snprintf(args, sizeof args, "'%s' %s -o %s", bvh, cases[c].target, cases[c].out);
+        }
+        AK_CHECK_MSG(run_cli(args, line, sizeof line) == 0, "%s", line);
+        ak_scene* s = NULL;
+        ak_diag diag;
+        AK_CHECK_MSG(ak_io_load(cases[c].out, NULL, NULL, &s, &diag) == AK_OK, "%s", diag.message);
+        if (!s) continue;
+        const ak_skeleton* sk = s->skeleton;
+        size_t n = ak_skeleton_joint_count(sk);
+        int a0 = ak_skeleton_find_joint(sk, cases[c].ankles[0]), a1 = ak_skeleton_find_joint(sk, cases[c].ankles[1]);
+        int hip = ak_skeleton_find_joint(sk, cases[c].hips);
+        AK_CHECK(a0 >= 0 && a1 >= 0 && hip >= 0 && s->clip_count >= 1);
+        if (a0 < 0 || a1 < 0 || hip < 0 || s->clip_count < 1) {
+            ak_scene_destroy(s);
+            continue;
+        }
+        ak_transform* local = malloc(n * sizeof *local);
+        ak_mat4* model = malloc(n * sizeof *model);
+        ak_skeleton_local_to_model(sk, ak_skeleton_rest_pose(sk), (ak_mat4_span){model, n});
+        double rest_floor = fmin(joint_pos(&model[a0]).y, joint_pos(&model[a1]).y);
+        double rest_hip = joint_pos(&model[hip]).y - rest_floor;
+        double low = 1e30, hip_lo = 1e30, hip_hi = -1e30;
+        const ak_clip* clip = s->clips[s->clip_count - 1];
+        for (double t = 0.0; t <= (double)ak_clip_duration(clip); t += 1.0 / 30.0) {
+            memcpy(local, ak_skeleton_rest_pose(sk).ptr, n * sizeof *local);
+            ak_clip_sample(clip, (float)t, NULL, (ak_transform_span){local, n}, (ak_f32_span){0}, (ak_f32_span){0});
+            ak_skeleton_local_to_model(sk, (ak_transform_cspan){local, n}, (ak_mat4_span){model, n});
+            low = fmin(low, fmin(joint_pos(&model[a0]).y, joint_pos(&model[a1]).y));
+            double h = joint_pos(&model[hip]).y - rest_floor;
+            hip_lo = fmin(hip_lo, h), hip_hi = fmax(hip_hi, h);
+        }
+        printf("  %s: lowest ankle %+.4f m from rest, hips %.3f..%.3f m above the floor (rest %.3f)\n", cases[c].out,
+               low - rest_floor, hip_lo, hip_hi, rest_hip);
+        AK_CHECK_MSG(fabs(low - rest_floor) < 0.01, "%s: lowest ankle %.4f m from its rest height", cases[c].out,
+                     low - rest_floor);
+        AK_CHECK_MSG(hip_lo > 0.8 * rest_hip && hip_hi < 1.1 * rest_hip, "%s: hips at %.3f..%.3f m, rest %.3f", cases[c].out,
+                     hip_lo, hip_hi, rest_hip);
+        free(local), free(model);
+        ak_scene_destroy(s);
+    }
 }
 
 AK_TEST(cli_retarget) {
@@ -284,6 +380,7 @@ AK_TEST(cli_retarget) {
 int main(void) {
     AK_RUN(cmu_bvh_onto_builtin_and_cesiumman);
 #ifdef AK_CLI_PATH
+    AK_RUN(cli_exports_stand_on_the_floor);
     AK_RUN_SLOW(cli_retarget);
 #endif
     return ak_test_finish();

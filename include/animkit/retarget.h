@@ -2,7 +2,9 @@
  *
  * What it does:
  *   - maps target joints to source joints by name: the same name (case and "prefix:" such as
- *     "mixamorig:" ignored) first, then humanoid bones recognised in CMU/BVH, Mixamo, Unreal
+ *     "mixamorig:" ignored, and never two joints the rules below give different humanoid
+ *     bones: builtin:humanoid's left_shoulder is an upper arm, a CMU LeftShoulder a collarbone)
+ *     first, then humanoid bones recognised in CMU/BVH, Mixamo, Unreal
  *     mannequin, VRM humanoid and animkit's builtin humanoid names (ak_humanoid_bone_of_name),
  *     left/right written as Left/Right/L/R prefixes or _l/_r/.L/.R suffixes; or a caller's map;
  *   - transfers rotations as deltas from each skeleton's rest pose in the common model
@@ -17,7 +19,10 @@
  *     joint stay at its rest pose); moves the root joint (the hips, else the first mapped
  *     joint) by the source's displacement from its rest position scaled by the ratio of leg
  *     lengths (target / source, hip to knee to ankle; the root's rest height when legs are
- *     not mapped), or unscaled;
+ *     not mapped), or unscaled; when both feet are mapped, the clip is then grounded: moved up or down by the one offset that brings the target's
+ *     lowest ankle over the clip to its lowest ankle at rest (a BVH's rest pose has the hips at
+ *     the origin while its motion carries them at hip height: the rest displacement alone
+ *     counted that height twice);
  *   - optionally cleans up foot contacts: a source foot is in contact at a frame when its
  *     height above its lowest point in the clip is below contact_height and its horizontal
  *     speed below contact_speed; during each run of contact frames the target foot is pinned
