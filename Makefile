@@ -1,9 +1,10 @@
-# The two commands: `make demo` and `make test`. Everything else is CMake.
+# The two commands: `make demo` and `make test` (and `make test-slow`, the long runs). Everything
+# else is CMake.
 BUILD ?= build
 JOBS  ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 
-.PHONY: all demo test deps configure build bench clean
+.PHONY: all demo test test-slow deps configure build bench clean
 
 all: build
 
@@ -22,7 +23,11 @@ demo: build
 	./$(BUILD)/animkit demo -o out
 
 test: build
-	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE slow
+
+# The long runs (ctest label `slow`, tests/CMakeLists.txt), left out of `make test`.
+test-slow: build
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L slow
 
 bench: build
 	@for b in $(BUILD)/bench/bench_*; do echo "== $$b"; $$b; done

@@ -294,7 +294,39 @@ AK_TEST(default_and_presets_flock) {
     AK_CHECK_MSG(m.speed < 1.0 && m.order < 0.3, "old defaults: speed %.3f, order %.3f", m.speed, m.order);
 }
 
-int main(void) {
+/* Slow (ctest label `slow`: test_boids_cli --slow): docs/boids.md's table over seeds 1 to 16.
+ * Every preset at every seed flies aligned (neighbour cosine >= 0.8) at >= 1 m/s after the
+ * default 2000 steps. */
+AK_TEST(presets_flock_at_every_seed) {
+    static const char* const presets[] = {"flock", "obstacles", "predator"};
+    for (size_t i = 0; i < sizeof presets / sizeof presets[0]; ++i) {
+        double cos_sum = 0, cos_min = 2, order_sum = 0, order_min = 2, order_max = -1, speed_min = 1e30;
+        const int seeds = 16;
+        for (int seed = 1; seed <= seeds; ++seed) {
+            char args[256];
+            snprintf(args, sizeof args, "boids --preset %s --seed %d --json slow_flock_measure.json", presets[i], seed);
+            AK_CHECK_EQ(run(args, true), 0);
+            flock_measure m;
+            AK_CHECK(flock_measure_json("slow_flock_measure.json", 2.5, &m));
+            AK_CHECK_MSG(m.cosine >= 0.8 && m.speed >= 1.0, "%s seed %d: neighbour cosine %.3f, speed %.3f m/s",
+                         presets[i], seed, m.cosine, m.speed);
+            cos_sum += m.cosine;
+            cos_min = fmin(cos_min, m.cosine);
+            order_sum += m.order;
+            order_min = fmin(order_min, m.order);
+            order_max = fmax(order_max, m.order);
+            speed_min = fmin(speed_min, m.speed);
+        }
+        printf("  %-9s order %.3f (%.3f, %.3f), neighbour cosine %.3f (%.3f), speed >= %.2f m/s\n", presets[i],
+               order_sum / seeds, order_min, order_max, cos_sum / seeds, cos_min, speed_min);
+    }
+}
+
+int main(int argc, char** argv) {
+    if (argc > 1 && strcmp(argv[1], "--slow") == 0) {
+        AK_RUN(presets_flock_at_every_seed);
+        return ak_test_finish();
+    }
     AK_RUN(usage);
     AK_RUN(bad_scenes_name_the_key);
     AK_RUN(json_contract);
