@@ -1,5 +1,6 @@
 /* animkit boids: exit codes, error messages naming the key, the --json contract checked against
- * values computed here (order parameter, smallest distance in double), thread independence. */
+ * values computed here (order parameter, smallest distance in double), thread independence,
+ * grid and naive search, and that the default run and every preset flock (issue 27). */
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
 
@@ -23,6 +24,15 @@ AK_TEST(usage) {
     AK_CHECK(strstr(out_buf, "no_such_scene.json") != NULL);
     AK_CHECK_EQ(run("boids --count 50 --steps 3", true), 0);
     AK_CHECK(strstr(out_buf, "50 agents") != NULL);
+    AK_CHECK_EQ(run("boids --preset starlings", true), 2);
+    AK_CHECK(strstr(out_buf, "flock, obstacles, predator") != NULL);
+    write_file("preset_and_scene.json", "{}");
+    AK_CHECK_EQ(run("boids preset_and_scene.json --preset flock", true), 2);
+    AK_CHECK_EQ(run("boids --search kdtree", true), 2);
+    AK_CHECK(strstr(out_buf, "grid or naive") != NULL);
+    /* The naive search is quadratic: its distance tests are budgeted before the run starts. */
+    AK_CHECK_EQ(run("boids --search naive --count 1000000 --steps 1", true), 1);
+    AK_CHECK(strstr(out_buf, "--search grid") != NULL);
 }
 
 AK_TEST(bad_scenes_name_the_key) {
@@ -181,11 +191,145 @@ AK_TEST(render_and_example_scene) {
     AK_CHECK_EQ(frames, 7);
 }
 
+/* The grid and the naive search give the same bits; so do the presets on either. */
+AK_TEST(search_grid_and_naive) {
+    static const char* const runs[] = {"--count 300 --steps 60 --seed 5", "--preset obstacles --count 200 --steps 60",
+                                       "--preset predator --count 300 --steps 60"};
+    for (size_t i = 0; i < sizeof runs / sizeof runs[0]; ++i) {
+        char args[256];
+        snprintf(args, sizeof args, "boids %s --search grid --json search_grid.json", runs[i]);
+        AK_CHECK_EQ(run(args, true), 0);
+        char* grid = strdup(read_file("search_grid.json"));
+        snprintf(args, sizeof args, "boids %s --search naive --threads 2 --json search_naive.json", runs[i]);
+        AK_CHECK_EQ(run(args, true), 0);
+        AK_CHECK_MSG(strcmp(grid, read_file("search_naive.json")) == 0, "%s: grid and naive differ", runs[i]);
+        free(grid);
+    }
+}
+
+typedef struct flock_measure {
+    int agents, steps;
+    double order;     /* as written by the command */
+    double cosine;    /* mean cos(v_i, v_j) over the pairs closer than the radius */
+    double speed;     /* mean |v| */
+    double neighbors; /* pairs closer than the radius per agent, both ways */
+} flock_measure;
+
+/* The measures of docs/boids.md ("Defaults and presets") from a --json file, in double: every
+ * pair of agents closer than r counts once; an agent at rest counts as cosine 0. */
+static bool flock_measure_json(const char* path, double r, flock_measure* m) {
+    memset(m, 0, sizeof *m);
+    cJSON* root = cJSON_Parse(read_file(path));
+    if (!root) return false;
+    const cJSON* agents = cJSON_GetObjectItem(root, "agents");
+    const int n = cJSON_GetArraySize(agents);
+    double(*P)[3] = malloc((size_t)(n > 0 ? n : 1) * sizeof *P);
+    double(*V)[3] = malloc((size_t)(n > 0 ? n : 1) * sizeof *V);
+    double* S = malloc((size_t)(n > 0 ? n : 1) * sizeof *S);
+    int i = 0;
+    for (const cJSON* a = agents ? agents->child : NULL; a && i < n; a = a->next, ++i) {
+        for (int k = 0; k < 3; ++k) {
+            P[i][k] = cJSON_GetArrayItem(cJSON_GetObjectItem(a, "p"), k)->valuedouble;
+            V[i][k] = cJSON_GetArrayItem(cJSON_GetObjectItem(a, "v"), k)->valuedouble;
+        }
+        S[i] = len3d(V[i][0], V[i][1], V[i][2]);
+        m->speed += S[i] / n;
+    }
+    double sum = 0.0;
+    long pairs = 0;
+    for (int a = 0; a < n; ++a)
+        for (int b = a + 1; b < n; ++b) {
+            if (!(len3d(P[a][0] - P[b][0], P[a][1] - P[b][1], P[a][2] - P[b][2]) < r)) continue;
+            ++pairs;
+            if (S[a] > 0 && S[b] > 0)
+                sum += (V[a][0] * V[b][0] + V[a][1] * V[b][1] + V[a][2] * V[b][2]) / (S[a] * S[b]);
+        }
+    m->agents = n;
+    m->steps = cJSON_GetObjectItem(root, "steps")->valueint;
+    m->order = cJSON_GetObjectItem(root, "order")->valuedouble;
+    m->cosine = pairs ? sum / (double)pairs : 0.0;
+    m->neighbors = n ? 2.0 * (double)pairs / n : 0.0;
+    free(P);
+    free(V);
+    free(S);
+    cJSON_Delete(root);
+    return true;
+}
+
+/* Issue 27: the default run and every preset form aligned flocks that keep flying. After the
+ * default 2000 steps, neighbours within 2.5 m fly aligned (mean cosine >= 0.8) at >= 1 m/s, as
+ * docs/boids.md's table says. The old defaults (min_speed 0) fail the same check: the flock
+ * stalls in a clump. */
+AK_TEST(default_and_presets_flock) {
+    /* The flock preset is the default run. */
+    AK_CHECK_EQ(run("boids --steps 50 --json flock_default.json", true), 0);
+    char* def = strdup(read_file("flock_default.json"));
+    AK_CHECK_EQ(run("boids --preset flock --steps 50 --json flock_preset.json", true), 0);
+    AK_CHECK(strcmp(def, read_file("flock_preset.json")) == 0);
+    free(def);
+    static const char* const runs[] = {"", "--preset obstacles", "--preset predator"};
+    for (size_t i = 0; i < sizeof runs / sizeof runs[0]; ++i) {
+        char args[256];
+        snprintf(args, sizeof args, "boids %s --json flock_measure.json", runs[i]);
+        AK_CHECK_EQ(run(args, true), 0);
+        flock_measure m;
+        AK_CHECK(flock_measure_json("flock_measure.json", 2.5, &m));
+        printf("  boids %-18s order %.3f, neighbour cosine %.3f, speed %.3f m/s, %.1f neighbours\n", runs[i], m.order,
+               m.cosine, m.speed, m.neighbors);
+        AK_CHECK_EQ(m.steps, 2000); /* the default run */
+        AK_CHECK_EQ(m.agents, 500);
+        AK_CHECK_MSG(m.cosine >= 0.8, "%s: neighbours fly apart (mean cosine %.3f)", runs[i], m.cosine);
+        AK_CHECK_MSG(m.speed >= 1.0, "%s: the flock stalls (mean speed %.3f m/s)", runs[i], m.speed);
+        AK_CHECK(m.neighbors >= 4.0); /* flocks, not scattered birds */
+        AK_CHECK(m.order > 0.3);      /* the order parameter the table gives is well above noise */
+    }
+    /* The defaults before issue 27: velocities matched without a speed floor slow to a stall. */
+    write_file("old_defaults.json",
+               "{\"bounds\": {\"margin\": 2}, \"species\": [{\"min_speed\": 0, \"max_force\": 8,"
+               " \"separation_weight\": 1.5, \"separation_radius\": 1, \"alignment_weight\": 1,"
+               " \"bounds_weight\": 4}]}");
+    AK_CHECK_EQ(run("boids old_defaults.json --json flock_measure.json", true), 0);
+    flock_measure m;
+    AK_CHECK(flock_measure_json("flock_measure.json", 2.5, &m));
+    AK_CHECK_MSG(m.speed < 1.0 && m.order < 0.3, "old defaults: speed %.3f, order %.3f", m.speed, m.order);
+}
+
+/* Slow (AK_RUN_SLOW: ctest test_boids_cli_slow, label `slow`): docs/boids.md's table over seeds 1 to 16.
+ * Every preset at every seed flies aligned (neighbour cosine >= 0.8) at >= 1 m/s after the
+ * default 2000 steps. */
+AK_TEST(presets_flock_at_every_seed) {
+    static const char* const presets[] = {"flock", "obstacles", "predator"};
+    for (size_t i = 0; i < sizeof presets / sizeof presets[0]; ++i) {
+        double cos_sum = 0, cos_min = 2, order_sum = 0, order_min = 2, order_max = -1, speed_min = 1e30;
+        const int seeds = 16;
+        for (int seed = 1; seed <= seeds; ++seed) {
+            char args[256];
+            snprintf(args, sizeof args, "boids --preset %s --seed %d --json slow_flock_measure.json", presets[i], seed);
+            AK_CHECK_EQ(run(args, true), 0);
+            flock_measure m;
+            AK_CHECK(flock_measure_json("slow_flock_measure.json", 2.5, &m));
+            AK_CHECK_MSG(m.cosine >= 0.8 && m.speed >= 1.0, "%s seed %d: neighbour cosine %.3f, speed %.3f m/s",
+                         presets[i], seed, m.cosine, m.speed);
+            cos_sum += m.cosine;
+            cos_min = fmin(cos_min, m.cosine);
+            order_sum += m.order;
+            order_min = fmin(order_min, m.order);
+            order_max = fmax(order_max, m.order);
+            speed_min = fmin(speed_min, m.speed);
+        }
+        printf("  %-9s order %.3f (%.3f, %.3f), neighbour cosine %.3f (%.3f), speed >= %.2f m/s\n", presets[i],
+               order_sum / seeds, order_min, order_max, cos_sum / seeds, cos_min, speed_min);
+    }
+}
+
 int main(void) {
     AK_RUN(usage);
     AK_RUN(bad_scenes_name_the_key);
     AK_RUN(json_contract);
     AK_RUN(default_box_grows_with_count);
     AK_RUN(render_and_example_scene);
+    AK_RUN(search_grid_and_naive);
+    AK_RUN(default_and_presets_flock);
+    AK_RUN_SLOW(presets_flock_at_every_seed);
     return ak_test_finish();
 }

@@ -495,12 +495,16 @@ AK_TEST(sim_bad_specs) {
         {"view cloth --headless", 2, "cloth:preset:NAME"},
         {"view cloth:no_such_cloth.json --headless", 1, "no_such_cloth.json"},
         {"view boids:sim_bad.json --headless", 1, "sim_bad.json"},
+        {"view boids:preset:starlings --headless", 2, "flock, obstacles, predator"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         int rc = run(cases[i].args, true);
         AK_CHECK_MSG(rc == cases[i].rc, "%s: exit %d (want %d): %s", cases[i].args, rc, cases[i].rc, out_buf);
         AK_CHECK_MSG(strstr(out_buf, cases[i].says) != NULL, "%s: '%s' not said: %s", cases[i].args, cases[i].says, out_buf);
     }
+    /* The boids presets run in the viewer as in `animkit boids --preset`. */
+    AK_CHECK_EQ(run("view boids:preset:obstacles --headless --frames 2 --size 64x48", true), 0);
+    AK_CHECK_EQ(run("view boids:preset:predator --headless --frames 2 --size 64x48", true), 0);
 }
 
 /* A simulation step that fails (here a cloth blowing up at its second step, the scene's

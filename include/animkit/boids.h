@@ -26,10 +26,12 @@
  *   - the neighbour lists themselves (ak_boids_neighbors_run), the flocking order parameter and
  *     the smallest distance between two agents.
  *
- * Integration (per agent, semi-implicit Euler): F = sum of the weighted forces, clamped to
- * max_force; v' = v + F dt clamped to [min_speed, max_speed]; p' = p + v' dt; then the bounds
- * wrap and the obstacle projection (below). In 2D (params.planar) every force and velocity has
- * y = 0 and agents keep their y.
+ * Integration (per agent, semi-implicit Euler): F = sum of the weighted forces, its length
+ * clamped to max_force; v' = v + F dt, its length clamped to [min_speed, max_speed] (the
+ * clamps scale the vector, keeping its direction); p' = p + v' dt; then the bounds wrap (a
+ * coordinate that left the box comes back by whole box widths: one, for a step shorter than
+ * the box) and the obstacle projection (below). In 2D (params.planar) every force and
+ * velocity has y = 0 and agents keep their y; the neighbour distance still includes y.
  *
  * Obstacles: the avoid force steers away before contact; the hard projection is the last
  * resort and always runs: a step whose segment p -> p' would enter an obstacle (or end inside

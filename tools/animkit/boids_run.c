@@ -5,7 +5,8 @@
 
 #include "boids_run.h"
 
-int boids_run_init(boids_run* st, const cli_boids_scene* sc, const char* cmd, const char* file, uint32_t threads) {
+int boids_run_init(boids_run* st, const cli_boids_scene* sc, const char* cmd, const char* file, uint32_t threads,
+                   bool naive) {
     memset(st, 0, sizeof *st);
     st->n = sc->agent_count > 0 ? sc->agent_count : sc->count;
     if (sc->params.has_leader && sc->params.leader_index >= st->n)
@@ -47,7 +48,7 @@ int boids_run_init(boids_run* st, const cli_boids_scene* sc, const char* cmd, co
 
     st->job = (ak_boids_step_job){.params = prm, .positions = {st->p, st->n}, .velocities = {st->v, st->n},
                                   .species = {st->s, st->n}, .wander = {st->w, st->n}, .dt = sc->dt,
-                                  .seed = (uint64_t)sc->seed, .thread_count = threads,
+                                  .seed = (uint64_t)sc->seed, .thread_count = threads, .use_naive = naive,
                                   .out_positions = {st->p2, st->n}, .out_velocities = {st->v2, st->n}};
     st->scratch_size = ak_boids_step_scratch_size(&st->job);
     st->scratch = st->scratch_size ? malloc(st->scratch_size) : NULL;

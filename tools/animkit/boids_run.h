@@ -18,9 +18,11 @@ typedef struct boids_run {
 } boids_run;
 
 /* Place the scene's agents ("agents", or count at random in the bounds from the seed) and
- * validate the step job. Returns an exit code with the message printed as `animkit CMD:`
+ * validate the step job (naive: the O(N^2) neighbour search instead of the grid; the same
+ * results, bit for bit). Returns an exit code with the message printed as `animkit CMD:`
  * naming file; free with boids_run_free in every case. */
-int boids_run_init(boids_run* r, const cli_boids_scene* sc, const char* cmd, const char* file, uint32_t threads);
+int boids_run_init(boids_run* r, const cli_boids_scene* sc, const char* cmd, const char* file, uint32_t threads,
+                   bool naive);
 /* Step number `step` (0-based; the wander noise depends on it). */
 ak_result boids_run_step(boids_run* r, long step);
 /* What a failed step's result means for a user (AK_ERR_BUDGET says what to lower). */

@@ -10,15 +10,21 @@
 #include "scene_boids.h"
 
 static const char* const usage =
-    "usage: animkit boids [SCENE.json] [--count N] [--steps S] [--dt DT] [--seed K] [--threads T] [--2d]\n"
-    "                     [--json OUT.json] [-o OUT.gif|OUT.png] [--size WxH]\n"
+    "usage: animkit boids [SCENE.json | --preset flock|obstacles|predator] [--count N] [--steps S] [--dt DT]\n"
+    "                     [--seed K] [--threads T] [--search grid|naive] [--2d] [--json OUT.json]\n"
+    "                     [-o OUT.gif|OUT.png] [--size WxH]\n"
     "Reynolds flocking (separation, alignment, cohesion with a view cone and a k-nearest cap),\n"
     "obstacles, bounds, goal, leader, predators and wander; see docs/boids.md for the scene keys.\n"
+    "Without a scene or preset it runs the flock preset (the scene file's defaults).\n"
+    "  --preset   flock (500 birds that form aligned flocks), obstacles (the flock around a sphere\n"
+    "             and four pillars), predator (3 predators chase the flock, which flees)\n"
     "  --count    agents placed at random in the bounds when the scene has no \"agents\" (default 500;\n"
     "             beyond 500 the default 20 m box grows with the count, so the density stays)\n"
-    "  --steps    steps to run (default 200)        --dt  seconds per step (default 0.02)\n"
+    "  --steps    steps to run (default 2000)       --dt  seconds per step (default 0.02)\n"
     "  --seed     random placement and wander (default 1)\n"
     "  --threads  threads per step (default 1; results are identical for any count)\n"
+    "  --search   neighbour search: grid (default) or naive (the O(N^2) reference loop; the same\n"
+    "             results, bit for bit)\n"
     "  --2d       agents on the horizontal plane y = 0 (same as \"planar\": true)\n"
     "  --json     write {\"steps\", \"agents\": [{\"p\", \"v\"}], \"order\", \"min_distance\"} after the run\n"
     "  -o         render the flock: .png (last step) or .gif (the run), --size WxH (default 640x480)\n"
@@ -109,7 +115,7 @@ int cmd_boids(int argc, char** argv) {
     static const cli_opt opts[] = {
         {"--count", NULL, true},   {"--steps", NULL, true}, {"--dt", NULL, true},   {"--seed", NULL, true},
         {"--threads", NULL, true}, {"--2d", NULL, false},   {"--json", NULL, true}, {"--output", "-o", true},
-        {"--size", NULL, true},
+        {"--size", NULL, true},    {"--preset", NULL, true}, {"--search", NULL, true},
     };
     cli_args a;
     int rc = cli_parse("boids", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
@@ -119,6 +125,12 @@ int cmd_boids(int argc, char** argv) {
         return CLI_OK;
     }
     if (a.pos_count > 1) return cli_usage("boids", "expected at most one SCENE.json");
+    const char* preset = CLI_GET(&a, "--preset");
+    if (preset && a.pos_count == 1) return cli_usage("boids", "give a scene file or --preset, not both");
+    const char* search = CLI_GET(&a, "--search");
+    if (search && strcmp(search, "grid") != 0 && strcmp(search, "naive") != 0)
+        return cli_usage("boids", "--search '%s' must be grid or naive", search);
+    const bool naive = search && strcmp(search, "naive") == 0;
     long count = -1, steps = -1, seed = -1, threads = 1;
     float dt = -1.0f;
     int w = 640, h = 480;
@@ -142,6 +154,14 @@ int cmd_boids(int argc, char** argv) {
 
     cli_boids_scene sc;
     cli_boids_scene_defaults(&sc);
+    if (preset) {
+        const int bad = cli_boids_scene_preset(preset, &sc);
+        if (bad) {
+            cli_boids_scene_free(&sc);
+            if (bad < 0) return cli_usage("boids", "--preset '%s' must be one of " CLI_BOIDS_PRESETS, preset);
+            return cli_fail("boids", "out of memory");
+        }
+    }
     if (a.pos_count == 1) {
         FILE* f = fopen(a.pos[0], "rb");
         if (!f) return cli_fail("boids", "%s: cannot open the file", a.pos[0]);
@@ -188,9 +208,14 @@ int cmd_boids(int argc, char** argv) {
 
     boids_run st;
     memset(&st, 0, sizeof st);
-    if ((rc = cli_work_check("boids", (double)(sc.agent_count > 0 ? sc.agent_count : sc.count) * (double)sc.steps,
-                             "agent updates (agents x steps)", "--steps or --count")) ||
-        (rc = boids_run_init(&st, &sc, "boids", a.pos_count ? a.pos[0] : "scene", (uint32_t)threads))) {
+    const double agents = (double)(sc.agent_count > 0 ? sc.agent_count : sc.count);
+    if ((rc = cli_work_check("boids", agents * (double)sc.steps, "agent updates (agents x steps)",
+                             "--steps or --count")) ||
+        (naive && (rc = cli_work_check("boids", agents * agents * (double)sc.steps,
+                                       "distance tests of the naive search (agents^2 x steps)",
+                                       "--steps or --count, or use --search grid"))) ||
+        (rc = boids_run_init(&st, &sc, "boids", a.pos_count ? a.pos[0] : preset ? preset : "scene", (uint32_t)threads,
+                             naive))) {
         boids_run_free(&st);
         cli_boids_scene_free(&sc);
         return rc;

@@ -13,10 +13,14 @@ void cli_boids_scene_defaults(cli_boids_scene* s) {
     static const ak_vec4 palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
                                        {0.75f, 0.30f, 0.55f, 1}};
     for (int k = 0; k < AK_BOIDS_MAX_SPECIES; ++k) {
-        s->species[k] = (ak_boids_species){.max_speed = 4, .max_force = 8, .separation_weight = 1.5f,
-                                           .separation_radius = 1, .alignment_weight = 1, .alignment_radius = 2.5f,
+        /* Why these values (docs/boids.md, "Defaults"): min_speed keeps the flock flying (alignment
+         * matches velocities, and the mean of unaligned velocities is short, so without a floor a
+         * flock slows to a stall); a gentle max_force and a wide, soft steer band turn a flock as
+         * a whole instead of folding it against a wall; separation out to 1.5 m keeps it spread. */
+        s->species[k] = (ak_boids_species){.max_speed = 4, .min_speed = 2, .max_force = 4, .separation_weight = 3,
+                                           .separation_radius = 1.5f, .alignment_weight = 3, .alignment_radius = 2.5f,
                                            .cohesion_weight = 0.6f, .cohesion_radius = 2.5f, .view_angle = 270,
-                                           .avoid_weight = 6, .avoid_distance = 2, .bounds_weight = 4};
+                                           .avoid_weight = 6, .avoid_distance = 2, .bounds_weight = 0.5f};
         s->color[k] = palette[k % 4];
     }
     s->params.species = s->species;
@@ -24,10 +28,10 @@ void cli_boids_scene_defaults(cli_boids_scene* s) {
     s->params.bounds_min = ak_vec3_make(-10, -10, -10);
     s->params.bounds_max = ak_vec3_make(10, 10, 10);
     s->params.bounds = AK_BOIDS_BOUNDS_STEER;
-    s->params.bounds_margin = 2;
+    s->params.bounds_margin = 5;
     s->params.leader_distance = 1;
     s->count = 500;
-    s->steps = 200;
+    s->steps = 2000;
     s->dt = 0.02f;
     s->seed = 1;
     s->shape_size = 0.5f;
@@ -39,6 +43,46 @@ void cli_boids_scene_scale_bounds(cli_boids_scene* s, size_t count) {
     const float k = (float)(s->params.planar ? sqrt(r) : cbrt(r));
     s->params.bounds_min = ak_vec3_scale(s->params.bounds_min, k);
     s->params.bounds_max = ak_vec3_scale(s->params.bounds_max, k);
+}
+
+int cli_boids_scene_preset(const char* name, cli_boids_scene* s) {
+    if (strcmp(name, "flock") == 0) return 0;
+    if (strcmp(name, "obstacles") == 0) {
+        /* A sphere in the middle and four pillars through the whole box, in the flock's way. */
+        static const ak_boids_obstacle obs[5] = {
+            {.kind = AK_BOIDS_SPHERE, .center = {0, 0, 0}, .radius = 2.5f},
+            {.kind = AK_BOIDS_BOX, .center = {-5, 0, -5}, .half_extents = {0.6f, 10, 0.6f}},
+            {.kind = AK_BOIDS_BOX, .center = {5, 0, -5}, .half_extents = {0.6f, 10, 0.6f}},
+            {.kind = AK_BOIDS_BOX, .center = {-5, 0, 5}, .half_extents = {0.6f, 10, 0.6f}},
+            {.kind = AK_BOIDS_BOX, .center = {5, 0, 5}, .half_extents = {0.6f, 10, 0.6f}},
+        };
+        s->obstacles = malloc(sizeof obs);
+        if (!s->obstacles) return 1;
+        memcpy(s->obstacles, obs, sizeof obs);
+        s->params.obstacles = s->obstacles;
+        s->params.obstacle_count = 5;
+        return 0;
+    }
+    if (strcmp(name, "predator") == 0) {
+        /* The flock flees from 0.6% predators (3 of 500) that chase the nearest bird. */
+        s->params.species_count = 2;
+        ak_boids_species* prey = &s->species[0];
+        prey->flee_mask = 1u << 1;
+        prey->flee_weight = 1;
+        prey->flee_radius = 6;
+        ak_boids_species* hunter = &s->species[1];
+        hunter->max_speed = 4.5f;
+        hunter->separation_radius = 4;
+        hunter->alignment_weight = 0;
+        hunter->cohesion_weight = 0;
+        hunter->pursue_mask = 1u << 0;
+        hunter->pursue_weight = 1;
+        hunter->pursue_radius = 10;
+        s->fraction[1] = 0.006f;
+        s->color[1] = ak_vec4_make(0.20f, 0.25f, 0.40f, 1);
+        return 0;
+    }
+    return -1;
 }
 
 void cli_boids_scene_free(cli_boids_scene* s) {

@@ -40,6 +40,13 @@ int cli_boids_scene_parse(const char* file, const char* text, size_t size, cli_b
 
 void cli_boids_scene_free(cli_boids_scene* s);
 
+/* The built-in scene NAME over the defaults already in s (nothing else set yet): "flock" (the
+ * defaults themselves), "obstacles" (a sphere and four pillars in the flock's way) or "predator"
+ * (a second species, 0.6% of the agents, that chases the flock, which flees). Returns 0, -1 for
+ * another name, 1 when out of memory; free s with cli_boids_scene_free in every case. */
+#define CLI_BOIDS_PRESETS "flock, obstacles, predator"
+int cli_boids_scene_preset(const char* name, cli_boids_scene* s);
+
 /* The default box for `count` random agents (call after --count and --2d are applied, only when
  * the scene lists no agents): unless the scene set bounds.min or bounds.max, the 20 m box of the
  * defaults grows beyond CLI_BOIDS_BOX_AGENTS agents by cbrt(count / CLI_BOIDS_BOX_AGENTS) on every

@@ -1,6 +1,6 @@
 /* animkit view: the simulations it runs live (view_sim plug-ins). `animkit view KIND:SPEC`
- * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json], cloth:SCENE.json,
- * cloth:preset:NAME, terrain[:preset:NAME] (view_terrain.c). Each reuses its command's scene
+ * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json], boids:preset:NAME,
+ * cloth:SCENE.json, cloth:preset:NAME, terrain[:preset:NAME] (view_terrain.c). Each reuses its command's scene
  * parser and drawing (particles_run.c, boids_run.c, cloth_run.c), so the viewer shows what the
  * command renders. */
 #include <math.h>
@@ -403,7 +403,7 @@ static int bsim_restart(bsim* b) {
     b->step_index = 0;
     b->carry = 0.0;
     b->failed = false;
-    int rc = boids_run_init(&b->run, &b->sc, "view", b->file, b->threads);
+    int rc = boids_run_init(&b->run, &b->sc, "view", b->file, b->threads, false);
     if (rc) return rc;
     return boids_shapes_obstacles(&b->sh, &b->sc.params, b->extent) ? CLI_OK : cli_fail("view", "out of memory");
 }
@@ -418,7 +418,13 @@ static int bsim_init(void** state, const char* spec, const view_sim_opts* o, cha
     b->threads = o->threads > 0 ? (uint32_t)o->threads : 1;
     b->file = spec[0] ? spec : "boids (default scene)";
     cli_boids_scene_defaults(&b->sc);
-    if (spec[0]) {
+    if (strncmp(spec, "preset:", 7) == 0) {
+        const int bad = cli_boids_scene_preset(spec + 7, &b->sc);
+        if (bad < 0)
+            return init_fail(bsim_destroy, b, CLI_BAD_USAGE, err, err_size,
+                             "boids:%s: the presets are " CLI_BOIDS_PRESETS, spec);
+        if (bad) return init_fail(bsim_destroy, b, CLI_BAD_INPUT, err, err_size, "out of memory");
+    } else if (spec[0]) {
         size_t size = 0;
         char* text = read_scene(spec, &size, err, err_size);
         int bad = !text || cli_boids_scene_parse(spec, text, size, &b->sc, err, err_size);
