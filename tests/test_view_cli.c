@@ -922,8 +922,32 @@ AK_TEST(sim_long_session) {
     }
 }
 
+/* No display: one clear message and exit 1 (SDL used to fall back to a driver that draws
+ * nowhere, after printing its XDG_RUNTIME_DIR complaint, and the viewer ran forever). The
+ * `timeout` turns the old hang into exit 124. */
+AK_TEST(no_display_is_an_error) {
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd,
+             "env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER timeout 60 '%s' view builtin:humanoid 2>&1", AK_CLI_PATH);
+    FILE* p = popen(cmd, "r");
+    AK_CHECK(p != NULL);
+    if (!p) return;
+    size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
+    out_buf[n] = '\0';
+    int st = pclose(p);
+    int rc = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    if (strstr(out_buf, "this build has no window")) { /* built without SDL2: the other message */
+        AK_CHECK_EQ(rc, 1);
+        return;
+    }
+    AK_CHECK_MSG(rc == 1, "rc %d: %s", rc, out_buf);
+    AK_CHECK_MSG(strstr(out_buf, "no display") && strstr(out_buf, "--headless"), "%s", out_buf);
+    AK_CHECK_MSG(!strstr(out_buf, "XDG_RUNTIME_DIR"), "%s", out_buf);
+}
+
 int main(void) {
     AK_RUN(bad_scripts_exit_2_naming_the_line);
+    AK_RUN(no_display_is_an_error);
     AK_RUN(methods_match_render);
     AK_RUN(camera_and_scrub);
     AK_RUN_SLOW(ik_drag_wrist);

@@ -5,6 +5,8 @@
 
 #ifdef AK_HAVE_SDL2
 #include <SDL.h>
+#include <stdlib.h> /* getenv */
+#include <string.h>
 
 typedef struct sdl_window {
     SDL_Window* window;
@@ -104,12 +106,26 @@ static int sdl_present(void* user, const view_app* a) {
 bool view_window_available(void) { return true; }
 
 int view_window_run(view_app* a, const view_script* script) {
+    /* Without a display SDL falls back to a driver that draws nowhere (after printing its own
+     * complaint about XDG_RUNTIME_DIR), and the viewer ran forever with no window. A user who
+     * wants such a driver names it in SDL_VIDEODRIVER. */
+    const char* x11 = getenv("DISPLAY");
+    const char* wl = getenv("WAYLAND_DISPLAY");
+    const char* drv = getenv("SDL_VIDEODRIVER");
+    if ((!x11 || !*x11) && (!wl || !*wl) && (!drv || !*drv))
+        return cli_fail("view", "no display (DISPLAY and WAYLAND_DISPLAY are not set): use --headless, or set "
+                        "SDL_VIDEODRIVER to choose a video driver");
     if (SDL_Init(SDL_INIT_VIDEO) != 0)
         return cli_fail("view", "cannot open a window (%s); use --headless where there is no display", SDL_GetError());
     sdl_window w = {0};
     int rc = CLI_OK;
     char title[300];
     snprintf(title, sizeof title, "animkit view - %s", a->scene->name);
+    const char* cur = SDL_GetCurrentVideoDriver();
+    if (cur && (!drv || !*drv) && (strcmp(cur, "offscreen") == 0 || strcmp(cur, "dummy") == 0)) {
+        SDL_Quit();
+        return cli_fail("view", "no display (SDL found only its '%s' video driver): use --headless", cur);
+    }
     w.window = SDL_CreateWindow(title, SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, a->width, a->height,
                                 SDL_WINDOW_RESIZABLE);
     if (!w.window) {
