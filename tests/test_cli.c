@@ -596,7 +596,8 @@ AK_TEST(messages_say_what_happened) {
     AK_CHECK_EQ(run("info builtin:cylinder", true), 0);
     AK_CHECK_MSG(strstr(out_buf, "1 channel\n") && !strstr(out_buf, "1 channels"), "%s", out_buf);
     AK_CHECK_EQ(run("export builtin:cylinder --clip nope -o x.obj", true), 1);
-    AK_CHECK_MSG(strstr(out_buf, "(3 clips)") != NULL, "%s", out_buf);
+    AK_CHECK_MSG(strstr(out_buf, "its clips (by name or number): #0 'bend', #1 'twist', #2 'bend_twist'") != NULL, "%s",
+                 out_buf);
     /* an option without its value is named as typed */
     AK_CHECK_EQ(run("render builtin:cylinder -o", true), 2);
     AK_CHECK_MSG(strstr(out_buf, "'-o' needs a value") != NULL, "%s", out_buf);
@@ -905,6 +906,33 @@ AK_TEST(render_obj_characters) {
     AK_CHECK_MSG(worst <= 9, "largest step between neighbouring pixels %d (r+g+b): faceted", worst);
 }
 
+/* Issue 33, round two of a new user's stumbles: each message says what happened. */
+AK_TEST(messages_round_two) {
+    /* an unknown clip lists the clips there are */
+    AK_CHECK_EQ(run("render builtin:humanoid --clip nope -o r2.png", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "no clip 'nope'; its clips (by name or number): #0 'walk', #1 'wave'") != NULL, "%s",
+                 out_buf);
+    /* a time outside the clip is clamped, and the command says so */
+    AK_CHECK_EQ(run("export builtin:humanoid --time 99 -o r2.obj", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "note: --time 99 is past the end of clip 'walk' (0 to 1 s): its last pose is used"), "%s",
+                 out_buf);
+    AK_CHECK_EQ(run("render builtin:humanoid --time -5 -o r2.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "note: --time -5 is before clip 'walk'"), "%s", out_buf);
+    AK_CHECK_EQ(run("export builtin:humanoid --time 0.5 -o r2.obj", true), 0);
+    AK_CHECK_MSG(!strstr(out_buf, "note:"), "%s", out_buf);
+    /* a channel kind alone selects every chart of that kind */
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel rotation -o r2c.png", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "wrote r2c.png") != NULL, "%s", out_buf);
+    AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel rotatoin -o r2c.png", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "'rotatoin' is no joint, chart number or channel kind") != NULL, "%s", out_buf);
+    /* --render with a GIF: the turntable (a GIF always is one) */
+    AK_CHECK_MSG(run("terrain --size 17x17 --render -o r2t.gif", true) == 0, "%s", out_buf);
+    AK_CHECK_EQ(run("terrain --size 17x17 --render -o r2t.obj", true), 2);
+    /* export counts as info does: skin joints within the hierarchy's nodes */
+    AK_CHECK_EQ(run("export builtin:humanoid -o r2.glb", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "joints in ") && strstr(out_buf, " nodes,"), "%s", out_buf);
+}
+
 int main(void) {
     AK_RUN(usage_and_help);
     AK_RUN(bad_input_paths);
@@ -928,5 +956,6 @@ int main(void) {
     AK_RUN(weights_png_shows_every_bone);
     AK_RUN_SLOW(curves_select_and_paginate);
     AK_RUN(render_obj_characters);
+    AK_RUN(messages_round_two);
     return ak_test_finish();
 }

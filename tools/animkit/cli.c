@@ -124,6 +124,30 @@ int cli_usage(const char* cmd, const char* fmt, ...) {
     return CLI_BAD_USAGE;
 }
 
+int cli_no_clip(const char* cmd, const char* file, const char* wanted, const ak_scene* s) {
+    char names[1024] = "";
+    size_t used = 0;
+    for (size_t c = 0; c < s->clip_count && used + 8 < sizeof names; ++c) {
+        const char* n = ak_clip_name(s->clips[c]);
+        int w = snprintf(names + used, sizeof names - used, "%s#%zu '%s'", c ? ", " : "", c, n && n[0] ? n : "");
+        if (w < 0) break;
+        used += (size_t)w < sizeof names - used ? (size_t)w : sizeof names - used - 1;
+    }
+    if (s->clip_count == 0) return cli_fail(cmd, "%s: no clip '%s': the file has no clips", file, wanted);
+    return cli_fail(cmd, "%s: no clip '%s'; its clip%s (by name or number): %s", file, wanted, cli_plural(s->clip_count),
+                    names);
+}
+
+void cli_time_note(const char* cmd, float t, const ak_clip* clip) {
+    if (!clip) return;
+    const float d = ak_clip_duration(clip);
+    if (t >= 0.0f && t <= d) return;
+    char name[256];
+    cli_escape(name, sizeof name, ak_clip_name(clip));
+    fprintf(stderr, "animkit %s: note: --time %g is %s clip '%s' (0 to %g s): its %s pose is used\n", cmd, (double)t,
+            t < 0.0f ? "before" : "past the end of", name, (double)d, t < 0.0f ? "first" : "last");
+}
+
 int cli_work_check(const char* cmd, double work, const char* what, const char* lower) {
     double budget = CLI_WORK_BUDGET;
     const char* env = getenv("ANIMKIT_MAX_WORK");

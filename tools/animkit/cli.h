@@ -50,6 +50,15 @@ size_t cli_get_all(const cli_args* a, const cli_opt* opts, size_t opt_count, con
  * character); returns the length. Every message quoting input goes through it. */
 size_t cli_escape(char* out, size_t cap, const char* s);
 
+/* "FILE: no clip 'WANTED'; its clips (by name or number): #0 'walk', #1 'wave'" (or "the file
+ * has no clips"); returns CLI_BAD_INPUT. */
+int cli_no_clip(const char* cmd, const char* file, const char* wanted, const ak_scene* s);
+
+/* A time outside [0, duration] is clamped by the clip (each channel holds its first or last
+ * key): say so on stderr, as "note: --time T is past the end of clip 'C' (0 to D s): its last
+ * pose is used". Nothing for a time inside the clip or a NULL clip. */
+void cli_time_note(const char* cmd, float t, const ak_clip* clip);
+
 /* The documented work budget of a simulation command (docs/cli.md, "Work budgets"): the run's
  * work in "particle updates" (cloth: particles x steps x substeps x iterations; fluid: particles
  * x steps x solver iterations; particles: capacity x steps; boids: agents x steps), refused above

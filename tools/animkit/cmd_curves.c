@@ -17,7 +17,8 @@ static const char* const usage =
     "(default 420x260, at least 120x80; the page is at most 8192x8192).\n"
     "  --joint NAME    only that joint's channels\n"
     "  --channel LIST  only these charts: numbers and ranges (3,7-9) and joint names, a name\n"
-    "                  with .translation, .rotation or .scale for one channel (Hips.rotation)\n"
+    "                  with .translation, .rotation or .scale for one channel (Hips.rotation),\n"
+    "                  or a kind alone (rotation: every rotation chart)\n"
     "  --page P        page P (from 1) of the selected charts; the title says how many pages\n";
 
 #define MAX_SIDE 8192 /* the page, like render's images */
@@ -146,7 +147,22 @@ static int select_channels(const char* file, const ak_scene* s, const ak_clip* c
             if (target >= 0) *dot = '\0';
         }
         int j = s->skeleton ? ak_skeleton_find_joint(s->skeleton, tok) : -1;
-        if (j < 0) return cli_fail("curves", "%s: --channel: no joint named '%s'", file, tok);
+        if (j < 0 && !dot) { /* a bare kind: every channel of that kind (of --joint's joint, when given) */
+            int kind = strcmp(tok, "translation") == 0 ? AK_CHANNEL_TRANSLATION
+                       : strcmp(tok, "rotation") == 0  ? AK_CHANNEL_ROTATION
+                       : strcmp(tok, "scale") == 0     ? AK_CHANNEL_SCALE
+                                                       : -1;
+            if (kind >= 0) {
+                bool any = false;
+                for (size_t k = 0; k < count; ++k)
+                    if ((int)ak_clip_channel_target(clip, chan[k]) == kind) sel[k] = any = true;
+                if (!any) return cli_fail("curves", "%s: clip '%s' has no %s channel", file, ak_clip_name(clip), tok);
+                continue;
+            }
+        }
+        if (j < 0)
+            return cli_fail("curves", "%s: --channel: '%s' is no joint, chart number or channel kind (translation, "
+                            "rotation, scale)", file, tok);
         bool any = false;
         for (size_t k = 0; k < count; ++k) {
             ak_channel_target tg = ak_clip_channel_target(clip, chan[k]);
@@ -198,7 +214,7 @@ int cli_curves_run(int argc, char** argv, bool quiet) {
     const char* list = CLI_GET(&a, "--channel");
     int jidx = -1;
     if (ci < 0) {
-        rc = cli_fail("curves", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count, cli_plural(s->clip_count));
+        rc = cli_no_clip("curves", a.pos[0], CLI_GET(&a, "--clip"), s);
         goto done;
     }
     if (joint && (jidx = s->skeleton ? ak_skeleton_find_joint(s->skeleton, joint) : -1) < 0) {

@@ -36,10 +36,14 @@ static int export_gltf(const char* in, const char* out) {
     ak_result r = ak_io_save(out, s, &desc, &diag);
     if (r != AK_OK)
         rc = cli_fail("export", "%s: %s", diag.path[0] ? diag.path : out, diag.message[0] ? diag.message : ak_result_string(r));
-    else
-        fprintf(stderr, "wrote %s (%zu joint%s, %zu mesh%s, %zu clip%s)\n", out, ak_scene_joint_count(s),
-                cli_plural(ak_scene_joint_count(s)), s->mesh_count, s->mesh_count == 1 ? "" : "es", s->clip_count,
+    else { /* the counts `animkit info` prints: skin joints, and the nodes of the hierarchy */
+        const size_t nodes = ak_scene_joint_count(s);
+        size_t joints = 0;
+        for (size_t j = 0; j < nodes; ++j) joints += !s->is_joint || s->is_joint[j];
+        fprintf(stderr, "wrote %s (%zu joint%s in %zu node%s, %zu mesh%s, %zu clip%s)\n", out, joints, cli_plural(joints),
+                nodes, cli_plural(nodes), s->mesh_count, s->mesh_count == 1 ? "" : "es", s->clip_count,
                 cli_plural(s->clip_count));
+    }
     ak_scene_destroy(s);
     return rc;
 }
@@ -83,13 +87,14 @@ int cmd_export(int argc, char** argv) {
     if (cname) {
         clip = ak_scene_find_clip(s, cname);
         if (clip < 0) {
-            rc = cli_fail("export", "%s: no clip '%s' (%zu clip%s)", a.pos[0], cname, s->clip_count, cli_plural(s->clip_count));
+            rc = cli_no_clip("export", a.pos[0], cname, s);
             ak_scene_destroy(s);
             return rc;
         }
     } else if (s->clip_count > 0) {
         clip = 0;
     }
+    if (clip >= 0 && !bind) cli_time_note("export", t, s->clips[clip]);
     cli_poser p;
     if (cli_poser_init(&p, s)) {
         ak_scene_destroy(s);

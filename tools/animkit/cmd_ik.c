@@ -145,10 +145,11 @@ int cmd_ik(int argc, char** argv) {
     if (CLI_GET(&a, "--clip")) {
         clip = ak_scene_find_clip(s, CLI_GET(&a, "--clip"));
         if (clip < 0) {
-            rc = cli_fail("ik", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count, s->clip_count == 1 ? "" : "s");
+            rc = cli_no_clip("ik", a.pos[0], CLI_GET(&a, "--clip"), s);
             goto done;
         }
     }
+    if (clip >= 0) cli_time_note("ik", t, s->clips[clip]);
     size_t n = ak_scene_joint_count(s), chain_count = 0;
     chain = calloc(n, sizeof(int16_t));
     before = calloc(n, sizeof(ak_vec3));

@@ -113,7 +113,8 @@ int cmd_info(int argc, char** argv) {
         char text[512];
         cli_escape(text, sizeof text, s->name);
         printf("%s\n", text);
-        printf("skeleton: %zu joint%s (%zu node%s)\n", count, cli_plural(count), n, cli_plural(n));
+        printf("skeleton: %zu joint%s in %zu node%s (joints: the skin's; nodes: the whole hierarchy)\n", count,
+               cli_plural(count), n, cli_plural(n));
         print_tree(s, list, parent, count, -1, 0);
         printf("meshes: %zu\n", s->mesh_count);
         for (size_t m = 0; m < s->mesh_count; ++m) {

@@ -206,7 +206,7 @@ int cmd_render(int argc, char** argv) {
     if (CLI_GET(&a, "--clip")) {
         clip = ak_scene_find_clip(s, CLI_GET(&a, "--clip"));
         if (clip < 0) {
-            rc = cli_fail("render", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count, cli_plural(s->clip_count));
+            rc = cli_no_clip("render", a.pos[0], CLI_GET(&a, "--clip"), s);
             goto done;
         }
     } else if (s->clip_count) {
@@ -253,6 +253,7 @@ int cmd_render(int argc, char** argv) {
     }
     float clip_duration = clip >= 0 ? ak_clip_duration(s->clips[clip]) : 0.0f;
     if ((rc = parse_times(&a, opts, nopts, gif, clip_duration, &ft))) goto done;
+    if (clip >= 0 && CLI_GET(&a, "--time") && ft.count == 1) cli_time_note("render", ft.t[0], s->clips[clip]);
     if (ft.subsampled)
         fprintf(stderr, "note: %.2f s clip: 12 fps (%zu frames) to keep the GIF small (24 fps up to %.0f s; --fps F to choose)\n",
                 (double)clip_duration, ft.count, (double)LONG_CLIP);

@@ -176,8 +176,7 @@ int cmd_retarget(int argc, char** argv) {
     if (CLI_GET(&a, "--clip")) ci = ak_scene_find_clip(src, CLI_GET(&a, "--clip"));
     if (ci < 0) {
         if (CLI_GET(&a, "--clip"))
-            rc = cli_fail("retarget", "%s: no clip '%s' (%zu clip%s)", a.pos[0], CLI_GET(&a, "--clip"), src->clip_count,
-                          cli_plural(src->clip_count));
+            rc = cli_no_clip("retarget", a.pos[0], CLI_GET(&a, "--clip"), src);
         else
             rc = cli_fail("retarget", "%s: the source has no clip", a.pos[0]);
         goto done;

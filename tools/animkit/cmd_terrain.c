@@ -203,7 +203,8 @@ int cmd_terrain(int argc, char** argv) {
     const bool obj = cli_has_ext(out, ".obj"), png = cli_has_ext(out, ".png"), gif = cli_has_ext(out, ".gif");
     if (!obj && !png && !gif) return cli_usage("terrain", "-o '%s': the name must end in .obj, .png or .gif", out);
     const bool render = CLI_GET(&a, "--render") != NULL;
-    if (render && !png) return cli_usage("terrain", "--render goes with -o OUT.png");
+    if (render && obj) /* a .gif is always a rendered turntable: --render changes nothing there */
+        return cli_usage("terrain", "--render makes an image: -o OUT.png for a still, OUT.gif for a turntable");
 
     terrain_data t = {.desc = {.width = 257, .height = 257, .world_size = 100, .height_scale = 20,
                                .fractal = {.type = AK_FRACTAL_FBM, .octaves = 8}, .thread_count = 2}};

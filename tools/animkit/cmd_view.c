@@ -168,7 +168,7 @@ int cmd_view(int argc, char** argv) {
     if (CLI_GET(&a, "--clip")) {
         vo.clip = ak_scene_find_clip(s, CLI_GET(&a, "--clip"));
         if (vo.clip < 0) {
-            rc = cli_fail("view", "%s: no clip '%s' (%zu clips)", a.pos[0], CLI_GET(&a, "--clip"), s->clip_count);
+            rc = cli_no_clip("view", a.pos[0], CLI_GET(&a, "--clip"), s);
             goto done;
         }
     } else if (s->clip_count) {
