@@ -291,6 +291,50 @@ AK_TEST(cli_exports_stand_on_the_floor) {
     }
 }
 
+/* The retarget GIF frames each figure (a walk travels several body lengths: framing the whole
+ * path left the figures a quarter of the panel high), the mesh drawn without the skeleton over
+ * it: in the middle frame, each half of the image has coloured figure pixels (the skeleton's
+ * joints on the BVH side, the clay mesh on the other: red above blue by more than 12, where
+ * the grid, the floor and the background are grey) spanning at least 40% of its height, their
+ * box centred in the middle third of the half (the whole-path framing put them at the edges). */
+AK_TEST(cli_gif_frames_each_figure) {
+    char bvh[1200];
+    if (!ak_test_asset(bvh, sizeof bvh, "bvh/02_01.bvh")) {
+        AK_SKIP("bvh/02_01.bvh absent (set ANIMKIT_ASSETS)");
+        return;
+    }
+    char args[2048], line[1024];
+    snprintf(args, sizeof args, "'%s' builtin:humanoid --size 200x150 --fps 4 -o framing.gif", bvh);
+    AK_CHECK_MSG(run_cli(args, line, sizeof line) == 0, "%s", line);
+    int w = 0, h = 0, frames = 0;
+    AK_CHECK_EQ(ak_gif_info("framing.gif", &w, &h, &frames), AK_OK);
+    if (w <= 0 || h <= 0 || frames <= 0) return;
+    ak_image img = {.pixels = malloc((size_t)w * (size_t)h * 4), .width = w, .height = h};
+    AK_CHECK_EQ(ak_gif_read_frame("framing.gif", frames / 2, &img), AK_OK);
+    for (int half = 0; half < 2; ++half) {
+        int top = h, bottom = -1, left = w, right = -1;
+        const int x0 = half * w / 2, x1 = (half + 1) * w / 2;
+        for (int y = 0; y < h; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const uint8_t* px = img.pixels + ((size_t)y * (size_t)w + (size_t)x) * 4;
+                if ((int)px[0] - (int)px[2] > 12 && px[0] >= px[1]) {
+                    if (y < top) top = y;
+                    if (y > bottom) bottom = y;
+                    if (x < left) left = x;
+                    if (x > right) right = x;
+                }
+            }
+        double span = bottom >= top ? (double)(bottom - top + 1) / (double)h : 0.0;
+        double centre = right >= left ? (0.5 * (left + right) - x0) / (double)(x1 - x0) : -1.0;
+        printf("  framing.gif %s: the figure spans %.0f%% of the height, centred at %.0f%% of the panel's width\n",
+               half ? "target" : "source", 100.0 * span, 100.0 * centre);
+        AK_CHECK_MSG(span >= 0.40 && centre > 1.0 / 3.0 && centre < 2.0 / 3.0,
+                     "%s panel: the figure spans %.0f%% of the height, centred at %.0f%% of the width",
+                     half ? "target" : "source", 100.0 * span, 100.0 * centre);
+    }
+    free(img.pixels);
+}
+
 AK_TEST(cli_retarget) {
     char bvh[1200], cesium[1200], nomotion[1200];
     if (!ak_test_asset(bvh, sizeof bvh, "bvh/02_01.bvh") ||
@@ -381,6 +425,7 @@ int main(void) {
     AK_RUN(cmu_bvh_onto_builtin_and_cesiumman);
 #ifdef AK_CLI_PATH
     AK_RUN(cli_exports_stand_on_the_floor);
+    AK_RUN(cli_gif_frames_each_figure);
     AK_RUN_SLOW(cli_retarget);
 #endif
     return ak_test_finish();

@@ -87,19 +87,44 @@ static int write_gif(const char* out, const ak_scene* src, int clip, const ak_sc
     float duration = ak_clip_duration(dst->clips[0]);
     size_t frames = (size_t)floor((double)duration * 24.0 + 1e-6) + 1;
     if (frames > 10000) frames = 10000;
+    /* Each panel follows its figure (a walk travels several body lengths: framing the whole path
+     * left the figures a quarter of the panel high): a box of the largest single-frame size of
+     * the pose, around the root plus the mean offset of the pose's centre from it; both panels
+     * look from the same angles, so both figures face the same way on screen. */
+    ak_vec3 size[2], offset[2];
+    ak_vec3* roots[2] = {calloc(frames, sizeof(ak_vec3)), calloc(frames, sizeof(ak_vec3))};
+    if (!roots[0] || !roots[1]) rc = cli_fail("retarget", "out of memory");
+    const cli_camera cam = {.has_angles = true, .yaw = ak_degrees(0.55f), .pitch = ak_degrees(0.22f)};
     for (int k = 0; k < 2 && rc == CLI_OK; ++k) {
         if (cli_poser_init(&p[k], scenes[k])) {
             rc = cli_fail("retarget", "out of memory");
             break;
         }
         ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
+        size[k] = offset[k] = ak_vec3_zero();
+        size_t framed = 0;
         for (size_t i = 0; i < frames && rc == CLI_OK; ++i) {
             ak_result r = cli_poser_pose(&p[k], clips[k], (float)i / 24.0f, false, CLI_LBS);
             if (r != AK_OK) rc = cli_fail("retarget", "%s: cannot pose: %s", scenes[k]->name, ak_result_string(r));
-            cli_bounds_add_pose(&p[k], &lo, &hi);
+            ak_vec3 flo = ak_vec3_splat(INFINITY), fhi = ak_vec3_splat(-INFINITY);
+            cli_bounds_add_pose(&p[k], &flo, &fhi);
+            roots[k][i] = ak_vec3_splat(NAN);
+            for (size_t j = 0; j < p[k].joint_count; ++j)
+                if (!scenes[k]->is_joint || scenes[k]->is_joint[j]) {
+                    roots[k][i] = ak_mat4_get_translation(p[k].world[j]);
+                    break;
+                }
+            if (!ak_vec3_is_finite(flo) || !ak_vec3_is_finite(fhi)) continue;
+            lo = ak_vec3_min(lo, flo), hi = ak_vec3_max(hi, fhi);
+            ak_vec3 c = ak_vec3_scale(ak_vec3_add(flo, fhi), 0.5f);
+            if (!ak_vec3_is_finite(roots[k][i])) roots[k][i] = c;
+            size[k] = ak_vec3_max(size[k], ak_vec3_sub(fhi, flo));
+            offset[k] = ak_vec3_add(offset[k], ak_vec3_sub(c, roots[k][i]));
+            ++framed;
         }
+        if (framed) offset[k] = ak_vec3_scale(offset[k], 1.0f / (float)framed);
         if (!ak_vec3_is_finite(lo) || !ak_vec3_is_finite(hi)) lo = hi = ak_vec3_zero();
-        if (rc == CLI_OK && (cli_frame_init(&fr[k], scenes[k], w, h, lo, hi, 0.55f) || cli_image_alloc(&panel[k], w, h)))
+        if (rc == CLI_OK && (cli_frame_init_camera(&fr[k], scenes[k], w, h, lo, hi, &cam) || cli_image_alloc(&panel[k], w, h)))
             rc = cli_fail("retarget", "out of memory");
     }
     ak_view_panels_desc pd = {.title = "animkit retarget"};
@@ -114,7 +139,12 @@ static int write_gif(const char* out, const ak_scene* src, int clip, const ak_sc
         for (int k = 0; k < 2 && rc == CLI_OK; ++k) {
             char title[160];
             snprintf(title, sizeof title, "%s  t=%.2fs", scenes[k]->name, (double)i / 24.0);
-            cli_draw_opts o = {.skeleton = true, .title = title};
+            /* the mesh first: the skeleton is drawn only for a figure without one (a BVH) */
+            cli_draw_opts o = {.skeleton = scenes[k]->mesh_count == 0, .title = title};
+            if (ak_vec3_is_finite(roots[k][i])) {
+                ak_vec3 c = ak_vec3_add(roots[k][i], offset[k]), half = ak_vec3_scale(size[k], 0.5f);
+                cli_frame_aim(&fr[k], ak_vec3_sub(c, half), ak_vec3_add(c, half), &cam);
+            }
             ak_result r = cli_poser_pose(&p[k], clips[k], (float)i / 24.0f, false, CLI_LBS);
             if (r == AK_OK) r = cli_frame_draw(&fr[k], &p[k], &o, &panel[k]);
             if (r != AK_OK) rc = cli_fail("retarget", "%s: %s", scenes[k]->name, ak_result_string(r));
@@ -131,6 +161,7 @@ static int write_gif(const char* out, const ak_scene* src, int clip, const ak_sc
         cli_frame_free(&fr[k]);
         cli_poser_free(&p[k]);
         free(panel[k].pixels);
+        free(roots[k]);
     }
     free(composed.pixels);
     if (rc == CLI_OK) fprintf(stderr, "wrote %s: %zu frames %dx%d\n", out, frames, cw, ch);
