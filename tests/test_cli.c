@@ -590,7 +590,7 @@ static box2 warm_box(const char* path) {
 /* Item 9: plurals, names as typed, subnormal numbers, the files a multi-frame PNG run writes. */
 AK_TEST(messages_say_what_happened) {
     AK_CHECK_EQ(run("export builtin:cylinder -o one.obj", true), 0);
-    AK_CHECK_MSG(strstr(out_buf, "(1 mesh)") && !strstr(out_buf, "meshes"), "%s", out_buf);
+    AK_CHECK_MSG(strstr(out_buf, ": 1 mesh\n") && !strstr(out_buf, "meshes"), "%s", out_buf);
     AK_CHECK_EQ(run("curves builtin:cylinder --clip bend -o one.png", true), 0);
     AK_CHECK_MSG(strstr(out_buf, ": 1 chart\n") != NULL, "%s", out_buf);
     AK_CHECK_EQ(run("info builtin:cylinder", true), 0);
@@ -928,6 +928,28 @@ AK_TEST(messages_round_two) {
     /* --render with a GIF: the turntable (a GIF always is one) */
     AK_CHECK_MSG(run("terrain --size 17x17 --render -o r2t.gif", true) == 0, "%s", out_buf);
     AK_CHECK_EQ(run("terrain --size 17x17 --render -o r2t.obj", true), 2);
+    /* one rule for success output: every file written is announced on stderr, --quiet says nothing */
+    static const char* const outputs[][2] = {
+        {"particles --preset rain --steps 3 --size 32x24 -o r2p.gif", "wrote r2p.gif"},
+        {"particles --preset rain --steps 3 --json r2p.json", "wrote r2p.json"},
+        {"ik builtin:humanoid --effector left_wrist --target 0.3,1.2,0.1 -o r2i.png", "wrote r2i.png"},
+        {"boids --count 20 --steps 2 --json r2b.json", "wrote r2b.json"},
+        {"terrain --size 17x17 -o r2t.obj", "wrote r2t.obj"},
+    };
+    for (size_t i = 0; i < sizeof outputs / sizeof outputs[0]; ++i) {
+        for (int quiet = 0; quiet < 2; ++quiet) { /* stderr alone: stdout goes to /dev/null */
+            char cmd[1024];
+            snprintf(cmd, sizeof cmd, "%s %s%s 2>&1 >/dev/null", AK_CLI_PATH, outputs[i][0], quiet ? " --quiet" : "");
+            FILE* p = popen(cmd, "r");
+            AK_CHECK(p != NULL);
+            if (!p) return;
+            size_t n = fread(out_buf, 1, sizeof out_buf - 1, p);
+            out_buf[n] = '\0';
+            AK_CHECK_EQ(pclose(p), 0);
+            if (quiet) AK_CHECK_MSG(n == 0, "%s --quiet: %s", outputs[i][0], out_buf);
+            else AK_CHECK_MSG(strstr(out_buf, outputs[i][1]) != NULL, "%s: %s", outputs[i][0], out_buf);
+        }
+    }
     /* export counts as info does: skin joints within the hierarchy's nodes */
     AK_CHECK_EQ(run("export builtin:humanoid -o r2.glb", true), 0);
     AK_CHECK_MSG(strstr(out_buf, "joints in ") && strstr(out_buf, " nodes,"), "%s", out_buf);

@@ -124,6 +124,25 @@ int cli_usage(const char* cmd, const char* fmt, ...) {
     return CLI_BAD_USAGE;
 }
 
+bool cli_quiet = false;
+
+void cli_wrote(const char* path, const char* fmt, ...) {
+    if (cli_quiet) return;
+    char safe[1024];
+    cli_escape(safe, sizeof safe, path);
+    fprintf(stderr, "wrote %s", safe);
+    if (fmt && *fmt) {
+        char raw[1024], detail[2048];
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(raw, sizeof raw, fmt, ap);
+        va_end(ap);
+        cli_escape(detail, sizeof detail, raw);
+        fprintf(stderr, ": %s", detail);
+    }
+    fputc('\n', stderr);
+}
+
 int cli_no_clip(const char* cmd, const char* file, const char* wanted, const ak_scene* s) {
     char names[1024] = "";
     size_t used = 0;
@@ -139,7 +158,7 @@ int cli_no_clip(const char* cmd, const char* file, const char* wanted, const ak_
 }
 
 void cli_time_note(const char* cmd, float t, const ak_clip* clip) {
-    if (!clip) return;
+    if (!clip || cli_quiet) return;
     const float d = ak_clip_duration(clip);
     if (t >= 0.0f && t <= d) return;
     char name[256];
@@ -328,7 +347,7 @@ void cli_json_write_number(FILE* f, double v) {
 }
 
 void cli_progress(const char* label, size_t done, size_t total) {
-    if (!isatty(STDERR_FILENO) || total == 0) return;
+    if (cli_quiet || !isatty(STDERR_FILENO) || total == 0) return;
     const int width = 30;
     int filled = (int)((double)done / (double)total * width);
     if (filled > width) filled = width;

@@ -50,6 +50,18 @@ size_t cli_get_all(const cli_args* a, const cli_opt* opts, size_t opt_count, con
  * character); returns the length. Every message quoting input goes through it. */
 size_t cli_escape(char* out, size_t cap, const char* s);
 
+/* The one rule for what a command says on success: every file it writes is announced once on
+ * stderr as "wrote PATH" or "wrote PATH: DETAILS" (cli_wrote); stdout carries the results asked
+ * for (info, a solve, the summary line a run without outputs prints). --quiet (or -q), taken
+ * by main before the command sees its arguments, silences the announcements, notes and
+ * progress bars; errors always print. */
+extern bool cli_quiet;
+void cli_wrote(const char* path, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
 /* "FILE: no clip 'WANTED'; its clips (by name or number): #0 'walk', #1 'wave'" (or "the file
  * has no clips"); returns CLI_BAD_INPUT. */
 int cli_no_clip(const char* cmd, const char* file, const char* wanted, const ak_scene* s);

@@ -267,7 +267,9 @@ int cmd_boids(int argc, char** argv) {
     if (res != AK_OK && failed_step >= 0) rc = cli_fail("boids", "step %ld: %s", failed_step, boids_run_error(res));
     else if (res != AK_OK) rc = cli_fail("boids", "%s", ak_result_string(res));
     else if (wres != AK_OK) rc = cli_fail("boids", "%s: cannot write the file: %s", out, ak_result_string(wres));
-    if (rc == CLI_OK && json) rc = write_json(json, sc.steps, &st);
+    if (rc == CLI_OK && out) cli_wrote(out, "%zu agents after %ld steps", st.n, sc.steps);
+    if (rc == CLI_OK && json && (rc = write_json(json, sc.steps, &st)) == CLI_OK)
+        cli_wrote(json, "%zu agents after %ld steps", st.n, sc.steps);
     if (rc == CLI_OK && !json && !out) {
         float dmin = 0.0f;
         const size_t bytes = ak_boids_min_distance_scratch_size(st.n);

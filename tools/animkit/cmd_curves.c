@@ -303,10 +303,10 @@ int cli_curves_run(int argc, char** argv, bool quiet) {
     }
     if (!quiet) {
         if (pages > 1)
-            fprintf(stderr, "wrote %s: %zu of %zu chart%s (#%zu-#%zu, page %zu of %zu; --page P for the others)\n", out, count,
+            cli_wrote(out, "%zu of %zu chart%s (#%zu-#%zu, page %zu of %zu; --page P for the others)", count,
                     selected, cli_plural(selected), first_shown, last_shown, page ? (size_t)page : 1, pages);
         else
-            fprintf(stderr, "wrote %s: %zu chart%s\n", out, count, cli_plural(count));
+            cli_wrote(out, "%zu chart%s", count, cli_plural(count));
     }
 done:
     for (size_t i = 0; i < MAX_CHARTS; ++i) free(charts[i].pixels);

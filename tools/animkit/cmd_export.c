@@ -40,7 +40,7 @@ static int export_gltf(const char* in, const char* out) {
         const size_t nodes = ak_scene_joint_count(s);
         size_t joints = 0;
         for (size_t j = 0; j < nodes; ++j) joints += !s->is_joint || s->is_joint[j];
-        fprintf(stderr, "wrote %s (%zu joint%s in %zu node%s, %zu mesh%s, %zu clip%s)\n", out, joints, cli_plural(joints),
+        cli_wrote(out, "%zu joint%s in %zu node%s, %zu mesh%s, %zu clip%s", joints, cli_plural(joints),
                 nodes, cli_plural(nodes), s->mesh_count, s->mesh_count == 1 ? "" : "es", s->clip_count,
                 cli_plural(s->clip_count));
     }
@@ -109,7 +109,7 @@ int cmd_export(int argc, char** argv) {
     } else {
         rc = cli_fail("export", "%s: cannot pose: %s", a.pos[0], ak_result_string(r));
     }
-    if (!rc) fprintf(stderr, "wrote %s (%zu mesh%s)\n", out, s->mesh_count, s->mesh_count == 1 ? "" : "es");
+    if (!rc) cli_wrote(out, "%zu mesh%s", s->mesh_count, s->mesh_count == 1 ? "" : "es");
     cli_poser_free(&p);
     ak_scene_destroy(s);
     return rc;

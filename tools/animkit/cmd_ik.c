@@ -229,6 +229,7 @@ int cmd_ik(int argc, char** argv) {
         } else {
             rc = cli_render_ik_png(out, &p, chain, chain_count, target);
         }
+        if (rc == CLI_OK) cli_wrote(out, "the solved pose");
     }
 done:
     free(scratch);

@@ -204,6 +204,7 @@ int cmd_particles(int argc, char** argv) {
     renderer rd;
     memset(&rd, 0, sizeof rd);
     ak_gif_writer* gw = NULL;
+    int gif_frames = 0; /* frames added to gw */
     sim_bake bake;
     memset(&bake, 0, sizeof bake);
     if ((rc = cli_work_check("particles", (double)scene.capacity * (double)steps,
@@ -294,6 +295,7 @@ int cmd_particles(int argc, char** argv) {
         if (gw && (s % every == 0 || s == steps)) {
             if ((rc = render_frame(&rd, &r, &rd.image))) goto done;
             ak_result res = ak_gif_writer_add_frame(gw, &rd.image);
+            gif_frames += res == AK_OK;
             if (res != AK_OK) {
                 rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
                 goto done;
@@ -302,6 +304,7 @@ int cmd_particles(int argc, char** argv) {
     }
     const double elapsed = cli_now() - t0;
     if (json && (rc = write_json(json, &r, (int)steps))) goto done;
+    if (json) cli_wrote(json, "%zu particles after %ld steps", ak_particles_count(r.ps), steps);
     if (!json && !out) {
         const size_t alive = ak_particles_count(r.ps);
         printf("particles %s: %ld step%s of %.4g s (t = %.3g s) in %.3f s (%.3f ms/step), %zu particle%s alive"
@@ -312,17 +315,19 @@ int cmd_particles(int argc, char** argv) {
     }
     if (glb) {
         if ((rc = sim_bake_points_write(&bake, preset ? preset : "particles", scene.dt))) goto done;
-        fprintf(stderr, "wrote %s: %zu frames, %.4g s apart\n", out, bake.frames, (double)scene.dt * (double)bake.every);
+        cli_wrote(out, "%zu frames, %.4g s apart", bake.frames, (double)scene.dt * (double)bake.every);
     } else if (out && !gif) {
         if ((rc = render_frame(&rd, &r, &rd.image))) goto done;
         ak_result res = ak_png_write(out, &rd.image);
         if (res != AK_OK) rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
+        else cli_wrote(out, "the last step");
     }
 done:
     if (gw && rc != CLI_OK) ak_gif_writer_discard(gw); /* a failed run leaves no partial GIF */
     else if (gw) {
         ak_result res = ak_gif_writer_finish(gw);
         if (res != AK_OK) rc = cli_fail("particles", "%s: %s", out, ak_result_string(res));
+        else cli_wrote(out, "%d frames", gif_frames);
     }
     sim_bake_free(&bake);
     particles_run_free(&r);

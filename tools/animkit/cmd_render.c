@@ -387,11 +387,11 @@ int cmd_render(int argc, char** argv) {
     }
     double secs = cli_now() - t_start;
     if (gif)
-        fprintf(stderr, "wrote %s: %zu frame%s %dx%d at %.4g fps in %.2f s\n", out, ft.count, cli_plural(ft.count),
+        cli_wrote(out, "%zu frame%s %dx%d at %.4g fps in %.2f s", ft.count, cli_plural(ft.count),
                 frame_img->width, frame_img->height, (double)rate, secs);
     else if (ft.count == 1)
-        fprintf(stderr, "wrote %s: 1 frame %dx%d in %.2f s\n", out, frame_img->width, frame_img->height, secs);
-    else
+        cli_wrote(out, "1 frame %dx%d in %.2f s", frame_img->width, frame_img->height, secs);
+    else if (!cli_quiet)
         fprintf(stderr, "wrote %.*s_0000.png .. %.*s_%04zu.png: %zu frames %dx%d in %.2f s\n", (int)(strlen(out) - 4), out,
                 (int)(strlen(out) - 4), out, ft.count - 1, ft.count, frame_img->width, frame_img->height, secs);
 done:

@@ -164,7 +164,7 @@ static int write_gif(const char* out, const ak_scene* src, int clip, const ak_sc
         free(roots[k]);
     }
     free(composed.pixels);
-    if (rc == CLI_OK) fprintf(stderr, "wrote %s: %zu frames %dx%d\n", out, frames, cw, ch);
+    if (rc == CLI_OK) cli_wrote(out, "%zu frames %dx%d", frames, cw, ch);
     return rc;
 }
 
@@ -253,7 +253,7 @@ int cmd_retarget(int argc, char** argv) {
         ak_io_save_desc sd = {0};
         r = ak_io_save(out, &view, &sd, &diag);
         if (r != AK_OK) rc = cli_fail("retarget", "%s: %s", out, diag.message[0] ? diag.message : ak_result_string(r));
-        else fprintf(stderr, "wrote %s\n", out);
+        else cli_wrote(out, NULL);
     }
 done:
     ak_clip_destroy(clip);

@@ -283,10 +283,11 @@ int cmd_terrain(int argc, char** argv) {
         what = gif ? "turntable GIF" : "shaded render";
         rc = render_decimated(&t, out, gif);
     }
-    if (rc == CLI_OK)
-        printf("terrain %ux%u, %g m wide, heights [%.3f, %.3f] m, %ld droplet%s: wrote %s (%s) in %.2f s\n", d->width,
-               d->height, (double)d->world_size, (double)lo, (double)hi, droplets, droplets == 1 ? "" : "s", out, what,
-               cli_now() - t0);
+    if (rc == CLI_OK) { /* the summary on stdout, the file announced as every command does */
+        printf("terrain %ux%u, %g m wide, heights [%.3f, %.3f] m, %ld droplet%s, in %.2f s\n", d->width, d->height,
+               (double)d->world_size, (double)lo, (double)hi, droplets, droplets == 1 ? "" : "s", cli_now() - t0);
+        cli_wrote(out, "%s", what);
+    }
     free(t.heights), free(t.normals);
     return rc;
 }

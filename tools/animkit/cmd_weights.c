@@ -175,7 +175,7 @@ int cmd_weights(int argc, char** argv) {
         if (r != AK_OK) rc = cli_fail("weights", "%s: %s", out, ak_result_string(r));
     }
     if (rc == CLI_OK)
-        fprintf(stderr, "wrote %s: %s weights, %zu vert%s, %zu bone%s, %u influence%s, %.3f s\n", out, method, vc,
+        cli_wrote(out, "%s weights, %zu vert%s, %zu bone%s, %u influence%s, %.3f s", method, vc,
                 vc == 1 ? "ex" : "ices", bone_count, cli_plural(bone_count), (unsigned)k, cli_plural((size_t)k), dt);
 done:
     free(joints);

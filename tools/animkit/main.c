@@ -33,7 +33,9 @@ static const command commands[] = {
 
 static void print_help(FILE* f) {
     fprintf(f, "animkit %s: character animation and deformation\n\n", ak_version_string());
-    fprintf(f, "usage: animkit COMMAND [ARGS]   (animkit COMMAND --help for details)\n\n");
+    fprintf(f, "usage: animkit COMMAND [ARGS] [--quiet]   (animkit COMMAND --help for details)\n"
+               "Every file a command writes is announced on stderr as 'wrote PATH'; --quiet (-q) silences\n"
+               "those lines, notes and progress bars (errors still print).\n\n");
     for (size_t i = 0; i < COMMAND_COUNT; ++i) fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].summary);
     fprintf(f, "\nMODEL arguments are a file (glTF/GLB, BVH, FBX, Collada, OBJ) or builtin:humanoid,\n"
                "builtin:cylinder. Exit status: 0 success, 1 bad input, 2 bad usage.\n");
@@ -68,6 +70,14 @@ int main(int argc, char** argv) {
         printf("animkit %s\n", ak_version_string());
         return CLI_OK;
     }
+    /* --quiet / -q, anywhere after the command: no "wrote ..." lines, notes or progress */
+    int kept = 2;
+    for (int i = 2; i < argc; ++i) {
+        if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) cli_quiet = true;
+        else argv[kept++] = argv[i];
+    }
+    argc = kept;
+    argv[argc] = NULL;
     for (size_t i = 0; i < COMMAND_COUNT; ++i)
         if (strcmp(name, commands[i].name) == 0) return commands[i].run(argc - 2, argv + 2);
     fprintf(stderr, "animkit: unknown command '%s'\ntry 'animkit help'\n", name);
