@@ -135,7 +135,7 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
                 stalled = 0;
             } else if (++stalled >= 3) {
                 /* Constrained and stuck straight on the target's line: bend again. */
-                if (constrained && rebends < 2 && akp_ik_unstraighten(c)) {
+                if (constrained && rebends < 2 && akp_ik_unstraighten(c, false)) {
                     ++rebends;
                     stalled = 0;
                     for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
@@ -157,7 +157,7 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
          * answer is worse than the input, the constrained iterations start from the input;
          * when it came back straight on the target's line, bend it the allowed way. */
         out.error = akp_ik_restore_best(c, out.error);
-        akp_ik_unstraighten(c);
+        akp_ik_unstraighten(c, false);
         for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
     }
     out.error = akp_ik_restore_best(c, out.error);
