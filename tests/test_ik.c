@@ -1446,6 +1446,29 @@ static bool straight_arm_pose_ok(const straight_arm* a, const ak_transform* pose
     return fabs(lu - 0.28) < 1e-5 && fabs(lv - 0.26) < 1e-5 && acos(fmax(-1.0, fmin(1.0, cosb))) <= 145.0 * PI_D / 180.0 + 1e-4;
 }
 
+/* Target k of the near-line series: at a random 35..97% of the reach on the straight arm's
+ * line, then (k % 4) exactly as float rounds the line, a few float steps (nextafterf) off
+ * in each coordinate, or 1e-7..1e-5 or 1e-5..1e-3 of the reach off in a random direction. */
+static ak_vec3 near_line_target(const straight_arm* a, ak_rng* rng, int k, double* out_f) {
+    const double f = 0.35 + 0.62 * ak_rng_double(rng);
+    ak_vec3 t = straight_arm_point(a, f);
+    if (k % 4 == 1) {
+        float* c = &t.x;
+        for (int i = 0; i < 3; ++i) {
+            const int steps = (int)(ak_rng_u32(rng) % 17) - 8;
+            for (int s = 0; s < abs(steps); ++s) c[i] = nextafterf(c[i], steps > 0 ? INFINITY : -INFINITY);
+        }
+    } else if (k % 4 >= 2) {
+        const double lo = k % 4 == 2 ? -7.0 : -5.0;
+        const double size = a->reach * pow(10.0, lo + 2.0 * ak_rng_double(rng));
+        const ak_vec3 d =
+            ak_vec3_normalize(ak_vec3_make(ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1)));
+        t = ak_vec3_make((float)(t.x + d.x * size), (float)(t.y + d.y * size), (float)(t.z + d.z * size));
+    }
+    *out_f = f;
+    return t;
+}
+
 /* The issue's case: the arm straight (A-pose rest), the target 5% of the reach in from the
  * wrist, on the arm's line and 1e-5 off it (0.552754, 1.057246, 1e-5 is what the CLI got: error
  * 2.7e-2, the arm straight and pointing at the target, stuck on the saddle). */
@@ -1494,21 +1517,8 @@ AK_TEST(dls_straight_arm_near_its_line) {
     int misses = 0;
     size_t most = 0, total_iterations = 0;
     for (int k = 0; k < 100; ++k) {
-        const double f = 0.35 + 0.62 * ak_rng_double(&rng);
-        ak_vec3 t = straight_arm_point(&a, f);
-        if (k % 4 == 1) {
-            float* c = &t.x;
-            for (int i = 0; i < 3; ++i) {
-                const int steps = (int)(ak_rng_u32(&rng) % 17) - 8;
-                for (int s = 0; s < abs(steps); ++s) c[i] = nextafterf(c[i], steps > 0 ? INFINITY : -INFINITY);
-            }
-        } else if (k % 4 >= 2) {
-            const double lo = k % 4 == 2 ? -7.0 : -5.0;
-            const double size = a.reach * pow(10.0, lo + 2.0 * ak_rng_double(&rng));
-            const ak_vec3 d = ak_vec3_normalize(
-                ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1)));
-            t = ak_vec3_make((float)(t.x + d.x * size), (float)(t.y + d.y * size), (float)(t.z + d.z * size));
-        }
+        double f;
+        const ak_vec3 t = near_line_target(&a, &rng, k, &f);
         ak_transform pose[4];
         memcpy(pose, a.rest, sizeof pose);
         if (k % 5 == 4) {
@@ -1548,6 +1558,42 @@ AK_TEST(dls_straight_arm_near_its_line) {
         AK_CHECK(o0.reached && o1.reached);
         AK_CHECK_MSG(dist3(q0[1], q1[1]) <= 1e-3 * a.reach, "%.2f of the reach: the elbows are %g apart", f,
                      dist3(q0[1], q1[1]));
+    }
+    ak_skeleton_destroy(a.skeleton);
+}
+
+/* The same 100 near-line targets (straight starts) for CCD and FABRIK: they curl the chain
+ * for a target on its line before iterating, and for one near it once they stall on the
+ * line, pointing at the target. */
+AK_TEST(ccd_fabrik_straight_arm_near_its_line) {
+    straight_arm a;
+    if (!straight_arm_make(&a)) {
+        AK_CHECK_MSG(false, "the straight arm could not be built");
+        ak_skeleton_destroy(a.skeleton);
+        return;
+    }
+    for (int s = 0; s < 2; ++s) {
+        const ak_ik_solver solver = s == 0 ? AK_IK_SOLVER_CCD : AK_IK_SOLVER_FABRIK;
+        ak_rng rng = ak_rng_make(27);
+        int misses = 0;
+        size_t most = 0;
+        for (int k = 0; k < 100; ++k) {
+            double f;
+            const ak_vec3 t = near_line_target(&a, &rng, k, &f);
+            ak_transform pose[4];
+            memcpy(pose, a.rest, sizeof pose);
+            solve_out o = solve(a.skeleton, pose, a.chain, 3, t, solver, NULL);
+            AK_CHECK_EQ(o.r, AK_OK);
+            double p[3][3];
+            AK_CHECK_MSG(straight_arm_pose_ok(&a, pose, p), "%s, target %d: lengths or elbow limit broken",
+                         ak_ik_solver_name(solver), k);
+            most = o.iterations > most ? o.iterations : most;
+            if (!o.reached && ++misses <= 3)
+                printf("  %s missed target %d (%.9g, %.9g, %.9g): error %g, %zu iterations\n", ak_ik_solver_name(solver), k,
+                       t.x, t.y, t.z, o.error, o.iterations);
+        }
+        printf("  %s: %d of 100 near-line targets missed, most iterations %zu\n", ak_ik_solver_name(solver), misses, most);
+        AK_CHECK_EQ(misses, 0);
     }
     ak_skeleton_destroy(a.skeleton);
 }
@@ -1705,6 +1751,7 @@ int main(void) {
     AK_RUN(dls_orientation_target);
     AK_RUN(dls_straight_arm_issue_case);
     AK_RUN(dls_straight_arm_near_its_line);
+    AK_RUN(ccd_fabrik_straight_arm_near_its_line);
     AK_RUN(dls_nearly_straight_arm);
     AK_RUN(dls_straight_free_chain_near_its_line);
     AK_RUN(dls_straight_arm_unreachable);

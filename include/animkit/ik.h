@@ -181,15 +181,15 @@ AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
  * first hinge below the root (bent to the side its limits allow), else of the root's hinge,
  * else ak_vec3_any_perpendicular of the line; every joint below the root turns by one angle
  * (bisected so the curled chord equals the target's distance, within the hinges' limits)
- * and the root turns the effector back onto the line. CCD and constrained FABRIK curl the
- * chain again if they stall straight on the target's line (a hinge clamped straight).
- * DLS curls wider: any straight or nearly straight chain (every joint within 1e-3 x chain
- * length of the root-effector line) whose target is nearer the root than the chain's
- * length, on the line or off it (the root then turns the effector towards the target), and
- * again, twice at most, if it stalls so. Near the line, first-order steps gain less than
- * float positions resolve, so a target 1e-5 off the line stalled as one on it did. The
- * curl depends on the target only through its distance and direction, so nearby targets
- * give nearby poses, and the same job gives the same bits.
+ * and the root turns the effector back onto the line. The wider curl takes any straight or
+ * nearly straight chain (every joint within 1e-3 x chain length of the root-effector line)
+ * whose target is nearer the root than the chain's length, on the line or off it (the root
+ * then turns the effector towards the target): near the line, first-order steps gain less
+ * than float positions resolve, so a target 1e-5 off the line stalled as one on it did.
+ * DLS curls so before iterating; CCD and constrained FABRIK curl so, twice at most, when
+ * they stall (a hinge clamped straight, or the chain turned to point at a target near its
+ * line), and so does DLS. The curl depends on the target only through its distance and
+ * direction, so nearby targets give nearby poses, and the same job gives the same bits.
  * DLS step (Wampler 1986; Buss 2004; Buss & Kim 2005), J the 3 x dof (6 x dof with
  * target_rotation, orientation rows times orientation_weight) Jacobian of the effector:
  *     dq = ClampMaxAbs(J^T (J J^T + lambda^2 I)^-1 e', pi / 4),

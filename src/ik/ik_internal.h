@@ -220,7 +220,8 @@ static inline ak_quat akp_ik_aim_rotation(ak_vec3 re, ak_vec3 rd, bool hinge, ak
  * configuration of CCD, FABRIK and DLS), bend it in one plane towards the side its hinges
  * allow, effector back on the line (chain.c); returns whether it did. world[] consistent.
  * off_line: the target need only be inside the reach (nearer the root than the chain's
- * length), on the line or not; the root then turns the effector onto the target's ray. */
+ * length), on the line or not, and a nearly straight chain (joints within 1e-3 of its length
+ * off the line) counts as straight; the root then turns the effector onto the target's ray. */
 bool akp_ik_unstraighten(akp_ik_chain* c, bool off_line);
 
 /* Solvers (src/ik/<name>.c). Each starts from a chain whose world[] is current and returns
