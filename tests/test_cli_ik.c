@@ -104,7 +104,7 @@ AK_TEST(ik_default_chain_is_the_limb) {
  * and 0.26 along (1, -1, 0) / sqrt 2, elbow a hinge limited to [0, 145] degrees. Targets on
  * the arm's own line are reachable from a = 0.28 + 0.26 down to the elbow's limit,
  * sqrt(a^2 + b^2 - 2 a b cos 35deg) = 0.1635 (30% of the reach); each solver must reach the
- * ones at 35..95% from the straight arm. The issue's target (0.2, 1.4, 0) lies 0.0224 from
+ * ones at 35..95% from the straight arm, and ones a few last digits off the line. The issue's target (0.2, 1.4, 0) lies 0.0224 from
  * the shoulder, inside that limit: no pose within the limits reaches it, and the best is
  * 0.1635 - 0.0224 = 0.14114 away; CCD finds that best, and no solver may claim better. */
 AK_TEST(ik_straight_arm_targets_on_its_line) {
@@ -123,6 +123,25 @@ AK_TEST(ik_straight_arm_targets_on_its_line) {
             const cJSON* err = cJSON_GetObjectItem(root, "error");
             AK_CHECK_MSG(cJSON_IsTrue(cJSON_GetObjectItem(root, "reached")), "%s at %d%%: not reached, error %g",
                          solvers[s], pct, cJSON_IsNumber(err) ? err->valuedouble : -1.0);
+            cJSON_Delete(root);
+        }
+    }
+    /* Near the line (issue 27): 5% in from the wrist, 1e-5 off the line (every solver stopped
+     * 0.027 away, the arm straight and pointing at it), the same rounded to 4 digits, and
+     * points at 56% and 73% of the reach a few last digits off. */
+    const char* near[] = {"0.552754,1.057246,0.00001", "0.5527,1.0573,0.0001", "0.4040,1.2060,-0.0003",
+                          "0.46831,1.14169,0.000007"};
+    for (int s = 0; s < 3; ++s) {
+        for (size_t k = 0; k < sizeof near / sizeof near[0]; ++k) {
+            char args[512];
+            snprintf(args, sizeof args,
+                     "ik builtin:humanoid --effector left_wrist --root left_shoulder --target %s --solver %s --json",
+                     near[k], solvers[s]);
+            cJSON* root = run_json(args);
+            if (!root) continue;
+            const cJSON* err = cJSON_GetObjectItem(root, "error");
+            AK_CHECK_MSG(cJSON_IsTrue(cJSON_GetObjectItem(root, "reached")), "%s at %s: not reached, error %g", solvers[s],
+                         near[k], cJSON_IsNumber(err) ? err->valuedouble : -1.0);
             cJSON_Delete(root);
         }
     }

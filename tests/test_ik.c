@@ -1377,6 +1377,358 @@ AK_TEST(extreme_scales) {
     }
 }
 
+/* ---- DLS on a straight limb, targets on and near its line (issue 27) ----------------------- */
+
+/* builtin:humanoid's left arm at rest, rebuilt here as the builtin defines it (test_ik links
+ * only the ik module; test_cli_ik runs the builtin itself): shoulder (0.19, 1.42, 0) under a
+ * chest joint, bones 0.28 and 0.26 along d = (1, -1, 0) / sqrt 2, identity rest rotations; a
+ * ball shoulder (cone 2.4 about d, twist +-2), the elbow a hinge about d x Z limited to
+ * [0, 145] degrees (so targets on the line are reachable from 30.3% of the reach, the law
+ * of cosines), a ball wrist (cone 1.2, twist +-0.8). */
+typedef struct straight_arm {
+    ak_skeleton* skeleton;
+    int16_t chain[3];
+    size_t joint_count;
+    ak_transform rest[4];
+    double shoulder[3], dir[3], reach;
+} straight_arm;
+
+static bool straight_arm_make(straight_arm* a) {
+    memset(a, 0, sizeof *a);
+    const float c45 = 0.70710678f;
+    const ak_vec3 d = ak_vec3_make(c45, -c45, 0.0f), elbow_axis = ak_vec3_cross(d, ak_vec3_make(0, 0, 1));
+    ak_joint_desc j[4];
+    memset(j, 0, sizeof j);
+    const char* names[4] = {"chest", "left_shoulder", "left_elbow", "left_wrist"};
+    const ak_vec3 offsets[4] = {ak_vec3_make(0, 1.3f, 0), ak_vec3_make(0.19f, 0.12f, 0), ak_vec3_scale(d, 0.28f),
+                                ak_vec3_scale(d, 0.26f)};
+    for (int i = 0; i < 4; ++i) {
+        j[i].name = names[i];
+        j[i].parent = i - 1;
+        j[i].rest = ak_transform_identity();
+        j[i].rest.translation = offsets[i];
+    }
+    j[1].type = AK_JOINT_BALL, j[1].limits = (ak_joint_limits){.axis = d, .cone_angle = 2.4f, .twist_min = -2.0f, .twist_max = 2.0f};
+    j[2].type = AK_JOINT_HINGE, j[2].limits = (ak_joint_limits){.axis = elbow_axis, .min = 0.0f, .max = 145.0f * (float)PI_D / 180.0f};
+    j[3].type = AK_JOINT_BALL, j[3].limits = (ak_joint_limits){.axis = d, .cone_angle = 1.2f, .twist_min = -0.8f, .twist_max = 0.8f};
+    ak_skeleton_desc desc = {.joints = j, .joint_count = 4};
+    if (ak_skeleton_create(&desc, NULL, &a->skeleton, NULL) != AK_OK) return false;
+    a->joint_count = 4;
+    a->chain[0] = 1, a->chain[1] = 2, a->chain[2] = 3;
+    rest_pose(a->skeleton, a->rest);
+    const double h = sqrt(0.5);
+    a->shoulder[0] = 0.19, a->shoulder[1] = 1.42, a->shoulder[2] = 0.0;
+    a->dir[0] = h, a->dir[1] = -h, a->dir[2] = 0.0;
+    a->reach = 0.28 + 0.26;
+    return true;
+}
+
+/* The point at fraction f of the reach along the straight arm, rounded to float. */
+static ak_vec3 straight_arm_point(const straight_arm* a, double f) {
+    return ak_vec3_make((float)(a->shoulder[0] + a->dir[0] * f * a->reach),
+                        (float)(a->shoulder[1] + a->dir[1] * f * a->reach),
+                        (float)(a->shoulder[2] + a->dir[2] * f * a->reach));
+}
+
+/* Chain positions of a pose; bone lengths kept (1e-5), elbow flexion within [0, 145] degrees
+ * (the angle between the bones, by the test's own arithmetic in double). */
+static bool straight_arm_pose_ok(const straight_arm* a, const ak_transform* pose, double out[3][3]) {
+    ak_vec3 p[3];
+    if (!pose_finite(pose, a->joint_count) ||
+        ak_ik_chain_positions(a->skeleton, (ak_transform_cspan){pose, a->joint_count},
+                              (ak_i16_cspan){a->chain, 3}, (ak_vec3_span)AK_SPAN(p)) != AK_OK)
+        return false;
+    for (int k = 0; k < 3; ++k) out[k][0] = p[k].x, out[k][1] = p[k].y, out[k][2] = p[k].z;
+    const double u[3] = {out[1][0] - out[0][0], out[1][1] - out[0][1], out[1][2] - out[0][2]};
+    const double v[3] = {out[2][0] - out[1][0], out[2][1] - out[1][1], out[2][2] - out[1][2]};
+    const double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]), lv = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    const double cosb = (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / (lu * lv);
+    return fabs(lu - 0.28) < 1e-5 && fabs(lv - 0.26) < 1e-5 && acos(fmax(-1.0, fmin(1.0, cosb))) <= 145.0 * PI_D / 180.0 + 1e-4;
+}
+
+/* Target k of the near-line series: at a random 35..97% of the reach on the straight arm's
+ * line, then (k % 4) exactly as float rounds the line, a few float steps (nextafterf) off
+ * in each coordinate, or 1e-7..1e-5 or 1e-5..1e-3 of the reach off in a random direction. */
+static ak_vec3 near_line_target(const straight_arm* a, ak_rng* rng, int k, double* out_f) {
+    const double f = 0.35 + 0.62 * ak_rng_double(rng);
+    ak_vec3 t = straight_arm_point(a, f);
+    if (k % 4 == 1) {
+        float* c = &t.x;
+        for (int i = 0; i < 3; ++i) {
+            const int steps = (int)(ak_rng_u32(rng) % 17) - 8;
+            for (int s = 0; s < abs(steps); ++s) c[i] = nextafterf(c[i], steps > 0 ? INFINITY : -INFINITY);
+        }
+    } else if (k % 4 >= 2) {
+        const double lo = k % 4 == 2 ? -7.0 : -5.0;
+        const double size = a->reach * pow(10.0, lo + 2.0 * ak_rng_double(rng));
+        const ak_vec3 d =
+            ak_vec3_normalize(ak_vec3_make(ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1), ak_rng_range(rng, -1, 1)));
+        t = ak_vec3_make((float)(t.x + d.x * size), (float)(t.y + d.y * size), (float)(t.z + d.z * size));
+    }
+    *out_f = f;
+    return t;
+}
+
+/* The issue's case: the arm straight (A-pose rest), the target 5% of the reach in from the
+ * wrist, on the arm's line and 1e-5 off it (0.552754, 1.057246, 1e-5 is what the CLI got: error
+ * 2.7e-2, the arm straight and pointing at the target, stuck on the saddle). */
+AK_TEST(dls_straight_arm_issue_case) {
+    straight_arm a;
+    if (!straight_arm_make(&a)) {
+        AK_CHECK_MSG(false, "the straight arm could not be built");
+        ak_skeleton_destroy(a.skeleton);
+        return;
+    }
+    const ak_vec3 on = straight_arm_point(&a, 0.95);
+    const ak_vec3 targets[3] = {on, ak_vec3_make(0.552754f, 1.057246f, 1e-5f), ak_vec3_make(on.x, on.y, 1e-4f)};
+    for (int k = 0; k < 3; ++k) {
+        ak_transform pose[4];
+        memcpy(pose, a.rest, sizeof pose);
+        solve_out o = solve(a.skeleton, pose, a.chain, 3, targets[k], AK_IK_SOLVER_DLS, NULL);
+        double p[3][3];
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(straight_arm_pose_ok(&a, pose, p));
+        const double want[3] = {targets[k].x, targets[k].y, targets[k].z};
+        AK_CHECK_MSG(o.reached && dist3(p[2], want) <= o.tolerance, "target %d: error %g (tolerance %g), %zu iterations", k,
+                     o.error, o.tolerance, o.iterations);
+        printf("  5%% in from the straight wrist, target %d: error %.3g, %zu iterations\n", k, o.error, o.iterations);
+    }
+    ak_skeleton_destroy(a.skeleton);
+}
+
+/* 100 targets on and near the straight arm's line, 35..97% of the reach: exactly as float
+ * rounds the line, a few float steps (nextafterf) off in each coordinate, and offsets of
+ * 1e-7..1e-5 and 1e-5..1e-3 of the reach in random directions (fixed seed); every fifth starts
+ * from an elbow bent by 1e-6..1e-2 rad instead of straight (nearly singular Jacobian). DLS must
+ * reach every one with the default budget and tolerance, within the joints' limits. Then
+ * nearby targets give nearby poses: the target on the line and 1e-5 of the reach off it put
+ * the elbow within 1e-3 of the reach of each other. */
+AK_TEST(dls_straight_arm_near_its_line) {
+    straight_arm a;
+    if (!straight_arm_make(&a)) {
+        AK_CHECK_MSG(false, "the straight arm could not be built");
+        ak_skeleton_destroy(a.skeleton);
+        return;
+    }
+    const ak_skeleton* sk = a.skeleton;
+    const int elbow = a.chain[1];
+    const ak_vec3 elbow_axis = ak_skeleton_joint_limits(sk, (size_t)elbow).axis;
+    ak_rng rng = ak_rng_make(27);
+    int misses = 0;
+    size_t most = 0, total_iterations = 0;
+    for (int k = 0; k < 100; ++k) {
+        double f;
+        const ak_vec3 t = near_line_target(&a, &rng, k, &f);
+        ak_transform pose[4];
+        memcpy(pose, a.rest, sizeof pose);
+        if (k % 5 == 4) {
+            const float bend = (float)pow(10.0, -6.0 + 4.0 * ak_rng_double(&rng));
+            pose[elbow].rotation = ak_quat_mul(a.rest[elbow].rotation, ak_quat_from_axis_angle(elbow_axis, bend));
+        }
+        solve_out o = solve(sk, pose, a.chain, 3, t, AK_IK_SOLVER_DLS, NULL);
+        AK_CHECK_EQ(o.r, AK_OK);
+        double p[3][3];
+        AK_CHECK_MSG(straight_arm_pose_ok(&a, pose, p), "target %d: lengths or elbow limit broken", k);
+        most = o.iterations > most ? o.iterations : most;
+        total_iterations += o.iterations;
+        if (!o.reached) {
+            ++misses;
+            if (misses <= 5)
+                printf("  missed target %d (%.9g, %.9g, %.9g), %.3f of the reach: error %g, %zu iterations\n", k, t.x, t.y,
+                       t.z, f, o.error, o.iterations);
+        }
+    }
+    printf("  100 targets on and near the straight arm's line: %d missed, iterations mean %.1f, most %zu\n", misses,
+           (double)total_iterations / 100.0, most);
+    AK_CHECK_EQ(misses, 0);
+
+    for (int k = 0; k < 3; ++k) {
+        const double f = 0.5 + 0.2 * k;
+        const ak_vec3 t0 = straight_arm_point(&a, f);
+        const float off = (float)(1e-5 * a.reach);
+        const ak_vec3 t1 = k == 1 ? ak_vec3_make(t0.x + off * 0.70710678f, t0.y + off * 0.70710678f, t0.z)
+                                  : ak_vec3_make(t0.x, t0.y, t0.z + off);
+        ak_transform p0[4], p1[4];
+        memcpy(p0, a.rest, sizeof p0);
+        memcpy(p1, a.rest, sizeof p1);
+        solve_out o0 = solve(sk, p0, a.chain, 3, t0, AK_IK_SOLVER_DLS, NULL);
+        solve_out o1 = solve(sk, p1, a.chain, 3, t1, AK_IK_SOLVER_DLS, NULL);
+        double q0[3][3], q1[3][3];
+        AK_CHECK(straight_arm_pose_ok(&a, p0, q0) && straight_arm_pose_ok(&a, p1, q1));
+        AK_CHECK(o0.reached && o1.reached);
+        AK_CHECK_MSG(dist3(q0[1], q1[1]) <= 1e-3 * a.reach, "%.2f of the reach: the elbows are %g apart", f,
+                     dist3(q0[1], q1[1]));
+    }
+    ak_skeleton_destroy(a.skeleton);
+}
+
+/* The same 100 near-line targets (straight starts) for CCD and FABRIK: they curl the chain
+ * for a target on its line before iterating, and for one near it once they stall on the
+ * line, pointing at the target. */
+AK_TEST(ccd_fabrik_straight_arm_near_its_line) {
+    straight_arm a;
+    if (!straight_arm_make(&a)) {
+        AK_CHECK_MSG(false, "the straight arm could not be built");
+        ak_skeleton_destroy(a.skeleton);
+        return;
+    }
+    for (int s = 0; s < 2; ++s) {
+        const ak_ik_solver solver = s == 0 ? AK_IK_SOLVER_CCD : AK_IK_SOLVER_FABRIK;
+        ak_rng rng = ak_rng_make(27);
+        int misses = 0;
+        size_t most = 0;
+        for (int k = 0; k < 100; ++k) {
+            double f;
+            const ak_vec3 t = near_line_target(&a, &rng, k, &f);
+            ak_transform pose[4];
+            memcpy(pose, a.rest, sizeof pose);
+            solve_out o = solve(a.skeleton, pose, a.chain, 3, t, solver, NULL);
+            AK_CHECK_EQ(o.r, AK_OK);
+            double p[3][3];
+            AK_CHECK_MSG(straight_arm_pose_ok(&a, pose, p), "%s, target %d: lengths or elbow limit broken",
+                         ak_ik_solver_name(solver), k);
+            most = o.iterations > most ? o.iterations : most;
+            if (!o.reached && ++misses <= 3)
+                printf("  %s missed target %d (%.9g, %.9g, %.9g): error %g, %zu iterations\n", ak_ik_solver_name(solver), k,
+                       t.x, t.y, t.z, o.error, o.iterations);
+        }
+        printf("  %s: %d of 100 near-line targets missed, most iterations %zu\n", ak_ik_solver_name(solver), misses, most);
+        AK_CHECK_EQ(misses, 0);
+    }
+    ak_skeleton_destroy(a.skeleton);
+}
+
+/* Nearly straight starts that the saddle escape leaves alone (the elbow bent 5e-3..0.2 rad,
+ * beyond its 1e-3-of-the-length test), targets on the line at 35..97% of the reach: the
+ * Jacobian is nearly singular along the line, and the damping must still get there within
+ * the default budget. */
+AK_TEST(dls_nearly_straight_arm) {
+    straight_arm a;
+    if (!straight_arm_make(&a)) {
+        AK_CHECK_MSG(false, "the straight arm could not be built");
+        ak_skeleton_destroy(a.skeleton);
+        return;
+    }
+    const int elbow = a.chain[1];
+    const ak_vec3 elbow_axis = ak_skeleton_joint_limits(a.skeleton, (size_t)elbow).axis;
+    ak_rng rng = ak_rng_make(2727);
+    int misses = 0;
+    size_t most = 0, total = 0;
+    for (int k = 0; k < 60; ++k) {
+        const double f = 0.35 + 0.62 * ak_rng_double(&rng);
+        const float bend = (float)(5e-3 * pow(40.0, ak_rng_double(&rng)));
+        ak_transform pose[4];
+        memcpy(pose, a.rest, sizeof pose);
+        pose[elbow].rotation = ak_quat_mul(a.rest[elbow].rotation, ak_quat_from_axis_angle(elbow_axis, bend));
+        const ak_vec3 t = straight_arm_point(&a, f);
+        solve_out o = solve(a.skeleton, pose, a.chain, 3, t, AK_IK_SOLVER_DLS, NULL);
+        AK_CHECK_EQ(o.r, AK_OK);
+        double p[3][3];
+        AK_CHECK(straight_arm_pose_ok(&a, pose, p));
+        most = o.iterations > most ? o.iterations : most;
+        total += o.iterations;
+        if (!o.reached && ++misses <= 3)
+            printf("  missed: bend %g, %.3f of the reach: error %g, %zu iterations\n", bend, f, o.error, o.iterations);
+    }
+    printf("  60 nearly straight starts: %d missed, iterations mean %.1f, most %zu\n", misses, (double)total / 60.0, most);
+    AK_CHECK_EQ(misses, 0);
+    ak_skeleton_destroy(a.skeleton);
+}
+
+/* A plain straight chain of three free joints (bones 0.5, 0.6 along +x, no limits): targets
+ * on and near its line reach the same way (the saddle is not a matter of the arm's limits). */
+AK_TEST(dls_straight_free_chain_near_its_line) {
+    chain_spec s = uniform_chain(3, AK_JOINT_FREE);
+    ak_skeleton* sk = make_chain(&s);
+    if (!sk) {
+        AK_CHECK(sk != NULL);
+        return;
+    }
+    int16_t chain[3] = {0, 1, 2};
+    const double reach = (double)s.lengths[0] + s.lengths[1];
+    ak_rng rng = ak_rng_make(2705);
+    int misses = 0;
+    for (int k = 0; k < 40; ++k) {
+        const double f = 0.15 + 0.83 * ak_rng_double(&rng); /* the reach is 0.1 .. 1.1 */
+        const double size = k % 2 ? reach * pow(10.0, -7.0 + 4.0 * ak_rng_double(&rng)) : 0.0;
+        const ak_vec3 d = ak_vec3_normalize(ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1)));
+        const ak_vec3 t = ak_vec3_make((float)(f * reach + d.x * size), (float)(d.y * size), (float)(d.z * size));
+        ak_transform pose[3];
+        rest_pose(sk, pose);
+        solve_out o = solve(sk, pose, chain, 3, t, AK_IK_SOLVER_DLS, NULL);
+        AK_CHECK_EQ(o.r, AK_OK);
+        AK_CHECK(pose_finite(pose, 3) && lengths_preserved(&s, pose));
+        if (!o.reached && ++misses <= 3)
+            printf("  missed (%.9g, %.9g, %.9g): error %g, %zu iterations\n", t.x, t.y, t.z, o.error, o.iterations);
+    }
+    AK_CHECK_EQ(misses, 0);
+    ak_skeleton_destroy(sk);
+}
+
+/* Beyond the reach, on, near and off the straight arm's line (1.001 to 1000 reaches): not
+ * reached, no NaN, the arm points at the target (wrist on the shoulder->target ray within
+ * 1e-3 rad) and the error is the distance minus the reach. Off the line, the target stands
+ * 135 degrees from the arm (near the shoulder's 2.4 rad cone): DLS turns the arm there in
+ * 30-50 steps, bending the elbow on the way and straightening it at Gauss-Newton's linear
+ * rate, so it gets 1e-2 rad (5e-3 at 1000 reaches; the error still within tolerance). */
+AK_TEST(dls_straight_arm_unreachable) {
+    straight_arm a;
+    if (!straight_arm_make(&a)) {
+        AK_CHECK_MSG(false, "the straight arm could not be built");
+        ak_skeleton_destroy(a.skeleton);
+        return;
+    }
+    const double fs[4] = {1.001, 1.05, 2.0, 1000.0};
+    for (int i = 0; i < 4; ++i) {
+        for (int v = 0; v < 3; ++v) {
+            ak_vec3 t = straight_arm_point(&a, fs[i]);
+            if (v == 1) t.z += (float)(1e-5 * a.reach);
+            if (v == 2) t = ak_vec3_make((float)a.shoulder[0], (float)(a.shoulder[1] + fs[i] * a.reach), 0.3f * (float)a.reach);
+            ak_transform pose[4];
+            memcpy(pose, a.rest, sizeof pose);
+            solve_out o = solve(a.skeleton, pose, a.chain, 3, t, AK_IK_SOLVER_DLS, NULL);
+            AK_CHECK_EQ(o.r, AK_OK);
+            double p[3][3];
+            AK_CHECK(straight_arm_pose_ok(&a, pose, p));
+            AK_CHECK(!o.reached && ak_finitef(o.error));
+            const double td[3] = {t.x - p[0][0], t.y - p[0][1], t.z - p[0][2]};
+            const double wd[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+            const double lt = sqrt(td[0] * td[0] + td[1] * td[1] + td[2] * td[2]);
+            const double cx = td[1] * wd[2] - td[2] * wd[1], cy = td[2] * wd[0] - td[0] * wd[2], cz = td[0] * wd[1] - td[1] * wd[0];
+            const double angle = atan2(sqrt(cx * cx + cy * cy + cz * cz), td[0] * wd[0] + td[1] * wd[1] + td[2] * wd[2]);
+            AK_CHECK_MSG(angle < (v == 2 ? 1e-2 : 1e-3), "%g reaches, variant %d: the arm is %g rad off the target", fs[i],
+                         v, angle);
+            if (getenv("IKDBG")) printf("   %g reaches, variant %d: %g rad off, %zu iterations\n", fs[i], v, angle, o.iterations);
+            AK_CHECK_MSG(fabs(o.error - (lt - a.reach)) <= o.tolerance + 1e-6 * lt,
+                         "%g reaches, variant %d: error %g, distance - reach %g", fs[i], v, o.error, lt - a.reach);
+        }
+    }
+    ak_skeleton_destroy(a.skeleton);
+}
+
+/* The same job twice gives the same bits (the saddle escape and the damping use no
+ * randomness and no state); so does the same target from a fresh copy of the rest pose. */
+AK_TEST(dls_deterministic) {
+    straight_arm a;
+    if (!straight_arm_make(&a)) {
+        AK_CHECK_MSG(false, "the straight arm could not be built");
+        ak_skeleton_destroy(a.skeleton);
+        return;
+    }
+    const ak_vec3 targets[3] = {straight_arm_point(&a, 0.95), ak_vec3_make(0.552754f, 1.057246f, 1e-5f),
+                                ak_vec3_make(0.3f, 1.1f, 0.2f)};
+    for (int k = 0; k < 3; ++k) {
+        ak_transform p0[4], p1[4];
+        memcpy(p0, a.rest, sizeof p0);
+        memcpy(p1, a.rest, sizeof p1);
+        solve_out o0 = solve(a.skeleton, p0, a.chain, 3, targets[k], AK_IK_SOLVER_DLS, NULL);
+        solve_out o1 = solve(a.skeleton, p1, a.chain, 3, targets[k], AK_IK_SOLVER_DLS, NULL);
+        AK_CHECK(memcmp(p0, p1, sizeof p0) == 0);
+        AK_CHECK(memcmp(&o0.error, &o1.error, sizeof o0.error) == 0 && o0.iterations == o1.iterations);
+    }
+    ak_skeleton_destroy(a.skeleton);
+}
+
 int main(void) {
     AK_RUN(chain_build);
     AK_RUN(solver_names);
@@ -1397,6 +1749,13 @@ int main(void) {
     AK_RUN(straight_chain_targets_on_its_line);
     AK_RUN(extreme_scales);
     AK_RUN(dls_orientation_target);
+    AK_RUN(dls_straight_arm_issue_case);
+    AK_RUN(dls_straight_arm_near_its_line);
+    AK_RUN(ccd_fabrik_straight_arm_near_its_line);
+    AK_RUN(dls_nearly_straight_arm);
+    AK_RUN(dls_straight_free_chain_near_its_line);
+    AK_RUN(dls_straight_arm_unreachable);
+    AK_RUN(dls_deterministic);
     AK_RUN(fabrik_tree);
     return ak_test_finish();
 }

@@ -4,8 +4,8 @@
  * at a target. Solvers: CCD (cyclic coordinate descent, tip to root), FABRIK (Aristidou &
  * Lasenby 2011, forward and backward reaching, converted back to rotations keeping each
  * joint's twist), an analytic two-bone solver (law of cosines, pole vector, soft reach limit,
- * blend weight), and damped least squares (Jacobian, Levenberg-Marquardt adaptive damping,
- * position and optional orientation targets). FABRIK also solves trees with several end
+ * blend weight), and damped least squares (Jacobian, Levenberg-Marquardt adaptive damping
+ * with Buss & Kim's step and target clamps, position and optional orientation targets). FABRIK also solves trees with several end
  * effectors (sub-bases, as in the paper). The two-bone solver also comes as a batch
  * (ak_ik_two_bone_run_many: many limbs per call, four at a time in SIMD registers). Every
  * chain solver honours the skeleton's joint types and limits (each changed rotation or slide
@@ -80,7 +80,8 @@ typedef enum ak_ik_solver {
     AK_IK_SOLVER_CCD,         /* cyclic coordinate descent */
     AK_IK_SOLVER_FABRIK,      /* forward and backward reaching */
     AK_IK_SOLVER_TWO_BONE,    /* analytic; the chain must have exactly 3 joints */
-    AK_IK_SOLVER_DLS,         /* damped least squares Jacobian, adaptive damping */
+    AK_IK_SOLVER_DLS,         /* damped least squares Jacobian, adaptive damping (see
+                                 ak_ik_chain_run) */
     AK_IK_SOLVER_COUNT
 } ak_ik_solver;
 
@@ -114,7 +115,8 @@ typedef struct ak_ik_chain_job {
     bool ccd_from_root;          /* CCD: visit the joints root to tip; false -> tip to root,
                                     the classic order */
     bool ignore_limits;          /* false -> joint types and limits are honoured */
-    float dls_damping;           /* DLS: initial lambda, model units (adapted each step);
+    float dls_damping;           /* DLS: initial lambda, model units (adapted each step,
+                                    within [1e-6, 1e4] x chain length; see ak_ik_chain_run);
                                     0 -> 0.1 * chain length (1e-6 at zero length) */
     float orientation_weight;    /* DLS: model units per radian of orientation error;
                                     0 -> chain length / pi (1e-6 at zero length) */
@@ -179,8 +181,26 @@ AK_API ak_result ak_ik_chain_validate(const ak_ik_chain_job* job);
  * first hinge below the root (bent to the side its limits allow), else of the root's hinge,
  * else ak_vec3_any_perpendicular of the line; every joint below the root turns by one angle
  * (bisected so the curled chord equals the target's distance, within the hinges' limits)
- * and the root turns the effector back onto the line. CCD and constrained FABRIK curl the
- * chain again if they stall straight on the target's line (a hinge clamped straight).
+ * and the root turns the effector back onto the line. The wider curl takes any straight or
+ * nearly straight chain (every joint within 1e-3 x chain length of the root-effector line)
+ * whose target is nearer the root than the chain's length, on the line or off it (the root
+ * then turns the effector towards the target): near the line, first-order steps gain less
+ * than float positions resolve, so a target 1e-5 off the line stalled as one on it did.
+ * DLS curls so before iterating; CCD and constrained FABRIK curl so, twice at most, when
+ * they stall (a hinge clamped straight, or the chain turned to point at a target near its
+ * line), and so does DLS. The curl depends on the target only through its distance and
+ * direction, so nearby targets give nearby poses, and the same job gives the same bits.
+ * DLS step (Wampler 1986; Buss 2004; Buss & Kim 2005), J the 3 x dof (6 x dof with
+ * target_rotation, orientation rows times orientation_weight) Jacobian of the effector:
+ *     dq = ClampMaxAbs(J^T (J J^T + lambda^2 I)^-1 e', pi / 4),
+ *     e' = e min(1, (L / 2) / |position error|)    (a far target pulls by its direction)
+ * L the chain length; ClampMaxAbs scales dq so no joint turns more than pi / 4 (a slide of
+ * L counts as 1 rad). In singular values the step is sum_i s_i / (s_i^2 + lambda^2)
+ * (u_i . e') v_i: lambda damps the directions a nearly singular J resolves badly. lambda
+ * starts at dls_damping and adapts to the error (Levenberg-Marquardt): a step that lowers
+ * it is kept and lambda halves (down to 1e-6 L), one that does not is undone and lambda
+ * grows 4x (up to 1e4 L); each try counts as an iteration. A limited hinge at its limit
+ * whose step points further out leaves J for that step.
  * FABRIK on a chain with limits first runs the plain passes (their answer often respects the
  * limits, e.g. a planar chain of hinges); if the converted pose misses, the remaining
  * iterations run constrained, from the better of the converted pose and the input: the

@@ -123,9 +123,10 @@ akp_ik_outcome akp_ik_ccd(akp_ik_chain* c, const ak_ik_chain_job* job) {
             best = out.error;
             stalled = 0;
         } else if (++stalled >= 3) {
-            /* Stuck straight on the target's line (a hinge clamped back to straight): bend
-             * again, a couple of times at most. */
-            if (rebends < 2 && akp_ik_unstraighten(c)) {
+            /* Stuck straight (a hinge clamped back to straight), or nearly straight and
+             * pointing at a target near its line, inside the reach: bend again, a couple of
+             * times at most. */
+            if (rebends < 2 && akp_ik_unstraighten(c, true)) {
                 ++rebends;
                 stalled = 0;
                 best = out.error = ak_vec3_distance(c->world[last].translation, c->target);

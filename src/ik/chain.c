@@ -237,13 +237,6 @@ static void apply_target_rotation(akp_ik_chain* c, const ak_quat* target_rotatio
     }
 }
 
-/* Angle of a hinge joint's local rotation about its axis, relative to its rest rotation. */
-static float hinge_angle(const ak_skeleton* sk, size_t joint, ak_quat local) {
-    const ak_quat rel = ak_quat_mul(ak_quat_conjugate(ak_skeleton_rest_pose(sk).ptr[joint].rotation), local);
-    const ak_vec3 axis = ak_skeleton_joint_limits(sk, joint).axis;
-    return 2.0f * atan2f(rel.x * axis.x + rel.y * axis.y + rel.z * axis.z, rel.w);
-}
-
 /* Direction (+1, -1) in which a hinge joint may bend from where it is, preferring
  * `preferred` when its limits leave at least 1e-3 rad that way, and the room left that way
  * (radians, INFINITY when unlimited); 0 when neither way has room. */
@@ -252,7 +245,7 @@ static float hinge_bend_sign(const akp_ik_chain* c, size_t i, float preferred, f
     const ak_joint_limits l = ak_skeleton_joint_limits(c->skeleton, j);
     *out_room = INFINITY;
     if (!c->clamp[i] || (l.min == 0.0f && l.max == 0.0f)) return preferred;
-    const float a = hinge_angle(c->skeleton, j, c->pose[j].rotation);
+    const float a = akp_ik_hinge_angle(c->skeleton, j, c->pose[j].rotation);
     const float up = l.max - a, down = a - l.min, need = 1e-3f;
     if ((preferred > 0.0f ? up : down) >= need) {
         *out_room = preferred > 0.0f ? up : down;
@@ -307,19 +300,27 @@ static float curled_chord(const akp_ik_chain* c, ak_vec3 normal, float beta) {
  * target at once; the solvers finish what limits or off-plane axes leave. The chain curls
  * like a limb flexing its hinges, the side the solvers keep (a hinge bent the other way
  * would be clamped straight again). */
-bool akp_ik_unstraighten(akp_ik_chain* c) {
+bool akp_ik_unstraighten(akp_ik_chain* c, bool off_line) {
     const size_t last = c->count - 1;
     const ak_vec3 root = c->world[0].translation;
     const ak_vec3 dir = ak_vec3_normalize(ak_vec3_sub(c->world[last].translation, root));
     if (ak_vec3_length_sq(dir) == 0.0f || !(c->length > 0.0f)) return false;
     const float eps = 1e-5f * c->length;
+    /* Off the line (DLS): nearly straight counts too, joints within 1e-3 of the length of the
+     * line (a bend of ~4e-3 rad): there the first-order gain of a step along the line is
+     * below what float positions resolve, so the Jacobian stalls as on the straight line. */
+    const float straight_eps = off_line ? 1e-3f * c->length : eps;
     for (size_t i = 1; i <= last; ++i) {
         ak_vec3 d = ak_vec3_sub(c->world[i].translation, root);
-        if (ak_vec3_length(ak_vec3_madd(d, dir, -ak_vec3_dot(d, dir))) > eps) return false; /* not straight */
+        if (ak_vec3_length(ak_vec3_madd(d, dir, -ak_vec3_dot(d, dir))) > straight_eps) return false; /* not straight */
     }
     const ak_vec3 dt = ak_vec3_sub(c->target, root);
-    if (ak_vec3_length(ak_vec3_madd(dt, dir, -ak_vec3_dot(dt, dir))) > eps) return false; /* target off the line */
-    if (ak_vec3_dot(dt, dir) >= c->length - eps) return false; /* beyond the reach: straight is the answer */
+    if (off_line) {
+        if (ak_vec3_length(dt) >= c->length - eps) return false; /* beyond the reach: straight is the answer */
+    } else {
+        if (ak_vec3_length(ak_vec3_madd(dt, dir, -ak_vec3_dot(dt, dir))) > eps) return false; /* target off the line */
+        if (ak_vec3_dot(dt, dir) >= c->length - eps) return false; /* beyond the reach: straight is the answer */
+    }
     /* The bend plane's normal: a hinge's axis (on its allowed side) fixes the plane the chain
      * can bend in; without hinges any normal of the line does. */
     ak_vec3 normal = ak_vec3_zero();
@@ -454,7 +455,9 @@ ak_result ak_ik_chain_run(const ak_ik_chain_job* job) {
         apply_target_rotation(&c, rj.target_rotation);
     } else {
         const float start_error = ak_vec3_distance(c.world[n - 1].translation, c.target);
-        if (rj.solver != AK_IK_SOLVER_TWO_BONE && start_error > c.tolerance) akp_ik_unstraighten(&c);
+        /* DLS curls a straight chain itself, for targets off the line too (dls.c). */
+        if (rj.solver != AK_IK_SOLVER_TWO_BONE && rj.solver != AK_IK_SOLVER_DLS && start_error > c.tolerance)
+            akp_ik_unstraighten(&c, false);
         switch (rj.solver) {
         case AK_IK_SOLVER_CCD:
             out = akp_ik_ccd(&c, &sj);

@@ -134,8 +134,9 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
                 best = out.error;
                 stalled = 0;
             } else if (++stalled >= 3) {
-                /* Constrained and stuck straight on the target's line: bend again. */
-                if (constrained && rebends < 2 && akp_ik_unstraighten(c)) {
+                /* Constrained and stuck (nearly) straight, the target inside the reach on or
+                 * near the line: bend again. */
+                if (constrained && rebends < 2 && akp_ik_unstraighten(c, true)) {
                     ++rebends;
                     stalled = 0;
                     for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
@@ -155,9 +156,10 @@ akp_ik_outcome akp_ik_fabrik(akp_ik_chain* c, const ak_ik_chain_job* job, ak_vec
         /* The plain passes need not bend the way the limits allow (from a nearly straight
          * chain, the forward pass folds the last bones back, zigzagging): when the converted
          * answer is worse than the input, the constrained iterations start from the input;
-         * when it came back straight on the target's line, bend it the allowed way. */
+         * when it came back (nearly) straight with the target inside the reach, bend it
+         * the allowed way. */
         out.error = akp_ik_restore_best(c, out.error);
-        akp_ik_unstraighten(c);
+        akp_ik_unstraighten(c, true);
         for (size_t i = 0; i < n; ++i) pos[i] = c->world[i].translation;
     }
     out.error = akp_ik_restore_best(c, out.error);

@@ -119,6 +119,13 @@ static inline ak_transform akp_ik_limit(const ak_skeleton* sk, size_t joint, ak_
     return r;
 }
 
+/* Angle of a hinge joint's local rotation about its axis, relative to its rest rotation. */
+static inline float akp_ik_hinge_angle(const ak_skeleton* sk, size_t joint, ak_quat local) {
+    const ak_quat rel = ak_quat_mul(ak_quat_conjugate(ak_skeleton_rest_pose(sk).ptr[joint].rotation), local);
+    const ak_vec3 axis = ak_skeleton_joint_limits(sk, joint).axis;
+    return 2.0f * atan2f(rel.x * axis.x + rel.y * axis.y + rel.z * axis.z, rel.w);
+}
+
 /* Joint type as the solver sees it: FREE when limits are ignored. */
 static inline ak_joint_type akp_ik_type(const akp_ik_chain* c, size_t i) { return (ak_joint_type)c->types[i]; }
 
@@ -211,8 +218,11 @@ static inline ak_quat akp_ik_aim_rotation(ak_vec3 re, ak_vec3 rd, bool hinge, ak
 
 /* When the chain is straight and the target lies on its line inside the reach (the singular
  * configuration of CCD, FABRIK and DLS), bend it in one plane towards the side its hinges
- * allow, effector back on the line (chain.c); returns whether it did. world[] consistent. */
-bool akp_ik_unstraighten(akp_ik_chain* c);
+ * allow, effector back on the line (chain.c); returns whether it did. world[] consistent.
+ * off_line: the target need only be inside the reach (nearer the root than the chain's
+ * length), on the line or not, and a nearly straight chain (joints within 1e-3 of its length
+ * off the line) counts as straight; the root then turns the effector onto the target's ray. */
+bool akp_ik_unstraighten(akp_ik_chain* c, bool off_line);
 
 /* Solvers (src/ik/<name>.c). Each starts from a chain whose world[] is current and returns
  * with world[] and the pose consistent. */
