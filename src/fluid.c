@@ -87,25 +87,29 @@ static bool desc_ok(const ak_fluid_desc* d) {
            d->rest_density >= 0.0f && ak_finitef(d->rest_density);
 }
 
-/* Neighbour count of a lattice point at rest spacing s (self included) and the PBF constraint
- * gradient norm sum_k |grad_k C|^2 there. */
-static void lattice_props(float h, float s, float m_over_rho, uint32_t* out_count, float* out_grad2) {
+/* Neighbour count of a lattice point at rest spacing s (self included), the PBF constraint
+ * gradient norm sum_k |grad_k C|^2 there, and its poly6 sum sum_j W(x_j) (1/m^3; times the
+ * particle mass it is the density the rest lattice measures). */
+static void lattice_props(float h, float s, float m_over_rho, uint32_t* out_count, float* out_grad2, float* out_wsum) {
     const int reach = (int)ceilf(h / s) + 1;
     uint32_t count = 0;
     ak_vec3 gi = {0.0f, 0.0f, 0.0f};
     float sum_gj2 = 0.0f;
+    double wsum = 0.0;
     for (int z = -reach; z <= reach; ++z)
         for (int y = -reach; y <= reach; ++y)
             for (int x = -reach; x <= reach; ++x) {
                 ak_vec3 r = ak_vec3_make((float)x * s, (float)y * s, (float)z * s);
                 if (ak_vec3_dot(r, r) >= h * h) continue;
                 ++count;
+                wsum += (double)ak_fluid_poly6(ak_vec3_dot(r, r), h);
                 ak_vec3 g = ak_vec3_scale(ak_fluid_spiky_grad(r, h), m_over_rho);
                 gi = ak_vec3_add(gi, g);
                 sum_gj2 += ak_vec3_dot(g, g);
             }
     *out_count = count;
     *out_grad2 = ak_vec3_dot(gi, gi) + sum_gj2;
+    if (out_wsum) *out_wsum = (float)wsum;
 }
 
 ak_fluid_desc ak_fluid_desc_resolved(const ak_fluid_desc* desc) {
@@ -114,7 +118,7 @@ ak_fluid_desc ak_fluid_desc_resolved(const ak_fluid_desc* desc) {
     if (desc) d = *desc;
     if (d.rest_density == 0.0f) d.rest_density = 1000.0f;
     if (d.iterations == 0) d.iterations = 4;
-    if (d.scorr_k == 0.0f) d.scorr_k = 0.1f;
+    if (d.scorr_k == 0.0f) d.scorr_k = 0.01f;
     if (d.scorr_n == 0.0f) d.scorr_n = 4.0f;
     if (d.scorr_dq == 0.0f) d.scorr_dq = 0.2f;
     if (d.stiffness == 0.0f) d.stiffness = 20.0f;
@@ -125,7 +129,7 @@ ak_fluid_desc ak_fluid_desc_resolved(const ak_fluid_desc* desc) {
         const float s = cbrtf(d.particle_mass / d.rest_density);
         uint32_t c;
         float g2;
-        lattice_props(d.h, s, s * s * s, &c, &g2);
+        lattice_props(d.h, s, s * s * s, &c, &g2, NULL);
         d.relaxation = 0.01f * g2;
     }
     return d;
@@ -459,11 +463,11 @@ static void parallel_n(ctx* c, phase_fn fn, size_t n) {
 
 static void parallel(ctx* c, phase_fn fn) { parallel_n(c, fn, c->n); }
 
-/* Collider projection: moves p outside every collider and inside the box; v (may be NULL)
- * loses its inward normal component relative to the collider, friction scales the rest. */
-void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
+/* One pass over the colliders; true when one of them moved p. */
+static bool collide_pass(const ctx* c, ak_vec3* p, ak_vec3* v) {
     const ak_fluid_desc* d = &c->d;
     const ak_fluid_step_job* job = c->job;
+    bool moved = false;
     for (size_t k = 0; k < job->colliders.count; ++k) {
         const ak_fluid_collider* col = &job->colliders.ptr[k];
         ak_vec3 n;
@@ -487,6 +491,7 @@ void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
             depth = col->radius - len;
         }
         if (!(depth > 0.0f)) continue;
+        moved = true;
         *p = ak_vec3_add(*p, ak_vec3_scale(n, depth));
         if (v) {
             ak_vec3 rel = ak_vec3_sub(*v, col->velocity);
@@ -497,6 +502,12 @@ void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
             }
         }
     }
+    return moved;
+}
+
+/* The box container: p clamped inside, v loses its outward components. */
+static void collide_box(const ctx* c, ak_vec3* p, ak_vec3* v) {
+    const ak_fluid_desc* d = &c->d;
     if (d->box_min.x < d->box_max.x || d->box_min.y < d->box_max.y || d->box_min.z < d->box_max.z) {
         float* pc = &p->x;
         float* vc = v ? &v->x : NULL;
@@ -519,6 +530,18 @@ void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
                 if (pc[a] > lo[a] && pc[a] < hi[a]) vc[a] *= 1.0f - d->friction;
         }
     }
+}
+
+/* Collider projection: moves p outside every collider and inside the box; v (may be NULL)
+ * loses its inward normal component relative to the collider, friction scales the rest.
+ * Colliders are visited in order; a particle squeezed between two of them can be pushed back
+ * into the first by the second, so the pass repeats (at most 4 times) while a collider moved
+ * it. */
+void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
+    const ak_fluid_step_job* job = c->job;
+    for (int pass = 0; pass < 4; ++pass)
+        if (!collide_pass(c, p, v) || job->colliders.count < 2) break;
+    collide_box(c, p, v);
 }
 
 /* Distance from p to the nearest boundary surface (box walls and colliders). */
@@ -785,7 +808,7 @@ static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
         }
         rho *= c->m;
         c->rho[i] = rho;
-        float C = rho / c->rho0 - 1.0f;
+        float C = rho / c->rho_c - 1.0f;
         if (!c->d.bilateral && C < 0.0f) C = 0.0f;
         c->lambda[i] = -C / (ak_vec3_dot(gi, gi) + sum_gj2 + c->d.relaxation);
     }
@@ -795,7 +818,7 @@ static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
  * collision response on p_i + dp_i, written to q (the next iterate). */
 static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
-    const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
+    const bool scorr = c->d.scorr && c->wdq > 0.0f;
     const float k = c->d.scorr_k / c->grad2_rest, np = c->d.scorr_n, inv_wdq = scorr ? 1.0f / c->wdq : 0.0f;
     const bool n4 = np == 4.0f;
     if (c->simd && (n4 || !scorr)) {
@@ -972,15 +995,29 @@ static void ph_integrate(ctx* c, size_t b, size_t e, uint32_t t) {
     }
 }
 
+/* Surface and full flags, and the particles that sit on another one (closer than 1% of the
+ * rest spacing at the end of the step: a collapsed liquid, see ak_fluid_stats). */
 static void ph_flags(ctx* c, size_t b, size_t e, uint32_t t) {
-    (void)t;
     const uint32_t surf = (c->full_lattice_count * 3u) / 4u;
+    const bool pbf = c->d.solver == AK_FLUID_PBF;
+    const float *fx = pbf ? c->px : c->qx, *fy = pbf ? c->py : c->qy, *fz = pbf ? c->pz : c->qz;
+    size_t coincident = 0;
     for (size_t i = b; i < e; ++i) {
         uint8_t f = 0;
         if (c->nb_count[i] < surf) f |= AK_FLUID_FLAG_SURFACE;
         else if (boundary_distance(c, P(c, (uint32_t)i)) >= c->h) f |= AK_FLUID_FLAG_FULL;
         c->flags[i] = f;
+        const uint32_t* nb = akp_fluid_nb(c, i);
+        for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
+            const uint32_t j = nb[(size_t)q * 16];
+            const float dx = fx[j] - fx[i], dy = fy[j] - fy[i], dz = fz[j] - fz[i];
+            if (j != i && dx * dx + dy * dy + dz * dz < c->coincident2) {
+                ++coincident;
+                break;
+            }
+        }
     }
+    c->coincident[t] = coincident;
 }
 
 /* A full neighbourhood also needs every neighbour away from the free surface. */
@@ -1092,7 +1129,10 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     c->kernels = ak_fluid_kernels_resolved(job->kernels);
     c->simd = c->kernels != AK_FLUID_KERNELS_SCALAR;
     const float s = cbrtf(c->mr);
-    lattice_props(c->h, s, c->mr, &c->full_lattice_count, &c->grad2_rest);
+    float wsum;
+    lattice_props(c->h, s, c->mr, &c->full_lattice_count, &c->grad2_rest, &wsum);
+    c->rho_c = c->m * wsum;
+    c->coincident2 = 1e-4f * s * s; /* (1% of the rest spacing)^2 */
     {
         const float h2 = c->h * c->h, h3 = h2 * c->h;
         c->poly6_k = (float)(315.0 / (64.0 * FLUID_PI)) / (h2 * h2 * h2 * h2 * c->h);
@@ -1193,7 +1233,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     /* blow-up check, statistics (sorted order: the same for any thread count) */
     const float limit = 100.0f * c->h;
     bool blown = false;
-    double sum = 0.0;
+    double sum = 0.0, sum_rho = 0.0;
     for (size_t a = 0; a < n; ++a) {
         const uint32_t i = c->order[a];
         const ak_vec3 v = c->vo[i];
@@ -1203,11 +1243,17 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
             float err = fabsf(c->rho[a] / c->rho0 - 1.0f);
             if (err > st.max_density_error) st.max_density_error = err;
             sum += err;
+            sum_rho += c->rho[a];
             ++st.full_count;
         }
     }
     st.mean_density_error = st.full_count ? (float)(sum / (double)st.full_count) : 0.0f;
-    for (uint32_t t = 0; t < AKP_FLUID_MAX_THREADS; ++t) st.truncated_count += c->truncated[t];
+    st.mean_density = st.full_count ? (float)(sum_rho / (double)st.full_count) : 0.0f;
+    st.rest_lattice_density = c->rho_c;
+    for (uint32_t t = 0; t < AKP_FLUID_MAX_THREADS; ++t) {
+        st.truncated_count += c->truncated[t];
+        st.coincident_count += c->coincident[t];
+    }
 
     /* sinks: stable compaction (order of the survivors kept) */
     if (job->sinks.count) {

@@ -191,7 +191,7 @@ AKP_AVX2 void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
         const __m256i li = _mm256_castps_si256(H.lanes);
         rho = _mm256_mul_ps(rho, _mm256_set1_ps(c->m));
         _mm256_maskstore_ps(c->rho + H.base, li, rho);
-        __m256 C = _mm256_sub_ps(_mm256_div_ps(rho, _mm256_set1_ps(c->rho0)), _mm256_set1_ps(1.0f));
+        __m256 C = _mm256_sub_ps(_mm256_div_ps(rho, _mm256_set1_ps(c->rho_c)), _mm256_set1_ps(1.0f));
         if (!c->d.bilateral) C = _mm256_blendv_ps(C, zero, _mm256_cmp_ps(C, zero, _CMP_LT_OQ));
         const __m256 gg = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(gx, gx), _mm256_mul_ps(gy, gy)),
                                         _mm256_mul_ps(gz, gz));
@@ -210,7 +210,7 @@ AKP_AVX2 void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
 }
 
 AKP_AVX2 void akp_fluid_delta_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
-    const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
+    const bool scorr = c->d.scorr && c->wdq > 0.0f;
     const __m256 negk = _mm256_set1_ps(-(c->d.scorr_k / c->grad2_rest)),
                  inv_wdq = _mm256_set1_ps(scorr ? 1.0f / c->wdq : 0.0f);
     const __m256 zero = _mm256_setzero_ps(), mr = _mm256_set1_ps(c->mr);

@@ -200,7 +200,7 @@ AKP_AVX512 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
         }
         rho = _mm512_mul_ps(rho, _mm512_set1_ps(c->m));
         _mm512_mask_storeu_ps(c->rho + blk, B.lanes, rho);
-        __m512 C = _mm512_sub_ps(_mm512_div_ps(rho, _mm512_set1_ps(c->rho0)), _mm512_set1_ps(1.0f));
+        __m512 C = _mm512_sub_ps(_mm512_div_ps(rho, _mm512_set1_ps(c->rho_c)), _mm512_set1_ps(1.0f));
         if (!c->d.bilateral)
             C = _mm512_mask_mov_ps(C, _mm512_cmp_ps_mask(C, zero, _CMP_LT_OQ), zero);
         const __m512 gg = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(gx, gx), _mm512_mul_ps(gy, gy)),
@@ -221,7 +221,7 @@ AKP_AVX512 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
 }
 
 AKP_AVX512 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
-    const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
+    const bool scorr = c->d.scorr && c->wdq > 0.0f;
     const __m512 negk = _mm512_set1_ps(-(c->d.scorr_k / c->grad2_rest)),
                  inv_wdq = _mm512_set1_ps(scorr ? 1.0f / c->wdq : 0.0f);
     const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);

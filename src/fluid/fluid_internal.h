@@ -49,6 +49,8 @@ typedef struct akp_fluid_ctx {
     int64_t cmin[3];  /* dense path: cell coordinates of the box's first cell */
     int64_t dim[3];   /* dense path: cells per axis */
     double inv_cell;  /* 1 / h in double (the grid's cell formula) */
+    float rho_c;      /* PBF: the density the constraint holds, m sum_j W_poly6 over the rest lattice */
+    float coincident2; /* squared distance below which two particles count as coincident */
     float wdq;        /* poly6 at delta q */
     float grad2_rest; /* sum_k |grad_k C|^2 of the rest lattice */
     float poly6_k;    /* 315 / (64 pi h^9) */
@@ -59,6 +61,7 @@ typedef struct akp_fluid_ctx {
     struct akp_fluid_team* team; /* fluid.c: the step's worker team (NULL: the caller alone) */
     /* per-thread results */
     size_t truncated[AKP_FLUID_MAX_THREADS];
+    size_t coincident[AKP_FLUID_MAX_THREADS];
 } akp_fluid_ctx;
 
 /* Neighbour q of sorted particle a is akp_fluid_nb(c, a)[16 q]: particles come in blocks of

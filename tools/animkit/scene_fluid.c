@@ -87,9 +87,7 @@ bool fluid_scene_parse(cli_json* j, const char* text, size_t size, fluid_scene* 
     d->iterations = (uint32_t)it;
     cli_json_float(j, root, "", "relaxation", 0.0f, 1e30f, &d->relaxation);
     cli_json_bool(j, root, "", "bilateral", &d->bilateral);
-    bool scorr = true;
-    cli_json_bool(j, root, "", "scorr", &scorr);
-    d->disable_scorr = !scorr;
+    cli_json_bool(j, root, "", "scorr", &d->scorr);
     cli_json_float(j, root, "", "scorr_k", 0.0f, 10.0f, &d->scorr_k);
     cli_json_float(j, root, "", "scorr_n", 0.0f, 16.0f, &d->scorr_n);
     cli_json_float(j, root, "", "scorr_dq", 0.0f, 0.99f, &d->scorr_dq);
