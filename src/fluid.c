@@ -765,6 +765,7 @@ static void ph_gather(ctx* c, size_t b, size_t e, uint32_t t) {
         const uint32_t i = c->order[a];
         c->x0[a] = c->xo[i];
         c->v[a] = c->vo[i];
+        c->pres[a] = 0.0f; /* PBF sums lambdas here */
     }
 }
 
@@ -847,6 +848,7 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
 }
 
 void akp_fluid_delta_finish(akp_fluid_ctx* c, size_t i, ak_vec3 p) {
+    c->pres[i] += c->lambda[i]; /* sum of the step's lambdas: the pressure, see ph_velocity */
     akp_fluid_collide(c, &p, NULL);
     c->qx[i] = p.x, c->qy[i] = p.y, c->qz[i] = p.z;
     /* the SIMD kernels' next iterate as (x, y, z, 0) records: no pass reads p4 until the next
@@ -854,11 +856,17 @@ void akp_fluid_delta_finish(akp_fluid_ctx* c, size_t i, ak_vec3 p) {
     if (c->simd) c->p4[4 * i] = p.x, c->p4[4 * i + 1] = p.y, c->p4[4 * i + 2] = p.z, c->p4[4 * i + 3] = 0.0f;
 }
 
-/* PBF: v = (x* - x) / dt. */
+/* PBF: v = (x* - x) / dt, and the pressure the step's corrections stand for. A correction
+ * (m/rho_0) sum_j (lambda_i + lambda_j) grad W_ij over one step is the displacement dt^2 a of
+ * the symmetric SPH pressure acceleration -(m/rho_0^2) sum_j (p_i + p_j) grad W_ij, so
+ * p_i = -rho_0 sum_iterations lambda_i / dt^2 (Pa). */
 static void ph_velocity(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
-    const float inv_dt = 1.0f / c->dt;
-    for (size_t i = b; i < e; ++i) c->v[i] = ak_vec3_scale(ak_vec3_sub(P(c, (uint32_t)i), c->x0[i]), inv_dt);
+    const float inv_dt = 1.0f / c->dt, pk = -c->rho0 / (c->dt * c->dt);
+    for (size_t i = b; i < e; ++i) {
+        c->v[i] = ak_vec3_scale(ak_vec3_sub(P(c, (uint32_t)i), c->x0[i]), inv_dt);
+        c->pres[i] *= pk;
+    }
 }
 
 /* AVX-512 PBF: (v, rho) records into q4 for the vorticity and XSPH kernels. */
@@ -1046,7 +1054,7 @@ static void ph_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
         c->xo[i] = ak_vec3_make(fx[a], fy[a], fz[a]);
         c->vo[i] = c->v[a];
         if (job->out_densities.ptr) job->out_densities.ptr[i] = c->rho[a];
-        if (job->out_pressures.ptr) job->out_pressures.ptr[i] = pbf ? 0.0f : c->pres[a];
+        if (job->out_pressures.ptr) job->out_pressures.ptr[i] = c->pres[a];
         if (job->out_flags.ptr) job->out_flags.ptr[i] = c->flags[a];
     }
 }

@@ -245,7 +245,7 @@ typedef struct ak_fluid_step_job {
     uint32_t thread_count;             /* 0 -> 1; at most 64 */
     ak_u8_span scratch;                /* required: >= ak_fluid_scratch_size(capacity, desc) */
     ak_f32_span out_densities;         /* optional (count >= capacity): rho per particle (kg/m^3) */
-    ak_f32_span out_pressures;         /* optional: SPH/WCSPH pressure (Pa); PBF writes 0 */
+    ak_f32_span out_pressures;         /* optional: pressure (Pa); PBF: -rho_0 sum_iterations lambda_i / dt^2 */
     ak_u8_span out_flags;              /* optional: AK_FLUID_FLAG_* per particle */
     ak_fluid_stats* out_stats;         /* optional */
     ak_fluid_kernels kernels;          /* 0 = the fastest this CPU runs; see ak_fluid_kernels_resolved */
