@@ -115,12 +115,16 @@ AK_TEST(lattice_density_is_rest_density) {
         memset(vel, 0, sizeof vel);
         size_t bytes = ak_fluid_scratch_size(n, &d);
         void* mem = malloc(bytes);
+        ak_fluid_stats st;
         ak_fluid_step_job job = {.desc = &d, .dt = 1e-6f, .positions = {pos, n}, .velocities = {vel, n},
-                                 .particle_count = &n, .scratch = {mem, bytes}, .out_densities = {rho, n}};
+                                 .particle_count = &n, .scratch = {mem, bytes}, .out_densities = {rho, n},
+                                 .out_stats = &st};
         AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
         size_t centre = (size_t)(5 * side * side + 5 * side + 5);
         double err = rho[centre] / 1000.0 - 1.0;
         AK_CHECK_MSG(fabs(err) < bounds[k], "h = %.1fs: density error %.5f", ratios[k], err);
+        /* the rest lattice density PBF's constraint holds is that same sum (another order) */
+        AK_CHECK_NEAR(st.rest_lattice_density, rho[centre], 1e-5 * rho[centre]);
         free(mem);
     }
 }
@@ -470,6 +474,7 @@ static void run_threads(uint32_t threads, ak_fluid_solver solver, ak_vec3* pos, 
     dam_desc(&d, &s);
     d.solver = solver;
     d.vorticity_epsilon = 0.5f;
+    d.scorr = true;
     d.viscosity = 0.01f;
     d.box_min = ak_vec3_make(0, 0, 0);
     d.box_max = ak_vec3_make(24 * s, 20 * s, 12 * s);
@@ -578,12 +583,13 @@ typedef struct simd_case {
     bool far; /* no box and a particle 1000 h away: the hashed grid path */
 } simd_case;
 
-static void run_case(const simd_case* k, ak_fluid_kernels kernels, ak_vec3* pos, ak_vec3* vel, float* rho, uint8_t* flags,
-                     ak_fluid_stats* st) {
+static void run_case(const simd_case* k, ak_fluid_kernels kernels, ak_vec3* pos, ak_vec3* vel, float* rho, float* pres,
+                     uint8_t* flags, ak_fluid_stats* st) {
     ak_fluid_desc d;
     float s;
     dam_desc(&d, &s);
     d.solver = k->solver;
+    d.scorr = true; /* the tensile term's paths (off by default) */
     d.scorr_n = k->scorr_n;
     d.max_neighbours = k->max_neighbours;
     d.vorticity_epsilon = 0.3f;
@@ -599,19 +605,19 @@ static void run_case(const simd_case* k, ak_fluid_kernels kernels, ak_vec3* pos,
     ak_fluid_step_job job = {.desc = &d, .dt = k->solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f,
                              .positions = {pos, n}, .velocities = {vel, n}, .particle_count = &n,
                              .colliders = {cols, 2}, .thread_count = 2, .kernels = kernels,
-                             .scratch = {mem, bytes}, .out_densities = {rho, n}, .out_flags = {flags, n},
-                             .out_stats = st};
+                             .scratch = {mem, bytes}, .out_densities = {rho, n}, .out_pressures = {pres, n},
+                             .out_flags = {flags, n}, .out_stats = st};
     for (int step = 0; step < 8; ++step) AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
     free(mem);
 }
 
 /* The AVX2 and AVX-512 kernels (where this CPU has them) against the scalar ones: the same bits
- * for positions, velocities, densities, flags and statistics after 8 steps, for PBF (with the
+ * for positions, velocities, densities, pressures, flags and statistics after 8 steps, for PBF (with the
  * tensile term's n = 4 fast path, a general n, lists truncated at 12 neighbours, and the hashed
  * grid path), SPH and WCSPH, with moving colliders and 2 threads. */
 AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
     static ak_vec3 p1[NAIVE_CAP], v1[NAIVE_CAP], p2[NAIVE_CAP], v2[NAIVE_CAP];
-    static float r1[NAIVE_CAP], r2[NAIVE_CAP];
+    static float r1[NAIVE_CAP], r2[NAIVE_CAP], q1[NAIVE_CAP], q2[NAIVE_CAP];
     static uint8_t f1[NAIVE_CAP], f2[NAIVE_CAP];
     const simd_case cases[] = {{"pbf", AK_FLUID_PBF, 0.0f, 0, false},
                                {"pbf scorr n=3", AK_FLUID_PBF, 3.0f, 0, false},
@@ -630,11 +636,12 @@ AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
         printf("  %s against scalar\n", ak_fluid_kernels_name(sets[s]));
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         ak_fluid_stats s1, s2;
-        run_case(&cases[k], sets[s], p1, v1, r1, f1, &s1);
-        run_case(&cases[k], AK_FLUID_KERNELS_SCALAR, p2, v2, r2, f2, &s2);
+        run_case(&cases[k], sets[s], p1, v1, r1, q1, f1, &s1);
+        run_case(&cases[k], AK_FLUID_KERNELS_SCALAR, p2, v2, r2, q2, f2, &s2);
         const size_t n = 13 * 11 * 9 + (cases[k].far ? 1 : 0);
         const bool same = memcmp(p1, p2, n * sizeof *p1) == 0 && memcmp(v1, v2, n * sizeof *v1) == 0 &&
-                          memcmp(r1, r2, n * sizeof *r1) == 0 && memcmp(f1, f2, n) == 0 &&
+                          memcmp(r1, r2, n * sizeof *r1) == 0 && memcmp(q1, q2, n * sizeof *q1) == 0 &&
+                          memcmp(f1, f2, n) == 0 && s1.coincident_count == s2.coincident_count &&
                           s1.max_density_error == s2.max_density_error && s1.full_count == s2.full_count &&
                           s1.surface_count == s2.surface_count && s1.truncated_count == s2.truncated_count;
         AK_CHECK_MSG(same, "%s: %s and scalar kernels differ", cases[k].name, ak_fluid_kernels_name(sets[s]));
