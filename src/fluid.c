@@ -588,16 +588,19 @@ static inline int64_t cell_coord(const ctx* c, float p) {
     return (int64_t)v;
 }
 
-/* Appends the candidates [begin, end) within h of q to list (capacity K, index order). */
+/* Appends the candidates [begin, end) within h of q to list (capacity K, index order); adds
+ * to *close those within sqrt(coincident2) (q's own particle included). */
 static inline uint32_t filter_scalar(const ctx* c, uint32_t begin, uint32_t end, float qx, float qy, float qz,
-                                     uint32_t* list, uint32_t* k) {
+                                     uint32_t* list, uint32_t* k, uint32_t* close) {
     const float r2 = c->h2;
     uint32_t found = 0;
     for (uint32_t bq = begin; bq < end; ++bq) {
         const float ddx = c->px[bq] - qx, ddy = c->py[bq] - qy, ddz = c->pz[bq] - qz;
-        if (ddx * ddx + ddy * ddy + ddz * ddz < r2) {
+        const float dd = ddx * ddx + ddy * ddy + ddz * ddz;
+        if (dd < r2) {
             if (*k < c->K) list[(*k)++] = bq;
             ++found;
+            if (dd < c->coincident2) ++*close;
         }
     }
     return found;
@@ -614,7 +617,7 @@ static void store_list(ctx* c, size_t a, const uint32_t* list, uint32_t k) {
  * a contiguous range of sorted indices (cells in (z, y, x) order), scanned z, then y, then x,
  * each cell in index order: the order of the hashed path's 27 cell lookups. */
 static void ph_neighbours_dense(ctx* c, size_t b, size_t e, uint32_t t) {
-    size_t trunc = 0;
+    size_t trunc = 0, coincident = 0;
     const int64_t X = c->dim[0], Y = c->dim[1], Z = c->dim[2];
     for (size_t a = b; a < e; ++a) {
         const float qx = c->px[a], qy = c->py[a], qz = c->pz[a];
@@ -622,7 +625,7 @@ static void ph_neighbours_dense(ctx* c, size_t b, size_t e, uint32_t t) {
                       cz = cell_coord(c, qz) - c->cmin[2];
         const int64_t xa = cx > 0 ? cx - 1 : 0, xb = cx + 1 < X ? cx + 1 : X - 1;
         uint32_t* list = c->tbuf + (size_t)t * (c->K + 16);
-        uint32_t k = 0, total = 0;
+        uint32_t k = 0, total = 0, close = 0;
         for (int64_t zz = cz - 1; zz <= cz + 1; ++zz) {
             if (zz < 0 || zz >= Z) continue;
             for (int64_t yy = cy - 1; yy <= cy + 1; ++yy) {
@@ -630,22 +633,26 @@ static void ph_neighbours_dense(ctx* c, size_t b, size_t e, uint32_t t) {
                 const size_t row = (size_t)((zz * Y + yy) * X);
                 const uint32_t rb = c->dstart[row + (size_t)xa], re = c->dstart[row + (size_t)xb + 1];
                 if (rb == re) continue;
-                total += c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_filter_avx512(c, rb, re, qx, qy, qz, list, &k)
-                         : c->kernels == AK_FLUID_KERNELS_AVX2   ? akp_fluid_filter_avx2(c, rb, re, qx, qy, qz, list, &k)
-                                                                 : filter_scalar(c, rb, re, qx, qy, qz, list, &k);
+                total += c->kernels == AK_FLUID_KERNELS_AVX512
+                             ? akp_fluid_filter_avx512(c, rb, re, qx, qy, qz, list, &k, &close)
+                         : c->kernels == AK_FLUID_KERNELS_AVX2
+                             ? akp_fluid_filter_avx2(c, rb, re, qx, qy, qz, list, &k, &close)
+                             : filter_scalar(c, rb, re, qx, qy, qz, list, &k, &close);
             }
         }
         if (total > c->K) ++trunc;
+        if (close > 1) ++coincident;
         store_list(c, a, list, k);
     }
     c->truncated[t] = trunc;
+    c->coincident[t] = coincident;
 }
 
 /* Hashed path, grid cells [b, e): every point of a cell scans the 27 cells around it (fixed
  * order z, y, x), each in sorted order. */
 static void ph_neighbours_hashed(ctx* c, size_t b, size_t e, uint32_t t) {
     const ak_grid* g = &c->grid;
-    size_t trunc = 0;
+    size_t trunc = 0, coincident = 0;
     uint32_t around[27];
     for (size_t m = b; m < e; ++m) {
         const ak_grid_cell cc = g->cell_coord[m];
@@ -659,14 +666,17 @@ static void ph_neighbours_hashed(ctx* c, size_t b, size_t e, uint32_t t) {
         for (uint32_t a = g->cell_start[m]; a < g->cell_start[m + 1]; ++a) {
             const float qx = c->px[a], qy = c->py[a], qz = c->pz[a];
             uint32_t* list = c->tbuf + (size_t)t * (c->K + 16);
-            uint32_t k = 0, total = 0;
+            uint32_t k = 0, total = 0, close = 0;
             for (int q = 0; q < na; ++q)
-                total += filter_scalar(c, g->cell_start[around[q]], g->cell_start[around[q] + 1], qx, qy, qz, list, &k);
+                total += filter_scalar(c, g->cell_start[around[q]], g->cell_start[around[q] + 1], qx, qy, qz, list,
+                                       &k, &close);
             if (total > c->K) ++trunc;
+            if (close > 1) ++coincident;
             store_list(c, a, list, k);
         }
     }
     c->truncated[t] = trunc;
+    c->coincident[t] = coincident;
 }
 
 /* Pads every list of blocks [b, e) (16-aligned) up to its block's longest list with index 0,
@@ -1003,29 +1013,15 @@ static void ph_integrate(ctx* c, size_t b, size_t e, uint32_t t) {
     }
 }
 
-/* Surface and full flags, and the particles that sit on another one (closer than 1% of the
- * rest spacing at the end of the step: a collapsed liquid, see ak_fluid_stats). */
 static void ph_flags(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
     const uint32_t surf = (c->full_lattice_count * 3u) / 4u;
-    const bool pbf = c->d.solver == AK_FLUID_PBF;
-    const float *fx = pbf ? c->px : c->qx, *fy = pbf ? c->py : c->qy, *fz = pbf ? c->pz : c->qz;
-    size_t coincident = 0;
     for (size_t i = b; i < e; ++i) {
         uint8_t f = 0;
         if (c->nb_count[i] < surf) f |= AK_FLUID_FLAG_SURFACE;
         else if (boundary_distance(c, P(c, (uint32_t)i)) >= c->h) f |= AK_FLUID_FLAG_FULL;
         c->flags[i] = f;
-        const uint32_t* nb = akp_fluid_nb(c, i);
-        for (uint32_t q = 0; q < c->nb_count[i]; ++q) {
-            const uint32_t j = nb[(size_t)q * 16];
-            const float dx = fx[j] - fx[i], dy = fy[j] - fy[i], dz = fz[j] - fz[i];
-            if (j != i && dx * dx + dy * dy + dz * dz < c->coincident2) {
-                ++coincident;
-                break;
-            }
-        }
     }
-    c->coincident[t] = coincident;
 }
 
 /* A full neighbourhood also needs every neighbour away from the free surface. */

@@ -268,8 +268,8 @@ static void dam_break(float a, float depth, float dt, uint32_t iterations, bool 
 AK_TEST(pbf_dam_break_keeps_interior_density) {
     dam_run r;
     dam_break(0.1f, 0.05f, 1e-3f, 6, false, 200, 10, &r);
-    printf("  dam (1 ms, 6 it): interior mean density %.4f..%.4f rho0, front Z %.2f at T %.2f\n", r.lo, r.hi,
-           r.front[20], 0.2 * sqrt(2 * 9.81 / 0.1));
+    printf("  dam (1 ms, 6 it): interior mean density %.4f..%.4f rho0, front Z %.2f at T %.2f, %zu coincident\n", r.lo,
+           r.hi, r.front[20], 0.2 * sqrt(2 * 9.81 / 0.1), r.coincident);
     AK_CHECK_EQ(r.r, AK_OK);
     AK_CHECK(r.inside);
     /* a few particles pinned to the same box edge (measured 14): far from a collapse */

@@ -209,9 +209,11 @@ typedef struct ak_fluid_stats {
     float mean_density_error;    /* mean of the same (0 if none) */
     float mean_density;          /* mean rho over the same particles, kg/m^3 (0 if none) */
     float rest_lattice_density;  /* m sum_j W_poly6 over the rest lattice (kg/m^3): PBF's rho_c */
-    size_t coincident_count;     /* particles closer than 1% of the rest spacing to another one at
-                                    the end of the step: a liquid collapsing onto itself or piled
-                                    into a corner (0 in a healthy liquid) */
+    size_t coincident_count;     /* particles closer than 1% of the rest spacing to another one
+                                    when the step found neighbours (PBF: the predicted positions,
+                                    already projected into the box; SPH: the step's start): a
+                                    liquid collapsing onto itself or piled into a corner (a few
+                                    pinned to one box edge in a healthy one) */
     size_t full_count;           /* particles counted */
     size_t surface_count;        /* particles flagged surface */
     size_t truncated_count;      /* particles with more than max_neighbours neighbours */

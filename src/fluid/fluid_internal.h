@@ -76,10 +76,11 @@ static inline const uint32_t* akp_fluid_nb(const akp_fluid_ctx* c, size_t a) {
  * fluid.c, 16 particles at a time (one per lane), each summing its neighbours in list order
  * with the scalar phase's float operations: results are bit-identical to the scalar phases. */
 bool akp_fluid_have_avx512(void);
-/* Appends to list[*k] (capacity K) the candidates [begin, end) closer than sqrt(r2) to
- * (qx, qy, qz), in index order; returns the number found (also those beyond K). */
+/* Appends to list[*k] (capacity K) the candidates [begin, end) closer than h to (qx, qy, qz),
+ * in index order; returns the number found (also those beyond K) and adds to *close those
+ * closer than sqrt(coincident2) (the particle itself included). */
 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
-                                 float qy, float qz, uint32_t* list, uint32_t* k);
+                                 float qy, float qz, uint32_t* list, uint32_t* k, uint32_t* close);
 void akp_fluid_density_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e);
@@ -89,7 +90,7 @@ void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 /* avx2.c: the same kernels on 8 lanes (each block of 16 as two halves), bit-identical too. */
 bool akp_fluid_have_avx2(void);
 uint32_t akp_fluid_filter_avx2(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
-                               float qy, float qz, uint32_t* list, uint32_t* k);
+                               float qy, float qz, uint32_t* list, uint32_t* k, uint32_t* close);
 void akp_fluid_density_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_delta_avx2(akp_fluid_ctx* c, size_t b, size_t e);
