@@ -87,25 +87,29 @@ static bool desc_ok(const ak_fluid_desc* d) {
            d->rest_density >= 0.0f && ak_finitef(d->rest_density);
 }
 
-/* Neighbour count of a lattice point at rest spacing s (self included) and the PBF constraint
- * gradient norm sum_k |grad_k C|^2 there. */
-static void lattice_props(float h, float s, float m_over_rho, uint32_t* out_count, float* out_grad2) {
+/* Neighbour count of a lattice point at rest spacing s (self included), the PBF constraint
+ * gradient norm sum_k |grad_k C|^2 there, and its poly6 sum sum_j W(x_j) (1/m^3; times the
+ * particle mass it is the density the rest lattice measures). */
+static void lattice_props(float h, float s, float m_over_rho, uint32_t* out_count, float* out_grad2, float* out_wsum) {
     const int reach = (int)ceilf(h / s) + 1;
     uint32_t count = 0;
     ak_vec3 gi = {0.0f, 0.0f, 0.0f};
     float sum_gj2 = 0.0f;
+    double wsum = 0.0;
     for (int z = -reach; z <= reach; ++z)
         for (int y = -reach; y <= reach; ++y)
             for (int x = -reach; x <= reach; ++x) {
                 ak_vec3 r = ak_vec3_make((float)x * s, (float)y * s, (float)z * s);
                 if (ak_vec3_dot(r, r) >= h * h) continue;
                 ++count;
+                wsum += (double)ak_fluid_poly6(ak_vec3_dot(r, r), h);
                 ak_vec3 g = ak_vec3_scale(ak_fluid_spiky_grad(r, h), m_over_rho);
                 gi = ak_vec3_add(gi, g);
                 sum_gj2 += ak_vec3_dot(g, g);
             }
     *out_count = count;
     *out_grad2 = ak_vec3_dot(gi, gi) + sum_gj2;
+    if (out_wsum) *out_wsum = (float)wsum;
 }
 
 ak_fluid_desc ak_fluid_desc_resolved(const ak_fluid_desc* desc) {
@@ -114,7 +118,7 @@ ak_fluid_desc ak_fluid_desc_resolved(const ak_fluid_desc* desc) {
     if (desc) d = *desc;
     if (d.rest_density == 0.0f) d.rest_density = 1000.0f;
     if (d.iterations == 0) d.iterations = 4;
-    if (d.scorr_k == 0.0f) d.scorr_k = 0.1f;
+    if (d.scorr_k == 0.0f) d.scorr_k = 0.01f;
     if (d.scorr_n == 0.0f) d.scorr_n = 4.0f;
     if (d.scorr_dq == 0.0f) d.scorr_dq = 0.2f;
     if (d.stiffness == 0.0f) d.stiffness = 20.0f;
@@ -125,7 +129,7 @@ ak_fluid_desc ak_fluid_desc_resolved(const ak_fluid_desc* desc) {
         const float s = cbrtf(d.particle_mass / d.rest_density);
         uint32_t c;
         float g2;
-        lattice_props(d.h, s, s * s * s, &c, &g2);
+        lattice_props(d.h, s, s * s * s, &c, &g2, NULL);
         d.relaxation = 0.01f * g2;
     }
     return d;
@@ -459,11 +463,11 @@ static void parallel_n(ctx* c, phase_fn fn, size_t n) {
 
 static void parallel(ctx* c, phase_fn fn) { parallel_n(c, fn, c->n); }
 
-/* Collider projection: moves p outside every collider and inside the box; v (may be NULL)
- * loses its inward normal component relative to the collider, friction scales the rest. */
-void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
+/* One pass over the colliders; true when one of them moved p. */
+static bool collide_pass(const ctx* c, ak_vec3* p, ak_vec3* v) {
     const ak_fluid_desc* d = &c->d;
     const ak_fluid_step_job* job = c->job;
+    bool moved = false;
     for (size_t k = 0; k < job->colliders.count; ++k) {
         const ak_fluid_collider* col = &job->colliders.ptr[k];
         ak_vec3 n;
@@ -487,6 +491,7 @@ void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
             depth = col->radius - len;
         }
         if (!(depth > 0.0f)) continue;
+        moved = true;
         *p = ak_vec3_add(*p, ak_vec3_scale(n, depth));
         if (v) {
             ak_vec3 rel = ak_vec3_sub(*v, col->velocity);
@@ -497,6 +502,12 @@ void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
             }
         }
     }
+    return moved;
+}
+
+/* The box container: p clamped inside, v loses its outward components. */
+static void collide_box(const ctx* c, ak_vec3* p, ak_vec3* v) {
+    const ak_fluid_desc* d = &c->d;
     if (d->box_min.x < d->box_max.x || d->box_min.y < d->box_max.y || d->box_min.z < d->box_max.z) {
         float* pc = &p->x;
         float* vc = v ? &v->x : NULL;
@@ -519,6 +530,18 @@ void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
                 if (pc[a] > lo[a] && pc[a] < hi[a]) vc[a] *= 1.0f - d->friction;
         }
     }
+}
+
+/* Collider projection: moves p outside every collider and inside the box; v (may be NULL)
+ * loses its inward normal component relative to the collider, friction scales the rest.
+ * Colliders are visited in order; a particle squeezed between two of them can be pushed back
+ * into the first by the second, so the pass repeats (at most 4 times) while a collider moved
+ * it. */
+void akp_fluid_collide(const ctx* c, ak_vec3* p, ak_vec3* v) {
+    const ak_fluid_step_job* job = c->job;
+    for (int pass = 0; pass < 4; ++pass)
+        if (!collide_pass(c, p, v) || job->colliders.count < 2) break;
+    collide_box(c, p, v);
 }
 
 /* Distance from p to the nearest boundary surface (box walls and colliders). */
@@ -565,16 +588,19 @@ static inline int64_t cell_coord(const ctx* c, float p) {
     return (int64_t)v;
 }
 
-/* Appends the candidates [begin, end) within h of q to list (capacity K, index order). */
+/* Appends the candidates [begin, end) within h of q to list (capacity K, index order); adds
+ * to *close those within sqrt(coincident2) (q's own particle included). */
 static inline uint32_t filter_scalar(const ctx* c, uint32_t begin, uint32_t end, float qx, float qy, float qz,
-                                     uint32_t* list, uint32_t* k) {
+                                     uint32_t* list, uint32_t* k, uint32_t* close) {
     const float r2 = c->h2;
     uint32_t found = 0;
     for (uint32_t bq = begin; bq < end; ++bq) {
         const float ddx = c->px[bq] - qx, ddy = c->py[bq] - qy, ddz = c->pz[bq] - qz;
-        if (ddx * ddx + ddy * ddy + ddz * ddz < r2) {
+        const float dd = ddx * ddx + ddy * ddy + ddz * ddz;
+        if (dd < r2) {
             if (*k < c->K) list[(*k)++] = bq;
             ++found;
+            if (dd < c->coincident2) ++*close;
         }
     }
     return found;
@@ -591,7 +617,7 @@ static void store_list(ctx* c, size_t a, const uint32_t* list, uint32_t k) {
  * a contiguous range of sorted indices (cells in (z, y, x) order), scanned z, then y, then x,
  * each cell in index order: the order of the hashed path's 27 cell lookups. */
 static void ph_neighbours_dense(ctx* c, size_t b, size_t e, uint32_t t) {
-    size_t trunc = 0;
+    size_t trunc = 0, coincident = 0;
     const int64_t X = c->dim[0], Y = c->dim[1], Z = c->dim[2];
     for (size_t a = b; a < e; ++a) {
         const float qx = c->px[a], qy = c->py[a], qz = c->pz[a];
@@ -599,7 +625,7 @@ static void ph_neighbours_dense(ctx* c, size_t b, size_t e, uint32_t t) {
                       cz = cell_coord(c, qz) - c->cmin[2];
         const int64_t xa = cx > 0 ? cx - 1 : 0, xb = cx + 1 < X ? cx + 1 : X - 1;
         uint32_t* list = c->tbuf + (size_t)t * (c->K + 16);
-        uint32_t k = 0, total = 0;
+        uint32_t k = 0, total = 0, close = 0;
         for (int64_t zz = cz - 1; zz <= cz + 1; ++zz) {
             if (zz < 0 || zz >= Z) continue;
             for (int64_t yy = cy - 1; yy <= cy + 1; ++yy) {
@@ -607,22 +633,26 @@ static void ph_neighbours_dense(ctx* c, size_t b, size_t e, uint32_t t) {
                 const size_t row = (size_t)((zz * Y + yy) * X);
                 const uint32_t rb = c->dstart[row + (size_t)xa], re = c->dstart[row + (size_t)xb + 1];
                 if (rb == re) continue;
-                total += c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_filter_avx512(c, rb, re, qx, qy, qz, list, &k)
-                         : c->kernels == AK_FLUID_KERNELS_AVX2   ? akp_fluid_filter_avx2(c, rb, re, qx, qy, qz, list, &k)
-                                                                 : filter_scalar(c, rb, re, qx, qy, qz, list, &k);
+                total += c->kernels == AK_FLUID_KERNELS_AVX512
+                             ? akp_fluid_filter_avx512(c, rb, re, qx, qy, qz, list, &k, &close)
+                         : c->kernels == AK_FLUID_KERNELS_AVX2
+                             ? akp_fluid_filter_avx2(c, rb, re, qx, qy, qz, list, &k, &close)
+                             : filter_scalar(c, rb, re, qx, qy, qz, list, &k, &close);
             }
         }
         if (total > c->K) ++trunc;
+        if (close > 1) ++coincident;
         store_list(c, a, list, k);
     }
     c->truncated[t] = trunc;
+    c->coincident[t] = coincident;
 }
 
 /* Hashed path, grid cells [b, e): every point of a cell scans the 27 cells around it (fixed
  * order z, y, x), each in sorted order. */
 static void ph_neighbours_hashed(ctx* c, size_t b, size_t e, uint32_t t) {
     const ak_grid* g = &c->grid;
-    size_t trunc = 0;
+    size_t trunc = 0, coincident = 0;
     uint32_t around[27];
     for (size_t m = b; m < e; ++m) {
         const ak_grid_cell cc = g->cell_coord[m];
@@ -636,14 +666,17 @@ static void ph_neighbours_hashed(ctx* c, size_t b, size_t e, uint32_t t) {
         for (uint32_t a = g->cell_start[m]; a < g->cell_start[m + 1]; ++a) {
             const float qx = c->px[a], qy = c->py[a], qz = c->pz[a];
             uint32_t* list = c->tbuf + (size_t)t * (c->K + 16);
-            uint32_t k = 0, total = 0;
+            uint32_t k = 0, total = 0, close = 0;
             for (int q = 0; q < na; ++q)
-                total += filter_scalar(c, g->cell_start[around[q]], g->cell_start[around[q] + 1], qx, qy, qz, list, &k);
+                total += filter_scalar(c, g->cell_start[around[q]], g->cell_start[around[q] + 1], qx, qy, qz, list,
+                                       &k, &close);
             if (total > c->K) ++trunc;
+            if (close > 1) ++coincident;
             store_list(c, a, list, k);
         }
     }
     c->truncated[t] = trunc;
+    c->coincident[t] = coincident;
 }
 
 /* Pads every list of blocks [b, e) (16-aligned) up to its block's longest list with index 0,
@@ -742,6 +775,7 @@ static void ph_gather(ctx* c, size_t b, size_t e, uint32_t t) {
         const uint32_t i = c->order[a];
         c->x0[a] = c->xo[i];
         c->v[a] = c->vo[i];
+        c->pres[a] = 0.0f; /* PBF sums lambdas here */
     }
 }
 
@@ -785,7 +819,7 @@ static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
         }
         rho *= c->m;
         c->rho[i] = rho;
-        float C = rho / c->rho0 - 1.0f;
+        float C = rho / c->rho_c - 1.0f;
         if (!c->d.bilateral && C < 0.0f) C = 0.0f;
         c->lambda[i] = -C / (ak_vec3_dot(gi, gi) + sum_gj2 + c->d.relaxation);
     }
@@ -795,7 +829,7 @@ static void ph_lambda(ctx* c, size_t b, size_t e, uint32_t t) {
  * collision response on p_i + dp_i, written to q (the next iterate). */
 static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
-    const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
+    const bool scorr = c->d.scorr && c->wdq > 0.0f;
     const float k = c->d.scorr_k / c->grad2_rest, np = c->d.scorr_n, inv_wdq = scorr ? 1.0f / c->wdq : 0.0f;
     const bool n4 = np == 4.0f;
     if (c->simd && (n4 || !scorr)) {
@@ -824,6 +858,7 @@ static void ph_delta(ctx* c, size_t b, size_t e, uint32_t t) {
 }
 
 void akp_fluid_delta_finish(akp_fluid_ctx* c, size_t i, ak_vec3 p) {
+    c->pres[i] += c->lambda[i]; /* sum of the step's lambdas: the pressure, see ph_velocity */
     akp_fluid_collide(c, &p, NULL);
     c->qx[i] = p.x, c->qy[i] = p.y, c->qz[i] = p.z;
     /* the SIMD kernels' next iterate as (x, y, z, 0) records: no pass reads p4 until the next
@@ -831,11 +866,17 @@ void akp_fluid_delta_finish(akp_fluid_ctx* c, size_t i, ak_vec3 p) {
     if (c->simd) c->p4[4 * i] = p.x, c->p4[4 * i + 1] = p.y, c->p4[4 * i + 2] = p.z, c->p4[4 * i + 3] = 0.0f;
 }
 
-/* PBF: v = (x* - x) / dt. */
+/* PBF: v = (x* - x) / dt, and the pressure the step's corrections stand for. A correction
+ * (m/rho_0) sum_j (lambda_i + lambda_j) grad W_ij over one step is the displacement dt^2 a of
+ * the symmetric SPH pressure acceleration -(m/rho_0^2) sum_j (p_i + p_j) grad W_ij, so
+ * p_i = -rho_0 sum_iterations lambda_i / dt^2 (Pa). */
 static void ph_velocity(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
-    const float inv_dt = 1.0f / c->dt;
-    for (size_t i = b; i < e; ++i) c->v[i] = ak_vec3_scale(ak_vec3_sub(P(c, (uint32_t)i), c->x0[i]), inv_dt);
+    const float inv_dt = 1.0f / c->dt, pk = -c->rho0 / (c->dt * c->dt);
+    for (size_t i = b; i < e; ++i) {
+        c->v[i] = ak_vec3_scale(ak_vec3_sub(P(c, (uint32_t)i), c->x0[i]), inv_dt);
+        c->pres[i] *= pk;
+    }
 }
 
 /* AVX-512 PBF: (v, rho) records into q4 for the vorticity and XSPH kernels. */
@@ -1009,7 +1050,7 @@ static void ph_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
         c->xo[i] = ak_vec3_make(fx[a], fy[a], fz[a]);
         c->vo[i] = c->v[a];
         if (job->out_densities.ptr) job->out_densities.ptr[i] = c->rho[a];
-        if (job->out_pressures.ptr) job->out_pressures.ptr[i] = pbf ? 0.0f : c->pres[a];
+        if (job->out_pressures.ptr) job->out_pressures.ptr[i] = c->pres[a];
         if (job->out_flags.ptr) job->out_flags.ptr[i] = c->flags[a];
     }
 }
@@ -1092,7 +1133,10 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     c->kernels = ak_fluid_kernels_resolved(job->kernels);
     c->simd = c->kernels != AK_FLUID_KERNELS_SCALAR;
     const float s = cbrtf(c->mr);
-    lattice_props(c->h, s, c->mr, &c->full_lattice_count, &c->grad2_rest);
+    float wsum;
+    lattice_props(c->h, s, c->mr, &c->full_lattice_count, &c->grad2_rest, &wsum);
+    c->rho_c = c->m * wsum;
+    c->coincident2 = 1e-4f * s * s; /* (1% of the rest spacing)^2 */
     {
         const float h2 = c->h * c->h, h3 = h2 * c->h;
         c->poly6_k = (float)(315.0 / (64.0 * FLUID_PI)) / (h2 * h2 * h2 * h2 * c->h);
@@ -1193,7 +1237,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     /* blow-up check, statistics (sorted order: the same for any thread count) */
     const float limit = 100.0f * c->h;
     bool blown = false;
-    double sum = 0.0;
+    double sum = 0.0, sum_rho = 0.0;
     for (size_t a = 0; a < n; ++a) {
         const uint32_t i = c->order[a];
         const ak_vec3 v = c->vo[i];
@@ -1203,11 +1247,17 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
             float err = fabsf(c->rho[a] / c->rho0 - 1.0f);
             if (err > st.max_density_error) st.max_density_error = err;
             sum += err;
+            sum_rho += c->rho[a];
             ++st.full_count;
         }
     }
     st.mean_density_error = st.full_count ? (float)(sum / (double)st.full_count) : 0.0f;
-    for (uint32_t t = 0; t < AKP_FLUID_MAX_THREADS; ++t) st.truncated_count += c->truncated[t];
+    st.mean_density = st.full_count ? (float)(sum_rho / (double)st.full_count) : 0.0f;
+    st.rest_lattice_density = c->rho_c;
+    for (uint32_t t = 0; t < AKP_FLUID_MAX_THREADS; ++t) {
+        st.truncated_count += c->truncated[t];
+        st.coincident_count += c->coincident[t];
+    }
 
     /* sinks: stable compaction (order of the survivors kept) */
     if (job->sinks.count) {

@@ -115,12 +115,16 @@ AK_TEST(lattice_density_is_rest_density) {
         memset(vel, 0, sizeof vel);
         size_t bytes = ak_fluid_scratch_size(n, &d);
         void* mem = malloc(bytes);
+        ak_fluid_stats st;
         ak_fluid_step_job job = {.desc = &d, .dt = 1e-6f, .positions = {pos, n}, .velocities = {vel, n},
-                                 .particle_count = &n, .scratch = {mem, bytes}, .out_densities = {rho, n}};
+                                 .particle_count = &n, .scratch = {mem, bytes}, .out_densities = {rho, n},
+                                 .out_stats = &st};
         AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
         size_t centre = (size_t)(5 * side * side + 5 * side + 5);
         double err = rho[centre] / 1000.0 - 1.0;
         AK_CHECK_MSG(fabs(err) < bounds[k], "h = %.1fs: density error %.5f", ratios[k], err);
+        /* the rest lattice density PBF's constraint holds is that same sum (another order) */
+        AK_CHECK_NEAR(st.rest_lattice_density, rho[centre], 1e-5 * rho[centre]);
         free(mem);
     }
 }
@@ -182,15 +186,15 @@ static double column_slope(int w, int ht, float jitter, uint32_t seed, int steps
 }
 
 /* Hydrostatic column: the fitted slope of p against depth, averaged over the last 500 of 1300
- * steps (0.39 s; the column settles in about 0.15 s), within 10% of rho0 g, also for a column
- * one particle wider with its lattice jittered by 10% of the spacing. Measured 1.002 and 1.046
+ * steps (0.39 s; the column settles in about 0.15 s), within 5% of rho0 g, and within 10% for a
+ * column one particle wider with its lattice jittered by 10% of the spacing. Measured 1.002 and 1.046
  * rho0 g (jitter seeds 2-5: 1.016-1.055); MCG's poly6/spiky pair in place of the cubic spline
  * gives 1.13 and 1.24 (fails). */
 AK_TEST(hydrostatic_column_pressure_is_linear) {
     const double want = 1000.0 * 9.81;
     const double a = column_slope(6, 16, 0.0f, 1u, 1300, 500), b = column_slope(7, 16, 0.1f, 7u, 1300, 500);
     printf("  hydrostatic: mean fitted slope %.1f and %.1f (jittered) Pa/m vs rho g %.1f\n", a, b, want);
-    AK_CHECK_MSG(fabs(a / want - 1.0) < 0.1, "slope %.1f vs rho g %.1f", a, want);
+    AK_CHECK_MSG(fabs(a / want - 1.0) < 0.05, "slope %.1f vs rho g %.1f", a, want);
     AK_CHECK_MSG(fabs(b / want - 1.0) < 0.1, "jittered: slope %.1f vs rho g %.1f", b, want);
 }
 
@@ -201,42 +205,126 @@ static void dam_desc(ak_fluid_desc* d, float* s) {
     d->h = 2.0f * *s;
 }
 
-AK_TEST(pbf_dam_break_settles_and_stays_in_box) {
-    ak_fluid_desc d;
-    float s;
-    dam_desc(&d, &s);
-    d.box_min = ak_vec3_make(0, 0, 0);
-    d.box_max = ak_vec3_make(10 * s, 24 * s, 8 * s);
-    enum { CAP = 6 * 16 * 8 };
-    ak_vec3 pos[CAP], vel[CAP];
-    size_t n = ak_fluid_fill_box(&d, d.box_min, ak_vec3_make(6 * s, 16 * s, 8 * s), (ak_vec3_span)AK_SPAN(pos));
-    AK_CHECK_EQ(n, CAP);
-    memset(vel, 0, sizeof vel);
-    size_t bytes = ak_fluid_scratch_size(n, &d);
+/* A PBF dam break: a column a wide and 2a high (Martin & Moyce's n^2 = 2), `depth` deep, at rest
+ * spacing 1 cm (h = 2 s) against the wall x = 0 of a box 4a long, as fill_box lays it out. Every
+ * step records the mean density of the full-neighbourhood particles (signed, ak_fluid_stats) and
+ * the front: the largest x + s/2 (a particle stands for a cube of side s). */
+typedef struct dam_run {
+    double lo, hi;       /* min and max over steps of mean_density / rho_0 (steps with >= 20 full) */
+    bool inside;         /* every particle inside the box after every step */
+    ak_result r;         /* the last step's result */
+    size_t coincident;   /* the largest coincident_count of any step */
+    double front[64];    /* front / a after step k * every (k < 64) */
+} dam_run;
+
+static void dam_break(float a, float depth, float dt, uint32_t iterations, bool scorr, int steps, int every,
+                      dam_run* out) {
+    ak_fluid_desc d = {.solver = AK_FLUID_PBF, .particle_mass = 0.001f, .gravity = {0, -9.81f, 0},
+                       .xsph_c = 0.01f, .iterations = iterations, .scorr = scorr};
+    const float s = ak_fluid_rest_spacing(&d);
+    d.h = 2.0f * s;
+    d.box_max = ak_vec3_make(4.0f * a, 3.0f * a, depth);
+    const ak_vec3 hi = ak_vec3_make(a, 2.0f * a, depth);
+    const size_t cap = ak_fluid_fill_box(&d, d.box_min, hi, (ak_vec3_span){NULL, 0});
+    ak_vec3* pos = malloc(cap * sizeof *pos);
+    ak_vec3* vel = calloc(cap, sizeof *vel);
+    size_t n = ak_fluid_fill_box(&d, d.box_min, hi, (ak_vec3_span){pos, cap});
+    size_t bytes = ak_fluid_scratch_size(cap, &d);
     void* mem = malloc(bytes);
-    ak_fluid_stats st = {0};
-    /* 1 cm particles: 1/400 s steps (a particle falls less than a spacing per step) */
-    ak_fluid_step_job job = {.desc = &d, .dt = 1.0f / 400.0f, .positions = {pos, n}, .velocities = {vel, n},
+    ak_fluid_stats st;
+    ak_fluid_step_job job = {.desc = &d, .dt = dt, .positions = {pos, cap}, .velocities = {vel, cap},
                              .particle_count = &n, .scratch = {mem, bytes}, .out_stats = &st};
-    bool inside = true;
-    ak_result r = AK_OK;
-    for (int step = 0; step < 300 && r == AK_OK; ++step) {
-        r = ak_fluid_step_run(&job);
-        if (getenv("FLUID_DEBUG")) printf("step %d r %d mean %.4f max %.4f full %zu surf %zu\n", step, r, st.mean_density_error, st.max_density_error, st.full_count, st.surface_count);
-        inside = inside && inside_box(pos, n, d.box_min, d.box_max);
+    memset(out, 0, sizeof *out);
+    out->lo = out->hi = 1.0;
+    out->inside = true;
+    for (int step = 0; step < steps; ++step) {
+        out->r = ak_fluid_step_run(&job);
+        if (out->r != AK_OK) break;
+        out->inside = out->inside && inside_box(pos, n, d.box_min, d.box_max);
+        if (st.coincident_count > out->coincident) out->coincident = st.coincident_count;
+        if (st.full_count >= 20) {
+            const double q = st.mean_density / 1000.0;
+            out->lo = q < out->lo ? q : out->lo;
+            out->hi = q > out->hi ? q : out->hi;
+        }
+        if ((step + 1) % every == 0 && (step + 1) / every < 64) {
+            float front = 0.0f;
+            for (size_t i = 0; i < n; ++i) front = fmaxf(front, pos[i].x);
+            out->front[(step + 1) / every] = (front + 0.5f * s) / a;
+        }
     }
-    AK_CHECK_EQ(r, AK_OK);
-    AK_CHECK(inside);
-    printf("  dam break: mean density error %.4f, max %.4f over %zu full particles\n", st.mean_density_error,
-           st.max_density_error, st.full_count);
-    AK_CHECK_MSG(st.full_count > 20, "%zu full particles", st.full_count);
-    AK_CHECK_MSG(st.mean_density_error < 0.01f, "mean density error %.4f (max %.4f)", st.mean_density_error,
-                 st.max_density_error);
-    /* it spread: the block was 6s wide, the box is 10s */
-    float maxx = 0;
-    for (size_t i = 0; i < n; ++i) maxx = fmaxf(maxx, pos[i].x);
-    AK_CHECK(maxx > 9 * s);
     free(mem);
+    free(vel);
+    free(pos);
+}
+
+/* Interior density through a dam break, with the defaults (unilateral constraint, no s_corr):
+ * the mean density of the full-neighbourhood particles stays within 3% of rho_0 at every step,
+ * at the issue's step (1 ms, 6 iterations) and the command's (1/400 s, 4 iterations); no
+ * particle leaves the box or sits on another. Measured (a = 0.1 m, 1000 particles, 0.2 s):
+ * 0.972-1.010 and 0.975-1.012 (see docs/fluid.md for the larger dam). The control: the same
+ * dam with s_corr on (k = 0.1) swells, its interior falls below 0.97 rho_0 (measured 0.71),
+ * which shows this check can fail. */
+AK_TEST(pbf_dam_break_keeps_interior_density) {
+    dam_run r;
+    dam_break(0.1f, 0.05f, 1e-3f, 6, false, 200, 10, &r);
+    printf("  dam (1 ms, 6 it): interior mean density %.4f..%.4f rho0, front Z %.2f at T %.2f, %zu coincident\n", r.lo,
+           r.hi, r.front[20], 0.2 * sqrt(2 * 9.81 / 0.1), r.coincident);
+    AK_CHECK_EQ(r.r, AK_OK);
+    AK_CHECK(r.inside);
+    /* a few particles pinned to the same box edge (measured 14): far from a collapse */
+    AK_CHECK_MSG(r.coincident < 20, "%zu coincident particles", r.coincident);
+    AK_CHECK_MSG(r.lo > 0.97 && r.hi < 1.03, "interior density %.4f..%.4f rho0", r.lo, r.hi);
+    AK_CHECK_MSG(r.front[20] > 2.0, "the front only reached %.2f a", r.front[20]);
+    dam_break(0.1f, 0.05f, 1.0f / 400.0f, 4, false, 80, 10, &r);
+    printf("  dam (1/400 s, 4 it): interior mean density %.4f..%.4f rho0\n", r.lo, r.hi);
+    AK_CHECK_EQ(r.r, AK_OK);
+    AK_CHECK_MSG(r.lo > 0.97 && r.hi < 1.03, "interior density %.4f..%.4f rho0", r.lo, r.hi);
+    ak_fluid_desc k = {.particle_mass = 0.001f, .h = 0.02f};
+    AK_CHECK_NEAR(ak_fluid_desc_resolved(&k).scorr_k, 0.01f, 0.0f);
+    dam_break(0.1f, 0.05f, 1e-3f, 6, true, 200, 10, &r);
+    printf("  control, s_corr on: interior mean density %.4f..%.4f rho0\n", r.lo, r.hi);
+    AK_CHECK_MSG(r.lo < 0.97, "s_corr on kept the interior at %.4f..%.4f rho0", r.lo, r.hi);
+}
+
+/* Martin & Moyce (1952), the collapse of a column of n^2 = 2 (height 2a): surge front Z = x/a
+ * against T = t sqrt(2 g / a), read from their table for a = 2.25 in (fronts every 0.25-0.5 in).
+ * The PBF front (a = 0.2 m, 20 x 40 x 5 particles, 1 ms, 6 iterations, free-slip walls) must
+ * stay within 12% of theirs for 1 <= T <= 2.5. Measured: 4.6-9% behind (docs/fluid.md); an
+ * inviscid, frictionless model would be ahead, a liquid that swells or sticks would be far off. */
+static const double martin_moyce[][2] = {{0.41, 1.11}, {0.84, 1.22}, {1.19, 1.44}, {1.43, 1.67},
+                                          {1.63, 1.89}, {1.83, 2.11}, {1.98, 2.33}, {2.20, 2.56},
+                                          {2.32, 2.78}, {2.51, 3.00}};
+
+static double martin_moyce_z(double T) {
+    const size_t count = sizeof martin_moyce / sizeof martin_moyce[0];
+    if (T <= martin_moyce[0][0]) return 1.0 + (martin_moyce[0][1] - 1.0) * T / martin_moyce[0][0];
+    for (size_t k = 1; k < count; ++k)
+        if (T <= martin_moyce[k][0]) {
+            const double u = (T - martin_moyce[k - 1][0]) / (martin_moyce[k][0] - martin_moyce[k - 1][0]);
+            return martin_moyce[k - 1][1] + u * (martin_moyce[k][1] - martin_moyce[k - 1][1]);
+        }
+    return martin_moyce[count - 1][1];
+}
+
+AK_TEST(pbf_dam_break_front_against_martin_moyce) {
+    const float a = 0.2f, dt = 1e-3f;
+    const double scale = sqrt(2.0 * 9.81 / a); /* T per second */
+    dam_run r;
+    const int every = 10;
+    dam_break(a, 0.05f, dt, 6, false, (int)(2.55 / scale / dt) + 1, every, &r);
+    AK_CHECK_EQ(r.r, AK_OK);
+    AK_CHECK_MSG(r.lo > 0.97 && r.hi < 1.03, "interior density %.4f..%.4f rho0", r.lo, r.hi);
+    int checked = 0;
+    for (int k = 1; k < 64; ++k) {
+        const double T = k * every * dt * scale;
+        if (T < 1.0 || T > 2.5) continue;
+        const double want = martin_moyce_z(T), got = r.front[k];
+        printf("  T %.2f: front Z %.3f, Martin & Moyce %.3f (%+.1f%%)\n", T, got, want, 100.0 * (got / want - 1.0));
+        AK_CHECK_MSG(fabs(got / want - 1.0) < 0.12, "T %.2f: Z %.3f vs %.3f", T, got, want);
+        ++checked;
+    }
+    AK_CHECK(checked >= 10);
 }
 
 static void free_fall(ak_fluid_solver solver) {
@@ -292,8 +380,10 @@ AK_TEST(plane_free_slip_no_sticking) {
     free(mem);
 }
 
-/* Liquid poured on a sphere and a capsule, with a moving sphere sweeping through: no particle
- * ever ends a step inside a collider or outside the box. */
+/* Liquid poured on a sphere and a capsule, with a moving sphere sweeping past: no particle
+ * ever ends a step inside a collider or outside the box. The moving sphere stays clear of the
+ * fixed one (centres at least 7.2 s apart, radii 4 s and 3 s): where two colliders overlap, the
+ * projection cannot always free a particle caught in the crease (see fluid.h). */
 AK_TEST(colliders_never_leak) {
     ak_fluid_desc d;
     float s;
@@ -303,7 +393,7 @@ AK_TEST(colliders_never_leak) {
     ak_fluid_collider cols[3] = {
         {.shape = AK_FLUID_SPHERE, .a = {10 * s, 8 * s, 10 * s}, .radius = 4 * s},
         {.shape = AK_FLUID_CAPSULE, .a = {2 * s, 3 * s, 5 * s}, .b = {18 * s, 3 * s, 5 * s}, .radius = 2 * s},
-        {.shape = AK_FLUID_SPHERE, .a = {4 * s, 4 * s, 15 * s}, .radius = 3 * s, .velocity = {0.2f, 0, 0}},
+        {.shape = AK_FLUID_SPHERE, .a = {4 * s, 4 * s, 16.5f * s}, .radius = 3 * s, .velocity = {0.2f, 0, 0}},
     };
     enum { CAP = 600 };
     ak_vec3 pos[CAP], vel[CAP];
@@ -384,6 +474,7 @@ static void run_threads(uint32_t threads, ak_fluid_solver solver, ak_vec3* pos, 
     dam_desc(&d, &s);
     d.solver = solver;
     d.vorticity_epsilon = 0.5f;
+    d.scorr = true;
     d.viscosity = 0.01f;
     d.box_min = ak_vec3_make(0, 0, 0);
     d.box_max = ak_vec3_make(24 * s, 20 * s, 12 * s);
@@ -492,12 +583,13 @@ typedef struct simd_case {
     bool far; /* no box and a particle 1000 h away: the hashed grid path */
 } simd_case;
 
-static void run_case(const simd_case* k, ak_fluid_kernels kernels, ak_vec3* pos, ak_vec3* vel, float* rho, uint8_t* flags,
-                     ak_fluid_stats* st) {
+static void run_case(const simd_case* k, ak_fluid_kernels kernels, ak_vec3* pos, ak_vec3* vel, float* rho, float* pres,
+                     uint8_t* flags, ak_fluid_stats* st) {
     ak_fluid_desc d;
     float s;
     dam_desc(&d, &s);
     d.solver = k->solver;
+    d.scorr = true; /* the tensile term's paths (off by default) */
     d.scorr_n = k->scorr_n;
     d.max_neighbours = k->max_neighbours;
     d.vorticity_epsilon = 0.3f;
@@ -513,19 +605,19 @@ static void run_case(const simd_case* k, ak_fluid_kernels kernels, ak_vec3* pos,
     ak_fluid_step_job job = {.desc = &d, .dt = k->solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f,
                              .positions = {pos, n}, .velocities = {vel, n}, .particle_count = &n,
                              .colliders = {cols, 2}, .thread_count = 2, .kernels = kernels,
-                             .scratch = {mem, bytes}, .out_densities = {rho, n}, .out_flags = {flags, n},
-                             .out_stats = st};
+                             .scratch = {mem, bytes}, .out_densities = {rho, n}, .out_pressures = {pres, n},
+                             .out_flags = {flags, n}, .out_stats = st};
     for (int step = 0; step < 8; ++step) AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
     free(mem);
 }
 
 /* The AVX2 and AVX-512 kernels (where this CPU has them) against the scalar ones: the same bits
- * for positions, velocities, densities, flags and statistics after 8 steps, for PBF (with the
+ * for positions, velocities, densities, pressures, flags and statistics after 8 steps, for PBF (with the
  * tensile term's n = 4 fast path, a general n, lists truncated at 12 neighbours, and the hashed
  * grid path), SPH and WCSPH, with moving colliders and 2 threads. */
 AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
     static ak_vec3 p1[NAIVE_CAP], v1[NAIVE_CAP], p2[NAIVE_CAP], v2[NAIVE_CAP];
-    static float r1[NAIVE_CAP], r2[NAIVE_CAP];
+    static float r1[NAIVE_CAP], r2[NAIVE_CAP], q1[NAIVE_CAP], q2[NAIVE_CAP];
     static uint8_t f1[NAIVE_CAP], f2[NAIVE_CAP];
     const simd_case cases[] = {{"pbf", AK_FLUID_PBF, 0.0f, 0, false},
                                {"pbf scorr n=3", AK_FLUID_PBF, 3.0f, 0, false},
@@ -544,11 +636,12 @@ AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
         printf("  %s against scalar\n", ak_fluid_kernels_name(sets[s]));
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         ak_fluid_stats s1, s2;
-        run_case(&cases[k], sets[s], p1, v1, r1, f1, &s1);
-        run_case(&cases[k], AK_FLUID_KERNELS_SCALAR, p2, v2, r2, f2, &s2);
+        run_case(&cases[k], sets[s], p1, v1, r1, q1, f1, &s1);
+        run_case(&cases[k], AK_FLUID_KERNELS_SCALAR, p2, v2, r2, q2, f2, &s2);
         const size_t n = 13 * 11 * 9 + (cases[k].far ? 1 : 0);
         const bool same = memcmp(p1, p2, n * sizeof *p1) == 0 && memcmp(v1, v2, n * sizeof *v1) == 0 &&
-                          memcmp(r1, r2, n * sizeof *r1) == 0 && memcmp(f1, f2, n) == 0 &&
+                          memcmp(r1, r2, n * sizeof *r1) == 0 && memcmp(q1, q2, n * sizeof *q1) == 0 &&
+                          memcmp(f1, f2, n) == 0 && s1.coincident_count == s2.coincident_count &&
                           s1.max_density_error == s2.max_density_error && s1.full_count == s2.full_count &&
                           s1.surface_count == s2.surface_count && s1.truncated_count == s2.truncated_count;
         AK_CHECK_MSG(same, "%s: %s and scalar kernels differ", cases[k].name, ak_fluid_kernels_name(sets[s]));
@@ -595,8 +688,8 @@ int main(void) {
     AK_RUN(kernels_support);
     AK_RUN(kernel_gradients_match_finite_differences);
     AK_RUN(lattice_density_is_rest_density);
-    AK_RUN_SLOW(hydrostatic_column_pressure_is_linear);
-    AK_RUN(pbf_dam_break_settles_and_stays_in_box);
+    AK_RUN(hydrostatic_column_pressure_is_linear);
+    AK_RUN(pbf_dam_break_keeps_interior_density);
     AK_RUN(free_fall_momentum_is_mgt);
     AK_RUN(plane_free_slip_no_sticking);
     AK_RUN(colliders_never_leak);
@@ -605,5 +698,6 @@ int main(void) {
     AK_RUN(densities_match_naive_sum_on_every_path);
     AK_RUN(simd_and_scalar_kernels_are_bit_identical);
     AK_RUN(validation_and_blow_up);
+    AK_RUN_SLOW(pbf_dam_break_front_against_martin_moyce);
     return ak_test_finish();
 }

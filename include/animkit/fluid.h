@@ -3,20 +3,26 @@
  * What it does: advances a particle liquid by one time step with one of three solvers:
  *  - AK_FLUID_PBF, position-based fluids (Macklin & Mueller 2013, Algorithm 1): predict
  *    positions, find neighbours once, then `iterations` Jacobi iterations of the density
- *    constraints C_i = rho_i / rho_0 - 1 (lambda_i = -C_i / (sum_k |grad_k C_i|^2 + epsilon),
- *    dp_i = (m / rho_0) sum_j (lambda_i + lambda_j + s_corr) grad W_spiky(p_i - p_j), with the
- *    tensile correction s_corr = -k (W_poly6(r) / W_poly6(dq))^n), collision projection after
- *    each iteration, v = (x* - x) / dt, vorticity confinement and XSPH viscosity. The paper
- *    writes its equations for unit mass; here m/rho_0 multiplies the constraint gradient and
- *    the position update, so any particle mass gives the same motion. Two readings where the
- *    paper's unit-mass scene units do not carry over (documented in docs/fluid.md): s_corr is
- *    divided by the rest lattice's sum_k |grad_k C|^2 so k means "a density deficit of k"
- *    whatever the units (lambda has units of length^2; the paper's k = 0.1 is tied to its
- *    h = 0.1, rho_0 = 6378 scene, and taken literally in SI units it throws the free surface
- *    apart), and the density constraint is unilateral by default (C_i clamped at 0: particles
- *    short of neighbours at the free surface are not pulled inward, the clumping the paper
- *    fights with s_corr; desc.bilateral restores the paper's equality constraint). XSPH
- *    carries the volume m / rho_j of Schechter & Bridson's form, as the paper's unit mass hides.
+ *    constraints C_i = rho_i / rho_c - 1 (lambda_i = -C_i / (sum_k |grad_k C_i|^2 + epsilon),
+ *    dp_i = (m / rho_0) sum_j (lambda_i + lambda_j + s_corr) grad W_spiky(p_i - p_j)),
+ *    collision projection after each iteration, v = (x* - x) / dt, vorticity confinement and
+ *    XSPH viscosity. The paper writes its equations for unit mass; here m/rho_0 multiplies the
+ *    constraint gradient and the position update, so any particle mass gives the same motion.
+ *    Where this reads the paper (docs/fluid.md gives the measurements):
+ *     - rho_c, the density the constraint holds, is m sum_j W_poly6 over the rest lattice
+ *       (1.0098 rho_0 at h = 2 spacings), the density a particle of a liquid at rest measures:
+ *       a block filled at rest spacing then starts at rest instead of 1% compressed.
+ *     - The constraint is unilateral by default, C_i = max(rho_i/rho_c - 1, 0): the liquid
+ *       never pulls itself together, so it has no tensile instability and needs no s_corr,
+ *       which is off by default (desc.scorr). desc.bilateral gives the paper's equality
+ *       constraint, whose negative pressures clump particles; the paper's tensile correction
+ *       s_corr = -k (W_poly6(r) / W_poly6(dq))^n, added to lambda_i + lambda_j, fights that.
+ *       On a unilateral constraint s_corr is a pressure nothing balances: the liquid swells
+ *       (a dam's interior fell to 0.82 rho_0). k is divided by the rest lattice's
+ *       sum_k |grad_k C|^2, so k reads as "a density deficit of k" in any units; the paper's
+ *       k = 0.1 belongs to its h = 0.1, rho_0 = 6378 scene units, where it means a deficit of
+ *       about 16 (it throws any liquid apart), and the default is 0.01.
+ *    XSPH carries the volume m / rho_j of Schechter & Bridson's form, as the paper's unit mass hides.
  *  - AK_FLUID_SPH (Mueller, Charypar, Gross 2003): density by poly6, pressure p = k (rho - rho_0),
  *    symmetric pressure force -sum_j m (p_i + p_j) / (2 rho_j) grad W_spiky, viscosity force
  *    mu sum_j m (v_j - v_i) / rho_j lap W_visc, semi-implicit Euler.
@@ -41,7 +47,9 @@
  * component into the surface relative to the collider's velocity (the tangential component is
  * kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so the velocity
  * update v = (x* - x)/dt inherits the same rule. Nothing leaks (every particle ends each step
- * outside every collider and inside the box, up to float rounding of the projection) and
+ * outside every collider and inside the box, up to float rounding of the projection; where two
+ * colliders overlap, a particle in the crease between them may stay inside one: the colliders
+ * are projected in turn, at most 4 passes) and
  * nothing sticks (no tangential velocity is removed unless friction > 0, and no attraction to
  * walls: boundaries add no density).
  *
@@ -50,7 +58,7 @@
  * largest count. Each step also flags surface particles (neighbour count below 3/4 of a full
  * lattice neighbourhood) for rendering, and can report density statistics.
  *
- * Density error (ak_fluid_stats): |rho_i / rho_0 - 1| over particles with a full
+ * Density error (ak_fluid_stats): |rho_i / rho_0 - 1| (rho_0, not rho_c) over particles with a full
  * neighbourhood, meaning neither it nor any of its neighbours is flagged as surface, and it is
  * at least h from the box walls and every collider (particles near the free surface or a wall lack neighbours by construction).
  *
@@ -130,9 +138,9 @@ typedef struct ak_fluid_desc {
     /* PBF */
     uint32_t iterations;       /* Jacobi iterations per step; 0 -> 4 */
     float relaxation;          /* epsilon in 1/m^2 (|grad C|^2 units); 0 -> 0.01 * |grad C|^2 of the rest lattice */
-    bool bilateral;            /* false: C_i = max(rho_i/rho_0 - 1, 0) (unilateral, see above); true: the paper's C_i */
-    bool disable_scorr;        /* false: tensile correction on */
-    float scorr_k;             /* 0 -> 0.1 */
+    bool bilateral;            /* false: C_i = max(rho_i/rho_c - 1, 0) (unilateral, see above); true: the paper's C_i */
+    bool scorr;                /* tensile correction s_corr (for bilateral); false = off */
+    float scorr_k;             /* s_corr at r = dq as a density deficit; 0 -> 0.01 (bilateral dam, h = 2s: 0.05 and up explode) */
     float scorr_n;             /* 0 -> 4 */
     float scorr_dq;            /* |delta q| as a fraction of h; 0 -> 0.2 */
     float xsph_c;              /* XSPH coefficient; 0 = none (the paper uses 0.01) */
@@ -199,6 +207,13 @@ enum { AK_FLUID_FLAG_SURFACE = 1, AK_FLUID_FLAG_FULL = 2 /* counted in the densi
 typedef struct ak_fluid_stats {
     float max_density_error;     /* max |rho/rho_0 - 1| over full-neighbourhood particles (0 if none) */
     float mean_density_error;    /* mean of the same (0 if none) */
+    float mean_density;          /* mean rho over the same particles, kg/m^3 (0 if none) */
+    float rest_lattice_density;  /* m sum_j W_poly6 over the rest lattice (kg/m^3): PBF's rho_c */
+    size_t coincident_count;     /* particles closer than 1% of the rest spacing to another one
+                                    when the step found neighbours (PBF: the predicted positions,
+                                    already projected into the box; SPH: the step's start): a
+                                    liquid collapsing onto itself or piled into a corner (a few
+                                    pinned to one box edge in a healthy one) */
     size_t full_count;           /* particles counted */
     size_t surface_count;        /* particles flagged surface */
     size_t truncated_count;      /* particles with more than max_neighbours neighbours */
@@ -232,7 +247,7 @@ typedef struct ak_fluid_step_job {
     uint32_t thread_count;             /* 0 -> 1; at most 64 */
     ak_u8_span scratch;                /* required: >= ak_fluid_scratch_size(capacity, desc) */
     ak_f32_span out_densities;         /* optional (count >= capacity): rho per particle (kg/m^3) */
-    ak_f32_span out_pressures;         /* optional: SPH/WCSPH pressure (Pa); PBF writes 0 */
+    ak_f32_span out_pressures;         /* optional: pressure (Pa); PBF: -rho_0 sum_iterations lambda_i / dt^2 */
     ak_u8_span out_flags;              /* optional: AK_FLUID_FLAG_* per particle */
     ak_fluid_stats* out_stats;         /* optional */
     ak_fluid_kernels kernels;          /* 0 = the fastest this CPU runs; see ak_fluid_kernels_resolved */

@@ -32,9 +32,10 @@ AKP_AVX2 static inline __m256 range_mask(int lo, int hi) {
 }
 
 AKP_AVX2 uint32_t akp_fluid_filter_avx2(const akp_fluid_ctx* c, uint32_t begin, uint32_t end,
-                                        float qx, float qy, float qz, uint32_t* list, uint32_t* k) {
+                                        float qx, float qy, float qz, uint32_t* list, uint32_t* k,
+                                        uint32_t* close) {
     const __m256 vx = _mm256_set1_ps(qx), vy = _mm256_set1_ps(qy), vz = _mm256_set1_ps(qz);
-    const __m256 vr = _mm256_set1_ps(c->h2);
+    const __m256 vr = _mm256_set1_ps(c->h2), vc = _mm256_set1_ps(c->coincident2);
     const uint32_t K = c->K;
     uint32_t found = 0, kk = *k;
     for (uint32_t t = begin; t < end; t += 8) {
@@ -47,6 +48,9 @@ AKP_AVX2 uint32_t akp_fluid_filter_avx2(const akp_fluid_ctx* c, uint32_t begin, 
                                         _mm256_mul_ps(dz, dz));
         unsigned m =
             (unsigned)_mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(dd, vr, _CMP_LT_OQ), live));
+        if (m)
+            *close += (uint32_t)__builtin_popcount(
+                (unsigned)_mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(dd, vc, _CMP_LT_OQ), live)));
         while (m) {
             const uint32_t u = (uint32_t)__builtin_ctz(m);
             m &= m - 1u;
@@ -191,7 +195,7 @@ AKP_AVX2 void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
         const __m256i li = _mm256_castps_si256(H.lanes);
         rho = _mm256_mul_ps(rho, _mm256_set1_ps(c->m));
         _mm256_maskstore_ps(c->rho + H.base, li, rho);
-        __m256 C = _mm256_sub_ps(_mm256_div_ps(rho, _mm256_set1_ps(c->rho0)), _mm256_set1_ps(1.0f));
+        __m256 C = _mm256_sub_ps(_mm256_div_ps(rho, _mm256_set1_ps(c->rho_c)), _mm256_set1_ps(1.0f));
         if (!c->d.bilateral) C = _mm256_blendv_ps(C, zero, _mm256_cmp_ps(C, zero, _CMP_LT_OQ));
         const __m256 gg = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(gx, gx), _mm256_mul_ps(gy, gy)),
                                         _mm256_mul_ps(gz, gz));
@@ -210,7 +214,7 @@ AKP_AVX2 void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
 }
 
 AKP_AVX2 void akp_fluid_delta_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
-    const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
+    const bool scorr = c->d.scorr && c->wdq > 0.0f;
     const __m256 negk = _mm256_set1_ps(-(c->d.scorr_k / c->grad2_rest)),
                  inv_wdq = _mm256_set1_ps(scorr ? 1.0f / c->wdq : 0.0f);
     const __m256 zero = _mm256_setzero_ps(), mr = _mm256_set1_ps(c->mr);
@@ -342,8 +346,8 @@ AKP_AVX2 void akp_fluid_xsph_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
 
 bool akp_fluid_have_avx2(void) { return false; }
 uint32_t akp_fluid_filter_avx2(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
-                               float qy, float qz, uint32_t* list, uint32_t* k) {
-    (void)c, (void)begin, (void)end, (void)qx, (void)qy, (void)qz, (void)list, (void)k;
+                               float qy, float qz, uint32_t* list, uint32_t* k, uint32_t* close) {
+    (void)c, (void)begin, (void)end, (void)qx, (void)qy, (void)qz, (void)list, (void)k, (void)close;
     return 0;
 }
 void akp_fluid_density_avx2(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }

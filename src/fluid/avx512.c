@@ -35,9 +35,9 @@ static inline __mmask16 live_mask(uint32_t left) {
 
 AKP_AVX512 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end,
                                             float qx, float qy, float qz, uint32_t* list,
-                                            uint32_t* k) {
+                                            uint32_t* k, uint32_t* close) {
     const __m512 vx = _mm512_set1_ps(qx), vy = _mm512_set1_ps(qy), vz = _mm512_set1_ps(qz);
-    const __m512 vr = _mm512_set1_ps(c->h2);
+    const __m512 vr = _mm512_set1_ps(c->h2), vc = _mm512_set1_ps(c->coincident2);
     const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     const uint32_t K = c->K;
     uint32_t found = 0, kk = *k;
@@ -52,6 +52,7 @@ AKP_AVX512 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t beg
         if (!m) continue;
         const uint32_t cnt = (uint32_t)__builtin_popcount(m);
         found += cnt;
+        *close += (uint32_t)__builtin_popcount(_mm512_mask_cmp_ps_mask(m, dd, vc, _CMP_LT_OQ));
         const __m512i packed =
             _mm512_maskz_compress_epi32(m, _mm512_add_epi32(_mm512_set1_epi32((int)t), lane));
         if (kk + 16 <= K) {
@@ -200,7 +201,7 @@ AKP_AVX512 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
         }
         rho = _mm512_mul_ps(rho, _mm512_set1_ps(c->m));
         _mm512_mask_storeu_ps(c->rho + blk, B.lanes, rho);
-        __m512 C = _mm512_sub_ps(_mm512_div_ps(rho, _mm512_set1_ps(c->rho0)), _mm512_set1_ps(1.0f));
+        __m512 C = _mm512_sub_ps(_mm512_div_ps(rho, _mm512_set1_ps(c->rho_c)), _mm512_set1_ps(1.0f));
         if (!c->d.bilateral)
             C = _mm512_mask_mov_ps(C, _mm512_cmp_ps_mask(C, zero, _CMP_LT_OQ), zero);
         const __m512 gg = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(gx, gx), _mm512_mul_ps(gy, gy)),
@@ -221,7 +222,7 @@ AKP_AVX512 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
 }
 
 AKP_AVX512 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
-    const bool scorr = !c->d.disable_scorr && c->wdq > 0.0f;
+    const bool scorr = c->d.scorr && c->wdq > 0.0f;
     const __m512 negk = _mm512_set1_ps(-(c->d.scorr_k / c->grad2_rest)),
                  inv_wdq = _mm512_set1_ps(scorr ? 1.0f / c->wdq : 0.0f);
     const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -364,8 +365,8 @@ AKP_AVX512 void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
 
 bool akp_fluid_have_avx512(void) { return false; }
 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
-                                 float qy, float qz, uint32_t* list, uint32_t* k) {
-    (void)c, (void)begin, (void)end, (void)qx, (void)qy, (void)qz, (void)list, (void)k;
+                                 float qy, float qz, uint32_t* list, uint32_t* k, uint32_t* close) {
+    (void)c, (void)begin, (void)end, (void)qx, (void)qy, (void)qz, (void)list, (void)k, (void)close;
     return 0;
 }
 void akp_fluid_density_avx512(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }

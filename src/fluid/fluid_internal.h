@@ -49,6 +49,8 @@ typedef struct akp_fluid_ctx {
     int64_t cmin[3];  /* dense path: cell coordinates of the box's first cell */
     int64_t dim[3];   /* dense path: cells per axis */
     double inv_cell;  /* 1 / h in double (the grid's cell formula) */
+    float rho_c;      /* PBF: the density the constraint holds, m sum_j W_poly6 over the rest lattice */
+    float coincident2; /* squared distance below which two particles count as coincident */
     float wdq;        /* poly6 at delta q */
     float grad2_rest; /* sum_k |grad_k C|^2 of the rest lattice */
     float poly6_k;    /* 315 / (64 pi h^9) */
@@ -59,6 +61,7 @@ typedef struct akp_fluid_ctx {
     struct akp_fluid_team* team; /* fluid.c: the step's worker team (NULL: the caller alone) */
     /* per-thread results */
     size_t truncated[AKP_FLUID_MAX_THREADS];
+    size_t coincident[AKP_FLUID_MAX_THREADS];
 } akp_fluid_ctx;
 
 /* Neighbour q of sorted particle a is akp_fluid_nb(c, a)[16 q]: particles come in blocks of
@@ -73,10 +76,11 @@ static inline const uint32_t* akp_fluid_nb(const akp_fluid_ctx* c, size_t a) {
  * fluid.c, 16 particles at a time (one per lane), each summing its neighbours in list order
  * with the scalar phase's float operations: results are bit-identical to the scalar phases. */
 bool akp_fluid_have_avx512(void);
-/* Appends to list[*k] (capacity K) the candidates [begin, end) closer than sqrt(r2) to
- * (qx, qy, qz), in index order; returns the number found (also those beyond K). */
+/* Appends to list[*k] (capacity K) the candidates [begin, end) closer than h to (qx, qy, qz),
+ * in index order; returns the number found (also those beyond K) and adds to *close those
+ * closer than sqrt(coincident2) (the particle itself included). */
 uint32_t akp_fluid_filter_avx512(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
-                                 float qy, float qz, uint32_t* list, uint32_t* k);
+                                 float qy, float qz, uint32_t* list, uint32_t* k, uint32_t* close);
 void akp_fluid_density_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e);
@@ -86,7 +90,7 @@ void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 /* avx2.c: the same kernels on 8 lanes (each block of 16 as two halves), bit-identical too. */
 bool akp_fluid_have_avx2(void);
 uint32_t akp_fluid_filter_avx2(const akp_fluid_ctx* c, uint32_t begin, uint32_t end, float qx,
-                               float qy, float qz, uint32_t* list, uint32_t* k);
+                               float qy, float qz, uint32_t* list, uint32_t* k, uint32_t* close);
 void akp_fluid_density_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_delta_avx2(akp_fluid_ctx* c, size_t b, size_t e);

@@ -18,15 +18,17 @@ static const char* const usage =
     "             also choose wcsph (Becker & Teschner 2007)\n"
     "  --count    particles of a preset, 8 to 2000000 (default 4000): rounded up to fill the preset's\n"
     "             whole block of lattice cells, so the run may have a few more\n"
-    "  --steps    time steps, 0 to 10000000 (default: the scene's, 400)\n"
-    "  --dt       step in seconds, (0, 1] (default 1/400 for PBF, 0.0002 for SPH)\n"
+    "  --steps    time steps, 0 to 10000000 (default: the scene's \"steps\", else its \"duration\"\n"
+    "             (1 s) divided by the step)\n"
+    "  --dt       step in seconds, [1e-7, 1] (default 1/400 for PBF, 0.001 for SPH)\n"
     "  --threads  1 to 64 (default 1); results are identical for any count\n"
-    "  --json     final state {\"time\", \"particles\": [{\"p\", \"v\"}], \"max_density_error\",\n"
-    "             \"mean_density_error\"} (errors relative to rest density, over particles with\n"
-    "             full neighbourhoods)\n"
+    "  --json     final state {\"time\", \"particles\": [{\"p\", \"v\", \"rho\", \"pressure\"}],\n"
+    "             \"max_density_error\", \"mean_density_error\"} (SI units; errors relative to rest\n"
+    "             density, over particles with full neighbourhoods)\n"
     "  -o         OUT.png (last step), OUT.gif (up to 60 frames), OUT.obj (surface mesh of the\n"
     "             smoothed density, marching tetrahedra)\n"
-    "Prints one summary line. Exit 1 for a bad scene or a blow-up (the step is named).\n";
+    "Prints one summary line. Exit 1 for a bad scene or a liquid that blows up, collapses onto\n"
+    "itself or explodes (the step and the symptom are named).\n";
 
 /* ---- rendering: particles as shaded spheres ---------------------------------------------- */
 
@@ -267,9 +269,77 @@ static int write_obj(const char* path, const fluid_scene* s, const ak_vec3* p, s
     return cli_outfile_commit(&out, "fluid");
 }
 
+/* ---- health: a liquid that collapses or explodes fails like a blow-up ---------------------- */
+
+/* Mechanical energy E = sum m (|v|^2 / 2 - g . x) may only fall, apart from what emitters bring
+ * in (each emitted particle counted at its nozzle with its exit speed) and what moving colliders
+ * can give; a liquid whose energy rises above the start's by more than the slack has exploded.
+ * Slack: the mass of the largest particle count times (|g| L + 2 v^2), L the diagonal of the box
+ * (or of the initial particles and nozzles), v the fastest initial particle, nozzle or collider:
+ * the energy a liquid could gain falling across the whole scene and being struck by a collider. */
+typedef struct health {
+    double e0;        /* energy at the start plus what emitters brought in */
+    double emit_e;    /* largest energy per kg of an emitted particle */
+    double per_kg;    /* slack per kg */
+    size_t peak;      /* largest particle count so far */
+} health;
+
+static double energy(const fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n) {
+    const ak_vec3 g = s->desc.gravity;
+    double e = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        e += 0.5 * ak_vec3_dot(v[i], v[i]) - ((double)g.x * p[i].x + (double)g.y * p[i].y + (double)g.z * p[i].z);
+    return e * s->desc.particle_mass;
+}
+
+static void health_start(health* hl, const fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n) {
+    const ak_vec3 g = s->desc.gravity;
+    ak_vec3 lo = s->desc.box_min, hi = s->desc.box_max;
+    const bool box = lo.x < hi.x;
+    if (!box) lo = hi = n ? p[0] : s->emitter_count ? s->emitters[0].position : ak_vec3_make(0, 0, 0);
+    double vmax = 0.0;
+    hl->emit_e = -INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        vmax = fmax(vmax, ak_vec3_length(v[i]));
+        if (!box) lo = ak_vec3_min(lo, p[i]), hi = ak_vec3_max(hi, p[i]);
+    }
+    for (size_t k = 0; k < s->emitter_count; ++k) {
+        const ak_fluid_emitter* m = &s->emitters[k];
+        vmax = fmax(vmax, m->speed);
+        if (!box) lo = ak_vec3_min(lo, m->position), hi = ak_vec3_max(hi, m->position);
+        hl->emit_e = fmax(hl->emit_e, 0.5 * (double)m->speed * m->speed - ak_vec3_dot(g, m->position) +
+                                          ak_vec3_length(g) * m->radius);
+    }
+    for (size_t k = 0; k < s->collider_count; ++k) vmax = fmax(vmax, ak_vec3_length(s->colliders[k].velocity));
+    const double L = ak_vec3_length(ak_vec3_sub(hi, lo)) + 2.0 * s->desc.h;
+    hl->per_kg = ak_vec3_length(g) * L + 2.0 * vmax * vmax;
+    hl->e0 = energy(s, p, v, n);
+    hl->peak = n;
+}
+
+static int health_check(health* hl, const fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n,
+                        const ak_fluid_stats* st, long step) {
+    const double t = (double)step * s->dt;
+    if (st->emitted_count) hl->e0 += (double)st->emitted_count * s->desc.particle_mass * hl->emit_e;
+    hl->peak = n > hl->peak ? n : hl->peak;
+    /* a collapse: more than 5% of the particles (and at least 8) sit on another one */
+    if (st->coincident_count >= 8 && st->coincident_count * 20 > n)
+        return cli_fail("fluid", "collapse at step %ld (t = %.4g s): %zu of %zu particles sit on another particle "
+                        "(closer than 1%% of the rest spacing); lower --dt (now %g s)%s", step, t, st->coincident_count, n,
+                        (double)s->dt, s->desc.bilateral && s->desc.scorr ? " or scorr_k (bilateral + s_corr)" : "");
+    const double e = energy(s, p, v, n), slack = hl->per_kg * (double)hl->peak * s->desc.particle_mass;
+    if (e > hl->e0 + slack)
+        return cli_fail("fluid", "explosion at step %ld (t = %.4g s): the mechanical energy rose from %.4g J to %.4g J, "
+                        "more than gravity and the scene's speeds can give (%.4g J); lower --dt (now %g s)%s", step, t,
+                        hl->e0, e, slack, (double)s->dt,
+                        s->desc.bilateral && s->desc.scorr ? " or scorr_k (bilateral + s_corr)" : "");
+    return CLI_OK;
+}
+
 /* ---- the command ------------------------------------------------------------------------- */
 
-static int write_json(const char* path, float t, const ak_vec3* p, const ak_vec3* v, size_t n, const ak_fluid_stats* st) {
+static int write_json(const char* path, float t, const ak_vec3* p, const ak_vec3* v, const float* rho, const float* pres,
+                      size_t n, const ak_fluid_stats* st) {
     /* "-": stdout; a file: a temporary renamed over path once complete */
     cli_outfile out;
     memset(&out, 0, sizeof out);
@@ -280,8 +350,12 @@ static int write_json(const char* path, float t, const ak_vec3* p, const ak_vec3
     cli_json_write_number(f, t);
     fprintf(f, ", \"particles\": [");
     for (size_t i = 0; i < n; ++i) {
-        fprintf(f, "%s{\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g]}", i ? ", " : "", p[i].x, p[i].y, p[i].z,
-                v[i].x, v[i].y, v[i].z);
+        fprintf(f, "%s{\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g], \"rho\": ", i ? ", " : "", p[i].x, p[i].y,
+                p[i].z, v[i].x, v[i].y, v[i].z);
+        cli_json_write_number(f, rho[i]);
+        fprintf(f, ", \"pressure\": ");
+        cli_json_write_number(f, pres[i]);
+        fputc('}', f);
     }
     fprintf(f, "], \"max_density_error\": ");
     cli_json_write_number(f, st->max_density_error);
@@ -349,11 +423,12 @@ int cmd_fluid(int argc, char** argv) {
     }
     if (solver) {
         s->desc.solver = strcmp(solver, "sph") == 0 ? AK_FLUID_SPH : AK_FLUID_PBF;
-        if (!s->dt_set) s->dt = s->desc.solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f;
+        if (!s->dt_set) s->dt = fluid_scene_default_dt(s->desc.solver);
         if (s->desc.solver == AK_FLUID_SPH && s->desc.viscosity == 0.0f) s->desc.viscosity = 0.02f;
     }
     if (dt > 0.0f) s->dt = dt;
     if (steps >= 0) s->steps = steps;
+    s->steps = fluid_scene_steps(s);
 
     const size_t cap = fluid_scene_capacity(s);
     {
@@ -369,12 +444,14 @@ int cmd_fluid(int argc, char** argv) {
     ak_vec3* pos = calloc(cap ? cap : 1, sizeof *pos);
     ak_vec3* vel = calloc(cap ? cap : 1, sizeof *vel);
     uint8_t* flags = calloc(cap ? cap : 1, 1);
+    float* rho = calloc(cap ? cap : 1, sizeof *rho);
+    float* pres = calloc(cap ? cap : 1, sizeof *pres);
     const size_t bytes = ak_fluid_scratch_size(cap, &s->desc);
     void* scratch = bytes ? malloc(bytes) : NULL;
     renderer ren;
     memset(&ren, 0, sizeof ren);
     ak_gif_writer* gw = NULL;
-    if (!pos || !vel || !flags || !scratch) {
+    if (!pos || !vel || !flags || !rho || !pres || !scratch) {
         rc = cli_fail("fluid", "out of memory for %zu particles", cap);
         goto done;
     }
@@ -396,7 +473,9 @@ int cmd_fluid(int argc, char** argv) {
                              .particle_count = &n, .colliders = {s->colliders, s->collider_count},
                              .emitters = {s->emitters, s->emitter_count}, .sinks = {s->sinks, s->sink_count},
                              .thread_count = (uint32_t)threads, .scratch = {scratch, bytes}, .out_flags = {flags, cap},
-                             .out_stats = &st};
+                             .out_densities = {rho, cap}, .out_pressures = {pres, cap}, .out_stats = &st};
+    health hl;
+    health_start(&hl, s, pos, vel, n);
     const long frame_every = s->steps > 60 ? (s->steps + 59) / 60 : 1;
     const double t0 = cli_now();
     for (long k = 0; k < s->steps; ++k) {
@@ -411,6 +490,8 @@ int cmd_fluid(int argc, char** argv) {
             rc = cli_fail("fluid", "step %ld: %s", k + 1, ak_result_string(res));
             goto done;
         }
+        rc = health_check(&hl, s, pos, vel, n, &st, k + 1);
+        if (rc) goto done;
         /* colliders with a velocity move with it */
         for (size_t c = 0; c < s->collider_count; ++c) {
             ak_vec3 dv = ak_vec3_scale(s->colliders[c].velocity, s->dt);
@@ -437,6 +518,7 @@ int cmd_fluid(int argc, char** argv) {
             rc = cli_fail("fluid", "%s: %s", out, ak_result_string(res));
             goto done;
         }
+        cli_wrote(out, "%zu particles over %ld steps", n, s->steps);
     }
     if (png) {
         ak_image img;
@@ -446,15 +528,18 @@ int cmd_fluid(int argc, char** argv) {
             rc = cli_fail("fluid", "%s: %s", out, ak_result_string(res));
             goto done;
         }
+        cli_wrote(out, "the last step");
     }
     if (obj) {
         rc = write_obj(out, s, pos, n);
         if (rc) goto done;
+        cli_wrote(out, "the liquid's surface");
     }
     const char* json = CLI_GET(&a, "--json");
     if (json) {
-        rc = write_json(json, t_end, pos, vel, n, &st);
+        rc = write_json(json, t_end, pos, vel, rho, pres, n, &st);
         if (rc) goto done;
+        if (strcmp(json, "-") != 0) cli_wrote(json, "%zu particles", n);
     }
     static const char* const names[] = {"pbf", "sph", "wcsph"};
     fprintf(json && strcmp(json, "-") == 0 ? stderr : stdout,
@@ -465,6 +550,6 @@ int cmd_fluid(int argc, char** argv) {
 done:
     ak_gif_writer_discard(gw); /* a failed run leaves no partial GIF */
     renderer_free(&ren);
-    free(pos), free(vel), free(flags), free(scratch), free(s);
+    free(pos), free(vel), free(flags), free(rho), free(pres), free(scratch), free(s);
     return rc;
 }

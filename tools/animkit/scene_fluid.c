@@ -16,7 +16,18 @@ void fluid_scene_defaults(fluid_scene* s) {
     s->desc.sound_speed = 20.0f;
     s->desc.tait_gamma = 7.0f;
     s->h_ratio = 2.0f;
-    s->steps = 400;
+    s->duration = 1.0f;
+    s->steps = -1;
+}
+
+float fluid_scene_default_dt(ak_fluid_solver solver) {
+    return solver == AK_FLUID_PBF ? 1.0f / 400.0f : solver == AK_FLUID_SPH ? 1e-3f : 2e-4f;
+}
+
+long fluid_scene_steps(const fluid_scene* s) {
+    if (s->steps >= 0) return s->steps;
+    const double k = ceil((double)s->duration / (double)s->dt - 1e-3); /* 1 s / 0.0025f is 400.00001 */
+    return k < 1.0 ? 1 : k > (double)FLUID_SCENE_MAX_STEPS ? FLUID_SCENE_MAX_STEPS : (long)k;
 }
 
 static float lattice_spacing(const fluid_scene* s) { return ak_fluid_rest_spacing(&s->desc); }
@@ -64,7 +75,7 @@ bool fluid_scene_parse(cli_json* j, const char* text, size_t size, fluid_scene* 
     cJSON* root = cli_json_parse(j, text, size);
     if (!root) return false;
     static const char* const keys[] = {"solver", "particle_mass", "rest_density", "h_ratio", "gravity", "dt",
-                                       "steps", "iterations", "relaxation", "bilateral", "scorr", "scorr_k",
+                                       "duration", "steps", "iterations", "relaxation", "bilateral", "scorr", "scorr_k",
                                        "scorr_n", "scorr_dq", "xsph", "vorticity", "stiffness", "viscosity",
                                        "sound_speed", "tait_gamma", "box", "friction", "max_neighbours",
                                        "max_particles", "blocks", "colliders", "emitters", "sinks", NULL};
@@ -81,15 +92,14 @@ bool fluid_scene_parse(cli_json* j, const char* text, size_t size, fluid_scene* 
     parse_vec_in(j, root, "", "gravity", &d->gravity);
     if (cJSON_GetObjectItemCaseSensitive(root, "dt")) s->dt_set = true;
     cli_json_float(j, root, "", "dt", 1e-7f, 1.0f, &s->dt);
+    cli_json_float(j, root, "", "duration", 1e-6f, 1e6f, &s->duration);
     cli_json_int(j, root, "", "steps", 0, FLUID_SCENE_MAX_STEPS, &s->steps);
     long it = d->iterations;
     cli_json_int(j, root, "", "iterations", 1, 1000, &it);
     d->iterations = (uint32_t)it;
     cli_json_float(j, root, "", "relaxation", 0.0f, 1e30f, &d->relaxation);
     cli_json_bool(j, root, "", "bilateral", &d->bilateral);
-    bool scorr = true;
-    cli_json_bool(j, root, "", "scorr", &scorr);
-    d->disable_scorr = !scorr;
+    cli_json_bool(j, root, "", "scorr", &d->scorr);
     cli_json_float(j, root, "", "scorr_k", 0.0f, 10.0f, &d->scorr_k);
     cli_json_float(j, root, "", "scorr_n", 0.0f, 16.0f, &d->scorr_n);
     cli_json_float(j, root, "", "scorr_dq", 0.0f, 0.99f, &d->scorr_dq);
@@ -194,7 +204,7 @@ bool fluid_scene_parse(cli_json* j, const char* text, size_t size, fluid_scene* 
     cJSON_Delete(root);
     if (j->failed) return false;
     d->h = s->h_ratio * lattice_spacing(s);
-    if (!s->dt_set) s->dt = d->solver == AK_FLUID_PBF ? 1.0f / 400.0f : 2e-4f;
+    if (!s->dt_set) s->dt = fluid_scene_default_dt(d->solver);
     const size_t n0 = fluid_scene_initial_count(s);
     if (n0 > FLUID_SCENE_MAX_PARTICLES)
         return cli_json_fail(j, "blocks", NULL, "the blocks hold more than %u particles", FLUID_SCENE_MAX_PARTICLES);

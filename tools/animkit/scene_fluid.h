@@ -22,8 +22,9 @@ typedef struct fluid_block {
 typedef struct fluid_scene {
     ak_fluid_desc desc;    /* h = h_ratio * rest spacing */
     float h_ratio;         /* default 2 */
-    float dt;              /* default 1/400 (PBF) or 2e-4 (SPH, WCSPH) */
-    long steps;            /* default 400 */
+    float dt;              /* default 1/400 (PBF), 1e-3 (SPH) or 2e-4 (WCSPH) */
+    float duration;        /* simulated seconds when steps is not given; default 1 */
+    long steps;            /* default (-1): ceil(duration / dt), see fluid_scene_steps */
     long max_particles;    /* capacity; default: initial particles + 20000 when emitters exist */
     size_t block_count, collider_count, emitter_count, sink_count;
     fluid_block blocks[FLUID_SCENE_MAX_ITEMS];
@@ -42,6 +43,10 @@ bool fluid_scene_parse(cli_json* j, const char* text, size_t size, fluid_scene* 
 /* Build a preset ("dam", "pour", "splash") of about count particles (0 -> 4000). False for an
  * unknown name. */
 bool fluid_scene_preset(const char* name, long count, fluid_scene* out);
+/* The default step of a solver: 1/400 s (PBF), 1e-3 s (SPH), 2e-4 s (WCSPH). */
+float fluid_scene_default_dt(ak_fluid_solver solver);
+/* The steps to run: s->steps when given, else ceil(duration / dt) (at least 1). */
+long fluid_scene_steps(const fluid_scene* s);
 /* Particles the blocks hold (lattice count) and the capacity to allocate. */
 size_t fluid_scene_initial_count(const fluid_scene* s);
 size_t fluid_scene_capacity(const fluid_scene* s);
