@@ -215,8 +215,8 @@ AK_TEST(read_only_folder) {
 }
 
 int main(void) {
-    AK_RUN(file_size_limit_leaves_no_file);
-    AK_RUN(failed_write_keeps_symlink_and_existing_file);
+    AK_RUN_SLOW(file_size_limit_leaves_no_file);
+    AK_RUN_SLOW(failed_write_keeps_symlink_and_existing_file);
     AK_RUN(read_only_folder);
     return ak_test_finish();
 }

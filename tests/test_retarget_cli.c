@@ -71,6 +71,6 @@ AK_TEST(map_file_kinds) {
 }
 
 int main(void) {
-    AK_RUN(map_file_kinds);
+    AK_RUN_SLOW(map_file_kinds);
     return ak_test_finish();
 }
