@@ -272,6 +272,107 @@ AK_TEST(isometric_bending) {
     sim_free(&s);
 }
 
+/* ---- substeps and translation: the hinge pendulum ----------------------------------------- */
+
+/* Complete elliptic integral of the first kind K(k) = pi / (2 AGM(1, sqrt(1 - k^2))), in double. */
+static double elliptic_k(double k) {
+    double a = 1.0, b = sqrt(1.0 - k * k);
+    for (int i = 0; i < 40 && fabs(a - b) > 1e-16 * a; ++i) {
+        const double m = 0.5 * (a + b);
+        b = sqrt(a * b);
+        a = m;
+    }
+    return 3.14159265358979323846 / (2.0 * a);
+}
+
+typedef struct swing {
+    double period;    /* s: mean time between upward zero crossings */
+    double amplitude; /* rad: largest |angle| after the release */
+    double last_amplitude; /* rad: largest |angle| over the last full period */
+    int crossings;
+} swing;
+
+#define HINGE_L 0.5
+#define HINGE_THETA0 0.35
+
+/* A 2 x 2 cloth (spacing L) pinned along its top edge and released at theta0 from the vertical:
+ * a rigid hinge pendulum (rigid constraints). The angle is that of the bottom edge's midpoint
+ * about the hinge, in double from the float positions. Runs `seconds` of 0.01 s steps. */
+static swing hinge_pendulum(uint32_t substeps, ak_vec3 offset, float seconds) {
+    swing out = {0, 0, 0, 0};
+    const float L = (float)HINGE_L, th0 = (float)HINGE_THETA0;
+    /* the float geometry as it lands 1 km away (the farthest offset the test uses), moved to
+     * `offset` by exact float subtractions and additions: every scene has the same edge vectors
+     * and rest lengths to the bit, so only where it is differs */
+    const ak_vec3 far = ak_vec3_make(577.35f, 577.35f, -577.35f), u = {L, 0, 0}, v = {0, -L * cosf(th0), L * sinf(th0)};
+    ak_vec3 p[4] = {far, ak_vec3_add(far, u), ak_vec3_add(far, v), ak_vec3_add(ak_vec3_add(far, u), v)};
+    for (int k = 0; k < 4; ++k) p[k] = ak_vec3_add(ak_vec3_sub(p[k], far), offset);
+    uint32_t tris[6] = {0, 3, 1, 0, 2, 3}; /* facing u x v, like a grid's */
+    uint32_t pins[2] = {0, 1};
+    ak_cloth_desc d = {.positions = AK_SPAN(p), .indices = AK_SPAN(tris), .pins = AK_SPAN(pins),
+                       .stretch_stiffness = INFINITY};
+    sim s;
+    if (!sim_init(&s, &d)) return out;
+    ak_vec3 res[4] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    s.job.dt = 0.01f;
+    s.job.substeps = substeps;
+    s.job.position_residuals = (ak_vec3_span)AK_SPAN(res);
+    sim_scratch(&s);
+    const int steps = (int)(seconds / 0.01f + 0.5f);
+    double prev = HINGE_THETA0, first = -1, last = -1, since = 0;
+    for (int f = 1; f <= steps; ++f) {
+        if (ak_cloth_step_run(&s.job) != AK_OK) return out;
+        /* bottom midpoint relative to the hinge's midpoint, in double */
+        const double y = 0.5 * (((double)s.x[2].y - s.x[0].y) + ((double)s.x[3].y - s.x[1].y) + res[2].y + res[3].y);
+        const double z = 0.5 * (((double)s.x[2].z - s.x[0].z) + ((double)s.x[3].z - s.x[1].z) + res[2].z + res[3].z);
+        const double th = atan2(z, -y);
+        out.amplitude = fmax(out.amplitude, fabs(th));
+        since = fmax(since, fabs(th));
+        if (prev < 0.0 && th >= 0.0) { /* upward crossing, linearly interpolated */
+            const double t = 0.01 * ((double)(f - 1) + prev / (prev - th));
+            if (first < 0) first = t;
+            else out.last_amplitude = since;
+            last = t;
+            out.crossings++;
+            since = 0;
+        }
+        prev = th;
+    }
+    out.period = out.crossings > 1 ? (last - first) / (out.crossings - 1) : 0.0;
+    sim_free(&s);
+    return out;
+}
+
+/* The period within 0.5% of the exact 4 sqrt(L/g) K(sin(theta0/2)) for 5 to 100 substeps, the
+ * amplitude not growing; 1 km from the origin the same within 1e-4 relative. */
+AK_TEST(hinge_pendulum_period_substeps_translation) {
+    const double exact = 4.0 * sqrt(HINGE_L / (double)G) * elliptic_k(sin(0.5 * HINGE_THETA0));
+    const uint32_t subs[] = {5, 10, 20, 40, 80, 100};
+    for (size_t k = 0; k < sizeof subs / sizeof subs[0]; ++k) {
+        const swing w = hinge_pendulum(subs[k], ak_vec3_make(0, 0, 0), 6.0f);
+        const double err = w.period / exact - 1.0;
+        printf("  %3u substeps: period %.5f s (exact %.5f, %+.3f%%), amplitude %.4f rad, last period %.4f\n", subs[k],
+               w.period, exact, 100.0 * err, w.amplitude, w.last_amplitude);
+        AK_CHECK_MSG(w.crossings >= 3, "%u substeps: %d crossings", subs[k], w.crossings);
+        AK_CHECK_MSG(fabs(err) < 0.005, "%u substeps: period off by %.3f%%", subs[k], 100.0 * err);
+        AK_CHECK_MSG(w.amplitude < HINGE_THETA0 * 1.001, "%u substeps: amplitude grew to %.4f", subs[k], w.amplitude);
+        AK_CHECK_MSG(w.last_amplitude < HINGE_THETA0 * 1.001, "%u substeps: amplitude grew to %.4f", subs[k], w.last_amplitude);
+    }
+    const ak_vec3 far[2] = {{0, 1000, 0}, {577.35f, 577.35f, -577.35f}};
+    const uint32_t far_subs[2] = {10, 100};
+    for (int q = 0; q < 2; ++q)
+        for (int k = 0; k < 2; ++k) {
+            const swing a = hinge_pendulum(far_subs[k], ak_vec3_make(0, 0, 0), 12.0f);
+            const swing b = hinge_pendulum(far_subs[k], far[q], 12.0f);
+            const double dp = fabs(b.period / a.period - 1.0), da = fabs(b.amplitude / a.amplitude - 1.0);
+            printf("  1 km away (%g, %g, %g), %u substeps: period %.6f vs %.6f s (%.1e), amplitude %.5f vs %.5f (%.1e)\n",
+                   (double)far[q].x, (double)far[q].y, (double)far[q].z, far_subs[k], b.period, a.period, dp,
+                   b.amplitude, a.amplitude, da);
+            AK_CHECK_MSG(dp < 1e-4 && da < 1e-4, "1 km away, %u substeps: period %.2e, amplitude %.2e relative", far_subs[k],
+                         dp, da);
+        }
+}
+
 /* ---- XPBD vs PBD ------------------------------------------------------------------------ */
 
 /* Mean stretch of the vertical structural edges of a hanging cloth at rest. */
@@ -672,6 +773,7 @@ int main(void) {
     AK_RUN(single_spring_static_stretch);
     AK_RUN(dihedral_gradient);
     AK_RUN(isometric_bending);
+    AK_RUN(hinge_pendulum_period_substeps_translation);
     AK_RUN(xpbd_stretch_independent_of_substeps);
     AK_RUN(drape_no_penetration_and_rest);
     AK_RUN(mesh_collider);

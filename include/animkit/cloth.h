@@ -249,6 +249,12 @@ typedef struct ak_cloth_step_job {
                                       this one (out of range: AK_ERR_BAD_ARG) */
     ak_vec3_span positions;        /* required, count == vertex count: in and out */
     ak_vec3_span velocities;       /* required, count == vertex count: in and out */
+    ak_vec3_span position_residuals; /* optional, count == vertex count, in and out (start them at
+                                      zero): what a float position cannot hold, so that
+                                      positions + residuals carry about 48 bits. Far from the
+                                      origin (1 km: float spacing 6e-5 m) a step otherwise rounds
+                                      every position once; with residuals the motion is the
+                                      same as near the origin. Empty -> rounded */
     ak_vec3_span out_normals;      /* optional, count >= vertex count: smooth normals after the step */
     ak_u8_span scratch;            /* required, size >= ak_cloth_step_scratch_size(job) */
 } ak_cloth_step_job;
@@ -259,12 +265,12 @@ AK_API size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job);
 
 /* First failing rule: AK_ERR_NULL_ARG (job, cloth, positions, velocities or scratch empty, a
  * collider count without its array, attachments without targets), AK_ERR_BAD_ARG (dt <= 0 or
- * non-finite, thread_count > 64, substeps or iterations > 10000, simd_limit out of range, negative or non-finite drag,
+ * non-finite, position_residuals count != vertex count when given, thread_count > 64, substeps or iterations > 10000, simd_limit out of range, negative or non-finite drag,
  * lift, air density, damping, thickness, friction or self_distance, a negative radius, collider mesh indices
  * not a multiple of 3, positions/velocities count != vertex count, attachment_targets count !=
  * attachment count), AK_ERR_SPAN_SMALL (out_normals or scratch too small), AK_ERR_BAD_INDEX (a
  * collider mesh index out of range), AK_ERR_BAD_DATA (a non-finite position, velocity,
- * gravity, wind, collider or target). A zero-initialised job gives AK_ERR_NULL_ARG. */
+ * gravity, wind, collider, target or residual). A zero-initialised job gives AK_ERR_NULL_ARG. */
 AK_API ak_result ak_cloth_step_validate(const ak_cloth_step_job* job);
 /* Validate, then step (writes nothing on a validation failure). Returns
  * AK_ERR_NO_CONVERGENCE when the state became non-finite (a blow-up: the spring solver with too

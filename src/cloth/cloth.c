@@ -68,8 +68,10 @@ static bool isometric_weights(const ak_vec3 x[4], float k, akp_bend* e) {
     const float a1 = 0.5f * ak_vec3_length(ak_vec3_cross(ak_vec3_sub(x[3], x[2]), ak_vec3_sub(x[1], x[2])));
     if (!(a0 > 1e-20f) || !(a1 > 1e-20f) || !ak_finitef(c01 + c02 + c03 + c04)) return false;
     e->K[0] = -c01 - c03, e->K[1] = -c02 - c04, e->K[2] = c03 + c04, e->K[3] = c01 + c02;
+    /* b = sum_{q != 2} K_q (x_q - x_2), as the step computes it (the weights sum to zero) */
     ak_vec3 bv = ak_vec3_make(0, 0, 0);
-    for (int q = 0; q < 4; ++q) bv = ak_vec3_madd(bv, x[q], e->K[q]);
+    for (int q = 0; q < 4; ++q)
+        if (q != 2) bv = ak_vec3_add(bv, ak_vec3_scale(ak_vec3_sub(x[q], x[2]), e->K[q]));
     e->rest = ak_vec3_length(bv);
     e->alpha = isinf(k) ? 0.0f : (a0 + a1) / (3.0f * k);
     return true;
@@ -566,9 +568,10 @@ ak_result ak_cloth_energy_compute(const ak_cloth* cloth, ak_vec3_cspan positions
         if (iso) {
             double b[3] = {0, 0, 0};
             for (int q = 0; q < 4; ++q) {
-                b[0] += (double)cloth->bend[k].K[q] * x[q].x;
-                b[1] += (double)cloth->bend[k].K[q] * x[q].y;
-                b[2] += (double)cloth->bend[k].K[q] * x[q].z;
+                if (q == 2) continue;
+                b[0] += (double)cloth->bend[k].K[q] * ((double)x[q].x - x[2].x);
+                b[1] += (double)cloth->bend[k].K[q] * ((double)x[q].y - x[2].y);
+                b[2] += (double)cloth->bend[k].K[q] * ((double)x[q].z - x[2].z);
             }
             const double C = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]) - cloth->bend[k].rest;
             if (cloth->bend[k].alpha > 0.0f) e.elastic += 0.5 * C * C / cloth->bend[k].alpha;

@@ -87,7 +87,7 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
     int rc = CLI_OK;
     ak_result r = AK_OK;
     ak_cloth* cloth = NULL;
-    ak_vec3 *x = NULL, *vel = NULL, *nrm = NULL, *targets = NULL;
+    ak_vec3 *x = NULL, *vel = NULL, *nrm = NULL, *targets = NULL, *res = NULL;
     uint8_t* scratch = NULL;
     uint32_t* attach_idx = NULL;
     ak_cloth_capsule* caps = NULL;
@@ -114,8 +114,9 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
     x = malloc(n * sizeof(ak_vec3));
     vel = calloc(n, sizeof(ak_vec3));
     nrm = malloc(n * sizeof(ak_vec3));
+    res = calloc(n, sizeof(ak_vec3));
     targets = calloc(sc->attach_count + 1, sizeof(ak_vec3));
-    if (!x || !vel || !nrm || !targets) {
+    if (!x || !vel || !nrm || !targets || !res) {
         rc = cli_fail(cmd, "out of memory");
         goto done;
     }
@@ -204,7 +205,7 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
         .thickness = sc->thickness, .friction = sc->friction, .self_collision = sc->self_collision,
         .self_distance = sc->self_distance,
         .attachment_targets = {targets, sc->attach_count}, .thread_count = (uint32_t)sc->thread_count,
-        .positions = {x, n}, .velocities = {vel, n}, .out_normals = {nrm, n},
+        .positions = {x, n}, .velocities = {vel, n}, .position_residuals = {res, n}, .out_normals = {nrm, n},
     };
     if (ch->scene && sc->mesh_collider && ch->mesh_tris)
         job.mesh = (ak_cloth_collider_mesh){{ch->mesh_pos, ch->mesh_vertices}, {ch->mesh_idx, ch->mesh_tris * 3}};
@@ -220,7 +221,7 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
 
 done:
     run->cloth = cloth;
-    run->x = x, run->vel = vel, run->nrm = nrm, run->targets = targets;
+    run->x = x, run->vel = vel, run->nrm = nrm, run->targets = targets, run->res = res;
     run->scratch = scratch, run->attach_idx = attach_idx, run->caps = caps;
     run->n = n;
     run->job = job;
@@ -287,7 +288,7 @@ void cloth_run_bounds(const cloth_run* run, ak_vec3* out_lo, ak_vec3* out_hi) {
 
 void cloth_run_free(cloth_run* run) {
     cloth_character_free(&run->ch);
-    free(run->x), free(run->vel), free(run->nrm), free(run->targets), free(run->scratch), free(run->attach_idx), free(run->caps);
+    free(run->x), free(run->res), free(run->vel), free(run->nrm), free(run->targets), free(run->scratch), free(run->attach_idx), free(run->caps);
     ak_cloth_destroy(run->cloth);
     memset(run, 0, sizeof *run);
 }
