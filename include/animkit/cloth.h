@@ -168,6 +168,20 @@ AK_API ak_cloth_desc ak_cloth_get_desc(const ak_cloth* cloth);
  * (count >= vertex count). Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_cloth_rest_positions(const ak_cloth* cloth, ak_vec3_span out_positions);
 
+/* Largest stable substep h (seconds) of the spring solver for this cloth: the mass-spring
+ * system's linearisation at rest, x'' = -M^-1 K x - M^-1 D x', under semi-implicit Euler is
+ * stable while h^2 omega^2 + 2 h gamma < 4, with omega^2 and gamma bounded (Gershgorin on
+ * M^-1/2 K M^-1/2, and on D) by
+ *     omega^2 <= max_i sum_{springs s = (i, j)} k_s (w_i + sqrt(w_i w_j)),
+ *     gamma   <= max_i sum_{springs s = (i, j)} c   (w_i + sqrt(w_i w_j))
+ * over the free particles i (w = 1/m the inverse masses, k_s the spring's stiffness, c =
+ * spring_damping): h = (sqrt(gamma^2 + 4 omega^2) - gamma) / omega^2, i.e. 2 / omega without
+ * damping. The stiffest springs on the lightest particle decide it. Substeps of dt / h or more
+ * keep the spring solver stable (a stretched spring's transverse stiffness stays below k; wind
+ * drag is not counted). INFINITY for the other solvers (unconditionally stable) and for a
+ * cloth without springs on a free particle; 0 for a NULL cloth. */
+AK_API float ak_cloth_stable_substep(const ak_cloth* cloth);
+
 /* ---- colliders ------------------------------------------------------------------------ */
 
 typedef struct ak_cloth_plane {

@@ -155,6 +155,28 @@ static ak_result check_desc(const ak_cloth_desc* d, const ak_allocator* alloc) {
     return AK_OK;
 }
 
+/* The spring solver's stable substep (ak_cloth_stable_substep): Gershgorin row sums per
+ * particle in row[n] (caller's memory), in double. */
+static float spring_stable_h(const ak_cloth* c, double* row) {
+    double omega2 = 0.0, gamma = 0.0;
+    for (int pass = 0; pass < 2; ++pass) {
+        memset(row, 0, c->n * sizeof(double));
+        for (size_t k = 0; k < c->dist_count; ++k) {
+            const akp_dist* d = &c->dist[k];
+            const double wi = c->inv_mass[d->i], wj = c->inv_mass[d->j], x = sqrt(wi * wj);
+            const double s = pass ? (double)c->desc.spring_damping : (double)d->k;
+            row[d->i] += s * (wi + x);
+            row[d->j] += s * (wj + x);
+        }
+        double m = 0.0;
+        for (size_t v = 0; v < c->n; ++v) m = fmax(m, row[v]);
+        if (pass) gamma = m;
+        else omega2 = m;
+    }
+    if (!(omega2 > 0.0) || !isfinite(omega2)) return INFINITY;
+    return (float)((sqrt(gamma * gamma + 4.0 * omega2) - gamma) / omega2);
+}
+
 /* ---- create ----------------------------------------------------------------------------- */
 
 typedef struct build {
@@ -458,6 +480,8 @@ ak_result ak_cloth_create(const ak_cloth_desc* desc_in, const ak_allocator* allo
             c->lra_dist[v] = best * (1.0f + d.long_range_slack);
         }
     }
+    c->desc = d; /* (the spans are set below) */
+    c->stable_h = spring_stable_h(c, (double*)used); /* n uint64 hold n doubles */
     /* vertex -> triangles (CSR, each vertex's triangles in increasing order) */
     for (size_t k = 0; k < nt * 3; ++k) c->vt_start[c->indices[k] + 1]++;
     for (size_t v = 0; v < n; ++v) c->vt_start[v + 1] += c->vt_start[v];
@@ -508,6 +532,11 @@ ak_result ak_cloth_rest_positions(const ak_cloth* cloth, ak_vec3_span out_positi
     memcpy(out_positions.ptr, cloth->rest, cloth->n * sizeof(ak_vec3));
     for (size_t k = 0; k < cloth->pin_count; ++k) out_positions.ptr[cloth->pins[k]] = cloth->pin_pos[k];
     return AK_OK;
+}
+
+float ak_cloth_stable_substep(const ak_cloth* cloth) {
+    if (!cloth) return 0.0f;
+    return cloth->desc.solver == AK_CLOTH_SPRINGS ? cloth->stable_h : INFINITY;
 }
 
 ak_result ak_cloth_normals(const ak_cloth* cloth, ak_vec3_cspan positions, ak_vec3_span out_normals) {

@@ -54,6 +54,7 @@ struct ak_cloth {
     float* lra_dist;      /* [n] allowed distance */
     uint32_t* vt_start;   /* [n + 1] CSR: triangles around each vertex */
     uint32_t* vt_tri;     /* [3 tri_count] */
+    float stable_h;       /* the spring solver's largest stable substep (s), INFINITY: none */
 };
 
 /* Dihedral angle of a bending element (wings x0, x1, edge x2 -> x3) and its gradient (grad NULL

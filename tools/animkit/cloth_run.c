@@ -110,6 +110,23 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
         rc = cli_fail(cmd, "%s: the cloth cannot be built: %s", name, ak_result_string(r));
         goto done;
     }
+    /* the spring solver is stable only below a substep it computes (ak_cloth_stable_substep):
+     * run at least dt / (0.9 h) substeps unless --substeps says otherwise */
+    if (sc->desc.solver == AK_CLOTH_SPRINGS) {
+        const double h = ak_cloth_stable_substep(cloth);
+        const double need = ceil((double)sc->dt / (0.9 * h));
+        if (isfinite(need) && need > (double)sc->substeps && !sc->substeps_forced) {
+            fprintf(stderr, "%s: mass-spring is stable below h = %.4g ms (the stiffest springs on the lightest particle, "
+                            "docs/cloth.md): %.0f substeps per step instead of %u\n",
+                    cmd, 1e3 * h, need, sc->substeps);
+            if (need > 10000.0) {
+                rc = cli_fail(cmd, "%s: the spring solver needs %.0f substeps per step (over 10000): lower dt or the "
+                                   "stiffness, or use --solver implicit or xpbd", name, need);
+                goto done;
+            }
+            sc->substeps = (uint32_t)need;
+        }
+    }
     n = ak_cloth_vertex_count(cloth);
     x = malloc(n * sizeof(ak_vec3));
     vel = calloc(n, sizeof(ak_vec3));

@@ -124,7 +124,7 @@ int cmd_cloth(int argc, char** argv) {
     }
     if (!rc && (v = CLI_GET(&a, "--substeps"))) {
         if (!cli_parse_int(v, 1, 10000, &lv)) rc = cli_usage("cloth", "--substeps must be 1..10000");
-        else sc.substeps = (uint32_t)lv;
+        else sc.substeps = (uint32_t)lv, sc.substeps_forced = true;
     }
     if (!rc && (v = CLI_GET(&a, "--threads"))) {
         if (!cli_parse_int(v, 1, 64, &lv)) rc = cli_usage("cloth", "--threads must be 1..64");
@@ -145,12 +145,12 @@ int cmd_cloth(int argc, char** argv) {
     memset(&bake, 0, sizeof bake);
 
     memset(&run, 0, sizeof run);
-    rc = cli_work_check("cloth",
+    rc = cloth_run_init(&run, &sc, "cloth", name); /* (the spring solver's substeps are known after it) */
+    if (!rc) rc = cli_work_check("cloth",
                         (double)sc.desc.grid_width * (double)sc.desc.grid_height * (double)sc.steps *
                             (double)sc.substeps * (double)sc.iterations,
                         "particle updates (particles x steps x substeps x iterations)",
                         "--steps, --substeps, the scene's \"iterations\" or the grid size");
-    if (!rc) rc = cloth_run_init(&run, &sc, "cloth", name);
     if (rc) goto done;
     if (sim_bake_wanted(out) && (rc = sim_bake_mesh_init(&bake, "cloth", out, run.n, sc.steps))) goto done;
     cloth_character* const ch = &run.ch;

@@ -29,6 +29,8 @@ typedef struct cloth_scene {
     float dt;                  /* seconds per step */
     long steps;
     uint32_t substeps, iterations;
+    bool substeps_forced;      /* --substeps given: the spring solver keeps it even below its
+                                  stable count (otherwise it runs at least that count) */
     ak_vec3 gravity, wind;
     float gust;                /* wind *= 1 + gust * sin(2 pi gust_frequency t) */
     float gust_frequency;
