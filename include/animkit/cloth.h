@@ -15,6 +15,13 @@
  *       AK_CLOTH_SPRINGS: the classic mass-spring model: structural, shear and bending springs
  *         (Hooke plus damping along the spring), semi-implicit (symplectic) Euler, v += h a,
  *         x += h v; stable only for h below about 2 sqrt(m/k), so it needs small steps;
+ *       AK_CLOTH_IMPLICIT: the same springs under implicit (backward) Euler, linearised once per
+ *         substep and solved by conjugate gradients (Baraff & Witkin 1998): (M + h D + h^2 K) dv
+ *         = h (f + h (df/dx) v) with K = -df/dx, D = -df/dv assembled from the springs (the
+ *         transverse stiffness of a compressed spring clamped at zero so the system stays
+ *         positive definite), Jacobi-preconditioned CG in double with the pinned and attached
+ *         particles' velocity changes fixed by a filter (their modified CG); stable at any
+ *         step, with numerical damping that grows with h; on the calling thread only;
  *       AK_CLOTH_PBD: plain position-based dynamics (Mueller et al. 2007): the same constraints
  *         projected with a per-projection stiffness factor in (0, 1]; its effective stiffness
  *         depends on the substep and iteration counts (the problem XPBD solves);
@@ -72,12 +79,13 @@ typedef enum ak_cloth_solver {
     AK_CLOTH_XPBD = 0,   /* default: compliant constraints, substeps */
     AK_CLOTH_SPRINGS,    /* mass-spring, semi-implicit Euler */
     AK_CLOTH_PBD,        /* plain PBD with a stiffness factor (for comparison) */
+    AK_CLOTH_IMPLICIT,   /* mass-spring, implicit (backward) Euler (Baraff & Witkin 1998) */
     AK_CLOTH_SOLVER_COUNT
 } ak_cloth_solver;
 
 typedef enum ak_cloth_bending {
-    AK_CLOTH_BEND_DEFAULT = 0, /* -> DIHEDRAL for XPBD and PBD; the spring solver always uses SPRINGS
-                                  (or NONE) */
+    AK_CLOTH_BEND_DEFAULT = 0, /* -> DIHEDRAL for XPBD and PBD; the spring solvers (SPRINGS,
+                                  IMPLICIT) always use SPRINGS (or NONE) */
     AK_CLOTH_BEND_DIHEDRAL,    /* angle between the two triangles of each interior edge */
     AK_CLOTH_BEND_SPRINGS,     /* distance between the wing vertices of each interior edge (grid:
                                   particles two apart along each axis) */
@@ -121,7 +129,7 @@ typedef struct ak_cloth_desc {
                                     XPBD compliance 1/k) and of isometric bending (N m); 0 -> 1e-4
                                     (cotton-like: a draped sheet folds) */
     ak_cloth_bending bending;    /* 0 -> see ak_cloth_bending */
-    float spring_damping;        /* SPRINGS: N s/m along each spring; 0 -> none */
+    float spring_damping;        /* SPRINGS, IMPLICIT: N s/m along each spring; 0 -> none */
     float constraint_damping;    /* XPBD: beta (s) of the paper's eq. 26, stiffness-proportional
                                     damping; 0 -> none */
     float pbd_stiffness;         /* PBD: factor (0, 1] applied to each projection; 0 -> 1 */
@@ -140,7 +148,7 @@ typedef struct ak_cloth ak_cloth;
  * particle at most once). Returns AK_ERR_NULL_ARG (desc or out_cloth NULL), AK_ERR_EMPTY (no
  * grid and no positions, or no triangle and no edge), AK_ERR_BAD_ARG (grid side < 2, grid over
  * 2^24 particles, unknown solver or bending, negative or NaN stiffness, damping, density, slack,
- * pbd_stiffness > 1, infinite stiffness with the spring solver, indices or edges not a multiple
+ * pbd_stiffness > 1, infinite stiffness with a spring solver, indices or edges not a multiple
  * of 3 or 2, pin_positions count != pins count, an allocator with only one function, a vertex on
  * no triangle whose mass must come from area_density), AK_ERR_BAD_INDEX (an index, edge, pin or
  * attachment out of range, an edge or triangle with a repeated vertex, a vertex both pinned and
@@ -226,7 +234,10 @@ typedef struct ak_cloth_step_job {
     const ak_cloth* cloth;         /* required */
     float dt;                      /* seconds, > 0 (required) */
     uint32_t substeps;             /* h = dt / substeps; 0 -> 10 */
-    uint32_t iterations;           /* XPBD/PBD Gauss-Seidel sweeps per substep; 0 -> 1 */
+    uint32_t iterations;           /* XPBD/PBD Gauss-Seidel sweeps per substep; 0 -> 1. IMPLICIT: the
+                                      most conjugate-gradient iterations per substep; 0 -> 200
+                                      (it stops earlier once the preconditioned residual falls
+                                      below 1e-5 of the right-hand side's) */
     ak_vec3 gravity;               /* m/s^2, world; zero -> none */
     ak_vec3 wind;                  /* m/s, world air velocity; zero -> still air */
     float drag;                    /* drag coefficient C_d per triangle; 0 -> no drag */

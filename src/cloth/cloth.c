@@ -126,8 +126,8 @@ ak_cloth_desc ak_cloth_desc_resolved(const ak_cloth_desc* desc) {
     if (d.bend_stiffness == 0.0f) d.bend_stiffness = d.stretch_stiffness / 100.0f;
     if (d.dihedral_stiffness == 0.0f) d.dihedral_stiffness = 1e-4f;
     if (d.bending == AK_CLOTH_BEND_DEFAULT)
-        d.bending = d.solver == AK_CLOTH_SPRINGS ? AK_CLOTH_BEND_SPRINGS : AK_CLOTH_BEND_DIHEDRAL;
-    if (d.solver == AK_CLOTH_SPRINGS && (d.bending == AK_CLOTH_BEND_DIHEDRAL || d.bending == AK_CLOTH_BEND_ISOMETRIC))
+        d.bending = akp_spring_solver(d.solver) ? AK_CLOTH_BEND_SPRINGS : AK_CLOTH_BEND_DIHEDRAL;
+    if (akp_spring_solver(d.solver) && (d.bending == AK_CLOTH_BEND_DIHEDRAL || d.bending == AK_CLOTH_BEND_ISOMETRIC))
         d.bending = AK_CLOTH_BEND_SPRINGS;
     if (d.pbd_stiffness == 0.0f) d.pbd_stiffness = 1.0f;
     return d;
@@ -140,7 +140,7 @@ static ak_result check_desc(const ak_cloth_desc* d, const ak_allocator* alloc) {
     const float ks[4] = {d->stretch_stiffness, d->shear_stiffness, d->bend_stiffness, d->dihedral_stiffness};
     for (int k = 0; k < 4; ++k) {
         if (!(ks[k] > 0.0f)) return AK_ERR_BAD_ARG; /* negative or NaN (0 was resolved) */
-        if (isinf(ks[k]) && d->solver == AK_CLOTH_SPRINGS) return AK_ERR_BAD_ARG;
+        if (isinf(ks[k]) && akp_spring_solver(d->solver)) return AK_ERR_BAD_ARG;
     }
     if (!nonneg_finite(d->spring_damping) || !nonneg_finite(d->constraint_damping) ||
         !nonneg_finite(d->long_range_slack) || !(d->area_density > 0.0f) || !ak_finitef(d->area_density) ||
@@ -376,7 +376,7 @@ ak_result ak_cloth_create(const ak_cloth_desc* desc_in, const ak_allocator* allo
     }
     const size_t n = b.n, nd = b.dist.count, nb = b.bend.count, nt = b.tri_count;
     const size_t np = d.pins.count, na = d.attachments.count;
-    const bool lra = d.long_range_attachments && d.solver != AK_CLOTH_SPRINGS;
+    const bool lra = d.long_range_attachments && !akp_spring_solver(d.solver);
     size_t size = akp_align16(sizeof(ak_cloth));
     const size_t s_rest = size; size += akp_align16(n * sizeof(ak_vec3));
     const size_t s_inv = size; size += akp_align16(n * sizeof(float));

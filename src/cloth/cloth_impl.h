@@ -4,6 +4,9 @@
 
 #include <animkit/cloth.h>
 
+/* The solvers that integrate forces of springs (no constraints, no multipliers). */
+static inline bool akp_spring_solver(ak_cloth_solver s) { return s == AK_CLOTH_SPRINGS || s == AK_CLOTH_IMPLICIT; }
+
 /* Kinds of distance constraint (springs). */
 enum { AKP_STRETCH = 0, AKP_SHEAR = 1, AKP_BEND = 2 };
 

@@ -30,9 +30,13 @@
 
 /* ---- scratch layout --------------------------------------------------------------------- */
 
+/* IMPLICIT: the conjugate-gradient vectors (3 n doubles each) */
+enum { CG_DV, CG_R, CG_C, CG_Q, CG_S, CG_B, CG_PRE, CG_VECTORS };
+
 typedef struct layout {
     size_t xw, xs, prev, ext, acc, lambda, tri_force, off, hash_start, hash_entry, tri_normal, grid, grid_size, size;
     size_t dist_stride, bend_stride; /* bytes between the per-step offset arrays */
+    size_t cg;                       /* IMPLICIT: CG_VECTORS vectors of 3 n doubles, then 4 per spring */
     size_t buckets, mesh_tris;
 } layout;
 
@@ -59,7 +63,10 @@ static layout make_layout(const ak_cloth* c, size_t mesh_tris, const ak_cloth_st
     l.tri_force = s, s += akp_align16(c->tri_count * sizeof(ak_vec3));
     l.dist_stride = akp_align16(c->dist_count * sizeof(float));
     l.bend_stride = akp_align16(c->bend_count * sizeof(float));
-    l.off = s, s += 3 * l.dist_stride + (c->desc.bending == AK_CLOTH_BEND_ISOMETRIC ? 3 : 9) * l.bend_stride;
+    l.off = s, s += akp_spring_solver(c->desc.solver)
+                        ? 0
+                        : 3 * l.dist_stride + (c->desc.bending == AK_CLOTH_BEND_ISOMETRIC ? 3 : 9) * l.bend_stride;
+    l.cg = s, s += c->desc.solver == AK_CLOTH_IMPLICIT ? akp_align16((CG_VECTORS * 3 * c->n + 4 * c->dist_count) * sizeof(double)) : 0;
     l.mesh_tris = mesh_tris;
     l.buckets = mesh_tris ? pow2_at_least(2 * mesh_tris) : 0;
     l.hash_start = s, s += akp_align16(mesh_tris ? (l.buckets + 1) * sizeof(uint32_t) : 0);
@@ -160,6 +167,9 @@ typedef struct ctx {
     ak_grid grid;
     ak_result grid_result;
     akp_solve solve;
+    double* cg;          /* IMPLICIT: the CG vectors, then per spring u (3) and its clamped
+                            transverse factor (1; -1: degenerate) */
+    uint32_t cg_max;     /* IMPLICIT: most CG iterations per substep */
     int simd;            /* 0 scalar, 1 AVX2, 2 AVX-512 */
     /* barrier */
     pthread_mutex_t m;
@@ -615,6 +625,148 @@ static void kinematic_targets(const ctx* c, float f, unsigned t) {
 
 static bool is_free(const ak_cloth* cl, size_t v) { return cl->inv_mass[v] > 0.0f; }
 
+/* ---- implicit Euler (Baraff & Witkin 1998) ---------------------------------------------- */
+
+#define CG_TOLERANCE 1e-5
+
+/* out = filter((M + h D + h^2 K) y): the springs' stiffness K_s = k (u u^T + g (I - u u^T)) and
+ * damping D_s = c u u^T couple each spring's two particles; kinematic rows are filtered out. */
+static void implicit_apply(const ctx* c, const double* y, double* out) {
+    const ak_cloth* cl = c->c;
+    const double h = c->h, hc = h * (double)cl->desc.spring_damping;
+    const double* spr = c->cg + CG_VECTORS * 3 * cl->n;
+    for (size_t v = 0; v < cl->n; ++v)
+        for (int a = 0; a < 3; ++a) out[3 * v + a] = (double)cl->mass[v] * y[3 * v + a];
+    for (size_t k = 0; k < cl->dist_count; ++k) {
+        const double* sp = spr + 4 * k;
+        if (sp[3] < 0.0) continue;
+        const size_t i = cl->dist[k].i, j = cl->dist[k].j;
+        const double hk = h * h * (double)cl->dist[k].k;
+        const double dy[3] = {y[3 * i] - y[3 * j], y[3 * i + 1] - y[3 * j + 1], y[3 * i + 2] - y[3 * j + 2]};
+        const double ud = sp[0] * dy[0] + sp[1] * dy[1] + sp[2] * dy[2];
+        for (int a = 0; a < 3; ++a) {
+            const double t = (hc + hk) * ud * sp[a] + hk * sp[3] * (dy[a] - ud * sp[a]);
+            out[3 * i + a] += t;
+            out[3 * j + a] -= t;
+        }
+    }
+    for (size_t v = 0; v < cl->n; ++v)
+        if (!is_free(cl, v)) out[3 * v] = out[3 * v + 1] = out[3 * v + 2] = 0.0;
+}
+
+static double cg_dot(const double* a, const double* b, size_t m) {
+    double s = 0.0;
+    for (size_t k = 0; k < m; ++k) s += a[k] * b[k];
+    return s;
+}
+
+/* One backward-Euler substep of the springs, linearised at the substep's start: solve
+ * (M + h D + h^2 K) dv = h (f - h K v) by Jacobi-preconditioned conjugate gradients with the
+ * kinematic particles' dv fixed (Baraff & Witkin's filtered CG), then v += dv, x += h v. Runs
+ * on one thread (the step runs the implicit solver on the calling thread only). */
+static void implicit_substep(ctx* c, float f) {
+    const ak_cloth* cl = c->c;
+    const ak_cloth_step_job* job = c->job;
+    const size_t n = cl->n, m3 = 3 * n;
+    const double h = c->h, cd = (double)cl->desc.spring_damping;
+    double* const dv = c->cg + CG_DV * m3;
+    double* const r = c->cg + CG_R * m3;
+    double* const cv = c->cg + CG_C * m3;
+    double* const q = c->cg + CG_Q * m3;
+    double* const sv = c->cg + CG_S * m3;
+    double* const b = c->cg + CG_B * m3;
+    double* const pre = c->cg + CG_PRE * m3;
+    double* const spr = c->cg + CG_VECTORS * m3;
+    /* forces at the substep's start (velocities damped first, as the other solvers do), and K v */
+    for (size_t v = 0; v < n; ++v) {
+        if (is_free(cl, v)) c->v[v] = ak_vec3_scale(c->v[v], c->decay);
+        const ak_vec3 fe = is_free(cl, v) ? ak_vec3_madd(c->ext[v], job->gravity, cl->mass[v]) : ak_vec3_make(0, 0, 0);
+        b[3 * v] = fe.x, b[3 * v + 1] = fe.y, b[3 * v + 2] = fe.z;
+        q[3 * v] = q[3 * v + 1] = q[3 * v + 2] = 0.0;
+        pre[3 * v] = pre[3 * v + 1] = pre[3 * v + 2] = cl->mass[v];
+    }
+    for (size_t k = 0; k < cl->dist_count; ++k) {
+        const akp_dist* d = &cl->dist[k];
+        double* sp = spr + 4 * k;
+        const ak_vec3 e = rel(c, d->j, d->i);
+        const double ex = e.x, ey = e.y, ez = e.z, l = sqrt(ex * ex + ey * ey + ez * ez);
+        if (!(l > 1e-12)) {
+            sp[3] = -1.0;
+            continue;
+        }
+        sp[0] = ex / l, sp[1] = ey / l, sp[2] = ez / l;
+        sp[3] = fmax(0.0, 1.0 - (double)d->rest / l);
+        const ak_vec3 vi = c->v[d->i], vj = c->v[d->j];
+        const double dvv[3] = {(double)vi.x - vj.x, (double)vi.y - vj.y, (double)vi.z - vj.z};
+        const double ud = sp[0] * dvv[0] + sp[1] * dvv[1] + sp[2] * dvv[2];
+        const double fs = (double)d->k * (l - (double)d->rest) - cd * ud; /* on i, along u (towards j) */
+        for (int a = 0; a < 3; ++a) {
+            b[3 * d->i + a] += fs * sp[a];
+            b[3 * d->j + a] -= fs * sp[a];
+            const double t = (double)d->k * (ud * sp[a] + sp[3] * (dvv[a] - ud * sp[a])); /* K_s (v_i - v_j) */
+            q[3 * d->i + a] += t;
+            q[3 * d->j + a] -= t;
+            const double dg = h * cd * sp[a] * sp[a] + h * h * (double)d->k * (sp[a] * sp[a] + sp[3] * (1.0 - sp[a] * sp[a]));
+            pre[3 * d->i + a] += dg;
+            pre[3 * d->j + a] += dg;
+        }
+    }
+    /* b = filter(h (f - h K v)); dv starts at the kinematic particles' required change */
+    const ak_cloth_step_job* jb = job;
+    for (size_t v = 0; v < n; ++v)
+        for (int a = 0; a < 3; ++a) {
+            b[3 * v + a] = is_free(cl, v) ? h * (b[3 * v + a] - h * q[3 * v + a]) : 0.0;
+            pre[3 * v + a] = is_free(cl, v) && pre[3 * v + a] > 0.0 ? 1.0 / pre[3 * v + a] : 0.0;
+            dv[3 * v + a] = 0.0;
+        }
+    for (size_t k = 0; k < cl->attach_count; ++k) {
+        const uint32_t v = cl->attach[k];
+        const ak_vec3 to = ak_vec3_sub(jb->attachment_targets.ptr[k], c->base[v]);
+        const ak_vec3 dt = f >= 1.0f ? to : ak_vec3_scale(to, f);
+        const ak_vec3 need = ak_vec3_sub(ak_vec3_scale(ak_vec3_sub(dt, c->x[v].p), (float)(1.0 / h)), c->v[v]);
+        dv[3 * v] = need.x, dv[3 * v + 1] = need.y, dv[3 * v + 2] = need.z;
+    }
+    for (size_t k = 0; k < cl->pin_count; ++k) {
+        const uint32_t v = cl->pins[k];
+        const ak_vec3 dt = ak_vec3_sub(cl->pin_pos[k], c->base[v]);
+        const ak_vec3 need = ak_vec3_sub(ak_vec3_scale(ak_vec3_sub(dt, c->x[v].p), (float)(1.0 / h)), c->v[v]);
+        dv[3 * v] = need.x, dv[3 * v + 1] = need.y, dv[3 * v + 2] = need.z;
+    }
+    /* filtered PCG */
+    implicit_apply(c, dv, q);
+    for (size_t k = 0; k < m3; ++k) {
+        r[k] = b[k] - q[k];
+        sv[k] = pre[k] * b[k];
+    }
+    const double delta0 = cg_dot(b, sv, m3);
+    for (size_t k = 0; k < m3; ++k) cv[k] = sv[k] = pre[k] * r[k];
+    double delta = cg_dot(r, sv, m3);
+    for (uint32_t it = 0; it < c->cg_max && delta > CG_TOLERANCE * CG_TOLERANCE * delta0 && delta > 0.0; ++it) {
+        implicit_apply(c, cv, q);
+        const double cq = cg_dot(cv, q, m3);
+        if (!(cq > 0.0)) break;
+        const double alpha = delta / cq;
+        for (size_t k = 0; k < m3; ++k) {
+            dv[k] += alpha * cv[k];
+            r[k] -= alpha * q[k];
+            sv[k] = pre[k] * r[k];
+        }
+        const double dnew = cg_dot(r, sv, m3);
+        const double beta = dnew / delta;
+        for (size_t k = 0; k < m3; ++k) cv[k] = sv[k] + beta * cv[k];
+        delta = dnew;
+    }
+    /* v += dv, x += h v (free particles; kinematic ones are placed by kinematic_targets) */
+    for (size_t v = 0; v < n; ++v) {
+        if (!is_free(cl, v)) continue;
+        const ak_vec3 vel = ak_vec3_make((float)((double)c->v[v].x + dv[3 * v]), (float)((double)c->v[v].y + dv[3 * v + 1]),
+                                         (float)((double)c->v[v].z + dv[3 * v + 2]));
+        c->prev[v].p = c->x[v].p;
+        c->v[v] = vel;
+        c->x[v].p = ak_vec3_madd(c->x[v].p, vel, (float)h);
+    }
+}
+
 static void run_spmd(ctx* c, unsigned t) {
     const ak_cloth* cl = c->c;
     const ak_cloth_step_job* job = c->job;
@@ -627,7 +779,7 @@ static void run_spmd(ctx* c, unsigned t) {
     range(cl->tri_count, t, c->T, &tb, &te);
     memset(c->ext + b, 0, (e - b) * sizeof(ak_vec3));
     /* the constraints' vectors at the start of the step (XPBD/PBD solves add the displacements) */
-    if (cl->desc.solver != AK_CLOTH_SPRINGS) {
+    if (!akp_spring_solver(cl->desc.solver)) {
         const ak_vec3* x0 = c->base;
         size_t kb, ke;
         range(cl->dist_count, t, c->T, &kb, &ke);
@@ -657,7 +809,7 @@ static void run_spmd(ctx* c, unsigned t) {
         }
     }
     barrier(c);
-    const bool springs = cl->desc.solver == AK_CLOTH_SPRINGS;
+    const bool springs = cl->desc.solver == AK_CLOTH_SPRINGS, implicit = cl->desc.solver == AK_CLOTH_IMPLICIT;
     for (uint32_t s = 0; s < c->substeps; ++s) {
         const float f = (float)(s + 1) / (float)c->substeps;
         /* wind each substep: drag acts like a damper of rate rho C_d A |v| / m, which an
@@ -668,7 +820,9 @@ static void run_spmd(ctx* c, unsigned t) {
             gather_wind(c, b, e);
             barrier(c);
         }
-        if (springs) {
+        if (springs || implicit) {
+            if (implicit) implicit_substep(c, f); /* one thread (T = 1) */
+            else {
             for (size_t v = b; v < e; ++v)
                 c->acc[v] = is_free(cl, v) ? ak_vec3_madd(c->ext[v], job->gravity, cl->mass[v]) : ak_vec3_make(0, 0, 0);
             barrier(c);
@@ -687,6 +841,7 @@ static void run_spmd(ctx* c, unsigned t) {
                 c->prev[v].p = c->x[v].p;
                 c->v[v] = vel;
                 c->x[v].p = ak_vec3_madd(c->x[v].p, vel, h);
+            }
             }
             kinematic_targets(c, f, t);
             barrier(c);
@@ -818,6 +973,8 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.self = job->self_collision;
     c.self_dist = self_distance(job);
     c.grid_mem = (ak_u8_span){base + l.grid, l.grid_size};
+    c.cg = (double*)(base + l.cg);
+    c.cg_max = job->iterations ? job->iterations : 200;
     /* displacements start at the residuals (the part of the position the float missed) */
     c.base = job->positions.ptr;
     ak_vec3* const res = job->position_residuals.ptr;
@@ -844,6 +1001,7 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
 #endif
     if (mesh_tris) build_hash(&c, 2.0f * c.thickness);
     unsigned want = job->thread_count > 1 ? job->thread_count : 1;
+    if (cl->desc.solver == AK_CLOTH_IMPLICIT) want = 1;
     if (want > 1 && !job->exact_thread_count && cl->desc.solver != AK_CLOTH_SPRINGS) {
         /* one thread per THREAD_MIN_PER_COLOR constraints of an average colour */
         size_t colors = 0;

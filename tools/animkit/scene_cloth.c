@@ -244,7 +244,7 @@ bool cloth_scene_parse(const char* file, const char* text, size_t size, cloth_sc
                                            "substeps", "iterations", "threads", "gravity", "wind", "gust",
                                            "gust_frequency", "drag", "lift", "air_density", "damping", "colliders",
                                            "character", NULL};
-        static const char* const solvers[] = {"xpbd", "springs", "pbd", NULL};
+        static const char* const solvers[] = {"xpbd", "springs", "pbd", "implicit", NULL}; /* enum order */
         cli_json_object(&j, root, "", keys);
         int solver = 0;
         cli_json_enum(&j, root, "", "solver", solvers, &solver);
