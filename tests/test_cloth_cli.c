@@ -120,6 +120,8 @@ AK_TEST(bad_scenes_and_blow_up) {
         {"{\"character\": {\"model\": \"builtin:humanoid\"}, \"attachments\": [{\"vertex\": 0, \"joint\": \"tail\"}]}",
          "attachments[0].joint"},
         {"{\"dt\": 0.01,", "invalid JSON"},
+        {"{\"pins\": [0], \"pin_positions\": [[0, 0, 0], [1, 1, 1]]}", "pin_positions"},
+        {"{\"pins\": [0], \"pin_positions\": [[0, 0]]}", "pin_positions[0]"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         write_file("bad.json", cases[k].text);

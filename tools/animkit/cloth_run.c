@@ -182,9 +182,11 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
             rc = cli_fail(cmd, "%s: cannot pose %s: %s", name, sc->model, ak_result_string(r));
             goto done;
         }
-        /* attachments keep their offset from the joint or skinned vertex at t = 0 */
+        /* attachments keep their offset from the joint or skinned vertex at t = 0, from their
+         * given start position or else their rest position */
         for (size_t k = 0; k < sc->attach_count; ++k) {
             const cloth_attach_spec* at = &sc->attach[k];
+            if (at->has_position) x[at->vertex] = at->position;
             const ak_vec3 p = x[at->vertex];
             char path[40];
             snprintf(path, sizeof path, "attachments[%zu]", k);

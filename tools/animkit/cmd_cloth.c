@@ -173,8 +173,9 @@ int cmd_cloth(int argc, char** argv) {
     if (gif || png) {
         ak_vec3 lo, hi;
         cloth_run_bounds(&run, &lo, &hi);
-        /* a character faces +Z: look from behind, where a cape hangs */
-        if (cli_frame_init(&frame, ch->scene, 480, 360, lo, hi, ch->scene ? 3.6f : 0.6f) || cli_image_alloc(&img, 480, 360)) {
+        /* a character faces +Z: look from behind and to its left, where a cape hangs and the
+         * key light (from the front left) still grazes it */
+        if (cli_frame_init(&frame, ch->scene, 480, 360, lo, hi, ch->scene ? 2.5f : 0.6f) || cli_image_alloc(&img, 480, 360)) {
             rc = cli_fail("cloth", "out of memory");
             goto done;
         }

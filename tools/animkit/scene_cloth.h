@@ -17,12 +17,16 @@ typedef struct cloth_attach_spec {
     uint32_t vertex;     /* cloth vertex */
     char joint[64];      /* follow this joint rigidly ("" -> mesh_vertex) */
     long mesh_vertex;    /* or follow this skinned vertex of the character's mesh 0 (-1: joint) */
+    bool has_position;   /* position given: the vertex starts there (else at its rest position) */
+    ak_vec3 position;    /* world, at t = 0: where the attachment holds it (gathers a collar) */
 } cloth_attach_spec;
 
 typedef struct cloth_scene {
     ak_cloth_desc desc;        /* grid, material, solver (spans point into the arrays below) */
     uint32_t* pins;            /* [pin_count] */
     size_t pin_count;
+    ak_vec3* pin_positions;    /* [pin_position_count]: 0 (rest positions) or pin_count */
+    size_t pin_position_count;
     cloth_attach_spec* attach; /* [attach_count] */
     size_t attach_count;
     /* stepping */
