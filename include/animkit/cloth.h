@@ -5,7 +5,7 @@
  *     plus optional extra edges) with per-vertex mass; particles can be pinned at fixed points
  *     or attached to target positions the caller gives every step (a skinned mesh's vertices or
  *     joints), so a cape, skirt or flag follows an animated character;
- *   - three solvers over the same cloth:
+ *   - four solvers over the same cloth:
  *       AK_CLOTH_XPBD (default): extended position-based dynamics (Macklin, Mueller, Chentanez
  *         2016): distance constraints with compliance alpha = 1/stiffness, alpha~ = alpha/h^2,
  *         the Lagrange multipliers reset at the start of every substep, dihedral-angle or
@@ -14,7 +14,8 @@
  *         sweeps each; optional long-range attachments (Kim, Chentanez, Mueller 2012);
  *       AK_CLOTH_SPRINGS: the classic mass-spring model: structural, shear and bending springs
  *         (Hooke plus damping along the spring), semi-implicit (symplectic) Euler, v += h a,
- *         x += h v; stable only for h below about 2 sqrt(m/k), so it needs small steps;
+ *         x += h v; stable only for h below about 2 sqrt(m/k), so it needs small steps
+ *         (ak_cloth_stable_substep says how small);
  *       AK_CLOTH_IMPLICIT: the same springs under implicit (backward) Euler, linearised once per
  *         substep and solved by conjugate gradients (Baraff & Witkin 1998): (M + h D + h^2 K) dv
  *         = h (f + h (df/dx) v) with K = -df/dx, D = -df/dv assembled from the springs (the
@@ -31,6 +32,10 @@
  *     character's skin, through a spatial hash rebuilt each step), with thickness and friction;
  *   - self-collision between particles through the shared neighbour grid (grid.h), switchable;
  *   - smooth (area-weighted) vertex normals, max stretch and energy for output and tests;
+ *   - precision: a step integrates each particle's displacement since the step's start and
+ *     reads vectors between particles as their start-of-step value plus the displacements'
+ *     difference, so a substep's motion keeps float precision at any substep count and
+ *     distance from the origin; optional position_residuals keep what float positions lose;
  *   - thread_count: threads split each phase over disjoint particles or over constraints of one
  *     colour (constraints of a colour share no particle), so results are bit-identical for any
  *     thread count; small cloths run on fewer threads than asked (see thread_count);
@@ -235,9 +240,9 @@ typedef struct ak_cloth_step_job {
     float dt;                      /* seconds, > 0 (required) */
     uint32_t substeps;             /* h = dt / substeps; 0 -> 10 */
     uint32_t iterations;           /* XPBD/PBD Gauss-Seidel sweeps per substep; 0 -> 1. IMPLICIT: the
-                                      most conjugate-gradient iterations per substep; 0 -> 200
+                                      most conjugate-gradient iterations per substep; 0 -> 100
                                       (it stops earlier once the preconditioned residual falls
-                                      below 1e-5 of the right-hand side's) */
+                                      below 1e-3 of the right-hand side's) */
     ak_vec3 gravity;               /* m/s^2, world; zero -> none */
     ak_vec3 wind;                  /* m/s, world air velocity; zero -> still air */
     float drag;                    /* drag coefficient C_d per triangle; 0 -> no drag */

@@ -627,7 +627,7 @@ static bool is_free(const ak_cloth* cl, size_t v) { return cl->inv_mass[v] > 0.0
 
 /* ---- implicit Euler (Baraff & Witkin 1998) ---------------------------------------------- */
 
-#define CG_TOLERANCE 1e-5
+#define CG_TOLERANCE 1e-3
 
 /* out = filter((M + h D + h^2 K) y): the springs' stiffness K_s = k (u u^T + g (I - u u^T)) and
  * damping D_s = c u u^T couple each spring's two particles; kinematic rows are filtered out. */
@@ -974,7 +974,7 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.self_dist = self_distance(job);
     c.grid_mem = (ak_u8_span){base + l.grid, l.grid_size};
     c.cg = (double*)(base + l.cg);
-    c.cg_max = job->iterations ? job->iterations : 200;
+    c.cg_max = job->iterations ? job->iterations : 100;
     /* displacements start at the residuals (the part of the position the float missed) */
     c.base = job->positions.ptr;
     ak_vec3* const res = job->position_residuals.ptr;

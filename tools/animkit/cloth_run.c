@@ -217,7 +217,10 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
     if (sc->capsule_count) memcpy(caps, sc->capsules, sc->capsule_count * sizeof(ak_cloth_capsule));
 
     job = (ak_cloth_step_job){
-        .cloth = cloth, .dt = sc->dt, .substeps = sc->substeps, .iterations = sc->iterations, .gravity = sc->gravity,
+        .cloth = cloth, .dt = sc->dt, .substeps = sc->substeps,
+        /* implicit: the scene's iterations cap CG only when given (else the library's 200) */
+        .iterations = sc->desc.solver == AK_CLOTH_IMPLICIT && !sc->iterations_given ? 0 : sc->iterations,
+        .gravity = sc->gravity,
         .drag = sc->drag, .lift = sc->lift, .air_density = sc->air_density, .damping = sc->damping,
         .planes = sc->planes, .plane_count = sc->plane_count, .spheres = sc->spheres, .sphere_count = sc->sphere_count,
         .capsules = caps, .capsule_count = sc->capsule_count + ch->bone_count,

@@ -298,6 +298,7 @@ bool cloth_scene_parse(const char* file, const char* text, size_t size, cloth_sc
         cli_json_int(&j, root, "", "iterations", 1, 10000, &it);
         cli_json_int(&j, root, "", "threads", 1, 64, &th);
         out->substeps = (uint32_t)sub, out->iterations = (uint32_t)it, out->thread_count = (int)th;
+        out->iterations_given = cJSON_GetObjectItemCaseSensitive(root, "iterations") != NULL;
         cli_json_vec3(&j, root, "", "gravity", &out->gravity);
         cli_json_vec3(&j, root, "", "wind", &out->wind);
         cli_json_float(&j, root, "", "gust", 0.0f, 10.0f, &out->gust);

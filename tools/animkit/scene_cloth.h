@@ -33,6 +33,7 @@ typedef struct cloth_scene {
     float dt;                  /* seconds per step */
     long steps;
     uint32_t substeps, iterations;
+    bool iterations_given;     /* the scene says "iterations" (else implicit uses its own cap) */
     bool substeps_forced;      /* --substeps given: the spring solver keeps it even below its
                                   stable count (otherwise it runs at least that count) */
     ak_vec3 gravity, wind;
