@@ -131,6 +131,13 @@ AK_TEST(step_rules) {
     AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_ARG);
     j = s.job, j.gravity.y = NAN;
     AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_DATA);
+    ak_vec3 res[12] = {{0, 0, 0}};
+    j = s.job, j.position_residuals = (ak_vec3_span){res, 11};
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_ARG);
+    j.position_residuals.count = 12;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_OK);
+    res[3].z = NAN;
+    AK_CHECK_EQ(ak_cloth_step_validate(&j), AK_ERR_BAD_DATA);
     ak_vec3 mp[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     uint32_t mi[3] = {0, 1, 3};
     j = s.job, j.mesh = (ak_cloth_collider_mesh){AK_SPAN(mp), AK_SPAN(mi)};
