@@ -1,4 +1,7 @@
-/* Tests of the cloth module: closed forms (a hanging spring's static stretch), properties
+/* Tests of the cloth module: closed forms (a hanging spring's static stretch, the hinge
+ * pendulum's elliptic-integral period, the spring solver's stability bound), an independent
+ * double-precision Newton minimum of a pinned sheet's energy, invariance to the substep count and
+ * to a 1 km translation, properties
  * (no particle inside a collider, pins and attachments exact, thread-count determinism, finite
  * state under strong wind), and the XPBD-vs-PBD substep comparison. */
 #include <animkit/cloth.h>
@@ -570,14 +573,20 @@ AK_TEST(pinned_sheet_rest_shape_is_energy_minimum) {
                 AK_CHECK(sim_init(&s, &d));
                 s.job.substeps = subs[k];
                 s.job.iterations = solvers[q] == AK_CLOTH_XPBD ? 20 : 0;
-                s.job.damping = 2.0f;
+                s.job.damping = 3.0f;
                 if (solvers[q] == AK_CLOTH_SPRINGS) {
                     const uint32_t need = (uint32_t)ceilf(s.job.dt / (0.9f * ak_cloth_stable_substep(s.cloth)));
                     if (mi == 0) AK_CHECK(need <= 5);
-                    if (need > s.job.substeps) s.job.substeps = need;
+                    if (need > s.job.substeps) {
+                        if (k > 0) { /* both counts are below the stable one: ran at it already */
+                            sim_free(&s);
+                            continue;
+                        }
+                        s.job.substeps = need;
+                    }
                 }
                 sim_scratch(&s);
-                for (int f = 0; f < 600; ++f)
+                for (int f = 0; f < 360; ++f) /* 6 s: motion decays by exp(-3 t) */
                     if (ak_cloth_step_run(&s.job) != AK_OK) break;
                 /* the sheet hangs in the plane z = 0 of its pins, and the energy is the same
                  * mirrored in it: a minimum's mirror image (z -> -z) is one too, and a stiff sheet
