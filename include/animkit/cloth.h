@@ -284,9 +284,8 @@ typedef struct ak_cloth_step_job {
                                       positions + residuals carry about 48 bits. Far from the
                                       origin (1 km: float spacing 6e-5 m) a step otherwise rounds
                                       every position once; with residuals the motion is the
-                                      same as near the origin. Empty -> rounded, and the
-                                      velocity keeps what the rounding took (v -= lost / dt), so
-                                      it stays the stored positions' motion */
+                                      same as near the origin. Empty -> rounded (velocities
+                                      are kept as integrated either way) */
     ak_vec3_span out_normals;      /* optional, count >= vertex count: smooth normals after the step */
     ak_u8_span scratch;            /* required, size >= ak_cloth_step_scratch_size(job) */
 } ak_cloth_step_job;

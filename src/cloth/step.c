@@ -1045,15 +1045,10 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     for (size_t v = 0; v < cl->n; ++v) {
         const ak_vec3 x0 = job->positions.ptr[v], d = c.x[v].p, x1 = ak_vec3_add(x0, d);
         job->positions.ptr[v] = x1;
-        /* what the rounding lost: d - (x1 - x0), both differences exact for |d| << |x0| (Sterbenz).
-         * With residuals it is kept there. Without, the velocity takes it back (v -= lost / dt):
-         * the velocity stays the stored positions' motion, as a particle whose step moved it
-         * less than half a float spacing did not move; otherwise it would keep a velocity that
-         * never moves it (a cloth creeping to rest would stall short of it). */
-        const ak_vec3 lost = ak_vec3_sub(d, ak_vec3_sub(x1, x0));
-        if (res) res[v] = lost;
-        else if (cl->inv_mass[v] > 0.0f && (lost.x != 0.0f || lost.y != 0.0f || lost.z != 0.0f))
-            c.v[v] = ak_vec3_sub(c.v[v], ak_vec3_scale(lost, 1.0f / job->dt));
+        /* what the rounding lost: d - (x1 - x0), both differences exact for |d| << |x0|
+         * (Sterbenz); kept when the caller keeps residuals. Velocities stay the integrated ones */
+        if (res) res[v] = ak_vec3_sub(d, ak_vec3_sub(x1, x0));
+
         finite = finite && ak_vec3_is_finite(d) && ak_vec3_is_finite(c.v[v]);
     }
     for (size_t k = 0; k < cl->pin_count; ++k) job->positions.ptr[cl->pins[k]] = cl->pin_pos[k];
