@@ -26,6 +26,20 @@ AK_TEST(usage) {
     AK_CHECK_EQ(run("cloth --preset flag x.json", true), 2);
 }
 
+/* The implicit solver by flag and by scene key; the spring solver picks its stable substep count
+ * (dt / (0.9 h)) and says so, unless --substeps is given. */
+AK_TEST(solvers) {
+    AK_CHECK_EQ(run("cloth --preset flag --solver implicit --steps 3", true), 0);
+    AK_CHECK(strstr(out_buf, "implicit Euler") != NULL);
+    write_file("implicit.json", "{\"solver\": \"implicit\", \"steps\": 3}");
+    AK_CHECK_EQ(run("cloth implicit.json", true), 0);
+    AK_CHECK(strstr(out_buf, "implicit Euler") != NULL);
+    AK_CHECK_EQ(run("cloth --preset flag --solver springs --steps 2", true), 0);
+    AK_CHECK(strstr(out_buf, "153 substeps per step instead of 10") != NULL);
+    AK_CHECK_EQ(run("cloth --preset flag --solver springs --steps 2 --substeps 200", true), 0);
+    AK_CHECK(strstr(out_buf, "instead of") == NULL && strstr(out_buf, "(200 substeps)") != NULL);
+}
+
 AK_TEST(drape_json_contract) {
     AK_CHECK_EQ(run("cloth --preset drape --steps 60 --threads 2 --json drape.json", true), 0);
     cJSON* j = read_json("drape.json");
@@ -106,6 +120,8 @@ AK_TEST(bad_scenes_and_blow_up) {
         {"{\"character\": {\"model\": \"builtin:humanoid\"}, \"attachments\": [{\"vertex\": 0, \"joint\": \"tail\"}]}",
          "attachments[0].joint"},
         {"{\"dt\": 0.01,", "invalid JSON"},
+        {"{\"pins\": [0], \"pin_positions\": [[0, 0, 0], [1, 1, 1]]}", "pin_positions"},
+        {"{\"pins\": [0], \"pin_positions\": [[0, 0]]}", "pin_positions[0]"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         write_file("bad.json", cases[k].text);
@@ -123,6 +139,7 @@ AK_TEST(bad_scenes_and_blow_up) {
 
 int main(void) {
     AK_RUN(usage);
+    AK_RUN(solvers);
     AK_RUN(drape_json_contract);
     AK_RUN(flag_pins_and_outputs);
     AK_RUN(bad_scenes_and_blow_up);

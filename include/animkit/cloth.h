@@ -5,7 +5,7 @@
  *     plus optional extra edges) with per-vertex mass; particles can be pinned at fixed points
  *     or attached to target positions the caller gives every step (a skinned mesh's vertices or
  *     joints), so a cape, skirt or flag follows an animated character;
- *   - three solvers over the same cloth:
+ *   - four solvers over the same cloth:
  *       AK_CLOTH_XPBD (default): extended position-based dynamics (Macklin, Mueller, Chentanez
  *         2016): distance constraints with compliance alpha = 1/stiffness, alpha~ = alpha/h^2,
  *         the Lagrange multipliers reset at the start of every substep, dihedral-angle or
@@ -14,7 +14,15 @@
  *         sweeps each; optional long-range attachments (Kim, Chentanez, Mueller 2012);
  *       AK_CLOTH_SPRINGS: the classic mass-spring model: structural, shear and bending springs
  *         (Hooke plus damping along the spring), semi-implicit (symplectic) Euler, v += h a,
- *         x += h v; stable only for h below about 2 sqrt(m/k), so it needs small steps;
+ *         x += h v; stable only for h below about 2 sqrt(m/k), so it needs small steps
+ *         (ak_cloth_stable_substep says how small);
+ *       AK_CLOTH_IMPLICIT: the same springs under implicit (backward) Euler, linearised once per
+ *         substep and solved by conjugate gradients (Baraff & Witkin 1998): (M + h D + h^2 K) dv
+ *         = h (f + h (df/dx) v) with K = -df/dx, D = -df/dv assembled from the springs (the
+ *         transverse stiffness of a compressed spring clamped at zero so the system stays
+ *         positive definite), Jacobi-preconditioned CG in double with the pinned and attached
+ *         particles' velocity changes fixed by a filter (their modified CG); stable at any
+ *         step, with numerical damping that grows with h; on the calling thread only;
  *       AK_CLOTH_PBD: plain position-based dynamics (Mueller et al. 2007): the same constraints
  *         projected with a per-projection stiffness factor in (0, 1]; its effective stiffness
  *         depends on the substep and iteration counts (the problem XPBD solves);
@@ -24,6 +32,10 @@
  *     character's skin, through a spatial hash rebuilt each step), with thickness and friction;
  *   - self-collision between particles through the shared neighbour grid (grid.h), switchable;
  *   - smooth (area-weighted) vertex normals, max stretch and energy for output and tests;
+ *   - precision: a step integrates each particle's displacement since the step's start and
+ *     reads vectors between particles as their start-of-step value plus the displacements'
+ *     difference, so a substep's motion keeps float precision at any substep count and
+ *     distance from the origin; optional position_residuals keep what float positions lose;
  *   - thread_count: threads split each phase over disjoint particles or over constraints of one
  *     colour (constraints of a colour share no particle), so results are bit-identical for any
  *     thread count; small cloths run on fewer threads than asked (see thread_count);
@@ -72,12 +84,13 @@ typedef enum ak_cloth_solver {
     AK_CLOTH_XPBD = 0,   /* default: compliant constraints, substeps */
     AK_CLOTH_SPRINGS,    /* mass-spring, semi-implicit Euler */
     AK_CLOTH_PBD,        /* plain PBD with a stiffness factor (for comparison) */
+    AK_CLOTH_IMPLICIT,   /* mass-spring, implicit (backward) Euler (Baraff & Witkin 1998) */
     AK_CLOTH_SOLVER_COUNT
 } ak_cloth_solver;
 
 typedef enum ak_cloth_bending {
-    AK_CLOTH_BEND_DEFAULT = 0, /* -> DIHEDRAL for XPBD and PBD; the spring solver always uses SPRINGS
-                                  (or NONE) */
+    AK_CLOTH_BEND_DEFAULT = 0, /* -> DIHEDRAL for XPBD and PBD; the spring solvers (SPRINGS,
+                                  IMPLICIT) always use SPRINGS (or NONE) */
     AK_CLOTH_BEND_DIHEDRAL,    /* angle between the two triangles of each interior edge */
     AK_CLOTH_BEND_SPRINGS,     /* distance between the wing vertices of each interior edge (grid:
                                   particles two apart along each axis) */
@@ -121,7 +134,7 @@ typedef struct ak_cloth_desc {
                                     XPBD compliance 1/k) and of isometric bending (N m); 0 -> 1e-4
                                     (cotton-like: a draped sheet folds) */
     ak_cloth_bending bending;    /* 0 -> see ak_cloth_bending */
-    float spring_damping;        /* SPRINGS: N s/m along each spring; 0 -> none */
+    float spring_damping;        /* SPRINGS, IMPLICIT: N s/m along each spring; 0 -> none */
     float constraint_damping;    /* XPBD: beta (s) of the paper's eq. 26, stiffness-proportional
                                     damping; 0 -> none */
     float pbd_stiffness;         /* PBD: factor (0, 1] applied to each projection; 0 -> 1 */
@@ -140,7 +153,7 @@ typedef struct ak_cloth ak_cloth;
  * particle at most once). Returns AK_ERR_NULL_ARG (desc or out_cloth NULL), AK_ERR_EMPTY (no
  * grid and no positions, or no triangle and no edge), AK_ERR_BAD_ARG (grid side < 2, grid over
  * 2^24 particles, unknown solver or bending, negative or NaN stiffness, damping, density, slack,
- * pbd_stiffness > 1, infinite stiffness with the spring solver, indices or edges not a multiple
+ * pbd_stiffness > 1, infinite stiffness with a spring solver, indices or edges not a multiple
  * of 3 or 2, pin_positions count != pins count, an allocator with only one function, a vertex on
  * no triangle whose mass must come from area_density), AK_ERR_BAD_INDEX (an index, edge, pin or
  * attachment out of range, an edge or triangle with a repeated vertex, a vertex both pinned and
@@ -167,6 +180,20 @@ AK_API ak_cloth_desc ak_cloth_get_desc(const ak_cloth* cloth);
 /* Rest positions, with pinned vertices at their pin positions, into out_positions
  * (count >= vertex count). Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_cloth_rest_positions(const ak_cloth* cloth, ak_vec3_span out_positions);
+
+/* Largest stable substep h (seconds) of the spring solver for this cloth: the mass-spring
+ * system's linearisation at rest, x'' = -M^-1 K x - M^-1 D x', under semi-implicit Euler is
+ * stable while h^2 omega^2 + 2 h gamma < 4, with omega^2 and gamma bounded (Gershgorin on
+ * M^-1/2 K M^-1/2, and on D) by
+ *     omega^2 <= max_i sum_{springs s = (i, j)} k_s (w_i + sqrt(w_i w_j)),
+ *     gamma   <= max_i sum_{springs s = (i, j)} c   (w_i + sqrt(w_i w_j))
+ * over the free particles i (w = 1/m the inverse masses, k_s the spring's stiffness, c =
+ * spring_damping): h = (sqrt(gamma^2 + 4 omega^2) - gamma) / omega^2, i.e. 2 / omega without
+ * damping. The stiffest springs on the lightest particle decide it. Substeps of dt / h or more
+ * keep the spring solver stable (a stretched spring's transverse stiffness stays below k; wind
+ * drag is not counted). INFINITY for the other solvers (unconditionally stable) and for a
+ * cloth without springs on a free particle; 0 for a NULL cloth. */
+AK_API float ak_cloth_stable_substep(const ak_cloth* cloth);
 
 /* ---- colliders ------------------------------------------------------------------------ */
 
@@ -212,7 +239,10 @@ typedef struct ak_cloth_step_job {
     const ak_cloth* cloth;         /* required */
     float dt;                      /* seconds, > 0 (required) */
     uint32_t substeps;             /* h = dt / substeps; 0 -> 10 */
-    uint32_t iterations;           /* XPBD/PBD Gauss-Seidel sweeps per substep; 0 -> 1 */
+    uint32_t iterations;           /* XPBD/PBD Gauss-Seidel sweeps per substep; 0 -> 1. IMPLICIT: the
+                                      most conjugate-gradient iterations per substep; 0 -> 100
+                                      (it stops earlier once the preconditioned residual falls
+                                      below 1e-3 of the right-hand side's) */
     ak_vec3 gravity;               /* m/s^2, world; zero -> none */
     ak_vec3 wind;                  /* m/s, world air velocity; zero -> still air */
     float drag;                    /* drag coefficient C_d per triangle; 0 -> no drag */
@@ -249,6 +279,13 @@ typedef struct ak_cloth_step_job {
                                       this one (out of range: AK_ERR_BAD_ARG) */
     ak_vec3_span positions;        /* required, count == vertex count: in and out */
     ak_vec3_span velocities;       /* required, count == vertex count: in and out */
+    ak_vec3_span position_residuals; /* optional, count == vertex count, in and out (start them at
+                                      zero): what a float position cannot hold, so that
+                                      positions + residuals carry about 48 bits. Far from the
+                                      origin (1 km: float spacing 6e-5 m) a step otherwise rounds
+                                      every position once; with residuals the motion is the
+                                      same as near the origin. Empty -> rounded (velocities
+                                      are kept as integrated either way) */
     ak_vec3_span out_normals;      /* optional, count >= vertex count: smooth normals after the step */
     ak_u8_span scratch;            /* required, size >= ak_cloth_step_scratch_size(job) */
 } ak_cloth_step_job;
@@ -259,12 +296,12 @@ AK_API size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job);
 
 /* First failing rule: AK_ERR_NULL_ARG (job, cloth, positions, velocities or scratch empty, a
  * collider count without its array, attachments without targets), AK_ERR_BAD_ARG (dt <= 0 or
- * non-finite, thread_count > 64, substeps or iterations > 10000, simd_limit out of range, negative or non-finite drag,
+ * non-finite, position_residuals count != vertex count when given, thread_count > 64, substeps or iterations > 10000, simd_limit out of range, negative or non-finite drag,
  * lift, air density, damping, thickness, friction or self_distance, a negative radius, collider mesh indices
  * not a multiple of 3, positions/velocities count != vertex count, attachment_targets count !=
  * attachment count), AK_ERR_SPAN_SMALL (out_normals or scratch too small), AK_ERR_BAD_INDEX (a
  * collider mesh index out of range), AK_ERR_BAD_DATA (a non-finite position, velocity,
- * gravity, wind, collider or target). A zero-initialised job gives AK_ERR_NULL_ARG. */
+ * gravity, wind, collider, target or residual). A zero-initialised job gives AK_ERR_NULL_ARG. */
 AK_API ak_result ak_cloth_step_validate(const ak_cloth_step_job* job);
 /* Validate, then step (writes nothing on a validation failure). Returns
  * AK_ERR_NO_CONVERGENCE when the state became non-finite (a blow-up: the spring solver with too

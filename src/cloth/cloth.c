@@ -68,8 +68,10 @@ static bool isometric_weights(const ak_vec3 x[4], float k, akp_bend* e) {
     const float a1 = 0.5f * ak_vec3_length(ak_vec3_cross(ak_vec3_sub(x[3], x[2]), ak_vec3_sub(x[1], x[2])));
     if (!(a0 > 1e-20f) || !(a1 > 1e-20f) || !ak_finitef(c01 + c02 + c03 + c04)) return false;
     e->K[0] = -c01 - c03, e->K[1] = -c02 - c04, e->K[2] = c03 + c04, e->K[3] = c01 + c02;
+    /* b = sum_{q != 2} K_q (x_q - x_2), as the step computes it (the weights sum to zero) */
     ak_vec3 bv = ak_vec3_make(0, 0, 0);
-    for (int q = 0; q < 4; ++q) bv = ak_vec3_madd(bv, x[q], e->K[q]);
+    for (int q = 0; q < 4; ++q)
+        if (q != 2) bv = ak_vec3_add(bv, ak_vec3_scale(ak_vec3_sub(x[q], x[2]), e->K[q]));
     e->rest = ak_vec3_length(bv);
     e->alpha = isinf(k) ? 0.0f : (a0 + a1) / (3.0f * k);
     return true;
@@ -124,8 +126,8 @@ ak_cloth_desc ak_cloth_desc_resolved(const ak_cloth_desc* desc) {
     if (d.bend_stiffness == 0.0f) d.bend_stiffness = d.stretch_stiffness / 100.0f;
     if (d.dihedral_stiffness == 0.0f) d.dihedral_stiffness = 1e-4f;
     if (d.bending == AK_CLOTH_BEND_DEFAULT)
-        d.bending = d.solver == AK_CLOTH_SPRINGS ? AK_CLOTH_BEND_SPRINGS : AK_CLOTH_BEND_DIHEDRAL;
-    if (d.solver == AK_CLOTH_SPRINGS && (d.bending == AK_CLOTH_BEND_DIHEDRAL || d.bending == AK_CLOTH_BEND_ISOMETRIC))
+        d.bending = akp_spring_solver(d.solver) ? AK_CLOTH_BEND_SPRINGS : AK_CLOTH_BEND_DIHEDRAL;
+    if (akp_spring_solver(d.solver) && (d.bending == AK_CLOTH_BEND_DIHEDRAL || d.bending == AK_CLOTH_BEND_ISOMETRIC))
         d.bending = AK_CLOTH_BEND_SPRINGS;
     if (d.pbd_stiffness == 0.0f) d.pbd_stiffness = 1.0f;
     return d;
@@ -138,7 +140,7 @@ static ak_result check_desc(const ak_cloth_desc* d, const ak_allocator* alloc) {
     const float ks[4] = {d->stretch_stiffness, d->shear_stiffness, d->bend_stiffness, d->dihedral_stiffness};
     for (int k = 0; k < 4; ++k) {
         if (!(ks[k] > 0.0f)) return AK_ERR_BAD_ARG; /* negative or NaN (0 was resolved) */
-        if (isinf(ks[k]) && d->solver == AK_CLOTH_SPRINGS) return AK_ERR_BAD_ARG;
+        if (isinf(ks[k]) && akp_spring_solver(d->solver)) return AK_ERR_BAD_ARG;
     }
     if (!nonneg_finite(d->spring_damping) || !nonneg_finite(d->constraint_damping) ||
         !nonneg_finite(d->long_range_slack) || !(d->area_density > 0.0f) || !ak_finitef(d->area_density) ||
@@ -151,6 +153,28 @@ static ak_result check_desc(const ak_cloth_desc* d, const ak_allocator* alloc) {
         return AK_ERR_NULL_ARG;
     if (d->pin_positions.count && d->pin_positions.count != d->pins.count) return AK_ERR_BAD_ARG;
     return AK_OK;
+}
+
+/* The spring solver's stable substep (ak_cloth_stable_substep): Gershgorin row sums per
+ * particle in row[n] (caller's memory), in double. */
+static float spring_stable_h(const ak_cloth* c, double* row) {
+    double omega2 = 0.0, gamma = 0.0;
+    for (int pass = 0; pass < 2; ++pass) {
+        memset(row, 0, c->n * sizeof(double));
+        for (size_t k = 0; k < c->dist_count; ++k) {
+            const akp_dist* d = &c->dist[k];
+            const double wi = c->inv_mass[d->i], wj = c->inv_mass[d->j], x = sqrt(wi * wj);
+            const double s = pass ? (double)c->desc.spring_damping : (double)d->k;
+            row[d->i] += s * (wi + x);
+            row[d->j] += s * (wj + x);
+        }
+        double m = 0.0;
+        for (size_t v = 0; v < c->n; ++v) m = fmax(m, row[v]);
+        if (pass) gamma = m;
+        else omega2 = m;
+    }
+    if (!(omega2 > 0.0) || !isfinite(omega2)) return INFINITY;
+    return (float)((sqrt(gamma * gamma + 4.0 * omega2) - gamma) / omega2);
 }
 
 /* ---- create ----------------------------------------------------------------------------- */
@@ -352,7 +376,7 @@ ak_result ak_cloth_create(const ak_cloth_desc* desc_in, const ak_allocator* allo
     }
     const size_t n = b.n, nd = b.dist.count, nb = b.bend.count, nt = b.tri_count;
     const size_t np = d.pins.count, na = d.attachments.count;
-    const bool lra = d.long_range_attachments && d.solver != AK_CLOTH_SPRINGS;
+    const bool lra = d.long_range_attachments && !akp_spring_solver(d.solver);
     size_t size = akp_align16(sizeof(ak_cloth));
     const size_t s_rest = size; size += akp_align16(n * sizeof(ak_vec3));
     const size_t s_inv = size; size += akp_align16(n * sizeof(float));
@@ -456,6 +480,8 @@ ak_result ak_cloth_create(const ak_cloth_desc* desc_in, const ak_allocator* allo
             c->lra_dist[v] = best * (1.0f + d.long_range_slack);
         }
     }
+    c->desc = d; /* (the spans are set below) */
+    c->stable_h = spring_stable_h(c, (double*)used); /* n uint64 hold n doubles */
     /* vertex -> triangles (CSR, each vertex's triangles in increasing order) */
     for (size_t k = 0; k < nt * 3; ++k) c->vt_start[c->indices[k] + 1]++;
     for (size_t v = 0; v < n; ++v) c->vt_start[v + 1] += c->vt_start[v];
@@ -506,6 +532,11 @@ ak_result ak_cloth_rest_positions(const ak_cloth* cloth, ak_vec3_span out_positi
     memcpy(out_positions.ptr, cloth->rest, cloth->n * sizeof(ak_vec3));
     for (size_t k = 0; k < cloth->pin_count; ++k) out_positions.ptr[cloth->pins[k]] = cloth->pin_pos[k];
     return AK_OK;
+}
+
+float ak_cloth_stable_substep(const ak_cloth* cloth) {
+    if (!cloth) return 0.0f;
+    return cloth->desc.solver == AK_CLOTH_SPRINGS ? cloth->stable_h : INFINITY;
 }
 
 ak_result ak_cloth_normals(const ak_cloth* cloth, ak_vec3_cspan positions, ak_vec3_span out_normals) {
@@ -566,9 +597,10 @@ ak_result ak_cloth_energy_compute(const ak_cloth* cloth, ak_vec3_cspan positions
         if (iso) {
             double b[3] = {0, 0, 0};
             for (int q = 0; q < 4; ++q) {
-                b[0] += (double)cloth->bend[k].K[q] * x[q].x;
-                b[1] += (double)cloth->bend[k].K[q] * x[q].y;
-                b[2] += (double)cloth->bend[k].K[q] * x[q].z;
+                if (q == 2) continue;
+                b[0] += (double)cloth->bend[k].K[q] * ((double)x[q].x - x[2].x);
+                b[1] += (double)cloth->bend[k].K[q] * ((double)x[q].y - x[2].y);
+                b[2] += (double)cloth->bend[k].K[q] * ((double)x[q].z - x[2].z);
             }
             const double C = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]) - cloth->bend[k].rest;
             if (cloth->bend[k].alpha > 0.0f) e.elastic += 0.5 * C * C / cloth->bend[k].alpha;

@@ -4,6 +4,9 @@
 
 #include <animkit/cloth.h>
 
+/* The solvers that integrate forces of springs (no constraints, no multipliers). */
+static inline bool akp_spring_solver(ak_cloth_solver s) { return s == AK_CLOTH_SPRINGS || s == AK_CLOTH_IMPLICIT; }
+
 /* Kinds of distance constraint (springs). */
 enum { AKP_STRETCH = 0, AKP_SHEAR = 1, AKP_BEND = 2 };
 
@@ -54,14 +57,17 @@ struct ak_cloth {
     float* lra_dist;      /* [n] allowed distance */
     uint32_t* vt_start;   /* [n + 1] CSR: triangles around each vertex */
     uint32_t* vt_tri;     /* [3 tri_count] */
+    float stable_h;       /* the spring solver's largest stable substep (s), INFINITY: none */
 };
 
 /* Dihedral angle of a bending element (wings x0, x1, edge x2 -> x3) and its gradient (grad NULL
  * -> angle only); 0 and a zero gradient for a degenerate element. The step's own formula. */
 float akp_dihedral(const ak_vec3 x[4], ak_vec3 grad[4]);
 
-/* A particle in the step's working copy: position and inverse mass in 16 bytes, so that a SIMD
- * solve loads or stores one particle with one 128-bit access. */
+/* A particle in the step's working copy: its displacement since the start of the step (the
+ * caller's positions) and its inverse mass in 16 bytes, so that a SIMD solve loads or stores one
+ * particle with one 128-bit access. Displacements are small, so float resolves a substep's
+ * motion (g h^2 is 1e-7 m at h = 1e-4 s) wherever the cloth is. */
 typedef struct akp_px {
     ak_vec3 p;
     float w;
@@ -71,7 +77,10 @@ typedef struct akp_px {
 typedef struct akp_solve {
     const ak_cloth* cl;
     akp_px* x;
-    const akp_px* prev;   /* positions at the start of the substep (read when damped) */
+    const akp_px* prev;   /* displacements at the start of the substep (read when damped) */
+    float* dist_off[3];   /* x_i - x_j of distance constraint k at the start of the step (x, y, z) */
+    float* bend_off[9];   /* dihedral: x3 - x2, x0 - x2, x1 - x2 of bending constraint k at the start
+                             of the step; isometric: [0..2] sum_{q != 2} K_q (x_q - x_2) */
     float* lambda;        /* [dist_count + bend_count] multipliers */
     float h, h2, beta;    /* substep, its square, constraint damping (s) */
     float pbd_stiffness;  /* PBD factor */

@@ -6,8 +6,10 @@
  * solves it, and the step's result does not depend on the CPU's SIMD level or thread count.
  *
  * A block solves the constraints [k, k + KW) of one colour: no two of them share a particle, so
- * each lane gathers its particles (position and inverse mass: one 16-byte akp_px each),
- * computes, and scatters them back without conflict. Early outs of the scalar solve (a
+ * each lane gathers its particles (displacement and inverse mass: one 16-byte akp_px each),
+ * computes, and scatters them back without conflict. Vectors between particles are their value
+ * at the start of the step (per-constraint arrays, contiguous loads) plus the difference of the
+ * displacements since (KN(rel)). Early outs of the scalar solve (a
  * degenerate constraint, no free particle) become lane masks: a masked lane writes its
  * particles back unchanged and keeps its multiplier.
  *
@@ -58,14 +60,12 @@ KFN KV KN(atan2)(KV y, KV x) {
     return K_SEL(K_EQ(mx, K_SET1(0.0f)), K_SET1(0.0f), r);
 }
 
-/* Dihedral angle of the element x (wings x0, x1, edge x2 -> x3; Bridson, Marino, Fedkiw 2003)
- * and its gradient g: the signed angle between the triangle normals n1 = e x (x0 - x2) and
- * n2 = (x1 - x2) x e about e = x3 - x2, from the unnormalised normals (atan2 ignores a common
- * positive scale). *out_ok is false where a triangle or the edge is degenerate (|n|^2 or |e|^2
- * below 1e-24); those lanes' angle and gradient are meaningless. */
-KFN KV KN(dihedral)(const kv3 x[4], kv3 g[4], KM* out_ok) {
-    const kv3 e = kv3_sub(x[3], x[2]);
-    const kv3 a = kv3_sub(x[0], x[2]), b = kv3_sub(x[1], x[2]);
+/* Dihedral angle of an element (wings x0, x1, edge x2 -> x3; Bridson, Marino, Fedkiw 2003) from
+ * its edge vectors e = x3 - x2, a = x0 - x2, b = x1 - x2, and its gradient g: the signed angle
+ * between the triangle normals n1 = e x a and n2 = b x e about e, from the unnormalised normals
+ * (atan2 ignores a common positive scale). *out_ok is false where a triangle or the edge is
+ * degenerate (|n|^2 or |e|^2 below 1e-24); those lanes' angle and gradient are meaningless. */
+KFN KV KN(dihedral)(kv3 e, kv3 a, kv3 b, kv3 g[4], KM* out_ok) {
     const kv3 n1 = kv3_cross(e, a), n2 = kv3_cross(b, e);
     const KV l1 = kv3_dot(n1, n1), l2 = kv3_dot(n2, n2), le2 = kv3_dot(e, e);
     const KV tiny = K_SET1(1e-24f);
@@ -82,6 +82,15 @@ KFN KV KN(dihedral)(const kv3 x[4], kv3 g[4], KM* out_ok) {
     g[2] = kv3_sub(kv3_scale(u1, K_NEG(a0)), kv3_scale(u2, a1));
     g[3] = kv3_add(kv3_scale(u1, b0), kv3_scale(u2, b1));
     return theta;
+}
+
+/* The vector from particle j to particle i of a constraint: its value at the start of the
+ * step (off[0..2] + k, computed once per step from the caller's positions) plus the difference
+ * of the two displacements since then, so that it keeps float's relative precision wherever
+ * the cloth is and however small the substep's motion. */
+KFN kv3 KN(rel)(float* const off[3], size_t k, kv3 di, kv3 dj) {
+    const kv3 o = {K_LOAD(off[0] + k), K_LOAD(off[1] + k), K_LOAD(off[2] + k)};
+    return kv3_add(o, kv3_sub(di, dj));
 }
 
 /* dlambda of one XPBD (or PBD) update: C the constraint, wsum = sum_i w_i |grad_i C|^2, alpha the
@@ -106,7 +115,7 @@ KFN void KN(dist)(const akp_solve* s, size_t k, bool first) {
     K_GATHER(s->x, cl->dist_i + k, xi, wi);
     K_GATHER(s->x, cl->dist_j + k, xj, wj);
     const KV w = K_ADD(wi, wj);
-    const kv3 e = kv3_sub(xi, xj);
+    const kv3 e = KN(rel)(s->dist_off, k, xi, xj);
     const KV len = K_SQRT(kv3_dot(e, e));
     const KM on = K_MAND(K_NE(w, K_SET1(0.0f)), K_NLT(len, K_SET1(1e-12f)));
     const kv3 g = kv3_scale(e, K_DIV(K_SET1(1.0f), len)); /* grad_i C; grad_j C = -g */
@@ -143,8 +152,12 @@ KFN void KN(bend)(const akp_solve* s, size_t k, bool first) {
         /* C = |b| - |b_rest|, grad_q C = K_q b / |b| */
         KV Kq[4];
         for (int q = 0; q < 4; ++q) Kq[q] = K_LOAD(cl->bend_K[q] + k);
-        kv3 bv = kv3_scale(x[0], Kq[0]);
-        for (int q = 1; q < 4; ++q) bv = kv3_add(bv, kv3_scale(x[q], Kq[q]));
+        /* b = sum_q K_q x_q = sum_{q != 2} K_q (x_q - x_2) (the weights sum to zero): its value at
+         * the start of the step plus the displacements' share */
+        kv3 bv = {K_LOAD(s->bend_off[0] + k), K_LOAD(s->bend_off[1] + k), K_LOAD(s->bend_off[2] + k)};
+        bv = kv3_add(bv, kv3_scale(kv3_sub(x[0], x[2]), Kq[0]));
+        bv = kv3_add(bv, kv3_scale(kv3_sub(x[1], x[2]), Kq[1]));
+        bv = kv3_add(bv, kv3_scale(kv3_sub(x[3], x[2]), Kq[3]));
         const KV l = K_SQRT(kv3_dot(bv, bv));
         on = K_NLT(l, K_SET1(1e-12f));
         const kv3 n = kv3_scale(bv, K_DIV(K_SET1(1.0f), l));
@@ -155,7 +168,10 @@ KFN void KN(bend)(const akp_solve* s, size_t k, bool first) {
         C = K_SUB(l, K_LOAD(cl->bend_rest + k));
         alpha = K_LOAD(cl->bend_alpha + k);
     } else {
-        C = K_SUB(KN(dihedral)(x, g, &on), K_LOAD(cl->bend_rest + k));
+        const kv3 e = KN(rel)(s->bend_off, k, x[3], x[2]);
+        const kv3 a = KN(rel)(s->bend_off + 3, k, x[0], x[2]);
+        const kv3 b = KN(rel)(s->bend_off + 6, k, x[1], x[2]);
+        C = K_SUB(KN(dihedral)(e, a, b, g, &on), K_LOAD(cl->bend_rest + k));
         const KV pi = K_SET1(AK_PI), two_pi = K_SET1(2.0f * AK_PI);
         C = K_SEL(K_GT(C, pi), K_SUB(C, two_pi), C);
         C = K_SEL(K_LT(C, K_NEG(pi)), K_ADD(C, two_pi), C);

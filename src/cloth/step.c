@@ -30,8 +30,13 @@
 
 /* ---- scratch layout --------------------------------------------------------------------- */
 
+/* IMPLICIT: the conjugate-gradient vectors (3 n doubles each) */
+enum { CG_DV, CG_R, CG_C, CG_Q, CG_S, CG_B, CG_PRE, CG_VECTORS };
+
 typedef struct layout {
-    size_t xw, xs, prev, ext, acc, lambda, tri_force, att_start, hash_start, hash_entry, tri_normal, grid, grid_size, size;
+    size_t xw, xs, prev, ext, acc, lambda, tri_force, off, hash_start, hash_entry, tri_normal, grid, grid_size, size;
+    size_t dist_stride, bend_stride; /* bytes between the per-step offset arrays */
+    size_t cg;                       /* IMPLICIT: CG_VECTORS vectors of 3 n doubles, then 4 per spring */
     size_t buckets, mesh_tris;
 } layout;
 
@@ -56,7 +61,12 @@ static layout make_layout(const ak_cloth* c, size_t mesh_tris, const ak_cloth_st
     l.acc = s, s += akp_align16(c->n * sizeof(ak_vec3));
     l.lambda = s, s += akp_align16((c->dist_count + c->bend_count) * sizeof(float));
     l.tri_force = s, s += akp_align16(c->tri_count * sizeof(ak_vec3));
-    l.att_start = s, s += akp_align16(c->attach_count * sizeof(ak_vec3));
+    l.dist_stride = akp_align16(c->dist_count * sizeof(float));
+    l.bend_stride = akp_align16(c->bend_count * sizeof(float));
+    l.off = s, s += akp_spring_solver(c->desc.solver)
+                        ? 0
+                        : 3 * l.dist_stride + (c->desc.bending == AK_CLOTH_BEND_ISOMETRIC ? 3 : 9) * l.bend_stride;
+    l.cg = s, s += c->desc.solver == AK_CLOTH_IMPLICIT ? akp_align16((CG_VECTORS * 3 * c->n + 4 * c->dist_count) * sizeof(double)) : 0;
     l.mesh_tris = mesh_tris;
     l.buckets = mesh_tris ? pow2_at_least(2 * mesh_tris) : 0;
     l.hash_start = s, s += akp_align16(mesh_tris ? (l.buckets + 1) * sizeof(uint32_t) : 0);
@@ -95,7 +105,8 @@ ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) {
         bad_nonneg(job->thickness) || bad_nonneg(job->friction) || bad_nonneg(job->self_distance))
         return AK_ERR_BAD_ARG;
     if (job->mesh.indices.count % 3 || job->positions.count != c->n || job->velocities.count != c->n ||
-        job->attachment_targets.count != c->attach_count)
+        job->attachment_targets.count != c->attach_count ||
+        (job->position_residuals.ptr && job->position_residuals.count != c->n))
         return AK_ERR_BAD_ARG;
     for (size_t k = 0; k < job->sphere_count; ++k)
         if (job->spheres[k].radius < 0.0f) return AK_ERR_BAD_ARG;
@@ -108,7 +119,9 @@ ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) {
     /* data */
     if (!ak_vec3_is_finite(job->gravity) || !ak_vec3_is_finite(job->wind)) return AK_ERR_BAD_DATA;
     for (size_t v = 0; v < c->n; ++v)
-        if (!ak_vec3_is_finite(job->positions.ptr[v]) || !ak_vec3_is_finite(job->velocities.ptr[v])) return AK_ERR_BAD_DATA;
+        if (!ak_vec3_is_finite(job->positions.ptr[v]) || !ak_vec3_is_finite(job->velocities.ptr[v]) ||
+            (job->position_residuals.ptr && !ak_vec3_is_finite(job->position_residuals.ptr[v])))
+            return AK_ERR_BAD_DATA;
     for (size_t k = 0; k < job->plane_count; ++k)
         if (!ak_vec3_is_finite(job->planes[k].normal) || !ak_finitef(job->planes[k].offset)) return AK_ERR_BAD_DATA;
     for (size_t k = 0; k < job->sphere_count; ++k)
@@ -132,7 +145,8 @@ typedef struct ctx {
     unsigned T;          /* threads taking part */
     uint32_t substeps, iterations;
     float h, decay, thickness;
-    akp_px* x;       /* working copy of the positions, with inverse masses */
+    const ak_vec3* base; /* the caller's positions: where the step starts */
+    akp_px* x;       /* working copy: displacements from base, with inverse masses */
     ak_vec3* xs;     /* plain copy for the self-collision grid */
     ak_vec3* v;
     akp_px* prev;
@@ -140,7 +154,6 @@ typedef struct ctx {
     ak_vec3* acc;
     float* lambda;
     ak_vec3* tri_force;
-    ak_vec3* att_start;
     /* mesh collider hash */
     uint32_t* hash_start;
     uint32_t* hash_entry;
@@ -154,6 +167,9 @@ typedef struct ctx {
     ak_grid grid;
     ak_result grid_result;
     akp_solve solve;
+    double* cg;          /* IMPLICIT: the CG vectors, then per spring u (3) and its clamped
+                            transverse factor (1; -1: degenerate) */
+    uint32_t cg_max;     /* IMPLICIT: most CG iterations per substep */
     int simd;            /* 0 scalar, 1 AVX2, 2 AVX-512 */
     /* barrier */
     pthread_mutex_t m;
@@ -235,6 +251,17 @@ static bool color_share(const uint32_t* starts, int col, unsigned t, unsigned T,
     }
     return true;
 }
+
+/* ---- positions ---------------------------------------------------------------------------- */
+
+/* x_i - x_j now: the difference at the start of the step (exact for nearby floats) plus the
+ * difference of the displacements, so it keeps its relative precision far from the origin. */
+static ak_vec3 rel(const ctx* c, size_t i, size_t j) {
+    return ak_vec3_add(ak_vec3_sub(c->base[i], c->base[j]), ak_vec3_sub(c->x[i].p, c->x[j].p));
+}
+
+/* World position of particle v now (rounded to float: for colliders and the neighbour grid). */
+static ak_vec3 world(const ctx* c, size_t v) { return ak_vec3_add(c->base[v], c->x[v].p); }
 
 /* ---- collisions ------------------------------------------------------------------------- */
 
@@ -342,11 +369,14 @@ static bool push_sphere(ak_vec3* x, ak_vec3 center, float r, ak_vec3* n, float* 
     return true;
 }
 
-static void collide(const ctx* c, size_t i) {
+/* Push particle i out of the colliders; true when it moved (its displacement is then rewritten
+ * from the world position; otherwise it is left as it was). */
+static bool collide(const ctx* c, size_t i) {
     const ak_cloth_step_job* job = c->job;
     const float th = c->thickness, mu = job->friction;
-    ak_vec3 x = c->x[i].p;
-    const ak_vec3 prev = c->prev[i].p;
+    const ak_vec3 x0 = world(c, i);
+    ak_vec3 x = x0;
+    const ak_vec3 prev = ak_vec3_add(c->base[i], c->prev[i].p);
     ak_vec3 n;
     float depth;
     for (size_t k = 0; k < job->plane_count; ++k) {
@@ -396,7 +426,9 @@ static void collide(const ctx* c, size_t i) {
             }
         }
     }
-    c->x[i].p = x;
+    if (x.x == x0.x && x.y == x0.y && x.z == x0.z) return false;
+    c->x[i].p = ak_vec3_sub(x, c->base[i]);
+    return true;
 }
 
 /* ---- constraints ------------------------------------------------------------------------ */
@@ -435,10 +467,10 @@ typedef bool KM;
 #include "cloth_kernel.h"
 
 float akp_dihedral(const ak_vec3 x[4], ak_vec3 grad[4]) {
-    kv3 xv[4], g[4];
-    for (int q = 0; q < 4; ++q) xv[q] = (kv3){x[q].x, x[q].y, x[q].z};
+    kv3 g[4];
+    const ak_vec3 e = ak_vec3_sub(x[3], x[2]), a = ak_vec3_sub(x[0], x[2]), b = ak_vec3_sub(x[1], x[2]);
     KM ok;
-    const float theta = scalar_dihedral(xv, g, &ok);
+    const float theta = scalar_dihedral((kv3){e.x, e.y, e.z}, (kv3){a.x, a.y, a.z}, (kv3){b.x, b.y, b.z}, g, &ok);
     if (grad)
         for (int q = 0; q < 4; ++q) grad[q] = ok ? ak_vec3_make(g[q].x, g[q].y, g[q].z) : ak_vec3_make(0, 0, 0);
     return ok ? theta : 0.0f;
@@ -467,7 +499,7 @@ static void solve_bend_range(const ctx* c, size_t kb, size_t ke, bool first) {
 static void spring_force(const ctx* c, size_t k) {
     const ak_cloth* cl = c->c;
     const akp_dist* d = &cl->dist[k];
-    const ak_vec3 e = ak_vec3_sub(c->x[d->j].p, c->x[d->i].p);
+    const ak_vec3 e = rel(c, d->j, d->i);
     const float len = ak_vec3_length(e);
     if (len < 1e-12f) return;
     const ak_vec3 u = ak_vec3_scale(e, 1.0f / len);
@@ -484,7 +516,7 @@ static void spring_force(const ctx* c, size_t k) {
 /* Rebuild the grid over the current positions (one thread). */
 static void self_grid(ctx* c) {
     const ak_grid_desc gd = {.cell_size = c->self_dist};
-    for (size_t v = 0; v < c->c->n; ++v) c->xs[v] = c->x[v].p;
+    for (size_t v = 0; v < c->c->n; ++v) c->xs[v] = world(c, v);
     const ak_result r = ak_grid_build(&gd, (ak_vec3_cspan){c->xs, c->c->n}, c->grid_mem, &c->grid);
     if (r != AK_OK) c->grid_result = r;
 }
@@ -499,7 +531,7 @@ static void self_delta(const ctx* c, size_t i) {
     const float wi = cl->inv_mass[i];
     if (wi == 0.0f || c->grid_result != AK_OK) return;
     uint32_t nb[SELF_MAX_NEIGHBOURS];
-    size_t total = ak_grid_query(&c->grid, c->x[i].p, c->self_dist, (ak_u32_span){nb, SELF_MAX_NEIGHBOURS});
+    size_t total = ak_grid_query(&c->grid, c->xs[i], c->self_dist, (ak_u32_span){nb, SELF_MAX_NEIGHBOURS});
     if (total > SELF_MAX_NEIGHBOURS) total = SELF_MAX_NEIGHBOURS;
     /* the grid returns neighbours in its own order: sort them so the sum is the same for any
      * grid layout (insertion sort of at most 32) */
@@ -513,7 +545,7 @@ static void self_delta(const ctx* c, size_t i) {
         const uint32_t j = nb[k];
         if (j == i) continue;
         const float target = ak_minf(c->self_dist, ak_vec3_distance(cl->rest[i], cl->rest[j]));
-        const ak_vec3 d = ak_vec3_sub(c->x[i].p, c->x[j].p);
+        const ak_vec3 d = rel(c, i, j);
         const float l = ak_vec3_length(d);
         if (l >= target || l < 1e-9f) continue;
         const float wj = cl->inv_mass[j];
@@ -532,9 +564,8 @@ static void wind_triangles(const ctx* c, size_t b, size_t e) {
     const float rho = job->air_density > 0.0f ? job->air_density : 1.2f;
     for (size_t t = b; t < e; ++t) {
         const uint32_t* o = cl->indices + 3 * t;
-        const ak_vec3 p0 = c->x[o[0]].p, p1 = c->x[o[1]].p, p2 = c->x[o[2]].p;
         ak_vec3 f = ak_vec3_make(0, 0, 0);
-        const ak_vec3 cr = ak_vec3_cross(ak_vec3_sub(p1, p0), ak_vec3_sub(p2, p0));
+        const ak_vec3 cr = ak_vec3_cross(rel(c, o[1], o[0]), rel(c, o[2], o[0]));
         const float cl2 = ak_vec3_length(cr);
         const ak_vec3 vt = ak_vec3_scale(ak_vec3_add(c->v[o[0]], ak_vec3_add(c->v[o[1]], c->v[o[2]])), 1.0f / 3.0f);
         const ak_vec3 vr = ak_vec3_sub(vt, job->wind); /* triangle velocity relative to the air */
@@ -571,7 +602,7 @@ static void gather_wind(const ctx* c, size_t b, size_t e) {
 }
 
 /* Move the kinematic particles to where they are at fraction f of the step: attachments on the
- * line from their start to their target, pins at their pin positions. */
+ * line from their start to their target, pins at their pin positions (as displacements). */
 static void kinematic_targets(const ctx* c, float f, unsigned t) {
     const ak_cloth* cl = c->c;
     size_t b, e;
@@ -579,19 +610,162 @@ static void kinematic_targets(const ctx* c, float f, unsigned t) {
     for (size_t k = b; k < e; ++k) {
         const uint32_t v = cl->attach[k];
         c->prev[v].p = c->x[v].p;
-        c->x[v].p = f >= 1.0f ? c->job->attachment_targets.ptr[k] : ak_vec3_lerp(c->att_start[k], c->job->attachment_targets.ptr[k], f);
+        const ak_vec3 to = ak_vec3_sub(c->job->attachment_targets.ptr[k], c->base[v]);
+        c->x[v].p = f >= 1.0f ? to : ak_vec3_scale(to, f);
         c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / c->h);
     }
     range(cl->pin_count, t, c->T, &b, &e);
     for (size_t k = b; k < e; ++k) {
         const uint32_t v = cl->pins[k];
         c->prev[v].p = c->x[v].p;
-        c->x[v].p = cl->pin_pos[k];
+        c->x[v].p = ak_vec3_sub(cl->pin_pos[k], c->base[v]);
         c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / c->h);
     }
 }
 
 static bool is_free(const ak_cloth* cl, size_t v) { return cl->inv_mass[v] > 0.0f; }
+
+/* ---- implicit Euler (Baraff & Witkin 1998) ---------------------------------------------- */
+
+#define CG_TOLERANCE 1e-3
+
+/* out = filter((M + h D + h^2 K) y): the springs' stiffness K_s = k (u u^T + g (I - u u^T)) and
+ * damping D_s = c u u^T couple each spring's two particles; kinematic rows are filtered out. */
+static void implicit_apply(const ctx* c, const double* y, double* out) {
+    const ak_cloth* cl = c->c;
+    const double h = c->h, hc = h * (double)cl->desc.spring_damping;
+    const double* spr = c->cg + CG_VECTORS * 3 * cl->n;
+    for (size_t v = 0; v < cl->n; ++v)
+        for (int a = 0; a < 3; ++a) out[3 * v + a] = (double)cl->mass[v] * y[3 * v + a];
+    for (size_t k = 0; k < cl->dist_count; ++k) {
+        const double* sp = spr + 4 * k;
+        if (sp[3] < 0.0) continue;
+        const size_t i = cl->dist[k].i, j = cl->dist[k].j;
+        const double hk = h * h * (double)cl->dist[k].k;
+        const double dy[3] = {y[3 * i] - y[3 * j], y[3 * i + 1] - y[3 * j + 1], y[3 * i + 2] - y[3 * j + 2]};
+        const double ud = sp[0] * dy[0] + sp[1] * dy[1] + sp[2] * dy[2];
+        for (int a = 0; a < 3; ++a) {
+            const double t = (hc + hk) * ud * sp[a] + hk * sp[3] * (dy[a] - ud * sp[a]);
+            out[3 * i + a] += t;
+            out[3 * j + a] -= t;
+        }
+    }
+    for (size_t v = 0; v < cl->n; ++v)
+        if (!is_free(cl, v)) out[3 * v] = out[3 * v + 1] = out[3 * v + 2] = 0.0;
+}
+
+static double cg_dot(const double* a, const double* b, size_t m) {
+    double s = 0.0;
+    for (size_t k = 0; k < m; ++k) s += a[k] * b[k];
+    return s;
+}
+
+/* One backward-Euler substep of the springs, linearised at the substep's start: solve
+ * (M + h D + h^2 K) dv = h (f - h K v) by Jacobi-preconditioned conjugate gradients with the
+ * kinematic particles' dv fixed (Baraff & Witkin's filtered CG), then v += dv, x += h v. Runs
+ * on one thread (the step runs the implicit solver on the calling thread only). */
+static void implicit_substep(ctx* c, float f) {
+    const ak_cloth* cl = c->c;
+    const ak_cloth_step_job* job = c->job;
+    const size_t n = cl->n, m3 = 3 * n;
+    const double h = c->h, cd = (double)cl->desc.spring_damping;
+    double* const dv = c->cg + CG_DV * m3;
+    double* const r = c->cg + CG_R * m3;
+    double* const cv = c->cg + CG_C * m3;
+    double* const q = c->cg + CG_Q * m3;
+    double* const sv = c->cg + CG_S * m3;
+    double* const b = c->cg + CG_B * m3;
+    double* const pre = c->cg + CG_PRE * m3;
+    double* const spr = c->cg + CG_VECTORS * m3;
+    /* forces at the substep's start (velocities damped first, as the other solvers do), and K v */
+    for (size_t v = 0; v < n; ++v) {
+        if (is_free(cl, v)) c->v[v] = ak_vec3_scale(c->v[v], c->decay);
+        const ak_vec3 fe = is_free(cl, v) ? ak_vec3_madd(c->ext[v], job->gravity, cl->mass[v]) : ak_vec3_make(0, 0, 0);
+        b[3 * v] = fe.x, b[3 * v + 1] = fe.y, b[3 * v + 2] = fe.z;
+        q[3 * v] = q[3 * v + 1] = q[3 * v + 2] = 0.0;
+        pre[3 * v] = pre[3 * v + 1] = pre[3 * v + 2] = cl->mass[v];
+    }
+    for (size_t k = 0; k < cl->dist_count; ++k) {
+        const akp_dist* d = &cl->dist[k];
+        double* sp = spr + 4 * k;
+        const ak_vec3 e = rel(c, d->j, d->i);
+        const double ex = e.x, ey = e.y, ez = e.z, l = sqrt(ex * ex + ey * ey + ez * ez);
+        if (!(l > 1e-12)) {
+            sp[3] = -1.0;
+            continue;
+        }
+        sp[0] = ex / l, sp[1] = ey / l, sp[2] = ez / l;
+        sp[3] = fmax(0.0, 1.0 - (double)d->rest / l);
+        const ak_vec3 vi = c->v[d->i], vj = c->v[d->j];
+        const double dvv[3] = {(double)vi.x - vj.x, (double)vi.y - vj.y, (double)vi.z - vj.z};
+        const double ud = sp[0] * dvv[0] + sp[1] * dvv[1] + sp[2] * dvv[2];
+        const double fs = (double)d->k * (l - (double)d->rest) - cd * ud; /* on i, along u (towards j) */
+        for (int a = 0; a < 3; ++a) {
+            b[3 * d->i + a] += fs * sp[a];
+            b[3 * d->j + a] -= fs * sp[a];
+            const double t = (double)d->k * (ud * sp[a] + sp[3] * (dvv[a] - ud * sp[a])); /* K_s (v_i - v_j) */
+            q[3 * d->i + a] += t;
+            q[3 * d->j + a] -= t;
+            const double dg = h * cd * sp[a] * sp[a] + h * h * (double)d->k * (sp[a] * sp[a] + sp[3] * (1.0 - sp[a] * sp[a]));
+            pre[3 * d->i + a] += dg;
+            pre[3 * d->j + a] += dg;
+        }
+    }
+    /* b = filter(h (f - h K v)); dv starts at the kinematic particles' required change */
+    const ak_cloth_step_job* jb = job;
+    for (size_t v = 0; v < n; ++v)
+        for (int a = 0; a < 3; ++a) {
+            b[3 * v + a] = is_free(cl, v) ? h * (b[3 * v + a] - h * q[3 * v + a]) : 0.0;
+            pre[3 * v + a] = is_free(cl, v) && pre[3 * v + a] > 0.0 ? 1.0 / pre[3 * v + a] : 0.0;
+            dv[3 * v + a] = 0.0;
+        }
+    for (size_t k = 0; k < cl->attach_count; ++k) {
+        const uint32_t v = cl->attach[k];
+        const ak_vec3 to = ak_vec3_sub(jb->attachment_targets.ptr[k], c->base[v]);
+        const ak_vec3 dt = f >= 1.0f ? to : ak_vec3_scale(to, f);
+        const ak_vec3 need = ak_vec3_sub(ak_vec3_scale(ak_vec3_sub(dt, c->x[v].p), (float)(1.0 / h)), c->v[v]);
+        dv[3 * v] = need.x, dv[3 * v + 1] = need.y, dv[3 * v + 2] = need.z;
+    }
+    for (size_t k = 0; k < cl->pin_count; ++k) {
+        const uint32_t v = cl->pins[k];
+        const ak_vec3 dt = ak_vec3_sub(cl->pin_pos[k], c->base[v]);
+        const ak_vec3 need = ak_vec3_sub(ak_vec3_scale(ak_vec3_sub(dt, c->x[v].p), (float)(1.0 / h)), c->v[v]);
+        dv[3 * v] = need.x, dv[3 * v + 1] = need.y, dv[3 * v + 2] = need.z;
+    }
+    /* filtered PCG */
+    implicit_apply(c, dv, q);
+    for (size_t k = 0; k < m3; ++k) {
+        r[k] = b[k] - q[k];
+        sv[k] = pre[k] * b[k];
+    }
+    const double delta0 = cg_dot(b, sv, m3);
+    for (size_t k = 0; k < m3; ++k) cv[k] = sv[k] = pre[k] * r[k];
+    double delta = cg_dot(r, sv, m3);
+    for (uint32_t it = 0; it < c->cg_max && delta > CG_TOLERANCE * CG_TOLERANCE * delta0 && delta > 0.0; ++it) {
+        implicit_apply(c, cv, q);
+        const double cq = cg_dot(cv, q, m3);
+        if (!(cq > 0.0)) break;
+        const double alpha = delta / cq;
+        for (size_t k = 0; k < m3; ++k) {
+            dv[k] += alpha * cv[k];
+            r[k] -= alpha * q[k];
+            sv[k] = pre[k] * r[k];
+        }
+        const double dnew = cg_dot(r, sv, m3);
+        const double beta = dnew / delta;
+        for (size_t k = 0; k < m3; ++k) cv[k] = sv[k] + beta * cv[k];
+        delta = dnew;
+    }
+    /* v += dv, x += h v (free particles; kinematic ones are placed by kinematic_targets) */
+    for (size_t v = 0; v < n; ++v) {
+        if (!is_free(cl, v)) continue;
+        const ak_vec3 vel = ak_vec3_make((float)((double)c->v[v].x + dv[3 * v]), (float)((double)c->v[v].y + dv[3 * v + 1]),
+                                         (float)((double)c->v[v].z + dv[3 * v + 2]));
+        c->prev[v].p = c->x[v].p;
+        c->v[v] = vel;
+        c->x[v].p = ak_vec3_madd(c->x[v].p, vel, (float)h);
+    }
+}
 
 static void run_spmd(ctx* c, unsigned t) {
     const ak_cloth* cl = c->c;
@@ -604,8 +778,38 @@ static void run_spmd(ctx* c, unsigned t) {
     range(n, t, c->T, &b, &e);
     range(cl->tri_count, t, c->T, &tb, &te);
     memset(c->ext + b, 0, (e - b) * sizeof(ak_vec3));
+    /* the constraints' vectors at the start of the step (XPBD/PBD solves add the displacements) */
+    if (!akp_spring_solver(cl->desc.solver)) {
+        const ak_vec3* x0 = c->base;
+        size_t kb, ke;
+        range(cl->dist_count, t, c->T, &kb, &ke);
+        for (size_t k = kb; k < ke; ++k) {
+            const ak_vec3 o = ak_vec3_sub(x0[cl->dist_i[k]], x0[cl->dist_j[k]]);
+            c->solve.dist_off[0][k] = o.x, c->solve.dist_off[1][k] = o.y, c->solve.dist_off[2][k] = o.z;
+        }
+        range(cl->bend_count, t, c->T, &kb, &ke);
+        for (size_t k = kb; k < ke; ++k) {
+            const ak_vec3 x2 = x0[cl->bend_p[2][k]];
+            ak_vec3 o[3];
+            if (c->solve.iso) {
+                o[0] = ak_vec3_make(0, 0, 0);
+                const int qs[3] = {0, 1, 3};
+                for (int q = 0; q < 3; ++q)
+                    o[0] = ak_vec3_add(o[0], ak_vec3_scale(ak_vec3_sub(x0[cl->bend_p[qs[q]][k]], x2), cl->bend_K[qs[q]][k]));
+            } else {
+                o[0] = ak_vec3_sub(x0[cl->bend_p[3][k]], x2);
+                o[1] = ak_vec3_sub(x0[cl->bend_p[0][k]], x2);
+                o[2] = ak_vec3_sub(x0[cl->bend_p[1][k]], x2);
+            }
+            for (int q = 0; q < (c->solve.iso ? 1 : 3); ++q) {
+                c->solve.bend_off[3 * q][k] = o[q].x;
+                c->solve.bend_off[3 * q + 1][k] = o[q].y;
+                c->solve.bend_off[3 * q + 2][k] = o[q].z;
+            }
+        }
+    }
     barrier(c);
-    const bool springs = cl->desc.solver == AK_CLOTH_SPRINGS;
+    const bool springs = cl->desc.solver == AK_CLOTH_SPRINGS, implicit = cl->desc.solver == AK_CLOTH_IMPLICIT;
     for (uint32_t s = 0; s < c->substeps; ++s) {
         const float f = (float)(s + 1) / (float)c->substeps;
         /* wind each substep: drag acts like a damper of rate rho C_d A |v| / m, which an
@@ -616,7 +820,9 @@ static void run_spmd(ctx* c, unsigned t) {
             gather_wind(c, b, e);
             barrier(c);
         }
-        if (springs) {
+        if (springs || implicit) {
+            if (implicit) implicit_substep(c, f); /* one thread (T = 1) */
+            else {
             for (size_t v = b; v < e; ++v)
                 c->acc[v] = is_free(cl, v) ? ak_vec3_madd(c->ext[v], job->gravity, cl->mass[v]) : ak_vec3_make(0, 0, 0);
             barrier(c);
@@ -636,6 +842,7 @@ static void run_spmd(ctx* c, unsigned t) {
                 c->v[v] = vel;
                 c->x[v].p = ak_vec3_madd(c->x[v].p, vel, h);
             }
+            }
             kinematic_targets(c, f, t);
             barrier(c);
             if (c->self) {
@@ -646,11 +853,12 @@ static void run_spmd(ctx* c, unsigned t) {
             }
             for (size_t v = b; v < e; ++v) {
                 if (!is_free(cl, v)) continue;
-                const ak_vec3 before = c->x[v].p;
-                if (c->self) c->x[v].p = ak_vec3_add(c->x[v].p, c->acc[v]);
-                collide(c, v);
-                if (c->x[v].p.x != before.x || c->x[v].p.y != before.y || c->x[v].p.z != before.z)
-                    c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / h);
+                bool moved = false;
+                if (c->self && (c->acc[v].x != 0.0f || c->acc[v].y != 0.0f || c->acc[v].z != 0.0f)) {
+                    c->x[v].p = ak_vec3_add(c->x[v].p, c->acc[v]);
+                    moved = true;
+                }
+                if (collide(c, v) || moved) c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / h);
             }
             barrier(c);
             continue;
@@ -689,9 +897,11 @@ static void run_spmd(ctx* c, unsigned t) {
                 for (size_t v = b; v < e; ++v) {
                     const uint32_t a = cl->lra_anchor[v];
                     if (a == UINT32_MAX) continue;
-                    const ak_vec3 d = ak_vec3_sub(c->x[v].p, c->x[a].p);
+                    const ak_vec3 d = rel(c, v, a);
                     const float l = ak_vec3_length(d);
-                    if (l > cl->lra_dist[v]) c->x[v].p = ak_vec3_madd(c->x[a].p, d, cl->lra_dist[v] / l);
+                    if (l > cl->lra_dist[v]) /* x_v = x_a + d * lra / l */
+                        c->x[v].p = ak_vec3_add(ak_vec3_add(ak_vec3_sub(c->base[a], c->base[v]), c->x[a].p),
+                                                ak_vec3_scale(d, cl->lra_dist[v] / l));
                 }
                 barrier(c);
             }
@@ -756,7 +966,6 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.acc = (ak_vec3*)(base + l.acc);
     c.lambda = (float*)(base + l.lambda);
     c.tri_force = (ak_vec3*)(base + l.tri_force);
-    c.att_start = (ak_vec3*)(base + l.att_start);
     c.hash_start = (uint32_t*)(base + l.hash_start);
     c.hash_entry = (uint32_t*)(base + l.hash_entry);
     c.tri_normal = (ak_vec3*)(base + l.tri_normal);
@@ -764,16 +973,24 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.self = job->self_collision;
     c.self_dist = self_distance(job);
     c.grid_mem = (ak_u8_span){base + l.grid, l.grid_size};
+    c.cg = (double*)(base + l.cg);
+    c.cg_max = job->iterations ? job->iterations : 100;
+    /* displacements start at the residuals (the part of the position the float missed) */
+    c.base = job->positions.ptr;
+    ak_vec3* const res = job->position_residuals.ptr;
     for (size_t v = 0; v < cl->n; ++v) {
-        c.x[v] = (akp_px){job->positions.ptr[v], cl->inv_mass[v]};
-        c.prev[v] = (akp_px){job->positions.ptr[v], 0.0f};
+        const ak_vec3 d0 = res && cl->inv_mass[v] > 0.0f ? res[v] : ak_vec3_make(0, 0, 0);
+        c.x[v] = (akp_px){d0, cl->inv_mass[v]};
+        c.prev[v] = (akp_px){d0, 0.0f};
     }
-    for (size_t k = 0; k < cl->attach_count; ++k) c.att_start[k] = job->positions.ptr[cl->attach[k]];
     c.solve = (akp_solve){.cl = cl, .x = c.x, .prev = c.prev, .lambda = c.lambda, .h = c.h, .h2 = c.h * c.h,
                           .beta = cl->desc.constraint_damping, .pbd_stiffness = cl->desc.pbd_stiffness,
                           .bend_alpha = 1.0f / cl->desc.dihedral_stiffness, .pbd = cl->desc.solver == AK_CLOTH_PBD,
                           .damped = cl->desc.constraint_damping > 0.0f,
                           .iso = cl->desc.bending == AK_CLOTH_BEND_ISOMETRIC};
+    for (int q = 0; q < 3; ++q) c.solve.dist_off[q] = (float*)(base + l.off + (size_t)q * l.dist_stride);
+    for (int q = 0; q < (c.solve.iso ? 3 : 9); ++q)
+        c.solve.bend_off[q] = (float*)(base + l.off + 3 * l.dist_stride + (size_t)q * l.bend_stride);
     c.simd = 0;
 #if AKP_CLOTH_SIMD
     {
@@ -784,6 +1001,7 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
 #endif
     if (mesh_tris) build_hash(&c, 2.0f * c.thickness);
     unsigned want = job->thread_count > 1 ? job->thread_count : 1;
+    if (cl->desc.solver == AK_CLOTH_IMPLICIT) want = 1;
     if (want > 1 && !job->exact_thread_count && cl->desc.solver != AK_CLOTH_SPRINGS) {
         /* one thread per THREAD_MIN_PER_COLOR constraints of an average colour */
         size_t colors = 0;
@@ -822,11 +1040,21 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
         pthread_cond_destroy(&c.cv);
         pthread_mutex_destroy(&c.m);
     }
+    /* the end of the step: start + displacement, kinematic particles exactly at their targets */
     bool finite = true;
     for (size_t v = 0; v < cl->n; ++v) {
-        job->positions.ptr[v] = c.x[v].p;
-        finite = finite && ak_vec3_is_finite(c.x[v].p) && ak_vec3_is_finite(c.v[v]);
+        const ak_vec3 x0 = job->positions.ptr[v], d = c.x[v].p, x1 = ak_vec3_add(x0, d);
+        job->positions.ptr[v] = x1;
+        /* what the rounding lost: d - (x1 - x0), both differences exact for |d| << |x0|
+         * (Sterbenz); kept when the caller keeps residuals. Velocities stay the integrated ones */
+        if (res) res[v] = ak_vec3_sub(d, ak_vec3_sub(x1, x0));
+
+        finite = finite && ak_vec3_is_finite(d) && ak_vec3_is_finite(c.v[v]);
     }
+    for (size_t k = 0; k < cl->pin_count; ++k) job->positions.ptr[cl->pins[k]] = cl->pin_pos[k];
+    for (size_t k = 0; k < cl->attach_count; ++k) job->positions.ptr[cl->attach[k]] = job->attachment_targets.ptr[k];
+    for (size_t v = 0; v < cl->n && res; ++v)
+        if (cl->inv_mass[v] == 0.0f) res[v] = ak_vec3_make(0, 0, 0);
     if (!finite) return AK_ERR_NO_CONVERGENCE;
     if (job->out_normals.ptr)
         ak_cloth_normals(cl, (ak_vec3_cspan){job->positions.ptr, cl->n}, job->out_normals);

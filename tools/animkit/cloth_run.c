@@ -87,7 +87,7 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
     int rc = CLI_OK;
     ak_result r = AK_OK;
     ak_cloth* cloth = NULL;
-    ak_vec3 *x = NULL, *vel = NULL, *nrm = NULL, *targets = NULL;
+    ak_vec3 *x = NULL, *vel = NULL, *nrm = NULL, *targets = NULL, *res = NULL;
     uint8_t* scratch = NULL;
     uint32_t* attach_idx = NULL;
     ak_cloth_capsule* caps = NULL;
@@ -110,12 +110,30 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
         rc = cli_fail(cmd, "%s: the cloth cannot be built: %s", name, ak_result_string(r));
         goto done;
     }
+    /* the spring solver is stable only below a substep it computes (ak_cloth_stable_substep):
+     * run at least dt / (0.9 h) substeps unless --substeps says otherwise */
+    if (sc->desc.solver == AK_CLOTH_SPRINGS) {
+        const double h = ak_cloth_stable_substep(cloth);
+        const double need = ceil((double)sc->dt / (0.9 * h));
+        if (isfinite(need) && need > (double)sc->substeps && !sc->substeps_forced) {
+            fprintf(stderr, "%s: mass-spring is stable below h = %.4g ms (the stiffest springs on the lightest particle, "
+                            "docs/cloth.md): %.0f substeps per step instead of %u\n",
+                    cmd, 1e3 * h, need, sc->substeps);
+            if (need > 10000.0) {
+                rc = cli_fail(cmd, "%s: the spring solver needs %.0f substeps per step (over 10000): lower dt or the "
+                                   "stiffness, or use --solver implicit or xpbd", name, need);
+                goto done;
+            }
+            sc->substeps = (uint32_t)need;
+        }
+    }
     n = ak_cloth_vertex_count(cloth);
     x = malloc(n * sizeof(ak_vec3));
     vel = calloc(n, sizeof(ak_vec3));
     nrm = malloc(n * sizeof(ak_vec3));
+    res = calloc(n, sizeof(ak_vec3));
     targets = calloc(sc->attach_count + 1, sizeof(ak_vec3));
-    if (!x || !vel || !nrm || !targets) {
+    if (!x || !vel || !nrm || !targets || !res) {
         rc = cli_fail(cmd, "out of memory");
         goto done;
     }
@@ -164,9 +182,11 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
             rc = cli_fail(cmd, "%s: cannot pose %s: %s", name, sc->model, ak_result_string(r));
             goto done;
         }
-        /* attachments keep their offset from the joint or skinned vertex at t = 0 */
+        /* attachments keep their offset from the joint or skinned vertex at t = 0, from their
+         * given start position or else their rest position */
         for (size_t k = 0; k < sc->attach_count; ++k) {
             const cloth_attach_spec* at = &sc->attach[k];
+            if (at->has_position) x[at->vertex] = at->position;
             const ak_vec3 p = x[at->vertex];
             char path[40];
             snprintf(path, sizeof path, "attachments[%zu]", k);
@@ -197,14 +217,17 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
     if (sc->capsule_count) memcpy(caps, sc->capsules, sc->capsule_count * sizeof(ak_cloth_capsule));
 
     job = (ak_cloth_step_job){
-        .cloth = cloth, .dt = sc->dt, .substeps = sc->substeps, .iterations = sc->iterations, .gravity = sc->gravity,
+        .cloth = cloth, .dt = sc->dt, .substeps = sc->substeps,
+        /* implicit: the scene's iterations cap CG only when given (else the library's 200) */
+        .iterations = sc->desc.solver == AK_CLOTH_IMPLICIT && !sc->iterations_given ? 0 : sc->iterations,
+        .gravity = sc->gravity,
         .drag = sc->drag, .lift = sc->lift, .air_density = sc->air_density, .damping = sc->damping,
         .planes = sc->planes, .plane_count = sc->plane_count, .spheres = sc->spheres, .sphere_count = sc->sphere_count,
         .capsules = caps, .capsule_count = sc->capsule_count + ch->bone_count,
         .thickness = sc->thickness, .friction = sc->friction, .self_collision = sc->self_collision,
         .self_distance = sc->self_distance,
         .attachment_targets = {targets, sc->attach_count}, .thread_count = (uint32_t)sc->thread_count,
-        .positions = {x, n}, .velocities = {vel, n}, .out_normals = {nrm, n},
+        .positions = {x, n}, .velocities = {vel, n}, .position_residuals = {res, n}, .out_normals = {nrm, n},
     };
     if (ch->scene && sc->mesh_collider && ch->mesh_tris)
         job.mesh = (ak_cloth_collider_mesh){{ch->mesh_pos, ch->mesh_vertices}, {ch->mesh_idx, ch->mesh_tris * 3}};
@@ -220,7 +243,7 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
 
 done:
     run->cloth = cloth;
-    run->x = x, run->vel = vel, run->nrm = nrm, run->targets = targets;
+    run->x = x, run->vel = vel, run->nrm = nrm, run->targets = targets, run->res = res;
     run->scratch = scratch, run->attach_idx = attach_idx, run->caps = caps;
     run->n = n;
     run->job = job;
@@ -287,7 +310,7 @@ void cloth_run_bounds(const cloth_run* run, ak_vec3* out_lo, ak_vec3* out_hi) {
 
 void cloth_run_free(cloth_run* run) {
     cloth_character_free(&run->ch);
-    free(run->x), free(run->vel), free(run->nrm), free(run->targets), free(run->scratch), free(run->attach_idx), free(run->caps);
+    free(run->x), free(run->res), free(run->vel), free(run->nrm), free(run->targets), free(run->scratch), free(run->attach_idx), free(run->caps);
     ak_cloth_destroy(run->cloth);
     memset(run, 0, sizeof *run);
 }

@@ -34,6 +34,7 @@ typedef struct cloth_run {
     cloth_character ch;
     ak_cloth* cloth;
     ak_vec3 *x, *vel, *nrm, *targets; /* [n], [n], [n], [attach_count] */
+    ak_vec3* res;                     /* [n] position residuals (the step's extra precision) */
     uint8_t* scratch;
     uint32_t* attach_idx;
     ak_cloth_capsule* caps; /* the scene's capsules, then the limb capsules */

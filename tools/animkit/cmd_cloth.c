@@ -12,17 +12,22 @@
 #include "sim_bake.h"
 
 static const char* const usage =
-    "usage: animkit cloth [SCENE.json | --preset flag|curtain|drape|cape] [--solver springs|xpbd]\n"
+    "usage: animkit cloth [SCENE.json | --preset flag|curtain|drape|cape] [--solver springs|implicit|xpbd]\n"
     "                     [--steps N] [--dt DT] [--substeps S] [--threads T] [--json OUT.json]\n"
     "                     [-o OUT.gif|OUT.png|OUT.obj|OUT.glb|OUT.gltf]\n"
     "Simulate a cloth: a flag in gusty wind, a curtain on rings, a square draped on a sphere, or a\n"
     "cape on builtin:humanoid walking; or the scene a JSON file describes (docs/cloth.md lists\n"
-    "every key). The solver is XPBD (compliant constraints, substeps) or the classic mass-spring\n"
-    "model (semi-implicit Euler, which needs small steps: raise --substeps if it blows up).\n"
+    "every key). The solver is XPBD (compliant constraints, substeps), the classic mass-spring\n"
+    "model (semi-implicit Euler, run at the substep count its stiffest springs need unless\n"
+    "--substeps is given), or the same springs under implicit Euler (Baraff-Witkin, stable at any step).\n"
     "--json writes {\"time\", \"positions\", \"max_stretch\", \"energy\"} of the final state;\n"
     "-o renders the run (GIF), its last frame (PNG), writes the last state as OBJ, or the whole run\n"
     "as glTF (.glb, or .gltf + .bin): morph-target animation of the cloth (docs/io.md).\n"
     "Exit status: 0 success, 1 bad scene or a blow-up (named by its step), 2 bad usage.\n";
+
+/* by ak_cloth_solver */
+static const char* const solver_names[AK_CLOTH_SOLVER_COUNT] = {"xpbd", "springs", "pbd", "implicit"};
+static const char* const solver_long[AK_CLOTH_SOLVER_COUNT] = {"XPBD", "mass-spring", "PBD", "implicit Euler"};
 
 /* ---- output ------------------------------------------------------------------------------ */
 
@@ -109,8 +114,9 @@ int cmd_cloth(int argc, char** argv) {
     if ((v = CLI_GET(&a, "--solver"))) {
         if (strcmp(v, "xpbd") == 0) sc.desc.solver = AK_CLOTH_XPBD;
         else if (strcmp(v, "springs") == 0) sc.desc.solver = AK_CLOTH_SPRINGS;
-        else rc = cli_usage("cloth", "--solver must be springs or xpbd, not '%s'", v);
-        if (sc.desc.solver == AK_CLOTH_SPRINGS &&
+        else if (strcmp(v, "implicit") == 0) sc.desc.solver = AK_CLOTH_IMPLICIT;
+        else rc = cli_usage("cloth", "--solver must be springs, implicit or xpbd, not '%s'", v);
+        if ((sc.desc.solver == AK_CLOTH_SPRINGS || sc.desc.solver == AK_CLOTH_IMPLICIT) &&
             (sc.desc.bending == AK_CLOTH_BEND_DIHEDRAL || sc.desc.bending == AK_CLOTH_BEND_ISOMETRIC))
             sc.desc.bending = AK_CLOTH_BEND_SPRINGS;
     }
@@ -125,7 +131,7 @@ int cmd_cloth(int argc, char** argv) {
     }
     if (!rc && (v = CLI_GET(&a, "--substeps"))) {
         if (!cli_parse_int(v, 1, 10000, &lv)) rc = cli_usage("cloth", "--substeps must be 1..10000");
-        else sc.substeps = (uint32_t)lv;
+        else sc.substeps = (uint32_t)lv, sc.substeps_forced = true;
     }
     if (!rc && (v = CLI_GET(&a, "--threads"))) {
         if (!cli_parse_int(v, 1, 64, &lv)) rc = cli_usage("cloth", "--threads must be 1..64");
@@ -146,12 +152,12 @@ int cmd_cloth(int argc, char** argv) {
     memset(&bake, 0, sizeof bake);
 
     memset(&run, 0, sizeof run);
-    rc = cli_work_check("cloth",
+    rc = cloth_run_init(&run, &sc, "cloth", name); /* (the spring solver's substeps are known after it) */
+    if (!rc) rc = cli_work_check("cloth",
                         (double)sc.desc.grid_width * (double)sc.desc.grid_height * (double)sc.steps *
                             (double)sc.substeps * (double)sc.iterations,
                         "particle updates (particles x steps x substeps x iterations)",
                         "--steps, --substeps, the scene's \"iterations\" or the grid size");
-    if (!rc) rc = cloth_run_init(&run, &sc, "cloth", name);
     if (rc) goto done;
     if (sim_bake_wanted(out) && (rc = sim_bake_mesh_init(&bake, "cloth", out, run.n, sc.steps))) goto done;
     cloth_character* const ch = &run.ch;
@@ -168,8 +174,9 @@ int cmd_cloth(int argc, char** argv) {
     if (gif || png) {
         ak_vec3 lo, hi;
         cloth_run_bounds(&run, &lo, &hi);
-        /* a character faces +Z: look from behind, where a cape hangs */
-        if (cli_frame_init(&frame, ch->scene, 480, 360, lo, hi, ch->scene ? 3.6f : 0.6f) || cli_image_alloc(&img, 480, 360)) {
+        /* a character faces +Z: look from behind and to its left, where a cape hangs and the
+         * key light (from the front left) still grazes it */
+        if (cli_frame_init(&frame, ch->scene, 480, 360, lo, hi, ch->scene ? 2.5f : 0.6f) || cli_image_alloc(&img, 480, 360)) {
             rc = cli_fail("cloth", "out of memory");
             goto done;
         }
@@ -210,7 +217,7 @@ int cmd_cloth(int argc, char** argv) {
                                                .indices = {props[k].idx, PROP_TRIS * 3},
                                                .material = {.color = {0.55f, 0.62f, 0.72f, 1}}};
             char title[160];
-            snprintf(title, sizeof title, "cloth %s  %s  t=%.2fs", preset ? preset : "", sc.desc.solver == AK_CLOTH_SPRINGS ? "springs" : sc.desc.solver == AK_CLOTH_PBD ? "pbd" : "xpbd", (double)time);
+            snprintf(title, sizeof title, "cloth %s  %s  t=%.2fs", preset ? preset : "", solver_names[sc.desc.solver < AK_CLOTH_SOLVER_COUNT ? sc.desc.solver : 0], (double)time);
             cli_draw_opts o = {.title = title, .extra = extra, .extra_count = ne};
             r = cli_frame_draw(&frame, ch->scene ? &ch->poser : NULL, &o, &img);
             if (r == AK_OK) r = gif ? ak_gif_writer_add_frame(gw, &img) : ak_png_write(out, &img);
@@ -250,7 +257,7 @@ int cmd_cloth(int argc, char** argv) {
         goto done;
     printf("cloth %s: %s, %zu particles, %ld steps of %.4g s (%u substeps): t = %.3g s, max stretch %.4f, energy %.6g J"
            " (kinetic %.3g)\n",
-           name, sc.desc.solver == AK_CLOTH_SPRINGS ? "mass-spring" : sc.desc.solver == AK_CLOTH_PBD ? "PBD" : "XPBD", n,
+           name, solver_long[sc.desc.solver < AK_CLOTH_SOLVER_COUNT ? sc.desc.solver : 0], n,
            sc.steps, (double)sc.dt, sc.substeps, (double)time, (double)stretch, e.total, e.kinetic);
     if (gif) fprintf(stderr, "wrote %s: %d frames\n", out, frames);
     else if (bake.cap) fprintf(stderr, "wrote %s: %zu frames, %.4g s apart\n", out, bake.frames, (double)sc.dt * (double)bake.every);

@@ -34,11 +34,12 @@ void cloth_scene_defaults(cloth_scene* s) {
 
 void cloth_scene_free(cloth_scene* s) {
     free(s->pins);
+    free(s->pin_positions);
     free(s->attach);
     free(s->planes);
     free(s->spheres);
     free(s->capsules);
-    s->pins = NULL, s->attach = NULL, s->planes = NULL, s->spheres = NULL, s->capsules = NULL;
+    s->pins = NULL, s->pin_positions = NULL, s->attach = NULL, s->planes = NULL, s->spheres = NULL, s->capsules = NULL;
 }
 
 static bool set_str(cli_json* j, const cJSON* obj, const char* path, const char* key, char* dst, size_t size) {
@@ -124,6 +125,40 @@ static void parse_pins(cli_json* j, const cJSON* root, cloth_scene* s) {
     }
 }
 
+static void parse_pin_positions(cli_json* j, const cJSON* root, cloth_scene* s) {
+    size_t n = 0;
+    const cJSON* e = cli_json_array(j, root, "", "pin_positions", CLOTH_SCENE_MAX_LIST, &n);
+    if (!e || j->failed) return;
+    if (n != s->pin_count) {
+        cli_json_fail(j, "", "pin_positions", "has %zu entries for %zu pins (one per pin, in order)", n, s->pin_count);
+        return;
+    }
+    s->pin_positions = calloc(n, sizeof(ak_vec3));
+    if (!s->pin_positions) {
+        cli_json_fail(j, "", "pin_positions", "out of memory");
+        return;
+    }
+    for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+        char path[40];
+        cli_json_index(path, sizeof path, "pin_positions", k);
+        if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != 3) {
+            cli_json_fail(j, path, "", "expected [x, y, z]");
+            break;
+        }
+        float c[3];
+        for (int q = 0; q < 3; ++q) {
+            const cJSON* x = cJSON_GetArrayItem(e, q);
+            if (!cJSON_IsNumber(x) || !(fabs(x->valuedouble) <= 1e6)) {
+                cli_json_fail(j, path, "", "expected three numbers within 1e6 m");
+                break;
+            }
+            c[q] = (float)x->valuedouble;
+        }
+        s->pin_positions[k] = ak_vec3_make(c[0], c[1], c[2]);
+        s->pin_position_count = k + 1;
+    }
+}
+
 static void parse_attachments(cli_json* j, const cJSON* root, cloth_scene* s) {
     size_t n = 0;
     const cJSON* e = cli_json_array(j, root, "", "attachments", CLOTH_SCENE_MAX_LIST, &n);
@@ -133,7 +168,7 @@ static void parse_attachments(cli_json* j, const cJSON* root, cloth_scene* s) {
         cli_json_fail(j, "", "attachments", "out of memory");
         return;
     }
-    static const char* const keys[] = {"vertex", "joint", "mesh_vertex", NULL};
+    static const char* const keys[] = {"vertex", "joint", "mesh_vertex", "position", NULL};
     const long count = (long)s->desc.grid_width * s->desc.grid_height;
     for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
         char path[40];
@@ -149,6 +184,8 @@ static void parse_attachments(cli_json* j, const cJSON* root, cloth_scene* s) {
         cli_json_int(j, e, path, "vertex", 0, count - 1, &v);
         set_str(j, e, path, "joint", a->joint, sizeof a->joint);
         cli_json_int(j, e, path, "mesh_vertex", 0, 100000000L, &a->mesh_vertex);
+        a->has_position = cJSON_GetObjectItemCaseSensitive(e, "position") != NULL;
+        cli_json_vec3(j, e, path, "position", &a->position);
         if (j->failed) break;
         if (v < 0) cli_json_fail(j, path, "vertex", "is required");
         else if ((a->joint[0] != '\0') == (a->mesh_vertex >= 0)) cli_json_fail(j, path, "", "give exactly one of joint, mesh_vertex");
@@ -240,11 +277,11 @@ bool cloth_scene_parse(const char* file, const char* text, size_t size, cloth_sc
     cli_json j = {.file = file ? file : "scene"};
     cJSON* root = cli_json_parse(&j, text, size);
     if (root) {
-        static const char* const keys[] = {"solver", "grid", "material", "pins", "attachments", "dt", "steps",
+        static const char* const keys[] = {"solver", "grid", "material", "pins", "pin_positions", "attachments", "dt", "steps",
                                            "substeps", "iterations", "threads", "gravity", "wind", "gust",
                                            "gust_frequency", "drag", "lift", "air_density", "damping", "colliders",
                                            "character", NULL};
-        static const char* const solvers[] = {"xpbd", "springs", "pbd", NULL};
+        static const char* const solvers[] = {"xpbd", "springs", "pbd", "implicit", NULL}; /* enum order */
         cli_json_object(&j, root, "", keys);
         int solver = 0;
         cli_json_enum(&j, root, "", "solver", solvers, &solver);
@@ -252,6 +289,7 @@ bool cloth_scene_parse(const char* file, const char* text, size_t size, cloth_sc
         parse_grid(&j, root, out);
         parse_material(&j, root, out);
         parse_pins(&j, root, out);
+        parse_pin_positions(&j, root, out);
         parse_attachments(&j, root, out);
         cli_json_float(&j, root, "", "dt", 1e-7f, 1.0f, &out->dt);
         cli_json_int(&j, root, "", "steps", 0, CLOTH_SCENE_MAX_STEPS, &out->steps);
@@ -260,6 +298,7 @@ bool cloth_scene_parse(const char* file, const char* text, size_t size, cloth_sc
         cli_json_int(&j, root, "", "iterations", 1, 10000, &it);
         cli_json_int(&j, root, "", "threads", 1, 64, &th);
         out->substeps = (uint32_t)sub, out->iterations = (uint32_t)it, out->thread_count = (int)th;
+        out->iterations_given = cJSON_GetObjectItemCaseSensitive(root, "iterations") != NULL;
         cli_json_vec3(&j, root, "", "gravity", &out->gravity);
         cli_json_vec3(&j, root, "", "wind", &out->wind);
         cli_json_float(&j, root, "", "gust", 0.0f, 10.0f, &out->gust);
@@ -280,6 +319,7 @@ bool cloth_scene_parse(const char* file, const char* text, size_t size, cloth_sc
         return false;
     }
     out->desc.pins = (ak_u32_cspan){out->pins, out->pin_count};
+    out->desc.pin_positions = (ak_vec3_cspan){out->pin_positions, out->pin_position_count};
     return true;
 }
 
@@ -297,14 +337,15 @@ bool cloth_scene_preset(const char* name, cloth_scene* s) {
         s->drag = 1.0f, s->lift = 0.6f;
         s->steps = 240;
     } else if (strcmp(name, "curtain") == 0) {
-        /* a 2 x 1.5 m curtain on rings (every third top particle), a breeze through it */
+        /* a 2 x 1.5 m curtain on 14 rings (every third top particle) gathered on the rod (see
+         * below), a light breeze through it */
         d->grid_width = 40, d->grid_height = 30, d->spacing = 0.05f;
         d->grid_origin = ak_vec3_make(-1.0f, 1.6f, 0);
         d->grid_axis_u = ak_vec3_make(1, 0, 0), d->grid_axis_v = ak_vec3_make(0, -1, 0);
         s->pin_count = 14;
-        s->wind = ak_vec3_make(0, 0, 1.5f);
-        s->gust = 1.0f, s->gust_frequency = 0.3f;
-        s->drag = 1.0f, s->lift = 0.5f;
+        s->wind = ak_vec3_make(0, 0, 0.6f);
+        s->gust = 0.8f, s->gust_frequency = 0.3f;
+        s->drag = 1.0f, s->lift = 0.3f;
         s->damping = 0.2f;
         s->steps = 240;
     } else if (strcmp(name, "drape") == 0) {
@@ -317,14 +358,20 @@ bool cloth_scene_preset(const char* name, cloth_scene* s) {
         s->damping = 0.5f;
         s->steps = 300;
     } else if (strcmp(name, "cape") == 0) {
-        /* a 0.4 x 0.9 m cape hung from the humanoid's upper back (spine_02), walking */
-        d->grid_width = 12, d->grid_height = 26, d->spacing = 0.4f / 11.0f;
-        d->grid_origin = ak_vec3_make(-0.2f, 1.43f, -0.13f);
+        /* a 0.38 x 0.95 m cape on the humanoid's back, walking (in place) into a gusty 1.8 m/s
+         * head wind that streams it back: its top row lies across the shoulder blades,
+         * attached to the upper spine (spine_02); soft bending (the default), drag and lift,
+         * long-range attachments with slack */
+        d->grid_width = 12, d->grid_height = 30, d->spacing = 0.38f / 11.0f;
+        d->grid_origin = ak_vec3_make(-0.19f, 1.44f, -0.15f);
         d->grid_axis_u = ak_vec3_make(1, 0, 0), d->grid_axis_v = ak_vec3_make(0, -1, 0);
         d->long_range_attachments = true;
-        d->long_range_slack = 0.05f;
+        d->long_range_slack = 0.15f;
         s->attach_count = 12;
-        s->damping = 0.5f;
+        s->wind = ak_vec3_make(0.3f, 0, -1.8f);
+        s->gust = 0.5f, s->gust_frequency = 0.7f;
+        s->drag = 1.0f, s->lift = 0.3f;
+        s->damping = 0.3f;
         s->friction = 0.2f;
         s->steps = 180;
         snprintf(s->model, sizeof s->model, "builtin:humanoid");
@@ -352,8 +399,28 @@ bool cloth_scene_preset(const char* name, cloth_scene* s) {
             s->attach[k].vertex = (uint32_t)k;
             s->attach[k].mesh_vertex = -1;
             snprintf(s->attach[k].joint, sizeof s->attach[k].joint, "spine_02");
+            if (strcmp(name, "cape") == 0) {
+                /* the top row gathered on a collar: an arc of radius 0.15 m round the back of
+                 * the neck, 130 degrees (0.34 m for 0.38 m of cloth), so the cape wraps the
+                 * shoulders and falls in folds instead of hanging as a flat board */
+                const float phi = (-65.0f + 130.0f * (float)k / (float)(s->attach_count - 1)) * AK_PI / 180.0f;
+                s->attach[k].has_position = true;
+                s->attach[k].position = ak_vec3_make(0.15f * sinf(phi), 1.46f, -0.01f - 0.15f * cosf(phi));
+            }
+        }
+    }
+    if (strcmp(name, "curtain") == 0) {
+        /* rings gathered on the rod to 60% of the curtain's width, alternately 4 cm in front of
+         * and behind it: the cloth between them falls in folds */
+        s->pin_positions = calloc(s->pin_count, sizeof(ak_vec3));
+        if (!s->pin_positions) return false;
+        s->pin_position_count = s->pin_count;
+        for (size_t k = 0; k < s->pin_count; ++k) {
+            const ak_vec3 rest = ak_vec3_madd(d->grid_origin, d->grid_axis_u, d->spacing * (float)s->pins[k]);
+            s->pin_positions[k] = ak_vec3_make(0.6f * rest.x, rest.y, (k & 1) ? 0.04f : -0.04f);
         }
     }
     d->pins = (ak_u32_cspan){s->pins, s->pin_count};
+    d->pin_positions = (ak_vec3_cspan){s->pin_positions, s->pin_position_count};
     return true;
 }

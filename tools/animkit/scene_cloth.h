@@ -17,18 +17,25 @@ typedef struct cloth_attach_spec {
     uint32_t vertex;     /* cloth vertex */
     char joint[64];      /* follow this joint rigidly ("" -> mesh_vertex) */
     long mesh_vertex;    /* or follow this skinned vertex of the character's mesh 0 (-1: joint) */
+    bool has_position;   /* position given: the vertex starts there (else at its rest position) */
+    ak_vec3 position;    /* world, at t = 0: where the attachment holds it (gathers a collar) */
 } cloth_attach_spec;
 
 typedef struct cloth_scene {
     ak_cloth_desc desc;        /* grid, material, solver (spans point into the arrays below) */
     uint32_t* pins;            /* [pin_count] */
     size_t pin_count;
+    ak_vec3* pin_positions;    /* [pin_position_count]: 0 (rest positions) or pin_count */
+    size_t pin_position_count;
     cloth_attach_spec* attach; /* [attach_count] */
     size_t attach_count;
     /* stepping */
     float dt;                  /* seconds per step */
     long steps;
     uint32_t substeps, iterations;
+    bool iterations_given;     /* the scene says "iterations" (else implicit uses its own cap) */
+    bool substeps_forced;      /* --substeps given: the spring solver keeps it even below its
+                                  stable count (otherwise it runs at least that count) */
     ak_vec3 gravity, wind;
     float gust;                /* wind *= 1 + gust * sin(2 pi gust_frequency t) */
     float gust_frequency;
