@@ -2323,8 +2323,10 @@ AK_TEST(obj_four_line_crash_file) {
     AK_CHECK(s == NULL);
     if (r != AK_OK) {
         AK_CHECK_EQ(r, AK_ERR_IO);
-        AK_CHECK_MSG(strstr(diag.message, "Assimp crashed reading") != NULL && strstr(diag.message, "signal 11"), "%s",
-                     diag.message);
+        /* SIGSEGV (11); under AddressSanitizer its handler turns the crash into an abort (6) */
+        AK_CHECK_MSG(strstr(diag.message, "Assimp crashed reading") != NULL &&
+                         (strstr(diag.message, "signal 11") || strstr(diag.message, "signal 6")),
+                     "%s", diag.message);
     } else {
         printf("  (this Assimp does not crash on the file)\n");
     }
@@ -2631,7 +2633,7 @@ AK_TEST(assimp_child_crash_and_hang) {
     write_file("child.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 32);
     ak_io_desc as_assimp = {.format = AK_IO_FORMAT_ASSIMP};
     static const char* hooks[2] = {"segv", "hang"};
-    static const char* want[2] = {"Assimp crashed reading child.obj (signal 11", "Assimp ran out of its time limit"};
+    static const char* want[2] = {"Assimp crashed reading child.obj (signal ", "Assimp ran out of its time limit"};
     for (int i = 0; i < 2; ++i) {
         setenv("AK_IO_TEST_ASSIMP_CHILD", hooks[i], 1);
         ak_scene* s = NULL;

@@ -890,6 +890,7 @@ typedef struct as_rbuf {
 } as_rbuf;
 
 static bool rb_get(as_rbuf* b, void* out, size_t size) {
+    if (size == 0) return !b->bad; /* out may be NULL then (an empty array) */
     if (b->bad || size > b->n - b->at) {
         b->bad = true;
         memset(out, 0, size);

@@ -227,6 +227,7 @@ static int material_cmp(const void* a, const void* b) {
 }
 
 static const ob_material* find_material(const ob_ctx* c, const char* name) {
+    if (c->material_count == 0) return NULL; /* bsearch on a NULL array is undefined even for 0 */
     ob_material key;
     snprintf(key.name, sizeof key.name, "%s", name);
     return (const ob_material*)bsearch(&key, c->materials, c->material_count, sizeof key, material_cmp);
