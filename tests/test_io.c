@@ -1487,7 +1487,8 @@ AK_TEST(bvh_mesh_skin_through_assimp) {
     ak_io_desc desc = {.keep_bvh_mesh = true, .format = AK_IO_FORMAT_ASSIMP};
     ak_scene* s = NULL;
     ak_diag diag;
-    AK_CHECK_EQ(ak_io_load(path, &desc, NULL, &s, &diag), AK_OK);
+    ak_result lr = ak_io_load(path, &desc, NULL, &s, &diag);
+    AK_CHECK_MSG(lr == AK_OK, "%s: %s", ak_result_name(lr), diag.message);
     if (!s) return;
     AK_CHECK_EQ(s->mesh_count, 1);
     AK_CHECK_EQ(s->skin_count, 1);
@@ -1992,7 +1993,8 @@ static void compare_bvh_readers(const char* rel) {
     ak_scene *own = NULL, *ref = NULL;
     ak_diag diag;
     AK_CHECK_EQ(ak_io_load(path, NULL, NULL, &own, &diag), AK_OK);
-    AK_CHECK_EQ(ak_io_load(path, &via_assimp, NULL, &ref, &diag), AK_OK);
+    ak_result lr = ak_io_load(path, &via_assimp, NULL, &ref, &diag);
+    AK_CHECK_MSG(lr == AK_OK, "%s: %s", ak_result_name(lr), diag.message);
     if (!own || !ref) {
         ak_scene_destroy(own);
         ak_scene_destroy(ref);

@@ -727,7 +727,8 @@ static ak_result import_here(const char* path, const ak_io_desc* desc, const ak_
  * space (RLIMIT_AS, the memory budget plus AS_HEADROOM; not under the sanitizers, whose
  * shadow memory needs terabytes of address space), CPU time (RLIMIT_CPU,
  * AK_IO_ASSIMP_SECONDS), no file writes (RLIMIT_FSIZE 0), few descriptors (RLIMIT_NOFILE),
- * no core dumps. The parent waits at most AK_IO_ASSIMP_SECONDS + AS_GRACE seconds of wall
+ * no core dumps; under valgrind neither the address-space nor the file-size limit (valgrind
+ * needs the space and writes files of its own). The parent waits at most AK_IO_ASSIMP_SECONDS + AS_GRACE seconds of wall
  * time, then kills it. The child converts the scene as before and sends it back over a pipe
  * (warnings first, then the scene or the error); the parent checks every count and index
  * while it rebuilds the scene with its own allocator, so a child that went wrong cannot make
@@ -836,15 +837,20 @@ static void put_scene(as_wbuf* b, const ak_scene* s, const as_wbuf* clips) {
 
 /* The child: limits, import, one message, _exit (no atexit handlers, no leak checks). */
 static void child_main(int fd, const char* path, const ak_io_desc* desc, size_t memory) {
+    /* Under valgrind (its preload library in LD_PRELOAD) the tool itself writes files (its
+     * gdbserver's shared memory) and needs far more address space than the budget, as the
+     * sanitizers do: no file-size and address-space limits then. */
+    const char* preload = getenv("LD_PRELOAD");
+    const bool under_valgrind = preload && strstr(preload, "vgpreload") != NULL;
     struct rlimit lim;
     lim.rlim_cur = lim.rlim_max = 0;
     setrlimit(RLIMIT_CORE, &lim);
-    setrlimit(RLIMIT_FSIZE, &lim);
+    if (!under_valgrind) setrlimit(RLIMIT_FSIZE, &lim);
     lim.rlim_cur = lim.rlim_max = AK_IO_ASSIMP_SECONDS;
     setrlimit(RLIMIT_CPU, &lim);
     lim.rlim_cur = lim.rlim_max = 64;
     setrlimit(RLIMIT_NOFILE, &lim);
-    if (!AS_SANITIZED) {
+    if (!AS_SANITIZED && !under_valgrind) {
         lim.rlim_cur = lim.rlim_max = (rlim_t)memory;
         setrlimit(RLIMIT_AS, &lim);
     }
