@@ -1,4 +1,4 @@
-/* Result strings, version; the internal atomic output files (internal.h). */
+/* Result strings, version; output files written whole or not at all (ak_atomic_file). */
 #include <errno.h>
 #include <fcntl.h>    /* open: O_EXCL for the temporary */
 #include <stdint.h>
@@ -34,7 +34,7 @@ const char* ak_result_name(ak_result result) {
 
 const char* ak_version_string(void) { return "0.1.0"; }
 
-/* ---- internal: atomic output files ---------------------------------------------------------- */
+/* ---- atomic output files -------------------------------------------------------------------- */
 
 /* "DIR/.BASE.XXXXXX" for path "DIR/BASE" (or ".BASE.XXXXXX" without a slash); false when the
  * name does not fit or path names a directory (ends in '/'). */
@@ -51,7 +51,7 @@ static bool temp_name(const char* path, uint64_t salt, char* out, size_t cap) {
     return n > 0 && (size_t)n < cap;
 }
 
-int akp_file_atomic_open_fd(akp_file_atomic* a, const char* path) {
+int ak_atomic_file_open_fd(ak_atomic_file* a, const char* path) {
     memset(a, 0, sizeof *a);
     if (!path || strlen(path) >= sizeof a->path) {
         a->err = ENAMETOOLONG;
@@ -87,20 +87,20 @@ int akp_file_atomic_open_fd(akp_file_atomic* a, const char* path) {
     return -1;
 }
 
-ak_result akp_file_atomic_open(akp_file_atomic* a, const char* path) {
-    int fd = akp_file_atomic_open_fd(a, path);
+ak_result ak_atomic_file_open(ak_atomic_file* a, const char* path) {
+    int fd = ak_atomic_file_open_fd(a, path);
     if (fd < 0) return AK_ERR_IO;
     a->f = fdopen(fd, "wb");
     if (!a->f) {
         a->err = errno;
         close(fd);
-        akp_file_atomic_abort(a);
+        ak_atomic_file_abort(a);
         return AK_ERR_IO;
     }
     return AK_OK;
 }
 
-ak_result akp_file_atomic_close(akp_file_atomic* a) {
+ak_result ak_atomic_file_close(ak_atomic_file* a) {
     if (!a->f) return a->tmp[0] ? AK_OK : AK_ERR_IO;
     bool ok = true;
     if (fflush(a->f) != 0) ok = false, a->err = a->err ? a->err : errno;
@@ -108,29 +108,29 @@ ak_result akp_file_atomic_close(akp_file_atomic* a) {
     if (fclose(a->f) != 0) ok = false, a->err = a->err ? a->err : errno;
     a->f = NULL;
     if (!ok) {
-        akp_file_atomic_abort(a);
+        ak_atomic_file_abort(a);
         return AK_ERR_IO;
     }
     return AK_OK;
 }
 
-ak_result akp_file_atomic_rename(akp_file_atomic* a) {
+ak_result ak_atomic_file_rename(ak_atomic_file* a) {
     if (!a->tmp[0]) return AK_ERR_IO;
     if (rename(a->tmp, a->path) != 0) {
         a->err = errno;
-        akp_file_atomic_abort(a);
+        ak_atomic_file_abort(a);
         return AK_ERR_IO;
     }
     a->tmp[0] = '\0';
     return AK_OK;
 }
 
-ak_result akp_file_atomic_commit(akp_file_atomic* a) {
-    ak_result r = akp_file_atomic_close(a);
-    return r == AK_OK ? akp_file_atomic_rename(a) : r;
+ak_result ak_atomic_file_commit(ak_atomic_file* a) {
+    ak_result r = ak_atomic_file_close(a);
+    return r == AK_OK ? ak_atomic_file_rename(a) : r;
 }
 
-void akp_file_atomic_abort(akp_file_atomic* a) {
+void ak_atomic_file_abort(ak_atomic_file* a) {
     if (a->f) fclose(a->f);
     a->f = NULL;
     if (a->tmp[0]) unlink(a->tmp);

@@ -9,7 +9,7 @@
 
 #include <animkit/terrain.h>
 
-#include "internal.h" /* akp_file_atomic: outputs written whole or not at all */
+#include "internal.h" /* ak_atomic_file: outputs written whole or not at all */
 
 #define AKP_TERRAIN_MAX_SIDE 16384u
 
@@ -401,8 +401,8 @@ ak_result ak_terrain_write_obj(const char* path, const ak_terrain_desc* desc, ak
     const ak_terrain_desc d = ak_terrain_desc_resolved(desc);
     const size_t n = sample_count(&d);
     if (heights.count < n || normals.count < n) return AK_ERR_SPAN_SMALL;
-    akp_file_atomic out; /* a temporary renamed over path once complete (internal.h) */
-    if (akp_file_atomic_open(&out, path) != AK_OK) return AK_ERR_IO;
+    ak_atomic_file out; /* a temporary renamed over path once complete (internal.h) */
+    if (ak_atomic_file_open(&out, path) != AK_OK) return AK_ERR_IO;
     FILE* f = out.f;
     const uint32_t w = d.width, h = d.height;
     fprintf(f, "# animkit terrain %ux%u, world %g m\no terrain\n", w, h, (double)d.world_size);
@@ -422,7 +422,7 @@ ak_result ak_terrain_write_obj(const char* path, const ak_terrain_desc* desc, ak
             fprintf(f, "f %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu\n", a, a, a, c, c, c, b, b, b);
             fprintf(f, "f %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu\n", b, b, b, c, c, c, e, e, e);
         }
-    return akp_file_atomic_commit(&out);
+    return ak_atomic_file_commit(&out);
 }
 
 typedef struct png_jmp {
@@ -488,11 +488,11 @@ ak_result ak_terrain_write_png16(const char* path, const ak_terrain_desc* desc, 
         }
     }
     const double scale = hi > lo ? 65535.0 / ((double)hi - lo) : 0.0;
-    akp_file_atomic out; /* a temporary renamed over path once complete (internal.h) */
-    if (akp_file_atomic_open(&out, path) != AK_OK) return AK_ERR_IO;
+    ak_atomic_file out; /* a temporary renamed over path once complete (internal.h) */
+    if (ak_atomic_file_open(&out, path) != AK_OK) return AK_ERR_IO;
     if (!write_png16_rows(out.f, heights.ptr, d.width, d.height, lo, scale)) {
-        akp_file_atomic_abort(&out);
+        ak_atomic_file_abort(&out);
         return AK_ERR_IO;
     }
-    return akp_file_atomic_commit(&out);
+    return ak_atomic_file_commit(&out);
 }

@@ -1,5 +1,5 @@
 /* Output files of every animkit command are written whole or not at all (a temporary beside
- * the path, renamed into place: src/internal.h akp_file_atomic, tools/animkit/outfile.c).
+ * the path, renamed into place: animkit/core.h ak_atomic_file, tools/animkit/outfile.c).
  * Each command runs under a file size limit (RLIMIT_FSIZE set in the child before exec,
  * SIGXFSZ ignored, as `ulimit -f` leaves a shell) and must exit 1 with a message naming the
  * path and leave no file and no temporary; a symlink or an existing file named as the output

@@ -26,6 +26,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h> /* FILE: ak_atomic_file */
 
 #ifdef __cplusplus
 extern "C" {
@@ -195,6 +196,44 @@ static inline double ak_rng_double(ak_rng* r) {
 
 /* Size of the fixed name buffers in joints, meshes, clips (names are truncated to fit). */
 #define AK_NAME_SIZE 64
+
+/* ---- output files written whole or not at all ---------------------------------------------
+ * The library's writers (PNG, GIF, OBJ, glTF, terrain, weights) and the command line write
+ * every output through this: a temporary ".NAME.XXXXXXX" is created beside the named path (the
+ * same directory, so the rename stays on one file system) and renamed over the path only after
+ * every write, the flush and the close succeeded. On any failure the temporary is removed and
+ * the named path is never touched: an existing file keeps its contents, and a symlink named as
+ * the output survives. On success the rename replaces what the path names: a symlink there is
+ * replaced by the new file (its target is left alone). The new file gets 0666 less the umask,
+ * or the mode of the regular file it replaces. No fsync: this guards against failed writes
+ * (full disk, file size limit, EIO), not against power loss.
+ *
+ *     ak_atomic_file out;
+ *     if (ak_atomic_file_open(&out, "scene.json") != AK_OK) -> strerror(out.err)
+ *     fprintf(out.f, ...);
+ *     if (ak_atomic_file_commit(&out) != AK_OK) -> strerror(out.err); nothing left behind */
+#define AK_ATOMIC_FILE_PATH_SIZE 4096
+typedef struct ak_atomic_file {
+    FILE* f;                                /* the temporary, open "wb" (ak_atomic_file_open only) */
+    int err;                                /* errno of the first failure (0 when none known) */
+    char path[AK_ATOMIC_FILE_PATH_SIZE];    /* the named output */
+    char tmp[AK_ATOMIC_FILE_PATH_SIZE + 32]; /* the temporary; "" once renamed or removed */
+} ak_atomic_file;
+
+/* Create the temporary and open it as a->f. AK_ERR_IO (a->err says why; nothing created). */
+AK_API ak_result ak_atomic_file_open(ak_atomic_file* a, const char* path);
+/* The same with a plain descriptor (a->f stays NULL) for writers that take an fd and close it
+ * themselves (giflib); returns it, or -1 (a->err says why). */
+AK_API int ak_atomic_file_open_fd(ak_atomic_file* a, const char* path);
+/* Flush, check and close a->f (when open); on failure remove the temporary. AK_OK or AK_ERR_IO. */
+AK_API ak_result ak_atomic_file_close(ak_atomic_file* a);
+/* Rename the closed temporary over the path; on failure remove it. AK_OK or AK_ERR_IO. */
+AK_API ak_result ak_atomic_file_rename(ak_atomic_file* a);
+/* close, then rename. */
+AK_API ak_result ak_atomic_file_commit(ak_atomic_file* a);
+/* Close a->f (when open) and remove the temporary (when there is one); idempotent, and fine on
+ * a zeroed ak_atomic_file. */
+AK_API void ak_atomic_file_abort(ak_atomic_file* a);
 
 /* ---- version ------------------------------------------------------------------------ */
 

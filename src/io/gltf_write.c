@@ -793,17 +793,17 @@ static void put_u32(uint8_t* p, uint32_t v) {
 }
 
 /* Write a then b to a temporary beside path and close it (internal.h); out keeps it for
- * akp_file_atomic_rename. On failure nothing is left and path is untouched. */
+ * ak_atomic_file_rename. On failure nothing is left and path is untouched. */
 static ak_result write_bytes(w_ctx* c, const char* path, const void* a, size_t an, const void* b, size_t bn,
-                             akp_file_atomic* out) {
-    if (akp_file_atomic_open(out, path) != AK_OK) {
+                             ak_atomic_file* out) {
+    if (ak_atomic_file_open(out, path) != AK_OK) {
         akp_diag_set(c->diag, path, "cannot create file (%s)", strerror(out->err));
         return AK_ERR_IO;
     }
     bool ok = fwrite(a, 1, an, out->f) == an && (!bn || fwrite(b, 1, bn, out->f) == bn);
     if (!ok) out->err = errno;
-    if (!ok || akp_file_atomic_close(out) != AK_OK) {
-        akp_file_atomic_abort(out);
+    if (!ok || ak_atomic_file_close(out) != AK_OK) {
+        ak_atomic_file_abort(out);
         akp_diag_set(c->diag, path, "cannot write file (%s)", strerror(out->err ? out->err : EIO));
         return AK_ERR_IO;
     }
@@ -811,8 +811,8 @@ static ak_result write_bytes(w_ctx* c, const char* path, const void* a, size_t a
 }
 
 /* Put a closed temporary in place; the diag names path when that fails. */
-static ak_result rename_into_place(w_ctx* c, akp_file_atomic* out) {
-    if (akp_file_atomic_rename(out) == AK_OK) return AK_OK;
+static ak_result rename_into_place(w_ctx* c, ak_atomic_file* out) {
+    if (ak_atomic_file_rename(out) == AK_OK) return AK_OK;
     akp_diag_set(c->diag, out->path, "cannot write file (%s)", strerror(out->err ? out->err : EIO));
     return AK_ERR_IO;
 }
@@ -938,8 +938,8 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
         }
     }
     /* the temporaries of the file and its .bin (16 KiB: kept off the stack) */
-    akp_file_atomic* out = NULL;
-    if (r == AK_OK && !(out = (akp_file_atomic*)calloc(2, sizeof *out))) r = oom(&c);
+    ak_atomic_file* out = NULL;
+    if (r == AK_OK && !(out = (ak_atomic_file*)calloc(2, sizeof *out))) r = oom(&c);
     char* json = NULL;
     if (r == AK_OK && !(json = glb ? cJSON_PrintUnformatted(c.root) : cJSON_Print(c.root))) r = oom(&c);
     if (r == AK_OK && glb) {
@@ -977,8 +977,8 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
         if (r == AK_OK) r = write_bytes(&c, path, json, strlen(json), "\n", 1, out);
         if (r == AK_OK && c.bin_size) r = rename_into_place(&c, &out[1]);
         if (r == AK_OK) r = rename_into_place(&c, out);
-        akp_file_atomic_abort(&out[1]);
-        akp_file_atomic_abort(out);
+        ak_atomic_file_abort(&out[1]);
+        ak_atomic_file_abort(out);
     }
     free(out);
     free(json);

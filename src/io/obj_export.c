@@ -29,8 +29,8 @@ ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3
             }
         }
     }
-    akp_file_atomic out; /* a temporary renamed over path once complete (internal.h) */
-    if (akp_file_atomic_open(&out, path) != AK_OK) {
+    ak_atomic_file out; /* a temporary renamed over path once complete (internal.h) */
+    if (ak_atomic_file_open(&out, path) != AK_OK) {
         akp_diag_set(diag, path, "cannot create file (%s)", strerror(out.err));
         return AK_ERR_IO;
     }
@@ -72,7 +72,7 @@ ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3
         if (mesh->uvs) base_t += mesh->vertex_count;
         if (n) base_n += mesh->vertex_count;
     }
-    if (akp_file_atomic_commit(&out) != AK_OK) {
+    if (ak_atomic_file_commit(&out) != AK_OK) {
         akp_diag_set(diag, path, "cannot write file (%s)", strerror(out.err ? out.err : EIO));
         return AK_ERR_IO;
     }

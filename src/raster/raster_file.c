@@ -38,7 +38,7 @@ struct ak_gif_writer {
     int pal_n;
     double pal_err;      /* its mean error on the frame it was built from */
     double shown_cs;     /* frame_rate: hundredths of a second written so far */
-    akp_file_atomic out; /* the temporary giflib writes; renamed over the path by finish */
+    ak_atomic_file out; /* the temporary giflib writes; renamed over the path by finish */
 };
 
 /* ---- helpers ------------------------------------------------------------------------------- */
@@ -174,15 +174,15 @@ ak_result ak_png_write(const char* path, const ak_image* image) {
     pi.format = PNG_FORMAT_RGBA;
     /* to a temporary renamed into place (internal.h): png_image_write_to_file would leave a
      * partial file, or remove whatever path named (a symlink included) when it fails */
-    akp_file_atomic out;
-    if (akp_file_atomic_open(&out, path) != AK_OK) return AK_ERR_IO;
+    ak_atomic_file out;
+    if (ak_atomic_file_open(&out, path) != AK_OK) return AK_ERR_IO;
     int ok = png_image_write_to_stdio(&pi, out.f, 0, image->pixels, (png_int_32)image_stride(image), NULL);
     png_image_free(&pi);
     if (!ok) {
-        akp_file_atomic_abort(&out);
+        ak_atomic_file_abort(&out);
         return AK_ERR_IO;
     }
-    return akp_file_atomic_commit(&out);
+    return ak_atomic_file_commit(&out);
 }
 
 static ak_result png_open(const char* path, png_image* pi) {
@@ -265,11 +265,11 @@ ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const 
      * same permissions as any other output (0666 less the umask, as fopen gives). giflib
      * writes a temporary that finish renames over path (internal.h), so a failed run leaves
      * no partial GIF and never touches what path names. */
-    int fd = akp_file_atomic_open_fd(&w->out, path);
+    int fd = ak_atomic_file_open_fd(&w->out, path);
     w->gif = fd >= 0 ? EGifOpenFileHandle(fd, &err) : NULL;
     if (!w->gif && fd >= 0) close(fd);
     if (!w->gif) {
-        akp_file_atomic_abort(&w->out);
+        ak_atomic_file_abort(&w->out);
         akp_free(w->has_alloc ? &w->alloc : NULL, mem);
         return AK_ERR_IO;
     }
@@ -284,7 +284,7 @@ ak_result ak_gif_writer_create(const char* path, const ak_gif_desc* desc, const 
     ok = ok && EGifPutExtensionTrailer(w->gif) == GIF_OK;
     if (!ok) {
         EGifCloseFile(w->gif, &err);
-        akp_file_atomic_abort(&w->out);
+        ak_atomic_file_abort(&w->out);
         akp_free(w->has_alloc ? &w->alloc : NULL, mem);
         return AK_ERR_IO;
     }
@@ -450,8 +450,8 @@ ak_result ak_gif_writer_finish(ak_gif_writer* w) {
     bool complete = EGifCloseFile(w->gif, &err) == GIF_OK && !w->failed;
     if (!complete) res = AK_ERR_IO;
     /* a complete file (the blank one of AK_ERR_EMPTY too) goes into place; the rest is removed */
-    if (complete && akp_file_atomic_rename(&w->out) != AK_OK) res = AK_ERR_IO;
-    akp_file_atomic_abort(&w->out);
+    if (complete && ak_atomic_file_rename(&w->out) != AK_OK) res = AK_ERR_IO;
+    ak_atomic_file_abort(&w->out);
     ak_allocator a = w->alloc;
     akp_free(w->has_alloc ? &a : NULL, w);
     return res;
@@ -461,7 +461,7 @@ void ak_gif_writer_discard(ak_gif_writer* w) {
     if (!w) return;
     int err = 0;
     EGifCloseFile(w->gif, &err);
-    akp_file_atomic_abort(&w->out);
+    ak_atomic_file_abort(&w->out);
     ak_allocator a = w->alloc;
     akp_free(w->has_alloc ? &a : NULL, w);
 }

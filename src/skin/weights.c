@@ -284,13 +284,13 @@ static ak_result read_all(const char* path, unsigned char** out, size_t* out_siz
 ak_result akp_read_file(const char* path, unsigned char** out, size_t* out_size) { return read_all(path, out, out_size); }
 
 ak_result akp_write_file(const char* path, const unsigned char* buf, size_t size) {
-    akp_file_atomic out; /* a temporary renamed over path once complete (internal.h) */
-    if (akp_file_atomic_open(&out, path) != AK_OK) return AK_ERR_IO;
+    ak_atomic_file out; /* a temporary renamed over path once complete (internal.h) */
+    if (ak_atomic_file_open(&out, path) != AK_OK) return AK_ERR_IO;
     if (fwrite(buf, 1, size, out.f) != size) {
-        akp_file_atomic_abort(&out);
+        ak_atomic_file_abort(&out);
         return AK_ERR_IO;
     }
-    return akp_file_atomic_commit(&out);
+    return ak_atomic_file_commit(&out);
 }
 
 /* Read a weights file and decode it: the header only (out_joints NULL) or everything. The

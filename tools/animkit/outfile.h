@@ -1,24 +1,16 @@
-/* Output files of the commands (JSON, OBJ, logs), written whole or not at all.
+/* Output files of the commands (JSON, OBJ, logs), written whole or not at all: the library's
+ * ak_atomic_file (animkit/core.h says how) with the command's messages.
  *
- * cli_outfile_open creates a temporary ".NAME.XXXXXX" beside PATH (the same directory, so the
- * rename stays on one file system); the command writes to o->f; cli_outfile_commit flushes,
- * checks and closes it and only then renames it over PATH. Any failure removes the temporary
- * and leaves PATH as it was: an existing file keeps its contents, a symlink named as the
- * output survives. On success the rename replaces the name itself: a symlink at PATH becomes
- * the new file (the file it pointed to is left alone). The new file gets 0666 less the umask,
- * or the mode of the regular file it replaces. The library's writers (PNG, GIF, OBJ, glTF)
- * do the same on their side (src/internal.h, akp_file_atomic). */
+ *     cli_outfile out;
+ *     if (cli_outfile_open(&out, "fluid", path)) return CLI_BAD_INPUT;   // message printed
+ *     fprintf(out.f, ...);
+ *     return cli_outfile_commit(&out, "fluid");                           // or _abort */
 #ifndef ANIMKIT_CLI_OUTFILE_H
 #define ANIMKIT_CLI_OUTFILE_H
 
-#include <stdio.h>
+#include <animkit/core.h>
 
-typedef struct cli_outfile {
-    FILE* f;             /* the temporary, open for writing */
-    int err;             /* errno of the first failure, 0 when none known */
-    char path[4096];     /* the named output */
-    char tmp[4096 + 32]; /* the temporary; "" once renamed or removed */
-} cli_outfile;
+typedef ak_atomic_file cli_outfile;
 
 /* Create the temporary for path. On failure prints "animkit CMD: PATH: cannot create the file
  * (reason)" and returns CLI_BAD_INPUT (nothing created); CLI_OK otherwise. */
