@@ -544,6 +544,7 @@ typedef struct step_ctx {
     ak_vec3 plane_n[PS_CACHE];
     ak_vec3 vortex_axis[PS_CACHE];
     ak_grid lj_grid;
+    bool lj_grid_of_x0; /* lj_grid holds the step's start (built by the budget check) */
     float lj_cutoff;
     /* the state the current evaluation reads, and where accelerations go */
     const ak_vec3* X;
@@ -639,9 +640,11 @@ static void eval_accel(step_ctx* c, const ak_vec3* X, const ak_vec3* V, ak_vec3*
             ps->force[s->j] = ak_vec3_madd(ps->force[s->j], u, -mag);
         }
         if (w->lennard_jones.epsilon != 0.0f && n > 1) {
+            /* the budget check already sorted the step's start (x0 is a copy of it) */
             ak_grid_desc gd = {.cell_size = c->lj_cutoff};
-            if (ak_grid_build(&gd, (ak_vec3_cspan){X, n},
-                              (ak_u8_span){ps->grid_mem, ps->grid_mem_size}, &c->lj_grid) == AK_OK)
+            c->lj_grid_of_x0 = c->lj_grid_of_x0 && X == ps->x0;
+            if (c->lj_grid_of_x0 || ak_grid_build(&gd, (ak_vec3_cspan){X, n},
+                                                  (ak_u8_span){ps->grid_mem, ps->grid_mem_size}, &c->lj_grid) == AK_OK)
                 parallel_for(ps->thread_count, n, lj_range, c);
         }
         if (w->callback) w->callback(X, V, ps->inv_mass, n, t, ps->force, w->callback_user);
@@ -1332,13 +1335,11 @@ ak_result ak_particles_step(ak_particles* ps, const ak_particles_world* w, float
     const double t = ps->time;
     if (w->lennard_jones.epsilon != 0.0f && n > 1) { /* the work budget, before anything moves */
         ak_grid_desc gd = {.cell_size = c.lj_cutoff};
-        ak_grid g;
         const uint64_t budget = w->lennard_jones.max_pair_tests ? w->lennard_jones.max_pair_tests
                                                                 : AK_PARTICLES_LJ_DEFAULT_PAIR_TESTS;
-        if (ak_grid_build(&gd, (ak_vec3_cspan){ps->pos, n}, (ak_u8_span){ps->grid_mem, ps->grid_mem_size}, &g) ==
-                AK_OK &&
-            ak_grid_candidate_count(&g, c.lj_cutoff) > budget)
-            return AK_ERR_BUDGET;
+        c.lj_grid_of_x0 = ak_grid_build(&gd, (ak_vec3_cspan){ps->pos, n},
+                                        (ak_u8_span){ps->grid_mem, ps->grid_mem_size}, &c.lj_grid) == AK_OK;
+        if (c.lj_grid_of_x0 && ak_grid_candidate_count(&c.lj_grid, c.lj_cutoff) > budget) return AK_ERR_BUDGET;
     }
 
     bool dead;
