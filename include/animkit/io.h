@@ -196,6 +196,20 @@ AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* na
 AK_API ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3* const* posed_positions,
                                  const ak_vec3* const* posed_normals, ak_diag* diag);
 
+/* Decode a PNG (libpng) or JPEG (libjpeg-turbo; a build without it refuses JPEG with
+ * AK_ERR_UNSUPPORTED) held in memory, told apart by its signature, into RGBA8 pixels (sRGB
+ * colour as stored, straight alpha, rows top to bottom, width * 4 bytes per row) allocated
+ * through alloc (NULL -> malloc) once the size in the header is checked: at most 16384 pixels
+ * per side and width * height * 4 bytes within memory_budget (0 -> AK_IO_DEFAULT_BUDGET).
+ * Free the pixels with ak_io_image_free (same alloc). This is the decoder the glTF and OBJ
+ * readers use for base-colour textures. Returns AK_ERR_NULL_ARG, AK_ERR_PARSE (neither
+ * format, or a broken image: diag says what libpng or libjpeg reported), AK_ERR_UNSUPPORTED
+ * (too large, CMYK JPEG, no JPEG decoder), AK_ERR_NO_MEMORY. On failure *out_pixels is NULL. */
+AK_API ak_result ak_io_image_decode(const void* data, size_t size, size_t memory_budget, const ak_allocator* alloc,
+                                    uint8_t** out_pixels, int* out_width, int* out_height, ak_diag* diag);
+/* Free pixels from ak_io_image_decode (alloc as given to it); NULL is a no-op. */
+AK_API void ak_io_image_free(const ak_allocator* alloc, uint8_t* pixels);
+
 /* How ak_io_save writes (all fields zero -> defaults). */
 typedef struct ak_io_save_desc {
     ak_logger logger; /* warnings (scalar channels and clips glTF cannot hold); zero -> silent */

@@ -61,6 +61,7 @@ typedef struct rtri {
     float a0[MAXA], da1[MAXA], da2[MAXA];
     float flat[4];
     int x0, x1, y0, y1;
+    bool minify; /* textured: more texels than samples over the triangle */
 } rtri;
 
 typedef struct drawctx drawctx;
@@ -104,6 +105,9 @@ struct drawctx {
     const ak_raster_lines* lines;
     const ak_raster_points* points;
     const cvert* quad;     /* ground: 4 corners */
+    const ak_raster_texture* tex; /* textured mesh: UVs are attributes uv_attr, uv_attr + 1 */
+    int uv_attr;
+    size_t tex_stride;
     float half_width_px;   /* lines: half width in samples; points: radius in samples */
     /* ground */
     ak_vec3 ground_lin, line_lin;
@@ -484,6 +488,15 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
         t->da2[k] = v[i2]->a[k] * iw[i2] - a0;
     }
     if (flat) memcpy(t->flat, flat, sizeof t->flat);
+    t->minify = false;
+    if (dc->tex) {
+        /* texels over the triangle (UV area x texture size) against the samples it covers */
+        const int ua = dc->uv_attr;
+        float du1 = v[1]->a[ua] - v[0]->a[ua], dv1 = v[1]->a[ua + 1] - v[0]->a[ua + 1];
+        float du2 = v[2]->a[ua] - v[0]->a[ua], dv2 = v[2]->a[ua + 1] - v[0]->a[ua + 1];
+        double texels = fabs((double)du1 * dv2 - (double)dv1 * du2) * dc->tex->image.width * dc->tex->image.height;
+        t->minify = texels > (double)area / ((double)SUBPIX * SUBPIX);
+    }
     if (sk->buf) ++sk->count;
     else raster_tri(dc, t, 0, 1);
 }
@@ -570,28 +583,105 @@ static inline float smoothstep(float e0, float e1, float x) {
     return t * t * (3.0f - 2.0f * t);
 }
 
+/* Attributes each fragment mode interpolates (a constant once the mode is). */
+static FORCE_INLINE int mode_attr_count(frag_mode mode) {
+    switch (mode) {
+    case FRAG_UNLIT_VCOLOR: return 4;
+    case FRAG_GOURAUD: return 4;
+    case FRAG_PHONG: return 6;
+    case FRAG_PHONG_VC: return 10;
+    case FRAG_POINT: return 2;
+    case FRAG_GROUND: return 3;
+    default: return 0;
+    }
+}
+
+/* ---- textures ------------------------------------------------------------------------------ */
+
+static inline int wrap_index(int64_t i, int n, ak_raster_wrap w) {
+    if (w == AK_RASTER_WRAP_CLAMP) return i < 0 ? 0 : (i >= n ? n - 1 : (int)i);
+    if (w == AK_RASTER_WRAP_MIRROR) {
+        int64_t p = 2 * (int64_t)n, m = i % p;
+        if (m < 0) m += p;
+        return (int)(m < n ? m : p - 1 - m);
+    }
+    int64_t m = i % n;
+    return (int)(m < 0 ? m + n : m);
+}
+
+/* Texel coordinate of u along an axis of n texels (scaled, sanitised: huge values keep their
+ * fractional behaviour only approximately, but never overflow). */
+static inline double tex_coord(float u, int n) {
+    if (!ak_finitef(u)) u = 0.0f;
+    if (u > 1e6f) u = 1e6f;
+    if (u < -1e6f) u = -1e6f;
+    return (double)u * (double)n;
+}
+
+/* The texel colour at (u, v): linear light (lit modes) or sRGB (unlit) in [0, 1], alpha in
+ * [0, 1]. Bilinear filtering weighs the 4 texels around the point. */
+static void tex_sample(const drawctx* dc, float u, float v, bool minify, bool linear, float out[4]) {
+    const ak_raster_texture* t = dc->tex;
+    const int w = t->image.width, h = t->image.height;
+    const uint8_t* px = t->image.pixels;
+    const size_t stride = dc->tex_stride;
+    ak_raster_filter f = minify ? t->min_filter : t->mag_filter;
+    const float* lut = dc->r->to_lin_lut;
+    double x = tex_coord(u, w), y = tex_coord(v, h);
+    if (f == AK_RASTER_FILTER_NEAREST) {
+        int i = wrap_index((int64_t)floor(x), w, t->wrap_u), j = wrap_index((int64_t)floor(y), h, t->wrap_v);
+        const uint8_t* p = px + (size_t)j * stride + (size_t)i * 4u;
+        for (int k = 0; k < 3; ++k) out[k] = linear ? lut[p[k]] : (float)p[k] * (1.0f / 255.0f);
+        out[3] = (float)p[3] * (1.0f / 255.0f);
+        return;
+    }
+    x -= 0.5;
+    y -= 0.5;
+    double fx0 = floor(x), fy0 = floor(y);
+    float fx = (float)(x - fx0), fy = (float)(y - fy0);
+    int i0 = wrap_index((int64_t)fx0, w, t->wrap_u), i1 = wrap_index((int64_t)fx0 + 1, w, t->wrap_u);
+    int j0 = wrap_index((int64_t)fy0, h, t->wrap_v), j1 = wrap_index((int64_t)fy0 + 1, h, t->wrap_v);
+    const uint8_t* p[4] = {px + (size_t)j0 * stride + (size_t)i0 * 4u, px + (size_t)j0 * stride + (size_t)i1 * 4u,
+                           px + (size_t)j1 * stride + (size_t)i0 * 4u, px + (size_t)j1 * stride + (size_t)i1 * 4u};
+    const float wt[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
+    for (int k = 0; k < 4; ++k) out[k] = 0.0f;
+    for (int q = 0; q < 4; ++q) {
+        for (int k = 0; k < 3; ++k) out[k] += wt[q] * (linear ? lut[p[q][k]] : (float)p[q][k] * (1.0f / 255.0f));
+        out[3] += wt[q] * (float)p[q][3] * (1.0f / 255.0f);
+    }
+}
+
 /* Compute the fragment colour; returns false to discard. */
-static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri* t, const float* a, uint8_t out[4],
-                                  const uint8_t* dst) {
+static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, bool tex, const rtri* t, const float* a,
+                                  uint8_t out[4], const uint8_t* dst) {
     const ak_raster* r = dc->r;
+    float tx[4] = {1, 1, 1, 1};
+    if (tex) {
+        const int ua = mode_attr_count(mode);
+        tex_sample(dc, a[ua], a[ua + 1], t->minify, mode != FRAG_UNLIT_CONST && mode != FRAG_UNLIT_VCOLOR, tx);
+    }
     switch (mode) {
     case FRAG_UNLIT_CONST:
+        if (tex) {
+            for (int k = 0; k < 4; ++k) out[k] = (uint8_t)(dc->const_rgba[k] * tx[k] + 0.5f);
+            return true;
+        }
         for (int k = 0; k < 4; ++k) out[k] = (uint8_t)dc->const_rgba[k];
         return true;
     case FRAG_UNLIT_VCOLOR:
-        for (int k = 0; k < 4; ++k) out[k] = (uint8_t)(clamp01(a[k]) * 255.0f + 0.5f);
+        for (int k = 0; k < 4; ++k) out[k] = (uint8_t)(clamp01(a[k] * tx[k]) * 255.0f + 0.5f);
         return true;
     case FRAG_FLAT:
-        out[0] = enc(r, t->flat[0]);
-        out[1] = enc(r, t->flat[1]);
-        out[2] = enc(r, t->flat[2]);
-        out[3] = (uint8_t)(clamp01(t->flat[3]) * 255.0f + 0.5f);
+        out[0] = enc(r, t->flat[0] * tx[0]);
+        out[1] = enc(r, t->flat[1] * tx[1]);
+        out[2] = enc(r, t->flat[2] * tx[2]);
+        out[3] = (uint8_t)(clamp01(t->flat[3] * tx[3]) * 255.0f + 0.5f);
         return true;
     case FRAG_GOURAUD:
-        out[0] = enc(r, a[0]);
-        out[1] = enc(r, a[1]);
-        out[2] = enc(r, a[2]);
-        out[3] = (uint8_t)(clamp01(a[3]) * 255.0f + 0.5f);
+        out[0] = enc(r, a[0] * tx[0]);
+        out[1] = enc(r, a[1] * tx[1]);
+        out[2] = enc(r, a[2] * tx[2]);
+        out[3] = (uint8_t)(clamp01(a[3] * tx[3]) * 255.0f + 0.5f);
         return true;
     case FRAG_PHONG:
     case FRAG_PHONG_VC: {
@@ -601,6 +691,10 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri*
         if (mode == FRAG_PHONG_VC) {
             alb = ak_vec3_mul(alb, ak_vec3_make(a[6], a[7], a[8]));
             alpha *= a[9];
+        }
+        if (tex) {
+            alb = ak_vec3_mul(alb, ak_vec3_make(tx[0], tx[1], tx[2]));
+            alpha *= tx[3];
         }
         ak_vec3 c = shade(dc, n, ak_vec3_make(a[0], a[1], a[2]), alb);
         out[0] = enc(r, c.x);
@@ -669,23 +763,10 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri*
     return false;
 }
 
-/* Attributes each fragment mode interpolates (a constant once the mode is). */
-static FORCE_INLINE int mode_attr_count(frag_mode mode) {
-    switch (mode) {
-    case FRAG_UNLIT_VCOLOR: return 4;
-    case FRAG_GOURAUD: return 4;
-    case FRAG_PHONG: return 6;
-    case FRAG_PHONG_VC: return 10;
-    case FRAG_POINT: return 2;
-    case FRAG_GROUND: return 3;
-    default: return 0;
-    }
-}
-
-static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, const rtri* t, int thread_index,
-                                         int thread_count) {
+static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, bool tex, const rtri* t,
+                                         int thread_index, int thread_count) {
     ak_raster* r = dc->r;
-    const int na = mode_attr_count(mode);
+    const int na = mode_attr_count(mode) + (tex ? 2 : 0);
     for (int y = t->y0; y <= t->y1; ++y) {
         if (thread_count > 1) {
             int blk = y >> ROW_BLOCK_SHIFT;
@@ -720,22 +801,33 @@ static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, cons
             }
             uint8_t src[4];
             uint8_t* px = crow + (size_t)x * 4u;
-            if (!fragment(dc, mode, t, a, src, px)) continue;
+            if (!fragment(dc, mode, tex, t, a, src, px)) continue;
             write_px(dc, px, &zrow[x], z, src);
         }
     }
 }
 
 static void raster_tri(const drawctx* dc, const rtri* t, int ti, int tc) {
+    if (dc->tex) {
+        switch (dc->mode) {
+        case FRAG_UNLIT_CONST: raster_tri_mode(dc, FRAG_UNLIT_CONST, true, t, ti, tc); break;
+        case FRAG_UNLIT_VCOLOR: raster_tri_mode(dc, FRAG_UNLIT_VCOLOR, true, t, ti, tc); break;
+        case FRAG_FLAT: raster_tri_mode(dc, FRAG_FLAT, true, t, ti, tc); break;
+        case FRAG_GOURAUD: raster_tri_mode(dc, FRAG_GOURAUD, true, t, ti, tc); break;
+        case FRAG_PHONG: raster_tri_mode(dc, FRAG_PHONG, true, t, ti, tc); break;
+        default: raster_tri_mode(dc, FRAG_PHONG_VC, true, t, ti, tc); break;
+        }
+        return;
+    }
     switch (dc->mode) {
-    case FRAG_UNLIT_CONST: raster_tri_mode(dc, FRAG_UNLIT_CONST, t, ti, tc); break;
-    case FRAG_UNLIT_VCOLOR: raster_tri_mode(dc, FRAG_UNLIT_VCOLOR, t, ti, tc); break;
-    case FRAG_FLAT: raster_tri_mode(dc, FRAG_FLAT, t, ti, tc); break;
-    case FRAG_GOURAUD: raster_tri_mode(dc, FRAG_GOURAUD, t, ti, tc); break;
-    case FRAG_PHONG: raster_tri_mode(dc, FRAG_PHONG, t, ti, tc); break;
-    case FRAG_PHONG_VC: raster_tri_mode(dc, FRAG_PHONG_VC, t, ti, tc); break;
-    case FRAG_POINT: raster_tri_mode(dc, FRAG_POINT, t, ti, tc); break;
-    case FRAG_GROUND: raster_tri_mode(dc, FRAG_GROUND, t, ti, tc); break;
+    case FRAG_UNLIT_CONST: raster_tri_mode(dc, FRAG_UNLIT_CONST, false, t, ti, tc); break;
+    case FRAG_UNLIT_VCOLOR: raster_tri_mode(dc, FRAG_UNLIT_VCOLOR, false, t, ti, tc); break;
+    case FRAG_FLAT: raster_tri_mode(dc, FRAG_FLAT, false, t, ti, tc); break;
+    case FRAG_GOURAUD: raster_tri_mode(dc, FRAG_GOURAUD, false, t, ti, tc); break;
+    case FRAG_PHONG: raster_tri_mode(dc, FRAG_PHONG, false, t, ti, tc); break;
+    case FRAG_PHONG_VC: raster_tri_mode(dc, FRAG_PHONG_VC, false, t, ti, tc); break;
+    case FRAG_POINT: raster_tri_mode(dc, FRAG_POINT, false, t, ti, tc); break;
+    case FRAG_GROUND: raster_tri_mode(dc, FRAG_GROUND, false, t, ti, tc); break;
     }
 }
 
@@ -971,7 +1063,7 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
             v[k].a[3] = n.x;
             v[k].a[4] = n.y;
             v[k].a[5] = n.z;
-            if (dc->has_vcolor) {
+            if (dc->mode == FRAG_PHONG_VC) { /* vertex colours, or white under a texture */
                 ak_vec3 lc = srgb3_to_lin(vc[k]);
                 v[k].a[6] = lc.x;
                 v[k].a[7] = lc.y;
@@ -983,6 +1075,12 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
     default:
         break;
     }
+    if (dc->tex)
+        for (int k = 0; k < 3; ++k) {
+            ak_vec2 uv = m->uvs.ptr[idx[k]];
+            v[k].a[dc->uv_attr] = ak_finitef(uv.x) ? uv.x : 0.0f;
+            v[k].a[dc->uv_attr + 1] = ak_finitef(uv.y) ? uv.y : 0.0f;
+        }
     clip_and_setup(dc, &v[0], &v[1], &v[2], flat, sk);
 }
 
@@ -1018,6 +1116,18 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
         return AK_ERR_BAD_ARG;
     if ((unsigned)mesh->shading > (unsigned)AK_SHADING_UNLIT || (unsigned)mesh->blend > (unsigned)AK_BLEND_ADD)
         return AK_ERR_BAD_ARG;
+    if (mesh->uvs.count && (mesh->uvs.count != mesh->positions.count || !mesh->uvs.ptr)) return AK_ERR_BAD_ARG;
+    const ak_raster_texture* tex = mesh->texture;
+    if (tex) {
+        const ak_image* ti = &tex->image;
+        if (!ti->pixels || ti->width <= 0 || ti->height <= 0 || (ti->stride && ti->stride < (size_t)ti->width * 4u) ||
+            (unsigned)tex->wrap_u > (unsigned)AK_RASTER_WRAP_MIRROR ||
+            (unsigned)tex->wrap_v > (unsigned)AK_RASTER_WRAP_MIRROR ||
+            (unsigned)tex->mag_filter > (unsigned)AK_RASTER_FILTER_NEAREST ||
+            (unsigned)tex->min_filter > (unsigned)AK_RASTER_FILTER_NEAREST)
+            return AK_ERR_BAD_ARG;
+        if (!mesh->uvs.count) tex = NULL;
+    }
     if (mesh->model && !ak_mat4_is_finite(mesh->model)) return AK_ERR_BAD_DATA;
     for (size_t i = 0; i < mesh->indices.count; ++i)
         if (mesh->indices.ptr[i] >= mesh->positions.count) return AK_ERR_BAD_INDEX;
@@ -1052,6 +1162,14 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
         dc.mode = dc.has_vcolor ? FRAG_PHONG_VC : FRAG_PHONG;
         dc.attr_count = mode_attr_count(dc.mode);
         break;
+    }
+    if (tex) {
+        /* textured Phong always carries vertex colours (white without them): 10 + 2 = MAXA */
+        if (dc.mode == FRAG_PHONG) dc.mode = FRAG_PHONG_VC;
+        dc.tex = tex;
+        dc.tex_stride = tex->image.stride ? tex->image.stride : (size_t)tex->image.width * 4u;
+        dc.uv_attr = mode_attr_count(dc.mode);
+        dc.attr_count = dc.uv_attr + 2;
     }
     dc.setup = mesh_setup;
     dc.input_count = mesh->indices.count ? mesh->indices.count / 3 : mesh->positions.count / 3;
