@@ -63,8 +63,9 @@ typedef enum ak_texture_wrap {
     AK_TEXTURE_WRAP_MIRROR      /* glTF 33648 MIRRORED_REPEAT */
 } ak_texture_wrap;
 
-/* How a texture is sampled between texels (glTF magFilter / minFilter; a mipmap minFilter
- * keeps its base filter: mipmaps are not built). */
+/* How a texture is sampled between texels (glTF magFilter / minFilter; a mipmap minFilter,
+ * 9984..9987, reads as LINEAR: mipmaps are not built, and bilinear comes closer to their
+ * averaged look than the nearest texel). */
 typedef enum ak_texture_filter {
     AK_TEXTURE_FILTER_LINEAR = 0, /* bilinear, the default when the sampler names none */
     AK_TEXTURE_FILTER_NEAREST     /* the texel under the point */

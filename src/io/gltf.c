@@ -1252,9 +1252,9 @@ static ak_result load_texture(gl_ctx* c, size_t ti) {
         if (v[3] != 9728 && v[3] != 9729 && (v[3] < 9984 || v[3] > 9987))
             return fail(c, AK_ERR_PARSE, "%s.minFilter = %zu is not a filter", sw, v[3]);
         st->mag_filter = v[2] == 9728 ? AK_TEXTURE_FILTER_NEAREST : AK_TEXTURE_FILTER_LINEAR;
-        /* NEAREST, NEAREST_MIPMAP_NEAREST (9984), NEAREST_MIPMAP_LINEAR (9986): nearest texel */
-        st->min_filter = (v[3] == 9728 || v[3] == 9984 || v[3] == 9986) ? AK_TEXTURE_FILTER_NEAREST
-                                                                        : AK_TEXTURE_FILTER_LINEAR;
+        /* mipmap filters (9984..9987) -> LINEAR: no mipmaps are built, and bilinear is closer to
+         * the averaged look they give than the nearest texel of the full-size image */
+        st->min_filter = v[3] == 9728 ? AK_TEXTURE_FILTER_NEAREST : AK_TEXTURE_FILTER_LINEAR;
     }
     const cJSON* im = cJSON_GetArrayItem(images, (int)src);
     const char* iname = get_string(im, "name");
