@@ -15,6 +15,7 @@
 #endif
 
 #include "ak_test.h"
+#include "cli_test.h"
 
 /* ---- helpers ------------------------------------------------------------------------------- */
 
@@ -607,6 +608,133 @@ AK_TEST(gltf_assets_textured) {
     ak_scene_destroy(s);
 }
 
+/* ---- export -------------------------------------------------------------------------------- */
+
+static bool same_texture(const ak_scene* a, const ak_scene* b, size_t mesh) {
+    int32_t ta = a->meshes[mesh].texture, tb = b->meshes[mesh].texture;
+    if (ta < 0 || tb < 0 || (size_t)tb >= b->texture_count) return false;
+    const ak_scene_texture *x = &a->textures[ta], *y = &b->textures[tb];
+    return x->width == y->width && x->height == y->height && y->pixels &&
+           memcmp(x->pixels, y->pixels, (size_t)x->width * (size_t)x->height * 4u) == 0;
+}
+
+/* `animkit export Fox.glb -o x.glb` keeps the texture: the re-loaded file has the same texels. */
+AK_TEST(cli_export_keeps_texture) {
+    const char* fox = asset("Fox/glTF-Binary/Fox.glb");
+    if (!file_exists(fox)) AK_SKIP("assets not found");
+    char args[2048];
+    snprintf(args, sizeof args, "export '%s' -o tex_fox.glb", fox);
+    AK_CHECK_EQ(run(args, true), 0);
+    ak_scene *a = NULL, *b = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(fox, NULL, NULL, &a, &diag), AK_OK);
+    AK_CHECK_EQ(ak_io_load("tex_fox.glb", NULL, NULL, &b, &diag), AK_OK);
+    if (a && b) {
+        AK_CHECK_EQ(b->texture_count, 1u);
+        AK_CHECK(b->mesh_count == a->mesh_count && same_texture(a, b, 0));
+        AK_CHECK(b->meshes[0].mesh->uvs && memcmp(a->meshes[0].mesh->uvs, b->meshes[0].mesh->uvs,
+                                                  a->meshes[0].mesh->vertex_count * sizeof(ak_vec2)) == 0);
+    }
+    ak_scene_destroy(a);
+    ak_scene_destroy(b);
+}
+
+/* OBJ export: vt, an .mtl with map_Kd and the PNG it names (rows flipped for OBJ's bottom-left
+ * origin); animkit's OBJ reader gives back the same texels for the same UVs. */
+AK_TEST(obj_export_map_kd) {
+    const char* fox = asset("Fox/glTF-Binary/Fox.glb");
+    if (!file_exists(fox)) AK_SKIP("assets not found");
+    ak_scene *a = NULL, *b = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load(fox, NULL, NULL, &a, &diag), AK_OK);
+    if (!a) return;
+    AK_CHECK_EQ(ak_io_write_obj("tex_fox.obj", a, NULL, NULL, &diag), AK_OK);
+    /* the files: mtllib/usemtl in the .obj, map_Kd in the .mtl, the PNG flipped */
+    FILE* f = fopen("tex_fox.mtl", "rb");
+    AK_CHECK(f != NULL);
+    char text[4096] = "";
+    if (f) {
+        text[fread(text, 1, sizeof text - 1, f)] = 0;
+        fclose(f);
+    }
+    AK_CHECK(strstr(text, "map_Kd tex_fox_0.png") != NULL);
+    int w = 0, h = 0;
+    AK_CHECK_EQ(ak_png_info("tex_fox_0.png", &w, &h), AK_OK);
+    const ak_scene_texture* t = &a->textures[0];
+    AK_CHECK(w == t->width && h == t->height);
+    uint8_t* png = malloc((size_t)w * (size_t)h * 4);
+    AK_CHECK_EQ(ak_png_read("tex_fox_0.png", &(ak_image){.pixels = png, .width = w, .height = h}), AK_OK);
+    AK_CHECK(memcmp(png, t->pixels + (size_t)(h - 1) * (size_t)w * 4, (size_t)w * 4) == 0); /* first row = last */
+    free(png);
+    AK_CHECK_EQ(ak_io_load("tex_fox.obj", NULL, NULL, &b, &diag), AK_OK);
+    if (b) {
+        AK_CHECK_EQ(b->mesh_count, a->mesh_count);
+        AK_CHECK(b->meshes[0].mesh->uvs != NULL);
+        AK_CHECK_MSG(same_texture(a, b, 0), "the OBJ's texture differs");
+        AK_CHECK(b->meshes[0].mesh->uvs[5].x == a->meshes[0].mesh->uvs[5].x &&
+                 b->meshes[0].mesh->uvs[5].y == a->meshes[0].mesh->uvs[5].y);
+    }
+    ak_scene_destroy(a);
+    ak_scene_destroy(b);
+    /* a map_Kd that leaves the folder or is broken: a warning, no texture, the OBJ loads */
+    f = fopen("tex_bad.obj", "wb");
+    fputs("mtllib tex_bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n", f);
+    fclose(f);
+    const char* maps[2] = {"../../../../etc/passwd", "tex_bad.obj"};
+    for (int k = 0; k < 2; ++k) {
+        f = fopen("tex_bad.mtl", "wb");
+        fprintf(f, "newmtl a\nKd 1 1 1\nmap_Kd -s 1 1 1 %s\n", maps[k]);
+        fclose(f);
+        ak_io_desc d = {.logger = {.func = count_warning}};
+        g_warnings = 0;
+        b = NULL;
+        AK_CHECK_EQ(ak_io_load("tex_bad.obj", &d, NULL, &b, &diag), AK_OK);
+        AK_CHECK_MSG(g_warnings == 1 && strstr(g_last_warning, "map_Kd") != NULL, "%d: '%s'", g_warnings,
+                     g_last_warning);
+        if (b) AK_CHECK(b->meshes[0].texture == -1 && b->meshes[0].has_material);
+        ak_scene_destroy(b);
+    }
+}
+
+/* CesiumMan's head: the render shows the texture's logo (blue, green and white), not a
+ * uniform grey or clay disc. The head is the topmost part of the figure: the rows from the
+ * first that differs from the background down 40 pixels. */
+AK_TEST(cesium_man_head_textured) {
+    const char* man = asset("CesiumMan/glTF-Binary/CesiumMan.glb");
+    if (!file_exists(man)) AK_SKIP("assets not found");
+    char args[2048];
+    snprintf(args, sizeof args, "render '%s' -o tex_man.png", man);
+    AK_CHECK_EQ(run(args, true), 0);
+    int w = 0, h = 0;
+    AK_CHECK_EQ(ak_png_info("tex_man.png", &w, &h), AK_OK);
+    uint8_t* px = malloc((size_t)w * (size_t)h * 4);
+    ak_image img = {.pixels = px, .width = w, .height = h};
+    AK_CHECK_EQ(ak_png_read("tex_man.png", &img), AK_OK);
+    /* background: a vertical gradient, so a figure pixel differs from its row's left end */
+    int top = -1;
+    for (int y = 30; y < h && top < 0; ++y)
+        for (int x = 0; x < w; ++x) {
+            const uint8_t *p = ak_image_pixel(&img, x, y), *bg = ak_image_pixel(&img, 2, y);
+            if (abs(p[0] - bg[0]) + abs(p[1] - bg[1]) + abs(p[2] - bg[2]) > 40) {
+                top = y;
+                break;
+            }
+        }
+    AK_CHECK(top > 0);
+    int blue = 0, green = 0, figure = 0;
+    for (int y = top; top > 0 && y < top + 40 && y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const uint8_t *p = ak_image_pixel(&img, x, y), *bg = ak_image_pixel(&img, 2, y);
+            if (abs(p[0] - bg[0]) + abs(p[1] - bg[1]) + abs(p[2] - bg[2]) <= 40) continue;
+            ++figure;
+            blue += p[2] > p[0] + 60 && p[2] > p[1] + 10;  /* the logo's sky blue */
+            green += p[1] > p[0] + 30 && p[1] > p[2] + 30; /* its green hills */
+        }
+    AK_CHECK_MSG(figure > 300 && blue > figure / 10 && green > figure / 50, "head: %d pixels, %d blue, %d green",
+                 figure, blue, green);
+    free(px);
+}
+
 int main(void) {
     AK_RUN(png_decode);
     AK_RUN(jpeg_decode);
@@ -617,5 +745,8 @@ int main(void) {
     AK_RUN(gltf_texture_and_sampler);
     AK_RUN(gltf_broken_texture_warns);
     AK_RUN(gltf_assets_textured);
+    AK_RUN(cli_export_keeps_texture);
+    AK_RUN(obj_export_map_kd);
+    AK_RUN(cesium_man_head_textured);
     return ak_test_finish();
 }
