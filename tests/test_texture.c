@@ -696,9 +696,35 @@ AK_TEST(obj_export_map_kd) {
     }
 }
 
-/* CesiumMan's head: the render shows the texture's logo (blue, green and white), not a
- * uniform grey or clay disc. The head is the topmost part of the figure: the rows from the
- * first that differs from the background down 40 pixels. */
+/* CesiumMan's head shows the texture's logo (blue, green and white), not a uniform grey or
+ * clay disc. The head is the topmost part of the figure: the rows from the first that differs
+ * from the background (a vertical gradient, so a figure pixel differs from its row's left end)
+ * down 40 pixels, from row `from` (below the viewer's text bar). */
+static void check_head(const ak_image* img, int from, const char* what) {
+    int top = -1;
+    for (int y = from; y < img->height && top < 0; ++y)
+        for (int x = 0; x < img->width; ++x) {
+            const uint8_t *p = ak_image_pixel(img, x, y), *bg = ak_image_pixel(img, 2, y);
+            if (abs(p[0] - bg[0]) + abs(p[1] - bg[1]) + abs(p[2] - bg[2]) > 40) {
+                top = y;
+                break;
+            }
+        }
+    AK_CHECK_MSG(top > 0, "%s: no figure", what);
+    int blue = 0, green = 0, figure = 0;
+    for (int y = top; top > 0 && y < top + 40 && y < img->height; ++y)
+        for (int x = 0; x < img->width; ++x) {
+            const uint8_t *p = ak_image_pixel(img, x, y), *bg = ak_image_pixel(img, 2, y);
+            if (abs(p[0] - bg[0]) + abs(p[1] - bg[1]) + abs(p[2] - bg[2]) <= 40) continue;
+            ++figure;
+            blue += p[2] > p[0] + 60 && p[2] > p[1] + 10;  /* the logo's sky blue */
+            green += p[1] > p[0] + 30 && p[1] > p[2] + 30; /* its green hills */
+        }
+    AK_CHECK_MSG(figure > 300 && blue > figure / 10 && green > figure / 50, "%s: head of %d pixels, %d blue, %d green",
+                 what, figure, blue, green);
+}
+
+/* `render` to a PNG shows the texture on the head. */
 AK_TEST(cesium_man_head_textured) {
     const char* man = asset("CesiumMan/glTF-Binary/CesiumMan.glb");
     if (!file_exists(man)) AK_SKIP("assets not found");
@@ -710,28 +736,37 @@ AK_TEST(cesium_man_head_textured) {
     uint8_t* px = malloc((size_t)w * (size_t)h * 4);
     ak_image img = {.pixels = px, .width = w, .height = h};
     AK_CHECK_EQ(ak_png_read("tex_man.png", &img), AK_OK);
-    /* background: a vertical gradient, so a figure pixel differs from its row's left end */
-    int top = -1;
-    for (int y = 30; y < h && top < 0; ++y)
-        for (int x = 0; x < w; ++x) {
-            const uint8_t *p = ak_image_pixel(&img, x, y), *bg = ak_image_pixel(&img, 2, y);
-            if (abs(p[0] - bg[0]) + abs(p[1] - bg[1]) + abs(p[2] - bg[2]) > 40) {
-                top = y;
-                break;
-            }
-        }
-    AK_CHECK(top > 0);
-    int blue = 0, green = 0, figure = 0;
-    for (int y = top; top > 0 && y < top + 40 && y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const uint8_t *p = ak_image_pixel(&img, x, y), *bg = ak_image_pixel(&img, 2, y);
-            if (abs(p[0] - bg[0]) + abs(p[1] - bg[1]) + abs(p[2] - bg[2]) <= 40) continue;
-            ++figure;
-            blue += p[2] > p[0] + 60 && p[2] > p[1] + 10;  /* the logo's sky blue */
-            green += p[1] > p[0] + 30 && p[1] > p[2] + 30; /* its green hills */
-        }
-    AK_CHECK_MSG(figure > 300 && blue > figure / 10 && green > figure / 50, "head: %d pixels, %d blue, %d green",
-                 figure, blue, green);
+    check_head(&img, 30, "render PNG");
+    free(px);
+}
+
+/* The GIF and the viewer draw through the same frame code: checked as slow cases. */
+AK_TEST(cesium_man_head_gif_and_viewer) {
+    const char* man = asset("CesiumMan/glTF-Binary/CesiumMan.glb");
+    if (!file_exists(man)) AK_SKIP("assets not found");
+    char args[2048];
+    int w = 0, h = 0;
+    uint8_t* px = NULL;
+    ak_image img;
+    snprintf(args, sizeof args, "render '%s' --frames 0:0.1:0.1 -o tex_man.gif", man);
+    AK_CHECK_EQ(run(args, true), 0);
+    int frames = 0;
+    AK_CHECK_EQ(ak_gif_info("tex_man.gif", &w, &h, &frames), AK_OK);
+    px = malloc((size_t)w * (size_t)h * 4);
+    img = (ak_image){.pixels = px, .width = w, .height = h};
+    AK_CHECK_EQ(ak_gif_read_frame("tex_man.gif", 0, &img), AK_OK);
+    check_head(&img, 30, "render GIF");
+    free(px);
+    FILE* f = fopen("tex_view.txt", "wb");
+    fputs("wait 2\nscreenshot tex_view.png\nquit\n", f);
+    fclose(f);
+    snprintf(args, sizeof args, "view '%s' --headless --size 480x360 --script tex_view.txt", man);
+    AK_CHECK_EQ(run(args, true), 0);
+    AK_CHECK_EQ(ak_png_info("tex_view.png", &w, &h), AK_OK);
+    px = malloc((size_t)w * (size_t)h * 4);
+    img = (ak_image){.pixels = px, .width = w, .height = h};
+    AK_CHECK_EQ(ak_png_read("tex_view.png", &img), AK_OK);
+    check_head(&img, 40, "viewer");
     free(px);
 }
 
@@ -748,5 +783,6 @@ int main(void) {
     AK_RUN(cli_export_keeps_texture);
     AK_RUN(obj_export_map_kd);
     AK_RUN(cesium_man_head_textured);
+    AK_RUN_SLOW(cesium_man_head_gif_and_viewer);
     return ak_test_finish();
 }
