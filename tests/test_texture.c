@@ -89,7 +89,7 @@ static size_t png_header_only(uint32_t w, uint32_t h, uint8_t out[64]) {
 }
 
 #ifdef HAVE_JPEG_WRITER
-static uint8_t* jpeg_encode(const uint8_t* px, int w, int h, int comps, size_t* out_size) {
+static uint8_t* jpeg_encode(const uint8_t* px, int w, int h, int comps, bool progressive, size_t* out_size) {
     struct jpeg_compress_struct ci;
     struct jpeg_error_mgr err;
     ci.err = jpeg_std_error(&err);
@@ -103,6 +103,7 @@ static uint8_t* jpeg_encode(const uint8_t* px, int w, int h, int comps, size_t* 
     ci.in_color_space = comps == 1 ? JCS_GRAYSCALE : JCS_RGB;
     jpeg_set_defaults(&ci);
     jpeg_set_quality(&ci, 100, TRUE);
+    if (progressive) jpeg_simple_progression(&ci);
     jpeg_start_compress(&ci, TRUE);
     while (ci.next_scanline < ci.image_height) {
         JSAMPROW row = (JSAMPROW)(px + (size_t)ci.next_scanline * (size_t)w * (size_t)comps);
@@ -183,7 +184,7 @@ AK_TEST(jpeg_decode) {
             rgb[(y * W + x) * 3 + 2] = 128;
         }
     size_t n = 0;
-    uint8_t* jpg = jpeg_encode(rgb, W, H, 3, &n);
+    uint8_t* jpg = jpeg_encode(rgb, W, H, 3, false, &n);
     uint8_t* out = NULL;
     int w = 0, h = 0;
     ak_result r = ak_io_image_decode(jpg, n, 0, NULL, &out, &w, &h, NULL);
@@ -208,7 +209,7 @@ AK_TEST(jpeg_decode) {
     /* greyscale JPEG */
     uint8_t grey[W * H];
     for (int i = 0; i < W * H; ++i) grey[i] = (uint8_t)(i % W * 10);
-    jpg = jpeg_encode(grey, W, H, 1, &n);
+    jpg = jpeg_encode(grey, W, H, 1, false, &n);
     AK_CHECK_EQ(ak_io_image_decode(jpg, n, 0, NULL, &out, &w, &h, NULL), AK_OK);
     worst = 0;
     for (int i = 0; out && i < W * H; ++i) {
@@ -222,6 +223,17 @@ AK_TEST(jpeg_decode) {
     ak_diag diag;
     AK_CHECK_EQ(ak_io_image_decode(jpg, n / 2, 0, NULL, &out, &w, &h, &diag), AK_ERR_PARSE);
     AK_CHECK(out == NULL && strstr(diag.message, "JPEG") != NULL);
+    free(jpg);
+    /* progressive: the same pixels; its coefficients count against the budget too */
+    jpg = jpeg_encode(rgb, W, H, 3, true, &n);
+    AK_CHECK_EQ(ak_io_image_decode(jpg, n, 0, NULL, &out, &w, &h, NULL), AK_OK);
+    worst = 0;
+    for (int i = 0; out && i < W * H; ++i)
+        for (int k = 0; k < 3; ++k) worst = abs((int)out[4 * i + k] - (int)rgb[3 * i + k]) > worst ? abs((int)out[4 * i + k] - (int)rgb[3 * i + k]) : worst;
+    AK_CHECK(worst <= 8);
+    ak_io_image_free(NULL, out);
+    AK_CHECK_EQ(ak_io_image_decode(jpg, n, W * H * 4 + 16, NULL, &out, &w, &h, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK(strstr(diag.message, "progressive") != NULL);
     free(jpg);
 #else
     AK_SKIP("jpeglib.h not found when building the test");

@@ -108,6 +108,14 @@ static ak_result decode_jpeg(const uint8_t* data, size_t size, akp_budget* budge
         snprintf(msg, msg_size, "JPEG colour space %d (CMYK/YCCK) is not supported", (int)cinfo.jpeg_color_space);
         r = AK_ERR_UNSUPPORTED;
     }
+    /* a progressive (multi-scan) JPEG keeps every DCT coefficient (2 bytes per sample) in
+     * libjpeg's own memory until the last scan: charged too */
+    if (r == AK_OK && budget && jpeg_has_multiple_scans(&cinfo) &&
+        !akp_budget_take(budget, (size_t)w * (size_t)h, (size_t)cinfo.num_components * 2u)) {
+        snprintf(msg, msg_size, "progressive JPEG of %d x %d pixels would exceed the memory budget of %zu bytes", w, h,
+                 budget->limit);
+        r = AK_ERR_UNSUPPORTED;
+    }
     if (r != AK_OK) {
         jpeg_destroy_decompress(&cinfo);
         return r;
