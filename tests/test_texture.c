@@ -89,7 +89,8 @@ static size_t png_header_only(uint32_t w, uint32_t h, uint8_t out[64]) {
 }
 
 #ifdef HAVE_JPEG_WRITER
-static uint8_t* jpeg_encode(const uint8_t* px, int w, int h, int comps, bool progressive, size_t* out_size) {
+static uint8_t* jpeg_encode(const uint8_t* px, int w, int h, int comps, bool progressive,
+                            size_t* out_size) {
     struct jpeg_compress_struct ci;
     struct jpeg_error_mgr err;
     ci.err = jpeg_std_error(&err);
@@ -124,7 +125,8 @@ static char* b64(const uint8_t* d, size_t n) {
     char* o = malloc(4 * (n / 3 + 1) + 1);
     size_t k = 0;
     for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) | (i + 2 < n ? d[i + 2] : 0);
+        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) |
+                     (i + 2 < n ? d[i + 2] : 0);
         o[k++] = a[v >> 18 & 63];
         o[k++] = a[v >> 12 & 63];
         o[k++] = i + 1 < n ? a[v >> 6 & 63] : '=';
@@ -229,10 +231,14 @@ AK_TEST(jpeg_decode) {
     AK_CHECK_EQ(ak_io_image_decode(jpg, n, 0, NULL, &out, &w, &h, NULL), AK_OK);
     worst = 0;
     for (int i = 0; out && i < W * H; ++i)
-        for (int k = 0; k < 3; ++k) worst = abs((int)out[4 * i + k] - (int)rgb[3 * i + k]) > worst ? abs((int)out[4 * i + k] - (int)rgb[3 * i + k]) : worst;
+        for (int k = 0; k < 3; ++k)
+            worst = abs((int)out[4 * i + k] - (int)rgb[3 * i + k]) > worst
+                        ? abs((int)out[4 * i + k] - (int)rgb[3 * i + k])
+                        : worst;
     AK_CHECK(worst <= 8);
     ak_io_image_free(NULL, out);
-    AK_CHECK_EQ(ak_io_image_decode(jpg, n, W * H * 4 + 16, NULL, &out, &w, &h, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK_EQ(ak_io_image_decode(jpg, n, W * H * 4 + 16, NULL, &out, &w, &h, &diag),
+                AK_ERR_UNSUPPORTED);
     AK_CHECK(strstr(diag.message, "progressive") != NULL);
     free(jpg);
 #else
@@ -267,7 +273,8 @@ AK_TEST(broken_images) {
     AK_CHECK_EQ(ak_io_image_decode(hdr, hn, 0, NULL, &out, &w, &h, &diag), AK_ERR_UNSUPPORTED);
     AK_CHECK(strstr(diag.message, "20000 x 20000") != NULL);
     hn = png_header_only(4000, 4000, hdr); /* 64 MB of pixels against a 1 MB budget */
-    AK_CHECK_EQ(ak_io_image_decode(hdr, hn, 1u << 20, NULL, &out, &w, &h, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK_EQ(ak_io_image_decode(hdr, hn, 1u << 20, NULL, &out, &w, &h, &diag),
+                AK_ERR_UNSUPPORTED);
     AK_CHECK(strstr(diag.message, "budget") != NULL);
     /* within the budget the same header decodes as far as the missing data: a parse error */
     hn = png_header_only(8, 8, hdr);
@@ -303,11 +310,16 @@ AK_TEST(raster_perspective_correct) {
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
     ak_raster* r = NULL;
     AK_CHECK_EQ(ak_raster_create(&(ak_raster_desc){.width = W, .height = H}, NULL, &r), AK_OK);
-    ak_raster_camera cam = ak_raster_camera_perspective(ak_vec3_make(0.2f, 0.9f, 2.2f), ak_vec3_make(0, 0, -0.3f),
-                                                        ak_radians(60), (float)W / H, 0.1f, 20);
+    ak_raster_camera cam =
+        ak_raster_camera_perspective(ak_vec3_make(0.2f, 0.9f, 2.2f), ak_vec3_make(0, 0, -0.3f),
+                                     ak_radians(60), (float)W / H, 0.1f, 20);
     ak_raster_clear(r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
-    ak_raster_mesh m = {.positions = {pos, 4}, .indices = {idx, 6}, .uvs = {uv, 4}, .texture = &tex,
-                        .material = {.color = {1, 1, 1, 1}}, .shading = AK_SHADING_UNLIT};
+    ak_raster_mesh m = {.positions = {pos, 4},
+                        .indices = {idx, 6},
+                        .uvs = {uv, 4},
+                        .texture = &tex,
+                        .material = {.color = {1, 1, 1, 1}},
+                        .shading = AK_SHADING_UNLIT};
     AK_CHECK_EQ(ak_raster_draw_mesh(r, &cam, &m), AK_OK);
     uint8_t* img_px = calloc(W * H, 4);
     ak_image img = {.pixels = img_px, .width = W, .height = H};
@@ -322,7 +334,8 @@ AK_TEST(raster_perspective_correct) {
             float nx = (x + 0.5f) / W * 2 - 1, ny = 1 - (y + 0.5f) / H * 2;
             ak_vec4 a = ak_mat4_mul_vec4(inv, ak_vec4_make(nx, ny, -1, 1));
             ak_vec4 b = ak_mat4_mul_vec4(inv, ak_vec4_make(nx, ny, 1, 1));
-            ak_vec3 p0 = ak_vec3_make(a.x / a.w, a.y / a.w, a.z / a.w), p1 = ak_vec3_make(b.x / b.w, b.y / b.w, b.z / b.w);
+            ak_vec3 p0 = ak_vec3_make(a.x / a.w, a.y / a.w, a.z / a.w),
+                    p1 = ak_vec3_make(b.x / b.w, b.y / b.w, b.z / b.w);
             double t = p0.y / (double)(p0.y - p1.y);
             double hx = p0.x + t * (p1.x - p0.x), hz = p0.z + t * (p1.z - p0.z);
             double u = (hx + 1) / 2, v = (hz + 1) / 2;
@@ -336,22 +349,28 @@ AK_TEST(raster_perspective_correct) {
             /* affine: screen-space barycentrics of the triangle holding the pixel */
             double px = x + 0.5, py = y + 0.5;
             for (int tri = 0; tri < 2; ++tri) {
-                const ak_vec3 *A = &sp[idx[3 * tri]], *B = &sp[idx[3 * tri + 1]], *C = &sp[idx[3 * tri + 2]];
+                const ak_vec3 *A = &sp[idx[3 * tri]], *B = &sp[idx[3 * tri + 1]],
+                              *C = &sp[idx[3 * tri + 2]];
                 double den = (B->y - C->y) * (A->x - C->x) + (C->x - B->x) * (A->y - C->y);
                 double l0 = ((B->y - C->y) * (px - C->x) + (C->x - B->x) * (py - C->y)) / den;
                 double l1 = ((C->y - A->y) * (px - C->x) + (A->x - C->x) * (py - C->y)) / den;
                 double l2 = 1 - l0 - l1;
                 if (l0 < 0 || l1 < 0 || l2 < 0) continue;
-                const ak_vec2 *ua = &uv[idx[3 * tri]], *ub = &uv[idx[3 * tri + 1]], *uc = &uv[idx[3 * tri + 2]];
-                double au = l0 * ua->x + l1 * ub->x + l2 * uc->x, av = l0 * ua->y + l1 * ub->y + l2 * uc->y;
-                if ((int)floor(au * T) != (int)floor(u * T) || (int)floor(av * T) != (int)floor(v * T)) ++affine_differs;
+                const ak_vec2 *ua = &uv[idx[3 * tri]], *ub = &uv[idx[3 * tri + 1]],
+                              *uc = &uv[idx[3 * tri + 2]];
+                double au = l0 * ua->x + l1 * ub->x + l2 * uc->x,
+                       av = l0 * ua->y + l1 * ub->y + l2 * uc->y;
+                if ((int)floor(au * T) != (int)floor(u * T) ||
+                    (int)floor(av * T) != (int)floor(v * T))
+                    ++affine_differs;
                 break;
             }
         }
     AK_CHECK_MSG(checked > 1000, "only %d pixels checked", checked);
     AK_CHECK_MSG(wrong == 0, "%d of %d pixels show the wrong texel", wrong, checked);
     /* the scene is chosen so that affine interpolation would be visibly wrong */
-    AK_CHECK_MSG(affine_differs > checked / 10, "affine differs at only %d of %d", affine_differs, checked);
+    AK_CHECK_MSG(affine_differs > checked / 10, "affine differs at only %d of %d", affine_differs,
+                 checked);
     free(img_px);
     ak_raster_destroy(r);
 }
@@ -378,25 +397,34 @@ static int wrap_ref(double u, int n, ak_raster_wrap w) {
  * centres is checked against the interpolated bytes (unlit filters sRGB bytes). */
 AK_TEST(raster_wrap_modes) {
     enum { W = 150, H = 4, T = 4 };
-    const uint8_t tex_px[T * 4] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 250, 250, 250, 255};
+    const uint8_t tex_px[T * 4] = {255, 0, 0,   255, 0,   255, 0,   255,
+                                   0,   0, 255, 255, 250, 250, 250, 255};
     const ak_vec3 pos[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
     const ak_vec2 uv[4] = {{-1, 0.5f}, {2, 0.5f}, {2, 0.5f}, {-1, 0.5f}};
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
     ak_raster* r = NULL;
     AK_CHECK_EQ(ak_raster_create(&(ak_raster_desc){.width = W, .height = H}, NULL, &r), AK_OK);
-    ak_raster_camera cam = ak_raster_camera_orthographic(ak_vec3_make(0, 0, 5), ak_vec3_zero(), 1, 1, 0.1f, 10);
+    ak_raster_camera cam =
+        ak_raster_camera_orthographic(ak_vec3_make(0, 0, 5), ak_vec3_zero(), 1, 1, 0.1f, 10);
     uint8_t* img_px = calloc(W * H, 4);
     ak_image img = {.pixels = img_px, .width = W, .height = H};
-    const ak_raster_wrap modes[3] = {AK_RASTER_WRAP_REPEAT, AK_RASTER_WRAP_CLAMP, AK_RASTER_WRAP_MIRROR};
+    const ak_raster_wrap modes[3] = {AK_RASTER_WRAP_REPEAT, AK_RASTER_WRAP_CLAMP,
+                                     AK_RASTER_WRAP_MIRROR};
     for (int mi = 0; mi < 3; ++mi) {
         for (int f = 0; f < 2; ++f) {
             ak_raster_filter filt = f ? AK_RASTER_FILTER_LINEAR : AK_RASTER_FILTER_NEAREST;
             ak_raster_texture tex = {.image = {.pixels = (uint8_t*)tex_px, .width = T, .height = 1},
-                                     .wrap_u = modes[mi], .wrap_v = AK_RASTER_WRAP_CLAMP, .mag_filter = filt,
+                                     .wrap_u = modes[mi],
+                                     .wrap_v = AK_RASTER_WRAP_CLAMP,
+                                     .mag_filter = filt,
                                      .min_filter = filt};
             ak_raster_clear(r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
-            ak_raster_mesh m = {.positions = {pos, 4}, .indices = {idx, 6}, .uvs = {uv, 4}, .texture = &tex,
-                                .material = {.color = {1, 1, 1, 1}}, .shading = AK_SHADING_UNLIT};
+            ak_raster_mesh m = {.positions = {pos, 4},
+                                .indices = {idx, 6},
+                                .uvs = {uv, 4},
+                                .texture = &tex,
+                                .material = {.color = {1, 1, 1, 1}},
+                                .shading = AK_SHADING_UNLIT};
             AK_CHECK_EQ(ak_raster_draw_mesh(r, &cam, &m), AK_OK);
             AK_CHECK_EQ(ak_raster_resolve(r, &img), AK_OK);
             int checked = 0, wrong = 0;
@@ -421,14 +449,17 @@ AK_TEST(raster_wrap_modes) {
                     }
                 }
             }
-            AK_CHECK_MSG(checked > 100 && wrong == 0, "mode %d filter %d: %d wrong of %d", mi, f, wrong, checked);
+            AK_CHECK_MSG(checked > 100 && wrong == 0, "mode %d filter %d: %d wrong of %d", mi, f,
+                         wrong, checked);
         }
     }
     /* bad texture descriptions are refused */
     ak_raster_texture bad = {.image = {.pixels = NULL, .width = T, .height = 1}};
-    ak_raster_mesh m = {.positions = {pos, 4}, .indices = {idx, 6}, .uvs = {uv, 4}, .texture = &bad};
+    ak_raster_mesh m = {
+        .positions = {pos, 4}, .indices = {idx, 6}, .uvs = {uv, 4}, .texture = &bad};
     AK_CHECK_EQ(ak_raster_draw_mesh(r, &cam, &m), AK_ERR_BAD_ARG);
-    ak_raster_texture bad_wrap = {.image = {.pixels = (uint8_t*)tex_px, .width = T, .height = 1}, .wrap_u = 7};
+    ak_raster_texture bad_wrap = {.image = {.pixels = (uint8_t*)tex_px, .width = T, .height = 1},
+                                  .wrap_u = 7};
     m.texture = &bad_wrap;
     AK_CHECK_EQ(ak_raster_draw_mesh(r, &cam, &m), AK_ERR_BAD_ARG);
     m.texture = NULL;
@@ -453,17 +484,23 @@ AK_TEST(raster_lit_texture_scales_albedo) {
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
     ak_raster* r = NULL;
     AK_CHECK_EQ(ak_raster_create(&(ak_raster_desc){.width = W, .height = H}, NULL, &r), AK_OK);
-    ak_raster_camera cam = ak_raster_camera_orthographic(ak_vec3_make(0, 0, 5), ak_vec3_zero(), 1, 1, 0.1f, 10);
+    ak_raster_camera cam =
+        ak_raster_camera_orthographic(ak_vec3_make(0, 0, 5), ak_vec3_zero(), 1, 1, 0.1f, 10);
     uint8_t img_px[2][W * H * 4];
     const uint8_t texels[2] = {200, half};
     for (int k = 0; k < 2; ++k) {
         uint8_t t[4] = {texels[k], texels[k], texels[k], 255};
         ak_raster_texture tex = {.image = {.pixels = t, .width = 1, .height = 1}};
         ak_raster_clear(r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
-        ak_raster_mesh m = {.positions = {pos, 4}, .normals = {nrm, 4}, .indices = {idx, 6}, .uvs = {uv, 4},
-                            .texture = &tex, .material = {.color = {0.5f, 0.5f, 0.5f, 1}, .specular = -1}};
+        ak_raster_mesh m = {.positions = {pos, 4},
+                            .normals = {nrm, 4},
+                            .indices = {idx, 6},
+                            .uvs = {uv, 4},
+                            .texture = &tex,
+                            .material = {.color = {0.5f, 0.5f, 0.5f, 1}, .specular = -1}};
         AK_CHECK_EQ(ak_raster_draw_mesh(r, &cam, &m), AK_OK);
-        AK_CHECK_EQ(ak_raster_resolve(r, &(ak_image){.pixels = img_px[k], .width = W, .height = H}), AK_OK);
+        AK_CHECK_EQ(ak_raster_resolve(r, &(ak_image){.pixels = img_px[k], .width = W, .height = H}),
+                    AK_OK);
     }
     float a = ak_srgb_to_linear(img_px[0][(8 * W + 8) * 4] / 255.0f);
     float b = ak_srgb_to_linear(img_px[1][(8 * W + 8) * 4] / 255.0f);
@@ -482,13 +519,19 @@ static char* gltf_triangle(const char* image_json, const char* sampler_json) {
     size_t cap = strlen(b) + strlen(image_json) + 2048;
     char* out = malloc(cap);
     snprintf(out, cap,
-             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":60,\"uri\":\"data:application/"
-             "octet-stream;base64,%s\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,"
-             "\"byteOffset\":36,\"byteLength\":24}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,"
-             "\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":"
-             "5126,\"count\":3,\"type\":\"VEC2\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,"
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":60,\"uri\":\"data:"
+             "application/"
+             "octet-stream;base64,%s\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{"
+             "\"buffer\":0,"
+             "\"byteOffset\":36,\"byteLength\":24}],\"accessors\":[{\"bufferView\":0,"
+             "\"componentType\":5126,"
+             "\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,"
+             "\"componentType\":"
+             "5126,\"count\":3,\"type\":\"VEC2\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{"
+             "\"POSITION\":0,"
              "\"TEXCOORD_0\":1},\"material\":0}]}],\"nodes\":[{\"mesh\":0}],\"materials\":[{"
-             "\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0.5,0.25,1],\"baseColorTexture\":{\"index\":0}}}],"
+             "\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0.5,0.25,1],\"baseColorTexture\":{"
+             "\"index\":0}}}],"
              "\"textures\":[{\"source\":0%s}],\"samplers\":[%s],\"images\":[%s]}",
              b, sampler_json[0] ? ",\"sampler\":0" : "", sampler_json, image_json);
     free(b);
@@ -503,16 +546,19 @@ AK_TEST(gltf_texture_and_sampler) {
     char* pb = b64(png, n);
     char* image = malloc(strlen(pb) + 64);
     sprintf(image, "{\"uri\":\"data:image/png;base64,%s\"}", pb);
-    char* doc = gltf_triangle(image, "{\"wrapS\":33648,\"wrapT\":33071,\"magFilter\":9728,\"minFilter\":9986}");
+    char* doc = gltf_triangle(
+        image, "{\"wrapS\":33648,\"wrapT\":33071,\"magFilter\":9728,\"minFilter\":9986}");
     ak_scene* s = NULL;
     ak_diag diag;
-    AK_CHECK_EQ(ak_io_load_memory(doc, strlen(doc), "tri.gltf", NULL, NULL, NULL, &s, &diag), AK_OK);
+    AK_CHECK_EQ(ak_io_load_memory(doc, strlen(doc), "tri.gltf", NULL, NULL, NULL, &s, &diag),
+                AK_OK);
     if (s) {
         AK_CHECK_EQ(s->texture_count, 1u);
         AK_CHECK_EQ(s->meshes[0].texture, 0);
         AK_CHECK_NEAR(s->meshes[0].base_color.y, 0.5f, 1e-6);
         const ak_scene_texture* t = &s->textures[0];
-        AK_CHECK(t->width == 3 && t->height == 2 && t->pixels && memcmp(t->pixels, px, sizeof px) == 0);
+        AK_CHECK(t->width == 3 && t->height == 2 && t->pixels &&
+                 memcmp(t->pixels, px, sizeof px) == 0);
         AK_CHECK_EQ(t->wrap_s, AK_TEXTURE_WRAP_MIRROR);
         AK_CHECK_EQ(t->wrap_t, AK_TEXTURE_WRAP_CLAMP);
         AK_CHECK_EQ(t->mag_filter, AK_TEXTURE_FILTER_NEAREST);
@@ -524,9 +570,11 @@ AK_TEST(gltf_texture_and_sampler) {
     /* no sampler: REPEAT and LINEAR */
     doc = gltf_triangle(image, "");
     s = NULL;
-    AK_CHECK_EQ(ak_io_load_memory(doc, strlen(doc), "tri.gltf", NULL, NULL, NULL, &s, &diag), AK_OK);
+    AK_CHECK_EQ(ak_io_load_memory(doc, strlen(doc), "tri.gltf", NULL, NULL, NULL, &s, &diag),
+                AK_OK);
     if (s) {
-        AK_CHECK(s->textures[0].wrap_s == AK_TEXTURE_WRAP_REPEAT && s->textures[0].wrap_t == AK_TEXTURE_WRAP_REPEAT);
+        AK_CHECK(s->textures[0].wrap_s == AK_TEXTURE_WRAP_REPEAT &&
+                 s->textures[0].wrap_t == AK_TEXTURE_WRAP_REPEAT);
         AK_CHECK(s->textures[0].mag_filter == AK_TEXTURE_FILTER_LINEAR);
     }
     ak_scene_destroy(s);
@@ -539,15 +587,16 @@ AK_TEST(gltf_texture_and_sampler) {
 /* A texture that cannot be read is a warning and no texture; the model still loads. */
 AK_TEST(gltf_broken_texture_warns) {
     const char* images[] = {
-        "{\"uri\":\"data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAAB\"}", /* a truncated PNG */
-        "{\"uri\":\"data:image/png;base64,aGVsbG8gd29ybGQ=\"}",                /* not an image */
-        "{\"uri\":\"../../../../etc/passwd\"}",                                    /* leaves the folder */
-        "{\"uri\":\"missing.png\"}",                                               /* not there */
-        "{\"bufferView\":99,\"mimeType\":\"image/png\"}",                          /* bad view */
-        "{\"name\":\"nothing\"}",                                                  /* no data */
+        "{\"uri\":\"data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAAB\"}", /* a truncated PNG
+                                                                                 */
+        "{\"uri\":\"data:image/png;base64,aGVsbG8gd29ybGQ=\"}",                 /* not an image */
+        "{\"uri\":\"../../../../etc/passwd\"}",           /* leaves the folder */
+        "{\"uri\":\"missing.png\"}",                      /* not there */
+        "{\"bufferView\":99,\"mimeType\":\"image/png\"}", /* bad view */
+        "{\"name\":\"nothing\"}",                         /* no data */
     };
-    const char* expect[] = {"PNG", "not a PNG or JPEG", "leaves the model's folder", "missing.png", "bufferView",
-                            "neither"};
+    const char* expect[] = {"PNG",         "not a PNG or JPEG", "leaves the model's folder",
+                            "missing.png", "bufferView",        "neither"};
     for (size_t i = 0; i < sizeof images / sizeof images[0]; ++i) {
         char* doc = gltf_triangle(images[i], "");
         ak_io_desc d = {.logger = {.func = count_warning}};
@@ -555,10 +604,11 @@ AK_TEST(gltf_broken_texture_warns) {
         g_last_warning[0] = 0;
         ak_scene* s = NULL;
         ak_diag diag;
-        ak_result r = ak_io_load_memory(doc, strlen(doc), "tri.gltf", AK_BINARY_DIR, &d, NULL, &s, &diag);
+        ak_result r =
+            ak_io_load_memory(doc, strlen(doc), "tri.gltf", AK_BINARY_DIR, &d, NULL, &s, &diag);
         AK_CHECK_MSG(r == AK_OK, "image %zu: %s (%s)", i, ak_result_string(r), diag.message);
-        AK_CHECK_MSG(g_warnings == 1 && strstr(g_last_warning, expect[i]) != NULL, "image %zu: %d warnings, '%s'", i,
-                     g_warnings, g_last_warning);
+        AK_CHECK_MSG(g_warnings == 1 && strstr(g_last_warning, expect[i]) != NULL,
+                     "image %zu: %d warnings, '%s'", i, g_warnings, g_last_warning);
         if (s) {
             AK_CHECK_EQ(s->meshes[0].texture, -1);
             AK_CHECK(s->textures[0].pixels == NULL);
@@ -573,7 +623,8 @@ AK_TEST(gltf_assets_textured) {
     const char* fox_gltf = asset("Fox/glTF/Fox.gltf");
     const char* fox_png = asset("Fox/glTF/Texture.png");
     const char* man = asset("CesiumMan/glTF-Binary/CesiumMan.glb");
-    if (!file_exists(fox_glb) || !file_exists(fox_gltf) || !file_exists(man)) AK_SKIP("assets not found");
+    if (!file_exists(fox_glb) || !file_exists(fox_gltf) || !file_exists(man))
+        AK_SKIP("assets not found");
     /* the PNG file itself, read by libpng's file reader: the independent reference */
     int w = 0, h = 0;
     AK_CHECK_EQ(ak_png_info(fox_png, &w, &h), AK_OK);
@@ -607,7 +658,8 @@ AK_TEST(gltf_assets_textured) {
         static bool seen[4096];
         memset(seen, 0, sizeof seen);
         for (int i = 0; t->pixels && i < t->width * t->height; ++i) {
-            int q = (t->pixels[4 * i] >> 4) << 8 | (t->pixels[4 * i + 1] >> 4) << 4 | (t->pixels[4 * i + 2] >> 4);
+            int q = (t->pixels[4 * i] >> 4) << 8 | (t->pixels[4 * i + 1] >> 4) << 4 |
+                    (t->pixels[4 * i + 2] >> 4);
             if (!seen[q]) ++distinct;
             seen[q] = true;
         }
@@ -644,8 +696,9 @@ AK_TEST(cli_export_keeps_texture) {
     if (a && b) {
         AK_CHECK_EQ(b->texture_count, 1u);
         AK_CHECK(b->mesh_count == a->mesh_count && same_texture(a, b, 0));
-        AK_CHECK(b->meshes[0].mesh->uvs && memcmp(a->meshes[0].mesh->uvs, b->meshes[0].mesh->uvs,
-                                                  a->meshes[0].mesh->vertex_count * sizeof(ak_vec2)) == 0);
+        AK_CHECK(b->meshes[0].mesh->uvs &&
+                 memcmp(a->meshes[0].mesh->uvs, b->meshes[0].mesh->uvs,
+                        a->meshes[0].mesh->vertex_count * sizeof(ak_vec2)) == 0);
     }
     ak_scene_destroy(a);
     ak_scene_destroy(b);
@@ -675,8 +728,10 @@ AK_TEST(obj_export_map_kd) {
     const ak_scene_texture* t = &a->textures[0];
     AK_CHECK(w == t->width && h == t->height);
     uint8_t* png = malloc((size_t)w * (size_t)h * 4);
-    AK_CHECK_EQ(ak_png_read("tex_fox_0.png", &(ak_image){.pixels = png, .width = w, .height = h}), AK_OK);
-    AK_CHECK(memcmp(png, t->pixels + (size_t)(h - 1) * (size_t)w * 4, (size_t)w * 4) == 0); /* first row = last */
+    AK_CHECK_EQ(ak_png_read("tex_fox_0.png", &(ak_image){.pixels = png, .width = w, .height = h}),
+                AK_OK);
+    AK_CHECK(memcmp(png, t->pixels + (size_t)(h - 1) * (size_t)w * 4, (size_t)w * 4) ==
+             0); /* first row = last */
     free(png);
     AK_CHECK_EQ(ak_io_load("tex_fox.obj", NULL, NULL, &b, &diag), AK_OK);
     if (b) {
@@ -690,7 +745,9 @@ AK_TEST(obj_export_map_kd) {
     ak_scene_destroy(b);
     /* a map_Kd that leaves the folder or is broken: a warning, no texture, the OBJ loads */
     f = fopen("tex_bad.obj", "wb");
-    fputs("mtllib tex_bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n", f);
+    fputs("mtllib tex_bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 "
+          "2/2 3/3\n",
+          f);
     fclose(f);
     const char* maps[2] = {"../../../../etc/passwd", "tex_bad.obj"};
     for (int k = 0; k < 2; ++k) {
@@ -701,8 +758,8 @@ AK_TEST(obj_export_map_kd) {
         g_warnings = 0;
         b = NULL;
         AK_CHECK_EQ(ak_io_load("tex_bad.obj", &d, NULL, &b, &diag), AK_OK);
-        AK_CHECK_MSG(g_warnings == 1 && strstr(g_last_warning, "map_Kd") != NULL, "%d: '%s'", g_warnings,
-                     g_last_warning);
+        AK_CHECK_MSG(g_warnings == 1 && strstr(g_last_warning, "map_Kd") != NULL, "%d: '%s'",
+                     g_warnings, g_last_warning);
         if (b) AK_CHECK(b->meshes[0].texture == -1 && b->meshes[0].has_material);
         ak_scene_destroy(b);
     }
@@ -732,8 +789,8 @@ static void check_head(const ak_image* img, int from, const char* what) {
             blue += p[2] > p[0] + 60 && p[2] > p[1] + 10;  /* the logo's sky blue */
             green += p[1] > p[0] + 30 && p[1] > p[2] + 30; /* its green hills */
         }
-    AK_CHECK_MSG(figure > 300 && blue > figure / 10 && green > figure / 50, "%s: head of %d pixels, %d blue, %d green",
-                 what, figure, blue, green);
+    AK_CHECK_MSG(figure > 300 && blue > figure / 10 && green > figure / 50,
+                 "%s: head of %d pixels, %d blue, %d green", what, figure, blue, green);
 }
 
 /* `render` to a PNG shows the texture on the head. */

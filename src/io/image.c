@@ -16,19 +16,22 @@
 
 static ak_result too_big(int w, int h, akp_budget* budget, char* msg, size_t msg_size) {
     if (w <= 0 || h <= 0 || w > AKP_IO_MAX_IMAGE_SIDE || h > AKP_IO_MAX_IMAGE_SIDE) {
-        snprintf(msg, msg_size, "image of %d x %d pixels (at most %d per side)", w, h, AKP_IO_MAX_IMAGE_SIDE);
+        snprintf(msg, msg_size, "image of %d x %d pixels (at most %d per side)", w, h,
+                 AKP_IO_MAX_IMAGE_SIDE);
         return AK_ERR_UNSUPPORTED;
     }
     if (budget && !akp_budget_take(budget, (size_t)w * (size_t)h, 4)) {
-        snprintf(msg, msg_size, "image of %d x %d pixels would exceed the memory budget of %zu bytes", w, h,
+        snprintf(msg, msg_size,
+                 "image of %d x %d pixels would exceed the memory budget of %zu bytes", w, h,
                  budget->limit);
         return AK_ERR_UNSUPPORTED;
     }
     return AK_OK;
 }
 
-static ak_result decode_png(const uint8_t* data, size_t size, akp_budget* budget, const ak_allocator* alloc,
-                            uint8_t** out, int* out_w, int* out_h, char* msg, size_t msg_size) {
+static ak_result decode_png(const uint8_t* data, size_t size, akp_budget* budget,
+                            const ak_allocator* alloc, uint8_t** out, int* out_w, int* out_h,
+                            char* msg, size_t msg_size) {
     png_image pi;
     memset(&pi, 0, sizeof pi);
     pi.version = PNG_IMAGE_VERSION;
@@ -50,7 +53,8 @@ static ak_result decode_png(const uint8_t* data, size_t size, akp_budget* budget
         snprintf(msg, msg_size, "out of memory");
         return AK_ERR_NO_MEMORY;
     }
-    pi.format = PNG_FORMAT_RGBA; /* any colour type, 16-bit reduced, tRNS as alpha; no gamma change */
+    pi.format =
+        PNG_FORMAT_RGBA; /* any colour type, 16-bit reduced, tRNS as alpha; no gamma change */
     if (!png_image_finish_read(&pi, NULL, px, (png_int_32)(w * 4), NULL)) {
         snprintf(msg, msg_size, "broken PNG: %s", pi.message);
         png_image_free(&pi);
@@ -77,10 +81,13 @@ static void jpeg_on_error(j_common_ptr cinfo) {
     longjmp(f->jump, 1);
 }
 
-static void jpeg_on_message(j_common_ptr cinfo) { (void)cinfo; /* warnings: silent, never printed */ }
+static void jpeg_on_message(j_common_ptr cinfo) {
+    (void)cinfo; /* warnings: silent, never printed */
+}
 
-static ak_result decode_jpeg(const uint8_t* data, size_t size, akp_budget* budget, const ak_allocator* alloc,
-                             uint8_t** out, int* out_w, int* out_h, char* msg, size_t msg_size) {
+static ak_result decode_jpeg(const uint8_t* data, size_t size, akp_budget* budget,
+                             const ak_allocator* alloc, uint8_t** out, int* out_w, int* out_h,
+                             char* msg, size_t msg_size) {
     struct jpeg_decompress_struct cinfo;
     jpeg_fail fail;
     memset(&cinfo, 0, sizeof cinfo);
@@ -103,17 +110,19 @@ static ak_result decode_jpeg(const uint8_t* data, size_t size, akp_budget* budge
     int w = cinfo.image_width > (JDIMENSION)INT32_MAX ? -1 : (int)cinfo.image_width;
     int h = cinfo.image_height > (JDIMENSION)INT32_MAX ? -1 : (int)cinfo.image_height;
     ak_result r = too_big(w, h, budget, msg, msg_size);
-    if (r == AK_OK && cinfo.jpeg_color_space != JCS_GRAYSCALE && cinfo.jpeg_color_space != JCS_YCbCr &&
-        cinfo.jpeg_color_space != JCS_RGB) {
-        snprintf(msg, msg_size, "JPEG colour space %d (CMYK/YCCK) is not supported", (int)cinfo.jpeg_color_space);
+    if (r == AK_OK && cinfo.jpeg_color_space != JCS_GRAYSCALE &&
+        cinfo.jpeg_color_space != JCS_YCbCr && cinfo.jpeg_color_space != JCS_RGB) {
+        snprintf(msg, msg_size, "JPEG colour space %d (CMYK/YCCK) is not supported",
+                 (int)cinfo.jpeg_color_space);
         r = AK_ERR_UNSUPPORTED;
     }
     /* a progressive (multi-scan) JPEG keeps every DCT coefficient (2 bytes per sample) in
      * libjpeg's own memory until the last scan: charged too */
     if (r == AK_OK && budget && jpeg_has_multiple_scans(&cinfo) &&
         !akp_budget_take(budget, (size_t)w * (size_t)h, (size_t)cinfo.num_components * 2u)) {
-        snprintf(msg, msg_size, "progressive JPEG of %d x %d pixels would exceed the memory budget of %zu bytes", w, h,
-                 budget->limit);
+        snprintf(msg, msg_size,
+                 "progressive JPEG of %d x %d pixels would exceed the memory budget of %zu bytes",
+                 w, h, budget->limit);
         r = AK_ERR_UNSUPPORTED;
     }
     if (r != AK_OK) {
@@ -128,7 +137,8 @@ static ak_result decode_jpeg(const uint8_t* data, size_t size, akp_budget* budge
     }
     cinfo.out_color_space = JCS_EXT_RGBA; /* libjpeg-turbo: grey and YCbCr to RGBA, alpha 255 */
     jpeg_start_decompress(&cinfo);
-    if (cinfo.output_components != 4 || cinfo.output_width != (JDIMENSION)w || cinfo.output_height != (JDIMENSION)h) {
+    if (cinfo.output_components != 4 || cinfo.output_width != (JDIMENSION)w ||
+        cinfo.output_height != (JDIMENSION)h) {
         snprintf(fail.text, sizeof fail.text, "unexpected output layout");
         longjmp(fail.jump, 1);
     }
@@ -147,19 +157,23 @@ static ak_result decode_jpeg(const uint8_t* data, size_t size, akp_budget* budge
 
 /* ---- internal ------------------------------------------------------------------------------ */
 
-ak_result akp_image_decode(const uint8_t* data, size_t size, akp_budget* budget, const ak_allocator* alloc,
-                           uint8_t** out_pixels, int* out_width, int* out_height, char* msg, size_t msg_size) {
+ak_result akp_image_decode(const uint8_t* data, size_t size, akp_budget* budget,
+                           const ak_allocator* alloc, uint8_t** out_pixels, int* out_width,
+                           int* out_height, char* msg, size_t msg_size) {
     static const uint8_t png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
     *out_pixels = NULL;
     *out_width = *out_height = 0;
     msg[0] = 0;
     if (data && size >= 8 && memcmp(data, png_sig, 8) == 0)
-        return decode_png(data, size, budget, alloc, out_pixels, out_width, out_height, msg, msg_size);
+        return decode_png(data, size, budget, alloc, out_pixels, out_width, out_height, msg,
+                          msg_size);
     if (data && size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF) {
 #ifdef AK_HAVE_JPEG
-        return decode_jpeg(data, size, budget, alloc, out_pixels, out_width, out_height, msg, msg_size);
+        return decode_jpeg(data, size, budget, alloc, out_pixels, out_width, out_height, msg,
+                           msg_size);
 #else
-        snprintf(msg, msg_size, "JPEG image, but this build has no JPEG decoder (libjpeg62-turbo-dev)");
+        snprintf(msg, msg_size,
+                 "JPEG image, but this build has no JPEG decoder (libjpeg62-turbo-dev)");
         return AK_ERR_UNSUPPORTED;
 #endif
     }
@@ -167,7 +181,8 @@ ak_result akp_image_decode(const uint8_t* data, size_t size, akp_budget* budget,
     return AK_ERR_PARSE;
 }
 
-ak_result akp_image_encode_png(const uint8_t* rgba, int width, int height, uint8_t** out_data, size_t* out_size) {
+ak_result akp_image_encode_png(const uint8_t* rgba, int width, int height, uint8_t** out_data,
+                               size_t* out_size) {
     *out_data = NULL;
     *out_size = 0;
     png_image pi;
@@ -177,7 +192,8 @@ ak_result akp_image_encode_png(const uint8_t* rgba, int width, int height, uint8
     pi.height = (png_uint_32)height;
     pi.format = PNG_FORMAT_RGBA;
     png_alloc_size_t n = 0;
-    if (!png_image_write_to_memory(&pi, NULL, &n, 0, rgba, (png_int_32)(width * 4), NULL) || n == 0) {
+    if (!png_image_write_to_memory(&pi, NULL, &n, 0, rgba, (png_int_32)(width * 4), NULL) ||
+        n == 0) {
         png_image_free(&pi);
         return AK_ERR_BAD_ARG;
     }
@@ -196,16 +212,17 @@ ak_result akp_image_encode_png(const uint8_t* rgba, int width, int height, uint8
 
 /* ---- public -------------------------------------------------------------------------------- */
 
-ak_result ak_io_image_decode(const void* data, size_t size, size_t memory_budget, const ak_allocator* alloc,
-                             uint8_t** out_pixels, int* out_width, int* out_height, ak_diag* diag) {
+ak_result ak_io_image_decode(const void* data, size_t size, size_t memory_budget,
+                             const ak_allocator* alloc, uint8_t** out_pixels, int* out_width,
+                             int* out_height, ak_diag* diag) {
     if (out_pixels) *out_pixels = NULL;
     if (out_width) *out_width = 0;
     if (out_height) *out_height = 0;
     if ((!data && size) || !out_pixels || !out_width || !out_height) return AK_ERR_NULL_ARG;
     akp_budget b = {.limit = memory_budget ? memory_budget : AK_IO_DEFAULT_BUDGET, .used = 0};
     char msg[256];
-    ak_result r = akp_image_decode((const uint8_t*)data, size, &b, alloc, out_pixels, out_width, out_height, msg,
-                                   sizeof msg);
+    ak_result r = akp_image_decode((const uint8_t*)data, size, &b, alloc, out_pixels, out_width,
+                                   out_height, msg, sizeof msg);
     if (r != AK_OK && diag) {
         memset(diag, 0, sizeof *diag);
         diag->byte_offset = -1;

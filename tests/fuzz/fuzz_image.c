@@ -37,8 +37,8 @@ static void draw(const ak_scene* s) {
                              .wrap_v = (ak_raster_wrap)t->wrap_t,
                              .mag_filter = (ak_raster_filter)t->mag_filter,
                              .min_filter = (ak_raster_filter)t->min_filter};
-    ak_raster_camera cam = ak_raster_camera_orthographic(ak_vec3_make(0.5f, 0.5f, 3), ak_vec3_make(0.5f, 0.5f, 0), 0.6f,
-                                                         1, 0.1f, 10);
+    ak_raster_camera cam = ak_raster_camera_orthographic(
+        ak_vec3_make(0.5f, 0.5f, 3), ak_vec3_make(0.5f, 0.5f, 0), 0.6f, 1, 0.1f, 10);
     ak_raster_mesh m = {.positions = {sm->mesh->positions, sm->mesh->vertex_count},
                         .uvs = {sm->mesh->uvs, sm->mesh->vertex_count},
                         .indices = {sm->mesh->indices, sm->mesh->triangle_count * 3},
@@ -66,18 +66,24 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size > (1u << 24)) return 0;
     size_t img_off = sizeof geo, bin = (img_off + size + 3) & ~(size_t)3;
     char json[1600];
-    int jn = snprintf(json, sizeof json,
-                      "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[{\"buffer\":0,"
-                      "\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},{\"buffer\":0,"
-                      "\"byteOffset\":%zu,\"byteLength\":%zu}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,"
-                      "\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,"
-                      "\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}],\"meshes\":[{\"primitives\":[{"
-                      "\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":0}]}],\"nodes\":[{\"mesh\":0}],"
-                      "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],\"textures\":[{"
-                      "\"source\":0,\"sampler\":0}],\"samplers\":[{\"wrapS\":%d,\"wrapT\":33648,\"magFilter\":%d}],"
-                      "\"images\":[{\"bufferView\":2,\"mimeType\":\"image/png\"}]}",
-                      bin, img_off, size ? size : 1, size && (data[0] & 1) ? 33071 : 10497,
-                      size && (data[0] & 2) ? 9728 : 9729);
+    int jn = snprintf(
+        json, sizeof json,
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[{"
+        "\"buffer\":0,"
+        "\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},{\"buffer\":0,"
+        "\"byteOffset\":%zu,\"byteLength\":%zu}],\"accessors\":[{\"bufferView\":0,"
+        "\"componentType\":5126,"
+        "\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,"
+        "\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}],\"meshes\":[{\"primitives\":[{"
+        "\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":0}]}],\"nodes\":[{\"mesh\":"
+        "0}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
+        "\"textures\":[{"
+        "\"source\":0,\"sampler\":0}],\"samplers\":[{\"wrapS\":%d,\"wrapT\":33648,\"magFilter\":%d}"
+        "],"
+        "\"images\":[{\"bufferView\":2,\"mimeType\":\"image/png\"}]}",
+        bin, img_off, size ? size : 1, size && (data[0] & 1) ? 33071 : 10497,
+        size && (data[0] & 2) ? 9728 : 9729);
     size_t jlen = ((size_t)jn + 3) & ~(size_t)3;
     size_t total = 12 + 8 + jlen + 8 + bin;
     uint8_t* glb = calloc(1, total);
