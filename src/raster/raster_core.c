@@ -598,24 +598,29 @@ static FORCE_INLINE int mode_attr_count(frag_mode mode) {
 
 /* ---- textures ------------------------------------------------------------------------------ */
 
-static inline int wrap_index(int64_t i, int n, ak_raster_wrap w) {
-    if (w == AK_RASTER_WRAP_CLAMP) return i < 0 ? 0 : (i >= n ? n - 1 : (int)i);
-    if (w == AK_RASTER_WRAP_MIRROR) {
-        int64_t p = 2 * (int64_t)n, m = i % p;
-        if (m < 0) m += p;
-        return (int)(m < n ? m : p - 1 - m);
-    }
-    int64_t m = i % n;
-    return (int)(m < 0 ? m + n : m);
+/* Reduce a texture coordinate to one period of its wrap mode, so that texel indices need no
+ * division: REPEAT -> [0, 1), MIRROR -> [0, 2) (the second half mirrored), CLAMP -> [0, 1].
+ * Non-finite -> 0; huge values keep their period only as far as float precision allows. */
+static inline float tex_period(float u, ak_raster_wrap w) {
+    if (!ak_finitef(u)) return 0.0f;
+    if (w == AK_RASTER_WRAP_CLAMP) return u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+    float p = w == AK_RASTER_WRAP_MIRROR ? 2.0f : 1.0f;
+    float f = u - p * floorf(u / p);
+    return f >= 0.0f && f < p ? f : 0.0f; /* rounding can give exactly p */
 }
 
-/* Texel coordinate of u along an axis of n texels (scaled, sanitised: huge values keep their
- * fractional behaviour only approximately, but never overflow). */
-static inline double tex_coord(float u, int n) {
-    if (!ak_finitef(u)) u = 0.0f;
-    if (u > 1e6f) u = 1e6f;
-    if (u < -1e6f) u = -1e6f;
-    return (double)u * (double)n;
+/* Texel index i (in [-1, 2n] after tex_period and the bilinear half-texel shift) of an axis of
+ * n texels, wrapped. */
+static inline int tex_index(int i, int n, ak_raster_wrap w) {
+    if (w == AK_RASTER_WRAP_CLAMP) return i < 0 ? 0 : (i >= n ? n - 1 : i);
+    if (w == AK_RASTER_WRAP_MIRROR) {
+        int p = 2 * n;
+        if (i < 0) i += p;
+        if (i >= p) i -= p;
+        return i < n ? i : p - 1 - i;
+    }
+    if (i < 0) return i + n;
+    return i >= n ? i - n : i;
 }
 
 /* The texel colour at (u, v): linear light (lit modes) or sRGB (unlit) in [0, 1], alpha in
@@ -627,28 +632,33 @@ static void tex_sample(const drawctx* dc, float u, float v, bool minify, bool li
     const size_t stride = dc->tex_stride;
     ak_raster_filter f = minify ? t->min_filter : t->mag_filter;
     const float* lut = dc->r->to_lin_lut;
-    double x = tex_coord(u, w), y = tex_coord(v, h);
+    const float x = tex_period(u, t->wrap_u) * (float)w, y = tex_period(v, t->wrap_v) * (float)h;
     if (f == AK_RASTER_FILTER_NEAREST) {
-        int i = wrap_index((int64_t)floor(x), w, t->wrap_u), j = wrap_index((int64_t)floor(y), h, t->wrap_v);
+        int i = tex_index((int)x, w, t->wrap_u), j = tex_index((int)y, h, t->wrap_v);
         const uint8_t* p = px + (size_t)j * stride + (size_t)i * 4u;
         for (int k = 0; k < 3; ++k) out[k] = linear ? lut[p[k]] : (float)p[k] * (1.0f / 255.0f);
         out[3] = (float)p[3] * (1.0f / 255.0f);
         return;
     }
-    x -= 0.5;
-    y -= 0.5;
-    double fx0 = floor(x), fy0 = floor(y);
-    float fx = (float)(x - fx0), fy = (float)(y - fy0);
-    int i0 = wrap_index((int64_t)fx0, w, t->wrap_u), i1 = wrap_index((int64_t)fx0 + 1, w, t->wrap_u);
-    int j0 = wrap_index((int64_t)fy0, h, t->wrap_v), j1 = wrap_index((int64_t)fy0 + 1, h, t->wrap_v);
-    const uint8_t* p[4] = {px + (size_t)j0 * stride + (size_t)i0 * 4u, px + (size_t)j0 * stride + (size_t)i1 * 4u,
-                           px + (size_t)j1 * stride + (size_t)i0 * 4u, px + (size_t)j1 * stride + (size_t)i1 * 4u};
+    const float xs = x - 0.5f, ys = y - 0.5f;
+    const float fx0 = floorf(xs), fy0 = floorf(ys);
+    const float fx = xs - fx0, fy = ys - fy0;
+    const int x0 = (int)fx0, y0 = (int)fy0;
+    const int i0 = tex_index(x0, w, t->wrap_u), i1 = tex_index(x0 + 1, w, t->wrap_u);
+    const int j0 = tex_index(y0, h, t->wrap_v), j1 = tex_index(y0 + 1, h, t->wrap_v);
+    const uint8_t* r0 = px + (size_t)j0 * stride;
+    const uint8_t* r1 = px + (size_t)j1 * stride;
+    const uint8_t* p[4] = {r0 + (size_t)i0 * 4u, r0 + (size_t)i1 * 4u, r1 + (size_t)i0 * 4u, r1 + (size_t)i1 * 4u};
     const float wt[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
     for (int k = 0; k < 4; ++k) out[k] = 0.0f;
-    for (int q = 0; q < 4; ++q) {
-        for (int k = 0; k < 3; ++k) out[k] += wt[q] * (linear ? lut[p[q][k]] : (float)p[q][k] * (1.0f / 255.0f));
-        out[3] += wt[q] * (float)p[q][3] * (1.0f / 255.0f);
+    if (linear) {
+        for (int q = 0; q < 4; ++q)
+            for (int k = 0; k < 3; ++k) out[k] += wt[q] * lut[p[q][k]];
+    } else {
+        for (int q = 0; q < 4; ++q)
+            for (int k = 0; k < 3; ++k) out[k] += wt[q] * (float)p[q][k] * (1.0f / 255.0f);
     }
+    for (int q = 0; q < 4; ++q) out[3] += wt[q] * (float)p[q][3] * (1.0f / 255.0f);
 }
 
 /* Compute the fragment colour; returns false to discard. */
@@ -1063,7 +1073,7 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
             v[k].a[3] = n.x;
             v[k].a[4] = n.y;
             v[k].a[5] = n.z;
-            if (dc->mode == FRAG_PHONG_VC) { /* vertex colours, or white under a texture */
+            if (dc->has_vcolor) {
                 ak_vec3 lc = srgb3_to_lin(vc[k]);
                 v[k].a[6] = lc.x;
                 v[k].a[7] = lc.y;
@@ -1164,8 +1174,6 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
         break;
     }
     if (tex) {
-        /* textured Phong always carries vertex colours (white without them): 10 + 2 = MAXA */
-        if (dc.mode == FRAG_PHONG) dc.mode = FRAG_PHONG_VC;
         dc.tex = tex;
         dc.tex_stride = tex->image.stride ? tex->image.stride : (size_t)tex->image.width * 4u;
         dc.uv_attr = mode_attr_count(dc.mode);
