@@ -197,7 +197,9 @@ AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* na
  * each texture used as such a PNG beside it, its rows flipped so that other tools, which take
  * v = 0 as the image's bottom, show it the right way up with the UVs as stored (animkit's OBJ
  * reader flips map_Kd images back); the .obj names them with mtllib and usemtl. These files
- * are written (each whole or not at all) before the .obj.
+ * go to temporaries too, renamed into place (before the .obj) only once the .obj is complete:
+ * a failure while writing leaves none of them (only a failed rename of the .obj after theirs
+ * can leave new side files beside the old .obj).
  * posed_positions: NULL, or an array of scene->mesh_count pointers, each to vertex_count
  * positions (NULL entry -> that mesh's own bind-space positions, as stored).
  * posed_normals: same shape; NULL or a NULL entry -> the mesh's own normals when it has them,
