@@ -21,6 +21,7 @@ PEERS_ON=${AK_BENCH_PEERS:-1}
 ONLY=${AK_BENCH_ONLY:-}
 ROOT=$PWD
 PEERS=$ROOT/../shared/peers
+[[ -d $PEERS ]] && PEERS=$(cd "$PEERS" && pwd)
 [[ -d $B/bench ]] || { echo "bench.sh: no $B/bench: build the project first (make build, Release)" >&2; exit 2; }
 B=$(cd "$B" && pwd)
 OUT=$B/bench-results
@@ -148,11 +149,14 @@ else
         done
     fi
     # Peers with no harness here, said once so that nobody wonders.
-    for d in "$PEERS"/*/; do
+    [[ -z $ONLY ]] && for d in "$PEERS"/*/; do
         p=$(basename "$d")
         case $p in vs_ozz | ozz-animation | noise | nsearch) continue ;; esac
-        [[ -x $d/run.sh ]] && skip "peer_$p" "$d/run.sh: no arguments known to scripts/bench.sh" ||
+        if [[ -x $d/run.sh ]]; then
+            skip "peer_$p" "$d/run.sh: no arguments known to scripts/bench.sh"
+        else
             skip "peer_$p" "no side-by-side harness in $d (see its README/PEER.md)"
+        fi
     done
 fi
 
