@@ -20,7 +20,7 @@ def noise_peers(text):
     """vs_noise: animkit's fastest batch job against FastNoise2's fastest path, per family
     (ns per point), and the per-point call against FastNoiseLite's."""
     rows = {}
-    for m in re.finditer(r"^(\S.{33})\s+" + NUM + r"\s+\[.*?\]\s+" + NUM, text, re.M):
+    for m in re.finditer(r"^(\S.*?)\s+" + NUM + r"\s+\[[^\]]*\]\s+" + NUM, text, re.M):
         rows[m.group(1).strip()] = float(m.group(3))  # name -> ns per point
     out = {"rate": [], "ratio": [], "path": []}
 
