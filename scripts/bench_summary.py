@@ -205,6 +205,9 @@ def main():
             text = ""
         got = extract(name, text)
         status = "ok" if rc == "0" else "FAILED (exit %s)" % rc
+        if got is not None and not any(got.values()):
+            got = None  # its key lines changed: say so rather than print an empty row
+            sys.stderr.write("bench_summary.py: no key line found in %s.txt (did its output change?)\n" % name)
         if got is None:
             lines.append("| %s | see %s.txt | - | - | %s | %s |" % (name, name, secs, status))
         else:
