@@ -699,7 +699,7 @@ AK_TEST(two_bone_closed_form_and_pole) {
  * hinge's sign: start (x = (K - s0) / a, z = +-c), mid = end (x = (T - K) / b, z = +-c).
  * Unsigned (default): the limb keeps its side, z = sign(beta) c. Signed (ozz's convention, a
  * positive turn about mid_axis opens the joint): (K - s0) x (T - K) along -mid_axis, so
- * z = -sign(mid_axis.z) c whatever the input. A wrong side leaves the positions right and turns
+ * z = -sign(mid_axis.z) c whatever the input (straight included). A wrong side leaves the positions right and turns
  * every frame half a turn about its bone (what ozz's harness saw), so the axes are checked. */
 AK_TEST(two_bone_bend_side_mid_axis) {
     const double a = 1.0, b = 0.8, d = 1.3;
@@ -723,14 +723,14 @@ AK_TEST(two_bone_bend_side_mid_axis) {
     for (int i = 0; i < 3; ++i) c[i] /= cn;
 
     const ak_quat start_q = ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(0.3f, 0.5f, 0.8f)), 0.7f);
-    for (int bent = -1; bent <= 1; bent += 2) {
+    for (int bent = -1; bent <= 1; ++bent) { /* bent 0: a straight input limb */
         const ak_quat bend_q = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.4f * (float)bent);
         const ak_quat mid_q = ak_quat_mul(start_q, bend_q);
         const ak_vec3 sp = ak_vec3_make((float)s0[0], (float)s0[1], (float)s0[2]);
         const ak_vec3 mp = ak_vec3_add(sp, ak_quat_rotate(start_q, ak_vec3_make((float)a, 0, 0)));
         const ak_vec3 ep = ak_vec3_add(mp, ak_quat_rotate(mid_q, ak_vec3_make((float)b, 0, 0)));
         for (int axis_sign = -1; axis_sign <= 1; axis_sign += 2) {
-            for (int sgn = 0; sgn < 2; ++sgn) {
+            for (int sgn = bent == 0; sgn < 2; ++sgn) { /* straight: no input side to keep */
                 ak_quat qs, qm;
                 bool reached = false;
                 ak_ik_two_bone_job job = {
