@@ -231,11 +231,14 @@ AK_API ak_result ak_ik_chain_run(const ak_ik_chain_job* job);
  * and mid joints' local rotations: local.rotation = ak_quat_mul(local.rotation, *out_x_rot).
  * Matrices must be rigid with uniform positive scale. Does not know about joint limits.
  * Bend side: by default the limb keeps the side it is bent to in the input (the sign of
- * mid_axis does not matter; the mid correction is the smaller of the two that reach). ozz's
+ * mid_axis does not matter; the mid correction is the smaller of the two that reach; a
+ * straight input bends with (mid - start) x (end - mid) along +mid_axis), so an input that
+ * passes through straight or hyperextends (animation noise) flips the bend. ozz's
  * IKTwoBoneJob instead reads the sign of mid_axis: a positive rotation about it opens the
  * joint, so the limb always ends bent with (mid - start) x (end - mid) along -mid_axis, and a
  * limb bent the other way in the input (e.g. a hyperextended knee) flips through straight.
- * mid_axis_signed = true selects ozz's convention. The two give the same joint positions
+ * mid_axis_signed = true selects ozz's convention (use it for a knee or an elbow, which bends
+ * one way only). The two give the same joint positions
  * (the pole puts the mid joint on its side either way) but, for a limb bent against
  * mid_axis, start, mid and end orientations that differ by half a turn about each bone: a
  * hand or foot below the end joint turns over. */
