@@ -593,8 +593,6 @@ done:
 
 /* ---- humanoid template (ak_humanoid_roles_find) ------------------------------------------- */
 
-#define ROLE_MAX_JOINTS 65536u
-
 enum { WORD_NONE = 0, WORD_TORSO, WORD_HEAD, WORD_ARM, WORD_LEG };
 
 typedef struct role_ctx {
@@ -949,10 +947,6 @@ ak_result ak_humanoid_roles_find(const ak_skeleton* skeleton, const ak_allocator
     for (int b = 0; b < AK_BONE_COUNT; ++b) out->joint[b] = -1;
     out->up = ak_vec3_make(0, 1, 0), out->forward = ak_vec3_make(0, 0, 1);
     const size_t n = ak_skeleton_joint_count(skeleton);
-    if (n > ROLE_MAX_JOINTS) {
-        akp_diag_set(diag, NULL, "%zu joints: more than the %u the humanoid search takes", n, ROLE_MAX_JOINTS);
-        return AK_ERR_BUDGET;
-    }
     if (n == 0) {
         akp_diag_set(diag, NULL, "not a humanoid: the skeleton has no joint");
         return AK_ERR_NOT_FOUND;

@@ -162,8 +162,8 @@ typedef struct ak_humanoid_roles {
  * and its front paws stand on the floor).
  * Returns AK_OK for a humanoid; AK_ERR_NOT_FOUND when the template does not fit (out holds
  * what was found, is_humanoid false; diag says what is missing or why it is not a humanoid);
- * AK_ERR_NULL_ARG, AK_ERR_NO_MEMORY, AK_ERR_BUDGET (more than 65536 joints). Temporary memory
- * (about 40 bytes a joint) from alloc (NULL: malloc). */
+ * AK_ERR_NULL_ARG, AK_ERR_BAD_DATA (a rest position not finite), AK_ERR_NO_MEMORY. Temporary
+ * memory (about 110 bytes a joint) from alloc (NULL: malloc/free). Reentrant. */
 AK_API ak_result ak_humanoid_roles_find(const ak_skeleton* skeleton, const ak_allocator* alloc, ak_humanoid_roles* out,
                                         ak_diag* diag);
 
