@@ -1,7 +1,11 @@
 /* animkit retarget: put a clip made for one skeleton onto another (mocap onto a character).
  *
  * What it does:
- *   - maps target joints to source joints by name: the same name (case and "prefix:" such as
+ *   - maps target joints to source joints automatically: both skeletons fitted to a humanoid
+ *     template by topology, rest-pose geometry and name hints (ak_humanoid_roles_find), then
+ *     paired bone by bone (ak_retarget_map_by_roles), with a report that is a map file
+ *     (ak_retarget_map_write); a skeleton that is not a humanoid (a quadruped) is reported so;
+ *   - or maps target joints to source joints by name: the same name (case and "prefix:" such as
  *     "mixamorig:" ignored, and never two joints the rules below give different humanoid
  *     bones: builtin:humanoid's left_shoulder is an upper arm, a CMU LeftShoulder a collarbone)
  *     first, then humanoid bones recognised in CMU/BVH, Mixamo, Unreal
