@@ -123,11 +123,11 @@ static int auto_map(const ak_scene* src, const char* src_name, const ak_scene* d
         if (!mapped)
             return cli_fail("retarget", "neither %s nor %s is a humanoid (%s; %s) and no joint name matches; give --map FILE",
                             src_name, dst_name, sd.message, td.message);
-        *out_text = map_text(src, NULL, dst, NULL, map);
+        if (!(*out_text = map_text(src, NULL, dst, NULL, map))) return cli_fail("retarget", "out of memory");
         if (!cli_quiet)
             fprintf(stderr, "animkit retarget: note: neither skeleton is a humanoid: %zu joint%s matched by name\n",
                     mapped, cli_plural(mapped));
-        return CLI_OK;
+        return report ? write_text(report, *out_text) : CLI_OK;
     }
     ak_retarget_map_by_roles(src->skeleton, &sr, dst->skeleton, &tr, (ak_i32_span){map, nt}, &mapped);
     char* text = map_text(src, &sr, dst, &tr, map);
