@@ -27,10 +27,10 @@ static const char* const usage =
     "  --map-out FILE  write the map used (the automatic one: the table) as a map file to edit\n"
     "                  and pass back with --map\n"
     "  --report FILE   write the table to FILE instead of stderr\n"
-    "  --no-feet    no foot-contact clean-up (by default feet in contact are pinned with IK)\n"
-    "  --unscaled   root motion as in the source (default: scaled by the leg-length ratio)\n"
-    "  --fps N      frames per second of the baked clip (default 30)\n"
-    "  --size WxH   GIF panel size (default 400x400)\n";
+    "  --no-feet       no foot-contact clean-up (by default feet in contact are pinned with IK)\n"
+    "  --unscaled      root motion as in the source (default: scaled by the leg-length ratio)\n"
+    "  --fps N         frames per second of the baked clip (default 30)\n"
+    "  --size WxH      GIF panel size (default 400x400)\n";
 
 /* ---- map files ---------------------------------------------------------------------------- */
 
