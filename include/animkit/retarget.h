@@ -190,7 +190,8 @@ AK_API ak_result ak_retarget_map_by_roles(const ak_skeleton* source, const ak_hu
  * target_roles may be NULL (no bone column). Writes at most buffer_size bytes, NUL-terminated
  * (buffer may be NULL when buffer_size is 0); *out_size (optional) = the text's length without
  * the NUL, as snprintf (a larger buffer is needed when >= buffer_size).
- * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL (map shorter than the target), AK_ERR_BAD_INDEX. */
+ * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL (map shorter than the target), AK_ERR_BAD_INDEX (a
+ * map entry or a role's joint out of its skeleton). Allocates nothing; reentrant. */
 AK_API ak_result ak_retarget_map_write(const ak_skeleton* source, const ak_humanoid_roles* source_roles,
                                        const ak_skeleton* target, const ak_humanoid_roles* target_roles,
                                        ak_i32_cspan source_of_target, char* buffer, size_t buffer_size,
