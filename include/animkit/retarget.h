@@ -154,7 +154,7 @@ typedef struct ak_humanoid_roles {
  *     the lower one (the hand or foot) or nothing; the joint before the upper arm is the
  *     shoulder (clavicle), the one after the foot the toes; spine joints between the hips and the
  *     chest become SPINE (first), CHEST (next to last) and UPPER_CHEST (last, the one the arms
- *     hang from) when there are three or more, SPINE, CHEST for two, CHEST for one; the
+ *     hang from) when there are three or more, SPINE, CHEST for two, SPINE for one; the
  *     neck is the first joint of the head chain, the head its last (its parent when the last
  *     is an "end"/"top" leaf, or the joint named head);
  *   - up = feet towards head; left vs right: the toes give the facing direction (left = up x
