@@ -12,6 +12,7 @@ PACKAGES=(
   libgif-dev        # animated GIF output (raster)
   libassimp-dev     # FBX, Collada, BVH, OBJ import (io)
   libcjson-dev      # JSON for the glTF 2.0 reader (io)
+  libjpeg62-turbo-dev # JPEG base-colour textures of glTF/OBJ models (io; optional: without it JPEG textures are skipped)
   libsuitesparse-dev # CHOLMOD sparse Cholesky for bone-heat weights (skin)
   libsdl2-dev       # the window of `animkit view` (optional: without it, --headless only)
   xvfb              # virtual display: tests run the viewer's window under xvfb-run
