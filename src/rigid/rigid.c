@@ -1,0 +1,257 @@
+/* Rigid-body model: validation, mass and inertia from shapes, queries. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rigid_impl.h"
+
+static void* def_alloc(size_t size, void* user) {
+    (void)user;
+    return malloc(size);
+}
+static void def_free(void* ptr, void* user) {
+    (void)user;
+    free(ptr);
+}
+
+static bool vec_finite(ak_vec3 v) { return ak_vec3_is_finite(v); }
+
+/* Mass (for density 1) and principal moments per unit mass of a shape. */
+static void shape_unit_mass(const ak_rigid_shape* s, double* out_volume, ak_vec3* out_i_per_mass) {
+    const double pi = 3.14159265358979323846;
+    double r = s->radius;
+    switch (s->type) {
+    case AK_RIGID_SPHERE: {
+        *out_volume = 4.0 / 3.0 * pi * r * r * r;
+        float k = (float)(0.4 * r * r);
+        *out_i_per_mass = ak_vec3_make(k, k, k);
+        break;
+    }
+    case AK_RIGID_BOX: {
+        double x = s->half_extents.x, y = s->half_extents.y, z = s->half_extents.z;
+        *out_volume = 8.0 * x * y * z;
+        /* solid box of sides 2x, 2y, 2z: I_x = m (4y^2 + 4z^2) / 12 */
+        *out_i_per_mass = ak_vec3_make((float)((y * y + z * z) / 3.0), (float)((x * x + z * z) / 3.0),
+                                       (float)((x * x + y * y) / 3.0));
+        break;
+    }
+    case AK_RIGID_CAPSULE: {
+        double h = s->half_height;
+        double vc = pi * r * r * 2.0 * h, vs = 4.0 / 3.0 * pi * r * r * r, v = vc + vs;
+        /* cylinder (length 2h) plus two hemispheres whose centres of mass sit 3r/8 beyond the
+         * cylinder's ends: about the long axis m r^2/2 and 2 m r^2/5; across it m (r^2/4 +
+         * (2h)^2/12) and m (2r^2/5 + h^2 + 3hr/4) */
+        double iy = vc * r * r / 2.0 + vs * 0.4 * r * r;
+        double ix = vc * (r * r / 4.0 + h * h / 3.0) + vs * (0.4 * r * r + h * h + 0.75 * h * r);
+        *out_volume = v;
+        *out_i_per_mass = ak_vec3_make((float)(ix / v), (float)(iy / v), (float)(ix / v));
+        break;
+    }
+    default:
+        *out_volume = 0.0;
+        *out_i_per_mass = ak_vec3_zero();
+        break;
+    }
+}
+
+ak_rigid_model_desc ak_rigid_model_desc_resolved(const ak_rigid_model_desc* desc) {
+    ak_rigid_model_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc) d = *desc;
+    if (d.contact_offset == 0.0f) d.contact_offset = 0.01f;
+    if (d.sleep_linear_speed == 0.0f) d.sleep_linear_speed = 0.05f;
+    if (d.sleep_angular_speed == 0.0f) d.sleep_angular_speed = 0.05f;
+    if (d.sleep_time == 0.0f) d.sleep_time = 0.5f;
+    if (d.max_contacts == 0) {
+        size_t n = d.bodies.count > (1u << 24) ? (1u << 24) : d.bodies.count;
+        d.max_contacts = (uint32_t)(16 * n + 64);
+    }
+    return d;
+}
+
+static ak_result check_friction(float f) {
+    if (!ak_finitef(f)) return AK_ERR_BAD_DATA;
+    if (f < 0.0f && f != AK_RIGID_FRICTIONLESS) return AK_ERR_BAD_ARG;
+    return AK_OK;
+}
+
+static ak_result check_body(const ak_rigid_body_desc* b) {
+    const ak_rigid_shape* s = &b->shape;
+    if ((unsigned)s->type >= AK_RIGID_SHAPE_COUNT) return AK_ERR_BAD_ARG;
+    if (!ak_finitef(s->radius) || !vec_finite(s->half_extents) || !ak_finitef(s->half_height) ||
+        !vec_finite(s->normal) || !vec_finite(b->position) || !ak_quat_is_finite(b->orientation) ||
+        !vec_finite(b->velocity) || !vec_finite(b->angular_velocity) || !ak_finitef(b->density) ||
+        !ak_finitef(b->mass) || !ak_finitef(b->restitution))
+        return AK_ERR_BAD_DATA;
+    ak_result r = check_friction(b->friction);
+    if (r == AK_OK) r = check_friction(b->dynamic_friction);
+    if (r != AK_OK) return r;
+    switch (s->type) {
+    case AK_RIGID_SPHERE:
+        if (!(s->radius > 0.0f)) return AK_ERR_BAD_ARG;
+        break;
+    case AK_RIGID_BOX:
+        if (!(s->half_extents.x > 0.0f && s->half_extents.y > 0.0f && s->half_extents.z > 0.0f))
+            return AK_ERR_BAD_ARG;
+        break;
+    case AK_RIGID_CAPSULE:
+        if (!(s->radius > 0.0f) || s->half_height < 0.0f) return AK_ERR_BAD_ARG;
+        break;
+    default:
+        break;
+    }
+    if (b->density < 0.0f || b->mass < 0.0f || b->restitution < 0.0f || b->restitution > 1.0f)
+        return AK_ERR_BAD_ARG;
+    return AK_OK;
+}
+
+ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_allocator* alloc,
+                                ak_rigid_model** out_model) {
+    if (out_model) *out_model = NULL;
+    if (!desc || !out_model) return AK_ERR_NULL_ARG;
+    if (alloc && (!alloc->alloc) != (!alloc->free)) return AK_ERR_BAD_ARG;
+    if (desc->bodies.count == 0 || !desc->bodies.ptr) return AK_ERR_EMPTY;
+    if (desc->bodies.count > (1u << 24)) return AK_ERR_BAD_ARG;
+    const float scalars[] = {desc->linear_damping, desc->angular_damping, desc->contact_offset,
+                             desc->sleep_linear_speed, desc->sleep_angular_speed, desc->sleep_time};
+    for (size_t i = 0; i < sizeof scalars / sizeof scalars[0]; ++i) {
+        if (!ak_finitef(scalars[i])) return AK_ERR_BAD_DATA;
+        if (scalars[i] < 0.0f) return AK_ERR_BAD_ARG;
+    }
+    for (size_t i = 0; i < desc->bodies.count; ++i) {
+        ak_result r = check_body(&desc->bodies.ptr[i]);
+        if (r != AK_OK) return r;
+    }
+    ak_allocator al = {def_alloc, def_free, NULL};
+    if (alloc && alloc->alloc) al = *alloc;
+    size_t n = desc->bodies.count;
+    size_t head = (sizeof(ak_rigid_model) + 15) & ~(size_t)15;
+    size_t bodies_size = ((n * sizeof(rigid_body)) + 15) & ~(size_t)15;
+    size_t total = head + bodies_size + n * sizeof(ak_rigid_body_desc);
+    unsigned char* mem = al.alloc(total, al.user);
+    if (!mem) return AK_ERR_NO_MEMORY;
+    memset(mem, 0, total);
+    ak_rigid_model* m = (ak_rigid_model*)mem;
+    m->alloc = al;
+    m->body_count = n;
+    m->bodies = (rigid_body*)(mem + head);
+    m->descs = (ak_rigid_body_desc*)(mem + head + bodies_size);
+    m->desc = ak_rigid_model_desc_resolved(desc);
+    m->desc.bodies.ptr = m->descs;
+    for (size_t i = 0; i < n; ++i) {
+        ak_rigid_body_desc d = desc->bodies.ptr[i];
+        rigid_body* b = &m->bodies[i];
+        if (ak_quat_dot(d.orientation, d.orientation) == 0.0f) d.orientation = ak_quat_identity();
+        d.orientation = ak_quat_normalize(d.orientation);
+        if (d.shape.type == AK_RIGID_PLANE) {
+            d.is_static = true;
+            if (ak_vec3_length_sq(d.shape.normal) == 0.0f) d.shape.normal = ak_vec3_make(0, 1, 0);
+            d.shape.normal = ak_vec3_normalize(d.shape.normal);
+            d.orientation = ak_quat_identity();
+            m->plane_count++;
+        }
+        if (d.density == 0.0f) d.density = 1000.0f;
+        if (d.friction == 0.0f) d.friction = 0.5f;
+        if (d.dynamic_friction == 0.0f) d.dynamic_friction = d.friction;
+        b->friction = d.friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.friction;
+        b->dynamic_friction = d.dynamic_friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.dynamic_friction;
+        b->restitution = d.restitution;
+        b->shape = d.shape;
+        double volume;
+        ak_vec3 ipm;
+        shape_unit_mass(&d.shape, &volume, &ipm);
+        switch (d.shape.type) {
+        case AK_RIGID_SPHERE: b->bound_radius = d.shape.radius; break;
+        case AK_RIGID_BOX: b->bound_radius = ak_vec3_length(d.shape.half_extents); break;
+        case AK_RIGID_CAPSULE: b->bound_radius = d.shape.radius + d.shape.half_height; break;
+        default: b->bound_radius = INFINITY; break;
+        }
+        if (d.is_static) {
+            d.velocity = ak_vec3_zero();
+            d.angular_velocity = ak_vec3_zero();
+            b->mass = INFINITY;
+            b->inertia = ak_vec3_make(INFINITY, INFINITY, INFINITY);
+        } else {
+            double mass = d.mass > 0.0f ? (double)d.mass : (double)d.density * volume;
+            if (d.mass > 0.0f && volume > 0.0) d.density = (float)(mass / volume);
+            d.mass = (float)mass;
+            if (!(mass > 0.0) || !isfinite((float)mass)) {
+                al.free(mem, al.user);
+                return AK_ERR_BAD_ARG;
+            }
+            b->mass = (float)mass;
+            b->inv_mass = (float)(1.0 / mass);
+            b->inertia = ak_vec3_scale(ipm, (float)mass);
+            b->inv_inertia = ak_vec3_make(1.0f / b->inertia.x, 1.0f / b->inertia.y, 1.0f / b->inertia.z);
+            if (!vec_finite(b->inv_inertia)) {
+                al.free(mem, al.user);
+                return AK_ERR_BAD_ARG;
+            }
+        }
+        m->descs[i] = d;
+    }
+    *out_model = m;
+    return AK_OK;
+}
+
+void ak_rigid_model_destroy(ak_rigid_model* model) {
+    if (!model) return;
+    model->alloc.free(model, model->alloc.user);
+}
+
+size_t ak_rigid_body_count(const ak_rigid_model* model) { return model ? model->body_count : 0; }
+
+float ak_rigid_body_mass(const ak_rigid_model* model, size_t i) {
+    return model && i < model->body_count ? model->bodies[i].mass : 0.0f;
+}
+
+ak_vec3 ak_rigid_body_inertia(const ak_rigid_model* model, size_t i) {
+    return model && i < model->body_count ? model->bodies[i].inertia : ak_vec3_zero();
+}
+
+ak_rigid_body_desc ak_rigid_body_get_desc(const ak_rigid_model* model, size_t i) {
+    ak_rigid_body_desc d;
+    memset(&d, 0, sizeof d);
+    if (model && i < model->body_count) d = model->descs[i];
+    return d;
+}
+
+ak_result ak_rigid_initial_state(const ak_rigid_model* model, ak_vec3_span x, ak_quat_span q,
+                                 ak_vec3_span v, ak_vec3_span w) {
+    if (!model || !x.ptr || !q.ptr || !v.ptr || !w.ptr) return AK_ERR_NULL_ARG;
+    size_t n = model->body_count;
+    if (x.count < n || q.count < n || v.count < n || w.count < n) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i) {
+        x.ptr[i] = model->descs[i].position;
+        q.ptr[i] = model->descs[i].orientation;
+        v.ptr[i] = model->descs[i].velocity;
+        w.ptr[i] = model->descs[i].angular_velocity;
+    }
+    return AK_OK;
+}
+
+ak_vec3 ak_rigid_angular_momentum(const ak_rigid_model* model, size_t i, ak_quat q, ak_vec3 w) {
+    if (!model || i >= model->body_count || model->bodies[i].inv_mass == 0.0f) return ak_vec3_zero();
+    ak_vec3 wl = ak_quat_rotate(ak_quat_conjugate(q), w);
+    ak_vec3 ll = ak_vec3_mul(model->bodies[i].inertia, wl);
+    return ak_quat_rotate(q, ll);
+}
+
+double ak_rigid_energy(const ak_rigid_model* model, ak_vec3 g, ak_vec3_cspan x, ak_quat_cspan q,
+                       ak_vec3_cspan v, ak_vec3_cspan w) {
+    if (!model) return 0.0;
+    size_t n = model->body_count;
+    if (x.count < n || q.count < n || v.count < n || w.count < n) return 0.0;
+    double e = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const rigid_body* b = &model->bodies[i];
+        if (b->inv_mass == 0.0f) continue;
+        double m = b->mass;
+        ak_vec3 wl = ak_quat_rotate(ak_quat_conjugate(q.ptr[i]), w.ptr[i]);
+        e += 0.5 * m * (double)ak_vec3_dot(v.ptr[i], v.ptr[i]);
+        e += 0.5 * ((double)b->inertia.x * wl.x * wl.x + (double)b->inertia.y * wl.y * wl.y +
+                    (double)b->inertia.z * wl.z * wl.z);
+        e -= m * ((double)g.x * x.ptr[i].x + (double)g.y * x.ptr[i].y + (double)g.z * x.ptr[i].z);
+    }
+    return e;
+}

@@ -1,0 +1,56 @@
+/* Internal types of the rigid-body module shared by rigid.c, collide.c and step.c. */
+#ifndef AK_RIGID_IMPL_H
+#define AK_RIGID_IMPL_H
+
+#include <animkit/rigid.h>
+
+/* What the solver reads per body, resolved once at build time. */
+typedef struct rigid_body {
+    ak_rigid_shape shape;   /* resolved (plane normal normalised) */
+    float inv_mass;         /* 1/kg; 0 static */
+    ak_vec3 inv_inertia;    /* 1/(kg m^2) about the local axes; 0 static */
+    ak_vec3 inertia;        /* kg m^2 (INFINITY static) */
+    float mass;             /* kg (INFINITY static) */
+    float friction;         /* static mu, resolved */
+    float dynamic_friction; /* dynamic mu, resolved */
+    float restitution;
+    float bound_radius;     /* metres from the centre that holds the shape (planes: INFINITY) */
+} rigid_body;
+
+struct ak_rigid_model {
+    ak_allocator alloc;
+    ak_rigid_model_desc desc; /* resolved; bodies points at descs */
+    size_t body_count;
+    size_t plane_count;
+    rigid_body* bodies;
+    ak_rigid_body_desc* descs;
+};
+
+/* One contact point found by the narrow phase. n points from body b to body a: pushing a along
+ * +n separates them. la, lb are the contact points in each body's local frame (for a plane:
+ * world). depth = (pb - pa) . n > 0 when the shapes overlap. */
+typedef struct rigid_contact {
+    uint32_t a, b;
+    ak_vec3 n;
+    ak_vec3 la, lb;
+    float depth;
+    float lambda_n;   /* accumulated normal position impulse (kg m) of this substep */
+    float vn_before;  /* relative normal velocity before the solve (m/s) */
+    float friction, dynamic_friction, restitution;
+} rigid_contact;
+
+/* Pose of a body as the narrow phase reads it. */
+typedef struct rigid_pose {
+    ak_vec3 x;
+    ak_quat q;
+} rigid_pose;
+
+/* Contact points between bodies a and b (a dynamic or both any; never two planes) into out (at
+ * most cap, returns how many were written; *out_wanted counts every point found). n of each
+ * points from b to a. Only points with separation < margin are reported. */
+int akp_rigid_collide(const ak_rigid_model* m, uint32_t a, uint32_t b, rigid_pose pa, rigid_pose pb,
+                      float margin, rigid_contact* out, int cap);
+
+#define AKP_RIGID_MAX_PAIR_CONTACTS 8
+
+#endif

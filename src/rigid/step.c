@@ -1,0 +1,484 @@
+/* XPBD rigid-body step (Mueller et al. 2020) with an implicit gyroscopic term, sweep-and-prune
+ * broad phase and sleeping groups. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rigid_impl.h"
+
+typedef struct sap_entry {
+    float lo, hi;
+    uint32_t body;
+} sap_entry;
+
+/* Scratch layout, in 16-byte aligned blocks. */
+typedef struct layout {
+    size_t x0, q0, v0, w0, xp, qp, dx, sap, contacts, parent, awake, total;
+} layout;
+
+static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
+
+static layout layout_of(const ak_rigid_model* m) {
+    layout l;
+    size_t n = m->body_count, off = 0;
+    l.x0 = off, off += align16(n * sizeof(ak_vec3));
+    l.q0 = off, off += align16(n * sizeof(ak_quat));
+    l.v0 = off, off += align16(n * sizeof(ak_vec3));
+    l.w0 = off, off += align16(n * sizeof(ak_vec3));
+    l.xp = off, off += align16(n * sizeof(ak_vec3));
+    l.qp = off, off += align16(n * sizeof(ak_quat));
+    l.dx = off, off += align16(n * sizeof(ak_vec3));
+    l.sap = off, off += align16(n * sizeof(sap_entry));
+    l.contacts = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) * sizeof(rigid_contact));
+    l.parent = off, off += align16(n * sizeof(uint32_t));
+    l.awake = off, off += align16(n);
+    l.total = off + 16; /* room to align the base */
+    return l;
+}
+
+size_t ak_rigid_step_scratch_size(const ak_rigid_step_job* job) {
+    if (!job || !job->model) return 0;
+    return layout_of(job->model).total;
+}
+
+ak_result ak_rigid_step_validate(const ak_rigid_step_job* job) {
+    if (!job || !job->model) return AK_ERR_NULL_ARG;
+    if (!(job->dt > 0.0f) || !ak_finitef(job->dt) || job->substeps > 1000 ||
+        job->thread_count > AK_RIGID_MAX_THREADS || !ak_vec3_is_finite(job->gravity))
+        return AK_ERR_BAD_ARG;
+    size_t n = job->model->body_count;
+    if (!job->positions.ptr || !job->orientations.ptr || !job->velocities.ptr || !job->angular_velocities.ptr ||
+        !job->scratch.ptr)
+        return AK_ERR_NULL_ARG;
+    if (job->positions.count < n || job->orientations.count < n || job->velocities.count < n ||
+        job->angular_velocities.count < n || (job->sleep_timers.count != 0 && job->sleep_timers.count < n) ||
+        (job->sleep_timers.count != 0 && !job->sleep_timers.ptr) || job->scratch.count < ak_rigid_step_scratch_size(job))
+        return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i) {
+        if (!ak_vec3_is_finite(job->positions.ptr[i]) || !ak_quat_is_finite(job->orientations.ptr[i]) ||
+            !ak_vec3_is_finite(job->velocities.ptr[i]) || !ak_vec3_is_finite(job->angular_velocities.ptr[i]))
+            return AK_ERR_BAD_DATA;
+        if (job->sleep_timers.count && !ak_finitef(job->sleep_timers.ptr[i])) return AK_ERR_BAD_DATA;
+    }
+    return AK_OK;
+}
+
+typedef struct solver {
+    const ak_rigid_model* m;
+    const rigid_body* bodies;
+    ak_vec3* x;
+    ak_quat* q;
+    ak_vec3* v;
+    ak_vec3* w;
+    ak_vec3* xp;
+    ak_quat* qp;
+    ak_vec3* dx;          /* displacement since the substep's start: x = xp + dx, kept apart so
+                             the velocity dx / h keeps float precision far from the origin */
+    const uint8_t* awake; /* 1: dynamic and awake (moves); 0: static or asleep */
+    float h;
+} solver;
+
+
+/* I^-1 (world) applied to v for body i (zero when it does not move). */
+static ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_quat q = s->q[i];
+    ak_vec3 l = ak_quat_rotate(ak_quat_conjugate(q), v);
+    return ak_quat_rotate(q, ak_vec3_mul(s->bodies[i].inv_inertia, l));
+}
+
+/* Generalised inverse mass of body i at offset r along unit direction n (their eq. 2-3). */
+static float gen_inv_mass(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n) {
+    if (!s->awake[i]) return 0.0f;
+    ak_vec3 rn = ak_quat_rotate(ak_quat_conjugate(s->q[i]), ak_vec3_cross(r, n));
+    ak_vec3 ii = s->bodies[i].inv_inertia;
+    return s->bodies[i].inv_mass + rn.x * rn.x * ii.x + rn.y * rn.y * ii.y + rn.z * rn.z * ii.z;
+}
+
+/* Apply positional impulse p at offset r to body i (sign +1 or -1). */
+static void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
+    if (!s->awake[i]) return;
+    s->dx[i] = ak_vec3_madd(s->dx[i], p, sign * s->bodies[i].inv_mass);
+    s->x[i] = ak_vec3_add(s->xp[i], s->dx[i]);
+    ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, ak_vec3_cross(r, p)), sign * 0.5f);
+    ak_quat q = s->q[i];
+    ak_quat dq = ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q);
+    s->q[i] = ak_quat_normalize(ak_quat_add(q, dq));
+}
+
+static void apply_velocity_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
+    if (!s->awake[i]) return;
+    s->v[i] = ak_vec3_madd(s->v[i], p, sign * s->bodies[i].inv_mass);
+    s->w[i] = ak_vec3_madd(s->w[i], inv_inertia_mul(s, i, ak_vec3_cross(r, p)), sign);
+}
+
+/* Angular velocity after one implicit (backward Euler) step of Euler's equations without torque,
+ * I w' = -w x (I w), linearised once about w (Newton's first iterate), in the body frame. */
+static ak_vec3 gyroscopic_step(ak_vec3 w, ak_vec3 inertia, float h) {
+    ak_vec3 iw = ak_vec3_mul(inertia, w);
+    ak_vec3 f = ak_vec3_scale(ak_vec3_cross(w, iw), h);
+    /* J = I + h (skew(w) I - skew(I w)) */
+    ak_mat3 sw = {{0, w.z, -w.y, -w.z, 0, w.x, w.y, -w.x, 0}};
+    ak_mat3 siw = {{0, iw.z, -iw.y, -iw.z, 0, iw.x, iw.y, -iw.x, 0}};
+    ak_mat3 j = ak_mat3_add(ak_mat3_diagonal(inertia),
+                            ak_mat3_scale(ak_mat3_add(ak_mat3_mul(sw, ak_mat3_diagonal(inertia)),
+                                                      ak_mat3_scale(siw, -1.0f)), h));
+    if (fabsf(ak_mat3_determinant(j)) < 1e-30f) return w;
+    return ak_vec3_sub(w, ak_mat3_mul_vec3(ak_mat3_inverse(j), f));
+}
+
+static void predict(solver* s, ak_vec3 g, float lin_damp, float ang_damp) {
+    float h = s->h;
+    for (uint32_t i = 0; i < (uint32_t)s->m->body_count; ++i) {
+        s->xp[i] = s->x[i];
+        s->qp[i] = s->q[i];
+        s->dx[i] = ak_vec3_zero();
+        if (!s->awake[i]) continue;
+        const rigid_body* b = &s->bodies[i];
+        ak_vec3 v = ak_vec3_madd(s->v[i], g, h);
+        if (lin_damp > 0.0f) v = ak_vec3_scale(v, 1.0f / (1.0f + h * lin_damp));
+        s->v[i] = v;
+        s->dx[i] = ak_vec3_scale(v, h);
+        s->x[i] = ak_vec3_add(s->xp[i], s->dx[i]);
+        ak_quat q = s->q[i];
+        ak_vec3 wl = ak_quat_rotate(ak_quat_conjugate(q), s->w[i]);
+        wl = gyroscopic_step(wl, b->inertia, h);
+        if (ang_damp > 0.0f) wl = ak_vec3_scale(wl, 1.0f / (1.0f + h * ang_damp));
+        ak_vec3 w = ak_quat_rotate(q, wl);
+        s->w[i] = w;
+        ak_quat dq = ak_quat_mul(ak_quat_make(w.x, w.y, w.z, 0.0f), q);
+        s->q[i] = ak_quat_normalize(ak_quat_add(q, ak_quat_scale(dq, 0.5f * h)));
+    }
+}
+
+static int sap_cmp(const void* pa, const void* pb) {
+    const sap_entry* a = pa;
+    const sap_entry* b = pb;
+    if (a->lo < b->lo) return -1;
+    if (a->lo > b->lo) return 1;
+    return a->body < b->body ? -1 : (a->body > b->body ? 1 : 0);
+}
+
+typedef struct contact_buf {
+    rigid_contact* c;
+    uint32_t count, cap;
+    uint32_t dropped;
+} contact_buf;
+
+static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float margin) {
+    rigid_pose pa = {s->x[a], s->q[a]}, pb = {s->x[b], s->q[b]};
+    /* the buffer has AKP_RIGID_MAX_PAIR_CONTACTS slack past cap */
+    int found = akp_rigid_collide(s->m, a, b, pa, pb, margin, cb->c + cb->count, AKP_RIGID_MAX_PAIR_CONTACTS);
+    int kept = found < AKP_RIGID_MAX_PAIR_CONTACTS ? found : AKP_RIGID_MAX_PAIR_CONTACTS;
+    if (cb->count + (uint32_t)kept > cb->cap) {
+        uint32_t room = cb->cap - cb->count;
+        cb->dropped += (uint32_t)found - room;
+        kept = (int)room;
+    } else {
+        cb->dropped += (uint32_t)(found - kept);
+    }
+    const rigid_body* ba = &s->bodies[a];
+    const rigid_body* bb = &s->bodies[b];
+    for (int k = 0; k < kept; ++k) {
+        rigid_contact* c = &cb->c[cb->count + (uint32_t)k];
+        c->friction = sqrtf(ba->friction * bb->friction);
+        c->dynamic_friction = sqrtf(ba->dynamic_friction * bb->dynamic_friction);
+        c->restitution = ak_maxf(ba->restitution, bb->restitution);
+        ak_vec3 ra = ak_quat_rotate(s->q[a], c->la), rb = ak_quat_rotate(s->q[b], c->lb);
+        ak_vec3 va = ak_vec3_add(s->v[a], ak_vec3_cross(s->w[a], ra));
+        ak_vec3 vb = ak_vec3_add(s->v[b], ak_vec3_cross(s->w[b], rb));
+        c->vn_before = ak_vec3_dot(c->n, ak_vec3_sub(va, vb));
+    }
+    cb->count += (uint32_t)kept;
+}
+
+static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float margin) {
+    const ak_rigid_model* m = s->m;
+    uint32_t n = (uint32_t)m->body_count, ns = 0;
+    cb->count = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        const rigid_body* b = &s->bodies[i];
+        if (b->shape.type == AK_RIGID_PLANE) continue;
+        float r = b->bound_radius + margin;
+        sap[ns].lo = s->x[i].x - r;
+        sap[ns].hi = s->x[i].x + r;
+        sap[ns].body = i;
+        ++ns;
+    }
+    qsort(sap, ns, sizeof *sap, sap_cmp);
+    for (uint32_t i = 0; i < ns; ++i) {
+        uint32_t a = sap[i].body;
+        for (uint32_t j = i + 1; j < ns && sap[j].lo <= sap[i].hi; ++j) {
+            uint32_t b = sap[j].body;
+            if (!s->awake[a] && !s->awake[b]) continue;
+            float rr = s->bodies[a].bound_radius + s->bodies[b].bound_radius + margin;
+            if (ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b])) > rr * rr) continue;
+            /* the awake (or lower-index) body first, so a static body is always b */
+            if (!s->awake[a] || (s->awake[b] && b < a)) narrow(s, cb, b, a, margin);
+            else narrow(s, cb, a, b, margin);
+        }
+    }
+    if (m->plane_count) {
+        for (uint32_t i = 0; i < n; ++i) {
+            if (!s->awake[i]) continue;
+            for (uint32_t p = 0; p < n; ++p)
+                if (s->bodies[p].shape.type == AK_RIGID_PLANE) narrow(s, cb, i, p, margin);
+        }
+    }
+}
+
+static ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) { return ak_vec3_add(s->x[i], ak_quat_rotate(s->q[i], l)); }
+
+/* Motion of body i's local point l during this substep, without the cancellation that
+ * (x + q l) - (xp + qp l) suffers far from the origin. */
+static ak_vec3 point_motion(const solver* s, uint32_t i, ak_vec3 l) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    return ak_vec3_add(s->dx[i], ak_vec3_sub(ak_quat_rotate(s->q[i], l), ak_quat_rotate(s->qp[i], l)));
+}
+
+/* End of the run of contacts from k that share their pair of bodies. */
+static uint32_t group_end(const contact_buf* cb, uint32_t k) {
+    uint32_t e = k + 1;
+    while (e < cb->count && cb->c[e].a == cb->c[k].a && cb->c[e].b == cb->c[k].b) ++e;
+    return e;
+}
+
+/* Centre of pressure of a group (the contacts' local points weighted by their normal
+ * multipliers) in each body's frame; false when no contact of the group pushed. */
+static bool pressure_centre(const contact_buf* cb, uint32_t k0, uint32_t k1, ak_vec3* la, ak_vec3* lb,
+                            float* out_lambda) {
+    float sum = 0.0f;
+    ak_vec3 ca = ak_vec3_zero(), cbp = ak_vec3_zero();
+    for (uint32_t k = k0; k < k1; ++k) {
+        const rigid_contact* c = &cb->c[k];
+        if (!(c->lambda_n > 0.0f)) continue;
+        sum += c->lambda_n;
+        ca = ak_vec3_madd(ca, c->la, c->lambda_n);
+        cbp = ak_vec3_madd(cbp, c->lb, c->lambda_n);
+    }
+    if (!(sum > 0.0f)) return false;
+    *la = ak_vec3_scale(ca, 1.0f / sum);
+    *lb = ak_vec3_scale(cbp, 1.0f / sum);
+    *out_lambda = sum;
+    return true;
+}
+
+static void solve_positions(solver* s, contact_buf* cb) {
+    for (uint32_t k0 = 0; k0 < cb->count;) {
+        uint32_t k1 = group_end(cb, k0);
+        for (uint32_t k = k0; k < k1; ++k) {
+            rigid_contact* c = &cb->c[k];
+            ak_vec3 pa = world_point(s, c->a, c->la), pb = world_point(s, c->b, c->lb);
+            float d = ak_vec3_dot(ak_vec3_sub(pb, pa), c->n);
+            if (d <= 0.0f) continue;
+            ak_vec3 ra = ak_vec3_sub(pa, s->x[c->a]), rb = ak_vec3_sub(pb, s->x[c->b]);
+            float w = gen_inv_mass(s, c->a, ra, c->n) + gen_inv_mass(s, c->b, rb, c->n);
+            if (!(w > 0.0f)) continue;
+            float dl = d / w;
+            c->lambda_n += dl;
+            ak_vec3 p = ak_vec3_scale(c->n, dl);
+            apply_position_impulse(s, c->a, ra, p, 1.0f);
+            apply_position_impulse(s, c->b, rb, p, -1.0f);
+        }
+        /* static friction, once per pair at the centre of pressure with the pair's whole normal
+         * multiplier: undo the relative tangential motion of this substep when the force it
+         * takes stays inside the friction cone (their eq. for lambda_t < mu_s lambda_n); one
+         * point per pair keeps the sequential order from handing the whole load to one corner */
+        ak_vec3 la, lb;
+        float lambda;
+        const rigid_contact* c = &cb->c[k0];
+        if (c->friction > 0.0f && pressure_centre(cb, k0, k1, &la, &lb, &lambda)) {
+            ak_vec3 dp = ak_vec3_sub(point_motion(s, c->a, la), point_motion(s, c->b, lb));
+            ak_vec3 dt = ak_vec3_madd(dp, c->n, -ak_vec3_dot(dp, c->n));
+            float lt = ak_vec3_length(dt);
+            if (lt > 1e-12f) {
+                ak_vec3 t = ak_vec3_scale(dt, 1.0f / lt);
+                ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
+                float wt = gen_inv_mass(s, c->a, ra, t) + gen_inv_mass(s, c->b, rb, t);
+                float dlt = wt > 0.0f ? lt / wt : INFINITY;
+                if (dlt < c->friction * lambda) {
+                    ak_vec3 pt = ak_vec3_scale(t, -dlt);
+                    apply_position_impulse(s, c->a, ra, pt, 1.0f);
+                    apply_position_impulse(s, c->b, rb, pt, -1.0f);
+                }
+            }
+        }
+        k0 = k1;
+    }
+}
+
+static void update_velocities(solver* s) {
+    float inv_h = 1.0f / s->h;
+    for (uint32_t i = 0; i < (uint32_t)s->m->body_count; ++i) {
+        if (!s->awake[i]) continue;
+        s->v[i] = ak_vec3_scale(s->dx[i], inv_h);
+        /* predict's q' = normalise((1 + h/2 [w, 0]) q) gives dq = q' q^-1 with dq.xyz / dq.w =
+         * h w / 2 exactly, so this inverse returns w unchanged when no constraint acted (2 dq.xyz
+         * / h alone loses w (w h)^2 / 8 per substep: 5% of a spin's momentum in 10 s) */
+        ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->qp[i]));
+        float sg = 2.0f * inv_h / (fabsf(dq.w) > 0.1f ? dq.w : (dq.w >= 0.0f ? 0.1f : -0.1f));
+        s->w[i] = ak_vec3_make(dq.x * sg, dq.y * sg, dq.z * sg);
+    }
+}
+
+static ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
+    return ak_vec3_add(s->v[i], ak_vec3_cross(s->w[i], r));
+}
+
+static void velocity_impulse_pair(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 dv) {
+    float l = ak_vec3_length(dv);
+    if (l < 1e-12f) return;
+    ak_vec3 dir = ak_vec3_scale(dv, 1.0f / l);
+    float w = gen_inv_mass(s, a, ra, dir) + gen_inv_mass(s, b, rb, dir);
+    if (!(w > 0.0f)) return;
+    ak_vec3 p = ak_vec3_scale(dv, 1.0f / w);
+    apply_velocity_impulse(s, a, ra, p, 1.0f);
+    apply_velocity_impulse(s, b, rb, p, -1.0f);
+}
+
+static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
+    float h = s->h;
+    for (uint32_t k0 = 0; k0 < cb->count;) {
+        uint32_t k1 = group_end(cb, k0);
+        for (uint32_t k = k0; k < k1; ++k) {
+            rigid_contact* c = &cb->c[k];
+            if (!(c->lambda_n > 0.0f)) continue;
+            ak_vec3 ra = ak_quat_rotate(s->q[c->a], c->la), rb = ak_quat_rotate(s->q[c->b], c->lb);
+            float vn = ak_vec3_dot(c->n, ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb)));
+            /* restitution: the normal velocity becomes -e times the one before the solve (none
+             * for slow impacts, which gravity alone could have made in two substeps) */
+            float e = fabsf(c->vn_before) <= 2.0f * gmag * h ? 0.0f : c->restitution;
+            velocity_impulse_pair(s, c->a, c->b, ra, rb, ak_vec3_scale(c->n, -vn + ak_maxf(-e * c->vn_before, 0.0f)));
+        }
+        /* dynamic friction at the centre of pressure (their eq. 30 with the units made whole) */
+        ak_vec3 la, lb;
+        float lambda;
+        const rigid_contact* c = &cb->c[k0];
+        if (c->dynamic_friction > 0.0f && pressure_centre(cb, k0, k1, &la, &lb, &lambda)) {
+            ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
+            ak_vec3 vr = ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb));
+            ak_vec3 vt = ak_vec3_madd(vr, c->n, -ak_vec3_dot(vr, c->n));
+            float lt = ak_vec3_length(vt);
+            if (lt > 1e-12f) {
+                /* the friction impulse is at most mu_d times the normal one, lambda_n / h; as a
+                 * change of relative velocity that is mu_d lambda_n w_t / h */
+                ak_vec3 t = ak_vec3_scale(vt, 1.0f / lt);
+                float wt = gen_inv_mass(s, c->a, ra, t) + gen_inv_mass(s, c->b, rb, t);
+                float cut = ak_minf(c->dynamic_friction * lambda * wt / h, lt);
+                velocity_impulse_pair(s, c->a, c->b, ra, rb, ak_vec3_scale(t, -cut));
+            }
+        }
+        k0 = k1;
+    }
+}
+
+static uint32_t uf_find(uint32_t* parent, uint32_t i) {
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* Sleep bookkeeping at the end of a step (see ak_rigid_step_job.sleep_timers). */
+static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_buf* cb, uint32_t* parent) {
+    const ak_rigid_model_desc* d = &s->m->desc;
+    uint32_t n = (uint32_t)s->m->body_count;
+    float* timer = job->sleep_timers.ptr;
+    for (uint32_t i = 0; i < n; ++i) {
+        parent[i] = i;
+        if (!s->awake[i]) continue;
+        bool slow = ak_vec3_length(s->v[i]) < d->sleep_linear_speed && ak_vec3_length(s->w[i]) < d->sleep_angular_speed;
+        timer[i] = slow ? timer[i] + job->dt : 0.0f;
+    }
+    for (uint32_t k = 0; k < cb->count; ++k) {
+        uint32_t a = cb->c[k].a, b = cb->c[k].b;
+        if (s->bodies[a].inv_mass == 0.0f || s->bodies[b].inv_mass == 0.0f) continue;
+        uint32_t ra = uf_find(parent, a), rb = uf_find(parent, b);
+        if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    }
+    /* a group sleeps when its least sleepy body has been slow long enough; otherwise every
+     * body of it is awake. Roots hold the group's minimum timer in a second pass. */
+    for (uint32_t i = 0; i < n; ++i) {
+        if (s->bodies[i].inv_mass == 0.0f) continue;
+        uint32_t r = uf_find(parent, i);
+        if (r != i && timer[i] < timer[r]) timer[r] = timer[i];
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        if (s->bodies[i].inv_mass == 0.0f) continue;
+        uint32_t r = uf_find(parent, i);
+        if (timer[r] >= d->sleep_time) {
+            s->v[i] = ak_vec3_zero();
+            s->w[i] = ak_vec3_zero();
+            if (timer[i] < d->sleep_time) timer[i] = d->sleep_time;
+        } else if (!s->awake[i]) {
+            timer[i] = 0.0f; /* asleep at the step's start, touched by a moving group: wake */
+        }
+    }
+}
+
+ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
+    ak_result r = ak_rigid_step_validate(job);
+    if (r != AK_OK) return r;
+    const ak_rigid_model* m = job->model;
+    uint32_t n = (uint32_t)m->body_count;
+    layout l = layout_of(m);
+    unsigned char* base = (unsigned char*)(((uintptr_t)job->scratch.ptr + 15) & ~(uintptr_t)15);
+    ak_vec3* x0 = (ak_vec3*)(base + l.x0);
+    ak_quat* q0 = (ak_quat*)(base + l.q0);
+    ak_vec3* v0 = (ak_vec3*)(base + l.v0);
+    ak_vec3* w0 = (ak_vec3*)(base + l.w0);
+    uint8_t* awake = base + l.awake;
+    uint32_t substeps = job->substeps ? job->substeps : 10;
+    solver s = {
+        .m = m, .bodies = m->bodies, .x = job->positions.ptr, .q = job->orientations.ptr,
+        .v = job->velocities.ptr, .w = job->angular_velocities.ptr,
+        .xp = (ak_vec3*)(base + l.xp), .qp = (ak_quat*)(base + l.qp), .dx = (ak_vec3*)(base + l.dx),
+        .awake = awake,
+        .h = job->dt / (float)substeps,
+    };
+    memcpy(x0, s.x, n * sizeof *x0);
+    memcpy(q0, s.q, n * sizeof *q0);
+    memcpy(v0, s.v, n * sizeof *v0);
+    memcpy(w0, s.w, n * sizeof *w0);
+    const bool sleeping = job->sleep_timers.count > 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        awake[i] = m->bodies[i].inv_mass > 0.0f && !(sleeping && job->sleep_timers.ptr[i] >= m->desc.sleep_time);
+        if (awake[i]) s.q[i] = ak_quat_normalize(s.q[i]);
+    }
+    contact_buf cb = {(rigid_contact*)(base + l.contacts), 0, m->desc.max_contacts, 0};
+    float gmag = ak_vec3_length(job->gravity);
+    /* contacts are looked for a little further than a substep's motion could close */
+    float margin = m->desc.contact_offset;
+    for (uint32_t step = 0; step < substeps; ++step) {
+        predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping);
+        find_contacts(&s, (sap_entry*)(base + l.sap), &cb, margin);
+        solve_positions(&s, &cb);
+        update_velocities(&s);
+        solve_velocities(&s, &cb, gmag);
+    }
+    bool finite = true;
+    for (uint32_t i = 0; i < n && finite; ++i)
+        finite = ak_vec3_is_finite(s.x[i]) && ak_quat_is_finite(s.q[i]) && ak_vec3_is_finite(s.v[i]) &&
+                 ak_vec3_is_finite(s.w[i]);
+    if (!finite) {
+        memcpy(s.x, x0, n * sizeof *x0);
+        memcpy(s.q, q0, n * sizeof *q0);
+        memcpy(s.v, v0, n * sizeof *v0);
+        memcpy(s.w, w0, n * sizeof *w0);
+        return AK_ERR_BAD_DATA;
+    }
+    if (job->out_max_penetration) {
+        float worst = 0.0f;
+        for (uint32_t k = 0; k < cb.count; ++k) {
+            const rigid_contact* c = &cb.c[k];
+            float d = ak_vec3_dot(ak_vec3_sub(world_point(&s, c->b, c->lb), world_point(&s, c->a, c->la)), c->n);
+            worst = ak_maxf(worst, d);
+        }
+        *job->out_max_penetration = worst;
+    }
+    if (job->out_contact_count) *job->out_contact_count = cb.count;
+    if (job->out_dropped_contacts) *job->out_dropped_contacts = cb.dropped;
+    if (sleeping) update_sleep(&s, job, &cb, (uint32_t*)(base + l.parent));
+    return AK_OK;
+}

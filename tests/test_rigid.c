@@ -1,0 +1,300 @@
+/* Rigid bodies against physics: closed forms and conservation laws. */
+#include <math.h>
+#include <stdlib.h>
+
+#include <animkit/rigid.h>
+
+#include "ak_test.h"
+
+/* A world: model plus state and scratch. */
+typedef struct world {
+    ak_rigid_model* model;
+    size_t n;
+    ak_vec3 x[64], v[64], w[64];
+    ak_quat q[64];
+    float sleep[64];
+    ak_rigid_step_job job;
+} world;
+
+static bool world_init(world* wd, const ak_rigid_body_desc* bodies, size_t n, const ak_rigid_model_desc* extra,
+                       float dt, uint32_t substeps, ak_vec3 g) {
+    memset(wd, 0, sizeof *wd);
+    ak_rigid_model_desc md = extra ? *extra : (ak_rigid_model_desc){0};
+    md.bodies = (ak_rigid_body_desc_cspan){bodies, n};
+    if (ak_rigid_model_create(&md, NULL, &wd->model) != AK_OK) return false;
+    wd->n = n;
+    ak_rigid_initial_state(wd->model, (ak_vec3_span){wd->x, n}, (ak_quat_span){wd->q, n},
+                           (ak_vec3_span){wd->v, n}, (ak_vec3_span){wd->w, n});
+    wd->job = (ak_rigid_step_job){.model = wd->model, .dt = dt, .substeps = substeps, .gravity = g,
+                                  .positions = {wd->x, n}, .orientations = {wd->q, n},
+                                  .velocities = {wd->v, n}, .angular_velocities = {wd->w, n}};
+    size_t size = ak_rigid_step_scratch_size(&wd->job);
+    wd->job.scratch = (ak_u8_span){malloc(size), size};
+    return wd->job.scratch.ptr != NULL;
+}
+
+static void world_free(world* wd) {
+    free(wd->job.scratch.ptr);
+    ak_rigid_model_destroy(wd->model);
+}
+
+static const ak_vec3 G = {0.0f, -9.81f, 0.0f};
+
+AK_TEST(mass_and_inertia_closed_forms) {
+    ak_rigid_body_desc b[3] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.5f}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {1.0f, 0.5f, 0.25f}}, .mass = 6.0f},
+        {.shape = {.type = AK_RIGID_CAPSULE, .radius = 0.1f, .half_height = 0.0f}, .density = 500.0f},
+    };
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {.bodies = {b, 3}};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
+    double ms = 1000.0 * 4.0 / 3.0 * 3.14159265358979 * 0.125;
+    AK_CHECK_NEAR(ak_rigid_body_mass(m, 0), ms, 1e-3 * ms);
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 0).y, 0.4 * ms * 0.25, 1e-3 * ms);
+    /* box 2 x 1 x 0.5 m, 6 kg: I_x = 6 (1 + 0.25) / 12 */
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 1).x, 6.0 * (1.0 + 0.25) / 12.0, 1e-5);
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 1).z, 6.0 * (4.0 + 1.0) / 12.0, 1e-5);
+    /* a capsule of zero length is a sphere */
+    double mc = 500.0 * 4.0 / 3.0 * 3.14159265358979 * 0.001;
+    AK_CHECK_NEAR(ak_rigid_body_mass(m, 2), mc, 1e-4 * mc);
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 2).x, 0.4 * mc * 0.01, 1e-4 * 0.4 * mc * 0.01);
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 2).y, 0.4 * mc * 0.01, 1e-4 * 0.4 * mc * 0.01);
+    ak_rigid_model_destroy(m);
+}
+
+AK_TEST(model_validity) {
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {0};
+    AK_CHECK_EQ(ak_rigid_model_create(NULL, NULL, &m), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_EMPTY);
+    ak_rigid_body_desc b = {.shape = {.type = AK_RIGID_SPHERE}};
+    md.bodies = (ak_rigid_body_desc_cspan){&b, 1};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG); /* radius 0 */
+    b.shape.radius = NAN;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_DATA);
+    b.shape.radius = 1.0f;
+    b.restitution = 1.5f;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
+    b.restitution = 0.0f;
+    b.friction = -0.5f;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
+    b.friction = 0.0f;
+    b.shape.type = AK_RIGID_SHAPE_COUNT;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
+    AK_CHECK(m == NULL);
+    b.shape.type = AK_RIGID_SPHERE;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
+    ak_rigid_step_job job = {0};
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_NULL_ARG);
+    job.model = m;
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_BAD_ARG); /* dt 0 */
+    job.dt = 0.01f;
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_NULL_ARG);
+    ak_vec3 x = {0, 0, 0}, v = {NAN, 0, 0}, w = {0, 0, 0};
+    ak_quat q = {0, 0, 0, 1};
+    unsigned char scratch[8];
+    job.positions = (ak_vec3_span){&x, 1};
+    job.orientations = (ak_quat_span){&q, 1};
+    job.velocities = (ak_vec3_span){&v, 1};
+    job.angular_velocities = (ak_vec3_span){&w, 1};
+    job.scratch = (ak_u8_span){scratch, sizeof scratch};
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_SPAN_SMALL);
+    size_t size = ak_rigid_step_scratch_size(&job);
+    job.scratch = (ak_u8_span){malloc(size), size};
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_BAD_DATA);
+    v.x = 0.0f;
+    AK_CHECK_EQ(ak_rigid_step_run(&job), AK_OK);
+    free(job.scratch.ptr);
+    ak_rigid_model_destroy(m);
+}
+
+/* Free fall and a thrown body: x(t) = x0 + v0 t + g t^2 / 2, up to semi-implicit Euler's
+ * error of g h t / 2 in position (16 mm after 2 s with h = 1/600 s); velocities exact. */
+AK_TEST(free_fall_and_parabola) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.2f, 0.3f}}, .position = {0, 100, 0}},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.1f}, .position = {0, 50, 0}, .velocity = {3, 8, -1}},
+    };
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 10, G));
+    for (int f = 0; f < 120; ++f) AK_CHECK_EQ(ak_rigid_step_run(&wd.job), AK_OK);
+    float t = 2.0f;
+    const float euler = 9.81f * (1.0f / 600.0f) * t / 2.0f;
+    AK_CHECK_NEAR(wd.x[0].y, 100.0f - 0.5f * 9.81f * t * t - euler, 1e-3);
+    AK_CHECK_NEAR(wd.v[0].y, -9.81f * t, 1e-3);
+    AK_CHECK_NEAR(wd.x[1].x, 3.0f * t, 1e-4);
+    AK_CHECK_NEAR(wd.x[1].y, 50.0f + 8.0f * t - 0.5f * 9.81f * t * t - euler, 1e-3);
+    AK_CHECK_NEAR(wd.x[1].z, -t, 1e-4);
+    AK_CHECK_NEAR(ak_quat_angle_between(wd.q[0], ak_quat_identity()), 0.0f, 1e-5);
+    world_free(&wd);
+}
+
+/* A box on a plane inclined by theta: stays when tan(theta) < mu, else slides with
+ * a = g (sin theta - mu cos theta). */
+static float incline_accel(float theta, float mu, float* out_drift) {
+    ak_vec3 nrm = {-sinf(theta), cosf(theta), 0.0f};
+    ak_quat rot = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), theta);
+    ak_vec3 start = ak_vec3_scale(nrm, 0.1f);
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_PLANE, .normal = nrm}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.2f}}, .position = start,
+         .orientation = rot, .friction = mu},
+    };
+    b[0].friction = mu;
+    world wd;
+    if (!world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 20, G)) return NAN;
+    /* settle 0.25 s, then measure the distance along the slope over 1 s */
+    ak_vec3 down = {-cosf(theta), -sinf(theta), 0.0f};
+    for (int f = 0; f < 15; ++f) ak_rigid_step_run(&wd.job);
+    float s0 = ak_vec3_dot(wd.x[1], down), v0 = ak_vec3_dot(wd.v[1], down);
+    for (int f = 0; f < 60; ++f) ak_rigid_step_run(&wd.job);
+    float s1 = ak_vec3_dot(wd.x[1], down);
+    *out_drift = s1 - s0;
+    world_free(&wd);
+    /* s1 - s0 = v0 T + a T^2 / 2 with T = 1 */
+    return 2.0f * (s1 - s0 - v0);
+}
+
+AK_TEST(incline_stays_or_slides) {
+    float drift;
+    /* tan(20 deg) = 0.364 < 0.5: stays */
+    incline_accel(ak_radians(20.0f), 0.5f, &drift);
+    AK_CHECK_MSG(fabsf(drift) < 1e-3f, "drift %g m", drift);
+    /* tan(35 deg) = 0.700 > 0.3: slides */
+    float th = ak_radians(35.0f), mu = 0.3f;
+    float a = incline_accel(th, mu, &drift);
+    float want = 9.81f * (sinf(th) - mu * cosf(th));
+    AK_CHECK_MSG(fabsf(a - want) < 0.01f * want, "a %g want %g", a, want);
+    /* frictionless slope: g sin theta */
+    th = ak_radians(25.0f);
+    a = incline_accel(th, AK_RIGID_FRICTIONLESS, &drift);
+    want = 9.81f * sinf(th);
+    AK_CHECK_MSG(fabsf(a - want) < 0.01f * want, "a %g want %g", a, want);
+}
+
+/* Torque-free box: world angular momentum conserved; spin about the intermediate axis flips,
+ * spins about the major and minor axes stay. Box half extents 0.5, 0.3, 0.1: I_z < I_y < I_x?
+ * I_x ~ (0.09 + 0.01), I_y ~ (0.25 + 0.01), I_z ~ (0.25 + 0.09): minor x, intermediate y,
+ * major z. */
+static void spin(int axis, float* out_l_err, float* out_min_comp, float* out_max_comp) {
+    ak_vec3 w = {0.01f, 0.01f, 0.01f};
+    if (axis == 0) w.x = 5.0f;
+    else if (axis == 1) w.y = 5.0f;
+    else w.z = 5.0f;
+    ak_rigid_body_desc b = {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.3f, 0.1f}},
+                            .angular_velocity = w};
+    world wd;
+    world_init(&wd, &b, 1, NULL, 1.0f / 60.0f, 10, ak_vec3_zero());
+    ak_vec3 l0 = ak_rigid_angular_momentum(wd.model, 0, wd.q[0], wd.w[0]);
+    float worst = 0.0f, lo = 1.0f, hi = -1.0f;
+    for (int f = 0; f < 600; ++f) {
+        ak_rigid_step_run(&wd.job);
+        ak_vec3 l = ak_rigid_angular_momentum(wd.model, 0, wd.q[0], wd.w[0]);
+        worst = ak_maxf(worst, ak_vec3_length(ak_vec3_sub(l, l0)) / ak_vec3_length(l0));
+        /* the spin axis's direction in the body: component along the starting axis */
+        ak_vec3 wl = ak_vec3_normalize(ak_quat_rotate(ak_quat_conjugate(wd.q[0]), wd.w[0]));
+        float c = axis == 0 ? wl.x : (axis == 1 ? wl.y : wl.z);
+        lo = ak_minf(lo, c);
+        hi = ak_maxf(hi, c);
+    }
+    *out_l_err = worst;
+    *out_min_comp = lo;
+    *out_max_comp = hi;
+    world_free(&wd);
+}
+
+AK_TEST(torque_free_spin) {
+    float err, lo, hi;
+    spin(1, &err, &lo, &hi);
+    AK_CHECK_MSG(err < 0.01f, "intermediate: |dL|/|L| %g", err);
+    AK_CHECK_MSG(lo < -0.9f, "intermediate axis did not flip: min component %g", lo);
+    spin(0, &err, &lo, &hi);
+    AK_CHECK_MSG(err < 0.01f, "minor: |dL|/|L| %g", err);
+    AK_CHECK_MSG(lo > 0.99f, "minor axis wandered: min component %g", lo);
+    spin(2, &err, &lo, &hi);
+    AK_CHECK_MSG(err < 0.01f, "major: |dL|/|L| %g", err);
+    AK_CHECK_MSG(lo > 0.99f, "major axis wandered: min component %g", lo);
+}
+
+/* A sphere dropped from h on a plane with restitution e rebounds to e^2 h. */
+AK_TEST(restitution_rebound) {
+    const float h = 1.0f, e = 0.6f, r = 0.1f;
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_PLANE}},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = r}, .position = {0, h + r, 0}, .restitution = e},
+    };
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 20, G));
+    float peak = 0.0f;
+    bool bounced = false;
+    for (int f = 0; f < 120; ++f) {
+        ak_rigid_step_run(&wd.job);
+        if (wd.v[1].y > 0.0f) bounced = true;
+        if (bounced) peak = ak_maxf(peak, wd.x[1].y - r);
+        if (bounced && wd.v[1].y < 0.0f) break;
+    }
+    AK_CHECK(bounced);
+    AK_CHECK_MSG(fabsf(peak - e * e * h) < 0.02f * e * e * h, "peak %g want %g", peak, e * e * h);
+    world_free(&wd);
+}
+
+/* A column of boxes on the ground, stepped for `seconds`: the largest horizontal drift of any
+ * box and the deepest penetration seen. */
+static void stack_run(int count, float seconds, float* out_drift, float* out_pen, bool* out_ok) {
+    ak_rigid_body_desc b[64];
+    memset(b, 0, sizeof b);
+    b[0].shape.type = AK_RIGID_PLANE;
+    for (int i = 1; i <= count; ++i) {
+        b[i].shape.type = AK_RIGID_BOX;
+        b[i].shape.half_extents = ak_vec3_make(0.5f, 0.5f, 0.5f);
+        b[i].position = ak_vec3_make(0.0f, 0.5f + 1.0f * (float)(i - 1), 0.0f);
+    }
+    world wd;
+    *out_ok = world_init(&wd, b, (size_t)count + 1, NULL, 1.0f / 60.0f, 20, G);
+    float pen_max = 0.0f, drift = 0.0f, pen;
+    wd.job.out_max_penetration = &pen;
+    int frames = (int)(seconds * 60.0f);
+    for (int f = 0; f < frames; ++f) {
+        if (ak_rigid_step_run(&wd.job) != AK_OK) *out_ok = false;
+        pen_max = ak_maxf(pen_max, pen);
+    }
+    for (int i = 1; i <= count; ++i) {
+        float dx = wd.x[i].x, dz = wd.x[i].z;
+        drift = ak_maxf(drift, sqrtf(dx * dx + dz * dz));
+        drift = ak_maxf(drift, fabsf(wd.x[i].y - (0.5f + (float)(i - 1))));
+    }
+    *out_drift = drift;
+    *out_pen = pen_max;
+    world_free(&wd);
+}
+
+AK_TEST(box_stack_stands) {
+    float drift, pen;
+    bool ok;
+    stack_run(10, 3.0f, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+}
+
+AK_TEST(box_stack_stands_20s) {
+    float drift, pen;
+    bool ok;
+    stack_run(10, 20.0f, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+}
+
+int main(void) {
+    AK_RUN(mass_and_inertia_closed_forms);
+    AK_RUN(model_validity);
+    AK_RUN(free_fall_and_parabola);
+    AK_RUN(incline_stays_or_slides);
+    AK_RUN(torque_free_spin);
+    AK_RUN(restitution_rebound);
+    AK_RUN(box_stack_stands);
+    AK_RUN_SLOW(box_stack_stands_20s);
+    return ak_test_finish();
+}
