@@ -275,7 +275,7 @@ AK_TEST(box_stack_stands) {
     float drift, pen;
     bool ok;
     /* with sleeping, as a scene would run: the stack falls asleep once it has settled */
-    stack_run(10, 3.0f, 20, true, &drift, &pen, &ok);
+    stack_run(10, 3.0f, 40, true, &drift, &pen, &ok);
     AK_CHECK(ok);
     AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
     AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
@@ -291,6 +291,75 @@ AK_TEST(box_stack_stands_20s) {
     AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
 }
 
+
+/* A 2D pyramid of unit boxes (layer k holds layers - k boxes, 0.1 m apart): the largest
+ * horizontal displacement of any box from where it started and the deepest penetration. */
+static void pyramid_run(int layers, float seconds, uint32_t substeps, bool sleep, float* out_drift,
+                        float* out_pen, bool* out_ok) {
+    size_t n = 1 + (size_t)layers * (size_t)(layers + 1) / 2;
+    ak_rigid_body_desc* b = calloc(n, sizeof *b);
+    ak_vec3 *x = calloc(n, sizeof *x), *v = calloc(n, sizeof *v), *w = calloc(n, sizeof *w);
+    ak_quat* q = calloc(n, sizeof *q);
+    float* timers = calloc(n, sizeof *timers);
+    *out_ok = b && x && v && w && q && timers;
+    if (!*out_ok) goto done;
+    b[0].shape.type = AK_RIGID_PLANE;
+    size_t k = 1;
+    for (int layer = 0; layer < layers; ++layer)
+        for (int i = 0; i < layers - layer; ++i, ++k) {
+            b[k].shape.type = AK_RIGID_BOX;
+            b[k].shape.half_extents = ak_vec3_make(0.5f, 0.5f, 0.5f);
+            b[k].position = ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - layer - 1)), 0.5f + (float)layer, 0.0f);
+        }
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {.bodies = {b, n}};
+    *out_ok = ak_rigid_model_create(&md, NULL, &m) == AK_OK;
+    if (!*out_ok) goto done;
+    ak_rigid_initial_state(m, (ak_vec3_span){x, n}, (ak_quat_span){q, n}, (ak_vec3_span){v, n}, (ak_vec3_span){w, n});
+    float pen = 0.0f, pen_max = 0.0f, drift = 0.0f;
+    ak_rigid_step_job job = {.model = m, .dt = 1.0f / 60.0f, .substeps = substeps, .gravity = G,
+                             .positions = {x, n}, .orientations = {q, n}, .velocities = {v, n},
+                             .angular_velocities = {w, n}, .out_max_penetration = &pen};
+    if (sleep) job.sleep_timers = (ak_f32_span){timers, n};
+    size_t size = ak_rigid_step_scratch_size(&job);
+    job.scratch = (ak_u8_span){malloc(size), size};
+    int frames = (int)(seconds * 60.0f);
+    for (int f = 0; f < frames && *out_ok; ++f) {
+        *out_ok = ak_rigid_step_run(&job) == AK_OK;
+        pen_max = ak_maxf(pen_max, pen);
+    }
+    /* horizontal: the column's vertical give is the contacts' penetration, checked apart */
+    for (size_t i = 1; i < n; ++i) {
+        float dx = x[i].x - b[i].position.x, dz = x[i].z - b[i].position.z;
+        drift = ak_maxf(drift, sqrtf(dx * dx + dz * dz));
+    }
+    *out_drift = drift;
+    *out_pen = pen_max;
+    free(job.scratch.ptr);
+    ak_rigid_model_destroy(m);
+done:
+    free(b), free(x), free(v), free(w), free(q), free(timers);
+}
+
+AK_TEST(pyramid_stands) {
+    float drift, pen;
+    bool ok;
+    pyramid_run(6, 2.0f, 40, true, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+}
+
+AK_TEST(pyramid_20_layers_20s) {
+    float drift, pen;
+    bool ok;
+    pyramid_run(20, 20.0f, 40, true, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+    printf("  20-layer pyramid, 20 s, 40 substeps, sleeping on: drift %.3g m, penetration %.3g m\n", drift, pen);
+}
+
 int main(void) {
     AK_RUN(mass_and_inertia_closed_forms);
     AK_RUN(model_validity);
@@ -299,6 +368,8 @@ int main(void) {
     AK_RUN(torque_free_spin);
     AK_RUN(restitution_rebound);
     AK_RUN(box_stack_stands);
+    AK_RUN(pyramid_stands);
     AK_RUN_SLOW(box_stack_stands_20s);
+    AK_RUN_SLOW(pyramid_20_layers_20s);
     return ak_test_finish();
 }

@@ -275,7 +275,14 @@ static void box_box(hits* hs, rigid_pose pa, ak_vec3 ha, rigid_pose pb, ak_vec3 
         count = clip_poly(poly, count, u, off + comp(hr, k), tmp);
         if (count > 0) count = clip_poly(poly, count, ak_vec3_neg(u), -off + comp(hr, k), tmp);
     }
+    /* faces that line up put incident corners on the clip planes, where rounding adds a second
+     * point a hair away: one of each such cluster is kept, or the manifold's uneven points tilt
+     * a resting box */
+    float tol = 1e-4f * (1.0f + comp(hr, (face_k + 1) % 3) + comp(hr, (face_k + 2) % 3));
     for (int i = 0; i < count; ++i) {
+        bool dup = false;
+        for (int k = 0; k < i && !dup; ++k) dup = ak_vec3_distance(poly[i], poly[k]) < tol;
+        if (dup) continue;
         float s = ak_vec3_dot(ak_vec3_sub(poly[i], rc), nref);
         ak_vec3 on_ref = ak_vec3_madd(poly[i], nref, -s);
         if (face_kind == 1) add_hit(hs, poly[i], on_ref, nref); /* B is the reference */
