@@ -19,7 +19,7 @@ typedef struct contact_group {
 
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, xp, qp, dx, ds, sap, contacts, groups, parent, awake, total;
+    size_t x0, q0, v0, w0, qp, dx, ds, sap, contacts, groups, parent, awake, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -31,7 +31,6 @@ static layout layout_of(const ak_rigid_model* m) {
     l.q0 = off, off += align16(n * sizeof(ak_quat));
     l.v0 = off, off += align16(n * sizeof(ak_vec3));
     l.w0 = off, off += align16(n * sizeof(ak_vec3));
-    l.xp = off, off += align16(n * sizeof(ak_vec3));
     l.qp = off, off += align16(n * sizeof(ak_quat));
     l.dx = off, off += align16(n * sizeof(ak_vec3));
     l.ds = off, off += align16(n * sizeof(ak_vec3));
@@ -78,11 +77,13 @@ typedef struct solver {
     ak_quat* q;
     ak_vec3* v;
     ak_vec3* w;
-    ak_vec3* xp;
+    const ak_vec3* x0;    /* positions at the step's start */
     ak_quat* qp;
-    ak_vec3* dx;          /* displacement since the substep's start: x = xp + dx, kept apart so
-                             the velocity dx / h keeps float precision far from the origin */
-    ak_vec3* ds;          /* displacement from the step's start to this substep's start */
+    ak_vec3* dx;          /* displacement since the substep's start, kept apart so the velocity
+                             dx / h keeps float precision far from the origin */
+    ak_vec3* ds;          /* displacement from the step's start to this substep's start; x is
+                             always x0 + (ds + dx), rounded once, so a body 100 m out does not
+                             lose a rounding of its position every substep (4 mm/s at 1200 Hz) */
     const ak_quat* q0;    /* orientations at the step's start */
     const uint8_t* awake; /* 1: dynamic and awake (moves); 0: static or asleep */
     float h;
@@ -109,7 +110,7 @@ static float gen_inv_mass(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n) {
 static void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
     if (!s->awake[i]) return;
     s->dx[i] = ak_vec3_madd(s->dx[i], p, sign * s->bodies[i].inv_mass);
-    s->x[i] = ak_vec3_add(s->xp[i], s->dx[i]);
+    s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
     ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, ak_vec3_cross(r, p)), sign * 0.5f);
     ak_quat q = s->q[i];
     ak_quat dq = ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q);
@@ -140,7 +141,6 @@ static ak_vec3 gyroscopic_step(ak_vec3 w, ak_vec3 inertia, float h) {
 static void predict(solver* s, ak_vec3 g, float lin_damp, float ang_damp) {
     float h = s->h;
     for (uint32_t i = 0; i < (uint32_t)s->m->body_count; ++i) {
-        s->xp[i] = s->x[i];
         s->qp[i] = s->q[i];
         s->dx[i] = ak_vec3_zero();
         if (!s->awake[i]) continue;
@@ -149,7 +149,7 @@ static void predict(solver* s, ak_vec3 g, float lin_damp, float ang_damp) {
         if (lin_damp > 0.0f) v = ak_vec3_scale(v, 1.0f / (1.0f + h * lin_damp));
         s->v[i] = v;
         s->dx[i] = ak_vec3_scale(v, h);
-        s->x[i] = ak_vec3_add(s->xp[i], s->dx[i]);
+        s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
         ak_quat q = s->q[i];
         ak_vec3 wl = ak_quat_rotate(ak_quat_conjugate(q), s->w[i]);
         wl = gyroscopic_step(wl, b->inertia, h);
@@ -557,7 +557,7 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
     solver s = {
         .m = m, .bodies = m->bodies, .x = job->positions.ptr, .q = job->orientations.ptr,
         .v = job->velocities.ptr, .w = job->angular_velocities.ptr,
-        .xp = (ak_vec3*)(base + l.xp), .qp = (ak_quat*)(base + l.qp), .dx = (ak_vec3*)(base + l.dx),
+        .x0 = x0, .qp = (ak_quat*)(base + l.qp), .dx = (ak_vec3*)(base + l.dx),
         .ds = (ak_vec3*)(base + l.ds), .q0 = q0,
         .awake = awake,
         .h = job->dt / (float)substeps,
