@@ -19,7 +19,8 @@ typedef struct world {
 static bool world_init(world* wd, const ak_rigid_body_desc* bodies, size_t n, const ak_rigid_model_desc* extra,
                        float dt, uint32_t substeps, ak_vec3 g) {
     memset(wd, 0, sizeof *wd);
-    ak_rigid_model_desc md = extra ? *extra : (ak_rigid_model_desc){0};
+    ak_rigid_model_desc md = {0};
+    if (extra) md = *extra;
     md.bodies = (ak_rigid_body_desc_cspan){bodies, n};
     if (ak_rigid_model_create(&md, NULL, &wd->model) != AK_OK) return false;
     wd->n = n;
@@ -84,6 +85,26 @@ AK_TEST(model_validity) {
     AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
     AK_CHECK(m == NULL);
     b.shape.type = AK_RIGID_SPHERE;
+    ak_rigid_body_desc two[2] = {b, b};
+    ak_rigid_joint_desc jd = {.body_a = 0, .body_b = 0};
+    ak_rigid_model_desc mj = {.bodies = {two, 2}, .joints = {&jd, 1}};
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_INDEX); /* a body joined to itself */
+    jd.body_b = 2;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_INDEX);
+    jd.body_b = 1;
+    jd.limited = true, jd.lower = 1.0f, jd.upper = 0.5f;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_ARG);
+    jd.lower = 0.0f, jd.compliance = -1.0f;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_ARG);
+    jd.compliance = 0.0f, jd.type = AK_RIGID_JOINT_TYPE_COUNT;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_ARG);
+    jd.type = AK_RIGID_JOINT_HINGE, jd.anchor.x = INFINITY;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_DATA);
+    jd.anchor.x = 0.0f;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_OK);
+    AK_CHECK_EQ(ak_rigid_joint_count(m), 1);
+    ak_rigid_model_destroy(m);
+    m = NULL;
     AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
     ak_rigid_step_job job = {0};
     AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_NULL_ARG);
@@ -360,6 +381,134 @@ AK_TEST(pyramid_20_layers_20s) {
     printf("  20-layer pyramid, 20 s, 40 substeps, sleeping on: drift %.3g m, penetration %.3g m\n", drift, pen);
 }
 
+/* A compound pendulum on a ball joint: a sphere of radius r at distance L below a static
+ * anchor, released at 5 degrees, swings with T = 2 pi sqrt(I_pivot / (m g L)), I_pivot =
+ * 2/5 m r^2 + m L^2 (small-amplitude closed form; 5 degrees adds 0.05%). */
+AK_TEST(pendulum_period_ball_joint) {
+    const float L = 1.0f, r = 0.05f, th0 = ak_radians(5.0f);
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.01f}, .is_static = true},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = r}, .position = {L * sinf(th0), -L * cosf(th0), 0}},
+    };
+    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_BALL, .body_a = 0, .body_b = 1};
+    ak_rigid_model_desc md = {.joints = {&jd, 1}};
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 240.0f, 10, G));
+    float prev_x = wd.x[1].x, t = 0.0f, crossings[3];
+    int nc = 0;
+    float worst_gap = 0.0f;
+    for (int f = 0; f < 240 * 5 && nc < 3; ++f) {
+        ak_rigid_step_run(&wd.job);
+        t += 1.0f / 240.0f;
+        float gap, excess;
+        ak_rigid_joint_error(wd.model, 0, (ak_vec3_cspan){wd.x, 2}, (ak_quat_cspan){wd.q, 2}, &gap, &excess);
+        worst_gap = ak_maxf(worst_gap, gap);
+        /* downward zero crossings of x, interpolated */
+        if (prev_x > 0.0f && wd.x[1].x <= 0.0f) crossings[nc++] = t - (1.0f / 240.0f) * wd.x[1].x / (wd.x[1].x - prev_x);
+        prev_x = wd.x[1].x;
+    }
+    AK_CHECK_EQ(nc, 3);
+    double m_i = 0.4 * r * r + L * L; /* I_pivot / m */
+    double T = 2.0 * 3.14159265358979 * sqrt(m_i / (9.81 * L));
+    if (nc == 3) {
+        double got = (double)(crossings[2] - crossings[0]) / 2.0;
+        AK_CHECK_MSG(fabs(got - T) < 0.01 * T, "period %g want %g", got, T);
+    }
+    AK_CHECK_MSG(worst_gap < 1e-4f, "joint gap %g m", worst_gap);
+    world_free(&wd);
+}
+
+/* A box hinged at one end to a static body, limits [-30, 30] degrees, released horizontal
+ * with the hinge's zero at 0: gravity pulls it to the lower limit, where it must stop within
+ * 2 degrees; swinging about any other axis is forbidden. */
+AK_TEST(hinge_limits_hold) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.05f}, .is_static = true},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.05f, 0.1f}}, .position = {0.5f, 0, 0},
+         .angular_velocity = {1.0f, 2.0f, 0.0f}},
+    };
+    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_HINGE, .body_a = 0, .body_b = 1, .axis = {0, 0, 1},
+                              .limited = true, .lower = ak_radians(-30.0f), .upper = ak_radians(30.0f)};
+    ak_rigid_model_desc md = {.joints = {&jd, 1}};
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 20, G));
+    float worst_excess = 0.0f, worst_gap = 0.0f, worst_tilt = 0.0f;
+    for (int f = 0; f < 120; ++f) {
+        ak_rigid_step_run(&wd.job);
+        float gap, excess;
+        ak_rigid_joint_error(wd.model, 0, (ak_vec3_cspan){wd.x, 2}, (ak_quat_cspan){wd.q, 2}, &gap, &excess);
+        worst_excess = ak_maxf(worst_excess, excess);
+        worst_gap = ak_maxf(worst_gap, gap);
+        ak_vec3 z = ak_quat_rotate(wd.q[1], ak_vec3_make(0, 0, 1));
+        worst_tilt = ak_maxf(worst_tilt, acosf(ak_clampf(z.z, -1.0f, 1.0f)));
+    }
+    /* at rest on the limit: the bar points 30 degrees below the horizontal */
+    ak_vec3 bar = ak_quat_rotate(wd.q[1], ak_vec3_make(1, 0, 0));
+    AK_CHECK_NEAR(atan2f(bar.y, bar.x), ak_radians(-30.0f), ak_radians(2.0f));
+    AK_CHECK_MSG(worst_excess < ak_radians(2.0f), "limit exceeded by %g deg", ak_degrees(worst_excess));
+    AK_CHECK_MSG(worst_tilt < ak_radians(2.0f), "hinge axis tilted by %g deg", ak_degrees(worst_tilt));
+    AK_CHECK_MSG(worst_gap < 1e-3f, "joint gap %g m", worst_gap);
+    world_free(&wd);
+}
+
+/* A box on a frictionless prismatic joint along x under gravity (3, -9.81, 0): the joint holds
+ * it up and it slides at 3 m/s^2 (x = 1.5 t^2 less Euler's 1.5 h t); limits stop it at 1 m. */
+AK_TEST(prismatic_slides_along_its_axis) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.05f}, .is_static = true},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.1f, 0.1f}}},
+    };
+    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_PRISMATIC, .body_a = 0, .body_b = 1, .axis = {1, 0, 0}};
+    ak_rigid_model_desc md = {.joints = {&jd, 1}};
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 10, ak_vec3_make(3.0f, -9.81f, 0.0f)));
+    for (int f = 0; f < 30; ++f) ak_rigid_step_run(&wd.job);
+    float t = 0.5f;
+    AK_CHECK_NEAR(wd.x[1].x, 1.5f * t * t + 1.5f * t / 600.0f, 2e-3);
+    AK_CHECK_NEAR(wd.x[1].y, 0.0f, 1e-4);
+    AK_CHECK_NEAR(ak_quat_angle_between(wd.q[1], ak_quat_identity()), 0.0f, 1e-3);
+    world_free(&wd);
+    jd.limited = true, jd.lower = -1.0f, jd.upper = 0.2f;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 10, ak_vec3_make(3.0f, -9.81f, 0.0f)));
+    for (int f = 0; f < 60; ++f) ak_rigid_step_run(&wd.job);
+    AK_CHECK_NEAR(wd.x[1].x, 0.2f, 1e-3);
+    world_free(&wd);
+}
+
+/* Two boxes welded by a fixed joint, thrown spinning: they keep their relative pose, and with
+ * no gravity the pair's total angular momentum about its centre of mass is conserved. */
+AK_TEST(fixed_joint_keeps_the_pose) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.1f}}, .position = {-0.2f, 0, 0},
+         .angular_velocity = {0.3f, 0.2f, 2.0f}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.1f}}, .position = {0.2f, 0, 0},
+         .angular_velocity = {0.3f, 0.2f, 2.0f}},
+    };
+    /* the bodies move as one: v = w x r about the common centre */
+    b[0].velocity = ak_vec3_cross(b[0].angular_velocity, b[0].position);
+    b[1].velocity = ak_vec3_cross(b[1].angular_velocity, b[1].position);
+    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_FIXED, .body_a = 0, .body_b = 1, .anchor = {0, 0, 0}};
+    ak_rigid_model_desc md = {.joints = {&jd, 1}};
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 20, ak_vec3_zero()));
+    ak_vec3 l0 = ak_vec3_zero();
+    for (int i = 0; i < 2; ++i)
+        l0 = ak_vec3_add(l0, ak_vec3_add(ak_rigid_angular_momentum(wd.model, (size_t)i, wd.q[i], wd.w[i]),
+                                         ak_vec3_scale(ak_vec3_cross(wd.x[i], wd.v[i]), ak_rigid_body_mass(wd.model, (size_t)i))));
+    for (int f = 0; f < 120; ++f) ak_rigid_step_run(&wd.job);
+    AK_CHECK_NEAR(ak_quat_angle_between(wd.q[0], wd.q[1]), 0.0f, ak_radians(0.5f));
+    AK_CHECK_NEAR(ak_vec3_distance(wd.x[0], wd.x[1]), 0.4f, 1e-3);
+    ak_vec3 l1 = ak_vec3_zero(), c = ak_vec3_scale(ak_vec3_add(wd.x[0], wd.x[1]), 0.5f);
+    ak_vec3 vc = ak_vec3_scale(ak_vec3_add(wd.v[0], wd.v[1]), 0.5f);
+    for (int i = 0; i < 2; ++i)
+        l1 = ak_vec3_add(l1, ak_vec3_add(ak_rigid_angular_momentum(wd.model, (size_t)i, wd.q[i], wd.w[i]),
+                                         ak_vec3_scale(ak_vec3_cross(ak_vec3_sub(wd.x[i], c), ak_vec3_sub(wd.v[i], vc)),
+                                                       ak_rigid_body_mass(wd.model, (size_t)i))));
+    AK_CHECK_MSG(ak_vec3_length(ak_vec3_sub(l1, l0)) < 0.02f * ak_vec3_length(l0), "L %g %g %g vs %g %g %g", l1.x, l1.y,
+                 l1.z, l0.x, l0.y, l0.z);
+    world_free(&wd);
+}
+
 int main(void) {
     AK_RUN(mass_and_inertia_closed_forms);
     AK_RUN(model_validity);
@@ -369,6 +518,10 @@ int main(void) {
     AK_RUN(restitution_rebound);
     AK_RUN(box_stack_stands);
     AK_RUN(pyramid_stands);
+    AK_RUN(pendulum_period_ball_joint);
+    AK_RUN(hinge_limits_hold);
+    AK_RUN(prismatic_slides_along_its_axis);
+    AK_RUN(fixed_joint_keeps_the_pose);
     AK_RUN_SLOW(box_stack_stands_20s);
     AK_RUN_SLOW(pyramid_20_layers_20s);
     return ak_test_finish();

@@ -25,8 +25,12 @@
  *     order fixed by body indices); thread_count is accepted for the interface's sake but this
  *     version runs every phase on the calling thread, so results are the same for any count.
  *
+ *   - joints: ball (optional swing cone), hinge (optional angle limits), fixed, prismatic
+ *     (optional distance limits), with compliance, and drives towards a target relative
+ *     orientation (XPBD positional and angular constraints, their section 3.3);
+ *
  * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
- * joints, ragdolls, continuous collision detection (a body moving more than its size in one
+ * twist limits on ball joints, ragdolls built from a skeleton, continuous collision detection (a body moving more than its size in one
  * substep can tunnel), collisions with particles or cloth.
  *
  * Usage (a box dropped on the ground):
@@ -100,8 +104,38 @@ typedef struct ak_rigid_body_desc {
 
 AK_DEFINE_SPAN(rigid_body_desc, ak_rigid_body_desc)
 
+typedef enum ak_rigid_joint_type {
+    AK_RIGID_JOINT_BALL = 0,  /* default: the anchors coincide; optional swing cone */
+    AK_RIGID_JOINT_HINGE,     /* ball plus the bodies' axes stay parallel; optional angle limits */
+    AK_RIGID_JOINT_FIXED,     /* ball plus the relative orientation stays as built */
+    AK_RIGID_JOINT_PRISMATIC, /* relative orientation as built; b slides along the axis only;
+                                 optional distance limits */
+    AK_RIGID_JOINT_TYPE_COUNT
+} ak_rigid_joint_type;
+
+/* A joint between two bodies, described in world space at the bodies' desc poses (the model
+ * stores each body's local anchor and axes from them). XPBD constraints with compliance 0
+ * (rigid) or the given one, solved before the contacts each substep. */
+typedef struct ak_rigid_joint_desc {
+    ak_rigid_joint_type type;  /* 0 -> ball */
+    uint32_t body_a, body_b;   /* body indices, different; either may be static */
+    ak_vec3 anchor;            /* world point where the bodies are joined */
+    ak_vec3 axis;              /* world: hinge axis, prismatic slide axis, ball's swing axis;
+                                  zero -> (0, 0, 1) */
+    bool limited;              /* hinge: lower <= angle <= upper; prismatic: lower <= offset
+                                  <= upper; ball: swing (angle between the bodies' axes) <= upper */
+    float lower, upper;        /* radians (hinge, ball) or metres (prismatic), as built = 0 */
+    float compliance;          /* m/N and rad/(N m) of every part of the joint; 0 -> rigid */
+    bool drive;                /* drive b's orientation relative to a towards drive_target */
+    ak_quat drive_target;      /* b's orientation in a's frame (a^-1 b); zero -> as built */
+    float drive_compliance;    /* rad/(N m); 0 -> rigid (the drive then acts as a fixed joint) */
+} ak_rigid_joint_desc;
+
+AK_DEFINE_SPAN(rigid_joint_desc, ak_rigid_joint_desc)
+
 typedef struct ak_rigid_model_desc {
     ak_rigid_body_desc_cspan bodies; /* at least one (required) */
+    ak_rigid_joint_desc_cspan joints; /* optional */
     float linear_damping;      /* 1/s: v *= 1 / (1 + h c) each substep; 0 -> none */
     float angular_damping;     /* 1/s: the same on angular velocity; 0 -> none */
     float contact_offset;      /* metres: contacts are found this far before touching; 0 -> 0.01 */
@@ -122,11 +156,21 @@ typedef struct ak_rigid_model ak_rigid_model;
  * AK_ERR_BAD_ARG (unknown shape, a radius or half extent <= 0 or a negative half height, a
  * negative density, mass, friction other than AK_RIGID_FRICTIONLESS, damping, offset or sleep
  * value, restitution outside [0, 1], more than 2^24 bodies, an allocator with only one function),
- * AK_ERR_BAD_DATA (a non-finite value), AK_ERR_NO_MEMORY. *out_model is NULL on failure. */
+ * AK_ERR_BAD_INDEX (a joint's body out of range, or both the same), AK_ERR_BAD_ARG (unknown
+ * joint type, lower > upper, negative compliance), AK_ERR_BAD_DATA (a non-finite value),
+ * AK_ERR_NO_MEMORY. *out_model is NULL on failure. */
 AK_API ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_allocator* alloc,
                                        ak_rigid_model** out_model);
 /* Free a model; NULL is a no-op. */
 AK_API void ak_rigid_model_destroy(ak_rigid_model* model);
+
+/* Number of joints (0 for NULL). */
+AK_API size_t ak_rigid_joint_count(const ak_rigid_model* model);
+/* How far joint i is from satisfied in a state: *out_gap the distance between its anchors (m,
+ * prismatic: off the axis), *out_limit_excess how far its angle or offset is outside its limits
+ * (rad or m, 0 when inside or unlimited). AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX, AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t joint_index, ak_vec3_cspan positions,
+                                      ak_quat_cspan orientations, float* out_gap, float* out_limit_excess);
 
 /* Number of bodies (0 for NULL). */
 AK_API size_t ak_rigid_body_count(const ak_rigid_model* model);

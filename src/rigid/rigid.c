@@ -122,12 +122,25 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         ak_result r = check_body(&desc->bodies.ptr[i]);
         if (r != AK_OK) return r;
     }
+    size_t n = desc->bodies.count, nj = desc->joints.count;
+    if (nj && !desc->joints.ptr) return AK_ERR_NULL_ARG;
+    if (nj > (1u << 24)) return AK_ERR_BAD_ARG;
+    for (size_t i = 0; i < nj; ++i) {
+        const ak_rigid_joint_desc* jd = &desc->joints.ptr[i];
+        if ((unsigned)jd->type >= AK_RIGID_JOINT_TYPE_COUNT) return AK_ERR_BAD_ARG;
+        if (jd->body_a >= n || jd->body_b >= n || jd->body_a == jd->body_b) return AK_ERR_BAD_INDEX;
+        if (!vec_finite(jd->anchor) || !vec_finite(jd->axis) || !ak_finitef(jd->lower) || !ak_finitef(jd->upper) ||
+            !ak_finitef(jd->compliance) || !ak_quat_is_finite(jd->drive_target) || !ak_finitef(jd->drive_compliance))
+            return AK_ERR_BAD_DATA;
+        if ((jd->limited && jd->lower > jd->upper) || jd->compliance < 0.0f || jd->drive_compliance < 0.0f)
+            return AK_ERR_BAD_ARG;
+    }
     ak_allocator al = {def_alloc, def_free, NULL};
     if (alloc && alloc->alloc) al = *alloc;
-    size_t n = desc->bodies.count;
     size_t head = (sizeof(ak_rigid_model) + 15) & ~(size_t)15;
     size_t bodies_size = ((n * sizeof(rigid_body)) + 15) & ~(size_t)15;
-    size_t total = head + bodies_size + n * sizeof(ak_rigid_body_desc);
+    size_t descs_size = ((n * sizeof(ak_rigid_body_desc)) + 15) & ~(size_t)15;
+    size_t total = head + bodies_size + descs_size + nj * sizeof(rigid_joint);
     unsigned char* mem = al.alloc(total, al.user);
     if (!mem) return AK_ERR_NO_MEMORY;
     memset(mem, 0, total);
@@ -136,6 +149,8 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
     m->body_count = n;
     m->bodies = (rigid_body*)(mem + head);
     m->descs = (ak_rigid_body_desc*)(mem + head + bodies_size);
+    m->joints = (rigid_joint*)(mem + head + bodies_size + descs_size);
+    m->joint_count = nj;
     m->desc = ak_rigid_model_desc_resolved(desc);
     m->desc.bodies.ptr = m->descs;
     for (size_t i = 0; i < n; ++i) {
@@ -190,6 +205,33 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         }
         m->descs[i] = d;
     }
+    for (size_t i = 0; i < nj; ++i) {
+        const ak_rigid_joint_desc* jd = &desc->joints.ptr[i];
+        rigid_joint* j = &m->joints[i];
+        const ak_rigid_body_desc* da = &m->descs[jd->body_a];
+        const ak_rigid_body_desc* db = &m->descs[jd->body_b];
+        ak_quat ia = ak_quat_conjugate(da->orientation), ib = ak_quat_conjugate(db->orientation);
+        ak_vec3 axis = ak_vec3_length_sq(jd->axis) > 0.0f ? ak_vec3_normalize(jd->axis) : ak_vec3_make(0, 0, 1);
+        ak_vec3 perp = ak_vec3_normalize(ak_vec3_any_perpendicular(axis));
+        j->type = jd->type;
+        j->a = jd->body_a;
+        j->b = jd->body_b;
+        j->la = ak_quat_rotate(ia, ak_vec3_sub(jd->anchor, da->position));
+        j->lb = ak_quat_rotate(ib, ak_vec3_sub(jd->anchor, db->position));
+        j->axis_a = ak_quat_rotate(ia, axis);
+        j->axis_b = ak_quat_rotate(ib, axis);
+        j->perp_a = ak_quat_rotate(ia, perp);
+        j->perp_b = ak_quat_rotate(ib, perp);
+        j->rel = ak_quat_normalize(ak_quat_mul(ia, db->orientation));
+        j->drive_target = ak_quat_dot(jd->drive_target, jd->drive_target) > 0.0f ? ak_quat_normalize(jd->drive_target) : j->rel;
+        j->limited = jd->limited;
+        j->drive = jd->drive;
+        j->lower = jd->lower;
+        j->upper = jd->upper;
+        j->compliance = jd->compliance;
+        j->drive_compliance = jd->drive_compliance;
+    }
+    m->desc.joints = (ak_rigid_joint_desc_cspan){NULL, 0};
     *out_model = m;
     return AK_OK;
 }
@@ -254,4 +296,35 @@ double ak_rigid_energy(const ak_rigid_model* model, ak_vec3 g, ak_vec3_cspan x, 
         e -= m * ((double)g.x * x.ptr[i].x + (double)g.y * x.ptr[i].y + (double)g.z * x.ptr[i].z);
     }
     return e;
+}
+
+size_t ak_rigid_joint_count(const ak_rigid_model* model) { return model ? model->joint_count : 0; }
+
+ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t i, ak_vec3_cspan x, ak_quat_cspan q, float* out_gap,
+                               float* out_limit_excess) {
+    if (!model || !x.ptr || !q.ptr || !out_gap || !out_limit_excess) return AK_ERR_NULL_ARG;
+    if (i >= model->joint_count) return AK_ERR_BAD_INDEX;
+    if (x.count < model->body_count || q.count < model->body_count) return AK_ERR_SPAN_SMALL;
+    const rigid_joint* j = &model->joints[i];
+    ak_quat qa = ak_quat_normalize(q.ptr[j->a]), qb = ak_quat_normalize(q.ptr[j->b]);
+    ak_vec3 pa = ak_vec3_add(x.ptr[j->a], ak_quat_rotate(qa, j->la));
+    ak_vec3 pb = ak_vec3_add(x.ptr[j->b], ak_quat_rotate(qb, j->lb));
+    ak_vec3 d = ak_vec3_sub(pb, pa);
+    float excess = 0.0f;
+    if (j->type == AK_RIGID_JOINT_PRISMATIC) {
+        ak_vec3 ax = ak_quat_rotate(qa, j->axis_a);
+        float s = ak_vec3_dot(d, ax);
+        d = ak_vec3_madd(d, ax, -s);
+        if (j->limited) excess = ak_maxf(j->lower - s, s - j->upper);
+    } else if (j->type == AK_RIGID_JOINT_HINGE && j->limited) {
+        float phi = akp_rigid_hinge_angle(j, qa, qb);
+        excess = ak_maxf(j->lower - phi, phi - j->upper);
+    } else if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
+        ak_vec3 a1 = ak_quat_rotate(qa, j->axis_a), a2 = ak_quat_rotate(qb, j->axis_b);
+        float swing = atan2f(ak_vec3_length(ak_vec3_cross(a1, a2)), ak_vec3_dot(a1, a2));
+        excess = swing - j->upper;
+    }
+    *out_gap = ak_vec3_length(d);
+    *out_limit_excess = ak_maxf(excess, 0.0f);
+    return AK_OK;
 }

@@ -2,6 +2,8 @@
 #ifndef AK_RIGID_IMPL_H
 #define AK_RIGID_IMPL_H
 
+#include <math.h>
+
 #include <animkit/rigid.h>
 
 /* What the solver reads per body, resolved once at build time. */
@@ -17,6 +19,26 @@ typedef struct rigid_body {
     float bound_radius;     /* metres from the centre that holds the shape (planes: INFINITY) */
 } rigid_body;
 
+/* A joint with its anchors and axes in each body's frame (from the descs' poses). */
+typedef struct rigid_joint {
+    ak_rigid_joint_type type;
+    uint32_t a, b;
+    ak_vec3 la, lb;          /* anchors, local */
+    ak_vec3 axis_a, axis_b;  /* the joint axis in each body's frame */
+    ak_vec3 perp_a, perp_b;  /* a reference direction perpendicular to it, in each frame */
+    ak_quat rel;             /* b's orientation in a's frame as built */
+    ak_quat drive_target;    /* b's orientation in a's frame the drive aims at */
+    bool limited, drive;
+    float lower, upper, compliance, drive_compliance;
+} rigid_joint;
+
+/* Signed angle (rad) of body b about the hinge axis relative to a, zero as built. */
+static inline float akp_rigid_hinge_angle(const rigid_joint* j, ak_quat qa, ak_quat qb) {
+    ak_vec3 n = ak_quat_rotate(qa, j->axis_a);
+    ak_vec3 b1 = ak_quat_rotate(qa, j->perp_a), b2 = ak_quat_rotate(qb, j->perp_b);
+    return atan2f(ak_vec3_dot(ak_vec3_cross(b1, b2), n), ak_vec3_dot(b1, b2));
+}
+
 struct ak_rigid_model {
     ak_allocator alloc;
     ak_rigid_model_desc desc; /* resolved; bodies points at descs */
@@ -24,6 +46,8 @@ struct ak_rigid_model {
     size_t plane_count;
     rigid_body* bodies;
     ak_rigid_body_desc* descs;
+    rigid_joint* joints;
+    size_t joint_count;
 };
 
 /* One contact point found by the narrow phase. n points from body b to body a: pushing a along

@@ -216,6 +216,8 @@ static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float mar
     cb->count += (uint32_t)kept;
 }
 
+static bool joined(const ak_rigid_model* m, uint32_t a, uint32_t b);
+
 static float axis_comp(ak_vec3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
 
 static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float margin) {
@@ -253,6 +255,7 @@ static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float marg
             if (!s->awake[a] && !s->awake[b]) continue;
             float rr = s->bodies[a].bound_radius + s->bodies[b].bound_radius + margin;
             if (ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b])) > rr * rr) continue;
+            if (m->joint_count && joined(m, a, b)) continue;
             /* the awake (or lower-index) body first, so a static body is always b */
             if (!s->awake[a] || (s->awake[b] && b < a)) narrow(s, cb, b, a, margin);
             else narrow(s, cb, a, b, margin);
@@ -423,6 +426,109 @@ static void solve_positions(solver* s, contact_buf* cb) {
     }
 }
 
+/* ---- joints (XPBD positional and angular constraints, Mueller et al. 2020, 3.3) ---------- */
+
+/* World inverse inertia tensor R diag(I^-1) R^T of body i (zero when it does not move). */
+static ak_mat3 inv_inertia_world(const solver* s, uint32_t i) {
+    if (!s->awake[i]) return ak_mat3_scale(ak_mat3_identity(), 0.0f);
+    ak_mat3 r = ak_mat3_from_quat(s->q[i]);
+    return ak_mat3_mul(ak_mat3_mul(r, ak_mat3_diagonal(s->bodies[i].inv_inertia)), ak_mat3_transpose(r));
+}
+
+static ak_mat3 skew(ak_vec3 v) {
+    ak_mat3 m = {{0.0f, v.z, -v.y, -v.z, 0.0f, v.x, v.y, -v.x, 0.0f}};
+    return m;
+}
+
+/* Move anchor points pa (on a, offset ra) and pb (on b, offset rb) together by e = pb - pa
+ * with compliance alpha (m/N), all three directions at once: the impulse p = K^-1 e with K =
+ * (1/m_a + 1/m_b + alpha/h^2) 1 - [ra]x Ia^-1 [ra]x - [rb]x Ib^-1 [rb]x moves the anchors by
+ * exactly e to first order. (Solving along e alone, as for a contact, turns a body whose
+ * rotation is cheap about its centre: the anchor then also moves across e, and a pendulum of a
+ * small ball on a long arm spins up 70 times too fast.) */
+static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 e, float alpha) {
+    if (ak_vec3_length_sq(e) < 1e-18f) return;
+    float lin = (s->awake[a] ? s->bodies[a].inv_mass : 0.0f) + (s->awake[b] ? s->bodies[b].inv_mass : 0.0f) +
+                alpha / (s->h * s->h);
+    ak_mat3 sa = skew(ra), sb = skew(rb);
+    ak_mat3 k = ak_mat3_scale(ak_mat3_identity(), lin);
+    k = ak_mat3_add(k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sa, inv_inertia_world(s, a)), sa), -1.0f));
+    k = ak_mat3_add(k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sb, inv_inertia_world(s, b)), sb), -1.0f));
+    float det = ak_mat3_determinant(k);
+    if (!(fabsf(det) > 1e-30f) || !ak_finitef(det)) return;
+    ak_vec3 p = ak_mat3_mul_vec3(ak_mat3_inverse(k), e);
+    apply_position_impulse(s, a, ra, p, 1.0f);
+    apply_position_impulse(s, b, rb, p, -1.0f);
+}
+
+/* Rotate a by (its share of) the rotation vector e and b by the opposite, so that a's frame
+ * turns towards b's: lambda = |e| / (w_a + w_b + alpha / h^2), w = n^T I^-1 n. */
+static void joint_rotation(solver* s, uint32_t a, uint32_t b, ak_vec3 e, float alpha) {
+    float c = ak_vec3_length(e);
+    if (c < 1e-9f) return;
+    ak_vec3 n = ak_vec3_scale(e, 1.0f / c);
+    float w = gen_inv_inertia(s, a, n) + gen_inv_inertia(s, b, n) + alpha / (s->h * s->h);
+    if (!(w > 0.0f)) return;
+    ak_vec3 p = ak_vec3_scale(n, c / w);
+    apply_angular_impulse(s, a, p, 1.0f);
+    apply_angular_impulse(s, b, p, -1.0f);
+}
+
+/* The rotation vector that turns a's frame times target onto b's orientation. */
+static ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
+    ak_quat dq = ak_quat_mul(qb, ak_quat_conjugate(ak_quat_mul(qa, target)));
+    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
+    return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
+}
+
+static void solve_joints(solver* s) {
+    const ak_rigid_model* m = s->m;
+    for (size_t k = 0; k < m->joint_count; ++k) {
+        const rigid_joint* j = &m->joints[k];
+        uint32_t a = j->a, b = j->b;
+        if (!s->awake[a] && !s->awake[b]) continue;
+        float alpha = j->compliance;
+        /* orientation first (it moves the anchors), then the anchors */
+        if (j->type == AK_RIGID_JOINT_FIXED || j->type == AK_RIGID_JOINT_PRISMATIC)
+            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->rel), alpha);
+        if (j->type == AK_RIGID_JOINT_HINGE) {
+            ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a), a2 = ak_quat_rotate(s->q[b], j->axis_b);
+            joint_rotation(s, a, b, ak_vec3_cross(a1, a2), alpha);
+            if (j->limited) {
+                float phi = akp_rigid_hinge_angle(j, s->q[a], s->q[b]);
+                float target = ak_clampf(phi, j->lower, j->upper);
+                if (phi != target) joint_rotation(s, a, b, ak_vec3_scale(ak_quat_rotate(s->q[a], j->axis_a), phi - target), 0.0f);
+            }
+        }
+        if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
+            ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a), a2 = ak_quat_rotate(s->q[b], j->axis_b);
+            ak_vec3 cr = ak_vec3_cross(a1, a2);
+            float sn = ak_vec3_length(cr), swing = atan2f(sn, ak_vec3_dot(a1, a2));
+            if (swing > j->upper && sn > 1e-9f) joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f);
+        }
+        if (j->drive && j->type != AK_RIGID_JOINT_FIXED && j->type != AK_RIGID_JOINT_PRISMATIC)
+            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->drive_target), j->drive_compliance);
+        ak_vec3 ra = ak_quat_rotate(s->q[a], j->la), rb = ak_quat_rotate(s->q[b], j->lb);
+        ak_vec3 e = ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra));
+        if (j->type == AK_RIGID_JOINT_PRISMATIC) {
+            ak_vec3 ax = ak_quat_rotate(s->q[a], j->axis_a);
+            float off = ak_vec3_dot(e, ax);
+            float keep = j->limited ? ak_clampf(off, j->lower, j->upper) : off;
+            e = ak_vec3_madd(e, ax, -keep);
+        }
+        joint_position(s, a, b, ra, rb, e, alpha);
+    }
+}
+
+/* True when bodies a and b are joined (jointed bodies do not collide with each other). */
+static bool joined(const ak_rigid_model* m, uint32_t a, uint32_t b) {
+    for (size_t k = 0; k < m->joint_count; ++k) {
+        const rigid_joint* j = &m->joints[k];
+        if ((j->a == a && j->b == b) || (j->a == b && j->b == a)) return true;
+    }
+    return false;
+}
+
 static void update_velocities(solver* s) {
     float inv_h = 1.0f / s->h;
     for (uint32_t i = 0; i < (uint32_t)s->m->body_count; ++i) {
@@ -521,6 +627,12 @@ static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_
         uint32_t ra = uf_find(parent, a), rb = uf_find(parent, b);
         if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
     }
+    for (size_t k = 0; k < s->m->joint_count; ++k) {
+        uint32_t a = s->m->joints[k].a, b = s->m->joints[k].b;
+        if (s->bodies[a].inv_mass == 0.0f || s->bodies[b].inv_mass == 0.0f) continue;
+        uint32_t ra = uf_find(parent, a), rb = uf_find(parent, b);
+        if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    }
     /* a group sleeps when its least sleepy body has been slow long enough; otherwise every
      * body of it is awake. Roots hold the group's minimum timer in a second pass. */
     for (uint32_t i = 0; i < n; ++i) {
@@ -581,6 +693,7 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping);
         find_contacts(&s, (sap_entry*)(base + l.sap), &cb, margin);
         order_groups(&s, &cb, up);
+        solve_joints(&s);
         solve_positions(&s, &cb);
         update_velocities(&s);
         solve_velocities(&s, &cb, gmag);
