@@ -28,9 +28,11 @@
  *   - joints: ball (optional swing cone), hinge (optional angle limits), fixed, prismatic
  *     (optional distance limits), with compliance, and drives towards a target relative
  *     orientation (XPBD positional and angular constraints, their section 3.3);
+ *   - ragdolls: a capsule per bone of a skeleton and a joint per joint with the skeleton's
+ *     limits, started from an animated pose (and its velocities), written back as a pose;
  *
  * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
- * twist limits on ball joints, ragdolls built from a skeleton, continuous collision detection (a body moving more than its size in one
+ * capsule sizes from a skin, a powered ragdoll, continuous collision detection (a body moving more than its size in one
  * substep can tunnel), collisions with particles or cloth.
  *
  * Usage (a box dropped on the ground):
@@ -100,6 +102,8 @@ typedef struct ak_rigid_body_desc {
                                  AK_RIGID_FRICTIONLESS -> 0 */
     float restitution;        /* normal velocity kept in a bounce, [0, 1]; 0 -> none */
     bool is_static;           /* infinite mass, never moves (planes always are) */
+    uint32_t collision_group; /* bodies sharing a nonzero group do not collide with each other
+                                 (a ragdoll's limbs); 0 -> collides with every body */
 } ak_rigid_body_desc;
 
 AK_DEFINE_SPAN(rigid_body_desc, ak_rigid_body_desc)
@@ -122,6 +126,13 @@ typedef struct ak_rigid_joint_desc {
     ak_vec3 anchor;            /* world point where the bodies are joined */
     ak_vec3 axis;              /* world: hinge axis, prismatic slide axis, ball's swing axis;
                                   zero -> (0, 0, 1) */
+    ak_vec3 axis_b;            /* world: the axis as body b carries it, when b's zero-swing
+                                  pose differs from the built one (ball swing); zero -> axis */
+    float angle_offset;        /* hinge: the built pose's angle (rad) in the limits' measure:
+                                  the limits apply to angle + angle_offset; ball: the same for
+                                  the twist; 0 -> as built is 0 */
+    bool twist_limited;        /* ball: twist_lower <= twist about the axis <= twist_upper */
+    float twist_lower, twist_upper; /* radians */
     bool limited;              /* hinge: lower <= angle <= upper; prismatic: lower <= offset
                                   <= upper; ball: swing (angle between the bodies' axes) <= upper */
     float lower, upper;        /* radians (hinge, ball) or metres (prismatic), as built = 0 */
@@ -197,6 +208,59 @@ AK_API double ak_rigid_energy(const ak_rigid_model* model, ak_vec3 gravity, ak_v
 /* World angular momentum (kg m^2/s) of one body about its centre of mass: R I R^T w. */
 AK_API ak_vec3 ak_rigid_angular_momentum(const ak_rigid_model* model, size_t body_index,
                                          ak_quat orientation, ak_vec3 angular_velocity);
+
+/* ---- ragdolls ------------------------------------------------------------------------- */
+
+struct ak_skeleton;
+
+/* How one skeleton joint maps onto the ragdoll's bodies. */
+typedef struct ak_rigid_ragdoll_bone {
+    int32_t body;          /* index into the model's bodies (body_offset included), or -1 for
+                              a joint without a body (a leaf: it keeps its local transform) */
+    ak_vec3 offset;        /* the joint's position in its body's frame (m) */
+    ak_quat rotation;      /* the joint's model rotation in its body's frame */
+} ak_rigid_ragdoll_bone;
+
+AK_DEFINE_SPAN(rigid_ragdoll_bone, ak_rigid_ragdoll_bone)
+
+typedef struct ak_rigid_ragdoll_desc {
+    const struct ak_skeleton* skeleton; /* required */
+    ak_transform_cspan local_pose;      /* the start pose, local transforms (required) */
+    ak_transform_cspan previous_pose;   /* optional: the pose `previous_dt` earlier, for the
+                                           bodies' start velocities; empty -> at rest */
+    float previous_dt;                  /* seconds; > 0 when previous_pose is given */
+    ak_mat4 root;                       /* world transform above the skeleton; zero -> identity */
+    uint32_t body_offset;               /* index the ragdoll's first body will have */
+    float radius_scale;                 /* capsule radius / bone length; 0 -> 0.2 */
+    float max_radius;                   /* metres; 0 -> 0.1 */
+    float density;                      /* kg/m^3; 0 -> 1000 */
+    float friction;                     /* 0 -> 0.5 */
+    uint32_t collision_group;           /* the limbs' group (no self-collision); 0 -> 1 */
+} ak_rigid_ragdoll_desc;
+
+/* Bodies and joints a ragdoll of this skeleton has: one capsule per joint with children (from
+ * the joint to the mean of its children's positions), one joint per such body whose joint has
+ * a parent. 0 for NULL. */
+AK_API size_t ak_rigid_ragdoll_body_count(const struct ak_skeleton* skeleton);
+AK_API size_t ak_rigid_ragdoll_joint_count(const struct ak_skeleton* skeleton);
+
+/* Build a ragdoll's body and joint descs (to put in an ak_rigid_model_desc, after body_offset
+ * other bodies) and the joint-to-body map. Skeleton joint types become rigid joints: hinge ->
+ * hinge with its limits, ball -> ball with its cone, free -> ball, prism -> prismatic; limits are
+ * taken relative to the skeleton's rest pose as the skeleton measures them. Sizes: out_bodies
+ * >= body count, out_joints >= joint count, out_bones >= skeleton joint count. Returns
+ * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_ARG (previous_pose without previous_dt > 0,
+ * negative sizes), AK_ERR_BAD_DATA (a non-finite pose). */
+AK_API ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc, ak_rigid_body_desc_span out_bodies,
+                                        ak_rigid_joint_desc_span out_joints, ak_rigid_ragdoll_bone_span out_bones);
+
+/* The ragdoll's bodies written back as a skeleton pose: local transforms (scale from
+ * fallback_pose) so that skinning and export work unchanged. Joints without a body keep
+ * fallback_pose's local transform. root as in the desc. Sizes >= skeleton joint count.
+ * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX (a bone's body out of the state). */
+AK_API ak_result ak_rigid_ragdoll_pose(const struct ak_skeleton* skeleton, ak_rigid_ragdoll_bone_cspan bones,
+                                       ak_mat4 root, ak_vec3_cspan positions, ak_quat_cspan orientations,
+                                       ak_transform_cspan fallback_pose, ak_transform_span out_local_pose);
 
 /* ---- step ------------------------------------------------------------------------------ */
 

@@ -130,9 +130,10 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         if ((unsigned)jd->type >= AK_RIGID_JOINT_TYPE_COUNT) return AK_ERR_BAD_ARG;
         if (jd->body_a >= n || jd->body_b >= n || jd->body_a == jd->body_b) return AK_ERR_BAD_INDEX;
         if (!vec_finite(jd->anchor) || !vec_finite(jd->axis) || !ak_finitef(jd->lower) || !ak_finitef(jd->upper) ||
-            !ak_finitef(jd->compliance) || !ak_quat_is_finite(jd->drive_target) || !ak_finitef(jd->drive_compliance))
+            !ak_finitef(jd->compliance) || !vec_finite(jd->axis_b) || !ak_finitef(jd->angle_offset) || !ak_quat_is_finite(jd->drive_target) || !ak_finitef(jd->drive_compliance))
             return AK_ERR_BAD_DATA;
-        if ((jd->limited && jd->lower > jd->upper) || jd->compliance < 0.0f || jd->drive_compliance < 0.0f)
+        if (!ak_finitef(jd->twist_lower) || !ak_finitef(jd->twist_upper)) return AK_ERR_BAD_DATA;
+        if ((jd->twist_limited && jd->twist_lower > jd->twist_upper) || (jd->limited && jd->lower > jd->upper) || jd->compliance < 0.0f || jd->drive_compliance < 0.0f)
             return AK_ERR_BAD_ARG;
     }
     ak_allocator al = {def_alloc, def_free, NULL};
@@ -171,6 +172,7 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         b->friction = d.friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.friction;
         b->dynamic_friction = d.dynamic_friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.dynamic_friction;
         b->restitution = d.restitution;
+        b->group = d.collision_group;
         b->shape = d.shape;
         double volume;
         ak_vec3 ipm;
@@ -219,9 +221,16 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         j->la = ak_quat_rotate(ia, ak_vec3_sub(jd->anchor, da->position));
         j->lb = ak_quat_rotate(ib, ak_vec3_sub(jd->anchor, db->position));
         j->axis_a = ak_quat_rotate(ia, axis);
-        j->axis_b = ak_quat_rotate(ib, axis);
+        ak_vec3 axis2 = ak_vec3_length_sq(jd->axis_b) > 0.0f ? ak_vec3_normalize(jd->axis_b) : axis;
+        j->axis_b = ak_quat_rotate(ib, jd->type == AK_RIGID_JOINT_BALL ? axis2 : axis);
         j->perp_a = ak_quat_rotate(ia, perp);
-        j->perp_b = ak_quat_rotate(ib, perp);
+        /* b's reference direction: a's swung onto b's axis (the swing of a swing-twist split) */
+        ak_vec3 perp2 = ak_vec3_normalize(ak_quat_rotate(ak_quat_from_to(axis, axis2), perp));
+        j->perp_b = ak_quat_rotate(ib, jd->type == AK_RIGID_JOINT_BALL ? perp2 : perp);
+        ak_quat fwa = ak_quat_from_mat3(ak_mat3_from_cols(perp, axis, ak_vec3_cross(perp, axis)));
+        ak_quat fwb = ak_quat_from_mat3(ak_mat3_from_cols(perp2, axis2, ak_vec3_cross(perp2, axis2)));
+        j->frame_a = ak_quat_normalize(ak_quat_mul(ia, fwa));
+        j->frame_b = ak_quat_normalize(ak_quat_mul(ib, fwb));
         j->rel = ak_quat_normalize(ak_quat_mul(ia, db->orientation));
         j->drive_target = ak_quat_dot(jd->drive_target, jd->drive_target) > 0.0f ? ak_quat_normalize(jd->drive_target) : j->rel;
         j->limited = jd->limited;
@@ -230,6 +239,10 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         j->upper = jd->upper;
         j->compliance = jd->compliance;
         j->drive_compliance = jd->drive_compliance;
+        j->angle_offset = jd->angle_offset;
+        j->twist_limited = jd->twist_limited;
+        j->twist_lower = jd->twist_lower;
+        j->twist_upper = jd->twist_upper;
     }
     m->desc.joints = (ak_rigid_joint_desc_cspan){NULL, 0};
     *out_model = m;
@@ -317,9 +330,15 @@ ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t i, ak_vec3_cs
         d = ak_vec3_madd(d, ax, -s);
         if (j->limited) excess = ak_maxf(j->lower - s, s - j->upper);
     } else if (j->type == AK_RIGID_JOINT_HINGE && j->limited) {
-        float phi = akp_rigid_hinge_angle(j, qa, qb);
+        float phi = akp_rigid_hinge_angle(j, qa, qb) + j->angle_offset;
         excess = ak_maxf(j->lower - phi, phi - j->upper);
-    } else if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
+    }
+    if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited) {
+        ak_vec3 n;
+        float tw = akp_rigid_twist_angle(j, qa, qb, &n) + j->angle_offset;
+        excess = ak_maxf(excess, ak_maxf(j->twist_lower - tw, tw - j->twist_upper));
+    }
+    if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
         ak_vec3 a1 = ak_quat_rotate(qa, j->axis_a), a2 = ak_quat_rotate(qb, j->axis_b);
         float swing = atan2f(ak_vec3_length(ak_vec3_cross(a1, a2)), ak_vec3_dot(a1, a2));
         excess = swing - j->upper;

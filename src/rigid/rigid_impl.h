@@ -17,6 +17,7 @@ typedef struct rigid_body {
     float dynamic_friction; /* dynamic mu, resolved */
     float restitution;
     float bound_radius;     /* metres from the centre that holds the shape (planes: INFINITY) */
+    uint32_t group;         /* collision group (0: none) */
 } rigid_body;
 
 /* A joint with its anchors and axes in each body's frame (from the descs' poses). */
@@ -28,8 +29,9 @@ typedef struct rigid_joint {
     ak_vec3 perp_a, perp_b;  /* a reference direction perpendicular to it, in each frame */
     ak_quat rel;             /* b's orientation in a's frame as built */
     ak_quat drive_target;    /* b's orientation in a's frame the drive aims at */
-    bool limited, drive;
-    float lower, upper, compliance, drive_compliance;
+    ak_quat frame_a, frame_b; /* ball: joint frames (Y along the axis) in each body */
+    bool limited, drive, twist_limited;
+    float lower, upper, compliance, drive_compliance, angle_offset, twist_lower, twist_upper;
 } rigid_joint;
 
 /* Signed angle (rad) of body b about the hinge axis relative to a, zero as built. */
@@ -37,6 +39,19 @@ static inline float akp_rigid_hinge_angle(const rigid_joint* j, ak_quat qa, ak_q
     ak_vec3 n = ak_quat_rotate(qa, j->axis_a);
     ak_vec3 b1 = ak_quat_rotate(qa, j->perp_a), b2 = ak_quat_rotate(qb, j->perp_b);
     return atan2f(ak_vec3_dot(ak_vec3_cross(b1, b2), n), ak_vec3_dot(b1, b2));
+}
+
+/* Twist (rad) of b relative to a (ball joints), as a swing-twist decomposition measures it:
+ * rel = (qa frame_a)^-1 (qb frame_b) = swing * twist with the twist about the frames' Y (the
+ * joint axis); zero as built. *out_n gets the twist axis in the world (b's axis). */
+static inline float akp_rigid_twist_angle(const rigid_joint* j, ak_quat qa, ak_quat qb, ak_vec3* out_n) {
+    ak_quat fa = ak_quat_mul(qa, j->frame_a), fb = ak_quat_mul(qb, j->frame_b);
+    ak_quat rel = ak_quat_mul(ak_quat_conjugate(fa), fb);
+    *out_n = ak_quat_rotate(fb, ak_vec3_make(0.0f, 1.0f, 0.0f));
+    float t = 2.0f * atan2f(rel.y, rel.w);
+    if (t > 3.14159265f) t -= 6.2831853f;
+    if (t < -3.14159265f) t += 6.2831853f;
+    return t;
 }
 
 struct ak_rigid_model {

@@ -255,6 +255,7 @@ static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float marg
             if (!s->awake[a] && !s->awake[b]) continue;
             float rr = s->bodies[a].bound_radius + s->bodies[b].bound_radius + margin;
             if (ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b])) > rr * rr) continue;
+            if (s->bodies[a].group != 0 && s->bodies[a].group == s->bodies[b].group) continue;
             if (m->joint_count && joined(m, a, b)) continue;
             /* the awake (or lower-index) body first, so a static body is always b */
             if (!s->awake[a] || (s->awake[b] && b < a)) narrow(s, cb, b, a, margin);
@@ -488,14 +489,24 @@ static void solve_joints(solver* s) {
         uint32_t a = j->a, b = j->b;
         if (!s->awake[a] && !s->awake[b]) continue;
         float alpha = j->compliance;
-        /* orientation first (it moves the anchors), then the anchors */
+        /* the anchors first, then the orientation parts (limits last, so a sweep ends with
+         * them met: anchors moved by a limit's pure rotation come back in the next sweep) */
+        ak_vec3 ra = ak_quat_rotate(s->q[a], j->la), rb = ak_quat_rotate(s->q[b], j->lb);
+        ak_vec3 e = ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra));
+        if (j->type == AK_RIGID_JOINT_PRISMATIC) {
+            ak_vec3 ax = ak_quat_rotate(s->q[a], j->axis_a);
+            float off = ak_vec3_dot(e, ax);
+            float keep = j->limited ? ak_clampf(off, j->lower, j->upper) : off;
+            e = ak_vec3_madd(e, ax, -keep);
+        }
+        joint_position(s, a, b, ra, rb, e, alpha);
         if (j->type == AK_RIGID_JOINT_FIXED || j->type == AK_RIGID_JOINT_PRISMATIC)
             joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->rel), alpha);
         if (j->type == AK_RIGID_JOINT_HINGE) {
             ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a), a2 = ak_quat_rotate(s->q[b], j->axis_b);
             joint_rotation(s, a, b, ak_vec3_cross(a1, a2), alpha);
             if (j->limited) {
-                float phi = akp_rigid_hinge_angle(j, s->q[a], s->q[b]);
+                float phi = akp_rigid_hinge_angle(j, s->q[a], s->q[b]) + j->angle_offset;
                 float target = ak_clampf(phi, j->lower, j->upper);
                 if (phi != target) joint_rotation(s, a, b, ak_vec3_scale(ak_quat_rotate(s->q[a], j->axis_a), phi - target), 0.0f);
             }
@@ -506,17 +517,14 @@ static void solve_joints(solver* s) {
             float sn = ak_vec3_length(cr), swing = atan2f(sn, ak_vec3_dot(a1, a2));
             if (swing > j->upper && sn > 1e-9f) joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f);
         }
+        if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited) {
+            ak_vec3 n;
+            float tw = akp_rigid_twist_angle(j, s->q[a], s->q[b], &n) + j->angle_offset;
+            float target = ak_clampf(tw, j->twist_lower, j->twist_upper);
+            if (tw != target) joint_rotation(s, a, b, ak_vec3_scale(n, tw - target), 0.0f);
+        }
         if (j->drive && j->type != AK_RIGID_JOINT_FIXED && j->type != AK_RIGID_JOINT_PRISMATIC)
             joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->drive_target), j->drive_compliance);
-        ak_vec3 ra = ak_quat_rotate(s->q[a], j->la), rb = ak_quat_rotate(s->q[b], j->lb);
-        ak_vec3 e = ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra));
-        if (j->type == AK_RIGID_JOINT_PRISMATIC) {
-            ak_vec3 ax = ak_quat_rotate(s->q[a], j->axis_a);
-            float off = ak_vec3_dot(e, ax);
-            float keep = j->limited ? ak_clampf(off, j->lower, j->upper) : off;
-            e = ak_vec3_madd(e, ax, -keep);
-        }
-        joint_position(s, a, b, ra, rb, e, alpha);
     }
 }
 
@@ -693,8 +701,12 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping);
         find_contacts(&s, (sap_entry*)(base + l.sap), &cb, margin);
         order_groups(&s, &cb, up);
+        /* joints, contacts, then four more sweeps over the joints: contacts solved last would
+         * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
+         * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
         solve_joints(&s);
         solve_positions(&s, &cb);
+        for (int it = 0; it < 8 && m->joint_count; ++it) solve_joints(&s);
         update_velocities(&s);
         solve_velocities(&s, &cb, gmag);
     }
