@@ -14,10 +14,10 @@ static const char* const usage =
     "usage: animkit rigid [SCENE.json | --preset stack|pyramid|dominoes|avalanche|ragdoll|incline]\n"
     "                     [--steps N] [--dt DT] [--substeps S] [--threads T] [--json OUT.json]\n"
     "                     [-o OUT.gif|OUT.png|OUT.glb]\n"
-    "Simulate rigid bodies (spheres, boxes, capsules, static planes) with XPBD substeps, contacts,\n"
-    "Coulomb friction and restitution: a 10-box stack, a 20-layer pyramid, dominoes, an avalanche\n"
-    "down a slope, boxes on an incline; or the scene a JSON file describes (docs/rigid.md lists\n"
-    "every key). --json writes {\"time\", \"bodies\": [{\"position\", \"orientation\", \"velocity\",\n"
+    "Simulate rigid bodies (spheres, boxes, capsules, static planes) and joints with XPBD substeps,\n"
+    "contacts, Coulomb friction and restitution: a 10-box stack, a 20-layer pyramid, dominoes, an\n"
+    "avalanche down a slope, builtin:humanoid as a ragdoll, boxes on an incline; or the scene a\n"
+    "JSON file describes (docs/rigid.md lists every key). --json writes {\"time\", \"bodies\": [{\"position\", \"orientation\", \"velocity\",\n"
     "\"angular_velocity\"}], \"max_penetration\", \"energy\"} of the final state (world space);\n"
     "-o renders the run (GIF), its last frame (PNG), or bakes it as glTF (.glb).\n"
     "Exit status: 0 success, 1 bad scene or a blow-up (named by its step), 2 bad usage.\n";
@@ -169,8 +169,6 @@ int cmd_rigid(int argc, char** argv) {
     rigid_scene sc;
     const char* name = preset ? preset : a.pos[0];
     if (preset) {
-        if (strcmp(preset, "ragdoll") == 0)
-            return cli_fail("rigid", "preset 'ragdoll' needs joints, which this version does not have yet");
         if (!rigid_scene_preset(preset, &sc)) {
             rigid_scene_free(&sc);
             return cli_usage("rigid", "unknown preset '%s' (stack, pyramid, dominoes, avalanche, ragdoll, incline)", preset);
@@ -234,6 +232,7 @@ int cmd_rigid(int argc, char** argv) {
 
     ak_rigid_model_desc md = sc.model;
     md.bodies = (ak_rigid_body_desc_cspan){sc.bodies, n};
+    md.joints = (ak_rigid_joint_desc_cspan){sc.joints, sc.joint_count};
     ak_result r = ak_rigid_model_create(&md, NULL, &model);
     if (r != AK_OK) {
         rc = cli_fail("rigid", "%s: the bodies cannot be built: %s", name, ak_result_string(r));
@@ -330,8 +329,8 @@ int cmd_rigid(int argc, char** argv) {
     if (bake.cap && (rc = sim_bake_mesh_write(&bake, preset ? preset : "rigid", sc.dt, (ak_u32_cspan){mesh.idx, mesh.icount},
                                               ak_vec4_make(0.80f, 0.55f, 0.25f, 1))))
         goto done;
-    printf("rigid %s: %zu bodies, %ld steps of %.4g s (%u substeps): t = %.3g s, max penetration %.3g m, energy %.6g J\n",
-           name, n, sc.steps, (double)sc.dt, sc.substeps, (double)time, (double)pen, energy);
+    printf("rigid %s: %zu bodies, %zu joints, %ld steps of %.4g s (%u substeps): t = %.3g s, max penetration %.3g m, energy %.6g J\n",
+           name, n, sc.joint_count, sc.steps, (double)sc.dt, sc.substeps, (double)time, (double)pen, energy);
     if (gif) cli_wrote(out, "%d frames", frames);
     else if (bake.cap) cli_wrote(out, "%zu frames, %.4g s apart", bake.frames, (double)sc.dt * (double)bake.every);
     else if (out) cli_wrote(out, NULL);

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <animkit/animkit.h>
+
 #include "cli_json.h"
 #include "scene_rigid.h"
 
@@ -21,8 +23,11 @@ void rigid_scene_defaults(rigid_scene* s) {
 
 void rigid_scene_free(rigid_scene* s) {
     free(s->bodies);
+    free(s->joints);
     s->bodies = NULL;
     s->body_count = 0;
+    s->joints = NULL;
+    s->joint_count = 0;
 }
 
 /* A body with the scene file's defaults (density 1000, friction 0.5, restitution 0). */
@@ -115,6 +120,42 @@ static void parse_body(cli_json* j, const cJSON* e, const char* path, ak_rigid_b
     cli_json_bool(j, e, path, "static", &b->is_static);
 }
 
+static void parse_joint(cli_json* j, const cJSON* e, const char* path, size_t body_count, ak_rigid_joint_desc* d) {
+    if (!cJSON_IsObject(e)) {
+        cli_json_fail(j, path, "", "expected an object with \"type\" and \"bodies\"");
+        return;
+    }
+    static const char* const keys[] = {"type", "bodies", "anchor", "axis", "limits", "compliance", NULL};
+    static const char* const types[] = {"ball", "hinge", "fixed", "prismatic", NULL};
+    cli_json_object(j, e, path, keys);
+    memset(d, 0, sizeof *d);
+    int type = -1;
+    cli_json_enum(j, e, path, "type", types, &type);
+    if (!j->failed && type < 0) cli_json_fail(j, path, "type", "is required (ball, hinge, fixed or prismatic)");
+    d->type = (ak_rigid_joint_type)(type < 0 ? 0 : type);
+    float ab[2] = {-1.0f, -1.0f};
+    cli_json_floats(j, e, path, "bodies", 2, 0.0f, (float)RIGID_SCENE_MAX_BODIES, ab);
+    if (!j->failed && ab[0] < 0.0f) cli_json_fail(j, path, "bodies", "is required: [a, b], two body indices");
+    if (!j->failed && (ab[0] != floorf(ab[0]) || ab[1] != floorf(ab[1])))
+        cli_json_fail(j, path, "bodies", "expected two whole body indices");
+    if (!j->failed && (ab[0] >= (float)body_count || ab[1] >= (float)body_count))
+        cli_json_fail(j, path, "bodies", "a body index is out of range (the scene has %zu bodies)", body_count);
+    if (!j->failed && ab[0] == ab[1]) cli_json_fail(j, path, "bodies", "joins a body to itself");
+    d->body_a = (uint32_t)ab[0], d->body_b = (uint32_t)ab[1];
+    cli_json_vec3(j, e, path, "anchor", &d->anchor);
+    d->axis = ak_vec3_make(0.0f, 0.0f, 1.0f);
+    cli_json_vec3(j, e, path, "axis", &d->axis);
+    if (!j->failed && (ak_vec3_length(d->anchor) > 1e6f || ak_vec3_length(d->axis) < 1e-6f))
+        cli_json_fail(j, path, "", "anchor over 1e6 m or a zero axis");
+    float lim[2] = {0.0f, 0.0f};
+    d->limited = cJSON_GetObjectItemCaseSensitive(e, "limits") != NULL;
+    cli_json_floats(j, e, path, "limits", 2, -1e3f, 1e3f, lim);
+    if (!j->failed && d->limited && lim[0] > lim[1]) cli_json_fail(j, path, "limits", "lower is above upper");
+    if (!j->failed && d->limited && d->type == AK_RIGID_JOINT_FIXED) cli_json_fail(j, path, "limits", "does not apply to a fixed joint");
+    d->lower = lim[0], d->upper = lim[1];
+    cli_json_float(j, e, path, "compliance", 0.0f, 1e3f, &d->compliance);
+}
+
 bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_scene* s, char* msg, size_t cap) {
     rigid_scene_defaults(s);
     if (cap) msg[0] = '\0';
@@ -136,9 +177,6 @@ bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_sc
         cli_json_float(&j, root, "", "angular_damping", 0.0f, 1e3f, &s->model.angular_damping);
         cli_json_float(&j, root, "", "contact_offset", 1e-5f, 1.0f, &s->model.contact_offset);
         cli_json_bool(&j, root, "", "sleep", &s->sleep);
-        size_t nj = 0;
-        cli_json_array(&j, root, "", "joints", 1000000, &nj);
-        if (!j.failed && nj > 0) cli_json_fail(&j, "", "joints", "joints are not supported yet (leave the array empty)");
         size_t n = 0;
         const cJSON* e = cli_json_array(&j, root, "", "bodies", RIGID_SCENE_MAX_BODIES, &n);
         if (!j.failed && n == 0) cli_json_fail(&j, "", "bodies", "is required and must hold at least one body");
@@ -151,6 +189,18 @@ bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_sc
             cli_json_index(path, sizeof path, "bodies", k);
             parse_body(&j, e, path, &s->bodies[k]);
             s->body_count = k + 1;
+        }
+        size_t nj = 0;
+        const cJSON* je = cli_json_array(&j, root, "", "joints", RIGID_SCENE_MAX_JOINTS, &nj);
+        if (!j.failed && nj > 0) {
+            s->joints = calloc(nj, sizeof *s->joints);
+            if (!s->joints) cli_json_fail(&j, "", "joints", "out of memory");
+        }
+        for (size_t k = 0; je && !j.failed; je = je->next, ++k) {
+            char path[48];
+            cli_json_index(path, sizeof path, "joints", k);
+            parse_joint(&j, je, path, s->body_count, &s->joints[k]);
+            s->joint_count = k + 1;
         }
         cJSON_Delete(root);
     }
@@ -247,6 +297,43 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         }
         s->steps = 300;
         return true;
+    }
+    if (strcmp(name, "ragdoll") == 0) {
+        /* builtin:humanoid as a ragdoll, dropped from 1 m in the middle of its walk (the pose
+         * and its velocities), onto the ground */
+        ak_scene* sc = NULL;
+        ak_builtin_desc bd = {.cell_size = 0.1f};
+        if (ak_builtin_create("humanoid", &bd, NULL, &sc) != AK_OK) return false;
+        const ak_skeleton* sk = sc->skeleton;
+        size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk), nj = ak_rigid_ragdoll_joint_count(sk);
+        ak_transform* pose = calloc(2 * n, sizeof *pose);
+        ak_rigid_ragdoll_bone* bones = calloc(n, sizeof *bones);
+        s->joints = calloc(nj + 1, sizeof *s->joints);
+        bool ok = pose && bones && s->joints && presize(s, nb + 1);
+        if (ok) {
+            ak_scene_rest_pose(sc, (ak_transform_span){pose, n});
+            ak_scene_rest_pose(sc, (ak_transform_span){pose + n, n});
+            if (sc->clip_count > 0) {
+                float t = 0.3f * ak_clip_duration(sc->clips[0]);
+                ak_clip_sample(sc->clips[0], t, NULL, (ak_transform_span){pose, n}, (ak_f32_span){0}, (ak_f32_span){0});
+                ak_clip_sample(sc->clips[0], t - s->dt, NULL, (ak_transform_span){pose + n, n}, (ak_f32_span){0},
+                               (ak_f32_span){0});
+            }
+            ground(&s->bodies[0]);
+            ak_rigid_ragdoll_desc rd = {.skeleton = sk, .local_pose = {pose, n}, .previous_pose = {pose + n, n},
+                                        .previous_dt = s->dt, .root = ak_mat4_translation(ak_vec3_make(0.0f, 1.0f, 0.0f)),
+                                        .body_offset = 1};
+            ok = ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){s->bodies + 1, nb},
+                                        (ak_rigid_joint_desc_span){s->joints, nj}, (ak_rigid_ragdoll_bone_span){bones, n}) == AK_OK;
+            s->joint_count = nj;
+        }
+        free(pose);
+        free(bones);
+        ak_scene_destroy(sc);
+        if (!ok) rigid_scene_free(s);
+        s->substeps = 40;
+        s->steps = 180;
+        return ok;
     }
     if (strcmp(name, "incline") == 0) {
         /* a box at rest on a 30 degree slope with friction 0.3 (< tan 30 = 0.577): it slides at

@@ -11,10 +11,13 @@
 /* Budgets: a scene file cannot ask for more than this. */
 #define RIGID_SCENE_MAX_BODIES 100000
 #define RIGID_SCENE_MAX_STEPS 1000000L
+#define RIGID_SCENE_MAX_JOINTS 100000
 
 typedef struct rigid_scene {
     ak_rigid_body_desc* bodies; /* [body_count], scene order */
     size_t body_count;
+    ak_rigid_joint_desc* joints; /* [joint_count] */
+    size_t joint_count;
     ak_rigid_model_desc model;  /* damping, contact offset (bodies filled by the caller) */
     ak_vec3 gravity;            /* m/s^2 */
     float dt;                   /* seconds per step */
@@ -31,8 +34,8 @@ void rigid_scene_free(rigid_scene* s);
 /* Parse text[0, size) of file `file`. On failure returns false with "FILE: KEY.PATH: problem"
  * in msg (cap bytes) and s freed. */
 bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_scene* s, char* msg, size_t cap);
-/* A built-in preset: stack, pyramid, dominoes, avalanche, incline. False (s empty) for an
- * unknown name. */
+/* A built-in preset: stack, pyramid, dominoes, avalanche, ragdoll, incline. False (s empty)
+ * for an unknown name (or when the ragdoll's character cannot be built). */
 bool rigid_scene_preset(const char* name, rigid_scene* s);
 
 #endif
