@@ -118,10 +118,33 @@ AK_TEST(bad_scenes_name_the_key) {
     }
 }
 
+/* Dominoes fall in order: after 6 s every domino but the last two has tipped, and each is tipped
+ * at least as far as the one after it (the wave runs from the first to the last). */
+AK_TEST(dominoes_fall_in_order) {
+    AK_CHECK_EQ(run("rigid --preset dominoes --json rigid_dominoes.json", true), 0);
+    cJSON* j = read_json("rigid_dominoes.json");
+    AK_CHECK(j != NULL);
+    if (!j) return;
+    const cJSON* bodies = cJSON_GetObjectItemCaseSensitive(j, "bodies");
+    int n = cJSON_GetArraySize(bodies);
+    AK_CHECK_EQ(n, 21);
+    double prev = 180.0;
+    for (int i = 1; i < n; ++i) {
+        const cJSON* o = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(bodies, i), "orientation");
+        double w = fabs(cJSON_GetArrayItem(o, 3)->valuedouble);
+        double tilt = 2.0 * acos(w < 1.0 ? w : 1.0) * 180.0 / 3.14159265358979;
+        if (i <= n - 3) AK_CHECK_MSG(tilt > 30.0, "domino %d tilted only %g deg", i, tilt);
+        AK_CHECK_MSG(tilt <= prev + 0.5, "domino %d (%g deg) is past domino %d (%g deg)", i, tilt, i - 1, prev);
+        prev = tilt;
+    }
+    cJSON_Delete(j);
+}
+
 int main(void) {
     AK_RUN(usage);
     AK_RUN(json_contract_and_closed_forms);
     AK_RUN(incline_preset);
     AK_RUN(bad_scenes_name_the_key);
+    AK_RUN_SLOW(dominoes_fall_in_order);
     return ak_test_finish();
 }

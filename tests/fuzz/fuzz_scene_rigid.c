@@ -2,7 +2,8 @@
  * module behind it (built by scripts/fuzz.sh with the library and the CLI sources).
  *
  * Each input is parsed as a scene file. A parsed scene must hold its documented invariants
- * (at least one body, positive step, finite values); when it has few bodies it is built and
+ * (at least one body, positive step, joints between two different bodies of the scene); when it
+ * has few bodies it is built and
  * stepped three times, and the state must stay finite or the step must say it blew up (and
  * then leave the state as it was). Any crash, leak or sanitizer report is a bug. */
 #include <math.h>
@@ -22,8 +23,12 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         return 0;
     }
     if (s.body_count == 0 || !(s.dt > 0.0f) || s.substeps == 0) abort();
+    for (size_t k = 0; k < s.joint_count; ++k)
+        if (s.joints[k].body_a >= s.body_count || s.joints[k].body_b >= s.body_count || s.joints[k].body_a == s.joints[k].body_b)
+            abort();
     ak_rigid_model_desc md = s.model;
     md.bodies = (ak_rigid_body_desc_cspan){s.bodies, s.body_count};
+    md.joints = (ak_rigid_joint_desc_cspan){s.joints, s.joint_count};
     ak_rigid_model* m = NULL;
     if (s.body_count <= 64 && ak_rigid_model_create(&md, NULL, &m) == AK_OK) {
         size_t n = s.body_count;
