@@ -141,6 +141,7 @@ static void parse_joint(cli_json* j, const cJSON* e, const char* path, size_t bo
     if (!j->failed && (ab[0] >= (float)body_count || ab[1] >= (float)body_count))
         cli_json_fail(j, path, "bodies", "a body index is out of range (the scene has %zu bodies)", body_count);
     if (!j->failed && ab[0] == ab[1]) cli_json_fail(j, path, "bodies", "joins a body to itself");
+    if (j->failed) return; /* ab may still hold -1: no conversion to an index */
     d->body_a = (uint32_t)ab[0], d->body_b = (uint32_t)ab[1];
     cli_json_vec3(j, e, path, "anchor", &d->anchor);
     d->axis = ak_vec3_make(0.0f, 0.0f, 1.0f);
