@@ -141,7 +141,8 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
     size_t head = (sizeof(ak_rigid_model) + 15) & ~(size_t)15;
     size_t bodies_size = ((n * sizeof(rigid_body)) + 15) & ~(size_t)15;
     size_t descs_size = ((n * sizeof(ak_rigid_body_desc)) + 15) & ~(size_t)15;
-    size_t total = head + bodies_size + descs_size + nj * sizeof(rigid_joint);
+    size_t joints_size = ((nj * sizeof(rigid_joint)) + 15) & ~(size_t)15;
+    size_t total = head + bodies_size + descs_size + joints_size + n * sizeof(uint32_t);
     unsigned char* mem = al.alloc(total, al.user);
     if (!mem) return AK_ERR_NO_MEMORY;
     memset(mem, 0, total);
@@ -152,6 +153,7 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
     m->descs = (ak_rigid_body_desc*)(mem + head + bodies_size);
     m->joints = (rigid_joint*)(mem + head + bodies_size + descs_size);
     m->joint_count = nj;
+    m->planes = (uint32_t*)(mem + head + bodies_size + descs_size + joints_size);
     m->desc = ak_rigid_model_desc_resolved(desc);
     m->desc.bodies.ptr = m->descs;
     for (size_t i = 0; i < n; ++i) {
@@ -164,7 +166,7 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             if (ak_vec3_length_sq(d.shape.normal) == 0.0f) d.shape.normal = ak_vec3_make(0, 1, 0);
             d.shape.normal = ak_vec3_normalize(d.shape.normal);
             d.orientation = ak_quat_identity();
-            m->plane_count++;
+            m->planes[m->plane_count++] = (uint32_t)i;
         }
         if (d.density == 0.0f) d.density = 1000.0f;
         if (d.friction == 0.0f) d.friction = 0.5f;

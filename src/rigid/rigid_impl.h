@@ -59,6 +59,7 @@ struct ak_rigid_model {
     ak_rigid_model_desc desc; /* resolved; bodies points at descs */
     size_t body_count;
     size_t plane_count;
+    uint32_t* planes;         /* [plane_count]: the planes' body indices, in order */
     rigid_body* bodies;
     ak_rigid_body_desc* descs;
     rigid_joint* joints;

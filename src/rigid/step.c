@@ -265,8 +265,7 @@ static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float marg
     if (m->plane_count) {
         for (uint32_t i = 0; i < n; ++i) {
             if (!s->awake[i]) continue;
-            for (uint32_t p = 0; p < n; ++p)
-                if (s->bodies[p].shape.type == AK_RIGID_PLANE) narrow(s, cb, i, p, margin);
+            for (size_t k = 0; k < m->plane_count; ++k) narrow(s, cb, i, m->planes[k], margin);
         }
     }
 }
