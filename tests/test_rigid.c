@@ -16,8 +16,8 @@ typedef struct world {
     ak_rigid_step_job job;
 } world;
 
-static bool world_init(world* wd, const ak_rigid_body_desc* bodies, size_t n, const ak_rigid_model_desc* extra,
-                       float dt, uint32_t substeps, ak_vec3 g) {
+static bool world_init(world* wd, const ak_rigid_body_desc* bodies, size_t n,
+                       const ak_rigid_model_desc* extra, float dt, uint32_t substeps, ak_vec3 g) {
     memset(wd, 0, sizeof *wd);
     ak_rigid_model_desc md = {0};
     if (extra) md = *extra;
@@ -26,9 +26,14 @@ static bool world_init(world* wd, const ak_rigid_body_desc* bodies, size_t n, co
     wd->n = n;
     ak_rigid_initial_state(wd->model, (ak_vec3_span){wd->x, n}, (ak_quat_span){wd->q, n},
                            (ak_vec3_span){wd->v, n}, (ak_vec3_span){wd->w, n});
-    wd->job = (ak_rigid_step_job){.model = wd->model, .dt = dt, .substeps = substeps, .gravity = g,
-                                  .positions = {wd->x, n}, .orientations = {wd->q, n},
-                                  .velocities = {wd->v, n}, .angular_velocities = {wd->w, n}};
+    wd->job = (ak_rigid_step_job){.model = wd->model,
+                                  .dt = dt,
+                                  .substeps = substeps,
+                                  .gravity = g,
+                                  .positions = {wd->x, n},
+                                  .orientations = {wd->q, n},
+                                  .velocities = {wd->v, n},
+                                  .angular_velocities = {wd->w, n}};
     size_t size = ak_rigid_step_scratch_size(&wd->job);
     wd->job.scratch = (ak_u8_span){malloc(size), size};
     return wd->job.scratch.ptr != NULL;
@@ -45,7 +50,8 @@ AK_TEST(mass_and_inertia_closed_forms) {
     ak_rigid_body_desc b[3] = {
         {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.5f}},
         {.shape = {.type = AK_RIGID_BOX, .half_extents = {1.0f, 0.5f, 0.25f}}, .mass = 6.0f},
-        {.shape = {.type = AK_RIGID_CAPSULE, .radius = 0.1f, .half_height = 0.0f}, .density = 500.0f},
+        {.shape = {.type = AK_RIGID_CAPSULE, .radius = 0.1f, .half_height = 0.0f},
+         .density = 500.0f},
     };
     ak_rigid_model* m = NULL;
     ak_rigid_model_desc md = {.bodies = {b, 3}};
@@ -88,7 +94,8 @@ AK_TEST(model_validity) {
     ak_rigid_body_desc two[2] = {b, b};
     ak_rigid_joint_desc jd = {.body_a = 0, .body_b = 0};
     ak_rigid_model_desc mj = {.bodies = {two, 2}, .joints = {&jd, 1}};
-    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_INDEX); /* a body joined to itself */
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m),
+                AK_ERR_BAD_INDEX); /* a body joined to itself */
     jd.body_b = 2;
     AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_INDEX);
     jd.body_b = 1;
@@ -134,8 +141,11 @@ AK_TEST(model_validity) {
  * error of g h t / 2 in position (16 mm after 2 s with h = 1/600 s); velocities exact. */
 AK_TEST(free_fall_and_parabola) {
     ak_rigid_body_desc b[2] = {
-        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.2f, 0.3f}}, .position = {0, 100, 0}},
-        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.1f}, .position = {0, 50, 0}, .velocity = {3, 8, -1}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.2f, 0.3f}},
+         .position = {0, 100, 0}},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.1f},
+         .position = {0, 50, 0},
+         .velocity = {3, 8, -1}},
     };
     world wd;
     AK_CHECK(world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 10, G));
@@ -159,8 +169,10 @@ static float incline_accel(float theta, float mu, float* out_drift) {
     ak_vec3 start = ak_vec3_scale(nrm, 0.1f);
     ak_rigid_body_desc b[2] = {
         {.shape = {.type = AK_RIGID_PLANE, .normal = nrm}},
-        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.2f}}, .position = start,
-         .orientation = rot, .friction = mu},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.2f}},
+         .position = start,
+         .orientation = rot,
+         .friction = mu},
     };
     b[0].friction = mu;
     world wd;
@@ -194,15 +206,18 @@ AK_TEST(incline_stays_or_slides) {
     AK_CHECK_MSG(fabsf(a - want) < 0.01f * want, "a %g want %g", a, want);
 }
 
-/* Torque-free box (5 rad/s, h = 1/1200 s): world angular momentum conserved; spin about the intermediate axis flips,
- * spins about the major and minor axes stay. Box half extents 0.5, 0.3, 0.1: I_z < I_y < I_x?
- * I_x ~ (0.09 + 0.01), I_y ~ (0.25 + 0.01), I_z ~ (0.25 + 0.09): minor x, intermediate y,
- * major z. */
+/* Torque-free box (5 rad/s, h = 1/1200 s): world angular momentum conserved; spin about the
+ * intermediate axis flips, spins about the major and minor axes stay. Box half extents 0.5, 0.3,
+ * 0.1: I_z < I_y < I_x? I_x ~ (0.09 + 0.01), I_y ~ (0.25 + 0.01), I_z ~ (0.25 + 0.09): minor x,
+ * intermediate y, major z. */
 static void spin(int axis, float* out_l_err, float* out_min_comp, float* out_max_comp) {
     ak_vec3 w = {0.01f, 0.01f, 0.01f};
-    if (axis == 0) w.x = 5.0f;
-    else if (axis == 1) w.y = 5.0f;
-    else w.z = 5.0f;
+    if (axis == 0)
+        w.x = 5.0f;
+    else if (axis == 1)
+        w.y = 5.0f;
+    else
+        w.z = 5.0f;
     ak_rigid_body_desc b = {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.3f, 0.1f}},
                             .angular_velocity = w};
     world wd;
@@ -243,7 +258,9 @@ AK_TEST(restitution_rebound) {
     const float h = 1.0f, e = 0.6f, r = 0.1f;
     ak_rigid_body_desc b[2] = {
         {.shape = {.type = AK_RIGID_PLANE}},
-        {.shape = {.type = AK_RIGID_SPHERE, .radius = r}, .position = {0, h + r, 0}, .restitution = e},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = r},
+         .position = {0, h + r, 0},
+         .restitution = e},
     };
     world wd;
     AK_CHECK(world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 20, G));
@@ -262,8 +279,8 @@ AK_TEST(restitution_rebound) {
 
 /* A column of boxes on the ground, stepped for `seconds`: the largest horizontal drift of any
  * box and the deepest penetration seen. */
-static void stack_run(int count, float seconds, uint32_t substeps, bool sleep, float* out_drift, float* out_pen,
-                      bool* out_ok) {
+static void stack_run(int count, float seconds, uint32_t substeps, bool sleep, float* out_drift,
+                      float* out_pen, bool* out_ok) {
     ak_rigid_body_desc b[64];
     memset(b, 0, sizeof b);
     b[0].shape.type = AK_RIGID_PLANE;
@@ -312,7 +329,6 @@ AK_TEST(box_stack_stands_20s) {
     AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
 }
 
-
 /* A 2D pyramid of unit boxes (layer k holds layers - k boxes, 0.1 m apart): the largest
  * horizontal displacement of any box from where it started and the deepest penetration. */
 static void pyramid_run(int layers, float seconds, uint32_t substeps, bool sleep, float* out_drift,
@@ -330,17 +346,25 @@ static void pyramid_run(int layers, float seconds, uint32_t substeps, bool sleep
         for (int i = 0; i < layers - layer; ++i, ++k) {
             b[k].shape.type = AK_RIGID_BOX;
             b[k].shape.half_extents = ak_vec3_make(0.5f, 0.5f, 0.5f);
-            b[k].position = ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - layer - 1)), 0.5f + (float)layer, 0.0f);
+            b[k].position = ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - layer - 1)),
+                                         0.5f + (float)layer, 0.0f);
         }
     ak_rigid_model* m = NULL;
     ak_rigid_model_desc md = {.bodies = {b, n}};
     *out_ok = ak_rigid_model_create(&md, NULL, &m) == AK_OK;
     if (!*out_ok) goto done;
-    ak_rigid_initial_state(m, (ak_vec3_span){x, n}, (ak_quat_span){q, n}, (ak_vec3_span){v, n}, (ak_vec3_span){w, n});
+    ak_rigid_initial_state(m, (ak_vec3_span){x, n}, (ak_quat_span){q, n}, (ak_vec3_span){v, n},
+                           (ak_vec3_span){w, n});
     float pen = 0.0f, pen_max = 0.0f, drift = 0.0f;
-    ak_rigid_step_job job = {.model = m, .dt = 1.0f / 60.0f, .substeps = substeps, .gravity = G,
-                             .positions = {x, n}, .orientations = {q, n}, .velocities = {v, n},
-                             .angular_velocities = {w, n}, .out_max_penetration = &pen};
+    ak_rigid_step_job job = {.model = m,
+                             .dt = 1.0f / 60.0f,
+                             .substeps = substeps,
+                             .gravity = G,
+                             .positions = {x, n},
+                             .orientations = {q, n},
+                             .velocities = {v, n},
+                             .angular_velocities = {w, n},
+                             .out_max_penetration = &pen};
     if (sleep) job.sleep_timers = (ak_f32_span){timers, n};
     size_t size = ak_rigid_step_scratch_size(&job);
     job.scratch = (ak_u8_span){malloc(size), size};
@@ -378,7 +402,8 @@ AK_TEST(pyramid_20_layers_20s) {
     AK_CHECK(ok);
     AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
     AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
-    printf("  20-layer pyramid, 20 s, 40 substeps, sleeping on: drift %.3g m, penetration %.3g m\n", drift, pen);
+    printf("  20-layer pyramid, 20 s, 40 substeps, sleeping on: drift %.3g m, penetration %.3g m\n",
+           drift, pen);
 }
 
 /* A compound pendulum on a ball joint: a sphere of radius r at distance L below a static
@@ -388,7 +413,8 @@ AK_TEST(pendulum_period_ball_joint) {
     const float L = 1.0f, r = 0.05f, th0 = ak_radians(5.0f);
     ak_rigid_body_desc b[2] = {
         {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.01f}, .is_static = true},
-        {.shape = {.type = AK_RIGID_SPHERE, .radius = r}, .position = {L * sinf(th0), -L * cosf(th0), 0}},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = r},
+         .position = {L * sinf(th0), -L * cosf(th0), 0}},
     };
     ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_BALL, .body_a = 0, .body_b = 1};
     ak_rigid_model_desc md = {.joints = {&jd, 1}};
@@ -401,10 +427,12 @@ AK_TEST(pendulum_period_ball_joint) {
         ak_rigid_step_run(&wd.job);
         t += 1.0f / 240.0f;
         float gap, excess;
-        ak_rigid_joint_error(wd.model, 0, (ak_vec3_cspan){wd.x, 2}, (ak_quat_cspan){wd.q, 2}, &gap, &excess);
+        ak_rigid_joint_error(wd.model, 0, (ak_vec3_cspan){wd.x, 2}, (ak_quat_cspan){wd.q, 2}, &gap,
+                             &excess);
         worst_gap = ak_maxf(worst_gap, gap);
         /* downward zero crossings of x, interpolated */
-        if (prev_x > 0.0f && wd.x[1].x <= 0.0f) crossings[nc++] = t - (1.0f / 240.0f) * wd.x[1].x / (wd.x[1].x - prev_x);
+        if (prev_x > 0.0f && wd.x[1].x <= 0.0f)
+            crossings[nc++] = t - (1.0f / 240.0f) * wd.x[1].x / (wd.x[1].x - prev_x);
         prev_x = wd.x[1].x;
     }
     AK_CHECK_EQ(nc, 3);
@@ -424,11 +452,17 @@ AK_TEST(pendulum_period_ball_joint) {
 AK_TEST(hinge_limits_hold) {
     ak_rigid_body_desc b[2] = {
         {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.05f}, .is_static = true},
-        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.05f, 0.1f}}, .position = {0.5f, 0, 0},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.05f, 0.1f}},
+         .position = {0.5f, 0, 0},
          .angular_velocity = {1.0f, 2.0f, 0.0f}},
     };
-    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_HINGE, .body_a = 0, .body_b = 1, .axis = {0, 0, 1},
-                              .limited = true, .lower = ak_radians(-30.0f), .upper = ak_radians(30.0f)};
+    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_HINGE,
+                              .body_a = 0,
+                              .body_b = 1,
+                              .axis = {0, 0, 1},
+                              .limited = true,
+                              .lower = ak_radians(-30.0f),
+                              .upper = ak_radians(30.0f)};
     ak_rigid_model_desc md = {.joints = {&jd, 1}};
     world wd;
     AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 20, G));
@@ -436,7 +470,8 @@ AK_TEST(hinge_limits_hold) {
     for (int f = 0; f < 120; ++f) {
         ak_rigid_step_run(&wd.job);
         float gap, excess;
-        ak_rigid_joint_error(wd.model, 0, (ak_vec3_cspan){wd.x, 2}, (ak_quat_cspan){wd.q, 2}, &gap, &excess);
+        ak_rigid_joint_error(wd.model, 0, (ak_vec3_cspan){wd.x, 2}, (ak_quat_cspan){wd.q, 2}, &gap,
+                             &excess);
         worst_excess = ak_maxf(worst_excess, excess);
         worst_gap = ak_maxf(worst_gap, gap);
         ak_vec3 z = ak_quat_rotate(wd.q[1], ak_vec3_make(0, 0, 1));
@@ -445,8 +480,10 @@ AK_TEST(hinge_limits_hold) {
     /* at rest on the limit: the bar points 30 degrees below the horizontal */
     ak_vec3 bar = ak_quat_rotate(wd.q[1], ak_vec3_make(1, 0, 0));
     AK_CHECK_NEAR(atan2f(bar.y, bar.x), ak_radians(-30.0f), ak_radians(2.0f));
-    AK_CHECK_MSG(worst_excess < ak_radians(2.0f), "limit exceeded by %g deg", ak_degrees(worst_excess));
-    AK_CHECK_MSG(worst_tilt < ak_radians(2.0f), "hinge axis tilted by %g deg", ak_degrees(worst_tilt));
+    AK_CHECK_MSG(worst_excess < ak_radians(2.0f), "limit exceeded by %g deg",
+                 ak_degrees(worst_excess));
+    AK_CHECK_MSG(worst_tilt < ak_radians(2.0f), "hinge axis tilted by %g deg",
+                 ak_degrees(worst_tilt));
     AK_CHECK_MSG(worst_gap < 1e-3f, "joint gap %g m", worst_gap);
     world_free(&wd);
 }
@@ -458,7 +495,8 @@ AK_TEST(prismatic_slides_along_its_axis) {
         {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.05f}, .is_static = true},
         {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.1f, 0.1f}}},
     };
-    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_PRISMATIC, .body_a = 0, .body_b = 1, .axis = {1, 0, 0}};
+    ak_rigid_joint_desc jd = {
+        .type = AK_RIGID_JOINT_PRISMATIC, .body_a = 0, .body_b = 1, .axis = {1, 0, 0}};
     ak_rigid_model_desc md = {.joints = {&jd, 1}};
     world wd;
     AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 10, ak_vec3_make(3.0f, -9.81f, 0.0f)));
@@ -479,33 +517,40 @@ AK_TEST(prismatic_slides_along_its_axis) {
  * no gravity the pair's total angular momentum about its centre of mass is conserved. */
 AK_TEST(fixed_joint_keeps_the_pose) {
     ak_rigid_body_desc b[2] = {
-        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.1f}}, .position = {-0.2f, 0, 0},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.1f}},
+         .position = {-0.2f, 0, 0},
          .angular_velocity = {0.3f, 0.2f, 2.0f}},
-        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.1f}}, .position = {0.2f, 0, 0},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.1f}},
+         .position = {0.2f, 0, 0},
          .angular_velocity = {0.3f, 0.2f, 2.0f}},
     };
     /* the bodies move as one: v = w x r about the common centre */
     b[0].velocity = ak_vec3_cross(b[0].angular_velocity, b[0].position);
     b[1].velocity = ak_vec3_cross(b[1].angular_velocity, b[1].position);
-    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_FIXED, .body_a = 0, .body_b = 1, .anchor = {0, 0, 0}};
+    ak_rigid_joint_desc jd = {
+        .type = AK_RIGID_JOINT_FIXED, .body_a = 0, .body_b = 1, .anchor = {0, 0, 0}};
     ak_rigid_model_desc md = {.joints = {&jd, 1}};
     world wd;
     AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 20, ak_vec3_zero()));
     ak_vec3 l0 = ak_vec3_zero();
     for (int i = 0; i < 2; ++i)
-        l0 = ak_vec3_add(l0, ak_vec3_add(ak_rigid_angular_momentum(wd.model, (size_t)i, wd.q[i], wd.w[i]),
-                                         ak_vec3_scale(ak_vec3_cross(wd.x[i], wd.v[i]), ak_rigid_body_mass(wd.model, (size_t)i))));
+        l0 = ak_vec3_add(
+            l0, ak_vec3_add(ak_rigid_angular_momentum(wd.model, (size_t)i, wd.q[i], wd.w[i]),
+                            ak_vec3_scale(ak_vec3_cross(wd.x[i], wd.v[i]),
+                                          ak_rigid_body_mass(wd.model, (size_t)i))));
     for (int f = 0; f < 120; ++f) ak_rigid_step_run(&wd.job);
     AK_CHECK_NEAR(ak_quat_angle_between(wd.q[0], wd.q[1]), 0.0f, ak_radians(0.5f));
     AK_CHECK_NEAR(ak_vec3_distance(wd.x[0], wd.x[1]), 0.4f, 1e-3);
     ak_vec3 l1 = ak_vec3_zero(), c = ak_vec3_scale(ak_vec3_add(wd.x[0], wd.x[1]), 0.5f);
     ak_vec3 vc = ak_vec3_scale(ak_vec3_add(wd.v[0], wd.v[1]), 0.5f);
     for (int i = 0; i < 2; ++i)
-        l1 = ak_vec3_add(l1, ak_vec3_add(ak_rigid_angular_momentum(wd.model, (size_t)i, wd.q[i], wd.w[i]),
-                                         ak_vec3_scale(ak_vec3_cross(ak_vec3_sub(wd.x[i], c), ak_vec3_sub(wd.v[i], vc)),
-                                                       ak_rigid_body_mass(wd.model, (size_t)i))));
-    AK_CHECK_MSG(ak_vec3_length(ak_vec3_sub(l1, l0)) < 0.02f * ak_vec3_length(l0), "L %g %g %g vs %g %g %g", l1.x, l1.y,
-                 l1.z, l0.x, l0.y, l0.z);
+        l1 = ak_vec3_add(
+            l1, ak_vec3_add(
+                    ak_rigid_angular_momentum(wd.model, (size_t)i, wd.q[i], wd.w[i]),
+                    ak_vec3_scale(ak_vec3_cross(ak_vec3_sub(wd.x[i], c), ak_vec3_sub(wd.v[i], vc)),
+                                  ak_rigid_body_mass(wd.model, (size_t)i))));
+    AK_CHECK_MSG(ak_vec3_length(ak_vec3_sub(l1, l0)) < 0.02f * ak_vec3_length(l0),
+                 "L %g %g %g vs %g %g %g", l1.x, l1.y, l1.z, l0.x, l0.y, l0.z);
     world_free(&wd);
 }
 

@@ -10,7 +10,8 @@
 static ak_vec3 vec_of(const cJSON* body, const char* key) {
     const cJSON* p = cJSON_GetObjectItemCaseSensitive(body, key);
     if (!cJSON_IsArray(p) || cJSON_GetArraySize(p) < 3) return ak_vec3_make(NAN, NAN, NAN);
-    return ak_vec3_make((float)cJSON_GetArrayItem(p, 0)->valuedouble, (float)cJSON_GetArrayItem(p, 1)->valuedouble,
+    return ak_vec3_make((float)cJSON_GetArrayItem(p, 0)->valuedouble,
+                        (float)cJSON_GetArrayItem(p, 1)->valuedouble,
                         (float)cJSON_GetArrayItem(p, 2)->valuedouble);
 }
 
@@ -38,12 +39,14 @@ AK_TEST(usage) {
  * from everything: after 1 s the box is at x0 + v0 t + g t^2 / 2 (less semi-implicit Euler's
  * g h t / 2), the sphere still at y = radius. */
 AK_TEST(json_contract_and_closed_forms) {
-    AK_CHECK(write_file("rigid_scene.json",
-                        "{\"gravity\": [0, -9.81, 0], \"steps\": 60, \"substeps\": 20, \"bodies\": ["
-                        "{\"shape\": {\"type\": \"plane\", \"normal\": [0, 1, 0]}, \"static\": true},"
-                        "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.25}, \"position\": [0, 0.25, 0]},"
-                        "{\"shape\": {\"type\": \"box\", \"half_extents\": [0.1, 0.2, 0.3]}, \"position\": [100, 50, 0],"
-                        " \"velocity\": [2, 5, -1], \"mass\": 3}]}"));
+    AK_CHECK(write_file(
+        "rigid_scene.json",
+        "{\"gravity\": [0, -9.81, 0], \"steps\": 60, \"substeps\": 20, \"bodies\": ["
+        "{\"shape\": {\"type\": \"plane\", \"normal\": [0, 1, 0]}, \"static\": true},"
+        "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.25}, \"position\": [0, 0.25, 0]},"
+        "{\"shape\": {\"type\": \"box\", \"half_extents\": [0.1, 0.2, 0.3]}, \"position\": [100, "
+        "50, 0],"
+        " \"velocity\": [2, 5, -1], \"mass\": 3}]}"));
     AK_CHECK_EQ(run("rigid rigid_scene.json --json rigid_out.json", true), 0);
     cJSON* j = read_json("rigid_out.json");
     AK_CHECK(j != NULL);
@@ -64,7 +67,8 @@ AK_TEST(json_contract_and_closed_forms) {
     ak_vec3 sphere = vec_of(cJSON_GetArrayItem(bodies, 1), "position");
     AK_CHECK_NEAR(sphere.y, 0.25, 1e-3);
     AK_CHECK_NEAR(sphere.x, 0.0, 1e-4);
-    ak_vec3 box = vec_of(cJSON_GetArrayItem(bodies, 2), "position"), bv = vec_of(cJSON_GetArrayItem(bodies, 2), "velocity");
+    ak_vec3 box = vec_of(cJSON_GetArrayItem(bodies, 2), "position"),
+            bv = vec_of(cJSON_GetArrayItem(bodies, 2), "velocity");
     const double t = 1.0, h = 1.0 / 1200.0;
     AK_CHECK_NEAR(box.x, 100.0 + 2.0 * t, 1e-3);
     AK_CHECK_NEAR(box.y, 50.0 + 5.0 * t - 0.5 * 9.81 * t * t - 9.81 * h * t / 2.0, 2e-3);
@@ -85,7 +89,8 @@ AK_TEST(incline_preset) {
     AK_CHECK(j != NULL);
     if (!j) return;
     const cJSON* bodies = cJSON_GetObjectItemCaseSensitive(j, "bodies");
-    ak_vec3 v1 = vec_of(cJSON_GetArrayItem(bodies, 1), "velocity"), v2 = vec_of(cJSON_GetArrayItem(bodies, 2), "velocity");
+    ak_vec3 v1 = vec_of(cJSON_GetArrayItem(bodies, 1), "velocity"),
+            v2 = vec_of(cJSON_GetArrayItem(bodies, 2), "velocity");
     const double th = 0.5236, a = 9.81 * (sin(th) - 0.3 * cos(th));
     AK_CHECK_NEAR(ak_vec3_length(v1), a * 2.0, 0.01 * a * 2.0);
     AK_CHECK_NEAR(ak_vec3_length(v2), 0.0, 1e-3);
@@ -99,22 +104,33 @@ AK_TEST(bad_scenes_name_the_key) {
         const char* want;
     } cases[] = {
         {"{\"bodies\": [{\"shape\": {\"type\": \"box\"}}]}", "bodies[0].shape.half_extents"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"densty\": 3}]}", "densty"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"points\": []}}]}", "bodies[0].shape.type"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"mass\": 1, \"density\": 2}]}", "bodies[0].mass"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"restitution\": 2}]}", "bodies[0].restitution"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1, \"half_height\": 1}}]}", "bodies[0].shape.half_height"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"densty\": 3}]}",
+         "densty"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"points\": []}}]}",
+         "bodies[0].shape.type"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"mass\": 1, "
+         "\"density\": 2}]}",
+         "bodies[0].mass"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"restitution\": 2}]}",
+         "bodies[0].restitution"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1, \"half_height\": 1}}]}",
+         "bodies[0].shape.half_height"},
         {"{\"bodies\": []}", "bodies"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"joints\": [{}]}", "joints[0].type"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"joints\": [{\"type\": \"ball\", \"bodies\": [0, 1]}]}",
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"joints\": [{}]}",
+         "joints[0].type"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"joints\": "
+         "[{\"type\": \"ball\", \"bodies\": [0, 1]}]}",
          "joints[0].bodies"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"position\": [0, \"a\", 0]}]}", "bodies[0].position"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"position\": [0, "
+         "\"a\", 0]}]}",
+         "bodies[0].position"},
         {"{\"bodies\": [", "invalid JSON"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         AK_CHECK(write_file("rigid_bad.json", cases[i].text));
         AK_CHECK_EQ(run("rigid rigid_bad.json", true), 1);
-        AK_CHECK_MSG(strstr(out_buf, "rigid_bad.json") && strstr(out_buf, cases[i].want), "case %zu: %s", i, out_buf);
+        AK_CHECK_MSG(strstr(out_buf, "rigid_bad.json") && strstr(out_buf, cases[i].want),
+                     "case %zu: %s", i, out_buf);
     }
 }
 
@@ -130,11 +146,13 @@ AK_TEST(dominoes_fall_in_order) {
     AK_CHECK_EQ(n, 21);
     double prev = 180.0;
     for (int i = 1; i < n; ++i) {
-        const cJSON* o = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(bodies, i), "orientation");
+        const cJSON* o =
+            cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(bodies, i), "orientation");
         double w = fabs(cJSON_GetArrayItem(o, 3)->valuedouble);
         double tilt = 2.0 * acos(w < 1.0 ? w : 1.0) * 180.0 / 3.14159265358979;
         if (i <= n - 3) AK_CHECK_MSG(tilt > 30.0, "domino %d tilted only %g deg", i, tilt);
-        AK_CHECK_MSG(tilt <= prev + 0.5, "domino %d (%g deg) is past domino %d (%g deg)", i, tilt, i - 1, prev);
+        AK_CHECK_MSG(tilt <= prev + 0.5, "domino %d (%g deg) is past domino %d (%g deg)", i, tilt,
+                     i - 1, prev);
         prev = tilt;
     }
     cJSON_Delete(j);

@@ -11,9 +11,9 @@
 
 typedef struct drop_result {
     bool ok;
-    float worst_limit_deg;   /* the largest tolerance a joint needed beyond 2 degrees, else 0 */
-    float lowest;            /* lowest point of any capsule (m) */
-    float worst_gap;         /* largest distance between a joint's anchors (m) */
+    float worst_limit_deg; /* the largest tolerance a joint needed beyond 2 degrees, else 0 */
+    float lowest;          /* lowest point of any capsule (m) */
+    float worst_gap;       /* largest distance between a joint's anchors (m) */
     bool finite;
 } drop_result;
 
@@ -25,8 +25,10 @@ static float limit_excess(const ak_skeleton* sk, size_t i, ak_transform local) {
     if (!ak_skeleton_joint_within_limits(sk, i, local, hi)) return hi;
     for (int it = 0; it < 30; ++it) {
         float mid = 0.5f * (lo + hi);
-        if (ak_skeleton_joint_within_limits(sk, i, local, mid)) hi = mid;
-        else lo = mid;
+        if (ak_skeleton_joint_within_limits(sk, i, local, mid))
+            hi = mid;
+        else
+            lo = mid;
     }
     return hi;
 }
@@ -51,28 +53,39 @@ static drop_result drop(bool animated, float seconds) {
     ak_quat* q = calloc(nb, sizeof *q);
     ak_rigid_model* m = NULL;
     ak_rigid_step_job job = {0};
-    if (!pose || !prev || !back || !world || !bodies || !joints || !bones || !x || !v || !w || !q) goto done;
+    if (!pose || !prev || !back || !world || !bodies || !joints || !bones || !x || !v || !w || !q)
+        goto done;
     ak_scene_rest_pose(scene, (ak_transform_span){pose, n});
     ak_scene_rest_pose(scene, (ak_transform_span){prev, n});
     if (animated && scene->clip_count > 0) {
         const ak_clip* clip = scene->clips[0];
         float t = 0.3f * ak_clip_duration(clip);
-        ak_clip_sample(clip, t, NULL, (ak_transform_span){pose, n}, (ak_f32_span){0}, (ak_f32_span){0});
-        ak_clip_sample(clip, t - 1.0f / 60.0f, NULL, (ak_transform_span){prev, n}, (ak_f32_span){0}, (ak_f32_span){0});
+        ak_clip_sample(clip, t, NULL, (ak_transform_span){pose, n}, (ak_f32_span){0},
+                       (ak_f32_span){0});
+        ak_clip_sample(clip, t - 1.0f / 60.0f, NULL, (ak_transform_span){prev, n}, (ak_f32_span){0},
+                       (ak_f32_span){0});
     }
     /* half a metre up, body 0 the ground */
     ak_mat4 root = ak_mat4_translation(ak_vec3_make(0.0f, 0.5f, 0.0f));
     bodies[0].shape.type = AK_RIGID_PLANE;
-    ak_rigid_ragdoll_desc rd = {.skeleton = sk, .local_pose = {pose, n}, .root = root, .body_offset = 1};
+    ak_rigid_ragdoll_desc rd = {
+        .skeleton = sk, .local_pose = {pose, n}, .root = root, .body_offset = 1};
     if (animated) rd.previous_pose = (ak_transform_cspan){prev, n}, rd.previous_dt = 1.0f / 60.0f;
-    if (ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){bodies + 1, nb - 1}, (ak_rigid_joint_desc_span){joints, nj},
+    if (ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){bodies + 1, nb - 1},
+                               (ak_rigid_joint_desc_span){joints, nj},
                                (ak_rigid_ragdoll_bone_span){bones, n}) != AK_OK)
         goto done;
     ak_rigid_model_desc md = {.bodies = {bodies, nb}, .joints = {joints, nj}};
     if (ak_rigid_model_create(&md, NULL, &m) != AK_OK) goto done;
-    ak_rigid_initial_state(m, (ak_vec3_span){x, nb}, (ak_quat_span){q, nb}, (ak_vec3_span){v, nb}, (ak_vec3_span){w, nb});
-    job = (ak_rigid_step_job){.model = m, .dt = 1.0f / 60.0f, .substeps = 40, .gravity = {0, -9.81f, 0},
-                              .positions = {x, nb}, .orientations = {q, nb}, .velocities = {v, nb},
+    ak_rigid_initial_state(m, (ak_vec3_span){x, nb}, (ak_quat_span){q, nb}, (ak_vec3_span){v, nb},
+                           (ak_vec3_span){w, nb});
+    job = (ak_rigid_step_job){.model = m,
+                              .dt = 1.0f / 60.0f,
+                              .substeps = 40,
+                              .gravity = {0, -9.81f, 0},
+                              .positions = {x, nb},
+                              .orientations = {q, nb},
+                              .velocities = {v, nb},
                               .angular_velocities = {w, nb}};
     size_t size = ak_rigid_step_scratch_size(&job);
     job.scratch = (ak_u8_span){malloc(size), size};
@@ -90,13 +103,16 @@ static drop_result drop(bool animated, float seconds) {
         }
         for (size_t k = 0; k < nj; ++k) {
             float gap, excess;
-            ak_rigid_joint_error(m, k, (ak_vec3_cspan){x, nb}, (ak_quat_cspan){q, nb}, &gap, &excess);
+            ak_rigid_joint_error(m, k, (ak_vec3_cspan){x, nb}, (ak_quat_cspan){q, nb}, &gap,
+                                 &excess);
             res.worst_gap = ak_maxf(res.worst_gap, gap);
         }
-        ak_rigid_ragdoll_pose(sk, (ak_rigid_ragdoll_bone_cspan){bones, n}, root, (ak_vec3_cspan){x, nb},
-                              (ak_quat_cspan){q, nb}, (ak_transform_cspan){pose, n}, (ak_transform_span){back, n});
+        ak_rigid_ragdoll_pose(sk, (ak_rigid_ragdoll_bone_cspan){bones, n}, root,
+                              (ak_vec3_cspan){x, nb}, (ak_quat_cspan){q, nb},
+                              (ak_transform_cspan){pose, n}, (ak_transform_span){back, n});
         for (size_t i = 0; i < n; ++i)
-            res.worst_limit_deg = ak_maxf(res.worst_limit_deg, ak_degrees(limit_excess(sk, i, back[i])));
+            res.worst_limit_deg =
+                ak_maxf(res.worst_limit_deg, ak_degrees(limit_excess(sk, i, back[i])));
         ak_scene_world_matrices(scene, (ak_transform_cspan){back, n}, (ak_mat4_span){world, n});
         for (size_t i = 0; i < n; ++i)
             for (int c = 0; c < 16; ++c) res.finite = res.finite && ak_finitef(world[i].m[c]);

@@ -1,4 +1,5 @@
-/* animkit rigid: rigid bodies (spheres, boxes, capsules, static planes) with contacts and friction.
+/* animkit rigid: rigid bodies (spheres, boxes, capsules, static planes), contacts, joints,
+ * ragdolls.
  *
  * What it does:
  *   - a model (ak_rigid_model) holds each body's shape, mass, inertia and material; it is built
@@ -14,26 +15,27 @@
  *     "Detailed Rigid Body Simulation with Extended Position Based Dynamics"): each substep
  *     predicts, finds contacts on the predicted state, projects non-penetration and static
  *     friction on positions, derives velocities, then applies dynamic friction and restitution;
- *   - contacts: sweep-and-prune broad phase on x, closed-form narrow phase for every pair of
- *     sphere, box, capsule and plane (box-box: separating axis test over the 15 axes, then the
- *     incident face clipped against the reference face for a manifold of up to 8 points);
- *     contacts are found within contact_offset of touching (speculative); a contact's friction is
- *     the geometric mean of its bodies' and its restitution the larger of the two;
- *   - sleeping: a connected group of touching bodies whose speeds all stay under the thresholds
- *     for sleep_time seconds is frozen until an awake body touches it;
- *   - deterministic: the same inputs give the same bits (contacts are found and solved in an
- *     order fixed by body indices); thread_count is accepted for the interface's sake but this
- *     version runs every phase on the calling thread, so results are the same for any count.
- *
- *   - joints: ball (optional swing cone), hinge (optional angle limits), fixed, prismatic
- *     (optional distance limits), with compliance, and drives towards a target relative
- *     orientation (XPBD positional and angular constraints, their section 3.3);
+ *   - contacts: sweep-and-prune broad phase along the axis of the bodies' largest spread,
+ *     closed-form narrow phase for every pair of sphere, box, capsule and plane (box-box:
+ *     separating axis test over the 15 axes, then the incident face clipped against the
+ *     reference face for a manifold of up to 8 points); contacts are found within
+ *     contact_offset of touching (speculative); a contact's friction is the geometric mean of
+ *     its bodies' and its restitution the larger of the two; pairs are solved from the top down;
+ *   - joints: ball (optional swing cone and twist range), hinge (optional angle limits), fixed,
+ *     prismatic (optional distance limits), with compliance, and drives towards a target
+ *     relative orientation (XPBD positional and angular constraints, their section 3.3);
  *   - ragdolls: a capsule per bone of a skeleton and a joint per joint with the skeleton's
  *     limits, started from an animated pose (and its velocities), written back as a pose;
+ *   - sleeping: a connected group of touching or joined bodies whose speeds all stay under the
+ *     thresholds for sleep_time seconds is frozen until an awake body touches it;
+ *   - deterministic: the same inputs give the same bits (contacts are found and solved in an
+ *     order fixed by the positions and body indices); thread_count is accepted for the
+ *     interface's sake but this version runs every phase on the calling thread.
  *
  * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
- * capsule sizes from a skin, a powered ragdoll, continuous collision detection (a body moving more than its size in one
- * substep can tunnel), collisions with particles or cloth.
+ * capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
+ * collision detection (a body moving more than its size in one substep can tunnel),
+ * collisions with particles or cloth.
  *
  * Usage (a box dropped on the ground):
  *     ak_rigid_body_desc bodies[2] = {
@@ -56,8 +58,7 @@
  *
  * Ownership and threading: ak_rigid_model_create makes one allocation; the model is read-only
  * afterwards and may be shared by threads. The state arrays and the scratch belong to the
- * caller; ak_rigid_step_run never allocates.
- * Steps of distinct states may run concurrently.
+ * caller; ak_rigid_step_run never allocates. Steps of distinct states may run concurrently.
  */
 #ifndef ANIMKIT_RIGID_H
 #define ANIMKIT_RIGID_H
@@ -97,11 +98,11 @@ typedef struct ak_rigid_body_desc {
     ak_vec3 angular_velocity; /* rad/s, world */
     float density;            /* kg/m^3 when mass is 0; 0 -> 1000 */
     float mass;               /* kg; 0 -> from density and the shape's volume */
-    float friction;           /* Coulomb coefficient (static); 0 -> 0.5; AK_RIGID_FRICTIONLESS -> 0 */
-    float dynamic_friction;   /* Coulomb coefficient when sliding; 0 -> friction;
-                                 AK_RIGID_FRICTIONLESS -> 0 */
-    float restitution;        /* normal velocity kept in a bounce, [0, 1]; 0 -> none */
-    bool is_static;           /* infinite mass, never moves (planes always are) */
+    float friction;         /* Coulomb coefficient (static); 0 -> 0.5; AK_RIGID_FRICTIONLESS -> 0 */
+    float dynamic_friction; /* Coulomb coefficient when sliding; 0 -> friction;
+                               AK_RIGID_FRICTIONLESS -> 0 */
+    float restitution;      /* normal velocity kept in a bounce, [0, 1]; 0 -> none */
+    bool is_static;         /* infinite mass, never moves (planes always are) */
     uint32_t collision_group; /* bodies sharing a nonzero group do not collide with each other
                                  (a ragdoll's limbs); 0 -> collides with every body */
 } ak_rigid_body_desc;
@@ -121,34 +122,34 @@ typedef enum ak_rigid_joint_type {
  * stores each body's local anchor and axes from them). XPBD constraints with compliance 0
  * (rigid) or the given one, solved before the contacts each substep. */
 typedef struct ak_rigid_joint_desc {
-    ak_rigid_joint_type type;  /* 0 -> ball */
-    uint32_t body_a, body_b;   /* body indices, different; either may be static */
-    ak_vec3 anchor;            /* world point where the bodies are joined */
-    ak_vec3 axis;              /* world: hinge axis, prismatic slide axis, ball's swing axis;
-                                  zero -> (0, 0, 1) */
-    ak_vec3 axis_b;            /* world: the axis as body b carries it, when b's zero-swing
-                                  pose differs from the built one (ball swing); zero -> axis */
-    float angle_offset;        /* hinge: the built pose's angle (rad) in the limits' measure:
-                                  the limits apply to angle + angle_offset; ball: the same for
-                                  the twist; 0 -> as built is 0 */
-    bool twist_limited;        /* ball: twist_lower <= twist about the axis <= twist_upper */
+    ak_rigid_joint_type type;       /* 0 -> ball */
+    uint32_t body_a, body_b;        /* body indices, different; either may be static */
+    ak_vec3 anchor;                 /* world point where the bodies are joined */
+    ak_vec3 axis;                   /* world: hinge axis, prismatic slide axis, ball's swing axis;
+                                       zero -> (0, 0, 1) */
+    ak_vec3 axis_b;                 /* world: the axis as body b carries it, when b's zero-swing
+                                       pose differs from the built one (ball swing); zero -> axis */
+    float angle_offset;             /* hinge: the built pose's angle (rad) in the limits' measure:
+                                       the limits apply to angle + angle_offset; ball: the same for
+                                       the twist; 0 -> as built is 0 */
+    bool twist_limited;             /* ball: twist_lower <= twist about the axis <= twist_upper */
     float twist_lower, twist_upper; /* radians */
-    bool limited;              /* hinge: lower <= angle <= upper; prismatic: lower <= offset
-                                  <= upper; ball: swing (angle between the bodies' axes) <= upper */
-    float lower, upper;        /* radians (hinge, ball) or metres (prismatic), as built = 0 */
-    float compliance;          /* m/N and rad/(N m) of every part of the joint; 0 -> rigid */
-    bool drive;                /* drive b's orientation relative to a towards drive_target */
-    ak_quat drive_target;      /* b's orientation in a's frame (a^-1 b); zero -> as built */
-    float drive_compliance;    /* rad/(N m); 0 -> rigid (the drive then acts as a fixed joint) */
+    bool limited;                   /* hinge: lower <= angle <= upper; prismatic: lower <= offset
+                                       <= upper; ball: swing (angle between the bodies' axes) <= upper */
+    float lower, upper;             /* radians (hinge, ball) or metres (prismatic), as built = 0 */
+    float compliance;               /* m/N and rad/(N m) of every part of the joint; 0 -> rigid */
+    bool drive;                     /* drive b's orientation relative to a towards drive_target */
+    ak_quat drive_target;           /* b's orientation in a's frame (a^-1 b); zero -> as built */
+    float drive_compliance; /* rad/(N m); 0 -> rigid (the drive then acts as a fixed joint) */
 } ak_rigid_joint_desc;
 
 AK_DEFINE_SPAN(rigid_joint_desc, ak_rigid_joint_desc)
 
 typedef struct ak_rigid_model_desc {
-    ak_rigid_body_desc_cspan bodies; /* at least one (required) */
+    ak_rigid_body_desc_cspan bodies;  /* at least one (required) */
     ak_rigid_joint_desc_cspan joints; /* optional */
-    float linear_damping;      /* 1/s: v *= 1 / (1 + h c) each substep; 0 -> none */
-    float angular_damping;     /* 1/s: the same on angular velocity; 0 -> none */
+    float linear_damping;             /* 1/s: v *= 1 / (1 + h c) each substep; 0 -> none */
+    float angular_damping;            /* 1/s: the same on angular velocity; 0 -> none */
     float contact_offset;      /* metres: contacts are found this far before touching; 0 -> 0.01 */
     float sleep_linear_speed;  /* m/s under which a body may sleep; 0 -> 0.05 */
     float sleep_angular_speed; /* rad/s under which a body may sleep; 0 -> 0.05 */
@@ -180,8 +181,9 @@ AK_API size_t ak_rigid_joint_count(const ak_rigid_model* model);
 /* How far joint i is from satisfied in a state: *out_gap the distance between its anchors (m,
  * prismatic: off the axis), *out_limit_excess how far its angle or offset is outside its limits
  * (rad or m, 0 when inside or unlimited). AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX, AK_ERR_SPAN_SMALL. */
-AK_API ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t joint_index, ak_vec3_cspan positions,
-                                      ak_quat_cspan orientations, float* out_gap, float* out_limit_excess);
+AK_API ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t joint_index,
+                                      ak_vec3_cspan positions, ak_quat_cspan orientations,
+                                      float* out_gap, float* out_limit_excess);
 
 /* Number of bodies (0 for NULL). */
 AK_API size_t ak_rigid_body_count(const ak_rigid_model* model);
@@ -215,10 +217,10 @@ struct ak_skeleton;
 
 /* How one skeleton joint maps onto the ragdoll's bodies. */
 typedef struct ak_rigid_ragdoll_bone {
-    int32_t body;          /* index into the model's bodies (body_offset included), or -1 for
-                              a joint without a body (a leaf: it keeps its local transform) */
-    ak_vec3 offset;        /* the joint's position in its body's frame (m) */
-    ak_quat rotation;      /* the joint's model rotation in its body's frame */
+    int32_t body;     /* index into the model's bodies (body_offset included), or -1 for
+                         a joint without a body (a leaf: it keeps its local transform) */
+    ak_vec3 offset;   /* the joint's position in its body's frame (m) */
+    ak_quat rotation; /* the joint's model rotation in its body's frame */
 } ak_rigid_ragdoll_bone;
 
 AK_DEFINE_SPAN(rigid_ragdoll_bone, ak_rigid_ragdoll_bone)
@@ -251,40 +253,44 @@ AK_API size_t ak_rigid_ragdoll_joint_count(const struct ak_skeleton* skeleton);
  * >= body count, out_joints >= joint count, out_bones >= skeleton joint count. Returns
  * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_ARG (previous_pose without previous_dt > 0,
  * negative sizes), AK_ERR_BAD_DATA (a non-finite pose). */
-AK_API ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc, ak_rigid_body_desc_span out_bodies,
-                                        ak_rigid_joint_desc_span out_joints, ak_rigid_ragdoll_bone_span out_bones);
+AK_API ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
+                                        ak_rigid_body_desc_span out_bodies,
+                                        ak_rigid_joint_desc_span out_joints,
+                                        ak_rigid_ragdoll_bone_span out_bones);
 
 /* The ragdoll's bodies written back as a skeleton pose: local transforms (scale from
  * fallback_pose) so that skinning and export work unchanged. Joints without a body keep
  * fallback_pose's local transform. root as in the desc. Sizes >= skeleton joint count.
  * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX (a bone's body out of the state). */
-AK_API ak_result ak_rigid_ragdoll_pose(const struct ak_skeleton* skeleton, ak_rigid_ragdoll_bone_cspan bones,
-                                       ak_mat4 root, ak_vec3_cspan positions, ak_quat_cspan orientations,
-                                       ak_transform_cspan fallback_pose, ak_transform_span out_local_pose);
+AK_API ak_result ak_rigid_ragdoll_pose(const struct ak_skeleton* skeleton,
+                                       ak_rigid_ragdoll_bone_cspan bones, ak_mat4 root,
+                                       ak_vec3_cspan positions, ak_quat_cspan orientations,
+                                       ak_transform_cspan fallback_pose,
+                                       ak_transform_span out_local_pose);
 
 /* ---- step ------------------------------------------------------------------------------ */
 
 #define AK_RIGID_MAX_THREADS 64
 
 typedef struct ak_rigid_step_job {
-    const ak_rigid_model* model;      /* required */
-    float dt;                         /* seconds, > 0 (required) */
-    uint32_t substeps;                /* XPBD substeps per step; 0 -> 10; <= 1000 */
-    ak_vec3 gravity;                  /* m/s^2, world (zero is a real choice: no gravity) */
-    uint32_t thread_count;            /* <= AK_RIGID_MAX_THREADS; for now always the
-                                         calling thread (see the header's opening) */
+    const ak_rigid_model* model; /* required */
+    float dt;                    /* seconds, > 0 (required) */
+    uint32_t substeps;           /* XPBD substeps per step; 0 -> 10; <= 1000 */
+    ak_vec3 gravity;             /* m/s^2, world (zero is a real choice: no gravity) */
+    uint32_t thread_count;       /* <= AK_RIGID_MAX_THREADS; for now always the
+                                    calling thread (see the header's opening) */
     /* State, one element per body, read and written (world space). */
     ak_vec3_span positions;
     ak_quat_span orientations;
     ak_vec3_span velocities;
     ak_vec3_span angular_velocities;
-    ak_f32_span sleep_timers;         /* optional: seconds each body has been slow (state, start at
-                                         0); empty -> bodies never sleep */
-    ak_u8_span scratch;               /* >= ak_rigid_step_scratch_size(job) bytes */
+    ak_f32_span sleep_timers; /* optional: seconds each body has been slow (state, start at
+                                 0); empty -> bodies never sleep */
+    ak_u8_span scratch;       /* >= ak_rigid_step_scratch_size(job) bytes */
     /* Outputs (optional). */
-    float* out_max_penetration;       /* metres: deepest contact after the step's last solve */
-    uint32_t* out_contact_count;      /* contact points of the last substep */
-    uint32_t* out_dropped_contacts;   /* contact points over max_contacts, summed over substeps */
+    float* out_max_penetration;     /* metres: deepest contact after the step's last solve */
+    uint32_t* out_contact_count;    /* contact points of the last substep */
+    uint32_t* out_dropped_contacts; /* contact points over max_contacts, summed over substeps */
 } ak_rigid_step_job;
 
 /* Bytes of scratch a step needs (0 for a NULL job or model). */

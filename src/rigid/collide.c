@@ -29,9 +29,12 @@ static void add_hit(hits* hs, ak_vec3 pa, ak_vec3 pb, ak_vec3 n) {
 
 static ak_vec3 axis_of(ak_quat q, int k) {
     ak_vec3 e = ak_vec3_zero();
-    if (k == 0) e.x = 1.0f;
-    else if (k == 1) e.y = 1.0f;
-    else e.z = 1.0f;
+    if (k == 0)
+        e.x = 1.0f;
+    else if (k == 1)
+        e.y = 1.0f;
+    else
+        e.z = 1.0f;
     return ak_quat_rotate(q, e);
 }
 
@@ -45,7 +48,8 @@ static ak_vec3 closest_on_segment(ak_vec3 p, ak_vec3 a, ak_vec3 b) {
 }
 
 /* Closest points c1 on segment p1-q1 and c2 on p2-q2 (minimising |c1 - c2|). */
-static void segment_segment(ak_vec3 p1, ak_vec3 q1, ak_vec3 p2, ak_vec3 q2, ak_vec3* c1, ak_vec3* c2) {
+static void segment_segment(ak_vec3 p1, ak_vec3 q1, ak_vec3 p2, ak_vec3 q2, ak_vec3* c1,
+                            ak_vec3* c2) {
     ak_vec3 d1 = ak_vec3_sub(q1, p1), d2 = ak_vec3_sub(q2, p2), r = ak_vec3_sub(p1, p2);
     float a = ak_vec3_dot(d1, d1), e = ak_vec3_dot(d2, d2), f = ak_vec3_dot(d2, r);
     float s, t;
@@ -110,9 +114,12 @@ static void sphere_box(hits* hs, ak_vec3 c, float r, ak_vec3 xb, ak_quat qb, ak_
         }
         float sgn = comp(lc, k) >= 0.0f ? 1.0f : -1.0f;
         nl = ak_vec3_zero();
-        if (k == 0) nl.x = sgn, cl.x = sgn * he.x;
-        else if (k == 1) nl.y = sgn, cl.y = sgn * he.y;
-        else nl.z = sgn, cl.z = sgn * he.z;
+        if (k == 0)
+            nl.x = sgn, cl.x = sgn * he.x;
+        else if (k == 1)
+            nl.y = sgn, cl.y = sgn * he.y;
+        else
+            nl.z = sgn, cl.z = sgn * he.z;
     }
     ak_vec3 n = ak_quat_rotate(qb, nl);
     ak_vec3 pb = ak_vec3_add(xb, ak_quat_rotate(qb, cl));
@@ -154,7 +161,8 @@ static void capsule_box(hits* hs, rigid_pose pa, const ak_rigid_shape* sa, rigid
     sphere_box(hs, a1, sa->radius, pb.x, pb.q, sb->half_extents);
     /* the segment's point nearest the box: alternate projections (converges for convex sets) */
     ak_quat qi = ak_quat_conjugate(pb.q);
-    ak_vec3 l0 = ak_quat_rotate(qi, ak_vec3_sub(a0, pb.x)), l1 = ak_quat_rotate(qi, ak_vec3_sub(a1, pb.x));
+    ak_vec3 l0 = ak_quat_rotate(qi, ak_vec3_sub(a0, pb.x)),
+            l1 = ak_quat_rotate(qi, ak_vec3_sub(a1, pb.x));
     ak_vec3 he = sb->half_extents, p = ak_vec3_scale(ak_vec3_add(l0, l1), 0.5f);
     for (int it = 0; it < 8; ++it) {
         ak_vec3 cb = ak_vec3_make(ak_clampf(p.x, -he.x, he.x), ak_clampf(p.y, -he.y, he.y),
@@ -197,7 +205,8 @@ static void box_box(hits* hs, rigid_pose pa, ak_vec3 ha, rigid_pose pb, ak_vec3 
     ak_vec3 d = ak_vec3_sub(pb.x, pa.x);
     float c[3][3], ac[3][3];
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) c[i][j] = ak_vec3_dot(ua[i], ub[j]), ac[i][j] = fabsf(c[i][j]) + 1e-6f;
+        for (int j = 0; j < 3; ++j)
+            c[i][j] = ak_vec3_dot(ua[i], ub[j]), ac[i][j] = fabsf(c[i][j]) + 1e-6f;
     float best_face = -INFINITY;
     int face_kind = 0, face_k = 0; /* kind 0: a face of A is the reference; 1: of B */
     for (int i = 0; i < 3; ++i) {
@@ -224,7 +233,8 @@ static void box_box(hits* hs, rigid_pose pa, ak_vec3 ha, rigid_pose pb, ak_vec3 
             l = ak_vec3_scale(l, 1.0f / len);
             float ra = 0.0f, rb = 0.0f;
             for (int k = 0; k < 3; ++k)
-                ra += comp(ha, k) * fabsf(ak_vec3_dot(ua[k], l)), rb += comp(hb, k) * fabsf(ak_vec3_dot(ub[k], l));
+                ra += comp(ha, k) * fabsf(ak_vec3_dot(ua[k], l)),
+                    rb += comp(hb, k) * fabsf(ak_vec3_dot(ub[k], l));
             float s = fabsf(ak_vec3_dot(d, l)) - ra - rb;
             if (s > hs->margin) return;
             if (s > best_edge) best_edge = s, ei = i, ej = j, edge_axis = l;
@@ -234,12 +244,17 @@ static void box_box(hits* hs, rigid_pose pa, ak_vec3 ha, rigid_pose pb, ak_vec3 
         if (ak_vec3_dot(l, d) < 0.0f) l = ak_vec3_neg(l); /* from A towards B */
         ak_vec3 ca = pa.x, cb = pb.x;
         for (int k = 0; k < 3; ++k) {
-            if (k != ei) ca = ak_vec3_madd(ca, ua[k], ak_vec3_dot(l, ua[k]) >= 0.0f ? comp(ha, k) : -comp(ha, k));
-            if (k != ej) cb = ak_vec3_madd(cb, ub[k], ak_vec3_dot(l, ub[k]) >= 0.0f ? -comp(hb, k) : comp(hb, k));
+            if (k != ei)
+                ca = ak_vec3_madd(ca, ua[k],
+                                  ak_vec3_dot(l, ua[k]) >= 0.0f ? comp(ha, k) : -comp(ha, k));
+            if (k != ej)
+                cb = ak_vec3_madd(cb, ub[k],
+                                  ak_vec3_dot(l, ub[k]) >= 0.0f ? -comp(hb, k) : comp(hb, k));
         }
         ak_vec3 ea = ak_vec3_scale(ua[ei], comp(ha, ei)), eb = ak_vec3_scale(ub[ej], comp(hb, ej));
         ak_vec3 c1, c2;
-        segment_segment(ak_vec3_sub(ca, ea), ak_vec3_add(ca, ea), ak_vec3_sub(cb, eb), ak_vec3_add(cb, eb), &c1, &c2);
+        segment_segment(ak_vec3_sub(ca, ea), ak_vec3_add(ca, ea), ak_vec3_sub(cb, eb),
+                        ak_vec3_add(cb, eb), &c1, &c2);
         add_hit(hs, c1, c2, ak_vec3_neg(l));
         return;
     }
@@ -285,8 +300,10 @@ static void box_box(hits* hs, rigid_pose pa, ak_vec3 ha, rigid_pose pb, ak_vec3 
         if (dup) continue;
         float s = ak_vec3_dot(ak_vec3_sub(poly[i], rc), nref);
         ak_vec3 on_ref = ak_vec3_madd(poly[i], nref, -s);
-        if (face_kind == 1) add_hit(hs, poly[i], on_ref, nref); /* B is the reference */
-        else add_hit(hs, on_ref, poly[i], ak_vec3_neg(nref));
+        if (face_kind == 1)
+            add_hit(hs, poly[i], on_ref, nref); /* B is the reference */
+        else
+            add_hit(hs, on_ref, poly[i], ak_vec3_neg(nref));
     }
 }
 
@@ -296,18 +313,24 @@ static void collide_ordered(hits* hs, rigid_pose pa, const ak_rigid_shape* sa, r
                             const ak_rigid_shape* sb) {
     ak_rigid_shape_type ta = sa->type, tb = sb->type;
     if (ta == AK_RIGID_SPHERE) {
-        if (tb == AK_RIGID_SPHERE) sphere_sphere(hs, pa.x, sa->radius, pb.x, sb->radius);
-        else if (tb == AK_RIGID_BOX) sphere_box(hs, pa.x, sa->radius, pb.x, pb.q, sb->half_extents);
+        if (tb == AK_RIGID_SPHERE)
+            sphere_sphere(hs, pa.x, sa->radius, pb.x, sb->radius);
+        else if (tb == AK_RIGID_BOX)
+            sphere_box(hs, pa.x, sa->radius, pb.x, pb.q, sb->half_extents);
         else if (tb == AK_RIGID_CAPSULE) {
             ak_vec3 b0, b1;
             capsule_ends(pb, sb, &b0, &b1);
             sphere_sphere(hs, pa.x, sa->radius, closest_on_segment(pa.x, b0, b1), sb->radius);
-        } else sphere_plane(hs, pa.x, sa->radius, pb.x, sb->normal);
+        } else
+            sphere_plane(hs, pa.x, sa->radius, pb.x, sb->normal);
     } else if (ta == AK_RIGID_BOX) {
-        if (tb == AK_RIGID_BOX) box_box(hs, pa, sa->half_extents, pb, sb->half_extents);
-        else if (tb == AK_RIGID_PLANE) box_plane(hs, pa, sa->half_extents, pb.x, sb->normal);
+        if (tb == AK_RIGID_BOX)
+            box_box(hs, pa, sa->half_extents, pb, sb->half_extents);
+        else if (tb == AK_RIGID_PLANE)
+            box_plane(hs, pa, sa->half_extents, pb.x, sb->normal);
     } else if (ta == AK_RIGID_CAPSULE) {
-        if (tb == AK_RIGID_CAPSULE) capsule_capsule(hs, pa, sa, pb, sb);
+        if (tb == AK_RIGID_CAPSULE)
+            capsule_capsule(hs, pa, sa, pb, sb);
         else if (tb == AK_RIGID_PLANE) {
             ak_vec3 a0, a1;
             capsule_ends(pa, sa, &a0, &a1);
@@ -321,17 +344,23 @@ static void collide_ordered(hits* hs, rigid_pose pa, const ak_rigid_shape* sa, r
  * first, so capsule-box pairs are flipped below). */
 static int rank_of(ak_rigid_shape_type t) {
     switch (t) {
-    case AK_RIGID_SPHERE: return 0;
-    case AK_RIGID_CAPSULE: return 1;
-    case AK_RIGID_BOX: return 2;
-    default: return 3;
+    case AK_RIGID_SPHERE:
+        return 0;
+    case AK_RIGID_CAPSULE:
+        return 1;
+    case AK_RIGID_BOX:
+        return 2;
+    default:
+        return 3;
     }
 }
 
 static void collide_any(hits* hs, rigid_pose pa, const ak_rigid_shape* sa, rigid_pose pb,
                         const ak_rigid_shape* sb) {
-    if (sa->type == AK_RIGID_CAPSULE && sb->type == AK_RIGID_BOX) capsule_box(hs, pa, sa, pb, sb);
-    else collide_ordered(hs, pa, sa, pb, sb);
+    if (sa->type == AK_RIGID_CAPSULE && sb->type == AK_RIGID_BOX)
+        capsule_box(hs, pa, sa, pb, sb);
+    else
+        collide_ordered(hs, pa, sa, pb, sb);
 }
 
 int akp_rigid_collide(const ak_rigid_model* m, uint32_t a, uint32_t b, rigid_pose pa, rigid_pose pb,
@@ -342,8 +371,10 @@ int akp_rigid_collide(const ak_rigid_model* m, uint32_t a, uint32_t b, rigid_pos
     hs.count = 0;
     hs.margin = margin;
     bool swap = rank_of(sa->type) > rank_of(sb->type);
-    if (swap) collide_any(&hs, pb, sb, pa, sa);
-    else collide_any(&hs, pa, sa, pb, sb);
+    if (swap)
+        collide_any(&hs, pb, sb, pa, sa);
+    else
+        collide_any(&hs, pa, sa, pb, sb);
     int count = hs.count < cap ? hs.count : cap;
     ak_quat qa = ak_quat_conjugate(pa.q), qb = ak_quat_conjugate(pb.q);
     for (int i = 0; i < count; ++i) {

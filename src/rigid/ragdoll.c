@@ -12,7 +12,8 @@
 static ak_mat4 joint_world(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 root, size_t i) {
     ak_i16_cspan parents = ak_skeleton_parents(sk);
     ak_mat4 m = ak_transform_to_mat4(pose.ptr[i]);
-    for (int p = parents.ptr[i]; p >= 0; p = parents.ptr[p]) m = ak_mat4_mul(ak_transform_to_mat4(pose.ptr[p]), m);
+    for (int p = parents.ptr[i]; p >= 0; p = parents.ptr[p])
+        m = ak_mat4_mul(ak_transform_to_mat4(pose.ptr[p]), m);
     return ak_mat4_mul(root, m);
 }
 
@@ -24,10 +25,13 @@ static ak_quat mat_rotation(ak_mat4 m) {
     return ak_quat_normalize(ak_quat_from_mat3(ak_mat3_from_cols(c0, c1, c2)));
 }
 
-static bool has_children(const ak_skeleton* sk, size_t i) { return ak_skeleton_child_count(sk, i) > 0; }
+static bool has_children(const ak_skeleton* sk, size_t i) {
+    return ak_skeleton_child_count(sk, i) > 0;
+}
 
 /* Mean world position of joint i's children. */
-static ak_vec3 children_mean(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 root, size_t i) {
+static ak_vec3 children_mean(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 root,
+                             size_t i) {
     ak_i16_cspan parents = ak_skeleton_parents(sk);
     ak_vec3 sum = ak_vec3_zero();
     float n = 0.0f;
@@ -36,7 +40,8 @@ static ak_vec3 children_mean(const ak_skeleton* sk, ak_transform_cspan pose, ak_
             sum = ak_vec3_add(sum, ak_mat4_get_translation(joint_world(sk, pose, root, c)));
             n += 1.0f;
         }
-    return n > 0.0f ? ak_vec3_scale(sum, 1.0f / n) : ak_mat4_get_translation(joint_world(sk, pose, root, i));
+    return n > 0.0f ? ak_vec3_scale(sum, 1.0f / n)
+                    : ak_mat4_get_translation(joint_world(sk, pose, root, i));
 }
 
 size_t ak_rigid_ragdoll_body_count(const ak_skeleton* sk) {
@@ -53,8 +58,8 @@ size_t ak_rigid_ragdoll_joint_count(const ak_skeleton* sk) {
 }
 
 /* A body's pose for joint i: centred on the bone, local Y along it. */
-static void bone_body(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 root, size_t i, ak_vec3* out_x,
-                      ak_quat* out_q, float* out_length) {
+static void bone_body(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 root, size_t i,
+                      ak_vec3* out_x, ak_quat* out_q, float* out_length) {
     ak_mat4 w = joint_world(sk, pose, root, i);
     ak_vec3 p0 = ak_mat4_get_translation(w), p1 = children_mean(sk, pose, root, i);
     ak_vec3 d = ak_vec3_sub(p1, p0);
@@ -68,7 +73,8 @@ static void bone_body(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 ro
     }
     /* the joint's frame turned so its Y runs along the bone (keeps the twist of the joint) */
     ak_vec3 y_now = ak_quat_rotate(qj, ak_vec3_make(0.0f, 1.0f, 0.0f));
-    *out_q = ak_quat_normalize(ak_quat_mul(ak_quat_from_to(y_now, ak_vec3_scale(d, 1.0f / len)), qj));
+    *out_q =
+        ak_quat_normalize(ak_quat_mul(ak_quat_from_to(y_now, ak_vec3_scale(d, 1.0f / len)), qj));
     *out_x = ak_vec3_scale(ak_vec3_add(p0, p1), 0.5f);
     *out_length = len;
 }
@@ -79,22 +85,29 @@ static bool mat_is_zero(ak_mat4 m) {
     return true;
 }
 
-ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc, ak_rigid_body_desc_span out_bodies,
-                                 ak_rigid_joint_desc_span out_joints, ak_rigid_ragdoll_bone_span out_bones) {
-    if (!desc || !desc->skeleton || !desc->local_pose.ptr || !out_bodies.ptr || !out_bones.ptr) return AK_ERR_NULL_ARG;
+ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
+                                 ak_rigid_body_desc_span out_bodies,
+                                 ak_rigid_joint_desc_span out_joints,
+                                 ak_rigid_ragdoll_bone_span out_bones) {
+    if (!desc || !desc->skeleton || !desc->local_pose.ptr || !out_bodies.ptr || !out_bones.ptr)
+        return AK_ERR_NULL_ARG;
     const ak_skeleton* sk = desc->skeleton;
     size_t n = ak_skeleton_joint_count(sk);
     size_t nb = ak_rigid_ragdoll_body_count(sk), nj = ak_rigid_ragdoll_joint_count(sk);
     if (nj && !out_joints.ptr) return AK_ERR_NULL_ARG;
-    if (desc->local_pose.count < n || out_bodies.count < nb || out_joints.count < nj || out_bones.count < n ||
-        (desc->previous_pose.count && desc->previous_pose.count < n))
+    if (desc->local_pose.count < n || out_bodies.count < nb || out_joints.count < nj ||
+        out_bones.count < n || (desc->previous_pose.count && desc->previous_pose.count < n))
         return AK_ERR_SPAN_SMALL;
-    if (desc->previous_pose.count && (!desc->previous_pose.ptr || !(desc->previous_dt > 0.0f))) return AK_ERR_BAD_ARG;
-    if (desc->radius_scale < 0.0f || desc->max_radius < 0.0f || desc->density < 0.0f || desc->friction < 0.0f)
+    if (desc->previous_pose.count && (!desc->previous_pose.ptr || !(desc->previous_dt > 0.0f)))
+        return AK_ERR_BAD_ARG;
+    if (desc->radius_scale < 0.0f || desc->max_radius < 0.0f || desc->density < 0.0f ||
+        desc->friction < 0.0f)
         return AK_ERR_BAD_ARG;
     if (!ak_pose_is_finite((ak_transform_cspan){desc->local_pose.ptr, n}) ||
-        (desc->previous_pose.count && !ak_pose_is_finite((ak_transform_cspan){desc->previous_pose.ptr, n})) ||
-        !ak_finitef(desc->previous_dt) || !ak_finitef(desc->radius_scale) || !ak_finitef(desc->max_radius))
+        (desc->previous_pose.count &&
+         !ak_pose_is_finite((ak_transform_cspan){desc->previous_pose.ptr, n})) ||
+        !ak_finitef(desc->previous_dt) || !ak_finitef(desc->radius_scale) ||
+        !ak_finitef(desc->max_radius))
         return AK_ERR_BAD_DATA;
     const ak_mat4 root = mat_is_zero(desc->root) ? ak_mat4_identity() : desc->root;
     const float scale = desc->radius_scale > 0.0f ? desc->radius_scale : 0.2f;
@@ -159,13 +172,17 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc, ak_rigid_bod
             jd->anchor = ak_mat4_get_translation(w);
             ak_joint_limits lim = ak_skeleton_joint_limits(sk, i);
             /* the joint's rest frame in the world, at the start pose of its parent */
-            ak_quat q_rest = ak_quat_normalize(ak_quat_mul(mat_rotation(joint_world(sk, desc->local_pose, root, (size_t)p)),
-                                                           rest.ptr[i].rotation));
+            ak_quat q_rest = ak_quat_normalize(
+                ak_quat_mul(mat_rotation(joint_world(sk, desc->local_pose, root, (size_t)p)),
+                            rest.ptr[i].rotation));
             switch (ak_skeleton_joint_type(sk, i)) {
             case AK_JOINT_HINGE: {
-                ak_vec3 axis = ak_vec3_length_sq(lim.axis) > 0.0f ? ak_vec3_normalize(lim.axis) : ak_vec3_make(1, 0, 0);
-                ak_quat rel = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(rest.ptr[i].rotation), desc->local_pose.ptr[i].rotation));
-                float phi0 = 2.0f * atan2f(ak_vec3_dot(ak_vec3_make(rel.x, rel.y, rel.z), axis), rel.w);
+                ak_vec3 axis = ak_vec3_length_sq(lim.axis) > 0.0f ? ak_vec3_normalize(lim.axis)
+                                                                  : ak_vec3_make(1, 0, 0);
+                ak_quat rel = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(rest.ptr[i].rotation),
+                                                            desc->local_pose.ptr[i].rotation));
+                float phi0 =
+                    2.0f * atan2f(ak_vec3_dot(ak_vec3_make(rel.x, rel.y, rel.z), axis), rel.w);
                 if (phi0 > AK_PI) phi0 -= 2.0f * AK_PI;
                 if (phi0 < -AK_PI) phi0 += 2.0f * AK_PI;
                 jd->type = AK_RIGID_JOINT_HINGE;
@@ -177,14 +194,16 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc, ak_rigid_bod
                 break;
             }
             case AK_JOINT_BALL: {
-                ak_vec3 axis = ak_vec3_length_sq(lim.axis) > 0.0f ? ak_vec3_normalize(lim.axis) : ak_vec3_make(0, 1, 0);
+                ak_vec3 axis = ak_vec3_length_sq(lim.axis) > 0.0f ? ak_vec3_normalize(lim.axis)
+                                                                  : ak_vec3_make(0, 1, 0);
                 jd->type = AK_RIGID_JOINT_BALL;
                 jd->axis = ak_quat_rotate(q_rest, axis);
                 jd->axis_b = ak_quat_rotate(qj, axis);
                 jd->limited = lim.cone_angle > 0.0f;
                 jd->upper = lim.cone_angle;
                 /* the start pose's twist in the skeleton's measure (swing-twist about the axis) */
-                ak_quat rel = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(rest.ptr[i].rotation), desc->local_pose.ptr[i].rotation));
+                ak_quat rel = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(rest.ptr[i].rotation),
+                                                            desc->local_pose.ptr[i].rotation));
                 ak_quat sw, tw;
                 ak_quat_swing_twist(rel, axis, &sw, &tw);
                 float t0 = 2.0f * atan2f(ak_vec3_dot(ak_vec3_make(tw.x, tw.y, tw.z), axis), tw.w);
@@ -198,7 +217,8 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc, ak_rigid_bod
             }
             case AK_JOINT_PRISM:
                 jd->type = AK_RIGID_JOINT_PRISMATIC;
-                jd->axis = ak_quat_rotate(q_rest, ak_vec3_length_sq(lim.axis) > 0.0f ? lim.axis : ak_vec3_make(1, 0, 0));
+                jd->axis = ak_quat_rotate(
+                    q_rest, ak_vec3_length_sq(lim.axis) > 0.0f ? lim.axis : ak_vec3_make(1, 0, 0));
                 break;
             default:
                 jd->type = AK_RIGID_JOINT_BALL;
@@ -210,13 +230,15 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc, ak_rigid_bod
     return AK_OK;
 }
 
-ak_result ak_rigid_ragdoll_pose(const ak_skeleton* sk, ak_rigid_ragdoll_bone_cspan bones, ak_mat4 root,
-                                ak_vec3_cspan x, ak_quat_cspan q, ak_transform_cspan fallback, ak_transform_span out) {
+ak_result ak_rigid_ragdoll_pose(const ak_skeleton* sk, ak_rigid_ragdoll_bone_cspan bones,
+                                ak_mat4 root, ak_vec3_cspan x, ak_quat_cspan q,
+                                ak_transform_cspan fallback, ak_transform_span out) {
     if (!sk || !bones.ptr || !x.ptr || !q.ptr || !fallback.ptr || !out.ptr) return AK_ERR_NULL_ARG;
     size_t n = ak_skeleton_joint_count(sk);
     if (bones.count < n || fallback.count < n || out.count < n) return AK_ERR_SPAN_SMALL;
     for (size_t i = 0; i < n; ++i)
-        if (bones.ptr[i].body >= 0 && ((size_t)bones.ptr[i].body >= x.count || (size_t)bones.ptr[i].body >= q.count))
+        if (bones.ptr[i].body >= 0 &&
+            ((size_t)bones.ptr[i].body >= x.count || (size_t)bones.ptr[i].body >= q.count))
             return AK_ERR_BAD_INDEX;
     if (mat_is_zero(root)) root = ak_mat4_identity();
     ak_i16_cspan parents = ak_skeleton_parents(sk);
@@ -242,8 +264,10 @@ ak_result ak_rigid_ragdoll_pose(const ak_skeleton* sk, ak_rigid_ragdoll_bone_csp
             parent_world = ak_mat4_mul(ak_mat4_translation(ppw), ak_mat4_from_quat(prw));
         }
         /* local = parent_world^-1 * world (rigid, so the inverse is the transpose) */
-        ak_mat4 inv = ak_mat4_transpose(ak_mat4_from_mat3(ak_mat4_to_mat3(parent_world), ak_vec3_zero()));
-        ak_vec3 t = ak_mat4_transform_vector(inv, ak_vec3_sub(pw, ak_mat4_get_translation(parent_world)));
+        ak_mat4 inv =
+            ak_mat4_transpose(ak_mat4_from_mat3(ak_mat4_to_mat3(parent_world), ak_vec3_zero()));
+        ak_vec3 t =
+            ak_mat4_transform_vector(inv, ak_vec3_sub(pw, ak_mat4_get_translation(parent_world)));
         ak_quat pr = p >= 0 ? mat_rotation(parent_world) : mat_rotation(root);
         out.ptr[i].translation = t;
         out.ptr[i].rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(pr), rw));

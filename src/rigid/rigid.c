@@ -31,8 +31,9 @@ static void shape_unit_mass(const ak_rigid_shape* s, double* out_volume, ak_vec3
         double x = s->half_extents.x, y = s->half_extents.y, z = s->half_extents.z;
         *out_volume = 8.0 * x * y * z;
         /* solid box of sides 2x, 2y, 2z: I_x = m (4y^2 + 4z^2) / 12 */
-        *out_i_per_mass = ak_vec3_make((float)((y * y + z * z) / 3.0), (float)((x * x + z * z) / 3.0),
-                                       (float)((x * x + y * y) / 3.0));
+        *out_i_per_mass =
+            ak_vec3_make((float)((y * y + z * z) / 3.0), (float)((x * x + z * z) / 3.0),
+                         (float)((x * x + y * y) / 3.0));
         break;
     }
     case AK_RIGID_CAPSULE: {
@@ -112,8 +113,9 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
     if (alloc && (!alloc->alloc) != (!alloc->free)) return AK_ERR_BAD_ARG;
     if (desc->bodies.count == 0 || !desc->bodies.ptr) return AK_ERR_EMPTY;
     if (desc->bodies.count > (1u << 24)) return AK_ERR_BAD_ARG;
-    const float scalars[] = {desc->linear_damping, desc->angular_damping, desc->contact_offset,
-                             desc->sleep_linear_speed, desc->sleep_angular_speed, desc->sleep_time};
+    const float scalars[] = {desc->linear_damping,      desc->angular_damping,
+                             desc->contact_offset,      desc->sleep_linear_speed,
+                             desc->sleep_angular_speed, desc->sleep_time};
     for (size_t i = 0; i < sizeof scalars / sizeof scalars[0]; ++i) {
         if (!ak_finitef(scalars[i])) return AK_ERR_BAD_DATA;
         if (scalars[i] < 0.0f) return AK_ERR_BAD_ARG;
@@ -129,11 +131,15 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         const ak_rigid_joint_desc* jd = &desc->joints.ptr[i];
         if ((unsigned)jd->type >= AK_RIGID_JOINT_TYPE_COUNT) return AK_ERR_BAD_ARG;
         if (jd->body_a >= n || jd->body_b >= n || jd->body_a == jd->body_b) return AK_ERR_BAD_INDEX;
-        if (!vec_finite(jd->anchor) || !vec_finite(jd->axis) || !ak_finitef(jd->lower) || !ak_finitef(jd->upper) ||
-            !ak_finitef(jd->compliance) || !vec_finite(jd->axis_b) || !ak_finitef(jd->angle_offset) || !ak_quat_is_finite(jd->drive_target) || !ak_finitef(jd->drive_compliance))
+        if (!vec_finite(jd->anchor) || !vec_finite(jd->axis) || !ak_finitef(jd->lower) ||
+            !ak_finitef(jd->upper) || !ak_finitef(jd->compliance) || !vec_finite(jd->axis_b) ||
+            !ak_finitef(jd->angle_offset) || !ak_quat_is_finite(jd->drive_target) ||
+            !ak_finitef(jd->drive_compliance))
             return AK_ERR_BAD_DATA;
         if (!ak_finitef(jd->twist_lower) || !ak_finitef(jd->twist_upper)) return AK_ERR_BAD_DATA;
-        if ((jd->twist_limited && jd->twist_lower > jd->twist_upper) || (jd->limited && jd->lower > jd->upper) || jd->compliance < 0.0f || jd->drive_compliance < 0.0f)
+        if ((jd->twist_limited && jd->twist_lower > jd->twist_upper) ||
+            (jd->limited && jd->lower > jd->upper) || jd->compliance < 0.0f ||
+            jd->drive_compliance < 0.0f)
             return AK_ERR_BAD_ARG;
     }
     ak_allocator al = {def_alloc, def_free, NULL};
@@ -172,7 +178,8 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         if (d.friction == 0.0f) d.friction = 0.5f;
         if (d.dynamic_friction == 0.0f) d.dynamic_friction = d.friction;
         b->friction = d.friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.friction;
-        b->dynamic_friction = d.dynamic_friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.dynamic_friction;
+        b->dynamic_friction =
+            d.dynamic_friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.dynamic_friction;
         b->restitution = d.restitution;
         b->group = d.collision_group;
         b->shape = d.shape;
@@ -180,10 +187,18 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         ak_vec3 ipm;
         shape_unit_mass(&d.shape, &volume, &ipm);
         switch (d.shape.type) {
-        case AK_RIGID_SPHERE: b->bound_radius = d.shape.radius; break;
-        case AK_RIGID_BOX: b->bound_radius = ak_vec3_length(d.shape.half_extents); break;
-        case AK_RIGID_CAPSULE: b->bound_radius = d.shape.radius + d.shape.half_height; break;
-        default: b->bound_radius = INFINITY; break;
+        case AK_RIGID_SPHERE:
+            b->bound_radius = d.shape.radius;
+            break;
+        case AK_RIGID_BOX:
+            b->bound_radius = ak_vec3_length(d.shape.half_extents);
+            break;
+        case AK_RIGID_CAPSULE:
+            b->bound_radius = d.shape.radius + d.shape.half_height;
+            break;
+        default:
+            b->bound_radius = INFINITY;
+            break;
         }
         if (d.is_static) {
             d.velocity = ak_vec3_zero();
@@ -201,7 +216,8 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             b->mass = (float)mass;
             b->inv_mass = (float)(1.0 / mass);
             b->inertia = ak_vec3_scale(ipm, (float)mass);
-            b->inv_inertia = ak_vec3_make(1.0f / b->inertia.x, 1.0f / b->inertia.y, 1.0f / b->inertia.z);
+            b->inv_inertia =
+                ak_vec3_make(1.0f / b->inertia.x, 1.0f / b->inertia.y, 1.0f / b->inertia.z);
             if (!vec_finite(b->inv_inertia)) {
                 al.free(mem, al.user);
                 return AK_ERR_BAD_ARG;
@@ -215,7 +231,8 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         const ak_rigid_body_desc* da = &m->descs[jd->body_a];
         const ak_rigid_body_desc* db = &m->descs[jd->body_b];
         ak_quat ia = ak_quat_conjugate(da->orientation), ib = ak_quat_conjugate(db->orientation);
-        ak_vec3 axis = ak_vec3_length_sq(jd->axis) > 0.0f ? ak_vec3_normalize(jd->axis) : ak_vec3_make(0, 0, 1);
+        ak_vec3 axis = ak_vec3_length_sq(jd->axis) > 0.0f ? ak_vec3_normalize(jd->axis)
+                                                          : ak_vec3_make(0, 0, 1);
         ak_vec3 perp = ak_vec3_normalize(ak_vec3_any_perpendicular(axis));
         j->type = jd->type;
         j->a = jd->body_a;
@@ -230,11 +247,14 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         ak_vec3 perp2 = ak_vec3_normalize(ak_quat_rotate(ak_quat_from_to(axis, axis2), perp));
         j->perp_b = ak_quat_rotate(ib, jd->type == AK_RIGID_JOINT_BALL ? perp2 : perp);
         ak_quat fwa = ak_quat_from_mat3(ak_mat3_from_cols(perp, axis, ak_vec3_cross(perp, axis)));
-        ak_quat fwb = ak_quat_from_mat3(ak_mat3_from_cols(perp2, axis2, ak_vec3_cross(perp2, axis2)));
+        ak_quat fwb =
+            ak_quat_from_mat3(ak_mat3_from_cols(perp2, axis2, ak_vec3_cross(perp2, axis2)));
         j->frame_a = ak_quat_normalize(ak_quat_mul(ia, fwa));
         j->frame_b = ak_quat_normalize(ak_quat_mul(ib, fwb));
         j->rel = ak_quat_normalize(ak_quat_mul(ia, db->orientation));
-        j->drive_target = ak_quat_dot(jd->drive_target, jd->drive_target) > 0.0f ? ak_quat_normalize(jd->drive_target) : j->rel;
+        j->drive_target = ak_quat_dot(jd->drive_target, jd->drive_target) > 0.0f
+                              ? ak_quat_normalize(jd->drive_target)
+                              : j->rel;
         j->limited = jd->limited;
         j->drive = jd->drive;
         j->lower = jd->lower;
@@ -288,7 +308,8 @@ ak_result ak_rigid_initial_state(const ak_rigid_model* model, ak_vec3_span x, ak
 }
 
 ak_vec3 ak_rigid_angular_momentum(const ak_rigid_model* model, size_t i, ak_quat q, ak_vec3 w) {
-    if (!model || i >= model->body_count || model->bodies[i].inv_mass == 0.0f) return ak_vec3_zero();
+    if (!model || i >= model->body_count || model->bodies[i].inv_mass == 0.0f)
+        return ak_vec3_zero();
     ak_vec3 wl = ak_quat_rotate(ak_quat_conjugate(q), w);
     ak_vec3 ll = ak_vec3_mul(model->bodies[i].inertia, wl);
     return ak_quat_rotate(q, ll);
@@ -315,8 +336,8 @@ double ak_rigid_energy(const ak_rigid_model* model, ak_vec3 g, ak_vec3_cspan x, 
 
 size_t ak_rigid_joint_count(const ak_rigid_model* model) { return model ? model->joint_count : 0; }
 
-ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t i, ak_vec3_cspan x, ak_quat_cspan q, float* out_gap,
-                               float* out_limit_excess) {
+ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t i, ak_vec3_cspan x,
+                               ak_quat_cspan q, float* out_gap, float* out_limit_excess) {
     if (!model || !x.ptr || !q.ptr || !out_gap || !out_limit_excess) return AK_ERR_NULL_ARG;
     if (i >= model->joint_count) return AK_ERR_BAD_INDEX;
     if (x.count < model->body_count || q.count < model->body_count) return AK_ERR_SPAN_SMALL;

@@ -16,19 +16,19 @@ typedef struct rigid_body {
     float friction;         /* static mu, resolved */
     float dynamic_friction; /* dynamic mu, resolved */
     float restitution;
-    float bound_radius;     /* metres from the centre that holds the shape (planes: INFINITY) */
-    uint32_t group;         /* collision group (0: none) */
+    float bound_radius; /* metres from the centre that holds the shape (planes: INFINITY) */
+    uint32_t group;     /* collision group (0: none) */
 } rigid_body;
 
 /* A joint with its anchors and axes in each body's frame (from the descs' poses). */
 typedef struct rigid_joint {
     ak_rigid_joint_type type;
     uint32_t a, b;
-    ak_vec3 la, lb;          /* anchors, local */
-    ak_vec3 axis_a, axis_b;  /* the joint axis in each body's frame */
-    ak_vec3 perp_a, perp_b;  /* a reference direction perpendicular to it, in each frame */
-    ak_quat rel;             /* b's orientation in a's frame as built */
-    ak_quat drive_target;    /* b's orientation in a's frame the drive aims at */
+    ak_vec3 la, lb;           /* anchors, local */
+    ak_vec3 axis_a, axis_b;   /* the joint axis in each body's frame */
+    ak_vec3 perp_a, perp_b;   /* a reference direction perpendicular to it, in each frame */
+    ak_quat rel;              /* b's orientation in a's frame as built */
+    ak_quat drive_target;     /* b's orientation in a's frame the drive aims at */
     ak_quat frame_a, frame_b; /* ball: joint frames (Y along the axis) in each body */
     bool limited, drive, twist_limited;
     float lower, upper, compliance, drive_compliance, angle_offset, twist_lower, twist_upper;
@@ -44,7 +44,8 @@ static inline float akp_rigid_hinge_angle(const rigid_joint* j, ak_quat qa, ak_q
 /* Twist (rad) of b relative to a (ball joints), as a swing-twist decomposition measures it:
  * rel = (qa frame_a)^-1 (qb frame_b) = swing * twist with the twist about the frames' Y (the
  * joint axis); zero as built. *out_n gets the twist axis in the world (b's axis). */
-static inline float akp_rigid_twist_angle(const rigid_joint* j, ak_quat qa, ak_quat qb, ak_vec3* out_n) {
+static inline float akp_rigid_twist_angle(const rigid_joint* j, ak_quat qa, ak_quat qb,
+                                          ak_vec3* out_n) {
     ak_quat fa = ak_quat_mul(qa, j->frame_a), fb = ak_quat_mul(qb, j->frame_b);
     ak_quat rel = ak_quat_mul(ak_quat_conjugate(fa), fb);
     *out_n = ak_quat_rotate(fb, ak_vec3_make(0.0f, 1.0f, 0.0f));
@@ -59,7 +60,7 @@ struct ak_rigid_model {
     ak_rigid_model_desc desc; /* resolved; bodies points at descs */
     size_t body_count;
     size_t plane_count;
-    uint32_t* planes;         /* [plane_count]: the planes' body indices, in order */
+    uint32_t* planes; /* [plane_count]: the planes' body indices, in order */
     rigid_body* bodies;
     ak_rigid_body_desc* descs;
     rigid_joint* joints;
@@ -74,8 +75,8 @@ typedef struct rigid_contact {
     ak_vec3 n;
     ak_vec3 la, lb;
     float depth;
-    float lambda_n;   /* accumulated normal position impulse (kg m) of this substep */
-    float vn_before;  /* relative normal velocity before the solve (m/s) */
+    float lambda_n;  /* accumulated normal position impulse (kg m) of this substep */
+    float vn_before; /* relative normal velocity before the solve (m/s) */
     float friction, dynamic_friction, restitution;
 } rigid_contact;
 

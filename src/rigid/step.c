@@ -35,8 +35,10 @@ static layout layout_of(const ak_rigid_model* m) {
     l.dx = off, off += align16(n * sizeof(ak_vec3));
     l.ds = off, off += align16(n * sizeof(ak_vec3));
     l.sap = off, off += align16(n * sizeof(sap_entry));
-    l.contacts = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) * sizeof(rigid_contact));
-    l.groups = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) * sizeof(contact_group));
+    l.contacts = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
+                                     sizeof(rigid_contact));
+    l.groups = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
+                                   sizeof(contact_group));
     l.parent = off, off += align16(n * sizeof(uint32_t));
     l.awake = off, off += align16(n);
     l.total = off + 16; /* room to align the base */
@@ -54,18 +56,23 @@ ak_result ak_rigid_step_validate(const ak_rigid_step_job* job) {
         job->thread_count > AK_RIGID_MAX_THREADS || !ak_vec3_is_finite(job->gravity))
         return AK_ERR_BAD_ARG;
     size_t n = job->model->body_count;
-    if (!job->positions.ptr || !job->orientations.ptr || !job->velocities.ptr || !job->angular_velocities.ptr ||
-        !job->scratch.ptr)
+    if (!job->positions.ptr || !job->orientations.ptr || !job->velocities.ptr ||
+        !job->angular_velocities.ptr || !job->scratch.ptr)
         return AK_ERR_NULL_ARG;
     if (job->positions.count < n || job->orientations.count < n || job->velocities.count < n ||
-        job->angular_velocities.count < n || (job->sleep_timers.count != 0 && job->sleep_timers.count < n) ||
-        (job->sleep_timers.count != 0 && !job->sleep_timers.ptr) || job->scratch.count < ak_rigid_step_scratch_size(job))
+        job->angular_velocities.count < n ||
+        (job->sleep_timers.count != 0 && job->sleep_timers.count < n) ||
+        (job->sleep_timers.count != 0 && !job->sleep_timers.ptr) ||
+        job->scratch.count < ak_rigid_step_scratch_size(job))
         return AK_ERR_SPAN_SMALL;
     for (size_t i = 0; i < n; ++i) {
-        if (!ak_vec3_is_finite(job->positions.ptr[i]) || !ak_quat_is_finite(job->orientations.ptr[i]) ||
-            !ak_vec3_is_finite(job->velocities.ptr[i]) || !ak_vec3_is_finite(job->angular_velocities.ptr[i]))
+        if (!ak_vec3_is_finite(job->positions.ptr[i]) ||
+            !ak_quat_is_finite(job->orientations.ptr[i]) ||
+            !ak_vec3_is_finite(job->velocities.ptr[i]) ||
+            !ak_vec3_is_finite(job->angular_velocities.ptr[i]))
             return AK_ERR_BAD_DATA;
-        if (job->sleep_timers.count && !ak_finitef(job->sleep_timers.ptr[i])) return AK_ERR_BAD_DATA;
+        if (job->sleep_timers.count && !ak_finitef(job->sleep_timers.ptr[i]))
+            return AK_ERR_BAD_DATA;
     }
     return AK_OK;
 }
@@ -77,7 +84,7 @@ typedef struct solver {
     ak_quat* q;
     ak_vec3* v;
     ak_vec3* w;
-    const ak_vec3* x0;    /* positions at the step's start */
+    const ak_vec3* x0; /* positions at the step's start */
     ak_quat* qp;
     ak_vec3* dx;          /* displacement since the substep's start, kept apart so the velocity
                              dx / h keeps float precision far from the origin */
@@ -88,7 +95,6 @@ typedef struct solver {
     const uint8_t* awake; /* 1: dynamic and awake (moves); 0: static or asleep */
     float h;
 } solver;
-
 
 /* I^-1 (world) applied to v for body i (zero when it does not move). */
 static ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
@@ -131,9 +137,10 @@ static ak_vec3 gyroscopic_step(ak_vec3 w, ak_vec3 inertia, float h) {
     /* J = I + h (skew(w) I - skew(I w)) */
     ak_mat3 sw = {{0, w.z, -w.y, -w.z, 0, w.x, w.y, -w.x, 0}};
     ak_mat3 siw = {{0, iw.z, -iw.y, -iw.z, 0, iw.x, iw.y, -iw.x, 0}};
-    ak_mat3 j = ak_mat3_add(ak_mat3_diagonal(inertia),
-                            ak_mat3_scale(ak_mat3_add(ak_mat3_mul(sw, ak_mat3_diagonal(inertia)),
-                                                      ak_mat3_scale(siw, -1.0f)), h));
+    ak_mat3 j = ak_mat3_add(
+        ak_mat3_diagonal(inertia),
+        ak_mat3_scale(
+            ak_mat3_add(ak_mat3_mul(sw, ak_mat3_diagonal(inertia)), ak_mat3_scale(siw, -1.0f)), h));
     if (fabsf(ak_mat3_determinant(j)) < 1e-30f) return w;
     return ak_vec3_sub(w, ak_mat3_mul_vec3(ak_mat3_inverse(j), f));
 }
@@ -192,7 +199,8 @@ typedef struct contact_buf {
 static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float margin) {
     rigid_pose pa = {s->x[a], s->q[a]}, pb = {s->x[b], s->q[b]};
     /* the buffer has AKP_RIGID_MAX_PAIR_CONTACTS slack past cap */
-    int found = akp_rigid_collide(s->m, a, b, pa, pb, margin, cb->c + cb->count, AKP_RIGID_MAX_PAIR_CONTACTS);
+    int found = akp_rigid_collide(s->m, a, b, pa, pb, margin, cb->c + cb->count,
+                                  AKP_RIGID_MAX_PAIR_CONTACTS);
     int kept = found < AKP_RIGID_MAX_PAIR_CONTACTS ? found : AKP_RIGID_MAX_PAIR_CONTACTS;
     if (cb->count + (uint32_t)kept > cb->cap) {
         uint32_t room = cb->cap - cb->count;
@@ -258,8 +266,10 @@ static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float marg
             if (s->bodies[a].group != 0 && s->bodies[a].group == s->bodies[b].group) continue;
             if (m->joint_count && joined(m, a, b)) continue;
             /* the awake (or lower-index) body first, so a static body is always b */
-            if (!s->awake[a] || (s->awake[b] && b < a)) narrow(s, cb, b, a, margin);
-            else narrow(s, cb, a, b, margin);
+            if (!s->awake[a] || (s->awake[b] && b < a))
+                narrow(s, cb, b, a, margin);
+            else
+                narrow(s, cb, a, b, margin);
         }
     }
     if (m->plane_count) {
@@ -270,7 +280,9 @@ static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float marg
     }
 }
 
-static ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) { return ak_vec3_add(s->x[i], ak_quat_rotate(s->q[i], l)); }
+static ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) {
+    return ak_vec3_add(s->x[i], ak_quat_rotate(s->q[i], l));
+}
 
 /* Motion of body i's local point l since the start of the step, without the cancellation that
  * (x + q l) - (x0 + q0 l) suffers far from the origin. Static friction undoes the slip of the
@@ -302,7 +314,9 @@ static void order_groups(const solver* s, contact_buf* cb, ak_vec3 up) {
     for (uint32_t k = 0; k < cb->count; ++g) {
         uint32_t e = group_end(cb, k);
         const rigid_contact* c = &cb->c[k];
-        ak_vec3 mid = s->bodies[c->b].shape.type == AK_RIGID_PLANE ? s->x[c->a] : ak_vec3_scale(ak_vec3_add(s->x[c->a], s->x[c->b]), 0.5f);
+        ak_vec3 mid = s->bodies[c->b].shape.type == AK_RIGID_PLANE
+                          ? s->x[c->a]
+                          : ak_vec3_scale(ak_vec3_add(s->x[c->a], s->x[c->b]), 0.5f);
         cb->groups[g] = (contact_group){k, e, ak_vec3_dot(mid, up)};
         k = e;
     }
@@ -324,8 +338,8 @@ static void order_groups(const solver* s, contact_buf* cb, ak_vec3 up) {
  * multipliers) in each body's frame, the group's total multiplier and the multipliers' mean
  * distance from the centre (the lever arm of torsional friction); false when no contact of the
  * group pushed. */
-static bool pressure_centre(const contact_buf* cb, uint32_t k0, uint32_t k1, ak_vec3* la, ak_vec3* lb,
-                            float* out_lambda, float* out_arm) {
+static bool pressure_centre(const contact_buf* cb, uint32_t k0, uint32_t k1, ak_vec3* la,
+                            ak_vec3* lb, float* out_lambda, float* out_arm) {
     float sum = 0.0f, arm = 0.0f;
     ak_vec3 ca = ak_vec3_zero(), cbp = ak_vec3_zero();
     for (uint32_t k = k0; k < k1; ++k) {
@@ -360,7 +374,8 @@ static void apply_angular_impulse(solver* s, uint32_t i, ak_vec3 p, float sign) 
     if (!s->awake[i]) return;
     ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, p), sign * 0.5f);
     ak_quat q = s->q[i];
-    s->q[i] = ak_quat_normalize(ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q)));
+    s->q[i] =
+        ak_quat_normalize(ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q)));
 }
 
 /* Rotation vector of body i over this substep (small-angle). */
@@ -415,9 +430,11 @@ static void solve_positions(solver* s, contact_buf* cb) {
             }
             /* torsional friction: a patch of contacts also resists twisting about the normal, up
              * to mu times the normal multiplier times its mean lever arm */
-            float twist = ak_vec3_dot(ak_vec3_sub(substep_rotation(s, c->a), substep_rotation(s, c->b)), c->n);
+            float twist = ak_vec3_dot(
+                ak_vec3_sub(substep_rotation(s, c->a), substep_rotation(s, c->b)), c->n);
             float wr = gen_inv_inertia(s, c->a, c->n) + gen_inv_inertia(s, c->b, c->n);
-            if (wr > 0.0f && fabsf(twist) > 0.0f && fabsf(twist) / wr < c->friction * lambda * arm) {
+            if (wr > 0.0f && fabsf(twist) > 0.0f &&
+                fabsf(twist) / wr < c->friction * lambda * arm) {
                 ak_vec3 pr = ak_vec3_scale(c->n, -twist / wr);
                 apply_angular_impulse(s, c->a, pr, 1.0f);
                 apply_angular_impulse(s, c->b, pr, -1.0f);
@@ -432,7 +449,8 @@ static void solve_positions(solver* s, contact_buf* cb) {
 static ak_mat3 inv_inertia_world(const solver* s, uint32_t i) {
     if (!s->awake[i]) return ak_mat3_scale(ak_mat3_identity(), 0.0f);
     ak_mat3 r = ak_mat3_from_quat(s->q[i]);
-    return ak_mat3_mul(ak_mat3_mul(r, ak_mat3_diagonal(s->bodies[i].inv_inertia)), ak_mat3_transpose(r));
+    return ak_mat3_mul(ak_mat3_mul(r, ak_mat3_diagonal(s->bodies[i].inv_inertia)),
+                       ak_mat3_transpose(r));
 }
 
 static ak_mat3 skew(ak_vec3 v) {
@@ -446,14 +464,17 @@ static ak_mat3 skew(ak_vec3 v) {
  * exactly e to first order. (Solving along e alone, as for a contact, turns a body whose
  * rotation is cheap about its centre: the anchor then also moves across e, and a pendulum of a
  * small ball on a long arm spins up 70 times too fast.) */
-static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 e, float alpha) {
+static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 e,
+                           float alpha) {
     if (ak_vec3_length_sq(e) < 1e-18f) return;
-    float lin = (s->awake[a] ? s->bodies[a].inv_mass : 0.0f) + (s->awake[b] ? s->bodies[b].inv_mass : 0.0f) +
-                alpha / (s->h * s->h);
+    float lin = (s->awake[a] ? s->bodies[a].inv_mass : 0.0f) +
+                (s->awake[b] ? s->bodies[b].inv_mass : 0.0f) + alpha / (s->h * s->h);
     ak_mat3 sa = skew(ra), sb = skew(rb);
     ak_mat3 k = ak_mat3_scale(ak_mat3_identity(), lin);
-    k = ak_mat3_add(k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sa, inv_inertia_world(s, a)), sa), -1.0f));
-    k = ak_mat3_add(k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sb, inv_inertia_world(s, b)), sb), -1.0f));
+    k = ak_mat3_add(
+        k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sa, inv_inertia_world(s, a)), sa), -1.0f));
+    k = ak_mat3_add(
+        k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sb, inv_inertia_world(s, b)), sb), -1.0f));
     float det = ak_mat3_determinant(k);
     if (!(fabsf(det) > 1e-30f) || !ak_finitef(det)) return;
     ak_vec3 p = ak_mat3_mul_vec3(ak_mat3_inverse(k), e);
@@ -502,19 +523,25 @@ static void solve_joints(solver* s) {
         if (j->type == AK_RIGID_JOINT_FIXED || j->type == AK_RIGID_JOINT_PRISMATIC)
             joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->rel), alpha);
         if (j->type == AK_RIGID_JOINT_HINGE) {
-            ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a), a2 = ak_quat_rotate(s->q[b], j->axis_b);
+            ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a),
+                    a2 = ak_quat_rotate(s->q[b], j->axis_b);
             joint_rotation(s, a, b, ak_vec3_cross(a1, a2), alpha);
             if (j->limited) {
                 float phi = akp_rigid_hinge_angle(j, s->q[a], s->q[b]) + j->angle_offset;
                 float target = ak_clampf(phi, j->lower, j->upper);
-                if (phi != target) joint_rotation(s, a, b, ak_vec3_scale(ak_quat_rotate(s->q[a], j->axis_a), phi - target), 0.0f);
+                if (phi != target)
+                    joint_rotation(s, a, b,
+                                   ak_vec3_scale(ak_quat_rotate(s->q[a], j->axis_a), phi - target),
+                                   0.0f);
             }
         }
         if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
-            ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a), a2 = ak_quat_rotate(s->q[b], j->axis_b);
+            ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a),
+                    a2 = ak_quat_rotate(s->q[b], j->axis_b);
             ak_vec3 cr = ak_vec3_cross(a1, a2);
             float sn = ak_vec3_length(cr), swing = atan2f(sn, ak_vec3_dot(a1, a2));
-            if (swing > j->upper && sn > 1e-9f) joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f);
+            if (swing > j->upper && sn > 1e-9f)
+                joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f);
         }
         if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited) {
             ak_vec3 n;
@@ -523,7 +550,8 @@ static void solve_joints(solver* s) {
             if (tw != target) joint_rotation(s, a, b, ak_vec3_scale(n, tw - target), 0.0f);
         }
         if (j->drive && j->type != AK_RIGID_JOINT_FIXED && j->type != AK_RIGID_JOINT_PRISMATIC)
-            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->drive_target), j->drive_compliance);
+            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->drive_target),
+                           j->drive_compliance);
     }
 }
 
@@ -555,7 +583,8 @@ static ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
     return ak_vec3_add(s->v[i], ak_vec3_cross(s->w[i], r));
 }
 
-static void velocity_impulse_pair(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 dv) {
+static void velocity_impulse_pair(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb,
+                                  ak_vec3 dv) {
     float l = ak_vec3_length(dv);
     if (l < 1e-12f) return;
     ak_vec3 dir = ak_vec3_scale(dv, 1.0f / l);
@@ -574,11 +603,13 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
             rigid_contact* c = &cb->c[k];
             if (!(c->lambda_n > 0.0f)) continue;
             ak_vec3 ra = ak_quat_rotate(s->q[c->a], c->la), rb = ak_quat_rotate(s->q[c->b], c->lb);
-            float vn = ak_vec3_dot(c->n, ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb)));
+            float vn = ak_vec3_dot(
+                c->n, ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb)));
             /* restitution: the normal velocity becomes -e times the one before the solve (none
              * for slow impacts, which gravity alone could have made in two substeps) */
             float e = fabsf(c->vn_before) <= 2.0f * gmag * h ? 0.0f : c->restitution;
-            velocity_impulse_pair(s, c->a, c->b, ra, rb, ak_vec3_scale(c->n, -vn + ak_maxf(-e * c->vn_before, 0.0f)));
+            velocity_impulse_pair(s, c->a, c->b, ra, rb,
+                                  ak_vec3_scale(c->n, -vn + ak_maxf(-e * c->vn_before, 0.0f)));
         }
         /* dynamic friction at the centre of pressure (their eq. 30 with the units made whole) */
         ak_vec3 la, lb;
@@ -602,8 +633,10 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
             if (wr > 0.0f && spin != 0.0f) {
                 float cut = ak_minf(c->dynamic_friction * lambda * arm * wr / h, fabsf(spin));
                 ak_vec3 pr = ak_vec3_scale(c->n, (spin > 0.0f ? -cut : cut) / wr);
-                if (s->awake[c->a]) s->w[c->a] = ak_vec3_add(s->w[c->a], inv_inertia_mul(s, c->a, pr));
-                if (s->awake[c->b]) s->w[c->b] = ak_vec3_sub(s->w[c->b], inv_inertia_mul(s, c->b, pr));
+                if (s->awake[c->a])
+                    s->w[c->a] = ak_vec3_add(s->w[c->a], inv_inertia_mul(s, c->a, pr));
+                if (s->awake[c->b])
+                    s->w[c->b] = ak_vec3_sub(s->w[c->b], inv_inertia_mul(s, c->b, pr));
             }
         }
     }
@@ -618,14 +651,16 @@ static uint32_t uf_find(uint32_t* parent, uint32_t i) {
 }
 
 /* Sleep bookkeeping at the end of a step (see ak_rigid_step_job.sleep_timers). */
-static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_buf* cb, uint32_t* parent) {
+static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_buf* cb,
+                         uint32_t* parent) {
     const ak_rigid_model_desc* d = &s->m->desc;
     uint32_t n = (uint32_t)s->m->body_count;
     float* timer = job->sleep_timers.ptr;
     for (uint32_t i = 0; i < n; ++i) {
         parent[i] = i;
         if (!s->awake[i]) continue;
-        bool slow = ak_vec3_length(s->v[i]) < d->sleep_linear_speed && ak_vec3_length(s->w[i]) < d->sleep_angular_speed;
+        bool slow = ak_vec3_length(s->v[i]) < d->sleep_linear_speed &&
+                    ak_vec3_length(s->w[i]) < d->sleep_angular_speed;
         timer[i] = slow ? timer[i] + job->dt : 0.0f;
     }
     for (uint32_t k = 0; k < cb->count; ++k) {
@@ -674,10 +709,17 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
     uint8_t* awake = base + l.awake;
     uint32_t substeps = job->substeps ? job->substeps : 10;
     solver s = {
-        .m = m, .bodies = m->bodies, .x = job->positions.ptr, .q = job->orientations.ptr,
-        .v = job->velocities.ptr, .w = job->angular_velocities.ptr,
-        .x0 = x0, .qp = (ak_quat*)(base + l.qp), .dx = (ak_vec3*)(base + l.dx),
-        .ds = (ak_vec3*)(base + l.ds), .q0 = q0,
+        .m = m,
+        .bodies = m->bodies,
+        .x = job->positions.ptr,
+        .q = job->orientations.ptr,
+        .v = job->velocities.ptr,
+        .w = job->angular_velocities.ptr,
+        .x0 = x0,
+        .qp = (ak_quat*)(base + l.qp),
+        .dx = (ak_vec3*)(base + l.dx),
+        .ds = (ak_vec3*)(base + l.ds),
+        .q0 = q0,
         .awake = awake,
         .h = job->dt / (float)substeps,
     };
@@ -688,10 +730,12 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
     memset(s.ds, 0, n * sizeof *s.ds);
     const bool sleeping = job->sleep_timers.count > 0;
     for (uint32_t i = 0; i < n; ++i) {
-        awake[i] = m->bodies[i].inv_mass > 0.0f && !(sleeping && job->sleep_timers.ptr[i] >= m->desc.sleep_time);
+        awake[i] = m->bodies[i].inv_mass > 0.0f &&
+                   !(sleeping && job->sleep_timers.ptr[i] >= m->desc.sleep_time);
         if (awake[i]) s.q[i] = q0[i] = ak_quat_normalize(s.q[i]);
     }
-    contact_buf cb = {(rigid_contact*)(base + l.contacts), 0, m->desc.max_contacts, 0, (contact_group*)(base + l.groups), 0};
+    contact_buf cb = {(rigid_contact*)(base + l.contacts), 0, m->desc.max_contacts, 0,
+                      (contact_group*)(base + l.groups),   0};
     ak_vec3 up = ak_vec3_scale(ak_vec3_normalize(job->gravity), -1.0f);
     float gmag = ak_vec3_length(job->gravity);
     /* contacts are looked for a little further than a substep's motion could close */
@@ -711,8 +755,8 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
     }
     bool finite = true;
     for (uint32_t i = 0; i < n && finite; ++i)
-        finite = ak_vec3_is_finite(s.x[i]) && ak_quat_is_finite(s.q[i]) && ak_vec3_is_finite(s.v[i]) &&
-                 ak_vec3_is_finite(s.w[i]);
+        finite = ak_vec3_is_finite(s.x[i]) && ak_quat_is_finite(s.q[i]) &&
+                 ak_vec3_is_finite(s.v[i]) && ak_vec3_is_finite(s.w[i]);
     if (!finite) {
         memcpy(s.x, x0, n * sizeof *x0);
         memcpy(s.q, q0, n * sizeof *q0);
@@ -724,7 +768,8 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         float worst = 0.0f;
         for (uint32_t k = 0; k < cb.count; ++k) {
             const rigid_contact* c = &cb.c[k];
-            float d = ak_vec3_dot(ak_vec3_sub(world_point(&s, c->b, c->lb), world_point(&s, c->a, c->la)), c->n);
+            float d = ak_vec3_dot(
+                ak_vec3_sub(world_point(&s, c->b, c->lb), world_point(&s, c->a, c->la)), c->n);
             worst = ak_maxf(worst, d);
         }
         *job->out_max_penetration = worst;

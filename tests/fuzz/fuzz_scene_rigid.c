@@ -24,7 +24,8 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     if (s.body_count == 0 || !(s.dt > 0.0f) || s.substeps == 0) abort();
     for (size_t k = 0; k < s.joint_count; ++k)
-        if (s.joints[k].body_a >= s.body_count || s.joints[k].body_b >= s.body_count || s.joints[k].body_a == s.joints[k].body_b)
+        if (s.joints[k].body_a >= s.body_count || s.joints[k].body_b >= s.body_count ||
+            s.joints[k].body_a == s.joints[k].body_b)
             abort();
     ak_rigid_model_desc md = s.model;
     md.bodies = (ak_rigid_body_desc_cspan){s.bodies, s.body_count};
@@ -35,10 +36,16 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         ak_vec3 x[64], v[64], w[64], x0[64];
         ak_quat q[64];
         float timers[64] = {0};
-        ak_rigid_initial_state(m, (ak_vec3_span){x, n}, (ak_quat_span){q, n}, (ak_vec3_span){v, n}, (ak_vec3_span){w, n});
-        ak_rigid_step_job job = {.model = m, .dt = s.dt, .substeps = s.substeps > 10 ? 10 : s.substeps,
-                                 .gravity = s.gravity, .positions = {x, n}, .orientations = {q, n},
-                                 .velocities = {v, n}, .angular_velocities = {w, n},
+        ak_rigid_initial_state(m, (ak_vec3_span){x, n}, (ak_quat_span){q, n}, (ak_vec3_span){v, n},
+                               (ak_vec3_span){w, n});
+        ak_rigid_step_job job = {.model = m,
+                                 .dt = s.dt,
+                                 .substeps = s.substeps > 10 ? 10 : s.substeps,
+                                 .gravity = s.gravity,
+                                 .positions = {x, n},
+                                 .orientations = {q, n},
+                                 .velocities = {v, n},
+                                 .angular_velocities = {w, n},
                                  .sleep_timers = {timers, s.sleep ? n : 0}};
         size_t bytes = ak_rigid_step_scratch_size(&job);
         job.scratch = (ak_u8_span){malloc(bytes), bytes};

@@ -49,7 +49,8 @@ static void parse_shape(cli_json* j, const cJSON* obj, const char* path, ak_rigi
         cli_json_fail(j, path, "shape", "is required");
         return;
     }
-    static const char* const keys[] = {"type", "radius", "half_extents", "half_height", "points", "normal", NULL};
+    static const char* const keys[] = {"type",   "radius", "half_extents", "half_height", "points",
+                                       "normal", NULL};
     static const char* const types[] = {"sphere", "box", "capsule", "hull", "plane", NULL};
     cli_json_object(j, sh, sp, keys);
     int type = -1;
@@ -64,14 +65,18 @@ static void parse_shape(cli_json* j, const cJSON* obj, const char* path, ak_rigi
         return;
     }
     /* which keys each type takes: the others are refused so a typo cannot pass unnoticed */
-    static const char* const takes[5] = {"radius", "half_extents", "radius half_height", "points", "normal"};
+    static const char* const takes[5] = {"radius", "half_extents", "radius half_height", "points",
+                                         "normal"};
     for (int k = 1; keys[k]; ++k)
         if (cJSON_GetObjectItemCaseSensitive(sh, keys[k]) && !strstr(takes[type], keys[k])) {
             cli_json_fail(j, sp, keys[k], "does not apply to a %s", types[type]);
             return;
         }
     ak_rigid_shape* s = &b->shape;
-    s->type = type == 0 ? AK_RIGID_SPHERE : type == 1 ? AK_RIGID_BOX : type == 2 ? AK_RIGID_CAPSULE : AK_RIGID_PLANE;
+    s->type = type == 0   ? AK_RIGID_SPHERE
+              : type == 1 ? AK_RIGID_BOX
+              : type == 2 ? AK_RIGID_CAPSULE
+                          : AK_RIGID_PLANE;
     s->radius = -1.0f;
     s->half_height = 0.0f;
     s->half_extents = ak_vec3_make(-1.0f, -1.0f, -1.0f);
@@ -83,9 +88,12 @@ static void parse_shape(cli_json* j, const cJSON* obj, const char* path, ak_rigi
     s->half_extents = ak_vec3_make(he[0], he[1], he[2]);
     cli_json_vec3(j, sh, sp, "normal", &s->normal);
     if (j->failed) return;
-    if ((type == 0 || type == 2) && s->radius < 0.0f) cli_json_fail(j, sp, "radius", "is required for a %s", types[type]);
-    else if (type == 1 && he[0] < 0.0f) cli_json_fail(j, sp, "half_extents", "is required for a box");
-    else if (type == 4 && ak_vec3_length(s->normal) < 1e-6f) cli_json_fail(j, sp, "normal", "is zero");
+    if ((type == 0 || type == 2) && s->radius < 0.0f)
+        cli_json_fail(j, sp, "radius", "is required for a %s", types[type]);
+    else if (type == 1 && he[0] < 0.0f)
+        cli_json_fail(j, sp, "half_extents", "is required for a box");
+    else if (type == 4 && ak_vec3_length(s->normal) < 1e-6f)
+        cli_json_fail(j, sp, "normal", "is zero");
 }
 
 static void parse_body(cli_json* j, const cJSON* e, const char* path, ak_rigid_body_desc* b) {
@@ -93,8 +101,9 @@ static void parse_body(cli_json* j, const cJSON* e, const char* path, ak_rigid_b
         cli_json_fail(j, path, "", "expected an object with at least \"shape\"");
         return;
     }
-    static const char* const keys[] = {"shape", "position", "orientation", "velocity", "angular_velocity", "density",
-                                       "mass", "friction", "restitution", "static", NULL};
+    static const char* const keys[] = {
+        "shape",    "position",    "orientation", "velocity", "angular_velocity", "density", "mass",
+        "friction", "restitution", "static",      NULL};
     cli_json_object(j, e, path, keys);
     *b = body_default();
     parse_shape(j, e, path, b);
@@ -108,8 +117,11 @@ static void parse_body(cli_json* j, const cJSON* e, const char* path, ak_rigid_b
     cli_json_vec3(j, e, path, "angular_velocity", &b->angular_velocity);
     if (!j->failed && (ak_vec3_length(b->position) > 1e6f || ak_vec3_length(b->velocity) > 1e5f ||
                        ak_vec3_length(b->angular_velocity) > 1e5f))
-        cli_json_fail(j, path, "", "position over 1e6 m, velocity over 1e5 m/s or angular velocity over 1e5 rad/s");
-    if (!j->failed && cJSON_GetObjectItemCaseSensitive(e, "density") && cJSON_GetObjectItemCaseSensitive(e, "mass"))
+        cli_json_fail(
+            j, path, "",
+            "position over 1e6 m, velocity over 1e5 m/s or angular velocity over 1e5 rad/s");
+    if (!j->failed && cJSON_GetObjectItemCaseSensitive(e, "density") &&
+        cJSON_GetObjectItemCaseSensitive(e, "mass"))
         cli_json_fail(j, path, "mass", "give density or mass, not both");
     cli_json_float(j, e, path, "density", 1e-3f, 1e6f, &b->density);
     cli_json_float(j, e, path, "mass", 1e-6f, 1e9f, &b->mass);
@@ -120,26 +132,31 @@ static void parse_body(cli_json* j, const cJSON* e, const char* path, ak_rigid_b
     cli_json_bool(j, e, path, "static", &b->is_static);
 }
 
-static void parse_joint(cli_json* j, const cJSON* e, const char* path, size_t body_count, ak_rigid_joint_desc* d) {
+static void parse_joint(cli_json* j, const cJSON* e, const char* path, size_t body_count,
+                        ak_rigid_joint_desc* d) {
     if (!cJSON_IsObject(e)) {
         cli_json_fail(j, path, "", "expected an object with \"type\" and \"bodies\"");
         return;
     }
-    static const char* const keys[] = {"type", "bodies", "anchor", "axis", "limits", "compliance", NULL};
+    static const char* const keys[] = {"type",   "bodies",     "anchor", "axis",
+                                       "limits", "compliance", NULL};
     static const char* const types[] = {"ball", "hinge", "fixed", "prismatic", NULL};
     cli_json_object(j, e, path, keys);
     memset(d, 0, sizeof *d);
     int type = -1;
     cli_json_enum(j, e, path, "type", types, &type);
-    if (!j->failed && type < 0) cli_json_fail(j, path, "type", "is required (ball, hinge, fixed or prismatic)");
+    if (!j->failed && type < 0)
+        cli_json_fail(j, path, "type", "is required (ball, hinge, fixed or prismatic)");
     d->type = (ak_rigid_joint_type)(type < 0 ? 0 : type);
     float ab[2] = {-1.0f, -1.0f};
     cli_json_floats(j, e, path, "bodies", 2, 0.0f, (float)RIGID_SCENE_MAX_BODIES, ab);
-    if (!j->failed && ab[0] < 0.0f) cli_json_fail(j, path, "bodies", "is required: [a, b], two body indices");
+    if (!j->failed && ab[0] < 0.0f)
+        cli_json_fail(j, path, "bodies", "is required: [a, b], two body indices");
     if (!j->failed && (ab[0] != floorf(ab[0]) || ab[1] != floorf(ab[1])))
         cli_json_fail(j, path, "bodies", "expected two whole body indices");
     if (!j->failed && (ab[0] >= (float)body_count || ab[1] >= (float)body_count))
-        cli_json_fail(j, path, "bodies", "a body index is out of range (the scene has %zu bodies)", body_count);
+        cli_json_fail(j, path, "bodies", "a body index is out of range (the scene has %zu bodies)",
+                      body_count);
     if (!j->failed && ab[0] == ab[1]) cli_json_fail(j, path, "bodies", "joins a body to itself");
     if (j->failed) return; /* ab may still hold -1: no conversion to an index */
     d->body_a = (uint32_t)ab[0], d->body_b = (uint32_t)ab[1];
@@ -151,23 +168,29 @@ static void parse_joint(cli_json* j, const cJSON* e, const char* path, size_t bo
     float lim[2] = {0.0f, 0.0f};
     d->limited = cJSON_GetObjectItemCaseSensitive(e, "limits") != NULL;
     cli_json_floats(j, e, path, "limits", 2, -1e3f, 1e3f, lim);
-    if (!j->failed && d->limited && lim[0] > lim[1]) cli_json_fail(j, path, "limits", "lower is above upper");
-    if (!j->failed && d->limited && d->type == AK_RIGID_JOINT_FIXED) cli_json_fail(j, path, "limits", "does not apply to a fixed joint");
+    if (!j->failed && d->limited && lim[0] > lim[1])
+        cli_json_fail(j, path, "limits", "lower is above upper");
+    if (!j->failed && d->limited && d->type == AK_RIGID_JOINT_FIXED)
+        cli_json_fail(j, path, "limits", "does not apply to a fixed joint");
     d->lower = lim[0], d->upper = lim[1];
     cli_json_float(j, e, path, "compliance", 0.0f, 1e3f, &d->compliance);
 }
 
-bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_scene* s, char* msg, size_t cap) {
+bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_scene* s, char* msg,
+                       size_t cap) {
     rigid_scene_defaults(s);
     if (cap) msg[0] = '\0';
     cli_json j = {.file = file};
     cJSON* root = cli_json_parse(&j, text, size);
     if (root) {
-        static const char* const keys[] = {"gravity", "bodies", "joints", "dt", "steps", "substeps", "threads",
-                                           "linear_damping", "angular_damping", "contact_offset", "sleep", NULL};
+        static const char* const keys[] = {
+            "gravity",         "bodies",         "joints",  "dt",
+            "steps",           "substeps",       "threads", "linear_damping",
+            "angular_damping", "contact_offset", "sleep",   NULL};
         cli_json_object(&j, root, "", keys);
         cli_json_vec3(&j, root, "", "gravity", &s->gravity);
-        if (!j.failed && ak_vec3_length(s->gravity) > 1e4f) cli_json_fail(&j, "", "gravity", "is over 1e4 m/s^2");
+        if (!j.failed && ak_vec3_length(s->gravity) > 1e4f)
+            cli_json_fail(&j, "", "gravity", "is over 1e4 m/s^2");
         cli_json_float(&j, root, "", "dt", 1e-6f, 1.0f, &s->dt);
         cli_json_int(&j, root, "", "steps", 0, RIGID_SCENE_MAX_STEPS, &s->steps);
         long sub = (long)s->substeps, th = s->thread_count;
@@ -180,7 +203,8 @@ bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_sc
         cli_json_bool(&j, root, "", "sleep", &s->sleep);
         size_t n = 0;
         const cJSON* e = cli_json_array(&j, root, "", "bodies", RIGID_SCENE_MAX_BODIES, &n);
-        if (!j.failed && n == 0) cli_json_fail(&j, "", "bodies", "is required and must hold at least one body");
+        if (!j.failed && n == 0)
+            cli_json_fail(&j, "", "bodies", "is required and must hold at least one body");
         if (!j.failed) {
             s->bodies = calloc(n, sizeof *s->bodies);
             if (!s->bodies) cli_json_fail(&j, "", "bodies", "out of memory");
@@ -241,7 +265,9 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         /* ten 1 m boxes on the ground */
         if (!presize(s, 11)) return false;
         ground(&s->bodies[0]);
-        for (int i = 0; i < 10; ++i) box(&s->bodies[1 + i], ak_vec3_make(0.5f, 0.5f, 0.5f), ak_vec3_make(0.0f, 0.5f + (float)i, 0.0f));
+        for (int i = 0; i < 10; ++i)
+            box(&s->bodies[1 + i], ak_vec3_make(0.5f, 0.5f, 0.5f),
+                ak_vec3_make(0.0f, 0.5f + (float)i, 0.0f));
         return true;
     }
     if (strcmp(name, "pyramid") == 0) {
@@ -253,7 +279,8 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         for (int l = 0; l < layers; ++l)
             for (int i = 0; i < layers - l; ++i, ++k)
                 box(&s->bodies[k], ak_vec3_make(0.5f, 0.5f, 0.5f),
-                    ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - l - 1)), 0.5f + (float)l, 0.0f));
+                    ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - l - 1)),
+                                 0.5f + (float)l, 0.0f));
         s->substeps = 40;
         return true;
     }
@@ -261,7 +288,9 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         /* 20 dominoes 1 m tall, 0.5 m apart; the first is pushed at the top */
         if (!presize(s, 21)) return false;
         ground(&s->bodies[0]);
-        for (int i = 0; i < 20; ++i) box(&s->bodies[1 + i], ak_vec3_make(0.05f, 0.5f, 0.25f), ak_vec3_make(0.5f * (float)i, 0.5f, 0.0f));
+        for (int i = 0; i < 20; ++i)
+            box(&s->bodies[1 + i], ak_vec3_make(0.05f, 0.5f, 0.25f),
+                ak_vec3_make(0.5f * (float)i, 0.5f, 0.0f));
         s->bodies[1].angular_velocity = ak_vec3_make(0.0f, 0.0f, -2.0f);
         s->bodies[1].velocity = ak_vec3_make(1.0f, 0.0f, 0.0f);
         s->steps = 360;
@@ -279,7 +308,8 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         ak_rng rng = ak_rng_make(7);
         for (int i = 0; i < 200; ++i) {
             ak_rigid_body_desc* b = &s->bodies[2 + i];
-            ak_vec3 p = ak_vec3_make(ak_rng_range(&rng, -6.0f, -2.0f), 0.0f, ak_rng_range(&rng, -2.0f, 2.0f));
+            ak_vec3 p = ak_vec3_make(ak_rng_range(&rng, -6.0f, -2.0f), 0.0f,
+                                     ak_rng_range(&rng, -2.0f, 2.0f));
             p.y = -p.x * tanf(0.5236f) + 0.5f + 0.45f * (float)(i / 20);
             if (i % 3 == 0) {
                 b->shape.type = AK_RIGID_SPHERE;
@@ -292,8 +322,9 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
                 b->shape.half_height = 0.15f;
             }
             b->position = p;
-            b->orientation = ak_quat_from_axis_angle(ak_vec3_make(ak_rng_float(&rng), ak_rng_float(&rng), ak_rng_float(&rng)),
-                                                     ak_rng_range(&rng, 0.0f, 3.0f));
+            b->orientation = ak_quat_from_axis_angle(
+                ak_vec3_make(ak_rng_float(&rng), ak_rng_float(&rng), ak_rng_float(&rng)),
+                ak_rng_range(&rng, 0.0f, 3.0f));
             b->restitution = 0.2f;
         }
         s->steps = 300;
@@ -306,7 +337,8 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         ak_builtin_desc bd = {.cell_size = 0.1f};
         if (ak_builtin_create("humanoid", &bd, NULL, &sc) != AK_OK) return false;
         const ak_skeleton* sk = sc->skeleton;
-        size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk), nj = ak_rigid_ragdoll_joint_count(sk);
+        size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk),
+               nj = ak_rigid_ragdoll_joint_count(sk);
         ak_transform* pose = calloc(2 * n, sizeof *pose);
         ak_rigid_ragdoll_bone* bones = calloc(n, sizeof *bones);
         s->joints = calloc(nj + 1, sizeof *s->joints);
@@ -316,16 +348,21 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
             ak_scene_rest_pose(sc, (ak_transform_span){pose + n, n});
             if (sc->clip_count > 0) {
                 float t = 0.3f * ak_clip_duration(sc->clips[0]);
-                ak_clip_sample(sc->clips[0], t, NULL, (ak_transform_span){pose, n}, (ak_f32_span){0}, (ak_f32_span){0});
-                ak_clip_sample(sc->clips[0], t - s->dt, NULL, (ak_transform_span){pose + n, n}, (ak_f32_span){0},
-                               (ak_f32_span){0});
+                ak_clip_sample(sc->clips[0], t, NULL, (ak_transform_span){pose, n},
+                               (ak_f32_span){0}, (ak_f32_span){0});
+                ak_clip_sample(sc->clips[0], t - s->dt, NULL, (ak_transform_span){pose + n, n},
+                               (ak_f32_span){0}, (ak_f32_span){0});
             }
             ground(&s->bodies[0]);
-            ak_rigid_ragdoll_desc rd = {.skeleton = sk, .local_pose = {pose, n}, .previous_pose = {pose + n, n},
-                                        .previous_dt = s->dt, .root = ak_mat4_translation(ak_vec3_make(0.0f, 1.0f, 0.0f)),
+            ak_rigid_ragdoll_desc rd = {.skeleton = sk,
+                                        .local_pose = {pose, n},
+                                        .previous_pose = {pose + n, n},
+                                        .previous_dt = s->dt,
+                                        .root = ak_mat4_translation(ak_vec3_make(0.0f, 1.0f, 0.0f)),
                                         .body_offset = 1};
             ok = ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){s->bodies + 1, nb},
-                                        (ak_rigid_joint_desc_span){s->joints, nj}, (ak_rigid_ragdoll_bone_span){bones, n}) == AK_OK;
+                                        (ak_rigid_joint_desc_span){s->joints, nj},
+                                        (ak_rigid_ragdoll_bone_span){bones, n}) == AK_OK;
             s->joint_count = nj;
         }
         free(pose);
@@ -347,10 +384,12 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         slope->is_static = true;
         slope->friction = 0.3f;
         ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(0.0f, 0.0f, 1.0f), 0.5236f);
-        box(&s->bodies[1], ak_vec3_make(0.2f, 0.1f, 0.2f), ak_vec3_madd(ak_vec3_make(0.0f, 0.0f, -1.0f), n, 0.1f));
+        box(&s->bodies[1], ak_vec3_make(0.2f, 0.1f, 0.2f),
+            ak_vec3_madd(ak_vec3_make(0.0f, 0.0f, -1.0f), n, 0.1f));
         s->bodies[1].orientation = q;
         s->bodies[1].friction = 0.3f;
-        box(&s->bodies[2], ak_vec3_make(0.2f, 0.1f, 0.2f), ak_vec3_madd(ak_vec3_make(0.0f, 0.0f, 1.0f), n, 0.1f));
+        box(&s->bodies[2], ak_vec3_make(0.2f, 0.1f, 0.2f),
+            ak_vec3_madd(ak_vec3_make(0.0f, 0.0f, 1.0f), n, 0.1f));
         s->bodies[2].orientation = q;
         s->bodies[2].friction = 1.6f; /* sqrt(0.3 * 1.6) = 0.69 > 0.577 */
         s->sleep = false;

@@ -18,13 +18,13 @@ typedef struct rigid_scene {
     size_t body_count;
     ak_rigid_joint_desc* joints; /* [joint_count] */
     size_t joint_count;
-    ak_rigid_model_desc model;  /* damping, contact offset (bodies filled by the caller) */
-    ak_vec3 gravity;            /* m/s^2 */
-    float dt;                   /* seconds per step */
+    ak_rigid_model_desc model; /* damping, contact offset (bodies filled by the caller) */
+    ak_vec3 gravity;           /* m/s^2 */
+    float dt;                  /* seconds per step */
     long steps;
     uint32_t substeps;
     int thread_count;
-    bool sleep;                 /* bodies may fall asleep */
+    bool sleep; /* bodies may fall asleep */
 } rigid_scene;
 
 /* Defaults (every key absent, no bodies). */
@@ -33,7 +33,8 @@ void rigid_scene_defaults(rigid_scene* s);
 void rigid_scene_free(rigid_scene* s);
 /* Parse text[0, size) of file `file`. On failure returns false with "FILE: KEY.PATH: problem"
  * in msg (cap bytes) and s freed. */
-bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_scene* s, char* msg, size_t cap);
+bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_scene* s, char* msg,
+                       size_t cap);
 /* A built-in preset: stack, pyramid, dominoes, avalanche, ragdoll, incline. False (s empty)
  * for an unknown name (or when the ragdoll's character cannot be built). */
 bool rigid_scene_preset(const char* name, rigid_scene* s);
