@@ -20,6 +20,7 @@ PACKAGES=(
   libx11-dev        # the X11 client that resizes and closes the viewer's window in test_view_window
   clang             # the ASan+UBSan CI stage and scripts/fuzz.sh
   libclang-rt-14-dev # clang's sanitizer and libFuzzer runtimes (-fsanitize=fuzzer), Debian 12
+  libbullet-dev     # Bullet 3, the peer of bench/vs_bullet (optional: the benchmark is skipped without it)
 )
 
 missing=()
