@@ -197,5 +197,6 @@ int cmd_view(int argc, char** argv);
 int cmd_cloth(int argc, char** argv);
 int cmd_retarget(int argc, char** argv);
 int cmd_fluid(int argc, char** argv);
+int cmd_batch(int argc, char** argv);
 
 #endif
