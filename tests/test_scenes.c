@@ -115,6 +115,40 @@ AK_TEST(particles_presets) {
     AK_CHECK(strstr(d.message, AK_PARTICLES_SCENE_PRESETS) != NULL);
 }
 
+/* A scene run as the command runs it: free fall against the closed form of symplectic Euler,
+ * bursts counted against their schedule. */
+AK_TEST(particles_scene_run) {
+    ak_particles_scene s;
+    ak_diag d;
+    const char* fall = "{\"dt\": 0.01, \"gravity\": [0, -10, 0], \"particles\": [{\"p\": [0, 5, 0], \"m\": 1}]}";
+    AK_CHECK_EQ(LOAD(ak_particles_scene_load_bytes, fall, &s, &d), AK_OK);
+    ak_particles_scene_run run;
+    AK_CHECK_EQ(ak_particles_scene_run_init(&run, &s, &(ak_particles_scene_run_desc){.seed = 1}, &d), AK_OK);
+    for (int k = 0; k < 10; ++k) AK_CHECK_EQ(ak_particles_scene_run_step(&run, &d), AK_OK);
+    AK_CHECK_EQ(run.step_index, 10);
+    ak_particles_state st = ak_particles_get_state(run.system);
+    AK_CHECK_EQ(st.count, 1u);
+    /* v_k = k g dt, x_n = x_0 + g dt^2 n (n + 1) / 2 */
+    if (st.count == 1) AK_CHECK_NEAR(st.position[0].y, 5.0f - 10.0f * 1e-4f * 55.0f, 2e-5f);
+    ak_particles_scene_run_free(&run);
+    ak_particles_scene_free(&s);
+
+    const char* bursts = "{\"dt\": 0.1, \"gravity\": [0, 0, 0], \"emitters\": [{\"rate\": 0, \"burst\": 7,"
+                         " \"burst_start\": 0.25, \"burst_interval\": 0.5, \"lifetime\": [100, 100]}]}";
+    AK_CHECK_EQ(LOAD(ak_particles_scene_load_bytes, bursts, &s, &d), AK_OK);
+    AK_CHECK_EQ(ak_particles_scene_run_init(&run, &s, NULL, &d), AK_OK);
+    /* bursts at 0.25, 0.75, 1.25 ...: fired in the step that ends after them */
+    const size_t want[10] = {0, 0, 7, 7, 7, 7, 7, 14, 14, 14};
+    for (int k = 0; k < 10; ++k) {
+        AK_CHECK_EQ(ak_particles_scene_run_step(&run, &d), AK_OK);
+        AK_CHECK_MSG(ak_particles_count(run.system) == want[k], "step %d: %zu particles, want %zu", k,
+                     ak_particles_count(run.system), want[k]);
+    }
+    ak_particles_scene_run_free(&run);
+    ak_particles_scene_run_free(&run); /* twice is fine */
+    ak_particles_scene_free(&s);
+}
+
 /* ---- files (every format): the example scenes load, a missing file is AK_ERR_IO ------------ */
 
 AK_TEST(files_load_and_missing_files_fail) {
@@ -337,6 +371,7 @@ int main(void) {
     AK_RUN(particles_from_bytes);
     AK_RUN(particles_errors_name_key_paths);
     AK_RUN(particles_presets);
+    AK_RUN(particles_scene_run);
     AK_RUN(files_load_and_missing_files_fail);
     AK_RUN(cloth_bytes_errors_and_presets);
     AK_RUN(fluid_bytes_errors_and_presets);

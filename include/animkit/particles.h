@@ -442,6 +442,51 @@ AK_API ak_result ak_particles_scene_preset(const char* name, ak_particles_scene*
 /* Free the scene's arrays and zero it (safe on a zeroed, failed or freed scene; NULL: no-op). */
 AK_API void ak_particles_scene_free(ak_particles_scene* scene);
 
+/* ---- running a scene ------------------------------------------------------------------- */
+/* Step a loaded scene exactly as `animkit particles` does, so that C and Python reproduce the
+ * command's output: the scene's particles added in file order, each step every emitter emits
+ * at its rate and fires the bursts due before the step's end (a bounded number of calls
+ * whatever the interval), the system steps, and springs follow the file particles' new indices
+ * as some die (springs to a dead particle go).
+ *     ak_particles_scene_run run;
+ *     if (ak_particles_scene_run_init(&run, &sc, &(ak_particles_scene_run_desc){.seed = 1}, &diag) == AK_OK)
+ *         for (long k = 0; k < steps && ak_particles_scene_run_step(&run, &diag) == AK_OK; ++k) {}
+ *     ak_particles_state st = ak_particles_get_state(run.system);   // the command's --json
+ *     ak_particles_scene_run_free(&run); */
+typedef struct ak_particles_scene_run_desc {
+    uint64_t seed;                        /* the system's seed (the command uses 1) */
+    uint32_t thread_count;                /* 0 -> 1 */
+    const ak_particle_mesh* mesh_collider; /* optional: a mesh the caller poses between steps */
+    ak_vec3_cspan mesh_positions;         /* optional: the surface of AK_EMITTER_MESH emitters */
+    ak_u32_cspan mesh_indices;
+    ak_f32_span mesh_area_cdf;            /* [mesh_indices.count / 3] */
+} ak_particles_scene_run_desc;
+
+typedef struct ak_particles_scene_run {
+    ak_particles_scene* scene;   /* the scene run (its emitters' carry changes as they emit) */
+    ak_particles* system;        /* the particle system: read its state between steps */
+    ak_particles_world world;    /* the scene's world with the run's springs and collider mesh;
+                                    a caller may change it between steps (wind, gravity...) */
+    long step_index;             /* steps taken; step k ends at time (k + 1) * scene->dt */
+    /* private */
+    const ak_particle_mesh* meshes[1];
+    uint64_t* fired;             /* bursts fired per emitter */
+    ak_particle_spring* springs; /* the world's springs, re-indexed as file particles die */
+    size_t file_alive;           /* file particles still alive */
+} ak_particles_scene_run;
+
+/* Create the system for scene (which must outlive the run) and add its particles. Returns
+ * AK_OK, or the failing code with "particles: problem" in out_diag (optional); the run is then
+ * safe to free. */
+AK_API ak_result ak_particles_scene_run_init(ak_particles_scene_run* run, ak_particles_scene* scene,
+                                             const ak_particles_scene_run_desc* desc, ak_diag* out_diag);
+/* One step (number run->step_index): emit, fire due bursts, step, re-index springs. Returns
+ * AK_OK or the failing code (AK_ERR_BUDGET: Lennard-Jones packed past its pair-test budget; the
+ * message says what to lower) with "particles: step K: problem" in out_diag. */
+AK_API ak_result ak_particles_scene_run_step(ak_particles_scene_run* run, ak_diag* out_diag);
+/* Destroy the system and free the run's arrays (safe on a zeroed or failed run). */
+AK_API void ak_particles_scene_run_free(ak_particles_scene_run* run);
+
 #ifdef __cplusplus
 }
 #endif

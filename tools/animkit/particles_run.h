@@ -28,14 +28,9 @@ void particles_character_free(particles_character* c);
 
 /* A system built from a scene (which it points to and whose emitters it updates). */
 typedef struct particles_run {
-    ak_particles_scene* scene;
-    ak_particles* ps;
-    particles_character* ch; /* NULL unless the character preset */
-    const ak_particle_mesh* meshes[1];
-    ak_particles_world world;
-    uint64_t* fired; /* bursts fired per emitter */
-    ak_particle_spring* springs; /* the world's springs, re-indexed as file particles die */
-    size_t file_alive;           /* file particles still alive */
+    ak_particles_scene_run lib; /* the library's run (its world may be edited: the viewer's wind) */
+    ak_particles* ps;           /* lib.system */
+    particles_character* ch;    /* NULL unless the character preset */
 } particles_run;
 
 /* Create the system, add the scene's particles; ch NULL unless the character preset.

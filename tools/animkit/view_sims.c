@@ -280,7 +280,7 @@ static void psim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
 
 static bool psim_key(void* state, int key, char* msg, size_t msg_size) {
     psim* p = state;
-    return wind_key(key, &p->run.world.wind, msg, msg_size);
+    return wind_key(key, &p->run.lib.world.wind, msg, msg_size);
 }
 
 static bool psim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
@@ -310,7 +310,7 @@ static void psim_drag(void* state, ak_vec3 delta) {
 
 static void psim_status(void* state, char* out, size_t n) {
     psim* p = state;
-    ak_vec3 w = p->run.world.wind;
+    ak_vec3 w = p->run.lib.world.wind;
     snprintf(out, n, "t %.2fs, %zu particles, wind %.2g %.2g %.2g%s", ak_particles_time(p->run.ps),
              ak_particles_get_state(p->run.ps).count, (double)w.x, (double)w.y, (double)w.z,
              p->failed ? ", stopped (step failed)" : "");
