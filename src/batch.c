@@ -13,6 +13,7 @@
 
 #include <animkit/builtin.h>
 #include <animkit/fluid.h>
+#include <animkit/particles.h>
 #include <animkit/io.h>
 #include <animkit/raster.h>
 #include <animkit/retarget.h>
@@ -118,12 +119,12 @@ static void parse_job(akp_json* j, const cJSON* root, ak_batch_job* job) {
     } else if (job->kind == AK_BATCH_BAKE) {
         static const char* const ik[] = {"scene", NULL};
         static const char* const pk[] = {"sim", "steps", "count", "frame_every", NULL};
-        static const char* const sims[] = {"fluid", NULL};
+        static const char* const sims[] = {"fluid", "particles", NULL};
         akp_json_object(j, in, "inputs", ik);
         akp_json_object(j, par, "parameters", pk);
         read_path(j, in, "inputs", "scene", true, job->scene, sizeof job->scene);
         if (!j->failed && !cJSON_GetObjectItemCaseSensitive(par, "sim"))
-            akp_json_fail(j, "parameters", "sim", "is required (\"fluid\")");
+            akp_json_fail(j, "parameters", "sim", "is required (\"fluid\" or \"particles\")");
         akp_json_enum(j, par, "parameters", "sim", sims, &job->sim);
         akp_json_int(j, par, "parameters", "steps", 1, 100000, &job->steps);
         akp_json_int(j, par, "parameters", "count", 0, BAKE_MAX_POINTS, &job->count);
@@ -399,6 +400,73 @@ done:
     return r;
 }
 
+/* A particle scene (file or preset:NAME) run as `animkit particles` runs it, baked every
+ * frame_every steps (points keep their system ids: births and deaths show as scale steps). */
+static ak_result run_bake_particles(job_ctx* c) {
+    const ak_batch_job* job = c->job;
+    ak_particles_scene s;
+    ak_particles_scene_run run;
+    memset(&run, 0, sizeof run);
+    ak_diag d;
+    const char* in = c->inputs[0].path;
+    if (strcmp(in, "preset:character") == 0)
+        return fail(c, AK_ERR_UNSUPPORTED, "inputs.scene: preset:character needs the command (a posed character)");
+    ak_result r = strncmp(in, "preset:", 7) == 0 ? ak_particles_scene_preset(in + 7, &s, &d)
+                                                 : ak_particles_scene_load_file(in, &s, &d);
+    if (r != AK_OK) return fail(c, r, "inputs.scene: %s", d.message);
+    const long steps = job->steps ? job->steps : 200;
+    const long every = job->frame_every ? job->frame_every : (steps + BAKE_DEFAULT_FRAMES - 1) / BAKE_DEFAULT_FRAMES;
+    const size_t frames = (size_t)(steps / every) + 1;
+    if (s.capacity > BAKE_MAX_POINTS) s.capacity = BAKE_MAX_POINTS > s.particle_count ? BAKE_MAX_POINTS : (uint32_t)s.particle_count;
+    const size_t cap = s.capacity;
+    ak_vec3* baked = calloc(frames * (cap + 1), sizeof *baked);
+    uint32_t* ids = calloc(frames * (cap + 1), sizeof *ids);
+    ak_scene_bake_points* fr = calloc(frames, sizeof *fr);
+    ak_scene* out = NULL;
+    if (!baked || !ids || !fr) {
+        r = fail(c, AK_ERR_NO_MEMORY, "out of memory");
+        goto done;
+    }
+    if ((r = ak_particles_scene_run_init(&run, &s, &(ak_particles_scene_run_desc){.seed = 1}, &d)) != AK_OK) {
+        r = fail(c, r, "%s", d.message);
+        goto done;
+    }
+    size_t f = 0;
+    for (long k = 0; k <= steps; ++k) {
+        if (k % every == 0 && f < frames) {
+            const ak_particles_state st = ak_particles_get_state(run.system);
+            const size_t n = st.count < cap ? st.count : cap;
+            memcpy(baked + f * (cap + 1), st.position, n * sizeof *baked);
+            memcpy(ids + f * (cap + 1), st.id, n * sizeof *ids);
+            fr[f] = (ak_scene_bake_points){.positions = baked + f * (cap + 1), .ids = ids + f * (cap + 1), .count = n};
+            ++f;
+        }
+        if (k == steps) break;
+        if ((r = ak_particles_scene_run_step(&run, &d)) != AK_OK) {
+            r = fail(c, r, "%s", d.message);
+            goto done;
+        }
+    }
+    ak_scene_bake_points_desc bd = {.name = "particles", .frames = fr, .frame_count = f, .interp = AK_INTERP_STEP,
+                                    .frame_time = (float)every * s.dt, .marker_size = 0.025f};
+    memset(&d, 0, sizeof d);
+    r = ak_scene_bake_point_frames(&bd, NULL, &out, &d);
+    if (r != AK_OK) {
+        r = fail(c, r, "bake: %s", d.message[0] ? d.message : ak_result_string(r));
+        goto done;
+    }
+    ak_io_save_desc sd = {0};
+    r = ak_io_save(c->output, out, &sd, &d);
+    if (r != AK_OK) r = fail(c, r, "output: %s: %s", c->output, d.message[0] ? d.message : ak_result_string(r));
+    c->frames = (long)f;
+done:
+    ak_scene_destroy(out);
+    ak_particles_scene_run_free(&run);
+    ak_particles_scene_free(&s);
+    free(fr), free(ids), free(baked);
+    return r;
+}
+
 static ak_result run_render(job_ctx* c) {
     const ak_batch_job* job = c->job;
     ak_scene* sc = NULL;
@@ -498,7 +566,7 @@ static void make_row(const job_ctx* c, const ak_batch_desc* desc, const ak_batch
         cJSON_AddBoolToObject(p, "unscaled_root_motion", job->unscaled);
         cJSON_AddBoolToObject(p, "skip_foot_contacts", job->no_feet);
     } else if (p && job && job->kind == AK_BATCH_BAKE) {
-        cJSON_AddStringToObject(p, "sim", "fluid");
+        cJSON_AddStringToObject(p, "sim", job->sim == 1 ? "particles" : "fluid");
         cJSON_AddNumberToObject(p, "steps", (double)job->steps);
         cJSON_AddNumberToObject(p, "count", (double)job->count);
         cJSON_AddNumberToObject(p, "frame_every", (double)job->frame_every);
@@ -607,7 +675,12 @@ ak_result ak_batch_run_job(const char* line, size_t size, const ak_batch_desc* d
         goto row;
     }
     remove(c->record); /* a record never describes an output it did not see written */
-    r = job->kind == AK_BATCH_RETARGET ? run_retarget(c) : job->kind == AK_BATCH_BAKE ? run_bake(c) : run_render(c);
+    if (job->kind == AK_BATCH_RETARGET)
+        r = run_retarget(c);
+    else if (job->kind == AK_BATCH_BAKE)
+        r = job->sim == 1 ? run_bake_particles(c) : run_bake(c);
+    else
+        r = run_render(c);
     if (r == AK_OK) out_row->status = AK_BATCH_RAN;
 row:
     if (r != AK_OK) {

@@ -192,6 +192,16 @@ AK_TEST(bake_lasts_its_steps) {
         if (out->clip_count == 1) AK_CHECK_NEAR(ak_clip_duration(out->clips[0]), 8.0f / 400.0f, 1e-5f);
     }
     ak_scene_destroy(out);
+    /* a particle scene (the fountain example, dt 0.01) runs as `animkit particles` runs it */
+    const char* pl = "{\"kind\": \"bake\", \"inputs\": {\"scene\": \"" AK_SOURCE_DIR "/examples/particles_fountain.json\"},"
+                     " \"parameters\": {\"sim\": \"particles\", \"steps\": 30, \"frame_every\": 5}, \"output\": \"fountain.glb\"}";
+    AK_CHECK_EQ(run_line(pl, "test_batch_out", true), AK_OK);
+    AK_CHECK_MSG(row.status == AK_BATCH_RAN, "%s", row.error);
+    AK_CHECK(strstr(row.json, "\"frames\":7") != NULL); /* steps 0, 5, ..., 30 */
+    out = NULL;
+    AK_CHECK_EQ(ak_io_load("test_batch_out/fountain.glb", NULL, NULL, &out, NULL), AK_OK);
+    if (out && out->clip_count == 1) AK_CHECK_NEAR(ak_clip_duration(out->clips[0]), 0.30f, 1e-5f);
+    ak_scene_destroy(out);
     /* the same job skips; other parameters run; a record of another job does not count */
     AK_CHECK_EQ(run_line(line, "test_batch_out", false), AK_OK);
     AK_CHECK_EQ(row.status, AK_BATCH_SKIPPED);

@@ -54,11 +54,11 @@ typedef struct ak_batch_job {
     char clip[128];                  /* parameters.clip: name or index; "" -> the first */
     float fps;                       /* parameters.fps [1, 1000]; default 30 */
     bool unscaled, no_feet;          /* parameters.unscaled_root_motion, skip_foot_contacts */
-    /* bake: inputs.scene (a fluid scene file, or "preset:dam|pour|splash") */
+    /* bake: inputs.scene (a scene file of the simulation, or "preset:NAME") */
     char scene[AK_BATCH_MAX_PATH];
-    int sim;                         /* parameters.sim: 0 "fluid" (the one simulation baked so far) */
-    long steps;                      /* parameters.steps [1, 100000]; default: the scene's */
-    long count;                      /* parameters.count (presets' particles) [0, 16384]; 0 -> 2000 */
+    int sim;                         /* parameters.sim (required): 0 "fluid", 1 "particles" */
+    long steps;                      /* parameters.steps [1, 100000]; 0 -> the fluid scene's, 200 particle steps */
+    long count;                      /* parameters.count (fluid presets' particles) [0, 16384]; 0 -> 2000 */
     long frame_every;                /* parameters.frame_every [1, 100000]: steps per baked frame; 0 -> so that <= 240 frames */
     /* render: inputs.model (a file or builtin:NAME) */
     char model[AK_BATCH_MAX_PATH];
