@@ -367,6 +367,44 @@ AK_TEST(boids_bytes_errors_and_presets) {
     AK_CHECK_NEAR(s.params.bounds_max.x, 20.0f, 1e-5f);
 }
 
+/* A boids scene run as the command runs it: the predator preset places 3 predators among 500
+ * agents inside the bounds (docs/boids.md), and a run is a function of the seed alone. */
+AK_TEST(boids_scene_run) {
+    ak_boids_scene s;
+    ak_diag d;
+    AK_CHECK_EQ(ak_boids_scene_preset("predator", &s, &d), AK_OK);
+    ak_boids_scene_run a, b;
+    AK_CHECK_EQ(ak_boids_scene_run_init(&a, &s, NULL, &d), AK_OK);
+    AK_CHECK_EQ(ak_boids_scene_run_init(&b, &s, &(ak_boids_scene_run_desc){.thread_count = 2, .naive = true}, &d), AK_OK);
+    AK_CHECK_EQ(a.agent_count, 500u);
+    size_t predators = 0;
+    for (size_t i = 0; i < a.agent_count; ++i) {
+        predators += a.species[i] == 1;
+        const ak_vec3 p = a.positions[i];
+        AK_CHECK(p.x >= -10.0f && p.x <= 10.0f && p.y >= -10.0f && p.y <= 10.0f && p.z >= -10.0f && p.z <= 10.0f);
+    }
+    AK_CHECK_EQ(predators, 3u);
+    for (int k = 0; k < 5; ++k) {
+        AK_CHECK_EQ(ak_boids_scene_run_step(&a), AK_OK);
+        AK_CHECK_EQ(ak_boids_scene_run_step(&b), AK_OK);
+    }
+    AK_CHECK_EQ(a.step_index, 5);
+    /* grid on one thread and naive search on two: the same bits (boids.h) */
+    AK_CHECK(memcmp(a.positions, b.positions, a.agent_count * sizeof(ak_vec3)) == 0);
+    AK_CHECK(memcmp(a.velocities, b.velocities, a.agent_count * sizeof(ak_vec3)) == 0);
+    ak_boids_scene_run_free(&a);
+    ak_boids_scene_run_free(&b);
+    ak_boids_scene_run_free(&b);
+    /* a leader index past the agents is refused with its key path */
+    ak_boids_scene_free(&s);
+    ak_boids_scene_defaults(&s);
+    AK_CHECK_EQ(LOAD(ak_boids_scene_load_bytes, "{\"count\": 4, \"leader\": {\"index\": 9}}", &s, &d), AK_OK);
+    AK_CHECK(ak_boids_scene_run_init(&a, &s, &(ak_boids_scene_run_desc){.name = "t.json"}, &d) != AK_OK);
+    AK_CHECK_STREQ(d.message, "t.json: leader.index: 9 is not below the 4 agents");
+    ak_boids_scene_run_free(&a);
+    ak_boids_scene_free(&s);
+}
+
 int main(void) {
     AK_RUN(particles_from_bytes);
     AK_RUN(particles_errors_name_key_paths);
@@ -376,5 +414,6 @@ int main(void) {
     AK_RUN(cloth_bytes_errors_and_presets);
     AK_RUN(fluid_bytes_errors_and_presets);
     AK_RUN(boids_bytes_errors_and_presets);
+    AK_RUN(boids_scene_run);
     return ak_test_finish();
 }

@@ -334,6 +334,49 @@ AK_API void ak_boids_scene_free(ak_boids_scene* scene);
  * 500 agents. */
 AK_API void ak_boids_scene_scale_bounds(ak_boids_scene* scene, size_t count);
 
+/* ---- running a scene ---------------------------------------------------------------------- */
+/* Step a loaded scene as `animkit boids` does, so that C and Python reproduce the command's
+ * output: the scene's agents, or scene->count agents placed at random in the bounds from
+ * scene->seed (species by fraction, speed half the species' max_speed), double-buffered steps
+ * whose wander noise follows the step number.
+ *     ak_boids_scene_run run;
+ *     if (ak_boids_scene_run_init(&run, &sc, NULL, &diag) == AK_OK)
+ *         for (long k = 0; k < sc.steps && ak_boids_scene_run_step(&run) == AK_OK; ++k) {}
+ *     ... run.positions[i], run.velocities[i] for i < run.agent_count ...
+ *     ak_boids_scene_run_free(&run); */
+typedef struct ak_boids_scene_run_desc {
+    const char* name;      /* starts messages; NULL -> "scene" */
+    uint32_t thread_count; /* 0 -> 1 */
+    bool naive;            /* the O(N^2) neighbour search instead of the grid (same results) */
+} ak_boids_scene_run_desc;
+
+typedef struct ak_boids_scene_run {
+    size_t agent_count;
+    ak_vec3* positions;    /* [agent_count]: the current state (swapped each step) */
+    ak_vec3* velocities;
+    uint8_t* species;
+    long step_index;       /* steps taken */
+    ak_boids_step_job job; /* points into the scene's params and the arrays below */
+    /* private */
+    size_t n;
+    ak_vec3 *p, *v, *p2, *v2, *w;
+    uint8_t* s;
+    uint8_t* scratch;
+    size_t scratch_size;
+} ak_boids_scene_run;
+
+/* Place the agents and validate the step job. The scene must outlive the run. AK_OK, or the
+ * failing code with "NAME: problem" in out_diag; free with ak_boids_scene_run_free either way. */
+AK_API ak_result ak_boids_scene_run_init(ak_boids_scene_run* run, const ak_boids_scene* scene,
+                                         const ak_boids_scene_run_desc* desc, ak_diag* out_diag);
+/* One step (number run->step_index). AK_ERR_BUDGET: agents packed past the grid's work budget
+ * (ak_boids_scene_run_error says what to lower). */
+AK_API ak_result ak_boids_scene_run_step(ak_boids_scene_run* run);
+/* What a failed step's result means for a user. */
+AK_API const char* ak_boids_scene_run_error(ak_result result);
+/* Free the arrays (safe on a zeroed or failed run, and twice). */
+AK_API void ak_boids_scene_run_free(ak_boids_scene_run* run);
+
 #ifdef __cplusplus
 }
 #endif

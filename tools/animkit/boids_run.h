@@ -7,15 +7,8 @@
 #include "cli.h"
 #include <animkit/boids.h>
 
-/* The agents (double-buffered) and the step job over them. */
-typedef struct boids_run {
-    size_t n;
-    ak_vec3 *p, *v, *p2, *v2, *w;
-    uint8_t* s;
-    uint8_t* scratch;
-    size_t scratch_size;
-    ak_boids_step_job job; /* points into sc->params and the arrays above */
-} boids_run;
+/* The library's run of a scene (ak_boids_scene_run, animkit/boids.h). */
+typedef ak_boids_scene_run boids_run;
 
 /* Place the scene's agents ("agents", or count at random in the bounds from the seed) and
  * validate the step job (naive: the O(N^2) neighbour search instead of the grid; the same

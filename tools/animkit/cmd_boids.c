@@ -92,19 +92,19 @@ static int write_json(const char* path, long steps, const boids_run* st) {
     cli_outfile out; /* a temporary renamed over path once complete */
     if (cli_outfile_open(&out, "boids", path)) return CLI_BAD_INPUT;
     FILE* f = out.f;
-    const float order = ak_boids_order((ak_vec3_cspan){st->v, st->n});
+    const float order = ak_boids_order((ak_vec3_cspan){st->velocities, st->agent_count});
     float dmin = 0.0f;
-    if (st->n >= 2) {
-        const size_t bytes = ak_boids_min_distance_scratch_size(st->n);
+    if (st->agent_count >= 2) {
+        const size_t bytes = ak_boids_min_distance_scratch_size(st->agent_count);
         uint8_t* scr = malloc(bytes);
-        if (!scr || ak_boids_min_distance((ak_vec3_cspan){st->p, st->n}, (ak_u8_span){scr, bytes}, &dmin) != AK_OK)
+        if (!scr || ak_boids_min_distance((ak_vec3_cspan){st->positions, st->agent_count}, (ak_u8_span){scr, bytes}, &dmin) != AK_OK)
             dmin = 0.0f;
         free(scr);
     }
     fprintf(f, "{\"steps\": %ld, \"agents\": [", steps);
-    for (size_t i = 0; i < st->n; ++i)
-        fprintf(f, "%s{\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g]}", i ? ", " : "", (double)st->p[i].x,
-                (double)st->p[i].y, (double)st->p[i].z, (double)st->v[i].x, (double)st->v[i].y, (double)st->v[i].z);
+    for (size_t i = 0; i < st->agent_count; ++i)
+        fprintf(f, "%s{\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g]}", i ? ", " : "", (double)st->positions[i].x,
+                (double)st->positions[i].y, (double)st->positions[i].z, (double)st->velocities[i].x, (double)st->velocities[i].y, (double)st->velocities[i].z);
     fprintf(f, "], \"order\": %.9g, \"min_distance\": %.9g}\n", (double)order, (double)dmin);
     return cli_outfile_commit(&out, "boids");
 }

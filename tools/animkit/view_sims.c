@@ -457,7 +457,7 @@ static size_t bsim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
     ak_raster_mesh birds, obs;
     boids_shapes_update(&b->sh, &b->sc, &b->run, (float)b->step_index * b->sc.dt, &birds, &obs);
     size_t n = 0;
-    if (n < cap && b->run.n) out[n++] = birds;
+    if (n < cap && b->run.agent_count) out[n++] = birds;
     if (n < cap && b->sh.otri) out[n++] = obs;
     return n;
 }
@@ -492,8 +492,8 @@ static void bsim_drag(void* state, ak_vec3 delta) {
 
 static void bsim_status(void* state, char* out, size_t n) {
     bsim* b = state;
-    snprintf(out, n, "t %.2fs, %zu agents, order %.3f%s", (double)b->step_index * (double)b->sc.dt, b->run.n,
-             (double)ak_boids_order((ak_vec3_cspan){b->run.v, b->run.n}), b->failed ? ", stopped (step failed)" : "");
+    snprintf(out, n, "t %.2fs, %zu agents, order %.3f%s", (double)b->step_index * (double)b->sc.dt, b->run.agent_count,
+             (double)ak_boids_order((ak_vec3_cspan){b->run.velocities, b->run.agent_count}), b->failed ? ", stopped (step failed)" : "");
 }
 
 static const view_help_entry bsim_keys[] = {
