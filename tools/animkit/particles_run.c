@@ -76,6 +76,11 @@ void particles_character_free(particles_character* c) {
 /* ---- simulation ------------------------------------------------------------------------ */
 
 
+/* The library's "particles: problem" without its prefix (the command says "animkit particles:"). */
+static const char* lib_message(const ak_diag* d) {
+    return strncmp(d->message, "particles: ", 11) == 0 ? d->message + 11 : d->message;
+}
+
 int particles_run_init(particles_run* r, ak_particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads) {
     memset(r, 0, sizeof *r);
     r->ch = ch;
@@ -89,7 +94,7 @@ int particles_run_init(particles_run* r, ak_particles_scene* s, particles_charac
     ak_diag diag;
     const ak_result res = ak_particles_scene_run_init(&r->lib, s, &d, &diag);
     r->ps = r->lib.system;
-    return res == AK_OK ? CLI_OK : cli_fail("particles", "%s", diag.message + strlen("particles: "));
+    return res == AK_OK ? CLI_OK : cli_fail("particles", "%s", lib_message(&diag));
 }
 
 /* One step: pose the character for the end of the step, then the library's step (emit, fire
@@ -102,7 +107,7 @@ int particles_run_step(particles_run* r, int step) {
     if (res != AK_OK) return cli_fail("particles", "step %d: %s", step, ak_result_string(res));
     ak_diag diag;
     if (ak_particles_scene_run_step(&r->lib, &diag) != AK_OK)
-        return cli_fail("particles", "%s", diag.message + strlen("particles: "));
+        return cli_fail("particles", "%s", lib_message(&diag));
     return CLI_OK;
 }
 
