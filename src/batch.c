@@ -596,9 +596,11 @@ static void make_row(const job_ctx* c, const ak_batch_desc* desc, const ak_batch
     if (text && strlen(text) < sizeof row->json) {
         memcpy(row->json, text, strlen(text) + 1);
     } else {
-        /* over the row's size (long paths): the essentials only */
-        snprintf(row->json, sizeof row->json, "{\"index\":%ld,\"status\":\"%s\",\"error\":\"%s\"}", desc->index,
-                 status[row->status], row->status == AK_BATCH_FAILED ? "the row is too long" : "");
+        /* over the row's size (paths full of escaped bytes): the essentials only */
+        hex64(hx, row->job_hash);
+        snprintf(row->json, sizeof row->json, "{\"index\":%ld,\"status\":\"%s\",\"job_hash\":\"%s\",\"error\":%s}",
+                 desc->index, status[row->status], hx,
+                 row->status == AK_BATCH_FAILED ? "\"the row is too long\"" : "null");
     }
     free(text);
 }

@@ -33,7 +33,7 @@ extern "C" {
 
 #define AK_BATCH_MAX_LINE_SIZE ((size_t)1 << 16) /* bytes of one job line */
 #define AK_BATCH_MAX_PATH 1024                   /* bytes of a path in a job, NUL included */
-#define AK_BATCH_ROW_SIZE 8192                   /* bytes of a row (JSON), NUL included */
+#define AK_BATCH_ROW_SIZE 16384                  /* bytes of a row (JSON), NUL included */
 #define AK_BATCH_RECORD_SUFFIX ".batch.json"     /* the record beside an output */
 
 typedef enum ak_batch_kind {
