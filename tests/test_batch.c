@@ -222,8 +222,8 @@ AK_TEST(bake_lasts_its_steps) {
 
 AK_TEST(bad_jobs_are_rows) {
     const char* lines[] = {
-        "{\"kind\": \"retarget\", \"inputs\": {\"source\": \"no/such.bvh\", \"target\": \"builtin:humanoid\"},"
-        " \"output\": \"x.glb\"}",
+        ("{\"kind\": \"retarget\", \"inputs\": {\"source\": \"no/such.bvh\", \"target\": \"builtin:humanoid\"},"
+         " \"output\": \"x.glb\"}"),
         "{\"kind\": \"render\", \"inputs\": {\"model\": \"builtin:nobody\"}, \"output\": \"x.png\"}",
         "{\"kind\": \"bake\", \"inputs\": {\"scene\": \"preset:lake\"}, \"parameters\": {\"sim\": \"fluid\"}, \"output\": \"x.glb\"}",
         "{\"kind\": \"retarget\"",
