@@ -417,6 +417,57 @@ AK_API ak_result ak_cloth_scene_preset(const char* name, ak_cloth_scene* out_sce
 /* Free the scene's arrays (NULL: no-op; safe on a failed or freed scene). */
 AK_API void ak_cloth_scene_free(ak_cloth_scene* scene);
 
+/* ---- running a scene ---------------------------------------------------------------------- */
+/* Step a loaded scene as `animkit cloth` does, so that C and Python reproduce the command's
+ * output: the cloth built from scene->desc, the spring solver raised to its stable substep count
+ * (unless scene->substeps_forced), gusty wind (wind x (1 + gust sin(2 pi gust_frequency t))),
+ * the scene's colliders. A scene with a character (scene->model) needs the caller: it loads and
+ * poses the model, passes the posed mesh and the number of its limb capsules here, and before
+ * each step writes run->targets (attachment targets at the step's end) and the capsules after
+ * the scene's (run->capsules[scene->capsule_count + k]); tools/animkit/cloth_run.c does so.
+ *     ak_cloth_scene_run run;
+ *     if (ak_cloth_scene_run_init(&run, &sc, NULL, &diag) == AK_OK)
+ *         for (long k = 0; k < sc.steps && ak_cloth_scene_run_step(&run, "flag", &diag) == AK_OK; ++k) {}
+ *     ... run.positions[i] for i < run.vertex_count ...
+ *     ak_cloth_scene_run_free(&run); */
+typedef struct ak_cloth_scene_run_desc {
+    const char* name;                /* starts messages; NULL -> "scene" */
+    size_t extra_capsule_count;      /* capsules after the scene's that the caller sets each step */
+    ak_cloth_collider_mesh mesh;     /* optional: a collider mesh the caller poses between steps */
+} ak_cloth_scene_run_desc;
+
+typedef struct ak_cloth_scene_run {
+    ak_cloth_scene* scene;           /* the scene run (its substeps may be raised, see above) */
+    ak_cloth* cloth;
+    ak_vec3* positions;              /* [vertex_count], stepped in place */
+    ak_vec3* velocities;
+    ak_vec3* normals;
+    ak_vec3* targets;                /* [scene->attach_count]: the caller's, before each step */
+    ak_cloth_capsule* capsules;      /* the scene's, then desc.extra_capsule_count of the caller's */
+    size_t vertex_count;
+    long step_index;                 /* steps taken */
+    float time;                      /* simulated seconds */
+    double stable_substep;           /* > 0 when the spring solver raised the substeps: its bound (s) */
+    uint32_t substeps_given;         /* ... the count the scene asked for */
+    double substeps_needed;          /* ... and the count it needs */
+    ak_cloth_step_job job;           /* points into the arrays above and the scene */
+    /* private */
+    ak_vec3* residuals;
+    uint8_t* scratch;
+    uint32_t* attach_idx;
+} ak_cloth_scene_run;
+
+/* Build the cloth and its step job. The scene must outlive the run. AK_OK, or the failing code
+ * with "NAME: problem" in out_diag (AK_ERR_BUDGET: the spring solver needs over 10000 substeps);
+ * free with ak_cloth_scene_run_free either way. */
+AK_API ak_result ak_cloth_scene_run_init(ak_cloth_scene_run* run, ak_cloth_scene* scene,
+                                         const ak_cloth_scene_run_desc* desc, ak_diag* out_diag);
+/* One step with the gust of the step's start. AK_ERR_NO_CONVERGENCE: a blow-up ("NAME: blow-up:
+ * the state became non-finite at step K ..."); other codes name the step. name NULL -> "scene". */
+AK_API ak_result ak_cloth_scene_run_step(ak_cloth_scene_run* run, const char* name, ak_diag* out_diag);
+/* Free the run (safe on a zeroed or failed run, and twice). */
+AK_API void ak_cloth_scene_run_free(ak_cloth_scene_run* run);
+
 #ifdef __cplusplus
 }
 #endif

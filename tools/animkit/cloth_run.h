@@ -28,20 +28,18 @@ typedef struct cloth_character {
 
 void cloth_character_free(cloth_character* c);
 
-/* A cloth built from a scene (which it points to), its state and its step job. */
+/* A cloth built from a scene (which it points to) by the library's run, with the character. */
 typedef struct cloth_run {
+    ak_cloth_scene_run lib;           /* the cloth, its state and its step job */
     ak_cloth_scene* sc;
     cloth_character ch;
+    /* lib's, under the command's names (refreshed by init and step) */
     ak_cloth* cloth;
     ak_vec3 *x, *vel, *nrm, *targets; /* [n], [n], [n], [attach_count] */
-    ak_vec3* res;                     /* [n] position residuals (the step's extra precision) */
-    uint8_t* scratch;
-    uint32_t* attach_idx;
-    ak_cloth_capsule* caps; /* the scene's capsules, then the limb capsules */
+    ak_cloth_capsule* caps;           /* the scene's capsules, then the limb capsules */
     size_t n;
-    ak_cloth_step_job job;  /* points into the above and sc (spheres, planes) */
-    long step;              /* steps run */
-    float time;             /* simulated seconds */
+    long step;                        /* steps run */
+    float time;                       /* simulated seconds */
 } cloth_run;
 
 /* Build the cloth, load and pose the character (attachments keep their offsets at t = 0),
