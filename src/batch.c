@@ -11,7 +11,9 @@
 #include <sys/stat.h> /* mkdir, stat */
 #include <time.h>
 
+#include <animkit/boids.h>
 #include <animkit/builtin.h>
+#include <animkit/cloth.h>
 #include <animkit/fluid.h>
 #include <animkit/particles.h>
 #include <animkit/io.h>
@@ -119,15 +121,15 @@ static void parse_job(akp_json* j, const cJSON* root, ak_batch_job* job) {
     } else if (job->kind == AK_BATCH_BAKE) {
         static const char* const ik[] = {"scene", NULL};
         static const char* const pk[] = {"sim", "steps", "count", "frame_every", NULL};
-        static const char* const sims[] = {"fluid", "particles", NULL};
+        static const char* const sims[] = {"fluid", "particles", "cloth", "boids", NULL};
         akp_json_object(j, in, "inputs", ik);
         akp_json_object(j, par, "parameters", pk);
         read_path(j, in, "inputs", "scene", true, job->scene, sizeof job->scene);
         if (!j->failed && !cJSON_GetObjectItemCaseSensitive(par, "sim"))
-            akp_json_fail(j, "parameters", "sim", "is required (\"fluid\" or \"particles\")");
+            akp_json_fail(j, "parameters", "sim", "is required (fluid, particles, cloth or boids)");
         akp_json_enum(j, par, "parameters", "sim", sims, &job->sim);
         akp_json_int(j, par, "parameters", "steps", 1, 100000, &job->steps);
-        akp_json_int(j, par, "parameters", "count", 0, BAKE_MAX_POINTS, &job->count);
+        akp_json_int(j, par, "parameters", "count", 0, BAKE_MAX_POINTS, &job->count); /* fluid presets, boids */
         akp_json_int(j, par, "parameters", "frame_every", 1, 100000, &job->frame_every);
     } else if (job->kind == AK_BATCH_RENDER) {
         static const char* const ik[] = {"model", NULL};
@@ -467,6 +469,150 @@ done:
     return r;
 }
 
+/* Steps and frames of a bake: every `every` steps from 0 to steps. */
+static long bake_every(const ak_batch_job* job, long steps) {
+    return job->frame_every ? job->frame_every : (steps + BAKE_DEFAULT_FRAMES - 1) / BAKE_DEFAULT_FRAMES;
+}
+
+static ak_result save_scene(job_ctx* c, ak_scene* out) {
+    ak_diag d;
+    memset(&d, 0, sizeof d);
+    ak_io_save_desc sd = {0};
+    const ak_result r = ak_io_save(c->output, out, &sd, &d);
+    return r == AK_OK ? AK_OK : fail(c, r, "output: %s: %s", c->output, d.message[0] ? d.message : ak_result_string(r));
+}
+
+/* A cloth scene (file or preset) without a character, run as `animkit cloth` runs it and baked
+ * as a deforming mesh. */
+static ak_result run_bake_cloth(job_ctx* c) {
+    const ak_batch_job* job = c->job;
+    ak_cloth_scene s;
+    ak_cloth_scene_run run;
+    memset(&run, 0, sizeof run);
+    ak_diag d;
+    const char* in = c->inputs[0].path;
+    ak_result r = strncmp(in, "preset:", 7) == 0 ? ak_cloth_scene_preset(in + 7, &s, &d) : ak_cloth_scene_load_file(in, &s, &d);
+    if (r != AK_OK) return fail(c, r, "inputs.scene: %s", d.message);
+    ak_vec3* frames_pos = NULL;
+    ak_scene* out = NULL;
+    if (s.model[0]) {
+        r = fail(c, AK_ERR_UNSUPPORTED, "inputs.scene: a scene with a character (%s) needs the command", s.model);
+        goto done;
+    }
+    const long steps = job->steps ? job->steps : s.steps;
+    const long every = bake_every(job, steps > 0 ? steps : 1);
+    const size_t frames = (size_t)(steps / every) + 1;
+    if ((r = ak_cloth_scene_run_init(&run, &s, &(ak_cloth_scene_run_desc){.name = in}, &d)) != AK_OK) {
+        r = fail(c, r, "%s", d.message);
+        goto done;
+    }
+    const size_t n = run.vertex_count;
+    if ((double)frames * (double)n * sizeof(ak_vec3) > (double)AK_SCENE_BAKE_DEFAULT_BUDGET) {
+        r = fail(c, AK_ERR_BUDGET, "%zu frames of %zu vertices are over the bake's memory budget", frames, n);
+        goto done;
+    }
+    if (!(frames_pos = malloc(frames * n * sizeof *frames_pos))) {
+        r = fail(c, AK_ERR_NO_MEMORY, "out of memory");
+        goto done;
+    }
+    size_t f = 0;
+    for (long k = 0; k <= steps; ++k) {
+        if (k % every == 0 && f < frames) memcpy(frames_pos + f++ * n, run.positions, n * sizeof *frames_pos);
+        if (k == steps) break;
+        if ((r = ak_cloth_scene_run_step(&run, in, &d)) != AK_OK) {
+            r = fail(c, r, "%s", d.message);
+            goto done;
+        }
+    }
+    ak_scene_bake_mesh_desc bd = {.name = "cloth", .vertex_count = n, .frame_count = f, .positions = frames_pos,
+                                  .indices = ak_cloth_indices(run.cloth), .frame_time = (float)every * s.dt,
+                                  .base_color = {0.8f, 0.25f, 0.2f, 1.0f}};
+    memset(&d, 0, sizeof d);
+    if ((r = ak_scene_bake_mesh_frames(&bd, NULL, &out, &d)) != AK_OK) {
+        r = fail(c, r, "bake: %s", d.message[0] ? d.message : ak_result_string(r));
+        goto done;
+    }
+    r = save_scene(c, out);
+    c->frames = (long)f;
+done:
+    ak_scene_destroy(out);
+    free(frames_pos);
+    ak_cloth_scene_run_free(&run);
+    ak_cloth_scene_free(&s);
+    return r;
+}
+
+/* A boids scene (file or preset) run as `animkit boids` runs it, baked as points (agent index
+ * = id). */
+static ak_result run_bake_boids(job_ctx* c) {
+    const ak_batch_job* job = c->job;
+    ak_boids_scene s;
+    ak_boids_scene_run run;
+    memset(&run, 0, sizeof run);
+    ak_diag d;
+    const char* in = c->inputs[0].path;
+    ak_boids_scene_defaults(&s);
+    ak_result r = strncmp(in, "preset:", 7) == 0 ? ak_boids_scene_preset(in + 7, &s, &d) : ak_boids_scene_load_file(in, &s, &d);
+    ak_vec3* pos = NULL;
+    uint32_t* ids = NULL;
+    ak_scene_bake_points* fr = NULL;
+    ak_scene* out = NULL;
+    if (r != AK_OK) {
+        r = fail(c, r, "inputs.scene: %s", d.message);
+        goto done;
+    }
+    if (job->count) s.count = (size_t)job->count;
+    if (s.agent_count == 0) ak_boids_scene_scale_bounds(&s, s.count);
+    const long steps = job->steps ? job->steps : s.steps;
+    const long every = bake_every(job, steps > 0 ? steps : 1);
+    const size_t frames = (size_t)(steps / every) + 1;
+    if ((r = ak_boids_scene_run_init(&run, &s, &(ak_boids_scene_run_desc){.name = in}, &d)) != AK_OK) {
+        r = fail(c, r, "%s", d.message);
+        goto done;
+    }
+    const size_t n = run.agent_count;
+    if (n > BAKE_MAX_POINTS) {
+        r = fail(c, AK_ERR_BUDGET, "%zu agents, more than the %u a bake holds", n, BAKE_MAX_POINTS);
+        goto done;
+    }
+    pos = malloc(frames * (n + 1) * sizeof *pos);
+    ids = malloc((n + 1) * sizeof *ids);
+    fr = calloc(frames, sizeof *fr);
+    if (!pos || !ids || !fr) {
+        r = fail(c, AK_ERR_NO_MEMORY, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < n; ++i) ids[i] = (uint32_t)i;
+    size_t f = 0;
+    for (long k = 0; k <= steps; ++k) {
+        if (k % every == 0 && f < frames) {
+            memcpy(pos + f * (n + 1), run.positions, n * sizeof *pos);
+            fr[f] = (ak_scene_bake_points){.positions = pos + f * (n + 1), .ids = ids, .count = n};
+            ++f;
+        }
+        if (k == steps) break;
+        if ((r = ak_boids_scene_run_step(&run)) != AK_OK) {
+            r = fail(c, r, "step %ld: %s", k, ak_boids_scene_run_error(r));
+            goto done;
+        }
+    }
+    ak_scene_bake_points_desc bd = {.name = "boids", .frames = fr, .frame_count = f,
+                                    .frame_time = (float)every * s.dt, .marker_size = 0.5f * s.shape_size};
+    memset(&d, 0, sizeof d);
+    if ((r = ak_scene_bake_point_frames(&bd, NULL, &out, &d)) != AK_OK) {
+        r = fail(c, r, "bake: %s", d.message[0] ? d.message : ak_result_string(r));
+        goto done;
+    }
+    r = save_scene(c, out);
+    c->frames = (long)f;
+done:
+    ak_scene_destroy(out);
+    free(fr), free(ids), free(pos);
+    ak_boids_scene_run_free(&run);
+    ak_boids_scene_free(&s);
+    return r;
+}
+
 static ak_result run_render(job_ctx* c) {
     const ak_batch_job* job = c->job;
     ak_scene* sc = NULL;
@@ -566,7 +712,8 @@ static void make_row(const job_ctx* c, const ak_batch_desc* desc, const ak_batch
         cJSON_AddBoolToObject(p, "unscaled_root_motion", job->unscaled);
         cJSON_AddBoolToObject(p, "skip_foot_contacts", job->no_feet);
     } else if (p && job && job->kind == AK_BATCH_BAKE) {
-        cJSON_AddStringToObject(p, "sim", job->sim == 1 ? "particles" : "fluid");
+        static const char* const sim_names[] = {"fluid", "particles", "cloth", "boids"};
+        cJSON_AddStringToObject(p, "sim", sim_names[job->sim]);
         cJSON_AddNumberToObject(p, "steps", (double)job->steps);
         cJSON_AddNumberToObject(p, "count", (double)job->count);
         cJSON_AddNumberToObject(p, "frame_every", (double)job->frame_every);
@@ -680,7 +827,7 @@ ak_result ak_batch_run_job(const char* line, size_t size, const ak_batch_desc* d
     if (job->kind == AK_BATCH_RETARGET)
         r = run_retarget(c);
     else if (job->kind == AK_BATCH_BAKE)
-        r = job->sim == 1 ? run_bake_particles(c) : run_bake(c);
+        r = job->sim == 1 ? run_bake_particles(c) : job->sim == 2 ? run_bake_cloth(c) : job->sim == 3 ? run_bake_boids(c) : run_bake(c);
     else
         r = run_render(c);
     if (r == AK_OK) out_row->status = AK_BATCH_RAN;

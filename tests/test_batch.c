@@ -82,6 +82,8 @@ AK_TEST(job_lines_with_errors) {
         {"{\"kind\": \"bake\", \"inputs\": {\"scene\": \"preset:dam\"}, \"parameters\": {\"sim\": \"fluid\", \"speed\": 1},"
          " \"output\": \"a.glb\"}",
          "j: parameters: unknown key \"speed\" (allowed: sim, steps, count, frame_every)"},
+        {"{\"kind\": \"bake\", \"inputs\": {\"scene\": \"s.json\"}, \"output\": \"a.glb\"}",
+         "j: parameters.sim: is required (fluid, particles, cloth or boids)"},
         {"{\"kind\": \"render\", \"inputs\": {\"model\": 3}, \"output\": \"a.png\"}",
          "j: inputs.model: expected a string, got a number"},
         {"{\"kind\": \"render\", \"inputs\": {\"model\": \"m\"}, \"parameters\": {\"size\": [8.5, 9]}, \"output\": \"a.png\"}",
@@ -202,6 +204,29 @@ AK_TEST(bake_lasts_its_steps) {
     AK_CHECK_EQ(ak_io_load("test_batch_out/fountain.glb", NULL, NULL, &out, NULL), AK_OK);
     if (out && out->clip_count == 1) AK_CHECK_NEAR(ak_clip_duration(out->clips[0]), 0.30f, 1e-5f);
     ak_scene_destroy(out);
+    /* cloth (the flag preset, dt 1/60) and boids (the predator preset, dt 0.02) run as their
+     * commands run them; a cloth scene with a character is the command's */
+    const char* cl = "{\"kind\": \"bake\", \"inputs\": {\"scene\": \"preset:flag\"},"
+                     " \"parameters\": {\"sim\": \"cloth\", \"steps\": 12, \"frame_every\": 3}, \"output\": \"flag.glb\"}";
+    AK_CHECK_EQ(run_line(cl, "test_batch_out", true), AK_OK);
+    AK_CHECK_MSG(row.status == AK_BATCH_RAN && strstr(row.json, "\"frames\":5"), "%s", row.json);
+    out = NULL;
+    AK_CHECK_EQ(ak_io_load("test_batch_out/flag.glb", NULL, NULL, &out, NULL), AK_OK);
+    if (out && out->clip_count == 1) AK_CHECK_NEAR(ak_clip_duration(out->clips[0]), 12.0f / 60.0f, 1e-5f);
+    if (out) AK_CHECK(out->mesh_count == 1 && out->meshes[0].mesh && out->meshes[0].mesh->vertex_count == 640);
+    ak_scene_destroy(out);
+    const char* bo = "{\"kind\": \"bake\", \"inputs\": {\"scene\": \"preset:predator\"},"
+                     " \"parameters\": {\"sim\": \"boids\", \"steps\": 10, \"count\": 100}, \"output\": \"boids.glb\"}";
+    AK_CHECK_EQ(run_line(bo, "test_batch_out", true), AK_OK);
+    AK_CHECK_MSG(row.status == AK_BATCH_RAN && strstr(row.json, "\"frames\":11"), "%s", row.json);
+    out = NULL;
+    AK_CHECK_EQ(ak_io_load("test_batch_out/boids.glb", NULL, NULL, &out, NULL), AK_OK);
+    if (out && out->clip_count == 1) AK_CHECK_NEAR(ak_clip_duration(out->clips[0]), 10.0f * 0.02f, 1e-5f);
+    ak_scene_destroy(out);
+    const char* cape = "{\"kind\": \"bake\", \"inputs\": {\"scene\": \"preset:cape\"}, \"parameters\": {\"sim\": \"cloth\"},"
+                       " \"output\": \"cape.glb\"}";
+    AK_CHECK(run_line(cape, "test_batch_out", true) != AK_OK);
+    AK_CHECK(strstr(row.error, "character") != NULL);
     /* the same job skips; other parameters run; a record of another job does not count */
     AK_CHECK_EQ(run_line(line, "test_batch_out", false), AK_OK);
     AK_CHECK_EQ(row.status, AK_BATCH_SKIPPED);

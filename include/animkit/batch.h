@@ -39,7 +39,7 @@ extern "C" {
 typedef enum ak_batch_kind {
     AK_BATCH_KIND_NONE = 0,
     AK_BATCH_RETARGET, /* a clip of inputs.source put on inputs.target: .glb / .gltf */
-    AK_BATCH_BAKE,     /* a simulation scene run and baked to animated points: .glb / .gltf */
+    AK_BATCH_BAKE,     /* a simulation scene run and baked (points, or the cloth mesh): .glb / .gltf */
     AK_BATCH_RENDER    /* a model's skeleton at a time drawn to a .png */
 } ak_batch_kind;
 
@@ -56,9 +56,10 @@ typedef struct ak_batch_job {
     bool unscaled, no_feet;          /* parameters.unscaled_root_motion, skip_foot_contacts */
     /* bake: inputs.scene (a scene file of the simulation, or "preset:NAME") */
     char scene[AK_BATCH_MAX_PATH];
-    int sim;                         /* parameters.sim (required): 0 "fluid", 1 "particles" */
-    long steps;                      /* parameters.steps [1, 100000]; 0 -> the fluid scene's, 200 particle steps */
-    long count;                      /* parameters.count (fluid presets' particles) [0, 16384]; 0 -> 2000 */
+    int sim;                         /* parameters.sim (required): 0 "fluid", 1 "particles", 2 "cloth", 3 "boids" */
+    long steps;                      /* parameters.steps [1, 100000]; 0 -> the scene's (particles: 200) */
+    long count;                      /* parameters.count [0, 16384]: a fluid preset's particles (0 -> 2000),
+                                        random boids (0 -> the scene's) */
     long frame_every;                /* parameters.frame_every [1, 100000]: steps per baked frame; 0 -> so that <= 240 frames */
     /* render: inputs.model (a file or builtin:NAME) */
     char model[AK_BATCH_MAX_PATH];
