@@ -33,5 +33,6 @@
 #include "retarget.h"
 #include "fluid.h"
 #include "rigid.h"
+#include "batch.h"
 
 #endif

@@ -198,5 +198,6 @@ int cmd_cloth(int argc, char** argv);
 int cmd_rigid(int argc, char** argv);
 int cmd_retarget(int argc, char** argv);
 int cmd_fluid(int argc, char** argv);
+int cmd_batch(int argc, char** argv);
 
 #endif
