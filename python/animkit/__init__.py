@@ -1,0 +1,36 @@
+"""animkit: character animation and deformation (Python bindings of the animkit C library).
+
+    import animkit as ak
+    scene = ak.load("CesiumMan.glb")              # also "builtin:humanoid", .bvh, .gltf
+    pose = scene.sample(clip=0, time=0.5)         # pose.model_matrices: (J, 4, 4) float32
+    verts = scene.skin(pose, method="lbs")        # (N, 3) float32, "dqs" and "cor" too
+    img = scene.render(time=0.5, size=(320, 240)) # (240, 320, 4) uint8
+
+Arrays are numpy arrays without copies: mesh data are read-only views of the scene's memory,
+results are written straight into the arrays returned. Failures raise animkit.Error subclasses
+carrying the library's message (.message), the file or item (.path) and the result code (.code).
+See docs/python.md.
+"""
+from ._core import (  # noqa: F401
+    ArgumentError,
+    DataError,
+    Error,
+    FileError,
+    Mesh,
+    NoMemoryError,
+    NotFoundError,
+    ParseError,
+    Pose,
+    Scene,
+    UnsupportedError,
+    __version__,
+    builtin_names,
+    load,
+    retarget,
+)
+
+__all__ = [
+    "ArgumentError", "DataError", "Error", "FileError", "Mesh", "NoMemoryError", "NotFoundError",
+    "ParseError", "Pose", "Scene", "UnsupportedError", "__version__", "builtin_names", "load",
+    "retarget",
+]
