@@ -24,6 +24,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <time.h>
 
 #include <animkit/animkit.h>
 
@@ -1142,7 +1143,72 @@ static PyObject* mod_builtin_names(PyObject* self, PyObject* noargs) {
     return list;
 }
 
+static double now_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The C side of bench/bench_python.py: the work of scene.sample(clip, time) followed by
+ * scene.skin(pose, method, mesh, out=...) run count times in a C loop (the same functions, no
+ * Python in between); seconds per iteration. */
+static PyObject* mod_bench_c(PyObject* self, PyObject* args) {
+    (void)self;
+    PyObject* scene_obj;
+    int clip;
+    double t;
+    const char* method_name;
+    Py_ssize_t mi, count;
+    if (!PyArg_ParseTuple(args, "O!idsnn:_bench_c", &SceneType, &scene_obj, &clip, &t, &method_name, &mi, &count))
+        return NULL;
+    SceneObject* o = (SceneObject*)scene_obj;
+    cli_method method;
+    if (method_arg(method_name, &method) < 0) return NULL;
+    if (mi < 0 || (size_t)mi >= o->scene->mesh_count || !o->scene->meshes[mi].mesh || count < 1 ||
+        clip >= (int)o->scene->clip_count)
+        return RAISE_ARG("bad mesh, clip or count");
+    PoseObject* pose = pose_new(o);
+    if (!pose) return NULL;
+    ak_vec3* out = PyMem_Calloc(o->scene->meshes[mi].mesh->vertex_count, sizeof(ak_vec3));
+    if (!out) {
+        Py_DECREF(pose);
+        return PyErr_NoMemory();
+    }
+    ak_result r;
+    double secs = 0.0;
+    Py_BEGIN_ALLOW_THREADS
+    r = poser_acquire(o);
+    if (r == AK_OK) {
+        cli_poser* pp = &o->poser;
+        ak_transform* keep_local = pp->local;
+        float* keep_morph = pp->morph_weights;
+        ak_vec3* keep_pos = pp->positions[mi];
+        double t0 = now_seconds();
+        for (Py_ssize_t i = 0; i < count && r == AK_OK; ++i) {
+            r = pose_sample_locked(pp, pose, clip, (float)t, clip < 0);
+            pp->local = pose->local;
+            pp->morph_weights = pose->morph;
+            pp->positions[mi] = out;
+            if (r == AK_OK) r = cli_poser_deform(pp, false, method);
+            pp->local = keep_local;
+            pp->morph_weights = keep_morph;
+            pp->positions[mi] = keep_pos;
+        }
+        secs = (now_seconds() - t0) / (double)count;
+        PyThread_release_lock(o->lock);
+    }
+    Py_END_ALLOW_THREADS
+    PyMem_Free(out);
+    Py_DECREF(pose);
+    if (r != AK_OK) return raise_result(r, o->scene->name, NULL);
+    return PyFloat_FromDouble(secs);
+}
+
 static PyMethodDef module_methods[] = {
+    {"_bench_c", (PyCFunction)mod_bench_c, METH_VARARGS,
+     "_bench_c(scene, clip, time, method, mesh, count) -> float\n\n"
+     "Seconds per iteration of sample + skin (out= a fixed buffer) in a C loop: the reference "
+     "of bench/bench_python.py."},
     {"load", (PyCFunction)(void (*)(void))mod_load, METH_VARARGS | METH_KEYWORDS,
      "load(path) -> Scene\n\nLoad a model file (.glb, .gltf, .bvh; FBX/Collada/OBJ through Assimp "
      "when built with it) or a built-in model ('builtin:humanoid', 'builtin:cylinder'). Raises "
