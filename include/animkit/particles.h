@@ -371,6 +371,77 @@ typedef struct ak_particles_world {
 AK_API ak_result ak_particles_step(ak_particles* particles, const ak_particles_world* world,
                                    float dt);
 
+/* ---- scene files and presets ------------------------------------------------------------ */
+/* A particle scene: the JSON format of `animkit particles SCENE.json` (docs/particles.md lists
+ * every key, its unit and its default) or a built-in preset, parsed into arrays the scene owns.
+ * The same loader serves C, the Python package and the command:
+ *     ak_particles_scene sc;
+ *     ak_diag diag;
+ *     if (ak_particles_scene_load_file("fountain.json", &sc, &diag) != AK_OK) {
+ *         fprintf(stderr, "%s\n", diag.message);   // "fountain.json: emitters[0].rate: ..."
+ *         return 1;
+ *     }
+ *     ... ak_particles_create(&(ak_particles_desc){.capacity = sc.capacity}, ...),
+ *         ak_particles_add(...sc.particles...), ak_particles_step(ps, &sc.world, sc.dt) ...
+ *     ak_particles_scene_free(&sc);
+ * Emitters with bursts fire burst.count particles at burst.start, then every burst.interval
+ * seconds (interval 0: once); the others emit at their rate. */
+
+/* Bursts of one emitter of a scene: count particles at time start, then every interval. */
+typedef struct ak_particles_scene_burst {
+    uint32_t count;
+    float start;    /* seconds */
+    float interval; /* seconds; 0 = once */
+} ak_particles_scene_burst;
+
+/* A loaded scene: the world and everything to add, owning its arrays (ak_particles_scene_free).
+ * world's spans point into the arrays below. */
+typedef struct ak_particles_scene {
+    float dt;                           /* seconds per step; default 0.01 */
+    ak_particles_integrator integrator; /* default SYMPLECTIC */
+    uint32_t capacity;                  /* default: particles + 100000 when there are emitters */
+    ak_particles_world world;
+    ak_particle_init* particles;        /* [particle_count] initial particles */
+    size_t particle_count;
+    ak_particle_spring* springs;        /* [world.springs.count] */
+    ak_particle_plane* planes;
+    ak_particle_sphere* spheres;
+    ak_particle_box* boxes;
+    ak_particle_attractor* attractors;
+    ak_particle_vortex* vortices;
+    ak_particle_emitter* emitters;      /* [emitter_count] */
+    ak_particles_scene_burst* bursts;   /* [emitter_count]; count 0: the emitter uses its rate */
+    size_t emitter_count;
+} ak_particles_scene;
+
+/* Budgets a scene file may ask for, checked before allocating. */
+#define AK_PARTICLES_SCENE_MAX_ITEMS 1000000u    /* particles, springs, colliders, emitters each */
+#define AK_PARTICLES_SCENE_MAX_CAPACITY 2000000u /* about 0.5 GB of system state */
+#define AK_PARTICLES_SCENE_MAX_FILE_SIZE ((size_t)64 << 20) /* bytes of a scene file */
+/* The names ak_particles_scene_preset knows. */
+#define AK_PARTICLES_SCENE_PRESETS "fountain, rain, fireworks, character"
+
+/* Parse a scene from bytes[0, size) (strict JSON, need not be NUL-terminated); name (NULL ->
+ * "(scene)") starts every message. Emitter shape "mesh" is not allowed in files. Returns AK_OK
+ * and fills *out_scene, or AK_ERR_PARSE (a syntax error, an unknown key, a value out of range or
+ * over a budget), AK_ERR_NULL_ARG, with *out_scene empty and, when out_diag is not NULL, the one
+ * line "NAME: key.path: problem" in out_diag->message (out_diag->path = name). */
+AK_API ak_result ak_particles_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                               ak_particles_scene* out_scene, ak_diag* out_diag);
+/* Read the file at path (at most AK_PARTICLES_SCENE_MAX_FILE_SIZE bytes) and parse it as
+ * ak_particles_scene_load_bytes does, path naming it in messages. AK_ERR_IO when the file cannot
+ * be opened or read or is too big ("PATH: cannot open the file"). */
+AK_API ak_result ak_particles_scene_load_file(const char* path, ak_particles_scene* out_scene,
+                                              ak_diag* out_diag);
+/* The built-in scene name (AK_PARTICLES_SCENE_PRESETS; docs/particles.md gives their values).
+ * "character" holds a mesh-surface emitter (sparks) and rain: the command supplies the
+ * humanoid's posed mesh as collider and emitter surface. AK_ERR_NOT_FOUND for another name,
+ * AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_particles_scene_preset(const char* name, ak_particles_scene* out_scene,
+                                           ak_diag* out_diag);
+/* Free the scene's arrays and zero it (safe on a zeroed, failed or freed scene; NULL: no-op). */
+AK_API void ak_particles_scene_free(ak_particles_scene* scene);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,11 +1,7 @@
-/* libFuzzer harness for particle scene files (tools/animkit/scene_particles.c).
+/* libFuzzer harness for particle scene files (ak_particles_scene_load_bytes, src/particles/scene.c).
  *
- * scripts/fuzz.sh builds it with the library and the CLI sources except main.c. By hand:
- *     clang -g -O1 -fsanitize=fuzzer,address,undefined -std=c11 -D_POSIX_C_SOURCE=200809L \
- *         -Iinclude -Isrc -Itools/animkit tests/fuzz/fuzz_scene_particles.c \
- *         tools/animkit/scene_particles.c tools/animkit/cli_json.c src/core.c src/math.c \
- *         src/math/[a-z]*.c src/grid.c src/particles.c -lcjson -lm -lpthread -o
- * fuzz_scene_particles
+ * scripts/fuzz.sh builds it with the library and the CLI sources except main.c (the runner,
+ * tools/animkit/particles_run.c), then runs e.g.
  *     ./fuzz_scene_particles -dict=tests/fuzz/scene_particles.dict examples/particles_fountain.json
  *
  * Each input is parsed from memory; an accepted scene (capacity cut to 2000) is stepped three
@@ -19,15 +15,14 @@
 #include <string.h>
 
 #include "particles_run.h"
-#include "scene_particles.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    particles_scene s;
-    char err[600];
-    if (!particles_scene_parse("fuzz.json", (const char*)data, size, &s, err, sizeof err)) {
-        if (err[0] == '\0' || strchr(err, '\n')) abort();
+    ak_particles_scene s;
+    ak_diag diag;
+    if (ak_particles_scene_load_bytes(data, size, "fuzz.json", &s, &diag) != AK_OK) {
+        if (strncmp(diag.message, "fuzz.json", 9) != 0 || strchr(diag.message, '\n')) abort();
         return 0;
     }
     if (s.capacity > 2000) s.capacity = s.particle_count > 2000 ? (uint32_t)s.particle_count : 2000;
@@ -43,6 +38,6 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                 abort();
     }
     particles_run_free(&run);
-    particles_scene_free(&s);
+    ak_particles_scene_free(&s);
     return 0;
 }

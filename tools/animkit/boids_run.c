@@ -5,7 +5,7 @@
 
 #include "boids_run.h"
 
-int boids_run_init(boids_run* st, const cli_boids_scene* sc, const char* cmd, const char* file, uint32_t threads,
+int boids_run_init(boids_run* st, const ak_boids_scene* sc, const char* cmd, const char* file, uint32_t threads,
                    bool naive) {
     memset(st, 0, sizeof *st);
     st->n = sc->agent_count > 0 ? sc->agent_count : sc->count;
@@ -182,7 +182,7 @@ bool boids_shapes_obstacles(boids_shapes* r, const ak_boids_params* prm, float p
     return true;
 }
 
-bool boids_shapes_init(boids_shapes* r, const cli_boids_scene* sc, size_t n, float plane_size) {
+bool boids_shapes_init(boids_shapes* r, const ak_boids_scene* sc, size_t n, float plane_size) {
     memset(r, 0, sizeof *r);
     r->pos = malloc((n * 5 + 1) * sizeof(ak_vec3));
     r->col = malloc((n * 5 + 1) * sizeof(ak_vec4));
@@ -208,7 +208,7 @@ void boids_shapes_free(boids_shapes* r) {
     memset(r, 0, sizeof *r);
 }
 
-void boids_shapes_update(boids_shapes* r, const cli_boids_scene* sc, const boids_run* st, float time, ak_raster_mesh* out_birds,
+void boids_shapes_update(boids_shapes* r, const ak_boids_scene* sc, const boids_run* st, float time, ak_raster_mesh* out_birds,
                          ak_raster_mesh* out_obstacles) {
     const float L = sc->shape_size;
     for (size_t i = 0; i < st->n; ++i) {

@@ -80,7 +80,7 @@ static int character_bones(cloth_character* c, float scale) {
     return CLI_OK;
 }
 
-int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char* name) {
+int cloth_run_init(cloth_run* run, ak_cloth_scene* sc, const char* cmd, const char* name) {
     memset(run, 0, sizeof *run);
     run->sc = sc;
     cloth_character* ch = &run->ch;
@@ -185,7 +185,7 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
         /* attachments keep their offset from the joint or skinned vertex at t = 0, from their
          * given start position or else their rest position */
         for (size_t k = 0; k < sc->attach_count; ++k) {
-            const cloth_attach_spec* at = &sc->attach[k];
+            const ak_cloth_attach_spec* at = &sc->attach[k];
             if (at->has_position) x[at->vertex] = at->position;
             const ak_vec3 p = x[at->vertex];
             char path[40];
@@ -251,7 +251,7 @@ done:
 }
 
 int cloth_run_step(cloth_run* run, const char* cmd, const char* name) {
-    const cloth_scene* sc = run->sc;
+    const ak_cloth_scene* sc = run->sc;
     cloth_character* ch = &run->ch;
     const long step = run->step;
     const float time = run->time;
@@ -287,7 +287,7 @@ int cloth_run_step(cloth_run* run, const char* cmd, const char* name) {
 }
 
 void cloth_run_bounds(const cloth_run* run, ak_vec3* out_lo, ak_vec3* out_hi) {
-    const cloth_scene* sc = run->sc;
+    const ak_cloth_scene* sc = run->sc;
     ak_vec3 lo, hi;
     ak_points_bounds((ak_vec3_cspan){run->x, run->n}, &lo, &hi);
     for (size_t k = 0; k < sc->sphere_count; ++k) {

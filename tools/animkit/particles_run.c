@@ -6,107 +6,6 @@
 #include "particles_run.h"
 #include "render.h"
 
-/* ---- presets -------------------------------------------------------------------------- */
-
-static ak_particle_emitter emitter_base(void) {
-    ak_particle_emitter e = {.direction = {0, 1, 0},
-                             .cone_angle = 0.3f,
-                             .speed_min = 1,
-                             .speed_max = 2,
-                             .lifetime_min = 1,
-                             .lifetime_max = 2,
-                             .size_min = 0.03f,
-                             .size_max = 0.03f,
-                             .mass = 1};
-    return e;
-}
-
-/* Rain: emitter_base falling straight down (a narrow cone) from a flat box. */
-static ak_particle_emitter rain_base(ak_vec3 center, ak_vec3 half_extents) {
-    ak_particle_emitter e = emitter_base();
-    e.shape = AK_EMITTER_BOX, e.center = center, e.half_extents = half_extents;
-    e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f;
-    return e;
-}
-
-/* Fills s for a preset; false when out of memory. */
-bool particles_preset(const char* name, particles_scene* s) {
-    memset(s, 0, sizeof *s);
-    s->dt = 0.01f;
-    s->integrator = AK_INTEGRATOR_SYMPLECTIC;
-    s->capacity = 60000;
-    s->world.gravity = ak_vec3_make(0, -9.81f, 0);
-    s->planes = calloc(1, sizeof *s->planes);
-    s->spheres = calloc(1, sizeof *s->spheres);
-    s->emitters = calloc(4, sizeof *s->emitters);
-    s->bursts = calloc(4, sizeof *s->bursts);
-    if (!s->planes || !s->spheres || !s->emitters || !s->bursts) return false;
-    s->planes[0] = (ak_particle_plane){.normal = {0, 1, 0}, .restitution = 0.4f, .friction = 0.3f};
-    s->world.planes = (ak_particle_plane_cspan){s->planes, 1};
-    ak_particle_emitter e = emitter_base();
-    if (strcmp(name, "fountain") == 0) {
-        e.center = ak_vec3_make(0, 0.05f, 0);
-        e.cone_angle = 0.18f, e.speed_min = 5.0f, e.speed_max = 5.6f;
-        e.lifetime_min = 2.5f, e.lifetime_max = 3.5f;
-        e.colour = ak_vec4_make(0.25f, 0.55f, 1.0f, 1), e.rate = 1500.0f;
-        s->emitters[0] = e;
-        s->emitter_count = 1;
-        s->spheres[0] = (ak_particle_sphere){
-            .center = {0.45f, 0.35f, 0}, .radius = 0.35f, .restitution = 0.3f, .friction = 0.2f};
-        s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
-        s->world.drag_linear = 0.02f;
-    } else if (strcmp(name, "rain") == 0) {
-        e = rain_base(ak_vec3_make(0, 4, 0), ak_vec3_make(2, 0.1f, 2));
-        e.speed_min = 3, e.speed_max = 4;
-        e.lifetime_min = 2.5f, e.lifetime_max = 3.0f, e.size_min = 0.015f, e.size_max = 0.02f;
-        e.colour = ak_vec4_make(0.55f, 0.7f, 1.0f, 1), e.rate = 3000.0f;
-        s->emitters[0] = e;
-        s->emitter_count = 1;
-        s->spheres[0] = (ak_particle_sphere){
-            .center = {0, 1.2f, 0}, .radius = 0.8f, .restitution = 0.2f, .friction = 0.1f};
-        s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
-        s->world.wind = ak_vec3_make(1.5f, 0, 0);
-        s->world.drag_linear = 0.3f;
-        s->planes[0].restitution = 0.1f;
-    } else if (strcmp(name, "fireworks") == 0) {
-        const ak_vec4 colours[4] = {
-            {1, 0.3f, 0.2f, 1}, {0.3f, 1, 0.4f, 1}, {1, 0.85f, 0.3f, 1}, {0.6f, 0.5f, 1, 1}};
-        const float x[4] = {-1.2f, 0.9f, 0.0f, 1.6f}, y[4] = {3.0f, 3.6f, 4.2f, 2.8f};
-        for (int k = 0; k < 4; ++k) {
-            ak_particle_emitter f = emitter_base();
-            f.shape = AK_EMITTER_SPHERE, f.center = ak_vec3_make(x[k], y[k], -0.5f * k),
-            f.radius = 0.05f;
-            f.cone_angle = AK_PI, f.speed_min = 2.5f, f.speed_max = 3.2f, f.lifetime_min = 1.2f,
-            f.lifetime_max = 1.8f;
-            f.colour = colours[k];
-            s->emitters[k] = f;
-            s->bursts[k] =
-                (particles_burst){.count = 800, .start = 0.45f * (float)k, .interval = 1.8f};
-        }
-        s->emitter_count = 4;
-        s->world.drag_quadratic = 0.02f;
-        s->world.gravity = ak_vec3_make(0, -3.0f, 0);
-    } else if (strcmp(name, "character") == 0) {
-        /* Rain on the character (collides with its posed mesh) and sparks from its surface. */
-        e = rain_base(ak_vec3_make(0, 2.6f, 0), ak_vec3_make(0.7f, 0.05f, 0.7f));
-        e.speed_min = 2, e.speed_max = 2.5f;
-        e.lifetime_min = 2, e.lifetime_max = 2.5f, e.size_min = 0.012f, e.size_max = 0.016f;
-        e.colour = ak_vec4_make(0.45f, 0.65f, 1.0f, 1), e.rate = 2500.0f;
-        s->emitters[0] = e;
-        ak_particle_emitter sp = emitter_base();
-        sp.shape = AK_EMITTER_MESH, sp.cone_angle = 0.5f, sp.speed_min = 0.3f, sp.speed_max = 0.8f;
-        sp.lifetime_min = 0.6f, sp.lifetime_max = 1.0f, sp.size_min = 0.01f, sp.size_max = 0.015f;
-        sp.colour = ak_vec4_make(1.0f, 0.55f, 0.15f, 1), sp.rate = 800.0f,
-        sp.base_velocity = ak_vec3_make(0, 0.5f, 0);
-        s->emitters[1] = sp;
-        s->emitter_count = 2;
-        s->planes[0].restitution = 0.2f;
-    } else {
-        return false;
-    }
-    return true;
-}
-
 /* ---- the character ----------------------------------------------------------------------- */
 
 
@@ -177,7 +76,7 @@ void particles_character_free(particles_character* c) {
 /* ---- simulation ------------------------------------------------------------------------ */
 
 
-int particles_run_init(particles_run* r, particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads) {
+int particles_run_init(particles_run* r, ak_particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads) {
     memset(r, 0, sizeof *r);
     r->scene = s;
     r->ch = ch;
@@ -230,7 +129,7 @@ static uint64_t bursts_due(float start, float interval, double t1, uint64_t fire
 
 /* One step: pose the character for the end of the step, emit, step. */
 int particles_run_step(particles_run* r, int step) {
-    particles_scene* s = r->scene;
+    ak_particles_scene* s = r->scene;
     const float dt = s->dt;
     const double t1 = (double)(step + 1) * dt;
     ak_result res = AK_OK;
@@ -242,7 +141,7 @@ int particles_run_step(particles_run* r, int step) {
          * a particle until the system is full); the bursts still due after that are counted,
          * not fired, in a bounded number of operations. A 1e-30 s interval used to hang here:
          * the count was stepped with k -= 1.0 on a double near 1e28, which no longer changes. */
-        const particles_burst* b = &s->bursts[e];
+        const ak_particles_scene_burst* b = &s->bursts[e];
         const uint64_t max_calls = (uint64_t)ak_particles_capacity(r->ps) + 1u;
         uint64_t calls = 0;
         while (res == AK_OK && b->count > 0 && (b->interval > 0.0f || r->fired[e] == 0)) {
@@ -302,7 +201,7 @@ void particles_run_free(particles_run* r) {
 
 
 /* UV spheres and boxes of the colliders as one triangle mesh. */
-bool particles_shapes_build(particles_shapes* sh, const particles_scene* s) {
+bool particles_shapes_build(particles_shapes* sh, const ak_particles_scene* s) {
     enum { SEG = 24, RINGS = 14 };
     size_t nv = s->world.spheres.count * (SEG + 1) * (RINGS + 1) + s->world.boxes.count * 24;
     size_t ni = s->world.spheres.count * SEG * RINGS * 6 + s->world.boxes.count * 36;

@@ -1,14 +1,15 @@
-/* animkit cloth: scene files (strict JSON through cli_json.h) and the built-in presets.
+/* animkit cloth: scene files (strict JSON through src/json.h) and the built-in presets.
  * docs/cloth.md lists every key with its unit and default. */
+#include <animkit/cloth.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli_json.h"
-#include "scene_cloth.h"
+#include "json.h"
 
-void cloth_scene_defaults(cloth_scene* s) {
+void ak_cloth_scene_defaults(ak_cloth_scene* s) {
     memset(s, 0, sizeof *s);
     s->desc.grid_width = 20;
     s->desc.grid_height = 20;
@@ -32,7 +33,8 @@ void cloth_scene_defaults(cloth_scene* s) {
     s->thread_count = 1;
 }
 
-void cloth_scene_free(cloth_scene* s) {
+void ak_cloth_scene_free(ak_cloth_scene* s) {
+    if (!s) return;
     free(s->pins);
     free(s->pin_positions);
     free(s->attach);
@@ -42,114 +44,114 @@ void cloth_scene_free(cloth_scene* s) {
     s->pins = NULL, s->pin_positions = NULL, s->attach = NULL, s->planes = NULL, s->spheres = NULL, s->capsules = NULL;
 }
 
-static bool set_str(cli_json* j, const cJSON* obj, const char* path, const char* key, char* dst, size_t size) {
+static bool set_str(akp_json* j, const cJSON* obj, const char* path, const char* key, char* dst, size_t size) {
     const char* v = NULL;
-    if (!cli_json_str(j, obj, path, key, &v)) return false;
+    if (!akp_json_str(j, obj, path, key, &v)) return false;
     if (!v) return true;
-    if (strlen(v) >= size) return cli_json_fail(j, path, key, "longer than %zu characters", size - 1);
+    if (strlen(v) >= size) return akp_json_fail(j, path, key, "longer than %zu characters", size - 1);
     snprintf(dst, size, "%s", v);
     return true;
 }
 
-static void parse_grid(cli_json* j, const cJSON* root, cloth_scene* s) {
-    const cJSON* g = cli_json_member(j, root, "", "grid");
+static void parse_grid(akp_json* j, const cJSON* root, ak_cloth_scene* s) {
+    const cJSON* g = akp_json_member(j, root, "", "grid");
     if (!g) return;
     static const char* const keys[] = {"width", "height", "spacing", "origin", "axis_u", "axis_v", NULL};
-    cli_json_object(j, g, "grid", keys);
+    akp_json_object(j, g, "grid", keys);
     long w = s->desc.grid_width, h = s->desc.grid_height;
-    cli_json_int(j, g, "grid", "width", 2, 4096, &w);
-    cli_json_int(j, g, "grid", "height", 2, 4096, &h);
-    if (!j->failed && (size_t)w * (size_t)h > CLOTH_SCENE_MAX_PARTICLES)
-        cli_json_fail(j, "grid", "", "%ld x %ld particles is over the budget of %zu", w, h, CLOTH_SCENE_MAX_PARTICLES);
+    akp_json_int(j, g, "grid", "width", 2, 4096, &w);
+    akp_json_int(j, g, "grid", "height", 2, 4096, &h);
+    if (!j->failed && (size_t)w * (size_t)h > AK_CLOTH_SCENE_MAX_PARTICLES)
+        akp_json_fail(j, "grid", "", "%ld x %ld particles is over the budget of %zu", w, h, AK_CLOTH_SCENE_MAX_PARTICLES);
     s->desc.grid_width = (uint32_t)w, s->desc.grid_height = (uint32_t)h;
-    cli_json_float(j, g, "grid", "spacing", 1e-4f, 100.0f, &s->desc.spacing);
-    cli_json_vec3(j, g, "grid", "origin", &s->desc.grid_origin);
-    cli_json_vec3(j, g, "grid", "axis_u", &s->desc.grid_axis_u);
-    cli_json_vec3(j, g, "grid", "axis_v", &s->desc.grid_axis_v);
-    if (!j->failed && ak_vec3_length(s->desc.grid_axis_u) < 1e-6f) cli_json_fail(j, "grid", "axis_u", "is zero");
-    if (!j->failed && ak_vec3_length(s->desc.grid_axis_v) < 1e-6f) cli_json_fail(j, "grid", "axis_v", "is zero");
+    akp_json_float(j, g, "grid", "spacing", 1e-4f, 100.0f, &s->desc.spacing);
+    akp_json_vec3(j, g, "grid", "origin", &s->desc.grid_origin);
+    akp_json_vec3(j, g, "grid", "axis_u", &s->desc.grid_axis_u);
+    akp_json_vec3(j, g, "grid", "axis_v", &s->desc.grid_axis_v);
+    if (!j->failed && ak_vec3_length(s->desc.grid_axis_u) < 1e-6f) akp_json_fail(j, "grid", "axis_u", "is zero");
+    if (!j->failed && ak_vec3_length(s->desc.grid_axis_v) < 1e-6f) akp_json_fail(j, "grid", "axis_v", "is zero");
     if (!j->failed &&
         ak_vec3_length(ak_vec3_cross(ak_vec3_normalize(s->desc.grid_axis_u), ak_vec3_normalize(s->desc.grid_axis_v))) < 1e-3f)
-        cli_json_fail(j, "grid", "axis_v", "is parallel to axis_u");
+        akp_json_fail(j, "grid", "axis_v", "is parallel to axis_u");
 }
 
-static void parse_material(cli_json* j, const cJSON* root, cloth_scene* s) {
-    const cJSON* m = cli_json_member(j, root, "", "material");
+static void parse_material(akp_json* j, const cJSON* root, ak_cloth_scene* s) {
+    const cJSON* m = akp_json_member(j, root, "", "material");
     if (!m) return;
     static const char* const keys[] = {"stretch_stiffness", "shear_stiffness", "bend_stiffness", "dihedral_stiffness",
                                        "bending", "spring_damping", "constraint_damping", "pbd_stiffness",
                                        "long_range_attachments", "long_range_slack", "area_density", NULL};
     static const char* const bendings[] = {"default", "dihedral", "springs", "none", "isometric", NULL};
     ak_cloth_desc* d = &s->desc;
-    cli_json_object(j, m, "material", keys);
-    cli_json_float(j, m, "material", "stretch_stiffness", 1e-3f, 1e9f, &d->stretch_stiffness);
-    cli_json_float(j, m, "material", "shear_stiffness", 1e-3f, 1e9f, &d->shear_stiffness);
-    cli_json_float(j, m, "material", "bend_stiffness", 1e-3f, 1e9f, &d->bend_stiffness);
-    cli_json_float(j, m, "material", "dihedral_stiffness", 1e-9f, 1e6f, &d->dihedral_stiffness);
+    akp_json_object(j, m, "material", keys);
+    akp_json_float(j, m, "material", "stretch_stiffness", 1e-3f, 1e9f, &d->stretch_stiffness);
+    akp_json_float(j, m, "material", "shear_stiffness", 1e-3f, 1e9f, &d->shear_stiffness);
+    akp_json_float(j, m, "material", "bend_stiffness", 1e-3f, 1e9f, &d->bend_stiffness);
+    akp_json_float(j, m, "material", "dihedral_stiffness", 1e-9f, 1e6f, &d->dihedral_stiffness);
     int bend = (int)d->bending;
-    cli_json_enum(j, m, "material", "bending", bendings, &bend);
+    akp_json_enum(j, m, "material", "bending", bendings, &bend);
     d->bending = (ak_cloth_bending)bend;
-    cli_json_float(j, m, "material", "spring_damping", 0.0f, 1e6f, &d->spring_damping);
-    cli_json_float(j, m, "material", "constraint_damping", 0.0f, 10.0f, &d->constraint_damping);
-    cli_json_float(j, m, "material", "pbd_stiffness", 1e-6f, 1.0f, &d->pbd_stiffness);
-    cli_json_bool(j, m, "material", "long_range_attachments", &d->long_range_attachments);
-    cli_json_float(j, m, "material", "long_range_slack", 0.0f, 10.0f, &d->long_range_slack);
-    cli_json_float(j, m, "material", "area_density", 1e-6f, 1e4f, &d->area_density);
+    akp_json_float(j, m, "material", "spring_damping", 0.0f, 1e6f, &d->spring_damping);
+    akp_json_float(j, m, "material", "constraint_damping", 0.0f, 10.0f, &d->constraint_damping);
+    akp_json_float(j, m, "material", "pbd_stiffness", 1e-6f, 1.0f, &d->pbd_stiffness);
+    akp_json_bool(j, m, "material", "long_range_attachments", &d->long_range_attachments);
+    akp_json_float(j, m, "material", "long_range_slack", 0.0f, 10.0f, &d->long_range_slack);
+    akp_json_float(j, m, "material", "area_density", 1e-6f, 1e4f, &d->area_density);
 }
 
-static void parse_pins(cli_json* j, const cJSON* root, cloth_scene* s) {
+static void parse_pins(akp_json* j, const cJSON* root, ak_cloth_scene* s) {
     size_t n = 0;
-    const cJSON* e = cli_json_array(j, root, "", "pins", CLOTH_SCENE_MAX_LIST, &n);
+    const cJSON* e = akp_json_array(j, root, "", "pins", AK_CLOTH_SCENE_MAX_LIST, &n);
     if (!e || j->failed) return;
     s->pins = calloc(n, sizeof(uint32_t));
     if (!s->pins) {
-        cli_json_fail(j, "", "pins", "out of memory");
+        akp_json_fail(j, "", "pins", "out of memory");
         return;
     }
     const size_t count = (size_t)s->desc.grid_width * s->desc.grid_height;
     for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
         char path[32];
-        cli_json_index(path, sizeof path, "pins", k);
+        akp_json_index(path, sizeof path, "pins", k);
         if (!cJSON_IsNumber(e) || e->valuedouble != floor(e->valuedouble) || e->valuedouble < 0) {
-            cli_json_fail(j, path, "", "expected a particle index (integer >= 0)");
+            akp_json_fail(j, path, "", "expected a particle index (integer >= 0)");
             break;
         }
         if (e->valuedouble >= (double)count) {
-            cli_json_fail(j, path, "", "particle %.0f is out of range (the grid has %zu)", e->valuedouble, count);
+            akp_json_fail(j, path, "", "particle %.0f is out of range (the grid has %zu)", e->valuedouble, count);
             break;
         }
         s->pins[k] = (uint32_t)e->valuedouble;
         for (size_t q = 0; q < k; ++q)
-            if (s->pins[q] == s->pins[k]) cli_json_fail(j, path, "", "particle %u is pinned twice", s->pins[k]);
+            if (s->pins[q] == s->pins[k]) akp_json_fail(j, path, "", "particle %u is pinned twice", s->pins[k]);
         s->pin_count = k + 1;
     }
 }
 
-static void parse_pin_positions(cli_json* j, const cJSON* root, cloth_scene* s) {
+static void parse_pin_positions(akp_json* j, const cJSON* root, ak_cloth_scene* s) {
     size_t n = 0;
-    const cJSON* e = cli_json_array(j, root, "", "pin_positions", CLOTH_SCENE_MAX_LIST, &n);
+    const cJSON* e = akp_json_array(j, root, "", "pin_positions", AK_CLOTH_SCENE_MAX_LIST, &n);
     if (!e || j->failed) return;
     if (n != s->pin_count) {
-        cli_json_fail(j, "", "pin_positions", "has %zu entries for %zu pins (one per pin, in order)", n, s->pin_count);
+        akp_json_fail(j, "", "pin_positions", "has %zu entries for %zu pins (one per pin, in order)", n, s->pin_count);
         return;
     }
     s->pin_positions = calloc(n, sizeof(ak_vec3));
     if (!s->pin_positions) {
-        cli_json_fail(j, "", "pin_positions", "out of memory");
+        akp_json_fail(j, "", "pin_positions", "out of memory");
         return;
     }
     for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
         char path[40];
-        cli_json_index(path, sizeof path, "pin_positions", k);
+        akp_json_index(path, sizeof path, "pin_positions", k);
         if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != 3) {
-            cli_json_fail(j, path, "", "expected [x, y, z]");
+            akp_json_fail(j, path, "", "expected [x, y, z]");
             break;
         }
         float c[3];
         for (int q = 0; q < 3; ++q) {
             const cJSON* x = cJSON_GetArrayItem(e, q);
             if (!cJSON_IsNumber(x) || !(fabs(x->valuedouble) <= 1e6)) {
-                cli_json_fail(j, path, "", "expected three numbers within 1e6 m");
+                akp_json_fail(j, path, "", "expected three numbers within 1e6 m");
                 break;
             }
             c[q] = (float)x->valuedouble;
@@ -159,172 +161,187 @@ static void parse_pin_positions(cli_json* j, const cJSON* root, cloth_scene* s) 
     }
 }
 
-static void parse_attachments(cli_json* j, const cJSON* root, cloth_scene* s) {
+static void parse_attachments(akp_json* j, const cJSON* root, ak_cloth_scene* s) {
     size_t n = 0;
-    const cJSON* e = cli_json_array(j, root, "", "attachments", CLOTH_SCENE_MAX_LIST, &n);
+    const cJSON* e = akp_json_array(j, root, "", "attachments", AK_CLOTH_SCENE_MAX_LIST, &n);
     if (!e || j->failed) return;
-    s->attach = calloc(n, sizeof(cloth_attach_spec));
+    s->attach = calloc(n, sizeof(ak_cloth_attach_spec));
     if (!s->attach) {
-        cli_json_fail(j, "", "attachments", "out of memory");
+        akp_json_fail(j, "", "attachments", "out of memory");
         return;
     }
     static const char* const keys[] = {"vertex", "joint", "mesh_vertex", "position", NULL};
     const long count = (long)s->desc.grid_width * s->desc.grid_height;
     for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
         char path[40];
-        cli_json_index(path, sizeof path, "attachments", k);
+        akp_json_index(path, sizeof path, "attachments", k);
         if (!cJSON_IsObject(e)) {
-            cli_json_fail(j, path, "", "expected an object {\"vertex\": i, \"joint\": NAME} or {\"vertex\": i, \"mesh_vertex\": k}");
+            akp_json_fail(j, path, "", "expected an object {\"vertex\": i, \"joint\": NAME} or {\"vertex\": i, \"mesh_vertex\": k}");
             break;
         }
-        cli_json_object(j, e, path, keys);
-        cloth_attach_spec* a = &s->attach[k];
+        akp_json_object(j, e, path, keys);
+        ak_cloth_attach_spec* a = &s->attach[k];
         long v = -1;
         a->mesh_vertex = -1;
-        cli_json_int(j, e, path, "vertex", 0, count - 1, &v);
+        akp_json_int(j, e, path, "vertex", 0, count - 1, &v);
         set_str(j, e, path, "joint", a->joint, sizeof a->joint);
-        cli_json_int(j, e, path, "mesh_vertex", 0, 100000000L, &a->mesh_vertex);
+        akp_json_int(j, e, path, "mesh_vertex", 0, 100000000L, &a->mesh_vertex);
         a->has_position = cJSON_GetObjectItemCaseSensitive(e, "position") != NULL;
-        cli_json_vec3(j, e, path, "position", &a->position);
+        akp_json_vec3(j, e, path, "position", &a->position);
         if (j->failed) break;
-        if (v < 0) cli_json_fail(j, path, "vertex", "is required");
-        else if ((a->joint[0] != '\0') == (a->mesh_vertex >= 0)) cli_json_fail(j, path, "", "give exactly one of joint, mesh_vertex");
+        if (v < 0) akp_json_fail(j, path, "vertex", "is required");
+        else if ((a->joint[0] != '\0') == (a->mesh_vertex >= 0)) akp_json_fail(j, path, "", "give exactly one of joint, mesh_vertex");
         a->vertex = (uint32_t)v;
         for (size_t q = 0; q < k && !j->failed; ++q)
-            if (s->attach[q].vertex == a->vertex) cli_json_fail(j, path, "vertex", "particle %ld is attached twice", v);
+            if (s->attach[q].vertex == a->vertex) akp_json_fail(j, path, "vertex", "particle %ld is attached twice", v);
         for (size_t q = 0; q < s->pin_count && !j->failed; ++q)
-            if (s->pins[q] == a->vertex) cli_json_fail(j, path, "vertex", "particle %ld is also pinned", v);
+            if (s->pins[q] == a->vertex) akp_json_fail(j, path, "vertex", "particle %ld is also pinned", v);
         s->attach_count = k + 1;
     }
 }
 
-static void parse_colliders(cli_json* j, const cJSON* root, cloth_scene* s) {
-    const cJSON* c = cli_json_member(j, root, "", "colliders");
+static void parse_colliders(akp_json* j, const cJSON* root, ak_cloth_scene* s) {
+    const cJSON* c = akp_json_member(j, root, "", "colliders");
     if (!c) return;
     static const char* const keys[] = {"planes", "spheres", "capsules", "thickness", "friction", "self_collision",
                                        "self_distance", NULL};
-    cli_json_object(j, c, "colliders", keys);
-    cli_json_float(j, c, "colliders", "thickness", 1e-5f, 10.0f, &s->thickness);
-    cli_json_float(j, c, "colliders", "friction", 0.0f, 10.0f, &s->friction);
-    cli_json_bool(j, c, "colliders", "self_collision", &s->self_collision);
-    cli_json_float(j, c, "colliders", "self_distance", 0.0f, 10.0f, &s->self_distance);
+    akp_json_object(j, c, "colliders", keys);
+    akp_json_float(j, c, "colliders", "thickness", 1e-5f, 10.0f, &s->thickness);
+    akp_json_float(j, c, "colliders", "friction", 0.0f, 10.0f, &s->friction);
+    akp_json_bool(j, c, "colliders", "self_collision", &s->self_collision);
+    akp_json_float(j, c, "colliders", "self_distance", 0.0f, 10.0f, &s->self_distance);
     size_t n = 0;
-    const cJSON* e = cli_json_array(j, c, "colliders", "planes", CLOTH_SCENE_MAX_LIST, &n);
+    const cJSON* e = akp_json_array(j, c, "colliders", "planes", AK_CLOTH_SCENE_MAX_LIST, &n);
     if (e && !j->failed && (s->planes = calloc(n, sizeof(ak_cloth_plane))) != NULL) {
         static const char* const pk[] = {"normal", "offset", NULL};
         for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
             char path[48];
-            cli_json_index(path, sizeof path, "colliders.planes", k);
-            if (!cJSON_IsObject(e)) { cli_json_fail(j, path, "", "expected an object"); break; }
-            cli_json_object(j, e, path, pk);
+            akp_json_index(path, sizeof path, "colliders.planes", k);
+            if (!cJSON_IsObject(e)) { akp_json_fail(j, path, "", "expected an object"); break; }
+            akp_json_object(j, e, path, pk);
             ak_cloth_plane p = {{0, 1, 0}, 0.0f};
-            cli_json_vec3(j, e, path, "normal", &p.normal);
-            cli_json_float(j, e, path, "offset", -1e6f, 1e6f, &p.offset);
-            if (!j->failed && ak_vec3_length(p.normal) < 1e-6f) cli_json_fail(j, path, "normal", "is zero");
+            akp_json_vec3(j, e, path, "normal", &p.normal);
+            akp_json_float(j, e, path, "offset", -1e6f, 1e6f, &p.offset);
+            if (!j->failed && ak_vec3_length(p.normal) < 1e-6f) akp_json_fail(j, path, "normal", "is zero");
             s->planes[k] = p;
             s->plane_count = k + 1;
         }
     }
-    e = cli_json_array(j, c, "colliders", "spheres", CLOTH_SCENE_MAX_LIST, &n);
+    e = akp_json_array(j, c, "colliders", "spheres", AK_CLOTH_SCENE_MAX_LIST, &n);
     if (e && !j->failed && (s->spheres = calloc(n, sizeof(ak_cloth_sphere))) != NULL) {
         static const char* const sk[] = {"center", "radius", NULL};
         for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
             char path[48];
-            cli_json_index(path, sizeof path, "colliders.spheres", k);
-            if (!cJSON_IsObject(e)) { cli_json_fail(j, path, "", "expected an object"); break; }
-            cli_json_object(j, e, path, sk);
+            akp_json_index(path, sizeof path, "colliders.spheres", k);
+            if (!cJSON_IsObject(e)) { akp_json_fail(j, path, "", "expected an object"); break; }
+            akp_json_object(j, e, path, sk);
             ak_cloth_sphere p = {{0, 0, 0}, 0.5f};
-            cli_json_vec3(j, e, path, "center", &p.center);
-            cli_json_float(j, e, path, "radius", 0.0f, 1e6f, &p.radius);
+            akp_json_vec3(j, e, path, "center", &p.center);
+            akp_json_float(j, e, path, "radius", 0.0f, 1e6f, &p.radius);
             s->spheres[k] = p;
             s->sphere_count = k + 1;
         }
     }
-    e = cli_json_array(j, c, "colliders", "capsules", CLOTH_SCENE_MAX_LIST, &n);
+    e = akp_json_array(j, c, "colliders", "capsules", AK_CLOTH_SCENE_MAX_LIST, &n);
     if (e && !j->failed && (s->capsules = calloc(n, sizeof(ak_cloth_capsule))) != NULL) {
         static const char* const ck[] = {"a", "b", "radius", NULL};
         for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
             char path[48];
-            cli_json_index(path, sizeof path, "colliders.capsules", k);
-            if (!cJSON_IsObject(e)) { cli_json_fail(j, path, "", "expected an object"); break; }
-            cli_json_object(j, e, path, ck);
+            akp_json_index(path, sizeof path, "colliders.capsules", k);
+            if (!cJSON_IsObject(e)) { akp_json_fail(j, path, "", "expected an object"); break; }
+            akp_json_object(j, e, path, ck);
             ak_cloth_capsule p = {{0, 0, 0}, {0, 1, 0}, 0.1f};
-            cli_json_vec3(j, e, path, "a", &p.a);
-            cli_json_vec3(j, e, path, "b", &p.b);
-            cli_json_float(j, e, path, "radius", 0.0f, 1e6f, &p.radius);
+            akp_json_vec3(j, e, path, "a", &p.a);
+            akp_json_vec3(j, e, path, "b", &p.b);
+            akp_json_float(j, e, path, "radius", 0.0f, 1e6f, &p.radius);
             s->capsules[k] = p;
             s->capsule_count = k + 1;
         }
     }
 }
 
-static void parse_character(cli_json* j, const cJSON* root, cloth_scene* s) {
-    const cJSON* c = cli_json_member(j, root, "", "character");
+static void parse_character(akp_json* j, const cJSON* root, ak_cloth_scene* s) {
+    const cJSON* c = akp_json_member(j, root, "", "character");
     if (!c) return;
     static const char* const keys[] = {"model", "clip", "mesh_collider", "limb_capsules", "capsule_scale", NULL};
-    cli_json_object(j, c, "character", keys);
+    akp_json_object(j, c, "character", keys);
     set_str(j, c, "character", "model", s->model, sizeof s->model);
     set_str(j, c, "character", "clip", s->clip, sizeof s->clip);
-    cli_json_bool(j, c, "character", "mesh_collider", &s->mesh_collider);
-    cli_json_bool(j, c, "character", "limb_capsules", &s->limb_capsules);
-    cli_json_float(j, c, "character", "capsule_scale", 0.0f, 10.0f, &s->capsule_scale);
-    if (!j->failed && s->model[0] == '\0') cli_json_fail(j, "character", "model", "is required");
+    akp_json_bool(j, c, "character", "mesh_collider", &s->mesh_collider);
+    akp_json_bool(j, c, "character", "limb_capsules", &s->limb_capsules);
+    akp_json_float(j, c, "character", "capsule_scale", 0.0f, 10.0f, &s->capsule_scale);
+    if (!j->failed && s->model[0] == '\0') akp_json_fail(j, "character", "model", "is required");
 }
 
-bool cloth_scene_parse(const char* file, const char* text, size_t size, cloth_scene* out, char* message,
-                       size_t message_size) {
-    cloth_scene_defaults(out);
-    cli_json j = {.file = file ? file : "scene"};
-    cJSON* root = cli_json_parse(&j, text, size);
+ak_result ak_cloth_scene_load_bytes(const void* bytes, size_t size, const char* name, ak_cloth_scene* out,
+                                   ak_diag* out_diag) {
+    if (!out) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, name ? name : "scene", "no scene to fill");
+    ak_cloth_scene_defaults(out);
+    akp_json j = {.file = name ? name : "scene"};
+    if (!bytes && size) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, j.file, "no bytes");
+    const char* text = bytes ? (const char*)bytes : "";
+    cJSON* root = akp_json_parse(&j, text, size);
     if (root) {
         static const char* const keys[] = {"solver", "grid", "material", "pins", "pin_positions", "attachments", "dt", "steps",
                                            "substeps", "iterations", "threads", "gravity", "wind", "gust",
                                            "gust_frequency", "drag", "lift", "air_density", "damping", "colliders",
                                            "character", NULL};
         static const char* const solvers[] = {"xpbd", "springs", "pbd", "implicit", NULL}; /* enum order */
-        cli_json_object(&j, root, "", keys);
+        akp_json_object(&j, root, "", keys);
         int solver = 0;
-        cli_json_enum(&j, root, "", "solver", solvers, &solver);
+        akp_json_enum(&j, root, "", "solver", solvers, &solver);
         out->desc.solver = (ak_cloth_solver)solver;
         parse_grid(&j, root, out);
         parse_material(&j, root, out);
         parse_pins(&j, root, out);
         parse_pin_positions(&j, root, out);
         parse_attachments(&j, root, out);
-        cli_json_float(&j, root, "", "dt", 1e-7f, 1.0f, &out->dt);
-        cli_json_int(&j, root, "", "steps", 0, CLOTH_SCENE_MAX_STEPS, &out->steps);
+        akp_json_float(&j, root, "", "dt", 1e-7f, 1.0f, &out->dt);
+        akp_json_int(&j, root, "", "steps", 0, AK_CLOTH_SCENE_MAX_STEPS, &out->steps);
         long sub = out->substeps, it = out->iterations, th = out->thread_count;
-        cli_json_int(&j, root, "", "substeps", 1, 10000, &sub);
-        cli_json_int(&j, root, "", "iterations", 1, 10000, &it);
-        cli_json_int(&j, root, "", "threads", 1, 64, &th);
+        akp_json_int(&j, root, "", "substeps", 1, 10000, &sub);
+        akp_json_int(&j, root, "", "iterations", 1, 10000, &it);
+        akp_json_int(&j, root, "", "threads", 1, 64, &th);
         out->substeps = (uint32_t)sub, out->iterations = (uint32_t)it, out->thread_count = (int)th;
         out->iterations_given = cJSON_GetObjectItemCaseSensitive(root, "iterations") != NULL;
-        cli_json_vec3(&j, root, "", "gravity", &out->gravity);
-        cli_json_vec3(&j, root, "", "wind", &out->wind);
-        cli_json_float(&j, root, "", "gust", 0.0f, 10.0f, &out->gust);
-        cli_json_float(&j, root, "", "gust_frequency", 0.0f, 100.0f, &out->gust_frequency);
-        cli_json_float(&j, root, "", "drag", 0.0f, 100.0f, &out->drag);
-        cli_json_float(&j, root, "", "lift", 0.0f, 100.0f, &out->lift);
-        cli_json_float(&j, root, "", "air_density", 0.0f, 1000.0f, &out->air_density);
-        cli_json_float(&j, root, "", "damping", 0.0f, 1000.0f, &out->damping);
+        akp_json_vec3(&j, root, "", "gravity", &out->gravity);
+        akp_json_vec3(&j, root, "", "wind", &out->wind);
+        akp_json_float(&j, root, "", "gust", 0.0f, 10.0f, &out->gust);
+        akp_json_float(&j, root, "", "gust_frequency", 0.0f, 100.0f, &out->gust_frequency);
+        akp_json_float(&j, root, "", "drag", 0.0f, 100.0f, &out->drag);
+        akp_json_float(&j, root, "", "lift", 0.0f, 100.0f, &out->lift);
+        akp_json_float(&j, root, "", "air_density", 0.0f, 1000.0f, &out->air_density);
+        akp_json_float(&j, root, "", "damping", 0.0f, 1000.0f, &out->damping);
         parse_colliders(&j, root, out);
         parse_character(&j, root, out);
         if (!j.failed && out->attach_count && out->model[0] == '\0')
-            cli_json_fail(&j, "", "attachments", "need a character (character.model)");
+            akp_json_fail(&j, "", "attachments", "need a character (character.model)");
         cJSON_Delete(root);
     }
     if (j.failed) {
-        snprintf(message, message_size, "%s", j.message);
-        cloth_scene_free(out);
-        return false;
+        ak_cloth_scene_free(out);
+        return akp_json_diag(&j, AK_ERR_PARSE, out_diag);
     }
     out->desc.pins = (ak_u32_cspan){out->pins, out->pin_count};
     out->desc.pin_positions = (ak_vec3_cspan){out->pin_positions, out->pin_position_count};
-    return true;
+    if (out_diag) memset(out_diag, 0, sizeof *out_diag);
+    return AK_OK;
 }
 
-bool cloth_scene_preset(const char* name, cloth_scene* s) {
-    cloth_scene_defaults(s);
+ak_result ak_cloth_scene_load_file(const char* path, ak_cloth_scene* out, ak_diag* out_diag) {
+    if (!out || !path) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, path ? path : "scene", "no path or scene");
+    ak_cloth_scene_defaults(out);
+    akp_json j = {.file = path};
+    size_t size = 0;
+    char* text = akp_json_read_file(&j, path, 0, &size);
+    if (!text) return akp_json_diag(&j, AK_ERR_IO, out_diag);
+    ak_result r = ak_cloth_scene_load_bytes(text, size, path, out, out_diag);
+    free(text);
+    return r;
+}
+
+static bool preset_fill(const char* name, ak_cloth_scene* s) {
+    ak_cloth_scene_defaults(s);
     ak_cloth_desc* d = &s->desc;
     if (strcmp(name, "flag") == 0) {
         /* a 1.6 x 1 m flag on a pole along its left edge, in gusty wind */
@@ -393,7 +410,7 @@ bool cloth_scene_preset(const char* name, cloth_scene* s) {
         s->planes[0] = (ak_cloth_plane){{0, 1, 0}, 0.0f};
     }
     if (s->attach_count) {
-        s->attach = calloc(s->attach_count, sizeof(cloth_attach_spec));
+        s->attach = calloc(s->attach_count, sizeof(ak_cloth_attach_spec));
         if (!s->attach) return false;
         for (size_t k = 0; k < s->attach_count; ++k) {
             s->attach[k].vertex = (uint32_t)k;
@@ -423,4 +440,18 @@ bool cloth_scene_preset(const char* name, cloth_scene* s) {
     d->pins = (ak_u32_cspan){s->pins, s->pin_count};
     d->pin_positions = (ak_vec3_cspan){s->pin_positions, s->pin_position_count};
     return true;
+}
+
+ak_result ak_cloth_scene_preset(const char* name, ak_cloth_scene* out, ak_diag* out_diag) {
+    if (!out || !name) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, "preset", "no name or scene");
+    if (!preset_fill(name, out)) {
+        const bool known = !strcmp(name, "flag") || !strcmp(name, "curtain") || !strcmp(name, "drape") ||
+                           !strcmp(name, "cape");
+        ak_cloth_scene_free(out);
+        ak_cloth_scene_defaults(out);
+        if (known) return akp_diag_set(out_diag, AK_ERR_NO_MEMORY, name, "out of memory");
+        return akp_diag_set(out_diag, AK_ERR_NOT_FOUND, name, "unknown preset (allowed: " AK_CLOTH_SCENE_PRESETS ")");
+    }
+    if (out_diag) memset(out_diag, 0, sizeof *out_diag);
+    return AK_OK;
 }

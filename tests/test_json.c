@@ -1,16 +1,17 @@
-/* The command line's strict JSON scene reader (tools/animkit/cli_json.c): every error names
- * the file, the key path and the problem; absent keys keep their defaults. */
+/* The library's strict JSON scene reader (src/json.c, internal; the scene loaders of particles,
+ * cloth, fluid and boids read through it): every error names the file, the key path and the
+ * problem; absent keys keep their defaults. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "../tools/animkit/cli_json.h"
+#include "json.h"
 #include "ak_test.h"
 
-static cJSON* parse(cli_json* j, const char* text) { return cli_json_parse(j, text, strlen(text)); }
+static cJSON* parse(akp_json* j, const char* text) { return akp_json_parse(j, text, strlen(text)); }
 
 AK_TEST(defaults_kept_and_values_read) {
-    cli_json j = {.file = "s.json"};
+    akp_json j = {.file = "s.json"};
     cJSON* root = parse(&j, "{\"dt\": 0.02, \"n\": 3, \"on\": true, \"g\": [0, -9.81, 0], \"mode\": \"b\"}");
     AK_CHECK(root != NULL);
     static const char* const keys[] = {"dt", "n", "on", "g", "mode", "absent", NULL};
@@ -20,13 +21,13 @@ AK_TEST(defaults_kept_and_values_read) {
     bool on = false;
     ak_vec3 g = {0, 0, 0};
     int mode = 0;
-    AK_CHECK(cli_json_object(&j, root, "", keys));
-    AK_CHECK(cli_json_float(&j, root, "", "dt", 0.0f, 1.0f, &dt));
-    AK_CHECK(cli_json_float(&j, root, "", "absent", 0.0f, 10.0f, &missing));
-    AK_CHECK(cli_json_int(&j, root, "", "n", 0, 10, &n));
-    AK_CHECK(cli_json_bool(&j, root, "", "on", &on));
-    AK_CHECK(cli_json_vec3(&j, root, "", "g", &g));
-    AK_CHECK(cli_json_enum(&j, root, "", "mode", modes, &mode));
+    AK_CHECK(akp_json_object(&j, root, "", keys));
+    AK_CHECK(akp_json_float(&j, root, "", "dt", 0.0f, 1.0f, &dt));
+    AK_CHECK(akp_json_float(&j, root, "", "absent", 0.0f, 10.0f, &missing));
+    AK_CHECK(akp_json_int(&j, root, "", "n", 0, 10, &n));
+    AK_CHECK(akp_json_bool(&j, root, "", "on", &on));
+    AK_CHECK(akp_json_vec3(&j, root, "", "g", &g));
+    AK_CHECK(akp_json_enum(&j, root, "", "mode", modes, &mode));
     AK_CHECK(!j.failed);
     AK_CHECK_NEAR(dt, 0.02, 1e-7);
     AK_CHECK_NEAR(missing, 7.0, 0.0);
@@ -43,27 +44,27 @@ typedef struct bad_case {
     const char* message;
 } bad_case;
 
-static void read_scene(cli_json* j, const cJSON* root) {
+static void read_scene(akp_json* j, const cJSON* root) {
     static const char* const keys[] = {"dt", "particles", "mode", NULL};
     static const char* const pkeys[] = {"p", "m", "n", NULL};
     static const char* const modes[] = {"a", "b", NULL};
     float dt = 0.01f;
     int mode = 0;
-    cli_json_object(j, root, "", keys);
-    cli_json_float(j, root, "", "dt", 1e-6f, 1.0f, &dt);
-    cli_json_enum(j, root, "", "mode", modes, &mode);
+    akp_json_object(j, root, "", keys);
+    akp_json_float(j, root, "", "dt", 1e-6f, 1.0f, &dt);
+    akp_json_enum(j, root, "", "mode", modes, &mode);
     size_t count = 0;
-    const cJSON* e = cli_json_array(j, root, "", "particles", 4, &count);
+    const cJSON* e = akp_json_array(j, root, "", "particles", 4, &count);
     for (size_t i = 0; i < count && e; ++i, e = e->next) {
         char path[64];
-        cli_json_index(path, sizeof path, "particles", i);
+        akp_json_index(path, sizeof path, "particles", i);
         ak_vec3 p = {0, 0, 0};
         float m = 1.0f;
         long n = 0;
-        cli_json_object(j, e, path, pkeys);
-        cli_json_vec3(j, e, path, "p", &p);
-        cli_json_float(j, e, path, "m", 0.0f, 1e6f, &m);
-        cli_json_int(j, e, path, "n", 0, 5, &n);
+        akp_json_object(j, e, path, pkeys);
+        akp_json_vec3(j, e, path, "p", &p);
+        akp_json_float(j, e, path, "m", 0.0f, 1e6f, &m);
+        akp_json_int(j, e, path, "n", 0, 5, &n);
     }
 }
 
@@ -93,7 +94,7 @@ AK_TEST(errors_name_file_path_and_problem) {
         {"{\"dt\\u0000\": 0.1}", "s.json: a string holds \\u0000 (NUL) at line 1, column 5"},
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
-        cli_json j = {.file = "s.json"};
+        akp_json j = {.file = "s.json"};
         cJSON* root = parse(&j, cases[c].text);
         if (root) read_scene(&j, root);
         cJSON_Delete(root);
@@ -103,11 +104,11 @@ AK_TEST(errors_name_file_path_and_problem) {
 }
 
 AK_TEST(first_error_is_kept) {
-    cli_json j = {.file = "s.json"};
+    akp_json j = {.file = "s.json"};
     cJSON* root = parse(&j, "{\"a\": \"x\", \"b\": \"y\"}");
     float a = 0, b = 0;
-    AK_CHECK(!cli_json_float(&j, root, "", "a", 0, 1, &a));
-    AK_CHECK(!cli_json_float(&j, root, "", "b", 0, 1, &b));
+    AK_CHECK(!akp_json_float(&j, root, "", "a", 0, 1, &a));
+    AK_CHECK(!akp_json_float(&j, root, "", "b", 0, 1, &b));
     AK_CHECK_STREQ(j.message, "s.json: a: expected a number, got a string");
     cJSON_Delete(root);
 }
@@ -119,18 +120,18 @@ AK_TEST(load_checks_size_and_missing_files) {
     if (!f) return;
     fputs("{\"dt\": 0.5}\n", f);
     fclose(f);
-    cli_json j = {0};
-    cJSON* root = cli_json_load(&j, path, 0);
+    akp_json j = {0};
+    cJSON* root = akp_json_load(&j, path, 0);
     AK_CHECK(root != NULL && !j.failed);
     float dt = 0;
-    AK_CHECK(cli_json_float(&j, root, "", "dt", 0, 1, &dt));
+    AK_CHECK(akp_json_float(&j, root, "", "dt", 0, 1, &dt));
     AK_CHECK_NEAR(dt, 0.5, 0.0);
     cJSON_Delete(root);
-    cli_json small = {0};
-    AK_CHECK(cli_json_load(&small, path, 4) == NULL);
+    akp_json small = {0};
+    AK_CHECK(akp_json_load(&small, path, 4) == NULL);
     AK_CHECK(strstr(small.message, "larger than 4 bytes") != NULL);
-    cli_json none = {.file = "nope.json"};
-    AK_CHECK(cli_json_load(&none, "does/not/exist.json", 0) == NULL);
+    akp_json none = {.file = "nope.json"};
+    AK_CHECK(akp_json_load(&none, "does/not/exist.json", 0) == NULL);
     AK_CHECK_STREQ(none.message, "nope.json: cannot open the file");
     remove(path);
 }
@@ -138,7 +139,7 @@ AK_TEST(load_checks_size_and_missing_files) {
 /* Deep nesting ends in an error from cJSON's nesting limit, not a stack overflow. */
 /* An escaped backslash followed by "u0000" is text, not a NUL. */
 AK_TEST(escaped_backslash_is_not_a_nul) {
-    cli_json j = {.file = "s.json"};
+    akp_json j = {.file = "s.json"};
     cJSON* root = parse(&j, "{\"mode\": \"\\\\u0000\"}");
     AK_CHECK(root != NULL && !j.failed);
     const cJSON* m = cJSON_GetObjectItemCaseSensitive(root, "mode");
@@ -156,8 +157,8 @@ AK_TEST(deep_nesting_is_an_error) {
     for (int i = 0; i < DEPTH; ++i) text[n++] = '[';
     for (int i = 0; i < DEPTH; ++i) text[n++] = ']';
     text[n++] = '}';
-    cli_json j = {.file = "deep.json"};
-    cJSON* root = cli_json_parse(&j, text, n);
+    akp_json j = {.file = "deep.json"};
+    cJSON* root = akp_json_parse(&j, text, n);
     AK_CHECK(root == NULL && j.failed);
     cJSON_Delete(root);
 }

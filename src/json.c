@@ -1,6 +1,5 @@
-/* Strict JSON scene reading for the command line: see cli_json.h. */
-#include "cli_json.h"
-
+/* Strict JSON reading of scene files (particles, cloth, fluid, boids): see json.h. */
+#include "json.h"
 
 #include <float.h>
 #include <math.h>
@@ -9,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-size_t cli_utf8_char(const unsigned char* p, size_t avail) {
+size_t akp_utf8_char(const unsigned char* p, size_t avail) {
     if (!avail) return 0;
     const unsigned char c = p[0];
     if (c < 0x80) return 1;
@@ -32,11 +31,11 @@ static const char* type_name(const cJSON* v) {
     return "an invalid value";
 }
 
-bool cli_json_fail(cli_json* j, const char* path, const char* key, const char* fmt, ...) {
+bool akp_json_fail(akp_json* j, const char* path, const char* key, const char* fmt, ...) {
     if (j->failed) return false;
     j->failed = true;
     char where[256];
-    cli_json_key(where, sizeof where, path ? path : "", key ? key : "");
+    akp_json_key(where, sizeof where, path ? path : "", key ? key : "");
     char what[384];
     va_list ap;
     va_start(ap, fmt);
@@ -54,12 +53,33 @@ bool cli_json_fail(cli_json* j, const char* path, const char* key, const char* f
     return false;
 }
 
-const char* cli_json_index(char* buf, size_t size, const char* base, size_t index) {
+ak_result akp_json_diag(const akp_json* j, ak_result code, ak_diag* out_diag) {
+    if (!out_diag) return code;
+    memset(out_diag, 0, sizeof *out_diag);
+    snprintf(out_diag->path, sizeof out_diag->path, "%s", j->file ? j->file : "");
+    out_diag->byte_offset = -1;
+    snprintf(out_diag->message, sizeof out_diag->message, "%s", j->message);
+    return code;
+}
+
+ak_result akp_diag_set(ak_diag* out_diag, ak_result code, const char* file, const char* fmt, ...) {
+    if (!out_diag) return code;
+    akp_json j = {.file = file};
+    char what[400];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    akp_json_fail(&j, "", NULL, "%s", what);
+    return akp_json_diag(&j, code, out_diag);
+}
+
+const char* akp_json_index(char* buf, size_t size, const char* base, size_t index) {
     if (size) snprintf(buf, size, "%s[%zu]", base ? base : "", index);
     return buf;
 }
 
-const char* cli_json_key(char* buf, size_t size, const char* base, const char* key) {
+const char* akp_json_key(char* buf, size_t size, const char* base, const char* key) {
     if (!size) return buf;
     base = base ? base : "";
     key = key ? key : "";
@@ -146,7 +166,7 @@ static const char* strict_json_error(const char* text, size_t size, const char**
                     ++i;
                     continue;
                 }
-                const size_t n = cli_utf8_char(s + i, size - i);
+                const size_t n = akp_utf8_char(s + i, size - i);
                 if (!n) {
                     *what = "invalid UTF-8 in a string";
                     return text + i;
@@ -195,14 +215,14 @@ static const char* strict_json_error(const char* text, size_t size, const char**
     return NULL;
 }
 
-cJSON* cli_json_parse(cli_json* j, const char* text, size_t size) {
+cJSON* akp_json_parse(akp_json* j, const char* text, size_t size) {
     if (j->failed) return NULL;
     const char* what = NULL;
     const char* bad = strict_json_error(text, size, &what);
     if (bad) {
         size_t line = 1, col = 1;
         for (const char* p = text; p < bad; ++p) line += *p == '\n', col = *p == '\n' ? 1 : col + 1;
-        cli_json_fail(j, "", NULL, "%s at line %zu, column %zu", what, line, col);
+        akp_json_fail(j, "", NULL, "%s at line %zu, column %zu", what, line, col);
         return NULL;
     }
     const char* end = NULL;
@@ -219,7 +239,7 @@ cJSON* cli_json_parse(cli_json* j, const char* text, size_t size) {
                 ++col;
             }
         }
-        cli_json_fail(j, "", NULL, "invalid JSON at line %zu, column %zu", line, col);
+        akp_json_fail(j, "", NULL, "invalid JSON at line %zu, column %zu", line, col);
         return NULL;
     }
     /* Trailing content other than whitespace is an error, as in any strict reader. */
@@ -227,26 +247,27 @@ cJSON* cli_json_parse(cli_json* j, const char* text, size_t size) {
         for (const char* p = end; p < text + size; ++p) {
             if (*p != ' ' && *p != '\t' && *p != '\n' && *p != '\r') {
                 cJSON_Delete(root);
-                cli_json_fail(j, "", NULL, "unexpected content after the JSON value");
+                akp_json_fail(j, "", NULL, "unexpected content after the JSON value");
                 return NULL;
             }
         }
     }
     if (!cJSON_IsObject(root)) {
-        cli_json_fail(j, "", NULL, "the top level is not an object (got %s)", type_name(root));
+        akp_json_fail(j, "", NULL, "the top level is not an object (got %s)", type_name(root));
         cJSON_Delete(root);
         return NULL;
     }
     return root;
 }
 
-cJSON* cli_json_load(cli_json* j, const char* path, size_t max_size) {
+char* akp_json_read_file(akp_json* j, const char* path, size_t max_size, size_t* out_size) {
+    *out_size = 0;
     if (!j->file) j->file = path;
     if (j->failed) return NULL;
-    if (!max_size) max_size = CLI_JSON_MAX_SIZE;
+    if (!max_size) max_size = AKP_JSON_MAX_SIZE;
     FILE* f = fopen(path, "rb");
     if (!f) {
-        cli_json_fail(j, "", NULL, "cannot open the file");
+        akp_json_fail(j, "", NULL, "cannot open the file");
         return NULL;
     }
     size_t cap = 4096, size = 0;
@@ -271,23 +292,34 @@ cJSON* cli_json_load(cli_json* j, const char* path, size_t max_size) {
     bool read_error = ferror(f) != 0;
     fclose(f);
     if (!text) {
-        cli_json_fail(j, "", NULL, "out of memory reading the file");
+        akp_json_fail(j, "", NULL, "out of memory reading the file");
         return NULL;
     }
-    cJSON* root = NULL;
-    if (read_error)
-        cli_json_fail(j, "", NULL, "read error");
-    else if (size > max_size)
-        cli_json_fail(j, "", NULL, "the file is larger than %zu bytes", max_size);
-    else
-        root = cli_json_parse(j, text, size);
+    if (read_error || size > max_size) {
+        if (read_error)
+            akp_json_fail(j, "", NULL, "read error");
+        else
+            akp_json_fail(j, "", NULL, "the file is larger than %zu bytes", max_size);
+        free(text);
+        return NULL;
+    }
+    text[size] = '\0'; /* size < cap here: the last read returned 0 with room left */
+    *out_size = size;
+    return text;
+}
+
+cJSON* akp_json_load(akp_json* j, const char* path, size_t max_size) {
+    size_t size = 0;
+    char* text = akp_json_read_file(j, path, max_size, &size);
+    if (!text) return NULL;
+    cJSON* root = akp_json_parse(j, text, size);
     free(text);
     return root;
 }
 
-bool cli_json_object(cli_json* j, const cJSON* obj, const char* path, const char* const* allowed) {
+bool akp_json_object(akp_json* j, const cJSON* obj, const char* path, const char* const* allowed) {
     if (j->failed) return false;
-    if (!cJSON_IsObject(obj)) return cli_json_fail(j, path, NULL, "expected an object, got %s", type_name(obj));
+    if (!cJSON_IsObject(obj)) return akp_json_fail(j, path, NULL, "expected an object, got %s", type_name(obj));
     for (const cJSON* m = obj->child; m; m = m->next) {
         const char* name = m->string ? m->string : "";
         bool known = false;
@@ -301,38 +333,38 @@ bool cli_json_object(cli_json* j, const cJSON* obj, const char* path, const char
                 if (w < 0) break;
                 used += (size_t)w;
             }
-            return cli_json_fail(j, path, NULL, "unknown key \"%s\" (allowed: %s)", name, list);
+            return akp_json_fail(j, path, NULL, "unknown key \"%s\" (allowed: %s)", name, list);
         }
         for (const cJSON* o = obj->child; o != m; o = o->next)
             if (o->string && strcmp(o->string, name) == 0)
-                return cli_json_fail(j, path, name, "the key appears twice");
+                return akp_json_fail(j, path, name, "the key appears twice");
     }
     return true;
 }
 
 /* The member key of obj, or NULL; fails when obj itself is not an object. */
-static const cJSON* member(cli_json* j, const cJSON* obj, const char* path, const char* key, bool* ok) {
+static const cJSON* member(akp_json* j, const cJSON* obj, const char* path, const char* key, bool* ok) {
     *ok = !j->failed;
     if (!*ok) return NULL;
     if (!cJSON_IsObject(obj)) {
-        *ok = cli_json_fail(j, path, NULL, "expected an object, got %s", type_name(obj));
+        *ok = akp_json_fail(j, path, NULL, "expected an object, got %s", type_name(obj));
         return NULL;
     }
     return cJSON_GetObjectItemCaseSensitive(obj, key);
 }
 
 /* A finite number in [lo, hi] from v, or an error at path.key. */
-static bool number_value(cli_json* j, const cJSON* v, const char* path, const char* key, double lo, double hi,
+static bool number_value(akp_json* j, const cJSON* v, const char* path, const char* key, double lo, double hi,
                          double* out) {
-    if (!cJSON_IsNumber(v)) return cli_json_fail(j, path, key, "expected a number, got %s", type_name(v));
+    if (!cJSON_IsNumber(v)) return akp_json_fail(j, path, key, "expected a number, got %s", type_name(v));
     double x = v->valuedouble;
-    if (!isfinite(x)) return cli_json_fail(j, path, key, "the number is not finite");
-    if (x < lo || x > hi) return cli_json_fail(j, path, key, "%.9g is outside [%g, %g]", x, lo, hi);
+    if (!isfinite(x)) return akp_json_fail(j, path, key, "the number is not finite");
+    if (x < lo || x > hi) return akp_json_fail(j, path, key, "%.9g is outside [%g, %g]", x, lo, hi);
     *out = x;
     return true;
 }
 
-bool cli_json_number(cli_json* j, const cJSON* obj, const char* path, const char* key, double lo, double hi,
+bool akp_json_number(akp_json* j, const cJSON* obj, const char* path, const char* key, double lo, double hi,
                      double* inout) {
     bool ok;
     const cJSON* v = member(j, obj, path, key, &ok);
@@ -344,7 +376,7 @@ bool cli_json_number(cli_json* j, const cJSON* obj, const char* path, const char
  * 1e-7 (which is not a float: 1e-7f is slightly above it) is accepted when written as 1e-7, and a
  * number beyond the float range fails here, naming its key, instead of turning into an infinity
  * that fails later without one. */
-bool cli_json_float(cli_json* j, const cJSON* obj, const char* path, const char* key, float lo, float hi,
+bool akp_json_float(akp_json* j, const cJSON* obj, const char* path, const char* key, float lo, float hi,
                     float* inout) {
     bool ok;
     const cJSON* v = member(j, obj, path, key, &ok);
@@ -352,49 +384,49 @@ bool cli_json_float(cli_json* j, const cJSON* obj, const char* path, const char*
     double x = 0.0;
     if (!number_value(j, v, path, key, -HUGE_VAL, HUGE_VAL, &x)) return false;
     if (fabs(x) > (double)FLT_MAX)
-        return cli_json_fail(j, path, key, "%.9g is beyond the range of a float (magnitude at most %.9g)", x,
+        return akp_json_fail(j, path, key, "%.9g is beyond the range of a float (magnitude at most %.9g)", x,
                              (double)FLT_MAX);
     float f = (float)x;
-    if (f < lo || f > hi) return cli_json_fail(j, path, key, "%.9g is outside [%g, %g]", x, (double)lo, (double)hi);
+    if (f < lo || f > hi) return akp_json_fail(j, path, key, "%.9g is outside [%g, %g]", x, (double)lo, (double)hi);
     *inout = f;
     return true;
 }
 
-bool cli_json_int(cli_json* j, const cJSON* obj, const char* path, const char* key, long lo, long hi,
+bool akp_json_int(akp_json* j, const cJSON* obj, const char* path, const char* key, long lo, long hi,
                   long* inout) {
     bool ok;
     const cJSON* v = member(j, obj, path, key, &ok);
     if (!ok || !v) return ok;
     double x = 0.0;
     if (!number_value(j, v, path, key, (double)lo, (double)hi, &x)) return false;
-    if (x != floor(x)) return cli_json_fail(j, path, key, "expected an integer, got %.9g", x);
+    if (x != floor(x)) return akp_json_fail(j, path, key, "expected an integer, got %.9g", x);
     *inout = (long)x;
     return true;
 }
 
-bool cli_json_bool(cli_json* j, const cJSON* obj, const char* path, const char* key, bool* inout) {
+bool akp_json_bool(akp_json* j, const cJSON* obj, const char* path, const char* key, bool* inout) {
     bool ok;
     const cJSON* v = member(j, obj, path, key, &ok);
     if (!ok || !v) return ok;
-    if (!cJSON_IsBool(v)) return cli_json_fail(j, path, key, "expected true or false, got %s", type_name(v));
+    if (!cJSON_IsBool(v)) return akp_json_fail(j, path, key, "expected true or false, got %s", type_name(v));
     *inout = cJSON_IsTrue(v);
     return true;
 }
 
-bool cli_json_str(cli_json* j, const cJSON* obj, const char* path, const char* key, const char** inout) {
+bool akp_json_str(akp_json* j, const cJSON* obj, const char* path, const char* key, const char** inout) {
     bool ok;
     const cJSON* v = member(j, obj, path, key, &ok);
     if (!ok || !v) return ok;
     if (!cJSON_IsString(v) || !v->valuestring)
-        return cli_json_fail(j, path, key, "expected a string, got %s", type_name(v));
+        return akp_json_fail(j, path, key, "expected a string, got %s", type_name(v));
     *inout = v->valuestring;
     return true;
 }
 
-bool cli_json_enum(cli_json* j, const cJSON* obj, const char* path, const char* key, const char* const* names,
+bool akp_json_enum(akp_json* j, const cJSON* obj, const char* path, const char* key, const char* const* names,
                    int* inout) {
     const char* s = NULL;
-    if (!cli_json_str(j, obj, path, key, &s)) return false;
+    if (!akp_json_str(j, obj, path, key, &s)) return false;
     if (!s) return true;
     char list[256] = "";
     size_t used = 0;
@@ -408,67 +440,67 @@ bool cli_json_enum(cli_json* j, const cJSON* obj, const char* path, const char* 
             if (w > 0) used += (size_t)w;
         }
     }
-    return cli_json_fail(j, path, key, "\"%s\" is not one of: %s", s, list);
+    return akp_json_fail(j, path, key, "\"%s\" is not one of: %s", s, list);
 }
 
-bool cli_json_floats(cli_json* j, const cJSON* obj, const char* path, const char* key, size_t count, float lo,
+bool akp_json_floats(akp_json* j, const cJSON* obj, const char* path, const char* key, size_t count, float lo,
                      float hi, float* inout) {
     bool ok;
     const cJSON* v = member(j, obj, path, key, &ok);
     if (!ok || !v) return ok;
-    if (!cJSON_IsArray(v)) return cli_json_fail(j, path, key, "expected an array of %zu numbers, got %s", count, type_name(v));
+    if (!cJSON_IsArray(v)) return akp_json_fail(j, path, key, "expected an array of %zu numbers, got %s", count, type_name(v));
     size_t n = 0;
     for (const cJSON* e = v->child; e; e = e->next) ++n;
-    if (n != count) return cli_json_fail(j, path, key, "expected %zu numbers, got %zu", count, n);
+    if (n != count) return akp_json_fail(j, path, key, "expected %zu numbers, got %zu", count, n);
     float tmp[16];
     float* dst = count <= 16 ? tmp : inout; /* small arrays are all-or-nothing */
     char at[256], el[280];
-    cli_json_key(at, sizeof at, path, key);
+    akp_json_key(at, sizeof at, path, key);
     size_t i = 0;
     for (const cJSON* e = v->child; e; e = e->next, ++i) {
         double x = 0.0;
-        if (!number_value(j, e, cli_json_index(el, sizeof el, at, i), NULL, lo, hi, &x)) return false;
+        if (!number_value(j, e, akp_json_index(el, sizeof el, at, i), NULL, lo, hi, &x)) return false;
         dst[i] = (float)x;
     }
     if (dst == tmp) memcpy(inout, tmp, count * sizeof(float));
     return true;
 }
 
-bool cli_json_vec3(cli_json* j, const cJSON* obj, const char* path, const char* key, ak_vec3* inout) {
+bool akp_json_vec3(akp_json* j, const cJSON* obj, const char* path, const char* key, ak_vec3* inout) {
     float v[3] = {inout->x, inout->y, inout->z};
-    if (!cli_json_floats(j, obj, path, key, 3, -HUGE_VALF, HUGE_VALF, v)) return false;
+    if (!akp_json_floats(j, obj, path, key, 3, -HUGE_VALF, HUGE_VALF, v)) return false;
     inout->x = v[0];
     inout->y = v[1];
     inout->z = v[2];
     return true;
 }
 
-const cJSON* cli_json_array(cli_json* j, const cJSON* obj, const char* path, const char* key, size_t max_count,
+const cJSON* akp_json_array(akp_json* j, const cJSON* obj, const char* path, const char* key, size_t max_count,
                             size_t* out_count) {
     *out_count = 0;
     bool ok;
     const cJSON* v = member(j, obj, path, key, &ok);
     if (!ok || !v) return NULL;
     if (!cJSON_IsArray(v)) {
-        cli_json_fail(j, path, key, "expected an array, got %s", type_name(v));
+        akp_json_fail(j, path, key, "expected an array, got %s", type_name(v));
         return NULL;
     }
     size_t n = 0;
     for (const cJSON* e = v->child; e; e = e->next) ++n;
     if (n > max_count) {
-        cli_json_fail(j, path, key, "%zu elements, more than the limit of %zu", n, max_count);
+        akp_json_fail(j, path, key, "%zu elements, more than the limit of %zu", n, max_count);
         return NULL;
     }
     *out_count = n;
     return v->child;
 }
 
-const cJSON* cli_json_member(cli_json* j, const cJSON* obj, const char* path, const char* key) {
+const cJSON* akp_json_member(akp_json* j, const cJSON* obj, const char* path, const char* key) {
     bool ok;
     const cJSON* v = member(j, obj, path, key, &ok);
     if (!ok || !v) return NULL;
     if (!cJSON_IsObject(v)) {
-        cli_json_fail(j, path, key, "expected an object, got %s", type_name(v));
+        akp_json_fail(j, path, key, "expected an object, got %s", type_name(v));
         return NULL;
     }
     return v;
