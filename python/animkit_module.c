@@ -30,6 +30,9 @@
 
 #include "cli.h"    /* the posing pipeline shared with the command (tools/animkit/pose.c) */
 #include "render.h" /* its framing and drawing (tools/animkit/render.c) */
+#include "boids_run.h"     /* the simulations' runs (tools/animkit/ *_run.c) */
+#include "cloth_run.h"
+#include "particles_run.h"
 
 /* ---- errors ------------------------------------------------------------------------------- */
 
@@ -969,6 +972,410 @@ static PyTypeObject SceneType = {
     .tp_getset = scene_getset,
 };
 
+/* ---- simulations (cloth, particles, boids, fluid) --------------------------------------------
+ * A scene file or preset loaded by the library (ak_<module>_scene_load_file / _preset) and
+ * stepped by the command's own run code (tools/animkit/cloth_run.c, particles_run.c,
+ * boids_run.c; fluid's loop is ak_fluid_step_run as `animkit fluid` calls it), so a Sim's state
+ * after n steps is the command's after --steps n. */
+
+typedef enum sim_kind { SIM_CLOTH, SIM_PARTICLES, SIM_BOIDS, SIM_FLUID } sim_kind;
+static const char* const sim_kind_names[] = {"cloth", "particles", "boids", "fluid"};
+
+typedef struct fluid_state {
+    ak_fluid_scene scene;
+    ak_vec3 *pos, *vel;
+    uint8_t* flags;
+    float *rho, *pres;
+    void* scratch;
+    size_t cap, n;
+    ak_fluid_stats stats;
+    ak_fluid_step_job job;
+} fluid_state;
+
+typedef struct sim_data {
+    ak_cloth_scene cloth_scene;
+    cloth_run cloth;
+    ak_particles_scene particles_scene;
+    particles_run particles;
+    particles_character character;
+    bool has_character;
+    ak_boids_scene boids_scene;
+    boids_run boids;
+    fluid_state fluid;
+} sim_data;
+
+typedef struct SimObject {
+    PyObject_HEAD
+    sim_kind kind;
+    char name[256];
+    sim_data* d;     /* PyMem_Calloc'ed: the run structs point into it */
+    bool ready;      /* the run is initialised (free it) */
+    bool scene_ready;/* the scene is loaded (free it) */
+    long steps_done;
+    long default_steps;
+    float dt;
+    PyThread_type_lock lock;
+} SimObject;
+
+static PyTypeObject SimType;
+
+static void sim_free_data(SimObject* o) {
+    sim_data* d = o->d;
+    if (!d) return;
+    switch (o->kind) {
+    case SIM_CLOTH:
+        if (o->ready) cloth_run_free(&d->cloth);
+        if (o->scene_ready) ak_cloth_scene_free(&d->cloth_scene);
+        break;
+    case SIM_PARTICLES:
+        if (o->ready) particles_run_free(&d->particles);
+        if (d->has_character) particles_character_free(&d->character);
+        if (o->scene_ready) ak_particles_scene_free(&d->particles_scene);
+        break;
+    case SIM_BOIDS:
+        if (o->ready) boids_run_free(&d->boids);
+        if (o->scene_ready) ak_boids_scene_free(&d->boids_scene);
+        break;
+    case SIM_FLUID:
+        free(d->fluid.pos);
+        free(d->fluid.vel);
+        free(d->fluid.flags);
+        free(d->fluid.rho);
+        free(d->fluid.pres);
+        free(d->fluid.scratch);
+        if (o->scene_ready) ak_fluid_scene_free(&d->fluid.scene);
+        break;
+    }
+    PyMem_Free(d);
+    o->d = NULL;
+}
+
+static void sim_dealloc(SimObject* o) {
+    sim_free_data(o);
+    if (o->lock) PyThread_free_lock(o->lock);
+    PyObject_Free(o);
+}
+
+static int fluid_init(fluid_state* f, uint32_t threads) {
+    ak_fluid_scene* s = &f->scene;
+    s->steps = ak_fluid_scene_steps(s);
+    f->cap = ak_fluid_scene_capacity(s);
+    size_t c = f->cap ? f->cap : 1;
+    f->pos = calloc(c, sizeof(ak_vec3));
+    f->vel = calloc(c, sizeof(ak_vec3));
+    f->flags = calloc(c, 1);
+    f->rho = calloc(c, sizeof(float));
+    f->pres = calloc(c, sizeof(float));
+    const size_t bytes = ak_fluid_scratch_size(f->cap, &s->desc);
+    f->scratch = malloc(bytes ? bytes : 1);
+    if (!f->pos || !f->vel || !f->flags || !f->rho || !f->pres || !f->scratch) return -1;
+    f->n = ak_fluid_scene_fill(s, f->pos, f->vel, f->cap);
+    f->job = (ak_fluid_step_job){.desc = &s->desc, .dt = s->dt, .positions = {f->pos, f->cap}, .velocities = {f->vel, f->cap},
+                                 .particle_count = &f->n, .colliders = {s->colliders, s->collider_count},
+                                 .emitters = {s->emitters, s->emitter_count}, .sinks = {s->sinks, s->sink_count},
+                                 .thread_count = threads, .scratch = {f->scratch, bytes}, .out_flags = {f->flags, f->cap},
+                                 .out_densities = {f->rho, f->cap}, .out_pressures = {f->pres, f->cap},
+                                 .out_stats = &f->stats};
+    return 0;
+}
+
+/* One step of the fluid as `animkit fluid` runs it (colliders with a velocity move after it). */
+static ak_result fluid_step(fluid_state* f, long k) {
+    ak_fluid_scene* s = &f->scene;
+    f->job.time = (float)((double)k * s->dt);
+    ak_result r = ak_fluid_step_run(&f->job);
+    if (r != AK_OK) return r;
+    for (size_t c = 0; c < s->collider_count; ++c) {
+        ak_vec3 dv = ak_vec3_scale(s->colliders[c].velocity, s->dt);
+        s->colliders[c].a = ak_vec3_add(s->colliders[c].a, dv);
+        s->colliders[c].b = ak_vec3_add(s->colliders[c].b, dv);
+    }
+    return AK_OK;
+}
+
+static int kind_arg(const char* name, sim_kind* out) {
+    for (int k = 0; k < 4; ++k)
+        if (strcmp(name, sim_kind_names[k]) == 0) {
+            *out = (sim_kind)k;
+            return 0;
+        }
+    RAISE_ARG("unknown simulation '%s' (cloth, particles, boids, fluid)", name);
+    return -1;
+}
+
+/* sim_make(kind, source, is_file, count=0, seed=-1, threads=1) */
+static PyObject* sim_make(sim_kind kind, const char* source, bool is_file, long count, long seed, int threads) {
+    SimObject* o = PyObject_New(SimObject, &SimType);
+    if (!o) return NULL;
+    o->kind = kind;
+    snprintf(o->name, sizeof o->name, "%s", source);
+    o->d = PyMem_Calloc(1, sizeof(sim_data));
+    o->ready = o->scene_ready = false;
+    o->steps_done = 0;
+    o->default_steps = 0;
+    o->dt = 0.0f;
+    o->lock = PyThread_allocate_lock();
+    if (!o->d || !o->lock) {
+        Py_DECREF(o);
+        return PyErr_NoMemory();
+    }
+    sim_data* d = o->d;
+    ak_diag diag;
+    memset(&diag, 0, sizeof diag);
+    ak_result r = AK_OK;
+    int rc = 0;
+    const char* presets = "";
+    Py_BEGIN_ALLOW_THREADS
+    switch (kind) {
+    case SIM_CLOTH:
+        presets = AK_CLOTH_SCENE_PRESETS;
+        r = is_file ? ak_cloth_scene_load_file(source, &d->cloth_scene, &diag)
+                    : ak_cloth_scene_preset(source, &d->cloth_scene, &diag);
+        if (r == AK_OK) {
+            o->scene_ready = true;
+            d->cloth_scene.thread_count = threads;
+            rc = cloth_run_init(&d->cloth, &d->cloth_scene, "cloth", o->name);
+            o->ready = true;
+            o->default_steps = d->cloth_scene.steps;
+            o->dt = d->cloth_scene.dt;
+        }
+        break;
+    case SIM_PARTICLES:
+        presets = AK_PARTICLES_SCENE_PRESETS;
+        r = is_file ? ak_particles_scene_load_file(source, &d->particles_scene, &diag)
+                    : ak_particles_scene_preset(source, &d->particles_scene, &diag);
+        if (r == AK_OK) {
+            o->scene_ready = true;
+            if (!is_file && strcmp(source, "character") == 0) {
+                d->has_character = true;
+                rc = particles_character_init(&d->character, &rc);
+            }
+            if (!rc) {
+                rc = particles_run_init(&d->particles, &d->particles_scene, d->has_character ? &d->character : NULL,
+                                        (uint64_t)(seed >= 0 ? seed : 1), (uint32_t)threads);
+                o->ready = true;
+            }
+            o->default_steps = 200; /* `animkit particles` --steps default */
+            o->dt = d->particles_scene.dt;
+        }
+        break;
+    case SIM_BOIDS:
+        presets = AK_BOIDS_SCENE_PRESETS;
+        ak_boids_scene_defaults(&d->boids_scene);
+        r = is_file ? ak_boids_scene_load_file(source, &d->boids_scene, &diag)
+                    : ak_boids_scene_preset(source, &d->boids_scene, &diag);
+        if (r == AK_OK) {
+            o->scene_ready = true;
+            ak_boids_scene* sc = &d->boids_scene;
+            if (count > 0 && sc->agent_count == 0) sc->count = (size_t)count;
+            if (seed >= 0) sc->seed = seed;
+            if (sc->agent_count == 0) ak_boids_scene_scale_bounds(sc, sc->count);
+            rc = boids_run_init(&d->boids, sc, "boids", o->name, (uint32_t)threads, false);
+            o->ready = true;
+            o->default_steps = sc->steps;
+            o->dt = sc->dt;
+        }
+        break;
+    case SIM_FLUID:
+        presets = AK_FLUID_SCENE_PRESETS;
+        r = is_file ? ak_fluid_scene_load_file(source, &d->fluid.scene, &diag)
+                    : ak_fluid_scene_preset(source, count, &d->fluid.scene, &diag);
+        if (r == AK_OK) {
+            o->scene_ready = true;
+            rc = fluid_init(&d->fluid, (uint32_t)threads) ? CLI_BAD_INPUT : 0;
+            o->ready = true;
+            o->default_steps = d->fluid.scene.steps;
+            o->dt = d->fluid.scene.dt;
+        }
+        break;
+    }
+    Py_END_ALLOW_THREADS
+    if (r == AK_ERR_NOT_FOUND && !is_file) {
+        Py_DECREF(o);
+        return raise_as(NotFoundError, r, source, "unknown %s preset (%s)", sim_kind_names[kind], presets);
+    }
+    if (r != AK_OK) {
+        Py_DECREF(o);
+        return raise_result(r, is_file ? source : NULL, &diag);
+    }
+    if (rc) {
+        Py_DECREF(o);
+        return raise_as(DataError, AK_ERR_BAD_DATA, source, "the %s run could not start (the reason is on stderr)",
+                        sim_kind_names[kind]);
+    }
+    return (PyObject*)o;
+}
+
+static PyObject* mod_sim_preset(PyObject* self, PyObject* args, PyObject* kw) {
+    (void)self;
+    static char* kwlist[] = {"kind", "name", "count", "seed", "threads", NULL};
+    const char *kind_name, *name;
+    long count = 0, seed = -1;
+    int threads = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|lli:sim_preset", kwlist, &kind_name, &name, &count, &seed, &threads))
+        return NULL;
+    sim_kind kind;
+    if (kind_arg(kind_name, &kind) < 0) return NULL;
+    if (threads < 1 || threads > 64) return RAISE_ARG("threads must be 1..64");
+    if (count < 0 || count > 10000000) return RAISE_ARG("count must be 0..10000000 (0: the preset's)");
+    return sim_make(kind, name, false, count, seed, threads);
+}
+
+static PyObject* mod_sim_load(PyObject* self, PyObject* args, PyObject* kw) {
+    (void)self;
+    static char* kwlist[] = {"kind", "path", "seed", "threads", NULL};
+    const char* kind_name;
+    PyObject* path_bytes = NULL;
+    long seed = -1;
+    int threads = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "sO&|li:sim_load", kwlist, &kind_name, PyUnicode_FSConverter, &path_bytes,
+                                     &seed, &threads))
+        return NULL;
+    sim_kind kind;
+    PyObject* res = NULL;
+    if (kind_arg(kind_name, &kind) == 0) {
+        if (threads < 1 || threads > 64) RAISE_ARG("threads must be 1..64");
+        else res = sim_make(kind, PyBytes_AS_STRING(path_bytes), true, 0, seed, threads);
+    }
+    Py_DECREF(path_bytes);
+    return res;
+}
+
+static PyObject* sim_step(SimObject* o, PyObject* args, PyObject* kw) {
+    static char* kwlist[] = {"steps", NULL};
+    long n = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|l:step", kwlist, &n)) return NULL;
+    if (n < 0 || n > 100000000L) return RAISE_ARG("steps must be 0..100000000, not %ld", n);
+    ak_result r = AK_OK;
+    int rc = 0;
+    long failed = -1;
+    sim_data* d = o->d;
+    Py_BEGIN_ALLOW_THREADS
+    PyThread_acquire_lock(o->lock, WAIT_LOCK);
+    for (long i = 0; i < n && r == AK_OK && rc == 0; ++i) {
+        const long k = o->steps_done;
+        switch (o->kind) {
+        case SIM_CLOTH: rc = cloth_run_step(&d->cloth, "cloth", o->name); break;
+        case SIM_PARTICLES: rc = particles_run_step(&d->particles, (int)k); break;
+        case SIM_BOIDS: r = boids_run_step(&d->boids, k); break;
+        case SIM_FLUID: r = fluid_step(&d->fluid, k); break;
+        }
+        if (r != AK_OK || rc) failed = k + 1;
+        else ++o->steps_done;
+    }
+    PyThread_release_lock(o->lock);
+    Py_END_ALLOW_THREADS
+    if (o->kind == SIM_BOIDS && r != AK_OK)
+        return raise_as(error_type(r), r, o->name, "step %ld: %s", failed, boids_run_error(r));
+    if (r == AK_ERR_NO_CONVERGENCE)
+        return raise_as(Error, r, o->name, "blow-up at step %ld: a particle became non-finite or moved too far; lower dt",
+                        failed);
+    if (r != AK_OK) return raise_as(error_type(r), r, o->name, "step %ld: %s", failed, ak_result_string(r));
+    if (rc) return raise_as(Error, AK_ERR_NO_CONVERGENCE, o->name, "step %ld failed (the reason is on stderr)", failed);
+    Py_RETURN_NONE;
+}
+
+/* Current positions (or velocities) and their count. */
+static const ak_vec3* sim_vectors(SimObject* o, bool velocities, size_t* out_count) {
+    sim_data* d = o->d;
+    switch (o->kind) {
+    case SIM_CLOTH: *out_count = d->cloth.n; return velocities ? d->cloth.vel : d->cloth.x;
+    case SIM_PARTICLES: {
+        ak_particles_state st = ak_particles_get_state(d->particles.ps);
+        *out_count = st.count;
+        return velocities ? st.velocity : st.position;
+    }
+    case SIM_BOIDS: *out_count = d->boids.n; return velocities ? d->boids.v : d->boids.p;
+    case SIM_FLUID: *out_count = d->fluid.n; return velocities ? d->fluid.vel : d->fluid.pos;
+    }
+    *out_count = 0;
+    return NULL;
+}
+
+static PyObject* sim_array(SimObject* o, bool velocities) {
+    size_t n = 0;
+    PyThread_acquire_lock(o->lock, WAIT_LOCK); /* a step running in another thread */
+    const ak_vec3* v = sim_vectors(o, velocities, &n);
+    PyThread_release_lock(o->lock);
+    npy_intp dims[2] = {(npy_intp)n, 3};
+    return view_array((PyObject*)o, 2, dims, NULL, NPY_FLOAT32, n ? v : NULL, 0);
+}
+
+static PyObject* sim_positions(SimObject* o, void* c) {
+    (void)c;
+    return sim_array(o, false);
+}
+
+static PyObject* sim_velocities(SimObject* o, void* c) {
+    (void)c;
+    return sim_array(o, true);
+}
+
+static PyObject* sim_get_kind(SimObject* o, void* c) {
+    (void)c;
+    return PyUnicode_FromString(sim_kind_names[o->kind]);
+}
+
+static PyObject* sim_get_name(SimObject* o, void* c) {
+    (void)c;
+    return PyUnicode_DecodeFSDefault(o->name);
+}
+
+static PyObject* sim_get_steps_done(SimObject* o, void* c) {
+    (void)c;
+    return PyLong_FromLong(o->steps_done);
+}
+
+static PyObject* sim_get_steps(SimObject* o, void* c) {
+    (void)c;
+    return PyLong_FromLong(o->default_steps);
+}
+
+static PyObject* sim_get_dt(SimObject* o, void* c) {
+    (void)c;
+    return PyFloat_FromDouble((double)o->dt);
+}
+
+static PyObject* sim_repr(SimObject* o) {
+    size_t n = 0;
+    sim_vectors(o, false, &n);
+    return PyUnicode_FromFormat("<animkit.Sim %s '%s': %zu points, %ld steps run>", sim_kind_names[o->kind], o->name, n,
+                                o->steps_done);
+}
+
+static PyMethodDef sim_methods[] = {
+    {"step", (PyCFunction)(void (*)(void))sim_step, METH_VARARGS | METH_KEYWORDS,
+     "step(steps=1) -> None\n\nAdvance the simulation by `steps` steps of dt (the GIL is released). "
+     "After n steps from the start the state is the one `animkit cloth|particles|boids|fluid "
+     "--steps n` ends with."},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyGetSetDef sim_getset[] = {
+    {"positions", (getter)sim_positions, NULL,
+     "Current positions (N, 3) float32: a read-only view of the simulation's memory (it changes "
+     "with each step; copy it to keep a frame). Particles and fluid: the live particles.",
+     NULL},
+    {"velocities", (getter)sim_velocities, NULL, "Current velocities (N, 3) float32, a read-only view.", NULL},
+    {"kind", (getter)sim_get_kind, NULL, "'cloth', 'particles', 'boids' or 'fluid'.", NULL},
+    {"name", (getter)sim_get_name, NULL, "The preset name or scene file.", NULL},
+    {"steps_done", (getter)sim_get_steps_done, NULL, "Steps run so far.", NULL},
+    {"steps", (getter)sim_get_steps, NULL, "The scene's own step count (what the command runs by default).", NULL},
+    {"dt", (getter)sim_get_dt, NULL, "Seconds per step.", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PyTypeObject SimType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "animkit.Sim",
+    .tp_basicsize = sizeof(SimObject),
+    .tp_dealloc = (destructor)sim_dealloc,
+    .tp_repr = (reprfunc)sim_repr,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "A running simulation (animkit.cloth / particles / boids / fluid .preset or .load).",
+    .tp_methods = sim_methods,
+    .tp_getset = sim_getset,
+};
+
 /* ---- module functions --------------------------------------------------------------------- */
 
 static PyObject* mod_load(PyObject* self, PyObject* args, PyObject* kw) {
@@ -1205,6 +1612,15 @@ static PyObject* mod_bench_c(PyObject* self, PyObject* args) {
 }
 
 static PyMethodDef module_methods[] = {
+    {"sim_preset", (PyCFunction)(void (*)(void))mod_sim_preset, METH_VARARGS | METH_KEYWORDS,
+     "sim_preset(kind, name, count=0, seed=-1, threads=1) -> Sim\n\n"
+     "A simulation preset of kind 'cloth', 'particles', 'boids' or 'fluid' (animkit.cloth.preset and "
+     "friends call it). count: boids agents / fluid particles (0: the preset's); seed: random seed "
+     "of particles and boids (-1: the scene's)."},
+    {"sim_load", (PyCFunction)(void (*)(void))mod_sim_load, METH_VARARGS | METH_KEYWORDS,
+     "sim_load(kind, path, seed=-1, threads=1) -> Sim\n\n"
+     "A simulation scene file (the JSON formats of docs/cloth.md, particles.md, boids.md, fluid.md); "
+     "errors name the key path."},
     {"_bench_c", (PyCFunction)mod_bench_c, METH_VARARGS,
      "_bench_c(scene, clip, time, method, mesh, count) -> float\n\n"
      "Seconds per iteration of sample + skin (out= a fixed buffer) in a C loop: the reference "
@@ -1254,7 +1670,9 @@ static PyObject* sub_error(PyObject* m, const char* name, PyObject* also, const 
 
 PyMODINIT_FUNC PyInit__core(void) {
     import_array();
-    if (PyType_Ready(&SceneType) < 0 || PyType_Ready(&PoseType) < 0 || PyType_Ready(&MeshType) < 0) return NULL;
+    if (PyType_Ready(&SceneType) < 0 || PyType_Ready(&PoseType) < 0 || PyType_Ready(&MeshType) < 0 ||
+        PyType_Ready(&SimType) < 0)
+        return NULL;
     PyObject* m = PyModule_Create(&module_def);
     if (!m) return NULL;
     if (!(Error = new_error(m, "Error", PyExc_Exception,
@@ -1273,8 +1691,9 @@ PyMODINIT_FUNC PyInit__core(void) {
     Py_INCREF(&SceneType);
     Py_INCREF(&PoseType);
     Py_INCREF(&MeshType);
+    Py_INCREF(&SimType);
     if (PyModule_AddObject(m, "Scene", (PyObject*)&SceneType) < 0 || PyModule_AddObject(m, "Pose", (PyObject*)&PoseType) < 0 ||
-        PyModule_AddObject(m, "Mesh", (PyObject*)&MeshType) < 0 ||
+        PyModule_AddObject(m, "Mesh", (PyObject*)&MeshType) < 0 || PyModule_AddObject(m, "Sim", (PyObject*)&SimType) < 0 ||
         PyModule_AddStringConstant(m, "__version__", ak_version_string()) < 0)
         goto fail;
     return m;

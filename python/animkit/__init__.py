@@ -5,6 +5,7 @@
     pose = scene.sample(clip=0, time=0.5)         # pose.model_matrices: (J, 4, 4) float32
     verts = scene.skin(pose, method="lbs")        # (N, 3) float32, "dqs" and "cor" too
     img = scene.render(time=0.5, size=(320, 240)) # (240, 320, 4) uint8
+    sim = ak.cloth.preset("flag"); sim.step(60); sim.positions   # particles, fluid, boids too
 
 Arrays are numpy arrays without copies: mesh data are read-only views of the scene's memory,
 results are written straight into the arrays returned. Failures raise animkit.Error subclasses
@@ -22,15 +23,17 @@ from ._core import (  # noqa: F401
     ParseError,
     Pose,
     Scene,
+    Sim,
     UnsupportedError,
     __version__,
     builtin_names,
     load,
     retarget,
 )
+from . import boids, cloth, fluid, particles  # noqa: F401,E402  (sim = animkit.cloth.preset("flag"))
 
 __all__ = [
     "ArgumentError", "DataError", "Error", "FileError", "Mesh", "NoMemoryError", "NotFoundError",
-    "ParseError", "Pose", "Scene", "UnsupportedError", "__version__", "builtin_names", "load",
-    "retarget",
+    "ParseError", "Pose", "Scene", "Sim", "UnsupportedError", "__version__", "builtin_names", "load",
+    "retarget", "boids", "cloth", "fluid", "particles",
 ]

@@ -367,3 +367,54 @@ def test_errors_carry_message_and_path(tmp_path):
         scene.save(str(tmp_path / "no" / "dir" / "x.glb"))
     with pytest.raises(TypeError):
         scene.skin("not a pose")
+
+
+# ---- simulations: ak.cloth / particles / boids / fluid ---------------------------------------
+
+SIMS = [  # (module, preset, command arguments, options, JSON list key)
+    ("cloth", "flag", [], {}, "positions"),
+    ("particles", "fountain", [], {}, "particles"),
+    ("boids", "flock", ["--count", "200"], {"count": 200}, "agents"),
+    ("fluid", "dam", ["--count", "500"], {"count": 500}, "particles"),
+]
+
+
+@need_cli
+@pytest.mark.parametrize("kind,name,args,options,key", SIMS)
+def test_sim_equals_command(tmp_path, kind, name, args, options, key):
+    """sim.step(n) ends where `animkit KIND --preset NAME --steps n` does, bit for bit (its JSON's
+    9 significant digits give every float32 back)."""
+    steps = 12
+    out = str(tmp_path / "s.json")
+    cli(kind, "--preset", name, "--steps", str(steps), *args, "--json", out)
+    rows = json.load(open(out))[key]
+    want = np.array([r["p"] if isinstance(r, dict) else r for r in rows], dtype=np.float32)
+    sim = getattr(ak, kind).preset(name, **options)
+    sim.step(steps // 2)
+    sim.step(steps - steps // 2)
+    assert sim.steps_done == steps
+    got = sim.positions
+    assert got.dtype == np.float32 and not got.flags.writeable
+    assert got.tobytes() == want.tobytes(), f"{kind} {name}: differs from animkit {kind}"
+
+
+def test_sim_physics_and_errors(tmp_path):
+    """A flag's pinned edge stays put while gravity pulls the rest down; bad input raises."""
+    sim = ak.cloth.preset("flag")
+    x0 = sim.positions.copy()
+    sim.step(30)
+    x1 = sim.positions
+    still = np.all(x1 == x0, axis=1)
+    assert 0 < still.sum() < len(x0) // 4  # the pins, and only them
+    assert np.isfinite(x1).all() and x1[~still, 1].mean() < x0[~still, 1].mean()
+    with pytest.raises(ak.NotFoundError, match="unknown cloth preset"):
+        ak.cloth.preset("sail")
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"steps": "many"}')
+    with pytest.raises(ak.ParseError) as e:
+        ak.cloth.load(str(bad))
+    assert "steps" in e.value.message
+    with pytest.raises(ak.FileError):
+        ak.boids.load(str(tmp_path / "missing.json"))
+    with pytest.raises(ak.ArgumentError):
+        sim.step(-1)
