@@ -1611,7 +1611,76 @@ static PyObject* mod_bench_c(PyObject* self, PyObject* args) {
     return PyFloat_FromDouble(secs);
 }
 
+/* write_png(path, image): an (H, W, 4) uint8 array to a PNG file (atomically). */
+static PyObject* mod_write_png(PyObject* self, PyObject* args, PyObject* kw) {
+    (void)self;
+    static char* kwlist[] = {"path", "image", NULL};
+    PyObject *path_bytes = NULL, *img_obj;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&O:write_png", kwlist, PyUnicode_FSConverter, &path_bytes, &img_obj))
+        return NULL;
+    PyArrayObject* a = (PyArrayObject*)PyArray_FROMANY(img_obj, NPY_UINT8, 3, 3, NPY_ARRAY_C_CONTIGUOUS | NPY_ARRAY_ALIGNED);
+    PyObject* res = NULL;
+    const char* path = PyBytes_AS_STRING(path_bytes);
+    if (!a) {
+        PyErr_Clear();
+        RAISE_ARG("image must be an (H, W, 4) uint8 array");
+    } else if (PyArray_DIM(a, 2) != 4 || PyArray_DIM(a, 0) < 1 || PyArray_DIM(a, 1) < 1 || PyArray_DIM(a, 0) > 65535 ||
+               PyArray_DIM(a, 1) > 65535) {
+        RAISE_ARG("image must be an (H, W, 4) uint8 array with 1..65535 pixels per side");
+    } else {
+        ak_image img = {.pixels = PyArray_DATA(a), .width = (int)PyArray_DIM(a, 1), .height = (int)PyArray_DIM(a, 0)};
+        ak_result r;
+        Py_BEGIN_ALLOW_THREADS
+        r = ak_png_write(path, &img);
+        Py_END_ALLOW_THREADS
+        if (r != AK_OK) raise_as(error_type(r), r, path, "cannot write the PNG: %s", ak_result_string(r));
+        else res = (Py_INCREF(Py_None), Py_None);
+    }
+    Py_XDECREF(a);
+    Py_DECREF(path_bytes);
+    return res;
+}
+
+#if defined(__has_include)
+#if __has_include(<animkit/batch.h>)
+#define AK_PY_HAVE_BATCH 1
+#endif
+#endif
+
+#ifdef AK_PY_HAVE_BATCH
+/* batch_run_job(line, name=None, input_dir=None, output_dir=None, index=0, force=False) -> str:
+ * ak_batch_run_job (animkit/batch.h) on one job line; the row's JSON. */
+static PyObject* mod_batch_run_job(PyObject* self, PyObject* args, PyObject* kw) {
+    (void)self;
+    static char* kwlist[] = {"line", "name", "input_dir", "output_dir", "index", "force", NULL};
+    const char *line, *name = NULL, *in_dir = NULL, *out_dir = NULL;
+    Py_ssize_t size;
+    long index = 0;
+    int force = 0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "s#|zzzlp:batch_run_job", kwlist, &line, &size, &name, &in_dir, &out_dir,
+                                     &index, &force))
+        return NULL;
+    ak_batch_row* row = PyMem_Calloc(1, sizeof *row);
+    if (!row) return PyErr_NoMemory();
+    ak_batch_desc d = {.name = name, .input_dir = in_dir, .output_dir = out_dir, .index = index, .force = force != 0};
+    Py_BEGIN_ALLOW_THREADS
+    (void)ak_batch_run_job(line, (size_t)size, &d, row);
+    Py_END_ALLOW_THREADS
+    PyObject* res = PyUnicode_FromString(row->json);
+    PyMem_Free(row);
+    return res;
+}
+#endif
+
 static PyMethodDef module_methods[] = {
+#ifdef AK_PY_HAVE_BATCH
+    {"batch_run_job", (PyCFunction)(void (*)(void))mod_batch_run_job, METH_VARARGS | METH_KEYWORDS,
+     "batch_run_job(line, name=None, input_dir=None, output_dir=None, index=0, force=False) -> str\n\n"
+     "Run one batch job line (docs/batch.md) with the library's runner; its manifest row as JSON. "
+     "Never raises for a bad job: errors are rows."},
+#endif
+    {"write_png", (PyCFunction)(void (*)(void))mod_write_png, METH_VARARGS | METH_KEYWORDS,
+     "write_png(path, image) -> None\n\nWrite an (H, W, 4) uint8 RGBA array as a PNG file, atomically."},
     {"sim_preset", (PyCFunction)(void (*)(void))mod_sim_preset, METH_VARARGS | METH_KEYWORDS,
      "sim_preset(kind, name, count=0, seed=-1, threads=1) -> Sim\n\n"
      "A simulation preset of kind 'cloth', 'particles', 'boids' or 'fluid' (animkit.cloth.preset and "

@@ -29,11 +29,21 @@ from ._core import (  # noqa: F401
     builtin_names,
     load,
     retarget,
+    write_png,
 )
 from . import boids, cloth, fluid, particles  # noqa: F401,E402  (sim = animkit.cloth.preset("flag"))
+
+
+def __getattr__(name):
+    """animkit.batch (Dask) is imported on first use: dask's import takes a second."""
+    if name == "batch":
+        import importlib
+        return importlib.import_module(".batch", __name__)
+    raise AttributeError(f"module 'animkit' has no attribute '{name}'")
+
 
 __all__ = [
     "ArgumentError", "DataError", "Error", "FileError", "Mesh", "NoMemoryError", "NotFoundError",
     "ParseError", "Pose", "Scene", "Sim", "UnsupportedError", "__version__", "builtin_names", "load",
-    "retarget", "boids", "cloth", "fluid", "particles",
+    "retarget", "write_png", "boids", "cloth", "fluid", "particles",
 ]
