@@ -143,6 +143,53 @@ class Scene:
     def save(self, path: PathLike) -> None:
         """Write the scene as glTF 2.0 (.glb, or .gltf + .bin), atomically."""
 
+class Sim:
+    """A running simulation (animkit.cloth / particles / boids / fluid .preset or .load)."""
+    @property
+    def positions(self) -> npt.NDArray[np.float32]:
+        """(N, 3) current positions: a read-only view that changes with each step (copy it to
+        keep a frame). Particles and fluid: the live particles."""
+    @property
+    def velocities(self) -> npt.NDArray[np.float32]:
+        """(N, 3) current velocities, a read-only view."""
+    @property
+    def kind(self) -> str:
+        """'cloth', 'particles', 'boids' or 'fluid'."""
+    @property
+    def name(self) -> str:
+        """The preset name or scene file."""
+    @property
+    def steps_done(self) -> int: ...
+    @property
+    def steps(self) -> int:
+        """The scene's own step count (what the command runs by default)."""
+    @property
+    def dt(self) -> float:
+        """Seconds per step."""
+    def step(self, steps: int = 1) -> None:
+        """Advance by `steps` steps (GIL released); after n steps the state is the one
+        `animkit KIND --preset NAME --steps n` ends with, bit for bit."""
+
+def sim_preset(kind: str, name: str, count: int = 0, seed: int = -1, threads: int = 1) -> Sim:
+    """A preset of kind 'cloth', 'particles', 'boids' or 'fluid' (animkit.<kind>.preset)."""
+
+def sim_load(kind: str, path: PathLike, seed: int = -1, threads: int = 1) -> Sim:
+    """A scene file of that kind (animkit.<kind>.load); errors name the key path."""
+
+def fnv1a64_file(path: PathLike) -> str:
+    """FNV-1a 64 of a file's bytes as 16 hex digits."""
+
+def write_png(path: PathLike, image: npt.ArrayLike) -> None:
+    """Write an (H, W, 4) uint8 RGBA array as a PNG file, atomically."""
+
+def batch_run_job(line: str, name: Optional[str] = None, input_dir: Optional[str] = None,
+                  output_dir: Optional[str] = None, index: int = 0, force: bool = False) -> str:
+    """Only when the library has animkit/batch.h: one job line run by ak_batch_run_job; the
+    row as JSON (animkit.batch.run_job uses it when present)."""
+
+def _bench_c(scene: Scene, clip: int, time: float, method: str, mesh: int, count: int) -> float:
+    """Seconds per sample + skin in a C loop (bench/bench_python.py's reference)."""
+
 def load(path: PathLike) -> Scene:
     """Load a model file (.glb, .gltf, .bvh; FBX/Collada/OBJ through Assimp when built with
     it) or a built-in model ('builtin:humanoid', 'builtin:cylinder')."""

@@ -49,11 +49,7 @@ def hash_file(path: str) -> str:
     """FNV-1a 64 of a file's bytes, as 16 hex digits ("builtin:NAME" hashes its name)."""
     if path.startswith("builtin:"):
         return "%016x" % _fnv1a64(path.encode())
-    h = FNV_BASIS
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 16), b""):
-            h = _fnv1a64(block, h)
-    return "%016x" % h
+    return _core.fnv1a64_file(path)
 
 
 def _resolve(path: str, base: Optional[str]) -> str:

@@ -418,3 +418,26 @@ def test_sim_physics_and_errors(tmp_path):
         ak.boids.load(str(tmp_path / "missing.json"))
     with pytest.raises(ak.ArgumentError):
         sim.step(-1)
+
+
+# ---- animkit.batch without a cluster (the Dask run is test_batch_dask.py, slow) ---------------
+
+def test_batch_jobs_rows_and_skip(tmp_path):
+    import animkit.batch as batch
+    for text, want in ((b"", "cbf29ce484222325"), (b"a", "af63dc4c8601ec8c"), (b"foobar", "85944171f73967e8")):
+        (tmp_path / "h").write_bytes(text)  # FNV-1a 64 test vectors (Fowler, Noll, Vo)
+        assert batch.hash_file(str(tmp_path / "h")) == want
+    job = {"kind": "render", "inputs": {"model": "builtin:cylinder"}, "parameters": {"time": 0.5, "size": [40, 30]},
+           "output": "sub/r.png"}
+    row = batch.run_job(job, 3, output_dir=str(tmp_path))
+    assert row["status"] == "ran" and row["index"] == 3 and row["error"] is None and row["job_hash"]
+    assert read_png_rgba(str(tmp_path / "sub" / "r.png")).tobytes() == \
+        load("builtin:cylinder").render(time=0.5, size=(40, 30)).tobytes()
+    assert batch.run_job(job, 3, output_dir=str(tmp_path))["status"] == "skipped"
+    changed = dict(job, parameters={"time": 0.25, "size": [40, 30]})
+    assert batch.run_job(changed, 3, output_dir=str(tmp_path))["status"] == "ran"  # new parameters: runs again
+    for bad, msg in (({"kind": "dance", "output": "x"}, "kind"), ({"kind": "render", "inputs": {}, "output": "x.png"},
+                     "inputs.model: is required"), ({"kind": "render", "inputs": {"model": str(tmp_path / "no.glb")},
+                     "output": "y.png"}, "no.glb"), ("junk", "JSON object")):
+        r = batch.run_job(bad, 0, output_dir=str(tmp_path))
+        assert r["status"] == "failed" and msg in r["error"], r
