@@ -342,6 +342,11 @@ static PyObject* pose_local(PoseObject* p, void* closure) {
 
 static PyObject* pose_model_matrices(PoseObject* p, void* closure) {
     (void)closure;
+    const float* f = (const float*)p->local;
+    for (size_t i = 0; i < p->joint_count * (sizeof(ak_transform) / sizeof(float)); ++i)
+        if (!isfinite(f[i]))
+            return raise_as(DataError, AK_ERR_BAD_DATA, p->scene->scene->name,
+                            "pose.local holds NaN or infinity (joint %zu)", i / (sizeof(ak_transform) / sizeof(float)));
     if (p->joint_count) {
         ak_result r = ak_scene_world_matrices(p->scene->scene, (ak_transform_cspan){p->local, p->joint_count},
                                               (ak_mat4_span){p->world, p->joint_count});
@@ -1294,9 +1299,12 @@ static const ak_vec3* sim_vectors(SimObject* o, bool velocities, size_t* out_cou
 
 static PyObject* sim_array(SimObject* o, bool velocities) {
     size_t n = 0;
+    const ak_vec3* v;
+    Py_BEGIN_ALLOW_THREADS
     PyThread_acquire_lock(o->lock, WAIT_LOCK); /* a step running in another thread */
-    const ak_vec3* v = sim_vectors(o, velocities, &n);
+    v = sim_vectors(o, velocities, &n);
     PyThread_release_lock(o->lock);
+    Py_END_ALLOW_THREADS
     npy_intp dims[2] = {(npy_intp)n, 3};
     return view_array((PyObject*)o, 2, dims, NULL, NPY_FLOAT32, n ? v : NULL, 0);
 }

@@ -367,6 +367,12 @@ def test_errors_carry_message_and_path(tmp_path):
         scene.save(str(tmp_path / "no" / "dir" / "x.glb"))
     with pytest.raises(TypeError):
         scene.skin("not a pose")
+    edited = scene.sample(time=0.3)
+    edited.local[1, 3] = float("nan")  # a user's edit: an error, never NaN output
+    with pytest.raises(ak.DataError, match="NaN"):
+        scene.skin(edited)
+    with pytest.raises(ak.DataError, match="NaN"):
+        edited.model_matrices
 
 
 # ---- simulations: ak.cloth / particles / boids / fluid ---------------------------------------
