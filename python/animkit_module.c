@@ -835,7 +835,10 @@ static ak_result render_frame(SceneObject* o, int clip, float t, cli_method meth
     ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
     cli_bounds_add_visible(p, NULL, &lo, &hi);
     if (!ak_vec3_is_finite(lo) || !ak_vec3_is_finite(hi)) lo = hi = ak_vec3_zero();
-    if (cli_frame_init_camera(&f, s, w, h, lo, hi, cam)) return AK_ERR_NO_MEMORY;
+    if (cli_frame_init_camera(&f, s, w, h, lo, hi, cam)) {
+        cli_frame_free(&f);
+        return AK_ERR_NO_MEMORY;
+    }
     bool skinned = false;
     for (size_t m = 0; m < s->mesh_count; ++m) skinned = skinned || (s->meshes[m].skin >= 0 && s->meshes[m].mesh->influence_count);
     static const char* const labels[3] = {"LBS", "DQS", "CoR"};
