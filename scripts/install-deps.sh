@@ -21,6 +21,12 @@ PACKAGES=(
   clang             # the ASan+UBSan CI stage and scripts/fuzz.sh
   libclang-rt-14-dev # clang's sanitizer and libFuzzer runtimes (-fsanitize=fuzzer), Debian 12
   libbullet-dev     # Bullet 3, the peer of bench/vs_bullet (optional: the benchmark is skipped without it)
+  python3-dev       # the Python package's C extension (python/; optional: AK_PYTHON skips it without)
+  python3-numpy     # its arrays (and the NumPy C API it builds against)
+  python3-pytest    # the Python tests (test_python SKIPs without)
+  python3-setuptools # pip install --no-build-isolation . (setup.py drives CMake)
+  python3-matplotlib # examples/python (its smoke test SKIPs without)
+  python3-distributed # animkit.batch on Dask (optional: its test SKIPs without)
 )
 
 missing=()
