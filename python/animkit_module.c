@@ -1489,11 +1489,11 @@ static PyObject* mod_retarget(PyObject* self, PyObject* args, PyObject* kw) {
     ak_diag diag;
     memset(&diag, 0, sizeof diag);
     if (map_obj == Py_None) {
-        size_t mapped = 0;
-        ak_retarget_map_by_name(src->scene->skeleton, dst->scene->skeleton, (ak_i32_span){map, nt}, &mapped);
-        if (!mapped) {
-            raise_as(NotFoundError, AK_ERR_NOT_FOUND, dst->scene->name,
-                     "no joint matches a joint of %s by name; give map=FILE", src->scene->name);
+        /* as `animkit retarget` without --map: the humanoid template, or names when neither is one */
+        ak_result r = ak_retarget_map_auto(src->scene->skeleton, dst->scene->skeleton, NULL, (ak_i32_span){map, nt},
+                                           NULL, NULL, &diag);
+        if (r != AK_OK) {
+            raise_result(r, dst->scene->name, &diag);
             goto done;
         }
     } else {
@@ -1745,7 +1745,8 @@ static PyMethodDef module_methods[] = {
     {"retarget", (PyCFunction)(void (*)(void))mod_retarget, METH_VARARGS | METH_KEYWORDS,
      "retarget(source, target, map=None, clip=0, fps=30.0, feet=True, scaled=True) -> Scene\n\n"
      "Retarget a clip of source onto target's skeleton, as `animkit retarget` does: joints matched "
-     "by name, or by a map file (map=PATH, 'TARGET = SOURCE' lines); baked at fps; foot contacts "
+     "automatically (both fitted to the humanoid template, by name when neither is a humanoid; "
+     "NotFoundError when only one is), or by a map file (map=PATH, 'TARGET = SOURCE' lines); baked at fps; foot contacts "
      "pinned unless feet=False; root motion scaled unless scaled=False. Returns the target with "
      "the one retargeted clip (save it with .save('out.glb'))."},
     {"builtin_names", (PyCFunction)mod_builtin_names, METH_NOARGS,

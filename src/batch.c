@@ -300,9 +300,10 @@ static ak_result run_retarget(job_ctx* c) {
             goto done;
         }
     } else {
-        ak_retarget_map_by_name(src->skeleton, dst->skeleton, (ak_i32_span){map, nt}, &mapped);
-        if (!mapped) {
-            r = fail(c, AK_ERR_NOT_FOUND, "no joint of the target matches a joint of the source by name; give inputs.map");
+        /* as `animkit retarget` without --map: the humanoid template (names when neither is one) */
+        r = ak_retarget_map_auto(src->skeleton, dst->skeleton, NULL, (ak_i32_span){map, nt}, &mapped, NULL, &d);
+        if (r != AK_OK) {
+            r = fail(c, r, "%s; give inputs.map", d.message[0] ? d.message : ak_result_string(r));
             goto done;
         }
     }
@@ -667,8 +668,9 @@ done:
 /* "hex" of a 64-bit hash. */
 static void hex64(char out[17], uint64_t h) { snprintf(out, 17, "%016llx", (unsigned long long)h); }
 
-/* The record beside the output holds this job hash and the output exists. */
-static bool up_to_date(const job_ctx* c, uint64_t job_hash) {
+/* The record beside the output holds this job hash and the output exists; a skipped job's row
+ * then repeats the record's frame count (c->frames). */
+static bool up_to_date(job_ctx* c, uint64_t job_hash) {
     struct stat st;
     if (stat(c->output, &st) != 0 || !S_ISREG(st.st_mode)) return false;
     akp_json j = {.file = c->record};
@@ -680,6 +682,9 @@ static bool up_to_date(const job_ctx* c, uint64_t job_hash) {
     hex64(want, job_hash);
     const bool ok = cJSON_IsString(h) && strcmp(h->valuestring, want) == 0 && cJSON_IsString(s) &&
                     strcmp(s->valuestring, "ran") == 0;
+    const cJSON* f = cJSON_GetObjectItemCaseSensitive(root, "frames");
+    if (ok && cJSON_IsNumber(f) && f->valuedouble >= 0.0 && f->valuedouble <= 1e9 && f->valuedouble == floor(f->valuedouble))
+        c->frames = (long)f->valuedouble;
     cJSON_Delete(root);
     return ok;
 }

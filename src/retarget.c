@@ -1090,6 +1090,45 @@ ak_result ak_retarget_map_by_roles(const ak_skeleton* source, const ak_humanoid_
     return AK_OK;
 }
 
+ak_result ak_retarget_map_auto(const ak_skeleton* source, const ak_skeleton* target, const ak_allocator* alloc,
+                               ak_i32_span out, size_t* out_mapped_count, bool* out_by_name, ak_diag* diag) {
+    if (out_mapped_count) *out_mapped_count = 0;
+    if (out_by_name) *out_by_name = false;
+    if (!source || !target || !out.ptr) return AK_ERR_NULL_ARG;
+    if (out.count < ak_skeleton_joint_count(target)) return AK_ERR_SPAN_SMALL;
+    ak_humanoid_roles sr, tr;
+    ak_diag sd, td;
+    memset(&sd, 0, sizeof sd);
+    memset(&td, 0, sizeof td);
+    ak_result a = ak_humanoid_roles_find(source, alloc, &sr, &sd);
+    if (a != AK_OK && a != AK_ERR_NOT_FOUND) {
+        akp_diag_set(diag, NULL, "source: %s", sd.message);
+        return a;
+    }
+    ak_result b = ak_humanoid_roles_find(target, alloc, &tr, &td);
+    if (b != AK_OK && b != AK_ERR_NOT_FOUND) {
+        akp_diag_set(diag, NULL, "target: %s", td.message);
+        return b;
+    }
+    if (a == AK_ERR_NOT_FOUND && b == AK_ERR_NOT_FOUND) {
+        size_t mapped = 0;
+        ak_retarget_map_by_name(source, target, out, &mapped);
+        if (out_mapped_count) *out_mapped_count = mapped;
+        if (out_by_name) *out_by_name = true;
+        if (!mapped) {
+            akp_diag_set(diag, NULL, "neither skeleton is a humanoid and no joint name matches; give a map");
+            return AK_ERR_NOT_FOUND;
+        }
+        return AK_OK;
+    }
+    if (a != AK_OK || b != AK_OK) {
+        akp_diag_set(diag, NULL, "%s: %s; give a map", a != AK_OK ? "source" : "target",
+                     a != AK_OK ? sd.message : td.message);
+        return AK_ERR_NOT_FOUND;
+    }
+    return ak_retarget_map_by_roles(source, &sr, target, &tr, out, out_mapped_count);
+}
+
 /* snprintf-style appender. */
 typedef struct text_out {
     char* buf;

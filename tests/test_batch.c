@@ -175,8 +175,19 @@ AK_TEST(retarget_bvh_rerun_skips) {
     /* a re-run skips it (other parameters run it again: bake_lasts_its_steps) */
     struct stat st0, st1;
     stat("test_batch_out/walk.glb", &st0);
+    double frames_ran = -1.0;
+    cJSON* o1 = row_json();
+    if (o1 && cJSON_IsNumber(cJSON_GetObjectItemCaseSensitive(o1, "frames")))
+        frames_ran = cJSON_GetObjectItemCaseSensitive(o1, "frames")->valuedouble;
+    cJSON_Delete(o1);
     AK_CHECK_EQ(run_line(line, "test_batch_out", false), AK_OK);
     AK_CHECK_EQ(row.status, AK_BATCH_SKIPPED);
+    /* the skipped row repeats the frame count of the run that wrote the output */
+    cJSON* o2 = row_json();
+    const cJSON* f2 = o2 ? cJSON_GetObjectItemCaseSensitive(o2, "frames") : NULL;
+    AK_CHECK_MSG(frames_ran > 0.0 && cJSON_IsNumber(f2) && f2->valuedouble == frames_ran, "frames %g then %g", frames_ran,
+                 cJSON_IsNumber(f2) ? f2->valuedouble : -1.0);
+    cJSON_Delete(o2);
     stat("test_batch_out/walk.glb", &st1);
     AK_CHECK(st0.st_ino == st1.st_ino); /* not rewritten (a rewrite renames a new file over it) */
 }

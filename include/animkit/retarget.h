@@ -182,6 +182,19 @@ AK_API ak_result ak_retarget_map_by_roles(const ak_skeleton* source, const ak_hu
                                           const ak_skeleton* target, const ak_humanoid_roles* target_roles,
                                           ak_i32_span out_source_of_target, size_t* out_mapped_count);
 
+/* The automatic mapping `animkit retarget` uses without --map, for library callers (the Python
+ * package, batch jobs): both skeletons fitted to the humanoid template (ak_humanoid_roles_find)
+ * and mapped by roles (ak_retarget_map_by_roles); when NEITHER is a humanoid, joints are matched
+ * by name (ak_retarget_map_by_name) and *out_by_name (optional) is set.
+ * Returns AK_OK; AK_ERR_NOT_FOUND when exactly one skeleton is a humanoid (diag: "source: ..." or
+ * "target: ..." and why it is not one: give a map instead) or when neither is and no joint name
+ * matches; AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL (out shorter than the target's joint count),
+ * AK_ERR_BAD_DATA, AK_ERR_NO_MEMORY from the template fit. *out_mapped_count (optional) = target
+ * joints mapped. Temporary memory from alloc (NULL: malloc/free); reentrant. */
+AK_API ak_result ak_retarget_map_auto(const ak_skeleton* source, const ak_skeleton* target, const ak_allocator* alloc,
+                                      ak_i32_span out_source_of_target, size_t* out_mapped_count, bool* out_by_name,
+                                      ak_diag* diag);
+
 /* Write a map as text in the map-file format (ak_retarget_map_parse reads it back to the same
  * map): a comment header (the roles' score, up, facing and side evidence when given), then one
  * "TARGET_JOINT = SOURCE_JOINT  # bone  confidence target/source" line per mapped target joint
