@@ -32,5 +32,6 @@
 #include "cloth.h"
 #include "retarget.h"
 #include "fluid.h"
+#include "crowd.h"
 
 #endif
