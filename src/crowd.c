@@ -882,10 +882,22 @@ size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd
 
 /* ---- measures ------------------------------------------------------------------------------- */
 
+typedef struct xkey {
+    float x;
+    uint32_t index;
+} xkey;
+
+static int xkey_cmp(const void* a, const void* b) {
+    const xkey *p = (const xkey*)a, *q = (const xkey*)b;
+    if (p->x != q->x) return p->x < q->x ? -1 : 1;
+    return p->index < q->index ? -1 : (p->index > q->index ? 1 : 0);
+}
+
 size_t ak_crowd_clearance_scratch_size(const ak_crowd* crowd, size_t count) {
     if (!crowd || count > AK_CROWD_MAX_AGENTS) return 0;
     ak_grid_desc gd = {.cell_size = ak_maxf(2.0f * crowd->max_radius, 1e-3f)};
-    return akp_align16(count * sizeof(ak_vec3)) + akp_align16(ak_grid_memory_size(count, &gd)) + 16;
+    return akp_align16(count * sizeof(ak_vec3)) + akp_align16(ak_grid_memory_size(count, &gd)) +
+           akp_align16(count * sizeof(xkey)) + 16;
 }
 
 ak_result ak_crowd_clearance(const ak_crowd* crowd, ak_vec2_cspan positions, float overlap, ak_u8_span scratch,
@@ -939,18 +951,26 @@ ak_result ak_crowd_clearance(const ak_crowd* crowd, ak_vec2_cspan positions, flo
                 }
             }
     }
-    if (!(best <= 0.0) && n <= 4096) {
-        /* No pair within reach: the exact minimum lies farther; small crowds pay the
-         * quadratic pass. */
-        for (size_t i = 0; i < n; ++i)
-            for (size_t j = i + 1; j < n; ++j) {
+    if (!(best <= 0.0)) {
+        /* No pair within reach: the minimum lies farther. Sort on x and sweep (exact; about
+         * N log N for spread-out agents). */
+        xkey* keys = (xkey*)(void*)(base + akp_align16(n * sizeof(ak_vec3)) + gm);
+        for (size_t i = 0; i < n; ++i) keys[i] = (xkey){positions.ptr[i].x, (uint32_t)i};
+        qsort(keys, n, sizeof *keys, xkey_cmp);
+        const double rmax = crowd->max_radius;
+        for (size_t a = 0; a < n; ++a) {
+            const uint32_t i = keys[a].index;
+            for (size_t b = a + 1; b < n; ++b) {
+                const double gap = (double)keys[b].x - keys[a].x - crowd->agents[i].radius - rmax;
+                if (gap >= best) break;
+                const uint32_t j = keys[b].index;
                 const double ddx = (double)positions.ptr[i].x - positions.ptr[j].x;
                 const double ddz = (double)positions.ptr[i].y - positions.ptr[j].y;
                 const double d = sqrt(ddx * ddx + ddz * ddz) - crowd->agents[i].radius - crowd->agents[j].radius;
                 if (d < best) best = d;
             }
+        }
     }
-    if (!(best <= 0.0) && n > 4096) best = 0.0; /* documented lower bound */
     *out_min_distance = (float)best;
     if (out_overlap_count) *out_overlap_count = over;
     return AK_OK;

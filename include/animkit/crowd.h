@@ -211,10 +211,9 @@ AK_API ak_vec2 ak_crowd_solve(ak_crowd_line_cspan lines, size_t obstacle_line_co
 
 /* ---- measures ------------------------------------------------------------------------- */
 
-/* Smallest |p_i - p_j| - r_i - r_j over all pairs (in double, through the grid) and the
- * number of pairs closer than r_i + r_j - overlap. Exact when some pair is within 2 * the
- * largest radius of touching or the crowd has at most 4096 agents; otherwise (a sparse large
- * crowd) 0, a lower bound. positions.count <= agent count (the first agents); fewer than
+/* Smallest |p_i - p_j| - r_i - r_j over all pairs (exact, in double: a grid pass over
+ * pairs within reach of touching, else a sort-and-sweep on x) and the number of pairs closer
+ * than r_i + r_j - overlap. positions.count <= agent count (the first agents); fewer than
  * two -> +infinity and 0. out_pairs (optional) receives the first out_pairs.count / 2
  * overlapping pairs as index pairs (i < j: i then j). scratch >=
  * ak_crowd_clearance_scratch_size(crowd, positions.count). Returns AK_ERR_NULL_ARG
