@@ -598,7 +598,10 @@ static ak_vec2 perturb(const ak_crowd_step_job* job, size_t i, ak_vec2 v) {
     const uint64_t h = mix64((uint64_t)i * 0x9e3779b97f4a7c15ull + mix64(job->step_index + 0x5851f42d4c957f2dull));
     const float angle = (float)(h >> 40) * (6.28318530717958647692f / 16777216.0f);
     const float mag = (float)((h >> 16) & 0xffffff) * (1e-4f / 16777216.0f);
-    return v2(v.x + mag * cosf(angle), v.y + mag * sinf(angle));
+    /* and a turn of 0.01 rad to the same side for every agent: a ring of agents that block
+     * each other on the way to the centre (the circle's deadlock) then turns and unwinds */
+    const float bias = 0.01f;
+    return v2(v.x + mag * cosf(angle) + bias * v.y, v.y + mag * sinf(angle) - bias * v.x);
 }
 
 static ak_vec2 pref_velocity(const ak_crowd_step_job* job, const ak_crowd_agent* a, size_t i, ak_vec2 p) {

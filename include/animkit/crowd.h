@@ -149,12 +149,14 @@ typedef struct ak_crowd_step_job {
     uint64_t max_cell_load;      /* work budget: sum over the grid's cells of (agents in the
                                     cell)^2; 0 -> AK_CROWD_DEFAULT_CELL_LOAD */
     uint64_t step_index;         /* the step number: seeds the perturbation below */
-    bool skip_perturbation;      /* false -> each preferred velocity gets a deterministic
-                                    perturbation below 1e-4 m/s (a hash of agent index and
-                                    step_index), which breaks the exact symmetries where ORCA
-                                    stalls (four agents crossing head-on, as RVO2's examples
-                                    perturb); true -> the preferred velocity as is (RVO2's
-                                    bits: bench/vs_rvo2) */
+    bool skip_perturbation;      /* false -> each preferred velocity is turned by -0.01 rad
+                                    in (x, z) (every agent to the same side, as people keep
+                                    to one side) and gets a deterministic jitter below
+                                    1e-4 m/s (a hash of agent index and step_index): they
+                                    break the symmetric deadlocks of ORCA (four agents
+                                    crossing head-on, a ring of agents blocking each other at
+                                    the circle's centre); true -> the preferred velocity as
+                                    is (RVO2's bits: bench/vs_rvo2) */
     uint32_t contact_iterations; /* 0 -> pure ORCA. ORCA lets agents overlap when the crowd
                                     is so dense that its program is infeasible (the 3D program
                                     then only minimises the violation; RVO2 does the same); n > 0

@@ -465,7 +465,7 @@ int cmd_crowd(int argc, char** argv) {
     else if (wres != AK_OK) rc = cli_fail("crowd", "%s: cannot write the file: %s", out, ak_result_string(wres));
     const size_t reached = reached_count(&st);
     if (rc == CLI_OK && out) cli_wrote(out, "%zu agents after %ld steps", st.n, done);
-    if (rc == CLI_OK && json && (rc = write_json(json, (double)done * sc.dt, &st)) == CLI_OK)
+    if (rc == CLI_OK && json && (rc = write_json(json, (double)((float)done * sc.dt), &st)) == CLI_OK)
         cli_wrote(json, "%zu agents after %ld steps, %zu at their goal", st.n, done, reached);
     if (rc == CLI_OK && !json && !out)
         printf("crowd: %zu agents, %ld steps in %.3f s (%.3f ms/step), %zu at their goal, min distance %.4g m, "
