@@ -310,7 +310,46 @@ typedef struct ctx {
     const ak_crowd_step_job* job;
     const ak_crowd* crowd;
     const ak_grid* grid;
+    /* A dense table of the grid's cells over their bounding rectangle (when it fits the
+     * scratch: about 4 cells per agent), so that a lookup is an index instead of a hash. */
+    const uint32_t* dense;
+    int32_t dense_x0, dense_z0, dense_w, dense_h;
 } ctx;
+
+static inline uint32_t cell_lookup(const ctx* c, int32_t x, int32_t z) {
+    if (c->dense) {
+        const int64_t u = (int64_t)x - c->dense_x0, w = (int64_t)z - c->dense_z0;
+        if (u < 0 || w < 0 || u >= c->dense_w || w >= c->dense_h) return UINT32_MAX;
+        return c->dense[w * c->dense_w + u];
+    }
+    const ak_grid_cell cc = {x, 0, z};
+    return ak_grid_cell_find(c->grid, cc);
+}
+
+/* Fill the dense table when the occupied rectangle fits cap entries; else leave it off. */
+static void dense_build(ctx* c, uint32_t* table, size_t cap) {
+    const ak_grid* g = c->grid;
+    c->dense = NULL;
+    if (g->cell_count == 0) return;
+    int32_t x0 = g->cell_coord[0].x, x1 = x0, z0 = g->cell_coord[0].z, z1 = z0;
+    for (uint32_t m = 1; m < g->cell_count; ++m) {
+        const ak_grid_cell q = g->cell_coord[m];
+        if (q.x < x0) x0 = q.x;
+        if (q.x > x1) x1 = q.x;
+        if (q.z < z0) z0 = q.z;
+        if (q.z > z1) z1 = q.z;
+    }
+    const int64_t w = (int64_t)x1 - x0 + 1, h = (int64_t)z1 - z0 + 1;
+    if (w * h > (int64_t)cap) return;
+    for (int64_t k = 0; k < w * h; ++k) table[k] = UINT32_MAX;
+    for (uint32_t m = 0; m < g->cell_count; ++m)
+        table[(int64_t)(g->cell_coord[m].z - z0) * w + (g->cell_coord[m].x - x0)] = m;
+    c->dense = table;
+    c->dense_x0 = x0;
+    c->dense_z0 = z0;
+    c->dense_w = (int32_t)w;
+    c->dense_h = (int32_t)h;
+}
 
 typedef struct worker {
     const ctx* c;
@@ -366,8 +405,14 @@ static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_c
                 dx = (k & 1) ? r : -r;
                 dz = -r + 1 + (k >> 1);
             }
-            ak_grid_cell cc = {home.x + dx, 0, home.z + dz};
-            const uint32_t m = ak_grid_cell_find(g, cc);
+            if (r >= 2) {
+                /* skip a cell whose nearest point is out of range (a margin for rounding) */
+                const float lx = (float)(home.x + dx) * cs, lz = (float)(home.z + dz) * cs;
+                const float gx = ak_maxf(0.0f, ak_maxf(lx - p.x, p.x - (lx + cs)));
+                const float gz = ak_maxf(0.0f, ak_maxf(lz - p.y, p.y - (lz + cs)));
+                if ((gx * gx + gz * gz) * (1.0f - 1e-4f) >= range_sq) continue;
+            }
+            const uint32_t m = cell_lookup(c, home.x + dx, home.z + dz);
             if (m == UINT32_MAX) continue;
             for (uint32_t s = g->cell_start[m]; s < g->cell_start[m + 1]; ++s) {
                 const uint32_t j = g->order[s];
@@ -723,7 +768,7 @@ static uint32_t thread_total(const ak_crowd_step_job* job, size_t n) {
 }
 
 typedef struct layout {
-    size_t grid_pts, grid_mem, per_thread, contact, total;
+    size_t grid_pts, grid_mem, per_thread, contact, dense, dense_cap, total;
     ak_grid_desc gd, contact_gd;
 } layout;
 
@@ -742,7 +787,9 @@ static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t 
     const size_t lines = (size_t)c->max_k + c->vertex_count;
     L->per_thread = akp_align16((size_t)c->max_k * sizeof(neigh)) + akp_align16((size_t)c->vertex_count * sizeof(neigh)) +
                     2 * akp_align16(lines * sizeof(ak_crowd_line));
-    L->total = L->grid_pts + L->grid_mem + L->contact + (size_t)threads * L->per_thread + 16;
+    L->dense_cap = 4 * n + 1024;
+    L->dense = akp_align16(L->dense_cap * sizeof(uint32_t));
+    L->total = L->grid_pts + L->grid_mem + L->contact + L->dense + (size_t)threads * L->per_thread + 16;
     return true;
 }
 
@@ -840,8 +887,9 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     const ak_result gr = build_grid(job, &L, &L.gd, job->positions.ptr, base, &grid);
     if (gr != AK_OK) return gr;
     ctx c = {.job = job, .crowd = crowd, .grid = &grid};
+    dense_build(&c, (uint32_t*)(void*)(base + L.grid_pts + L.grid_mem + L.contact), L.dense_cap);
     worker w[64];
-    char* tb = base + L.grid_pts + L.grid_mem + L.contact;
+    char* tb = base + L.grid_pts + L.grid_mem + L.contact + L.dense;
     for (uint32_t t = 0; t < threads; ++t) {
         w[t].c = &c;
         w[t].begin = n * t / threads;
@@ -871,9 +919,10 @@ size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd
     ak_grid grid;
     if (build_grid(job, &L, &L.gd, job->positions.ptr, base, &grid) != AK_OK) return 0;
     ctx c = {.job = job, .crowd = crowd, .grid = &grid};
+    dense_build(&c, (uint32_t*)(void*)(base + L.grid_pts + L.grid_mem + L.contact), L.dense_cap);
     worker w;
     w.c = &c;
-    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact, &w);
+    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense, &w);
     const ak_crowd_agent* a = &crowd->agents[index];
     size_t no = 0;
     const ak_vec2 p = job->positions.ptr[index], v = job->velocities.ptr[index];
