@@ -62,7 +62,12 @@ static inline float dot(ak_vec2 a, ak_vec2 b) { return a.x * b.x + a.y * b.y; }
 static inline float det(ak_vec2 a, ak_vec2 b) { return a.x * b.y - a.y * b.x; }
 static inline float abs_sq(ak_vec2 a) { return dot(a, a); }
 static inline float len(ak_vec2 a) { return sqrtf(abs_sq(a)); }
-static inline ak_vec2 normalize(ak_vec2 a) { return divs(a, len(a)); }
+/* A zero vector (agents on the same point, an agent on a vertex) has no direction: +x then,
+ * so that degenerate input gives a finite answer (RVO2 divides by zero there). */
+static inline ak_vec2 normalize(ak_vec2 a) {
+    const float l = len(a);
+    return l > 0.0f ? divs(a, l) : v2(1.0f, 0.0f);
+}
 /* > 0 when c lies left of the directed line a -> b. */
 static inline float left_of(ak_vec2 a, ak_vec2 b, ak_vec2 c) { return det(sub(a, c), sub(b, a)); }
 
@@ -126,11 +131,17 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
             const ak_vec2 g = desc->agents.ptr[i].goals.ptr[k];
             if (!finite_in(g.x, COORD_MAX) || !finite_in(g.y, COORD_MAX)) return AK_ERR_BAD_DATA;
         }
-    for (uint32_t o = 0; o < desc->obstacle_count; ++o)
-        for (size_t k = 0; k < desc->obstacles[o].vertices.count; ++k) {
-            const ak_vec2 g = desc->obstacles[o].vertices.ptr[k];
+    for (uint32_t o = 0; o < desc->obstacle_count; ++o) {
+        const ak_vec2_cspan vs = desc->obstacles[o].vertices;
+        for (size_t k = 0; k < vs.count; ++k) {
+            const ak_vec2 g = vs.ptr[k];
             if (!finite_in(g.x, COORD_MAX) || !finite_in(g.y, COORD_MAX)) return AK_ERR_BAD_DATA;
         }
+        for (size_t k = 0; k < vs.count; ++k) { /* every edge has a length */
+            const ak_vec2 e = sub(vs.ptr[(k + 1) % vs.count], vs.ptr[k]);
+            if (!(abs_sq(e) > 0.0f)) return AK_ERR_BAD_DATA;
+        }
+    }
 
     const size_t s_head = akp_align16(sizeof(ak_crowd));
     const size_t s_agents = akp_align16(n * sizeof(ak_crowd_agent));
@@ -592,7 +603,7 @@ static size_t obstacle_lines(const ak_crowd* c, ak_vec2 pos, ak_vec2 vel, const 
 /* The reciprocal half-plane for a neighbour (paper section 4): u is the smallest change of
  * relative velocity that leaves the truncated velocity obstacle; each agent takes half. */
 static ak_crowd_line agent_line(ak_vec2 pos, ak_vec2 vel, float radius, ak_vec2 opos, ak_vec2 ovel, float oradius,
-                                float inv_th, float dt) {
+                                float inv_th, float dt, float tie) {
     const ak_vec2 rp = sub(opos, pos);
     const ak_vec2 rv = sub(vel, ovel);
     const float dsq = abs_sq(rp);
@@ -621,7 +632,8 @@ static ak_crowd_line agent_line(ak_vec2 pos, ak_vec2 vel, float radius, ak_vec2 
         const float inv_dt = 1.0f / dt;
         const ak_vec2 w = sub(rv, mul(inv_dt, rp));
         const float wl = len(w);
-        const ak_vec2 uw = divs(w, wl);
+        /* same point, same velocity: the lower index moves toward +x, the other toward -x */
+        const ak_vec2 uw = wl > 0.0f ? divs(w, wl) : v2(tie, 0.0f);
         line.direction = v2(uw.y, -uw.x);
         u = mul(cr * inv_dt - wl, uw);
     }
@@ -674,7 +686,7 @@ static size_t build_lines(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const
     for (uint32_t k = 0; k < na; ++k) {
         const uint32_t j = w->agent_n[k].index;
         w->lines[nl++] = agent_line(p, v, a->radius, job->positions.ptr[j], job->velocities.ptr[j],
-                                    c->crowd->agents[j].radius, inv_th, job->dt);
+                                    c->crowd->agents[j].radius, inv_th, job->dt, i < j ? 1.0f : -1.0f);
     }
     return nl;
 }
@@ -692,6 +704,7 @@ static void* work(void* arg) {
         ak_vec2 nv;
         const size_t fail = lp2(w->lines, nl, a->max_speed, pref, false, &nv);
         if (fail < nl) lp3(w->lines, nl, no, fail, a->max_speed, w->proj, &nv);
+        if (!ak_finitef(nv.x) || !ak_finitef(nv.y)) nv = v2(0.0f, 0.0f); /* never NaN out */
         job->out_velocities.ptr[i] = nv;
         job->out_positions.ptr[i] = add(p, mul(job->dt, nv));
     }

@@ -464,6 +464,31 @@ AK_TEST(validation) {
     ak_crowd_destroy(NULL);
 }
 
+/* Degenerate input gives finite output: two agents on one point with the same velocity, an
+ * agent on an obstacle's vertex; an obstacle edge of zero length is refused. */
+AK_TEST(degenerate_finite) {
+    ak_vec2 g[3] = {{5, 0}, {5, 0}, {-1, -1}};
+    ak_vec2 sq[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    ak_crowd_obstacle ob = {.vertices = {sq, 4}};
+    ak_crowd_agent ag[3] = {{.goals = {&g[0], 1}}, {.goals = {&g[1], 1}}, {.goals = {&g[2], 1}}};
+    ak_crowd_desc desc = {.agents = {ag, 3}, .obstacles = &ob, .obstacle_count = 1};
+    ak_vec2 start[3] = {{0, 3}, {0, 3}, {-1, -1}};
+    run r;
+    AK_CHECK(run_init(&r, &desc, start));
+    r.v[0] = r.v[1] = (ak_vec2){0.5f, 0.0f};
+    AK_CHECK_EQ(run_steps(&r, 0.1f, 1, 5, false), AK_OK);
+    for (int i = 0; i < 3; ++i)
+        AK_CHECK(ak_finitef(r.p[i].x) && ak_finitef(r.p[i].y) && ak_finitef(r.v[i].x) && ak_finitef(r.v[i].y));
+    AK_CHECK(fabsf(r.p[0].y - r.p[1].y) + fabsf(r.p[0].x - r.p[1].x) > 0.0f); /* they separated */
+    run_free(&r);
+    ak_vec2 dup[3] = {{0, 0}, {1, 0}, {1, 0}};
+    ak_crowd_obstacle bad = {.vertices = {dup, 3}};
+    desc.obstacles = &bad;
+    ak_crowd* c = NULL;
+    AK_CHECK_EQ(ak_crowd_create(&desc, NULL, &c), AK_ERR_BAD_DATA);
+    AK_CHECK(c == NULL);
+}
+
 /* Agents stacked on one point: the budget stops the step. */
 AK_TEST(budget) {
     enum { N = 5000 };
@@ -490,6 +515,7 @@ int main(void) {
     AK_RUN(step_velocity_is_lp_optimum);
     AK_RUN(threads_bit_identical);
     AK_RUN(validation);
+    AK_RUN(degenerate_finite);
     AK_RUN(budget);
     AK_RUN_SLOW(circle_250);
     return ak_test_finish();

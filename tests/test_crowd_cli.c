@@ -68,6 +68,8 @@ AK_TEST(bad_scenes_name_the_key) {
         {"{\"obstacles\": [{\"vertices\": [[0, 0]]}]}", "obstacles[0].vertices"},
         {"{\"obstacles\": [{\"vertices\": [[0, 0], [0, 1], [1, 1], [1, 0]]}]}", "counter-clockwise"},
         {"{\"obstacles\": [{\"points\": []}]}", "points"},
+        {"{\"obstacles\": [{\"vertices\": [[0, 0], [1, 0], [1, 0]]}]}", "obstacles[0].vertices[2]"},
+        {"{\"agents\": [{\"position\": [0, 0], \"goal\": [1, 0], \"pref_speed\": 0}]}", "agents[0].pref_speed"},
         {"{\"method\": \"rvo\"}", "method"},
         {"{\"contact_iterations\": 65}", "contact_iterations"},
         {"{\"dt\": 0}", "dt"},

@@ -114,7 +114,8 @@ AK_API ak_crowd_agent ak_crowd_agent_resolved(const ak_crowd_agent* agent);
  * vertices), AK_ERR_EMPTY (no agents, an agent without waypoints), AK_ERR_BAD_ARG (a
  * parameter negative or not finite, max_speed < pref_speed, max_neighbors > 64, an obstacle
  * with fewer than 2 vertices, an unknown method, counts above the AK_CROWD_MAX_* limits),
- * AK_ERR_BAD_DATA (a NaN or infinite waypoint or vertex, or beyond 1e7 m), AK_ERR_NO_MEMORY. */
+ * AK_ERR_BAD_DATA (a NaN or infinite waypoint or vertex, or beyond 1e7 m; an obstacle edge
+ * of zero length), AK_ERR_NO_MEMORY. */
 AK_API ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, ak_crowd** out_crowd);
 
 /* Free a crowd (NULL: no-op). */

@@ -190,7 +190,7 @@ static const char* const agent_param_keys[] = {"radius", "pref_speed", "max_spee
 /* The parameter keys of an agent or of agent_defaults over *a. */
 static void read_params(cli_json* j, const cJSON* o, const char* path, ak_crowd_agent* a) {
     cli_json_float(j, o, path, "radius", 0.01f, 100.0f, &a->radius);
-    cli_json_float(j, o, path, "pref_speed", 0.0f, 100.0f, &a->pref_speed);
+    cli_json_float(j, o, path, "pref_speed", 0.01f, 100.0f, &a->pref_speed);
     cli_json_float(j, o, path, "max_speed", 0.01f, 100.0f, &a->max_speed);
     cli_json_float(j, o, path, "neighbor_distance", 0.01f, 1000.0f, &a->neighbor_distance);
     long k = (long)a->max_neighbors;
@@ -265,6 +265,15 @@ static int parse(cli_json* j, const cJSON* root, cli_crowd_scene* s) {
             vec2_elem(j, v, cli_json_index(ep, sizeof ep, vp, q), &s->vertices[used + q]);
         }
         if (j->failed) return 1;
+        for (size_t q = 0; q < m; ++q) {
+            const ak_vec2 a = s->vertices[used + q], b = s->vertices[used + (q + 1) % m];
+            const float ex = b.x - a.x, ez = b.y - a.y;
+            if (!(ex * ex + ez * ez > 0.0f)) {
+                char ep[128];
+                return cli_json_fail(j, cli_json_index(ep, sizeof ep, vp, (q + 1) % m), NULL,
+                                     "equals the vertex before it (an edge of zero length)"), 1;
+            }
+        }
         if (m >= 3 && !(signed_area(s->vertices + used, m) > 0.0))
             return cli_json_fail(j, vp, NULL, "a polygon must be counter-clockwise in (x, z) with a positive area"), 1;
         s->obstacles[k].vertices = (ak_vec2_cspan){s->vertices + used, m};
