@@ -986,6 +986,12 @@ ak_result ak_crowd_clearance(const ak_crowd* crowd, ak_vec2_cspan positions, flo
     const ak_result r = ak_grid_build(&gd, (ak_vec3_cspan){pts, n},
                                       (ak_u8_span){(uint8_t*)(base + akp_align16(n * sizeof(ak_vec3))), gm}, &g);
     if (r != AK_OK) return r;
+    uint64_t load = 0; /* agents stacked on a few points: the pair pass is quadratic */
+    for (uint32_t m = 0; m < g.cell_count; ++m) {
+        const uint64_t k = g.cell_start[m + 1] - g.cell_start[m];
+        load += k * k;
+    }
+    if (load > AK_CROWD_DEFAULT_CELL_LOAD) return AK_ERR_BUDGET;
     /* Nearest pair within one cell of reach (radius sums <= the cell); pairs farther apart
      * only matter when no pair is that close, then a brute-force pass below decides. */
     double best = INFINITY;

@@ -180,6 +180,22 @@ AK_TEST(presets_and_threads) {
     }
 }
 
+/* Untrusted input: 5000 agents stacked on one point make every pass quadratic; the run stops
+ * with the budget error before that work, and no partial GIF is left. */
+AK_TEST(stacked_agents_budget) {
+    FILE* f = fopen("crowd_stacked.json", "w");
+    AK_CHECK(f != NULL);
+    if (!f) return;
+    fputs("{\"agents\": [", f);
+    for (int i = 0; i < 5000; ++i) fprintf(f, "%s{\"position\": [1, 2], \"goal\": [3, 4]}", i ? ", " : "");
+    fputs("]}", f);
+    fclose(f);
+    remove("crowd_stacked.gif");
+    AK_CHECK_EQ(run("crowd crowd_stacked.json --steps 2 -o crowd_stacked.gif", true), 1);
+    AK_CHECK(strstr(out_buf, "budget") != NULL);
+    AK_CHECK(read_file("crowd_stacked.gif") == NULL);
+}
+
 AK_TEST(render) {
     remove("crowd_out.png");
     AK_CHECK_EQ(run("crowd --preset evacuation --agents 9 --steps 20 -o crowd_out.png --size 64x48", true), 0);
@@ -193,6 +209,7 @@ int main(void) {
     AK_RUN(json_contract_head_on);
     AK_RUN(collisions_counted);
     AK_RUN(presets_and_threads);
+    AK_RUN(stacked_agents_budget);
     AK_RUN(render);
     return ak_test_finish();
 }

@@ -221,7 +221,9 @@ AK_API ak_vec2 ak_crowd_solve(ak_crowd_line_cspan lines, size_t obstacle_line_co
  * overlapping pairs as index pairs (i < j: i then j). scratch >=
  * ak_crowd_clearance_scratch_size(crowd, positions.count). Returns AK_ERR_NULL_ARG
  * (crowd, out_min_distance), AK_ERR_BAD_ARG (more positions than agents), AK_ERR_SPAN_SMALL,
- * AK_ERR_BAD_DATA (a non-finite position or beyond 1e7 m). */
+ * AK_ERR_BAD_DATA (a non-finite position or beyond 1e7 m), AK_ERR_BUDGET (agents so stacked
+ * that the grid's cell load, sum of (agents in a cell)^2 over cells of 2 x the largest
+ * radius, exceeds AK_CROWD_DEFAULT_CELL_LOAD). */
 AK_API size_t ak_crowd_clearance_scratch_size(const ak_crowd* crowd, size_t count);
 AK_API ak_result ak_crowd_clearance(const ak_crowd* crowd, ak_vec2_cspan positions, float overlap,
                                     ak_u8_span scratch, float* out_min_distance, ak_u32_span out_pairs,
