@@ -35,6 +35,8 @@ struct ak_crowd {
     obst_vertex* verts;
     uint32_t vertex_count;
     ak_crowd_method method;
+    uint32_t vision_width;
+    float vision_fov; /* radians */
     float max_neighbor_distance;
     float max_radius;
     uint32_t max_k;
@@ -116,7 +118,8 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
         vert_total += desc->obstacles[o].vertices.count;
         if (vert_total > AK_CROWD_MAX_OBSTACLE_VERTICES) return AK_ERR_BAD_ARG;
     }
-    if (n > AK_CROWD_MAX_AGENTS || (unsigned)desc->method >= AK_CROWD_METHOD_COUNT ||
+    if (n > AK_CROWD_MAX_AGENTS || (unsigned)desc->method >= AK_CROWD_METHOD_COUNT || desc->vision_width > 1024 ||
+        !(desc->vision_fov >= 0.0f && desc->vision_fov < 360.0f) ||
         desc->obstacle_count > AK_CROWD_MAX_OBSTACLE_VERTICES)
         return AK_ERR_BAD_ARG;
     if (n == 0) return AK_ERR_EMPTY;
@@ -157,6 +160,8 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
     c->verts = (obst_vertex*)(void*)(mem + s_head + s_agents + s_wp);
     c->vertex_count = (uint32_t)vert_total;
     c->method = desc->method;
+    c->vision_width = desc->vision_width ? desc->vision_width : 48;
+    c->vision_fov = (desc->vision_fov > 0.0f ? desc->vision_fov : 150.0f) * (3.14159265358979f / 180.0f);
     size_t w = 0;
     for (size_t i = 0; i < n; ++i) {
         ak_crowd_agent a = ak_crowd_agent_resolved(&desc->agents.ptr[i]);
@@ -691,6 +696,108 @@ static size_t build_lines(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const
     return nl;
 }
 
+/* Nearest ray hit t > 0 of o + t d (d unit) on a disc (centre q, radius r); INFINITY when
+ * none. A ray starting inside the disc hits at t = 0. */
+static float ray_disc(ak_vec2 o, ak_vec2 d, ak_vec2 q, float r) {
+    const ak_vec2 m = sub(o, q);
+    const float b = dot(m, d), cc = abs_sq(m) - r * r;
+    if (cc <= 0.0f) return 0.0f;
+    if (b > 0.0f) return INFINITY;
+    const float disc = b * b - cc;
+    if (disc < 0.0f) return INFINITY;
+    return -b - sqrtf(disc);
+}
+
+/* Nearest hit of o + t d on segment a-b; INFINITY when none. */
+static float ray_segment(ak_vec2 o, ak_vec2 d, ak_vec2 a, ak_vec2 b) {
+    const ak_vec2 e = sub(b, a);
+    const float den = det(d, e);
+    if (fabsf(den) < 1e-12f) return INFINITY;
+    const ak_vec2 ao = sub(a, o);
+    const float t = det(ao, e) / den, u = det(ao, d) / den;
+    return (t > 0.0f && u >= 0.0f && u <= 1.0f) ? t : INFINITY;
+}
+
+/* Synthetic-vision steering (Ondrej et al. 2010) for one agent: a 1D view of vision_width
+ * pixels; per pixel the visible object's hit point, its time to interaction and the rate of
+ * its bearing; threats turn and slow the agent. */
+static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const ak_crowd_agent* a, ak_vec2 pref) {
+    const ctx* c = w->c;
+    const ak_crowd* crowd = c->crowd;
+    const ak_crowd_step_job* job = c->job;
+    const uint32_t na = agent_neighbors(c, i, p, a, w->agent_n);
+    const uint32_t no = crowd->vertex_count ? obstacle_neighbors(crowd, p, a, w->obst_n) : 0;
+    const float speed = len(v);
+    const float pref_len = len(pref);
+    /* heading: the velocity, or the goal's direction when standing */
+    const ak_vec2 head = speed > 1e-3f ? mul(1.0f / speed, v) : (pref_len > 0.0f ? mul(1.0f / pref_len, pref) : v2(1.0f, 0.0f));
+    const float theta = atan2f(head.y, head.x);
+    const float fov = crowd->vision_fov;
+    const uint32_t W = crowd->vision_width;
+    float need_right = INFINITY, need_left = -INFINITY; /* turn-rate bounds from the threats */
+    bool right = false, left = false;
+    float ttc_min = INFINITY;
+    for (uint32_t k = 0; k < W; ++k) {
+        const float ang = theta + fov * (0.5f - ((float)k + 0.5f) / (float)W);
+        const ak_vec2 d = v2(cosf(ang), sinf(ang));
+        float best = INFINITY;
+        ak_vec2 ovel = v2(0.0f, 0.0f);
+        for (uint32_t q = 0; q < na; ++q) {
+            const uint32_t j = w->agent_n[q].index;
+            const float t = ray_disc(p, d, job->positions.ptr[j], crowd->agents[j].radius);
+            if (t < best) {
+                best = t;
+                ovel = job->velocities.ptr[j];
+            }
+        }
+        for (uint32_t q = 0; q < no; ++q) {
+            const obst_vertex* o1 = &crowd->verts[w->obst_n[q].index];
+            const float t = ray_segment(p, d, o1->point, crowd->verts[o1->next].point);
+            if (t < best) {
+                best = t;
+                ovel = v2(0.0f, 0.0f);
+            }
+        }
+        if (!(best < INFINITY)) continue;
+        /* the pixel's point relative to the agent, and its relative velocity */
+        const ak_vec2 rp = mul(best, d), rv = sub(ovel, v);
+        const float dist2 = abs_sq(rp);
+        const float closing = -dot(rp, rv); /* > 0 when approaching (times |rp|) */
+        if (!(closing > 0.0f)) continue;
+        const float dist = sqrtf(dist2);
+        const float ttc = fmaxf(dist - a->radius, 0.0f) * dist / closing;
+        const float rate = dist2 > 0.0f ? det(rp, rv) / dist2 : 0.0f; /* bearing rate, rad/s */
+        const float thr = 0.6f * powf(fmaxf(ttc, 1e-3f), -1.5f);
+        if (fabsf(rate) >= thr) continue; /* not a threat: it will pass */
+        if (ttc < ttc_min) ttc_min = ttc;
+        /* Turning the heading by delta changes this bearing rate by about -k delta, with
+         * k = (own speed) cos(angle to the point) / distance: keep the rate's sign and lift
+         * it over the threshold (points beside or behind do not respond to a turn). */
+        const float k = fmaxf(speed, 0.1f * pref_len) * dot(head, d) / dist;
+        if (!(k > 1e-4f)) continue;
+        if (rate >= 0.0f) {
+            right = true;
+            need_right = fminf(need_right, (rate - thr) / k); /* delta <= this (< 0: clockwise) */
+        } else {
+            left = true;
+            need_left = fmaxf(need_left, (rate + thr) / k); /* delta >= this (> 0) */
+        }
+    }
+    /* toward the goal, then the threats' bound on the side that asks for the smaller turn */
+    float delta = 0.0f;
+    if (pref_len > 0.0f) delta = atan2f(det(head, pref), dot(head, pref));
+    if (right && (!left || -need_right <= need_left)) delta = fminf(delta, need_right);
+    else if (left) delta = fmaxf(delta, need_left);
+    const float max_turn = 3.0f * job->dt; /* 3 rad/s */
+    const float turn = ak_clampf(delta, -max_turn, max_turn);
+    const ak_vec2 nh = v2(head.x * cosf(turn) - head.y * sinf(turn), head.x * sinf(turn) + head.y * cosf(turn));
+    float s = pref_len;
+    if (ttc_min < INFINITY) s *= 1.0f - expf(-0.5f * ttc_min * ttc_min);
+    /* a floor of 2 mm/s keeps the heading (the velocity's direction) of a stopped agent */
+    s = fmaxf(fminf(s, a->max_speed), fminf(2e-3f, pref_len));
+    return mul(s, nh);
+}
+
 static void* work(void* arg) {
     worker* w = (worker*)arg;
     const ctx* c = w->c;
@@ -699,6 +806,13 @@ static void* work(void* arg) {
         const ak_crowd_agent* a = &c->crowd->agents[i];
         const ak_vec2 p = job->positions.ptr[i], v = job->velocities.ptr[i];
         const ak_vec2 pref = pref_velocity(job, a, i, p);
+        if (c->crowd->method == AK_CROWD_VISION) {
+            ak_vec2 nv = vision_velocity(w, i, p, v, a, pref);
+            if (!ak_finitef(nv.x) || !ak_finitef(nv.y)) nv = v2(0.0f, 0.0f);
+            job->out_velocities.ptr[i] = nv;
+            job->out_positions.ptr[i] = add(p, mul(job->dt, nv));
+            continue;
+        }
         size_t no = 0;
         const size_t nl = build_lines(w, i, p, v, a, &no);
         ak_vec2 nv;

@@ -196,6 +196,29 @@ AK_TEST(circle_250) {
     circle(16, -0.2);
 }
 
+/* Vision-based steering: head-on and four crossing reach their goals without overlap. */
+AK_TEST(vision_head_on_and_crossing) {
+    const ak_vec2 s2[2] = {{-5, 0}, {5, 0}}, s4[4] = {{-6, 0}, {6, 0}, {0, -6}, {0, 6}};
+    for (int which = 0; which < 2; ++which) {
+        const size_t n = which == 0 ? 2 : 4;
+        const ak_vec2* start = which == 0 ? s2 : s4;
+        ak_vec2 goal[4];
+        ak_crowd_agent ag[4];
+        for (size_t i = 0; i < n; ++i) {
+            goal[i] = (ak_vec2){-start[i].x, -start[i].y};
+            ag[i] = (ak_crowd_agent){.goals = {&goal[i], 1}};
+        }
+        ak_crowd_desc desc = {.agents = {ag, n}, .method = AK_CROWD_VISION};
+        run r;
+        AK_CHECK(run_init(&r, &desc, start));
+        AK_CHECK_EQ(run_steps(&r, 0.1f, 1, 600, true), AK_OK);
+        AK_CHECK_MSG(all_reached(&r), "%zu agents: not all reached after %d steps", n, r.steps_done);
+        AK_CHECK_MSG(r.min_clearance >= -1e-3, "%zu agents: min clearance %g", n, r.min_clearance);
+        printf("  vision, %zu agents: %d steps, min clearance %.4f m\n", n, r.steps_done, r.min_clearance);
+        run_free(&r);
+    }
+}
+
 /* ---- obstacles ------------------------------------------------------------------------------ */
 
 static double seg_dist(ak_vec2 p, ak_vec2 a, ak_vec2 b) {
@@ -371,19 +394,22 @@ AK_TEST(threads_bit_identical) {
         goal[i] = (ak_vec2){lcg(&seed) * 60.0f, lcg(&seed) * 60.0f};
         ag[i] = (ak_crowd_agent){.goals = {&goal[i], 1}};
     }
-    ak_crowd_desc desc = {.agents = {ag, N}};
-    run a, b;
-    AK_CHECK(run_init(&a, &desc, start));
-    AK_CHECK(run_init(&b, &desc, start));
-    AK_CHECK_EQ(run_steps(&a, 0.1f, 1, 20, false), AK_OK);
-    AK_CHECK_EQ(run_steps(&b, 0.1f, 2, 20, false), AK_OK);
-    AK_CHECK(memcmp(a.p, b.p, N * sizeof(ak_vec2)) == 0);
-    AK_CHECK(memcmp(a.v, b.v, N * sizeof(ak_vec2)) == 0);
-    AK_CHECK(memcmp(a.wp, b.wp, N * sizeof(uint32_t)) == 0);
-    /* and something happened */
-    AK_CHECK(memcmp(a.p, start, N * sizeof(ak_vec2)) != 0);
-    run_free(&a);
-    run_free(&b);
+    for (int method = 0; method < 2; ++method) { /* ORCA, then vision */
+        ak_crowd_desc desc = {.agents = {ag, N}, .method = method ? AK_CROWD_VISION : AK_CROWD_ORCA};
+        run a, b;
+        AK_CHECK(run_init(&a, &desc, start));
+        AK_CHECK(run_init(&b, &desc, start));
+        a.contacts = b.contacts = 2;
+        AK_CHECK_EQ(run_steps(&a, 0.1f, 1, method ? 10 : 20, false), AK_OK);
+        AK_CHECK_EQ(run_steps(&b, 0.1f, 2, method ? 10 : 20, false), AK_OK);
+        AK_CHECK(memcmp(a.p, b.p, N * sizeof(ak_vec2)) == 0);
+        AK_CHECK(memcmp(a.v, b.v, N * sizeof(ak_vec2)) == 0);
+        AK_CHECK(memcmp(a.wp, b.wp, N * sizeof(uint32_t)) == 0);
+        /* and something happened */
+        AK_CHECK(memcmp(a.p, start, N * sizeof(ak_vec2)) != 0);
+        run_free(&a);
+        run_free(&b);
+    }
     free(start);
     free(goal);
     free(ag);
@@ -427,6 +453,13 @@ AK_TEST(validation) {
     d.obstacle_count = 0;
     d.method = AK_CROWD_METHOD_COUNT;
     AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d.method = AK_CROWD_VISION;
+    d.vision_fov = 360.0f;
+    AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d.vision_fov = 0.0f;
+    d.vision_width = 1025;
+    AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d.vision_width = 0;
     d.method = AK_CROWD_ORCA;
     AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_OK);
     const ak_crowd_agent r = ak_crowd_agent_get(c, 0);
@@ -511,6 +544,7 @@ int main(void) {
     AK_RUN(four_crossing);
     AK_RUN(groups_crossing);
     AK_RUN(obstacle_square);
+    AK_RUN(vision_head_on_and_crossing);
     AK_RUN(lp_vs_brute_force);
     AK_RUN(step_velocity_is_lp_optimum);
     AK_RUN(threads_bit_identical);

@@ -24,8 +24,19 @@
  *   - thread_count threads each take a range of agents; every agent reads only the step's
  *     inputs, so results are bit-identical for any thread count.
  *
- * What it does NOT do: vision-based steering (not yet), dynamic obstacles, path planning
- * (waypoints come from the caller), 3D terrain (the ground is the plane y = 0).
+ *   - AK_CROWD_VISION instead: synthetic-vision steering (Ondrej, Pettre, Olivier, Donikian,
+ *     "A synthetic-vision based steering approach for crowd simulation", SIGGRAPH 2010): each
+ *     agent casts vision_width rays over vision_fov around its heading against its neighbours'
+ *     discs and the obstacle edges (a direct per-pixel ray cast, not the rasterizer: it gives
+ *     each pixel its object and hit point); per pixel, the time to interaction and the bearing
+ *     angle's rate; pixels whose |rate| is below the paper's threshold 0.6 ttc^-1.5 are
+ *     threats; the agent turns toward its goal unless that leaves a threat under the
+ *     threshold, then by the smallest heading change that lifts the rates over it (keeping
+ *     their signs; at most 3 rad/s), and slows to pref_speed (1 - exp(-0.5 ttc_min^2)).
+ *     No guarantee against overlap (the contact passes apply as for ORCA).
+ *
+ * What it does NOT do: dynamic obstacles, path planning (waypoints come from the caller), 3D
+ * terrain (the ground is the plane y = 0).
  *
  * Usage:
  *     ak_vec2 goal[2] = {{10, 0}, {-10, 0}};
@@ -91,6 +102,7 @@ typedef struct ak_crowd_obstacle {
 /* Avoidance method. */
 typedef enum ak_crowd_method {
     AK_CROWD_ORCA = 0, /* default: velocity-based (ORCA) */
+    AK_CROWD_VISION,   /* synthetic vision (Ondrej et al. 2010), see ak_crowd_desc */
     AK_CROWD_METHOD_COUNT
 } ak_crowd_method;
 
@@ -102,6 +114,9 @@ typedef struct ak_crowd_desc {
     const ak_crowd_obstacle* obstacles;  /* optional: [obstacle_count] */
     uint32_t obstacle_count;
     ak_crowd_method method;              /* 0 -> ORCA */
+    uint32_t vision_width;               /* VISION: pixels of each agent's 1D view; 0 -> 48;
+                                            <= 1024 */
+    float vision_fov;                    /* VISION: field of view, degrees; 0 -> 150; < 360 */
 } ak_crowd_desc;
 
 typedef struct ak_crowd ak_crowd;
@@ -113,7 +128,8 @@ AK_API ak_crowd_agent ak_crowd_agent_resolved(const ak_crowd_agent* agent);
  * agents.ptr, an agent's goals.ptr, obstacles with obstacle_count > 0, an obstacle's
  * vertices), AK_ERR_EMPTY (no agents, an agent without waypoints), AK_ERR_BAD_ARG (a
  * parameter negative or not finite, max_speed < pref_speed, max_neighbors > 64, an obstacle
- * with fewer than 2 vertices, an unknown method, counts above the AK_CROWD_MAX_* limits),
+ * with fewer than 2 vertices, an unknown method, vision_width > 1024, vision_fov not in
+ * [0, 360) or not finite, counts above the AK_CROWD_MAX_* limits),
  * AK_ERR_BAD_DATA (a NaN or infinite waypoint or vertex, or beyond 1e7 m; an obstacle edge
  * of zero length), AK_ERR_NO_MEMORY. */
 AK_API ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, ak_crowd** out_crowd);

@@ -19,7 +19,7 @@ static const char* const usage =
     "             across each other), corridor (two groups meet in a corridor), evacuation (a room\n"
     "             empties through one door)\n"
     "  --agents   agents of the preset (default 100; up to 1000000)\n"
-    "  --method   orca (default); vision (synthetic-vision steering) is not implemented yet\n"
+    "  --method   orca (default) or vision (synthetic-vision steering, Ondrej et al. 2010)\n"
     "  --steps    steps to run (default: the preset's, long enough for every agent to arrive)\n"
     "  --dt       seconds per step (default 0.1)\n"
     "  --threads  threads per step (default 1; results are identical for any count)\n"
@@ -127,7 +127,8 @@ static ak_result run_init(crowd_run* r, const cli_crowd_scene* sc, uint32_t thre
     memset(r, 0, sizeof *r);
     r->min_distance = INFINITY;
     ak_crowd_desc d = {.agents = {sc->agents, sc->agent_count}, .obstacles = sc->obstacles,
-                       .obstacle_count = (uint32_t)sc->obstacle_count};
+                       .obstacle_count = (uint32_t)sc->obstacle_count,
+                       .method = sc->method == 1 ? AK_CROWD_VISION : AK_CROWD_ORCA};
     ak_result res = ak_crowd_create(&d, NULL, &r->crowd);
     if (res != AK_OK) return res;
     const size_t n = r->n = sc->agent_count;
@@ -397,10 +398,6 @@ int cmd_crowd(int argc, char** argv) {
     if (steps >= 0) sc.steps = steps;
     if (method) sc.method = strcmp(method, "vision") == 0 ? 1 : 0;
     /* Refused before any work, so that no file is left half-written. */
-    if (sc.method == 1) {
-        cli_crowd_scene_free(&sc);
-        return cli_fail("crowd", "--method vision: synthetic-vision steering is not implemented yet (use orca)");
-    }
     if (out && cli_has_ext(out, ".glb")) {
         cli_crowd_scene_free(&sc);
         return cli_fail("crowd", "%s: glTF export of a crowd is not implemented yet (use .png or .gif)", out);
