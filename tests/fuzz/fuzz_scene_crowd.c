@@ -2,9 +2,9 @@
  * scripts/fuzz.sh with the CLI objects linked in.
  *
  * Each input is parsed from memory. A parse error must come with a message naming the file.
- * A parsed scene with at most 256 agents and 256 obstacle vertices is built into a crowd and
- * stepped three times on 1 and on 2 threads (with contact passes): both must give the same
- * finite positions and velocities. */
+ * A parsed scene with at most 256 agents and 256 obstacle vertices is built into a crowd (ORCA
+ * or vision, as the scene says) and stepped three times on 1 and on 2 threads (with contact
+ * passes): both must give the same finite positions and velocities. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -55,7 +55,8 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (cli_crowd_scene_parse("fuzz.json", (const char*)data, size, &sc, msg, sizeof msg) == 0) {
         if (sc.agent_count > 0 && sc.agent_count <= 256 && sc.vertex_count <= 256) {
             ak_crowd_desc d = {.agents = {sc.agents, sc.agent_count}, .obstacles = sc.obstacles,
-                               .obstacle_count = (uint32_t)sc.obstacle_count};
+                               .obstacle_count = (uint32_t)sc.obstacle_count,
+                               .method = sc.method == 1 ? AK_CROWD_VISION : AK_CROWD_ORCA};
             ak_crowd* c = NULL;
             if (ak_crowd_create(&d, NULL, &c) == AK_OK) {
                 const size_t n = sc.agent_count;
