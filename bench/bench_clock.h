@@ -27,4 +27,11 @@ static inline double bench_percentile(double* v, size_t n, double p) {
     return v[(size_t)(p * (double)(n - 1) + 0.5)];
 }
 
+/* AK_BENCH_QUICK set (and not "0"): `make bench-quick`, which checks the benchmark pipeline; a
+ * bench whose sizes are fixed may then run fewer rounds or leave out a slow part (and says so). */
+static inline int bench_quick(void) {
+    const char* q = getenv("AK_BENCH_QUICK");
+    return q && *q && !(q[0] == '0' && q[1] == '\0');
+}
+
 #endif

@@ -164,6 +164,10 @@ int main(int argc, char** argv) {
         if (npaths < 3) printf("  (SKIP: %s)\n", npaths == 1 ? "no AVX2 or AVX-512 on this CPU/build" : "no AVX-512 on this CPU");
     }
     /* mass-spring at the step it needs for the same stiffness */
+    if (bench_quick()) {
+        printf("mass-spring: skipped (AK_BENCH_QUICK)\n");
+        return 0;
+    }
     uint32_t sub = 10;
     while (sub <= 5120 && !springs_stable(64, sub)) sub *= 2;
     if (sub > 5120) {

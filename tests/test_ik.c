@@ -689,6 +689,95 @@ AK_TEST(two_bone_closed_form_and_pole) {
     }
 }
 
+/* Bend side with a hinge axis (ak_ik_two_bone_job.mid_axis_signed), against a construction in
+ * double: the limb start s0 (turned by some rotation), bones a = 1 and b = 0.8 along each
+ * joint's +x, the mid joint turned by beta about its local z (the hinge, mid_axis = +-z), so
+ * the input is bent with (mid - start) x (end - mid) along sign(beta) times the hinge. Law of
+ * cosines: the knee sits at K = s0 + a cos(alpha) k + a sin(alpha) w (k towards the target, w
+ * the pole's part normal to k), the end at the target; the hinge of the solved limb is normal
+ * to that triangle, c = (K - s0) x (T - K) normalised, so the joints' frames are fixed up to the
+ * hinge's sign: start (x = (K - s0) / a, z = +-c), mid = end (x = (T - K) / b, z = +-c).
+ * Unsigned (default): the limb keeps its side, z = sign(beta) c. Signed (ozz's convention, a
+ * positive turn about mid_axis opens the joint): (K - s0) x (T - K) along -mid_axis, so
+ * z = -sign(mid_axis.z) c whatever the input (straight included). A wrong side leaves the positions right and turns
+ * every frame half a turn about its bone (what ozz's harness saw), so the axes are checked. */
+AK_TEST(two_bone_bend_side_mid_axis) {
+    const double a = 1.0, b = 0.8, d = 1.3;
+    const double s0[3] = {0.2, -0.1, 0.3};
+    double kd[3] = {0.3, 0.9, -0.4}, pl[3] = {0.2, -0.3, 1.0};
+    const double kn = sqrt(kd[0] * kd[0] + kd[1] * kd[1] + kd[2] * kd[2]);
+    for (int i = 0; i < 3; ++i) kd[i] /= kn;
+    const double pk = pl[0] * kd[0] + pl[1] * kd[1] + pl[2] * kd[2];
+    double w[3] = {pl[0] - pk * kd[0], pl[1] - pk * kd[1], pl[2] - pk * kd[2]};
+    const double wn = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    for (int i = 0; i < 3; ++i) w[i] /= wn;
+    const double alpha = acos((a * a + d * d - b * b) / (2 * a * d));
+    double T[3], K[3], u[3], v[3];
+    for (int i = 0; i < 3; ++i) {
+        T[i] = s0[i] + d * kd[i];
+        K[i] = s0[i] + a * cos(alpha) * kd[i] + a * sin(alpha) * w[i];
+        u[i] = (K[i] - s0[i]) / a, v[i] = (T[i] - K[i]) / b;
+    }
+    double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double cn = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    for (int i = 0; i < 3; ++i) c[i] /= cn;
+
+    const ak_quat start_q = ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(0.3f, 0.5f, 0.8f)), 0.7f);
+    for (int bent = -1; bent <= 1; ++bent) { /* bent 0: a straight input limb */
+        const ak_quat bend_q = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.4f * (float)bent);
+        const ak_quat mid_q = ak_quat_mul(start_q, bend_q);
+        const ak_vec3 sp = ak_vec3_make((float)s0[0], (float)s0[1], (float)s0[2]);
+        const ak_vec3 mp = ak_vec3_add(sp, ak_quat_rotate(start_q, ak_vec3_make((float)a, 0, 0)));
+        const ak_vec3 ep = ak_vec3_add(mp, ak_quat_rotate(mid_q, ak_vec3_make((float)b, 0, 0)));
+        for (int axis_sign = -1; axis_sign <= 1; axis_sign += 2) {
+            for (int sgn = bent == 0; sgn < 2; ++sgn) { /* straight: no input side to keep */
+                ak_quat qs, qm;
+                bool reached = false;
+                ak_ik_two_bone_job job = {
+                    .start = ak_transform_to_mat4((ak_transform){sp, start_q, ak_vec3_make(1, 1, 1)}),
+                    .mid = ak_transform_to_mat4((ak_transform){mp, mid_q, ak_vec3_make(1, 1, 1)}),
+                    .end = ak_transform_to_mat4((ak_transform){ep, mid_q, ak_vec3_make(1, 1, 1)}),
+                    .target = ak_vec3_make((float)T[0], (float)T[1], (float)T[2]),
+                    .pole = ak_vec3_make((float)pl[0], (float)pl[1], (float)pl[2]),
+                    .mid_axis = ak_vec3_make(0, 0, (float)axis_sign),
+                    .mid_axis_signed = sgn != 0,
+                    .out_start_rot = &qs,
+                    .out_mid_rot = &qm,
+                    .out_reached = &reached,
+                };
+                AK_CHECK_EQ(ak_ik_two_bone_run(&job), AK_OK);
+                AK_CHECK(reached);
+                /* the batch takes jobs with a mid_axis one by one: the same answer */
+                ak_quat bs, bm;
+                ak_ik_two_bone_job jb = job;
+                jb.out_start_rot = &bs, jb.out_mid_rot = &bm, jb.out_reached = NULL;
+                AK_CHECK_EQ(ak_ik_two_bone_run_many(&jb, 1, NULL), AK_OK);
+                AK_CHECK(memcmp(&bs, &qs, sizeof qs) == 0 && memcmp(&bm, &qm, sizeof qm) == 0);
+                /* the corrected joints' model rotations (local post-multiplied corrections) */
+                const ak_quat start_n = ak_quat_mul(start_q, qs);
+                const ak_quat mid_n = ak_quat_mul(ak_quat_mul(start_n, bend_q), qm);
+                const double zs = sgn ? -axis_sign : bent; /* expected hinge z along zs * c */
+                const ak_vec3 sx = ak_quat_rotate(start_n, ak_vec3_make(1, 0, 0)),
+                              sz = ak_quat_rotate(start_n, ak_vec3_make(0, 0, 1));
+                const ak_vec3 mx = ak_quat_rotate(mid_n, ak_vec3_make(1, 0, 0)),
+                              mz = ak_quat_rotate(mid_n, ak_vec3_make(0, 0, 1));
+                const double got[4][3] = {{sx.x, sx.y, sx.z}, {sz.x, sz.y, sz.z}, {mx.x, mx.y, mx.z}, {mz.x, mz.y, mz.z}};
+                const double want[4][3] = {{u[0], u[1], u[2]},
+                                           {zs * c[0], zs * c[1], zs * c[2]},
+                                           {v[0], v[1], v[2]},
+                                           {zs * c[0], zs * c[1], zs * c[2]}};
+                for (int k = 0; k < 4; ++k)
+                    for (int i = 0; i < 3; ++i) AK_CHECK_NEAR(got[k][i], want[k][i], 2e-5);
+                /* the end joint lands on the target */
+                const ak_vec3 kp = ak_vec3_add(sp, ak_vec3_scale(sx, (float)a));
+                const ak_vec3 tp = ak_vec3_add(kp, ak_vec3_scale(mx, (float)b));
+                AK_CHECK_NEAR(ak_vec3_distance(kp, ak_vec3_make((float)K[0], (float)K[1], (float)K[2])), 0.0, 2e-5);
+                AK_CHECK_NEAR(ak_vec3_distance(tp, job.target), 0.0, 2e-5);
+            }
+        }
+    }
+}
+
 AK_TEST(two_bone_chain_matches_job_and_limits) {
     /* The chain solver on a leg: hip (ball), knee (hinge about z, bends 0..2.6), ankle. */
     chain_spec s = uniform_chain(3, AK_JOINT_BALL);
@@ -778,6 +867,7 @@ AK_TEST(two_bone_run_many_equals_single_jobs) {
         case 5: j.pole = ak_vec3_zero(); break;
         case 6: j.end.m[5] = NAN; if (first_bad < 0) first_bad = i; break;  /* invalid: BAD_DATA */
         case 7: j.soft = 1.5f; if (first_bad < 0) first_bad = i; break;     /* invalid: BAD_ARG */
+        case 8: j.mid_axis = ak_vec3_make(0.3f, -0.5f, 0.8f), j.mid_axis_signed = true; break;
         default: break;
         }
         jobs[i] = j;
@@ -1741,6 +1831,7 @@ int main(void) {
     AK_RUN(limits_never_violated);
     AK_RUN(animated_translation_kept);
     AK_RUN(two_bone_closed_form_and_pole);
+    AK_RUN(two_bone_bend_side_mid_axis);
     AK_RUN(two_bone_chain_matches_job_and_limits);
     AK_RUN(two_bone_soft_weight_unreachable);
     AK_RUN(two_bone_run_many_equals_single_jobs);

@@ -125,7 +125,12 @@ void akh_ik_setup(const float* start, const float* mid, const float* end, const 
     memcpy(g_ik.mid.m, mid, 64);
     memcpy(g_ik.end.m, end, 64);
     g_ik.pole = ak_vec3_make(pole[0], pole[1], pole[2]);
-    if (mid_axis) g_ik.mid_axis = ak_vec3_make(mid_axis[0], mid_axis[1], mid_axis[2]);
+    /* ozz's mid_axis is signed (a positive turn about it opens the joint, which sets the bend
+     * side); animkit keeps the input's bend side unless mid_axis_signed asks for ozz's rule.
+     * The driver's limb is bent +0.6 rad about z, against ozz's side for mid_axis z, so
+     * without it the two solve different problems (same positions, joints turned half a
+     * turn about their bones). */
+    if (mid_axis) g_ik.mid_axis = ak_vec3_make(mid_axis[0], mid_axis[1], mid_axis[2]), g_ik.mid_axis_signed = true;
     g_ik.out_start_rot = &g_qs;
     g_ik.out_mid_rot = &g_qm;
 }

@@ -33,5 +33,7 @@
 #include "retarget.h"
 #include "fluid.h"
 #include "crowd.h"
+#include "rigid.h"
+#include "batch.h"
 
 #endif

@@ -229,7 +229,19 @@ AK_API ak_result ak_ik_chain_run(const ak_ik_chain_job* job);
 /* The fast analytic solver on three model-space joint matrices (as ak_skeleton_local_to_model
  * gives), after ozz's IKTwoBoneJob: outputs rotation corrections to multiply onto the start
  * and mid joints' local rotations: local.rotation = ak_quat_mul(local.rotation, *out_x_rot).
- * Matrices must be rigid with uniform positive scale. Does not know about joint limits. */
+ * Matrices must be rigid with uniform positive scale. Does not know about joint limits.
+ * Bend side: by default the limb keeps the side it is bent to in the input (the sign of
+ * mid_axis does not matter; the mid correction is the smaller of the two that reach; a
+ * straight input bends with (mid - start) x (end - mid) along +mid_axis), so an input that
+ * passes through straight or hyperextends (animation noise) flips the bend. ozz's
+ * IKTwoBoneJob instead reads the sign of mid_axis: a positive rotation about it opens the
+ * joint, so the limb always ends bent with (mid - start) x (end - mid) along -mid_axis, and a
+ * limb bent the other way in the input (e.g. a hyperextended knee) flips through straight.
+ * mid_axis_signed = true selects ozz's convention (use it for a knee or an elbow, which bends
+ * one way only). The two give the same joint positions
+ * (the pole puts the mid joint on its side either way) but, for a limb bent against
+ * mid_axis, start, mid and end orientations that differ by half a turn about each bone: a
+ * hand or foot below the end joint turns over. */
 typedef struct ak_ik_two_bone_job {
     ak_mat4 start, mid, end; /* model space joint matrices (e.g. hip, knee, ankle) */
     ak_vec3 target;          /* model space */
@@ -237,6 +249,10 @@ typedef struct ak_ik_two_bone_job {
                                 the current bend plane */
     ak_vec3 mid_axis;        /* mid joint's local bend axis (a knee hinge); zero -> the normal
                                 of the current bend plane (any perpendicular when straight) */
+    bool mid_axis_signed;    /* with a nonzero mid_axis: true -> its sign sets the bend side
+                                (ozz's convention: a positive rotation about mid_axis opens the
+                                joint); false -> keep the input's bend side. No effect without
+                                mid_axis */
     float twist;             /* radians: extra rotation of the bend plane about the
                                 start-to-target axis; 0 -> none */
     float soft;              /* softening band in [0, 1) of the reach; 0 -> hard limit */

@@ -237,7 +237,8 @@ size_t akp_ik_dls_scratch_size(size_t chain_count);
 void akp_ik_two_bone_chain(akp_ik_chain* c, const ak_ik_chain_job* job);
 
 /* The analytic two-bone core shared by the job and the chain solver. branch 0 picks the bend
- * closest to the current one, 1 the other. Returns whether the target was within reach. */
+ * closest to the current one, 1 the other (both ignored when job->mid_axis_signed applies: the
+ * side mid_axis sets). Returns whether the target was within reach. */
 bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* out_start, ak_quat* out_mid);
 
 #endif

@@ -262,7 +262,11 @@ bool akp_ik_two_bone_solve(const ak_ik_two_bone_job* job, int branch, ak_quat* o
         const float inv = 1.0f / r2;
         const float c1 = (A * K - B * S) * inv, s1 = (B * K + A * S) * inv; /* phi = alpha + beta */
         const float c2 = (A * K + B * S) * inv, s2 = (B * K - A * S) * inv; /* phi = alpha - beta */
-        if ((c1 >= c2) != (branch != 0)) cphi = c1, sphi = s1;
+        /* The bend side after the turn, n.(u x R(phi) v) = A sin - B cos, is +S for the first
+         * solution and -S for the second. Signed axis (ozz's convention, a positive turn
+         * about n opens the joint): the limb ends bent with u x v along -n, the second. */
+        if (axis_given && job->mid_axis_signed) cphi = c2, sphi = s2;
+        else if ((c1 >= c2) != (branch != 0)) cphi = c1, sphi = s1;
         else cphi = c2, sphi = s2;
     }
     ak_quat q_mid = akp_quat_half_angle(n_local, cphi, sphi);

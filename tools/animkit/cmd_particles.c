@@ -4,11 +4,9 @@
 #include <string.h>
 
 #include "cli.h"
-#include "cli_json.h"
 #include "render.h"
 #include "particles_run.h"
 #include "outfile.h"
-#include "scene_particles.h"
 #include "sim_bake.h"
 
 static const char* const usage =
@@ -164,34 +162,12 @@ int cmd_particles(int argc, char** argv) {
         return cli_usage("particles", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
     const char* json = CLI_GET(&a, "--json");
 
-    particles_scene scene;
+    ak_particles_scene scene;
+    ak_diag diag;
     if (preset) {
-        if (!particles_preset(preset, &scene)) {
-            particles_scene_free(&scene);
-            return cli_fail("particles", "out of memory");
-        }
-    } else {
-        cli_json j = {.file = a.pos[0]};
-        cJSON* root = cli_json_load(&j, a.pos[0], 0);
-        cJSON_Delete(root);
-        if (!root) return cli_fail("particles", "%s", j.message);
-        /* Read again as text for the parser (which wants memory, for the fuzzer). */
-        FILE* f = fopen(a.pos[0], "rb");
-        if (!f) return cli_fail("particles", "%s: cannot open the file", a.pos[0]);
-        fseek(f, 0, SEEK_END);
-        long size = ftell(f);
-        fseek(f, 0, SEEK_SET);
-        char* text = size >= 0 ? malloc((size_t)size + 1) : NULL;
-        size_t got = text ? fread(text, 1, (size_t)size, f) : 0;
-        fclose(f);
-        if (!text || got != (size_t)size) {
-            free(text);
-            return cli_fail("particles", "%s: cannot read the file", a.pos[0]);
-        }
-        char err[600];
-        bool ok = particles_scene_parse(a.pos[0], text, got, &scene, err, sizeof err);
-        free(text);
-        if (!ok) return cli_fail("particles", "%s", err);
+        if (ak_particles_scene_preset(preset, &scene, &diag) != AK_OK) return cli_fail("particles", "%s", diag.message);
+    } else if (ak_particles_scene_load_file(a.pos[0], &scene, &diag) != AK_OK) {
+        return cli_fail("particles", "%s", diag.message);
     }
     if (dt > 0.0f) scene.dt = dt;
     if (integ != AK_INTEGRATOR_DEFAULT) scene.integrator = integ;
@@ -336,6 +312,6 @@ done:
     free(rd.colours);
     particles_shapes_free(&rd.sh);
     if (use_char) particles_character_free(&ch);
-    particles_scene_free(&scene);
+    ak_particles_scene_free(&scene);
     return rc;
 }

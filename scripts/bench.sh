@@ -1,0 +1,170 @@
+#!/usr/bin/env bash
+# Runs every benchmark built under BUILD/bench and the side-by-side harnesses of ../shared/peers,
+# saves each program's full output under BUILD/bench-results/NAME.txt and writes the summary
+# table BUILD/bench-results/SUMMARY.md (scripts/bench_summary.py). From the project root, after
+# a Release build:
+#   scripts/bench.sh [BUILD_DIR=build]                  (`make bench`)
+#   AK_BENCH_QUICK=1 scripts/bench.sh [BUILD_DIR]       (`make bench-quick`)
+# Quick mode runs each program with the smallest sizes and fewest rounds it accepts, and exports
+# AK_BENCH_QUICK=1 to it (bench_clock.h's bench_quick(): fewer rounds or a slow fixed-size part
+# left out): it checks the pipeline in about two minutes; its numbers are not measurements. It runs a peer harness only
+# when the peer library is already built (the full run builds ozz once, ~1 min, and FastNoise2
+# once, 5-9 min, under BUILD). AK_BENCH_PEERS=0 leaves the peers out; AK_BENCH_ONLY='bench_ik
+# vs_ozz' runs only the named programs; AK_BENCH_NSEARCH_SIDES (default "38 80": 55k and 512k
+# points) sets the neighbour-search sizes.
+set -uo pipefail
+B=${1:-build}
+QUICK=${AK_BENCH_QUICK:-0}
+[[ $QUICK == 0 ]] && QUICK=
+[[ -n $QUICK ]] && export AK_BENCH_QUICK=1
+PEERS_ON=${AK_BENCH_PEERS:-1}
+ONLY=${AK_BENCH_ONLY:-}
+ROOT=$PWD
+PEERS=$ROOT/../shared/peers
+[[ -d $PEERS ]] && PEERS=$(cd "$PEERS" && pwd)
+[[ -d $B/bench ]] || { echo "bench.sh: no $B/bench: build the project first (make build, Release)" >&2; exit 2; }
+B=$(cd "$B" && pwd)
+OUT=$B/bench-results
+rm -rf "$OUT"
+mkdir -p "$OUT"
+LOG=$OUT/run.log
+: >"$LOG"
+
+wanted() { [[ -z $ONLY || " $ONLY " == *" $1 "* ]]; }
+
+# Quick arguments: the smallest sizes / fewest rounds each bench accepts (its usage line).
+# A bench not listed runs with its defaults in both modes.
+quick_args() {
+    case $1 in
+        bench_blendshape) echo "3000 5 10" ;;  # vertices, targets, moved %
+        bench_boids) echo "--quick" ;;         # 5 steps instead of 21, no 1M-agent run
+        bench_cloth) echo "5" ;;               # frames
+        bench_fluid) echo "2000 2 1 all" ;;    # particles, timed steps, rounds, solvers
+        bench_ik) echo "200" ;;                # targets per chain
+        bench_particles) echo "10000" ;;       # particles of the step (the grid part is fixed)
+        bench_retarget) echo "1" ;;            # repetitions
+        bench_skin) echo "20000" ;;            # vertices (the triad and in-cache parts are fixed)
+        *) echo "" ;;
+    esac
+}
+
+# run NAME COMMAND...: runs the command, output (stdout and stderr) to OUT/NAME.txt, one line in run.log.
+run() {
+    local name=$1
+    shift
+    local t0 t1 rc
+    echo "== $name: $*"
+    t0=$(date +%s.%N)
+    "$@" >"$OUT/$name.txt" 2>&1
+    rc=$?
+    t1=$(date +%s.%N)
+    local secs
+    secs=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.1f", b - a }')
+    printf '%s\t%s\t%s\t%s\n' "$name" "$rc" "$secs" "$*" >>"$LOG"
+    if [[ $rc -ne 0 ]]; then
+        echo "   FAILED (exit $rc, ${secs} s): last lines of $OUT/$name.txt:"
+        tail -5 "$OUT/$name.txt" | sed 's/^/   | /'
+    else
+        echo "   ok (${secs} s) -> $OUT/$name.txt"
+    fi
+}
+
+# skip NAME WHY: one clear line on the terminal and in run.log.
+skip() {
+    echo "== $1: SKIP: $2"
+    printf '%s\tskip\t-\t%s\n' "$1" "$2" >>"$LOG"
+}
+
+{
+    echo "date: $(date -u '+%Y-%m-%d %H:%M UTC')"
+    if [[ -n $QUICK ]]; then echo "mode: quick (smallest sizes: checks the pipeline, not a measurement)"; else echo "mode: full"; fi
+    echo "commit: $(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)$(git -C "$ROOT" diff --quiet HEAD 2>/dev/null || echo ' (with local changes)')"
+    echo "cpu: $(grep -m1 'model name' /proc/cpuinfo 2>/dev/null | sed 's/.*: //')"
+    echo "cores: $(nproc 2>/dev/null)"
+    echo "simd: $(grep -m1 '^flags' /proc/cpuinfo 2>/dev/null | tr ' ' '\n' | grep -E '^(sse4_2|avx|avx2|fma|avx512f|avx512bw|avx512dq|avx512vl)$' | tr '\n' ' ')"
+    echo "compiler: $(grep -m1 'CMAKE_C_COMPILER:' "$B/CMakeCache.txt" 2>/dev/null | sed 's/.*=//') $(grep -m1 'CMAKE_BUILD_TYPE:' "$B/CMakeCache.txt" 2>/dev/null | sed 's/.*=//')"
+    echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)"
+} >"$OUT/machine.txt"
+cat "$OUT/machine.txt"
+
+# 1. The benchmarks of bench/ (whatever bench_* the build has).
+found=0
+for exe in "$B"/bench/bench_*; do
+    [[ -x $exe && -f $exe ]] || continue
+    found=1
+    name=$(basename "$exe")
+    wanted "$name" || continue
+    args=
+    [[ -n $QUICK ]] && args=$(quick_args "$name")
+    # shellcheck disable=SC2086
+    run "$name" "$exe" $args
+done
+[[ $found == 1 ]] || echo "bench.sh: no benchmark programs in $B/bench (configure with -DAK_BUILD_BENCH=ON)"
+
+# 2. The side-by-side harnesses (../shared/peers/*/run.sh, arguments from each run.sh's usage line).
+peer_lib_missing() { # prints why the harness cannot run, or nothing
+    [[ -f $B/libanimkit.a ]] || { echo "no $B/libanimkit.a (build the animkit_static target)"; return; }
+    [[ -d $PEERS ]] || { echo "no $PEERS"; return; }
+}
+if [[ $PEERS_ON == 0 ]]; then
+    skip peers "AK_BENCH_PEERS=0"
+elif [[ -n $(peer_lib_missing) ]]; then
+    skip peers "$(peer_lib_missing)"
+else
+    # vs_ozz: skinning, sample+FK, two-bone IK against ozz-animation.
+    if wanted vs_ozz || wanted vs_ozz_avx2; then
+        if [[ ! -x $PEERS/vs_ozz/run.sh || ! -d $PEERS/ozz-animation ]]; then
+            skip vs_ozz "peer absent ($PEERS/vs_ozz/run.sh or $PEERS/ozz-animation)"
+        elif [[ -n $QUICK && ! -f $B/peers/ozz/src/geometry/runtime/libozz_geometry_r.a ]]; then
+            skip vs_ozz "quick mode: ozz not built yet under $B/peers/ozz (make bench builds it, ~1 min)"
+        else
+            if [[ -n $QUICK ]]; then set -- 10000 3 sai; else set -- 1000000 11 sai; fi
+            wanted vs_ozz && run vs_ozz "$PEERS/vs_ozz/run.sh" "$B" "$@"
+            # The skinning rows again with animkit capped to its AVX2 kernel (bench/vs_ozz), on a CPU
+            # that also has AVX-512: the targets hold on every CPU path.
+            if wanted vs_ozz_avx2 && [[ -x $ROOT/bench/vs_ozz/run.sh ]] && grep -q avx512f /proc/cpuinfo; then
+                run vs_ozz_avx2 env AK_VS_OZZ_SIMD=avx2 "$ROOT/bench/vs_ozz/run.sh" "$B" "$1" "$2" s
+            fi
+        fi
+    fi
+    # vs_noise: FastNoiseLite and FastNoise2.
+    if wanted vs_noise; then
+        if [[ ! -x $PEERS/noise/run.sh || ! -d $PEERS/noise/FastNoise2 ]]; then
+            skip vs_noise "peer absent ($PEERS/noise)"
+        elif [[ -n $QUICK && ! -f $B/vs_noise/fn2/lib/libFastNoise.a && ! -f $B/vs_noise/fn2/Release/lib/libFastNoise.a ]]; then
+            skip vs_noise "quick mode: FastNoise2 not built yet under $B/vs_noise (make bench builds it, 5-9 min)"
+        else
+            if [[ -n $QUICK ]]; then rounds=1; else rounds=5; fi
+            run vs_noise "$PEERS/noise/run.sh" "$B" "$rounds"
+        fi
+    fi
+    # vs_nsearch: CompactNSearch, at each size.
+    if [[ ! -x $PEERS/nsearch/run.sh || ! -d $PEERS/nsearch/CompactNSearch ]]; then
+        skip vs_nsearch "peer absent ($PEERS/nsearch)"
+    elif [[ -n $QUICK ]]; then
+        wanted vs_nsearch_12 && run vs_nsearch_12 "$PEERS/nsearch/run.sh" "$B" 12 1
+    else
+        for side in ${AK_BENCH_NSEARCH_SIDES:-38 80}; do
+            wanted "vs_nsearch_$side" && run "vs_nsearch_$side" "$PEERS/nsearch/run.sh" "$B" "$side" 7
+        done
+    fi
+    # Peers with no harness here, said once so that nobody wonders.
+    [[ -z $ONLY ]] && for d in "$PEERS"/*/; do
+        p=$(basename "$d")
+        case $p in vs_ozz | ozz-animation | noise | nsearch) continue ;; esac
+        if [[ -x $d/run.sh ]]; then
+            skip "peer_$p" "$d/run.sh: no arguments known to scripts/bench.sh"
+        else
+            skip "peer_$p" "no side-by-side harness in $d (see its README/PEER.md)"
+        fi
+    done
+fi
+
+echo "load at end: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)" >>"$OUT/machine.txt"
+if [[ -x /usr/bin/python3 ]]; then
+    /usr/bin/python3 "$ROOT/scripts/bench_summary.py" "$OUT" && echo "summary: $OUT/SUMMARY.md"
+else
+    echo "bench.sh: no /usr/bin/python3: no SUMMARY.md (the outputs are in $OUT)"
+fi
+# A failed program fails the whole run (after the others ran).
+! awk -F'\t' '$2 != "0" && $2 != "skip" { bad = 1 } END { exit !bad }' "$LOG"
