@@ -1,8 +1,11 @@
 /* crowd: ORCA scenarios (goals reached, no overlap, measured by an independent pairwise
  * pass in double), the linear program against a brute-force search over a velocity grid,
- * obstacles never entered, thread-count invariance, validation codes. */
+ * obstacles never entered, thread-count invariance, validation codes; the scene format and
+ * presets of the library (values read equal the numbers written, defaults as docs/crowd.md,
+ * errors naming the key path, preset layouts against their closed forms). */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -542,6 +545,252 @@ AK_TEST(budget) {
     free(ag);
 }
 
+/* ---- scene files and presets (ak_crowd_scene_*) ------------------------------------------ */
+
+#define SCENE_LOAD(text, scene, diag) ak_crowd_scene_load_bytes((text), strlen(text), "t.json", (scene), (diag))
+
+/* The defaults are docs/crowd.md's table; values read from bytes are the numbers written. */
+AK_TEST(scene_defaults_and_bytes) {
+    ak_crowd_scene s;
+    ak_crowd_scene_defaults(&s);
+    AK_CHECK_NEAR(s.dt, 0.1f, 0.0f);
+    AK_CHECK_EQ(s.steps, 1000);
+    AK_CHECK_EQ(s.contact_iterations, 8u);
+    AK_CHECK_EQ(s.method, AK_CROWD_ORCA);
+    AK_CHECK_NEAR(s.duration, 0.0f, 0.0f);
+    AK_CHECK(s.agents == NULL && s.agent_count == 0 && s.obstacle_count == 0);
+    AK_CHECK_NEAR(s.defaults.radius, 0.3f, 0.0f);
+    AK_CHECK_NEAR(s.defaults.pref_speed, 1.3f, 0.0f);
+    AK_CHECK_NEAR(s.defaults.max_speed, 2.0f, 0.0f);
+    AK_CHECK_NEAR(s.defaults.neighbor_distance, 5.0f, 0.0f);
+    AK_CHECK_EQ(s.defaults.max_neighbors, 10u);
+    AK_CHECK_NEAR(s.defaults.time_horizon, 2.0f, 0.0f);
+    AK_CHECK_NEAR(s.defaults.time_horizon_obstacles, 2.0f, 0.0f);
+    AK_CHECK_NEAR(s.defaults.waypoint_radius, 0.0f, 0.0f); /* 0: each agent's radius */
+
+    const char* text = "{\"dt\": 0.05, \"steps\": 321, \"method\": \"vision\", \"contact_iterations\": 3,"
+                       " \"agent_defaults\": {\"radius\": 0.4, \"max_neighbors\": 7},"
+                       " \"obstacles\": [{\"vertices\": [[5, 5], [6, 5], [6, 6]]}, {\"vertices\": [[-9, 2], [-9, 3]]}],"
+                       " \"agents\": [{\"position\": [1, 2], \"velocity\": [0.5, -0.25], \"goal\": [3, 4], \"group\": 7},"
+                       " {\"position\": [-1, -2], \"path\": [[0, 1], [2, 3]], \"pref_speed\": 0.9, \"radius\": 0.2}]}";
+    ak_diag d;
+    AK_CHECK_EQ(SCENE_LOAD(text, &s, &d), AK_OK);
+    AK_CHECK_NEAR(s.dt, 0.05f, 0.0f);
+    AK_CHECK_EQ(s.steps, 321);
+    AK_CHECK_EQ(s.method, AK_CROWD_VISION);
+    AK_CHECK_EQ(s.contact_iterations, 3u);
+    AK_CHECK_EQ(s.obstacle_count, 2u);
+    AK_CHECK_EQ(s.vertex_count, 5u);
+    if (s.obstacle_count == 2) {
+        AK_CHECK_EQ(s.obstacles[0].vertices.count, 3u);
+        AK_CHECK_EQ(s.obstacles[1].vertices.count, 2u);
+        AK_CHECK_NEAR(s.obstacles[0].vertices.ptr[2].y, 6.0f, 0.0f);
+        AK_CHECK_NEAR(s.obstacles[1].vertices.ptr[1].x, -9.0f, 0.0f);
+    }
+    AK_CHECK_EQ(s.agent_count, 2u);
+    AK_CHECK_EQ(s.waypoint_count, 3u);
+    if (s.agent_count == 2) {
+        AK_CHECK_NEAR(s.positions[0].x, 1.0f, 0.0f);
+        AK_CHECK_NEAR(s.positions[0].y, 2.0f, 0.0f);
+        AK_CHECK_NEAR(s.velocities[0].x, 0.5f, 0.0f);
+        AK_CHECK_NEAR(s.velocities[0].y, -0.25f, 0.0f);
+        AK_CHECK_NEAR(s.velocities[1].x, 0.0f, 0.0f); /* absent: at rest */
+        AK_CHECK_EQ(s.group[0], 7);
+        AK_CHECK_EQ(s.group[1], 0);
+        /* agent_defaults over the defaults, then the agent's own keys */
+        AK_CHECK_NEAR(s.agents[0].radius, 0.4f, 0.0f);
+        AK_CHECK_EQ(s.agents[0].max_neighbors, 7u);
+        AK_CHECK_NEAR(s.agents[0].pref_speed, 1.3f, 0.0f);
+        AK_CHECK_NEAR(s.agents[1].radius, 0.2f, 0.0f);
+        AK_CHECK_NEAR(s.agents[1].pref_speed, 0.9f, 0.0f);
+        AK_CHECK_EQ(s.agents[0].goals.count, 1u);
+        AK_CHECK_NEAR(s.agents[0].goals.ptr[0].y, 4.0f, 0.0f);
+        AK_CHECK_EQ(s.agents[1].goals.count, 2u);
+        AK_CHECK_NEAR(s.agents[1].goals.ptr[1].x, 2.0f, 0.0f);
+        /* the scene is what ak_crowd_create takes */
+        ak_crowd_desc desc = {.agents = {s.agents, s.agent_count}, .obstacles = s.obstacles,
+                              .obstacle_count = (uint32_t)s.obstacle_count, .method = s.method};
+        ak_crowd* c = NULL;
+        AK_CHECK_EQ(ak_crowd_create(&desc, NULL, &c), AK_OK);
+        AK_CHECK_EQ(ak_crowd_agent_count(c), 2u);
+        ak_crowd_destroy(c);
+    }
+    ak_crowd_scene_free(&s);
+    AK_CHECK(s.agents == NULL && s.agent_count == 0 && s.obstacles == NULL && s.vertices == NULL);
+    ak_crowd_scene_free(&s); /* twice is fine */
+    ak_crowd_scene_free(NULL);
+
+    /* a file from disk: the example scene */
+    ak_crowd_scene_defaults(&s);
+    AK_CHECK_EQ(ak_crowd_scene_load_file(AK_SOURCE_DIR "/examples/crowd_corridor.json", &s, &d), AK_OK);
+    AK_CHECK_EQ(s.agent_count, 6u);
+    AK_CHECK_EQ(s.obstacle_count, 3u);
+    AK_CHECK_EQ(s.steps, 400);
+    if (s.agent_count == 6) AK_CHECK_NEAR(s.agents[5].radius, 0.25f, 0.0f);
+    ak_crowd_scene_free(&s);
+}
+
+/* Every error names the file and the key path, as one line. */
+AK_TEST(scene_errors_name_key_paths) {
+    static const struct {
+        const char* text;
+        const char* message;
+    } cases[] = {
+        {"{\"agents\": [{\"position\": [0, 0], \"path\": [[1, 0], [2]]}]}",
+         "t.json: agents[0].path[1]: expected [x, z], two numbers"},
+        {"{\"agents\": [{\"goal\": [1, 0]}]}", "t.json: agents[0].position: is required"},
+        {"{\"agents\": [{\"position\": [0, 0]}]}", "t.json: agents[0]: expected exactly one of \"goal\" and \"path\""},
+        {"{\"agents\": [{\"position\": [0, 0], \"goal\": [1, 0], \"pref_speed\": 3, \"max_speed\": 2}]}",
+         "t.json: agents[0].max_speed: must be at least pref_speed (3 m/s)"},
+        {"{\"agents\": [{\"position\": [0, 1e9], \"goal\": [1, 0]}]}",
+         "t.json: agents[0].position: expected coordinates within +-1e6 m"},
+        {"{\"obstacles\": [{\"vertices\": [[0, 0], [0, 1], [1, 1], [1, 0]]}]}",
+         "t.json: obstacles[0].vertices: a polygon must be counter-clockwise in (x, z) with a positive area"},
+        {"{\"obstacles\": [{\"vertices\": [[0, 0], [1, 0], [1, 0]]}]}",
+         "t.json: obstacles[0].vertices[2]: equals the vertex before it (an edge of zero length)"},
+        {"{\"obstacles\": [{\"vertices\": [[0, 0]]}]}", "t.json: obstacles[0].vertices: expected at least 2 vertices"},
+        {"{}", "t.json: agents: the scene has no agents"},
+        {"{\"agents\": []}", "t.json: agents: the scene has no agents"},
+        {"[1]", "t.json: the top level is not an object (got an array)"},
+        {"{\"dt\": 0.1, \"dt\": 0.2}", "t.json: dt: the key appears twice"},
+        {"{\"dt\": 0.1,", NULL}, /* a syntax error: line and column */
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        ak_crowd_scene s;
+        ak_crowd_scene_defaults(&s);
+        ak_diag d;
+        AK_CHECK_EQ(SCENE_LOAD(cases[k].text, &s, &d), AK_ERR_PARSE);
+        AK_CHECK_STREQ(d.path, "t.json");
+        if (cases[k].message)
+            AK_CHECK_STREQ(d.message, cases[k].message);
+        else
+            AK_CHECK_MSG(strncmp(d.message, "t.json: ", 8) == 0 && strstr(d.message, "line 1, column"), "%s",
+                         d.message);
+        AK_CHECK(strchr(d.message, '\n') == NULL);
+        ak_crowd_scene_free(&s);
+    }
+    /* prefix checks where the reader's wording is its own */
+    static const struct {
+        const char* text;
+        const char* prefix;
+    } keyed[] = {
+        {"{\"agents\": [{\"position\": [0, 0], \"goal\": [1, 0], \"speed\": 1}]}", "t.json: agents[0]: "},
+        {"{\"agent_defaults\": {\"time_horizon\": 0}}", "t.json: agent_defaults.time_horizon: "},
+        {"{\"agents\": [{\"position\": [0, 0], \"goal\": [1, 0], \"max_neighbors\": 65}]}",
+         "t.json: agents[0].max_neighbors: "},
+        {"{\"method\": \"rvo\"}", "t.json: method: "},
+        {"{\"contact_iterations\": 65}", "t.json: contact_iterations: "},
+        {"{\"steps\": 1.5}", "t.json: steps: "},
+    };
+    for (size_t k = 0; k < sizeof keyed / sizeof keyed[0]; ++k) {
+        ak_crowd_scene s;
+        ak_crowd_scene_defaults(&s);
+        ak_diag d;
+        AK_CHECK_EQ(SCENE_LOAD(keyed[k].text, &s, &d), AK_ERR_PARSE);
+        AK_CHECK_MSG(strncmp(d.message, keyed[k].prefix, strlen(keyed[k].prefix)) == 0, "'%s' lacks '%s'", d.message,
+                     keyed[k].prefix);
+        ak_crowd_scene_free(&s);
+    }
+    /* NULL arguments, a missing file */
+    ak_crowd_scene s;
+    ak_crowd_scene_defaults(&s);
+    ak_diag d;
+    AK_CHECK_EQ(ak_crowd_scene_load_bytes(NULL, 4, "n.json", &s, &d), AK_ERR_NULL_ARG);
+    AK_CHECK(strncmp(d.message, "n.json: ", 8) == 0);
+    AK_CHECK_EQ(ak_crowd_scene_load_bytes("{}", 2, "n.json", NULL, &d), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_crowd_scene_load_bytes("{\"zz\": 1}", 9, NULL, &s, NULL), AK_ERR_PARSE);
+    AK_CHECK_EQ(ak_crowd_scene_load_file("no_such_crowd_scene.json", &s, &d), AK_ERR_IO);
+    AK_CHECK(strncmp(d.message, "no_such_crowd_scene.json: ", 26) == 0);
+    AK_CHECK_EQ(s.agent_count, 0u);
+    ak_crowd_scene_free(&s);
+}
+
+/* The presets hold docs/crowd.md's layouts and run times: steps = ceil(duration / dt) with the
+ * documented duration in seconds, at pref_speed 1.3 m/s. */
+AK_TEST(scene_presets) {
+    const float pi = 3.14159265358979f;
+    ak_crowd_scene s;
+    ak_diag d;
+    /* circle: 12 agents on a circle of radius max(8, N * 1.8 / 2 pi) = 8 m, each to the antipode */
+    AK_CHECK_EQ(ak_crowd_scene_preset("circle", 12, &s, &d), AK_OK);
+    AK_CHECK_EQ(s.agent_count, 12u);
+    AK_CHECK_EQ(s.obstacle_count, 0u);
+    for (size_t i = 0; i < s.agent_count; ++i) {
+        AK_CHECK_NEAR(hypotf(s.positions[i].x, s.positions[i].y), 8.0f, 1e-5f);
+        AK_CHECK_EQ(s.agents[i].goals.count, 1u);
+        AK_CHECK_NEAR(s.agents[i].goals.ptr[0].x, -s.positions[i].x, 0.0f);
+        AK_CHECK_NEAR(s.agents[i].goals.ptr[0].y, -s.positions[i].y, 0.0f);
+    }
+    AK_CHECK_NEAR(s.duration, 1.5 * 16.0 / 1.3 + 120.0 + 0.02 * 12, 1e-3);
+    AK_CHECK_EQ(s.steps, (long)ceil((double)s.duration / 0.1));
+    AK_CHECK_EQ(s.steps, 1388); /* 138.70 s */
+    ak_crowd_scene_free(&s);
+    /* 0 agents -> 100: radius 100 * 1.8 / 2 pi */
+    AK_CHECK_EQ(ak_crowd_scene_preset("circle", 0, &s, &d), AK_OK);
+    AK_CHECK_EQ(s.agent_count, (size_t)AK_CROWD_SCENE_DEFAULT_AGENTS);
+    AK_CHECK_NEAR(hypotf(s.positions[0].x, s.positions[0].y), 100 * 1.8f / (2 * pi), 1e-4f);
+    ak_crowd_scene_free(&s);
+    /* crossing: four groups from the four sides, each goal straight across along one axis */
+    AK_CHECK_EQ(ak_crowd_scene_preset("crossing", 12, &s, &d), AK_OK);
+    AK_CHECK_EQ(s.agent_count, 12u);
+    int groups[4] = {0};
+    for (size_t i = 0; i < s.agent_count; ++i) {
+        const ak_vec2 p = s.positions[i], g = s.agents[i].goals.ptr[0];
+        AK_CHECK(s.group[i] < 4);
+        if (s.group[i] < 4) groups[s.group[i]]++;
+        AK_CHECK_MSG((p.x == g.x) != (p.y == g.y), "agent %zu does not cross along one axis", i);
+        AK_CHECK((p.x != g.x && p.x * g.x < 0) || (p.y != g.y && p.y * g.y < 0)); /* through the centre */
+    }
+    AK_CHECK(groups[0] == 3 && groups[1] == 3 && groups[2] == 3 && groups[3] == 3);
+    ak_crowd_scene_free(&s);
+    /* corridor: two walls along x at z = +-4, two groups walking at each other */
+    AK_CHECK_EQ(ak_crowd_scene_preset("corridor", 12, &s, &d), AK_OK);
+    AK_CHECK_EQ(s.obstacle_count, 2u);
+    AK_CHECK_EQ(s.vertex_count, 4u);
+    for (size_t k = 0; k < s.obstacle_count; ++k) {
+        AK_CHECK_EQ(s.obstacles[k].vertices.count, 2u);
+        AK_CHECK_NEAR(fabsf(s.obstacles[k].vertices.ptr[0].y), 4.0f, 0.0f);
+        AK_CHECK_NEAR(s.obstacles[k].vertices.ptr[1].y, s.obstacles[k].vertices.ptr[0].y, 0.0f);
+    }
+    for (size_t i = 0; i < s.agent_count; ++i) {
+        AK_CHECK(fabsf(s.positions[i].y) < 4.0f);
+        AK_CHECK(s.positions[i].x * s.agents[i].goals.ptr[0].x < 0.0f);
+    }
+    ak_crowd_scene_free(&s);
+    /* evacuation: a room of four walls, one split by the door; three waypoints, the last outside */
+    AK_CHECK_EQ(ak_crowd_scene_preset("evacuation", 12, &s, &d), AK_OK);
+    AK_CHECK_EQ(s.obstacle_count, 5u);
+    AK_CHECK_EQ(s.agent_count, 12u);
+    AK_CHECK_EQ(s.waypoint_count, 36u);
+    for (size_t i = 0; i < s.agent_count; ++i) {
+        AK_CHECK_EQ(s.agents[i].goals.count, 3u);
+        AK_CHECK(fabsf(s.positions[i].x) < 5.0f && fabsf(s.positions[i].y) < 5.0f); /* inside the 10 m room */
+        AK_CHECK(s.agents[i].goals.ptr[2].x > 5.0f);
+    }
+    /* S = 10 m, door = 0.02 cols + 2 = 2.08 m (cols = 4): 3 S / 1.3 + 2.5 N / door + 120 s */
+    AK_CHECK_NEAR(s.duration, 30.0 / 1.3 + 2.5 * 12 / 2.08 + 120.0, 1e-3);
+    /* a file over the preset: its dt re-times the run, its steps win */
+    const long steps01 = s.steps;
+    AK_CHECK_EQ(SCENE_LOAD("{\"dt\": 0.05}", &s, &d), AK_OK);
+    AK_CHECK_EQ(s.agent_count, 12u);
+    AK_CHECK(s.steps == 2 * steps01 || s.steps == 2 * steps01 - 1);
+    AK_CHECK_EQ(SCENE_LOAD("{\"steps\": 7, \"agents\": [{\"position\": [0, 0], \"goal\": [1, 0]}]}", &s, &d), AK_OK);
+    AK_CHECK_EQ(s.steps, 7);
+    AK_CHECK_NEAR(s.duration, 0.0f, 0.0f);
+    AK_CHECK_EQ(s.agent_count, 1u); /* the file's agents replace the preset's */
+    AK_CHECK_EQ(s.obstacle_count, 5u); /* its obstacles stay */
+    AK_CHECK_EQ(SCENE_LOAD("{\"obstacles\": []}", &s, &d), AK_OK);
+    AK_CHECK_EQ(s.obstacle_count, 0u);
+    ak_crowd_scene_free(&s);
+    /* unknown names, too many agents */
+    AK_CHECK_EQ(ak_crowd_scene_preset("stadium", 12, &s, &d), AK_ERR_NOT_FOUND);
+    AK_CHECK(strstr(d.message, AK_CROWD_SCENE_PRESETS) != NULL);
+    AK_CHECK(s.agents == NULL && s.agent_count == 0);
+    AK_CHECK_EQ(ak_crowd_scene_preset("circle", (size_t)AK_CROWD_SCENE_MAX_AGENTS + 1, &s, &d), AK_ERR_BAD_ARG);
+    AK_CHECK(s.agents == NULL);
+    AK_CHECK_EQ(ak_crowd_scene_preset(NULL, 12, &s, &d), AK_ERR_NULL_ARG);
+}
+
 int main(void) {
     AK_RUN(head_on);
     AK_RUN(four_crossing);
@@ -554,6 +803,9 @@ int main(void) {
     AK_RUN(validation);
     AK_RUN(degenerate_finite);
     AK_RUN(budget);
+    AK_RUN(scene_defaults_and_bytes);
+    AK_RUN(scene_errors_name_key_paths);
+    AK_RUN(scene_presets);
     AK_RUN_SLOW(circle_250);
     return ak_test_finish();
 }

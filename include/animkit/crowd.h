@@ -245,6 +245,84 @@ AK_API ak_result ak_crowd_clearance(const ak_crowd* crowd, ak_vec2_cspan positio
                                     ak_u8_span scratch, float* out_min_distance, ak_u32_span out_pairs,
                                     size_t* out_overlap_count);
 
+/* ---- scene files and presets ------------------------------------------------------------ */
+/* A crowd scene: the JSON format of `animkit crowd SCENE.json` (docs/crowd.md lists every key,
+ * its default and its range) or a preset, over the defaults:
+ *     ak_crowd_scene sc;
+ *     ak_diag diag;
+ *     ak_crowd_scene_defaults(&sc);                        // or ak_crowd_scene_preset(...)
+ *     if (ak_crowd_scene_load_file("corridor.json", &sc, &diag) != AK_OK) puts(diag.message);
+ *     ak_crowd_desc desc = {.agents = {sc.agents, sc.agent_count}, .obstacles = sc.obstacles,
+ *                           .obstacle_count = (uint32_t)sc.obstacle_count, .method = sc.method};
+ *     ... ak_crowd_create(&desc, ...), then sc.steps steps of sc.dt from sc.positions and
+ *         sc.velocities with sc.contact_iterations contact passes ...
+ *     ak_crowd_scene_free(&sc); */
+
+#define AK_CROWD_SCENE_MAX_AGENTS 1000000u    /* agents in a file or asked of a preset */
+#define AK_CROWD_SCENE_MAX_OBSTACLES 10000u   /* obstacles in a file */
+#define AK_CROWD_SCENE_MAX_VERTICES 100000u   /* obstacle vertices in a file, in all */
+#define AK_CROWD_SCENE_MAX_PATH 1000u         /* waypoints of one agent's "path" */
+#define AK_CROWD_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
+/* The names ak_crowd_scene_preset knows. */
+#define AK_CROWD_SCENE_PRESETS "circle, crossing, corridor, evacuation"
+/* Agents of a preset asked for with count 0. */
+#define AK_CROWD_SCENE_DEFAULT_AGENTS 100u
+
+/* A loaded scene; it owns agents, positions, velocities, group, waypoints, obstacles and
+ * vertices (malloc). */
+typedef struct ak_crowd_scene {
+    ak_crowd_agent defaults;      /* "agent_defaults": ak_crowd_agent_resolved(NULL) but
+                                     waypoint_radius 0 (each agent's radius), no goals */
+    ak_crowd_agent* agents;       /* [agent_count]: the defaults with the agent's own keys
+                                     over them; goals point into waypoints */
+    ak_vec2* positions;           /* [agent_count] start positions (ground x, z) */
+    ak_vec2* velocities;          /* [agent_count] start velocities */
+    uint8_t* group;               /* [agent_count] colour group when rendering */
+    size_t agent_count;
+    ak_vec2* waypoints;           /* every agent's path, one after another */
+    size_t waypoint_count;
+    ak_crowd_obstacle* obstacles; /* [obstacle_count]; vertices point into vertices */
+    size_t obstacle_count;
+    ak_vec2* vertices;
+    size_t vertex_count;
+    long steps;                   /* default 1000; a preset's: ceil(duration / dt) */
+    float dt;                     /* s per step, default 0.1 */
+    float duration;               /* s: a preset's run time, long enough for every agent to
+                                     arrive (docs/crowd.md); 0 for the defaults and once a
+                                     file sets "steps" */
+    uint32_t contact_iterations;  /* default 8 */
+    ak_crowd_method method;       /* default AK_CROWD_ORCA */
+} ak_crowd_scene;
+
+/* The defaults of every key (the scene without a file: no agents, no obstacles); owns
+ * nothing. */
+AK_API void ak_crowd_scene_defaults(ak_crowd_scene* scene);
+/* Parse bytes[0, size) (strict JSON) OVER the scene already in *scene, which must hold
+ * ak_crowd_scene_defaults or a preset (keys absent from the file keep its values; "agents"
+ * and "obstacles", when present, replace the scene's; a preset's steps follow a "dt" of the
+ * file unless it sets "steps"); name (NULL -> "(scene)") starts every message. The scene must
+ * end with at least one agent. Returns AK_OK, or AK_ERR_PARSE / AK_ERR_NULL_ARG with, when
+ * out_diag is not NULL, the one line "NAME: key.path: problem" in out_diag->message
+ * ("t.json: agents[3].path[1]: expected [x, z], two numbers"). In every case *scene owns its
+ * arrays afterwards: free it with ak_crowd_scene_free. */
+AK_API ak_result ak_crowd_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                           ak_crowd_scene* scene, ak_diag* out_diag);
+/* Read the file at path (at most AK_CROWD_SCENE_MAX_FILE_SIZE bytes) and parse it over *scene
+ * as ak_crowd_scene_load_bytes does; AK_ERR_IO when it cannot be read. */
+AK_API ak_result ak_crowd_scene_load_file(const char* path, ak_crowd_scene* scene, ak_diag* out_diag);
+/* The defaults, then the preset name (AK_CROWD_SCENE_PRESETS; docs/crowd.md gives their
+ * layouts) with count agents (0 -> AK_CROWD_SCENE_DEFAULT_AGENTS): "circle" (on a circle,
+ * each to the antipode), "crossing" (four blocks cross from the four sides), "corridor" (two
+ * groups meet in an 8 m corridor between two walls), "evacuation" (a room empties through one
+ * door). Sets duration, and steps = ceil(duration / dt). *out_scene is overwritten without
+ * being freed (pass a new or freed scene). AK_ERR_NOT_FOUND for another name, AK_ERR_BAD_ARG
+ * for count above AK_CROWD_SCENE_MAX_AGENTS, AK_ERR_NO_MEMORY, AK_ERR_NULL_ARG; on failure
+ * *out_scene holds the defaults. */
+AK_API ak_result ak_crowd_scene_preset(const char* name, size_t count, ak_crowd_scene* out_scene,
+                                       ak_diag* out_diag);
+/* Free the arrays (NULL: no-op; safe twice); the scalar keys stay. */
+AK_API void ak_crowd_scene_free(ak_crowd_scene* scene);
+
 #ifdef __cplusplus
 }
 #endif

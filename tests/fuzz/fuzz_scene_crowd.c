@@ -1,7 +1,8 @@
-/* libFuzzer target for the crowd scene reader (tools/animkit/scene_crowd.c); built and run by
- * scripts/fuzz.sh with the CLI objects linked in.
+/* libFuzzer target for the crowd scene reader (ak_crowd_scene_load_bytes, src/crowd/scene.c);
+ * built and run by scripts/fuzz.sh.
  *
- * Each input is parsed from memory. A parse error must come with a message naming the file.
+ * Each input is parsed from memory. A parse error must come with a message naming the file; a
+ * loaded scene must hold agents.
  * A parsed scene with at most 256 agents and 256 obstacle vertices is built into a crowd (ORCA
  * or vision, as the scene says) and stepped three times on 1 and on 2 threads (with contact
  * passes): both must give the same finite positions and velocities. */
@@ -10,11 +11,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../../tools/animkit/scene_crowd.h"
+#include <animkit/crowd.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
-static void steps(const cli_crowd_scene* sc, ak_crowd* c, uint32_t threads, ak_vec2* p, ak_vec2* v) {
+static void steps(const ak_crowd_scene* sc, ak_crowd* c, uint32_t threads, ak_vec2* p, ak_vec2* v) {
     const size_t n = sc->agent_count;
     ak_vec2* p2 = calloc(n, sizeof *p2);
     ak_vec2* v2 = calloc(n, sizeof *v2);
@@ -49,14 +50,15 @@ static void steps(const cli_crowd_scene* sc, ak_crowd* c, uint32_t threads, ak_v
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    cli_crowd_scene sc;
-    cli_crowd_scene_defaults(&sc);
-    char msg[600];
-    if (cli_crowd_scene_parse("fuzz.json", (const char*)data, size, &sc, msg, sizeof msg) == 0) {
+    ak_crowd_scene sc;
+    ak_crowd_scene_defaults(&sc);
+    ak_diag diag;
+    if (ak_crowd_scene_load_bytes(data, size, "fuzz.json", &sc, &diag) == AK_OK) {
+        if (sc.agent_count == 0) abort(); /* a loaded scene has agents */
         if (sc.agent_count > 0 && sc.agent_count <= 256 && sc.vertex_count <= 256) {
             ak_crowd_desc d = {.agents = {sc.agents, sc.agent_count}, .obstacles = sc.obstacles,
                                .obstacle_count = (uint32_t)sc.obstacle_count,
-                               .method = sc.method == 1 ? AK_CROWD_VISION : AK_CROWD_ORCA};
+                               .method = sc.method};
             ak_crowd* c = NULL;
             if (ak_crowd_create(&d, NULL, &c) == AK_OK) {
                 const size_t n = sc.agent_count;
@@ -69,9 +71,9 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                 ak_crowd_destroy(c);
             }
         }
-    } else if (strncmp(msg, "fuzz.json", 9) != 0) {
+    } else if (strncmp(diag.message, "fuzz.json: ", 11) != 0 || strcmp(diag.path, "fuzz.json") != 0) {
         abort();
     }
-    cli_crowd_scene_free(&sc);
+    ak_crowd_scene_free(&sc);
     return 0;
 }

@@ -4,9 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "cli_json.h"
 #include "outfile.h"
-#include "scene_crowd.h"
 
 static const char* const usage =
     "usage: animkit crowd [SCENE.json | --preset circle|crossing|corridor|evacuation] [--agents N]\n"
@@ -123,12 +121,12 @@ static ak_result measure(crowd_run* r) {
     }
 }
 
-static ak_result run_init(crowd_run* r, const cli_crowd_scene* sc, uint32_t threads) {
+static ak_result run_init(crowd_run* r, const ak_crowd_scene* sc, uint32_t threads) {
     memset(r, 0, sizeof *r);
     r->min_distance = INFINITY;
     ak_crowd_desc d = {.agents = {sc->agents, sc->agent_count}, .obstacles = sc->obstacles,
                        .obstacle_count = (uint32_t)sc->obstacle_count,
-                       .method = sc->method == 1 ? AK_CROWD_VISION : AK_CROWD_ORCA};
+                       .method = sc->method};
     ak_result res = ak_crowd_create(&d, NULL, &r->crowd);
     if (res != AK_OK) return res;
     const size_t n = r->n = sc->agent_count;
@@ -202,7 +200,7 @@ static void renderer_free(renderer* r) {
     free(r->pixels);
 }
 
-static int renderer_init(renderer* r, int w, int h, const cli_crowd_scene* sc) {
+static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc) {
     memset(r, 0, sizeof *r);
     r->w = w;
     r->h = h;
@@ -250,7 +248,7 @@ static int renderer_init(renderer* r, int w, int h, const cli_crowd_scene* sc) {
 
 /* Each agent an upright octagonal prism (1.7 m, its radius) coloured by group, its front face
  * (toward the velocity) light. */
-static ak_result draw_frame(renderer* r, const cli_crowd_scene* sc, const crowd_run* st, ak_image* out) {
+static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, ak_image* out) {
     static const ak_vec4 palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
                                        {0.75f, 0.30f, 0.55f, 1}};
     const float pi = 3.14159265358979f;
@@ -308,37 +306,6 @@ static int write_json(const char* path, double time, const crowd_run* st) {
     return cli_outfile_commit(&out, "crowd");
 }
 
-static int read_scene_file(const char* file, cli_crowd_scene* sc) {
-    FILE* f = fopen(file, "rb");
-    if (!f) return cli_fail("crowd", "%s: cannot open the file", file);
-    char* text = NULL;
-    size_t size = 0, cap = 0;
-    for (;;) {
-        if (size == cap) {
-            if (cap > CLI_JSON_MAX_SIZE) break;
-            cap = cap ? cap * 2 : 65536;
-            char* g = realloc(text, cap + 1);
-            if (!g) break;
-            text = g;
-        }
-        const size_t got = fread(text + size, 1, cap - size, f);
-        size += got;
-        if (got == 0) break;
-    }
-    fclose(f);
-    if (!text) return cli_fail("crowd", "%s: out of memory", file);
-    if (size > CLI_JSON_MAX_SIZE) {
-        free(text);
-        return cli_fail("crowd", "%s: larger than %zu bytes", file, (size_t)CLI_JSON_MAX_SIZE);
-    }
-    char msg[600];
-    const int bad = cli_crowd_scene_parse(file, text, size, sc, msg, sizeof msg);
-    free(text);
-    if (bad) return cli_fail("crowd", "%s", msg);
-    if (sc->agent_count == 0) return cli_fail("crowd", "%s: agents: the scene has no agents", file);
-    return CLI_OK;
-}
-
 int cmd_crowd(int argc, char** argv) {
     static const cli_opt opts[] = {
         {"--agents", NULL, true}, {"--steps", NULL, true},  {"--dt", NULL, true},     {"--threads", NULL, true},
@@ -361,8 +328,8 @@ int cmd_crowd(int argc, char** argv) {
     long agents = 0, steps = -1, threads = 1;
     float dt = -1.0f;
     int w = 640, h = 480;
-    if (CLI_GET(&a, "--agents") && !cli_parse_int(CLI_GET(&a, "--agents"), 1, CLI_CROWD_MAX_AGENTS, &agents))
-        return cli_usage_int("crowd", "--agents", CLI_GET(&a, "--agents"), 1, CLI_CROWD_MAX_AGENTS);
+    if (CLI_GET(&a, "--agents") && !cli_parse_int(CLI_GET(&a, "--agents"), 1, AK_CROWD_SCENE_MAX_AGENTS, &agents))
+        return cli_usage_int("crowd", "--agents", CLI_GET(&a, "--agents"), 1, AK_CROWD_SCENE_MAX_AGENTS);
     if (CLI_GET(&a, "--steps") && !cli_parse_int(CLI_GET(&a, "--steps"), 0, 100000000, &steps))
         return cli_usage_int("crowd", "--steps", CLI_GET(&a, "--steps"), 0, 100000000);
     if (CLI_GET(&a, "--threads") && !cli_parse_int(CLI_GET(&a, "--threads"), 1, 64, &threads))
@@ -377,41 +344,41 @@ int cmd_crowd(int argc, char** argv) {
         return cli_usage("crowd", "output '%s' must end in .png, .gif or .glb", out);
     if (a.pos_count == 1 && agents > 0) return cli_usage("crowd", "--agents sets a preset's size; the scene lists its agents");
 
-    cli_crowd_scene sc;
-    cli_crowd_scene_defaults(&sc);
-    if (dt > 0.0f) sc.dt = dt; /* before the preset: its default step count depends on dt */
+    ak_crowd_scene sc;
+    ak_diag diag;
     if (a.pos_count == 1) {
-        if ((rc = read_scene_file(a.pos[0], &sc)) != CLI_OK) {
-            cli_crowd_scene_free(&sc);
-            return rc;
+        ak_crowd_scene_defaults(&sc);
+        if (ak_crowd_scene_load_file(a.pos[0], &sc, &diag) != AK_OK) {
+            ak_crowd_scene_free(&sc);
+            return cli_fail("crowd", "%s", diag.message);
         }
-        if (dt > 0.0f) sc.dt = dt;
-        if (sc.steps < 0) sc.steps = 1000;
     } else {
-        const int bad = cli_crowd_scene_preset(preset ? preset : "circle", (size_t)agents, &sc);
-        if (bad) {
-            cli_crowd_scene_free(&sc);
-            if (bad < 0) return cli_usage("crowd", "--preset '%s' must be one of " CLI_CROWD_PRESETS, preset);
-            return cli_fail("crowd", "out of memory");
-        }
+        const ak_result pr = ak_crowd_scene_preset(preset ? preset : "circle", (size_t)agents, &sc, &diag);
+        if (pr == AK_ERR_NOT_FOUND)
+            return cli_usage("crowd", "--preset '%s' must be one of " AK_CROWD_SCENE_PRESETS, preset);
+        if (pr != AK_OK) return cli_fail("crowd", "%s", diag.message);
+    }
+    if (dt > 0.0f) {
+        sc.dt = dt;
+        if (sc.duration > 0.0f) sc.steps = (long)ceilf(sc.duration / dt); /* a preset's run at this dt */
     }
     if (steps >= 0) sc.steps = steps;
-    if (method) sc.method = strcmp(method, "vision") == 0 ? 1 : 0;
+    if (method) sc.method = strcmp(method, "vision") == 0 ? AK_CROWD_VISION : AK_CROWD_ORCA;
     /* Refused before any work, so that no file is left half-written. */
     if (out && cli_has_ext(out, ".glb")) {
-        cli_crowd_scene_free(&sc);
+        ak_crowd_scene_free(&sc);
         return cli_fail("crowd", "%s: glTF export of a crowd is not implemented yet (use .png or .gif)", out);
     }
     if ((rc = cli_work_check("crowd", (double)sc.agent_count * (double)sc.steps, "agent updates (agents x steps)",
                              "--steps or --agents"))) {
-        cli_crowd_scene_free(&sc);
+        ak_crowd_scene_free(&sc);
         return rc;
     }
     crowd_run st;
     ak_result res = run_init(&st, &sc, (uint32_t)threads);
     if (res != AK_OK) {
         run_free(&st);
-        cli_crowd_scene_free(&sc);
+        ak_crowd_scene_free(&sc);
         return cli_fail("crowd", "%s: %s", a.pos_count ? a.pos[0] : "preset", ak_result_string(res));
     }
 
@@ -423,14 +390,14 @@ int cmd_crowd(int argc, char** argv) {
         if (renderer_init(&rd, w, h, &sc)) {
             renderer_free(&rd);
             run_free(&st);
-            cli_crowd_scene_free(&sc);
+            ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "out of memory for rendering");
         }
         img = (ak_image){.pixels = rd.pixels, .width = w, .height = h};
         if (is_gif && ak_gif_writer_create(out, &(ak_gif_desc){.width = w, .height = h, .delay_cs = 4}, NULL, &gif) != AK_OK) {
             renderer_free(&rd);
             run_free(&st);
-            cli_crowd_scene_free(&sc);
+            ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "%s: cannot create the file", out);
         }
     }
@@ -470,6 +437,6 @@ int cmd_crowd(int argc, char** argv) {
                st.n, done, elapsed, done ? 1e3 * elapsed / (double)done : 0.0, reached, st.min_distance,
                st.collided.count);
     run_free(&st);
-    cli_crowd_scene_free(&sc);
+    ak_crowd_scene_free(&sc);
     return rc;
 }
