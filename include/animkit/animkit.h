@@ -32,6 +32,7 @@
 #include "cloth.h"
 #include "retarget.h"
 #include "fluid.h"
+#include "crowd.h"
 #include "rigid.h"
 #include "batch.h"
 

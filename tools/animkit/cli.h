@@ -193,6 +193,7 @@ int cmd_noise(int argc, char** argv);
 int cmd_terrain(int argc, char** argv);
 int cmd_particles(int argc, char** argv);
 int cmd_boids(int argc, char** argv);
+int cmd_crowd(int argc, char** argv);
 int cmd_view(int argc, char** argv);
 int cmd_cloth(int argc, char** argv);
 int cmd_rigid(int argc, char** argv);

@@ -24,6 +24,7 @@ static const command commands[] = {
     {"terrain", cmd_terrain, "generate a fractal terrain: OBJ, 16-bit PNG heightmap, render or GIF flight"},
     {"particles", cmd_particles, "simulate a particle system (scene file or preset) to JSON, PNG or GIF"},
     {"boids", cmd_boids, "flocking: Reynolds boids with obstacles and predators (JSON, PNG, GIF)"},
+    {"crowd", cmd_crowd, "crowds walking to goals without colliding: ORCA (JSON, PNG, GIF)"},
     {"view", cmd_view, "interactive viewer: play clips, compare skinning, drag IK targets (--headless, --script)"},
     {"cloth", cmd_cloth, "simulate cloth (XPBD or mass-spring): flag, curtain, drape, cape"},
     {"rigid", cmd_rigid, "rigid bodies and ragdolls (XPBD): stack, pyramid, dominoes, avalanche, ragdoll, incline"},

@@ -1,0 +1,330 @@
+/* animkit crowd: people walking on the ground plane without colliding (ORCA).
+ *
+ * What it does:
+ *   - agents are discs on the ground plane (2D; an ak_vec2 {x, y} here is the world point
+ *     (x, 0, y): y of the vec2 is world z), each with a radius, preferred and maximum speed,
+ *     neighbour distance and count, time horizons, and a goal: a path of one or more waypoints;
+ *   - static obstacles are polygons (vertices counter-clockwise; two vertices: a wall segment);
+ *   - ORCA, "Optimal Reciprocal Collision Avoidance" (van den Berg, Guy, Lin, Manocha,
+ *     "Reciprocal n-Body Collision Avoidance", ISRR 2011), as the paper and its reference
+ *     library RVO2 compute it: one half-plane of velocities per neighbouring agent (each agent
+ *     takes half the avoidance) and per nearby obstacle edge (the agent takes all of it), the
+ *     new velocity is the one closest to the preferred velocity inside all half-planes and the
+ *     max-speed disc (incremental 2D linear program, each line solved as a 1D program); when
+ *     the half-planes leave no velocity, a 3D linear program minimises the largest violation
+ *     of the agent half-planes while the obstacle half-planes stay hard;
+ *   - neighbour selection as RVO2's: the max_neighbors nearest agents closer than
+ *     neighbor_distance (found through the shared grid, grid.h, visiting rings of cells
+ *     nearest first), every obstacle edge closer than time_horizon_obstacles * max_speed +
+ *     radius, nearest first;
+ *   - the preferred velocity points at the current waypoint at pref_speed, and is the offset
+ *     to the waypoint itself (per second) within pref_speed * 1 s of the last one, so agents
+ *     slow down and stop on their goal (RVO2's examples do this for pref_speed 1); an agent
+ *     moves on to its next waypoint once within waypoint_radius of the current one;
+ *   - thread_count threads each take a range of agents; every agent reads only the step's
+ *     inputs, so results are bit-identical for any thread count.
+ *
+ *   - AK_CROWD_VISION instead: synthetic-vision steering (Ondrej, Pettre, Olivier, Donikian,
+ *     "A synthetic-vision based steering approach for crowd simulation", SIGGRAPH 2010): each
+ *     agent casts vision_width rays over vision_fov around its heading against its neighbours'
+ *     discs and the obstacle edges (a direct per-pixel ray cast, not the rasterizer: it gives
+ *     each pixel its object and hit point); per pixel, the time to interaction and the bearing
+ *     angle's rate; pixels whose |rate| is below the paper's threshold 0.6 ttc^-1.5 are
+ *     threats; the agent turns toward its goal unless that leaves a threat under the
+ *     threshold, then by the smallest heading change that lifts the rates over it (keeping
+ *     their signs; at most 3 rad/s), and slows to pref_speed (1 - exp(-0.5 ttc_min^2)).
+ *     No guarantee against overlap (the contact passes apply as for ORCA).
+ *
+ * What it does NOT do: dynamic obstacles, path planning (waypoints come from the caller), 3D
+ * terrain (the ground is the plane y = 0).
+ *
+ * Usage:
+ *     ak_vec2 goal[2] = {{10, 0}, {-10, 0}};
+ *     ak_crowd_agent agents[2] = {{.goals = {&goal[0], 1}}, {.goals = {&goal[1], 1}}};
+ *     ak_crowd_desc desc = {.agents = {agents, 2}};
+ *     ak_crowd* crowd = NULL;
+ *     if (ak_crowd_create(&desc, NULL, &crowd) != AK_OK) return 1;
+ *     ak_vec2 p[2] = {{-10, 0}, {10, 0}}, v[2] = {{0}}, p2[2], v2[2];
+ *     uint32_t wp[2] = {0, 0};
+ *     ak_crowd_step_job job = {.crowd = crowd, .dt = 0.1f, .positions = {p, 2},
+ *                              .velocities = {v, 2}, .waypoints = {wp, 2},
+ *                              .out_positions = {p2, 2}, .out_velocities = {v2, 2}};
+ *     size_t bytes = ak_crowd_step_scratch_size(&job);
+ *     job.scratch = (ak_u8_span){malloc(bytes), bytes};
+ *     for (int s = 0; s < 300; ++s) {
+ *         ak_crowd_step_run(&job);        // then copy p2 -> p, v2 -> v (or swap the spans)
+ *         memcpy(p, p2, sizeof p); memcpy(v, v2, sizeof v);
+ *     }
+ *     ak_crowd_destroy(crowd);
+ *
+ * Ownership and threading: ak_crowd_create copies everything it needs (agent parameters,
+ * waypoints, obstacles) into one allocation; the built crowd is read-only and may be shared
+ * by threads. The state (positions, velocities, waypoint indices) is caller-owned: the step
+ * job reads the inputs, writes the outputs (which must not alias the inputs) and advances
+ * each agent's waypoint index in place. The step never allocates (scratch comes from the
+ * caller); thread_count > 1 starts pthreads.
+ */
+#ifndef ANIMKIT_CROWD_H
+#define ANIMKIT_CROWD_H
+
+#include "math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define AK_CROWD_MAX_AGENTS 10000000u   /* largest agent count a crowd accepts */
+#define AK_CROWD_MAX_NEIGHBORS 64u      /* largest max_neighbors */
+#define AK_CROWD_MAX_WAYPOINTS 1000000u /* waypoints over all agents */
+#define AK_CROWD_MAX_OBSTACLE_VERTICES 100000u /* obstacle vertices over all obstacles */
+
+/* One agent's parameters and goal path (cold configuration). */
+typedef struct ak_crowd_agent {
+    float radius;                 /* m; 0 -> 0.3 */
+    float pref_speed;             /* m/s, speed toward the goal; 0 -> 1.3 */
+    float max_speed;              /* m/s, >= pref_speed; 0 -> max(2, pref_speed) */
+    float neighbor_distance;      /* m: agents closer than this are considered; 0 -> 5 */
+    uint32_t max_neighbors;       /* the nearest this many count; 0 -> 10; <= 64 */
+    float time_horizon;           /* s: ORCA avoids agents this far ahead; 0 -> 2 */
+    float time_horizon_obstacles; /* s: and obstacles this far ahead; 0 -> 2 */
+    float waypoint_radius;        /* m: an intermediate waypoint counts as passed this close;
+                                     0 -> radius */
+    ak_vec2_cspan goals;          /* required: waypoints (ground x, z), the last is the goal */
+} ak_crowd_agent;
+
+/* A static polygon: vertices counter-clockwise seen from above (+y looking down with x to
+ * the right and z down, i.e. positive signed area in (x, z)); two vertices: a segment that
+ * blocks from both sides. */
+typedef struct ak_crowd_obstacle {
+    ak_vec2_cspan vertices; /* >= 2, ground (x, z) m */
+} ak_crowd_obstacle;
+
+/* Avoidance method. */
+typedef enum ak_crowd_method {
+    AK_CROWD_ORCA = 0, /* default: velocity-based (ORCA) */
+    AK_CROWD_VISION,   /* synthetic vision (Ondrej et al. 2010), see ak_crowd_desc */
+    AK_CROWD_METHOD_COUNT
+} ak_crowd_method;
+
+typedef struct ak_crowd_desc {
+    struct {
+        const ak_crowd_agent* ptr;
+        size_t count;
+    } agents;                            /* required: 1 ..= AK_CROWD_MAX_AGENTS */
+    const ak_crowd_obstacle* obstacles;  /* optional: [obstacle_count] */
+    uint32_t obstacle_count;
+    ak_crowd_method method;              /* 0 -> ORCA */
+    uint32_t vision_width;               /* VISION: pixels of each agent's 1D view; 0 -> 48;
+                                            <= 1024 */
+    float vision_fov;                    /* VISION: field of view, degrees; 0 -> 150; < 360 */
+} ak_crowd_desc;
+
+typedef struct ak_crowd ak_crowd;
+
+/* An agent with every zero default filled in (NULL -> all defaults; goals are kept). */
+AK_API ak_crowd_agent ak_crowd_agent_resolved(const ak_crowd_agent* agent);
+
+/* Build a crowd. alloc may be NULL (malloc/free). Returns AK_ERR_NULL_ARG (desc, out_crowd,
+ * agents.ptr, an agent's goals.ptr, obstacles with obstacle_count > 0, an obstacle's
+ * vertices), AK_ERR_EMPTY (no agents, an agent without waypoints), AK_ERR_BAD_ARG (a
+ * parameter negative or not finite, max_speed < pref_speed, max_neighbors > 64, an obstacle
+ * with fewer than 2 vertices, an unknown method, vision_width > 1024, vision_fov not in
+ * [0, 360) or not finite, counts above the AK_CROWD_MAX_* limits),
+ * AK_ERR_BAD_DATA (a NaN or infinite waypoint or vertex, or beyond 1e7 m; an obstacle edge
+ * of zero length), AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, ak_crowd** out_crowd);
+
+/* Free a crowd (NULL: no-op). */
+AK_API void ak_crowd_destroy(ak_crowd* crowd);
+
+/* Number of agents (0 for NULL). */
+AK_API size_t ak_crowd_agent_count(const ak_crowd* crowd);
+
+/* Agent i's resolved parameters (its goals span points into the crowd). i out of range or
+ * NULL crowd -> a zero agent. */
+AK_API ak_crowd_agent ak_crowd_agent_get(const ak_crowd* crowd, size_t index);
+
+/* Whether agent i, at position p with current waypoint index wp, has reached its final goal:
+ * wp is its last waypoint and |p - goal| <= radius (RVO2's examples' test). */
+AK_API bool ak_crowd_goal_reached(const ak_crowd* crowd, size_t index, ak_vec2 position, uint32_t waypoint);
+
+/* ---- the step job --------------------------------------------------------------------- */
+
+typedef struct ak_crowd_step_job {
+    const ak_crowd* crowd;       /* required */
+    float dt;                    /* s, required: > 0 and finite */
+    uint32_t thread_count;       /* 0 or 1 -> the calling thread; <= 64 */
+    ak_vec2_cspan positions;     /* required: [agent_count] ground (x, z) m */
+    ak_vec2_cspan velocities;    /* required: [agent_count] m/s */
+    ak_u32_span waypoints;       /* required: [agent_count] current waypoint index (in/out:
+                                    advanced in place; out-of-range values are clamped) */
+    ak_vec2_cspan pref_velocities; /* optional: [agent_count] preferred velocities that
+                                    replace the goal rule (the caller steers); empty -> goals */
+    ak_u8_span scratch;          /* >= ak_crowd_step_scratch_size(job) bytes */
+    ak_vec2_span out_positions;  /* [agent_count]: p + dt * v_new; must not alias inputs */
+    ak_vec2_span out_velocities; /* [agent_count]: the ORCA velocity; must not alias inputs */
+    uint64_t max_cell_load;      /* work budget: sum over the grid's cells of (agents in the
+                                    cell)^2; 0 -> AK_CROWD_DEFAULT_CELL_LOAD */
+    uint64_t step_index;         /* the step number: seeds the perturbation below */
+    bool skip_perturbation;      /* false -> each preferred velocity is turned by -0.01 rad
+                                    in (x, z) (every agent to the same side, as people keep
+                                    to one side) and gets a deterministic jitter below
+                                    1e-4 m/s (a hash of agent index and step_index): they
+                                    break the symmetric deadlocks of ORCA (four agents
+                                    crossing head-on, a ring of agents blocking each other at
+                                    the circle's centre); true -> the preferred velocity as
+                                    is (RVO2's bits: bench/vs_rvo2) */
+    uint32_t contact_iterations; /* 0 -> pure ORCA. ORCA lets agents overlap when the crowd
+                                    is so dense that its program is infeasible (the 3D program
+                                    then only minimises the violation; RVO2 does the same); n > 0
+                                    -> after the ORCA move, n Gauss-Seidel passes (on the
+                                    calling thread, pairs in the grid's order) move each
+                                    overlapping pair apart to touching and agents out of
+                                    obstacle edges; velocities stay ORCA's. <= 64 */
+} ak_crowd_step_job;
+
+/* Agents stacked on a few points make the neighbour search quadratic; above this load the
+ * step returns AK_ERR_BUDGET (about 4,000 agents in one cell). */
+#define AK_CROWD_DEFAULT_CELL_LOAD 20000000u
+
+/* Scratch bytes for this job (reads crowd, thread_count and contact_iterations); 0 when the
+ * job cannot be sized (validate says why). */
+AK_API size_t ak_crowd_step_scratch_size(const ak_crowd_step_job* job);
+
+/* First failing rule: AK_ERR_NULL_ARG (job, crowd, a required span), AK_ERR_BAD_ARG (dt not
+ * > 0 and finite, thread_count > 64, contact_iterations > 64, outputs aliasing inputs), AK_ERR_SPAN_SMALL (a span
+ * shorter than the agent count, scratch too small), AK_ERR_BAD_DATA (a NaN or infinite
+ * position or velocity, or one beyond 1e7 m or m/s). */
+AK_API ak_result ak_crowd_step_validate(const ak_crowd_step_job* job);
+
+/* One ORCA step for every agent: neighbours, half-planes, linear program, then
+ * p_out = p + dt * v_out (then the contact passes, when asked). Validates first and writes nothing on failure; besides the
+ * validation codes returns AK_ERR_BUDGET (cell load above max_cell_load). */
+AK_API ak_result ak_crowd_step_run(const ak_crowd_step_job* job);
+
+/* ---- the linear program (exposed for tests and tools) --------------------------------- */
+
+/* A half-plane of velocities: v is allowed when det(direction, point - v) <= 0, i.e. v lies
+ * on the left of the directed line through point along direction (unit). */
+typedef struct ak_crowd_line {
+    ak_vec2 point;
+    ak_vec2 direction;
+} ak_crowd_line;
+
+AK_DEFINE_SPAN(crowd_line, ak_crowd_line)
+
+/* Agent i's ORCA half-planes for the given state: obstacle lines first (their count in
+ * *out_obstacle_line_count), then agent lines, exactly as the step builds them. Writes
+ * min(total, out_lines.count) lines and returns the total (0 on a bad argument). scratch as
+ * for the step job (one thread). */
+AK_API size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd_line_span out_lines,
+                                   size_t* out_obstacle_line_count);
+
+/* Solve ORCA's program: the velocity closest to pref within |v| <= max_speed satisfying every
+ * line; when none exists, the velocity minimising the largest violation of lines
+ * [obstacle_line_count, count) while lines [0, obstacle_line_count) stay satisfied.
+ * scratch: >= lines.count ak_crowd_line entries (the 3D program's projected lines). Returns
+ * the velocity; *out_feasible (optional) says whether the 2D program was feasible. */
+AK_API ak_vec2 ak_crowd_solve(ak_crowd_line_cspan lines, size_t obstacle_line_count, float max_speed, ak_vec2 pref,
+                              ak_crowd_line_span scratch, bool* out_feasible);
+
+/* ---- measures ------------------------------------------------------------------------- */
+
+/* Smallest |p_i - p_j| - r_i - r_j over all pairs (exact, in double: a grid pass over
+ * pairs within reach of touching, else a sort-and-sweep on x) and the number of pairs closer
+ * than r_i + r_j - overlap. positions.count <= agent count (the first agents); fewer than
+ * two -> +infinity and 0. out_pairs (optional) receives the first out_pairs.count / 2
+ * overlapping pairs as index pairs (i < j: i then j). scratch >=
+ * ak_crowd_clearance_scratch_size(crowd, positions.count). Returns AK_ERR_NULL_ARG
+ * (crowd, out_min_distance), AK_ERR_BAD_ARG (more positions than agents), AK_ERR_SPAN_SMALL,
+ * AK_ERR_BAD_DATA (a non-finite position or beyond 1e7 m), AK_ERR_BUDGET (agents so stacked
+ * that the grid's cell load, sum of (agents in a cell)^2 over cells of 2 x the largest
+ * radius, exceeds AK_CROWD_DEFAULT_CELL_LOAD). */
+AK_API size_t ak_crowd_clearance_scratch_size(const ak_crowd* crowd, size_t count);
+AK_API ak_result ak_crowd_clearance(const ak_crowd* crowd, ak_vec2_cspan positions, float overlap,
+                                    ak_u8_span scratch, float* out_min_distance, ak_u32_span out_pairs,
+                                    size_t* out_overlap_count);
+
+/* ---- scene files and presets ------------------------------------------------------------ */
+/* A crowd scene: the JSON format of `animkit crowd SCENE.json` (docs/crowd.md lists every key,
+ * its default and its range) or a preset, over the defaults:
+ *     ak_crowd_scene sc;
+ *     ak_diag diag;
+ *     ak_crowd_scene_defaults(&sc);                        // or ak_crowd_scene_preset(...)
+ *     if (ak_crowd_scene_load_file("corridor.json", &sc, &diag) != AK_OK) puts(diag.message);
+ *     ak_crowd_desc desc = {.agents = {sc.agents, sc.agent_count}, .obstacles = sc.obstacles,
+ *                           .obstacle_count = (uint32_t)sc.obstacle_count, .method = sc.method};
+ *     ... ak_crowd_create(&desc, ...), then sc.steps steps of sc.dt from sc.positions and
+ *         sc.velocities with sc.contact_iterations contact passes ...
+ *     ak_crowd_scene_free(&sc); */
+
+#define AK_CROWD_SCENE_MAX_AGENTS 1000000u    /* agents in a file or asked of a preset */
+#define AK_CROWD_SCENE_MAX_OBSTACLES 10000u   /* obstacles in a file */
+#define AK_CROWD_SCENE_MAX_VERTICES 100000u   /* obstacle vertices in a file, in all */
+#define AK_CROWD_SCENE_MAX_PATH 1000u         /* waypoints of one agent's "path" */
+#define AK_CROWD_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
+/* The names ak_crowd_scene_preset knows. */
+#define AK_CROWD_SCENE_PRESETS "circle, crossing, corridor, evacuation"
+/* Agents of a preset asked for with count 0. */
+#define AK_CROWD_SCENE_DEFAULT_AGENTS 100u
+
+/* A loaded scene; it owns agents, positions, velocities, group, waypoints, obstacles and
+ * vertices (malloc). */
+typedef struct ak_crowd_scene {
+    ak_crowd_agent defaults;      /* "agent_defaults": ak_crowd_agent_resolved(NULL) but
+                                     waypoint_radius 0 (each agent's radius), no goals */
+    ak_crowd_agent* agents;       /* [agent_count]: the defaults with the agent's own keys
+                                     over them; goals point into waypoints */
+    ak_vec2* positions;           /* [agent_count] start positions (ground x, z) */
+    ak_vec2* velocities;          /* [agent_count] start velocities */
+    uint8_t* group;               /* [agent_count] colour group when rendering */
+    size_t agent_count;
+    ak_vec2* waypoints;           /* every agent's path, one after another */
+    size_t waypoint_count;
+    ak_crowd_obstacle* obstacles; /* [obstacle_count]; vertices point into vertices */
+    size_t obstacle_count;
+    ak_vec2* vertices;
+    size_t vertex_count;
+    long steps;                   /* default 1000; a preset's: ceil(duration / dt) */
+    float dt;                     /* s per step, default 0.1 */
+    float duration;               /* s: a preset's run time, long enough for every agent to
+                                     arrive (docs/crowd.md); 0 for the defaults and once a
+                                     file sets "steps" */
+    uint32_t contact_iterations;  /* default 8 */
+    ak_crowd_method method;       /* default AK_CROWD_ORCA */
+} ak_crowd_scene;
+
+/* The defaults of every key (the scene without a file: no agents, no obstacles); owns
+ * nothing. */
+AK_API void ak_crowd_scene_defaults(ak_crowd_scene* scene);
+/* Parse bytes[0, size) (strict JSON) OVER the scene already in *scene, which must hold
+ * ak_crowd_scene_defaults or a preset (keys absent from the file keep its values; "agents"
+ * and "obstacles", when present, replace the scene's; a preset's steps follow a "dt" of the
+ * file unless it sets "steps"); name (NULL -> "(scene)") starts every message. The scene must
+ * end with at least one agent. Returns AK_OK, or AK_ERR_PARSE / AK_ERR_NULL_ARG with, when
+ * out_diag is not NULL, the one line "NAME: key.path: problem" in out_diag->message
+ * ("t.json: agents[3].path[1]: expected [x, z], two numbers"). In every case *scene owns its
+ * arrays afterwards: free it with ak_crowd_scene_free. */
+AK_API ak_result ak_crowd_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                           ak_crowd_scene* scene, ak_diag* out_diag);
+/* Read the file at path (at most AK_CROWD_SCENE_MAX_FILE_SIZE bytes) and parse it over *scene
+ * as ak_crowd_scene_load_bytes does; AK_ERR_IO when it cannot be read. */
+AK_API ak_result ak_crowd_scene_load_file(const char* path, ak_crowd_scene* scene, ak_diag* out_diag);
+/* The defaults, then the preset name (AK_CROWD_SCENE_PRESETS; docs/crowd.md gives their
+ * layouts) with count agents (0 -> AK_CROWD_SCENE_DEFAULT_AGENTS): "circle" (on a circle,
+ * each to the antipode), "crossing" (four blocks cross from the four sides), "corridor" (two
+ * groups meet in an 8 m corridor between two walls), "evacuation" (a room empties through one
+ * door). Sets duration, and steps = ceil(duration / dt). *out_scene is overwritten without
+ * being freed (pass a new or freed scene). AK_ERR_NOT_FOUND for another name, AK_ERR_BAD_ARG
+ * for count above AK_CROWD_SCENE_MAX_AGENTS, AK_ERR_NO_MEMORY, AK_ERR_NULL_ARG; on failure
+ * *out_scene holds the defaults. */
+AK_API ak_result ak_crowd_scene_preset(const char* name, size_t count, ak_crowd_scene* out_scene,
+                                       ak_diag* out_diag);
+/* Free the arrays (NULL: no-op; safe twice); the scalar keys stay. */
+AK_API void ak_crowd_scene_free(ak_crowd_scene* scene);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

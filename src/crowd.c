@@ -1,0 +1,1162 @@
+/* Crowds: ORCA (van den Berg, Guy, Lin, Manocha 2011) on the shared neighbour grid.
+ *
+ * The arithmetic follows the paper's construction in single precision, in the order its
+ * reference library evaluates it, so that trajectories can be compared with RVO2 bit for bit
+ * up to the neighbour order (bench/vs_rvo2). Each agent reads only the step's inputs and
+ * writes its own outputs: threads split agents into ranges and results do not depend on the
+ * split. */
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <animkit/crowd.h>
+#include <animkit/grid.h>
+
+#include "internal.h"
+
+#define EPS 1e-5f   /* the LP's parallel-line tolerance (RVO2's RVO_EPSILON) */
+#define COORD_MAX 1e7f
+
+/* ---- private types --------------------------------------------------------------------- */
+
+typedef struct obst_vertex {
+    ak_vec2 point;
+    ak_vec2 direction; /* unit, toward next */
+    uint32_t next, prev;
+    bool convex;
+} obst_vertex;
+
+struct ak_crowd {
+    ak_allocator alloc;
+    size_t agent_count;
+    ak_crowd_agent* agents; /* resolved; goals point into waypoints */
+    ak_vec2* waypoints;
+    obst_vertex* verts;
+    uint32_t vertex_count;
+    ak_crowd_method method;
+    uint32_t vision_width;
+    float vision_fov; /* radians */
+    float max_neighbor_distance;
+    float max_radius;
+    uint32_t max_k;
+    float cell_size;
+};
+
+typedef struct neigh {
+    float dist_sq;
+    uint32_t index;
+} neigh;
+
+/* ---- small vector helpers (single precision, as written in the paper) ------------------ */
+
+static inline ak_vec2 v2(float x, float y) { ak_vec2 r = {x, y}; return r; }
+static inline ak_vec2 add(ak_vec2 a, ak_vec2 b) { return v2(a.x + b.x, a.y + b.y); }
+static inline ak_vec2 sub(ak_vec2 a, ak_vec2 b) { return v2(a.x - b.x, a.y - b.y); }
+static inline ak_vec2 mul(float s, ak_vec2 a) { return v2(s * a.x, s * a.y); }
+/* Division as a multiplication by the reciprocal (RVO2's Vector2 divides this way). */
+static inline ak_vec2 divs(ak_vec2 a, float s) {
+    const float inv = 1.0f / s;
+    return v2(a.x * inv, a.y * inv);
+}
+static inline ak_vec2 neg(ak_vec2 a) { return v2(-a.x, -a.y); }
+static inline float dot(ak_vec2 a, ak_vec2 b) { return a.x * b.x + a.y * b.y; }
+static inline float det(ak_vec2 a, ak_vec2 b) { return a.x * b.y - a.y * b.x; }
+static inline float abs_sq(ak_vec2 a) { return dot(a, a); }
+static inline float len(ak_vec2 a) { return sqrtf(abs_sq(a)); }
+/* A zero vector (agents on the same point, an agent on a vertex) has no direction: +x then,
+ * so that degenerate input gives a finite answer (RVO2 divides by zero there). */
+static inline ak_vec2 normalize(ak_vec2 a) {
+    const float l = len(a);
+    return l > 0.0f ? divs(a, l) : v2(1.0f, 0.0f);
+}
+/* > 0 when c lies left of the directed line a -> b. */
+static inline float left_of(ak_vec2 a, ak_vec2 b, ak_vec2 c) { return det(sub(a, c), sub(b, a)); }
+
+static bool finite_in(float x, float lim) { return ak_finitef(x) && fabsf(x) <= lim; }
+
+/* ---- agents and the crowd object ---------------------------------------------------------- */
+
+ak_crowd_agent ak_crowd_agent_resolved(const ak_crowd_agent* agent) {
+    ak_crowd_agent a;
+    if (agent) a = *agent;
+    else memset(&a, 0, sizeof a);
+    if (a.radius == 0.0f) a.radius = 0.3f;
+    if (a.pref_speed == 0.0f) a.pref_speed = 1.3f;
+    if (a.max_speed == 0.0f) a.max_speed = ak_maxf(2.0f, a.pref_speed);
+    if (a.neighbor_distance == 0.0f) a.neighbor_distance = 5.0f;
+    if (a.max_neighbors == 0) a.max_neighbors = 10;
+    if (a.time_horizon == 0.0f) a.time_horizon = 2.0f;
+    if (a.time_horizon_obstacles == 0.0f) a.time_horizon_obstacles = 2.0f;
+    if (a.waypoint_radius == 0.0f) a.waypoint_radius = a.radius;
+    return a;
+}
+
+static bool agent_ok(const ak_crowd_agent* a) {
+    const float f[] = {a->radius,       a->pref_speed,   a->max_speed,           a->neighbor_distance,
+                       a->time_horizon, a->time_horizon_obstacles, a->waypoint_radius};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
+        if (!(f[i] >= 0.0f) || !finite_in(f[i], COORD_MAX)) return false;
+    if (a->max_neighbors > AK_CROWD_MAX_NEIGHBORS) return false;
+    const ak_crowd_agent r = ak_crowd_agent_resolved(a);
+    return r.max_speed >= r.pref_speed;
+}
+
+ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, ak_crowd** out_crowd) {
+    if (out_crowd) *out_crowd = NULL;
+    if (!desc || !out_crowd || !desc->agents.ptr) return AK_ERR_NULL_ARG;
+    if (desc->obstacle_count > 0 && !desc->obstacles) return AK_ERR_NULL_ARG;
+    const size_t n = desc->agents.count;
+    size_t wp_total = 0, vert_total = 0;
+    for (size_t i = 0; i < n && i <= AK_CROWD_MAX_AGENTS; ++i) {
+        if (!desc->agents.ptr[i].goals.ptr && desc->agents.ptr[i].goals.count > 0) return AK_ERR_NULL_ARG;
+        wp_total += desc->agents.ptr[i].goals.count;
+        if (wp_total > AK_CROWD_MAX_WAYPOINTS) return AK_ERR_BAD_ARG;
+    }
+    for (uint32_t o = 0; o < desc->obstacle_count && o <= AK_CROWD_MAX_OBSTACLE_VERTICES; ++o) {
+        if (!desc->obstacles[o].vertices.ptr) return AK_ERR_NULL_ARG;
+        vert_total += desc->obstacles[o].vertices.count;
+        if (vert_total > AK_CROWD_MAX_OBSTACLE_VERTICES) return AK_ERR_BAD_ARG;
+    }
+    if (n > AK_CROWD_MAX_AGENTS || (unsigned)desc->method >= AK_CROWD_METHOD_COUNT || desc->vision_width > 1024 ||
+        !(desc->vision_fov >= 0.0f && desc->vision_fov < 360.0f) ||
+        desc->obstacle_count > AK_CROWD_MAX_OBSTACLE_VERTICES)
+        return AK_ERR_BAD_ARG;
+    if (n == 0) return AK_ERR_EMPTY;
+    for (size_t i = 0; i < n; ++i) {
+        if (desc->agents.ptr[i].goals.count == 0) return AK_ERR_EMPTY;
+        if (!agent_ok(&desc->agents.ptr[i])) return AK_ERR_BAD_ARG;
+    }
+    for (uint32_t o = 0; o < desc->obstacle_count; ++o)
+        if (desc->obstacles[o].vertices.count < 2) return AK_ERR_BAD_ARG;
+    for (size_t i = 0; i < n; ++i)
+        for (size_t k = 0; k < desc->agents.ptr[i].goals.count; ++k) {
+            const ak_vec2 g = desc->agents.ptr[i].goals.ptr[k];
+            if (!finite_in(g.x, COORD_MAX) || !finite_in(g.y, COORD_MAX)) return AK_ERR_BAD_DATA;
+        }
+    for (uint32_t o = 0; o < desc->obstacle_count; ++o) {
+        const ak_vec2_cspan vs = desc->obstacles[o].vertices;
+        for (size_t k = 0; k < vs.count; ++k) {
+            const ak_vec2 g = vs.ptr[k];
+            if (!finite_in(g.x, COORD_MAX) || !finite_in(g.y, COORD_MAX)) return AK_ERR_BAD_DATA;
+        }
+        for (size_t k = 0; k < vs.count; ++k) { /* every edge has a length */
+            const ak_vec2 e = sub(vs.ptr[(k + 1) % vs.count], vs.ptr[k]);
+            if (!(abs_sq(e) > 0.0f)) return AK_ERR_BAD_DATA;
+        }
+    }
+
+    const size_t s_head = akp_align16(sizeof(ak_crowd));
+    const size_t s_agents = akp_align16(n * sizeof(ak_crowd_agent));
+    const size_t s_wp = akp_align16(wp_total * sizeof(ak_vec2));
+    const size_t s_verts = akp_align16(vert_total * sizeof(obst_vertex));
+    char* mem = (char*)akp_calloc(alloc, s_head + s_agents + s_wp + s_verts);
+    if (!mem) return AK_ERR_NO_MEMORY;
+    ak_crowd* c = (ak_crowd*)(void*)mem;
+    if (alloc) c->alloc = *alloc;
+    c->agent_count = n;
+    c->agents = (ak_crowd_agent*)(void*)(mem + s_head);
+    c->waypoints = (ak_vec2*)(void*)(mem + s_head + s_agents);
+    c->verts = (obst_vertex*)(void*)(mem + s_head + s_agents + s_wp);
+    c->vertex_count = (uint32_t)vert_total;
+    c->method = desc->method;
+    c->vision_width = desc->vision_width ? desc->vision_width : 48;
+    c->vision_fov = (desc->vision_fov > 0.0f ? desc->vision_fov : 150.0f) * (3.14159265358979f / 180.0f);
+    size_t w = 0;
+    for (size_t i = 0; i < n; ++i) {
+        ak_crowd_agent a = ak_crowd_agent_resolved(&desc->agents.ptr[i]);
+        memcpy(c->waypoints + w, a.goals.ptr, a.goals.count * sizeof(ak_vec2));
+        a.goals.ptr = c->waypoints + w;
+        w += a.goals.count;
+        c->agents[i] = a;
+        c->max_neighbor_distance = ak_maxf(c->max_neighbor_distance, a.neighbor_distance);
+        c->max_radius = ak_maxf(c->max_radius, a.radius);
+        if (a.max_neighbors > c->max_k) c->max_k = a.max_neighbors;
+    }
+    /* Obstacles: a ring of vertices per polygon, each with its edge direction and convexity
+     * (a segment's two vertices are both convex). */
+    uint32_t v = 0;
+    for (uint32_t o = 0; o < desc->obstacle_count; ++o) {
+        const ak_vec2* p = desc->obstacles[o].vertices.ptr;
+        const uint32_t m = (uint32_t)desc->obstacles[o].vertices.count;
+        for (uint32_t k = 0; k < m; ++k) {
+            obst_vertex* ov = &c->verts[v + k];
+            ov->point = p[k];
+            ov->next = v + (k + 1 == m ? 0 : k + 1);
+            ov->prev = v + (k == 0 ? m - 1 : k - 1);
+            ov->convex = m == 2 || left_of(p[k == 0 ? m - 1 : k - 1], p[k], p[k + 1 == m ? 0 : k + 1]) >= 0.0f;
+            const ak_vec2 e = sub(p[k + 1 == m ? 0 : k + 1], p[k]);
+            ov->direction = abs_sq(e) > 0.0f ? normalize(e) : v2(1.0f, 0.0f);
+        }
+        v += m;
+    }
+    /* Cells a quarter of the neighbour distance: the ring search stops as soon as the
+     * max_neighbors nearest are found, which in a dense crowd is well inside that distance. */
+    c->cell_size = ak_maxf(c->max_neighbor_distance * 0.25f, 1e-3f);
+    *out_crowd = c;
+    return AK_OK;
+}
+
+void ak_crowd_destroy(ak_crowd* crowd) {
+    if (!crowd) return;
+    const ak_allocator a = crowd->alloc;
+    akp_free(a.alloc ? &a : NULL, crowd);
+}
+
+size_t ak_crowd_agent_count(const ak_crowd* crowd) { return crowd ? crowd->agent_count : 0; }
+
+ak_crowd_agent ak_crowd_agent_get(const ak_crowd* crowd, size_t index) {
+    ak_crowd_agent a;
+    memset(&a, 0, sizeof a);
+    if (crowd && index < crowd->agent_count) a = crowd->agents[index];
+    return a;
+}
+
+bool ak_crowd_goal_reached(const ak_crowd* crowd, size_t index, ak_vec2 position, uint32_t waypoint) {
+    if (!crowd || index >= crowd->agent_count) return false;
+    const ak_crowd_agent* a = &crowd->agents[index];
+    if ((size_t)waypoint + 1 < a->goals.count) return false;
+    const ak_vec2 g = a->goals.ptr[a->goals.count - 1];
+    return abs_sq(sub(position, g)) <= a->radius * a->radius;
+}
+
+/* ---- the linear programs ------------------------------------------------------------------- */
+
+/* 1D program on line `no` (within the speed disc and the lines before it). */
+static bool lp1(const ak_crowd_line* lines, size_t no, float radius, ak_vec2 opt, bool dir_opt, ak_vec2* result) {
+    const ak_crowd_line L = lines[no];
+    const float dp = dot(L.point, L.direction);
+    const float disc = dp * dp + radius * radius - abs_sq(L.point);
+    if (disc < 0.0f) return false; /* the line misses the speed disc */
+    const float sq = sqrtf(disc);
+    float t_left = -dp - sq, t_right = -dp + sq;
+    for (size_t i = 0; i < no; ++i) {
+        const float denom = det(L.direction, lines[i].direction);
+        const float numer = det(lines[i].direction, sub(L.point, lines[i].point));
+        if (fabsf(denom) <= EPS) { /* parallel */
+            if (numer < 0.0f) return false;
+            continue;
+        }
+        const float t = numer / denom;
+        if (denom >= 0.0f) t_right = ak_minf(t_right, t);
+        else t_left = ak_maxf(t_left, t);
+        if (t_left > t_right) return false;
+    }
+    if (dir_opt) {
+        *result = dot(opt, L.direction) > 0.0f ? add(L.point, mul(t_right, L.direction))
+                                                : add(L.point, mul(t_left, L.direction));
+    } else {
+        const float t = dot(L.direction, sub(opt, L.point));
+        if (t < t_left) *result = add(L.point, mul(t_left, L.direction));
+        else if (t > t_right) *result = add(L.point, mul(t_right, L.direction));
+        else *result = add(L.point, mul(t, L.direction));
+    }
+    return true;
+}
+
+/* 2D program (incremental, Seidel-style in input order). Returns the first line that could
+ * not be satisfied, or count. */
+static size_t lp2(const ak_crowd_line* lines, size_t count, float radius, ak_vec2 opt, bool dir_opt, ak_vec2* result) {
+    if (dir_opt) *result = mul(radius, opt);
+    else if (abs_sq(opt) > radius * radius) *result = mul(radius, normalize(opt));
+    else *result = opt;
+    for (size_t i = 0; i < count; ++i) {
+        if (det(lines[i].direction, sub(lines[i].point, *result)) > 0.0f) {
+            const ak_vec2 keep = *result;
+            if (!lp1(lines, i, radius, opt, dir_opt, result)) {
+                *result = keep;
+                return i;
+            }
+        }
+    }
+    return count;
+}
+
+/* 3D program: minimise the largest violation of lines [begin, count) by a projection of the
+ * earlier agent lines onto each violated one; obstacle lines stay hard. */
+static void lp3(const ak_crowd_line* lines, size_t count, size_t obst_count, size_t begin, float radius,
+                ak_crowd_line* proj, ak_vec2* result) {
+    float distance = 0.0f;
+    for (size_t i = begin; i < count; ++i) {
+        if (det(lines[i].direction, sub(lines[i].point, *result)) > distance) {
+            size_t np = obst_count;
+            memcpy(proj, lines, obst_count * sizeof *proj);
+            for (size_t j = obst_count; j < i; ++j) {
+                ak_crowd_line l;
+                const float d = det(lines[i].direction, lines[j].direction);
+                if (fabsf(d) <= EPS) {
+                    if (dot(lines[i].direction, lines[j].direction) > 0.0f) continue; /* same way */
+                    l.point = mul(0.5f, add(lines[i].point, lines[j].point));
+                } else {
+                    l.point = add(lines[i].point,
+                                  mul(det(lines[j].direction, sub(lines[i].point, lines[j].point)) / d,
+                                      lines[i].direction));
+                }
+                l.direction = normalize(sub(lines[j].direction, lines[i].direction));
+                proj[np++] = l;
+            }
+            const ak_vec2 keep = *result;
+            if (lp2(proj, np, radius, v2(-lines[i].direction.y, lines[i].direction.x), true, result) < np)
+                *result = keep; /* rounding: keep the previous solution */
+            distance = det(lines[i].direction, sub(lines[i].point, *result));
+        }
+    }
+}
+
+ak_vec2 ak_crowd_solve(ak_crowd_line_cspan lines, size_t obstacle_line_count, float max_speed, ak_vec2 pref,
+                       ak_crowd_line_span scratch, bool* out_feasible) {
+    ak_vec2 r = v2(0.0f, 0.0f);
+    if (out_feasible) *out_feasible = false;
+    if ((lines.count > 0 && !lines.ptr) || obstacle_line_count > lines.count || !(max_speed >= 0.0f) ||
+        !ak_finitef(pref.x) || !ak_finitef(pref.y))
+        return r;
+    const size_t fail = lp2(lines.ptr, lines.count, max_speed, pref, false, &r);
+    if (fail < lines.count) {
+        if (scratch.count >= lines.count && scratch.ptr)
+            lp3(lines.ptr, lines.count, obstacle_line_count, fail, max_speed, scratch.ptr, &r);
+    } else if (out_feasible) {
+        *out_feasible = true;
+    }
+    return r;
+}
+
+/* ---- per-thread work ------------------------------------------------------------------------- */
+
+typedef struct ctx {
+    const ak_crowd_step_job* job;
+    const ak_crowd* crowd;
+    const ak_grid* grid;
+    /* A dense table of the grid's cells over their bounding rectangle (when it fits the
+     * scratch: about 4 cells per agent), so that a lookup is an index instead of a hash. */
+    const uint32_t* dense;
+    int32_t dense_x0, dense_z0, dense_w, dense_h;
+} ctx;
+
+static inline uint32_t cell_lookup(const ctx* c, int32_t x, int32_t z) {
+    if (c->dense) {
+        const int64_t u = (int64_t)x - c->dense_x0, w = (int64_t)z - c->dense_z0;
+        if (u < 0 || w < 0 || u >= c->dense_w || w >= c->dense_h) return UINT32_MAX;
+        return c->dense[w * c->dense_w + u];
+    }
+    const ak_grid_cell cc = {x, 0, z};
+    return ak_grid_cell_find(c->grid, cc);
+}
+
+/* Fill the dense table when the occupied rectangle fits cap entries; else leave it off. */
+static void dense_build(ctx* c, uint32_t* table, size_t cap) {
+    const ak_grid* g = c->grid;
+    c->dense = NULL;
+    if (g->cell_count == 0) return;
+    int32_t x0 = g->cell_coord[0].x, x1 = x0, z0 = g->cell_coord[0].z, z1 = z0;
+    for (uint32_t m = 1; m < g->cell_count; ++m) {
+        const ak_grid_cell q = g->cell_coord[m];
+        if (q.x < x0) x0 = q.x;
+        if (q.x > x1) x1 = q.x;
+        if (q.z < z0) z0 = q.z;
+        if (q.z > z1) z1 = q.z;
+    }
+    const int64_t w = (int64_t)x1 - x0 + 1, h = (int64_t)z1 - z0 + 1;
+    if (w * h > (int64_t)cap) return;
+    for (int64_t k = 0; k < w * h; ++k) table[k] = UINT32_MAX;
+    for (uint32_t m = 0; m < g->cell_count; ++m)
+        table[(int64_t)(g->cell_coord[m].z - z0) * w + (g->cell_coord[m].x - x0)] = m;
+    c->dense = table;
+    c->dense_x0 = x0;
+    c->dense_z0 = z0;
+    c->dense_w = (int32_t)w;
+    c->dense_h = (int32_t)h;
+}
+
+typedef struct worker {
+    const ctx* c;
+    size_t begin, end;
+    neigh* agent_n;       /* [max_k] */
+    neigh* obst_n;        /* [vertex_count] */
+    ak_crowd_line* lines; /* [max_k + vertex_count] */
+    ak_crowd_line* proj;  /* [max_k + vertex_count] */
+} worker;
+
+/* Insert (d, j) into a list sorted by (distance, index); when the list is full the range
+ * shrinks to its last entry (the k nearest, as RVO2 selects them). */
+static void insert_agent(neigh* list, uint32_t* count, uint32_t k, float* range_sq, float d, uint32_t j) {
+    if (!(d < *range_sq)) return;
+    uint32_t i = *count < k ? (*count)++ : k - 1;
+    while (i > 0 && (d < list[i - 1].dist_sq || (d == list[i - 1].dist_sq && j < list[i - 1].index))) {
+        list[i] = list[i - 1];
+        --i;
+    }
+    list[i].dist_sq = d;
+    list[i].index = j;
+    if (*count == k) *range_sq = list[k - 1].dist_sq;
+}
+
+static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, neigh* out) {
+    if (a->max_neighbors == 0) return 0;
+    const ak_grid* g = c->grid;
+    uint32_t count = 0;
+    float range_sq = a->neighbor_distance * a->neighbor_distance;
+    const ak_grid_cell home = ak_grid_cell_of(g, ak_vec3_make(p.x, 0.0f, p.y));
+    const float cs = g->cell_size;
+    const int32_t rmax = (int32_t)ceilf(a->neighbor_distance / cs) + 1;
+    for (int32_t r = 0; r <= rmax; ++r) {
+        if (r >= 2) {
+            const float md = (float)(r - 1) * cs;
+            if (md * md * (1.0f - 1e-5f) >= range_sq) break; /* every cell of this ring is farther */
+        }
+        const int32_t side = r == 0 ? 1 : 2 * r + 1;
+        /* the ring: top and bottom rows in full, then the two side columns */
+        for (int32_t e = 0; e < (r == 0 ? 1 : 8 * r); ++e) {
+            int32_t dx, dz;
+            if (r == 0) {
+                dx = 0;
+                dz = 0;
+            } else if (e < side) {
+                dx = e - r;
+                dz = -r;
+            } else if (e < 2 * side) {
+                dx = e - side - r;
+                dz = r;
+            } else {
+                const int32_t k = e - 2 * side; /* 0 .. 2(2r-1)-1 */
+                dx = (k & 1) ? r : -r;
+                dz = -r + 1 + (k >> 1);
+            }
+            if (r >= 2) {
+                /* skip a cell whose nearest point is out of range (a margin for rounding) */
+                const float lx = (float)(home.x + dx) * cs, lz = (float)(home.z + dz) * cs;
+                const float gx = ak_maxf(0.0f, ak_maxf(lx - p.x, p.x - (lx + cs)));
+                const float gz = ak_maxf(0.0f, ak_maxf(lz - p.y, p.y - (lz + cs)));
+                if ((gx * gx + gz * gz) * (1.0f - 1e-4f) >= range_sq) continue;
+            }
+            const uint32_t m = cell_lookup(c, home.x + dx, home.z + dz);
+            if (m == UINT32_MAX) continue;
+            for (uint32_t s = g->cell_start[m]; s < g->cell_start[m + 1]; ++s) {
+                const uint32_t j = g->order[s];
+                if (j == self) continue;
+                const float dx2 = p.x - g->x[s], dz2 = p.y - g->z[s];
+                const float d = dx2 * dx2 + dz2 * dz2;
+                insert_agent(out, &count, a->max_neighbors, &range_sq, d, j);
+            }
+        }
+    }
+    return count;
+}
+
+/* Obstacle edges within range that the agent sees from their outer (right) side, nearest
+ * first (ties in vertex order). */
+static uint32_t obstacle_neighbors(const ak_crowd* c, ak_vec2 p, const ak_crowd_agent* a, neigh* out) {
+    const float range = a->time_horizon_obstacles * a->max_speed + a->radius;
+    const float range_sq = range * range;
+    uint32_t count = 0;
+    for (uint32_t k = 0; k < c->vertex_count; ++k) {
+        const obst_vertex* o1 = &c->verts[k];
+        const obst_vertex* o2 = &c->verts[o1->next];
+        if (!(left_of(o1->point, o2->point, p) < 0.0f)) continue;
+        const ak_vec2 e = sub(o2->point, o1->point);
+        const float r = dot(sub(p, o1->point), e) / abs_sq(e);
+        float d;
+        if (r < 0.0f) d = abs_sq(sub(p, o1->point));
+        else if (r > 1.0f) d = abs_sq(sub(p, o2->point));
+        else d = abs_sq(sub(p, add(o1->point, mul(r, e))));
+        if (!(d < range_sq)) continue;
+        uint32_t i = count++;
+        while (i > 0 && d < out[i - 1].dist_sq) {
+            out[i] = out[i - 1];
+            --i;
+        }
+        out[i].dist_sq = d;
+        out[i].index = k;
+    }
+    return count;
+}
+
+/* The half-planes an obstacle edge puts on agent velocities (paper section 5.2), appended
+ * to lines. */
+static size_t obstacle_lines(const ak_crowd* c, ak_vec2 pos, ak_vec2 vel, const ak_crowd_agent* a,
+                             const neigh* on, uint32_t on_count, ak_crowd_line* lines) {
+    size_t nl = 0;
+    const float inv_th = 1.0f / a->time_horizon_obstacles;
+    const float radius = a->radius;
+    for (uint32_t q = 0; q < on_count; ++q) {
+        const obst_vertex* o1 = &c->verts[on[q].index];
+        const obst_vertex* o2 = &c->verts[o1->next];
+        const ak_vec2 rp1 = sub(o1->point, pos), rp2 = sub(o2->point, pos);
+        /* An edge whose cut-off is already behind an earlier line adds nothing. */
+        bool covered = false;
+        for (size_t j = 0; j < nl; ++j)
+            if (det(sub(mul(inv_th, rp1), lines[j].point), lines[j].direction) - inv_th * radius >= -EPS &&
+                det(sub(mul(inv_th, rp2), lines[j].point), lines[j].direction) - inv_th * radius >= -EPS) {
+                covered = true;
+                break;
+            }
+        if (covered) continue;
+        const float d1 = abs_sq(rp1), d2 = abs_sq(rp2), r2 = radius * radius;
+        const ak_vec2 ov = sub(o2->point, o1->point);
+        const float s = dot(neg(rp1), ov) / abs_sq(ov);
+        const float dline = abs_sq(sub(neg(rp1), mul(s, ov)));
+        ak_crowd_line line;
+        /* Already colliding: push straight out. */
+        if (s < 0.0f && d1 <= r2) {
+            if (o1->convex) {
+                line.point = v2(0.0f, 0.0f);
+                line.direction = normalize(v2(-rp1.y, rp1.x));
+                lines[nl++] = line;
+            }
+            continue;
+        }
+        if (s > 1.0f && d2 <= r2) {
+            if (o2->convex && det(rp2, o2->direction) >= 0.0f) {
+                line.point = v2(0.0f, 0.0f);
+                line.direction = normalize(v2(-rp2.y, rp2.x));
+                lines[nl++] = line;
+            }
+            continue;
+        }
+        if (s >= 0.0f && s <= 1.0f && dline <= r2) {
+            line.point = v2(0.0f, 0.0f);
+            line.direction = neg(o1->direction);
+            lines[nl++] = line;
+            continue;
+        }
+        /* Not colliding: the legs of the velocity obstacle (tangents from the agent's centre
+         * to the discs of radius r around the edge's ends). */
+        ak_vec2 left_leg, right_leg;
+        const obst_vertex* e1 = o1;
+        const obst_vertex* e2 = o2;
+        if (s < 0.0f && dline <= r2) { /* seen end-on from o1's side: one vertex */
+            if (!e1->convex) continue;
+            e2 = e1;
+            const float leg = sqrtf(d1 - r2);
+            left_leg = divs(v2(rp1.x * leg - rp1.y * radius, rp1.x * radius + rp1.y * leg), d1);
+            right_leg = divs(v2(rp1.x * leg + rp1.y * radius, -rp1.x * radius + rp1.y * leg), d1);
+        } else if (s > 1.0f && dline <= r2) {
+            if (!e2->convex) continue;
+            e1 = e2;
+            const float leg = sqrtf(d2 - r2);
+            left_leg = divs(v2(rp2.x * leg - rp2.y * radius, rp2.x * radius + rp2.y * leg), d2);
+            right_leg = divs(v2(rp2.x * leg + rp2.y * radius, -rp2.x * radius + rp2.y * leg), d2);
+        } else {
+            if (e1->convex) {
+                const float leg = sqrtf(d1 - r2);
+                left_leg = divs(v2(rp1.x * leg - rp1.y * radius, rp1.x * radius + rp1.y * leg), d1);
+            } else {
+                left_leg = neg(e1->direction);
+            }
+            if (e2->convex) {
+                const float leg = sqrtf(d2 - r2);
+                right_leg = divs(v2(rp2.x * leg + rp2.y * radius, -rp2.x * radius + rp2.y * leg), d2);
+            } else {
+                right_leg = e1->direction;
+            }
+        }
+        /* A leg pointing into a neighbouring edge is replaced by that edge ("foreign"). */
+        const obst_vertex* left_nb = &c->verts[e1->prev];
+        bool left_foreign = false, right_foreign = false;
+        if (e1->convex && det(left_leg, neg(left_nb->direction)) >= 0.0f) {
+            left_leg = neg(left_nb->direction);
+            left_foreign = true;
+        }
+        if (e2->convex && det(right_leg, e2->direction) <= 0.0f) {
+            right_leg = e2->direction;
+            right_foreign = true;
+        }
+        /* Project the velocity on the cut-off segment or a leg, whichever is nearest. */
+        const ak_vec2 lc = mul(inv_th, sub(e1->point, pos));
+        const ak_vec2 rc = mul(inv_th, sub(e2->point, pos));
+        const ak_vec2 cv = sub(rc, lc);
+        const float t = e1 == e2 ? 0.5f : dot(sub(vel, lc), cv) / abs_sq(cv);
+        const float tl = dot(sub(vel, lc), left_leg);
+        const float tr = dot(sub(vel, rc), right_leg);
+        if ((t < 0.0f && tl < 0.0f) || (e1 == e2 && tl < 0.0f && tr < 0.0f)) {
+            const ak_vec2 w = normalize(sub(vel, lc)); /* the left cut-off circle */
+            line.direction = v2(w.y, -w.x);
+            line.point = add(lc, mul(radius * inv_th, w));
+            lines[nl++] = line;
+            continue;
+        }
+        if (t > 1.0f && tr < 0.0f) {
+            const ak_vec2 w = normalize(sub(vel, rc)); /* the right cut-off circle */
+            line.direction = v2(w.y, -w.x);
+            line.point = add(rc, mul(radius * inv_th, w));
+            lines[nl++] = line;
+            continue;
+        }
+        const float dcut = (t < 0.0f || t > 1.0f || e1 == e2) ? INFINITY : abs_sq(sub(vel, add(lc, mul(t, cv))));
+        const float dleft = tl < 0.0f ? INFINITY : abs_sq(sub(vel, add(lc, mul(tl, left_leg))));
+        const float dright = tr < 0.0f ? INFINITY : abs_sq(sub(vel, add(rc, mul(tr, right_leg))));
+        if (dcut <= dleft && dcut <= dright) {
+            line.direction = neg(e1->direction);
+            line.point = add(lc, mul(radius * inv_th, v2(-line.direction.y, line.direction.x)));
+            lines[nl++] = line;
+            continue;
+        }
+        if (dleft <= dright) {
+            if (left_foreign) continue;
+            line.direction = left_leg;
+            line.point = add(lc, mul(radius * inv_th, v2(-line.direction.y, line.direction.x)));
+            lines[nl++] = line;
+            continue;
+        }
+        if (right_foreign) continue;
+        line.direction = neg(right_leg);
+        line.point = add(rc, mul(radius * inv_th, v2(-line.direction.y, line.direction.x)));
+        lines[nl++] = line;
+    }
+    return nl;
+}
+
+/* The reciprocal half-plane for a neighbour (paper section 4): u is the smallest change of
+ * relative velocity that leaves the truncated velocity obstacle; each agent takes half. */
+static ak_crowd_line agent_line(ak_vec2 pos, ak_vec2 vel, float radius, ak_vec2 opos, ak_vec2 ovel, float oradius,
+                                float inv_th, float dt, float tie) {
+    const ak_vec2 rp = sub(opos, pos);
+    const ak_vec2 rv = sub(vel, ovel);
+    const float dsq = abs_sq(rp);
+    const float cr = radius + oradius;
+    const float cr2 = cr * cr;
+    ak_crowd_line line;
+    ak_vec2 u;
+    if (dsq > cr2) {
+        const ak_vec2 w = sub(rv, mul(inv_th, rp)); /* from the cut-off centre */
+        const float wl2 = abs_sq(w);
+        const float dp = dot(w, rp);
+        if (dp < 0.0f && dp * dp > cr2 * wl2) { /* project on the cut-off circle */
+            const float wl = sqrtf(wl2);
+            const ak_vec2 uw = divs(w, wl);
+            line.direction = v2(uw.y, -uw.x);
+            u = mul(cr * inv_th - wl, uw);
+        } else { /* project on a leg */
+            const float leg = sqrtf(dsq - cr2);
+            if (det(rp, w) > 0.0f)
+                line.direction = divs(v2(rp.x * leg - rp.y * cr, rp.x * cr + rp.y * leg), dsq);
+            else
+                line.direction = neg(divs(v2(rp.x * leg + rp.y * cr, -rp.x * cr + rp.y * leg), dsq));
+            u = sub(mul(dot(rv, line.direction), line.direction), rv);
+        }
+    } else { /* overlapping: resolve within one step */
+        const float inv_dt = 1.0f / dt;
+        const ak_vec2 w = sub(rv, mul(inv_dt, rp));
+        const float wl = len(w);
+        /* same point, same velocity: the lower index moves toward +x, the other toward -x */
+        const ak_vec2 uw = wl > 0.0f ? divs(w, wl) : v2(tie, 0.0f);
+        line.direction = v2(uw.y, -uw.x);
+        u = mul(cr * inv_dt - wl, uw);
+    }
+    line.point = add(vel, mul(0.5f, u));
+    return line;
+}
+
+static uint64_t mix64(uint64_t x) {
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ull;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+/* Below 1e-4 m/s in a direction drawn from (agent, step): breaks exact symmetries. */
+static ak_vec2 perturb(const ak_crowd_step_job* job, size_t i, ak_vec2 v) {
+    if (job->skip_perturbation) return v;
+    const uint64_t h = mix64((uint64_t)i * 0x9e3779b97f4a7c15ull + mix64(job->step_index + 0x5851f42d4c957f2dull));
+    const float angle = (float)(h >> 40) * (6.28318530717958647692f / 16777216.0f);
+    const float mag = (float)((h >> 16) & 0xffffff) * (1e-4f / 16777216.0f);
+    /* and a turn of 0.01 rad to the same side for every agent: a ring of agents that block
+     * each other on the way to the centre (the circle's deadlock) then turns and unwinds */
+    const float bias = 0.01f;
+    return v2(v.x + mag * cosf(angle) + bias * v.y, v.y + mag * sinf(angle) - bias * v.x);
+}
+
+static ak_vec2 pref_velocity(const ak_crowd_step_job* job, const ak_crowd_agent* a, size_t i, ak_vec2 p) {
+    if (job->pref_velocities.ptr) return perturb(job, i, job->pref_velocities.ptr[i]);
+    uint32_t wp = job->waypoints.ptr[i];
+    const uint32_t last = (uint32_t)a->goals.count - 1;
+    if (wp > last) wp = last;
+    while (wp < last && abs_sq(sub(a->goals.ptr[wp], p)) <= a->waypoint_radius * a->waypoint_radius) ++wp;
+    job->waypoints.ptr[i] = wp;
+    const ak_vec2 g = sub(a->goals.ptr[wp], p);
+    const float s = a->pref_speed;
+    if (wp < last || abs_sq(g) > s * s) return perturb(job, i, mul(s, normalize(g)));
+    return perturb(job, i, g); /* within one second of the goal: arrive */
+}
+
+/* All lines of agent i into w->lines; returns the count and the obstacle-line count. */
+static size_t build_lines(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const ak_crowd_agent* a, size_t* out_obst) {
+    const ctx* c = w->c;
+    const ak_crowd_step_job* job = c->job;
+    const uint32_t no = c->crowd->vertex_count ? obstacle_neighbors(c->crowd, p, a, w->obst_n) : 0;
+    size_t nl = no ? obstacle_lines(c->crowd, p, v, a, w->obst_n, no, w->lines) : 0;
+    *out_obst = nl;
+    const uint32_t na = agent_neighbors(c, i, p, a, w->agent_n);
+    const float inv_th = 1.0f / a->time_horizon;
+    for (uint32_t k = 0; k < na; ++k) {
+        const uint32_t j = w->agent_n[k].index;
+        w->lines[nl++] = agent_line(p, v, a->radius, job->positions.ptr[j], job->velocities.ptr[j],
+                                    c->crowd->agents[j].radius, inv_th, job->dt, i < j ? 1.0f : -1.0f);
+    }
+    return nl;
+}
+
+/* Nearest ray hit t > 0 of o + t d (d unit) on a disc (centre q, radius r); INFINITY when
+ * none. A ray starting inside the disc hits at t = 0. */
+static float ray_disc(ak_vec2 o, ak_vec2 d, ak_vec2 q, float r) {
+    const ak_vec2 m = sub(o, q);
+    const float b = dot(m, d), cc = abs_sq(m) - r * r;
+    if (cc <= 0.0f) return 0.0f;
+    if (b > 0.0f) return INFINITY;
+    const float disc = b * b - cc;
+    if (disc < 0.0f) return INFINITY;
+    return -b - sqrtf(disc);
+}
+
+/* Nearest hit of o + t d on segment a-b; INFINITY when none. */
+static float ray_segment(ak_vec2 o, ak_vec2 d, ak_vec2 a, ak_vec2 b) {
+    const ak_vec2 e = sub(b, a);
+    const float den = det(d, e);
+    if (fabsf(den) < 1e-12f) return INFINITY;
+    const ak_vec2 ao = sub(a, o);
+    const float t = det(ao, e) / den, u = det(ao, d) / den;
+    return (t > 0.0f && u >= 0.0f && u <= 1.0f) ? t : INFINITY;
+}
+
+/* Synthetic-vision steering (Ondrej et al. 2010) for one agent: a 1D view of vision_width
+ * pixels; per pixel the visible object's hit point, its time to interaction and the rate of
+ * its bearing; threats turn and slow the agent. */
+static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const ak_crowd_agent* a, ak_vec2 pref) {
+    const ctx* c = w->c;
+    const ak_crowd* crowd = c->crowd;
+    const ak_crowd_step_job* job = c->job;
+    const uint32_t na = agent_neighbors(c, i, p, a, w->agent_n);
+    const uint32_t no = crowd->vertex_count ? obstacle_neighbors(crowd, p, a, w->obst_n) : 0;
+    const float speed = len(v);
+    const float pref_len = len(pref);
+    /* heading: the velocity, or the goal's direction when standing */
+    const ak_vec2 head = speed > 1e-3f ? mul(1.0f / speed, v) : (pref_len > 0.0f ? mul(1.0f / pref_len, pref) : v2(1.0f, 0.0f));
+    const float theta = atan2f(head.y, head.x);
+    const float fov = crowd->vision_fov;
+    const uint32_t W = crowd->vision_width;
+    float need_right = INFINITY, need_left = -INFINITY; /* turn-rate bounds from the threats */
+    bool right = false, left = false;
+    float ttc_min = INFINITY;
+    for (uint32_t k = 0; k < W; ++k) {
+        const float ang = theta + fov * (0.5f - ((float)k + 0.5f) / (float)W);
+        const ak_vec2 d = v2(cosf(ang), sinf(ang));
+        float best = INFINITY;
+        ak_vec2 ovel = v2(0.0f, 0.0f);
+        for (uint32_t q = 0; q < na; ++q) {
+            const uint32_t j = w->agent_n[q].index;
+            const float t = ray_disc(p, d, job->positions.ptr[j], crowd->agents[j].radius);
+            if (t < best) {
+                best = t;
+                ovel = job->velocities.ptr[j];
+            }
+        }
+        for (uint32_t q = 0; q < no; ++q) {
+            const obst_vertex* o1 = &crowd->verts[w->obst_n[q].index];
+            const float t = ray_segment(p, d, o1->point, crowd->verts[o1->next].point);
+            if (t < best) {
+                best = t;
+                ovel = v2(0.0f, 0.0f);
+            }
+        }
+        if (!(best < INFINITY)) continue;
+        /* the pixel's point relative to the agent, and its relative velocity */
+        const ak_vec2 rp = mul(best, d), rv = sub(ovel, v);
+        const float dist2 = abs_sq(rp);
+        const float closing = -dot(rp, rv); /* > 0 when approaching (times |rp|) */
+        if (!(closing > 0.0f)) continue;
+        const float dist = sqrtf(dist2);
+        const float ttc = fmaxf(dist - a->radius, 0.0f) * dist / closing;
+        const float rate = dist2 > 0.0f ? det(rp, rv) / dist2 : 0.0f; /* bearing rate, rad/s */
+        const float thr = 0.6f * powf(fmaxf(ttc, 1e-3f), -1.5f);
+        if (fabsf(rate) >= thr) continue; /* not a threat: it will pass */
+        if (ttc < ttc_min) ttc_min = ttc;
+        /* Turning the heading by delta changes this bearing rate by about -k delta, with
+         * k = (own speed) cos(angle to the point) / distance: keep the rate's sign and lift
+         * it over the threshold (points beside or behind do not respond to a turn). */
+        const float k = fmaxf(speed, 0.1f * pref_len) * dot(head, d) / dist;
+        if (!(k > 1e-4f)) continue;
+        if (rate >= 0.0f) {
+            right = true;
+            need_right = fminf(need_right, (rate - thr) / k); /* delta <= this (< 0: clockwise) */
+        } else {
+            left = true;
+            need_left = fmaxf(need_left, (rate + thr) / k); /* delta >= this (> 0) */
+        }
+    }
+    /* toward the goal, then the threats' bound on the side that asks for the smaller turn */
+    float delta = 0.0f;
+    if (pref_len > 0.0f) delta = atan2f(det(head, pref), dot(head, pref));
+    if (right && (!left || -need_right <= need_left)) delta = fminf(delta, need_right);
+    else if (left) delta = fmaxf(delta, need_left);
+    const float max_turn = 3.0f * job->dt; /* 3 rad/s */
+    const float turn = ak_clampf(delta, -max_turn, max_turn);
+    const ak_vec2 nh = v2(head.x * cosf(turn) - head.y * sinf(turn), head.x * sinf(turn) + head.y * cosf(turn));
+    float s = pref_len;
+    if (ttc_min < INFINITY) s *= 1.0f - expf(-0.5f * ttc_min * ttc_min);
+    /* a floor of 2 mm/s keeps the heading (the velocity's direction) of a stopped agent */
+    s = fmaxf(fminf(s, a->max_speed), fminf(2e-3f, pref_len));
+    return mul(s, nh);
+}
+
+static void* work(void* arg) {
+    worker* w = (worker*)arg;
+    const ctx* c = w->c;
+    const ak_crowd_step_job* job = c->job;
+    for (size_t i = w->begin; i < w->end; ++i) {
+        const ak_crowd_agent* a = &c->crowd->agents[i];
+        const ak_vec2 p = job->positions.ptr[i], v = job->velocities.ptr[i];
+        const ak_vec2 pref = pref_velocity(job, a, i, p);
+        if (c->crowd->method == AK_CROWD_VISION) {
+            ak_vec2 nv = vision_velocity(w, i, p, v, a, pref);
+            if (!ak_finitef(nv.x) || !ak_finitef(nv.y)) nv = v2(0.0f, 0.0f);
+            job->out_velocities.ptr[i] = nv;
+            job->out_positions.ptr[i] = add(p, mul(job->dt, nv));
+            continue;
+        }
+        size_t no = 0;
+        const size_t nl = build_lines(w, i, p, v, a, &no);
+        ak_vec2 nv;
+        const size_t fail = lp2(w->lines, nl, a->max_speed, pref, false, &nv);
+        if (fail < nl) lp3(w->lines, nl, no, fail, a->max_speed, w->proj, &nv);
+        if (!ak_finitef(nv.x) || !ak_finitef(nv.y)) nv = v2(0.0f, 0.0f); /* never NaN out */
+        job->out_velocities.ptr[i] = nv;
+        job->out_positions.ptr[i] = add(p, mul(job->dt, nv));
+    }
+    return NULL;
+}
+
+/* Push an agent out of the obstacle edges it overlaps (from their outer side). */
+static ak_vec2 push_out_of_obstacles(const ak_crowd* crowd, ak_vec2 q, float r) {
+    for (uint32_t k = 0; k < crowd->vertex_count; ++k) {
+        const obst_vertex* o1 = &crowd->verts[k];
+        const ak_vec2 b = crowd->verts[o1->next].point;
+        const ak_vec2 e = sub(b, o1->point);
+        const float t = ak_clampf(dot(sub(q, o1->point), e) / abs_sq(e), 0.0f, 1.0f);
+        const ak_vec2 d = sub(q, add(o1->point, mul(t, e)));
+        const float d2 = abs_sq(d);
+        if (d2 >= r * r || !(d2 > 0.0f) || left_of(o1->point, b, q) > 0.0f) continue;
+        const float dl = sqrtf(d2);
+        q = add(q, mul((r - dl) / dl, d));
+    }
+    return q;
+}
+
+/* One Gauss-Seidel contact pass over every overlapping pair, in the grid's order (cells,
+ * then the 9-cell stencil, then sorted entries: a function of the positions only), each pair
+ * moved apart to touching, then agents out of obstacle edges. */
+static void contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P) {
+    for (uint32_t m = 0; m < g->cell_count; ++m) {
+        const ak_grid_cell cm = g->cell_coord[m];
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const ak_grid_cell cc = {cm.x + dx, 0, cm.z + dz};
+                const uint32_t m2 = ak_grid_cell_find(g, cc);
+                if (m2 == UINT32_MAX || m2 < m) continue;
+                for (uint32_t s = g->cell_start[m]; s < g->cell_start[m + 1]; ++s) {
+                    const uint32_t i = g->order[s];
+                    for (uint32_t t = (m2 == m ? s + 1 : g->cell_start[m2]); t < g->cell_start[m2 + 1]; ++t) {
+                        const uint32_t j = g->order[t];
+                        const float rr = crowd->agents[i].radius + crowd->agents[j].radius;
+                        const ak_vec2 d = sub(P[i], P[j]);
+                        const float d2 = abs_sq(d);
+                        if (!(d2 < rr * rr)) continue;
+                        const float dl = sqrtf(d2);
+                        /* coincident centres: split along x, lower index to -x */
+                        const ak_vec2 dir = dl > 1e-6f * rr ? mul(1.0f / dl, d) : v2(i < j ? -1.0f : 1.0f, 0.0f);
+                        const ak_vec2 h = mul(0.5f * (rr - dl), dir);
+                        P[i] = add(P[i], h);
+                        P[j] = sub(P[j], h);
+                    }
+                }
+            }
+    }
+    if (crowd->vertex_count)
+        for (size_t i = 0; i < crowd->agent_count; ++i) P[i] = push_out_of_obstacles(crowd, P[i], crowd->agents[i].radius);
+}
+
+static void run_threads(void* (*fn)(void*), worker* w, uint32_t threads) {
+    pthread_t ids[64];
+    bool started[64] = {false};
+    for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, fn, &w[t]) == 0;
+    fn(&w[0]);
+    for (uint32_t t = 1; t < threads; ++t) {
+        if (started[t]) pthread_join(ids[t], NULL);
+        else fn(&w[t]);
+    }
+}
+
+/* ---- scratch layout -------------------------------------------------------------------------- */
+
+static uint32_t thread_total(const ak_crowd_step_job* job, size_t n) {
+    uint32_t t = job->thread_count == 0 ? 1u : job->thread_count;
+    if (t > 64) t = 64;
+    if ((size_t)t * 256u > n) t = n / 256u > 0 ? (uint32_t)(n / 256u) : 1u; /* a thread start ~ 256 agents */
+    return t;
+}
+
+typedef struct layout {
+    size_t grid_pts, grid_mem, per_thread, contact, dense, dense_cap, total;
+    ak_grid_desc gd, contact_gd;
+} layout;
+
+static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t contact_iterations, layout* L) {
+    memset(L, 0, sizeof *L);
+    L->gd.cell_size = c->cell_size;
+    L->contact_gd.cell_size = ak_maxf(2.0f * c->max_radius, 1e-3f);
+    size_t gm = ak_grid_memory_size(n, &L->gd);
+    if (contact_iterations > 0) {
+        const size_t gm2 = ak_grid_memory_size(n, &L->contact_gd);
+        if (gm2 > gm) gm = gm2;
+    }
+    if (gm == 0 && n > 0) return false;
+    L->grid_pts = akp_align16(n * sizeof(ak_vec3));
+    L->grid_mem = akp_align16(gm);
+    const size_t lines = (size_t)c->max_k + c->vertex_count;
+    L->per_thread = akp_align16((size_t)c->max_k * sizeof(neigh)) + akp_align16((size_t)c->vertex_count * sizeof(neigh)) +
+                    2 * akp_align16(lines * sizeof(ak_crowd_line));
+    L->dense_cap = 4 * n + 1024;
+    L->dense = akp_align16(L->dense_cap * sizeof(uint32_t));
+    L->total = L->grid_pts + L->grid_mem + L->contact + L->dense + (size_t)threads * L->per_thread + 16;
+    return true;
+}
+
+static void carve_worker(const ak_crowd* c, char* base, worker* w) {
+    const size_t lines = (size_t)c->max_k + c->vertex_count;
+    w->agent_n = (neigh*)(void*)base;
+    base += akp_align16((size_t)c->max_k * sizeof(neigh));
+    w->obst_n = (neigh*)(void*)base;
+    base += akp_align16((size_t)c->vertex_count * sizeof(neigh));
+    w->lines = (ak_crowd_line*)(void*)base;
+    base += akp_align16(lines * sizeof(ak_crowd_line));
+    w->proj = (ak_crowd_line*)(void*)base;
+}
+
+static char* align_up(void* p) { return (char*)(((uintptr_t)p + 15u) & ~(uintptr_t)15u); }
+
+size_t ak_crowd_step_scratch_size(const ak_crowd_step_job* job) {
+    if (!job || !job->crowd || job->thread_count > 64 || job->contact_iterations > 64) return 0;
+    const size_t n = job->crowd->agent_count;
+    layout L;
+    if (!make_layout(job->crowd, n, thread_total(job, n), job->contact_iterations, &L)) return 0;
+    return L.total;
+}
+
+static bool overlaps(const void* a, size_t an, const void* b, size_t bn) {
+    const char *pa = (const char*)a, *pb = (const char*)b;
+    if (!pa || !pb || an == 0 || bn == 0) return false;
+    return pa < pb + bn && pb < pa + an;
+}
+
+ak_result ak_crowd_step_validate(const ak_crowd_step_job* job) {
+    if (!job || !job->crowd || !job->positions.ptr || !job->velocities.ptr || !job->waypoints.ptr ||
+        !job->out_positions.ptr || !job->out_velocities.ptr)
+        return AK_ERR_NULL_ARG;
+    if (!(job->dt > 0.0f) || !ak_finitef(job->dt) || job->thread_count > 64 || job->contact_iterations > 64)
+        return AK_ERR_BAD_ARG;
+    const size_t n = job->crowd->agent_count, b = n * sizeof(ak_vec2);
+    const size_t ob = job->out_positions.count * sizeof(ak_vec2), ovb = job->out_velocities.count * sizeof(ak_vec2);
+    if (overlaps(job->out_positions.ptr, ob, job->positions.ptr, b) ||
+        overlaps(job->out_positions.ptr, ob, job->velocities.ptr, b) ||
+        overlaps(job->out_velocities.ptr, ovb, job->positions.ptr, b) ||
+        overlaps(job->out_velocities.ptr, ovb, job->velocities.ptr, b) ||
+        overlaps(job->out_velocities.ptr, ovb, job->out_positions.ptr, ob) ||
+        overlaps(job->waypoints.ptr, job->waypoints.count * sizeof(uint32_t), job->out_positions.ptr, ob) ||
+        overlaps(job->waypoints.ptr, job->waypoints.count * sizeof(uint32_t), job->out_velocities.ptr, ovb) ||
+        overlaps(job->scratch.ptr, job->scratch.count, job->out_positions.ptr, ob) ||
+        overlaps(job->scratch.ptr, job->scratch.count, job->out_velocities.ptr, ovb))
+        return AK_ERR_BAD_ARG;
+    if (job->positions.count < n || job->velocities.count < n || job->waypoints.count < n ||
+        job->out_positions.count < n || job->out_velocities.count < n ||
+        (job->pref_velocities.ptr && job->pref_velocities.count < n))
+        return AK_ERR_SPAN_SMALL;
+    const size_t need = ak_crowd_step_scratch_size(job);
+    if (need == 0 || job->scratch.count < need || !job->scratch.ptr) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i) {
+        const ak_vec2 p = job->positions.ptr[i], v = job->velocities.ptr[i];
+        if (!finite_in(p.x, COORD_MAX) || !finite_in(p.y, COORD_MAX) || !finite_in(v.x, COORD_MAX) ||
+            !finite_in(v.y, COORD_MAX))
+            return AK_ERR_BAD_DATA;
+        if (job->pref_velocities.ptr) {
+            const ak_vec2 q = job->pref_velocities.ptr[i];
+            if (!finite_in(q.x, COORD_MAX) || !finite_in(q.y, COORD_MAX)) return AK_ERR_BAD_DATA;
+        }
+    }
+    return AK_OK;
+}
+
+/* Build a grid over ground positions in the scratch; checks the budget. */
+static ak_result build_grid(const ak_crowd_step_job* job, const layout* L, const ak_grid_desc* gd,
+                            const ak_vec2* positions, char* base, ak_grid* grid) {
+    const size_t n = job->crowd->agent_count;
+    ak_vec3* pts = (ak_vec3*)(void*)base;
+    for (size_t i = 0; i < n; ++i) pts[i] = ak_vec3_make(positions[i].x, 0.0f, positions[i].y);
+    const ak_result r = ak_grid_build(gd, (ak_vec3_cspan){pts, n}, (ak_u8_span){(uint8_t*)(base + L->grid_pts), L->grid_mem}, grid);
+    if (r != AK_OK) return r;
+    uint64_t load = 0;
+    for (uint32_t m = 0; m < grid->cell_count; ++m) {
+        const uint64_t k = grid->cell_start[m + 1] - grid->cell_start[m];
+        load += k * k;
+    }
+    const uint64_t budget = job->max_cell_load ? job->max_cell_load : AK_CROWD_DEFAULT_CELL_LOAD;
+    return load > budget ? AK_ERR_BUDGET : AK_OK;
+}
+
+ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
+    const ak_result vr = ak_crowd_step_validate(job);
+    if (vr != AK_OK) return vr;
+    const ak_crowd* crowd = job->crowd;
+    const size_t n = crowd->agent_count;
+    const uint32_t threads = thread_total(job, n);
+    layout L;
+    make_layout(crowd, n, threads, job->contact_iterations, &L);
+    char* base = align_up(job->scratch.ptr);
+    ak_grid grid;
+    const ak_result gr = build_grid(job, &L, &L.gd, job->positions.ptr, base, &grid);
+    if (gr != AK_OK) return gr;
+    ctx c = {.job = job, .crowd = crowd, .grid = &grid};
+    dense_build(&c, (uint32_t*)(void*)(base + L.grid_pts + L.grid_mem + L.contact), L.dense_cap);
+    worker w[64];
+    char* tb = base + L.grid_pts + L.grid_mem + L.contact + L.dense;
+    for (uint32_t t = 0; t < threads; ++t) {
+        w[t].c = &c;
+        w[t].begin = n * t / threads;
+        w[t].end = n * (t + 1) / threads;
+        carve_worker(crowd, tb + (size_t)t * L.per_thread, &w[t]);
+    }
+    run_threads(work, w, threads);
+    if (job->contact_iterations == 0) return AK_OK;
+    /* Contacts: Gauss-Seidel passes over the moved positions (on this thread), the grid
+     * rebuilt for each. */
+    for (uint32_t it = 0; it < job->contact_iterations; ++it) {
+        const ak_result cr = build_grid(job, &L, &L.contact_gd, job->out_positions.ptr, base, &grid);
+        if (cr != AK_OK) return cr;
+        contact_pass(crowd, &grid, job->out_positions.ptr);
+    }
+    return AK_OK;
+}
+
+size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd_line_span out_lines,
+                            size_t* out_obstacle_line_count) {
+    if (out_obstacle_line_count) *out_obstacle_line_count = 0;
+    if (ak_crowd_step_validate(job) != AK_OK || index >= job->crowd->agent_count) return 0;
+    const ak_crowd* crowd = job->crowd;
+    layout L;
+    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), job->contact_iterations, &L);
+    char* base = align_up(job->scratch.ptr);
+    ak_grid grid;
+    if (build_grid(job, &L, &L.gd, job->positions.ptr, base, &grid) != AK_OK) return 0;
+    ctx c = {.job = job, .crowd = crowd, .grid = &grid};
+    dense_build(&c, (uint32_t*)(void*)(base + L.grid_pts + L.grid_mem + L.contact), L.dense_cap);
+    worker w;
+    w.c = &c;
+    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense, &w);
+    const ak_crowd_agent* a = &crowd->agents[index];
+    size_t no = 0;
+    const ak_vec2 p = job->positions.ptr[index], v = job->velocities.ptr[index];
+    const size_t nl = build_lines(&w, index, p, v, a, &no);
+    for (size_t k = 0; k < nl && k < out_lines.count && out_lines.ptr; ++k) out_lines.ptr[k] = w.lines[k];
+    if (out_obstacle_line_count) *out_obstacle_line_count = no;
+    return nl;
+}
+
+/* ---- measures ------------------------------------------------------------------------------- */
+
+typedef struct xkey {
+    float x;
+    uint32_t index;
+} xkey;
+
+static int xkey_cmp(const void* a, const void* b) {
+    const xkey *p = (const xkey*)a, *q = (const xkey*)b;
+    if (p->x != q->x) return p->x < q->x ? -1 : 1;
+    return p->index < q->index ? -1 : (p->index > q->index ? 1 : 0);
+}
+
+size_t ak_crowd_clearance_scratch_size(const ak_crowd* crowd, size_t count) {
+    if (!crowd || count > AK_CROWD_MAX_AGENTS) return 0;
+    ak_grid_desc gd = {.cell_size = ak_maxf(2.0f * crowd->max_radius, 1e-3f)};
+    return akp_align16(count * sizeof(ak_vec3)) + akp_align16(ak_grid_memory_size(count, &gd)) +
+           akp_align16(count * sizeof(xkey)) + 16;
+}
+
+ak_result ak_crowd_clearance(const ak_crowd* crowd, ak_vec2_cspan positions, float overlap, ak_u8_span scratch,
+                             float* out_min_distance, ak_u32_span out_pairs, size_t* out_overlap_count) {
+    if (!crowd || !out_min_distance || (positions.count > 0 && !positions.ptr)) return AK_ERR_NULL_ARG;
+    *out_min_distance = INFINITY;
+    if (out_overlap_count) *out_overlap_count = 0;
+    const size_t n = positions.count;
+    if (n > crowd->agent_count) return AK_ERR_BAD_ARG;
+    if (n < 2) return AK_OK;
+    const size_t need = ak_crowd_clearance_scratch_size(crowd, n);
+    if (!scratch.ptr || scratch.count < need) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i)
+        if (!finite_in(positions.ptr[i].x, COORD_MAX) || !finite_in(positions.ptr[i].y, COORD_MAX)) return AK_ERR_BAD_DATA;
+    ak_grid_desc gd = {.cell_size = ak_maxf(2.0f * crowd->max_radius, 1e-3f)};
+    char* base = align_up(scratch.ptr);
+    ak_vec3* pts = (ak_vec3*)(void*)base;
+    for (size_t i = 0; i < n; ++i) pts[i] = ak_vec3_make(positions.ptr[i].x, 0.0f, positions.ptr[i].y);
+    ak_grid g;
+    const size_t gm = akp_align16(ak_grid_memory_size(n, &gd));
+    const ak_result r = ak_grid_build(&gd, (ak_vec3_cspan){pts, n},
+                                      (ak_u8_span){(uint8_t*)(base + akp_align16(n * sizeof(ak_vec3))), gm}, &g);
+    if (r != AK_OK) return r;
+    uint64_t load = 0; /* agents stacked on a few points: the pair pass is quadratic */
+    for (uint32_t m = 0; m < g.cell_count; ++m) {
+        const uint64_t k = g.cell_start[m + 1] - g.cell_start[m];
+        load += k * k;
+    }
+    if (load > AK_CROWD_DEFAULT_CELL_LOAD) return AK_ERR_BUDGET;
+    /* Nearest pair within one cell of reach (radius sums <= the cell); pairs farther apart
+     * only matter when no pair is that close, then a brute-force pass below decides. */
+    double best = INFINITY;
+    size_t over = 0;
+    for (uint32_t m = 0; m < g.cell_count; ++m) {
+        const ak_grid_cell cm = g.cell_coord[m];
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const ak_grid_cell cc = {cm.x + dx, 0, cm.z + dz};
+                const uint32_t m2 = ak_grid_cell_find(&g, cc);
+                if (m2 == UINT32_MAX || m2 < m) continue;
+                for (uint32_t s = g.cell_start[m]; s < g.cell_start[m + 1]; ++s) {
+                    const uint32_t i = g.order[s];
+                    for (uint32_t t = (m2 == m ? s + 1 : g.cell_start[m2]); t < g.cell_start[m2 + 1]; ++t) {
+                        const uint32_t j = g.order[t];
+                        const double ddx = (double)positions.ptr[i].x - positions.ptr[j].x;
+                        const double ddz = (double)positions.ptr[i].y - positions.ptr[j].y;
+                        const double d = sqrt(ddx * ddx + ddz * ddz) - crowd->agents[i].radius - crowd->agents[j].radius;
+                        if (d < best) best = d;
+                        if (d < -(double)overlap) {
+                            if (out_pairs.ptr && 2 * over + 1 < out_pairs.count) {
+                                out_pairs.ptr[2 * over] = i < j ? i : j;
+                                out_pairs.ptr[2 * over + 1] = i < j ? j : i;
+                            }
+                            ++over;
+                        }
+                    }
+                }
+            }
+    }
+    if (!(best <= 0.0)) {
+        /* No pair within reach: the minimum lies farther. Sort on x and sweep (exact; about
+         * N log N for spread-out agents). */
+        xkey* keys = (xkey*)(void*)(base + akp_align16(n * sizeof(ak_vec3)) + gm);
+        for (size_t i = 0; i < n; ++i) keys[i] = (xkey){positions.ptr[i].x, (uint32_t)i};
+        qsort(keys, n, sizeof *keys, xkey_cmp);
+        const double rmax = crowd->max_radius;
+        for (size_t a = 0; a < n; ++a) {
+            const uint32_t i = keys[a].index;
+            for (size_t b = a + 1; b < n; ++b) {
+                const double gap = (double)keys[b].x - keys[a].x - crowd->agents[i].radius - rmax;
+                if (gap >= best) break;
+                const uint32_t j = keys[b].index;
+                const double ddx = (double)positions.ptr[i].x - positions.ptr[j].x;
+                const double ddz = (double)positions.ptr[i].y - positions.ptr[j].y;
+                const double d = sqrt(ddx * ddx + ddz * ddz) - crowd->agents[i].radius - crowd->agents[j].radius;
+                if (d < best) best = d;
+            }
+        }
+    }
+    *out_min_distance = (float)best;
+    if (out_overlap_count) *out_overlap_count = over;
+    return AK_OK;
+}
