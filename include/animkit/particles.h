@@ -37,7 +37,8 @@
  * indices: point them at such particles). The id array follows each particle.
  *
  * What it does NOT do: rigid bodies, particle-particle collisions (use Lennard-Jones for
- * repulsion), implicit integration, or rendering (the CLI draws with raster.h).
+ * repulsion), implicit integration, or rendering (the CLI draws with raster.h; ak_particle_look
+ * describes colour, size and sprite frame over a particle's life for a renderer).
  *
  * Usage:
  *     ak_particles* ps;
@@ -370,6 +371,44 @@ typedef struct ak_particles_world {
  * the end of the step rather than poisoning the output. */
 AK_API ak_result ak_particles_step(ak_particles* particles, const ak_particles_world* world,
                                    float dt);
+
+/* ---- appearance over life (for rendering) --------------------------------------------- */
+
+/* How a particle looks as it ages, as the fraction of its life t = age / lifetime in [0, 1]
+ * (t = 0 for an infinite lifetime): its colour and size multiply keyframed curves, linear
+ * between keys and held constant before the first and after the last, and its sprite-sheet
+ * frame comes from its age. The system itself never reads this (rendering only). */
+#define AK_PARTICLE_LOOK_MAX_KEYS 8
+
+typedef struct ak_particle_colour_key {
+    float t;        /* life fraction in [0, 1]; keys strictly increasing */
+    ak_vec4 colour; /* multiplies the particle's colour (RGBA, alpha included) */
+} ak_particle_colour_key;
+
+typedef struct ak_particle_size_key {
+    float t;    /* life fraction in [0, 1]; keys strictly increasing */
+    float size; /* multiplies the particle's size, >= 0 */
+} ak_particle_size_key;
+
+typedef struct ak_particle_look {
+    ak_particle_colour_key colour_keys[AK_PARTICLE_LOOK_MAX_KEYS];
+    uint32_t colour_key_count; /* 0 -> the colour is not changed (a factor of 1, 1, 1, 1) */
+    ak_particle_size_key size_keys[AK_PARTICLE_LOOK_MAX_KEYS];
+    uint32_t size_key_count;   /* 0 -> the size is not changed (a factor of 1) */
+    uint32_t frame_count;      /* frames of the sprite sheet; 0 -> 1 */
+    float frame_rate;          /* frames per second from emission, looping; 0 -> the frames
+                                  spread once over the lifetime (frame floor(t * frame_count)) */
+} ak_particle_look;
+
+/* AK_OK, or AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (a key count above AK_PARTICLE_LOOK_MAX_KEYS, a key
+ * t outside [0, 1] or not increasing, a negative size, a non-finite value, frame_rate < 0). */
+AK_API ak_result ak_particle_look_validate(const ak_particle_look* look);
+/* Colour factor at the given age and lifetime (seconds; look NULL or without keys -> 1). */
+AK_API ak_vec4 ak_particle_look_colour(const ak_particle_look* look, float age, float lifetime);
+/* Size factor at the given age and lifetime (look NULL or without keys -> 1). */
+AK_API float ak_particle_look_size(const ak_particle_look* look, float age, float lifetime);
+/* Sprite-sheet frame in [0, frame_count) at the given age and lifetime (NULL -> 0). */
+AK_API uint32_t ak_particle_look_frame(const ak_particle_look* look, float age, float lifetime);
 
 #ifdef __cplusplus
 }
