@@ -296,5 +296,6 @@ void particles_scene_free(particles_scene* s) {
     free(s->vortices);
     free(s->emitters);
     free(s->bursts);
+    free(s->sprites.sheet_path);
     memset(s, 0, sizeof *s);
 }

@@ -6,6 +6,7 @@
 #include <stddef.h>
 
 #include <animkit/particles.h>
+#include <animkit/raster.h>
 
 /* Bursts the CLI fires from an emitter: count particles at time start, then every interval. */
 typedef struct particles_burst {
@@ -13,6 +14,18 @@ typedef struct particles_burst {
     float start;    /* seconds */
     float interval; /* seconds; 0 = once */
 } particles_burst;
+
+/* How the particles are drawn: round points (the default) or camera-facing sprites with a
+ * texture, a sprite sheet, blending and colour/size over life ("render" in a scene file). */
+typedef struct particles_sprites {
+    bool enabled;              /* false -> points */
+    ak_sprite_texture texture; /* built-in texture when sheet_path is NULL: DISC or PUFF */
+    char* sheet_path;          /* a PNG sprite sheet (owned), or NULL */
+    int sheet_columns;         /* frames across; 0 -> 1 (built-in PUFF with frames: that many puffs) */
+    int sheet_rows;            /* frames down; 0 -> 1 */
+    ak_blend blend;            /* AK_BLEND_ALPHA (sorted back to front) or AK_BLEND_ADD */
+    ak_particle_look look;     /* colour, size and frame over life */
+} particles_sprites;
 
 /* A parsed scene: the world and everything to add, owning its arrays (particles_scene_free). */
 typedef struct particles_scene {
@@ -31,6 +44,7 @@ typedef struct particles_scene {
     ak_particle_emitter* emitters;
     particles_burst* bursts; /* [emitter_count] */
     size_t emitter_count;
+    particles_sprites sprites;
 } particles_scene;
 
 /* Limits a scene file may ask for (memory budget before allocating). */
