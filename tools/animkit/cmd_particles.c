@@ -12,14 +12,15 @@
 #include "sim_bake.h"
 
 static const char* const usage =
-    "usage: animkit particles [SCENE.json | --preset fountain|rain|fireworks|character] [--steps "
-    "N]\n"
-    "                         [--dt DT] [--integrator euler|symplectic|verlet|rk4] [--seed K]\n"
+    "usage: animkit particles [SCENE.json | --preset fountain|rain|fireworks|character|fire|smoke]\n"
+    "                         [--steps N]"
+    " [--dt DT] [--integrator euler|symplectic|verlet|rk4] [--seed K]\n"
     "                         [--threads T] [--json OUT.json] [-o OUT.gif|OUT.png|OUT.glb|OUT.gltf]\n"
     "                         [--size WxH]\n"
     "Simulate a particle system (docs/particles.md describes the scene format).\n"
     "  --preset     a built-in scene instead of a file (character: rain and sparks on the walking\n"
-    "               builtin:humanoid, which the particles collide with)\n"
+    "               builtin:humanoid, which the particles collide with; fire and smoke: textured\n"
+    "               sprites with colour and size over life)\n"
     "  --steps      steps to run, 0 to 100000000 (default 200)\n"
     "  --dt         step in seconds (overrides the file; default 0.01)\n"
     "  --integrator overrides the file (default symplectic)\n"
@@ -39,6 +40,7 @@ typedef struct renderer {
     ak_image image;
     particles_shapes sh;
     ak_vec4* colours;
+    particles_sprite_renderer sprites;
     float ground;
     const char* title;
 } renderer;
@@ -46,8 +48,10 @@ typedef struct renderer {
 static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
     cli_frame* f = &rd->frame;
     ak_raster* ras = f->raster;
-    ak_raster_clear(ras, ak_vec4_make(0.83f, 0.87f, 0.93f, 1),
-                    ak_vec4_make(0.48f, 0.51f, 0.58f, 1));
+    if (r->scene->sprites.enabled && r->scene->sprites.blend == AK_BLEND_ADD) /* a glow shows on a dark sky */
+        ak_raster_clear(ras, ak_vec4_make(0.05f, 0.06f, 0.10f, 1), ak_vec4_make(0.16f, 0.16f, 0.20f, 1));
+    else
+        ak_raster_clear(ras, ak_vec4_make(0.83f, 0.87f, 0.93f, 1), ak_vec4_make(0.48f, 0.51f, 0.58f, 1));
     ak_raster_mesh meshes[2];
     size_t mc = 0;
     if (rd->sh.icount)
@@ -68,20 +72,25 @@ static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
                           .grid_spacing = powf(10.0f, floorf(log10f(extent / 4.0f))),
                           .casters = meshes,
                           .caster_count = mc};
+    if (r->scene->sprites.enabled && r->scene->sprites.blend == AK_BLEND_ADD)
+        g.color = ak_vec4_make(0.26f, 0.25f, 0.25f, 1), g.line_color = ak_vec4_make(0.33f, 0.32f, 0.32f, 1);
     ak_result res = ak_raster_draw_ground(ras, &f->camera, &g);
     for (size_t m = 0; res == AK_OK && m < mc; ++m)
         res = ak_raster_draw_mesh(ras, &f->camera, &meshes[m]);
     ak_particles_state st = ak_particles_get_state(r->ps);
-    if (res == AK_OK)
+    if (res == AK_OK && rd->sprites.ready)
+        res = particles_draw_sprites(ras, &f->camera, r->scene, &rd->sprites, r->ps);
+    else if (res == AK_OK)
         res = particles_draw_points(ras, &f->camera, f->width, f->height,
                                     ak_vec3_scale(ak_vec3_add(f->bmin, f->bmax), 0.5f), r->ps,
                                     rd->colours);
     char title[160];
     snprintf(title, sizeof title, "%s  t=%.2fs  %zu particle%s", rd->title, ak_particles_time(r->ps),
              st.count, cli_plural(st.count));
+    const bool dark = r->scene->sprites.enabled && r->scene->sprites.blend == AK_BLEND_ADD;
     if (res == AK_OK)
         res = ak_raster_draw_text(ras, 10, 10, title, f->height >= 300 ? 2 : 1,
-                                  ak_vec4_make(0.08f, 0.09f, 0.12f, 1));
+                                  dark ? ak_vec4_make(0.9f, 0.9f, 0.92f, 1) : ak_vec4_make(0.08f, 0.09f, 0.12f, 1));
     if (res == AK_OK) res = ak_raster_resolve(ras, out);
     return res == AK_OK ? CLI_OK : cli_fail("particles", "render: %s", ak_result_string(res));
 }
@@ -120,11 +129,8 @@ int cmd_particles(int argc, char** argv) {
     if ((a.pos_count == 1) == (preset != NULL))
         return cli_usage("particles", "give either SCENE.json or --preset NAME");
     if (a.pos_count > 1) return cli_usage("particles", "expected one SCENE.json");
-    if (preset && strcmp(preset, "fountain") && strcmp(preset, "rain") &&
-        strcmp(preset, "fireworks") && strcmp(preset, "character"))
-        return cli_usage("particles",
-                         "--preset must be fountain, rain, fireworks or character, not '%s'",
-                         preset);
+    if (preset && !particles_preset_known(preset))
+        return cli_usage("particles", "--preset must be %s, not '%s'", particles_preset_names, preset);
     long steps = 200, seed = 1, threads = 1;
     if (CLI_GET(&a, "--steps") && !cli_parse_int(CLI_GET(&a, "--steps"), 0, 100000000, &steps))
         return cli_usage("particles", "--steps '%s' is not a whole number in 0..100000000",
@@ -269,6 +275,7 @@ int cmd_particles(int argc, char** argv) {
             rc = cli_fail("particles", "out of memory");
             goto done;
         }
+        if ((rc = particles_sprites_init(&rd.sprites, &scene, "particles"))) goto done;
         rd.title = preset ? preset : "particles";
         if (gif) {
             ak_gif_desc gd = {.width = width,
@@ -334,6 +341,7 @@ done:
     if (rd.framed) cli_frame_free(&rd.frame);
     free(rd.image.pixels);
     free(rd.colours);
+    particles_sprites_free(&rd.sprites);
     particles_shapes_free(&rd.sh);
     if (use_char) particles_character_free(&ch);
     particles_scene_free(&scene);

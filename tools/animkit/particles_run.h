@@ -7,9 +7,12 @@
 #include "cli.h"
 #include "scene_particles.h"
 
-/* Fill s for a preset: fountain, rain, fireworks or character; false for another name or
- * when out of memory (s is then safe to free). */
+/* Fill s for a preset: fountain, rain, fireworks, character, fire or smoke; false for another
+ * name or when out of memory (s is then safe to free). */
 bool particles_preset(const char* name, particles_scene* s);
+/* Whether name is a preset, and the names in words for messages. */
+bool particles_preset_known(const char* name);
+extern const char* const particles_preset_names;
 
 /* The character preset: builtin:humanoid walking (clip 0), its posed meshes concatenated as
  * one collider and one emitter surface. */
@@ -69,5 +72,27 @@ void particles_bounds_add(ak_vec3* lo, ak_vec3* hi, ak_vec3 p);
  * at `centre` (1..12 pixels), outlined above 3 pixels. colours has room for the capacity. */
 ak_result particles_draw_points(ak_raster* ras, const ak_raster_camera* camera, int width, int height, ak_vec3 centre,
                                 ak_particles* ps, ak_vec4* colours);
+
+/* Sprite drawing of a scene whose "render" asks for sprites: per-particle arrays for the
+ * capacity, the texture (the scene's PNG sheet, or built-in puffs/discs, one per frame). */
+typedef struct particles_sprite_renderer {
+    bool ready; /* false: the scene draws points */
+    float* sizes;
+    ak_vec4* colours;
+    uint32_t* frames;
+    uint32_t* order;
+    float* depth;
+    ak_image texture;
+    int columns, rows;
+} particles_sprite_renderer;
+
+/* Prepare sr for s (nothing when s draws points); an exit code, with the message printed. */
+int particles_sprites_init(particles_sprite_renderer* sr, const particles_scene* s, const char* command);
+/* Draw the live particles as sprites: colour and size over life, the frame from the age, sorted
+ * back to front for alpha blending. */
+ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera, const particles_scene* s,
+                                 particles_sprite_renderer* sr, ak_particles* ps);
+/* Free (safe on a zeroed renderer). */
+void particles_sprites_free(particles_sprite_renderer* sr);
 
 #endif

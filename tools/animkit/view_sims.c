@@ -136,6 +136,7 @@ typedef struct psim {
     bool run_ready, failed;
     particles_shapes sh;
     ak_vec4* colours;
+    particles_sprite_renderer sprites;
     long step_index;
     double carry; /* simulated time owed to the next step */
     ak_vec3 lo, hi;
@@ -152,6 +153,7 @@ static void psim_destroy(void* state) {
     if (p->char_ready) particles_character_free(&p->ch);
     free(p->spheres0);
     free(p->colours);
+    particles_sprites_free(&p->sprites);
     particles_scene_free(&p->scene);
     free(p);
 }
@@ -223,9 +225,9 @@ static int psim_init(void** state, const char* spec, const view_sim_opts* o, cha
     int rc = CLI_OK;
     if (strncmp(spec, "preset:", 7) == 0) {
         const char* name = spec + 7;
-        if (strcmp(name, "fountain") && strcmp(name, "rain") && strcmp(name, "fireworks") && strcmp(name, "character"))
+        if (!particles_preset_known(name))
             return init_fail(psim_destroy, p, CLI_BAD_USAGE, err, err_size,
-                             "particles:preset:%s: the presets are fountain, rain, fireworks, character", name);
+                             "particles:preset:%s: the presets are %s", name, particles_preset_names);
         if (!particles_preset(name, &p->scene))
             return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "out of memory");
         p->use_char = strcmp(name, "character") == 0;
@@ -253,6 +255,7 @@ static int psim_init(void** state, const char* spec, const view_sim_opts* o, cha
         p->char_ready = true; /* freed at the end whatever init made */
     }
     if (rc == CLI_OK) rc = psim_bounds_run(p);
+    if (rc == CLI_OK) rc = particles_sprites_init(&p->sprites, &p->scene, "view");
     if (rc)
         return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "cannot start the particle simulation");
     *state = p;
@@ -296,6 +299,7 @@ static size_t psim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
 
 static ak_result psim_draw(void* state, ak_raster* ras, const ak_raster_camera* cam, int w, int h) {
     psim* p = state;
+    if (p->sprites.ready) return particles_draw_sprites(ras, cam, &p->scene, &p->sprites, p->run.ps);
     return particles_draw_points(ras, cam, w, h, ak_vec3_scale(ak_vec3_add(p->lo, p->hi), 0.5f), p->run.ps, p->colours);
 }
 
