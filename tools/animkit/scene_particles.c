@@ -45,11 +45,92 @@ static void read_range(cli_json* j, const cJSON* o, const char* path, const char
     *hi = r[1];
 }
 
+/* One key of a "..._over_life" list: an array of exactly n finite numbers, the first (the life
+ * fraction) in [0, 1] and above the previous key's, the others in [lo, hi]. */
+static bool read_life_key(cli_json* j, const cJSON* e, const char* path, int n, float lo, float hi, float prev_t,
+                          float* out) {
+    if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != n)
+        return cli_json_fail(j, path, NULL, "a key is an array of %d numbers [t, %s]", n,
+                             n == 2 ? "size" : "r, g, b, a");
+    int k = 0;
+    for (const cJSON* v = e->child; v; v = v->next, ++k) {
+        double x = cJSON_IsNumber(v) ? v->valuedouble : NAN;
+        const double a = k ? lo : 0.0, b = k ? hi : 1.0;
+        if (!(x >= a && x <= b)) return cli_json_fail(j, path, NULL, "value %d is not a number in [%g, %g]", k, a, b);
+        out[k] = (float)x;
+    }
+    if (!(out[0] > prev_t)) return cli_json_fail(j, path, NULL, "t %g does not come after the previous key's %g", (double)out[0], (double)prev_t);
+    return true;
+}
+
+/* "render": how the CLI and the viewer draw the particles (docs/particles.md). A texture that
+ * is not a built-in name is a PNG path relative to the scene file. */
+static void read_render(cli_json* j, const cJSON* root, const char* file, particles_scene* s) {
+    const cJSON* r = cli_json_member(j, root, "", "render");
+    if (!r || j->failed) return;
+    static const char* const keys[] = {"style", "texture", "sheet", "frame_rate", "blend",
+                                       "colour_over_life", "size_over_life", NULL};
+    static const char* const styles[] = {"points", "sprites", NULL};
+    static const char* const blends[] = {"alpha", "add", NULL};
+    if (!cli_json_object(j, r, "render", keys)) return;
+    particles_sprites* sp = &s->sprites;
+    int style = 0, blend = 0;
+    cli_json_enum(j, r, "render", "style", styles, &style);
+    sp->enabled = style == 1;
+    cli_json_enum(j, r, "render", "blend", blends, &blend);
+    sp->blend = blend ? AK_BLEND_ADD : AK_BLEND_ALPHA;
+    const char* tex = NULL;
+    cli_json_str(j, r, "render", "texture", &tex);
+    if (tex && strcmp(tex, "disc") == 0) sp->texture = AK_SPRITE_TEXTURE_DISC;
+    else if (tex && strcmp(tex, "puff") == 0) sp->texture = AK_SPRITE_TEXTURE_PUFF;
+    else if (tex) {
+        size_t n = strlen(tex);
+        if (n < 5 || strcmp(tex + n - 4, ".png") != 0) {
+            cli_json_fail(j, "render", "texture", "\"%.80s\" is not disc, puff or a .png file", tex);
+            return;
+        }
+        const char* slash = file ? strrchr(file, '/') : NULL;
+        size_t dir = tex[0] == '/' || !slash ? 0 : (size_t)(slash - file) + 1;
+        sp->sheet_path = malloc(dir + n + 1);
+        if (!sp->sheet_path) {
+            cli_json_fail(j, "render", "texture", "out of memory");
+            return;
+        }
+        memcpy(sp->sheet_path, file, dir);
+        memcpy(sp->sheet_path + dir, tex, n + 1);
+    }
+    float sheet[2] = {1, 1};
+    if (cli_json_floats(j, r, "render", "sheet", 2, 1.0f, 64.0f, sheet) &&
+        (sheet[0] != floorf(sheet[0]) || sheet[1] != floorf(sheet[1])))
+        cli_json_fail(j, "render", "sheet", "[columns, rows] are whole numbers");
+    sp->sheet_columns = (int)sheet[0], sp->sheet_rows = (int)sheet[1];
+    sp->look.frame_count = (uint32_t)(sp->sheet_columns * sp->sheet_rows);
+    cli_json_float(j, r, "render", "frame_rate", 0.0f, 1000.0f, &sp->look.frame_rate);
+    char path[64];
+    size_t n = 0;
+    const cJSON* e = cli_json_array(j, r, "render", "colour_over_life", AK_PARTICLE_LOOK_MAX_KEYS, &n);
+    for (size_t i = 0; i < n && e && !j->failed; ++i, e = e->next) {
+        float v[5];
+        cli_json_index(path, sizeof path, "render.colour_over_life", i);
+        if (!read_life_key(j, e, path, 5, 0.0f, 16.0f, i ? sp->look.colour_keys[i - 1].t : -1.0f, v)) break;
+        sp->look.colour_keys[i] = (ak_particle_colour_key){v[0], {v[1], v[2], v[3], v[4]}};
+        sp->look.colour_key_count = (uint32_t)(i + 1);
+    }
+    e = cli_json_array(j, r, "render", "size_over_life", AK_PARTICLE_LOOK_MAX_KEYS, &n);
+    for (size_t i = 0; i < n && e && !j->failed; ++i, e = e->next) {
+        float v[2];
+        cli_json_index(path, sizeof path, "render.size_over_life", i);
+        if (!read_life_key(j, e, path, 2, 0.0f, 1000.0f, i ? sp->look.size_keys[i - 1].t : -1.0f, v)) break;
+        sp->look.size_keys[i] = (ak_particle_size_key){v[0], v[1]};
+        sp->look.size_key_count = (uint32_t)(i + 1);
+    }
+}
+
 static void read_scene(cli_json* j, const cJSON* root, particles_scene* s) {
     static const char* const keys[] = {"dt",       "integrator",    "capacity",  "gravity",
                                        "drag",     "wind",          "particles", "springs",
                                        "planes",   "spheres",       "boxes",     "attractors",
-                                       "vortices", "lennard_jones", "emitters",  NULL};
+                                       "vortices", "lennard_jones", "emitters",  "render", NULL};
     if (!cli_json_object(j, root, "", keys)) return;
     cli_json_float(j, root, "", "dt", 1e-7f, 10.0f, &s->dt);
     int integ = 1;
@@ -276,6 +357,7 @@ bool particles_scene_parse(const char* file, const char* text, size_t size, part
     cli_json j = {.file = file ? file : "(scene)"};
     cJSON* root = cli_json_parse(&j, text, size);
     if (root) read_scene(&j, root, out);
+    if (root && !j.failed) read_render(&j, root, file, out);
     cJSON_Delete(root);
     if (j.failed) {
         if (err && err_size) snprintf(err, err_size, "%s", j.message); /* one line: cli_json says so */
