@@ -62,31 +62,49 @@ static float value_noise(float x, float y, uint32_t seed) {
     return (v[0] + (v[1] - v[0]) * tx) + ((v[2] + (v[3] - v[2]) * tx) - (v[0] + (v[1] - v[0]) * tx)) * ty;
 }
 
-/* Bilinear sample of frame rectangle [fx0, fx0 + fw) x [fy0, fy0 + fh) of tex at (u, v) in
- * [0, 1]^2, taps clamped to the frame (no bleeding from the neighbours in a sheet). Colour
+/* One row of bilinear taps: the two texel rows of the frame rectangle (taps clamped to the
+ * frame, so no bleeding from the neighbours in a sheet) and the weight of the second. */
+typedef struct tap_row {
+    const uint8_t *r0, *r1;
+    float w1;
+} tap_row;
+
+static tap_row tap_row_at(const ak_image* tex, int fx0, int fy0, int fh, float v) {
+    const float y = v * (float)fh - 0.5f;
+    int y0 = (int)floorf(y);
+    const float ty = y - (float)y0;
+    int y1 = y0 + 1;
+    y0 = y0 < 0 ? 0 : (y0 >= fh ? fh - 1 : y0);
+    y1 = y1 < 0 ? 0 : (y1 >= fh ? fh - 1 : y1);
+    tap_row t = {ak_image_pixel(tex, fx0, fy0 + y0), ak_image_pixel(tex, fx0, fy0 + y1), ty};
+    return t;
+}
+
+/* Bilinear sample at u in [0, 1] across the frame's fw texels on the row's taps, colour
  * weighted by alpha (no dark fringes); out rgb 0..255, alpha 0..1. */
-static void sample_frame(const ak_image* tex, int fx0, int fy0, int fw, int fh, float u, float v, float out[4]) {
-    float x = u * (float)fw - 0.5f, y = v * (float)fh - 0.5f;
-    float x0f = floorf(x), y0f = floorf(y);
-    float tx = x - x0f, ty = y - y0f;
-    int xs[2] = {(int)x0f, (int)x0f + 1}, ys[2] = {(int)y0f, (int)y0f + 1};
-    for (int k = 0; k < 2; ++k) {
-        xs[k] = xs[k] < 0 ? 0 : (xs[k] >= fw ? fw - 1 : xs[k]);
-        ys[k] = ys[k] < 0 ? 0 : (ys[k] >= fh ? fh - 1 : ys[k]);
+static inline void sample_row(const tap_row* row, int fw, float u, float out[4]) {
+    const float x = u * (float)fw - 0.5f;
+    int x0 = (int)floorf(x);
+    const float tx = x - (float)x0;
+    int x1 = x0 + 1;
+    x0 = x0 < 0 ? 0 : (x0 >= fw ? fw - 1 : x0);
+    x1 = x1 < 0 ? 0 : (x1 >= fw ? fw - 1 : x1);
+    const uint8_t* p[4] = {row->r0 + 4 * x0, row->r0 + 4 * x1, row->r1 + 4 * x0, row->r1 + 4 * x1};
+    if ((p[0][3] | p[1][3] | p[2][3] | p[3][3]) == 0) {
+        out[0] = out[1] = out[2] = out[3] = 0.0f;
+        return;
     }
+    const float w[4] = {(1.0f - tx) * (1.0f - row->w1), tx * (1.0f - row->w1), (1.0f - tx) * row->w1, tx * row->w1};
     float acc[4] = {0, 0, 0, 0};
-    for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) {
-            float w = (i ? tx : 1.0f - tx) * (j ? ty : 1.0f - ty);
-            const uint8_t* p = ak_image_pixel(tex, fx0 + xs[i], fy0 + ys[j]);
-            float a = (float)p[3] * (1.0f / 255.0f) * w;
-            acc[0] += (float)p[0] * a;
-            acc[1] += (float)p[1] * a;
-            acc[2] += (float)p[2] * a;
-            acc[3] += a;
-        }
-    float inv = acc[3] > 1e-8f ? 1.0f / acc[3] : 0.0f;
-    out[0] = acc[0] * inv, out[1] = acc[1] * inv, out[2] = acc[2] * inv, out[3] = acc[3];
+    for (int k = 0; k < 4; ++k) {
+        const float a = (float)p[k][3] * w[k];
+        acc[0] += (float)p[k][0] * a;
+        acc[1] += (float)p[k][1] * a;
+        acc[2] += (float)p[k][2] * a;
+        acc[3] += a;
+    }
+    const float inv = acc[3] > 1e-6f ? 1.0f / acc[3] : 0.0f;
+    out[0] = acc[0] * inv, out[1] = acc[1] * inv, out[2] = acc[2] * inv, out[3] = acc[3] * (1.0f / 255.0f);
 }
 
 /* Heap sort of order[]: "before" = farther (smaller view z), ties by
@@ -217,6 +235,7 @@ ak_result ak_raster_draw_sprites(ak_raster* raster, const ak_raster_camera* came
         const float iw = 1.0f / (X1 - X0), ih = 1.0f / (Y1 - Y0);
         for (int y = y0; y <= y1; ++y) {
             const float v = ((float)y + 0.5f - Y0) * ih;
+            const tap_row row = s->texture ? tap_row_at(s->texture, fx0, fy0, fh, v) : (tap_row){NULL, NULL, 0.0f};
             uint8_t* crow = t.color + (size_t)y * (size_t)t.width * 4u;
             float* zrow = t.depth + (size_t)y * (size_t)t.width;
             for (int x = x0; x <= x1; ++x) {
@@ -224,7 +243,8 @@ ak_result ak_raster_draw_sprites(ak_raster* raster, const ak_raster_camera* came
                 const float u = ((float)x + 0.5f - X0) * iw;
                 float tex[4];
                 if (s->texture) {
-                    sample_frame(s->texture, fx0, fy0, fw, fh, u, v, tex);
+                    sample_row(&row, fw, u, tex);
+                    if (!(tex[3] > 0.0f) && blend != AK_BLEND_OPAQUE) continue;
                 } else {
                     tex[0] = tex[1] = tex[2] = 255.0f;
                     tex[3] = disc_alpha(u, v);
