@@ -71,14 +71,14 @@ static void read_render(cli_json* j, const cJSON* root, const char* file, partic
     static const char* const keys[] = {"style", "texture", "sheet", "frame_rate", "blend",
                                        "colour_over_life", "size_over_life", NULL};
     static const char* const styles[] = {"points", "sprites", NULL};
-    static const char* const blends[] = {"alpha", "add", NULL};
+    static const char* const blends[] = {"alpha", "add", "cutout", NULL};
     if (!cli_json_object(j, r, "render", keys)) return;
     particles_sprites* sp = &s->sprites;
     int style = 0, blend = 0;
     cli_json_enum(j, r, "render", "style", styles, &style);
     sp->enabled = style == 1;
     cli_json_enum(j, r, "render", "blend", blends, &blend);
-    sp->blend = blend ? AK_BLEND_ADD : AK_BLEND_ALPHA;
+    sp->blend = blend == 2 ? AK_BLEND_OPAQUE : blend ? AK_BLEND_ADD : AK_BLEND_ALPHA;
     const char* tex = NULL;
     cli_json_str(j, r, "render", "texture", &tex);
     if (tex && strcmp(tex, "disc") == 0) sp->texture = AK_SPRITE_TEXTURE_DISC;
