@@ -173,6 +173,24 @@ AK_TEST(scene_sprites_colour_and_sheet_over_life) {
     AK_CHECK_EQ(run("particles particles_sprite.json --steps 10 --size 160x120 -o sprite_blue.png", true), 0);
     int blue = count_colour("sprite_blue.png", 160, 120, 0, 0, 255);
     AK_CHECK_MSG(blue >= 20, "%d blue pixels", blue);
+    /* cut-outs: alpha-tested, so every drawn pixel has the full colour (none half blended) */
+    write_file("particles_cutout.json",
+               "{\"particles\": [{\"m\": 0, \"p\": [0, 1, 0], \"size\": 0.15}],"
+               " \"render\": {\"style\": \"sprites\", \"blend\": \"cutout\", \"colour_over_life\": [[0, 0, 0, 1, 1]]}}");
+    AK_CHECK_EQ(run("particles particles_cutout.json --steps 1 --size 160x120 -o sprite_cut.png", true), 0);
+    static uint8_t cut_px[160 * 120 * 4];
+    const ak_image cut = {.pixels = cut_px, .width = 160, .height = 120};
+    AK_CHECK_EQ(ak_png_read("sprite_cut.png", &cut), AK_OK);
+    int full = 0, partial = 0;
+    for (int i = 0; i < 160 * 120; ++i) {
+        const uint8_t* p = cut_px + 4 * i;
+        if (p[2] > 2 * p[0] + 40 && p[2] > 2 * p[1] + 40) { /* clearly blue: sprite pixels */
+            if (p[0] <= 2 && p[1] <= 2 && p[2] >= 253) ++full;
+            else ++partial;
+        }
+    }
+    AK_CHECK_MSG(full >= 20 && partial <= full / 4, "cut-out: %d full and %d partly blue pixels", full, partial);
+    remove("particles_cutout.json"), remove("sprite_cut.png");
     uint8_t sheet_px[2 * 8 * 8 * 4];
     ak_image sheet = {.pixels = sheet_px, .width = 16, .height = 8};
     for (int y = 0; y < 8; ++y)

@@ -502,7 +502,8 @@ ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera,
         sr->sizes[i] = 2.0f * st.size[i] * ak_particle_look_size(look, st.age[i], st.lifetime[i]);
         sr->frames[i] = ak_particle_look_frame(look, st.age[i], st.lifetime[i]);
     }
-    const ak_blend blend = s->sprites.blend == AK_BLEND_ADD ? AK_BLEND_ADD : AK_BLEND_ALPHA;
+    const ak_blend blend = s->sprites.blend == AK_BLEND_ADD || s->sprites.blend == AK_BLEND_OPAQUE ? s->sprites.blend
+                                                                                                 : AK_BLEND_ALPHA;
     ak_raster_sprites d = {.positions = {st.position, st.count},
                            .sizes = {sr->sizes, st.count},
                            .colors = {sr->colours, st.count},
@@ -511,7 +512,7 @@ ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera,
                            .sheet_columns = sr->columns,
                            .sheet_rows = sr->rows,
                            .blend = blend};
-    if (blend == AK_BLEND_ALPHA) { /* additive blending does not depend on the order */
+    if (blend == AK_BLEND_ALPHA) { /* additive blending and depth-tested cut-outs do not depend on the order */
         ak_result res = ak_raster_sprites_sort(camera, (ak_vec3_cspan){st.position, st.count},
                                                (ak_f32_span){sr->depth, st.count}, (ak_u32_span){sr->order, st.count});
         if (res != AK_OK) return res;

@@ -23,7 +23,8 @@ typedef struct particles_sprites {
     char* sheet_path;          /* a PNG sprite sheet (owned), or NULL */
     int sheet_columns;         /* frames across; 0 -> 1 (built-in PUFF with frames: that many puffs) */
     int sheet_rows;            /* frames down; 0 -> 1 */
-    ak_blend blend;            /* AK_BLEND_ALPHA (sorted back to front) or AK_BLEND_ADD */
+    ak_blend blend;            /* AK_BLEND_ALPHA (sorted back to front), AK_BLEND_ADD, or
+                                  AK_BLEND_OPAQUE (alpha-tested cut-outs: leaves, grass) */
     ak_particle_look look;     /* colour, size and frame over life */
 } particles_sprites;
 
