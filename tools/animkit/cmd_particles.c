@@ -48,8 +48,10 @@ typedef struct renderer {
 static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
     cli_frame* f = &rd->frame;
     ak_raster* ras = f->raster;
-    if (r->scene->sprites.enabled && r->scene->sprites.blend == AK_BLEND_ADD) /* a glow shows on a dark sky */
-        ak_raster_clear(ras, ak_vec4_make(0.05f, 0.06f, 0.10f, 1), ak_vec4_make(0.16f, 0.16f, 0.20f, 1));
+    ak_vec4 sky_top, sky_bottom;
+    const bool dark = particles_dark_sky(r->scene, &sky_top, &sky_bottom); /* a glow shows on a dark sky */
+    if (dark)
+        ak_raster_clear(ras, sky_top, sky_bottom);
     else
         ak_raster_clear(ras, ak_vec4_make(0.83f, 0.87f, 0.93f, 1), ak_vec4_make(0.48f, 0.51f, 0.58f, 1));
     ak_raster_mesh meshes[2];
@@ -72,7 +74,7 @@ static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
                           .grid_spacing = powf(10.0f, floorf(log10f(extent / 4.0f))),
                           .casters = meshes,
                           .caster_count = mc};
-    if (r->scene->sprites.enabled && r->scene->sprites.blend == AK_BLEND_ADD)
+    if (dark)
         g.color = ak_vec4_make(0.26f, 0.25f, 0.25f, 1), g.line_color = ak_vec4_make(0.33f, 0.32f, 0.32f, 1);
     ak_result res = ak_raster_draw_ground(ras, &f->camera, &g);
     for (size_t m = 0; res == AK_OK && m < mc; ++m)
@@ -87,7 +89,6 @@ static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
     char title[160];
     snprintf(title, sizeof title, "%s  t=%.2fs  %zu particle%s", rd->title, ak_particles_time(r->ps),
              st.count, cli_plural(st.count));
-    const bool dark = r->scene->sprites.enabled && r->scene->sprites.blend == AK_BLEND_ADD;
     if (res == AK_OK)
         res = ak_raster_draw_text(ras, 10, 10, title, f->height >= 300 ? 2 : 1,
                                   dark ? ak_vec4_make(0.9f, 0.9f, 0.92f, 1) : ak_vec4_make(0.08f, 0.09f, 0.12f, 1));

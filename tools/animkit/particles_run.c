@@ -521,6 +521,12 @@ ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera,
     return ak_raster_draw_sprites(ras, camera, &d);
 }
 
+bool particles_dark_sky(const particles_scene* s, ak_vec4* top, ak_vec4* bottom) {
+    if (!s->sprites.enabled || s->sprites.blend != AK_BLEND_ADD) return false;
+    *top = ak_vec4_make(0.05f, 0.06f, 0.10f, 1), *bottom = ak_vec4_make(0.16f, 0.16f, 0.20f, 1);
+    return true;
+}
+
 void particles_sprites_free(particles_sprite_renderer* sr) {
     free(sr->sizes);
     free(sr->colours);

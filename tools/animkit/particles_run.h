@@ -94,5 +94,8 @@ ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera,
                                  particles_sprite_renderer* sr, ak_particles* ps);
 /* Free (safe on a zeroed renderer). */
 void particles_sprites_free(particles_sprite_renderer* sr);
+/* Whether s draws glowing (additive) sprites, which `particles -o` and the viewer show on a
+ * dark sky; then *top and *bottom get its colours. */
+bool particles_dark_sky(const particles_scene* s, ak_vec4* top, ak_vec4* bottom);
 
 #endif

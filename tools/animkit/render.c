@@ -113,7 +113,10 @@ void cli_frame_free(cli_frame* f) {
 ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* o, const ak_image* out) {
     const ak_scene* s = p ? p->scene : NULL;
     ak_raster* r = f->raster;
-    ak_raster_clear(r, rgba(0.83f, 0.87f, 0.93f, 1), rgba(0.48f, 0.51f, 0.58f, 1));
+    if (o && (o->sky_top.w > 0.0f || o->sky_bottom.w > 0.0f))
+        ak_raster_clear(r, o->sky_top, o->sky_bottom);
+    else
+        ak_raster_clear(r, rgba(0.83f, 0.87f, 0.93f, 1), rgba(0.48f, 0.51f, 0.58f, 1));
     ak_raster_mesh* meshes = f->draw;
     size_t mc = 0;
     ak_vec4 clay = rgba(0.80f, 0.74f, 0.68f, 1);

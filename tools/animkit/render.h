@@ -35,6 +35,7 @@ typedef struct cli_draw_opts {
      * simulations draw their particles and agents here); NULL -> nothing */
     ak_result (*draw)(void* user, ak_raster* raster, const ak_raster_camera* camera, int width, int height);
     void* draw_user;
+    ak_vec4 sky_top, sky_bottom; /* background gradient; both all zero -> the light default sky */
 } cli_draw_opts;
 
 /* Where the camera looks from. Zero -> the orbit framing cli_frame_init uses (yaw 31.5, pitch

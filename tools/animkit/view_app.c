@@ -526,6 +526,8 @@ static ak_result draw_view(view_app* a, cli_frame* f, const ak_image* img) {
         .draw = a->sim ? a->sim->draw : NULL,
         .draw_user = a->sim_state,
     };
+    if (a->sim && a->sim->sky && !a->sim->sky(a->sim_state, &o.sky_top, &o.sky_bottom))
+        o.sky_top = o.sky_bottom = ak_vec4_make(0, 0, 0, 0);
     ak_result r = cli_frame_draw(f, &a->poser, &o, img);
     if (r != AK_OK) return r;
     if (a->show_normals) draw_normals(a, f, img);

@@ -145,6 +145,10 @@ typedef struct psim {
     uint32_t threads;
 } psim;
 
+static bool psim_sky(void* state, ak_vec4* top, ak_vec4* bottom) {
+    return particles_dark_sky(&((const psim*)state)->scene, top, bottom);
+}
+
 static void psim_destroy(void* state) {
     psim* p = state;
     if (!p) return;
@@ -363,6 +367,7 @@ static const view_sim particles_sim = {
     .meshes = psim_meshes,
     .draw = psim_draw,
     .bounds = psim_bounds,
+    .sky = psim_sky,
     .key = psim_key,
     .grab = psim_grab,
     .drag = psim_drag,
