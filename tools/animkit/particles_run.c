@@ -473,8 +473,9 @@ int particles_sprites_init(particles_sprite_renderer* sr, const particles_scene*
         }
         if (res != AK_OK) return cli_fail(command, "%s: cannot read the sprite sheet: %s", sp->sheet_path, ak_result_string(res));
     } else {
-        /* a sheet of built-in textures, one seed per frame (64 x 64 pixels each) */
-        const int fw = 64;
+        /* a sheet of built-in textures, one seed per frame: 64 x 64 pixels each, smaller for
+         * sheets of more than 16 frames a side (the sheet stays within 1024 x 1024, 4 MiB) */
+        const int side = cols > rows ? cols : rows, fw = side > 16 ? 1024 / side : 64;
         sr->texture = (ak_image){.pixels = malloc((size_t)(cols * fw) * (size_t)(rows * fw) * 4u),
                                  .width = cols * fw, .height = rows * fw};
         if (!sr->texture.pixels) return cli_fail(command, "out of memory");
