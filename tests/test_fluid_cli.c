@@ -202,7 +202,7 @@ AK_TEST(obj_surface) {
  * is the renderer's: eye = centre + 1.1 |diagonal| (0.45, 0.55, 1), fovy 0.7, 800 x 600. */
 AK_TEST(tank_walls_drawn) {
     write_file("fluid_tank.json", "{\"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]},"
-                                  " \"blocks\": [{\"min\": [0.4, 0, 0.4], \"max\": [0.6, 0.1, 0.6]}]}");
+                                  " \"blocks\": [{\"min\": [0.45, 0, 0.45], \"max\": [0.5, 0.05, 0.5]}]}");
     AK_CHECK_EQ(run("fluid fluid_tank.json --steps 0 -o tank.png", true), 0);
     const int w = 800, h = 600;
     static uint8_t px[800 * 600 * 4];
