@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS  ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 
-.PHONY: all demo test test-slow deps configure build bench bench-quick clean
+.PHONY: all demo test test-slow deps configure build bench bench-quick clean python
 
 all: build
 
@@ -28,6 +28,13 @@ test: build
 
 test-slow: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L slow
+
+# The Python package in place: python/animkit/_core*.so beside the sources, so that
+# PYTHONPATH=python finds `import animkit` (docs/python.md; pip install --no-build-isolation .
+# installs it instead).
+python: configure
+	cmake --build $(BUILD) -j $(JOBS) --target animkit_python
+	cp $(BUILD)/python/animkit/_core*.so python/animkit/
 
 # Every benchmark and every side-by-side harness of ../shared/peers (skipped when absent): full
 # outputs and SUMMARY.md under $(BUILD)/bench-results (scripts/bench.sh, docs/BENCHMARKS.md).

@@ -1,5 +1,6 @@
-/* retarget_bvh: put CMU motion capture (a BVH walk) on the builtin humanoid, with and without
- * the foot-contact clean-up, and write the result as retarget_bvh.glb.
+/* retarget_bvh: put CMU motion capture (a BVH walk) on the builtin humanoid, mapped
+ * automatically (humanoid template), with and without the foot-contact clean-up, and write
+ * the result as retarget_bvh.glb.
  * Usage: example_retarget_bvh [FILE.bvh]; without FILE it looks for the shared 02_01.bvh and
  * prints "no assets" (exit 0) when that is absent. */
 #include <animkit/animkit.h>
@@ -39,15 +40,21 @@ int main(int argc, char** argv) {
     }
     if (ak_builtin_create("humanoid", NULL, NULL, &human) != AK_OK) return 1;
 
-    /* which target joint follows which source joint (by name: CMU "LeftUpLeg" and the
-     * builtin "left_hip" are both the left upper leg) */
+    /* which target joint follows which source joint: both skeletons fitted to the humanoid
+     * template (topology, rest pose, name hints), then paired bone by bone; the table printed
+     * is a map file (animkit retarget --map reads it) */
     size_t nt = ak_scene_joint_count(human);
     int32_t* map = malloc(nt * sizeof *map);
-    size_t mapped = 0;
-    ak_retarget_map_by_name(mocap->skeleton, human->skeleton, (ak_i32_span){map, nt}, &mapped);
-    for (size_t k = 0; k < nt; ++k)
-        printf("  %-16s <- %s\n", ak_skeleton_joint_name(human->skeleton, k),
-               map[k] >= 0 ? ak_skeleton_joint_name(mocap->skeleton, (size_t)map[k]) : "(rest pose)");
+    ak_humanoid_roles sr, tr;
+    if (ak_humanoid_roles_find(mocap->skeleton, NULL, &sr, &diag) != AK_OK ||
+        ak_humanoid_roles_find(human->skeleton, NULL, &tr, &diag) != AK_OK) {
+        fprintf(stderr, "%s\n", diag.message); /* e.g. "not a humanoid: ..." */
+        return 1;
+    }
+    ak_retarget_map_by_roles(mocap->skeleton, &sr, human->skeleton, &tr, (ak_i32_span){map, nt}, NULL);
+    char table[8192];
+    ak_retarget_map_write(mocap->skeleton, &sr, human->skeleton, &tr, (ak_i32_cspan){map, nt}, table, sizeof table, NULL);
+    fputs(table, stdout);
 
     ak_clip* clip[2] = {NULL, NULL};
     for (int clean = 0; clean < 2; ++clean) {

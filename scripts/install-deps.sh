@@ -12,6 +12,7 @@ PACKAGES=(
   libgif-dev        # animated GIF output (raster)
   libassimp-dev     # FBX, Collada, BVH, OBJ import (io)
   libcjson-dev      # JSON for the glTF 2.0 reader (io)
+  libjpeg62-turbo-dev # JPEG base-colour textures of glTF/OBJ models (io; optional: without it JPEG textures are skipped)
   libsuitesparse-dev # CHOLMOD sparse Cholesky for bone-heat weights (skin)
   libsdl2-dev       # the window of `animkit view` (optional: without it, --headless only)
   xvfb              # virtual display: tests run the viewer's window under xvfb-run
@@ -19,6 +20,13 @@ PACKAGES=(
   libx11-dev        # the X11 client that resizes and closes the viewer's window in test_view_window
   clang             # the ASan+UBSan CI stage and scripts/fuzz.sh
   libclang-rt-14-dev # clang's sanitizer and libFuzzer runtimes (-fsanitize=fuzzer), Debian 12
+  libbullet-dev     # Bullet 3, the peer of bench/vs_bullet (optional: the benchmark is skipped without it)
+  python3-dev       # the Python package's C extension (python/; optional: AK_PYTHON skips it without)
+  python3-numpy     # its arrays (and the NumPy C API it builds against)
+  python3-pytest    # the Python tests (test_python SKIPs without)
+  python3-setuptools # pip install --no-build-isolation . (setup.py drives CMake)
+  python3-matplotlib # examples/python (its smoke test SKIPs without)
+  python3-distributed # animkit.batch on Dask (optional: its test SKIPs without)
 )
 
 missing=()

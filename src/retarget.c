@@ -590,3 +590,601 @@ done:
     akp_free(alloc, mem);
     return r;
 }
+
+/* ---- humanoid template (ak_humanoid_roles_find) ------------------------------------------- */
+
+enum { WORD_NONE = 0, WORD_TORSO, WORD_HEAD, WORD_ARM, WORD_LEG };
+
+typedef struct role_ctx {
+    const ak_skeleton* sk;
+    size_t n;
+    const int16_t* parent;
+    ak_vec3* pos;          /* rest model positions */
+    int32_t* first_child;  /* child lists in index order */
+    int32_t* next_sibling;
+    int32_t* size;         /* joints in the subtree */
+    float* reach;          /* longest path length below the joint */
+    int32_t* name_bone;    /* ak_humanoid_bones_of_skeleton */
+    uint8_t* name_side;    /* from the name's words: 1 left, 2 right */
+    uint8_t* name_word;    /* WORD_* from the name's words */
+    int32_t* chain;        /* scratch: a chain, then its merged keys */
+    int32_t* stack;        /* scratch: DFS / BFS */
+    float eps;             /* positions closer than this are one */
+} role_ctx;
+
+/* A limb: the joints found along one chain. */
+typedef struct limb {
+    int32_t before, upper, lower, end, after; /* -1 when absent */
+    float quality;                            /* 1, or 0.6 when no bone pair passed the rules */
+} limb;
+
+static bool word_is(const char* w, size_t n, const char* s) { return strlen(s) == n && strncmp(w, s, n) == 0; }
+
+/* Side (1 left, 2 right) and limb word of a name, from its words: split at separators, at a
+ * lower-to-upper case change, before the last capital of a run of capitals followed by a
+ * lower-case letter ("LHip" -> L, Hip) and between letters and digits. */
+static void name_words(const char* name, uint8_t* out_side, uint8_t* out_word) {
+    const char* colon = strrchr(name, ':');
+    const char* s = colon ? colon + 1 : name;
+    char w[AK_NAME_SIZE];
+    size_t n = 0;
+    *out_side = 0, *out_word = WORD_NONE;
+    for (size_t i = 0;; ++i) {
+        unsigned char ch = (unsigned char)s[i];
+        bool cut = !ch || !isalnum(ch);
+        if (!cut && n > 0 && i > 0) {
+            unsigned char pv = (unsigned char)s[i - 1], nx = (unsigned char)s[i + 1];
+            cut = (islower(pv) && isupper(ch)) || (isupper(pv) && isupper(ch) && islower(nx)) ||
+                  (isdigit(pv) != 0) != (isdigit(ch) != 0);
+        }
+        if (cut && n > 0) {
+            static const char* const side_l[] = {"l", "left", "lft"};
+            static const char* const side_r[] = {"r", "right", "rt", "rgt"};
+            static const char* const words[][2] = {
+                {"hips", "1"},     {"pelvis", "1"},   {"spine", "1"},    {"chest", "1"},   {"torso", "1"},
+                {"abdomen", "1"},  {"lowerback", "1"}, {"back", "1"},    {"neck", "2"},    {"head", "2"},
+                {"skull", "2"},    {"arm", "3"},      {"shoulder", "3"}, {"clavicle", "3"}, {"collar", "3"},
+                {"elbow", "3"},    {"forearm", "3"},  {"hand", "3"},     {"wrist", "3"},   {"finger", "3"},
+                {"thumb", "3"},    {"leg", "4"},      {"thigh", "4"},    {"upleg", "4"},   {"knee", "4"},
+                {"shin", "4"},     {"calf", "4"},     {"foot", "4"},     {"ankle", "4"},   {"toe", "4"},
+                {"toes", "4"},     {"femur", "4"},
+            };
+            for (size_t k = 0; k < sizeof side_l / sizeof side_l[0]; ++k)
+                if (word_is(w, n, side_l[k])) *out_side = 1;
+            for (size_t k = 0; k < sizeof side_r / sizeof side_r[0]; ++k)
+                if (word_is(w, n, side_r[k])) *out_side = 2;
+            /* "LeftUpLeg" -> left, up, leg; "leftUpperArm" -> left, upper, arm */
+            if (n > 4 && strncmp(w, "left", 4) == 0) *out_side = 1;
+            if (n > 5 && strncmp(w, "right", 5) == 0) *out_side = 2;
+            for (size_t k = 0; k < sizeof words / sizeof words[0]; ++k)
+                if (word_is(w, n, words[k][0]) && *out_word == WORD_NONE) *out_word = (uint8_t)(words[k][1][0] - '0');
+            n = 0;
+        }
+        if (!ch) break;
+        if (!cut || (isalnum(ch) && n == 0)) {
+            if (n + 1 < sizeof w) w[n++] = (char)tolower(ch);
+        }
+    }
+}
+
+static int role_word(int bone) {
+    if (bone == AK_BONE_HIPS || (bone >= AK_BONE_SPINE && bone <= AK_BONE_UPPER_CHEST)) return WORD_TORSO;
+    if (bone == AK_BONE_NECK || bone == AK_BONE_HEAD) return WORD_HEAD;
+    if (bone >= AK_BONE_LEFT_SHOULDER && bone <= AK_BONE_RIGHT_HAND) return WORD_ARM;
+    if (bone >= AK_BONE_LEFT_UPPER_LEG && bone <= AK_BONE_RIGHT_TOES) return WORD_LEG;
+    return WORD_NONE;
+}
+
+static int role_side(int bone) {
+    if ((bone >= AK_BONE_LEFT_SHOULDER && bone <= AK_BONE_LEFT_HAND) ||
+        (bone >= AK_BONE_LEFT_UPPER_LEG && bone <= AK_BONE_LEFT_TOES))
+        return 1;
+    if ((bone >= AK_BONE_RIGHT_SHOULDER && bone <= AK_BONE_RIGHT_HAND) ||
+        (bone >= AK_BONE_RIGHT_UPPER_LEG && bone <= AK_BONE_RIGHT_TOES))
+        return 2;
+    return 0;
+}
+
+static bool name_has_word(const char* name, const char* word) {
+    char n[AK_NAME_SIZE];
+    normalise(name, n);
+    return strstr(n, word) != NULL;
+}
+
+/* Walk down from start, each time to the child with the longest path below it; returns the
+ * joint count written to c->chain. */
+static size_t chain_follow(const role_ctx* c, int32_t start) {
+    size_t m = 0;
+    for (int32_t j = start; j >= 0 && m < c->n;) {
+        c->chain[m++] = j;
+        int32_t best = -1;
+        float best_len = -1.0f;
+        for (int32_t k = c->first_child[j]; k >= 0; k = c->next_sibling[k]) {
+            float len = ak_vec3_length(ak_vec3_sub(c->pos[k], c->pos[j])) + c->reach[k];
+            if (len > best_len || (len == best_len && c->size[k] > c->size[best])) best = k, best_len = len;
+        }
+        j = best;
+    }
+    return m;
+}
+
+static float dist(const role_ctx* c, int32_t a, int32_t b) { return ak_vec3_length(ak_vec3_sub(c->pos[a], c->pos[b])); }
+
+/* Upper, lower, end (hand or foot), the joint before and after, along the chain from start. */
+static limb limb_find(const role_ctx* c, int32_t start) {
+    limb L = {-1, -1, -1, -1, -1, 0.0f};
+    size_t m = chain_follow(c, start), keys = 0;
+    for (size_t i = 0; i < m; ++i) /* joints at one position: the first of them stands for all */
+        if (keys == 0 || dist(c, c->chain[i], c->chain[keys - 1]) > c->eps) c->chain[keys++] = c->chain[i];
+    if (keys < 3) return L;
+    const int32_t* k = c->chain;
+    int best = -1, fallback = -1;
+    float best_sum = 0.0f, fallback_sum = 0.0f;
+    for (size_t i = 0; i + 2 < keys; ++i) {
+        float up = dist(c, k[i], k[i + 1]), lo = dist(c, k[i + 1], k[i + 2]);
+        float next = i + 3 < keys ? dist(c, k[i + 2], k[i + 3]) : 0.0f;
+        if (up + lo > fallback_sum) fallback = (int)i, fallback_sum = up + lo;
+        if (lo < 0.4f * up || lo > 2.5f * up || next >= 0.6f * lo) continue;
+        if (up + lo > best_sum) best = (int)i, best_sum = up + lo;
+    }
+    L.quality = 1.0f;
+    if (best < 0) best = fallback, L.quality = 0.6f;
+    if (best < 0) return L;
+    L.upper = k[best], L.lower = k[best + 1], L.end = k[best + 2];
+    L.before = best > 0 ? k[best - 1] : -1;
+    L.after = (size_t)best + 3 < keys ? k[best + 3] : -1;
+    return L;
+}
+
+/* The most similar pair among the children of j with subtrees of >= 3 joints, skipping
+ * `skip`; false when fewer than two. Similarity: path length and distance from j. */
+static bool pair_find(const role_ctx* c, int32_t j, int32_t skip, int32_t* a, int32_t* b) {
+    float best = INFINITY;
+    *a = *b = -1;
+    for (int32_t x = c->first_child[j]; x >= 0; x = c->next_sibling[x]) {
+        if (x == skip || c->size[x] < 3) continue;
+        for (int32_t y = c->next_sibling[x]; y >= 0; y = c->next_sibling[y]) {
+            if (y == skip || c->size[y] < 3) continue;
+            float lx = c->reach[x] + dist(c, x, j), ly = c->reach[y] + dist(c, y, j);
+            float scale = fmaxf(fmaxf(lx, ly), 1e-20f);
+            float d = fabsf(lx - ly) / scale + fabsf(dist(c, x, j) - dist(c, y, j)) / scale;
+            if (d < best) best = d, *a = x, *b = y;
+        }
+    }
+    return *a >= 0;
+}
+
+/* A chest below s: the shallowest joint of s's subtree with an arm pair and one more child. */
+static int32_t chest_find(const role_ctx* c, int32_t s, int32_t* arm_a, int32_t* arm_b) {
+    size_t top = 0;
+    int32_t found = -1;
+    c->stack[top++] = s;
+    /* breadth first: the first joint found is the shallowest */
+    for (size_t head = 0; head < top && found < 0; ++head) {
+        int32_t j = c->stack[head];
+        int kids = 0;
+        for (int32_t k = c->first_child[j]; k >= 0; k = c->next_sibling[k]) ++kids;
+        if (kids >= 3 && pair_find(c, j, -1, arm_a, arm_b)) {
+            found = j;
+            break;
+        }
+        for (int32_t k = c->first_child[j]; k >= 0 && top < c->n; k = c->next_sibling[k]) c->stack[top++] = k;
+    }
+    return found;
+}
+
+static float angle_deg(ak_vec3 a, ak_vec3 b) {
+    float la = ak_vec3_length(a), lb = ak_vec3_length(b);
+    if (!(la > 0.0f) || !(lb > 0.0f)) return 180.0f;
+    float cs = ak_vec3_dot(a, b) / (la * lb);
+    return acosf(fmaxf(-1.0f, fminf(1.0f, cs))) * (180.0f / 3.14159265f);
+}
+
+static ak_vec3 unit_or(ak_vec3 v, ak_vec3 fallback) {
+    float l = ak_vec3_length(v);
+    return l > 1e-20f ? ak_vec3_scale(v, 1.0f / l) : fallback;
+}
+
+static void role_set(ak_humanoid_roles* r, const role_ctx* c, int bone, int32_t j, float quality) {
+    if (j < 0) return;
+    r->joint[bone] = j;
+    int nb = c->name_bone[j];
+    r->name_bone[bone] = nb;
+    float f = 0.8f;
+    if (nb == bone) f = 1.0f;
+    else if (nb != AK_BONE_NONE) f = 0.5f;
+    else if ((c->name_word[j] != WORD_NONE && c->name_word[j] != role_word(bone)) ||
+             (c->name_side[j] && role_side(bone) && c->name_side[j] != role_side(bone)))
+        f = 0.5f;
+    r->confidence[bone] = f * quality;
+}
+
+static int side_votes(const role_ctx* c, const limb* L) {
+    int32_t js[5] = {L->before, L->upper, L->lower, L->end, L->after};
+    int v = 0;
+    for (int i = 0; i < 5; ++i)
+        if (js[i] >= 0) v += c->name_side[js[i]] == 1 ? 1 : c->name_side[js[i]] == 2 ? -1 : 0;
+    return v;
+}
+
+/* Fit the template with h as the hips; false when it does not fit. */
+static bool template_fit(const role_ctx* c, int32_t h, ak_humanoid_roles* r) {
+    int32_t spine = -1, chest = -1, arm[2] = {-1, -1};
+    int32_t best_size = -1;
+    for (int32_t s = c->first_child[h]; s >= 0; s = c->next_sibling[s]) {
+        if (c->size[s] < 3) continue;
+        int32_t a, b;
+        int32_t ch = chest_find(c, s, &a, &b);
+        if (ch >= 0 && c->size[s] > best_size) spine = s, chest = ch, arm[0] = a, arm[1] = b, best_size = c->size[s];
+    }
+    if (spine < 0) return false;
+    int32_t leg[2];
+    if (!pair_find(c, h, spine, &leg[0], &leg[1])) return false;
+    /* head chain: the chest's other child pointing most along hips -> chest */
+    ak_vec3 body = ak_vec3_sub(c->pos[chest], c->pos[h]);
+    int32_t neck = -1;
+    float best_cos = -2.0f;
+    for (int32_t k = c->first_child[chest]; k >= 0; k = c->next_sibling[k]) {
+        if (k == arm[0] || k == arm[1]) continue;
+        size_t m = chain_follow(c, k);
+        ak_vec3 d = ak_vec3_sub(c->pos[c->chain[m - 1]], c->pos[chest]);
+        float cs = ak_vec3_dot(unit_or(d, ak_vec3_zero()), unit_or(body, ak_vec3_zero()));
+        if (cs > best_cos) best_cos = cs, neck = k;
+    }
+    if (neck < 0) return false;
+    limb legs[2] = {limb_find(c, leg[0]), limb_find(c, leg[1])};
+    limb arms[2] = {limb_find(c, arm[0]), limb_find(c, arm[1])};
+    if (legs[0].end < 0 || legs[1].end < 0 || arms[0].end < 0 || arms[1].end < 0) return false;
+
+    /* head: the joint named head on the chain, else its last joint (its parent when that is an
+     * "end"/"top" leaf); the neck is the chain's first joint when the head is not */
+    size_t m = chain_follow(c, neck);
+    int32_t head = -1;
+    for (size_t i = 0; i < m; ++i)
+        if (c->name_bone[c->chain[i]] == AK_BONE_HEAD) head = c->chain[i];
+    if (head < 0) {
+        head = c->chain[m - 1];
+        const char* hn = ak_skeleton_joint_name(c->sk, (size_t)head);
+        if (m >= 2 && (name_has_word(hn, "end") || name_has_word(hn, "top"))) head = c->chain[m - 2];
+    }
+    /* torso: hips .. chest */
+    int32_t torso[3] = {-1, -1, -1};
+    size_t k = 0;
+    for (int32_t j = chest; j >= 0 && j != h; j = c->parent[j]) ++k;
+    {
+        size_t i = k;
+        for (int32_t j = chest; j >= 0 && j != h && i > 0; j = c->parent[j]) c->stack[--i] = j;
+    }
+    if (k == 1) torso[0] = c->stack[0];
+    else if (k == 2) torso[0] = c->stack[0], torso[1] = c->stack[1];
+    else torso[0] = c->stack[0], torso[1] = c->stack[k - 2], torso[2] = c->stack[k - 1];
+
+    /* axes */
+    ak_vec3 feet = ak_vec3_scale(ak_vec3_add(c->pos[legs[0].end], c->pos[legs[1].end]), 0.5f);
+    ak_vec3 up = unit_or(ak_vec3_sub(c->pos[head], feet), ak_vec3_make(0, 1, 0));
+    ak_vec3 lat = ak_vec3_sub(c->pos[legs[0].upper], c->pos[legs[1].upper]);
+    lat = ak_vec3_sub(lat, ak_vec3_scale(up, ak_vec3_dot(lat, up)));
+    if (ak_vec3_length(lat) < c->eps) {
+        lat = ak_vec3_sub(c->pos[arms[0].upper], c->pos[arms[1].upper]);
+        lat = ak_vec3_sub(lat, ak_vec3_scale(up, ak_vec3_dot(lat, up)));
+    }
+    ak_vec3 fwd0 = unit_or(ak_vec3_cross(lat, up), ak_vec3_make(0, 0, 1)); /* forward if leg 0 is left */
+    int leg0_left = 0; /* 1 yes, -1 no, 0 undecided */
+    if (legs[0].after >= 0 && legs[1].after >= 0) {
+        ak_vec3 t = ak_vec3_add(ak_vec3_sub(c->pos[legs[0].after], c->pos[legs[0].end]),
+                                ak_vec3_sub(c->pos[legs[1].after], c->pos[legs[1].end]));
+        t = ak_vec3_sub(t, ak_vec3_scale(up, ak_vec3_dot(t, up)));
+        float d = ak_vec3_dot(t, fwd0), tl = ak_vec3_length(t);
+        if (tl > c->eps && fabsf(d) > 0.3f * tl) leg0_left = d > 0 ? 1 : -1, r->sides = AK_SIDES_TOES;
+    }
+    if (!leg0_left) {
+        int v = side_votes(c, &legs[0]) - side_votes(c, &legs[1]);
+        if (v) leg0_left = v > 0 ? 1 : -1, r->sides = AK_SIDES_NAMES;
+    }
+    if (!leg0_left) {
+        ak_vec3 z = ak_vec3_make(0, 0, 1);
+        z = ak_vec3_sub(z, ak_vec3_scale(up, ak_vec3_dot(z, up)));
+        float d = ak_vec3_length(z) > 1e-3f ? ak_vec3_dot(fwd0, z) : lat.x;
+        leg0_left = d >= 0 ? 1 : -1, r->sides = AK_SIDES_CONVENTION;
+    }
+    r->up = up;
+    r->forward = leg0_left > 0 ? fwd0 : ak_vec3_scale(fwd0, -1.0f);
+    ak_vec3 left = ak_vec3_cross(up, r->forward);
+    if (leg0_left < 0) {
+        limb t = legs[0];
+        legs[0] = legs[1], legs[1] = t;
+    }
+    if (ak_vec3_dot(ak_vec3_sub(c->pos[arms[0].upper], c->pos[chest]), left) <
+        ak_vec3_dot(ak_vec3_sub(c->pos[arms[1].upper], c->pos[chest]), left)) {
+        limb t = arms[0];
+        arms[0] = arms[1], arms[1] = t;
+    }
+
+    role_set(r, c, AK_BONE_HIPS, h, 1.0f);
+    role_set(r, c, AK_BONE_SPINE, torso[0], 1.0f);
+    role_set(r, c, AK_BONE_CHEST, torso[1], 1.0f);
+    role_set(r, c, AK_BONE_UPPER_CHEST, torso[2], 1.0f);
+    if (neck != head) role_set(r, c, AK_BONE_NECK, neck, 1.0f);
+    role_set(r, c, AK_BONE_HEAD, head, 1.0f);
+    for (int s = 0; s < 2; ++s) {
+        const int ab = s == 0 ? AK_BONE_LEFT_SHOULDER : AK_BONE_RIGHT_SHOULDER;
+        const int lb = s == 0 ? AK_BONE_LEFT_UPPER_LEG : AK_BONE_RIGHT_UPPER_LEG;
+        role_set(r, c, ab, arms[s].before, arms[s].quality);
+        role_set(r, c, ab + 1, arms[s].upper, arms[s].quality);
+        role_set(r, c, ab + 2, arms[s].lower, arms[s].quality);
+        role_set(r, c, ab + 3, arms[s].end, arms[s].quality);
+        role_set(r, c, lb, legs[s].upper, legs[s].quality);
+        role_set(r, c, lb + 1, legs[s].lower, legs[s].quality);
+        role_set(r, c, lb + 2, legs[s].end, legs[s].quality);
+        role_set(r, c, lb + 3, legs[s].after, legs[s].quality);
+    }
+    /* does it stand? */
+    ak_vec3 leg_up = ak_vec3_sub(c->pos[h], feet);
+    r->spine_angle = angle_deg(ak_vec3_sub(c->pos[head], c->pos[h]), leg_up);
+    float leg_len = 0.5f * (dist(c, legs[0].upper, legs[0].lower) + dist(c, legs[0].lower, legs[0].end) +
+                            dist(c, legs[1].upper, legs[1].lower) + dist(c, legs[1].lower, legs[1].end));
+    ak_vec3 lu = unit_or(leg_up, up);
+    float lowest = fminf(ak_vec3_dot(ak_vec3_sub(c->pos[arms[0].end], c->pos[h]), lu),
+                         ak_vec3_dot(ak_vec3_sub(c->pos[arms[1].end], c->pos[h]), lu));
+    r->hand_height = leg_len > 0.0f ? lowest / leg_len : 0.0f;
+    return true;
+}
+
+static const int k_required[15] = {
+    AK_BONE_HIPS,           AK_BONE_SPINE,          AK_BONE_HEAD,           AK_BONE_LEFT_UPPER_ARM,
+    AK_BONE_LEFT_LOWER_ARM, AK_BONE_LEFT_HAND,      AK_BONE_RIGHT_UPPER_ARM, AK_BONE_RIGHT_LOWER_ARM,
+    AK_BONE_RIGHT_HAND,     AK_BONE_LEFT_UPPER_LEG, AK_BONE_LEFT_LOWER_LEG, AK_BONE_LEFT_FOOT,
+    AK_BONE_RIGHT_UPPER_LEG, AK_BONE_RIGHT_LOWER_LEG, AK_BONE_RIGHT_FOOT,
+};
+
+ak_result ak_humanoid_roles_find(const ak_skeleton* skeleton, const ak_allocator* alloc, ak_humanoid_roles* out,
+                                 ak_diag* diag) {
+    if (!skeleton || !out) {
+        akp_diag_set(diag, NULL, "skeleton and out are required");
+        return AK_ERR_NULL_ARG;
+    }
+    memset(out, 0, sizeof *out);
+    for (int b = 0; b < AK_BONE_COUNT; ++b) out->joint[b] = -1;
+    out->up = ak_vec3_make(0, 1, 0), out->forward = ak_vec3_make(0, 0, 1);
+    const size_t n = ak_skeleton_joint_count(skeleton);
+    if (n == 0) {
+        akp_diag_set(diag, NULL, "not a humanoid: the skeleton has no joint");
+        return AK_ERR_NOT_FOUND;
+    }
+    size_t bytes = n * (sizeof(ak_vec3) + sizeof(ak_mat4) + 6 * sizeof(int32_t) + sizeof(float) + 2) + 16 * 16;
+    uint8_t* mem = (uint8_t*)akp_calloc(alloc, bytes);
+    if (!mem) {
+        akp_diag_set(diag, NULL, "out of memory (%zu joints)", n);
+        return AK_ERR_NO_MEMORY;
+    }
+    uint8_t* cur = mem;
+#define TAKE(type, count) ((type*)(void*)(cur += akp_align16((count) * sizeof(type)), cur - akp_align16((count) * sizeof(type))))
+    role_ctx c = {.sk = skeleton, .n = n, .parent = ak_skeleton_parents(skeleton).ptr};
+    ak_mat4* model = TAKE(ak_mat4, n);
+    c.pos = TAKE(ak_vec3, n);
+    c.first_child = TAKE(int32_t, n);
+    c.next_sibling = TAKE(int32_t, n);
+    c.size = TAKE(int32_t, n);
+    c.name_bone = TAKE(int32_t, n);
+    c.chain = TAKE(int32_t, n);
+    c.stack = TAKE(int32_t, n);
+    c.reach = TAKE(float, n);
+    c.name_side = TAKE(uint8_t, n);
+    c.name_word = TAKE(uint8_t, n);
+#undef TAKE
+    ak_result r = ak_skeleton_local_to_model(skeleton, ak_skeleton_rest_pose(skeleton), (ak_mat4_span){model, n});
+    float extent = 0.0f;
+    for (size_t j = 0; j < n && r == AK_OK; ++j) {
+        c.pos[j] = model_position(&model[j]);
+        if (!ak_vec3_is_finite(c.pos[j])) r = AK_ERR_BAD_DATA;
+        c.first_child[j] = c.next_sibling[j] = -1;
+        c.size[j] = 1;
+        name_words(ak_skeleton_joint_name(skeleton, j), &c.name_side[j], &c.name_word[j]);
+    }
+    if (r != AK_OK) {
+        akp_diag_set(diag, NULL, "the rest pose is not finite");
+        akp_free(alloc, mem);
+        return AK_ERR_BAD_DATA;
+    }
+    ak_humanoid_bones_of_skeleton(skeleton, (ak_i32_span){c.name_bone, n});
+    for (size_t jj = n; jj-- > 0;) { /* parents come before their children */
+        int32_t p = c.parent[jj];
+        if (p < 0) continue;
+        c.next_sibling[jj] = c.first_child[p], c.first_child[p] = (int32_t)jj;
+        c.size[p] += c.size[jj];
+        c.reach[p] = fmaxf(c.reach[p], dist(&c, p, (int32_t)jj) + c.reach[jj]);
+        extent = fmaxf(extent, c.reach[p]);
+    }
+    c.eps = fmaxf(extent * 1e-5f, 1e-12f);
+    /* hips candidates breadth first from the roots; the first that fits */
+    int32_t* queue = (int32_t*)akp_calloc(alloc, n * sizeof(int32_t));
+    if (!queue) {
+        akp_free(alloc, mem);
+        akp_diag_set(diag, NULL, "out of memory (%zu joints)", n);
+        return AK_ERR_NO_MEMORY;
+    }
+    size_t qn = 0;
+    for (size_t j = 0; j < n; ++j)
+        if (c.parent[j] < 0) queue[qn++] = (int32_t)j;
+    bool fit = false;
+    int32_t two_legs = -1;
+    for (size_t qi = 0; qi < qn && !fit; ++qi) {
+        int32_t h = queue[qi];
+        int big = 0;
+        for (int32_t k = c.first_child[h]; k >= 0; k = c.next_sibling[k]) {
+            big += c.size[k] >= 3;
+            if (qn < n) queue[qn++] = k;
+        }
+        if (big >= 2 && two_legs < 0) two_legs = h;
+        if (big >= 3) fit = template_fit(&c, h, out);
+    }
+    akp_free(alloc, queue);
+    float sum = 0.0f;
+    for (int i = 0; i < 15; ++i) sum += out->confidence[k_required[i]];
+    out->score = sum / 15.0f;
+    r = AK_OK;
+    if (!fit) {
+        r = AK_ERR_NOT_FOUND;
+        if (two_legs < 0)
+            akp_diag_set(diag, NULL, "not a humanoid: no joint has two leg chains (subtrees of 3 joints or more)");
+        else
+            akp_diag_set(diag, NULL, "not a humanoid: no joint has two leg chains beside a spine whose chest has two "
+                                     "arm chains and a head chain (first branching joint: %s)",
+                         ak_skeleton_joint_name(skeleton, (size_t)two_legs));
+    } else if (out->spine_angle > 45.0f || out->hand_height < -0.8f) {
+        r = AK_ERR_NOT_FOUND;
+        char why[300];
+        if (out->spine_angle > 45.0f && out->hand_height < -0.8f)
+            snprintf(why, sizeof why, "hips -> head runs %.0f degrees from the legs' upward direction (at most 45) and "
+                                      "the front limbs reach %.2f leg lengths below the hips, as low as the feet",
+                     (double)out->spine_angle, (double)-out->hand_height);
+        else if (out->spine_angle > 45.0f)
+            snprintf(why, sizeof why, "hips -> head runs %.0f degrees from the legs' upward direction (at most 45)",
+                     (double)out->spine_angle);
+        else
+            snprintf(why, sizeof why, "the hands reach %.2f leg lengths below the hips (at most 0.8)",
+                     (double)-out->hand_height);
+        akp_diag_set(diag, NULL, "not a humanoid: %s (a quadruped?)", why);
+    } else {
+        for (int i = 0; i < 15; ++i)
+            if (out->joint[k_required[i]] < 0) {
+                r = AK_ERR_NOT_FOUND;
+                akp_diag_set(diag, NULL, "not a humanoid: no %s", k_bone_names[k_required[i]]);
+                break;
+            }
+    }
+    out->is_humanoid = r == AK_OK;
+    if (r == AK_OK) akp_diag_set(diag, NULL, "humanoid, score %.2f", (double)out->score);
+    akp_free(alloc, mem);
+    return r;
+}
+
+static bool is_torso(int b) { return b >= AK_BONE_SPINE && b <= AK_BONE_UPPER_CHEST; }
+
+ak_result ak_retarget_map_by_roles(const ak_skeleton* source, const ak_humanoid_roles* sr, const ak_skeleton* target,
+                                   const ak_humanoid_roles* tr, ak_i32_span out, size_t* out_mapped_count) {
+    if (out_mapped_count) *out_mapped_count = 0;
+    if (!source || !sr || !target || !tr || !out.ptr) return AK_ERR_NULL_ARG;
+    const size_t ns = ak_skeleton_joint_count(source), nt = ak_skeleton_joint_count(target);
+    if (out.count < nt) return AK_ERR_SPAN_SMALL;
+    for (int b = 1; b < AK_BONE_COUNT; ++b)
+        if (sr->joint[b] < -1 || sr->joint[b] >= (int32_t)ns || tr->joint[b] < -1 || tr->joint[b] >= (int32_t)nt)
+            return AK_ERR_BAD_INDEX;
+    for (size_t k = 0; k < nt; ++k) out.ptr[k] = -1;
+    for (int b = 1; b < AK_BONE_COUNT; ++b)
+        if (!is_torso(b) && sr->joint[b] >= 0 && tr->joint[b] >= 0) out.ptr[tr->joint[b]] = sr->joint[b];
+    /* torso: bottom to bottom, top to top, the middle in proportion */
+    int32_t st[3], tt[3];
+    size_t sn = 0, tn = 0;
+    for (int b = AK_BONE_SPINE; b <= AK_BONE_UPPER_CHEST; ++b) {
+        if (sr->joint[b] >= 0) st[sn++] = sr->joint[b];
+        if (tr->joint[b] >= 0) tt[tn++] = tr->joint[b];
+    }
+    for (size_t i = 0; i < tn && sn > 0; ++i) {
+        size_t si = tn == 1 ? sn - 1 : (i * (sn - 1) * 2 + (tn - 1)) / (2 * (tn - 1));
+        out.ptr[tt[i]] = st[si];
+    }
+    size_t mapped = 0;
+    for (size_t k = 0; k < nt; ++k) mapped += out.ptr[k] >= 0;
+    if (out_mapped_count) *out_mapped_count = mapped;
+    return AK_OK;
+}
+
+/* snprintf-style appender. */
+typedef struct text_out {
+    char* buf;
+    size_t cap, len;
+} text_out;
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void text_add(text_out* t, const char* fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    char* at = t->len < t->cap ? t->buf + t->len : NULL;
+    int n = vsnprintf(at, at ? t->cap - t->len : 0, fmt, ap);
+    va_end(ap);
+    if (n > 0) t->len += (size_t)n;
+}
+
+static const char* sides_text(ak_humanoid_sides s) {
+    switch (s) {
+    case AK_SIDES_TOES: return "left/right from the toes' direction";
+    case AK_SIDES_NAMES: return "left/right from the names (no toes)";
+    case AK_SIDES_CONVENTION: return "left/right from glTF's +Z facing (no toes, no side in the names)";
+    default: return "left/right not decided";
+    }
+}
+
+static void roles_header(text_out* t, const char* what, const ak_skeleton* sk, const ak_humanoid_roles* r) {
+    (void)sk;
+    text_add(t, "# %s: %s, score %.2f, up (%.2f, %.2f, %.2f), forward (%.2f, %.2f, %.2f), %s\n", what,
+             r->is_humanoid ? "humanoid" : "NOT a humanoid", (double)r->score, (double)r->up.x, (double)r->up.y,
+             (double)r->up.z, (double)r->forward.x, (double)r->forward.y, (double)r->forward.z, sides_text(r->sides));
+}
+
+ak_result ak_retarget_map_write(const ak_skeleton* source, const ak_humanoid_roles* sr, const ak_skeleton* target,
+                                const ak_humanoid_roles* tr, ak_i32_cspan map, char* buffer, size_t buffer_size,
+                                size_t* out_size) {
+    if (out_size) *out_size = 0;
+    if (!source || !target || !map.ptr || (!buffer && buffer_size > 0)) return AK_ERR_NULL_ARG;
+    const size_t ns = ak_skeleton_joint_count(source), nt = ak_skeleton_joint_count(target);
+    if (map.count < nt) return AK_ERR_SPAN_SMALL;
+    for (size_t k = 0; k < nt; ++k)
+        if (map.ptr[k] < -1 || map.ptr[k] >= (int32_t)ns) return AK_ERR_BAD_INDEX;
+    for (int b = 1; b < AK_BONE_COUNT; ++b)
+        if ((sr && (sr->joint[b] < -1 || sr->joint[b] >= (int32_t)ns)) ||
+            (tr && (tr->joint[b] < -1 || tr->joint[b] >= (int32_t)nt)))
+            return AK_ERR_BAD_INDEX;
+    text_out t = {buffer, buffer_size, 0};
+    if (buffer_size) buffer[0] = '\0';
+    text_add(&t, "# animkit retarget map: TARGET_JOINT = SOURCE_JOINT, one a line ('#' starts a comment).\n"
+                 "# Edit it and pass it back with --map FILE: only the joints listed are driven.\n");
+    if (tr) roles_header(&t, "target", target, tr);
+    if (sr) roles_header(&t, "source", source, sr);
+    /* column widths */
+    int tw = 12, sw = 12;
+    for (size_t k = 0; k < nt; ++k)
+        if (map.ptr[k] >= 0) {
+            tw = (int)fmax(tw, (double)strlen(ak_skeleton_joint_name(target, k)));
+            sw = (int)fmax(sw, (double)strlen(ak_skeleton_joint_name(source, (size_t)map.ptr[k])));
+        }
+    text_add(&t, "# %-*s   %-*s  # bone           confidence target / source\n", tw - 2, "TARGET", sw, "SOURCE");
+    for (int b = 1; b < AK_BONE_COUNT; ++b) {
+        int32_t tj = tr ? tr->joint[b] : -1, sj = sr ? sr->joint[b] : -1;
+        if (tj >= 0 && map.ptr[tj] >= 0) {
+            text_add(&t, "%-*s = %-*s  # %-14s %.2f / ", tw, ak_skeleton_joint_name(target, (size_t)tj), sw,
+                     ak_skeleton_joint_name(source, (size_t)map.ptr[tj]), k_bone_names[b], (double)tr->confidence[b]);
+            int sb = 0;
+            for (int x = 1; sr && x < AK_BONE_COUNT && !sb; ++x)
+                if (sr->joint[x] == map.ptr[tj]) sb = x;
+            if (sb == b) text_add(&t, "%.2f\n", (double)sr->confidence[b]);
+            else if (sb) text_add(&t, "%.2f (%s)\n", (double)sr->confidence[sb], k_bone_names[sb]);
+            else text_add(&t, "-\n");
+        } else if (tr && sr && (tj >= 0 || sj >= 0) && !(tj >= 0 && map.ptr[tj] >= 0)) {
+            bool used = false;
+            for (size_t k = 0; k < nt && sj >= 0; ++k) used |= map.ptr[k] == sj;
+            if (used) continue;
+            if (tj < 0)
+                text_add(&t, "# %-14s no target joint (source %s)\n", k_bone_names[b],
+                         ak_skeleton_joint_name(source, (size_t)sj));
+            else
+                text_add(&t, "# %-14s no source joint (target %s keeps its rest pose)\n", k_bone_names[b],
+                         ak_skeleton_joint_name(target, (size_t)tj));
+        } else if (tr && sr && tj < 0 && sj < 0 && b != AK_BONE_UPPER_CHEST && b != AK_BONE_CHEST) {
+            bool required = false;
+            for (int i = 0; i < 15; ++i) required |= k_required[i] == b;
+            if (required) text_add(&t, "# %-14s not found in either skeleton\n", k_bone_names[b]);
+        }
+    }
+    for (size_t k = 0; k < nt; ++k) {
+        bool role = false;
+        for (int b = 1; tr && b < AK_BONE_COUNT; ++b) role |= tr->joint[b] == (int32_t)k;
+        if (map.ptr[k] >= 0 && !role)
+            text_add(&t, "%-*s = %s\n", tw, ak_skeleton_joint_name(target, k),
+                     ak_skeleton_joint_name(source, (size_t)map.ptr[k]));
+    }
+    if (out_size) *out_size = t.len;
+    return AK_OK;
+}

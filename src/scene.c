@@ -19,7 +19,7 @@ ak_result ak_scene_alloc(size_t mesh_count, size_t skin_count, size_t clip_count
     const ak_allocator* a = &s->alloc;
     if (mesh_count && !(s->meshes = (ak_scene_mesh*)akp_calloc(a, mesh_count * sizeof(ak_scene_mesh)))) goto oom;
     s->mesh_count = mesh_count;
-    for (size_t i = 0; i < mesh_count; ++i) s->meshes[i].node = s->meshes[i].skin = -1;
+    for (size_t i = 0; i < mesh_count; ++i) s->meshes[i].node = s->meshes[i].skin = s->meshes[i].texture = -1;
     if (skin_count && !(s->skins = (ak_scene_skin*)akp_calloc(a, skin_count * sizeof(ak_scene_skin)))) goto oom;
     s->skin_count = skin_count;
     if (clip_count && !(s->clips = (ak_clip**)akp_calloc(a, clip_count * sizeof(ak_clip*)))) goto oom;
@@ -49,6 +49,39 @@ ak_result ak_scene_skin_alloc(ak_scene* scene, size_t skin_index, size_t joint_c
     return AK_OK;
 }
 
+static void free_textures(ak_scene* scene) {
+    for (size_t i = 0; i < scene->texture_count; ++i) akp_free(&scene->alloc, scene->textures[i].pixels);
+    akp_free(&scene->alloc, scene->textures);
+    scene->textures = NULL;
+    scene->texture_count = 0;
+}
+
+ak_result ak_scene_texture_alloc(ak_scene* scene, size_t texture_count) {
+    if (!scene) return AK_ERR_NULL_ARG;
+    free_textures(scene);
+    if (texture_count == 0) return AK_OK;
+    if (texture_count > SIZE_MAX / sizeof(ak_scene_texture)) return AK_ERR_NO_MEMORY;
+    scene->textures = (ak_scene_texture*)akp_calloc(&scene->alloc, texture_count * sizeof(ak_scene_texture));
+    if (!scene->textures) return AK_ERR_NO_MEMORY;
+    scene->texture_count = texture_count;
+    return AK_OK;
+}
+
+ak_result ak_scene_texture_alloc_pixels(ak_scene* scene, size_t texture_index, int width, int height) {
+    if (!scene) return AK_ERR_NULL_ARG;
+    if (texture_index >= scene->texture_count) return AK_ERR_BAD_INDEX;
+    if (width <= 0 || height <= 0 || width > 32768 || height > 32768) return AK_ERR_BAD_ARG;
+    ak_scene_texture* t = &scene->textures[texture_index];
+    akp_free(&scene->alloc, t->pixels);
+    t->pixels = NULL;
+    t->width = t->height = 0;
+    t->pixels = (uint8_t*)akp_calloc(&scene->alloc, (size_t)width * (size_t)height * 4u);
+    if (!t->pixels) return AK_ERR_NO_MEMORY;
+    t->width = width;
+    t->height = height;
+    return AK_OK;
+}
+
 void ak_scene_destroy(ak_scene* scene) {
     if (!scene) return;
     ak_allocator a = scene->alloc;
@@ -59,6 +92,7 @@ void ak_scene_destroy(ak_scene* scene) {
         akp_free(&a, scene->skins[i].inverse_binds);
     }
     for (size_t i = 0; i < scene->clip_count; ++i) ak_clip_destroy(scene->clips[i]);
+    free_textures(scene);
     akp_free(&a, scene->meshes);
     akp_free(&a, scene->skins);
     akp_free(&a, scene->clips);

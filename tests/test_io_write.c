@@ -103,6 +103,17 @@ static int compare_scenes_n(const ak_scene* a, const ak_scene* b, const char* wh
         if (a->meshes[m].has_material && b->meshes[m].has_material)
             AK_CHECK_MSG(!memcmp(&a->meshes[m].base_color, &b->meshes[m].base_color, sizeof(ak_vec4)),
                          "%s mesh %zu: base colour differs", what, m);
+        /* base colour textures kept: same texels, wrap modes and filters */
+        int32_t ta = a->meshes[m].texture, tb = b->meshes[m].texture;
+        AK_CHECK_MSG((ta >= 0) == (tb >= 0), "%s mesh %zu: texture %s", what, m, ta >= 0 ? "lost" : "appeared");
+        if (ta >= 0 && tb >= 0 && (size_t)tb < b->texture_count) {
+            const ak_scene_texture *xa = &a->textures[ta], *xb = &b->textures[tb];
+            AK_CHECK_MSG(xa->width == xb->width && xa->height == xb->height && xb->pixels &&
+                             !memcmp(xa->pixels, xb->pixels, (size_t)xa->width * (size_t)xa->height * 4u),
+                         "%s mesh %zu: texture pixels differ", what, m);
+            AK_CHECK(xa->wrap_s == xb->wrap_s && xa->wrap_t == xb->wrap_t && xa->mag_filter == xb->mag_filter &&
+                     xa->min_filter == xb->min_filter);
+        }
         if (a->meshes[m].mesh->vertex_count != b->meshes[m].mesh->vertex_count ||
             a->meshes[m].mesh->morph_target_count != b->meshes[m].mesh->morph_target_count)
             bad = 1;

@@ -4,6 +4,7 @@
 #include <animkit/retarget.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "ak_test.h"
@@ -290,6 +291,185 @@ AK_TEST(map_parse) {
     ak_skeleton_destroy(sk);
 }
 
+/* ---- automatic humanoid mapping ------------------------------------------------------------ */
+
+enum { HJ = 23, QJ = 24 };
+
+/* A humanoid standing at the origin, facing +Z, left at +X (model positions): hips, spine,
+ * chest, neck, head, then per side a clavicle, upper arm, forearm, hand, finger, then per side
+ * thigh, shin, foot, toe. As in the CMU rigs, clavicle + upper arm (0.24 + 0.30) is longer
+ * than upper + lower arm (0.30 + 0.22): only the rule that a short bone (the hand) follows
+ * the lower arm tells them apart. */
+static const float k_human[HJ][3] = {
+    {0, 1, 0},        {0, 1.1f, 0},      {0, 1.3f, 0},     {0, 1.5f, 0},       {0, 1.6f, 0.02f},
+    {0.02f, 1.45f, 0}, {0.26f, 1.45f, 0}, {0.56f, 1.45f, 0}, {0.78f, 1.45f, 0}, {0.86f, 1.45f, 0},
+    {-0.02f, 1.45f, 0}, {-0.26f, 1.45f, 0}, {-0.56f, 1.45f, 0}, {-0.78f, 1.45f, 0}, {-0.86f, 1.45f, 0},
+    {0.1f, 0.95f, 0}, {0.1f, 0.52f, 0.01f}, {0.1f, 0.08f, 0}, {0.1f, 0.02f, 0.12f},
+    {-0.1f, 0.95f, 0}, {-0.1f, 0.52f, 0.01f}, {-0.1f, 0.08f, 0}, {-0.1f, 0.02f, 0.12f}};
+static const int k_human_parent[HJ] = {-1, 0, 1, 2, 3, 2, 5, 6, 7, 8, 2, 10, 11, 12, 13, 0, 15, 16, 17, 0, 19, 20, 21};
+static const char* const k_human_names[HJ] = {
+    "Hips",         "Spine",       "Chest",          "Neck",        "Head",        "LeftShoulder", "LeftArm",
+    "LeftForeArm",  "LeftHand",    "LeftHandIndex1", "RightShoulder", "RightArm",   "RightForeArm", "RightHand",
+    "RightHandIndex1", "LeftUpLeg", "LeftLeg",       "LeftFoot",    "LeftToeBase", "RightUpLeg",  "RightLeg",
+    "RightFoot",    "RightToeBase"};
+/* The joint each bone must get (-1: none), in ak_humanoid_bone order. */
+static const int k_human_roles[AK_BONE_COUNT] = {-1, 0, 1, 2, -1, 3, 4, 5, 6, 7, 8, 10, 11, 12, 13,
+                                                 15, 16, 17, 18, 19, 20, 21, 22};
+
+/* A fox-like quadruped facing +Z: hips, spine, chest, neck, head, front legs off the chest,
+ * hind legs off the hips, a tail. */
+static const float k_quad[QJ][3] = {
+    {0, 0.6f, 0},      {0, 0.62f, 0.2f},  {0, 0.62f, 0.5f},  {0, 0.7f, 0.65f},  {0, 0.8f, 0.75f},
+    {0.1f, 0.55f, 0.5f}, {0.1f, 0.3f, 0.5f}, {0.1f, 0.05f, 0.5f}, {0.1f, 0, 0.55f},
+    {-0.1f, 0.55f, 0.5f}, {-0.1f, 0.3f, 0.5f}, {-0.1f, 0.05f, 0.5f}, {-0.1f, 0, 0.55f},
+    {0.1f, 0.55f, 0},  {0.1f, 0.3f, -0.02f}, {0.1f, 0.05f, 0}, {0.1f, 0, 0.05f},
+    {-0.1f, 0.55f, 0}, {-0.1f, 0.3f, -0.02f}, {-0.1f, 0.05f, 0}, {-0.1f, 0, 0.05f},
+    {0, 0.6f, -0.1f},  {0, 0.55f, -0.3f}, {0, 0.5f, -0.5f}};
+static const int k_quad_parent[QJ] = {-1, 0, 1, 2, 3, 2, 5, 6, 7, 2, 9, 10, 11, 0, 13, 14, 15, 0, 17, 18, 19, 0, 21, 22};
+
+/* Skeleton from model positions turned by yaw about +Y (identity rest rotations). names NULL:
+ * "bone_0", "bone_1", ...; drop >= 0: that joint and its subtree's toe left out (a leaf). */
+static ak_skeleton* make_posed(const float (*pos)[3], const int* parent, int count, const char* const* names, float yaw,
+                               int drop) {
+    ak_joint_desc j[QJ];
+    char nm[QJ][16];
+    int index[QJ], n = 0;
+    ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), yaw);
+    for (int i = 0; i < count; ++i) {
+        index[i] = -1;
+        if (i == drop) continue;
+        ak_vec3 p = ak_quat_rotate(q, ak_vec3_make(pos[i][0], pos[i][1], pos[i][2]));
+        if (parent[i] >= 0) {
+            ak_vec3 pp = ak_quat_rotate(q, ak_vec3_make(pos[parent[i]][0], pos[parent[i]][1], pos[parent[i]][2]));
+            p = ak_vec3_sub(p, pp);
+        }
+        snprintf(nm[n], sizeof nm[n], "bone_%d", i);
+        j[n] = (ak_joint_desc){.name = names ? names[i] : nm[n], .parent = parent[i] >= 0 ? index[parent[i]] : -1,
+                               .rest = ak_transform_make(p, ak_quat_identity(), ak_vec3_make(1, 1, 1))};
+        index[i] = n++;
+    }
+    ak_skeleton* s = NULL;
+    ak_skeleton_create(&(ak_skeleton_desc){.joints = j, .joint_count = (size_t)n}, NULL, &s, NULL);
+    return s;
+}
+
+/* Every bone on the joint the table says (indices of the full table; swap: left <-> right). */
+static void check_roles(const char* what, const ak_humanoid_roles* r, bool swap) {
+    for (int b = 1; b < AK_BONE_COUNT; ++b) {
+        int e = b;
+        if (swap && b >= AK_BONE_LEFT_SHOULDER && b <= AK_BONE_RIGHT_HAND)
+            e = b < AK_BONE_RIGHT_SHOULDER ? b + 4 : b - 4;
+        if (swap && b >= AK_BONE_LEFT_UPPER_LEG) e = b < AK_BONE_RIGHT_UPPER_LEG ? b + 4 : b - 4;
+        AK_CHECK_MSG(r->joint[b] == k_human_roles[e], "%s: %s on joint %d, expected %d", what, ak_humanoid_bone_name(b),
+                     (int)r->joint[b], k_human_roles[e]);
+    }
+}
+
+AK_TEST(humanoid_roles_template) {
+    ak_humanoid_roles r;
+    ak_diag diag;
+    /* named, facing +Z: every bone, names agree (confidence 1), sides from the toes */
+    ak_skeleton* s = make_posed(k_human, k_human_parent, HJ, k_human_names, 0.0f, -1);
+    AK_CHECK_EQ(ak_humanoid_roles_find(s, NULL, &r, &diag), AK_OK);
+    check_roles("named", &r, false);
+    AK_CHECK(r.is_humanoid && r.sides == AK_SIDES_TOES);
+    AK_CHECK_MSG(fabsf(r.score - 1.0f) < 1e-6f, "score %g", (double)r.score);
+    AK_CHECK(ak_vec3_dot(r.up, ak_vec3_make(0, 1, 0)) > 0.99f && ak_vec3_dot(r.forward, ak_vec3_make(0, 0, 1)) > 0.99f);
+    ak_skeleton_destroy(s);
+    /* no names, turned to face -Z: topology and geometry alone; the toes say which side is
+     * left (the chain now at -X); confidence 0.8 (the names say nothing) */
+    s = make_posed(k_human, k_human_parent, HJ, NULL, 3.14159265f, -1);
+    AK_CHECK_EQ(ak_humanoid_roles_find(s, NULL, &r, &diag), AK_OK);
+    check_roles("anonymous, facing -Z", &r, false);
+    AK_CHECK(r.sides == AK_SIDES_TOES && ak_vec3_dot(r.forward, ak_vec3_make(0, 0, -1)) > 0.99f);
+    AK_CHECK_MSG(fabsf(r.score - 0.8f) < 1e-6f, "score %g", (double)r.score);
+    ak_skeleton_destroy(s);
+    /* named, facing -Z, without the left toe: the names decide */
+    s = make_posed(k_human, k_human_parent, HJ, k_human_names, 3.14159265f, 18);
+    AK_CHECK_EQ(ak_humanoid_roles_find(s, NULL, &r, &diag), AK_OK);
+    AK_CHECK_EQ(r.sides, AK_SIDES_NAMES);
+    AK_CHECK_EQ(r.joint[AK_BONE_LEFT_UPPER_ARM], ak_skeleton_find_joint(s, "LeftArm"));
+    AK_CHECK_EQ(r.joint[AK_BONE_RIGHT_FOOT], ak_skeleton_find_joint(s, "RightFoot"));
+    AK_CHECK_EQ(r.joint[AK_BONE_LEFT_TOES], -1);
+    ak_skeleton_destroy(s);
+    /* neither toes nor names, facing -Z: glTF's +Z convention takes the chain at +X (the
+     * right one) for the left: documented, and why a rig without toes needs sided names */
+    s = make_posed(k_human, k_human_parent, HJ, NULL, 3.14159265f, 18);
+    AK_CHECK_EQ(ak_humanoid_roles_find(s, NULL, &r, &diag), AK_OK);
+    AK_CHECK_EQ(r.sides, AK_SIDES_CONVENTION);
+    AK_CHECK_EQ(r.joint[AK_BONE_LEFT_UPPER_ARM], ak_skeleton_find_joint(s, "bone_11"));
+    ak_skeleton_destroy(s);
+    /* the quadruped fits the topology but does not stand */
+    s = make_posed(k_quad, k_quad_parent, QJ, NULL, 0.0f, -1);
+    memset(&diag, 0, sizeof diag);
+    AK_CHECK_EQ(ak_humanoid_roles_find(s, NULL, &r, &diag), AK_ERR_NOT_FOUND);
+    AK_CHECK(!r.is_humanoid && r.spine_angle > 60.0f && r.hand_height < -0.8f);
+    AK_CHECK_MSG(strstr(diag.message, "not a humanoid") && strstr(diag.message, "quadruped"), "%s", diag.message);
+    AK_CHECK_EQ(r.joint[AK_BONE_HIPS], 0);
+    ak_skeleton_destroy(s);
+    /* a chain: no legs at all */
+    s = make_posed(k_human, k_human_parent, 5, NULL, 0.0f, -1);
+    AK_CHECK_EQ(ak_humanoid_roles_find(s, NULL, &r, &diag), AK_ERR_NOT_FOUND);
+    AK_CHECK_MSG(strstr(diag.message, "no joint has two leg chains") != NULL, "%s", diag.message);
+    AK_CHECK_EQ(ak_humanoid_roles_find(NULL, NULL, &r, NULL), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_humanoid_roles_find(s, NULL, NULL, NULL), AK_ERR_NULL_ARG);
+    ak_skeleton_destroy(s);
+}
+
+/* By roles from an anonymous 23-joint figure onto the named one: every bone pairs with the
+ * same table entry; the written map parses back to the same map; a short buffer gets the
+ * needed size. Torso pairing: a 1-joint spine drives both target spine joints' ends. */
+AK_TEST(map_by_roles_and_write) {
+    ak_skeleton* src = make_posed(k_human, k_human_parent, HJ, NULL, 0.0f, -1);
+    ak_skeleton* dst = make_posed(k_human, k_human_parent, HJ, k_human_names, 0.0f, -1);
+    ak_humanoid_roles sr, tr;
+    AK_CHECK_EQ(ak_humanoid_roles_find(src, NULL, &sr, NULL), AK_OK);
+    AK_CHECK_EQ(ak_humanoid_roles_find(dst, NULL, &tr, NULL), AK_OK);
+    int32_t map[HJ], back[HJ];
+    size_t mapped = 0;
+    AK_CHECK_EQ(ak_retarget_map_by_roles(src, &sr, dst, &tr, (ak_i32_span){map, HJ}, &mapped), AK_OK);
+    AK_CHECK_EQ(mapped, (size_t)21); /* all but the two fingers */
+    for (int j = 0; j < HJ; ++j) AK_CHECK_EQ(map[j], j == 9 || j == 14 ? -1 : j);
+    size_t need = 0;
+    AK_CHECK_EQ(ak_retarget_map_write(src, &sr, dst, &tr, (ak_i32_cspan){map, HJ}, NULL, 0, &need), AK_OK);
+    AK_CHECK(need > 100);
+    char* text = malloc(need + 1);
+    char small[16];
+    size_t need2 = 0;
+    AK_CHECK_EQ(ak_retarget_map_write(src, &sr, dst, &tr, (ak_i32_cspan){map, HJ}, small, sizeof small, &need2), AK_OK);
+    AK_CHECK(need2 == need && small[15] == '\0' && strlen(small) == 15);
+    AK_CHECK_EQ(ak_retarget_map_write(src, &sr, dst, &tr, (ak_i32_cspan){map, HJ}, text, need + 1, NULL), AK_OK);
+    AK_CHECK_EQ(strlen(text), need);
+    AK_CHECK(strstr(text, "LeftArm") && strstr(text, "leftUpperArm"));
+    size_t n2 = 0;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_retarget_map_parse(text, need, src, dst, (ak_i32_span){back, HJ}, &n2, &diag), AK_OK);
+    AK_CHECK_EQ(n2, (size_t)21);
+    AK_CHECK(memcmp(back, map, sizeof map) == 0);
+    free(text);
+    /* torso: a source whose spine is one joint (the chest joint dropped: the arms and neck hang
+     * from the spine) drives both target torso joints */
+    ak_humanoid_roles one = sr;
+    one.joint[AK_BONE_CHEST] = -1;
+    AK_CHECK_EQ(ak_retarget_map_by_roles(src, &one, dst, &tr, (ak_i32_span){map, HJ}, &mapped), AK_OK);
+    AK_CHECK(map[1] == 1 && map[2] == 1);
+    /* three target torso joints from two source ones: bottom to bottom, top to top */
+    ak_humanoid_roles three = tr;
+    three.joint[AK_BONE_UPPER_CHEST] = 3, three.joint[AK_BONE_NECK] = -1;
+    AK_CHECK_EQ(ak_retarget_map_by_roles(src, &sr, dst, &three, (ak_i32_span){map, HJ}, &mapped), AK_OK);
+    AK_CHECK(map[1] == 1 && map[2] == 2 && map[3] == 2);
+    /* bad arguments */
+    AK_CHECK_EQ(ak_retarget_map_by_roles(src, &sr, dst, NULL, (ak_i32_span){map, HJ}, NULL), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_retarget_map_by_roles(src, &sr, dst, &tr, (ak_i32_span){map, HJ - 1}, NULL), AK_ERR_SPAN_SMALL);
+    three.joint[AK_BONE_HEAD] = HJ;
+    AK_CHECK_EQ(ak_retarget_map_by_roles(src, &sr, dst, &three, (ak_i32_span){map, HJ}, NULL), AK_ERR_BAD_INDEX);
+    map[0] = HJ;
+    AK_CHECK_EQ(ak_retarget_map_write(src, NULL, dst, NULL, (ak_i32_cspan){map, HJ}, NULL, 0, NULL), AK_ERR_BAD_INDEX);
+    AK_CHECK_EQ(ak_retarget_map_write(src, NULL, dst, NULL, (ak_i32_cspan){map, HJ - 1}, NULL, 0, NULL), AK_ERR_SPAN_SMALL);
+    ak_skeleton_destroy(src);
+    ak_skeleton_destroy(dst);
+}
+
 int main(void) {
     AK_RUN(identity_on_same_skeleton);
     AK_RUN(uniformly_scaled_copy);
@@ -297,5 +477,7 @@ int main(void) {
     AK_RUN(bone_names);
     AK_RUN(desc_rules);
     AK_RUN(map_parse);
+    AK_RUN(humanoid_roles_template);
+    AK_RUN(map_by_roles_and_write);
     return ak_test_finish();
 }

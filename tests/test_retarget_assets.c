@@ -202,9 +202,206 @@ AK_TEST(cmu_bvh_onto_builtin_and_cesiumman) {
 }
 
 
+/* ---- automatic mapping ------------------------------------------------------------------------ */
+
+/* The joint each template bone must land on, written by hand from each file's hierarchy and
+ * rest pose ("" = none), in ak_humanoid_bone order from hips. */
+typedef struct role_case {
+    const char *file, *roles[AK_BONE_COUNT - 1];
+    bool slow; /* a long file (2 MB): checked by the slow entry */
+} role_case;
+
+#define CMU_ROLES                                                                                               \
+    {"Hips", "LowerBack", "Spine", "Spine1", "Neck", "Head", "LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand", \
+     "RightShoulder", "RightArm", "RightForeArm", "RightHand", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase",    \
+     "RightUpLeg", "RightLeg", "RightFoot", "RightToeBase"}
+
+static const role_case k_role_cases[] = {
+    {"bvh/01_01.bvh", CMU_ROLES, true},
+    {"bvh/02_01.bvh", CMU_ROLES, false},
+    {"bvh/49_04.bvh", CMU_ROLES, false},
+    {"bvh/131_03.bvh",
+     {"Hips", "lowerback", "Chest", "Chest2", "lowerneck", "Head", "LeftCollar", "LeftShoulder", "LeftElbow",
+      "LeftWrist", "RightCollar", "RightShoulder", "RightElbow", "RightWrist", "LeftHip", "LeftKnee", "LeftAnkle",
+      "LeftToe", "RightHip", "RightKnee", "RightAnkle", "RightToe"},
+     false},
+    {"builtin:humanoid",
+     {"pelvis", "spine_01", "spine_02", "", "neck", "head", "", "left_shoulder", "left_elbow", "left_wrist", "",
+      "right_shoulder", "right_elbow", "right_wrist", "left_hip", "left_knee", "left_ankle", "", "right_hip",
+      "right_knee", "right_ankle", ""},
+     false},
+    {"gltf/CesiumMan/glTF-Binary/CesiumMan.glb",
+     {"Skeleton_torso_joint_1", "Skeleton_torso_joint_2", "torso_joint_3", "", "Skeleton_neck_joint_1",
+      "Skeleton_neck_joint_2", "", "Skeleton_arm_joint_L__4_", "Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", "",
+      "Skeleton_arm_joint_R", "Skeleton_arm_joint_R__2_", "Skeleton_arm_joint_R__3_", "leg_joint_L_1", "leg_joint_L_2",
+      "leg_joint_L_3", "leg_joint_L_5", "leg_joint_R_1", "leg_joint_R_2", "leg_joint_R_3", "leg_joint_R_5"},
+     false},
+};
+
+static ak_scene* load_case(const char* file) {
+    ak_scene* s = NULL;
+    ak_diag diag;
+    char path[1200];
+    if (strncmp(file, "builtin:", 8) == 0) ak_builtin_create(file + 8, NULL, NULL, &s);
+    else if (ak_test_asset(path, sizeof path, file)) ak_io_load(path, NULL, NULL, &s, &diag);
+    return s;
+}
+
+/* Every BVH of the shared assets, builtin:humanoid and CesiumMan: each template bone on the
+ * joint the table above names; every one a humanoid, left/right from the toes where there
+ * are toes. Fox: the template's topology fits (a quadruped has the same tree) but it does not
+ * stand: not a humanoid, and the reason given. */
+static void check_asset_roles(bool slow) {
+    for (size_t c = 0; c < sizeof k_role_cases / sizeof k_role_cases[0]; ++c) {
+        if (k_role_cases[c].slow != slow) continue;
+        ak_scene* s = load_case(k_role_cases[c].file);
+        if (!s) {
+            AK_SKIP("asset absent (set ANIMKIT_ASSETS)");
+            continue;
+        }
+        ak_humanoid_roles r;
+        ak_diag diag;
+        AK_CHECK_MSG(ak_humanoid_roles_find(s->skeleton, NULL, &r, &diag) == AK_OK, "%s: %s", k_role_cases[c].file,
+                     diag.message);
+        int wrong = 0;
+        for (int b = 1; b < AK_BONE_COUNT; ++b) {
+            const char* want = k_role_cases[c].roles[b - 1];
+            const char* got = r.joint[b] >= 0 ? ak_skeleton_joint_name(s->skeleton, (size_t)r.joint[b]) : "";
+            if (strcmp(want, got) != 0) ++wrong;
+            AK_CHECK_MSG(strcmp(want, got) == 0, "%s: %s is '%s', expected '%s'", k_role_cases[c].file,
+                         ak_humanoid_bone_name(b), got, want);
+        }
+        bool toes = k_role_cases[c].roles[AK_BONE_LEFT_TOES - 1][0] != '\0';
+        AK_CHECK(r.is_humanoid && r.sides == (toes ? AK_SIDES_TOES : AK_SIDES_NAMES));
+        printf("  %s: %d of 22 bones as expected, score %.2f, spine %.1f deg from the legs' up, sides from %s\n",
+               k_role_cases[c].file, 22 - wrong, (double)r.score, (double)r.spine_angle, toes ? "toes" : "names");
+        ak_scene_destroy(s);
+    }
+}
+
+AK_TEST(automatic_roles_of_the_long_bvh) { check_asset_roles(true); }
+
+AK_TEST(automatic_roles_of_the_assets) {
+    check_asset_roles(false);
+    ak_scene* fox = load_case("gltf/Fox/glTF-Binary/Fox.glb");
+    if (!fox) {
+        AK_SKIP("Fox absent");
+        return;
+    }
+    ak_humanoid_roles r;
+    ak_diag diag;
+    memset(&diag, 0, sizeof diag);
+    AK_CHECK_EQ(ak_humanoid_roles_find(fox->skeleton, NULL, &r, &diag), AK_ERR_NOT_FOUND);
+    AK_CHECK(!r.is_humanoid && r.spine_angle > 45.0f);
+    AK_CHECK_MSG(strstr(diag.message, "not a humanoid") != NULL, "%s", diag.message);
+    printf("  Fox: %s\n", diag.message);
+    ak_scene_destroy(fox);
+}
+
+/* Model-space direction of the bone from joint a to joint b at time t of clip (rest pose for
+ * joints the clip leaves out). */
+static ak_vec3 bone_dir(const ak_skeleton* sk, const ak_clip* clip, float t, int a, int b, ak_transform* local,
+                        ak_mat4* model) {
+    size_t n = ak_skeleton_joint_count(sk);
+    memcpy(local, ak_skeleton_rest_pose(sk).ptr, n * sizeof *local);
+    ak_clip_sample(clip, t, NULL, (ak_transform_span){local, n}, (ak_f32_span){0}, (ak_f32_span){0});
+    ak_skeleton_local_to_model(sk, (ak_transform_cspan){local, n}, (ak_mat4_span){model, n});
+    return ak_vec3_sub(joint_pos(&model[b]), joint_pos(&model[a]));
+}
+
+/* 02_01.bvh onto CesiumMan with the automatic map and with the hand-written map the tests used
+ * before (k_cesium_map), and onto builtin:humanoid automatically and by name: over the whole
+ * clip (at 10 fps), the model-space direction of every arm and leg bone (upper arm, forearm, thigh, shin,
+ * both sides) agrees within 2 degrees. */
+AK_TEST(automatic_map_matches_the_hand_written_one) {
+    ak_scene* src = load_case("bvh/02_01.bvh");
+    ak_scene* cesium = load_case("gltf/CesiumMan/glTF-Binary/CesiumMan.glb");
+    ak_scene* human = load_case("builtin:humanoid");
+    if (!src || !cesium || !human) {
+        AK_SKIP("assets absent (set ANIMKIT_ASSETS)");
+        ak_scene_destroy(src), ak_scene_destroy(cesium), ak_scene_destroy(human);
+        return;
+    }
+    ak_humanoid_roles sr;
+    AK_CHECK_EQ(ak_humanoid_roles_find(src->skeleton, NULL, &sr, NULL), AK_OK);
+    for (int c = 0; c < 2; ++c) {
+        const ak_scene* dst = c == 0 ? cesium : human;
+        const ak_skeleton* ts = dst->skeleton;
+        size_t nt = ak_skeleton_joint_count(ts);
+        int32_t* hand = malloc(nt * sizeof *hand);
+        int32_t* autom = malloc(nt * sizeof *autom);
+        if (c == 0) {
+            for (size_t k = 0; k < nt; ++k) hand[k] = -1;
+            for (size_t i = 0; i < sizeof k_cesium_map / sizeof k_cesium_map[0]; ++i)
+                hand[ak_skeleton_find_joint(ts, k_cesium_map[i][0])] = ak_skeleton_find_joint(src->skeleton, k_cesium_map[i][1]);
+            /* the shipped copy of that map reads as the same map */
+            FILE* f = fopen(AK_SOURCE_DIR "/examples/retarget_cesiumman.map", "rb");
+            char text[4096];
+            size_t n = f ? fread(text, 1, sizeof text, f) : 0;
+            if (f) fclose(f);
+            AK_CHECK_MSG(n > 0 && n < sizeof text, "examples/retarget_cesiumman.map: unreadable");
+            AK_CHECK_EQ(ak_retarget_map_parse(text, n, src->skeleton, ts, (ak_i32_span){autom, nt}, NULL, NULL), AK_OK);
+            AK_CHECK(memcmp(autom, hand, nt * sizeof *hand) == 0);
+        } else {
+            ak_retarget_map_by_name(src->skeleton, ts, (ak_i32_span){hand, nt}, NULL);
+        }
+        ak_humanoid_roles tr;
+        AK_CHECK_EQ(ak_humanoid_roles_find(ts, NULL, &tr, NULL), AK_OK);
+        size_t mapped = 0;
+        AK_CHECK_EQ(ak_retarget_map_by_roles(src->skeleton, &sr, ts, &tr, (ak_i32_span){autom, nt}, &mapped), AK_OK);
+        ak_clip *a = NULL, *b = NULL;
+        ak_retarget_desc d = {.source = src->skeleton, .clip = src->clips[0], .target = ts, .source_of_target = {hand, nt},
+                              .frame_rate = 10};
+        AK_CHECK_EQ(ak_retarget_clip(&d, NULL, &a, NULL, NULL), AK_OK);
+        d.source_of_target.ptr = autom;
+        AK_CHECK_EQ(ak_retarget_clip(&d, NULL, &b, NULL, NULL), AK_OK);
+        static const int bones[8][2] = {
+            {AK_BONE_LEFT_UPPER_ARM, AK_BONE_LEFT_LOWER_ARM},   {AK_BONE_LEFT_LOWER_ARM, AK_BONE_LEFT_HAND},
+            {AK_BONE_RIGHT_UPPER_ARM, AK_BONE_RIGHT_LOWER_ARM}, {AK_BONE_RIGHT_LOWER_ARM, AK_BONE_RIGHT_HAND},
+            {AK_BONE_LEFT_UPPER_LEG, AK_BONE_LEFT_LOWER_LEG},   {AK_BONE_LEFT_LOWER_LEG, AK_BONE_LEFT_FOOT},
+            {AK_BONE_RIGHT_UPPER_LEG, AK_BONE_RIGHT_LOWER_LEG}, {AK_BONE_RIGHT_LOWER_LEG, AK_BONE_RIGHT_FOOT}};
+        ak_transform* local = malloc(nt * sizeof *local);
+        ak_mat4* model = malloc(nt * sizeof *model);
+        double worst = 0.0;
+        size_t frames = 0;
+        for (float t = 0.0f; a && b && t <= ak_clip_duration(a); t += 1.0f / 10.0f, ++frames)
+            for (int i = 0; i < 8; ++i) {
+                int j0 = tr.joint[bones[i][0]], j1 = tr.joint[bones[i][1]];
+                ak_vec3 u = bone_dir(ts, a, t, j0, j1, local, model), v = bone_dir(ts, b, t, j0, j1, local, model);
+                double cs = ak_vec3_dot(u, v) / ((double)ak_vec3_length(u) * (double)ak_vec3_length(v));
+                worst = fmax(worst, acos(fmax(-1.0, fmin(1.0, cs))) * (180.0 / 3.14159265358979323846));
+            }
+        printf("  02_01.bvh -> %s: automatic map (%zu joints) vs %s: arm and leg bones within %.4f deg over %zu frames\n",
+               c == 0 ? "CesiumMan" : "builtin:humanoid", mapped, c == 0 ? "the hand-written map" : "the name map", worst,
+               frames);
+        AK_CHECK(frames > 25);
+        AK_CHECK_MSG(worst < 2.0, "bones differ by %.3f deg", worst);
+        /* the automatic map holds every pair of the hand-written one but the torso's */
+        for (size_t k = 0; k < nt; ++k) {
+            bool torso = (int32_t)k == tr.joint[AK_BONE_SPINE] || (int32_t)k == tr.joint[AK_BONE_CHEST];
+            if (hand[k] >= 0 && !torso)
+                AK_CHECK_MSG(autom[k] == hand[k], "%s: %s -> %s, the hand map says %s", c == 0 ? "CesiumMan" : "humanoid",
+                             ak_skeleton_joint_name(ts, k), autom[k] >= 0 ? ak_skeleton_joint_name(src->skeleton, (size_t)autom[k]) : "-",
+                             ak_skeleton_joint_name(src->skeleton, (size_t)hand[k]));
+        }
+        /* the written map reads back as the same map */
+        size_t need = 0;
+        ak_retarget_map_write(src->skeleton, &sr, ts, &tr, (ak_i32_cspan){autom, nt}, NULL, 0, &need);
+        char* text = malloc(need + 1);
+        AK_CHECK_EQ(ak_retarget_map_write(src->skeleton, &sr, ts, &tr, (ak_i32_cspan){autom, nt}, text, need + 1, NULL), AK_OK);
+        AK_CHECK_EQ(ak_retarget_map_parse(text, need, src->skeleton, ts, (ak_i32_span){hand, nt}, NULL, NULL), AK_OK);
+        AK_CHECK(memcmp(hand, autom, nt * sizeof *hand) == 0);
+        free(text), free(local), free(model), free(hand), free(autom);
+        ak_clip_destroy(a), ak_clip_destroy(b);
+    }
+    ak_scene_destroy(src), ak_scene_destroy(cesium), ak_scene_destroy(human);
+}
+
 #ifdef AK_CLI_PATH
-/* Lines the last run_cli printed on stderr. */
+/* Lines the last run_cli printed on stderr, the last of them, and all of it (truncated). */
 static int g_cli_lines;
+static char g_cli_last[1024];
+static char g_cli_err[16384];
 
 /* Run the CLI; returns the exit status and the first line of stderr in line. */
 static int run_cli(const char* args, char* line, size_t n) {
@@ -215,8 +412,13 @@ static int run_cli(const char* args, char* line, size_t n) {
     line[0] = '\0';
     char buf[1024];
     int lines = 0;
-    while (fgets(buf, sizeof buf, p))
+    size_t at = 0;
+    g_cli_last[0] = g_cli_err[0] = '\0';
+    while (fgets(buf, sizeof buf, p)) {
         if (lines++ == 0) snprintf(line, n, "%s", buf);
+        snprintf(g_cli_last, sizeof g_cli_last, "%s", buf);
+        if (at < sizeof g_cli_err) at += (size_t)snprintf(g_cli_err + at, sizeof g_cli_err - at, "%s", buf);
+    }
     g_cli_lines = lines;
     int st = pclose(p);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
@@ -335,6 +537,44 @@ AK_TEST(cli_gif_frames_each_figure) {
     free(img.pixels);
 }
 
+/* Without --map: the automatic map's table on stderr (or --report FILE), --map-out FILE
+ * writes it as a map file that --map reads back; Fox (a quadruped) is refused with exit 1, the
+ * table of what matched and a last line naming the file, "not a humanoid" and --map. */
+AK_TEST(cli_automatic_map) {
+    char bvh[1200], cesium[1200], fox[1200];
+    if (!ak_test_asset(bvh, sizeof bvh, "bvh/02_01.bvh") ||
+        !ak_test_asset(cesium, sizeof cesium, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb") ||
+        !ak_test_asset(fox, sizeof fox, "gltf/Fox/glTF-Binary/Fox.glb")) {
+        AK_SKIP("assets absent (set ANIMKIT_ASSETS)");
+        return;
+    }
+    char args[4096], line[1024];
+    snprintf(args, sizeof args, "'%s' '%s' --fps 5 -o auto_cesium.glb", bvh, cesium);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 0);
+    AK_CHECK_MSG(strstr(g_cli_err, "leg_joint_L_1") && strstr(g_cli_err, "= LeftUpLeg") &&
+                 strstr(g_cli_err, "leftUpperLeg"), "%s", g_cli_err);
+    snprintf(args, sizeof args, "'%s' '%s' --fps 5 --map-out auto.map --report auto.txt -o auto_cesium.glb", bvh, cesium);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 0);
+    AK_CHECK_MSG(!strstr(g_cli_err, "= LeftUpLeg"), "the table went to stderr despite --report: %s", g_cli_err);
+    FILE* f = fopen("auto.map", "r");
+    char text[8192] = "";
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    if (f) fclose(f);
+    text[n] = '\0';
+    AK_CHECK_MSG(strstr(text, "Skeleton_arm_joint_L__4_") && strstr(text, "= LeftArm"), "%s", text);
+    snprintf(args, sizeof args, "'%s' '%s' --fps 5 --map auto.map -o auto_cesium.glb", bvh, cesium);
+    AK_CHECK_MSG(run_cli(args, line, sizeof line) == 0, "%s", line);
+    AK_CHECK_MSG(strstr(g_cli_err, "19 of 22 target joints driven") != NULL, "%s", g_cli_err);
+    /* Fox */
+    snprintf(args, sizeof args, "'%s' '%s' -o auto_fox.glb", bvh, fox);
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
+    AK_CHECK_MSG(strstr(g_cli_last, "Fox.glb") && strstr(g_cli_last, "not a humanoid") && strstr(g_cli_last, "--map"),
+                 "%s", g_cli_last);
+    AK_CHECK_MSG(strstr(g_cli_err, "NOT a humanoid") && strstr(g_cli_err, "b_Hip_01"), "%s", g_cli_err);
+    struct stat st;
+    AK_CHECK(stat("auto_fox.glb", &st) != 0);
+}
+
 AK_TEST(cli_retarget) {
     char bvh[1200], cesium[1200], nomotion[1200];
     if (!ak_test_asset(bvh, sizeof bvh, "bvh/02_01.bvh") ||
@@ -374,10 +614,9 @@ AK_TEST(cli_retarget) {
     s = NULL;
     AK_CHECK_EQ(ak_io_load(out, NULL, NULL, &s, &diag), AK_OK);
     ak_scene_destroy(s);
-    /* no name in common: exit 1, one line naming the target */
+    /* no name in common: the automatic map */
     snprintf(args, sizeof args, "'%s' '%s' -o '%s'", bvh, cesium, out);
-    AK_CHECK_EQ(run_cli(args, line, sizeof line), 1);
-    AK_CHECK(strstr(line, "CesiumMan.glb") && strstr(line, "--map"));
+    AK_CHECK_EQ(run_cli(args, line, sizeof line), 0);
     /* bad map files: each exits 1 with one line naming the file and the problem */
     struct {
         const char* text;
@@ -423,9 +662,13 @@ AK_TEST(cli_retarget) {
 
 int main(void) {
     AK_RUN(cmu_bvh_onto_builtin_and_cesiumman);
+    AK_RUN(automatic_roles_of_the_assets);
+    AK_RUN(automatic_map_matches_the_hand_written_one);
+    AK_RUN_SLOW(automatic_roles_of_the_long_bvh);
 #ifdef AK_CLI_PATH
     AK_RUN(cli_exports_stand_on_the_floor);
     AK_RUN(cli_gif_frames_each_figure);
+    AK_RUN(cli_automatic_map);
     AK_RUN_SLOW(cli_retarget);
 #endif
     return ak_test_finish();

@@ -32,5 +32,7 @@
 #include "cloth.h"
 #include "retarget.h"
 #include "fluid.h"
+#include "rigid.h"
+#include "batch.h"
 
 #endif

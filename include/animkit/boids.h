@@ -268,6 +268,115 @@ AK_API ak_result ak_boids_min_distance(ak_vec3_cspan positions, ak_u8_span scrat
  * (AK_NO_SIMD builds). Every kernel gives bit-identical results. */
 AK_API const char* ak_boids_simd_name(void);
 
+/* ---- scene files and presets ------------------------------------------------------------ */
+/* A boids scene: the JSON format of `animkit boids SCENE.json` (docs/boids.md lists every key,
+ * its default and its range) or a preset, over the defaults:
+ *     ak_boids_scene sc;
+ *     ak_diag diag;
+ *     ak_boids_scene_defaults(&sc);                          // or ak_boids_scene_preset(...)
+ *     if (ak_boids_scene_load_file("flock.json", &sc, &diag) != AK_OK) puts(diag.message);
+ *     if (sc.agent_count == 0) ak_boids_scene_scale_bounds(&sc, sc.count);
+ *     ... ak_boids_* with sc.params, sc.steps steps of sc.dt; sc.agent_count agents from the
+ *         file (sc.positions...), else sc.count placed at random (seed sc.seed) ...
+ *     ak_boids_scene_free(&sc); */
+
+#define AK_BOIDS_SCENE_MAX_AGENTS 10000000u /* agents in a file or asked for by count */
+#define AK_BOIDS_SCENE_MAX_OBSTACLES 1024u
+#define AK_BOIDS_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
+/* The names ak_boids_scene_preset knows. */
+#define AK_BOIDS_SCENE_PRESETS "flock, obstacles, predator"
+/* Agents the default 20 m box is sized for (ak_boids_scene_scale_bounds). */
+#define AK_BOIDS_SCENE_BOX_AGENTS 500u
+
+/* A loaded scene; it owns obstacles, positions, velocities and agent_species (malloc). */
+typedef struct ak_boids_scene {
+    ak_boids_species species[AK_BOIDS_MAX_SPECIES];
+    float fraction[AK_BOIDS_MAX_SPECIES]; /* share of the random agents (species 0 takes the rest) */
+    ak_vec4 color[AK_BOIDS_MAX_SPECIES];  /* sRGB body colour when rendering */
+    ak_boids_obstacle* obstacles;         /* [params.obstacle_count] */
+    ak_boids_params params;               /* points into species / obstacles */
+    ak_vec3* positions;                   /* [agent_count] from "agents", or NULL */
+    ak_vec3* velocities;
+    uint8_t* agent_species;
+    size_t agent_count;                   /* 0: place `count` agents at random */
+    size_t count;                         /* random agents; default 500 */
+    long steps;                           /* default 2000 */
+    float dt;                             /* default 0.02 */
+    long seed;                            /* default 1 */
+    float shape_size;                     /* metres, length of a rendered bird */
+    int shape;                            /* 0 bird, 1 fish */
+    bool bounds_given;                    /* the scene set bounds.min or bounds.max */
+} ak_boids_scene;
+
+/* The defaults of every key (the scene without a file); owns nothing. */
+AK_API void ak_boids_scene_defaults(ak_boids_scene* scene);
+/* Parse bytes[0, size) (strict JSON) OVER the scene already in *scene, which must hold
+ * ak_boids_scene_defaults or a preset (keys absent from the file keep its values); name (NULL ->
+ * "(scene)") starts every message. Returns AK_OK, or AK_ERR_PARSE / AK_ERR_NULL_ARG with, when
+ * out_diag is not NULL, the one line "NAME: key.path: problem" in out_diag->message. In every case
+ * *scene owns its arrays afterwards: free it with ak_boids_scene_free. */
+AK_API ak_result ak_boids_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                           ak_boids_scene* scene, ak_diag* out_diag);
+/* Read the file at path (at most AK_BOIDS_SCENE_MAX_FILE_SIZE bytes) and parse it over *scene as
+ * ak_boids_scene_load_bytes does; AK_ERR_IO when it cannot be read. */
+AK_API ak_result ak_boids_scene_load_file(const char* path, ak_boids_scene* scene, ak_diag* out_diag);
+/* The defaults, then the preset name (AK_BOIDS_SCENE_PRESETS): "flock" (the defaults themselves),
+ * "obstacles" (a sphere and four pillars in the flock's way) or "predator" (a second species,
+ * 0.6% of the agents, that chases the flock, which flees). *out_scene is overwritten without
+ * being freed (pass a new or freed scene). AK_ERR_NOT_FOUND for another name, AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_boids_scene_preset(const char* name, ak_boids_scene* out_scene, ak_diag* out_diag);
+/* Free the arrays (NULL: no-op; safe twice). */
+AK_API void ak_boids_scene_free(ak_boids_scene* scene);
+/* The default box for count random agents (call after count and planar are final, only when the
+ * scene lists no agents): unless the scene set bounds.min or bounds.max, the 20 m box of the
+ * defaults grows beyond AK_BOIDS_SCENE_BOX_AGENTS agents by cbrt(count / AK_BOIDS_SCENE_BOX_AGENTS)
+ * on every axis (sqrt when planar), so the density, and the neighbours per agent, stay those of
+ * 500 agents. */
+AK_API void ak_boids_scene_scale_bounds(ak_boids_scene* scene, size_t count);
+
+/* ---- running a scene ---------------------------------------------------------------------- */
+/* Step a loaded scene as `animkit boids` does, so that C and Python reproduce the command's
+ * output: the scene's agents, or scene->count agents placed at random in the bounds from
+ * scene->seed (species by fraction, speed half the species' max_speed), double-buffered steps
+ * whose wander noise follows the step number.
+ *     ak_boids_scene_run run;
+ *     if (ak_boids_scene_run_init(&run, &sc, NULL, &diag) == AK_OK)
+ *         for (long k = 0; k < sc.steps && ak_boids_scene_run_step(&run) == AK_OK; ++k) {}
+ *     ... run.positions[i], run.velocities[i] for i < run.agent_count ...
+ *     ak_boids_scene_run_free(&run); */
+typedef struct ak_boids_scene_run_desc {
+    const char* name;      /* starts messages; NULL -> "scene" */
+    uint32_t thread_count; /* 0 -> 1 */
+    bool naive;            /* the O(N^2) neighbour search instead of the grid (same results) */
+} ak_boids_scene_run_desc;
+
+typedef struct ak_boids_scene_run {
+    size_t agent_count;
+    ak_vec3* positions;    /* [agent_count]: the current state (swapped each step) */
+    ak_vec3* velocities;
+    uint8_t* species;
+    long step_index;       /* steps taken */
+    ak_boids_step_job job; /* points into the scene's params and the arrays below */
+    /* private */
+    size_t n;
+    ak_vec3 *p, *v, *p2, *v2, *w;
+    uint8_t* s;
+    uint8_t* scratch;
+    size_t scratch_size;
+} ak_boids_scene_run;
+
+/* Place the agents and validate the step job. The scene must outlive the run. AK_OK, or the
+ * failing code with "NAME: problem" in out_diag; free with ak_boids_scene_run_free either way. */
+AK_API ak_result ak_boids_scene_run_init(ak_boids_scene_run* run, const ak_boids_scene* scene,
+                                         const ak_boids_scene_run_desc* desc, ak_diag* out_diag);
+/* One step (number run->step_index). AK_ERR_BUDGET: agents packed past the grid's work budget
+ * (ak_boids_scene_run_error says what to lower). */
+AK_API ak_result ak_boids_scene_run_step(ak_boids_scene_run* run);
+/* What a failed step's result means for a user. */
+AK_API const char* ak_boids_scene_run_error(ak_result result);
+/* Free the arrays (safe on a zeroed or failed run, and twice). */
+AK_API void ak_boids_scene_run_free(ak_boids_scene_run* run);
+
 #ifdef __cplusplus
 }
 #endif

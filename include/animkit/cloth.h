@@ -335,6 +335,139 @@ typedef struct ak_cloth_energy {
 AK_API ak_result ak_cloth_energy_compute(const ak_cloth* cloth, ak_vec3_cspan positions, ak_vec3_cspan velocities,
                                          ak_vec3 gravity, ak_cloth_energy* out_energy);
 
+/* ---- scene files and presets ------------------------------------------------------------ */
+/* A cloth scene: the JSON format of `animkit cloth SCENE.json` (docs/cloth.md lists every key,
+ * its unit and its default) or a preset, parsed into one struct that owns its arrays. A scene
+ * may name a character (character.model: a file or builtin:NAME, and attachments to its joints
+ * or skinned vertices): the loader only records the names; loading and posing the model is the
+ * caller's (animkit/io.h; the command does it in tools/animkit/cloth_run.c).
+ *     ak_cloth_scene sc;
+ *     ak_diag diag;
+ *     if (ak_cloth_scene_preset("flag", &sc, &diag) != AK_OK) puts(diag.message);
+ *     ak_cloth* cloth; ak_cloth_create(&sc.desc, NULL, &cloth);   // desc's spans point into sc
+ *     ... step sc.steps times with sc.dt, sc.substeps, sc.gravity, sc.wind, the colliders ...
+ *     ak_cloth_scene_free(&sc); */
+
+/* Budgets: a scene file cannot ask for more than this. */
+#define AK_CLOTH_SCENE_MAX_PARTICLES ((size_t)1 << 20)
+#define AK_CLOTH_SCENE_MAX_LIST 4096 /* pins, attachments, colliders of each kind */
+#define AK_CLOTH_SCENE_MAX_STEPS 1000000L
+#define AK_CLOTH_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
+/* The names ak_cloth_scene_preset knows. */
+#define AK_CLOTH_SCENE_PRESETS "flag, curtain, drape, cape"
+
+/* A cloth vertex held by the character. */
+typedef struct ak_cloth_attach_spec {
+    uint32_t vertex;     /* cloth vertex */
+    char joint[64];      /* follow this joint rigidly ("" -> mesh_vertex) */
+    long mesh_vertex;    /* or follow this skinned vertex of the character's mesh 0 (-1: joint) */
+    bool has_position;   /* position given: the vertex starts there (else at its rest position) */
+    ak_vec3 position;    /* world, at t = 0: where the attachment holds it (gathers a collar) */
+} ak_cloth_attach_spec;
+
+/* A loaded scene (free with ak_cloth_scene_free). */
+typedef struct ak_cloth_scene {
+    ak_cloth_desc desc;        /* grid, material, solver (spans point into the arrays below) */
+    uint32_t* pins;            /* [pin_count] */
+    size_t pin_count;
+    ak_vec3* pin_positions;    /* [pin_position_count]: 0 (rest positions) or pin_count */
+    size_t pin_position_count;
+    ak_cloth_attach_spec* attach; /* [attach_count] */
+    size_t attach_count;
+    /* stepping */
+    float dt;                  /* seconds per step; default 1/60 */
+    long steps;                /* default 120 */
+    uint32_t substeps, iterations; /* defaults 10, 1 */
+    bool iterations_given;     /* the scene says "iterations" (else implicit uses its own cap) */
+    bool substeps_forced;      /* set by the caller (the command's --substeps): the spring solver
+                                  keeps it even below its stable count (else runs at least that) */
+    ak_vec3 gravity, wind;
+    float gust;                /* wind *= 1 + gust * sin(2 pi gust_frequency t) */
+    float gust_frequency;
+    float drag, lift, air_density, damping, thickness, friction, self_distance;
+    bool self_collision;
+    ak_cloth_plane* planes;
+    size_t plane_count;
+    ak_cloth_sphere* spheres;
+    size_t sphere_count;
+    ak_cloth_capsule* capsules;
+    size_t capsule_count;
+    /* character (recorded only, see above) */
+    char model[256];           /* "" -> none; else FILE or builtin:NAME */
+    char clip[64];             /* clip name or index; "" -> the first */
+    bool mesh_collider;        /* the posed character mesh collides */
+    bool limb_capsules;        /* capsules along the character's bones collide */
+    float capsule_scale;       /* limb capsule radius / mean skin distance to the bone */
+    int thread_count;          /* default 1 */
+} ak_cloth_scene;
+
+/* The defaults of every key (no arrays). */
+AK_API void ak_cloth_scene_defaults(ak_cloth_scene* scene);
+/* Parse a scene from bytes[0, size) (strict JSON); name (NULL -> "scene") starts every message.
+ * Returns AK_OK, or AK_ERR_PARSE / AK_ERR_NULL_ARG with *out_scene at its defaults (no arrays)
+ * and, when out_diag is not NULL, the one line "NAME: key.path: problem" in out_diag->message. */
+AK_API ak_result ak_cloth_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                           ak_cloth_scene* out_scene, ak_diag* out_diag);
+/* Read the file at path (at most AK_CLOTH_SCENE_MAX_FILE_SIZE bytes) and parse it; AK_ERR_IO
+ * when it cannot be read ("PATH: cannot open the file"). */
+AK_API ak_result ak_cloth_scene_load_file(const char* path, ak_cloth_scene* out_scene, ak_diag* out_diag);
+/* The preset name (AK_CLOTH_SCENE_PRESETS; docs/cloth.md describes them). AK_ERR_NOT_FOUND for
+ * another name, AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_cloth_scene_preset(const char* name, ak_cloth_scene* out_scene, ak_diag* out_diag);
+/* Free the scene's arrays (NULL: no-op; safe on a failed or freed scene). */
+AK_API void ak_cloth_scene_free(ak_cloth_scene* scene);
+
+/* ---- running a scene ---------------------------------------------------------------------- */
+/* Step a loaded scene as `animkit cloth` does, so that C and Python reproduce the command's
+ * output: the cloth built from scene->desc, the spring solver raised to its stable substep count
+ * (unless scene->substeps_forced), gusty wind (wind x (1 + gust sin(2 pi gust_frequency t))),
+ * the scene's colliders. A scene with a character (scene->model) needs the caller: it loads and
+ * poses the model, passes the posed mesh and the number of its limb capsules here, and before
+ * each step writes run->targets (attachment targets at the step's end) and the capsules after
+ * the scene's (run->capsules[scene->capsule_count + k]); tools/animkit/cloth_run.c does so.
+ *     ak_cloth_scene_run run;
+ *     if (ak_cloth_scene_run_init(&run, &sc, NULL, &diag) == AK_OK)
+ *         for (long k = 0; k < sc.steps && ak_cloth_scene_run_step(&run, "flag", &diag) == AK_OK; ++k) {}
+ *     ... run.positions[i] for i < run.vertex_count ...
+ *     ak_cloth_scene_run_free(&run); */
+typedef struct ak_cloth_scene_run_desc {
+    const char* name;                /* starts messages; NULL -> "scene" */
+    size_t extra_capsule_count;      /* capsules after the scene's that the caller sets each step */
+    ak_cloth_collider_mesh mesh;     /* optional: a collider mesh the caller poses between steps */
+} ak_cloth_scene_run_desc;
+
+typedef struct ak_cloth_scene_run {
+    ak_cloth_scene* scene;           /* the scene run (its substeps may be raised, see above) */
+    ak_cloth* cloth;
+    ak_vec3* positions;              /* [vertex_count], stepped in place */
+    ak_vec3* velocities;
+    ak_vec3* normals;
+    ak_vec3* targets;                /* [scene->attach_count]: the caller's, before each step */
+    ak_cloth_capsule* capsules;      /* the scene's, then desc.extra_capsule_count of the caller's */
+    size_t vertex_count;
+    long step_index;                 /* steps taken */
+    float time;                      /* simulated seconds */
+    double stable_substep;           /* > 0 when the spring solver raised the substeps: its bound (s) */
+    uint32_t substeps_given;         /* ... the count the scene asked for */
+    double substeps_needed;          /* ... and the count it needs */
+    ak_cloth_step_job job;           /* points into the arrays above and the scene */
+    /* private */
+    ak_vec3* residuals;
+    uint8_t* scratch;
+    uint32_t* attach_idx;
+} ak_cloth_scene_run;
+
+/* Build the cloth and its step job. The scene must outlive the run. AK_OK, or the failing code
+ * with "NAME: problem" in out_diag (AK_ERR_BUDGET: the spring solver needs over 10000 substeps);
+ * free with ak_cloth_scene_run_free either way. */
+AK_API ak_result ak_cloth_scene_run_init(ak_cloth_scene_run* run, ak_cloth_scene* scene,
+                                         const ak_cloth_scene_run_desc* desc, ak_diag* out_diag);
+/* One step with the gust of the step's start. AK_ERR_NO_CONVERGENCE: a blow-up ("NAME: blow-up:
+ * the state became non-finite at step K ..."); other codes name the step. name NULL -> "scene". */
+AK_API ak_result ak_cloth_scene_run_step(ak_cloth_scene_run* run, const char* name, ak_diag* out_diag);
+/* Free the run (safe on a zeroed or failed run, and twice). */
+AK_API void ak_cloth_scene_run_free(ak_cloth_scene_run* run);
+
 #ifdef __cplusplus
 }
 #endif

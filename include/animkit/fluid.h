@@ -279,6 +279,77 @@ AK_API ak_result ak_fluid_step_validate(const ak_fluid_step_job* job);
  * the caller should stop. */
 AK_API ak_result ak_fluid_step_run(const ak_fluid_step_job* job);
 
+/* ---- scene files and presets ------------------------------------------------------------ */
+/* A fluid scene: the JSON format of `animkit fluid SCENE.json` (docs/fluid.md lists every key
+ * and its default) or a preset. The same loader serves C, the Python package and the command:
+ *     ak_fluid_scene* sc = malloc(sizeof *sc);   // about 60 KB: the item lists are inline
+ *     ak_diag diag;
+ *     if (ak_fluid_scene_load_file("dam.json", sc, &diag) != AK_OK) puts(diag.message);
+ *     size_t cap = ak_fluid_scene_capacity(sc), n;
+ *     ... positions/velocities of cap entries; n = ak_fluid_scene_fill(sc, pos, vel, cap);
+ *     ... ak_fluid_step_job job = {.desc = &sc->desc, .dt = sc->dt, .particle_count = &n,
+ *             .colliders = {sc->colliders, sc->collider_count}, ...}; run
+ *         ak_fluid_scene_steps(sc) steps of ak_fluid_step_run, job.time = k * sc->dt. */
+
+/* Budgets that bound a hostile scene's memory (checked before anything is allocated). */
+#define AK_FLUID_SCENE_MAX_PARTICLES 2000000u
+#define AK_FLUID_SCENE_MAX_ITEMS 256u     /* blocks, colliders, emitters, sinks each */
+#define AK_FLUID_SCENE_MAX_STEPS 10000000L
+#define AK_FLUID_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
+/* The names ak_fluid_scene_preset knows. */
+#define AK_FLUID_SCENE_PRESETS "dam, pour, splash"
+
+/* An initial block of liquid: the rest lattice filling [min, max], moving at velocity. */
+typedef struct ak_fluid_block {
+    ak_vec3 min, max, velocity;
+} ak_fluid_block;
+
+/* A loaded scene (no pointers: copy it freely). */
+typedef struct ak_fluid_scene {
+    ak_fluid_desc desc;    /* h = h_ratio * rest spacing */
+    float h_ratio;         /* default 2 */
+    float dt;              /* default 1/400 (PBF), 1e-3 (SPH) or 2e-4 (WCSPH) */
+    float duration;        /* simulated seconds when steps is not given; default 1 */
+    long steps;            /* default (-1): ceil(duration / dt), see ak_fluid_scene_steps */
+    long max_particles;    /* capacity; default: initial particles + 20000 when emitters exist */
+    size_t block_count, collider_count, emitter_count, sink_count;
+    ak_fluid_block blocks[AK_FLUID_SCENE_MAX_ITEMS];
+    ak_fluid_collider colliders[AK_FLUID_SCENE_MAX_ITEMS];
+    ak_fluid_emitter emitters[AK_FLUID_SCENE_MAX_ITEMS];
+    ak_fluid_sink sinks[AK_FLUID_SCENE_MAX_ITEMS];
+    bool dt_set;           /* "dt" was given (else dt follows the solver) */
+} ak_fluid_scene;
+
+/* The defaults of every key: PBF, 1 cm particles of water, gravity -9.81 Y, no box, nothing else. */
+AK_API void ak_fluid_scene_defaults(ak_fluid_scene* scene);
+/* Parse a scene from bytes[0, size) (strict JSON); name (NULL -> "(scene)") starts every
+ * message. Counts and sizes are checked against the budgets above (the initial particle count
+ * included). Returns AK_OK, or AK_ERR_PARSE / AK_ERR_NULL_ARG with *out_scene at its defaults
+ * and, when out_diag is not NULL, the one line "NAME: key.path: problem" in out_diag->message. */
+AK_API ak_result ak_fluid_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                           ak_fluid_scene* out_scene, ak_diag* out_diag);
+/* Read the file at path (at most AK_FLUID_SCENE_MAX_FILE_SIZE bytes) and parse it; AK_ERR_IO
+ * when it cannot be read ("PATH: cannot open the file"). */
+AK_API ak_result ak_fluid_scene_load_file(const char* path, ak_fluid_scene* out_scene, ak_diag* out_diag);
+/* The preset name (AK_FLUID_SCENE_PRESETS) of about count particles (<= 0 -> 4000; at most
+ * AK_FLUID_SCENE_MAX_PARTICLES). AK_ERR_NOT_FOUND for another name. */
+AK_API ak_result ak_fluid_scene_preset(const char* name, long count, ak_fluid_scene* out_scene,
+                                       ak_diag* out_diag);
+/* A fluid scene owns no memory: this resets it to the defaults (NULL: no-op); it exists so every
+ * scene type has the same life cycle. */
+AK_API void ak_fluid_scene_free(ak_fluid_scene* scene);
+/* The default step of a solver: 1/400 s (PBF), 1e-3 s (SPH), 2e-4 s (WCSPH). */
+AK_API float ak_fluid_scene_default_dt(ak_fluid_solver solver);
+/* The steps to run: scene->steps when >= 0, else ceil(duration / dt) (1 to AK_FLUID_SCENE_MAX_STEPS). */
+AK_API long ak_fluid_scene_steps(const ak_fluid_scene* scene);
+/* Particles the blocks hold (their lattice points). */
+AK_API size_t ak_fluid_scene_initial_count(const ak_fluid_scene* scene);
+/* The capacity to allocate: max_particles when given, else the initial count (+ 20000 with emitters). */
+AK_API size_t ak_fluid_scene_capacity(const ak_fluid_scene* scene);
+/* Fill positions/velocities (capacity entries at most) with the blocks' particles; returns the count. */
+AK_API size_t ak_fluid_scene_fill(const ak_fluid_scene* scene, ak_vec3* positions, ak_vec3* velocities,
+                                  size_t capacity);
+
 #ifdef __cplusplus
 }
 #endif

@@ -11,8 +11,8 @@
  *     AK_ERR_BAD_DATA), STEP/LINEAR/CUBICSPLINE samplers).
  *   - BVH through animkit's own streaming reader (src/io/bvh.c): bounded nesting, the frame
  *     count checked against the data present, the same scene layout Assimp gave (docs/io.md).
- *   - Wavefront OBJ (+ the .mtl files it names, for base colours) through animkit's own
- *     reader (src/io/obj.c), with the scene layout Assimp gave (docs/io.md).
+ *   - Wavefront OBJ (+ the .mtl files it names, for base colours and map_Kd textures) through
+ *     animkit's own reader (src/io/obj.c), with the scene layout Assimp gave (docs/io.md).
  *   - Everything else (FBX, Collada, ...) through Assimp's C API, run in a forked child
  *     process under resource limits (a crash there is AK_ERR_IO): the node tree
  *     becomes the skeleton, aiAnimation channels become clips (ticks -> seconds), meshes with
@@ -20,10 +20,16 @@
  *   - ak_io_save: glTF 2.0 (.glb, or .gltf + .bin) of a whole scene: nodes, skins, meshes,
  *     morph targets and clips (src/io/gltf_write.c); it passes the Khronos glTF validator.
  *   - ak_io_write_obj: Wavefront OBJ of a scene's meshes at positions the caller computed
- *     (one `o` group per scene mesh, vertices in the scene's order, no welding).
+ *     (one `o` group per scene mesh, vertices in the scene's order, no welding), with an .mtl
+ *     and PNG files for materials and textures.
+ *   - Base-colour textures (glTF pbrMetallicRoughness.baseColorTexture with TEXCOORD_0, its
+ *     sampler's wrap modes and filters; OBJ map_Kd): PNG through libpng, JPEG through
+ *     libjpeg-turbo (ak_io_image_decode), decoded into scene->textures; an image that cannot be
+ *     read is a warning and the mesh stays untextured (the load succeeds).
  *
- * What it does NOT do: materials beyond a primitive's base colour factor (ak_scene_mesh
- * base_color), textures, cameras, lights, glTF extensions (a file whose
+ * What it does NOT do: materials beyond a primitive's base colour factor and texture (ak_scene_mesh
+ * base_color, texture): no normal, metallic-roughness, occlusion or emissive maps, no
+ * KHR_texture_transform, no texture coordinate set other than 0, no mipmaps; cameras, lights, glTF extensions (a file whose
  * extensionsRequired names one that changes geometry or animation, e.g. Draco, is refused),
  * morph targets through Assimp, posing (scene.h, skin.h, blendshape.h). It never prints;
  * warnings go to desc->logger.
@@ -60,11 +66,12 @@
  *     ak_scene_destroy(scene);
  *
  * Untrusted input: glTF, BVH and OBJ are safe to load from untrusted sources (memory bounded by
- * desc->memory_budget, checked before allocating; recursion bounded (cJSON stops at 1000
+ * desc->memory_budget, checked before allocating, texture images included: their size is read
+ * from the image header and charged before the pixels are allocated, at most 16384 per side; recursion bounded (cJSON stops at 1000
  * nesting levels, the BVH and OBJ readers do not recurse); external glTF buffers and OBJ
  * mtllib files only inside the model's directory unless desc->extra_roots/allow_any_path say
- * otherwise, and a path that leaves it is refused without looking at what is there; images
- * never opened; names must be valid UTF-8 without control bytes; error messages escape raw
+ * otherwise, and a path that leaves it is refused without looking at what is there; texture
+ * images (glTF image uris, OBJ map_Kd) under the same rule; names must be valid UTF-8 without control bytes; error messages escape raw
  * bytes). Assimp formats (FBX, Collada, ...) are contained, not hardened: Assimp runs in a
  * child process with RLIMIT_AS/CPU/FSIZE/NOFILE limits and a wall-clock limit
  * (AK_IO_ASSIMP_SECONDS); a crash or a timeout there is AK_ERR_IO, and the scene it sends
@@ -184,6 +191,15 @@ AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* na
  * before). No welding, no reordering: UVs are written as the mesh stores them (for glTF,
  * origin at the top left, so tools that assume OBJ's bottom-left origin show textures
  * flipped), and triangles keep the file's index order, also under a mirroring node.
+ * Materials: when a scene mesh has a material or a texture (with UVs), "<stem>.mtl" is written
+ * beside path (stem: path's file name without ".obj") with one "material_<mesh index>" per such
+ * mesh (Kd and d from base_color, white without one; map_Kd "<stem>_<texture index>.png"),
+ * each texture used as such a PNG beside it, its rows flipped so that other tools, which take
+ * v = 0 as the image's bottom, show it the right way up with the UVs as stored (animkit's OBJ
+ * reader flips map_Kd images back); the .obj names them with mtllib and usemtl. These files
+ * go to temporaries too, renamed into place (before the .obj) only once the .obj is complete:
+ * a failure while writing leaves none of them (only a failed rename of the .obj after theirs
+ * can leave new side files beside the old .obj).
  * posed_positions: NULL, or an array of scene->mesh_count pointers, each to vertex_count
  * positions (NULL entry -> that mesh's own bind-space positions, as stored).
  * posed_normals: same shape; NULL or a NULL entry -> the mesh's own normals when it has them,
@@ -195,6 +211,20 @@ AK_API ak_result ak_io_load_memory(const void* data, size_t size, const char* na
  * nothing is written), AK_ERR_IO (cannot create or write the file; diag names it). */
 AK_API ak_result ak_io_write_obj(const char* path, const ak_scene* scene, const ak_vec3* const* posed_positions,
                                  const ak_vec3* const* posed_normals, ak_diag* diag);
+
+/* Decode a PNG (libpng) or JPEG (libjpeg-turbo; a build without it refuses JPEG with
+ * AK_ERR_UNSUPPORTED) held in memory, told apart by its signature, into RGBA8 pixels (sRGB
+ * colour as stored, straight alpha, rows top to bottom, width * 4 bytes per row) allocated
+ * through alloc (NULL -> malloc) once the size in the header is checked: at most 16384 pixels
+ * per side and width * height * 4 bytes within memory_budget (0 -> AK_IO_DEFAULT_BUDGET).
+ * Free the pixels with ak_io_image_free (same alloc). This is the decoder the glTF and OBJ
+ * readers use for base-colour textures. Returns AK_ERR_NULL_ARG, AK_ERR_PARSE (neither
+ * format, or a broken image: diag says what libpng or libjpeg reported), AK_ERR_UNSUPPORTED
+ * (too large, CMYK JPEG, no JPEG decoder), AK_ERR_NO_MEMORY. On failure *out_pixels is NULL. */
+AK_API ak_result ak_io_image_decode(const void* data, size_t size, size_t memory_budget, const ak_allocator* alloc,
+                                    uint8_t** out_pixels, int* out_width, int* out_height, ak_diag* diag);
+/* Free pixels from ak_io_image_decode (alloc as given to it); NULL is a no-op. */
+AK_API void ak_io_image_free(const ak_allocator* alloc, uint8_t* pixels);
 
 /* How ak_io_save writes (all fields zero -> defaults). */
 typedef struct ak_io_save_desc {
@@ -228,12 +258,14 @@ typedef struct ak_io_save_desc {
  *     CUBICSPLINE keys are written as stored; HERMITE, and CARDINAL/NATURAL/BEZIER on
  *     non-rotation channels, become CUBICSPLINE with the per-second tangents of
  *     ak_track_key (the same curve); SCALAR channels are skipped with a warning.
- *   - each distinct base colour of the scene meshes as a material holding only
- *     pbrMetallicRoughness.baseColorFactor (channels clamped to [0, 1]), named by the
- *     primitives that have one.
+ *   - each distinct (base colour, texture) of the scene meshes as a material holding only
+ *     pbrMetallicRoughness.baseColorFactor (channels clamped to [0, 1]) and, for a mesh with
+ *     a texture and UVs, baseColorTexture: each texture used is written once as an image
+ *     (PNG, lossless, embedded in the buffer through a bufferView, also for .gltf), a sampler
+ *     (its wrap modes; filters NEAREST or LINEAR, no mipmap filters) and a texture.
  * Simulations: scene.h's ak_scene_bake_mesh_frames (a cloth as morph-target animation) and
  * ak_scene_bake_point_frames (particles as one animated node each) build the scene to write.
- * Not written: other material properties and textures, the clip duration (a
+ * Not written: other material properties and maps, the clip duration (a
  * reader takes the last key time), ak_skeleton joint types and limits.
  * Layout: one buffer, one bufferView per accessor (4-byte aligned, zero padded, so no
  * byteStride), GLB JSON chunk padded with spaces and BIN chunk with zeros.

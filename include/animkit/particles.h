@@ -66,6 +66,7 @@
 #define ANIMKIT_PARTICLES_H
 
 #include "grid.h"
+#include "raster.h" /* ak_blend, ak_sprite_texture: a scene's "render" settings */
 
 #ifdef __cplusplus
 extern "C" {
@@ -409,6 +410,141 @@ AK_API ak_vec4 ak_particle_look_colour(const ak_particle_look* look, float age, 
 AK_API float ak_particle_look_size(const ak_particle_look* look, float age, float lifetime);
 /* Sprite-sheet frame in [0, frame_count) at the given age and lifetime (NULL -> 0). */
 AK_API uint32_t ak_particle_look_frame(const ak_particle_look* look, float age, float lifetime);
+
+/* ---- scene files and presets ------------------------------------------------------------ */
+/* A particle scene: the JSON format of `animkit particles SCENE.json` (docs/particles.md lists
+ * every key, its unit and its default) or a built-in preset, parsed into arrays the scene owns.
+ * The same loader serves C, the Python package and the command:
+ *     ak_particles_scene sc;
+ *     ak_diag diag;
+ *     if (ak_particles_scene_load_file("fountain.json", &sc, &diag) != AK_OK) {
+ *         fprintf(stderr, "%s\n", diag.message);   // "fountain.json: emitters[0].rate: ..."
+ *         return 1;
+ *     }
+ *     ... ak_particles_create(&(ak_particles_desc){.capacity = sc.capacity}, ...),
+ *         ak_particles_add(...sc.particles...), ak_particles_step(ps, &sc.world, sc.dt) ...
+ *     ak_particles_scene_free(&sc);
+ * Emitters with bursts fire burst.count particles at burst.start, then every burst.interval
+ * seconds (interval 0: once); the others emit at their rate. */
+
+/* Bursts of one emitter of a scene: count particles at time start, then every interval. */
+typedef struct ak_particles_scene_burst {
+    uint32_t count;
+    float start;    /* seconds */
+    float interval; /* seconds; 0 = once */
+} ak_particles_scene_burst;
+
+/* How a scene's particles are drawn (its "render" key; docs/particles.md): round points (the
+ * default) or camera-facing sprites with a texture, a sprite sheet, blending and colour/size
+ * over life. The simulation never reads it; the command and the viewer draw with it. */
+typedef struct ak_particles_scene_sprites {
+    bool enabled;              /* false -> points */
+    ak_sprite_texture texture; /* built-in texture when sheet_path is NULL: DISC or PUFF */
+    char* sheet_path;          /* a PNG sprite sheet (owned by the scene; a relative "texture"
+                                  is resolved against the scene file's directory), or NULL */
+    int sheet_columns;         /* frames across; 0 -> 1 (built-in PUFF with frames: that many puffs) */
+    int sheet_rows;            /* frames down; 0 -> 1 */
+    ak_blend blend;            /* AK_BLEND_ALPHA (sorted back to front), AK_BLEND_ADD, or
+                                  AK_BLEND_OPAQUE (alpha-tested cut-outs: leaves, grass) */
+    ak_particle_look look;     /* colour, size and frame over life */
+} ak_particles_scene_sprites;
+
+/* A loaded scene: the world and everything to add, owning its arrays (ak_particles_scene_free).
+ * world's spans point into the arrays below. */
+typedef struct ak_particles_scene {
+    float dt;                           /* seconds per step; default 0.01 */
+    ak_particles_integrator integrator; /* default SYMPLECTIC */
+    uint32_t capacity;                  /* default: particles + 100000 when there are emitters */
+    ak_particles_world world;
+    ak_particle_init* particles;        /* [particle_count] initial particles */
+    size_t particle_count;
+    ak_particle_spring* springs;        /* [world.springs.count] */
+    ak_particle_plane* planes;
+    ak_particle_sphere* spheres;
+    ak_particle_box* boxes;
+    ak_particle_attractor* attractors;
+    ak_particle_vortex* vortices;
+    ak_particle_emitter* emitters;      /* [emitter_count] */
+    ak_particles_scene_burst* bursts;   /* [emitter_count]; count 0: the emitter uses its rate */
+    size_t emitter_count;
+    ak_particles_scene_sprites sprites; /* "render": how to draw the particles */
+} ak_particles_scene;
+
+/* Budgets a scene file may ask for, checked before allocating. */
+#define AK_PARTICLES_SCENE_MAX_ITEMS 1000000u    /* particles, springs, colliders, emitters each */
+#define AK_PARTICLES_SCENE_MAX_CAPACITY 2000000u /* about 0.5 GB of system state */
+#define AK_PARTICLES_SCENE_MAX_FILE_SIZE ((size_t)64 << 20) /* bytes of a scene file */
+/* The names ak_particles_scene_preset knows. */
+#define AK_PARTICLES_SCENE_PRESETS "fountain, rain, fireworks, character, fire, smoke"
+
+/* Parse a scene from bytes[0, size) (strict JSON, need not be NUL-terminated); name (NULL ->
+ * "(scene)") starts every message. Emitter shape "mesh" is not allowed in files. A "render"
+ * texture that is a relative .png path is resolved against name's directory (the file is not
+ * read here: sprites.sheet_path holds the resolved path). Returns AK_OK
+ * and fills *out_scene, or AK_ERR_PARSE (a syntax error, an unknown key, a value out of range or
+ * over a budget), AK_ERR_NULL_ARG, with *out_scene empty and, when out_diag is not NULL, the one
+ * line "NAME: key.path: problem" in out_diag->message (out_diag->path = name). */
+AK_API ak_result ak_particles_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                               ak_particles_scene* out_scene, ak_diag* out_diag);
+/* Read the file at path (at most AK_PARTICLES_SCENE_MAX_FILE_SIZE bytes) and parse it as
+ * ak_particles_scene_load_bytes does, path naming it in messages. AK_ERR_IO when the file cannot
+ * be opened or read or is too big ("PATH: cannot open the file"). */
+AK_API ak_result ak_particles_scene_load_file(const char* path, ak_particles_scene* out_scene,
+                                              ak_diag* out_diag);
+/* The built-in scene name (AK_PARTICLES_SCENE_PRESETS; docs/particles.md gives their values).
+ * "character" holds a mesh-surface emitter (sparks) and rain: the command supplies the
+ * humanoid's posed mesh as collider and emitter surface; "fire" (additive) and "smoke"
+ * (alpha-blended) draw built-in puff sprites. AK_ERR_NOT_FOUND for another name,
+ * AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_particles_scene_preset(const char* name, ak_particles_scene* out_scene,
+                                           ak_diag* out_diag);
+/* Free the scene's arrays and zero it (safe on a zeroed, failed or freed scene; NULL: no-op). */
+AK_API void ak_particles_scene_free(ak_particles_scene* scene);
+
+/* ---- running a scene ------------------------------------------------------------------- */
+/* Step a loaded scene exactly as `animkit particles` does, so that C and Python reproduce the
+ * command's output: the scene's particles added in file order, each step every emitter emits
+ * at its rate and fires the bursts due before the step's end (a bounded number of calls
+ * whatever the interval), the system steps, and springs follow the file particles' new indices
+ * as some die (springs to a dead particle go).
+ *     ak_particles_scene_run run;
+ *     if (ak_particles_scene_run_init(&run, &sc, &(ak_particles_scene_run_desc){.seed = 1}, &diag) == AK_OK)
+ *         for (long k = 0; k < steps && ak_particles_scene_run_step(&run, &diag) == AK_OK; ++k) {}
+ *     ak_particles_state st = ak_particles_get_state(run.system);   // the command's --json
+ *     ak_particles_scene_run_free(&run); */
+typedef struct ak_particles_scene_run_desc {
+    uint64_t seed;                        /* the system's seed (the command uses 1) */
+    uint32_t thread_count;                /* 0 -> 1 */
+    const ak_particle_mesh* mesh_collider; /* optional: a mesh the caller poses between steps */
+    ak_vec3_cspan mesh_positions;         /* optional: the surface of AK_EMITTER_MESH emitters */
+    ak_u32_cspan mesh_indices;
+    ak_f32_span mesh_area_cdf;            /* [mesh_indices.count / 3] */
+} ak_particles_scene_run_desc;
+
+typedef struct ak_particles_scene_run {
+    ak_particles_scene* scene;   /* the scene run (its emitters' carry changes as they emit) */
+    ak_particles* system;        /* the particle system: read its state between steps */
+    ak_particles_world world;    /* the scene's world with the run's springs and collider mesh;
+                                    a caller may change it between steps (wind, gravity...) */
+    long step_index;             /* steps taken; step k ends at time (k + 1) * scene->dt */
+    /* private */
+    const ak_particle_mesh* meshes[1];
+    uint64_t* fired;             /* bursts fired per emitter */
+    ak_particle_spring* springs; /* the world's springs, re-indexed as file particles die */
+    size_t file_alive;           /* file particles still alive */
+} ak_particles_scene_run;
+
+/* Create the system for scene (which must outlive the run) and add its particles. Returns
+ * AK_OK, or the failing code with "particles: problem" in out_diag (optional); the run is then
+ * safe to free. */
+AK_API ak_result ak_particles_scene_run_init(ak_particles_scene_run* run, ak_particles_scene* scene,
+                                             const ak_particles_scene_run_desc* desc, ak_diag* out_diag);
+/* One step (number run->step_index): emit, fire due bursts, step, re-index springs. Returns
+ * AK_OK or the failing code (AK_ERR_BUDGET: Lennard-Jones packed past its pair-test budget; the
+ * message says what to lower) with "particles: step K: problem" in out_diag. */
+AK_API ak_result ak_particles_scene_run_step(ak_particles_scene_run* run, ak_diag* out_diag);
+/* Destroy the system and free the run's arrays (safe on a zeroed or failed run). */
+AK_API void ak_particles_scene_run_free(ak_particles_scene_run* run);
 
 #ifdef __cplusplus
 }

@@ -11,11 +11,17 @@
  * anti-aliasing, a built-in 5x7 bitmap font, simple 2D drawing on RGBA8 images (plots),
  * PNG read/write (libpng) and animated GIF read/write (giflib, own palette quantizer).
  *
+ * Base-colour textures: per-vertex UVs (texture coordinate (0, 0) at the image's top-left
+ * corner, glTF's rule) interpolated perspective-correctly, REPEAT / CLAMP / MIRROR wrapping,
+ * nearest or bilinear filtering (filtered in linear light for lit shading), chosen per
+ * triangle between a minification and a magnification filter (no mipmaps).
+ *
  * Camera-facing textured sprites (billboards: particles, fire, smoke) with sprite sheets,
  * alpha or additive blending and a back-to-front sort.
  *
- * What it does NOT do: textures on meshes, shadows other than on the ground
- * plane, MP4 output (ak_image_format_available says what this build can write), windows.
+ * What it does NOT do: mipmaps, normal or other maps, sorting of transparent meshes, shadows
+ * other than on the ground plane, MP4 output (ak_image_format_available says what this build
+ * can write), windows.
  *
  * Usage:
  *     ak_raster* r = NULL;
@@ -211,6 +217,28 @@ typedef struct ak_raster_material {
     float shininess;  /* Phong exponent; 0 -> 32 */
 } ak_raster_material;
 
+/* How texture coordinates outside [0, 1] map to texels. */
+typedef enum ak_raster_wrap {
+    AK_RASTER_WRAP_REPEAT = 0, /* the fractional part (default) */
+    AK_RASTER_WRAP_CLAMP,      /* clamped to the edge texels */
+    AK_RASTER_WRAP_MIRROR      /* repeated, every other copy mirrored */
+} ak_raster_wrap;
+
+typedef enum ak_raster_filter {
+    AK_RASTER_FILTER_LINEAR = 0, /* bilinear between the 4 nearest texel centres (default) */
+    AK_RASTER_FILTER_NEAREST     /* the texel that holds the point */
+} ak_raster_filter;
+
+/* A base-colour texture: the caller's RGBA8 image (sRGB colour, straight alpha), read during
+ * draw calls only. Texel (i, j) covers u in [i/width, (i+1)/width) and v in [j/height,
+ * (j+1)/height): (u, v) = (0, 0) is the image's top-left corner. */
+typedef struct ak_raster_texture {
+    ak_image image;             /* required */
+    ak_raster_wrap wrap_u, wrap_v;
+    ak_raster_filter mag_filter; /* a triangle showing fewer texels than samples it covers */
+    ak_raster_filter min_filter; /* a triangle showing more texels than samples it covers */
+} ak_raster_texture;
+
 /* ---- draw calls ----------------------------------------------------------------------- */
 
 /* A triangle mesh. Triangles are counter-clockwise seen from their front. */
@@ -227,13 +255,21 @@ typedef struct ak_raster_mesh {
     ak_blend blend;          /* DEFAULT -> OPAQUE */
     bool cull_back_faces;    /* false -> both sides drawn and lit on the side facing the camera */
     bool no_depth_test;      /* false -> z-buffered; true -> always drawn (depth still written when opaque) */
+    ak_vec2_cspan uvs;       /* texture coordinates, count == positions.count; used with texture */
+    const ak_raster_texture* texture; /* base colour texture (with uvs; NULL or no uvs -> none):
+                                the colour is material.color x vertex colour x texel, multiplied
+                                in linear light when lit (PHONG exactly: the texel scales the
+                                albedo; GOURAUD and FLAT scale the lit colour), as sRGB values
+                                when UNLIT; the texel's alpha multiplies the alpha */
 } ak_raster_mesh;
 
 /* Draw a triangle mesh. Triangles with a non-finite vertex are skipped (counted nowhere, no
  * error: the rest still draws). Returns AK_ERR_NULL_ARG (raster, camera or mesh NULL, or
  * positions empty), AK_ERR_BAD_ARG (indices.count not a multiple of 3, normals/colours count
- * mismatch, bad enum), AK_ERR_BAD_INDEX (an index >= positions.count), AK_ERR_BAD_DATA (a
- * non-finite camera or model matrix); nothing is drawn on error. */
+ * mismatch, bad enum, a uvs count other than positions.count, a texture whose image has no
+ * pixels, a size <= 0, a stride below width * 4 or a bad wrap/filter), AK_ERR_BAD_INDEX (an
+ * index >= positions.count), AK_ERR_BAD_DATA (a non-finite camera or model matrix); nothing is
+ * drawn on error. A non-finite UV reads as (0, 0). */
 AK_API ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera, const ak_raster_mesh* mesh);
 
 /* Depth-tested (or on-top) lines: screen-space ribbons of constant pixel width. */

@@ -1,7 +1,11 @@
 /* animkit retarget: put a clip made for one skeleton onto another (mocap onto a character).
  *
  * What it does:
- *   - maps target joints to source joints by name: the same name (case and "prefix:" such as
+ *   - maps target joints to source joints automatically: both skeletons fitted to a humanoid
+ *     template by topology, rest-pose geometry and name hints (ak_humanoid_roles_find), then
+ *     paired bone by bone (ak_retarget_map_by_roles), with a report that is a map file
+ *     (ak_retarget_map_write); a skeleton that is not a humanoid (a quadruped) is reported so;
+ *   - or maps target joints to source joints by name: the same name (case and "prefix:" such as
  *     "mixamorig:" ignored, and never two joints the rules below give different humanoid
  *     bones: builtin:humanoid's left_shoulder is an upper arm, a CMU LeftShoulder a collarbone)
  *     first, then humanoid bones recognised in CMU/BVH, Mixamo, Unreal
@@ -113,6 +117,85 @@ AK_API ak_result ak_retarget_map_by_name(const ak_skeleton* source, const ak_ske
 AK_API ak_result ak_retarget_map_parse(const char* text, size_t text_size, const ak_skeleton* source,
                                        const ak_skeleton* target, ak_i32_span out_source_of_target,
                                        size_t* out_mapped_count, ak_diag* diag);
+
+/* How a skeleton's joints fill the humanoid template (ak_humanoid_roles_find). */
+typedef enum ak_humanoid_sides {
+    AK_SIDES_NONE = 0,   /* no limbs found: sides not decided */
+    AK_SIDES_TOES,       /* from the rest pose: toes point forward, left = up x forward */
+    AK_SIDES_NAMES,      /* from the names (Left/L/_l ...): the rig has no toes */
+    AK_SIDES_CONVENTION  /* neither: glTF's convention, the model faces +Z (left = up x +Z) */
+} ak_humanoid_sides;
+
+typedef struct ak_humanoid_roles {
+    int32_t joint[AK_BONE_COUNT];     /* joint playing each bone, -1 none ([AK_BONE_NONE] = -1) */
+    float confidence[AK_BONE_COUNT];  /* 0 (none) .. 1: 1 = topology, geometry and the name
+                                         agree; 0.8 = the name says nothing (or only the limb
+                                         or the side); 0.5 = the name says another bone or
+                                         the other side */
+    int32_t name_bone[AK_BONE_COUNT]; /* what the joint's name alone says (ak_humanoid_bone) */
+    float score;             /* mean confidence over the 15 required bones (0 .. 1) */
+    bool is_humanoid;        /* every required bone found and the rest pose stands upright */
+    ak_vec3 up;              /* model-space up: from the feet towards the head (unit) */
+    ak_vec3 forward;         /* model-space facing direction (unit, perpendicular to up) */
+    ak_humanoid_sides sides; /* what decided left from right */
+    float spine_angle;       /* degrees between hips->head and the legs' upward direction */
+    float hand_height;       /* lowest hand's height above the hips, in leg lengths */
+} ak_humanoid_roles;
+
+/* Find the humanoid template in a skeleton's rest pose, the way engines auto-map avatars:
+ *   - topology: the hips are the shallowest joint with two leg chains (subtrees of >= 3
+ *     joints, the pair of most similar length) and a spine subtree holding a chest: the
+ *     shallowest joint with two arm chains (the most similar pair of >= 3-joint subtrees) and a
+ *     neck/head chain (the remaining child pointing most along hips -> chest); each chain
+ *     follows, from joint to joint, the child with the longest path below it;
+ *   - geometry (rest pose, joints at one position merged into the first): along a limb the
+ *     upper and lower bone are the two consecutive bones of largest total length whose lengths
+ *     are within a factor 2.5 of each other and after which comes a bone shorter than 0.6 of
+ *     the lower one (the hand or foot) or nothing; the joint before the upper arm is the
+ *     shoulder (clavicle), the one after the foot the toes; spine joints between the hips and the
+ *     chest become SPINE (first), CHEST (next to last) and UPPER_CHEST (last, the one the arms
+ *     hang from) when there are three or more, SPINE, CHEST for two, SPINE for one; the
+ *     neck is the first joint of the head chain, the head its last (its parent when the last
+ *     is an "end"/"top" leaf, or the joint named head);
+ *   - up = feet towards head; left vs right: the toes give the facing direction (left = up x
+ *     forward), else the names (Left/Right/L/R/_l/_r ...), else glTF's +Z facing;
+ *   - names (ak_humanoid_bones_of_skeleton, plus "arm"/"leg"/"spine"... words and L/R tokens
+ *     for rigs such as CesiumMan's "leg_joint_L_1") only grade each role's confidence.
+ * A humanoid also stands: hips -> head within 45 degrees of the legs' upward direction and
+ * the hands no lower than 0.8 leg lengths below the hips (a quadruped's spine is horizontal
+ * and its front paws stand on the floor).
+ * Returns AK_OK for a humanoid; AK_ERR_NOT_FOUND when the template does not fit (out holds
+ * what was found, is_humanoid false; diag says what is missing or why it is not a humanoid);
+ * AK_ERR_NULL_ARG, AK_ERR_BAD_DATA (a rest position not finite), AK_ERR_NO_MEMORY. Temporary
+ * memory (about 110 bytes a joint) from alloc (NULL: malloc/free). Reentrant. */
+AK_API ak_result ak_humanoid_roles_find(const ak_skeleton* skeleton, const ak_allocator* alloc, ak_humanoid_roles* out,
+                                        ak_diag* diag);
+
+/* Source joint for every target joint by humanoid role: out[target_roles->joint[b]] =
+ * source_roles->joint[b] for every bone b both have, except the torso: the spine joints
+ * (SPINE, CHEST, UPPER_CHEST present) are paired bottom to bottom and top to top (the joint
+ * the arms hang from drives the joint the arms hang from), the middle ones in proportion.
+ * Every other target joint gets -1. out_source_of_target.count >= target joint count.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX (a role's joint out of its
+ * skeleton); *out_mapped_count (optional) = target joints mapped. Allocates nothing. */
+AK_API ak_result ak_retarget_map_by_roles(const ak_skeleton* source, const ak_humanoid_roles* source_roles,
+                                          const ak_skeleton* target, const ak_humanoid_roles* target_roles,
+                                          ak_i32_span out_source_of_target, size_t* out_mapped_count);
+
+/* Write a map as text in the map-file format (ak_retarget_map_parse reads it back to the same
+ * map): a comment header (the roles' score, up, facing and side evidence when given), then one
+ * "TARGET_JOINT = SOURCE_JOINT  # bone  confidence target/source" line per mapped target joint
+ * in template order (roles given) or joint order, then comment lines for the template bones
+ * one side lacks ("# leftToes: no target joint (source LeftToeBase)"). source_roles and
+ * target_roles may be NULL (no bone column). Writes at most buffer_size bytes, NUL-terminated
+ * (buffer may be NULL when buffer_size is 0); *out_size (optional) = the text's length without
+ * the NUL, as snprintf (a larger buffer is needed when >= buffer_size).
+ * Returns AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL (map shorter than the target), AK_ERR_BAD_INDEX (a
+ * map entry or a role's joint out of its skeleton). Allocates nothing; reentrant. */
+AK_API ak_result ak_retarget_map_write(const ak_skeleton* source, const ak_humanoid_roles* source_roles,
+                                       const ak_skeleton* target, const ak_humanoid_roles* target_roles,
+                                       ak_i32_cspan source_of_target, char* buffer, size_t buffer_size,
+                                       size_t* out_size);
 
 typedef struct ak_retarget_desc {
     const ak_skeleton* source;     /* required: the skeleton the clip animates */

@@ -56,6 +56,34 @@ typedef struct ak_scene_skin {
     ak_mat4* inverse_binds; /* [joint_count] model-space inverse bind matrices */
 } ak_scene_skin;
 
+/* How texture coordinates outside [0, 1] are mapped (glTF sampler wrapS / wrapT). */
+typedef enum ak_texture_wrap {
+    AK_TEXTURE_WRAP_REPEAT = 0, /* glTF 10497, the default: the fractional part */
+    AK_TEXTURE_WRAP_CLAMP,      /* glTF 33071 CLAMP_TO_EDGE */
+    AK_TEXTURE_WRAP_MIRROR      /* glTF 33648 MIRRORED_REPEAT */
+} ak_texture_wrap;
+
+/* How a texture is sampled between texels (glTF magFilter / minFilter; a mipmap minFilter,
+ * 9984..9987, reads as LINEAR: mipmaps are not built, and bilinear comes closer to their
+ * averaged look than the nearest texel). */
+typedef enum ak_texture_filter {
+    AK_TEXTURE_FILTER_LINEAR = 0, /* bilinear, the default when the sampler names none */
+    AK_TEXTURE_FILTER_NEAREST     /* the texel under the point */
+} ak_texture_filter;
+
+/* A decoded base-colour texture (a glTF texture: its image and sampler; an OBJ map_Kd). */
+typedef struct ak_scene_texture {
+    char name[AK_NAME_SIZE]; /* the image's name or file name, "" when it has none */
+    int width, height;       /* texels; 0 when the texture is absent (pixels NULL) */
+    uint8_t* pixels;         /* [width * height * 4] RGBA8, sRGB colour, straight alpha, rows
+                                top to bottom (texture coordinate (0, 0) is the top-left
+                                corner, glTF's rule), owned by the scene; NULL -> absent (a
+                                texture no material uses, or an image that failed to decode:
+                                the loader warned) */
+    ak_texture_wrap wrap_s, wrap_t;
+    ak_texture_filter mag_filter, min_filter;
+} ak_scene_texture;
+
 /* One mesh (one glTF primitive) placed in the scene. */
 typedef struct ak_scene_mesh {
     ak_mesh* mesh; /* owned; mesh->joints index skin slots */
@@ -64,6 +92,9 @@ typedef struct ak_scene_mesh {
     bool has_material;  /* glTF: the primitive names a material; false -> none */
     ak_vec4 base_color; /* that material's pbrMetallicRoughness.baseColorFactor (linear RGBA,
                            (1,1,1,1) when it gives none); unused when has_material is false */
+    int32_t texture;    /* base colour texture: index into scene->textures (its texels are
+                           multiplied by base_color; texture coordinates are the mesh's uvs),
+                           -1 -> none (ak_scene_alloc sets -1) */
 } ak_scene_mesh;
 
 typedef struct ak_scene {
@@ -77,6 +108,8 @@ typedef struct ak_scene {
     size_t clip_count;
     bool* is_joint;           /* [joint count of skeleton]: true for joints used by a skin
                                  (false for plain nodes); NULL -> all are joints */
+    ak_scene_texture* textures; /* [texture_count] (ak_scene_texture_alloc); NULL when none */
+    size_t texture_count;
     ak_allocator alloc;       /* the allocator everything above was made with */
 } ak_scene;
 
@@ -86,6 +119,13 @@ AK_API ak_result ak_scene_alloc(size_t mesh_count, size_t skin_count, size_t cli
                                 const ak_allocator* alloc, ak_scene** out_scene);
 /* Allocate the arrays of one skin (joints, inverse_binds) for joint_count slots. */
 AK_API ak_result ak_scene_skin_alloc(ak_scene* scene, size_t skin_index, size_t joint_count);
+/* Give the scene texture_count empty textures (pixels NULL, REPEAT, LINEAR), replacing any it
+ * had. Returns AK_ERR_NULL_ARG, AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_scene_texture_alloc(ak_scene* scene, size_t texture_count);
+/* Allocate texture texture_index's pixels (width * height * 4 bytes, zeroed) through the
+ * scene's allocator, replacing any it had. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX,
+ * AK_ERR_BAD_ARG (a size <= 0, or above 32768), AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_scene_texture_alloc_pixels(ak_scene* scene, size_t texture_index, int width, int height);
 /* Free the scene and everything it owns; NULL is a no-op. */
 AK_API void ak_scene_destroy(ak_scene* scene);
 

@@ -247,15 +247,13 @@ static int b64_value(uint8_t ch) {
 }
 
 /* Strict base64 (padding optional at the very end). */
-static ak_result b64_decode(gl_ctx* c, const char* s, size_t n, size_t bi, uint8_t** out, size_t* out_size) {
+static ak_result b64_decode(gl_ctx* c, const char* s, size_t n, const char* what, uint8_t** out, size_t* out_size) {
     while (n > 0 && s[n - 1] == '=') --n;
-    if (n % 4 == 1) return fail(c, AK_ERR_PARSE, "buffers[%zu]: base64 data has a bad length", bi);
+    if (n % 4 == 1) return fail(c, AK_ERR_PARSE, "%s: base64 data has a bad length", what);
     size_t size = n / 4 * 3 + (n % 4 ? n % 4 - 1 : 0);
-    char what[64];
-    snprintf(what, sizeof what, "buffers[%zu]", bi);
     TRY(charge(c, size + 1, 1, what));
     uint8_t* d = (uint8_t*)akp_alloc(c->alloc, size + 1);
-    if (!d) return fail(c, AK_ERR_NO_MEMORY, "buffers[%zu]: out of memory decoding %zu bytes", bi, size);
+    if (!d) return fail(c, AK_ERR_NO_MEMORY, "%s: out of memory decoding %zu bytes", what, size);
     uint32_t acc = 0;
     int bits = 0;
     size_t o = 0;
@@ -263,7 +261,7 @@ static ak_result b64_decode(gl_ctx* c, const char* s, size_t n, size_t bi, uint8
         int v = b64_value((uint8_t)s[i]);
         if (v < 0) {
             akp_free(c->alloc, d);
-            return fail(c, AK_ERR_PARSE, "buffers[%zu]: invalid base64 character at position %zu", bi, i);
+            return fail(c, AK_ERR_PARSE, "%s: invalid base64 character at position %zu", what, i);
         }
         acc = (acc << 6) | (uint32_t)v;
         bits += 6;
@@ -333,7 +331,7 @@ static ak_result load_buffer(gl_ctx* c, size_t bi) {
             const char* comma = strchr(uri, ',');
             if (!comma || comma - uri < 12 || strncmp(comma - 7, ";base64", 7) != 0)
                 return fail(c, AK_ERR_UNSUPPORTED, "%s: only base64 data: URIs are supported", where);
-            TRY(b64_decode(c, comma + 1, strlen(comma + 1), bi, &gb->owned, &gb->size));
+            TRY(b64_decode(c, comma + 1, strlen(comma + 1), where, &gb->owned, &gb->size));
         } else {
             if (!c->base_dir)
                 return fail(c, AK_ERR_IO, "%s: external buffer '%.200s' needs a base directory", where, uri);
@@ -1177,7 +1175,182 @@ static ak_result count_scene_meshes(gl_ctx* c, const gl_table* nodes, const gl_t
     return r;
 }
 
-/* The primitive's material: its base colour factor (materials are otherwise not read). */
+/* ---- static helpers: textures ------------------------------------------------------------- */
+
+/* The bytes of image ii: a bufferView's range, a base64 data: URI or a file inside the
+ * model's folder (owned: what to free afterwards). */
+static ak_result image_bytes(gl_ctx* c, size_t ii, const uint8_t** out, size_t* out_size, uint8_t** owned) {
+    const cJSON* im = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(c->root, "images"), (int)ii);
+    char where[64];
+    snprintf(where, sizeof where, "images[%zu]", ii);
+    if (!cJSON_IsObject(im)) return fail(c, AK_ERR_PARSE, "%s is not an object", where);
+    const char* uri = get_string(im, "uri");
+    if (cJSON_GetObjectItemCaseSensitive(im, "bufferView")) {
+        size_t vi = 0;
+        TRY(get_uint(c, im, "bufferView", where, true, 0, c->n_views, &vi));
+        return view_range(c, vi, where, out, out_size, NULL);
+    }
+    if (!uri) return fail(c, AK_ERR_PARSE, "%s has neither a uri nor a bufferView", where);
+    if (strncmp(uri, "data:", 5) == 0) {
+        const char* comma = strchr(uri, ',');
+        if (!comma || comma - uri < 12 || strncmp(comma - 7, ";base64", 7) != 0)
+            return fail(c, AK_ERR_UNSUPPORTED, "%s: only base64 data: URIs are supported", where);
+        TRY(b64_decode(c, comma + 1, strlen(comma + 1), where, owned, out_size));
+        *out = *owned;
+        return AK_OK;
+    }
+    if (!c->base_dir) return fail(c, AK_ERR_IO, "%s: external image '%.200s' needs a base directory", where, uri);
+    char path[PATH_MAX];
+    TRY(resolve_uri(c, uri, where, path));
+    ak_diag sub;
+    ak_result r = akp_io_read_file(path, c->alloc, 0, &c->budget, owned, out_size, &sub);
+    if (r != AK_OK) return fail(c, r, "%s: uri '%.200s': %s", where, uri, sub.message);
+    *out = *owned;
+    return AK_OK;
+}
+
+static ak_result sampler_field(gl_ctx* c, const cJSON* s, const char* key, const char* where, size_t dflt,
+                               size_t* out) {
+    TRY(get_uint(c, s, key, where, false, dflt, NO_LIMIT, out));
+    return AK_OK;
+}
+
+/* glTF texture ti -> scene texture ti: its sampler and its decoded source image. */
+static ak_result load_texture(gl_ctx* c, size_t ti) {
+    const cJSON* t = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(c->root, "textures"), (int)ti);
+    char where[64];
+    snprintf(where, sizeof where, "textures[%zu]", ti);
+    if (!cJSON_IsObject(t)) return fail(c, AK_ERR_PARSE, "%s is not an object", where);
+    const cJSON* images = cJSON_GetObjectItemCaseSensitive(c->root, "images");
+    const cJSON* samplers = cJSON_GetObjectItemCaseSensitive(c->root, "samplers");
+    size_t n_images = cJSON_IsArray(images) ? (size_t)cJSON_GetArraySize(images) : 0;
+    size_t n_samplers = cJSON_IsArray(samplers) ? (size_t)cJSON_GetArraySize(samplers) : 0;
+    int64_t src = -1, smp = -1;
+    TRY(get_opt_index(c, t, "source", where, n_images, &src));
+    if (src < 0) return fail(c, AK_ERR_UNSUPPORTED, "%s has no source image (only PNG and JPEG are read)", where);
+    TRY(get_opt_index(c, t, "sampler", where, n_samplers, &smp));
+    ak_scene_texture* st = &c->scene->textures[ti];
+    st->wrap_s = st->wrap_t = AK_TEXTURE_WRAP_REPEAT;
+    st->mag_filter = st->min_filter = AK_TEXTURE_FILTER_LINEAR;
+    if (smp >= 0) {
+        const cJSON* s = cJSON_GetArrayItem(samplers, (int)smp);
+        char sw[64];
+        snprintf(sw, sizeof sw, "samplers[%lld]", (long long)smp);
+        if (!cJSON_IsObject(s)) return fail(c, AK_ERR_PARSE, "%s is not an object", sw);
+        size_t v[4];
+        static const char* const keys[4] = {"wrapS", "wrapT", "magFilter", "minFilter"};
+        for (int k = 0; k < 4; ++k) TRY(sampler_field(c, s, keys[k], sw, k < 2 ? 10497u : 9729u, &v[k]));
+        for (int k = 0; k < 2; ++k) {
+            ak_texture_wrap w = AK_TEXTURE_WRAP_REPEAT;
+            if (v[k] == 33071) w = AK_TEXTURE_WRAP_CLAMP;
+            else if (v[k] == 33648) w = AK_TEXTURE_WRAP_MIRROR;
+            else if (v[k] != 10497) return fail(c, AK_ERR_PARSE, "%s.%s = %zu is not a wrap mode", sw, keys[k], v[k]);
+            if (k == 0) st->wrap_s = w;
+            else st->wrap_t = w;
+        }
+        if (v[2] != 9728 && v[2] != 9729) return fail(c, AK_ERR_PARSE, "%s.magFilter = %zu is not a filter", sw, v[2]);
+        if (v[3] != 9728 && v[3] != 9729 && (v[3] < 9984 || v[3] > 9987))
+            return fail(c, AK_ERR_PARSE, "%s.minFilter = %zu is not a filter", sw, v[3]);
+        st->mag_filter = v[2] == 9728 ? AK_TEXTURE_FILTER_NEAREST : AK_TEXTURE_FILTER_LINEAR;
+        /* mipmap filters (9984..9987) -> LINEAR: no mipmaps are built, and bilinear is closer to
+         * the averaged look they give than the nearest texel of the full-size image */
+        st->min_filter = v[3] == 9728 ? AK_TEXTURE_FILTER_NEAREST : AK_TEXTURE_FILTER_LINEAR;
+    }
+    const cJSON* im = cJSON_GetArrayItem(images, (int)src);
+    const char* iname = get_string(im, "name");
+    if (!iname) {
+        const char* uri = get_string(im, "uri");
+        if (uri && strncmp(uri, "data:", 5) != 0) iname = strrchr(uri, '/') ? strrchr(uri, '/') + 1 : uri;
+    }
+    if (iname && akp_io_utf8_valid(iname, strlen(iname))) {
+        akp_io_copy_name(st->name, iname);
+        akp_io_sanitize(st->name, sizeof st->name);
+    }
+    const uint8_t* bytes = NULL;
+    size_t n = 0;
+    uint8_t* owned = NULL;
+    ak_result r = image_bytes(c, (size_t)src, &bytes, &n, &owned);
+    if (r == AK_OK) {
+        char msg[200];
+        uint8_t* px = NULL;
+        int w = 0, h = 0;
+        r = akp_image_decode(bytes, n, &c->budget, &c->scene->alloc, &px, &w, &h, msg, sizeof msg);
+        if (r != AK_OK) {
+            r = fail(c, r, "images[%lld]: %s", (long long)src, msg);
+        } else {
+            st->pixels = px;
+            st->width = w;
+            st->height = h;
+        }
+    }
+    akp_free(c->alloc, owned);
+    return r;
+}
+
+/* Decode the textures that materials use as base colour (scene texture i = glTF texture i;
+ * the others stay absent). A texture that cannot be read (a broken or missing image, a bad
+ * sampler, over the memory budget) is a warning and stays absent: its meshes are drawn
+ * without it. Only running out of memory fails the load. */
+static ak_result load_textures(gl_ctx* c) {
+    const cJSON* texs = cJSON_GetObjectItemCaseSensitive(c->root, "textures");
+    size_t n = cJSON_IsArray(texs) ? (size_t)cJSON_GetArraySize(texs) : 0;
+    if (n == 0) return AK_OK;
+    TRY(charge(c, n, sizeof(ak_scene_texture) + 1, "textures"));
+    if (ak_scene_texture_alloc(c->scene, n) != AK_OK) return fail(c, AK_ERR_NO_MEMORY, "out of memory");
+    bool* used = (bool*)akp_calloc(c->alloc, n);
+    if (!used) return fail(c, AK_ERR_NO_MEMORY, "out of memory");
+    const cJSON* mats = cJSON_GetObjectItemCaseSensitive(c->root, "materials");
+    for (const cJSON* m = cJSON_IsArray(mats) ? mats->child : NULL; m; m = m->next) {
+        const cJSON* pbr = cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness");
+        const cJSON* bct = cJSON_IsObject(pbr) ? cJSON_GetObjectItemCaseSensitive(pbr, "baseColorTexture") : NULL;
+        size_t ti = 0;
+        if (cJSON_IsObject(bct) && as_uint(cJSON_GetObjectItemCaseSensitive(bct, "index"), &ti) && ti < n)
+            used[ti] = true;
+    }
+    ak_result r = AK_OK;
+    for (size_t ti = 0; ti < n && r == AK_OK; ++ti) {
+        if (!used[ti]) continue;
+        ak_diag sub;
+        memset(&sub, 0, sizeof sub);
+        ak_diag* keep = c->diag;
+        c->diag = &sub;
+        ak_result tr = load_texture(c, ti);
+        c->diag = keep;
+        if (tr == AK_ERR_NO_MEMORY) {
+            r = fail(c, tr, "%s", sub.message);
+        } else if (tr != AK_OK) {
+            char msg[sizeof sub.message + 80];
+            snprintf(msg, sizeof msg, "%s (%s); the meshes using it are drawn untextured", sub.message,
+                     ak_result_string(tr));
+            warn(c, msg);
+        }
+    }
+    akp_free(c->alloc, used);
+    return r;
+}
+
+/* The primitive's base colour texture (pbrMetallicRoughness.baseColorTexture), when it was
+ * decoded and uses TEXCOORD_0; anything else is a warning and no texture. */
+static void read_base_texture(gl_ctx* c, const cJSON* pbr, const char* mw, ak_scene_mesh* sm) {
+    const cJSON* bct = cJSON_GetObjectItemCaseSensitive(pbr, "baseColorTexture");
+    if (!bct) return;
+    char msg[300];
+    size_t ti = 0, tc = 0;
+    const cJSON* tcj = cJSON_IsObject(bct) ? cJSON_GetObjectItemCaseSensitive(bct, "texCoord") : NULL;
+    if (!cJSON_IsObject(bct) || !as_uint(cJSON_GetObjectItemCaseSensitive(bct, "index"), &ti) ||
+        ti >= c->scene->texture_count) {
+        snprintf(msg, sizeof msg, "%s.baseColorTexture does not name a texture; ignored", mw);
+        warn(c, msg);
+    } else if (tcj && (!as_uint(tcj, &tc) || tc != 0)) {
+        snprintf(msg, sizeof msg, "%s.baseColorTexture uses a texCoord other than 0 (only TEXCOORD_0 is read); ignored",
+                 mw);
+        warn(c, msg);
+    } else if (c->scene->textures[ti].pixels) {
+        sm->texture = (int32_t)ti;
+    }
+}
+
+/* The primitive's material: its base colour factor and texture (materials are otherwise not read). */
 static ak_result read_material(gl_ctx* c, const cJSON* prim, const char* where, ak_scene_mesh* sm) {
     const cJSON* mats = cJSON_GetObjectItemCaseSensitive(c->root, "materials");
     size_t n = cJSON_IsArray(mats) ? (size_t)cJSON_GetArraySize(mats) : 0;
@@ -1191,6 +1364,7 @@ static ak_result read_material(gl_ctx* c, const cJSON* prim, const char* where, 
         char mw[64];
         snprintf(mw, sizeof mw, "materials[%lld].pbrMetallicRoughness", (long long)mi);
         TRY(get_floats(c, pbr, "baseColorFactor", mw, 4, col, NULL));
+        read_base_texture(c, pbr, mw, sm);
     }
     sm->has_material = true;
     sm->base_color = ak_vec4_make(col[0], col[1], col[2], col[3]);
@@ -1248,6 +1422,12 @@ static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* m
                     r = fail(c, AK_ERR_PARSE, "%s: nodes[%zu] has a skin but the primitive has no JOINTS_0/WEIGHTS_0",
                              where, ni);
                 if (r == AK_OK) r = make_mesh(c, &p, name, mj, where, &sm->mesh);
+                if (r == AK_OK && sm->texture >= 0 && !sm->mesh->uvs) {
+                    char msg[240];
+                    snprintf(msg, sizeof msg, "%s has a base colour texture but no TEXCOORD_0; drawn untextured", where);
+                    warn(c, msg);
+                    sm->texture = -1;
+                }
                 if (r == AK_OK && ns >= 0) {
                     sm->skin = (int32_t)ns;
                     r = check_slots(c, sm->mesh, scene->skins[ns].joint_count, where, (size_t)ns);
@@ -1514,6 +1694,7 @@ static ak_result load_document(gl_ctx* c, const uint8_t* data, size_t size) {
         if (!c->morph_base) r = fail(c, AK_ERR_NO_MEMORY, "out of memory");
     }
     if (r == AK_OK) r = load_nodes_and_skins(c, &nodes);
+    if (r == AK_OK) r = load_textures(c);
     if (r == AK_OK) r = load_meshes(c, &nodes, &meshes);
     ak_raw_channel* chans = NULL;
     size_t cap = 0, ai = 0;

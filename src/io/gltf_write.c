@@ -25,6 +25,9 @@ typedef struct w_ctx {
     uint8_t* bin;
     size_t bin_size, bin_cap;
     cJSON *root, *views, *accessors, *nodes, *meshes, *skins, *animations, *materials;
+    cJSON *textures, *images, *samplers;
+    int32_t* gltf_texture; /* [scene texture_count] glTF texture written for it, -1 not yet */
+    int n_textures;
     size_t n_nodes; /* written so far (joints, then extra mesh nodes) */
     /* counts and a node table: cJSON arrays are linked lists, and asking their size or
      * item i walks them (quadratic for scenes of thousands of nodes and accessors) */
@@ -545,15 +548,64 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
     return AK_OK;
 }
 
-/* Index of a material with this base colour (made on first use; channels clamped to [0, 1],
- * the range glTF allows); -1 when out of memory. */
-static int material_index(w_ctx* c, ak_vec4 col) {
+/* The glTF texture of scene texture ti, written on first use: its pixels as an embedded PNG
+ * (a bufferView, also for .gltf), a sampler with its wrap modes and filters, the texture.
+ * Returns the index, -1 when out of memory or the PNG cannot be encoded. */
+static int texture_index(w_ctx* c, size_t ti) {
+    if (c->gltf_texture[ti] >= 0) return c->gltf_texture[ti];
+    const ak_scene_texture* st = &c->scene->textures[ti];
+    uint8_t* png = NULL;
+    size_t png_size = 0;
+    if (akp_image_encode_png(st->pixels, st->width, st->height, &png, &png_size) != AK_OK) return -1;
+    int view = add_view(c, png, png_size, 0);
+    free(png);
+    if (view < 0) return -1;
+    static const int wraps[3] = {10497, 33071, 33648};
+    cJSON* im = cJSON_CreateObject();
+    cJSON* sm = cJSON_CreateObject();
+    cJSON* tx = cJSON_CreateObject();
+    bool ok = im && sm && tx;
+    if (ok) {
+        add_num(im, "bufferView", view);
+        cJSON_AddStringToObject(im, "mimeType", "image/png");
+        if (st->name[0] && akp_io_utf8_valid(st->name, strlen(st->name))) cJSON_AddStringToObject(im, "name", st->name);
+        add_num(sm, "magFilter", st->mag_filter == AK_TEXTURE_FILTER_NEAREST ? 9728 : 9729);
+        add_num(sm, "minFilter", st->min_filter == AK_TEXTURE_FILTER_NEAREST ? 9728 : 9729);
+        add_num(sm, "wrapS", wraps[(unsigned)st->wrap_s < 3u ? st->wrap_s : 0]);
+        add_num(sm, "wrapT", wraps[(unsigned)st->wrap_t < 3u ? st->wrap_t : 0]);
+        add_num(tx, "sampler", c->n_textures);
+        add_num(tx, "source", c->n_textures);
+    }
+    if (!ok || !cJSON_AddItemToArray(c->images, im)) {
+        cJSON_Delete(im);
+        cJSON_Delete(sm);
+        cJSON_Delete(tx);
+        return -1;
+    }
+    if (!cJSON_AddItemToArray(c->samplers, sm)) {
+        cJSON_Delete(sm);
+        cJSON_Delete(tx);
+        return -1;
+    }
+    if (!cJSON_AddItemToArray(c->textures, tx)) {
+        cJSON_Delete(tx);
+        return -1;
+    }
+    c->gltf_texture[ti] = c->n_textures;
+    return c->n_textures++;
+}
+
+/* Index of a material with this base colour and base colour texture (-1: none) (made on
+ * first use; channels clamped to [0, 1], the range glTF allows); -1 when out of memory. */
+static int material_index(w_ctx* c, ak_vec4 col, int texture) {
     float v[4] = {col.x, col.y, col.z, col.w};
     for (int k = 0; k < 4; ++k) v[k] = v[k] < 0.0f ? 0.0f : v[k] > 1.0f ? 1.0f : v[k];
     int i = 0;
     for (const cJSON* m = c->materials->child; m; m = m->next, ++i) {
-        const cJSON* f = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness"),
-                                                          "baseColorFactor");
+        const cJSON* pbr = cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness");
+        const cJSON* f = cJSON_GetObjectItemCaseSensitive(pbr, "baseColorFactor");
+        const cJSON* t = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(pbr, "baseColorTexture"), "index");
+        if ((t ? (int)t->valuedouble : -1) != texture) continue;
         int k = 0;
         for (const cJSON* e = f ? f->child : NULL; e && k < 4 && e->valuedouble == (double)v[k]; e = e->next) ++k;
         if (k == 4) return i;
@@ -561,11 +613,13 @@ static int material_index(w_ctx* c, ak_vec4 col) {
     cJSON* m = cJSON_CreateObject();
     cJSON* pbr = m ? cJSON_AddObjectToObject(m, "pbrMetallicRoughness") : NULL;
     cJSON* f = pbr ? cJSON_AddArrayToObject(pbr, "baseColorFactor") : NULL;
-    if (!f || !cJSON_AddItemToArray(c->materials, m)) {
+    cJSON* bt = pbr && texture >= 0 ? cJSON_AddObjectToObject(pbr, "baseColorTexture") : NULL;
+    if (!f || (texture >= 0 && !bt) || !cJSON_AddItemToArray(c->materials, m)) {
         cJSON_Delete(m);
         return -1;
     }
     for (int k = 0; k < 4; ++k) cJSON_AddItemToArray(f, num(v[k]));
+    if (bt) add_num(bt, "index", texture);
     return i;
 }
 
@@ -621,8 +675,13 @@ static ak_result write_meshes(w_ctx* c) {
             cJSON* prim = cJSON_CreateObject();
             if (!prim || !cJSON_AddItemToArray(prims, prim)) r = oom(c);
             else r = write_primitive(c, k, prim);
-            if (r == AK_OK && s->meshes[k].has_material) {
-                int mi = material_index(c, s->meshes[k].base_color);
+            const ak_scene_mesh* sk = &s->meshes[k];
+            bool textured = sk->texture >= 0 && (size_t)sk->texture < s->texture_count &&
+                            s->textures[sk->texture].pixels && sk->mesh->uvs;
+            if (r == AK_OK && (sk->has_material || textured)) {
+                int ti = textured ? texture_index(c, (size_t)sk->texture) : -1;
+                int mi = textured && ti < 0 ? -1
+                                            : material_index(c, sk->has_material ? sk->base_color : ak_vec4_make(1, 1, 1, 1), ti);
                 if (mi < 0) r = oom(c);
                 else add_num(prim, "material", mi);
             }
@@ -850,6 +909,12 @@ static ak_result build_document(w_ctx* c) {
     c->views = cJSON_CreateArray();
     c->accessors = cJSON_CreateArray();
     c->materials = cJSON_CreateArray();
+    c->textures = cJSON_CreateArray();
+    c->images = cJSON_CreateArray();
+    c->samplers = cJSON_CreateArray();
+    c->gltf_texture = (int32_t*)malloc((s->texture_count ? s->texture_count : 1) * sizeof(int32_t));
+    if (!c->textures || !c->images || !c->samplers || !c->gltf_texture) return oom(c);
+    for (size_t t = 0; t < s->texture_count; ++t) c->gltf_texture[t] = -1;
     size_t mc = s->mesh_count ? s->mesh_count : 1;
     c->node_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
     c->group_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
@@ -888,9 +953,11 @@ static ak_result build_document(w_ctx* c) {
         free(child);
         add_num(c->root, "scene", 0);
     }
-    cJSON** arrays[] = {&c->nodes, &c->meshes, &c->materials, &c->skins, &c->animations, &c->accessors, &c->views};
-    const char* names[] = {"nodes", "meshes", "materials", "skins", "animations", "accessors", "bufferViews"};
-    for (size_t i = 0; i < 7; ++i) {
+    cJSON** arrays[] = {&c->nodes,    &c->meshes,     &c->materials, &c->textures, &c->images,
+                        &c->samplers, &c->skins,      &c->animations, &c->accessors, &c->views};
+    const char* names[] = {"nodes",    "meshes", "materials",  "textures",  "images",
+                           "samplers", "skins",  "animations", "accessors", "bufferViews"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
         cJSON* a = *arrays[i];
         *arrays[i] = NULL;
         if (cJSON_GetArraySize(a) == 0) cJSON_Delete(a);
@@ -990,6 +1057,10 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
     cJSON_Delete(c.views);
     cJSON_Delete(c.accessors);
     cJSON_Delete(c.materials);
+    cJSON_Delete(c.textures);
+    cJSON_Delete(c.images);
+    cJSON_Delete(c.samplers);
+    free(c.gltf_texture);
     free(c.bin);
     free(c.node_of_mesh);
     free(c.node_tab);

@@ -14,6 +14,9 @@
  * absurd counts in corrupt files. */
 #define AKP_IO_MAX_ELEMENTS (1u << 26)
 
+/* Largest texture image side the decoders accept (the pixels are also charged to the budget). */
+#define AKP_IO_MAX_IMAGE_SIDE 16384
+
 /* Memory budget of one load: every large allocation is charged before it is made. */
 typedef struct akp_budget {
     size_t limit, used;
@@ -87,5 +90,16 @@ ak_result akp_io_load_obj(const uint8_t* data, size_t size, const char* name, co
                           const ak_io_desc* desc, const ak_allocator* alloc, ak_scene** out_scene, ak_diag* diag);
 ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_allocator* alloc,
                              ak_scene** out_scene, ak_diag* diag);
+
+/* Decode a PNG or JPEG (told apart by the signature) into RGBA8 rows top to bottom, allocated
+ * through alloc after the header's size was checked (at most AKP_IO_MAX_IMAGE_SIDE per side) and
+ * charged to budget (NULL -> not charged). msg (msg_size bytes) says what is wrong on failure.
+ * Returns AK_ERR_PARSE (not an image, or broken), AK_ERR_UNSUPPORTED (too large, over budget,
+ * CMYK JPEG, no JPEG decoder in this build), AK_ERR_NO_MEMORY. (src/io/image.c) */
+ak_result akp_image_decode(const uint8_t* data, size_t size, akp_budget* budget, const ak_allocator* alloc,
+                           uint8_t** out_pixels, int* out_width, int* out_height, char* msg, size_t msg_size);
+/* Encode RGBA8 (rows top to bottom, tightly packed) as a PNG in a malloc'ed buffer.
+ * Returns AK_ERR_BAD_ARG (libpng refused), AK_ERR_NO_MEMORY. */
+ak_result akp_image_encode_png(const uint8_t* rgba, int width, int height, uint8_t** out_data, size_t* out_size);
 
 #endif

@@ -19,7 +19,11 @@
  *   - normals (UVs) when every corner of the mesh has a "vn" ("vt") index, as written;
  *   - is_joint all false, no skins, no clips.
  * Beyond Assimp: a mesh whose material a read .mtl defines gets has_material and base_color
- * (Kd, alpha = d, or 1 - Tr); a file with vertices and no faces gives one point mesh
+ * (Kd, alpha = d, or 1 - Tr), and, when the mesh has UVs, the material's map_Kd image as its
+ * texture (PNG or JPEG, the last word of the line, relative to the .mtl's folder and read only
+ * inside the model's folder; stored with its rows flipped, since OBJ puts v = 0 at the
+ * image's bottom and animkit at its top, so the UVs stay as written; REPEAT, LINEAR; an image
+ * that cannot be read is a warning and no texture); a file with vertices and no faces gives one point mesh
  * "defaultobject" holding every "v" (Assimp refused it).
  * mtllib: read only inside the model's folder (akp_io_resolve_inside); a refused, missing or
  * unreadable .mtl is not an error (viewers ignore it): the meshes then have no material and
@@ -51,9 +55,12 @@ typedef struct ob_mesh {
     bool all_vt, all_vn;
 } ob_mesh;
 
+#define OB_MAP_SIZE 512
+
 typedef struct ob_material {
     char name[AK_NAME_SIZE];
     ak_vec4 color;
+    char map_kd[OB_MAP_SIZE]; /* map_Kd file relative to the model's folder, "" none */
 } ob_material;
 
 typedef struct ob_ctx {
@@ -284,9 +291,74 @@ static ak_result parse_mtl(ob_ctx* c, const char* lib, const char* data, size_t 
                 return fail_at(c, lib, t.line, AK_ERR_PARSE, "d -halo has no value");
             TRY(parse_float(c, lib, t.line, wb, we, tr ? "Tr" : "d", &a));
             cur->color.w = tr ? 1.0f - a : a;
+        } else if (word_is(wb, we, "map_Kd")) {
+            /* options (-s u v w, -clamp on, ...) come first: the file is the last word */
+            const char *fb = NULL, *fe = NULL;
+            while (next_word(&p, e, &wb, &we) && *wb != '#') fb = wb, fe = we;
+            const char* slash = strrchr(lib, '/');
+            size_t dir = slash ? (size_t)(slash - lib) + 1 : 0;
+            if (!fb || dir + (size_t)(fe - fb) >= OB_MAP_SIZE) {
+                warn(c, "%.200s line %ld: map_Kd without a usable file name; ignored", lib, t.line);
+                continue;
+            }
+            memcpy(cur->map_kd, lib, dir);
+            memcpy(cur->map_kd + dir, fb, (size_t)(fe - fb));
+            cur->map_kd[dir + (size_t)(fe - fb)] = 0;
+            if (memchr(cur->map_kd, 0, dir + (size_t)(fe - fb)) || !akp_io_utf8_valid(cur->map_kd, strlen(cur->map_kd)))
+                cur->map_kd[0] = 0;
         }
     }
     return AK_OK;
+}
+
+/* Decode material mat's map_Kd into scene texture ti (rows flipped: OBJ's v runs up from the
+ * image's bottom). Failures are warnings; the texture then stays absent. */
+static void load_map_kd(ob_ctx* c, ak_scene* s, size_t ti, const ob_material* mat) {
+    char real[PATH_MAX];
+    bool leaves = false;
+    if (!c->base_dir) {
+        warn(c, "map_Kd '%.200s' not read: the OBJ came from memory without a base directory", mat->map_kd);
+        return;
+    }
+    if (akp_io_resolve_inside(c->base_dir, mat->map_kd, c->desc, real, sizeof real, &leaves) != AK_OK) {
+        warn(c, "map_Kd '%.200s' not read: %s", mat->map_kd,
+             leaves ? "the path leaves the model's folder (ak_io_desc.extra_roots, allow_any_path)" : "cannot open it");
+        return;
+    }
+    uint8_t* data = NULL;
+    size_t size = 0;
+    ak_diag sub;
+    ak_result r = akp_io_read_file(real, c->alloc, 0, &c->budget, &data, &size, &sub);
+    if (r != AK_OK) {
+        warn(c, "map_Kd '%.200s' not read: %s", mat->map_kd, sub.message);
+        return;
+    }
+    char msg[200];
+    uint8_t* px = NULL;
+    int w = 0, h = 0;
+    r = akp_image_decode(data, size, &c->budget, &s->alloc, &px, &w, &h, msg, sizeof msg);
+    akp_free(c->alloc, data);
+    if (r != AK_OK) {
+        warn(c, "map_Kd '%.200s' not read: %s", mat->map_kd, msg);
+        return;
+    }
+    size_t row = (size_t)w * 4u;
+    for (int y = 0; y < h / 2; ++y) {
+        uint8_t* a = px + (size_t)y * row;
+        uint8_t* b = px + (size_t)(h - 1 - y) * row;
+        for (size_t k = 0; k < row; ++k) {
+            uint8_t tmp = a[k];
+            a[k] = b[k];
+            b[k] = tmp;
+        }
+    }
+    ak_scene_texture* t = &s->textures[ti];
+    const char* base = strrchr(mat->map_kd, '/');
+    akp_io_copy_name(t->name, base ? base + 1 : mat->map_kd);
+    akp_io_sanitize(t->name, sizeof t->name);
+    t->pixels = px;
+    t->width = w;
+    t->height = h;
 }
 
 static void read_mtllib(ob_ctx* c, const char* lib) {
@@ -583,6 +655,26 @@ static ak_result build_scene(ob_ctx* c, ak_scene** out_scene) {
         goto done;
     }
     if (c->material_count > 1) qsort(c->materials, c->material_count, sizeof(ob_material), material_cmp);
+    /* textures: one per material whose map_Kd a mesh with UVs uses (tex_of[material] = index) */
+    int32_t* tex_of = (int32_t*)akp_alloc(c->alloc, (c->material_count ? c->material_count : 1) * sizeof(int32_t));
+    if (!tex_of) {
+        r = fail_at(c, c->name, 0, AK_ERR_NO_MEMORY, "out of memory");
+        goto done;
+    }
+    size_t tex_count = 0;
+    for (size_t i = 0; i < c->material_count; ++i) tex_of[i] = -1;
+    for (size_t i = 0; i < c->mesh_count && !points; ++i) {
+        const ob_material* mat = c->meshes[i].material[0] ? find_material(c, c->meshes[i].material) : NULL;
+        if (mat && mat->map_kd[0] && c->meshes[i].face_count && c->meshes[i].all_vt && tex_of[mat - c->materials] < 0)
+            tex_of[mat - c->materials] = (int32_t)tex_count++;
+    }
+    if (tex_count && ak_scene_texture_alloc(s, tex_count) != AK_OK) {
+        akp_free(c->alloc, tex_of);
+        r = fail_at(c, c->name, 0, AK_ERR_NO_MEMORY, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < c->material_count; ++i)
+        if (tex_of[i] >= 0) load_map_kd(c, s, (size_t)tex_of[i], &c->materials[i]);
     size_t out = 0;
     for (size_t i = 0; i < c->mesh_count && r == AK_OK; ++i) {
         ob_mesh* om = &c->meshes[i];
@@ -610,8 +702,12 @@ static ak_result build_scene(ob_ctx* c, ak_scene** out_scene) {
         const ob_material* mat = om->material[0] ? find_material(c, om->material) : NULL;
         sm->has_material = mat != NULL;
         if (mat) sm->base_color = mat->color;
+        if (mat && !points && tex_of[mat - c->materials] >= 0 && s->textures[tex_of[mat - c->materials]].pixels &&
+            sm->mesh->uvs)
+            sm->texture = tex_of[mat - c->materials];
         if (points) break;
     }
+    akp_free(c->alloc, tex_of);
 done:
     akp_free(c->alloc, nodes);
     akp_free(c->alloc, joint_of_node);

@@ -62,6 +62,7 @@ typedef struct rtri {
     float a0[MAXA], da1[MAXA], da2[MAXA];
     float flat[4];
     int x0, x1, y0, y1;
+    bool minify; /* textured: more texels than samples over the triangle */
 } rtri;
 
 typedef struct drawctx drawctx;
@@ -105,6 +106,9 @@ struct drawctx {
     const ak_raster_lines* lines;
     const ak_raster_points* points;
     const cvert* quad;     /* ground: 4 corners */
+    const ak_raster_texture* tex; /* textured mesh: UVs are attributes uv_attr, uv_attr + 1 */
+    int uv_attr;
+    size_t tex_stride;
     float half_width_px;   /* lines: half width in samples; points: radius in samples */
     /* ground */
     ak_vec3 ground_lin, line_lin;
@@ -485,6 +489,15 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
         t->da2[k] = v[i2]->a[k] * iw[i2] - a0;
     }
     if (flat) memcpy(t->flat, flat, sizeof t->flat);
+    t->minify = false;
+    if (dc->tex) {
+        /* texels over the triangle (UV area x texture size) against the samples it covers */
+        const int ua = dc->uv_attr;
+        float du1 = v[1]->a[ua] - v[0]->a[ua], dv1 = v[1]->a[ua + 1] - v[0]->a[ua + 1];
+        float du2 = v[2]->a[ua] - v[0]->a[ua], dv2 = v[2]->a[ua + 1] - v[0]->a[ua + 1];
+        double texels = fabs((double)du1 * dv2 - (double)dv1 * du2) * dc->tex->image.width * dc->tex->image.height;
+        t->minify = texels > (double)area / ((double)SUBPIX * SUBPIX);
+    }
     if (sk->buf) ++sk->count;
     else raster_tri(dc, t, 0, 1);
 }
@@ -571,28 +584,115 @@ static inline float smoothstep(float e0, float e1, float x) {
     return t * t * (3.0f - 2.0f * t);
 }
 
+/* Attributes each fragment mode interpolates (a constant once the mode is). */
+static FORCE_INLINE int mode_attr_count(frag_mode mode) {
+    switch (mode) {
+    case FRAG_UNLIT_VCOLOR: return 4;
+    case FRAG_GOURAUD: return 4;
+    case FRAG_PHONG: return 6;
+    case FRAG_PHONG_VC: return 10;
+    case FRAG_POINT: return 2;
+    case FRAG_GROUND: return 3;
+    default: return 0;
+    }
+}
+
+/* ---- textures ------------------------------------------------------------------------------ */
+
+/* Reduce a texture coordinate to one period of its wrap mode, so that texel indices need no
+ * division: REPEAT -> [0, 1), MIRROR -> [0, 2) (the second half mirrored), CLAMP -> [0, 1].
+ * Non-finite -> 0; huge values keep their period only as far as float precision allows. */
+static inline float tex_period(float u, ak_raster_wrap w) {
+    if (!ak_finitef(u)) return 0.0f;
+    if (w == AK_RASTER_WRAP_CLAMP) return u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+    float p = w == AK_RASTER_WRAP_MIRROR ? 2.0f : 1.0f;
+    float f = u - p * floorf(u / p);
+    return f >= 0.0f && f < p ? f : 0.0f; /* rounding can give exactly p */
+}
+
+/* Texel index i (in [-1, 2n] after tex_period and the bilinear half-texel shift) of an axis of
+ * n texels, wrapped. */
+static inline int tex_index(int i, int n, ak_raster_wrap w) {
+    if (w == AK_RASTER_WRAP_CLAMP) return i < 0 ? 0 : (i >= n ? n - 1 : i);
+    if (w == AK_RASTER_WRAP_MIRROR) {
+        int p = 2 * n;
+        if (i < 0) i += p;
+        if (i >= p) i -= p;
+        return i < n ? i : p - 1 - i;
+    }
+    if (i < 0) return i + n;
+    return i >= n ? i - n : i;
+}
+
+/* The texel colour at (u, v): linear light (lit modes) or sRGB (unlit) in [0, 1], alpha in
+ * [0, 1]. Bilinear filtering weighs the 4 texels around the point. */
+static void tex_sample(const drawctx* dc, float u, float v, bool minify, bool linear, float out[4]) {
+    const ak_raster_texture* t = dc->tex;
+    const int w = t->image.width, h = t->image.height;
+    const uint8_t* px = t->image.pixels;
+    const size_t stride = dc->tex_stride;
+    ak_raster_filter f = minify ? t->min_filter : t->mag_filter;
+    const float* lut = dc->r->to_lin_lut;
+    const float x = tex_period(u, t->wrap_u) * (float)w, y = tex_period(v, t->wrap_v) * (float)h;
+    if (f == AK_RASTER_FILTER_NEAREST) {
+        int i = tex_index((int)x, w, t->wrap_u), j = tex_index((int)y, h, t->wrap_v);
+        const uint8_t* p = px + (size_t)j * stride + (size_t)i * 4u;
+        for (int k = 0; k < 3; ++k) out[k] = linear ? lut[p[k]] : (float)p[k] * (1.0f / 255.0f);
+        out[3] = (float)p[3] * (1.0f / 255.0f);
+        return;
+    }
+    const float xs = x - 0.5f, ys = y - 0.5f;
+    const float fx0 = floorf(xs), fy0 = floorf(ys);
+    const float fx = xs - fx0, fy = ys - fy0;
+    const int x0 = (int)fx0, y0 = (int)fy0;
+    const int i0 = tex_index(x0, w, t->wrap_u), i1 = tex_index(x0 + 1, w, t->wrap_u);
+    const int j0 = tex_index(y0, h, t->wrap_v), j1 = tex_index(y0 + 1, h, t->wrap_v);
+    const uint8_t* r0 = px + (size_t)j0 * stride;
+    const uint8_t* r1 = px + (size_t)j1 * stride;
+    const uint8_t* p[4] = {r0 + (size_t)i0 * 4u, r0 + (size_t)i1 * 4u, r1 + (size_t)i0 * 4u, r1 + (size_t)i1 * 4u};
+    const float wt[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
+    for (int k = 0; k < 4; ++k) out[k] = 0.0f;
+    if (linear) {
+        for (int q = 0; q < 4; ++q)
+            for (int k = 0; k < 3; ++k) out[k] += wt[q] * lut[p[q][k]];
+    } else {
+        for (int q = 0; q < 4; ++q)
+            for (int k = 0; k < 3; ++k) out[k] += wt[q] * (float)p[q][k] * (1.0f / 255.0f);
+    }
+    for (int q = 0; q < 4; ++q) out[3] += wt[q] * (float)p[q][3] * (1.0f / 255.0f);
+}
+
 /* Compute the fragment colour; returns false to discard. */
-static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri* t, const float* a, uint8_t out[4],
-                                  const uint8_t* dst) {
+static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, bool tex, const rtri* t, const float* a,
+                                  uint8_t out[4], const uint8_t* dst) {
     const ak_raster* r = dc->r;
+    float tx[4] = {1, 1, 1, 1};
+    if (tex) {
+        const int ua = mode_attr_count(mode);
+        tex_sample(dc, a[ua], a[ua + 1], t->minify, mode != FRAG_UNLIT_CONST && mode != FRAG_UNLIT_VCOLOR, tx);
+    }
     switch (mode) {
     case FRAG_UNLIT_CONST:
+        if (tex) {
+            for (int k = 0; k < 4; ++k) out[k] = (uint8_t)(dc->const_rgba[k] * tx[k] + 0.5f);
+            return true;
+        }
         for (int k = 0; k < 4; ++k) out[k] = (uint8_t)dc->const_rgba[k];
         return true;
     case FRAG_UNLIT_VCOLOR:
-        for (int k = 0; k < 4; ++k) out[k] = (uint8_t)(clamp01(a[k]) * 255.0f + 0.5f);
+        for (int k = 0; k < 4; ++k) out[k] = (uint8_t)(clamp01(a[k] * tx[k]) * 255.0f + 0.5f);
         return true;
     case FRAG_FLAT:
-        out[0] = enc(r, t->flat[0]);
-        out[1] = enc(r, t->flat[1]);
-        out[2] = enc(r, t->flat[2]);
-        out[3] = (uint8_t)(clamp01(t->flat[3]) * 255.0f + 0.5f);
+        out[0] = enc(r, t->flat[0] * tx[0]);
+        out[1] = enc(r, t->flat[1] * tx[1]);
+        out[2] = enc(r, t->flat[2] * tx[2]);
+        out[3] = (uint8_t)(clamp01(t->flat[3] * tx[3]) * 255.0f + 0.5f);
         return true;
     case FRAG_GOURAUD:
-        out[0] = enc(r, a[0]);
-        out[1] = enc(r, a[1]);
-        out[2] = enc(r, a[2]);
-        out[3] = (uint8_t)(clamp01(a[3]) * 255.0f + 0.5f);
+        out[0] = enc(r, a[0] * tx[0]);
+        out[1] = enc(r, a[1] * tx[1]);
+        out[2] = enc(r, a[2] * tx[2]);
+        out[3] = (uint8_t)(clamp01(a[3] * tx[3]) * 255.0f + 0.5f);
         return true;
     case FRAG_PHONG:
     case FRAG_PHONG_VC: {
@@ -602,6 +702,10 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri*
         if (mode == FRAG_PHONG_VC) {
             alb = ak_vec3_mul(alb, ak_vec3_make(a[6], a[7], a[8]));
             alpha *= a[9];
+        }
+        if (tex) {
+            alb = ak_vec3_mul(alb, ak_vec3_make(tx[0], tx[1], tx[2]));
+            alpha *= tx[3];
         }
         ak_vec3 c = shade(dc, n, ak_vec3_make(a[0], a[1], a[2]), alb);
         out[0] = enc(r, c.x);
@@ -670,23 +774,10 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, const rtri*
     return false;
 }
 
-/* Attributes each fragment mode interpolates (a constant once the mode is). */
-static FORCE_INLINE int mode_attr_count(frag_mode mode) {
-    switch (mode) {
-    case FRAG_UNLIT_VCOLOR: return 4;
-    case FRAG_GOURAUD: return 4;
-    case FRAG_PHONG: return 6;
-    case FRAG_PHONG_VC: return 10;
-    case FRAG_POINT: return 2;
-    case FRAG_GROUND: return 3;
-    default: return 0;
-    }
-}
-
-static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, const rtri* t, int thread_index,
-                                         int thread_count) {
+static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, bool tex, const rtri* t,
+                                         int thread_index, int thread_count) {
     ak_raster* r = dc->r;
-    const int na = mode_attr_count(mode);
+    const int na = mode_attr_count(mode) + (tex ? 2 : 0);
     for (int y = t->y0; y <= t->y1; ++y) {
         if (thread_count > 1) {
             int blk = y >> ROW_BLOCK_SHIFT;
@@ -721,22 +812,33 @@ static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, cons
             }
             uint8_t src[4];
             uint8_t* px = crow + (size_t)x * 4u;
-            if (!fragment(dc, mode, t, a, src, px)) continue;
+            if (!fragment(dc, mode, tex, t, a, src, px)) continue;
             write_px(dc, px, &zrow[x], z, src);
         }
     }
 }
 
 static void raster_tri(const drawctx* dc, const rtri* t, int ti, int tc) {
+    if (dc->tex) {
+        switch (dc->mode) {
+        case FRAG_UNLIT_CONST: raster_tri_mode(dc, FRAG_UNLIT_CONST, true, t, ti, tc); break;
+        case FRAG_UNLIT_VCOLOR: raster_tri_mode(dc, FRAG_UNLIT_VCOLOR, true, t, ti, tc); break;
+        case FRAG_FLAT: raster_tri_mode(dc, FRAG_FLAT, true, t, ti, tc); break;
+        case FRAG_GOURAUD: raster_tri_mode(dc, FRAG_GOURAUD, true, t, ti, tc); break;
+        case FRAG_PHONG: raster_tri_mode(dc, FRAG_PHONG, true, t, ti, tc); break;
+        default: raster_tri_mode(dc, FRAG_PHONG_VC, true, t, ti, tc); break;
+        }
+        return;
+    }
     switch (dc->mode) {
-    case FRAG_UNLIT_CONST: raster_tri_mode(dc, FRAG_UNLIT_CONST, t, ti, tc); break;
-    case FRAG_UNLIT_VCOLOR: raster_tri_mode(dc, FRAG_UNLIT_VCOLOR, t, ti, tc); break;
-    case FRAG_FLAT: raster_tri_mode(dc, FRAG_FLAT, t, ti, tc); break;
-    case FRAG_GOURAUD: raster_tri_mode(dc, FRAG_GOURAUD, t, ti, tc); break;
-    case FRAG_PHONG: raster_tri_mode(dc, FRAG_PHONG, t, ti, tc); break;
-    case FRAG_PHONG_VC: raster_tri_mode(dc, FRAG_PHONG_VC, t, ti, tc); break;
-    case FRAG_POINT: raster_tri_mode(dc, FRAG_POINT, t, ti, tc); break;
-    case FRAG_GROUND: raster_tri_mode(dc, FRAG_GROUND, t, ti, tc); break;
+    case FRAG_UNLIT_CONST: raster_tri_mode(dc, FRAG_UNLIT_CONST, false, t, ti, tc); break;
+    case FRAG_UNLIT_VCOLOR: raster_tri_mode(dc, FRAG_UNLIT_VCOLOR, false, t, ti, tc); break;
+    case FRAG_FLAT: raster_tri_mode(dc, FRAG_FLAT, false, t, ti, tc); break;
+    case FRAG_GOURAUD: raster_tri_mode(dc, FRAG_GOURAUD, false, t, ti, tc); break;
+    case FRAG_PHONG: raster_tri_mode(dc, FRAG_PHONG, false, t, ti, tc); break;
+    case FRAG_PHONG_VC: raster_tri_mode(dc, FRAG_PHONG_VC, false, t, ti, tc); break;
+    case FRAG_POINT: raster_tri_mode(dc, FRAG_POINT, false, t, ti, tc); break;
+    case FRAG_GROUND: raster_tri_mode(dc, FRAG_GROUND, false, t, ti, tc); break;
     }
 }
 
@@ -984,6 +1086,12 @@ static void mesh_setup(const drawctx* dc, size_t ti, sink* sk) {
     default:
         break;
     }
+    if (dc->tex)
+        for (int k = 0; k < 3; ++k) {
+            ak_vec2 uv = m->uvs.ptr[idx[k]];
+            v[k].a[dc->uv_attr] = ak_finitef(uv.x) ? uv.x : 0.0f;
+            v[k].a[dc->uv_attr + 1] = ak_finitef(uv.y) ? uv.y : 0.0f;
+        }
     clip_and_setup(dc, &v[0], &v[1], &v[2], flat, sk);
 }
 
@@ -1019,6 +1127,18 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
         return AK_ERR_BAD_ARG;
     if ((unsigned)mesh->shading > (unsigned)AK_SHADING_UNLIT || (unsigned)mesh->blend > (unsigned)AK_BLEND_ADD)
         return AK_ERR_BAD_ARG;
+    if (mesh->uvs.count && (mesh->uvs.count != mesh->positions.count || !mesh->uvs.ptr)) return AK_ERR_BAD_ARG;
+    const ak_raster_texture* tex = mesh->texture;
+    if (tex) {
+        const ak_image* ti = &tex->image;
+        if (!ti->pixels || ti->width <= 0 || ti->height <= 0 || (ti->stride && ti->stride < (size_t)ti->width * 4u) ||
+            (unsigned)tex->wrap_u > (unsigned)AK_RASTER_WRAP_MIRROR ||
+            (unsigned)tex->wrap_v > (unsigned)AK_RASTER_WRAP_MIRROR ||
+            (unsigned)tex->mag_filter > (unsigned)AK_RASTER_FILTER_NEAREST ||
+            (unsigned)tex->min_filter > (unsigned)AK_RASTER_FILTER_NEAREST)
+            return AK_ERR_BAD_ARG;
+        if (!mesh->uvs.count) tex = NULL;
+    }
     if (mesh->model && !ak_mat4_is_finite(mesh->model)) return AK_ERR_BAD_DATA;
     for (size_t i = 0; i < mesh->indices.count; ++i)
         if (mesh->indices.ptr[i] >= mesh->positions.count) return AK_ERR_BAD_INDEX;
@@ -1053,6 +1173,12 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
         dc.mode = dc.has_vcolor ? FRAG_PHONG_VC : FRAG_PHONG;
         dc.attr_count = mode_attr_count(dc.mode);
         break;
+    }
+    if (tex) {
+        dc.tex = tex;
+        dc.tex_stride = tex->image.stride ? tex->image.stride : (size_t)tex->image.width * 4u;
+        dc.uv_attr = mode_attr_count(dc.mode);
+        dc.attr_count = dc.uv_attr + 2;
     }
     dc.setup = mesh_setup;
     dc.input_count = mesh->indices.count ? mesh->indices.count / 3 : mesh->positions.count / 3;

@@ -1,5 +1,5 @@
-/* libFuzzer target for the boids scene reader (tools/animkit/scene_boids.c); built and run by
- * scripts/fuzz.sh with the CLI objects linked in.
+/* libFuzzer target for the boids scene reader (ak_boids_scene_load_bytes, src/boids/scene.c);
+ * built and run by scripts/fuzz.sh.
  *
  * Each input is parsed from memory. A parse error must come with a message naming the file.
  * A parsed scene with at most 256 agents (or, without agents, up to 64 placed at random) is
@@ -10,11 +10,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../../tools/animkit/scene_boids.h"
+#include <animkit/boids.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
-static void run(const cli_boids_scene* sc) {
+static void run(const ak_boids_scene* sc) {
     size_t n = sc->agent_count ? sc->agent_count : (sc->count < 64 ? sc->count : 64);
     if (n == 0 || n > 256) return;
     ak_vec3* buf = calloc(7 * n, sizeof(ak_vec3));
@@ -59,11 +59,11 @@ static void run(const cli_boids_scene* sc) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    cli_boids_scene sc;
-    cli_boids_scene_defaults(&sc);
-    char msg[600];
-    if (cli_boids_scene_parse("fuzz.json", (const char*)data, size, &sc, msg, sizeof msg) == 0) run(&sc);
-    else if (strncmp(msg, "fuzz.json", 9) != 0) abort();
-    cli_boids_scene_free(&sc);
+    ak_boids_scene sc;
+    ak_boids_scene_defaults(&sc);
+    ak_diag diag;
+    if (ak_boids_scene_load_bytes(data, size, "fuzz.json", &sc, &diag) == AK_OK) run(&sc);
+    else if (strncmp(diag.message, "fuzz.json", 9) != 0 || strchr(diag.message, '\n')) abort();
+    ak_boids_scene_free(&sc);
     return 0;
 }

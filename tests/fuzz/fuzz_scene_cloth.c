@@ -1,5 +1,5 @@
-/* libFuzzer harness for the cloth scene reader (tools/animkit/scene_cloth.c) and the cloth
- * module behind it (built by scripts/fuzz.sh with the library and the CLI sources).
+/* libFuzzer harness for the cloth scene reader (ak_cloth_scene_load_bytes, src/cloth/scene.c) and
+ * the cloth module behind it (built by scripts/fuzz.sh with the library).
  *
  * Each input is parsed as a scene file. A parsed scene must hold its documented invariants
  * (pins inside the grid, positive step); when its grid is small it is built into a cloth and
@@ -11,15 +11,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../../tools/animkit/scene_cloth.h"
+#include <animkit/cloth.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    cloth_scene s;
-    char msg[600];
-    if (!cloth_scene_parse("fuzz.json", (const char*)data, size, &s, msg, sizeof msg)) {
-        if (msg[0] == '\0') abort(); /* a failure always says why */
+    ak_cloth_scene s;
+    ak_diag diag;
+    if (ak_cloth_scene_load_bytes(data, size, "fuzz.json", &s, &diag) != AK_OK) {
+        if (strncmp(diag.message, "fuzz.json", 9) != 0 || strchr(diag.message, '\n')) abort(); /* says why */
         return 0;
     }
     const size_t n = (size_t)s.desc.grid_width * s.desc.grid_height;
@@ -59,6 +59,6 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     ak_cloth_destroy(cloth);
     free(att);
-    cloth_scene_free(&s);
+    ak_cloth_scene_free(&s);
     return 0;
 }

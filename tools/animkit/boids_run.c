@@ -5,94 +5,22 @@
 
 #include "boids_run.h"
 
-int boids_run_init(boids_run* st, const cli_boids_scene* sc, const char* cmd, const char* file, uint32_t threads,
+int boids_run_init(boids_run* r, const ak_boids_scene* sc, const char* cmd, const char* file, uint32_t threads,
                    bool naive) {
-    memset(st, 0, sizeof *st);
-    st->n = sc->agent_count > 0 ? sc->agent_count : sc->count;
-    if (sc->params.has_leader && sc->params.leader_index >= st->n)
-        return cli_fail(cmd, "%s: leader.index: %u is not below the %zu agents", file, sc->params.leader_index, st->n);
-    st->p = malloc(st->n * sizeof(ak_vec3));
-    st->v = malloc(st->n * sizeof(ak_vec3));
-    st->p2 = malloc(st->n * sizeof(ak_vec3));
-    st->v2 = malloc(st->n * sizeof(ak_vec3));
-    st->w = calloc(st->n, sizeof(ak_vec3));
-    st->s = calloc(st->n, 1);
-    if (!st->p || !st->v || !st->p2 || !st->v2 || !st->w || !st->s)
-        return cli_fail(cmd, "out of memory for %zu agents", st->n);
-    const ak_boids_params* prm = &sc->params;
-    if (sc->agent_count > 0) {
-        memcpy(st->p, sc->positions, st->n * sizeof(ak_vec3));
-        memcpy(st->v, sc->velocities, st->n * sizeof(ak_vec3));
-        memcpy(st->s, sc->agent_species, st->n);
-    } else {
-        ak_rng r = ak_rng_make((uint64_t)sc->seed);
-        const ak_vec3 lo = prm->bounds_min, hi = prm->bounds_max;
-        size_t used = 0;
-        for (uint32_t k = 1; k < prm->species_count; ++k) {
-            size_t c = (size_t)((double)sc->fraction[k] * (double)st->n + 0.5);
-            if (c > st->n - used) c = st->n - used;
-            for (size_t i = st->n - used - c; i < st->n - used; ++i) st->s[i] = (uint8_t)k;
-            used += c;
-        }
-        for (size_t i = 0; i < st->n; ++i) {
-            st->p[i] = ak_vec3_make(ak_rng_range(&r, lo.x, hi.x), prm->planar ? 0.0f : ak_rng_range(&r, lo.y, hi.y),
-                                    ak_rng_range(&r, lo.z, hi.z));
-            ak_vec3 d = ak_vec3_make(ak_rng_range(&r, -1, 1), prm->planar ? 0.0f : ak_rng_range(&r, -1, 1),
-                                     ak_rng_range(&r, -1, 1));
-            const float sp = sc->species[st->s[i]].max_speed;
-            st->v[i] = ak_vec3_scale(ak_vec3_normalize(d), 0.5f * sp);
-        }
-    }
-    if (prm->planar)
-        for (size_t i = 0; i < st->n; ++i) st->v[i].y = 0.0f;
-
-    st->job = (ak_boids_step_job){.params = prm, .positions = {st->p, st->n}, .velocities = {st->v, st->n},
-                                  .species = {st->s, st->n}, .wander = {st->w, st->n}, .dt = sc->dt,
-                                  .seed = (uint64_t)sc->seed, .thread_count = threads, .use_naive = naive,
-                                  .out_positions = {st->p2, st->n}, .out_velocities = {st->v2, st->n}};
-    st->scratch_size = ak_boids_step_scratch_size(&st->job);
-    st->scratch = st->scratch_size ? malloc(st->scratch_size) : NULL;
-    st->job.scratch = (ak_u8_span){st->scratch, st->scratch_size};
-    ak_result res = ak_boids_step_validate(&st->job);
-    if (res != AK_OK) return cli_fail(cmd, "%s: %s", file, ak_result_string(res));
+    ak_diag diag;
+    ak_boids_scene_run_desc d = {.name = file, .thread_count = threads, .naive = naive};
+    if (ak_boids_scene_run_init(r, sc, &d, &diag) != AK_OK) return cli_fail(cmd, "%s", diag.message);
     return CLI_OK;
 }
 
-ak_result boids_run_step(boids_run* st, long step) {
-    ak_boids_step_job* job = &st->job;
-    job->step_index = (uint64_t)step;
-    job->positions.ptr = st->p;
-    job->velocities.ptr = st->v;
-    job->out_positions.ptr = st->p2;
-    job->out_velocities.ptr = st->v2;
-    ak_result res = ak_boids_step_run(job);
-    ak_vec3* t = st->p;
-    st->p = st->p2;
-    st->p2 = t;
-    t = st->v;
-    st->v = st->v2;
-    st->v2 = t;
-    return res;
+ak_result boids_run_step(boids_run* r, long step) {
+    r->step_index = step;
+    return ak_boids_scene_run_step(r);
 }
 
-const char* boids_run_error(ak_result res) {
-    if (res == AK_ERR_BUDGET)
-        return "the agents are packed too densely: the grid's cell load (sum over cells of agents^2) is above the "
-               "work budget of 2e7 (a quadratic step); spread them out (a larger bounds box, fewer agents) or "
-               "lower the rule radii";
-    return ak_result_string(res);
-}
+const char* boids_run_error(ak_result res) { return ak_boids_scene_run_error(res); }
 
-void boids_run_free(boids_run* r) {
-    free(r->p);
-    free(r->v);
-    free(r->p2);
-    free(r->v2);
-    free(r->w);
-    free(r->s);
-    free(r->scratch);
-    memset(r, 0, sizeof *r);
-}
+void boids_run_free(boids_run* r) { ak_boids_scene_run_free(r); }
 
 /* ---- shapes ------------------------------------------------------------------------------- */
 
@@ -182,7 +110,7 @@ bool boids_shapes_obstacles(boids_shapes* r, const ak_boids_params* prm, float p
     return true;
 }
 
-bool boids_shapes_init(boids_shapes* r, const cli_boids_scene* sc, size_t n, float plane_size) {
+bool boids_shapes_init(boids_shapes* r, const ak_boids_scene* sc, size_t n, float plane_size) {
     memset(r, 0, sizeof *r);
     r->pos = malloc((n * 5 + 1) * sizeof(ak_vec3));
     r->col = malloc((n * 5 + 1) * sizeof(ak_vec4));
@@ -208,11 +136,11 @@ void boids_shapes_free(boids_shapes* r) {
     memset(r, 0, sizeof *r);
 }
 
-void boids_shapes_update(boids_shapes* r, const cli_boids_scene* sc, const boids_run* st, float time, ak_raster_mesh* out_birds,
+void boids_shapes_update(boids_shapes* r, const ak_boids_scene* sc, const boids_run* st, float time, ak_raster_mesh* out_birds,
                          ak_raster_mesh* out_obstacles) {
     const float L = sc->shape_size;
-    for (size_t i = 0; i < st->n; ++i) {
-        ak_vec3 f = ak_vec3_normalize(st->v[i]);
+    for (size_t i = 0; i < st->agent_count; ++i) {
+        ak_vec3 f = ak_vec3_normalize(st->velocities[i]);
         if (ak_vec3_length_sq(f) < 0.5f) f = ak_vec3_make(0, 0, 1);
         ak_vec3 right = ak_vec3_normalize(ak_vec3_cross(f, ak_vec3_make(0, 1, 0)));
         if (ak_vec3_length_sq(right) < 0.5f) right = ak_vec3_make(1, 0, 0);
@@ -222,7 +150,7 @@ void boids_shapes_update(boids_shapes* r, const cli_boids_scene* sc, const boids
         float beat = 0.0f;
         ak_clip_sample(r->beat, ak_time_wrap(time + phase * period, period, AK_WRAP_LOOP), NULL,
                        (ak_transform_span){NULL, 0}, (ak_f32_span){NULL, 0}, (ak_f32_span){&beat, 1});
-        const ak_vec3 p = st->p[i];
+        const ak_vec3 p = st->positions[i];
         ak_vec3* q = r->pos + 5 * i;
         if (sc->shape == 0) {
             q[0] = ak_vec3_madd(p, f, 0.5f * L);                                       /* beak */
@@ -238,11 +166,11 @@ void boids_shapes_update(boids_shapes* r, const cli_boids_scene* sc, const boids
             q[3] = ak_vec3_madd(p, right, 0.08f * L);
             q[4] = ak_vec3_madd(p, up, 0.18f * L);
         }
-        const ak_vec4 c = sc->color[st->s[i]];
+        const ak_vec4 c = sc->color[st->species[i]];
         for (int k = 0; k < 5; ++k) r->col[5 * i + (size_t)k] = c;
     }
-    *out_birds = (ak_raster_mesh){.positions = {r->pos, 5 * st->n}, .colors = {r->col, 5 * st->n},
-                            .indices = {r->idx, 12 * st->n}, .shading = AK_SHADING_FLAT,
+    *out_birds = (ak_raster_mesh){.positions = {r->pos, 5 * st->agent_count}, .colors = {r->col, 5 * st->agent_count},
+                            .indices = {r->idx, 12 * st->agent_count}, .shading = AK_SHADING_FLAT,
                             .material = {.color = {1, 1, 1, 1}, .specular = -1}};
     *out_obstacles = (ak_raster_mesh){.positions = {r->opos, r->overt}, .indices = {r->oidx, 3 * r->otri},
                           .material = {.color = {0.62f, 0.64f, 0.68f, 1}}};

@@ -5,23 +5,16 @@
 #define ANIMKIT_CLI_BOIDS_RUN_H
 
 #include "cli.h"
-#include "scene_boids.h"
+#include <animkit/boids.h>
 
-/* The agents (double-buffered) and the step job over them. */
-typedef struct boids_run {
-    size_t n;
-    ak_vec3 *p, *v, *p2, *v2, *w;
-    uint8_t* s;
-    uint8_t* scratch;
-    size_t scratch_size;
-    ak_boids_step_job job; /* points into sc->params and the arrays above */
-} boids_run;
+/* The library's run of a scene (ak_boids_scene_run, animkit/boids.h). */
+typedef ak_boids_scene_run boids_run;
 
 /* Place the scene's agents ("agents", or count at random in the bounds from the seed) and
  * validate the step job (naive: the O(N^2) neighbour search instead of the grid; the same
  * results, bit for bit). Returns an exit code with the message printed as `animkit CMD:`
  * naming file; free with boids_run_free in every case. */
-int boids_run_init(boids_run* r, const cli_boids_scene* sc, const char* cmd, const char* file, uint32_t threads,
+int boids_run_init(boids_run* r, const ak_boids_scene* sc, const char* cmd, const char* file, uint32_t threads,
                    bool naive);
 /* Step number `step` (0-based; the wander noise depends on it). */
 ak_result boids_run_step(boids_run* r, long step);
@@ -44,11 +37,11 @@ typedef struct boids_shapes {
 bool boids_is_floor(const ak_boids_obstacle* o);
 /* Allocate for n agents and build the obstacles (planes as slabs plane_size across); false
  * when out of memory (free it anyway). */
-bool boids_shapes_init(boids_shapes* r, const cli_boids_scene* sc, size_t n, float plane_size);
+bool boids_shapes_init(boids_shapes* r, const ak_boids_scene* sc, size_t n, float plane_size);
 /* Rebuild the obstacle triangles (after an obstacle moved); false when out of memory. */
 bool boids_shapes_obstacles(boids_shapes* r, const ak_boids_params* prm, float plane_size);
 /* Pose every agent at `time` (each at its own beat phase) and give the two meshes. */
-void boids_shapes_update(boids_shapes* r, const cli_boids_scene* sc, const boids_run* st, float time, ak_raster_mesh* out_birds,
+void boids_shapes_update(boids_shapes* r, const ak_boids_scene* sc, const boids_run* st, float time, ak_raster_mesh* out_birds,
                          ak_raster_mesh* out_obstacles);
 void boids_shapes_free(boids_shapes* r);
 

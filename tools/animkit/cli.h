@@ -195,7 +195,9 @@ int cmd_particles(int argc, char** argv);
 int cmd_boids(int argc, char** argv);
 int cmd_view(int argc, char** argv);
 int cmd_cloth(int argc, char** argv);
+int cmd_rigid(int argc, char** argv);
 int cmd_retarget(int argc, char** argv);
 int cmd_fluid(int argc, char** argv);
+int cmd_batch(int argc, char** argv);
 
 #endif

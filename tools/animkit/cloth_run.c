@@ -80,79 +80,35 @@ static int character_bones(cloth_character* c, float scale) {
     return CLI_OK;
 }
 
-int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char* name) {
+/* The library's message ("NAME: problem") after "animkit CMD: ". */
+static int fail_diag(const char* cmd, const ak_diag* d) { return cli_fail(cmd, "%s", d->message); }
+
+/* Mirror the library run's arrays into the command's names. */
+static void mirror(cloth_run* run) {
+    run->cloth = run->lib.cloth;
+    run->x = run->lib.positions, run->vel = run->lib.velocities, run->nrm = run->lib.normals;
+    run->targets = run->lib.targets, run->caps = run->lib.capsules;
+    run->n = run->lib.vertex_count;
+    run->step = run->lib.step_index, run->time = run->lib.time;
+}
+
+int cloth_run_init(cloth_run* run, ak_cloth_scene* sc, const char* cmd, const char* name) {
     memset(run, 0, sizeof *run);
     run->sc = sc;
     cloth_character* ch = &run->ch;
-    int rc = CLI_OK;
     ak_result r = AK_OK;
-    ak_cloth* cloth = NULL;
-    ak_vec3 *x = NULL, *vel = NULL, *nrm = NULL, *targets = NULL, *res = NULL;
-    uint8_t* scratch = NULL;
-    uint32_t* attach_idx = NULL;
-    ak_cloth_capsule* caps = NULL;
-    size_t n = 0, scratch_size = 0;
-    ak_cloth_step_job job;
-    memset(&job, 0, sizeof job);
 
-    /* the cloth */
-    if (sc->attach_count) {
-        attach_idx = calloc(sc->attach_count, sizeof(uint32_t));
-        if (!attach_idx) {
-            rc = cli_fail(cmd, "out of memory");
-            goto done;
-        }
-        for (size_t k = 0; k < sc->attach_count; ++k) attach_idx[k] = sc->attach[k].vertex;
-        sc->desc.attachments = (ak_u32_cspan){attach_idx, sc->attach_count};
-    }
-    r = ak_cloth_create(&sc->desc, NULL, &cloth);
-    if (r != AK_OK) {
-        rc = cli_fail(cmd, "%s: the cloth cannot be built: %s", name, ak_result_string(r));
-        goto done;
-    }
-    /* the spring solver is stable only below a substep it computes (ak_cloth_stable_substep):
-     * run at least dt / (0.9 h) substeps unless --substeps says otherwise */
-    if (sc->desc.solver == AK_CLOTH_SPRINGS) {
-        const double h = ak_cloth_stable_substep(cloth);
-        const double need = ceil((double)sc->dt / (0.9 * h));
-        if (isfinite(need) && need > (double)sc->substeps && !sc->substeps_forced) {
-            fprintf(stderr, "%s: mass-spring is stable below h = %.4g ms (the stiffest springs on the lightest particle, "
-                            "docs/cloth.md): %.0f substeps per step instead of %u\n",
-                    cmd, 1e3 * h, need, sc->substeps);
-            if (need > 10000.0) {
-                rc = cli_fail(cmd, "%s: the spring solver needs %.0f substeps per step (over 10000): lower dt or the "
-                                   "stiffness, or use --solver implicit or xpbd", name, need);
-                goto done;
-            }
-            sc->substeps = (uint32_t)need;
-        }
-    }
-    n = ak_cloth_vertex_count(cloth);
-    x = malloc(n * sizeof(ak_vec3));
-    vel = calloc(n, sizeof(ak_vec3));
-    nrm = malloc(n * sizeof(ak_vec3));
-    res = calloc(n, sizeof(ak_vec3));
-    targets = calloc(sc->attach_count + 1, sizeof(ak_vec3));
-    if (!x || !vel || !nrm || !targets || !res) {
-        rc = cli_fail(cmd, "out of memory");
-        goto done;
-    }
-    ak_cloth_rest_positions(cloth, (ak_vec3_span){x, n});
-
-    /* the character */
+    /* the character, posed at t = 0 (the library builds the cloth around its mesh and capsules) */
     if (sc->model[0]) {
-        if ((rc = cli_load_scene(cmd, sc->model, &ch->scene))) goto done;
+        int rc;
+        if ((rc = cli_load_scene(cmd, sc->model, &ch->scene))) return rc;
         if (cli_poser_init(&ch->poser, ch->scene)) {
             ak_scene_destroy(ch->scene);
             ch->scene = NULL;
-            rc = cli_fail(cmd, "out of memory");
-            goto done;
+            return cli_fail(cmd, "out of memory");
         }
         ch->clip = ch->scene->clip_count ? ak_scene_find_clip(ch->scene, sc->clip[0] ? sc->clip : NULL) : -1;
-        if (sc->clip[0] && ch->clip < 0) {
-            rc = cli_fail(cmd, "%s: character.clip: no clip '%s' in %s", name, sc->clip, sc->model);
-            goto done;
-        }
+        if (sc->clip[0] && ch->clip < 0) return cli_fail(cmd, "%s: character.clip: no clip '%s' in %s", name, sc->clip, sc->model);
         ch->duration = ch->clip >= 0 ? ak_clip_duration(ch->scene->clips[ch->clip]) : 0.0f;
         for (size_t m = 0; m < ch->scene->mesh_count; ++m)
             if (ch->scene->meshes[m].mesh) {
@@ -163,10 +119,7 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
         ch->mesh_idx = calloc(ch->mesh_tris * 3 + 1, sizeof(uint32_t));
         ch->attach_joint = calloc(sc->attach_count + 1, sizeof(int));
         ch->attach_offset = calloc(sc->attach_count + 1, sizeof(ak_vec3));
-        if (!ch->mesh_pos || !ch->mesh_idx || !ch->attach_joint || !ch->attach_offset) {
-            rc = cli_fail(cmd, "out of memory");
-            goto done;
-        }
+        if (!ch->mesh_pos || !ch->mesh_idx || !ch->attach_joint || !ch->attach_offset) return cli_fail(cmd, "out of memory");
         for (size_t m = 0, vo = 0, to = 0; m < ch->scene->mesh_count; ++m) {
             const ak_mesh* mesh = ch->scene->meshes[m].mesh;
             if (!mesh) continue;
@@ -174,89 +127,52 @@ int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char*
             vo += mesh->vertex_count;
             to += mesh->triangle_count * 3;
         }
-        if (sc->limb_capsules && character_bones(ch, sc->capsule_scale)) {
-            rc = cli_fail(cmd, "out of memory");
-            goto done;
-        }
-        if ((r = character_pose(ch, 0.0f)) != AK_OK) {
-            rc = cli_fail(cmd, "%s: cannot pose %s: %s", name, sc->model, ak_result_string(r));
-            goto done;
-        }
-        /* attachments keep their offset from the joint or skinned vertex at t = 0, from their
-         * given start position or else their rest position */
-        for (size_t k = 0; k < sc->attach_count; ++k) {
-            const cloth_attach_spec* at = &sc->attach[k];
-            if (at->has_position) x[at->vertex] = at->position;
-            const ak_vec3 p = x[at->vertex];
-            char path[40];
-            snprintf(path, sizeof path, "attachments[%zu]", k);
-            if (at->joint[0]) {
-                const int j = ch->scene->skeleton ? ak_skeleton_find_joint(ch->scene->skeleton, at->joint) : -1;
-                if (j < 0) {
-                    rc = cli_fail(cmd, "%s: %s.joint: no joint '%s' in %s", name, path, at->joint, sc->model);
-                    goto done;
-                }
-                ch->attach_joint[k] = j;
-                ch->attach_offset[k] = ak_mat4_transform_point(ak_mat4_inverse(ch->poser.world[j]), p);
-            } else {
-                if ((size_t)at->mesh_vertex >= ch->mesh_vertices) {
-                    rc = cli_fail(cmd, "%s: %s.mesh_vertex: %ld is out of range (%s has %zu vertices)", name, path,
-                                  at->mesh_vertex, sc->model, ch->mesh_vertices);
-                    goto done;
-                }
-                ch->attach_joint[k] = -1;
-                ch->attach_offset[k] = ak_vec3_sub(p, ch->mesh_pos[at->mesh_vertex]);
-            }
-        }
+        if (sc->limb_capsules && character_bones(ch, sc->capsule_scale)) return cli_fail(cmd, "out of memory");
+        if ((r = character_pose(ch, 0.0f)) != AK_OK)
+            return cli_fail(cmd, "%s: cannot pose %s: %s", name, sc->model, ak_result_string(r));
     }
-    caps = calloc(sc->capsule_count + ch->bone_count + 1, sizeof(ak_cloth_capsule));
-    if (!caps) {
-        rc = cli_fail(cmd, "out of memory");
-        goto done;
-    }
-    if (sc->capsule_count) memcpy(caps, sc->capsules, sc->capsule_count * sizeof(ak_cloth_capsule));
 
-    job = (ak_cloth_step_job){
-        .cloth = cloth, .dt = sc->dt, .substeps = sc->substeps,
-        /* implicit: the scene's iterations cap CG only when given (else the library's 200) */
-        .iterations = sc->desc.solver == AK_CLOTH_IMPLICIT && !sc->iterations_given ? 0 : sc->iterations,
-        .gravity = sc->gravity,
-        .drag = sc->drag, .lift = sc->lift, .air_density = sc->air_density, .damping = sc->damping,
-        .planes = sc->planes, .plane_count = sc->plane_count, .spheres = sc->spheres, .sphere_count = sc->sphere_count,
-        .capsules = caps, .capsule_count = sc->capsule_count + ch->bone_count,
-        .thickness = sc->thickness, .friction = sc->friction, .self_collision = sc->self_collision,
-        .self_distance = sc->self_distance,
-        .attachment_targets = {targets, sc->attach_count}, .thread_count = (uint32_t)sc->thread_count,
-        .positions = {x, n}, .velocities = {vel, n}, .position_residuals = {res, n}, .out_normals = {nrm, n},
-    };
+    /* the cloth and its step job */
+    ak_cloth_scene_run_desc d = {.name = name, .extra_capsule_count = ch->bone_count};
     if (ch->scene && sc->mesh_collider && ch->mesh_tris)
-        job.mesh = (ak_cloth_collider_mesh){{ch->mesh_pos, ch->mesh_vertices}, {ch->mesh_idx, ch->mesh_tris * 3}};
-    scratch_size = ak_cloth_step_scratch_size(&job);
-    scratch = malloc(scratch_size);
-    if (!scratch) {
-        rc = cli_fail(cmd, "out of memory");
-        goto done;
+        d.mesh = (ak_cloth_collider_mesh){{ch->mesh_pos, ch->mesh_vertices}, {ch->mesh_idx, ch->mesh_tris * 3}};
+    ak_diag diag;
+    r = ak_cloth_scene_run_init(&run->lib, sc, &d, &diag);
+    if (run->lib.stable_substep > 0.0)
+        fprintf(stderr, "%s: mass-spring is stable below h = %.4g ms (the stiffest springs on the lightest particle, "
+                        "docs/cloth.md): %.0f substeps per step instead of %u\n",
+                cmd, 1e3 * run->lib.stable_substep, run->lib.substeps_needed, run->lib.substeps_given);
+    mirror(run);
+    if (r != AK_OK) return fail_diag(cmd, &diag);
+
+    /* attachments keep their offset from the joint or skinned vertex at t = 0, from their given
+     * start position (the library put them there) or else their rest position */
+    for (size_t k = 0; ch->scene && k < sc->attach_count; ++k) {
+        const ak_cloth_attach_spec* at = &sc->attach[k];
+        const ak_vec3 p = run->x[at->vertex];
+        char path[40];
+        snprintf(path, sizeof path, "attachments[%zu]", k);
+        if (at->joint[0]) {
+            const int j = ch->scene->skeleton ? ak_skeleton_find_joint(ch->scene->skeleton, at->joint) : -1;
+            if (j < 0) return cli_fail(cmd, "%s: %s.joint: no joint '%s' in %s", name, path, at->joint, sc->model);
+            ch->attach_joint[k] = j;
+            ch->attach_offset[k] = ak_mat4_transform_point(ak_mat4_inverse(ch->poser.world[j]), p);
+        } else {
+            if ((size_t)at->mesh_vertex >= ch->mesh_vertices)
+                return cli_fail(cmd, "%s: %s.mesh_vertex: %ld is out of range (%s has %zu vertices)", name, path,
+                                at->mesh_vertex, sc->model, ch->mesh_vertices);
+            ch->attach_joint[k] = -1;
+            ch->attach_offset[k] = ak_vec3_sub(p, ch->mesh_pos[at->mesh_vertex]);
+        }
     }
-    job.scratch = (ak_u8_span){scratch, scratch_size};
-    ak_cloth_normals(cloth, (ak_vec3_cspan){x, n}, (ak_vec3_span){nrm, n});
-
-
-done:
-    run->cloth = cloth;
-    run->x = x, run->vel = vel, run->nrm = nrm, run->targets = targets, run->res = res;
-    run->scratch = scratch, run->attach_idx = attach_idx, run->caps = caps;
-    run->n = n;
-    run->job = job;
-    return rc;
+    return CLI_OK;
 }
 
 int cloth_run_step(cloth_run* run, const char* cmd, const char* name) {
-    const cloth_scene* sc = run->sc;
+    const ak_cloth_scene* sc = run->sc;
     cloth_character* ch = &run->ch;
-    const long step = run->step;
-    const float time = run->time;
     /* the character and the attachment targets at the end of this step */
-    const float t_end = (float)(step + 1) * sc->dt;
+    const float t_end = (float)(run->lib.step_index + 1) * sc->dt;
     if (ch->scene) {
         ak_result r;
         if ((r = character_pose(ch, t_end)) != AK_OK) {
@@ -271,23 +187,14 @@ int cloth_run_step(cloth_run* run, const char* cmd, const char* name) {
                                                             ak_mat4_get_translation(ch->poser.world[ch->bone_child[k]]),
                                                             ch->bone_radius[k]};
     }
-    const float gust = 1.0f + sc->gust * sinf(2.0f * AK_PI * sc->gust_frequency * time);
-    run->job.wind = ak_vec3_scale(sc->wind, gust);
-    ak_result r = ak_cloth_step_run(&run->job);
-    if (r == AK_ERR_NO_CONVERGENCE) {
-        return cli_fail(cmd, "%s: blow-up: the state became non-finite at step %ld (t = %.4g s); try a smaller --dt "
-                               "or more --substeps", name, step + 1, (double)t_end);
-    }
-    if (r != AK_OK) {
-        return cli_fail(cmd, "%s: step %ld: %s", name, step + 1, ak_result_string(r));
-    }
-    run->time = t_end;
-    run->step = step + 1;
-    return CLI_OK;
+    ak_diag diag;
+    const ak_result r = ak_cloth_scene_run_step(&run->lib, name, &diag);
+    mirror(run);
+    return r == AK_OK ? CLI_OK : fail_diag(cmd, &diag);
 }
 
 void cloth_run_bounds(const cloth_run* run, ak_vec3* out_lo, ak_vec3* out_hi) {
-    const cloth_scene* sc = run->sc;
+    const ak_cloth_scene* sc = run->sc;
     ak_vec3 lo, hi;
     ak_points_bounds((ak_vec3_cspan){run->x, run->n}, &lo, &hi);
     for (size_t k = 0; k < sc->sphere_count; ++k) {
@@ -310,8 +217,7 @@ void cloth_run_bounds(const cloth_run* run, ak_vec3* out_lo, ak_vec3* out_hi) {
 
 void cloth_run_free(cloth_run* run) {
     cloth_character_free(&run->ch);
-    free(run->x), free(run->res), free(run->vel), free(run->nrm), free(run->targets), free(run->scratch), free(run->attach_idx), free(run->caps);
-    ak_cloth_destroy(run->cloth);
+    ak_cloth_scene_run_free(&run->lib);
     memset(run, 0, sizeof *run);
 }
 

@@ -6,7 +6,7 @@
 
 #include "cli.h"
 #include "render.h"
-#include "scene_cloth.h"
+#include <animkit/cloth.h>
 
 /* The character: pose, attachments, colliders. */
 typedef struct cloth_character {
@@ -28,26 +28,24 @@ typedef struct cloth_character {
 
 void cloth_character_free(cloth_character* c);
 
-/* A cloth built from a scene (which it points to), its state and its step job. */
+/* A cloth built from a scene (which it points to) by the library's run, with the character. */
 typedef struct cloth_run {
-    cloth_scene* sc;
+    ak_cloth_scene_run lib;           /* the cloth, its state and its step job */
+    ak_cloth_scene* sc;
     cloth_character ch;
+    /* lib's, under the command's names (refreshed by init and step) */
     ak_cloth* cloth;
     ak_vec3 *x, *vel, *nrm, *targets; /* [n], [n], [n], [attach_count] */
-    ak_vec3* res;                     /* [n] position residuals (the step's extra precision) */
-    uint8_t* scratch;
-    uint32_t* attach_idx;
-    ak_cloth_capsule* caps; /* the scene's capsules, then the limb capsules */
+    ak_cloth_capsule* caps;           /* the scene's capsules, then the limb capsules */
     size_t n;
-    ak_cloth_step_job job;  /* points into the above and sc (spheres, planes) */
-    long step;              /* steps run */
-    float time;             /* simulated seconds */
+    long step;                        /* steps run */
+    float time;                       /* simulated seconds */
 } cloth_run;
 
 /* Build the cloth, load and pose the character (attachments keep their offsets at t = 0),
  * and the step job. Returns an exit code with the message printed as `animkit CMD:` naming
  * name; free with cloth_run_free in every case. */
-int cloth_run_init(cloth_run* run, cloth_scene* sc, const char* cmd, const char* name);
+int cloth_run_init(cloth_run* run, ak_cloth_scene* sc, const char* cmd, const char* name);
 /* One step: pose the character and the attachment targets at its end, gusty wind, step.
  * Returns an exit code (a blow-up names its step). */
 int cloth_run_step(cloth_run* run, const char* cmd, const char* name);

@@ -4,10 +4,8 @@
 #include <string.h>
 
 #include "cli.h"
-#include "cli_json.h"
 #include "boids_run.h"
 #include "outfile.h"
-#include "scene_boids.h"
 
 static const char* const usage =
     "usage: animkit boids [SCENE.json | --preset flock|obstacles|predator] [--count N] [--steps S] [--dt DT]\n"
@@ -43,7 +41,7 @@ typedef struct renderer {
     uint8_t* pixels;
 } renderer;
 
-static int renderer_init(renderer* r, int w, int h, const cli_boids_scene* sc, size_t n) {
+static int renderer_init(renderer* r, int w, int h, const ak_boids_scene* sc, size_t n) {
     memset(r, 0, sizeof *r);
     r->w = w;
     r->h = h;
@@ -74,7 +72,7 @@ static void renderer_free(renderer* r) {
 
 /* One frame: every agent a small bird (a body and two wings that flap) or fish (a body whose
  * tail sways), aligned with its velocity, animated by the beat clip at the agent's own phase. */
-static ak_result draw_frame(renderer* r, const cli_boids_scene* sc, const boids_run* st, float time, ak_image* out) {
+static ak_result draw_frame(renderer* r, const ak_boids_scene* sc, const boids_run* st, float time, ak_image* out) {
     ak_raster_mesh birds, obs;
     boids_shapes_update(&r->sh, sc, st, time, &birds, &obs);
     ak_raster_mesh casters[2] = {birds, obs};
@@ -94,19 +92,19 @@ static int write_json(const char* path, long steps, const boids_run* st) {
     cli_outfile out; /* a temporary renamed over path once complete */
     if (cli_outfile_open(&out, "boids", path)) return CLI_BAD_INPUT;
     FILE* f = out.f;
-    const float order = ak_boids_order((ak_vec3_cspan){st->v, st->n});
+    const float order = ak_boids_order((ak_vec3_cspan){st->velocities, st->agent_count});
     float dmin = 0.0f;
-    if (st->n >= 2) {
-        const size_t bytes = ak_boids_min_distance_scratch_size(st->n);
+    if (st->agent_count >= 2) {
+        const size_t bytes = ak_boids_min_distance_scratch_size(st->agent_count);
         uint8_t* scr = malloc(bytes);
-        if (!scr || ak_boids_min_distance((ak_vec3_cspan){st->p, st->n}, (ak_u8_span){scr, bytes}, &dmin) != AK_OK)
+        if (!scr || ak_boids_min_distance((ak_vec3_cspan){st->positions, st->agent_count}, (ak_u8_span){scr, bytes}, &dmin) != AK_OK)
             dmin = 0.0f;
         free(scr);
     }
     fprintf(f, "{\"steps\": %ld, \"agents\": [", steps);
-    for (size_t i = 0; i < st->n; ++i)
-        fprintf(f, "%s{\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g]}", i ? ", " : "", (double)st->p[i].x,
-                (double)st->p[i].y, (double)st->p[i].z, (double)st->v[i].x, (double)st->v[i].y, (double)st->v[i].z);
+    for (size_t i = 0; i < st->agent_count; ++i)
+        fprintf(f, "%s{\"p\": [%.9g, %.9g, %.9g], \"v\": [%.9g, %.9g, %.9g]}", i ? ", " : "", (double)st->positions[i].x,
+                (double)st->positions[i].y, (double)st->positions[i].z, (double)st->velocities[i].x, (double)st->velocities[i].y, (double)st->velocities[i].z);
     fprintf(f, "], \"order\": %.9g, \"min_distance\": %.9g}\n", (double)order, (double)dmin);
     return cli_outfile_commit(&out, "boids");
 }
@@ -134,9 +132,9 @@ int cmd_boids(int argc, char** argv) {
     long count = -1, steps = -1, seed = -1, threads = 1;
     float dt = -1.0f;
     int w = 640, h = 480;
-    if (CLI_GET(&a, "--count") && !cli_parse_int(CLI_GET(&a, "--count"), 1, CLI_BOIDS_MAX_AGENTS, &count))
+    if (CLI_GET(&a, "--count") && !cli_parse_int(CLI_GET(&a, "--count"), 1, AK_BOIDS_SCENE_MAX_AGENTS, &count))
         return cli_usage("boids", "--count '%s' is not a whole number in [1, %u]", CLI_GET(&a, "--count"),
-                         CLI_BOIDS_MAX_AGENTS);
+                         AK_BOIDS_SCENE_MAX_AGENTS);
     if (CLI_GET(&a, "--steps") && !cli_parse_int(CLI_GET(&a, "--steps"), 0, 100000000, &steps))
         return cli_usage("boids", "--steps '%s' is not a whole number >= 0", CLI_GET(&a, "--steps"));
     if (CLI_GET(&a, "--seed") && !cli_parse_int(CLI_GET(&a, "--seed"), 0, 2147483647, &seed))
@@ -152,50 +150,22 @@ int cmd_boids(int argc, char** argv) {
     if (out && !cli_has_ext(out, ".png") && !cli_has_ext(out, ".gif"))
         return cli_usage("boids", "output '%s' must end in .png or .gif", out);
 
-    cli_boids_scene sc;
-    cli_boids_scene_defaults(&sc);
+    ak_boids_scene sc;
+    ak_diag diag;
+    ak_boids_scene_defaults(&sc);
     if (preset) {
-        const int bad = cli_boids_scene_preset(preset, &sc);
-        if (bad) {
-            cli_boids_scene_free(&sc);
-            if (bad < 0) return cli_usage("boids", "--preset '%s' must be one of " CLI_BOIDS_PRESETS, preset);
-            return cli_fail("boids", "out of memory");
-        }
+        const ak_result res = ak_boids_scene_preset(preset, &sc, &diag);
+        if (res == AK_ERR_NOT_FOUND)
+            return cli_usage("boids", "--preset '%s' must be one of " AK_BOIDS_SCENE_PRESETS, preset);
+        if (res != AK_OK) return cli_fail("boids", "out of memory");
     }
-    if (a.pos_count == 1) {
-        FILE* f = fopen(a.pos[0], "rb");
-        if (!f) return cli_fail("boids", "%s: cannot open the file", a.pos[0]);
-        char* text = NULL;
-        size_t size = 0, cap = 0;
-        for (;;) {
-            if (size == cap) {
-                if (cap > CLI_JSON_MAX_SIZE) break;
-                cap = cap ? cap * 2 : 65536;
-                char* g = realloc(text, cap + 1);
-                if (!g) break;
-                text = g;
-            }
-            const size_t got = fread(text + size, 1, cap - size, f);
-            size += got;
-            if (got == 0) break;
-        }
-        fclose(f);
-        if (!text) return cli_fail("boids", "%s: out of memory", a.pos[0]);
-        if (size > CLI_JSON_MAX_SIZE) {
-            free(text);
-            return cli_fail("boids", "%s: larger than %zu bytes", a.pos[0], (size_t)CLI_JSON_MAX_SIZE);
-        }
-        char msg[600];
-        const int bad = cli_boids_scene_parse(a.pos[0], text, size, &sc, msg, sizeof msg);
-        free(text);
-        if (bad) {
-            cli_boids_scene_free(&sc);
-            return cli_fail("boids", "%s", msg);
-        }
+    if (a.pos_count == 1 && ak_boids_scene_load_file(a.pos[0], &sc, &diag) != AK_OK) {
+        ak_boids_scene_free(&sc);
+        return cli_fail("boids", "%s", diag.message);
     }
     if (count > 0) {
         if (sc.agent_count > 0) {
-            cli_boids_scene_free(&sc);
+            ak_boids_scene_free(&sc);
             return cli_usage("boids", "--count conflicts with the scene's \"agents\"");
         }
         sc.count = (size_t)count;
@@ -204,7 +174,7 @@ int cmd_boids(int argc, char** argv) {
     if (seed >= 0) sc.seed = seed;
     if (dt > 0.0f) sc.dt = dt;
     if (CLI_GET(&a, "--2d")) sc.params.planar = true;
-    if (sc.agent_count == 0) cli_boids_scene_scale_bounds(&sc, sc.count);
+    if (sc.agent_count == 0) ak_boids_scene_scale_bounds(&sc, sc.count);
 
     boids_run st;
     memset(&st, 0, sizeof st);
@@ -217,7 +187,7 @@ int cmd_boids(int argc, char** argv) {
         (rc = boids_run_init(&st, &sc, "boids", a.pos_count ? a.pos[0] : preset ? preset : "scene", (uint32_t)threads,
                              naive))) {
         boids_run_free(&st);
-        cli_boids_scene_free(&sc);
+        ak_boids_scene_free(&sc);
         return rc;
     }
     ak_result res = AK_OK;
@@ -231,14 +201,14 @@ int cmd_boids(int argc, char** argv) {
         if (renderer_init(&rd, w, h, &sc, st.n)) {
             renderer_free(&rd);
             boids_run_free(&st);
-            cli_boids_scene_free(&sc);
+            ak_boids_scene_free(&sc);
             return cli_fail("boids", "out of memory for rendering");
         }
         img = (ak_image){.pixels = rd.pixels, .width = w, .height = h};
         if (is_gif && ak_gif_writer_create(out, &(ak_gif_desc){.width = w, .height = h, .delay_cs = 4}, NULL, &gif) != AK_OK) {
             renderer_free(&rd);
             boids_run_free(&st);
-            cli_boids_scene_free(&sc);
+            ak_boids_scene_free(&sc);
             return cli_fail("boids", "%s: cannot create the file", out);
         }
     }
@@ -281,6 +251,6 @@ int cmd_boids(int argc, char** argv) {
                (double)ak_boids_order((ak_vec3_cspan){st.v, st.n}), (double)dmin);
     }
     boids_run_free(&st);
-    cli_boids_scene_free(&sc);
+    ak_boids_scene_free(&sc);
     return rc;
 }

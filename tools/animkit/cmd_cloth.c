@@ -4,11 +4,9 @@
 #include <string.h>
 
 #include "cli.h"
-#include "cli_json.h"
 #include "render.h"
 #include "cloth_run.h"
 #include "outfile.h"
-#include "scene_cloth.h"
 #include "sim_bake.h"
 
 static const char* const usage =
@@ -59,20 +57,6 @@ static int write_obj(const char* path, const ak_cloth* cloth, const ak_vec3* x, 
 
 /* ---- the command -------------------------------------------------------------------------- */
 
-static char* read_file(const char* path, size_t* out_size) {
-    FILE* f = fopen(path, "rb");
-    if (!f) return NULL;
-    char* buf = malloc(CLI_JSON_MAX_SIZE + 1);
-    size_t n = buf ? fread(buf, 1, CLI_JSON_MAX_SIZE + 1, f) : 0;
-    fclose(f);
-    if (!buf || n > CLI_JSON_MAX_SIZE) {
-        free(buf);
-        return NULL;
-    }
-    *out_size = n;
-    return buf;
-}
-
 int cmd_cloth(int argc, char** argv) {
     static const cli_opt opts[] = {{"--preset", NULL, true}, {"--solver", NULL, true},   {"--steps", NULL, true},
                                    {"--dt", NULL, true},     {"--substeps", NULL, true}, {"--threads", NULL, true},
@@ -91,22 +75,15 @@ int cmd_cloth(int argc, char** argv) {
     const char* json = CLI_GET(&a, "--json");
     if (out && !cli_has_ext(out, ".gif") && !cli_has_ext(out, ".png") && !cli_has_ext(out, ".obj") && !sim_bake_wanted(out))
         return cli_usage("cloth", "output '%s' must end in .gif, .png, .obj, .glb or .gltf", out);
-    cloth_scene sc;
+    ak_cloth_scene sc;
     const char* name = preset ? preset : a.pos[0];
+    ak_diag diag;
     if (preset) {
-        if (!cloth_scene_preset(preset, &sc)) {
-            cloth_scene_free(&sc);
-            return cli_usage("cloth", "unknown preset '%s' (flag, curtain, drape, cape)", preset);
-        }
-    } else {
-        size_t size = 0;
-        char* text = read_file(a.pos[0], &size);
-        if (!text) return cli_fail("cloth", "%s: cannot read the file (missing, unreadable or over %zu bytes)", a.pos[0],
-                                   CLI_JSON_MAX_SIZE);
-        char msg[600];
-        bool ok = cloth_scene_parse(a.pos[0], text, size, &sc, msg, sizeof msg);
-        free(text);
-        if (!ok) return cli_fail("cloth", "%s", msg);
+        const ak_result res = ak_cloth_scene_preset(preset, &sc, &diag);
+        if (res == AK_ERR_NOT_FOUND) return cli_usage("cloth", "unknown preset '%s' (flag, curtain, drape, cape)", preset);
+        if (res != AK_OK) return cli_fail("cloth", "%s", diag.message);
+    } else if (ak_cloth_scene_load_file(a.pos[0], &sc, &diag) != AK_OK) {
+        return cli_fail("cloth", "%s", diag.message);
     }
     /* command-line overrides */
     const char* v;
@@ -121,7 +98,7 @@ int cmd_cloth(int argc, char** argv) {
             sc.desc.bending = AK_CLOTH_BEND_SPRINGS;
     }
     if (!rc && (v = CLI_GET(&a, "--steps"))) {
-        if (!cli_parse_int(v, 0, CLOTH_SCENE_MAX_STEPS, &lv)) rc = cli_usage("cloth", "--steps must be 0..%ld", CLOTH_SCENE_MAX_STEPS);
+        if (!cli_parse_int(v, 0, AK_CLOTH_SCENE_MAX_STEPS, &lv)) rc = cli_usage("cloth", "--steps must be 0..%ld", AK_CLOTH_SCENE_MAX_STEPS);
         else sc.steps = lv;
     }
     if (!rc && (v = CLI_GET(&a, "--dt"))) {
@@ -138,7 +115,7 @@ int cmd_cloth(int argc, char** argv) {
         else sc.thread_count = (int)lv;
     }
     if (rc) {
-        cloth_scene_free(&sc);
+        ak_cloth_scene_free(&sc);
         return rc;
     }
 
@@ -272,6 +249,6 @@ done:
     free(img.pixels);
     cli_frame_free(&frame);
     cloth_run_free(&run);
-    cloth_scene_free(&sc);
+    ak_cloth_scene_free(&sc);
     return rc;
 }

@@ -6,7 +6,6 @@
 
 #include "cli.h"
 #include "outfile.h"
-#include "scene_fluid.h"
 
 static const char* const usage =
     "usage: animkit fluid [SCENE.json | --preset dam|pour|splash] [--solver sph|pbf] [--count N]\n"
@@ -63,7 +62,7 @@ typedef struct renderer {
     float extent;
 } renderer;
 
-static int renderer_init(renderer* r, const fluid_scene* s, size_t cap, const ak_vec3* p, size_t n, bool gif) {
+static int renderer_init(renderer* r, const ak_fluid_scene* s, size_t cap, const ak_vec3* p, size_t n, bool gif) {
     memset(r, 0, sizeof *r);
     r->w = gif ? 480 : 800;
     r->h = gif ? 360 : 600;
@@ -101,7 +100,7 @@ static void renderer_free(renderer* r) {
 }
 
 /* Spheres and capsules (as spheres along the segment) in grey; planes are not drawn. */
-static ak_result draw_colliders(renderer* r, const fluid_scene* s) {
+static ak_result draw_colliders(renderer* r, const ak_fluid_scene* s) {
     ak_vec3 unit[SPHERE_TRIS * 3], pos[SPHERE_TRIS * 3];
     unit_sphere(unit);
     for (size_t c = 0; c < s->collider_count; ++c) {
@@ -123,7 +122,7 @@ static ak_result draw_colliders(renderer* r, const fluid_scene* s) {
 
 /* The tank: the box's four side walls as faint glass (alpha-blended over the particles behind
  * them, depth tested, not hiding what is in front) and its twelve edges as dark lines. */
-static ak_result draw_tank(renderer* r, const fluid_scene* s) {
+static ak_result draw_tank(renderer* r, const ak_fluid_scene* s) {
     const ak_vec3 lo = s->desc.box_min, hi = s->desc.box_max;
     if (!(lo.x < hi.x) || !(lo.y < hi.y) || !(lo.z < hi.z)) return AK_OK;
     ak_vec3 c[8];
@@ -141,7 +140,7 @@ static ak_result draw_tank(renderer* r, const fluid_scene* s) {
     return res;
 }
 
-static ak_result render_frame(renderer* r, const fluid_scene* s, const ak_vec3* p, const uint8_t* flags, size_t n,
+static ak_result render_frame(renderer* r, const ak_fluid_scene* s, const ak_vec3* p, const uint8_t* flags, size_t n,
                               ak_image* out) {
     ak_vec3 unit[SPHERE_TRIS * 3];
     unit_sphere(unit);
@@ -222,7 +221,7 @@ static void tet(mesh_out* o, const ak_vec3 p[4], const float f[4], float iso) {
     }
 }
 
-static int write_obj(const char* path, const fluid_scene* s, const ak_vec3* p, size_t n) {
+static int write_obj(const char* path, const ak_fluid_scene* s, const ak_vec3* p, size_t n) {
     if (n == 0) return cli_fail("fluid", "%s: no particles left to mesh", path);
     const float h = s->desc.h, cell = 0.5f * ak_fluid_rest_spacing(&s->desc);
     ak_vec3 lo = p[0], hi = p[0];
@@ -305,7 +304,7 @@ typedef struct health {
     size_t peak;      /* largest particle count so far */
 } health;
 
-static double energy(const fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n) {
+static double energy(const ak_fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n) {
     const ak_vec3 g = s->desc.gravity;
     double e = 0.0;
     for (size_t i = 0; i < n; ++i)
@@ -313,7 +312,7 @@ static double energy(const fluid_scene* s, const ak_vec3* p, const ak_vec3* v, s
     return e * s->desc.particle_mass;
 }
 
-static void health_start(health* hl, const fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n) {
+static void health_start(health* hl, const ak_fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n) {
     const ak_vec3 g = s->desc.gravity;
     ak_vec3 lo = s->desc.box_min, hi = s->desc.box_max;
     const bool box = lo.x < hi.x;
@@ -338,7 +337,7 @@ static void health_start(health* hl, const fluid_scene* s, const ak_vec3* p, con
     hl->peak = n;
 }
 
-static int health_check(health* hl, const fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n,
+static int health_check(health* hl, const ak_fluid_scene* s, const ak_vec3* p, const ak_vec3* v, size_t n,
                         const ak_fluid_stats* st, long step) {
     const double t = (double)step * s->dt;
     if (st->emitted_count) hl->e0 += (double)st->emitted_count * s->desc.particle_mass * hl->emit_e;
@@ -406,12 +405,12 @@ int cmd_fluid(int argc, char** argv) {
     long count = 0, steps = -1, threads = 1;
     float dt = 0.0f;
     const char* sv = CLI_GET(&a, "--count");
-    if (sv && !cli_parse_int(sv, 8, FLUID_SCENE_MAX_PARTICLES, &count))
-        return cli_usage("fluid", "--count '%s': allowed 8 to %u", sv, FLUID_SCENE_MAX_PARTICLES);
+    if (sv && !cli_parse_int(sv, 8, AK_FLUID_SCENE_MAX_PARTICLES, &count))
+        return cli_usage("fluid", "--count '%s': allowed 8 to %u", sv, AK_FLUID_SCENE_MAX_PARTICLES);
     if (sv && a.pos_count == 1) return cli_usage("fluid", "--count applies to presets (a scene file sets its blocks)");
     sv = CLI_GET(&a, "--steps");
-    if (sv && !cli_parse_int(sv, 0, FLUID_SCENE_MAX_STEPS, &steps))
-        return cli_usage("fluid", "--steps '%s': allowed 0 to %ld", sv, FLUID_SCENE_MAX_STEPS);
+    if (sv && !cli_parse_int(sv, 0, AK_FLUID_SCENE_MAX_STEPS, &steps))
+        return cli_usage("fluid", "--steps '%s': allowed 0 to %ld", sv, AK_FLUID_SCENE_MAX_STEPS);
     sv = CLI_GET(&a, "--dt");
     if (sv && (!cli_parse_float(sv, &dt) || !(dt >= 1e-7f) || dt > 1.0f))
         return cli_usage("fluid", "--dt '%s': allowed [1e-07, 1] seconds", sv);
@@ -425,33 +424,28 @@ int cmd_fluid(int argc, char** argv) {
                obj = out && cli_has_ext(out, ".obj");
     if (out && !gif && !png && !obj) return cli_usage("fluid", "-o '%s': expected a .gif, .png or .obj file", out);
 
-    fluid_scene* s = malloc(sizeof *s);
+    ak_fluid_scene* s = malloc(sizeof *s);
     if (!s) return cli_fail("fluid", "out of memory");
+    ak_diag diag;
     if (a.pos_count == 1) {
-        cli_json j = {.file = a.pos[0]};
-        cJSON* root = cli_json_load(&j, a.pos[0], 0);
-        char* text = root ? cJSON_PrintUnformatted(root) : NULL;
-        cJSON_Delete(root);
-        bool ok = text && fluid_scene_parse(&j, text, strlen(text), s);
-        free(text);
-        if (!ok) {
+        if (ak_fluid_scene_load_file(a.pos[0], s, &diag) != AK_OK) {
             free(s);
-            return cli_fail("fluid", "%s", j.failed ? j.message : "out of memory reading the scene");
+            return cli_fail("fluid", "%s", diag.message);
         }
-    } else if (!fluid_scene_preset(preset ? preset : "dam", count, s)) {
+    } else if (ak_fluid_scene_preset(preset ? preset : "dam", count, s, &diag) != AK_OK) {
         free(s);
-        return cli_usage("fluid", "--preset '%s': allowed dam, pour, splash", preset);
+        return cli_usage("fluid", "--preset '%s': allowed " AK_FLUID_SCENE_PRESETS, preset);
     }
     if (solver) {
         s->desc.solver = strcmp(solver, "sph") == 0 ? AK_FLUID_SPH : AK_FLUID_PBF;
-        if (!s->dt_set) s->dt = fluid_scene_default_dt(s->desc.solver);
+        if (!s->dt_set) s->dt = ak_fluid_scene_default_dt(s->desc.solver);
         if (s->desc.solver == AK_FLUID_SPH && s->desc.viscosity == 0.0f) s->desc.viscosity = 0.02f;
     }
     if (dt > 0.0f) s->dt = dt;
     if (steps >= 0) s->steps = steps;
-    s->steps = fluid_scene_steps(s);
+    s->steps = ak_fluid_scene_steps(s);
 
-    const size_t cap = fluid_scene_capacity(s);
+    const size_t cap = ak_fluid_scene_capacity(s);
     {
         const double iters = s->desc.solver == AK_FLUID_PBF ? (s->desc.iterations ? s->desc.iterations : 4) : 1;
         int wrc = cli_work_check("fluid", (double)cap * (double)s->steps * iters,
@@ -476,7 +470,7 @@ int cmd_fluid(int argc, char** argv) {
         rc = cli_fail("fluid", "out of memory for %zu particles", cap);
         goto done;
     }
-    size_t n = fluid_scene_fill(s, pos, vel, cap);
+    size_t n = ak_fluid_scene_fill(s, pos, vel, cap);
     if (gif || png) {
         rc = renderer_init(&ren, s, cap, pos, n, gif);
         if (rc) goto done;

@@ -4,11 +4,9 @@
 #include <string.h>
 
 #include "cli.h"
-#include "cli_json.h"
 #include "render.h"
 #include "particles_run.h"
 #include "outfile.h"
-#include "scene_particles.h"
 #include "sim_bake.h"
 
 static const char* const usage =
@@ -49,7 +47,7 @@ static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
     cli_frame* f = &rd->frame;
     ak_raster* ras = f->raster;
     ak_vec4 sky_top, sky_bottom;
-    const bool dark = particles_dark_sky(r->scene, &sky_top, &sky_bottom); /* a glow shows on a dark sky */
+    const bool dark = particles_dark_sky(r->lib.scene, &sky_top, &sky_bottom); /* a glow shows on a dark sky */
     if (dark)
         ak_raster_clear(ras, sky_top, sky_bottom);
     else
@@ -81,7 +79,7 @@ static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
         res = ak_raster_draw_mesh(ras, &f->camera, &meshes[m]);
     ak_particles_state st = ak_particles_get_state(r->ps);
     if (res == AK_OK && rd->sprites.ready)
-        res = particles_draw_sprites(ras, &f->camera, r->scene, &rd->sprites, r->ps);
+        res = particles_draw_sprites(ras, &f->camera, r->lib.scene, &rd->sprites, r->ps);
     else if (res == AK_OK)
         res = particles_draw_points(ras, &f->camera, f->width, f->height,
                                     ak_vec3_scale(ak_vec3_add(f->bmin, f->bmax), 0.5f), r->ps,
@@ -131,7 +129,7 @@ int cmd_particles(int argc, char** argv) {
         return cli_usage("particles", "give either SCENE.json or --preset NAME");
     if (a.pos_count > 1) return cli_usage("particles", "expected one SCENE.json");
     if (preset && !particles_preset_known(preset))
-        return cli_usage("particles", "--preset must be %s, not '%s'", particles_preset_names, preset);
+        return cli_usage("particles", "--preset must be one of " AK_PARTICLES_SCENE_PRESETS ", not '%s'", preset);
     long steps = 200, seed = 1, threads = 1;
     if (CLI_GET(&a, "--steps") && !cli_parse_int(CLI_GET(&a, "--steps"), 0, 100000000, &steps))
         return cli_usage("particles", "--steps '%s' is not a whole number in 0..100000000",
@@ -171,34 +169,12 @@ int cmd_particles(int argc, char** argv) {
         return cli_usage("particles", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
     const char* json = CLI_GET(&a, "--json");
 
-    particles_scene scene;
+    ak_particles_scene scene;
+    ak_diag diag;
     if (preset) {
-        if (!particles_preset(preset, &scene)) {
-            particles_scene_free(&scene);
-            return cli_fail("particles", "out of memory");
-        }
-    } else {
-        cli_json j = {.file = a.pos[0]};
-        cJSON* root = cli_json_load(&j, a.pos[0], 0);
-        cJSON_Delete(root);
-        if (!root) return cli_fail("particles", "%s", j.message);
-        /* Read again as text for the parser (which wants memory, for the fuzzer). */
-        FILE* f = fopen(a.pos[0], "rb");
-        if (!f) return cli_fail("particles", "%s: cannot open the file", a.pos[0]);
-        fseek(f, 0, SEEK_END);
-        long size = ftell(f);
-        fseek(f, 0, SEEK_SET);
-        char* text = size >= 0 ? malloc((size_t)size + 1) : NULL;
-        size_t got = text ? fread(text, 1, (size_t)size, f) : 0;
-        fclose(f);
-        if (!text || got != (size_t)size) {
-            free(text);
-            return cli_fail("particles", "%s: cannot read the file", a.pos[0]);
-        }
-        char err[600];
-        bool ok = particles_scene_parse(a.pos[0], text, got, &scene, err, sizeof err);
-        free(text);
-        if (!ok) return cli_fail("particles", "%s", err);
+        if (ak_particles_scene_preset(preset, &scene, &diag) != AK_OK) return cli_fail("particles", "%s", diag.message);
+    } else if (ak_particles_scene_load_file(a.pos[0], &scene, &diag) != AK_OK) {
+        return cli_fail("particles", "%s", diag.message);
     }
     if (dt > 0.0f) scene.dt = dt;
     if (integ != AK_INTEGRATOR_DEFAULT) scene.integrator = integ;
@@ -345,6 +321,6 @@ done:
     particles_sprites_free(&rd.sprites);
     particles_shapes_free(&rd.sh);
     if (use_char) particles_character_free(&ch);
-    particles_scene_free(&scene);
+    ak_particles_scene_free(&scene);
     return rc;
 }

@@ -8,21 +8,29 @@
 #include <sys/stat.h>
 #include <unistd.h> /* read, close */
 
+#include "outfile.h"
 #include "render.h"
 
 static const char* const usage =
-    "usage: animkit retarget SOURCE TARGET [--map FILE] [--clip C] [--no-feet] [--unscaled]\n"
-    "                        [--fps N] [--size WxH] -o OUT.glb|OUT.gltf|OUT.gif\n"
+    "usage: animkit retarget SOURCE TARGET [--map FILE] [--map-out FILE] [--report FILE]\n"
+    "                        [--clip C] [--no-feet] [--unscaled] [--fps N] [--size WxH]\n"
+    "                        -o OUT.glb|OUT.gltf|OUT.gif\n"
     "Put SOURCE's clip C (default the first) on TARGET (FILE or builtin:NAME) and write the\n"
     "target with that one clip as glTF 2.0, or a GIF of the source skeleton and the target side\n"
-    "by side. Joints are matched by name (the same name, then humanoid bones of CMU/BVH, Mixamo,\n"
-    "Unreal, VRM and builtin rigs) unless --map gives the map. docs/retarget.md has the method.\n"
-    "  --map FILE   lines 'TARGET_JOINT = SOURCE_JOINT' ('#' starts a comment); only the joints\n"
-    "               listed are driven, the others keep their rest pose\n"
-    "  --no-feet    no foot-contact clean-up (by default feet in contact are pinned with IK)\n"
-    "  --unscaled   root motion as in the source (default: scaled by the leg-length ratio)\n"
-    "  --fps N      frames per second of the baked clip (default 30)\n"
-    "  --size WxH   GIF panel size (default 400x400)\n";
+    "by side. Without --map, joints are mapped automatically: both skeletons are fitted to a\n"
+    "humanoid template (hips, spine, chest, neck, head, clavicles, arms, hands, legs, feet, toes)\n"
+    "by topology, rest-pose geometry and name hints, and the map is printed as a table on stderr\n"
+    "(a map file). A skeleton that is not a humanoid (a quadruped) is refused (exit 1) unless\n"
+    "neither is and joint names match. docs/retarget.md has the method.\n"
+    "  --map FILE      lines 'TARGET_JOINT = SOURCE_JOINT' ('#' starts a comment); only the\n"
+    "                  joints listed are driven, the others keep their rest pose\n"
+    "  --map-out FILE  write the map used (the automatic one: the table) as a map file to edit\n"
+    "                  and pass back with --map\n"
+    "  --report FILE   write the table to FILE instead of stderr\n"
+    "  --no-feet       no foot-contact clean-up (by default feet in contact are pinned with IK)\n"
+    "  --unscaled      root motion as in the source (default: scaled by the leg-length ratio)\n"
+    "  --fps N         frames per second of the baked clip (default 30)\n"
+    "  --size WxH      GIF panel size (default 400x400)\n";
 
 /* ---- map files ---------------------------------------------------------------------------- */
 
@@ -70,6 +78,69 @@ static int read_map(const char* path, const ak_scene* src, const char* src_name,
         return cli_fail("retarget", "%s: %s (target %s, source %s)", path, diag.message, dst_name, src_name);
     if (r != AK_OK) return cli_fail("retarget", "%s: %s", path, diag.message);
     return CLI_OK;
+}
+
+/* ---- automatic map ------------------------------------------------------------------------ */
+
+/* The map as text (ak_retarget_map_write); NULL when out of memory. */
+static char* map_text(const ak_scene* src, const ak_humanoid_roles* sr, const ak_scene* dst,
+                      const ak_humanoid_roles* tr, const int32_t* map) {
+    size_t nt = ak_scene_joint_count(dst), need = 0;
+    ak_i32_cspan m = {map, nt};
+    if (ak_retarget_map_write(src->skeleton, sr, dst->skeleton, tr, m, NULL, 0, &need) != AK_OK) return NULL;
+    char* text = malloc(need + 1);
+    if (text && ak_retarget_map_write(src->skeleton, sr, dst->skeleton, tr, m, text, need + 1, NULL) != AK_OK) {
+        free(text);
+        text = NULL;
+    }
+    return text;
+}
+
+static int write_text(const char* path, const char* text) {
+    cli_outfile o;
+    if (cli_outfile_open(&o, "retarget", path)) return CLI_BAD_INPUT;
+    fputs(text, o.f);
+    if (cli_outfile_commit(&o, "retarget")) return CLI_BAD_INPUT;
+    cli_wrote(path, NULL);
+    return CLI_OK;
+}
+
+/* Map automatically: both skeletons fitted to the humanoid template and mapped by roles; the
+ * table goes to stderr or --report FILE. Neither a humanoid: joint names. */
+static int auto_map(const ak_scene* src, const char* src_name, const ak_scene* dst, const char* dst_name,
+                    const char* report, int32_t* map, char** out_text) {
+    ak_humanoid_roles sr, tr;
+    ak_diag sd, td;
+    memset(&sd, 0, sizeof sd), memset(&td, 0, sizeof td);
+    ak_result a = ak_humanoid_roles_find(src->skeleton, NULL, &sr, &sd);
+    ak_result b = ak_humanoid_roles_find(dst->skeleton, NULL, &tr, &td);
+    size_t nt = ak_scene_joint_count(dst), mapped = 0;
+    if ((a != AK_OK && a != AK_ERR_NOT_FOUND) || (b != AK_OK && b != AK_ERR_NOT_FOUND))
+        return cli_fail("retarget", "%s: %s", a != AK_OK && a != AK_ERR_NOT_FOUND ? src_name : dst_name,
+                        a != AK_OK && a != AK_ERR_NOT_FOUND ? sd.message : td.message);
+    if (a == AK_ERR_NOT_FOUND && b == AK_ERR_NOT_FOUND) {
+        ak_retarget_map_by_name(src->skeleton, dst->skeleton, (ak_i32_span){map, nt}, &mapped);
+        if (!mapped)
+            return cli_fail("retarget", "neither %s nor %s is a humanoid (%s; %s) and no joint name matches; give --map FILE",
+                            src_name, dst_name, sd.message, td.message);
+        if (!(*out_text = map_text(src, NULL, dst, NULL, map))) return cli_fail("retarget", "out of memory");
+        if (!cli_quiet)
+            fprintf(stderr, "animkit retarget: note: neither skeleton is a humanoid: %zu joint%s matched by name\n",
+                    mapped, cli_plural(mapped));
+        return report ? write_text(report, *out_text) : CLI_OK;
+    }
+    ak_retarget_map_by_roles(src->skeleton, &sr, dst->skeleton, &tr, (ak_i32_span){map, nt}, &mapped);
+    char* text = map_text(src, &sr, dst, &tr, map);
+    if (!text) return cli_fail("retarget", "out of memory");
+    int rc = CLI_OK;
+    if (report) rc = write_text(report, text);
+    else if (!cli_quiet || a != AK_OK || b != AK_OK) fputs(text, stderr);
+    if (rc == CLI_OK && (a != AK_OK || b != AK_OK))
+        rc = cli_fail("retarget", "%s: %s; the table above shows what matched; give --map FILE", a != AK_OK ? src_name : dst_name,
+                      a != AK_OK ? sd.message : td.message);
+    if (rc == CLI_OK) *out_text = text;
+    else free(text);
+    return rc;
 }
 
 /* ---- GIF ------------------------------------------------------------------------------------ */
@@ -173,7 +244,8 @@ static int write_gif(const char* out, const ak_scene* src, int clip, const ak_sc
 int cmd_retarget(int argc, char** argv) {
     static const cli_opt opts[] = {{"--map", NULL, true},      {"--clip", "-c", true}, {"--no-feet", NULL, false},
                                    {"--unscaled", NULL, false}, {"--fps", NULL, true},  {"--size", NULL, true},
-                                   {"--output", "-o", true}};
+                                   {"--output", "-o", true}, {"--map-out", NULL, true},
+                                   {"--report", NULL, true}};
     cli_args a;
     int rc = cli_parse("retarget", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
     if (rc) return rc;
@@ -196,6 +268,7 @@ int cmd_retarget(int argc, char** argv) {
 
     ak_scene *src = NULL, *dst = NULL;
     int32_t* map = NULL;
+    char* text = NULL;
     ak_clip* clip = NULL;
     if ((rc = cli_load_scene("retarget", a.pos[0], &src))) return rc;
     if ((rc = cli_load_scene("retarget", a.pos[1], &dst))) goto done;
@@ -217,16 +290,16 @@ int cmd_retarget(int argc, char** argv) {
         rc = cli_fail("retarget", "out of memory");
         goto done;
     }
-    size_t mapped = 0;
     if (CLI_GET(&a, "--map")) {
         if ((rc = read_map(CLI_GET(&a, "--map"), src, a.pos[0], dst, a.pos[1], map))) goto done;
-    } else {
-        ak_retarget_map_by_name(src->skeleton, dst->skeleton, (ak_i32_span){map, nt}, &mapped);
-        if (!mapped) {
-            rc = cli_fail("retarget", "%s: no joint matches a joint of %s by name; give --map FILE", a.pos[1], a.pos[0]);
+        if (CLI_GET(&a, "--map-out") && !(text = map_text(src, NULL, dst, NULL, map))) {
+            rc = cli_fail("retarget", "out of memory");
             goto done;
         }
+    } else if ((rc = auto_map(src, a.pos[0], dst, a.pos[1], CLI_GET(&a, "--report"), map, &text))) {
+        goto done;
     }
+    if (CLI_GET(&a, "--map-out") && text && (rc = write_text(CLI_GET(&a, "--map-out"), text))) goto done;
     ak_retarget_desc d = {.source = src->skeleton, .clip = src->clips[ci], .target = dst->skeleton,
                           .source_of_target = {map, nt}, .frame_rate = fps,
                           .unscaled_root_motion = CLI_GET(&a, "--unscaled") != NULL,
@@ -256,6 +329,7 @@ int cmd_retarget(int argc, char** argv) {
         else cli_wrote(out, NULL);
     }
 done:
+    free(text);
     ak_clip_destroy(clip);
     free(map);
     ak_scene_destroy(src);

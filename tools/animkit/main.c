@@ -26,8 +26,10 @@ static const command commands[] = {
     {"boids", cmd_boids, "flocking: Reynolds boids with obstacles and predators (JSON, PNG, GIF)"},
     {"view", cmd_view, "interactive viewer: play clips, compare skinning, drag IK targets (--headless, --script)"},
     {"cloth", cmd_cloth, "simulate cloth (XPBD or mass-spring): flag, curtain, drape, cape"},
+    {"rigid", cmd_rigid, "rigid bodies and ragdolls (XPBD): stack, pyramid, dominoes, avalanche, ragdoll, incline"},
     {"retarget", cmd_retarget, "put a clip (e.g. BVH mocap) on another character; glTF or GIF out"},
     {"fluid", cmd_fluid, "simulate a particle liquid (PBF, SPH, WCSPH): JSON state, PNG/GIF render, OBJ surface"},
+    {"batch", cmd_batch, "run a manifest of retarget/bake/render jobs (JSON lines), one --shard I/N of it, idempotently"},
 };
 #define COMMAND_COUNT (sizeof(commands) / sizeof(commands[0]))
 

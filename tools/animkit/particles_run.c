@@ -6,162 +6,13 @@
 #include "particles_run.h"
 #include "render.h"
 
-/* ---- presets -------------------------------------------------------------------------- */
-
-static ak_particle_emitter emitter_base(void) {
-    ak_particle_emitter e = {.direction = {0, 1, 0},
-                             .cone_angle = 0.3f,
-                             .speed_min = 1,
-                             .speed_max = 2,
-                             .lifetime_min = 1,
-                             .lifetime_max = 2,
-                             .size_min = 0.03f,
-                             .size_max = 0.03f,
-                             .mass = 1};
-    return e;
-}
-
-/* Rain: emitter_base falling straight down (a narrow cone) from a flat box. */
-static ak_particle_emitter rain_base(ak_vec3 center, ak_vec3 half_extents) {
-    ak_particle_emitter e = emitter_base();
-    e.shape = AK_EMITTER_BOX, e.center = center, e.half_extents = half_extents;
-    e.direction = ak_vec3_make(0, -1, 0), e.cone_angle = 0.02f;
-    return e;
-}
-
-/* Fills s for a preset; false when out of memory. */
-bool particles_preset(const char* name, particles_scene* s) {
-    memset(s, 0, sizeof *s);
-    s->dt = 0.01f;
-    s->integrator = AK_INTEGRATOR_SYMPLECTIC;
-    s->capacity = 60000;
-    s->world.gravity = ak_vec3_make(0, -9.81f, 0);
-    s->planes = calloc(1, sizeof *s->planes);
-    s->spheres = calloc(1, sizeof *s->spheres);
-    s->emitters = calloc(4, sizeof *s->emitters);
-    s->bursts = calloc(4, sizeof *s->bursts);
-    if (!s->planes || !s->spheres || !s->emitters || !s->bursts) return false;
-    s->planes[0] = (ak_particle_plane){.normal = {0, 1, 0}, .restitution = 0.4f, .friction = 0.3f};
-    s->world.planes = (ak_particle_plane_cspan){s->planes, 1};
-    ak_particle_emitter e = emitter_base();
-    particles_sprites* look = &s->sprites;
-    if (strcmp(name, "fountain") == 0) {
-        /* droplets of 6 mm radius (they were 3 cm: 4500 touching balls read as one blob) */
-        e.center = ak_vec3_make(0, 0.05f, 0);
-        e.size_min = 0.005f, e.size_max = 0.007f;
-        e.cone_angle = 0.18f, e.speed_min = 5.0f, e.speed_max = 5.6f;
-        e.lifetime_min = 2.5f, e.lifetime_max = 3.5f;
-        e.colour = ak_vec4_make(0.25f, 0.55f, 1.0f, 1), e.rate = 1500.0f;
-        s->emitters[0] = e;
-        s->emitter_count = 1;
-        s->spheres[0] = (ak_particle_sphere){
-            .center = {0.45f, 0.35f, 0}, .radius = 0.35f, .restitution = 0.3f, .friction = 0.2f};
-        s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
-        s->world.drag_linear = 0.02f;
-    } else if (strcmp(name, "rain") == 0) {
-        e = rain_base(ak_vec3_make(0, 4, 0), ak_vec3_make(2, 0.1f, 2));
-        e.speed_min = 3, e.speed_max = 4;
-        e.lifetime_min = 2.5f, e.lifetime_max = 3.0f, e.size_min = 0.015f, e.size_max = 0.02f;
-        e.colour = ak_vec4_make(0.55f, 0.7f, 1.0f, 1), e.rate = 3000.0f;
-        s->emitters[0] = e;
-        s->emitter_count = 1;
-        s->spheres[0] = (ak_particle_sphere){
-            .center = {0, 1.2f, 0}, .radius = 0.8f, .restitution = 0.2f, .friction = 0.1f};
-        s->world.spheres = (ak_particle_sphere_cspan){s->spheres, 1};
-        s->world.wind = ak_vec3_make(1.5f, 0, 0);
-        s->world.drag_linear = 0.3f;
-        s->planes[0].restitution = 0.1f;
-    } else if (strcmp(name, "fireworks") == 0) {
-        const ak_vec4 colours[4] = {
-            {1, 0.3f, 0.2f, 1}, {0.3f, 1, 0.4f, 1}, {1, 0.85f, 0.3f, 1}, {0.6f, 0.5f, 1, 1}};
-        const float x[4] = {-1.2f, 0.9f, 0.0f, 1.6f}, y[4] = {3.0f, 3.6f, 4.2f, 2.8f};
-        for (int k = 0; k < 4; ++k) {
-            ak_particle_emitter f = emitter_base();
-            f.shape = AK_EMITTER_SPHERE, f.center = ak_vec3_make(x[k], y[k], -0.5f * k),
-            f.radius = 0.05f;
-            f.cone_angle = AK_PI, f.speed_min = 2.5f, f.speed_max = 3.2f, f.lifetime_min = 1.2f,
-            f.lifetime_max = 1.8f;
-            f.colour = colours[k];
-            s->emitters[k] = f;
-            s->bursts[k] =
-                (particles_burst){.count = 800, .start = 0.45f * (float)k, .interval = 1.8f};
-        }
-        s->emitter_count = 4;
-        s->world.drag_quadratic = 0.02f;
-        s->world.gravity = ak_vec3_make(0, -3.0f, 0);
-    } else if (strcmp(name, "character") == 0) {
-        /* Rain on the character (collides with its posed mesh) and sparks from its surface. */
-        e = rain_base(ak_vec3_make(0, 2.6f, 0), ak_vec3_make(0.7f, 0.05f, 0.7f));
-        e.speed_min = 2, e.speed_max = 2.5f;
-        e.lifetime_min = 2, e.lifetime_max = 2.5f, e.size_min = 0.012f, e.size_max = 0.016f;
-        e.colour = ak_vec4_make(0.45f, 0.65f, 1.0f, 1), e.rate = 2500.0f;
-        s->emitters[0] = e;
-        ak_particle_emitter sp = emitter_base();
-        sp.shape = AK_EMITTER_MESH, sp.cone_angle = 0.5f, sp.speed_min = 0.3f, sp.speed_max = 0.8f;
-        sp.lifetime_min = 0.6f, sp.lifetime_max = 1.0f, sp.size_min = 0.01f, sp.size_max = 0.015f;
-        sp.colour = ak_vec4_make(1.0f, 0.55f, 0.15f, 1), sp.rate = 800.0f,
-        sp.base_velocity = ak_vec3_make(0, 0.5f, 0);
-        s->emitters[1] = sp;
-        s->emitter_count = 2;
-        s->planes[0].restitution = 0.2f;
-    } else if (strcmp(name, "fire") == 0) {
-        /* Flames: additive puffs rising from a disc, hot yellow to red to nothing while they
-         * shrink, buoyant (gravity up) and slowed by the air; each puff plays a 4x4 sheet. */
-        e.shape = AK_EMITTER_DISC, e.radius = 0.22f, e.center = ak_vec3_make(0, 0.02f, 0);
-        e.cone_angle = 0.2f, e.speed_min = 0.8f, e.speed_max = 1.4f;
-        e.lifetime_min = 0.6f, e.lifetime_max = 1.1f, e.size_min = 0.08f, e.size_max = 0.12f;
-        e.colour = ak_vec4_make(1.0f, 0.62f, 0.22f, 1), e.rate = 350.0f;
-        s->emitters[0] = e;
-        s->emitter_count = 1;
-        s->world.gravity = ak_vec3_make(0, 2.0f, 0);
-        s->world.drag_linear = 0.8f;
-        look->enabled = true, look->texture = AK_SPRITE_TEXTURE_PUFF, look->sheet_columns = 4, look->sheet_rows = 4;
-        look->blend = AK_BLEND_ADD;
-        look->look = (ak_particle_look){
-            .colour_keys = {{0.0f, {1.0f, 1.0f, 0.75f, 0.3f}},
-                            {0.3f, {1.0f, 0.75f, 0.45f, 0.3f}},
-                            {0.7f, {0.9f, 0.35f, 0.25f, 0.2f}},
-                            {1.0f, {0.5f, 0.2f, 0.2f, 0.0f}}},
-            .colour_key_count = 4,
-            .size_keys = {{0.0f, 0.7f}, {0.35f, 1.0f}, {1.0f, 0.35f}},
-            .size_key_count = 3,
-            .frame_count = 16};
-    } else if (strcmp(name, "smoke") == 0) {
-        /* Smoke: few large puffs drifting up and downwind, fading in then out while they grow
-         * and lighten; alpha-blended back to front. */
-        e.shape = AK_EMITTER_DISC, e.radius = 0.12f, e.center = ak_vec3_make(0, 0.05f, 0);
-        e.cone_angle = 0.3f, e.speed_min = 0.5f, e.speed_max = 0.8f;
-        e.lifetime_min = 3.0f, e.lifetime_max = 4.0f, e.size_min = 0.12f, e.size_max = 0.18f;
-        e.colour = ak_vec4_make(0.42f, 0.42f, 0.45f, 1), e.rate = 40.0f;
-        s->emitters[0] = e;
-        s->emitter_count = 1;
-        s->world.gravity = ak_vec3_make(0, 0.25f, 0);
-        s->world.wind = ak_vec3_make(0.5f, 0, 0);
-        s->world.drag_linear = 0.6f;
-        look->enabled = true, look->texture = AK_SPRITE_TEXTURE_PUFF, look->sheet_columns = 4, look->sheet_rows = 2;
-        look->blend = AK_BLEND_ALPHA;
-        look->look = (ak_particle_look){
-            .colour_keys = {{0.0f, {0.8f, 0.8f, 0.8f, 0.0f}},
-                            {0.1f, {1.0f, 1.0f, 1.0f, 0.75f}},
-                            {1.0f, {1.9f, 1.9f, 1.9f, 0.0f}}},
-            .colour_key_count = 3,
-            .size_keys = {{0.0f, 0.6f}, {1.0f, 3.0f}},
-            .size_key_count = 2,
-            .frame_count = 8,
-            .frame_rate = 2.0f};
-    } else {
-        return false;
-    }
-    return true;
-}
-
-const char* const particles_preset_names = "fountain, rain, fireworks, character, fire or smoke";
-
 bool particles_preset_known(const char* name) {
-    static const char* const names[] = {"fountain", "rain", "fireworks", "character", "fire", "smoke"};
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k)
-        if (name && strcmp(name, names[k]) == 0) return true;
-    return false;
+    if (!name) return false;
+    ak_particles_scene s;
+    ak_diag diag;
+    const ak_result res = ak_particles_scene_preset(name, &s, &diag);
+    ak_particles_scene_free(&s);
+    return res != AK_ERR_NOT_FOUND;
 }
 
 /* ---- the character ----------------------------------------------------------------------- */
@@ -234,132 +85,49 @@ void particles_character_free(particles_character* c) {
 /* ---- simulation ------------------------------------------------------------------------ */
 
 
-int particles_run_init(particles_run* r, particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads) {
+/* The library's "particles: problem" without its prefix (the command says "animkit particles:"). */
+static const char* lib_message(const ak_diag* d) {
+    return strncmp(d->message, "particles: ", 11) == 0 ? d->message + 11 : d->message;
+}
+
+int particles_run_init(particles_run* r, ak_particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads) {
     memset(r, 0, sizeof *r);
-    r->scene = s;
     r->ch = ch;
-    ak_particles_desc d = {.capacity = s->capacity,
-                           .integrator = s->integrator,
-                           .seed = seed,
-                           .thread_count = threads};
-    ak_result res = ak_particles_create(&d, NULL, &r->ps);
-    if (res != AK_OK)
-        return cli_fail("particles", "cannot create the system: %s", ak_result_string(res));
-    for (size_t i = 0; i < s->particle_count; ++i) {
-        res = ak_particles_add(r->ps, &s->particles[i], NULL);
-        if (res != AK_OK)
-            return cli_fail("particles", "particle %zu: %s", i, ak_result_string(res));
-    }
-    r->fired = calloc(s->emitter_count + 1, sizeof(uint64_t));
-    r->springs = calloc(s->world.springs.count + 1, sizeof(ak_particle_spring));
-    if (!r->fired || !r->springs) return cli_fail("particles", "out of memory");
-    for (size_t e = 0; e < s->emitter_count; ++e) s->emitters[e].carry = 0.0;
-    r->world = s->world;
-    if (s->world.springs.count)
-        memcpy(r->springs, s->world.springs.ptr, s->world.springs.count * sizeof *r->springs);
-    r->world.springs.ptr = r->springs;
-    r->file_alive = s->particle_count;
+    ak_particles_scene_run_desc d = {.seed = seed, .thread_count = threads};
     if (ch) {
-        r->meshes[0] = ch->collider;
-        r->world.meshes = (ak_particle_mesh_cspan){r->meshes, 1};
-        for (size_t e = 0; e < s->emitter_count; ++e)
-            if (s->emitters[e].shape == AK_EMITTER_MESH) {
-                s->emitters[e].mesh_positions = (ak_vec3_cspan){ch->positions, ch->vertex_count};
-                s->emitters[e].mesh_indices = (ak_u32_cspan){ch->indices, ch->index_count};
-                s->emitters[e].mesh_area_cdf = (ak_f32_span){ch->cdf, ch->index_count / 3};
-            }
+        d.mesh_collider = ch->collider;
+        d.mesh_positions = (ak_vec3_cspan){ch->positions, ch->vertex_count};
+        d.mesh_indices = (ak_u32_cspan){ch->indices, ch->index_count};
+        d.mesh_area_cdf = (ak_f32_span){ch->cdf, ch->index_count / 3};
     }
-    return CLI_OK;
+    ak_diag diag;
+    const ak_result res = ak_particles_scene_run_init(&r->lib, s, &d, &diag);
+    r->ps = r->lib.system;
+    return res == AK_OK ? CLI_OK : cli_fail("particles", "%s", lib_message(&diag));
 }
 
-/* How many bursts (start + k interval, k = 0, 1, ...) are due before t1: the smallest k >= fired
- * with start + k interval >= t1, saturating at 2^53 (where a double stops counting by one).
- * A bounded number of operations whatever the interval. */
-static uint64_t bursts_due(float start, float interval, double t1, uint64_t fired) {
-    const double limit = 9007199254740992.0; /* 2^53 */
-    double k = ceil((t1 - (double)start) / (double)interval);
-    if (!(k < limit)) k = limit;
-    if (k < (double)fired) k = (double)fired;
-    for (int i = 0; i < 4 && k > (double)fired && (double)start + (k - 1.0) * (double)interval >= t1; ++i) k -= 1.0;
-    for (int i = 0; i < 4 && k < limit && (double)start + k * (double)interval < t1; ++i) k += 1.0;
-    return (uint64_t)k;
-}
-
-/* One step: pose the character for the end of the step, emit, step. */
+/* One step: pose the character for the end of the step, then the library's step (emit, fire
+ * bursts, step, re-index springs). */
 int particles_run_step(particles_run* r, int step) {
-    particles_scene* s = r->scene;
-    const float dt = s->dt;
-    const double t1 = (double)(step + 1) * dt;
+    const float dt = r->lib.scene->dt;
     ak_result res = AK_OK;
-    if (r->ch) res = particles_character_pose(r->ch, (float)t1, dt);
-    for (size_t e = 0; e < s->emitter_count && res == AK_OK; ++e) {
-        res = ak_particles_emit(r->ps, &s->emitters[e], dt, NULL);
-        /* Bursts due before the end of this step (start, start + interval, ...). The loop is
-         * bounded by integers: at most capacity + 1 calls per emitter and step (each call adds
-         * a particle until the system is full); the bursts still due after that are counted,
-         * not fired, in a bounded number of operations. A 1e-30 s interval used to hang here:
-         * the count was stepped with k -= 1.0 on a double near 1e28, which no longer changes. */
-        const particles_burst* b = &s->bursts[e];
-        const uint64_t max_calls = (uint64_t)ak_particles_capacity(r->ps) + 1u;
-        uint64_t calls = 0;
-        while (res == AK_OK && b->count > 0 && (b->interval > 0.0f || r->fired[e] == 0)) {
-            if ((double)b->start + (double)r->fired[e] * (double)b->interval >= t1) break;
-            if (b->interval > 0.0f && (ak_particles_count(r->ps) >= ak_particles_capacity(r->ps) || calls >= max_calls)) {
-                /* full: every burst still due this step would be dropped (a full system emits
-                 * nothing and draws no random numbers), so count them without calling */
-                r->fired[e] = bursts_due(b->start, b->interval, t1, r->fired[e]);
-                break;
-            }
-            res = ak_particles_burst(r->ps, &s->emitters[e], b->count, NULL);
-            ++r->fired[e];
-            ++calls;
-        }
-    }
-    if (res == AK_OK) res = ak_particles_step(r->ps, &r->world, dt);
-    if (res == AK_ERR_BUDGET)
-        return cli_fail("particles",
-                        "step %d: Lennard-Jones needs more than %.3g distance tests per force evaluation (particles "
-                        "packed into few cells of the %g m cut-off); lower lennard_jones.cutoff or sigma, or spread "
-                        "the particles out",
-                        step, (double)AK_PARTICLES_LJ_DEFAULT_PAIR_TESTS,
-                        (double)(r->world.lennard_jones.cutoff > 0.0f ? r->world.lennard_jones.cutoff
-                                                                       : 2.5f * r->world.lennard_jones.sigma));
+    r->lib.step_index = step;
+    if (r->ch) res = particles_character_pose(r->ch, (float)((double)(step + 1) * dt), dt);
     if (res != AK_OK) return cli_fail("particles", "step %d: %s", step, ak_result_string(res));
-    /* File particles come first and keep their order (ids 0.. in file order); when some die
-     * (a lifetime, or a state that stopped being finite) the springs follow the survivors'
-     * new indices and springs to a dead particle go (they used to point past the end: the
-     * next step failed with "an index is out of range") */
-    const ak_particles_state st = ak_particles_get_state(r->ps);
-    size_t alive = 0;
-    while (alive < st.count && st.id[alive] < s->particle_count) ++alive;
-    if (alive != r->file_alive && s->world.springs.count) {
-        uint32_t* where = malloc(s->particle_count * sizeof *where);
-        if (!where) return cli_fail("particles", "out of memory");
-        for (size_t i = 0; i < s->particle_count; ++i) where[i] = UINT32_MAX;
-        for (size_t i = 0; i < alive; ++i) where[st.id[i]] = (uint32_t)i;
-        size_t n = 0;
-        for (size_t k = 0; k < s->world.springs.count; ++k) {
-            ak_particle_spring sp = s->world.springs.ptr[k];
-            if (where[sp.i] == UINT32_MAX || where[sp.j] == UINT32_MAX) continue;
-            sp.i = where[sp.i], sp.j = where[sp.j];
-            r->springs[n++] = sp;
-        }
-        r->world.springs.count = n;
-        free(where);
-    }
-    r->file_alive = alive;
+    ak_diag diag;
+    if (ak_particles_scene_run_step(&r->lib, &diag) != AK_OK)
+        return cli_fail("particles", "%s", lib_message(&diag));
     return CLI_OK;
 }
 
 void particles_run_free(particles_run* r) {
-    ak_particles_destroy(r->ps);
-    free(r->fired);
-    free(r->springs);
+    ak_particles_scene_run_free(&r->lib);
+    r->ps = NULL;
 }
 
 
 /* UV spheres and boxes of the colliders as one triangle mesh. */
-bool particles_shapes_build(particles_shapes* sh, const particles_scene* s) {
+bool particles_shapes_build(particles_shapes* sh, const ak_particles_scene* s) {
     enum { SEG = 24, RINGS = 14 };
     size_t nv = s->world.spheres.count * (SEG + 1) * (RINGS + 1) + s->world.boxes.count * 24;
     size_t ni = s->world.spheres.count * SEG * RINGS * 6 + s->world.boxes.count * 36;
@@ -449,9 +217,9 @@ ak_result particles_draw_points(ak_raster* ras, const ak_raster_camera* camera, 
 
 /* ---- sprites ------------------------------------------------------------------------------- */
 
-int particles_sprites_init(particles_sprite_renderer* sr, const particles_scene* s, const char* command) {
+int particles_sprites_init(particles_sprite_renderer* sr, const ak_particles_scene* s, const char* command) {
     memset(sr, 0, sizeof *sr);
-    const particles_sprites* sp = &s->sprites;
+    const ak_particles_scene_sprites* sp = &s->sprites;
     if (!sp->enabled) return CLI_OK;
     const size_t cap = (size_t)s->capacity + 1;
     sr->sizes = calloc(cap, sizeof *sr->sizes);
@@ -492,7 +260,7 @@ int particles_sprites_init(particles_sprite_renderer* sr, const particles_scene*
     return CLI_OK;
 }
 
-ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera, const particles_scene* s,
+ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera, const ak_particles_scene* s,
                                  particles_sprite_renderer* sr, ak_particles* ps) {
     ak_particles_state st = ak_particles_get_state(ps);
     if (!st.count || !sr->ready) return AK_OK;
@@ -522,7 +290,7 @@ ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera,
     return ak_raster_draw_sprites(ras, camera, &d);
 }
 
-bool particles_dark_sky(const particles_scene* s, ak_vec4* top, ak_vec4* bottom) {
+bool particles_dark_sky(const ak_particles_scene* s, ak_vec4* top, ak_vec4* bottom) {
     if (!s->sprites.enabled || s->sprites.blend != AK_BLEND_ADD) return false;
     *top = ak_vec4_make(0.05f, 0.06f, 0.10f, 1), *bottom = ak_vec4_make(0.16f, 0.16f, 0.20f, 1);
     return true;

@@ -5,14 +5,10 @@
 #define ANIMKIT_CLI_PARTICLES_RUN_H
 
 #include "cli.h"
-#include "scene_particles.h"
+#include <animkit/particles.h>
 
-/* Fill s for a preset: fountain, rain, fireworks, character, fire or smoke; false for another
- * name or when out of memory (s is then safe to free). */
-bool particles_preset(const char* name, particles_scene* s);
-/* Whether name is a preset, and the names in words for messages. */
+/* Whether name is a preset of ak_particles_scene_preset (AK_PARTICLES_SCENE_PRESETS). */
 bool particles_preset_known(const char* name);
-extern const char* const particles_preset_names;
 
 /* The character preset: builtin:humanoid walking (clip 0), its posed meshes concatenated as
  * one collider and one emitter surface. */
@@ -35,19 +31,14 @@ void particles_character_free(particles_character* c);
 
 /* A system built from a scene (which it points to and whose emitters it updates). */
 typedef struct particles_run {
-    particles_scene* scene;
-    ak_particles* ps;
-    particles_character* ch; /* NULL unless the character preset */
-    const ak_particle_mesh* meshes[1];
-    ak_particles_world world;
-    uint64_t* fired; /* bursts fired per emitter */
-    ak_particle_spring* springs; /* the world's springs, re-indexed as file particles die */
-    size_t file_alive;           /* file particles still alive */
+    ak_particles_scene_run lib; /* the library's run (its world may be edited: the viewer's wind) */
+    ak_particles* ps;           /* lib.system */
+    particles_character* ch;    /* NULL unless the character preset */
 } particles_run;
 
 /* Create the system, add the scene's particles; ch NULL unless the character preset.
  * Returns an exit code (message printed). */
-int particles_run_init(particles_run* r, particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads);
+int particles_run_init(particles_run* r, ak_particles_scene* s, particles_character* ch, uint64_t seed, uint32_t threads);
 /* Step number `step` (0-based): pose the character for its end, emit, fire bursts, step. */
 int particles_run_step(particles_run* r, int step);
 /* Free the system (safe on a zeroed run). */
@@ -62,7 +53,7 @@ typedef struct particles_shapes {
 } particles_shapes;
 
 /* Build sh from the world's spheres and boxes; false when out of memory (free it anyway). */
-bool particles_shapes_build(particles_shapes* sh, const particles_scene* s);
+bool particles_shapes_build(particles_shapes* sh, const ak_particles_scene* s);
 void particles_shapes_free(particles_shapes* sh);
 
 /* Grow [lo, hi] by p (points beyond 1e6 in some axis are skipped). */
@@ -87,15 +78,15 @@ typedef struct particles_sprite_renderer {
 } particles_sprite_renderer;
 
 /* Prepare sr for s (nothing when s draws points); an exit code, with the message printed. */
-int particles_sprites_init(particles_sprite_renderer* sr, const particles_scene* s, const char* command);
+int particles_sprites_init(particles_sprite_renderer* sr, const ak_particles_scene* s, const char* command);
 /* Draw the live particles as sprites: colour and size over life, the frame from the age, sorted
  * back to front for alpha blending. */
-ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera, const particles_scene* s,
+ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera, const ak_particles_scene* s,
                                  particles_sprite_renderer* sr, ak_particles* ps);
 /* Free (safe on a zeroed renderer). */
 void particles_sprites_free(particles_sprite_renderer* sr);
 /* Whether s draws glowing (additive) sprites, which `particles -o` and the viewer show on a
  * dark sky; then *top and *bottom get its colours. */
-bool particles_dark_sky(const particles_scene* s, ak_vec4* top, ak_vec4* bottom);
+bool particles_dark_sky(const ak_particles_scene* s, ak_vec4* top, ak_vec4* bottom);
 
 #endif

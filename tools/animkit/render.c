@@ -9,6 +9,11 @@
 
 static ak_vec4 rgba(float r, float g, float b, float a) { return ak_vec4_make(r, g, b, a); }
 
+/* the scene's texture enums are cast to the raster's */
+_Static_assert((int)AK_TEXTURE_WRAP_CLAMP == (int)AK_RASTER_WRAP_CLAMP && (int)AK_TEXTURE_WRAP_MIRROR == (int)AK_RASTER_WRAP_MIRROR &&
+                   (int)AK_TEXTURE_FILTER_NEAREST == (int)AK_RASTER_FILTER_NEAREST,
+               "texture enums");
+
 void cli_bounds_add_pose(const cli_poser* p, ak_vec3* lo, ak_vec3* hi) { cli_bounds_add_visible(p, NULL, lo, hi); }
 
 void cli_bounds_add_visible(const cli_poser* p, const bool* hidden, ak_vec3* lo, ak_vec3* hi) {
@@ -75,11 +80,12 @@ int cli_frame_init_camera(cli_frame* f, const ak_scene* s, int width, int height
     size_t n = s ? ak_scene_joint_count(s) : 0;
     f->draw_capacity = (s ? s->mesh_count : 0) + CLI_MAX_EXTRA;
     f->draw = calloc(f->draw_capacity, sizeof(ak_raster_mesh));
+    f->tex = calloc(f->draw_capacity, sizeof(ak_raster_texture));
     f->joint_list = calloc(n + 1, sizeof(int));
     f->joint_parent = calloc(n + 1, sizeof(int16_t));
     f->joint_model = calloc(n + 1, sizeof(ak_mat4));
     int* map = calloc(n + 1, sizeof(int));
-    if (!f->draw || !f->joint_list || !f->joint_parent || !f->joint_model || !map) {
+    if (!f->draw || !f->tex || !f->joint_list || !f->joint_parent || !f->joint_model || !map) {
         free(map);
         cli_frame_free(f);
         return CLI_BAD_INPUT;
@@ -107,6 +113,7 @@ void cli_frame_free(cli_frame* f) {
     free(f->joint_parent);
     free(f->joint_model);
     free(f->draw);
+    free(f->tex);
     memset(f, 0, sizeof(*f));
 }
 
@@ -132,6 +139,27 @@ ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* 
         if (o && o->colors && o->colors[m]) {
             rm.colors = (ak_vec4_cspan){o->colors[m], mesh->vertex_count};
             rm.material.color = rgba(1, 1, 1, 1);
+            rm.material.specular = 0.15f;
+        } else if (!(o && o->tint.w > 0) && mesh->uvs && s->meshes[m].texture >= 0 &&
+                   (size_t)s->meshes[m].texture < s->texture_count && s->textures[s->meshes[m].texture].pixels) {
+            /* glTF: base colour = baseColorFactor (linear) x the sRGB texture, so the factor goes
+             * to the raster as an sRGB colour and the texel multiplies it in linear light */
+            const ak_scene_texture* st = &s->textures[s->meshes[m].texture];
+            ak_vec4 bc = s->meshes[m].has_material ? s->meshes[m].base_color : rgba(1, 1, 1, 1);
+            ak_raster_texture* t = &f->tex[mc];
+            *t = (ak_raster_texture){
+                .image = {.pixels = st->pixels, .width = st->width, .height = st->height},
+                .wrap_u = (ak_raster_wrap)st->wrap_s,
+                .wrap_v = (ak_raster_wrap)st->wrap_t,
+                .mag_filter = (ak_raster_filter)st->mag_filter,
+                .min_filter = (ak_raster_filter)st->min_filter,
+            };
+            rm.uvs = (ak_vec2_cspan){mesh->uvs, mesh->vertex_count};
+            rm.texture = t;
+            rm.material.color = rgba(ak_linear_to_srgb(ak_clampf(bc.x, 0, 1)), ak_linear_to_srgb(ak_clampf(bc.y, 0, 1)),
+                                     ak_linear_to_srgb(ak_clampf(bc.z, 0, 1)), 1);
+            if (rm.material.color.x == 0 && rm.material.color.y == 0 && rm.material.color.z == 0)
+                rm.material.color.w = 1; /* black factor: not the "all zero -> clay" default */
             rm.material.specular = 0.15f;
         }
         meshes[mc++] = rm;

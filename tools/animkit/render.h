@@ -17,6 +17,7 @@ typedef struct cli_frame {
     ak_mat4* joint_model;
     size_t joint_count;
     ak_raster_mesh* draw;  /* draw list: every scene mesh plus CLI_MAX_EXTRA extras */
+    ak_raster_texture* tex; /* [draw_capacity] the base colour texture of draw[i] */
     size_t draw_capacity;
 } cli_frame;
 

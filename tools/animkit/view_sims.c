@@ -9,7 +9,6 @@
 #include <string.h>
 
 #include "boids_run.h"
-#include "cli_json.h"
 #include "cloth_run.h"
 #include "particles_run.h"
 #include "view_app.h"
@@ -19,33 +18,9 @@ const char* const view_sim_kinds = "particles, boids, cloth, terrain";
 #define MAX_STEPS_PER_FRAME 64
 #define WIND_STEP 0.5f
 
-/* Read a scene file after checking it with the strict JSON reader (size budget, syntax). */
-static char* read_scene(const char* path, size_t* size, char* err, size_t err_size) {
-    cli_json j = {.file = path};
-    cJSON* root = cli_json_load(&j, path, 0);
-    if (!root) {
-        snprintf(err, err_size, "%s", j.message);
-        return NULL;
-    }
-    cJSON_Delete(root);
-    FILE* f = fopen(path, "rb");
-    if (!f) {
-        snprintf(err, err_size, "%s: cannot open the file", path);
-        return NULL;
-    }
-    char* text = NULL;
-    long n = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
-    if (n >= 0 && fseek(f, 0, SEEK_SET) == 0) text = malloc((size_t)n + 1);
-    size_t got = text ? fread(text, 1, (size_t)n, f) : 0;
-    fclose(f);
-    if (!text || got != (size_t)n) {
-        free(text);
-        snprintf(err, err_size, "%s: cannot read the file", path);
-        return NULL;
-    }
-    text[got] = '\0';
-    *size = got;
-    return text;
+/* A library scene loader's message into err. */
+static void diag_copy(const ak_diag* d, char* err, size_t err_size) {
+    if (err && err_size) snprintf(err, err_size, "%s", d->message);
 }
 
 /* Pixel radius of a sphere (centre c, radius r) as the camera sees it; false when behind. */
@@ -128,7 +103,7 @@ static int init_fail(void (*destroy)(void*), void* state, int rc, char* err, siz
 /* ---- particles ---------------------------------------------------------------------------- */
 
 typedef struct psim {
-    particles_scene scene;
+    ak_particles_scene scene;
     ak_particle_sphere* spheres0; /* the spheres as loaded (reset puts them back) */
     particles_character ch;
     bool use_char, char_ready;
@@ -158,7 +133,7 @@ static void psim_destroy(void* state) {
     free(p->spheres0);
     free(p->colours);
     particles_sprites_free(&p->sprites);
-    particles_scene_free(&p->scene);
+    ak_particles_scene_free(&p->scene);
     free(p);
 }
 
@@ -184,7 +159,7 @@ static int psim_restart(psim* p) {
  * the first 2 seconds (as `animkit particles -o` frames its whole run); the floor plane. */
 static int psim_bounds_run(psim* p) {
     ak_vec3 lo = ak_vec3_splat(INFINITY), hi = ak_vec3_splat(-INFINITY);
-    const particles_scene* s = &p->scene;
+    const ak_particles_scene* s = &p->scene;
     for (size_t k = 0; k < s->world.spheres.count; ++k) {
         const ak_particle_sphere* sp = &s->world.spheres.ptr[k];
         particles_bounds_add(&lo, &hi, ak_vec3_sub(sp->center, ak_vec3_splat(sp->radius)));
@@ -231,19 +206,18 @@ static int psim_init(void** state, const char* spec, const view_sim_opts* o, cha
         const char* name = spec + 7;
         if (!particles_preset_known(name))
             return init_fail(psim_destroy, p, CLI_BAD_USAGE, err, err_size,
-                             "particles:preset:%s: the presets are %s", name, particles_preset_names);
-        if (!particles_preset(name, &p->scene))
-            return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "out of memory");
+                             "particles:preset:%s: the presets are " AK_PARTICLES_SCENE_PRESETS, name);
+        ak_diag diag;
+        if (ak_particles_scene_preset(name, &p->scene, &diag) != AK_OK)
+            return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "%s", diag.message);
         p->use_char = strcmp(name, "character") == 0;
     } else if (!spec[0]) {
         return init_fail(psim_destroy, p, CLI_BAD_USAGE, err, err_size,
                          "particles: give a scene file (particles:SCENE.json) or a preset (particles:preset:NAME)");
     } else {
-        size_t size = 0;
-        char* text = read_scene(spec, &size, err, err_size);
-        bool ok = text && particles_scene_parse(spec, text, size, &p->scene, err, err_size);
-        free(text);
-        if (!ok) {
+        ak_diag diag;
+        if (ak_particles_scene_load_file(spec, &p->scene, &diag) != AK_OK) {
+            diag_copy(&diag, err, err_size);
             psim_destroy(p);
             return CLI_BAD_INPUT;
         }
@@ -314,7 +288,7 @@ static void psim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
 
 static bool psim_key(void* state, int key, char* msg, size_t msg_size) {
     psim* p = state;
-    return wind_key(key, &p->run.world.wind, msg, msg_size);
+    return wind_key(key, &p->run.lib.world.wind, msg, msg_size);
 }
 
 static bool psim_grab(void* state, const ak_raster_camera* cam, int w, int h, float x, float y, ak_vec3* anchor) {
@@ -344,7 +318,7 @@ static void psim_drag(void* state, ak_vec3 delta) {
 
 static void psim_status(void* state, char* out, size_t n) {
     psim* p = state;
-    ak_vec3 w = p->run.world.wind;
+    ak_vec3 w = p->run.lib.world.wind;
     snprintf(out, n, "t %.2fs, %zu particles, wind %.2g %.2g %.2g%s", ak_particles_time(p->run.ps),
              ak_particles_get_state(p->run.ps).count, (double)w.x, (double)w.y, (double)w.z,
              p->failed ? ", stopped (step failed)" : "");
@@ -381,7 +355,7 @@ static const view_sim particles_sim = {
 /* ---- boids ------------------------------------------------------------------------------- */
 
 typedef struct bsim {
-    cli_boids_scene sc;
+    ak_boids_scene sc;
     ak_boids_obstacle* obstacles0; /* as loaded (reset puts them back) */
     boids_run run;
     boids_shapes sh;
@@ -401,7 +375,7 @@ static void bsim_destroy(void* state) {
     boids_run_free(&b->run);
     boids_shapes_free(&b->sh);
     free(b->obstacles0);
-    cli_boids_scene_free(&b->sc);
+    ak_boids_scene_free(&b->sc);
     free(b);
 }
 
@@ -426,19 +400,18 @@ static int bsim_init(void** state, const char* spec, const view_sim_opts* o, cha
     b->grabbed = -1;
     b->threads = o->threads > 0 ? (uint32_t)o->threads : 1;
     b->file = spec[0] ? spec : "boids (default scene)";
-    cli_boids_scene_defaults(&b->sc);
+    ak_boids_scene_defaults(&b->sc);
     if (strncmp(spec, "preset:", 7) == 0) {
-        const int bad = cli_boids_scene_preset(spec + 7, &b->sc);
-        if (bad < 0)
+        ak_diag diag;
+        const ak_result res = ak_boids_scene_preset(spec + 7, &b->sc, &diag);
+        if (res == AK_ERR_NOT_FOUND)
             return init_fail(bsim_destroy, b, CLI_BAD_USAGE, err, err_size,
-                             "boids:%s: the presets are " CLI_BOIDS_PRESETS, spec);
-        if (bad) return init_fail(bsim_destroy, b, CLI_BAD_INPUT, err, err_size, "out of memory");
+                             "boids:%s: the presets are " AK_BOIDS_SCENE_PRESETS, spec);
+        if (res != AK_OK) return init_fail(bsim_destroy, b, CLI_BAD_INPUT, err, err_size, "out of memory");
     } else if (spec[0]) {
-        size_t size = 0;
-        char* text = read_scene(spec, &size, err, err_size);
-        int bad = !text || cli_boids_scene_parse(spec, text, size, &b->sc, err, err_size);
-        free(text);
-        if (bad) {
+        ak_diag diag;
+        if (ak_boids_scene_load_file(spec, &b->sc, &diag) != AK_OK) {
+            diag_copy(&diag, err, err_size);
             bsim_destroy(b);
             return CLI_BAD_INPUT;
         }
@@ -493,7 +466,7 @@ static size_t bsim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
     ak_raster_mesh birds, obs;
     boids_shapes_update(&b->sh, &b->sc, &b->run, (float)b->step_index * b->sc.dt, &birds, &obs);
     size_t n = 0;
-    if (n < cap && b->run.n) out[n++] = birds;
+    if (n < cap && b->run.agent_count) out[n++] = birds;
     if (n < cap && b->sh.otri) out[n++] = obs;
     return n;
 }
@@ -528,8 +501,8 @@ static void bsim_drag(void* state, ak_vec3 delta) {
 
 static void bsim_status(void* state, char* out, size_t n) {
     bsim* b = state;
-    snprintf(out, n, "t %.2fs, %zu agents, order %.3f%s", (double)b->step_index * (double)b->sc.dt, b->run.n,
-             (double)ak_boids_order((ak_vec3_cspan){b->run.v, b->run.n}), b->failed ? ", stopped (step failed)" : "");
+    snprintf(out, n, "t %.2fs, %zu agents, order %.3f%s", (double)b->step_index * (double)b->sc.dt, b->run.agent_count,
+             (double)ak_boids_order((ak_vec3_cspan){b->run.velocities, b->run.agent_count}), b->failed ? ", stopped (step failed)" : "");
 }
 
 static const view_help_entry bsim_keys[] = {
@@ -556,7 +529,7 @@ static const view_sim boids_sim = {
 /* ---- cloth -------------------------------------------------------------------------------- */
 
 typedef struct csim {
-    cloth_scene sc;
+    ak_cloth_scene sc;
     bool sc_ready;
     char name[64];
     ak_cloth_sphere* spheres0; /* as loaded (reset puts them back, and the wind) */
@@ -576,7 +549,7 @@ static void csim_destroy(void* state) {
     cloth_run_free(&c->run);
     free(c->props);
     free(c->spheres0);
-    if (c->sc_ready) cloth_scene_free(&c->sc);
+    if (c->sc_ready) ak_cloth_scene_free(&c->sc);
     free(c);
 }
 
@@ -611,7 +584,8 @@ static int csim_init(void** state, const char* spec, const view_sim_opts* o, cha
     snprintf(c->name, sizeof c->name, "%s", spec);
     if (strncmp(spec, "preset:", 7) == 0) {
         c->sc_ready = true;
-        if (!cloth_scene_preset(spec + 7, &c->sc))
+        ak_diag diag;
+        if (ak_cloth_scene_preset(spec + 7, &c->sc, &diag) != AK_OK)
             return init_fail(csim_destroy, c, CLI_BAD_USAGE, err, err_size,
                              "cloth:%s: the presets are flag, curtain, drape, cape", spec);
         snprintf(c->name, sizeof c->name, "%s", spec + 7);
@@ -619,12 +593,11 @@ static int csim_init(void** state, const char* spec, const view_sim_opts* o, cha
         return init_fail(csim_destroy, c, CLI_BAD_USAGE, err, err_size,
                          "cloth: give a scene file (cloth:SCENE.json) or a preset (cloth:preset:NAME)");
     } else {
-        size_t size = 0;
-        char* text = read_scene(spec, &size, err, err_size);
-        bool ok = text && cloth_scene_parse(spec, text, size, &c->sc, err, err_size);
-        free(text);
+        ak_diag diag;
+        const bool ok = ak_cloth_scene_load_file(spec, &c->sc, &diag) == AK_OK;
         c->sc_ready = ok;
         if (!ok) {
+            diag_copy(&diag, err, err_size);
             csim_destroy(c);
             return CLI_BAD_INPUT;
         }

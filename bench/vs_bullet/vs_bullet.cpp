@@ -1,0 +1,224 @@
+// bench/vs_bullet: animkit's rigid bodies (XPBD, animkit/rigid.h) beside Bullet 3 (Debian's
+// libbullet-dev, btDiscreteDynamicsWorld with its sequential-impulse solver), in one process
+// on the same scenes with matched settings: a 2D pyramid of unit boxes on the ground, and
+// spheres dropped as a block into an open box. Prints time per step for both, the ratio, and
+// the stability of each (the largest horizontal drift of a body from its start, the deepest
+// penetration seen). One thread; sleeping on in both; dt = 1/60; friction 0.5; density 1000.
+//
+//   bench_rigid_vs_bullet [--layers L] [--spheres N] [--steps S] [--substeps K]
+#include <btBulletDynamicsCommon.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include <animkit/rigid.h>
+
+#include "bench_clock.h"
+
+struct result {
+    double ms_per_step;
+    double drift;  // m, largest horizontal displacement of a body from its start
+    double pen;    // m, deepest penetration seen over the run
+};
+
+struct scene {
+    std::vector<ak_rigid_body_desc> bodies;  // the first `planes` are static planes
+    size_t planes;
+};
+
+static ak_rigid_body_desc zero_body() {
+    ak_rigid_body_desc b;
+    std::memset(&b, 0, sizeof b);
+    return b;
+}
+
+static scene pyramid(int layers) {
+    scene s;
+    ak_rigid_body_desc g = zero_body();
+    g.shape.type = AK_RIGID_PLANE;
+    g.shape.normal = ak_vec3_make(0, 1, 0);
+    s.bodies.push_back(g);
+    s.planes = 1;
+    for (int l = 0; l < layers; ++l)
+        for (int i = 0; i < layers - l; ++i) {
+            ak_rigid_body_desc b = zero_body();
+            b.shape.type = AK_RIGID_BOX;
+            b.shape.half_extents = ak_vec3_make(0.5f, 0.5f, 0.5f);
+            b.position = ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - l - 1)), 0.5f + (float)l, 0.0f);
+            s.bodies.push_back(b);
+        }
+    return s;
+}
+
+// n spheres of radius 0.1 in a lattice 0.25 m apart (15 x 15 per layer) above an open 4 x 4 m
+// box: the ground and four walls
+static scene spheres(int n) {
+    scene s;
+    const ak_vec3 normals[5] = {{0, 1, 0}, {1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1}};
+    const ak_vec3 points[5] = {{0, 0, 0}, {-2, 0, 0}, {2, 0, 0}, {0, 0, -2}, {0, 0, 2}};
+    for (int k = 0; k < 5; ++k) {
+        ak_rigid_body_desc g = zero_body();
+        g.shape.type = AK_RIGID_PLANE;
+        g.shape.normal = normals[k];
+        g.position = points[k];
+        s.bodies.push_back(g);
+    }
+    s.planes = 5;
+    const int side = 15;
+    for (int i = 0; i < n; ++i) {
+        ak_rigid_body_desc b = zero_body();
+        b.shape.type = AK_RIGID_SPHERE;
+        b.shape.radius = 0.1f;
+        int x = i % side, z = (i / side) % side, y = i / (side * side);
+        b.position = ak_vec3_make(-1.75f + 0.25f * (float)x + 0.01f * (float)(y % 3), 0.3f + 0.25f * (float)y,
+                                  -1.75f + 0.25f * (float)z);
+        s.bodies.push_back(b);
+    }
+    return s;
+}
+
+static result run_animkit(const scene& sc, int steps, unsigned substeps) {
+    const size_t n = sc.bodies.size();
+    ak_rigid_model_desc md;
+    std::memset(&md, 0, sizeof md);
+    md.bodies.ptr = sc.bodies.data();
+    md.bodies.count = n;
+    ak_rigid_model* m = nullptr;
+    result r = {0, 0, 0};
+    if (ak_rigid_model_create(&md, nullptr, &m) != AK_OK) return r;
+    std::vector<ak_vec3> x(n), v(n), w(n);
+    std::vector<ak_quat> q(n);
+    std::vector<float> timers(n, 0.0f);
+    ak_rigid_initial_state(m, {x.data(), n}, {q.data(), n}, {v.data(), n}, {w.data(), n});
+    float pen = 0.0f;
+    ak_rigid_step_job job;
+    std::memset(&job, 0, sizeof job);
+    job.model = m;
+    job.dt = 1.0f / 60.0f;
+    job.substeps = substeps;
+    job.gravity = ak_vec3_make(0, -9.81f, 0);
+    job.positions = {x.data(), n};
+    job.orientations = {q.data(), n};
+    job.velocities = {v.data(), n};
+    job.angular_velocities = {w.data(), n};
+    job.sleep_timers = {timers.data(), n};
+    job.out_max_penetration = &pen;
+    const size_t bytes = ak_rigid_step_scratch_size(&job);
+    std::vector<uint8_t> scratch(bytes);
+    job.scratch = {scratch.data(), bytes};
+    const double t0 = bench_wall_s();
+    for (int s = 0; s < steps; ++s) {
+        ak_rigid_step_run(&job);
+        r.pen = std::fmax(r.pen, (double)pen);
+    }
+    r.ms_per_step = 1e3 * (bench_wall_s() - t0) / steps;
+    for (size_t i = sc.planes; i < n; ++i)
+        r.drift = std::fmax(r.drift, std::hypot((double)(x[i].x - sc.bodies[i].position.x),
+                                                (double)(x[i].z - sc.bodies[i].position.z)));
+    ak_rigid_model_destroy(m);
+    return r;
+}
+
+static result run_bullet(const scene& sc, int steps) {
+    btDefaultCollisionConfiguration config;
+    btCollisionDispatcher dispatcher(&config);
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
+    world.setGravity(btVector3(0, -9.81f, 0));
+    std::vector<btCollisionShape*> shapes;
+    std::vector<btRigidBody*> bodies;
+    std::vector<btDefaultMotionState*> states;
+    for (const ak_rigid_body_desc& d : sc.bodies) {
+        btCollisionShape* shape;
+        btScalar mass = 0;
+        if (d.shape.type == AK_RIGID_PLANE) {
+            btVector3 nrm(d.shape.normal.x, d.shape.normal.y, d.shape.normal.z);
+            shape = new btStaticPlaneShape(nrm, nrm.dot(btVector3(d.position.x, d.position.y, d.position.z)));
+        } else if (d.shape.type == AK_RIGID_BOX) {
+            btVector3 he(d.shape.half_extents.x, d.shape.half_extents.y, d.shape.half_extents.z);
+            shape = new btBoxShape(he);
+            mass = 1000.0f * 8.0f * he.x() * he.y() * he.z();
+        } else {
+            shape = new btSphereShape(d.shape.radius);
+            mass = 1000.0f * 4.0f / 3.0f * 3.14159265f * d.shape.radius * d.shape.radius * d.shape.radius;
+        }
+        btVector3 inertia(0, 0, 0);
+        if (mass > 0) shape->calculateLocalInertia(mass, inertia);
+        btTransform t;
+        t.setIdentity();
+        if (d.shape.type != AK_RIGID_PLANE) t.setOrigin(btVector3(d.position.x, d.position.y, d.position.z));
+        btDefaultMotionState* ms = new btDefaultMotionState(t);
+        btRigidBody::btRigidBodyConstructionInfo info(mass, ms, shape, inertia);
+        info.m_friction = 0.5f;
+        btRigidBody* b = new btRigidBody(info);
+        world.addRigidBody(b);
+        shapes.push_back(shape);
+        bodies.push_back(b);
+        states.push_back(ms);
+    }
+    result r = {0, 0, 0};
+    const btScalar dt = 1.0f / 60.0f;
+    const double t0 = bench_wall_s();
+    double in_probe = 0.0;
+    for (int s = 0; s < steps; ++s) {
+        world.stepSimulation(dt, 1, dt);
+        const double p0 = bench_wall_s();
+        for (int k = 0; k < dispatcher.getNumManifolds(); ++k) {
+            btPersistentManifold* mf = dispatcher.getManifoldByIndexInternal(k);
+            for (int c = 0; c < mf->getNumContacts(); ++c)
+                r.pen = std::fmax(r.pen, -(double)mf->getContactPoint(c).getDistance());
+        }
+        in_probe += bench_wall_s() - p0;
+    }
+    r.ms_per_step = 1e3 * (bench_wall_s() - t0 - in_probe) / steps;
+    for (size_t i = sc.planes; i < bodies.size(); ++i) {
+        btVector3 p = bodies[i]->getCenterOfMassPosition();
+        r.drift = std::fmax(r.drift, std::hypot((double)(p.x() - sc.bodies[i].position.x),
+                                                (double)(p.z() - sc.bodies[i].position.z)));
+    }
+    for (size_t i = 0; i < bodies.size(); ++i) {
+        world.removeRigidBody(bodies[i]);
+        delete bodies[i];
+        delete states[i];
+        delete shapes[i];
+    }
+    return r;
+}
+
+int main(int argc, char** argv) {
+    int layers = 20, nspheres = 10000, steps = 300;
+    unsigned substeps = 20;
+    for (int i = 1; i + 1 < argc; i += 2) {
+        if (!std::strcmp(argv[i], "--layers")) layers = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--spheres")) nspheres = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--substeps")) substeps = (unsigned)std::atoi(argv[i + 1]);
+    }
+    if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || steps < 1 || substeps < 1 || substeps > 1000) {
+        std::fprintf(stderr, "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--steps S] [--substeps K]\n");
+        return 2;
+    }
+    std::printf("dt 1/60 s, %d steps, one thread, sleeping on; animkit XPBD %u substeps x 1 iteration; Bullet %d.%02d "
+                "1 step x 10 iterations (its defaults)\n",
+                steps, substeps, btGetVersion() / 100, btGetVersion() % 100);
+    std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s\n", "scene", "animkit ms", "Bullet ms", "ratio",
+                "animkit drift", "Bullet drift", "animkit pen", "Bullet pen");
+    const scene scenes[2] = {pyramid(layers), spheres(nspheres)};
+    const char* names[2] = {"pyramid", "spheres"};
+    for (int k = 0; k < 2; ++k) {
+        result a = run_animkit(scenes[k], steps, substeps);
+        result b = run_bullet(scenes[k], steps);
+        char label[64];
+        std::snprintf(label, sizeof label, "%s (%zu bodies)", names[k], scenes[k].bodies.size() - scenes[k].planes);
+        std::printf("%-26s %11.3f %11.3f %7.3f %13.3g %13.3g %12.3g %12.3g\n", label, a.ms_per_step, b.ms_per_step,
+                    b.ms_per_step / a.ms_per_step, a.drift, b.drift, a.pen, b.pen);
+        std::fflush(stdout);
+    }
+    std::printf("ratio = Bullet time / animkit time (above 1: animkit faster); drift: largest horizontal\n"
+                "displacement of a body from its start (pyramid: should be ~0); pen: deepest penetration seen\n");
+    return 0;
+}

@@ -1,0 +1,313 @@
+/* animkit rigid: rigid bodies (spheres, boxes, capsules, static planes), contacts, joints,
+ * ragdolls.
+ *
+ * What it does:
+ *   - a model (ak_rigid_model) holds each body's shape, mass, inertia and material; it is built
+ *     once from descs and is read-only afterwards;
+ *   - mass and inertia tensor from the shape and a density (kg/m^3) or a given mass; static
+ *     bodies (and every plane) have infinite mass;
+ *   - dynamics: position, quaternion orientation, linear and angular velocity in world space; the
+ *     gyroscopic term -w x (I w) is integrated implicitly in the body frame (one Newton step of
+ *     backward Euler per substep, as in Box2D v3 / Catto GDC 2015), so a torque-free box spinning
+ *     near its intermediate axis flips and angular momentum stays (see docs/rigid.md);
+ *     linear and angular damping;
+ *   - solver: XPBD rigid bodies with substeps (Mueller, Macklin, Chentanez, Jeschke, Kim 2020,
+ *     "Detailed Rigid Body Simulation with Extended Position Based Dynamics"): each substep
+ *     predicts, finds contacts on the predicted state, projects non-penetration and static
+ *     friction on positions, derives velocities, then applies dynamic friction and restitution;
+ *   - contacts: sweep-and-prune broad phase along the axis of the bodies' largest spread,
+ *     closed-form narrow phase for every pair of sphere, box, capsule and plane (box-box:
+ *     separating axis test over the 15 axes, then the incident face clipped against the
+ *     reference face for a manifold of up to 8 points); contacts are found within
+ *     contact_offset of touching (speculative); a contact's friction is the geometric mean of
+ *     its bodies' and its restitution the larger of the two; pairs are solved from the top down;
+ *   - joints: ball (optional swing cone and twist range), hinge (optional angle limits), fixed,
+ *     prismatic (optional distance limits), with compliance, and drives towards a target
+ *     relative orientation (XPBD positional and angular constraints, their section 3.3);
+ *   - ragdolls: a capsule per bone of a skeleton and a joint per joint with the skeleton's
+ *     limits, started from an animated pose (and its velocities), written back as a pose;
+ *   - sleeping: a connected group of touching or joined bodies whose speeds all stay under the
+ *     thresholds for sleep_time seconds is frozen until an awake body touches it;
+ *   - deterministic: the same inputs give the same bits (contacts are found and solved in an
+ *     order fixed by the positions and body indices); thread_count is accepted for the
+ *     interface's sake but this version runs every phase on the calling thread.
+ *
+ * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
+ * capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
+ * collision detection (a body moving more than its size in one substep can tunnel),
+ * collisions with particles or cloth.
+ *
+ * Usage (a box dropped on the ground):
+ *     ak_rigid_body_desc bodies[2] = {
+ *         { .shape = { .type = AK_RIGID_PLANE }, .is_static = true },
+ *         { .shape = { .type = AK_RIGID_BOX, .half_extents = {0.5f, 0.5f, 0.5f} },
+ *           .position = {0, 3, 0} } };
+ *     ak_rigid_model* model = NULL;
+ *     ak_rigid_model_desc md = { .bodies = { bodies, 2 } };
+ *     if (ak_rigid_model_create(&md, NULL, &model) != AK_OK) return 1;
+ *     ak_vec3 x[2], v[2], w[2]; ak_quat q[2];
+ *     ak_rigid_initial_state(model, (ak_vec3_span){x, 2}, (ak_quat_span){q, 2},
+ *                            (ak_vec3_span){v, 2}, (ak_vec3_span){w, 2});
+ *     ak_rigid_step_job job = { .model = model, .dt = 1.0f / 60, .gravity = {0, -9.81f, 0},
+ *         .positions = {x, 2}, .orientations = {q, 2}, .velocities = {v, 2},
+ *         .angular_velocities = {w, 2} };
+ *     size_t size = ak_rigid_step_scratch_size(&job);
+ *     job.scratch = (ak_u8_span){ malloc(size), size };
+ *     for (int f = 0; f < 120; ++f) if (ak_rigid_step_run(&job) != AK_OK) break;
+ *     ak_rigid_model_destroy(model);
+ *
+ * Ownership and threading: ak_rigid_model_create makes one allocation; the model is read-only
+ * afterwards and may be shared by threads. The state arrays and the scratch belong to the
+ * caller; ak_rigid_step_run never allocates. Steps of distinct states may run concurrently.
+ */
+#ifndef ANIMKIT_RIGID_H
+#define ANIMKIT_RIGID_H
+
+#include "math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum ak_rigid_shape_type {
+    AK_RIGID_SPHERE = 0, /* default: radius */
+    AK_RIGID_BOX,        /* half_extents along the body's local axes */
+    AK_RIGID_CAPSULE,    /* segment along the local Y axis from -half_height to +half_height,
+                            swept by radius */
+    AK_RIGID_PLANE,      /* static half-space below the plane through position with normal
+                            `normal` (world); the body's orientation is ignored */
+    AK_RIGID_SHAPE_COUNT
+} ak_rigid_shape_type;
+
+typedef struct ak_rigid_shape {
+    ak_rigid_shape_type type; /* 0 -> sphere */
+    float radius;             /* metres; sphere and capsule: > 0 (required) */
+    ak_vec3 half_extents;     /* metres; box: each > 0 (required) */
+    float half_height;        /* metres; capsule: half the segment's length, >= 0 */
+    ak_vec3 normal;           /* plane: world normal (normalised here); zero -> (0, 1, 0) */
+} ak_rigid_shape;
+
+/* Friction value that means "none" (zero friction means the default). */
+#define AK_RIGID_FRICTIONLESS (-1.0f)
+
+typedef struct ak_rigid_body_desc {
+    ak_rigid_shape shape;
+    ak_vec3 position;         /* world, centre of mass (plane: a point on it) */
+    ak_quat orientation;      /* body to world; zero -> identity (normalised here) */
+    ak_vec3 velocity;         /* m/s, world */
+    ak_vec3 angular_velocity; /* rad/s, world */
+    float density;            /* kg/m^3 when mass is 0; 0 -> 1000 */
+    float mass;               /* kg; 0 -> from density and the shape's volume */
+    float friction;         /* Coulomb coefficient (static); 0 -> 0.5; AK_RIGID_FRICTIONLESS -> 0 */
+    float dynamic_friction; /* Coulomb coefficient when sliding; 0 -> friction;
+                               AK_RIGID_FRICTIONLESS -> 0 */
+    float restitution;      /* normal velocity kept in a bounce, [0, 1]; 0 -> none */
+    bool is_static;         /* infinite mass, never moves (planes always are) */
+    uint32_t collision_group; /* bodies sharing a nonzero group do not collide with each other
+                                 (a ragdoll's limbs); 0 -> collides with every body */
+} ak_rigid_body_desc;
+
+AK_DEFINE_SPAN(rigid_body_desc, ak_rigid_body_desc)
+
+typedef enum ak_rigid_joint_type {
+    AK_RIGID_JOINT_BALL = 0,  /* default: the anchors coincide; optional swing cone */
+    AK_RIGID_JOINT_HINGE,     /* ball plus the bodies' axes stay parallel; optional angle limits */
+    AK_RIGID_JOINT_FIXED,     /* ball plus the relative orientation stays as built */
+    AK_RIGID_JOINT_PRISMATIC, /* relative orientation as built; b slides along the axis only;
+                                 optional distance limits */
+    AK_RIGID_JOINT_TYPE_COUNT
+} ak_rigid_joint_type;
+
+/* A joint between two bodies, described in world space at the bodies' desc poses (the model
+ * stores each body's local anchor and axes from them). XPBD constraints with compliance 0
+ * (rigid) or the given one, solved before the contacts each substep. */
+typedef struct ak_rigid_joint_desc {
+    ak_rigid_joint_type type;       /* 0 -> ball */
+    uint32_t body_a, body_b;        /* body indices, different; either may be static */
+    ak_vec3 anchor;                 /* world point where the bodies are joined */
+    ak_vec3 axis;                   /* world: hinge axis, prismatic slide axis, ball's swing axis;
+                                       zero -> (0, 0, 1) */
+    ak_vec3 axis_b;                 /* world: the axis as body b carries it, when b's zero-swing
+                                       pose differs from the built one (ball swing); zero -> axis */
+    float angle_offset;             /* hinge: the built pose's angle (rad) in the limits' measure:
+                                       the limits apply to angle + angle_offset; ball: the same for
+                                       the twist; 0 -> as built is 0 */
+    bool twist_limited;             /* ball: twist_lower <= twist about the axis <= twist_upper */
+    float twist_lower, twist_upper; /* radians */
+    bool limited;                   /* hinge: lower <= angle <= upper; prismatic: lower <= offset
+                                       <= upper; ball: swing (angle between the bodies' axes) <= upper */
+    float lower, upper;             /* radians (hinge, ball) or metres (prismatic), as built = 0 */
+    float compliance;               /* m/N and rad/(N m) of every part of the joint; 0 -> rigid */
+    bool drive;                     /* drive b's orientation relative to a towards drive_target */
+    ak_quat drive_target;           /* b's orientation in a's frame (a^-1 b); zero -> as built */
+    float drive_compliance; /* rad/(N m); 0 -> rigid (the drive then acts as a fixed joint) */
+} ak_rigid_joint_desc;
+
+AK_DEFINE_SPAN(rigid_joint_desc, ak_rigid_joint_desc)
+
+typedef struct ak_rigid_model_desc {
+    ak_rigid_body_desc_cspan bodies;  /* at least one (required) */
+    ak_rigid_joint_desc_cspan joints; /* optional */
+    float linear_damping;             /* 1/s: v *= 1 / (1 + h c) each substep; 0 -> none */
+    float angular_damping;            /* 1/s: the same on angular velocity; 0 -> none */
+    float contact_offset;      /* metres: contacts are found this far before touching; 0 -> 0.01 */
+    float sleep_linear_speed;  /* m/s under which a body may sleep; 0 -> 0.05 */
+    float sleep_angular_speed; /* rad/s under which a body may sleep; 0 -> 0.05 */
+    float sleep_time;          /* seconds a group must stay slow before it sleeps; 0 -> 0.5 */
+    uint32_t max_contacts;     /* contact points per substep the scratch holds; 0 -> 16 per body
+                                  + 64; more are dropped and counted in out_dropped_contacts */
+} ak_rigid_model_desc;
+
+/* The desc with zero defaults filled in (desc NULL -> every default; bodies copied, not checked;
+ * the bodies' own defaults are filled by ak_rigid_model_create). */
+AK_API ak_rigid_model_desc ak_rigid_model_desc_resolved(const ak_rigid_model_desc* desc);
+
+typedef struct ak_rigid_model ak_rigid_model;
+
+/* Build a model. Returns AK_ERR_NULL_ARG (desc or out_model NULL), AK_ERR_EMPTY (no body),
+ * AK_ERR_BAD_ARG (unknown shape, a radius or half extent <= 0 or a negative half height, a
+ * negative density, mass, friction other than AK_RIGID_FRICTIONLESS, damping, offset or sleep
+ * value, restitution outside [0, 1], more than 2^24 bodies, an allocator with only one function),
+ * AK_ERR_BAD_INDEX (a joint's body out of range, or both the same), AK_ERR_BAD_ARG (unknown
+ * joint type, lower > upper, negative compliance), AK_ERR_BAD_DATA (a non-finite value),
+ * AK_ERR_NO_MEMORY. *out_model is NULL on failure. */
+AK_API ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_allocator* alloc,
+                                       ak_rigid_model** out_model);
+/* Free a model; NULL is a no-op. */
+AK_API void ak_rigid_model_destroy(ak_rigid_model* model);
+
+/* Number of joints (0 for NULL). */
+AK_API size_t ak_rigid_joint_count(const ak_rigid_model* model);
+/* How far joint i is from satisfied in a state: *out_gap the distance between its anchors (m,
+ * prismatic: off the axis), *out_limit_excess how far its angle or offset is outside its limits
+ * (rad or m, 0 when inside or unlimited). AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX, AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t joint_index,
+                                      ak_vec3_cspan positions, ak_quat_cspan orientations,
+                                      float* out_gap, float* out_limit_excess);
+
+/* Number of bodies (0 for NULL). */
+AK_API size_t ak_rigid_body_count(const ak_rigid_model* model);
+/* Mass of a body in kg (INFINITY for a static one; 0 for NULL or an index out of range). */
+AK_API float ak_rigid_body_mass(const ak_rigid_model* model, size_t body_index);
+/* Principal moments of inertia (kg m^2) about the body's local axes (INFINITY for static; zero
+ * for NULL or an index out of range). */
+AK_API ak_vec3 ak_rigid_body_inertia(const ak_rigid_model* model, size_t body_index);
+/* A body's resolved desc (defaults filled in, orientation normalised, plane normal normalised);
+ * a zeroed desc for NULL or an index out of range. */
+AK_API ak_rigid_body_desc ak_rigid_body_get_desc(const ak_rigid_model* model, size_t body_index);
+
+/* The descs' initial state into the spans (each count >= body count). AK_ERR_NULL_ARG,
+ * AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_rigid_initial_state(const ak_rigid_model* model, ak_vec3_span out_positions,
+                                        ak_quat_span out_orientations, ak_vec3_span out_velocities,
+                                        ak_vec3_span out_angular_velocities);
+
+/* Kinetic plus gravitational potential energy (J) of a state, -g.x m summed over dynamic bodies. */
+AK_API double ak_rigid_energy(const ak_rigid_model* model, ak_vec3 gravity, ak_vec3_cspan positions,
+                              ak_quat_cspan orientations, ak_vec3_cspan velocities,
+                              ak_vec3_cspan angular_velocities);
+
+/* World angular momentum (kg m^2/s) of one body about its centre of mass: R I R^T w. */
+AK_API ak_vec3 ak_rigid_angular_momentum(const ak_rigid_model* model, size_t body_index,
+                                         ak_quat orientation, ak_vec3 angular_velocity);
+
+/* ---- ragdolls ------------------------------------------------------------------------- */
+
+struct ak_skeleton;
+
+/* How one skeleton joint maps onto the ragdoll's bodies. */
+typedef struct ak_rigid_ragdoll_bone {
+    int32_t body;     /* index into the model's bodies (body_offset included), or -1 for
+                         a joint without a body (a leaf: it keeps its local transform) */
+    ak_vec3 offset;   /* the joint's position in its body's frame (m) */
+    ak_quat rotation; /* the joint's model rotation in its body's frame */
+} ak_rigid_ragdoll_bone;
+
+AK_DEFINE_SPAN(rigid_ragdoll_bone, ak_rigid_ragdoll_bone)
+
+typedef struct ak_rigid_ragdoll_desc {
+    const struct ak_skeleton* skeleton; /* required */
+    ak_transform_cspan local_pose;      /* the start pose, local transforms (required) */
+    ak_transform_cspan previous_pose;   /* optional: the pose `previous_dt` earlier, for the
+                                           bodies' start velocities; empty -> at rest */
+    float previous_dt;                  /* seconds; > 0 when previous_pose is given */
+    ak_mat4 root;                       /* world transform above the skeleton; zero -> identity */
+    uint32_t body_offset;               /* index the ragdoll's first body will have */
+    float radius_scale;                 /* capsule radius / bone length; 0 -> 0.2 */
+    float max_radius;                   /* metres; 0 -> 0.1 */
+    float density;                      /* kg/m^3; 0 -> 1000 */
+    float friction;                     /* 0 -> 0.5 */
+    uint32_t collision_group;           /* the limbs' group (no self-collision); 0 -> 1 */
+} ak_rigid_ragdoll_desc;
+
+/* Bodies and joints a ragdoll of this skeleton has: one capsule per joint with children (from
+ * the joint to the mean of its children's positions), one joint per such body whose joint has
+ * a parent. 0 for NULL. */
+AK_API size_t ak_rigid_ragdoll_body_count(const struct ak_skeleton* skeleton);
+AK_API size_t ak_rigid_ragdoll_joint_count(const struct ak_skeleton* skeleton);
+
+/* Build a ragdoll's body and joint descs (to put in an ak_rigid_model_desc, after body_offset
+ * other bodies) and the joint-to-body map. Skeleton joint types become rigid joints: hinge ->
+ * hinge with its limits, ball -> ball with its cone, free -> ball, prism -> prismatic; limits are
+ * taken relative to the skeleton's rest pose as the skeleton measures them. Sizes: out_bodies
+ * >= body count, out_joints >= joint count, out_bones >= skeleton joint count. Returns
+ * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_ARG (previous_pose without previous_dt > 0,
+ * negative sizes), AK_ERR_BAD_DATA (a non-finite pose). */
+AK_API ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
+                                        ak_rigid_body_desc_span out_bodies,
+                                        ak_rigid_joint_desc_span out_joints,
+                                        ak_rigid_ragdoll_bone_span out_bones);
+
+/* The ragdoll's bodies written back as a skeleton pose: local transforms (scale from
+ * fallback_pose) so that skinning and export work unchanged. Joints without a body keep
+ * fallback_pose's local transform. root as in the desc. Sizes >= skeleton joint count.
+ * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX (a bone's body out of the state). */
+AK_API ak_result ak_rigid_ragdoll_pose(const struct ak_skeleton* skeleton,
+                                       ak_rigid_ragdoll_bone_cspan bones, ak_mat4 root,
+                                       ak_vec3_cspan positions, ak_quat_cspan orientations,
+                                       ak_transform_cspan fallback_pose,
+                                       ak_transform_span out_local_pose);
+
+/* ---- step ------------------------------------------------------------------------------ */
+
+#define AK_RIGID_MAX_THREADS 64
+
+typedef struct ak_rigid_step_job {
+    const ak_rigid_model* model; /* required */
+    float dt;                    /* seconds, > 0 (required) */
+    uint32_t substeps;           /* XPBD substeps per step; 0 -> 10; <= 1000 */
+    ak_vec3 gravity;             /* m/s^2, world (zero is a real choice: no gravity) */
+    uint32_t thread_count;       /* <= AK_RIGID_MAX_THREADS; for now always the
+                                    calling thread (see the header's opening) */
+    /* State, one element per body, read and written (world space). */
+    ak_vec3_span positions;
+    ak_quat_span orientations;
+    ak_vec3_span velocities;
+    ak_vec3_span angular_velocities;
+    ak_f32_span sleep_timers; /* optional: seconds each body has been slow (state, start at
+                                 0); empty -> bodies never sleep */
+    ak_u8_span scratch;       /* >= ak_rigid_step_scratch_size(job) bytes */
+    /* Outputs (optional). */
+    float* out_max_penetration;     /* metres: deepest contact after the step's last solve */
+    uint32_t* out_contact_count;    /* contact points of the last substep */
+    uint32_t* out_dropped_contacts; /* contact points over max_contacts, summed over substeps */
+} ak_rigid_step_job;
+
+/* Bytes of scratch a step needs (0 for a NULL job or model). */
+AK_API size_t ak_rigid_step_scratch_size(const ak_rigid_step_job* job);
+
+/* First rule the job breaks: AK_ERR_NULL_ARG (job or model NULL), AK_ERR_BAD_ARG (dt <= 0 or
+ * not finite, substeps > 1000, thread_count > AK_RIGID_MAX_THREADS, non-finite gravity),
+ * AK_ERR_SPAN_SMALL (a state span shorter than the body count, sleep_timers neither empty nor
+ * long enough, scratch too small), AK_ERR_BAD_DATA (a non-finite state value). */
+AK_API ak_result ak_rigid_step_validate(const ak_rigid_step_job* job);
+
+/* Advance the state by dt. Validates first and writes nothing on failure. Returns AK_ERR_BAD_DATA
+ * (and leaves the state as it was) when the step produced a non-finite value, so a caller can
+ * name the step that blew up. */
+AK_API ak_result ak_rigid_step_run(const ak_rigid_step_job* job);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ANIMKIT_RIGID_H */

@@ -1,0 +1,372 @@
+/* Rigid-body model: validation, mass and inertia from shapes, queries. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rigid_impl.h"
+
+static void* def_alloc(size_t size, void* user) {
+    (void)user;
+    return malloc(size);
+}
+static void def_free(void* ptr, void* user) {
+    (void)user;
+    free(ptr);
+}
+
+static bool vec_finite(ak_vec3 v) { return ak_vec3_is_finite(v); }
+
+/* Mass (for density 1) and principal moments per unit mass of a shape. */
+static void shape_unit_mass(const ak_rigid_shape* s, double* out_volume, ak_vec3* out_i_per_mass) {
+    const double pi = 3.14159265358979323846;
+    double r = s->radius;
+    switch (s->type) {
+    case AK_RIGID_SPHERE: {
+        *out_volume = 4.0 / 3.0 * pi * r * r * r;
+        float k = (float)(0.4 * r * r);
+        *out_i_per_mass = ak_vec3_make(k, k, k);
+        break;
+    }
+    case AK_RIGID_BOX: {
+        double x = s->half_extents.x, y = s->half_extents.y, z = s->half_extents.z;
+        *out_volume = 8.0 * x * y * z;
+        /* solid box of sides 2x, 2y, 2z: I_x = m (4y^2 + 4z^2) / 12 */
+        *out_i_per_mass =
+            ak_vec3_make((float)((y * y + z * z) / 3.0), (float)((x * x + z * z) / 3.0),
+                         (float)((x * x + y * y) / 3.0));
+        break;
+    }
+    case AK_RIGID_CAPSULE: {
+        double h = s->half_height;
+        double vc = pi * r * r * 2.0 * h, vs = 4.0 / 3.0 * pi * r * r * r, v = vc + vs;
+        /* cylinder (length 2h) plus two hemispheres whose centres of mass sit 3r/8 beyond the
+         * cylinder's ends: about the long axis m r^2/2 and 2 m r^2/5; across it m (r^2/4 +
+         * (2h)^2/12) and m (2r^2/5 + h^2 + 3hr/4) */
+        double iy = vc * r * r / 2.0 + vs * 0.4 * r * r;
+        double ix = vc * (r * r / 4.0 + h * h / 3.0) + vs * (0.4 * r * r + h * h + 0.75 * h * r);
+        *out_volume = v;
+        *out_i_per_mass = ak_vec3_make((float)(ix / v), (float)(iy / v), (float)(ix / v));
+        break;
+    }
+    default:
+        *out_volume = 0.0;
+        *out_i_per_mass = ak_vec3_zero();
+        break;
+    }
+}
+
+ak_rigid_model_desc ak_rigid_model_desc_resolved(const ak_rigid_model_desc* desc) {
+    ak_rigid_model_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc) d = *desc;
+    if (d.contact_offset == 0.0f) d.contact_offset = 0.01f;
+    if (d.sleep_linear_speed == 0.0f) d.sleep_linear_speed = 0.05f;
+    if (d.sleep_angular_speed == 0.0f) d.sleep_angular_speed = 0.05f;
+    if (d.sleep_time == 0.0f) d.sleep_time = 0.5f;
+    if (d.max_contacts == 0) {
+        size_t n = d.bodies.count > (1u << 24) ? (1u << 24) : d.bodies.count;
+        d.max_contacts = (uint32_t)(16 * n + 64);
+    }
+    return d;
+}
+
+static ak_result check_friction(float f) {
+    if (!ak_finitef(f)) return AK_ERR_BAD_DATA;
+    if (f < 0.0f && f != AK_RIGID_FRICTIONLESS) return AK_ERR_BAD_ARG;
+    return AK_OK;
+}
+
+static ak_result check_body(const ak_rigid_body_desc* b) {
+    const ak_rigid_shape* s = &b->shape;
+    if ((unsigned)s->type >= AK_RIGID_SHAPE_COUNT) return AK_ERR_BAD_ARG;
+    if (!ak_finitef(s->radius) || !vec_finite(s->half_extents) || !ak_finitef(s->half_height) ||
+        !vec_finite(s->normal) || !vec_finite(b->position) || !ak_quat_is_finite(b->orientation) ||
+        !vec_finite(b->velocity) || !vec_finite(b->angular_velocity) || !ak_finitef(b->density) ||
+        !ak_finitef(b->mass) || !ak_finitef(b->restitution))
+        return AK_ERR_BAD_DATA;
+    ak_result r = check_friction(b->friction);
+    if (r == AK_OK) r = check_friction(b->dynamic_friction);
+    if (r != AK_OK) return r;
+    switch (s->type) {
+    case AK_RIGID_SPHERE:
+        if (!(s->radius > 0.0f)) return AK_ERR_BAD_ARG;
+        break;
+    case AK_RIGID_BOX:
+        if (!(s->half_extents.x > 0.0f && s->half_extents.y > 0.0f && s->half_extents.z > 0.0f))
+            return AK_ERR_BAD_ARG;
+        break;
+    case AK_RIGID_CAPSULE:
+        if (!(s->radius > 0.0f) || s->half_height < 0.0f) return AK_ERR_BAD_ARG;
+        break;
+    default:
+        break;
+    }
+    if (b->density < 0.0f || b->mass < 0.0f || b->restitution < 0.0f || b->restitution > 1.0f)
+        return AK_ERR_BAD_ARG;
+    return AK_OK;
+}
+
+ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_allocator* alloc,
+                                ak_rigid_model** out_model) {
+    if (out_model) *out_model = NULL;
+    if (!desc || !out_model) return AK_ERR_NULL_ARG;
+    if (alloc && (!alloc->alloc) != (!alloc->free)) return AK_ERR_BAD_ARG;
+    if (desc->bodies.count == 0 || !desc->bodies.ptr) return AK_ERR_EMPTY;
+    if (desc->bodies.count > (1u << 24)) return AK_ERR_BAD_ARG;
+    const float scalars[] = {desc->linear_damping,      desc->angular_damping,
+                             desc->contact_offset,      desc->sleep_linear_speed,
+                             desc->sleep_angular_speed, desc->sleep_time};
+    for (size_t i = 0; i < sizeof scalars / sizeof scalars[0]; ++i) {
+        if (!ak_finitef(scalars[i])) return AK_ERR_BAD_DATA;
+        if (scalars[i] < 0.0f) return AK_ERR_BAD_ARG;
+    }
+    for (size_t i = 0; i < desc->bodies.count; ++i) {
+        ak_result r = check_body(&desc->bodies.ptr[i]);
+        if (r != AK_OK) return r;
+    }
+    size_t n = desc->bodies.count, nj = desc->joints.count;
+    if (nj && !desc->joints.ptr) return AK_ERR_NULL_ARG;
+    if (nj > (1u << 24)) return AK_ERR_BAD_ARG;
+    for (size_t i = 0; i < nj; ++i) {
+        const ak_rigid_joint_desc* jd = &desc->joints.ptr[i];
+        if ((unsigned)jd->type >= AK_RIGID_JOINT_TYPE_COUNT) return AK_ERR_BAD_ARG;
+        if (jd->body_a >= n || jd->body_b >= n || jd->body_a == jd->body_b) return AK_ERR_BAD_INDEX;
+        if (!vec_finite(jd->anchor) || !vec_finite(jd->axis) || !ak_finitef(jd->lower) ||
+            !ak_finitef(jd->upper) || !ak_finitef(jd->compliance) || !vec_finite(jd->axis_b) ||
+            !ak_finitef(jd->angle_offset) || !ak_quat_is_finite(jd->drive_target) ||
+            !ak_finitef(jd->drive_compliance))
+            return AK_ERR_BAD_DATA;
+        if (!ak_finitef(jd->twist_lower) || !ak_finitef(jd->twist_upper)) return AK_ERR_BAD_DATA;
+        if ((jd->twist_limited && jd->twist_lower > jd->twist_upper) ||
+            (jd->limited && jd->lower > jd->upper) || jd->compliance < 0.0f ||
+            jd->drive_compliance < 0.0f)
+            return AK_ERR_BAD_ARG;
+    }
+    ak_allocator al = {def_alloc, def_free, NULL};
+    if (alloc && alloc->alloc) al = *alloc;
+    size_t head = (sizeof(ak_rigid_model) + 15) & ~(size_t)15;
+    size_t bodies_size = ((n * sizeof(rigid_body)) + 15) & ~(size_t)15;
+    size_t descs_size = ((n * sizeof(ak_rigid_body_desc)) + 15) & ~(size_t)15;
+    size_t joints_size = ((nj * sizeof(rigid_joint)) + 15) & ~(size_t)15;
+    size_t total = head + bodies_size + descs_size + joints_size + n * sizeof(uint32_t);
+    unsigned char* mem = al.alloc(total, al.user);
+    if (!mem) return AK_ERR_NO_MEMORY;
+    memset(mem, 0, total);
+    ak_rigid_model* m = (ak_rigid_model*)mem;
+    m->alloc = al;
+    m->body_count = n;
+    m->bodies = (rigid_body*)(mem + head);
+    m->descs = (ak_rigid_body_desc*)(mem + head + bodies_size);
+    m->joints = (rigid_joint*)(mem + head + bodies_size + descs_size);
+    m->joint_count = nj;
+    m->planes = (uint32_t*)(mem + head + bodies_size + descs_size + joints_size);
+    m->desc = ak_rigid_model_desc_resolved(desc);
+    m->desc.bodies.ptr = m->descs;
+    for (size_t i = 0; i < n; ++i) {
+        ak_rigid_body_desc d = desc->bodies.ptr[i];
+        rigid_body* b = &m->bodies[i];
+        if (ak_quat_dot(d.orientation, d.orientation) == 0.0f) d.orientation = ak_quat_identity();
+        d.orientation = ak_quat_normalize(d.orientation);
+        if (d.shape.type == AK_RIGID_PLANE) {
+            d.is_static = true;
+            if (ak_vec3_length_sq(d.shape.normal) == 0.0f) d.shape.normal = ak_vec3_make(0, 1, 0);
+            d.shape.normal = ak_vec3_normalize(d.shape.normal);
+            d.orientation = ak_quat_identity();
+            m->planes[m->plane_count++] = (uint32_t)i;
+        }
+        if (d.density == 0.0f) d.density = 1000.0f;
+        if (d.friction == 0.0f) d.friction = 0.5f;
+        if (d.dynamic_friction == 0.0f) d.dynamic_friction = d.friction;
+        b->friction = d.friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.friction;
+        b->dynamic_friction =
+            d.dynamic_friction == AK_RIGID_FRICTIONLESS ? 0.0f : d.dynamic_friction;
+        b->restitution = d.restitution;
+        b->group = d.collision_group;
+        b->shape = d.shape;
+        double volume;
+        ak_vec3 ipm;
+        shape_unit_mass(&d.shape, &volume, &ipm);
+        switch (d.shape.type) {
+        case AK_RIGID_SPHERE:
+            b->bound_radius = d.shape.radius;
+            break;
+        case AK_RIGID_BOX:
+            b->bound_radius = ak_vec3_length(d.shape.half_extents);
+            break;
+        case AK_RIGID_CAPSULE:
+            b->bound_radius = d.shape.radius + d.shape.half_height;
+            break;
+        default:
+            b->bound_radius = INFINITY;
+            break;
+        }
+        if (d.is_static) {
+            d.velocity = ak_vec3_zero();
+            d.angular_velocity = ak_vec3_zero();
+            b->mass = INFINITY;
+            b->inertia = ak_vec3_make(INFINITY, INFINITY, INFINITY);
+        } else {
+            double mass = d.mass > 0.0f ? (double)d.mass : (double)d.density * volume;
+            if (d.mass > 0.0f && volume > 0.0) d.density = (float)(mass / volume);
+            d.mass = (float)mass;
+            if (!(mass > 0.0) || !isfinite((float)mass)) {
+                al.free(mem, al.user);
+                return AK_ERR_BAD_ARG;
+            }
+            b->mass = (float)mass;
+            b->inv_mass = (float)(1.0 / mass);
+            b->inertia = ak_vec3_scale(ipm, (float)mass);
+            b->inv_inertia =
+                ak_vec3_make(1.0f / b->inertia.x, 1.0f / b->inertia.y, 1.0f / b->inertia.z);
+            if (!vec_finite(b->inv_inertia)) {
+                al.free(mem, al.user);
+                return AK_ERR_BAD_ARG;
+            }
+        }
+        m->descs[i] = d;
+    }
+    for (size_t i = 0; i < nj; ++i) {
+        const ak_rigid_joint_desc* jd = &desc->joints.ptr[i];
+        rigid_joint* j = &m->joints[i];
+        const ak_rigid_body_desc* da = &m->descs[jd->body_a];
+        const ak_rigid_body_desc* db = &m->descs[jd->body_b];
+        ak_quat ia = ak_quat_conjugate(da->orientation), ib = ak_quat_conjugate(db->orientation);
+        ak_vec3 axis = ak_vec3_length_sq(jd->axis) > 0.0f ? ak_vec3_normalize(jd->axis)
+                                                          : ak_vec3_make(0, 0, 1);
+        ak_vec3 perp = ak_vec3_normalize(ak_vec3_any_perpendicular(axis));
+        j->type = jd->type;
+        j->a = jd->body_a;
+        j->b = jd->body_b;
+        j->la = ak_quat_rotate(ia, ak_vec3_sub(jd->anchor, da->position));
+        j->lb = ak_quat_rotate(ib, ak_vec3_sub(jd->anchor, db->position));
+        j->axis_a = ak_quat_rotate(ia, axis);
+        ak_vec3 axis2 = ak_vec3_length_sq(jd->axis_b) > 0.0f ? ak_vec3_normalize(jd->axis_b) : axis;
+        j->axis_b = ak_quat_rotate(ib, jd->type == AK_RIGID_JOINT_BALL ? axis2 : axis);
+        j->perp_a = ak_quat_rotate(ia, perp);
+        /* b's reference direction: a's swung onto b's axis (the swing of a swing-twist split) */
+        ak_vec3 perp2 = ak_vec3_normalize(ak_quat_rotate(ak_quat_from_to(axis, axis2), perp));
+        j->perp_b = ak_quat_rotate(ib, jd->type == AK_RIGID_JOINT_BALL ? perp2 : perp);
+        ak_quat fwa = ak_quat_from_mat3(ak_mat3_from_cols(perp, axis, ak_vec3_cross(perp, axis)));
+        ak_quat fwb =
+            ak_quat_from_mat3(ak_mat3_from_cols(perp2, axis2, ak_vec3_cross(perp2, axis2)));
+        j->frame_a = ak_quat_normalize(ak_quat_mul(ia, fwa));
+        j->frame_b = ak_quat_normalize(ak_quat_mul(ib, fwb));
+        j->rel = ak_quat_normalize(ak_quat_mul(ia, db->orientation));
+        j->drive_target = ak_quat_dot(jd->drive_target, jd->drive_target) > 0.0f
+                              ? ak_quat_normalize(jd->drive_target)
+                              : j->rel;
+        j->limited = jd->limited;
+        j->drive = jd->drive;
+        j->lower = jd->lower;
+        j->upper = jd->upper;
+        j->compliance = jd->compliance;
+        j->drive_compliance = jd->drive_compliance;
+        j->angle_offset = jd->angle_offset;
+        j->twist_limited = jd->twist_limited;
+        j->twist_lower = jd->twist_lower;
+        j->twist_upper = jd->twist_upper;
+    }
+    m->desc.joints = (ak_rigid_joint_desc_cspan){NULL, 0};
+    *out_model = m;
+    return AK_OK;
+}
+
+void ak_rigid_model_destroy(ak_rigid_model* model) {
+    if (!model) return;
+    model->alloc.free(model, model->alloc.user);
+}
+
+size_t ak_rigid_body_count(const ak_rigid_model* model) { return model ? model->body_count : 0; }
+
+float ak_rigid_body_mass(const ak_rigid_model* model, size_t i) {
+    return model && i < model->body_count ? model->bodies[i].mass : 0.0f;
+}
+
+ak_vec3 ak_rigid_body_inertia(const ak_rigid_model* model, size_t i) {
+    return model && i < model->body_count ? model->bodies[i].inertia : ak_vec3_zero();
+}
+
+ak_rigid_body_desc ak_rigid_body_get_desc(const ak_rigid_model* model, size_t i) {
+    ak_rigid_body_desc d;
+    memset(&d, 0, sizeof d);
+    if (model && i < model->body_count) d = model->descs[i];
+    return d;
+}
+
+ak_result ak_rigid_initial_state(const ak_rigid_model* model, ak_vec3_span x, ak_quat_span q,
+                                 ak_vec3_span v, ak_vec3_span w) {
+    if (!model || !x.ptr || !q.ptr || !v.ptr || !w.ptr) return AK_ERR_NULL_ARG;
+    size_t n = model->body_count;
+    if (x.count < n || q.count < n || v.count < n || w.count < n) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i) {
+        x.ptr[i] = model->descs[i].position;
+        q.ptr[i] = model->descs[i].orientation;
+        v.ptr[i] = model->descs[i].velocity;
+        w.ptr[i] = model->descs[i].angular_velocity;
+    }
+    return AK_OK;
+}
+
+ak_vec3 ak_rigid_angular_momentum(const ak_rigid_model* model, size_t i, ak_quat q, ak_vec3 w) {
+    if (!model || i >= model->body_count || model->bodies[i].inv_mass == 0.0f)
+        return ak_vec3_zero();
+    ak_vec3 wl = ak_quat_rotate(ak_quat_conjugate(q), w);
+    ak_vec3 ll = ak_vec3_mul(model->bodies[i].inertia, wl);
+    return ak_quat_rotate(q, ll);
+}
+
+double ak_rigid_energy(const ak_rigid_model* model, ak_vec3 g, ak_vec3_cspan x, ak_quat_cspan q,
+                       ak_vec3_cspan v, ak_vec3_cspan w) {
+    if (!model) return 0.0;
+    size_t n = model->body_count;
+    if (x.count < n || q.count < n || v.count < n || w.count < n) return 0.0;
+    double e = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const rigid_body* b = &model->bodies[i];
+        if (b->inv_mass == 0.0f) continue;
+        double m = b->mass;
+        ak_vec3 wl = ak_quat_rotate(ak_quat_conjugate(q.ptr[i]), w.ptr[i]);
+        e += 0.5 * m * (double)ak_vec3_dot(v.ptr[i], v.ptr[i]);
+        e += 0.5 * ((double)b->inertia.x * wl.x * wl.x + (double)b->inertia.y * wl.y * wl.y +
+                    (double)b->inertia.z * wl.z * wl.z);
+        e -= m * ((double)g.x * x.ptr[i].x + (double)g.y * x.ptr[i].y + (double)g.z * x.ptr[i].z);
+    }
+    return e;
+}
+
+size_t ak_rigid_joint_count(const ak_rigid_model* model) { return model ? model->joint_count : 0; }
+
+ak_result ak_rigid_joint_error(const ak_rigid_model* model, size_t i, ak_vec3_cspan x,
+                               ak_quat_cspan q, float* out_gap, float* out_limit_excess) {
+    if (!model || !x.ptr || !q.ptr || !out_gap || !out_limit_excess) return AK_ERR_NULL_ARG;
+    if (i >= model->joint_count) return AK_ERR_BAD_INDEX;
+    if (x.count < model->body_count || q.count < model->body_count) return AK_ERR_SPAN_SMALL;
+    const rigid_joint* j = &model->joints[i];
+    ak_quat qa = ak_quat_normalize(q.ptr[j->a]), qb = ak_quat_normalize(q.ptr[j->b]);
+    ak_vec3 pa = ak_vec3_add(x.ptr[j->a], ak_quat_rotate(qa, j->la));
+    ak_vec3 pb = ak_vec3_add(x.ptr[j->b], ak_quat_rotate(qb, j->lb));
+    ak_vec3 d = ak_vec3_sub(pb, pa);
+    float excess = 0.0f;
+    if (j->type == AK_RIGID_JOINT_PRISMATIC) {
+        ak_vec3 ax = ak_quat_rotate(qa, j->axis_a);
+        float s = ak_vec3_dot(d, ax);
+        d = ak_vec3_madd(d, ax, -s);
+        if (j->limited) excess = ak_maxf(j->lower - s, s - j->upper);
+    } else if (j->type == AK_RIGID_JOINT_HINGE && j->limited) {
+        float phi = akp_rigid_hinge_angle(j, qa, qb) + j->angle_offset;
+        excess = ak_maxf(j->lower - phi, phi - j->upper);
+    }
+    if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited) {
+        ak_vec3 n;
+        float tw = akp_rigid_twist_angle(j, qa, qb, &n) + j->angle_offset;
+        excess = ak_maxf(excess, ak_maxf(j->twist_lower - tw, tw - j->twist_upper));
+    }
+    if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
+        ak_vec3 a1 = ak_quat_rotate(qa, j->axis_a), a2 = ak_quat_rotate(qb, j->axis_b);
+        float swing = atan2f(ak_vec3_length(ak_vec3_cross(a1, a2)), ak_vec3_dot(a1, a2));
+        excess = swing - j->upper;
+    }
+    *out_gap = ak_vec3_length(d);
+    *out_limit_excess = ak_maxf(excess, 0.0f);
+    return AK_OK;
+}

@@ -1,0 +1,781 @@
+/* XPBD rigid-body step (Mueller et al. 2020) with an implicit gyroscopic term, sweep-and-prune
+ * broad phase and sleeping groups. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rigid_impl.h"
+
+typedef struct sap_entry {
+    float lo, hi;
+    uint32_t body;
+} sap_entry;
+
+/* The contacts of one pair of bodies, c[start, end), and its place in the solve order. */
+typedef struct contact_group {
+    uint32_t start, end;
+    float height; /* the pair's midpoint against gravity: higher pairs are solved first */
+} contact_group;
+
+/* Scratch layout, in 16-byte aligned blocks. */
+typedef struct layout {
+    size_t x0, q0, v0, w0, qp, dx, ds, sap, contacts, groups, parent, awake, total;
+} layout;
+
+static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
+
+static layout layout_of(const ak_rigid_model* m) {
+    layout l;
+    size_t n = m->body_count, off = 0;
+    l.x0 = off, off += align16(n * sizeof(ak_vec3));
+    l.q0 = off, off += align16(n * sizeof(ak_quat));
+    l.v0 = off, off += align16(n * sizeof(ak_vec3));
+    l.w0 = off, off += align16(n * sizeof(ak_vec3));
+    l.qp = off, off += align16(n * sizeof(ak_quat));
+    l.dx = off, off += align16(n * sizeof(ak_vec3));
+    l.ds = off, off += align16(n * sizeof(ak_vec3));
+    l.sap = off, off += align16(n * sizeof(sap_entry));
+    l.contacts = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
+                                     sizeof(rigid_contact));
+    l.groups = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
+                                   sizeof(contact_group));
+    l.parent = off, off += align16(n * sizeof(uint32_t));
+    l.awake = off, off += align16(n);
+    l.total = off + 16; /* room to align the base */
+    return l;
+}
+
+size_t ak_rigid_step_scratch_size(const ak_rigid_step_job* job) {
+    if (!job || !job->model) return 0;
+    return layout_of(job->model).total;
+}
+
+ak_result ak_rigid_step_validate(const ak_rigid_step_job* job) {
+    if (!job || !job->model) return AK_ERR_NULL_ARG;
+    if (!(job->dt > 0.0f) || !ak_finitef(job->dt) || job->substeps > 1000 ||
+        job->thread_count > AK_RIGID_MAX_THREADS || !ak_vec3_is_finite(job->gravity))
+        return AK_ERR_BAD_ARG;
+    size_t n = job->model->body_count;
+    if (!job->positions.ptr || !job->orientations.ptr || !job->velocities.ptr ||
+        !job->angular_velocities.ptr || !job->scratch.ptr)
+        return AK_ERR_NULL_ARG;
+    if (job->positions.count < n || job->orientations.count < n || job->velocities.count < n ||
+        job->angular_velocities.count < n ||
+        (job->sleep_timers.count != 0 && job->sleep_timers.count < n) ||
+        (job->sleep_timers.count != 0 && !job->sleep_timers.ptr) ||
+        job->scratch.count < ak_rigid_step_scratch_size(job))
+        return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i) {
+        if (!ak_vec3_is_finite(job->positions.ptr[i]) ||
+            !ak_quat_is_finite(job->orientations.ptr[i]) ||
+            !ak_vec3_is_finite(job->velocities.ptr[i]) ||
+            !ak_vec3_is_finite(job->angular_velocities.ptr[i]))
+            return AK_ERR_BAD_DATA;
+        if (job->sleep_timers.count && !ak_finitef(job->sleep_timers.ptr[i]))
+            return AK_ERR_BAD_DATA;
+    }
+    return AK_OK;
+}
+
+typedef struct solver {
+    const ak_rigid_model* m;
+    const rigid_body* bodies;
+    ak_vec3* x;
+    ak_quat* q;
+    ak_vec3* v;
+    ak_vec3* w;
+    const ak_vec3* x0; /* positions at the step's start */
+    ak_quat* qp;
+    ak_vec3* dx;          /* displacement since the substep's start, kept apart so the velocity
+                             dx / h keeps float precision far from the origin */
+    ak_vec3* ds;          /* displacement from the step's start to this substep's start; x is
+                             always x0 + (ds + dx), rounded once, so a body 100 m out does not
+                             lose a rounding of its position every substep (4 mm/s at 1200 Hz) */
+    const ak_quat* q0;    /* orientations at the step's start */
+    const uint8_t* awake; /* 1: dynamic and awake (moves); 0: static or asleep */
+    float h;
+} solver;
+
+/* I^-1 (world) applied to v for body i (zero when it does not move). */
+static ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_quat q = s->q[i];
+    ak_vec3 l = ak_quat_rotate(ak_quat_conjugate(q), v);
+    return ak_quat_rotate(q, ak_vec3_mul(s->bodies[i].inv_inertia, l));
+}
+
+/* Generalised inverse mass of body i at offset r along unit direction n (their eq. 2-3). */
+static float gen_inv_mass(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n) {
+    if (!s->awake[i]) return 0.0f;
+    ak_vec3 rn = ak_quat_rotate(ak_quat_conjugate(s->q[i]), ak_vec3_cross(r, n));
+    ak_vec3 ii = s->bodies[i].inv_inertia;
+    return s->bodies[i].inv_mass + rn.x * rn.x * ii.x + rn.y * rn.y * ii.y + rn.z * rn.z * ii.z;
+}
+
+/* Apply positional impulse p at offset r to body i (sign +1 or -1). */
+static void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
+    if (!s->awake[i]) return;
+    s->dx[i] = ak_vec3_madd(s->dx[i], p, sign * s->bodies[i].inv_mass);
+    s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
+    ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, ak_vec3_cross(r, p)), sign * 0.5f);
+    ak_quat q = s->q[i];
+    ak_quat dq = ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q);
+    s->q[i] = ak_quat_normalize(ak_quat_add(q, dq));
+}
+
+static void apply_velocity_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
+    if (!s->awake[i]) return;
+    s->v[i] = ak_vec3_madd(s->v[i], p, sign * s->bodies[i].inv_mass);
+    s->w[i] = ak_vec3_madd(s->w[i], inv_inertia_mul(s, i, ak_vec3_cross(r, p)), sign);
+}
+
+/* Angular velocity after one implicit (backward Euler) step of Euler's equations without torque,
+ * I w' = -w x (I w), linearised once about w (Newton's first iterate), in the body frame. */
+static ak_vec3 gyroscopic_step(ak_vec3 w, ak_vec3 inertia, float h) {
+    ak_vec3 iw = ak_vec3_mul(inertia, w);
+    ak_vec3 f = ak_vec3_scale(ak_vec3_cross(w, iw), h);
+    /* J = I + h (skew(w) I - skew(I w)) */
+    ak_mat3 sw = {{0, w.z, -w.y, -w.z, 0, w.x, w.y, -w.x, 0}};
+    ak_mat3 siw = {{0, iw.z, -iw.y, -iw.z, 0, iw.x, iw.y, -iw.x, 0}};
+    ak_mat3 j = ak_mat3_add(
+        ak_mat3_diagonal(inertia),
+        ak_mat3_scale(
+            ak_mat3_add(ak_mat3_mul(sw, ak_mat3_diagonal(inertia)), ak_mat3_scale(siw, -1.0f)), h));
+    if (fabsf(ak_mat3_determinant(j)) < 1e-30f) return w;
+    return ak_vec3_sub(w, ak_mat3_mul_vec3(ak_mat3_inverse(j), f));
+}
+
+static void predict(solver* s, ak_vec3 g, float lin_damp, float ang_damp) {
+    float h = s->h;
+    for (uint32_t i = 0; i < (uint32_t)s->m->body_count; ++i) {
+        s->qp[i] = s->q[i];
+        s->dx[i] = ak_vec3_zero();
+        if (!s->awake[i]) continue;
+        const rigid_body* b = &s->bodies[i];
+        ak_vec3 v = ak_vec3_madd(s->v[i], g, h);
+        if (lin_damp > 0.0f) v = ak_vec3_scale(v, 1.0f / (1.0f + h * lin_damp));
+        s->v[i] = v;
+        s->dx[i] = ak_vec3_scale(v, h);
+        s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
+        ak_quat q = s->q[i];
+        ak_vec3 wl = ak_quat_rotate(ak_quat_conjugate(q), s->w[i]);
+        wl = gyroscopic_step(wl, b->inertia, h);
+        if (ang_damp > 0.0f) wl = ak_vec3_scale(wl, 1.0f / (1.0f + h * ang_damp));
+        ak_vec3 w = ak_quat_rotate(q, wl);
+        s->w[i] = w;
+        ak_quat dq = ak_quat_mul(ak_quat_make(w.x, w.y, w.z, 0.0f), q);
+        s->q[i] = ak_quat_normalize(ak_quat_add(q, ak_quat_scale(dq, 0.5f * h)));
+    }
+}
+
+/* Entries ordered by (lo, body): a total order, so every sort gives the same sequence. */
+static bool sap_less(const sap_entry* a, const sap_entry* b) {
+    return a->lo < b->lo || (a->lo == b->lo && a->body < b->body);
+}
+
+/* Shell sort (Ciura's gaps, then insertion): in place, no allocation (qsort may call malloc),
+ * and nearly linear on the almost sorted arrays consecutive substeps give. */
+static void sap_sort(sap_entry* e, uint32_t n) {
+    static const uint32_t gaps[] = {701, 301, 132, 57, 23, 10, 4, 1};
+    for (size_t g = 0; g < sizeof gaps / sizeof gaps[0]; ++g) {
+        uint32_t gap = gaps[g];
+        for (uint32_t i = gap; i < n; ++i) {
+            sap_entry t = e[i];
+            uint32_t j = i;
+            for (; j >= gap && sap_less(&t, &e[j - gap]); j -= gap) e[j] = e[j - gap];
+            e[j] = t;
+        }
+    }
+}
+
+typedef struct contact_buf {
+    rigid_contact* c;
+    uint32_t count, cap;
+    uint32_t dropped;
+    contact_group* groups;
+    uint32_t group_count;
+} contact_buf;
+
+static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float margin) {
+    rigid_pose pa = {s->x[a], s->q[a]}, pb = {s->x[b], s->q[b]};
+    /* the buffer has AKP_RIGID_MAX_PAIR_CONTACTS slack past cap */
+    int found = akp_rigid_collide(s->m, a, b, pa, pb, margin, cb->c + cb->count,
+                                  AKP_RIGID_MAX_PAIR_CONTACTS);
+    int kept = found < AKP_RIGID_MAX_PAIR_CONTACTS ? found : AKP_RIGID_MAX_PAIR_CONTACTS;
+    if (cb->count + (uint32_t)kept > cb->cap) {
+        uint32_t room = cb->cap - cb->count;
+        cb->dropped += (uint32_t)found - room;
+        kept = (int)room;
+    } else {
+        cb->dropped += (uint32_t)(found - kept);
+    }
+    const rigid_body* ba = &s->bodies[a];
+    const rigid_body* bb = &s->bodies[b];
+    for (int k = 0; k < kept; ++k) {
+        rigid_contact* c = &cb->c[cb->count + (uint32_t)k];
+        c->friction = sqrtf(ba->friction * bb->friction);
+        c->dynamic_friction = sqrtf(ba->dynamic_friction * bb->dynamic_friction);
+        c->restitution = ak_maxf(ba->restitution, bb->restitution);
+        ak_vec3 ra = ak_quat_rotate(s->q[a], c->la), rb = ak_quat_rotate(s->q[b], c->lb);
+        ak_vec3 va = ak_vec3_add(s->v[a], ak_vec3_cross(s->w[a], ra));
+        ak_vec3 vb = ak_vec3_add(s->v[b], ak_vec3_cross(s->w[b], rb));
+        c->vn_before = ak_vec3_dot(c->n, ak_vec3_sub(va, vb));
+    }
+    cb->count += (uint32_t)kept;
+}
+
+static bool joined(const ak_rigid_model* m, uint32_t a, uint32_t b);
+
+static float axis_comp(ak_vec3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
+
+static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float margin) {
+    const ak_rigid_model* m = s->m;
+    uint32_t n = (uint32_t)m->body_count, ns = 0;
+    cb->count = 0;
+    /* sweep along the axis over which the bodies spread most (their centres' variance) */
+    double mean[3] = {0, 0, 0}, var[3] = {0, 0, 0};
+    uint32_t counted = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (s->bodies[i].shape.type == AK_RIGID_PLANE) continue;
+        ++counted;
+        for (int k = 0; k < 3; ++k) {
+            double x = axis_comp(s->x[i], k), d = x - mean[k];
+            mean[k] += d / counted;
+            var[k] += d * (x - mean[k]);
+        }
+    }
+    int axis = var[1] > var[0] ? 1 : 0;
+    if (var[2] > var[axis]) axis = 2;
+    for (uint32_t i = 0; i < n; ++i) {
+        const rigid_body* b = &s->bodies[i];
+        if (b->shape.type == AK_RIGID_PLANE) continue;
+        float r = b->bound_radius + margin, c = axis_comp(s->x[i], axis);
+        sap[ns].lo = c - r;
+        sap[ns].hi = c + r;
+        sap[ns].body = i;
+        ++ns;
+    }
+    sap_sort(sap, ns);
+    for (uint32_t i = 0; i < ns; ++i) {
+        uint32_t a = sap[i].body;
+        for (uint32_t j = i + 1; j < ns && sap[j].lo <= sap[i].hi; ++j) {
+            uint32_t b = sap[j].body;
+            if (!s->awake[a] && !s->awake[b]) continue;
+            float rr = s->bodies[a].bound_radius + s->bodies[b].bound_radius + margin;
+            if (ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b])) > rr * rr) continue;
+            if (s->bodies[a].group != 0 && s->bodies[a].group == s->bodies[b].group) continue;
+            if (m->joint_count && joined(m, a, b)) continue;
+            /* the awake (or lower-index) body first, so a static body is always b */
+            if (!s->awake[a] || (s->awake[b] && b < a))
+                narrow(s, cb, b, a, margin);
+            else
+                narrow(s, cb, a, b, margin);
+        }
+    }
+    if (m->plane_count) {
+        for (uint32_t i = 0; i < n; ++i) {
+            if (!s->awake[i]) continue;
+            for (size_t k = 0; k < m->plane_count; ++k) narrow(s, cb, i, m->planes[k], margin);
+        }
+    }
+}
+
+static ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) {
+    return ak_vec3_add(s->x[i], ak_quat_rotate(s->q[i], l));
+}
+
+/* Motion of body i's local point l since the start of the step, without the cancellation that
+ * (x + q l) - (x0 + q0 l) suffers far from the origin. Static friction undoes the slip of the
+ * whole step, not only of the substep: a slip left over by one substep (the next pair's solve
+ * moves a box after its friction ran) is taken back by the next, so stacks do not creep. */
+static ak_vec3 point_motion(const solver* s, uint32_t i, ak_vec3 l) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_vec3 d = ak_vec3_add(s->ds[i], s->dx[i]);
+    return ak_vec3_add(d, ak_vec3_sub(ak_quat_rotate(s->q[i], l), ak_quat_rotate(s->q0[i], l)));
+}
+
+/* End of the run of contacts from k that share their pair of bodies. */
+static uint32_t group_end(const contact_buf* cb, uint32_t k) {
+    uint32_t e = k + 1;
+    while (e < cb->count && cb->c[e].a == cb->c[k].a && cb->c[e].b == cb->c[k].b) ++e;
+    return e;
+}
+
+static bool group_before(const contact_group* a, const contact_group* b) {
+    return a->height > b->height || (a->height == b->height && a->start < b->start);
+}
+
+/* Split the contacts into per-pair groups and order them from the top down (against gravity;
+ * the found order when there is none): in a stack or a pyramid the ground is then solved last,
+ * which lets a 10-box stack creep several times less than bottom-up order. Shell sort as for
+ * the sweep (no allocation, a total order). */
+static void order_groups(const solver* s, contact_buf* cb, ak_vec3 up) {
+    uint32_t g = 0;
+    for (uint32_t k = 0; k < cb->count; ++g) {
+        uint32_t e = group_end(cb, k);
+        const rigid_contact* c = &cb->c[k];
+        ak_vec3 mid = s->bodies[c->b].shape.type == AK_RIGID_PLANE
+                          ? s->x[c->a]
+                          : ak_vec3_scale(ak_vec3_add(s->x[c->a], s->x[c->b]), 0.5f);
+        cb->groups[g] = (contact_group){k, e, ak_vec3_dot(mid, up)};
+        k = e;
+    }
+    cb->group_count = g;
+    static const uint32_t gaps[] = {701, 301, 132, 57, 23, 10, 4, 1};
+    contact_group* e = cb->groups;
+    for (size_t gi = 0; gi < sizeof gaps / sizeof gaps[0]; ++gi) {
+        uint32_t gap = gaps[gi];
+        for (uint32_t i = gap; i < g; ++i) {
+            contact_group t = e[i];
+            uint32_t j = i;
+            for (; j >= gap && group_before(&t, &e[j - gap]); j -= gap) e[j] = e[j - gap];
+            e[j] = t;
+        }
+    }
+}
+
+/* Centre of pressure of a group (the contacts' local points weighted by their normal
+ * multipliers) in each body's frame, the group's total multiplier and the multipliers' mean
+ * distance from the centre (the lever arm of torsional friction); false when no contact of the
+ * group pushed. */
+static bool pressure_centre(const contact_buf* cb, uint32_t k0, uint32_t k1, ak_vec3* la,
+                            ak_vec3* lb, float* out_lambda, float* out_arm) {
+    float sum = 0.0f, arm = 0.0f;
+    ak_vec3 ca = ak_vec3_zero(), cbp = ak_vec3_zero();
+    for (uint32_t k = k0; k < k1; ++k) {
+        const rigid_contact* c = &cb->c[k];
+        if (!(c->lambda_n > 0.0f)) continue;
+        sum += c->lambda_n;
+        ca = ak_vec3_madd(ca, c->la, c->lambda_n);
+        cbp = ak_vec3_madd(cbp, c->lb, c->lambda_n);
+    }
+    if (!(sum > 0.0f)) return false;
+    *la = ak_vec3_scale(ca, 1.0f / sum);
+    *lb = ak_vec3_scale(cbp, 1.0f / sum);
+    for (uint32_t k = k0; k < k1; ++k) {
+        const rigid_contact* c = &cb->c[k];
+        if (c->lambda_n > 0.0f) arm += c->lambda_n * ak_vec3_distance(c->la, *la);
+    }
+    *out_lambda = sum;
+    *out_arm = arm / sum;
+    return true;
+}
+
+/* I^-1 n . n of body i (0 when it does not move). */
+static float gen_inv_inertia(const solver* s, uint32_t i, ak_vec3 n) {
+    if (!s->awake[i]) return 0.0f;
+    ak_vec3 nl = ak_quat_rotate(ak_quat_conjugate(s->q[i]), n);
+    ak_vec3 ii = s->bodies[i].inv_inertia;
+    return nl.x * nl.x * ii.x + nl.y * nl.y * ii.y + nl.z * nl.z * ii.z;
+}
+
+/* Rotate body i by the angular position impulse (sign) * p (world). */
+static void apply_angular_impulse(solver* s, uint32_t i, ak_vec3 p, float sign) {
+    if (!s->awake[i]) return;
+    ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, p), sign * 0.5f);
+    ak_quat q = s->q[i];
+    s->q[i] =
+        ak_quat_normalize(ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q)));
+}
+
+/* Rotation vector of body i over this substep (small-angle). */
+static ak_vec3 substep_rotation(const solver* s, uint32_t i) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->qp[i]));
+    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
+    return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
+}
+
+static void solve_positions(solver* s, contact_buf* cb) {
+    for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
+        uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
+        /* (alternating the points' order from substep to substep halves a 10-box stack's creep
+         * but moves the centre of pressure each substep, and a block on an incline then creeps:
+         * the order stays fixed) */
+        for (uint32_t k = k0; k < k1; ++k) {
+            rigid_contact* c = &cb->c[k];
+            ak_vec3 pa = world_point(s, c->a, c->la), pb = world_point(s, c->b, c->lb);
+            float d = ak_vec3_dot(ak_vec3_sub(pb, pa), c->n);
+            if (d <= 0.0f) continue;
+            ak_vec3 ra = ak_vec3_sub(pa, s->x[c->a]), rb = ak_vec3_sub(pb, s->x[c->b]);
+            float w = gen_inv_mass(s, c->a, ra, c->n) + gen_inv_mass(s, c->b, rb, c->n);
+            if (!(w > 0.0f)) continue;
+            float dl = d / w;
+            c->lambda_n += dl;
+            ak_vec3 p = ak_vec3_scale(c->n, dl);
+            apply_position_impulse(s, c->a, ra, p, 1.0f);
+            apply_position_impulse(s, c->b, rb, p, -1.0f);
+        }
+        /* static friction, once per pair at the centre of pressure with the pair's whole normal
+         * multiplier: undo the relative tangential motion of this substep when the force it
+         * takes stays inside the friction cone (their eq. for lambda_t < mu_s lambda_n); one
+         * point per pair keeps the sequential order from handing the whole load to one corner */
+        ak_vec3 la, lb;
+        float lambda, arm;
+        const rigid_contact* c = &cb->c[k0];
+        if (c->friction > 0.0f && pressure_centre(cb, k0, k1, &la, &lb, &lambda, &arm)) {
+            ak_vec3 dp = ak_vec3_sub(point_motion(s, c->a, la), point_motion(s, c->b, lb));
+            ak_vec3 dt = ak_vec3_madd(dp, c->n, -ak_vec3_dot(dp, c->n));
+            float lt = ak_vec3_length(dt);
+            if (lt > 1e-12f) {
+                ak_vec3 t = ak_vec3_scale(dt, 1.0f / lt);
+                ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
+                float wt = gen_inv_mass(s, c->a, ra, t) + gen_inv_mass(s, c->b, rb, t);
+                float dlt = wt > 0.0f ? lt / wt : INFINITY;
+                if (dlt < c->friction * lambda) {
+                    ak_vec3 pt = ak_vec3_scale(t, -dlt);
+                    apply_position_impulse(s, c->a, ra, pt, 1.0f);
+                    apply_position_impulse(s, c->b, rb, pt, -1.0f);
+                }
+            }
+            /* torsional friction: a patch of contacts also resists twisting about the normal, up
+             * to mu times the normal multiplier times its mean lever arm */
+            float twist = ak_vec3_dot(
+                ak_vec3_sub(substep_rotation(s, c->a), substep_rotation(s, c->b)), c->n);
+            float wr = gen_inv_inertia(s, c->a, c->n) + gen_inv_inertia(s, c->b, c->n);
+            if (wr > 0.0f && fabsf(twist) > 0.0f &&
+                fabsf(twist) / wr < c->friction * lambda * arm) {
+                ak_vec3 pr = ak_vec3_scale(c->n, -twist / wr);
+                apply_angular_impulse(s, c->a, pr, 1.0f);
+                apply_angular_impulse(s, c->b, pr, -1.0f);
+            }
+        }
+    }
+}
+
+/* ---- joints (XPBD positional and angular constraints, Mueller et al. 2020, 3.3) ---------- */
+
+/* World inverse inertia tensor R diag(I^-1) R^T of body i (zero when it does not move). */
+static ak_mat3 inv_inertia_world(const solver* s, uint32_t i) {
+    if (!s->awake[i]) return ak_mat3_scale(ak_mat3_identity(), 0.0f);
+    ak_mat3 r = ak_mat3_from_quat(s->q[i]);
+    return ak_mat3_mul(ak_mat3_mul(r, ak_mat3_diagonal(s->bodies[i].inv_inertia)),
+                       ak_mat3_transpose(r));
+}
+
+static ak_mat3 skew(ak_vec3 v) {
+    ak_mat3 m = {{0.0f, v.z, -v.y, -v.z, 0.0f, v.x, v.y, -v.x, 0.0f}};
+    return m;
+}
+
+/* Move anchor points pa (on a, offset ra) and pb (on b, offset rb) together by e = pb - pa
+ * with compliance alpha (m/N), all three directions at once: the impulse p = K^-1 e with K =
+ * (1/m_a + 1/m_b + alpha/h^2) 1 - [ra]x Ia^-1 [ra]x - [rb]x Ib^-1 [rb]x moves the anchors by
+ * exactly e to first order. (Solving along e alone, as for a contact, turns a body whose
+ * rotation is cheap about its centre: the anchor then also moves across e, and a pendulum of a
+ * small ball on a long arm spins up 70 times too fast.) */
+static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 e,
+                           float alpha) {
+    if (ak_vec3_length_sq(e) < 1e-18f) return;
+    float lin = (s->awake[a] ? s->bodies[a].inv_mass : 0.0f) +
+                (s->awake[b] ? s->bodies[b].inv_mass : 0.0f) + alpha / (s->h * s->h);
+    ak_mat3 sa = skew(ra), sb = skew(rb);
+    ak_mat3 k = ak_mat3_scale(ak_mat3_identity(), lin);
+    k = ak_mat3_add(
+        k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sa, inv_inertia_world(s, a)), sa), -1.0f));
+    k = ak_mat3_add(
+        k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sb, inv_inertia_world(s, b)), sb), -1.0f));
+    float det = ak_mat3_determinant(k);
+    if (!(fabsf(det) > 1e-30f) || !ak_finitef(det)) return;
+    ak_vec3 p = ak_mat3_mul_vec3(ak_mat3_inverse(k), e);
+    apply_position_impulse(s, a, ra, p, 1.0f);
+    apply_position_impulse(s, b, rb, p, -1.0f);
+}
+
+/* Rotate a by (its share of) the rotation vector e and b by the opposite, so that a's frame
+ * turns towards b's: lambda = |e| / (w_a + w_b + alpha / h^2), w = n^T I^-1 n. */
+static void joint_rotation(solver* s, uint32_t a, uint32_t b, ak_vec3 e, float alpha) {
+    float c = ak_vec3_length(e);
+    if (c < 1e-9f) return;
+    ak_vec3 n = ak_vec3_scale(e, 1.0f / c);
+    float w = gen_inv_inertia(s, a, n) + gen_inv_inertia(s, b, n) + alpha / (s->h * s->h);
+    if (!(w > 0.0f)) return;
+    ak_vec3 p = ak_vec3_scale(n, c / w);
+    apply_angular_impulse(s, a, p, 1.0f);
+    apply_angular_impulse(s, b, p, -1.0f);
+}
+
+/* The rotation vector that turns a's frame times target onto b's orientation. */
+static ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
+    ak_quat dq = ak_quat_mul(qb, ak_quat_conjugate(ak_quat_mul(qa, target)));
+    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
+    return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
+}
+
+static void solve_joints(solver* s) {
+    const ak_rigid_model* m = s->m;
+    for (size_t k = 0; k < m->joint_count; ++k) {
+        const rigid_joint* j = &m->joints[k];
+        uint32_t a = j->a, b = j->b;
+        if (!s->awake[a] && !s->awake[b]) continue;
+        float alpha = j->compliance;
+        /* the anchors first, then the orientation parts (limits last, so a sweep ends with
+         * them met: anchors moved by a limit's pure rotation come back in the next sweep) */
+        ak_vec3 ra = ak_quat_rotate(s->q[a], j->la), rb = ak_quat_rotate(s->q[b], j->lb);
+        ak_vec3 e = ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra));
+        if (j->type == AK_RIGID_JOINT_PRISMATIC) {
+            ak_vec3 ax = ak_quat_rotate(s->q[a], j->axis_a);
+            float off = ak_vec3_dot(e, ax);
+            float keep = j->limited ? ak_clampf(off, j->lower, j->upper) : off;
+            e = ak_vec3_madd(e, ax, -keep);
+        }
+        joint_position(s, a, b, ra, rb, e, alpha);
+        if (j->type == AK_RIGID_JOINT_FIXED || j->type == AK_RIGID_JOINT_PRISMATIC)
+            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->rel), alpha);
+        if (j->type == AK_RIGID_JOINT_HINGE) {
+            ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a),
+                    a2 = ak_quat_rotate(s->q[b], j->axis_b);
+            joint_rotation(s, a, b, ak_vec3_cross(a1, a2), alpha);
+            if (j->limited) {
+                float phi = akp_rigid_hinge_angle(j, s->q[a], s->q[b]) + j->angle_offset;
+                float target = ak_clampf(phi, j->lower, j->upper);
+                if (phi != target)
+                    joint_rotation(s, a, b,
+                                   ak_vec3_scale(ak_quat_rotate(s->q[a], j->axis_a), phi - target),
+                                   0.0f);
+            }
+        }
+        if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
+            ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a),
+                    a2 = ak_quat_rotate(s->q[b], j->axis_b);
+            ak_vec3 cr = ak_vec3_cross(a1, a2);
+            float sn = ak_vec3_length(cr), swing = atan2f(sn, ak_vec3_dot(a1, a2));
+            if (swing > j->upper && sn > 1e-9f)
+                joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f);
+        }
+        if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited) {
+            ak_vec3 n;
+            float tw = akp_rigid_twist_angle(j, s->q[a], s->q[b], &n) + j->angle_offset;
+            float target = ak_clampf(tw, j->twist_lower, j->twist_upper);
+            if (tw != target) joint_rotation(s, a, b, ak_vec3_scale(n, tw - target), 0.0f);
+        }
+        if (j->drive && j->type != AK_RIGID_JOINT_FIXED && j->type != AK_RIGID_JOINT_PRISMATIC)
+            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->drive_target),
+                           j->drive_compliance);
+    }
+}
+
+/* True when bodies a and b are joined (jointed bodies do not collide with each other). */
+static bool joined(const ak_rigid_model* m, uint32_t a, uint32_t b) {
+    for (size_t k = 0; k < m->joint_count; ++k) {
+        const rigid_joint* j = &m->joints[k];
+        if ((j->a == a && j->b == b) || (j->a == b && j->b == a)) return true;
+    }
+    return false;
+}
+
+static void update_velocities(solver* s) {
+    float inv_h = 1.0f / s->h;
+    for (uint32_t i = 0; i < (uint32_t)s->m->body_count; ++i) {
+        if (!s->awake[i]) continue;
+        s->v[i] = ak_vec3_scale(s->dx[i], inv_h);
+        s->ds[i] = ak_vec3_add(s->ds[i], s->dx[i]);
+        /* predict's q' = normalise((1 + h/2 [w, 0]) q) gives dq = q' q^-1 with dq.xyz / dq.w =
+         * h w / 2 exactly, so this inverse returns w unchanged when no constraint acted (2 dq.xyz
+         * / h alone loses w (w h)^2 / 8 per substep: 5% of a spin's momentum in 10 s) */
+        ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->qp[i]));
+        float sg = 2.0f * inv_h / (fabsf(dq.w) > 0.1f ? dq.w : (dq.w >= 0.0f ? 0.1f : -0.1f));
+        s->w[i] = ak_vec3_make(dq.x * sg, dq.y * sg, dq.z * sg);
+    }
+}
+
+static ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
+    return ak_vec3_add(s->v[i], ak_vec3_cross(s->w[i], r));
+}
+
+static void velocity_impulse_pair(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb,
+                                  ak_vec3 dv) {
+    float l = ak_vec3_length(dv);
+    if (l < 1e-12f) return;
+    ak_vec3 dir = ak_vec3_scale(dv, 1.0f / l);
+    float w = gen_inv_mass(s, a, ra, dir) + gen_inv_mass(s, b, rb, dir);
+    if (!(w > 0.0f)) return;
+    ak_vec3 p = ak_vec3_scale(dv, 1.0f / w);
+    apply_velocity_impulse(s, a, ra, p, 1.0f);
+    apply_velocity_impulse(s, b, rb, p, -1.0f);
+}
+
+static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
+    float h = s->h;
+    for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
+        uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
+        for (uint32_t k = k0; k < k1; ++k) {
+            rigid_contact* c = &cb->c[k];
+            if (!(c->lambda_n > 0.0f)) continue;
+            ak_vec3 ra = ak_quat_rotate(s->q[c->a], c->la), rb = ak_quat_rotate(s->q[c->b], c->lb);
+            float vn = ak_vec3_dot(
+                c->n, ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb)));
+            /* restitution: the normal velocity becomes -e times the one before the solve (none
+             * for slow impacts, which gravity alone could have made in two substeps) */
+            float e = fabsf(c->vn_before) <= 2.0f * gmag * h ? 0.0f : c->restitution;
+            velocity_impulse_pair(s, c->a, c->b, ra, rb,
+                                  ak_vec3_scale(c->n, -vn + ak_maxf(-e * c->vn_before, 0.0f)));
+        }
+        /* dynamic friction at the centre of pressure (their eq. 30 with the units made whole) */
+        ak_vec3 la, lb;
+        float lambda, arm;
+        const rigid_contact* c = &cb->c[k0];
+        if (c->dynamic_friction > 0.0f && pressure_centre(cb, k0, k1, &la, &lb, &lambda, &arm)) {
+            ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
+            ak_vec3 vr = ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb));
+            ak_vec3 vt = ak_vec3_madd(vr, c->n, -ak_vec3_dot(vr, c->n));
+            float lt = ak_vec3_length(vt);
+            if (lt > 1e-12f) {
+                /* the friction impulse is at most mu_d times the normal one, lambda_n / h; as a
+                 * change of relative velocity that is mu_d lambda_n w_t / h */
+                ak_vec3 t = ak_vec3_scale(vt, 1.0f / lt);
+                float wt = gen_inv_mass(s, c->a, ra, t) + gen_inv_mass(s, c->b, rb, t);
+                float cut = ak_minf(c->dynamic_friction * lambda * wt / h, lt);
+                velocity_impulse_pair(s, c->a, c->b, ra, rb, ak_vec3_scale(t, -cut));
+            }
+            float spin = ak_vec3_dot(ak_vec3_sub(s->w[c->a], s->w[c->b]), c->n);
+            float wr = gen_inv_inertia(s, c->a, c->n) + gen_inv_inertia(s, c->b, c->n);
+            if (wr > 0.0f && spin != 0.0f) {
+                float cut = ak_minf(c->dynamic_friction * lambda * arm * wr / h, fabsf(spin));
+                ak_vec3 pr = ak_vec3_scale(c->n, (spin > 0.0f ? -cut : cut) / wr);
+                if (s->awake[c->a])
+                    s->w[c->a] = ak_vec3_add(s->w[c->a], inv_inertia_mul(s, c->a, pr));
+                if (s->awake[c->b])
+                    s->w[c->b] = ak_vec3_sub(s->w[c->b], inv_inertia_mul(s, c->b, pr));
+            }
+        }
+    }
+}
+
+static uint32_t uf_find(uint32_t* parent, uint32_t i) {
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* Sleep bookkeeping at the end of a step (see ak_rigid_step_job.sleep_timers). */
+static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_buf* cb,
+                         uint32_t* parent) {
+    const ak_rigid_model_desc* d = &s->m->desc;
+    uint32_t n = (uint32_t)s->m->body_count;
+    float* timer = job->sleep_timers.ptr;
+    for (uint32_t i = 0; i < n; ++i) {
+        parent[i] = i;
+        if (!s->awake[i]) continue;
+        bool slow = ak_vec3_length(s->v[i]) < d->sleep_linear_speed &&
+                    ak_vec3_length(s->w[i]) < d->sleep_angular_speed;
+        timer[i] = slow ? timer[i] + job->dt : 0.0f;
+    }
+    for (uint32_t k = 0; k < cb->count; ++k) {
+        uint32_t a = cb->c[k].a, b = cb->c[k].b;
+        if (s->bodies[a].inv_mass == 0.0f || s->bodies[b].inv_mass == 0.0f) continue;
+        uint32_t ra = uf_find(parent, a), rb = uf_find(parent, b);
+        if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    }
+    for (size_t k = 0; k < s->m->joint_count; ++k) {
+        uint32_t a = s->m->joints[k].a, b = s->m->joints[k].b;
+        if (s->bodies[a].inv_mass == 0.0f || s->bodies[b].inv_mass == 0.0f) continue;
+        uint32_t ra = uf_find(parent, a), rb = uf_find(parent, b);
+        if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    }
+    /* a group sleeps when its least sleepy body has been slow long enough; otherwise every
+     * body of it is awake. Roots hold the group's minimum timer in a second pass. */
+    for (uint32_t i = 0; i < n; ++i) {
+        if (s->bodies[i].inv_mass == 0.0f) continue;
+        uint32_t r = uf_find(parent, i);
+        if (r != i && timer[i] < timer[r]) timer[r] = timer[i];
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        if (s->bodies[i].inv_mass == 0.0f) continue;
+        uint32_t r = uf_find(parent, i);
+        if (timer[r] >= d->sleep_time) {
+            s->v[i] = ak_vec3_zero();
+            s->w[i] = ak_vec3_zero();
+            if (timer[i] < d->sleep_time) timer[i] = d->sleep_time;
+        } else if (!s->awake[i]) {
+            timer[i] = 0.0f; /* asleep at the step's start, touched by a moving group: wake */
+        }
+    }
+}
+
+ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
+    ak_result r = ak_rigid_step_validate(job);
+    if (r != AK_OK) return r;
+    const ak_rigid_model* m = job->model;
+    uint32_t n = (uint32_t)m->body_count;
+    layout l = layout_of(m);
+    unsigned char* base = (unsigned char*)(((uintptr_t)job->scratch.ptr + 15) & ~(uintptr_t)15);
+    ak_vec3* x0 = (ak_vec3*)(base + l.x0);
+    ak_quat* q0 = (ak_quat*)(base + l.q0);
+    ak_vec3* v0 = (ak_vec3*)(base + l.v0);
+    ak_vec3* w0 = (ak_vec3*)(base + l.w0);
+    uint8_t* awake = base + l.awake;
+    uint32_t substeps = job->substeps ? job->substeps : 10;
+    solver s = {
+        .m = m,
+        .bodies = m->bodies,
+        .x = job->positions.ptr,
+        .q = job->orientations.ptr,
+        .v = job->velocities.ptr,
+        .w = job->angular_velocities.ptr,
+        .x0 = x0,
+        .qp = (ak_quat*)(base + l.qp),
+        .dx = (ak_vec3*)(base + l.dx),
+        .ds = (ak_vec3*)(base + l.ds),
+        .q0 = q0,
+        .awake = awake,
+        .h = job->dt / (float)substeps,
+    };
+    memcpy(x0, s.x, n * sizeof *x0);
+    memcpy(q0, s.q, n * sizeof *q0);
+    memcpy(v0, s.v, n * sizeof *v0);
+    memcpy(w0, s.w, n * sizeof *w0);
+    memset(s.ds, 0, n * sizeof *s.ds);
+    const bool sleeping = job->sleep_timers.count > 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        awake[i] = m->bodies[i].inv_mass > 0.0f &&
+                   !(sleeping && job->sleep_timers.ptr[i] >= m->desc.sleep_time);
+        if (awake[i]) s.q[i] = q0[i] = ak_quat_normalize(s.q[i]);
+    }
+    contact_buf cb = {(rigid_contact*)(base + l.contacts), 0, m->desc.max_contacts, 0,
+                      (contact_group*)(base + l.groups),   0};
+    ak_vec3 up = ak_vec3_scale(ak_vec3_normalize(job->gravity), -1.0f);
+    float gmag = ak_vec3_length(job->gravity);
+    /* contacts are looked for a little further than a substep's motion could close */
+    float margin = m->desc.contact_offset;
+    for (uint32_t step = 0; step < substeps; ++step) {
+        predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping);
+        find_contacts(&s, (sap_entry*)(base + l.sap), &cb, margin);
+        order_groups(&s, &cb, up);
+        /* joints, contacts, then four more sweeps over the joints: contacts solved last would
+         * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
+         * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
+        solve_joints(&s);
+        solve_positions(&s, &cb);
+        for (int it = 0; it < 8 && m->joint_count; ++it) solve_joints(&s);
+        update_velocities(&s);
+        solve_velocities(&s, &cb, gmag);
+    }
+    bool finite = true;
+    for (uint32_t i = 0; i < n && finite; ++i)
+        finite = ak_vec3_is_finite(s.x[i]) && ak_quat_is_finite(s.q[i]) &&
+                 ak_vec3_is_finite(s.v[i]) && ak_vec3_is_finite(s.w[i]);
+    if (!finite) {
+        memcpy(s.x, x0, n * sizeof *x0);
+        memcpy(s.q, q0, n * sizeof *q0);
+        memcpy(s.v, v0, n * sizeof *v0);
+        memcpy(s.w, w0, n * sizeof *w0);
+        return AK_ERR_BAD_DATA;
+    }
+    if (job->out_max_penetration) {
+        float worst = 0.0f;
+        for (uint32_t k = 0; k < cb.count; ++k) {
+            const rigid_contact* c = &cb.c[k];
+            float d = ak_vec3_dot(
+                ak_vec3_sub(world_point(&s, c->b, c->lb), world_point(&s, c->a, c->la)), c->n);
+            worst = ak_maxf(worst, d);
+        }
+        *job->out_max_penetration = worst;
+    }
+    if (job->out_contact_count) *job->out_contact_count = cb.count;
+    if (job->out_dropped_contacts) *job->out_dropped_contacts = cb.dropped;
+    if (sleeping) update_sleep(&s, job, &cb, (uint32_t*)(base + l.parent));
+    return AK_OK;
+}

@@ -1,0 +1,573 @@
+/* Rigid bodies against physics: closed forms and conservation laws. */
+#include <math.h>
+#include <stdlib.h>
+
+#include <animkit/rigid.h>
+
+#include "ak_test.h"
+
+/* A world: model plus state and scratch. */
+typedef struct world {
+    ak_rigid_model* model;
+    size_t n;
+    ak_vec3 x[64], v[64], w[64];
+    ak_quat q[64];
+    float sleep[64];
+    ak_rigid_step_job job;
+} world;
+
+static bool world_init(world* wd, const ak_rigid_body_desc* bodies, size_t n,
+                       const ak_rigid_model_desc* extra, float dt, uint32_t substeps, ak_vec3 g) {
+    memset(wd, 0, sizeof *wd);
+    ak_rigid_model_desc md = {0};
+    if (extra) md = *extra;
+    md.bodies = (ak_rigid_body_desc_cspan){bodies, n};
+    if (ak_rigid_model_create(&md, NULL, &wd->model) != AK_OK) return false;
+    wd->n = n;
+    ak_rigid_initial_state(wd->model, (ak_vec3_span){wd->x, n}, (ak_quat_span){wd->q, n},
+                           (ak_vec3_span){wd->v, n}, (ak_vec3_span){wd->w, n});
+    wd->job = (ak_rigid_step_job){.model = wd->model,
+                                  .dt = dt,
+                                  .substeps = substeps,
+                                  .gravity = g,
+                                  .positions = {wd->x, n},
+                                  .orientations = {wd->q, n},
+                                  .velocities = {wd->v, n},
+                                  .angular_velocities = {wd->w, n}};
+    size_t size = ak_rigid_step_scratch_size(&wd->job);
+    wd->job.scratch = (ak_u8_span){malloc(size), size};
+    return wd->job.scratch.ptr != NULL;
+}
+
+static void world_free(world* wd) {
+    free(wd->job.scratch.ptr);
+    ak_rigid_model_destroy(wd->model);
+}
+
+static const ak_vec3 G = {0.0f, -9.81f, 0.0f};
+
+AK_TEST(mass_and_inertia_closed_forms) {
+    ak_rigid_body_desc b[3] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.5f}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {1.0f, 0.5f, 0.25f}}, .mass = 6.0f},
+        {.shape = {.type = AK_RIGID_CAPSULE, .radius = 0.1f, .half_height = 0.0f},
+         .density = 500.0f},
+    };
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {.bodies = {b, 3}};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
+    double ms = 1000.0 * 4.0 / 3.0 * 3.14159265358979 * 0.125;
+    AK_CHECK_NEAR(ak_rigid_body_mass(m, 0), ms, 1e-3 * ms);
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 0).y, 0.4 * ms * 0.25, 1e-3 * ms);
+    /* box 2 x 1 x 0.5 m, 6 kg: I_x = 6 (1 + 0.25) / 12 */
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 1).x, 6.0 * (1.0 + 0.25) / 12.0, 1e-5);
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 1).z, 6.0 * (4.0 + 1.0) / 12.0, 1e-5);
+    /* a capsule of zero length is a sphere */
+    double mc = 500.0 * 4.0 / 3.0 * 3.14159265358979 * 0.001;
+    AK_CHECK_NEAR(ak_rigid_body_mass(m, 2), mc, 1e-4 * mc);
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 2).x, 0.4 * mc * 0.01, 1e-4 * 0.4 * mc * 0.01);
+    AK_CHECK_NEAR(ak_rigid_body_inertia(m, 2).y, 0.4 * mc * 0.01, 1e-4 * 0.4 * mc * 0.01);
+    ak_rigid_model_destroy(m);
+}
+
+AK_TEST(model_validity) {
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {0};
+    AK_CHECK_EQ(ak_rigid_model_create(NULL, NULL, &m), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_EMPTY);
+    ak_rigid_body_desc b = {.shape = {.type = AK_RIGID_SPHERE}};
+    md.bodies = (ak_rigid_body_desc_cspan){&b, 1};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG); /* radius 0 */
+    b.shape.radius = NAN;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_DATA);
+    b.shape.radius = 1.0f;
+    b.restitution = 1.5f;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
+    b.restitution = 0.0f;
+    b.friction = -0.5f;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
+    b.friction = 0.0f;
+    b.shape.type = AK_RIGID_SHAPE_COUNT;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
+    AK_CHECK(m == NULL);
+    b.shape.type = AK_RIGID_SPHERE;
+    ak_rigid_body_desc two[2] = {b, b};
+    ak_rigid_joint_desc jd = {.body_a = 0, .body_b = 0};
+    ak_rigid_model_desc mj = {.bodies = {two, 2}, .joints = {&jd, 1}};
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m),
+                AK_ERR_BAD_INDEX); /* a body joined to itself */
+    jd.body_b = 2;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_INDEX);
+    jd.body_b = 1;
+    jd.limited = true, jd.lower = 1.0f, jd.upper = 0.5f;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_ARG);
+    jd.lower = 0.0f, jd.compliance = -1.0f;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_ARG);
+    jd.compliance = 0.0f, jd.type = AK_RIGID_JOINT_TYPE_COUNT;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_ARG);
+    jd.type = AK_RIGID_JOINT_HINGE, jd.anchor.x = INFINITY;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_ERR_BAD_DATA);
+    jd.anchor.x = 0.0f;
+    AK_CHECK_EQ(ak_rigid_model_create(&mj, NULL, &m), AK_OK);
+    AK_CHECK_EQ(ak_rigid_joint_count(m), 1);
+    ak_rigid_model_destroy(m);
+    m = NULL;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
+    ak_rigid_step_job job = {0};
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_NULL_ARG);
+    job.model = m;
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_BAD_ARG); /* dt 0 */
+    job.dt = 0.01f;
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_NULL_ARG);
+    ak_vec3 x = {0, 0, 0}, v = {NAN, 0, 0}, w = {0, 0, 0};
+    ak_quat q = {0, 0, 0, 1};
+    unsigned char scratch[8];
+    job.positions = (ak_vec3_span){&x, 1};
+    job.orientations = (ak_quat_span){&q, 1};
+    job.velocities = (ak_vec3_span){&v, 1};
+    job.angular_velocities = (ak_vec3_span){&w, 1};
+    job.scratch = (ak_u8_span){scratch, sizeof scratch};
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_SPAN_SMALL);
+    size_t size = ak_rigid_step_scratch_size(&job);
+    job.scratch = (ak_u8_span){malloc(size), size};
+    AK_CHECK_EQ(ak_rigid_step_validate(&job), AK_ERR_BAD_DATA);
+    v.x = 0.0f;
+    AK_CHECK_EQ(ak_rigid_step_run(&job), AK_OK);
+    free(job.scratch.ptr);
+    ak_rigid_model_destroy(m);
+}
+
+/* Free fall and a thrown body: x(t) = x0 + v0 t + g t^2 / 2, up to semi-implicit Euler's
+ * error of g h t / 2 in position (16 mm after 2 s with h = 1/600 s); velocities exact. */
+AK_TEST(free_fall_and_parabola) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.2f, 0.3f}},
+         .position = {0, 100, 0}},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.1f},
+         .position = {0, 50, 0},
+         .velocity = {3, 8, -1}},
+    };
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 10, G));
+    for (int f = 0; f < 120; ++f) AK_CHECK_EQ(ak_rigid_step_run(&wd.job), AK_OK);
+    float t = 2.0f;
+    const float euler = 9.81f * (1.0f / 600.0f) * t / 2.0f;
+    AK_CHECK_NEAR(wd.x[0].y, 100.0f - 0.5f * 9.81f * t * t - euler, 1e-3);
+    AK_CHECK_NEAR(wd.v[0].y, -9.81f * t, 1e-3);
+    AK_CHECK_NEAR(wd.x[1].x, 3.0f * t, 1e-4);
+    AK_CHECK_NEAR(wd.x[1].y, 50.0f + 8.0f * t - 0.5f * 9.81f * t * t - euler, 1e-3);
+    AK_CHECK_NEAR(wd.x[1].z, -t, 1e-4);
+    AK_CHECK_NEAR(ak_quat_angle_between(wd.q[0], ak_quat_identity()), 0.0f, 1e-5);
+    world_free(&wd);
+}
+
+/* A box on a plane inclined by theta: stays when tan(theta) < mu, else slides with
+ * a = g (sin theta - mu cos theta). */
+static float incline_accel(float theta, float mu, float* out_drift) {
+    ak_vec3 nrm = {-sinf(theta), cosf(theta), 0.0f};
+    ak_quat rot = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), theta);
+    ak_vec3 start = ak_vec3_scale(nrm, 0.1f);
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_PLANE, .normal = nrm}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.2f}},
+         .position = start,
+         .orientation = rot,
+         .friction = mu},
+    };
+    b[0].friction = mu;
+    world wd;
+    if (!world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 20, G)) return NAN;
+    /* settle 0.25 s, then measure the distance along the slope over 1 s */
+    ak_vec3 down = {-cosf(theta), -sinf(theta), 0.0f};
+    for (int f = 0; f < 15; ++f) ak_rigid_step_run(&wd.job);
+    float s0 = ak_vec3_dot(wd.x[1], down), v0 = ak_vec3_dot(wd.v[1], down);
+    for (int f = 0; f < 60; ++f) ak_rigid_step_run(&wd.job);
+    float s1 = ak_vec3_dot(wd.x[1], down);
+    *out_drift = s1 - s0;
+    world_free(&wd);
+    /* s1 - s0 = v0 T + a T^2 / 2 with T = 1 */
+    return 2.0f * (s1 - s0 - v0);
+}
+
+AK_TEST(incline_stays_or_slides) {
+    float drift;
+    /* tan(20 deg) = 0.364 < 0.5: stays */
+    incline_accel(ak_radians(20.0f), 0.5f, &drift);
+    AK_CHECK_MSG(fabsf(drift) < 1e-3f, "drift %g m", drift);
+    /* tan(35 deg) = 0.700 > 0.3: slides */
+    float th = ak_radians(35.0f), mu = 0.3f;
+    float a = incline_accel(th, mu, &drift);
+    float want = 9.81f * (sinf(th) - mu * cosf(th));
+    AK_CHECK_MSG(fabsf(a - want) < 0.01f * want, "a %g want %g", a, want);
+    /* frictionless slope: g sin theta */
+    th = ak_radians(25.0f);
+    a = incline_accel(th, AK_RIGID_FRICTIONLESS, &drift);
+    want = 9.81f * sinf(th);
+    AK_CHECK_MSG(fabsf(a - want) < 0.01f * want, "a %g want %g", a, want);
+}
+
+/* Torque-free box (5 rad/s, h = 1/1200 s): world angular momentum conserved; spin about the
+ * intermediate axis flips, spins about the major and minor axes stay. Box half extents 0.5, 0.3,
+ * 0.1: I_z < I_y < I_x? I_x ~ (0.09 + 0.01), I_y ~ (0.25 + 0.01), I_z ~ (0.25 + 0.09): minor x,
+ * intermediate y, major z. */
+static void spin(int axis, float* out_l_err, float* out_min_comp, float* out_max_comp) {
+    ak_vec3 w = {0.01f, 0.01f, 0.01f};
+    if (axis == 0)
+        w.x = 5.0f;
+    else if (axis == 1)
+        w.y = 5.0f;
+    else
+        w.z = 5.0f;
+    ak_rigid_body_desc b = {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.3f, 0.1f}},
+                            .angular_velocity = w};
+    world wd;
+    world_init(&wd, &b, 1, NULL, 1.0f / 60.0f, 20, ak_vec3_zero());
+    ak_vec3 l0 = ak_rigid_angular_momentum(wd.model, 0, wd.q[0], wd.w[0]);
+    float worst = 0.0f, lo = 1.0f, hi = -1.0f;
+    for (int f = 0; f < 600; ++f) {
+        ak_rigid_step_run(&wd.job);
+        ak_vec3 l = ak_rigid_angular_momentum(wd.model, 0, wd.q[0], wd.w[0]);
+        worst = ak_maxf(worst, ak_vec3_length(ak_vec3_sub(l, l0)) / ak_vec3_length(l0));
+        /* the spin axis's direction in the body: component along the starting axis */
+        ak_vec3 wl = ak_vec3_normalize(ak_quat_rotate(ak_quat_conjugate(wd.q[0]), wd.w[0]));
+        float c = axis == 0 ? wl.x : (axis == 1 ? wl.y : wl.z);
+        lo = ak_minf(lo, c);
+        hi = ak_maxf(hi, c);
+    }
+    *out_l_err = worst;
+    *out_min_comp = lo;
+    *out_max_comp = hi;
+    world_free(&wd);
+}
+
+AK_TEST(torque_free_spin) {
+    float err, lo, hi;
+    spin(1, &err, &lo, &hi);
+    AK_CHECK_MSG(err < 0.01f, "intermediate: |dL|/|L| %g", err);
+    AK_CHECK_MSG(lo < -0.9f, "intermediate axis did not flip: min component %g", lo);
+    spin(0, &err, &lo, &hi);
+    AK_CHECK_MSG(err < 0.01f, "minor: |dL|/|L| %g", err);
+    AK_CHECK_MSG(lo > 0.99f, "minor axis wandered: min component %g", lo);
+    spin(2, &err, &lo, &hi);
+    AK_CHECK_MSG(err < 0.01f, "major: |dL|/|L| %g", err);
+    AK_CHECK_MSG(lo > 0.99f, "major axis wandered: min component %g", lo);
+}
+
+/* A sphere dropped from h on a plane with restitution e rebounds to e^2 h. */
+AK_TEST(restitution_rebound) {
+    const float h = 1.0f, e = 0.6f, r = 0.1f;
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_PLANE}},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = r},
+         .position = {0, h + r, 0},
+         .restitution = e},
+    };
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 20, G));
+    float peak = 0.0f;
+    bool bounced = false;
+    for (int f = 0; f < 120; ++f) {
+        ak_rigid_step_run(&wd.job);
+        if (wd.v[1].y > 0.0f) bounced = true;
+        if (bounced) peak = ak_maxf(peak, wd.x[1].y - r);
+        if (bounced && wd.v[1].y < 0.0f) break;
+    }
+    AK_CHECK(bounced);
+    AK_CHECK_MSG(fabsf(peak - e * e * h) < 0.02f * e * e * h, "peak %g want %g", peak, e * e * h);
+    world_free(&wd);
+}
+
+/* A column of boxes on the ground, stepped for `seconds`: the largest horizontal drift of any
+ * box and the deepest penetration seen. */
+static void stack_run(int count, float seconds, uint32_t substeps, bool sleep, float* out_drift,
+                      float* out_pen, bool* out_ok) {
+    ak_rigid_body_desc b[64];
+    memset(b, 0, sizeof b);
+    b[0].shape.type = AK_RIGID_PLANE;
+    for (int i = 1; i <= count; ++i) {
+        b[i].shape.type = AK_RIGID_BOX;
+        b[i].shape.half_extents = ak_vec3_make(0.5f, 0.5f, 0.5f);
+        b[i].position = ak_vec3_make(0.0f, 0.5f + 1.0f * (float)(i - 1), 0.0f);
+    }
+    world wd;
+    *out_ok = world_init(&wd, b, (size_t)count + 1, NULL, 1.0f / 60.0f, substeps, G);
+    if (sleep) wd.job.sleep_timers = (ak_f32_span){wd.sleep, (size_t)count + 1};
+    float pen_max = 0.0f, drift = 0.0f, pen;
+    wd.job.out_max_penetration = &pen;
+    int frames = (int)(seconds * 60.0f);
+    for (int f = 0; f < frames; ++f) {
+        if (ak_rigid_step_run(&wd.job) != AK_OK) *out_ok = false;
+        pen_max = ak_maxf(pen_max, pen);
+    }
+    for (int i = 1; i <= count; ++i) {
+        float dx = wd.x[i].x, dz = wd.x[i].z;
+        drift = ak_maxf(drift, sqrtf(dx * dx + dz * dz));
+        drift = ak_maxf(drift, fabsf(wd.x[i].y - (0.5f + (float)(i - 1))));
+    }
+    *out_drift = drift;
+    *out_pen = pen_max;
+    world_free(&wd);
+}
+
+AK_TEST(box_stack_stands) {
+    float drift, pen;
+    bool ok;
+    /* with sleeping, as a scene would run: the stack falls asleep once it has settled */
+    stack_run(10, 3.0f, 40, true, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+}
+
+AK_TEST(box_stack_stands_20s) {
+    float drift, pen;
+    bool ok;
+    /* awake for all 20 s: the solver alone holds it (40 substeps) */
+    stack_run(10, 20.0f, 40, false, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+}
+
+/* A 2D pyramid of unit boxes (layer k holds layers - k boxes, 0.1 m apart): the largest
+ * horizontal displacement of any box from where it started and the deepest penetration. */
+static void pyramid_run(int layers, float seconds, uint32_t substeps, bool sleep, float* out_drift,
+                        float* out_pen, bool* out_ok) {
+    size_t n = 1 + (size_t)layers * (size_t)(layers + 1) / 2;
+    ak_rigid_body_desc* b = calloc(n, sizeof *b);
+    ak_vec3 *x = calloc(n, sizeof *x), *v = calloc(n, sizeof *v), *w = calloc(n, sizeof *w);
+    ak_quat* q = calloc(n, sizeof *q);
+    float* timers = calloc(n, sizeof *timers);
+    *out_ok = b && x && v && w && q && timers;
+    if (!*out_ok) goto done;
+    b[0].shape.type = AK_RIGID_PLANE;
+    size_t k = 1;
+    for (int layer = 0; layer < layers; ++layer)
+        for (int i = 0; i < layers - layer; ++i, ++k) {
+            b[k].shape.type = AK_RIGID_BOX;
+            b[k].shape.half_extents = ak_vec3_make(0.5f, 0.5f, 0.5f);
+            b[k].position = ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - layer - 1)),
+                                         0.5f + (float)layer, 0.0f);
+        }
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {.bodies = {b, n}};
+    *out_ok = ak_rigid_model_create(&md, NULL, &m) == AK_OK;
+    if (!*out_ok) goto done;
+    ak_rigid_initial_state(m, (ak_vec3_span){x, n}, (ak_quat_span){q, n}, (ak_vec3_span){v, n},
+                           (ak_vec3_span){w, n});
+    float pen = 0.0f, pen_max = 0.0f, drift = 0.0f;
+    ak_rigid_step_job job = {.model = m,
+                             .dt = 1.0f / 60.0f,
+                             .substeps = substeps,
+                             .gravity = G,
+                             .positions = {x, n},
+                             .orientations = {q, n},
+                             .velocities = {v, n},
+                             .angular_velocities = {w, n},
+                             .out_max_penetration = &pen};
+    if (sleep) job.sleep_timers = (ak_f32_span){timers, n};
+    size_t size = ak_rigid_step_scratch_size(&job);
+    job.scratch = (ak_u8_span){malloc(size), size};
+    int frames = (int)(seconds * 60.0f);
+    for (int f = 0; f < frames && *out_ok; ++f) {
+        *out_ok = ak_rigid_step_run(&job) == AK_OK;
+        pen_max = ak_maxf(pen_max, pen);
+    }
+    /* horizontal: the column's vertical give is the contacts' penetration, checked apart */
+    for (size_t i = 1; i < n; ++i) {
+        float dx = x[i].x - b[i].position.x, dz = x[i].z - b[i].position.z;
+        drift = ak_maxf(drift, sqrtf(dx * dx + dz * dz));
+    }
+    *out_drift = drift;
+    *out_pen = pen_max;
+    free(job.scratch.ptr);
+    ak_rigid_model_destroy(m);
+done:
+    free(b), free(x), free(v), free(w), free(q), free(timers);
+}
+
+AK_TEST(pyramid_stands) {
+    float drift, pen;
+    bool ok;
+    pyramid_run(6, 2.0f, 40, true, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+}
+
+AK_TEST(pyramid_20_layers_20s) {
+    float drift, pen;
+    bool ok;
+    pyramid_run(20, 20.0f, 40, true, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+    printf("  20-layer pyramid, 20 s, 40 substeps, sleeping on: drift %.3g m, penetration %.3g m\n",
+           drift, pen);
+}
+
+/* A compound pendulum on a ball joint: a sphere of radius r at distance L below a static
+ * anchor, released at 5 degrees, swings with T = 2 pi sqrt(I_pivot / (m g L)), I_pivot =
+ * 2/5 m r^2 + m L^2 (small-amplitude closed form; 5 degrees adds 0.05%). */
+AK_TEST(pendulum_period_ball_joint) {
+    const float L = 1.0f, r = 0.05f, th0 = ak_radians(5.0f);
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.01f}, .is_static = true},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = r},
+         .position = {L * sinf(th0), -L * cosf(th0), 0}},
+    };
+    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_BALL, .body_a = 0, .body_b = 1};
+    ak_rigid_model_desc md = {.joints = {&jd, 1}};
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 240.0f, 10, G));
+    float prev_x = wd.x[1].x, t = 0.0f, crossings[3];
+    int nc = 0;
+    float worst_gap = 0.0f;
+    for (int f = 0; f < 240 * 5 && nc < 3; ++f) {
+        ak_rigid_step_run(&wd.job);
+        t += 1.0f / 240.0f;
+        float gap, excess;
+        ak_rigid_joint_error(wd.model, 0, (ak_vec3_cspan){wd.x, 2}, (ak_quat_cspan){wd.q, 2}, &gap,
+                             &excess);
+        worst_gap = ak_maxf(worst_gap, gap);
+        /* downward zero crossings of x, interpolated */
+        if (prev_x > 0.0f && wd.x[1].x <= 0.0f)
+            crossings[nc++] = t - (1.0f / 240.0f) * wd.x[1].x / (wd.x[1].x - prev_x);
+        prev_x = wd.x[1].x;
+    }
+    AK_CHECK_EQ(nc, 3);
+    double m_i = 0.4 * r * r + L * L; /* I_pivot / m */
+    double T = 2.0 * 3.14159265358979 * sqrt(m_i / (9.81 * L));
+    if (nc == 3) {
+        double got = (double)(crossings[2] - crossings[0]) / 2.0;
+        AK_CHECK_MSG(fabs(got - T) < 0.01 * T, "period %g want %g", got, T);
+    }
+    AK_CHECK_MSG(worst_gap < 1e-4f, "joint gap %g m", worst_gap);
+    world_free(&wd);
+}
+
+/* A box hinged at one end to a static body, limits [-30, 30] degrees, released horizontal
+ * with the hinge's zero at 0: gravity pulls it to the lower limit, where it must stop within
+ * 2 degrees; swinging about any other axis is forbidden. */
+AK_TEST(hinge_limits_hold) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.05f}, .is_static = true},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.05f, 0.1f}},
+         .position = {0.5f, 0, 0},
+         .angular_velocity = {1.0f, 2.0f, 0.0f}},
+    };
+    ak_rigid_joint_desc jd = {.type = AK_RIGID_JOINT_HINGE,
+                              .body_a = 0,
+                              .body_b = 1,
+                              .axis = {0, 0, 1},
+                              .limited = true,
+                              .lower = ak_radians(-30.0f),
+                              .upper = ak_radians(30.0f)};
+    ak_rigid_model_desc md = {.joints = {&jd, 1}};
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 20, G));
+    float worst_excess = 0.0f, worst_gap = 0.0f, worst_tilt = 0.0f;
+    for (int f = 0; f < 120; ++f) {
+        ak_rigid_step_run(&wd.job);
+        float gap, excess;
+        ak_rigid_joint_error(wd.model, 0, (ak_vec3_cspan){wd.x, 2}, (ak_quat_cspan){wd.q, 2}, &gap,
+                             &excess);
+        worst_excess = ak_maxf(worst_excess, excess);
+        worst_gap = ak_maxf(worst_gap, gap);
+        ak_vec3 z = ak_quat_rotate(wd.q[1], ak_vec3_make(0, 0, 1));
+        worst_tilt = ak_maxf(worst_tilt, acosf(ak_clampf(z.z, -1.0f, 1.0f)));
+    }
+    /* at rest on the limit: the bar points 30 degrees below the horizontal */
+    ak_vec3 bar = ak_quat_rotate(wd.q[1], ak_vec3_make(1, 0, 0));
+    AK_CHECK_NEAR(atan2f(bar.y, bar.x), ak_radians(-30.0f), ak_radians(2.0f));
+    AK_CHECK_MSG(worst_excess < ak_radians(2.0f), "limit exceeded by %g deg",
+                 ak_degrees(worst_excess));
+    AK_CHECK_MSG(worst_tilt < ak_radians(2.0f), "hinge axis tilted by %g deg",
+                 ak_degrees(worst_tilt));
+    AK_CHECK_MSG(worst_gap < 1e-3f, "joint gap %g m", worst_gap);
+    world_free(&wd);
+}
+
+/* A box on a frictionless prismatic joint along x under gravity (3, -9.81, 0): the joint holds
+ * it up and it slides at 3 m/s^2 (x = 1.5 t^2 less Euler's 1.5 h t); limits stop it at 1 m. */
+AK_TEST(prismatic_slides_along_its_axis) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.05f}, .is_static = true},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.1f, 0.1f}}},
+    };
+    ak_rigid_joint_desc jd = {
+        .type = AK_RIGID_JOINT_PRISMATIC, .body_a = 0, .body_b = 1, .axis = {1, 0, 0}};
+    ak_rigid_model_desc md = {.joints = {&jd, 1}};
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 10, ak_vec3_make(3.0f, -9.81f, 0.0f)));
+    for (int f = 0; f < 30; ++f) ak_rigid_step_run(&wd.job);
+    float t = 0.5f;
+    AK_CHECK_NEAR(wd.x[1].x, 1.5f * t * t + 1.5f * t / 600.0f, 2e-3);
+    AK_CHECK_NEAR(wd.x[1].y, 0.0f, 1e-4);
+    AK_CHECK_NEAR(ak_quat_angle_between(wd.q[1], ak_quat_identity()), 0.0f, 1e-3);
+    world_free(&wd);
+    jd.limited = true, jd.lower = -1.0f, jd.upper = 0.2f;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 10, ak_vec3_make(3.0f, -9.81f, 0.0f)));
+    for (int f = 0; f < 60; ++f) ak_rigid_step_run(&wd.job);
+    AK_CHECK_NEAR(wd.x[1].x, 0.2f, 1e-3);
+    world_free(&wd);
+}
+
+/* Two boxes welded by a fixed joint, thrown spinning: they keep their relative pose, and with
+ * no gravity the pair's total angular momentum about its centre of mass is conserved. */
+AK_TEST(fixed_joint_keeps_the_pose) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.1f}},
+         .position = {-0.2f, 0, 0},
+         .angular_velocity = {0.3f, 0.2f, 2.0f}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.1f, 0.1f}},
+         .position = {0.2f, 0, 0},
+         .angular_velocity = {0.3f, 0.2f, 2.0f}},
+    };
+    /* the bodies move as one: v = w x r about the common centre */
+    b[0].velocity = ak_vec3_cross(b[0].angular_velocity, b[0].position);
+    b[1].velocity = ak_vec3_cross(b[1].angular_velocity, b[1].position);
+    ak_rigid_joint_desc jd = {
+        .type = AK_RIGID_JOINT_FIXED, .body_a = 0, .body_b = 1, .anchor = {0, 0, 0}};
+    ak_rigid_model_desc md = {.joints = {&jd, 1}};
+    world wd;
+    AK_CHECK(world_init(&wd, b, 2, &md, 1.0f / 60.0f, 20, ak_vec3_zero()));
+    ak_vec3 l0 = ak_vec3_zero();
+    for (int i = 0; i < 2; ++i)
+        l0 = ak_vec3_add(
+            l0, ak_vec3_add(ak_rigid_angular_momentum(wd.model, (size_t)i, wd.q[i], wd.w[i]),
+                            ak_vec3_scale(ak_vec3_cross(wd.x[i], wd.v[i]),
+                                          ak_rigid_body_mass(wd.model, (size_t)i))));
+    for (int f = 0; f < 120; ++f) ak_rigid_step_run(&wd.job);
+    AK_CHECK_NEAR(ak_quat_angle_between(wd.q[0], wd.q[1]), 0.0f, ak_radians(0.5f));
+    AK_CHECK_NEAR(ak_vec3_distance(wd.x[0], wd.x[1]), 0.4f, 1e-3);
+    ak_vec3 l1 = ak_vec3_zero(), c = ak_vec3_scale(ak_vec3_add(wd.x[0], wd.x[1]), 0.5f);
+    ak_vec3 vc = ak_vec3_scale(ak_vec3_add(wd.v[0], wd.v[1]), 0.5f);
+    for (int i = 0; i < 2; ++i)
+        l1 = ak_vec3_add(
+            l1, ak_vec3_add(
+                    ak_rigid_angular_momentum(wd.model, (size_t)i, wd.q[i], wd.w[i]),
+                    ak_vec3_scale(ak_vec3_cross(ak_vec3_sub(wd.x[i], c), ak_vec3_sub(wd.v[i], vc)),
+                                  ak_rigid_body_mass(wd.model, (size_t)i))));
+    AK_CHECK_MSG(ak_vec3_length(ak_vec3_sub(l1, l0)) < 0.02f * ak_vec3_length(l0),
+                 "L %g %g %g vs %g %g %g", l1.x, l1.y, l1.z, l0.x, l0.y, l0.z);
+    world_free(&wd);
+}
+
+int main(void) {
+    AK_RUN(mass_and_inertia_closed_forms);
+    AK_RUN(model_validity);
+    AK_RUN(free_fall_and_parabola);
+    AK_RUN(incline_stays_or_slides);
+    AK_RUN(torque_free_spin);
+    AK_RUN(restitution_rebound);
+    AK_RUN(box_stack_stands);
+    AK_RUN_SLOW(pyramid_stands);
+    AK_RUN(pendulum_period_ball_joint);
+    AK_RUN(hinge_limits_hold);
+    AK_RUN(prismatic_slides_along_its_axis);
+    AK_RUN(fixed_joint_keeps_the_pose);
+    AK_RUN_SLOW(box_stack_stands_20s);
+    AK_RUN_SLOW(pyramid_20_layers_20s);
+    return ak_test_finish();
+}

@@ -1,0 +1,407 @@
+/* animkit rigid: simulate a rigid-body scene or preset; write JSON, PNG, GIF or glTF. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "cli_json.h"
+#include "outfile.h"
+#include "render.h"
+#include "scene_rigid.h"
+#include "sim_bake.h"
+
+static const char* const usage =
+    "usage: animkit rigid [SCENE.json | --preset "
+    "stack|pyramid|dominoes|avalanche|ragdoll|incline]\n"
+    "                     [--steps N] [--dt DT] [--substeps S] [--threads T] [--json OUT.json]\n"
+    "                     [-o OUT.gif|OUT.png|OUT.glb]\n"
+    "Simulate rigid bodies (spheres, boxes, capsules, static planes) and joints with XPBD "
+    "substeps,\n"
+    "contacts, Coulomb friction and restitution: a 10-box stack, a 20-layer pyramid, dominoes, an\n"
+    "avalanche down a slope, builtin:humanoid as a ragdoll, boxes on an incline; or the scene a\n"
+    "JSON file describes (docs/rigid.md lists every key). --json writes {\"time\", \"bodies\": "
+    "[{\"position\", \"orientation\", \"velocity\",\n"
+    "\"angular_velocity\"}], \"max_penetration\", \"energy\"} of the final state (world space);\n"
+    "-o renders the run (GIF), its last frame (PNG), or bakes it as glTF (.glb).\n"
+    "Exit status: 0 success, 1 bad scene or a blow-up (named by its step), 2 bad usage.\n";
+
+/* ---- the bodies as one mesh ---------------------------------------------------------------- */
+
+enum { RINGS = 8, SEGS = 12 };
+
+typedef struct body_mesh {
+    ak_vec3 *local_pos, *local_nrm, *pos, *nrm;
+    uint32_t* body; /* per vertex */
+    uint32_t* idx;
+    size_t vcount, icount;
+} body_mesh;
+
+static void mesh_free(body_mesh* m) {
+    free(m->local_pos), free(m->local_nrm), free(m->pos), free(m->nrm), free(m->body), free(m->idx);
+    memset(m, 0, sizeof *m);
+}
+
+static void add_vertex(body_mesh* m, uint32_t body, ak_vec3 p, ak_vec3 n) {
+    m->local_pos[m->vcount] = p;
+    m->local_nrm[m->vcount] = n;
+    m->body[m->vcount++] = body;
+}
+
+static void add_quad(body_mesh* m, uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+    uint32_t* t = m->idx + m->icount;
+    t[0] = a, t[1] = b, t[2] = c, t[3] = a, t[4] = c, t[5] = d;
+    m->icount += 6;
+}
+
+static bool mesh_build(body_mesh* m, const ak_rigid_model* model) {
+    memset(m, 0, sizeof *m);
+    size_t n = ak_rigid_body_count(model), nv = 0, ni = 0;
+    for (size_t i = 0; i < n; ++i) {
+        ak_rigid_shape_type t = ak_rigid_body_get_desc(model, i).shape.type;
+        if (t == AK_RIGID_BOX)
+            nv += 24, ni += 36;
+        else if (t != AK_RIGID_PLANE)
+            nv += (RINGS + 2) * SEGS, ni += (RINGS + 1) * SEGS * 6;
+    }
+    m->local_pos = malloc((nv + 1) * sizeof(ak_vec3));
+    m->local_nrm = malloc((nv + 1) * sizeof(ak_vec3));
+    m->pos = malloc((nv + 1) * sizeof(ak_vec3));
+    m->nrm = malloc((nv + 1) * sizeof(ak_vec3));
+    m->body = malloc((nv + 1) * sizeof(uint32_t));
+    m->idx = malloc((ni + 1) * sizeof(uint32_t));
+    if (!m->local_pos || !m->local_nrm || !m->pos || !m->nrm || !m->body || !m->idx) return false;
+    for (uint32_t i = 0; i < (uint32_t)n; ++i) {
+        ak_rigid_shape s = ak_rigid_body_get_desc(model, i).shape;
+        uint32_t base = (uint32_t)m->vcount;
+        if (s.type == AK_RIGID_BOX) {
+            ak_vec3 h = s.half_extents;
+            for (int axis = 0; axis < 3; ++axis)
+                for (int sg = -1; sg <= 1; sg += 2) {
+                    float f = (float)sg;
+                    ak_vec3 nn = ak_vec3_make(axis == 0 ? f : 0.0f, axis == 1 ? f : 0.0f,
+                                              axis == 2 ? f : 0.0f);
+                    ak_vec3 u = axis == 0   ? ak_vec3_make(0, 1, 0)
+                                : axis == 1 ? ak_vec3_make(0, 0, 1)
+                                            : ak_vec3_make(1, 0, 0);
+                    ak_vec3 v = ak_vec3_cross(nn, u);
+                    uint32_t b0 = (uint32_t)m->vcount;
+                    for (int c = 0; c < 4; ++c) {
+                        float a = (c == 0 || c == 3) ? -1.0f : 1.0f, b = c < 2 ? -1.0f : 1.0f;
+                        ak_vec3 p =
+                            ak_vec3_add(ak_vec3_add(nn, ak_vec3_scale(u, a)), ak_vec3_scale(v, b));
+                        add_vertex(m, i, ak_vec3_mul(p, h), nn);
+                    }
+                    add_quad(m, b0, b0 + 1, b0 + 2, b0 + 3);
+                }
+        } else if (s.type != AK_RIGID_PLANE) {
+            float hh = s.type == AK_RIGID_CAPSULE ? s.half_height : 0.0f;
+            /* rings 0..RINGS/2 on the top cap, RINGS/2..RINGS on the bottom (the equator twice) */
+            for (int r = 0; r <= RINGS + 1; ++r) {
+                int rr = r <= RINGS / 2 ? r : r - 1;
+                float th = 3.14159265f * (float)rr / (float)RINGS;
+                float off = r <= RINGS / 2 ? hh : -hh;
+                for (int k = 0; k < SEGS; ++k) {
+                    float ph = 6.2831853f * (float)k / (float)SEGS;
+                    ak_vec3 nn = ak_vec3_make(sinf(th) * cosf(ph), cosf(th), sinf(th) * sinf(ph));
+                    add_vertex(
+                        m, i, ak_vec3_make(nn.x * s.radius, nn.y * s.radius + off, nn.z * s.radius),
+                        nn);
+                }
+            }
+            for (int r = 0; r <= RINGS; ++r)
+                for (int k = 0; k < SEGS; ++k) {
+                    uint32_t a = base + (uint32_t)(r * SEGS + k),
+                             b = base + (uint32_t)(r * SEGS + (k + 1) % SEGS);
+                    add_quad(m, a, a + SEGS, b + SEGS, b);
+                }
+        }
+    }
+    return true;
+}
+
+static void mesh_pose(body_mesh* m, const ak_vec3* x, const ak_quat* q) {
+    for (size_t v = 0; v < m->vcount; ++v) {
+        uint32_t b = m->body[v];
+        m->pos[v] = ak_vec3_add(x[b], ak_quat_rotate(q[b], m->local_pos[v]));
+        m->nrm[v] = ak_quat_rotate(q[b], m->local_nrm[v]);
+    }
+}
+
+/* ---- output ------------------------------------------------------------------------------ */
+
+static void put_vec(FILE* f, const char* key, const float* c, int count) {
+    fprintf(f, "\"%s\": [", key);
+    for (int k = 0; k < count; ++k) fprintf(f, "%s%.9g", k ? ", " : "", (double)c[k]);
+    fprintf(f, "]");
+}
+
+static int write_json(const char* path, float time, size_t n, const ak_vec3* x, const ak_quat* q,
+                      const ak_vec3* v, const ak_vec3* w, float pen, double energy) {
+    cli_outfile out; /* a temporary renamed over path once complete */
+    if (cli_outfile_open(&out, "rigid", path)) return CLI_BAD_INPUT;
+    FILE* f = out.f;
+    fprintf(f, "{\"time\": %.9g, \"bodies\": [", (double)time);
+    for (size_t i = 0; i < n; ++i) {
+        const float p[3] = {x[i].x, x[i].y, x[i].z}, o[4] = {q[i].x, q[i].y, q[i].z, q[i].w};
+        const float vv[3] = {v[i].x, v[i].y, v[i].z}, ww[3] = {w[i].x, w[i].y, w[i].z};
+        fprintf(f, "%s{", i ? ", " : "");
+        put_vec(f, "position", p, 3);
+        fprintf(f, ", ");
+        put_vec(f, "orientation", o, 4);
+        fprintf(f, ", ");
+        put_vec(f, "velocity", vv, 3);
+        fprintf(f, ", ");
+        put_vec(f, "angular_velocity", ww, 3);
+        fprintf(f, "}");
+    }
+    fprintf(f, "], \"max_penetration\": %.9g, \"energy\": %.9g}\n", (double)pen, energy);
+    return cli_outfile_commit(&out, "rigid");
+}
+
+/* ---- the command -------------------------------------------------------------------------- */
+
+int cmd_rigid(int argc, char** argv) {
+    static const cli_opt opts[] = {{"--preset", NULL, true},  {"--steps", NULL, true},
+                                   {"--dt", NULL, true},      {"--substeps", NULL, true},
+                                   {"--threads", NULL, true}, {"--json", NULL, true},
+                                   {"--output", "-o", true}};
+    cli_args a;
+    int rc = cli_parse("rigid", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+    if (rc) return rc;
+    if (a.help) {
+        fputs(usage, stdout);
+        return CLI_OK;
+    }
+    const char* preset = CLI_GET(&a, "--preset");
+    if (a.pos_count > 1) return cli_usage("rigid", "expected at most one SCENE.json");
+    if ((a.pos_count == 1) == (preset != NULL))
+        return cli_usage("rigid", "give either SCENE.json or --preset NAME");
+    const char* out = CLI_GET(&a, "--output");
+    const char* json = CLI_GET(&a, "--json");
+    if (out && !cli_has_ext(out, ".gif") && !cli_has_ext(out, ".png") && !cli_has_ext(out, ".glb"))
+        return cli_usage("rigid", "output '%s' must end in .gif, .png or .glb", out);
+    rigid_scene sc;
+    const char* name = preset ? preset : a.pos[0];
+    if (preset) {
+        if (!rigid_scene_preset(preset, &sc)) {
+            rigid_scene_free(&sc);
+            return cli_usage(
+                "rigid",
+                "unknown preset '%s' (stack, pyramid, dominoes, avalanche, ragdoll, incline)",
+                preset);
+        }
+    } else {
+        FILE* f = fopen(a.pos[0], "rb");
+        char* text = f ? malloc(CLI_JSON_MAX_SIZE + 1) : NULL;
+        size_t size = text ? fread(text, 1, CLI_JSON_MAX_SIZE + 1, f) : 0;
+        if (f) fclose(f);
+        if (!text || size > CLI_JSON_MAX_SIZE) {
+            free(text);
+            return cli_fail("rigid",
+                            "%s: cannot read the file (missing, unreadable or over %zu bytes)",
+                            a.pos[0], CLI_JSON_MAX_SIZE);
+        }
+        char msg[600];
+        bool ok = rigid_scene_parse(a.pos[0], text, size, &sc, msg, sizeof msg);
+        free(text);
+        if (!ok) return cli_fail("rigid", "%s", msg);
+    }
+    const char* v;
+    long lv;
+    if ((v = CLI_GET(&a, "--steps"))) {
+        if (!cli_parse_int(v, 0, RIGID_SCENE_MAX_STEPS, &lv))
+            rc = cli_usage_int("rigid", "--steps", v, 0, RIGID_SCENE_MAX_STEPS);
+        else
+            sc.steps = lv;
+    }
+    if (!rc && (v = CLI_GET(&a, "--dt"))) {
+        float dt;
+        if (!cli_parse_float(v, &dt) || !(dt >= 1e-6f) || dt > 1.0f)
+            rc = cli_usage("rigid", "--dt must be in [1e-06, 1] seconds");
+        else
+            sc.dt = dt;
+    }
+    if (!rc && (v = CLI_GET(&a, "--substeps"))) {
+        if (!cli_parse_int(v, 1, 1000, &lv))
+            rc = cli_usage_int("rigid", "--substeps", v, 1, 1000);
+        else
+            sc.substeps = (uint32_t)lv;
+    }
+    if (!rc && (v = CLI_GET(&a, "--threads"))) {
+        if (!cli_parse_int(v, 1, AK_RIGID_MAX_THREADS, &lv))
+            rc = cli_usage_int("rigid", "--threads", v, 1, AK_RIGID_MAX_THREADS);
+        else
+            sc.thread_count = (int)lv;
+    }
+    const size_t n = sc.body_count;
+    if (!rc)
+        rc = cli_work_check("rigid", (double)n * (double)sc.steps * (double)sc.substeps * 4.0,
+                            "body updates (bodies x steps x substeps x 4)",
+                            "--steps, --substeps or the body count");
+    if (rc) {
+        rigid_scene_free(&sc);
+        return rc;
+    }
+
+    ak_rigid_model* model = NULL;
+    ak_vec3 *x = NULL, *vel = NULL, *w = NULL;
+    ak_quat* q = NULL;
+    float* timers = NULL;
+    ak_rigid_step_job job;
+    memset(&job, 0, sizeof job);
+    body_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    cli_frame frame;
+    memset(&frame, 0, sizeof frame);
+    ak_image img = {0};
+    ak_gif_writer* gw = NULL;
+    sim_bake bake;
+    memset(&bake, 0, sizeof bake);
+
+    ak_rigid_model_desc md = sc.model;
+    md.bodies = (ak_rigid_body_desc_cspan){sc.bodies, n};
+    md.joints = (ak_rigid_joint_desc_cspan){sc.joints, sc.joint_count};
+    ak_result r = ak_rigid_model_create(&md, NULL, &model);
+    if (r != AK_OK) {
+        rc = cli_fail("rigid", "%s: the bodies cannot be built: %s", name, ak_result_string(r));
+        goto done;
+    }
+    x = malloc(n * sizeof *x), vel = malloc(n * sizeof *vel), w = malloc(n * sizeof *w),
+    q = malloc(n * sizeof *q);
+    timers = calloc(n, sizeof *timers);
+    if (!x || !vel || !w || !q || !timers) {
+        rc = cli_fail("rigid", "out of memory");
+        goto done;
+    }
+    ak_rigid_initial_state(model, (ak_vec3_span){x, n}, (ak_quat_span){q, n},
+                           (ak_vec3_span){vel, n}, (ak_vec3_span){w, n});
+    float pen = 0.0f;
+    job = (ak_rigid_step_job){.model = model,
+                              .dt = sc.dt,
+                              .substeps = sc.substeps,
+                              .gravity = sc.gravity,
+                              .thread_count = (uint32_t)sc.thread_count,
+                              .positions = {x, n},
+                              .orientations = {q, n},
+                              .velocities = {vel, n},
+                              .angular_velocities = {w, n},
+                              .out_max_penetration = &pen};
+    if (sc.sleep) job.sleep_timers = (ak_f32_span){timers, n};
+    size_t bytes = ak_rigid_step_scratch_size(&job);
+    job.scratch = (ak_u8_span){malloc(bytes), bytes};
+    if (!job.scratch.ptr) {
+        rc = cli_fail("rigid", "out of memory");
+        goto done;
+    }
+
+    const bool gif = out && cli_has_ext(out, ".gif"), png = out && cli_has_ext(out, ".png");
+    if (out) {
+        if (!mesh_build(&mesh, model)) {
+            rc = cli_fail("rigid", "out of memory");
+            goto done;
+        }
+        mesh_pose(&mesh, x, q);
+    }
+    if (out && sim_bake_wanted(out) &&
+        (rc = sim_bake_mesh_init(&bake, "rigid", out, mesh.vcount, sc.steps)))
+        goto done;
+    if (gif || png) {
+        ak_vec3 lo = ak_vec3_splat(-1.0f), hi = ak_vec3_splat(1.0f);
+        for (size_t v2 = 0; v2 < mesh.vcount; ++v2)
+            lo = ak_vec3_min(lo, mesh.pos[v2]), hi = ak_vec3_max(hi, mesh.pos[v2]);
+        if (cli_frame_init(&frame, NULL, 480, 360, lo, hi, 0.6f) ||
+            cli_image_alloc(&img, 480, 360)) {
+            rc = cli_fail("rigid", "out of memory");
+            goto done;
+        }
+        if (gif &&
+            ak_gif_writer_create(out, &(ak_gif_desc){.width = 480, .height = 360, .delay_cs = 4},
+                                 NULL, &gw) != AK_OK) {
+            rc = cli_fail("rigid", "%s: cannot create the file", out);
+            goto done;
+        }
+    }
+
+    const double t0 = cli_now();
+    int frames = 0;
+    float time = 0.0f;
+    for (long step = 0; step <= sc.steps; ++step) {
+        if (out) mesh_pose(&mesh, x, q);
+        if ((gif && (step == 0 || floorf(time * 25.0f) != floorf((time - sc.dt) * 25.0f))) ||
+            (png && step == sc.steps)) {
+            ak_raster_mesh extra = {
+                .positions = {mesh.pos, mesh.vcount},
+                .normals = {mesh.nrm, mesh.vcount},
+                .indices = {mesh.idx, mesh.icount},
+                .material = {.color = {0.80f, 0.55f, 0.25f, 1}, .specular = 0.2f}};
+            char title[160];
+            snprintf(title, sizeof title, "rigid %s  t=%.2fs", preset ? preset : "", (double)time);
+            cli_draw_opts o = {.title = title, .extra = &extra, .extra_count = 1};
+            r = cli_frame_draw(&frame, NULL, &o, &img);
+            if (r == AK_OK) r = gif ? ak_gif_writer_add_frame(gw, &img) : ak_png_write(out, &img);
+            if (r != AK_OK) {
+                rc = cli_fail("rigid", "%s: cannot render or write: %s", out, ak_result_string(r));
+                goto done;
+            }
+            ++frames;
+        }
+        if (bake.cap && (rc = sim_bake_mesh_add(&bake, step, mesh.pos, mesh.nrm))) goto done;
+        if (step == sc.steps) break;
+        r = ak_rigid_step_run(&job);
+        if (r == AK_ERR_BAD_DATA) {
+            rc = cli_fail("rigid",
+                          "%s: the simulation blew up at step %ld (t = %.4g s): a non-finite "
+                          "state; lower --dt or"
+                          " raise --substeps",
+                          name, step + 1, (double)time);
+            goto done;
+        }
+        if (r != AK_OK) {
+            rc = cli_fail("rigid", "%s: step %ld failed: %s", name, step + 1, ak_result_string(r));
+            goto done;
+        }
+        time = (float)((double)(step + 1) * (double)sc.dt);
+        cli_progress("rigid", (size_t)step + 1, (size_t)sc.steps);
+    }
+    const double elapsed = cli_now() - t0;
+    if (gw) {
+        r = ak_gif_writer_finish(gw);
+        gw = NULL;
+        if (r != AK_OK) {
+            rc = cli_fail("rigid", "%s: cannot write: %s", out, ak_result_string(r));
+            goto done;
+        }
+    }
+    const double energy =
+        ak_rigid_energy(model, sc.gravity, (ak_vec3_cspan){x, n}, (ak_quat_cspan){q, n},
+                        (ak_vec3_cspan){vel, n}, (ak_vec3_cspan){w, n});
+    if (json && (rc = write_json(json, time, n, x, q, vel, w, pen, energy))) goto done;
+    if (bake.cap && (rc = sim_bake_mesh_write(&bake, preset ? preset : "rigid", sc.dt,
+                                              (ak_u32_cspan){mesh.idx, mesh.icount},
+                                              ak_vec4_make(0.80f, 0.55f, 0.25f, 1))))
+        goto done;
+    printf("rigid %s: %zu bodies, %zu joints, %ld steps of %.4g s (%u substeps): t = %.3g s, max "
+           "penetration %.3g m, energy %.6g J\n",
+           name, n, sc.joint_count, sc.steps, (double)sc.dt, sc.substeps, (double)time, (double)pen,
+           energy);
+    if (gif)
+        cli_wrote(out, "%d frames", frames);
+    else if (bake.cap)
+        cli_wrote(out, "%zu frames, %.4g s apart", bake.frames, (double)sc.dt * (double)bake.every);
+    else if (out)
+        cli_wrote(out, NULL);
+    if (sc.steps > 0 && !cli_quiet)
+        fprintf(stderr, "%.3f ms per step\n", 1e3 * elapsed / (double)sc.steps);
+
+done:
+    sim_bake_free(&bake);
+    ak_gif_writer_discard(gw);
+    free(img.pixels);
+    cli_frame_free(&frame);
+    mesh_free(&mesh);
+    free(job.scratch.ptr);
+    free(x), free(vel), free(w), free(q), free(timers);
+    ak_rigid_model_destroy(model);
+    rigid_scene_free(&sc);
+    return rc;
+}

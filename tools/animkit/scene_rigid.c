@@ -1,0 +1,400 @@
+/* animkit rigid: scene files (strict JSON through cli_json.h) and the built-in presets.
+ * docs/rigid.md lists every key with its unit and default. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <animkit/animkit.h>
+
+#include "cli_json.h"
+#include "scene_rigid.h"
+
+void rigid_scene_defaults(rigid_scene* s) {
+    memset(s, 0, sizeof *s);
+    s->gravity = ak_vec3_make(0.0f, -9.81f, 0.0f);
+    s->dt = 1.0f / 60.0f;
+    s->steps = 240;
+    s->substeps = 20;
+    s->thread_count = 1;
+    s->sleep = true;
+    s->model.contact_offset = 0.01f;
+}
+
+void rigid_scene_free(rigid_scene* s) {
+    free(s->bodies);
+    free(s->joints);
+    s->bodies = NULL;
+    s->body_count = 0;
+    s->joints = NULL;
+    s->joint_count = 0;
+}
+
+/* A body with the scene file's defaults (density 1000, friction 0.5, restitution 0). */
+static ak_rigid_body_desc body_default(void) {
+    ak_rigid_body_desc b;
+    memset(&b, 0, sizeof b);
+    b.orientation = ak_quat_identity();
+    b.density = 1000.0f;
+    b.friction = 0.5f;
+    return b;
+}
+
+static void parse_shape(cli_json* j, const cJSON* obj, const char* path, ak_rigid_body_desc* b) {
+    char sp[96];
+    cli_json_key(sp, sizeof sp, path, "shape");
+    const cJSON* sh = cli_json_member(j, obj, path, "shape");
+    if (j->failed) return;
+    if (!sh) {
+        cli_json_fail(j, path, "shape", "is required");
+        return;
+    }
+    static const char* const keys[] = {"type",   "radius", "half_extents", "half_height", "points",
+                                       "normal", NULL};
+    static const char* const types[] = {"sphere", "box", "capsule", "hull", "plane", NULL};
+    cli_json_object(j, sh, sp, keys);
+    int type = -1;
+    cli_json_enum(j, sh, sp, "type", types, &type);
+    if (j->failed) return;
+    if (type < 0) {
+        cli_json_fail(j, sp, "type", "is required (sphere, box, capsule, hull or plane)");
+        return;
+    }
+    if (type == 3) {
+        cli_json_fail(j, sp, "type", "\"hull\" is not supported yet (sphere, box, capsule, plane)");
+        return;
+    }
+    /* which keys each type takes: the others are refused so a typo cannot pass unnoticed */
+    static const char* const takes[5] = {"radius", "half_extents", "radius half_height", "points",
+                                         "normal"};
+    for (int k = 1; keys[k]; ++k)
+        if (cJSON_GetObjectItemCaseSensitive(sh, keys[k]) && !strstr(takes[type], keys[k])) {
+            cli_json_fail(j, sp, keys[k], "does not apply to a %s", types[type]);
+            return;
+        }
+    ak_rigid_shape* s = &b->shape;
+    s->type = type == 0   ? AK_RIGID_SPHERE
+              : type == 1 ? AK_RIGID_BOX
+              : type == 2 ? AK_RIGID_CAPSULE
+                          : AK_RIGID_PLANE;
+    s->radius = -1.0f;
+    s->half_height = 0.0f;
+    s->half_extents = ak_vec3_make(-1.0f, -1.0f, -1.0f);
+    s->normal = ak_vec3_make(0.0f, 1.0f, 0.0f);
+    cli_json_float(j, sh, sp, "radius", 1e-4f, 1e4f, &s->radius);
+    cli_json_float(j, sh, sp, "half_height", 0.0f, 1e4f, &s->half_height);
+    float he[3] = {-1.0f, -1.0f, -1.0f};
+    cli_json_floats(j, sh, sp, "half_extents", 3, 1e-4f, 1e4f, he);
+    s->half_extents = ak_vec3_make(he[0], he[1], he[2]);
+    cli_json_vec3(j, sh, sp, "normal", &s->normal);
+    if (j->failed) return;
+    if ((type == 0 || type == 2) && s->radius < 0.0f)
+        cli_json_fail(j, sp, "radius", "is required for a %s", types[type]);
+    else if (type == 1 && he[0] < 0.0f)
+        cli_json_fail(j, sp, "half_extents", "is required for a box");
+    else if (type == 4 && ak_vec3_length(s->normal) < 1e-6f)
+        cli_json_fail(j, sp, "normal", "is zero");
+}
+
+static void parse_body(cli_json* j, const cJSON* e, const char* path, ak_rigid_body_desc* b) {
+    if (!cJSON_IsObject(e)) {
+        cli_json_fail(j, path, "", "expected an object with at least \"shape\"");
+        return;
+    }
+    static const char* const keys[] = {
+        "shape",    "position",    "orientation", "velocity", "angular_velocity", "density", "mass",
+        "friction", "restitution", "static",      NULL};
+    cli_json_object(j, e, path, keys);
+    *b = body_default();
+    parse_shape(j, e, path, b);
+    cli_json_vec3(j, e, path, "position", &b->position);
+    float q[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    cli_json_floats(j, e, path, "orientation", 4, -1e3f, 1e3f, q);
+    if (!j->failed && q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] < 1e-12f)
+        cli_json_fail(j, path, "orientation", "is the zero quaternion");
+    b->orientation = ak_quat_normalize(ak_quat_make(q[0], q[1], q[2], q[3]));
+    cli_json_vec3(j, e, path, "velocity", &b->velocity);
+    cli_json_vec3(j, e, path, "angular_velocity", &b->angular_velocity);
+    if (!j->failed && (ak_vec3_length(b->position) > 1e6f || ak_vec3_length(b->velocity) > 1e5f ||
+                       ak_vec3_length(b->angular_velocity) > 1e5f))
+        cli_json_fail(
+            j, path, "",
+            "position over 1e6 m, velocity over 1e5 m/s or angular velocity over 1e5 rad/s");
+    if (!j->failed && cJSON_GetObjectItemCaseSensitive(e, "density") &&
+        cJSON_GetObjectItemCaseSensitive(e, "mass"))
+        cli_json_fail(j, path, "mass", "give density or mass, not both");
+    cli_json_float(j, e, path, "density", 1e-3f, 1e6f, &b->density);
+    cli_json_float(j, e, path, "mass", 1e-6f, 1e9f, &b->mass);
+    float mu = b->friction;
+    cli_json_float(j, e, path, "friction", 0.0f, 100.0f, &mu);
+    b->friction = mu == 0.0f ? AK_RIGID_FRICTIONLESS : mu; /* 0 in the file is a real zero */
+    cli_json_float(j, e, path, "restitution", 0.0f, 1.0f, &b->restitution);
+    cli_json_bool(j, e, path, "static", &b->is_static);
+}
+
+static void parse_joint(cli_json* j, const cJSON* e, const char* path, size_t body_count,
+                        ak_rigid_joint_desc* d) {
+    if (!cJSON_IsObject(e)) {
+        cli_json_fail(j, path, "", "expected an object with \"type\" and \"bodies\"");
+        return;
+    }
+    static const char* const keys[] = {"type",   "bodies",     "anchor", "axis",
+                                       "limits", "compliance", NULL};
+    static const char* const types[] = {"ball", "hinge", "fixed", "prismatic", NULL};
+    cli_json_object(j, e, path, keys);
+    memset(d, 0, sizeof *d);
+    int type = -1;
+    cli_json_enum(j, e, path, "type", types, &type);
+    if (!j->failed && type < 0)
+        cli_json_fail(j, path, "type", "is required (ball, hinge, fixed or prismatic)");
+    d->type = (ak_rigid_joint_type)(type < 0 ? 0 : type);
+    float ab[2] = {-1.0f, -1.0f};
+    cli_json_floats(j, e, path, "bodies", 2, 0.0f, (float)RIGID_SCENE_MAX_BODIES, ab);
+    if (!j->failed && ab[0] < 0.0f)
+        cli_json_fail(j, path, "bodies", "is required: [a, b], two body indices");
+    if (!j->failed && (ab[0] != floorf(ab[0]) || ab[1] != floorf(ab[1])))
+        cli_json_fail(j, path, "bodies", "expected two whole body indices");
+    if (!j->failed && (ab[0] >= (float)body_count || ab[1] >= (float)body_count))
+        cli_json_fail(j, path, "bodies", "a body index is out of range (the scene has %zu bodies)",
+                      body_count);
+    if (!j->failed && ab[0] == ab[1]) cli_json_fail(j, path, "bodies", "joins a body to itself");
+    if (j->failed) return; /* ab may still hold -1: no conversion to an index */
+    d->body_a = (uint32_t)ab[0], d->body_b = (uint32_t)ab[1];
+    cli_json_vec3(j, e, path, "anchor", &d->anchor);
+    d->axis = ak_vec3_make(0.0f, 0.0f, 1.0f);
+    cli_json_vec3(j, e, path, "axis", &d->axis);
+    if (!j->failed && (ak_vec3_length(d->anchor) > 1e6f || ak_vec3_length(d->axis) < 1e-6f))
+        cli_json_fail(j, path, "", "anchor over 1e6 m or a zero axis");
+    float lim[2] = {0.0f, 0.0f};
+    d->limited = cJSON_GetObjectItemCaseSensitive(e, "limits") != NULL;
+    cli_json_floats(j, e, path, "limits", 2, -1e3f, 1e3f, lim);
+    if (!j->failed && d->limited && lim[0] > lim[1])
+        cli_json_fail(j, path, "limits", "lower is above upper");
+    if (!j->failed && d->limited && d->type == AK_RIGID_JOINT_FIXED)
+        cli_json_fail(j, path, "limits", "does not apply to a fixed joint");
+    d->lower = lim[0], d->upper = lim[1];
+    cli_json_float(j, e, path, "compliance", 0.0f, 1e3f, &d->compliance);
+}
+
+bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_scene* s, char* msg,
+                       size_t cap) {
+    rigid_scene_defaults(s);
+    if (cap) msg[0] = '\0';
+    cli_json j = {.file = file};
+    cJSON* root = cli_json_parse(&j, text, size);
+    if (root) {
+        static const char* const keys[] = {
+            "gravity",         "bodies",         "joints",  "dt",
+            "steps",           "substeps",       "threads", "linear_damping",
+            "angular_damping", "contact_offset", "sleep",   NULL};
+        cli_json_object(&j, root, "", keys);
+        cli_json_vec3(&j, root, "", "gravity", &s->gravity);
+        if (!j.failed && ak_vec3_length(s->gravity) > 1e4f)
+            cli_json_fail(&j, "", "gravity", "is over 1e4 m/s^2");
+        cli_json_float(&j, root, "", "dt", 1e-6f, 1.0f, &s->dt);
+        cli_json_int(&j, root, "", "steps", 0, RIGID_SCENE_MAX_STEPS, &s->steps);
+        long sub = (long)s->substeps, th = s->thread_count;
+        cli_json_int(&j, root, "", "substeps", 1, 1000, &sub);
+        cli_json_int(&j, root, "", "threads", 1, AK_RIGID_MAX_THREADS, &th);
+        s->substeps = (uint32_t)sub, s->thread_count = (int)th;
+        cli_json_float(&j, root, "", "linear_damping", 0.0f, 1e3f, &s->model.linear_damping);
+        cli_json_float(&j, root, "", "angular_damping", 0.0f, 1e3f, &s->model.angular_damping);
+        cli_json_float(&j, root, "", "contact_offset", 1e-5f, 1.0f, &s->model.contact_offset);
+        cli_json_bool(&j, root, "", "sleep", &s->sleep);
+        size_t n = 0;
+        const cJSON* e = cli_json_array(&j, root, "", "bodies", RIGID_SCENE_MAX_BODIES, &n);
+        if (!j.failed && n == 0)
+            cli_json_fail(&j, "", "bodies", "is required and must hold at least one body");
+        if (!j.failed) {
+            s->bodies = calloc(n, sizeof *s->bodies);
+            if (!s->bodies) cli_json_fail(&j, "", "bodies", "out of memory");
+        }
+        for (size_t k = 0; e && !j.failed; e = e->next, ++k) {
+            char path[48];
+            cli_json_index(path, sizeof path, "bodies", k);
+            parse_body(&j, e, path, &s->bodies[k]);
+            s->body_count = k + 1;
+        }
+        size_t nj = 0;
+        const cJSON* je = cli_json_array(&j, root, "", "joints", RIGID_SCENE_MAX_JOINTS, &nj);
+        if (!j.failed && nj > 0) {
+            s->joints = calloc(nj, sizeof *s->joints);
+            if (!s->joints) cli_json_fail(&j, "", "joints", "out of memory");
+        }
+        for (size_t k = 0; je && !j.failed; je = je->next, ++k) {
+            char path[48];
+            cli_json_index(path, sizeof path, "joints", k);
+            parse_joint(&j, je, path, s->body_count, &s->joints[k]);
+            s->joint_count = k + 1;
+        }
+        cJSON_Delete(root);
+    }
+    if (j.failed || !root) {
+        snprintf(msg, cap, "%s", j.message[0] ? j.message : "invalid scene");
+        rigid_scene_free(s);
+        return false;
+    }
+    return true;
+}
+
+/* ---- presets --------------------------------------------------------------------------- */
+
+static bool presize(rigid_scene* s, size_t n) {
+    s->bodies = calloc(n, sizeof *s->bodies);
+    if (!s->bodies) return false;
+    for (size_t i = 0; i < n; ++i) s->bodies[i] = body_default();
+    s->body_count = n;
+    return true;
+}
+
+static void ground(ak_rigid_body_desc* b) {
+    b->shape.type = AK_RIGID_PLANE;
+    b->shape.normal = ak_vec3_make(0.0f, 1.0f, 0.0f);
+    b->is_static = true;
+}
+
+static void box(ak_rigid_body_desc* b, ak_vec3 he, ak_vec3 p) {
+    b->shape.type = AK_RIGID_BOX;
+    b->shape.half_extents = he;
+    b->position = p;
+}
+
+bool rigid_scene_preset(const char* name, rigid_scene* s) {
+    rigid_scene_defaults(s);
+    if (strcmp(name, "stack") == 0) {
+        /* ten 1 m boxes on the ground */
+        if (!presize(s, 11)) return false;
+        ground(&s->bodies[0]);
+        for (int i = 0; i < 10; ++i)
+            box(&s->bodies[1 + i], ak_vec3_make(0.5f, 0.5f, 0.5f),
+                ak_vec3_make(0.0f, 0.5f + (float)i, 0.0f));
+        return true;
+    }
+    if (strcmp(name, "pyramid") == 0) {
+        /* 20 layers of 1 m boxes, 0.1 m apart: 210 boxes (the benchmark's scene) */
+        const int layers = 20;
+        if (!presize(s, 1 + (size_t)(layers * (layers + 1) / 2))) return false;
+        ground(&s->bodies[0]);
+        size_t k = 1;
+        for (int l = 0; l < layers; ++l)
+            for (int i = 0; i < layers - l; ++i, ++k)
+                box(&s->bodies[k], ak_vec3_make(0.5f, 0.5f, 0.5f),
+                    ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - l - 1)),
+                                 0.5f + (float)l, 0.0f));
+        s->substeps = 40;
+        return true;
+    }
+    if (strcmp(name, "dominoes") == 0) {
+        /* 20 dominoes 1 m tall, 0.5 m apart; the first is pushed at the top */
+        if (!presize(s, 21)) return false;
+        ground(&s->bodies[0]);
+        for (int i = 0; i < 20; ++i)
+            box(&s->bodies[1 + i], ak_vec3_make(0.05f, 0.5f, 0.25f),
+                ak_vec3_make(0.5f * (float)i, 0.5f, 0.0f));
+        s->bodies[1].angular_velocity = ak_vec3_make(0.0f, 0.0f, -2.0f);
+        s->bodies[1].velocity = ak_vec3_make(1.0f, 0.0f, 0.0f);
+        s->steps = 360;
+        return true;
+    }
+    if (strcmp(name, "avalanche") == 0) {
+        /* 200 spheres, boxes and capsules poured on a 30 degree slope that ends on the ground */
+        if (!presize(s, 202)) return false;
+        ground(&s->bodies[0]);
+        ak_rigid_body_desc* slope = &s->bodies[1];
+        slope->shape.type = AK_RIGID_PLANE;
+        slope->shape.normal = ak_vec3_make(sinf(0.5236f), cosf(0.5236f), 0.0f);
+        slope->position = ak_vec3_make(0.0f, 0.0f, 0.0f);
+        slope->is_static = true;
+        ak_rng rng = ak_rng_make(7);
+        for (int i = 0; i < 200; ++i) {
+            ak_rigid_body_desc* b = &s->bodies[2 + i];
+            ak_vec3 p = ak_vec3_make(ak_rng_range(&rng, -6.0f, -2.0f), 0.0f,
+                                     ak_rng_range(&rng, -2.0f, 2.0f));
+            p.y = -p.x * tanf(0.5236f) + 0.5f + 0.45f * (float)(i / 20);
+            if (i % 3 == 0) {
+                b->shape.type = AK_RIGID_SPHERE;
+                b->shape.radius = 0.2f;
+            } else if (i % 3 == 1) {
+                box(b, ak_vec3_make(0.2f, 0.15f, 0.2f), p);
+            } else {
+                b->shape.type = AK_RIGID_CAPSULE;
+                b->shape.radius = 0.12f;
+                b->shape.half_height = 0.15f;
+            }
+            b->position = p;
+            b->orientation = ak_quat_from_axis_angle(
+                ak_vec3_make(ak_rng_float(&rng), ak_rng_float(&rng), ak_rng_float(&rng)),
+                ak_rng_range(&rng, 0.0f, 3.0f));
+            b->restitution = 0.2f;
+        }
+        s->steps = 300;
+        return true;
+    }
+    if (strcmp(name, "ragdoll") == 0) {
+        /* builtin:humanoid as a ragdoll, dropped from 1 m in the middle of its walk (the pose
+         * and its velocities), onto the ground */
+        ak_scene* sc = NULL;
+        ak_builtin_desc bd = {.cell_size = 0.1f};
+        if (ak_builtin_create("humanoid", &bd, NULL, &sc) != AK_OK) return false;
+        const ak_skeleton* sk = sc->skeleton;
+        size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk),
+               nj = ak_rigid_ragdoll_joint_count(sk);
+        ak_transform* pose = calloc(2 * n, sizeof *pose);
+        ak_rigid_ragdoll_bone* bones = calloc(n, sizeof *bones);
+        s->joints = calloc(nj + 1, sizeof *s->joints);
+        bool ok = pose && bones && s->joints && presize(s, nb + 1);
+        if (ok) {
+            ak_scene_rest_pose(sc, (ak_transform_span){pose, n});
+            ak_scene_rest_pose(sc, (ak_transform_span){pose + n, n});
+            if (sc->clip_count > 0) {
+                float t = 0.3f * ak_clip_duration(sc->clips[0]);
+                ak_clip_sample(sc->clips[0], t, NULL, (ak_transform_span){pose, n},
+                               (ak_f32_span){0}, (ak_f32_span){0});
+                ak_clip_sample(sc->clips[0], t - s->dt, NULL, (ak_transform_span){pose + n, n},
+                               (ak_f32_span){0}, (ak_f32_span){0});
+            }
+            ground(&s->bodies[0]);
+            ak_rigid_ragdoll_desc rd = {.skeleton = sk,
+                                        .local_pose = {pose, n},
+                                        .previous_pose = {pose + n, n},
+                                        .previous_dt = s->dt,
+                                        .root = ak_mat4_translation(ak_vec3_make(0.0f, 1.0f, 0.0f)),
+                                        .body_offset = 1};
+            ok = ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){s->bodies + 1, nb},
+                                        (ak_rigid_joint_desc_span){s->joints, nj},
+                                        (ak_rigid_ragdoll_bone_span){bones, n}) == AK_OK;
+            s->joint_count = nj;
+        }
+        free(pose);
+        free(bones);
+        ak_scene_destroy(sc);
+        if (!ok) rigid_scene_free(s);
+        s->substeps = 40;
+        s->steps = 180;
+        return ok;
+    }
+    if (strcmp(name, "incline") == 0) {
+        /* a box at rest on a 30 degree slope with friction 0.3 (< tan 30 = 0.577): it slides at
+         * g (sin 30 - 0.3 cos 30) = 2.36 m/s^2; a second with friction 0.7 stays */
+        if (!presize(s, 3)) return false;
+        ak_vec3 n = ak_vec3_make(-sinf(0.5236f), cosf(0.5236f), 0.0f);
+        ak_rigid_body_desc* slope = &s->bodies[0];
+        slope->shape.type = AK_RIGID_PLANE;
+        slope->shape.normal = n;
+        slope->is_static = true;
+        slope->friction = 0.3f;
+        ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(0.0f, 0.0f, 1.0f), 0.5236f);
+        box(&s->bodies[1], ak_vec3_make(0.2f, 0.1f, 0.2f),
+            ak_vec3_madd(ak_vec3_make(0.0f, 0.0f, -1.0f), n, 0.1f));
+        s->bodies[1].orientation = q;
+        s->bodies[1].friction = 0.3f;
+        box(&s->bodies[2], ak_vec3_make(0.2f, 0.1f, 0.2f),
+            ak_vec3_madd(ak_vec3_make(0.0f, 0.0f, 1.0f), n, 0.1f));
+        s->bodies[2].orientation = q;
+        s->bodies[2].friction = 1.6f; /* sqrt(0.3 * 1.6) = 0.69 > 0.577 */
+        s->sleep = false;
+        s->steps = 120;
+        return true;
+    }
+    return false;
+}
