@@ -119,17 +119,17 @@ static bool preset_fill(const char* name, ak_particles_scene* s) {
         s->emitter_count = 1;
         s->world.gravity = ak_vec3_make(0, 2.0f, 0);
         s->world.drag_linear = 0.8f;
-        look->enabled = true, look->texture = AK_SPRITE_TEXTURE_PUFF, look->sheet_columns = 4, look->sheet_rows = 4;
+        look->enabled = true, look->texture = AK_SPRITE_TEXTURE_PUFF, look->sheet_columns = 4,
+        look->sheet_rows = 4;
         look->blend = AK_BLEND_ADD;
-        look->look = (ak_particle_look){
-            .colour_keys = {{0.0f, {1.0f, 1.0f, 0.75f, 0.3f}},
-                            {0.3f, {1.0f, 0.75f, 0.45f, 0.3f}},
-                            {0.7f, {0.9f, 0.35f, 0.25f, 0.2f}},
-                            {1.0f, {0.5f, 0.2f, 0.2f, 0.0f}}},
-            .colour_key_count = 4,
-            .size_keys = {{0.0f, 0.7f}, {0.35f, 1.0f}, {1.0f, 0.35f}},
-            .size_key_count = 3,
-            .frame_count = 16};
+        look->look = (ak_particle_look){.colour_keys = {{0.0f, {1.0f, 1.0f, 0.75f, 0.3f}},
+                                                        {0.3f, {1.0f, 0.75f, 0.45f, 0.3f}},
+                                                        {0.7f, {0.9f, 0.35f, 0.25f, 0.2f}},
+                                                        {1.0f, {0.5f, 0.2f, 0.2f, 0.0f}}},
+                                        .colour_key_count = 4,
+                                        .size_keys = {{0.0f, 0.7f}, {0.35f, 1.0f}, {1.0f, 0.35f}},
+                                        .size_key_count = 3,
+                                        .frame_count = 16};
     } else if (strcmp(name, "smoke") == 0) {
         /* Smoke: few large puffs drifting up and downwind, fading in then out while they grow
          * and lighten; alpha-blended back to front. */
@@ -142,17 +142,17 @@ static bool preset_fill(const char* name, ak_particles_scene* s) {
         s->world.gravity = ak_vec3_make(0, 0.25f, 0);
         s->world.wind = ak_vec3_make(0.5f, 0, 0);
         s->world.drag_linear = 0.6f;
-        look->enabled = true, look->texture = AK_SPRITE_TEXTURE_PUFF, look->sheet_columns = 4, look->sheet_rows = 2;
+        look->enabled = true, look->texture = AK_SPRITE_TEXTURE_PUFF, look->sheet_columns = 4,
+        look->sheet_rows = 2;
         look->blend = AK_BLEND_ALPHA;
-        look->look = (ak_particle_look){
-            .colour_keys = {{0.0f, {0.8f, 0.8f, 0.8f, 0.0f}},
-                            {0.1f, {1.0f, 1.0f, 1.0f, 0.75f}},
-                            {1.0f, {1.9f, 1.9f, 1.9f, 0.0f}}},
-            .colour_key_count = 3,
-            .size_keys = {{0.0f, 0.6f}, {1.0f, 3.0f}},
-            .size_key_count = 2,
-            .frame_count = 8,
-            .frame_rate = 2.0f};
+        look->look = (ak_particle_look){.colour_keys = {{0.0f, {0.8f, 0.8f, 0.8f, 0.0f}},
+                                                        {0.1f, {1.0f, 1.0f, 1.0f, 0.75f}},
+                                                        {1.0f, {1.9f, 1.9f, 1.9f, 0.0f}}},
+                                        .colour_key_count = 3,
+                                        .size_keys = {{0.0f, 0.6f}, {1.0f, 3.0f}},
+                                        .size_key_count = 2,
+                                        .frame_count = 8,
+                                        .frame_rate = 2.0f};
     } else {
         return false;
     }
@@ -161,13 +161,12 @@ static bool preset_fill(const char* name, ak_particles_scene* s) {
 
 /* The names preset_fill knows (AK_PARTICLES_SCENE_PRESETS in words). */
 static bool preset_known(const char* name) {
-    static const char* const names[] = {"fountain", "rain", "fireworks", "character", "fire", "smoke"};
+    static const char* const names[] = {"fountain",  "rain", "fireworks",
+                                        "character", "fire", "smoke"};
     for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k)
         if (strcmp(name, names[k]) == 0) return true;
     return false;
 }
-
-
 
 static const char* const integrator_names[] = {"euler", "symplectic", "verlet", "rk4", NULL};
 static const ak_particles_integrator integrator_values[] = {
@@ -206,8 +205,8 @@ static void read_range(akp_json* j, const cJSON* o, const char* path, const char
 
 /* One key of a "..._over_life" list: an array of exactly n finite numbers, the first (the life
  * fraction) in [0, 1] and above the previous key's, the others in [lo, hi]. */
-static bool read_life_key(akp_json* j, const cJSON* e, const char* path, int n, float lo, float hi, float prev_t,
-                          float* out) {
+static bool read_life_key(akp_json* j, const cJSON* e, const char* path, int n, float lo, float hi,
+                          float prev_t, float* out) {
     if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != n)
         return akp_json_fail(j, path, NULL, "a key is an array of %d numbers [t, %s]", n,
                              n == 2 ? "size" : "r, g, b, a");
@@ -215,10 +214,13 @@ static bool read_life_key(akp_json* j, const cJSON* e, const char* path, int n, 
     for (const cJSON* v = e->child; v; v = v->next, ++k) {
         double x = cJSON_IsNumber(v) ? v->valuedouble : NAN;
         const double a = k ? lo : 0.0, b = k ? hi : 1.0;
-        if (!(x >= a && x <= b)) return akp_json_fail(j, path, NULL, "value %d is not a number in [%g, %g]", k, a, b);
+        if (!(x >= a && x <= b))
+            return akp_json_fail(j, path, NULL, "value %d is not a number in [%g, %g]", k, a, b);
         out[k] = (float)x;
     }
-    if (!(out[0] > prev_t)) return akp_json_fail(j, path, NULL, "t %g does not come after the previous key's %g", (double)out[0], (double)prev_t);
+    if (!(out[0] > prev_t))
+        return akp_json_fail(j, path, NULL, "t %g does not come after the previous key's %g",
+                             (double)out[0], (double)prev_t);
     return true;
 }
 
@@ -227,8 +229,8 @@ static bool read_life_key(akp_json* j, const cJSON* e, const char* path, int n, 
 static void read_render(akp_json* j, const cJSON* root, const char* file, ak_particles_scene* s) {
     const cJSON* r = akp_json_member(j, root, "", "render");
     if (!r || j->failed) return;
-    static const char* const keys[] = {"style", "texture", "sheet", "frame_rate", "blend",
-                                       "colour_over_life", "size_over_life", NULL};
+    static const char* const keys[] = {"style", "texture",          "sheet",          "frame_rate",
+                                       "blend", "colour_over_life", "size_over_life", NULL};
     static const char* const styles[] = {"points", "sprites", NULL};
     static const char* const blends[] = {"alpha", "add", "cutout", NULL};
     if (!akp_json_object(j, r, "render", keys)) return;
@@ -240,12 +242,15 @@ static void read_render(akp_json* j, const cJSON* root, const char* file, ak_par
     sp->blend = blend == 2 ? AK_BLEND_OPAQUE : blend ? AK_BLEND_ADD : AK_BLEND_ALPHA;
     const char* tex = NULL;
     akp_json_str(j, r, "render", "texture", &tex);
-    if (tex && strcmp(tex, "disc") == 0) sp->texture = AK_SPRITE_TEXTURE_DISC;
-    else if (tex && strcmp(tex, "puff") == 0) sp->texture = AK_SPRITE_TEXTURE_PUFF;
+    if (tex && strcmp(tex, "disc") == 0)
+        sp->texture = AK_SPRITE_TEXTURE_DISC;
+    else if (tex && strcmp(tex, "puff") == 0)
+        sp->texture = AK_SPRITE_TEXTURE_PUFF;
     else if (tex) {
         size_t n = strlen(tex);
         if (n < 5 || strcmp(tex + n - 4, ".png") != 0) {
-            akp_json_fail(j, "render", "texture", "\"%.80s\" is not disc, puff or a .png file", tex);
+            akp_json_fail(j, "render", "texture", "\"%.80s\" is not disc, puff or a .png file",
+                          tex);
             return;
         }
         const char* slash = file ? strrchr(file, '/') : NULL;
@@ -267,11 +272,14 @@ static void read_render(akp_json* j, const cJSON* root, const char* file, ak_par
     akp_json_float(j, r, "render", "frame_rate", 0.0f, 1000.0f, &sp->look.frame_rate);
     char path[64];
     size_t n = 0;
-    const cJSON* e = akp_json_array(j, r, "render", "colour_over_life", AK_PARTICLE_LOOK_MAX_KEYS, &n);
+    const cJSON* e =
+        akp_json_array(j, r, "render", "colour_over_life", AK_PARTICLE_LOOK_MAX_KEYS, &n);
     for (size_t i = 0; i < n && e && !j->failed; ++i, e = e->next) {
         float v[5];
         akp_json_index(path, sizeof path, "render.colour_over_life", i);
-        if (!read_life_key(j, e, path, 5, 0.0f, 16.0f, i ? sp->look.colour_keys[i - 1].t : -1.0f, v)) break;
+        if (!read_life_key(j, e, path, 5, 0.0f, 16.0f, i ? sp->look.colour_keys[i - 1].t : -1.0f,
+                           v))
+            break;
         sp->look.colour_keys[i] = (ak_particle_colour_key){v[0], {v[1], v[2], v[3], v[4]}};
         sp->look.colour_key_count = (uint32_t)(i + 1);
     }
@@ -279,7 +287,9 @@ static void read_render(akp_json* j, const cJSON* root, const char* file, ak_par
     for (size_t i = 0; i < n && e && !j->failed; ++i, e = e->next) {
         float v[2];
         akp_json_index(path, sizeof path, "render.size_over_life", i);
-        if (!read_life_key(j, e, path, 2, 0.0f, 1000.0f, i ? sp->look.size_keys[i - 1].t : -1.0f, v)) break;
+        if (!read_life_key(j, e, path, 2, 0.0f, 1000.0f, i ? sp->look.size_keys[i - 1].t : -1.0f,
+                           v))
+            break;
         sp->look.size_keys[i] = (ak_particle_size_key){v[0], v[1]};
         sp->look.size_key_count = (uint32_t)(i + 1);
     }
