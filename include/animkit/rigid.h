@@ -307,6 +307,106 @@ AK_API ak_result ak_rigid_step_validate(const ak_rigid_step_job* job);
  * name the step that blew up. */
 AK_API ak_result ak_rigid_step_run(const ak_rigid_step_job* job);
 
+/* ---- scene files and presets ------------------------------------------------------------ */
+/* A rigid-body scene: the JSON format of `animkit rigid SCENE.json` (docs/rigid.md lists every
+ * key, its unit, its default and its range) or a preset, over the defaults:
+ *     ak_rigid_scene sc;
+ *     ak_diag diag;
+ *     ak_rigid_scene_defaults(&sc);                          // or ak_rigid_scene_preset(...)
+ *     if (ak_rigid_scene_load_file("stack.json", &sc, &diag) != AK_OK) puts(diag.message);
+ *     ... ak_rigid_scene_run_* (below), or ak_rigid_model_create with sc.model, sc.bodies and
+ *         sc.joints, then sc.steps steps of sc.dt with sc.substeps and sc.gravity ...
+ *     ak_rigid_scene_free(&sc); */
+
+/* Budgets that bound a hostile scene's memory (checked before anything is allocated). */
+#define AK_RIGID_SCENE_MAX_BODIES 100000u
+#define AK_RIGID_SCENE_MAX_JOINTS 100000u
+#define AK_RIGID_SCENE_MAX_STEPS 1000000L
+#define AK_RIGID_SCENE_MAX_SUBSTEPS 1000L
+#define AK_RIGID_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
+/* The names ak_rigid_scene_preset knows (also as a list: ak_rigid_scene_preset_names). */
+#define AK_RIGID_SCENE_PRESETS "stack, pyramid, dominoes, avalanche, ragdoll, incline"
+
+/* A loaded scene; it owns bodies and joints (malloc). */
+typedef struct ak_rigid_scene {
+    ak_rigid_body_desc* bodies;  /* [body_count], scene order */
+    size_t body_count;
+    ak_rigid_joint_desc* joints; /* [joint_count]; body indices into bodies */
+    size_t joint_count;
+    ak_rigid_model_desc model;   /* damping and contact offset; its bodies and joints spans are
+                                    left empty (ak_rigid_scene_run_init fills a copy) */
+    ak_vec3 gravity;             /* m/s^2; default (0, -9.81, 0) */
+    float dt;                    /* seconds per step; default 1/60 */
+    long steps;                  /* default 240 */
+    uint32_t substeps;           /* default 20 */
+    uint32_t thread_count;       /* default 1 */
+    bool sleep;                  /* bodies may fall asleep; default true */
+} ak_rigid_scene;
+
+/* The defaults of every key, no bodies, no joints (the scene without a file); owns nothing. */
+AK_API void ak_rigid_scene_defaults(ak_rigid_scene* scene);
+/* Parse bytes[0, size) (strict JSON) OVER the scene already in *scene, which must hold
+ * ak_rigid_scene_defaults or a preset (keys absent from the file keep its values; "bodies" is
+ * required, so the file's bodies and joints replace the scene's). name (NULL -> "(scene)") starts
+ * every message. Returns AK_OK, or AK_ERR_PARSE / AK_ERR_NULL_ARG with, when out_diag is not NULL,
+ * the one line "NAME: key.path: problem" in out_diag->message, and no bodies or joints left in
+ * *scene. In every case free *scene with ak_rigid_scene_free afterwards. */
+AK_API ak_result ak_rigid_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                           ak_rigid_scene* scene, ak_diag* out_diag);
+/* Read the file at path (at most AK_RIGID_SCENE_MAX_FILE_SIZE bytes) and parse it over *scene as
+ * ak_rigid_scene_load_bytes does; AK_ERR_IO when it cannot be read or is too big. */
+AK_API ak_result ak_rigid_scene_load_file(const char* path, ak_rigid_scene* scene, ak_diag* out_diag);
+/* The defaults, then the preset name (AK_RIGID_SCENE_PRESETS; docs/rigid.md describes them):
+ * "stack" (ten 1 m boxes), "pyramid" (20 layers, 210 boxes), "dominoes" (20, the first pushed),
+ * "avalanche" (200 spheres, boxes and capsules down a 30 degree slope), "ragdoll"
+ * (builtin:humanoid dropped mid-walk), "incline" (a box that slides and one that stays on a 30
+ * degree slope). *out_scene is overwritten without being freed (pass a new or freed scene).
+ * AK_ERR_NOT_FOUND for another name (the scene then holds the defaults), AK_ERR_NO_MEMORY, or the
+ * error building the ragdoll's character. */
+AK_API ak_result ak_rigid_scene_preset(const char* name, ak_rigid_scene* out_scene, ak_diag* out_diag);
+/* The preset names as a NULL-terminated list (static storage); *out_count (may be NULL) gets
+ * their number. */
+AK_API const char* const* ak_rigid_scene_preset_names(size_t* out_count);
+/* Free the arrays (NULL: no-op; safe twice); the other fields keep their values. */
+AK_API void ak_rigid_scene_free(ak_rigid_scene* scene);
+
+/* ---- running a scene ---------------------------------------------------------------------- */
+/* Step a loaded scene as `animkit rigid` does, so that C and Python reproduce the command's
+ * output (the model built from the scene, its initial state, sleep timers when scene->sleep):
+ *     ak_rigid_scene_run run;
+ *     if (ak_rigid_scene_run_init(&run, &sc, "stack", &diag) == AK_OK)
+ *         while (run.step_index < sc.steps && ak_rigid_scene_run_step(&run) == AK_OK) {}
+ *     ... run.positions[i], run.orientations[i], ak_rigid_scene_run_energy(&run) ...
+ *     ak_rigid_scene_run_free(&run); */
+typedef struct ak_rigid_scene_run {
+    ak_rigid_model* model; /* built from the scene (owned by the run) */
+    size_t body_count;
+    ak_vec3* positions;    /* [body_count]: the current state, world space */
+    ak_quat* orientations;
+    ak_vec3* velocities;
+    ak_vec3* angular_velocities;
+    ak_vec3 gravity;       /* the scene's */
+    float max_penetration; /* metres, after the last step (0 before the first) */
+    long step_index;       /* steps taken */
+    double time;           /* seconds simulated: step_index * dt */
+    ak_rigid_step_job job; /* points into the arrays above */
+    /* private */
+    float* sleep_timers;
+} ak_rigid_scene_run;
+
+/* Build the model and the initial state and validate the step job. The scene may be freed
+ * afterwards (the model copies what it needs). AK_OK, or the failing code with "NAME: problem" in
+ * out_diag (name NULL -> "scene"); free with ak_rigid_scene_run_free either way. */
+AK_API ak_result ak_rigid_scene_run_init(ak_rigid_scene_run* run, const ak_rigid_scene* scene,
+                                         const char* name, ak_diag* out_diag);
+/* One step of the scene's dt. AK_ERR_BAD_DATA: the step blew up (a non-finite state; the state
+ * is left as it was and step_index does not advance: lower dt or raise substeps). */
+AK_API ak_result ak_rigid_scene_run_step(ak_rigid_scene_run* run);
+/* Kinetic plus gravitational potential energy of the current state (J), as ak_rigid_energy. */
+AK_API double ak_rigid_scene_run_energy(const ak_rigid_scene_run* run);
+/* Free the model and the arrays (safe on a zeroed or failed run, and twice). */
+AK_API void ak_rigid_scene_run_free(ak_rigid_scene_run* run);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,5 +1,5 @@
-/* libFuzzer harness for the rigid-body scene reader (tools/animkit/scene_rigid.c) and the rigid
- * module behind it (built by scripts/fuzz.sh with the library and the CLI sources).
+/* libFuzzer harness for the rigid-body scene reader (ak_rigid_scene_load_bytes, src/rigid/scene.c)
+ * and the rigid module behind it; built and run by scripts/fuzz.sh.
  *
  * Each input is parsed as a scene file. A parsed scene must hold its documented invariants
  * (at least one body, positive step, joints between two different bodies of the scene); when it
@@ -11,15 +11,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../../tools/animkit/scene_rigid.h"
+#include <animkit/rigid.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    rigid_scene s;
-    char msg[600];
-    if (!rigid_scene_parse("fuzz.json", (const char*)data, size, &s, msg, sizeof msg)) {
-        if (msg[0] == '\0') abort(); /* a failure always says why */
+    ak_rigid_scene s;
+    ak_diag diag;
+    ak_rigid_scene_defaults(&s);
+    if (ak_rigid_scene_load_bytes(data, size, "fuzz.json", &s, &diag) != AK_OK) {
+        /* a failure always says why, in one line that names the file, and leaves no bodies */
+        if (strncmp(diag.message, "fuzz.json", 9) != 0 || strchr(diag.message, '\n') ||
+            s.bodies || s.joints || s.body_count || s.joint_count)
+            abort();
+        ak_rigid_scene_free(&s);
         return 0;
     }
     if (s.body_count == 0 || !(s.dt > 0.0f) || s.substeps == 0) abort();
@@ -63,6 +68,6 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         free(job.scratch.ptr);
     }
     ak_rigid_model_destroy(m);
-    rigid_scene_free(&s);
+    ak_rigid_scene_free(&s);
     return 0;
 }

@@ -4,10 +4,8 @@
 #include <string.h>
 
 #include "cli.h"
-#include "cli_json.h"
 #include "outfile.h"
 #include "render.h"
-#include "scene_rigid.h"
 #include "sim_bake.h"
 
 static const char* const usage =
@@ -180,37 +178,24 @@ int cmd_rigid(int argc, char** argv) {
     const char* json = CLI_GET(&a, "--json");
     if (out && !cli_has_ext(out, ".gif") && !cli_has_ext(out, ".png") && !cli_has_ext(out, ".glb"))
         return cli_usage("rigid", "output '%s' must end in .gif, .png or .glb", out);
-    rigid_scene sc;
+    ak_rigid_scene sc;
+    ak_diag diag;
     const char* name = preset ? preset : a.pos[0];
+    ak_rigid_scene_defaults(&sc);
     if (preset) {
-        if (!rigid_scene_preset(preset, &sc)) {
-            rigid_scene_free(&sc);
-            return cli_usage(
-                "rigid",
-                "unknown preset '%s' (stack, pyramid, dominoes, avalanche, ragdoll, incline)",
-                preset);
-        }
-    } else {
-        FILE* f = fopen(a.pos[0], "rb");
-        char* text = f ? malloc(CLI_JSON_MAX_SIZE + 1) : NULL;
-        size_t size = text ? fread(text, 1, CLI_JSON_MAX_SIZE + 1, f) : 0;
-        if (f) fclose(f);
-        if (!text || size > CLI_JSON_MAX_SIZE) {
-            free(text);
-            return cli_fail("rigid",
-                            "%s: cannot read the file (missing, unreadable or over %zu bytes)",
-                            a.pos[0], CLI_JSON_MAX_SIZE);
-        }
-        char msg[600];
-        bool ok = rigid_scene_parse(a.pos[0], text, size, &sc, msg, sizeof msg);
-        free(text);
-        if (!ok) return cli_fail("rigid", "%s", msg);
+        const ak_result res = ak_rigid_scene_preset(preset, &sc, &diag);
+        if (res == AK_ERR_NOT_FOUND)
+            return cli_usage("rigid", "unknown preset '%s' (" AK_RIGID_SCENE_PRESETS ")", preset);
+        if (res != AK_OK) return cli_fail("rigid", "%s", diag.message);
+    } else if (ak_rigid_scene_load_file(a.pos[0], &sc, &diag) != AK_OK) {
+        ak_rigid_scene_free(&sc);
+        return cli_fail("rigid", "%s", diag.message);
     }
     const char* v;
     long lv;
     if ((v = CLI_GET(&a, "--steps"))) {
-        if (!cli_parse_int(v, 0, RIGID_SCENE_MAX_STEPS, &lv))
-            rc = cli_usage_int("rigid", "--steps", v, 0, RIGID_SCENE_MAX_STEPS);
+        if (!cli_parse_int(v, 0, AK_RIGID_SCENE_MAX_STEPS, &lv))
+            rc = cli_usage_int("rigid", "--steps", v, 0, AK_RIGID_SCENE_MAX_STEPS);
         else
             sc.steps = lv;
     }
@@ -222,8 +207,8 @@ int cmd_rigid(int argc, char** argv) {
             sc.dt = dt;
     }
     if (!rc && (v = CLI_GET(&a, "--substeps"))) {
-        if (!cli_parse_int(v, 1, 1000, &lv))
-            rc = cli_usage_int("rigid", "--substeps", v, 1, 1000);
+        if (!cli_parse_int(v, 1, AK_RIGID_SCENE_MAX_SUBSTEPS, &lv))
+            rc = cli_usage_int("rigid", "--substeps", v, 1, AK_RIGID_SCENE_MAX_SUBSTEPS);
         else
             sc.substeps = (uint32_t)lv;
     }
@@ -231,7 +216,7 @@ int cmd_rigid(int argc, char** argv) {
         if (!cli_parse_int(v, 1, AK_RIGID_MAX_THREADS, &lv))
             rc = cli_usage_int("rigid", "--threads", v, 1, AK_RIGID_MAX_THREADS);
         else
-            sc.thread_count = (int)lv;
+            sc.thread_count = (uint32_t)lv;
     }
     const size_t n = sc.body_count;
     if (!rc)
@@ -239,16 +224,12 @@ int cmd_rigid(int argc, char** argv) {
                             "body updates (bodies x steps x substeps x 4)",
                             "--steps, --substeps or the body count");
     if (rc) {
-        rigid_scene_free(&sc);
+        ak_rigid_scene_free(&sc);
         return rc;
     }
 
-    ak_rigid_model* model = NULL;
-    ak_vec3 *x = NULL, *vel = NULL, *w = NULL;
-    ak_quat* q = NULL;
-    float* timers = NULL;
-    ak_rigid_step_job job;
-    memset(&job, 0, sizeof job);
+    ak_rigid_scene_run run;
+    memset(&run, 0, sizeof run);
     body_mesh mesh;
     memset(&mesh, 0, sizeof mesh);
     cli_frame frame;
@@ -257,43 +238,15 @@ int cmd_rigid(int argc, char** argv) {
     ak_gif_writer* gw = NULL;
     sim_bake bake;
     memset(&bake, 0, sizeof bake);
+    ak_result r;
 
-    ak_rigid_model_desc md = sc.model;
-    md.bodies = (ak_rigid_body_desc_cspan){sc.bodies, n};
-    md.joints = (ak_rigid_joint_desc_cspan){sc.joints, sc.joint_count};
-    ak_result r = ak_rigid_model_create(&md, NULL, &model);
-    if (r != AK_OK) {
-        rc = cli_fail("rigid", "%s: the bodies cannot be built: %s", name, ak_result_string(r));
+    if (ak_rigid_scene_run_init(&run, &sc, name, &diag) != AK_OK) {
+        rc = cli_fail("rigid", "%s", diag.message);
         goto done;
     }
-    x = malloc(n * sizeof *x), vel = malloc(n * sizeof *vel), w = malloc(n * sizeof *w),
-    q = malloc(n * sizeof *q);
-    timers = calloc(n, sizeof *timers);
-    if (!x || !vel || !w || !q || !timers) {
-        rc = cli_fail("rigid", "out of memory");
-        goto done;
-    }
-    ak_rigid_initial_state(model, (ak_vec3_span){x, n}, (ak_quat_span){q, n},
-                           (ak_vec3_span){vel, n}, (ak_vec3_span){w, n});
-    float pen = 0.0f;
-    job = (ak_rigid_step_job){.model = model,
-                              .dt = sc.dt,
-                              .substeps = sc.substeps,
-                              .gravity = sc.gravity,
-                              .thread_count = (uint32_t)sc.thread_count,
-                              .positions = {x, n},
-                              .orientations = {q, n},
-                              .velocities = {vel, n},
-                              .angular_velocities = {w, n},
-                              .out_max_penetration = &pen};
-    if (sc.sleep) job.sleep_timers = (ak_f32_span){timers, n};
-    size_t bytes = ak_rigid_step_scratch_size(&job);
-    job.scratch = (ak_u8_span){malloc(bytes), bytes};
-    if (!job.scratch.ptr) {
-        rc = cli_fail("rigid", "out of memory");
-        goto done;
-    }
-
+    const ak_rigid_model* model = run.model;
+    const ak_vec3* x = run.positions;
+    const ak_quat* q = run.orientations;
     const bool gif = out && cli_has_ext(out, ".gif"), png = out && cli_has_ext(out, ".png");
     if (out) {
         if (!mesh_build(&mesh, model)) {
@@ -347,7 +300,7 @@ int cmd_rigid(int argc, char** argv) {
         }
         if (bake.cap && (rc = sim_bake_mesh_add(&bake, step, mesh.pos, mesh.nrm))) goto done;
         if (step == sc.steps) break;
-        r = ak_rigid_step_run(&job);
+        r = ak_rigid_scene_run_step(&run);
         if (r == AK_ERR_BAD_DATA) {
             rc = cli_fail("rigid",
                           "%s: the simulation blew up at step %ld (t = %.4g s): a non-finite "
@@ -360,7 +313,7 @@ int cmd_rigid(int argc, char** argv) {
             rc = cli_fail("rigid", "%s: step %ld failed: %s", name, step + 1, ak_result_string(r));
             goto done;
         }
-        time = (float)((double)(step + 1) * (double)sc.dt);
+        time = (float)run.time;
         cli_progress("rigid", (size_t)step + 1, (size_t)sc.steps);
     }
     const double elapsed = cli_now() - t0;
@@ -372,10 +325,11 @@ int cmd_rigid(int argc, char** argv) {
             goto done;
         }
     }
-    const double energy =
-        ak_rigid_energy(model, sc.gravity, (ak_vec3_cspan){x, n}, (ak_quat_cspan){q, n},
-                        (ak_vec3_cspan){vel, n}, (ak_vec3_cspan){w, n});
-    if (json && (rc = write_json(json, time, n, x, q, vel, w, pen, energy))) goto done;
+    const double energy = ak_rigid_scene_run_energy(&run);
+    const float pen = run.max_penetration;
+    if (json && (rc = write_json(json, time, n, x, q, run.velocities, run.angular_velocities, pen,
+                                 energy)))
+        goto done;
     if (bake.cap && (rc = sim_bake_mesh_write(&bake, preset ? preset : "rigid", sc.dt,
                                               (ak_u32_cspan){mesh.idx, mesh.icount},
                                               ak_vec4_make(0.80f, 0.55f, 0.25f, 1))))
@@ -399,9 +353,7 @@ done:
     free(img.pixels);
     cli_frame_free(&frame);
     mesh_free(&mesh);
-    free(job.scratch.ptr);
-    free(x), free(vel), free(w), free(q), free(timers);
-    ak_rigid_model_destroy(model);
-    rigid_scene_free(&sc);
+    ak_rigid_scene_run_free(&run);
+    ak_rigid_scene_free(&sc);
     return rc;
 }

@@ -1,16 +1,20 @@
-/* animkit rigid: scene files (strict JSON through cli_json.h) and the built-in presets.
- * docs/rigid.md lists every key with its unit and default. */
+/* animkit rigid: scene files (strict JSON through src/json.h) and the built-in presets
+ * (ak_rigid_scene in animkit/rigid.h; docs/rigid.md lists every key with its unit and default). */
+#include <animkit/rigid.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <animkit/animkit.h>
+#include <animkit/builtin.h>
+#include <animkit/clip.h>
+#include <animkit/scene.h>
+#include <animkit/skeleton.h>
 
-#include "cli_json.h"
-#include "scene_rigid.h"
+#include "json.h"
 
-void rigid_scene_defaults(rigid_scene* s) {
+void ak_rigid_scene_defaults(ak_rigid_scene* s) {
     memset(s, 0, sizeof *s);
     s->gravity = ak_vec3_make(0.0f, -9.81f, 0.0f);
     s->dt = 1.0f / 60.0f;
@@ -21,7 +25,8 @@ void rigid_scene_defaults(rigid_scene* s) {
     s->model.contact_offset = 0.01f;
 }
 
-void rigid_scene_free(rigid_scene* s) {
+void ak_rigid_scene_free(ak_rigid_scene* s) {
+    if (!s) return;
     free(s->bodies);
     free(s->joints);
     s->bodies = NULL;
@@ -40,28 +45,28 @@ static ak_rigid_body_desc body_default(void) {
     return b;
 }
 
-static void parse_shape(cli_json* j, const cJSON* obj, const char* path, ak_rigid_body_desc* b) {
+static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigid_body_desc* b) {
     char sp[96];
-    cli_json_key(sp, sizeof sp, path, "shape");
-    const cJSON* sh = cli_json_member(j, obj, path, "shape");
+    akp_json_key(sp, sizeof sp, path, "shape");
+    const cJSON* sh = akp_json_member(j, obj, path, "shape");
     if (j->failed) return;
     if (!sh) {
-        cli_json_fail(j, path, "shape", "is required");
+        akp_json_fail(j, path, "shape", "is required");
         return;
     }
     static const char* const keys[] = {"type",   "radius", "half_extents", "half_height", "points",
                                        "normal", NULL};
     static const char* const types[] = {"sphere", "box", "capsule", "hull", "plane", NULL};
-    cli_json_object(j, sh, sp, keys);
+    akp_json_object(j, sh, sp, keys);
     int type = -1;
-    cli_json_enum(j, sh, sp, "type", types, &type);
+    akp_json_enum(j, sh, sp, "type", types, &type);
     if (j->failed) return;
     if (type < 0) {
-        cli_json_fail(j, sp, "type", "is required (sphere, box, capsule, hull or plane)");
+        akp_json_fail(j, sp, "type", "is required (sphere, box, capsule, hull or plane)");
         return;
     }
     if (type == 3) {
-        cli_json_fail(j, sp, "type", "\"hull\" is not supported yet (sphere, box, capsule, plane)");
+        akp_json_fail(j, sp, "type", "\"hull\" is not supported yet (sphere, box, capsule, plane)");
         return;
     }
     /* which keys each type takes: the others are refused so a typo cannot pass unnoticed */
@@ -69,7 +74,7 @@ static void parse_shape(cli_json* j, const cJSON* obj, const char* path, ak_rigi
                                          "normal"};
     for (int k = 1; keys[k]; ++k)
         if (cJSON_GetObjectItemCaseSensitive(sh, keys[k]) && !strstr(takes[type], keys[k])) {
-            cli_json_fail(j, sp, keys[k], "does not apply to a %s", types[type]);
+            akp_json_fail(j, sp, keys[k], "does not apply to a %s", types[type]);
             return;
         }
     ak_rigid_shape* s = &b->shape;
@@ -81,165 +86,185 @@ static void parse_shape(cli_json* j, const cJSON* obj, const char* path, ak_rigi
     s->half_height = 0.0f;
     s->half_extents = ak_vec3_make(-1.0f, -1.0f, -1.0f);
     s->normal = ak_vec3_make(0.0f, 1.0f, 0.0f);
-    cli_json_float(j, sh, sp, "radius", 1e-4f, 1e4f, &s->radius);
-    cli_json_float(j, sh, sp, "half_height", 0.0f, 1e4f, &s->half_height);
+    akp_json_float(j, sh, sp, "radius", 1e-4f, 1e4f, &s->radius);
+    akp_json_float(j, sh, sp, "half_height", 0.0f, 1e4f, &s->half_height);
     float he[3] = {-1.0f, -1.0f, -1.0f};
-    cli_json_floats(j, sh, sp, "half_extents", 3, 1e-4f, 1e4f, he);
+    akp_json_floats(j, sh, sp, "half_extents", 3, 1e-4f, 1e4f, he);
     s->half_extents = ak_vec3_make(he[0], he[1], he[2]);
-    cli_json_vec3(j, sh, sp, "normal", &s->normal);
+    akp_json_vec3(j, sh, sp, "normal", &s->normal);
     if (j->failed) return;
     if ((type == 0 || type == 2) && s->radius < 0.0f)
-        cli_json_fail(j, sp, "radius", "is required for a %s", types[type]);
+        akp_json_fail(j, sp, "radius", "is required for a %s", types[type]);
     else if (type == 1 && he[0] < 0.0f)
-        cli_json_fail(j, sp, "half_extents", "is required for a box");
+        akp_json_fail(j, sp, "half_extents", "is required for a box");
     else if (type == 4 && ak_vec3_length(s->normal) < 1e-6f)
-        cli_json_fail(j, sp, "normal", "is zero");
+        akp_json_fail(j, sp, "normal", "is zero");
 }
 
-static void parse_body(cli_json* j, const cJSON* e, const char* path, ak_rigid_body_desc* b) {
+static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_body_desc* b) {
     if (!cJSON_IsObject(e)) {
-        cli_json_fail(j, path, "", "expected an object with at least \"shape\"");
+        akp_json_fail(j, path, "", "expected an object with at least \"shape\"");
         return;
     }
     static const char* const keys[] = {
         "shape",    "position",    "orientation", "velocity", "angular_velocity", "density", "mass",
         "friction", "restitution", "static",      NULL};
-    cli_json_object(j, e, path, keys);
+    akp_json_object(j, e, path, keys);
     *b = body_default();
     parse_shape(j, e, path, b);
-    cli_json_vec3(j, e, path, "position", &b->position);
+    akp_json_vec3(j, e, path, "position", &b->position);
     float q[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-    cli_json_floats(j, e, path, "orientation", 4, -1e3f, 1e3f, q);
+    akp_json_floats(j, e, path, "orientation", 4, -1e3f, 1e3f, q);
     if (!j->failed && q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] < 1e-12f)
-        cli_json_fail(j, path, "orientation", "is the zero quaternion");
+        akp_json_fail(j, path, "orientation", "is the zero quaternion");
     b->orientation = ak_quat_normalize(ak_quat_make(q[0], q[1], q[2], q[3]));
-    cli_json_vec3(j, e, path, "velocity", &b->velocity);
-    cli_json_vec3(j, e, path, "angular_velocity", &b->angular_velocity);
+    akp_json_vec3(j, e, path, "velocity", &b->velocity);
+    akp_json_vec3(j, e, path, "angular_velocity", &b->angular_velocity);
     if (!j->failed && (ak_vec3_length(b->position) > 1e6f || ak_vec3_length(b->velocity) > 1e5f ||
                        ak_vec3_length(b->angular_velocity) > 1e5f))
-        cli_json_fail(
+        akp_json_fail(
             j, path, "",
             "position over 1e6 m, velocity over 1e5 m/s or angular velocity over 1e5 rad/s");
     if (!j->failed && cJSON_GetObjectItemCaseSensitive(e, "density") &&
         cJSON_GetObjectItemCaseSensitive(e, "mass"))
-        cli_json_fail(j, path, "mass", "give density or mass, not both");
-    cli_json_float(j, e, path, "density", 1e-3f, 1e6f, &b->density);
-    cli_json_float(j, e, path, "mass", 1e-6f, 1e9f, &b->mass);
+        akp_json_fail(j, path, "mass", "give density or mass, not both");
+    akp_json_float(j, e, path, "density", 1e-3f, 1e6f, &b->density);
+    akp_json_float(j, e, path, "mass", 1e-6f, 1e9f, &b->mass);
     float mu = b->friction;
-    cli_json_float(j, e, path, "friction", 0.0f, 100.0f, &mu);
+    akp_json_float(j, e, path, "friction", 0.0f, 100.0f, &mu);
     b->friction = mu == 0.0f ? AK_RIGID_FRICTIONLESS : mu; /* 0 in the file is a real zero */
-    cli_json_float(j, e, path, "restitution", 0.0f, 1.0f, &b->restitution);
-    cli_json_bool(j, e, path, "static", &b->is_static);
+    akp_json_float(j, e, path, "restitution", 0.0f, 1.0f, &b->restitution);
+    akp_json_bool(j, e, path, "static", &b->is_static);
 }
 
-static void parse_joint(cli_json* j, const cJSON* e, const char* path, size_t body_count,
+static void parse_joint(akp_json* j, const cJSON* e, const char* path, size_t body_count,
                         ak_rigid_joint_desc* d) {
     if (!cJSON_IsObject(e)) {
-        cli_json_fail(j, path, "", "expected an object with \"type\" and \"bodies\"");
+        akp_json_fail(j, path, "", "expected an object with \"type\" and \"bodies\"");
         return;
     }
     static const char* const keys[] = {"type",   "bodies",     "anchor", "axis",
                                        "limits", "compliance", NULL};
     static const char* const types[] = {"ball", "hinge", "fixed", "prismatic", NULL};
-    cli_json_object(j, e, path, keys);
+    akp_json_object(j, e, path, keys);
     memset(d, 0, sizeof *d);
     int type = -1;
-    cli_json_enum(j, e, path, "type", types, &type);
+    akp_json_enum(j, e, path, "type", types, &type);
     if (!j->failed && type < 0)
-        cli_json_fail(j, path, "type", "is required (ball, hinge, fixed or prismatic)");
+        akp_json_fail(j, path, "type", "is required (ball, hinge, fixed or prismatic)");
     d->type = (ak_rigid_joint_type)(type < 0 ? 0 : type);
     float ab[2] = {-1.0f, -1.0f};
-    cli_json_floats(j, e, path, "bodies", 2, 0.0f, (float)RIGID_SCENE_MAX_BODIES, ab);
+    akp_json_floats(j, e, path, "bodies", 2, 0.0f, (float)AK_RIGID_SCENE_MAX_BODIES, ab);
     if (!j->failed && ab[0] < 0.0f)
-        cli_json_fail(j, path, "bodies", "is required: [a, b], two body indices");
+        akp_json_fail(j, path, "bodies", "is required: [a, b], two body indices");
     if (!j->failed && (ab[0] != floorf(ab[0]) || ab[1] != floorf(ab[1])))
-        cli_json_fail(j, path, "bodies", "expected two whole body indices");
+        akp_json_fail(j, path, "bodies", "expected two whole body indices");
     if (!j->failed && (ab[0] >= (float)body_count || ab[1] >= (float)body_count))
-        cli_json_fail(j, path, "bodies", "a body index is out of range (the scene has %zu bodies)",
+        akp_json_fail(j, path, "bodies", "a body index is out of range (the scene has %zu bodies)",
                       body_count);
-    if (!j->failed && ab[0] == ab[1]) cli_json_fail(j, path, "bodies", "joins a body to itself");
+    if (!j->failed && ab[0] == ab[1]) akp_json_fail(j, path, "bodies", "joins a body to itself");
     if (j->failed) return; /* ab may still hold -1: no conversion to an index */
     d->body_a = (uint32_t)ab[0], d->body_b = (uint32_t)ab[1];
-    cli_json_vec3(j, e, path, "anchor", &d->anchor);
+    akp_json_vec3(j, e, path, "anchor", &d->anchor);
     d->axis = ak_vec3_make(0.0f, 0.0f, 1.0f);
-    cli_json_vec3(j, e, path, "axis", &d->axis);
+    akp_json_vec3(j, e, path, "axis", &d->axis);
     if (!j->failed && (ak_vec3_length(d->anchor) > 1e6f || ak_vec3_length(d->axis) < 1e-6f))
-        cli_json_fail(j, path, "", "anchor over 1e6 m or a zero axis");
+        akp_json_fail(j, path, "", "anchor over 1e6 m or a zero axis");
     float lim[2] = {0.0f, 0.0f};
     d->limited = cJSON_GetObjectItemCaseSensitive(e, "limits") != NULL;
-    cli_json_floats(j, e, path, "limits", 2, -1e3f, 1e3f, lim);
+    akp_json_floats(j, e, path, "limits", 2, -1e3f, 1e3f, lim);
     if (!j->failed && d->limited && lim[0] > lim[1])
-        cli_json_fail(j, path, "limits", "lower is above upper");
+        akp_json_fail(j, path, "limits", "lower is above upper");
     if (!j->failed && d->limited && d->type == AK_RIGID_JOINT_FIXED)
-        cli_json_fail(j, path, "limits", "does not apply to a fixed joint");
+        akp_json_fail(j, path, "limits", "does not apply to a fixed joint");
     d->lower = lim[0], d->upper = lim[1];
-    cli_json_float(j, e, path, "compliance", 0.0f, 1e3f, &d->compliance);
+    akp_json_float(j, e, path, "compliance", 0.0f, 1e3f, &d->compliance);
 }
 
-bool rigid_scene_parse(const char* file, const char* text, size_t size, rigid_scene* s, char* msg,
-                       size_t cap) {
-    rigid_scene_defaults(s);
-    if (cap) msg[0] = '\0';
-    cli_json j = {.file = file};
-    cJSON* root = cli_json_parse(&j, text, size);
+/* Parse text over *s; false with the message in *jp (and no bodies or joints left in *s). */
+static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s) {
+    akp_json j = *jp;
+    ak_rigid_scene_free(s); /* "bodies" is required: the file's bodies and joints replace these */
+    cJSON* root = akp_json_parse(&j, text, size);
     if (root) {
         static const char* const keys[] = {
             "gravity",         "bodies",         "joints",  "dt",
             "steps",           "substeps",       "threads", "linear_damping",
             "angular_damping", "contact_offset", "sleep",   NULL};
-        cli_json_object(&j, root, "", keys);
-        cli_json_vec3(&j, root, "", "gravity", &s->gravity);
+        akp_json_object(&j, root, "", keys);
+        akp_json_vec3(&j, root, "", "gravity", &s->gravity);
         if (!j.failed && ak_vec3_length(s->gravity) > 1e4f)
-            cli_json_fail(&j, "", "gravity", "is over 1e4 m/s^2");
-        cli_json_float(&j, root, "", "dt", 1e-6f, 1.0f, &s->dt);
-        cli_json_int(&j, root, "", "steps", 0, RIGID_SCENE_MAX_STEPS, &s->steps);
-        long sub = (long)s->substeps, th = s->thread_count;
-        cli_json_int(&j, root, "", "substeps", 1, 1000, &sub);
-        cli_json_int(&j, root, "", "threads", 1, AK_RIGID_MAX_THREADS, &th);
-        s->substeps = (uint32_t)sub, s->thread_count = (int)th;
-        cli_json_float(&j, root, "", "linear_damping", 0.0f, 1e3f, &s->model.linear_damping);
-        cli_json_float(&j, root, "", "angular_damping", 0.0f, 1e3f, &s->model.angular_damping);
-        cli_json_float(&j, root, "", "contact_offset", 1e-5f, 1.0f, &s->model.contact_offset);
-        cli_json_bool(&j, root, "", "sleep", &s->sleep);
+            akp_json_fail(&j, "", "gravity", "is over 1e4 m/s^2");
+        akp_json_float(&j, root, "", "dt", 1e-6f, 1.0f, &s->dt);
+        akp_json_int(&j, root, "", "steps", 0, AK_RIGID_SCENE_MAX_STEPS, &s->steps);
+        long sub = (long)s->substeps, th = (long)s->thread_count;
+        akp_json_int(&j, root, "", "substeps", 1, AK_RIGID_SCENE_MAX_SUBSTEPS, &sub);
+        akp_json_int(&j, root, "", "threads", 1, AK_RIGID_MAX_THREADS, &th);
+        s->substeps = (uint32_t)sub, s->thread_count = (uint32_t)th;
+        akp_json_float(&j, root, "", "linear_damping", 0.0f, 1e3f, &s->model.linear_damping);
+        akp_json_float(&j, root, "", "angular_damping", 0.0f, 1e3f, &s->model.angular_damping);
+        akp_json_float(&j, root, "", "contact_offset", 1e-5f, 1.0f, &s->model.contact_offset);
+        akp_json_bool(&j, root, "", "sleep", &s->sleep);
         size_t n = 0;
-        const cJSON* e = cli_json_array(&j, root, "", "bodies", RIGID_SCENE_MAX_BODIES, &n);
+        const cJSON* e = akp_json_array(&j, root, "", "bodies", AK_RIGID_SCENE_MAX_BODIES, &n);
         if (!j.failed && n == 0)
-            cli_json_fail(&j, "", "bodies", "is required and must hold at least one body");
+            akp_json_fail(&j, "", "bodies", "is required and must hold at least one body");
         if (!j.failed) {
             s->bodies = calloc(n, sizeof *s->bodies);
-            if (!s->bodies) cli_json_fail(&j, "", "bodies", "out of memory");
+            if (!s->bodies) akp_json_fail(&j, "", "bodies", "out of memory");
         }
         for (size_t k = 0; e && !j.failed; e = e->next, ++k) {
             char path[48];
-            cli_json_index(path, sizeof path, "bodies", k);
+            akp_json_index(path, sizeof path, "bodies", k);
             parse_body(&j, e, path, &s->bodies[k]);
             s->body_count = k + 1;
         }
         size_t nj = 0;
-        const cJSON* je = cli_json_array(&j, root, "", "joints", RIGID_SCENE_MAX_JOINTS, &nj);
+        const cJSON* je = akp_json_array(&j, root, "", "joints", AK_RIGID_SCENE_MAX_JOINTS, &nj);
         if (!j.failed && nj > 0) {
             s->joints = calloc(nj, sizeof *s->joints);
-            if (!s->joints) cli_json_fail(&j, "", "joints", "out of memory");
+            if (!s->joints) akp_json_fail(&j, "", "joints", "out of memory");
         }
         for (size_t k = 0; je && !j.failed; je = je->next, ++k) {
             char path[48];
-            cli_json_index(path, sizeof path, "joints", k);
+            akp_json_index(path, sizeof path, "joints", k);
             parse_joint(&j, je, path, s->body_count, &s->joints[k]);
             s->joint_count = k + 1;
         }
         cJSON_Delete(root);
     }
-    if (j.failed || !root) {
-        snprintf(msg, cap, "%s", j.message[0] ? j.message : "invalid scene");
-        rigid_scene_free(s);
-        return false;
-    }
-    return true;
+    if (!j.failed && !root) akp_json_fail(&j, "", NULL, "invalid scene");
+    *jp = j;
+    if (j.failed) ak_rigid_scene_free(s);
+    return !j.failed;
 }
+
+ak_result ak_rigid_scene_load_bytes(const void* bytes, size_t size, const char* name, ak_rigid_scene* scene,
+                                    ak_diag* out_diag) {
+    if (!scene) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, name ? name : "(scene)", "no scene to fill");
+    akp_json j = {.file = name ? name : "(scene)"};
+    if (!bytes && size) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, j.file, "no bytes");
+    if (!parse(&j, bytes ? (const char*)bytes : "", size, scene)) return akp_json_diag(&j, AK_ERR_PARSE, out_diag);
+    if (out_diag) memset(out_diag, 0, sizeof *out_diag);
+    return AK_OK;
+}
+
+ak_result ak_rigid_scene_load_file(const char* path, ak_rigid_scene* scene, ak_diag* out_diag) {
+    if (!scene || !path) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, path ? path : "(scene)", "no path or scene");
+    akp_json j = {.file = path};
+    size_t size = 0;
+    char* text = akp_json_read_file(&j, path, AK_RIGID_SCENE_MAX_FILE_SIZE, &size);
+    if (!text) return akp_json_diag(&j, AK_ERR_IO, out_diag);
+    ak_result r = ak_rigid_scene_load_bytes(text, size, path, scene, out_diag);
+    free(text);
+    return r;
+}
+
+
 
 /* ---- presets --------------------------------------------------------------------------- */
 
-static bool presize(rigid_scene* s, size_t n) {
+static bool presize(ak_rigid_scene* s, size_t n) {
     s->bodies = calloc(n, sizeof *s->bodies);
     if (!s->bodies) return false;
     for (size_t i = 0; i < n; ++i) s->bodies[i] = body_default();
@@ -259,21 +284,20 @@ static void box(ak_rigid_body_desc* b, ak_vec3 he, ak_vec3 p) {
     b->position = p;
 }
 
-bool rigid_scene_preset(const char* name, rigid_scene* s) {
-    rigid_scene_defaults(s);
+static ak_result preset_fill(const char* name, ak_rigid_scene* s) {
     if (strcmp(name, "stack") == 0) {
         /* ten 1 m boxes on the ground */
-        if (!presize(s, 11)) return false;
+        if (!presize(s, 11)) return AK_ERR_NO_MEMORY;
         ground(&s->bodies[0]);
         for (int i = 0; i < 10; ++i)
             box(&s->bodies[1 + i], ak_vec3_make(0.5f, 0.5f, 0.5f),
                 ak_vec3_make(0.0f, 0.5f + (float)i, 0.0f));
-        return true;
+        return AK_OK;
     }
     if (strcmp(name, "pyramid") == 0) {
         /* 20 layers of 1 m boxes, 0.1 m apart: 210 boxes (the benchmark's scene) */
         const int layers = 20;
-        if (!presize(s, 1 + (size_t)(layers * (layers + 1) / 2))) return false;
+        if (!presize(s, 1 + (size_t)(layers * (layers + 1) / 2))) return AK_ERR_NO_MEMORY;
         ground(&s->bodies[0]);
         size_t k = 1;
         for (int l = 0; l < layers; ++l)
@@ -282,11 +306,11 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
                     ak_vec3_make(1.1f * ((float)i - 0.5f * (float)(layers - l - 1)),
                                  0.5f + (float)l, 0.0f));
         s->substeps = 40;
-        return true;
+        return AK_OK;
     }
     if (strcmp(name, "dominoes") == 0) {
         /* 20 dominoes 1 m tall, 0.5 m apart; the first is pushed at the top */
-        if (!presize(s, 21)) return false;
+        if (!presize(s, 21)) return AK_ERR_NO_MEMORY;
         ground(&s->bodies[0]);
         for (int i = 0; i < 20; ++i)
             box(&s->bodies[1 + i], ak_vec3_make(0.05f, 0.5f, 0.25f),
@@ -294,11 +318,11 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         s->bodies[1].angular_velocity = ak_vec3_make(0.0f, 0.0f, -2.0f);
         s->bodies[1].velocity = ak_vec3_make(1.0f, 0.0f, 0.0f);
         s->steps = 360;
-        return true;
+        return AK_OK;
     }
     if (strcmp(name, "avalanche") == 0) {
         /* 200 spheres, boxes and capsules poured on a 30 degree slope that ends on the ground */
-        if (!presize(s, 202)) return false;
+        if (!presize(s, 202)) return AK_ERR_NO_MEMORY;
         ground(&s->bodies[0]);
         ak_rigid_body_desc* slope = &s->bodies[1];
         slope->shape.type = AK_RIGID_PLANE;
@@ -328,22 +352,23 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
             b->restitution = 0.2f;
         }
         s->steps = 300;
-        return true;
+        return AK_OK;
     }
     if (strcmp(name, "ragdoll") == 0) {
         /* builtin:humanoid as a ragdoll, dropped from 1 m in the middle of its walk (the pose
          * and its velocities), onto the ground */
         ak_scene* sc = NULL;
         ak_builtin_desc bd = {.cell_size = 0.1f};
-        if (ak_builtin_create("humanoid", &bd, NULL, &sc) != AK_OK) return false;
+        ak_result r = ak_builtin_create("humanoid", &bd, NULL, &sc);
+        if (r != AK_OK) return r;
         const ak_skeleton* sk = sc->skeleton;
         size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk),
                nj = ak_rigid_ragdoll_joint_count(sk);
         ak_transform* pose = calloc(2 * n, sizeof *pose);
         ak_rigid_ragdoll_bone* bones = calloc(n, sizeof *bones);
         s->joints = calloc(nj + 1, sizeof *s->joints);
-        bool ok = pose && bones && s->joints && presize(s, nb + 1);
-        if (ok) {
+        r = pose && bones && s->joints && presize(s, nb + 1) ? AK_OK : AK_ERR_NO_MEMORY;
+        if (r == AK_OK) {
             ak_scene_rest_pose(sc, (ak_transform_span){pose, n});
             ak_scene_rest_pose(sc, (ak_transform_span){pose + n, n});
             if (sc->clip_count > 0) {
@@ -360,23 +385,22 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
                                         .previous_dt = s->dt,
                                         .root = ak_mat4_translation(ak_vec3_make(0.0f, 1.0f, 0.0f)),
                                         .body_offset = 1};
-            ok = ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){s->bodies + 1, nb},
-                                        (ak_rigid_joint_desc_span){s->joints, nj},
-                                        (ak_rigid_ragdoll_bone_span){bones, n}) == AK_OK;
+            r = ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){s->bodies + 1, nb},
+                                       (ak_rigid_joint_desc_span){s->joints, nj},
+                                       (ak_rigid_ragdoll_bone_span){bones, n});
             s->joint_count = nj;
         }
         free(pose);
         free(bones);
         ak_scene_destroy(sc);
-        if (!ok) rigid_scene_free(s);
         s->substeps = 40;
         s->steps = 180;
-        return ok;
+        return r;
     }
     if (strcmp(name, "incline") == 0) {
         /* a box at rest on a 30 degree slope with friction 0.3 (< tan 30 = 0.577): it slides at
          * g (sin 30 - 0.3 cos 30) = 2.36 m/s^2; a second with friction 0.7 stays */
-        if (!presize(s, 3)) return false;
+        if (!presize(s, 3)) return AK_ERR_NO_MEMORY;
         ak_vec3 n = ak_vec3_make(-sinf(0.5236f), cosf(0.5236f), 0.0f);
         ak_rigid_body_desc* slope = &s->bodies[0];
         slope->shape.type = AK_RIGID_PLANE;
@@ -394,7 +418,30 @@ bool rigid_scene_preset(const char* name, rigid_scene* s) {
         s->bodies[2].friction = 1.6f; /* sqrt(0.3 * 1.6) = 0.69 > 0.577 */
         s->sleep = false;
         s->steps = 120;
-        return true;
+        return AK_OK;
     }
-    return false;
+    return AK_ERR_NOT_FOUND;
+}
+
+static const char* const preset_names[] = {"stack", "pyramid", "dominoes", "avalanche", "ragdoll", "incline", NULL};
+
+const char* const* ak_rigid_scene_preset_names(size_t* out_count) {
+    if (out_count) *out_count = sizeof preset_names / sizeof preset_names[0] - 1;
+    return preset_names;
+}
+
+ak_result ak_rigid_scene_preset(const char* name, ak_rigid_scene* s, ak_diag* out_diag) {
+    if (!s || !name) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, "preset", "no name or scene");
+    ak_rigid_scene_defaults(s);
+    const ak_result r = preset_fill(name, s);
+    if (r != AK_OK) {
+        ak_rigid_scene_free(s);
+        ak_rigid_scene_defaults(s);
+        if (r == AK_ERR_NOT_FOUND)
+            return akp_diag_set(out_diag, r, name, "unknown preset (allowed: " AK_RIGID_SCENE_PRESETS ")");
+        if (r == AK_ERR_NO_MEMORY) return akp_diag_set(out_diag, r, name, "out of memory");
+        return akp_diag_set(out_diag, r, name, "the ragdoll's character cannot be built: %s", ak_result_string(r));
+    }
+    if (out_diag) memset(out_diag, 0, sizeof *out_diag);
+    return AK_OK;
 }
