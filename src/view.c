@@ -138,6 +138,80 @@ ak_vec4 ak_view_palette_color(size_t index) {
     return rgba(c[0], c[1], c[2], 1.0f);
 }
 
+/* OKLab (Ottosson 2020) -> linear sRGB. */
+static void oklab_to_linear(double L, double a, double b, double out[3]) {
+    double l_ = L + 0.3963377774 * a + 0.2158037573 * b;
+    double m_ = L - 0.1055613458 * a - 0.0638541728 * b;
+    double s_ = L - 0.0894841775 * a - 1.2914855480 * b;
+    double l = l_ * l_ * l_, m = m_ * m_ * m_, s = s_ * s_ * s_;
+    out[0] = 4.0767416621 * l - 3.3077115913 * m + 0.2309699292 * s;
+    out[1] = -1.2684380046 * l + 2.6097574011 * m - 0.3413193965 * s;
+    out[2] = -0.0041960863 * l - 0.7034186147 * m + 1.7076147010 * s;
+}
+
+/* The candidates (OKLab and sRGB) in a fixed order: lightness x chroma x hue, in gamut. */
+#define DISTINCT_GRID (5 * 3 * 24) /* lightness x chroma x hue; AK_VIEW_DISTINCT_COLOR_COUNT are in gamut */
+typedef struct distinct_candidates {
+    double lab[DISTINCT_GRID][3];
+    float rgb[DISTINCT_GRID][3];
+    double dmin[DISTINCT_GRID]; /* squared distance to the nearest chosen one */
+    int count;
+} distinct_candidates;
+
+static void distinct_fill(distinct_candidates* c) {
+    static const double Ls[5] = {0.50, 0.58, 0.66, 0.74, 0.82}, Cs[3] = {0.09, 0.14, 0.19};
+    c->count = 0;
+    for (int li = 0; li < 5; ++li)
+        for (int ci = 0; ci < 3; ++ci)
+            for (int hi = 0; hi < 24; ++hi) {
+                const double h = (double)hi * (2.0 * 3.14159265358979323846 / 24.0);
+                const double L = Ls[li], a = Cs[ci] * cos(h), b = Cs[ci] * sin(h);
+                double lin[3];
+                oklab_to_linear(L, a, b, lin);
+                if (lin[0] < 0.0 || lin[0] > 1.0 || lin[1] < 0.0 || lin[1] > 1.0 || lin[2] < 0.0 || lin[2] > 1.0) continue;
+                c->lab[c->count][0] = L, c->lab[c->count][1] = a, c->lab[c->count][2] = b;
+                for (int k = 0; k < 3; ++k) c->rgb[c->count][k] = ak_linear_to_srgb((float)lin[k]);
+                c->dmin[c->count] = INFINITY;
+                ++c->count;
+            }
+}
+
+ak_result ak_view_distinct_colors(ak_vec4_span out_colors) {
+    if (out_colors.count && !out_colors.ptr) return AK_ERR_NULL_ARG;
+    if (!out_colors.count) return AK_OK;
+    distinct_candidates c;
+    distinct_fill(&c);
+    /* start from the candidate nearest a mid blue (L 0.58, hue 255 degrees, chroma 0.14) */
+    const double b0[3] = {0.58, 0.14 * cos(4.45), 0.14 * sin(4.45)};
+    int pick = 0;
+    double best = INFINITY;
+    for (int i = 0; i < c.count; ++i) {
+        double d = 0;
+        for (int k = 0; k < 3; ++k) d += (c.lab[i][k] - b0[k]) * (c.lab[i][k] - b0[k]);
+        if (d < best) best = d, pick = i;
+    }
+    const size_t distinct = (size_t)c.count;
+    for (size_t n = 0; n < out_colors.count; ++n) {
+        if (n >= distinct) { /* every candidate used: repeat */
+            out_colors.ptr[n] = out_colors.ptr[n % distinct];
+            continue;
+        }
+        out_colors.ptr[n] = rgba(c.rgb[pick][0], c.rgb[pick][1], c.rgb[pick][2], 1.0f);
+        c.dmin[pick] = -1.0; /* taken */
+        int next = -1;
+        double far = -1.0;
+        for (int i = 0; i < c.count; ++i) {
+            if (c.dmin[i] < 0.0) continue;
+            double d = 0;
+            for (int k = 0; k < 3; ++k) d += (c.lab[i][k] - c.lab[pick][k]) * (c.lab[i][k] - c.lab[pick][k]);
+            if (d < c.dmin[i]) c.dmin[i] = d;
+            if (c.dmin[i] > far) far = c.dmin[i], next = i;
+        }
+        if (next >= 0) pick = next;
+    }
+    return AK_OK;
+}
+
 /* ---- scenes ----------------------------------------------------------------------------------- */
 
 ak_raster_mesh ak_view_raster_mesh(const ak_mesh* mesh) {

@@ -800,6 +800,59 @@ AK_TEST(weights_png_shows_every_bone) {
     AK_CHECK_EQ(run("weights builtin:humanoid --method distance --bone left_elbow -o one.png", true), 0);
 }
 
+/* CIE 1976 L*a*b* of sRGB bytes (D65), from the standards. */
+static void rgb8_to_lab(const uint8_t* px, double out[3]) {
+    double rgb[3], xyz[3];
+    for (int k = 0; k < 3; ++k) {
+        double c = px[k] / 255.0;
+        rgb[k] = c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+    }
+    xyz[0] = (0.4124 * rgb[0] + 0.3576 * rgb[1] + 0.1805 * rgb[2]) / 0.95047;
+    xyz[1] = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    xyz[2] = (0.0193 * rgb[0] + 0.1192 * rgb[1] + 0.9505 * rgb[2]) / 1.08883;
+    for (int k = 0; k < 3; ++k) xyz[k] = xyz[k] > 216.0 / 24389.0 ? cbrt(xyz[k]) : (24389.0 / 27.0 * xyz[k] + 16.0) / 116.0;
+    out[0] = 116.0 * xyz[1] - 16.0, out[1] = 500.0 * (xyz[0] - xyz[1]), out[2] = 200.0 * (xyz[1] - xyz[2]);
+}
+
+/* Issue 33 item 7 (slow: three weight computations; tests/test_view.c checks the palette itself
+ * fast): the dominant-bone legend gave spine_02 and right_knee, left_elbow and
+ * right_hip the same colour. Now no two legend swatches of builtin:humanoid or CesiumMan are
+ * closer than 15 CIE76 units (the swatches are the 9x9 squares at x = 10, y = 40 + 12 row). */
+AK_TEST(weights_legend_colours_distinct) {
+    char path[1100], args[1300];
+    const char* subjects[2] = {"builtin:humanoid", NULL};
+    if (ak_test_asset(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) subjects[1] = path;
+    for (int s = 0; s < 2 && subjects[s]; ++s) {
+        snprintf(args, sizeof args, "weights %s --method distance -o legend.png", subjects[s]);
+        AK_CHECK_EQ(run(args, true), 0);
+        ak_image img;
+        AK_CHECK(load_png("legend.png", &img));
+        if (!img.pixels) return;
+        double lab[64][3];
+        int rows = 0;
+        for (; rows < 48; ++rows) { /* swatches until the background (grey-blue, unsaturated) */
+            const uint8_t* px = ak_image_pixel(&img, 14, 44 + 12 * rows);
+            int mx = px[0] > px[1] ? (px[0] > px[2] ? px[0] : px[2]) : (px[1] > px[2] ? px[1] : px[2]);
+            int mn = px[0] < px[1] ? (px[0] < px[2] ? px[0] : px[2]) : (px[1] < px[2] ? px[1] : px[2]);
+            if (mx - mn < 40) break;
+            rgb8_to_lab(px, lab[rows]);
+        }
+        free(img.pixels);
+        AK_CHECK_MSG(rows >= 10, "%s: %d legend swatches", subjects[s], rows);
+        double worst = 1e9;
+        int wi = 0, wj = 0;
+        for (int i = 0; i < rows; ++i)
+            for (int j = 0; j < i; ++j) {
+                double d = sqrt((lab[i][0] - lab[j][0]) * (lab[i][0] - lab[j][0]) + (lab[i][1] - lab[j][1]) * (lab[i][1] - lab[j][1]) +
+                                (lab[i][2] - lab[j][2]) * (lab[i][2] - lab[j][2]));
+                if (d < worst) worst = d, wi = i, wj = j;
+            }
+        AK_CHECK_MSG(worst > 15.0, "%s: legend rows %d and %d are %.1f CIE76 units apart", subjects[s], wj, wi, worst);
+    }
+    if (!subjects[1]) AK_SKIP("CesiumMan.glb absent (set ANIMKIT_ASSETS)");
+    remove("legend.png");
+}
+
 /* Item 3: curves --channel and --page. */
 AK_TEST(curves_select_and_paginate) {
     AK_CHECK_EQ(run("curves builtin:humanoid --clip walk --channel 0,2 -o sel.png", true), 0);
@@ -980,6 +1033,7 @@ int main(void) {
     AK_RUN(export_without_mesh_fails);
     AK_RUN_SLOW(render_camera_options);
     AK_RUN(weights_png_shows_every_bone);
+    AK_RUN_SLOW(weights_legend_colours_distinct);
     AK_RUN_SLOW(curves_select_and_paginate);
     AK_RUN(render_obj_characters);
     AK_RUN(messages_round_two);

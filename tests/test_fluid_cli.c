@@ -196,6 +196,38 @@ AK_TEST(obj_surface) {
     cJSON_Delete(root);
 }
 
+/* Issue 33 item 7: the tank's walls were invisible. The box [0,1]^3 with a small block on its
+ * floor, rendered at step 0: the middles of the top rim's four edges (nothing but air there)
+ * are drawn as dark lines. The camera
+ * is the renderer's: eye = centre + 1.1 |diagonal| (0.45, 0.55, 1), fovy 0.7, 800 x 600. */
+AK_TEST(tank_walls_drawn) {
+    write_file("fluid_tank.json", "{\"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]},"
+                                  " \"blocks\": [{\"min\": [0.45, 0, 0.45], \"max\": [0.5, 0.05, 0.5]}]}");
+    AK_CHECK_EQ(run("fluid fluid_tank.json --steps 0 -o tank.png", true), 0);
+    const int w = 800, h = 600;
+    static uint8_t px[800 * 600 * 4];
+    ak_image img = {.pixels = px, .width = w, .height = h};
+    AK_CHECK_EQ(ak_png_read("tank.png", &img), AK_OK);
+    const ak_vec3 c = {0.5f, 0.5f, 0.5f};
+    const float ext = sqrtf(3.0f);
+    ak_vec3 eye = ak_vec3_add(c, ak_vec3_scale(ak_vec3_make(0.45f, 0.55f, 1.0f), 1.1f * ext));
+    ak_raster_camera cam = ak_raster_camera_perspective(eye, c, 0.7f, (float)w / (float)h, 0.01f * ext, 10.0f * ext);
+    const ak_vec3 rim[4] = {{0.5f, 1, 0}, {0.5f, 1, 1}, {0, 1, 0.5f}, {1, 1, 0.5f}};
+    for (int k = 0; k < 4; ++k) {
+        ak_vec3 q;
+        AK_CHECK(ak_raster_camera_project(&cam, w, h, rim[k], &q));
+        int darkest = 255; /* within a pixel of the projected point (the line is 2 px wide) */
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const uint8_t* p = ak_image_pixel(&img, (int)q.x + dx, (int)q.y + dy);
+                int luma = (p[0] + p[1] + p[2]) / 3;
+                darkest = luma < darkest ? luma : darkest;
+            }
+        AK_CHECK_MSG(darkest < 140, "rim edge %d: darkest pixel %d (background is about 220)", k, darkest);
+    }
+    remove("fluid_tank.json"), remove("tank.png");
+}
+
 int main(void) {
     AK_RUN(dam_json_contract);
     AK_RUN(scene_files);
@@ -203,5 +235,6 @@ int main(void) {
     AK_RUN(json_pressure_is_hydrostatic);
     AK_RUN(bad_usage);
     AK_RUN(obj_surface);
+    AK_RUN(tank_walls_drawn);
     return ak_test_finish();
 }

@@ -710,6 +710,65 @@ AK_TEST(lennard_jones_work_budget) {
     ak_particles_destroy(ps);
 }
 
+/* Colour and size over life at known ages, worked out by hand from the keys; frames. */
+AK_TEST(look_over_life) {
+    ak_particle_look look = {
+        .colour_keys = {{0.0f, {1, 1, 0, 1}}, {0.25f, {1, 0.5f, 0, 0.8f}}, {1.0f, {0.2f, 0.2f, 0.2f, 0}}},
+        .colour_key_count = 3,
+        .size_keys = {{0.1f, 0.5f}, {0.5f, 2.0f}},
+        .size_key_count = 2,
+        .frame_count = 16,
+    };
+    AK_CHECK_EQ(ak_particle_look_validate(&look), AK_OK);
+    const float life = 2.0f;
+    /* age 0.25 s: t = 0.125, half way between keys 0 and 1 */
+    ak_vec4 c = ak_particle_look_colour(&look, 0.25f, life);
+    AK_CHECK_NEAR(c.x, 1.0f, 1e-6);
+    AK_CHECK_NEAR(c.y, 0.75f, 1e-6);
+    AK_CHECK_NEAR(c.w, 0.9f, 1e-6);
+    /* age 1.25 s: t = 0.625 = 0.25 + 0.5 * 0.75 */
+    c = ak_particle_look_colour(&look, 1.25f, life);
+    AK_CHECK_NEAR(c.x, 0.6f, 1e-6);
+    AK_CHECK_NEAR(c.y, 0.35f, 1e-6);
+    AK_CHECK_NEAR(c.z, 0.1f, 1e-6);
+    AK_CHECK_NEAR(c.w, 0.4f, 1e-6);
+    /* past the end of life: held at the last key */
+    c = ak_particle_look_colour(&look, 5.0f, life);
+    AK_CHECK_NEAR(c.w, 0.0f, 1e-7);
+    /* size: held before the first key (t = 0.05), linear after (t = 0.3 -> 0.5 + 1.5 * 0.5) */
+    AK_CHECK_NEAR(ak_particle_look_size(&look, 0.1f, life), 0.5f, 1e-6);
+    AK_CHECK_NEAR(ak_particle_look_size(&look, 0.6f, life), 1.25f, 1e-6);
+    AK_CHECK_NEAR(ak_particle_look_size(&look, 1.9f, life), 2.0f, 1e-6);
+    /* no keys, NULL, infinite lifetime (t = 0) */
+    AK_CHECK_NEAR(ak_particle_look_size(NULL, 1.0f, life), 1.0f, 0);
+    ak_particle_look plain = {0};
+    AK_CHECK_NEAR(ak_particle_look_colour(&plain, 1.0f, life).y, 1.0f, 0);
+    AK_CHECK_NEAR(ak_particle_look_colour(&look, 7.0f, INFINITY).y, 1.0f, 0);
+    /* frames spread over the lifetime: t = 0.5 -> 8; the last instant stays on 15 */
+    AK_CHECK_EQ(ak_particle_look_frame(&look, 1.0f, life), 8u);
+    AK_CHECK_EQ(ak_particle_look_frame(&look, 0.0f, life), 0u);
+    AK_CHECK_EQ(ak_particle_look_frame(&look, 1.99f, life), 15u);
+    AK_CHECK_EQ(ak_particle_look_frame(&look, 2.0f, life), 15u);
+    /* at a frame rate, looping: 24 fps, 1.0 s -> frame 24 mod 16 = 8; 0.49 s -> 11 */
+    look.frame_rate = 24.0f;
+    AK_CHECK_EQ(ak_particle_look_frame(&look, 1.0f, life), 8u);
+    AK_CHECK_EQ(ak_particle_look_frame(&look, 0.49f, life), 11u);
+    /* validation */
+    ak_particle_look bad = look;
+    bad.size_keys[1].t = 0.05f; /* not increasing */
+    AK_CHECK_EQ(ak_particle_look_validate(&bad), AK_ERR_BAD_ARG);
+    bad = look;
+    bad.colour_key_count = AK_PARTICLE_LOOK_MAX_KEYS + 1;
+    AK_CHECK_EQ(ak_particle_look_validate(&bad), AK_ERR_BAD_ARG);
+    bad = look;
+    bad.colour_keys[0].colour.x = NAN;
+    AK_CHECK_EQ(ak_particle_look_validate(&bad), AK_ERR_BAD_ARG);
+    bad = look;
+    bad.frame_rate = -1.0f;
+    AK_CHECK_EQ(ak_particle_look_validate(&bad), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_particle_look_validate(NULL), AK_ERR_NULL_ARG);
+}
+
 int main(void) {
     AK_RUN(projectile_closed_forms);
     AK_RUN(convergence_orders);
@@ -728,5 +787,6 @@ int main(void) {
     AK_RUN_SLOW(determinism_and_threads);
     AK_RUN(fused_path_any_split);
     AK_RUN(validation_codes);
+    AK_RUN(look_over_life);
     return ak_test_finish();
 }

@@ -2,6 +2,7 @@
  * path, the --json keys and order) with results checked against closed forms. */
 #include <animkit/animkit.h>
 #include <cjson/cJSON.h>
+#include <unistd.h> /* rmdir */
 
 #include "ak_test.h"
 #include "cli_test.h"
@@ -26,6 +27,12 @@ AK_TEST(bad_scenes_exit_1_with_path) {
         {"{\"planes\": [{\"n\": [0, 0, 0]}]}", "planes[0].n"},
         {"{\"particles\": [{\"m\": 1, \"m\": 2}]}", "particles[0]"},
         {"[1, 2]", "top level"},
+        {"{\"render\": {\"style\": \"blobs\"}}", "render.style"},
+        {"{\"render\": {\"texture\": \"fire.jpg\"}}", "render.texture"},
+        {"{\"render\": {\"sheet\": [2.5, 1]}}", "render.sheet"},
+        {"{\"render\": {\"colour_over_life\": [[0.5, 1, 1, 1, 1], [0.2, 1, 1, 1, 1]]}}",
+         "render.colour_over_life[1]"},
+        {"{\"render\": {\"size_over_life\": [[0, 1, 2]]}}", "render.size_over_life[0]"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         write_file("particles_bad.json", cases[k].text);
@@ -145,9 +152,74 @@ AK_TEST(single_particle_is_framed) {
     remove("particles_one.json"), remove("one.png");
 }
 
+/* Count pixels of an image file near an sRGB colour (each channel within 40 levels). */
+static int count_colour(const char* path, int w, int h, int r, int g, int b) {
+    static uint8_t px[200 * 150 * 4];
+    const ak_image img = {.pixels = px, .width = w, .height = h};
+    if (w * h > 200 * 150 || ak_png_read(path, &img) != AK_OK) return -1;
+    int n = 0;
+    for (int i = 0; i < w * h; ++i)
+        n += abs(px[4 * i] - r) < 40 && abs(px[4 * i + 1] - g) < 40 && abs(px[4 * i + 2] - b) < 40;
+    return n;
+}
+
+AK_TEST(scene_sprites_colour_and_sheet_over_life) {
+    /* A white pinned particle of lifetime 1 s drawn as a sprite: its colour comes from the
+     * colour_over_life key (blue), and with a 2-frame PNG sheet (red | green, relative to the
+     * scene file) the frame follows the age: frame 0 before t = 0.5, frame 1 after. */
+    write_file("particles_sprite.json",
+               "{\"particles\": [{\"m\": 0, \"p\": [0, 1, 0], \"size\": 0.15, \"lifetime\": 1}],"
+               " \"render\": {\"style\": \"sprites\", \"colour_over_life\": [[0, 0, 0, 1, 1]]}}");
+    AK_CHECK_EQ(run("particles particles_sprite.json --steps 10 --size 160x120 -o sprite_blue.png", true), 0);
+    int blue = count_colour("sprite_blue.png", 160, 120, 0, 0, 255);
+    AK_CHECK_MSG(blue >= 20, "%d blue pixels", blue);
+    /* cut-outs: alpha-tested, so every drawn pixel has the full colour (none half blended) */
+    write_file("particles_cutout.json",
+               "{\"particles\": [{\"m\": 0, \"p\": [0, 1, 0], \"size\": 0.15}],"
+               " \"render\": {\"style\": \"sprites\", \"blend\": \"cutout\", \"colour_over_life\": [[0, 0, 0, 1, 1]]}}");
+    AK_CHECK_EQ(run("particles particles_cutout.json --steps 1 --size 160x120 -o sprite_cut.png", true), 0);
+    static uint8_t cut_px[160 * 120 * 4];
+    const ak_image cut = {.pixels = cut_px, .width = 160, .height = 120};
+    AK_CHECK_EQ(ak_png_read("sprite_cut.png", &cut), AK_OK);
+    int full = 0, partial = 0;
+    for (int i = 0; i < 160 * 120; ++i) {
+        const uint8_t* p = cut_px + 4 * i;
+        if (p[2] > 2 * p[0] + 40 && p[2] > 2 * p[1] + 40) { /* clearly blue: sprite pixels */
+            if (p[0] <= 2 && p[1] <= 2 && p[2] >= 253) ++full;
+            else ++partial;
+        }
+    }
+    AK_CHECK_MSG(full >= 20 && partial <= full / 4, "cut-out: %d full and %d partly blue pixels", full, partial);
+    remove("particles_cutout.json"), remove("sprite_cut.png");
+    uint8_t sheet_px[2 * 8 * 8 * 4];
+    ak_image sheet = {.pixels = sheet_px, .width = 16, .height = 8};
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 16; ++x) {
+            uint8_t* p = ak_image_pixel(&sheet, x, y);
+            p[0] = x < 8 ? 255 : 0, p[1] = x < 8 ? 0 : 255, p[2] = 0, p[3] = 255;
+        }
+    mkdir("sprite_dir", 0755);
+    AK_CHECK_EQ(ak_png_write("sprite_dir/sheet.png", &sheet), AK_OK);
+    write_file("sprite_dir/s.json",
+               "{\"particles\": [{\"m\": 0, \"p\": [0, 1, 0], \"size\": 0.15, \"lifetime\": 1}],"
+               " \"render\": {\"style\": \"sprites\", \"texture\": \"sheet.png\", \"sheet\": [2, 1]}}");
+    AK_CHECK_EQ(run("particles sprite_dir/s.json --steps 20 --size 160x120 -o sprite_f0.png", true), 0);
+    AK_CHECK_EQ(run("particles sprite_dir/s.json --steps 70 --size 160x120 -o sprite_f1.png", true), 0);
+    int r0 = count_colour("sprite_f0.png", 160, 120, 255, 0, 0), g0 = count_colour("sprite_f0.png", 160, 120, 0, 255, 0);
+    int r1 = count_colour("sprite_f1.png", 160, 120, 255, 0, 0), g1 = count_colour("sprite_f1.png", 160, 120, 0, 255, 0);
+    AK_CHECK_MSG(r0 >= 20 && g0 == 0, "age 0.2 s: %d red, %d green pixels", r0, g0);
+    AK_CHECK_MSG(g1 >= 20 && r1 == 0, "age 0.7 s: %d red, %d green pixels", r1, g1);
+    /* a missing sheet is a one-line error naming the file */
+    write_file("sprite_dir/m.json", "{\"render\": {\"style\": \"sprites\", \"texture\": \"nope.png\"}}");
+    AK_CHECK_EQ(run("particles sprite_dir/m.json --steps 1 -o sprite_m.png", true), 1);
+    AK_CHECK_MSG(strstr(out_buf, "sprite_dir/nope.png") != NULL, "%s", out_buf);
+    remove("particles_sprite.json"), remove("sprite_blue.png"), remove("sprite_f0.png"), remove("sprite_f1.png");
+    remove("sprite_dir/s.json"), remove("sprite_dir/m.json"), remove("sprite_dir/sheet.png"), rmdir("sprite_dir");
+}
+
 AK_TEST(presets_run_and_render) {
-    const char* presets[] = {"fountain", "rain", "fireworks", "character"};
-    for (int k = 0; k < 4; ++k) {
+    const char* presets[] = {"fountain", "rain", "fireworks", "character", "fire", "smoke"};
+    for (int k = 0; k < 6; ++k) {
         char args[256];
         snprintf(
             args, sizeof args,
@@ -184,6 +256,7 @@ int main(void) {
     AK_RUN(json_matches_closed_form);
     AK_RUN(springs_survive_a_death);
     AK_RUN(single_particle_is_framed);
+    AK_RUN(scene_sprites_colour_and_sheet_over_life);
     AK_RUN(presets_run_and_render);
     return ak_test_finish();
 }

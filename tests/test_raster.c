@@ -956,6 +956,157 @@ AK_TEST(gif_delta_frames) {
     }
 }
 
+/* ---- sprites ------------------------------------------------------------------------------- */
+
+/* A w x h texture of one opaque colour per sprite-sheet frame (cols x rows frames). */
+static uint8_t* sheet_make(ak_image* img, int cols, int rows, int fw, int fh) {
+    img->width = cols * fw, img->height = rows * fh, img->stride = 0;
+    img->pixels = (uint8_t*)calloc((size_t)img->width * (size_t)img->height * 4, 1);
+    if (!img->pixels) return NULL;
+    for (int y = 0; y < img->height; ++y)
+        for (int x = 0; x < img->width; ++x) {
+            int f = (y / fh) * cols + x / fw;
+            uint8_t* p = ak_image_pixel(img, x, y);
+            p[0] = (uint8_t)(20 * f), p[1] = (uint8_t)(250 - 20 * f), p[2] = (uint8_t)(7 * f), p[3] = 255;
+        }
+    return img->pixels;
+}
+
+AK_TEST(sprite_billboard_faces_the_camera) {
+    /* An oblique camera: the quad must still project to an axis-aligned square of side
+     * size * (H / 2) / (d tan(fovy / 2)) pixels centred on the image centre (pinhole formula). */
+    enum { W = 96, H = 96 };
+    target t;
+    AK_CHECK(target_make(&t, W, H, 1, 1));
+    const ak_vec3 eye = ak_vec3_make(3, 2, 4);
+    const double d = sqrt(9.0 + 4.0 + 16.0), fovy = 40.0 * 3.14159265358979323846 / 180.0, size = 0.6;
+    ak_raster_camera cam = ak_raster_camera_perspective(eye, ak_vec3_zero(), (float)fovy, 1, 0.1f, 20);
+    ak_raster_clear(t.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+    uint8_t tex_px[4 * 4 * 4];
+    ak_image tex = {.pixels = tex_px, .width = 4, .height = 4};
+    AK_CHECK_EQ(ak_sprite_texture_generate(AK_SPRITE_TEXTURE_SOLID, 0, &tex), AK_OK);
+    ak_vec3 p = ak_vec3_zero();
+    ak_raster_sprites sp = {.positions = {&p, 1}, .size = (float)size, .texture = &tex, .blend = AK_BLEND_OPAQUE};
+    AK_CHECK_EQ(ak_raster_draw_sprites(t.r, &cam, &sp), AK_OK);
+    ak_raster_resolve(t.r, &t.img);
+    int x0 = W, x1 = -1, y0 = H, y1 = -1, n = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x)
+            if (at(&t, x, y)[0] > 128) {
+                x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1, y0 = y < y0 ? y : y0, y1 = y > y1 ? y : y1;
+                ++n;
+            }
+    const double side = size * (H / 2.0) / (d * tan(fovy / 2.0));
+    AK_CHECK_NEAR((double)(x1 - x0 + 1), side, 1.0);
+    AK_CHECK_NEAR((double)(y1 - y0 + 1), side, 1.0);
+    AK_CHECK_EQ(n, (x1 - x0 + 1) * (y1 - y0 + 1)); /* a filled axis-aligned rectangle */
+    AK_CHECK_NEAR(0.5 * (x0 + x1 + 1), W / 2.0, 0.75);
+    AK_CHECK_NEAR(0.5 * (y0 + y1 + 1), H / 2.0, 0.75);
+    target_free(&t);
+}
+
+AK_TEST(sprite_blending_back_to_front) {
+    /* Three half-transparent sprites at one pixel, given front to back: sorted, the result is
+     * the over-composite of the known colours far to near, computed here; unsorted it is not. */
+    target t;
+    AK_CHECK(target_make(&t, 32, 32, 1, 1));
+    ak_raster_camera cam = ak_raster_camera_perspective(ak_vec3_make(0, 0, 5), ak_vec3_zero(), ak_radians(50), 1, 0.1f, 20);
+    uint8_t tex_px[2 * 2 * 4];
+    ak_image tex = {.pixels = tex_px, .width = 2, .height = 2};
+    AK_CHECK_EQ(ak_sprite_texture_generate(AK_SPRITE_TEXTURE_SOLID, 0, &tex), AK_OK);
+    ak_vec3 pos[3] = {{0, 0, 1}, {0, 0, 0}, {0, 0, -1}}; /* near, middle, far */
+    ak_vec4 col[3] = {{1, 0, 0, 0.5f}, {0, 1, 0, 0.6f}, {0, 0, 1, 0.7f}};
+    float depth[3];
+    uint32_t order[3];
+    AK_CHECK_EQ(ak_raster_sprites_sort(&cam, (ak_vec3_cspan){pos, 3}, (ak_f32_span){depth, 3}, (ak_u32_span){order, 3}), AK_OK);
+    AK_CHECK_EQ(order[0], 2u);
+    AK_CHECK_EQ(order[1], 1u);
+    AK_CHECK_EQ(order[2], 0u);
+    const double bg[3] = {40, 80, 120};
+    double expect[3] = {bg[0], bg[1], bg[2]};
+    for (int k = 2; k >= 0; --k) { /* far to near, in doubles on 0..255 */
+        const double c[3] = {col[k].x * 255.0, col[k].y * 255.0, col[k].z * 255.0}, a = col[k].w;
+        for (int ch = 0; ch < 3; ++ch) expect[ch] = c[ch] * a + expect[ch] * (1.0 - a);
+    }
+    for (int sorted = 0; sorted < 2; ++sorted) {
+        ak_vec4 b = ak_vec4_make(40.0f / 255.0f, 80.0f / 255.0f, 120.0f / 255.0f, 1);
+        ak_raster_clear(t.r, b, b);
+        ak_raster_sprites sp = {.positions = {pos, 3}, .size = 1.0f, .colors = {col, 3}, .texture = &tex};
+        if (sorted) sp.order = (ak_u32_cspan){order, 3};
+        AK_CHECK_EQ(ak_raster_draw_sprites(t.r, &cam, &sp), AK_OK);
+        ak_raster_resolve(t.r, &t.img);
+        const uint8_t* px = at(&t, 16, 16);
+        double err = 0;
+        for (int ch = 0; ch < 3; ++ch) err = fmax(err, fabs(px[ch] - expect[ch]));
+        if (sorted) AK_CHECK_MSG(err <= 2.0, "sorted composite off by %.1f levels", err);
+        else AK_CHECK_MSG(err > 20.0, "the unsorted order should differ (off by only %.1f)", err);
+    }
+    /* depth tested against opaque geometry: a sprite behind an opaque triangle is hidden */
+    ak_raster_clear(t.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+    ak_vec3 tri[3] = {{-2, -2, 0}, {2, -2, 0}, {0, 2, 0}};
+    ak_raster_mesh m = unlit_tri(tri, ak_vec4_make(0, 0, 1, 1));
+    AK_CHECK_EQ(ak_raster_draw_mesh(t.r, &cam, &m), AK_OK);
+    ak_vec3 behind = {0, 0, -1}, front = {0.3f, 0, 1};
+    ak_vec4 red = {1, 0, 0, 1};
+    ak_raster_sprites hidden = {.positions = {&behind, 1}, .size = 0.5f, .color = red, .texture = &tex};
+    AK_CHECK_EQ(ak_raster_draw_sprites(t.r, &cam, &hidden), AK_OK);
+    ak_raster_resolve(t.r, &t.img);
+    AK_CHECK_EQ(at(&t, 16, 16)[0], 0);
+    AK_CHECK_EQ(at(&t, 16, 16)[2], 255);
+    ak_raster_sprites shown = {.positions = {&front, 1}, .size = 0.5f, .color = red, .texture = &tex};
+    AK_CHECK_EQ(ak_raster_draw_sprites(t.r, &cam, &shown), AK_OK);
+    ak_vec3 fp;
+    AK_CHECK(ak_raster_camera_project(&cam, 32, 32, front, &fp));
+    ak_raster_resolve(t.r, &t.img);
+    AK_CHECK_EQ(at(&t, (int)fp.x, (int)fp.y)[0], 255);
+    target_free(&t);
+}
+
+AK_TEST(sprite_sheet_frame_and_textures) {
+    target t;
+    AK_CHECK(target_make(&t, 32, 32, 1, 1));
+    ak_raster_camera cam = ak_raster_camera_perspective(ak_vec3_make(0, 0, 3), ak_vec3_zero(), ak_radians(50), 1, 0.1f, 20);
+    ak_image sheet;
+    AK_CHECK(sheet_make(&sheet, 4, 2, 8, 8) != NULL);
+    ak_vec3 p = ak_vec3_zero();
+    for (uint32_t f = 0; f < 10; ++f) { /* 8 frames: 8 and 9 wrap to 0 and 1 */
+        ak_raster_clear(t.r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+        ak_raster_sprites sp = {.positions = {&p, 1}, .size = 1.0f, .frames = {&f, 1}, .texture = &sheet,
+                                .sheet_columns = 4, .sheet_rows = 2};
+        AK_CHECK_EQ(ak_raster_draw_sprites(t.r, &cam, &sp), AK_OK);
+        ak_raster_resolve(t.r, &t.img);
+        const uint8_t* px = at(&t, 16, 16);
+        const int k = (int)(f % 8);
+        AK_CHECK_MSG(px[0] == 20 * k && px[1] == 250 - 20 * k && px[2] == 7 * k, "frame %u: got %d %d %d", f, px[0], px[1],
+                     px[2]);
+    }
+    free(sheet.pixels);
+    /* the soft disc: alpha (1 - r^2)^2, r from the texel centre */
+    uint8_t dpx[16 * 16 * 4];
+    ak_image disc = {.pixels = dpx, .width = 16, .height = 16};
+    AK_CHECK_EQ(ak_sprite_texture_generate(AK_SPRITE_TEXTURE_DISC, 0, &disc), AK_OK);
+    for (int y = 0; y < 16; y += 3)
+        for (int x = 0; x < 16; x += 3) {
+            double u = 2.0 * (x + 0.5) / 16.0 - 1.0, v = 2.0 * (y + 0.5) / 16.0 - 1.0, r2 = u * u + v * v;
+            double a = r2 < 1.0 ? (1.0 - r2) * (1.0 - r2) : 0.0;
+            AK_CHECK_NEAR((double)ak_image_pixel(&disc, x, y)[3], a * 255.0, 0.6);
+        }
+    uint8_t ppx[32 * 32 * 4];
+    ak_image puff = {.pixels = ppx, .width = 32, .height = 32};
+    AK_CHECK_EQ(ak_sprite_texture_generate(AK_SPRITE_TEXTURE_PUFF, 3, &puff), AK_OK);
+    AK_CHECK(ak_image_pixel(&puff, 16, 16)[3] > 60);  /* dense middle */
+    AK_CHECK_EQ(ak_image_pixel(&puff, 0, 0)[3], 0);   /* clear corners */
+    /* bad input */
+    AK_CHECK_EQ(ak_sprite_texture_generate(AK_SPRITE_TEXTURE_COUNT, 0, &puff), AK_ERR_BAD_ARG);
+    uint32_t bad = 1;
+    ak_raster_sprites sp = {.positions = {&p, 1}, .order = {&bad, 1}};
+    AK_CHECK_EQ(ak_raster_draw_sprites(t.r, &cam, &sp), AK_ERR_BAD_INDEX);
+    float nan_size = NAN;
+    ak_raster_sprites nan_sp = {.positions = {&p, 1}, .sizes = {&nan_size, 1}};
+    AK_CHECK_EQ(ak_raster_draw_sprites(t.r, &cam, &nan_sp), AK_OK); /* skipped, not drawn */
+    target_free(&t);
+}
+
 int main(void) {
     AK_RUN(coverage_matches_point_in_triangle);
     AK_RUN(shared_edges_quad_and_fan_cover_once);
@@ -977,5 +1128,8 @@ int main(void) {
     AK_RUN(gif_delta_frames);
     AK_RUN(truncated_files_give_errors_not_crashes);
     AK_RUN(bad_input_codes);
+    AK_RUN(sprite_billboard_faces_the_camera);
+    AK_RUN(sprite_blending_back_to_front);
+    AK_RUN(sprite_sheet_frame_and_textures);
     return ak_test_finish();
 }

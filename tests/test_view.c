@@ -303,6 +303,52 @@ AK_TEST(plot_readable_dense_keys_noise_titles) {
     AK_CHECK_MSG(ink > 50 && ink_edge == 0, "title ink %d, at the edges %d", ink, ink_edge);
 }
 
+/* CIE 1976 L*a*b* of an sRGB colour (D65), written out here from the standards. */
+static void srgb_to_lab(ak_vec4 c, double out[3]) {
+    double rgb[3] = {c.x, c.y, c.z};
+    for (int k = 0; k < 3; ++k) rgb[k] = rgb[k] <= 0.04045 ? rgb[k] / 12.92 : pow((rgb[k] + 0.055) / 1.055, 2.4);
+    double xyz[3] = {(0.4124 * rgb[0] + 0.3576 * rgb[1] + 0.1805 * rgb[2]) / 0.95047,
+                     0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2],
+                     (0.0193 * rgb[0] + 0.1192 * rgb[1] + 0.9505 * rgb[2]) / 1.08883};
+    for (int k = 0; k < 3; ++k) xyz[k] = xyz[k] > 216.0 / 24389.0 ? cbrt(xyz[k]) : (24389.0 / 27.0 * xyz[k] + 16.0) / 116.0;
+    out[0] = 116.0 * xyz[1] - 16.0, out[1] = 500.0 * (xyz[0] - xyz[1]), out[2] = 200.0 * (xyz[1] - xyz[2]);
+}
+
+static double delta_e(ak_vec4 a, ak_vec4 b) {
+    double p[3], q[3];
+    srgb_to_lab(a, p), srgb_to_lab(b, q);
+    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+}
+
+/* The legend palette: for 24 colours (the humanoid and CesiumMan skins have 21 and 23 bones)
+ * every pair differs by more than 15 CIE76 units (the golden-angle hues it replaces, at one
+ * saturation and value, put slots 13 apart only 12 degrees of hue from each other);
+ * consecutive colours by more than 20; none is grey; the first k do not depend on the count;
+ * they repeat only after AK_VIEW_DISTINCT_COLOR_COUNT. */
+AK_TEST(distinct_colors_for_legends) {
+    static ak_vec4 c[AK_VIEW_DISTINCT_COLOR_COUNT + 2];
+    AK_CHECK_EQ(ak_view_distinct_colors((ak_vec4_span){c, AK_VIEW_DISTINCT_COLOR_COUNT + 2}), AK_OK);
+    double worst = 1e9, worst_next = 1e9;
+    for (int i = 0; i < 24; ++i) {
+        for (int j = 0; j < i; ++j) worst = fmin(worst, delta_e(c[i], c[j]));
+        if (i) worst_next = fmin(worst_next, delta_e(c[i], c[i - 1]));
+        double lab[3];
+        srgb_to_lab(c[i], lab);
+        AK_CHECK_MSG(hypot(lab[1], lab[2]) > 15.0, "colour %d is greyish (chroma %.1f)", i, hypot(lab[1], lab[2]));
+    }
+    AK_CHECK_MSG(worst > 15.0, "closest pair of 24: %.1f", worst);
+    AK_CHECK_MSG(worst_next > 20.0, "closest consecutive pair: %.1f", worst_next);
+    for (int i = 0; i < AK_VIEW_DISTINCT_COLOR_COUNT; ++i)
+        for (int j = 0; j < i; ++j)
+            AK_CHECK_MSG(delta_e(c[i], c[j]) > 1.0, "colours %d and %d are the same", i, j);
+    AK_CHECK(c[AK_VIEW_DISTINCT_COLOR_COUNT].x == c[0].x && c[AK_VIEW_DISTINCT_COLOR_COUNT + 1].z == c[1].z);
+    ak_vec4 few[5];
+    AK_CHECK_EQ(ak_view_distinct_colors((ak_vec4_span){few, 5}), AK_OK);
+    for (int i = 0; i < 5; ++i) AK_CHECK(few[i].x == c[i].x && few[i].y == c[i].y && few[i].z == c[i].z);
+    AK_CHECK_EQ(ak_view_distinct_colors((ak_vec4_span){NULL, 3}), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_view_distinct_colors((ak_vec4_span){NULL, 0}), AK_OK);
+}
+
 int main(void) {
     AK_RUN(orbit_framing_keeps_box_inside);
     AK_RUN(heatmap_endpoints_and_mapping);
@@ -311,5 +357,6 @@ int main(void) {
     AK_RUN(plot_draws_at_mapped_pixels);
     AK_RUN(scene_render_skeleton_and_gif);
     AK_RUN(plot_readable_dense_keys_noise_titles);
+    AK_RUN(distinct_colors_for_legends);
     return ak_test_finish();
 }

@@ -704,19 +704,74 @@ AK_TEST(sim_help_keys_do_something) {
  * library's own mesh of `animkit terrain`'s default heightfield (seed 0) at 129 x 129 samples. Eroding changes the
  * image only inside the terrain's projected box (the ground and its shadow lie at its floor);
  * G, T and E change it, R gives the first terrain back, and --seed 3 is G pressed three times. */
-static bool terrain_box(uint64_t seed, ak_vec3* lo, ak_vec3* hi) {
+static bool terrain_box_of(uint64_t seed, ak_fractal_type type, ak_vec3* lo, ak_vec3* hi) {
     ak_noise nz = ak_noise_make(seed);
     ak_terrain_desc d = {.noise = &nz, .width = 129, .height = 129, .world_size = 100, .height_scale = 20,
-                         .fractal = {.type = AK_FRACTAL_FBM, .octaves = 8}};
+                         .fractal = {.type = type, .octaves = 8}};
     size_t n = 129u * 129u;
     float* h = malloc(n * sizeof *h);
     ak_vec3* p = malloc(n * sizeof *p);
     bool ok = h && p && ak_terrain_generate(&d, (ak_f32_span){h, n}, (ak_vec3_span){0}) == AK_OK &&
               ak_terrain_mesh(&d, (ak_f32_cspan){h, n}, (ak_vec3_span){p, n}, (ak_vec2_span){0}, (ak_u32_span){0}) == AK_OK;
     if (ok) ak_points_bounds((ak_vec3_cspan){p, n}, lo, hi);
+    if (ok) hi->y -= lo->y, lo->y = 0.0f; /* the viewer puts the lowest point on the floor */
     free(h);
     free(p);
     return ok;
+}
+
+static bool terrain_box(uint64_t seed, ak_vec3* lo, ak_vec3* hi) { return terrain_box_of(seed, AK_FRACTAL_FBM, lo, hi); }
+
+/* The mountains stand on the floor like `animkit terrain --type ridged`: the foot of the side
+ * facing the camera (0.3 m above the floor, where the lowest sample is 3.5 m up) shows the
+ * terrain's brown wall, not the grey ground under a floating sheet; the heights are 20 m at
+ * most (they were 30 m needles). */
+AK_TEST(terrain_mountains_on_the_floor) {
+    const int w = 320, h = 240;
+    write_file("mountains.txt", "screenshot mnt.png\n");
+    AK_CHECK_EQ(run("view terrain:preset:mountains --headless --size 320x240 --script mountains.txt", true), 0);
+    ak_vec3 lo, hi;
+    AK_CHECK(terrain_box_of(0, AK_FRACTAL_RIDGED, &lo, &hi));
+    AK_CHECK(hi.y <= 20.0f);
+    ak_view_orbit orb = {.azimuth = 0.55f, .elevation = 0.22f, .aspect = (float)w / (float)h, .margin = 1.08f};
+    ak_raster_camera cam = ak_view_orbit_camera(lo, hi, &orb);
+    ak_image im = {0};
+    AK_CHECK(load_png("mnt.png", &im, w, h));
+    int wall = 0, tested = 0;
+    for (int k = 1; k < 8; ++k) { /* along the near +z side, the camera being at azimuth 0.55 */
+        ak_vec3 q;
+        if (!ak_raster_camera_project(&cam, w, h, ak_vec3_make(lo.x + (hi.x - lo.x) * (float)k / 8.0f, 0.3f, hi.z), &q)) continue;
+        const uint8_t* px = ak_image_pixel(&im, (int)q.x, (int)q.y - 1);
+        ++tested;
+        wall += px[0] > px[2] + 15; /* brown, where the ground and the sky are grey-blue */
+    }
+    AK_CHECK_MSG(tested == 7 && wall == 7, "%d of %d points at the foot of the near side show the wall", wall, tested);
+    free(im.pixels);
+    remove("mountains.txt"), remove("mnt.png");
+}
+
+/* Orbiting down stops with the camera above the floor: after a drag of 6 radians down, the rows
+ * under the status band still show the sky (bluish), not the underside of the ground. */
+AK_TEST(orbit_stays_above_the_floor) {
+    const int w = 320, h = 240;
+    write_file("orbit.txt", "mouse_down left 160 220\nmouse_move 160 120\nmouse_move 160 40\nmouse_move 160 -300\n"
+                            "mouse_up left 160 -300\nscreenshot orbit_low.png\n");
+    const char* subjects[] = {"builtin:cylinder", "terrain"};
+    for (int s = 0; s < 2; ++s) {
+        char args[160];
+        snprintf(args, sizeof args, "view %s --headless --size 320x240 --script orbit.txt", subjects[s]);
+        AK_CHECK_EQ(run(args, true), 0);
+        ak_image im = {0};
+        AK_CHECK(load_png("orbit_low.png", &im, w, h));
+        int sky = 0;
+        for (int x = 0; x < w; ++x) {
+            const uint8_t* px = ak_image_pixel(&im, x, HUD_TOP + 4);
+            sky += px[2] > px[0] + 8;
+        }
+        AK_CHECK_MSG(sky > w * 9 / 10, "%s: %d of %d pixels under the status band are sky", subjects[s], sky, w);
+        free(im.pixels);
+    }
+    remove("orbit.txt"), remove("orbit_low.png");
 }
 
 AK_TEST(terrain_view) {
@@ -965,6 +1020,8 @@ int main(void) {
     AK_RUN(sim_drag_sphere);
     AK_RUN(sim_help_keys_do_something);
     AK_RUN(terrain_view);
+    AK_RUN(terrain_mountains_on_the_floor);
+    AK_RUN(orbit_stays_above_the_floor);
     AK_RUN_SLOW(sim_cloth_drag_sphere);
     AK_RUN(sim_particles_drag_deflects);
     AK_RUN(sim_threads_and_seed);

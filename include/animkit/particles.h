@@ -37,7 +37,8 @@
  * indices: point them at such particles). The id array follows each particle.
  *
  * What it does NOT do: rigid bodies, particle-particle collisions (use Lennard-Jones for
- * repulsion), implicit integration, or rendering (the CLI draws with raster.h).
+ * repulsion), implicit integration, or rendering (the CLI draws with raster.h; ak_particle_look
+ * describes colour, size and sprite frame over a particle's life for a renderer).
  *
  * Usage:
  *     ak_particles* ps;
@@ -65,6 +66,7 @@
 #define ANIMKIT_PARTICLES_H
 
 #include "grid.h"
+#include "raster.h" /* ak_blend, ak_sprite_texture: a scene's "render" settings */
 
 #ifdef __cplusplus
 extern "C" {
@@ -371,6 +373,44 @@ typedef struct ak_particles_world {
 AK_API ak_result ak_particles_step(ak_particles* particles, const ak_particles_world* world,
                                    float dt);
 
+/* ---- appearance over life (for rendering) --------------------------------------------- */
+
+/* How a particle looks as it ages, as the fraction of its life t = age / lifetime in [0, 1]
+ * (t = 0 for an infinite lifetime): its colour and size multiply keyframed curves, linear
+ * between keys and held constant before the first and after the last, and its sprite-sheet
+ * frame comes from its age. The system itself never reads this (rendering only). */
+#define AK_PARTICLE_LOOK_MAX_KEYS 8
+
+typedef struct ak_particle_colour_key {
+    float t;        /* life fraction in [0, 1]; keys strictly increasing */
+    ak_vec4 colour; /* multiplies the particle's colour (RGBA, alpha included) */
+} ak_particle_colour_key;
+
+typedef struct ak_particle_size_key {
+    float t;    /* life fraction in [0, 1]; keys strictly increasing */
+    float size; /* multiplies the particle's size, >= 0 */
+} ak_particle_size_key;
+
+typedef struct ak_particle_look {
+    ak_particle_colour_key colour_keys[AK_PARTICLE_LOOK_MAX_KEYS];
+    uint32_t colour_key_count; /* 0 -> the colour is not changed (a factor of 1, 1, 1, 1) */
+    ak_particle_size_key size_keys[AK_PARTICLE_LOOK_MAX_KEYS];
+    uint32_t size_key_count;   /* 0 -> the size is not changed (a factor of 1) */
+    uint32_t frame_count;      /* frames of the sprite sheet; 0 -> 1 */
+    float frame_rate;          /* frames per second from emission, looping; 0 -> the frames
+                                  spread once over the lifetime (frame floor(t * frame_count)) */
+} ak_particle_look;
+
+/* AK_OK, or AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (a key count above AK_PARTICLE_LOOK_MAX_KEYS, a key
+ * t outside [0, 1] or not increasing, a negative size, a non-finite value, frame_rate < 0). */
+AK_API ak_result ak_particle_look_validate(const ak_particle_look* look);
+/* Colour factor at the given age and lifetime (seconds; look NULL or without keys -> 1). */
+AK_API ak_vec4 ak_particle_look_colour(const ak_particle_look* look, float age, float lifetime);
+/* Size factor at the given age and lifetime (look NULL or without keys -> 1). */
+AK_API float ak_particle_look_size(const ak_particle_look* look, float age, float lifetime);
+/* Sprite-sheet frame in [0, frame_count) at the given age and lifetime (NULL -> 0). */
+AK_API uint32_t ak_particle_look_frame(const ak_particle_look* look, float age, float lifetime);
+
 /* ---- scene files and presets ------------------------------------------------------------ */
 /* A particle scene: the JSON format of `animkit particles SCENE.json` (docs/particles.md lists
  * every key, its unit and its default) or a built-in preset, parsed into arrays the scene owns.
@@ -394,6 +434,21 @@ typedef struct ak_particles_scene_burst {
     float interval; /* seconds; 0 = once */
 } ak_particles_scene_burst;
 
+/* How a scene's particles are drawn (its "render" key; docs/particles.md): round points (the
+ * default) or camera-facing sprites with a texture, a sprite sheet, blending and colour/size
+ * over life. The simulation never reads it; the command and the viewer draw with it. */
+typedef struct ak_particles_scene_sprites {
+    bool enabled;              /* false -> points */
+    ak_sprite_texture texture; /* built-in texture when sheet_path is NULL: DISC or PUFF */
+    char* sheet_path;          /* a PNG sprite sheet (owned by the scene; a relative "texture"
+                                  is resolved against the scene file's directory), or NULL */
+    int sheet_columns;         /* frames across; 0 -> 1 (built-in PUFF with frames: that many puffs) */
+    int sheet_rows;            /* frames down; 0 -> 1 */
+    ak_blend blend;            /* AK_BLEND_ALPHA (sorted back to front), AK_BLEND_ADD, or
+                                  AK_BLEND_OPAQUE (alpha-tested cut-outs: leaves, grass) */
+    ak_particle_look look;     /* colour, size and frame over life */
+} ak_particles_scene_sprites;
+
 /* A loaded scene: the world and everything to add, owning its arrays (ak_particles_scene_free).
  * world's spans point into the arrays below. */
 typedef struct ak_particles_scene {
@@ -412,6 +467,7 @@ typedef struct ak_particles_scene {
     ak_particle_emitter* emitters;      /* [emitter_count] */
     ak_particles_scene_burst* bursts;   /* [emitter_count]; count 0: the emitter uses its rate */
     size_t emitter_count;
+    ak_particles_scene_sprites sprites; /* "render": how to draw the particles */
 } ak_particles_scene;
 
 /* Budgets a scene file may ask for, checked before allocating. */
@@ -419,10 +475,12 @@ typedef struct ak_particles_scene {
 #define AK_PARTICLES_SCENE_MAX_CAPACITY 2000000u /* about 0.5 GB of system state */
 #define AK_PARTICLES_SCENE_MAX_FILE_SIZE ((size_t)64 << 20) /* bytes of a scene file */
 /* The names ak_particles_scene_preset knows. */
-#define AK_PARTICLES_SCENE_PRESETS "fountain, rain, fireworks, character"
+#define AK_PARTICLES_SCENE_PRESETS "fountain, rain, fireworks, character, fire, smoke"
 
 /* Parse a scene from bytes[0, size) (strict JSON, need not be NUL-terminated); name (NULL ->
- * "(scene)") starts every message. Emitter shape "mesh" is not allowed in files. Returns AK_OK
+ * "(scene)") starts every message. Emitter shape "mesh" is not allowed in files. A "render"
+ * texture that is a relative .png path is resolved against name's directory (the file is not
+ * read here: sprites.sheet_path holds the resolved path). Returns AK_OK
  * and fills *out_scene, or AK_ERR_PARSE (a syntax error, an unknown key, a value out of range or
  * over a budget), AK_ERR_NULL_ARG, with *out_scene empty and, when out_diag is not NULL, the one
  * line "NAME: key.path: problem" in out_diag->message (out_diag->path = name). */
@@ -435,7 +493,8 @@ AK_API ak_result ak_particles_scene_load_file(const char* path, ak_particles_sce
                                               ak_diag* out_diag);
 /* The built-in scene name (AK_PARTICLES_SCENE_PRESETS; docs/particles.md gives their values).
  * "character" holds a mesh-surface emitter (sparks) and rain: the command supplies the
- * humanoid's posed mesh as collider and emitter surface. AK_ERR_NOT_FOUND for another name,
+ * humanoid's posed mesh as collider and emitter surface; "fire" (additive) and "smoke"
+ * (alpha-blended) draw built-in puff sprites. AK_ERR_NOT_FOUND for another name,
  * AK_ERR_NO_MEMORY. */
 AK_API ak_result ak_particles_scene_preset(const char* name, ak_particles_scene* out_scene,
                                            ak_diag* out_diag);

@@ -16,8 +16,12 @@
  * nearest or bilinear filtering (filtered in linear light for lit shading), chosen per
  * triangle between a minification and a magnification filter (no mipmaps).
  *
- * What it does NOT do: mipmaps, normal or other maps, transparency sorting, shadows other than on the ground
- * plane, MP4 output (ak_image_format_available says what this build can write), windows.
+ * Camera-facing textured sprites (billboards: particles, fire, smoke) with sprite sheets,
+ * alpha or additive blending and a back-to-front sort.
+ *
+ * What it does NOT do: mipmaps, normal or other maps, sorting of transparent meshes, shadows
+ * other than on the ground plane, MP4 output (ak_image_format_available says what this build
+ * can write), windows.
  *
  * Usage:
  *     ak_raster* r = NULL;
@@ -328,6 +332,60 @@ AK_API ak_result ak_raster_draw_ground(ak_raster* raster, const ak_raster_camera
 /* Text in output-image pixels (top-left corner at x, y) drawn into the target over
  * everything (scale 0 -> 1). AK_ERR_NULL_ARG for NULL raster or text. */
 AK_API ak_result ak_raster_draw_text(ak_raster* raster, int x, int y, const char* text, int scale, ak_vec4 color);
+
+/* ---- sprites (camera-facing billboards) ------------------------------------------------- */
+
+/* Built-in sprite textures (ak_sprite_texture_generate). */
+typedef enum ak_sprite_texture {
+    AK_SPRITE_TEXTURE_DISC = 0, /* white soft disc: alpha (1 - r^2)^2 inside the unit circle */
+    AK_SPRITE_TEXTURE_PUFF,     /* white puff: the soft disc times seeded lumpy value noise,
+                                   for smoke and vegetation-like clumps */
+    AK_SPRITE_TEXTURE_SOLID,    /* opaque white square (tests, debugging) */
+    AK_SPRITE_TEXTURE_COUNT
+} ak_sprite_texture;
+
+/* Fill out (any size, RGBA8 straight alpha, white colour) with a built-in sprite texture; seed
+ * varies the puff's lumps. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (size <= 0, bad kind). */
+AK_API ak_result ak_sprite_texture_generate(ak_sprite_texture kind, uint32_t seed, const ak_image* out);
+
+/* Camera-facing square quads (spherical billboards: their sides follow the camera's right and
+ * up axes, so a sprite's projection is an axis-aligned square in the image), textured and
+ * tinted, depth tested against what is drawn, blended in the given order. */
+typedef struct ak_raster_sprites {
+    ak_vec3_cspan positions;  /* required; world-space centres */
+    ak_f32_cspan sizes;       /* per-sprite side length in metres (count == positions.count);
+                                 empty -> size */
+    float size;               /* metres; 0 -> 0.1 */
+    ak_vec4_cspan colors;     /* per-sprite sRGB tint, alpha multiplies the texture's; empty -> color */
+    ak_vec4 color;            /* all zero -> opaque white */
+    ak_u32_cspan frames;      /* per-sprite sprite-sheet frame (row-major from the top left,
+                                 taken modulo the frame count); empty -> frame 0 */
+    ak_u32_cspan order;       /* indices into positions in drawing order (ak_raster_sprites_sort
+                                 gives back to front); empty -> 0, 1, ..., count - 1 */
+    const ak_image* texture;  /* RGBA8 straight alpha, sampled bilinearly; NULL -> the DISC
+                                 texture computed per sample */
+    int sheet_columns;        /* frames across the texture; 0 -> 1 */
+    int sheet_rows;           /* frames down the texture; 0 -> 1 */
+    ak_blend blend;           /* DEFAULT -> ALPHA (src * a + dst * (1 - a) on sRGB bytes, depth
+                                 tested, not written); ADD (dst + src * a, saturating, not
+                                 written); OPAQUE (alpha-tested at 0.5, depth written) */
+} ak_raster_sprites;
+
+/* Draw sprites; sprites with a non-finite centre, size or colour, of size <= 0, or reaching
+ * behind the near plane are skipped. Runs on the calling thread (blending needs the order).
+ * Returns AK_ERR_NULL_ARG (raster, camera or sprites NULL, positions empty), AK_ERR_BAD_ARG
+ * (a count mismatch, sheet size outside 1..4096, a texture without pixels or smaller than the
+ * sheet, bad blend), AK_ERR_BAD_INDEX (an order entry >= positions.count), AK_ERR_BAD_DATA
+ * (non-finite camera). Nothing is drawn on error. */
+AK_API ak_result ak_raster_draw_sprites(ak_raster* raster, const ak_raster_camera* camera,
+                                        const ak_raster_sprites* sprites);
+
+/* Back-to-front order of positions for the camera: out_order gets 0..count-1 sorted by
+ * decreasing distance along the view direction (ties by index; non-finite points first).
+ * scratch_depth and out_order need positions.count entries. Never allocates.
+ * AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (a span too small), AK_ERR_BAD_DATA (non-finite camera). */
+AK_API ak_result ak_raster_sprites_sort(const ak_raster_camera* camera, ak_vec3_cspan positions,
+                                        ak_f32_span scratch_depth, ak_u32_span out_order);
 
 /* ---- files ---------------------------------------------------------------------------- */
 

@@ -1,6 +1,6 @@
 """animkit.particles: particles simulations (docs/particles.md has the scene format).
 
-    sim = animkit.particles.preset("fountain")   # presets: fountain, rain, fireworks, character
+    sim = animkit.particles.preset("fountain")   # fountain, rain, fireworks, character, fire, smoke
     sim.step(60)
     sim.positions                  # (N, 3) float32 view of the current state
 """
@@ -11,7 +11,7 @@ from . import _core
 
 
 def preset(name: str, **options) -> _core.Sim:
-    """The particles preset `name` (fountain, rain, fireworks, character). Options: threads (1..64), seed (default 1)."""
+    """The particles preset `name` (fountain, rain, fireworks, character, fire, smoke). Options: threads (1..64), seed (default 1)."""
     return _core.sim_preset("particles", name, **options)
 
 

@@ -1384,3 +1384,82 @@ ak_result ak_particles_step(ak_particles* ps, const ak_particles_world* w, float
     ps->time += (double)dt;
     return AK_OK;
 }
+
+/* ---- appearance over life ----------------------------------------------------------------- */
+
+static bool vec4_finite(ak_vec4 v) { return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z) && ak_finitef(v.w); }
+
+static float life_fraction(float age, float lifetime) {
+    if (!(lifetime > 0.0f) || !ak_finitef(lifetime) || !ak_finitef(age)) return 0.0f;
+    float t = age / lifetime;
+    return t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+}
+
+/* Index k of the segment [keys[k], keys[k + 1]] holding t, and the weight of key k + 1, for a
+ * key table of count >= 2 entries whose t values are at stride bytes. */
+static size_t key_segment(const float* first_t, size_t stride, size_t count, float t, float* out_w) {
+    size_t k = 0;
+    const char* base = (const char*)first_t;
+    while (k + 2 < count && t > *(const float*)(const void*)(base + (k + 1) * stride)) ++k;
+    float t0 = *(const float*)(const void*)(base + k * stride);
+    float t1 = *(const float*)(const void*)(base + (k + 1) * stride);
+    float w = t1 > t0 ? (t - t0) / (t1 - t0) : 1.0f;
+    *out_w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
+    return k;
+}
+
+ak_result ak_particle_look_validate(const ak_particle_look* look) {
+    if (!look) return AK_ERR_NULL_ARG;
+    if (look->colour_key_count > AK_PARTICLE_LOOK_MAX_KEYS || look->size_key_count > AK_PARTICLE_LOOK_MAX_KEYS)
+        return AK_ERR_BAD_ARG;
+    if (!(look->frame_rate >= 0.0f) || !ak_finitef(look->frame_rate)) return AK_ERR_BAD_ARG;
+    for (uint32_t k = 0; k < look->colour_key_count; ++k) {
+        const ak_particle_colour_key* c = &look->colour_keys[k];
+        if (!(c->t >= 0.0f && c->t <= 1.0f) || !vec4_finite(c->colour)) return AK_ERR_BAD_ARG;
+        if (k && !(c->t > look->colour_keys[k - 1].t)) return AK_ERR_BAD_ARG;
+    }
+    for (uint32_t k = 0; k < look->size_key_count; ++k) {
+        const ak_particle_size_key* c = &look->size_keys[k];
+        if (!(c->t >= 0.0f && c->t <= 1.0f) || !(c->size >= 0.0f) || !ak_finitef(c->size)) return AK_ERR_BAD_ARG;
+        if (k && !(c->t > look->size_keys[k - 1].t)) return AK_ERR_BAD_ARG;
+    }
+    return AK_OK;
+}
+
+ak_vec4 ak_particle_look_colour(const ak_particle_look* look, float age, float lifetime) {
+    if (!look || look->colour_key_count == 0) return ak_vec4_make(1, 1, 1, 1);
+    const uint32_t n = look->colour_key_count < AK_PARTICLE_LOOK_MAX_KEYS ? look->colour_key_count
+                                                                         : AK_PARTICLE_LOOK_MAX_KEYS;
+    const ak_particle_colour_key* k = look->colour_keys;
+    const float t = life_fraction(age, lifetime);
+    if (n == 1 || t <= k[0].t) return k[0].colour;
+    if (t >= k[n - 1].t) return k[n - 1].colour;
+    float w;
+    size_t i = key_segment(&k[0].t, sizeof *k, n, t, &w);
+    const ak_vec4 a = k[i].colour, b = k[i + 1].colour;
+    return ak_vec4_make(a.x + (b.x - a.x) * w, a.y + (b.y - a.y) * w, a.z + (b.z - a.z) * w, a.w + (b.w - a.w) * w);
+}
+
+float ak_particle_look_size(const ak_particle_look* look, float age, float lifetime) {
+    if (!look || look->size_key_count == 0) return 1.0f;
+    const uint32_t n = look->size_key_count < AK_PARTICLE_LOOK_MAX_KEYS ? look->size_key_count
+                                                                       : AK_PARTICLE_LOOK_MAX_KEYS;
+    const ak_particle_size_key* k = look->size_keys;
+    const float t = life_fraction(age, lifetime);
+    if (n == 1 || t <= k[0].t) return k[0].size;
+    if (t >= k[n - 1].t) return k[n - 1].size;
+    float w;
+    size_t i = key_segment(&k[0].t, sizeof *k, n, t, &w);
+    return k[i].size + (k[i + 1].size - k[i].size) * w;
+}
+
+uint32_t ak_particle_look_frame(const ak_particle_look* look, float age, float lifetime) {
+    if (!look || look->frame_count <= 1) return 0;
+    const uint32_t n = look->frame_count;
+    if (look->frame_rate > 0.0f && ak_finitef(look->frame_rate)) {
+        double f = floor((double)(ak_finitef(age) && age > 0.0f ? age : 0.0f) * (double)look->frame_rate);
+        return (uint32_t)fmod(f, (double)n);
+    }
+    float f = floorf(life_fraction(age, lifetime) * (float)n);
+    return f >= (float)n ? n - 1 : (uint32_t)f;
+}

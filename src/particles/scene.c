@@ -48,8 +48,11 @@ static bool preset_fill(const char* name, ak_particles_scene* s) {
     s->planes[0] = (ak_particle_plane){.normal = {0, 1, 0}, .restitution = 0.4f, .friction = 0.3f};
     s->world.planes = (ak_particle_plane_cspan){s->planes, 1};
     ak_particle_emitter e = emitter_base();
+    ak_particles_scene_sprites* look = &s->sprites;
     if (strcmp(name, "fountain") == 0) {
+        /* droplets of 6 mm radius (they were 3 cm: 4500 touching balls read as one blob) */
         e.center = ak_vec3_make(0, 0.05f, 0);
+        e.size_min = 0.005f, e.size_max = 0.007f;
         e.cone_angle = 0.18f, e.speed_min = 5.0f, e.speed_max = 5.6f;
         e.lifetime_min = 2.5f, e.lifetime_max = 3.5f;
         e.colour = ak_vec4_make(0.25f, 0.55f, 1.0f, 1), e.rate = 1500.0f;
@@ -105,13 +108,65 @@ static bool preset_fill(const char* name, ak_particles_scene* s) {
         s->emitters[1] = sp;
         s->emitter_count = 2;
         s->planes[0].restitution = 0.2f;
+    } else if (strcmp(name, "fire") == 0) {
+        /* Flames: additive puffs rising from a disc, hot yellow to red to nothing while they
+         * shrink, buoyant (gravity up) and slowed by the air; each puff plays a 4x4 sheet. */
+        e.shape = AK_EMITTER_DISC, e.radius = 0.22f, e.center = ak_vec3_make(0, 0.02f, 0);
+        e.cone_angle = 0.2f, e.speed_min = 0.8f, e.speed_max = 1.4f;
+        e.lifetime_min = 0.6f, e.lifetime_max = 1.1f, e.size_min = 0.08f, e.size_max = 0.12f;
+        e.colour = ak_vec4_make(1.0f, 0.62f, 0.22f, 1), e.rate = 350.0f;
+        s->emitters[0] = e;
+        s->emitter_count = 1;
+        s->world.gravity = ak_vec3_make(0, 2.0f, 0);
+        s->world.drag_linear = 0.8f;
+        look->enabled = true, look->texture = AK_SPRITE_TEXTURE_PUFF, look->sheet_columns = 4,
+        look->sheet_rows = 4;
+        look->blend = AK_BLEND_ADD;
+        look->look = (ak_particle_look){.colour_keys = {{0.0f, {1.0f, 1.0f, 0.75f, 0.3f}},
+                                                        {0.3f, {1.0f, 0.75f, 0.45f, 0.3f}},
+                                                        {0.7f, {0.9f, 0.35f, 0.25f, 0.2f}},
+                                                        {1.0f, {0.5f, 0.2f, 0.2f, 0.0f}}},
+                                        .colour_key_count = 4,
+                                        .size_keys = {{0.0f, 0.7f}, {0.35f, 1.0f}, {1.0f, 0.35f}},
+                                        .size_key_count = 3,
+                                        .frame_count = 16};
+    } else if (strcmp(name, "smoke") == 0) {
+        /* Smoke: few large puffs drifting up and downwind, fading in then out while they grow
+         * and lighten; alpha-blended back to front. */
+        e.shape = AK_EMITTER_DISC, e.radius = 0.12f, e.center = ak_vec3_make(0, 0.05f, 0);
+        e.cone_angle = 0.3f, e.speed_min = 0.5f, e.speed_max = 0.8f;
+        e.lifetime_min = 3.0f, e.lifetime_max = 4.0f, e.size_min = 0.12f, e.size_max = 0.18f;
+        e.colour = ak_vec4_make(0.42f, 0.42f, 0.45f, 1), e.rate = 40.0f;
+        s->emitters[0] = e;
+        s->emitter_count = 1;
+        s->world.gravity = ak_vec3_make(0, 0.25f, 0);
+        s->world.wind = ak_vec3_make(0.5f, 0, 0);
+        s->world.drag_linear = 0.6f;
+        look->enabled = true, look->texture = AK_SPRITE_TEXTURE_PUFF, look->sheet_columns = 4,
+        look->sheet_rows = 2;
+        look->blend = AK_BLEND_ALPHA;
+        look->look = (ak_particle_look){.colour_keys = {{0.0f, {0.8f, 0.8f, 0.8f, 0.0f}},
+                                                        {0.1f, {1.0f, 1.0f, 1.0f, 0.75f}},
+                                                        {1.0f, {1.9f, 1.9f, 1.9f, 0.0f}}},
+                                        .colour_key_count = 3,
+                                        .size_keys = {{0.0f, 0.6f}, {1.0f, 3.0f}},
+                                        .size_key_count = 2,
+                                        .frame_count = 8,
+                                        .frame_rate = 2.0f};
     } else {
         return false;
     }
     return true;
 }
 
-
+/* The names preset_fill knows (AK_PARTICLES_SCENE_PRESETS in words). */
+static bool preset_known(const char* name) {
+    static const char* const names[] = {"fountain",  "rain", "fireworks",
+                                        "character", "fire", "smoke"};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k)
+        if (strcmp(name, names[k]) == 0) return true;
+    return false;
+}
 
 static const char* const integrator_names[] = {"euler", "symplectic", "verlet", "rk4", NULL};
 static const ak_particles_integrator integrator_values[] = {
@@ -148,11 +203,103 @@ static void read_range(akp_json* j, const cJSON* o, const char* path, const char
     *hi = r[1];
 }
 
+/* One key of a "..._over_life" list: an array of exactly n finite numbers, the first (the life
+ * fraction) in [0, 1] and above the previous key's, the others in [lo, hi]. */
+static bool read_life_key(akp_json* j, const cJSON* e, const char* path, int n, float lo, float hi,
+                          float prev_t, float* out) {
+    if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != n)
+        return akp_json_fail(j, path, NULL, "a key is an array of %d numbers [t, %s]", n,
+                             n == 2 ? "size" : "r, g, b, a");
+    int k = 0;
+    for (const cJSON* v = e->child; v; v = v->next, ++k) {
+        double x = cJSON_IsNumber(v) ? v->valuedouble : NAN;
+        const double a = k ? lo : 0.0, b = k ? hi : 1.0;
+        if (!(x >= a && x <= b))
+            return akp_json_fail(j, path, NULL, "value %d is not a number in [%g, %g]", k, a, b);
+        out[k] = (float)x;
+    }
+    if (!(out[0] > prev_t))
+        return akp_json_fail(j, path, NULL, "t %g does not come after the previous key's %g",
+                             (double)out[0], (double)prev_t);
+    return true;
+}
+
+/* "render": how the CLI and the viewer draw the particles (docs/particles.md). A texture that
+ * is not a built-in name is a PNG path relative to the scene file. */
+static void read_render(akp_json* j, const cJSON* root, const char* file, ak_particles_scene* s) {
+    const cJSON* r = akp_json_member(j, root, "", "render");
+    if (!r || j->failed) return;
+    static const char* const keys[] = {"style", "texture",          "sheet",          "frame_rate",
+                                       "blend", "colour_over_life", "size_over_life", NULL};
+    static const char* const styles[] = {"points", "sprites", NULL};
+    static const char* const blends[] = {"alpha", "add", "cutout", NULL};
+    if (!akp_json_object(j, r, "render", keys)) return;
+    ak_particles_scene_sprites* sp = &s->sprites;
+    int style = 0, blend = 0;
+    akp_json_enum(j, r, "render", "style", styles, &style);
+    sp->enabled = style == 1;
+    akp_json_enum(j, r, "render", "blend", blends, &blend);
+    sp->blend = blend == 2 ? AK_BLEND_OPAQUE : blend ? AK_BLEND_ADD : AK_BLEND_ALPHA;
+    const char* tex = NULL;
+    akp_json_str(j, r, "render", "texture", &tex);
+    if (tex && strcmp(tex, "disc") == 0)
+        sp->texture = AK_SPRITE_TEXTURE_DISC;
+    else if (tex && strcmp(tex, "puff") == 0)
+        sp->texture = AK_SPRITE_TEXTURE_PUFF;
+    else if (tex) {
+        size_t n = strlen(tex);
+        if (n < 5 || strcmp(tex + n - 4, ".png") != 0) {
+            akp_json_fail(j, "render", "texture", "\"%.80s\" is not disc, puff or a .png file",
+                          tex);
+            return;
+        }
+        const char* slash = file ? strrchr(file, '/') : NULL;
+        size_t dir = tex[0] == '/' || !slash ? 0 : (size_t)(slash - file) + 1;
+        sp->sheet_path = malloc(dir + n + 1);
+        if (!sp->sheet_path) {
+            akp_json_fail(j, "render", "texture", "out of memory");
+            return;
+        }
+        if (dir) memcpy(sp->sheet_path, file, dir);
+        memcpy(sp->sheet_path + dir, tex, n + 1);
+    }
+    float sheet[2] = {1, 1};
+    if (akp_json_floats(j, r, "render", "sheet", 2, 1.0f, 64.0f, sheet) &&
+        (sheet[0] != floorf(sheet[0]) || sheet[1] != floorf(sheet[1])))
+        akp_json_fail(j, "render", "sheet", "[columns, rows] are whole numbers");
+    sp->sheet_columns = (int)sheet[0], sp->sheet_rows = (int)sheet[1];
+    sp->look.frame_count = (uint32_t)(sp->sheet_columns * sp->sheet_rows);
+    akp_json_float(j, r, "render", "frame_rate", 0.0f, 1000.0f, &sp->look.frame_rate);
+    char path[64];
+    size_t n = 0;
+    const cJSON* e =
+        akp_json_array(j, r, "render", "colour_over_life", AK_PARTICLE_LOOK_MAX_KEYS, &n);
+    for (size_t i = 0; i < n && e && !j->failed; ++i, e = e->next) {
+        float v[5];
+        akp_json_index(path, sizeof path, "render.colour_over_life", i);
+        if (!read_life_key(j, e, path, 5, 0.0f, 16.0f, i ? sp->look.colour_keys[i - 1].t : -1.0f,
+                           v))
+            break;
+        sp->look.colour_keys[i] = (ak_particle_colour_key){v[0], {v[1], v[2], v[3], v[4]}};
+        sp->look.colour_key_count = (uint32_t)(i + 1);
+    }
+    e = akp_json_array(j, r, "render", "size_over_life", AK_PARTICLE_LOOK_MAX_KEYS, &n);
+    for (size_t i = 0; i < n && e && !j->failed; ++i, e = e->next) {
+        float v[2];
+        akp_json_index(path, sizeof path, "render.size_over_life", i);
+        if (!read_life_key(j, e, path, 2, 0.0f, 1000.0f, i ? sp->look.size_keys[i - 1].t : -1.0f,
+                           v))
+            break;
+        sp->look.size_keys[i] = (ak_particle_size_key){v[0], v[1]};
+        sp->look.size_key_count = (uint32_t)(i + 1);
+    }
+}
+
 static void read_scene(akp_json* j, const cJSON* root, ak_particles_scene* s) {
     static const char* const keys[] = {"dt",       "integrator",    "capacity",  "gravity",
                                        "drag",     "wind",          "particles", "springs",
                                        "planes",   "spheres",       "boxes",     "attractors",
-                                       "vortices", "lennard_jones", "emitters",  NULL};
+                                       "vortices", "lennard_jones", "emitters",  "render", NULL};
     if (!akp_json_object(j, root, "", keys)) return;
     akp_json_float(j, root, "", "dt", 1e-7f, 10.0f, &s->dt);
     int integ = 1;
@@ -381,6 +528,7 @@ ak_result ak_particles_scene_load_bytes(const void* bytes, size_t size, const ch
     if (!bytes && size) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, j.file, "no bytes");
     cJSON* root = akp_json_parse(&j, bytes ? (const char*)bytes : "", size);
     if (root) read_scene(&j, root, out_scene);
+    if (root && !j.failed) read_render(&j, root, name, out_scene);
     cJSON_Delete(root);
     if (j.failed) {
         ak_particles_scene_free(out_scene);
@@ -405,8 +553,7 @@ ak_result ak_particles_scene_load_file(const char* path, ak_particles_scene* out
 ak_result ak_particles_scene_preset(const char* name, ak_particles_scene* out_scene, ak_diag* out_diag) {
     if (!out_scene || !name) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, "preset", "no name or scene");
     if (!preset_fill(name, out_scene)) {
-        const bool known = !strcmp(name, "fountain") || !strcmp(name, "rain") || !strcmp(name, "fireworks") ||
-                           !strcmp(name, "character");
+        const bool known = preset_known(name);
         ak_particles_scene_free(out_scene);
         if (known) return akp_diag_set(out_diag, AK_ERR_NO_MEMORY, name, "out of memory");
         return akp_diag_set(out_diag, AK_ERR_NOT_FOUND, name,
@@ -427,5 +574,6 @@ void ak_particles_scene_free(ak_particles_scene* s) {
     free(s->vortices);
     free(s->emitters);
     free(s->bursts);
+    free(s->sprites.sheet_path);
     memset(s, 0, sizeof *s);
 }

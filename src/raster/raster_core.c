@@ -15,6 +15,7 @@
 #include <animkit/raster.h>
 
 #include "../internal.h"
+#include "raster_internal.h"
 
 /* ---- private types ------------------------------------------------------------------ */
 
@@ -1525,4 +1526,11 @@ ak_result ak_raster_draw_text(ak_raster* raster, int x, int y, const char* text,
     ak_image img = {raster->color, raster->sw, raster->sh, 0};
     int s = scale > 0 ? (scale > 64 ? 64 : scale) : 1;
     return ak_image_draw_text(&img, x * raster->ss, y * raster->ss, text, s * raster->ss, color);
+}
+
+/* ---- internal access for the other raster files ----------------------------------------- */
+
+akp_raster_target akp_raster_target_of(ak_raster* raster) {
+    akp_raster_target t = {raster->color, raster->depth, raster->sw, raster->sh, raster->ss};
+    return t;
 }

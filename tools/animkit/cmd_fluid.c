@@ -120,6 +120,26 @@ static ak_result draw_colliders(renderer* r, const ak_fluid_scene* s) {
     return AK_OK;
 }
 
+/* The tank: the box's four side walls as faint glass (alpha-blended over the particles behind
+ * them, depth tested, not hiding what is in front) and its twelve edges as dark lines. */
+static ak_result draw_tank(renderer* r, const ak_fluid_scene* s) {
+    const ak_vec3 lo = s->desc.box_min, hi = s->desc.box_max;
+    if (!(lo.x < hi.x) || !(lo.y < hi.y) || !(lo.z < hi.z)) return AK_OK;
+    ak_vec3 c[8];
+    for (int k = 0; k < 8; ++k) c[k] = ak_vec3_make(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
+    static const uint32_t walls[24] = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5,  /* z = lo, z = hi */
+                                       0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3}; /* x = lo, x = hi */
+    static const uint32_t edges[24] = {0, 1, 2, 3, 4, 5, 6, 7, 0, 2, 1, 3, 4, 6, 5, 7, 0, 4, 1, 5, 2, 6, 3, 7};
+    ak_raster_mesh glass = {.positions = {c, 8}, .indices = {walls, 24},
+                            .material = {.color = ak_vec4_make(0.80f, 0.90f, 1.0f, 0.18f)},
+                            .shading = AK_SHADING_UNLIT, .blend = AK_BLEND_ALPHA};
+    ak_result res = ak_raster_draw_mesh(r->raster, &r->cam, &glass);
+    ak_raster_lines lines = {.positions = {c, 8}, .indices = {edges, 24}, .color = ak_vec4_make(0.25f, 0.30f, 0.38f, 1),
+                             .width = 2.0f};
+    if (res == AK_OK) res = ak_raster_draw_lines(r->raster, &r->cam, &lines);
+    return res;
+}
+
 static ak_result render_frame(renderer* r, const ak_fluid_scene* s, const ak_vec3* p, const uint8_t* flags, size_t n,
                               ak_image* out) {
     ak_vec3 unit[SPHERE_TRIS * 3];
@@ -142,6 +162,7 @@ static ak_result render_frame(renderer* r, const ak_fluid_scene* s, const ak_vec
     ak_result res = ak_raster_draw_ground(r->raster, &r->cam, &g);
     if (res == AK_OK && n) res = ak_raster_draw_mesh(r->raster, &r->cam, &m);
     if (res == AK_OK) res = draw_colliders(r, s);
+    if (res == AK_OK) res = draw_tank(r, s);
     *out = (ak_image){.pixels = r->px, .width = r->w, .height = r->h};
     if (res == AK_OK) res = ak_raster_resolve(r->raster, out);
     return res;

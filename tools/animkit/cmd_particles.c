@@ -10,14 +10,15 @@
 #include "sim_bake.h"
 
 static const char* const usage =
-    "usage: animkit particles [SCENE.json | --preset fountain|rain|fireworks|character] [--steps "
-    "N]\n"
-    "                         [--dt DT] [--integrator euler|symplectic|verlet|rk4] [--seed K]\n"
+    "usage: animkit particles [SCENE.json | --preset fountain|rain|fireworks|character|fire|smoke]\n"
+    "                         [--steps N]"
+    " [--dt DT] [--integrator euler|symplectic|verlet|rk4] [--seed K]\n"
     "                         [--threads T] [--json OUT.json] [-o OUT.gif|OUT.png|OUT.glb|OUT.gltf]\n"
     "                         [--size WxH]\n"
     "Simulate a particle system (docs/particles.md describes the scene format).\n"
     "  --preset     a built-in scene instead of a file (character: rain and sparks on the walking\n"
-    "               builtin:humanoid, which the particles collide with)\n"
+    "               builtin:humanoid, which the particles collide with; fire and smoke: textured\n"
+    "               sprites with colour and size over life)\n"
     "  --steps      steps to run, 0 to 100000000 (default 200)\n"
     "  --dt         step in seconds (overrides the file; default 0.01)\n"
     "  --integrator overrides the file (default symplectic)\n"
@@ -37,6 +38,7 @@ typedef struct renderer {
     ak_image image;
     particles_shapes sh;
     ak_vec4* colours;
+    particles_sprite_renderer sprites;
     float ground;
     const char* title;
 } renderer;
@@ -44,8 +46,12 @@ typedef struct renderer {
 static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
     cli_frame* f = &rd->frame;
     ak_raster* ras = f->raster;
-    ak_raster_clear(ras, ak_vec4_make(0.83f, 0.87f, 0.93f, 1),
-                    ak_vec4_make(0.48f, 0.51f, 0.58f, 1));
+    ak_vec4 sky_top, sky_bottom;
+    const bool dark = particles_dark_sky(r->lib.scene, &sky_top, &sky_bottom); /* a glow shows on a dark sky */
+    if (dark)
+        ak_raster_clear(ras, sky_top, sky_bottom);
+    else
+        ak_raster_clear(ras, ak_vec4_make(0.83f, 0.87f, 0.93f, 1), ak_vec4_make(0.48f, 0.51f, 0.58f, 1));
     ak_raster_mesh meshes[2];
     size_t mc = 0;
     if (rd->sh.icount)
@@ -66,11 +72,15 @@ static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
                           .grid_spacing = powf(10.0f, floorf(log10f(extent / 4.0f))),
                           .casters = meshes,
                           .caster_count = mc};
+    if (dark)
+        g.color = ak_vec4_make(0.26f, 0.25f, 0.25f, 1), g.line_color = ak_vec4_make(0.33f, 0.32f, 0.32f, 1);
     ak_result res = ak_raster_draw_ground(ras, &f->camera, &g);
     for (size_t m = 0; res == AK_OK && m < mc; ++m)
         res = ak_raster_draw_mesh(ras, &f->camera, &meshes[m]);
     ak_particles_state st = ak_particles_get_state(r->ps);
-    if (res == AK_OK)
+    if (res == AK_OK && rd->sprites.ready)
+        res = particles_draw_sprites(ras, &f->camera, r->lib.scene, &rd->sprites, r->ps);
+    else if (res == AK_OK)
         res = particles_draw_points(ras, &f->camera, f->width, f->height,
                                     ak_vec3_scale(ak_vec3_add(f->bmin, f->bmax), 0.5f), r->ps,
                                     rd->colours);
@@ -79,7 +89,7 @@ static int render_frame(renderer* rd, particles_run* r, const ak_image* out) {
              st.count, cli_plural(st.count));
     if (res == AK_OK)
         res = ak_raster_draw_text(ras, 10, 10, title, f->height >= 300 ? 2 : 1,
-                                  ak_vec4_make(0.08f, 0.09f, 0.12f, 1));
+                                  dark ? ak_vec4_make(0.9f, 0.9f, 0.92f, 1) : ak_vec4_make(0.08f, 0.09f, 0.12f, 1));
     if (res == AK_OK) res = ak_raster_resolve(ras, out);
     return res == AK_OK ? CLI_OK : cli_fail("particles", "render: %s", ak_result_string(res));
 }
@@ -118,11 +128,8 @@ int cmd_particles(int argc, char** argv) {
     if ((a.pos_count == 1) == (preset != NULL))
         return cli_usage("particles", "give either SCENE.json or --preset NAME");
     if (a.pos_count > 1) return cli_usage("particles", "expected one SCENE.json");
-    if (preset && strcmp(preset, "fountain") && strcmp(preset, "rain") &&
-        strcmp(preset, "fireworks") && strcmp(preset, "character"))
-        return cli_usage("particles",
-                         "--preset must be fountain, rain, fireworks or character, not '%s'",
-                         preset);
+    if (preset && !particles_preset_known(preset))
+        return cli_usage("particles", "--preset must be one of " AK_PARTICLES_SCENE_PRESETS ", not '%s'", preset);
     long steps = 200, seed = 1, threads = 1;
     if (CLI_GET(&a, "--steps") && !cli_parse_int(CLI_GET(&a, "--steps"), 0, 100000000, &steps))
         return cli_usage("particles", "--steps '%s' is not a whole number in 0..100000000",
@@ -245,6 +252,7 @@ int cmd_particles(int argc, char** argv) {
             rc = cli_fail("particles", "out of memory");
             goto done;
         }
+        if ((rc = particles_sprites_init(&rd.sprites, &scene, "particles"))) goto done;
         rd.title = preset ? preset : "particles";
         if (gif) {
             ak_gif_desc gd = {.width = width,
@@ -310,6 +318,7 @@ done:
     if (rd.framed) cli_frame_free(&rd.frame);
     free(rd.image.pixels);
     free(rd.colours);
+    particles_sprites_free(&rd.sprites);
     particles_shapes_free(&rd.sh);
     if (use_char) particles_character_free(&ch);
     ak_particles_scene_free(&scene);

@@ -6,6 +6,15 @@
 #include "particles_run.h"
 #include "render.h"
 
+bool particles_preset_known(const char* name) {
+    if (!name) return false;
+    ak_particles_scene s;
+    ak_diag diag;
+    const ak_result res = ak_particles_scene_preset(name, &s, &diag);
+    ak_particles_scene_free(&s);
+    return res != AK_ERR_NOT_FOUND;
+}
+
 /* ---- the character ----------------------------------------------------------------------- */
 
 
@@ -204,4 +213,95 @@ ak_result particles_draw_points(ak_raster* ras, const ak_raster_camera* camera, 
                             .radius = ak_clampf(px, 1.0f, 12.0f),
                             .outline = px > 3.0f ? 1.0f : 0.0f};
     return ak_raster_draw_points(ras, camera, &pts);
+}
+
+/* ---- sprites ------------------------------------------------------------------------------- */
+
+int particles_sprites_init(particles_sprite_renderer* sr, const ak_particles_scene* s, const char* command) {
+    memset(sr, 0, sizeof *sr);
+    const ak_particles_scene_sprites* sp = &s->sprites;
+    if (!sp->enabled) return CLI_OK;
+    const size_t cap = (size_t)s->capacity + 1;
+    sr->sizes = calloc(cap, sizeof *sr->sizes);
+    sr->colours = calloc(cap, sizeof *sr->colours);
+    sr->frames = calloc(cap, sizeof *sr->frames);
+    sr->order = calloc(cap, sizeof *sr->order);
+    sr->depth = calloc(cap, sizeof *sr->depth);
+    if (!sr->sizes || !sr->colours || !sr->frames || !sr->order || !sr->depth) return cli_fail(command, "out of memory");
+    const int cols = sp->sheet_columns > 0 ? sp->sheet_columns : 1, rows = sp->sheet_rows > 0 ? sp->sheet_rows : 1;
+    if (sp->sheet_path) {
+        int w = 0, h = 0;
+        ak_result res = ak_png_info(sp->sheet_path, &w, &h);
+        if (res == AK_OK && ((double)w * (double)h > 4096.0 * 4096.0 || w < cols || h < rows))
+            return cli_fail(command, "%s: a %dx%d sprite sheet cannot hold %dx%d frames of at least 1 pixel (at most 4096x4096)",
+                            sp->sheet_path, w, h, cols, rows);
+        if (res == AK_OK) {
+            sr->texture = (ak_image){.pixels = malloc((size_t)w * (size_t)h * 4u), .width = w, .height = h};
+            res = sr->texture.pixels ? ak_png_read(sp->sheet_path, &sr->texture) : AK_ERR_NO_MEMORY;
+        }
+        if (res != AK_OK) return cli_fail(command, "%s: cannot read the sprite sheet: %s", sp->sheet_path, ak_result_string(res));
+    } else {
+        /* a sheet of built-in textures, one seed per frame: 64 x 64 pixels each, smaller for
+         * sheets of more than 16 frames a side (the sheet stays within 1024 x 1024, 4 MiB) */
+        const int side = cols > rows ? cols : rows, fw = side > 16 ? 1024 / side : 64;
+        sr->texture = (ak_image){.pixels = malloc((size_t)(cols * fw) * (size_t)(rows * fw) * 4u),
+                                 .width = cols * fw, .height = rows * fw};
+        if (!sr->texture.pixels) return cli_fail(command, "out of memory");
+        for (int f = 0; f < cols * rows; ++f) {
+            ak_image cell = {.pixels = ak_image_pixel(&sr->texture, (f % cols) * fw, (f / cols) * fw),
+                             .width = fw,
+                             .height = fw,
+                             .stride = (size_t)sr->texture.width * 4u};
+            ak_sprite_texture_generate(sp->texture, (uint32_t)f * 7919u + 1u, &cell);
+        }
+    }
+    sr->columns = cols, sr->rows = rows;
+    sr->ready = true;
+    return CLI_OK;
+}
+
+ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera, const ak_particles_scene* s,
+                                 particles_sprite_renderer* sr, ak_particles* ps) {
+    ak_particles_state st = ak_particles_get_state(ps);
+    if (!st.count || !sr->ready) return AK_OK;
+    const ak_particle_look* look = &s->sprites.look;
+    for (size_t i = 0; i < st.count; ++i) {
+        const ak_vec4 k = ak_particle_look_colour(look, st.age[i], st.lifetime[i]), c = st.colour[i];
+        sr->colours[i] = ak_vec4_make(c.x * k.x, c.y * k.y, c.z * k.z, c.w * k.w);
+        sr->sizes[i] = 2.0f * st.size[i] * ak_particle_look_size(look, st.age[i], st.lifetime[i]);
+        sr->frames[i] = ak_particle_look_frame(look, st.age[i], st.lifetime[i]);
+    }
+    const ak_blend blend = s->sprites.blend == AK_BLEND_ADD || s->sprites.blend == AK_BLEND_OPAQUE ? s->sprites.blend
+                                                                                                 : AK_BLEND_ALPHA;
+    ak_raster_sprites d = {.positions = {st.position, st.count},
+                           .sizes = {sr->sizes, st.count},
+                           .colors = {sr->colours, st.count},
+                           .frames = {sr->frames, st.count},
+                           .texture = &sr->texture,
+                           .sheet_columns = sr->columns,
+                           .sheet_rows = sr->rows,
+                           .blend = blend};
+    if (blend == AK_BLEND_ALPHA) { /* additive blending and depth-tested cut-outs do not depend on the order */
+        ak_result res = ak_raster_sprites_sort(camera, (ak_vec3_cspan){st.position, st.count},
+                                               (ak_f32_span){sr->depth, st.count}, (ak_u32_span){sr->order, st.count});
+        if (res != AK_OK) return res;
+        d.order = (ak_u32_cspan){sr->order, st.count};
+    }
+    return ak_raster_draw_sprites(ras, camera, &d);
+}
+
+bool particles_dark_sky(const ak_particles_scene* s, ak_vec4* top, ak_vec4* bottom) {
+    if (!s->sprites.enabled || s->sprites.blend != AK_BLEND_ADD) return false;
+    *top = ak_vec4_make(0.05f, 0.06f, 0.10f, 1), *bottom = ak_vec4_make(0.16f, 0.16f, 0.20f, 1);
+    return true;
+}
+
+void particles_sprites_free(particles_sprite_renderer* sr) {
+    free(sr->sizes);
+    free(sr->colours);
+    free(sr->frames);
+    free(sr->order);
+    free(sr->depth);
+    free(sr->texture.pixels);
+    memset(sr, 0, sizeof *sr);
 }

@@ -7,6 +7,9 @@
 #include "cli.h"
 #include <animkit/particles.h>
 
+/* Whether name is a preset of ak_particles_scene_preset (AK_PARTICLES_SCENE_PRESETS). */
+bool particles_preset_known(const char* name);
+
 /* The character preset: builtin:humanoid walking (clip 0), its posed meshes concatenated as
  * one collider and one emitter surface. */
 typedef struct particles_character {
@@ -60,5 +63,30 @@ void particles_bounds_add(ak_vec3* lo, ak_vec3* hi, ak_vec3 p);
  * at `centre` (1..12 pixels), outlined above 3 pixels. colours has room for the capacity. */
 ak_result particles_draw_points(ak_raster* ras, const ak_raster_camera* camera, int width, int height, ak_vec3 centre,
                                 ak_particles* ps, ak_vec4* colours);
+
+/* Sprite drawing of a scene whose "render" asks for sprites: per-particle arrays for the
+ * capacity, the texture (the scene's PNG sheet, or built-in puffs/discs, one per frame). */
+typedef struct particles_sprite_renderer {
+    bool ready; /* false: the scene draws points */
+    float* sizes;
+    ak_vec4* colours;
+    uint32_t* frames;
+    uint32_t* order;
+    float* depth;
+    ak_image texture;
+    int columns, rows;
+} particles_sprite_renderer;
+
+/* Prepare sr for s (nothing when s draws points); an exit code, with the message printed. */
+int particles_sprites_init(particles_sprite_renderer* sr, const ak_particles_scene* s, const char* command);
+/* Draw the live particles as sprites: colour and size over life, the frame from the age, sorted
+ * back to front for alpha blending. */
+ak_result particles_draw_sprites(ak_raster* ras, const ak_raster_camera* camera, const ak_particles_scene* s,
+                                 particles_sprite_renderer* sr, ak_particles* ps);
+/* Free (safe on a zeroed renderer). */
+void particles_sprites_free(particles_sprite_renderer* sr);
+/* Whether s draws glowing (additive) sprites, which `particles -o` and the viewer show on a
+ * dark sky; then *top and *bottom get its colours. */
+bool particles_dark_sky(const ak_particles_scene* s, ak_vec4* top, ak_vec4* bottom);
 
 #endif

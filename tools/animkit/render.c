@@ -120,7 +120,10 @@ void cli_frame_free(cli_frame* f) {
 ak_result cli_frame_draw(cli_frame* f, const cli_poser* p, const cli_draw_opts* o, const ak_image* out) {
     const ak_scene* s = p ? p->scene : NULL;
     ak_raster* r = f->raster;
-    ak_raster_clear(r, rgba(0.83f, 0.87f, 0.93f, 1), rgba(0.48f, 0.51f, 0.58f, 1));
+    if (o && (o->sky_top.w > 0.0f || o->sky_bottom.w > 0.0f))
+        ak_raster_clear(r, o->sky_top, o->sky_bottom);
+    else
+        ak_raster_clear(r, rgba(0.83f, 0.87f, 0.93f, 1), rgba(0.48f, 0.51f, 0.58f, 1));
     ak_raster_mesh* meshes = f->draw;
     size_t mc = 0;
     ak_vec4 clay = rgba(0.80f, 0.74f, 0.68f, 1);
@@ -237,15 +240,6 @@ int cli_weights_colors(const ak_scene* s, const char* bone, ak_vec4** colors, in
     return CLI_OK;
 }
 
-ak_vec4 cli_bone_color(size_t slot) {
-    /* hue steps of the golden angle: neighbours in the joint list get far-apart hues */
-    double hue = fmod((double)slot * 137.508, 360.0) / 60.0, s = 0.75, v = 0.95;
-    int sector = (int)hue;
-    double f = hue - sector, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
-    double rgb[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
-    const double* c = rgb[sector % 6];
-    return rgba((float)c[0], (float)c[1], (float)c[2], 1);
-}
 
 /* Render one still of the scene at its rest pose with colours on mesh_index; legend: up to
  * legend_count names with swatches down the left side. */
@@ -311,8 +305,9 @@ int cli_render_bones_png(const char* path, const ak_scene* s, size_t mesh_index,
     ak_vec4* sw = calloc(slot_count + 1, sizeof(ak_vec4));
     const char** names = calloc(slot_count + 1, sizeof(char*));
     size_t* dominant = calloc(slot_count + 1, sizeof(size_t));
-    if (!c || !sw || !names || !dominant) {
-        free(c), free(sw), free(names), free(dominant);
+    size_t* top_of = calloc(n + 1, sizeof(size_t));
+    if (!c || !sw || !names || !dominant || !top_of) {
+        free(c), free(sw), free(names), free(dominant), free(top_of);
         return cli_fail("weights", "out of memory");
     }
     for (size_t v = 0; v < n; ++v) {
@@ -323,16 +318,22 @@ int cli_render_bones_png(const char* path, const ak_scene* s, size_t mesh_index,
             size_t q = joints[v * k + i];
             if (wi > best && q < slot_count) best = wi, top = q;
         }
-        c[v] = top < slot_count ? cli_bone_color(top) : rgba(0.5f, 0.5f, 0.5f, 1);
+        top_of[v] = top;
         if (top < slot_count) ++dominant[top];
     }
-    /* legend: the bones that dominate some vertex, in slot order */
+    /* legend: the bones that dominate some vertex, in slot order, coloured with the first
+     * colours of ak_view_distinct_colors (each one far from all before it in OKLab), so the
+     * colours shown are as distinct as the palette allows; dominant[] becomes the legend row */
     size_t shown = 0;
     for (size_t q = 0; q < slot_count; ++q) {
         if (!dominant[q]) continue;
-        sw[shown] = cli_bone_color(q);
+        dominant[q] = shown;
         names[shown++] = slot_names[q];
     }
+    ak_view_distinct_colors((ak_vec4_span){sw, shown});
+    for (size_t v = 0; v < n; ++v)
+        c[v] = top_of[v] < slot_count ? sw[dominant[top_of[v]]] : rgba(0.5f, 0.5f, 0.5f, 1);
+    free(top_of);
     char title[160];
     snprintf(title, sizeof title, "dominant bone per vertex (%zu bone%s)", shown, cli_plural(shown));
     int rc = render_colored_png(path, s, mesh_index, c, title, names, sw, shown);

@@ -36,6 +36,7 @@ typedef struct cli_draw_opts {
      * simulations draw their particles and agents here); NULL -> nothing */
     ak_result (*draw)(void* user, ak_raster* raster, const ak_raster_camera* camera, int width, int height);
     void* draw_user;
+    ak_vec4 sky_top, sky_bottom; /* background gradient; both all zero -> the light default sky */
 } cli_draw_opts;
 
 /* Where the camera looks from. Zero -> the orbit framing cli_frame_init uses (yaw 31.5, pitch
@@ -72,12 +73,10 @@ int cli_weights_colors(const ak_scene* s, const char* bone, ak_vec4** colors, in
 
 int cli_render_weights_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
                            const float* weights, uint32_t k, int slot, const char* bone_name);
-/* Colour of skin slot (bone) number slot in "every bone's region" pictures: hue slot * 137.508
- * degrees (the golden angle) mod 360, saturation 0.75, value 0.95 (HSV, sRGB out). */
-ak_vec4 cli_bone_color(size_t slot);
-/* Every bone's region: each vertex coloured by its weights' blend of cli_bone_color(slot),
- * so the dominant bone's colour fills its region, with a legend naming each bone that
- * dominates some vertex (slot_names[slot_count]). */
+/* Every bone's region: each vertex in the colour of the bone that weighs it most, with a legend
+ * naming each bone that dominates some vertex (slot_names[slot_count]); the legend's bones take
+ * the colours of ak_view_distinct_colors in order (distinct for up to 222 bones, the most
+ * distinct first), undominated vertices are grey. */
 int cli_render_bones_png(const char* path, const ak_scene* s, size_t mesh_index, const uint16_t* joints,
                          const float* weights, uint32_t k, size_t slot_count, const char* const* slot_names);
 int cli_render_ik_png(const char* path, cli_poser* p, const int16_t* chain, size_t n, ak_vec3 target);

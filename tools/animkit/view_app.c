@@ -71,11 +71,37 @@ static int make_frame(view_app* a, cli_frame* f, ak_image* img, int w, int h) {
     return CLI_OK;
 }
 
+/* The camera's position: -R^T t of the rigid view matrix. */
+static ak_vec3 camera_eye(const ak_raster_camera* c) {
+    const float* m = c->view.m;
+    return ak_vec3_make(-(m[0] * m[12] + m[1] * m[13] + m[2] * m[14]), -(m[4] * m[12] + m[5] * m[13] + m[6] * m[14]),
+                        -(m[8] * m[12] + m[9] * m[13] + m[10] * m[14]));
+}
+
+/* Where the eye may not go below: the floor (the ground is drawn at the framed box's bottom)
+ * and a simulation's surface under it (terrain), plus 1% of the box's diagonal. */
+static float camera_min_height(const view_app* a, ak_vec3 eye) {
+    const float clearance = 0.01f * ak_vec3_length(ak_vec3_sub(a->box_hi, a->box_lo));
+    float floor_y = a->box_lo.y, surface = 0.0f;
+    if (a->sim && a->sim->surface && a->sim->surface(a->sim_state, eye.x, eye.z, &surface) && surface > floor_y)
+        floor_y = surface;
+    return floor_y + clearance;
+}
+
+/* The orbit camera; orbiting or panning never takes it under the floor or the terrain: the
+ * elevation is raised (in steps of 0.01 rad, up to the orbit's 1.45 limit) until the eye is
+ * above both, and kept, so dragging further down leaves the view where it is. */
 static void camera_update(view_app* a, cli_frame* f) {
     ak_view_orbit o = a->orbit;
     o.aspect = (float)f->width / (float)f->height;
     o.margin = 1.08f * a->zoom;
-    f->camera = ak_view_orbit_camera(ak_vec3_add(a->box_lo, a->pan), ak_vec3_add(a->box_hi, a->pan), &o);
+    for (int k = 0; k < 400; ++k) {
+        f->camera = ak_view_orbit_camera(ak_vec3_add(a->box_lo, a->pan), ak_vec3_add(a->box_hi, a->pan), &o);
+        const ak_vec3 eye = camera_eye(&f->camera);
+        if (!(eye.y < camera_min_height(a, eye)) || o.elevation >= 1.45f) break;
+        o.elevation = ak_minf(o.elevation + 0.01f, 1.45f);
+    }
+    a->orbit.elevation = o.elevation;
     f->bmin = a->box_lo;
     f->bmax = a->box_hi;
 }
@@ -500,6 +526,8 @@ static ak_result draw_view(view_app* a, cli_frame* f, const ak_image* img) {
         .draw = a->sim ? a->sim->draw : NULL,
         .draw_user = a->sim_state,
     };
+    if (a->sim && a->sim->sky && !a->sim->sky(a->sim_state, &o.sky_top, &o.sky_bottom))
+        o.sky_top = o.sky_bottom = ak_vec4_make(0, 0, 0, 0);
     ak_result r = cli_frame_draw(f, &a->poser, &o, img);
     if (r != AK_OK) return r;
     if (a->show_normals) draw_normals(a, f, img);

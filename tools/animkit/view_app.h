@@ -109,6 +109,12 @@ typedef struct view_sim {
     ak_result (*draw)(void* state, ak_raster* raster, const ak_raster_camera* camera, int width, int height);
     void (*overlay)(void* state, const ak_raster_camera* camera, const ak_image* image);
     void (*bounds)(void* state, ak_vec3* lo, ak_vec3* hi);
+    /* Optional: height of the simulation's ground surface under (x, z) (terrain), false where
+     * there is none; the orbit keeps the camera above it as above the floor. */
+    bool (*surface)(void* state, float x, float z, float* out_height);
+    /* Optional: a background gradient instead of the light sky (the fire preset's additive
+     * sprites glow on a dark one); false -> the default. */
+    bool (*sky)(void* state, ak_vec4* top, ak_vec4* bottom);
     bool (*key)(void* state, int key, char* msg, size_t msg_size);
     bool (*grab)(void* state, const ak_raster_camera* camera, int width, int height, float x, float y, ak_vec3* anchor);
     void (*drag)(void* state, ak_vec3 delta);

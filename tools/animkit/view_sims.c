@@ -111,6 +111,7 @@ typedef struct psim {
     bool run_ready, failed;
     particles_shapes sh;
     ak_vec4* colours;
+    particles_sprite_renderer sprites;
     long step_index;
     double carry; /* simulated time owed to the next step */
     ak_vec3 lo, hi;
@@ -118,6 +119,10 @@ typedef struct psim {
     uint64_t seed;
     uint32_t threads;
 } psim;
+
+static bool psim_sky(void* state, ak_vec4* top, ak_vec4* bottom) {
+    return particles_dark_sky(&((const psim*)state)->scene, top, bottom);
+}
 
 static void psim_destroy(void* state) {
     psim* p = state;
@@ -127,6 +132,7 @@ static void psim_destroy(void* state) {
     if (p->char_ready) particles_character_free(&p->ch);
     free(p->spheres0);
     free(p->colours);
+    particles_sprites_free(&p->sprites);
     ak_particles_scene_free(&p->scene);
     free(p);
 }
@@ -198,9 +204,9 @@ static int psim_init(void** state, const char* spec, const view_sim_opts* o, cha
     int rc = CLI_OK;
     if (strncmp(spec, "preset:", 7) == 0) {
         const char* name = spec + 7;
-        if (strcmp(name, "fountain") && strcmp(name, "rain") && strcmp(name, "fireworks") && strcmp(name, "character"))
+        if (!particles_preset_known(name))
             return init_fail(psim_destroy, p, CLI_BAD_USAGE, err, err_size,
-                             "particles:preset:%s: the presets are fountain, rain, fireworks, character", name);
+                             "particles:preset:%s: the presets are " AK_PARTICLES_SCENE_PRESETS, name);
         ak_diag diag;
         if (ak_particles_scene_preset(name, &p->scene, &diag) != AK_OK)
             return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "%s", diag.message);
@@ -227,6 +233,7 @@ static int psim_init(void** state, const char* spec, const view_sim_opts* o, cha
         p->char_ready = true; /* freed at the end whatever init made */
     }
     if (rc == CLI_OK) rc = psim_bounds_run(p);
+    if (rc == CLI_OK) rc = particles_sprites_init(&p->sprites, &p->scene, "view");
     if (rc)
         return init_fail(psim_destroy, p, CLI_BAD_INPUT, err, err_size, "cannot start the particle simulation");
     *state = p;
@@ -270,6 +277,7 @@ static size_t psim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
 
 static ak_result psim_draw(void* state, ak_raster* ras, const ak_raster_camera* cam, int w, int h) {
     psim* p = state;
+    if (p->sprites.ready) return particles_draw_sprites(ras, cam, &p->scene, &p->sprites, p->run.ps);
     return particles_draw_points(ras, cam, w, h, ak_vec3_scale(ak_vec3_add(p->lo, p->hi), 0.5f), p->run.ps, p->colours);
 }
 
@@ -333,6 +341,7 @@ static const view_sim particles_sim = {
     .meshes = psim_meshes,
     .draw = psim_draw,
     .bounds = psim_bounds,
+    .sky = psim_sky,
     .key = psim_key,
     .grab = psim_grab,
     .drag = psim_drag,
