@@ -1,9 +1,9 @@
 """animkit.batch on Dask: throughput with 1 and 2 workers and per-job overhead
 (docs/BENCHMARKS.md, "Python bindings").
 
-    make python && PYTHONPATH=python /usr/bin/python3 bench/bench_batch_dask.py [JOBS]
+    make python && PYTHONPATH=build/python /usr/bin/python3 bench/bench_batch_dask.py [JOBS] [WxH]
 
-JOBS render jobs (CesiumMan, or builtin:cylinder without the assets, 160x120, each at its own
+JOBS render jobs (CesiumMan, or builtin:cylinder without the assets, WxH (160x120), each at its own
 time) run three ways in one run: in this process one after another (animkit.batch.run_job), and
 through animkit.batch.run on a LocalCluster of 1 and of 2 single-threaded worker processes
 (force=True so no job is skipped). Prints jobs/s of each, the 2-worker scaling (target >= 1.8x
@@ -23,10 +23,11 @@ ASSETS = os.environ.get("ANIMKIT_ASSETS") or os.path.join(HERE, "..", "..", "sha
 
 def main():
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 48
+    w, h = (int(v) for v in (sys.argv[2] if len(sys.argv) > 2 else "160x120").split("x"))
     model = os.path.join(ASSETS, "gltf", "CesiumMan", "glTF-Binary", "CesiumMan.glb")
     if not os.path.exists(model):
         model = "builtin:cylinder"
-    jobs = [{"kind": "render", "inputs": {"model": model}, "parameters": {"time": 0.04 * i, "size": [160, 120]},
+    jobs = [{"kind": "render", "inputs": {"model": model}, "parameters": {"time": 0.04 * i, "size": [w, h]},
              "output": f"frame_{i:03d}.png"} for i in range(n)]
     out = tempfile.mkdtemp(prefix="bench_batch_")
     try:
@@ -45,7 +46,7 @@ def main():
                 assert all(r["status"] == "ran" for r in rows), [r for r in rows if r["status"] != "ran"][:1]
     finally:
         shutil.rmtree(out, ignore_errors=True)
-    print(f"{n} render jobs of {os.path.basename(model)} at 160x120")
+    print(f"{n} render jobs of {os.path.basename(model)} at {w}x{h}")
     print(f"in-process        {n / local:8.1f} jobs/s   ({local / n * 1e3:7.2f} ms per job)")
     for w in (1, 2):
         print(f"Dask, {w} worker{'s' if w > 1 else ' '}    {n / rates[w]:8.1f} jobs/s   ({rates[w] / n * 1e3:7.2f} ms per job)")
