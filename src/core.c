@@ -34,6 +34,20 @@ const char* ak_result_name(ak_result result) {
 
 const char* ak_version_string(void) { return "0.1.0"; }
 
+size_t ak_utf8_char(const void* ptr, size_t avail) {
+    const unsigned char* p = (const unsigned char*)ptr;
+    if (!p || !avail) return 0;
+    const unsigned char c = p[0];
+    if (c < 0x80) return 1;
+    const size_t len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+    if (!len || len > avail) return 0;
+    for (size_t k = 1; k < len; ++k) /* stops at a NUL too: it is no continuation byte */
+        if ((p[k] & 0xC0) != 0x80) return 0;
+    if (len == 3 && ((c == 0xE0 && p[1] < 0xA0) || (c == 0xED && p[1] >= 0xA0))) return 0; /* overlong, surrogate */
+    if (len == 4 && ((c == 0xF0 && p[1] < 0x90) || (c == 0xF4 && p[1] >= 0x90))) return 0; /* overlong, > U+10FFFF */
+    return len;
+}
+
 /* ---- atomic output files -------------------------------------------------------------------- */
 
 /* "DIR/.BASE.XXXXXX" for path "DIR/BASE" (or ".BASE.XXXXXX" without a slash); false when the

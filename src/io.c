@@ -198,25 +198,10 @@ done:
     return r;
 }
 
-/* Length of the valid UTF-8 sequence at s (n bytes left), 0 when invalid. */
-static size_t utf8_seq(const unsigned char* s, size_t n) {
-    unsigned char c = s[0];
-    if (c < 0x80) return 1;
-    size_t len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
-    if (len == 0 || len > n) return 0;
-    for (size_t i = 1; i < len; ++i)
-        if ((s[i] & 0xC0) != 0x80) return 0;
-    if (c == 0xE0 && s[1] < 0xA0) return 0; /* overlong */
-    if (c == 0xED && s[1] > 0x9F) return 0; /* surrogates */
-    if (c == 0xF0 && s[1] < 0x90) return 0; /* overlong */
-    if (c == 0xF4 && s[1] > 0x8F) return 0; /* above U+10FFFF */
-    return len;
-}
-
 bool akp_io_utf8_valid(const char* s, size_t n) {
     const unsigned char* u = (const unsigned char*)s;
     for (size_t i = 0; i < n;) {
-        size_t l = utf8_seq(u + i, n - i);
+        size_t l = ak_utf8_char(u + i, n - i);
         if (l == 0) return false;
         i += l;
     }
@@ -230,7 +215,7 @@ void akp_io_sanitize(char* msg, size_t size) {
     bool changed = false;
     for (size_t i = 0; i < n && o + 1 < sizeof tmp;) {
         const unsigned char c = (unsigned char)msg[i];
-        size_t l = c < 0x20 || c == 0x7F ? 0 : utf8_seq((const unsigned char*)msg + i, n - i);
+        size_t l = c < 0x20 || c == 0x7F ? 0 : ak_utf8_char(msg + i, n - i);
         if (l == 0) {
             if (o + 5 >= sizeof tmp) break;
             snprintf(tmp + o, 5, "\\x%02X", c);

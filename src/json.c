@@ -8,19 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-size_t akp_utf8_char(const unsigned char* p, size_t avail) {
-    if (!avail) return 0;
-    const unsigned char c = p[0];
-    if (c < 0x80) return 1;
-    const size_t len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
-    if (!len || len > avail) return 0;
-    for (size_t k = 1; k < len; ++k) /* stops at a NUL too: it is no continuation byte */
-        if ((p[k] & 0xC0) != 0x80) return 0;
-    if (len == 3 && ((c == 0xE0 && p[1] < 0xA0) || (c == 0xED && p[1] >= 0xA0))) return 0; /* overlong, surrogate */
-    if (len == 4 && ((c == 0xF0 && p[1] < 0x90) || (c == 0xF4 && p[1] >= 0x90))) return 0; /* overlong, > U+10FFFF */
-    return len;
-}
-
 static const char* type_name(const cJSON* v) {
     if (cJSON_IsNumber(v)) return "a number";
     if (cJSON_IsString(v)) return "a string";
@@ -166,7 +153,7 @@ static const char* strict_json_error(const char* text, size_t size, const char**
                     ++i;
                     continue;
                 }
-                const size_t n = akp_utf8_char(s + i, size - i);
+                const size_t n = ak_utf8_char(s + i, size - i);
                 if (!n) {
                     *what = "invalid UTF-8 in a string";
                     return text + i;

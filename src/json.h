@@ -33,10 +33,6 @@
 #include <animkit/math.h>
 #include <cjson/cJSON.h> /* Debian libcjson-dev, as the glTF reader */
 
-/* Bytes of the valid UTF-8 character (RFC 3629: no overlong form, no surrogate, at most
- * U+10FFFF) at p, reading at most avail bytes; 0 when the bytes there are not one. */
-size_t akp_utf8_char(const unsigned char* p, size_t avail);
-
 /* Largest scene file akp_json_load reads when max_size is 0. */
 #define AKP_JSON_MAX_SIZE ((size_t)64 << 20)
 

@@ -244,6 +244,12 @@ AK_API void ak_atomic_file_abort(ak_atomic_file* a);
 /* "0.1.0" */
 AK_API const char* ak_version_string(void);
 
+/* Bytes of the valid UTF-8 character at p (RFC 3629: no overlong form, no surrogate, at most
+ * U+10FFFF), reading at most avail bytes; 0 when the bytes there are not one (a NUL inside a
+ * multi-byte sequence included) or avail is 0. The one UTF-8 check of the readers (glTF, BVH,
+ * OBJ names; JSON scene files) and of the command's printing. Pure. */
+AK_API size_t ak_utf8_char(const void* p, size_t avail);
+
 #ifdef __cplusplus
 }
 #endif

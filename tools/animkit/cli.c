@@ -11,22 +11,6 @@
 #include <string.h>
 #include <strings.h>
 
-/* Bytes of the valid UTF-8 character (RFC 3629: no overlong form, no surrogate, at most
- * U+10FFFF) at p, reading at most avail bytes; 0 when the bytes there are not one. The
- * library's scene reader checks input with its own copy (src/json.c); this one guards what
- * the command prints. */
-static size_t cli_utf8_char(const unsigned char* p, size_t avail) {
-    if (!avail) return 0;
-    const unsigned char c = p[0];
-    if (c < 0x80) return 1;
-    const size_t len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
-    if (!len || len > avail) return 0;
-    for (size_t k = 1; k < len; ++k) /* stops at a NUL too: it is no continuation byte */
-        if ((p[k] & 0xC0) != 0x80) return 0;
-    if (len == 3 && ((c == 0xE0 && p[1] < 0xA0) || (c == 0xED && p[1] >= 0xA0))) return 0; /* overlong, surrogate */
-    if (len == 4 && ((c == 0xF0 && p[1] < 0x90) || (c == 0xF4 && p[1] >= 0x90))) return 0; /* overlong, > U+10FFFF */
-    return len;
-}
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -92,7 +76,7 @@ size_t cli_escape(char* out, size_t cap, const char* s) {
     const unsigned char* p = (const unsigned char*)(s ? s : "");
     while (*p) {
         unsigned char c = *p;
-        const size_t len = cli_utf8_char(p, SIZE_MAX);
+        const size_t len = ak_utf8_char(p, SIZE_MAX);
         const bool ok = len > 0;
         const bool c1 = ok && len == 2 && c == 0xC2 && p[1] < 0xA0; /* U+0080..U+009F: C1 controls */
         if (!ok || c < 0x20 || c == 0x7f || c1) {
@@ -337,7 +321,7 @@ void cli_json_string(FILE* f, const char* s) {
     for (const unsigned char* p = (const unsigned char*)(s ? s : ""); *p;) {
         const unsigned char c = *p;
         if (c >= 0x80) { /* copy a valid UTF-8 character; an invalid byte becomes U+FFFD */
-            const size_t len = cli_utf8_char(p, SIZE_MAX);
+            const size_t len = ak_utf8_char(p, SIZE_MAX);
             if (len) fwrite(p, 1, len, f), p += len;
             else fputs("\\ufffd", f), ++p;
             continue;
