@@ -217,6 +217,30 @@ static void add_input(job_ctx* c, const char* role, const char* as_written, cons
     ++c->input_count;
 }
 
+static ak_result save_scene(job_ctx* c, ak_scene* out) {
+    ak_diag d;
+    memset(&d, 0, sizeof d);
+    ak_io_save_desc sd = {0};
+    const ak_result r = ak_io_save(c->output, out, &sd, &d);
+    return r == AK_OK ? AK_OK : fail(c, r, "output: %s: %s", c->output, d.message[0] ? d.message : ak_result_string(r));
+}
+
+/* Bake point frames (fluid, particles, boids) into a scene and write it to the job's output;
+ * c->frames = the frames written. */
+static ak_result save_points(job_ctx* c, const ak_scene_bake_points_desc* bd) {
+    ak_scene* out = NULL;
+    ak_diag d;
+    memset(&d, 0, sizeof d);
+    ak_result r = ak_scene_bake_point_frames(bd, NULL, &out, &d);
+    if (r != AK_OK) {
+        r = fail(c, r, "bake: %s", d.message[0] ? d.message : ak_result_string(r));
+    } else if ((r = save_scene(c, out)) == AK_OK) {
+        c->frames = (long)bd->frame_count;
+    }
+    ak_scene_destroy(out);
+    return r;
+}
+
 /* The inputs' hashes (built-in names and presets hash their name) and the job hash. */
 static ak_result hash_job(job_ctx* c, uint64_t* out) {
     const ak_batch_job* job = c->job;
@@ -361,7 +385,6 @@ static ak_result run_bake(job_ctx* c) {
     uint32_t* ids = calloc(cap + 1, sizeof *ids);
     ak_scene_bake_points* fr = calloc(frames, sizeof *fr);
     void* scratch = scratch_size ? malloc(scratch_size) : NULL;
-    ak_scene* out = NULL;
     if (!pos || !vel || !baked || !ids || !fr || !scratch) {
         r = scratch_size ? fail(c, AK_ERR_NO_MEMORY, "out of memory") : fail(c, AK_ERR_BAD_ARG, "no valid solver setup");
         goto done;
@@ -387,18 +410,8 @@ static ak_result run_bake(job_ctx* c) {
     if (r != AK_OK) goto done;
     ak_scene_bake_points_desc bd = {.name = "fluid", .frames = fr, .frame_count = f,
                                     .frame_time = (float)every * s->dt, .marker_size = 0.5f * ak_fluid_rest_spacing(&s->desc)};
-    memset(&d, 0, sizeof d);
-    r = ak_scene_bake_point_frames(&bd, NULL, &out, &d);
-    if (r != AK_OK) {
-        r = fail(c, r, "bake: %s", d.message[0] ? d.message : ak_result_string(r));
-        goto done;
-    }
-    ak_io_save_desc sd = {0};
-    r = ak_io_save(c->output, out, &sd, &d);
-    if (r != AK_OK) r = fail(c, r, "output: %s: %s", c->output, d.message[0] ? d.message : ak_result_string(r));
-    c->frames = (long)f;
+    r = save_points(c, &bd);
 done:
-    ak_scene_destroy(out);
     free(scratch), free(fr), free(ids), free(baked), free(vel), free(pos), free(s);
     return r;
 }
@@ -425,7 +438,6 @@ static ak_result run_bake_particles(job_ctx* c) {
     ak_vec3* baked = calloc(frames * (cap + 1), sizeof *baked);
     uint32_t* ids = calloc(frames * (cap + 1), sizeof *ids);
     ak_scene_bake_points* fr = calloc(frames, sizeof *fr);
-    ak_scene* out = NULL;
     if (!baked || !ids || !fr) {
         r = fail(c, AK_ERR_NO_MEMORY, "out of memory");
         goto done;
@@ -452,18 +464,8 @@ static ak_result run_bake_particles(job_ctx* c) {
     }
     ak_scene_bake_points_desc bd = {.name = "particles", .frames = fr, .frame_count = f, .interp = AK_INTERP_STEP,
                                     .frame_time = (float)every * s.dt, .marker_size = 0.025f};
-    memset(&d, 0, sizeof d);
-    r = ak_scene_bake_point_frames(&bd, NULL, &out, &d);
-    if (r != AK_OK) {
-        r = fail(c, r, "bake: %s", d.message[0] ? d.message : ak_result_string(r));
-        goto done;
-    }
-    ak_io_save_desc sd = {0};
-    r = ak_io_save(c->output, out, &sd, &d);
-    if (r != AK_OK) r = fail(c, r, "output: %s: %s", c->output, d.message[0] ? d.message : ak_result_string(r));
-    c->frames = (long)f;
+    r = save_points(c, &bd);
 done:
-    ak_scene_destroy(out);
     ak_particles_scene_run_free(&run);
     ak_particles_scene_free(&s);
     free(fr), free(ids), free(baked);
@@ -473,14 +475,6 @@ done:
 /* Steps and frames of a bake: every `every` steps from 0 to steps. */
 static long bake_every(const ak_batch_job* job, long steps) {
     return job->frame_every ? job->frame_every : (steps + BAKE_DEFAULT_FRAMES - 1) / BAKE_DEFAULT_FRAMES;
-}
-
-static ak_result save_scene(job_ctx* c, ak_scene* out) {
-    ak_diag d;
-    memset(&d, 0, sizeof d);
-    ak_io_save_desc sd = {0};
-    const ak_result r = ak_io_save(c->output, out, &sd, &d);
-    return r == AK_OK ? AK_OK : fail(c, r, "output: %s: %s", c->output, d.message[0] ? d.message : ak_result_string(r));
 }
 
 /* A cloth scene (file or preset) without a character, run as `animkit cloth` runs it and baked
@@ -557,7 +551,6 @@ static ak_result run_bake_boids(job_ctx* c) {
     ak_vec3* pos = NULL;
     uint32_t* ids = NULL;
     ak_scene_bake_points* fr = NULL;
-    ak_scene* out = NULL;
     if (r != AK_OK) {
         r = fail(c, r, "inputs.scene: %s", d.message);
         goto done;
@@ -599,15 +592,8 @@ static ak_result run_bake_boids(job_ctx* c) {
     }
     ak_scene_bake_points_desc bd = {.name = "boids", .frames = fr, .frame_count = f,
                                     .frame_time = (float)every * s.dt, .marker_size = 0.5f * s.shape_size};
-    memset(&d, 0, sizeof d);
-    if ((r = ak_scene_bake_point_frames(&bd, NULL, &out, &d)) != AK_OK) {
-        r = fail(c, r, "bake: %s", d.message[0] ? d.message : ak_result_string(r));
-        goto done;
-    }
-    r = save_scene(c, out);
-    c->frames = (long)f;
+    r = save_points(c, &bd);
 done:
-    ak_scene_destroy(out);
     free(fr), free(ids), free(pos);
     ak_boids_scene_run_free(&run);
     ak_boids_scene_free(&s);
