@@ -329,7 +329,7 @@ int main(void) {
     AK_RUN(default_box_grows_with_count);
     AK_RUN(render_and_example_scene);
     AK_RUN(search_grid_and_naive);
-    AK_RUN(default_and_presets_flock);
+    AK_RUN_SLOW(default_and_presets_flock); /* 4-6 s of flocking runs: end to end */
     AK_RUN_SLOW(presets_flock_at_every_seed);
     return ak_test_finish();
 }

@@ -1036,7 +1036,7 @@ int main(void) {
     AK_RUN_SLOW(weights_legend_colours_distinct);
     AK_RUN_SLOW(curves_select_and_paginate);
     AK_RUN(render_obj_characters);
-    AK_RUN(messages_round_two);
+    AK_RUN_SLOW(messages_round_two); /* ten commands on builtin:humanoid: end to end */
     AK_RUN_SLOW(success_output_rule);
     return ak_test_finish();
 }

@@ -667,7 +667,7 @@ int main(void) {
     AK_RUN_SLOW(automatic_roles_of_the_long_bvh);
 #ifdef AK_CLI_PATH
     AK_RUN(cli_exports_stand_on_the_floor);
-    AK_RUN(cli_gif_frames_each_figure);
+    AK_RUN_SLOW(cli_gif_frames_each_figure); /* a whole retarget GIF: end to end */
     AK_RUN(cli_automatic_map);
     AK_RUN_SLOW(cli_retarget);
 #endif
