@@ -35,7 +35,7 @@ mapfile -t LIB < <(ls src/*.c src/*/*.c | grep -v -E '^src/(raster/raster_file|i
 TOOLS=(tools/animkit/view_app.c tools/animkit/view_sims.c tools/animkit/view_terrain.c
        tools/animkit/view_script.c tools/animkit/cli.c tools/animkit/render.c tools/animkit/pose.c
        tools/animkit/boids_run.c tools/animkit/cloth_run.c tools/animkit/particles_run.c tools/animkit/outfile.c)
-WEB=(web/animkit_web.c web/cjson.c web/stubs.c)
+WEB=(web/animkit_web.c web/fluid_sim.c web/cjson.c web/stubs.c)
 
 CFLAGS=(--target=wasm32-wasi -std=c11 -O2 -msimd128 -Wall -Wextra -Wpedantic -Werror
         -fno-math-errno -ffp-contract=off -D_POSIX_C_SOURCE=200809L -D_WASI_EMULATED_GETPID -DAK_BUILDING -include web/shim/wasi_compat.h

@@ -49,7 +49,7 @@ ak_result ak_mesh_create(const ak_mesh_desc* desc, const ak_allocator* alloc, ak
     if (!mul_ok(t, 3, &idx_count) || !mul_ok(v, desc->influence_count, &infl_count) ||
         !mul_ok(v, m, &morph_count))
         return AK_ERR_BAD_ARG;
-    if (idx_count > 0 && v > (size_t)UINT32_MAX + 1u) return AK_ERR_BAD_ARG; /* indices are u32 */
+    if (idx_count > 0 && (uint64_t)v > (uint64_t)UINT32_MAX + 1u) return AK_ERR_BAD_ARG; /* indices are u32 (64-bit sum: size_t may be 32 bits) */
 
     size_t total = MESH_HEADER_SIZE + akp_align16(sizeof(ak_mesh));
     bool ok = add_array(&total, v, sizeof(ak_vec3)) &&

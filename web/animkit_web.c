@@ -21,6 +21,7 @@
 #include <animkit/animkit.h>
 
 #include "view_app.h"
+#include "web.h"
 
 #define AKW_EXPORT(name) __attribute__((export_name(#name)))
 
@@ -95,6 +96,10 @@ AKW_EXPORT(akw_open) int akw_open(const char* what, int width, int height) {
     vo.sim_opts.threads = 1;
     const char* spec = NULL;
     vo.sim = view_sim_find(what, &spec);
+    if (!vo.sim && strncmp(what, "fluid", 5) == 0 && (what[5] == 0 || what[5] == ':')) {
+        vo.sim = &web_fluid_sim;
+        spec = what[5] ? what + 6 : "";
+    }
     vo.sim_spec = spec;
     if (vo.sim) {
         if (ak_scene_alloc(0, 0, 0, NULL, &g.scene) != AK_OK) return fail("out of memory");
@@ -109,7 +114,7 @@ AKW_EXPORT(akw_open) int akw_open(const char* what, int width, int height) {
     } else if (strncmp(what, "builtin:", 8) == 0) {
         if (cli_load_scene("view", what, &g.scene)) return fail("%s: cannot build it", what);
     } else {
-        return fail("'%s' is neither builtin:NAME, file: nor a simulation (%s)", what, view_sim_kinds);
+        return fail("'%s' is neither builtin:NAME, file: nor a simulation (%s, fluid)", what, view_sim_kinds);
     }
     if (g.scene->clip_count) vo.clip = 0;
     if (view_app_init(&g.app, g.scene, &vo)) {

@@ -1,0 +1,232 @@
+// Browser tests of the WebAssembly page (docs/web.md): Debian's Chromium, headless, driven by
+// puppeteer-core. Usage:
+//   node tests/web/run.mjs WEB_DIR ANIMKIT_CLI OUT_DIR [CESIUMMAN.glb]
+// WEB_DIR holds `make web`'s output (index.html, animkit.wasm); ANIMKIT_CLI is the native
+// command (the cloth reference); OUT_DIR receives the screenshots and results.json. Exit 0 pass,
+// 1 fail, 77 skip (no Chromium, no puppeteer-core).
+import { execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import http from 'node:http';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const [webArg, cli, outDir, cesium] = process.argv.slice(2);
+const webDir = webArg && path.resolve(webArg);
+if (!webArg || !cli || !outDir) {
+  console.error('usage: node run.mjs WEB_DIR ANIMKIT_CLI OUT_DIR [CESIUMMAN.glb]');
+  process.exit(2);
+}
+const chromium = process.env.CHROMIUM || ['/usr/bin/chromium', '/usr/bin/chromium-browser'].find((p) => fs.existsSync(p));
+if (!chromium) {
+  console.log('SKIP: no Chromium (Debian: apt-get install chromium; or set CHROMIUM)');
+  process.exit(77);
+}
+let puppeteer;
+try {
+  puppeteer = (await import('puppeteer-core')).default;
+} catch {
+  console.log('SKIP: puppeteer-core is not installed (cd tests/web && npm ci)');
+  process.exit(77);
+}
+fs.mkdirSync(outDir, { recursive: true });
+
+// ---- a static server on 127.0.0.1 for WEB_DIR ----
+const types = { '.html': 'text/html', '.js': 'text/javascript', '.wasm': 'application/wasm' };
+const server = http.createServer((req, res) => {
+  const rel = decodeURIComponent(new URL(req.url, 'http://x').pathname).replace(/^\/+/, '') || 'index.html';
+  const file = path.join(webDir, rel);
+  if (!file.startsWith(webDir + path.sep) || !fs.existsSync(file)) { res.writeHead(404); res.end(); return; }
+  res.writeHead(200, { 'Content-Type': types[path.extname(file)] || 'application/octet-stream' });
+  fs.createReadStream(file).pipe(res);
+});
+await new Promise((r) => server.listen(0, '127.0.0.1', r));
+const origin = `http://127.0.0.1:${server.address().port}`;
+
+let failures = 0;
+const results = {};
+function check(ok, what, detail) {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}${detail ? ': ' + detail : ''}`);
+  if (!ok) failures++;
+}
+
+const browser = await puppeteer.launch({
+  executablePath: chromium,
+  headless: true,
+  args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--no-first-run', '--disable-extensions'],
+});
+try {
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1000, height: 760 });
+  const consoleErrors = [], offsite = [];
+  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+  page.on('pageerror', (e) => consoleErrors.push(String(e)));
+  await page.setRequestInterception(true);
+  page.on('request', (req) => {
+    if (req.url().startsWith(origin + '/') || req.url().startsWith('data:')) req.continue();
+    else { offsite.push(req.url()); req.abort(); }
+  });
+
+  // ---- 1. the page loads, nothing from the network, no console errors ----
+  await page.goto(`${origin}/index.html?paused=1`, { waitUntil: 'load' });
+  const loaded = await page.evaluate(() => window.animkit && window.animkit.ready.then(() => true, (e) => String(e)));
+  if (loaded !== true) throw new Error(`the page did not start: ${loaded}; console: ${consoleErrors.join(' | ')}`);
+  const wasmBytes = await page.evaluate(() => window.animkit.wasmBytes);
+  results.wasm_bytes = wasmBytes;
+  check(wasmBytes > 0 && wasmBytes <= 1.5 * 1024 * 1024, 'animkit.wasm is at most 1.5 MB', `${wasmBytes} bytes`);
+  const canvas = await page.$('#view');
+  const shot = async (name) => { await canvas.screenshot({ path: path.join(outDir, name) }); };
+  await page.evaluate(() => window.animkit.frame(0));
+  await shot('01_humanoid.png');
+
+  // ---- 2. drag an IK target with the mouse; the effector follows within 1e-3 ----
+  const ik = await page.evaluate(() => {
+    const a = window.animkit;
+    a.open('builtin:humanoid', 960, 600);
+    a.key(' '); // pause the walk: the target is dragged on a still pose
+    a.frame(0);
+    const j = a.jointFind('left_wrist');
+    return { j, xy: a.jointScreen(j) };
+  });
+  check(ik.j >= 0 && ik.xy, 'builtin:humanoid has a left_wrist on screen', JSON.stringify(ik));
+  const box = await canvas.boundingBox();
+  const sx = box.width / 960, sy = box.height / 600; // canvas pixels -> page pixels
+  const drags = [[18, -22], [-10, 14], [6, 8]];
+  let x = box.x + ik.xy[0] * sx, y = box.y + ik.xy[1] * sy;
+  const ikRows = [];
+  for (const [dx, dy] of drags) {
+    // press on the effector (the first press picks the joint, later ones grab its target marker)
+    await page.mouse.move(x, y);
+    await page.mouse.down();
+    for (let k = 1; k <= 8; k++) await page.mouse.move(x + (dx * k) / 8, y + (dy * k) / 8);
+    await page.mouse.up();
+    x += dx; y += dy;
+    const r = await page.evaluate(() => {
+      const a = window.animkit;
+      a.frame(0); // poses with IK towards the dragged target
+      return { eff: a.ikEffector(), target: a.ikTarget(), pos: a.ikEffectorPosition() };
+    });
+    const d = r.pos ? Math.hypot(r.pos[0] - r.target[0], r.pos[1] - r.target[1], r.pos[2] - r.target[2]) : Infinity;
+    ikRows.push({ ...r, distance: d });
+    check(r.eff === ik.j && d <= 1e-3, `IK drag ${ikRows.length}: effector within 1e-3 of the target`,
+          `effector joint ${r.eff}, distance ${d.toExponential(2)}, target ${r.target && r.target.map((v) => v.toFixed(3))}`);
+  }
+  const moved = ikRows.length && ikRows[0].target && (() => {
+    const t0 = ikRows[0].target, t2 = ikRows[ikRows.length - 1].target;
+    return Math.hypot(t0[0] - t2[0], t0[1] - t2[1], t0[2] - t2[2]);
+  })();
+  check(moved > 0.01, 'the drags moved the target', `${moved}`);
+  results.ik = ikRows;
+  await shot('02_ik_drag.png');
+
+  // ---- 3. switching LBS / DQS / CoR changes pixels ----
+  const methods = await page.evaluate(() => {
+    const a = window.animkit;
+    a.open('builtin:cylinder', 960, 600);
+    a.key(' ');
+    a.setTime(a.duration() * 0.5); // bent and twisted: where the methods differ most
+    const grab = () => {
+      a.frame(0);
+      return Array.from(document.getElementById('view').getContext('2d').getImageData(0, 0, 960, 600).data);
+    };
+    const out = {};
+    for (const [k, name] of [['1', 'lbs'], ['2', 'dqs'], ['3', 'cor']]) {
+      a.key(k);
+      out[name] = { method: a.method(), px: grab() };
+    }
+    const diff = (p, q) => { let n = 0; for (let i = 0; i < p.length; i += 4) if (p[i] !== q[i] || p[i + 1] !== q[i + 1] || p[i + 2] !== q[i + 2]) n++; return n; };
+    return {
+      methods: [out.lbs.method, out.dqs.method, out.cor.method],
+      lbs_dqs: diff(out.lbs.px, out.dqs.px), dqs_cor: diff(out.dqs.px, out.cor.px), lbs_cor: diff(out.lbs.px, out.cor.px),
+    };
+  });
+  results.methods = methods;
+  check(methods.methods.join() === '0,1,2', 'keys 1, 2, 3 select LBS, DQS, CoR', methods.methods.join());
+  for (const k of ['lbs_dqs', 'dqs_cor', 'lbs_cor'])
+    check(methods[k] > 500, `switching ${k.replace('_', ' -> ')} changes pixels`, `${methods[k]} pixels differ`);
+  await page.evaluate(() => { window.animkit.key('4'); window.animkit.frame(0); });
+  await shot('03_methods_side_by_side.png');
+
+  // ---- 4. cloth: the page's positions against the native command's ----
+  const sceneText = fs.readFileSync(path.join(here, '..', '..', 'examples', 'cloth_flag.json'), 'utf8');
+  const steps = 90;
+  const native = path.join(outDir, 'cloth_native.json');
+  execFileSync(cli, ['cloth', path.join(here, '..', '..', 'examples', 'cloth_flag.json'), '--steps', String(steps),
+                     '--threads', '1', '--json', native], { stdio: ['ignore', 'ignore', 'inherit'] });
+  const ref = JSON.parse(fs.readFileSync(native, 'utf8')).positions.flat().map(Math.fround);
+  const got = await page.evaluate((t, s) => window.animkit.clothRun(t, s), sceneText, steps);
+  let same = 0, maxDiff = 0;
+  for (let i = 0; i < ref.length; i++) {
+    if (Object.is(ref[i], got[i])) same++;
+    maxDiff = Math.max(maxDiff, Math.abs(ref[i] - got[i]));
+  }
+  results.cloth = { steps, floats: ref.length, bit_identical: same, max_abs_diff: maxDiff };
+  check(got.length === ref.length && ref.length > 0, 'cloth: as many positions as the native run', `${got.length} vs ${ref.length}`);
+  check(maxDiff <= 1e-5, 'cloth: the page matches the native library', `${same}/${ref.length} floats bit-identical, max |diff| ${maxDiff}`);
+
+  // ---- 5. the simulations run live ----
+  results.sims = {};
+  for (const what of ['particles:preset:fountain', 'cloth:preset:flag', 'boids:preset:flock', 'fluid:preset:dam', 'terrain']) {
+    const r = await page.evaluate((w) => {
+      const a = window.animkit;
+      if (!a.open(w, 960, 600)) return { error: a.error() };
+      const c = document.getElementById('view').getContext('2d');
+      a.frame(0);
+      const p0 = c.getImageData(0, 0, 960, 600).data.slice();
+      const t0 = performance.now();
+      let frames = 0;
+      for (; frames < 20; frames++) if (a.frame(1 / 30) < 0) return { error: a.error() };
+      const ms = (performance.now() - t0) / frames;
+      const p1 = c.getImageData(0, 0, 960, 600).data;
+      let n = 0;
+      for (let i = 0; i < p1.length; i += 4) if (p0[i] !== p1[i] || p0[i + 1] !== p1[i + 1] || p0[i + 2] !== p1[i + 2]) n++;
+      return { changed: n, ms };
+    }, what);
+    results.sims[what] = r;
+    // the terrain stands still (its camera and erosion move only on keys): it must draw, not move
+    const moves = what !== 'terrain';
+    check(!r.error && (!moves || r.changed > 200), `${what} runs in the page`,
+          r.error || `${r.changed} pixels changed over 20 frames, ${r.ms.toFixed(1)} ms a frame`);
+    await shot(`05_${what.replace(/[:]/g, '_')}.png`);
+  }
+
+  // ---- 6. a .bvh through the page's file input (the drop path) ----
+  const bvh = path.join(here, '..', 'fuzz', 'seeds', 'bvh_49_04_3frames.bvh');
+  const input = await page.$('#file');
+  await input.uploadFile(bvh);
+  await page.waitForFunction(() => window.animkit.current === 'file:', { timeout: 10000 }).catch(() => {});
+  const bvhState = await page.evaluate(() => ({ current: window.animkit.current, joints: window.animkit.ikEffector() }));
+  check(bvhState.current === 'file:', 'a .bvh given to the page opens', JSON.stringify(bvhState));
+  await page.evaluate(() => window.animkit.frame(0));
+  await shot('06_bvh.png');
+
+  // ---- 7. frame time: CesiumMan at 960x600 ----
+  if (cesium && fs.existsSync(cesium)) {
+    const b64 = fs.readFileSync(cesium).toString('base64');
+    const perf = await page.evaluate((data) => {
+      const a = window.animkit;
+      if (!a.openBytes('CesiumMan.glb', Uint8Array.from(atob(data), (c) => c.charCodeAt(0)))) return { error: a.error() };
+      for (let k = 0; k < 10; k++) a.frame(1 / 30); // warm up
+      const ms = [];
+      for (let k = 0; k < 90; k++) ms.push(a.frame(1 / 30));
+      ms.sort((p, q) => p - q);
+      return { median_ms: ms[45], mean_ms: ms.reduce((p, q) => p + q, 0) / ms.length, p90_ms: ms[81], stats: a.stats() };
+    }, b64);
+    results.cesiumman_960x600 = perf;
+    if (perf.error) check(false, 'CesiumMan loads in the page', perf.error);
+    else console.log(`info CesiumMan 960x600: median ${perf.median_ms.toFixed(2)} ms a frame (${(1000 / perf.median_ms).toFixed(1)} fps), ` +
+                     `mean ${perf.mean_ms.toFixed(2)} ms, p90 ${perf.p90_ms.toFixed(2)} ms`);
+    await shot('07_cesiumman.png');
+  } else {
+    console.log('info CesiumMan.glb not given: no frame-time measurement');
+  }
+
+  check(offsite.length === 0, 'the page requested nothing beyond its own files', offsite.join(' '));
+  check(consoleErrors.length === 0, 'no console errors', consoleErrors.join(' | '));
+} finally {
+  await browser.close();
+  server.close();
+}
+fs.writeFileSync(path.join(outDir, 'results.json'), JSON.stringify(results, null, 1));
+console.log(failures ? `${failures} check(s) failed` : 'all checks passed');
+process.exit(failures ? 1 : 0);
