@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS  ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 
-.PHONY: all demo test test-slow deps configure build bench bench-quick clean python
+.PHONY: all demo test test-slow deps configure build bench bench-quick clean python web
 
 all: build
 
@@ -44,6 +44,12 @@ bench: build
 
 bench-quick: build
 	@AK_BENCH_QUICK=1 bash scripts/bench.sh $(BUILD)
+
+# animkit in a browser: the library compiled to WebAssembly (clang --target=wasm32-wasi, Debian's
+# wasi-libc) and the page, into $(BUILD)/web (docs/web.md). Needs `scripts/install-deps.sh --web`;
+# says what is missing otherwise. Serve it: python3 -m http.server -d $(BUILD)/web
+web:
+	@bash scripts/build-web.sh $(BUILD)/web
 
 clean:
 	rm -rf $(BUILD) build-asan build-scalar out

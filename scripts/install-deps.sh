@@ -2,7 +2,11 @@
 # Installs the Debian packages animkit needs to build and test, only those missing.
 # Works as root on a fresh Debian 12; as another user it uses sudo when available, and
 # otherwise prints the exact command to run.
+# --web also installs the optional WebAssembly group (`make web` and the browser test
+# test_web, docs/web.md): without it those say what is missing and skip.
 set -euo pipefail
+WEB=0
+[ "${1:-}" = "--web" ] && WEB=1
 
 PACKAGES=(
   build-essential   # gcc, make
@@ -29,6 +33,16 @@ PACKAGES=(
   python3-distributed # animkit.batch on Dask (optional: its test SKIPs without)
 )
 
+# Optional group (--web): animkit compiled to WebAssembly and tested in a real browser.
+WEB_PACKAGES=(
+  lld               # wasm-ld, the WebAssembly linker (scripts/build-web.sh)
+  wasi-libc         # the C library for clang --target=wasm32-wasi
+  libclang-rt-14-dev-wasm32 # clang's wasm32 builtins (compiler-rt)
+  chromium          # the headless browser test_web drives (tests/web/run.mjs)
+  nodejs            # runs tests/web/run.mjs (puppeteer-core from npm, tests/web/package-lock.json)
+)
+if [ "$WEB" = 1 ]; then PACKAGES+=("${WEB_PACKAGES[@]}"); fi
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
@@ -49,7 +63,17 @@ else
   echo "animkit: npm not found; the glTF validator test will SKIP (optional)" >&2
 fi
 
+# --web: puppeteer-core for the browser test into tests/web/node_modules (git-ignored), at the
+# versions tests/web/package-lock.json records. Never fails the script (offline: test_web SKIPs).
+web_npm() {
+  if [ "$WEB" = 1 ] && command -v npm >/dev/null 2>&1; then
+    (cd "$(dirname "$0")/../tests/web" && npm ci --no-audit --no-fund --silent >/dev/null 2>&1) ||
+      echo "animkit: optional npm ci in tests/web failed (offline?); test_web will SKIP" >&2
+  fi
+}
+
 if [ ${#missing[@]} -eq 0 ]; then
+  web_npm
   exit 0
 fi
 
@@ -66,3 +90,4 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+web_npm
