@@ -331,7 +331,7 @@ cJSON* cJSON_CreateNumber(double num) {
     cJSON* n = node_new(cJSON_Number);
     if (n) {
         n->valuedouble = num;
-        n->valueint = num >= (double)INT_MAX ? INT_MAX : num <= (double)INT_MIN ? INT_MIN : (int)num;
+        n->valueint = num != num ? 0 : num >= (double)INT_MAX ? INT_MAX : num <= (double)INT_MIN ? INT_MIN : (int)num;
     }
     return n;
 }
@@ -429,7 +429,7 @@ static void print_number(out_buf* b, double d) {
         put_s(b, "null");
         return;
     }
-    if (d == (double)(long long)d && fabs(d) < 1e15) {
+    if (fabs(d) < 1e15 && d == (double)(long long)d) { /* (the cast only where it fits) */
         snprintf(tmp, sizeof tmp, "%lld", (long long)d);
     } else {
         /* the shortest of 15 or 17 significant digits that reads back as the same double */
