@@ -239,6 +239,20 @@ try {
       return { frames: 90, total_ms: total, median_ms: ms[45], mean_ms: total / 90, p90_ms: ms[81], stats: a.stats() };
     });
     if (!perf.error) perf.cpu_ms_per_frame = (1000 * (chromiumCpuSeconds(browser.process().pid) - cpu0)) / perf.frames;
+    // The native viewer side by side: CPU per frame of `animkit view --headless` at the same size
+    // on one thread (difference of a 100- and a 10-frame run, so loading is not counted). It draws
+    // CesiumMan's JPEG texture, which the page has no decoder for (docs/web.md).
+    const selfChildCpu = () => { const f = fs.readFileSync('/proc/self/stat', 'utf8').split(') ')[1].split(' '); return (Number(f[13]) + Number(f[14])) / 100; };
+    const nativeCpu = (frames) => {
+      const c0 = selfChildCpu();
+      execFileSync(cli, ['view', cesium, '--headless', '--size', '960x600', '--threads', '1', '--frames', String(frames)], { stdio: 'ignore' });
+      return selfChildCpu() - c0;
+    };
+    if (!perf.error) {
+      perf.native_cpu_ms_per_frame = (1000 * (nativeCpu(100) - nativeCpu(10))) / 90;
+      perf.cpu_ratio_page_to_native = perf.cpu_ms_per_frame / perf.native_cpu_ms_per_frame;
+      console.log(`info native animkit view, same frame: ${perf.native_cpu_ms_per_frame.toFixed(2)} ms CPU a frame; page / native CPU ${perf.cpu_ratio_page_to_native.toFixed(2)}`);
+    }
     results.cesiumman_960x600 = perf;
     if (perf.error) check(false, 'CesiumMan loads in the page', perf.error);
     else console.log(`info CesiumMan 960x600: median ${perf.median_ms.toFixed(2)} ms a frame (${(1000 / perf.median_ms).toFixed(1)} fps), ` +
