@@ -107,11 +107,13 @@
       if (rc !== 0) { api.onMessage(api.error(), true); return false; }
       return api.open('file:');
     },
-    // one frame: advance dt seconds, draw, show; returns the milliseconds it took
-    frame(dt) {
+    // one frame: advance dt seconds, draw, show (present false: draw only, for timing the
+    // module alone); returns the milliseconds it took
+    frame(dt, present = true) {
       const t0 = performance.now();
       const p = wasm.akw_frame(dt);
       if (!p) { api.onMessage(api.error(), true); return -1; }
+      if (!present) return performance.now() - t0;
       const w = wasm.akw_width(), h = wasm.akw_height();
       if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
       ctx.putImageData(new ImageData(new Uint8ClampedArray(wasm.memory.buffer, p, w * h * 4), w, h), 0, 0);
