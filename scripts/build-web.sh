@@ -37,7 +37,7 @@ TOOLS=(tools/animkit/view_app.c tools/animkit/view_sims.c tools/animkit/view_ter
        tools/animkit/boids_run.c tools/animkit/cloth_run.c tools/animkit/particles_run.c tools/animkit/outfile.c)
 WEB=(web/animkit_web.c web/fluid_sim.c web/cjson.c web/stubs.c)
 
-CFLAGS=(--target=wasm32-wasi -std=c11 -O2 -msimd128 -Wall -Wextra -Wpedantic -Werror
+CFLAGS=(--target=wasm32-wasi -std=c11 -O2 -msimd128 -mnontrapping-fptoint -msign-ext -Wall -Wextra -Wpedantic -Werror
         -fno-math-errno -ffp-contract=off -D_POSIX_C_SOURCE=200809L -D_WASI_EMULATED_GETPID -DAK_BUILDING -include web/shim/wasi_compat.h
         -Iweb/shim -I"$OUT/inc" -Iinclude -Isrc -Itools/animkit)
 LAUNCHER=""
