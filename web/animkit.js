@@ -130,6 +130,7 @@
     time() { return wasm.akw_time(); },
     duration() { return wasm.akw_duration(); },
     setTime(t) { wasm.akw_set_time(t); },
+    jointCount() { return wasm.akw_joint_count(); },
     jointFind(name) { return withString(name, (p) => wasm.akw_joint_find(p)); },
     jointScreen(j) { return floats(wasm.akw_joint_screen(j), 2); },
     ikEffector() { return wasm.akw_ik_effector(); },

@@ -212,10 +212,26 @@ try {
   const input = await page.$('#file');
   await input.uploadFile(bvh);
   await page.waitForFunction(() => window.animkit.current === 'file:', { timeout: 10000 }).catch(() => {});
-  const bvhState = await page.evaluate(() => ({ current: window.animkit.current, joints: window.animkit.ikEffector() }));
-  check(bvhState.current === 'file:', 'a .bvh given to the page opens', JSON.stringify(bvhState));
+  const bvhState = await page.evaluate(() => { window.animkit.frame(0); return { current: window.animkit.current, joints: window.animkit.jointCount() }; });
+  check(bvhState.current === 'file:' && bvhState.joints > 20, 'a .bvh given to the page\'s file input opens', JSON.stringify(bvhState));
   await page.evaluate(() => window.animkit.frame(0));
   await shot('06_bvh.png');
+
+  // ---- 6b. a .glb dropped on the page (a real drop event carrying a File) ----
+  const dropped = await page.evaluate(async () => {
+    const b64 = (window.ANIMKIT_ASSETS || {})['RiggedFigure.glb'];
+    if (!b64) return { skipped: true };
+    window.animkit.open('builtin:cylinder');
+    const dt = new DataTransfer();
+    dt.items.add(new File([Uint8Array.from(atob(b64), (c) => c.charCodeAt(0))], 'dropped.glb'));
+    document.body.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, bubbles: true, cancelable: true }));
+    for (let k = 0; k < 100 && window.animkit.current !== 'file:'; k++) await new Promise((r) => setTimeout(r, 50));
+    window.animkit.frame(0);
+    return { current: window.animkit.current, joints: window.animkit.jointCount() };
+  });
+  if (dropped.skipped) console.log('info no bundled RiggedFigure.glb: the drop check is skipped');
+  else check(dropped.current === 'file:' && dropped.joints >= 19, 'a .glb dropped on the page opens (RiggedFigure: a skin of 19 joints among its nodes)', JSON.stringify(dropped));
+  if (!dropped.skipped) await shot('06_dropped_glb.png');
 
   // ---- 7. frame time: CesiumMan at 960x600 ----
   if (cesium && fs.existsSync(cesium)) {
