@@ -429,7 +429,9 @@ static void print_number(out_buf* b, double d) {
         put_s(b, "null");
         return;
     }
-    if (fabs(d) < 1e15 && d == (double)(long long)d) { /* (the cast only where it fits) */
+    if (d == 0.0 && signbit(d)) {
+        snprintf(tmp, sizeof tmp, "-0"); /* (the integer path would drop the sign) */
+    } else if (fabs(d) < 1e15 && d == (double)(long long)d) { /* (the cast only where it fits) */
         snprintf(tmp, sizeof tmp, "%lld", (long long)d);
     } else {
         /* the shortest of 15 or 17 significant digits that reads back as the same double */
