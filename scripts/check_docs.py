@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
-"""Every public function has a doc comment: run by ctest as test_docs.
+"""Every public function has a doc comment, and every module an example: run by ctest as
+test_docs.
 
 A declaration `AK_API ...;` in include/animkit/*.h counts as documented when a comment ends on
 the line above it (or above the group of declarations it belongs to, with no blank line
-between), or when the declaration itself carries a trailing comment. Prints each undocumented
-function as FILE:LINE: NAME and exits 1 if there is any."""
+between), or when the declaration itself carries a trailing comment. A module (a public header
+other than the umbrella animkit.h) has an example when examples/ holds a file named
+<module>_*.c or <module>_*.json. Prints each undocumented function as FILE:LINE: NAME and each
+module without an example, and exits 1 if there is any."""
 import glob
 import os
 import re
@@ -52,7 +55,14 @@ def main():
     for b in bad:
         print(b)
     print(f"{count} public declarations in {len(headers)} headers, {len(bad)} without a doc comment")
-    return 1 if bad else 0
+    modules = [os.path.basename(h)[:-2] for h in headers if not h.endswith("animkit.h")]
+    examples = os.listdir(os.path.join(root, "examples"))
+    missing = [m for m in modules
+               if not any(e.startswith(m + "_") and e.endswith((".c", ".json")) for e in examples)]
+    for m in missing:
+        print(f"module {m} (include/animkit/{m}.h) has no example: add examples/{m}_<what>.c")
+    print(f"{len(modules)} modules, {len(missing)} without an example")
+    return 1 if bad or missing else 0
 
 
 if __name__ == "__main__":
