@@ -1,0 +1,166 @@
+/* Tests for the worker team (src/tasks.h): every task runs once, on its own thread, the team is
+ * reused across calls, and the busy cases (a second caller, a call from inside a task, a forked
+ * child) still run every task. */
+#include <pthread.h>
+#include <stdatomic.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "ak_test.h"
+#include "tasks.h"
+
+typedef struct probe {
+    atomic_int* runs;     /* per task: times run */
+    pthread_t thread;     /* the thread that ran it */
+    uint32_t index;
+    uint32_t count;
+    atomic_uint* arrived; /* rendezvous: every task waits until all have arrived (bounded) */
+    bool met;             /* all arrived before the deadline */
+    int nested;           /* > 0: run a nested call of this many tasks */
+    int nested_ok;
+} probe;
+
+static void* count_task(void* arg) {
+    probe* p = (probe*)arg;
+    atomic_fetch_add(&p->runs[p->index], 1);
+    p->thread = pthread_self();
+    return NULL;
+}
+
+/* A rendezvous that fails instead of hanging: it can only be met if every task runs at once. */
+static void* meet_task(void* arg) {
+    probe* p = (probe*)arg;
+    p->thread = pthread_self();
+    atomic_fetch_add(p->arrived, 1u);
+    struct timespec t0;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (;;) {
+        if (atomic_load(p->arrived) >= p->count) {
+            p->met = true;
+            break;
+        }
+        struct timespec t;
+        clock_gettime(CLOCK_MONOTONIC, &t);
+        if ((double)(t.tv_sec - t0.tv_sec) + 1e-9 * (double)(t.tv_nsec - t0.tv_nsec) > 10.0) break;
+        sched_yield();
+    }
+    return NULL;
+}
+
+static void* nested_task(void* arg) {
+    probe* p = (probe*)arg;
+    atomic_int runs[8] = {0};
+    probe inner[8];
+    for (int i = 0; i < p->nested; ++i) inner[i] = (probe){.runs = runs, .index = (uint32_t)i};
+    akp_run_tasks(count_task, inner, sizeof(probe), (uint32_t)p->nested);
+    int ok = 1;
+    for (int i = 0; i < p->nested; ++i) ok = ok && atomic_load(&runs[i]) == 1;
+    p->nested_ok = ok;
+    return NULL;
+}
+
+/* Runs count tasks that count themselves; checks each ran once and on distinct threads. */
+static void run_counted(uint32_t count) {
+    atomic_int runs[AKP_TASKS_MAX];
+    probe tasks[AKP_TASKS_MAX];
+    for (uint32_t i = 0; i < count; ++i) {
+        atomic_init(&runs[i], 0);
+        tasks[i] = (probe){.runs = runs, .index = i, .count = count};
+    }
+    akp_run_tasks(count_task, tasks, sizeof(probe), count);
+    for (uint32_t i = 0; i < count; ++i) AK_CHECK_EQ(atomic_load(&runs[i]), 1);
+    if (count > 0) AK_CHECK(pthread_equal(tasks[0].thread, pthread_self()));
+    for (uint32_t i = 0; i < count; ++i)
+        for (uint32_t j = i + 1; j < count; ++j) AK_CHECK(!pthread_equal(tasks[i].thread, tasks[j].thread));
+}
+
+AK_TEST(every_task_once_on_its_own_thread) {
+    for (uint32_t count = 0; count <= 16; ++count) run_counted(count);
+    run_counted(AKP_TASKS_MAX);
+}
+
+AK_TEST(tasks_run_at_the_same_time) {
+    /* 8 tasks meet in a rendezvous: impossible if any ran after another finished */
+    for (int round = 0; round < 20; ++round) {
+        atomic_uint arrived;
+        atomic_init(&arrived, 0u);
+        probe tasks[8];
+        for (uint32_t i = 0; i < 8; ++i) tasks[i] = (probe){.index = i, .count = 8, .arrived = &arrived};
+        akp_run_tasks(meet_task, tasks, sizeof(probe), 8);
+        for (uint32_t i = 0; i < 8; ++i) AK_CHECK(tasks[i].met);
+    }
+}
+
+AK_TEST(team_is_reused) {
+    uint64_t team0, fresh0, team1, fresh1;
+    run_counted(4);
+    akp_tasks_stats(&team0, &fresh0);
+    for (int i = 0; i < 2000; ++i) run_counted(4);
+    akp_tasks_stats(&team1, &fresh1);
+    AK_CHECK_EQ(team1 - team0, 2000u);
+    AK_CHECK_EQ(fresh1 - fresh0, 0u);
+}
+
+AK_TEST(nested_call_runs_every_task) {
+    uint64_t fresh0, fresh1;
+    akp_tasks_stats(NULL, &fresh0);
+    probe tasks[4];
+    for (uint32_t i = 0; i < 4; ++i) tasks[i] = (probe){.index = i, .nested = 3};
+    akp_run_tasks(nested_task, tasks, sizeof(probe), 4);
+    for (uint32_t i = 0; i < 4; ++i) AK_CHECK(tasks[i].nested_ok);
+    akp_tasks_stats(NULL, &fresh1);
+    AK_CHECK_EQ(fresh1 - fresh0, 4u); /* the team was busy: each inner call started threads */
+}
+
+static void* caller_thread(void* arg) {
+    int* ok = (int*)arg;
+    for (int i = 0; i < 300 && *ok; ++i) {
+        atomic_int runs[6];
+        probe tasks[6];
+        for (uint32_t k = 0; k < 6; ++k) {
+            atomic_init(&runs[k], 0);
+            tasks[k] = (probe){.runs = runs, .index = k};
+        }
+        akp_run_tasks(count_task, tasks, sizeof(probe), 6);
+        for (uint32_t k = 0; k < 6; ++k) *ok = *ok && atomic_load(&runs[k]) == 1;
+    }
+    return NULL;
+}
+
+AK_TEST(concurrent_callers) {
+    pthread_t ids[3];
+    int ok[3] = {1, 1, 1};
+    for (int i = 0; i < 3; ++i) AK_CHECK_EQ(pthread_create(&ids[i], NULL, caller_thread, &ok[i]), 0);
+    for (int i = 0; i < 3; ++i) pthread_join(ids[i], NULL);
+    for (int i = 0; i < 3; ++i) AK_CHECK(ok[i]);
+}
+
+AK_TEST(forked_child_starts_a_new_team) {
+    run_counted(4); /* the parent's team exists */
+    pid_t pid = fork();
+    AK_CHECK(pid >= 0);
+    if (pid == 0) {
+        atomic_uint arrived;
+        atomic_init(&arrived, 0u);
+        probe tasks[4];
+        for (uint32_t i = 0; i < 4; ++i) tasks[i] = (probe){.index = i, .count = 4, .arrived = &arrived};
+        akp_run_tasks(meet_task, tasks, sizeof(probe), 4);
+        int met = 1;
+        for (uint32_t i = 0; i < 4; ++i) met = met && tasks[i].met;
+        _exit(met ? 0 : 3);
+    }
+    int status = 0;
+    AK_CHECK_EQ(waitpid(pid, &status, 0), pid);
+    AK_CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+}
+
+int main(void) {
+    AK_RUN(every_task_once_on_its_own_thread);
+    AK_RUN(tasks_run_at_the_same_time);
+    AK_RUN(team_is_reused);
+    AK_RUN(nested_call_runs_every_task);
+    AK_RUN(concurrent_callers);
+    AK_RUN(forked_child_starts_a_new_team);
+    return ak_test_finish();
+}
