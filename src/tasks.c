@@ -8,10 +8,7 @@
  * with several parallel phases per step pays per phase. */
 #include "tasks.h"
 
-#include <pthread.h>
 #include <semaphore.h>
-#include <stdatomic.h>
-#include <stdbool.h>
 
 typedef struct team_job {
     void* (*fn)(void*);
@@ -78,44 +75,141 @@ static bool team_grow(uint32_t count) {
     return true;
 }
 
-static void run_fresh(void* (*fn)(void*), char* base, size_t size, uint32_t count) {
-    pthread_t ids[AKP_TASKS_MAX];
-    bool started[AKP_TASKS_MAX];
-    for (uint32_t t = 1; t < count; ++t) started[t] = pthread_create(&ids[t], NULL, fn, base + t * size) == 0;
-    fn(base);
-    for (uint32_t t = 1; t < count; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else fn(base + t * size);
+static void* fresh_main(void* arg) {
+    const struct akp_team_fresh* f = (const struct akp_team_fresh*)arg;
+    akp_team_run* run = f->run;
+    pthread_mutex_lock(&run->gate_m);
+    while (run->gate == 0) pthread_cond_wait(&run->gate_cv, &run->gate_m);
+    const int go = run->gate;
+    pthread_mutex_unlock(&run->gate_m);
+    if (go > 0) run->fn(run->base + f->index * run->size);
+    return NULL;
+}
+
+static void open_gate(akp_team_run* run, int value) {
+    pthread_mutex_lock(&run->gate_m);
+    run->gate = value;
+    pthread_cond_broadcast(&run->gate_cv);
+    pthread_mutex_unlock(&run->gate_m);
+}
+
+/* Tasks 1 .. count - 1 on fresh threads held at a gate until every one has started. */
+static bool begin_fresh(akp_team_run* run) {
+    if (pthread_mutex_init(&run->gate_m, NULL) != 0) return false;
+    if (pthread_cond_init(&run->gate_cv, NULL) != 0) {
+        pthread_mutex_destroy(&run->gate_m);
+        return false;
     }
+    run->gate = 0;
+    uint32_t started = 1;
+    for (uint32_t t = 1; t < run->count; ++t) {
+        run->fresh[t] = (struct akp_team_fresh){run, t};
+        if (pthread_create(&run->ids[t], NULL, fresh_main, &run->fresh[t]) != 0) break;
+        ++started;
+    }
+    const bool all = started == run->count;
+    open_gate(run, all ? 1 : -1);
+    if (all) return true;
+    for (uint32_t t = 1; t < started; ++t) pthread_join(run->ids[t], NULL);
+    pthread_cond_destroy(&run->gate_cv);
+    pthread_mutex_destroy(&run->gate_m);
+    return false;
+}
+
+bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t size, uint32_t count) {
+    run->count = 1;
+    run->on_team = false;
+    if (count > AKP_TASKS_MAX || count < 2) return false;
+    run->fn = fn, run->base = (char*)tasks, run->size = size, run->count = count;
+    pthread_once(&team_once, team_init);
+    if (pthread_mutex_trylock(&team_lock) == 0) {
+        if (team_grow(count)) {
+            job = (team_job){fn, (char*)tasks, size};
+            atomic_store_explicit(&pending, count - 1u, memory_order_release);
+            for (uint32_t t = 1; t < count; ++t) sem_post(&worker_go[t]); /* a post orders the writes above */
+            run->on_team = true;
+            atomic_fetch_add_explicit(&team_runs, 1u, memory_order_relaxed);
+            return true;
+        }
+        pthread_mutex_unlock(&team_lock);
+    }
+    /* the team is busy (another caller, or a task calling in) or cannot grow */
+    atomic_fetch_add_explicit(&fresh_runs, 1u, memory_order_relaxed);
+    if (begin_fresh(run)) return true;
+    run->count = 1;
+    return false;
+}
+
+void akp_team_end(akp_team_run* run) {
+    if (run->count < 2) return;
+    if (run->on_team) {
+        while (sem_wait(&team_done) != 0) {
+        }
+        pthread_mutex_unlock(&team_lock);
+    } else {
+        for (uint32_t t = 1; t < run->count; ++t) pthread_join(run->ids[t], NULL);
+        pthread_cond_destroy(&run->gate_cv);
+        pthread_mutex_destroy(&run->gate_m);
+    }
+    run->count = 1;
 }
 
 void akp_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count) {
     char* base = (char*)tasks;
     if (count > AKP_TASKS_MAX) count = AKP_TASKS_MAX;
-    if (count <= 1) {
-        if (count == 1) fn(base);
+    akp_team_run run;
+    if (akp_team_begin(&run, fn, tasks, size, count)) {
+        fn(base);
+        akp_team_end(&run);
         return;
     }
-    pthread_once(&team_once, team_init);
-    if (pthread_mutex_trylock(&team_lock) != 0) {
-        atomic_fetch_add_explicit(&fresh_runs, 1u, memory_order_relaxed);
-        run_fresh(fn, base, size, count);
+    for (uint32_t t = 0; t < count; ++t) fn(base + t * size); /* alone: one after another */
+}
+
+/* ---- barrier ------------------------------------------------------------------------------ */
+
+static void cpu_relax(void) {
+#if defined(__x86_64__) || defined(__i386__)
+    __asm__ __volatile__("pause");
+#endif
+}
+
+void akp_barrier_init(akp_barrier* b, uint32_t size) {
+    pthread_mutex_init(&b->m, NULL);
+    pthread_cond_init(&b->cv, NULL);
+    atomic_init(&b->arrived, 0u);
+    atomic_init(&b->generation, 0u);
+    atomic_init(&b->sleepers, 0u);
+    b->size = size ? size : 1u;
+}
+
+void akp_barrier_wait(akp_barrier* b) {
+    if (b->size <= 1) return;
+    const unsigned g = atomic_load(&b->generation);
+    if (atomic_fetch_add(&b->arrived, 1) + 1 == b->size) {
+        atomic_store(&b->arrived, 0);
+        atomic_fetch_add(&b->generation, 1);
+        if (atomic_load(&b->sleepers)) {
+            pthread_mutex_lock(&b->m);
+            pthread_cond_broadcast(&b->cv);
+            pthread_mutex_unlock(&b->m);
+        }
         return;
     }
-    if (!team_grow(count)) {
-        pthread_mutex_unlock(&team_lock);
-        atomic_fetch_add_explicit(&fresh_runs, 1u, memory_order_relaxed);
-        run_fresh(fn, base, size, count);
-        return;
+    for (int k = 0; k < AKP_BARRIER_SPIN; ++k) {
+        if (atomic_load_explicit(&b->generation, memory_order_acquire) != g) return;
+        cpu_relax();
     }
-    job = (team_job){fn, base, size};
-    atomic_store_explicit(&pending, count - 1u, memory_order_release);
-    for (uint32_t t = 1; t < count; ++t) sem_post(&worker_go[t]); /* a post orders the writes above */
-    fn(base);
-    while (sem_wait(&team_done) != 0) {
-    }
-    atomic_fetch_add_explicit(&team_runs, 1u, memory_order_relaxed);
-    pthread_mutex_unlock(&team_lock);
+    pthread_mutex_lock(&b->m);
+    atomic_fetch_add(&b->sleepers, 1);
+    while (atomic_load(&b->generation) == g) pthread_cond_wait(&b->cv, &b->m);
+    atomic_fetch_sub(&b->sleepers, 1);
+    pthread_mutex_unlock(&b->m);
+}
+
+void akp_barrier_destroy(akp_barrier* b) {
+    pthread_cond_destroy(&b->cv);
+    pthread_mutex_destroy(&b->m);
 }
 
 void akp_tasks_stats(uint64_t* out_team_runs, uint64_t* out_fresh_runs) {

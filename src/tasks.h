@@ -4,6 +4,9 @@
 #ifndef ANIMKIT_TASKS_H
 #define ANIMKIT_TASKS_H
 
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -16,10 +19,54 @@
  * task runs: see the last case). The team is created on first use, grows to the largest count
  * asked for and lives until the process ends (a forked child starts a new one).
  * When the team is busy (a call from another thread meanwhile, or from inside a task) the call
- * starts fresh threads as the jobs used to; a task whose thread cannot start runs on the
- * calling thread after task 0. Results never depend on which of these happened, since each
- * task's work is fixed by its index. */
+ * starts fresh threads as the jobs used to; when those cannot all start, the calling thread
+ * runs every task, one after another (so tasks that wait for each other must use
+ * akp_team_begin instead). Results never depend on which of these happened, since each task's
+ * work is fixed by its index. */
 void akp_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
+
+/* A team run split in two, for jobs whose calling thread leads the others through phases
+ * (barriers between them) rather than running one task: akp_team_begin starts tasks 1 ..
+ * count - 1, each on its own thread, all at the same time, and returns true; the caller then
+ * does its share (task 0's) and calls akp_team_end, which returns when those tasks have
+ * returned. When even one task cannot have its own thread, begin runs none, returns false, and
+ * the caller does the whole job alone (end is then a no-op). The run lives on the caller's
+ * stack between the two calls. */
+typedef struct akp_team_run {
+    uint32_t count;   /* tasks started by begin, task 0 included; 1 when begin returned false */
+    bool on_team;     /* the persistent team ran them (else fresh threads) */
+    /* fresh threads: the gate that holds them until all have started */
+    pthread_t ids[AKP_TASKS_MAX];
+    pthread_mutex_t gate_m;
+    pthread_cond_t gate_cv;
+    int gate;         /* 0 closed, 1 run, -1 abandon */
+    void* (*fn)(void*);
+    char* base;
+    size_t size;
+    struct akp_team_fresh {
+        struct akp_team_run* run;
+        uint32_t index;
+    } fresh[AKP_TASKS_MAX];
+} akp_team_run;
+bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
+void akp_team_end(akp_team_run* run);
+
+/* A barrier for the tasks of one team run: the first to arrive spin up to AKP_BARRIER_SPIN pauses
+ * (most meetings of busy threads end within microseconds), then sleep on a condition variable
+ * (a descheduled partner on a loaded machine would make spinning burn its core); the last to
+ * arrive bumps the generation and wakes the sleepers. Sequentially consistent atomics order
+ * "bump, then look for sleepers" against "announce sleeping, then look at the generation", so
+ * no wake-up is lost. size 1 makes wait a no-op. */
+#define AKP_BARRIER_SPIN 512
+typedef struct akp_barrier {
+    pthread_mutex_t m;
+    pthread_cond_t cv;
+    atomic_uint arrived, generation, sleepers;
+    uint32_t size;
+} akp_barrier;
+void akp_barrier_init(akp_barrier* b, uint32_t size);
+void akp_barrier_wait(akp_barrier* b);
+void akp_barrier_destroy(akp_barrier* b);
 
 /* How many of the calls so far ran on the team and how many had to start threads of their own
  * (tests and benchmarks; counts since the process started). */
