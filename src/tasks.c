@@ -9,6 +9,7 @@
 #include "tasks.h"
 
 #include <semaphore.h>
+#include <time.h>
 
 typedef struct team_job {
     void* (*fn)(void*);
@@ -24,6 +25,20 @@ static uint32_t worker_count; /* workers started: indices 1 .. worker_count; und
 static team_job job;          /* written under team_lock before the posts, read after a wait */
 static atomic_uint pending;
 static atomic_ullong team_runs, fresh_runs;
+
+/* profiling (akp_tasks_profile_enable) */
+static atomic_bool profiling;
+static atomic_ullong prof_sections, prof_barrier_waits, prof_section_ns, prof_caller_wait_ns, prof_barrier_ns;
+
+static double now_s(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void prof_add(atomic_ullong* counter, double seconds) {
+    atomic_fetch_add_explicit(counter, (unsigned long long)(seconds * 1e9 + 0.5), memory_order_relaxed);
+}
 
 static void* worker_main(void* arg) {
     const uint32_t index = (uint32_t)(uintptr_t)arg;
@@ -120,6 +135,7 @@ bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t s
     run->count = 1;
     run->on_team = false;
     if (count > AKP_TASKS_MAX || count < 2) return false;
+    run->begin_s = atomic_load_explicit(&profiling, memory_order_relaxed) ? now_s() : 0.0;
     run->fn = fn, run->base = (char*)tasks, run->size = size, run->count = count;
     pthread_once(&team_once, team_init);
     if (pthread_mutex_trylock(&team_lock) == 0) {
@@ -142,6 +158,7 @@ bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t s
 
 void akp_team_end(akp_team_run* run) {
     if (run->count < 2) return;
+    const double wait_s = run->begin_s > 0.0 ? now_s() : 0.0;
     if (run->on_team) {
         while (sem_wait(&team_done) != 0) {
         }
@@ -150,6 +167,12 @@ void akp_team_end(akp_team_run* run) {
         for (uint32_t t = 1; t < run->count; ++t) pthread_join(run->ids[t], NULL);
         pthread_cond_destroy(&run->gate_cv);
         pthread_mutex_destroy(&run->gate_m);
+    }
+    if (run->begin_s > 0.0) {
+        const double end_s = now_s();
+        atomic_fetch_add_explicit(&prof_sections, 1u, memory_order_relaxed);
+        prof_add(&prof_section_ns, end_s - run->begin_s);
+        prof_add(&prof_caller_wait_ns, end_s - wait_s);
     }
     run->count = 1;
 }
@@ -183,8 +206,21 @@ void akp_barrier_init(akp_barrier* b, uint32_t size) {
     b->size = size ? size : 1u;
 }
 
+static void barrier_wait(akp_barrier* b);
+
 void akp_barrier_wait(akp_barrier* b) {
     if (b->size <= 1) return;
+    if (!atomic_load_explicit(&profiling, memory_order_relaxed)) {
+        barrier_wait(b);
+        return;
+    }
+    const double t0 = now_s();
+    barrier_wait(b);
+    atomic_fetch_add_explicit(&prof_barrier_waits, 1u, memory_order_relaxed);
+    prof_add(&prof_barrier_ns, now_s() - t0);
+}
+
+static void barrier_wait(akp_barrier* b) {
     const unsigned g = atomic_load(&b->generation);
     if (atomic_fetch_add(&b->arrived, 1) + 1 == b->size) {
         atomic_store(&b->arrived, 0);
@@ -215,4 +251,21 @@ void akp_barrier_destroy(akp_barrier* b) {
 void akp_tasks_stats(uint64_t* out_team_runs, uint64_t* out_fresh_runs) {
     if (out_team_runs) *out_team_runs = atomic_load_explicit(&team_runs, memory_order_relaxed);
     if (out_fresh_runs) *out_fresh_runs = atomic_load_explicit(&fresh_runs, memory_order_relaxed);
+}
+
+void akp_tasks_profile_enable(bool on) {
+    atomic_store(&prof_sections, 0u);
+    atomic_store(&prof_barrier_waits, 0u);
+    atomic_store(&prof_section_ns, 0u);
+    atomic_store(&prof_caller_wait_ns, 0u);
+    atomic_store(&prof_barrier_ns, 0u);
+    atomic_store(&profiling, on);
+}
+
+void akp_tasks_profile_read(akp_tasks_profile* out) {
+    out->sections = atomic_load(&prof_sections);
+    out->barrier_waits = atomic_load(&prof_barrier_waits);
+    out->section_seconds = 1e-9 * (double)atomic_load(&prof_section_ns);
+    out->caller_wait_seconds = 1e-9 * (double)atomic_load(&prof_caller_wait_ns);
+    out->barrier_wait_seconds = 1e-9 * (double)atomic_load(&prof_barrier_ns);
 }

@@ -34,6 +34,7 @@ void akp_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count)
  * stack between the two calls. */
 typedef struct akp_team_run {
     uint32_t count;   /* tasks started by begin, task 0 included; 1 when begin returned false */
+    double begin_s;   /* when begin started the tasks (profiling on) */
     bool on_team;     /* the persistent team ran them (else fresh threads) */
     /* fresh threads: the gate that holds them until all have started */
     pthread_t ids[AKP_TASKS_MAX];
@@ -71,5 +72,19 @@ void akp_barrier_destroy(akp_barrier* b);
 /* How many of the calls so far ran on the team and how many had to start threads of their own
  * (tests and benchmarks; counts since the process started). */
 void akp_tasks_stats(uint64_t* out_team_runs, uint64_t* out_fresh_runs);
+
+/* Where the time of the threaded jobs goes (benchmarks; off by default, when nothing is
+ * measured): parallel sections run (team runs and akp_run_tasks calls with >= 2 tasks), the
+ * caller's wall time inside them (from begin to the end of end), the part of that the caller
+ * spent waiting in end for the other tasks (imbalance at the end of a section), and the time
+ * threads spent waiting at barriers, summed over threads (imbalance between phases plus the
+ * barrier's own cost). A job's serial part is its wall time minus section_seconds. Enabling
+ * resets the counts. */
+typedef struct akp_tasks_profile {
+    uint64_t sections, barrier_waits;
+    double section_seconds, caller_wait_seconds, barrier_wait_seconds;
+} akp_tasks_profile;
+void akp_tasks_profile_enable(bool on);
+void akp_tasks_profile_read(akp_tasks_profile* out);
 
 #endif

@@ -227,6 +227,35 @@ AK_TEST(team_run_from_inside_a_task) {
     AK_CHECK_EQ(fresh1 - fresh0, 2u);
 }
 
+static void* sleep_if_odd(void* arg) {
+    probe* p = (probe*)arg;
+    if (p->index & 1u) {
+        struct timespec ts = {0, 2000000}; /* 2 ms */
+        nanosleep(&ts, NULL);
+    }
+    return NULL;
+}
+
+AK_TEST(profile_counts_sections_waits_and_barriers) {
+    akp_tasks_profile_enable(true);
+    probe tasks[2] = {{.index = 0}, {.index = 1}};
+    for (int i = 0; i < 10; ++i) akp_run_tasks(sleep_if_odd, tasks, sizeof(probe), 2);
+    akp_tasks_profile pr;
+    akp_tasks_profile_read(&pr);
+    AK_CHECK_EQ(pr.sections, 10u);
+    AK_CHECK(pr.caller_wait_seconds >= 10 * 0.0019); /* task 0 returns at once, then waits 2 ms */
+    AK_CHECK(pr.section_seconds >= pr.caller_wait_seconds);
+    AK_CHECK_EQ(pr.barrier_waits, 0u);
+    AK_CHECK_EQ(run_phased(3, 50), 0);
+    akp_tasks_profile_read(&pr);
+    AK_CHECK_EQ(pr.sections, 11u);
+    AK_CHECK_EQ(pr.barrier_waits, 3u * 50u * 2u);
+    akp_tasks_profile_enable(false);
+    for (int i = 0; i < 3; ++i) akp_run_tasks(sleep_if_odd, tasks, sizeof(probe), 2);
+    akp_tasks_profile_read(&pr);
+    AK_CHECK_EQ(pr.sections, 0u); /* enabling reset the counts; off counts nothing */
+}
+
 int main(void) {
     AK_RUN(every_task_once_on_its_own_thread);
     AK_RUN(tasks_run_at_the_same_time);
@@ -236,5 +265,6 @@ int main(void) {
     AK_RUN(forked_child_starts_a_new_team);
     AK_RUN(team_run_with_barriers);
     AK_RUN(team_run_from_inside_a_task);
+    AK_RUN(profile_counts_sections_waits_and_barriers);
     return ak_test_finish();
 }
