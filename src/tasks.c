@@ -8,8 +8,10 @@
  * with several parallel phases per step pays per phase. */
 #include "tasks.h"
 
-#include <semaphore.h>
 #include <time.h>
+
+#ifndef AKP_NO_THREADS
+#include <semaphore.h>
 
 typedef struct team_job {
     void* (*fn)(void*);
@@ -247,6 +249,37 @@ void akp_barrier_destroy(akp_barrier* b) {
     pthread_cond_destroy(&b->cv);
     pthread_mutex_destroy(&b->m);
 }
+
+#else /* AKP_NO_THREADS: one thread (the WebAssembly build); every job runs on the caller */
+
+static atomic_bool profiling;
+static atomic_ullong team_runs, fresh_runs;
+static atomic_ullong prof_sections, prof_barrier_waits, prof_section_ns, prof_caller_wait_ns, prof_barrier_ns;
+
+bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t size, uint32_t count) {
+    (void)fn, (void)tasks, (void)size, (void)count;
+    run->count = 1;
+    run->on_team = false;
+    return false;
+}
+
+void akp_team_end(akp_team_run* run) { (void)run; }
+
+void akp_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count) {
+    if (count > AKP_TASKS_MAX) count = AKP_TASKS_MAX;
+    for (uint32_t t = 0; t < count; ++t) fn((char*)tasks + t * size);
+}
+
+void akp_barrier_init(akp_barrier* b, uint32_t size) {
+    (void)size;
+    b->size = 1; /* never more than one thread meets here */
+}
+
+void akp_barrier_wait(akp_barrier* b) { (void)b; }
+
+void akp_barrier_destroy(akp_barrier* b) { (void)b; }
+
+#endif
 
 void akp_tasks_stats(uint64_t* out_team_runs, uint64_t* out_fresh_runs) {
     if (out_team_runs) *out_team_runs = atomic_load_explicit(&team_runs, memory_order_relaxed);

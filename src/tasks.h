@@ -10,6 +10,11 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* Builds without threads (WebAssembly/WASI) run every task on the calling thread. */
+#if defined(__wasi__) && !defined(AKP_NO_THREADS)
+#define AKP_NO_THREADS 1
+#endif
+
 /* Most tasks one call runs (the jobs cap thread_count at this). */
 #define AKP_TASKS_MAX 64u
 
