@@ -825,8 +825,9 @@ static void* work(void* arg) {
     return NULL;
 }
 
-/* Push an agent out of the obstacle edges it overlaps (from their outer side). */
-static ak_vec2 push_out_of_obstacles(const ak_crowd* crowd, ak_vec2 q, float r) {
+/* Push an agent out of the obstacle edges it overlaps (from their outer side) to skin
+ * beyond touching; *depth grows to the deepest penetration found. */
+static ak_vec2 push_out_of_obstacles(const ak_crowd* crowd, ak_vec2 q, float r, float skin, float* depth) {
     for (uint32_t k = 0; k < crowd->vertex_count; ++k) {
         const obst_vertex* o1 = &crowd->verts[k];
         const ak_vec2 b = crowd->verts[o1->next].point;
@@ -836,15 +837,18 @@ static ak_vec2 push_out_of_obstacles(const ak_crowd* crowd, ak_vec2 q, float r) 
         const float d2 = abs_sq(d);
         if (d2 >= r * r || !(d2 > 0.0f) || left_of(o1->point, b, q) > 0.0f) continue;
         const float dl = sqrtf(d2);
-        q = add(q, mul((r - dl) / dl, d));
+        if (r - dl > *depth) *depth = r - dl;
+        q = add(q, mul((r + skin - dl) / dl, d));
     }
     return q;
 }
 
 /* One Gauss-Seidel contact pass over every overlapping pair, in the grid's order (cells,
  * then the 9-cell stencil, then sorted entries: a function of the positions only), each pair
- * moved apart to touching, then agents out of obstacle edges. */
-static void contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P) {
+ * moved apart to skin beyond touching, then agents out of obstacle edges. Returns the deepest
+ * overlap (pair or obstacle) the pass found, 0 when none. */
+static float contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P, float skin) {
+    float depth = 0.0f;
     for (uint32_t m = 0; m < g->cell_count; ++m) {
         const ak_grid_cell cm = g->cell_coord[m];
         for (int dz = -1; dz <= 1; ++dz)
@@ -861,9 +865,10 @@ static void contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P) {
                         const float d2 = abs_sq(d);
                         if (!(d2 < rr * rr)) continue;
                         const float dl = sqrtf(d2);
+                        if (rr - dl > depth) depth = rr - dl;
                         /* coincident centres: split along x, lower index to -x */
                         const ak_vec2 dir = dl > 1e-6f * rr ? mul(1.0f / dl, d) : v2(i < j ? -1.0f : 1.0f, 0.0f);
-                        const ak_vec2 h = mul(0.5f * (rr - dl), dir);
+                        const ak_vec2 h = mul(0.5f * (rr + skin - dl), dir);
                         P[i] = add(P[i], h);
                         P[j] = sub(P[j], h);
                     }
@@ -871,7 +876,9 @@ static void contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P) {
             }
     }
     if (crowd->vertex_count)
-        for (size_t i = 0; i < crowd->agent_count; ++i) P[i] = push_out_of_obstacles(crowd, P[i], crowd->agents[i].radius);
+        for (size_t i = 0; i < crowd->agent_count; ++i)
+            P[i] = push_out_of_obstacles(crowd, P[i], crowd->agents[i].radius, skin, &depth);
+    return depth;
 }
 
 static void run_threads(void* (*fn)(void*), worker* w, uint32_t threads) {
@@ -892,6 +899,11 @@ static uint32_t thread_total(const ak_crowd_step_job* job, size_t n) {
     if (t > 64) t = 64;
     if ((size_t)t * 256u > n) t = n / 256u > 0 ? (uint32_t)(n / 256u) : 1u; /* a thread start ~ 256 agents */
     return t;
+}
+
+/* Whether the step runs contact passes (their grid shares the scratch). */
+static uint32_t contact_need(const ak_crowd_step_job* job) {
+    return job->allow_overlap ? job->contact_iterations : 1u;
 }
 
 typedef struct layout {
@@ -937,7 +949,7 @@ size_t ak_crowd_step_scratch_size(const ak_crowd_step_job* job) {
     if (!job || !job->crowd || job->thread_count > 64 || job->contact_iterations > 64) return 0;
     const size_t n = job->crowd->agent_count;
     layout L;
-    if (!make_layout(job->crowd, n, thread_total(job, n), job->contact_iterations, &L)) return 0;
+    if (!make_layout(job->crowd, n, thread_total(job, n), contact_need(job), &L)) return 0;
     return L.total;
 }
 
@@ -1008,7 +1020,7 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     const size_t n = crowd->agent_count;
     const uint32_t threads = thread_total(job, n);
     layout L;
-    make_layout(crowd, n, threads, job->contact_iterations, &L);
+    make_layout(crowd, n, threads, contact_need(job), &L);
     char* base = align_up(job->scratch.ptr);
     ak_grid grid;
     const ak_result gr = build_grid(job, &L, &L.gd, job->positions.ptr, base, &grid);
@@ -1024,13 +1036,31 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
         carve_worker(crowd, tb + (size_t)t * L.per_thread, &w[t]);
     }
     run_threads(work, w, threads);
-    if (job->contact_iterations == 0) return AK_OK;
-    /* Contacts: Gauss-Seidel passes over the moved positions (on this thread), the grid
-     * rebuilt for each. */
-    for (uint32_t it = 0; it < job->contact_iterations; ++it) {
+    if (job->allow_overlap) {
+        /* RVO2's behaviour, with at most contact_iterations passes after it (0: pure ORCA) */
+        for (uint32_t it = 0; it < job->contact_iterations; ++it) {
+            const ak_result cr = build_grid(job, &L, &L.contact_gd, job->out_positions.ptr, base, &grid);
+            if (cr != AK_OK) return cr;
+            (void)contact_pass(crowd, &grid, job->out_positions.ptr, 0.0f);
+        }
+        return AK_OK;
+    }
+    /* The hard-contact projection: Gauss-Seidel passes (on this thread, the grid rebuilt for
+     * each) until a pass finds no overlap deeper than AK_CROWD_CONTACT_TOLERANCE; pairs are
+     * moved apart to a skin of a tenth of it beyond touching so that rounding does not leave
+     * them overlapping. */
+    const float tol = AK_CROWD_CONTACT_TOLERANCE;
+    for (uint32_t it = 0; it < AK_CROWD_MAX_CONTACT_PASSES; ++it) {
         const ak_result cr = build_grid(job, &L, &L.contact_gd, job->out_positions.ptr, base, &grid);
         if (cr != AK_OK) return cr;
-        contact_pass(crowd, &grid, job->out_positions.ptr);
+        const float depth = contact_pass(crowd, &grid, job->out_positions.ptr, 0.1f * tol);
+        if (!(depth > tol) && it + 1 >= job->contact_iterations) break;
+    }
+    if (!job->orca_velocities) {
+        /* the velocity the agent actually moved with */
+        const float inv_dt = 1.0f / job->dt;
+        for (size_t i = 0; i < n; ++i)
+            job->out_velocities.ptr[i] = mul(inv_dt, sub(job->out_positions.ptr[i], job->positions.ptr[i]));
     }
     return AK_OK;
 }
@@ -1041,7 +1071,7 @@ size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd
     if (ak_crowd_step_validate(job) != AK_OK || index >= job->crowd->agent_count) return 0;
     const ak_crowd* crowd = job->crowd;
     layout L;
-    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), job->contact_iterations, &L);
+    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), contact_need(job), &L);
     char* base = align_up(job->scratch.ptr);
     ak_grid grid;
     if (build_grid(job, &L, &L.gd, job->positions.ptr, base, &grid) != AK_OK) return 0;

@@ -128,6 +128,7 @@ struct Ak {
         job.dt = s.dt;
         job.thread_count = threads;
         job.skip_perturbation = true;  // RVO2's preferred velocities, bit for bit
+        job.allow_overlap = true;      // pure ORCA: RVO2 has no contact projection
         bind();
         scratch.resize(ak_crowd_step_scratch_size(&job));
         job.scratch = ak_u8_span{scratch.data(), scratch.size()};

@@ -180,8 +180,26 @@ typedef struct ak_crowd_step_job {
                                     -> after the ORCA move, n Gauss-Seidel passes (on the
                                     calling thread, pairs in the grid's order) move each
                                     overlapping pair apart to touching and agents out of
-                                    obstacle edges; velocities stay ORCA's. <= 64 */
+                                    obstacle edges; velocities stay ORCA's. <= 64. With
+                                    allow_overlap false: the least number of passes. */
+    bool allow_overlap;          /* false (default) -> no overlap: after the move, the
+                                    hard-contact projection repeats contact passes until
+                                    none finds a pair or an obstacle edge overlapping by
+                                    more than AK_CROWD_CONTACT_TOLERANCE (at most
+                                    AK_CROWD_MAX_CONTACT_PASSES). true -> RVO2's behaviour:
+                                    only the contact_iterations passes (0: pure ORCA, whose
+                                    positions overlap where its program is infeasible;
+                                    bench/vs_rvo2) */
+    bool orca_velocities;        /* with allow_overlap false: false (default) ->
+                                    out_velocities are the displacement over dt after the
+                                    projection (what the agent did: an agent pushed back by
+                                    its neighbours does not keep pressing on them); true ->
+                                    ORCA's velocity */
 } ak_crowd_step_job;
+
+/* The hard-contact projection's tolerance (m) and its most passes in one step. */
+#define AK_CROWD_CONTACT_TOLERANCE 1e-4f
+#define AK_CROWD_MAX_CONTACT_PASSES 256u
 
 /* Agents stacked on a few points make the neighbour search quadratic; above this load the
  * step returns AK_ERR_BUDGET (about 4,000 agents in one cell). */
