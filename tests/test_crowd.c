@@ -246,7 +246,6 @@ AK_TEST(presets_24_home_apart) {
     preset_home("evacuation", 24, 24, 1);
 }
 
-AK_TEST(corridor_1000) { preset_home("corridor", 1000, 0, 2); }
 
 /* Vision-based steering: head-on and four crossing reach their goals without overlap. */
 AK_TEST(vision_head_on_and_crossing) {
@@ -856,6 +855,5 @@ int main(void) {
     AK_RUN(presets_24_home_apart);
     AK_RUN_SLOW(presets_100_home_apart);
     AK_RUN_SLOW(circle_250);
-    AK_RUN_SLOW(corridor_1000);
     return ak_test_finish();
 }
