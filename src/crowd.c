@@ -449,33 +449,39 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
         const float d = ddx * ddx + ddz * ddz;                                                        \
         if (d < range_sq && sidx[s] != self32) insert_agent(out, &count, k, &range_sq, d, sidx[s]); \
     }
-    for (int64_t r = 0; r <= rmax; ++r) {
-        if (r >= 2) {
-            const float md = (float)(r - 1) * cs;
-            if (md * md * (1.0f - 1e-5f) >= range_sq) break; /* every cell of this ring is farther */
+    /* rings 0 and 1: the 3 x 3 block, three row ranges (home row first) */
+    {
+        const int64_t xa = hx > 0 ? hx - 1 : 0, xb = hx + 1 < c->w ? hx + 1 : c->w - 1;
+        for (int q = 0; q < 3; ++q) {
+            const int64_t z = hz + (q == 0 ? 0 : q == 1 ? -1 : 1);
+            if (z < 0 || z >= c->h) continue;
+            const uint32_t* row = cstart + z * c->w;
+            SCAN(row[xa], row[xb + 1])
         }
-        /* rows dz = -r and dz = +r (one row when r = 0) */
-        for (int side = 0; side < (r == 0 ? 1 : 2); ++side) {
+    }
+    for (int64_t r = 2; r <= rmax; ++r) {
+        const float md = (float)(r - 1) * cs;
+        if (md * md * (1.0f - 1e-5f) >= range_sq) break; /* every cell of this ring is farther */
+        /* rows dz = -r and dz = +r */
+        for (int side = 0; side < 2; ++side) {
             const int64_t dz = side ? r : -r, z = hz + dz;
             if (z < 0 || z >= c->h) continue;
             int64_t xa = hx - r, xb = hx + r;
-            if (r >= 2) {
-                const float lz = bz + (float)dz * cs;
-                const float gz = ak_maxf(0.0f, ak_maxf(lz, -(lz + cs)));
-                if (gz * gz * (1.0f - 1e-4f) >= range_sq) continue;
-                /* cut the row to the cells whose nearest point is within range */
-                while (xa <= xb) {
-                    const float lx = bx + (float)(xa - hx) * cs;
-                    const float gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
-                    if ((gx * gx + gz * gz) * (1.0f - 1e-4f) < range_sq) break;
-                    ++xa;
-                }
-                while (xb >= xa) {
-                    const float lx = bx + (float)(xb - hx) * cs;
-                    const float gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
-                    if ((gx * gx + gz * gz) * (1.0f - 1e-4f) < range_sq) break;
-                    --xb;
-                }
+            const float lz = bz + (float)dz * cs;
+            const float gz = ak_maxf(0.0f, ak_maxf(lz, -(lz + cs)));
+            if (gz * gz * (1.0f - 1e-4f) >= range_sq) continue;
+            /* cut the row to the cells whose nearest point is within range */
+            while (xa <= xb) {
+                const float lx = bx + (float)(xa - hx) * cs;
+                const float gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
+                if ((gx * gx + gz * gz) * (1.0f - 1e-4f) < range_sq) break;
+                ++xa;
+            }
+            while (xb >= xa) {
+                const float lx = bx + (float)(xb - hx) * cs;
+                const float gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
+                if ((gx * gx + gz * gz) * (1.0f - 1e-4f) < range_sq) break;
+                --xb;
             }
             if (xa < 0) xa = 0;
             if (xb >= c->w) xb = c->w - 1;
@@ -484,23 +490,18 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
             SCAN(row[xa], row[xb + 1])
         }
         /* columns dx = -r and dx = +r, rows -r+1 .. r-1 */
-        for (int side = 0; side < (r == 0 ? 0 : 2); ++side) {
+        for (int side = 0; side < 2; ++side) {
             const int64_t dx = side ? r : -r, x = hx + dx;
             if (x < 0 || x >= c->w) continue;
-            float gx = 0.0f;
-            if (r >= 2) {
-                const float lx = bx + (float)dx * cs;
-                gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
-                if (gx * gx * (1.0f - 1e-4f) >= range_sq) continue;
-            }
+            const float lx = bx + (float)dx * cs;
+            const float gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
+            if (gx * gx * (1.0f - 1e-4f) >= range_sq) continue;
             for (int64_t dz = -r + 1; dz <= r - 1; ++dz) {
                 const int64_t z = hz + dz;
                 if (z < 0 || z >= c->h) continue;
-                if (r >= 2) {
-                    const float lz = bz + (float)dz * cs;
-                    const float gz = ak_maxf(0.0f, ak_maxf(lz, -(lz + cs)));
-                    if ((gx * gx + gz * gz) * (1.0f - 1e-4f) >= range_sq) continue;
-                }
+                const float lz = bz + (float)dz * cs;
+                const float gz = ak_maxf(0.0f, ak_maxf(lz, -(lz + cs)));
+                if ((gx * gx + gz * gz) * (1.0f - 1e-4f) >= range_sq) continue;
                 const uint32_t m = (uint32_t)(z * c->w + x);
                 SCAN(cstart[m], cstart[m + 1])
             }
