@@ -14,9 +14,14 @@
  *     the half-planes leave no velocity, a 3D linear program minimises the largest violation
  *     of the agent half-planes while the obstacle half-planes stay hard;
  *   - neighbour selection as RVO2's: the max_neighbors nearest agents closer than
- *     neighbor_distance (found through the shared grid, grid.h, visiting rings of cells
- *     nearest first), every obstacle edge closer than time_horizon_obstacles * max_speed +
- *     radius, nearest first;
+ *     neighbor_distance (ties by index; found on a cell-sorted dense grid, or the shared
+ *     grid, grid.h, for sparse layouts, visiting rings of cells nearest first), every
+ *     obstacle edge closer than time_horizon_obstacles * max_speed + radius, nearest first;
+ *   - no overlap by default: ORCA alone lets agents overlap where its program is infeasible
+ *     (dense crowds; RVO2 does too), so after the move the step repeats Gauss-Seidel contact
+ *     passes until no pair and no obstacle edge overlaps by more than
+ *     AK_CROWD_CONTACT_TOLERANCE, and reports the displacement as the velocity
+ *     (allow_overlap: RVO2's pure ORCA);
  *   - the preferred velocity points at the current waypoint at pref_speed, and is the offset
  *     to the waypoint itself (per second) within pref_speed * 1 s of the last one, so agents
  *     slow down and stop on their goal (RVO2's examples do this for pref_speed 1); an agent
@@ -174,20 +179,39 @@ typedef struct ak_crowd_step_job {
                                     crossing head-on, a ring of agents blocking each other at
                                     the circle's centre); true -> the preferred velocity as
                                     is (RVO2's bits: bench/vs_rvo2) */
-    uint32_t contact_iterations; /* 0 -> pure ORCA. ORCA lets agents overlap when the crowd
-                                    is so dense that its program is infeasible (the 3D program
-                                    then only minimises the violation; RVO2 does the same); n > 0
-                                    -> after the ORCA move, n Gauss-Seidel passes (on the
-                                    calling thread, pairs in the grid's order) move each
-                                    overlapping pair apart to touching and agents out of
-                                    obstacle edges; velocities stay ORCA's. <= 64 */
+    uint32_t contact_iterations; /* with allow_overlap: 0 -> pure ORCA, which lets agents
+                                    overlap when the crowd is so dense that its program is
+                                    infeasible (the 3D program then only minimises the
+                                    violation; RVO2 does the same); n > 0 -> after the ORCA
+                                    move, n Gauss-Seidel passes (on the calling thread,
+                                    pairs in the grid's order) move each overlapping pair
+                                    apart to touching and agents out of obstacle edges;
+                                    velocities stay ORCA's. Without allow_overlap: the
+                                    least number of passes. <= 64 */
+    bool allow_overlap;          /* false (default) -> no overlap: after the move, the
+                                    hard-contact projection repeats contact passes until
+                                    none finds a pair or an obstacle edge overlapping by
+                                    more than AK_CROWD_CONTACT_TOLERANCE (at most
+                                    AK_CROWD_MAX_CONTACT_PASSES). true -> RVO2's behaviour:
+                                    only the contact_iterations passes (0: pure ORCA, whose
+                                    positions overlap where its program is infeasible;
+                                    bench/vs_rvo2) */
+    bool orca_velocities;        /* with allow_overlap false: false (default) ->
+                                    out_velocities are the displacement over dt after the
+                                    projection (what the agent did: an agent pushed back by
+                                    its neighbours does not keep pressing on them); true ->
+                                    ORCA's velocity */
 } ak_crowd_step_job;
+
+/* The hard-contact projection's tolerance (m) and its most passes in one step. */
+#define AK_CROWD_CONTACT_TOLERANCE 1e-4f
+#define AK_CROWD_MAX_CONTACT_PASSES 256u
 
 /* Agents stacked on a few points make the neighbour search quadratic; above this load the
  * step returns AK_ERR_BUDGET (about 4,000 agents in one cell). */
 #define AK_CROWD_DEFAULT_CELL_LOAD 20000000u
 
-/* Scratch bytes for this job (reads crowd, thread_count and contact_iterations); 0 when the
+/* Scratch bytes for this job (reads crowd, thread_count, contact_iterations, allow_overlap); 0 when the
  * job cannot be sized (validate says why). */
 AK_API size_t ak_crowd_step_scratch_size(const ak_crowd_step_job* job);
 
