@@ -6,7 +6,6 @@
  * writes its own outputs: threads split agents into ranges and results do not depend on the
  * split. */
 #include <math.h>
-#include <pthread.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -14,6 +13,7 @@
 #include <animkit/grid.h>
 
 #include "internal.h"
+#include "tasks.h"
 
 #define EPS 1e-5f   /* the LP's parallel-line tolerance (RVO2's RVO_EPSILON) */
 #define COORD_MAX 1e7f
@@ -1006,14 +1006,7 @@ static float contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P, f
 }
 
 static void run_threads(void* (*fn)(void*), worker* w, uint32_t threads) {
-    pthread_t ids[64];
-    bool started[64] = {false};
-    for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, fn, &w[t]) == 0;
-    fn(&w[0]);
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else fn(&w[t]);
-    }
+    akp_run_tasks(fn, w, sizeof(worker), threads); /* the library's worker team (src/tasks.h) */
 }
 
 /* ---- scratch layout -------------------------------------------------------------------------- */
