@@ -433,6 +433,36 @@ AK_API ak_result ak_crowd_character_pose(const ak_crowd_gait* gait, const ak_cro
  * turning the gait's forward onto the heading, then the translation (p.x, 0, p.y). */
 AK_API ak_mat4 ak_crowd_character_root(const ak_crowd_gait* gait, const ak_crowd_character* character, ak_vec2 p);
 
+/* ---- the crowd as an animated glTF scene ---------------------------------------------------- */
+
+/* Recorded frames of a crowd with characters, to bake into a scene (frame-major arrays). */
+typedef struct ak_crowd_bake_desc {
+    const ak_crowd_gait* gait;                /* required: the character (gait->scene) */
+    size_t agent_count;                       /* required, > 0 */
+    size_t frame_count;                       /* required, 1 .. AK_SCENE_BAKE_MAX_FRAMES */
+    const ak_vec2* positions;                 /* required: [frame_count * agent_count] */
+    const ak_crowd_character* characters;     /* required: same layout */
+    float frame_time;                         /* required: > 0 s between frames */
+    const ak_vec4* colors;                    /* optional: [agent_count] base colours (linear
+                                                 RGBA); NULL -> the character's materials */
+    const char* name;                         /* scene, clip and node prefix; NULL -> "crowd" */
+    size_t memory_budget;                     /* bytes; 0 -> AK_SCENE_BAKE_DEFAULT_BUDGET */
+} ak_crowd_bake_desc;
+
+/* Build an animated scene of the crowd (io.h's ak_io_save writes it as glTF): per agent a root
+ * node "<name>_<i>" (translation and rotation keyed at every frame: the root matrix of
+ * ak_crowd_character_root) holding a copy of the character's nodes ("<i>/<joint name>") with
+ * their own skin and a copy of the character's meshes, and one clip "<name>" keying, for every
+ * agent, the joint properties the walk clip animates at every frame (ak_crowd_character_pose;
+ * LINEAR, rotations sign-continuous). The scene model owns one mesh per entry, so each agent
+ * carries its own copy of the mesh (glTF itself would let agents share one mesh).
+ * Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no agent or frame), AK_ERR_BAD_ARG (frame_time not
+ * > 0 and finite), AK_ERR_BAD_DATA (a non-finite position), AK_ERR_UNSUPPORTED (more than
+ * AK_SCENE_BAKE_MAX_FRAMES frames, more than 32767 nodes in all, or more bytes than
+ * memory_budget: checked before allocating; diag gives the numbers), AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
+                                     ak_diag* out_diag);
+
 #ifdef __cplusplus
 }
 #endif

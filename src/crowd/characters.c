@@ -250,3 +250,218 @@ ak_mat4 ak_crowd_character_root(const ak_crowd_gait* gait, const ak_crowd_charac
     m.m[14] = p.y;
     return m;
 }
+
+/* ---- baking the crowd into a scene -------------------------------------------------------- */
+
+static ak_quat root_rotation(const ak_crowd_gait* g, const ak_crowd_character* c) {
+    const float af = atan2f(g->forward.x, g->forward.z);
+    const float ah = atan2f(c->heading.x, c->heading.y);
+    return ak_quat_from_axis_angle(ak_vec3_make(0.0f, 1.0f, 0.0f), ah - af);
+}
+
+ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
+                              ak_diag* out_diag) {
+    if (out_scene) *out_scene = NULL;
+    if (!desc || !out_scene || !desc->gait || !desc->gait->scene || !desc->gait->scene->skeleton ||
+        !desc->positions || !desc->characters) {
+        akp_diag_set(out_diag, "crowd", "no desc, gait, scene, positions, characters or output");
+        return AK_ERR_NULL_ARG;
+    }
+    const char* name = desc->name ? desc->name : "crowd";
+    const size_t N = desc->agent_count, F = desc->frame_count;
+    if (N == 0 || F == 0) {
+        akp_diag_set(out_diag, name, "no %s", N == 0 ? "agent" : "frame");
+        return AK_ERR_EMPTY;
+    }
+    if (!(desc->frame_time > 0.0f) || !ak_finitef(desc->frame_time) ||
+        !ak_finitef(desc->frame_time * (float)(F - 1))) {
+        akp_diag_set(out_diag, name, "frame time %g s: not > 0 and finite", (double)desc->frame_time);
+        return AK_ERR_BAD_ARG;
+    }
+    if (F > AK_SCENE_BAKE_MAX_FRAMES) {
+        akp_diag_set(out_diag, name, "%zu frames: more than %u", F, AK_SCENE_BAKE_MAX_FRAMES);
+        return AK_ERR_UNSUPPORTED;
+    }
+    const ak_crowd_gait* g = desc->gait;
+    const ak_scene* cs = g->scene;
+    const size_t J = ak_scene_joint_count(cs);
+    if ((double)N * (double)(J + 1) > 32767.0) {
+        akp_diag_set(out_diag, name, "%zu agents x %zu nodes: more than 32767 nodes", N, J + 1);
+        return AK_ERR_UNSUPPORTED;
+    }
+    for (size_t k = 0; k < N * F; ++k)
+        if (!ak_finitef(desc->positions[k].x) || !ak_finitef(desc->positions[k].y) ||
+            fabsf(desc->positions[k].x) > 1e7f || fabsf(desc->positions[k].y) > 1e7f) {
+            akp_diag_set(out_diag, name, "frame %zu, agent %zu: position not finite or beyond 1e7 m", k / N, k % N);
+            return AK_ERR_BAD_DATA;
+        }
+    /* The walk clip's joint channels: each becomes one channel per agent. */
+    const ak_clip* clip = cs->clips[g->clip_index];
+    size_t cc = 0;
+    for (size_t c = 0; c < ak_clip_channel_count(clip); ++c) {
+        const ak_channel_target t = ak_clip_channel_target(clip, c);
+        if ((t == AK_CHANNEL_TRANSLATION || t == AK_CHANNEL_ROTATION || t == AK_CHANNEL_SCALE) &&
+            ak_clip_channel_index(clip, c) < J)
+            ++cc;
+    }
+    const size_t per_agent = 2 + cc; /* root translation and rotation, then the clip's */
+    /* Bytes, estimated before allocating: the meshes, the raw keys and the built clip. */
+    double bytes = 0.0;
+    for (size_t m = 0; m < cs->mesh_count; ++m) {
+        const ak_mesh* me = cs->meshes[m].mesh;
+        if (!me) continue;
+        bytes += (double)me->vertex_count * (80.0 + 6.0 * me->influence_count) + 12.0 * (double)me->triangle_count +
+                 40.0 * (double)me->vertex_count * (double)me->morph_target_count;
+    }
+    bytes *= (double)N;
+    bytes += 2.0 * (double)N * (double)per_agent * (double)F * 16.0 + (double)N * (double)J * 256.0;
+    const size_t budget = desc->memory_budget ? desc->memory_budget : AK_SCENE_BAKE_DEFAULT_BUDGET;
+    if (bytes > (double)budget) {
+        akp_diag_set(out_diag, name, "%zu agents x %zu frames need about %.0f MB, more than the budget of %.0f MB", N,
+                     F, bytes / 1048576.0, (double)budget / 1048576.0);
+        return AK_ERR_UNSUPPORTED;
+    }
+
+    ak_scene* sc = NULL;
+    ak_result res = ak_scene_alloc(N * cs->mesh_count, N * cs->skin_count, 1, alloc, &sc);
+    if (res != AK_OK) return res;
+    snprintf(sc->name, sizeof sc->name, "%s", name);
+    const size_t nodes = N * (J + 1);
+    ak_joint_desc* jd = akp_alloc(alloc, nodes * sizeof *jd);
+    char(*names)[AK_NAME_SIZE] = akp_alloc(alloc, nodes * sizeof *names);
+    ak_raw_channel* ch = akp_alloc(alloc, N * per_agent * sizeof *ch);
+    float* times = akp_alloc(alloc, F * sizeof *times);
+    float* keys = akp_alloc(alloc, N * per_agent * F * 4 * sizeof *keys);
+    ak_transform* pose = akp_alloc(alloc, J * sizeof *pose);
+    sc->is_joint = akp_alloc(&sc->alloc, nodes * sizeof *sc->is_joint);
+    if (!jd || !names || !ch || !times || !keys || !pose || !sc->is_joint) {
+        res = AK_ERR_NO_MEMORY;
+        goto done;
+    }
+    /* nodes: per agent its root, then the character's nodes */
+    const ak_i16_cspan parents = ak_skeleton_parents(cs->skeleton);
+    for (size_t a = 0; a < N; ++a) {
+        const size_t base = a * (J + 1);
+        const ak_crowd_character* c0 = &desc->characters[a];
+        const ak_vec2 p0 = desc->positions[a];
+        snprintf(names[base], AK_NAME_SIZE, "%.40s_%zu", name, a);
+        jd[base] = (ak_joint_desc){.name = names[base], .parent = -1,
+                                   .rest = ak_transform_make(ak_vec3_make(p0.x, 0.0f, p0.y), root_rotation(g, c0),
+                                                             ak_vec3_make(1.0f, 1.0f, 1.0f))};
+        sc->is_joint[base] = false;
+        /* the nodes rest in the first frame's pose (a one-frame scene is that frame) */
+        res = ak_crowd_character_pose(g, c0, (ak_transform_span){pose, J});
+        if (res != AK_OK) goto done;
+        for (size_t j = 0; j < J; ++j) {
+            snprintf(names[base + 1 + j], AK_NAME_SIZE, "%zu/%.40s", a, ak_skeleton_joint_name(cs->skeleton, j));
+            jd[base + 1 + j] = (ak_joint_desc){.name = names[base + 1 + j],
+                                               .parent = parents.ptr[j] < 0 ? (int)base : (int)(base + 1) + parents.ptr[j],
+                                               .rest = pose[j]};
+            sc->is_joint[base + 1 + j] = cs->is_joint ? cs->is_joint[j] : true;
+        }
+    }
+    ak_skeleton_desc sd = {.joints = jd, .joint_count = nodes, .name = name, .palette_from_skins = true};
+    res = ak_skeleton_create(&sd, &sc->alloc, &sc->skeleton, out_diag);
+    if (res != AK_OK) goto done;
+    /* skins and meshes: copies, their joints and nodes moved to the agent's */
+    for (size_t a = 0; a < N && res == AK_OK; ++a) {
+        const size_t base = a * (J + 1) + 1;
+        for (size_t s = 0; s < cs->skin_count && res == AK_OK; ++s) {
+            const ak_scene_skin* from = &cs->skins[s];
+            ak_scene_skin* to = &sc->skins[a * cs->skin_count + s];
+            res = ak_scene_skin_alloc(sc, a * cs->skin_count + s, from->joint_count);
+            if (res != AK_OK) break;
+            snprintf(to->name, sizeof to->name, "%zu/%.40s", a, from->name);
+            for (size_t k = 0; k < from->joint_count; ++k) {
+                to->joints[k] = (int32_t)base + from->joints[k];
+                to->inverse_binds[k] = from->inverse_binds[k];
+            }
+        }
+        for (size_t m = 0; m < cs->mesh_count && res == AK_OK; ++m) {
+            const ak_scene_mesh* from = &cs->meshes[m];
+            ak_scene_mesh* to = &sc->meshes[a * cs->mesh_count + m];
+            *to = *from;
+            to->mesh = NULL;
+            to->texture = -1; /* textures are not copied */
+            /* skinned: no node (ak_io_save gives it its own root: glTF ignores a skinned mesh's
+             * node transform and warns when that node is animated); rigid: the agent's node */
+            to->node = from->skin >= 0 ? -1 : (from->node < 0 ? (int32_t)(base - 1) : (int32_t)base + from->node);
+            to->skin = from->skin < 0 ? -1 : (int32_t)(a * cs->skin_count) + from->skin;
+            if (desc->colors) {
+                to->has_material = true;
+                to->base_color = desc->colors[a];
+            }
+            if (from->mesh) {
+                res = ak_mesh_clone(from->mesh, &sc->alloc, &to->mesh);
+                if (res == AK_OK) snprintf(to->mesh->name, sizeof to->mesh->name, "%zu/%.40s", a, from->mesh->name);
+            }
+        }
+    }
+    if (res != AK_OK) goto done;
+    /* the clip: every frame's root and pose */
+    for (size_t f = 0; f < F; ++f) times[f] = desc->frame_time * (float)f;
+    for (size_t a = 0; a < N; ++a) {
+        const size_t base = a * (J + 1);
+        ak_raw_channel* c = ch + a * per_agent;
+        float* kv = keys + a * per_agent * F * 4;
+        c[0] = (ak_raw_channel){.target = AK_CHANNEL_TRANSLATION, .index = (uint32_t)base, .component_count = 3,
+                                .interp = AK_INTERP_LINEAR, .key_count = F, .times = times, .values = kv};
+        c[1] = (ak_raw_channel){.target = AK_CHANNEL_ROTATION, .index = (uint32_t)base, .component_count = 4,
+                                .interp = AK_INTERP_LINEAR, .key_count = F, .times = times, .values = kv + F * 4};
+        size_t k = 2;
+        for (size_t q = 0; q < ak_clip_channel_count(clip); ++q) {
+            const ak_channel_target t = ak_clip_channel_target(clip, q);
+            const uint32_t j = ak_clip_channel_index(clip, q);
+            if ((t != AK_CHANNEL_TRANSLATION && t != AK_CHANNEL_ROTATION && t != AK_CHANNEL_SCALE) || j >= J) continue;
+            c[k] = (ak_raw_channel){.target = t, .index = (uint32_t)(base + 1 + j),
+                                    .component_count = t == AK_CHANNEL_ROTATION ? 4u : 3u,
+                                    .interp = AK_INTERP_LINEAR, .key_count = F, .times = times,
+                                    .values = kv + k * F * 4};
+            ++k;
+        }
+        for (size_t f = 0; f < F; ++f) {
+            const ak_crowd_character* chr = &desc->characters[f * N + a];
+            const ak_vec2 p = desc->positions[f * N + a];
+            float* tr = kv + 3 * f;
+            tr[0] = p.x, tr[1] = 0.0f, tr[2] = p.y;
+            ak_quat r = root_rotation(g, chr);
+            float* rq = kv + F * 4 + 4 * f;
+            if (f > 0 && rq[-4] * r.x + rq[-3] * r.y + rq[-2] * r.z + rq[-1] * r.w < 0.0f) r = ak_quat_neg(r);
+            rq[0] = r.x, rq[1] = r.y, rq[2] = r.z, rq[3] = r.w;
+            res = ak_crowd_character_pose(g, chr, (ak_transform_span){pose, J});
+            if (res != AK_OK) goto done;
+            for (size_t q = 2; q < per_agent; ++q) {
+                const size_t j = c[q].index - base - 1;
+                float* v = (float*)c[q].values + c[q].component_count * f;
+                if (c[q].target == AK_CHANNEL_ROTATION) {
+                    ak_quat o = pose[j].rotation;
+                    if (f > 0 && v[-4] * o.x + v[-3] * o.y + v[-2] * o.z + v[-1] * o.w < 0.0f) o = ak_quat_neg(o);
+                    v[0] = o.x, v[1] = o.y, v[2] = o.z, v[3] = o.w;
+                } else {
+                    const ak_vec3 o = c[q].target == AK_CHANNEL_TRANSLATION ? pose[j].translation : pose[j].scale;
+                    v[0] = o.x, v[1] = o.y, v[2] = o.z;
+                }
+            }
+        }
+    }
+    if (F > 1) {
+        ak_raw_clip raw = {.name = name, .channels = ch, .channel_count = N * per_agent, .joint_count = nodes};
+        res = ak_clip_build(&raw, &sc->alloc, &sc->clips[0], out_diag);
+    } else {
+        sc->clip_count = 0; /* one frame: the rest pose is the frame */
+    }
+done:
+    akp_free(alloc, jd);
+    akp_free(alloc, names);
+    akp_free(alloc, ch);
+    akp_free(alloc, times);
+    akp_free(alloc, keys);
+    akp_free(alloc, pose);
+    if (res != AK_OK) {
+        if (res == AK_ERR_NO_MEMORY) akp_diag_set(out_diag, name, "out of memory");
+        ak_scene_destroy(sc);
+        return res;
+    }
+    *out_scene = sc;
+    return AK_OK;
+}

@@ -23,7 +23,9 @@ static const char* const usage =
     "  --threads  threads per step (default 1; results are identical for any count)\n"
     "  --json     write {\"time\", \"agents\": [{\"position\", \"velocity\", \"goal_reached\"}],\n"
     "             \"min_distance\", \"collisions\"} after the run\n"
-    "  -o         render: .png (last step) or .gif (the run); .glb (glTF export) is not implemented\n"
+    "  -o         .png (the last step) or .gif (the run) rendered, walking characters (builtin:humanoid)\n"
+    "             up to 500 agents, discs above; .glb: the run as glTF, a skinned character per agent\n"
+    "             (up to 1800 agents)\n"
     "Without --json or -o prints a summary line.\n";
 
 /* ---- collisions: the set of pairs that ever overlapped ------------------------------------ */
@@ -172,6 +174,94 @@ static size_t reached_count(const crowd_run* r) {
     return k;
 }
 
+/* ---- characters ----------------------------------------------------------------------------- */
+
+#define CHARACTER_CELL 0.08f       /* builtin:humanoid's grid: about 2,300 triangles */
+#define RENDER_CHARACTERS_MAX 500u /* above: discs */
+
+typedef struct crowd_chars {
+    ak_scene* scene;
+    ak_crowd_gait gait;
+    ak_crowd_character* ch;
+    size_t n;
+    cli_poser poser;
+    bool poser_ready;
+    ak_vec2* rec_pos; /* recorded frames for glTF: [frame_cap * n] */
+    ak_crowd_character* rec_ch;
+    size_t frames, frame_cap;
+} crowd_chars;
+
+static void chars_free(crowd_chars* c) {
+    if (c->poser_ready) cli_poser_free(&c->poser);
+    ak_scene_destroy(c->scene);
+    free(c->ch);
+    free(c->rec_pos);
+    free(c->rec_ch);
+    memset(c, 0, sizeof *c);
+}
+
+/* The humanoid, its gait, one character per agent facing its first waypoint, phases spread. */
+static ak_result chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t frame_cap, ak_diag* diag) {
+    memset(c, 0, sizeof *c);
+    ak_builtin_desc bd = {.cell_size = CHARACTER_CELL};
+    ak_result r = ak_builtin_create("builtin:humanoid", &bd, NULL, &c->scene);
+    if (r != AK_OK) return r;
+    ak_crowd_gait_desc gd = {.scene = c->scene, .clip_index = ak_scene_find_clip(c->scene, "walk")};
+    if ((r = ak_crowd_gait_measure(&gd, NULL, &c->gait, diag)) != AK_OK) return r;
+    c->n = sc->agent_count;
+    c->ch = malloc(c->n * sizeof *c->ch);
+    if (!c->ch) return AK_ERR_NO_MEMORY;
+    for (size_t i = 0; i < c->n; ++i) {
+        const ak_vec2 to = ak_vec2_sub(sc->agents[i].goals.ptr[0], sc->positions[i]);
+        const float phase = (float)((i * 2654435761u) & 0xffffu) / 65536.0f;
+        c->ch[i] = ak_crowd_character_init(&c->gait, to, phase);
+    }
+    if (cli_poser_init(&c->poser, c->scene)) return AK_ERR_NO_MEMORY;
+    c->poser_ready = true;
+    if (frame_cap) {
+        c->frame_cap = frame_cap;
+        c->rec_pos = malloc(frame_cap * c->n * sizeof *c->rec_pos);
+        c->rec_ch = malloc(frame_cap * c->n * sizeof *c->rec_ch);
+        if (!c->rec_pos || !c->rec_ch) return AK_ERR_NO_MEMORY;
+    }
+    return AK_OK;
+}
+
+static ak_result chars_update(crowd_chars* c, const crowd_run* st, float dt) {
+    ak_crowd_characters_job job = {.gait = &c->gait, .dt = dt, .velocities = {st->v, st->n},
+                                   .characters = {c->ch, c->n}};
+    return ak_crowd_characters_update(&job);
+}
+
+static void chars_record(crowd_chars* c, const crowd_run* st) {
+    if (c->frames >= c->frame_cap) return;
+    memcpy(c->rec_pos + c->frames * c->n, st->p, c->n * sizeof *st->p);
+    memcpy(c->rec_ch + c->frames * c->n, c->ch, c->n * sizeof *c->ch);
+    ++c->frames;
+}
+
+static const ak_vec4 k_palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
+                                     {0.75f, 0.30f, 0.55f, 1}};
+
+/* The recorded run as glTF: a skinned character per agent (ak_crowd_bake_scene). */
+static int chars_write_gltf(crowd_chars* c, const ak_crowd_scene* sc, float frame_time, const char* out) {
+    ak_vec4* colors = malloc(c->n * sizeof *colors);
+    if (!colors) return cli_fail("crowd", "out of memory");
+    for (size_t i = 0; i < c->n; ++i) colors[i] = k_palette[sc->group[i] % 4];
+    ak_crowd_bake_desc bd = {.gait = &c->gait, .agent_count = c->n, .frame_count = c->frames,
+                             .positions = c->rec_pos, .characters = c->rec_ch, .frame_time = frame_time,
+                             .colors = colors, .name = "crowd"};
+    ak_scene* baked = NULL;
+    ak_diag diag = {0};
+    ak_result r = ak_crowd_bake_scene(&bd, NULL, &baked, &diag);
+    free(colors);
+    if (r != AK_OK) return cli_fail("crowd", "%s: %s", out, diag.message[0] ? diag.message : ak_result_string(r));
+    r = ak_io_save(out, baked, NULL, &diag);
+    ak_scene_destroy(baked);
+    if (r != AK_OK) return cli_fail("crowd", "%s: %s", out, diag.message[0] ? diag.message : ak_result_string(r));
+    return CLI_OK;
+}
+
 /* ---- rendering ------------------------------------------------------------------------------ */
 
 #define SIDES 8
@@ -186,6 +276,8 @@ typedef struct renderer {
     ak_vec3 *pos, *nrm;
     ak_vec4* col;
     size_t vcount;
+    uint32_t* idx; /* characters: [agents * triangles * 3] */
+    size_t icount;
     ak_vec3* wall;
     size_t wall_count;
     uint8_t* pixels;
@@ -196,11 +288,12 @@ static void renderer_free(renderer* r) {
     free(r->pos);
     free(r->nrm);
     free(r->col);
+    free(r->idx);
     free(r->wall);
     free(r->pixels);
 }
 
-static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc) {
+static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc, const crowd_chars* chars) {
     memset(r, 0, sizeof *r);
     r->w = w;
     r->h = h;
@@ -221,6 +314,16 @@ static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc) {
                                           10.0f * r->extent);
     const size_t n = sc->agent_count;
     r->vcount = n * TRIS_PER_AGENT * 3;
+    if (chars) {
+        const ak_mesh* m = chars->scene->meshes[0].mesh;
+        r->vcount = n * m->vertex_count;
+        r->icount = n * m->triangle_count * 3;
+        r->idx = malloc(r->icount * sizeof *r->idx);
+        if (!r->idx) return 1;
+        for (size_t a = 0; a < n; ++a)
+            for (size_t k = 0; k < m->triangle_count * 3; ++k)
+                r->idx[a * m->triangle_count * 3 + k] = (uint32_t)(a * m->vertex_count + m->indices[k]);
+    }
     r->pos = malloc(r->vcount * sizeof *r->pos);
     r->nrm = malloc(r->vcount * sizeof *r->nrm);
     r->col = malloc(r->vcount * sizeof *r->col);
@@ -248,12 +351,37 @@ static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc) {
 
 /* Each agent an upright octagonal prism (1.7 m, its radius) coloured by group, its front face
  * (toward the velocity) light. */
-static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, ak_image* out) {
-    static const ak_vec4 palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
-                                       {0.75f, 0.30f, 0.55f, 1}};
+/* Each character posed (its clip time and heading), skinned (LBS) and placed in the world. */
+static ak_result pose_characters(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, crowd_chars* c) {
+    const ak_mesh* m = c->scene->meshes[0].mesh;
+    const size_t J = ak_scene_joint_count(c->scene);
+    for (size_t i = 0; i < st->n; ++i) {
+        ak_result res = ak_crowd_character_pose(&c->gait, &c->ch[i], (ak_transform_span){c->poser.local, J});
+        if (res == AK_OK) res = cli_poser_deform(&c->poser, false, CLI_LBS);
+        if (res != AK_OK) return res;
+        const ak_mat4 root = ak_crowd_character_root(&c->gait, &c->ch[i], st->p[i]);
+        const ak_vec4 col = k_palette[sc->group[i] % 4];
+        for (size_t v = 0; v < m->vertex_count; ++v) {
+            const size_t o = i * m->vertex_count + v;
+            r->pos[o] = ak_mat4_transform_point(root, c->poser.positions[0][v]);
+            r->nrm[o] = ak_mat4_transform_vector(root, c->poser.normals[0][v]);
+            r->col[o] = col;
+        }
+    }
+    return AK_OK;
+}
+
+static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, crowd_chars* chars,
+                            ak_image* out) {
+    const ak_vec4* palette = k_palette;
     const float pi = 3.14159265358979f;
     size_t k = 0;
-    for (size_t i = 0; i < st->n; ++i) {
+    if (chars) {
+        const ak_result pr = pose_characters(r, sc, st, chars);
+        if (pr != AK_OK) return pr;
+        k = r->vcount;
+    }
+    for (size_t i = 0; i < st->n && !chars; ++i) {
         const float rad = sc->agents[i].radius > 0.0f ? sc->agents[i].radius : 0.3f, hgt = 1.7f;
         const ak_vec2 p = st->p[i], v = st->v[i];
         const float heading = (v.x * v.x + v.y * v.y) > 1e-6f ? atan2f(v.y, v.x) : 0.0f;
@@ -275,7 +403,7 @@ static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_r
         }
     }
     ak_raster_mesh people = {.positions = {r->pos, k}, .normals = {r->nrm, k}, .colors = {r->col, k},
-                             .material = {.color = {1, 1, 1, 1}}};
+                             .indices = {r->idx, r->icount}, .material = {.color = {1, 1, 1, 1}}};
     ak_raster_mesh walls = {.positions = {r->wall, r->wall_count * 6}, .material = {.color = {0.6f, 0.6f, 0.62f, 1}}};
     ak_raster_mesh casters[2] = {people, walls};
     ak_raster_clear(r->raster, ak_vec4_make(0.80f, 0.86f, 0.93f, 1), ak_vec4_make(0.55f, 0.60f, 0.68f, 1));
@@ -364,10 +492,12 @@ int cmd_crowd(int argc, char** argv) {
     }
     if (steps >= 0) sc.steps = steps;
     if (method) sc.method = strcmp(method, "vision") == 0 ? AK_CROWD_VISION : AK_CROWD_ORCA;
-    /* Refused before any work, so that no file is left half-written. */
-    if (out && cli_has_ext(out, ".glb")) {
+    const bool is_glb = out && cli_has_ext(out, ".glb"), is_gif = out && cli_has_ext(out, ".gif");
+    /* Refused before any work: a glTF crowd holds at most 32767 nodes (18 per character). */
+    if (is_glb && sc.agent_count > 1800) {
         ak_crowd_scene_free(&sc);
-        return cli_fail("crowd", "%s: glTF export of a crowd is not implemented yet (use .png or .gif)", out);
+        return cli_fail("crowd", "%s: %zu agents: glTF export holds at most 1800 characters (use --agents)", out,
+                        sc.agent_count);
     }
     if ((rc = cli_work_check("crowd", (double)sc.agent_count * (double)sc.steps, "agent updates (agents x steps)",
                              "--steps or --agents"))) {
@@ -381,14 +511,31 @@ int cmd_crowd(int argc, char** argv) {
         ak_crowd_scene_free(&sc);
         return cli_fail("crowd", "%s: %s", a.pos_count ? a.pos[0] : "preset", ak_result_string(res));
     }
+    /* Frames: at most 150 in a GIF, 300 in a glTF file. */
+    const long max_frames = is_glb ? 300 : 150;
+    const long every = sc.steps > max_frames ? (sc.steps + max_frames - 1) / max_frames : 1;
+    crowd_chars chars;
+    memset(&chars, 0, sizeof chars);
+    const bool with_chars = is_glb || (out && sc.agent_count <= RENDER_CHARACTERS_MAX);
+    if (with_chars) {
+        ak_diag cd = {0};
+        res = chars_init(&chars, &sc, is_glb ? (size_t)(sc.steps / every + 1) : 0, &cd);
+        if (res != AK_OK) {
+            chars_free(&chars);
+            run_free(&st);
+            ak_crowd_scene_free(&sc);
+            return cli_fail("crowd", "characters: %s", cd.message[0] ? cd.message : ak_result_string(res));
+        }
+    }
 
     renderer rd;
     ak_gif_writer* gif = NULL;
     ak_image img = {0};
-    const bool rendering = out != NULL, is_gif = out && cli_has_ext(out, ".gif");
+    const bool rendering = out != NULL && !is_glb;
     if (rendering) {
-        if (renderer_init(&rd, w, h, &sc)) {
+        if (renderer_init(&rd, w, h, &sc, with_chars ? &chars : NULL)) {
             renderer_free(&rd);
+            chars_free(&chars);
             run_free(&st);
             ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "out of memory for rendering");
@@ -396,28 +543,31 @@ int cmd_crowd(int argc, char** argv) {
         img = (ak_image){.pixels = rd.pixels, .width = w, .height = h};
         if (is_gif && ak_gif_writer_create(out, &(ak_gif_desc){.width = w, .height = h, .delay_cs = 4}, NULL, &gif) != AK_OK) {
             renderer_free(&rd);
+            chars_free(&chars);
             run_free(&st);
             ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "%s: cannot create the file", out);
         }
     }
-    const long every = sc.steps > 150 ? (sc.steps + 149) / 150 : 1;
+    crowd_chars* cp = with_chars ? &chars : NULL;
     const double t0 = cli_now();
     long failed_step = -1, done = 0;
     ak_result wres = AK_OK;
     for (long s = 0; s <= sc.steps && res == AK_OK && wres == AK_OK; ++s) {
         if (gif && s % every == 0) {
-            res = draw_frame(&rd, &sc, &st, &img);
+            res = draw_frame(&rd, &sc, &st, cp, &img);
             if (res == AK_OK) wres = ak_gif_writer_add_frame(gif, &img);
         }
+        if (is_glb && s % every == 0) chars_record(&chars, &st);
         if (s == sc.steps) break;
         if (res == AK_OK && (res = run_step(&st, s)) != AK_OK) failed_step = s;
         else done = s + 1;
+        if (res == AK_OK && cp && (res = chars_update(cp, &st, sc.dt)) != AK_OK) failed_step = s;
         cli_progress("crowd", (size_t)s + 1, (size_t)sc.steps);
     }
     const double elapsed = cli_now() - t0;
     if (res == AK_OK && rendering && !is_gif) {
-        res = draw_frame(&rd, &sc, &st, &img);
+        res = draw_frame(&rd, &sc, &st, cp, &img);
         if (res == AK_OK) wres = ak_png_write(out, &img);
     }
     if (gif && (res != AK_OK || wres != AK_OK)) ak_gif_writer_discard(gif); /* no partial GIF */
@@ -427,8 +577,12 @@ int cmd_crowd(int argc, char** argv) {
     if (res != AK_OK && failed_step >= 0) rc = cli_fail("crowd", "step %ld: %s", failed_step, ak_result_string(res));
     else if (res != AK_OK) rc = cli_fail("crowd", "%s", ak_result_string(res));
     else if (wres != AK_OK) rc = cli_fail("crowd", "%s: cannot write the file: %s", out, ak_result_string(wres));
+    if (rc == CLI_OK && is_glb) rc = chars_write_gltf(&chars, &sc, (float)every * sc.dt, out);
+    chars_free(&chars);
     const size_t reached = reached_count(&st);
-    if (rc == CLI_OK && out) cli_wrote(out, "%zu agents after %ld steps", st.n, done);
+    if (rc == CLI_OK && out)
+        cli_wrote(out, "%zu agents after %ld steps%s", st.n, done,
+                  is_glb ? " (a skinned character each)" : (with_chars ? " (characters)" : ""));
     if (rc == CLI_OK && json && (rc = write_json(json, (double)((float)done * sc.dt), &st)) == CLI_OK)
         cli_wrote(json, "%zu agents after %ld steps, %zu at their goal", st.n, done, reached);
     if (rc == CLI_OK && !json && !out)
