@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "crowd_draw.h"
 #include "outfile.h"
 
 static const char* const usage =
@@ -174,80 +175,11 @@ static size_t reached_count(const crowd_run* r) {
     return k;
 }
 
-/* ---- characters ----------------------------------------------------------------------------- */
-
-#define CHARACTER_CELL 0.08f       /* builtin:humanoid's grid: about 2,300 triangles */
-#define RENDER_CHARACTERS_MAX 500u /* above: discs */
-
-typedef struct crowd_chars {
-    ak_scene* scene;
-    ak_crowd_gait gait;
-    ak_crowd_character* ch;
-    size_t n;
-    cli_poser poser;
-    bool poser_ready;
-    ak_vec2* rec_pos; /* recorded frames for glTF: [frame_cap * n] */
-    ak_crowd_character* rec_ch;
-    size_t frames, frame_cap;
-} crowd_chars;
-
-static void chars_free(crowd_chars* c) {
-    if (c->poser_ready) cli_poser_free(&c->poser);
-    ak_scene_destroy(c->scene);
-    free(c->ch);
-    free(c->rec_pos);
-    free(c->rec_ch);
-    memset(c, 0, sizeof *c);
-}
-
-/* The humanoid, its gait, one character per agent facing its first waypoint, phases spread. */
-static ak_result chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t frame_cap, ak_diag* diag) {
-    memset(c, 0, sizeof *c);
-    ak_builtin_desc bd = {.cell_size = CHARACTER_CELL};
-    ak_result r = ak_builtin_create("builtin:humanoid", &bd, NULL, &c->scene);
-    if (r != AK_OK) return r;
-    ak_crowd_gait_desc gd = {.scene = c->scene, .clip_index = ak_scene_find_clip(c->scene, "walk")};
-    if ((r = ak_crowd_gait_measure(&gd, NULL, &c->gait, diag)) != AK_OK) return r;
-    c->n = sc->agent_count;
-    c->ch = malloc(c->n * sizeof *c->ch);
-    if (!c->ch) return AK_ERR_NO_MEMORY;
-    for (size_t i = 0; i < c->n; ++i) {
-        const ak_vec2 to = ak_vec2_sub(sc->agents[i].goals.ptr[0], sc->positions[i]);
-        const float phase = (float)((i * 2654435761u) & 0xffffu) / 65536.0f;
-        c->ch[i] = ak_crowd_character_init(&c->gait, to, phase);
-    }
-    if (cli_poser_init(&c->poser, c->scene)) return AK_ERR_NO_MEMORY;
-    c->poser_ready = true;
-    if (frame_cap) {
-        c->frame_cap = frame_cap;
-        c->rec_pos = malloc(frame_cap * c->n * sizeof *c->rec_pos);
-        c->rec_ch = malloc(frame_cap * c->n * sizeof *c->rec_ch);
-        if (!c->rec_pos || !c->rec_ch) return AK_ERR_NO_MEMORY;
-    }
-    return AK_OK;
-}
-
-static ak_result chars_update(crowd_chars* c, const crowd_run* st, float dt) {
-    ak_crowd_characters_job job = {.gait = &c->gait, .dt = dt, .velocities = {st->v, st->n},
-                                   .characters = {c->ch, c->n}};
-    return ak_crowd_characters_update(&job);
-}
-
-static void chars_record(crowd_chars* c, const crowd_run* st) {
-    if (c->frames >= c->frame_cap) return;
-    memcpy(c->rec_pos + c->frames * c->n, st->p, c->n * sizeof *st->p);
-    memcpy(c->rec_ch + c->frames * c->n, c->ch, c->n * sizeof *c->ch);
-    ++c->frames;
-}
-
-static const ak_vec4 k_palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
-                                     {0.75f, 0.30f, 0.55f, 1}};
-
 /* The recorded run as glTF: a skinned character per agent (ak_crowd_bake_scene). */
 static int chars_write_gltf(crowd_chars* c, const ak_crowd_scene* sc, float frame_time, const char* out) {
     ak_vec4* colors = malloc(c->n * sizeof *colors);
     if (!colors) return cli_fail("crowd", "out of memory");
-    for (size_t i = 0; i < c->n; ++i) colors[i] = k_palette[sc->group[i] % 4];
+    for (size_t i = 0; i < c->n; ++i) colors[i] = crowd_palette[sc->group[i] % 4];
     ak_crowd_bake_desc bd = {.gait = &c->gait, .agent_count = c->n, .frame_count = c->frames,
                              .positions = c->rec_pos, .characters = c->rec_ch, .frame_time = frame_time,
                              .colors = colors, .name = "crowd"};
@@ -264,31 +196,21 @@ static int chars_write_gltf(crowd_chars* c, const ak_crowd_scene* sc, float fram
 
 /* ---- rendering ------------------------------------------------------------------------------ */
 
-#define SIDES 8
-#define TRIS_PER_AGENT (3 * SIDES)
-
 typedef struct renderer {
     int w, h;
     ak_raster* raster;
     ak_raster_camera cam;
     ak_vec3 center;
     float extent;
-    ak_vec3 *pos, *nrm;
-    ak_vec4* col;
-    size_t vcount;
-    uint32_t* idx; /* characters: [agents * triangles * 3] */
-    size_t icount;
+    crowd_people people;
     ak_vec3* wall;
-    size_t wall_count;
+    size_t wall_count; /* vertices */
     uint8_t* pixels;
 } renderer;
 
 static void renderer_free(renderer* r) {
     ak_raster_destroy(r->raster);
-    free(r->pos);
-    free(r->nrm);
-    free(r->col);
-    free(r->idx);
+    crowd_people_free(&r->people);
     free(r->wall);
     free(r->pixels);
 }
@@ -312,104 +234,24 @@ static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc, co
     const ak_vec3 eye = ak_vec3_add(r->center, ak_vec3_make(0.0f, 1.5f * r->extent, 1.1f * r->extent));
     r->cam = ak_raster_camera_perspective(eye, r->center, ak_radians(45), (float)w / (float)h, 0.05f * r->extent,
                                           10.0f * r->extent);
-    const size_t n = sc->agent_count;
-    r->vcount = n * TRIS_PER_AGENT * 3;
-    if (chars) {
-        const ak_mesh* m = chars->scene->meshes[0].mesh;
-        r->vcount = n * m->vertex_count;
-        r->icount = n * m->triangle_count * 3;
-        r->idx = malloc(r->icount * sizeof *r->idx);
-        if (!r->idx) return 1;
-        for (size_t a = 0; a < n; ++a)
-            for (size_t k = 0; k < m->triangle_count * 3; ++k)
-                r->idx[a * m->triangle_count * 3 + k] = (uint32_t)(a * m->vertex_count + m->indices[k]);
-    }
-    r->pos = malloc(r->vcount * sizeof *r->pos);
-    r->nrm = malloc(r->vcount * sizeof *r->nrm);
-    r->col = malloc(r->vcount * sizeof *r->col);
     r->pixels = malloc((size_t)w * (size_t)h * 4);
-    if (!r->pos || !r->nrm || !r->col || !r->pixels) return 1;
-    /* walls: each obstacle edge a 1.2 m high quad (two triangles) */
-    size_t edges = 0;
-    for (size_t k = 0; k < sc->obstacle_count; ++k) edges += sc->obstacles[k].vertices.count == 2 ? 1 : sc->obstacles[k].vertices.count;
-    if (edges) {
-        r->wall = malloc(edges * 6 * sizeof *r->wall);
-        if (!r->wall) return 1;
-        for (size_t k = 0; k < sc->obstacle_count; ++k) {
-            const ak_vec2_cspan v = sc->obstacles[k].vertices;
-            const size_t m = v.count == 2 ? 1 : v.count;
-            for (size_t e = 0; e < m; ++e) {
-                const ak_vec2 a = v.ptr[e], b = v.ptr[(e + 1) % v.count];
-                const ak_vec3 q[4] = {{a.x, 0, a.y}, {b.x, 0, b.y}, {b.x, 1.2f, b.y}, {a.x, 1.2f, a.y}};
-                ak_vec3* o = r->wall + 6 * r->wall_count++;
-                o[0] = q[0], o[1] = q[1], o[2] = q[2], o[3] = q[0], o[4] = q[2], o[5] = q[3];
-            }
-        }
-    }
-    return 0;
+    if (!r->pixels || !crowd_people_init(&r->people, sc->agent_count, chars)) return 1;
+    return crowd_walls(sc, &r->wall, &r->wall_count) ? 0 : 1;
 }
 
-/* Each agent an upright octagonal prism (1.7 m, its radius) coloured by group, its front face
- * (toward the velocity) light. */
-/* Each character posed (its clip time and heading), skinned (LBS) and placed in the world. */
-static ak_result pose_characters(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, crowd_chars* c) {
-    const ak_mesh* m = c->scene->meshes[0].mesh;
-    const size_t J = ak_scene_joint_count(c->scene);
-    for (size_t i = 0; i < st->n; ++i) {
-        ak_result res = ak_crowd_character_pose(&c->gait, &c->ch[i], (ak_transform_span){c->poser.local, J});
-        if (res == AK_OK) res = cli_poser_deform(&c->poser, false, CLI_LBS);
-        if (res != AK_OK) return res;
-        const ak_mat4 root = ak_crowd_character_root(&c->gait, &c->ch[i], st->p[i]);
-        const ak_vec4 col = k_palette[sc->group[i] % 4];
-        for (size_t v = 0; v < m->vertex_count; ++v) {
-            const size_t o = i * m->vertex_count + v;
-            r->pos[o] = ak_mat4_transform_point(root, c->poser.positions[0][v]);
-            r->nrm[o] = ak_mat4_transform_vector(root, c->poser.normals[0][v]);
-            r->col[o] = col;
-        }
-    }
-    return AK_OK;
-}
-
+/* The agents (characters or prisms) and the walls, over the ground with shadows. */
 static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, crowd_chars* chars,
                             ak_image* out) {
-    const ak_vec4* palette = k_palette;
-    const float pi = 3.14159265358979f;
-    size_t k = 0;
-    if (chars) {
-        const ak_result pr = pose_characters(r, sc, st, chars);
-        if (pr != AK_OK) return pr;
-        k = r->vcount;
-    }
-    for (size_t i = 0; i < st->n && !chars; ++i) {
-        const float rad = sc->agents[i].radius > 0.0f ? sc->agents[i].radius : 0.3f, hgt = 1.7f;
-        const ak_vec2 p = st->p[i], v = st->v[i];
-        const float heading = (v.x * v.x + v.y * v.y) > 1e-6f ? atan2f(v.y, v.x) : 0.0f;
-        const ak_vec4 c = palette[sc->group[i] % 4];
-        for (int s = 0; s < SIDES; ++s) {
-            const float a0 = heading + 2.0f * pi * ((float)s - 0.5f) / SIDES, a1 = heading + 2.0f * pi * ((float)s + 0.5f) / SIDES;
-            const ak_vec3 b0 = {p.x + rad * cosf(a0), 0, p.y + rad * sinf(a0)}, b1 = {p.x + rad * cosf(a1), 0, p.y + rad * sinf(a1)};
-            const ak_vec3 t0 = {b0.x, hgt, b0.z}, t1 = {b1.x, hgt, b1.z}, top = {p.x, hgt, p.y};
-            const float am = heading + 2.0f * pi * (float)s / SIDES;
-            const ak_vec3 n = {cosf(am), 0, sinf(am)}, up = {0, 1, 0};
-            const ak_vec4 cc = s == 0 ? ak_vec4_make(0.95f, 0.95f, 0.9f, 1) : c;
-            const ak_vec3 tri[9] = {b0, b1, t1, b0, t1, t0, t0, t1, top};
-            for (int q = 0; q < 9; ++q) {
-                r->pos[k] = tri[q];
-                r->nrm[k] = q < 6 ? n : up;
-                r->col[k] = cc;
-                ++k;
-            }
-        }
-    }
-    ak_raster_mesh people = {.positions = {r->pos, k}, .normals = {r->nrm, k}, .colors = {r->col, k},
-                             .indices = {r->idx, r->icount}, .material = {.color = {1, 1, 1, 1}}};
-    ak_raster_mesh walls = {.positions = {r->wall, r->wall_count * 6}, .material = {.color = {0.6f, 0.6f, 0.62f, 1}}};
+    ak_raster_mesh people;
+    ak_result res = crowd_people_update(&r->people, sc, st->p, st->v, chars, &people);
+    if (res != AK_OK) return res;
+    const size_t k = people.positions.count;
+    ak_raster_mesh walls = {.positions = {r->wall, r->wall_count}, .material = {.color = {0.6f, 0.6f, 0.62f, 1}}};
     ak_raster_mesh casters[2] = {people, walls};
     ak_raster_clear(r->raster, ak_vec4_make(0.80f, 0.86f, 0.93f, 1), ak_vec4_make(0.55f, 0.60f, 0.68f, 1));
     ak_raster_ground g = {.height = 0.0f, .center = r->center, .half_extent = 1.6f * r->extent,
                           .casters = casters, .caster_count = r->wall_count ? 2 : 1};
-    ak_result res = k ? ak_raster_draw_ground(r->raster, &r->cam, &g) : AK_OK;
+    res = k ? ak_raster_draw_ground(r->raster, &r->cam, &g) : AK_OK;
     if (res == AK_OK && r->wall_count) res = ak_raster_draw_mesh(r->raster, &r->cam, &walls);
     if (res == AK_OK && k) res = ak_raster_draw_mesh(r->raster, &r->cam, &people);
     if (res == AK_OK) res = ak_raster_resolve(r->raster, out);
@@ -516,12 +358,12 @@ int cmd_crowd(int argc, char** argv) {
     const long every = sc.steps > max_frames ? (sc.steps + max_frames - 1) / max_frames : 1;
     crowd_chars chars;
     memset(&chars, 0, sizeof chars);
-    const bool with_chars = is_glb || (out && sc.agent_count <= RENDER_CHARACTERS_MAX);
+    const bool with_chars = is_glb || (out && sc.agent_count <= CROWD_CHARACTERS_MAX);
     if (with_chars) {
         ak_diag cd = {0};
-        res = chars_init(&chars, &sc, is_glb ? (size_t)(sc.steps / every + 1) : 0, &cd);
+        res = crowd_chars_init(&chars, &sc, is_glb ? (size_t)(sc.steps / every + 1) : 0, &cd);
         if (res != AK_OK) {
-            chars_free(&chars);
+            crowd_chars_free(&chars);
             run_free(&st);
             ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "characters: %s", cd.message[0] ? cd.message : ak_result_string(res));
@@ -535,7 +377,7 @@ int cmd_crowd(int argc, char** argv) {
     if (rendering) {
         if (renderer_init(&rd, w, h, &sc, with_chars ? &chars : NULL)) {
             renderer_free(&rd);
-            chars_free(&chars);
+            crowd_chars_free(&chars);
             run_free(&st);
             ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "out of memory for rendering");
@@ -543,7 +385,7 @@ int cmd_crowd(int argc, char** argv) {
         img = (ak_image){.pixels = rd.pixels, .width = w, .height = h};
         if (is_gif && ak_gif_writer_create(out, &(ak_gif_desc){.width = w, .height = h, .delay_cs = 4}, NULL, &gif) != AK_OK) {
             renderer_free(&rd);
-            chars_free(&chars);
+            crowd_chars_free(&chars);
             run_free(&st);
             ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "%s: cannot create the file", out);
@@ -558,11 +400,11 @@ int cmd_crowd(int argc, char** argv) {
             res = draw_frame(&rd, &sc, &st, cp, &img);
             if (res == AK_OK) wres = ak_gif_writer_add_frame(gif, &img);
         }
-        if (is_glb && s % every == 0) chars_record(&chars, &st);
+        if (is_glb && s % every == 0) crowd_chars_record(&chars, st.p);
         if (s == sc.steps) break;
         if (res == AK_OK && (res = run_step(&st, s)) != AK_OK) failed_step = s;
         else done = s + 1;
-        if (res == AK_OK && cp && (res = chars_update(cp, &st, sc.dt)) != AK_OK) failed_step = s;
+        if (res == AK_OK && cp && (res = crowd_chars_update(cp, st.v, sc.dt)) != AK_OK) failed_step = s;
         cli_progress("crowd", (size_t)s + 1, (size_t)sc.steps);
     }
     const double elapsed = cli_now() - t0;
@@ -578,7 +420,7 @@ int cmd_crowd(int argc, char** argv) {
     else if (res != AK_OK) rc = cli_fail("crowd", "%s", ak_result_string(res));
     else if (wres != AK_OK) rc = cli_fail("crowd", "%s: cannot write the file: %s", out, ak_result_string(wres));
     if (rc == CLI_OK && is_glb) rc = chars_write_gltf(&chars, &sc, (float)every * sc.dt, out);
-    chars_free(&chars);
+    crowd_chars_free(&chars);
     const size_t reached = reached_count(&st);
     if (rc == CLI_OK && out)
         cli_wrote(out, "%zu agents after %ld steps%s", st.n, done,
