@@ -22,6 +22,15 @@ void crowd_chars_free(crowd_chars* c) {
     memset(c, 0, sizeof *c);
 }
 
+void crowd_chars_reset(crowd_chars* c, const ak_crowd_scene* sc) {
+    for (size_t i = 0; i < c->n; ++i) {
+        const ak_vec2 to = ak_vec2_sub(sc->agents[i].goals.ptr[0], sc->positions[i]);
+        const float phase = (float)((i * 2654435761u) & 0xffffu) / 65536.0f; /* spread, reproducible */
+        c->ch[i] = ak_crowd_character_init(&c->gait, to, phase);
+    }
+    c->frames = 0;
+}
+
 ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t frame_cap, ak_diag* diag) {
     memset(c, 0, sizeof *c);
     ak_builtin_desc bd = {.cell_size = CROWD_CHARACTER_CELL};
@@ -32,11 +41,7 @@ ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t fram
     c->n = sc->agent_count;
     c->ch = malloc(c->n * sizeof *c->ch);
     if (!c->ch) return AK_ERR_NO_MEMORY;
-    for (size_t i = 0; i < c->n; ++i) {
-        const ak_vec2 to = ak_vec2_sub(sc->agents[i].goals.ptr[0], sc->positions[i]);
-        const float phase = (float)((i * 2654435761u) & 0xffffu) / 65536.0f; /* spread, reproducible */
-        c->ch[i] = ak_crowd_character_init(&c->gait, to, phase);
-    }
+    crowd_chars_reset(c, sc);
     if (cli_poser_init(&c->poser, c->scene)) return AK_ERR_NO_MEMORY;
     c->poser_ready = true;
     if (frame_cap) {
@@ -59,12 +64,6 @@ void crowd_chars_record(crowd_chars* c, const ak_vec2* positions) {
     memcpy(c->rec_pos + c->frames * c->n, positions, c->n * sizeof *positions);
     memcpy(c->rec_ch + c->frames * c->n, c->ch, c->n * sizeof *c->ch);
     ++c->frames;
-}
-
-void crowd_chars_face(crowd_chars* c, size_t i, ak_vec2 direction) {
-    if (i >= c->n) return;
-    const float l = ak_vec2_length(direction);
-    if (l > 1e-6f && ak_finitef(l)) c->ch[i].heading = ak_vec2_scale(direction, 1.0f / l);
 }
 
 /* ---- people ------------------------------------------------------------------------------------ */

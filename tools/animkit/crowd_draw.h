@@ -27,11 +27,11 @@ typedef struct crowd_chars {
  * and room to record frame_cap frames (0: none). */
 ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t frame_cap, ak_diag* diag);
 void crowd_chars_free(crowd_chars* c);
+/* Back to the start: every character facing its first waypoint, standing; no recorded frame. */
+void crowd_chars_reset(crowd_chars* c, const ak_crowd_scene* sc);
 ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, float dt);
 /* Record the current frame (positions of the n agents, the characters); no-op when full. */
 void crowd_chars_record(crowd_chars* c, const ak_vec2* positions);
-/* Turn a character toward its new goal at once (a goal set by the viewer). */
-void crowd_chars_face(crowd_chars* c, size_t i, ak_vec2 direction);
 
 /* World-space triangles of every agent, rebuilt each frame. */
 typedef struct crowd_people {
