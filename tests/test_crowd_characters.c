@@ -285,10 +285,105 @@ AK_TEST(validation) {
     ak_scene_destroy(sc);
 }
 
+/* ak_crowd_bake_scene: every agent's joints in the baked scene, posed by its clip at frame k,
+ * sit where the character's own forward kinematics, placed by the root matrix, puts them. */
+AK_TEST(bake_scene) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    enum { N = 3, F = 5 };
+    ak_vec2 pos[F * N];
+    ak_crowd_character ch[F * N];
+    for (int a = 0; a < N; ++a) {
+        ak_crowd_character c = ak_crowd_character_init(&g, ak_vec2_make(1, (float)a), 0.3f * (float)a);
+        ak_vec2 v = ak_vec2_make(1.2f, 0.4f * (float)(a - 1));
+        ak_crowd_characters_job job = {.gait = &g, .dt = 0.1f, .velocities = {&v, 1}, .characters = {&c, 1}};
+        for (int f = 0; f < F; ++f) {
+            pos[f * N + a] = ak_vec2_make(0.12f * (float)f + 2.0f * (float)a, 0.04f * (float)f * (float)(a - 1));
+            ch[f * N + a] = c;
+            ak_crowd_characters_update(&job);
+        }
+    }
+    ak_crowd_bake_desc bd = {.gait = &g, .agent_count = N, .frame_count = F, .positions = pos, .characters = ch,
+                             .frame_time = 0.1f};
+    ak_scene* baked = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_OK);
+    if (!baked) {
+        ak_scene_destroy(sc);
+        return;
+    }
+    const size_t J = ak_scene_joint_count(sc), n = ak_scene_joint_count(baked);
+    AK_CHECK_EQ(n, (size_t)N * (J + 1));
+    AK_CHECK_EQ(baked->mesh_count, (size_t)N * sc->mesh_count);
+    AK_CHECK_EQ(baked->skin_count, (size_t)N * sc->skin_count);
+    AK_CHECK_EQ(baked->clip_count, 1u);
+    AK_CHECK_NEAR(ak_clip_duration(baked->clips[0]), 0.4f, 1e-6f);
+    ak_transform* lb = malloc(n * sizeof *lb);
+    ak_mat4* wb = malloc(n * sizeof *wb);
+    ak_transform* lc = malloc(J * sizeof *lc);
+    ak_mat4* wc = malloc(J * sizeof *wc);
+    double worst = 0.0;
+    for (int f = 0; f < F; ++f) {
+        ak_scene_rest_pose(baked, (ak_transform_span){lb, n});
+        ak_clip_sample(baked->clips[0], 0.1f * (float)f, NULL, (ak_transform_span){lb, n}, (ak_f32_span){0},
+                       (ak_f32_span){0});
+        ak_scene_world_matrices(baked, (ak_transform_cspan){lb, n}, (ak_mat4_span){wb, n});
+        for (int a = 0; a < N; ++a) {
+            ak_crowd_character_pose(&g, &ch[f * N + a], (ak_transform_span){lc, J});
+            ak_scene_world_matrices(sc, (ak_transform_cspan){lc, J}, (ak_mat4_span){wc, J});
+            const ak_mat4 root = ak_crowd_character_root(&g, &ch[f * N + a], pos[f * N + a]);
+            for (size_t j = 0; j < J; ++j) {
+                const ak_vec3 want = ak_mat4_transform_point(root, ak_mat4_get_translation(wc[j]));
+                const ak_vec3 got = ak_mat4_get_translation(wb[(size_t)a * (J + 1) + 1 + j]);
+                worst = fmax(worst, (double)ak_vec3_length(ak_vec3_sub(want, got)));
+            }
+        }
+    }
+    printf("  baked joints vs the characters' own: %.2g m at most\n", worst);
+    AK_CHECK(worst < 1e-4);
+    /* each skin names its agent's joints */
+    AK_CHECK_EQ(baked->skins[N - 1].joints[0], (int32_t)((N - 1) * (J + 1) + 1) + sc->skins[0].joints[0]);
+    free(lb);
+    free(wb);
+    free(lc);
+    free(wc);
+    ak_scene_destroy(baked);
+    /* errors, checked before allocating */
+    bd.memory_budget = 1000;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK(baked == NULL && strstr(diag.message, "budget") != NULL);
+    bd.memory_budget = 0;
+    bd.frame_count = AK_SCENE_BAKE_MAX_FRAMES + 1;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
+    bd.frame_count = 0;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_EMPTY);
+    bd.frame_count = F;
+    bd.frame_time = 0;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_BAD_ARG);
+    bd.frame_time = 0.1f;
+    pos[4].x = NAN;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_BAD_DATA);
+    bd.agent_count = 2000;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK_EQ(ak_crowd_bake_scene(NULL, NULL, &baked, &diag), AK_ERR_NULL_ARG);
+    /* one frame: no clip, the nodes rest in that frame */
+    pos[4].x = 0;
+    bd.agent_count = N;
+    bd.frame_count = 1;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_OK);
+    if (baked) AK_CHECK_EQ(baked->clip_count, 0u);
+    ak_scene_destroy(baked);
+    ak_scene_destroy(sc);
+}
+
 int main(void) {
     AK_RUN(gait_of_builtin_walk);
     AK_RUN(foot_sliding_straight);
     AK_RUN(turning_and_idle);
     AK_RUN(validation);
+    AK_RUN(bake_scene);
     return ak_test_finish();
 }
