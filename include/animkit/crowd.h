@@ -35,6 +35,11 @@
  *     their signs; at most 3 rad/s), and slows to pref_speed (1 - exp(-0.5 ttc_min^2)).
  *     No guarantee against overlap (the contact passes apply as for ORCA).
  *
+ *   - characters: each agent drives a skinned character's in-place walk clip, its clip time
+ *     following the distance walked (measured from the clip's stance foot: ak_crowd_gait_*),
+ *     its heading the velocity, idle when stopped; the crowd baked into an animated scene
+ *     for glTF (ak_crowd_bake_scene). See the "characters" sections below.
+ *
  * What it does NOT do: dynamic obstacles, path planning (waypoints come from the caller), 3D
  * terrain (the ground is the plane y = 0).
  *
