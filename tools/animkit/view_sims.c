@@ -13,7 +13,7 @@
 #include "particles_run.h"
 #include "view_app.h"
 
-const char* const view_sim_kinds = "particles, boids, cloth, terrain";
+const char* const view_sim_kinds = "particles, boids, cloth, terrain, crowd";
 
 #define MAX_STEPS_PER_FRAME 64
 #define WIND_STEP 0.5f
@@ -733,6 +733,7 @@ static const struct {
     {"boids", &boids_sim},
     {"cloth", &cloth_sim},
     {"terrain", &view_terrain_sim},
+    {"crowd", &view_crowd_sim},
 };
 
 const view_sim* view_sim_at(size_t index) { return index < sizeof sims / sizeof sims[0] ? sims[index].sim : NULL; }
