@@ -32,9 +32,8 @@ ln -sf /usr/include/cjson/cJSON.h "$OUT/inc/cjson/cJSON.h"
 # build of (libpng/giflib, libpng/libjpeg, Assimp, CHOLMOD); web/stubs.c stands in for them.
 mapfile -t LIB < <(ls src/*.c src/*/*.c | grep -v -E '^src/(raster/raster_file|io/image|io/assimp|skin/weights_heat)\.c$')
 # The viewer's platform-independent state machine and simulations (tools/animkit/view_app.h).
-TOOLS=(tools/animkit/view_app.c tools/animkit/view_sims.c tools/animkit/view_terrain.c
-       tools/animkit/view_script.c tools/animkit/cli.c tools/animkit/render.c tools/animkit/pose.c
-       tools/animkit/boids_run.c tools/animkit/cloth_run.c tools/animkit/particles_run.c tools/animkit/outfile.c)
+# Every file there but main.c, the commands (cmd_*.c) and the SDL window (view_sdl.c).
+mapfile -t TOOLS < <(ls tools/animkit/*.c | grep -v -E '/(main|view_sdl|cmd_[a-z_]*)\.c$')
 WEB=(web/animkit_web.c web/fluid_sim.c web/cjson.c web/stubs.c)
 
 CFLAGS=(--target=wasm32-wasi -std=c11 -O2 -msimd128 -mnontrapping-fptoint -msign-ext -Wall -Wextra -Wpedantic -Werror

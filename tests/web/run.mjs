@@ -183,7 +183,7 @@ try {
 
   // ---- 5. the simulations run live ----
   results.sims = {};
-  for (const what of ['particles:preset:fountain', 'cloth:preset:flag', 'boids:preset:flock', 'fluid:preset:dam', 'terrain']) {
+  for (const what of ['particles:preset:fountain', 'cloth:preset:flag', 'boids:preset:flock', 'fluid:preset:dam', 'crowd:preset:circle', 'terrain']) {
     const r = await page.evaluate((w) => {
       const a = window.animkit;
       if (!a.open(w, 960, 600)) return { error: a.error() };
