@@ -17,9 +17,20 @@ typedef struct contact_group {
     float height; /* the pair's midpoint against gravity: higher pairs are solved first */
 } contact_group;
 
+/* A pair of bodies the broad phase found at the step's start. Pairs of boxes and planes
+ * (flat faces and corners: their contact points are fixed on the bodies) keep the contacts
+ * found then, c[start, end), for every substep; other pairs (spheres, capsules: the contact
+ * point rolls over the surface) run the narrow phase again in each substep. */
+typedef struct pair_entry {
+    uint32_t a, b; /* the awake (or lower-index) body first: a static body is always b */
+    uint32_t start, end;
+    float height; /* the pair's midpoint against gravity: higher pairs are solved first */
+    uint32_t cached;
+} pair_entry;
+
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, qp, dx, ds, sap, contacts, groups, parent, awake, total;
+    size_t x0, q0, v0, w0, qp, dx, ds, grow, sap, pairs, contacts, groups, parent, awake, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -34,7 +45,9 @@ static layout layout_of(const ak_rigid_model* m) {
     l.qp = off, off += align16(n * sizeof(ak_quat));
     l.dx = off, off += align16(n * sizeof(ak_vec3));
     l.ds = off, off += align16(n * sizeof(ak_vec3));
+    l.grow = off, off += align16(n * sizeof(float));
     l.sap = off, off += align16(n * sizeof(sap_entry));
+    l.pairs = off, off += align16((size_t)m->desc.max_contacts * sizeof(pair_entry));
     l.contacts = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
                                      sizeof(rigid_contact));
     l.groups = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
@@ -196,6 +209,8 @@ typedef struct contact_buf {
     uint32_t group_count;
 } contact_buf;
 
+static float contact_vn(const solver* s, const rigid_contact* c);
+
 static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float margin) {
     rigid_pose pa = {s->x[a], s->q[a]}, pb = {s->x[b], s->q[b]};
     /* the buffer has AKP_RIGID_MAX_PAIR_CONTACTS slack past cap */
@@ -216,10 +231,7 @@ static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float mar
         c->friction = sqrtf(ba->friction * bb->friction);
         c->dynamic_friction = sqrtf(ba->dynamic_friction * bb->dynamic_friction);
         c->restitution = ak_maxf(ba->restitution, bb->restitution);
-        ak_vec3 ra = ak_quat_rotate(s->q[a], c->la), rb = ak_quat_rotate(s->q[b], c->lb);
-        ak_vec3 va = ak_vec3_add(s->v[a], ak_vec3_cross(s->w[a], ra));
-        ak_vec3 vb = ak_vec3_add(s->v[b], ak_vec3_cross(s->w[b], rb));
-        c->vn_before = ak_vec3_dot(c->n, ak_vec3_sub(va, vb));
+        c->vn_before = contact_vn(s, c);
     }
     cb->count += (uint32_t)kept;
 }
@@ -228,10 +240,76 @@ static bool joined(const ak_rigid_model* m, uint32_t a, uint32_t b);
 
 static float axis_comp(ak_vec3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
 
-static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float margin) {
+static bool flat_shape(ak_rigid_shape_type t) { return t == AK_RIGID_BOX || t == AK_RIGID_PLANE; }
+
+/* Relative normal velocity of contact c's points (before the solve; restitution reads it). */
+static float contact_vn(const solver* s, const rigid_contact* c) {
+    ak_vec3 ra = ak_quat_rotate(s->q[c->a], c->la), rb = ak_quat_rotate(s->q[c->b], c->lb);
+    ak_vec3 va = ak_vec3_add(s->v[c->a], ak_vec3_cross(s->w[c->a], ra));
+    ak_vec3 vb = ak_vec3_add(s->v[c->b], ak_vec3_cross(s->w[c->b], rb));
+    return ak_vec3_dot(c->n, ak_vec3_sub(va, vb));
+}
+
+typedef struct pair_buf {
+    pair_entry* p;
+    uint32_t count, cap;
+} pair_buf;
+
+/* Keep pair (a, b) for the step: a pair of flat shapes gets its contacts now, at the step's
+ * start, with a margin that covers how far the two can close in the step (grow[a] + grow[b]),
+ * and is dropped when it has none; any other pair is kept for the substeps' narrow phase. */
+static void add_pair(solver* s, contact_buf* cb, pair_buf* pb, const float* grow, uint32_t a,
+                     uint32_t b, float offset, ak_vec3 up) {
+    if (pb->count >= pb->cap) {
+        cb->dropped += 1;
+        return;
+    }
+    pair_entry* e = &pb->p[pb->count];
+    e->a = a;
+    e->b = b;
+    e->cached = flat_shape(s->bodies[a].shape.type) && flat_shape(s->bodies[b].shape.type);
+    if (e->cached) {
+        e->start = cb->count;
+        narrow(s, cb, a, b, offset + grow[a] + grow[b]);
+        e->end = cb->count;
+        if (e->end == e->start) return;
+    } else {
+        e->start = e->end = cb->count;
+    }
+    ak_vec3 mid = s->bodies[b].shape.type == AK_RIGID_PLANE
+                      ? s->x[a]
+                      : ak_vec3_scale(ak_vec3_add(s->x[a], s->x[b]), 0.5f);
+    /* in steps of the contact offset: pairs level to rounding (a layer of a pyramid) keep the
+     * sweep's order rather than one their rounding noise picks */
+    e->height = floorf(ak_vec3_dot(mid, up) / offset);
+    pb->count++;
+}
+
+static bool pair_before(const pair_entry* a, const pair_entry* b) {
+    return a->height > b->height || (a->height == b->height && a->start < b->start) ||
+           (a->height == b->height && a->start == b->start &&
+            (a->a < b->a || (a->a == b->a && a->b < b->b)));
+}
+
+/* Broad phase, once per step on the step's start poses: sweep and prune over bounding spheres
+ * grown by the contact offset and by how far each body can move in the step (grow: twice its
+ * speed times dt, plus what gravity adds, plus its corners' turn for flat shapes). Then the
+ * pairs are ordered from the top down (against gravity; the found order when there is none):
+ * in a stack or a pyramid the ground is then solved last, which lets a 10-box stack creep
+ * several times less than bottom-up order. Shell sorts (no allocation, a total order). */
+static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb, float* grow,
+                       float offset, float dt, float gmag, ak_vec3 up) {
     const ak_rigid_model* m = s->m;
     uint32_t n = (uint32_t)m->body_count, ns = 0;
     cb->count = 0;
+    pb->count = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        const rigid_body* b = &s->bodies[i];
+        grow[i] = 0.0f;
+        if (!s->awake[i]) continue;
+        float turn = flat_shape(b->shape.type) ? ak_vec3_length(s->w[i]) * b->bound_radius : 0.0f;
+        grow[i] = 2.0f * dt * (ak_vec3_length(s->v[i]) + turn) + dt * dt * gmag;
+    }
     /* sweep along the axis over which the bodies spread most (their centres' variance) */
     double mean[3] = {0, 0, 0}, var[3] = {0, 0, 0};
     uint32_t counted = 0;
@@ -249,7 +327,7 @@ static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float marg
     for (uint32_t i = 0; i < n; ++i) {
         const rigid_body* b = &s->bodies[i];
         if (b->shape.type == AK_RIGID_PLANE) continue;
-        float r = b->bound_radius + margin, c = axis_comp(s->x[i], axis);
+        float r = b->bound_radius + offset + grow[i], c = axis_comp(s->x[i], axis);
         sap[ns].lo = c - r;
         sap[ns].hi = c + r;
         sap[ns].body = i;
@@ -261,23 +339,63 @@ static void find_contacts(solver* s, sap_entry* sap, contact_buf* cb, float marg
         for (uint32_t j = i + 1; j < ns && sap[j].lo <= sap[i].hi; ++j) {
             uint32_t b = sap[j].body;
             if (!s->awake[a] && !s->awake[b]) continue;
-            float rr = s->bodies[a].bound_radius + s->bodies[b].bound_radius + margin;
+            float rr = s->bodies[a].bound_radius + s->bodies[b].bound_radius + offset + grow[a] +
+                       grow[b];
             if (ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b])) > rr * rr) continue;
             if (s->bodies[a].group != 0 && s->bodies[a].group == s->bodies[b].group) continue;
             if (m->joint_count && joined(m, a, b)) continue;
             /* the awake (or lower-index) body first, so a static body is always b */
             if (!s->awake[a] || (s->awake[b] && b < a))
-                narrow(s, cb, b, a, margin);
+                add_pair(s, cb, pb, grow, b, a, offset, up);
             else
-                narrow(s, cb, a, b, margin);
+                add_pair(s, cb, pb, grow, a, b, offset, up);
         }
     }
-    if (m->plane_count) {
-        for (uint32_t i = 0; i < n; ++i) {
-            if (!s->awake[i]) continue;
-            for (size_t k = 0; k < m->plane_count; ++k) narrow(s, cb, i, m->planes[k], margin);
+    for (uint32_t i = 0; i < n && m->plane_count; ++i) {
+        if (!s->awake[i]) continue;
+        for (size_t k = 0; k < m->plane_count; ++k) {
+            const rigid_body* pl = &s->bodies[m->planes[k]];
+            float dist = ak_vec3_dot(ak_vec3_sub(s->x[i], s->x[m->planes[k]]), pl->shape.normal);
+            if (dist - s->bodies[i].bound_radius > offset + grow[i]) continue;
+            add_pair(s, cb, pb, grow, i, m->planes[k], offset, up);
         }
     }
+    static const uint32_t gaps[] = {701, 301, 132, 57, 23, 10, 4, 1};
+    pair_entry* e = pb->p;
+    for (size_t gi = 0; gi < sizeof gaps / sizeof gaps[0]; ++gi) {
+        uint32_t gap = gaps[gi];
+        for (uint32_t i = gap; i < pb->count; ++i) {
+            pair_entry t = e[i];
+            uint32_t j = i;
+            for (; j >= gap && pair_before(&t, &e[j - gap]); j -= gap) e[j] = e[j - gap];
+            e[j] = t;
+        }
+    }
+}
+
+/* A substep's contacts, pair by pair in the step's order: the kept contacts of flat pairs
+ * (their multipliers reset, their normal velocity read again) and the narrow phase of the
+ * others on the predicted poses. */
+static void substep_contacts(solver* s, contact_buf* cb, const pair_buf* pb, uint32_t kept,
+                             float offset) {
+    cb->count = kept;
+    for (uint32_t k = 0; k < kept; ++k) {
+        rigid_contact* c = &cb->c[k];
+        c->lambda_n = 0.0f;
+        c->vn_before = contact_vn(s, c);
+    }
+    uint32_t g = 0;
+    for (uint32_t i = 0; i < pb->count; ++i) {
+        const pair_entry* e = &pb->p[i];
+        if (e->cached) {
+            cb->groups[g++] = (contact_group){e->start, e->end, e->height};
+            continue;
+        }
+        uint32_t start = cb->count;
+        narrow(s, cb, e->a, e->b, offset);
+        if (cb->count > start) cb->groups[g++] = (contact_group){start, cb->count, e->height};
+    }
+    cb->group_count = g;
 }
 
 static ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) {
@@ -292,46 +410,6 @@ static ak_vec3 point_motion(const solver* s, uint32_t i, ak_vec3 l) {
     if (!s->awake[i]) return ak_vec3_zero();
     ak_vec3 d = ak_vec3_add(s->ds[i], s->dx[i]);
     return ak_vec3_add(d, ak_vec3_sub(ak_quat_rotate(s->q[i], l), ak_quat_rotate(s->q0[i], l)));
-}
-
-/* End of the run of contacts from k that share their pair of bodies. */
-static uint32_t group_end(const contact_buf* cb, uint32_t k) {
-    uint32_t e = k + 1;
-    while (e < cb->count && cb->c[e].a == cb->c[k].a && cb->c[e].b == cb->c[k].b) ++e;
-    return e;
-}
-
-static bool group_before(const contact_group* a, const contact_group* b) {
-    return a->height > b->height || (a->height == b->height && a->start < b->start);
-}
-
-/* Split the contacts into per-pair groups and order them from the top down (against gravity;
- * the found order when there is none): in a stack or a pyramid the ground is then solved last,
- * which lets a 10-box stack creep several times less than bottom-up order. Shell sort as for
- * the sweep (no allocation, a total order). */
-static void order_groups(const solver* s, contact_buf* cb, ak_vec3 up) {
-    uint32_t g = 0;
-    for (uint32_t k = 0; k < cb->count; ++g) {
-        uint32_t e = group_end(cb, k);
-        const rigid_contact* c = &cb->c[k];
-        ak_vec3 mid = s->bodies[c->b].shape.type == AK_RIGID_PLANE
-                          ? s->x[c->a]
-                          : ak_vec3_scale(ak_vec3_add(s->x[c->a], s->x[c->b]), 0.5f);
-        cb->groups[g] = (contact_group){k, e, ak_vec3_dot(mid, up)};
-        k = e;
-    }
-    cb->group_count = g;
-    static const uint32_t gaps[] = {701, 301, 132, 57, 23, 10, 4, 1};
-    contact_group* e = cb->groups;
-    for (size_t gi = 0; gi < sizeof gaps / sizeof gaps[0]; ++gi) {
-        uint32_t gap = gaps[gi];
-        for (uint32_t i = gap; i < g; ++i) {
-            contact_group t = e[i];
-            uint32_t j = i;
-            for (; j >= gap && group_before(&t, &e[j - gap]); j -= gap) e[j] = e[j - gap];
-            e[j] = t;
-        }
-    }
 }
 
 /* Centre of pressure of a group (the contacts' local points weighted by their normal
@@ -738,13 +816,18 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
                       (contact_group*)(base + l.groups),   0};
     ak_vec3 up = ak_vec3_scale(ak_vec3_normalize(job->gravity), -1.0f);
     float gmag = ak_vec3_length(job->gravity);
-    /* contacts are looked for a little further than a substep's motion could close */
-    float margin = m->desc.contact_offset;
+    /* pairs once per step (Mueller et al. 2020: "collect potential pairs once per time step"),
+     * with margins that cover the step's motion; flat pairs keep their contacts for every
+     * substep, the others run the narrow phase in each */
+    float offset = m->desc.contact_offset;
+    pair_buf pb = {(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts};
+    find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow), offset, job->dt,
+               gmag, up);
+    uint32_t kept = cb.count;
     for (uint32_t step = 0; step < substeps; ++step) {
         predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping);
-        find_contacts(&s, (sap_entry*)(base + l.sap), &cb, margin);
-        order_groups(&s, &cb, up);
-        /* joints, contacts, then four more sweeps over the joints: contacts solved last would
+        substep_contacts(&s, &cb, &pb, kept, offset);
+        /* joints, contacts, then eight more sweeps over the joints: contacts solved last would
          * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
          * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
         solve_joints(&s);
