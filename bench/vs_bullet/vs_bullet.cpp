@@ -22,6 +22,7 @@ struct result {
     double ms_per_step;
     double drift;  // m, largest horizontal displacement of a body from its start
     double pen;    // m, deepest penetration seen over the run
+    double contacts;  // contact points per step, mean over the run
 };
 
 struct scene {
@@ -87,7 +88,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps) {
     md.bodies.ptr = sc.bodies.data();
     md.bodies.count = n;
     ak_rigid_model* m = nullptr;
-    result r = {0, 0, 0};
+    result r = {0, 0, 0, 0};
     if (ak_rigid_model_create(&md, nullptr, &m) != AK_OK) return r;
     std::vector<ak_vec3> x(n), v(n), w(n);
     std::vector<ak_quat> q(n);
@@ -106,15 +107,18 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps) {
     job.angular_velocities = {w.data(), n};
     job.sleep_timers = {timers.data(), n};
     job.out_max_penetration = &pen;
+    uint32_t contacts = 0;
+    job.out_contact_count = &contacts;
     const size_t bytes = ak_rigid_step_scratch_size(&job);
     std::vector<uint8_t> scratch(bytes);
     job.scratch = {scratch.data(), bytes};
-    const double t0 = bench_wall_s();
+    const double t0 = bench_cpu_s();
     for (int s = 0; s < steps; ++s) {
         ak_rigid_step_run(&job);
         r.pen = std::fmax(r.pen, (double)pen);
+        r.contacts += contacts / (double)steps;
     }
-    r.ms_per_step = 1e3 * (bench_wall_s() - t0) / steps;
+    r.ms_per_step = 1e3 * (bench_cpu_s() - t0) / steps;
     for (size_t i = sc.planes; i < n; ++i)
         r.drift = std::fmax(r.drift, std::hypot((double)(x[i].x - sc.bodies[i].position.x),
                                                 (double)(x[i].z - sc.bodies[i].position.z)));
@@ -160,21 +164,22 @@ static result run_bullet(const scene& sc, int steps) {
         bodies.push_back(b);
         states.push_back(ms);
     }
-    result r = {0, 0, 0};
+    result r = {0, 0, 0, 0};
     const btScalar dt = 1.0f / 60.0f;
-    const double t0 = bench_wall_s();
+    const double t0 = bench_cpu_s();
     double in_probe = 0.0;
     for (int s = 0; s < steps; ++s) {
         world.stepSimulation(dt, 1, dt);
-        const double p0 = bench_wall_s();
+        const double p0 = bench_cpu_s();
         for (int k = 0; k < dispatcher.getNumManifolds(); ++k) {
             btPersistentManifold* mf = dispatcher.getManifoldByIndexInternal(k);
+            r.contacts += mf->getNumContacts() / (double)steps;
             for (int c = 0; c < mf->getNumContacts(); ++c)
                 r.pen = std::fmax(r.pen, -(double)mf->getContactPoint(c).getDistance());
         }
-        in_probe += bench_wall_s() - p0;
+        in_probe += bench_cpu_s() - p0;
     }
-    r.ms_per_step = 1e3 * (bench_wall_s() - t0 - in_probe) / steps;
+    r.ms_per_step = 1e3 * (bench_cpu_s() - t0 - in_probe) / steps;
     for (size_t i = sc.planes; i < bodies.size(); ++i) {
         btVector3 p = bodies[i]->getCenterOfMassPosition();
         r.drift = std::fmax(r.drift, std::hypot((double)(p.x() - sc.bodies[i].position.x),
@@ -205,8 +210,8 @@ int main(int argc, char** argv) {
     std::printf("dt 1/60 s, %d steps, one thread, sleeping on; animkit XPBD %u substeps x 1 iteration; Bullet %d.%02d "
                 "1 step x 10 iterations (its defaults)\n",
                 steps, substeps, btGetVersion() / 100, btGetVersion() % 100);
-    std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s\n", "scene", "animkit ms", "Bullet ms", "ratio",
-                "animkit drift", "Bullet drift", "animkit pen", "Bullet pen");
+    std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s %9s %9s\n", "scene", "animkit ms", "Bullet ms", "ratio",
+                "animkit drift", "Bullet drift", "animkit pen", "Bullet pen", "ak pts", "bt pts");
     const scene scenes[2] = {pyramid(layers), spheres(nspheres)};
     const char* names[2] = {"pyramid", "spheres"};
     for (int k = 0; k < 2; ++k) {
@@ -214,8 +219,9 @@ int main(int argc, char** argv) {
         result b = run_bullet(scenes[k], steps);
         char label[64];
         std::snprintf(label, sizeof label, "%s (%zu bodies)", names[k], scenes[k].bodies.size() - scenes[k].planes);
-        std::printf("%-26s %11.3f %11.3f %7.3f %13.3g %13.3g %12.3g %12.3g\n", label, a.ms_per_step, b.ms_per_step,
-                    b.ms_per_step / a.ms_per_step, a.drift, b.drift, a.pen, b.pen);
+        std::printf("%-26s %11.3f %11.3f %7.3f %13.3g %13.3g %12.3g %12.3g %9.0f %9.0f\n", label, a.ms_per_step,
+                    b.ms_per_step, b.ms_per_step / a.ms_per_step, a.drift, b.drift, a.pen, b.pen, a.contacts,
+                    b.contacts);
         std::fflush(stdout);
     }
     std::printf("ratio = Bullet time / animkit time (above 1: animkit faster); drift: largest horizontal\n"

@@ -15,6 +15,10 @@ typedef struct sap_entry {
 typedef struct contact_group {
     uint32_t start, end;
     float height; /* the pair's midpoint against gravity: higher pairs are solved first */
+    /* the centre of pressure after the position solve (the velocity solve reads it again) */
+    uint32_t pressed;
+    ak_vec3 la, lb;
+    float lambda, arm;
 } contact_group;
 
 /* A pair of bodies the broad phase found at the step's start. Pairs of boxes and planes
@@ -247,7 +251,7 @@ static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float mar
         c->friction = sqrtf(ba->friction * bb->friction);
         c->dynamic_friction = sqrtf(ba->dynamic_friction * bb->dynamic_friction);
         c->restitution = ak_maxf(ba->restitution, bb->restitution);
-        c->vn_before = contact_vn(s, c);
+        c->vn_before = c->restitution > 0.0f ? contact_vn(s, c) : 0.0f;
     }
     cb->count += (uint32_t)kept;
 }
@@ -398,18 +402,20 @@ static void substep_contacts(solver* s, contact_buf* cb, const pair_buf* pb, uin
     for (uint32_t k = 0; k < kept; ++k) {
         rigid_contact* c = &cb->c[k];
         c->lambda_n = 0.0f;
-        c->vn_before = contact_vn(s, c);
+        /* only restitution reads it */
+        c->vn_before = c->restitution > 0.0f ? contact_vn(s, c) : 0.0f;
     }
     uint32_t g = 0;
     for (uint32_t i = 0; i < pb->count; ++i) {
         const pair_entry* e = &pb->p[i];
         if (e->cached) {
-            cb->groups[g++] = (contact_group){e->start, e->end, e->height};
+            cb->groups[g++] = (contact_group){.start = e->start, .end = e->end, .height = e->height};
             continue;
         }
         uint32_t start = cb->count;
         narrow(s, cb, e->a, e->b, offset);
-        if (cb->count > start) cb->groups[g++] = (contact_group){start, cb->count, e->height};
+        if (cb->count > start) cb->groups[g++] =
+                (contact_group){.start = start, .end = cb->count, .height = e->height};
     }
     cb->group_count = g;
 }
@@ -502,10 +508,12 @@ static void solve_positions(solver* s, contact_buf* cb) {
          * multiplier: undo the relative tangential motion of this substep when the force it
          * takes stays inside the friction cone (their eq. for lambda_t < mu_s lambda_n); one
          * point per pair keeps the sequential order from handing the whole load to one corner */
-        ak_vec3 la, lb;
-        float lambda, arm;
+        contact_group* grp = &cb->groups[gi];
+        grp->pressed = pressure_centre(cb, k0, k1, &grp->la, &grp->lb, &grp->lambda, &grp->arm);
+        ak_vec3 la = grp->la, lb = grp->lb;
+        float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
-        if (c->friction > 0.0f && pressure_centre(cb, k0, k1, &la, &lb, &lambda, &arm)) {
+        if (c->friction > 0.0f && grp->pressed) {
             ak_vec3 dp = ak_vec3_sub(point_motion(s, c->a, la), point_motion(s, c->b, lb));
             ak_vec3 dt = ak_vec3_madd(dp, c->n, -ak_vec3_dot(dp, c->n));
             float lt = ak_vec3_length(dt);
@@ -702,10 +710,11 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
                                   ak_vec3_scale(c->n, -vn + ak_maxf(-e * c->vn_before, 0.0f)));
         }
         /* dynamic friction at the centre of pressure (their eq. 30 with the units made whole) */
-        ak_vec3 la, lb;
-        float lambda, arm;
+        const contact_group* grp = &cb->groups[gi];
+        ak_vec3 la = grp->la, lb = grp->lb;
+        float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
-        if (c->dynamic_friction > 0.0f && pressure_centre(cb, k0, k1, &la, &lb, &lambda, &arm)) {
+        if (c->dynamic_friction > 0.0f && grp->pressed) {
             ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
             ak_vec3 vr = ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb));
             ak_vec3 vt = ak_vec3_madd(vr, c->n, -ak_vec3_dot(vr, c->n));
