@@ -155,11 +155,40 @@ static void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, 
     s->q[i] = ak_quat_normalize(ak_quat_add(q, dq));
 }
 
-static void apply_velocity_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
-    if (!s->awake[i]) return;
-    s->v[i] = ak_vec3_madd(s->v[i], p, sign * s->bodies[i].inv_mass);
-    s->w[i] = ak_vec3_madd(s->w[i], inv_inertia_mul(s, i, ak_vec3_cross(r, p)), sign);
+/* Body i's response to a unit impulse along unit n at offset r: the turn I^-1 (r x n) and the
+ * generalised inverse mass 1/m + (r x n) . I^-1 (r x n); the contact loops compute it once and
+ * use it for both the multiplier and the update. */
+typedef struct response {
+    ak_vec3 turn;
+    float w;
+} response;
+
+static inline response respond(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n) {
+    response o = {ak_vec3_zero(), 0.0f};
+    if (!s->awake[i]) return o;
+    ak_vec3 rn = ak_vec3_cross(r, n);
+    o.turn = ak_mat3_mul_vec3(s->iw[i], rn);
+    o.w = s->bodies[i].inv_mass + ak_vec3_dot(rn, o.turn);
+    return o;
 }
+
+/* Positional impulse mag * n on body i (n, o: as given to respond). */
+static inline void move_along(solver* s, uint32_t i, ak_vec3 n, float mag, response o) {
+    if (!s->awake[i]) return;
+    s->dx[i] = ak_vec3_madd(s->dx[i], n, mag * s->bodies[i].inv_mass);
+    s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
+    ak_vec3 dw = ak_vec3_scale(o.turn, 0.5f * mag);
+    ak_quat q = s->q[i];
+    s->q[i] = ak_quat_normalize(ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q)));
+}
+
+/* Velocity impulse mag * n on body i. */
+static inline void push_along(solver* s, uint32_t i, ak_vec3 n, float mag, response o) {
+    if (!s->awake[i]) return;
+    s->v[i] = ak_vec3_madd(s->v[i], n, mag * s->bodies[i].inv_mass);
+    s->w[i] = ak_vec3_madd(s->w[i], o.turn, mag);
+}
+
 
 /* Angular velocity after one implicit (backward Euler) step of Euler's equations without torque,
  * I w' = -w x (I w), linearised once about w (Newton's first iterate), in the body frame. */
@@ -496,13 +525,13 @@ static void solve_positions(solver* s, contact_buf* cb) {
             float d = ak_vec3_dot(ak_vec3_sub(pb, pa), c->n);
             if (d <= 0.0f) continue;
             ak_vec3 ra = ak_vec3_sub(pa, s->x[c->a]), rb = ak_vec3_sub(pb, s->x[c->b]);
-            float w = gen_inv_mass(s, c->a, ra, c->n) + gen_inv_mass(s, c->b, rb, c->n);
+            response oa = respond(s, c->a, ra, c->n), ob = respond(s, c->b, rb, c->n);
+            float w = oa.w + ob.w;
             if (!(w > 0.0f)) continue;
             float dl = d / w;
             c->lambda_n += dl;
-            ak_vec3 p = ak_vec3_scale(c->n, dl);
-            apply_position_impulse(s, c->a, ra, p, 1.0f);
-            apply_position_impulse(s, c->b, rb, p, -1.0f);
+            move_along(s, c->a, c->n, dl, oa);
+            move_along(s, c->b, c->n, -dl, ob);
         }
         /* static friction, once per pair at the centre of pressure with the pair's whole normal
          * multiplier: undo the relative tangential motion of this substep when the force it
@@ -520,12 +549,12 @@ static void solve_positions(solver* s, contact_buf* cb) {
             if (lt > 1e-12f) {
                 ak_vec3 t = ak_vec3_scale(dt, 1.0f / lt);
                 ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
-                float wt = gen_inv_mass(s, c->a, ra, t) + gen_inv_mass(s, c->b, rb, t);
+                response oa = respond(s, c->a, ra, t), ob = respond(s, c->b, rb, t);
+                float wt = oa.w + ob.w;
                 float dlt = wt > 0.0f ? lt / wt : INFINITY;
                 if (dlt < c->friction * lambda) {
-                    ak_vec3 pt = ak_vec3_scale(t, -dlt);
-                    apply_position_impulse(s, c->a, ra, pt, 1.0f);
-                    apply_position_impulse(s, c->b, rb, pt, -1.0f);
+                    move_along(s, c->a, t, -dlt, oa);
+                    move_along(s, c->b, t, dlt, ob);
                 }
             }
             /* torsional friction: a patch of contacts also resists twisting about the normal, up
@@ -686,11 +715,11 @@ static void velocity_impulse_pair(solver* s, uint32_t a, uint32_t b, ak_vec3 ra,
     float l = ak_vec3_length(dv);
     if (l < 1e-12f) return;
     ak_vec3 dir = ak_vec3_scale(dv, 1.0f / l);
-    float w = gen_inv_mass(s, a, ra, dir) + gen_inv_mass(s, b, rb, dir);
+    response oa = respond(s, a, ra, dir), ob = respond(s, b, rb, dir);
+    float w = oa.w + ob.w;
     if (!(w > 0.0f)) return;
-    ak_vec3 p = ak_vec3_scale(dv, 1.0f / w);
-    apply_velocity_impulse(s, a, ra, p, 1.0f);
-    apply_velocity_impulse(s, b, rb, p, -1.0f);
+    push_along(s, a, dir, l / w, oa);
+    push_along(s, b, dir, -l / w, ob);
 }
 
 static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
