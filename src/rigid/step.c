@@ -137,13 +137,6 @@ static ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
     return ak_mat3_mul_vec3(s->iw[i], v);
 }
 
-/* Generalised inverse mass of body i at offset r along unit direction n (their eq. 2-3). */
-static float gen_inv_mass(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n) {
-    if (!s->awake[i]) return 0.0f;
-    ak_vec3 rn = ak_vec3_cross(r, n);
-    return s->bodies[i].inv_mass + ak_vec3_dot(rn, ak_mat3_mul_vec3(s->iw[i], rn));
-}
-
 /* Apply positional impulse p at offset r to body i (sign +1 or -1). */
 static void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
     if (!s->awake[i]) return;
@@ -709,20 +702,14 @@ static void update_velocities(solver* s) {
     }
 }
 
-static ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
-    return ak_vec3_add(s->v[i], ak_vec3_cross(s->w[i], r));
+/* World offset of body i's local point l, zero for a body that does not move (its velocity
+ * and its response are zero whatever the offset). */
+static ak_vec3 moving_arm(const solver* s, uint32_t i, ak_vec3 l) {
+    return s->awake[i] ? ak_quat_rotate(s->q[i], l) : ak_vec3_zero();
 }
 
-static void velocity_impulse_pair(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb,
-                                  ak_vec3 dv) {
-    float l = ak_vec3_length(dv);
-    if (l < 1e-12f) return;
-    ak_vec3 dir = ak_vec3_scale(dv, 1.0f / l);
-    response oa = respond(s, a, ra, dir), ob = respond(s, b, rb, dir);
-    float w = oa.w + ob.w;
-    if (!(w > 0.0f)) return;
-    push_along(s, a, dir, l / w, oa);
-    push_along(s, b, dir, -l / w, ob);
+static ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
+    return ak_vec3_add(s->v[i], ak_vec3_cross(s->w[i], r));
 }
 
 static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
@@ -732,14 +719,19 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
         for (uint32_t k = k0; k < k1; ++k) {
             rigid_contact* c = &cb->c[k];
             if (!(c->lambda_n > 0.0f)) continue;
-            ak_vec3 ra = ak_quat_rotate(s->q[c->a], c->la), rb = ak_quat_rotate(s->q[c->b], c->lb);
+            ak_vec3 ra = moving_arm(s, c->a, c->la), rb = moving_arm(s, c->b, c->lb);
             float vn = ak_vec3_dot(
                 c->n, ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb)));
             /* restitution: the normal velocity becomes -e times the one before the solve (none
              * for slow impacts, which gravity alone could have made in two substeps) */
             float e = fabsf(c->vn_before) <= 2.0f * gmag * h ? 0.0f : c->restitution;
-            velocity_impulse_pair(s, c->a, c->b, ra, rb,
-                                  ak_vec3_scale(c->n, -vn + ak_maxf(-e * c->vn_before, 0.0f)));
+            float dvn = -vn + ak_maxf(-e * c->vn_before, 0.0f);
+            if (fabsf(dvn) < 1e-12f) continue;
+            response oa = respond(s, c->a, ra, c->n), ob = respond(s, c->b, rb, c->n);
+            float w = oa.w + ob.w;
+            if (!(w > 0.0f)) continue;
+            push_along(s, c->a, c->n, dvn / w, oa);
+            push_along(s, c->b, c->n, -dvn / w, ob);
         }
         /* dynamic friction at the centre of pressure (their eq. 30 with the units made whole) */
         const contact_group* grp = &cb->groups[gi];
@@ -747,7 +739,7 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
         float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
         if (c->dynamic_friction > 0.0f && grp->pressed) {
-            ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
+            ak_vec3 ra = moving_arm(s, c->a, la), rb = moving_arm(s, c->b, lb);
             ak_vec3 vr = ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb));
             ak_vec3 vt = ak_vec3_madd(vr, c->n, -ak_vec3_dot(vr, c->n));
             float lt = ak_vec3_length(vt);
@@ -755,9 +747,13 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
                 /* the friction impulse is at most mu_d times the normal one, lambda_n / h; as a
                  * change of relative velocity that is mu_d lambda_n w_t / h */
                 ak_vec3 t = ak_vec3_scale(vt, 1.0f / lt);
-                float wt = gen_inv_mass(s, c->a, ra, t) + gen_inv_mass(s, c->b, rb, t);
+                response oa = respond(s, c->a, ra, t), ob = respond(s, c->b, rb, t);
+                float wt = oa.w + ob.w;
                 float cut = ak_minf(c->dynamic_friction * lambda * wt / h, lt);
-                velocity_impulse_pair(s, c->a, c->b, ra, rb, ak_vec3_scale(t, -cut));
+                if (wt > 0.0f) {
+                    push_along(s, c->a, t, -cut / wt, oa);
+                    push_along(s, c->b, t, cut / wt, ob);
+                }
             }
             float spin = ak_vec3_dot(ak_vec3_sub(s->w[c->a], s->w[c->b]), c->n);
             float wr = gen_inv_inertia(s, c->a, c->n) + gen_inv_inertia(s, c->b, c->n);
