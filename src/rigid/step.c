@@ -437,6 +437,12 @@ static void substep_contacts(solver* s, contact_buf* cb, const pair_buf* pb, uin
             cb->groups[g++] = (contact_group){.start = e->start, .end = e->end, .height = e->height};
             continue;
         }
+        /* bounding spheres apart by more than the offset now: nothing to find this substep */
+        const rigid_body *ba = &s->bodies[e->a], *bb = &s->bodies[e->b];
+        if (bb->shape.type != AK_RIGID_PLANE) {
+            float rr = ba->bound_radius + bb->bound_radius + offset;
+            if (ak_vec3_length_sq(ak_vec3_sub(s->x[e->a], s->x[e->b])) > rr * rr) continue;
+        }
         uint32_t start = cb->count;
         narrow(s, cb, e->a, e->b, offset);
         if (cb->count > start) cb->groups[g++] =
