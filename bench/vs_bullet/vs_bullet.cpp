@@ -156,8 +156,9 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps) {
     job.angular_velocities = {w.data(), n};
     job.sleep_timers = {timers.data(), n};
     job.out_max_penetration = &pen;
-    uint32_t contacts = 0;
+    uint32_t contacts = 0, dropped = 0;
     job.out_contact_count = &contacts;
+    job.out_dropped_contacts = &dropped;
     const size_t bytes = ak_rigid_step_scratch_size(&job);
     std::vector<uint8_t> scratch(bytes);
     job.scratch = {scratch.data(), bytes};
@@ -166,6 +167,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps) {
         ak_rigid_step_run(&job);
         r.pen = std::fmax(r.pen, (double)pen);
         r.contacts += contacts / (double)steps;
+        if (dropped) std::fprintf(stderr, "animkit dropped %u contact points (max_contacts) in step %d\n", dropped, s);
     }
     r.ms_per_step = 1e3 * (bench_cpu_s() - t0) / steps;
     for (size_t i = sc.planes; i < n && sc.joints.empty(); ++i)
