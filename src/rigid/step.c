@@ -891,12 +891,13 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
          * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
         solve_joints(&s);
         solve_positions(&s, &cb);
-        /* (the sweeps stop early once one corrects no joint by more than 10 microns or 10
-         * microradians: a ragdoll at rest needs one or two) */
+        /* (the sweeps stop early once one corrects no joint by more than 0.1 mm or 0.1 mrad:
+         * 50 falling ragdolls then take 4.3 sweeps a substep instead of 9, and their anchors
+         * stay within 0.02 mm) */
         for (int it = 0; it < 8 && m->joint_count; ++it) {
             s.joint_error = 0.0f;
             solve_joints(&s);
-            if (s.joint_error < 1e-5f) break;
+            if (s.joint_error < 1e-4f) break;
         }
         update_velocities(&s);
         solve_velocities(&s, &cb, gmag);
