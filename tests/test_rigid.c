@@ -277,6 +277,39 @@ AK_TEST(restitution_rebound) {
     world_free(&wd);
 }
 
+/* Contacts are found once per step with margins for the step's motion: a box thrown at 15 m/s
+ * (0.25 m a step, 25 times the contact offset) onto a resting box, and another onto the ground,
+ * must be caught in the step they arrive, not after they have sunk in. */
+AK_TEST(fast_boxes_are_caught) {
+    ak_rigid_body_desc b[4] = {
+        {.shape = {.type = AK_RIGID_PLANE}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.5f, 0.5f}},
+         .position = {0, 0.5f, 0}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.5f, 0.5f}},
+         .position = {0, 2.6f, 0},
+         .velocity = {0, -15.0f, 0}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.5f, 0.5f}},
+         .position = {5.0f, 1.6f, 0},
+         .velocity = {0, -15.0f, 0}},
+    };
+    world wd;
+    AK_CHECK(world_init(&wd, b, 4, NULL, 1.0f / 60.0f, 10, G));
+    float pen = 0.0f, pen_max = 0.0f, low_b = INFINITY, low_c = INFINITY;
+    wd.job.out_max_penetration = &pen;
+    for (int f = 0; f < 30; ++f) {
+        AK_CHECK(ak_rigid_step_run(&wd.job) == AK_OK);
+        pen_max = ak_maxf(pen_max, pen);
+        low_b = ak_minf(low_b, wd.x[2].y - wd.x[1].y);
+        low_c = ak_minf(low_c, wd.x[3].y);
+    }
+    AK_CHECK_MSG(pen_max < 0.01f, "penetration %g m (contact offset 0.01)", pen_max);
+    AK_CHECK_MSG(low_b > 0.98f, "the thrown box came within %g m of the resting one's centre", low_b);
+    AK_CHECK_MSG(low_c > 0.48f, "the box thrown at the ground sank to %g m", low_c);
+    AK_CHECK_MSG(fabsf(wd.x[2].y - 1.5f) < 0.01f && fabsf(wd.x[3].y - 0.5f) < 0.01f,
+                 "resting at %g and %g m", wd.x[2].y, wd.x[3].y);
+    world_free(&wd);
+}
+
 /* A column of boxes on the ground, stepped for `seconds`: the largest horizontal drift of any
  * box and the deepest penetration seen. */
 static void stack_run(int count, float seconds, uint32_t substeps, bool sleep, float* out_drift,
@@ -561,6 +594,7 @@ int main(void) {
     AK_RUN(incline_stays_or_slides);
     AK_RUN(torque_free_spin);
     AK_RUN(restitution_rebound);
+    AK_RUN(fast_boxes_are_caught);
     AK_RUN(box_stack_stands);
     AK_RUN_SLOW(pyramid_stands);
     AK_RUN(pendulum_period_ball_joint);

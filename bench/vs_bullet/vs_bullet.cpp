@@ -1,11 +1,14 @@
 // bench/vs_bullet: animkit's rigid bodies (XPBD, animkit/rigid.h) beside Bullet 3 (Debian's
 // libbullet-dev, btDiscreteDynamicsWorld with its sequential-impulse solver), in one process
-// on the same scenes with matched settings: a 2D pyramid of unit boxes on the ground, and
-// spheres dropped as a block into an open box. Prints time per step for both, the ratio, and
-// the stability of each (the largest horizontal drift of a body from its start, the deepest
-// penetration seen). One thread; sleeping on in both; dt = 1/60; friction 0.5; density 1000.
+// on the same scenes with matched settings: a 2D pyramid of unit boxes on the ground, spheres
+// dropped as a block into an open box, and ragdolls of builtin:humanoid dropped on the ground.
+// Prints time per step for both (CPU time of the calling thread, so that other processes on a
+// shared machine count less), the ratio, and the stability of each (the largest horizontal
+// drift of a body from its start, or for ragdolls the widest joint gap; the deepest penetration
+// seen). One thread; sleeping on in both; dt = 1/60; friction 0.5; density 1000.
 //
-//   bench_rigid_vs_bullet [--layers L] [--spheres N] [--steps S] [--substeps K]
+//   bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] [--substeps K]
+//                         [--only pyramid|spheres|ragdolls]
 #include <btBulletDynamicsCommon.h>
 
 #include <cmath>
@@ -14,7 +17,10 @@
 #include <cstring>
 #include <vector>
 
+#include <animkit/builtin.h>
 #include <animkit/rigid.h>
+#include <animkit/scene.h>
+#include <animkit/skeleton.h>
 
 #include "bench_clock.h"
 
@@ -22,11 +28,13 @@ struct result {
     double ms_per_step;
     double drift;  // m, largest horizontal displacement of a body from its start
     double pen;    // m, deepest penetration seen over the run
+    double contacts;  // contact points per step, mean over the run
 };
 
 struct scene {
     std::vector<ak_rigid_body_desc> bodies;  // the first `planes` are static planes
-    size_t planes;
+    size_t planes = 0;
+    std::vector<ak_rigid_joint_desc> joints;  // ragdolls: `drift` is then the widest joint gap
 };
 
 static ak_rigid_body_desc zero_body() {
@@ -80,14 +88,56 @@ static scene spheres(int n) {
     return s;
 }
 
+// count ragdolls of builtin:humanoid in its rest pose (ak_rigid_ragdoll_build: a capsule per
+// bone, ball and hinge joints with the skeleton's limits), on a grid 2.5 m apart, dropped from
+// 1 m onto the ground; each ragdoll its own collision group (limbs of one do not collide, two
+// ragdolls do)
+static bool ragdolls(int count, scene* s) {
+    ak_rigid_body_desc g = zero_body();
+    g.shape.type = AK_RIGID_PLANE;
+    g.shape.normal = ak_vec3_make(0, 1, 0);
+    s->bodies.push_back(g);
+    s->planes = 1;
+    ak_scene* sc = nullptr;
+    ak_builtin_desc bd;
+    std::memset(&bd, 0, sizeof bd);
+    bd.cell_size = 0.1f;
+    if (ak_builtin_create("humanoid", &bd, nullptr, &sc) != AK_OK) return false;
+    const ak_skeleton* sk = sc->skeleton;
+    const size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk),
+                 nj = ak_rigid_ragdoll_joint_count(sk);
+    std::vector<ak_transform> pose(n);
+    std::vector<ak_rigid_ragdoll_bone> bones(n);
+    ak_scene_rest_pose(sc, {pose.data(), n});
+    bool ok = true;
+    for (int r = 0; r < count && ok; ++r) {
+        std::vector<ak_rigid_body_desc> b(nb);
+        std::vector<ak_rigid_joint_desc> j(nj);
+        ak_rigid_ragdoll_desc rd;
+        std::memset(&rd, 0, sizeof rd);
+        rd.skeleton = sk;
+        rd.local_pose = {pose.data(), n};
+        rd.root = ak_mat4_translation(ak_vec3_make(2.5f * (float)(r % 10), 1.0f, 2.5f * (float)(r / 10)));
+        rd.body_offset = (uint32_t)s->bodies.size();
+        rd.collision_group = (uint32_t)r + 1;
+        ok = ak_rigid_ragdoll_build(&rd, {b.data(), nb}, {j.data(), nj}, {bones.data(), n}) == AK_OK;
+        s->bodies.insert(s->bodies.end(), b.begin(), b.end());
+        s->joints.insert(s->joints.end(), j.begin(), j.end());
+    }
+    ak_scene_destroy(sc);
+    return ok;
+}
+
 static result run_animkit(const scene& sc, int steps, unsigned substeps) {
     const size_t n = sc.bodies.size();
     ak_rigid_model_desc md;
     std::memset(&md, 0, sizeof md);
     md.bodies.ptr = sc.bodies.data();
     md.bodies.count = n;
+    md.joints.ptr = sc.joints.data();
+    md.joints.count = sc.joints.size();
     ak_rigid_model* m = nullptr;
-    result r = {0, 0, 0};
+    result r = {0, 0, 0, 0};
     if (ak_rigid_model_create(&md, nullptr, &m) != AK_OK) return r;
     std::vector<ak_vec3> x(n), v(n), w(n);
     std::vector<ak_quat> q(n);
@@ -106,26 +156,60 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps) {
     job.angular_velocities = {w.data(), n};
     job.sleep_timers = {timers.data(), n};
     job.out_max_penetration = &pen;
+    uint32_t contacts = 0, dropped = 0;
+    job.out_contact_count = &contacts;
+    job.out_dropped_contacts = &dropped;
     const size_t bytes = ak_rigid_step_scratch_size(&job);
     std::vector<uint8_t> scratch(bytes);
     job.scratch = {scratch.data(), bytes};
-    const double t0 = bench_wall_s();
+    const double t0 = bench_cpu_s();
     for (int s = 0; s < steps; ++s) {
         ak_rigid_step_run(&job);
         r.pen = std::fmax(r.pen, (double)pen);
+        r.contacts += contacts / (double)steps;
+        if (dropped) std::fprintf(stderr, "animkit dropped %u contact points (max_contacts) in step %d\n", dropped, s);
     }
-    r.ms_per_step = 1e3 * (bench_wall_s() - t0) / steps;
-    for (size_t i = sc.planes; i < n; ++i)
+    r.ms_per_step = 1e3 * (bench_cpu_s() - t0) / steps;
+    for (size_t i = sc.planes; i < n && sc.joints.empty(); ++i)
         r.drift = std::fmax(r.drift, std::hypot((double)(x[i].x - sc.bodies[i].position.x),
                                                 (double)(x[i].z - sc.bodies[i].position.z)));
+    for (size_t k = 0; k < sc.joints.size(); ++k) {
+        float gap = 0.0f, excess = 0.0f;
+        ak_rigid_joint_error(m, k, {x.data(), n}, {q.data(), n}, &gap, &excess);
+        r.drift = std::fmax(r.drift, (double)gap);
+    }
     ak_rigid_model_destroy(m);
     return r;
 }
+
+// Bullet's side of collision groups: bodies whose user index (the group) is the same nonzero
+// value do not collide, as animkit's collision_group
+struct group_filter : public btOverlapFilterCallback {
+    bool needBroadphaseCollision(btBroadphaseProxy* p0, btBroadphaseProxy* p1) const override {
+        if (!(p0->m_collisionFilterGroup & p1->m_collisionFilterMask) ||
+            !(p1->m_collisionFilterGroup & p0->m_collisionFilterMask))
+            return false;
+        const btCollisionObject* a = static_cast<const btCollisionObject*>(p0->m_clientObject);
+        const btCollisionObject* b = static_cast<const btCollisionObject*>(p1->m_clientObject);
+        return a->getUserIndex() <= 0 || a->getUserIndex() != b->getUserIndex();
+    }
+};
+
+// an orthonormal basis whose X column is the unit vector x
+static btMatrix3x3 basis_x(const btVector3& x) {
+    btVector3 y, z;
+    btPlaneSpace1(x, y, z);
+    return btMatrix3x3(x.x(), y.x(), z.x(), x.y(), y.y(), z.y(), x.z(), y.z(), z.z());
+}
+
+static btVector3 bt(ak_vec3 v) { return btVector3(v.x, v.y, v.z); }
 
 static result run_bullet(const scene& sc, int steps) {
     btDefaultCollisionConfiguration config;
     btCollisionDispatcher dispatcher(&config);
     btDbvtBroadphase broadphase;
+    group_filter filter;
+    broadphase.getOverlappingPairCache()->setOverlapFilterCallback(&filter);
     btSequentialImpulseConstraintSolver solver;
     btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
     world.setGravity(btVector3(0, -9.81f, 0));
@@ -142,6 +226,11 @@ static result run_bullet(const scene& sc, int steps) {
             btVector3 he(d.shape.half_extents.x, d.shape.half_extents.y, d.shape.half_extents.z);
             shape = new btBoxShape(he);
             mass = 1000.0f * 8.0f * he.x() * he.y() * he.z();
+        } else if (d.shape.type == AK_RIGID_CAPSULE) {
+            // the same mass as animkit's (density 1000 or the desc's); Bullet's own inertia
+            const float rr = d.shape.radius, hh = d.shape.half_height;
+            shape = new btCapsuleShape(rr, 2.0f * hh);
+            mass = (d.density > 0 ? d.density : 1000.0f) * 3.14159265f * rr * rr * (2.0f * hh + 4.0f / 3.0f * rr);
         } else {
             shape = new btSphereShape(d.shape.radius);
             mass = 1000.0f * 4.0f / 3.0f * 3.14159265f * d.shape.radius * d.shape.radius * d.shape.radius;
@@ -150,32 +239,91 @@ static result run_bullet(const scene& sc, int steps) {
         if (mass > 0) shape->calculateLocalInertia(mass, inertia);
         btTransform t;
         t.setIdentity();
-        if (d.shape.type != AK_RIGID_PLANE) t.setOrigin(btVector3(d.position.x, d.position.y, d.position.z));
+        if (d.shape.type != AK_RIGID_PLANE) {
+            t.setOrigin(btVector3(d.position.x, d.position.y, d.position.z));
+            const ak_quat o = d.orientation;
+            if (o.x != 0 || o.y != 0 || o.z != 0 || o.w != 0) t.setRotation(btQuaternion(o.x, o.y, o.z, o.w).normalized());
+        }
         btDefaultMotionState* ms = new btDefaultMotionState(t);
         btRigidBody::btRigidBodyConstructionInfo info(mass, ms, shape, inertia);
-        info.m_friction = 0.5f;
+        info.m_friction = d.friction > 0 ? d.friction : 0.5f;
         btRigidBody* b = new btRigidBody(info);
+        b->setUserIndex((int)d.collision_group);
+        b->setLinearVelocity(bt(d.velocity));
+        b->setAngularVelocity(bt(d.angular_velocity));
         world.addRigidBody(b);
         shapes.push_back(shape);
         bodies.push_back(b);
         states.push_back(ms);
     }
-    result r = {0, 0, 0};
+    // joints: ball with a cone -> btConeTwistConstraint (twist axis X = the joint axis), free
+    // ball -> btPoint2PointConstraint, hinge -> btHingeConstraint with the limits shifted by the
+    // built pose's angle, fixed -> btFixedConstraint; jointed bodies do not collide
+    std::vector<btTypedConstraint*> constraints;
+    std::vector<btVector3> pivots;  // per joint: pivot in a, pivot in b (for the gap)
+    for (const ak_rigid_joint_desc& j : sc.joints) {
+        btRigidBody& a = *bodies[j.body_a];
+        btRigidBody& b = *bodies[j.body_b];
+        const btTransform ta = a.getCenterOfMassTransform(), tb = b.getCenterOfMassTransform();
+        const btVector3 anchor = bt(j.anchor);
+        btVector3 axis = bt(j.axis);
+        if (axis.length2() == 0) axis = btVector3(0, 0, 1);
+        axis.normalize();
+        btVector3 axis_b = j.axis_b.x != 0 || j.axis_b.y != 0 || j.axis_b.z != 0 ? bt(j.axis_b).normalized() : axis;
+        const btVector3 pa = ta.inverse() * anchor, pb = tb.inverse() * anchor;
+        btTypedConstraint* c = nullptr;
+        if (j.type == AK_RIGID_JOINT_HINGE) {
+            btHingeConstraint* h = new btHingeConstraint(a, b, pa, pb, ta.getBasis().transpose() * axis,
+                                                         tb.getBasis().transpose() * axis_b);
+            if (j.limited) h->setLimit(j.lower - j.angle_offset, j.upper - j.angle_offset);
+            c = h;
+        } else if (j.type == AK_RIGID_JOINT_BALL && (j.limited || j.twist_limited)) {
+            const btMatrix3x3 wa = basis_x(axis), wb = btMatrix3x3(shortestArcQuat(axis, axis_b)) * wa;
+            btTransform fa(ta.getBasis().transpose() * wa, pa), fb(tb.getBasis().transpose() * wb, pb);
+            btConeTwistConstraint* ct = new btConeTwistConstraint(a, b, fa, fb);
+            const float swing = j.limited ? j.upper : SIMD_PI;
+            const float twist = j.twist_limited ? std::fmax(std::fabs(j.twist_lower + j.angle_offset),
+                                                            std::fabs(j.twist_upper + j.angle_offset))
+                                                : SIMD_PI;
+            ct->setLimit(swing, swing, twist);
+            c = ct;
+        } else if (j.type == AK_RIGID_JOINT_FIXED) {
+            btTransform fa(ta.getBasis().transpose(), pa), fb(tb.getBasis().transpose(), pb);
+            c = new btFixedConstraint(a, b, fa, fb);
+        } else {
+            c = new btPoint2PointConstraint(a, b, pa, pb);  // free ball (prismatic: not in these scenes)
+        }
+        world.addConstraint(c, true);
+        constraints.push_back(c);
+        pivots.push_back(pa);
+        pivots.push_back(pb);
+    }
+    result r = {0, 0, 0, 0};
     const btScalar dt = 1.0f / 60.0f;
-    const double t0 = bench_wall_s();
+    const double t0 = bench_cpu_s();
     double in_probe = 0.0;
     for (int s = 0; s < steps; ++s) {
         world.stepSimulation(dt, 1, dt);
-        const double p0 = bench_wall_s();
+        const double p0 = bench_cpu_s();
         for (int k = 0; k < dispatcher.getNumManifolds(); ++k) {
             btPersistentManifold* mf = dispatcher.getManifoldByIndexInternal(k);
+            r.contacts += mf->getNumContacts() / (double)steps;
             for (int c = 0; c < mf->getNumContacts(); ++c)
                 r.pen = std::fmax(r.pen, -(double)mf->getContactPoint(c).getDistance());
         }
-        in_probe += bench_wall_s() - p0;
+        in_probe += bench_cpu_s() - p0;
     }
-    r.ms_per_step = 1e3 * (bench_wall_s() - t0 - in_probe) / steps;
-    for (size_t i = sc.planes; i < bodies.size(); ++i) {
+    r.ms_per_step = 1e3 * (bench_cpu_s() - t0 - in_probe) / steps;
+    for (size_t k = 0; k < sc.joints.size(); ++k) {
+        const btVector3 wa = bodies[sc.joints[k].body_a]->getCenterOfMassTransform() * pivots[2 * k];
+        const btVector3 wb = bodies[sc.joints[k].body_b]->getCenterOfMassTransform() * pivots[2 * k + 1];
+        r.drift = std::fmax(r.drift, (double)(wa - wb).length());
+    }
+    for (size_t k = 0; k < constraints.size(); ++k) {
+        world.removeConstraint(constraints[k]);
+        delete constraints[k];
+    }
+    for (size_t i = sc.planes; i < bodies.size() && sc.joints.empty(); ++i) {
         btVector3 p = bodies[i]->getCenterOfMassPosition();
         r.drift = std::fmax(r.drift, std::hypot((double)(p.x() - sc.bodies[i].position.x),
                                                 (double)(p.z() - sc.bodies[i].position.z)));
@@ -190,35 +338,48 @@ static result run_bullet(const scene& sc, int steps) {
 }
 
 int main(int argc, char** argv) {
-    int layers = 20, nspheres = 10000, steps = 300;
+    int layers = 20, nspheres = 10000, nragdolls = 50, steps = 300;
     unsigned substeps = 20;
+    const char* only = nullptr;
     for (int i = 1; i + 1 < argc; i += 2) {
         if (!std::strcmp(argv[i], "--layers")) layers = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--spheres")) nspheres = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--substeps")) substeps = (unsigned)std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--ragdolls")) nragdolls = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
     }
-    if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || steps < 1 || substeps < 1 || substeps > 1000) {
-        std::fprintf(stderr, "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--steps S] [--substeps K]\n");
+    if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || nragdolls < 1 || nragdolls > 10000 || steps < 1 || substeps < 1 || substeps > 1000) {
+        std::fprintf(stderr, "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
+                             "[--substeps K] [--only pyramid|spheres|ragdolls]\n");
         return 2;
     }
     std::printf("dt 1/60 s, %d steps, one thread, sleeping on; animkit XPBD %u substeps x 1 iteration; Bullet %d.%02d "
                 "1 step x 10 iterations (its defaults)\n",
                 steps, substeps, btGetVersion() / 100, btGetVersion() % 100);
-    std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s\n", "scene", "animkit ms", "Bullet ms", "ratio",
-                "animkit drift", "Bullet drift", "animkit pen", "Bullet pen");
-    const scene scenes[2] = {pyramid(layers), spheres(nspheres)};
-    const char* names[2] = {"pyramid", "spheres"};
-    for (int k = 0; k < 2; ++k) {
+    std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s %9s %9s\n", "scene", "animkit ms", "Bullet ms", "ratio",
+                "animkit drift", "Bullet drift", "animkit pen", "Bullet pen", "ak pts", "bt pts");
+    const char* names[3] = {"pyramid", "spheres", "ragdolls"};
+    scene scenes[3];
+    if (!only || !std::strcmp(only, names[0])) scenes[0] = pyramid(layers);
+    if (!only || !std::strcmp(only, names[1])) scenes[1] = spheres(nspheres);
+    if ((!only || !std::strcmp(only, names[2])) && !ragdolls(nragdolls, &scenes[2])) {
+        std::fprintf(stderr, "bench_rigid_vs_bullet: the ragdolls cannot be built\n");
+        return 1;
+    }
+    for (int k = 0; k < 3; ++k) {
+        if (scenes[k].bodies.empty()) continue;
         result a = run_animkit(scenes[k], steps, substeps);
         result b = run_bullet(scenes[k], steps);
         char label[64];
         std::snprintf(label, sizeof label, "%s (%zu bodies)", names[k], scenes[k].bodies.size() - scenes[k].planes);
-        std::printf("%-26s %11.3f %11.3f %7.3f %13.3g %13.3g %12.3g %12.3g\n", label, a.ms_per_step, b.ms_per_step,
-                    b.ms_per_step / a.ms_per_step, a.drift, b.drift, a.pen, b.pen);
+        std::printf("%-26s %11.3f %11.3f %7.3f %13.3g %13.3g %12.3g %12.3g %9.0f %9.0f\n", label, a.ms_per_step,
+                    b.ms_per_step, b.ms_per_step / a.ms_per_step, a.drift, b.drift, a.pen, b.pen, a.contacts,
+                    b.contacts);
         std::fflush(stdout);
     }
     std::printf("ratio = Bullet time / animkit time (above 1: animkit faster); drift: largest horizontal\n"
-                "displacement of a body from its start (pyramid: should be ~0); pen: deepest penetration seen\n");
+                "displacement of a body from its start (pyramid: should be ~0; ragdolls: the widest joint gap at\n"
+                "the end); pen: deepest penetration seen; pts: contact points per step; thread CPU time\n");
     return 0;
 }

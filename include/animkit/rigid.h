@@ -12,8 +12,10 @@
  *     near its intermediate axis flips and angular momentum stays (see docs/rigid.md);
  *     linear and angular damping;
  *   - solver: XPBD rigid bodies with substeps (Mueller, Macklin, Chentanez, Jeschke, Kim 2020,
- *     "Detailed Rigid Body Simulation with Extended Position Based Dynamics"): each substep
- *     predicts, finds contacts on the predicted state, projects non-penetration and static
+ *     "Detailed Rigid Body Simulation with Extended Position Based Dynamics"): the pairs are
+ *     found once per step with margins that cover the step's motion; each substep predicts,
+ *     takes the contacts (box and plane pairs keep the points found at the step's start, the
+ *     others run the narrow phase on the predicted state), projects non-penetration and static
  *     friction on positions, derives velocities, then applies dynamic friction and restitution;
  *   - contacts: sweep-and-prune broad phase along the axis of the bodies' largest spread,
  *     closed-form narrow phase for every pair of sphere, box, capsule and plane (box-box:
@@ -154,8 +156,9 @@ typedef struct ak_rigid_model_desc {
     float sleep_linear_speed;  /* m/s under which a body may sleep; 0 -> 0.05 */
     float sleep_angular_speed; /* rad/s under which a body may sleep; 0 -> 0.05 */
     float sleep_time;          /* seconds a group must stay slow before it sleeps; 0 -> 0.5 */
-    uint32_t max_contacts;     /* contact points per substep the scratch holds; 0 -> 16 per body
-                                  + 64; more are dropped and counted in out_dropped_contacts */
+    uint32_t max_contacts;     /* contact points (and pairs) per step the scratch holds; 0 -> 16
+                                  per body + 64; more are dropped and counted in
+                                  out_dropped_contacts */
 } ak_rigid_model_desc;
 
 /* The desc with zero defaults filled in (desc NULL -> every default; bodies copied, not checked;
@@ -290,7 +293,9 @@ typedef struct ak_rigid_step_job {
     /* Outputs (optional). */
     float* out_max_penetration;     /* metres: deepest contact after the step's last solve */
     uint32_t* out_contact_count;    /* contact points of the last substep */
-    uint32_t* out_dropped_contacts; /* contact points over max_contacts, summed over substeps */
+    uint32_t* out_dropped_contacts; /* contact points (and pairs) over max_contacts: those of box
+                                       and plane pairs once per step, the others summed over
+                                       substeps */
 } ak_rigid_step_job;
 
 /* Bytes of scratch a step needs (0 for a NULL job or model). */
