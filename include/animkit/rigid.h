@@ -1,4 +1,4 @@
-/* animkit rigid: rigid bodies (spheres, boxes, capsules, static planes), contacts, joints,
+/* animkit rigid: rigid bodies (spheres, boxes, capsules, convex hulls, static planes), contacts, joints,
  * ragdolls.
  *
  * What it does:
@@ -18,7 +18,9 @@
  *   - contacts: sweep-and-prune broad phase along the axis of the bodies' largest spread,
  *     closed-form narrow phase for every pair of sphere, box, capsule and plane (box-box:
  *     separating axis test over the 15 axes, then the incident face clipped against the
- *     reference face for a manifold of up to 8 points); contacts are found within
+ *     reference face for a manifold of up to 8 points); hulls against every convex shape by GJK
+ *     (distance) and, when the shapes' cores overlap, a separating axis test over faces and
+ *     Gauss-map-pruned edge pairs, then the same face clipping; contacts are found within
  *     contact_offset of touching (speculative); a contact's friction is the geometric mean of
  *     its bodies' and its restitution the larger of the two; pairs are solved from the top down;
  *   - joints: ball (optional swing cone and twist range), hinge (optional angle limits), fixed,
@@ -32,7 +34,7 @@
  *     order fixed by the positions and body indices); thread_count is accepted for the
  *     interface's sake but this version runs every phase on the calling thread.
  *
- * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
+ * What it does NOT do (yet): triangle meshes, heightfields, compound bodies,
  * capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
  * collision detection (a body moving more than its size in one substep can tunnel),
  * collisions with particles or cloth.
@@ -76,6 +78,8 @@ typedef enum ak_rigid_shape_type {
                             swept by radius */
     AK_RIGID_PLANE,      /* static half-space below the plane through position with normal
                             `normal` (world); the body's orientation is ignored */
+    AK_RIGID_HULL,       /* convex hull of `points` (solid, uniform density); see below for
+                            its frame */
     AK_RIGID_SHAPE_COUNT
 } ak_rigid_shape_type;
 
@@ -85,7 +89,23 @@ typedef struct ak_rigid_shape {
     ak_vec3 half_extents;     /* metres; box: each > 0 (required) */
     float half_height;        /* metres; capsule: half the segment's length, >= 0 */
     ak_vec3 normal;           /* plane: world normal (normalised here); zero -> (0, 1, 0) */
+    ak_vec3_cspan points;     /* hull: 4 to AK_RIGID_HULL_MAX_POINTS points, in the shape's own
+                                 frame, not all in one plane (interior points are allowed and
+                                 dropped); read by ak_rigid_model_create only */
 } ak_rigid_shape;
+
+/* Most points a hull may be built from (the build is O(n^2) in the worst case). */
+#define AK_RIGID_HULL_MAX_POINTS 1024u
+
+/* The hull's frame. A body's frame is always its centre of mass and principal axes, so that the
+ * solver's inertia stays diagonal. For a hull the desc's position and orientation place the frame
+ * the points were given in (the "shape frame"); ak_rigid_model_create computes the hull's centre
+ * of mass c and principal axes R (in the shape frame) and resolves the desc to the body frame:
+ * position + orientation * c and orientation * R. The resolved desc (ak_rigid_body_get_desc) and
+ * the state hold that body frame; ak_rigid_body_shape_frame gives the shape frame back. When the
+ * inertia about c is already diagonal (a box's corners, any hull symmetric about its axes) R is
+ * the identity. The resolved shape's points are the hull's vertices in the body frame (owned by
+ * the model). */
 
 /* Friction value that means "none" (zero friction means the default). */
 #define AK_RIGID_FRICTIONLESS (-1.0f)
@@ -165,7 +185,9 @@ AK_API ak_rigid_model_desc ak_rigid_model_desc_resolved(const ak_rigid_model_des
 typedef struct ak_rigid_model ak_rigid_model;
 
 /* Build a model. Returns AK_ERR_NULL_ARG (desc or out_model NULL), AK_ERR_EMPTY (no body),
- * AK_ERR_BAD_ARG (unknown shape, a radius or half extent <= 0 or a negative half height, a
+ * AK_ERR_BAD_ARG (unknown shape, a radius or half extent <= 0 or a negative half height, a hull
+ * with fewer than 4 or more than AK_RIGID_HULL_MAX_POINTS points or points that are all in one
+ * plane (ak_rigid_hull_check says which), a
  * negative density, mass, friction other than AK_RIGID_FRICTIONLESS, damping, offset or sleep
  * value, restitution outside [0, 1], more than 2^24 bodies, an allocator with only one function),
  * AK_ERR_BAD_INDEX (a joint's body out of range, or both the same), AK_ERR_BAD_ARG (unknown
@@ -175,6 +197,13 @@ AK_API ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak
                                        ak_rigid_model** out_model);
 /* Free a model; NULL is a no-op. */
 AK_API void ak_rigid_model_destroy(ak_rigid_model* model);
+
+/* Whether points make a valid hull (as ak_rigid_model_create builds it): AK_OK, AK_ERR_NULL_ARG
+ * (points.ptr NULL with a count), AK_ERR_BAD_DATA (a non-finite point), AK_ERR_BAD_ARG (fewer
+ * than 4 or more than AK_RIGID_HULL_MAX_POINTS points, all on a line or in a plane, or too
+ * nearly so for a valid hull), AK_ERR_NO_MEMORY; *out_problem (may be NULL) gets a static
+ * message saying what is wrong ("" on success). */
+AK_API ak_result ak_rigid_hull_check(ak_vec3_cspan points, const char** out_problem);
 
 /* Number of joints (0 for NULL). */
 AK_API size_t ak_rigid_joint_count(const ak_rigid_model* model);
@@ -192,6 +221,12 @@ AK_API float ak_rigid_body_mass(const ak_rigid_model* model, size_t body_index);
 /* Principal moments of inertia (kg m^2) about the body's local axes (INFINITY for static; zero
  * for NULL or an index out of range). */
 AK_API ak_vec3 ak_rigid_body_inertia(const ak_rigid_model* model, size_t body_index);
+/* Pose of a body's shape frame (the frame a hull's points were given in) in the body frame:
+ * identity for every shape but a hull (see AK_RIGID_HULL); identity for NULL or an index out of
+ * range. World pose of the shape frame = body pose * this. */
+AK_API ak_transform ak_rigid_body_shape_frame(const ak_rigid_model* model, size_t body_index);
+/* Volume (m^3) of a body's shape (0 for a plane, NULL or an index out of range). */
+AK_API double ak_rigid_body_volume(const ak_rigid_model* model, size_t body_index);
 /* A body's resolved desc (defaults filled in, orientation normalised, plane normal normalised);
  * a zeroed desc for NULL or an index out of range. */
 AK_API ak_rigid_body_desc ak_rigid_body_get_desc(const ak_rigid_model* model, size_t body_index);
@@ -321,6 +356,7 @@ AK_API ak_result ak_rigid_step_run(const ak_rigid_step_job* job);
 /* Budgets that bound a hostile scene's memory (checked before anything is allocated). */
 #define AK_RIGID_SCENE_MAX_BODIES 100000u
 #define AK_RIGID_SCENE_MAX_JOINTS 100000u
+#define AK_RIGID_SCENE_MAX_POINTS 1000000u /* hull points, all bodies together */
 #define AK_RIGID_SCENE_MAX_STEPS 1000000L
 #define AK_RIGID_SCENE_MAX_SUBSTEPS 1000L
 #define AK_RIGID_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
@@ -333,6 +369,9 @@ typedef struct ak_rigid_scene {
     size_t body_count;
     ak_rigid_joint_desc* joints; /* [joint_count]; body indices into bodies */
     size_t joint_count;
+    ak_vec3* points;             /* [point_count]: the hulls' points (bodies' shape.points point
+                                    here) */
+    size_t point_count;
     ak_rigid_model_desc model;   /* damping and contact offset; its bodies and joints spans are
                                     left empty (ak_rigid_scene_run_init fills a copy) */
     ak_vec3 gravity;             /* m/s^2; default (0, -9.81, 0) */

@@ -98,6 +98,12 @@ static ak_result check_body(const ak_rigid_body_desc* b) {
     case AK_RIGID_CAPSULE:
         if (!(s->radius > 0.0f) || s->half_height < 0.0f) return AK_ERR_BAD_ARG;
         break;
+    case AK_RIGID_HULL:
+        if (s->points.count < 4 || s->points.count > AK_RIGID_HULL_MAX_POINTS) return AK_ERR_BAD_ARG;
+        if (!s->points.ptr) return AK_ERR_NULL_ARG;
+        for (size_t i = 0; i < s->points.count; ++i)
+            if (!vec_finite(s->points.ptr[i])) return AK_ERR_BAD_DATA;
+        break;
     default:
         break;
     }
@@ -148,10 +154,28 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
     size_t bodies_size = ((n * sizeof(rigid_body)) + 15) & ~(size_t)15;
     size_t descs_size = ((n * sizeof(ak_rigid_body_desc)) + 15) & ~(size_t)15;
     size_t joints_size = ((nj * sizeof(rigid_joint)) + 15) & ~(size_t)15;
-    size_t total = head + bodies_size + descs_size + joints_size + n * sizeof(uint32_t);
+    size_t planes_size = ((n * sizeof(uint32_t)) + 15) & ~(size_t)15;
+    size_t hulls_size = 0, hull_scratch_size = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const ak_rigid_shape* s = &desc->bodies.ptr[i].shape;
+        if (s->type != AK_RIGID_HULL) continue;
+        hulls_size += akp_rigid_hull_size(s->points.count);
+        size_t ss = akp_rigid_hull_scratch_size(s->points.count);
+        if (ss > hull_scratch_size) hull_scratch_size = ss;
+    }
+    size_t total = head + bodies_size + descs_size + joints_size + planes_size + hulls_size;
     unsigned char* mem = al.alloc(total, al.user);
     if (!mem) return AK_ERR_NO_MEMORY;
     memset(mem, 0, total);
+    void* hull_scratch = NULL;
+    if (hull_scratch_size) {
+        hull_scratch = al.alloc(hull_scratch_size, al.user);
+        if (!hull_scratch) {
+            al.free(mem, al.user);
+            return AK_ERR_NO_MEMORY;
+        }
+    }
+    unsigned char* hull_mem = mem + head + bodies_size + descs_size + joints_size + planes_size;
     ak_rigid_model* m = (ak_rigid_model*)mem;
     m->alloc = al;
     m->body_count = n;
@@ -186,6 +210,26 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         double volume;
         ak_vec3 ipm;
         shape_unit_mass(&d.shape, &volume, &ipm);
+        if (d.shape.type == AK_RIGID_HULL) {
+            akp_hull* h = NULL;
+            const char* problem;
+            ak_result hr = akp_rigid_hull_build(d.shape.points, hull_mem, hull_scratch, &h, &problem);
+            if (hr != AK_OK) {
+                if (hull_scratch) al.free(hull_scratch, al.user);
+                al.free(mem, al.user);
+                return hr;
+            }
+            hull_mem += akp_rigid_hull_size(d.shape.points.count);
+            b->hull = h;
+            volume = h->volume;
+            ipm = h->inertia_per_mass;
+            /* the desc places the shape frame: resolve it to the body frame (centre of mass,
+             * principal axes) */
+            d.position = ak_vec3_add(d.position, ak_quat_rotate(d.orientation, h->centroid));
+            d.orientation = ak_quat_normalize(ak_quat_mul(d.orientation, h->frame));
+            d.shape.points = (ak_vec3_cspan){h->verts, h->nv};
+            b->shape = d.shape;
+        }
         switch (d.shape.type) {
         case AK_RIGID_SPHERE:
             b->bound_radius = d.shape.radius;
@@ -195,6 +239,9 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             break;
         case AK_RIGID_CAPSULE:
             b->bound_radius = d.shape.radius + d.shape.half_height;
+            break;
+        case AK_RIGID_HULL:
+            b->bound_radius = b->hull->bound_radius;
             break;
         default:
             b->bound_radius = INFINITY;
@@ -210,6 +257,7 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             if (d.mass > 0.0f && volume > 0.0) d.density = (float)(mass / volume);
             d.mass = (float)mass;
             if (!(mass > 0.0) || !isfinite((float)mass)) {
+                if (hull_scratch) al.free(hull_scratch, al.user);
                 al.free(mem, al.user);
                 return AK_ERR_BAD_ARG;
             }
@@ -219,12 +267,14 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             b->inv_inertia =
                 ak_vec3_make(1.0f / b->inertia.x, 1.0f / b->inertia.y, 1.0f / b->inertia.z);
             if (!vec_finite(b->inv_inertia)) {
+                if (hull_scratch) al.free(hull_scratch, al.user);
                 al.free(mem, al.user);
                 return AK_ERR_BAD_ARG;
             }
         }
         m->descs[i] = d;
     }
+    if (hull_scratch) al.free(hull_scratch, al.user);
     for (size_t i = 0; i < nj; ++i) {
         const ak_rigid_joint_desc* jd = &desc->joints.ptr[i];
         rigid_joint* j = &m->joints[i];
@@ -284,6 +334,25 @@ float ak_rigid_body_mass(const ak_rigid_model* model, size_t i) {
 
 ak_vec3 ak_rigid_body_inertia(const ak_rigid_model* model, size_t i) {
     return model && i < model->body_count ? model->bodies[i].inertia : ak_vec3_zero();
+}
+
+ak_transform ak_rigid_body_shape_frame(const ak_rigid_model* model, size_t i) {
+    ak_transform t = ak_transform_identity();
+    if (!model || i >= model->body_count || !model->bodies[i].hull) return t;
+    const akp_hull* h = model->bodies[i].hull;
+    t.rotation = ak_quat_conjugate(h->frame);
+    t.translation = ak_vec3_neg(ak_quat_rotate(t.rotation, h->centroid));
+    return t;
+}
+
+double ak_rigid_body_volume(const ak_rigid_model* model, size_t i) {
+    if (!model || i >= model->body_count) return 0.0;
+    const rigid_body* b = &model->bodies[i];
+    if (b->hull) return b->hull->volume;
+    double v;
+    ak_vec3 ipm;
+    shape_unit_mass(&b->shape, &v, &ipm);
+    return v;
 }
 
 ak_rigid_body_desc ak_rigid_body_get_desc(const ak_rigid_model* model, size_t i) {

@@ -6,6 +6,55 @@
 
 #include <animkit/rigid.h>
 
+/* Pose of a body as the narrow phase reads it. */
+typedef struct rigid_pose {
+    ak_vec3 x;
+    ak_quat q;
+} rigid_pose;
+
+/* A convex hull in its body's frame (centre of mass at the origin, principal axes). Faces are
+ * convex polygons (coplanar triangles merged), their vertices counter-clockwise seen from
+ * outside; edges join two faces (f0, f1). */
+typedef struct akp_hull_face {
+    ak_vec3 n;             /* outward unit normal */
+    float d;               /* plane: n . x = d */
+    uint32_t first, count; /* vertex indices idx[first .. first + count) */
+} akp_hull_face;
+
+typedef struct akp_hull_edge {
+    uint32_t v0, v1, f0, f1;
+} akp_hull_edge;
+
+typedef struct akp_hull {
+    const ak_vec3* verts;
+    const akp_hull_face* faces;
+    const uint32_t* idx;
+    const akp_hull_edge* edges;
+    uint32_t nv, nf, ne;
+    ak_vec3 centroid; /* centre of mass in the shape frame */
+    ak_quat frame;    /* principal axes in the shape frame (body = shape * frame) */
+    double volume;    /* m^3 */
+    ak_vec3 inertia_per_mass; /* principal moments / mass (m^2) */
+    float bound_radius;       /* max |vertex| */
+} akp_hull;
+
+/* Bytes akp_rigid_hull_build writes for `count` points (an upper bound, 16-byte multiple) and
+ * the scratch it needs. */
+size_t akp_rigid_hull_size(size_t count);
+size_t akp_rigid_hull_scratch_size(size_t count);
+/* Build the hull of points into mem (akp_rigid_hull_size bytes, 16-aligned) with scratch
+ * (akp_rigid_hull_scratch_size bytes, 8-aligned); *out_hull points into mem. AK_ERR_BAD_ARG /
+ * AK_ERR_BAD_DATA with *out_problem saying why. */
+ak_result akp_rigid_hull_build(ak_vec3_cspan points, void* mem, void* scratch, akp_hull** out_hull,
+                               const char** out_problem);
+
+/* Distance between two convex shapes by GJK: the closest points pa (on a) and pb (on b) of the
+ * shapes' cores (hull, box, a capsule's segment, a sphere's centre), radii not included. Returns
+ * false when the cores overlap. Exposed for tests. */
+bool akp_rigid_gjk(const ak_rigid_shape* sa, const akp_hull* ha, rigid_pose pa,
+                   const ak_rigid_shape* sb, const akp_hull* hb, rigid_pose pb,
+                   ak_vec3* out_pa, ak_vec3* out_pb);
+
 /* What the solver reads per body, resolved once at build time. */
 typedef struct rigid_body {
     ak_rigid_shape shape;   /* resolved (plane normal normalised) */
@@ -18,6 +67,7 @@ typedef struct rigid_body {
     float restitution;
     float bound_radius; /* metres from the centre that holds the shape (planes: INFINITY) */
     uint32_t group;     /* collision group (0: none) */
+    const akp_hull* hull; /* AK_RIGID_HULL: the hull (in the model's allocation); else NULL */
 } rigid_body;
 
 /* A joint with its anchors and axes in each body's frame (from the descs' poses). */
@@ -80,11 +130,6 @@ typedef struct rigid_contact {
     float friction, dynamic_friction, restitution;
 } rigid_contact;
 
-/* Pose of a body as the narrow phase reads it. */
-typedef struct rigid_pose {
-    ak_vec3 x;
-    ak_quat q;
-} rigid_pose;
 
 /* Contact points between bodies a and b (a dynamic or both any; never two planes) into out (at
  * most cap, returns how many were written; *out_wanted counts every point found). n of each

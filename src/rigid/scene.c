@@ -29,6 +29,9 @@ void ak_rigid_scene_free(ak_rigid_scene* s) {
     if (!s) return;
     free(s->bodies);
     free(s->joints);
+    free(s->points);
+    s->points = NULL;
+    s->point_count = 0;
     s->bodies = NULL;
     s->body_count = 0;
     s->joints = NULL;
@@ -45,7 +48,54 @@ static ak_rigid_body_desc body_default(void) {
     return b;
 }
 
-static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigid_body_desc* b) {
+/* The hull points of a shape (already counted into the scene's points array; *next is where
+ * this body's go). */
+static void parse_points(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_scene* sc,
+                         ak_rigid_shape* s) {
+    size_t n = 0;
+    const cJSON* e = akp_json_array(j, sh, sp, "points", AK_RIGID_HULL_MAX_POINTS, &n);
+    if (j->failed) return;
+    if (n < 4) {
+        akp_json_fail(j, sp, "points", "is required for a hull: at least 4 [x, y, z] points");
+        return;
+    }
+    if (sc->point_count + n > AK_RIGID_SCENE_MAX_POINTS || !sc->points) {
+        akp_json_fail(j, sp, "points", "more hull points than the scene may have (%u)",
+                      AK_RIGID_SCENE_MAX_POINTS);
+        return;
+    }
+    ak_vec3* out = sc->points + sc->point_count;
+    char pp[128];
+    akp_json_key(pp, sizeof pp, sp, "points");
+    for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+        float v[3] = {0, 0, 0};
+        size_t m = (size_t)cJSON_GetArraySize(e);
+        const cJSON* c = cJSON_IsArray(e) ? e->child : NULL;
+        for (size_t i = 0; c && i < 3 && m == 3; c = c->next, ++i) {
+            if (!cJSON_IsNumber(c) || !(fabs(c->valuedouble) <= 1e4)) break;
+            v[i] = (float)c->valuedouble;
+            if (i == 2) m = 0; /* all three read */
+        }
+        if (m != 0) {
+            char ip[160];
+            akp_json_index(ip, sizeof ip, pp, k);
+            akp_json_fail(j, ip, "", "expected [x, y, z], each finite and within 1e4 m");
+            return;
+        }
+        out[k] = ak_vec3_make(v[0], v[1], v[2]);
+    }
+    const char* problem = "";
+    ak_result r = ak_rigid_hull_check((ak_vec3_cspan){out, n}, &problem);
+    if (r != AK_OK) {
+        akp_json_fail(j, sp, "points", "%s", problem);
+        return;
+    }
+    sc->point_count += n;
+    s->points = (ak_vec3_cspan){out, n};
+}
+
+static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigid_scene* sc,
+                        ak_rigid_body_desc* b) {
     char sp[96];
     akp_json_key(sp, sizeof sp, path, "shape");
     const cJSON* sh = akp_json_member(j, obj, path, "shape");
@@ -65,10 +115,6 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
         akp_json_fail(j, sp, "type", "is required (sphere, box, capsule, hull or plane)");
         return;
     }
-    if (type == 3) {
-        akp_json_fail(j, sp, "type", "\"hull\" is not supported yet (sphere, box, capsule, plane)");
-        return;
-    }
     /* which keys each type takes: the others are refused so a typo cannot pass unnoticed */
     static const char* const takes[5] = {"radius", "half_extents", "radius half_height", "points",
                                          "normal"};
@@ -81,6 +127,7 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
     s->type = type == 0   ? AK_RIGID_SPHERE
               : type == 1 ? AK_RIGID_BOX
               : type == 2 ? AK_RIGID_CAPSULE
+              : type == 3 ? AK_RIGID_HULL
                           : AK_RIGID_PLANE;
     s->radius = -1.0f;
     s->half_height = 0.0f;
@@ -92,6 +139,7 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
     akp_json_floats(j, sh, sp, "half_extents", 3, 1e-4f, 1e4f, he);
     s->half_extents = ak_vec3_make(he[0], he[1], he[2]);
     akp_json_vec3(j, sh, sp, "normal", &s->normal);
+    if (!j->failed && type == 3) parse_points(j, sh, sp, sc, s);
     if (j->failed) return;
     if ((type == 0 || type == 2) && s->radius < 0.0f)
         akp_json_fail(j, sp, "radius", "is required for a %s", types[type]);
@@ -101,7 +149,8 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
         akp_json_fail(j, sp, "normal", "is zero");
 }
 
-static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_body_desc* b) {
+static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_scene* sc,
+                       ak_rigid_body_desc* b) {
     if (!cJSON_IsObject(e)) {
         akp_json_fail(j, path, "", "expected an object with at least \"shape\"");
         return;
@@ -111,7 +160,7 @@ static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_b
         "friction", "restitution", "static",      NULL};
     akp_json_object(j, e, path, keys);
     *b = body_default();
-    parse_shape(j, e, path, b);
+    parse_shape(j, e, path, sc, b);
     akp_json_vec3(j, e, path, "position", &b->position);
     float q[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     akp_json_floats(j, e, path, "orientation", 4, -1e3f, 1e3f, q);
@@ -213,10 +262,28 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
             s->bodies = calloc(n, sizeof *s->bodies);
             if (!s->bodies) akp_json_fail(&j, "", "bodies", "out of memory");
         }
+        /* the hulls' points: counted first (each body's list is bounded by the hull's limit
+         * when it is parsed; here only the total is), one array for all */
+        size_t total_points = 0;
+        for (const cJSON* b = e; b && !j.failed; b = b->next) {
+            const cJSON* sh = cJSON_IsObject(b) ? cJSON_GetObjectItemCaseSensitive(b, "shape") : NULL;
+            const cJSON* pts = cJSON_IsObject(sh) ? cJSON_GetObjectItemCaseSensitive(sh, "points") : NULL;
+            if (cJSON_IsArray(pts)) {
+                size_t c = (size_t)cJSON_GetArraySize(pts);
+                total_points += c < AK_RIGID_HULL_MAX_POINTS ? c : AK_RIGID_HULL_MAX_POINTS;
+            }
+        }
+        if (!j.failed && total_points > AK_RIGID_SCENE_MAX_POINTS)
+            akp_json_fail(&j, "", "bodies", "more hull points than a scene may have (%u)",
+                          AK_RIGID_SCENE_MAX_POINTS);
+        if (!j.failed && total_points > 0) {
+            s->points = calloc(total_points, sizeof *s->points);
+            if (!s->points) akp_json_fail(&j, "", "bodies", "out of memory");
+        }
         for (size_t k = 0; e && !j.failed; e = e->next, ++k) {
             char path[48];
             akp_json_index(path, sizeof path, "bodies", k);
-            parse_body(&j, e, path, &s->bodies[k]);
+            parse_body(&j, e, path, s, &s->bodies[k]);
             s->body_count = k + 1;
         }
         size_t nj = 0;
