@@ -719,12 +719,14 @@ static float axis_sep(const cvx* P, const cvx* X, ak_vec3 l) {
 
 /* Overlapping cores, P a polytope, X any core: SAT. */
 static void sat_pair(hits* hs, const cvx* X, const cvx* P, bool x_is_a) {
-    /* P's faces */
+    /* P's faces: the separation along a face's normal is the other's lowest point above the
+     * face's plane, d_f known */
     float best = -INFINITY;
     uint32_t bf = 0;
     for (uint32_t f = 0; f < P->h->nf; ++f) {
         ak_vec3 n = ak_quat_rotate(P->q, P->h->faces[f].n);
-        float s = axis_sep(P, X, n);
+        ak_vec3 sx = cvx_support(X, ak_vec3_neg(n));
+        float s = ak_vec3_dot(ak_vec3_sub(sx, P->x), n) - P->h->faces[f].d;
         if (s > best) best = s, bf = f;
     }
     int kind = 0; /* 0: P's face; 1: X's face; 2: edges */
@@ -733,56 +735,70 @@ static void sat_pair(hits* hs, const cvx* X, const cvx* P, bool x_is_a) {
     if (X->kind == CV_POLY)
         for (uint32_t f = 0; f < X->h->nf; ++f) {
             ak_vec3 n = ak_quat_rotate(X->q, X->h->faces[f].n);
-            float s = axis_sep(X, P, n);
+            ak_vec3 sp = cvx_support(P, ak_vec3_neg(n));
+            float s = ak_vec3_dot(ak_vec3_sub(sp, X->x), n) - X->h->faces[f].d;
             if (s > best_x) best_x = s, bxf = f;
         }
     if (best_x > best + 1e-3f) kind = 1;
     float best_face = kind == 1 ? best_x : best;
-    /* edge pairs */
+    /* edge pairs, in P's frame: X's edges (or segment) and face normals brought over once */
     float best_e = -INFINITY;
     ak_vec3 e_axis = ak_vec3_zero(), ep0 = ak_vec3_zero(), ep1 = ak_vec3_zero(),
             ex0 = ak_vec3_zero(), ex1 = ak_vec3_zero();
     if (X->kind != CV_POINT) {
-        ak_vec3 xs0, xs1;
+        ak_quat xp = ak_quat_mul(P->qi, X->q); /* X's frame to P's */
+        ak_vec3 xo = ak_quat_rotate(P->qi, ak_vec3_sub(X->x, P->x));
         uint32_t nxe = X->kind == CV_POLY ? X->h->ne : 1;
         for (uint32_t j = 0; j < nxe; ++j) {
-            ak_vec3 xu = ak_vec3_zero(), xv = ak_vec3_zero();
+            ak_vec3 xs0, xs1, c = ak_vec3_zero(), d = ak_vec3_zero();
             if (X->kind == CV_POLY) {
                 const akp_hull_edge* e = &X->h->edges[j];
-                xs0 = cvx_world(X, X->h->verts[e->v0]);
-                xs1 = cvx_world(X, X->h->verts[e->v1]);
-                xu = ak_quat_rotate(X->q, X->h->faces[e->f0].n);
-                xv = ak_quat_rotate(X->q, X->h->faces[e->f1].n);
+                xs0 = ak_vec3_add(xo, ak_quat_rotate(xp, X->h->verts[e->v0]));
+                xs1 = ak_vec3_add(xo, ak_quat_rotate(xp, X->h->verts[e->v1]));
+                c = ak_vec3_neg(ak_quat_rotate(xp, X->h->faces[e->f0].n));
+                d = ak_vec3_neg(ak_quat_rotate(xp, X->h->faces[e->f1].n));
             } else {
-                ak_vec3 ax = ak_vec3_scale(ak_quat_rotate(X->q, ak_vec3_make(0, 1, 0)), X->hh);
-                xs0 = ak_vec3_sub(X->x, ax);
-                xs1 = ak_vec3_add(X->x, ax);
+                ak_vec3 ax = ak_vec3_scale(ak_quat_rotate(xp, ak_vec3_make(0, 1, 0)), X->hh);
+                xs0 = ak_vec3_sub(xo, ax);
+                xs1 = ak_vec3_add(xo, ax);
             }
-            ak_vec3 dx = ak_vec3_sub(xs1, xs0);
+            ak_vec3 dx = ak_vec3_sub(xs1, xs0), dxc = ak_vec3_cross(d, c);
+            float dxl = ak_vec3_length(dx);
             for (uint32_t i = 0; i < P->h->ne; ++i) {
                 const akp_hull_edge* e = &P->h->edges[i];
-                ak_vec3 a = ak_quat_rotate(P->q, P->h->faces[e->f0].n);
-                ak_vec3 b = ak_quat_rotate(P->q, P->h->faces[e->f1].n);
                 if (X->kind == CV_POLY) {
-                    /* Gregorius: the arcs a-b and -xu..-xv cross on the Gauss map */
-                    ak_vec3 c = ak_vec3_neg(xu), d = ak_vec3_neg(xv);
-                    ak_vec3 bxa = ak_vec3_cross(b, a), dxc = ak_vec3_cross(d, c);
+                    /* Gregorius: the arcs a-b and c-d (X's normals negated) cross on the Gauss
+                     * map, so the edges make a face of the Minkowski difference */
+                    ak_vec3 a = P->h->faces[e->f0].n, b = P->h->faces[e->f1].n;
+                    ak_vec3 bxa = ak_vec3_cross(b, a);
                     float cba = ak_vec3_dot(c, bxa), dba = ak_vec3_dot(d, bxa);
+                    if (!(cba * dba < 0.0f)) continue;
                     float adc = ak_vec3_dot(a, dxc), bdc = ak_vec3_dot(b, dxc);
-                    if (!(cba * dba < 0.0f && adc * bdc < 0.0f && cba * bdc > 0.0f)) continue;
+                    if (!(adc * bdc < 0.0f && cba * bdc > 0.0f)) continue;
                 }
-                ak_vec3 p0 = cvx_world(P, P->h->verts[e->v0]), p1 = cvx_world(P, P->h->verts[e->v1]);
-                ak_vec3 l = ak_vec3_cross(ak_vec3_sub(p1, p0), dx);
+                ak_vec3 p0 = P->h->verts[e->v0], p1 = P->h->verts[e->v1];
+                ak_vec3 pe = ak_vec3_sub(p1, p0);
+                ak_vec3 l = ak_vec3_cross(pe, dx);
                 float ll = ak_vec3_length(l);
-                if (ll < 1e-5f * ak_vec3_distance(p0, p1) * ak_vec3_length(dx)) continue;
+                if (ll < 1e-5f * ak_vec3_length(pe) * dxl) continue;
                 l = ak_vec3_scale(l, 1.0f / ll);
-                if (ak_vec3_dot(l, ak_vec3_sub(p0, P->x)) < 0.0f) l = ak_vec3_neg(l);
-                float s = axis_sep(P, X, l);
-                if (s > best_e) {
-                    best_e = s, e_axis = l, ep0 = p0, ep1 = p1, ex0 = xs0, ex1 = xs1;
+                if (ak_vec3_dot(l, p0) < 0.0f) l = ak_vec3_neg(l); /* P's centre is its origin */
+                float sep;
+                if (X->kind == CV_POLY) {
+                    sep = ak_vec3_dot(l, ak_vec3_sub(xs0, p0));
+                } else {
+                    ak_vec3 lw = ak_quat_rotate(P->q, l);
+                    sep = axis_sep(P, X, lw);
+                }
+                if (sep > best_e) {
+                    best_e = sep, e_axis = l, ep0 = p0, ep1 = p1, ex0 = xs0, ex1 = xs1;
                 }
             }
         }
+        /* back to the world */
+        e_axis = ak_quat_rotate(P->q, e_axis);
+        ep0 = cvx_world(P, ep0), ep1 = cvx_world(P, ep1);
+        ex0 = cvx_world(P, ex0), ex1 = cvx_world(P, ex1);
     }
     if (best_e > best_face + 0.02f * fabsf(best_face) + 1e-3f) {
         ak_vec3 c1, c2;
