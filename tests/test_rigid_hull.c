@@ -188,6 +188,21 @@ AK_TEST(degenerate_hulls_are_refused) {
     AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
     b.shape.points = (ak_vec3_cspan){NULL, 8};
     AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_NULL_ARG);
+    /* hard but valid: a 4 x 4 x 4 grid (collinear and coplanar points everywhere) and points
+     * scattered on a box's faces; the hull is the cube, 6 faces */
+    static ak_vec3 grid[64 + 200];
+    for (int i = 0; i < 64; ++i) grid[i] = ak_vec3_make((float)(i % 4), (float)(i / 4 % 4), (float)(i / 16));
+    for (int i = 0; i < 200; ++i) {
+        float u = 3.0f * frand(), v = 3.0f * frand();
+        int f = i % 6;
+        float c = f & 1 ? 3.0f : 0.0f;
+        grid[64 + i] = f < 2 ? ak_vec3_make(c, u, v) : (f < 4 ? ak_vec3_make(u, c, v) : ak_vec3_make(u, v, c));
+    }
+    b.shape.points = (ak_vec3_cspan){grid, 64 + 200};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
+    AK_CHECK_NEAR(ak_rigid_body_volume(m, 0), 27.0, 1e-4);
+    AK_CHECK_EQ(m->bodies[0].hull->nf, 6u);
+    ak_rigid_model_destroy(m);
     /* nearly flat: 1e-9 m of relief on a 1 m square is no volume */
     ak_vec3 thin[5] = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {1, 0, 1}, {0.5f, 1e-9f, 0.5f}};
     AK_CHECK_EQ(ak_rigid_hull_check((ak_vec3_cspan){thin, 5}, &why), AK_ERR_BAD_ARG);
