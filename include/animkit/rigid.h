@@ -1,4 +1,5 @@
-/* animkit rigid: rigid bodies (spheres, boxes, capsules, convex hulls, static planes), contacts, joints,
+/* animkit rigid: rigid bodies (spheres, boxes, capsules, convex hulls; static planes,
+ * heightfields and triangle meshes), contacts, joints,
  * ragdolls.
  *
  * What it does:
@@ -34,7 +35,7 @@
  *     order fixed by the positions and body indices); thread_count is accepted for the
  *     interface's sake but this version runs every phase on the calling thread.
  *
- * What it does NOT do (yet): triangle meshes, heightfields, compound bodies,
+ * What it does NOT do (yet): compound bodies,
  * capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
  * collision detection (a body moving more than its size in one substep can tunnel),
  * collisions with particles or cloth.
@@ -80,6 +81,8 @@ typedef enum ak_rigid_shape_type {
                             `normal` (world); the body's orientation is ignored */
     AK_RIGID_HULL,       /* convex hull of `points` (solid, uniform density); see below for
                             its frame */
+    AK_RIGID_HEIGHTFIELD, /* static: a grid of heights (rows x cols samples `spacing` apart) */
+    AK_RIGID_TRIMESH,     /* static: a triangle mesh (vertices, 3 indices per triangle) */
     AK_RIGID_SHAPE_COUNT
 } ak_rigid_shape_type;
 
@@ -92,7 +95,27 @@ typedef struct ak_rigid_shape {
     ak_vec3_cspan points;     /* hull: 4 to AK_RIGID_HULL_MAX_POINTS points, in the shape's own
                                  frame, not all in one plane (interior points are allowed and
                                  dropped); read by ak_rigid_model_create only */
+    /* heightfield (always static): sample (col, row), col < cols along the body's +X and row <
+       rows along its +Z, is at (col * spacing, heights[row * cols + col], row * spacing) in the
+       body frame (the body's position is sample (0, 0)'s foot); each cell is two triangles.
+       animkit terrain's layout (include/animkit/terrain.h) is this one with cols = width, rows =
+       height, spacing = world_size / (width - 1) and the position at its first sample's (x, 0,
+       z). Copied by ak_rigid_model_create. */
+    ak_f32_cspan heights;     /* rows * cols finite heights (m) */
+    uint32_t rows, cols;      /* >= 2 each; rows * cols <= AK_RIGID_HEIGHTFIELD_MAX_SAMPLES */
+    float spacing;            /* metres between neighbouring samples, > 0 */
+    /* trimesh (always static): triangles (indices[3k], [3k+1], [3k+2]) of vertices in the body
+       frame, counter-clockwise seen from the side bodies rest on (one-sided: a contact whose
+       normal points into that side is dropped). Copied by ak_rigid_model_create, which builds a
+       bounding volume hierarchy over the triangles. */
+    ak_vec3_cspan vertices;
+    ak_u32_cspan indices;     /* 3 per triangle, each < vertices.count; at most
+                                 3 * AK_RIGID_TRIMESH_MAX_TRIANGLES */
 } ak_rigid_shape;
+
+/* Budgets of the static mesh shapes (checked before anything is allocated). */
+#define AK_RIGID_HEIGHTFIELD_MAX_SAMPLES (1u << 24)
+#define AK_RIGID_TRIMESH_MAX_TRIANGLES (1u << 22)
 
 /* Most points a hull may be built from (the build is O(n^2) in the worst case). */
 #define AK_RIGID_HULL_MAX_POINTS 1024u
@@ -356,7 +379,7 @@ AK_API ak_result ak_rigid_step_run(const ak_rigid_step_job* job);
 /* Budgets that bound a hostile scene's memory (checked before anything is allocated). */
 #define AK_RIGID_SCENE_MAX_BODIES 100000u
 #define AK_RIGID_SCENE_MAX_JOINTS 100000u
-#define AK_RIGID_SCENE_MAX_POINTS 1000000u /* hull points, all bodies together */
+#define AK_RIGID_SCENE_MAX_POINTS 1000000u /* hull points and mesh vertices, all bodies */
 #define AK_RIGID_SCENE_MAX_STEPS 1000000L
 #define AK_RIGID_SCENE_MAX_SUBSTEPS 1000L
 #define AK_RIGID_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
@@ -369,9 +392,13 @@ typedef struct ak_rigid_scene {
     size_t body_count;
     ak_rigid_joint_desc* joints; /* [joint_count]; body indices into bodies */
     size_t joint_count;
-    ak_vec3* points;             /* [point_count]: the hulls' points (bodies' shape.points point
-                                    here) */
-    size_t point_count;
+    ak_vec3* points;             /* [point_count]: the hulls' points and the meshes' vertices
+                                    (bodies' shape.points / shape.vertices point here) */
+    size_t point_count, point_cap;
+    float* heights;              /* [height_count]: the heightfields' samples */
+    size_t height_count, height_cap;
+    uint32_t* indices;           /* [index_count]: the triangle meshes' indices */
+    size_t index_count, index_cap;
     ak_rigid_model_desc model;   /* damping and contact offset; its bodies and joints spans are
                                     left empty (ak_rigid_scene_run_init fills a copy) */
     ak_vec3 gravity;             /* m/s^2; default (0, -9.81, 0) */

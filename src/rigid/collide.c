@@ -830,12 +830,8 @@ static void sat_pair(hits* hs, const cvx* X, const cvx* P, bool x_is_a) {
 }
 
 /* Any convex pair with at least one polytope; B must be a polytope (the dispatcher orders). */
-static void convex_pair(hits* hs, rigid_pose pa, const ak_rigid_shape* sa, const akp_hull* ha,
-                        rigid_pose pb, const ak_rigid_shape* sb, const akp_hull* hb) {
-    cvx A, B;
-    box_hull boxa, boxb;
-    cvx_make(&A, sa, ha, pa, &boxa);
-    cvx_make(&B, sb, hb, pb, &boxb);
+static void convex_cvx(hits* hs, const cvx* pA, const cvx* pB) {
+    const cvx A = *pA, B = *pB;
     ak_vec3 ca, cb;
     if (!gjk_cores(&A, &B, &ca, &cb)) {
         sat_pair(hs, &A, &B, true);
@@ -857,6 +853,148 @@ static void convex_pair(hits* hs, rigid_pose pa, const ak_rigid_shape* sa, const
     else if (al_a >= face_cos)
         done = clip_face(hs, &A, fa, &B, true);
     if (!done) add_hit(hs, ak_vec3_madd(ca, n, -A.radius), ak_vec3_madd(cb, n, B.radius), n);
+}
+
+static void convex_pair(hits* hs, rigid_pose pa, const ak_rigid_shape* sa, const akp_hull* ha,
+                        rigid_pose pb, const ak_rigid_shape* sb, const akp_hull* hb) {
+    cvx A, B;
+    box_hull boxa, boxb;
+    cvx_make(&A, sa, ha, pa, &boxa);
+    cvx_make(&B, sb, hb, pb, &boxb);
+    convex_cvx(hs, &A, &B);
+}
+
+/* ---- static heightfields and triangle meshes --------------------------------------------
+ * Each triangle near the body is a thin polytope (its front and back faces, three edges) run
+ * through the convex pair above; contacts whose normal points into the surface's back are
+ * dropped (one-sided), the rest of all triangles gathered and reduced to a manifold. */
+
+typedef struct tri_hull {
+    akp_hull h;
+    ak_vec3 v[3];
+    akp_hull_face f[2];
+    uint32_t idx[6];
+    akp_hull_edge e[3];
+} tri_hull;
+
+#define MESH_HITS 64
+
+typedef struct mesh_query {
+    const cvx* A;
+    rigid_pose pose; /* the mesh's */
+    float margin;
+    hit h[MESH_HITS];
+    int count;
+} mesh_query;
+
+static void mesh_triangle(mesh_query* mq, ak_vec3 a, ak_vec3 b, ak_vec3 c) {
+    ak_vec3 n = ak_vec3_cross(ak_vec3_sub(b, a), ak_vec3_sub(c, a));
+    float l = ak_vec3_length(n);
+    if (!(l > 1e-12f)) return;
+    n = ak_vec3_scale(n, 1.0f / l);
+    tri_hull t;
+    memset(&t, 0, sizeof t);
+    t.v[0] = a, t.v[1] = b, t.v[2] = c;
+    t.f[0] = (akp_hull_face){n, ak_vec3_dot(n, a), 0, 3};
+    t.f[1] = (akp_hull_face){ak_vec3_neg(n), -ak_vec3_dot(n, a), 3, 3};
+    t.idx[0] = 0, t.idx[1] = 1, t.idx[2] = 2, t.idx[3] = 0, t.idx[4] = 2, t.idx[5] = 1;
+    t.e[0] = (akp_hull_edge){0, 1, 0, 1};
+    t.e[1] = (akp_hull_edge){1, 2, 0, 1};
+    t.e[2] = (akp_hull_edge){2, 0, 0, 1};
+    t.h.verts = t.v, t.h.faces = t.f, t.h.idx = t.idx, t.h.edges = t.e;
+    t.h.nv = 3, t.h.nf = 2, t.h.ne = 3;
+    cvx B;
+    memset(&B, 0, sizeof B);
+    B.kind = CV_POLY;
+    B.h = &t.h;
+    B.x = mq->pose.x;
+    B.q = mq->pose.q;
+    B.qi = ak_quat_conjugate(mq->pose.q);
+    hits one;
+    one.count = 0;
+    one.margin = mq->margin;
+    convex_cvx(&one, mq->A, &B);
+    ak_vec3 nw = ak_quat_rotate(mq->pose.q, n);
+    for (int i = 0; i < one.count && mq->count < MESH_HITS; ++i)
+        if (ak_vec3_dot(one.h[i].n, nw) > 0.0f) mq->h[mq->count++] = one.h[i];
+}
+
+static ak_vec3 mesh_vertex_hf(const akp_mesh* me, uint32_t i, uint32_t j) {
+    return ak_vec3_make((float)i * me->spacing, me->heights[(size_t)j * me->cols + i],
+                        (float)j * me->spacing);
+}
+
+static void mesh_pair(hits* hs, const cvx* A, float bound, rigid_pose pb, const akp_mesh* me) {
+    mesh_query mq;
+    mq.A = A;
+    mq.pose = pb;
+    mq.margin = hs->margin;
+    mq.count = 0;
+    ak_vec3 c = ak_quat_rotate(ak_quat_conjugate(pb.q), ak_vec3_sub(A->x, pb.x));
+    float r = bound + hs->margin;
+    if (me->is_heightfield) {
+        if (c.y - r > me->max_height || c.y + r < me->min_height) return;
+        float inv = 1.0f / me->spacing;
+        float fi0 = floorf((c.x - r) * inv), fi1 = floorf((c.x + r) * inv);
+        float fj0 = floorf((c.z - r) * inv), fj1 = floorf((c.z + r) * inv);
+        float imax = (float)(me->cols - 2), jmax = (float)(me->rows - 2);
+        if (fi1 < 0.0f || fj1 < 0.0f || fi0 > imax || fj0 > jmax) return;
+        uint32_t i0 = (uint32_t)ak_maxf(fi0, 0.0f), i1 = (uint32_t)ak_minf(fi1, imax);
+        uint32_t j0 = (uint32_t)ak_maxf(fj0, 0.0f), j1 = (uint32_t)ak_minf(fj1, jmax);
+        for (uint32_t j = j0; j <= j1; ++j)
+            for (uint32_t i = i0; i <= i1; ++i) {
+                ak_vec3 p00 = mesh_vertex_hf(me, i, j), p10 = mesh_vertex_hf(me, i + 1, j),
+                        p01 = mesh_vertex_hf(me, i, j + 1), p11 = mesh_vertex_hf(me, i + 1, j + 1);
+                float lo = ak_minf(ak_minf(p00.y, p10.y), ak_minf(p01.y, p11.y));
+                float hi = ak_maxf(ak_maxf(p00.y, p10.y), ak_maxf(p01.y, p11.y));
+                if (lo > c.y + r || hi < c.y - r) continue;
+                mesh_triangle(&mq, p00, p01, p11);
+                mesh_triangle(&mq, p00, p11, p10);
+            }
+    } else {
+        ak_vec3 lo = ak_vec3_sub(c, ak_vec3_make(r, r, r)), hi = ak_vec3_add(c, ak_vec3_make(r, r, r));
+        uint32_t stack[64];
+        int sp = 0;
+        stack[sp++] = 0;
+        while (sp > 0) {
+            const akp_bvh_node* nd = &me->nodes[stack[--sp]];
+            if (nd->lo.x > hi.x || nd->lo.y > hi.y || nd->lo.z > hi.z || nd->hi.x < lo.x ||
+                nd->hi.y < lo.y || nd->hi.z < lo.z)
+                continue;
+            if (nd->count == 0) {
+                if (sp + 2 <= 64) {
+                    stack[sp++] = nd->first + 1;
+                    stack[sp++] = nd->first;
+                }
+                continue;
+            }
+            for (uint32_t k = nd->first; k < nd->first + nd->count; ++k) {
+                const uint32_t* t = &me->tris[3 * (size_t)me->order[k]];
+                mesh_triangle(&mq, me->verts[t[0]], me->verts[t[1]], me->verts[t[2]]);
+            }
+        }
+    }
+    /* the deepest point, then each next the farthest from those kept */
+    bool kept[MESH_HITS] = {false};
+    int next = -1;
+    float deepest = INFINITY;
+    for (int i = 0; i < mq.count; ++i) {
+        float s = ak_vec3_dot(ak_vec3_sub(mq.h[i].pa, mq.h[i].pb), mq.h[i].n);
+        if (s < deepest) deepest = s, next = i;
+    }
+    while (next >= 0 && hs->count < AKP_RIGID_MAX_PAIR_CONTACTS) {
+        kept[next] = true;
+        add_hit(hs, mq.h[next].pa, mq.h[next].pb, mq.h[next].n);
+        next = -1;
+        float far = -1.0f;
+        for (int j = 0; j < mq.count; ++j) {
+            if (kept[j]) continue;
+            float dmin = INFINITY;
+            for (int k = 0; k < mq.count; ++k)
+                if (kept[k]) dmin = ak_minf(dmin, ak_vec3_distance(mq.h[j].pa, mq.h[k].pa));
+            if (dmin > far) far = dmin, next = j;
+        }
+    }
 }
 
 /* Shapes in canonical order: type(a) <= type(b) with the enum's order sphere, box, capsule,
@@ -904,14 +1042,27 @@ static int rank_of(ak_rigid_shape_type t) {
         return 2;
     case AK_RIGID_HULL:
         return 3;
-    default:
+    case AK_RIGID_HEIGHTFIELD:
+    case AK_RIGID_TRIMESH:
         return 4;
+    default:
+        return 5;
     }
 }
 
-static void collide_any(hits* hs, rigid_pose pa, const ak_rigid_shape* sa, const akp_hull* ha,
-                        rigid_pose pb, const ak_rigid_shape* sb, const akp_hull* hb) {
-    if (sa->type == AK_RIGID_HULL && sb->type == AK_RIGID_PLANE) {
+static void collide_any(hits* hs, rigid_pose pa, const rigid_body* ba, rigid_pose pb,
+                        const rigid_body* bb) {
+    const ak_rigid_shape* sa = &ba->shape;
+    const ak_rigid_shape* sb = &bb->shape;
+    const akp_hull* ha = ba->hull;
+    const akp_hull* hb = bb->hull;
+    if (bb->mesh) {
+        if (ba->mesh || sa->type == AK_RIGID_PLANE) return;
+        cvx A;
+        box_hull boxa;
+        cvx_make(&A, sa, ha, pa, &boxa);
+        mesh_pair(hs, &A, ba->bound_radius, pb, bb->mesh);
+    } else if (sa->type == AK_RIGID_HULL && sb->type == AK_RIGID_PLANE) {
         cvx A;
         cvx_make(&A, sa, ha, pa, NULL);
         hull_plane(hs, &A, pb.x, sb->normal);
@@ -931,12 +1082,10 @@ int akp_rigid_collide(const ak_rigid_model* m, uint32_t a, uint32_t b, rigid_pos
     hs.count = 0;
     hs.margin = margin;
     bool swap = rank_of(sa->type) > rank_of(sb->type);
-    const akp_hull* ha = m->bodies[a].hull;
-    const akp_hull* hb = m->bodies[b].hull;
     if (swap)
-        collide_any(&hs, pb, sb, hb, pa, sa, ha);
+        collide_any(&hs, pb, &m->bodies[b], pa, &m->bodies[a]);
     else
-        collide_any(&hs, pa, sa, ha, pb, sb, hb);
+        collide_any(&hs, pa, &m->bodies[a], pb, &m->bodies[b]);
     int count = hs.count < cap ? hs.count : cap;
     ak_quat qa = ak_quat_conjugate(pa.q), qb = ak_quat_conjugate(pb.q);
     for (int i = 0; i < count; ++i) {

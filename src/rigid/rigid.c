@@ -98,6 +98,12 @@ static ak_result check_body(const ak_rigid_body_desc* b) {
     case AK_RIGID_CAPSULE:
         if (!(s->radius > 0.0f) || s->half_height < 0.0f) return AK_ERR_BAD_ARG;
         break;
+    case AK_RIGID_HEIGHTFIELD:
+    case AK_RIGID_TRIMESH: {
+        ak_result r2 = akp_rigid_mesh_check(s);
+        if (r2 != AK_OK) return r2;
+        break;
+    }
     case AK_RIGID_HULL:
         if (s->points.count < 4 || s->points.count > AK_RIGID_HULL_MAX_POINTS) return AK_ERR_BAD_ARG;
         if (!s->points.ptr) return AK_ERR_NULL_ARG;
@@ -161,6 +167,13 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         if (s->type != AK_RIGID_HULL) continue;
         hulls_size += akp_rigid_hull_size(s->points.count);
         size_t ss = akp_rigid_hull_scratch_size(s->points.count);
+        if (ss > hull_scratch_size) hull_scratch_size = ss;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const ak_rigid_shape* s = &desc->bodies.ptr[i].shape;
+        if (s->type != AK_RIGID_HEIGHTFIELD && s->type != AK_RIGID_TRIMESH) continue;
+        hulls_size += akp_rigid_mesh_size(s);
+        size_t ss = akp_rigid_mesh_scratch_size(s);
         if (ss > hull_scratch_size) hull_scratch_size = ss;
     }
     size_t total = head + bodies_size + descs_size + joints_size + planes_size + hulls_size;
@@ -230,6 +243,19 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             d.shape.points = (ak_vec3_cspan){h->verts, h->nv};
             b->shape = d.shape;
         }
+        if (d.shape.type == AK_RIGID_HEIGHTFIELD || d.shape.type == AK_RIGID_TRIMESH) {
+            akp_mesh* me = akp_rigid_mesh_build(&d.shape, hull_mem, hull_scratch);
+            hull_mem += akp_rigid_mesh_size(&d.shape);
+            b->mesh = me;
+            d.is_static = true;
+            if (me->is_heightfield) {
+                d.shape.heights = (ak_f32_cspan){me->heights, (size_t)me->rows * me->cols};
+            } else {
+                d.shape.vertices = (ak_vec3_cspan){me->verts, me->nv};
+                d.shape.indices = (ak_u32_cspan){me->tris, 3 * (size_t)me->nt};
+            }
+            b->shape = d.shape;
+        }
         switch (d.shape.type) {
         case AK_RIGID_SPHERE:
             b->bound_radius = d.shape.radius;
@@ -242,6 +268,10 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             break;
         case AK_RIGID_HULL:
             b->bound_radius = b->hull->bound_radius;
+            break;
+        case AK_RIGID_HEIGHTFIELD:
+        case AK_RIGID_TRIMESH:
+            b->bound_radius = b->mesh->bound_radius;
             break;
         default:
             b->bound_radius = INFINITY;

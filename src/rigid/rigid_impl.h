@@ -55,6 +55,35 @@ bool akp_rigid_gjk(const ak_rigid_shape* sa, const akp_hull* ha, rigid_pose pa,
                    const ak_rigid_shape* sb, const akp_hull* hb, rigid_pose pb,
                    ak_vec3* out_pa, ak_vec3* out_pb);
 
+/* A static heightfield or triangle mesh in its body's frame (copied into the model). */
+typedef struct akp_bvh_node {
+    ak_vec3 lo, hi;
+    uint32_t first; /* leaf: into order; inner: the left child (the right is first + 1) */
+    uint32_t count; /* triangles of a leaf; 0 for an inner node */
+} akp_bvh_node;
+
+typedef struct akp_mesh {
+    bool is_heightfield;
+    const float* heights; /* [rows * cols] */
+    uint32_t rows, cols;
+    float spacing;
+    float min_height, max_height;
+    const ak_vec3* verts; /* trimesh */
+    const uint32_t* tris; /* [3 * nt] */
+    uint32_t nv, nt;
+    const akp_bvh_node* nodes; /* nodes[0] the root */
+    const uint32_t* order;     /* triangle indices in leaf order */
+    float bound_radius;        /* max distance of the mesh from the body's origin */
+} akp_mesh;
+
+/* Bytes akp_rigid_mesh_build writes for a heightfield or trimesh shape (16-byte multiple), the
+ * scratch it needs, and the build into mem (16-aligned). The shape must be valid (checked by
+ * akp_rigid_mesh_check). */
+size_t akp_rigid_mesh_size(const ak_rigid_shape* s);
+size_t akp_rigid_mesh_scratch_size(const ak_rigid_shape* s);
+akp_mesh* akp_rigid_mesh_build(const ak_rigid_shape* s, void* mem, void* scratch);
+ak_result akp_rigid_mesh_check(const ak_rigid_shape* s);
+
 /* What the solver reads per body, resolved once at build time. */
 typedef struct rigid_body {
     ak_rigid_shape shape;   /* resolved (plane normal normalised) */
@@ -68,6 +97,7 @@ typedef struct rigid_body {
     float bound_radius; /* metres from the centre that holds the shape (planes: INFINITY) */
     uint32_t group;     /* collision group (0: none) */
     const akp_hull* hull; /* AK_RIGID_HULL: the hull (in the model's allocation); else NULL */
+    const akp_mesh* mesh; /* heightfield, trimesh: the mesh (in the model's allocation) */
 } rigid_body;
 
 /* A joint with its anchors and axes in each body's frame (from the descs' poses). */
