@@ -503,6 +503,127 @@ AK_TEST(hull_scene_keys) {
     }
 }
 
+/* Eigenvalues of a symmetric 3x3 by the trigonometric solution of its characteristic cubic
+ * (Smith 1961), ascending. */
+static void sym_eigenvalues(double a[3][3], double out[3]) {
+    double p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    double q = (a[0][0] + a[1][1] + a[2][2]) / 3.0;
+    double p2 = (a[0][0] - q) * (a[0][0] - q) + (a[1][1] - q) * (a[1][1] - q) +
+                (a[2][2] - q) * (a[2][2] - q) + 2.0 * p1;
+    double p = sqrt(p2 / 6.0);
+    double b[3][3];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) b[i][j] = (a[i][j] - (i == j ? q : 0.0)) / p;
+    double det = b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1]) -
+                 b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0]) +
+                 b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]);
+    double r = det / 2.0;
+    double phi = r <= -1.0 ? 3.14159265358979 / 3.0 : (r >= 1.0 ? 0.0 : acos(r) / 3.0);
+    double e1 = q + 2.0 * p * cos(phi), e3 = q + 2.0 * p * cos(phi + 2.0 * 3.14159265358979 / 3.0);
+    out[2] = e1, out[0] = e3, out[1] = 3.0 * q - e1 - e3;
+}
+
+AK_TEST(compound_l_shape_inertia) {
+    /* an L of two boxes (2 x 0.5 x 1 lying, 0.5 x 1.5 x 1 standing at its end), density 1000,
+     * against an independent reference: the solid's mass, centre and inertia tensor integrated
+     * over a 0.02 m voxel grid, and its principal moments from the characteristic cubic */
+    ak_rigid_child kids[2] = {
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {1.0f, 0.25f, 0.5f}}, .position = {0, 0, 0}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.25f, 0.75f, 0.5f}},
+         .position = {0.75f, 1.0f, 0.0f}},
+    };
+    ak_rigid_body_desc b = {.shape = {.type = AK_RIGID_COMPOUND, .children = kids, .child_count = 2},
+                            .position = {5.0f, 0.0f, 0.0f}};
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {.bodies = {&b, 1}};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
+    const double hstep = 0.02, rho = 1000.0;
+    double mass = 0.0, c[3] = {0, 0, 0}, sxx[3][3] = {{0}};
+    for (double x = -1.0 + hstep / 2; x < 1.0; x += hstep)
+        for (double y = -0.25 + hstep / 2; y < 1.75; y += hstep)
+            for (double z = -0.5 + hstep / 2; z < 0.5; z += hstep) {
+                bool in = y < 0.25 || x > 0.5;
+                if (!in) continue;
+                double dm = rho * hstep * hstep * hstep, p[3] = {x, y, z};
+                mass += dm;
+                for (int i = 0; i < 3; ++i) {
+                    c[i] += dm * p[i];
+                    for (int j = 0; j < 3; ++j) sxx[i][j] += dm * p[i] * p[j];
+                }
+            }
+    for (int i = 0; i < 3; ++i) c[i] /= mass;
+    double in[3][3];
+    double tr = 0.0;
+    double cov[3][3];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) cov[i][j] = sxx[i][j] - mass * c[i] * c[j];
+    for (int i = 0; i < 3; ++i) tr += cov[i][i];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) in[i][j] = (i == j ? tr : 0.0) - cov[i][j];
+    double eig[3];
+    sym_eigenvalues(in, eig);
+    AK_CHECK_NEAR(ak_rigid_body_mass(m, 0), mass, 1e-4 * mass);
+    ak_rigid_body_desc r = ak_rigid_body_get_desc(m, 0);
+    AK_CHECK_NEAR(r.position.x, 5.0 + c[0], 1e-4);
+    AK_CHECK_NEAR(r.position.y, c[1], 1e-4);
+    AK_CHECK_NEAR(r.position.z, c[2], 1e-4);
+    ak_vec3 got = ak_rigid_body_inertia(m, 0);
+    float g[3] = {got.x, got.y, got.z};
+    qsort(g, 3, sizeof g[0], cmp_float);
+    for (int k = 0; k < 3; ++k)
+        AK_CHECK_MSG(fabs(g[k] - eig[k]) < 2e-3 * eig[2], "moment %d: %g vs %g", k, g[k], eig[k]);
+    /* the L's tensor has an xy term: the body frame is turned about z */
+    AK_CHECK(fabsf(r.orientation.z) > 0.01f);
+    ak_rigid_model_destroy(m);
+}
+
+AK_TEST(compound_rests_on_its_children) {
+    /* a dumbbell (two spheres on a capsule bar) and an L of two boxes, dropped on the ground:
+     * they come to rest on their children, at the closed-form heights */
+    ak_rigid_child bell[3] = {
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.2f}, .position = {-0.5f, 0, 0}},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.2f}, .position = {0.5f, 0, 0}},
+        {.shape = {.type = AK_RIGID_CAPSULE, .radius = 0.05f, .half_height = 0.4f},
+         .orientation = {0.0f, 0.0f, 0.7071068f, 0.7071068f}},
+    };
+    ak_rigid_child ell[2] = {
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {1.0f, 0.25f, 0.5f}}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.25f, 0.75f, 0.5f}},
+         .position = {0.75f, 1.0f, 0.0f}},
+    };
+    ak_rigid_body_desc b[3] = {
+        ground(),
+        {.shape = {.type = AK_RIGID_COMPOUND, .children = bell, .child_count = 3},
+         .position = {0.0f, 0.5f, 0.0f}},
+        {.shape = {.type = AK_RIGID_COMPOUND, .children = ell, .child_count = 2},
+         .position = {0.0f, 0.27f, 3.0f}},
+    };
+    world wd;
+    AK_CHECK(world_init(&wd, b, 3, 20));
+    float pen;
+    AK_CHECK(world_run(&wd, 2.0f, &pen));
+    /* the dumbbell's centre is its bar's: 0.2 above the ground */
+    AK_CHECK_MSG(fabsf(wd.x[1].y - 0.2f) < 3e-3f, "dumbbell at %g", wd.x[1].y);
+    /* the L's shape frame: its lying box's centre 0.25 above the ground, not turned */
+    ak_transform sf = ak_rigid_body_shape_frame(wd.model, 2);
+    ak_vec3 origin = ak_vec3_add(wd.x[2], ak_quat_rotate(wd.q[2], sf.translation));
+    ak_quat q = ak_quat_mul(wd.q[2], sf.rotation);
+    AK_CHECK_MSG(fabsf(origin.y - 0.25f) < 3e-3f, "L's base at %g", origin.y);
+    AK_CHECK_MSG(fabsf(ak_quat_rotate(q, ak_vec3_make(0, 1, 0)).y) > 0.9999f, "L tipped");
+    AK_CHECK_MSG(ak_vec3_distance(ak_vec3_make(origin.x, 0, origin.z), ak_vec3_make(0, 0, 3)) < 1e-3f,
+                 "L slid to %g %g", origin.x, origin.z);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g", pen);
+    /* invalid compounds */
+    ak_rigid_child bad = {.shape = {.type = AK_RIGID_PLANE}};
+    ak_rigid_body_desc bd = {.shape = {.type = AK_RIGID_COMPOUND, .children = &bad, .child_count = 1}};
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {.bodies = {&bd, 1}};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
+    bd.shape.child_count = 0;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_ERR_BAD_ARG);
+    world_free(&wd);
+}
+
 int main(void) {
     AK_RUN(box_corners_hull_inertia_is_the_box_closed_form);
     AK_RUN(sampled_sphere_hull_approaches_the_sphere);
@@ -513,5 +634,7 @@ int main(void) {
     AK_RUN(tetrahedron_lands_on_a_face);
     AK_RUN(shapes_rest_on_a_static_hull);
     AK_RUN(hull_scene_keys);
+    AK_RUN(compound_l_shape_inertia);
+    AK_RUN(compound_rests_on_its_children);
     return ak_test_finish();
 }

@@ -35,8 +35,7 @@
  *     order fixed by the positions and body indices); thread_count is accepted for the
  *     interface's sake but this version runs every phase on the calling thread.
  *
- * What it does NOT do (yet): compound bodies,
- * capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
+ * What it does NOT do (yet): capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
  * collision detection (a body moving more than its size in one substep can tunnel),
  * collisions with particles or cloth.
  *
@@ -83,6 +82,7 @@ typedef enum ak_rigid_shape_type {
                             its frame */
     AK_RIGID_HEIGHTFIELD, /* static: a grid of heights (rows x cols samples `spacing` apart) */
     AK_RIGID_TRIMESH,     /* static: a triangle mesh (vertices, 3 indices per triangle) */
+    AK_RIGID_COMPOUND,    /* several spheres, boxes, capsules and hulls fixed together */
     AK_RIGID_SHAPE_COUNT
 } ak_rigid_shape_type;
 
@@ -111,7 +111,25 @@ typedef struct ak_rigid_shape {
     ak_vec3_cspan vertices;
     ak_u32_cspan indices;     /* 3 per triangle, each < vertices.count; at most
                                  3 * AK_RIGID_TRIMESH_MAX_TRIANGLES */
+    /* compound: 1 to AK_RIGID_COMPOUND_MAX_CHILDREN children (sphere, box, capsule or hull),
+       placed in the shape frame, one density for all. Mass, centre of mass and inertia are the
+       children's summed by the parallel axis theorem; the body frame is the centre of mass and
+       the principal axes, resolved from the desc's pose as for a hull (see AK_RIGID_HULL).
+       Children may overlap (their volumes then count twice). Read by ak_rigid_model_create
+       only. */
+    const struct ak_rigid_child* children;
+    size_t child_count;
 } ak_rigid_shape;
+
+/* One shape of a compound body. */
+typedef struct ak_rigid_child {
+    ak_rigid_shape shape;     /* sphere, box, capsule or hull */
+    ak_vec3 position;         /* the child's frame in the compound's shape frame (a hull's
+                                 points are in the child's frame) */
+    ak_quat orientation;      /* zero -> identity */
+} ak_rigid_child;
+
+#define AK_RIGID_COMPOUND_MAX_CHILDREN 64u
 
 /* Budgets of the static mesh shapes (checked before anything is allocated). */
 #define AK_RIGID_HEIGHTFIELD_MAX_SAMPLES (1u << 24)
@@ -244,8 +262,8 @@ AK_API float ak_rigid_body_mass(const ak_rigid_model* model, size_t body_index);
 /* Principal moments of inertia (kg m^2) about the body's local axes (INFINITY for static; zero
  * for NULL or an index out of range). */
 AK_API ak_vec3 ak_rigid_body_inertia(const ak_rigid_model* model, size_t body_index);
-/* Pose of a body's shape frame (the frame a hull's points were given in) in the body frame:
- * identity for every shape but a hull (see AK_RIGID_HULL); identity for NULL or an index out of
+/* Pose of a body's shape frame (the frame a hull's points or a compound's children were given
+ * in) in the body frame: identity for every other shape (see AK_RIGID_HULL); identity for NULL or an index out of
  * range. World pose of the shape frame = body pose * this. */
 AK_API ak_transform ak_rigid_body_shape_frame(const ak_rigid_model* model, size_t body_index);
 /* Volume (m^3) of a body's shape (0 for a plane, NULL or an index out of range). */

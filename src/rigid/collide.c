@@ -919,6 +919,31 @@ static void mesh_triangle(mesh_query* mq, ak_vec3 a, ak_vec3 b, ak_vec3 c) {
         if (ak_vec3_dot(one.h[i].n, nw) > 0.0f) mq->h[mq->count++] = one.h[i];
 }
 
+/* Up to AKP_RIGID_MAX_PAIR_CONTACTS of h[0, count) into hs: the deepest point, then each next
+ * the farthest from those kept. */
+static void reduce_into(hits* hs, const hit* h, int count) {
+    bool kept[MESH_HITS] = {false};
+    int next = -1;
+    float deepest = INFINITY;
+    for (int i = 0; i < count; ++i) {
+        float s = ak_vec3_dot(ak_vec3_sub(h[i].pa, h[i].pb), h[i].n);
+        if (s < deepest) deepest = s, next = i;
+    }
+    while (next >= 0 && hs->count < AKP_RIGID_MAX_PAIR_CONTACTS) {
+        kept[next] = true;
+        add_hit(hs, h[next].pa, h[next].pb, h[next].n);
+        next = -1;
+        float far = -1.0f;
+        for (int j = 0; j < count; ++j) {
+            if (kept[j]) continue;
+            float dmin = INFINITY;
+            for (int k = 0; k < count; ++k)
+                if (kept[k]) dmin = ak_minf(dmin, ak_vec3_distance(h[j].pa, h[k].pa));
+            if (dmin > far) far = dmin, next = j;
+        }
+    }
+}
+
 static ak_vec3 mesh_vertex_hf(const akp_mesh* me, uint32_t i, uint32_t j) {
     return ak_vec3_make((float)i * me->spacing, me->heights[(size_t)j * me->cols + i],
                         (float)j * me->spacing);
@@ -974,27 +999,7 @@ static void mesh_pair(hits* hs, const cvx* A, float bound, rigid_pose pb, const 
             }
         }
     }
-    /* the deepest point, then each next the farthest from those kept */
-    bool kept[MESH_HITS] = {false};
-    int next = -1;
-    float deepest = INFINITY;
-    for (int i = 0; i < mq.count; ++i) {
-        float s = ak_vec3_dot(ak_vec3_sub(mq.h[i].pa, mq.h[i].pb), mq.h[i].n);
-        if (s < deepest) deepest = s, next = i;
-    }
-    while (next >= 0 && hs->count < AKP_RIGID_MAX_PAIR_CONTACTS) {
-        kept[next] = true;
-        add_hit(hs, mq.h[next].pa, mq.h[next].pb, mq.h[next].n);
-        next = -1;
-        float far = -1.0f;
-        for (int j = 0; j < mq.count; ++j) {
-            if (kept[j]) continue;
-            float dmin = INFINITY;
-            for (int k = 0; k < mq.count; ++k)
-                if (kept[k]) dmin = ak_minf(dmin, ak_vec3_distance(mq.h[j].pa, mq.h[k].pa));
-            if (dmin > far) far = dmin, next = j;
-        }
-    }
+    reduce_into(hs, mq.h, mq.count);
 }
 
 /* Shapes in canonical order: type(a) <= type(b) with the enum's order sphere, box, capsule,
@@ -1045,8 +1050,10 @@ static int rank_of(ak_rigid_shape_type t) {
     case AK_RIGID_HEIGHTFIELD:
     case AK_RIGID_TRIMESH:
         return 4;
-    default:
+    case AK_RIGID_PLANE:
         return 5;
+    default:
+        return 6;
     }
 }
 
@@ -1074,21 +1081,18 @@ static void collide_any(hits* hs, rigid_pose pa, const rigid_body* ba, rigid_pos
         collide_ordered(hs, pa, sa, pb, sb);
 }
 
-int akp_rigid_collide(const ak_rigid_model* m, uint32_t a, uint32_t b, rigid_pose pa, rigid_pose pb,
-                      float margin, rigid_contact* out, int cap) {
-    const ak_rigid_shape* sa = &m->bodies[a].shape;
-    const ak_rigid_shape* sb = &m->bodies[b].shape;
+/* Hits of ba at pa against bb at pb (bodies or a compound's children), n from b to a. */
+static void pair_hits(hits* out, rigid_pose pa, const rigid_body* ba, rigid_pose pb,
+                      const rigid_body* bb) {
     hits hs;
     hs.count = 0;
-    hs.margin = margin;
-    bool swap = rank_of(sa->type) > rank_of(sb->type);
+    hs.margin = out->margin;
+    bool swap = rank_of(ba->shape.type) > rank_of(bb->shape.type);
     if (swap)
-        collide_any(&hs, pb, &m->bodies[b], pa, &m->bodies[a]);
+        collide_any(&hs, pb, bb, pa, ba);
     else
-        collide_any(&hs, pa, &m->bodies[a], pb, &m->bodies[b]);
-    int count = hs.count < cap ? hs.count : cap;
-    ak_quat qa = ak_quat_conjugate(pa.q), qb = ak_quat_conjugate(pb.q);
-    for (int i = 0; i < count; ++i) {
+        collide_any(&hs, pa, ba, pb, bb);
+    for (int i = 0; i < hs.count && out->count < AKP_RIGID_MAX_PAIR_CONTACTS; ++i) {
         hit h = hs.h[i];
         if (swap) {
             ak_vec3 t = h.pa;
@@ -1096,6 +1100,55 @@ int akp_rigid_collide(const ak_rigid_model* m, uint32_t a, uint32_t b, rigid_pos
             h.pb = t;
             h.n = ak_vec3_neg(h.n);
         }
+        out->h[out->count++] = h;
+    }
+}
+
+static rigid_pose pose_mul(rigid_pose a, rigid_pose b) {
+    rigid_pose r = {ak_vec3_add(a.x, ak_quat_rotate(a.q, b.x)), ak_quat_mul(a.q, b.q)};
+    return r;
+}
+
+/* A compound against anything: every pair of children (a body that is not a compound is its
+ * own single child), the points gathered and reduced to one manifold. */
+static void compound_hits(hits* hs, rigid_pose pa, const rigid_body* ba, rigid_pose pb,
+                          const rigid_body* bb) {
+    hit big[MESH_HITS];
+    int nb = 0;
+    uint32_t na = ba->compound ? ba->compound->count : 1, nbk = bb->compound ? bb->compound->count : 1;
+    for (uint32_t i = 0; i < na; ++i) {
+        const rigid_body* ka = ba->compound ? &ba->compound->kids[i] : ba;
+        rigid_pose wa = ba->compound ? pose_mul(pa, ba->compound->poses[i]) : pa;
+        for (uint32_t j = 0; j < nbk; ++j) {
+            const rigid_body* kb = bb->compound ? &bb->compound->kids[j] : bb;
+            rigid_pose wb = bb->compound ? pose_mul(pb, bb->compound->poses[j]) : pb;
+            float rr = ka->bound_radius + kb->bound_radius + hs->margin;
+            if (isfinite(rr) && ak_vec3_length_sq(ak_vec3_sub(wa.x, wb.x)) > rr * rr) continue;
+            hits one;
+            one.count = 0;
+            one.margin = hs->margin;
+            pair_hits(&one, wa, ka, wb, kb);
+            for (int k = 0; k < one.count && nb < MESH_HITS; ++k) big[nb++] = one.h[k];
+        }
+    }
+    reduce_into(hs, big, nb);
+}
+
+int akp_rigid_collide(const ak_rigid_model* m, uint32_t a, uint32_t b, rigid_pose pa, rigid_pose pb,
+                      float margin, rigid_contact* out, int cap) {
+    const rigid_body* ba = &m->bodies[a];
+    const rigid_body* bb = &m->bodies[b];
+    hits hs;
+    hs.count = 0;
+    hs.margin = margin;
+    if (ba->compound || bb->compound)
+        compound_hits(&hs, pa, ba, pb, bb);
+    else
+        pair_hits(&hs, pa, ba, pb, bb);
+    int count = hs.count < cap ? hs.count : cap;
+    ak_quat qa = ak_quat_conjugate(pa.q), qb = ak_quat_conjugate(pb.q);
+    for (int i = 0; i < count; ++i) {
+        hit h = hs.h[i];
         rigid_contact* c = &out[i];
         memset(c, 0, sizeof *c);
         c->a = a;

@@ -121,6 +121,33 @@ static void jacobi3(double a[3][3], double v[3][3]) {
     }
 }
 
+void akp_rigid_principal(double inert[3][3], ak_quat* out_frame, ak_vec3* out_moments) {
+    double vec[3][3];
+    double offd = fabs(inert[0][1]) + fabs(inert[0][2]) + fabs(inert[1][2]);
+    double diag = fabs(inert[0][0]) + fabs(inert[1][1]) + fabs(inert[2][2]);
+    if (offd <= 1e-6 * diag) {
+        /* already principal (up to rounding): keep the given axes */
+        for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q) {
+                vec[r][q] = r == q ? 1.0 : 0.0;
+                if (r != q) inert[r][q] = 0.0;
+            }
+    } else {
+        jacobi3(inert, vec);
+        double det = vec[0][0] * (vec[1][1] * vec[2][2] - vec[2][1] * vec[1][2]) -
+                     vec[0][1] * (vec[1][0] * vec[2][2] - vec[2][0] * vec[1][2]) +
+                     vec[0][2] * (vec[1][0] * vec[2][1] - vec[2][0] * vec[1][1]);
+        if (det < 0.0)
+            for (int r = 0; r < 3; ++r) vec[r][2] = -vec[r][2];
+    }
+    ak_mat3 rm = ak_mat3_from_cols(
+        ak_vec3_make((float)vec[0][0], (float)vec[1][0], (float)vec[2][0]),
+        ak_vec3_make((float)vec[0][1], (float)vec[1][1], (float)vec[2][1]),
+        ak_vec3_make((float)vec[0][2], (float)vec[1][2], (float)vec[2][2]));
+    *out_frame = ak_quat_normalize(ak_quat_from_mat3(rm));
+    *out_moments = ak_vec3_make((float)inert[0][0], (float)inert[1][1], (float)inert[2][2]);
+}
+
 #define FAIL(code, msg)                                                                            \
     do {                                                                                           \
         *out_problem = (msg);                                                                      \
@@ -312,7 +339,7 @@ ak_result akp_rigid_hull_build(ak_vec3_cspan points, void* mem, void* scratch, a
         FAIL(AK_ERR_BAD_ARG, "the points are too nearly in one plane (no volume)");
     cm = dscale(cm, 1.0 / vol);
     const double* pcm = &cm.x;
-    double inert[3][3], vec[3][3];
+    double inert[3][3];
     double tr = 0.0;
     for (int r = 0; r < 3; ++r) {
         for (int q = 0; q < 3; ++q) cov[r][q] -= vol * pcm[r] * pcm[q];
@@ -320,29 +347,10 @@ ak_result akp_rigid_hull_build(ak_vec3_cspan points, void* mem, void* scratch, a
     }
     for (int r = 0; r < 3; ++r)
         for (int q = 0; q < 3; ++q) inert[r][q] = (r == q ? tr : 0.0) - cov[r][q];
-    double offd = fabs(inert[0][1]) + fabs(inert[0][2]) + fabs(inert[1][2]);
-    double diag = fabs(inert[0][0]) + fabs(inert[1][1]) + fabs(inert[2][2]);
-    if (offd <= 1e-6 * diag) {
-        /* already principal (up to rounding): keep the given axes */
-        for (int r = 0; r < 3; ++r)
-            for (int q = 0; q < 3; ++q) {
-                vec[r][q] = r == q ? 1.0 : 0.0;
-                if (r != q) inert[r][q] = 0.0;
-            }
-    } else {
-        jacobi3(inert, vec);
-        double det = vec[0][0] * (vec[1][1] * vec[2][2] - vec[2][1] * vec[1][2]) -
-                     vec[0][1] * (vec[1][0] * vec[2][2] - vec[2][0] * vec[1][2]) +
-                     vec[0][2] * (vec[1][0] * vec[2][1] - vec[2][0] * vec[1][1]);
-        if (det < 0.0)
-            for (int r = 0; r < 3; ++r) vec[r][2] = -vec[r][2];
-    }
     cm = dadd(cm, o); /* from here on: in the shape frame */
-    ak_mat3 rm = ak_mat3_from_cols(
-        ak_vec3_make((float)vec[0][0], (float)vec[1][0], (float)vec[2][0]),
-        ak_vec3_make((float)vec[0][1], (float)vec[1][1], (float)vec[2][1]),
-        ak_vec3_make((float)vec[0][2], (float)vec[1][2], (float)vec[2][2]));
-    ak_quat frame = ak_quat_normalize(ak_quat_from_mat3(rm));
+    ak_quat frame;
+    ak_vec3 moments;
+    akp_rigid_principal(inert, &frame, &moments);
     ak_quat to_body = ak_quat_conjugate(frame);
 
     /* output */
@@ -441,8 +449,7 @@ ak_result akp_rigid_hull_build(ak_vec3_cspan points, void* mem, void* scratch, a
     h->centroid = ak_vec3_make((float)cm.x, (float)cm.y, (float)cm.z);
     h->frame = frame;
     h->volume = vol;
-    h->inertia_per_mass = ak_vec3_make((float)(inert[0][0] / vol), (float)(inert[1][1] / vol),
-                                       (float)(inert[2][2] / vol));
+    h->inertia_per_mass = ak_vec3_scale(moments, (float)(1.0 / vol));
     h->bound_radius = bound;
     *out_hull = h;
     return AK_OK;

@@ -48,6 +48,22 @@ size_t akp_rigid_hull_scratch_size(size_t count);
 ak_result akp_rigid_hull_build(ak_vec3_cspan points, void* mem, void* scratch, akp_hull** out_hull,
                                const char** out_problem);
 
+/* Principal axes of a symmetric inertia tensor (modified): *out_frame's columns are the axes
+ * (identity when the tensor is diagonal to 1e-6), *out_moments the moments about them. */
+void akp_rigid_principal(double inert[3][3], ak_quat* out_frame, ak_vec3* out_moments);
+
+/* A compound body's children in the body frame (centre of mass, principal axes). */
+typedef struct akp_compound {
+    uint32_t count;
+    struct rigid_body* kids; /* shape, hull and bound radius of each child (no mass) */
+    rigid_pose* poses;       /* each child's body frame in the compound's body frame */
+    ak_vec3 centroid;        /* centre of mass in the shape frame */
+    ak_quat frame;           /* principal axes in the shape frame */
+    double volume;           /* summed over the children (m^3) */
+    ak_vec3 inertia_per_mass;
+    float bound_radius;
+} akp_compound;
+
 /* Distance between two convex shapes by GJK: the closest points pa (on a) and pb (on b) of the
  * shapes' cores (hull, box, a capsule's segment, a sphere's centre), radii not included. Returns
  * false when the cores overlap. Exposed for tests. */
@@ -86,6 +102,7 @@ ak_result akp_rigid_mesh_check(const ak_rigid_shape* s);
 
 /* What the solver reads per body, resolved once at build time. */
 typedef struct rigid_body {
+    /* (a compound's children are rigid_body too: only shape, hull and bound_radius are set) */
     ak_rigid_shape shape;   /* resolved (plane normal normalised) */
     float inv_mass;         /* 1/kg; 0 static */
     ak_vec3 inv_inertia;    /* 1/(kg m^2) about the local axes; 0 static */
@@ -98,6 +115,7 @@ typedef struct rigid_body {
     uint32_t group;     /* collision group (0: none) */
     const akp_hull* hull; /* AK_RIGID_HULL: the hull (in the model's allocation); else NULL */
     const akp_mesh* mesh; /* heightfield, trimesh: the mesh (in the model's allocation) */
+    const akp_compound* compound; /* compound: its children (in the model's allocation) */
 } rigid_body;
 
 /* A joint with its anchors and axes in each body's frame (from the descs' poses). */
