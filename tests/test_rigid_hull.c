@@ -485,14 +485,34 @@ AK_TEST(hull_scene_keys) {
     AK_CHECK_NEAR(run.positions[1].y, 2.25f, 1e-5f);
     ak_rigid_scene_run_free(&run);
     ak_rigid_scene_free(&sc);
+    const char* comp =
+        "{\"bodies\": [{\"shape\": {\"type\": \"compound\", \"children\": ["
+        " {\"shape\": {\"type\": \"box\", \"half_extents\": [1, 0.25, 0.5]}},"
+        " {\"shape\": {\"type\": \"hull\", \"points\": [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]},"
+        "  \"position\": [0.75, 1, 0], \"orientation\": [0, 0, 0, 1]}]}}]}";
+    ak_rigid_scene_defaults(&sc);
+    AK_CHECK_EQ(ak_rigid_scene_load_bytes(comp, strlen(comp), "t", &sc, &diag), AK_OK);
+    AK_CHECK_EQ(sc.bodies[0].shape.type, AK_RIGID_COMPOUND);
+    AK_CHECK_EQ(sc.bodies[0].shape.child_count, (size_t)2);
+    AK_CHECK_EQ(sc.bodies[0].shape.children[1].shape.points.count, (size_t)4);
+    AK_CHECK_NEAR(sc.bodies[0].shape.children[1].position.x, 0.75f, 0.0f);
+    AK_CHECK_EQ(ak_rigid_scene_run_init(&run, &sc, "t", &diag), AK_OK);
+    ak_rigid_scene_run_free(&run);
+    ak_rigid_scene_free(&sc);
     const char* bad[] = {
+        "{\"bodies\": [{\"shape\": {\"type\": \"compound\", \"children\": [{\"shape\": {\"type\": \"plane\"}}]}}]}",
+        "{\"bodies\": [{\"shape\": {\"type\": \"compound\", \"children\": []}}]}",
+        "{\"bodies\": [{\"shape\": {\"type\": \"compound\", \"children\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"mass\": 1}]}}]}",
         "{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"points\": [[0,0,0],[1,0,0],[0,0,1],[1,0,1]]}}]}",
         "{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"points\": [[0,0,0],[1,0,0],[0,1,0]]}}]}",
         "{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"points\": [[0,0,0],[1,0,0],[0,1,0],[0,0]]}}]}",
         "{\"bodies\": [{\"shape\": {\"type\": \"hull\"}}]}",
         "{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"radius\": 1, \"points\": []}}]}",
     };
-    const char* where[] = {"bodies[0].shape.points: the points are all in one plane",
+    const char* where[] = {"bodies[0].shape.children[0].shape.type: a compound's child",
+                           "bodies[0].shape.children: is required",
+                           "bodies[0].shape.children[0]: unknown key \"mass\"",
+                           "bodies[0].shape.points: the points are all in one plane",
                            "bodies[0].shape.points", "bodies[0].shape.points[3]",
                            "bodies[0].shape.points", "bodies[0].shape.radius"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {

@@ -398,6 +398,7 @@ AK_API ak_result ak_rigid_step_run(const ak_rigid_step_job* job);
 #define AK_RIGID_SCENE_MAX_BODIES 100000u
 #define AK_RIGID_SCENE_MAX_JOINTS 100000u
 #define AK_RIGID_SCENE_MAX_POINTS 1000000u /* hull points and mesh vertices, all bodies */
+#define AK_RIGID_SCENE_MAX_CHILDREN 100000u /* compound children, all bodies */
 #define AK_RIGID_SCENE_MAX_STEPS 1000000L
 #define AK_RIGID_SCENE_MAX_SUBSTEPS 1000L
 #define AK_RIGID_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
@@ -417,6 +418,8 @@ typedef struct ak_rigid_scene {
     size_t height_count, height_cap;
     uint32_t* indices;           /* [index_count]: the triangle meshes' indices */
     size_t index_count, index_cap;
+    struct ak_rigid_child* children; /* [child_count]: the compounds' children */
+    size_t child_count, child_cap;
     ak_rigid_model_desc model;   /* damping and contact offset; its bodies and joints spans are
                                     left empty (ak_rigid_scene_run_init fills a copy) */
     ak_vec3 gravity;             /* m/s^2; default (0, -9.81, 0) */

@@ -38,6 +38,9 @@ void ak_rigid_scene_free(ak_rigid_scene* s) {
     s->height_count = s->height_cap = 0;
     s->indices = NULL;
     s->index_count = s->index_cap = 0;
+    free(s->children);
+    s->children = NULL;
+    s->child_count = s->child_cap = 0;
     s->bodies = NULL;
     s->body_count = 0;
     s->joints = NULL;
@@ -174,9 +177,14 @@ static void parse_points(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_
         akp_json_fail(j, sp, "points", "%s", problem);
 }
 
+static void parse_children(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_scene* sc,
+                           ak_rigid_shape* s);
+
+/* The "shape" member of obj (a body, or a compound's child when depth is 1) into *s; *is_static
+ * (may be NULL) set for the static-only shapes. */
 static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigid_scene* sc,
-                        ak_rigid_body_desc* b) {
-    char sp[96];
+                        ak_rigid_shape* s, bool* is_static, int depth) {
+    char sp[128];
     akp_json_key(sp, sizeof sp, path, "shape");
     const cJSON* sh = akp_json_member(j, obj, path, "shape");
     if (j->failed) return;
@@ -187,34 +195,41 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
     static const char* const keys[] = {"type",   "radius",  "half_extents", "half_height",
                                        "points", "normal",  "rows",         "cols",
                                        "spacing", "heights", "vertices",    "indices",
-                                       NULL};
+                                       "children", NULL};
     static const char* const types[] = {"sphere", "box",         "capsule", "hull",
-                                        "plane",  "heightfield", "trimesh", NULL};
+                                        "plane",  "heightfield", "trimesh", "compound", NULL};
     akp_json_object(j, sh, sp, keys);
     int type = -1;
     akp_json_enum(j, sh, sp, "type", types, &type);
     if (j->failed) return;
     if (type < 0) {
         akp_json_fail(j, sp, "type",
-                      "is required (sphere, box, capsule, hull, plane, heightfield or trimesh)");
+                      "is required (sphere, box, capsule, hull, plane, heightfield, trimesh or "
+                      "compound)");
+        return;
+    }
+    if (depth > 0 && type > 3) {
+        akp_json_fail(j, sp, "type", "a compound's child is a sphere, box, capsule or hull");
         return;
     }
     /* which keys each type takes: the others are refused so a typo cannot pass unnoticed */
-    static const char* const takes[7] = {"radius", "half_extents", "radius half_height", "points",
-                                         "normal", "rows cols spacing heights", "vertices indices"};
+    static const char* const takes[8] = {"radius",           "half_extents",
+                                         "radius half_height", "points",
+                                         "normal",           "rows cols spacing heights",
+                                         "vertices indices", "children"};
     for (int k = 1; keys[k]; ++k)
         if (cJSON_GetObjectItemCaseSensitive(sh, keys[k]) && !strstr(takes[type], keys[k])) {
             akp_json_fail(j, sp, keys[k], "does not apply to a %s", types[type]);
             return;
         }
-    ak_rigid_shape* s = &b->shape;
     s->type = type == 0   ? AK_RIGID_SPHERE
               : type == 1 ? AK_RIGID_BOX
               : type == 2 ? AK_RIGID_CAPSULE
               : type == 3 ? AK_RIGID_HULL
               : type == 4 ? AK_RIGID_PLANE
               : type == 5 ? AK_RIGID_HEIGHTFIELD
-                          : AK_RIGID_TRIMESH;
+              : type == 6 ? AK_RIGID_TRIMESH
+                          : AK_RIGID_COMPOUND;
     s->radius = -1.0f;
     s->half_height = 0.0f;
     s->half_extents = ak_vec3_make(-1.0f, -1.0f, -1.0f);
@@ -228,7 +243,8 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
     if (!j->failed && type == 3) parse_points(j, sh, sp, sc, s);
     if (!j->failed && type == 5) parse_heightfield(j, sh, sp, sc, s);
     if (!j->failed && type == 6) parse_trimesh(j, sh, sp, sc, s);
-    if (!j->failed && type >= 5) b->is_static = true;
+    if (!j->failed && type == 7) parse_children(j, sh, sp, sc, s);
+    if (!j->failed && (type == 5 || type == 6) && is_static) *is_static = true;
     if (j->failed) return;
     if ((type == 0 || type == 2) && s->radius < 0.0f)
         akp_json_fail(j, sp, "radius", "is required for a %s", types[type]);
@@ -236,6 +252,50 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
         akp_json_fail(j, sp, "half_extents", "is required for a box");
     else if (type == 4 && ak_vec3_length(s->normal) < 1e-6f)
         akp_json_fail(j, sp, "normal", "is zero");
+}
+
+static void parse_children(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_scene* sc,
+                           ak_rigid_shape* s) {
+    size_t n = 0;
+    const cJSON* e = akp_json_array(j, sh, sp, "children", AK_RIGID_COMPOUND_MAX_CHILDREN, &n);
+    if (j->failed) return;
+    if (n == 0) {
+        akp_json_fail(j, sp, "children", "is required for a compound: 1 to %u children",
+                      AK_RIGID_COMPOUND_MAX_CHILDREN);
+        return;
+    }
+    if (sc->child_count + n > sc->child_cap) {
+        akp_json_fail(j, sp, "children", "more children than the scene may have");
+        return;
+    }
+    ak_rigid_child* out = sc->children + sc->child_count;
+    sc->child_count += n;
+    char cp[128];
+    akp_json_key(cp, sizeof cp, sp, "children");
+    for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+        char ip[160];
+        akp_json_index(ip, sizeof ip, cp, k);
+        if (!cJSON_IsObject(e)) {
+            akp_json_fail(j, ip, "", "expected an object with \"shape\"");
+            return;
+        }
+        static const char* const keys[] = {"shape", "position", "orientation", NULL};
+        akp_json_object(j, e, ip, keys);
+        ak_rigid_child* c = &out[k];
+        memset(c, 0, sizeof *c);
+        c->orientation = ak_quat_identity();
+        parse_shape(j, e, ip, sc, &c->shape, NULL, 1);
+        akp_json_vec3(j, e, ip, "position", &c->position);
+        float q[4] = {0, 0, 0, 1};
+        akp_json_floats(j, e, ip, "orientation", 4, -1e3f, 1e3f, q);
+        if (!j->failed && q[0] == 0.0f && q[1] == 0.0f && q[2] == 0.0f && q[3] == 0.0f)
+            akp_json_fail(j, ip, "orientation", "is the zero quaternion");
+        c->orientation = (ak_quat){q[0], q[1], q[2], q[3]};
+        if (!j->failed && ak_vec3_length(c->position) > 1e4f)
+            akp_json_fail(j, ip, "position", "is over 1e4 m");
+    }
+    s->children = out;
+    s->child_count = n;
 }
 
 static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_scene* sc,
@@ -249,7 +309,7 @@ static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_s
         "friction", "restitution", "static",      NULL};
     akp_json_object(j, e, path, keys);
     *b = body_default();
-    parse_shape(j, e, path, sc, b);
+    parse_shape(j, e, path, sc, &b->shape, &b->is_static, 0);
     akp_json_vec3(j, e, path, "position", &b->position);
     float q[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     akp_json_floats(j, e, path, "orientation", 4, -1e3f, 1e3f, q);
@@ -355,12 +415,30 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
          * list is bounded again when it is parsed; here the totals are), one array each */
         size_t counts[3] = {0, 0, 0};
         static const char* const lists[4] = {"points", "vertices", "heights", "indices"};
+        size_t kids = 0;
         for (const cJSON* b = e; b && !j.failed; b = b->next) {
             const cJSON* sh = cJSON_IsObject(b) ? cJSON_GetObjectItemCaseSensitive(b, "shape") : NULL;
-            for (int l = 0; l < 4 && cJSON_IsObject(sh); ++l) {
-                const cJSON* arr = cJSON_GetObjectItemCaseSensitive(sh, lists[l]);
-                if (cJSON_IsArray(arr)) counts[l < 2 ? 0 : l - 1] += (size_t)cJSON_GetArraySize(arr);
+            const cJSON* ch = cJSON_IsObject(sh) ? cJSON_GetObjectItemCaseSensitive(sh, "children") : NULL;
+            /* the shape, then its children's (at most one more than allowed: parsing refuses) */
+            const cJSON* kid = cJSON_IsArray(ch) ? ch->child : NULL;
+            for (size_t k = 0; k <= AK_RIGID_COMPOUND_MAX_CHILDREN + 1 && cJSON_IsObject(sh); ++k) {
+                for (int l = 0; l < 4; ++l) {
+                    const cJSON* arr = cJSON_GetObjectItemCaseSensitive(sh, lists[l]);
+                    if (cJSON_IsArray(arr)) counts[l < 2 ? 0 : l - 1] += (size_t)cJSON_GetArraySize(arr);
+                }
+                if (!kid) break;
+                ++kids;
+                sh = cJSON_IsObject(kid) ? cJSON_GetObjectItemCaseSensitive(kid, "shape") : NULL;
+                kid = kid->next;
             }
+        }
+        if (!j.failed && kids > AK_RIGID_SCENE_MAX_CHILDREN)
+            akp_json_fail(&j, "", "bodies", "more compound children than a scene may have (%u)",
+                          AK_RIGID_SCENE_MAX_CHILDREN);
+        if (!j.failed && kids > 0) {
+            s->children = calloc(kids, sizeof *s->children);
+            s->child_cap = kids;
+            if (!s->children) akp_json_fail(&j, "", "bodies", "out of memory");
         }
         if (!j.failed && counts[0] > AK_RIGID_SCENE_MAX_POINTS)
             akp_json_fail(&j, "", "bodies", "more points and vertices than a scene may have (%u)",
