@@ -228,7 +228,11 @@ typedef struct ak_rigid_model ak_rigid_model;
 /* Build a model. Returns AK_ERR_NULL_ARG (desc or out_model NULL), AK_ERR_EMPTY (no body),
  * AK_ERR_BAD_ARG (unknown shape, a radius or half extent <= 0 or a negative half height, a hull
  * with fewer than 4 or more than AK_RIGID_HULL_MAX_POINTS points or points that are all in one
- * plane (ak_rigid_hull_check says which), a
+ * plane (ak_rigid_hull_check says which), a heightfield with rows or cols < 2, too many samples,
+ * spacing <= 0 or heights.count != rows * cols, a trimesh with no triangles, an index count
+ * that is not a multiple of 3 or too many triangles, a compound with no or too many children or
+ * a child that is not a sphere, box, capsule or hull), AK_ERR_NULL_ARG (a hull's, mesh's or
+ * compound's array NULL with a count), AK_ERR_BAD_INDEX (a trimesh index >= vertices.count), a
  * negative density, mass, friction other than AK_RIGID_FRICTIONLESS, damping, offset or sleep
  * value, restitution outside [0, 1], more than 2^24 bodies, an allocator with only one function),
  * AK_ERR_BAD_INDEX (a joint's body out of range, or both the same), AK_ERR_BAD_ARG (unknown
