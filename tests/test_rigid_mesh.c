@@ -163,7 +163,7 @@ AK_TEST(nothing_tunnels_through_a_trimesh_floor) {
     world wd;
     AK_CHECK(world_init(&wd, b, 5, 20));
     float lowest[5] = {0, 0, 0, 0, 0};
-    for (int s = 0; s < 150; ++s) {
+    for (int s = 0; s < 80; ++s) {
         AK_CHECK(world_steps(&wd, 1));
         for (int i = 1; i < 5; ++i) {
             /* each body's lowest point against the floor's highest (0.2 m): never below its lowest (0) */
