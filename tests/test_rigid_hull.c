@@ -467,6 +467,47 @@ AK_TEST(shapes_rest_on_a_static_hull) {
     world_free(&wd);
 }
 
+AK_TEST(deep_overlaps_with_a_hull_push_out_through_the_nearest_face) {
+    /* a sphere whose centre, a capsule whose segment and a hull cube whose centre lie inside a
+     * static hull slab, just under its top face (the separating axis path, not GJK's): their
+     * contacts push them up through the top, by the depth of their lowest points (the solver
+     * would turn such an overlap into a launch: XPBD derives velocities from positions, so this
+     * checks the narrow phase itself) */
+    ak_vec3 slab[8];
+    box_corners(ak_vec3_make(2.0f, 0.5f, 2.0f), slab);
+    ak_vec3 cube[8];
+    box_corners(ak_vec3_make(0.2f, 0.2f, 0.2f), cube);
+    ak_quat lying = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 1.5707963f);
+    ak_rigid_body_desc b[4] = {
+        {.shape = {.type = AK_RIGID_HULL, .points = {slab, 8}}, .is_static = true},
+        {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.2f}, .position = {-1.2f, 0.45f, 0.0f}},
+        {.shape = {.type = AK_RIGID_CAPSULE, .radius = 0.15f, .half_height = 0.3f},
+         .position = {0.0f, 0.4f, -1.0f},
+         .orientation = lying},
+        {.shape = {.type = AK_RIGID_HULL, .points = {cube, 8}}, .position = {0.3f, 0.42f, 1.0f}},
+    };
+    const float depth[4] = {0.0f, 0.25f, 0.25f, 0.28f};
+    const int points[4] = {0, 1, 2, 4};
+    ak_rigid_model* m = NULL;
+    ak_rigid_model_desc md = {.bodies = {b, 4}};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
+    ak_rigid_body_desc d0 = ak_rigid_body_get_desc(m, 0);
+    rigid_pose pb = {d0.position, d0.orientation};
+    for (uint32_t i = 1; i < 4; ++i) {
+        ak_rigid_body_desc d = ak_rigid_body_get_desc(m, i);
+        rigid_pose pa = {d.position, d.orientation};
+        rigid_contact c[AKP_RIGID_MAX_PAIR_CONTACTS];
+        int n = akp_rigid_collide(m, i, 0, pa, pb, 0.01f, c, AKP_RIGID_MAX_PAIR_CONTACTS);
+        AK_CHECK_EQ(n, points[i]);
+        for (int k = 0; k < n; ++k) {
+            AK_CHECK_MSG(c[k].n.y > 0.9999f, "body %u: normal %g %g %g", i, c[k].n.x, c[k].n.y,
+                         c[k].n.z);
+            AK_CHECK_NEAR(c[k].depth, depth[i], 1e-4f);
+        }
+    }
+    ak_rigid_model_destroy(m);
+}
+
 AK_TEST(hull_scene_keys) {
     const char* good =
         "{\"bodies\": [{\"shape\": {\"type\": \"plane\"}},"
@@ -653,6 +694,7 @@ int main(void) {
     AK_RUN(hull_stack_stands);
     AK_RUN(tetrahedron_lands_on_a_face);
     AK_RUN(shapes_rest_on_a_static_hull);
+    AK_RUN(deep_overlaps_with_a_hull_push_out_through_the_nearest_face);
     AK_RUN(hull_scene_keys);
     AK_RUN(compound_l_shape_inertia);
     AK_RUN(compound_rests_on_its_children);
