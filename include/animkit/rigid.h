@@ -116,7 +116,7 @@ typedef struct ak_rigid_shape {
        children's summed by the parallel axis theorem; the body frame is the centre of mass and
        the principal axes, resolved from the desc's pose as for a hull (see AK_RIGID_HULL).
        Children may overlap (their volumes then count twice). Read by ak_rigid_model_create
-       only. */
+       only: the resolved desc (ak_rigid_body_get_desc) has no children (NULL, 0). */
     const struct ak_rigid_child* children;
     size_t child_count;
 } ak_rigid_shape;
