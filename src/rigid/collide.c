@@ -691,7 +691,7 @@ static bool clip_face(hits* hs, const cvx* R, uint32_t rf, const cvx* I, bool re
             } else if (db > 0.0f) {
                 poly[1] = ak_vec3_lerp(poly[0], poly[1], da / (da - db));
             }
-        } else if (count + 1 < CLIP_CAP) {
+        } else if (2 * count <= CLIP_CAP) { /* clip_poly emits at most 2 per edge */
             count = clip_poly(poly, count, u, off, tmp);
         }
     }
