@@ -1,5 +1,6 @@
 /* Convex hull bodies against closed forms, brute-force references and physics. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -332,6 +333,7 @@ AK_TEST(gjk_distance_matches_brute_force) {
     }
     AK_CHECK_MSG(pairs >= 40, "only %d pairs", pairs);
     AK_CHECK_MSG(worst < 1e-4, "worst GJK error %g m", worst);
+    if (getenv("AK_TEST_VERBOSE")) printf("GJK: %d pairs, worst error %g m\n", pairs, worst);
     /* overlapping hulls are reported as such */
     {
         ak_vec3 c8[8];
@@ -372,6 +374,7 @@ AK_TEST(hull_rests_on_a_plane) {
     float drift = sqrtf((wd.x[1].x - 1.0f) * (wd.x[1].x - 1.0f) +
                         (wd.x[1].z + 2.0f) * (wd.x[1].z + 2.0f));
     AK_CHECK_MSG(drift < 1e-3f, "slid %g m", drift);
+    if (getenv("AK_TEST_VERBOSE")) printf("prism: slid %g m, height %g\n", drift, wd.x[1].y);
     AK_CHECK_MSG(fabsf(wd.x[1].y - 0.3f) < 0.01f, "height %g vs 0.3", wd.x[1].y);
     AK_CHECK_MSG(pen < 0.01f, "penetration %g", pen);
     ak_vec3 up = ak_quat_rotate(wd.q[1], ak_vec3_make(0, 1, 0));
@@ -400,6 +403,7 @@ AK_TEST(hull_stack_stands) {
     }
     AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
     AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+    if (getenv("AK_TEST_VERBOSE")) printf("hull stack: drift %g m, penetration %g m\n", drift, pen);
     world_free(&wd);
 }
 
@@ -420,6 +424,7 @@ AK_TEST(tetrahedron_lands_on_a_face) {
     AK_CHECK(world_run(&wd, 4.0f, &pen));
     float inr = a / (2.0f * sqrtf(6.0f));
     AK_CHECK_MSG(fabsf(wd.x[1].y - inr) < 3e-3f, "height %g vs inradius %g", wd.x[1].y, inr);
+    if (getenv("AK_TEST_VERBOSE")) printf("tetrahedron: height %g vs inradius %g\n", wd.x[1].y, inr);
     /* three corners on the ground, one at the tetrahedron's height above it */
     ak_rigid_body_desc r = ak_rigid_body_get_desc(wd.model, 1);
     int low = 0;
@@ -631,8 +636,10 @@ AK_TEST(compound_l_shape_inertia) {
     ak_vec3 got = ak_rigid_body_inertia(m, 0);
     float g[3] = {got.x, got.y, got.z};
     qsort(g, 3, sizeof g[0], cmp_float);
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 3; ++k) {
         AK_CHECK_MSG(fabs(g[k] - eig[k]) < 2e-3 * eig[2], "moment %d: %g vs %g", k, g[k], eig[k]);
+        if (getenv("AK_TEST_VERBOSE")) printf("L: moment %d %g vs voxels %g\n", k, g[k], eig[k]);
+    }
     /* the L's tensor has an xy term: the body frame is turned about z */
     AK_CHECK(fabsf(r.orientation.z) > 0.01f);
     ak_rigid_model_destroy(m);
