@@ -107,7 +107,7 @@ AK_TEST(bad_scenes_name_the_key) {
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"densty\": 3}]}",
          "densty"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"points\": []}}]}",
-         "bodies[0].shape.type"},
+         "bodies[0].shape.points"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"mass\": 1, "
          "\"density\": 2}]}",
          "bodies[0].mass"},

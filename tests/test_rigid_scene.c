@@ -118,7 +118,7 @@ AK_TEST(rigid_scene_errors_name_key_paths) {
          "t.json: bodies[0].mass: give density or mass, not both"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"restitution\": 2}]}",
          "t.json: bodies[0].restitution"},
-        {"{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"points\": []}}]}", "t.json: bodies[0].shape.type"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"hull\", \"points\": []}}]}", "t.json: bodies[0].shape.points: is required"},
         {"{\"bodies\": []}", "t.json: bodies: is required and must hold at least one body"},
         {"{\"dt\": 0.01}", "t.json: bodies: is required"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"joints\": "

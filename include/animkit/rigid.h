@@ -1,4 +1,5 @@
-/* animkit rigid: rigid bodies (spheres, boxes, capsules, static planes), contacts, joints,
+/* animkit rigid: rigid bodies (spheres, boxes, capsules, convex hulls; static planes,
+ * heightfields and triangle meshes), contacts, joints,
  * ragdolls.
  *
  * What it does:
@@ -20,7 +21,9 @@
  *   - contacts: sweep-and-prune broad phase along the axis of the bodies' largest spread,
  *     closed-form narrow phase for every pair of sphere, box, capsule and plane (box-box:
  *     separating axis test over the 15 axes, then the incident face clipped against the
- *     reference face for a manifold of up to 8 points); contacts are found within
+ *     reference face for a manifold of up to 8 points); hulls against every convex shape by GJK
+ *     (distance) and, when the shapes' cores overlap, a separating axis test over faces and
+ *     Gauss-map-pruned edge pairs, then the same face clipping; contacts are found within
  *     contact_offset of touching (speculative); a contact's friction is the geometric mean of
  *     its bodies' and its restitution the larger of the two; pairs are solved from the top down;
  *   - joints: ball (optional swing cone and twist range), hinge (optional angle limits), fixed,
@@ -34,8 +37,7 @@
  *     order fixed by the positions and body indices); thread_count is accepted for the
  *     interface's sake but this version runs every phase on the calling thread.
  *
- * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
- * capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
+ * What it does NOT do (yet): capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
  * collision detection (a body moving more than its size in one substep can tunnel),
  * collisions with particles or cloth.
  *
@@ -78,6 +80,11 @@ typedef enum ak_rigid_shape_type {
                             swept by radius */
     AK_RIGID_PLANE,      /* static half-space below the plane through position with normal
                             `normal` (world); the body's orientation is ignored */
+    AK_RIGID_HULL,       /* convex hull of `points` (solid, uniform density); see below for
+                            its frame */
+    AK_RIGID_HEIGHTFIELD, /* static: a grid of heights (rows x cols samples `spacing` apart) */
+    AK_RIGID_TRIMESH,     /* static: a triangle mesh (vertices, 3 indices per triangle) */
+    AK_RIGID_COMPOUND,    /* several spheres, boxes, capsules and hulls fixed together */
     AK_RIGID_SHAPE_COUNT
 } ak_rigid_shape_type;
 
@@ -87,7 +94,61 @@ typedef struct ak_rigid_shape {
     ak_vec3 half_extents;     /* metres; box: each > 0 (required) */
     float half_height;        /* metres; capsule: half the segment's length, >= 0 */
     ak_vec3 normal;           /* plane: world normal (normalised here); zero -> (0, 1, 0) */
+    ak_vec3_cspan points;     /* hull: 4 to AK_RIGID_HULL_MAX_POINTS points, in the shape's own
+                                 frame, not all in one plane (interior points are allowed and
+                                 dropped); read by ak_rigid_model_create only */
+    /* heightfield (always static): sample (col, row), col < cols along the body's +X and row <
+       rows along its +Z, is at (col * spacing, heights[row * cols + col], row * spacing) in the
+       body frame (the body's position is sample (0, 0)'s foot); each cell is two triangles.
+       animkit terrain's layout (include/animkit/terrain.h) is this one with cols = width, rows =
+       height, spacing = world_size / (width - 1) and the position at its first sample's (x, 0,
+       z). Copied by ak_rigid_model_create. */
+    ak_f32_cspan heights;     /* rows * cols finite heights (m) */
+    uint32_t rows, cols;      /* >= 2 each; rows * cols <= AK_RIGID_HEIGHTFIELD_MAX_SAMPLES */
+    float spacing;            /* metres between neighbouring samples, > 0 */
+    /* trimesh (always static): triangles (indices[3k], [3k+1], [3k+2]) of vertices in the body
+       frame, counter-clockwise seen from the side bodies rest on (one-sided: a contact whose
+       normal points into that side is dropped). Copied by ak_rigid_model_create, which builds a
+       bounding volume hierarchy over the triangles. */
+    ak_vec3_cspan vertices;
+    ak_u32_cspan indices;     /* 3 per triangle, each < vertices.count; at most
+                                 3 * AK_RIGID_TRIMESH_MAX_TRIANGLES */
+    /* compound: 1 to AK_RIGID_COMPOUND_MAX_CHILDREN children (sphere, box, capsule or hull),
+       placed in the shape frame, one density for all. Mass, centre of mass and inertia are the
+       children's summed by the parallel axis theorem; the body frame is the centre of mass and
+       the principal axes, resolved from the desc's pose as for a hull (see AK_RIGID_HULL).
+       Children may overlap (their volumes then count twice). Read by ak_rigid_model_create
+       only: the resolved desc (ak_rigid_body_get_desc) has no children (NULL, 0). */
+    const struct ak_rigid_child* children;
+    size_t child_count;
 } ak_rigid_shape;
+
+/* One shape of a compound body. */
+typedef struct ak_rigid_child {
+    ak_rigid_shape shape;     /* sphere, box, capsule or hull */
+    ak_vec3 position;         /* the child's frame in the compound's shape frame (a hull's
+                                 points are in the child's frame) */
+    ak_quat orientation;      /* zero -> identity */
+} ak_rigid_child;
+
+#define AK_RIGID_COMPOUND_MAX_CHILDREN 64u
+
+/* Budgets of the static mesh shapes (checked before anything is allocated). */
+#define AK_RIGID_HEIGHTFIELD_MAX_SAMPLES (1u << 24)
+#define AK_RIGID_TRIMESH_MAX_TRIANGLES (1u << 22)
+
+/* Most points a hull may be built from (the build is O(n^2) in the worst case). */
+#define AK_RIGID_HULL_MAX_POINTS 1024u
+
+/* The hull's frame. A body's frame is always its centre of mass and principal axes, so that the
+ * solver's inertia stays diagonal. For a hull the desc's position and orientation place the frame
+ * the points were given in (the "shape frame"); ak_rigid_model_create computes the hull's centre
+ * of mass c and principal axes R (in the shape frame) and resolves the desc to the body frame:
+ * position + orientation * c and orientation * R. The resolved desc (ak_rigid_body_get_desc) and
+ * the state hold that body frame; ak_rigid_body_shape_frame gives the shape frame back. When the
+ * inertia about c is already diagonal (a box's corners, any hull symmetric about its axes) R is
+ * the identity. The resolved shape's points are the hull's vertices in the body frame (owned by
+ * the model). */
 
 /* Friction value that means "none" (zero friction means the default). */
 #define AK_RIGID_FRICTIONLESS (-1.0f)
@@ -168,7 +229,13 @@ AK_API ak_rigid_model_desc ak_rigid_model_desc_resolved(const ak_rigid_model_des
 typedef struct ak_rigid_model ak_rigid_model;
 
 /* Build a model. Returns AK_ERR_NULL_ARG (desc or out_model NULL), AK_ERR_EMPTY (no body),
- * AK_ERR_BAD_ARG (unknown shape, a radius or half extent <= 0 or a negative half height, a
+ * AK_ERR_BAD_ARG (unknown shape, a radius or half extent <= 0 or a negative half height, a hull
+ * with fewer than 4 or more than AK_RIGID_HULL_MAX_POINTS points or points that are all in one
+ * plane (ak_rigid_hull_check says which), a heightfield with rows or cols < 2, too many samples,
+ * spacing <= 0 or heights.count != rows * cols, a trimesh with no triangles, an index count
+ * that is not a multiple of 3 or too many triangles, a compound with no or too many children or
+ * a child that is not a sphere, box, capsule or hull), AK_ERR_NULL_ARG (a hull's, mesh's or
+ * compound's array NULL with a count), AK_ERR_BAD_INDEX (a trimesh index >= vertices.count), a
  * negative density, mass, friction other than AK_RIGID_FRICTIONLESS, damping, offset or sleep
  * value, restitution outside [0, 1], more than 2^24 bodies, an allocator with only one function),
  * AK_ERR_BAD_INDEX (a joint's body out of range, or both the same), AK_ERR_BAD_ARG (unknown
@@ -178,6 +245,13 @@ AK_API ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak
                                        ak_rigid_model** out_model);
 /* Free a model; NULL is a no-op. */
 AK_API void ak_rigid_model_destroy(ak_rigid_model* model);
+
+/* Whether points make a valid hull (as ak_rigid_model_create builds it): AK_OK, AK_ERR_NULL_ARG
+ * (points.ptr NULL with a count), AK_ERR_BAD_DATA (a non-finite point), AK_ERR_BAD_ARG (fewer
+ * than 4 or more than AK_RIGID_HULL_MAX_POINTS points, all on a line or in a plane, or too
+ * nearly so for a valid hull), AK_ERR_NO_MEMORY; *out_problem (may be NULL) gets a static
+ * message saying what is wrong ("" on success). */
+AK_API ak_result ak_rigid_hull_check(ak_vec3_cspan points, const char** out_problem);
 
 /* Number of joints (0 for NULL). */
 AK_API size_t ak_rigid_joint_count(const ak_rigid_model* model);
@@ -195,6 +269,12 @@ AK_API float ak_rigid_body_mass(const ak_rigid_model* model, size_t body_index);
 /* Principal moments of inertia (kg m^2) about the body's local axes (INFINITY for static; zero
  * for NULL or an index out of range). */
 AK_API ak_vec3 ak_rigid_body_inertia(const ak_rigid_model* model, size_t body_index);
+/* Pose of a body's shape frame (the frame a hull's points or a compound's children were given
+ * in) in the body frame: identity for every other shape (see AK_RIGID_HULL); identity for NULL or an index out of
+ * range. World pose of the shape frame = body pose * this. */
+AK_API ak_transform ak_rigid_body_shape_frame(const ak_rigid_model* model, size_t body_index);
+/* Volume (m^3) of a body's shape (0 for a plane, NULL or an index out of range). */
+AK_API double ak_rigid_body_volume(const ak_rigid_model* model, size_t body_index);
 /* A body's resolved desc (defaults filled in, orientation normalised, plane normal normalised);
  * a zeroed desc for NULL or an index out of range. */
 AK_API ak_rigid_body_desc ak_rigid_body_get_desc(const ak_rigid_model* model, size_t body_index);
@@ -326,6 +406,8 @@ AK_API ak_result ak_rigid_step_run(const ak_rigid_step_job* job);
 /* Budgets that bound a hostile scene's memory (checked before anything is allocated). */
 #define AK_RIGID_SCENE_MAX_BODIES 100000u
 #define AK_RIGID_SCENE_MAX_JOINTS 100000u
+#define AK_RIGID_SCENE_MAX_POINTS 1000000u /* hull points and mesh vertices, all bodies */
+#define AK_RIGID_SCENE_MAX_CHILDREN 100000u /* compound children, all bodies */
 #define AK_RIGID_SCENE_MAX_STEPS 1000000L
 #define AK_RIGID_SCENE_MAX_SUBSTEPS 1000L
 #define AK_RIGID_SCENE_MAX_FILE_SIZE ((size_t)64 << 20)
@@ -338,6 +420,15 @@ typedef struct ak_rigid_scene {
     size_t body_count;
     ak_rigid_joint_desc* joints; /* [joint_count]; body indices into bodies */
     size_t joint_count;
+    ak_vec3* points;             /* [point_count]: the hulls' points and the meshes' vertices
+                                    (bodies' shape.points / shape.vertices point here) */
+    size_t point_count, point_cap;
+    float* heights;              /* [height_count]: the heightfields' samples */
+    size_t height_count, height_cap;
+    uint32_t* indices;           /* [index_count]: the triangle meshes' indices */
+    size_t index_count, index_cap;
+    struct ak_rigid_child* children; /* [child_count]: the compounds' children */
+    size_t child_count, child_cap;
     ak_rigid_model_desc model;   /* damping and contact offset; its bodies and joints spans are
                                     left empty (ak_rigid_scene_run_init fills a copy) */
     ak_vec3 gravity;             /* m/s^2; default (0, -9.81, 0) */

@@ -76,17 +76,11 @@ static ak_result check_friction(float f) {
     return AK_OK;
 }
 
-static ak_result check_body(const ak_rigid_body_desc* b) {
-    const ak_rigid_shape* s = &b->shape;
+static ak_result check_shape(const ak_rigid_shape* s, int depth) {
     if ((unsigned)s->type >= AK_RIGID_SHAPE_COUNT) return AK_ERR_BAD_ARG;
     if (!ak_finitef(s->radius) || !vec_finite(s->half_extents) || !ak_finitef(s->half_height) ||
-        !vec_finite(s->normal) || !vec_finite(b->position) || !ak_quat_is_finite(b->orientation) ||
-        !vec_finite(b->velocity) || !vec_finite(b->angular_velocity) || !ak_finitef(b->density) ||
-        !ak_finitef(b->mass) || !ak_finitef(b->restitution))
+        !vec_finite(s->normal))
         return AK_ERR_BAD_DATA;
-    ak_result r = check_friction(b->friction);
-    if (r == AK_OK) r = check_friction(b->dynamic_friction);
-    if (r != AK_OK) return r;
     switch (s->type) {
     case AK_RIGID_SPHERE:
         if (!(s->radius > 0.0f)) return AK_ERR_BAD_ARG;
@@ -98,11 +92,168 @@ static ak_result check_body(const ak_rigid_body_desc* b) {
     case AK_RIGID_CAPSULE:
         if (!(s->radius > 0.0f) || s->half_height < 0.0f) return AK_ERR_BAD_ARG;
         break;
+    case AK_RIGID_HEIGHTFIELD:
+    case AK_RIGID_TRIMESH:
+        return depth > 0 ? AK_ERR_BAD_ARG : akp_rigid_mesh_check(s);
+    case AK_RIGID_HULL:
+        if (s->points.count < 4 || s->points.count > AK_RIGID_HULL_MAX_POINTS) return AK_ERR_BAD_ARG;
+        if (!s->points.ptr) return AK_ERR_NULL_ARG;
+        for (size_t i = 0; i < s->points.count; ++i)
+            if (!vec_finite(s->points.ptr[i])) return AK_ERR_BAD_DATA;
+        break;
+    case AK_RIGID_COMPOUND:
+        /* children are one level deep: no compound or static-only shape inside */
+        if (depth > 0 || s->child_count == 0 || s->child_count > AK_RIGID_COMPOUND_MAX_CHILDREN)
+            return AK_ERR_BAD_ARG;
+        if (!s->children) return AK_ERR_NULL_ARG;
+        for (size_t i = 0; i < s->child_count; ++i) {
+            const ak_rigid_child* c = &s->children[i];
+            if (c->shape.type == AK_RIGID_PLANE) return AK_ERR_BAD_ARG;
+            if (!vec_finite(c->position) || !ak_quat_is_finite(c->orientation)) return AK_ERR_BAD_DATA;
+            ak_result r = check_shape(&c->shape, depth + 1);
+            if (r != AK_OK) return r;
+        }
+        break;
     default:
+        if (depth > 0) return AK_ERR_BAD_ARG;
         break;
     }
+    return AK_OK;
+}
+
+static ak_result check_body(const ak_rigid_body_desc* b) {
+    if (!vec_finite(b->position) || !ak_quat_is_finite(b->orientation) ||
+        !vec_finite(b->velocity) || !vec_finite(b->angular_velocity) || !ak_finitef(b->density) ||
+        !ak_finitef(b->mass) || !ak_finitef(b->restitution))
+        return AK_ERR_BAD_DATA;
+    ak_result r = check_shape(&b->shape, 0);
+    if (r != AK_OK) return r;
+    r = check_friction(b->friction);
+    if (r == AK_OK) r = check_friction(b->dynamic_friction);
+    if (r != AK_OK) return r;
     if (b->density < 0.0f || b->mass < 0.0f || b->restitution < 0.0f || b->restitution > 1.0f)
         return AK_ERR_BAD_ARG;
+    return AK_OK;
+}
+
+static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
+
+static size_t compound_size(const ak_rigid_shape* s) {
+    size_t total = align16(sizeof(akp_compound)) + align16(s->child_count * sizeof(rigid_body)) +
+                   align16(s->child_count * sizeof(rigid_pose));
+    for (size_t i = 0; i < s->child_count; ++i)
+        if (s->children[i].shape.type == AK_RIGID_HULL)
+            total += akp_rigid_hull_size(s->children[i].shape.points.count);
+    return total;
+}
+
+static size_t compound_scratch_size(const ak_rigid_shape* s) {
+    size_t most = 0;
+    for (size_t i = 0; i < s->child_count; ++i)
+        if (s->children[i].shape.type == AK_RIGID_HULL) {
+            size_t k = akp_rigid_hull_scratch_size(s->children[i].shape.points.count);
+            if (k > most) most = k;
+        }
+    return most;
+}
+
+static float shape_bound(const ak_rigid_shape* s, const akp_hull* h) {
+    switch (s->type) {
+    case AK_RIGID_SPHERE:
+        return s->radius;
+    case AK_RIGID_BOX:
+        return ak_vec3_length(s->half_extents);
+    case AK_RIGID_CAPSULE:
+        return s->radius + s->half_height;
+    case AK_RIGID_HULL:
+        return h->bound_radius;
+    default:
+        return INFINITY;
+    }
+}
+
+/* Build a compound's children into mem: each child's volume, centre and inertia summed by the
+ * parallel axis theorem (one density), then the principal frame; the children re-expressed in
+ * the body frame. */
+static ak_result compound_build(const ak_rigid_shape* s, unsigned char* mem, void* scratch,
+                                akp_compound** out) {
+    akp_compound* c = (akp_compound*)mem;
+    unsigned char* p = mem + align16(sizeof(akp_compound));
+    rigid_body* kids = (rigid_body*)p;
+    p += align16(s->child_count * sizeof(rigid_body));
+    rigid_pose* poses = (rigid_pose*)p;
+    p += align16(s->child_count * sizeof(rigid_pose));
+    double vol = 0.0, cm[3] = {0, 0, 0};
+    double vols[AK_RIGID_COMPOUND_MAX_CHILDREN];
+    ak_vec3 ipms[AK_RIGID_COMPOUND_MAX_CHILDREN];
+    for (size_t i = 0; i < s->child_count; ++i) {
+        const ak_rigid_child* ch = &s->children[i];
+        rigid_body* k = &kids[i];
+        memset(k, 0, sizeof *k);
+        k->shape = ch->shape;
+        ak_quat q = ak_quat_dot(ch->orientation, ch->orientation) == 0.0f
+                        ? ak_quat_identity()
+                        : ak_quat_normalize(ch->orientation);
+        poses[i] = (rigid_pose){ch->position, q};
+        if (ch->shape.type == AK_RIGID_HULL) {
+            akp_hull* h = NULL;
+            const char* why;
+            ak_result r = akp_rigid_hull_build(ch->shape.points, p, scratch, &h, &why);
+            if (r != AK_OK) return r;
+            p += akp_rigid_hull_size(ch->shape.points.count);
+            k->hull = h;
+            k->shape.points = (ak_vec3_cspan){h->verts, h->nv};
+            poses[i].x = ak_vec3_add(ch->position, ak_quat_rotate(q, h->centroid));
+            poses[i].q = ak_quat_normalize(ak_quat_mul(q, h->frame));
+            vols[i] = h->volume;
+            ipms[i] = h->inertia_per_mass;
+        } else {
+            shape_unit_mass(&ch->shape, &vols[i], &ipms[i]);
+        }
+        k->shape.children = NULL;
+        k->shape.child_count = 0;
+        k->bound_radius = shape_bound(&k->shape, k->hull);
+        vol += vols[i];
+        cm[0] += vols[i] * poses[i].x.x, cm[1] += vols[i] * poses[i].x.y, cm[2] += vols[i] * poses[i].x.z;
+    }
+    if (!(vol > 0.0)) return AK_ERR_BAD_ARG;
+    for (int k = 0; k < 3; ++k) cm[k] /= vol;
+    /* inertia per unit density about the centre of mass */
+    double in[3][3] = {{0}};
+    for (size_t i = 0; i < s->child_count; ++i) {
+        ak_mat3 r = ak_mat3_from_quat(poses[i].q);
+        double d[3] = {poses[i].x.x - cm[0], poses[i].x.y - cm[1], poses[i].x.z - cm[2]};
+        double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        const float* ip = &ipms[i].x;
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) {
+                /* R diag(I) R^T + m (|d|^2 E - d d^T) */
+                double rot = 0.0;
+                for (int k = 0; k < 3; ++k) rot += ak_mat3_at(&r, a, k) * ip[k] * ak_mat3_at(&r, b, k);
+                in[a][b] += vols[i] * (rot + (a == b ? dd : 0.0) - d[a] * d[b]);
+            }
+    }
+    ak_quat frame;
+    ak_vec3 moments;
+    akp_rigid_principal(in, &frame, &moments);
+    ak_quat to_body = ak_quat_conjugate(frame);
+    ak_vec3 centroid = ak_vec3_make((float)cm[0], (float)cm[1], (float)cm[2]);
+    float bound = 0.0f;
+    for (size_t i = 0; i < s->child_count; ++i) {
+        poses[i].x = ak_quat_rotate(to_body, ak_vec3_sub(poses[i].x, centroid));
+        poses[i].q = ak_quat_normalize(ak_quat_mul(to_body, poses[i].q));
+        bound = ak_maxf(bound, ak_vec3_length(poses[i].x) + kids[i].bound_radius);
+    }
+    memset(c, 0, sizeof *c);
+    c->count = (uint32_t)s->child_count;
+    c->kids = kids;
+    c->poses = poses;
+    c->centroid = centroid;
+    c->frame = frame;
+    c->volume = vol;
+    c->inertia_per_mass = ak_vec3_scale(moments, (float)(1.0 / vol));
+    c->bound_radius = bound;
+    *out = c;
     return AK_OK;
 }
 
@@ -148,10 +299,42 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
     size_t bodies_size = ((n * sizeof(rigid_body)) + 15) & ~(size_t)15;
     size_t descs_size = ((n * sizeof(ak_rigid_body_desc)) + 15) & ~(size_t)15;
     size_t joints_size = ((nj * sizeof(rigid_joint)) + 15) & ~(size_t)15;
-    size_t total = head + bodies_size + descs_size + joints_size + n * sizeof(uint32_t);
+    size_t planes_size = ((n * sizeof(uint32_t)) + 15) & ~(size_t)15;
+    size_t hulls_size = 0, hull_scratch_size = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const ak_rigid_shape* s = &desc->bodies.ptr[i].shape;
+        if (s->type != AK_RIGID_HULL) continue;
+        hulls_size += akp_rigid_hull_size(s->points.count);
+        size_t ss = akp_rigid_hull_scratch_size(s->points.count);
+        if (ss > hull_scratch_size) hull_scratch_size = ss;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const ak_rigid_shape* s = &desc->bodies.ptr[i].shape;
+        if (s->type != AK_RIGID_COMPOUND) continue;
+        hulls_size += compound_size(s);
+        size_t ss = compound_scratch_size(s);
+        if (ss > hull_scratch_size) hull_scratch_size = ss;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const ak_rigid_shape* s = &desc->bodies.ptr[i].shape;
+        if (s->type != AK_RIGID_HEIGHTFIELD && s->type != AK_RIGID_TRIMESH) continue;
+        hulls_size += akp_rigid_mesh_size(s);
+        size_t ss = akp_rigid_mesh_scratch_size(s);
+        if (ss > hull_scratch_size) hull_scratch_size = ss;
+    }
+    size_t total = head + bodies_size + descs_size + joints_size + planes_size + hulls_size;
     unsigned char* mem = al.alloc(total, al.user);
     if (!mem) return AK_ERR_NO_MEMORY;
     memset(mem, 0, total);
+    void* hull_scratch = NULL;
+    if (hull_scratch_size) {
+        hull_scratch = al.alloc(hull_scratch_size, al.user);
+        if (!hull_scratch) {
+            al.free(mem, al.user);
+            return AK_ERR_NO_MEMORY;
+        }
+    }
+    unsigned char* hull_mem = mem + head + bodies_size + descs_size + joints_size + planes_size;
     ak_rigid_model* m = (ak_rigid_model*)mem;
     m->alloc = al;
     m->body_count = n;
@@ -186,6 +369,57 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         double volume;
         ak_vec3 ipm;
         shape_unit_mass(&d.shape, &volume, &ipm);
+        if (d.shape.type == AK_RIGID_HULL) {
+            akp_hull* h = NULL;
+            const char* problem;
+            ak_result hr = akp_rigid_hull_build(d.shape.points, hull_mem, hull_scratch, &h, &problem);
+            if (hr != AK_OK) {
+                if (hull_scratch) al.free(hull_scratch, al.user);
+                al.free(mem, al.user);
+                return hr;
+            }
+            hull_mem += akp_rigid_hull_size(d.shape.points.count);
+            b->hull = h;
+            volume = h->volume;
+            ipm = h->inertia_per_mass;
+            /* the desc places the shape frame: resolve it to the body frame (centre of mass,
+             * principal axes) */
+            d.position = ak_vec3_add(d.position, ak_quat_rotate(d.orientation, h->centroid));
+            d.orientation = ak_quat_normalize(ak_quat_mul(d.orientation, h->frame));
+            d.shape.points = (ak_vec3_cspan){h->verts, h->nv};
+            b->shape = d.shape;
+        }
+        if (d.shape.type == AK_RIGID_COMPOUND) {
+            akp_compound* c = NULL;
+            ak_result cr = compound_build(&d.shape, hull_mem, hull_scratch, &c);
+            if (cr != AK_OK) {
+                if (hull_scratch) al.free(hull_scratch, al.user);
+                al.free(mem, al.user);
+                return cr;
+            }
+            hull_mem += compound_size(&d.shape);
+            b->compound = c;
+            volume = c->volume;
+            ipm = c->inertia_per_mass;
+            d.position = ak_vec3_add(d.position, ak_quat_rotate(d.orientation, c->centroid));
+            d.orientation = ak_quat_normalize(ak_quat_mul(d.orientation, c->frame));
+            d.shape.children = NULL; /* the caller's; the model's children are internal */
+            d.shape.child_count = 0;
+            b->shape = d.shape;
+        }
+        if (d.shape.type == AK_RIGID_HEIGHTFIELD || d.shape.type == AK_RIGID_TRIMESH) {
+            akp_mesh* me = akp_rigid_mesh_build(&d.shape, hull_mem, hull_scratch);
+            hull_mem += akp_rigid_mesh_size(&d.shape);
+            b->mesh = me;
+            d.is_static = true;
+            if (me->is_heightfield) {
+                d.shape.heights = (ak_f32_cspan){me->heights, (size_t)me->rows * me->cols};
+            } else {
+                d.shape.vertices = (ak_vec3_cspan){me->verts, me->nv};
+                d.shape.indices = (ak_u32_cspan){me->tris, 3 * (size_t)me->nt};
+            }
+            b->shape = d.shape;
+        }
         switch (d.shape.type) {
         case AK_RIGID_SPHERE:
             b->bound_radius = d.shape.radius;
@@ -195,6 +429,16 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             break;
         case AK_RIGID_CAPSULE:
             b->bound_radius = d.shape.radius + d.shape.half_height;
+            break;
+        case AK_RIGID_HULL:
+            b->bound_radius = b->hull->bound_radius;
+            break;
+        case AK_RIGID_HEIGHTFIELD:
+        case AK_RIGID_TRIMESH:
+            b->bound_radius = b->mesh->bound_radius;
+            break;
+        case AK_RIGID_COMPOUND:
+            b->bound_radius = b->compound->bound_radius;
             break;
         default:
             b->bound_radius = INFINITY;
@@ -210,6 +454,7 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             if (d.mass > 0.0f && volume > 0.0) d.density = (float)(mass / volume);
             d.mass = (float)mass;
             if (!(mass > 0.0) || !isfinite((float)mass)) {
+                if (hull_scratch) al.free(hull_scratch, al.user);
                 al.free(mem, al.user);
                 return AK_ERR_BAD_ARG;
             }
@@ -219,12 +464,14 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
             b->inv_inertia =
                 ak_vec3_make(1.0f / b->inertia.x, 1.0f / b->inertia.y, 1.0f / b->inertia.z);
             if (!vec_finite(b->inv_inertia)) {
+                if (hull_scratch) al.free(hull_scratch, al.user);
                 al.free(mem, al.user);
                 return AK_ERR_BAD_ARG;
             }
         }
         m->descs[i] = d;
     }
+    if (hull_scratch) al.free(hull_scratch, al.user);
     for (size_t i = 0; i < nj; ++i) {
         const ak_rigid_joint_desc* jd = &desc->joints.ptr[i];
         rigid_joint* j = &m->joints[i];
@@ -284,6 +531,29 @@ float ak_rigid_body_mass(const ak_rigid_model* model, size_t i) {
 
 ak_vec3 ak_rigid_body_inertia(const ak_rigid_model* model, size_t i) {
     return model && i < model->body_count ? model->bodies[i].inertia : ak_vec3_zero();
+}
+
+ak_transform ak_rigid_body_shape_frame(const ak_rigid_model* model, size_t i) {
+    ak_transform t = ak_transform_identity();
+    if (!model || i >= model->body_count) return t;
+    const rigid_body* b = &model->bodies[i];
+    if (!b->hull && !b->compound) return t;
+    ak_quat frame = b->hull ? b->hull->frame : b->compound->frame;
+    ak_vec3 centroid = b->hull ? b->hull->centroid : b->compound->centroid;
+    t.rotation = ak_quat_conjugate(frame);
+    t.translation = ak_vec3_neg(ak_quat_rotate(t.rotation, centroid));
+    return t;
+}
+
+double ak_rigid_body_volume(const ak_rigid_model* model, size_t i) {
+    if (!model || i >= model->body_count) return 0.0;
+    const rigid_body* b = &model->bodies[i];
+    if (b->hull) return b->hull->volume;
+    if (b->compound) return b->compound->volume;
+    double v;
+    ak_vec3 ipm;
+    shape_unit_mass(&b->shape, &v, &ipm);
+    return v;
 }
 
 ak_rigid_body_desc ak_rigid_body_get_desc(const ak_rigid_model* model, size_t i) {

@@ -6,8 +6,103 @@
 
 #include <animkit/rigid.h>
 
+/* Pose of a body as the narrow phase reads it. */
+typedef struct rigid_pose {
+    ak_vec3 x;
+    ak_quat q;
+} rigid_pose;
+
+/* A convex hull in its body's frame (centre of mass at the origin, principal axes). Faces are
+ * convex polygons (coplanar triangles merged), their vertices counter-clockwise seen from
+ * outside; edges join two faces (f0, f1). */
+typedef struct akp_hull_face {
+    ak_vec3 n;             /* outward unit normal */
+    float d;               /* plane: n . x = d */
+    uint32_t first, count; /* vertex indices idx[first .. first + count) */
+} akp_hull_face;
+
+typedef struct akp_hull_edge {
+    uint32_t v0, v1, f0, f1;
+} akp_hull_edge;
+
+typedef struct akp_hull {
+    const ak_vec3* verts;
+    const akp_hull_face* faces;
+    const uint32_t* idx;
+    const akp_hull_edge* edges;
+    uint32_t nv, nf, ne;
+    ak_vec3 centroid; /* centre of mass in the shape frame */
+    ak_quat frame;    /* principal axes in the shape frame (body = shape * frame) */
+    double volume;    /* m^3 */
+    ak_vec3 inertia_per_mass; /* principal moments / mass (m^2) */
+    float bound_radius;       /* max |vertex| */
+} akp_hull;
+
+/* Bytes akp_rigid_hull_build writes for `count` points (an upper bound, 16-byte multiple) and
+ * the scratch it needs. */
+size_t akp_rigid_hull_size(size_t count);
+size_t akp_rigid_hull_scratch_size(size_t count);
+/* Build the hull of points into mem (akp_rigid_hull_size bytes, 16-aligned) with scratch
+ * (akp_rigid_hull_scratch_size bytes, 8-aligned); *out_hull points into mem. AK_ERR_BAD_ARG /
+ * AK_ERR_BAD_DATA with *out_problem saying why. */
+ak_result akp_rigid_hull_build(ak_vec3_cspan points, void* mem, void* scratch, akp_hull** out_hull,
+                               const char** out_problem);
+
+/* Principal axes of a symmetric inertia tensor (modified): *out_frame's columns are the axes
+ * (identity when the tensor is diagonal to 1e-6), *out_moments the moments about them. */
+void akp_rigid_principal(double inert[3][3], ak_quat* out_frame, ak_vec3* out_moments);
+
+/* A compound body's children in the body frame (centre of mass, principal axes). */
+typedef struct akp_compound {
+    uint32_t count;
+    struct rigid_body* kids; /* shape, hull and bound radius of each child (no mass) */
+    rigid_pose* poses;       /* each child's body frame in the compound's body frame */
+    ak_vec3 centroid;        /* centre of mass in the shape frame */
+    ak_quat frame;           /* principal axes in the shape frame */
+    double volume;           /* summed over the children (m^3) */
+    ak_vec3 inertia_per_mass;
+    float bound_radius;
+} akp_compound;
+
+/* Distance between two convex shapes by GJK: the closest points pa (on a) and pb (on b) of the
+ * shapes' cores (hull, box, a capsule's segment, a sphere's centre), radii not included. Returns
+ * false when the cores overlap. Exposed for tests. */
+bool akp_rigid_gjk(const ak_rigid_shape* sa, const akp_hull* ha, rigid_pose pa,
+                   const ak_rigid_shape* sb, const akp_hull* hb, rigid_pose pb,
+                   ak_vec3* out_pa, ak_vec3* out_pb);
+
+/* A static heightfield or triangle mesh in its body's frame (copied into the model). */
+typedef struct akp_bvh_node {
+    ak_vec3 lo, hi;
+    uint32_t first; /* leaf: into order; inner: the left child (the right is first + 1) */
+    uint32_t count; /* triangles of a leaf; 0 for an inner node */
+} akp_bvh_node;
+
+typedef struct akp_mesh {
+    bool is_heightfield;
+    const float* heights; /* [rows * cols] */
+    uint32_t rows, cols;
+    float spacing;
+    float min_height, max_height;
+    const ak_vec3* verts; /* trimesh */
+    const uint32_t* tris; /* [3 * nt] */
+    uint32_t nv, nt;
+    const akp_bvh_node* nodes; /* nodes[0] the root */
+    const uint32_t* order;     /* triangle indices in leaf order */
+    float bound_radius;        /* max distance of the mesh from the body's origin */
+} akp_mesh;
+
+/* Bytes akp_rigid_mesh_build writes for a heightfield or trimesh shape (16-byte multiple), the
+ * scratch it needs, and the build into mem (16-aligned). The shape must be valid (checked by
+ * akp_rigid_mesh_check). */
+size_t akp_rigid_mesh_size(const ak_rigid_shape* s);
+size_t akp_rigid_mesh_scratch_size(const ak_rigid_shape* s);
+akp_mesh* akp_rigid_mesh_build(const ak_rigid_shape* s, void* mem, void* scratch);
+ak_result akp_rigid_mesh_check(const ak_rigid_shape* s);
+
 /* What the solver reads per body, resolved once at build time. */
 typedef struct rigid_body {
+    /* (a compound's children are rigid_body too: only shape, hull and bound_radius are set) */
     ak_rigid_shape shape;   /* resolved (plane normal normalised) */
     float inv_mass;         /* 1/kg; 0 static */
     ak_vec3 inv_inertia;    /* 1/(kg m^2) about the local axes; 0 static */
@@ -18,6 +113,9 @@ typedef struct rigid_body {
     float restitution;
     float bound_radius; /* metres from the centre that holds the shape (planes: INFINITY) */
     uint32_t group;     /* collision group (0: none) */
+    const akp_hull* hull; /* AK_RIGID_HULL: the hull (in the model's allocation); else NULL */
+    const akp_mesh* mesh; /* heightfield, trimesh: the mesh (in the model's allocation) */
+    const akp_compound* compound; /* compound: its children (in the model's allocation) */
 } rigid_body;
 
 /* A joint with its anchors and axes in each body's frame (from the descs' poses). */
@@ -80,11 +178,6 @@ typedef struct rigid_contact {
     float friction, dynamic_friction, restitution;
 } rigid_contact;
 
-/* Pose of a body as the narrow phase reads it. */
-typedef struct rigid_pose {
-    ak_vec3 x;
-    ak_quat q;
-} rigid_pose;
 
 /* Contact points between bodies a and b (a dynamic or both any; never two planes) into out (at
  * most cap, returns how many were written; *out_wanted counts every point found). n of each

@@ -29,6 +29,18 @@ void ak_rigid_scene_free(ak_rigid_scene* s) {
     if (!s) return;
     free(s->bodies);
     free(s->joints);
+    free(s->points);
+    free(s->heights);
+    free(s->indices);
+    s->points = NULL;
+    s->point_count = s->point_cap = 0;
+    s->heights = NULL;
+    s->height_count = s->height_cap = 0;
+    s->indices = NULL;
+    s->index_count = s->index_cap = 0;
+    free(s->children);
+    s->children = NULL;
+    s->child_count = s->child_cap = 0;
     s->bodies = NULL;
     s->body_count = 0;
     s->joints = NULL;
@@ -45,8 +57,134 @@ static ak_rigid_body_desc body_default(void) {
     return b;
 }
 
-static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigid_body_desc* b) {
-    char sp[96];
+/* An array of [x, y, z] under key into the scene's points array (counted before parsing, so
+ * the array is big enough unless the file lied: then an error). */
+static bool read_vec3s(akp_json* j, const cJSON* sh, const char* sp, const char* key, size_t min,
+                       size_t max, ak_rigid_scene* sc, ak_vec3_cspan* out_span) {
+    size_t n = 0;
+    const cJSON* e = akp_json_array(j, sh, sp, key, max, &n);
+    if (j->failed) return false;
+    if (n < min)
+        return akp_json_fail(j, sp, key, "is required: at least %zu [x, y, z] points", min);
+    if (sc->point_count + n > sc->point_cap)
+        return akp_json_fail(j, sp, key, "more points than the scene may have (%u)",
+                             AK_RIGID_SCENE_MAX_POINTS);
+    ak_vec3* out = sc->points + sc->point_count;
+    char pp[128];
+    akp_json_key(pp, sizeof pp, sp, key);
+    for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+        float v[3] = {0, 0, 0};
+        size_t m = (size_t)cJSON_GetArraySize(e);
+        const cJSON* c = cJSON_IsArray(e) ? e->child : NULL;
+        for (size_t i = 0; c && i < 3 && m == 3; c = c->next, ++i) {
+            if (!cJSON_IsNumber(c) || !(fabs(c->valuedouble) <= 1e4)) break;
+            v[i] = (float)c->valuedouble;
+            if (i == 2) m = 0; /* all three read */
+        }
+        if (m != 0) {
+            char ip[160];
+            akp_json_index(ip, sizeof ip, pp, k);
+            return akp_json_fail(j, ip, "", "expected [x, y, z], each finite and within 1e4 m");
+        }
+        out[k] = ak_vec3_make(v[0], v[1], v[2]);
+    }
+    sc->point_count += n;
+    *out_span = (ak_vec3_cspan){out, n};
+    return true;
+}
+
+/* An array of numbers in [lo, hi] (whole numbers when integral) into out (count known). */
+static bool read_numbers(akp_json* j, const cJSON* e, const char* sp, const char* key, double lo,
+                         double hi, bool integral, float* out_f, uint32_t* out_u) {
+    char pp[128];
+    akp_json_key(pp, sizeof pp, sp, key);
+    for (size_t k = 0; e; e = e->next, ++k) {
+        double x = cJSON_IsNumber(e) ? e->valuedouble : NAN;
+        if (!(x >= lo && x <= hi) || (integral && x != floor(x))) {
+            char ip[160];
+            akp_json_index(ip, sizeof ip, pp, k);
+            return akp_json_fail(j, ip, "", integral ? "expected a whole number in [%g, %g]"
+                                                     : "expected a number in [%g, %g]",
+                                 lo, hi);
+        }
+        if (out_f) out_f[k] = (float)x;
+        if (out_u) out_u[k] = (uint32_t)x;
+    }
+    return true;
+}
+
+static void parse_heightfield(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_scene* sc,
+                              ak_rigid_shape* s) {
+    long rows = 0, cols = 0;
+    s->spacing = 1.0f;
+    akp_json_int(j, sh, sp, "rows", 2, 1L << 24, &rows);
+    akp_json_int(j, sh, sp, "cols", 2, 1L << 24, &cols);
+    akp_json_float(j, sh, sp, "spacing", 1e-4f, 1e4f, &s->spacing);
+    if (j->failed) return;
+    if (rows == 0 || cols == 0) {
+        akp_json_fail(j, sp, rows == 0 ? "rows" : "cols", "is required for a heightfield (>= 2)");
+        return;
+    }
+    if ((uint64_t)rows * (uint64_t)cols > AK_RIGID_HEIGHTFIELD_MAX_SAMPLES) {
+        akp_json_fail(j, sp, "rows", "rows x cols is over %u samples", AK_RIGID_HEIGHTFIELD_MAX_SAMPLES);
+        return;
+    }
+    size_t want = (size_t)rows * (size_t)cols, n = 0;
+    const cJSON* e = akp_json_array(j, sh, sp, "heights", AK_RIGID_HEIGHTFIELD_MAX_SAMPLES, &n);
+    if (j->failed) return;
+    if (n != want) {
+        akp_json_fail(j, sp, "heights", "expected rows x cols = %zu numbers, found %zu", want, n);
+        return;
+    }
+    if (sc->height_count + n > sc->height_cap) {
+        akp_json_fail(j, sp, "heights", "more heights than the scene may have");
+        return;
+    }
+    float* out = sc->heights + sc->height_count;
+    if (!read_numbers(j, e, sp, "heights", -1e4, 1e4, false, out, NULL)) return;
+    sc->height_count += n;
+    s->rows = (uint32_t)rows, s->cols = (uint32_t)cols;
+    s->heights = (ak_f32_cspan){out, n};
+}
+
+static void parse_trimesh(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_scene* sc,
+                          ak_rigid_shape* s) {
+    if (!read_vec3s(j, sh, sp, "vertices", 3, AK_RIGID_SCENE_MAX_POINTS, sc, &s->vertices)) return;
+    size_t n = 0;
+    const cJSON* e =
+        akp_json_array(j, sh, sp, "indices", 3 * (size_t)AK_RIGID_TRIMESH_MAX_TRIANGLES, &n);
+    if (j->failed) return;
+    if (n == 0 || n % 3) {
+        akp_json_fail(j, sp, "indices", "is required: 3 vertex indices per triangle");
+        return;
+    }
+    if (sc->index_count + n > sc->index_cap) {
+        akp_json_fail(j, sp, "indices", "more indices than the scene may have");
+        return;
+    }
+    uint32_t* out = sc->indices + sc->index_count;
+    if (!read_numbers(j, e, sp, "indices", 0.0, (double)s->vertices.count - 1.0, true, NULL, out))
+        return;
+    sc->index_count += n;
+    s->indices = (ak_u32_cspan){out, n};
+}
+
+static void parse_points(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_scene* sc,
+                         ak_rigid_shape* s) {
+    if (!read_vec3s(j, sh, sp, "points", 4, AK_RIGID_HULL_MAX_POINTS, sc, &s->points)) return;
+    const char* problem = "";
+    if (ak_rigid_hull_check(s->points, &problem) != AK_OK)
+        akp_json_fail(j, sp, "points", "%s", problem);
+}
+
+static void parse_children(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_scene* sc,
+                           ak_rigid_shape* s);
+
+/* The "shape" member of obj (a body, or a compound's child when depth is 1) into *s; *is_static
+ * (may be NULL) set for the static-only shapes. */
+static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigid_scene* sc,
+                        ak_rigid_shape* s, bool* is_static, int depth) {
+    char sp[128];
     akp_json_key(sp, sizeof sp, path, "shape");
     const cJSON* sh = akp_json_member(j, obj, path, "shape");
     if (j->failed) return;
@@ -54,34 +192,44 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
         akp_json_fail(j, path, "shape", "is required");
         return;
     }
-    static const char* const keys[] = {"type",   "radius", "half_extents", "half_height", "points",
-                                       "normal", NULL};
-    static const char* const types[] = {"sphere", "box", "capsule", "hull", "plane", NULL};
+    static const char* const keys[] = {"type",   "radius",  "half_extents", "half_height",
+                                       "points", "normal",  "rows",         "cols",
+                                       "spacing", "heights", "vertices",    "indices",
+                                       "children", NULL};
+    static const char* const types[] = {"sphere", "box",         "capsule", "hull",
+                                        "plane",  "heightfield", "trimesh", "compound", NULL};
     akp_json_object(j, sh, sp, keys);
     int type = -1;
     akp_json_enum(j, sh, sp, "type", types, &type);
     if (j->failed) return;
     if (type < 0) {
-        akp_json_fail(j, sp, "type", "is required (sphere, box, capsule, hull or plane)");
+        akp_json_fail(j, sp, "type",
+                      "is required (sphere, box, capsule, hull, plane, heightfield, trimesh or "
+                      "compound)");
         return;
     }
-    if (type == 3) {
-        akp_json_fail(j, sp, "type", "\"hull\" is not supported yet (sphere, box, capsule, plane)");
+    if (depth > 0 && type > 3) {
+        akp_json_fail(j, sp, "type", "a compound's child is a sphere, box, capsule or hull");
         return;
     }
     /* which keys each type takes: the others are refused so a typo cannot pass unnoticed */
-    static const char* const takes[5] = {"radius", "half_extents", "radius half_height", "points",
-                                         "normal"};
+    static const char* const takes[8] = {"radius",           "half_extents",
+                                         "radius half_height", "points",
+                                         "normal",           "rows cols spacing heights",
+                                         "vertices indices", "children"};
     for (int k = 1; keys[k]; ++k)
         if (cJSON_GetObjectItemCaseSensitive(sh, keys[k]) && !strstr(takes[type], keys[k])) {
             akp_json_fail(j, sp, keys[k], "does not apply to a %s", types[type]);
             return;
         }
-    ak_rigid_shape* s = &b->shape;
     s->type = type == 0   ? AK_RIGID_SPHERE
               : type == 1 ? AK_RIGID_BOX
               : type == 2 ? AK_RIGID_CAPSULE
-                          : AK_RIGID_PLANE;
+              : type == 3 ? AK_RIGID_HULL
+              : type == 4 ? AK_RIGID_PLANE
+              : type == 5 ? AK_RIGID_HEIGHTFIELD
+              : type == 6 ? AK_RIGID_TRIMESH
+                          : AK_RIGID_COMPOUND;
     s->radius = -1.0f;
     s->half_height = 0.0f;
     s->half_extents = ak_vec3_make(-1.0f, -1.0f, -1.0f);
@@ -92,6 +240,11 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
     akp_json_floats(j, sh, sp, "half_extents", 3, 1e-4f, 1e4f, he);
     s->half_extents = ak_vec3_make(he[0], he[1], he[2]);
     akp_json_vec3(j, sh, sp, "normal", &s->normal);
+    if (!j->failed && type == 3) parse_points(j, sh, sp, sc, s);
+    if (!j->failed && type == 5) parse_heightfield(j, sh, sp, sc, s);
+    if (!j->failed && type == 6) parse_trimesh(j, sh, sp, sc, s);
+    if (!j->failed && type == 7) parse_children(j, sh, sp, sc, s);
+    if (!j->failed && (type == 5 || type == 6) && is_static) *is_static = true;
     if (j->failed) return;
     if ((type == 0 || type == 2) && s->radius < 0.0f)
         akp_json_fail(j, sp, "radius", "is required for a %s", types[type]);
@@ -101,7 +254,52 @@ static void parse_shape(akp_json* j, const cJSON* obj, const char* path, ak_rigi
         akp_json_fail(j, sp, "normal", "is zero");
 }
 
-static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_body_desc* b) {
+static void parse_children(akp_json* j, const cJSON* sh, const char* sp, ak_rigid_scene* sc,
+                           ak_rigid_shape* s) {
+    size_t n = 0;
+    const cJSON* e = akp_json_array(j, sh, sp, "children", AK_RIGID_COMPOUND_MAX_CHILDREN, &n);
+    if (j->failed) return;
+    if (n == 0) {
+        akp_json_fail(j, sp, "children", "is required for a compound: 1 to %u children",
+                      AK_RIGID_COMPOUND_MAX_CHILDREN);
+        return;
+    }
+    if (sc->child_count + n > sc->child_cap) {
+        akp_json_fail(j, sp, "children", "more children than the scene may have");
+        return;
+    }
+    ak_rigid_child* out = sc->children + sc->child_count;
+    sc->child_count += n;
+    char cp[128];
+    akp_json_key(cp, sizeof cp, sp, "children");
+    for (size_t k = 0; e && !j->failed; e = e->next, ++k) {
+        char ip[160];
+        akp_json_index(ip, sizeof ip, cp, k);
+        if (!cJSON_IsObject(e)) {
+            akp_json_fail(j, ip, "", "expected an object with \"shape\"");
+            return;
+        }
+        static const char* const keys[] = {"shape", "position", "orientation", NULL};
+        akp_json_object(j, e, ip, keys);
+        ak_rigid_child* c = &out[k];
+        memset(c, 0, sizeof *c);
+        c->orientation = ak_quat_identity();
+        parse_shape(j, e, ip, sc, &c->shape, NULL, 1);
+        akp_json_vec3(j, e, ip, "position", &c->position);
+        float q[4] = {0, 0, 0, 1};
+        akp_json_floats(j, e, ip, "orientation", 4, -1e3f, 1e3f, q);
+        if (!j->failed && q[0] == 0.0f && q[1] == 0.0f && q[2] == 0.0f && q[3] == 0.0f)
+            akp_json_fail(j, ip, "orientation", "is the zero quaternion");
+        c->orientation = (ak_quat){q[0], q[1], q[2], q[3]};
+        if (!j->failed && ak_vec3_length(c->position) > 1e4f)
+            akp_json_fail(j, ip, "position", "is over 1e4 m");
+    }
+    s->children = out;
+    s->child_count = n;
+}
+
+static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_scene* sc,
+                       ak_rigid_body_desc* b) {
     if (!cJSON_IsObject(e)) {
         akp_json_fail(j, path, "", "expected an object with at least \"shape\"");
         return;
@@ -111,7 +309,7 @@ static void parse_body(akp_json* j, const cJSON* e, const char* path, ak_rigid_b
         "friction", "restitution", "static",      NULL};
     akp_json_object(j, e, path, keys);
     *b = body_default();
-    parse_shape(j, e, path, b);
+    parse_shape(j, e, path, sc, &b->shape, &b->is_static, 0);
     akp_json_vec3(j, e, path, "position", &b->position);
     float q[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     akp_json_floats(j, e, path, "orientation", 4, -1e3f, 1e3f, q);
@@ -213,10 +411,63 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
             s->bodies = calloc(n, sizeof *s->bodies);
             if (!s->bodies) akp_json_fail(&j, "", "bodies", "out of memory");
         }
+        /* the hulls' points, the meshes' vertices, heights and indices: counted first (each
+         * list is bounded again when it is parsed; here the totals are), one array each */
+        size_t counts[3] = {0, 0, 0};
+        static const char* const lists[4] = {"points", "vertices", "heights", "indices"};
+        size_t kids = 0;
+        for (const cJSON* b = e; b && !j.failed; b = b->next) {
+            const cJSON* sh = cJSON_IsObject(b) ? cJSON_GetObjectItemCaseSensitive(b, "shape") : NULL;
+            const cJSON* ch = cJSON_IsObject(sh) ? cJSON_GetObjectItemCaseSensitive(sh, "children") : NULL;
+            /* the shape, then its children's (at most one more than allowed: parsing refuses) */
+            const cJSON* kid = cJSON_IsArray(ch) ? ch->child : NULL;
+            for (size_t k = 0; k <= AK_RIGID_COMPOUND_MAX_CHILDREN + 1 && cJSON_IsObject(sh); ++k) {
+                for (int l = 0; l < 4; ++l) {
+                    const cJSON* arr = cJSON_GetObjectItemCaseSensitive(sh, lists[l]);
+                    if (cJSON_IsArray(arr)) counts[l < 2 ? 0 : l - 1] += (size_t)cJSON_GetArraySize(arr);
+                }
+                if (!kid) break;
+                ++kids;
+                sh = cJSON_IsObject(kid) ? cJSON_GetObjectItemCaseSensitive(kid, "shape") : NULL;
+                kid = kid->next;
+            }
+        }
+        if (!j.failed && kids > AK_RIGID_SCENE_MAX_CHILDREN)
+            akp_json_fail(&j, "", "bodies", "more compound children than a scene may have (%u)",
+                          AK_RIGID_SCENE_MAX_CHILDREN);
+        if (!j.failed && kids > 0) {
+            s->children = calloc(kids, sizeof *s->children);
+            s->child_cap = kids;
+            if (!s->children) akp_json_fail(&j, "", "bodies", "out of memory");
+        }
+        if (!j.failed && counts[0] > AK_RIGID_SCENE_MAX_POINTS)
+            akp_json_fail(&j, "", "bodies", "more points and vertices than a scene may have (%u)",
+                          AK_RIGID_SCENE_MAX_POINTS);
+        if (!j.failed && counts[1] > AK_RIGID_HEIGHTFIELD_MAX_SAMPLES)
+            akp_json_fail(&j, "", "bodies", "more heights than a scene may have (%u)",
+                          AK_RIGID_HEIGHTFIELD_MAX_SAMPLES);
+        if (!j.failed && counts[2] > 3 * (size_t)AK_RIGID_TRIMESH_MAX_TRIANGLES)
+            akp_json_fail(&j, "", "bodies", "more triangle indices than a scene may have (%u)",
+                          3 * AK_RIGID_TRIMESH_MAX_TRIANGLES);
+        if (!j.failed && counts[0] > 0) {
+            s->points = calloc(counts[0], sizeof *s->points);
+            s->point_cap = counts[0];
+            if (!s->points) akp_json_fail(&j, "", "bodies", "out of memory");
+        }
+        if (!j.failed && counts[1] > 0) {
+            s->heights = calloc(counts[1], sizeof *s->heights);
+            s->height_cap = counts[1];
+            if (!s->heights) akp_json_fail(&j, "", "bodies", "out of memory");
+        }
+        if (!j.failed && counts[2] > 0) {
+            s->indices = calloc(counts[2], sizeof *s->indices);
+            s->index_cap = counts[2];
+            if (!s->indices) akp_json_fail(&j, "", "bodies", "out of memory");
+        }
         for (size_t k = 0; e && !j.failed; e = e->next, ++k) {
             char path[48];
             akp_json_index(path, sizeof path, "bodies", k);
-            parse_body(&j, e, path, &s->bodies[k]);
+            parse_body(&j, e, path, s, &s->bodies[k]);
             s->body_count = k + 1;
         }
         size_t nj = 0;

@@ -22,7 +22,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (ak_rigid_scene_load_bytes(data, size, "fuzz.json", &s, &diag) != AK_OK) {
         /* a failure always says why, in one line that names the file, and leaves no bodies */
         if (strncmp(diag.message, "fuzz.json", 9) != 0 || strchr(diag.message, '\n') ||
-            s.bodies || s.joints || s.body_count || s.joint_count)
+            s.bodies || s.joints || s.body_count || s.joint_count || s.points || s.point_count)
             abort();
         ak_rigid_scene_free(&s);
         return 0;
