@@ -24,8 +24,9 @@
  *   - joints: ball (optional swing cone and twist range), hinge (optional angle limits), fixed,
  *     prismatic (optional distance limits), with compliance, and drives towards a target
  *     relative orientation (XPBD positional and angular constraints, their section 3.3);
- *   - ragdolls: a capsule per bone of a skeleton and a joint per joint with the skeleton's
- *     limits, started from an animated pose (and its velocities), written back as a pose;
+ *   - ragdolls: a capsule per bone of a skeleton (sized from the bone, or fitted to the
+ *     vertices of a skin) and a joint per joint with the skeleton's limits, started from an
+ *     animated pose (and its velocities), written back as a pose;
  *   - sleeping: a connected group of touching or joined bodies whose speeds all stay under the
  *     thresholds for sleep_time seconds is frozen until an awake body touches it;
  *   - deterministic: the same inputs give the same bits (contacts are found and solved in an
@@ -33,7 +34,7 @@
  *     interface's sake but this version runs every phase on the calling thread.
  *
  * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
- * capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
+ * a powered ragdoll that follows an animation, threads, continuous
  * collision detection (a body moving more than its size in one substep can tunnel),
  * collisions with particles or cloth.
  *
@@ -238,6 +239,22 @@ typedef struct ak_rigid_ragdoll_desc {
     float density;                      /* kg/m^3; 0 -> 1000 */
     float friction;                     /* 0 -> 0.5 */
     uint32_t collision_group;           /* the limbs' group (no self-collision); 0 -> 1 */
+    float free_cone_angle;              /* radians: a free joint (glTF's joints have no type)
+                                           becomes a ball whose bone may swing this far from its
+                                           rest direction; 0 -> unlimited */
+    /* Optional: a skinned mesh (a glTF skin and one of its meshes), so each capsule is fitted
+     * to the vertices its bone carries instead of sized from radius_scale (see
+     * ak_rigid_ragdoll_build). All empty -> no skin. */
+    ak_vec3_cspan skin_positions;      /* bind-pose vertices, the mesh's model space */
+    ak_u16_cspan skin_joints;          /* [vertex count * skin_influence_count] skin slots */
+    ak_f32_cspan skin_weights;         /* the same layout */
+    uint32_t skin_influence_count;     /* influences per vertex, 1..8 with a skin */
+    ak_i32_cspan skin_slot_joints;     /* per slot: the skeleton joint it names */
+    ak_mat4_cspan skin_inverse_binds;  /* per slot: its inverse bind matrix */
+    float skin_min_weight;             /* a vertex belongs to its heaviest bone when that weight
+                                          is >= this; 0 -> 0.5 */
+    uint32_t skin_min_vertices;        /* fewer vertices than this on a bone -> radius_scale's
+                                          capsule; 0 -> 8 */
 } ak_rigid_ragdoll_desc;
 
 /* Bodies and joints a ragdoll of this skeleton has: one capsule per joint with children (from
@@ -248,11 +265,17 @@ AK_API size_t ak_rigid_ragdoll_joint_count(const struct ak_skeleton* skeleton);
 
 /* Build a ragdoll's body and joint descs (to put in an ak_rigid_model_desc, after body_offset
  * other bodies) and the joint-to-body map. Skeleton joint types become rigid joints: hinge ->
- * hinge with its limits, ball -> ball with its cone, free -> ball, prism -> prismatic; limits are
- * taken relative to the skeleton's rest pose as the skeleton measures them. Sizes: out_bodies
- * >= body count, out_joints >= joint count, out_bones >= skeleton joint count. Returns
+ * hinge with its limits, ball -> ball with its cone, free -> ball (coned by free_cone_angle),
+ * prism -> prismatic; limits are taken relative to the skeleton's rest pose as the skeleton
+ * measures them. With a skin, each body's capsule is fitted to the vertices whose heaviest
+ * weight (>= skin_min_weight) is its bone's, posed rigidly with the bone at the start pose:
+ * radius = the mean plus one standard deviation of their distances from the bone's line, and the capsule spans their extent along
+ * the bone (so the body's centre may move off the bone's middle). Sizes: out_bodies >= body
+ * count, out_joints >= joint count, out_bones >= skeleton joint count. Returns
  * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_ARG (previous_pose without previous_dt > 0,
- * negative sizes), AK_ERR_BAD_DATA (a non-finite pose). */
+ * negative sizes or angle, a skin with a span missing or an influence count outside 1..8),
+ * AK_ERR_BAD_INDEX (a skin slot or slot joint out of range), AK_ERR_BAD_DATA (a non-finite
+ * pose, skin position, weight or matrix). */
 AK_API ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
                                         ak_rigid_body_desc_span out_bodies,
                                         ak_rigid_joint_desc_span out_joints,
