@@ -1,9 +1,9 @@
 /* Ragdolls dropped onto the ground: builtin:humanoid (typed joints, capsules sized from its
- * bones, or fitted to its skin) and CesiumMan (a glTF: free joints coned by free_cone_angle, capsules fitted to its
- * skin), each started from its walk clip's pose with the velocities of a finite difference of
- * two sampled poses. Checked against the skeleton, not the solver: every written-back joint
- * stays within the skeleton's own limits (ak_skeleton_joint_within_limits) and, for free
- * joints, its bone within the cone of its rest direction, within 2 degrees; no body goes
+ * bones, or fitted to its skin) and CesiumMan (a glTF: free joints coned by free_cone_angle,
+ * capsules fitted to its skin), each started from its walk clip's pose with the velocities of a
+ * finite difference of two sampled poses. Checked against the skeleton, not the solver: every
+ * written-back joint stays within the skeleton's own limits (ak_skeleton_joint_within_limits) and,
+ * for free joints, its bone within the cone of its rest direction, within 2 degrees; no body goes
  * through the ground; the joints hold together; the start velocity of each joint's anchor is
  * the finite difference of the joint's world positions; and the pose read back skins (LBS, on
  * the skinned mesh) to finite vertices that stay above the ground within 3 cm (capsules fitted
@@ -19,11 +19,11 @@
 #define CESIUM "gltf/CesiumMan/glTF-Binary/CesiumMan.glb"
 
 typedef struct drop_opts {
-    bool animated;    /* start from the first clip at 30% of its length, with velocities */
+    bool animated; /* start from the first clip at 30% of its length, with velocities */
     float seconds;
-    bool skin;        /* fit the capsules to the first skinned mesh */
-    float cone;       /* free_cone_angle (rad) */
-    float lift;       /* metres above the ground */
+    bool skin;  /* fit the capsules to the first skinned mesh */
+    float cone; /* free_cone_angle (rad) */
+    float lift; /* metres above the ground */
 } drop_opts;
 
 typedef struct drop_result {
@@ -37,7 +37,7 @@ typedef struct drop_result {
     float max_speed;       /* the anchors' largest start speed (m/s) */
     float mass;            /* kg, the whole ragdoll */
     float min_radius, max_radius; /* of the capsules */
-    float lowest_vertex;   /* lowest skinned vertex at the end (m) */
+    float lowest_vertex;          /* lowest skinned vertex at the end (m) */
     size_t bodies, skinned_vertices;
     bool finite;
 } drop_result;
@@ -68,7 +68,8 @@ static float cone_swing_deg(const ak_skeleton* sk, size_t i, ak_transform local)
     ak_vec3 dir = ak_vec3_zero();
     bool kids = false;
     for (size_t c = i + 1; c < parents.count; ++c)
-        if (parents.ptr[c] == (int16_t)i) dir = ak_vec3_add(dir, rest.ptr[c].translation), kids = true;
+        if (parents.ptr[c] == (int16_t)i)
+            dir = ak_vec3_add(dir, rest.ptr[c].translation), kids = true;
     if (!kids) return -1.0f;
     dir = ak_vec3_length_sq(dir) > 1e-12f ? ak_vec3_normalize(dir) : ak_vec3_make(0, 1, 0);
     ak_quat rel = ak_quat_mul(ak_quat_conjugate(rest.ptr[i].rotation), local.rotation);
@@ -76,20 +77,24 @@ static float cone_swing_deg(const ak_skeleton* sk, size_t i, ak_transform local)
     return ak_degrees(acosf(c));
 }
 
-static void world_positions(const ak_scene* scene, const ak_transform* pose, ak_mat4 root, ak_mat4* world,
-                            size_t n) {
+static void world_positions(const ak_scene* scene, const ak_transform* pose, ak_mat4 root,
+                            ak_mat4* world, size_t n) {
     ak_scene_world_matrices(scene, (ak_transform_cspan){pose, n}, (ak_mat4_span){world, n});
     for (size_t i = 0; i < n; ++i) world[i] = ak_mat4_mul(root, world[i]);
 }
 
 static drop_result drop(const ak_scene* scene, drop_opts o) {
-    drop_result res = {.ok = false, .lowest = INFINITY, .lowest_vertex = INFINITY, .finite = true,
+    drop_result res = {.ok = false,
+                       .lowest = INFINITY,
+                       .lowest_vertex = INFINITY,
+                       .finite = true,
                        .min_radius = INFINITY};
     const ak_skeleton* sk = scene->skeleton;
     size_t n = ak_skeleton_joint_count(sk);
     const ak_scene_mesh* sm = NULL;
     for (size_t i = 0; i < scene->mesh_count && !sm; ++i)
-        if (scene->meshes[i].skin >= 0 && scene->meshes[i].mesh->influence_count) sm = &scene->meshes[i];
+        if (scene->meshes[i].skin >= 0 && scene->meshes[i].mesh->influence_count)
+            sm = &scene->meshes[i];
     const ak_mesh* mesh = sm ? sm->mesh : NULL;
     const ak_scene_skin* skin = sm ? &scene->skins[sm->skin] : NULL;
     size_t nv = mesh ? mesh->vertex_count : 0;
@@ -117,13 +122,19 @@ static drop_result drop(const ak_scene* scene, drop_opts o) {
     if (o.animated && scene->clip_count > 0) {
         const ak_clip* clip = scene->clips[0];
         float t = 0.3f * ak_clip_duration(clip);
-        ak_clip_sample(clip, t, NULL, (ak_transform_span){pose, n}, (ak_f32_span){0}, (ak_f32_span){0});
-        ak_clip_sample(clip, t - dt, NULL, (ak_transform_span){prev, n}, (ak_f32_span){0}, (ak_f32_span){0});
+        ak_clip_sample(clip, t, NULL, (ak_transform_span){pose, n}, (ak_f32_span){0},
+                       (ak_f32_span){0});
+        ak_clip_sample(clip, t - dt, NULL, (ak_transform_span){prev, n}, (ak_f32_span){0},
+                       (ak_f32_span){0});
     }
-    for (size_t i = 0; i < n; ++i) res.start_cone_deg = ak_maxf(res.start_cone_deg, cone_swing_deg(sk, i, pose[i]));
+    for (size_t i = 0; i < n; ++i)
+        res.start_cone_deg = ak_maxf(res.start_cone_deg, cone_swing_deg(sk, i, pose[i]));
     ak_mat4 root = ak_mat4_translation(ak_vec3_make(0.0f, o.lift, 0.0f));
     bodies[0].shape.type = AK_RIGID_PLANE;
-    ak_rigid_ragdoll_desc rd = {.skeleton = sk, .local_pose = {pose, n}, .root = root, .body_offset = 1,
+    ak_rigid_ragdoll_desc rd = {.skeleton = sk,
+                                .local_pose = {pose, n},
+                                .root = root,
+                                .body_offset = 1,
                                 .free_cone_angle = o.cone};
     if (o.animated) rd.previous_pose = (ak_transform_cspan){prev, n}, rd.previous_dt = dt;
     if (o.skin && mesh) {
@@ -136,7 +147,8 @@ static drop_result drop(const ak_scene* scene, drop_opts o) {
         res.skinned_vertices = nv;
     }
     if (ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){bodies + 1, nb - 1},
-                               (ak_rigid_joint_desc_span){joints, nj}, (ak_rigid_ragdoll_bone_span){bones, n}) != AK_OK)
+                               (ak_rigid_joint_desc_span){joints, nj},
+                               (ak_rigid_ragdoll_bone_span){bones, n}) != AK_OK)
         goto done;
     ak_rigid_model_desc md = {.bodies = {bodies, nb}, .joints = {joints, nj}};
     if (ak_rigid_model_create(&md, NULL, &m) != AK_OK) goto done;
@@ -156,7 +168,8 @@ static drop_result drop(const ak_scene* scene, drop_opts o) {
         int b = bones[i].body;
         if (b < 0) continue;
         ak_vec3 p = ak_mat4_get_translation(world[i]);
-        ak_vec3 fd = ak_vec3_scale(ak_vec3_sub(p, ak_mat4_get_translation(world_prev[i])), 1.0f / dt);
+        ak_vec3 fd =
+            ak_vec3_scale(ak_vec3_sub(p, ak_mat4_get_translation(world_prev[i])), 1.0f / dt);
         ak_vec3 va = ak_vec3_add(v[b], ak_vec3_cross(w[b], ak_vec3_sub(p, x[b])));
         res.worst_velocity = ak_maxf(res.worst_velocity, ak_vec3_distance(va, fd));
         res.max_speed = ak_maxf(res.max_speed, ak_vec3_length(fd));
@@ -185,13 +198,16 @@ static drop_result drop(const ak_scene* scene, drop_opts o) {
         }
         for (size_t k = 0; k < nj; ++k) {
             float gap, excess;
-            ak_rigid_joint_error(m, k, (ak_vec3_cspan){x, nb}, (ak_quat_cspan){q, nb}, &gap, &excess);
+            ak_rigid_joint_error(m, k, (ak_vec3_cspan){x, nb}, (ak_quat_cspan){q, nb}, &gap,
+                                 &excess);
             res.worst_gap = ak_maxf(res.worst_gap, gap);
         }
-        ak_rigid_ragdoll_pose(sk, (ak_rigid_ragdoll_bone_cspan){bones, n}, root, (ak_vec3_cspan){x, nb},
-                              (ak_quat_cspan){q, nb}, (ak_transform_cspan){pose, n}, (ak_transform_span){back, n});
+        ak_rigid_ragdoll_pose(sk, (ak_rigid_ragdoll_bone_cspan){bones, n}, root,
+                              (ak_vec3_cspan){x, nb}, (ak_quat_cspan){q, nb},
+                              (ak_transform_cspan){pose, n}, (ak_transform_span){back, n});
         for (size_t i = 0; i < n; ++i) {
-            res.worst_limit_deg = ak_maxf(res.worst_limit_deg, ak_degrees(limit_excess(sk, i, back[i])));
+            res.worst_limit_deg =
+                ak_maxf(res.worst_limit_deg, ak_degrees(limit_excess(sk, i, back[i])));
             res.worst_cone_deg = ak_maxf(res.worst_cone_deg, cone_swing_deg(sk, i, back[i]));
         }
         world_positions(scene, back, ak_mat4_identity(), world, n);
@@ -225,23 +241,27 @@ done:
 }
 
 static void check_drop(const char* name, drop_result r, float cone_deg) {
-    printf("  %s: %zu bodies, %.1f kg, radii %.3f..%.3f m, lowest capsule %.4f m, lowest vertex %.3f m, "
-           "limit excess %.2f deg, cone swing start %.1f max %.2f deg, gap %.4f m, anchor velocity error "
+    printf("  %s: %zu bodies, %.1f kg, radii %.3f..%.3f m, lowest capsule %.4f m, lowest vertex "
+           "%.3f m, "
+           "limit excess %.2f deg, cone swing start %.1f max %.2f deg, gap %.4f m, anchor velocity "
+           "error "
            "%.4f m/s (speeds up to %.2f)\n",
-           name, r.bodies, r.mass, r.min_radius, r.max_radius, r.lowest, r.lowest_vertex, r.worst_limit_deg,
-           r.start_cone_deg, r.worst_cone_deg, r.worst_gap, r.worst_velocity, r.max_speed);
+           name, r.bodies, r.mass, r.min_radius, r.max_radius, r.lowest, r.lowest_vertex,
+           r.worst_limit_deg, r.start_cone_deg, r.worst_cone_deg, r.worst_gap, r.worst_velocity,
+           r.max_speed);
     AK_CHECK(r.ok);
-    AK_CHECK_MSG(r.worst_limit_deg <= 2.0f, "%s: a joint left its limits by %g deg", name, r.worst_limit_deg);
+    AK_CHECK_MSG(r.worst_limit_deg <= 2.0f, "%s: a joint left its limits by %g deg", name,
+                 r.worst_limit_deg);
     if (cone_deg > 0.0f)
-        AK_CHECK_MSG(r.worst_cone_deg <= cone_deg + 2.0f, "%s: a free joint swung %g deg (cone %g)", name,
-                     r.worst_cone_deg, cone_deg);
+        AK_CHECK_MSG(r.worst_cone_deg <= cone_deg + 2.0f, "%s: a free joint swung %g deg (cone %g)",
+                     name, r.worst_cone_deg, cone_deg);
     AK_CHECK_MSG(r.lowest > -0.02f, "%s: a body reached %g m below the ground", name, -r.lowest);
     AK_CHECK_MSG(r.worst_gap < 0.01f, "%s: joint gap %g m", name, r.worst_gap);
     /* the anchors start as fast as the clip moves the joints; the ragdoll's velocities are the
      * backward difference over one frame, whose direction lags a joint turning at w by w dt / 2
      * (5% at 6 rad/s) */
-    AK_CHECK_MSG(r.worst_velocity <= 0.05f * r.max_speed + 0.01f, "%s: anchor start velocity off by %g m/s", name,
-                 r.worst_velocity);
+    AK_CHECK_MSG(r.worst_velocity <= 0.05f * r.max_speed + 0.01f,
+                 "%s: anchor start velocity off by %g m/s", name, r.worst_velocity);
     AK_CHECK(r.finite);
 }
 
@@ -255,11 +275,15 @@ static void humanoid_drop(bool animated, bool skin) {
     ak_scene* scene = humanoid();
     AK_CHECK(scene != NULL);
     if (!scene) return;
-    drop_result r = drop(scene, (drop_opts){.animated = animated, .seconds = 1.5f, .lift = 0.5f, .skin = skin});
-    check_drop(animated ? (skin ? "humanoid walk, skin" : "humanoid walk") : "humanoid rest", r, 0.0f);
+    drop_result r =
+        drop(scene, (drop_opts){.animated = animated, .seconds = 1.5f, .lift = 0.5f, .skin = skin});
+    check_drop(animated ? (skin ? "humanoid walk, skin" : "humanoid walk") : "humanoid rest", r,
+               0.0f);
     /* fitted to the skin, the capsules hold the mesh above the ground (up to the mesh's
      * bulge beyond a capsule of its mean radius) */
-    if (skin) AK_CHECK_MSG(r.lowest_vertex > -0.03f, "a skinned vertex went %g m under the ground", -r.lowest_vertex);
+    if (skin)
+        AK_CHECK_MSG(r.lowest_vertex > -0.03f, "a skinned vertex went %g m under the ground",
+                     -r.lowest_vertex);
     ak_scene_destroy(scene);
 }
 
@@ -283,11 +307,16 @@ AK_TEST(cesium_ragdoll_from_walk_skin_fitted) {
     if (!scene) AK_SKIP(CESIUM " absent (set ANIMKIT_ASSETS or put them in ../shared/assets)");
     if (!scene) return;
     const float cone = 100.0f;
-    drop_result r = drop(scene, (drop_opts){.animated = true, .seconds = 1.5f, .skin = true,
-                                            .cone = ak_radians(cone), .lift = 0.3f});
+    drop_result r = drop(scene, (drop_opts){.animated = true,
+                                            .seconds = 1.5f,
+                                            .skin = true,
+                                            .cone = ak_radians(cone),
+                                            .lift = 0.3f});
     check_drop("CesiumMan walk, skin", r, cone);
-    AK_CHECK_MSG(r.lowest_vertex > -0.03f, "a skinned vertex went %g m under the ground", -r.lowest_vertex);
-    AK_CHECK_MSG(r.start_cone_deg <= cone, "the start pose is already outside the cone (%g deg)", r.start_cone_deg);
+    AK_CHECK_MSG(r.lowest_vertex > -0.03f, "a skinned vertex went %g m under the ground",
+                 -r.lowest_vertex);
+    AK_CHECK_MSG(r.start_cone_deg <= cone, "the start pose is already outside the cone (%g deg)",
+                 r.start_cone_deg);
     ak_scene_destroy(scene);
 }
 
@@ -299,7 +328,8 @@ AK_TEST(ragdoll_skin_bad_input) {
     const ak_skeleton* sk = scene->skeleton;
     const ak_mesh* mesh = scene->meshes[0].mesh;
     const ak_scene_skin* skin = &scene->skins[scene->meshes[0].skin];
-    size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk), nj = ak_rigid_ragdoll_joint_count(sk);
+    size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk),
+           nj = ak_rigid_ragdoll_joint_count(sk);
     size_t nv = mesh->vertex_count, k = mesh->influence_count;
     ak_transform* pose = malloc(n * sizeof *pose);
     ak_rigid_body_desc* bodies = calloc(nb, sizeof *bodies);
@@ -335,9 +365,12 @@ AK_TEST(ragdoll_skin_bad_input) {
         plain.skin_slot_joints = (ak_i32_cspan){0};
         plain.skin_inverse_binds = (ak_mat4_cspan){0};
         ak_rigid_body_desc* plain_bodies = calloc(nb, sizeof *plain_bodies);
-        AK_CHECK_EQ(ak_rigid_ragdoll_build(&plain, (ak_rigid_body_desc_span){plain_bodies, nb}, oj, obn), AK_OK);
+        AK_CHECK_EQ(
+            ak_rigid_ragdoll_build(&plain, (ak_rigid_body_desc_span){plain_bodies, nb}, oj, obn),
+            AK_OK);
         int differ = 0;
-        for (size_t b = 0; b < nb; ++b) differ += bodies[b].shape.radius != plain_bodies[b].shape.radius;
+        for (size_t b = 0; b < nb; ++b)
+            differ += bodies[b].shape.radius != plain_bodies[b].shape.radius;
         AK_CHECK_MSG(differ > 0, "the skin changed no capsule");
         free(plain_bodies);
         ak_rigid_ragdoll_desc bad = rd;

@@ -268,9 +268,10 @@ AK_API size_t ak_rigid_ragdoll_joint_count(const struct ak_skeleton* skeleton);
  * hinge with its limits, ball -> ball with its cone, free -> ball (coned by free_cone_angle),
  * prism -> prismatic; limits are taken relative to the skeleton's rest pose as the skeleton
  * measures them. With a skin, each body's capsule is fitted to the vertices whose heaviest
- * weight (>= skin_min_weight) is its bone's, posed rigidly with the bone at the start pose:
- * radius = the mean plus one standard deviation of their distances from the bone's line, and the capsule spans their extent along
- * the bone (so the body's centre may move off the bone's middle). Sizes: out_bodies >= body
+ * weight (>= skin_min_weight) is its bone's or a leaf child's, posed rigidly with their joint
+ * at the start pose: radius = the mean plus one standard deviation of their distances from
+ * the bone's line, and the capsule spans their extent along the bone (so the body's centre
+ * may move off the bone's middle). Sizes: out_bodies >= body
  * count, out_joints >= joint count, out_bones >= skeleton joint count. Returns
  * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_ARG (previous_pose without previous_dt > 0,
  * negative sizes or angle, a skin with a span missing or an influence count outside 1..8),

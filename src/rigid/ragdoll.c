@@ -147,8 +147,8 @@ static bool skin_given(const ak_rigid_ragdoll_desc* d, size_t joint_count, ak_re
  * false when fewer than min_vertices qualify; else *out_radius = the mean plus one standard
  * deviation of their distances from the body's Y axis (a round limb's radius; more for a flat
  * torso or a neck that carries a head) and [*out_lo, *out_hi] their extent along it. */
-static bool skin_fit(const ak_rigid_ragdoll_desc* d, ak_mat4 root, size_t i, ak_vec3 x,
-                     ak_quat q, float* out_radius, float* out_lo, float* out_hi) {
+static bool skin_fit(const ak_rigid_ragdoll_desc* d, ak_mat4 root, size_t i, ak_vec3 x, ak_quat q,
+                     float* out_radius, float* out_lo, float* out_hi) {
     const ak_skeleton* sk = d->skeleton;
     ak_i16_cspan parents = ak_skeleton_parents(sk);
     const size_t nv = d->skin_positions.count, k = d->skin_influence_count;
