@@ -26,7 +26,8 @@
  *     relative orientation (XPBD positional and angular constraints, their section 3.3);
  *   - ragdolls: a capsule per bone of a skeleton (sized from the bone, or fitted to the
  *     vertices of a skin) and a joint per joint with the skeleton's limits, started from an
- *     animated pose (and its velocities), written back as a pose;
+ *     animated pose (and its velocities), written back as a pose; powered, its joints driven
+ *     towards an animation's pose each step (drive_targets);
  *   - sleeping: a connected group of touching or joined bodies whose speeds all stay under the
  *     thresholds for sleep_time seconds is frozen until an awake body touches it;
  *   - deterministic: the same inputs give the same bits (contacts are found and solved in an
@@ -34,7 +35,7 @@
  *     interface's sake but this version runs every phase on the calling thread.
  *
  * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
- * a powered ragdoll that follows an animation, threads, continuous
+ * threads, continuous
  * collision detection (a body moving more than its size in one substep can tunnel),
  * collisions with particles or cloth.
  *
@@ -142,6 +143,10 @@ typedef struct ak_rigid_joint_desc {
     bool drive;                     /* drive b's orientation relative to a towards drive_target */
     ak_quat drive_target;           /* b's orientation in a's frame (a^-1 b); zero -> as built */
     float drive_compliance; /* rad/(N m); 0 -> rigid (the drive then acts as a fixed joint) */
+    float drive_damping;    /* 1/s: with a drive, each substep removes the fraction
+                               min(drive_damping h, 1) of the bodies' relative angular velocity
+                               (shared by their inverse inertias, so momentum is kept: a damped
+                               spring that settles instead of ringing); 0 -> none */
 } ak_rigid_joint_desc;
 
 AK_DEFINE_SPAN(rigid_joint_desc, ak_rigid_joint_desc)
@@ -255,6 +260,14 @@ typedef struct ak_rigid_ragdoll_desc {
                                           is >= this; 0 -> 0.5 */
     uint32_t skin_min_vertices;        /* fewer vertices than this on a bone -> radius_scale's
                                           capsule; 0 -> 8 */
+    /* Powered ragdoll: every ball and hinge joint gets a drive towards the start pose (set
+     * each step's targets from an animation with ak_rigid_ragdoll_drive_targets and the step
+     * job's drive_targets, so the character follows the clip, is knocked off it by a hit and
+     * comes back). A joint desc's drive_compliance may be changed per joint after the build. */
+    bool powered;
+    float drive_compliance;            /* rad/(N m) of every drive; 0 -> rigid (the clip is
+                                          played exactly; only the root body reacts) */
+    float drive_damping;               /* 1/s of every drive (ak_rigid_joint_desc); 0 -> none */
 } ak_rigid_ragdoll_desc;
 
 /* Bodies and joints a ragdoll of this skeleton has: one capsule per joint with children (from
@@ -281,6 +294,19 @@ AK_API ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
                                         ak_rigid_body_desc_span out_bodies,
                                         ak_rigid_joint_desc_span out_joints,
                                         ak_rigid_ragdoll_bone_span out_bones);
+
+/* A powered ragdoll's drive targets for a pose (an animation's local pose at the current
+ * time), one per ragdoll joint in the order of ak_rigid_ragdoll_build's out_joints: the
+ * orientation of each joint's body relative to its parent's body when the skeleton is in
+ * local_pose (the rotation part of the local transforms; translations and scale are ignored).
+ * Put them at the ragdoll's joints' places in the step job's drive_targets. Sizes: bones and
+ * local_pose >= skeleton joint count, out_targets >= ak_rigid_ragdoll_joint_count.
+ * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX (a bone's parent without a body: bones
+ * not from this skeleton's build), AK_ERR_BAD_DATA (a non-finite rotation). */
+AK_API ak_result ak_rigid_ragdoll_drive_targets(const struct ak_skeleton* skeleton,
+                                                ak_rigid_ragdoll_bone_cspan bones,
+                                                ak_transform_cspan local_pose,
+                                                ak_quat_span out_targets);
 
 /* The ragdoll's bodies written back as a skeleton pose: local transforms (scale from
  * fallback_pose) so that skinning and export work unchanged. Joints without a body keep
@@ -311,6 +337,11 @@ typedef struct ak_rigid_step_job {
     ak_f32_span sleep_timers; /* optional: seconds each body has been slow (state, start at
                                  0); empty -> bodies never sleep */
     ak_u8_span scratch;       /* >= ak_rigid_step_scratch_size(job) bytes */
+    ak_quat_cspan drive_targets; /* optional, one per joint (model order): the drive target of
+                                    each joint with `drive` for this step, in place of its
+                                    desc's (a powered ragdoll's animation: see
+                                    ak_rigid_ragdoll_drive_targets; normalised here); entries
+                                    of joints without a drive are ignored; empty -> the descs' */
     /* Outputs (optional). */
     float* out_max_penetration;     /* metres: deepest contact after the step's last solve */
     uint32_t* out_contact_count;    /* contact points of the last substep */
@@ -320,10 +351,12 @@ typedef struct ak_rigid_step_job {
 /* Bytes of scratch a step needs (0 for a NULL job or model). */
 AK_API size_t ak_rigid_step_scratch_size(const ak_rigid_step_job* job);
 
-/* First rule the job breaks: AK_ERR_NULL_ARG (job or model NULL), AK_ERR_BAD_ARG (dt <= 0 or
- * not finite, substeps > 1000, thread_count > AK_RIGID_MAX_THREADS, non-finite gravity),
- * AK_ERR_SPAN_SMALL (a state span shorter than the body count, sleep_timers neither empty nor
- * long enough, scratch too small), AK_ERR_BAD_DATA (a non-finite state value). */
+/* First rule the job breaks: AK_ERR_NULL_ARG (job or model NULL, drive_targets counted but
+ * NULL), AK_ERR_BAD_ARG (dt <= 0 or not finite, substeps > 1000, thread_count >
+ * AK_RIGID_MAX_THREADS, non-finite gravity), AK_ERR_SPAN_SMALL (a state span shorter than the
+ * body count, sleep_timers neither empty nor long enough, drive_targets neither empty nor one
+ * per joint, scratch too small), AK_ERR_BAD_DATA (a non-finite state value, a non-finite or
+ * zero drive target). */
 AK_API ak_result ak_rigid_step_validate(const ak_rigid_step_job* job);
 
 /* Advance the state by dt. Validates first and writes nothing on failure. Returns AK_ERR_BAD_DATA

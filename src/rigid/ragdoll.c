@@ -216,9 +216,11 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
         (desc->previous_pose.count &&
          !ak_pose_is_finite((ak_transform_cspan){desc->previous_pose.ptr, n})) ||
         !ak_finitef(desc->previous_dt) || !ak_finitef(desc->radius_scale) ||
-        !ak_finitef(desc->max_radius) || !ak_finitef(desc->free_cone_angle))
+        !ak_finitef(desc->max_radius) || !ak_finitef(desc->free_cone_angle) ||
+        !ak_finitef(desc->drive_compliance) || !ak_finitef(desc->drive_damping))
         return AK_ERR_BAD_DATA;
-    if (desc->free_cone_angle < 0.0f) return AK_ERR_BAD_ARG;
+    if (desc->free_cone_angle < 0.0f || desc->drive_compliance < 0.0f || desc->drive_damping < 0.0f)
+        return AK_ERR_BAD_ARG;
     ak_result skin_r;
     const bool skin = skin_given(desc, n, &skin_r);
     if (skin_r != AK_OK) return skin_r;
@@ -298,6 +300,14 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
             ak_quat q_rest = ak_quat_normalize(
                 ak_quat_mul(mat_rotation(joint_world(sk, desc->local_pose, root, (size_t)p)),
                             rest.ptr[i].rotation));
+            /* powered: drive b's orientation in a's frame towards the start pose's */
+            jd->drive = desc->powered;
+            jd->drive_compliance = desc->drive_compliance;
+            jd->drive_damping = desc->drive_damping;
+            jd->drive_target = ak_quat_normalize(ak_quat_mul(
+                ak_quat_conjugate(
+                    out_bodies.ptr[out_bones.ptr[p].body - desc->body_offset].orientation),
+                q));
             switch (ak_skeleton_joint_type(sk, i)) {
             case AK_JOINT_HINGE: {
                 ak_vec3 axis = ak_vec3_length_sq(lim.axis) > 0.0f ? ak_vec3_normalize(lim.axis)
@@ -364,6 +374,30 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
             }
         }
         ++k;
+    }
+    return AK_OK;
+}
+
+ak_result ak_rigid_ragdoll_drive_targets(const ak_skeleton* sk, ak_rigid_ragdoll_bone_cspan bones,
+                                         ak_transform_cspan pose, ak_quat_span out) {
+    if (!sk || !bones.ptr || !pose.ptr || (!out.ptr && out.count)) return AK_ERR_NULL_ARG;
+    const size_t n = ak_skeleton_joint_count(sk);
+    if (bones.count < n || pose.count < n || out.count < ak_rigid_ragdoll_joint_count(sk))
+        return AK_ERR_SPAN_SMALL;
+    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    size_t k = 0;
+    for (size_t i = 0; i < n; ++i) {
+        /* the build's order: a joint per joint with a body and a parent */
+        if (!has_children(sk, i) || parents.ptr[i] < 0) continue;
+        const ak_rigid_ragdoll_bone* bi = &bones.ptr[i];
+        const ak_rigid_ragdoll_bone* bp = &bones.ptr[parents.ptr[i]];
+        if (bi->body < 0 || bp->body < 0) return AK_ERR_BAD_INDEX;
+        if (!ak_quat_is_finite(pose.ptr[i].rotation)) return AK_ERR_BAD_DATA;
+        /* body = joint world rotation * bone.rotation^-1, and joint i's world rotation is its
+         * parent's times its local one: a^-1 b = bp.rotation local bi.rotation^-1 */
+        out.ptr[k++] = ak_quat_normalize(
+            ak_quat_mul(ak_quat_mul(bp->rotation, ak_quat_normalize(pose.ptr[i].rotation)),
+                        ak_quat_conjugate(bi->rotation)));
     }
     return AK_OK;
 }
