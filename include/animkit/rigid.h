@@ -318,6 +318,37 @@ AK_API ak_result ak_rigid_ragdoll_pose(const struct ak_skeleton* skeleton,
                                        ak_transform_cspan fallback_pose,
                                        ak_transform_span out_local_pose);
 
+/* ---- a run baked as glTF node animation ------------------------------------------------ */
+
+struct ak_scene;
+
+typedef struct ak_rigid_bake_desc {
+    const char* name;              /* scene, root node, meshes and clip name; NULL -> "rigid" */
+    const ak_rigid_model* model;   /* required: the bodies' shapes */
+    size_t frame_count;            /* required, 1 .. max_frames */
+    const ak_vec3* positions;      /* required, [frame_count * body count], frame k first */
+    const ak_quat* orientations;   /* required, the same layout */
+    float frame_time;              /* required, > 0 seconds between frames */
+    float plane_size;              /* half the side of the square drawn for a plane (m);
+                                      0 -> 10 */
+    size_t max_frames;             /* 0 -> AK_SCENE_BAKE_MAX_FRAMES (scene.h) */
+    size_t memory_budget;          /* bytes; 0 -> AK_SCENE_BAKE_DEFAULT_BUDGET (scene.h) */
+} ak_rigid_bake_desc;
+
+/* Bake recorded frames of a run as an animated scene (io.h's ak_io_save writes it as glTF):
+ * a root node named name and one child node "<name>_<i>" per body in body order, each
+ * carrying its shape as a mesh in the body's frame (a sphere or capsule as a latitude-
+ * longitude grid, a box's 6 faces, a plane as a square around its point with Y along its
+ * normal), rest transform = frame 0's pose; one clip named name with a LINEAR translation and
+ * rotation channel per dynamic body keyed at every frame (rotations taken the short way from
+ * the previous key), frame k at time k * frame_time. One frame, or only static bodies: no
+ * clip. The bytes needed are estimated before anything is allocated. Returns AK_ERR_NULL_ARG,
+ * AK_ERR_EMPTY (no frame), AK_ERR_BAD_ARG (frame_time, plane_size), AK_ERR_BAD_DATA (a
+ * non-finite or zero pose: diag names frame and body), AK_ERR_UNSUPPORTED (over max_frames,
+ * the memory budget, or 32000 bodies), AK_ERR_NO_MEMORY; *out_scene NULL on failure. */
+AK_API ak_result ak_rigid_bake_scene(const ak_rigid_bake_desc* desc, const ak_allocator* alloc,
+                                     struct ak_scene** out_scene, ak_diag* diag);
+
 /* ---- step ------------------------------------------------------------------------------ */
 
 #define AK_RIGID_MAX_THREADS 64
