@@ -318,6 +318,34 @@ AK_API ak_result ak_rigid_ragdoll_pose(const struct ak_skeleton* skeleton,
                                        ak_transform_cspan fallback_pose,
                                        ak_transform_span out_local_pose);
 
+/* ---- meshes of the bodies (drawing, baking, colliders for other simulations) ----------- */
+
+/* Vertices and indices (3 per triangle) of a shape's mesh: a sphere or capsule as an 8 x 16
+ * latitude-longitude grid (capsules with a doubled equator), a box's 6 faces (24 vertices), a
+ * plane as a square (4); 0 for NULL or an unknown type. */
+AK_API void ak_rigid_shape_mesh_size(const ak_rigid_shape* shape, size_t* out_vertex_count,
+                                     size_t* out_index_count);
+/* A shape's closed, outward-facing mesh (counter-clockwise seen from outside) in the body's
+ * frame: vertices on the shape's surface (a sphere's and a capsule's inscribed in it), unit
+ * normals, triangles; a plane is a square of half side plane_size (0 -> 10 m) in its own frame
+ * (Y up). Sizes from ak_rigid_shape_mesh_size. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (type),
+ * AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_rigid_shape_mesh(const ak_rigid_shape* shape, float plane_size,
+                                     ak_vec3_span out_positions, ak_vec3_span out_normals,
+                                     ak_u32_span out_indices);
+/* Totals of ak_rigid_world_mesh: every body but the planes (0 for NULL). */
+AK_API void ak_rigid_world_mesh_size(const ak_rigid_model* model, size_t* out_vertex_count,
+                                     size_t* out_index_count);
+/* Every body but the planes as one world-space triangle mesh at a state (body order, each
+ * body's ak_rigid_shape_mesh moved by its pose): to draw a scene, or to give cloth
+ * (ak_cloth_collider_mesh) and particles (ak_particle_mesh) the bodies as a one-way collider
+ * each step. Boxes are exact; spheres and capsules are inscribed polyhedra (at most 8% inside
+ * the true surface at 8 x 16). AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a
+ * non-finite state). */
+AK_API ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan positions,
+                                     ak_quat_cspan orientations, ak_vec3_span out_positions,
+                                     ak_vec3_span out_normals, ak_u32_span out_indices);
+
 /* ---- a run baked as glTF node animation ------------------------------------------------ */
 
 struct ak_scene;

@@ -37,7 +37,8 @@ static void shape_counts(ak_rigid_shape_type t, size_t* nv, size_t* nt) {
  * the north; a capsule's rows below the equator are moved down by half_height and those above
  * up (the equator row is doubled so the cylinder joins the caps). Degenerate triangles at the
  * poles are left out. */
-static void round_mesh(ak_mesh* m, float radius, float half_height, bool capsule) {
+static void round_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, float radius, float half_height,
+                       bool capsule) {
     const int rows = capsule ? RINGS + 2 : RINGS + 1;
     size_t v = 0;
     for (int k = 0; k < rows; ++k) {
@@ -49,11 +50,10 @@ static void round_mesh(ak_mesh* m, float radius, float half_height, bool capsule
             ak_vec3 n = ak_vec3_make(cosf(th) * sinf(ph), sinf(th), cosf(th) * cosf(ph));
             if (k == 0) n = ak_vec3_make(0.0f, -1.0f, 0.0f);
             if (k == rows - 1) n = ak_vec3_make(0.0f, 1.0f, 0.0f);
-            m->normals[v] = n;
-            m->positions[v++] = ak_vec3_make(radius * n.x, radius * n.y + shift, radius * n.z);
+            nrm[v] = n;
+            pos[v++] = ak_vec3_make(radius * n.x, radius * n.y + shift, radius * n.z);
         }
     }
-    uint32_t* t = m->indices;
     for (int k = 0; k + 1 < rows; ++k)
         for (int s = 0; s < SEGS; ++s) {
             uint32_t a = (uint32_t)(k * (SEGS + 1) + s), b = a + 1, c = a + SEGS + 1, d = c + 1;
@@ -62,9 +62,8 @@ static void round_mesh(ak_mesh* m, float radius, float half_height, bool capsule
         }
 }
 
-static void box_mesh(ak_mesh* m, ak_vec3 h) {
+static void box_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, ak_vec3 h) {
     size_t v = 0;
-    uint32_t* t = m->indices;
     for (int axis = 0; axis < 3; ++axis)
         for (int sign = -1; sign <= 1; sign += 2) {
             float n[3] = {0, 0, 0};
@@ -77,8 +76,8 @@ static void box_mesh(ak_mesh* m, ak_vec3 h) {
                 p[axis] = (float)sign;
                 p[u] = cu[c];
                 p[w] = cw[c];
-                m->positions[v] = ak_vec3_make(p[0] * h.x, p[1] * h.y, p[2] * h.z);
-                m->normals[v++] = ak_vec3_make(n[0], n[1], n[2]);
+                pos[v] = ak_vec3_make(p[0] * h.x, p[1] * h.y, p[2] * h.z);
+                nrm[v++] = ak_vec3_make(n[0], n[1], n[2]);
             }
             /* (u, w, axis) is right-handed: corners 0..3 run counter-clockwise about +axis */
             if (sign > 0)
@@ -91,14 +90,105 @@ static void box_mesh(ak_mesh* m, ak_vec3 h) {
         }
 }
 
-static void plane_mesh(ak_mesh* m, float size) {
+static void plane_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, float size) {
     const float c[4][2] = {{-1, -1}, {-1, 1}, {1, 1}, {1, -1}}; /* ccw seen from +Y */
     for (int k = 0; k < 4; ++k) {
-        m->positions[k] = ak_vec3_make(c[k][0] * size, 0.0f, c[k][1] * size);
-        m->normals[k] = ak_vec3_make(0.0f, 1.0f, 0.0f);
+        pos[k] = ak_vec3_make(c[k][0] * size, 0.0f, c[k][1] * size);
+        nrm[k] = ak_vec3_make(0.0f, 1.0f, 0.0f);
     }
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(m->indices, idx, sizeof idx);
+    memcpy(t, idx, sizeof idx);
+}
+
+/* The shape's mesh into arrays sized by shape_counts. */
+static void shape_mesh(const ak_rigid_shape* sh, float plane_size, ak_vec3* pos, ak_vec3* nrm,
+                       uint32_t* idx) {
+    switch (sh->type) {
+    case AK_RIGID_BOX:
+        box_mesh(pos, nrm, idx, sh->half_extents);
+        break;
+    case AK_RIGID_PLANE:
+        plane_mesh(pos, nrm, idx, plane_size > 0.0f ? plane_size : 10.0f);
+        break;
+    case AK_RIGID_CAPSULE:
+        round_mesh(pos, nrm, idx, sh->radius, sh->half_height, true);
+        break;
+    case AK_RIGID_SPHERE:
+        round_mesh(pos, nrm, idx, sh->radius, 0.0f, false);
+        break;
+    default:
+        break;
+    }
+}
+
+void ak_rigid_shape_mesh_size(const ak_rigid_shape* shape, size_t* out_vertex_count,
+                              size_t* out_index_count) {
+    size_t nv = 0, nt = 0;
+    if (shape) shape_counts(shape->type, &nv, &nt);
+    if (out_vertex_count) *out_vertex_count = nv;
+    if (out_index_count) *out_index_count = 3 * nt;
+}
+
+ak_result ak_rigid_shape_mesh(const ak_rigid_shape* shape, float plane_size,
+                              ak_vec3_span out_positions, ak_vec3_span out_normals,
+                              ak_u32_span out_indices) {
+    if (!shape || !out_positions.ptr || !out_normals.ptr || !out_indices.ptr)
+        return AK_ERR_NULL_ARG;
+    if ((unsigned)shape->type >= AK_RIGID_SHAPE_COUNT) return AK_ERR_BAD_ARG;
+    size_t nv, ni;
+    ak_rigid_shape_mesh_size(shape, &nv, &ni);
+    if (out_positions.count < nv || out_normals.count < nv || out_indices.count < ni)
+        return AK_ERR_SPAN_SMALL;
+    shape_mesh(shape, plane_size, out_positions.ptr, out_normals.ptr, out_indices.ptr);
+    return AK_OK;
+}
+
+void ak_rigid_world_mesh_size(const ak_rigid_model* model, size_t* out_vertex_count,
+                              size_t* out_index_count) {
+    size_t nv = 0, ni = 0, n = ak_rigid_body_count(model);
+    for (size_t i = 0; i < n; ++i) {
+        ak_rigid_body_desc d = ak_rigid_body_get_desc(model, i);
+        if (d.shape.type == AK_RIGID_PLANE) continue;
+        size_t a, b;
+        ak_rigid_shape_mesh_size(&d.shape, &a, &b);
+        nv += a, ni += b;
+    }
+    if (out_vertex_count) *out_vertex_count = nv;
+    if (out_index_count) *out_index_count = ni;
+}
+
+ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan positions,
+                              ak_quat_cspan orientations, ak_vec3_span out_positions,
+                              ak_vec3_span out_normals, ak_u32_span out_indices) {
+    if (!model || !positions.ptr || !orientations.ptr || !out_positions.ptr || !out_normals.ptr ||
+        !out_indices.ptr)
+        return AK_ERR_NULL_ARG;
+    const size_t n = ak_rigid_body_count(model);
+    size_t nv, ni;
+    ak_rigid_world_mesh_size(model, &nv, &ni);
+    if (positions.count < n || orientations.count < n || out_positions.count < nv ||
+        out_normals.count < nv || out_indices.count < ni)
+        return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i)
+        if (!ak_vec3_is_finite(positions.ptr[i]) || !ak_quat_is_finite(orientations.ptr[i]))
+            return AK_ERR_BAD_DATA;
+    size_t v = 0, k = 0;
+    for (size_t i = 0; i < n; ++i) {
+        ak_rigid_body_desc d = ak_rigid_body_get_desc(model, i);
+        if (d.shape.type == AK_RIGID_PLANE) continue;
+        size_t a, b;
+        ak_rigid_shape_mesh_size(&d.shape, &a, &b);
+        shape_mesh(&d.shape, 0.0f, out_positions.ptr + v, out_normals.ptr + v, out_indices.ptr + k);
+        const ak_quat q = ak_quat_normalize(orientations.ptr[i]);
+        for (size_t j = v; j < v + a; ++j) {
+            out_positions.ptr[j] =
+                ak_vec3_add(positions.ptr[i], ak_quat_rotate(q, out_positions.ptr[j]));
+            out_normals.ptr[j] = ak_quat_rotate(q, out_normals.ptr[j]);
+        }
+        for (size_t j = k; j < k + b; ++j) out_indices.ptr[j] += (uint32_t)v;
+        v += a, k += b;
+    }
+    return AK_OK;
 }
 
 /* A node's pose for body i in a frame: planes are drawn around their point, Y along the normal. */
@@ -200,20 +290,7 @@ ak_result ak_rigid_bake_scene(const ak_rigid_bake_desc* desc, const ak_allocator
             .vertex_count = nv, .triangle_count = nt, .has_normals = true, .name = mname};
         if ((r = ak_mesh_create(&md, &s->alloc, &s->meshes[i].mesh)) != AK_OK) break;
         ak_mesh* m = s->meshes[i].mesh;
-        switch (d.shape.type) {
-        case AK_RIGID_BOX:
-            box_mesh(m, d.shape.half_extents);
-            break;
-        case AK_RIGID_PLANE:
-            plane_mesh(m, desc->plane_size > 0.0f ? desc->plane_size : 10.0f);
-            break;
-        case AK_RIGID_CAPSULE:
-            round_mesh(m, d.shape.radius, d.shape.half_height, true);
-            break;
-        default:
-            round_mesh(m, d.shape.radius, 0.0f, false);
-            break;
-        }
+        shape_mesh(&d.shape, desc->plane_size, m->positions, m->normals, m->indices);
         s->meshes[i].node = (int32_t)(i + 1);
         s->meshes[i].has_material = true;
         s->meshes[i].base_color = d.is_static ? ak_vec4_make(0.55f, 0.55f, 0.5f, 1.0f)
