@@ -35,9 +35,9 @@
  *     interface's sake but this version runs every phase on the calling thread.
  *
  * What it does NOT do (yet): convex hulls, triangle meshes, heightfields, compound bodies,
- * threads, continuous
- * collision detection (a body moving more than its size in one substep can tunnel),
- * collisions with particles or cloth.
+ * threads, continuous collision detection (a body moving more than its size in one substep
+ * can tunnel), collisions with the fluid (cloth and particles take the bodies as a mesh:
+ * ak_rigid_world_mesh).
  *
  * Usage (a box dropped on the ground):
  *     ak_rigid_body_desc bodies[2] = {
