@@ -3,7 +3,9 @@
  * radius from its segment, box vertices at the half extents, every triangle facing outwards);
  * the clip, sampled at a frame's time, gives that frame's recorded pose and, halfway between
  * two frames, the midpoint of their positions (LINEAR) - also after a round trip through a
- * .glb file; bad input gets its code; the command writes a .glb of the ragdoll preset, and
+ * .glb file; bad input gets its code; the command writes a .glb of the stack preset (a node per
+ * body) and of the ragdoll preset (builtin:humanoid's skeleton animated: its skinned mesh
+ * starts a metre up and ends on the ground), and
  * (slow: node's start takes most of a second) the Khronos validator, when
  * build-tools/node_modules/gltf-validator and node exist (else SKIP), finds no error and no
  * warning in the files written here. */
@@ -19,7 +21,7 @@
 #include "cli_test.h"
 
 static char g_tmp[1024];
-static char g_written[4][1100];
+static char g_written[8][1100];
 static int g_written_count;
 
 enum { NB = 5, NF = 12 };
@@ -183,21 +185,83 @@ AK_TEST(bake_nodes_match_shapes_and_frames) {
     ak_rigid_model_destroy(m);
 }
 
+/* Lowest vertex (m) of the first skinned mesh of a scene posed by its first clip at time t. */
+static float lowest_skinned(const ak_scene* s, float t) {
+    const size_t n = ak_skeleton_joint_count(s->skeleton);
+    float low = INFINITY;
+    ak_transform* pose = malloc(n * sizeof *pose);
+    ak_mat4* world = malloc(n * sizeof *world);
+    for (size_t m = 0; pose && world && m < s->mesh_count; ++m) {
+        const ak_mesh* mesh = s->meshes[m].mesh;
+        if (s->meshes[m].skin < 0 || !mesh->influence_count) continue;
+        const ak_scene_skin* skin = &s->skins[s->meshes[m].skin];
+        ak_mat4* palette = malloc(skin->joint_count * sizeof *palette);
+        ak_vec3* out = malloc(mesh->vertex_count * sizeof *out);
+        ak_scene_rest_pose(s, (ak_transform_span){pose, n});
+        ak_clip_sample(s->clips[0], t, NULL, (ak_transform_span){pose, n}, (ak_f32_span){0},
+                       (ak_f32_span){0});
+        ak_scene_world_matrices(s, (ak_transform_cspan){pose, n}, (ak_mat4_span){world, n});
+        ak_scene_skin_palette(s, (size_t)s->meshes[m].skin, (ak_mat4_cspan){world, n},
+                              (ak_mat4_span){palette, skin->joint_count});
+        ak_skin_job job = {.influence_count = mesh->influence_count,
+                           .palette = {palette, skin->joint_count},
+                           .positions = {mesh->positions, mesh->vertex_count, 0},
+                           .joints = {mesh->joints, mesh->vertex_count, 0},
+                           .weights = {mesh->weights, mesh->vertex_count, 0},
+                           .out_positions = {out, mesh->vertex_count, 0}};
+        if (palette && out && ak_skin_job_run(&job) == AK_OK)
+            for (size_t v = 0; v < mesh->vertex_count; ++v) low = ak_minf(low, out[v].y);
+        free(palette), free(out);
+        break;
+    }
+    free(pose), free(world);
+    return low;
+}
+
 AK_TEST(cli_writes_node_animation) {
     char args[1400], path[1100];
-    snprintf(path, sizeof path, "%s/ragdoll.glb", g_tmp);
-    snprintf(args, sizeof args, "rigid --preset ragdoll --steps 20 -o '%s'", path);
+    snprintf(path, sizeof path, "%s/stack.glb", g_tmp);
+    snprintf(args, sizeof args, "rigid --preset stack --steps 10 -o '%s'", path);
     AK_CHECK_EQ(run(args, true), 0);
     AK_CHECK_MSG(strstr(out_buf, "one node per body") != NULL, "output: %s", out_buf);
     ak_scene* s = NULL;
     ak_diag diag = {0};
     AK_CHECK_EQ(ak_io_load(path, NULL, NULL, &s, &diag), AK_OK);
     if (s) {
-        /* the ground and 12 capsules, a node each under the root; 21 frames */
-        AK_CHECK_EQ(s->mesh_count, (size_t)13);
-        AK_CHECK_EQ(ak_skeleton_joint_count(s->skeleton), (size_t)14);
+        /* the ground and 10 boxes, a node each under the root; 11 frames */
+        AK_CHECK_EQ(s->mesh_count, (size_t)11);
+        AK_CHECK_EQ(ak_skeleton_joint_count(s->skeleton), (size_t)12);
         AK_CHECK_EQ(s->clip_count, (size_t)1);
-        if (s->clip_count) AK_CHECK(fabsf(ak_clip_duration(s->clips[0]) - 20.0f / 60.0f) < 1e-5f);
+        if (s->clip_count) AK_CHECK(fabsf(ak_clip_duration(s->clips[0]) - 10.0f / 60.0f) < 1e-5f);
+        snprintf(g_written[g_written_count++], sizeof g_written[0], "%s", path);
+    }
+    ak_scene_destroy(s);
+}
+
+/* The ragdoll preset: builtin:humanoid with the run as its skeleton's animation. Dropped from
+ * 1 m, its skinned mesh starts about a metre up and ends on the ground (capsules fitted to
+ * the skin hold it within 3 cm of it). */
+AK_TEST(cli_writes_ragdoll_skeleton_animation) {
+    char args[1400], path[1100];
+    snprintf(path, sizeof path, "%s/ragdoll.glb", g_tmp);
+    snprintf(args, sizeof args, "rigid --preset ragdoll --steps 60 -o '%s'", path);
+    AK_CHECK_EQ(run(args, true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "skeleton animated") != NULL, "output: %s", out_buf);
+    ak_scene* s = NULL;
+    ak_diag diag = {0};
+    AK_CHECK_EQ(ak_io_load(path, NULL, NULL, &s, &diag), AK_OK);
+    if (s) {
+        AK_CHECK(s->skin_count >= 1);
+        AK_CHECK_EQ(s->clip_count, (size_t)1);
+        if (s->clip_count && s->skin_count) {
+            AK_CHECK(fabsf(ak_clip_duration(s->clips[0]) - 1.0f) < 1e-5f);
+            float start = lowest_skinned(s, 0.0f), end = lowest_skinned(s, 1.0f);
+            printf("  ragdoll.glb: lowest skinned vertex %.3f m at 0 s, %.3f m at 1 s\n",
+                   (double)start, (double)end);
+            AK_CHECK_MSG(start > 0.8f, "the character starts at %g m, not a metre up", start);
+            AK_CHECK_MSG(end > -0.03f && end < 0.15f,
+                         "the character ends at %g m, not on the ground", end);
+        }
         snprintf(g_written[g_written_count++], sizeof g_written[0], "%s", path);
     }
     ak_scene_destroy(s);
@@ -217,6 +281,7 @@ AK_TEST(validator) {
     if (g_written_count == 0) { /* run alone (the slow selection): write the files first */
         ak_test_bake_nodes_match_shapes_and_frames();
         ak_test_cli_writes_node_animation();
+        ak_test_cli_writes_ragdoll_skeleton_animation();
     }
     AK_CHECK(g_written_count > 0);
     char cmd[8000];
@@ -254,6 +319,7 @@ int main(void) {
     }
     AK_RUN(bake_nodes_match_shapes_and_frames);
     AK_RUN(cli_writes_node_animation);
+    AK_RUN_SLOW(cli_writes_ragdoll_skeleton_animation); /* 60 steps of 40 substeps */
     AK_RUN_SLOW(validator); /* node's start alone takes most of a second */
     for (int i = 0; i < g_written_count; ++i) remove(g_written[i]);
     rmdir(g_tmp);

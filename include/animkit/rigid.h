@@ -377,6 +377,40 @@ typedef struct ak_rigid_bake_desc {
 AK_API ak_result ak_rigid_bake_scene(const ak_rigid_bake_desc* desc, const ak_allocator* alloc,
                                      struct ak_scene** out_scene, ak_diag* diag);
 
+/* A ragdoll's recorded run as the skeleton's animation: the clip that plays, on the character
+ * the ragdoll was built from, the pose ak_rigid_ragdoll_pose writes back at each frame (so the
+ * skinned mesh moves as the bodies did when the character's scene, with this clip, is saved as
+ * glTF). */
+struct ak_clip;
+
+typedef struct ak_rigid_bake_ragdoll_desc {
+    const char* name;                   /* clip name; NULL -> "ragdoll" */
+    const struct ak_skeleton* skeleton; /* required */
+    ak_rigid_ragdoll_bone_cspan bones;  /* required: ak_rigid_ragdoll_build's map */
+    ak_mat4 root;                       /* the world transform the character is drawn under;
+                                           zero -> identity (the root joints then carry the
+                                           ragdoll's world pose) */
+    ak_transform_cspan fallback_pose;   /* required: joints without a body keep these */
+    size_t body_count;                  /* bodies per frame in positions and orientations */
+    size_t frame_count;                 /* required, 1 .. max_frames */
+    const ak_vec3* positions;           /* required, [frame_count * body_count] */
+    const ak_quat* orientations;        /* required, the same layout */
+    float frame_time;                   /* required, > 0 */
+    size_t max_frames;                  /* 0 -> AK_SCENE_BAKE_MAX_FRAMES (scene.h) */
+    size_t memory_budget;               /* 0 -> AK_SCENE_BAKE_DEFAULT_BUDGET (scene.h) */
+} ak_rigid_bake_ragdoll_desc;
+
+/* Build the clip: a LINEAR translation and rotation channel for every joint of the skeleton,
+ * keyed at every frame with ak_rigid_ragdoll_pose's local transforms (rotations taken the short
+ * way from the previous key), frame k at time k * frame_time. Returns AK_ERR_NULL_ARG,
+ * AK_ERR_EMPTY, AK_ERR_BAD_ARG (frame_time), AK_ERR_SPAN_SMALL (bones or fallback_pose shorter
+ * than the skeleton), AK_ERR_BAD_INDEX (a bone's body not below body_count), AK_ERR_BAD_DATA (a
+ * non-finite pose: diag names the frame), AK_ERR_UNSUPPORTED (over max_frames or the budget),
+ * AK_ERR_NO_MEMORY; *out_clip NULL on failure (free a clip with ak_clip_destroy). */
+AK_API ak_result ak_rigid_bake_ragdoll_clip(const ak_rigid_bake_ragdoll_desc* desc,
+                                            const ak_allocator* alloc, struct ak_clip** out_clip,
+                                            ak_diag* diag);
+
 /* ---- step ------------------------------------------------------------------------------ */
 
 #define AK_RIGID_MAX_THREADS 64
@@ -457,6 +491,17 @@ typedef struct ak_rigid_scene {
     uint32_t substeps;           /* default 20 */
     uint32_t thread_count;       /* default 1 */
     bool sleep;                  /* bodies may fall asleep; default true */
+    /* The ragdoll preset's character (empty otherwise, and after a file is loaded over it), so
+     * a run can be shown as the character (ak_rigid_bake_ragdoll_clip): the builtin model
+     * (ak_builtin_create(ragdoll_character, {.cell_size = ragdoll_cell_size})) whose skeleton
+     * the ragdoll was built from, its bone map (body indices into bodies) and root, and its
+     * start pose (local transforms). Owned (malloc), freed by ak_rigid_scene_free. */
+    char ragdoll_character[32];
+    float ragdoll_cell_size;
+    ak_rigid_ragdoll_bone* ragdoll_bones; /* [ragdoll_bone_count] */
+    ak_transform* ragdoll_pose;           /* [ragdoll_bone_count] */
+    size_t ragdoll_bone_count;            /* the skeleton's joint count; 0 -> no character */
+    ak_mat4 ragdoll_root;
 } ak_rigid_scene;
 
 /* The defaults of every key, no bodies, no joints (the scene without a file); owns nothing. */

@@ -2,6 +2,7 @@
  * carrying its shape's mesh, with translation and rotation channels. */
 #include <animkit/rigid.h>
 #include <animkit/scene.h>
+#include <animkit/skeleton.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -339,4 +340,91 @@ ak_result ak_rigid_bake_scene(const ak_rigid_bake_desc* desc, const ak_allocator
     }
     *out_scene = s;
     return AK_OK;
+}
+
+ak_result ak_rigid_bake_ragdoll_clip(const ak_rigid_bake_ragdoll_desc* desc,
+                                     const ak_allocator* alloc, struct ak_clip** out_clip,
+                                     ak_diag* diag) {
+    if (out_clip) *out_clip = NULL;
+    if (!desc || !out_clip || !desc->skeleton || !desc->bones.ptr || !desc->fallback_pose.ptr ||
+        !desc->positions || !desc->orientations)
+        return akp_diag_set(diag, AK_ERR_NULL_ARG, "ragdoll bake", "a required pointer is NULL");
+    const ak_skeleton* sk = desc->skeleton;
+    const size_t n = ak_skeleton_joint_count(sk), nb = desc->body_count, nf = desc->frame_count;
+    if (!nf || !n) return akp_diag_set(diag, AK_ERR_EMPTY, "ragdoll bake", "no frames or joints");
+    if (!(desc->frame_time > 0.0f) || !ak_finitef(desc->frame_time))
+        return akp_diag_set(diag, AK_ERR_BAD_ARG, "ragdoll bake", "frame_time must be > 0");
+    if (desc->bones.count < n || desc->fallback_pose.count < n)
+        return akp_diag_set(diag, AK_ERR_SPAN_SMALL, "ragdoll bake",
+                            "bones and fallback_pose need %zu entries", n);
+    for (size_t i = 0; i < n; ++i)
+        if (desc->bones.ptr[i].body >= 0 && (size_t)desc->bones.ptr[i].body >= nb)
+            return akp_diag_set(diag, AK_ERR_BAD_INDEX, "ragdoll bake",
+                                "joint %zu's body is past the %zu bodies", i, nb);
+    const size_t max_frames = desc->max_frames ? desc->max_frames : AK_SCENE_BAKE_MAX_FRAMES;
+    if (nf > max_frames)
+        return akp_diag_set(diag, AK_ERR_UNSUPPORTED, "ragdoll bake",
+                            "%zu frames, more than the limit of %zu", nf, max_frames);
+    const size_t per_key = 2 * (sizeof(float) + sizeof(ak_vec3) + sizeof(ak_quat));
+    size_t need = nf > SIZE_MAX / n / (per_key + 64) ? SIZE_MAX : nf * n * (per_key + 64);
+    const size_t budget = desc->memory_budget ? desc->memory_budget : AK_SCENE_BAKE_DEFAULT_BUDGET;
+    if (need > budget)
+        return akp_diag_set(diag, AK_ERR_UNSUPPORTED, "ragdoll bake",
+                            "needs about %zu bytes, over the memory budget of %zu", need, budget);
+    float* times = malloc(nf * sizeof *times);
+    ak_vec3* tv = malloc(nf * n * sizeof *tv); /* joint-major: joint i's keys at [i * nf] */
+    ak_quat* rv = malloc(nf * n * sizeof *rv);
+    ak_transform* local = malloc(n * sizeof *local);
+    ak_raw_channel* ch = calloc(2 * n, sizeof *ch);
+    ak_result r = times && tv && rv && local && ch ? AK_OK : AK_ERR_NO_MEMORY;
+    for (size_t k = 0; r == AK_OK && k < nf; ++k) {
+        times[k] = (float)((double)k * (double)desc->frame_time);
+        if (!ak_finitef(times[k]) || (k && !(times[k] > times[k - 1]))) {
+            r = akp_diag_set(diag, AK_ERR_BAD_ARG, "ragdoll bake",
+                             "%zu frames of this frame_time do not give distinct finite times", nf);
+            break;
+        }
+        r = ak_rigid_ragdoll_pose(sk, desc->bones, desc->root,
+                                  (ak_vec3_cspan){desc->positions + k * nb, nb},
+                                  (ak_quat_cspan){desc->orientations + k * nb, nb},
+                                  desc->fallback_pose, (ak_transform_span){local, n});
+        if (r == AK_OK && !ak_pose_is_finite((ak_transform_cspan){local, n})) r = AK_ERR_BAD_DATA;
+        if (r != AK_OK) {
+            akp_diag_set(diag, r, "ragdoll bake", "frame %zu: %s", k, ak_result_string(r));
+            break;
+        }
+        for (size_t i = 0; i < n; ++i) {
+            tv[i * nf + k] = local[i].translation;
+            ak_quat q = local[i].rotation;
+            if (k && ak_quat_dot(q, rv[i * nf + k - 1]) < 0.0f) q = ak_quat_neg(q);
+            rv[i * nf + k] = q;
+        }
+    }
+    if (r == AK_OK) {
+        for (size_t i = 0; i < n; ++i) {
+            ch[2 * i] = (ak_raw_channel){.target = AK_CHANNEL_TRANSLATION,
+                                         .index = (uint32_t)i,
+                                         .component_count = 3,
+                                         .interp = AK_INTERP_LINEAR,
+                                         .key_count = nf,
+                                         .times = times,
+                                         .values = &tv[i * nf].x};
+            ch[2 * i + 1] = (ak_raw_channel){.target = AK_CHANNEL_ROTATION,
+                                             .index = (uint32_t)i,
+                                             .component_count = 4,
+                                             .interp = AK_INTERP_LINEAR,
+                                             .key_count = nf,
+                                             .times = times,
+                                             .values = &rv[i * nf].x};
+        }
+        ak_raw_clip raw = {.name = desc->name ? desc->name : "ragdoll",
+                           .duration = times[nf - 1],
+                           .channels = ch,
+                           .channel_count = 2 * n,
+                           .joint_count = n};
+        r = ak_clip_build(&raw, alloc, out_clip, diag);
+    }
+    if (r == AK_ERR_NO_MEMORY) akp_diag_set(diag, r, "ragdoll bake", "out of memory");
+    free(times), free(tv), free(rv), free(local), free(ch);
+    return r;
 }

@@ -361,7 +361,39 @@ int cmd_rigid(int argc, char** argv) {
                                  .positions = rec_x,
                                  .orientations = rec_q,
                                  .frame_time = sc.dt * (float)every};
-        r = ak_rigid_bake_scene(&bd, NULL, &baked, &diag);
+        if (sc.ragdoll_bone_count) {
+            /* the ragdoll preset: its character, the run as its skeleton's animation */
+            r = ak_builtin_create(sc.ragdoll_character,
+                                  &(ak_builtin_desc){.cell_size = sc.ragdoll_cell_size}, NULL,
+                                  &baked);
+            ak_clip* clip = NULL;
+            if (r == AK_OK && (!baked->clip_count ||
+                               ak_skeleton_joint_count(baked->skeleton) != sc.ragdoll_bone_count)) {
+                snprintf(diag.message, sizeof diag.message,
+                         "builtin:%s is not the ragdoll's character", sc.ragdoll_character);
+                r = AK_ERR_BAD_DATA;
+            }
+            if (r == AK_OK) {
+                ak_rigid_bake_ragdoll_desc rb = {
+                    .name = "ragdoll",
+                    .skeleton = baked->skeleton,
+                    .bones = {sc.ragdoll_bones, sc.ragdoll_bone_count},
+                    .fallback_pose = {sc.ragdoll_pose, sc.ragdoll_bone_count},
+                    .body_count = n,
+                    .frame_count = rec_frames,
+                    .positions = rec_x,
+                    .orientations = rec_q,
+                    .frame_time = sc.dt * (float)every};
+                r = ak_rigid_bake_ragdoll_clip(&rb, &baked->alloc, &clip, &diag);
+            }
+            if (r == AK_OK) { /* the baked run replaces the character's own clips */
+                for (size_t c = 0; c < baked->clip_count; ++c) ak_clip_destroy(baked->clips[c]);
+                baked->clips[0] = clip;
+                baked->clip_count = 1;
+            }
+        } else {
+            r = ak_rigid_bake_scene(&bd, NULL, &baked, &diag);
+        }
         if (r == AK_OK) r = ak_io_save(out, baked, NULL, &diag);
         if (r == AK_ERR_UNSUPPORTED) {
             rc = cli_fail("rigid", "%s: %s; use fewer --steps", out, diag.message);
@@ -378,6 +410,9 @@ int cmd_rigid(int argc, char** argv) {
            energy);
     if (gif)
         cli_wrote(out, "%d frames", frames);
+    else if (rec_cap && sc.ragdoll_bone_count)
+        cli_wrote(out, "%zu frames, %.4g s apart, builtin:%s's skeleton animated", rec_frames,
+                  (double)sc.dt * (double)every, sc.ragdoll_character);
     else if (rec_cap)
         cli_wrote(out, "%zu frames, %.4g s apart, one node per body", rec_frames,
                   (double)sc.dt * (double)every);
