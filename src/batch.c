@@ -20,6 +20,7 @@
 #include <animkit/raster.h>
 #include <animkit/retarget.h>
 #include <animkit/scene.h>
+#include <animkit/skin.h>
 #include <animkit/view.h>
 
 #include "json.h"
@@ -600,10 +601,83 @@ done:
     return r;
 }
 
+/* The posed meshes of a render job: skinned meshes by LBS from the pose's palette, the others
+ * carried by their node; base colour and texture from the material. */
+typedef struct posed_meshes {
+    ak_raster_mesh* draws;
+    ak_raster_texture* textures;
+    ak_mat4* models;
+    ak_vec3** buffers; /* per mesh: positions then normals, skinned meshes only */
+    size_t count;
+} posed_meshes;
+
+static void posed_free(posed_meshes* pm) {
+    for (size_t m = 0; pm->buffers && m < pm->count; ++m) free(pm->buffers[m]);
+    free(pm->buffers), free(pm->draws), free(pm->textures), free(pm->models);
+    memset(pm, 0, sizeof *pm);
+}
+
+static ak_result pose_meshes(job_ctx* c, const ak_scene* sc, const ak_mat4* world, size_t nj, posed_meshes* pm) {
+    const size_t n = sc->mesh_count;
+    pm->draws = calloc(n + 1, sizeof *pm->draws);
+    pm->textures = calloc(n + 1, sizeof *pm->textures);
+    pm->models = calloc(n + 1, sizeof *pm->models);
+    pm->buffers = calloc(n + 1, sizeof *pm->buffers);
+    if (!pm->draws || !pm->textures || !pm->models || !pm->buffers) return fail(c, AK_ERR_NO_MEMORY, "out of memory");
+    for (size_t m = 0; m < n; ++m) {
+        const ak_scene_mesh* sm = &sc->meshes[m];
+        const ak_mesh* mesh = sm->mesh;
+        if (!mesh || mesh->vertex_count == 0 || mesh->triangle_count == 0) continue;
+        ak_raster_mesh* d = &pm->draws[pm->count];
+        *d = ak_view_raster_mesh(mesh);
+        const size_t v = mesh->vertex_count;
+        if (sm->skin >= 0 && (size_t)sm->skin < sc->skin_count && mesh->influence_count > 0) {
+            const ak_scene_skin* skin = &sc->skins[sm->skin];
+            ak_mat4* palette = malloc((skin->joint_count + 1) * sizeof *palette);
+            ak_vec3* buf = pm->buffers[pm->count] = malloc(2 * v * sizeof(ak_vec3));
+            if (!palette || !buf) {
+                free(palette);
+                return fail(c, AK_ERR_NO_MEMORY, "out of memory");
+            }
+            ak_result r = ak_scene_skin_palette(sc, (size_t)sm->skin, (ak_mat4_cspan){world, nj},
+                                                (ak_mat4_span){palette, skin->joint_count});
+            ak_skin_job job = {.method = AK_SKIN_LBS, .influence_count = mesh->influence_count,
+                               .palette = {palette, skin->joint_count}, .positions = {mesh->positions, v, 0},
+                               .joints = {mesh->joints, v, mesh->influence_count * sizeof(uint16_t)},
+                               .weights = {mesh->weights, v, mesh->influence_count * sizeof(float)},
+                               .out_positions = {buf, v, 0}};
+            if (mesh->normals) job.normals = (ak_cstream){mesh->normals, v, 0}, job.out_normals = (ak_stream){buf + v, v, 0};
+            if (r == AK_OK) r = ak_skin_job_run(&job);
+            free(palette);
+            if (r != AK_OK) return fail(c, r, "skinning mesh %zu: %s", m, ak_result_string(r));
+            d->positions = (ak_vec3_cspan){buf, v};
+            if (mesh->normals) d->normals = (ak_vec3_cspan){buf + v, v};
+        } else if (sm->node >= 0 && (size_t)sm->node < nj) {
+            pm->models[pm->count] = world[sm->node];
+            d->model = &pm->models[pm->count];
+        }
+        if (sm->has_material) d->material.color = sm->base_color;
+        if (sm->texture >= 0 && (size_t)sm->texture < sc->texture_count && mesh->uvs) {
+            const ak_scene_texture* t = &sc->textures[sm->texture];
+            if (t->pixels && t->width > 0 && t->height > 0) {
+                pm->textures[pm->count] = (ak_raster_texture){
+                    .image = {t->pixels, t->width, t->height, 0}, .wrap_u = (ak_raster_wrap)t->wrap_s,
+                    .wrap_v = (ak_raster_wrap)t->wrap_t, .mag_filter = (ak_raster_filter)t->mag_filter,
+                    .min_filter = (ak_raster_filter)t->min_filter};
+                d->texture = &pm->textures[pm->count];
+                d->uvs = (ak_vec2_cspan){mesh->uvs, v};
+            }
+        }
+        pm->count++;
+    }
+    return AK_OK;
+}
+
 static ak_result run_render(job_ctx* c) {
     const ak_batch_job* job = c->job;
     ak_scene* sc = NULL;
     ak_raster* ras = NULL;
+    posed_meshes pm = {0};
     ak_result r = load_model(c, "model", c->inputs[0].path, &sc);
     const size_t nj = sc ? ak_scene_joint_count(sc) : 0;
     ak_transform* local = calloc(nj + 1, sizeof *local);
@@ -629,10 +703,12 @@ static ak_result run_render(job_ctx* c) {
         r = fail(c, r, "pose: %s", ak_result_string(r));
         goto done;
     }
+    if ((r = pose_meshes(c, sc, world, nj, &pm)) != AK_OK) goto done;
     const ak_i16_cspan par = ak_skeleton_parents(sc->skeleton);
     for (size_t i = 0; i < nj; ++i) parents[i] = i < par.count ? par.ptr[i] : -1;
+    /* the skeleton over a model without meshes (a BVH); with meshes, the meshes alone */
     ak_view_skeleton vs = {.joint_model = {world, nj}, .parents = {parents, nj}};
-    ak_view_scene view = {.skeleton = &vs};
+    ak_view_scene view = {.meshes = pm.draws, .mesh_count = pm.count, .skeleton = pm.count ? NULL : &vs};
     ak_vec3 lo, hi;
     ak_view_scene_bounds(&view, &lo, &hi);
     ak_view_orbit orbit = {.azimuth = 0.5f, .elevation = 0.25f, .aspect = (float)job->width / (float)job->height};
@@ -646,6 +722,7 @@ static ak_result run_render(job_ctx* c) {
     if ((r = ak_png_write(c->output, &img)) != AK_OK) r = fail(c, r, "output: %s: cannot write the PNG", c->output);
 done:
     ak_raster_destroy(ras);
+    posed_free(&pm);
     free(px), free(parents), free(world), free(local);
     ak_scene_destroy(sc);
     return r;

@@ -6,7 +6,6 @@
  * writes its own outputs: threads split agents into ranges and results do not depend on the
  * split. */
 #include <math.h>
-#include <pthread.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -14,6 +13,7 @@
 #include <animkit/grid.h>
 
 #include "internal.h"
+#include "tasks.h"
 
 #define EPS 1e-5f   /* the LP's parallel-line tolerance (RVO2's RVO_EPSILON) */
 #define COORD_MAX 1e7f
@@ -325,46 +325,83 @@ ak_vec2 ak_crowd_solve(ak_crowd_line_cspan lines, size_t obstacle_line_count, fl
 typedef struct ctx {
     const ak_crowd_step_job* job;
     const ak_crowd* crowd;
+    /* The neighbour search's grid: when the occupied rectangle of cells fits the scratch
+     * (about 4 cells per agent), a dense one of our own, cells in row-major order with the
+     * agents sorted by cell, so that a row of cells is one contiguous range (cstart != NULL);
+     * else the shared hash grid. */
     const ak_grid* grid;
-    /* A dense table of the grid's cells over their bounding rectangle (when it fits the
-     * scratch: about 4 cells per agent), so that a lookup is an index instead of a hash. */
-    const uint32_t* dense;
-    int32_t dense_x0, dense_z0, dense_w, dense_h;
+    const uint32_t* cstart; /* [w * h + 1]: cell (x, z) holds sorted entries
+                               [cstart[z w + x], cstart[z w + x + 1]) */
+    const float *sx, *sz;   /* [n] positions in cell order */
+    const uint32_t* sidx;   /* [n] agent of each sorted entry */
+    int64_t x0, z0;         /* the rectangle's first cell */
+    int32_t w, h;
+    float cs;
 } ctx;
 
-static inline uint32_t cell_lookup(const ctx* c, int32_t x, int32_t z) {
-    if (c->dense) {
-        const int64_t u = (int64_t)x - c->dense_x0, w = (int64_t)z - c->dense_z0;
-        if (u < 0 || w < 0 || u >= c->dense_w || w >= c->dense_h) return UINT32_MAX;
-        return c->dense[w * c->dense_w + u];
+/* floor(v / cs) as the shared grid computes it (in double). */
+static inline double cell_coord(float v, double inv_cs) { return floor((double)v * inv_cs); }
+
+/* The dense grid over positions[0, n) into mem (cstart [cap + 1], sx, sz, sidx, cell [n]);
+ * false when the rectangle has more than cap cells. *load: sum over cells of count^2. */
+static bool dense_grid_build(ctx* c, const ak_vec2* P, size_t n, float cs, void* mem, size_t cap, uint64_t* load) {
+    c->cstart = NULL;
+    if (n == 0) return false;
+    const double inv = 1.0 / (double)cs;
+    double x0 = cell_coord(P[0].x, inv), x1 = x0, z0 = cell_coord(P[0].y, inv), z1 = z0;
+    for (size_t i = 1; i < n; ++i) {
+        const double x = cell_coord(P[i].x, inv), z = cell_coord(P[i].y, inv);
+        x0 = x < x0 ? x : x0;
+        x1 = x > x1 ? x : x1;
+        z0 = z < z0 ? z : z0;
+        z1 = z > z1 ? z : z1;
     }
-    const ak_grid_cell cc = {x, 0, z};
-    return ak_grid_cell_find(c->grid, cc);
+    const double wd = x1 - x0 + 1.0, hd = z1 - z0 + 1.0;
+    if (!(wd * hd <= (double)cap)) return false;
+    const int32_t w = (int32_t)wd, h = (int32_t)hd;
+    const size_t cells = (size_t)w * (size_t)h;
+    uint32_t* cstart = (uint32_t*)mem;
+    float* sx = (float*)(void*)(cstart + akp_align16((cap + 1) * sizeof(uint32_t)) / sizeof(uint32_t));
+    float* sz = sx + akp_align16(n * sizeof(float)) / sizeof(float);
+    uint32_t* sidx = (uint32_t*)(void*)(sz + akp_align16(n * sizeof(float)) / sizeof(float));
+    uint32_t* cell = sidx + akp_align16(n * sizeof(uint32_t)) / sizeof(uint32_t);
+    memset(cstart, 0, (cells + 1) * sizeof(uint32_t));
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t m = (uint32_t)((cell_coord(P[i].y, inv) - z0) * wd + (cell_coord(P[i].x, inv) - x0));
+        cell[i] = m;
+        ++cstart[m + 1];
+    }
+    uint64_t l = 0;
+    for (size_t m = 0; m < cells; ++m) {
+        l += (uint64_t)cstart[m + 1] * cstart[m + 1];
+        cstart[m + 1] += cstart[m];
+    }
+    /* scatter in agent order (stable), cstart[m] advancing to the cell's end, then back */
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t s = cstart[cell[i]]++;
+        sx[s] = P[i].x;
+        sz[s] = P[i].y;
+        sidx[s] = (uint32_t)i;
+    }
+    for (size_t m = cells; m > 0; --m) cstart[m] = cstart[m - 1];
+    cstart[0] = 0;
+    *load = l;
+    c->cstart = cstart;
+    c->sx = sx;
+    c->sz = sz;
+    c->sidx = sidx;
+    c->x0 = (int64_t)x0;
+    c->z0 = (int64_t)z0;
+    c->w = w;
+    c->h = h;
+    c->cs = cs;
+    return true;
 }
 
-/* Fill the dense table when the occupied rectangle fits cap entries; else leave it off. */
-static void dense_build(ctx* c, uint32_t* table, size_t cap) {
-    const ak_grid* g = c->grid;
-    c->dense = NULL;
-    if (g->cell_count == 0) return;
-    int32_t x0 = g->cell_coord[0].x, x1 = x0, z0 = g->cell_coord[0].z, z1 = z0;
-    for (uint32_t m = 1; m < g->cell_count; ++m) {
-        const ak_grid_cell q = g->cell_coord[m];
-        if (q.x < x0) x0 = q.x;
-        if (q.x > x1) x1 = q.x;
-        if (q.z < z0) z0 = q.z;
-        if (q.z > z1) z1 = q.z;
-    }
-    const int64_t w = (int64_t)x1 - x0 + 1, h = (int64_t)z1 - z0 + 1;
-    if (w * h > (int64_t)cap) return;
-    for (int64_t k = 0; k < w * h; ++k) table[k] = UINT32_MAX;
-    for (uint32_t m = 0; m < g->cell_count; ++m)
-        table[(int64_t)(g->cell_coord[m].z - z0) * w + (g->cell_coord[m].x - x0)] = m;
-    c->dense = table;
-    c->dense_x0 = x0;
-    c->dense_z0 = z0;
-    c->dense_w = (int32_t)w;
-    c->dense_h = (int32_t)h;
+/* Bytes of the dense grid for n agents and cap cells. */
+static size_t dense_grid_bytes(size_t n, size_t cap) {
+    return akp_align16((cap + 1) * sizeof(uint32_t)) + 2 * akp_align16(n * sizeof(float)) +
+           2 * akp_align16(n * sizeof(uint32_t));
 }
 
 typedef struct worker {
@@ -378,7 +415,7 @@ typedef struct worker {
 
 /* Insert (d, j) into a list sorted by (distance, index); when the list is full the range
  * shrinks to its last entry (the k nearest, as RVO2 selects them). */
-static void insert_agent(neigh* list, uint32_t* count, uint32_t k, float* range_sq, float d, uint32_t j) {
+static inline void insert_agent(neigh* list, uint32_t* count, uint32_t k, float* range_sq, float d, uint32_t j) {
     if (!(d < *range_sq)) return;
     uint32_t i = *count < k ? (*count)++ : k - 1;
     while (i > 0 && (d < list[i - 1].dist_sq || (d == list[i - 1].dist_sq && j < list[i - 1].index))) {
@@ -390,8 +427,93 @@ static void insert_agent(neigh* list, uint32_t* count, uint32_t k, float* range_
     if (*count == k) *range_sq = list[k - 1].dist_sq;
 }
 
+/* The ring search on the dense grid: a ring's top and bottom rows are each one contiguous
+ * range of sorted entries (cut to the cells within range), its sides single cells. */
+static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, neigh* out) {
+    uint32_t count = 0;
+    const uint32_t k = a->max_neighbors;
+    float range_sq = a->neighbor_distance * a->neighbor_distance;
+    const double inv = 1.0 / (double)c->cs;
+    const int64_t hx = (int64_t)cell_coord(p.x, inv) - c->x0, hz = (int64_t)cell_coord(p.y, inv) - c->z0;
+    const float cs = c->cs;
+    /* the home cell's corner relative to p (cell bounds as the shared grid's) */
+    const float bx = (float)(hx + c->x0) * cs - p.x, bz = (float)(hz + c->z0) * cs - p.y;
+    const int64_t rmax = (int64_t)ceilf(a->neighbor_distance / cs) + 1;
+    const uint32_t* cstart = c->cstart;
+    const float *sx = c->sx, *sz = c->sz;
+    const uint32_t* sidx = c->sidx;
+    const uint32_t self32 = (uint32_t)self;
+#define SCAN(s0, s1)                                                                                  \
+    for (uint32_t s = (s0); s < (s1); ++s) {                                                          \
+        const float ddx = p.x - sx[s], ddz = p.y - sz[s];                                             \
+        const float d = ddx * ddx + ddz * ddz;                                                        \
+        if (d < range_sq && sidx[s] != self32) insert_agent(out, &count, k, &range_sq, d, sidx[s]); \
+    }
+    /* rings 0 and 1: the 3 x 3 block, three row ranges (home row first) */
+    {
+        const int64_t xa = hx > 0 ? hx - 1 : 0, xb = hx + 1 < c->w ? hx + 1 : c->w - 1;
+        for (int q = 0; q < 3; ++q) {
+            const int64_t z = hz + (q == 0 ? 0 : q == 1 ? -1 : 1);
+            if (z < 0 || z >= c->h) continue;
+            const uint32_t* row = cstart + z * c->w;
+            SCAN(row[xa], row[xb + 1])
+        }
+    }
+    for (int64_t r = 2; r <= rmax; ++r) {
+        const float md = (float)(r - 1) * cs;
+        if (md * md * (1.0f - 1e-5f) >= range_sq) break; /* every cell of this ring is farther */
+        /* rows dz = -r and dz = +r */
+        for (int side = 0; side < 2; ++side) {
+            const int64_t dz = side ? r : -r, z = hz + dz;
+            if (z < 0 || z >= c->h) continue;
+            int64_t xa = hx - r, xb = hx + r;
+            const float lz = bz + (float)dz * cs;
+            const float gz = ak_maxf(0.0f, ak_maxf(lz, -(lz + cs)));
+            if (gz * gz * (1.0f - 1e-4f) >= range_sq) continue;
+            /* cut the row to the cells whose nearest point is within range */
+            while (xa <= xb) {
+                const float lx = bx + (float)(xa - hx) * cs;
+                const float gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
+                if ((gx * gx + gz * gz) * (1.0f - 1e-4f) < range_sq) break;
+                ++xa;
+            }
+            while (xb >= xa) {
+                const float lx = bx + (float)(xb - hx) * cs;
+                const float gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
+                if ((gx * gx + gz * gz) * (1.0f - 1e-4f) < range_sq) break;
+                --xb;
+            }
+            if (xa < 0) xa = 0;
+            if (xb >= c->w) xb = c->w - 1;
+            if (xa > xb) continue;
+            const uint32_t* row = cstart + z * c->w;
+            SCAN(row[xa], row[xb + 1])
+        }
+        /* columns dx = -r and dx = +r, rows -r+1 .. r-1 */
+        for (int side = 0; side < 2; ++side) {
+            const int64_t dx = side ? r : -r, x = hx + dx;
+            if (x < 0 || x >= c->w) continue;
+            const float lx = bx + (float)dx * cs;
+            const float gx = ak_maxf(0.0f, ak_maxf(lx, -(lx + cs)));
+            if (gx * gx * (1.0f - 1e-4f) >= range_sq) continue;
+            for (int64_t dz = -r + 1; dz <= r - 1; ++dz) {
+                const int64_t z = hz + dz;
+                if (z < 0 || z >= c->h) continue;
+                const float lz = bz + (float)dz * cs;
+                const float gz = ak_maxf(0.0f, ak_maxf(lz, -(lz + cs)));
+                if ((gx * gx + gz * gz) * (1.0f - 1e-4f) >= range_sq) continue;
+                const uint32_t m = (uint32_t)(z * c->w + x);
+                SCAN(cstart[m], cstart[m + 1])
+            }
+        }
+    }
+#undef SCAN
+    return count;
+}
+
 static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, neigh* out) {
     if (a->max_neighbors == 0) return 0;
+    if (c->cstart) return agent_neighbors_dense(c, self, p, a, out);
     const ak_grid* g = c->grid;
     uint32_t count = 0;
     float range_sq = a->neighbor_distance * a->neighbor_distance;
@@ -428,7 +550,8 @@ static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_c
                 const float gz = ak_maxf(0.0f, ak_maxf(lz - p.y, p.y - (lz + cs)));
                 if ((gx * gx + gz * gz) * (1.0f - 1e-4f) >= range_sq) continue;
             }
-            const uint32_t m = cell_lookup(c, home.x + dx, home.z + dz);
+            const ak_grid_cell cc = {home.x + dx, 0, home.z + dz};
+            const uint32_t m = ak_grid_cell_find(g, cc);
             if (m == UINT32_MAX) continue;
             for (uint32_t s = g->cell_start[m]; s < g->cell_start[m + 1]; ++s) {
                 const uint32_t j = g->order[s];
@@ -802,7 +925,8 @@ static void* work(void* arg) {
     worker* w = (worker*)arg;
     const ctx* c = w->c;
     const ak_crowd_step_job* job = c->job;
-    for (size_t i = w->begin; i < w->end; ++i) {
+    for (size_t s = w->begin; s < w->end; ++s) {
+        const size_t i = c->cstart ? c->sidx[s] : s; /* in cell order: neighbours share the cache */
         const ak_crowd_agent* a = &c->crowd->agents[i];
         const ak_vec2 p = job->positions.ptr[i], v = job->velocities.ptr[i];
         const ak_vec2 pref = pref_velocity(job, a, i, p);
@@ -825,8 +949,9 @@ static void* work(void* arg) {
     return NULL;
 }
 
-/* Push an agent out of the obstacle edges it overlaps (from their outer side). */
-static ak_vec2 push_out_of_obstacles(const ak_crowd* crowd, ak_vec2 q, float r) {
+/* Push an agent out of the obstacle edges it overlaps (from their outer side) to skin
+ * beyond touching; *depth grows to the deepest penetration found. */
+static ak_vec2 push_out_of_obstacles(const ak_crowd* crowd, ak_vec2 q, float r, float skin, float* depth) {
     for (uint32_t k = 0; k < crowd->vertex_count; ++k) {
         const obst_vertex* o1 = &crowd->verts[k];
         const ak_vec2 b = crowd->verts[o1->next].point;
@@ -836,15 +961,18 @@ static ak_vec2 push_out_of_obstacles(const ak_crowd* crowd, ak_vec2 q, float r) 
         const float d2 = abs_sq(d);
         if (d2 >= r * r || !(d2 > 0.0f) || left_of(o1->point, b, q) > 0.0f) continue;
         const float dl = sqrtf(d2);
-        q = add(q, mul((r - dl) / dl, d));
+        if (r - dl > *depth) *depth = r - dl;
+        q = add(q, mul((r + skin - dl) / dl, d));
     }
     return q;
 }
 
 /* One Gauss-Seidel contact pass over every overlapping pair, in the grid's order (cells,
  * then the 9-cell stencil, then sorted entries: a function of the positions only), each pair
- * moved apart to touching, then agents out of obstacle edges. */
-static void contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P) {
+ * moved apart to skin beyond touching, then agents out of obstacle edges. Returns the deepest
+ * overlap (pair or obstacle) the pass found, 0 when none. */
+static float contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P, float skin) {
+    float depth = 0.0f;
     for (uint32_t m = 0; m < g->cell_count; ++m) {
         const ak_grid_cell cm = g->cell_coord[m];
         for (int dz = -1; dz <= 1; ++dz)
@@ -861,9 +989,10 @@ static void contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P) {
                         const float d2 = abs_sq(d);
                         if (!(d2 < rr * rr)) continue;
                         const float dl = sqrtf(d2);
+                        if (rr - dl > depth) depth = rr - dl;
                         /* coincident centres: split along x, lower index to -x */
                         const ak_vec2 dir = dl > 1e-6f * rr ? mul(1.0f / dl, d) : v2(i < j ? -1.0f : 1.0f, 0.0f);
-                        const ak_vec2 h = mul(0.5f * (rr - dl), dir);
+                        const ak_vec2 h = mul(0.5f * (rr + skin - dl), dir);
                         P[i] = add(P[i], h);
                         P[j] = sub(P[j], h);
                     }
@@ -871,18 +1000,13 @@ static void contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P) {
             }
     }
     if (crowd->vertex_count)
-        for (size_t i = 0; i < crowd->agent_count; ++i) P[i] = push_out_of_obstacles(crowd, P[i], crowd->agents[i].radius);
+        for (size_t i = 0; i < crowd->agent_count; ++i)
+            P[i] = push_out_of_obstacles(crowd, P[i], crowd->agents[i].radius, skin, &depth);
+    return depth;
 }
 
 static void run_threads(void* (*fn)(void*), worker* w, uint32_t threads) {
-    pthread_t ids[64];
-    bool started[64] = {false};
-    for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, fn, &w[t]) == 0;
-    fn(&w[0]);
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else fn(&w[t]);
-    }
+    akp_run_tasks(fn, w, sizeof(worker), threads); /* the library's worker team (src/tasks.h) */
 }
 
 /* ---- scratch layout -------------------------------------------------------------------------- */
@@ -892,6 +1016,11 @@ static uint32_t thread_total(const ak_crowd_step_job* job, size_t n) {
     if (t > 64) t = 64;
     if ((size_t)t * 256u > n) t = n / 256u > 0 ? (uint32_t)(n / 256u) : 1u; /* a thread start ~ 256 agents */
     return t;
+}
+
+/* Whether the step runs contact passes (their grid shares the scratch). */
+static uint32_t contact_need(const ak_crowd_step_job* job) {
+    return job->allow_overlap ? job->contact_iterations : 1u;
 }
 
 typedef struct layout {
@@ -915,7 +1044,7 @@ static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t 
     L->per_thread = akp_align16((size_t)c->max_k * sizeof(neigh)) + akp_align16((size_t)c->vertex_count * sizeof(neigh)) +
                     2 * akp_align16(lines * sizeof(ak_crowd_line));
     L->dense_cap = 4 * n + 1024;
-    L->dense = akp_align16(L->dense_cap * sizeof(uint32_t));
+    L->dense = dense_grid_bytes(n, L->dense_cap);
     L->total = L->grid_pts + L->grid_mem + L->contact + L->dense + (size_t)threads * L->per_thread + 16;
     return true;
 }
@@ -937,7 +1066,7 @@ size_t ak_crowd_step_scratch_size(const ak_crowd_step_job* job) {
     if (!job || !job->crowd || job->thread_count > 64 || job->contact_iterations > 64) return 0;
     const size_t n = job->crowd->agent_count;
     layout L;
-    if (!make_layout(job->crowd, n, thread_total(job, n), job->contact_iterations, &L)) return 0;
+    if (!make_layout(job->crowd, n, thread_total(job, n), contact_need(job), &L)) return 0;
     return L.total;
 }
 
@@ -1001,6 +1130,20 @@ static ak_result build_grid(const ak_crowd_step_job* job, const layout* L, const
     return load > budget ? AK_ERR_BUDGET : AK_OK;
 }
 
+/* The neighbour search's grid: the dense one when it fits, else the shared hash grid; both
+ * check the cell-load budget. */
+static ak_result search_grid(ctx* c, const layout* L, char* base, ak_grid* grid) {
+    const ak_crowd_step_job* job = c->job;
+    uint64_t load = 0;
+    if (dense_grid_build(c, job->positions.ptr, c->crowd->agent_count, c->crowd->cell_size,
+                         base + L->grid_pts + L->grid_mem + L->contact, L->dense_cap, &load)) {
+        const uint64_t budget = job->max_cell_load ? job->max_cell_load : AK_CROWD_DEFAULT_CELL_LOAD;
+        return load > budget ? AK_ERR_BUDGET : AK_OK;
+    }
+    c->grid = grid;
+    return build_grid(job, L, &L->gd, job->positions.ptr, base, grid);
+}
+
 ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     const ak_result vr = ak_crowd_step_validate(job);
     if (vr != AK_OK) return vr;
@@ -1008,13 +1151,12 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     const size_t n = crowd->agent_count;
     const uint32_t threads = thread_total(job, n);
     layout L;
-    make_layout(crowd, n, threads, job->contact_iterations, &L);
+    make_layout(crowd, n, threads, contact_need(job), &L);
     char* base = align_up(job->scratch.ptr);
     ak_grid grid;
-    const ak_result gr = build_grid(job, &L, &L.gd, job->positions.ptr, base, &grid);
+    ctx c = {.job = job, .crowd = crowd};
+    const ak_result gr = search_grid(&c, &L, base, &grid);
     if (gr != AK_OK) return gr;
-    ctx c = {.job = job, .crowd = crowd, .grid = &grid};
-    dense_build(&c, (uint32_t*)(void*)(base + L.grid_pts + L.grid_mem + L.contact), L.dense_cap);
     worker w[64];
     char* tb = base + L.grid_pts + L.grid_mem + L.contact + L.dense;
     for (uint32_t t = 0; t < threads; ++t) {
@@ -1024,13 +1166,31 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
         carve_worker(crowd, tb + (size_t)t * L.per_thread, &w[t]);
     }
     run_threads(work, w, threads);
-    if (job->contact_iterations == 0) return AK_OK;
-    /* Contacts: Gauss-Seidel passes over the moved positions (on this thread), the grid
-     * rebuilt for each. */
-    for (uint32_t it = 0; it < job->contact_iterations; ++it) {
+    if (job->allow_overlap) {
+        /* RVO2's behaviour, with at most contact_iterations passes after it (0: pure ORCA) */
+        for (uint32_t it = 0; it < job->contact_iterations; ++it) {
+            const ak_result cr = build_grid(job, &L, &L.contact_gd, job->out_positions.ptr, base, &grid);
+            if (cr != AK_OK) return cr;
+            (void)contact_pass(crowd, &grid, job->out_positions.ptr, 0.0f);
+        }
+        return AK_OK;
+    }
+    /* The hard-contact projection: Gauss-Seidel passes (on this thread, the grid rebuilt for
+     * each) until a pass finds no overlap deeper than AK_CROWD_CONTACT_TOLERANCE; pairs are
+     * moved apart to a skin of a tenth of it beyond touching so that rounding does not leave
+     * them overlapping. */
+    const float tol = AK_CROWD_CONTACT_TOLERANCE;
+    for (uint32_t it = 0; it < AK_CROWD_MAX_CONTACT_PASSES; ++it) {
         const ak_result cr = build_grid(job, &L, &L.contact_gd, job->out_positions.ptr, base, &grid);
         if (cr != AK_OK) return cr;
-        contact_pass(crowd, &grid, job->out_positions.ptr);
+        const float depth = contact_pass(crowd, &grid, job->out_positions.ptr, 0.1f * tol);
+        if (!(depth > tol) && it + 1 >= job->contact_iterations) break;
+    }
+    if (!job->orca_velocities) {
+        /* the velocity the agent actually moved with */
+        const float inv_dt = 1.0f / job->dt;
+        for (size_t i = 0; i < n; ++i)
+            job->out_velocities.ptr[i] = mul(inv_dt, sub(job->out_positions.ptr[i], job->positions.ptr[i]));
     }
     return AK_OK;
 }
@@ -1041,12 +1201,11 @@ size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd
     if (ak_crowd_step_validate(job) != AK_OK || index >= job->crowd->agent_count) return 0;
     const ak_crowd* crowd = job->crowd;
     layout L;
-    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), job->contact_iterations, &L);
+    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), contact_need(job), &L);
     char* base = align_up(job->scratch.ptr);
     ak_grid grid;
-    if (build_grid(job, &L, &L.gd, job->positions.ptr, base, &grid) != AK_OK) return 0;
-    ctx c = {.job = job, .crowd = crowd, .grid = &grid};
-    dense_build(&c, (uint32_t*)(void*)(base + L.grid_pts + L.grid_mem + L.contact), L.dense_cap);
+    ctx c = {.job = job, .crowd = crowd};
+    if (search_grid(&c, &L, base, &grid) != AK_OK) return 0;
     worker w;
     w.c = &c;
     carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense, &w);

@@ -12,10 +12,11 @@
 #include "fluid/fluid_internal.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <string.h>
 #include <time.h>
+
+#include "tasks.h"
 
 #define FLUID_PI 3.14159265358979323846
 #define FLUID_MAX_THREADS 64u
@@ -339,24 +340,17 @@ static size_t split(size_t n, uint32_t t, uint32_t threads) {
     return t >= threads ? n : (n * t / threads) & ~(size_t)15;
 }
 
-/* The step's worker team: thread_count - 1 workers started once per step (not once per
- * phase: a PBF step has about 20 phases) that run each phase's share and meet the caller at a
- * barrier. A thread that arrives first spins up to TEAM_SPIN pauses, then sleeps on the
- * condition variable (a descheduled partner on a loaded machine would make spinning burn its
- * core); the last to arrive bumps the generation and wakes sleepers through the mutex.
- * Sequentially consistent atomics order "bump, then look for sleepers" against "announce
- * sleeping, then look at the generation", so no wake-up is lost (the cloth barrier's scheme). */
-#define TEAM_SPIN 512
-
+/* The step's team: thread_count - 1 of the library's workers (src/tasks.h) lent for the
+ * whole step (not once per phase: a PBF step has about 20 phases); they run each phase's share
+ * and meet the caller at a barrier before and after it. */
 typedef struct akp_fluid_team {
-    pthread_mutex_t m;
-    pthread_cond_t cv;
-    atomic_uint arrived, generation, sleepers;
+    akp_barrier bar;
+    akp_team_run run;
     uint32_t size; /* threads meeting at the barrier, the caller included */
     /* the phase being run (written by the caller before the start barrier) */
     phase_fn fn;
     size_t n;
-    bool quit, go;
+    bool quit;
 } team;
 
 typedef struct worker {
@@ -364,86 +358,39 @@ typedef struct worker {
     uint32_t t;
 } worker;
 
-static void cpu_relax(void) {
-#if defined(__x86_64__) || defined(__i386__)
-    __asm__ __volatile__("pause");
-#endif
-}
-
-static void team_barrier(team* tm) {
-    const unsigned g = atomic_load(&tm->generation);
-    if (atomic_fetch_add(&tm->arrived, 1) + 1 == tm->size) {
-        atomic_store(&tm->arrived, 0);
-        atomic_fetch_add(&tm->generation, 1);
-        if (atomic_load(&tm->sleepers)) {
-            pthread_mutex_lock(&tm->m);
-            pthread_cond_broadcast(&tm->cv);
-            pthread_mutex_unlock(&tm->m);
-        }
-        return;
-    }
-    for (int k = 0; k < TEAM_SPIN; ++k) {
-        if (atomic_load_explicit(&tm->generation, memory_order_acquire) != g) return;
-        cpu_relax();
-    }
-    pthread_mutex_lock(&tm->m);
-    atomic_fetch_add(&tm->sleepers, 1);
-    while (atomic_load(&tm->generation) == g) pthread_cond_wait(&tm->cv, &tm->m);
-    atomic_fetch_sub(&tm->sleepers, 1);
-    pthread_mutex_unlock(&tm->m);
-}
-
 static void* worker_main(void* arg) {
     const worker* w = (const worker*)arg;
     team* tm = w->c->team;
-    pthread_mutex_lock(&tm->m);
-    while (!tm->go) pthread_cond_wait(&tm->cv, &tm->m);
-    pthread_mutex_unlock(&tm->m);
     for (;;) {
-        team_barrier(tm); /* start of a phase (or quit) */
+        akp_barrier_wait(&tm->bar); /* start of a phase (or quit) */
         if (tm->quit) return NULL;
         tm->fn(w->c, split(tm->n, w->t, tm->size), split(tm->n, w->t + 1, tm->size), w->t);
-        team_barrier(tm); /* end of the phase */
+        akp_barrier_wait(&tm->bar); /* end of the phase */
     }
 }
 
-/* Starts up to threads - 1 workers; c->team stays NULL when none starts. */
-static void team_start(ctx* c, team* tm, worker* ws, pthread_t* ids, uint32_t threads) {
+/* Lends threads - 1 workers to the step; c->team stays NULL when they cannot all run (the
+ * caller then runs every phase alone). */
+static void team_start(ctx* c, team* tm, worker* ws, uint32_t threads) {
     memset(tm, 0, sizeof *tm);
     if (threads < 2) return;
-    pthread_mutex_init(&tm->m, NULL);
-    pthread_cond_init(&tm->cv, NULL);
-    atomic_init(&tm->arrived, 0u);
-    atomic_init(&tm->generation, 0u);
-    atomic_init(&tm->sleepers, 0u);
-    c->team = tm;
-    uint32_t started = 1;
-    for (uint32_t t = 1; t < threads; ++t) {
-        ws[t] = (worker){c, t};
-        if (pthread_create(&ids[t], NULL, worker_main, &ws[t]) != 0) break;
-        ++started;
-    }
-    /* the workers wait for go, so none meets the barrier before size is final */
-    pthread_mutex_lock(&tm->m);
-    tm->size = started;
-    tm->go = true;
-    pthread_cond_broadcast(&tm->cv);
-    pthread_mutex_unlock(&tm->m);
-    if (started == 1) { /* no worker: run alone */
-        pthread_cond_destroy(&tm->cv);
-        pthread_mutex_destroy(&tm->m);
+    tm->size = threads;
+    akp_barrier_init(&tm->bar, threads);
+    for (uint32_t t = 0; t < threads; ++t) ws[t] = (worker){c, t};
+    c->team = tm; /* before the workers read it */
+    if (!akp_team_begin(&tm->run, worker_main, ws, sizeof(worker), threads)) {
+        akp_barrier_destroy(&tm->bar);
         c->team = NULL;
     }
 }
 
-static void team_stop(ctx* c, pthread_t* ids) {
+static void team_stop(ctx* c) {
     team* tm = c->team;
     if (!tm) return;
     tm->quit = true;
-    team_barrier(tm);
-    for (uint32_t t = 1; t < tm->size; ++t) pthread_join(ids[t], NULL);
-    pthread_cond_destroy(&tm->cv);
-    pthread_mutex_destroy(&tm->m);
+    akp_barrier_wait(&tm->bar);
+    akp_team_end(&tm->run);
+    akp_barrier_destroy(&tm->bar);
     c->team = NULL;
 }
 
@@ -456,9 +403,9 @@ static void parallel_n(ctx* c, phase_fn fn, size_t n) {
         return;
     }
     tm->fn = fn, tm->n = n;
-    team_barrier(tm);
+    akp_barrier_wait(&tm->bar);
     fn(c, split(n, 0, tm->size), split(n, 1, tm->size), 0);
-    team_barrier(tm);
+    akp_barrier_wait(&tm->bar);
 }
 
 static void parallel(ctx* c, phase_fn fn) { parallel_n(c, fn, c->n); }
@@ -1188,8 +1135,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
 
     team tm;
     worker ws[AKP_FLUID_MAX_THREADS];
-    pthread_t ids[AKP_FLUID_MAX_THREADS];
-    team_start(c, &tm, ws, ids, n >= 1024 ? threads : 1u); /* small steps: the caller alone */
+    team_start(c, &tm, ws, n >= 1024 ? threads : 1u); /* small steps: the caller alone */
 
     /* predict (PBF) or take the current positions (SPH), sort by cell, neighbour lists */
     parallel(c, ph_predict);
@@ -1197,7 +1143,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     ak_grid_desc gd = {.cell_size = c->h};
     bool dense = false;
     if (!sort_by_cell(c, base + L.grid, ak_grid_memory_size(n, &gd), cap, &dense)) {
-        team_stop(c, ids);
+        team_stop(c);
         return AK_ERR_NO_CONVERGENCE; /* only non-finite predictions fail here */
     }
     if (dense) parallel(c, ph_neighbours_dense);
@@ -1232,7 +1178,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     parallel(c, ph_flags);
     parallel(c, ph_full);
     parallel(c, ph_scatter);
-    team_stop(c, ids);
+    team_stop(c);
 
     /* blow-up check, statistics (sorted order: the same for any thread count) */
     const float limit = 100.0f * c->h;

@@ -2,8 +2,8 @@
 #include <animkit/grid.h>
 
 #include <math.h>
-#include <pthread.h>
 
+#include "tasks.h"
 #include "internal.h"
 
 #define GRID_COORD_LIMIT 1073741824.0 /* 2^30: clamp for cell coordinates */
@@ -366,17 +366,7 @@ static void* pair_thread(void* arg) {
 }
 
 static void run_tasks(void* (*fn)(void*), pair_task* tasks, uint32_t count) {
-    pthread_t ids[GRID_MAX_THREADS];
-    bool started[GRID_MAX_THREADS];
-    for (uint32_t t = 1; t < count; ++t)
-        started[t] = pthread_create(&ids[t], NULL, fn, &tasks[t]) == 0;
-    fn(&tasks[0]);
-    for (uint32_t t = 1; t < count; ++t) {
-        if (started[t])
-            pthread_join(ids[t], NULL);
-        else
-            fn(&tasks[t]);
-    }
+    akp_run_tasks(fn, tasks, sizeof(pair_task), count);
 }
 
 ak_result ak_grid_pairs_validate(const ak_grid_pairs_job* job) {

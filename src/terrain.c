@@ -2,7 +2,6 @@
  * thermal erosion, colours, meshes, OBJ and 16-bit PNG files. */
 #include <math.h>
 #include <png.h> /* libpng classic API: 16-bit greyscale written row by row, no buffer */
-#include <pthread.h>
 #include <setjmp.h>
 #include <stdio.h>
 #include <string.h>
@@ -10,6 +9,7 @@
 #include <animkit/terrain.h>
 
 #include "internal.h" /* ak_atomic_file: outputs written whole or not at all */
+#include "tasks.h"
 
 #define AKP_TERRAIN_MAX_SIDE 16384u
 
@@ -111,20 +111,13 @@ ak_result ak_terrain_generate(const ak_terrain_desc* desc, ak_f32_span out_heigh
     uint32_t threads = d.thread_count > 1 ? d.thread_count : 1;
     if (threads > n / GEN_CHUNK + 1) threads = (uint32_t)(n / GEN_CHUNK + 1);
     gen_task tasks[64];
-    pthread_t ids[64];
-    bool started[64];
     const size_t per = (n + threads - 1) / threads;
     for (uint32_t t = 0; t < threads; ++t) {
         const size_t b = (size_t)t * per, e = b + per;
         tasks[t] = (gen_task){&d, origin.x * inv_f, origin.z * inv_f, c * inv_f, k, k * inv_f, out_heights.ptr,
                               out_normals.ptr, b < n ? b : n, e < n ? e : n};
     }
-    for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, gen_thread, &tasks[t]) == 0;
-    gen_thread(&tasks[0]);
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else gen_thread(&tasks[t]);
-    }
+    akp_run_tasks(gen_thread, tasks, sizeof(gen_task), threads);
     return AK_OK;
 }
 

@@ -33,11 +33,11 @@ AK_TEST(usage) {
     AK_CHECK_EQ(run("crowd crowd_two.json --agents 5", true), 2);
     AK_CHECK_EQ(run("crowd no_such_crowd.json", true), 1);
     AK_CHECK(strstr(out_buf, "no_such_crowd.json") != NULL);
-    /* not implemented yet: a clear error, exit 1, no file written */
+    /* more characters than glTF nodes allow: a clear error before any work, no file */
     remove("crowd_never.glb");
-    AK_CHECK_EQ(run("crowd --agents 4 -o crowd_never.glb", true), 1);
+    AK_CHECK_EQ(run("crowd --agents 2000 -o crowd_never.glb", true), 1);
     AK_CHECK(read_file("crowd_never.glb") == NULL);
-    AK_CHECK(strstr(out_buf, "glTF") != NULL);
+    AK_CHECK(strstr(out_buf, "1800") != NULL);
     /* the work budget, before any work */
     AK_CHECK_EQ(run("crowd --agents 1000000 --steps 100000", true), 1);
     AK_CHECK(strstr(out_buf, "budget") != NULL);
@@ -230,6 +230,82 @@ AK_TEST(render) {
     AK_CHECK(png && memcmp(png, "\x89PNG", 4) == 0);
 }
 
+/* -o X.glb: a skinned character per agent. Read back: one node per agent plus the character's
+ * 17 joints each, one skin and one mesh per agent, an animation lasting steps x dt whose agent
+ * root translations at the end are the positions the --json of the same run reports, and
+ * facing: the root turns the humanoid's +z onto the last velocity's direction (within the
+ * heading's smoothing). */
+AK_TEST(gltf_export) {
+    remove("crowd_chars.glb");
+    AK_CHECK_EQ(run("crowd --preset crossing --agents 8 --steps 40 --json crowd_chars.json -o crowd_chars.glb", true), 0);
+    cJSON* j = read_json("crowd_chars.json");
+    ak_scene* sc = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_load("crowd_chars.glb", NULL, NULL, &sc, &diag), AK_OK);
+    if (!sc || !j) {
+        cJSON_Delete(j);
+        ak_scene_destroy(sc);
+        return;
+    }
+    AK_CHECK_EQ(sc->skin_count, 8u);
+    AK_CHECK_EQ(sc->mesh_count, 8u);
+    AK_CHECK_EQ(sc->clip_count, 1u);
+    const size_t n = ak_scene_joint_count(sc);
+    AK_CHECK(n >= 8 * 18);
+    AK_CHECK_NEAR(ak_clip_duration(sc->clips[0]), 4.0f, 1e-5f);
+    ak_transform* local = malloc(n * sizeof *local);
+    ak_scene_rest_pose(sc, (ak_transform_span){local, n});
+    ak_clip_sample(sc->clips[0], 4.0f, NULL, (ak_transform_span){local, n}, (ak_f32_span){0}, (ak_f32_span){0});
+    int i = 0;
+    for (const cJSON* a = cJSON_GetObjectItem(j, "agents")->child; a; a = a->next, ++i) {
+        char name[32];
+        snprintf(name, sizeof name, "crowd_%d", i);
+        const int node = ak_skeleton_find_joint(sc->skeleton, name);
+        AK_CHECK(node >= 0);
+        if (node < 0) continue;
+        const cJSON* p = cJSON_GetObjectItem(a, "position");
+        const cJSON* v = cJSON_GetObjectItem(a, "velocity");
+        AK_CHECK_NEAR(local[node].translation.x, cJSON_GetArrayItem(p, 0)->valuedouble, 1e-4);
+        AK_CHECK_NEAR(local[node].translation.y, 0.0, 1e-6);
+        AK_CHECK_NEAR(local[node].translation.z, cJSON_GetArrayItem(p, 1)->valuedouble, 1e-4);
+        const ak_vec3 f = ak_quat_rotate(local[node].rotation, ak_vec3_make(0, 0, 1));
+        const double vx = cJSON_GetArrayItem(v, 0)->valuedouble, vz = cJSON_GetArrayItem(v, 1)->valuedouble;
+        const double sp = sqrt(vx * vx + vz * vz);
+        if (sp > 0.5) AK_CHECK_MSG((f.x * vx + f.z * vz) / sp > 0.95, "agent %d faces %g, %g, walks %g, %g", i,
+                                   (double)f.x, (double)f.z, vx, vz);
+    }
+    AK_CHECK_EQ(i, 8);
+    free(local);
+    ak_scene_destroy(sc);
+    cJSON_Delete(j);
+}
+
+/* The Khronos validator on a crowd's glTF (slow: node starts in about a second). */
+AK_TEST(gltf_export_validator) {
+    remove("crowd_chars_v.glb");
+    AK_CHECK_EQ(run("crowd --preset circle --agents 6 --steps 30 -o crowd_chars_v.glb", true), 0);
+    char mod[1024];
+    snprintf(mod, sizeof mod, "%s/build-tools/node_modules/gltf-validator", AK_SOURCE_DIR);
+    struct stat st;
+    if (stat(mod, &st) != 0 || system("node --version >/dev/null 2>&1") != 0) {
+        AK_SKIP("glTF validator absent (%s)", mod);
+        return;
+    }
+    char cmd[3000];
+    snprintf(cmd, sizeof cmd,
+             "NODE_PATH='%s/build-tools/node_modules' node '%s/scripts/gltf_validate.js' crowd_chars_v.glb 2>&1",
+             AK_SOURCE_DIR, AK_SOURCE_DIR);
+    FILE* pp = popen(cmd, "r");
+    AK_CHECK(pp != NULL);
+    if (!pp) return;
+    char line[1024];
+    int errors = -1, warnings = -1;
+    while (fgets(line, sizeof line, pp))
+        if (line[0] != ' ' && sscanf(line, "%d %d", &errors, &warnings) == 2) break;
+    pclose(pp);
+    AK_CHECK_MSG(errors == 0 && warnings == 0, "validator: %d errors, %d warnings", errors, warnings);
+}
+
 int main(void) {
     AK_RUN(usage);
     AK_RUN(bad_scenes_name_the_key);
@@ -240,5 +316,7 @@ int main(void) {
     AK_RUN_SLOW(presets_and_threads);
     AK_RUN(stacked_agents_budget);
     AK_RUN(render);
+    AK_RUN(gltf_export);
+    AK_RUN_SLOW(gltf_export_validator);
     return ak_test_finish();
 }

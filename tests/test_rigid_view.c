@@ -1,8 +1,8 @@
-/* `animkit view rigid`, headless with a script: the stack preset runs the same with and
- * without a right click until the click (the run is deterministic), and a right click left of
- * the stack throws a sphere from the camera that shows up in the picture (the pixels
- * differ from the run without it); the default is the ragdoll preset and it plays; a bad
- * preset exits 2 naming the presets, a missing scene file 1. */
+/* `animkit view rigid`, headless with a script: the stack preset (as rigid:preset:stack and
+ * as rigid --preset stack) runs the same with and without a right click until the click (the run is
+ * deterministic), and a right click left of the stack throws a sphere from the camera that shows up
+ * in the picture (the pixels differ from the run without it); the default is the ragdoll preset and
+ * it plays; a bad preset exits 2 naming the presets, a missing scene file 1. */
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -56,7 +56,8 @@ AK_TEST(right_click_throws_a_sphere) {
                      "wait 3\nscreenshot s0.png\nmouse_down right 60 50\nmouse_up right 60 50\n"
                      "wait 20\nscreenshot s1.png\n"),
                 0);
-    AK_CHECK_EQ(view("rigid:preset:stack", "still.txt",
+    /* the same preset named the other way: `view rigid --preset stack` */
+    AK_CHECK_EQ(view("rigid --preset stack", "still.txt",
                      "wait 3\nscreenshot n0.png\nwait 20\nscreenshot n1.png\n"),
                 0);
     long before = count_diff("s0.png", "n0.png", 0, H);

@@ -1000,6 +1000,60 @@ AK_TEST(no_display_is_an_error) {
     AK_CHECK_MSG(!strstr(out_buf, "XDG_RUNTIME_DIR"), "%s", out_buf);
 }
 
+/* `view crowd SCENE.json` (slow: 160 frames, about 2 s of CPU): two groups of three people standing on their goals (x = -3 and
+ * x = +3). A click on the ground at (-1, 0, 0) (the pixel computed with the viewer's framing
+ * camera, as drag_sphere does) sends the nearest group, the left one, there: after 100 frames
+ * the image changed where it stood and where it went, and not where the right group stands.
+ * Then G (the whole crowd) and a click at (0, 0, 0): the right group moves too. */
+AK_TEST(crowd_click_sets_goal) {
+    write_file("sim_crowd.json",
+               "{\"agents\": [{\"position\": [-3, -0.8], \"goal\": [-3, -0.8]}, {\"position\": [-3, 0], \"goal\": [-3, 0]},"
+               " {\"position\": [-3, 0.8], \"goal\": [-3, 0.8]},"
+               " {\"position\": [3, -0.8], \"goal\": [3, -0.8], \"group\": 1}, {\"position\": [3, 0], \"goal\": [3, 0], \"group\": 1},"
+               " {\"position\": [3, 0.8], \"goal\": [3, 0.8], \"group\": 1}]}\n");
+    const int w = 320, h = 240;
+    ak_view_orbit o = {.azimuth = 0.55f, .elevation = 0.22f, .aspect = (float)w / (float)h, .margin = 1.08f};
+    ak_raster_camera cam = ak_view_orbit_camera(ak_vec3_make(-3, 0, -0.8f), ak_vec3_make(3, 1.8f, 0.8f), &o);
+    ak_vec3 click = {0}, left = {0}, right = {0}, dest = {0}, mid = {0};
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(-1, 0, 0), &click));
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(-3, 1.0f, 0), &left));
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(3, 1.0f, 0), &right));
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(-1, 1.0f, 0), &dest));
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(0, 0, 0), &mid));
+    char script[512];
+    snprintf(script, sizeof script,
+             "wait 1\nscreenshot crowd0.png\nmouse_down left %d %d\nmouse_up left %d %d\nwait 100\n"
+             "screenshot crowd1.png\nkey g\nmouse_down left %d %d\nmouse_up left %d %d\nwait 60\nscreenshot crowd2.png\n",
+             (int)click.x, (int)click.y, (int)click.x, (int)click.y, (int)mid.x, (int)mid.y, (int)mid.x, (int)mid.y);
+    write_file("sim_crowd.txt", script);
+    AK_CHECK_MSG(run("view crowd sim_crowd.json --headless --size 320x240 --script sim_crowd.txt", true) == 0, "%s",
+                 out_buf);
+    ak_image a = {0}, b = {0}, c = {0};
+    if (load_png("crowd0.png", &a, w, h) && load_png("crowd1.png", &b, w, h) && load_png("crowd2.png", &c, w, h)) {
+        AK_CHECK_MSG(window_diff(&a, &b, (int)left.x, (int)left.y) >= 20, "the left group did not leave");
+        AK_CHECK_MSG(window_diff(&a, &b, (int)dest.x, (int)dest.y) >= 20, "the left group did not arrive");
+        AK_CHECK_MSG(window_diff(&a, &b, (int)right.x, (int)right.y) == 0, "the right group moved");
+        AK_CHECK_MSG(window_diff(&b, &c, (int)right.x, (int)right.y) >= 20, "G: the right group did not move");
+    } else {
+        AK_CHECK_MSG(false, "cannot read the crowd screenshots");
+    }
+    free(a.pixels);
+    free(b.pixels);
+    free(c.pixels);
+}
+
+/* The command line's forms of `view crowd` (fast). */
+AK_TEST(crowd_forms) {
+    AK_CHECK_EQ(run("view crowd --preset corridor --agents 3 --headless", true), 2); /* no --agents in view */
+    AK_CHECK_EQ(run("view crowd:preset:crossing --headless --frames 2 --size 64x48", true), 0);
+    AK_CHECK_EQ(run("view crowd --preset stadium --headless", true), 2);
+    AK_CHECK(strstr(out_buf, "circle, crossing, corridor, evacuation") != NULL);
+    AK_CHECK_EQ(run("view crowd sim_crowd.json --preset circle --headless", true), 2);
+    AK_CHECK_EQ(run("view boids --preset flock --headless", true), 2);
+    AK_CHECK_EQ(run("view crowd no_such_crowd.json --headless", true), 1);
+    AK_CHECK(strstr(out_buf, "no_such_crowd.json") != NULL);
+}
+
 int main(void) {
     AK_RUN(bad_scripts_exit_2_naming_the_line);
     AK_RUN(no_display_is_an_error);
@@ -1026,5 +1080,7 @@ int main(void) {
     AK_RUN(sim_particles_drag_deflects);
     AK_RUN(sim_threads_and_seed);
     AK_RUN_SLOW(sim_long_session);
+    AK_RUN(crowd_forms);
+    AK_RUN_SLOW(crowd_click_sets_goal);
     return ak_test_finish();
 }

@@ -9,6 +9,7 @@
 //                        jittered square block of N agents 4 m apart, each walking to the
 //                        point mirrored through the block's centre, 1 and 2 threads (RVO2
 //                        through OpenMP when built with it).
+//   vs_rvo2 time1 [N...] the same on 1 thread only (for profiling).
 //
 // RVO2 is linked from ../shared/peers/rvo2 (Apache-2.0), never copied into animkit.
 #include <algorithm>
@@ -128,6 +129,7 @@ struct Ak {
         job.dt = s.dt;
         job.thread_count = threads;
         job.skip_perturbation = true;  // RVO2's preferred velocities, bit for bit
+        job.allow_overlap = true;      // pure ORCA: RVO2 has no contact projection
         bind();
         scratch.resize(ak_crowd_step_scratch_size(&job));
         job.scratch = ak_u8_span{scratch.data(), scratch.size()};
@@ -228,14 +230,15 @@ void time_one(size_t n, int threads) {
 
 int main(int argc, char** argv) {
     if (argc >= 2 && std::strcmp(argv[1], "agree") == 0) return agree(argc >= 3 ? std::atoi(argv[2]) : 500);
-    if (argc >= 2 && std::strcmp(argv[1], "time") == 0) {
+    if (argc >= 2 && (std::strcmp(argv[1], "time") == 0 || std::strcmp(argv[1], "time1") == 0)) {
+        const int max_threads = std::strcmp(argv[1], "time1") == 0 ? 1 : 2;
         std::vector<size_t> sizes;
         for (int i = 2; i < argc; ++i) sizes.push_back(static_cast<size_t>(std::atol(argv[i])));
         if (sizes.empty()) sizes = {1000, 10000, 100000};
         for (size_t n : sizes)
-            for (int t = 1; t <= 2; ++t) time_one(n, t);
+            for (int t = 1; t <= max_threads; ++t) time_one(n, t);
         return 0;
     }
-    std::fprintf(stderr, "usage: vs_rvo2 agree | time [N...]\n");
+    std::fprintf(stderr, "usage: vs_rvo2 agree [STEPS] | time [N...] | time1 [N...]\n");
     return 2;
 }

@@ -107,8 +107,8 @@ AK_API ak_result ak_batch_run_job(const char* line, size_t size, const ak_batch_
 /* FNV-1a 64 of a file's bytes (offset basis 0xcbf29ce484222325, prime 0x100000001b3), read in
  * blocks. AK_ERR_NULL_ARG, AK_ERR_IO. */
 AK_API ak_result ak_batch_hash_file(const char* path, uint64_t* out_hash);
-/* FNV-1a 64 of bytes[0, size), continuing from hash (pass AK_BATCH_FNV_BASIS to start). */
 #define AK_BATCH_FNV_BASIS 0xcbf29ce484222325ull
+/* FNV-1a 64 of bytes[0, size), continuing from hash (pass AK_BATCH_FNV_BASIS to start). */
 AK_API uint64_t ak_batch_hash_bytes(uint64_t hash, const void* bytes, size_t size);
 
 /* Shard i of n (0 <= i < n) runs the jobs whose 0-based index k has k % n == i. */

@@ -14,9 +14,14 @@
  *     the half-planes leave no velocity, a 3D linear program minimises the largest violation
  *     of the agent half-planes while the obstacle half-planes stay hard;
  *   - neighbour selection as RVO2's: the max_neighbors nearest agents closer than
- *     neighbor_distance (found through the shared grid, grid.h, visiting rings of cells
- *     nearest first), every obstacle edge closer than time_horizon_obstacles * max_speed +
- *     radius, nearest first;
+ *     neighbor_distance (ties by index; found on a cell-sorted dense grid, or the shared
+ *     grid, grid.h, for sparse layouts, visiting rings of cells nearest first), every
+ *     obstacle edge closer than time_horizon_obstacles * max_speed + radius, nearest first;
+ *   - no overlap by default: ORCA alone lets agents overlap where its program is infeasible
+ *     (dense crowds; RVO2 does too), so after the move the step repeats Gauss-Seidel contact
+ *     passes until no pair and no obstacle edge overlaps by more than
+ *     AK_CROWD_CONTACT_TOLERANCE, and reports the displacement as the velocity
+ *     (allow_overlap: RVO2's pure ORCA);
  *   - the preferred velocity points at the current waypoint at pref_speed, and is the offset
  *     to the waypoint itself (per second) within pref_speed * 1 s of the last one, so agents
  *     slow down and stop on their goal (RVO2's examples do this for pref_speed 1); an agent
@@ -34,6 +39,11 @@
  *     threshold, then by the smallest heading change that lifts the rates over it (keeping
  *     their signs; at most 3 rad/s), and slows to pref_speed (1 - exp(-0.5 ttc_min^2)).
  *     No guarantee against overlap (the contact passes apply as for ORCA).
+ *
+ *   - characters: each agent drives a skinned character's in-place walk clip, its clip time
+ *     following the distance walked (measured from the clip's stance foot: ak_crowd_gait_*),
+ *     its heading the velocity, idle when stopped; the crowd baked into an animated scene
+ *     for glTF (ak_crowd_bake_scene). See the "characters" sections below.
  *
  * What it does NOT do: dynamic obstacles, path planning (waypoints come from the caller), 3D
  * terrain (the ground is the plane y = 0).
@@ -68,6 +78,7 @@
 #define ANIMKIT_CROWD_H
 
 #include "math.h"
+#include "scene.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -174,20 +185,39 @@ typedef struct ak_crowd_step_job {
                                     crossing head-on, a ring of agents blocking each other at
                                     the circle's centre); true -> the preferred velocity as
                                     is (RVO2's bits: bench/vs_rvo2) */
-    uint32_t contact_iterations; /* 0 -> pure ORCA. ORCA lets agents overlap when the crowd
-                                    is so dense that its program is infeasible (the 3D program
-                                    then only minimises the violation; RVO2 does the same); n > 0
-                                    -> after the ORCA move, n Gauss-Seidel passes (on the
-                                    calling thread, pairs in the grid's order) move each
-                                    overlapping pair apart to touching and agents out of
-                                    obstacle edges; velocities stay ORCA's. <= 64 */
+    uint32_t contact_iterations; /* with allow_overlap: 0 -> pure ORCA, which lets agents
+                                    overlap when the crowd is so dense that its program is
+                                    infeasible (the 3D program then only minimises the
+                                    violation; RVO2 does the same); n > 0 -> after the ORCA
+                                    move, n Gauss-Seidel passes (on the calling thread,
+                                    pairs in the grid's order) move each overlapping pair
+                                    apart to touching and agents out of obstacle edges;
+                                    velocities stay ORCA's. Without allow_overlap: the
+                                    least number of passes. <= 64 */
+    bool allow_overlap;          /* false (default) -> no overlap: after the move, the
+                                    hard-contact projection repeats contact passes until
+                                    none finds a pair or an obstacle edge overlapping by
+                                    more than AK_CROWD_CONTACT_TOLERANCE (at most
+                                    AK_CROWD_MAX_CONTACT_PASSES). true -> RVO2's behaviour:
+                                    only the contact_iterations passes (0: pure ORCA, whose
+                                    positions overlap where its program is infeasible;
+                                    bench/vs_rvo2) */
+    bool orca_velocities;        /* with allow_overlap false: false (default) ->
+                                    out_velocities are the displacement over dt after the
+                                    projection (what the agent did: an agent pushed back by
+                                    its neighbours does not keep pressing on them); true ->
+                                    ORCA's velocity */
 } ak_crowd_step_job;
+
+/* The hard-contact projection's tolerance (m) and its most passes in one step. */
+#define AK_CROWD_CONTACT_TOLERANCE 1e-4f
+#define AK_CROWD_MAX_CONTACT_PASSES 256u
 
 /* Agents stacked on a few points make the neighbour search quadratic; above this load the
  * step returns AK_ERR_BUDGET (about 4,000 agents in one cell). */
 #define AK_CROWD_DEFAULT_CELL_LOAD 20000000u
 
-/* Scratch bytes for this job (reads crowd, thread_count and contact_iterations); 0 when the
+/* Scratch bytes for this job (reads crowd, thread_count, contact_iterations, allow_overlap); 0 when the
  * job cannot be sized (validate says why). */
 AK_API size_t ak_crowd_step_scratch_size(const ak_crowd_step_job* job);
 
@@ -322,6 +352,145 @@ AK_API ak_result ak_crowd_scene_preset(const char* name, size_t count, ak_crowd_
                                        ak_diag* out_diag);
 /* Free the arrays (NULL: no-op; safe twice); the scalar keys stay. */
 AK_API void ak_crowd_scene_free(ak_crowd_scene* scene);
+
+
+/* ---- characters: a walk cycle per agent ------------------------------------------------- */
+/* Each agent drives a skinned character (builtin:humanoid's "walk", or any in-place walk
+ * clip): the clip's time follows the distance the agent walks, its heading follows the
+ * velocity (smoothed), and it blends to the rest pose when it stops (docs/crowd.md,
+ * "Characters"):
+ *     ak_crowd_gait gait;
+ *     ak_crowd_gait_desc gd = {.scene = humanoid, .clip_index = ak_scene_find_clip(humanoid, "walk")};
+ *     if (ak_crowd_gait_measure(&gd, NULL, &gait, &diag) != AK_OK) ...;
+ *     ak_crowd_character ch[N];
+ *     for (i) ch[i] = ak_crowd_character_init(&gait, heading_i, phase_i);
+ *     each step: ak_crowd_characters_update(&(ak_crowd_characters_job){.gait = &gait, .dt = dt,
+ *                    .velocities = {v, N}, .characters = {ch, N}});
+ *     then per agent: ak_crowd_character_pose(&gait, &ch[i], local) -> local joint transforms,
+ *     ak_crowd_character_root(&gait, &ch[i], p[i]) -> the model-to-world matrix. */
+
+/* Samples of the gait's distance table over one cycle. */
+#define AK_CROWD_GAIT_SAMPLES 256u
+
+typedef struct ak_crowd_gait_desc {
+    const ak_scene* scene; /* required: a skeleton and the walk clip; kept by the gait */
+    int clip_index;        /* the walk clip: a loop (its last pose equals its first) that
+                              walks in place (no horizontal root motion: remove it first with
+                              ak_clip_extract_root_motion) */
+    int left_foot;         /* foot joints; both 0 -> automatic: the lowest joint of the rest
+                              pose with x > 0 (left) and with x < 0 (right) */
+    int right_foot;
+} ak_crowd_gait_desc;
+
+/* A walk clip measured once (a value: copy it freely). The stance foot at clip time t is the
+ * lower of the two feet; over one cycle it travels stride_length backward (along -forward);
+ * distance[k] is that travel accumulated from clip time 0 to k * duration /
+ * AK_CROWD_GAIT_SAMPLES (non-decreasing, distance[0] = 0, distance[SAMPLES] =
+ * stride_length). An agent that walked d metres shows the clip at the time where the
+ * accumulated travel is d mod stride_length: its stance foot then moves back exactly as fast
+ * as the agent moves forward, and the mean playback rate is speed / stride_speed. */
+typedef struct ak_crowd_gait {
+    const ak_scene* scene;
+    int clip_index;
+    int feet[2];          /* left, right joint */
+    float duration;       /* s, the clip's */
+    float stride_length;  /* m per cycle */
+    float stride_speed;   /* m/s at playback rate 1: stride_length / duration */
+    ak_vec3 forward;      /* model-space walking direction (unit, y = 0) */
+    float foot_min_y[2];  /* model-space lowest height of each foot over the cycle */
+    float distance[AK_CROWD_GAIT_SAMPLES + 1];
+} ak_crowd_gait;
+
+/* Measure the walk clip: sample it AK_CROWD_GAIT_SAMPLES times over its duration (forward
+ * kinematics, model space), take the lower foot of each interval, forward = the opposite of
+ * its mean horizontal motion, distance = its accumulated backward motion. alloc (NULL ->
+ * malloc) holds two poses during the call. Returns AK_ERR_NULL_ARG (desc, scene, its
+ * skeleton, out_gait), AK_ERR_BAD_INDEX (clip or foot joint out of range, both feet one
+ * joint), AK_ERR_NOT_FOUND (no joint on one side for the automatic feet), AK_ERR_BAD_DATA
+ * (a clip shorter than 1 ms, or one whose stance foot does not travel at least 1 cm per
+ * cycle: not a walk), AK_ERR_NO_MEMORY; diag (optional) says why. */
+AK_API ak_result ak_crowd_gait_measure(const ak_crowd_gait_desc* desc, const ak_allocator* alloc,
+                                       ak_crowd_gait* out_gait, ak_diag* out_diag);
+
+/* The clip time (in [0, duration)) at which the stance foot has travelled distance mod
+ * stride_length (a negative or non-finite distance -> 0). */
+AK_API float ak_crowd_gait_clip_time(const ak_crowd_gait* gait, float distance);
+
+/* One agent's character state (caller-owned, one per agent). */
+typedef struct ak_crowd_character {
+    float distance;    /* m walked along the cycle, in [0, stride_length) */
+    float clip_time;   /* s: ak_crowd_gait_clip_time(distance) */
+    ak_vec2 heading;   /* unit facing on the ground (x, z) */
+    float walk_weight; /* 1 walking .. 0 idle (the rest pose) */
+} ak_crowd_character;
+
+AK_DEFINE_SPAN(crowd_character, ak_crowd_character)
+
+/* A character facing heading (normalised; zero or non-finite -> +z), at the cycle phase
+ * phase in [0, 1) (a fraction of the stride: give agents different phases so that they do
+ * not all step together), walk_weight 0. */
+AK_API ak_crowd_character ak_crowd_character_init(const ak_crowd_gait* gait, ak_vec2 heading, float phase);
+
+typedef struct ak_crowd_characters_job {
+    const ak_crowd_gait* gait;            /* required */
+    float dt;                             /* s, > 0 and finite */
+    ak_vec2_cspan velocities;             /* required: [count] the agents' velocities this step */
+    ak_crowd_character_span characters;   /* in/out: [count] */
+    float turn_time;     /* s: heading follows the velocity's direction with this time
+                            constant (exponential smoothing); 0 -> 0.1 */
+    float max_turn_rate; /* rad/s; 0 -> 6 */
+    float idle_speed;    /* m/s: below it the character blends to the rest pose
+                            (walk_weight = smoothstep(speed / idle_speed)) and keeps its
+                            heading; 0 -> 0.15 */
+} ak_crowd_characters_job;
+
+/* Advance every character by dt: distance += |v| dt (wrapped), clip_time from the gait,
+ * heading turned toward v (while |v| > idle_speed / 2), walk_weight from the speed.
+ * Returns AK_ERR_NULL_ARG (job, gait, a span), AK_ERR_BAD_ARG (dt not > 0 and finite, a
+ * negative or non-finite parameter), AK_ERR_SPAN_SMALL (velocities shorter than
+ * characters), AK_ERR_BAD_DATA (a non-finite velocity: nothing is written). */
+AK_API ak_result ak_crowd_characters_update(const ak_crowd_characters_job* job);
+
+/* The character's local pose: the rest pose, the walk clip at clip_time over it, then every
+ * joint blended toward the rest pose by 1 - walk_weight (translation and scale linearly,
+ * rotation by SLERP). out_local.count >= the skeleton's joint count. Returns AK_ERR_NULL_ARG,
+ * AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_crowd_character_pose(const ak_crowd_gait* gait, const ak_crowd_character* character,
+                                         ak_transform_span out_local);
+
+/* Model-to-world matrix of the character standing at ground position p: a rotation about +y
+ * turning the gait's forward onto the heading, then the translation (p.x, 0, p.y). */
+AK_API ak_mat4 ak_crowd_character_root(const ak_crowd_gait* gait, const ak_crowd_character* character, ak_vec2 p);
+
+/* ---- the crowd as an animated glTF scene ---------------------------------------------------- */
+
+/* Recorded frames of a crowd with characters, to bake into a scene (frame-major arrays). */
+typedef struct ak_crowd_bake_desc {
+    const ak_crowd_gait* gait;                /* required: the character (gait->scene) */
+    size_t agent_count;                       /* required, > 0 */
+    size_t frame_count;                       /* required, 1 .. AK_SCENE_BAKE_MAX_FRAMES */
+    const ak_vec2* positions;                 /* required: [frame_count * agent_count] */
+    const ak_crowd_character* characters;     /* required: same layout */
+    float frame_time;                         /* required: > 0 s between frames */
+    const ak_vec4* colors;                    /* optional: [agent_count] base colours (linear
+                                                 RGBA); NULL -> the character's materials */
+    const char* name;                         /* scene, clip and node prefix; NULL -> "crowd" */
+    size_t memory_budget;                     /* bytes; 0 -> AK_SCENE_BAKE_DEFAULT_BUDGET */
+} ak_crowd_bake_desc;
+
+/* Build an animated scene of the crowd (io.h's ak_io_save writes it as glTF): per agent a root
+ * node "<name>_<i>" (translation and rotation keyed at every frame: the root matrix of
+ * ak_crowd_character_root) holding a copy of the character's nodes ("<i>/<joint name>") with
+ * their own skin and a copy of the character's meshes, and one clip "<name>" keying, for every
+ * agent, the joint properties the walk clip animates at every frame (ak_crowd_character_pose;
+ * LINEAR, rotations sign-continuous). The scene model owns one mesh per entry, so each agent
+ * carries its own copy of the mesh (glTF itself would let agents share one mesh).
+ * Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no agent or frame), AK_ERR_BAD_ARG (frame_time not
+ * > 0 and finite), AK_ERR_BAD_DATA (a non-finite position), AK_ERR_UNSUPPORTED (more than
+ * AK_SCENE_BAKE_MAX_FRAMES frames, more than 32767 nodes in all, or more bytes than
+ * memory_budget: checked before allocating; diag gives the numbers), AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
+                                     ak_diag* out_diag);
 
 #ifdef __cplusplus
 }

@@ -71,6 +71,7 @@ AK_API ak_result ak_view_heatmap_colors(ak_f32_cspan values, float lo, float hi,
 AK_API ak_result ak_view_joint_weights(const ak_mesh* mesh, uint32_t joint_index, ak_f32_span out_weights);
 /* Distinct colour number index of a small qualitative palette (plots, several meshes). */
 AK_API ak_vec4 ak_view_palette_color(size_t index);
+#define AK_VIEW_DISTINCT_COLOR_COUNT 222
 /* Colours for many categories (a legend of bones): out_colors.count sRGB colours, each as far
  * as possible from all the ones before it in OKLab (a perceptually uniform space): greedy
  * farthest-point picks among AK_VIEW_DISTINCT_COLOR_COUNT candidates of medium lightness
@@ -79,7 +80,6 @@ AK_API ak_vec4 ak_view_palette_color(size_t index);
  * is grey, and entries repeat (cyclically) only beyond AK_VIEW_DISTINCT_COLOR_COUNT. The closest
  * pair of the first 24 colours is 18.8 CIE76 units apart (13.3 for 32, 9.3 for 64; about 2.3 is
  * just noticeable). AK_ERR_NULL_ARG when count > 0 and ptr is NULL. */
-#define AK_VIEW_DISTINCT_COLOR_COUNT 222
 AK_API ak_result ak_view_distinct_colors(ak_vec4_span out_colors);
 
 /* ---- scenes ------------------------------------------------------------------------------ */

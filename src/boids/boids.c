@@ -3,10 +3,10 @@
  * candidates in different orders and this file's sums do not depend on that order (64-bit
  * fixed point), so both paths give bit-identical steps. */
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "tasks.h"
 #include "../simd.h"
 #include "boids_internal.h"
 
@@ -595,15 +595,7 @@ static void* step_finish_thread(void* arg) {
 }
 
 void akp_boids_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count) {
-    pthread_t ids[64];
-    bool started[64];
-    char* base = (char*)tasks;
-    for (uint32_t t = 1; t < count; ++t) started[t] = pthread_create(&ids[t], NULL, fn, base + t * size) == 0;
-    fn(base);
-    for (uint32_t t = 1; t < count; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else fn(base + t * size);
-    }
+    akp_run_tasks(fn, tasks, size, count);
 }
 
 uint32_t akp_boids_threads(uint32_t requested, size_t n) {

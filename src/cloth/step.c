@@ -9,7 +9,6 @@
  * time; the same bits). The step works on a copy of the positions as 16-byte (position, inverse
  * mass) records, copied back at the end. */
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <string.h>
@@ -18,6 +17,7 @@
 
 #include "cloth_impl.h"
 #include "internal.h"
+#include "tasks.h"
 
 #define MAX_THREADS 64u
 /* Threads meet at a barrier after every constraint colour (about 29 meetings per substep of a
@@ -171,11 +171,7 @@ typedef struct ctx {
                             transverse factor (1; -1: degenerate) */
     uint32_t cg_max;     /* IMPLICIT: most CG iterations per substep */
     int simd;            /* 0 scalar, 1 AVX2, 2 AVX-512 */
-    /* barrier */
-    pthread_mutex_t m;
-    pthread_cond_t cv;
-    atomic_uint arrived, generation, sleepers;
-    bool go;
+    akp_barrier bar; /* the step's team meets here between phases (src/tasks.h) */
 } ctx;
 
 typedef struct worker {
@@ -183,43 +179,8 @@ typedef struct worker {
     unsigned t;
 } worker;
 
-/* Spin, then sleep: a thread that arrives first spins up to BARRIER_SPIN pauses (about 11 us on
- * the Zen 5 test machine, 22 ns each; most meetings of two busy threads end within a few
- * microseconds) and then waits on the condition variable (a descheduled partner on a loaded
- * machine would make spinning burn its core). The last to
- * arrive bumps the generation, and wakes sleepers through the mutex; sequentially consistent
- * atomics order "bump, then look for sleepers" against "announce sleeping, then look at the
- * generation", so no wake-up is lost. */
-#define BARRIER_SPIN 512
-
-static void cpu_relax(void) {
-#if defined(__x86_64__) || defined(__i386__)
-    __asm__ __volatile__("pause");
-#endif
-}
-
 static void barrier(ctx* c) {
-    if (c->T == 1) return;
-    const unsigned g = atomic_load(&c->generation);
-    if (atomic_fetch_add(&c->arrived, 1) + 1 == c->T) {
-        atomic_store(&c->arrived, 0);
-        atomic_fetch_add(&c->generation, 1);
-        if (atomic_load(&c->sleepers)) {
-            pthread_mutex_lock(&c->m);
-            pthread_cond_broadcast(&c->cv);
-            pthread_mutex_unlock(&c->m);
-        }
-        return;
-    }
-    for (int k = 0; k < BARRIER_SPIN; ++k) {
-        if (atomic_load_explicit(&c->generation, memory_order_acquire) != g) return;
-        cpu_relax();
-    }
-    pthread_mutex_lock(&c->m);
-    atomic_fetch_add(&c->sleepers, 1);
-    while (atomic_load(&c->generation) == g) pthread_cond_wait(&c->cv, &c->m);
-    atomic_fetch_sub(&c->sleepers, 1);
-    pthread_mutex_unlock(&c->m);
+    if (c->T > 1) akp_barrier_wait(&c->bar);
 }
 
 static void range(size_t count, unsigned t, unsigned T, size_t* b, size_t* e) {
@@ -933,11 +894,7 @@ const char* ak_cloth_simd_name(void) {
 
 static void* worker_main(void* arg) {
     worker* w = (worker*)arg;
-    ctx* c = w->c;
-    pthread_mutex_lock(&c->m);
-    while (!c->go) pthread_cond_wait(&c->cv, &c->m);
-    pthread_mutex_unlock(&c->m);
-    run_spmd(c, w->t);
+    run_spmd(w->c, w->t);
     return NULL;
 }
 
@@ -1012,33 +969,20 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
         if (fit < want) want = fit > 1 ? (unsigned)fit : 1;
     }
     if ((size_t)want > cl->n) want = cl->n ? (unsigned)cl->n : 1;
-    pthread_t ids[MAX_THREADS];
+    /* the library's worker team runs the other threads' shares (src/tasks.h); when it cannot
+     * give each its own thread the caller runs the whole step alone */
     worker ws[MAX_THREADS];
-    unsigned started = 1;
-    atomic_init(&c.arrived, 0u);
-    atomic_init(&c.generation, 0u);
-    atomic_init(&c.sleepers, 0u);
+    akp_team_run team;
+    c.T = want;
     if (want > 1) {
-        pthread_mutex_init(&c.m, NULL);
-        pthread_cond_init(&c.cv, NULL);
-        for (unsigned t = 1; t < want; ++t) {
-            ws[t] = (worker){&c, t};
-            if (pthread_create(&ids[t], NULL, worker_main, &ws[t]) != 0) break;
-            started++;
-        }
-        pthread_mutex_lock(&c.m);
-        c.T = started;
-        c.go = true;
-        pthread_cond_broadcast(&c.cv);
-        pthread_mutex_unlock(&c.m);
-    } else {
-        c.T = 1;
+        for (unsigned t = 0; t < want; ++t) ws[t] = (worker){&c, t};
+        akp_barrier_init(&c.bar, want);
+        if (!akp_team_begin(&team, worker_main, ws, sizeof(worker), want)) c.T = 1;
     }
     run_spmd(&c, 0);
     if (want > 1) {
-        for (unsigned t = 1; t < started; ++t) pthread_join(ids[t], NULL);
-        pthread_cond_destroy(&c.cv);
-        pthread_mutex_destroy(&c.m);
+        akp_team_end(&team);
+        akp_barrier_destroy(&c.bar);
     }
     /* the end of the step: start + displacement, kinematic particles exactly at their targets */
     bool finite = true;

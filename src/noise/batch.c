@@ -3,9 +3,9 @@
  * the chunk's coordinates on the stack, the kernel gets whole blocks of 8 (a short tail is
  * padded into a block of 8, so it also runs the kernel and gives the same bits). */
 #include <math.h>
-#include <pthread.h>
 #include <string.h>
 
+#include "tasks.h"
 #include "noise_internal.h"
 
 #define CHUNK 256u
@@ -76,14 +76,7 @@ typedef struct range_task {
 } range_task;
 
 static void run_tasks(void* (*fn)(void*), range_task* tasks, uint32_t count) {
-    pthread_t ids[64];
-    bool started[64];
-    for (uint32_t t = 1; t < count; ++t) started[t] = pthread_create(&ids[t], NULL, fn, &tasks[t]) == 0;
-    fn(&tasks[0]);
-    for (uint32_t t = 1; t < count; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else fn(&tasks[t]);
-    }
+    akp_run_tasks(fn, tasks, sizeof(range_task), count);
 }
 
 /* ---- batch ------------------------------------------------------------------------------ */

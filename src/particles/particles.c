@@ -2,8 +2,8 @@
 #include <animkit/particles.h>
 
 #include <math.h>
-#include <pthread.h>
 
+#include "tasks.h"
 #include "internal.h"
 #include "simd.h"
 
@@ -97,21 +97,11 @@ static bool parallel_for(uint32_t threads, size_t n, range_fn fn, void* ctx) {
     if (threads > most) threads = most ? (uint32_t)most : 1;
     if (threads <= 1) return fn(ctx, 0, n);
     range_task tasks[PS_MAX_THREADS];
-    pthread_t ids[PS_MAX_THREADS];
-    bool started[PS_MAX_THREADS];
     for (uint32_t t = 0; t < threads; ++t)
         tasks[t] = (range_task){fn, ctx, n * t / threads, n * (t + 1) / threads, false};
-    for (uint32_t t = 1; t < threads; ++t)
-        started[t] = pthread_create(&ids[t], NULL, range_thread, &tasks[t]) == 0;
-    range_thread(&tasks[0]);
-    bool dead = tasks[0].dead;
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t])
-            pthread_join(ids[t], NULL);
-        else
-            range_thread(&tasks[t]);
-        dead = dead || tasks[t].dead;
-    }
+    akp_run_tasks(range_thread, tasks, sizeof(range_task), threads);
+    bool dead = false;
+    for (uint32_t t = 0; t < threads; ++t) dead = dead || tasks[t].dead;
     return dead;
 }
 

@@ -10,12 +10,12 @@
  * threads write the same pixel, and the per-pixel drawing order is the input order for any
  * thread count, so the image does not depend on it. */
 #include <math.h>
-#include <pthread.h>
 
 #include <animkit/raster.h>
 
 #include "../internal.h"
 #include "raster_internal.h"
+#include "../tasks.h"
 
 /* ---- private types ------------------------------------------------------------------ */
 
@@ -844,12 +844,6 @@ static void raster_tri(const drawctx* dc, const rtri* t, int ti, int tc) {
 
 /* ---- threading -------------------------------------------------------------------------- */
 
-typedef struct gate {
-    pthread_mutex_t mu;
-    pthread_cond_t cv;
-    int go; /* 0 wait, 1 run, -1 quit */
-} gate;
-
 /* What each thread's setup produced in a round; written before the first barrier of the
  * round, read after it. */
 typedef struct rounds {
@@ -861,8 +855,7 @@ typedef struct rounds {
 typedef struct worker {
     const drawctx* dc;
     int index, count;
-    gate* gate;
-    pthread_barrier_t* barrier;
+    akp_barrier* barrier;
     rounds* rounds;
 } worker;
 
@@ -894,7 +887,7 @@ static void run_worker(const worker* w) {
         st->count[w->index] = sk.count;
         st->next[w->index] = i;
         st->full[w->index] = i < e;
-        pthread_barrier_wait(w->barrier);
+        akp_barrier_wait(w->barrier);
         size_t last = T - 1;
         for (size_t k = 0; k < T; ++k)
             if (st->full[k]) {
@@ -906,23 +899,18 @@ static void run_worker(const worker* w) {
             for (size_t t = 0; t < st->count[k]; ++t) raster_tri(dc, &seg[t], w->index, w->count);
         }
         size_t next_base = st->full[last] ? st->next[last] : base + T * CHUNK;
-        pthread_barrier_wait(w->barrier);
+        akp_barrier_wait(w->barrier);
         base = next_base;
     }
 }
 
 static void* worker_main(void* p) {
-    worker* w = (worker*)p;
-    pthread_mutex_lock(&w->gate->mu);
-    while (w->gate->go == 0) pthread_cond_wait(&w->gate->cv, &w->gate->mu);
-    int go = w->gate->go;
-    pthread_mutex_unlock(&w->gate->mu);
-    if (go > 0) run_worker(w);
+    run_worker((worker*)p);
     return NULL;
 }
 
-/* Run a draw over up to desc.thread_count threads (see run_worker). Threads that cannot be
- * started are simply not used. */
+/* Run a draw over desc.thread_count threads (see run_worker): the caller and thread_count - 1
+ * of the library's workers (src/tasks.h); alone when they cannot all have a thread. */
 static void run_draw(const drawctx* dc) {
     int tc = dc->r->desc.thread_count;
     if (dc->input_count < 256 || !dc->r->segs) tc = 1; /* threads would cost more than they save */
@@ -931,46 +919,18 @@ static void run_draw(const drawctx* dc) {
         return;
     }
     worker ws[MAX_THREADS];
-    gate g;
     rounds st;
-    pthread_barrier_t barrier;
-    if (pthread_mutex_init(&g.mu, NULL) != 0) {
+    akp_barrier barrier;
+    akp_barrier_init(&barrier, (uint32_t)tc);
+    for (int i = 0; i < tc; ++i) ws[i] = (worker){dc, i, tc, &barrier, &st};
+    akp_team_run team;
+    if (akp_team_begin(&team, worker_main, ws, sizeof(worker), (uint32_t)tc)) {
+        run_worker(&ws[0]);
+        akp_team_end(&team);
+    } else {
         run_single(dc);
-        return;
     }
-    if (pthread_cond_init(&g.cv, NULL) != 0) {
-        pthread_mutex_destroy(&g.mu);
-        run_single(dc);
-        return;
-    }
-    g.go = 0;
-    for (int i = 0; i < tc; ++i) {
-        ws[i].dc = dc;
-        ws[i].index = i;
-        ws[i].count = tc;
-        ws[i].gate = &g;
-        ws[i].barrier = &barrier;
-        ws[i].rounds = &st;
-    }
-    pthread_t th[MAX_THREADS];
-    int started = 1;
-    for (int i = 1; i < tc; ++i) {
-        if (pthread_create(&th[i], NULL, worker_main, &ws[i]) != 0) break;
-        ++started;
-    }
-    bool ok = started > 1 && pthread_barrier_init(&barrier, NULL, (unsigned)started) == 0;
-    pthread_mutex_lock(&g.mu);
-    /* workers read count only after taking the lock */
-    for (int i = 0; i < started; ++i) ws[i].count = started;
-    g.go = ok ? 1 : -1;
-    pthread_cond_broadcast(&g.cv);
-    pthread_mutex_unlock(&g.mu);
-    if (ok) run_worker(&ws[0]);
-    for (int i = 1; i < started; ++i) pthread_join(th[i], NULL);
-    if (ok) pthread_barrier_destroy(&barrier);
-    else run_single(dc);
-    pthread_cond_destroy(&g.cv);
-    pthread_mutex_destroy(&g.mu);
+    akp_barrier_destroy(&barrier);
 }
 
 /* ---- meshes ------------------------------------------------------------------------------- */

@@ -13,7 +13,7 @@
  *    a per-thread stamp array). Vertices are split between threads in interleaved chunks.
  * 4. A center depends only on the weights of its vertex, so vertices with bitwise-equal weights
  *    (seams, symmetric rings) are computed once. The naive reference skips 3 and 4. */
-#include <pthread.h> /* thread_count > 1 */
+#include "tasks.h" /* thread_count > 1 */
 
 #include "weights_internal.h"
 
@@ -447,8 +447,6 @@ ak_result ak_skin_cor_centers_compute(const ak_skin_cor_desc* desc, const ak_all
     }
     if (res == AK_OK) {
         cor_job jobs[64];
-        pthread_t ids[64];
-        bool started[64];
         for (uint32_t t = 0; t < threads; ++t) {
             jobs[t].d = &d;
             jobs[t].st = &st;
@@ -461,14 +459,8 @@ ak_result ak_skin_cor_centers_compute(const ak_skin_cor_desc* desc, const ak_all
             jobs[t].vdense = vdense + (size_t)t * joint_count;
             jobs[t].stamp = stamps + (size_t)t * (st.tri_count ? st.tri_count : 1);
             jobs[t].out = out_centers.ptr;
-            started[t] = false;
         }
-        for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, cor_worker, &jobs[t]) == 0;
-        cor_worker(&jobs[0]);
-        for (uint32_t t = 1; t < threads; ++t) {
-            if (started[t]) pthread_join(ids[t], NULL);
-            else cor_worker(&jobs[t]);
-        }
+        akp_run_tasks(cor_worker, jobs, sizeof(jobs[0]), threads);
         /* shared centers; a representative that fell back to its own position (single
          * influence, zero similarity) makes its members fall back to theirs */
         for (size_t v = 0; v < n; ++v) {

@@ -2,7 +2,7 @@
  * DQS and CoR, thread split and face-normal recomputation. The AVX-512 and AVX2 kernels are in
  * deform_avx512.c and deform_avx2.c and are only used for configurations they handle (see
  * akp_skin_range_avx512 and akp_skin_range_avx2); the job's simd_limit caps the choice. */
-#include <pthread.h> /* thread_count > 1 */
+#include "tasks.h" /* thread_count > 1 */
 
 #include "simd.h"
 #include "skin_internal.h"
@@ -487,18 +487,9 @@ static bool screen_range(const ak_skin_job* job, size_t b, size_t e) {
     return ok;
 }
 
-/* Run fn on the count (<= 64) tasks at tasks, size bytes apart: task 0 on the calling thread,
- * the others on new pthreads, or on the calling thread when one cannot start. */
+/* Run fn on the count (<= 64) tasks at tasks, size bytes apart, on the worker team. */
 static void run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count) {
-    pthread_t ids[64];
-    bool started[64];
-    char* base = (char*)tasks;
-    for (uint32_t t = 1; t < count; ++t) started[t] = pthread_create(&ids[t], NULL, fn, base + t * size) == 0;
-    fn(base);
-    for (uint32_t t = 1; t < count; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else fn(base + t * size);
-    }
+    akp_run_tasks(fn, tasks, size, count);
 }
 
 typedef struct screen_task {

@@ -446,7 +446,7 @@ def test_batch_jobs_rows_and_skip(tmp_path):
     assert row["status"] == "ran" and row["index"] == 3 and row["error"] is None and row["job_hash"]
     img = read_png_rgba(str(tmp_path / "sub" / "r.png"))
     assert img.shape == (30, 40, 4) and len(np.unique(img.reshape(-1, 4), axis=0)) > 1  # a picture, not a fill
-    if os.access(CLI, os.X_OK):  # the render kind draws the skeleton (docs/batch.md): as `animkit batch` does
+    if os.access(CLI, os.X_OK):  # the same picture as `animkit batch` draws (docs/batch.md)
         (tmp_path / "cli").mkdir()
         (tmp_path / "cli" / "m.jsonl").write_text(json.dumps(job) + "\n")
         cli("batch", str(tmp_path / "cli" / "m.jsonl"), "--out", str(tmp_path / "cli"))

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "crowd_draw.h"
 #include "outfile.h"
 
 static const char* const usage =
@@ -23,7 +24,9 @@ static const char* const usage =
     "  --threads  threads per step (default 1; results are identical for any count)\n"
     "  --json     write {\"time\", \"agents\": [{\"position\", \"velocity\", \"goal_reached\"}],\n"
     "             \"min_distance\", \"collisions\"} after the run\n"
-    "  -o         render: .png (last step) or .gif (the run); .glb (glTF export) is not implemented\n"
+    "  -o         .png (the last step) or .gif (the run) rendered, walking characters (builtin:humanoid)\n"
+    "             up to 500 agents, discs above; .glb: the run as glTF, a skinned character per agent\n"
+    "             (up to 1800 agents)\n"
     "Without --json or -o prints a summary line.\n";
 
 /* ---- collisions: the set of pairs that ever overlapped ------------------------------------ */
@@ -172,10 +175,26 @@ static size_t reached_count(const crowd_run* r) {
     return k;
 }
 
-/* ---- rendering ------------------------------------------------------------------------------ */
+/* The recorded run as glTF: a skinned character per agent (ak_crowd_bake_scene). */
+static int chars_write_gltf(crowd_chars* c, const ak_crowd_scene* sc, float frame_time, const char* out) {
+    ak_vec4* colors = malloc(c->n * sizeof *colors);
+    if (!colors) return cli_fail("crowd", "out of memory");
+    for (size_t i = 0; i < c->n; ++i) colors[i] = crowd_palette[sc->group[i] % 4];
+    ak_crowd_bake_desc bd = {.gait = &c->gait, .agent_count = c->n, .frame_count = c->frames,
+                             .positions = c->rec_pos, .characters = c->rec_ch, .frame_time = frame_time,
+                             .colors = colors, .name = "crowd"};
+    ak_scene* baked = NULL;
+    ak_diag diag = {0};
+    ak_result r = ak_crowd_bake_scene(&bd, NULL, &baked, &diag);
+    free(colors);
+    if (r != AK_OK) return cli_fail("crowd", "%s: %s", out, diag.message[0] ? diag.message : ak_result_string(r));
+    r = ak_io_save(out, baked, NULL, &diag);
+    ak_scene_destroy(baked);
+    if (r != AK_OK) return cli_fail("crowd", "%s: %s", out, diag.message[0] ? diag.message : ak_result_string(r));
+    return CLI_OK;
+}
 
-#define SIDES 8
-#define TRIS_PER_AGENT (3 * SIDES)
+/* ---- rendering ------------------------------------------------------------------------------ */
 
 typedef struct renderer {
     int w, h;
@@ -183,24 +202,20 @@ typedef struct renderer {
     ak_raster_camera cam;
     ak_vec3 center;
     float extent;
-    ak_vec3 *pos, *nrm;
-    ak_vec4* col;
-    size_t vcount;
+    crowd_people people;
     ak_vec3* wall;
-    size_t wall_count;
+    size_t wall_count; /* vertices */
     uint8_t* pixels;
 } renderer;
 
 static void renderer_free(renderer* r) {
     ak_raster_destroy(r->raster);
-    free(r->pos);
-    free(r->nrm);
-    free(r->col);
+    crowd_people_free(&r->people);
     free(r->wall);
     free(r->pixels);
 }
 
-static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc) {
+static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc, const crowd_chars* chars) {
     memset(r, 0, sizeof *r);
     r->w = w;
     r->h = h;
@@ -219,69 +234,24 @@ static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc) {
     const ak_vec3 eye = ak_vec3_add(r->center, ak_vec3_make(0.0f, 1.5f * r->extent, 1.1f * r->extent));
     r->cam = ak_raster_camera_perspective(eye, r->center, ak_radians(45), (float)w / (float)h, 0.05f * r->extent,
                                           10.0f * r->extent);
-    const size_t n = sc->agent_count;
-    r->vcount = n * TRIS_PER_AGENT * 3;
-    r->pos = malloc(r->vcount * sizeof *r->pos);
-    r->nrm = malloc(r->vcount * sizeof *r->nrm);
-    r->col = malloc(r->vcount * sizeof *r->col);
     r->pixels = malloc((size_t)w * (size_t)h * 4);
-    if (!r->pos || !r->nrm || !r->col || !r->pixels) return 1;
-    /* walls: each obstacle edge a 1.2 m high quad (two triangles) */
-    size_t edges = 0;
-    for (size_t k = 0; k < sc->obstacle_count; ++k) edges += sc->obstacles[k].vertices.count == 2 ? 1 : sc->obstacles[k].vertices.count;
-    if (edges) {
-        r->wall = malloc(edges * 6 * sizeof *r->wall);
-        if (!r->wall) return 1;
-        for (size_t k = 0; k < sc->obstacle_count; ++k) {
-            const ak_vec2_cspan v = sc->obstacles[k].vertices;
-            const size_t m = v.count == 2 ? 1 : v.count;
-            for (size_t e = 0; e < m; ++e) {
-                const ak_vec2 a = v.ptr[e], b = v.ptr[(e + 1) % v.count];
-                const ak_vec3 q[4] = {{a.x, 0, a.y}, {b.x, 0, b.y}, {b.x, 1.2f, b.y}, {a.x, 1.2f, a.y}};
-                ak_vec3* o = r->wall + 6 * r->wall_count++;
-                o[0] = q[0], o[1] = q[1], o[2] = q[2], o[3] = q[0], o[4] = q[2], o[5] = q[3];
-            }
-        }
-    }
-    return 0;
+    if (!r->pixels || !crowd_people_init(&r->people, sc->agent_count, chars)) return 1;
+    return crowd_walls(sc, &r->wall, &r->wall_count) ? 0 : 1;
 }
 
-/* Each agent an upright octagonal prism (1.7 m, its radius) coloured by group, its front face
- * (toward the velocity) light. */
-static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, ak_image* out) {
-    static const ak_vec4 palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
-                                       {0.75f, 0.30f, 0.55f, 1}};
-    const float pi = 3.14159265358979f;
-    size_t k = 0;
-    for (size_t i = 0; i < st->n; ++i) {
-        const float rad = sc->agents[i].radius > 0.0f ? sc->agents[i].radius : 0.3f, hgt = 1.7f;
-        const ak_vec2 p = st->p[i], v = st->v[i];
-        const float heading = (v.x * v.x + v.y * v.y) > 1e-6f ? atan2f(v.y, v.x) : 0.0f;
-        const ak_vec4 c = palette[sc->group[i] % 4];
-        for (int s = 0; s < SIDES; ++s) {
-            const float a0 = heading + 2.0f * pi * ((float)s - 0.5f) / SIDES, a1 = heading + 2.0f * pi * ((float)s + 0.5f) / SIDES;
-            const ak_vec3 b0 = {p.x + rad * cosf(a0), 0, p.y + rad * sinf(a0)}, b1 = {p.x + rad * cosf(a1), 0, p.y + rad * sinf(a1)};
-            const ak_vec3 t0 = {b0.x, hgt, b0.z}, t1 = {b1.x, hgt, b1.z}, top = {p.x, hgt, p.y};
-            const float am = heading + 2.0f * pi * (float)s / SIDES;
-            const ak_vec3 n = {cosf(am), 0, sinf(am)}, up = {0, 1, 0};
-            const ak_vec4 cc = s == 0 ? ak_vec4_make(0.95f, 0.95f, 0.9f, 1) : c;
-            const ak_vec3 tri[9] = {b0, b1, t1, b0, t1, t0, t0, t1, top};
-            for (int q = 0; q < 9; ++q) {
-                r->pos[k] = tri[q];
-                r->nrm[k] = q < 6 ? n : up;
-                r->col[k] = cc;
-                ++k;
-            }
-        }
-    }
-    ak_raster_mesh people = {.positions = {r->pos, k}, .normals = {r->nrm, k}, .colors = {r->col, k},
-                             .material = {.color = {1, 1, 1, 1}}};
-    ak_raster_mesh walls = {.positions = {r->wall, r->wall_count * 6}, .material = {.color = {0.6f, 0.6f, 0.62f, 1}}};
+/* The agents (characters or prisms) and the walls, over the ground with shadows. */
+static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, crowd_chars* chars,
+                            ak_image* out) {
+    ak_raster_mesh people;
+    ak_result res = crowd_people_update(&r->people, sc, st->p, st->v, chars, &people);
+    if (res != AK_OK) return res;
+    const size_t k = people.positions.count;
+    ak_raster_mesh walls = {.positions = {r->wall, r->wall_count}, .material = {.color = {0.6f, 0.6f, 0.62f, 1}}};
     ak_raster_mesh casters[2] = {people, walls};
     ak_raster_clear(r->raster, ak_vec4_make(0.80f, 0.86f, 0.93f, 1), ak_vec4_make(0.55f, 0.60f, 0.68f, 1));
     ak_raster_ground g = {.height = 0.0f, .center = r->center, .half_extent = 1.6f * r->extent,
                           .casters = casters, .caster_count = r->wall_count ? 2 : 1};
-    ak_result res = k ? ak_raster_draw_ground(r->raster, &r->cam, &g) : AK_OK;
+    res = k ? ak_raster_draw_ground(r->raster, &r->cam, &g) : AK_OK;
     if (res == AK_OK && r->wall_count) res = ak_raster_draw_mesh(r->raster, &r->cam, &walls);
     if (res == AK_OK && k) res = ak_raster_draw_mesh(r->raster, &r->cam, &people);
     if (res == AK_OK) res = ak_raster_resolve(r->raster, out);
@@ -364,10 +334,12 @@ int cmd_crowd(int argc, char** argv) {
     }
     if (steps >= 0) sc.steps = steps;
     if (method) sc.method = strcmp(method, "vision") == 0 ? AK_CROWD_VISION : AK_CROWD_ORCA;
-    /* Refused before any work, so that no file is left half-written. */
-    if (out && cli_has_ext(out, ".glb")) {
+    const bool is_glb = out && cli_has_ext(out, ".glb"), is_gif = out && cli_has_ext(out, ".gif");
+    /* Refused before any work: a glTF crowd holds at most 32767 nodes (18 per character). */
+    if (is_glb && sc.agent_count > 1800) {
         ak_crowd_scene_free(&sc);
-        return cli_fail("crowd", "%s: glTF export of a crowd is not implemented yet (use .png or .gif)", out);
+        return cli_fail("crowd", "%s: %zu agents: glTF export holds at most 1800 characters (use --agents)", out,
+                        sc.agent_count);
     }
     if ((rc = cli_work_check("crowd", (double)sc.agent_count * (double)sc.steps, "agent updates (agents x steps)",
                              "--steps or --agents"))) {
@@ -381,14 +353,31 @@ int cmd_crowd(int argc, char** argv) {
         ak_crowd_scene_free(&sc);
         return cli_fail("crowd", "%s: %s", a.pos_count ? a.pos[0] : "preset", ak_result_string(res));
     }
+    /* Frames: at most 150 in a GIF, 300 in a glTF file. */
+    const long max_frames = is_glb ? 300 : 150;
+    const long every = sc.steps > max_frames ? (sc.steps + max_frames - 1) / max_frames : 1;
+    crowd_chars chars;
+    memset(&chars, 0, sizeof chars);
+    const bool with_chars = is_glb || (out && sc.agent_count <= CROWD_CHARACTERS_MAX);
+    if (with_chars) {
+        ak_diag cd = {0};
+        res = crowd_chars_init(&chars, &sc, is_glb ? (size_t)(sc.steps / every + 1) : 0, &cd);
+        if (res != AK_OK) {
+            crowd_chars_free(&chars);
+            run_free(&st);
+            ak_crowd_scene_free(&sc);
+            return cli_fail("crowd", "characters: %s", cd.message[0] ? cd.message : ak_result_string(res));
+        }
+    }
 
     renderer rd;
     ak_gif_writer* gif = NULL;
     ak_image img = {0};
-    const bool rendering = out != NULL, is_gif = out && cli_has_ext(out, ".gif");
+    const bool rendering = out != NULL && !is_glb;
     if (rendering) {
-        if (renderer_init(&rd, w, h, &sc)) {
+        if (renderer_init(&rd, w, h, &sc, with_chars ? &chars : NULL)) {
             renderer_free(&rd);
+            crowd_chars_free(&chars);
             run_free(&st);
             ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "out of memory for rendering");
@@ -396,28 +385,31 @@ int cmd_crowd(int argc, char** argv) {
         img = (ak_image){.pixels = rd.pixels, .width = w, .height = h};
         if (is_gif && ak_gif_writer_create(out, &(ak_gif_desc){.width = w, .height = h, .delay_cs = 4}, NULL, &gif) != AK_OK) {
             renderer_free(&rd);
+            crowd_chars_free(&chars);
             run_free(&st);
             ak_crowd_scene_free(&sc);
             return cli_fail("crowd", "%s: cannot create the file", out);
         }
     }
-    const long every = sc.steps > 150 ? (sc.steps + 149) / 150 : 1;
+    crowd_chars* cp = with_chars ? &chars : NULL;
     const double t0 = cli_now();
     long failed_step = -1, done = 0;
     ak_result wres = AK_OK;
     for (long s = 0; s <= sc.steps && res == AK_OK && wres == AK_OK; ++s) {
         if (gif && s % every == 0) {
-            res = draw_frame(&rd, &sc, &st, &img);
+            res = draw_frame(&rd, &sc, &st, cp, &img);
             if (res == AK_OK) wres = ak_gif_writer_add_frame(gif, &img);
         }
+        if (is_glb && s % every == 0) crowd_chars_record(&chars, st.p);
         if (s == sc.steps) break;
         if (res == AK_OK && (res = run_step(&st, s)) != AK_OK) failed_step = s;
         else done = s + 1;
+        if (res == AK_OK && cp && (res = crowd_chars_update(cp, st.v, sc.dt)) != AK_OK) failed_step = s;
         cli_progress("crowd", (size_t)s + 1, (size_t)sc.steps);
     }
     const double elapsed = cli_now() - t0;
     if (res == AK_OK && rendering && !is_gif) {
-        res = draw_frame(&rd, &sc, &st, &img);
+        res = draw_frame(&rd, &sc, &st, cp, &img);
         if (res == AK_OK) wres = ak_png_write(out, &img);
     }
     if (gif && (res != AK_OK || wres != AK_OK)) ak_gif_writer_discard(gif); /* no partial GIF */
@@ -427,8 +419,12 @@ int cmd_crowd(int argc, char** argv) {
     if (res != AK_OK && failed_step >= 0) rc = cli_fail("crowd", "step %ld: %s", failed_step, ak_result_string(res));
     else if (res != AK_OK) rc = cli_fail("crowd", "%s", ak_result_string(res));
     else if (wres != AK_OK) rc = cli_fail("crowd", "%s: cannot write the file: %s", out, ak_result_string(wres));
+    if (rc == CLI_OK && is_glb) rc = chars_write_gltf(&chars, &sc, (float)every * sc.dt, out);
+    crowd_chars_free(&chars);
     const size_t reached = reached_count(&st);
-    if (rc == CLI_OK && out) cli_wrote(out, "%zu agents after %ld steps", st.n, done);
+    if (rc == CLI_OK && out)
+        cli_wrote(out, "%zu agents after %ld steps%s", st.n, done,
+                  is_glb ? " (a skinned character each)" : (with_chars ? " (characters)" : ""));
     if (rc == CLI_OK && json && (rc = write_json(json, (double)((float)done * sc.dt), &st)) == CLI_OK)
         cli_wrote(json, "%zu agents after %ld steps, %zu at their goal", st.n, done, reached);
     if (rc == CLI_OK && !json && !out)

@@ -507,7 +507,7 @@ static void draw_hud(view_app* a) {
         }
         ty += (int)((float)(rows + 1) * lh);
         for (size_t i = 0; i < MOUSE_HELP_COUNT; ++i, ty += (int)lh)
-            ak_image_draw_text(img, (int)bx + 8, ty, a->sim && i == 1 ? (a->sim->grab ? "left on a sphere: drag the collider" : "") : mouse_help[i],
+            ak_image_draw_text(img, (int)bx + 8, ty, a->sim && i == 1 ? (a->sim->grab ? (a->sim->grab_help ? a->sim->grab_help : "left on a sphere: drag the collider") : "") : mouse_help[i],
                                sc, rgba(0.8f, 0.9f, 1, 1));
     }
 }

@@ -127,6 +127,8 @@ typedef struct view_sim {
     bool (*failed)(void* state);
     const view_help_entry* keys; /* the simulation's keys for the help overlay */
     size_t key_count;
+    const char* grab_help; /* the help overlay's line for a left click; NULL -> "left on a
+                              sphere: drag the collider" */
 } view_sim;
 
 /* The simulation a `animkit view` argument names ("particles:...", "boids", "boids:...", "cloth:...",
@@ -140,6 +142,9 @@ const view_sim* view_sim_at(size_t index);
 size_t view_help_list(const view_sim* sim, const view_help_entry** out, size_t capacity);
 /* The terrain plug-in (view_terrain.c). */
 extern const view_sim view_terrain_sim;
+/* The crowd plug-in (view_crowd.c). */
+extern const view_sim view_crowd_sim;
+/* The rigid-body plug-in (view_rigid.c). */
 extern const view_sim view_rigid_sim;
 /* The kinds, for messages ("particles, boids, cloth, terrain"). */
 extern const char* const view_sim_kinds;

@@ -14,7 +14,7 @@
 #include "particles_run.h"
 #include "view_app.h"
 
-const char* const view_sim_kinds = "particles, boids, cloth, terrain, rigid";
+const char* const view_sim_kinds = "particles, boids, cloth, terrain, crowd, rigid";
 
 #define MAX_STEPS_PER_FRAME 64
 #define WIND_STEP 0.5f
@@ -734,6 +734,7 @@ static const struct {
     {"boids", &boids_sim},
     {"cloth", &cloth_sim},
     {"terrain", &view_terrain_sim},
+    {"crowd", &view_crowd_sim},
     {"rigid", &view_rigid_sim},
 };
 

@@ -1,0 +1,467 @@
+/* Crowd characters: a walk cycle per agent whose clip time follows the distance walked. */
+#include <math.h>
+
+#include <animkit/crowd.h>
+
+#include "internal.h"
+
+/* ---- helpers ------------------------------------------------------------------------------ */
+
+/* Model-space positions of both feet at clip time t (local and world: [joint_count]). */
+static ak_result feet_at(const ak_crowd_gait_desc* d, int left, int right, float t, ak_transform_span local,
+                         ak_mat4_span world, ak_vec3 out[2]) {
+    ak_result r = ak_scene_rest_pose(d->scene, local);
+    if (r == AK_OK)
+        r = ak_clip_sample(d->scene->clips[d->clip_index], t, NULL, local, (ak_f32_span){0}, (ak_f32_span){0});
+    if (r == AK_OK) r = ak_scene_world_matrices(d->scene, (ak_transform_cspan){local.ptr, local.count}, world);
+    if (r != AK_OK) return r;
+    out[0] = ak_mat4_get_translation(world.ptr[left]);
+    out[1] = ak_mat4_get_translation(world.ptr[right]);
+    return AK_OK;
+}
+
+static float smoothstep01(float x) {
+    x = ak_clampf(x, 0.0f, 1.0f);
+    return x * x * (3.0f - 2.0f * x);
+}
+
+/* ---- public -------------------------------------------------------------------------------- */
+
+ak_result ak_crowd_gait_measure(const ak_crowd_gait_desc* desc, const ak_allocator* alloc, ak_crowd_gait* out_gait,
+                                ak_diag* out_diag) {
+    if (!desc || !out_gait || !desc->scene || !desc->scene->skeleton) {
+        akp_diag_set(out_diag, "gait", "no desc, scene, skeleton or output");
+        return AK_ERR_NULL_ARG;
+    }
+    const ak_scene* sc = desc->scene;
+    if (desc->clip_index < 0 || (size_t)desc->clip_index >= sc->clip_count) {
+        akp_diag_set(out_diag, sc->name, "clip %d out of range (%zu clips)", desc->clip_index, sc->clip_count);
+        return AK_ERR_BAD_INDEX;
+    }
+    const size_t n = ak_scene_joint_count(sc);
+    const ak_transform_cspan rest = ak_skeleton_rest_pose(sc->skeleton);
+    int feet[2] = {desc->left_foot, desc->right_foot};
+    ak_transform* local = akp_alloc(alloc, n * sizeof *local);
+    ak_mat4* world = akp_alloc(alloc, n * sizeof *world);
+    ak_result res = AK_OK;
+    if (!local || !world) {
+        akp_diag_set(out_diag, sc->name, "out of memory");
+        res = AK_ERR_NO_MEMORY;
+        goto done;
+    }
+    const ak_transform_span ls = {local, n};
+    const ak_mat4_span ws = {world, n};
+    if (feet[0] == 0 && feet[1] == 0) {
+        /* automatic: the lowest joint of the rest pose on each side */
+        for (size_t j = 0; j < n; ++j) local[j] = rest.ptr[j];
+        res = ak_scene_world_matrices(sc, (ak_transform_cspan){local, n}, ws);
+        if (res != AK_OK) goto done;
+        float low[2] = {INFINITY, INFINITY};
+        feet[0] = feet[1] = -1;
+        for (size_t j = 0; j < n; ++j) {
+            if (sc->is_joint && !sc->is_joint[j]) continue;
+            const ak_vec3 p = ak_mat4_get_translation(world[j]);
+            const int side = p.x > 0.0f ? 0 : (p.x < 0.0f ? 1 : -1);
+            if (side >= 0 && p.y < low[side]) {
+                low[side] = p.y;
+                feet[side] = (int)j;
+            }
+        }
+        if (feet[0] < 0 || feet[1] < 0) {
+            akp_diag_set(out_diag, sc->name, "no joint on the %s side (x %s 0) to take for a foot",
+                         feet[0] < 0 ? "left" : "right", feet[0] < 0 ? ">" : "<");
+            res = AK_ERR_NOT_FOUND;
+            goto done;
+        }
+    } else if (feet[0] < 0 || feet[1] < 0 || (size_t)feet[0] >= n || (size_t)feet[1] >= n || feet[0] == feet[1]) {
+        akp_diag_set(out_diag, sc->name, "feet %d, %d: not two distinct joints of %zu", feet[0], feet[1], n);
+        res = AK_ERR_BAD_INDEX;
+        goto done;
+    }
+    const ak_clip* clip = sc->clips[desc->clip_index];
+    const float T = ak_clip_duration(clip);
+    if (!(T >= 1e-3f) || !ak_finitef(T)) {
+        akp_diag_set(out_diag, sc->name, "clip '%s' lasts %g s: too short for a walk cycle", ak_clip_name(clip),
+                     (double)T);
+        res = AK_ERR_BAD_DATA;
+        goto done;
+    }
+    /* Pass 1: the lower foot's positions; the sum of its horizontal motion gives forward. */
+    enum { S = AK_CROWD_GAIT_SAMPLES };
+    ak_vec3 prev[2], cur[2];
+    res = feet_at(desc, feet[0], feet[1], 0.0f, ls, ws, prev);
+    if (res != AK_OK) goto done;
+    float lo[2] = {prev[0].y, prev[1].y};
+    double sx = 0.0, sz = 0.0;
+    /* Keep the per-interval motion of the lower foot for pass 2 (stack: S small). */
+    float mx[S], mz[S];
+    for (unsigned k = 1; k <= S; ++k) {
+        res = feet_at(desc, feet[0], feet[1], T * (float)k / (float)S, ls, ws, cur);
+        if (res != AK_OK) goto done;
+        /* the lower foot over the interval: by the mean height of its two ends */
+        const int f = (prev[0].y + cur[0].y) <= (prev[1].y + cur[1].y) ? 0 : 1;
+        mx[k - 1] = cur[f].x - prev[f].x;
+        mz[k - 1] = cur[f].z - prev[f].z;
+        sx += mx[k - 1];
+        sz += mz[k - 1];
+        for (int s = 0; s < 2; ++s) lo[s] = fminf(lo[s], cur[s].y);
+        prev[0] = cur[0];
+        prev[1] = cur[1];
+    }
+    const double len = sqrt(sx * sx + sz * sz);
+    if (!(len >= 0.01)) {
+        akp_diag_set(out_diag, sc->name,
+                     "clip '%s': the stance foot travels %.3g m per cycle: not a walk in place (at least 0.01 m)",
+                     ak_clip_name(clip), len);
+        res = AK_ERR_BAD_DATA;
+        goto done;
+    }
+    const float fx = (float)(-sx / len), fz = (float)(-sz / len);
+    memset(out_gait, 0, sizeof *out_gait);
+    double acc = 0.0;
+    out_gait->distance[0] = 0.0f;
+    for (unsigned k = 0; k < S; ++k) {
+        const double back = -((double)mx[k] * fx + (double)mz[k] * fz);
+        if (back > 0.0) acc += back;
+        out_gait->distance[k + 1] = (float)acc;
+    }
+    out_gait->scene = sc;
+    out_gait->clip_index = desc->clip_index;
+    out_gait->feet[0] = feet[0];
+    out_gait->feet[1] = feet[1];
+    out_gait->duration = T;
+    out_gait->stride_length = (float)acc;
+    out_gait->stride_speed = (float)acc / T;
+    out_gait->forward = ak_vec3_make(fx, 0.0f, fz);
+    out_gait->foot_min_y[0] = lo[0];
+    out_gait->foot_min_y[1] = lo[1];
+done:
+    akp_free(alloc, local);
+    akp_free(alloc, world);
+    return res;
+}
+
+float ak_crowd_gait_clip_time(const ak_crowd_gait* gait, float distance) {
+    if (!gait || !(gait->stride_length > 0.0f) || !ak_finitef(distance) || distance < 0.0f) return 0.0f;
+    const float L = gait->stride_length;
+    float d = fmodf(distance, L);
+    if (d >= L) d = 0.0f;
+    /* the first interval k with distance[k + 1] > d (distance[0] = 0 <= d) */
+    unsigned a = 0, b = AK_CROWD_GAIT_SAMPLES - 1;
+    while (a < b) {
+        const unsigned m = (a + b) / 2;
+        if (gait->distance[m + 1] > d) b = m;
+        else a = m + 1;
+    }
+    const float d0 = gait->distance[a], d1 = gait->distance[a + 1];
+    const float u = d1 > d0 ? ak_clampf((d - d0) / (d1 - d0), 0.0f, 1.0f) : 0.0f;
+    const float t = gait->duration * ((float)a + u) / (float)AK_CROWD_GAIT_SAMPLES;
+    return t < gait->duration ? t : 0.0f;
+}
+
+ak_crowd_character ak_crowd_character_init(const ak_crowd_gait* gait, ak_vec2 heading, float phase) {
+    ak_crowd_character c = {0};
+    const float h = ak_vec2_length(heading);
+    c.heading = (ak_finitef(h) && h > 1e-6f) ? ak_vec2_scale(heading, 1.0f / h) : ak_vec2_make(0.0f, 1.0f);
+    if (gait && gait->stride_length > 0.0f && ak_finitef(phase)) {
+        const float p = phase - floorf(phase);
+        c.distance = p * gait->stride_length;
+        if (!(c.distance < gait->stride_length)) c.distance = 0.0f;
+        c.clip_time = ak_crowd_gait_clip_time(gait, c.distance);
+    }
+    return c;
+}
+
+ak_result ak_crowd_characters_update(const ak_crowd_characters_job* job) {
+    if (!job || !job->gait || !job->characters.ptr || (job->characters.count && !job->velocities.ptr))
+        return AK_ERR_NULL_ARG;
+    if (!(job->dt > 0.0f) || !ak_finitef(job->dt) || !(job->turn_time >= 0.0f) || !ak_finitef(job->turn_time) ||
+        !(job->max_turn_rate >= 0.0f) || !ak_finitef(job->max_turn_rate) || !(job->idle_speed >= 0.0f) ||
+        !ak_finitef(job->idle_speed))
+        return AK_ERR_BAD_ARG;
+    const size_t n = job->characters.count;
+    if (job->velocities.count < n) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < n; ++i)
+        if (!ak_finitef(job->velocities.ptr[i].x) || !ak_finitef(job->velocities.ptr[i].y) ||
+            fabsf(job->velocities.ptr[i].x) > 1e7f || fabsf(job->velocities.ptr[i].y) > 1e7f)
+            return AK_ERR_BAD_DATA;
+    const ak_crowd_gait* g = job->gait;
+    const float turn_time = job->turn_time > 0.0f ? job->turn_time : 0.1f;
+    const float max_turn = (job->max_turn_rate > 0.0f ? job->max_turn_rate : 6.0f) * job->dt;
+    const float idle = job->idle_speed > 0.0f ? job->idle_speed : 0.15f;
+    const float follow = 1.0f - expf(-job->dt / turn_time);
+    const float L = g->stride_length;
+    for (size_t i = 0; i < n; ++i) {
+        ak_crowd_character* c = &job->characters.ptr[i];
+        const ak_vec2 v = job->velocities.ptr[i];
+        const float speed = ak_vec2_length(v);
+        if (L > 0.0f) {
+            double d = (double)c->distance + (double)speed * (double)job->dt;
+            if (!(d >= 0.0) || !isfinite(d)) d = 0.0;
+            d = fmod(d, (double)L);
+            c->distance = (float)d < L ? (float)d : 0.0f;
+            c->clip_time = ak_crowd_gait_clip_time(g, c->distance);
+        }
+        if (speed > 0.5f * idle) {
+            /* turn toward v by the smoothed angle, at most max_turn */
+            const ak_vec2 h = c->heading, u = ak_vec2_scale(v, 1.0f / speed);
+            float a = atan2f(ak_vec2_cross(h, u), ak_vec2_dot(h, u)) * follow;
+            a = ak_clampf(a, -max_turn, max_turn);
+            const float ca = cosf(a), sa = sinf(a);
+            ak_vec2 nh = ak_vec2_make(h.x * ca - h.y * sa, h.x * sa + h.y * ca);
+            const float l = ak_vec2_length(nh);
+            c->heading = l > 1e-6f && ak_finitef(l) ? ak_vec2_scale(nh, 1.0f / l) : u;
+        }
+        c->walk_weight = smoothstep01(speed / idle);
+    }
+    return AK_OK;
+}
+
+ak_result ak_crowd_character_pose(const ak_crowd_gait* gait, const ak_crowd_character* character,
+                                  ak_transform_span out_local) {
+    if (!gait || !character || !gait->scene || !gait->scene->skeleton || !out_local.ptr) return AK_ERR_NULL_ARG;
+    const ak_transform_cspan rest = ak_skeleton_rest_pose(gait->scene->skeleton);
+    if (out_local.count < rest.count) return AK_ERR_SPAN_SMALL;
+    for (size_t j = 0; j < rest.count; ++j) out_local.ptr[j] = rest.ptr[j];
+    const float w = ak_clampf(ak_finitef(character->walk_weight) ? character->walk_weight : 0.0f, 0.0f, 1.0f);
+    if (w <= 0.0f) return AK_OK;
+    const float t = ak_finitef(character->clip_time) ? ak_clampf(character->clip_time, 0.0f, gait->duration) : 0.0f;
+    const ak_result r = ak_clip_sample(gait->scene->clips[gait->clip_index], t, NULL, out_local, (ak_f32_span){0},
+                                       (ak_f32_span){0});
+    if (r != AK_OK || w >= 1.0f) return r;
+    for (size_t j = 0; j < rest.count; ++j) {
+        ak_transform* o = &out_local.ptr[j];
+        o->translation = ak_vec3_lerp(rest.ptr[j].translation, o->translation, w);
+        o->scale = ak_vec3_lerp(rest.ptr[j].scale, o->scale, w);
+        o->rotation = ak_quat_slerp(rest.ptr[j].rotation, o->rotation, w);
+    }
+    return AK_OK;
+}
+
+ak_mat4 ak_crowd_character_root(const ak_crowd_gait* gait, const ak_crowd_character* character, ak_vec2 p) {
+    if (!gait || !character) return ak_mat4_identity();
+    /* yaw about +y maps (x, z) by x' = x cos + z sin, z' = -x sin + z cos; turn forward onto heading */
+    const float af = atan2f(gait->forward.x, gait->forward.z);
+    const float ah = atan2f(character->heading.x, character->heading.y);
+    const ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(0.0f, 1.0f, 0.0f), ah - af);
+    ak_mat4 m = ak_mat4_from_quat(q);
+    m.m[12] = p.x;
+    m.m[13] = 0.0f;
+    m.m[14] = p.y;
+    return m;
+}
+
+/* ---- baking the crowd into a scene -------------------------------------------------------- */
+
+static ak_quat root_rotation(const ak_crowd_gait* g, const ak_crowd_character* c) {
+    const float af = atan2f(g->forward.x, g->forward.z);
+    const float ah = atan2f(c->heading.x, c->heading.y);
+    return ak_quat_from_axis_angle(ak_vec3_make(0.0f, 1.0f, 0.0f), ah - af);
+}
+
+ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
+                              ak_diag* out_diag) {
+    if (out_scene) *out_scene = NULL;
+    if (!desc || !out_scene || !desc->gait || !desc->gait->scene || !desc->gait->scene->skeleton ||
+        !desc->positions || !desc->characters) {
+        akp_diag_set(out_diag, "crowd", "no desc, gait, scene, positions, characters or output");
+        return AK_ERR_NULL_ARG;
+    }
+    const char* name = desc->name ? desc->name : "crowd";
+    const size_t N = desc->agent_count, F = desc->frame_count;
+    if (N == 0 || F == 0) {
+        akp_diag_set(out_diag, name, "no %s", N == 0 ? "agent" : "frame");
+        return AK_ERR_EMPTY;
+    }
+    if (!(desc->frame_time > 0.0f) || !ak_finitef(desc->frame_time) ||
+        !ak_finitef(desc->frame_time * (float)(F - 1))) {
+        akp_diag_set(out_diag, name, "frame time %g s: not > 0 and finite", (double)desc->frame_time);
+        return AK_ERR_BAD_ARG;
+    }
+    if (F > AK_SCENE_BAKE_MAX_FRAMES) {
+        akp_diag_set(out_diag, name, "%zu frames: more than %u", F, AK_SCENE_BAKE_MAX_FRAMES);
+        return AK_ERR_UNSUPPORTED;
+    }
+    const ak_crowd_gait* g = desc->gait;
+    const ak_scene* cs = g->scene;
+    const size_t J = ak_scene_joint_count(cs);
+    if ((double)N * (double)(J + 1) > 32767.0) {
+        akp_diag_set(out_diag, name, "%zu agents x %zu nodes: more than 32767 nodes", N, J + 1);
+        return AK_ERR_UNSUPPORTED;
+    }
+    for (size_t k = 0; k < N * F; ++k)
+        if (!ak_finitef(desc->positions[k].x) || !ak_finitef(desc->positions[k].y) ||
+            fabsf(desc->positions[k].x) > 1e7f || fabsf(desc->positions[k].y) > 1e7f) {
+            akp_diag_set(out_diag, name, "frame %zu, agent %zu: position not finite or beyond 1e7 m", k / N, k % N);
+            return AK_ERR_BAD_DATA;
+        }
+    /* The walk clip's joint channels: each becomes one channel per agent. */
+    const ak_clip* clip = cs->clips[g->clip_index];
+    size_t cc = 0;
+    for (size_t c = 0; c < ak_clip_channel_count(clip); ++c) {
+        const ak_channel_target t = ak_clip_channel_target(clip, c);
+        if ((t == AK_CHANNEL_TRANSLATION || t == AK_CHANNEL_ROTATION || t == AK_CHANNEL_SCALE) &&
+            ak_clip_channel_index(clip, c) < J)
+            ++cc;
+    }
+    const size_t per_agent = 2 + cc; /* root translation and rotation, then the clip's */
+    /* Bytes, estimated before allocating: the meshes, the raw keys and the built clip. */
+    double bytes = 0.0;
+    for (size_t m = 0; m < cs->mesh_count; ++m) {
+        const ak_mesh* me = cs->meshes[m].mesh;
+        if (!me) continue;
+        bytes += (double)me->vertex_count * (80.0 + 6.0 * me->influence_count) + 12.0 * (double)me->triangle_count +
+                 40.0 * (double)me->vertex_count * (double)me->morph_target_count;
+    }
+    bytes *= (double)N;
+    bytes += 2.0 * (double)N * (double)per_agent * (double)F * 16.0 + (double)N * (double)J * 256.0;
+    const size_t budget = desc->memory_budget ? desc->memory_budget : AK_SCENE_BAKE_DEFAULT_BUDGET;
+    if (bytes > (double)budget) {
+        akp_diag_set(out_diag, name, "%zu agents x %zu frames need about %.0f MB, more than the budget of %.0f MB", N,
+                     F, bytes / 1048576.0, (double)budget / 1048576.0);
+        return AK_ERR_UNSUPPORTED;
+    }
+
+    ak_scene* sc = NULL;
+    ak_result res = ak_scene_alloc(N * cs->mesh_count, N * cs->skin_count, 1, alloc, &sc);
+    if (res != AK_OK) return res;
+    snprintf(sc->name, sizeof sc->name, "%s", name);
+    const size_t nodes = N * (J + 1);
+    ak_joint_desc* jd = akp_alloc(alloc, nodes * sizeof *jd);
+    char(*names)[AK_NAME_SIZE] = akp_alloc(alloc, nodes * sizeof *names);
+    ak_raw_channel* ch = akp_alloc(alloc, N * per_agent * sizeof *ch);
+    float* times = akp_alloc(alloc, F * sizeof *times);
+    float* keys = akp_alloc(alloc, N * per_agent * F * 4 * sizeof *keys);
+    ak_transform* pose = akp_alloc(alloc, J * sizeof *pose);
+    sc->is_joint = akp_alloc(&sc->alloc, nodes * sizeof *sc->is_joint);
+    if (!jd || !names || !ch || !times || !keys || !pose || !sc->is_joint) {
+        res = AK_ERR_NO_MEMORY;
+        goto done;
+    }
+    /* nodes: per agent its root, then the character's nodes */
+    const ak_i16_cspan parents = ak_skeleton_parents(cs->skeleton);
+    for (size_t a = 0; a < N; ++a) {
+        const size_t base = a * (J + 1);
+        const ak_crowd_character* c0 = &desc->characters[a];
+        const ak_vec2 p0 = desc->positions[a];
+        snprintf(names[base], AK_NAME_SIZE, "%.40s_%zu", name, a);
+        jd[base] = (ak_joint_desc){.name = names[base], .parent = -1,
+                                   .rest = ak_transform_make(ak_vec3_make(p0.x, 0.0f, p0.y), root_rotation(g, c0),
+                                                             ak_vec3_make(1.0f, 1.0f, 1.0f))};
+        sc->is_joint[base] = false;
+        /* the nodes rest in the first frame's pose (a one-frame scene is that frame) */
+        res = ak_crowd_character_pose(g, c0, (ak_transform_span){pose, J});
+        if (res != AK_OK) goto done;
+        for (size_t j = 0; j < J; ++j) {
+            snprintf(names[base + 1 + j], AK_NAME_SIZE, "%zu/%.40s", a, ak_skeleton_joint_name(cs->skeleton, j));
+            jd[base + 1 + j] = (ak_joint_desc){.name = names[base + 1 + j],
+                                               .parent = parents.ptr[j] < 0 ? (int)base : (int)(base + 1) + parents.ptr[j],
+                                               .rest = pose[j]};
+            sc->is_joint[base + 1 + j] = cs->is_joint ? cs->is_joint[j] : true;
+        }
+    }
+    ak_skeleton_desc sd = {.joints = jd, .joint_count = nodes, .name = name, .palette_from_skins = true};
+    res = ak_skeleton_create(&sd, &sc->alloc, &sc->skeleton, out_diag);
+    if (res != AK_OK) goto done;
+    /* skins and meshes: copies, their joints and nodes moved to the agent's */
+    for (size_t a = 0; a < N && res == AK_OK; ++a) {
+        const size_t base = a * (J + 1) + 1;
+        for (size_t s = 0; s < cs->skin_count && res == AK_OK; ++s) {
+            const ak_scene_skin* from = &cs->skins[s];
+            ak_scene_skin* to = &sc->skins[a * cs->skin_count + s];
+            res = ak_scene_skin_alloc(sc, a * cs->skin_count + s, from->joint_count);
+            if (res != AK_OK) break;
+            snprintf(to->name, sizeof to->name, "%zu/%.40s", a, from->name);
+            for (size_t k = 0; k < from->joint_count; ++k) {
+                to->joints[k] = (int32_t)base + from->joints[k];
+                to->inverse_binds[k] = from->inverse_binds[k];
+            }
+        }
+        for (size_t m = 0; m < cs->mesh_count && res == AK_OK; ++m) {
+            const ak_scene_mesh* from = &cs->meshes[m];
+            ak_scene_mesh* to = &sc->meshes[a * cs->mesh_count + m];
+            *to = *from;
+            to->mesh = NULL;
+            to->texture = -1; /* textures are not copied */
+            /* skinned: no node (ak_io_save gives it its own root: glTF ignores a skinned mesh's
+             * node transform and warns when that node is animated); rigid: the agent's node */
+            to->node = from->skin >= 0 ? -1 : (from->node < 0 ? (int32_t)(base - 1) : (int32_t)base + from->node);
+            to->skin = from->skin < 0 ? -1 : (int32_t)(a * cs->skin_count) + from->skin;
+            if (desc->colors) {
+                to->has_material = true;
+                to->base_color = desc->colors[a];
+            }
+            if (from->mesh) {
+                res = ak_mesh_clone(from->mesh, &sc->alloc, &to->mesh);
+                if (res == AK_OK) snprintf(to->mesh->name, sizeof to->mesh->name, "%zu/%.40s", a, from->mesh->name);
+            }
+        }
+    }
+    if (res != AK_OK) goto done;
+    /* the clip: every frame's root and pose */
+    for (size_t f = 0; f < F; ++f) times[f] = desc->frame_time * (float)f;
+    for (size_t a = 0; a < N; ++a) {
+        const size_t base = a * (J + 1);
+        ak_raw_channel* c = ch + a * per_agent;
+        float* kv = keys + a * per_agent * F * 4;
+        c[0] = (ak_raw_channel){.target = AK_CHANNEL_TRANSLATION, .index = (uint32_t)base, .component_count = 3,
+                                .interp = AK_INTERP_LINEAR, .key_count = F, .times = times, .values = kv};
+        c[1] = (ak_raw_channel){.target = AK_CHANNEL_ROTATION, .index = (uint32_t)base, .component_count = 4,
+                                .interp = AK_INTERP_LINEAR, .key_count = F, .times = times, .values = kv + F * 4};
+        size_t k = 2;
+        for (size_t q = 0; q < ak_clip_channel_count(clip); ++q) {
+            const ak_channel_target t = ak_clip_channel_target(clip, q);
+            const uint32_t j = ak_clip_channel_index(clip, q);
+            if ((t != AK_CHANNEL_TRANSLATION && t != AK_CHANNEL_ROTATION && t != AK_CHANNEL_SCALE) || j >= J) continue;
+            c[k] = (ak_raw_channel){.target = t, .index = (uint32_t)(base + 1 + j),
+                                    .component_count = t == AK_CHANNEL_ROTATION ? 4u : 3u,
+                                    .interp = AK_INTERP_LINEAR, .key_count = F, .times = times,
+                                    .values = kv + k * F * 4};
+            ++k;
+        }
+        for (size_t f = 0; f < F; ++f) {
+            const ak_crowd_character* chr = &desc->characters[f * N + a];
+            const ak_vec2 p = desc->positions[f * N + a];
+            float* tr = kv + 3 * f;
+            tr[0] = p.x, tr[1] = 0.0f, tr[2] = p.y;
+            ak_quat r = root_rotation(g, chr);
+            float* rq = kv + F * 4 + 4 * f;
+            if (f > 0 && rq[-4] * r.x + rq[-3] * r.y + rq[-2] * r.z + rq[-1] * r.w < 0.0f) r = ak_quat_neg(r);
+            rq[0] = r.x, rq[1] = r.y, rq[2] = r.z, rq[3] = r.w;
+            res = ak_crowd_character_pose(g, chr, (ak_transform_span){pose, J});
+            if (res != AK_OK) goto done;
+            for (size_t q = 2; q < per_agent; ++q) {
+                const size_t j = c[q].index - base - 1;
+                float* v = (float*)c[q].values + c[q].component_count * f;
+                if (c[q].target == AK_CHANNEL_ROTATION) {
+                    ak_quat o = pose[j].rotation;
+                    if (f > 0 && v[-4] * o.x + v[-3] * o.y + v[-2] * o.z + v[-1] * o.w < 0.0f) o = ak_quat_neg(o);
+                    v[0] = o.x, v[1] = o.y, v[2] = o.z, v[3] = o.w;
+                } else {
+                    const ak_vec3 o = c[q].target == AK_CHANNEL_TRANSLATION ? pose[j].translation : pose[j].scale;
+                    v[0] = o.x, v[1] = o.y, v[2] = o.z;
+                }
+            }
+        }
+    }
+    if (F > 1) {
+        ak_raw_clip raw = {.name = name, .channels = ch, .channel_count = N * per_agent, .joint_count = nodes};
+        res = ak_clip_build(&raw, &sc->alloc, &sc->clips[0], out_diag);
+    } else {
+        sc->clip_count = 0; /* one frame: the rest pose is the frame */
+    }
+done:
+    akp_free(alloc, jd);
+    akp_free(alloc, names);
+    akp_free(alloc, ch);
+    akp_free(alloc, times);
+    akp_free(alloc, keys);
+    akp_free(alloc, pose);
+    if (res != AK_OK) {
+        if (res == AK_ERR_NO_MEMORY) akp_diag_set(out_diag, name, "out of memory");
+        ak_scene_destroy(sc);
+        return res;
+    }
+    *out_scene = sc;
+    return AK_OK;
+}

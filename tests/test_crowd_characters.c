@@ -1,0 +1,387 @@
+/* Crowd characters (crowd.h, "characters"): the walk clip measured, clip time following the
+ * distance walked, heading, idle, and foot sliding measured in the world. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <animkit/animkit.h>
+
+#include "ak_test.h"
+
+/* One humanoid for every case (built once: valgrind runs these cases too). Its mesh only
+ * matters to bake_scene: coarse is quick. */
+static ak_scene* g_humanoid;
+
+static ak_scene* humanoid(void) {
+    if (!g_humanoid) {
+        ak_builtin_desc bd = {.cell_size = 0.1f};
+        if (ak_builtin_create("builtin:humanoid", &bd, NULL, &g_humanoid) != AK_OK) return NULL;
+    }
+    return g_humanoid;
+}
+
+static bool gait_of(const ak_scene* sc, ak_crowd_gait* g) {
+    ak_crowd_gait_desc d = {.scene = sc, .clip_index = ak_scene_find_clip(sc, "walk")};
+    ak_diag diag;
+    const ak_result r = ak_crowd_gait_measure(&d, NULL, g, &diag);
+    if (r != AK_OK) fprintf(stderr, "gait: %s\n", diag.message);
+    return r == AK_OK;
+}
+
+/* World positions of the two feet of a character at ground position p. */
+static void feet_world(const ak_crowd_gait* g, const ak_crowd_character* c, ak_vec2 p, ak_transform* local,
+                       ak_mat4* world, size_t n, ak_vec3 out[2]) {
+    ak_crowd_character_pose(g, c, (ak_transform_span){local, n});
+    ak_scene_world_matrices(g->scene, (ak_transform_cspan){local, n}, (ak_mat4_span){world, n});
+    const ak_mat4 root = ak_crowd_character_root(g, c, p);
+    for (int f = 0; f < 2; ++f)
+        out[f] = ak_mat4_transform_point(root, ak_mat4_get_translation(world[g->feet[f]]));
+}
+
+/* How the clip time is chosen in a sliding run. */
+typedef enum { TIME_GAIT, TIME_RATE_ONE, TIME_CONSTANT_RATE } time_mode;
+
+/* The agent's path: a straight line at speed along dir, or a circle of radius R. */
+typedef struct path {
+    float speed;
+    ak_vec2 dir;
+    float radius; /* 0 -> straight */
+} path;
+
+static ak_vec2 path_pos(const path* pa, float t) {
+    if (pa->radius <= 0.0f) return ak_vec2_scale(pa->dir, pa->speed * t);
+    const float a = pa->speed * t / pa->radius;
+    return ak_vec2_make(pa->radius * cosf(a), pa->radius * sinf(a));
+}
+static ak_vec2 path_vel(const path* pa, float t) {
+    if (pa->radius <= 0.0f) return ak_vec2_scale(pa->dir, pa->speed);
+    const float a = pa->speed * t / pa->radius;
+    return ak_vec2_make(-pa->speed * sinf(a), pa->speed * cosf(a));
+}
+
+/* Walk the path for seconds and measure foot sliding independently of the gait's own notion of
+ * stance: a foot is in stance while its world height is within stance_band of the lowest height
+ * it reaches over the run (after the first second); over each stance the largest horizontal
+ * distance from where the stance began is its slide. Returns the largest slide (m). */
+static double max_slide(const ak_crowd_gait* g, const path* pa, time_mode mode, float seconds, float stance_band,
+                        int* out_stances, double* out_along) {
+    const size_t n = ak_scene_joint_count(g->scene);
+    ak_transform* local = malloc(n * sizeof *local);
+    ak_mat4* world = malloc(n * sizeof *world);
+    const float dt = 1.0f / 120.0f;
+    const int steps = (int)(seconds / dt);
+    ak_vec3(*feet)[2] = malloc((size_t)steps * sizeof *feet);
+    ak_crowd_character c = ak_crowd_character_init(g, path_vel(pa, 0.0f), 0.0f);
+    c.walk_weight = 1.0f;
+    for (int s = 0; s < steps; ++s) {
+        const float t = dt * (float)(s + 1);
+        ak_vec2 v = path_vel(pa, t);
+        ak_crowd_characters_job job = {.gait = g, .dt = dt, .velocities = {&v, 1}, .characters = {&c, 1}};
+        AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+        if (mode == TIME_RATE_ONE) c.clip_time = fmodf(t, g->duration);
+        if (mode == TIME_CONSTANT_RATE) c.clip_time = fmodf(t * pa->speed / g->stride_speed, g->duration);
+        feet_world(g, &c, path_pos(pa, t), local, world, n, feet[s]);
+    }
+    const int skip = (int)(1.0f / dt);
+    double worst = 0.0, along = 0.0;
+    int stances = 0;
+    for (int f = 0; f < 2; ++f) {
+        float low = INFINITY;
+        for (int s = skip; s < steps; ++s) low = fminf(low, feet[s][f].y);
+        int start = -1;
+        for (int s = skip; s < steps; ++s) {
+            const bool st = feet[s][f].y <= low + stance_band;
+            if (st && start < 0) start = s, ++stances;
+            if (!st) start = -1;
+            if (start >= 0) {
+                const double dx = feet[s][f].x - feet[start][f].x, dz = feet[s][f].z - feet[start][f].z;
+                worst = fmax(worst, sqrt(dx * dx + dz * dz));
+                along = fmax(along, fabs(dx * pa->dir.x + dz * pa->dir.y));
+            }
+        }
+    }
+    free(local);
+    free(world);
+    free(feet);
+    if (out_stances) *out_stances = stances;
+    if (out_along) *out_along = along;
+    return worst;
+}
+
+/* ---- cases ---------------------------------------------------------------------------------- */
+
+AK_TEST(gait_of_builtin_walk) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    /* The automatic feet are the ankles (the lowest joints of each side). */
+    AK_CHECK_STREQ(ak_skeleton_joint_name(sc->skeleton, (size_t)g.feet[0]), "left_ankle");
+    AK_CHECK_STREQ(ak_skeleton_joint_name(sc->skeleton, (size_t)g.feet[1]), "right_ankle");
+    /* builtin.h: the humanoid faces +z. */
+    AK_CHECK_NEAR(g.forward.x, 0.0f, 0.02f);
+    AK_CHECK_NEAR(g.forward.z, 1.0f, 1e-3f);
+    AK_CHECK_NEAR(g.duration, 1.0f, 1e-6f);
+    /* Reference: the stance foot's backward travel, sampled 16x finer than the gait's table
+     * with the forward axis builtin.h states (+z); the lower ankle at each sample is in stance. */
+    const size_t n = ak_scene_joint_count(sc);
+    ak_mat4* w = malloc(n * sizeof *w);
+    ak_transform* l = malloc(n * sizeof *l);
+    const int la = ak_skeleton_find_joint(sc->skeleton, "left_ankle"), ra = ak_skeleton_find_joint(sc->skeleton, "right_ankle");
+    double travel = 0.0, prev_z[2] = {0, 0};
+    for (int k = 0; k <= 4096; ++k) {
+        ak_scene_rest_pose(sc, (ak_transform_span){l, n});
+        ak_clip_sample(sc->clips[ak_scene_find_clip(sc, "walk")], (float)k / 4096.0f, NULL, (ak_transform_span){l, n},
+                       (ak_f32_span){0}, (ak_f32_span){0});
+        ak_scene_world_matrices(sc, (ak_transform_cspan){l, n}, (ak_mat4_span){w, n});
+        const ak_vec3 a = ak_mat4_get_translation(w[la]), b = ak_mat4_get_translation(w[ra]);
+        const int f = a.y <= b.y ? 0 : 1;
+        const double z = f ? b.z : a.z;
+        if (k > 0 && z < prev_z[f]) travel += prev_z[f] - z;
+        prev_z[0] = a.z, prev_z[1] = b.z;
+    }
+    free(w);
+    free(l);
+    printf("  stride %.4f m per cycle (reference %.4f), stride speed %.3f m/s\n", (double)g.stride_length, travel,
+           (double)g.stride_speed);
+    AK_CHECK_MSG(fabs(g.stride_length - travel) < 0.01 * travel, "stride %g vs %g", (double)g.stride_length, travel);
+    AK_CHECK_NEAR(g.stride_speed, g.stride_length / g.duration, 1e-6f);
+    /* The table inverts: distance[k] maps back to sample k's time where the foot moves. */
+    int checked = 0;
+    for (unsigned k = 0; k < AK_CROWD_GAIT_SAMPLES; ++k) {
+        if (!(g.distance[k + 1] > g.distance[k])) continue;
+        const float mid = 0.5f * (g.distance[k] + g.distance[k + 1]);
+        const float t = ak_crowd_gait_clip_time(&g, mid), expect_t = g.duration * ((float)k + 0.5f) / AK_CROWD_GAIT_SAMPLES;
+        AK_CHECK_NEAR(t, expect_t, 1e-4f);
+        ++checked;
+    }
+    AK_CHECK(checked > (int)AK_CROWD_GAIT_SAMPLES / 2);
+    /* Periodic: a whole stride later, the same time. */
+    AK_CHECK_NEAR(ak_crowd_gait_clip_time(&g, 0.3f), ak_crowd_gait_clip_time(&g, 0.3f + 2.0f * g.stride_length), 1e-4f);
+    AK_CHECK_EQ(ak_crowd_gait_clip_time(&g, NAN), 0.0f);
+}
+
+/* The acceptance test: a foot in stance moves < 2 cm in the world. It can fail: the same run
+ * with the clip at rate 1, or at the mean rate speed / stride_speed without the distance
+ * table, slides by decimetres. */
+AK_TEST(foot_sliding_straight) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    const float speeds[3] = {0.7f, 1.3f, 1.9f};
+    for (int k = 0; k < 3; ++k) {
+        const float l = sqrtf(1.0f + 0.36f);
+        const path pa = {speeds[k], {1.0f / l, 0.6f / l}, 0.0f};
+        int stances = 0;
+        double along = 0.0, along2 = 0.0;
+        const float secs = 1.0f + 3.05f * g.stride_length / speeds[k]; /* 1 s, then three cycles */
+        const double slide = max_slide(&g, &pa, TIME_GAIT, secs, 0.01f, &stances, &along);
+        const double slide2 = max_slide(&g, &pa, TIME_GAIT, secs, 0.02f, NULL, &along2);
+        const double one = max_slide(&g, &pa, TIME_RATE_ONE, secs, 0.01f, NULL, NULL);
+        const double constant = max_slide(&g, &pa, TIME_CONSTANT_RATE, secs, 0.01f, NULL, NULL);
+        printf("  %.1f m/s: %d stances, slide %.2f cm (along the path %.2f cm); 2 cm band: %.2f cm (along %.2f cm); "
+               "rate 1: %.1f cm; constant rate: %.1f cm\n",
+               (double)speeds[k], stances, 100 * slide, 100 * along, 100 * slide2, 100 * along2, 100 * one,
+               100 * constant);
+        AK_CHECK(stances >= 6);
+        AK_CHECK_MSG(slide < 0.02, "%.1f m/s: a stance foot slides %.2f cm", (double)speeds[k], 100 * slide);
+        AK_CHECK_MSG(one > 0.02, "rate 1 should slide at %.1f m/s (%.2f cm)", (double)speeds[k], 100 * one);
+        AK_CHECK_MSG(constant > 0.02, "the constant mean rate should slide (%.2f cm)", 100 * constant);
+    }
+}
+
+/* Turning on a circle of 4 m radius: the heading follows the velocity. */
+AK_TEST(turning_and_idle) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    const path pa = {1.3f, {0, 0}, 4.0f};
+    const double slide = max_slide(&g, &pa, TIME_GAIT, 4.0f, 0.01f, NULL, NULL);
+    printf("  circle r = 4 m at 1.3 m/s: slide %.2f cm\n", 100 * slide);
+    /* The root turns under the planted foot (0.33 rad/s here) and the heading lags the
+     * velocity by about omega * turn_time: measured 3.1 cm, bounded at 4 cm. */
+    AK_CHECK_MSG(slide < 0.04, "turning: %.2f cm", 100 * slide);
+    /* The heading converges to the velocity's direction (smoothing only, no lag left). */
+    ak_crowd_character c = ak_crowd_character_init(&g, ak_vec2_make(1, 0), 0.25f);
+    AK_CHECK_NEAR(c.heading.x, 1.0f, 1e-6f);
+    ak_vec2 v = {0.0f, -1.2f};
+    ak_crowd_characters_job job = {.gait = &g, .dt = 0.05f, .velocities = {&v, 1}, .characters = {&c, 1}};
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    /* one step turns by at most max_turn_rate * dt (6 rad/s default) */
+    AK_CHECK(atan2f(-c.heading.y, c.heading.x) <= 0.3f + 1e-5f);
+    for (int s = 0; s < 40; ++s) ak_crowd_characters_update(&job);
+    AK_CHECK_NEAR(c.heading.x, 0.0f, 1e-3f);
+    AK_CHECK_NEAR(c.heading.y, -1.0f, 1e-3f);
+    AK_CHECK_NEAR(c.walk_weight, 1.0f, 1e-6f);
+    /* The root matrix turns the model's forward (+z) onto the heading and stands on p. */
+    const ak_mat4 m = ak_crowd_character_root(&g, &c, ak_vec2_make(2, 3));
+    const ak_vec3 f = ak_mat4_transform_vector(m, g.forward), o = ak_mat4_transform_point(m, ak_vec3_zero());
+    AK_CHECK_NEAR(f.x, c.heading.x, 1e-5f);
+    AK_CHECK_NEAR(f.z, c.heading.y, 1e-5f);
+    AK_CHECK_NEAR(o.x, 2.0f, 1e-6f);
+    AK_CHECK_NEAR(o.z, 3.0f, 1e-6f);
+    /* Stopped: the clip freezes, the heading stays, the pose is the rest pose. */
+    const ak_vec2 h = c.heading;
+    const float t = c.clip_time;
+    v = ak_vec2_make(0, 0);
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    AK_CHECK_EQ(c.walk_weight, 0.0f);
+    AK_CHECK_EQ(c.clip_time, t);
+    AK_CHECK_EQ(c.heading.x, h.x);
+    AK_CHECK_EQ(c.heading.y, h.y);
+    const size_t n = ak_scene_joint_count(sc);
+    ak_transform* local = malloc(n * sizeof *local);
+    AK_CHECK_EQ(ak_crowd_character_pose(&g, &c, (ak_transform_span){local, n}), AK_OK);
+    const ak_transform_cspan rest = ak_skeleton_rest_pose(sc->skeleton);
+    AK_CHECK(memcmp(local, rest.ptr, n * sizeof *local) == 0);
+    /* Half the idle speed: halfway (smoothstep(0.5) = 0.5) between rest and walk. */
+    v = ak_vec2_make(0.075f, 0);
+    ak_crowd_characters_update(&job);
+    AK_CHECK_NEAR(c.walk_weight, 0.5f, 1e-6f);
+    free(local);
+}
+
+AK_TEST(validation) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_crowd_gait_measure(NULL, NULL, &g, &diag), AK_ERR_NULL_ARG);
+    ak_crowd_gait_desc d = {.scene = sc, .clip_index = 7};
+    AK_CHECK_EQ(ak_crowd_gait_measure(&d, NULL, &g, &diag), AK_ERR_BAD_INDEX);
+    d.clip_index = ak_scene_find_clip(sc, "walk");
+    d.left_foot = 3, d.right_foot = 3;
+    AK_CHECK_EQ(ak_crowd_gait_measure(&d, NULL, &g, &diag), AK_ERR_BAD_INDEX);
+    /* the wave clip does not walk: its feet do not move */
+    d = (ak_crowd_gait_desc){.scene = sc, .clip_index = ak_scene_find_clip(sc, "wave")};
+    AK_CHECK_EQ(ak_crowd_gait_measure(&d, NULL, &g, &diag), AK_ERR_BAD_DATA);
+    AK_CHECK(strstr(diag.message, "not a walk") != NULL);
+    AK_CHECK(gait_of(sc, &g));
+    ak_crowd_character c = ak_crowd_character_init(&g, ak_vec2_make(NAN, 0), 0.5f);
+    AK_CHECK_EQ(c.heading.y, 1.0f);
+    ak_vec2 v = {NAN, 0};
+    ak_crowd_characters_job job = {.gait = &g, .dt = 0.1f, .velocities = {&v, 1}, .characters = {&c, 1}};
+    const ak_crowd_character before = c;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_BAD_DATA);
+    AK_CHECK(memcmp(&before, &c, sizeof c) == 0);
+    v.x = 1;
+    job.dt = 0;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_BAD_ARG);
+    job.dt = 0.1f;
+    job.turn_time = -1;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_BAD_ARG);
+    job.turn_time = 0;
+    job.velocities.count = 0;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_SPAN_SMALL);
+    job.gait = NULL;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_NULL_ARG);
+    ak_transform one;
+    AK_CHECK_EQ(ak_crowd_character_pose(&g, &c, (ak_transform_span){&one, 1}), AK_ERR_SPAN_SMALL);
+}
+
+/* ak_crowd_bake_scene: every agent's joints in the baked scene, posed by its clip at frame k,
+ * sit where the character's own forward kinematics, placed by the root matrix, puts them. */
+AK_TEST(bake_scene) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    enum { N = 3, F = 5 };
+    ak_vec2 pos[F * N];
+    ak_crowd_character ch[F * N];
+    for (int a = 0; a < N; ++a) {
+        ak_crowd_character c = ak_crowd_character_init(&g, ak_vec2_make(1, (float)a), 0.3f * (float)a);
+        ak_vec2 v = ak_vec2_make(1.2f, 0.4f * (float)(a - 1));
+        ak_crowd_characters_job job = {.gait = &g, .dt = 0.1f, .velocities = {&v, 1}, .characters = {&c, 1}};
+        for (int f = 0; f < F; ++f) {
+            pos[f * N + a] = ak_vec2_make(0.12f * (float)f + 2.0f * (float)a, 0.04f * (float)f * (float)(a - 1));
+            ch[f * N + a] = c;
+            ak_crowd_characters_update(&job);
+        }
+    }
+    ak_crowd_bake_desc bd = {.gait = &g, .agent_count = N, .frame_count = F, .positions = pos, .characters = ch,
+                             .frame_time = 0.1f};
+    ak_scene* baked = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_OK);
+    if (!baked) return;
+    const size_t J = ak_scene_joint_count(sc), n = ak_scene_joint_count(baked);
+    AK_CHECK_EQ(n, (size_t)N * (J + 1));
+    AK_CHECK_EQ(baked->mesh_count, (size_t)N * sc->mesh_count);
+    AK_CHECK_EQ(baked->skin_count, (size_t)N * sc->skin_count);
+    AK_CHECK_EQ(baked->clip_count, 1u);
+    AK_CHECK_NEAR(ak_clip_duration(baked->clips[0]), 0.4f, 1e-6f);
+    ak_transform* lb = malloc(n * sizeof *lb);
+    ak_mat4* wb = malloc(n * sizeof *wb);
+    ak_transform* lc = malloc(J * sizeof *lc);
+    ak_mat4* wc = malloc(J * sizeof *wc);
+    double worst = 0.0;
+    for (int f = 0; f < F; ++f) {
+        ak_scene_rest_pose(baked, (ak_transform_span){lb, n});
+        ak_clip_sample(baked->clips[0], 0.1f * (float)f, NULL, (ak_transform_span){lb, n}, (ak_f32_span){0},
+                       (ak_f32_span){0});
+        ak_scene_world_matrices(baked, (ak_transform_cspan){lb, n}, (ak_mat4_span){wb, n});
+        for (int a = 0; a < N; ++a) {
+            ak_crowd_character_pose(&g, &ch[f * N + a], (ak_transform_span){lc, J});
+            ak_scene_world_matrices(sc, (ak_transform_cspan){lc, J}, (ak_mat4_span){wc, J});
+            const ak_mat4 root = ak_crowd_character_root(&g, &ch[f * N + a], pos[f * N + a]);
+            for (size_t j = 0; j < J; ++j) {
+                const ak_vec3 want = ak_mat4_transform_point(root, ak_mat4_get_translation(wc[j]));
+                const ak_vec3 got = ak_mat4_get_translation(wb[(size_t)a * (J + 1) + 1 + j]);
+                worst = fmax(worst, (double)ak_vec3_length(ak_vec3_sub(want, got)));
+            }
+        }
+    }
+    printf("  baked joints vs the characters' own: %.2g m at most\n", worst);
+    AK_CHECK(worst < 1e-4);
+    /* each skin names its agent's joints */
+    AK_CHECK_EQ(baked->skins[N - 1].joints[0], (int32_t)((N - 1) * (J + 1) + 1) + sc->skins[0].joints[0]);
+    free(lb);
+    free(wb);
+    free(lc);
+    free(wc);
+    ak_scene_destroy(baked);
+    /* errors, checked before allocating */
+    bd.memory_budget = 1000;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK(baked == NULL && strstr(diag.message, "budget") != NULL);
+    bd.memory_budget = 0;
+    bd.frame_count = AK_SCENE_BAKE_MAX_FRAMES + 1;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
+    bd.frame_count = 0;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_EMPTY);
+    bd.frame_count = F;
+    bd.frame_time = 0;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_BAD_ARG);
+    bd.frame_time = 0.1f;
+    pos[4].x = NAN;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_BAD_DATA);
+    bd.agent_count = 2000;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK_EQ(ak_crowd_bake_scene(NULL, NULL, &baked, &diag), AK_ERR_NULL_ARG);
+    /* one frame: no clip, the nodes rest in that frame */
+    pos[4].x = 0;
+    bd.agent_count = N;
+    bd.frame_count = 1;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_OK);
+    if (baked) AK_CHECK_EQ(baked->clip_count, 0u);
+    ak_scene_destroy(baked);
+}
+
+int main(void) {
+    AK_RUN(gait_of_builtin_walk);
+    AK_RUN(foot_sliding_straight);
+    AK_RUN(turning_and_idle);
+    AK_RUN(validation);
+    AK_RUN(bake_scene);
+    ak_scene_destroy(g_humanoid);
+    return ak_test_finish();
+}

@@ -1,0 +1,185 @@
+/* The crowd's characters and drawing (crowd_draw.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "crowd_draw.h"
+
+#define SIDES 8
+#define VERTS_PER_PRISM (9 * SIDES)
+
+const ak_vec4 crowd_palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
+                                  {0.75f, 0.30f, 0.55f, 1}};
+
+/* ---- characters ------------------------------------------------------------------------------ */
+
+void crowd_chars_free(crowd_chars* c) {
+    if (c->poser_ready) cli_poser_free(&c->poser);
+    ak_scene_destroy(c->scene);
+    free(c->ch);
+    free(c->rec_pos);
+    free(c->rec_ch);
+    memset(c, 0, sizeof *c);
+}
+
+void crowd_chars_reset(crowd_chars* c, const ak_crowd_scene* sc) {
+    for (size_t i = 0; i < c->n; ++i) {
+        const ak_vec2 to = ak_vec2_sub(sc->agents[i].goals.ptr[0], sc->positions[i]);
+        const float phase = (float)((i * 2654435761u) & 0xffffu) / 65536.0f; /* spread, reproducible */
+        c->ch[i] = ak_crowd_character_init(&c->gait, to, phase);
+    }
+    c->frames = 0;
+}
+
+ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t frame_cap, ak_diag* diag) {
+    memset(c, 0, sizeof *c);
+    ak_builtin_desc bd = {.cell_size = CROWD_CHARACTER_CELL};
+    ak_result r = ak_builtin_create("builtin:humanoid", &bd, NULL, &c->scene);
+    if (r != AK_OK) return r;
+    ak_crowd_gait_desc gd = {.scene = c->scene, .clip_index = ak_scene_find_clip(c->scene, "walk")};
+    if ((r = ak_crowd_gait_measure(&gd, NULL, &c->gait, diag)) != AK_OK) return r;
+    c->n = sc->agent_count;
+    c->ch = malloc(c->n * sizeof *c->ch);
+    if (!c->ch) return AK_ERR_NO_MEMORY;
+    crowd_chars_reset(c, sc);
+    if (cli_poser_init(&c->poser, c->scene)) return AK_ERR_NO_MEMORY;
+    c->poser_ready = true;
+    if (frame_cap) {
+        c->frame_cap = frame_cap;
+        c->rec_pos = malloc(frame_cap * c->n * sizeof *c->rec_pos);
+        c->rec_ch = malloc(frame_cap * c->n * sizeof *c->rec_ch);
+        if (!c->rec_pos || !c->rec_ch) return AK_ERR_NO_MEMORY;
+    }
+    return AK_OK;
+}
+
+ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, float dt) {
+    ak_crowd_characters_job job = {.gait = &c->gait, .dt = dt, .velocities = {velocities, c->n},
+                                   .characters = {c->ch, c->n}};
+    return ak_crowd_characters_update(&job);
+}
+
+void crowd_chars_record(crowd_chars* c, const ak_vec2* positions) {
+    if (c->frames >= c->frame_cap) return;
+    memcpy(c->rec_pos + c->frames * c->n, positions, c->n * sizeof *positions);
+    memcpy(c->rec_ch + c->frames * c->n, c->ch, c->n * sizeof *c->ch);
+    ++c->frames;
+}
+
+/* ---- people ------------------------------------------------------------------------------------ */
+
+void crowd_people_free(crowd_people* pp) {
+    free(pp->pos);
+    free(pp->nrm);
+    free(pp->col);
+    free(pp->idx);
+    memset(pp, 0, sizeof *pp);
+}
+
+bool crowd_people_init(crowd_people* pp, size_t n, const crowd_chars* chars) {
+    memset(pp, 0, sizeof *pp);
+    pp->vcount = n * VERTS_PER_PRISM;
+    if (chars) {
+        const ak_mesh* m = chars->scene->meshes[0].mesh;
+        pp->vcount = n * m->vertex_count;
+        pp->icount = n * m->triangle_count * 3;
+        pp->idx = malloc(pp->icount * sizeof *pp->idx);
+        if (!pp->idx) return false;
+        for (size_t a = 0; a < n; ++a)
+            for (size_t k = 0; k < m->triangle_count * 3; ++k)
+                pp->idx[a * m->triangle_count * 3 + k] = (uint32_t)(a * m->vertex_count + m->indices[k]);
+    }
+    pp->pos = malloc(pp->vcount * sizeof *pp->pos);
+    pp->nrm = malloc(pp->vcount * sizeof *pp->nrm);
+    pp->col = malloc(pp->vcount * sizeof *pp->col);
+    return pp->pos && pp->nrm && pp->col;
+}
+
+/* Each character posed (its clip time and heading), skinned (LBS) and placed in the world. */
+static ak_result pose_characters(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
+                                 crowd_chars* c) {
+    const ak_mesh* m = c->scene->meshes[0].mesh;
+    const size_t J = ak_scene_joint_count(c->scene);
+    for (size_t i = 0; i < c->n; ++i) {
+        ak_result res = ak_crowd_character_pose(&c->gait, &c->ch[i], (ak_transform_span){c->poser.local, J});
+        if (res == AK_OK) res = cli_poser_deform(&c->poser, false, CLI_LBS);
+        if (res != AK_OK) return res;
+        const ak_mat4 root = ak_crowd_character_root(&c->gait, &c->ch[i], positions[i]);
+        const ak_vec4 col = crowd_palette[sc->group[i] % 4];
+        for (size_t v = 0; v < m->vertex_count; ++v) {
+            const size_t o = i * m->vertex_count + v;
+            pp->pos[o] = ak_mat4_transform_point(root, c->poser.positions[0][v]);
+            pp->nrm[o] = ak_mat4_transform_vector(root, c->poser.normals[0][v]);
+            pp->col[o] = col;
+        }
+    }
+    return AK_OK;
+}
+
+/* Each agent an upright octagonal prism (1.7 m, its radius) coloured by group, its front face
+ * (toward the velocity) light. */
+static void prisms(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions, const ak_vec2* velocities) {
+    const float pi = 3.14159265358979f;
+    size_t k = 0;
+    for (size_t i = 0; i < sc->agent_count; ++i) {
+        const float rad = sc->agents[i].radius > 0.0f ? sc->agents[i].radius : 0.3f, hgt = 1.7f;
+        const ak_vec2 p = positions[i], v = velocities[i];
+        const float heading = (v.x * v.x + v.y * v.y) > 1e-6f ? atan2f(v.y, v.x) : 0.0f;
+        const ak_vec4 c = crowd_palette[sc->group[i] % 4];
+        for (int s = 0; s < SIDES; ++s) {
+            const float a0 = heading + 2.0f * pi * ((float)s - 0.5f) / SIDES, a1 = heading + 2.0f * pi * ((float)s + 0.5f) / SIDES;
+            const ak_vec3 b0 = {p.x + rad * cosf(a0), 0, p.y + rad * sinf(a0)}, b1 = {p.x + rad * cosf(a1), 0, p.y + rad * sinf(a1)};
+            const ak_vec3 t0 = {b0.x, hgt, b0.z}, t1 = {b1.x, hgt, b1.z}, top = {p.x, hgt, p.y};
+            const float am = heading + 2.0f * pi * (float)s / SIDES;
+            const ak_vec3 n = {cosf(am), 0, sinf(am)}, up = {0, 1, 0};
+            const ak_vec4 cc = s == 0 ? ak_vec4_make(0.95f, 0.95f, 0.9f, 1) : c;
+            const ak_vec3 tri[9] = {b0, b1, t1, b0, t1, t0, t0, t1, top};
+            for (int q = 0; q < 9; ++q) {
+                pp->pos[k] = tri[q];
+                pp->nrm[k] = q < 6 ? n : up;
+                pp->col[k] = cc;
+                ++k;
+            }
+        }
+    }
+}
+
+ak_result crowd_people_update(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
+                              const ak_vec2* velocities, crowd_chars* chars, ak_raster_mesh* out) {
+    if (chars) {
+        const ak_result r = pose_characters(pp, sc, positions, chars);
+        if (r != AK_OK) return r;
+    } else {
+        prisms(pp, sc, positions, velocities);
+    }
+    *out = (ak_raster_mesh){.positions = {pp->pos, pp->vcount}, .normals = {pp->nrm, pp->vcount},
+                            .colors = {pp->col, pp->vcount}, .indices = {pp->idx, pp->icount},
+                            .material = {.color = {1, 1, 1, 1}}};
+    return AK_OK;
+}
+
+bool crowd_walls(const ak_crowd_scene* sc, ak_vec3** out, size_t* out_vertex_count) {
+    *out = NULL;
+    *out_vertex_count = 0;
+    size_t edges = 0;
+    for (size_t k = 0; k < sc->obstacle_count; ++k)
+        edges += sc->obstacles[k].vertices.count == 2 ? 1 : sc->obstacles[k].vertices.count;
+    if (!edges) return true;
+    ak_vec3* w = malloc(edges * 6 * sizeof *w);
+    if (!w) return false;
+    size_t n = 0;
+    for (size_t k = 0; k < sc->obstacle_count; ++k) {
+        const ak_vec2_cspan v = sc->obstacles[k].vertices;
+        const size_t m = v.count == 2 ? 1 : v.count;
+        for (size_t e = 0; e < m; ++e) {
+            const ak_vec2 a = v.ptr[e], b = v.ptr[(e + 1) % v.count];
+            const ak_vec3 q[4] = {{a.x, 0, a.y}, {b.x, 0, b.y}, {b.x, 1.2f, b.y}, {a.x, 1.2f, a.y}};
+            ak_vec3* o = w + n;
+            o[0] = q[0], o[1] = q[1], o[2] = q[2], o[3] = q[0], o[4] = q[2], o[5] = q[3];
+            n += 6;
+        }
+    }
+    *out = w;
+    *out_vertex_count = n;
+    return true;
+}

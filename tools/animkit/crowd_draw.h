@@ -1,0 +1,57 @@
+/* The crowd's characters and drawing, shared by `animkit crowd` (PNG, GIF, glTF) and
+ * `animkit view crowd`: builtin:humanoid walking per agent (crowd.h's characters), or
+ * octagonal prisms above CROWD_CHARACTERS_MAX agents, and the obstacles as walls. */
+#ifndef ANIMKIT_CLI_CROWD_DRAW_H
+#define ANIMKIT_CLI_CROWD_DRAW_H
+
+#include "cli.h"
+
+#define CROWD_CHARACTER_CELL 0.08f /* builtin:humanoid's grid: about 2,300 triangles */
+#define CROWD_CHARACTERS_MAX 500u  /* drawn as characters up to this many agents, prisms above */
+
+extern const ak_vec4 crowd_palette[4]; /* colour per group (group % 4) */
+
+typedef struct crowd_chars {
+    ak_scene* scene;
+    ak_crowd_gait gait;
+    ak_crowd_character* ch;
+    size_t n;
+    cli_poser poser;
+    bool poser_ready;
+    ak_vec2* rec_pos; /* recorded frames (glTF): [frame_cap * n] */
+    ak_crowd_character* rec_ch;
+    size_t frames, frame_cap;
+} crowd_chars;
+
+/* The humanoid, its gait, one character per agent facing its first waypoint (phases spread),
+ * and room to record frame_cap frames (0: none). */
+ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t frame_cap, ak_diag* diag);
+void crowd_chars_free(crowd_chars* c);
+/* Back to the start: every character facing its first waypoint, standing; no recorded frame. */
+void crowd_chars_reset(crowd_chars* c, const ak_crowd_scene* sc);
+ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, float dt);
+/* Record the current frame (positions of the n agents, the characters); no-op when full. */
+void crowd_chars_record(crowd_chars* c, const ak_vec2* positions);
+
+/* World-space triangles of every agent, rebuilt each frame. */
+typedef struct crowd_people {
+    ak_vec3 *pos, *nrm;
+    ak_vec4* col;
+    size_t vcount;
+    uint32_t* idx; /* characters: indexed; prisms: none */
+    size_t icount;
+} crowd_people;
+
+/* Room for n agents, as characters when chars is not NULL. Returns false when out of memory. */
+bool crowd_people_init(crowd_people* pp, size_t n, const crowd_chars* chars);
+void crowd_people_free(crowd_people* pp);
+/* Pose and place every agent (positions, velocities: [n]; radius and group from sc) and return
+ * the mesh (colours per vertex). */
+ak_result crowd_people_update(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
+                              const ak_vec2* velocities, crowd_chars* chars, ak_raster_mesh* out);
+
+/* The obstacles' edges as 1.2 m high walls: 6 vertices per edge into *out (malloc; NULL when
+ * there is none). Returns false when out of memory. */
+bool crowd_walls(const ak_crowd_scene* sc, ak_vec3** out, size_t* out_vertex_count);
+
+#endif
