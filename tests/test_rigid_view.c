@@ -1,8 +1,9 @@
-/* `animkit view rigid`, headless with a script: the stack preset (as rigid:preset:stack and
- * as rigid --preset stack) runs the same with and without a right click until the click (the run is
- * deterministic), and a right click left of the stack throws a sphere from the camera that shows up
- * in the picture (the pixels differ from the run without it); the default is the ragdoll preset and
- * it plays; a bad preset exits 2 naming the presets, a missing scene file 1. */
+/* `animkit view rigid`, headless with a script: the stack preset (as rigid:preset:stack and as
+ * rigid --preset stack) runs the same with and without a right click until the click (the run
+ * is deterministic), and a right click left of the stack throws a sphere from the camera that
+ * shows up in the picture (the pixels differ from the run without it); the default is the
+ * ragdoll preset and it plays; a bad preset exits 2 naming the presets, a missing scene file
+ * 1, a scene file and --preset together 2. */
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -79,6 +80,10 @@ AK_TEST(bad_spec_errors) {
     AK_CHECK(strstr(out_buf, "stack, pyramid") != NULL);
     AK_CHECK_EQ(run("view rigid:no_such_rigid_scene.json --headless", true), 1);
     AK_CHECK(strstr(out_buf, "no_such_rigid_scene.json") != NULL);
+    AK_CHECK_EQ(run("view rigid no_such_rigid_scene.json --headless", true), 1);
+    AK_CHECK_EQ(run("view rigid --preset nope --headless", true), 2);
+    AK_CHECK_EQ(run("view rigid x.json --preset stack --headless", true), 2);
+    AK_CHECK(strstr(out_buf, "not both") != NULL);
 }
 
 int main(void) {
