@@ -29,17 +29,20 @@
  *   - joints: ball (optional swing cone and twist range), hinge (optional angle limits), fixed,
  *     prismatic (optional distance limits), with compliance, and drives towards a target
  *     relative orientation (XPBD positional and angular constraints, their section 3.3);
- *   - ragdolls: a capsule per bone of a skeleton and a joint per joint with the skeleton's
- *     limits, started from an animated pose (and its velocities), written back as a pose;
+ *   - ragdolls: a capsule per bone of a skeleton (sized from the bone, or fitted to the
+ *     vertices of a skin) and a joint per joint with the skeleton's limits, started from an
+ *     animated pose (and its velocities), written back as a pose; powered, its joints driven
+ *     towards an animation's pose each step (drive_targets);
  *   - sleeping: a connected group of touching or joined bodies whose speeds all stay under the
  *     thresholds for sleep_time seconds is frozen until an awake body touches it;
  *   - deterministic: the same inputs give the same bits (contacts are found and solved in an
  *     order fixed by the positions and body indices); thread_count is accepted for the
  *     interface's sake but this version runs every phase on the calling thread.
  *
- * What it does NOT do (yet): capsule sizes from a skin, a powered ragdoll that follows an animation, threads, continuous
- * collision detection (a body moving more than its size in one substep can tunnel),
- * collisions with particles or cloth.
+ * What it does NOT do (yet): threads, continuous collision detection (a body moving more than
+ * its size in one substep can tunnel), dynamic triangle meshes and heightfields (they are
+ * static), collisions with the fluid (cloth and particles take the bodies as a mesh:
+ * ak_rigid_world_mesh).
  *
  * Usage (a box dropped on the ground):
  *     ak_rigid_body_desc bodies[2] = {
@@ -204,6 +207,10 @@ typedef struct ak_rigid_joint_desc {
     bool drive;                     /* drive b's orientation relative to a towards drive_target */
     ak_quat drive_target;           /* b's orientation in a's frame (a^-1 b); zero -> as built */
     float drive_compliance; /* rad/(N m); 0 -> rigid (the drive then acts as a fixed joint) */
+    float drive_damping;    /* 1/s: with a drive, each substep removes the fraction
+                               min(drive_damping h, 1) of the bodies' relative angular velocity
+                               (shared by their inverse inertias, so momentum is kept: a damped
+                               spring that settles instead of ringing); 0 -> none */
 } ak_rigid_joint_desc;
 
 AK_DEFINE_SPAN(rigid_joint_desc, ak_rigid_joint_desc)
@@ -321,6 +328,30 @@ typedef struct ak_rigid_ragdoll_desc {
     float density;                      /* kg/m^3; 0 -> 1000 */
     float friction;                     /* 0 -> 0.5 */
     uint32_t collision_group;           /* the limbs' group (no self-collision); 0 -> 1 */
+    float free_cone_angle;              /* radians: a free joint (glTF's joints have no type)
+                                           becomes a ball whose bone may swing this far from its
+                                           rest direction; 0 -> unlimited */
+    /* Optional: a skinned mesh (a glTF skin and one of its meshes), so each capsule is fitted
+     * to the vertices its bone carries instead of sized from radius_scale (see
+     * ak_rigid_ragdoll_build). All empty -> no skin. */
+    ak_vec3_cspan skin_positions;      /* bind-pose vertices, the mesh's model space */
+    ak_u16_cspan skin_joints;          /* [vertex count * skin_influence_count] skin slots */
+    ak_f32_cspan skin_weights;         /* the same layout */
+    uint32_t skin_influence_count;     /* influences per vertex, 1..8 with a skin */
+    ak_i32_cspan skin_slot_joints;     /* per slot: the skeleton joint it names */
+    ak_mat4_cspan skin_inverse_binds;  /* per slot: its inverse bind matrix */
+    float skin_min_weight;             /* a vertex belongs to its heaviest bone when that weight
+                                          is >= this; 0 -> 0.5 */
+    uint32_t skin_min_vertices;        /* fewer vertices than this on a bone -> radius_scale's
+                                          capsule; 0 -> 8 */
+    /* Powered ragdoll: every ball and hinge joint gets a drive towards the start pose (set
+     * each step's targets from an animation with ak_rigid_ragdoll_drive_targets and the step
+     * job's drive_targets, so the character follows the clip, is knocked off it by a hit and
+     * comes back). A joint desc's drive_compliance may be changed per joint after the build. */
+    bool powered;
+    float drive_compliance;            /* rad/(N m) of every drive; 0 -> rigid (the clip is
+                                          played exactly; only the root body reacts) */
+    float drive_damping;               /* 1/s of every drive (ak_rigid_joint_desc); 0 -> none */
 } ak_rigid_ragdoll_desc;
 
 /* Bodies and joints a ragdoll of this skeleton has: one capsule per joint with children (from
@@ -331,15 +362,35 @@ AK_API size_t ak_rigid_ragdoll_joint_count(const struct ak_skeleton* skeleton);
 
 /* Build a ragdoll's body and joint descs (to put in an ak_rigid_model_desc, after body_offset
  * other bodies) and the joint-to-body map. Skeleton joint types become rigid joints: hinge ->
- * hinge with its limits, ball -> ball with its cone, free -> ball, prism -> prismatic; limits are
- * taken relative to the skeleton's rest pose as the skeleton measures them. Sizes: out_bodies
- * >= body count, out_joints >= joint count, out_bones >= skeleton joint count. Returns
+ * hinge with its limits, ball -> ball with its cone, free -> ball (coned by free_cone_angle),
+ * prism -> prismatic; limits are taken relative to the skeleton's rest pose as the skeleton
+ * measures them. With a skin, each body's capsule is fitted to the vertices whose heaviest
+ * weight (>= skin_min_weight) is its bone's or a leaf child's, posed rigidly with their joint
+ * at the start pose: radius = the mean plus one standard deviation of their distances from
+ * the bone's line, and the capsule spans their extent along the bone (so the body's centre
+ * may move off the bone's middle). Sizes: out_bodies >= body
+ * count, out_joints >= joint count, out_bones >= skeleton joint count. Returns
  * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_ARG (previous_pose without previous_dt > 0,
- * negative sizes), AK_ERR_BAD_DATA (a non-finite pose). */
+ * negative sizes or angle, a skin with a span missing or an influence count outside 1..8),
+ * AK_ERR_BAD_INDEX (a skin slot or slot joint out of range), AK_ERR_BAD_DATA (a non-finite
+ * pose, skin position, weight or matrix). */
 AK_API ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
                                         ak_rigid_body_desc_span out_bodies,
                                         ak_rigid_joint_desc_span out_joints,
                                         ak_rigid_ragdoll_bone_span out_bones);
+
+/* A powered ragdoll's drive targets for a pose (an animation's local pose at the current
+ * time), one per ragdoll joint in the order of ak_rigid_ragdoll_build's out_joints: the
+ * orientation of each joint's body relative to its parent's body when the skeleton is in
+ * local_pose (the rotation part of the local transforms; translations and scale are ignored).
+ * Put them at the ragdoll's joints' places in the step job's drive_targets. Sizes: bones and
+ * local_pose >= skeleton joint count, out_targets >= ak_rigid_ragdoll_joint_count.
+ * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX (a bone's parent without a body: bones
+ * not from this skeleton's build), AK_ERR_BAD_DATA (a non-finite rotation). */
+AK_API ak_result ak_rigid_ragdoll_drive_targets(const struct ak_skeleton* skeleton,
+                                                ak_rigid_ragdoll_bone_cspan bones,
+                                                ak_transform_cspan local_pose,
+                                                ak_quat_span out_targets);
 
 /* The ragdoll's bodies written back as a skeleton pose: local transforms (scale from
  * fallback_pose) so that skinning and export work unchanged. Joints without a body keep
@@ -350,6 +401,99 @@ AK_API ak_result ak_rigid_ragdoll_pose(const struct ak_skeleton* skeleton,
                                        ak_vec3_cspan positions, ak_quat_cspan orientations,
                                        ak_transform_cspan fallback_pose,
                                        ak_transform_span out_local_pose);
+
+/* ---- meshes of the bodies (drawing, baking, colliders for other simulations) ----------- */
+
+/* Vertices and indices (3 per triangle) of a shape's mesh: a sphere or capsule as an 8 x 16
+ * latitude-longitude grid (capsules with a doubled equator), a box's 6 faces (24 vertices), a
+ * plane as a square (4); 0 for NULL or an unknown type. */
+AK_API void ak_rigid_shape_mesh_size(const ak_rigid_shape* shape, size_t* out_vertex_count,
+                                     size_t* out_index_count);
+/* A shape's closed, outward-facing mesh (counter-clockwise seen from outside) in the body's
+ * frame: vertices on the shape's surface (a sphere's and a capsule's inscribed in it), unit
+ * normals, triangles; a plane is a square of half side plane_size (0 -> 10 m) in its own frame
+ * (Y up). Sizes from ak_rigid_shape_mesh_size. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (type),
+ * AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_rigid_shape_mesh(const ak_rigid_shape* shape, float plane_size,
+                                     ak_vec3_span out_positions, ak_vec3_span out_normals,
+                                     ak_u32_span out_indices);
+/* Totals of ak_rigid_world_mesh: every body but the planes (0 for NULL). */
+AK_API void ak_rigid_world_mesh_size(const ak_rigid_model* model, size_t* out_vertex_count,
+                                     size_t* out_index_count);
+/* Every body but the planes as one world-space triangle mesh at a state (body order, each
+ * body's ak_rigid_shape_mesh moved by its pose): to draw a scene, or to give cloth
+ * (ak_cloth_collider_mesh) and particles (ak_particle_mesh) the bodies as a one-way collider
+ * each step. Boxes are exact; spheres and capsules are inscribed polyhedra (at most 8% inside
+ * the true surface at 8 x 16). AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a
+ * non-finite state). */
+AK_API ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan positions,
+                                     ak_quat_cspan orientations, ak_vec3_span out_positions,
+                                     ak_vec3_span out_normals, ak_u32_span out_indices);
+
+/* ---- a run baked as glTF node animation ------------------------------------------------ */
+
+struct ak_scene;
+
+typedef struct ak_rigid_bake_desc {
+    const char* name;              /* scene, root node, meshes and clip name; NULL -> "rigid" */
+    const ak_rigid_model* model;   /* required: the bodies' shapes */
+    size_t frame_count;            /* required, 1 .. max_frames */
+    const ak_vec3* positions;      /* required, [frame_count * body count], frame k first */
+    const ak_quat* orientations;   /* required, the same layout */
+    float frame_time;              /* required, > 0 seconds between frames */
+    float plane_size;              /* half the side of the square drawn for a plane (m);
+                                      0 -> 10 */
+    size_t max_frames;             /* 0 -> AK_SCENE_BAKE_MAX_FRAMES (scene.h) */
+    size_t memory_budget;          /* bytes; 0 -> AK_SCENE_BAKE_DEFAULT_BUDGET (scene.h) */
+} ak_rigid_bake_desc;
+
+/* Bake recorded frames of a run as an animated scene (io.h's ak_io_save writes it as glTF):
+ * a root node named name and one child node "<name>_<i>" per body in body order, each
+ * carrying its shape as a mesh in the body's frame (a sphere or capsule as a latitude-
+ * longitude grid, a box's 6 faces, a plane as a square around its point with Y along its
+ * normal), rest transform = frame 0's pose; one clip named name with a LINEAR translation and
+ * rotation channel per dynamic body keyed at every frame (rotations taken the short way from
+ * the previous key), frame k at time k * frame_time. One frame, or only static bodies: no
+ * clip. The bytes needed are estimated before anything is allocated. Returns AK_ERR_NULL_ARG,
+ * AK_ERR_EMPTY (no frame), AK_ERR_BAD_ARG (frame_time, plane_size), AK_ERR_BAD_DATA (a
+ * non-finite or zero pose: diag names frame and body), AK_ERR_UNSUPPORTED (over max_frames,
+ * the memory budget, or 32000 bodies), AK_ERR_NO_MEMORY; *out_scene NULL on failure. */
+AK_API ak_result ak_rigid_bake_scene(const ak_rigid_bake_desc* desc, const ak_allocator* alloc,
+                                     struct ak_scene** out_scene, ak_diag* diag);
+
+/* A ragdoll's recorded run as the skeleton's animation: the clip that plays, on the character
+ * the ragdoll was built from, the pose ak_rigid_ragdoll_pose writes back at each frame (so the
+ * skinned mesh moves as the bodies did when the character's scene, with this clip, is saved as
+ * glTF). */
+struct ak_clip;
+
+typedef struct ak_rigid_bake_ragdoll_desc {
+    const char* name;                   /* clip name; NULL -> "ragdoll" */
+    const struct ak_skeleton* skeleton; /* required */
+    ak_rigid_ragdoll_bone_cspan bones;  /* required: ak_rigid_ragdoll_build's map */
+    ak_mat4 root;                       /* the world transform the character is drawn under;
+                                           zero -> identity (the root joints then carry the
+                                           ragdoll's world pose) */
+    ak_transform_cspan fallback_pose;   /* required: joints without a body keep these */
+    size_t body_count;                  /* bodies per frame in positions and orientations */
+    size_t frame_count;                 /* required, 1 .. max_frames */
+    const ak_vec3* positions;           /* required, [frame_count * body_count] */
+    const ak_quat* orientations;        /* required, the same layout */
+    float frame_time;                   /* required, > 0 */
+    size_t max_frames;                  /* 0 -> AK_SCENE_BAKE_MAX_FRAMES (scene.h) */
+    size_t memory_budget;               /* 0 -> AK_SCENE_BAKE_DEFAULT_BUDGET (scene.h) */
+} ak_rigid_bake_ragdoll_desc;
+
+/* Build the clip: a LINEAR translation and rotation channel for every joint of the skeleton,
+ * keyed at every frame with ak_rigid_ragdoll_pose's local transforms (rotations taken the short
+ * way from the previous key), frame k at time k * frame_time. Returns AK_ERR_NULL_ARG,
+ * AK_ERR_EMPTY, AK_ERR_BAD_ARG (frame_time), AK_ERR_SPAN_SMALL (bones or fallback_pose shorter
+ * than the skeleton), AK_ERR_BAD_INDEX (a bone's body not below body_count), AK_ERR_BAD_DATA (a
+ * non-finite pose: diag names the frame), AK_ERR_UNSUPPORTED (over max_frames or the budget),
+ * AK_ERR_NO_MEMORY; *out_clip NULL on failure (free a clip with ak_clip_destroy). */
+AK_API ak_result ak_rigid_bake_ragdoll_clip(const ak_rigid_bake_ragdoll_desc* desc,
+                                            const ak_allocator* alloc, struct ak_clip** out_clip,
+                                            ak_diag* diag);
 
 /* ---- step ------------------------------------------------------------------------------ */
 
@@ -370,6 +514,11 @@ typedef struct ak_rigid_step_job {
     ak_f32_span sleep_timers; /* optional: seconds each body has been slow (state, start at
                                  0); empty -> bodies never sleep */
     ak_u8_span scratch;       /* >= ak_rigid_step_scratch_size(job) bytes */
+    ak_quat_cspan drive_targets; /* optional, one per joint (model order): the drive target of
+                                    each joint with `drive` for this step, in place of its
+                                    desc's (a powered ragdoll's animation: see
+                                    ak_rigid_ragdoll_drive_targets; normalised here); entries
+                                    of joints without a drive are ignored; empty -> the descs' */
     /* Outputs (optional). */
     float* out_max_penetration;     /* metres: deepest contact after the step's last solve */
     uint32_t* out_contact_count;    /* contact points of the last substep */
@@ -381,10 +530,12 @@ typedef struct ak_rigid_step_job {
 /* Bytes of scratch a step needs (0 for a NULL job or model). */
 AK_API size_t ak_rigid_step_scratch_size(const ak_rigid_step_job* job);
 
-/* First rule the job breaks: AK_ERR_NULL_ARG (job or model NULL), AK_ERR_BAD_ARG (dt <= 0 or
- * not finite, substeps > 1000, thread_count > AK_RIGID_MAX_THREADS, non-finite gravity),
- * AK_ERR_SPAN_SMALL (a state span shorter than the body count, sleep_timers neither empty nor
- * long enough, scratch too small), AK_ERR_BAD_DATA (a non-finite state value). */
+/* First rule the job breaks: AK_ERR_NULL_ARG (job or model NULL, drive_targets counted but
+ * NULL), AK_ERR_BAD_ARG (dt <= 0 or not finite, substeps > 1000, thread_count >
+ * AK_RIGID_MAX_THREADS, non-finite gravity), AK_ERR_SPAN_SMALL (a state span shorter than the
+ * body count, sleep_timers neither empty nor long enough, drive_targets neither empty nor one
+ * per joint, scratch too small), AK_ERR_BAD_DATA (a non-finite state value, a non-finite or
+ * zero drive target). */
 AK_API ak_result ak_rigid_step_validate(const ak_rigid_step_job* job);
 
 /* Advance the state by dt. Validates first and writes nothing on failure. Returns AK_ERR_BAD_DATA
@@ -437,6 +588,17 @@ typedef struct ak_rigid_scene {
     uint32_t substeps;           /* default 20 */
     uint32_t thread_count;       /* default 1 */
     bool sleep;                  /* bodies may fall asleep; default true */
+    /* The ragdoll preset's character (empty otherwise, and after a file is loaded over it), so
+     * a run can be shown as the character (ak_rigid_bake_ragdoll_clip): the builtin model
+     * (ak_builtin_create(ragdoll_character, {.cell_size = ragdoll_cell_size})) whose skeleton
+     * the ragdoll was built from, its bone map (body indices into bodies) and root, and its
+     * start pose (local transforms). Owned (malloc), freed by ak_rigid_scene_free. */
+    char ragdoll_character[32];
+    float ragdoll_cell_size;
+    ak_rigid_ragdoll_bone* ragdoll_bones; /* [ragdoll_bone_count] */
+    ak_transform* ragdoll_pose;           /* [ragdoll_bone_count] */
+    size_t ragdoll_bone_count;            /* the skeleton's joint count; 0 -> no character */
+    ak_mat4 ragdoll_root;
 } ak_rigid_scene;
 
 /* The defaults of every key, no bodies, no joints (the scene without a file); owns nothing. */

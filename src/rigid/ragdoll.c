@@ -71,12 +71,121 @@ static void bone_body(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 ro
         *out_length = 0.0f;
         return;
     }
-    /* the joint's frame turned so its Y runs along the bone (keeps the twist of the joint) */
-    ak_vec3 y_now = ak_quat_rotate(qj, ak_vec3_make(0.0f, 1.0f, 0.0f));
-    *out_q =
-        ak_quat_normalize(ak_quat_mul(ak_quat_from_to(y_now, ak_vec3_scale(d, 1.0f / len)), qj));
+    /* the joint's frame turned so its Y runs along the bone (keeps the twist of the joint):
+     * the turn is found in the joint's frame, so a bone that moves rigidly with its joint
+     * gets the same turn in every pose (its velocities then come out right); a bone pointing
+     * down the joint's -Y (a leg) is turned half a turn about X first, since from_to is
+     * ill-conditioned near opposite vectors */
+    ak_vec3 dl = ak_quat_rotate(ak_quat_conjugate(qj), ak_vec3_scale(d, 1.0f / len));
+    ak_quat turn;
+    if (dl.y > -0.5f) {
+        turn = ak_quat_from_to(ak_vec3_make(0.0f, 1.0f, 0.0f), dl);
+    } else {
+        const ak_quat half = ak_quat_make(1.0f, 0.0f, 0.0f, 0.0f); /* pi about X: Y -> -Y */
+        turn = ak_quat_mul(ak_quat_from_to(ak_vec3_make(0.0f, -1.0f, 0.0f), dl), half);
+    }
+    *out_q = ak_quat_normalize(ak_quat_mul(qj, turn));
     *out_x = ak_vec3_scale(ak_vec3_add(p0, p1), 0.5f);
     *out_length = len;
+}
+
+/* The skin's spans: all empty (no skin, false), or consistent (true); *out_r the error. */
+static bool skin_given(const ak_rigid_ragdoll_desc* d, size_t joint_count, ak_result* out_r) {
+    *out_r = AK_OK;
+    if (!d->skin_positions.count && !d->skin_joints.count && !d->skin_weights.count &&
+        !d->skin_slot_joints.count && !d->skin_inverse_binds.count && !d->skin_influence_count)
+        return false;
+    const size_t nv = d->skin_positions.count, k = d->skin_influence_count;
+    const size_t slots = d->skin_slot_joints.count;
+    if (!d->skin_positions.ptr || !d->skin_joints.ptr || !d->skin_weights.ptr ||
+        !d->skin_slot_joints.ptr || !d->skin_inverse_binds.ptr) {
+        *out_r = nv || slots ? AK_ERR_NULL_ARG : AK_ERR_BAD_ARG;
+        return false;
+    }
+    if (k < 1 || k > 8 || !slots || !(d->skin_min_weight >= 0.0f && d->skin_min_weight <= 1.0f)) {
+        *out_r = AK_ERR_BAD_ARG;
+        return false;
+    }
+    if (d->skin_joints.count / k < nv || d->skin_weights.count / k < nv ||
+        d->skin_inverse_binds.count < slots) {
+        *out_r = AK_ERR_SPAN_SMALL;
+        return false;
+    }
+    for (size_t s = 0; s < slots; ++s) {
+        if (d->skin_slot_joints.ptr[s] < 0 || (size_t)d->skin_slot_joints.ptr[s] >= joint_count) {
+            *out_r = AK_ERR_BAD_INDEX;
+            return false;
+        }
+        if (!ak_mat4_is_finite(&d->skin_inverse_binds.ptr[s])) {
+            *out_r = AK_ERR_BAD_DATA;
+            return false;
+        }
+    }
+    for (size_t v = 0; v < nv; ++v) {
+        if (!ak_vec3_is_finite(d->skin_positions.ptr[v])) {
+            *out_r = AK_ERR_BAD_DATA;
+            return false;
+        }
+        for (size_t e = 0; e < k; ++e) {
+            if (d->skin_joints.ptr[v * k + e] >= slots) {
+                *out_r = AK_ERR_BAD_INDEX;
+                return false;
+            }
+            if (!ak_finitef(d->skin_weights.ptr[v * k + e])) {
+                *out_r = AK_ERR_BAD_DATA;
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+/* A capsule fitted to the skin vertices joint i carries, in the frame of its body (x, q: local
+ * Y along the bone): the vertices whose heaviest weight (at least the minimum weight) is a slot
+ * naming joint i, or one of i's leaf children (a head, a hand: leaves have no body and move with
+ * their parent), each posed rigidly with its joint (root * world_j * inverse_bind p). Returns
+ * false when fewer than min_vertices qualify; else *out_radius = the mean plus one standard
+ * deviation of their distances from the body's Y axis (a round limb's radius; more for a flat
+ * torso or a neck that carries a head) and [*out_lo, *out_hi] their extent along it. */
+static bool skin_fit(const ak_rigid_ragdoll_desc* d, ak_mat4 root, size_t i, ak_vec3 x, ak_quat q,
+                     float* out_radius, float* out_lo, float* out_hi) {
+    const ak_skeleton* sk = d->skeleton;
+    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    const size_t nv = d->skin_positions.count, k = d->skin_influence_count;
+    const float wmin = d->skin_min_weight > 0.0f ? d->skin_min_weight : 0.5f;
+    const size_t need = d->skin_min_vertices ? d->skin_min_vertices : 8;
+    const ak_quat qi = ak_quat_conjugate(q);
+    double sum_r = 0.0, sum_rr = 0.0;
+    float lo = INFINITY, hi = -INFINITY;
+    size_t count = 0;
+    for (size_t v = 0; v < nv; ++v) {
+        size_t best = 0;
+        for (size_t e = 1; e < k; ++e)
+            if (d->skin_weights.ptr[v * k + e] > d->skin_weights.ptr[v * k + best]) best = e;
+        const uint16_t slot = d->skin_joints.ptr[v * k + best];
+        const size_t j = (size_t)d->skin_slot_joints.ptr[slot];
+        if (d->skin_weights.ptr[v * k + best] < wmin ||
+            !(j == i || (parents.ptr[j] == (int16_t)i && !has_children(sk, j))))
+            continue;
+        const ak_mat4 m =
+            ak_mat4_mul(joint_world(sk, d->local_pose, root, j), d->skin_inverse_binds.ptr[slot]);
+        const ak_vec3 p = ak_mat4_transform_point(m, d->skin_positions.ptr[v]);
+        const ak_vec3 l = ak_quat_rotate(qi, ak_vec3_sub(p, x));
+        const double rr = (double)l.x * l.x + (double)l.z * l.z;
+        sum_r += sqrt(rr);
+        sum_rr += rr;
+        lo = ak_minf(lo, l.y);
+        hi = ak_maxf(hi, l.y);
+        ++count;
+    }
+    if (count < need || count == 0) return false;
+    const double mean = sum_r / (double)count;
+    const float r = (float)(mean + sqrt(fmax(0.0, sum_rr / (double)count - mean * mean)));
+    if (!(r > 1e-5f) || !ak_finitef(r) || !ak_finitef(lo) || !ak_finitef(hi)) return false;
+    *out_radius = r;
+    *out_lo = lo;
+    *out_hi = hi;
+    return true;
 }
 
 static bool mat_is_zero(ak_mat4 m) {
@@ -107,8 +216,14 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
         (desc->previous_pose.count &&
          !ak_pose_is_finite((ak_transform_cspan){desc->previous_pose.ptr, n})) ||
         !ak_finitef(desc->previous_dt) || !ak_finitef(desc->radius_scale) ||
-        !ak_finitef(desc->max_radius))
+        !ak_finitef(desc->max_radius) || !ak_finitef(desc->free_cone_angle) ||
+        !ak_finitef(desc->drive_compliance) || !ak_finitef(desc->drive_damping))
         return AK_ERR_BAD_DATA;
+    if (desc->free_cone_angle < 0.0f || desc->drive_compliance < 0.0f || desc->drive_damping < 0.0f)
+        return AK_ERR_BAD_ARG;
+    ak_result skin_r;
+    const bool skin = skin_given(desc, n, &skin_r);
+    if (skin_r != AK_OK) return skin_r;
     const ak_mat4 root = mat_is_zero(desc->root) ? ak_mat4_identity() : desc->root;
     const float scale = desc->radius_scale > 0.0f ? desc->radius_scale : 0.2f;
     const float rmax = desc->max_radius > 0.0f ? desc->max_radius : 0.1f;
@@ -138,9 +253,18 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
                 spread = ak_maxf(spread, ak_vec3_length(d));
             }
         float r = ak_minf(rmax, ak_maxf(ak_maxf(scale * len, spread), 0.4f * rmax));
+        float half = ak_maxf(0.0f, 0.5f * len - r);
+        /* with a skin: the capsule its vertices fit, centred on their extent along the bone */
+        float shift = 0.0f, fr, lo, hi;
+        if (skin && skin_fit(desc, root, i, x, q, &fr, &lo, &hi)) {
+            r = fr;
+            shift = 0.5f * (lo + hi);
+            half = ak_maxf(0.0f, 0.5f * (hi - lo) - r);
+            x = ak_vec3_add(x, ak_quat_rotate(q, ak_vec3_make(0.0f, shift, 0.0f)));
+        }
         b->shape.type = AK_RIGID_CAPSULE;
         b->shape.radius = r;
-        b->shape.half_height = ak_maxf(0.0f, 0.5f * len - r);
+        b->shape.half_height = half;
         b->position = x;
         b->orientation = q;
         b->density = desc->density;
@@ -151,6 +275,7 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
             ak_quat qp;
             float lp;
             bone_body(sk, desc->previous_pose, root, i, &xp, &qp, &lp);
+            xp = ak_vec3_add(xp, ak_quat_rotate(qp, ak_vec3_make(0.0f, shift, 0.0f)));
             b->velocity = ak_vec3_scale(ak_vec3_sub(x, xp), 1.0f / desc->previous_dt);
             ak_quat dq = ak_quat_mul(q, ak_quat_conjugate(qp));
             float f = (dq.w >= 0.0f ? 2.0f : -2.0f) / desc->previous_dt;
@@ -175,6 +300,14 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
             ak_quat q_rest = ak_quat_normalize(
                 ak_quat_mul(mat_rotation(joint_world(sk, desc->local_pose, root, (size_t)p)),
                             rest.ptr[i].rotation));
+            /* powered: drive b's orientation in a's frame towards the start pose's */
+            jd->drive = desc->powered;
+            jd->drive_compliance = desc->drive_compliance;
+            jd->drive_damping = desc->drive_damping;
+            jd->drive_target = ak_quat_normalize(ak_quat_mul(
+                ak_quat_conjugate(
+                    out_bodies.ptr[out_bones.ptr[p].body - desc->body_offset].orientation),
+                q));
             switch (ak_skeleton_joint_type(sk, i)) {
             case AK_JOINT_HINGE: {
                 ak_vec3 axis = ak_vec3_length_sq(lim.axis) > 0.0f ? ak_vec3_normalize(lim.axis)
@@ -220,12 +353,51 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
                 jd->axis = ak_quat_rotate(
                     q_rest, ak_vec3_length_sq(lim.axis) > 0.0f ? lim.axis : ak_vec3_make(1, 0, 0));
                 break;
-            default:
+            default: {
+                /* free: a ball; with free_cone_angle, its bone's rest direction (towards the
+                 * mean of its children's rest offsets) may swing that far */
                 jd->type = AK_RIGID_JOINT_BALL;
+                if (desc->free_cone_angle > 0.0f) {
+                    ak_vec3 dir = ak_vec3_zero();
+                    for (size_t c = i + 1; c < n; ++c)
+                        if (parents.ptr[c] == (int16_t)i)
+                            dir = ak_vec3_add(dir, rest.ptr[c].translation);
+                    dir = ak_vec3_length_sq(dir) > 1e-12f ? ak_vec3_normalize(dir)
+                                                          : ak_vec3_make(0, 1, 0);
+                    jd->axis = ak_quat_rotate(q_rest, dir);
+                    jd->axis_b = ak_quat_rotate(qj, dir);
+                    jd->limited = true;
+                    jd->upper = desc->free_cone_angle;
+                }
                 break;
+            }
             }
         }
         ++k;
+    }
+    return AK_OK;
+}
+
+ak_result ak_rigid_ragdoll_drive_targets(const ak_skeleton* sk, ak_rigid_ragdoll_bone_cspan bones,
+                                         ak_transform_cspan pose, ak_quat_span out) {
+    if (!sk || !bones.ptr || !pose.ptr || (!out.ptr && out.count)) return AK_ERR_NULL_ARG;
+    const size_t n = ak_skeleton_joint_count(sk);
+    if (bones.count < n || pose.count < n || out.count < ak_rigid_ragdoll_joint_count(sk))
+        return AK_ERR_SPAN_SMALL;
+    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    size_t k = 0;
+    for (size_t i = 0; i < n; ++i) {
+        /* the build's order: a joint per joint with a body and a parent */
+        if (!has_children(sk, i) || parents.ptr[i] < 0) continue;
+        const ak_rigid_ragdoll_bone* bi = &bones.ptr[i];
+        const ak_rigid_ragdoll_bone* bp = &bones.ptr[parents.ptr[i]];
+        if (bi->body < 0 || bp->body < 0) return AK_ERR_BAD_INDEX;
+        if (!ak_quat_is_finite(pose.ptr[i].rotation)) return AK_ERR_BAD_DATA;
+        /* body = joint world rotation * bone.rotation^-1, and joint i's world rotation is its
+         * parent's times its local one: a^-1 b = bp.rotation local bi.rotation^-1 */
+        out.ptr[k++] = ak_quat_normalize(
+            ak_quat_mul(ak_quat_mul(bp->rotation, ak_quat_normalize(pose.ptr[i].rotation)),
+                        ak_quat_conjugate(bi->rotation)));
     }
     return AK_OK;
 }

@@ -285,12 +285,12 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         if (!vec_finite(jd->anchor) || !vec_finite(jd->axis) || !ak_finitef(jd->lower) ||
             !ak_finitef(jd->upper) || !ak_finitef(jd->compliance) || !vec_finite(jd->axis_b) ||
             !ak_finitef(jd->angle_offset) || !ak_quat_is_finite(jd->drive_target) ||
-            !ak_finitef(jd->drive_compliance))
+            !ak_finitef(jd->drive_compliance) || !ak_finitef(jd->drive_damping))
             return AK_ERR_BAD_DATA;
         if (!ak_finitef(jd->twist_lower) || !ak_finitef(jd->twist_upper)) return AK_ERR_BAD_DATA;
         if ((jd->twist_limited && jd->twist_lower > jd->twist_upper) ||
             (jd->limited && jd->lower > jd->upper) || jd->compliance < 0.0f ||
-            jd->drive_compliance < 0.0f)
+            jd->drive_compliance < 0.0f || jd->drive_damping < 0.0f)
             return AK_ERR_BAD_ARG;
     }
     ak_allocator al = {def_alloc, def_free, NULL};
@@ -508,6 +508,7 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         j->upper = jd->upper;
         j->compliance = jd->compliance;
         j->drive_compliance = jd->drive_compliance;
+        j->drive_damping = jd->drive_damping;
         j->angle_offset = jd->angle_offset;
         j->twist_limited = jd->twist_limited;
         j->twist_lower = jd->twist_lower;

@@ -130,6 +130,7 @@ typedef struct rigid_joint {
     ak_quat frame_a, frame_b; /* ball: joint frames (Y along the axis) in each body */
     bool limited, drive, twist_limited;
     float lower, upper, compliance, drive_compliance, angle_offset, twist_lower, twist_upper;
+    float drive_damping; /* 1/s: the drive's relative angular velocity damped each substep */
 } rigid_joint;
 
 /* Signed angle (rad) of body b about the hinge axis relative to a, zero as built. */

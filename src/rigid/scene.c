@@ -41,10 +41,16 @@ void ak_rigid_scene_free(ak_rigid_scene* s) {
     free(s->children);
     s->children = NULL;
     s->child_count = s->child_cap = 0;
+    free(s->ragdoll_bones);
+    free(s->ragdoll_pose);
     s->bodies = NULL;
     s->body_count = 0;
     s->joints = NULL;
     s->joint_count = 0;
+    s->ragdoll_bones = NULL;
+    s->ragdoll_pose = NULL;
+    s->ragdoll_bone_count = 0;
+    s->ragdoll_character[0] = '\0';
 }
 
 /* A body with the scene file's defaults (density 1000, friction 0.5, restitution 0). */
@@ -490,18 +496,21 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
     return !j.failed;
 }
 
-ak_result ak_rigid_scene_load_bytes(const void* bytes, size_t size, const char* name, ak_rigid_scene* scene,
-                                    ak_diag* out_diag) {
-    if (!scene) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, name ? name : "(scene)", "no scene to fill");
+ak_result ak_rigid_scene_load_bytes(const void* bytes, size_t size, const char* name,
+                                    ak_rigid_scene* scene, ak_diag* out_diag) {
+    if (!scene)
+        return akp_diag_set(out_diag, AK_ERR_NULL_ARG, name ? name : "(scene)", "no scene to fill");
     akp_json j = {.file = name ? name : "(scene)"};
     if (!bytes && size) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, j.file, "no bytes");
-    if (!parse(&j, bytes ? (const char*)bytes : "", size, scene)) return akp_json_diag(&j, AK_ERR_PARSE, out_diag);
+    if (!parse(&j, bytes ? (const char*)bytes : "", size, scene))
+        return akp_json_diag(&j, AK_ERR_PARSE, out_diag);
     if (out_diag) memset(out_diag, 0, sizeof *out_diag);
     return AK_OK;
 }
 
 ak_result ak_rigid_scene_load_file(const char* path, ak_rigid_scene* scene, ak_diag* out_diag) {
-    if (!scene || !path) return akp_diag_set(out_diag, AK_ERR_NULL_ARG, path ? path : "(scene)", "no path or scene");
+    if (!scene || !path)
+        return akp_diag_set(out_diag, AK_ERR_NULL_ARG, path ? path : "(scene)", "no path or scene");
     akp_json j = {.file = path};
     size_t size = 0;
     char* text = akp_json_read_file(&j, path, AK_RIGID_SCENE_MAX_FILE_SIZE, &size);
@@ -510,8 +519,6 @@ ak_result ak_rigid_scene_load_file(const char* path, ak_rigid_scene* scene, ak_d
     free(text);
     return r;
 }
-
-
 
 /* ---- presets --------------------------------------------------------------------------- */
 
@@ -606,19 +613,21 @@ static ak_result preset_fill(const char* name, ak_rigid_scene* s) {
         return AK_OK;
     }
     if (strcmp(name, "ragdoll") == 0) {
-        /* builtin:humanoid as a ragdoll, dropped from 1 m in the middle of its walk (the pose
-         * and its velocities), onto the ground */
+        /* builtin:humanoid as a ragdoll (capsules fitted to its skin), dropped from 1 m in the
+         * middle of its walk (the pose and its velocities), onto the ground; the scene keeps
+         * the bone map and the start pose so a run can be shown as the character */
         ak_scene* sc = NULL;
-        ak_builtin_desc bd = {.cell_size = 0.1f};
+        const float cell = 0.1f;
+        ak_builtin_desc bd = {.cell_size = cell};
         ak_result r = ak_builtin_create("humanoid", &bd, NULL, &sc);
         if (r != AK_OK) return r;
         const ak_skeleton* sk = sc->skeleton;
         size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk),
                nj = ak_rigid_ragdoll_joint_count(sk);
         ak_transform* pose = calloc(2 * n, sizeof *pose);
-        ak_rigid_ragdoll_bone* bones = calloc(n, sizeof *bones);
+        s->ragdoll_bones = calloc(n, sizeof *s->ragdoll_bones);
         s->joints = calloc(nj + 1, sizeof *s->joints);
-        r = pose && bones && s->joints && presize(s, nb + 1) ? AK_OK : AK_ERR_NO_MEMORY;
+        r = pose && s->ragdoll_bones && s->joints && presize(s, nb + 1) ? AK_OK : AK_ERR_NO_MEMORY;
         if (r == AK_OK) {
             ak_scene_rest_pose(sc, (ak_transform_span){pose, n});
             ak_scene_rest_pose(sc, (ak_transform_span){pose + n, n});
@@ -630,19 +639,41 @@ static ak_result preset_fill(const char* name, ak_rigid_scene* s) {
                                (ak_f32_span){0}, (ak_f32_span){0});
             }
             ground(&s->bodies[0]);
+            s->ragdoll_root = ak_mat4_translation(ak_vec3_make(0.0f, 1.0f, 0.0f));
             ak_rigid_ragdoll_desc rd = {.skeleton = sk,
                                         .local_pose = {pose, n},
                                         .previous_pose = {pose + n, n},
                                         .previous_dt = s->dt,
-                                        .root = ak_mat4_translation(ak_vec3_make(0.0f, 1.0f, 0.0f)),
+                                        .root = s->ragdoll_root,
                                         .body_offset = 1};
+            /* the first skinned mesh, for the capsules' sizes */
+            for (size_t m = 0; m < sc->mesh_count; ++m) {
+                const ak_mesh* mesh = sc->meshes[m].mesh;
+                if (sc->meshes[m].skin < 0 || !mesh->influence_count) continue;
+                const ak_scene_skin* skin = &sc->skins[sc->meshes[m].skin];
+                const size_t nv = mesh->vertex_count, k = mesh->influence_count;
+                rd.skin_positions = (ak_vec3_cspan){mesh->positions, nv};
+                rd.skin_joints = (ak_u16_cspan){mesh->joints, nv * k};
+                rd.skin_weights = (ak_f32_cspan){mesh->weights, nv * k};
+                rd.skin_influence_count = (uint32_t)k;
+                rd.skin_slot_joints = (ak_i32_cspan){skin->joints, skin->joint_count};
+                rd.skin_inverse_binds = (ak_mat4_cspan){skin->inverse_binds, skin->joint_count};
+                break;
+            }
             r = ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){s->bodies + 1, nb},
                                        (ak_rigid_joint_desc_span){s->joints, nj},
-                                       (ak_rigid_ragdoll_bone_span){bones, n});
+                                       (ak_rigid_ragdoll_bone_span){s->ragdoll_bones, n});
             s->joint_count = nj;
         }
+        if (r == AK_OK) {
+            s->ragdoll_pose = realloc(pose, n * sizeof *pose); /* keep the start pose */
+            pose = NULL;
+            r = s->ragdoll_pose ? AK_OK : AK_ERR_NO_MEMORY;
+            s->ragdoll_bone_count = n;
+            snprintf(s->ragdoll_character, sizeof s->ragdoll_character, "humanoid");
+            s->ragdoll_cell_size = cell;
+        }
         free(pose);
-        free(bones);
         ak_scene_destroy(sc);
         s->substeps = 40;
         s->steps = 180;
@@ -674,7 +705,8 @@ static ak_result preset_fill(const char* name, ak_rigid_scene* s) {
     return AK_ERR_NOT_FOUND;
 }
 
-static const char* const preset_names[] = {"stack", "pyramid", "dominoes", "avalanche", "ragdoll", "incline", NULL};
+static const char* const preset_names[] = {"stack",   "pyramid", "dominoes", "avalanche",
+                                           "ragdoll", "incline", NULL};
 
 const char* const* ak_rigid_scene_preset_names(size_t* out_count) {
     if (out_count) *out_count = sizeof preset_names / sizeof preset_names[0] - 1;
@@ -689,9 +721,11 @@ ak_result ak_rigid_scene_preset(const char* name, ak_rigid_scene* s, ak_diag* ou
         ak_rigid_scene_free(s);
         ak_rigid_scene_defaults(s);
         if (r == AK_ERR_NOT_FOUND)
-            return akp_diag_set(out_diag, r, name, "unknown preset (allowed: " AK_RIGID_SCENE_PRESETS ")");
+            return akp_diag_set(out_diag, r, name,
+                                "unknown preset (allowed: " AK_RIGID_SCENE_PRESETS ")");
         if (r == AK_ERR_NO_MEMORY) return akp_diag_set(out_diag, r, name, "out of memory");
-        return akp_diag_set(out_diag, r, name, "the ragdoll's character cannot be built: %s", ak_result_string(r));
+        return akp_diag_set(out_diag, r, name, "the ragdoll's character cannot be built: %s",
+                            ak_result_string(r));
     }
     if (out_diag) memset(out_diag, 0, sizeof *out_diag);
     return AK_OK;

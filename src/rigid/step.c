@@ -92,6 +92,14 @@ ak_result ak_rigid_step_validate(const ak_rigid_step_job* job) {
         if (job->sleep_timers.count && !ak_finitef(job->sleep_timers.ptr[i]))
             return AK_ERR_BAD_DATA;
     }
+    if (job->drive_targets.count) {
+        if (!job->drive_targets.ptr) return AK_ERR_NULL_ARG;
+        if (job->drive_targets.count < job->model->joint_count) return AK_ERR_SPAN_SMALL;
+        for (size_t k = 0; k < job->model->joint_count; ++k)
+            if (!ak_quat_is_finite(job->drive_targets.ptr[k]) ||
+                !(ak_quat_dot(job->drive_targets.ptr[k], job->drive_targets.ptr[k]) > 0.0f))
+                return AK_ERR_BAD_DATA;
+    }
     return AK_OK;
 }
 
@@ -112,6 +120,7 @@ typedef struct solver {
     const ak_quat* q0;    /* orientations at the step's start */
     const uint8_t* awake; /* 1: dynamic and awake (moves); 0: static or asleep */
     ak_mat3* iw;          /* world inverse inertia R diag(I^-1) R^T at the substep's start */
+    const ak_quat* drive_targets; /* the job's, per joint; NULL -> the model's */
     float h;
     float joint_error; /* the largest joint correction of the sweep (m or rad) */
 } solver;
@@ -681,7 +690,11 @@ static void solve_joints(solver* s) {
             if (tw != target) joint_rotation(s, a, b, ak_vec3_scale(n, tw - target), 0.0f);
         }
         if (j->drive && j->type != AK_RIGID_JOINT_FIXED && j->type != AK_RIGID_JOINT_PRISMATIC)
-            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->drive_target),
+            joint_rotation(s, a, b,
+                           orientation_error(s->q[a], s->q[b],
+                                             s->drive_targets
+                                                 ? ak_quat_normalize(s->drive_targets[k])
+                                                 : j->drive_target),
                            j->drive_compliance);
     }
 }
@@ -693,6 +706,27 @@ static bool joined(const ak_rigid_model* m, uint32_t a, uint32_t b) {
         if ((j->a == a && j->b == b) || (j->a == b && j->b == a)) return true;
     }
     return false;
+}
+
+/* Drive damping: remove the fraction min(c h, 1) of each driven joint's relative angular
+ * velocity with an equal and opposite angular impulse (momentum kept). */
+static void damp_drives(solver* s) {
+    const ak_rigid_model* m = s->m;
+    for (size_t k = 0; k < m->joint_count; ++k) {
+        const rigid_joint* j = &m->joints[k];
+        if (!j->drive || !(j->drive_damping > 0.0f)) continue;
+        uint32_t a = j->a, b = j->b;
+        if (!s->awake[a] && !s->awake[b]) continue;
+        ak_vec3 dw = ak_vec3_sub(s->w[b], s->w[a]);
+        float c = ak_vec3_length(dw);
+        if (c < 1e-9f) continue;
+        ak_vec3 n = ak_vec3_scale(dw, 1.0f / c);
+        float wsum = gen_inv_inertia(s, a, n) + gen_inv_inertia(s, b, n);
+        if (!(wsum > 0.0f)) continue;
+        ak_vec3 p = ak_vec3_scale(n, c * ak_minf(j->drive_damping * s->h, 1.0f) / wsum);
+        s->w[a] = ak_vec3_add(s->w[a], inv_inertia_mul(s, a, p));
+        s->w[b] = ak_vec3_sub(s->w[b], inv_inertia_mul(s, b, p));
+    }
 }
 
 static void update_velocities(solver* s) {
@@ -858,6 +892,7 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         .q0 = q0,
         .awake = awake,
         .iw = (ak_mat3*)(base + l.iw),
+        .drive_targets = job->drive_targets.count ? job->drive_targets.ptr : NULL,
         .h = job->dt / (float)substeps,
     };
     memcpy(x0, s.x, n * sizeof *x0);
@@ -900,6 +935,7 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
             if (s.joint_error < 1e-4f) break;
         }
         update_velocities(&s);
+        damp_drives(&s);
         solve_velocities(&s, &cb, gmag);
     }
     bool finite = true;

@@ -20,7 +20,8 @@ static const char* const usage =
     "JSON file describes (docs/rigid.md lists every key). --json writes {\"time\", \"bodies\": "
     "[{\"position\", \"orientation\", \"velocity\",\n"
     "\"angular_velocity\"}], \"max_penetration\", \"energy\"} of the final state (world space);\n"
-    "-o renders the run (GIF), its last frame (PNG), or bakes it as glTF (.glb).\n"
+    "-o renders the run (GIF), its last frame (PNG), or bakes it as glTF node animation\n"
+    "(.glb: one node per body, translation and rotation channels).\n"
     "Exit status: 0 success, 1 bad scene or a blow-up (named by its step), 2 bad usage.\n";
 
 /* ---- the bodies as one mesh ---------------------------------------------------------------- */
@@ -236,8 +237,12 @@ int cmd_rigid(int argc, char** argv) {
     memset(&frame, 0, sizeof frame);
     ak_image img = {0};
     ak_gif_writer* gw = NULL;
-    sim_bake bake;
-    memset(&bake, 0, sizeof bake);
+    /* -o OUT.glb: the states of every `every`-th step, baked as node animation */
+    ak_vec3* rec_x = NULL;
+    ak_quat* rec_q = NULL;
+    size_t rec_frames = 0, rec_cap = 0;
+    long every = 1;
+    ak_scene* baked = NULL;
     ak_result r;
 
     if (ak_rigid_scene_run_init(&run, &sc, name, &diag) != AK_OK) {
@@ -255,9 +260,24 @@ int cmd_rigid(int argc, char** argv) {
         }
         mesh_pose(&mesh, x, q);
     }
-    if (out && sim_bake_wanted(out) &&
-        (rc = sim_bake_mesh_init(&bake, "rigid", out, mesh.vcount, sc.steps)))
-        goto done;
+    if (out && sim_bake_wanted(out)) {
+        /* every step a frame, unless that passes the bake's frame limit or SIM_BAKE_BUDGET */
+        size_t by_mem = SIM_BAKE_BUDGET / ((n ? n : 1) * (sizeof(ak_vec3) + sizeof(ak_quat)));
+        size_t max_frames = by_mem < AK_SCENE_BAKE_MAX_FRAMES ? by_mem : AK_SCENE_BAKE_MAX_FRAMES;
+        if (max_frames < 2) {
+            rc = cli_fail("rigid", "%s: %zu bodies are too many to bake", out, n);
+            goto done;
+        }
+        if (sc.steps > 0 && (size_t)sc.steps + 1 > max_frames)
+            every = (long)(((size_t)sc.steps + max_frames - 2) / (max_frames - 1));
+        rec_cap = (size_t)(sc.steps / every) + 1;
+        rec_x = malloc(rec_cap * (n ? n : 1) * sizeof *rec_x);
+        rec_q = malloc(rec_cap * (n ? n : 1) * sizeof *rec_q);
+        if (!rec_x || !rec_q) {
+            rc = cli_fail("rigid", "%s: out of memory for %zu frames", out, rec_cap);
+            goto done;
+        }
+    }
     if (gif || png) {
         ak_vec3 lo = ak_vec3_splat(-1.0f), hi = ak_vec3_splat(1.0f);
         for (size_t v2 = 0; v2 < mesh.vcount; ++v2)
@@ -298,7 +318,11 @@ int cmd_rigid(int argc, char** argv) {
             }
             ++frames;
         }
-        if (bake.cap && (rc = sim_bake_mesh_add(&bake, step, mesh.pos, mesh.nrm))) goto done;
+        if (rec_cap && step % every == 0 && rec_frames < rec_cap) {
+            memcpy(rec_x + rec_frames * n, x, n * sizeof *rec_x);
+            memcpy(rec_q + rec_frames * n, q, n * sizeof *rec_q);
+            ++rec_frames;
+        }
         if (step == sc.steps) break;
         r = ak_rigid_scene_run_step(&run);
         if (r == AK_ERR_BAD_DATA) {
@@ -327,28 +351,80 @@ int cmd_rigid(int argc, char** argv) {
     }
     const double energy = ak_rigid_scene_run_energy(&run);
     const float pen = run.max_penetration;
-    if (json && (rc = write_json(json, time, n, x, q, run.velocities, run.angular_velocities, pen,
-                                 energy)))
+    if (json &&
+        (rc = write_json(json, time, n, x, q, run.velocities, run.angular_velocities, pen, energy)))
         goto done;
-    if (bake.cap && (rc = sim_bake_mesh_write(&bake, preset ? preset : "rigid", sc.dt,
-                                              (ak_u32_cspan){mesh.idx, mesh.icount},
-                                              ak_vec4_make(0.80f, 0.55f, 0.25f, 1))))
-        goto done;
+    if (rec_cap) {
+        ak_rigid_bake_desc bd = {.name = preset ? preset : "rigid",
+                                 .model = model,
+                                 .frame_count = rec_frames,
+                                 .positions = rec_x,
+                                 .orientations = rec_q,
+                                 .frame_time = sc.dt * (float)every};
+        if (sc.ragdoll_bone_count) {
+            /* the ragdoll preset: its character, the run as its skeleton's animation */
+            r = ak_builtin_create(sc.ragdoll_character,
+                                  &(ak_builtin_desc){.cell_size = sc.ragdoll_cell_size}, NULL,
+                                  &baked);
+            ak_clip* clip = NULL;
+            if (r == AK_OK && (!baked->clip_count ||
+                               ak_skeleton_joint_count(baked->skeleton) != sc.ragdoll_bone_count)) {
+                snprintf(diag.message, sizeof diag.message,
+                         "builtin:%s is not the ragdoll's character", sc.ragdoll_character);
+                r = AK_ERR_BAD_DATA;
+            }
+            if (r == AK_OK) {
+                ak_rigid_bake_ragdoll_desc rb = {
+                    .name = "ragdoll",
+                    .skeleton = baked->skeleton,
+                    .bones = {sc.ragdoll_bones, sc.ragdoll_bone_count},
+                    .fallback_pose = {sc.ragdoll_pose, sc.ragdoll_bone_count},
+                    .body_count = n,
+                    .frame_count = rec_frames,
+                    .positions = rec_x,
+                    .orientations = rec_q,
+                    .frame_time = sc.dt * (float)every};
+                r = ak_rigid_bake_ragdoll_clip(&rb, &baked->alloc, &clip, &diag);
+            }
+            if (r == AK_OK) { /* the baked run replaces the character's own clips */
+                for (size_t c = 0; c < baked->clip_count; ++c) ak_clip_destroy(baked->clips[c]);
+                baked->clips[0] = clip;
+                baked->clip_count = 1;
+            }
+        } else {
+            r = ak_rigid_bake_scene(&bd, NULL, &baked, &diag);
+        }
+        if (r == AK_OK) r = ak_io_save(out, baked, NULL, &diag);
+        if (r == AK_ERR_UNSUPPORTED) {
+            rc = cli_fail("rigid", "%s: %s; use fewer --steps", out, diag.message);
+            goto done;
+        }
+        if (r != AK_OK) {
+            rc = cli_fail("rigid", "%s: %s (%s)", out, diag.message, ak_result_string(r));
+            goto done;
+        }
+    }
     printf("rigid %s: %zu bodies, %zu joints, %ld steps of %.4g s (%u substeps): t = %.3g s, max "
            "penetration %.3g m, energy %.6g J\n",
            name, n, sc.joint_count, sc.steps, (double)sc.dt, sc.substeps, (double)time, (double)pen,
            energy);
     if (gif)
         cli_wrote(out, "%d frames", frames);
-    else if (bake.cap)
-        cli_wrote(out, "%zu frames, %.4g s apart", bake.frames, (double)sc.dt * (double)bake.every);
+    else if (rec_cap && sc.ragdoll_bone_count)
+        cli_wrote(out, "%zu frames, %.4g s apart, builtin:%s's skeleton animated", rec_frames,
+                  (double)sc.dt * (double)every, sc.ragdoll_character);
+    else if (rec_cap)
+        cli_wrote(out, "%zu frames, %.4g s apart, one node per body", rec_frames,
+                  (double)sc.dt * (double)every);
     else if (out)
         cli_wrote(out, NULL);
     if (sc.steps > 0 && !cli_quiet)
         fprintf(stderr, "%.3f ms per step\n", 1e3 * elapsed / (double)sc.steps);
 
 done:
-    sim_bake_free(&bake);
+    free(rec_x);
+    free(rec_q);
+    ak_scene_destroy(baked);
     ak_gif_writer_discard(gw);
     free(img.pixels);
     cli_frame_free(&frame);

@@ -11,7 +11,7 @@ static const char* const usage =
     "usage: animkit view FILE|builtin:NAME|SIM [--clip C] [--size WxH] [--script FILE] [--headless]\n"
     "                    [--ik-log FILE] [--frames N] [--supersample N] [--threads N] [--stats]\n"
     "                    [--shot-dir DIR] [--seed K]\n"
-    "       animkit view crowd [--preset P | SCENE.json] [options above]\n"
+    "       animkit view crowd|rigid [--preset P | SCENE.json] [options above]\n"
     "Open a window on the model, shaded by animkit's own rasterizer, playing clip C (default the\n"
     "first). The camera starts framed on the first pose as `animkit render` frames one time.\n"
     "SIM runs a simulation live: particles:SCENE.json, particles:preset:fountain|rain|fireworks|\n"
@@ -21,7 +21,9 @@ static const char* const usage =
     "terrain[:preset:hills|mountains|dunes] (g new seed, t next fractal, e erodes, r the first\n"
     "terrain), or crowd [--preset circle|crossing|corridor|evacuation | SCENE.json] (also\n"
     "crowd:preset:P, crowd:SCENE.json; a left click on the ground sends the nearest group there,\n"
-    "g: the whole crowd); docs/view.md.\n"
+    "g: the whole crowd), or rigid [--preset stack|pyramid|dominoes|avalanche|ragdoll|incline |\n"
+    "SCENE.json] (also rigid:preset:P, rigid:SCENE.json; default the ragdoll preset; a right\n"
+    "click throws a sphere from the camera); docs/view.md.\n"
     "  --size WxH       window size (default 960x600)\n"
     "  --script FILE    replay input from FILE, one event a line: key NAME, mouse_down BUTTON X Y,\n"
     "                   mouse_move X Y, mouse_up BUTTON X Y, wheel DY, wait FRAMES,\n"
@@ -97,17 +99,20 @@ int cmd_view(int argc, char** argv) {
         print_usage();
         return CLI_OK;
     }
-    /* `view crowd --preset P` and `view crowd SCENE.json` are crowd:preset:P and crowd:SCENE.json */
+    /* `view crowd|rigid --preset P` and `view crowd|rigid SCENE.json` are KIND:preset:P and
+     * KIND:SCENE.json */
     char crowd_arg[1100];
     const char* preset = CLI_GET(&a, "--preset");
-    if (a.pos_count >= 1 && strcmp(a.pos[0], "crowd") == 0 && (preset || a.pos_count == 2)) {
-        if (preset && a.pos_count == 2) return cli_usage("view", "crowd: give a scene file or --preset, not both");
-        if (strlen(preset ? preset : a.pos[1]) > 1000) return cli_usage("view", "crowd: the scene's name is too long");
-        snprintf(crowd_arg, sizeof crowd_arg, preset ? "crowd:preset:%s" : "crowd:%s", preset ? preset : a.pos[1]);
+    const bool kind_first = a.pos_count >= 1 && (strcmp(a.pos[0], "crowd") == 0 || strcmp(a.pos[0], "rigid") == 0);
+    if (kind_first && (preset || a.pos_count == 2)) {
+        const char* kind = a.pos[0];
+        if (preset && a.pos_count == 2) return cli_usage("view", "%s: give a scene file or --preset, not both", kind);
+        if (strlen(preset ? preset : a.pos[1]) > 1000) return cli_usage("view", "%s: the scene's name is too long", kind);
+        snprintf(crowd_arg, sizeof crowd_arg, preset ? "%s:preset:%s" : "%s:%s", kind, preset ? preset : a.pos[1]);
         a.pos[0] = crowd_arg;
         a.pos_count = 1;
     } else if (preset) {
-        return cli_usage("view", "--preset is for `view crowd` (other simulations: KIND:preset:NAME)");
+        return cli_usage("view", "--preset is for `view crowd` and `view rigid` (other simulations: KIND:preset:NAME)");
     }
     if (a.pos_count != 1) return cli_usage("view", "expected one FILE, builtin:NAME or simulation");
     view_options vo = {.width = 960, .height = 600, .clip = -1, .supersample = 1, .threads = 2};

@@ -824,6 +824,14 @@ void view_app_event(view_app* a, const view_event* ev) {
             a->drag = VIEW_DRAG_PAN;
             break;
         }
+        if (ev->button == VIEW_BUTTON_RIGHT && a->sim && a->sim->shoot && !a->side_by_side) {
+            char m[160] = "";
+            if (a->sim->shoot(a->sim_state, &a->frame.camera, a->frame.width, a->frame.height, ev->x, ev->y, m,
+                              sizeof m) &&
+                m[0])
+                message(a, m);
+            break;
+        }
         if (ev->button != VIEW_BUTTON_LEFT) break;
         if (a->sim && a->sim->grab && !a->side_by_side &&
             a->sim->grab(a->sim_state, &a->frame.camera, a->frame.width, a->frame.height, ev->x, ev->y, &a->sim_anchor)) {

@@ -118,6 +118,10 @@ typedef struct view_sim {
     bool (*key)(void* state, int key, char* msg, size_t msg_size);
     bool (*grab)(void* state, const ak_raster_camera* camera, int width, int height, float x, float y, ak_vec3* anchor);
     void (*drag)(void* state, ak_vec3 delta);
+    /* Optional: the right button went down at (x, y) (rigid: throw a sphere from the camera
+     * through that pixel); true when it did something (msg: a status message). */
+    bool (*shoot)(void* state, const ak_raster_camera* camera, int width, int height, float x, float y, char* msg,
+                  size_t msg_size);
     void (*status)(void* state, char* out, size_t out_size);
     void (*destroy)(void* state);
     bool (*failed)(void* state);
@@ -140,6 +144,8 @@ size_t view_help_list(const view_sim* sim, const view_help_entry** out, size_t c
 extern const view_sim view_terrain_sim;
 /* The crowd plug-in (view_crowd.c). */
 extern const view_sim view_crowd_sim;
+/* The rigid-body plug-in (view_rigid.c). */
+extern const view_sim view_rigid_sim;
 /* The kinds, for messages ("particles, boids, cloth, terrain"). */
 extern const char* const view_sim_kinds;
 

@@ -1,6 +1,7 @@
 /* animkit view: the simulations it runs live (view_sim plug-ins). `animkit view KIND:SPEC`
  * picks one: particles:SCENE.json, particles:preset:NAME, boids[:SCENE.json], boids:preset:NAME,
- * cloth:SCENE.json, cloth:preset:NAME, terrain[:preset:NAME] (view_terrain.c). Each reuses its command's scene
+ * cloth:SCENE.json, cloth:preset:NAME, terrain[:preset:NAME] (view_terrain.c), rigid[:SCENE.json],
+ * rigid:preset:NAME (view_rigid.c). Each reuses its command's scene
  * parser and drawing (particles_run.c, boids_run.c, cloth_run.c), so the viewer shows what the
  * command renders. */
 #include <math.h>
@@ -13,7 +14,7 @@
 #include "particles_run.h"
 #include "view_app.h"
 
-const char* const view_sim_kinds = "particles, boids, cloth, terrain, crowd";
+const char* const view_sim_kinds = "particles, boids, cloth, terrain, crowd, rigid";
 
 #define MAX_STEPS_PER_FRAME 64
 #define WIND_STEP 0.5f
@@ -734,6 +735,7 @@ static const struct {
     {"cloth", &cloth_sim},
     {"terrain", &view_terrain_sim},
     {"crowd", &view_crowd_sim},
+    {"rigid", &view_rigid_sim},
 };
 
 const view_sim* view_sim_at(size_t index) { return index < sizeof sims / sizeof sims[0] ? sims[index].sim : NULL; }
