@@ -128,8 +128,9 @@ int main(int argc, char** argv) {
                    best[one].cpu_ms / best[one + 1].cpu_ms,
                    best[one].cpu_ms * 1e6 / (double)best[one].count);
             if (sc != SETS - 1 && used[scalar1])
-                printf("; vs scalar (1 thread): cpu %.2fx",
-                       best[scalar1].cpu_ms / best[one].cpu_ms);
+                printf("; SIMD/scalar cpu time: %.2f (1 thread), %.2f (2 threads)",
+                       best[one].cpu_ms / best[scalar1].cpu_ms,
+                       best[one + 1].cpu_ms / best[scalar1 + 1].cpu_ms);
             printf("\n");
         }
     }
