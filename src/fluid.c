@@ -729,8 +729,9 @@ static void ph_gather(ctx* c, size_t b, size_t e, uint32_t t) {
 static void ph_density(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
     const bool cubic = c->d.solver == AK_FLUID_WCSPH;
-    if (c->simd && !cubic) {
-        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_density_avx512 : akp_fluid_density_avx2)(c, b, e);
+    if (c->simd) {
+        if (cubic) (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_density_cubic_avx512 : akp_fluid_density_cubic_avx2)(c, b, e);
+        else (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_density_avx512 : akp_fluid_density_avx2)(c, b, e);
         return;
     }
     for (size_t i = b; i < e; ++i) {
@@ -907,9 +908,23 @@ static void ph_pressure(ctx* c, size_t b, size_t e, uint32_t t) {
     }
 }
 
+/* SIMD SPH / WCSPH: (v, rho) records into q4 and the pressures into p4's w, for the force
+ * kernels (p4 is rebuilt by the next step's sort; no other pass reads its w). */
+static void ph_pack_forces(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        c->q4[4 * i] = c->v[i].x, c->q4[4 * i + 1] = c->v[i].y, c->q4[4 * i + 2] = c->v[i].z, c->q4[4 * i + 3] = c->rho[i];
+        c->p4[4 * i + 3] = c->pres[i];
+    }
+}
+
 /* SPH / WCSPH: accelerations into acc. */
 static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
     (void)t;
+    if (c->simd) {
+        (c->kernels == AK_FLUID_KERNELS_AVX512 ? akp_fluid_forces_avx512 : akp_fluid_forces_avx2)(c, b, e);
+        return;
+    }
     const ak_fluid_desc* d = &c->d;
     const bool mcg = d->solver == AK_FLUID_SPH;
     const float mu = d->viscosity, m = c->m, h = c->h;
@@ -943,9 +958,13 @@ static void ph_forces(ctx* c, size_t b, size_t e, uint32_t t) {
                 a = ak_vec3_add(a, ak_vec3_scale(g, -m * coef));
             }
         }
-        if (mcg) a = ak_vec3_scale(a, 1.0f / rhoi);
-        c->acc[i] = ak_vec3_add(a, d->gravity);
+        akp_fluid_forces_finish(c, i, a);
     }
+}
+
+void akp_fluid_forces_finish(akp_fluid_ctx* c, size_t i, ak_vec3 a) {
+    if (c->d.solver == AK_FLUID_SPH) a = ak_vec3_scale(a, 1.0f / c->rho[i]);
+    c->acc[i] = ak_vec3_add(a, c->d.gravity);
 }
 
 /* SPH / WCSPH: semi-implicit Euler into q (positions) and v. */
@@ -1091,6 +1110,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
         c->inv_h = 1.0f / c->h;
         c->cubic_k = (float)(8.0 / FLUID_PI) / h3;
         c->cubic_gk = (float)(48.0 / FLUID_PI) / (h3 * c->h);
+        c->visc_lap_k = (float)(45.0 / FLUID_PI) / (h3 * h3); /* ak_fluid_visc_laplacian's factor */
     }
     c->wdq = ak_fluid_poly6(c->d.scorr_dq * c->h * c->d.scorr_dq * c->h, c->h);
 
@@ -1172,6 +1192,7 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     } else {
         parallel(c, ph_density);
         parallel(c, ph_pressure);
+        if (c->simd) parallel(c, ph_pack_forces);
         parallel(c, ph_forces);
         parallel(c, ph_integrate);
     }

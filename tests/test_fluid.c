@@ -614,7 +614,8 @@ static void run_case(const simd_case* k, ak_fluid_kernels kernels, ak_vec3* pos,
 /* The AVX2 and AVX-512 kernels (where this CPU has them) against the scalar ones: the same bits
  * for positions, velocities, densities, pressures, flags and statistics after 8 steps, for PBF (with the
  * tensile term's n = 4 fast path, a general n, lists truncated at 12 neighbours, and the hashed
- * grid path), SPH and WCSPH, with moving colliders and 2 threads. */
+ * grid path), SPH and WCSPH (their density and force kernels with viscosity, on the hashed grid
+ * path and with truncated lists too), with moving colliders and 2 threads. */
 AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
     static ak_vec3 p1[NAIVE_CAP], v1[NAIVE_CAP], p2[NAIVE_CAP], v2[NAIVE_CAP];
     static float r1[NAIVE_CAP], r2[NAIVE_CAP], q1[NAIVE_CAP], q2[NAIVE_CAP];
@@ -624,7 +625,9 @@ AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
                                {"pbf 12 neighbours", AK_FLUID_PBF, 0.0f, 12, false},
                                {"pbf hashed grid", AK_FLUID_PBF, 0.0f, 0, true},
                                {"sph", AK_FLUID_SPH, 0.0f, 0, false},
-                               {"wcsph", AK_FLUID_WCSPH, 0.0f, 0, false}};
+                               {"wcsph", AK_FLUID_WCSPH, 0.0f, 0, false},
+                               {"sph hashed grid", AK_FLUID_SPH, 0.0f, 0, true},
+                               {"wcsph 20 neighbours", AK_FLUID_WCSPH, 0.0f, 20, false}};
     const ak_fluid_kernels sets[] = {AK_FLUID_KERNELS_AVX2, AK_FLUID_KERNELS_AVX512};
     for (int s = 0; s < 2; ++s) {
         const ak_fluid_kernels got = ak_fluid_kernels_resolved(sets[s]);

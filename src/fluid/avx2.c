@@ -342,6 +342,129 @@ AKP_AVX2 void akp_fluid_xsph_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
     }
 }
 
+/* k_cubic: the cubic spline at r^2 (+0 outside), the scalar formula's operations in order. */
+AKP_AVX2 static inline __m256 cubic_8(const akp_fluid_ctx* c, const pairs8* p) {
+    const __m256 q = _mm256_mul_ps(_mm256_sqrt_ps(p->r2), _mm256_set1_ps(c->inv_h));
+    const __m256 k = _mm256_set1_ps(c->cubic_k), qq = _mm256_mul_ps(q, q);
+    const __m256 near = _mm256_mul_ps(
+        k, _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(6.0f),
+                                       _mm256_sub_ps(_mm256_mul_ps(qq, q), qq)),
+                         _mm256_set1_ps(1.0f)));
+    const __m256 u = _mm256_sub_ps(_mm256_set1_ps(1.0f), q);
+    const __m256 far = _mm256_mul_ps(
+        _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(k, _mm256_set1_ps(2.0f)), u), u), u);
+    const __m256 is_near = _mm256_cmp_ps(q, _mm256_set1_ps(0.5f), _CMP_LE_OQ);
+    return _mm256_and_ps(p->in, _mm256_blendv_ps(far, near, is_near));
+}
+
+/* k_cubic_grad's factor dw / |r| (+0 outside and at r = 0). */
+AKP_AVX2 static inline __m256 cubic_grad_8(const akp_fluid_ctx* c, const pairs8* p) {
+    const __m256 pos = _mm256_and_ps(p->in, _mm256_cmp_ps(p->r2, _mm256_setzero_ps(), _CMP_GT_OQ));
+    const __m256 len = _mm256_sqrt_ps(p->r2);
+    const __m256 q = _mm256_mul_ps(len, _mm256_set1_ps(c->inv_h));
+    const __m256 u = _mm256_sub_ps(_mm256_set1_ps(1.0f), q);
+    const __m256 gk = _mm256_set1_ps(c->cubic_gk);
+    const __m256 near = _mm256_mul_ps(
+        gk, _mm256_sub_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(3.0f), q), q),
+                          _mm256_mul_ps(_mm256_set1_ps(2.0f), q)));
+    const __m256 far = _mm256_mul_ps(_mm256_mul_ps(neg8(gk), u), u);
+    const __m256 is_near = _mm256_cmp_ps(q, _mm256_set1_ps(0.5f), _CMP_LE_OQ);
+    return _mm256_and_ps(pos, _mm256_div_ps(_mm256_blendv_ps(far, near, is_near), len));
+}
+
+AKP_AVX2 void akp_fluid_density_cubic_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
+    half8 H;
+    FOR_HALVES(c, b, e, H) {
+        __m256 rho = _mm256_setzero_ps();
+        for (uint32_t q = 0; q < H.max_count; ++q) {
+            pairs8 p;
+            load_pairs(c, &H, q, c->p4, NULL, &p);
+            rho = add_masked(rho, p.m, cubic_8(c, &p));
+        }
+        _mm256_maskstore_ps(c->rho + H.base, _mm256_castps_si256(H.lanes),
+                            _mm256_mul_ps(rho, _mm256_set1_ps(c->m)));
+    }
+}
+
+/* ph_forces on 8 particles at a time: neighbour positions and pressures from p4, velocities and
+ * densities from q4 (ph_pack_forces); the sums' tails in akp_fluid_forces_finish. */
+AKP_AVX2 void akp_fluid_forces_avx2(akp_fluid_ctx* c, size_t b, size_t e) {
+    const ak_fluid_desc* d = &c->d;
+    const bool mcg = d->solver == AK_FLUID_SPH, visc = d->viscosity != 0.0f;
+    const float mu = d->viscosity, h = c->h;
+    const __m256 zero = _mm256_setzero_ps(), negm = _mm256_set1_ps(-c->m),
+                 two = _mm256_set1_ps(2.0f), vh = _mm256_set1_ps(h),
+                 mum = _mm256_set1_ps(mu * c->m), lapk = _mm256_set1_ps(c->visc_lap_k),
+                 nuk = _mm256_set1_ps(2.0f * mu * h * d->sound_speed),
+                 eps2 = _mm256_set1_ps(0.01f * h * h);
+    half8 H;
+    FOR_HALVES(c, b, e, H) {
+        const __m256i self = _mm256_add_epi32(_mm256_set1_epi32((int)H.base),
+                                              _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        const __m256i li = _mm256_castps_si256(H.lanes);
+        __m256 vix, viy, viz;
+        own_v(c, &H, &vix, &viy, &viz);
+        const __m256 rhoi = _mm256_maskload_ps(c->rho + H.base, li),
+                     pri = _mm256_maskload_ps(c->pres + H.base, li);
+        const __m256 pri_r = _mm256_div_ps(pri, _mm256_mul_ps(rhoi, rhoi)); /* WCSPH */
+        __m256 ax = zero, ay = zero, az = zero;
+        for (uint32_t q = 0; q < H.max_count; ++q) {
+            pairs8 p;
+            __m256 prj, vjx, vjy, vjz, rhoj;
+            load_pairs(c, &H, q, c->p4, &prj, &p);
+            load4(c->q4, p.id, &vjx, &vjy, &vjz, &rhoj);
+            const __m256i idx = _mm256_loadu_si256((const __m256i*)(const void*)p.id);
+            const __m256 other = _mm256_andnot_ps(
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(idx, self)), p.m); /* j != i */
+            if (mcg) {
+                const __m256 f = spiky_8(c, &p);
+                const __m256 s = _mm256_div_ps(_mm256_mul_ps(negm, _mm256_add_ps(pri, prj)),
+                                               _mm256_mul_ps(two, rhoj));
+                ax = add_masked(ax, other, _mm256_mul_ps(_mm256_mul_ps(p.rx, f), s));
+                ay = add_masked(ay, other, _mm256_mul_ps(_mm256_mul_ps(p.ry, f), s));
+                az = add_masked(az, other, _mm256_mul_ps(_mm256_mul_ps(p.rz, f), s));
+                if (visc) {
+                    /* ak_fluid_visc_laplacian(|r|, h): +0 unless |r| < h */
+                    const __m256 len = _mm256_sqrt_ps(p.r2);
+                    const __m256 near = _mm256_cmp_ps(len, vh, _CMP_LT_OQ);
+                    const __m256 lap = _mm256_and_ps(near, _mm256_mul_ps(lapk, _mm256_sub_ps(vh, len)));
+                    const __m256 s2 = _mm256_mul_ps(_mm256_div_ps(mum, rhoj), lap);
+                    ax = add_masked(ax, other, _mm256_mul_ps(_mm256_sub_ps(vjx, vix), s2));
+                    ay = add_masked(ay, other, _mm256_mul_ps(_mm256_sub_ps(vjy, viy), s2));
+                    az = add_masked(az, other, _mm256_mul_ps(_mm256_sub_ps(vjz, viz), s2));
+                }
+            } else {
+                const __m256 f = cubic_grad_8(c, &p);
+                __m256 coef = _mm256_add_ps(pri_r, _mm256_div_ps(prj, _mm256_mul_ps(rhoj, rhoj)));
+                if (visc) {
+                    const __m256 ux = _mm256_sub_ps(vix, vjx), uy = _mm256_sub_ps(viy, vjy),
+                                 uz = _mm256_sub_ps(viz, vjz);
+                    const __m256 vx = _mm256_add_ps(
+                        _mm256_add_ps(_mm256_mul_ps(ux, p.rx), _mm256_mul_ps(uy, p.ry)),
+                        _mm256_mul_ps(uz, p.rz));
+                    const __m256 app = _mm256_cmp_ps(vx, zero, _CMP_LT_OQ);
+                    const __m256 nu = _mm256_div_ps(nuk, _mm256_add_ps(rhoi, rhoj));
+                    coef = _mm256_blendv_ps(
+                        coef,
+                        _mm256_add_ps(coef, _mm256_div_ps(_mm256_mul_ps(neg8(nu), vx),
+                                                          _mm256_add_ps(p.r2, eps2))),
+                        app);
+                }
+                const __m256 s = _mm256_mul_ps(negm, coef);
+                ax = add_masked(ax, other, _mm256_mul_ps(_mm256_mul_ps(p.rx, f), s));
+                ay = add_masked(ay, other, _mm256_mul_ps(_mm256_mul_ps(p.ry, f), s));
+                az = add_masked(az, other, _mm256_mul_ps(_mm256_mul_ps(p.rz, f), s));
+            }
+        }
+        float x[8], y[8], z[8];
+        _mm256_storeu_ps(x, ax), _mm256_storeu_ps(y, ay), _mm256_storeu_ps(z, az);
+        for (uint32_t u = 0; u < 8; ++u)
+            if (H.bits >> u & 1u)
+                akp_fluid_forces_finish(c, H.base + u, ak_vec3_make(x[u], y[u], z[u]));
+    }
+}
+
+
 #else
 
 bool akp_fluid_have_avx2(void) { return false; }
@@ -355,5 +478,7 @@ void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (voi
 void akp_fluid_delta_avx2(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
 void akp_fluid_vorticity_avx2(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
 void akp_fluid_xsph_avx2(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
+void akp_fluid_density_cubic_avx2(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
+void akp_fluid_forces_avx2(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
 
 #endif

@@ -361,6 +361,124 @@ AKP_AVX512 void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
     }
 }
 
+/* k_cubic: the cubic spline at r^2 (+0 outside), the scalar formula's operations in order. */
+AKP_AVX512 static inline __m512 cubic_16(const akp_fluid_ctx* c, const pairs16* p) {
+    const __m512 q = _mm512_mul_ps(_mm512_sqrt_ps(p->r2), _mm512_set1_ps(c->inv_h));
+    const __m512 k = _mm512_set1_ps(c->cubic_k), qq = _mm512_mul_ps(q, q);
+    const __m512 near = _mm512_mul_ps(
+        k, _mm512_add_ps(_mm512_mul_ps(_mm512_set1_ps(6.0f),
+                                       _mm512_sub_ps(_mm512_mul_ps(qq, q), qq)),
+                         _mm512_set1_ps(1.0f)));
+    const __m512 u = _mm512_sub_ps(_mm512_set1_ps(1.0f), q);
+    const __m512 far = _mm512_mul_ps(
+        _mm512_mul_ps(_mm512_mul_ps(_mm512_mul_ps(k, _mm512_set1_ps(2.0f)), u), u), u);
+    const __mmask16 is_near = _mm512_cmp_ps_mask(q, _mm512_set1_ps(0.5f), _CMP_LE_OQ);
+    return _mm512_maskz_mov_ps(p->in, _mm512_mask_blend_ps(is_near, far, near));
+}
+
+/* k_cubic_grad's factor dw / |r| (+0 outside and at r = 0). */
+AKP_AVX512 static inline __m512 cubic_grad_16(const akp_fluid_ctx* c, const pairs16* p) {
+    const __mmask16 pos = _mm512_mask_cmp_ps_mask(p->in, p->r2, _mm512_setzero_ps(), _CMP_GT_OQ);
+    const __m512 len = _mm512_sqrt_ps(p->r2);
+    const __m512 q = _mm512_mul_ps(len, _mm512_set1_ps(c->inv_h));
+    const __m512 u = _mm512_sub_ps(_mm512_set1_ps(1.0f), q);
+    const __m512 gk = _mm512_set1_ps(c->cubic_gk);
+    const __m512 near = _mm512_mul_ps(
+        gk, _mm512_sub_ps(_mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(3.0f), q), q),
+                          _mm512_mul_ps(_mm512_set1_ps(2.0f), q)));
+    const __m512 far = _mm512_mul_ps(_mm512_mul_ps(neg16(gk), u), u);
+    const __mmask16 is_near = _mm512_cmp_ps_mask(q, _mm512_set1_ps(0.5f), _CMP_LE_OQ);
+    return _mm512_maskz_div_ps(pos, _mm512_mask_blend_ps(is_near, far, near), len);
+}
+
+AKP_AVX512 void akp_fluid_density_cubic_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
+    for (size_t blk = b & ~(size_t)15; blk < e; blk += 16) {
+        block16 B;
+        block_begin(c, blk, b, e, &B);
+        __m512 rho = _mm512_setzero_ps();
+        for (uint32_t q = 0; q < B.max_count; ++q) {
+            pairs16 p;
+            load_pairs(c, &B, q, &p);
+            rho = _mm512_mask_add_ps(rho, p.m, rho, cubic_16(c, &p));
+        }
+        _mm512_mask_storeu_ps(c->rho + blk, B.lanes, _mm512_mul_ps(rho, _mm512_set1_ps(c->m)));
+    }
+}
+
+/* ph_forces on 16 particles at a time: neighbour positions and pressures from p4, velocities
+ * and densities from q4 (ph_pack_forces); the sums' tails in akp_fluid_forces_finish. */
+AKP_AVX512 void akp_fluid_forces_avx512(akp_fluid_ctx* c, size_t b, size_t e) {
+    const ak_fluid_desc* d = &c->d;
+    const bool mcg = d->solver == AK_FLUID_SPH, visc = d->viscosity != 0.0f;
+    const float mu = d->viscosity, h = c->h;
+    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m512 zero = _mm512_setzero_ps(), negm = _mm512_set1_ps(-c->m),
+                 two = _mm512_set1_ps(2.0f), vh = _mm512_set1_ps(h),
+                 mum = _mm512_set1_ps(mu * c->m), lapk = _mm512_set1_ps(c->visc_lap_k),
+                 nuk = _mm512_set1_ps(2.0f * mu * h * d->sound_speed),
+                 eps2 = _mm512_set1_ps(0.01f * h * h);
+    for (size_t blk = b & ~(size_t)15; blk < e; blk += 16) {
+        block16 B;
+        block_begin(c, blk, b, e, &B);
+        const __m512i self = _mm512_add_epi32(_mm512_set1_epi32((int)blk), lane);
+        __m512 vix, viy, viz;
+        own_v(c, &B, &vix, &viy, &viz);
+        const __m512 rhoi = _mm512_maskz_loadu_ps(B.lanes, c->rho + blk),
+                     pri = _mm512_maskz_loadu_ps(B.lanes, c->pres + blk);
+        const __m512 pri_r = _mm512_div_ps(pri, _mm512_mul_ps(rhoi, rhoi)); /* WCSPH */
+        __m512 ax = zero, ay = zero, az = zero;
+        for (uint32_t q = 0; q < B.max_count; ++q) {
+            pairs16 p;
+            __m512 prj, vjx, vjy, vjz, rhoj;
+            load_pairs_from(c, &B, q, c->p4, &prj, &p);
+            load4(c->q4, p.id, &vjx, &vjy, &vjz, &rhoj);
+            const __mmask16 other = _mm512_mask_cmpneq_epi32_mask(p.m, p.idx, self); /* j != i */
+            if (mcg) {
+                const __m512 f = spiky_16(c, &p);
+                const __m512 s = _mm512_div_ps(_mm512_mul_ps(negm, _mm512_add_ps(pri, prj)),
+                                               _mm512_mul_ps(two, rhoj));
+                ax = _mm512_mask_add_ps(ax, other, ax, _mm512_mul_ps(_mm512_mul_ps(p.rx, f), s));
+                ay = _mm512_mask_add_ps(ay, other, ay, _mm512_mul_ps(_mm512_mul_ps(p.ry, f), s));
+                az = _mm512_mask_add_ps(az, other, az, _mm512_mul_ps(_mm512_mul_ps(p.rz, f), s));
+                if (visc) {
+                    /* ak_fluid_visc_laplacian(|r|, h): +0 unless |r| < h */
+                    const __m512 len = _mm512_sqrt_ps(p.r2);
+                    const __mmask16 near = _mm512_cmp_ps_mask(len, vh, _CMP_LT_OQ);
+                    const __m512 lap = _mm512_maskz_mul_ps(near, lapk, _mm512_sub_ps(vh, len));
+                    const __m512 s2 = _mm512_mul_ps(_mm512_div_ps(mum, rhoj), lap);
+                    ax = _mm512_mask_add_ps(ax, other, ax, _mm512_mul_ps(_mm512_sub_ps(vjx, vix), s2));
+                    ay = _mm512_mask_add_ps(ay, other, ay, _mm512_mul_ps(_mm512_sub_ps(vjy, viy), s2));
+                    az = _mm512_mask_add_ps(az, other, az, _mm512_mul_ps(_mm512_sub_ps(vjz, viz), s2));
+                }
+            } else {
+                const __m512 f = cubic_grad_16(c, &p);
+                __m512 coef = _mm512_add_ps(pri_r, _mm512_div_ps(prj, _mm512_mul_ps(rhoj, rhoj)));
+                if (visc) {
+                    const __m512 ux = _mm512_sub_ps(vix, vjx), uy = _mm512_sub_ps(viy, vjy),
+                                 uz = _mm512_sub_ps(viz, vjz);
+                    const __m512 vx = _mm512_add_ps(
+                        _mm512_add_ps(_mm512_mul_ps(ux, p.rx), _mm512_mul_ps(uy, p.ry)),
+                        _mm512_mul_ps(uz, p.rz));
+                    const __mmask16 app = _mm512_cmp_ps_mask(vx, zero, _CMP_LT_OQ);
+                    const __m512 nu = _mm512_div_ps(nuk, _mm512_add_ps(rhoi, rhoj));
+                    coef = _mm512_mask_add_ps(
+                        coef, app, coef,
+                        _mm512_div_ps(_mm512_mul_ps(neg16(nu), vx), _mm512_add_ps(p.r2, eps2)));
+                }
+                const __m512 s = _mm512_mul_ps(negm, coef);
+                ax = _mm512_mask_add_ps(ax, other, ax, _mm512_mul_ps(_mm512_mul_ps(p.rx, f), s));
+                ay = _mm512_mask_add_ps(ay, other, ay, _mm512_mul_ps(_mm512_mul_ps(p.ry, f), s));
+                az = _mm512_mask_add_ps(az, other, az, _mm512_mul_ps(_mm512_mul_ps(p.rz, f), s));
+            }
+        }
+        float x[16], y[16], z[16];
+        _mm512_storeu_ps(x, ax), _mm512_storeu_ps(y, ay), _mm512_storeu_ps(z, az);
+        for (uint32_t u = 0; u < 16; ++u)
+            if (B.lanes >> u & 1u) akp_fluid_forces_finish(c, blk + u, ak_vec3_make(x[u], y[u], z[u]));
+    }
+}
+
+
 #else
 
 bool akp_fluid_have_avx512(void) { return false; }
@@ -374,5 +492,7 @@ void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (v
 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
 void akp_fluid_vorticity_avx512(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
 void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
+void akp_fluid_density_cubic_avx512(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
+void akp_fluid_forces_avx512(akp_fluid_ctx* c, size_t b, size_t e) { (void)c, (void)b, (void)e; }
 
 #endif

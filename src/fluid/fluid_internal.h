@@ -58,6 +58,7 @@ typedef struct akp_fluid_ctx {
     float inv_h;      /* 1 / h */
     float cubic_k;    /* 8 / (pi h^3) */
     float cubic_gk;   /* 48 / (pi h^4) */
+    float visc_lap_k; /* 45 / (pi h^6): ak_fluid_visc_laplacian(r, h) = visc_lap_k (h - r) */
     struct akp_fluid_team* team; /* fluid.c: the step's worker team (NULL: the caller alone) */
     /* per-thread results */
     size_t truncated[AKP_FLUID_MAX_THREADS];
@@ -86,6 +87,11 @@ void akp_fluid_lambda_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_delta_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_vorticity_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_xsph_avx512(akp_fluid_ctx* c, size_t b, size_t e);
+/* SPH / WCSPH: WCSPH's cubic-spline density pass and the force pass (ph_forces: MCG pressure and
+ * viscosity Laplacian, or WCSPH pressure with the artificial viscosity). The force kernels read
+ * (v, rho) records from q4 and the pressures from p4's w (ph_pack_forces). */
+void akp_fluid_density_cubic_avx512(akp_fluid_ctx* c, size_t b, size_t e);
+void akp_fluid_forces_avx512(akp_fluid_ctx* c, size_t b, size_t e);
 
 /* avx2.c: the same kernels on 8 lanes (each block of 16 as two halves), bit-identical too. */
 bool akp_fluid_have_avx2(void);
@@ -96,6 +102,8 @@ void akp_fluid_lambda_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_delta_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_vorticity_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_xsph_avx2(akp_fluid_ctx* c, size_t b, size_t e);
+void akp_fluid_density_cubic_avx2(akp_fluid_ctx* c, size_t b, size_t e);
+void akp_fluid_forces_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 
 /* fluid.c: the collision projection of every solver (v may be NULL); the scalar tails shared
  * by every kernel set: the corrected position p of particle i collided and stored as the next
@@ -103,5 +111,7 @@ void akp_fluid_xsph_avx2(akp_fluid_ctx* c, size_t b, size_t e);
 void akp_fluid_collide(const akp_fluid_ctx* c, ak_vec3* p, ak_vec3* v);
 void akp_fluid_delta_finish(akp_fluid_ctx* c, size_t i, ak_vec3 p);
 void akp_fluid_xsph_finish(akp_fluid_ctx* c, size_t i, ak_vec3 eta, ak_vec3 xs);
+/* SPH / WCSPH: particle i's acceleration from its force sum a (SPH divides by rho_i). */
+void akp_fluid_forces_finish(akp_fluid_ctx* c, size_t i, ak_vec3 a);
 
 #endif
