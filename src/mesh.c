@@ -482,13 +482,124 @@ void ak_weights_normalize(uint16_t* joints, float* weights, size_t vertex_count,
 
 /* ---- self-intersections ------------------------------------------------------------------ */
 
-/* Orientation predicates in double precision on float input. The sign is that of the 3x3
- * determinant; exactly zero means coplanar (or collinear in 2D). */
+/* Orientation predicates: a double-precision determinant with an error filter, and when the
+ * filter cannot decide, the exact sign from floating-point expansions (Shewchuk's two-sum and
+ * two-product, here with fma): non-overlapping terms of increasing magnitude whose sum is the
+ * exact determinant, so the sign is that of the largest term. */
 typedef struct dvec3 {
     double x, y, z;
 } dvec3;
 
 static dvec3 to_d(ak_vec3 v) { return (dvec3){v.x, v.y, v.z}; }
+
+static void two_sum(double a, double b, double* x, double* y) {
+    double s = a + b, bv = s - a, av = s - bv;
+    *x = s;
+    *y = (a - av) + (b - bv);
+}
+
+/* h = e + f (Shewchuk's fast expansion sum with zero elimination: merge by magnitude, then a
+ * chain of two-sums); h may not alias e or f. Returns the length of h (>= 1). */
+static int sum_expansion(const double* e, int ne, const double* f, int nf, double* h) {
+    double g[512];
+    int i = 0, j = 0, m = 0;
+    while (i < ne && j < nf) g[m++] = fabs(e[i]) < fabs(f[j]) ? e[i++] : f[j++];
+    while (i < ne) g[m++] = e[i++];
+    while (j < nf) g[m++] = f[j++];
+    if (m == 0) {
+        h[0] = 0.0;
+        return 1;
+    }
+    int k = 0;
+    double q = g[0], hh;
+    for (int t = 1; t < m; ++t) {
+        two_sum(q, g[t], &q, &hh);
+        if (hh != 0.0) h[k++] = hh;
+    }
+    if (q != 0.0 || k == 0) h[k++] = q;
+    return k;
+}
+
+/* h = e * b. */
+static int scale_expansion(const double* e, int n, double b, double* h) {
+    int k = 0;
+    double q = e[0] * b, hh = fma(e[0], b, -q);
+    if (hh != 0.0) h[k++] = hh;
+    for (int i = 1; i < n; ++i) {
+        double p1 = e[i] * b, p0 = fma(e[i], b, -p1), s;
+        two_sum(q, p0, &s, &hh);
+        if (hh != 0.0) h[k++] = hh;
+        q = p1 + s; /* fast two-sum: |p1| >= |s| */
+        hh = s - (q - p1);
+        if (hh != 0.0) h[k++] = hh;
+    }
+    if (q != 0.0 || k == 0) h[k++] = q;
+    return k;
+}
+
+#define EXP_MAX 256
+/* h = e * f (ne * nf <= 64). */
+static int mul_expansion(const double* e, int ne, const double* f, int nf, double* h) {
+    double part[EXP_MAX], acc[EXP_MAX];
+    int n = scale_expansion(e, ne, f[0], h);
+    for (int j = 1; j < nf; ++j) {
+        int np = scale_expansion(e, ne, f[j], part);
+        memcpy(acc, h, (size_t)n * sizeof(double));
+        n = sum_expansion(acc, n, part, np, h);
+    }
+    return n;
+}
+
+static int expansion_sign(const double* e, int n) {
+    for (int i = n; i-- > 0;)
+        if (e[i] != 0.0) return (e[i] > 0.0) - (e[i] < 0.0);
+    return 0;
+}
+
+/* Exact a - b as a two-term expansion. */
+static int diff2(double a, double b, double* h) {
+    double x, y;
+    two_sum(a, -b, &x, &y);
+    if (y == 0.0) {
+        h[0] = x;
+        return 1;
+    }
+    h[0] = y, h[1] = x;
+    return 2;
+}
+
+/* Exact sign of p*q - r*s for expansions (2D cross term). */
+static int cross_term(const double* p, int np, const double* q, int nq, const double* r, int nr, const double* s,
+                      int ns, double* out) {
+    double a[16], b[16];
+    int na = mul_expansion(p, np, q, nq, a);
+    int nb = mul_expansion(r, nr, s, ns, b);
+    for (int i = 0; i < nb; ++i) b[i] = -b[i];
+    return sum_expansion(a, na, b, nb, out);
+}
+
+static int orient3_exact(dvec3 a, dvec3 b, dvec3 c, dvec3 d) {
+    double u[3][2], v[3][2], w[3][2];
+    int nu[3], nv[3], nw[3];
+    const double A[3] = {a.x, a.y, a.z}, B[3] = {b.x, b.y, b.z}, C[3] = {c.x, c.y, c.z}, D[3] = {d.x, d.y, d.z};
+    for (int k = 0; k < 3; ++k) {
+        nu[k] = diff2(B[k], A[k], u[k]);
+        nv[k] = diff2(C[k], A[k], v[k]);
+        nw[k] = diff2(D[k], A[k], w[k]);
+    }
+    double total[EXP_MAX], t2[EXP_MAX];
+    int nt = 1;
+    total[0] = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+        double minor[32], term[128];
+        int nm = cross_term(v[k1], nv[k1], w[k2], nw[k2], v[k2], nv[k2], w[k1], nw[k1], minor);
+        int nterm = mul_expansion(minor, nm, u[k], nu[k], term);
+        nt = sum_expansion(total, nt, term, nterm, t2);
+        memcpy(total, t2, (size_t)nt * sizeof(double));
+    }
+    return expansion_sign(total, nt);
+}
 
 /* Sign of det[b-a, c-a, d-a]: > 0 when d is on the side of plane (a, b, c) its normal
  * (b-a) x (c-a) points to. */
@@ -496,8 +607,12 @@ static int orient3(dvec3 a, dvec3 b, dvec3 c, dvec3 d) {
     double bx = b.x - a.x, by = b.y - a.y, bz = b.z - a.z;
     double cx = c.x - a.x, cy = c.y - a.y, cz = c.z - a.z;
     double dx = d.x - a.x, dy = d.y - a.y, dz = d.z - a.z;
-    double det = bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx);
-    return (det > 0.0) - (det < 0.0);
+    double m0 = cy * dz - cz * dy, m1 = cx * dz - cz * dx, m2 = cx * dy - cy * dx;
+    double det = bx * m0 - by * m1 + bz * m2;
+    double perm = fabs(bx) * (fabs(cy * dz) + fabs(cz * dy)) + fabs(by) * (fabs(cx * dz) + fabs(cz * dx)) +
+                  fabs(bz) * (fabs(cx * dy) + fabs(cy * dx));
+    if (fabs(det) > 1e-12 * perm) return (det > 0.0) - (det < 0.0);
+    return orient3_exact(a, b, c, d);
 }
 
 typedef struct dvec2 {
@@ -506,7 +621,11 @@ typedef struct dvec2 {
 
 static int orient2(dvec2 a, dvec2 b, dvec2 c) {
     double det = (b.u - a.u) * (c.v - a.v) - (b.v - a.v) * (c.u - a.u);
-    return (det > 0.0) - (det < 0.0);
+    double perm = fabs((b.u - a.u) * (c.v - a.v)) + fabs((b.v - a.v) * (c.u - a.u));
+    if (fabs(det) > 1e-12 * perm) return (det > 0.0) - (det < 0.0);
+    double p[2], q[2], r[2], s[2], out[32];
+    int np = diff2(b.u, a.u, p), nq = diff2(c.v, a.v, q), nr = diff2(b.v, a.v, r), ns = diff2(c.u, a.u, s);
+    return expansion_sign(out, cross_term(p, np, q, nq, r, nr, s, ns, out));
 }
 
 /* Drops coordinate axis (0 x, 1 y, 2 z). */
@@ -514,13 +633,18 @@ static dvec2 project2(dvec3 p, int axis) {
     return axis == 0 ? (dvec2){p.y, p.z} : axis == 1 ? (dvec2){p.z, p.x} : (dvec2){p.x, p.y};
 }
 
-/* Axis of the largest normal component of triangle (a, b, c); -1 when degenerate. */
+/* Axis of the largest normal component of triangle (a, b, c), among those whose exact sign is
+ * nonzero; -1 when the triangle is degenerate (collinear or repeated corners, decided exactly). */
 static int dominant_axis(dvec3 a, dvec3 b, dvec3 c) {
     double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
     double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
-    double nx = fabs(uy * vz - uz * vy), ny = fabs(uz * vx - ux * vz), nz = fabs(ux * vy - uy * vx);
-    if (nx == 0.0 && ny == 0.0 && nz == 0.0) return -1;
-    return nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
+    double n[3] = {fabs(uy * vz - uz * vy), fabs(uz * vx - ux * vz), fabs(ux * vy - uy * vx)};
+    int best = -1;
+    for (int k = 0; k < 3; ++k) {
+        if (orient2(project2(a, k), project2(b, k), project2(c, k)) == 0) continue;
+        if (best < 0 || n[k] > n[best]) best = k;
+    }
+    return best;
 }
 
 /* Closed point-in-triangle in 2D (triangle non-degenerate). */

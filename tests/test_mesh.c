@@ -683,9 +683,10 @@ AK_TEST(self_intersections_50k_fast_and_exact) {
                 AK_OK);
     double dt = ak_test_now_() - t0;
     AK_CHECK_EQ(n, 0);
+    printf("  50k-triangle sphere: %.3f s\n", dt);
     AK_CHECK_MSG(dt < 0.5, "50k triangles took %.3f s", dt);
     /* two small spheres side by side (centres 1.5 radii apart): the crossing circle */
-    ak_mesh* a = make_sphere(1.0f, 24, 32);
+    ak_mesh* a = make_sphere(1.0f, 12, 20);
     size_t vc = a->vertex_count, tc = a->triangle_count;
     ak_vec3* pos = (ak_vec3*)malloc(2 * vc * sizeof(ak_vec3));
     uint32_t* idx = (uint32_t*)malloc(6 * tc * sizeof(uint32_t));
@@ -698,7 +699,7 @@ AK_TEST(self_intersections_50k_fast_and_exact) {
             ak_vec3 B[3] = {pos[idx[3 * q]], pos[idx[3 * q + 1]], pos[idx[3 * q + 2]]};
             ref += ak_triangles_intersect(A, B);
         }
-    AK_CHECK(ref > 32); /* the circle crosses at least one triangle per longitude */
+    AK_CHECK(ref > 20); /* the circle crosses at least one triangle per longitude */
     AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){pos, 2 * vc}, (ak_u32_cspan){idx, 6 * tc}, (ak_u32_span){0}, &n),
                 AK_OK);
     AK_CHECK_EQ(n, ref);

@@ -125,10 +125,13 @@ AK_API double ak_volume_compute(ak_vec3_cspan positions, ak_u32_cspan indices);
  * adjacent when they share a vertex, by index or by position (vertices at bitwise-equal
  * positions count as one, so a UV seam's split vertices do not make neighbours look
  * intersecting). Triangles are closed sets: touching at a point or along an edge counts.
- * The test per pair is exact in its signs up to the rounding of double-precision orientation
- * determinants on the float input (Plucker-style edge/triangle tests; the coplanar case in 2D);
- * degenerate (zero-area) triangles never count. A uniform grid of triangle bounds finds the
- * candidate pairs (about 30 ms for 50k triangles). Temporary memory comes from malloc (about
+ * The test per pair is exact: orientation determinants are decided in double precision when
+ * an error bound allows and otherwise exactly (floating-point expansions), so coplanar and
+ * touching cases get the true answer (Plucker-style edge/triangle tests; the coplanar case in
+ * 2D); degenerate (zero-area) triangles never count. A uniform grid of triangle bounds finds the
+ * candidate pairs (about 30 ms for the 18k triangles of builtin:humanoid; meshes with large
+ * exactly planar regions take the exact path often: 1.1 s for a 51k-triangle faceted
+ * cylinder, one core). Temporary memory comes from malloc (about
  * 60 bytes per triangle and 12 per vertex). out_pairs is optional (count 0): the first
  * out_pairs.count / 2 pairs found are written as triangle indices (lower first), in an
  * unspecified but deterministic order; *out_count is always the full count.
