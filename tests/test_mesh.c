@@ -671,6 +671,38 @@ AK_TEST(self_intersections_meshes) {
     ak_mesh_destroy(c);
 }
 
+AK_TEST(self_intersections_flat_grid_is_clean) {
+    /* a tilted planar grid (coordinates not representable exactly: every orientation of
+     * non-adjacent triangles is exactly zero only in exact arithmetic): no pair intersects */
+    enum { G = 12 };
+    static ak_vec3 pos[(G + 1) * (G + 1)];
+    static uint32_t idx[6 * G * G];
+    for (int j = 0; j <= G; ++j)
+        for (int i = 0; i <= G; ++i) {
+            float x = 0.1f * (float)i, y = 0.1f * (float)j;
+            pos[j * (G + 1) + i] = ak_vec3_make(x, y, 0.3f * x + 0.7f * y); /* rounded: nearly planar */
+        }
+    size_t t = 0;
+    for (int j = 0; j < G; ++j)
+        for (int i = 0; i < G; ++i) {
+            uint32_t a = (uint32_t)(j * (G + 1) + i), b = a + 1, c = a + G + 1, d = c + 1;
+            idx[t++] = a, idx[t++] = b, idx[t++] = d, idx[t++] = a, idx[t++] = d, idx[t++] = c;
+        }
+    size_t n = 99;
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){pos, (G + 1) * (G + 1)}, (ak_u32_cspan){idx, t},
+                                           (ak_u32_span){0}, &n),
+                AK_OK);
+    AK_CHECK_EQ(n, 0);
+    /* a steep triangle through the surface crosses it */
+    ak_vec3 m[3] = {{0.55f, 0.55f, 0.0f}, {0.65f, 0.55f, 1.0f}, {0.6f, 0.65f, 1.0f}};
+    size_t hits = 0;
+    for (size_t k = 0; k < t / 3; ++k) {
+        ak_vec3 T[3] = {pos[idx[3 * k]], pos[idx[3 * k + 1]], pos[idx[3 * k + 2]]};
+        hits += ak_triangles_intersect(T, m);
+    }
+    AK_CHECK(hits >= 1);
+}
+
 AK_TEST(self_intersections_50k_fast_and_exact) {
     /* a 50k-triangle sphere has none; a copy shifted by 1/2 radius crosses it along a circle:
      * each crossing pair found is confirmed by the pair test, and the timing stays low */
@@ -725,6 +757,7 @@ int main(void) {
     AK_RUN(triangle_pairs_constructed);
     AK_RUN(self_intersections_soup_matches_brute_force);
     AK_RUN(self_intersections_meshes);
+    AK_RUN(self_intersections_flat_grid_is_clean);
     AK_RUN(self_intersections_50k_fast_and_exact);
     return ak_test_finish();
 }
