@@ -201,9 +201,10 @@ AK_TEST(bent_cylinder_methods) {
                r[2].volume_ratio);
         AK_CHECK(r[0].crossings > 0 && r[1].crossings > 0);
         for (size_t v = 0; v < c.mesh->vertex_count; ++v) AK_CHECK(ak_vec3_is_finite(out[v]));
-        /* measured: 3.6% at 120 and 4.2% at 150 (the issue's target of 3% is not met yet, nor
-         * zero crossings): a regression guard at 6% */
-        AK_CHECK(fabs(r[2].volume_ratio - 1.0) < 0.06);
+        /* measured: -5.5% at 120 and +1.8% at 150 (the issue's target of 3% is not met at 120,
+         * nor zero crossings: the contact sheets of both sides land on one surface): a
+         * regression guard at 7% */
+        AK_CHECK(fabs(r[2].volume_ratio - 1.0) < 0.07);
     }
     free(out);
     cyl_free(&c);
@@ -222,7 +223,7 @@ AK_TEST(twist_180_does_not_collapse) {
     printf("  twist 180: min radius LBS %.3f implicit %.3f, implicit crossings %zu\n", (double)lbs.min_radius,
            (double)imp.min_radius, imp.crossings);
     AK_CHECK(lbs.min_radius < 0.1f); /* the candy wrapper */
-    AK_CHECK(imp.min_radius > 0.7f);
+    AK_CHECK(imp.min_radius > 0.9f); /* measured 0.96 */
     AK_CHECK(fabs(imp.volume_ratio - 1.0) < 0.03);
     free(out);
     cyl_free(&c);

@@ -444,7 +444,12 @@ typedef struct ak_skin_implicit_job {
     uint32_t thread_count;       /* 0 or 1 -> calling thread; n (<= 64) -> n vertex ranges */
     ak_u8_span scratch;          /* >= ak_skin_implicit_scratch_size(implicit, palette.count) */
     ak_vec3_span out_positions;  /* required: count >= vertex count */
-    ak_vec3_span out_normals;    /* optional: area-weighted normals of the result (welded) */
+    ak_vec3_cspan normals;       /* optional: unit bind-space normals (count >= vertex count),
+                                    rotated by DQS where the projection leaves the surface as
+                                    it is */
+    ak_vec3_span out_normals;    /* optional: normals of the result: area-weighted face normals
+                                    (welded) around moved vertices, elsewhere the rotated input
+                                    normals (all face normals without input normals) */
     size_t* out_moved;           /* optional: vertices the projection moved */
 } ak_skin_implicit_job;
 
@@ -452,7 +457,7 @@ typedef struct ak_skin_implicit_job {
 AK_API size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count);
 
 /* Deform. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (thread_count > 64), AK_ERR_SPAN_SMALL
- * (palette, scratch or an output), AK_ERR_BAD_DATA (a palette matrix not finite or not
+ * (palette, scratch, normals or an output), AK_ERR_BAD_DATA (a palette matrix not finite or not
  * invertible); writes nothing on error. Never allocates except thread stacks. */
 AK_API ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job);
 

@@ -20,10 +20,9 @@
 #define MAX_CAPS 16
 #define STOP_COS 0.57357643635f /* cos 55 degrees: the 2014 paper's discontinuity angle */
 #define ISO_EPS 1e-4f
-#define MAX_CAP_PLANES 8
-#define CAPSULE_AT (12 + 4 * MAX_CAP_PLANES)
-#define BONE_FLOATS (CAPSULE_AT + 8) /* cx cy cz s | ax ay az b | r sphere2 valid caps | cap planes
-                                        (nx ny nz offset) | capsule a(3) b(3) radius pad, bind space */
+#define CAPSULE_AT 12
+#define BONE_FLOATS (CAPSULE_AT + 8) /* cx cy cz s | ax ay az b | r sphere2 valid pad |
+                                        capsule a(3) b(3) radius pad, bind space */
 #define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
 
 struct ak_skin_implicit {
@@ -132,15 +131,8 @@ static bool bone_distance(const ak_skin_implicit* o, size_t b, ak_vec3 y, float*
         gx += k1 * vx + k2 * bx, gy += k1 * vy + k2 * by, gz += k1 * vz + k2 * bz;
     }
     d *= B[3];
-    /* the HRBF of an open part extrapolates badly past its holes: intersect with the caps'
-     * half-spaces (the larger of the two distances) */
-    const uint32_t caps = (uint32_t)B[11];
-    for (uint32_t k = 0; k < caps && k < MAX_CAP_PLANES; ++k) {
-        const float* P = B + 12 + 4 * k;
-        float dp = P[0] * y.x + P[1] * y.y + P[2] * y.z - P[3];
-        if (dp > d) d = dp, gx = P[0], gy = P[1], gz = P[2];
-    }
-    /* and with a capsule around the part: no phantom surface far from it */
+    /* the HRBF of an open part extrapolates badly past its holes and far from its samples:
+     * intersect it with a capsule around the part (the larger of the two distances) */
     {
         const float* K = B + CAPSULE_AT;
         ak_vec3 a = ak_vec3_make(K[0], K[1], K[2]), ab = ak_vec3_make(K[3] - K[0], K[4] - K[1], K[5] - K[2]);
@@ -373,8 +365,7 @@ static void fit_bone(fit_shared* sh, size_t b, double* A, double* rhs, float* mi
     }
     /* each cap is a small disk: its centre and six points at 0.6 of the hole's mean radius,
      * all with the cap's normal (the hole's centre minus the part's centroid) */
-    size_t n = 0, planes = 0;
-    float plane[MAX_CAP_PLANES][4];
+    size_t n = 0;
     const size_t cap_max = sh->spb / 3;
     for (uint32_t k = 0; k < caps && n + 7 <= cap_max; ++k) {
         double h[3], d[3];
@@ -394,11 +385,6 @@ static void fit_bone(fit_shared* sh, size_t b, double* A, double* rhs, float* mi
             hr += sqrt(fmax(0.0, w[0] * w[0] + w[1] * w[1] + w[2] * w[2] - al * al));
         }
         hr /= cap_n[k];
-        if (planes < MAX_CAP_PLANES) {
-            plane[planes][0] = (float)d[0], plane[planes][1] = (float)d[1], plane[planes][2] = (float)d[2];
-            plane[planes][3] = (float)(d[0] * h[0] + d[1] * h[1] + d[2] * h[2]);
-            ++planes;
-        }
         /* two unit vectors spanning the cap's plane */
         double t1[3] = {fabs(d[0]) < 0.9 ? 1.0 : 0.0, fabs(d[0]) < 0.9 ? 0.0 : 1.0, 0.0}, t2[3];
         double dp = t1[0] * d[0] + t1[1] * d[1] + t1[2] * d[2];
@@ -508,13 +494,15 @@ static void fit_bone(fit_shared* sh, size_t b, double* A, double* rhs, float* mi
     double sph = reach + 1.5 * support / s;
     B[9] = (float)(sph * sph);
     B[10] = 1.0f;
-    B[11] = (float)planes;
     {
         float* K = B + CAPSULE_AT;
-        for (int q = 0; q < 3; ++q) K[q] = (float)(c[q] + tmin * ax[q]), K[3 + q] = (float)(c[q] + tmax * ax[q]);
-        K[6] = (float)(rmax + 0.25 * support);
+        /* hemispherical ends inside the part's extent, so that past a hole the part closes
+         * round (the paper's capped HRBFs) and never reaches into the neighbour's side */
+        double rk = rmax + 0.25 * support, t0 = tmin + 0.5 * rk, t1 = tmax - 0.5 * rk;
+        if (t0 > t1) t0 = t1 = 0.5 * (tmin + tmax);
+        for (int q = 0; q < 3; ++q) K[q] = (float)(c[q] + t0 * ax[q]), K[3 + q] = (float)(c[q] + t1 * ax[q]);
+        K[6] = (float)rk;
     }
-    memcpy(B + 12, plane, planes * 4 * sizeof(float));
 }
 
 static void* fit_worker(void* arg) {
@@ -996,7 +984,7 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     if (job->thread_count > 64) return AK_ERR_BAD_ARG;
     const size_t nv = o->vertex_count;
     if (job->palette.count < o->joint_count || job->out_positions.count < nv ||
-        (job->out_normals.ptr && job->out_normals.count < nv) ||
+        (job->out_normals.ptr && job->out_normals.count < nv) || (job->normals.ptr && job->normals.count < nv) ||
         job->scratch.count < ak_skin_implicit_scratch_size(o, job->palette.count))
         return AK_ERR_SPAN_SMALL;
     unsigned char* base = (unsigned char*)align64((size_t)job->scratch.ptr);
@@ -1026,6 +1014,10 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
         .scratch = {dq_scratch, dq_size},
         .out_positions = {job->out_positions.ptr, nv, 0},
     };
+    if (job->normals.ptr && job->out_normals.ptr) {
+        dq.normals = (ak_cstream){job->normals.ptr, nv, 0};
+        dq.out_normals = (ak_stream){job->out_normals.ptr, nv, 0};
+    }
     ak_result r = ak_skin_job_run(&dq);
     if (r != AK_OK) return r;
     ak_vec3* pos = job->out_positions.ptr;
@@ -1046,22 +1038,36 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     }
     if (job->out_moved) *job->out_moved = moved;
     if (job->out_normals.ptr) {
+        /* face normals (welded) where the projection moved a corner of a triangle; elsewhere the
+         * DQS-rotated input normals when given */
         ak_vec3* n = job->out_normals.ptr;
-        for (size_t v = 0; v < nv; ++v) n[v] = ak_vec3_zero();
+        const bool all = job->normals.ptr == NULL;
+        for (size_t t = 0; t < o->triangle_count && !all; ++t) {
+            const uint32_t* ix = o->indices + 3 * t;
+            uint32_t a = o->rep[ix[0]], b = o->rep[ix[1]], cc = o->rep[ix[2]];
+            bool moved = (state[a] & 3) == ST_MOVED || (state[a] & 3) == ST_STOPPED || (state[b] & 3) == ST_MOVED ||
+                         (state[b] & 3) == ST_STOPPED || (state[cc] & 3) == ST_MOVED || (state[cc] & 3) == ST_STOPPED;
+            if (moved) state[a] |= 4, state[b] |= 4, state[cc] |= 4;
+        }
+        for (size_t v = 0; v < nv; ++v)
+            if (all || (state[v] & 4)) n[v] = ak_vec3_zero();
         for (size_t t = 0; t < o->triangle_count; ++t) {
             const uint32_t* ix = o->indices + 3 * t;
             uint32_t a = o->rep[ix[0]], b = o->rep[ix[1]], cc = o->rep[ix[2]];
+            if (!all && !((state[a] | state[b] | state[cc]) & 4)) continue;
             ak_vec3 fn = ak_vec3_cross(ak_vec3_sub(pos[b], pos[a]), ak_vec3_sub(pos[cc], pos[a]));
             if (!ak_vec3_is_finite(fn)) continue;
-            n[a] = ak_vec3_add(n[a], fn), n[b] = ak_vec3_add(n[b], fn), n[cc] = ak_vec3_add(n[cc], fn);
+            if (all || (state[a] & 4)) n[a] = ak_vec3_add(n[a], fn);
+            if (all || (state[b] & 4)) n[b] = ak_vec3_add(n[b], fn);
+            if (all || (state[cc] & 4)) n[cc] = ak_vec3_add(n[cc], fn);
         }
         for (size_t v = 0; v < nv; ++v) {
-            if (o->rep[v] != v) continue;
+            if (o->rep[v] != v || !(all || (state[v] & 4))) continue;
             float l = ak_vec3_length(n[v]);
             n[v] = l > 1e-30f && ak_finitef(l) ? ak_vec3_scale(n[v], 1.0f / l) : ak_vec3_make(0, 1, 0);
         }
         for (size_t v = 0; v < nv; ++v)
-            if (o->rep[v] != v) n[v] = n[o->rep[v]];
+            if (o->rep[v] != v && (all || (state[o->rep[v]] & 4))) n[v] = n[o->rep[v]];
     }
     return AK_OK;
 }
