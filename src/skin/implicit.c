@@ -850,7 +850,24 @@ ak_result ak_skin_implicit_read_file(const char* path, uint64_t key, const ak_al
                     o->bones[b * BONE_FLOATS + 8] <= 0.0f)
                     if (o->bones[b * BONE_FLOATS + 10] != 0.0f) r = AK_ERR_PARSE;
             if (r == AK_OK && o->sample_start[c.joint_count] > c.sample_capacity) r = AK_ERR_PARSE;
-            if (r == AK_OK && !(o->step_cap >= 0.0f && o->bulge >= 0.0f && o->bulge <= 10.0f)) r = AK_ERR_PARSE;
+            if (r == AK_OK && !(o->step_cap >= 0.0f && o->step_cap < 1e30f && o->bulge >= 0.0f && o->bulge <= 10.0f))
+                r = AK_ERR_PARSE;
+            /* every float finite, every valid bone's scale and radius positive, weights valid */
+            for (size_t i = 0; r == AK_OK && i < c.sample_capacity * SAMPLE_FLOATS; ++i)
+                if (!ak_finitef(o->samples[i]) || fabsf(o->samples[i]) > 1e15f) r = AK_ERR_PARSE;
+            for (size_t i = 0; r == AK_OK && i < c.joint_count * BONE_FLOATS; ++i)
+                if (!ak_finitef(o->bones[i]) || fabsf(o->bones[i]) > 1e15f) r = AK_ERR_PARSE;
+            for (size_t b = 0; r == AK_OK && b < c.joint_count; ++b)
+                if (o->bones[b * BONE_FLOATS + 10] != 0.0f &&
+                    !(o->bones[b * BONE_FLOATS + 3] > 1e-20f && o->bones[b * BONE_FLOATS + 8] > 1e-20f))
+                    r = AK_ERR_PARSE;
+            for (size_t v = 0; r == AK_OK && v < c.vertex_count; ++v)
+                if (!ak_finitef(o->iso[v])) r = AK_ERR_PARSE;
+            if (r == AK_OK &&
+                ak_skin_weights_validate((ak_u16_cspan){o->joints, c.vertex_count * c.influence_count},
+                                         (ak_f32_cspan){o->weights, c.vertex_count * c.influence_count}, c.vertex_count,
+                                         c.influence_count, c.joint_count, 0.0f, NULL) != AK_OK)
+                r = AK_ERR_PARSE;
         }
     }
     fclose(f);
@@ -922,6 +939,11 @@ static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, 
         gprev = g;
         if (st == ST_KEEP) st = ST_MOVED;
     }
+    if (!ak_vec3_is_finite(x) || !ak_vec3_is_finite(g)) { /* never NaN out: keep the start */
+        x = *p;
+        g = ak_vec3_zero();
+        st = ST_STOPPED;
+    }
     *p = x;
     *out_g = g;
     return st;
@@ -952,7 +974,8 @@ static void* run_worker(void* arg) {
             ak_vec3 d = ak_vec3_sub(ak_vec3_scale(sum, 1.0f / (float)(b - a)), c->prev[v]);
             ak_vec3 n = ak_vec3_normalize(c->grad[v]);
             d = ak_vec3_sub(d, ak_vec3_scale(n, ak_vec3_dot(d, n)));
-            c->pos[v] = ak_vec3_add(c->prev[v], ak_vec3_scale(d, 0.5f));
+            ak_vec3 q = ak_vec3_add(c->prev[v], ak_vec3_scale(d, 0.5f));
+            c->pos[v] = ak_vec3_is_finite(q) ? q : c->prev[v];
         } else {
             if (c->state[v] == ST_KEEP) continue;
             uint8_t st = project(c, o->iso[v], &c->pos[v], &c->grad[v], false);
