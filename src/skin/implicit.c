@@ -845,10 +845,10 @@ ak_result ak_skin_implicit_read_file(const char* path, uint64_t key, const ak_al
                 if (o->adj[i] >= c.vertex_count) r = AK_ERR_PARSE;
             for (size_t i = 0; r == AK_OK && i < c.vertex_count * c.influence_count; ++i)
                 if (o->joints[i] >= c.joint_count) r = AK_ERR_PARSE;
+            /* sample ranges: non-decreasing from 0, the last within the capacity */
+            if (r == AK_OK && o->sample_start[0] != 0) r = AK_ERR_PARSE;
             for (size_t b = 0; r == AK_OK && b < c.joint_count; ++b)
-                if (o->sample_start[b] > o->sample_start[b + 1] || o->bones[b * BONE_FLOATS + 3] <= 0.0f ||
-                    o->bones[b * BONE_FLOATS + 8] <= 0.0f)
-                    if (o->bones[b * BONE_FLOATS + 10] != 0.0f) r = AK_ERR_PARSE;
+                if (o->sample_start[b] > o->sample_start[b + 1]) r = AK_ERR_PARSE;
             if (r == AK_OK && o->sample_start[c.joint_count] > c.sample_capacity) r = AK_ERR_PARSE;
             if (r == AK_OK && !(o->step_cap >= 0.0f && o->step_cap < 1e30f && o->bulge >= 0.0f && o->bulge <= 10.0f))
                 r = AK_ERR_PARSE;
