@@ -10,7 +10,10 @@
  *     vertices (AVX-512 or AVX2+FMA chosen at run time; scalar reference always built, forced by
  *     AK_NO_SIMD or job.skip_simd);
  *   - the CoR precomputation (per-vertex centers), pruned by bone pair and multithreaded, with
- *     a cache format keyed by a hash of the mesh and weights.
+ *     a cache format keyed by a hash of the mesh and weights;
+ *   - implicit skinning (Vaillant et al. 2013/2014): per-bone HRBF fields composed with a
+ *     contact operator, vertices projected from DQS onto their rest iso-values
+ *     (ak_skin_implicit_*, cached like CoR's centers).
  *
  * What it does NOT do: build the palette (scene.h's ak_scene_skin_palette does for a scene:
  * M_k = world(skin.joints[k]) * skin.inverse_binds[k]), read asset files (io.h), or measure
@@ -349,6 +352,114 @@ AK_API ak_result ak_skin_job_split(const ak_skin_job* job, size_t first_vertex, 
 /* Name of the fastest kernel ak_skin_job_run can use on this CPU: "avx512", "avx2" or
  * "scalar" (AK_NO_SIMD builds: "scalar"). */
 AK_API const char* ak_skin_simd_name(void);
+
+/* ---- implicit skinning ------------------------------------------------------------------
+ * Vaillant et al. 2013 ("Implicit Skinning: Real-Time Skin Deformation with Contact
+ * Modeling") and 2014 ("Robust Iso-Surface Tracking for Interactive Character Skinning").
+ *
+ * Precompute (ak_skin_implicit_create): the mesh is segmented by dominant joint; each part
+ * gets a Hermite RBF implicit (phi(r) = r^3 plus a linear polynomial) fitted to up to
+ * samples_per_bone of its vertices (farthest-point sampled, welded area-weighted normals) and
+ * one cap sample per hole where it meets another part (the hole's centre, normal pointing out
+ * of the part), closing it as the paper does; the HRBF distance d is reparameterised to
+ * compact support f = t(d / r) in [0, 1] (1 inside, 0.5 on the surface, 0 beyond r outside;
+ * t a C2 quintic; r = support_scale times the part's mean distance to its principal axis).
+ * Each vertex keeps its rest iso-value F(v) of the composed field.
+ *
+ * Per frame (ak_skin_implicit_run): field j moves rigidly with palette matrix M_j (evaluated
+ * at M_j^-1 x); fields compose by union (max), plus, where the two strongest fields meet
+ * with opposing gradients (a contact: elbow, knee), a bulge term bulge * w * min(f1, f2)^2,
+ * w = max(0, -cos angle(grad f1, grad f2)), that swells the skin beside the contact instead
+ * of letting it sink. Vertices start from DQS, march along the gradient to their rest
+ * iso-value (Newton steps), stop where the gradient turns by more than 55 degrees (the 2014
+ * rule at gradient discontinuities: the contact surface), then alternate tangential
+ * relaxation (towards the one-ring centroid, in the tangent plane) and re-projection.
+ * Vertices whose DQS position is already at their iso-value (within 1e-4) keep it, so the
+ * bind pose reproduces the mesh exactly. Split vertices (same bind position) move together.
+ * Multithreaded by vertex ranges with the same result on any thread count. */
+
+typedef struct ak_skin_implicit ak_skin_implicit;
+
+typedef struct ak_skin_implicit_desc {
+    ak_vec3_cspan positions;  /* required: bind-space positions */
+    ak_u32_cspan indices;     /* required: triangles, 3 per, counter-clockwise from outside */
+    ak_u16_cspan joints;      /* required: vertex_count * influence_count */
+    ak_f32_cspan weights;     /* required: same layout, valid (ak_skin_weights_validate) */
+    uint32_t influence_count; /* required: 1..AK_MAX_INFLUENCES */
+    size_t joint_count;       /* required: palette size (joint indices are below it) */
+    uint32_t samples_per_bone; /* HRBF samples per part, caps included; 0 -> 48; 8..256 */
+    float support_scale;      /* r relative to the part's mean radius; 0 -> 0.5 */
+    uint32_t thread_count;    /* fitting threads; 0 -> 2; 1 -> calling thread only */
+    float bulge;              /* contact bulge strength; 0 -> 0.5; negative -> none (plain
+                                 union); at most 10 */
+} ak_skin_implicit_desc;
+
+/* The desc with every zero field replaced by its documented default. */
+AK_API ak_skin_implicit_desc ak_skin_implicit_desc_resolved(const ak_skin_implicit_desc* desc);
+
+/* 64-bit FNV-1a hash of the inputs and resolved parameters: the key of a cached precompute.
+ * 0 for a NULL desc. */
+AK_API uint64_t ak_skin_implicit_key(const ak_skin_implicit_desc* desc);
+
+/* Segment, fit one HRBF per part and store the rest iso-values (one allocation; the object
+ * keeps copies of the arrays it needs and is then read-only, shareable between threads).
+ * Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no vertices or triangles), AK_ERR_BAD_ARG
+ * (influence_count, indices.count % 3, samples_per_bone, support_scale or bulge out of range,
+ * joint_count 0 or > 65535, more than 64 threads), AK_ERR_SPAN_SMALL, AK_ERR_BAD_INDEX
+ * (triangle or joint index), AK_ERR_BAD_WEIGHTS, AK_ERR_BAD_DATA (NaN position),
+ * AK_ERR_BUDGET (more than 2^24 vertices), AK_ERR_NO_MEMORY. *out is NULL on failure. */
+AK_API ak_result ak_skin_implicit_create(const ak_skin_implicit_desc* desc, const ak_allocator* alloc,
+                                         ak_skin_implicit** out_implicit);
+/* NULL is a no-op. */
+AK_API void ak_skin_implicit_destroy(ak_skin_implicit* implicit);
+/* Vertex count and part (dominant joint) of vertex v, for viewers and tests; UINT16_MAX when
+ * v is out of range. */
+AK_API size_t ak_skin_implicit_vertex_count(const ak_skin_implicit* implicit);
+AK_API uint16_t ak_skin_implicit_part(const ak_skin_implicit* implicit, size_t vertex_index);
+/* Rest iso-value of vertex v (0 when out of range). */
+AK_API float ak_skin_implicit_iso(const ak_skin_implicit* implicit, size_t vertex_index);
+/* The composed field and its gradient at point x under palette (palette.count >= the
+ * object's joint_count); the bind pose when palette.ptr is NULL. */
+AK_API float ak_skin_implicit_field(const ak_skin_implicit* implicit, ak_mat4_cspan palette, ak_vec3 x,
+                                    ak_vec3* out_gradient);
+
+/* Serialise the object with its key into a file ("AKIS" v1, little-endian; malloc'd buffer)
+ * and read it back: read gives AK_ERR_NOT_FOUND when the stored key differs (a stale
+ * cache), AK_ERR_PARSE for a malformed file, AK_ERR_IO, AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_skin_implicit_write_file(const ak_skin_implicit* implicit, uint64_t key, const char* path);
+AK_API ak_result ak_skin_implicit_read_file(const char* path, uint64_t key, const ak_allocator* alloc,
+                                            ak_skin_implicit** out_implicit);
+/* Read the object from cache_path when its key matches ak_skin_implicit_key(desc), else
+ * create it and write the file (a failed write is not an error). *out_from_cache (optional)
+ * says which happened. Codes of ak_skin_implicit_create. */
+AK_API ak_result ak_skin_implicit_cached(const ak_skin_implicit_desc* desc, const char* cache_path,
+                                         const ak_allocator* alloc, ak_skin_implicit** out_implicit,
+                                         bool* out_from_cache);
+
+typedef struct ak_skin_implicit_job {
+    const ak_skin_implicit* implicit; /* required */
+    ak_mat4_cspan palette;       /* required: skinning matrices (count >= joint_count) */
+    uint32_t iterations;         /* Newton steps per projection; 0 -> 10 */
+    uint32_t relax_rounds;       /* relaxation + re-projection rounds; 0 -> 3 (UINT32_MAX -> none) */
+    uint32_t thread_count;       /* 0 or 1 -> calling thread; n (<= 64) -> n vertex ranges */
+    ak_u8_span scratch;          /* >= ak_skin_implicit_scratch_size(implicit, palette.count) */
+    ak_vec3_span out_positions;  /* required: count >= vertex count */
+    ak_vec3_cspan normals;       /* optional: unit bind-space normals (count >= vertex count),
+                                    rotated by DQS where the projection leaves the surface as
+                                    it is */
+    ak_vec3_span out_normals;    /* optional: normals of the result: area-weighted face normals
+                                    (welded) around moved vertices, elsewhere the rotated input
+                                    normals (all face normals without input normals) */
+    size_t* out_moved;           /* optional: vertices the projection moved */
+} ak_skin_implicit_job;
+
+/* Bytes of scratch a run needs (0 for a NULL object). */
+AK_API size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count);
+
+/* Deform. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (thread_count > 64), AK_ERR_SPAN_SMALL
+ * (palette, scratch, normals or an output), AK_ERR_BAD_DATA (a palette matrix not finite or not
+ * invertible); writes nothing on error. Never allocates except thread stacks. */
+AK_API ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job);
 
 #ifdef __cplusplus
 }

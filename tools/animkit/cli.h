@@ -141,7 +141,7 @@ bool cli_mkdir_p(const char* path);
 
 /* ---- posing: sample a clip, FK, morph, skin (the pipeline every command shares) ---- */
 
-typedef enum cli_method { CLI_LBS = 0, CLI_DQS, CLI_COR } cli_method;
+typedef enum cli_method { CLI_LBS = 0, CLI_DQS, CLI_COR, CLI_IMPLICIT } cli_method;
 
 /* Per-scene working state for posing. */
 typedef struct cli_poser {
@@ -156,6 +156,9 @@ typedef struct cli_poser {
     ak_vec3* morphed;         /* scratch [max vertices] */
     ak_vec3* morphed_normals; /* scratch [max vertices] */
     ak_vec3** cor_centers;    /* per mesh, computed on first CoR use; NULL until then */
+    ak_skin_implicit** implicit; /* per mesh, precomputed on first implicit use */
+    uint8_t* implicit_scratch;   /* grown on use */
+    size_t implicit_scratch_size;
     uint8_t* skin_scratch;    /* DQS/CoR scratch for the largest skin, allocated once */
     size_t skin_scratch_size;
     /* Set by the caller after init: unskinned meshes without stored normals get normals shared

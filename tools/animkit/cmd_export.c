@@ -6,7 +6,7 @@
 
 static const char* const usage =
     "usage: animkit export FILE|builtin:NAME [--clip N|NAME] [--time T] [--bind]\n"
-    "                      [--method lbs|dqs|cor] -o OUT.obj|OUT.glb|OUT.gltf\n"
+    "                      [--method lbs|dqs|cor|implicit] -o OUT.obj|OUT.glb|OUT.gltf\n"
     "OUT.glb / OUT.gltf (+ OUT.bin): the whole scene as glTF 2.0 (every node, skin, mesh, morph\n"
     "target and clip; keys kept as they are); --clip, --time, --bind and --method apply to OBJ.\n"
     "Write the meshes posed at time T (default 0) of a clip (default the first) as OBJ with\n"
@@ -68,7 +68,7 @@ int cmd_export(int argc, char** argv) {
         return cli_usage("export", "--time '%s' is not a number", CLI_GET(&a, "--time"));
     cli_method method = CLI_LBS;
     if (CLI_GET(&a, "--method") && !cli_method_parse(CLI_GET(&a, "--method"), &method))
-        return cli_usage("export", "--method must be lbs, dqs or cor, not '%s'", CLI_GET(&a, "--method"));
+        return cli_usage("export", "--method must be lbs, dqs, cor or implicit, not '%s'", CLI_GET(&a, "--method"));
     bool bind = CLI_GET(&a, "--bind") != NULL;
 
     ak_scene* s = NULL;

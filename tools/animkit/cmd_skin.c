@@ -1,4 +1,5 @@
-/* animkit skin --compare: LBS vs DQS vs CoR on the classic poses: volume and bulge. */
+/* animkit skin --compare: LBS vs DQS vs CoR vs implicit on the classic poses: volume, bulge,
+ * collapse and self-intersections. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,21 +8,36 @@
 
 static const char* const usage =
     "usage: animkit skin --compare [FILE|builtin:NAME] [--json]\n"
-    "Compare linear blend (LBS), dual quaternion (DQS) and optimized-center (CoR) skinning.\n"
-    "On builtin:cylinder (the default) the middle joint is bent 90 degrees and twisted 90 and\n"
-    "180 degrees (179.8, so the turn has a defined direction); for each pose and method it\n"
-    "prints the volume of the deformed closed mesh relative to rest and the maximum bulge: the\n"
-    "largest distance of a vertex from the posed bone axis beyond the rest radius, as a\n"
-    "fraction of that radius, and the minimum radius (the narrowest cross-section: the\n"
-    "candy-wrapper collapse).\n"
+    "Compare linear blend (LBS), dual quaternion (DQS), optimized-center (CoR) and implicit\n"
+    "(Vaillant et al. 2013/2014) skinning.\n"
+    "On builtin:cylinder (the default) the middle joint is bent 90, 120 and 150 degrees and\n"
+    "twisted 90 and 180 degrees (179.8, so the turn has a defined direction); for each pose and\n"
+    "method it prints the volume of the deformed closed mesh relative to rest, the maximum\n"
+    "bulge: the largest distance of a vertex from the posed bone axis beyond the rest radius, as\n"
+    "a fraction of that radius, the minimum radius (the narrowest cross-section: the\n"
+    "candy-wrapper collapse) and the number of intersecting pairs of non-adjacent triangles\n"
+    "(exact test, ak_mesh_self_intersections).\n"
     "On another model it samples every clip at 24 times and prints, per method, the range of\n"
-    "the volume ratio (closed meshes only) and the largest distance from the LBS result.\n"
+    "the volume ratio (closed meshes only), the largest distance from the LBS result and the\n"
+    "most self-intersecting triangle pairs (every 4th frame).\n"
     "  --json  one JSON object instead: {\"model\", \"rest_volume\", \"rest_radius\", \"poses\":\n"
-    "          [{\"pose\", \"LBS\"|\"DQS\"|\"CoR\": {\"volume_ratio\", \"max_bulge\", \"min_radius\"}}]}\n"
-    "          for the cylinder; {\"model\", \"methods\": [{\"method\", \"max_distance_from_lbs\",\n"
-    "          \"volume_min\", \"volume_max\"}]} for another model (volumes for closed meshes)\n";
+    "          [{\"pose\", \"LBS\"|\"DQS\"|\"CoR\"|\"implicit\": {\"volume_ratio\", \"volume_change\",\n"
+    "          \"max_bulge\", \"min_radius\", \"self_intersections\"}}]} for the cylinder;\n"
+    "          {\"model\", \"methods\": [{\"method\", \"max_distance_from_lbs\", \"volume_min\",\n"
+    "          \"volume_max\", \"self_intersections_max\"}]} for another model (volumes for closed\n"
+    "          meshes)\n";
 
-static const cli_method methods[3] = {CLI_LBS, CLI_DQS, CLI_COR};
+#define METHOD_COUNT 4
+static const cli_method methods[METHOD_COUNT] = {CLI_LBS, CLI_DQS, CLI_COR, CLI_IMPLICIT};
+
+/* Pairs of non-adjacent triangles of mesh that intersect at pos (exact count, mesh.h). */
+static size_t crossings(const ak_mesh* m, const ak_vec3* pos) {
+    size_t n = 0;
+    if (ak_mesh_self_intersections((ak_vec3_cspan){pos, m->vertex_count}, (ak_u32_cspan){m->indices, m->triangle_count * 3},
+                                   (ak_u32_span){NULL, 0}, &n) != AK_OK)
+        return 0;
+    return n;
+}
 
 /* Distance from p to segment ab. */
 static float seg_dist(ak_vec3 p, ak_vec3 a, ak_vec3 b) {
@@ -73,18 +89,20 @@ static int compare_cylinder(ak_scene* s, bool json) {
     struct {
         const char* name;
         ak_quat rot;
-    } poses[3] = {
+    } poses[5] = {
         {"bend 90", ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), AK_HALF_PI)},
+        {"bend 120", ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), AK_PI * 2.0f / 3.0f)},
+        {"bend 150", ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), AK_PI * 5.0f / 6.0f)},
         {"twist 90", ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), AK_HALF_PI)},
         {"twist 180", ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), AK_PI * 0.999f)},
     };
     if (json) printf("{\"model\": \"%s\", \"rest_volume\": %.9g, \"rest_radius\": %.9g, \"poses\": [", s->name,
                      rest_volume, (double)radius);
-    else printf("%s: rest volume %.6g, rest radius %.4g\n%-10s %-4s %12s %12s %12s\n", s->name, rest_volume, (double)radius,
-                "pose", "", "volume/rest", "max bulge", "min radius");
-    for (int k = 0; k < 3 && rc == CLI_OK; ++k) {
+    else printf("%s: rest volume %.6g, rest radius %.4g\n%-10s %-8s %12s %12s %12s %10s\n", s->name, rest_volume, (double)radius,
+                "pose", "", "volume/rest", "max bulge", "min radius", "crossings");
+    for (int k = 0; k < 5 && rc == CLI_OK; ++k) {
         if (json) printf("%s{\"pose\": \"%s\"", k ? ", " : "", poses[k].name);
-        for (int mi = 0; mi < 3; ++mi) {
+        for (int mi = 0; mi < METHOD_COUNT; ++mi) {
             cli_poser_sample(&p, -1, 0.0f, true);
             p.local[mid].rotation = ak_quat_mul(p.local[mid].rotation, poses[k].rot);
             ak_result r = cli_poser_deform(&p, false, methods[mi]);
@@ -100,12 +118,14 @@ static int compare_cylinder(ak_scene* s, bool json) {
                 bulge = ak_maxf(bulge, dv - radius);
                 if (side[v]) narrowest = ak_minf(narrowest, dv);
             }
+            size_t cross = crossings(mesh, p.positions[0]);
             if (json)
-                printf(", \"%s\": {\"volume_ratio\": %.9g, \"max_bulge\": %.9g, \"min_radius\": %.9g}",
-                       cli_method_name(methods[mi]), vol, (double)(bulge / radius), (double)(narrowest / radius));
+                printf(", \"%s\": {\"volume_ratio\": %.9g, \"volume_change\": %.9g, \"max_bulge\": %.9g, \"min_radius\": %.9g, "
+                       "\"self_intersections\": %zu}",
+                       cli_method_name(methods[mi]), vol, vol - 1.0, (double)(bulge / radius), (double)(narrowest / radius), cross);
             else
-                printf("%-10s %-4s %12.4f %11.2f%% %11.2f%%\n", mi == 0 ? poses[k].name : "", cli_method_name(methods[mi]),
-                       vol, 100.0 * (double)(bulge / radius), 100.0 * (double)(narrowest / radius));
+                printf("%-10s %-8s %12.4f %11.2f%% %11.2f%% %10zu\n", mi == 0 ? poses[k].name : "", cli_method_name(methods[mi]),
+                       vol, 100.0 * (double)(bulge / radius), 100.0 * (double)(narrowest / radius), cross);
         }
         if (json) printf("}");
     }
@@ -120,8 +140,10 @@ static int compare_generic(ak_scene* s, bool json) {
     cli_poser p;
     if (cli_poser_init(&p, s)) return cli_fail("skin", "out of memory");
     int rc = CLI_OK;
-    double vmin[3] = {INFINITY, INFINITY, INFINITY}, vmax[3] = {-INFINITY, -INFINITY, -INFINITY};
-    float dmax[3] = {0, 0, 0};
+    double vmin[METHOD_COUNT] = {INFINITY, INFINITY, INFINITY, INFINITY};
+    double vmax[METHOD_COUNT] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    float dmax[METHOD_COUNT] = {0, 0, 0, 0};
+    size_t xmax[METHOD_COUNT] = {0, 0, 0, 0};
     size_t max_v = 0;
     for (size_t m = 0; m < s->mesh_count; ++m) max_v = s->meshes[m].mesh->vertex_count > max_v ? s->meshes[m].mesh->vertex_count : max_v;
     ak_vec3* lbs = calloc(max_v ? max_v : 1, sizeof(ak_vec3));
@@ -131,7 +153,7 @@ static int compare_generic(ak_scene* s, bool json) {
         float dur = s->clip_count ? ak_clip_duration(s->clips[c]) : 0.0f;
         for (int f = 0; f < 24 && rc == CLI_OK; ++f) {
             float t = dur * (float)f / 23.0f;
-            for (int mi = 0; mi < 3; ++mi) {
+            for (int mi = 0; mi < METHOD_COUNT; ++mi) {
                 ak_result r = cli_poser_pose(&p, s->clip_count ? (int)c : -1, t, false, methods[mi]);
                 if (r != AK_OK) {
                     rc = cli_fail("skin", "%s: %s", s->name, ak_result_string(r));
@@ -146,6 +168,10 @@ static int compare_generic(ak_scene* s, bool json) {
                         vmin[mi] = v < vmin[mi] ? v : vmin[mi];
                         vmax[mi] = v > vmax[mi] ? v : vmax[mi];
                     }
+                    if (f % 4 == 0 && mesh->triangle_count) { /* every 4th frame: the count costs more */
+                        size_t x = crossings(mesh, p.positions[m]);
+                        xmax[mi] = x > xmax[mi] ? x : xmax[mi];
+                    }
                     if (m == 0 && mi == 0) memcpy(lbs, p.positions[0], mesh->vertex_count * sizeof(ak_vec3));
                     if (m == 0)
                         for (size_t v = 0; v < mesh->vertex_count; ++v)
@@ -158,18 +184,19 @@ static int compare_generic(ak_scene* s, bool json) {
         if (json) printf("{\"model\": ");
         if (json) cli_json_string(stdout, s->name);
         if (json) printf(", \"methods\": [");
-        else printf("%s: %zu clip%s x 24 frames\n%-5s %22s %18s\n", s->name, s->clip_count, cli_plural(s->clip_count), "", "volume/rest (min..max)",
-                    "max dist from LBS");
-        for (int mi = 0; mi < 3; ++mi) {
+        else printf("%s: %zu clip%s x 24 frames\n%-8s %22s %18s %10s\n", s->name, s->clip_count, cli_plural(s->clip_count), "",
+                    "volume/rest (min..max)", "max dist from LBS", "crossings");
+        for (int mi = 0; mi < METHOD_COUNT; ++mi) {
             if (json) {
                 printf("%s{\"method\": \"%s\", \"max_distance_from_lbs\": %.9g", mi ? ", " : "", cli_method_name(methods[mi]),
                        (double)dmax[mi]);
                 if (any_closed) printf(", \"volume_min\": %.9g, \"volume_max\": %.9g", vmin[mi], vmax[mi]);
-                printf("}");
+                printf(", \"self_intersections_max\": %zu}", xmax[mi]);
             } else if (any_closed) {
-                printf("%-5s %10.4f .. %-9.4f %18.6g\n", cli_method_name(methods[mi]), vmin[mi], vmax[mi], (double)dmax[mi]);
+                printf("%-8s %10.4f .. %-9.4f %18.6g %10zu\n", cli_method_name(methods[mi]), vmin[mi], vmax[mi], (double)dmax[mi],
+                       xmax[mi]);
             } else {
-                printf("%-5s %22s %18.6g\n", cli_method_name(methods[mi]), "(open mesh)", (double)dmax[mi]);
+                printf("%-8s %22s %18.6g %10zu\n", cli_method_name(methods[mi]), "(open mesh)", (double)dmax[mi], xmax[mi]);
             }
         }
         if (json) printf("]}\n");

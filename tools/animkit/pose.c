@@ -10,6 +10,7 @@ bool cli_method_parse(const char* s, cli_method* out) {
     if (strcmp(s, "lbs") == 0) *out = CLI_LBS;
     else if (strcmp(s, "dqs") == 0) *out = CLI_DQS;
     else if (strcmp(s, "cor") == 0) *out = CLI_COR;
+    else if (strcmp(s, "implicit") == 0) *out = CLI_IMPLICIT;
     else return false;
     return true;
 }
@@ -18,6 +19,7 @@ const char* cli_method_name(cli_method m) {
     switch (m) {
     case CLI_DQS: return "DQS";
     case CLI_COR: return "CoR";
+    case CLI_IMPLICIT: return "implicit";
     default: return "LBS";
     }
 }
@@ -51,13 +53,14 @@ int cli_poser_init(cli_poser* p, const ak_scene* scene) {
     p->positions = calloc(mc, sizeof(ak_vec3*));
     p->normals = calloc(mc, sizeof(ak_vec3*));
     p->cor_centers = calloc(mc, sizeof(ak_vec3*));
+    p->implicit = calloc(mc, sizeof(ak_skin_implicit*));
     /* DQS/CoR scratch depends only on the method and palette size: size it once for the
      * largest skin and the method that needs most (CoR) */
     ak_skin_job probe = {.method = AK_SKIN_COR, .palette = {p->palette, max_skin}};
     p->skin_scratch_size = ak_skin_job_scratch_size(&probe);
     p->skin_scratch = malloc(p->skin_scratch_size);
     bool ok = p->local && p->world && p->palette && p->morph_weights && p->morphed && p->morphed_normals &&
-              p->positions && p->normals && p->cor_centers && p->skin_scratch;
+              p->positions && p->normals && p->cor_centers && p->implicit && p->skin_scratch;
     for (size_t m = 0; ok && m < scene->mesh_count; ++m) {
         size_t n = scene->meshes[m].mesh ? scene->meshes[m].mesh->vertex_count : 1;
         p->positions[m] = calloc(n, sizeof(ak_vec3));
@@ -77,11 +80,14 @@ void cli_poser_free(cli_poser* p) {
             if (p->positions) free(p->positions[m]);
             if (p->normals) free(p->normals[m]);
             if (p->cor_centers) free(p->cor_centers[m]);
+            if (p->implicit) ak_skin_implicit_destroy(p->implicit[m]);
         }
     }
     free(p->positions);
     free(p->normals);
     free(p->cor_centers);
+    free(p->implicit);
+    free(p->implicit_scratch);
     free(p->local);
     free(p->world);
     free(p->palette);
@@ -114,6 +120,42 @@ static ak_result cor_centers(cli_poser* p, size_t m) {
     }
     p->cor_centers[m] = c;
     return AK_OK;
+}
+
+/* Implicit skinning of mesh m with the palette in p->palette: the precompute on first use,
+ * then one run into p->positions[m] / p->normals[m]. */
+static ak_result implicit_deform(cli_poser* p, size_t m, size_t joint_count) {
+    const ak_mesh* mesh = p->scene->meshes[m].mesh;
+    if (!p->implicit[m]) {
+        size_t wn = mesh->vertex_count * mesh->influence_count;
+        ak_skin_implicit_desc d = {
+            .positions = {mesh->positions, mesh->vertex_count},
+            .indices = {mesh->indices, mesh->triangle_count * 3},
+            .joints = {mesh->joints, wn},
+            .weights = {mesh->weights, wn},
+            .influence_count = mesh->influence_count,
+            .joint_count = joint_count,
+        };
+        ak_result r = ak_skin_implicit_create(&d, NULL, &p->implicit[m]);
+        if (r != AK_OK) return r;
+    }
+    size_t need = ak_skin_implicit_scratch_size(p->implicit[m], joint_count);
+    if (need > p->implicit_scratch_size) {
+        uint8_t* grown = realloc(p->implicit_scratch, need);
+        if (!grown) return AK_ERR_NO_MEMORY;
+        p->implicit_scratch = grown;
+        p->implicit_scratch_size = need;
+    }
+    ak_skin_implicit_job job = {
+        .implicit = p->implicit[m],
+        .palette = {p->palette, joint_count},
+        .thread_count = 2,
+        .scratch = {p->implicit_scratch, p->implicit_scratch_size},
+        .normals = {mesh->normals, mesh->normals ? mesh->vertex_count : 0},
+        .out_positions = {p->positions[m], mesh->vertex_count},
+        .out_normals = {p->normals[m], mesh->vertex_count},
+    };
+    return ak_skin_implicit_run(&job);
 }
 
 static void transform_rigid(const ak_mesh* mesh, ak_mat4 m, const ak_vec3* pos, const ak_vec3* nrm, ak_vec3* out_p,
@@ -215,7 +257,14 @@ ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method) {
             if ((r = ak_scene_skin_palette(s, (size_t)sm->skin, (ak_mat4_cspan){p->world, p->joint_count},
                                            (ak_mat4_span){p->palette, skin->joint_count})) != AK_OK)
                 return r;
-            ak_skin_method sm_method = method == CLI_DQS ? AK_SKIN_DQS : method == CLI_COR ? AK_SKIN_COR : AK_SKIN_LBS;
+            if (method == CLI_IMPLICIT && mesh->triangle_count > 0 && mesh->morph_target_count == 0) {
+                if ((r = implicit_deform(p, m, skin->joint_count)) != AK_OK) return r;
+                continue;
+            }
+            ak_skin_method sm_method = method == CLI_DQS ? AK_SKIN_DQS
+                                       : method == CLI_COR ? AK_SKIN_COR
+                                       : method == CLI_IMPLICIT ? AK_SKIN_DQS /* points or morphs: DQS */
+                                                                : AK_SKIN_LBS;
             if (sm_method == AK_SKIN_COR && mesh->triangle_count == 0) sm_method = AK_SKIN_DQS;
             if (sm_method == AK_SKIN_COR && (r = cor_centers(p, m)) != AK_OK) return r;
             bool faces = nrm == NULL && mesh->triangle_count > 0;
