@@ -2,6 +2,8 @@
  * skin-weight validation and clean-up). */
 #include <animkit/mesh.h>
 
+#include <float.h>
+
 #include "internal.h"
 
 /* A mesh is one allocation: [header][ak_mesh][arrays...]. The header remembers the allocator
@@ -250,6 +252,32 @@ static uint32_t coord_bits(float f) {
 
 static bool same_position(ak_vec3 a, ak_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
+/* rep[v]: the first vertex at v's position (open addressing, linear probing in table, whose
+ * size T is a power of two >= 2n); non-finite positions stand for themselves. */
+static void weld_reps(const ak_vec3* positions, size_t n, uint32_t* rep, uint32_t* table, size_t T) {
+    const size_t mask = T - 1;
+    for (size_t k = 0; k < T; ++k) table[k] = UINT32_MAX;
+    for (size_t v = 0; v < n; ++v) {
+        ak_vec3 p = positions[v];
+        rep[v] = (uint32_t)v;
+        if (!ak_vec3_is_finite(p)) continue;
+        uint32_t h = coord_bits(p.x) * 0x9E3779B1u;
+        h = (h ^ (h >> 15) ^ coord_bits(p.y)) * 0x85EBCA77u;
+        h = (h ^ (h >> 13) ^ coord_bits(p.z)) * 0xC2B2AE3Du;
+        h ^= h >> 16;
+        for (size_t k = h & mask;; k = (k + 1) & mask) {
+            if (table[k] == UINT32_MAX) {
+                table[k] = (uint32_t)v;
+                break;
+            }
+            if (same_position(positions[table[k]], p)) {
+                rep[v] = table[k];
+                break;
+            }
+        }
+    }
+}
+
 ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indices,
                                     ak_u32_span scratch, ak_vec3_span out_normals) {
     if (!out_normals.ptr || !scratch.ptr || (positions.count && !positions.ptr) ||
@@ -262,30 +290,9 @@ ak_result ak_normals_compute_welded(ak_vec3_cspan positions, ak_u32_cspan indice
     const size_t tri = indices.count / 3;
     for (size_t i = 0; i < 3 * tri; ++i)
         if (indices.ptr[i] >= n) return AK_ERR_BAD_INDEX;
-    /* rep[v]: the first vertex at v's position (open addressing, linear probing) */
+    /* rep[v]: the first vertex at v's position */
     uint32_t* rep = scratch.ptr;
-    uint32_t* table = scratch.ptr + n;
-    const size_t T = need - n, mask = T - 1;
-    for (size_t k = 0; k < T; ++k) table[k] = UINT32_MAX;
-    for (size_t v = 0; v < n; ++v) {
-        ak_vec3 p = positions.ptr[v];
-        rep[v] = (uint32_t)v;
-        if (!ak_vec3_is_finite(p)) continue;
-        uint32_t h = coord_bits(p.x) * 0x9E3779B1u;
-        h = (h ^ (h >> 15) ^ coord_bits(p.y)) * 0x85EBCA77u;
-        h = (h ^ (h >> 13) ^ coord_bits(p.z)) * 0xC2B2AE3Du;
-        h ^= h >> 16;
-        for (size_t k = h & mask;; k = (k + 1) & mask) {
-            if (table[k] == UINT32_MAX) {
-                table[k] = (uint32_t)v;
-                break;
-            }
-            if (same_position(positions.ptr[table[k]], p)) {
-                rep[v] = table[k];
-                break;
-            }
-        }
-    }
+    weld_reps(positions.ptr, n, rep, scratch.ptr + n, need - n);
     for (size_t v = 0; v < n; ++v) out_normals.ptr[v] = ak_vec3_zero();
     for (size_t t = 0; t < tri; ++t) {
         uint32_t a = indices.ptr[3 * t], b = indices.ptr[3 * t + 1], c = indices.ptr[3 * t + 2];
@@ -471,4 +478,275 @@ void ak_weights_normalize(uint16_t* joints, float* weights, size_t vertex_count,
             wv[i] = i < n ? w[i] : 0.0f;
         }
     }
+}
+
+/* ---- self-intersections ------------------------------------------------------------------ */
+
+/* Orientation predicates in double precision on float input. The sign is that of the 3x3
+ * determinant; exactly zero means coplanar (or collinear in 2D). */
+typedef struct dvec3 {
+    double x, y, z;
+} dvec3;
+
+static dvec3 to_d(ak_vec3 v) { return (dvec3){v.x, v.y, v.z}; }
+
+/* Sign of det[b-a, c-a, d-a]: > 0 when d is on the side of plane (a, b, c) its normal
+ * (b-a) x (c-a) points to. */
+static int orient3(dvec3 a, dvec3 b, dvec3 c, dvec3 d) {
+    double bx = b.x - a.x, by = b.y - a.y, bz = b.z - a.z;
+    double cx = c.x - a.x, cy = c.y - a.y, cz = c.z - a.z;
+    double dx = d.x - a.x, dy = d.y - a.y, dz = d.z - a.z;
+    double det = bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx);
+    return (det > 0.0) - (det < 0.0);
+}
+
+typedef struct dvec2 {
+    double u, v;
+} dvec2;
+
+static int orient2(dvec2 a, dvec2 b, dvec2 c) {
+    double det = (b.u - a.u) * (c.v - a.v) - (b.v - a.v) * (c.u - a.u);
+    return (det > 0.0) - (det < 0.0);
+}
+
+/* Drops coordinate axis (0 x, 1 y, 2 z). */
+static dvec2 project2(dvec3 p, int axis) {
+    return axis == 0 ? (dvec2){p.y, p.z} : axis == 1 ? (dvec2){p.z, p.x} : (dvec2){p.x, p.y};
+}
+
+/* Axis of the largest normal component of triangle (a, b, c); -1 when degenerate. */
+static int dominant_axis(dvec3 a, dvec3 b, dvec3 c) {
+    double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
+    double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
+    double nx = fabs(uy * vz - uz * vy), ny = fabs(uz * vx - ux * vz), nz = fabs(ux * vy - uy * vx);
+    if (nx == 0.0 && ny == 0.0 && nz == 0.0) return -1;
+    return nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
+}
+
+/* Closed point-in-triangle in 2D (triangle non-degenerate). */
+static bool point_in_tri2(dvec2 x, dvec2 p, dvec2 q, dvec2 r) {
+    int o1 = orient2(p, q, x), o2 = orient2(q, r, x), o3 = orient2(r, p, x);
+    bool pos = o1 > 0 || o2 > 0 || o3 > 0, neg = o1 < 0 || o2 < 0 || o3 < 0;
+    return !(pos && neg);
+}
+
+static bool interval_overlap(double a0, double a1, double b0, double b1) {
+    double alo = a0 < a1 ? a0 : a1, ahi = a0 < a1 ? a1 : a0;
+    double blo = b0 < b1 ? b0 : b1, bhi = b0 < b1 ? b1 : b0;
+    return alo <= bhi && blo <= ahi;
+}
+
+/* Closed segment-segment intersection in 2D. */
+static bool seg_seg2(dvec2 a, dvec2 b, dvec2 c, dvec2 d) {
+    int o1 = orient2(a, b, c), o2 = orient2(a, b, d);
+    int o3 = orient2(c, d, a), o4 = orient2(c, d, b);
+    if ((o1 == 0 && o2 == 0) || (o3 == 0 && o4 == 0)) /* collinear: overlapping extents */
+        return interval_overlap(a.u, b.u, c.u, d.u) && interval_overlap(a.v, b.v, c.v, d.v);
+    if (o1 * o2 > 0 || o3 * o4 > 0) return false;
+    return true;
+}
+
+/* Closed segment (a, b) against the closed triangle (p, q, r), all in one plane whose
+ * dominant normal axis is axis. */
+static bool seg_tri_coplanar(dvec3 a, dvec3 b, dvec3 p, dvec3 q, dvec3 r, int axis) {
+    dvec2 a2 = project2(a, axis), b2 = project2(b, axis);
+    dvec2 p2 = project2(p, axis), q2 = project2(q, axis), r2 = project2(r, axis);
+    if (point_in_tri2(a2, p2, q2, r2) || point_in_tri2(b2, p2, q2, r2)) return true;
+    return seg_seg2(a2, b2, p2, q2) || seg_seg2(a2, b2, q2, r2) || seg_seg2(a2, b2, r2, p2);
+}
+
+/* Closed segment (a, b) against the closed, non-degenerate triangle t[0..2]. */
+static bool seg_tri(dvec3 a, dvec3 b, const dvec3 t[3], int axis) {
+    int sa = orient3(t[0], t[1], t[2], a), sb = orient3(t[0], t[1], t[2], b);
+    if (sa * sb > 0) return false;
+    if (sa == 0 && sb == 0) return seg_tri_coplanar(a, b, t[0], t[1], t[2], axis);
+    /* The segment meets the plane; its line pierces the closed triangle iff the three signed
+     * volumes against the triangle's edges do not disagree. */
+    int o1 = orient3(a, b, t[0], t[1]), o2 = orient3(a, b, t[1], t[2]), o3 = orient3(a, b, t[2], t[0]);
+    bool pos = o1 > 0 || o2 > 0 || o3 > 0, neg = o1 < 0 || o2 < 0 || o3 < 0;
+    return !(pos && neg);
+}
+
+/* Exact-sign test of two closed, non-degenerate triangles (ax: their dominant axes). Two
+ * triangles in different planes meet iff an edge of one meets the other (the ends of the
+ * common segment on the planes' line lie on edges); coplanar ones meet iff edges cross or a
+ * vertex of one lies in the other. */
+static bool tri_tri(const dvec3 A[3], int axA, const dvec3 B[3], int axB) {
+    int dB[3], dA[3];
+    for (int k = 0; k < 3; ++k) dB[k] = orient3(A[0], A[1], A[2], B[k]);
+    if ((dB[0] > 0 && dB[1] > 0 && dB[2] > 0) || (dB[0] < 0 && dB[1] < 0 && dB[2] < 0)) return false;
+    for (int k = 0; k < 3; ++k) dA[k] = orient3(B[0], B[1], B[2], A[k]);
+    if ((dA[0] > 0 && dA[1] > 0 && dA[2] > 0) || (dA[0] < 0 && dA[1] < 0 && dA[2] < 0)) return false;
+    if ((dB[0] == 0 && dB[1] == 0 && dB[2] == 0) || (dA[0] == 0 && dA[1] == 0 && dA[2] == 0)) {
+        dvec2 a[3], b[3];
+        for (int k = 0; k < 3; ++k) a[k] = project2(A[k], axA), b[k] = project2(B[k], axA);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                if (seg_seg2(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3])) return true;
+        return point_in_tri2(a[0], b[0], b[1], b[2]) || point_in_tri2(b[0], a[0], a[1], a[2]);
+    }
+    for (int i = 0; i < 3; ++i)
+        if (seg_tri(A[i], A[(i + 1) % 3], B, axB) || seg_tri(B[i], B[(i + 1) % 3], A, axA)) return true;
+    return false;
+}
+
+bool ak_triangles_intersect(const ak_vec3 a[3], const ak_vec3 b[3]) {
+    if (!a || !b) return false;
+    dvec3 A[3], B[3];
+    for (int k = 0; k < 3; ++k) {
+        if (!ak_vec3_is_finite(a[k]) || !ak_vec3_is_finite(b[k])) return false;
+        A[k] = to_d(a[k]), B[k] = to_d(b[k]);
+    }
+    int axA = dominant_axis(A[0], A[1], A[2]), axB = dominant_axis(B[0], B[1], B[2]);
+    if (axA < 0 || axB < 0) return false;
+    return tri_tri(A, axA, B, axB);
+}
+
+ak_result ak_mesh_self_intersections(ak_vec3_cspan positions, ak_u32_cspan indices, ak_u32_span out_pairs,
+                                     size_t* out_count) {
+    if (out_count) *out_count = 0;
+    if (!out_count || !positions.ptr || (!indices.ptr && indices.count)) return AK_ERR_NULL_ARG;
+    if (out_pairs.count && !out_pairs.ptr) return AK_ERR_NULL_ARG;
+    const size_t nv = positions.count, nt = indices.count / 3;
+    if (nv > UINT32_MAX || nt > UINT32_MAX / 8) return AK_ERR_BAD_ARG;
+    for (size_t i = 0; i < 3 * nt; ++i)
+        if (indices.ptr[i] >= nv) return AK_ERR_BAD_INDEX;
+    for (size_t i = 0; i < nv; ++i)
+        if (!ak_vec3_is_finite(positions.ptr[i])) return AK_ERR_BAD_DATA;
+    if (nt < 2) return AK_OK;
+
+    /* Weld: canonical id per vertex, shared by vertices at the same position, so triangles
+     * across a UV seam (split vertices) count as adjacent. */
+    const size_t wcount = ak_normals_welded_scratch_count(nv);
+    uint32_t* weld = wcount != SIZE_MAX ? (uint32_t*)malloc(wcount * sizeof(uint32_t)) : NULL;
+    float* box = (float*)malloc(6 * nt * sizeof(float));
+    uint32_t* tri_cell = (uint32_t*)malloc(6 * nt * sizeof(uint32_t)); /* cell range lo/hi */
+    if (!weld || !box || !tri_cell) {
+        free(weld), free(box), free(tri_cell);
+        return AK_ERR_NO_MEMORY;
+    }
+    weld_reps(positions.ptr, nv, weld, weld + nv, wcount - nv);
+
+    /* Triangle bounds; degenerate triangles (zero area) get an empty box and never count. */
+    double mean_ext = 0.0;
+    ak_vec3 lo_all = {FLT_MAX, FLT_MAX, FLT_MAX}, hi_all = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    for (size_t t = 0; t < nt; ++t) {
+        const uint32_t* ix = indices.ptr + 3 * t;
+        ak_vec3 a = positions.ptr[ix[0]], b = positions.ptr[ix[1]], c = positions.ptr[ix[2]];
+        float* bx = box + 6 * t;
+        bx[0] = fminf(a.x, fminf(b.x, c.x)), bx[1] = fminf(a.y, fminf(b.y, c.y));
+        bx[2] = fminf(a.z, fminf(b.z, c.z)), bx[3] = fmaxf(a.x, fmaxf(b.x, c.x));
+        bx[4] = fmaxf(a.y, fmaxf(b.y, c.y)), bx[5] = fmaxf(a.z, fmaxf(b.z, c.z));
+        if (dominant_axis(to_d(a), to_d(b), to_d(c)) < 0) {
+            bx[0] = 1.0f, bx[3] = -1.0f; /* empty */
+            continue;
+        }
+        lo_all = ak_vec3_make(fminf(lo_all.x, bx[0]), fminf(lo_all.y, bx[1]), fminf(lo_all.z, bx[2]));
+        hi_all = ak_vec3_make(fmaxf(hi_all.x, bx[3]), fmaxf(hi_all.y, bx[4]), fmaxf(hi_all.z, bx[5]));
+        double e = fmax((double)bx[3] - bx[0], fmax((double)bx[4] - bx[1], (double)bx[5] - bx[2]));
+        mean_ext += e;
+    }
+    mean_ext /= (double)nt;
+    size_t count = 0, written = 0;
+    ak_result res = AK_OK;
+    if (lo_all.x > hi_all.x) goto done; /* every triangle degenerate */
+
+    /* Uniform grid over the bounds, cells about one mean triangle extent wide, at most about
+     * 2 * nt cells; grown while the triangle-cell entries exceed 16 per triangle. */
+    double ext[3] = {(double)hi_all.x - lo_all.x, (double)hi_all.y - lo_all.y, (double)hi_all.z - lo_all.z};
+    double org[3] = {lo_all.x, lo_all.y, lo_all.z};
+    double h = mean_ext > 0.0 ? mean_ext : 1.0;
+    double hmin = fmax(ext[0], fmax(ext[1], ext[2])) * 1e-6;
+    if (h < hmin || h == 0.0) h = hmin > 0.0 ? hmin : 1.0;
+    size_t dim[3], cells = 0, entries = 0;
+    for (int attempt = 0;; ++attempt, h *= 2.0) {
+        for (int k = 0; k < 3; ++k) dim[k] = (size_t)fmin(ext[k] / h + 1.0, 1e6);
+        cells = dim[0] * dim[1] * dim[2];
+        if (cells > 2 * nt + 64 && attempt < 64) continue;
+        entries = 0;
+        for (size_t t = 0; t < nt; ++t) {
+            const float* bx = box + 6 * t;
+            if (bx[0] > bx[3]) continue;
+            size_t n = 1;
+            for (int k = 0; k < 3; ++k) {
+                size_t a = (size_t)fmin(((double)bx[k] - org[k]) / h, (double)(dim[k] - 1));
+                size_t b = (size_t)fmin(((double)bx[k + 3] - org[k]) / h, (double)(dim[k] - 1));
+                tri_cell[6 * t + (size_t)k] = (uint32_t)a, tri_cell[6 * t + 3 + (size_t)k] = (uint32_t)b;
+                n *= b - a + 1;
+            }
+            entries += n;
+        }
+        if (entries <= 16 * nt + 1024 || attempt >= 64) break;
+    }
+    uint32_t* cell_start = (uint32_t*)calloc(cells + 1, sizeof(uint32_t));
+    uint32_t* cell_tri = entries <= UINT32_MAX ? (uint32_t*)malloc((entries ? entries : 1) * sizeof(uint32_t)) : NULL;
+    if (!cell_start || !cell_tri) {
+        free(cell_start), free(cell_tri);
+        res = AK_ERR_NO_MEMORY;
+        goto done;
+    }
+#define AKP_CELL_ID(x, y, z) (((size_t)(z) * dim[1] + (size_t)(y)) * dim[0] + (size_t)(x))
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t t = 0; t < nt; ++t) {
+            const uint32_t* c = tri_cell + 6 * t;
+            if (box[6 * t] > box[6 * t + 3]) continue;
+            for (uint32_t z = c[2]; z <= c[5]; ++z)
+                for (uint32_t y = c[1]; y <= c[4]; ++y)
+                    for (uint32_t x = c[0]; x <= c[3]; ++x) {
+                        size_t id = AKP_CELL_ID(x, y, z);
+                        if (pass == 0)
+                            ++cell_start[id + 1];
+                        else
+                            cell_tri[cell_start[id]++] = (uint32_t)t;
+                    }
+        }
+        if (pass == 0)
+            for (size_t m = 0; m < cells; ++m) cell_start[m + 1] += cell_start[m];
+        else
+            for (size_t m = cells; m > 0; --m) cell_start[m] = cell_start[m - 1];
+    }
+    cell_start[0] = 0;
+    /* Each candidate pair is tested in one cell only: the cell holding the lower corner of the
+     * overlap of the two boxes. Triangles are in increasing order within a cell. */
+    for (size_t m = 0; m < cells; ++m) {
+        for (uint32_t i = cell_start[m]; i < cell_start[m + 1]; ++i) {
+            uint32_t ta = cell_tri[i];
+            const float* ba = box + 6 * (size_t)ta;
+            const uint32_t* ia = indices.ptr + 3 * (size_t)ta;
+            uint32_t wa[3] = {weld[ia[0]], weld[ia[1]], weld[ia[2]]};
+            dvec3 A[3] = {to_d(positions.ptr[ia[0]]), to_d(positions.ptr[ia[1]]), to_d(positions.ptr[ia[2]])};
+            int axA = -2;
+            for (uint32_t j = i + 1; j < cell_start[m + 1]; ++j) {
+                uint32_t tb = cell_tri[j];
+                const float* bb = box + 6 * (size_t)tb;
+                if (ba[0] > bb[3] || bb[0] > ba[3] || ba[1] > bb[4] || bb[1] > ba[4] || ba[2] > bb[5] ||
+                    bb[2] > ba[5])
+                    continue;
+                const uint32_t* ca = tri_cell + 6 * (size_t)ta;
+                const uint32_t* cb = tri_cell + 6 * (size_t)tb;
+                size_t own = AKP_CELL_ID(ca[0] > cb[0] ? ca[0] : cb[0], ca[1] > cb[1] ? ca[1] : cb[1],
+                                         ca[2] > cb[2] ? ca[2] : cb[2]);
+                if (own != m) continue;
+                const uint32_t* ib = indices.ptr + 3 * (size_t)tb;
+                bool shared = false;
+                for (int p = 0; p < 3; ++p)
+                    for (int q = 0; q < 3; ++q) shared = shared || wa[p] == weld[ib[q]];
+                if (shared) continue;
+                if (axA == -2) axA = dominant_axis(A[0], A[1], A[2]);
+                dvec3 B[3] = {to_d(positions.ptr[ib[0]]), to_d(positions.ptr[ib[1]]), to_d(positions.ptr[ib[2]])};
+                if (!tri_tri(A, axA, B, dominant_axis(B[0], B[1], B[2]))) continue;
+                ++count;
+                if (written + 2 <= out_pairs.count) {
+                    out_pairs.ptr[written++] = ta < tb ? ta : tb;
+                    out_pairs.ptr[written++] = ta < tb ? tb : ta;
+                }
+            }
+        }
+    }
+#undef AKP_CELL_ID
+    free(cell_start), free(cell_tri);
+done:
+    free(weld), free(box), free(tri_cell);
+    *out_count = count;
+    return res;
 }

@@ -486,6 +486,228 @@ AK_TEST(normals_welded) {
     AK_CHECK_EQ(ak_normals_welded_scratch_count(SIZE_MAX / 2), SIZE_MAX);
 }
 
+/* ---- self-intersections ---- */
+
+static bool tri_hit(const float a[9], const float b[9]) {
+    ak_vec3 A[3], B[3];
+    for (int k = 0; k < 3; ++k) {
+        A[k] = ak_vec3_make(a[3 * k], a[3 * k + 1], a[3 * k + 2]);
+        B[k] = ak_vec3_make(b[3 * k], b[3 * k + 1], b[3 * k + 2]);
+    }
+    bool h1 = ak_triangles_intersect(A, B), h2 = ak_triangles_intersect(B, A);
+    return h1 && h2 ? true : (!h1 && !h2 ? false : (printf("  asymmetric\n"), !h1));
+}
+
+AK_TEST(triangle_pairs_constructed) {
+    const float base[9] = {0, 0, 0, 4, 0, 0, 0, 4, 0}; /* in z = 0 */
+    /* crossing: a vertical triangle through the interior */
+    const float cross[9] = {1, 1, -1, 1, 1, 1, 2, 0.5f, 0};
+    AK_CHECK(tri_hit(base, cross));
+    /* the same one lifted above the plane: disjoint */
+    const float above[9] = {1, 1, 0.5f, 1, 1, 2, 2, 0.5f, 1};
+    AK_CHECK(!tri_hit(base, above));
+    /* touching: a vertex resting on the interior, then on an edge, then on a corner */
+    const float on_face[9] = {1, 1, 0, 1, 2, 3, 2, 1, 3};
+    const float on_edge[9] = {2, 0, 0, 2, -1, 3, 3, -1, 3};
+    const float on_corner[9] = {4, 0, 0, 5, 1, 2, 5, -1, 2};
+    AK_CHECK(tri_hit(base, on_face));
+    AK_CHECK(tri_hit(base, on_edge));
+    AK_CHECK(tri_hit(base, on_corner));
+    /* just missing the corner (x = 4 + 2^-20) */
+    const float near_corner[9] = {4.00000095f, 0, 0, 5, 1, 2, 5, -1, 2};
+    AK_CHECK(!tri_hit(base, near_corner));
+    /* an edge lying in the plane and crossing the triangle, the rest above */
+    const float edge_in_plane[9] = {-1, 1, 0, 3, 1, 0, 1, 1, 2};
+    AK_CHECK(tri_hit(base, edge_in_plane));
+    const float edge_in_plane_out[9] = {-1, -1, 0, 3, -1, 0, 1, -1, 2};
+    AK_CHECK(!tri_hit(base, edge_in_plane_out));
+    /* coplanar: overlapping edges, contained, sharing only an edge segment, disjoint */
+    const float co_overlap[9] = {1, 1, 0, 5, 1, 0, 1, 5, 0};
+    const float co_inside[9] = {0.5f, 0.5f, 0, 1.5f, 0.5f, 0, 0.5f, 1.5f, 0};
+    const float co_edge[9] = {1, 0, 0, 3, 0, 0, 2, -2, 0};
+    const float co_apart[9] = {3, 3, 0, 5, 3, 0, 3, 5, 0}; /* beyond the hypotenuse x + y = 4 */
+    AK_CHECK(tri_hit(base, co_overlap));
+    AK_CHECK(tri_hit(base, co_inside));
+    AK_CHECK(tri_hit(co_inside, base));
+    AK_CHECK(tri_hit(base, co_edge));
+    AK_CHECK(!tri_hit(base, co_apart));
+    /* parallel planes, overlapping in projection */
+    const float parallel[9] = {0, 0, 1e-3f, 4, 0, 1e-3f, 0, 4, 1e-3f};
+    AK_CHECK(!tri_hit(base, parallel));
+    /* degenerate triangles never count */
+    const float degenerate[9] = {0, 0, -1, 1, 1, 0, 2, 2, 1};
+    AK_CHECK(!tri_hit(base, degenerate));
+}
+
+/* Independent reference for triangles in general position: a pair meets iff an edge of one
+ * passes through the other (Moller-Trumbore ray test with barycentric coordinates). */
+static bool ref_edge_hits(const double* o, const double* e, const double* t) {
+    double e1[3], e2[3], d[3] = {e[0] - o[0], e[1] - o[1], e[2] - o[2]}, p[3], s[3], q[3];
+    for (int k = 0; k < 3; ++k) e1[k] = t[3 + k] - t[k], e2[k] = t[6 + k] - t[k], s[k] = o[k] - t[k];
+    p[0] = d[1] * e2[2] - d[2] * e2[1], p[1] = d[2] * e2[0] - d[0] * e2[2], p[2] = d[0] * e2[1] - d[1] * e2[0];
+    double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    if (fabs(det) < 1e-300) return false;
+    double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
+    q[0] = s[1] * e1[2] - s[2] * e1[1], q[1] = s[2] * e1[0] - s[0] * e1[2], q[2] = s[0] * e1[1] - s[1] * e1[0];
+    double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+    double w = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+    return u >= 0 && v >= 0 && u + v <= 1 && w >= 0 && w <= 1;
+}
+
+static bool ref_tri_tri(const ak_vec3* P, const uint32_t* a, const uint32_t* b) {
+    double A[9], B[9];
+    for (int k = 0; k < 3; ++k) {
+        A[3 * k] = P[a[k]].x, A[3 * k + 1] = P[a[k]].y, A[3 * k + 2] = P[a[k]].z;
+        B[3 * k] = P[b[k]].x, B[3 * k + 1] = P[b[k]].y, B[3 * k + 2] = P[b[k]].z;
+    }
+    for (int i = 0; i < 3; ++i) {
+        int j = (i + 1) % 3;
+        if (ref_edge_hits(A + 3 * i, A + 3 * j, B) || ref_edge_hits(B + 3 * i, B + 3 * j, A)) return true;
+    }
+    return false;
+}
+
+AK_TEST(self_intersections_soup_matches_brute_force) {
+    /* 300 random triangles (no shared vertices) in a box: the grid count and the pairs it lists
+     * equal an all-pairs reference. */
+    enum { NT = 300 };
+    static ak_vec3 pos[3 * NT];
+    static uint32_t idx[3 * NT];
+    ak_rng rng = ak_rng_make(7);
+    for (int t = 0; t < NT; ++t) {
+        ak_vec3 c = ak_vec3_make(ak_rng_range(&rng, 0, 10), ak_rng_range(&rng, 0, 10), ak_rng_range(&rng, 0, 10));
+        float s = ak_rng_range(&rng, 0.2f, 1.5f);
+        for (int k = 0; k < 3; ++k) {
+            pos[3 * t + k] = ak_vec3_add(c, ak_vec3_make(s * ak_rng_range(&rng, -1, 1), s * ak_rng_range(&rng, -1, 1),
+                                                         s * ak_rng_range(&rng, -1, 1)));
+            idx[3 * t + k] = (uint32_t)(3 * t + k);
+        }
+    }
+    size_t ref = 0;
+    static unsigned char hit[NT][NT];
+    memset(hit, 0, sizeof hit);
+    for (int a = 0; a < NT; ++a)
+        for (int b = a + 1; b < NT; ++b)
+            if (ref_tri_tri(pos, idx + 3 * a, idx + 3 * b)) ++ref, hit[a][b] = 1;
+    static uint32_t pairs[2 * NT * NT];
+    size_t count = 0;
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){pos, 3 * NT}, (ak_u32_cspan){idx, 3 * NT},
+                                           (ak_u32_span){pairs, 2 * NT * NT}, &count),
+                AK_OK);
+    AK_CHECK(ref > 20);
+    AK_CHECK_EQ(count, ref);
+    size_t matched = 0;
+    for (size_t k = 0; k < count && k < NT * NT; ++k) {
+        uint32_t a = pairs[2 * k], b = pairs[2 * k + 1];
+        if (a < b && b < NT && hit[a][b]) ++matched, hit[a][b] = 0; /* each pair once */
+    }
+    AK_CHECK_EQ(matched, ref);
+    /* a short pair buffer still gives the full count */
+    size_t count2 = 0;
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){pos, 3 * NT}, (ak_u32_cspan){idx, 3 * NT},
+                                           (ak_u32_span){pairs, 3}, &count2),
+                AK_OK);
+    AK_CHECK_EQ(count2, ref);
+}
+
+AK_TEST(self_intersections_meshes) {
+    /* a closed sphere and a cube: none (neighbours share vertices) */
+    ak_mesh* s = make_sphere(1.0f, 12, 16);
+    ak_mesh* c = make_cube(ak_vec3_zero(), false);
+    size_t n = 99;
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){s->positions, s->vertex_count},
+                                           (ak_u32_cspan){s->indices, 3 * s->triangle_count}, (ak_u32_span){0}, &n),
+                AK_OK);
+    AK_CHECK_EQ(n, 0);
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){c->positions, 8}, (ak_u32_cspan){c->indices, 36},
+                                           (ak_u32_span){0}, &n),
+                AK_OK);
+    AK_CHECK_EQ(n, 0);
+    /* two unit cubes offset by (0.5, 0.25, 0.125) : an all-pairs count with the pair test */
+    ak_vec3 pos[16];
+    uint32_t idx[72];
+    for (int i = 0; i < 8; ++i) {
+        pos[i] = c->positions[i];
+        pos[8 + i] = ak_vec3_add(c->positions[i], ak_vec3_make(0.5f, 0.25f, 0.125f));
+    }
+    for (int i = 0; i < 36; ++i) idx[i] = c->indices[i], idx[36 + i] = c->indices[i] + 8;
+    size_t ref = 0;
+    for (int a = 0; a < 12; ++a)
+        for (int b = 12; b < 24; ++b) {
+            ak_vec3 A[3] = {pos[idx[3 * a]], pos[idx[3 * a + 1]], pos[idx[3 * a + 2]]};
+            ak_vec3 B[3] = {pos[idx[3 * b]], pos[idx[3 * b + 1]], pos[idx[3 * b + 2]]};
+            ref += ak_triangles_intersect(A, B);
+        }
+    /* faces x=1 of cube A cut faces y and z of cube B and so on: 3 faces of each cross 2 of the
+     * other, each face being 2 triangles; the reference counts them pair by pair */
+    AK_CHECK(ref >= 12);
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){pos, 16}, (ak_u32_cspan){idx, 72}, (ak_u32_span){0}, &n),
+                AK_OK);
+    AK_CHECK_EQ(n, ref);
+    /* shared vertices exclude a pair, by index or by position */
+    ak_vec3 fan[6] = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {1, 0.2f, -1}, {0.2f, 1, 1}, {0, 0, 0}};
+    uint32_t fi[6] = {0, 1, 2, 0, 3, 4};
+    ak_vec3 A[3] = {fan[0], fan[1], fan[2]}, B[3] = {fan[0], fan[3], fan[4]};
+    AK_CHECK(ak_triangles_intersect(A, B)); /* they do cross */
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){fan, 6}, (ak_u32_cspan){fi, 6}, (ak_u32_span){0}, &n), AK_OK);
+    AK_CHECK_EQ(n, 0);
+    fi[3] = 5; /* a split copy of vertex 0 */
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){fan, 6}, (ak_u32_cspan){fi, 6}, (ak_u32_span){0}, &n), AK_OK);
+    AK_CHECK_EQ(n, 0);
+    fan[5] = ak_vec3_make(0, 0, 1e-6f); /* no longer the same position: counted */
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){fan, 6}, (ak_u32_cspan){fi, 6}, (ak_u32_span){0}, &n), AK_OK);
+    AK_CHECK_EQ(n, 1);
+    /* errors */
+    fi[1] = 6;
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){fan, 6}, (ak_u32_cspan){fi, 6}, (ak_u32_span){0}, &n),
+                AK_ERR_BAD_INDEX);
+    fi[1] = 1;
+    fan[2].y = NAN;
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){fan, 6}, (ak_u32_cspan){fi, 6}, (ak_u32_span){0}, &n),
+                AK_ERR_BAD_DATA);
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){fan, 6}, (ak_u32_cspan){fi, 6}, (ak_u32_span){0}, NULL),
+                AK_ERR_NULL_ARG);
+    ak_mesh_destroy(s);
+    ak_mesh_destroy(c);
+}
+
+AK_TEST(self_intersections_50k_fast_and_exact) {
+    /* a 50k-triangle sphere has none; a copy shifted by 1/2 radius crosses it along a circle:
+     * each crossing pair found is confirmed by the pair test, and the timing stays low */
+    ak_mesh* s = make_sphere(1.0f, 126, 200); /* 2 * 200 * 125 = 50000 triangles */
+    AK_CHECK_EQ(s->triangle_count, 50000);
+    size_t n = 1;
+    double t0 = ak_test_now_();
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){s->positions, s->vertex_count},
+                                           (ak_u32_cspan){s->indices, 3 * s->triangle_count}, (ak_u32_span){0}, &n),
+                AK_OK);
+    double dt = ak_test_now_() - t0;
+    AK_CHECK_EQ(n, 0);
+    AK_CHECK_MSG(dt < 0.5, "50k triangles took %.3f s", dt);
+    /* two small spheres side by side (centres 1.5 radii apart): the crossing circle */
+    ak_mesh* a = make_sphere(1.0f, 24, 32);
+    size_t vc = a->vertex_count, tc = a->triangle_count;
+    ak_vec3* pos = (ak_vec3*)malloc(2 * vc * sizeof(ak_vec3));
+    uint32_t* idx = (uint32_t*)malloc(6 * tc * sizeof(uint32_t));
+    for (size_t i = 0; i < vc; ++i) pos[i] = a->positions[i], pos[vc + i] = ak_vec3_add(a->positions[i], ak_vec3_make(1.5f, 0, 0));
+    for (size_t i = 0; i < 3 * tc; ++i) idx[i] = a->indices[i], idx[3 * tc + i] = a->indices[i] + (uint32_t)vc;
+    size_t ref = 0;
+    for (size_t p = 0; p < tc; ++p) /* brute force across the two spheres only */
+        for (size_t q = tc; q < 2 * tc; ++q) {
+            ak_vec3 A[3] = {pos[idx[3 * p]], pos[idx[3 * p + 1]], pos[idx[3 * p + 2]]};
+            ak_vec3 B[3] = {pos[idx[3 * q]], pos[idx[3 * q + 1]], pos[idx[3 * q + 2]]};
+            ref += ak_triangles_intersect(A, B);
+        }
+    AK_CHECK(ref > 32); /* the circle crosses at least one triangle per longitude */
+    AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){pos, 2 * vc}, (ak_u32_cspan){idx, 6 * tc}, (ak_u32_span){0}, &n),
+                AK_OK);
+    AK_CHECK_EQ(n, ref);
+    free(pos);
+    free(idx);
+    ak_mesh_destroy(a);
+    ak_mesh_destroy(s);
+}
+
 int main(void) {
     AK_RUN(create_one_allocation_and_zeroed);
     AK_RUN(create_bad_input);
@@ -499,5 +721,9 @@ int main(void) {
     AK_RUN(validate_weights_codes);
     AK_RUN(weights_normalize_keeps_largest);
     AK_RUN(weights_normalize_edge_cases);
+    AK_RUN(triangle_pairs_constructed);
+    AK_RUN(self_intersections_soup_matches_brute_force);
+    AK_RUN(self_intersections_meshes);
+    AK_RUN(self_intersections_50k_fast_and_exact);
     return ak_test_finish();
 }

@@ -2,8 +2,8 @@
  *
  * What it does: one container type shared by the skinning, blend-shape, import, builtin and
  * rendering modules, plus the geometric queries they all need: bounds, normals, enclosed
- * volume, closed/consistently-oriented checks, and skin-weight validation and clean-up
- * (limit to k influences, renormalise).
+ * volume, closed/consistently-oriented checks, self-intersection counts, and skin-weight
+ * validation and clean-up (limit to k influences, renormalise).
  *
  * What it does NOT do: deform (see skin.h, blendshape.h) or read files (see io.h).
  *
@@ -120,6 +120,25 @@ AK_API ak_result ak_mesh_compute_normals(ak_mesh* mesh);
  * positive when triangles are counter-clockwise seen from outside. Open meshes give the
  * volume of the cone to the origin (meaningless but finite). */
 AK_API double ak_volume_compute(ak_vec3_cspan positions, ak_u32_cspan indices);
+
+/* Number of pairs of triangles that intersect without being adjacent: two triangles are
+ * adjacent when they share a vertex, by index or by position (vertices at bitwise-equal
+ * positions count as one, so a UV seam's split vertices do not make neighbours look
+ * intersecting). Triangles are closed sets: touching at a point or along an edge counts.
+ * The test per pair is exact in its signs up to the rounding of double-precision orientation
+ * determinants on the float input (Plucker-style edge/triangle tests; the coplanar case in 2D);
+ * degenerate (zero-area) triangles never count. A uniform grid of triangle bounds finds the
+ * candidate pairs (about 30 ms for 50k triangles). Temporary memory comes from malloc (about
+ * 60 bytes per triangle and 12 per vertex). out_pairs is optional (count 0): the first
+ * out_pairs.count / 2 pairs found are written as triangle indices (lower first), in an
+ * unspecified but deterministic order; *out_count is always the full count.
+ * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX, AK_ERR_BAD_DATA (a non-finite position),
+ * AK_ERR_BAD_ARG (more than 2^32 vertices or 2^29 triangles), AK_ERR_NO_MEMORY. */
+AK_API ak_result ak_mesh_self_intersections(ak_vec3_cspan positions, ak_u32_cspan indices,
+                                            ak_u32_span out_pairs, size_t* out_count);
+/* The same closed triangle-triangle test for one pair (a[3], b[3]): true when they share a
+ * point. Degenerate or non-finite triangles give false. */
+AK_API bool ak_triangles_intersect(const ak_vec3 a[3], const ak_vec3 b[3]);
 
 /* True when every edge is shared by exactly two triangles that traverse it in opposite
  * directions (closed, edge-manifold and consistently oriented). Degenerate triangles (a
