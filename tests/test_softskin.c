@@ -6,6 +6,7 @@
 #include "ak_test.h"
 
 typedef struct rig {
+    ak_mat4 previous[8];    /* the palette of the previous step */
     ak_scene* scene;
     const ak_mesh* mesh;
     size_t joints;          /* skeleton joints */
@@ -15,6 +16,8 @@ typedef struct rig {
     ak_transform local[8];
     ak_mat4 world[8], palette[8];
 } rig;
+
+static void rig_pose(rig* g, ak_quat q);
 
 static bool rig_load(rig* g, uint32_t rings, uint32_t segments) {
     memset(g, 0, sizeof *g);
@@ -36,12 +39,17 @@ static bool rig_load(rig* g, uint32_t rings, uint32_t segments) {
         for (size_t q = 0; q < g->slots; ++q)
             if (sk->joints[q] == pj) parent[k] = (int16_t)q;
     }
-    return ak_skin_bones_from_joints((ak_vec3_cspan){pos, g->slots}, (ak_i16_cspan){parent, g->slots}, false,
-                                     (ak_skin_bone_span){g->bones, 16}, &g->bone_count) == AK_OK;
+    if (ak_skin_bones_from_joints((ak_vec3_cspan){pos, g->slots}, (ak_i16_cspan){parent, g->slots}, false,
+                                  (ak_skin_bone_span){g->bones, 16}, &g->bone_count) != AK_OK)
+        return false;
+    rig_pose(g, ak_quat_identity()); /* twice: the previous palette is the bind pose too */
+    rig_pose(g, ak_quat_identity());
+    return true;
 }
 
 /* Palette with joint1 rotated by q (identity: the bind pose). */
 static void rig_pose(rig* g, ak_quat q) {
+    memcpy(g->previous, g->palette, sizeof g->palette);
     ak_scene_rest_pose(g->scene, (ak_transform_span){g->local, g->joints});
     int mid = ak_skeleton_find_joint(g->scene->skeleton, "joint1");
     g->local[mid].rotation = ak_quat_mul(g->local[mid].rotation, q);
@@ -80,6 +88,7 @@ static bool sim_init(sim* s, const rig* g, const ak_skin_soft_desc* d) {
     if (!s->x || !s->v || !s->out || !s->scratch) return false;
     s->job = (ak_skin_soft_step_job){.soft = s->soft,
                                      .palette = {g->palette, g->slots},
+                                     .previous_palette = {g->previous, g->slots},
                                      .node_positions = {s->x, n},
                                      .node_velocities = {s->v, n},
                                      .scratch = {s->scratch, ss},
@@ -173,8 +182,17 @@ AK_TEST(held_pose_converges_and_keeps_volume) {
     ak_scene_destroy(g.scene);
 }
 
-/* Volume of the mesh skinned by LBS or DQS at the rig's current palette (shown beside). */
-static double skinned_volume(const rig* g, ak_skin_method method) {
+static size_t intersections(const rig* g, const ak_vec3* p) {
+    size_t count = 0;
+    ak_result r = ak_mesh_self_intersections((ak_vec3_cspan){p, g->mesh->vertex_count},
+                                             (ak_u32_cspan){g->mesh->indices, 3 * g->mesh->triangle_count},
+                                             (ak_u32_span){NULL, 0}, &count);
+    return r == AK_OK ? count : SIZE_MAX;
+}
+
+/* Volume (and self-intersecting pairs) of the mesh skinned by LBS or DQS at the rig's current
+ * palette (shown beside). */
+static double skinned_volume(const rig* g, ak_skin_method method, size_t* out_pairs) {
     const ak_mesh* m = g->mesh;
     size_t n = m->vertex_count;
     ak_vec3* out = malloc(n * sizeof(ak_vec3));
@@ -188,6 +206,7 @@ static double skinned_volume(const rig* g, ak_skin_method method) {
                        .scratch = {scratch, sizeof scratch},
                        .out_positions = {out, n, 0}};
     double v = out && ak_skin_job_run(&job) == AK_OK ? volume_of(g, out) : NAN;
+    *out_pairs = out ? intersections(g, out) : SIZE_MAX;
     free(out);
     return v;
 }
@@ -227,9 +246,14 @@ static void bend_case(float degrees, int res, bool print) {
         free(rest);
         free(tt);
     }
-    if (print) printf("  bend %.0f: soft volume ratio %.5f (%zu nodes, %zu tets); LBS %.5f, DQS %.5f\n", (double)degrees, vr,
-                      ak_skin_soft_node_count(s.soft), ak_skin_soft_tet_count(s.soft), skinned_volume(&g, AK_SKIN_LBS) / v0,
-                      skinned_volume(&g, AK_SKIN_DQS) / v0);
+    size_t lbs_pairs = 0, dqs_pairs = 0, soft_pairs = intersections(&g, s.out);
+    double lbs_v = skinned_volume(&g, AK_SKIN_LBS, &lbs_pairs) / v0, dqs_v = skinned_volume(&g, AK_SKIN_DQS, &dqs_pairs) / v0;
+    if (print)
+        printf("  bend %.0f: volume ratio soft %.5f LBS %.5f DQS %.5f; intersecting pairs soft %zu LBS %zu DQS %zu (%zu nodes, %zu tets)\n",
+               (double)degrees, vr, lbs_v, dqs_v, soft_pairs, lbs_pairs, dqs_pairs, ak_skin_soft_node_count(s.soft),
+               ak_skin_soft_tet_count(s.soft));
+    AK_CHECK_MSG(lbs_pairs + dqs_pairs > 0, "bend %g: LBS and DQS should interpenetrate", (double)degrees);
+    AK_CHECK_MSG(soft_pairs == 0, "bend %g: %zu self-intersecting pairs", (double)degrees, soft_pairs);
     AK_CHECK_MSG(fabs(vr - 1.0) < 0.01, "bend %g: volume ratio %g", (double)degrees, vr);
     sim_free(&s);
     ak_scene_destroy(g.scene);

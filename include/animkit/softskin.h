@@ -85,6 +85,9 @@ typedef struct ak_skin_soft_desc {
     float bone_radius;         /* kinematic capsule radius as a fraction of the median flesh
                                   radius of the bone, in (0, 1]; 0 -> 0.5 */
     size_t memory_budget;      /* most bytes create may allocate; 0 -> 512 MiB */
+    float jiggle_damping;      /* 1/s: the flesh's velocity relative to the skinned motion
+                                  (see previous_palette) decays as exp(-jiggle_damping t);
+                                  0 -> 5; negative -> none */
 } ak_skin_soft_desc;
 
 /* The desc with every zero field replaced by its documented default. */
@@ -142,6 +145,10 @@ typedef struct ak_skin_soft_step_job {
     const ak_skin_soft* soft;       /* required */
     ak_mat4_cspan palette;          /* required: this step's end pose; count > every bone's
                                        joint_index */
+    ak_mat4_cspan previous_palette; /* optional (ptr NULL -> none): the previous step's palette
+                                       (count >= palette.count): jiggle damping then damps the
+                                       flesh's motion relative to the skinned motion; without it,
+                                       the absolute velocity (a drag) */
     float dt;                       /* seconds, in (0, 1]; 0 -> 1/60 */
     ak_vec3 gravity;                /* m/s^2 on the flesh; zero -> none */
     ak_vec3_span node_positions;    /* required: state, in and out (count >= node count) */

@@ -10,11 +10,12 @@
 
 #define SOFT_MAX_COLORS 128u
 #define SOFT_INFLUENCES 4u
+#define SOFT_NODE_PLANES 4u
 
 struct ak_skin_soft {
     ak_allocator alloc;
     size_t node_count, tet_count, kin_count, vertex_count, bone_count;
-    float mu, lambda, damping;
+    float mu, lambda, damping, jiggle_damping;
     uint32_t substeps;
     uint16_t max_joint;
     ak_vec3* rest;          /* [node] */
@@ -35,6 +36,10 @@ struct ak_skin_soft {
     float* core_radius;     /* [bone] kinematic capsule and collider radius */
     uint64_t* collide;      /* [node * collide_words]: bit b -> node collides with bone b */
     size_t collide_words;
+    uint32_t plane_count;
+    uint32_t* planes;       /* [2 * plane]: parent bone, child bone meeting at a joint */
+    int32_t* node_planes;   /* [node * SOFT_NODE_PLANES]: +(p + 1) parent side, -(p + 1) child
+                               side, 0 none */
 };
 
 /* ---- small helpers -------------------------------------------------------------------- */
@@ -105,12 +110,13 @@ ak_skin_soft_desc ak_skin_soft_desc_resolved(const ak_skin_soft_desc* desc) {
     if (desc) d = *desc;
     else memset(&d, 0, sizeof d);
     if (d.resolution == 0) d.resolution = 16;
-    if (d.youngs_modulus == 0.0f) d.youngs_modulus = 2e5f;
+    if (d.youngs_modulus == 0.0f) d.youngs_modulus = 5e4f;
     if (d.poisson_ratio == 0.0f) d.poisson_ratio = 0.499f;
     if (d.density == 0.0f) d.density = 1000.0f;
-    if (d.damping == 0.0f) d.damping = 0.01f;
+    if (d.damping == 0.0f) d.damping = 0.1f;
     if (d.substeps == 0) d.substeps = 10;
     if (d.bone_radius == 0.0f) d.bone_radius = 0.5f;
+    if (d.jiggle_damping == 0.0f) d.jiggle_damping = 5.0f;
     if (d.memory_budget == 0) d.memory_budget = (size_t)512 << 20;
     return d;
 }
@@ -134,6 +140,8 @@ void ak_skin_soft_destroy(ak_skin_soft* s) {
     akp_free(a, s->contact_radius);
     akp_free(a, s->core_radius);
     akp_free(a, s->collide);
+    akp_free(a, s->planes);
+    akp_free(a, s->node_planes);
     ak_allocator copy = s->alloc;
     akp_free(&copy, s);
 }
@@ -153,7 +161,7 @@ static ak_result check_desc(const ak_skin_soft_desc* d) {
         return AK_ERR_BAD_ARG;
     if (d->resolution < 2 || d->resolution > 256 || !(d->youngs_modulus > 0.0f) || !isfinite(d->youngs_modulus) ||
         !(d->poisson_ratio > 0.0f && d->poisson_ratio <= 0.4999f) || !(d->density > 0.0f) || !isfinite(d->density) ||
-        !isfinite(d->damping) || d->substeps > 1000 || !(d->bone_radius > 0.0f && d->bone_radius <= 1.0f))
+        !isfinite(d->damping) || !isfinite(d->jiggle_damping) || d->substeps > 1000 || !(d->bone_radius > 0.0f && d->bone_radius <= 1.0f))
         return AK_ERR_BAD_ARG;
     size_t wn = d->positions.count * d->influence_count;
     if (d->joints.count < wn || d->weights.count < wn) return AK_ERR_SPAN_SMALL;
@@ -247,6 +255,7 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     s->bone_count = nb;
     s->substeps = d.substeps;
     s->damping = d.damping > 0.0f ? d.damping : 0.0f;
+    s->jiggle_damping = d.jiggle_damping > 0.0f ? d.jiggle_damping : 0.0f;
     s->mu = d.youngs_modulus / (2.0f * (1.0f + d.poisson_ratio));
     s->lambda = d.youngs_modulus * d.poisson_ratio / ((1.0f + d.poisson_ratio) * (1.0f - 2.0f * d.poisson_ratio));
 #define SOFT_ALLOC(ptr, type, n)                                      \
@@ -564,9 +573,9 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
         s->core_radius[b] = s->contact_radius[b] > 0.0f ? ak_maxf(d.bone_radius * s->contact_radius[b], 1.2f * h) : 0.0f;
     /* kinematic: inside a capsule and bound (almost) rigidly to one joint, so that the nodes
      * around a joint, whose weights blend, are flesh */
-    /* ... and not within two capsule radii of another bone: the flesh around a joint stays
+    /* ... and not within three capsule radii of another bone: the flesh around a joint stays
      * free, so that the bones' cores do not crush it at a deep bend */
-    const float zone = 2.0f;
+    const float zone = 3.0f;
     for (size_t n = 0; n < nn; ++n) {
         if (s->node_weights[SOFT_INFLUENCES * n] < 0.99f) continue;
         uint16_t part = s->node_joints[SOFT_INFLUENCES * n];
@@ -608,6 +617,53 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
             if (!(rc > 0.0f) || s->bones[b].joint_index == part) continue;
             if (akp_segment_dist_sq(s->rest[n], s->bones[b].head, s->bones[b].tail, NULL) < rc * rc) continue;
             s->collide[n * s->collide_words + b / 64] |= (uint64_t)1 << (b % 64);
+        }
+    }
+    /* 10. joint contact planes: where bone c starts at bone p's end, the flesh of each side
+     * stays on its side of the plane bisecting the two bones (a bent knee or elbow presses its
+     * two sides flat against each other instead of passing through) */
+    {
+        size_t np = 0;
+        for (int pass = 0; pass < 2; ++pass) {
+            np = 0;
+            for (size_t b1 = 0; b1 < nb; ++b1)
+                for (size_t b2 = 0; b2 < nb; ++b2) {
+                    const ak_skin_bone *P1 = &s->bones[b1], *C1 = &s->bones[b2];
+                    if (b1 == b2 || !(s->contact_radius[b1] > 0.0f) || !(s->contact_radius[b2] > 0.0f)) continue;
+                    if (P1->joint_index == C1->joint_index) continue;
+                    if (ak_vec3_distance(P1->tail, C1->head) > 1e-4f * longest) continue;
+                    if (ak_vec3_length(ak_vec3_sub(P1->tail, P1->head)) <= 0.0f || ak_vec3_length(ak_vec3_sub(C1->tail, C1->head)) <= 0.0f) continue;
+                    if (pass == 1) {
+                        s->planes[2 * np] = (uint32_t)b1;
+                        s->planes[2 * np + 1] = (uint32_t)b2;
+                    }
+                    ++np;
+                }
+            if (pass == 0) {
+                s->plane_count = (uint32_t)np;
+                if (np == 0) break;
+                SOFT_ALLOC(s->planes, uint32_t, 2 * np);
+            }
+        }
+        SOFT_ALLOC(s->node_planes, int32_t, SOFT_NODE_PLANES * nn);
+        for (size_t n = 0; n < nn && np; ++n) {
+            if (s->kinematic[n]) continue;
+            uint16_t part = s->node_joints[SOFT_INFLUENCES * n];
+            uint32_t k = 0;
+            for (uint32_t pl = 0; pl < s->plane_count && k < SOFT_NODE_PLANES; ++pl) {
+                const ak_skin_bone *P1 = &s->bones[s->planes[2 * pl]], *C1 = &s->bones[s->planes[2 * pl + 1]];
+                ak_vec3 u = ak_vec3_add(ak_vec3_normalize(ak_vec3_sub(P1->tail, P1->head)), ak_vec3_normalize(ak_vec3_sub(C1->tail, C1->head)));
+                if (ak_vec3_length(u) < 0.1f) continue;
+                ak_vec3 nrm = ak_vec3_normalize(u);
+                /* the two limbs: as far as the longer bone plus its flesh */
+                float reach = ak_maxf(ak_vec3_distance(P1->head, P1->tail), ak_vec3_distance(C1->head, C1->tail)) +
+                              2.0f * ak_maxf(s->contact_radius[s->planes[2 * pl]], s->contact_radius[s->planes[2 * pl + 1]]);
+                ak_vec3 rel = ak_vec3_sub(s->rest[n], P1->tail);
+                if (ak_vec3_length(rel) > reach) continue;
+                float sd = ak_vec3_dot(rel, nrm);
+                if (sd < -0.5f * h && part == P1->joint_index) s->node_planes[SOFT_NODE_PLANES * n + k++] = (int32_t)pl + 1;
+                else if (sd > 0.5f * h && part == C1->joint_index) s->node_planes[SOFT_NODE_PLANES * n + k++] = -((int32_t)pl + 1);
+            }
         }
     }
 #undef SOFT_ALLOC
@@ -686,11 +742,12 @@ ak_result ak_skin_soft_surface(const ak_skin_soft* s, ak_vec3_cspan x, ak_vec3_s
 
 /* ---- step ----------------------------------------------------------------------------- */
 
-/* Scratch layout: start[node], prev[node], target[node], lambda[2 * tet], posed bones[2 * bone]. */
+/* Scratch layout: start[node], prev[node], target[node], vref[node], lambda[2 * tet], posed
+ * bones[2 * bone], joint planes[2 * plane]. */
 size_t ak_skin_soft_step_scratch_size(const ak_skin_soft* s) {
     if (!s) return 0;
-    return 64 + akp_align16(3 * s->node_count * sizeof(ak_vec3)) + akp_align16(2 * s->tet_count * sizeof(float)) +
-           akp_align16(2 * s->bone_count * sizeof(ak_vec3));
+    return 64 + akp_align16(4 * s->node_count * sizeof(ak_vec3)) + akp_align16(2 * s->tet_count * sizeof(float)) +
+           akp_align16(2 * s->bone_count * sizeof(ak_vec3)) + akp_align16(2 * s->plane_count * sizeof(ak_vec3));
 }
 
 ak_result ak_skin_soft_step_validate(const ak_skin_soft_step_job* j) {
@@ -700,15 +757,17 @@ ak_result ak_skin_soft_step_validate(const ak_skin_soft_step_job* j) {
     if (!(j->dt >= 0.0f && j->dt <= 1.0f) || j->thread_count > 64 || !ak_vec3_is_finite(j->gravity)) return AK_ERR_BAD_ARG;
     if (j->node_positions.count < s->node_count || j->node_velocities.count < s->node_count ||
         j->palette.count <= s->max_joint || j->scratch.count < ak_skin_soft_step_scratch_size(s) ||
+        (j->previous_palette.ptr && j->previous_palette.count < j->palette.count) ||
         (j->out_positions.ptr && j->out_positions.count < s->vertex_count))
         return AK_ERR_SPAN_SMALL;
-    if (!palette_finite(j->palette)) return AK_ERR_BAD_DATA;
+    if (!palette_finite(j->palette) || (j->previous_palette.ptr && !palette_finite(j->previous_palette))) return AK_ERR_BAD_DATA;
     return AK_OK;
 }
 
 typedef struct step_ctx {
     const ak_skin_soft* s;
-    ak_vec3 *x, *v, *start, *prev, *target, *bones;
+    ak_vec3 *x, *v, *start, *prev, *target, *bones, *planes, *vref;
+    float jiggle; /* 1 - exp(-jiggle_damping h) */
     float* lambda;
     float h, gamma, gamma_h, adev, ahyd;
     uint32_t iterations; /* adev = 1 / (mu h^2), ahyd = 1 / (lambda h^2): divide by V */
@@ -790,6 +849,15 @@ static void solve_tet(const step_ctx* c, size_t q) {
 
 static void collide_node(const step_ctx* c, size_t n) {
     const ak_skin_soft* s = c->s;
+    for (uint32_t k = 0; k < SOFT_NODE_PLANES && s->plane_count; ++k) {
+        int32_t e = s->node_planes[SOFT_NODE_PLANES * n + k];
+        if (e == 0) break;
+        size_t pl = (size_t)(e > 0 ? e : -e) - 1;
+        ak_vec3 nrm = c->planes[2 * pl + 1];
+        if (nrm.x == 0.0f && nrm.y == 0.0f && nrm.z == 0.0f) continue;
+        float sd = ak_vec3_dot(ak_vec3_sub(c->x[n], c->planes[2 * pl]), nrm);
+        if (e > 0 ? sd > 0.0f : sd < 0.0f) c->x[n] = ak_vec3_madd(c->x[n], nrm, -sd);
+    }
     const uint64_t* bits = &s->collide[n * s->collide_words];
     for (size_t wi = 0; wi < s->collide_words; ++wi)
         for (uint64_t m = bits[wi]; m; m &= m - 1) {
@@ -860,6 +928,8 @@ static void step_work(soft_team* team, uint32_t index) {
         for (size_t n = nb; n < ne; ++n) {
             if (!s->kinematic[n]) collide_node(c, n);
             c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n], c->prev[n]), inv_h);
+            /* jiggle damping: velocity relative to the skinned motion decays */
+            if (!s->kinematic[n]) c->v[n] = ak_vec3_madd(c->v[n], ak_vec3_sub(c->v[n], c->vref[n]), -c->jiggle);
         }
         sync(team);
     }
@@ -890,8 +960,10 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     c.start = (ak_vec3*)(void*)base;
     c.prev = c.start + nn;
     c.target = c.prev + nn;
-    c.lambda = (float*)(void*)(base + akp_align16(3 * nn * sizeof(ak_vec3)));
+    c.vref = c.target + nn;
+    c.lambda = (float*)(void*)(base + akp_align16(4 * nn * sizeof(ak_vec3)));
     c.bones = (ak_vec3*)(void*)((uint8_t*)c.lambda + akp_align16(2 * s->tet_count * sizeof(float)));
+    c.planes = (ak_vec3*)(void*)((uint8_t*)c.bones + akp_align16(2 * s->bone_count * sizeof(ak_vec3)));
     float dt = j->dt > 0.0f ? j->dt : 1.0f / 60.0f;
     c.h = dt / (float)s->substeps;
     c.gamma = s->damping / c.h;
@@ -900,14 +972,28 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     c.ahyd = 1.0f / (s->lambda * c.h * c.h);
     c.hyd_rest = 1.0f + s->mu / s->lambda;
     c.gravity = j->gravity;
+    c.jiggle = 1.0f - expf(-s->jiggle_damping * c.h);
+    const bool have_prev = j->previous_palette.ptr != NULL;
     for (size_t n = 0; n < nn; ++n) {
         c.start[n] = c.x[n];
-        if (s->kinematic[n]) c.target[n] = lbs_node(s, n, j->palette.ptr, j->palette.count);
+        ak_vec3 end = lbs_node(s, n, j->palette.ptr, j->palette.count);
+        if (s->kinematic[n]) c.target[n] = end;
+        c.vref[n] = have_prev ? ak_vec3_scale(ak_vec3_sub(end, lbs_node(s, n, j->previous_palette.ptr, j->previous_palette.count)), 1.0f / dt)
+                              : ak_vec3_zero();
     }
     for (size_t b = 0; b < s->bone_count; ++b) {
         size_t jn = s->bones[b].joint_index;
         c.bones[2 * b] = ak_mat4_transform_point(j->palette.ptr[jn], s->bones[b].head);
         c.bones[2 * b + 1] = ak_mat4_transform_point(j->palette.ptr[jn], s->bones[b].tail);
+    }
+    for (uint32_t pl = 0; pl < s->plane_count; ++pl) {
+        const ak_skin_bone *bp = &s->bones[s->planes[2 * pl]], *bc = &s->bones[s->planes[2 * pl + 1]];
+        const ak_mat4 mp = j->palette.ptr[bp->joint_index], mc = j->palette.ptr[bc->joint_index];
+        ak_vec3 up = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mp, bp->tail), ak_mat4_transform_point(mp, bp->head)));
+        ak_vec3 uc = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mc, bc->tail), ak_mat4_transform_point(mc, bc->head)));
+        ak_vec3 u = ak_vec3_add(up, uc);
+        c.planes[2 * pl] = ak_mat4_transform_point(mp, bp->tail);
+        c.planes[2 * pl + 1] = ak_vec3_length(u) > 0.1f ? ak_vec3_normalize(u) : ak_vec3_zero(); /* folded: off */
     }
     uint32_t tc = j->thread_count > 1 ? j->thread_count : 1;
     if (tc > 1 && nn < 256 * (size_t)tc) tc = (uint32_t)(nn / 256 > 1 ? nn / 256 : 1);
