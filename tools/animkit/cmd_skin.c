@@ -7,21 +7,37 @@
 
 static const char* const usage =
     "usage: animkit skin --compare [FILE|builtin:NAME] [--json]\n"
-    "Compare linear blend (LBS), dual quaternion (DQS) and optimized-center (CoR) skinning.\n"
+    "Compare linear blend (LBS), dual quaternion (DQS), optimized-center (CoR) and volumetric\n"
+    "(soft: a simulated tetrahedral flesh, softskin.h) skinning. Soft reaches each cylinder\n"
+    "pose by turning the joint over 1/6 s and holding it 1/2 s (60 Hz steps), and runs\n"
+    "through a clip's 24 samples in order.\n"
     "On builtin:cylinder (the default) the middle joint is bent 90 degrees and twisted 90 and\n"
     "180 degrees (179.8, so the turn has a defined direction); for each pose and method it\n"
     "prints the volume of the deformed closed mesh relative to rest and the maximum bulge: the\n"
     "largest distance of a vertex from the posed bone axis beyond the rest radius, as a\n"
     "fraction of that radius, and the minimum radius (the narrowest cross-section: the\n"
-    "candy-wrapper collapse).\n"
+    "candy-wrapper collapse), and the number of self-intersecting triangle pairs.\n"
     "On another model it samples every clip at 24 times and prints, per method, the range of\n"
-    "the volume ratio (closed meshes only) and the largest distance from the LBS result.\n"
+    "the volume ratio (closed meshes only), the largest distance from the LBS result and the\n"
+    "most self-intersecting triangle pairs.\n"
     "  --json  one JSON object instead: {\"model\", \"rest_volume\", \"rest_radius\", \"poses\":\n"
-    "          [{\"pose\", \"LBS\"|\"DQS\"|\"CoR\": {\"volume_ratio\", \"max_bulge\", \"min_radius\"}}]}\n"
+    "          [{\"pose\", \"LBS\"|\"DQS\"|\"CoR\"|\"soft\": {\"volume_ratio\", \"volume_change\",\n"
+    "          \"max_bulge\", \"min_radius\", \"self_intersections\"}}]}\n"
     "          for the cylinder; {\"model\", \"methods\": [{\"method\", \"max_distance_from_lbs\",\n"
-    "          \"volume_min\", \"volume_max\"}]} for another model (volumes for closed meshes)\n";
+    "          \"max_self_intersections\", \"volume_min\", \"volume_max\", \"volume_change_max\"}]}\n"
+    "          for another model (volumes for closed meshes)\n";
 
-static const cli_method methods[3] = {CLI_LBS, CLI_DQS, CLI_COR};
+#define METHOD_COUNT 4
+static const cli_method methods[METHOD_COUNT] = {CLI_LBS, CLI_DQS, CLI_COR, CLI_SOFT};
+
+/* Self-intersecting triangle pairs of mesh m at positions pos (exact test, mesh.h); -1 when
+ * the count fails. */
+static long long pairs_of(const ak_mesh* m, const ak_vec3* pos) {
+    size_t count = 0;
+    ak_result r = ak_mesh_self_intersections((ak_vec3_cspan){pos, m->vertex_count}, (ak_u32_cspan){m->indices, m->triangle_count * 3},
+                                             (ak_u32_span){NULL, 0}, &count);
+    return r == AK_OK ? (long long)count : -1;
+}
 
 /* Distance from p to segment ab. */
 static float seg_dist(ak_vec3 p, ak_vec3 a, ak_vec3 b) {
@@ -80,20 +96,29 @@ static int compare_cylinder(ak_scene* s, bool json) {
     };
     if (json) printf("{\"model\": \"%s\", \"rest_volume\": %.9g, \"rest_radius\": %.9g, \"poses\": [", s->name,
                      rest_volume, (double)radius);
-    else printf("%s: rest volume %.6g, rest radius %.4g\n%-10s %-4s %12s %12s %12s\n", s->name, rest_volume, (double)radius,
-                "pose", "", "volume/rest", "max bulge", "min radius");
+    else printf("%s: rest volume %.6g, rest radius %.4g\n%-10s %-4s %12s %12s %12s %10s\n", s->name, rest_volume, (double)radius,
+                "pose", "", "volume/rest", "max bulge", "min radius", "x-pairs");
     for (int k = 0; k < 3 && rc == CLI_OK; ++k) {
         if (json) printf("%s{\"pose\": \"%s\"", k ? ", " : "", poses[k].name);
-        for (int mi = 0; mi < 3; ++mi) {
-            cli_poser_sample(&p, -1, 0.0f, true);
-            p.local[mid].rotation = ak_quat_mul(p.local[mid].rotation, poses[k].rot);
-            ak_result r = cli_poser_deform(&p, false, methods[mi]);
+        for (int mi = 0; mi < METHOD_COUNT; ++mi) {
+            ak_result r = AK_OK;
+            /* soft: turn the joint over 10 frames, then hold 30 (60 Hz) */
+            int frames = methods[mi] == CLI_SOFT ? 40 : 1;
+            if (methods[mi] == CLI_SOFT) cli_poser_soft_reset(&p);
+            for (int fr = 0; fr < frames && r == AK_OK; ++fr) {
+                cli_poser_sample(&p, -1, 0.0f, true);
+                float u = frames > 1 ? ak_minf(1.0f, (float)fr / 10.0f) : 1.0f;
+                p.local[mid].rotation = ak_quat_mul(p.local[mid].rotation, ak_quat_slerp(ak_quat_identity(), poses[k].rot, u));
+                p.sample_time = (float)fr / 60.0f;
+                r = cli_poser_deform(&p, false, methods[mi]);
+            }
             if (r != AK_OK) {
                 rc = cli_fail("skin", "%s: %s", s->name, ak_result_string(r));
                 break;
             }
             for (size_t j = 0; j < n; ++j) jp[j] = ak_mat4_get_translation(p.world[j]);
             double vol = mesh_volume(mesh, p.positions[0]) / rest_volume;
+            long long xp = pairs_of(mesh, p.positions[0]);
             float bulge = 0.0f, narrowest = INFINITY;
             for (size_t v = 0; v < mesh->vertex_count; ++v) {
                 float dv = chain_dist(p.positions[0][v], jp, n);
@@ -101,11 +126,12 @@ static int compare_cylinder(ak_scene* s, bool json) {
                 if (side[v]) narrowest = ak_minf(narrowest, dv);
             }
             if (json)
-                printf(", \"%s\": {\"volume_ratio\": %.9g, \"max_bulge\": %.9g, \"min_radius\": %.9g}",
-                       cli_method_name(methods[mi]), vol, (double)(bulge / radius), (double)(narrowest / radius));
+                printf(", \"%s\": {\"volume_ratio\": %.9g, \"volume_change\": %.9g, \"max_bulge\": %.9g, \"min_radius\": %.9g, "
+                       "\"self_intersections\": %lld}",
+                       cli_method_name(methods[mi]), vol, vol - 1.0, (double)(bulge / radius), (double)(narrowest / radius), xp);
             else
-                printf("%-10s %-4s %12.4f %11.2f%% %11.2f%%\n", mi == 0 ? poses[k].name : "", cli_method_name(methods[mi]),
-                       vol, 100.0 * (double)(bulge / radius), 100.0 * (double)(narrowest / radius));
+                printf("%-10s %-4s %12.4f %11.2f%% %11.2f%% %10lld\n", mi == 0 ? poses[k].name : "", cli_method_name(methods[mi]),
+                       vol, 100.0 * (double)(bulge / radius), 100.0 * (double)(narrowest / radius), xp);
         }
         if (json) printf("}");
     }
@@ -120,18 +146,21 @@ static int compare_generic(ak_scene* s, bool json) {
     cli_poser p;
     if (cli_poser_init(&p, s)) return cli_fail("skin", "out of memory");
     int rc = CLI_OK;
-    double vmin[3] = {INFINITY, INFINITY, INFINITY}, vmax[3] = {-INFINITY, -INFINITY, -INFINITY};
-    float dmax[3] = {0, 0, 0};
+    double vmin[METHOD_COUNT], vmax[METHOD_COUNT];
+    float dmax[METHOD_COUNT];
+    long long xmax[METHOD_COUNT];
+    for (int mi = 0; mi < METHOD_COUNT; ++mi) vmin[mi] = INFINITY, vmax[mi] = -INFINITY, dmax[mi] = 0.0f, xmax[mi] = 0;
     size_t max_v = 0;
     for (size_t m = 0; m < s->mesh_count; ++m) max_v = s->meshes[m].mesh->vertex_count > max_v ? s->meshes[m].mesh->vertex_count : max_v;
     ak_vec3* lbs = calloc(max_v ? max_v : 1, sizeof(ak_vec3));
     bool any_closed = false;
     size_t clips = s->clip_count ? s->clip_count : 1;
     for (size_t c = 0; c < clips && rc == CLI_OK && lbs; ++c) {
+        cli_poser_soft_reset(&p);
         float dur = s->clip_count ? ak_clip_duration(s->clips[c]) : 0.0f;
         for (int f = 0; f < 24 && rc == CLI_OK; ++f) {
             float t = dur * (float)f / 23.0f;
-            for (int mi = 0; mi < 3; ++mi) {
+            for (int mi = 0; mi < METHOD_COUNT; ++mi) {
                 ak_result r = cli_poser_pose(&p, s->clip_count ? (int)c : -1, t, false, methods[mi]);
                 if (r != AK_OK) {
                     rc = cli_fail("skin", "%s: %s", s->name, ak_result_string(r));
@@ -140,6 +169,8 @@ static int compare_generic(ak_scene* s, bool json) {
                 for (size_t m = 0; m < s->mesh_count; ++m) {
                     const ak_mesh* mesh = s->meshes[m].mesh;
                     if (s->meshes[m].skin < 0) continue;
+                    long long xp = pairs_of(mesh, p.positions[m]);
+                    if (xp > xmax[mi] || xp < 0) xmax[mi] = xp < 0 || xmax[mi] < 0 ? -1 : xp;
                     if (ak_mesh_is_closed_oriented(mesh)) {
                         any_closed = true;
                         double v = mesh_volume(mesh, p.positions[m]) / mesh_volume(mesh, mesh->positions);
@@ -158,18 +189,20 @@ static int compare_generic(ak_scene* s, bool json) {
         if (json) printf("{\"model\": ");
         if (json) cli_json_string(stdout, s->name);
         if (json) printf(", \"methods\": [");
-        else printf("%s: %zu clip%s x 24 frames\n%-5s %22s %18s\n", s->name, s->clip_count, cli_plural(s->clip_count), "", "volume/rest (min..max)",
-                    "max dist from LBS");
-        for (int mi = 0; mi < 3; ++mi) {
+        else printf("%s: %zu clip%s x 24 frames\n%-5s %22s %18s %10s\n", s->name, s->clip_count, cli_plural(s->clip_count), "",
+                    "volume/rest (min..max)", "max dist from LBS", "max x-pairs");
+        for (int mi = 0; mi < METHOD_COUNT; ++mi) {
             if (json) {
-                printf("%s{\"method\": \"%s\", \"max_distance_from_lbs\": %.9g", mi ? ", " : "", cli_method_name(methods[mi]),
-                       (double)dmax[mi]);
-                if (any_closed) printf(", \"volume_min\": %.9g, \"volume_max\": %.9g", vmin[mi], vmax[mi]);
+                printf("%s{\"method\": \"%s\", \"max_distance_from_lbs\": %.9g, \"max_self_intersections\": %lld", mi ? ", " : "",
+                       cli_method_name(methods[mi]), (double)dmax[mi], xmax[mi]);
+                if (any_closed)
+                    printf(", \"volume_min\": %.9g, \"volume_max\": %.9g, \"volume_change_max\": %.9g", vmin[mi], vmax[mi],
+                           fmax(fabs(vmin[mi] - 1.0), fabs(vmax[mi] - 1.0)));
                 printf("}");
             } else if (any_closed) {
-                printf("%-5s %10.4f .. %-9.4f %18.6g\n", cli_method_name(methods[mi]), vmin[mi], vmax[mi], (double)dmax[mi]);
+                printf("%-5s %10.4f .. %-9.4f %18.6g %10lld\n", cli_method_name(methods[mi]), vmin[mi], vmax[mi], (double)dmax[mi], xmax[mi]);
             } else {
-                printf("%-5s %22s %18.6g\n", cli_method_name(methods[mi]), "(open mesh)", (double)dmax[mi]);
+                printf("%-5s %22s %18.6g %10lld\n", cli_method_name(methods[mi]), "(open mesh)", (double)dmax[mi], xmax[mi]);
             }
         }
         if (json) printf("]}\n");

@@ -23,6 +23,7 @@ const view_help_entry view_help[] = {
     {"1", "LBS skinning"},
     {"2", "DQS skinning"},
     {"3", "CoR skinning"},
+    {"6", "soft (volumetric) skinning"},
     {"4", "LBS | DQS | CoR side by side"},
     {"w", "weight heatmap: next bone"},
     {"n", "normals overlay"},
@@ -718,6 +719,7 @@ static void key(view_app* a, int k) {
     case '1': a->method = CLI_LBS, a->side_by_side = false; break;
     case '2': a->method = CLI_DQS, a->side_by_side = false; break;
     case '3': a->method = CLI_COR, a->side_by_side = false; break;
+    case '6': a->method = CLI_SOFT, a->side_by_side = false; break;
     case '4': a->side_by_side = !a->side_by_side; break;
     case 'w':
         if (!a->weight_joint_count) {
