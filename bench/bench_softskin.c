@@ -3,7 +3,7 @@
  * cylinder. Prints the lattice size, the precompute (create) time, ms per 60 Hz frame with 1 and
  * 2 threads (the step plus the surface), DQS's ms per frame, and the ratio soft / DQS.
  *
- *     build/bench/bench_softskin [CesiumMan.glb]
+ *     build/bench/bench_softskin [CesiumMan.glb [RESOLUTION]]
  *
  * Single-thread figures use this thread's CPU time (a loaded machine's other processes do not
  * count); the two-thread figures use wall time. */
@@ -54,6 +54,8 @@ done:
     return count;
 }
 
+static uint32_t g_resolution = 0; /* argv[2]; 0 -> the library default */
+
 static void run_case(const char* name, ak_scene* s, int frames) {
     size_t mi = 0;
     while (mi < s->mesh_count && (s->meshes[mi].skin < 0 || !s->meshes[mi].mesh || !s->meshes[mi].mesh->triangle_count)) ++mi;
@@ -72,7 +74,8 @@ static void run_case(const char* name, ak_scene* s, int frames) {
                            .joints = {mesh->joints, wn},
                            .weights = {mesh->weights, wn},
                            .influence_count = mesh->influence_count,
-                           .bones = {bones, nb}};
+                           .bones = {bones, nb},
+                           .resolution = g_resolution};
     ak_skin_soft* soft = NULL;
     double t0 = bench_wall_s();
     ak_result r = ak_skin_soft_create(&d, NULL, &soft);
@@ -138,7 +141,8 @@ static void run_case(const char* name, ak_scene* s, int frames) {
         per[f - 1] = bench_cpu_s() - a;
     }
     double dqs_ms = 1e3 * bench_percentile(per, (size_t)frames, 0.5);
-    printf("%-22s %7zu %7zu %7zu %8.1f %9.3f %9.3f %9.4f %9.0f %9.0f\n", name, nv, nn, ak_skin_soft_tet_count(soft), 1e3 * create_s,
+    printf("%-22s %7zu %7zu %7zu %7zu %8.1f %9.3f %9.3f %9.4f %9.1f %9.0f\n", name, nv, nn, ak_skin_soft_kinematic_count(soft),
+           ak_skin_soft_tet_count(soft), 1e3 * create_s,
            ms[0], ms[1], dqs_ms, ms[0] / dqs_ms, 1e3 / ms[0]);
     free(per);
     free(dq);
@@ -155,8 +159,9 @@ static void run_case(const char* name, ak_scene* s, int frames) {
 
 int main(int argc, char** argv) {
     int frames = bench_quick() ? 10 : 240;
+    if (argc > 2) g_resolution = (uint32_t)atoi(argv[2]);
     printf("soft skinning, median ms per 60 Hz frame (10 substeps, step + surface); DQS the same frames\n");
-    printf("%-22s %7s %7s %7s %8s %9s %9s %9s %9s %9s\n", "model", "verts", "nodes", "tets", "build ms", "soft 1t", "soft 2t",
+    printf("%-22s %7s %7s %7s %7s %8s %9s %9s %9s %9s %9s\n", "model", "verts", "nodes", "kinem.", "tets", "build ms", "soft 1t", "soft 2t",
            "DQS 1t", "soft/DQS", "fps 1t");
     char buf[1024];
     const char* path = argc > 1 ? argv[1] : asset_path(buf, sizeof buf, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb");

@@ -573,22 +573,39 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
         s->core_radius[b] = s->contact_radius[b] > 0.0f ? ak_maxf(d.bone_radius * s->contact_radius[b], 1.2f * h) : 0.0f;
     /* kinematic: inside a capsule and bound (almost) rigidly to one joint, so that the nodes
      * around a joint, whose weights blend, are flesh */
-    /* ... and not within three capsule radii of another bone: the flesh around a joint stays
-     * free, so that the bones' cores do not crush it at a deep bend */
+    /* ... and not within three capsule radii (at most half its own bone's length) of
+     * another bone: the flesh around a joint stays free, so that the bones' cores do not crush
+     * it at a deep bend */
     const float zone = 3.0f;
-    for (size_t n = 0; n < nn; ++n) {
-        if (s->node_weights[SOFT_INFLUENCES * n] < 0.99f) continue;
-        uint16_t part = s->node_joints[SOFT_INFLUENCES * n];
-        bool inside = false, near_other = false;
-        for (size_t b = 0; b < nb; ++b) {
-            float core = s->core_radius[b];
-            if (!(core > 0.0f)) continue;
-            float d2 = akp_segment_dist_sq(s->rest[n], s->bones[b].head, s->bones[b].tail, NULL);
-            if (s->bones[b].joint_index == part) inside = inside || d2 < core * core;
-            else near_other = near_other || d2 < zone * zone * core * core;
-        }
-        s->kinematic[n] = inside && !near_other;
+    /* per joint: whether any node became kinematic with these rules; a joint that got none (its
+     * bones too short or too crowded for them: a dense skeleton at a coarse lattice) takes every
+     * node inside its capsule that it weighs most */
+    uint8_t* joint_has = (uint8_t*)akp_calloc(A, (size_t)s->max_joint + 1);
+    if (!joint_has) {
+        r = AK_ERR_NO_MEMORY;
+        goto fail;
     }
+    for (int pass = 0; pass < 2; ++pass)
+        for (size_t n = 0; n < nn; ++n) {
+            uint16_t part = s->node_joints[SOFT_INFLUENCES * n];
+            if (pass == 0 ? s->node_weights[SOFT_INFLUENCES * n] < 0.99f : joint_has[part] != 0) continue;
+            bool inside = false, near_other = false;
+            float own_len = 0.0f;
+            for (size_t b = 0; b < nb; ++b)
+                if (s->bones[b].joint_index == part && s->core_radius[b] > 0.0f)
+                    own_len = ak_maxf(own_len, ak_vec3_distance(s->bones[b].head, s->bones[b].tail));
+            for (size_t b = 0; b < nb; ++b) {
+                float core = s->core_radius[b];
+                if (!(core > 0.0f)) continue;
+                float d2 = akp_segment_dist_sq(s->rest[n], s->bones[b].head, s->bones[b].tail, NULL);
+                float z = ak_minf(zone * core, own_len / 2.0f);
+                if (s->bones[b].joint_index == part) inside = inside || d2 < core * core;
+                else near_other = near_other || (pass == 0 && d2 < z * z);
+            }
+            s->kinematic[n] = inside && !near_other;
+            if (pass == 0 && s->kinematic[n]) joint_has[part] = 1;
+        }
+    akp_free(A, joint_has);
     /* connected pieces without a kinematic node become kinematic whole */
     SOFT_ALLOC(t.uf, uint32_t, nn);
     SOFT_ALLOC(t.comp_kin, uint8_t, nn);
