@@ -431,10 +431,10 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     for (size_t q = 0; q < nt; ++q) s->color_start[t.color[q] + 1]++;
     for (uint32_t c = 0; c < ncol; ++c) s->color_start[c + 1] += s->color_start[c];
     {
-        uint32_t* fill = t.col_count; /* reuse: cols + 1 >= ... not guaranteed; use used[] */
-        (void)fill;
-        uint32_t* next = (uint32_t*)(void*)t.used; /* 8 * 2 * nn bytes >= 4 * ncol: nn >= 4 */
-        if (2 * nn * 2 < ncol) {
+        /* the colour masks are no longer needed: reuse them as the per-colour fill counters
+         * (4 * nn uint32_t slots; a tet has 4 nodes, so ncol <= 128 <= 4 * nn for nn >= 32) */
+        uint32_t* next = (uint32_t*)(void*)t.used;
+        if (4 * nn < ncol) {
             r = AK_ERR_UNSUPPORTED;
             goto fail;
         }
