@@ -276,7 +276,7 @@ static int method_arg(const char* s, cli_method* out) {
         return 0;
     }
     if (!cli_method_parse(s, out)) {
-        RAISE_ARG("method must be 'lbs', 'dqs' or 'cor', not '%s'", s);
+        RAISE_ARG("method must be 'lbs', 'dqs', 'cor', 'implicit' or 'soft', not '%s'", s);
         return -1;
     }
     return 0;
@@ -935,7 +935,7 @@ static PyMethodDef scene_methods[] = {
     {"skin", (PyCFunction)(void (*)(void))scene_skin, METH_VARARGS | METH_KEYWORDS,
      "skin(pose, method='lbs', mesh=0, out=None) -> numpy.ndarray\n\n"
      "World-space vertex positions (N, 3) float32 of scene mesh `mesh` in `pose`: morphed, then "
-     "skinned with 'lbs', 'dqs' or 'cor' (an unskinned mesh is moved by its node). Bit for bit the "
+     "skinned with 'lbs', 'dqs', 'cor', 'implicit' or 'soft' (an unskinned mesh is moved by its node). Bit for bit the "
      "vertices `animkit export --time T --method M` writes. out: a writable C-contiguous (N, 3) "
      "float32 array to write into (no allocation)."},
     {"ik", (PyCFunction)(void (*)(void))scene_ik, METH_VARARGS | METH_KEYWORDS,

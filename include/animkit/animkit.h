@@ -17,6 +17,7 @@
 #include "mesh.h"
 #include "scene.h"
 #include "skin.h"
+#include "softskin.h"
 #include "ik.h"
 #include "blendshape.h"
 #include "deform.h"

@@ -126,7 +126,7 @@ class Scene:
         """The skeleton's rest pose."""
     def skin(self, pose: Pose, method: str = "lbs", mesh: int = 0,
              out: Optional[npt.NDArray[np.float32]] = None) -> npt.NDArray[np.float32]:
-        """(N, 3) float32 world-space vertices of mesh `mesh` in `pose` ('lbs', 'dqs' or 'cor'):
+        """(N, 3) float32 world-space vertices of mesh `mesh` in `pose` ('lbs', 'dqs', 'cor', 'implicit' or 'soft'):
         bit for bit what `animkit export --time T --method M` writes. out: a writable
         C-contiguous (N, 3) float32 array to write into (returned)."""
     def ik(self, effector: str, target: Sequence[float], solver: Optional[str] = "fabrik",

@@ -343,7 +343,7 @@ def test_errors_carry_message_and_path(tmp_path):
         ak.load(str(tmp_path))
     scene = load("builtin:humanoid")
     pose = scene.sample()
-    with pytest.raises(ValueError, match="method must be 'lbs', 'dqs' or 'cor', not 'xyz'"):
+    with pytest.raises(ValueError, match="method must be 'lbs', 'dqs', 'cor', 'implicit' or 'soft', not 'xyz'"):
         scene.skin(pose, method="xyz")
     with pytest.raises(ak.ArgumentError, match="time must be a finite number"):
         scene.sample(time=float("inf"))

@@ -141,7 +141,17 @@ bool cli_mkdir_p(const char* path);
 
 /* ---- posing: sample a clip, FK, morph, skin (the pipeline every command shares) ---- */
 
-typedef enum cli_method { CLI_LBS = 0, CLI_DQS, CLI_COR, CLI_IMPLICIT } cli_method;
+typedef enum cli_method { CLI_LBS = 0, CLI_DQS, CLI_COR, CLI_IMPLICIT, CLI_SOFT } cli_method;
+
+/* Volumetric skinning state of one mesh (softskin.h), built on first CLI_SOFT use. */
+typedef struct cli_soft_mesh {
+    ak_skin_soft* soft;
+    ak_vec3 *x, *v;       /* node state */
+    uint8_t* scratch;
+    ak_mat4* previous;    /* the palette of the previous step */
+    bool started;         /* false: the next deform starts at rest under its pose */
+    bool failed;          /* the build failed (not a closed mesh...): deform with DQS */
+} cli_soft_mesh;
 
 /* Per-scene working state for posing. */
 typedef struct cli_poser {
@@ -167,6 +177,12 @@ typedef struct cli_poser {
     bool weld_normals;
     uint32_t* weld_scratch; /* allocated on first use */
     size_t weld_scratch_count;
+    /* CLI_SOFT: the flesh is simulated from one deform to the next by the time between their
+     * samples (sample_time, set by cli_poser_sample): 0 -> no step; negative or above 0.5 s
+     * -> restart at rest under the pose; steps of at most 1/60 s */
+    cli_soft_mesh* soft;    /* [mesh_count], NULL until the first CLI_SOFT deform */
+    float sample_time, soft_time;
+    uint32_t soft_resolution; /* lattice resolution; 0 -> the library default */
 } cli_poser;
 
 bool cli_method_parse(const char* s, cli_method* out);
@@ -180,6 +196,11 @@ ak_result cli_poser_pose(cli_poser* p, int clip, float t, bool bind, cli_method 
  * weights; then FK, morph and skin from whatever p->local holds. */
 ak_result cli_poser_sample(cli_poser* p, int clip, float t, bool bind);
 ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method);
+/* Restart the soft simulation at the next CLI_SOFT deform. */
+void cli_poser_soft_reset(cli_poser* p);
+/* Bind-space bones of a skin: one segment from each slot's joint to each child slot's joint,
+ * a point bone for slots without a child slot; out holds 2 * skin->joint_count. */
+size_t cli_skin_bones(const ak_scene* s, const ak_scene_skin* skin, ak_skin_bone* out);
 
 /* Commands. */
 int cmd_demo(int argc, char** argv);

@@ -6,7 +6,7 @@
 
 static const char* const usage =
     "usage: animkit export FILE|builtin:NAME [--clip N|NAME] [--time T] [--bind]\n"
-    "                      [--method lbs|dqs|cor|implicit] -o OUT.obj|OUT.glb|OUT.gltf\n"
+    "                      [--method lbs|dqs|cor|implicit|soft] -o OUT.obj|OUT.glb|OUT.gltf\n"
     "OUT.glb / OUT.gltf (+ OUT.bin): the whole scene as glTF 2.0 (every node, skin, mesh, morph\n"
     "target and clip; keys kept as they are); --clip, --time, --bind and --method apply to OBJ.\n"
     "Write the meshes posed at time T (default 0) of a clip (default the first) as OBJ with\n"
@@ -17,7 +17,7 @@ static const char* const usage =
     "no mesh (a BVH: skeleton and motion only) is an error: exit 1, \"no mesh to export\".\n"
     "  --bind     write every mesh's vertices as stored (bind space: no clip, no skinning,\n"
     "             no morphing, no node transform)\n"
-    "  --method   skinning method (default lbs)\n";
+    "  --method   skinning method (default lbs); soft simulates the flesh from time 0 to --time\n";
 
 static void export_warn(ak_log_level level, const char* message, void* user) {
     (void)level;
@@ -68,7 +68,7 @@ int cmd_export(int argc, char** argv) {
         return cli_usage("export", "--time '%s' is not a number", CLI_GET(&a, "--time"));
     cli_method method = CLI_LBS;
     if (CLI_GET(&a, "--method") && !cli_method_parse(CLI_GET(&a, "--method"), &method))
-        return cli_usage("export", "--method must be lbs, dqs, cor or implicit, not '%s'", CLI_GET(&a, "--method"));
+        return cli_usage("export", "--method must be lbs, dqs, cor, implicit or soft, not '%s'", CLI_GET(&a, "--method"));
     bool bind = CLI_GET(&a, "--bind") != NULL;
 
     ak_scene* s = NULL;
@@ -100,7 +100,11 @@ int cmd_export(int argc, char** argv) {
         ak_scene_destroy(s);
         return cli_fail("export", "out of memory");
     }
-    ak_result r = cli_poser_pose(&p, clip, t, bind, method);
+    ak_result r = AK_OK;
+    /* soft: simulate the flesh through the clip's frames (60 Hz) up to t */
+    for (int k = 0; method == CLI_SOFT && !bind && r == AK_OK && (float)k / 60.0f < t; ++k)
+        r = cli_poser_pose(&p, clip, (float)k / 60.0f, false, method);
+    if (r == AK_OK) r = cli_poser_pose(&p, clip, t, bind, method);
     if (r == AK_OK) {
         ak_diag diag;
         memset(&diag, 0, sizeof diag);

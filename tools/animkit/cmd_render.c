@@ -8,7 +8,7 @@
 
 static const char* const usage =
     "usage: animkit render FILE|builtin:NAME [--clip C] [--time T | --frames A:B:STEP |\n"
-    "                      --fps F [--duration D]] [--method lbs|dqs|cor|implicit|all] [--size WxH]\n"
+    "                      --fps F [--duration D]] [--method lbs|dqs|cor|implicit|soft|all] [--size WxH]\n"
     "                      [--camera YAW,PITCH[,DIST]] [--follow] [--fov DEG] [--mesh NAME]...\n"
     "                      [--skeleton] [--weights BONE] -o OUT.png|OUT.gif\n"
     "Render the model posed by clip C (default the first) with an orbit camera framing the\n"
@@ -18,7 +18,8 @@ static const char* const usage =
     "when the clip is longer than 10 s (it says which); a PNG without times shows t = 0. GIF\n"
     "frame delays are whole 1/100 s: they alternate (24 fps: 4,4,5,4,4,4) so that the average\n"
     "matches the rate. Several frames into a PNG write OUT_0000.png, OUT_0001.png, ...\n"
-    "  --method all   LBS | DQS | CoR | implicit in labelled panels side by side\n"
+    "  --method all   LBS | DQS | CoR | implicit | soft in labelled panels side by side (soft:\n"
+    "                 the flesh simulated through the frames from time 0, see 'animkit skin --help')\n"
     "  --size WxH     output size of one panel (default 640x480); the whole image, panels\n"
     "                 included, is at most 8192x8192\n"
     "  --camera YAW,PITCH[,DIST]  degrees about +Y (0: from +Z, 90: from +X) and above the\n"
@@ -155,11 +156,12 @@ int cmd_render(int argc, char** argv) {
     int w = 640, h = 480;
     if (CLI_GET(&a, "--size") && !cli_parse_size(CLI_GET(&a, "--size"), &w, &h))
         return cli_usage("render", "--size '%s' is not WxH with 8..8192 pixels each", CLI_GET(&a, "--size"));
-    cli_method methods[4] = {CLI_LBS, CLI_DQS, CLI_COR, CLI_IMPLICIT};
+    cli_method methods[5] = {CLI_LBS, CLI_DQS, CLI_COR, CLI_IMPLICIT, CLI_SOFT};
     size_t method_count = 1;
     const char* ms = CLI_GET(&a, "--method");
-    if (ms && strcmp(ms, "all") == 0) method_count = 4;
-    else if (ms && !cli_method_parse(ms, &methods[0])) return cli_usage("render", "--method must be lbs, dqs, cor, implicit or all, not '%s'", ms);
+    if (ms && strcmp(ms, "all") == 0) method_count = 5;
+    else if (ms && !cli_method_parse(ms, &methods[0]))
+        return cli_usage("render", "--method must be lbs, dqs, cor, implicit, soft or all, not '%s'", ms);
     cli_camera cam = {0};
     if (CLI_GET(&a, "--camera") && !parse_camera(CLI_GET(&a, "--camera"), &cam))
         return cli_usage("render", "--camera '%s' is not YAW,PITCH[,DIST] (degrees, pitch in -85..85, distance in (0, 1e9])",
@@ -170,7 +172,7 @@ int cmd_render(int argc, char** argv) {
     const char* mesh_names[CLI_MAX_ALL];
     size_t mesh_name_count = cli_get_all(&a, opts, nopts, "--mesh", mesh_names, CLI_MAX_ALL);
     /* the size limit holds for the whole image, panels and labels included */
-    static const char* const labels[4] = {"LBS", "DQS", "CoR", "implicit"};
+    static const char* const labels[5] = {"LBS", "DQS", "CoR", "implicit", "soft"};
     ak_view_panels_desc pd = {.title = "title"};
     int cw = w, ch = h;
     if (method_count > 1) ak_view_panels_size(&pd, method_count, w, h, &cw, &ch);
@@ -195,7 +197,7 @@ int cmd_render(int argc, char** argv) {
     cli_poser p;
     cli_frame f;
     frame_times ft = {0};
-    ak_image panel[4] = {{0}}, composed = {0};
+    ak_image panel[5] = {{0}}, composed = {0};
     ak_vec4** colors = NULL;
     bool* hidden = NULL;
     ak_vec3 *frame_lo = NULL, *frame_hi = NULL, *roots = NULL;
@@ -309,7 +311,7 @@ int cmd_render(int argc, char** argv) {
         rc = cli_fail("render", "out of memory");
         goto done;
     }
-    ak_view_panel panels[4];
+    ak_view_panel panels[5];
     char strip[160];
     snprintf(strip, sizeof strip, "%s%s%s", s->name, clip >= 0 ? "  " : "", clip >= 0 ? ak_clip_name(s->clips[clip]) : "");
     pd.title = strip;
@@ -343,6 +345,9 @@ int cmd_render(int argc, char** argv) {
             cli_frame_aim(&f, ak_vec3_sub(c, half), ak_vec3_add(c, half), &cam);
         }
         for (size_t k = 0; k < method_count; ++k) {
+            /* soft: simulate the flesh from time 0 to the first frame (60 Hz) */
+            for (int q = 0; i == 0 && methods[k] == CLI_SOFT && (float)q / 60.0f < ft.t[0]; ++q)
+                if (cli_poser_pose(&p, clip, (float)q / 60.0f, false, CLI_SOFT) != AK_OK) break;
             ak_result r = cli_poser_pose(&p, clip, ft.t[i], false, methods[k]);
             char title[200];
             if (method_count > 1)
@@ -402,7 +407,7 @@ done:
     free(frame_lo);
     free(frame_hi);
     free(roots);
-    for (int k = 0; k < 4; ++k) free(panel[k].pixels);
+    for (int k = 0; k < 5; ++k) free(panel[k].pixels);
     free(composed.pixels);
     free(ft.t);
     cli_frame_free(&f);

@@ -8,8 +8,10 @@
 
 static const char* const usage =
     "usage: animkit skin --compare [FILE|builtin:NAME] [--json]\n"
-    "Compare linear blend (LBS), dual quaternion (DQS), optimized-center (CoR) and implicit\n"
-    "(Vaillant et al. 2013/2014) skinning.\n"
+    "Compare linear blend (LBS), dual quaternion (DQS), optimized-center (CoR), implicit\n"
+    "(Vaillant et al. 2013/2014) and volumetric (soft: a simulated tetrahedral flesh,\n"
+    "softskin.h) skinning. Soft reaches each cylinder pose by turning the joint over 1/6 s and\n"
+    "holding it 1/2 s (60 Hz steps), and runs through a clip's 24 samples in order.\n"
     "On builtin:cylinder (the default) the middle joint is bent 90, 120 and 150 degrees and\n"
     "twisted 90 and 180 degrees (179.8, so the turn has a defined direction); for each pose and\n"
     "method it prints the volume of the deformed closed mesh relative to rest, the maximum\n"
@@ -21,14 +23,14 @@ static const char* const usage =
     "the volume ratio (closed meshes only), the largest distance from the LBS result and the\n"
     "most self-intersecting triangle pairs (every 4th frame).\n"
     "  --json  one JSON object instead: {\"model\", \"rest_volume\", \"rest_radius\", \"poses\":\n"
-    "          [{\"pose\", \"LBS\"|\"DQS\"|\"CoR\"|\"implicit\": {\"volume_ratio\", \"volume_change\",\n"
+    "          [{\"pose\", \"LBS\"|\"DQS\"|\"CoR\"|\"implicit\"|\"soft\": {\"volume_ratio\", \"volume_change\",\n"
     "          \"max_bulge\", \"min_radius\", \"self_intersections\"}}]} for the cylinder;\n"
     "          {\"model\", \"methods\": [{\"method\", \"max_distance_from_lbs\", \"volume_min\",\n"
-    "          \"volume_max\", \"self_intersections_max\"}]} for another model (volumes for closed\n"
+    "          \"volume_max\", \"volume_change_max\", \"self_intersections_max\"}]} for another model (volumes for closed\n"
     "          meshes)\n";
 
-#define METHOD_COUNT 4
-static const cli_method methods[METHOD_COUNT] = {CLI_LBS, CLI_DQS, CLI_COR, CLI_IMPLICIT};
+#define METHOD_COUNT 5
+static const cli_method methods[METHOD_COUNT] = {CLI_LBS, CLI_DQS, CLI_COR, CLI_IMPLICIT, CLI_SOFT};
 
 /* Pairs of non-adjacent triangles of mesh that intersect at pos (exact count, mesh.h). */
 static size_t crossings(const ak_mesh* m, const ak_vec3* pos) {
@@ -103,9 +105,17 @@ static int compare_cylinder(ak_scene* s, bool json) {
     for (int k = 0; k < 5 && rc == CLI_OK; ++k) {
         if (json) printf("%s{\"pose\": \"%s\"", k ? ", " : "", poses[k].name);
         for (int mi = 0; mi < METHOD_COUNT; ++mi) {
-            cli_poser_sample(&p, -1, 0.0f, true);
-            p.local[mid].rotation = ak_quat_mul(p.local[mid].rotation, poses[k].rot);
-            ak_result r = cli_poser_deform(&p, false, methods[mi]);
+            ak_result r = AK_OK;
+            /* soft: turn the joint over 10 frames, then hold 30 (60 Hz) */
+            const int frames = methods[mi] == CLI_SOFT ? 40 : 1;
+            if (methods[mi] == CLI_SOFT) cli_poser_soft_reset(&p);
+            for (int fr = 0; fr < frames && r == AK_OK; ++fr) {
+                cli_poser_sample(&p, -1, 0.0f, true);
+                const float u = frames > 1 ? ak_minf(1.0f, (float)fr / 10.0f) : 1.0f;
+                p.local[mid].rotation = ak_quat_mul(p.local[mid].rotation, ak_quat_slerp(ak_quat_identity(), poses[k].rot, u));
+                p.sample_time = (float)fr / 60.0f;
+                r = cli_poser_deform(&p, false, methods[mi]);
+            }
             if (r != AK_OK) {
                 rc = cli_fail("skin", "%s: %s", s->name, ak_result_string(r));
                 break;
@@ -140,10 +150,10 @@ static int compare_generic(ak_scene* s, bool json) {
     cli_poser p;
     if (cli_poser_init(&p, s)) return cli_fail("skin", "out of memory");
     int rc = CLI_OK;
-    double vmin[METHOD_COUNT] = {INFINITY, INFINITY, INFINITY, INFINITY};
-    double vmax[METHOD_COUNT] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
-    float dmax[METHOD_COUNT] = {0, 0, 0, 0};
-    size_t xmax[METHOD_COUNT] = {0, 0, 0, 0};
+    double vmin[METHOD_COUNT] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY};
+    double vmax[METHOD_COUNT] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    float dmax[METHOD_COUNT] = {0, 0, 0, 0, 0};
+    size_t xmax[METHOD_COUNT] = {0, 0, 0, 0, 0};
     size_t max_v = 0;
     for (size_t m = 0; m < s->mesh_count; ++m) max_v = s->meshes[m].mesh->vertex_count > max_v ? s->meshes[m].mesh->vertex_count : max_v;
     ak_vec3* lbs = calloc(max_v ? max_v : 1, sizeof(ak_vec3));
@@ -151,6 +161,7 @@ static int compare_generic(ak_scene* s, bool json) {
     size_t clips = s->clip_count ? s->clip_count : 1;
     for (size_t c = 0; c < clips && rc == CLI_OK && lbs; ++c) {
         float dur = s->clip_count ? ak_clip_duration(s->clips[c]) : 0.0f;
+        cli_poser_soft_reset(&p); /* soft runs through the clip's samples in order */
         for (int f = 0; f < 24 && rc == CLI_OK; ++f) {
             float t = dur * (float)f / 23.0f;
             for (int mi = 0; mi < METHOD_COUNT; ++mi) {
@@ -190,7 +201,9 @@ static int compare_generic(ak_scene* s, bool json) {
             if (json) {
                 printf("%s{\"method\": \"%s\", \"max_distance_from_lbs\": %.9g", mi ? ", " : "", cli_method_name(methods[mi]),
                        (double)dmax[mi]);
-                if (any_closed) printf(", \"volume_min\": %.9g, \"volume_max\": %.9g", vmin[mi], vmax[mi]);
+                if (any_closed)
+                    printf(", \"volume_min\": %.9g, \"volume_max\": %.9g, \"volume_change_max\": %.9g", vmin[mi], vmax[mi],
+                           fmax(fabs(vmin[mi] - 1.0), fabs(vmax[mi] - 1.0)));
                 printf(", \"self_intersections_max\": %zu}", xmax[mi]);
             } else if (any_closed) {
                 printf("%-8s %10.4f .. %-9.4f %18.6g %10zu\n", cli_method_name(methods[mi]), vmin[mi], vmax[mi], (double)dmax[mi],

@@ -21,37 +21,6 @@ static const char* const usage =
     "  --power   distance exponent n (default 4)\n";
 
 
-/* Bind-space bones of mesh m's skin: one segment from each slot's joint to each child slot's
- * joint, and a point bone for slots without a child slot. */
-static size_t skin_bones(const ak_scene* s, const ak_scene_skin* skin, ak_skin_bone* out) {
-    size_t n = skin->joint_count, count = 0;
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
-    ak_vec3* pos = calloc(n, sizeof(ak_vec3));
-    int* parent_slot = calloc(n, sizeof(int));
-    bool* has_child = calloc(n, sizeof(bool));
-    if (!pos || !parent_slot || !has_child) goto done;
-    for (size_t k = 0; k < n; ++k) pos[k] = ak_mat4_get_translation(ak_mat4_inverse_affine(skin->inverse_binds[k]));
-    for (size_t k = 0; k < n; ++k) {
-        parent_slot[k] = -1;
-        for (int j = parents.ptr[skin->joints[k]]; j >= 0 && parent_slot[k] < 0; j = parents.ptr[j])
-            for (size_t q = 0; q < n; ++q)
-                if (skin->joints[q] == j) parent_slot[k] = (int)q;
-    }
-    for (size_t k = 0; k < n; ++k) {
-        if (parent_slot[k] < 0) continue;
-        size_t ps = (size_t)parent_slot[k];
-        has_child[ps] = true;
-        out[count++] = (ak_skin_bone){pos[ps], pos[k], (uint16_t)ps};
-    }
-    for (size_t k = 0; k < n; ++k)
-        if (!has_child[k]) out[count++] = (ak_skin_bone){pos[k], pos[k], (uint16_t)k};
-done:
-    free(pos);
-    free(parent_slot);
-    free(has_child);
-    return count;
-}
-
 static int write_json(const char* path, const ak_scene* s, const ak_scene_skin* skin, size_t vc, uint32_t k,
                       const uint16_t* joints, const float* weights) {
     cli_outfile out; /* a temporary renamed over path once complete */
@@ -137,7 +106,7 @@ int cmd_weights(int argc, char** argv) {
         rc = cli_fail("weights", "out of memory");
         goto done;
     }
-    size_t bone_count = skin_bones(s, skin, bones);
+    size_t bone_count = cli_skin_bones(s, skin, bones);
     ak_weights_desc d = {
         .method = wm,
         .positions = {mesh->positions, vc},

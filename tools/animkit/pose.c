@@ -1,5 +1,6 @@
 /* The posing pipeline shared by the commands: sample a clip into the local pose, forward
  * kinematics, morph targets, then skinning, exactly as glTF 2.0 defines it (see scene.h). */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -11,6 +12,7 @@ bool cli_method_parse(const char* s, cli_method* out) {
     else if (strcmp(s, "dqs") == 0) *out = CLI_DQS;
     else if (strcmp(s, "cor") == 0) *out = CLI_COR;
     else if (strcmp(s, "implicit") == 0) *out = CLI_IMPLICIT;
+    else if (strcmp(s, "soft") == 0) *out = CLI_SOFT;
     else return false;
     return true;
 }
@@ -20,6 +22,7 @@ const char* cli_method_name(cli_method m) {
     case CLI_DQS: return "DQS";
     case CLI_COR: return "CoR";
     case CLI_IMPLICIT: return "implicit";
+    case CLI_SOFT: return "soft";
     default: return "LBS";
     }
 }
@@ -96,7 +99,118 @@ void cli_poser_free(cli_poser* p) {
     free(p->morphed_normals);
     free(p->skin_scratch);
     free(p->weld_scratch);
+    if (p->soft && p->scene)
+        for (size_t m = 0; m < p->scene->mesh_count; ++m) {
+            ak_skin_soft_destroy(p->soft[m].soft);
+            free(p->soft[m].x);
+            free(p->soft[m].v);
+            free(p->soft[m].scratch);
+            free(p->soft[m].previous);
+        }
+    free(p->soft);
     memset(p, 0, sizeof(*p));
+}
+
+size_t cli_skin_bones(const ak_scene* s, const ak_scene_skin* skin, ak_skin_bone* out) {
+    size_t n = skin->joint_count, count = 0;
+    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_vec3* pos = calloc(n, sizeof(ak_vec3));
+    int* parent_slot = calloc(n, sizeof(int));
+    bool* has_child = calloc(n, sizeof(bool));
+    if (!pos || !parent_slot || !has_child) goto done;
+    for (size_t k = 0; k < n; ++k) pos[k] = ak_mat4_get_translation(ak_mat4_inverse_affine(skin->inverse_binds[k]));
+    for (size_t k = 0; k < n; ++k) {
+        parent_slot[k] = -1;
+        for (int j = parents.ptr[skin->joints[k]]; j >= 0 && parent_slot[k] < 0; j = parents.ptr[j])
+            for (size_t q = 0; q < n; ++q)
+                if (skin->joints[q] == j) parent_slot[k] = (int)q;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        if (parent_slot[k] < 0) continue;
+        size_t ps = (size_t)parent_slot[k];
+        has_child[ps] = true;
+        out[count++] = (ak_skin_bone){pos[ps], pos[k], (uint16_t)ps};
+    }
+    for (size_t k = 0; k < n; ++k)
+        if (!has_child[k]) out[count++] = (ak_skin_bone){pos[k], pos[k], (uint16_t)k};
+done:
+    free(pos);
+    free(parent_slot);
+    free(has_child);
+    return count;
+}
+
+void cli_poser_soft_reset(cli_poser* p) {
+    if (p->soft && p->scene)
+        for (size_t m = 0; m < p->scene->mesh_count; ++m) p->soft[m].started = false;
+}
+
+/* Build mesh m's soft body on first use; false when it cannot be built (then DQS). */
+static ak_result soft_build(cli_poser* p, size_t m, size_t palette_count) {
+    if (!p->soft && !(p->soft = calloc(p->scene->mesh_count, sizeof(cli_soft_mesh)))) return AK_ERR_NO_MEMORY;
+    cli_soft_mesh* sm = &p->soft[m];
+    if (sm->soft || sm->failed) return AK_OK;
+    const ak_scene_mesh* scm = &p->scene->meshes[m];
+    const ak_mesh* mesh = scm->mesh;
+    const ak_scene_skin* skin = &p->scene->skins[scm->skin];
+    ak_skin_bone* bones = calloc(2 * skin->joint_count + 1, sizeof(ak_skin_bone));
+    if (!bones) return AK_ERR_NO_MEMORY;
+    size_t bone_count = cli_skin_bones(p->scene, skin, bones);
+    size_t wn = mesh->vertex_count * mesh->influence_count;
+    ak_skin_soft_desc d = {.positions = {mesh->positions, mesh->vertex_count},
+                           .indices = {mesh->indices, 3 * mesh->triangle_count},
+                           .joints = {mesh->joints, wn},
+                           .weights = {mesh->weights, wn},
+                           .influence_count = mesh->influence_count,
+                           .bones = {bones, bone_count},
+                           .resolution = p->soft_resolution};
+    ak_result r = ak_skin_soft_create(&d, NULL, &sm->soft);
+    free(bones);
+    if (r == AK_ERR_NO_MEMORY) return r;
+    if (r != AK_OK) {
+        sm->failed = true;
+        return AK_OK;
+    }
+    size_t nn = ak_skin_soft_node_count(sm->soft);
+    sm->x = malloc(nn * sizeof(ak_vec3));
+    sm->v = malloc(nn * sizeof(ak_vec3));
+    sm->scratch = malloc(ak_skin_soft_step_scratch_size(sm->soft));
+    sm->previous = malloc(palette_count * sizeof(ak_mat4));
+    if (!sm->x || !sm->v || !sm->scratch || !sm->previous) return AK_ERR_NO_MEMORY;
+    return AK_OK;
+}
+
+/* Advance mesh m's soft body to the palette in p->palette and write its surface. */
+static ak_result soft_deform(cli_poser* p, size_t m, size_t palette_count) {
+    cli_soft_mesh* sm = &p->soft[m];
+    const ak_mesh* mesh = p->scene->meshes[m].mesh;
+    size_t nn = ak_skin_soft_node_count(sm->soft);
+    ak_mat4_cspan pal = {p->palette, palette_count};
+    ak_result r = AK_OK;
+    float dt = p->sample_time - p->soft_time;
+    if (!sm->started || dt < 0.0f || dt > 0.5f) {
+        if ((r = ak_skin_soft_state_init(sm->soft, pal, (ak_vec3_span){sm->x, nn}, (ak_vec3_span){sm->v, nn})) != AK_OK) return r;
+        memcpy(sm->previous, p->palette, palette_count * sizeof(ak_mat4));
+        sm->started = true;
+        dt = 0.0f;
+    }
+    int steps = dt > 0.0f ? (int)ceilf(dt * 60.0f - 1e-3f) : 0;
+    for (int k = 0; k < steps; ++k) {
+        ak_skin_soft_step_job job = {.soft = sm->soft,
+                                     .palette = pal,
+                                     .previous_palette = {sm->previous, palette_count},
+                                     .dt = dt / (float)steps,
+                                     .node_positions = {sm->x, nn},
+                                     .node_velocities = {sm->v, nn},
+                                     .scratch = {sm->scratch, ak_skin_soft_step_scratch_size(sm->soft)}};
+        if ((r = ak_skin_soft_step_run(&job)) != AK_OK) return r;
+        memcpy(sm->previous, p->palette, palette_count * sizeof(ak_mat4));
+    }
+    if ((r = ak_skin_soft_surface(sm->soft, (ak_vec3_cspan){sm->x, nn}, (ak_vec3_span){p->positions[m], mesh->vertex_count})) != AK_OK)
+        return r;
+    return ak_normals_compute((ak_vec3_cspan){p->positions[m], mesh->vertex_count},
+                              (ak_u32_cspan){mesh->indices, 3 * mesh->triangle_count},
+                              (ak_vec3_span){p->normals[m], mesh->vertex_count});
 }
 
 /* Centers of rotation for mesh m, computed on first use. */
@@ -199,6 +313,7 @@ ak_result cli_poser_sample(cli_poser* p, int clip, float t, bool bind) {
             p->morph_weights[off + k] = mesh->morph_weights ? mesh->morph_weights[k] : 0.0f;
         off += mesh->morph_target_count;
     }
+    p->sample_time = bind ? 0.0f : t;
     if (!p->joint_count) return AK_OK;
     ak_transform_span local = {p->local, p->joint_count};
     if ((r = ak_scene_rest_pose(s, local)) != AK_OK) return r;
@@ -261,10 +376,17 @@ ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method) {
                 if ((r = implicit_deform(p, m, skin->joint_count)) != AK_OK) return r;
                 continue;
             }
-            ak_skin_method sm_method = method == CLI_DQS ? AK_SKIN_DQS
-                                       : method == CLI_COR ? AK_SKIN_COR
-                                       : method == CLI_IMPLICIT ? AK_SKIN_DQS /* points or morphs: DQS */
-                                                                : AK_SKIN_LBS;
+            if (method == CLI_SOFT && mesh->triangle_count > 0) {
+                if ((r = soft_build(p, m, skin->joint_count)) != AK_OK) return r;
+                if (!p->soft[m].failed) {
+                    if ((r = soft_deform(p, m, skin->joint_count)) != AK_OK) return r;
+                    continue;
+                }
+            }
+            /* implicit on points or morphs, soft that could not build: DQS */
+            ak_skin_method sm_method = method == CLI_DQS || method == CLI_IMPLICIT || method == CLI_SOFT ? AK_SKIN_DQS
+                                       : method == CLI_COR                                             ? AK_SKIN_COR
+                                                                                                       : AK_SKIN_LBS;
             if (sm_method == AK_SKIN_COR && mesh->triangle_count == 0) sm_method = AK_SKIN_DQS;
             if (sm_method == AK_SKIN_COR && (r = cor_centers(p, m)) != AK_OK) return r;
             bool faces = nrm == NULL && mesh->triangle_count > 0;
@@ -293,5 +415,6 @@ ak_result cli_poser_deform(cli_poser* p, bool bind, cli_method method) {
             if (!nrm && (r = computed_normals(p, m)) != AK_OK) return r;
         }
     }
+    if (method == CLI_SOFT) p->soft_time = p->sample_time;
     return AK_OK;
 }

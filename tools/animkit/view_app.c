@@ -25,6 +25,7 @@ const view_help_entry view_help[] = {
     {"3", "CoR skinning"},
     {"4", "LBS | DQS | CoR side by side"},
     {"5", "implicit skinning"},
+    {"6", "soft (volumetric) skinning"},
     {"w", "weight heatmap: next bone"},
     {"n", "normals overlay"},
     {"k", "skeleton overlay"},
@@ -719,6 +720,7 @@ static void key(view_app* a, int k) {
     case '1': a->method = CLI_LBS, a->side_by_side = false; break;
     case '2': a->method = CLI_DQS, a->side_by_side = false; break;
     case '3': a->method = CLI_COR, a->side_by_side = false; break;
+    case '6': a->method = CLI_SOFT, a->side_by_side = false; break;
     case '4': a->side_by_side = !a->side_by_side; break;
     case '5': a->method = CLI_IMPLICIT, a->side_by_side = false; break;
     case 'w':

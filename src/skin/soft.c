@@ -1,0 +1,1060 @@
+/* Volumetric (soft-tissue) skinning: a tetrahedral lattice inside the mesh, kinematic nodes
+ * around the bones, flesh simulated by XPBD with the stable Neo-Hookean constraints of Macklin
+ * & Mueller 2021. See softskin.h. */
+#include <animkit/softskin.h>
+
+#include <math.h>
+#include <pthread.h> /* thread_count > 1 */
+
+#include "skin_internal.h"
+
+#define SOFT_MAX_COLORS 128u
+#define SOFT_INFLUENCES 4u
+#define SOFT_NODE_PLANES 4u
+
+struct ak_skin_soft {
+    ak_allocator alloc;
+    size_t node_count, tet_count, kin_count, vertex_count, bone_count;
+    float mu, lambda, damping, jiggle_damping;
+    uint32_t substeps;
+    uint16_t max_joint;
+    ak_vec3* rest;          /* [node] */
+    uint8_t* kinematic;     /* [node] */
+    float* mass;            /* [node] lumped */
+    float* inv_mass;        /* [node] 0 for kinematic */
+    uint16_t* node_joints;  /* [node * 4] */
+    float* node_weights;    /* [node * 4] */
+    uint32_t* tets;         /* [4 * tet], sorted by colour */
+    float* dm_inv;          /* [9 * tet] column-major inverse rest edge matrix */
+    float* volume;          /* [tet] rest volume */
+    uint32_t color_count;
+    uint32_t* color_start;  /* [color_count + 1] */
+    uint32_t* embed_tet;    /* [vertex] */
+    float* embed_bary;      /* [4 * vertex] */
+    ak_skin_bone* bones;    /* [bone] */
+    float* contact_radius;  /* [bone] median distance of the bone's vertices (0: owns none) */
+    float* core_radius;     /* [bone] kinematic capsule and collider radius */
+    uint64_t* collide;      /* [node * collide_words]: bit b -> node collides with bone b */
+    size_t collide_words;
+    uint32_t plane_count;
+    uint32_t* planes;       /* [2 * plane]: parent bone, child bone meeting at a joint */
+    int32_t* node_planes;   /* [node * SOFT_NODE_PLANES]: +(p + 1) parent side, -(p + 1) child
+                               side, 0 none */
+};
+
+/* ---- small helpers -------------------------------------------------------------------- */
+
+static bool mat3_inverse(const float m[9], float out[9], float* out_det) {
+    /* column-major m: m[r + 3c] */
+    double a = m[0], b = m[3], c = m[6], d = m[1], e = m[4], f = m[7], g = m[2], h = m[5], i = m[8];
+    double A = e * i - f * h, B = -(d * i - f * g), C = d * h - e * g;
+    double det = a * A + b * B + c * C;
+    *out_det = (float)det;
+    if (!(fabs(det) > 1e-30)) return false;
+    double inv = 1.0 / det;
+    out[0] = (float)(A * inv);
+    out[1] = (float)(B * inv);
+    out[2] = (float)(C * inv);
+    out[3] = (float)(-(b * i - c * h) * inv);
+    out[4] = (float)((a * i - c * g) * inv);
+    out[5] = (float)(-(a * h - b * g) * inv);
+    out[6] = (float)((b * f - c * e) * inv);
+    out[7] = (float)(-(a * f - c * d) * inv);
+    out[8] = (float)((a * e - b * d) * inv);
+    return true;
+}
+
+/* Barycentrics of p in the tet with rest origin x0 and inverse edge matrix dmi. */
+static void tet_bary(ak_vec3 x0, const float dmi[9], ak_vec3 p, float out[4]) {
+    ak_vec3 r = ak_vec3_sub(p, x0);
+    float b1 = dmi[0] * r.x + dmi[3] * r.y + dmi[6] * r.z;
+    float b2 = dmi[1] * r.x + dmi[4] * r.y + dmi[7] * r.z;
+    float b3 = dmi[2] * r.x + dmi[5] * r.y + dmi[8] * r.z;
+    out[0] = 1.0f - b1 - b2 - b3;
+    out[1] = b1;
+    out[2] = b2;
+    out[3] = b3;
+}
+
+static float min4(const float b[4]) { return ak_minf(ak_minf(b[0], b[1]), ak_minf(b[2], b[3])); }
+
+static uint32_t uf_find(uint32_t* p, uint32_t x) {
+    while (p[x] != x) {
+        p[x] = p[p[x]];
+        x = p[x];
+    }
+    return x;
+}
+
+static int cmp_float(const void* a, const void* b) {
+    float x = *(const float*)a, y = *(const float*)b;
+    return (x > y) - (x < y);
+}
+
+static ak_vec3 lbs_node(const ak_skin_soft* s, size_t n, const ak_mat4* palette, size_t palette_count) {
+    ak_vec3 p = ak_vec3_zero();
+    for (uint32_t k = 0; k < SOFT_INFLUENCES; ++k) {
+        float w = s->node_weights[n * SOFT_INFLUENCES + k];
+        if (w == 0.0f) continue;
+        size_t j = s->node_joints[n * SOFT_INFLUENCES + k];
+        if (j >= palette_count) j = palette_count - 1;
+        p = ak_vec3_madd(p, ak_mat4_transform_point(palette[j], s->rest[n]), w);
+    }
+    return p;
+}
+
+/* ---- public: desc --------------------------------------------------------------------- */
+
+ak_skin_soft_desc ak_skin_soft_desc_resolved(const ak_skin_soft_desc* desc) {
+    ak_skin_soft_desc d;
+    if (desc) d = *desc;
+    else memset(&d, 0, sizeof d);
+    if (d.resolution == 0) d.resolution = 16;
+    if (d.youngs_modulus == 0.0f) d.youngs_modulus = 5e4f;
+    if (d.poisson_ratio == 0.0f) d.poisson_ratio = 0.499f;
+    if (d.density == 0.0f) d.density = 1000.0f;
+    if (d.damping == 0.0f) d.damping = 0.1f;
+    if (d.substeps == 0) d.substeps = 10;
+    if (d.bone_radius == 0.0f) d.bone_radius = 0.5f;
+    if (d.jiggle_damping == 0.0f) d.jiggle_damping = 5.0f;
+    if (d.memory_budget == 0) d.memory_budget = (size_t)512 << 20;
+    return d;
+}
+
+void ak_skin_soft_destroy(ak_skin_soft* s) {
+    if (!s) return;
+    const ak_allocator* a = &s->alloc;
+    akp_free(a, s->rest);
+    akp_free(a, s->kinematic);
+    akp_free(a, s->mass);
+    akp_free(a, s->inv_mass);
+    akp_free(a, s->node_joints);
+    akp_free(a, s->node_weights);
+    akp_free(a, s->tets);
+    akp_free(a, s->dm_inv);
+    akp_free(a, s->volume);
+    akp_free(a, s->color_start);
+    akp_free(a, s->embed_tet);
+    akp_free(a, s->embed_bary);
+    akp_free(a, s->bones);
+    akp_free(a, s->contact_radius);
+    akp_free(a, s->core_radius);
+    akp_free(a, s->collide);
+    akp_free(a, s->planes);
+    akp_free(a, s->node_planes);
+    ak_allocator copy = s->alloc;
+    akp_free(&copy, s);
+}
+
+/* ---- create --------------------------------------------------------------------------- */
+
+typedef struct crossing {
+    float x;
+    int sign;
+} crossing;
+
+static ak_result check_desc(const ak_skin_soft_desc* d) {
+    if (!d->positions.ptr || !d->indices.ptr || !d->joints.ptr || !d->weights.ptr || !d->bones.ptr) return AK_ERR_NULL_ARG;
+    if (d->positions.count == 0 || d->indices.count == 0 || d->bones.count == 0) return AK_ERR_EMPTY;
+    if (d->indices.count % 3 || d->influence_count == 0 || d->influence_count > AK_MAX_INFLUENCES ||
+        d->positions.count > ((size_t)1 << 31) || d->bones.count > 65535)
+        return AK_ERR_BAD_ARG;
+    if (d->resolution < 2 || d->resolution > 256 || !(d->youngs_modulus > 0.0f) || !isfinite(d->youngs_modulus) ||
+        !(d->poisson_ratio > 0.0f && d->poisson_ratio <= 0.4999f) || !(d->density > 0.0f) || !isfinite(d->density) ||
+        !isfinite(d->damping) || !isfinite(d->jiggle_damping) || d->substeps > 1000 || !(d->bone_radius > 0.0f && d->bone_radius <= 1.0f))
+        return AK_ERR_BAD_ARG;
+    size_t wn = d->positions.count * d->influence_count;
+    if (d->joints.count < wn || d->weights.count < wn) return AK_ERR_SPAN_SMALL;
+    for (size_t i = 0; i < d->indices.count; ++i)
+        if (d->indices.ptr[i] >= d->positions.count) return AK_ERR_BAD_INDEX;
+    for (size_t v = 0; v < d->positions.count; ++v)
+        if (!ak_vec3_is_finite(d->positions.ptr[v])) return AK_ERR_BAD_DATA;
+    for (size_t b = 0; b < d->bones.count; ++b)
+        if (!ak_vec3_is_finite(d->bones.ptr[b].head) || !ak_vec3_is_finite(d->bones.ptr[b].tail)) return AK_ERR_BAD_DATA;
+    for (size_t i = 0; i < wn; ++i)
+        if (!(d->weights.ptr[i] >= 0.0f) || !isfinite(d->weights.ptr[i])) return AK_ERR_BAD_WEIGHTS;
+    return AK_OK;
+}
+
+/* Temporary arrays of create, freed together. */
+typedef struct build_tmp {
+    uint8_t* keep;         /* [cells] */
+    uint32_t* col_count;   /* [columns + 1] */
+    crossing* cross;       /* [crossings] */
+    uint32_t* grid_node;   /* [grid nodes] -> node index or UINT32_MAX */
+    uint32_t* cell_tet;    /* [cells] first tet of a kept cell (pre-colour order) */
+    uint32_t* tets;        /* [4 * tets] pre-colour */
+    uint32_t* color;       /* [tets] */
+    uint64_t* used;        /* [node * 2] colour masks */
+    uint32_t* perm;        /* [tets] new index of old tet */
+    uint32_t* uf;          /* [node] */
+    uint8_t* comp_kin;     /* [node] */
+    float* dist;           /* [vertex] */
+    uint32_t* owner;       /* [vertex] bone of a vertex */
+} build_tmp;
+
+static void tmp_free(const ak_allocator* a, build_tmp* t) {
+    akp_free(a, t->keep);
+    akp_free(a, t->col_count);
+    akp_free(a, t->cross);
+    akp_free(a, t->grid_node);
+    akp_free(a, t->cell_tet);
+    akp_free(a, t->tets);
+    akp_free(a, t->color);
+    akp_free(a, t->used);
+    akp_free(a, t->perm);
+    akp_free(a, t->uf);
+    akp_free(a, t->comp_kin);
+    akp_free(a, t->dist);
+    akp_free(a, t->owner);
+}
+
+/* Kuhn split of a cube: the 6 monotone paths from corner 0 to corner 7 (bits x=1, y=2, z=4). */
+static const uint8_t kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+
+ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocator* alloc, ak_skin_soft** out_soft) {
+    if (out_soft) *out_soft = NULL;
+    if (!desc_in || !out_soft) return AK_ERR_NULL_ARG;
+    if (alloc && ((alloc->alloc == NULL) != (alloc->free == NULL))) return AK_ERR_BAD_ARG;
+    const ak_skin_soft_desc d = ak_skin_soft_desc_resolved(desc_in);
+    ak_result r = check_desc(&d);
+    if (r != AK_OK) return r;
+    const size_t nv = d.positions.count, ntri = d.indices.count / 3, nb = d.bones.count;
+    const ak_vec3* P = d.positions.ptr;
+
+    /* grid */
+    ak_vec3 lo, hi;
+    ak_points_bounds(d.positions, &lo, &hi);
+    ak_vec3 ext = ak_vec3_sub(hi, lo);
+    float longest = ak_maxf(ext.x, ak_maxf(ext.y, ext.z));
+    if (!(longest > 0.0f)) return AK_ERR_BAD_DATA;
+    const float h = longest / (float)d.resolution;
+    size_t dim[3];
+    float e3[3] = {ext.x, ext.y, ext.z}, lo3[3] = {lo.x, lo.y, lo.z}, org[3];
+    for (int a = 0; a < 3; ++a) {
+        size_t n = (size_t)ceilf(e3[a] / h * 0.9999f);
+        if (n < 1) n = 1;
+        if (n > 256) n = 256;
+        dim[a] = n;
+        org[a] = lo3[a] - 0.5f * ((float)n * h - e3[a]);
+    }
+    const size_t nx = dim[0], ny = dim[1], nz = dim[2];
+    const size_t cells = nx * ny * nz, gnodes = (nx + 1) * (ny + 1) * (nz + 1), cols = ny * nz;
+    /* budget: temporaries and the worst case (every cell kept) of the result */
+    size_t budget_need = cells * (1 + 4 + 6 * (16 + 4 + 4 + 36 + 4 + 4)) + gnodes * (4 + 12 + 1 + 8 + 4 + 32 + 16 + 4 + 1 + 8 * ((nb + 63) / 64)) +
+                         (cols + 1) * 4 + nv * (4 + 16 + 4 + 4) + nb * 64;
+    if (budget_need > d.memory_budget) return AK_ERR_BUDGET;
+
+    const ak_allocator* A = alloc;
+    build_tmp t;
+    memset(&t, 0, sizeof t);
+    ak_skin_soft* s = (ak_skin_soft*)akp_calloc(A, sizeof(ak_skin_soft));
+    if (!s) return AK_ERR_NO_MEMORY;
+    if (alloc) s->alloc = *alloc;
+    s->vertex_count = nv;
+    s->bone_count = nb;
+    s->substeps = d.substeps;
+    s->damping = d.damping > 0.0f ? d.damping : 0.0f;
+    s->jiggle_damping = d.jiggle_damping > 0.0f ? d.jiggle_damping : 0.0f;
+    s->mu = d.youngs_modulus / (2.0f * (1.0f + d.poisson_ratio));
+    s->lambda = d.youngs_modulus * d.poisson_ratio / ((1.0f + d.poisson_ratio) * (1.0f - 2.0f * d.poisson_ratio));
+#define SOFT_ALLOC(ptr, type, n)                                      \
+    do {                                                              \
+        (ptr) = (type*)akp_calloc(A, (size_t)(n) * sizeof(type));     \
+        if (!(ptr)) {                                                 \
+            r = AK_ERR_NO_MEMORY;                                     \
+            goto fail;                                                \
+        }                                                             \
+    } while (0)
+
+    /* 1. inside test: per column of cell centres, signed crossings of a ray along +X */
+    SOFT_ALLOC(t.keep, uint8_t, cells);
+    SOFT_ALLOC(t.col_count, uint32_t, cols + 1);
+    /* a tiny irrational offset keeps rays off the vertices and edges of regular meshes */
+    const float jy = 0.5f + 0.000137f * 3.14159265f, jz = 0.5f + 0.000173f * 2.71828183f;
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1) {
+            size_t total = 0;
+            for (size_t c = 0; c < cols; ++c) {
+                size_t k = t.col_count[c];
+                t.col_count[c] = (uint32_t)total;
+                total += k;
+            }
+            t.col_count[cols] = (uint32_t)total;
+            if (total * sizeof(crossing) > d.memory_budget) {
+                r = AK_ERR_BUDGET;
+                goto fail;
+            }
+            if (total) SOFT_ALLOC(t.cross, crossing, total);
+        }
+        for (size_t f = 0; f < ntri; ++f) {
+            ak_vec3 a = P[d.indices.ptr[3 * f]], b = P[d.indices.ptr[3 * f + 1]], c = P[d.indices.ptr[3 * f + 2]];
+            float ymin = ak_minf(a.y, ak_minf(b.y, c.y)), ymax = ak_maxf(a.y, ak_maxf(b.y, c.y));
+            float zmin = ak_minf(a.z, ak_minf(b.z, c.z)), zmax = ak_maxf(a.z, ak_maxf(b.z, c.z));
+            long j0 = (long)floorf((ymin - org[1]) / h - jy) + 1, j1 = (long)floorf((ymax - org[1]) / h - jy);
+            long k0 = (long)floorf((zmin - org[2]) / h - jz) + 1, k1 = (long)floorf((zmax - org[2]) / h - jz);
+            if (j0 < 0) j0 = 0;
+            if (k0 < 0) k0 = 0;
+            if (j1 >= (long)ny) j1 = (long)ny - 1;
+            if (k1 >= (long)nz) k1 = (long)nz - 1;
+            float nxs = (b.y - a.y) * (c.z - a.z) - (b.z - a.z) * (c.y - a.y);
+            if (nxs == 0.0f) continue;
+            for (long k = k0; k <= k1; ++k)
+                for (long j = j0; j <= j1; ++j) {
+                    float py = org[1] + ((float)j + jy) * h, pz = org[2] + ((float)k + jz) * h;
+                    /* 2D edge functions in the yz plane */
+                    float ea = (b.y - py) * (c.z - pz) - (b.z - pz) * (c.y - py);
+                    float eb = (c.y - py) * (a.z - pz) - (c.z - pz) * (a.y - py);
+                    float ec = (a.y - py) * (b.z - pz) - (a.z - pz) * (b.y - py);
+                    bool in = (ea >= 0 && eb >= 0 && ec >= 0) || (ea <= 0 && eb <= 0 && ec <= 0);
+                    float sum = ea + eb + ec;
+                    if (!in || sum == 0.0f) continue;
+                    size_t col = (size_t)k * ny + (size_t)j;
+                    if (pass == 0) {
+                        t.col_count[col]++;
+                    } else {
+                        float x = (ea * a.x + eb * b.x + ec * c.x) / sum;
+                        t.cross[t.col_count[col]++] = (crossing){x, nxs > 0.0f ? 1 : -1};
+                    }
+                }
+        }
+        if (pass == 1) /* fill advanced each start to the next column's start: shift back */
+            for (size_t c = cols; c > 0; --c) t.col_count[c] = t.col_count[c - 1];
+    }
+    t.col_count[0] = 0;
+    for (size_t k = 0; k < nz; ++k)
+        for (size_t j = 0; j < ny; ++j) {
+            size_t col = k * ny + j;
+            for (size_t i = 0; i < nx; ++i) {
+                float cx = org[0] + ((float)i + 0.5f) * h;
+                int w = 0;
+                for (uint32_t q = t.col_count[col]; q < t.col_count[col + 1]; ++q)
+                    if (t.cross[q].x > cx) w += t.cross[q].sign;
+                if (w != 0) t.keep[(k * ny + j) * nx + i] = 1;
+            }
+        }
+    /* cells holding a surface vertex */
+    for (size_t v = 0; v < nv; ++v) {
+        size_t ci[3];
+        float p3[3] = {P[v].x, P[v].y, P[v].z};
+        for (int a = 0; a < 3; ++a) {
+            float f = floorf((p3[a] - org[a]) / h);
+            ci[a] = f < 0.0f ? 0 : (size_t)f >= dim[a] ? dim[a] - 1 : (size_t)f;
+        }
+        t.keep[(ci[2] * ny + ci[1]) * nx + ci[0]] = 1;
+    }
+
+    /* 2. nodes: the corners of kept cells, numbered in grid order */
+    SOFT_ALLOC(t.grid_node, uint32_t, gnodes);
+    size_t kept = 0;
+    for (size_t c = 0; c < cells; ++c) kept += t.keep[c];
+    if (kept == 0) {
+        r = AK_ERR_EMPTY;
+        goto fail;
+    }
+    for (size_t g = 0; g < gnodes; ++g) t.grid_node[g] = 0;
+#define GRID(i, j, k) ((((k) * (ny + 1)) + (j)) * (nx + 1) + (i))
+    for (size_t k = 0; k < nz; ++k)
+        for (size_t j = 0; j < ny; ++j)
+            for (size_t i = 0; i < nx; ++i)
+                if (t.keep[(k * ny + j) * nx + i])
+                    for (int c = 0; c < 8; ++c) t.grid_node[GRID(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] = 1;
+    size_t nn = 0;
+    for (size_t g = 0; g < gnodes; ++g) t.grid_node[g] = t.grid_node[g] ? (uint32_t)nn++ : UINT32_MAX;
+    s->node_count = nn;
+    SOFT_ALLOC(s->rest, ak_vec3, nn);
+    for (size_t k = 0; k <= nz; ++k)
+        for (size_t j = 0; j <= ny; ++j)
+            for (size_t i = 0; i <= nx; ++i) {
+                uint32_t id = t.grid_node[GRID(i, j, k)];
+                if (id != UINT32_MAX)
+                    s->rest[id] = ak_vec3_make(org[0] + (float)i * h, org[1] + (float)j * h, org[2] + (float)k * h);
+            }
+
+    /* 3. tets: 6 per kept cell, positively oriented */
+    const size_t nt = kept * 6;
+    s->tet_count = nt;
+    SOFT_ALLOC(t.tets, uint32_t, 4 * nt);
+    SOFT_ALLOC(t.cell_tet, uint32_t, cells);
+    {
+        size_t ti = 0;
+        for (size_t k = 0; k < nz; ++k)
+            for (size_t j = 0; j < ny; ++j)
+                for (size_t i = 0; i < nx; ++i) {
+                    size_t cell = (k * ny + j) * nx + i;
+                    t.cell_tet[cell] = UINT32_MAX;
+                    if (!t.keep[cell]) continue;
+                    t.cell_tet[cell] = (uint32_t)ti;
+                    for (int q = 0; q < 6; ++q, ++ti) {
+                        uint32_t* tt = &t.tets[4 * ti];
+                        for (int c = 0; c < 4; ++c) {
+                            int corner = kuhn[q][c];
+                            tt[c] = t.grid_node[GRID(i + (corner & 1), j + ((corner >> 1) & 1), k + ((corner >> 2) & 1))];
+                        }
+                        ak_vec3 e1 = ak_vec3_sub(s->rest[tt[1]], s->rest[tt[0]]);
+                        ak_vec3 e2 = ak_vec3_sub(s->rest[tt[2]], s->rest[tt[0]]);
+                        ak_vec3 e3v = ak_vec3_sub(s->rest[tt[3]], s->rest[tt[0]]);
+                        if (ak_vec3_dot(e1, ak_vec3_cross(e2, e3v)) < 0.0f) {
+                            uint32_t tmp = tt[2];
+                            tt[2] = tt[3];
+                            tt[3] = tmp;
+                        }
+                    }
+                }
+    }
+#undef GRID
+
+    /* 4. colour the tets greedily (no two of a colour share a node), then sort by colour */
+    SOFT_ALLOC(t.color, uint32_t, nt);
+    SOFT_ALLOC(t.used, uint64_t, 2 * nn);
+    uint32_t ncol = 0;
+    for (size_t q = 0; q < nt; ++q) {
+        uint64_t m0 = 0, m1 = 0;
+        for (int c = 0; c < 4; ++c) {
+            m0 |= t.used[2 * t.tets[4 * q + c]];
+            m1 |= t.used[2 * t.tets[4 * q + c] + 1];
+        }
+        uint32_t col = UINT32_MAX;
+        for (uint32_t b = 0; b < SOFT_MAX_COLORS && col == UINT32_MAX; ++b)
+            if (!((b < 64 ? m0 >> b : m1 >> (b - 64)) & 1u)) col = b;
+        if (col == UINT32_MAX) {
+            r = AK_ERR_UNSUPPORTED;
+            goto fail;
+        }
+        t.color[q] = col;
+        if (col + 1 > ncol) ncol = col + 1;
+        for (int c = 0; c < 4; ++c) t.used[2 * t.tets[4 * q + c] + (col >= 64)] |= (uint64_t)1 << (col & 63);
+    }
+    s->color_count = ncol;
+    SOFT_ALLOC(s->color_start, uint32_t, ncol + 1);
+    SOFT_ALLOC(t.perm, uint32_t, nt);
+    for (size_t q = 0; q < nt; ++q) s->color_start[t.color[q] + 1]++;
+    for (uint32_t c = 0; c < ncol; ++c) s->color_start[c + 1] += s->color_start[c];
+    {
+        /* the colour masks are no longer needed: reuse them as the per-colour fill counters
+         * (4 * nn uint32_t slots; a tet has 4 nodes, so ncol <= 128 <= 4 * nn for nn >= 32) */
+        uint32_t* next = (uint32_t*)(void*)t.used;
+        if (4 * nn < ncol) {
+            r = AK_ERR_UNSUPPORTED;
+            goto fail;
+        }
+        for (uint32_t c = 0; c < ncol; ++c) next[c] = s->color_start[c];
+        for (size_t q = 0; q < nt; ++q) t.perm[q] = next[t.color[q]]++;
+    }
+    SOFT_ALLOC(s->tets, uint32_t, 4 * nt);
+    for (size_t q = 0; q < nt; ++q) memcpy(&s->tets[4 * (size_t)t.perm[q]], &t.tets[4 * q], 4 * sizeof(uint32_t));
+
+    /* 5. rest shapes and lumped masses */
+    SOFT_ALLOC(s->dm_inv, float, 9 * nt);
+    SOFT_ALLOC(s->volume, float, nt);
+    SOFT_ALLOC(s->mass, float, nn);
+    SOFT_ALLOC(s->inv_mass, float, nn);
+    for (size_t q = 0; q < nt; ++q) {
+        const uint32_t* tt = &s->tets[4 * q];
+        ak_vec3 x0 = s->rest[tt[0]];
+        ak_vec3 e[3] = {ak_vec3_sub(s->rest[tt[1]], x0), ak_vec3_sub(s->rest[tt[2]], x0), ak_vec3_sub(s->rest[tt[3]], x0)};
+        float dm[9] = {e[0].x, e[0].y, e[0].z, e[1].x, e[1].y, e[1].z, e[2].x, e[2].y, e[2].z}, det;
+        if (!mat3_inverse(dm, &s->dm_inv[9 * q], &det)) {
+            r = AK_ERR_BAD_DATA;
+            goto fail;
+        }
+        s->volume[q] = det / 6.0f;
+        for (int c = 0; c < 4; ++c) s->mass[tt[c]] += d.density * s->volume[q] * 0.25f;
+    }
+
+    /* 6. embedding of the surface vertices */
+    SOFT_ALLOC(s->embed_tet, uint32_t, nv);
+    SOFT_ALLOC(s->embed_bary, float, 4 * nv);
+    for (size_t v = 0; v < nv; ++v) {
+        size_t ci[3];
+        float p3[3] = {P[v].x, P[v].y, P[v].z};
+        for (int a = 0; a < 3; ++a) {
+            float f = floorf((p3[a] - org[a]) / h);
+            ci[a] = f < 0.0f ? 0 : (size_t)f >= dim[a] ? dim[a] - 1 : (size_t)f;
+        }
+        uint32_t first = t.cell_tet[(ci[2] * ny + ci[1]) * nx + ci[0]];
+        float best = -INFINITY, bary[4];
+        uint32_t best_t = 0;
+        if (first != UINT32_MAX) {
+            for (uint32_t q = first; q < first + 6; ++q) {
+                uint32_t tq = t.perm[q];
+                tet_bary(s->rest[s->tets[4 * tq]], &s->dm_inv[9 * tq], P[v], bary);
+                if (min4(bary) > best) {
+                    best = min4(bary);
+                    best_t = tq;
+                }
+            }
+        } else { /* nearest tet by centroid (cannot happen: every vertex's cell is kept) */
+            float bd = INFINITY;
+            for (size_t q = 0; q < nt; ++q) {
+                const uint32_t* tt = &s->tets[4 * q];
+                ak_vec3 cen = ak_vec3_scale(
+                    ak_vec3_add(ak_vec3_add(s->rest[tt[0]], s->rest[tt[1]]), ak_vec3_add(s->rest[tt[2]], s->rest[tt[3]])), 0.25f);
+                float dd = ak_vec3_length_sq(ak_vec3_sub(cen, P[v]));
+                if (dd < bd) {
+                    bd = dd;
+                    best_t = (uint32_t)q;
+                }
+            }
+        }
+        s->embed_tet[v] = best_t;
+        tet_bary(s->rest[s->tets[4 * best_t]], &s->dm_inv[9 * best_t], P[v], &s->embed_bary[4 * v]);
+    }
+
+    /* 7. bones: flesh radius = median distance of the vertices each bone owns */
+    SOFT_ALLOC(s->bones, ak_skin_bone, nb);
+    SOFT_ALLOC(s->contact_radius, float, nb);
+    SOFT_ALLOC(s->core_radius, float, nb);
+    memcpy(s->bones, d.bones.ptr, nb * sizeof(ak_skin_bone));
+    for (size_t b = 0; b < nb; ++b)
+        if (s->bones[b].joint_index > s->max_joint) s->max_joint = s->bones[b].joint_index;
+    SOFT_ALLOC(t.dist, float, nv);
+    SOFT_ALLOC(t.owner, uint32_t, nv);
+    for (size_t v = 0; v < nv; ++v) {
+        const uint16_t* jv = &d.joints.ptr[v * d.influence_count];
+        const float* wv = &d.weights.ptr[v * d.influence_count];
+        uint16_t dom = jv[0];
+        float wmax = wv[0];
+        for (uint32_t k = 1; k < d.influence_count; ++k)
+            if (wv[k] > wmax) {
+                wmax = wv[k];
+                dom = jv[k];
+            }
+        float best = INFINITY;
+        t.owner[v] = UINT32_MAX;
+        for (size_t b = 0; b < nb; ++b) {
+            if (s->bones[b].joint_index != dom) continue;
+            float dd = akp_segment_dist_sq(P[v], s->bones[b].head, s->bones[b].tail, NULL);
+            if (dd < best) {
+                best = dd;
+                t.owner[v] = (uint32_t)b;
+            }
+        }
+    }
+    for (size_t b = 0; b < nb; ++b) {
+        size_t cnt = 0;
+        for (size_t v = 0; v < nv; ++v)
+            if (t.owner[v] == b) t.dist[cnt++] = sqrtf(akp_segment_dist_sq(P[v], s->bones[b].head, s->bones[b].tail, NULL));
+        if (cnt == 0) continue;
+        qsort(t.dist, cnt, sizeof(float), cmp_float);
+        s->contact_radius[b] = t.dist[cnt / 2];
+    }
+
+    /* 8. node weights (inverse distance to the bones) and kinematic nodes */
+    SOFT_ALLOC(s->node_joints, uint16_t, SOFT_INFLUENCES * nn);
+    SOFT_ALLOC(s->node_weights, float, SOFT_INFLUENCES * nn);
+    {
+        /* only the bones that own surface vertices: a bone that moves no vertex (a leaf's
+         * point bone) must not pull the flesh around it */
+        ak_skin_bone* owning = (ak_skin_bone*)akp_alloc(A, nb * sizeof(ak_skin_bone));
+        if (!owning) {
+            r = AK_ERR_NO_MEMORY;
+            goto fail;
+        }
+        size_t no = 0;
+        for (size_t b = 0; b < nb; ++b)
+            if (s->contact_radius[b] > 0.0f) owning[no++] = s->bones[b];
+        if (no == 0) {
+            memcpy(owning, s->bones, nb * sizeof(ak_skin_bone));
+            no = nb;
+        }
+        ak_weights_desc wd = {.method = AK_WEIGHTS_DISTANCE,
+                              .positions = {s->rest, nn},
+                              .bones = {owning, no},
+                              .max_influences = SOFT_INFLUENCES};
+        r = ak_skin_weights_compute(&wd, alloc, (ak_u16_span){s->node_joints, SOFT_INFLUENCES * nn},
+                                    (ak_f32_span){s->node_weights, SOFT_INFLUENCES * nn});
+        akp_free(A, owning);
+        if (r != AK_OK) goto fail;
+    }
+    SOFT_ALLOC(s->kinematic, uint8_t, nn);
+    /* at least 1.2 cubes: every bone holds a column of nodes and its nearest neighbours */
+    for (size_t b = 0; b < nb; ++b)
+        s->core_radius[b] = s->contact_radius[b] > 0.0f ? ak_maxf(d.bone_radius * s->contact_radius[b], 1.2f * h) : 0.0f;
+    /* kinematic: inside a capsule and bound (almost) rigidly to one joint, so that the nodes
+     * around a joint, whose weights blend, are flesh */
+    /* ... and not within three capsule radii (at most half its own bone's length) of
+     * another bone: the flesh around a joint stays free, so that the bones' cores do not crush
+     * it at a deep bend */
+    const float zone = 3.0f;
+    /* per joint: whether any node became kinematic with these rules; a joint that got none (its
+     * bones too short or too crowded for them: a dense skeleton at a coarse lattice) takes every
+     * node inside its capsule that it weighs most */
+    uint8_t* joint_has = (uint8_t*)akp_calloc(A, (size_t)s->max_joint + 1);
+    if (!joint_has) {
+        r = AK_ERR_NO_MEMORY;
+        goto fail;
+    }
+    for (int pass = 0; pass < 2; ++pass)
+        for (size_t n = 0; n < nn; ++n) {
+            uint16_t part = s->node_joints[SOFT_INFLUENCES * n];
+            if (pass == 0 ? s->node_weights[SOFT_INFLUENCES * n] < 0.99f : joint_has[part] != 0) continue;
+            bool inside = false, near_other = false;
+            float own_len = 0.0f;
+            for (size_t b = 0; b < nb; ++b)
+                if (s->bones[b].joint_index == part && s->core_radius[b] > 0.0f)
+                    own_len = ak_maxf(own_len, ak_vec3_distance(s->bones[b].head, s->bones[b].tail));
+            for (size_t b = 0; b < nb; ++b) {
+                float core = s->core_radius[b];
+                if (!(core > 0.0f)) continue;
+                float d2 = akp_segment_dist_sq(s->rest[n], s->bones[b].head, s->bones[b].tail, NULL);
+                float z = ak_minf(zone * core, own_len / 2.0f);
+                if (s->bones[b].joint_index == part) inside = inside || d2 < core * core;
+                else near_other = near_other || (pass == 0 && d2 < z * z);
+            }
+            s->kinematic[n] = inside && !near_other;
+            if (pass == 0 && s->kinematic[n]) joint_has[part] = 1;
+        }
+    akp_free(A, joint_has);
+    /* connected pieces without a kinematic node become kinematic whole */
+    SOFT_ALLOC(t.uf, uint32_t, nn);
+    SOFT_ALLOC(t.comp_kin, uint8_t, nn);
+    for (size_t n = 0; n < nn; ++n) t.uf[n] = (uint32_t)n;
+    for (size_t q = 0; q < nt; ++q)
+        for (int c = 1; c < 4; ++c) {
+            uint32_t a = uf_find(t.uf, s->tets[4 * q]), b = uf_find(t.uf, s->tets[4 * q + c]);
+            if (a != b) t.uf[a < b ? b : a] = a < b ? a : b;
+        }
+    for (size_t n = 0; n < nn; ++n)
+        if (s->kinematic[n]) t.comp_kin[uf_find(t.uf, (uint32_t)n)] = 1;
+    for (size_t n = 0; n < nn; ++n) {
+        if (!t.comp_kin[uf_find(t.uf, (uint32_t)n)]) s->kinematic[n] = 1;
+        s->kin_count += s->kinematic[n];
+        s->inv_mass[n] = s->kinematic[n] || !(s->mass[n] > 0.0f) ? 0.0f : 1.0f / s->mass[n];
+    }
+
+    /* 9. which bones each flesh node collides with */
+    s->collide_words = (nb + 63) / 64;
+    SOFT_ALLOC(s->collide, uint64_t, nn * s->collide_words);
+    for (size_t n = 0; n < nn; ++n) {
+        if (s->kinematic[n]) continue;
+        uint16_t part = s->node_joints[n * SOFT_INFLUENCES];
+        for (size_t b = 0; b < nb; ++b) {
+            float rc = s->core_radius[b];
+            if (!(rc > 0.0f) || s->bones[b].joint_index == part) continue;
+            if (akp_segment_dist_sq(s->rest[n], s->bones[b].head, s->bones[b].tail, NULL) < rc * rc) continue;
+            s->collide[n * s->collide_words + b / 64] |= (uint64_t)1 << (b % 64);
+        }
+    }
+    /* 10. joint contact planes: where bone c starts at bone p's end, the flesh of each side
+     * stays on its side of the plane bisecting the two bones (a bent knee or elbow presses its
+     * two sides flat against each other instead of passing through) */
+    {
+        size_t np = 0;
+        for (int pass = 0; pass < 2; ++pass) {
+            np = 0;
+            for (size_t b1 = 0; b1 < nb; ++b1)
+                for (size_t b2 = 0; b2 < nb; ++b2) {
+                    const ak_skin_bone *P1 = &s->bones[b1], *C1 = &s->bones[b2];
+                    if (b1 == b2 || !(s->contact_radius[b1] > 0.0f) || !(s->contact_radius[b2] > 0.0f)) continue;
+                    if (P1->joint_index == C1->joint_index) continue;
+                    if (ak_vec3_distance(P1->tail, C1->head) > 1e-4f * longest) continue;
+                    if (ak_vec3_length(ak_vec3_sub(P1->tail, P1->head)) <= 0.0f || ak_vec3_length(ak_vec3_sub(C1->tail, C1->head)) <= 0.0f) continue;
+                    if (pass == 1) {
+                        s->planes[2 * np] = (uint32_t)b1;
+                        s->planes[2 * np + 1] = (uint32_t)b2;
+                    }
+                    ++np;
+                }
+            if (pass == 0) {
+                s->plane_count = (uint32_t)np;
+                if (np == 0) break;
+                SOFT_ALLOC(s->planes, uint32_t, 2 * np);
+            }
+        }
+        SOFT_ALLOC(s->node_planes, int32_t, SOFT_NODE_PLANES * nn);
+        for (size_t n = 0; n < nn && np; ++n) {
+            if (s->kinematic[n]) continue;
+            uint16_t part = s->node_joints[SOFT_INFLUENCES * n];
+            uint32_t k = 0;
+            for (uint32_t pl = 0; pl < s->plane_count && k < SOFT_NODE_PLANES; ++pl) {
+                const ak_skin_bone *P1 = &s->bones[s->planes[2 * pl]], *C1 = &s->bones[s->planes[2 * pl + 1]];
+                ak_vec3 u = ak_vec3_add(ak_vec3_normalize(ak_vec3_sub(P1->tail, P1->head)), ak_vec3_normalize(ak_vec3_sub(C1->tail, C1->head)));
+                if (ak_vec3_length(u) < 0.1f) continue;
+                ak_vec3 nrm = ak_vec3_normalize(u);
+                /* the two limbs: as far as the longer bone plus its flesh */
+                float reach = ak_maxf(ak_vec3_distance(P1->head, P1->tail), ak_vec3_distance(C1->head, C1->tail)) +
+                              2.0f * ak_maxf(s->contact_radius[s->planes[2 * pl]], s->contact_radius[s->planes[2 * pl + 1]]);
+                ak_vec3 rel = ak_vec3_sub(s->rest[n], P1->tail);
+                if (ak_vec3_length(rel) > reach) continue;
+                float sd = ak_vec3_dot(rel, nrm);
+                if (sd < -0.5f * h && part == P1->joint_index) s->node_planes[SOFT_NODE_PLANES * n + k++] = (int32_t)pl + 1;
+                else if (sd > 0.5f * h && part == C1->joint_index) s->node_planes[SOFT_NODE_PLANES * n + k++] = -((int32_t)pl + 1);
+            }
+        }
+    }
+#undef SOFT_ALLOC
+    tmp_free(A, &t);
+    *out_soft = s;
+    return AK_OK;
+fail:
+    tmp_free(A, &t);
+    ak_skin_soft_destroy(s);
+    return r;
+}
+
+/* ---- queries -------------------------------------------------------------------------- */
+
+size_t ak_skin_soft_node_count(const ak_skin_soft* s) { return s ? s->node_count : 0; }
+size_t ak_skin_soft_tet_count(const ak_skin_soft* s) { return s ? s->tet_count : 0; }
+size_t ak_skin_soft_kinematic_count(const ak_skin_soft* s) { return s ? s->kin_count : 0; }
+size_t ak_skin_soft_vertex_count(const ak_skin_soft* s) { return s ? s->vertex_count : 0; }
+
+ak_result ak_skin_soft_rest_nodes(const ak_skin_soft* s, ak_vec3_span out) {
+    if (!s || !out.ptr) return AK_ERR_NULL_ARG;
+    if (out.count < s->node_count) return AK_ERR_SPAN_SMALL;
+    memcpy(out.ptr, s->rest, s->node_count * sizeof(ak_vec3));
+    return AK_OK;
+}
+
+ak_result ak_skin_soft_kinematic_flags(const ak_skin_soft* s, ak_u8_span out) {
+    if (!s || !out.ptr) return AK_ERR_NULL_ARG;
+    if (out.count < s->node_count) return AK_ERR_SPAN_SMALL;
+    memcpy(out.ptr, s->kinematic, s->node_count);
+    return AK_OK;
+}
+
+ak_result ak_skin_soft_tets(const ak_skin_soft* s, ak_u32_span out) {
+    if (!s || !out.ptr) return AK_ERR_NULL_ARG;
+    if (out.count < 4 * s->tet_count) return AK_ERR_SPAN_SMALL;
+    memcpy(out.ptr, s->tets, 4 * s->tet_count * sizeof(uint32_t));
+    return AK_OK;
+}
+
+static bool palette_finite(ak_mat4_cspan p) {
+    for (size_t j = 0; j < p.count; ++j)
+        for (int i = 0; i < 16; ++i)
+            if (!isfinite(p.ptr[j].m[i])) return false;
+    return true;
+}
+
+ak_result ak_skin_soft_state_init(const ak_skin_soft* s, ak_mat4_cspan palette, ak_vec3_span x, ak_vec3_span v) {
+    if (!s || !palette.ptr || !x.ptr || !v.ptr) return AK_ERR_NULL_ARG;
+    if (x.count < s->node_count || v.count < s->node_count || palette.count <= s->max_joint) return AK_ERR_SPAN_SMALL;
+    if (!palette_finite(palette)) return AK_ERR_BAD_DATA;
+    for (size_t n = 0; n < s->node_count; ++n) {
+        x.ptr[n] = lbs_node(s, n, palette.ptr, palette.count);
+        v.ptr[n] = ak_vec3_zero();
+    }
+    return AK_OK;
+}
+
+static void surface_range(const ak_skin_soft* s, const ak_vec3* x, ak_vec3* out, size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+        const uint32_t* tt = &s->tets[4 * (size_t)s->embed_tet[v]];
+        const float* b = &s->embed_bary[4 * v];
+        ak_vec3 p = ak_vec3_scale(x[tt[0]], b[0]);
+        p = ak_vec3_madd(p, x[tt[1]], b[1]);
+        p = ak_vec3_madd(p, x[tt[2]], b[2]);
+        out[v] = ak_vec3_madd(p, x[tt[3]], b[3]);
+    }
+}
+
+ak_result ak_skin_soft_surface(const ak_skin_soft* s, ak_vec3_cspan x, ak_vec3_span out) {
+    if (!s || !x.ptr || !out.ptr) return AK_ERR_NULL_ARG;
+    if (x.count < s->node_count || out.count < s->vertex_count) return AK_ERR_SPAN_SMALL;
+    surface_range(s, x.ptr, out.ptr, 0, s->vertex_count);
+    return AK_OK;
+}
+
+/* ---- step ----------------------------------------------------------------------------- */
+
+/* Scratch layout: start[node], prev[node], target[node], vref[node], lambda[2 * tet], posed
+ * bones[2 * bone], joint planes[2 * plane]. */
+size_t ak_skin_soft_step_scratch_size(const ak_skin_soft* s) {
+    if (!s) return 0;
+    return 64 + akp_align16(4 * s->node_count * sizeof(ak_vec3)) + akp_align16(2 * s->tet_count * sizeof(float)) +
+           akp_align16(2 * s->bone_count * sizeof(ak_vec3)) + akp_align16(2 * s->plane_count * sizeof(ak_vec3));
+}
+
+ak_result ak_skin_soft_step_validate(const ak_skin_soft_step_job* j) {
+    if (!j || !j->soft || !j->palette.ptr || !j->node_positions.ptr || !j->node_velocities.ptr || !j->scratch.ptr)
+        return AK_ERR_NULL_ARG;
+    const ak_skin_soft* s = j->soft;
+    if (!(j->dt >= 0.0f && j->dt <= 1.0f) || j->thread_count > 64 || !ak_vec3_is_finite(j->gravity)) return AK_ERR_BAD_ARG;
+    if (j->node_positions.count < s->node_count || j->node_velocities.count < s->node_count ||
+        j->palette.count <= s->max_joint || j->scratch.count < ak_skin_soft_step_scratch_size(s) ||
+        (j->previous_palette.ptr && j->previous_palette.count < j->palette.count) ||
+        (j->out_positions.ptr && j->out_positions.count < s->vertex_count))
+        return AK_ERR_SPAN_SMALL;
+    if (!palette_finite(j->palette) || (j->previous_palette.ptr && !palette_finite(j->previous_palette))) return AK_ERR_BAD_DATA;
+    return AK_OK;
+}
+
+typedef struct step_ctx {
+    const ak_skin_soft* s;
+    ak_vec3 *x, *v, *start, *prev, *target, *bones, *planes, *vref;
+    float jiggle; /* 1 - exp(-jiggle_damping h) */
+    float* lambda;
+    float h, gamma, gamma_h, adev, ahyd;
+    uint32_t iterations; /* adev = 1 / (mu h^2), ahyd = 1 / (lambda h^2): divide by V */
+    float hyd_rest;             /* 1 + mu / lambda */
+    ak_vec3 gravity;
+} step_ctx;
+
+static void solve_tet(const step_ctx* c, size_t q) {
+    const ak_skin_soft* s = c->s;
+    const uint32_t* tt = &s->tets[4 * q];
+    float w[4] = {s->inv_mass[tt[0]], s->inv_mass[tt[1]], s->inv_mass[tt[2]], s->inv_mass[tt[3]]};
+    if (w[0] + w[1] + w[2] + w[3] == 0.0f) return;
+    ak_vec3* x = c->x;
+    const float* m = &s->dm_inv[9 * q];
+    ak_vec3 x0 = x[tt[0]];
+    ak_vec3 d1 = ak_vec3_sub(x[tt[1]], x0), d2 = ak_vec3_sub(x[tt[2]], x0), d3 = ak_vec3_sub(x[tt[3]], x0);
+    /* F = Ds Dm^-1: column j = d1 m[0 + 3j] + d2 m[1 + 3j] + d3 m[2 + 3j] */
+    ak_vec3 f[3];
+    for (int jc = 0; jc < 3; ++jc)
+        f[jc] = ak_vec3_madd(ak_vec3_madd(ak_vec3_scale(d1, m[3 * jc]), d2, m[1 + 3 * jc]), d3, m[2 + 3 * jc]);
+    float cd = sqrtf(ak_vec3_length_sq(f[0]) + ak_vec3_length_sq(f[1]) + ak_vec3_length_sq(f[2]));
+    ak_vec3 ph[3] = {ak_vec3_cross(f[1], f[2]), ak_vec3_cross(f[2], f[0]), ak_vec3_cross(f[0], f[1])};
+    float det = ak_vec3_dot(f[0], ph[0]);
+    float ch = det - c->hyd_rest;
+    /* node gradients: g_k = sum_j P_col_j m[k + 3j] (k = 1..3), g_0 = -sum */
+    ak_vec3 gd[4], gh[4];
+    float inv_cd = cd > 1e-12f ? 1.0f / cd : 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        ak_vec3 a = ak_vec3_zero(), b = ak_vec3_zero();
+        for (int jc = 0; jc < 3; ++jc) {
+            a = ak_vec3_madd(a, f[jc], m[k + 3 * jc] * inv_cd);
+            b = ak_vec3_madd(b, ph[jc], m[k + 3 * jc]);
+        }
+        gd[k + 1] = a;
+        gh[k + 1] = b;
+    }
+    gd[0] = ak_vec3_neg(ak_vec3_add(ak_vec3_add(gd[1], gd[2]), gd[3]));
+    gh[0] = ak_vec3_neg(ak_vec3_add(ak_vec3_add(gh[1], gh[2]), gh[3]));
+    float a11 = 0, a12 = 0, a22 = 0, vd = 0, vh = 0;
+    for (int k = 0; k < 4; ++k) {
+        a11 += w[k] * ak_vec3_dot(gd[k], gd[k]);
+        a12 += w[k] * ak_vec3_dot(gd[k], gh[k]);
+        a22 += w[k] * ak_vec3_dot(gh[k], gh[k]);
+        if (c->gamma > 0.0f || c->gamma_h > 0.0f) {
+            ak_vec3 dx = ak_vec3_sub(x[tt[k]], c->prev[tt[k]]);
+            vd += ak_vec3_dot(gd[k], dx);
+            vh += ak_vec3_dot(gh[k], dx);
+        }
+    }
+    float vol = s->volume[q];
+    float atd = c->adev / vol, ath = c->ahyd / vol, g1 = 1.0f + c->gamma;
+    float* lam = &c->lambda[2 * q];
+    float b1 = -cd - atd * lam[0] - c->gamma * vd;
+    /* damping on the deviatoric constraint only (gamma_h = 0): damping the stiff volume term
+     * makes the volume creep back over many steps */
+    float gh_ = c->gamma_h, g2 = 1.0f + gh_;
+    float b2 = -ch - ath * lam[1] - gh_ * vh;
+    /* row i is (1 + gamma_i) (grad C_i . dx) + alpha~_i dlambda_i = b_i: each constraint damps
+     * the motion along its own gradient, so the rest state (where the two gradients are
+     * parallel and the corrections cancel) stays a fixed point for any damping */
+    float m11 = g1 * a11 + atd, m12 = g1 * a12, m21 = g2 * a12, m22 = g2 * a22 + ath;
+    float dl1, dl2;
+    if (inv_cd == 0.0f) { /* collapsed to a point: hydrostatic alone */
+        dl1 = 0.0f;
+        dl2 = m22 > 0.0f ? b2 / m22 : 0.0f;
+    } else {
+        float dt2 = m11 * m22 - m12 * m21;
+        if (!(fabsf(dt2) > 1e-30f)) return;
+        dl1 = (b1 * m22 - b2 * m12) / dt2;
+        dl2 = (m11 * b2 - m21 * b1) / dt2;
+    }
+    if (!isfinite(dl1) || !isfinite(dl2)) return;
+    lam[0] += dl1;
+    lam[1] += dl2;
+    for (int k = 0; k < 4; ++k)
+        if (w[k] > 0.0f)
+            x[tt[k]] = ak_vec3_add(x[tt[k]], ak_vec3_scale(ak_vec3_add(ak_vec3_scale(gd[k], dl1), ak_vec3_scale(gh[k], dl2)), w[k]));
+}
+
+static void collide_node(const step_ctx* c, size_t n) {
+    const ak_skin_soft* s = c->s;
+    for (uint32_t k = 0; k < SOFT_NODE_PLANES && s->plane_count; ++k) {
+        int32_t e = s->node_planes[SOFT_NODE_PLANES * n + k];
+        if (e == 0) break;
+        size_t pl = (size_t)(e > 0 ? e : -e) - 1;
+        ak_vec3 nrm = c->planes[2 * pl + 1];
+        if (nrm.x == 0.0f && nrm.y == 0.0f && nrm.z == 0.0f) continue;
+        float sd = ak_vec3_dot(ak_vec3_sub(c->x[n], c->planes[2 * pl]), nrm);
+        if (e > 0 ? sd > 0.0f : sd < 0.0f) c->x[n] = ak_vec3_madd(c->x[n], nrm, -sd);
+    }
+    const uint64_t* bits = &s->collide[n * s->collide_words];
+    for (size_t wi = 0; wi < s->collide_words; ++wi)
+        for (uint64_t m = bits[wi]; m; m &= m - 1) {
+            size_t b = wi * 64 + (size_t)__builtin_ctzll(m);
+            float rc = s->core_radius[b];
+            ak_vec3 cp;
+            float d2 = akp_segment_dist_sq(c->x[n], c->bones[2 * b], c->bones[2 * b + 1], &cp);
+            if (d2 >= rc * rc || d2 < 1e-20f) continue;
+            float dl = sqrtf(d2);
+            c->x[n] = ak_vec3_madd(cp, ak_vec3_sub(c->x[n], cp), rc / dl);
+        }
+}
+
+/* Threads: the phases run over node ranges or over the tets of one colour, with a barrier
+ * between phases. With one thread the same loops run in the same order. Workers wait for a
+ * start signal carrying the final thread count, so a thread that fails to start only lowers it. */
+typedef struct soft_team {
+    const step_ctx* c;
+    pthread_mutex_t mutex;
+    pthread_cond_t cond;
+    pthread_barrier_t barrier;
+    int go;      /* 1: run; -1: give up */
+    uint32_t count;
+} soft_team;
+
+typedef struct soft_worker {
+    soft_team* team;
+    uint32_t index;
+} soft_worker;
+
+static void range_of(size_t n, uint32_t index, uint32_t count, size_t* b, size_t* e) {
+    *b = n * index / count;
+    *e = n * (index + 1) / count;
+}
+
+static void sync(soft_team* t) {
+    if (t->count > 1) pthread_barrier_wait(&t->barrier);
+}
+
+static void step_work(soft_team* team, uint32_t index) {
+    const step_ctx* c = team->c;
+    const ak_skin_soft* s = c->s;
+    const uint32_t count = team->count;
+    size_t nb, ne, tb, te;
+    range_of(s->node_count, index, count, &nb, &ne);
+    range_of(s->tet_count, index, count, &tb, &te);
+    const uint32_t S = s->substeps;
+    for (uint32_t sub = 0; sub < S; ++sub) {
+        float frac = (float)(sub + 1) / (float)S;
+        for (size_t n = nb; n < ne; ++n) {
+            c->prev[n] = c->x[n];
+            if (s->kinematic[n]) c->x[n] = ak_vec3_lerp(c->start[n], c->target[n], frac);
+            else {
+                c->v[n] = ak_vec3_madd(c->v[n], c->gravity, c->h);
+                c->x[n] = ak_vec3_madd(c->x[n], c->v[n], c->h);
+            }
+        }
+        for (size_t q = tb; q < te; ++q) c->lambda[2 * q] = c->lambda[2 * q + 1] = 0.0f;
+        sync(team);
+        for (uint32_t it = 0; it < c->iterations; ++it)
+        for (uint32_t col = 0; col < s->color_count; ++col) {
+            size_t cb = s->color_start[col], ce = s->color_start[col + 1], b, e;
+            range_of(ce - cb, index, count, &b, &e);
+            for (size_t q = cb + b; q < cb + e; ++q) solve_tet(c, q);
+            sync(team);
+        }
+        float inv_h = 1.0f / c->h;
+        for (size_t n = nb; n < ne; ++n) {
+            if (!s->kinematic[n]) collide_node(c, n);
+            c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n], c->prev[n]), inv_h);
+            /* jiggle damping: velocity relative to the skinned motion decays */
+            if (!s->kinematic[n]) c->v[n] = ak_vec3_madd(c->v[n], ak_vec3_sub(c->v[n], c->vref[n]), -c->jiggle);
+        }
+        sync(team);
+    }
+}
+
+static void* step_thread(void* arg) {
+    soft_worker* w = (soft_worker*)arg;
+    soft_team* t = w->team;
+    pthread_mutex_lock(&t->mutex);
+    while (t->go == 0) pthread_cond_wait(&t->cond, &t->mutex);
+    int go = t->go;
+    pthread_mutex_unlock(&t->mutex);
+    if (go > 0 && w->index < t->count) step_work(t, w->index);
+    return NULL;
+}
+
+ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
+    ak_result r = ak_skin_soft_step_validate(j);
+    if (r != AK_OK) return r;
+    const ak_skin_soft* s = j->soft;
+    const size_t nn = s->node_count;
+    uint8_t* base = (uint8_t*)(((uintptr_t)j->scratch.ptr + 63) & ~(uintptr_t)63);
+    step_ctx c;
+    memset(&c, 0, sizeof c);
+    c.s = s;
+    c.x = j->node_positions.ptr;
+    c.v = j->node_velocities.ptr;
+    c.start = (ak_vec3*)(void*)base;
+    c.prev = c.start + nn;
+    c.target = c.prev + nn;
+    c.vref = c.target + nn;
+    c.lambda = (float*)(void*)(base + akp_align16(4 * nn * sizeof(ak_vec3)));
+    c.bones = (ak_vec3*)(void*)((uint8_t*)c.lambda + akp_align16(2 * s->tet_count * sizeof(float)));
+    c.planes = (ak_vec3*)(void*)((uint8_t*)c.bones + akp_align16(2 * s->bone_count * sizeof(ak_vec3)));
+    float dt = j->dt > 0.0f ? j->dt : 1.0f / 60.0f;
+    c.h = dt / (float)s->substeps;
+    c.gamma = s->damping / c.h;
+    c.iterations = 1;
+    c.adev = 1.0f / (s->mu * c.h * c.h);
+    c.ahyd = 1.0f / (s->lambda * c.h * c.h);
+    c.hyd_rest = 1.0f + s->mu / s->lambda;
+    c.gravity = j->gravity;
+    c.jiggle = 1.0f - expf(-s->jiggle_damping * c.h);
+    const bool have_prev = j->previous_palette.ptr != NULL;
+    for (size_t n = 0; n < nn; ++n) {
+        c.start[n] = c.x[n];
+        ak_vec3 end = lbs_node(s, n, j->palette.ptr, j->palette.count);
+        if (s->kinematic[n]) c.target[n] = end;
+        c.vref[n] = have_prev ? ak_vec3_scale(ak_vec3_sub(end, lbs_node(s, n, j->previous_palette.ptr, j->previous_palette.count)), 1.0f / dt)
+                              : ak_vec3_zero();
+    }
+    for (size_t b = 0; b < s->bone_count; ++b) {
+        size_t jn = s->bones[b].joint_index;
+        c.bones[2 * b] = ak_mat4_transform_point(j->palette.ptr[jn], s->bones[b].head);
+        c.bones[2 * b + 1] = ak_mat4_transform_point(j->palette.ptr[jn], s->bones[b].tail);
+    }
+    for (uint32_t pl = 0; pl < s->plane_count; ++pl) {
+        const ak_skin_bone *bp = &s->bones[s->planes[2 * pl]], *bc = &s->bones[s->planes[2 * pl + 1]];
+        const ak_mat4 mp = j->palette.ptr[bp->joint_index], mc = j->palette.ptr[bc->joint_index];
+        ak_vec3 up = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mp, bp->tail), ak_mat4_transform_point(mp, bp->head)));
+        ak_vec3 uc = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mc, bc->tail), ak_mat4_transform_point(mc, bc->head)));
+        ak_vec3 u = ak_vec3_add(up, uc);
+        c.planes[2 * pl] = ak_mat4_transform_point(mp, bp->tail);
+        c.planes[2 * pl + 1] = ak_vec3_length(u) > 0.1f ? ak_vec3_normalize(u) : ak_vec3_zero(); /* folded: off */
+    }
+    uint32_t tc = j->thread_count > 1 ? j->thread_count : 1;
+    if (tc > 1 && nn < 256 * (size_t)tc) tc = (uint32_t)(nn / 256 > 1 ? nn / 256 : 1);
+    soft_team team;
+    team.c = &c;
+    team.count = 1;
+    team.go = 0;
+    if (tc > 1 && pthread_mutex_init(&team.mutex, NULL) == 0) {
+        if (pthread_cond_init(&team.cond, NULL) == 0) {
+            soft_worker w[64];
+            pthread_t ids[64];
+            uint32_t started = 1;
+            for (; started < tc; ++started) {
+                w[started] = (soft_worker){&team, started};
+                if (pthread_create(&ids[started], NULL, step_thread, &w[started]) != 0) break;
+            }
+            pthread_mutex_lock(&team.mutex);
+            team.count = started;
+            team.go = started > 1 && pthread_barrier_init(&team.barrier, NULL, started) == 0 ? 1 : -1;
+            if (team.go < 0) team.count = 1;
+            pthread_cond_broadcast(&team.cond);
+            pthread_mutex_unlock(&team.mutex);
+            step_work(&team, 0);
+            for (uint32_t i = 1; i < started; ++i) pthread_join(ids[i], NULL);
+            if (team.go > 0) pthread_barrier_destroy(&team.barrier);
+            pthread_cond_destroy(&team.cond);
+        } else {
+            step_work(&team, 0);
+        }
+        pthread_mutex_destroy(&team.mutex);
+    } else {
+        step_work(&team, 0);
+    }
+    bool finite = true;
+    double ke = 0.0;
+    for (size_t n = 0; n < nn && finite; ++n) {
+        finite = ak_vec3_is_finite(c.x[n]) && ak_vec3_is_finite(c.v[n]);
+        if (!s->kinematic[n]) ke += 0.5 * (double)s->mass[n] * (double)ak_vec3_length_sq(c.v[n]);
+    }
+    if (!finite) {
+        (void)ak_skin_soft_state_init(s, j->palette, j->node_positions, j->node_velocities);
+        ke = 0.0;
+    }
+    if (j->out_positions.ptr) surface_range(s, c.x, j->out_positions.ptr, 0, s->vertex_count);
+    if (j->out_kinetic_energy) *j->out_kinetic_energy = (float)ke;
+    return AK_OK;
+}
