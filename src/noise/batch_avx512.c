@@ -1,0 +1,71 @@
+/* AVX-512 fractal kernels (16 points at a time, AVX-512 F and DQ): the same body as the AVX2
+ * kernel (simd_body.h) over 16 lanes with mask registers. Compiled only for GCC/Clang on
+ * x86-64 without AK_NO_SIMD (the rest of the build needs no -mavx512 flag); selected at run
+ * time with __builtin_cpu_supports. */
+#include "noise_internal.h"
+
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
+#include <immintrin.h>
+
+bool akp_noise_have_avx512(void) {
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+}
+
+#define KI __attribute__((target("avx512f,avx512dq"), always_inline))
+#define KERNEL_RUN __attribute__((target("avx512f,avx512dq")))
+#define KERNEL_ENTRY akp_noise_fractal_avx512
+#define AKP_W 16
+typedef __m512 VF;
+typedef __m512i VI;
+typedef __mmask16 VM;
+
+KI static inline VF vf_set1(float a) { return _mm512_set1_ps(a); }
+KI static inline VI vi_set1(int a) { return _mm512_set1_epi32(a); }
+KI static inline VF vf_zero(void) { return _mm512_setzero_ps(); }
+KI static inline VF vf_load(const float* p) { return _mm512_loadu_ps(p); }
+KI static inline void vf_store(float* p, VF v) { _mm512_storeu_ps(p, v); }
+KI static inline VF vf_add(VF a, VF b) { return _mm512_add_ps(a, b); }
+KI static inline VF vf_sub(VF a, VF b) { return _mm512_sub_ps(a, b); }
+KI static inline VF vf_mul(VF a, VF b) { return _mm512_mul_ps(a, b); }
+KI static inline VF vf_min(VF a, VF b) { return _mm512_min_ps(a, b); }
+KI static inline VF vf_max(VF a, VF b) { return _mm512_max_ps(a, b); }
+KI static inline VF vf_floor(VF a) { return _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
+KI static inline VI vf_cvtt(VF a) { return _mm512_cvttps_epi32(a); }
+KI static inline VF vf_cast(VI a) { return _mm512_castsi512_ps(a); }
+KI static inline VF vf_xor(VF a, VF b) { return _mm512_xor_ps(a, b); }
+KI static inline VF vf_and(VF a, VF b) { return _mm512_and_ps(a, b); }
+KI static inline VF vf_abs(VF a) { return _mm512_andnot_ps(_mm512_set1_ps(-0.0f), a); }
+KI static inline VI vi_and(VI a, VI b) { return _mm512_and_si512(a, b); }
+KI static inline VI vi_add(VI a, VI b) { return _mm512_add_epi32(a, b); }
+#define VI_SLLI(a, n) _mm512_slli_epi32((a), (n))
+#define VI_SRLI(a, n) _mm512_srli_epi32((a), (n))
+/* The 4 bytes perm[idx .. idx + 3] of each lane (little-endian: perm[idx] in the low byte). */
+KI static inline VI gather4(const uint8_t* perm, VI idx) {
+    return _mm512_i32gather_epi32(idx, (const void*)perm, 1);
+}
+KI static inline VM m_lt(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
+KI static inline VM m_gt(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
+KI static inline VM m_ge(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_GE_OQ); }
+KI static inline VM mi_lt(VI a, int v) { return _mm512_cmplt_epi32_mask(a, _mm512_set1_epi32(v)); }
+KI static inline VM mi_eq(VI a, int v) { return _mm512_cmpeq_epi32_mask(a, _mm512_set1_epi32(v)); }
+KI static inline VM m_and(VM a, VM b) { return (VM)(a & b); }
+KI static inline VM m_or(VM a, VM b) { return (VM)(a | b); }
+KI static inline VM m_andn(VM a, VM b) { return (VM)(~a & b); } /* !a & b */
+KI static inline VM m_not(VM a) { return (VM)~a; }
+KI static inline VF vf_sel(VM m, VF a, VF b) { return _mm512_mask_blend_ps(m, b, a); } /* m ? a : b */
+KI static inline VI vi_sel(VM m, VI a, VI b) { return _mm512_mask_blend_epi32(m, b, a); }
+KI static inline VF vf_maskz(VM m, VF a) { return _mm512_maskz_mov_ps(m, a); } /* m ? a : +0 */
+/* tab[idx] for idx in 0..15 */
+KI static inline VF vf_lut16(const float* tab, VI idx) { return _mm512_permutexvar_ps(idx, _mm512_loadu_ps(tab)); }
+
+#include "simd_body.h"
+
+#else
+
+bool akp_noise_have_avx512(void) { return false; }
+void akp_noise_fractal_avx512(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
+                              size_t count, float* out, float* const* grad) {
+    (void)noise, (void)d, (void)dims, (void)xs, (void)count, (void)out, (void)grad;
+}
+
+#endif
