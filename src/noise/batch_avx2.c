@@ -41,6 +41,13 @@ KI static inline VI vi_add(VI a, VI b) { return _mm256_add_epi32(a, b); }
 KI static inline VI gather4(const uint8_t* perm, VI idx) {
     return _mm256_i32gather_epi32((const int*)(const void*)perm, idx, 1);
 }
+/* The lookup table: the byte table itself (an index is at most 255 + 256, so a gather reads at
+ * most perm[514]: inside ak_noise, whose 8-byte seed follows perm[512]). */
+typedef struct PermTab {
+    const uint8_t* perm;
+} PermTab;
+KI static inline void tab_make(const uint8_t* perm, PermTab* t) { t->perm = perm; }
+KI static inline VI tab_pair(const PermTab* t, VI idx) { return gather4(t->perm, idx); }
 KI static inline VM m_lt(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
 KI static inline VM m_gt(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
 KI static inline VM m_ge(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }

@@ -39,9 +39,29 @@ KI static inline VI vi_and(VI a, VI b) { return _mm512_and_si512(a, b); }
 KI static inline VI vi_add(VI a, VI b) { return _mm512_add_epi32(a, b); }
 #define VI_SLLI(a, n) _mm512_slli_epi32((a), (n))
 #define VI_SRLI(a, n) _mm512_srli_epi32((a), (n))
-/* The 4 bytes perm[idx .. idx + 3] of each lane (little-endian: perm[idx] in the low byte). */
-KI static inline VI gather4(const uint8_t* perm, VI idx) {
-    return _mm512_i32gather_epi32(idx, (const void*)perm, 1);
+/* perm[j] | perm[j + 1] << 8 for j = 0..255 in 16 registers (entries 32 c .. 32 c + 31 in
+ * t[c][0..1]): a lookup is 8 two-register permutes on the index's low 5 bits and a blend tree
+ * on bits 5..7, which on CPUs with slow gathers beats a 16-lane gather several times. */
+typedef struct PermTab {
+    VI t[8][2];
+} PermTab;
+KI static inline void tab_make(const uint8_t* perm, PermTab* t) {
+    int32_t v[256];
+    for (int j = 0; j < 256; ++j) v[j] = (int32_t)perm[j] | (int32_t)perm[j + 1] << 8;
+    for (int c = 0; c < 8; ++c) {
+        t->t[c][0] = _mm512_loadu_si512((const void*)(v + 32 * c));
+        t->t[c][1] = _mm512_loadu_si512((const void*)(v + 32 * c + 16));
+    }
+}
+KI static inline VI tab_pair(const PermTab* t, VI idx) {
+    VI r[8];
+    for (int c = 0; c < 8; ++c) r[c] = _mm512_permutex2var_epi32(t->t[c][0], idx, t->t[c][1]);
+    const VM b5 = _mm512_test_epi32_mask(idx, _mm512_set1_epi32(32));
+    const VM b6 = _mm512_test_epi32_mask(idx, _mm512_set1_epi32(64));
+    const VM b7 = _mm512_test_epi32_mask(idx, _mm512_set1_epi32(128));
+    for (int c = 0; c < 4; ++c) r[c] = _mm512_mask_blend_epi32(b5, r[2 * c], r[2 * c + 1]);
+    for (int c = 0; c < 2; ++c) r[c] = _mm512_mask_blend_epi32(b6, r[2 * c], r[2 * c + 1]);
+    return _mm512_mask_blend_epi32(b7, r[0], r[1]);
 }
 KI static inline VM m_lt(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
 KI static inline VM m_gt(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }

@@ -13,10 +13,16 @@
  * masked to 0 first). So the results equal the scalar ones bit for bit; test_noise checks it
  * on every path the CPU has.
  *
- * Permutation lookups are 32-bit gathers from the byte table with scale 1: the low byte is
- * perm[i] and the next one perm[i + 1], the upper corner's hash. An index is at most
- * 255 + 256, so a gather reads at most perm[514]: inside ak_noise, whose 8-byte seed follows
- * perm[512]. Never installed. */
+ * Permutation lookups go through tab_pair(T, i), which gives perm[i] in the low byte and
+ * perm[i + 1] (the upper corner's hash) in the next one, for 0 <= i <= 511 (the table is
+ * doubled, so that is a function of i & 255): AVX2 gathers 32 bits at perm + i, AVX-512 looks
+ * i & 255 up in a 256-entry table held in registers (PermTab, made once per call by
+ * tab_make). Never installed. */
+
+/* Small fixed loops (dimensions, corners) are unrolled so that per-corner vectors stay in
+ * registers. */
+#define AKP_PRAGMA(x) _Pragma(#x)
+#define AKP_UNROLL AKP_PRAGMA(GCC unroll 8)
 
 /* ---- Perlin -------------------------------------------------------------------------------- */
 
@@ -58,17 +64,19 @@ KI static inline VF corner_perlin(int dims, VI h, const VF* d, VF* g, bool want_
  * chain with the upper corner at index + 1 unwrapped (p[A + 1] in his code: the doubled table
  * makes it equal to the wrapped index): one 32-bit gather at perm + i reads perm[i] and
  * perm[i + 1] together, so 3D takes 1 + 2 + 4 gathers instead of 14. */
-KI static inline void cell_hashes(const uint8_t* perm, int dims, const VI* lo, VI* hash) {
+KI static inline void cell_hashes(const PermTab* perm, int dims, const VI* lo, VI* hash) {
     const VI m8 = vi_set1(255);
     {
-        const VI g = gather4(perm, lo[0]);
+        const VI g = tab_pair(perm, lo[0]);
         hash[0] = vi_and(g, m8);
         hash[1] = vi_and(VI_SRLI(g, 8), m8);
     }
+    AKP_UNROLL
     for (int k = 1; k < dims; ++k) {
         const int half = 1 << k;
+        AKP_UNROLL
         for (int c = 0; c < half; ++c) {
-            const VI g = gather4(perm, vi_add(hash[c], lo[k]));
+            const VI g = tab_pair(perm, vi_add(hash[c], lo[k]));
             hash[c] = vi_and(g, m8);
             hash[c + half] = vi_and(VI_SRLI(g, 8), m8);
         }
@@ -78,6 +86,7 @@ KI static inline void cell_hashes(const uint8_t* perm, int dims, const VI* lo, V
 KI static inline VM in_range(int dims, const VF* p) {
     const VF limit = vf_set1(AKP_NOISE_LIMIT);
     VM valid = m_lt(vf_abs(p[0]), limit);
+    AKP_UNROLL
     for (int k = 1; k < dims; ++k) valid = m_and(valid, m_lt(vf_abs(p[k]), limit));
     return valid;
 }
@@ -97,10 +106,11 @@ KI static inline VF dfade_v(VF t) {
 KI static inline VF lerp_v(VF t, VF a, VF b) { return vf_add(a, vf_mul(t, vf_sub(b, a))); }
 
 /* Perlin noise at W points p[0..dims-1]; value returned, gradient into grad when want_grad. */
-KI static inline VF perlin_v(const uint8_t* perm, int dims, const VF* p, VF* grad, bool want_grad) {
+KI static inline VF perlin_v(const PermTab* perm, int dims, const VF* p, VF* grad, bool want_grad) {
     const VM valid = in_range(dims, p);
     VI lo[3];
     VF f[3];
+    AKP_UNROLL
     for (int k = 0; k < dims; ++k) {
         const VF fl = vf_floor(p[k]);
         f[k] = vf_sub(p[k], fl);
@@ -110,25 +120,31 @@ KI static inline VF perlin_v(const uint8_t* perm, int dims, const VF* p, VF* gra
     VF val[8], gv[8][3];
     VI hash[8];
     cell_hashes(perm, dims, lo, hash);
+    AKP_UNROLL
     for (int c = 0; c < corners; ++c) {
         VF d[3];
+        AKP_UNROLL
         for (int k = 0; k < dims; ++k) d[k] = ((c >> k) & 1) ? vf_sub(f[k], vf_set1(1.0f)) : f[k];
         val[c] = corner_perlin(dims, hash[c], d, gv[c], want_grad);
     }
+    AKP_UNROLL
     for (int k = 0; k < dims; ++k) {
         const VF t = fade_v(f[k]);
         const VF dt = want_grad ? dfade_v(f[k]) : vf_zero();
         const int step = 1 << k;
+        AKP_UNROLL
         for (int c = 0; c < corners; c += 2 * step) {
             const VF a = val[c], b = val[c + step];
             val[c] = lerp_v(t, a, b);
             if (want_grad) {
+                AKP_UNROLL
                 for (int m = 0; m < dims; ++m) gv[c][m] = lerp_v(t, gv[c][m], gv[c + step][m]);
                 gv[c][k] = vf_add(gv[c][k], vf_mul(vf_sub(b, a), dt));
             }
         }
     }
     if (want_grad)
+        AKP_UNROLL
         for (int m = 0; m < dims; ++m) grad[m] = vf_maskz(valid, gv[0][m]);
     return vf_maskz(valid, val[0]);
 }
@@ -147,6 +163,7 @@ static const float simplex_g3z[16] = {0, 0, 0, 0, 1, 1, -1, -1, 1, 1, -1, -1, 0,
 KI static inline VF corner_simplex(int dims, const VF* d, const VF* g, VF* G, bool want_grad) {
     const VF zero = vf_zero();
     VF r2 = zero, gd = zero;
+    AKP_UNROLL
     for (int k = 0; k < dims; ++k) {
         r2 = vf_add(r2, vf_mul(d[k], d[k]));
         gd = vf_add(gd, vf_mul(g[k], d[k]));
@@ -156,13 +173,14 @@ KI static inline VF corner_simplex(int dims, const VF* d, const VF* g, VF* G, bo
     const VF t2 = vf_mul(t, t), t4 = vf_mul(t2, t2);
     if (want_grad) {
         const VF c = vf_mul(vf_mul(vf_mul(vf_set1(8.0f), t2), t), gd);
+        AKP_UNROLL
         for (int k = 0; k < dims; ++k)
             G[k] = vf_sel(pos, vf_add(G[k], vf_sub(vf_mul(t4, g[k]), vf_mul(c, d[k]))), G[k]);
     }
     return vf_maskz(pos, vf_mul(t4, gd));
 }
 
-KI static inline VF simplex2_v(const uint8_t* perm, const VF* p, VF* grad, bool want_grad) {
+KI static inline VF simplex2_v(const PermTab* perm, const VF* p, VF* grad, bool want_grad) {
     const VM valid = in_range(2, p);
     const float F2 = 0.36602540378f, G2 = 0.2113248654f; /* as bases.c */
     const VF x = p[0], y = p[1];
@@ -181,6 +199,7 @@ KI static inline VF simplex2_v(const uint8_t* perm, const VF* p, VF* grad, bool 
                         {vf_add(vf_sub(x0, i1f), vg2), vf_add(vf_sub(y0, j1f), vg2)},
                         {vf_add(vf_sub(x0, one), c2), vf_add(vf_sub(y0, one), c2)}};
     VF sum = vf_zero(), G[2] = {vf_zero(), vf_zero()};
+    AKP_UNROLL
     for (int c = 0; c < 3; ++c) {
         const VI hi = vi_and(h[c], vi_set1(7));
         const VF g[2] = {vf_lut16(simplex_g2x, hi), vf_lut16(simplex_g2y, hi)};
@@ -188,11 +207,12 @@ KI static inline VF simplex2_v(const uint8_t* perm, const VF* p, VF* grad, bool 
     }
     const VF scale = vf_set1(70.0f);
     if (want_grad)
+        AKP_UNROLL
         for (int k = 0; k < 2; ++k) grad[k] = vf_maskz(valid, vf_mul(scale, G[k]));
     return vf_maskz(valid, vf_mul(scale, sum));
 }
 
-KI static inline VF simplex3_v(const uint8_t* perm, const VF* p, VF* grad, bool want_grad) {
+KI static inline VF simplex3_v(const PermTab* perm, const VF* p, VF* grad, bool want_grad) {
     const VM valid = in_range(3, p);
     const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f; /* as bases.c */
     const VF x = p[0], y = p[1], z = p[2];
@@ -218,6 +238,7 @@ KI static inline VF simplex3_v(const uint8_t* perm, const VF* p, VF* grad, bool 
                           {vf_maskz(o2x, one), vf_maskz(o2y, one), vf_maskz(o2z, one)},
                           {one, one, one}};
     VF sum = zero, G[3] = {zero, zero, zero};
+    AKP_UNROLL
     for (int c = 0; c < 4; ++c) {
         const VF k = vf_set1((float)c * G3);
         const VF d[3] = {vf_add(vf_sub(x0, off[c][0]), k), vf_add(vf_sub(y0, off[c][1]), k),
@@ -228,19 +249,20 @@ KI static inline VF simplex3_v(const uint8_t* perm, const VF* p, VF* grad, bool 
     }
     const VF scale = vf_set1(76.0f);
     if (want_grad)
+        AKP_UNROLL
         for (int k = 0; k < 3; ++k) grad[k] = vf_maskz(valid, vf_mul(scale, G[k]));
     return vf_maskz(valid, vf_mul(scale, sum));
 }
 
 /* ---- the octave loop ----------------------------------------------------------------------- */
 
-KI static inline VF basis_v(int basis, const uint8_t* perm, int dims, const VF* q, VF* g, bool want_grad) {
+KI static inline VF basis_v(int basis, const PermTab* perm, int dims, const VF* q, VF* g, bool want_grad) {
     if (basis == AK_NOISE_BASIS_SIMPLEX)
         return dims == 2 ? simplex2_v(perm, q, g, want_grad) : simplex3_v(perm, q, g, want_grad);
     return perlin_v(perm, dims, q, g, want_grad);
 }
 
-KI static inline void fractal_v(const ak_noise* noise, const ak_fractal_desc* d, int basis, int dims, const VF* p,
+KI static inline void fractal_v(const PermTab* perm, const ak_fractal_desc* d, int basis, int dims, const VF* p,
                                 VF* out, VF* gout, bool want_grad) {
     const VF signmask = vf_cast(vi_set1((int)0x80000000u));
     const VF one = vf_set1(1.0f), zero = vf_zero();
@@ -249,12 +271,14 @@ KI static inline void fractal_v(const ak_noise* noise, const ak_fractal_desc* d,
     for (uint32_t o = 0; o < d->octaves; ++o) {
         VF q[3], g[3];
         const VF vf = vf_set1(freq), va = vf_set1(amp);
+        AKP_UNROLL
         for (int k = 0; k < dims; ++k) q[k] = vf_mul(p[k], vf);
-        const VF n = basis_v(basis, noise->perm, dims, q, g, want_grad);
+        const VF n = basis_v(basis, perm, dims, q, g, want_grad);
         if (d->type == AK_FRACTAL_FBM) {
             sum = vf_add(sum, vf_mul(va, n));
             if (want_grad) {
                 const VF af = vf_set1(amp * freq);
+                AKP_UNROLL
                 for (int k = 0; k < dims; ++k) gs[k] = vf_add(gs[k], vf_mul(af, g[k]));
             }
         } else if (d->type == AK_FRACTAL_TURBULENCE) {
@@ -262,6 +286,7 @@ KI static inline void fractal_v(const ak_noise* noise, const ak_fractal_desc* d,
             sum = vf_add(sum, vf_mul(va, vf_abs(n)));
             if (want_grad) {
                 const VF af = vf_set1(amp * freq);
+                AKP_UNROLL
                 for (int k = 0; k < dims; ++k) gs[k] = vf_add(gs[k], vf_mul(af, vf_xor(g[k], sign)));
             }
         } else {
@@ -276,6 +301,7 @@ KI static inline void fractal_v(const ak_noise* noise, const ak_fractal_desc* d,
             nw = vf_min(vf_max(nw, zero), one);
             if (want_grad) {
                 const VF m2s = vf_mul(vf_set1(-2.0f), s);
+                AKP_UNROLL
                 for (int k = 0; k < dims; ++k) {
                     const VF ds2 = vf_maskz(unclipped, vf_mul(m2s, vf_mul(vf, vf_xor(g[k], sign))));
                     gs[k] = vf_add(gs[k], vf_mul(va, vf_add(vf_mul(weight, ds2), vf_mul(s2, gw[k]))));
@@ -289,19 +315,24 @@ KI static inline void fractal_v(const ak_noise* noise, const ak_fractal_desc* d,
     }
     *out = sum;
     if (want_grad)
+        AKP_UNROLL
         for (int k = 0; k < dims; ++k) gout[k] = gs[k];
 }
 
 KI static inline void run_dims(const ak_noise* noise, const ak_fractal_desc* d, int basis, int dims,
                                const float* const* xs, size_t count, float* out, float* const* grad) {
+    PermTab perm;
+    tab_make(noise->perm, &perm);
     for (size_t i = 0; i < count; i += AKP_W) {
         VF p[3], v, g[3];
+        AKP_UNROLL
         for (int k = 0; k < dims; ++k) p[k] = vf_load(xs[k] + i);
         if (grad) {
-            fractal_v(noise, d, basis, dims, p, &v, g, true);
+            fractal_v(&perm, d, basis, dims, p, &v, g, true);
+            AKP_UNROLL
             for (int k = 0; k < dims; ++k) vf_store(grad[k] + i, g[k]);
         } else {
-            fractal_v(noise, d, basis, dims, p, &v, g, false);
+            fractal_v(&perm, d, basis, dims, p, &v, g, false);
         }
         vf_store(out + i, v);
     }
