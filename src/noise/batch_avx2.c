@@ -6,6 +6,7 @@
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
 #include <immintrin.h>
+#include <string.h>
 
 bool akp_noise_have_avx2(void) { return __builtin_cpu_supports("avx2"); }
 
@@ -47,7 +48,20 @@ typedef struct PermTab {
     const uint8_t* perm;
 } PermTab;
 KI static inline void tab_make(const uint8_t* perm, PermTab* t) { t->perm = perm; }
+#if defined(AKP_NOISE_AVX2_GATHER)
 KI static inline VI tab_pair(const PermTab* t, VI idx) { return gather4(t->perm, idx); }
+#else
+/* Eight scalar 16-bit loads: on CPUs whose gathers are microcoded slowly (the 2023 gather
+ * data sampling mitigation) this beats vpgatherdd; the result is the same. */
+KI static inline VI tab_pair(const PermTab* t, VI idx) {
+    int32_t i[8];
+    _mm256_storeu_si256((__m256i*)(void*)i, idx);
+    uint16_t v[8];
+    for (int k = 0; k < 8; ++k) memcpy(&v[k], t->perm + i[k], 2);
+    const __m128i lo = _mm_setr_epi32(v[0], v[1], v[2], v[3]), hi = _mm_setr_epi32(v[4], v[5], v[6], v[7]);
+    return _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
+}
+#endif
 KI static inline VM m_lt(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
 KI static inline VM m_gt(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
 KI static inline VM m_ge(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
