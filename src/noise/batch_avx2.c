@@ -38,18 +38,18 @@ KI static inline VI vi_and(VI a, VI b) { return _mm256_and_si256(a, b); }
 KI static inline VI vi_add(VI a, VI b) { return _mm256_add_epi32(a, b); }
 #define VI_SLLI(a, n) _mm256_slli_epi32((a), (n))
 #define VI_SRLI(a, n) _mm256_srli_epi32((a), (n))
-/* The 4 bytes perm[idx .. idx + 3] of each lane (little-endian: perm[idx] in the low byte). */
-KI static inline VI gather4(const uint8_t* perm, VI idx) {
-    return _mm256_i32gather_epi32((const int*)(const void*)perm, idx, 1);
-}
-/* The lookup table: the byte table itself (an index is at most 255 + 256, so a gather reads at
- * most perm[514]: inside ak_noise, whose 8-byte seed follows perm[512]). */
+/* The lookup table is the byte table itself. An index is at most 255 + 255: the scalar loads
+ * read at most perm[511]; the gather (AKP_NOISE_AVX2_GATHER) reads 4 bytes, at most perm[513],
+ * inside ak_noise, whose 8-byte seed follows perm[511]. */
 typedef struct PermTab {
     const uint8_t* perm;
 } PermTab;
 KI static inline void tab_make(const uint8_t* perm, PermTab* t) { t->perm = perm; }
 #if defined(AKP_NOISE_AVX2_GATHER)
-KI static inline VI tab_pair(const PermTab* t, VI idx) { return gather4(t->perm, idx); }
+/* The 4 bytes perm[idx .. idx + 3] of each lane (little-endian: perm[idx] in the low byte). */
+KI static inline VI tab_pair(const PermTab* t, VI idx) {
+    return _mm256_i32gather_epi32((const int*)(const void*)t->perm, idx, 1);
+}
 #else
 /* Eight scalar 16-bit loads: on CPUs whose gathers are microcoded slowly (the 2023 gather
  * data sampling mitigation) this beats vpgatherdd; the result is the same. */
