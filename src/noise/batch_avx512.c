@@ -47,12 +47,13 @@ typedef struct PermTab {
     VI t[8][2];
 } PermTab;
 KI static inline void tab_make(const uint8_t* perm, PermTab* t) {
-    int32_t v[256];
-    for (int j = 0; j < 256; ++j) v[j] = (int32_t)perm[j] | (int32_t)perm[j + 1] << 8;
-    for (int c = 0; c < 8; ++c) {
-        t->t[c][0] = _mm512_loadu_si512((const void*)(v + 32 * c));
-        t->t[c][1] = _mm512_loadu_si512((const void*)(v + 32 * c + 16));
-    }
+    for (int c = 0; c < 8; ++c)
+        for (int h = 0; h < 2; ++h) {
+            const int j = 32 * c + 16 * h; /* perm[j + 16] <= perm[256]: inside the doubled table */
+            const __m512i a = _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i*)(const void*)(perm + j)));
+            const __m512i b = _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i*)(const void*)(perm + j + 1)));
+            t->t[c][h] = _mm512_or_si512(a, _mm512_slli_epi32(b, 8));
+        }
 }
 KI static inline VI tab_pair(const PermTab* t, VI idx) {
     VI r[8];
