@@ -5,7 +5,7 @@
  * perm[perm[perm[ix] + iy] + iz]... (Perlin's A/AA/AB chain written for any N), the corner
  * values are gradient . offset, and the corners are blended axis by axis in Perlin's order (x
  * first, then y, z, w) with the quintic fade. The gradient rides along the same blend:
- * lerp(t, a, b) has derivative lerp(t, da, db) + (b - a) dt. The AVX2 kernel (batch_avx2.c)
+ * lerp(t, a, b) has derivative lerp(t, da, db) + (b - a) dt. The SIMD kernels (simd_body.h)
  * repeats these float operations in the same order, so both give the same bits. */
 #include <math.h>
 #include <string.h>
