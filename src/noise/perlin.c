@@ -6,7 +6,7 @@
  * values are gradient . offset, and the corners are blended axis by axis in Perlin's order (x
  * first, then y, z, w) with the quintic fade. The gradient rides along the same blend:
  * lerp(t, a, b) has derivative lerp(t, da, db) + (b - a) dt. The SIMD kernels (simd_body.h)
- * repeats these float operations in the same order, so both give the same bits. */
+ * repeat these float operations in the same order, so all give the same bits. */
 #include <math.h>
 #include <string.h>
 
