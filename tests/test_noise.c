@@ -424,16 +424,22 @@ AK_TEST(batch_simd_equals_scalar) {
 AK_TEST(grid_job_equals_points) {
     ak_noise n = ak_noise_make(0);
     enum { W = 37, H = 11 };
-    static float v[2][W * H], gx[2][W * H], gy[2][W * H];
+    static float v[4][W * H], gx[4][W * H], gy[4][W * H];
     const ak_fractal_desc fd = {.octaves = 4};
-    for (int run = 0; run < 2; ++run) {
+    /* run 0 skip_simd, 1 the widest path on 4 threads, 2 AVX2, 3 AVX-512 (each where the CPU has it) */
+    for (int run = 0; run < 4; ++run) {
         ak_noise_grid_job job = {.noise = &n, .fractal = fd, .width = W, .height = H, .origin_x = -3.5f,
                                  .origin_y = 1.25f, .spacing_x = 0.173f, .spacing_y = 0.31f, .out_values = {v[run], W * H},
                                  .out_gradient_x = {gx[run], W * H}, .out_gradient_y = {gy[run], W * H},
-                                 .thread_count = (uint32_t)(run ? 4 : 1), .skip_simd = run == 0};
+                                 .thread_count = (uint32_t)(run == 1 ? 4 : 1), .skip_simd = run == 0,
+                                 .simd_limit = run == 2 ? AK_NOISE_SIMD_AVX2 : run == 3 ? AK_NOISE_SIMD_AVX512
+                                                                                      : AK_NOISE_SIMD_DEFAULT};
         AK_CHECK_EQ(ak_noise_grid_job_run(&job), AK_OK);
     }
-    AK_CHECK(memcmp(v[0], v[1], sizeof v[0]) == 0 && memcmp(gx[0], gx[1], sizeof gx[0]) == 0);
+    for (int run = 1; run < 4; ++run)
+        AK_CHECK_MSG(memcmp(v[0], v[run], sizeof v[0]) == 0 && memcmp(gx[0], gx[run], sizeof gx[0]) == 0 &&
+                         memcmp(gy[0], gy[run], sizeof gy[0]) == 0,
+                     "grid run %d", run);
     for (int j = 0; j < H; ++j)
         for (int i = 0; i < W; ++i) {
             /* two statements: a compiler allowed to contract must not fuse into an FMA here */
