@@ -343,11 +343,15 @@ AK_TEST(fractal_gradient_matches_differences) {
     }
 }
 
+/* Every SIMD path this CPU has, each selected explicitly with simd_limit, against the scalar
+ * job and against ak_fractal_eval point by point: the same bits (values and gradients), for
+ * Perlin and simplex, 2D and 3D, every fractal type, 1 and 3 threads, with and without
+ * gradients, a length that leaves a padded tail, out-of-range and tied (x0 = y0 = z0) points. */
 AK_TEST(batch_simd_equals_scalar) {
-    printf("  AVX2 kernel %s\n", ak_noise_simd_available() ? "available: compared with scalar" : "not available");
+    printf("  widest noise kernel: %s\n", ak_noise_simd_name());
     ak_noise n = ak_noise_make(11);
     enum { N = 1003 };
-    static float x[N], y[N], z[N], v[4][N], gx[4][N], gy[4][N], gz[4][N];
+    static float x[N], y[N], z[N], v[5][N], gx[5][N], gy[5][N], gz[5][N];
     ak_rng rng = ak_rng_make(1);
     for (int i = 0; i < N; ++i) {
         x[i] = frand(&rng, -300, 300);
@@ -357,49 +361,85 @@ AK_TEST(batch_simd_equals_scalar) {
     x[5] = NAN;
     y[6] = INFINITY;
     z[7] = 4e7f;
+    x[8] = y[8] = z[8] = 1.5f;
+    x[9] = y[9] = 2.0f, z[9] = -1.0f;
+    x[10] = 0.25f, y[10] = z[10] = 0.75f;
+    x[11] = -16777215.0f;
+    /* the paths: [0] scalar reference; then AVX2 and AVX-512 where the CPU has them */
+    ak_noise_simd paths[3] = {AK_NOISE_SIMD_SCALAR};
+    int npaths = 1;
+    const char* widest = ak_noise_simd_name();
+    if (strcmp(widest, "scalar") != 0) paths[npaths++] = AK_NOISE_SIMD_AVX2;
+    if (strcmp(widest, "avx512") == 0) paths[npaths++] = AK_NOISE_SIMD_AVX512;
+    printf("  paths compared with scalar: %d\n", npaths - 1);
     const ak_fractal_type types[] = {AK_FRACTAL_FBM, AK_FRACTAL_TURBULENCE, AK_FRACTAL_RIDGED};
-    for (uint32_t dims = 2; dims <= 3; ++dims) {
-        for (int t = 0; t < 3; ++t) {
-            const ak_fractal_desc fd = {.type = types[t], .octaves = 5, .gain = 0.55f, .lacunarity = 2.03f,
-                                        .frequency = 0.7f};
-            for (int run = 0; run < 4; ++run) {
-                ak_noise_job job = {.noise = &n, .fractal = fd, .dimensions = dims, .x = {x, N}, .y = {y, N},
-                                    .z = {z, N}, .out_values = {v[run], N}, .out_gradient_x = {gx[run], N},
-                                    .out_gradient_y = {gy[run], N}, .out_gradient_z = {dims == 3 ? gz[run] : NULL, N},
-                                    .thread_count = (uint32_t)(run == 3 ? 3 : 1), .skip_simd = run == 0};
-                if (run == 2) job.out_gradient_x = job.out_gradient_y = job.out_gradient_z = (ak_f32_span){0};
-                AK_CHECK_EQ(ak_noise_job_run(&job), AK_OK);
-            }
-            AK_CHECK(memcmp(v[0], v[1], sizeof v[0]) == 0);
-            AK_CHECK(memcmp(v[0], v[2], sizeof v[0]) == 0);
-            AK_CHECK(memcmp(v[0], v[3], sizeof v[0]) == 0);
-            AK_CHECK(memcmp(gx[0], gx[1], sizeof gx[0]) == 0 && memcmp(gy[0], gy[1], sizeof gy[0]) == 0);
-            AK_CHECK(memcmp(gx[0], gx[3], sizeof gx[0]) == 0 && memcmp(gy[0], gy[3], sizeof gy[0]) == 0);
-            if (dims == 3) AK_CHECK(memcmp(gz[0], gz[1], sizeof gz[0]) == 0);
-            for (int i = 0; i < N; ++i) {
-                const float p[3] = {x[i], y[i], z[i]};
-                float g[3];
-                const float e = ak_fractal_eval(&n, &fd, dims, p, g);
-                AK_CHECK(memcmp(&e, &v[1][i], sizeof e) == 0 && isfinite(v[1][i]));
-                AK_CHECK(memcmp(&g[0], &gx[1][i], sizeof e) == 0);
+    const ak_noise_basis bases[] = {AK_NOISE_BASIS_PERLIN, AK_NOISE_BASIS_SIMPLEX};
+    for (int bi = 0; bi < 2; ++bi)
+        for (uint32_t dims = 2; dims <= 3; ++dims) {
+            for (int t = 0; t < 3; ++t) {
+                const ak_fractal_desc fd = {.type = types[t], .basis = bases[bi], .octaves = 5, .gain = 0.55f,
+                                            .lacunarity = 2.03f, .frequency = 0.7f};
+                for (int pi = 1; pi < npaths; ++pi) {
+                    /* run 0 scalar, 1 the path, 2 the path without gradient, 3 the path on 3 threads */
+                    for (int run = 0; run < 4; ++run) {
+                        ak_noise_job job = {.noise = &n, .fractal = fd, .dimensions = dims, .x = {x, N}, .y = {y, N},
+                                            .z = {z, N}, .out_values = {v[run], N}, .out_gradient_x = {gx[run], N},
+                                            .out_gradient_y = {gy[run], N},
+                                            .out_gradient_z = {dims == 3 ? gz[run] : NULL, N},
+                                            .thread_count = (uint32_t)(run == 3 ? 3 : 1),
+                                            .simd_limit = run == 0 ? AK_NOISE_SIMD_SCALAR : paths[pi]};
+                        if (run == 2) job.out_gradient_x = job.out_gradient_y = job.out_gradient_z = (ak_f32_span){0};
+                        AK_CHECK_EQ(ak_noise_job_run(&job), AK_OK);
+                    }
+                    AK_CHECK_MSG(memcmp(v[0], v[1], sizeof v[0]) == 0, "basis %d dims %u type %d path %d", bi,
+                                 (unsigned)dims, t, (int)paths[pi]);
+                    AK_CHECK(memcmp(v[0], v[2], sizeof v[0]) == 0);
+                    AK_CHECK(memcmp(v[0], v[3], sizeof v[0]) == 0);
+                    AK_CHECK(memcmp(gx[0], gx[1], sizeof gx[0]) == 0 && memcmp(gy[0], gy[1], sizeof gy[0]) == 0);
+                    AK_CHECK(memcmp(gx[0], gx[3], sizeof gx[0]) == 0 && memcmp(gy[0], gy[3], sizeof gy[0]) == 0);
+                    if (dims == 3) AK_CHECK(memcmp(gz[0], gz[1], sizeof gz[0]) == 0);
+                }
+                /* the scalar job (or the only path) against the per-point reference */
+                if (npaths == 1) {
+                    ak_noise_job job = {.noise = &n, .fractal = fd, .dimensions = dims, .x = {x, N}, .y = {y, N},
+                                        .z = {z, N}, .out_values = {v[0], N}, .out_gradient_x = {gx[0], N},
+                                        .out_gradient_y = {gy[0], N}, .out_gradient_z = {dims == 3 ? gz[0] : NULL, N}};
+                    AK_CHECK_EQ(ak_noise_job_run(&job), AK_OK);
+                }
+                for (int i = 0; i < N; ++i) {
+                    const float p[3] = {x[i], y[i], z[i]};
+                    float g[3];
+                    const float e = ak_fractal_eval(&n, &fd, dims, p, g);
+                    AK_CHECK(memcmp(&e, &v[0][i], sizeof e) == 0 && isfinite(v[0][i]));
+                    AK_CHECK(memcmp(&g[0], &gx[0][i], sizeof e) == 0 && memcmp(&g[1], &gy[0][i], sizeof e) == 0);
+                }
             }
         }
-    }
+    /* a simd_limit out of range is an argument error */
+    ak_noise_job bad = {.noise = &n, .dimensions = 2, .x = {x, 8}, .y = {y, 8}, .out_values = {v[0], 8},
+                        .simd_limit = AK_NOISE_SIMD_COUNT};
+    AK_CHECK_EQ(ak_noise_job_validate(&bad), AK_ERR_BAD_ARG);
 }
 
 AK_TEST(grid_job_equals_points) {
     ak_noise n = ak_noise_make(0);
     enum { W = 37, H = 11 };
-    static float v[2][W * H], gx[2][W * H], gy[2][W * H];
+    static float v[4][W * H], gx[4][W * H], gy[4][W * H];
     const ak_fractal_desc fd = {.octaves = 4};
-    for (int run = 0; run < 2; ++run) {
+    /* run 0 skip_simd, 1 the widest path on 4 threads, 2 AVX2, 3 AVX-512 (each where the CPU has it) */
+    for (int run = 0; run < 4; ++run) {
         ak_noise_grid_job job = {.noise = &n, .fractal = fd, .width = W, .height = H, .origin_x = -3.5f,
                                  .origin_y = 1.25f, .spacing_x = 0.173f, .spacing_y = 0.31f, .out_values = {v[run], W * H},
                                  .out_gradient_x = {gx[run], W * H}, .out_gradient_y = {gy[run], W * H},
-                                 .thread_count = (uint32_t)(run ? 4 : 1), .skip_simd = run == 0};
+                                 .thread_count = (uint32_t)(run == 1 ? 4 : 1), .skip_simd = run == 0,
+                                 .simd_limit = run == 2 ? AK_NOISE_SIMD_AVX2 : run == 3 ? AK_NOISE_SIMD_AVX512
+                                                                                      : AK_NOISE_SIMD_DEFAULT};
         AK_CHECK_EQ(ak_noise_grid_job_run(&job), AK_OK);
     }
-    AK_CHECK(memcmp(v[0], v[1], sizeof v[0]) == 0 && memcmp(gx[0], gx[1], sizeof gx[0]) == 0);
+    for (int run = 1; run < 4; ++run)
+        AK_CHECK_MSG(memcmp(v[0], v[run], sizeof v[0]) == 0 && memcmp(gx[0], gx[run], sizeof gx[0]) == 0 &&
+                         memcmp(gy[0], gy[run], sizeof gy[0]) == 0,
+                     "grid run %d", run);
     for (int j = 0; j < H; ++j)
         for (int i = 0; i < W; ++i) {
             /* two statements: a compiler allowed to contract must not fuse into an FMA here */

@@ -11,9 +11,10 @@
  *   - fractal sums over any basis: fBm, turbulence, ridged multifractal, domain warping, each
  *     with octaves, lacunarity and gain and a documented output range;
  *   - a batch job over coordinate arrays and a grid job over a 2D lattice of points, on
- *     threads, 8 points at a time with AVX2 where the CPU has it (chosen at run time, scalar
- *     reference always built; AK_NO_SIMD or skip_simd forces it). The AVX2 path gives the
- *     same bits as the scalar one (no FMA contraction on either side).
+ *     threads, 16 points at a time with AVX-512 or 8 with AVX2 where the CPU has it (chosen
+ *     at run time, scalar reference always built; AK_NO_SIMD, skip_simd or simd_limit force
+ *     it). The SIMD paths give the same bits as the scalar one (no FMA contraction on either
+ *     side).
  *
  * What it does NOT do: sparse convolution or wavelet noise, anti-aliasing of the sum (octaves
  * above the sampling rate are the caller's business), textures or images (see terrain.h).
@@ -178,6 +179,19 @@ AK_API void ak_fractal_range(const ak_fractal_desc* desc, uint32_t dimensions, f
 
 /* ---- batch evaluation ---------------------------------------------------------------- */
 
+/* Upper limit on the SIMD kernel the batch and grid jobs may pick (the widest this CPU has up
+ * to the limit is used; tests and benchmarks run every path side by side with it). The SIMD
+ * kernels cover Perlin and simplex noise in 2D and 3D without warping (every fractal type,
+ * with or without gradient); other configurations run the scalar reference. Every kernel
+ * gives the scalar reference's bits. */
+typedef enum ak_noise_simd {
+    AK_NOISE_SIMD_DEFAULT = 0, /* -> the widest kernel this CPU has (AK_NOISE_SIMD_AVX512) */
+    AK_NOISE_SIMD_SCALAR,      /* scalar code (as skip_simd) */
+    AK_NOISE_SIMD_AVX2,        /* 8 points per block, where the CPU has AVX2 */
+    AK_NOISE_SIMD_AVX512,      /* 16 points per block, where the CPU has AVX-512 F and DQ, else AVX2 */
+    AK_NOISE_SIMD_COUNT
+} ak_noise_simd;
+
 /* Evaluate a fractal at many points given as separate coordinate arrays. */
 typedef struct ak_noise_job {
     const ak_noise* noise;     /* required */
@@ -190,11 +204,12 @@ typedef struct ak_noise_job {
                                /* optional (empty -> not computed); when any is given, the
                                   first `dimensions` are required with count >= points */
     uint32_t thread_count;     /* 0 or 1 -> calling thread only; at most 64 */
-    bool skip_simd;            /* false -> AVX2 when the CPU has it */
+    bool skip_simd;            /* false -> SIMD when the CPU has it (as simd_limit SCALAR) */
+    ak_noise_simd simd_limit;  /* the widest kernel allowed; DEFAULT -> the widest this CPU has */
 } ak_noise_job;
 
 /* AK_OK, AK_ERR_NULL_ARG (noise, out_values or a needed coordinate/gradient span missing),
- * AK_ERR_BAD_ARG (dimensions, thread_count, or the fractal desc out of range),
+ * AK_ERR_BAD_ARG (dimensions, thread_count, simd_limit, or the fractal desc out of range),
  * AK_ERR_SPAN_SMALL (a coordinate or gradient span shorter than out_values). */
 AK_API ak_result ak_noise_job_validate(const ak_noise_job* job);
 /* Validate, then fill the outputs (nothing is written on error). Results are identical for any
@@ -212,10 +227,11 @@ typedef struct ak_noise_grid_job {
     ak_f32_span out_values;  /* required; count >= width * height */
     ak_f32_span out_gradient_x, out_gradient_y; /* optional; both or neither, count >= width * height */
     uint32_t thread_count;   /* 0 or 1 -> calling thread only; at most 64 */
-    bool skip_simd;          /* false -> AVX2 when the CPU has it */
+    bool skip_simd;          /* false -> SIMD when the CPU has it (as simd_limit SCALAR) */
+    ak_noise_simd simd_limit; /* the widest kernel allowed; DEFAULT -> the widest this CPU has */
 } ak_noise_grid_job;
 
-/* AK_OK, AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (zero size, width * height overflow, non-finite
+/* AK_OK, AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (zero size, width * height overflow, simd_limit, non-finite
  * origin or spacing, thread_count > 64, bad fractal), AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_noise_grid_job_validate(const ak_noise_grid_job* job);
 /* Validate, then fill the grid (nothing is written on error); same results for any thread
@@ -277,8 +293,10 @@ AK_API ak_result ak_noise_sway_validate(const ak_noise_sway_job* job);
 /* Validate, then write out_pose (nothing written on error). */
 AK_API ak_result ak_noise_sway_run(const ak_noise_sway_job* job);
 
-/* True when this build and CPU run the AVX2 batch kernels. */
+/* True when this build and CPU run a SIMD batch kernel (AVX2 or AVX-512). */
 AK_API bool ak_noise_simd_available(void);
+/* Name of the widest batch kernel this build and CPU run: "avx512", "avx2" or "scalar". */
+AK_API const char* ak_noise_simd_name(void);
 
 #ifdef __cplusplus
 }

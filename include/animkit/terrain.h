@@ -54,7 +54,7 @@ typedef struct ak_terrain_desc {
     float feature_size;       /* metres per noise lattice cell of the first octave;
                                  0 -> world_size / 4 */
     uint32_t thread_count;    /* 0 or 1 -> calling thread; at most 64 */
-    bool skip_simd;           /* false -> AVX2 noise kernels where available */
+    bool skip_simd;           /* false -> SIMD noise kernels (AVX-512 or AVX2) where available */
 } ak_terrain_desc;
 
 /* The desc with zero fields replaced by their defaults. */

@@ -1,7 +1,8 @@
-/* Batch and grid evaluation: validation, thread fan-out, and the choice between the AVX2
- * kernel and the scalar reference. Points go through in chunks of CHUNK: the grid job makes
- * the chunk's coordinates on the stack, the kernel gets whole blocks of 8 (a short tail is
- * padded into a block of 8, so it also runs the kernel and gives the same bits). */
+/* Batch and grid evaluation: validation, thread fan-out, and the choice between the AVX-512
+ * and AVX2 kernels and the scalar reference. Points go through in chunks of CHUNK: the grid
+ * job makes the chunk's coordinates on the stack, the kernel gets whole blocks of 16 (AVX-512)
+ * or 8 (AVX2); a short tail is padded into one block, so it also runs the kernel and gives the
+ * same bits. */
 #include <math.h>
 #include <string.h>
 
@@ -10,11 +11,27 @@
 
 #define CHUNK 256u
 
+enum { PATH_SCALAR = 0, PATH_AVX2 = 1, PATH_AVX512 = 2 };
+
+bool akp_noise_simd_handles(const ak_fractal_desc* d, uint32_t dims) {
+    return (dims == 2 || dims == 3) && d->warp == 0.0f &&
+           (d->basis == AK_NOISE_BASIS_PERLIN || d->basis == AK_NOISE_BASIS_SIMPLEX) &&
+           (d->type == AK_FRACTAL_FBM || d->type == AK_FRACTAL_TURBULENCE || d->type == AK_FRACTAL_RIDGED);
+}
+
 bool ak_noise_simd_available(void) {
 #if defined(AK_NO_SIMD)
     return false;
 #else
-    return akp_noise_have_avx2();
+    return akp_noise_have_avx2() || akp_noise_have_avx512();
+#endif
+}
+
+const char* ak_noise_simd_name(void) {
+#if defined(AK_NO_SIMD)
+    return "scalar";
+#else
+    return akp_noise_have_avx512() ? "avx512" : akp_noise_have_avx2() ? "avx2" : "scalar";
 #endif
 }
 
@@ -22,27 +39,29 @@ typedef struct eval_ctx {
     const ak_noise* noise;
     ak_fractal_desc desc; /* resolved */
     uint32_t dims;
-    bool simd;
+    int path; /* PATH_* */
 } eval_ctx;
 
 /* Evaluate count (<= CHUNK) points: xs[k][i] coordinates, out[i], grad[k][i] (grad NULL -> none). */
 static void eval_chunk(const eval_ctx* c, const float* const* xs, size_t count, float* out, float* const* grad) {
     const uint32_t dims = c->dims;
-    size_t done = 0;
-    if (c->simd) {
-        const size_t whole = count & ~(size_t)7u;
-        if (whole) akp_noise_fractal_avx2(c->noise, &c->desc, dims, xs, whole, out, grad);
-        done = whole;
+    if (c->path != PATH_SCALAR) {
+        const size_t w = c->path == PATH_AVX512 ? 16u : 8u;
+        void (*kernel)(const ak_noise*, const ak_fractal_desc*, uint32_t, const float* const*, size_t, float*,
+                       float* const*) = c->path == PATH_AVX512 ? akp_noise_fractal_avx512 : akp_noise_fractal_avx2;
+        const size_t whole = count / w * w;
+        if (whole) kernel(c->noise, &c->desc, dims, xs, whole, out, grad);
+        const size_t done = whole;
         if (done < count) {
-            float px[4][8], po[8], pg[4][8];
+            float px[4][16], po[16], pg[4][16];
             const float* pxs[4];
             float* pgs[4];
             for (uint32_t k = 0; k < 4; ++k) {
-                for (size_t i = 0; i < 8; ++i) px[k][i] = (k < dims && done + i < count) ? xs[k][done + i] : 0.0f;
+                for (size_t i = 0; i < 16; ++i) px[k][i] = (k < dims && done + i < count) ? xs[k][done + i] : 0.0f;
                 pxs[k] = px[k];
                 pgs[k] = pg[k];
             }
-            akp_noise_fractal_avx2(c->noise, &c->desc, dims, pxs, 8, po, grad ? pgs : NULL);
+            kernel(c->noise, &c->desc, dims, pxs, w, po, grad ? pgs : NULL);
             for (size_t i = done; i < count; ++i) {
                 out[i] = po[i - done];
                 if (grad)
@@ -60,12 +79,14 @@ static void eval_chunk(const eval_ctx* c, const float* const* xs, size_t count, 
     }
 }
 
-static bool use_simd(const ak_fractal_desc* d, uint32_t dims, bool skip) {
+static int pick_path(const ak_fractal_desc* d, uint32_t dims, bool skip, ak_noise_simd limit) {
 #if defined(AK_NO_SIMD)
-    (void)d, (void)dims, (void)skip;
-    return false;
+    (void)d, (void)dims, (void)skip, (void)limit;
+    return PATH_SCALAR;
 #else
-    return !skip && akp_noise_avx2_handles(d, dims) && akp_noise_have_avx2();
+    if (skip || limit == AK_NOISE_SIMD_SCALAR || !akp_noise_simd_handles(d, dims)) return PATH_SCALAR;
+    if (limit != AK_NOISE_SIMD_AVX2 && akp_noise_have_avx512()) return PATH_AVX512;
+    return akp_noise_have_avx2() ? PATH_AVX2 : PATH_SCALAR;
 #endif
 }
 
@@ -90,7 +111,7 @@ static bool has_gradient(const ak_noise_job* job) {
 ak_result ak_noise_job_validate(const ak_noise_job* job) {
     if (!job || !job->noise || !job->out_values.ptr) return AK_ERR_NULL_ARG;
     const uint32_t dims = job_dims(job);
-    if (dims > 4 || job->thread_count > 64) return AK_ERR_BAD_ARG;
+    if (dims > 4 || job->thread_count > 64 || (unsigned)job->simd_limit >= AK_NOISE_SIMD_COUNT) return AK_ERR_BAD_ARG;
     if (ak_fractal_desc_validate(&job->fractal) != AK_OK) return AK_ERR_BAD_ARG;
     if (!ak_noise_basis_supports(ak_fractal_desc_resolved(&job->fractal).basis, dims)) return AK_ERR_BAD_ARG;
     const ak_f32_cspan in[4] = {job->x, job->y, job->z, job->w};
@@ -129,14 +150,14 @@ static void* batch_thread(void* arg) {
 ak_result ak_noise_job_run(const ak_noise_job* job) {
     const ak_result r = ak_noise_job_validate(job);
     if (r != AK_OK) return r;
-    eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), job_dims(job), false};
-    ctx.simd = use_simd(&ctx.desc, ctx.dims, job->skip_simd);
+    eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), job_dims(job), PATH_SCALAR};
+    ctx.path = pick_path(&ctx.desc, ctx.dims, job->skip_simd, job->simd_limit);
     const size_t n = job->out_values.count;
     uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
     if (threads > n / CHUNK + 1) threads = (uint32_t)(n / CHUNK + 1);
     range_task tasks[64];
     size_t chunk = (n + threads - 1) / threads;
-    chunk = (chunk + 7u) & ~(size_t)7u;
+    chunk = (chunk + 15u) & ~(size_t)15u;
     for (uint32_t t = 0; t < threads; ++t) {
         size_t b = (size_t)t * chunk, e = b + chunk;
         tasks[t] = (range_task){job, &ctx, b < n ? b : n, e < n ? e : n};
@@ -149,7 +170,8 @@ ak_result ak_noise_job_run(const ak_noise_job* job) {
 
 ak_result ak_noise_grid_job_validate(const ak_noise_grid_job* job) {
     if (!job || !job->noise || !job->out_values.ptr) return AK_ERR_NULL_ARG;
-    if (job->width == 0 || job->height == 0 || job->thread_count > 64) return AK_ERR_BAD_ARG;
+    if (job->width == 0 || job->height == 0 || job->thread_count > 64 || (unsigned)job->simd_limit >= AK_NOISE_SIMD_COUNT)
+        return AK_ERR_BAD_ARG;
     if (!isfinite(job->origin_x) || !isfinite(job->origin_y) || !isfinite(job->spacing_x) || !isfinite(job->spacing_y))
         return AK_ERR_BAD_ARG;
     if (ak_fractal_desc_validate(&job->fractal) != AK_OK) return AK_ERR_BAD_ARG;
@@ -190,8 +212,8 @@ static void* grid_thread(void* arg) {
 ak_result ak_noise_grid_job_run(const ak_noise_grid_job* job) {
     const ak_result r = ak_noise_grid_job_validate(job);
     if (r != AK_OK) return r;
-    eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), 2, false};
-    ctx.simd = use_simd(&ctx.desc, 2, job->skip_simd);
+    eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), 2, PATH_SCALAR};
+    ctx.path = pick_path(&ctx.desc, 2, job->skip_simd, job->simd_limit);
     const size_t rows = job->height;
     uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
     if (threads > rows) threads = (uint32_t)rows;

@@ -1,6 +1,6 @@
 /* Basis dispatch and fractal sums (fBm, turbulence, ridged multifractal, domain warping).
  *
- * The octave loop here is the scalar reference of the AVX2 kernel in batch_avx2.c: the same
+ * The octave loop here is the scalar reference of the SIMD kernels in simd_body.h: the same
  * float operations in the same order (frequency and amplitude by repeated multiplication,
  * sign-bit tests for |n|), so both give the same bits. */
 #include <math.h>

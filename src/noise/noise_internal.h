@@ -11,12 +11,17 @@
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);
 
-/* True when the AVX2 kernel handles this desc and dimension (Perlin 2D/3D without warp). */
-bool akp_noise_avx2_handles(const ak_fractal_desc* d, uint32_t dims);
-/* CPU check (false in builds without the kernel). */
+/* True when the SIMD kernels handle this desc and dimension (Perlin and simplex, 2D and 3D,
+ * without warp; the AVX2 and AVX-512 kernels handle the same set). */
+bool akp_noise_simd_handles(const ak_fractal_desc* d, uint32_t dims);
+/* CPU checks (false in builds without the kernels). */
 bool akp_noise_have_avx2(void);
-/* count % 8 == 0. xs[d] (d < dims) coordinates; grad[d] may all be NULL (no gradient). */
+bool akp_noise_have_avx512(void);
+/* count % 8 == 0 (AVX2) or % 16 == 0 (AVX-512). xs[d] (d < dims) coordinates; grad[d] may all
+ * be NULL (no gradient). */
 void akp_noise_fractal_avx2(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
                             size_t count, float* out, float* const* grad);
+void akp_noise_fractal_avx512(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
+                              size_t count, float* out, float* const* grad);
 
 #endif

@@ -5,8 +5,8 @@
  * perm[perm[perm[ix] + iy] + iz]... (Perlin's A/AA/AB chain written for any N), the corner
  * values are gradient . offset, and the corners are blended axis by axis in Perlin's order (x
  * first, then y, z, w) with the quintic fade. The gradient rides along the same blend:
- * lerp(t, a, b) has derivative lerp(t, da, db) + (b - a) dt. The AVX2 kernel (batch_avx2.c)
- * repeats these float operations in the same order, so both give the same bits. */
+ * lerp(t, a, b) has derivative lerp(t, da, db) + (b - a) dt. The SIMD kernels (simd_body.h)
+ * repeat these float operations in the same order, so all give the same bits. */
 #include <math.h>
 #include <string.h>
 
@@ -105,6 +105,11 @@ static inline void corner_gradient(uint32_t dims, int h, float* g) {
     }
 }
 
+/* Loops over dimensions and corners are unrolled (dims is a constant in every caller), so the
+ * corner values stay in registers. */
+#define AKP_PRAGMA(x) _Pragma(#x)
+#define AKP_UNROLL AKP_PRAGMA(GCC unroll 16)
+
 /* The lattice routine: lo[k], hi[k] the wrapped lattice indices (0..255) of the cell's two
  * corners along axis k, f[k] the fractional offset in [0, 1). */
 static inline __attribute__((always_inline)) float lattice(const uint8_t* perm, uint32_t dims, const int* lo,
@@ -115,33 +120,41 @@ static inline __attribute__((always_inline)) float lattice(const uint8_t* perm, 
     int hash[16];
     hash[0] = perm[lo[0]];
     hash[1] = perm[hi[0]];
+    AKP_UNROLL
     for (uint32_t k = 1; k < dims; ++k) {
         const uint32_t half = 1u << k;
+        AKP_UNROLL
         for (uint32_t c = 0; c < half; ++c) {
             hash[c + half] = perm[hash[c] + hi[k]];
             hash[c] = perm[hash[c] + lo[k]];
         }
     }
+    AKP_UNROLL
     for (uint32_t c = 0; c < corners; ++c) {
         float d[5] = {0, 0, 0, 0, 0};
+        AKP_UNROLL
         for (uint32_t k = 0; k < dims; ++k) d[k] = ((c >> k) & 1u) ? f[k] - 1.0f : f[k];
         val[c] = corner_dot(dims, hash[c], d);
         if (grad) corner_gradient(dims, hash[c], gv[c]);
     }
+    AKP_UNROLL
     for (uint32_t k = 0; k < dims; ++k) {
         const float t = fade(f[k]);
         const float dt = grad ? dfade(f[k]) : 0.0f;
         const uint32_t step = 1u << k;
+        AKP_UNROLL
         for (uint32_t c = 0; c < corners; c += 2u * step) {
             const float a = val[c], b = val[c + step];
             val[c] = lerp(t, a, b);
             if (grad) {
+                AKP_UNROLL
                 for (uint32_t m = 0; m < dims; ++m) gv[c][m] = lerp(t, gv[c][m], gv[c + step][m]);
                 gv[c][k] = gv[c][k] + (b - a) * dt;
             }
         }
     }
     if (grad)
+        AKP_UNROLL
         for (uint32_t m = 0; m < dims; ++m) grad[m] = gv[0][m];
     return val[0];
 }
@@ -150,9 +163,11 @@ static inline __attribute__((always_inline)) float perlin_n(const ak_noise* nois
                                                             const int* period, float* grad) {
     int lo[4], hi[4];
     float f[4];
+    AKP_UNROLL
     for (uint32_t k = 0; k < dims; ++k) {
         if (!(fabsf(p[k]) < AKP_NOISE_LIMIT)) {
             if (grad)
+                AKP_UNROLL
                 for (uint32_t m = 0; m < dims; ++m) grad[m] = 0.0f;
             return 0.0f;
         }

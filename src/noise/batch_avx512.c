@@ -1,0 +1,93 @@
+/* AVX-512 fractal kernels (16 points at a time, AVX-512 F and DQ): the same body as the AVX2
+ * kernel (simd_body.h) over 16 lanes with mask registers. Compiled only for GCC/Clang on
+ * x86-64 without AK_NO_SIMD (the rest of the build needs no -mavx512 flag); selected at run
+ * time with __builtin_cpu_supports. */
+#include "noise_internal.h"
+
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
+#include <immintrin.h>
+
+bool akp_noise_have_avx512(void) {
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+}
+
+#define KI __attribute__((target("avx512f,avx512dq"), always_inline))
+#define KERNEL_RUN __attribute__((target("avx512f,avx512dq")))
+#define KERNEL_ENTRY akp_noise_fractal_avx512
+#define AKP_W 16
+typedef __m512 VF;
+typedef __m512i VI;
+typedef __mmask16 VM;
+
+KI static inline VF vf_set1(float a) { return _mm512_set1_ps(a); }
+KI static inline VI vi_set1(int a) { return _mm512_set1_epi32(a); }
+KI static inline VF vf_zero(void) { return _mm512_setzero_ps(); }
+KI static inline VF vf_load(const float* p) { return _mm512_loadu_ps(p); }
+KI static inline void vf_store(float* p, VF v) { _mm512_storeu_ps(p, v); }
+KI static inline VF vf_add(VF a, VF b) { return _mm512_add_ps(a, b); }
+KI static inline VF vf_sub(VF a, VF b) { return _mm512_sub_ps(a, b); }
+KI static inline VF vf_mul(VF a, VF b) { return _mm512_mul_ps(a, b); }
+KI static inline VF vf_min(VF a, VF b) { return _mm512_min_ps(a, b); }
+KI static inline VF vf_max(VF a, VF b) { return _mm512_max_ps(a, b); }
+KI static inline VF vf_floor(VF a) { return _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
+KI static inline VI vf_cvtt(VF a) { return _mm512_cvttps_epi32(a); }
+KI static inline VF vf_cast(VI a) { return _mm512_castsi512_ps(a); }
+KI static inline VF vf_xor(VF a, VF b) { return _mm512_xor_ps(a, b); }
+KI static inline VF vf_and(VF a, VF b) { return _mm512_and_ps(a, b); }
+KI static inline VF vf_abs(VF a) { return _mm512_andnot_ps(_mm512_set1_ps(-0.0f), a); }
+KI static inline VI vi_and(VI a, VI b) { return _mm512_and_si512(a, b); }
+KI static inline VI vi_add(VI a, VI b) { return _mm512_add_epi32(a, b); }
+#define VI_SLLI(a, n) _mm512_slli_epi32((a), (n))
+#define VI_SRLI(a, n) _mm512_srli_epi32((a), (n))
+/* perm[j] | perm[j + 1] << 8 for j = 0..255 in 16 registers (entries 32 c .. 32 c + 31 in
+ * t[c][0..1]): a lookup is 8 two-register permutes on the index's low 5 bits and a blend tree
+ * on bits 5..7, which beats a 16-lane gather on CPUs with slow gathers (3D Perlin 1.45x faster
+ * on the Xeon of docs/BENCHMARKS.md). */
+typedef struct PermTab {
+    VI t[8][2];
+} PermTab;
+KI static inline void tab_make(const uint8_t* perm, PermTab* t) {
+    for (int c = 0; c < 8; ++c)
+        for (int h = 0; h < 2; ++h) {
+            const int j = 32 * c + 16 * h; /* perm[j + 16] <= perm[256]: inside the doubled table */
+            const __m512i a = _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i*)(const void*)(perm + j)));
+            const __m512i b = _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i*)(const void*)(perm + j + 1)));
+            t->t[c][h] = _mm512_or_si512(a, _mm512_slli_epi32(b, 8));
+        }
+}
+KI static inline VI tab_pair(const PermTab* t, VI idx) {
+    VI r[8];
+    for (int c = 0; c < 8; ++c) r[c] = _mm512_permutex2var_epi32(t->t[c][0], idx, t->t[c][1]);
+    const VM b5 = _mm512_test_epi32_mask(idx, _mm512_set1_epi32(32));
+    const VM b6 = _mm512_test_epi32_mask(idx, _mm512_set1_epi32(64));
+    const VM b7 = _mm512_test_epi32_mask(idx, _mm512_set1_epi32(128));
+    for (int c = 0; c < 4; ++c) r[c] = _mm512_mask_blend_epi32(b5, r[2 * c], r[2 * c + 1]);
+    for (int c = 0; c < 2; ++c) r[c] = _mm512_mask_blend_epi32(b6, r[2 * c], r[2 * c + 1]);
+    return _mm512_mask_blend_epi32(b7, r[0], r[1]);
+}
+KI static inline VM m_lt(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
+KI static inline VM m_gt(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
+KI static inline VM m_ge(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_GE_OQ); }
+KI static inline VM mi_lt(VI a, int v) { return _mm512_cmplt_epi32_mask(a, _mm512_set1_epi32(v)); }
+KI static inline VM mi_eq(VI a, int v) { return _mm512_cmpeq_epi32_mask(a, _mm512_set1_epi32(v)); }
+KI static inline VM m_and(VM a, VM b) { return (VM)(a & b); }
+KI static inline VM m_or(VM a, VM b) { return (VM)(a | b); }
+KI static inline VM m_andn(VM a, VM b) { return (VM)(~a & b); } /* !a & b */
+KI static inline VM m_not(VM a) { return (VM)~a; }
+KI static inline VF vf_sel(VM m, VF a, VF b) { return _mm512_mask_blend_ps(m, b, a); } /* m ? a : b */
+KI static inline VI vi_sel(VM m, VI a, VI b) { return _mm512_mask_blend_epi32(m, b, a); }
+KI static inline VF vf_maskz(VM m, VF a) { return _mm512_maskz_mov_ps(m, a); } /* m ? a : +0 */
+/* tab[idx] for idx in 0..15 */
+KI static inline VF vf_lut16(const float* tab, VI idx) { return _mm512_permutexvar_ps(idx, _mm512_loadu_ps(tab)); }
+
+#include "simd_body.h"
+
+#else
+
+bool akp_noise_have_avx512(void) { return false; }
+void akp_noise_fractal_avx512(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
+                              size_t count, float* out, float* const* grad) {
+    (void)noise, (void)d, (void)dims, (void)xs, (void)count, (void)out, (void)grad;
+}
+
+#endif
