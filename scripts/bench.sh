@@ -135,9 +135,7 @@ else
             skip vs_noise "quick mode: FastNoise2 not built yet under $B/vs_noise (make bench builds it, 5-9 min)"
         else
             if [[ -n $QUICK ]]; then rounds=1; else rounds=5; fi
-            # bench/vs_noise/run.sh: the same harness with each animkit SIMD path chosen explicitly
-            if [[ -x $ROOT/bench/vs_noise/run.sh ]]; then run vs_noise "$ROOT/bench/vs_noise/run.sh" "$B" "$rounds"
-            else run vs_noise "$PEERS/noise/run.sh" "$B" "$rounds"; fi
+            run vs_noise "$PEERS/noise/run.sh" "$B" "$rounds"
         fi
     fi
     # vs_nsearch: CompactNSearch, at each size.
