@@ -7,9 +7,9 @@
 #include <animkit/rigid.h>
 
 #include "ak_test.h"
+#include "rigid_world.h"
 #include "rigid/rigid_impl.h"
 
-static const ak_vec3 G = {0.0f, -9.81f, 0.0f};
 
 /* Deterministic uniform numbers in [0, 1). */
 static uint32_t rng_state = 12345u;
@@ -18,35 +18,6 @@ static float frand(void) {
     return (float)(rng_state >> 8) / 16777216.0f;
 }
 
-typedef struct world {
-    ak_rigid_model* model;
-    size_t n;
-    ak_vec3 x[32], v[32], w[32];
-    ak_quat q[32];
-    ak_rigid_step_job job;
-    float pen;
-} world;
-
-static bool world_init(world* wd, const ak_rigid_body_desc* bodies, size_t n, uint32_t substeps) {
-    memset(wd, 0, sizeof *wd);
-    ak_rigid_model_desc md = {.bodies = {bodies, n}};
-    if (ak_rigid_model_create(&md, NULL, &wd->model) != AK_OK) return false;
-    wd->n = n;
-    ak_rigid_initial_state(wd->model, (ak_vec3_span){wd->x, n}, (ak_quat_span){wd->q, n},
-                           (ak_vec3_span){wd->v, n}, (ak_vec3_span){wd->w, n});
-    wd->job = (ak_rigid_step_job){.model = wd->model,
-                                  .dt = 1.0f / 60.0f,
-                                  .substeps = substeps,
-                                  .gravity = G,
-                                  .positions = {wd->x, n},
-                                  .orientations = {wd->q, n},
-                                  .velocities = {wd->v, n},
-                                  .angular_velocities = {wd->w, n},
-                                  .out_max_penetration = &wd->pen};
-    size_t size = ak_rigid_step_scratch_size(&wd->job);
-    wd->job.scratch = (ak_u8_span){malloc(size), size};
-    return wd->job.scratch.ptr != NULL;
-}
 
 static bool world_run(world* wd, float seconds, float* max_pen) {
     int steps = (int)lroundf(seconds * 60.0f);
@@ -58,10 +29,6 @@ static bool world_run(world* wd, float seconds, float* max_pen) {
     return true;
 }
 
-static void world_free(world* wd) {
-    free(wd->job.scratch.ptr);
-    ak_rigid_model_destroy(wd->model);
-}
 
 static void box_corners(ak_vec3 he, ak_vec3* out) {
     for (int i = 0; i < 8; ++i)

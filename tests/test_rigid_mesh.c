@@ -8,38 +8,9 @@
 #include <animkit/terrain.h>
 
 #include "ak_test.h"
+#include "rigid_world.h"
 
-static const ak_vec3 G = {0.0f, -9.81f, 0.0f};
 
-typedef struct world {
-    ak_rigid_model* model;
-    size_t n;
-    ak_vec3 x[16], v[16], w[16];
-    ak_quat q[16];
-    ak_rigid_step_job job;
-    float pen;
-} world;
-
-static bool world_init(world* wd, const ak_rigid_body_desc* bodies, size_t n, uint32_t substeps) {
-    memset(wd, 0, sizeof *wd);
-    ak_rigid_model_desc md = {.bodies = {bodies, n}};
-    if (ak_rigid_model_create(&md, NULL, &wd->model) != AK_OK) return false;
-    wd->n = n;
-    ak_rigid_initial_state(wd->model, (ak_vec3_span){wd->x, n}, (ak_quat_span){wd->q, n},
-                           (ak_vec3_span){wd->v, n}, (ak_vec3_span){wd->w, n});
-    wd->job = (ak_rigid_step_job){.model = wd->model,
-                                  .dt = 1.0f / 60.0f,
-                                  .substeps = substeps,
-                                  .gravity = G,
-                                  .positions = {wd->x, n},
-                                  .orientations = {wd->q, n},
-                                  .velocities = {wd->v, n},
-                                  .angular_velocities = {wd->w, n},
-                                  .out_max_penetration = &wd->pen};
-    size_t size = ak_rigid_step_scratch_size(&wd->job);
-    wd->job.scratch = (ak_u8_span){malloc(size), size};
-    return wd->job.scratch.ptr != NULL;
-}
 
 static bool world_steps(world* wd, int steps) {
     for (int s = 0; s < steps; ++s)
@@ -47,10 +18,6 @@ static bool world_steps(world* wd, int steps) {
     return true;
 }
 
-static void world_free(world* wd) {
-    free(wd->job.scratch.ptr);
-    ak_rigid_model_destroy(wd->model);
-}
 
 /* Height of the heightfield's surface at local (x, z), from its two triangles per cell (the
  * documented split: (00, 01, 11) where v >= u, (00, 11, 10) elsewhere). */
