@@ -47,13 +47,29 @@ CFLAGS=(-std=c11 -D_POSIX_C_SOURCE=200809L -O1 -g $SAN -Wall -Wextra -Werror
         -Iinclude -Isrc -Itools/animkit -DAK_FUZZ_ASSETS="\"$ASSETS\"")
 mkdir -p "$OUT/cli" "$OUT/bin" "$OUT/corpus" "$OUT/artifacts" "$OUT/logs"
 rm -f "$OUT/cli/"*.o "$OUT/libanimkit_cli.a"
+
+# Compiles run JOBS at a time (background jobs); wait_all fails if any failed.
+pids=()
+spawn() {
+  while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n || true; done
+  "$@" &
+  pids+=($!)
+}
+wait_all() {
+  local bad=0 pid
+  for pid in "${pids[@]}"; do wait "$pid" || bad=1; done
+  pids=()
+  [ "$bad" = 0 ] || { echo "fuzz.sh: a compile failed" >&2; exit 1; }
+}
+
 cli_objs=()
 for src in tools/animkit/*.c; do
   [ "$(basename "$src")" = main.c ] && continue
   obj=$OUT/cli/$(basename "${src%.c}").o
-  "$CC" "${CFLAGS[@]}" -fsanitize=fuzzer-no-link -c "$src" -o "$obj"
+  spawn "$CC" "${CFLAGS[@]}" -fsanitize=fuzzer-no-link -c "$src" -o "$obj"
   cli_objs+=("$obj")
 done
+wait_all
 [ ${#cli_objs[@]} -gt 0 ] && ar rcs "$OUT/libanimkit_cli.a" "${cli_objs[@]}"
 
 targets=()
@@ -61,10 +77,11 @@ for src in tests/fuzz/fuzz_*.c; do
   name=$(basename "${src%.c}"); name=${name#fuzz_}
   if [ ${#ONLY[@]} -gt 0 ] && [[ ! " ${ONLY[*]} " == *" $name "* ]]; then continue; fi
   echo "== fuzz: building fuzz_$name"
-  "$CC" "${CFLAGS[@]}" -fsanitize=fuzzer "$src" -o "$OUT/bin/fuzz_$name" \
+  spawn "$CC" "${CFLAGS[@]}" -fsanitize=fuzzer "$src" -o "$OUT/bin/fuzz_$name" \
     ${cli_objs:+"$OUT/libanimkit_cli.a"} "$OUT/lib/libanimkit.a" $LIBS
   targets+=("$name")
 done
+wait_all
 [ ${#targets[@]} -gt 0 ] || { echo "fuzz.sh: no targets" >&2; exit 1; }
 
 # Seeds: each line of tests/fuzz/<name>.seeds, $ASSETS expanded, globs allowed.
