@@ -31,6 +31,7 @@ struct ak_crowd {
     ak_allocator alloc;
     size_t agent_count;
     ak_crowd_agent* agents; /* resolved; goals point into waypoints */
+    float* radii;           /* [agent_count] agents[i].radius, compact for the neighbour loops */
     ak_vec2* waypoints;
     obst_vertex* verts;
     uint32_t vertex_count;
@@ -150,7 +151,8 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
     const size_t s_agents = akp_align16(n * sizeof(ak_crowd_agent));
     const size_t s_wp = akp_align16(wp_total * sizeof(ak_vec2));
     const size_t s_verts = akp_align16(vert_total * sizeof(obst_vertex));
-    char* mem = (char*)akp_calloc(alloc, s_head + s_agents + s_wp + s_verts);
+    const size_t s_radii = akp_align16(n * sizeof(float));
+    char* mem = (char*)akp_calloc(alloc, s_head + s_agents + s_wp + s_verts + s_radii);
     if (!mem) return AK_ERR_NO_MEMORY;
     ak_crowd* c = (ak_crowd*)(void*)mem;
     if (alloc) c->alloc = *alloc;
@@ -158,6 +160,7 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
     c->agents = (ak_crowd_agent*)(void*)(mem + s_head);
     c->waypoints = (ak_vec2*)(void*)(mem + s_head + s_agents);
     c->verts = (obst_vertex*)(void*)(mem + s_head + s_agents + s_wp);
+    c->radii = (float*)(void*)(mem + s_head + s_agents + s_wp + s_verts);
     c->vertex_count = (uint32_t)vert_total;
     c->method = desc->method;
     c->vision_width = desc->vision_width ? desc->vision_width : 48;
@@ -169,6 +172,7 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
         a.goals.ptr = c->waypoints + w;
         w += a.goals.count;
         c->agents[i] = a;
+        c->radii[i] = a.radius;
         c->max_neighbor_distance = ak_maxf(c->max_neighbor_distance, a.neighbor_distance);
         c->max_radius = ak_maxf(c->max_radius, a.radius);
         if (a.max_neighbors > c->max_k) c->max_k = a.max_neighbors;
@@ -831,7 +835,7 @@ static size_t build_lines(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const
     for (uint32_t k = 0; k < na; ++k) {
         const uint32_t j = nkey_index(w->agent_n[k]);
         w->lines[nl++] = agent_line(p, v, a->radius, job->positions.ptr[j], job->velocities.ptr[j],
-                                    c->crowd->agents[j].radius, inv_th, job->dt, i < j ? 1.0f : -1.0f);
+                                    c->crowd->radii[j], inv_th, job->dt, i < j ? 1.0f : -1.0f);
     }
     return nl;
 }
@@ -1001,7 +1005,7 @@ static float contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P, f
                     const uint32_t i = g->order[s];
                     for (uint32_t t = (m2 == m ? s + 1 : g->cell_start[m2]); t < g->cell_start[m2 + 1]; ++t) {
                         const uint32_t j = g->order[t];
-                        const float rr = crowd->agents[i].radius + crowd->agents[j].radius;
+                        const float rr = crowd->radii[i] + crowd->radii[j];
                         const ak_vec2 d = sub(P[i], P[j]);
                         const float d2 = abs_sq(d);
                         if (!(d2 < rr * rr)) continue;
