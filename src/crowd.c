@@ -31,6 +31,7 @@ struct ak_crowd {
     ak_allocator alloc;
     size_t agent_count;
     ak_crowd_agent* agents; /* resolved; goals point into waypoints */
+    float* radii;           /* [agent_count] agents[i].radius, compact for the neighbour loops */
     ak_vec2* waypoints;
     obst_vertex* verts;
     uint32_t vertex_count;
@@ -150,7 +151,8 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
     const size_t s_agents = akp_align16(n * sizeof(ak_crowd_agent));
     const size_t s_wp = akp_align16(wp_total * sizeof(ak_vec2));
     const size_t s_verts = akp_align16(vert_total * sizeof(obst_vertex));
-    char* mem = (char*)akp_calloc(alloc, s_head + s_agents + s_wp + s_verts);
+    const size_t s_radii = akp_align16(n * sizeof(float));
+    char* mem = (char*)akp_calloc(alloc, s_head + s_agents + s_wp + s_verts + s_radii);
     if (!mem) return AK_ERR_NO_MEMORY;
     ak_crowd* c = (ak_crowd*)(void*)mem;
     if (alloc) c->alloc = *alloc;
@@ -158,6 +160,7 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
     c->agents = (ak_crowd_agent*)(void*)(mem + s_head);
     c->waypoints = (ak_vec2*)(void*)(mem + s_head + s_agents);
     c->verts = (obst_vertex*)(void*)(mem + s_head + s_agents + s_wp);
+    c->radii = (float*)(void*)(mem + s_head + s_agents + s_wp + s_verts);
     c->vertex_count = (uint32_t)vert_total;
     c->method = desc->method;
     c->vision_width = desc->vision_width ? desc->vision_width : 48;
@@ -169,6 +172,7 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
         a.goals.ptr = c->waypoints + w;
         w += a.goals.count;
         c->agents[i] = a;
+        c->radii[i] = a.radius;
         c->max_neighbor_distance = ak_maxf(c->max_neighbor_distance, a.neighbor_distance);
         c->max_radius = ak_maxf(c->max_radius, a.radius);
         if (a.max_neighbors > c->max_k) c->max_k = a.max_neighbors;
@@ -407,29 +411,44 @@ static size_t dense_grid_bytes(size_t n, size_t cap) {
 typedef struct worker {
     const ctx* c;
     size_t begin, end;
-    neigh* agent_n;       /* [max_k] */
+    uint64_t* agent_n;    /* [max_k] keys (nkey) */
     neigh* obst_n;        /* [vertex_count] */
     ak_crowd_line* lines; /* [max_k + vertex_count] */
     ak_crowd_line* proj;  /* [max_k + vertex_count] */
 } worker;
 
+/* Agent neighbours are kept as one key each, (bits of the squared distance) << 32 | index:
+ * distances are >= 0, so the keys order as (distance, index) do. */
+static inline uint64_t nkey(float d, uint32_t j) {
+    uint32_t b;
+    memcpy(&b, &d, sizeof b);
+    return (uint64_t)b << 32 | j;
+}
+static inline uint32_t nkey_index(uint64_t key) { return (uint32_t)key; }
+static inline float nkey_dist(uint64_t key) {
+    const uint32_t b = (uint32_t)(key >> 32);
+    float d;
+    memcpy(&d, &b, sizeof d);
+    return d;
+}
+
 /* Insert (d, j) into a list sorted by (distance, index); when the list is full the range
  * shrinks to its last entry (the k nearest, as RVO2 selects them). */
-static inline void insert_agent(neigh* list, uint32_t* count, uint32_t k, float* range_sq, float d, uint32_t j) {
+static inline void insert_agent(uint64_t* list, uint32_t* count, uint32_t k, float* range_sq, float d, uint32_t j) {
     if (!(d < *range_sq)) return;
+    const uint64_t key = nkey(d, j);
     uint32_t i = *count < k ? (*count)++ : k - 1;
-    while (i > 0 && (d < list[i - 1].dist_sq || (d == list[i - 1].dist_sq && j < list[i - 1].index))) {
+    while (i > 0 && key < list[i - 1]) {
         list[i] = list[i - 1];
         --i;
     }
-    list[i].dist_sq = d;
-    list[i].index = j;
-    if (*count == k) *range_sq = list[k - 1].dist_sq;
+    list[i] = key;
+    if (*count == k) *range_sq = nkey_dist(list[k - 1]);
 }
 
 /* The ring search on the dense grid: a ring's top and bottom rows are each one contiguous
  * range of sorted entries (cut to the cells within range), its sides single cells. */
-static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, neigh* out) {
+static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, uint64_t* out) {
     uint32_t count = 0;
     const uint32_t k = a->max_neighbors;
     float range_sq = a->neighbor_distance * a->neighbor_distance;
@@ -449,9 +468,10 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
         const float d = ddx * ddx + ddz * ddz;                                                        \
         if (d < range_sq && sidx[s] != self32) insert_agent(out, &count, k, &range_sq, d, sidx[s]); \
     }
-    /* rings 0 and 1: the 3 x 3 block, three row ranges (home row first) */
+    /* first the 5 x 3 block (rings 0 and 1, and ring 2's side cells of these rows): three
+     * row ranges, the home row first; then ring 2's top and bottom rows; then rings >= 3 */
     {
-        const int64_t xa = hx > 0 ? hx - 1 : 0, xb = hx + 1 < c->w ? hx + 1 : c->w - 1;
+        const int64_t xa = hx > 1 ? hx - 2 : 0, xb = hx + 2 < c->w ? hx + 2 : c->w - 1;
         for (int q = 0; q < 3; ++q) {
             const int64_t z = hz + (q == 0 ? 0 : q == 1 ? -1 : 1);
             if (z < 0 || z >= c->h) continue;
@@ -489,6 +509,7 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
             const uint32_t* row = cstart + z * c->w;
             SCAN(row[xa], row[xb + 1])
         }
+        if (r == 2) continue; /* its side cells were in the first block */
         /* columns dx = -r and dx = +r, rows -r+1 .. r-1 */
         for (int side = 0; side < 2; ++side) {
             const int64_t dx = side ? r : -r, x = hx + dx;
@@ -511,7 +532,7 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
     return count;
 }
 
-static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, neigh* out) {
+static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, uint64_t* out) {
     if (a->max_neighbors == 0) return 0;
     if (c->cstart) return agent_neighbors_dense(c, self, p, a, out);
     const ak_grid* g = c->grid;
@@ -812,9 +833,9 @@ static size_t build_lines(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const
     const uint32_t na = agent_neighbors(c, i, p, a, w->agent_n);
     const float inv_th = 1.0f / a->time_horizon;
     for (uint32_t k = 0; k < na; ++k) {
-        const uint32_t j = w->agent_n[k].index;
+        const uint32_t j = nkey_index(w->agent_n[k]);
         w->lines[nl++] = agent_line(p, v, a->radius, job->positions.ptr[j], job->velocities.ptr[j],
-                                    c->crowd->agents[j].radius, inv_th, job->dt, i < j ? 1.0f : -1.0f);
+                                    c->crowd->radii[j], inv_th, job->dt, i < j ? 1.0f : -1.0f);
     }
     return nl;
 }
@@ -866,7 +887,7 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
         float best = INFINITY;
         ak_vec2 ovel = v2(0.0f, 0.0f);
         for (uint32_t q = 0; q < na; ++q) {
-            const uint32_t j = w->agent_n[q].index;
+            const uint32_t j = nkey_index(w->agent_n[q]);
             const float t = ray_disc(p, d, job->positions.ptr[j], crowd->agents[j].radius);
             if (t < best) {
                 best = t;
@@ -984,7 +1005,7 @@ static float contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P, f
                     const uint32_t i = g->order[s];
                     for (uint32_t t = (m2 == m ? s + 1 : g->cell_start[m2]); t < g->cell_start[m2 + 1]; ++t) {
                         const uint32_t j = g->order[t];
-                        const float rr = crowd->agents[i].radius + crowd->agents[j].radius;
+                        const float rr = crowd->radii[i] + crowd->radii[j];
                         const ak_vec2 d = sub(P[i], P[j]);
                         const float d2 = abs_sq(d);
                         if (!(d2 < rr * rr)) continue;
@@ -1051,7 +1072,7 @@ static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t 
 
 static void carve_worker(const ak_crowd* c, char* base, worker* w) {
     const size_t lines = (size_t)c->max_k + c->vertex_count;
-    w->agent_n = (neigh*)(void*)base;
+    w->agent_n = (uint64_t*)(void*)base;
     base += akp_align16((size_t)c->max_k * sizeof(neigh));
     w->obst_n = (neigh*)(void*)base;
     base += akp_align16((size_t)c->vertex_count * sizeof(neigh));
