@@ -11,6 +11,7 @@
 #include <time.h>
 
 #ifndef AKP_NO_THREADS
+#include <sched.h>
 #include <semaphore.h>
 #include <unistd.h>
 
@@ -43,18 +44,13 @@ static void prof_add(atomic_ullong* counter, double seconds) {
     atomic_fetch_add_explicit(counter, (unsigned long long)(seconds * 1e9 + 0.5), memory_order_relaxed);
 }
 
-static void spin_pause(void) {
-#if defined(__x86_64__) || defined(__i386__)
-    __asm__ __volatile__("pause");
-#endif
-}
-
 /* Take the semaphore, polling it `spins` times before sleeping: a job's next parallel phase
- * usually follows within microseconds, and a futex wake-up costs about 10 us. Polling only pays
- * when every thread of the run has a core: with more threads than cores a poller takes the core
- * the thread it waits for needs (bench_tasks: 4 tasks on 2 cores, 18 -> 79 us a section), so
- * runs larger than the CPU count poll 0 times. */
-#define TEAM_SPIN 4000
+ * usually follows within microseconds, and a futex wake-up costs about 10 us. Each poll yields
+ * the core (sched_yield), so a poller never holds a core another runnable thread needs (other
+ * processes' included: ctest runs tests side by side). Polling only pays when every thread of
+ * the run has a core, so runs larger than the CPU count poll 0 times (bench_tasks: 4 tasks on
+ * 2 cores polling took 79 us a section against 18 without). */
+#define TEAM_SPIN 200
 static atomic_int spin_count; /* TEAM_SPIN or 0, set by each run from its size */
 static long cpu_count = 1;
 
@@ -62,7 +58,7 @@ static void take(sem_t* sem) {
     const int spins = atomic_load_explicit(&spin_count, memory_order_relaxed);
     for (int k = 0; k < spins; ++k) {
         if (sem_trywait(sem) == 0) return;
-        spin_pause();
+        sched_yield();
     }
     while (sem_wait(sem) != 0) {
     }
