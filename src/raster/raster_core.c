@@ -774,6 +774,128 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, bool tex, c
     return false;
 }
 
+#if defined(__wasm_simd128__)
+/* The WebAssembly build (docs/web.md): the ground's pixels four at a time with SIMD128. The
+ * ground is the frame's largest surface and its fragment (fade, grid, shadow) the heaviest per
+ * pixel; every lane runs the scalar FRAG_GROUND code's float operations in the same order
+ * (IEEE division, square root and floor per lane; -ffp-contract=off, no fused multiply-add), so
+ * the pixels are bit-identical to the scalar path's, which every other build runs and the raster
+ * tests check (tests/web/run.mjs compares the page's frame with the native viewer's). */
+#include <wasm_simd128.h>
+
+static FORCE_INLINE v128_t v_clamp01(v128_t x) {
+    v128_t r = wasm_v128_bitselect(wasm_f32x4_splat(1.0f), x, wasm_f32x4_gt(x, wasm_f32x4_splat(1.0f)));
+    return wasm_v128_bitselect(wasm_f32x4_splat(0.0f), r, wasm_f32x4_lt(x, wasm_f32x4_splat(0.0f)));
+}
+
+/* Row y of triangle t, pixels x0..x1, with the edge values e* at x0 and their steps s*. */
+static void ground_row_simd(const drawctx* dc, const rtri* t, int x0, int x1, int64_t e0, int64_t e1, int64_t e2,
+                            int64_t s0, int64_t s1, int64_t s2, uint8_t* crow, float* zrow) {
+    const ak_raster* r = dc->r;
+    const v128_t one = wasm_f32x4_splat(1.0f), zero = wasm_f32x4_splat(0.0f);
+    const v128_t gcx = wasm_f32x4_splat(dc->ground_cx), gcz = wasm_f32x4_splat(dc->ground_cz);
+    const v128_t ge = wasm_f32x4_splat(dc->ground_e), sp = wasm_f32x4_splat(dc->grid_spacing);
+    const v128_t ss = wasm_f32x4_splat((float)r->ss);
+    const float texel = 2.0f * dc->ground_e / (float)SHADOW_RES;
+    for (int x = x0; x <= x1; x += 4) {
+        const int n = x1 - x + 1 < 4 ? x1 - x + 1 : 4;
+        float l1s[4] = {0, 0, 0, 0}, l2s[4] = {0, 0, 0, 0}, zb[4] = {0, 0, 0, 0};
+        int live[4] = {0, 0, 0, 0}, any = 0;
+        for (int k = 0; k < n; ++k, e0 += s0, e1 += s1, e2 += s2) {
+            if ((e0 | e1 | e2) < 0) continue;
+            live[k] = -1;
+            any = 1;
+            l1s[k] = (float)(e1 - t->bias[1]) * t->inv_area;
+            l2s[k] = (float)(e2 - t->bias[2]) * t->inv_area;
+            zb[k] = zrow[x + k];
+        }
+        if (!any) continue;
+        const v128_t l1 = wasm_v128_load(l1s), l2 = wasm_v128_load(l2s);
+        v128_t alive = wasm_v128_load(live);
+        const v128_t z = wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_splat(t->z0), wasm_f32x4_mul(l1, wasm_f32x4_splat(t->dz1))),
+                                        wasm_f32x4_mul(l2, wasm_f32x4_splat(t->dz2)));
+        if (dc->depth_test) alive = wasm_v128_and(alive, wasm_f32x4_lt(z, wasm_v128_load(zb)));
+        alive = wasm_v128_and(alive, wasm_v128_and(wasm_f32x4_ge(z, zero), wasm_f32x4_le(z, one)));
+        if (!wasm_v128_any_true(alive)) continue;
+        const v128_t iw = wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_splat(t->iw0), wasm_f32x4_mul(l1, wasm_f32x4_splat(t->diw1))),
+                                         wasm_f32x4_mul(l2, wasm_f32x4_splat(t->diw2)));
+        const v128_t w = wasm_f32x4_div(one, iw);
+        v128_t a[3];
+        for (int k = 0; k < 3; ++k)
+            a[k] = wasm_f32x4_mul(wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_splat(t->a0[k]), wasm_f32x4_mul(l1, wasm_f32x4_splat(t->da1[k]))),
+                                                 wasm_f32x4_mul(l2, wasm_f32x4_splat(t->da2[k]))),
+                                  w);
+        /* fade towards the edge of the ground's disc */
+        const v128_t px = a[0], pz = a[2];
+        const v128_t dx = wasm_f32x4_sub(px, gcx), dz = wasm_f32x4_sub(pz, gcz);
+        const v128_t rad = wasm_f32x4_div(wasm_f32x4_sqrt(wasm_f32x4_add(wasm_f32x4_mul(dx, dx), wasm_f32x4_mul(dz, dz))), ge);
+        const v128_t st = v_clamp01(wasm_f32x4_div(wasm_f32x4_sub(rad, wasm_f32x4_splat(0.45f)), wasm_f32x4_splat(1.0f - 0.45f)));
+        const v128_t fade = wasm_f32x4_sub(
+            one, wasm_f32x4_mul(wasm_f32x4_mul(st, st), wasm_f32x4_sub(wasm_f32x4_splat(3.0f), wasm_f32x4_mul(wasm_f32x4_splat(2.0f), st))));
+        alive = wasm_v128_andnot(alive, wasm_f32x4_le(fade, zero));
+        if (!wasm_v128_any_true(alive)) continue;
+        /* grid: pixel footprint in metres from distance and grazing angle */
+        const v128_t tx = wasm_f32x4_sub(wasm_f32x4_splat(dc->eye.x), a[0]);
+        const v128_t ty = wasm_f32x4_sub(wasm_f32x4_splat(dc->eye.y), a[1]);
+        const v128_t tz = wasm_f32x4_sub(wasm_f32x4_splat(dc->eye.z), a[2]);
+        v128_t dist = wasm_f32x4_sqrt(wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(tx, tx), wasm_f32x4_mul(ty, ty)), wasm_f32x4_mul(tz, tz)));
+        v128_t cosv = wasm_v128_bitselect(wasm_f32x4_div(wasm_f32x4_abs(ty), dist), one, wasm_f32x4_gt(dist, zero));
+        if (dc->ortho) {
+            dist = one;
+            cosv = wasm_f32x4_splat(fabsf(dc->view_forward.y));
+        }
+        const v128_t c012 = wasm_f32x4_splat(0.12f);
+        const v128_t foot = wasm_f32x4_div(wasm_f32x4_mul(dist, wasm_f32x4_splat(dc->pix_angle)),
+                                           wasm_v128_bitselect(cosv, c012, wasm_f32x4_gt(cosv, c012)));
+        const v128_t half = wasm_f32x4_splat(0.5f);
+        const v128_t gu = wasm_f32x4_div(px, sp), gv = wasm_f32x4_div(pz, sp);
+        const v128_t du = wasm_f32x4_mul(wasm_f32x4_abs(wasm_f32x4_sub(gu, wasm_f32x4_floor(wasm_f32x4_add(gu, half)))), sp);
+        const v128_t dv = wasm_f32x4_mul(wasm_f32x4_abs(wasm_f32x4_sub(gv, wasm_f32x4_floor(wasm_f32x4_add(gv, half)))), sp);
+        const v128_t d = wasm_v128_bitselect(du, dv, wasm_f32x4_lt(du, dv));
+        const v128_t hw = wasm_f32x4_mul(wasm_f32x4_mul(half, ss), foot);
+        v128_t line = v_clamp01(wasm_f32x4_sub(one, wasm_f32x4_div(wasm_f32x4_sub(d, hw), foot)));
+        line = wasm_f32x4_mul(line, v_clamp01(wasm_f32x4_sub(wasm_f32x4_splat(1.6f),
+                                                             wasm_f32x4_div(wasm_f32x4_mul(wasm_f32x4_mul(wasm_f32x4_splat(4.0f), foot), ss), sp))));
+        const v128_t lt = wasm_f32x4_mul(line, wasm_f32x4_splat(0.8f));
+        const float gl[3] = {dc->ground_lin.x, dc->ground_lin.y, dc->ground_lin.z};
+        const float ll[3] = {dc->line_lin.x, dc->line_lin.y, dc->line_lin.z};
+        v128_t c[3];
+        for (int k = 0; k < 3; ++k) {
+            const v128_t g = wasm_f32x4_splat(gl[k]);
+            c[k] = wasm_f32x4_add(g, wasm_f32x4_mul(wasm_f32x4_sub(wasm_f32x4_splat(ll[k]), g), lt));
+        }
+        float fl[4], cl[3][4];
+        if (dc->shadow) {
+            const v128_t tv = wasm_f32x4_splat(texel);
+            float su[4], sv[4], sh[4];
+            wasm_v128_store(su, wasm_f32x4_div(wasm_f32x4_sub(px, wasm_f32x4_splat(dc->ground_cx - dc->ground_e)), tv));
+            wasm_v128_store(sv, wasm_f32x4_div(wasm_f32x4_sub(pz, wasm_f32x4_splat(dc->ground_cz - dc->ground_e)), tv));
+            for (int k = 0; k < n; ++k) sh[k] = live[k] ? shadow_sample(r, su[k], sv[k]) : 0.0f;
+            for (int k = n; k < 4; ++k) sh[k] = 0.0f;
+            const v128_t f = wasm_f32x4_sub(one, wasm_v128_load(sh));
+            for (int k = 0; k < 3; ++k) c[k] = wasm_f32x4_mul(c[k], f);
+        }
+        wasm_v128_store(fl, fade);
+        for (int k = 0; k < 3; ++k) wasm_v128_store(cl[k], c[k]);
+        uint32_t am[4];
+        wasm_v128_store(am, alive);
+        for (int k = 0; k < n; ++k) {
+            if (!am[k]) continue;
+            uint8_t* dst = crow + (size_t)(x + k) * 4u;
+            uint8_t out[4];
+            for (int q = 0; q < 3; ++q) {
+                float bg = r->to_lin_lut[dst[q]];
+                out[q] = (uint8_t)r->to_srgb_lut[(int)(clamp01(bg + (cl[q][k] - bg) * fl[k]) * 4096.0f + 0.5f)];
+            }
+            out[3] = 255;
+            float zk[4];
+            wasm_v128_store(zk, z);
+            write_px(dc, dst, &zrow[x + k], zk[k], out);
+        }
+    }
+}
+#endif
+
 static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, bool tex, const rtri* t,
                                          int thread_index, int thread_count) {
     ak_raster* r = dc->r;
@@ -796,6 +918,12 @@ static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, bool
         const int64_t s0 = t->A[0] * SUBPIX, s1 = t->A[1] * SUBPIX, s2 = t->A[2] * SUBPIX;
         uint8_t* crow = r->color + (size_t)y * (size_t)r->sw * 4u;
         float* zrow = r->depth + (size_t)y * (size_t)r->sw;
+#if defined(__wasm_simd128__)
+        if (mode == FRAG_GROUND && !tex) {
+            ground_row_simd(dc, t, t->x0, t->x1, e0, e1, e2, s0, s1, s2, crow, zrow);
+            continue;
+        }
+#endif
         for (int x = t->x0; x <= t->x1; ++x, e0 += s0, e1 += s1, e2 += s2) {
             if ((e0 | e1 | e2) < 0) continue;
             /* remove the bias again so the barycentrics are exact */

@@ -288,6 +288,7 @@ try {
       // page against native, below the HUD's first line (rows 0..23)
       let sum = 0, n = 0, maxd = 0, same = 0, changedByTexture = 0;
       const bb = [960, 600, -1, -1]; // where pixels differ: x0, y0, x1, y1
+      const bands = new Array(15).fill(0); // differing pixels in rows 0-39, 40-79, ...
       for (let y = 24; y < 600; y++)
         for (let x = 0; x < 960; x++) {
           const i = 4 * (y * 960 + x);
@@ -296,12 +297,12 @@ try {
           n += 3;
           maxd = Math.max(maxd, px);
           if (px === 0) same++;
-          else { bb[0] = Math.min(bb[0], x); bb[1] = Math.min(bb[1], y); bb[2] = Math.max(bb[2], x); bb[3] = Math.max(bb[3], y); }
+          else { bands[Math.floor(y / 40)]++; bb[0] = Math.min(bb[0], x); bb[1] = Math.min(bb[1], y); bb[2] = Math.max(bb[2], x); bb[3] = Math.max(bb[3], y); }
           if (page[i] !== plain[i] || page[i + 1] !== plain[i + 1] || page[i + 2] !== plain[i + 2]) changedByTexture++;
         }
       return { given, served, info, native_texture: { width: nt.w, height: nt.h, fnv1a: h }, native_frame: [nf.w, nf.h],
                head: { at: top, box: [x0, y0, 40, 40], differs_from_untextured: headDiff, pixels: headN, colours: headColours.size },
-               frame_mean_abs_diff: sum / n, frame_max_diff: maxd, frame_identical_pixels: same, frame_pixels: n / 3, frame_diff_box: bb,
+               frame_mean_abs_diff: sum / n, frame_max_diff: maxd, frame_identical_pixels: same, frame_pixels: n / 3, frame_diff_box: bb, frame_diff_rows_by_40: bands,
                pixels_changed_by_texture: changedByTexture };
     }, glb, texPng, framePng);
     results.cesiumman_texture = tex;
