@@ -16,6 +16,9 @@
 #include "../internal.h"
 #include "raster_internal.h"
 #include "../tasks.h"
+#if defined(__wasm_simd128__)
+#include <wasm_simd128.h> /* the WebAssembly build's SIMD128 paths (tex_sample, ground_row_simd) */
+#endif
 
 /* ---- private types ------------------------------------------------------------------ */
 
@@ -286,7 +289,10 @@ void ak_raster_clear(ak_raster* raster, ak_vec4 top_color, ak_vec4 bottom_color)
                          (uint8_t)raster->to_srgb_lut[(int)(clamp01(c.z) * 4096.0f + 0.5f)],
                          (uint8_t)(ak_lerpf(ta, ba, s) * 255.0f + 0.5f)};
         uint8_t* row = raster->color + (size_t)y * (size_t)raster->sw * 4u;
-        for (int x = 0; x < raster->sw; ++x) memcpy(row + (size_t)x * 4u, px, 4);
+        /* one pixel, then the filled part copied onto the rest, doubling */
+        const size_t bytes = (size_t)raster->sw * 4u;
+        memcpy(row, px, 4);
+        for (size_t done = 4; done < bytes; done *= 2) memcpy(row + done, row, done < bytes - done ? done : bytes - done);
     }
 }
 
@@ -651,6 +657,21 @@ static void tex_sample(const drawctx* dc, float u, float v, bool minify, bool li
     const uint8_t* r1 = px + (size_t)j1 * stride;
     const uint8_t* p[4] = {r0 + (size_t)i0 * 4u, r0 + (size_t)i1 * 4u, r1 + (size_t)i0 * 4u, r1 + (size_t)i1 * 4u};
     const float wt[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
+#if defined(__wasm_simd128__)
+    /* the four channels at once: per channel the scalar loops' sums in the same order, each
+     * term rounded as there (lit: wt * lut for colour, (wt * a) * (1/255) for alpha) */
+    {
+        const v128_t scale = linear ? wasm_f32x4_make(1.0f, 1.0f, 1.0f, 1.0f / 255.0f) : wasm_f32x4_splat(1.0f / 255.0f);
+        v128_t acc = wasm_f32x4_splat(0.0f);
+        for (int q = 0; q < 4; ++q) {
+            const v128_t c = linear ? wasm_f32x4_make(lut[p[q][0]], lut[p[q][1]], lut[p[q][2]], (float)p[q][3])
+                                    : wasm_f32x4_make((float)p[q][0], (float)p[q][1], (float)p[q][2], (float)p[q][3]);
+            acc = wasm_f32x4_add(acc, wasm_f32x4_mul(wasm_f32x4_mul(wasm_f32x4_splat(wt[q]), c), scale));
+        }
+        wasm_v128_store(out, acc);
+        return;
+    }
+#endif
     for (int k = 0; k < 4; ++k) out[k] = 0.0f;
     if (linear) {
         for (int q = 0; q < 4; ++q)
@@ -781,8 +802,6 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, bool tex, c
  * (IEEE division, square root and floor per lane; -ffp-contract=off, no fused multiply-add), so
  * the pixels are bit-identical to the scalar path's, which every other build runs and the raster
  * tests check (tests/web/run.mjs compares the page's frame with the native viewer's). */
-#include <wasm_simd128.h>
-
 static FORCE_INLINE v128_t v_clamp01(v128_t x) {
     v128_t r = wasm_v128_bitselect(wasm_f32x4_splat(1.0f), x, wasm_f32x4_gt(x, wasm_f32x4_splat(1.0f)));
     return wasm_v128_bitselect(wasm_f32x4_splat(0.0f), r, wasm_f32x4_lt(x, wasm_f32x4_splat(0.0f)));
@@ -867,12 +886,38 @@ static void ground_row_simd(const drawctx* dc, const rtri* t, int x0, int x1, in
         float fl[4], cl[3][4];
         if (dc->shadow) {
             const v128_t tv = wasm_f32x4_splat(texel);
-            float su[4], sv[4], sh[4];
-            wasm_v128_store(su, wasm_f32x4_div(wasm_f32x4_sub(px, wasm_f32x4_splat(dc->ground_cx - dc->ground_e)), tv));
-            wasm_v128_store(sv, wasm_f32x4_div(wasm_f32x4_sub(pz, wasm_f32x4_splat(dc->ground_cz - dc->ground_e)), tv));
-            for (int k = 0; k < n; ++k) sh[k] = live[k] ? shadow_sample(r, su[k], sv[k]) : 0.0f;
-            for (int k = n; k < 4; ++k) sh[k] = 0.0f;
-            const v128_t f = wasm_f32x4_sub(one, wasm_v128_load(sh));
+            /* shadow_sample, lane by lane in the same order: the 4 taps' weights, a tap outside
+             * the map adds w * 0 (+0: the sum is the same), out of range -> 0 */
+            const v128_t u = wasm_f32x4_sub(
+                wasm_f32x4_div(wasm_f32x4_sub(px, wasm_f32x4_splat(dc->ground_cx - dc->ground_e)), tv), half);
+            const v128_t v = wasm_f32x4_sub(
+                wasm_f32x4_div(wasm_f32x4_sub(pz, wasm_f32x4_splat(dc->ground_cz - dc->ground_e)), tv), half);
+            const v128_t m1 = wasm_f32x4_splat(-1.0f), sr = wasm_f32x4_splat((float)SHADOW_RES);
+            const v128_t inr = wasm_v128_and(wasm_v128_and(wasm_f32x4_gt(u, m1), wasm_f32x4_gt(v, m1)),
+                                             wasm_v128_and(wasm_f32x4_lt(u, sr), wasm_f32x4_lt(v, sr)));
+            const v128_t fu = wasm_f32x4_floor(u), fv = wasm_f32x4_floor(v);
+            const v128_t fx = wasm_f32x4_sub(u, fu), fy = wasm_f32x4_sub(v, fv);
+            int32_t ix[4], iy[4], in[4];
+            wasm_v128_store(ix, wasm_i32x4_trunc_sat_f32x4(fu));
+            wasm_v128_store(iy, wasm_i32x4_trunc_sat_f32x4(fv));
+            wasm_v128_store(in, wasm_v128_and(inr, alive));
+            float tap[4][4] = {{0}}; /* [j * 2 + i][lane] */
+            for (int k = 0; k < n; ++k) {
+                if (!in[k]) continue;
+                for (int j = 0; j < 2; ++j)
+                    for (int i = 0; i < 2; ++i) {
+                        int sx = ix[k] + i, sy = iy[k] + j;
+                        if (sx >= 0 && sy >= 0 && sx < SHADOW_RES && sy < SHADOW_RES)
+                            tap[j * 2 + i][k] = r->shadow[sy * SHADOW_RES + sx];
+                    }
+            }
+            const v128_t gx = wasm_f32x4_sub(one, fx), gy = wasm_f32x4_sub(one, fy);
+            v128_t sh = wasm_f32x4_add(zero, wasm_f32x4_mul(wasm_f32x4_mul(gx, gy), wasm_v128_load(tap[0])));
+            sh = wasm_f32x4_add(sh, wasm_f32x4_mul(wasm_f32x4_mul(fx, gy), wasm_v128_load(tap[1])));
+            sh = wasm_f32x4_add(sh, wasm_f32x4_mul(wasm_f32x4_mul(gx, fy), wasm_v128_load(tap[2])));
+            sh = wasm_f32x4_add(sh, wasm_f32x4_mul(wasm_f32x4_mul(fx, fy), wasm_v128_load(tap[3])));
+            sh = wasm_v128_and(sh, inr); /* out of range: 0 */
+            const v128_t f = wasm_f32x4_sub(one, sh);
             for (int k = 0; k < 3; ++k) c[k] = wasm_f32x4_mul(c[k], f);
         }
         wasm_v128_store(fl, fade);
