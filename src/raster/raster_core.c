@@ -494,6 +494,10 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
         t->da1[k] = v[i1]->a[k] * iw[i1] - a0;
         t->da2[k] = v[i2]->a[k] * iw[i2] - a0;
     }
+#if defined(__wasm_simd128__)
+    _Static_assert(MAXA % 4 == 0, "the SIMD128 interpolation reads attributes four at a time");
+    for (int k = dc->attr_count; k < MAXA; ++k) t->a0[k] = t->da1[k] = t->da2[k] = 0.0f; /* defined lanes */
+#endif
     if (flat) memcpy(t->flat, flat, sizeof t->flat);
     t->minify = false;
     if (dc->tex) {
@@ -611,7 +615,11 @@ static FORCE_INLINE int mode_attr_count(frag_mode mode) {
 static inline float tex_period(float u, ak_raster_wrap w) {
     if (!ak_finitef(u)) return 0.0f;
     if (w == AK_RASTER_WRAP_CLAMP) return u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
-    float p = w == AK_RASTER_WRAP_MIRROR ? 2.0f : 1.0f;
+    if (w != AK_RASTER_WRAP_MIRROR) { /* REPEAT: the line below with p = 1 (u / 1 and 1 * x are exact) */
+        float f = u - floorf(u);
+        return f >= 0.0f && f < 1.0f ? f : 0.0f;
+    }
+    float p = 2.0f;
     float f = u - p * floorf(u / p);
     return f >= 0.0f && f < p ? f : 0.0f; /* rounding can give exactly p */
 }
@@ -883,7 +891,6 @@ static void ground_row_simd(const drawctx* dc, const rtri* t, int x0, int x1, in
             const v128_t g = wasm_f32x4_splat(gl[k]);
             c[k] = wasm_f32x4_add(g, wasm_f32x4_mul(wasm_f32x4_sub(wasm_f32x4_splat(ll[k]), g), lt));
         }
-        float fl[4], cl[3][4];
         if (dc->shadow) {
             const v128_t tv = wasm_f32x4_splat(texel);
             /* shadow_sample, lane by lane in the same order: the 4 taps' weights, a tap outside
@@ -920,22 +927,26 @@ static void ground_row_simd(const drawctx* dc, const rtri* t, int x0, int x1, in
             const v128_t f = wasm_f32x4_sub(one, sh);
             for (int k = 0; k < 3; ++k) c[k] = wasm_f32x4_mul(c[k], f);
         }
-        wasm_v128_store(fl, fade);
-        for (int k = 0; k < 3; ++k) wasm_v128_store(cl[k], c[k]);
+        /* over what is there (the background): clamp01(bg + (c - bg) * fade) through the sRGB
+         * table, as the scalar code does per channel */
+        uint8_t* dst = crow + (size_t)x * 4u;
+        int32_t idx[3][4];
+        for (int q = 0; q < 3; ++q) {
+            float bgs[4] = {0, 0, 0, 0};
+            for (int k = 0; k < n; ++k) bgs[k] = r->to_lin_lut[dst[4 * k + q]];
+            const v128_t bg = wasm_v128_load(bgs);
+            const v128_t m = v_clamp01(wasm_f32x4_add(bg, wasm_f32x4_mul(wasm_f32x4_sub(c[q], bg), fade)));
+            wasm_v128_store(idx[q], wasm_i32x4_trunc_sat_f32x4(wasm_f32x4_add(wasm_f32x4_mul(m, wasm_f32x4_splat(4096.0f)), half)));
+        }
         uint32_t am[4];
+        float zk[4];
         wasm_v128_store(am, alive);
+        wasm_v128_store(zk, z);
         for (int k = 0; k < n; ++k) {
             if (!am[k]) continue;
-            uint8_t* dst = crow + (size_t)(x + k) * 4u;
-            uint8_t out[4];
-            for (int q = 0; q < 3; ++q) {
-                float bg = r->to_lin_lut[dst[q]];
-                out[q] = (uint8_t)r->to_srgb_lut[(int)(clamp01(bg + (cl[q][k] - bg) * fl[k]) * 4096.0f + 0.5f)];
-            }
-            out[3] = 255;
-            float zk[4];
-            wasm_v128_store(zk, z);
-            write_px(dc, dst, &zrow[x + k], zk[k], out);
+            uint8_t out[4] = {(uint8_t)r->to_srgb_lut[idx[0][k]], (uint8_t)r->to_srgb_lut[idx[1][k]],
+                              (uint8_t)r->to_srgb_lut[idx[2][k]], 255};
+            write_px(dc, dst + 4 * k, &zrow[x + k], zk[k], out);
         }
     }
 }
@@ -981,6 +992,16 @@ static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, bool
             if (na) {
                 float iw = t->iw0 + l1 * t->diw1 + l2 * t->diw2;
                 float w = 1.0f / iw;
+#if defined(__wasm_simd128__)
+                if (na > 3) { /* four attributes at a time, each as the scalar line rounds it */
+                    const v128_t vl1 = wasm_f32x4_splat(l1), vl2 = wasm_f32x4_splat(l2), vw = wasm_f32x4_splat(w);
+                    for (int k = 0; k < na; k += 4) /* na <= MAXA = 12: lanes past na are unused */
+                        wasm_v128_store(&a[k], wasm_f32x4_mul(wasm_f32x4_add(wasm_f32x4_add(wasm_v128_load(&t->a0[k]),
+                                                                                            wasm_f32x4_mul(vl1, wasm_v128_load(&t->da1[k]))),
+                                                                             wasm_f32x4_mul(vl2, wasm_v128_load(&t->da2[k]))),
+                                                              vw));
+                } else
+#endif
                 for (int k = 0; k < na; ++k) a[k] = (t->a0[k] + l1 * t->da1[k] + l2 * t->da2[k]) * w;
             }
             uint8_t src[4];
