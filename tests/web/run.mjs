@@ -305,6 +305,16 @@ try {
                frame_mean_abs_diff: sum / n, frame_max_diff: maxd, frame_identical_pixels: same, frame_pixels: n / 3, frame_diff_box: bb, frame_diff_rows_by_40: bands,
                pixels_changed_by_texture: changedByTexture };
     }, glb, texPng, framePng);
+    // the same file dropped on the page (a real drop event carrying a File): textured too
+    tex.dropped = await page.evaluate(async (data) => {
+      const a = window.animkit;
+      a.open('builtin:cylinder');
+      const dt = new DataTransfer();
+      dt.items.add(new File([Uint8Array.from(atob(data), (c) => c.charCodeAt(0))], 'CesiumMan.glb'));
+      document.body.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, bubbles: true, cancelable: true }));
+      for (let k = 0; k < 200 && a.current !== 'file:'; k++) await new Promise((r) => setTimeout(r, 50));
+      return { current: a.current, served: a.imagesServed(), info: a.textureInfo(0) };
+    }, glb);
     results.cesiumman_texture = tex;
     await shot('07_cesiumman_textured.png');
     if (tex.error) {
@@ -316,6 +326,8 @@ try {
             tex.info.fnv1a === tex.native_texture.fnv1a,
             'CesiumMan: the texture\'s RGBA in the module is bit-identical to libjpeg\'s decode (native build)',
             `page ${JSON.stringify(tex.info)}, native ${JSON.stringify(tex.native_texture)}`);
+      check(tex.dropped.current === 'file:' && tex.dropped.served === 1 && tex.dropped.info && tex.dropped.info.fnv1a === tex.native_texture.fnv1a,
+            'CesiumMan dropped on the page opens textured, the same texture', JSON.stringify(tex.dropped));
       check(tex.head.differs_from_untextured > tex.head.pixels / 2 && tex.head.colours > 20,
             'CesiumMan\'s head is textured, not the flat untextured colour',
             `${tex.head.differs_from_untextured}/${tex.head.pixels} pixels of the box ${tex.head.box} (x, y, w, h) differ from the untextured frame, ${tex.head.colours} colours`);
