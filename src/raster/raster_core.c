@@ -1584,13 +1584,17 @@ static void box_blur(float* s, float* tmp, int radius) {
                 acc += (xa < SHADOW_RES ? s[y * SHADOW_RES + xa] : 0.0f) - (xr >= 0 ? s[y * SHADOW_RES + xr] : 0.0f);
             }
         }
-        for (int x = 0; x < SHADOW_RES; ++x) {
-            float acc = 0.0f;
-            for (int y = -radius; y <= radius; ++y) acc += (y >= 0 && y < SHADOW_RES) ? tmp[y * SHADOW_RES + x] : 0.0f;
-            for (int y = 0; y < SHADOW_RES; ++y) {
-                s[y * SHADOW_RES + x] = acc * inv;
-                int ya = y + radius + 1, yr = y - radius;
-                acc += (ya < SHADOW_RES ? tmp[ya * SHADOW_RES + x] : 0.0f) - (yr >= 0 ? tmp[yr * SHADOW_RES + x] : 0.0f);
+        /* vertical: every column's running sum at once, row by row (each column sees the same
+         * additions in the same order as a column-by-column pass; rows are contiguous) */
+        float acc[SHADOW_RES];
+        for (int x = 0; x < SHADOW_RES; ++x) acc[x] = 0.0f;
+        for (int y = -radius; y <= radius; ++y)
+            for (int x = 0; x < SHADOW_RES; ++x) acc[x] += (y >= 0 && y < SHADOW_RES) ? tmp[y * SHADOW_RES + x] : 0.0f;
+        for (int y = 0; y < SHADOW_RES; ++y) {
+            const int ya = y + radius + 1, yr = y - radius;
+            for (int x = 0; x < SHADOW_RES; ++x) {
+                s[y * SHADOW_RES + x] = acc[x] * inv;
+                acc[x] += (ya < SHADOW_RES ? tmp[ya * SHADOW_RES + x] : 0.0f) - (yr >= 0 ? tmp[yr * SHADOW_RES + x] : 0.0f);
             }
         }
     }
