@@ -1121,9 +1121,11 @@ AK_TEST(fill_rect_translucent_matches_closed_form) {
     }
     memcpy(a_px, orig, sizeof orig);
     memcpy(b_px, orig, sizeof orig);
-    ak_image a = {.pixels = a_px, .width = W, .height = H}, b = {.pixels = b_px, .width = W, .height = H};
-    const ak_vec4 col = ak_vec4_make(40.0f / 255.0f, 200.0f / 255.0f, 1.0f, 153.0f / 255.0f); /* alpha 0.6 */
-    const float x = 10.25f, y = 1.5f, w = 250.5f, h = 6.0f;               /* rows 1..7, columns 10..260 */
+    ak_image a = {.pixels = a_px, .width = W, .height = H},
+             b = {.pixels = b_px, .width = W, .height = H};
+    const ak_vec4 col =
+        ak_vec4_make(40.0f / 255.0f, 200.0f / 255.0f, 1.0f, 153.0f / 255.0f); /* alpha 0.6 */
+    const float x = 10.25f, y = 1.5f, w = 250.5f, h = 6.0f; /* rows 1..7, columns 10..260 */
     AK_CHECK_EQ(ak_image_fill_rect(&a, x, y, w, h, col), AK_OK);
     /* strips: [10.25, 60), [60, 110), ... [260, 260.75): the same coverage per pixel */
     AK_CHECK_EQ(ak_image_fill_rect(&b, x, y, 60.0f - x, h, col), AK_OK);
@@ -1149,7 +1151,8 @@ AK_TEST(fill_rect_translucent_matches_closed_form) {
                 if (a_px[i] != orig[i]) ++changed;
             }
         }
-    AK_CHECK_MSG(worst <= 1 && changed > 4000, "worst %d, %d channel values changed", worst, changed);
+    AK_CHECK_MSG(worst <= 1 && changed > 4000, "worst %d, %d channel values changed", worst,
+                 changed);
 }
 
 int main(void) {

@@ -639,7 +639,9 @@ AK_TEST(gltf_caller_image_decoder) {
         st.w = cases[k].w;
         st.h = cases[k].h;
         st.calls = st.seen_right_bytes = 0;
-        ak_io_desc d = {.logger = {.func = count_warning}, .image_decoder = hook_decoder, .image_decoder_user = &st,
+        ak_io_desc d = {.logger = {.func = count_warning},
+                        .image_decoder = hook_decoder,
+                        .image_decoder_user = &st,
                         .memory_budget = cases[k].budget};
         g_warnings = 0;
         g_last_warning[0] = 0;
@@ -647,25 +649,29 @@ AK_TEST(gltf_caller_image_decoder) {
         ak_diag diag;
         ak_result r = ak_io_load_memory(doc, strlen(doc), "tri.gltf", NULL, &d, NULL, &s, &diag);
         AK_CHECK_MSG(r == AK_OK, "case %zu: %s (%s)", k, ak_result_string(r), diag.message);
-        AK_CHECK_MSG(st.calls == 1 && st.seen_right_bytes == 1, "case %zu: %d calls, %d with the PNG's bytes", k,
-                     st.calls, st.seen_right_bytes);
+        AK_CHECK_MSG(st.calls == 1 && st.seen_right_bytes == 1,
+                     "case %zu: %d calls, %d with the PNG's bytes", k, st.calls,
+                     st.seen_right_bytes);
         if (!s) continue;
         const ak_scene_texture* t = &s->textures[0];
         if (cases[k].expect == 0) {
             AK_CHECK(t->width == 5 && t->height == 4 && t->pixels && t->pixels != st.px);
             uint8_t ref[sizeof st.px];
             memcpy(ref, st.px, sizeof ref);
-            memset(st.px, 0, sizeof st.px); /* the decoder's buffer changes: the texture is a copy */
+            memset(st.px, 0,
+                   sizeof st.px); /* the decoder's buffer changes: the texture is a copy */
             AK_CHECK(t->pixels && memcmp(t->pixels, ref, sizeof ref) == 0);
             memcpy(st.px, ref, sizeof ref);
             AK_CHECK_EQ(g_warnings, 0);
         } else if (cases[k].expect == 1) {
-            AK_CHECK(t->width == 3 && t->height == 2 && t->pixels && memcmp(t->pixels, png_px, sizeof png_px) == 0);
+            AK_CHECK(t->width == 3 && t->height == 2 && t->pixels &&
+                     memcmp(t->pixels, png_px, sizeof png_px) == 0);
             AK_CHECK_EQ(g_warnings, 0);
         } else {
             AK_CHECK_MSG(t->pixels == NULL && s->meshes[0].texture == -1 && g_warnings == 1 &&
                              strstr(g_last_warning, cases[k].warning),
-                         "case %zu: pixels %p, %d warnings '%s'", k, (void*)t->pixels, g_warnings, g_last_warning);
+                         "case %zu: pixels %p, %d warnings '%s'", k, (void*)t->pixels, g_warnings,
+                         g_last_warning);
         }
         ak_scene_destroy(s);
     }

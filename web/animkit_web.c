@@ -102,12 +102,14 @@ AKW_EXPORT(akw_images_clear) void akw_images_clear(void) {
  * decoder (ak_io_desc.image_decoder) serves each image whose bytes equal an encoded[] given
  * here, so the library samples these pixels exactly as it samples libpng's and libjpeg's in
  * the native build. Returns 0, or 1 with akw_error() set. */
-AKW_EXPORT(akw_image_add) int akw_image_add(const uint8_t* encoded, size_t encoded_size, const uint8_t* rgba, int width,
-                                            int height) {
+AKW_EXPORT(akw_image_add)
+int akw_image_add(const uint8_t* encoded, size_t encoded_size, const uint8_t* rgba, int width,
+                  int height) {
     if (!encoded || !rgba || encoded_size == 0) return fail("no image");
     if (g.image_count >= AKW_MAX_IMAGES) return fail("more than %d texture images", AKW_MAX_IMAGES);
     if (width <= 0 || height <= 0 || width > AKW_MAX_IMAGE_SIDE || height > AKW_MAX_IMAGE_SIDE)
-        return fail("texture image of %d x %d pixels (1..%d per side)", width, height, AKW_MAX_IMAGE_SIDE);
+        return fail("texture image of %d x %d pixels (1..%d per side)", width, height,
+                    AKW_MAX_IMAGE_SIDE);
     if (encoded_size > AKW_MAX_FILE_SIZE) return fail("texture image of %zu bytes", encoded_size);
     size_t px = (size_t)width * (size_t)height * 4u; /* <= 2^28 */
     struct akw_image im = {malloc(encoded_size), encoded_size, malloc(px), width, height};
@@ -148,7 +150,8 @@ AKW_EXPORT(akw_images_served) int akw_images_served(void) { return g.images_serv
  * tests compare the hash with the native build's decode). */
 AKW_EXPORT(akw_texture_info) const double* akw_texture_info(int t) {
     static double out[3];
-    if (!g.open || t < 0 || (size_t)t >= g.scene->texture_count || !g.scene->textures[t].pixels) return NULL;
+    if (!g.open || t < 0 || (size_t)t >= g.scene->texture_count || !g.scene->textures[t].pixels)
+        return NULL;
     const ak_scene_texture* st = &g.scene->textures[t];
     uint32_t h = 2166136261u;
     size_t n = (size_t)st->width * (size_t)st->height * 4u;
@@ -202,7 +205,8 @@ AKW_EXPORT(akw_open) int akw_open(const char* what, int width, int height) {
         memset(&diag, 0, sizeof diag);
         ak_io_desc desc = {.image_decoder = serve_image};
         g.images_served = 0;
-        ak_result r = ak_io_load_memory(g.file, g.file_size, g.file_name, NULL, &desc, NULL, &g.scene, &diag);
+        ak_result r =
+            ak_io_load_memory(g.file, g.file_size, g.file_name, NULL, &desc, NULL, &g.scene, &diag);
         if (r != AK_OK)
             return fail("%s: %s", g.file_name, diag.message[0] ? diag.message : ak_result_string(r));
     } else if (strncmp(what, "builtin:", 8) == 0) {

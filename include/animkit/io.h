@@ -122,7 +122,8 @@ typedef struct ak_io_image_view {
  * loading thread, at most once per texture image, with user as given in ak_io_desc. Used where
  * the library has no decoder but the host has one: the WebAssembly page (docs/web.md) hands
  * over what the browser decoded. */
-typedef ak_result (*ak_io_image_decoder)(void* user, const void* data, size_t size, ak_io_image_view* out);
+typedef ak_result (*ak_io_image_decoder)(void* user, const void* data, size_t size,
+                                         ak_io_image_view* out);
 
 /* Which reader handles a file. */
 typedef enum ak_io_format {
@@ -166,7 +167,7 @@ typedef struct ak_io_desc {
                                 opened, a warning) */
     ak_io_image_decoder image_decoder; /* glTF and OBJ texture images go to it first (see
                                 ak_io_image_decoder); NULL (default) -> the built-in decoder */
-    void* image_decoder_user; /* passed to image_decoder */
+    void* image_decoder_user;          /* passed to image_decoder */
 } ak_io_desc;
 
 /* The desc with its zero fields replaced by their defaults (NULL -> all defaults).

@@ -193,13 +193,15 @@ ak_result ak_image_fill_rect(const ak_image* image, float x, float y, float w, f
             float cx = clamp01(ak_minf((float)px + 1.0f, x1) - ak_maxf((float)px, x));
             float cov = cx * cy;
             float a = cov * (float)c[3] * (1.0f / 255.0f);
-            if (!(a > 0.0f && a < 1.0f) || cx != 1.0f || ix1 - ix0 < 64) { /* edges, small or opaque */
+            if (!(a > 0.0f && a < 1.0f) || cx != 1.0f ||
+                ix1 - ix0 < 64) { /* edges, small or opaque */
                 blend(ak_image_pixel(image, px, py), c, cov);
                 continue;
             }
             if (cov != lut_cov) {
                 for (int v = 0; v < 256; ++v) {
-                    for (int k = 0; k < 3; ++k) lut[k][v] = (uint8_t)((float)v + ((float)c[k] - (float)v) * a + 0.5f);
+                    for (int k = 0; k < 3; ++k)
+                        lut[k][v] = (uint8_t)((float)v + ((float)c[k] - (float)v) * a + 0.5f);
                     lut[3][v] = (uint8_t)((float)v + (255.0f - (float)v) * a + 0.5f);
                 }
                 lut_cov = cov;
