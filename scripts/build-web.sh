@@ -50,12 +50,15 @@ compile() { # src -> obj (named after the path, so src/io.c and src/io/io.c stay
 export -f compile
 printf '%s\n' "${LIB[@]}" "${TOOLS[@]}" "${WEB[@]}" | xargs -P "${JOBS:-2}" -n 1 bash -c 'compile "$1"' _
 
+# AK_WEB_STRIP=0 keeps the function names (for profiling: tests/web/profile.mjs)
+STRIP=-Wl,--strip-all
+[[ ${AK_WEB_STRIP:-1} == 0 ]] && STRIP=""
 OBJS=()
 for s in "${LIB[@]}" "${TOOLS[@]}" "${WEB[@]}"; do OBJS+=("$OUT/obj/$(echo "$s" | tr / _ | sed 's/\.c$/.o/')"); done
 # A reactor module (no main): the page calls the exports of web/animkit_web.c. 4 MiB of stack
 # for the recursive-descent parsers' bounded depth; memory grows on demand.
 "$CC" --target=wasm32-wasi -mexec-model=reactor -O2 "${OBJS[@]}" -o "$OUT/animkit.wasm" \
-  -Wl,--strip-all -Wl,-z,stack-size=4194304 -Wl,--export=malloc -Wl,--export=free -lwasi-emulated-getpid -lm
+  $STRIP -Wl,-z,stack-size=4194304 -Wl,--export=malloc -Wl,--export=free -lwasi-emulated-getpid -lm
 cp web/index.html web/animkit.js "$OUT/"
 # The one bundled asset: a small rigged glTF (RiggedFigure.glb, 50 KB, CC-BY-4.0 (c) 2017 Cesium,
 # from ../shared/assets when present), as a script so the page needs no fetch for it.

@@ -267,6 +267,52 @@ bool akp_budget_take(akp_budget* b, size_t a, size_t n) {
     return true;
 }
 
+ak_result akp_io_image_decode(const ak_io_desc* desc, const uint8_t* data, size_t size,
+                              akp_budget* budget, const ak_allocator* alloc, uint8_t** out_pixels,
+                              int* out_width, int* out_height, char* msg, size_t msg_size) {
+    *out_pixels = NULL;
+    *out_width = *out_height = 0;
+    msg[0] = 0;
+    if (desc && desc->image_decoder) {
+        ak_io_image_view v = {NULL, 0, 0};
+        ak_result r = desc->image_decoder(desc->image_decoder_user, data, size, &v);
+        if (r == AK_OK) {
+            if (!v.pixels || v.width <= 0 || v.height <= 0 || v.width > AKP_IO_MAX_IMAGE_SIDE ||
+                v.height > AKP_IO_MAX_IMAGE_SIDE) {
+                snprintf(msg, msg_size,
+                         "the caller's image decoder gave %d x %d pixels%s (1..%d per side)",
+                         v.width, v.height, v.pixels ? "" : " at NULL", AKP_IO_MAX_IMAGE_SIDE);
+                return AK_ERR_BAD_DATA;
+            }
+            size_t bytes =
+                (size_t)v.width * (size_t)v.height * 4u; /* <= 2^30: fits 32-bit size_t */
+            if (budget && !akp_budget_take(budget, bytes, 1)) {
+                snprintf(msg, msg_size,
+                         "image of %d x %d pixels would exceed the memory budget of %zu bytes",
+                         v.width, v.height, budget->limit);
+                return AK_ERR_UNSUPPORTED;
+            }
+            uint8_t* px = (uint8_t*)akp_alloc(alloc, bytes);
+            if (!px) {
+                snprintf(msg, msg_size, "out of memory");
+                return AK_ERR_NO_MEMORY;
+            }
+            memcpy(px, v.pixels, bytes);
+            *out_pixels = px;
+            *out_width = v.width;
+            *out_height = v.height;
+            return AK_OK;
+        }
+        if (r != AK_ERR_UNSUPPORTED) {
+            snprintf(msg, msg_size, "the caller's image decoder refused it (%s)",
+                     ak_result_string(r));
+            return r == AK_ERR_NO_MEMORY ? r : AK_ERR_PARSE;
+        }
+    }
+    return akp_image_decode(data, size, budget, alloc, out_pixels, out_width, out_height, msg,
+                            msg_size);
+}
+
 ak_result akp_io_read_file(const char* path, const ak_allocator* alloc, size_t want, akp_budget* budget,
                            uint8_t** out_data, size_t* out_size, ak_diag* diag) {
     *out_data = NULL;

@@ -1107,7 +1107,56 @@ AK_TEST(sprite_sheet_frame_and_textures) {
     target_free(&t);
 }
 
+/* A wide translucent rectangle (the viewer's HUD bars): every pixel against the blend's closed
+ * form p + (c - p) * a (a = coverage x alpha; within 1 of it: float rounding), and bit for bit
+ * against the same rectangle drawn as strips narrower than 64 pixels, which take the per-pixel
+ * path (the wide one is served from per-byte tables, src/raster/raster_image.c). */
+AK_TEST(fill_rect_translucent_matches_closed_form) {
+    enum { W = 300, H = 9 };
+    static uint8_t a_px[W * H * 4], b_px[W * H * 4], orig[W * H * 4];
+    uint32_t seed = 12345u;
+    for (size_t i = 0; i < sizeof orig; ++i) {
+        seed = seed * 1664525u + 1013904223u;
+        orig[i] = (uint8_t)(seed >> 24);
+    }
+    memcpy(a_px, orig, sizeof orig);
+    memcpy(b_px, orig, sizeof orig);
+    ak_image a = {.pixels = a_px, .width = W, .height = H},
+             b = {.pixels = b_px, .width = W, .height = H};
+    const ak_vec4 col =
+        ak_vec4_make(40.0f / 255.0f, 200.0f / 255.0f, 1.0f, 153.0f / 255.0f); /* alpha 0.6 */
+    const float x = 10.25f, y = 1.5f, w = 250.5f, h = 6.0f; /* rows 1..7, columns 10..260 */
+    AK_CHECK_EQ(ak_image_fill_rect(&a, x, y, w, h, col), AK_OK);
+    /* strips: [10.25, 60), [60, 110), ... [260, 260.75): the same coverage per pixel */
+    AK_CHECK_EQ(ak_image_fill_rect(&b, x, y, 60.0f - x, h, col), AK_OK);
+    for (float sx = 60.0f; sx < x + w; sx += 50.0f) {
+        float ex = sx + 50.0f < x + w ? sx + 50.0f : x + w;
+        AK_CHECK_EQ(ak_image_fill_rect(&b, sx, y, ex - sx, h, col), AK_OK);
+    }
+    AK_CHECK(memcmp(a_px, b_px, sizeof a_px) == 0);
+    const double c[4] = {40, 200, 255, 255};
+    int worst = 0, changed = 0;
+    for (int py = 0; py < H; ++py)
+        for (int px = 0; px < W; ++px) {
+            double cx = fmin(px + 1.0, (double)x + w) - fmax((double)px, (double)x);
+            double cy = fmin(py + 1.0, (double)y + h) - fmax((double)py, (double)y);
+            cx = cx < 0 ? 0 : cx > 1 ? 1 : cx;
+            cy = cy < 0 ? 0 : cy > 1 ? 1 : cy;
+            double al = cx * cy * 153.0 / 255.0;
+            for (int k = 0; k < 4; ++k) {
+                size_t i = ((size_t)py * W + (size_t)px) * 4u + (size_t)k;
+                double want = al > 0 ? orig[i] + (c[k] - orig[i]) * al : orig[i];
+                int d = abs((int)a_px[i] - (int)floor(want + 0.5));
+                if (d > worst) worst = d;
+                if (a_px[i] != orig[i]) ++changed;
+            }
+        }
+    AK_CHECK_MSG(worst <= 1 && changed > 4000, "worst %d, %d channel values changed", worst,
+                 changed);
+}
+
 int main(void) {
+    AK_RUN(fill_rect_translucent_matches_closed_form);
     AK_RUN(coverage_matches_point_in_triangle);
     AK_RUN(shared_edges_quad_and_fan_cover_once);
     AK_RUN(depth_test_orders_by_distance);

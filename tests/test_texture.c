@@ -584,6 +584,104 @@ AK_TEST(gltf_texture_and_sampler) {
     free(png);
 }
 
+/* ak_io_desc.image_decoder (the browser's decoder in the WebAssembly page): the decoder sees the
+ * image's encoded bytes; its pixels become the texture (copied: the decoder's buffer is changed
+ * after the load and the texture must not follow); AK_ERR_UNSUPPORTED falls back to libpng; a
+ * refusal or an absurd size is a warning and no texture; an image over the memory budget too. */
+typedef struct hook_state {
+    const uint8_t* want; /* the encoded bytes the decoder must be handed */
+    size_t want_size;
+    uint8_t px[5 * 4 * 4];
+    const uint8_t* big; /* w * h * 4 bytes when w * h > 20 */
+    int w, h, calls, seen_right_bytes;
+    ak_result answer;
+} hook_state;
+static ak_result hook_decoder(void* user, const void* data, size_t size, ak_io_image_view* out) {
+    hook_state* st = (hook_state*)user;
+    ++st->calls;
+    if (size == st->want_size && memcmp(data, st->want, size) == 0) ++st->seen_right_bytes;
+    if (st->answer != AK_OK) return st->answer;
+    out->pixels = st->w * st->h > 20 ? st->big : st->px;
+    out->width = st->w;
+    out->height = st->h;
+    return AK_OK;
+}
+
+AK_TEST(gltf_caller_image_decoder) {
+    uint8_t png_px[3 * 2 * 4];
+    for (size_t i = 0; i < sizeof png_px; ++i) png_px[i] = (uint8_t)(i * 9 + 3);
+    size_t n = 0;
+    uint8_t* png = png_encode(png_px, 3, 2, PNG_FORMAT_RGBA, &n);
+    char* pb = b64(png, n);
+    char* image = malloc(strlen(pb) + 64);
+    sprintf(image, "{\"uri\":\"data:image/png;base64,%s\"}", pb);
+    char* doc = gltf_triangle(image, "");
+    hook_state st = {.want = png, .want_size = n, .w = 5, .h = 4, .answer = AK_OK};
+    for (size_t i = 0; i < sizeof st.px; ++i) st.px[i] = (uint8_t)(250 - i);
+    struct {
+        ak_result answer;
+        int w, h;
+        size_t budget;
+        int expect; /* 0: the decoder's pixels, 1: libpng's, 2: none and one warning */
+        const char* warning;
+    } cases[] = {
+        {AK_OK, 5, 4, 0, 0, ""},
+        {AK_ERR_UNSUPPORTED, 5, 4, 0, 1, ""},
+        {AK_ERR_PARSE, 5, 4, 0, 2, "decoder refused it"},
+        {AK_OK, 0, 4, 0, 2, "decoder gave 0 x 4"},
+        {AK_OK, 5, 16385, 0, 2, "decoder gave 5 x 16385"},
+        {AK_OK, 200, 200, 100000, 2, "memory budget"},
+    };
+    uint8_t* big = calloc(200 * 200, 4); /* 160 kB: over a budget of 100 kB, which the file fits */
+    st.big = big;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        st.answer = cases[k].answer;
+        st.w = cases[k].w;
+        st.h = cases[k].h;
+        st.calls = st.seen_right_bytes = 0;
+        ak_io_desc d = {.logger = {.func = count_warning},
+                        .image_decoder = hook_decoder,
+                        .image_decoder_user = &st,
+                        .memory_budget = cases[k].budget};
+        g_warnings = 0;
+        g_last_warning[0] = 0;
+        ak_scene* s = NULL;
+        ak_diag diag;
+        ak_result r = ak_io_load_memory(doc, strlen(doc), "tri.gltf", NULL, &d, NULL, &s, &diag);
+        AK_CHECK_MSG(r == AK_OK, "case %zu: %s (%s)", k, ak_result_string(r), diag.message);
+        AK_CHECK_MSG(st.calls == 1 && st.seen_right_bytes == 1,
+                     "case %zu: %d calls, %d with the PNG's bytes", k, st.calls,
+                     st.seen_right_bytes);
+        if (!s) continue;
+        const ak_scene_texture* t = &s->textures[0];
+        if (cases[k].expect == 0) {
+            AK_CHECK(t->width == 5 && t->height == 4 && t->pixels && t->pixels != st.px);
+            uint8_t ref[sizeof st.px];
+            memcpy(ref, st.px, sizeof ref);
+            memset(st.px, 0,
+                   sizeof st.px); /* the decoder's buffer changes: the texture is a copy */
+            AK_CHECK(t->pixels && memcmp(t->pixels, ref, sizeof ref) == 0);
+            memcpy(st.px, ref, sizeof ref);
+            AK_CHECK_EQ(g_warnings, 0);
+        } else if (cases[k].expect == 1) {
+            AK_CHECK(t->width == 3 && t->height == 2 && t->pixels &&
+                     memcmp(t->pixels, png_px, sizeof png_px) == 0);
+            AK_CHECK_EQ(g_warnings, 0);
+        } else {
+            AK_CHECK_MSG(t->pixels == NULL && s->meshes[0].texture == -1 && g_warnings == 1 &&
+                             strstr(g_last_warning, cases[k].warning),
+                         "case %zu: pixels %p, %d warnings '%s'", k, (void*)t->pixels, g_warnings,
+                         g_last_warning);
+        }
+        ak_scene_destroy(s);
+    }
+    free(big);
+    free(doc);
+    free(image);
+    free(pb);
+    free(png);
+}
+
 /* A texture that cannot be read is a warning and no texture; the model still loads. */
 AK_TEST(gltf_broken_texture_warns) {
     const char* images[] = {
@@ -847,6 +945,7 @@ int main(void) {
     AK_RUN(raster_wrap_modes);
     AK_RUN(raster_lit_texture_scales_albedo);
     AK_RUN(gltf_texture_and_sampler);
+    AK_RUN(gltf_caller_image_decoder);
     AK_RUN(gltf_broken_texture_warns);
     AK_RUN(gltf_assets_textured);
     AK_RUN(cli_export_keeps_texture);

@@ -78,6 +78,76 @@
   }
   function floats(p, n) { return p ? Array.from(new Float32Array(wasm.memory.buffer, p, n)) : null; }
 
+  // ---- texture images: the browser decodes them, the library samples them ----
+  // The encoded images of a glTF file (.glb, or .gltf with data: URIs): [{ bytes, mime }] for
+  // every images[i] held in a bufferView or a data: URI. Anything malformed gives no image (the
+  // library's glTF reader then reports the file's problem itself).
+  function gltfEncodedImages(bytes) {
+    try {
+      const dv = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+      let json, bin = null;
+      if (bytes.length >= 20 && dv.getUint32(0, true) === 0x46546c67) { // "glTF": GLB
+        const total = Math.min(dv.getUint32(8, true), bytes.length);
+        for (let off = 12; off + 8 <= total;) {
+          const len = dv.getUint32(off, true), type = dv.getUint32(off + 4, true);
+          if (off + 8 + len > total) break;
+          const chunk = bytes.subarray(off + 8, off + 8 + len);
+          if (type === 0x4e4f534a && !json) json = JSON.parse(dec.decode(chunk));
+          else if (type === 0x004e4942 && !bin) bin = chunk;
+          off += 8 + ((len + 3) & ~3);
+        }
+      } else {
+        json = JSON.parse(dec.decode(bytes));
+      }
+      if (!json || !Array.isArray(json.images)) return [];
+      const dataUri = (uri) => {
+        const m = /^data:([^;,]*)(;base64)?,(.*)$/s.exec(uri || '');
+        if (!m || !m[2]) return null;
+        return { mime: m[1], bytes: Uint8Array.from(atob(m[3]), (c) => c.charCodeAt(0)) };
+      };
+      const buffers = (json.buffers || []).map((b, i) => (b && b.uri ? (dataUri(b.uri) || {}).bytes : i === 0 ? bin : null));
+      const out = [];
+      for (const im of json.images) {
+        if (!im) continue;
+        if (typeof im.uri === 'string') {
+          const d = dataUri(im.uri);
+          if (d) out.push({ bytes: d.bytes, mime: im.mimeType || d.mime });
+        } else if (Number.isInteger(im.bufferView)) {
+          const bv = (json.bufferViews || [])[im.bufferView], buf = bv && buffers[bv.buffer];
+          const o = (bv && bv.byteOffset) || 0, n = bv && bv.byteLength;
+          if (buf && Number.isInteger(n) && o + n <= buf.length) out.push({ bytes: buf.subarray(o, o + n), mime: im.mimeType });
+        }
+      }
+      return out;
+    } catch (e) {
+      return [];
+    }
+  }
+  // Decode them to RGBA8 with the browser's decoders (PNG, JPEG): createImageBitmap with no
+  // colour-space conversion and no premultiplication, drawn onto an OffscreenCanvas and read
+  // back. (The 2D canvas keeps premultiplied pixels, so a PNG's partly transparent texels can
+  // come back a unit off; opaque ones, and every JPEG, come back as decoded.) An image the
+  // browser cannot decode is left out: the library then warns and draws its meshes untextured.
+  async function decodeImages(bytes) {
+    const out = [];
+    for (const im of gltfEncodedImages(bytes)) {
+      const sig = im.bytes;
+      const mime = sig[0] === 0x89 && sig[1] === 0x50 ? 'image/png' : sig[0] === 0xff && sig[1] === 0xd8 ? 'image/jpeg' : null;
+      if (!mime) continue;
+      try {
+        const bmp = await createImageBitmap(new Blob([im.bytes], { type: mime }), { premultiplyAlpha: 'none', colorSpaceConversion: 'none' });
+        const c = new OffscreenCanvas(bmp.width, bmp.height).getContext('2d', { willReadFrequently: true });
+        c.drawImage(bmp, 0, 0);
+        const rgba = new Uint8Array(c.getImageData(0, 0, bmp.width, bmp.height).data.buffer);
+        out.push({ encoded: im.bytes, rgba, width: bmp.width, height: bmp.height });
+        bmp.close();
+      } catch (e) {
+        console.warn('animkit: a texture image could not be decoded: ' + e.message);
+      }
+    }
+    return out;
+  }
+
   // ---- the page ----
   let canvas = null, ctx = null, running = true, last = 0;
   const frameMs = []; // wall time of akw_frame + putImageData, the last 240 frames
@@ -99,14 +169,32 @@
       api.onMessage('', false);
       return true;
     },
-    openBytes(name, bytes) {
+    // a file's bytes (a .glb/.gltf/.bvh): its texture images decoded by the browser first
+    // (decodeImages), then handed to the module with the file; resolves to open()'s result
+    // (options.textures false: without them, as a build with no decoder draws it)
+    async openBytes(name, bytes, options = {}) {
+      const images = options.textures === false ? [] : await decodeImages(bytes);
       const p = wasm.akw_alloc(bytes.length);
       u8().set(bytes, p);
       const rc = withString(name, (n) => wasm.akw_file_set(p, bytes.length, n));
       wasm.akw_free(p);
       if (rc !== 0) { api.onMessage(api.error(), true); return false; }
+      for (const im of images) {
+        const pe = wasm.akw_alloc(im.encoded.length), pr = wasm.akw_alloc(im.rgba.length);
+        u8().set(im.encoded, pe);
+        u8().set(im.rgba, pr);
+        const r = wasm.akw_image_add(pe, im.encoded.length, pr, im.width, im.height);
+        wasm.akw_free(pe);
+        wasm.akw_free(pr);
+        if (r !== 0) console.warn('animkit: ' + api.error());
+      }
+      api.imagesGiven = images.length;
       return api.open('file:');
     },
+    imagesGiven: 0,
+    imagesServed() { return wasm.akw_images_served(); },
+    // texture t of the open scene: { width, height, fnv1a } of its RGBA8 pixels, or null
+    textureInfo(t) { const p = wasm.akw_texture_info(t); return p ? (([w, h, f]) => ({ width: w, height: h, fnv1a: f }))(Array.from(new Float64Array(wasm.memory.buffer, p, 3))) : null; },
     // one frame: advance dt seconds, draw, show (present false: draw only, for timing the
     // module alone); returns the milliseconds it took
     frame(dt, present = true) {

@@ -27,6 +27,10 @@
 
 /* Largest file the page accepts from a drop: glTF/BVH files of a course fit many times over. */
 #define AKW_MAX_FILE_SIZE (64u << 20)
+/* Most decoded images the page hands over for one file, and their largest side (the library's
+ * own limit, AKP_IO_MAX_IMAGE_SIDE, is 16384; a course's textures are 4096 at most). */
+#define AKW_MAX_IMAGES 64
+#define AKW_MAX_IMAGE_SIDE 8192
 
 static struct {
     bool open;
@@ -41,6 +45,16 @@ static struct {
     ak_cloth_scene cloth_scene;
     ak_cloth_scene_run cloth_run;
     bool cloth_loaded;
+    /* images the browser decoded for the dropped file (akw_image_add), served to the glTF
+     * reader through ak_io_desc.image_decoder: the encoded bytes (the key) and RGBA8 pixels */
+    struct akw_image {
+        uint8_t* encoded;
+        size_t encoded_size;
+        uint8_t* rgba;
+        int width, height;
+    } images[AKW_MAX_IMAGES];
+    int image_count;
+    int images_served; /* how many the last load took from the table */
 } g;
 
 static int fail(const char* fmt, ...) {
@@ -69,13 +83,94 @@ static void close_view(void) {
     g.open = false;
 }
 
-/* Keep the bytes of a dropped file (copied) under name, for akw_open("file:NAME"). */
+/* ---- texture images, decoded by the browser ---- */
+
+/* Forget the decoded images (akw_image_add). */
+AKW_EXPORT(akw_images_clear) void akw_images_clear(void) {
+    for (int i = 0; i < g.image_count; ++i) {
+        free(g.images[i].encoded);
+        free(g.images[i].rgba);
+    }
+    memset(g.images, 0, sizeof g.images);
+    g.image_count = 0;
+}
+
+/* Hand over one texture image of the file akw_file_set holds, as the browser decoded it:
+ * encoded[encoded_size] is the image as the file stores it (a glTF image's bufferView or data:
+ * URI bytes: PNG or JPEG), rgba its width x height RGBA8 pixels (straight alpha, rows top to
+ * bottom). Both are copied. When akw_open("file:") loads the file, the glTF reader's image
+ * decoder (ak_io_desc.image_decoder) serves each image whose bytes equal an encoded[] given
+ * here, so the library samples these pixels exactly as it samples libpng's and libjpeg's in
+ * the native build. Returns 0, or 1 with akw_error() set. */
+AKW_EXPORT(akw_image_add)
+int akw_image_add(const uint8_t* encoded, size_t encoded_size, const uint8_t* rgba, int width,
+                  int height) {
+    if (!encoded || !rgba || encoded_size == 0) return fail("no image");
+    if (g.image_count >= AKW_MAX_IMAGES) return fail("more than %d texture images", AKW_MAX_IMAGES);
+    if (width <= 0 || height <= 0 || width > AKW_MAX_IMAGE_SIDE || height > AKW_MAX_IMAGE_SIDE)
+        return fail("texture image of %d x %d pixels (1..%d per side)", width, height,
+                    AKW_MAX_IMAGE_SIDE);
+    if (encoded_size > AKW_MAX_FILE_SIZE) return fail("texture image of %zu bytes", encoded_size);
+    size_t px = (size_t)width * (size_t)height * 4u; /* <= 2^28 */
+    struct akw_image im = {malloc(encoded_size), encoded_size, malloc(px), width, height};
+    if (!im.encoded || !im.rgba) {
+        free(im.encoded);
+        free(im.rgba);
+        return fail("texture image of %d x %d pixels: out of memory", width, height);
+    }
+    memcpy(im.encoded, encoded, encoded_size);
+    memcpy(im.rgba, rgba, px);
+    g.images[g.image_count++] = im;
+    return 0;
+}
+
+/* ak_io_image_decoder over the table: the image whose encoded bytes are data[size]; others
+ * (none handed over) go to the library's decoder, which in this build has none: a warning,
+ * drawn untextured. */
+static ak_result serve_image(void* user, const void* data, size_t size, ak_io_image_view* out) {
+    (void)user;
+    for (int i = 0; i < g.image_count; ++i) {
+        const struct akw_image* im = &g.images[i];
+        if (im->encoded_size == size && memcmp(im->encoded, data, size) == 0) {
+            out->pixels = im->rgba;
+            out->width = im->width;
+            out->height = im->height;
+            ++g.images_served;
+            return AK_OK;
+        }
+    }
+    return AK_ERR_UNSUPPORTED;
+}
+
+/* How many texture images the last akw_open("file:") took from akw_image_add's table. */
+AKW_EXPORT(akw_images_served) int akw_images_served(void) { return g.images_served; }
+
+/* Texture t of the open scene: its width, height and the FNV-1a 32-bit hash of its RGBA8 pixels
+ * (rows top to bottom) in out[0..2]; returns out, or NULL when there is no such texture (the
+ * tests compare the hash with the native build's decode). */
+AKW_EXPORT(akw_texture_info) const double* akw_texture_info(int t) {
+    static double out[3];
+    if (!g.open || t < 0 || (size_t)t >= g.scene->texture_count || !g.scene->textures[t].pixels)
+        return NULL;
+    const ak_scene_texture* st = &g.scene->textures[t];
+    uint32_t h = 2166136261u;
+    size_t n = (size_t)st->width * (size_t)st->height * 4u;
+    for (size_t i = 0; i < n; ++i) h = (h ^ st->pixels[i]) * 16777619u;
+    out[0] = st->width;
+    out[1] = st->height;
+    out[2] = h;
+    return out;
+}
+
+/* Keep the bytes of a dropped file (copied) under name, for akw_open("file:NAME"). The texture
+ * images handed over for the previous file are forgotten (akw_image_add after this call). */
 AKW_EXPORT(akw_file_set) int akw_file_set(const uint8_t* bytes, size_t size, const char* name) {
     if (!bytes || !name) return fail("no file");
     if (size > AKW_MAX_FILE_SIZE) return fail("%s: %zu bytes, larger than the page's %u MiB", name, size, AKW_MAX_FILE_SIZE >> 20);
     uint8_t* copy = malloc(size ? size : 1);
     if (!copy) return fail("%s: out of memory", name);
     memcpy(copy, bytes, size);
+    akw_images_clear();
     free(g.file);
     g.file = copy;
     g.file_size = size;
@@ -108,7 +203,10 @@ AKW_EXPORT(akw_open) int akw_open(const char* what, int width, int height) {
         if (!g.file) return fail("no file was dropped");
         ak_diag diag;
         memset(&diag, 0, sizeof diag);
-        ak_result r = ak_io_load_memory(g.file, g.file_size, g.file_name, NULL, NULL, NULL, &g.scene, &diag);
+        ak_io_desc desc = {.image_decoder = serve_image};
+        g.images_served = 0;
+        ak_result r =
+            ak_io_load_memory(g.file, g.file_size, g.file_name, NULL, &desc, NULL, &g.scene, &diag);
         if (r != AK_OK)
             return fail("%s: %s", g.file_name, diag.message[0] ? diag.message : ak_result_string(r));
     } else if (strncmp(what, "builtin:", 8) == 0) {

@@ -3,9 +3,11 @@
  * src/io/image.c (libpng, libjpeg), src/io/assimp.c (Assimp) and src/skin/weights_heat.c
  * (CHOLMOD). scripts/build-web.sh compiles this file instead of those four. Each function
  * keeps its native contract and fails the way the native build fails when the format is
- * missing: ak_image_format_available says false, PNG/GIF files are AK_ERR_UNSUPPORTED, a
- * glTF texture is a warning and the mesh is drawn untextured (as a JPEG is without libjpeg),
- * FBX/Collada/OBJ-through-Assimp and bone heat weights are AK_ERR_UNSUPPORTED. The page never
+ * missing: ak_image_format_available says false, PNG/GIF files are AK_ERR_UNSUPPORTED, the
+ * built-in image decoder knows no format (the page's textures come from the browser through
+ * ak_io_desc.image_decoder, web/animkit_web.c; an image it did not decode is a warning and the
+ * mesh is drawn untextured, as a JPEG is without libjpeg), FBX/Collada/OBJ-through-Assimp and
+ * bone heat weights are AK_ERR_UNSUPPORTED. The page never
  * writes files: frames go to the canvas. */
 #include <stdio.h>
 #include <string.h>

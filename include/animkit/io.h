@@ -106,6 +106,25 @@ extern "C" {
 /* Deepest element/brace nesting the pre-check lets through to Assimp (Collada, ASCII FBX). */
 #define AK_IO_ASSIMP_MAX_DEPTH 1024u
 
+/* An image decoded by a caller-supplied decoder (ak_io_desc.image_decoder): RGBA8, sRGB colour as
+ * stored, straight (not premultiplied) alpha, rows top to bottom, width * 4 bytes per row. The
+ * pixels stay the decoder's: the loader copies them (after charging width * height * 4 bytes to
+ * the load's memory budget) before it calls the decoder again or returns. */
+typedef struct ak_io_image_view {
+    const uint8_t* pixels;
+    int width, height; /* 1..16384 each, else the image is refused (a warning, drawn untextured) */
+} ak_io_image_view;
+
+/* A caller-supplied texture image decoder: decode data[size] (the image's encoded bytes as the
+ * file holds them: a PNG, a JPEG, ...) into *out. Return AK_OK with *out filled; AK_ERR_UNSUPPORTED
+ * to let the library's own decoder (libpng/libjpeg, ak_io_image_decode) try it instead; any other
+ * code refuses the image (a warning; the meshes using it are drawn untextured). Called on the
+ * loading thread, at most once per texture image, with user as given in ak_io_desc. Used where
+ * the library has no decoder but the host has one: the WebAssembly page (docs/web.md) hands
+ * over what the browser decoded. */
+typedef ak_result (*ak_io_image_decoder)(void* user, const void* data, size_t size,
+                                         ak_io_image_view* out);
+
 /* Which reader handles a file. */
 typedef enum ak_io_format {
     AK_IO_FORMAT_AUTO = 0, /* default: a .gltf/.glb extension or the GLB magic -> GLTF, .bvh -> BVH,
@@ -146,6 +165,9 @@ typedef struct ak_io_desc {
                                 trusted files); false (default) -> outside the model's directory
                                 and extra_roots is AK_ERR_IO (an Assimp model's own files: not
                                 opened, a warning) */
+    ak_io_image_decoder image_decoder; /* glTF and OBJ texture images go to it first (see
+                                ak_io_image_decoder); NULL (default) -> the built-in decoder */
+    void* image_decoder_user;          /* passed to image_decoder */
 } ak_io_desc;
 
 /* The desc with its zero fields replaced by their defaults (NULL -> all defaults).

@@ -1274,7 +1274,8 @@ static ak_result load_texture(gl_ctx* c, size_t ti) {
         char msg[200];
         uint8_t* px = NULL;
         int w = 0, h = 0;
-        r = akp_image_decode(bytes, n, &c->budget, &c->scene->alloc, &px, &w, &h, msg, sizeof msg);
+        r = akp_io_image_decode(c->desc, bytes, n, &c->budget, &c->scene->alloc, &px, &w, &h, msg,
+                                sizeof msg);
         if (r != AK_OK) {
             r = fail(c, r, "images[%lld]: %s", (long long)src, msg);
         } else {

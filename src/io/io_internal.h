@@ -98,6 +98,12 @@ ak_result akp_io_load_assimp(const char* path, const ak_io_desc* desc, const ak_
  * CMYK JPEG, no JPEG decoder in this build), AK_ERR_NO_MEMORY. (src/io/image.c) */
 ak_result akp_image_decode(const uint8_t* data, size_t size, akp_budget* budget, const ak_allocator* alloc,
                            uint8_t** out_pixels, int* out_width, int* out_height, char* msg, size_t msg_size);
+/* akp_image_decode behind the caller's decoder: desc->image_decoder (when set) first; it returning
+ * AK_ERR_UNSUPPORTED (or no decoder) -> akp_image_decode. Same contract and results as
+ * akp_image_decode; a decoded image's size is checked and charged before the copy. (src/io.c) */
+ak_result akp_io_image_decode(const ak_io_desc* desc, const uint8_t* data, size_t size,
+                              akp_budget* budget, const ak_allocator* alloc, uint8_t** out_pixels,
+                              int* out_width, int* out_height, char* msg, size_t msg_size);
 /* Encode RGBA8 (rows top to bottom, tightly packed) as a PNG in a malloc'ed buffer.
  * Returns AK_ERR_BAD_ARG (libpng refused), AK_ERR_NO_MEMORY. */
 ak_result akp_image_encode_png(const uint8_t* rgba, int width, int height, uint8_t** out_data, size_t* out_size);

@@ -336,7 +336,8 @@ static void load_map_kd(ob_ctx* c, ak_scene* s, size_t ti, const ob_material* ma
     char msg[200];
     uint8_t* px = NULL;
     int w = 0, h = 0;
-    r = akp_image_decode(data, size, &c->budget, &s->alloc, &px, &w, &h, msg, sizeof msg);
+    r = akp_io_image_decode(c->desc, data, size, &c->budget, &s->alloc, &px, &w, &h, msg,
+                            sizeof msg);
     akp_free(c->alloc, data);
     if (r != AK_OK) {
         warn(c, "map_Kd '%.200s' not read: %s", mat->map_kd, msg);

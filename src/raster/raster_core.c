@@ -16,6 +16,9 @@
 #include "../internal.h"
 #include "raster_internal.h"
 #include "../tasks.h"
+#if defined(__wasm_simd128__)
+#include <wasm_simd128.h> /* the WebAssembly build's SIMD128 paths (tex_sample, ground_row_simd) */
+#endif
 
 /* ---- private types ------------------------------------------------------------------ */
 
@@ -286,7 +289,11 @@ void ak_raster_clear(ak_raster* raster, ak_vec4 top_color, ak_vec4 bottom_color)
                          (uint8_t)raster->to_srgb_lut[(int)(clamp01(c.z) * 4096.0f + 0.5f)],
                          (uint8_t)(ak_lerpf(ta, ba, s) * 255.0f + 0.5f)};
         uint8_t* row = raster->color + (size_t)y * (size_t)raster->sw * 4u;
-        for (int x = 0; x < raster->sw; ++x) memcpy(row + (size_t)x * 4u, px, 4);
+        /* one pixel, then the filled part copied onto the rest, doubling */
+        const size_t bytes = (size_t)raster->sw * 4u;
+        memcpy(row, px, 4);
+        for (size_t done = 4; done < bytes; done *= 2)
+            memcpy(row + done, row, done < bytes - done ? done : bytes - done);
     }
 }
 
@@ -488,6 +495,11 @@ static void setup_screen_tri(const drawctx* dc, const cvert* v0, const cvert* v1
         t->da1[k] = v[i1]->a[k] * iw[i1] - a0;
         t->da2[k] = v[i2]->a[k] * iw[i2] - a0;
     }
+#if defined(__wasm_simd128__)
+    _Static_assert(MAXA % 4 == 0, "the SIMD128 interpolation reads attributes four at a time");
+    for (int k = dc->attr_count; k < MAXA; ++k)
+        t->a0[k] = t->da1[k] = t->da2[k] = 0.0f; /* defined lanes */
+#endif
     if (flat) memcpy(t->flat, flat, sizeof t->flat);
     t->minify = false;
     if (dc->tex) {
@@ -605,7 +617,12 @@ static FORCE_INLINE int mode_attr_count(frag_mode mode) {
 static inline float tex_period(float u, ak_raster_wrap w) {
     if (!ak_finitef(u)) return 0.0f;
     if (w == AK_RASTER_WRAP_CLAMP) return u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
-    float p = w == AK_RASTER_WRAP_MIRROR ? 2.0f : 1.0f;
+    /* REPEAT: the lines below with p = 1 (u / 1 and 1 * x are exact) */
+    if (w != AK_RASTER_WRAP_MIRROR) {
+        float f = u - floorf(u);
+        return f >= 0.0f && f < 1.0f ? f : 0.0f;
+    }
+    float p = 2.0f;
     float f = u - p * floorf(u / p);
     return f >= 0.0f && f < p ? f : 0.0f; /* rounding can give exactly p */
 }
@@ -651,6 +668,25 @@ static void tex_sample(const drawctx* dc, float u, float v, bool minify, bool li
     const uint8_t* r1 = px + (size_t)j1 * stride;
     const uint8_t* p[4] = {r0 + (size_t)i0 * 4u, r0 + (size_t)i1 * 4u, r1 + (size_t)i0 * 4u, r1 + (size_t)i1 * 4u};
     const float wt[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
+#if defined(__wasm_simd128__)
+    /* the four channels at once: per channel the scalar loops' sums in the same order, each
+     * term rounded as there (lit: wt * lut for colour, (wt * a) * (1/255) for alpha) */
+    {
+        const v128_t scale = linear ? wasm_f32x4_make(1.0f, 1.0f, 1.0f, 1.0f / 255.0f)
+                                    : wasm_f32x4_splat(1.0f / 255.0f);
+        v128_t acc = wasm_f32x4_splat(0.0f);
+        for (int q = 0; q < 4; ++q) {
+            const v128_t c =
+                linear ? wasm_f32x4_make(lut[p[q][0]], lut[p[q][1]], lut[p[q][2]], (float)p[q][3])
+                       : wasm_f32x4_make((float)p[q][0], (float)p[q][1], (float)p[q][2],
+                                         (float)p[q][3]);
+            acc = wasm_f32x4_add(acc,
+                                 wasm_f32x4_mul(wasm_f32x4_mul(wasm_f32x4_splat(wt[q]), c), scale));
+        }
+        wasm_v128_store(out, acc);
+        return;
+    }
+#endif
     for (int k = 0; k < 4; ++k) out[k] = 0.0f;
     if (linear) {
         for (int q = 0; q < 4; ++q)
@@ -774,6 +810,184 @@ static FORCE_INLINE bool fragment(const drawctx* dc, frag_mode mode, bool tex, c
     return false;
 }
 
+#if defined(__wasm_simd128__)
+/* The WebAssembly build (docs/web.md): the ground's pixels four at a time with SIMD128. The
+ * ground is the frame's largest surface and its fragment (fade, grid, shadow) the heaviest per
+ * pixel; every lane runs the scalar FRAG_GROUND code's float operations in the same order
+ * (IEEE division, square root and floor per lane; -ffp-contract=off, no fused multiply-add), so
+ * the pixels are bit-identical to the scalar path's, which every other build runs and the raster
+ * tests check (tests/web/run.mjs compares the page's frame with the native viewer's). */
+static FORCE_INLINE v128_t v_clamp01(v128_t x) {
+    v128_t r =
+        wasm_v128_bitselect(wasm_f32x4_splat(1.0f), x, wasm_f32x4_gt(x, wasm_f32x4_splat(1.0f)));
+    return wasm_v128_bitselect(wasm_f32x4_splat(0.0f), r, wasm_f32x4_lt(x, wasm_f32x4_splat(0.0f)));
+}
+
+/* Row y of triangle t, pixels x0..x1, with the edge values e* at x0 and their steps s*. */
+static void ground_row_simd(const drawctx* dc, const rtri* t, int x0, int x1, int64_t e0,
+                            int64_t e1, int64_t e2, int64_t s0, int64_t s1, int64_t s2,
+                            uint8_t* crow, float* zrow) {
+    const ak_raster* r = dc->r;
+    const v128_t one = wasm_f32x4_splat(1.0f), zero = wasm_f32x4_splat(0.0f);
+    const v128_t gcx = wasm_f32x4_splat(dc->ground_cx), gcz = wasm_f32x4_splat(dc->ground_cz);
+    const v128_t ge = wasm_f32x4_splat(dc->ground_e), sp = wasm_f32x4_splat(dc->grid_spacing);
+    const v128_t ss = wasm_f32x4_splat((float)r->ss);
+    const float texel = 2.0f * dc->ground_e / (float)SHADOW_RES;
+    for (int x = x0; x <= x1; x += 4) {
+        const int n = x1 - x + 1 < 4 ? x1 - x + 1 : 4;
+        float l1s[4] = {0, 0, 0, 0}, l2s[4] = {0, 0, 0, 0}, zb[4] = {0, 0, 0, 0};
+        int live[4] = {0, 0, 0, 0}, any = 0;
+        for (int k = 0; k < n; ++k, e0 += s0, e1 += s1, e2 += s2) {
+            if ((e0 | e1 | e2) < 0) continue;
+            live[k] = -1;
+            any = 1;
+            l1s[k] = (float)(e1 - t->bias[1]) * t->inv_area;
+            l2s[k] = (float)(e2 - t->bias[2]) * t->inv_area;
+            zb[k] = zrow[x + k];
+        }
+        if (!any) continue;
+        const v128_t l1 = wasm_v128_load(l1s), l2 = wasm_v128_load(l2s);
+        v128_t alive = wasm_v128_load(live);
+        const v128_t z = wasm_f32x4_add(
+            wasm_f32x4_add(wasm_f32x4_splat(t->z0), wasm_f32x4_mul(l1, wasm_f32x4_splat(t->dz1))),
+            wasm_f32x4_mul(l2, wasm_f32x4_splat(t->dz2)));
+        if (dc->depth_test) alive = wasm_v128_and(alive, wasm_f32x4_lt(z, wasm_v128_load(zb)));
+        alive = wasm_v128_and(alive, wasm_v128_and(wasm_f32x4_ge(z, zero), wasm_f32x4_le(z, one)));
+        if (!wasm_v128_any_true(alive)) continue;
+        const v128_t iw = wasm_f32x4_add(
+            wasm_f32x4_add(wasm_f32x4_splat(t->iw0), wasm_f32x4_mul(l1, wasm_f32x4_splat(t->diw1))),
+            wasm_f32x4_mul(l2, wasm_f32x4_splat(t->diw2)));
+        const v128_t w = wasm_f32x4_div(one, iw);
+        v128_t a[3];
+        for (int k = 0; k < 3; ++k)
+            a[k] = wasm_f32x4_mul(
+                wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_splat(t->a0[k]),
+                                              wasm_f32x4_mul(l1, wasm_f32x4_splat(t->da1[k]))),
+                               wasm_f32x4_mul(l2, wasm_f32x4_splat(t->da2[k]))),
+                w);
+        /* fade towards the edge of the ground's disc */
+        const v128_t px = a[0], pz = a[2];
+        const v128_t dx = wasm_f32x4_sub(px, gcx), dz = wasm_f32x4_sub(pz, gcz);
+        const v128_t rad = wasm_f32x4_div(
+            wasm_f32x4_sqrt(wasm_f32x4_add(wasm_f32x4_mul(dx, dx), wasm_f32x4_mul(dz, dz))), ge);
+        const v128_t st = v_clamp01(wasm_f32x4_div(wasm_f32x4_sub(rad, wasm_f32x4_splat(0.45f)),
+                                                   wasm_f32x4_splat(1.0f - 0.45f)));
+        const v128_t fade = wasm_f32x4_sub(
+            one, wasm_f32x4_mul(wasm_f32x4_mul(st, st),
+                                wasm_f32x4_sub(wasm_f32x4_splat(3.0f),
+                                               wasm_f32x4_mul(wasm_f32x4_splat(2.0f), st))));
+        alive = wasm_v128_andnot(alive, wasm_f32x4_le(fade, zero));
+        if (!wasm_v128_any_true(alive)) continue;
+        /* grid: pixel footprint in metres from distance and grazing angle */
+        const v128_t tx = wasm_f32x4_sub(wasm_f32x4_splat(dc->eye.x), a[0]);
+        const v128_t ty = wasm_f32x4_sub(wasm_f32x4_splat(dc->eye.y), a[1]);
+        const v128_t tz = wasm_f32x4_sub(wasm_f32x4_splat(dc->eye.z), a[2]);
+        v128_t dist = wasm_f32x4_sqrt(
+            wasm_f32x4_add(wasm_f32x4_add(wasm_f32x4_mul(tx, tx), wasm_f32x4_mul(ty, ty)),
+                           wasm_f32x4_mul(tz, tz)));
+        v128_t cosv = wasm_v128_bitselect(wasm_f32x4_div(wasm_f32x4_abs(ty), dist), one,
+                                          wasm_f32x4_gt(dist, zero));
+        if (dc->ortho) {
+            dist = one;
+            cosv = wasm_f32x4_splat(fabsf(dc->view_forward.y));
+        }
+        const v128_t c012 = wasm_f32x4_splat(0.12f);
+        const v128_t foot =
+            wasm_f32x4_div(wasm_f32x4_mul(dist, wasm_f32x4_splat(dc->pix_angle)),
+                           wasm_v128_bitselect(cosv, c012, wasm_f32x4_gt(cosv, c012)));
+        const v128_t half = wasm_f32x4_splat(0.5f);
+        const v128_t gu = wasm_f32x4_div(px, sp), gv = wasm_f32x4_div(pz, sp);
+        const v128_t du = wasm_f32x4_mul(
+            wasm_f32x4_abs(wasm_f32x4_sub(gu, wasm_f32x4_floor(wasm_f32x4_add(gu, half)))), sp);
+        const v128_t dv = wasm_f32x4_mul(
+            wasm_f32x4_abs(wasm_f32x4_sub(gv, wasm_f32x4_floor(wasm_f32x4_add(gv, half)))), sp);
+        const v128_t d = wasm_v128_bitselect(du, dv, wasm_f32x4_lt(du, dv));
+        const v128_t hw = wasm_f32x4_mul(wasm_f32x4_mul(half, ss), foot);
+        v128_t line = v_clamp01(wasm_f32x4_sub(one, wasm_f32x4_div(wasm_f32x4_sub(d, hw), foot)));
+        line = wasm_f32x4_mul(
+            line, v_clamp01(wasm_f32x4_sub(
+                      wasm_f32x4_splat(1.6f),
+                      wasm_f32x4_div(
+                          wasm_f32x4_mul(wasm_f32x4_mul(wasm_f32x4_splat(4.0f), foot), ss), sp))));
+        const v128_t lt = wasm_f32x4_mul(line, wasm_f32x4_splat(0.8f));
+        const float gl[3] = {dc->ground_lin.x, dc->ground_lin.y, dc->ground_lin.z};
+        const float ll[3] = {dc->line_lin.x, dc->line_lin.y, dc->line_lin.z};
+        v128_t c[3];
+        for (int k = 0; k < 3; ++k) {
+            const v128_t g = wasm_f32x4_splat(gl[k]);
+            c[k] =
+                wasm_f32x4_add(g, wasm_f32x4_mul(wasm_f32x4_sub(wasm_f32x4_splat(ll[k]), g), lt));
+        }
+        if (dc->shadow) {
+            const v128_t tv = wasm_f32x4_splat(texel);
+            /* shadow_sample, lane by lane in the same order: the 4 taps' weights, a tap outside
+             * the map adds w * 0 (+0: the sum is the same), out of range -> 0 */
+            const v128_t u = wasm_f32x4_sub(
+                wasm_f32x4_div(wasm_f32x4_sub(px, wasm_f32x4_splat(dc->ground_cx - dc->ground_e)),
+                               tv),
+                half);
+            const v128_t v = wasm_f32x4_sub(
+                wasm_f32x4_div(wasm_f32x4_sub(pz, wasm_f32x4_splat(dc->ground_cz - dc->ground_e)),
+                               tv),
+                half);
+            const v128_t m1 = wasm_f32x4_splat(-1.0f), sr = wasm_f32x4_splat((float)SHADOW_RES);
+            const v128_t inr =
+                wasm_v128_and(wasm_v128_and(wasm_f32x4_gt(u, m1), wasm_f32x4_gt(v, m1)),
+                              wasm_v128_and(wasm_f32x4_lt(u, sr), wasm_f32x4_lt(v, sr)));
+            const v128_t fu = wasm_f32x4_floor(u), fv = wasm_f32x4_floor(v);
+            const v128_t fx = wasm_f32x4_sub(u, fu), fy = wasm_f32x4_sub(v, fv);
+            int32_t ix[4], iy[4], in[4];
+            wasm_v128_store(ix, wasm_i32x4_trunc_sat_f32x4(fu));
+            wasm_v128_store(iy, wasm_i32x4_trunc_sat_f32x4(fv));
+            wasm_v128_store(in, wasm_v128_and(inr, alive));
+            float tap[4][4] = {{0}}; /* [j * 2 + i][lane] */
+            for (int k = 0; k < n; ++k) {
+                if (!in[k]) continue;
+                for (int j = 0; j < 2; ++j)
+                    for (int i = 0; i < 2; ++i) {
+                        int sx = ix[k] + i, sy = iy[k] + j;
+                        if (sx >= 0 && sy >= 0 && sx < SHADOW_RES && sy < SHADOW_RES)
+                            tap[j * 2 + i][k] = r->shadow[sy * SHADOW_RES + sx];
+                    }
+            }
+            const v128_t gx = wasm_f32x4_sub(one, fx), gy = wasm_f32x4_sub(one, fy);
+            v128_t sh = wasm_f32x4_add(
+                zero, wasm_f32x4_mul(wasm_f32x4_mul(gx, gy), wasm_v128_load(tap[0])));
+            sh = wasm_f32x4_add(sh, wasm_f32x4_mul(wasm_f32x4_mul(fx, gy), wasm_v128_load(tap[1])));
+            sh = wasm_f32x4_add(sh, wasm_f32x4_mul(wasm_f32x4_mul(gx, fy), wasm_v128_load(tap[2])));
+            sh = wasm_f32x4_add(sh, wasm_f32x4_mul(wasm_f32x4_mul(fx, fy), wasm_v128_load(tap[3])));
+            sh = wasm_v128_and(sh, inr); /* out of range: 0 */
+            const v128_t f = wasm_f32x4_sub(one, sh);
+            for (int k = 0; k < 3; ++k) c[k] = wasm_f32x4_mul(c[k], f);
+        }
+        /* over what is there (the background): clamp01(bg + (c - bg) * fade) through the sRGB
+         * table, as the scalar code does per channel */
+        uint8_t* dst = crow + (size_t)x * 4u;
+        int32_t idx[3][4];
+        for (int q = 0; q < 3; ++q) {
+            float bgs[4] = {0, 0, 0, 0};
+            for (int k = 0; k < n; ++k) bgs[k] = r->to_lin_lut[dst[4 * k + q]];
+            const v128_t bg = wasm_v128_load(bgs);
+            const v128_t m =
+                v_clamp01(wasm_f32x4_add(bg, wasm_f32x4_mul(wasm_f32x4_sub(c[q], bg), fade)));
+            wasm_v128_store(idx[q], wasm_i32x4_trunc_sat_f32x4(wasm_f32x4_add(
+                                        wasm_f32x4_mul(m, wasm_f32x4_splat(4096.0f)), half)));
+        }
+        uint32_t am[4];
+        float zk[4];
+        wasm_v128_store(am, alive);
+        wasm_v128_store(zk, z);
+        for (int k = 0; k < n; ++k) {
+            if (!am[k]) continue;
+            uint8_t out[4] = {(uint8_t)r->to_srgb_lut[idx[0][k]],
+                              (uint8_t)r->to_srgb_lut[idx[1][k]],
+                              (uint8_t)r->to_srgb_lut[idx[2][k]], 255};
+            write_px(dc, dst + 4 * k, &zrow[x + k], zk[k], out);
+        }
+    }
+}
+#endif
+
 static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, bool tex, const rtri* t,
                                          int thread_index, int thread_count) {
     ak_raster* r = dc->r;
@@ -796,6 +1010,12 @@ static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, bool
         const int64_t s0 = t->A[0] * SUBPIX, s1 = t->A[1] * SUBPIX, s2 = t->A[2] * SUBPIX;
         uint8_t* crow = r->color + (size_t)y * (size_t)r->sw * 4u;
         float* zrow = r->depth + (size_t)y * (size_t)r->sw;
+#if defined(__wasm_simd128__)
+        if (mode == FRAG_GROUND && !tex) {
+            ground_row_simd(dc, t, t->x0, t->x1, e0, e1, e2, s0, s1, s2, crow, zrow);
+            continue;
+        }
+#endif
         for (int x = t->x0; x <= t->x1; ++x, e0 += s0, e1 += s1, e2 += s2) {
             if ((e0 | e1 | e2) < 0) continue;
             /* remove the bias again so the barycentrics are exact */
@@ -808,7 +1028,23 @@ static FORCE_INLINE void raster_tri_mode(const drawctx* dc, frag_mode mode, bool
             if (na) {
                 float iw = t->iw0 + l1 * t->diw1 + l2 * t->diw2;
                 float w = 1.0f / iw;
-                for (int k = 0; k < na; ++k) a[k] = (t->a0[k] + l1 * t->da1[k] + l2 * t->da2[k]) * w;
+#if defined(__wasm_simd128__)
+                if (na > 3) { /* four attributes at a time, each as the scalar line rounds it */
+                    const v128_t vl1 = wasm_f32x4_splat(l1), vl2 = wasm_f32x4_splat(l2),
+                                 vw = wasm_f32x4_splat(w);
+                    for (int k = 0; k < na; k += 4) /* na <= MAXA = 12: lanes past na are unused */
+                        wasm_v128_store(
+                            &a[k],
+                            wasm_f32x4_mul(
+                                wasm_f32x4_add(
+                                    wasm_f32x4_add(wasm_v128_load(&t->a0[k]),
+                                                   wasm_f32x4_mul(vl1, wasm_v128_load(&t->da1[k]))),
+                                    wasm_f32x4_mul(vl2, wasm_v128_load(&t->da2[k]))),
+                                vw));
+                } else
+#endif
+                    for (int k = 0; k < na; ++k)
+                        a[k] = (t->a0[k] + l1 * t->da1[k] + l2 * t->da2[k]) * w;
             }
             uint8_t src[4];
             uint8_t* px = crow + (size_t)x * 4u;
@@ -1390,13 +1626,19 @@ static void box_blur(float* s, float* tmp, int radius) {
                 acc += (xa < SHADOW_RES ? s[y * SHADOW_RES + xa] : 0.0f) - (xr >= 0 ? s[y * SHADOW_RES + xr] : 0.0f);
             }
         }
-        for (int x = 0; x < SHADOW_RES; ++x) {
-            float acc = 0.0f;
-            for (int y = -radius; y <= radius; ++y) acc += (y >= 0 && y < SHADOW_RES) ? tmp[y * SHADOW_RES + x] : 0.0f;
-            for (int y = 0; y < SHADOW_RES; ++y) {
-                s[y * SHADOW_RES + x] = acc * inv;
-                int ya = y + radius + 1, yr = y - radius;
-                acc += (ya < SHADOW_RES ? tmp[ya * SHADOW_RES + x] : 0.0f) - (yr >= 0 ? tmp[yr * SHADOW_RES + x] : 0.0f);
+        /* vertical: every column's running sum at once, row by row (each column sees the same
+         * additions in the same order as a column-by-column pass; rows are contiguous) */
+        float acc[SHADOW_RES];
+        for (int x = 0; x < SHADOW_RES; ++x) acc[x] = 0.0f;
+        for (int y = -radius; y <= radius; ++y)
+            for (int x = 0; x < SHADOW_RES; ++x)
+                acc[x] += (y >= 0 && y < SHADOW_RES) ? tmp[y * SHADOW_RES + x] : 0.0f;
+        for (int y = 0; y < SHADOW_RES; ++y) {
+            const int ya = y + radius + 1, yr = y - radius;
+            for (int x = 0; x < SHADOW_RES; ++x) {
+                s[y * SHADOW_RES + x] = acc[x] * inv;
+                acc[x] += (ya < SHADOW_RES ? tmp[ya * SHADOW_RES + x] : 0.0f) -
+                          (yr >= 0 ? tmp[yr * SHADOW_RES + x] : 0.0f);
             }
         }
     }

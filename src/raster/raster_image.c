@@ -182,11 +182,32 @@ ak_result ak_image_fill_rect(const ak_image* image, float x, float y, float w, f
     float x1 = x + w, y1 = y + h;
     int ix0 = to_int_clamped(floorf(x), 0, image->width), iy0 = to_int_clamped(floorf(y), 0, image->height);
     int ix1 = to_int_clamped(ceilf(x1), 0, image->width), iy1 = to_int_clamped(ceilf(y1), 0, image->height);
+    /* blend() of a coverage seen before is a table lookup per channel: the tables hold blend()'s
+     * own results for each byte value (the same float operations), built once per distinct
+     * partial coverage (one for a translucent rectangle's inside) */
+    uint8_t lut[4][256];
+    float lut_cov = -1.0f;
     for (int py = iy0; py < iy1; ++py) {
         float cy = clamp01(ak_minf((float)py + 1.0f, y1) - ak_maxf((float)py, y));
         for (int px = ix0; px < ix1; ++px) {
             float cx = clamp01(ak_minf((float)px + 1.0f, x1) - ak_maxf((float)px, x));
-            blend(ak_image_pixel(image, px, py), c, cx * cy);
+            float cov = cx * cy;
+            float a = cov * (float)c[3] * (1.0f / 255.0f);
+            if (!(a > 0.0f && a < 1.0f) || cx != 1.0f ||
+                ix1 - ix0 < 64) { /* edges, small or opaque */
+                blend(ak_image_pixel(image, px, py), c, cov);
+                continue;
+            }
+            if (cov != lut_cov) {
+                for (int v = 0; v < 256; ++v) {
+                    for (int k = 0; k < 3; ++k)
+                        lut[k][v] = (uint8_t)((float)v + ((float)c[k] - (float)v) * a + 0.5f);
+                    lut[3][v] = (uint8_t)((float)v + (255.0f - (float)v) * a + 0.5f);
+                }
+                lut_cov = cov;
+            }
+            uint8_t* p = ak_image_pixel(image, px, py);
+            for (int k = 0; k < 4; ++k) p[k] = lut[k][p[k]];
         }
     }
     return AK_OK;

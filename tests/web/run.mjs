@@ -233,12 +233,116 @@ try {
   else check(dropped.current === 'file:' && dropped.joints >= 19, 'a .glb dropped on the page opens (RiggedFigure: a skin of 19 joints among its nodes)', JSON.stringify(dropped));
   if (!dropped.skipped) await shot('06_dropped_glb.png');
 
-  // ---- 7. frame time: CesiumMan at 960x600 ----
+  // ---- 7. CesiumMan textured: the browser decodes its JPEG, the library samples it ----
+  // References from the native build: the texture as libjpeg decoded it (`animkit export` writes
+  // it as a PNG beside an OBJ, rows flipped for OBJ's v axis) and the native viewer's frame 1
+  // (`animkit view --headless --script`: one step of 1/30 s, then a screenshot). The page's
+  // texture must hash the same, and its frame must match the native frame pixel for pixel
+  // within a small mean difference (the HUD's first line differs: "30 fps (fixed step)" natively,
+  // the measured rate in the page; those rows are left out).
+  if (cesium && fs.existsSync(cesium)) {
+    const exp = path.join(outDir, 'cesium_native.obj');
+    execFileSync(cli, ['export', cesium, '-o', exp], { stdio: ['ignore', 'ignore', 'inherit'] });
+    const texPng = fs.readFileSync(path.join(outDir, 'cesium_native_0.png')).toString('base64');
+    const script = path.join(outDir, 'cesium_native_script.txt');
+    fs.writeFileSync(script, 'wait 1\nscreenshot 07_cesiumman_native.png\nquit\n');
+    execFileSync(cli, ['view', cesium, '--headless', '--size', '960x600', '--threads', '1', '--script', script,
+                       '--shot-dir', outDir], { stdio: ['ignore', 'ignore', 'inherit'] });
+    const framePng = fs.readFileSync(path.join(outDir, '07_cesiumman_native.png')).toString('base64');
+    const glb = fs.readFileSync(cesium).toString('base64');
+    const tex = await page.evaluate(async (data, texB64, frameB64) => {
+      const a = window.animkit;
+      const bytes = Uint8Array.from(atob(data), (c) => c.charCodeAt(0));
+      const pngPixels = async (b64) => { // PNG decoding is lossless: these are the native bytes
+        const bmp = await createImageBitmap(new Blob([Uint8Array.from(atob(b64), (c) => c.charCodeAt(0))], { type: 'image/png' }),
+                                            { premultiplyAlpha: 'none', colorSpaceConversion: 'none' });
+        const c = new OffscreenCanvas(bmp.width, bmp.height).getContext('2d');
+        c.drawImage(bmp, 0, 0);
+        return { w: bmp.width, h: bmp.height, px: c.getImageData(0, 0, bmp.width, bmp.height).data };
+      };
+      const grab = () => { a.frame(1 / 30); return document.getElementById('view').getContext('2d').getImageData(0, 0, 960, 600).data; };
+      // untextured: the file without its decoded images (as the page drew it before)
+      if (!(await a.openBytes('CesiumMan.glb', bytes, { textures: false }))) return { error: a.error() };
+      const plain = grab();
+      if (!(await a.openBytes('CesiumMan.glb', bytes))) return { error: a.error() };
+      const given = a.imagesGiven, served = a.imagesServed(), info = a.textureInfo(0);
+      const page = grab();
+      // the native texture, rows flipped back, hashed as akw_texture_info hashes
+      const nt = await pngPixels(texB64);
+      let h = 2166136261;
+      for (let y = nt.h - 1; y >= 0; y--)
+        for (let i = y * nt.w * 4; i < (y + 1) * nt.w * 4; i++) h = Math.imul(h ^ nt.px[i], 16777619) >>> 0;
+      const nf = await pngPixels(frameB64);
+      // the head: above the joint drawn highest on screen (CesiumMan's neck-head joint)
+      let top = null;
+      for (let j = 0; j < a.jointCount(); j++) { const p = a.jointScreen(j); if (p && (!top || p[1] < top[1])) top = p; }
+      let headDiff = 0, headN = 0, headColours = new Set();
+      const x0 = Math.round(top[0]) - 20, y0 = Math.round(top[1]) - 60;
+      for (let y = y0; y < y0 + 40; y++)
+        for (let x = x0; x < x0 + 40; x++) {
+          const i = 4 * (y * 960 + x);
+          headN++;
+          if (page[i] !== plain[i] || page[i + 1] !== plain[i + 1] || page[i + 2] !== plain[i + 2]) headDiff++;
+          headColours.add((page[i] << 16) | (page[i + 1] << 8) | page[i + 2]);
+        }
+      // page against native, below the HUD's first line (rows 0..23)
+      let sum = 0, n = 0, maxd = 0, same = 0, changedByTexture = 0;
+      const bb = [960, 600, -1, -1]; // where pixels differ: x0, y0, x1, y1
+      const bands = new Array(15).fill(0); // differing pixels in rows 0-39, 40-79, ...
+      for (let y = 24; y < 600; y++)
+        for (let x = 0; x < 960; x++) {
+          const i = 4 * (y * 960 + x);
+          let px = 0;
+          for (let c = 0; c < 3; c++) { const d = Math.abs(page[i + c] - nf.px[i + c]); sum += d; px = Math.max(px, d); }
+          n += 3;
+          maxd = Math.max(maxd, px);
+          if (px === 0) same++;
+          else { bands[Math.floor(y / 40)]++; bb[0] = Math.min(bb[0], x); bb[1] = Math.min(bb[1], y); bb[2] = Math.max(bb[2], x); bb[3] = Math.max(bb[3], y); }
+          if (page[i] !== plain[i] || page[i + 1] !== plain[i + 1] || page[i + 2] !== plain[i + 2]) changedByTexture++;
+        }
+      return { given, served, info, native_texture: { width: nt.w, height: nt.h, fnv1a: h }, native_frame: [nf.w, nf.h],
+               head: { at: top, box: [x0, y0, 40, 40], differs_from_untextured: headDiff, pixels: headN, colours: headColours.size },
+               frame_mean_abs_diff: sum / n, frame_max_diff: maxd, frame_identical_pixels: same, frame_pixels: n / 3, frame_diff_box: bb, frame_diff_rows_by_40: bands,
+               pixels_changed_by_texture: changedByTexture };
+    }, glb, texPng, framePng);
+    // the same file dropped on the page (a real drop event carrying a File): textured too
+    tex.dropped = await page.evaluate(async (data) => {
+      const a = window.animkit;
+      a.open('builtin:cylinder');
+      const dt = new DataTransfer();
+      dt.items.add(new File([Uint8Array.from(atob(data), (c) => c.charCodeAt(0))], 'CesiumMan.glb'));
+      document.body.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, bubbles: true, cancelable: true }));
+      for (let k = 0; k < 200 && a.current !== 'file:'; k++) await new Promise((r) => setTimeout(r, 50));
+      return { current: a.current, served: a.imagesServed(), info: a.textureInfo(0) };
+    }, glb);
+    results.cesiumman_texture = tex;
+    await shot('07_cesiumman_textured.png');
+    if (tex.error) {
+      check(false, 'CesiumMan loads in the page', tex.error);
+    } else {
+      check(tex.given === 1 && tex.served === 1, 'CesiumMan: the browser decoded its one texture image and the glTF reader took it',
+            `${tex.given} given, ${tex.served} served`);
+      check(tex.info && tex.info.width === tex.native_texture.width && tex.info.height === tex.native_texture.height &&
+            tex.info.fnv1a === tex.native_texture.fnv1a,
+            'CesiumMan: the texture\'s RGBA in the module is bit-identical to libjpeg\'s decode (native build)',
+            `page ${JSON.stringify(tex.info)}, native ${JSON.stringify(tex.native_texture)}`);
+      check(tex.dropped.current === 'file:' && tex.dropped.served === 1 && tex.dropped.info && tex.dropped.info.fnv1a === tex.native_texture.fnv1a,
+            'CesiumMan dropped on the page opens textured, the same texture', JSON.stringify(tex.dropped));
+      check(tex.head.differs_from_untextured > tex.head.pixels / 2 && tex.head.colours > 20,
+            'CesiumMan\'s head is textured, not the flat untextured colour',
+            `${tex.head.differs_from_untextured}/${tex.head.pixels} pixels of the box ${tex.head.box} (x, y, w, h) differ from the untextured frame, ${tex.head.colours} colours`);
+      check(tex.pixels_changed_by_texture > 5000 && tex.frame_mean_abs_diff <= 0.5,
+            'CesiumMan: the page\'s textured frame matches the native viewer\'s (mean |diff| <= 0.5 of 255)',
+            `mean |diff| ${tex.frame_mean_abs_diff.toFixed(4)}, max ${tex.frame_max_diff}, ${tex.frame_identical_pixels}/${tex.frame_pixels} pixels identical (the others in x, y ${tex.frame_diff_box}); the texture changed ${tex.pixels_changed_by_texture} pixels`);
+    }
+  }
+
+  // ---- 8. frame time: CesiumMan at 960x600, textured ----
   if (cesium && fs.existsSync(cesium)) {
     const b64 = fs.readFileSync(cesium).toString('base64');
-    const loaded = await page.evaluate((data) => {
+    const loaded = await page.evaluate(async (data) => {
       const a = window.animkit;
-      if (!a.openBytes('CesiumMan.glb', Uint8Array.from(atob(data), (c) => c.charCodeAt(0)))) return a.error();
+      if (!(await a.openBytes('CesiumMan.glb', Uint8Array.from(atob(data), (c) => c.charCodeAt(0))))) return a.error();
       for (let k = 0; k < 10; k++) a.frame(1 / 30); // warm up
       return '';
     }, b64);
@@ -262,8 +366,8 @@ try {
       perf.cpu_ms_per_frame_draw_only = (1000 * (chromiumCpuSeconds(browser.process().pid) - cpu1)) / 90;
     }
     // The native viewer side by side: CPU per frame of `animkit view --headless` at the same size
-    // on one thread (difference of a 100- and a 10-frame run, so loading is not counted). It draws
-    // CesiumMan's JPEG texture, which the page has no decoder for (docs/web.md).
+    // on one thread (difference of a 100- and a 10-frame run, so loading is not counted). Both
+    // draw CesiumMan's JPEG texture.
     const selfChildCpu = () => { const f = fs.readFileSync('/proc/self/stat', 'utf8').split(') ')[1].split(' '); return (Number(f[13]) + Number(f[14])) / 100; };
     const nativeCpu = (frames) => {
       const c0 = selfChildCpu();
@@ -281,7 +385,7 @@ try {
                      `mean ${perf.mean_ms.toFixed(2)} ms, p90 ${perf.p90_ms.toFixed(2)} ms; Chromium CPU ${perf.cpu_ms_per_frame.toFixed(2)} ms a frame ` +
                      `(${(1000 / perf.cpu_ms_per_frame).toFixed(1)} fps on an idle core), of which the module ${perf.cpu_ms_per_frame_draw_only.toFixed(2)} ms; sample ${perf.stats.sampleMs.toFixed(2)}, ` +
                      `skin ${perf.stats.skinMs.toFixed(2)}, raster ${perf.stats.rasterMs.toFixed(2)} ms (averages since opening)`);
-    await shot('07_cesiumman.png');
+    await shot('08_cesiumman_timed.png');
   } else {
     console.log('info CesiumMan.glb not given: no frame-time measurement');
   }
