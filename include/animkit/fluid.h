@@ -41,10 +41,12 @@
  * the caller's order. Each list holds the particles closer than h in a fixed order (cells z,
  * then y, then x, each in index order), the same on both paths.
  *
- * Boundaries (all solvers): a box container, planes, spheres and capsules, each optionally
- * moving with a velocity. The method is projection: a particle found inside a collider (or
- * outside the box) is moved to the nearest surface point, and its velocity loses only the
- * component into the surface relative to the collider's velocity (the tangential component is
+ * Boundaries (all solvers): a box container, planes, spheres, capsules, oriented boxes and
+ * convex polytopes (so rigid bodies reach the liquid one-way: ak_rigid_fluid_colliders in
+ * rigid.h), each optionally moving with a velocity and an angular velocity. The method is
+ * projection: a particle found inside a collider (or outside the box) is moved to the nearest
+ * surface point (a box's or a polytope's: through the face it is least deep under), and its
+ * velocity loses only the component into the surface relative to the surface's velocity (the tangential component is
  * kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so the velocity
  * update v = (x* - x)/dt inherits the same rule. Nothing leaks (every particle ends each step
  * outside every collider and inside the box, up to float rounding of the projection; where two
@@ -173,15 +175,35 @@ typedef enum ak_fluid_shape {
     AK_FLUID_PLANE = 0, /* point a, unit normal n: the liquid stays on the +n side */
     AK_FLUID_SPHERE,    /* centre a, radius: the liquid stays outside */
     AK_FLUID_CAPSULE,   /* segment a-b, radius: the liquid stays outside (a limb) */
+    AK_FLUID_BOX,       /* centre a, half_extents along the axes of orientation: the liquid stays
+                           outside (a rigid box: ak_rigid_fluid_colliders) */
+    AK_FLUID_CONVEX,    /* a convex polytope: the points x with n.(x') <= d for every plane
+                           (n, d) of planes, x' = orientation^-1 (x - a) in the collider's frame:
+                           the liquid stays outside (a rigid hull: ak_rigid_fluid_colliders) */
     AK_FLUID_SHAPE_COUNT
 } ak_fluid_shape;
 
+/* Most planes a convex collider may have. */
+#define AK_FLUID_CONVEX_MAX_PLANES 65536u
+
 typedef struct ak_fluid_collider {
     ak_fluid_shape shape; /* 0 -> plane */
-    ak_vec3 a, b;         /* world: plane point / sphere centre / capsule ends */
+    ak_vec3 a, b;         /* world: plane point / sphere centre / capsule ends / box and convex
+                             frame origin */
     ak_vec3 normal;       /* plane normal (normalised by the solver; zero -> +Y) */
     float radius;         /* sphere and capsule radius (m), >= 0 */
-    ak_vec3 velocity;     /* world m/s: a moving collider (the caller moves a, b each step) */
+    ak_vec3 velocity;     /* world m/s of the point a: a moving collider (the caller moves it
+                             each step) */
+    /* A turning collider: the surface at x moves at velocity + angular_velocity x (x - a), the
+     * velocity a particle pushed out there keeps relative to (any shape; zero -> translation
+     * only, as before). */
+    ak_vec3 angular_velocity; /* world rad/s */
+    ak_quat orientation;      /* box and convex: the frame's rotation, frame to world; zero ->
+                                 identity (normalised here) */
+    ak_vec3 half_extents;     /* box: metres along the frame's axes, each >= 0 */
+    const ak_vec4* planes;    /* convex: (n.x, n.y, n.z, d) in the frame, n unit (within 1e-3);
+                                 the liquid stays where n.x' > d for some plane */
+    uint32_t plane_count;     /* convex: 1 .. AK_FLUID_CONVEX_MAX_PLANES */
 } ak_fluid_collider;
 
 typedef struct ak_fluid_emitter {

@@ -41,8 +41,8 @@
  *
  * What it does NOT do (yet): threads, continuous collision detection (a body moving more than
  * its size in one substep can tunnel), dynamic triangle meshes and heightfields (they are
- * static), collisions with the fluid (cloth and particles take the bodies as a mesh:
- * ak_rigid_world_mesh).
+ * static), two-way coupling with other simulations: cloth and particles take the bodies as a
+ * mesh (ak_rigid_world_mesh), the fluid as its colliders (ak_rigid_fluid_colliders), one-way.
  *
  * Usage (a box dropped on the ground):
  *     ak_rigid_body_desc bodies[2] = {
@@ -70,6 +70,7 @@
 #ifndef ANIMKIT_RIGID_H
 #define ANIMKIT_RIGID_H
 
+#include "fluid.h" /* ak_fluid_collider (ak_rigid_fluid_colliders fills them; no link dependency) */
 #include "math.h"
 
 #ifdef __cplusplus
@@ -448,6 +449,37 @@ AK_API void ak_rigid_world_mesh_size(const ak_rigid_model* model, size_t* out_ve
 AK_API ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan positions,
                                      ak_quat_cspan orientations, ak_vec3_span out_positions,
                                      ak_vec3_span out_normals, ak_u32_span out_indices);
+
+/* ---- the bodies as colliders of the fluid (one-way) ------------------------------------ */
+
+/* Colliders and convex planes ak_rigid_fluid_colliders writes for a model: one collider per
+ * sphere, box, capsule, plane and hull body and per child of a compound; a hull's collider
+ * takes one plane per face. Heightfields and triangle meshes are not passed to the fluid (0).
+ * 0 for NULL. */
+AK_API void ak_rigid_fluid_colliders_size(const ak_rigid_model* model, size_t* out_collider_count,
+                                          size_t* out_plane_count);
+/* The bodies at a state as the fluid's colliders (fluid.h), so a liquid collides one-way with
+ * them: each step, write them at the bodies' current poses and velocities and pass them as the
+ * fluid step job's colliders (after the rigid step, so the liquid is pushed out of where the
+ * bodies now are):
+ *     ak_rigid_step_run(&rigid_job);
+ *     ak_rigid_fluid_colliders(model, x, q, v, w, (ak_fluid_collider_span){cols, nc},
+ *                              (ak_vec4_span){planes, np}, &nc);
+ *     fluid_job.colliders = (ak_fluid_collider_cspan){cols, nc};
+ *     ak_fluid_step_run(&fluid_job);
+ * A sphere becomes AK_FLUID_SPHERE, a capsule AK_FLUID_CAPSULE (its segment's ends), a box
+ * AK_FLUID_BOX, a plane AK_FLUID_PLANE, a hull AK_FLUID_CONVEX (its faces' planes in its body
+ * frame, written to out_planes, which the colliders point into: keep it alive while they are
+ * used), a compound one of those per child, in body order (children in order). Each collider
+ * carries its body's motion: velocity at its point a (v + w x (a - x)) and angular velocity w
+ * (zero for static bodies). Sizes from ak_rigid_fluid_colliders_size; *out_collider_count (may
+ * be NULL) gets the count written. AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a
+ * non-finite state). The fluid sees only the shapes: the bodies feel no force from the liquid. */
+AK_API ak_result ak_rigid_fluid_colliders(const ak_rigid_model* model, ak_vec3_cspan positions,
+                                          ak_quat_cspan orientations, ak_vec3_cspan velocities,
+                                          ak_vec3_cspan angular_velocities,
+                                          ak_fluid_collider_span out_colliders,
+                                          ak_vec4_span out_planes, size_t* out_collider_count);
 
 /* ---- a run baked as glTF node animation ------------------------------------------------ */
 
