@@ -445,7 +445,8 @@ AK_API void ak_rigid_world_mesh_size(const ak_rigid_model* model, size_t* out_ve
  * (ak_cloth_collider_mesh) and particles (ak_particle_mesh) the bodies as a one-way collider
  * each step. Boxes, hulls, compounds of them, heightfields and trimeshes are exact; spheres and
  * capsules are inscribed polyhedra (at most 8% inside the true surface at 8 x 16).
- * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a non-finite state). */
+ * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a non-finite state), AK_ERR_UNSUPPORTED
+ * (more than 2^32 - 1 vertices: 32-bit indices cannot reach them). */
 AK_API ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan positions,
                                      ak_quat_cspan orientations, ak_vec3_span out_positions,
                                      ak_vec3_span out_normals, ak_u32_span out_indices);

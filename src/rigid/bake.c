@@ -319,6 +319,7 @@ ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan positio
     if (positions.count < n || orientations.count < n || out_positions.count < nv ||
         out_normals.count < nv || out_indices.count < ni)
         return AK_ERR_SPAN_SMALL;
+    if (nv > UINT32_MAX) return AK_ERR_UNSUPPORTED; /* the 32-bit indices could not reach them */
     for (size_t i = 0; i < n; ++i)
         if (!ak_vec3_is_finite(positions.ptr[i]) || !ak_quat_is_finite(orientations.ptr[i]))
             return AK_ERR_BAD_DATA;

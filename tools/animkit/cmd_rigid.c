@@ -38,9 +38,14 @@ static void mesh_free(body_mesh* m) {
     memset(m, 0, sizeof *m);
 }
 
+/* Most vertices drawn (1.6 GB of positions and normals): a scene's meshes are bounded by its
+ * file's size, far below this; the check keeps the 32-bit indices exact. */
+#define DRAW_MAX_VERTICES ((size_t)1 << 26)
+
 static bool mesh_build(body_mesh* m, const ak_rigid_model* model) {
     memset(m, 0, sizeof *m);
     ak_rigid_world_mesh_size(model, &m->vcount, &m->icount);
+    if (m->vcount > DRAW_MAX_VERTICES) return false;
     m->pos = malloc((m->vcount + 1) * sizeof(ak_vec3));
     m->nrm = malloc((m->vcount + 1) * sizeof(ak_vec3));
     m->idx = malloc((m->icount + 1) * sizeof(uint32_t));
@@ -185,7 +190,8 @@ int cmd_rigid(int argc, char** argv) {
     const bool gif = out && cli_has_ext(out, ".gif"), png = out && cli_has_ext(out, ".png");
     if (gif || png) {
         if (!mesh_build(&mesh, model)) {
-            rc = cli_fail("rigid", "out of memory for the bodies' mesh");
+            rc = cli_fail("rigid", "%s: the bodies' mesh (%zu vertices) is too large to draw or "
+                          "out of memory", name, mesh.vcount);
             goto done;
         }
         if ((r = mesh_pose(&mesh, model, x, q)) != AK_OK) {
