@@ -12,6 +12,7 @@
 
 #include "ak_test.h"
 #include "cli_test.h"
+#include "gltf_validate.h"
 
 typedef struct mesh_buf {
     ak_vec3 *p, *n;
@@ -289,10 +290,50 @@ AK_TEST(cli_draws_a_hull_as_itself) {
     AK_CHECK_MSG(sphere > 2 * hull, "sphere %ld pixels, hull %ld", sphere, hull);
 }
 
+/* examples/rigid_shapes.json (a heightfield, a trimesh, a hull, a compound, a sphere) baked by
+ * `animkit rigid -o X.glb`: one mesh per body, each with the vertex and triangle counts of the
+ * body's ak_rigid_body_mesh (before: hulls, compounds and meshes came out empty). */
+AK_TEST(glb_carries_every_shape) {
+    AK_CHECK_MSG(run("rigid " AK_SOURCE_DIR "/examples/rigid_shapes.json --steps 10 -o draw_shapes.glb",
+                     true) == 0, "%s", out_buf);
+    ak_rigid_scene sc;
+    ak_rigid_scene_run rr;
+    memset(&rr, 0, sizeof rr);
+    ak_diag diag;
+    ak_rigid_scene_defaults(&sc);
+    AK_CHECK_EQ(ak_rigid_scene_load_file(AK_SOURCE_DIR "/examples/rigid_shapes.json", &sc, &diag), AK_OK);
+    AK_CHECK_EQ(ak_rigid_scene_run_init(&rr, &sc, "shapes", &diag), AK_OK);
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load("draw_shapes.glb", NULL, NULL, &s, &diag), AK_OK);
+    if (s && rr.model) {
+        AK_CHECK_EQ(s->mesh_count, rr.body_count);
+        for (size_t i = 0; i < s->mesh_count && i < rr.body_count; ++i) {
+            size_t nv, ni;
+            ak_rigid_body_mesh_size(rr.model, i, &nv, &ni);
+            AK_CHECK(nv > 0);
+            AK_CHECK_EQ(s->meshes[i].mesh->vertex_count, nv);
+            AK_CHECK_EQ(3 * s->meshes[i].mesh->triangle_count, ni);
+        }
+    }
+    ak_scene_destroy(s);
+    ak_rigid_scene_run_free(&rr);
+    ak_rigid_scene_free(&sc);
+}
+
+/* The Khronos validator on that file (slow: node starts; SKIP without it). */
+AK_TEST(glb_of_every_shape_validates) {
+    AK_CHECK_MSG(run("rigid " AK_SOURCE_DIR "/examples/rigid_shapes.json --steps 10 -o draw_shapes_v.glb",
+                     true) == 0, "%s", out_buf);
+    const char* files[1] = {"draw_shapes_v.glb"};
+    ak_test_gltf_validate(files, 1, "every shape baked");
+}
+
 int main(void) {
     AK_RUN(hull_mesh_is_closed_holds_the_volume_and_the_points);
     AK_RUN(compound_mesh_is_its_children);
     AK_RUN(heightfield_and_trimesh_meshes_keep_their_geometry);
     AK_RUN(cli_draws_a_hull_as_itself);
+    AK_RUN(glb_carries_every_shape);
+    AK_RUN_SLOW(glb_of_every_shape_validates);
     return ak_test_finish();
 }
