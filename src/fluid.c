@@ -274,6 +274,14 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
             !vfinite(k->half_extents) || !(k->half_extents.x >= 0.0f) || !(k->half_extents.y >= 0.0f) ||
             !(k->half_extents.z >= 0.0f))
             return AK_ERR_BAD_ARG;
+        if (k->shape == AK_FLUID_HEIGHTFIELD) {
+            if (k->rows < 2 || k->cols < 2 || (uint64_t)k->rows * k->cols > (1u << 24) ||
+                !(k->spacing > 0.0f) || !ak_finitef(k->spacing))
+                return AK_ERR_BAD_ARG;
+            if (!k->heights) return AK_ERR_NULL_ARG;
+            for (size_t q = 0; q < (size_t)k->rows * k->cols; ++q)
+                if (!ak_finitef(k->heights[q])) return AK_ERR_BAD_ARG;
+        }
         if (k->shape == AK_FLUID_CONVEX) {
             if (k->plane_count == 0 || k->plane_count > AK_FLUID_CONVEX_MAX_PLANES) return AK_ERR_BAD_ARG;
             if (!k->planes) return AK_ERR_NULL_ARG;
@@ -422,6 +430,28 @@ static void parallel_n(ctx* c, phase_fn fn, size_t n) {
 
 static void parallel(ctx* c, phase_fn fn) { parallel_n(c, fn, c->n); }
 
+/* A heightfield collider at p: p in its frame (*l), the surface's height under it (*y) and the
+ * upward unit normal of that triangle (*n, in the frame); false when p is off the grid. */
+static bool heightfield_surface(const ak_fluid_collider* col, ak_quat q, ak_vec3 p, ak_vec3* l,
+                                float* y, ak_vec3* n) {
+    *l = ak_quat_rotate(ak_quat_conjugate(q), ak_vec3_sub(p, col->a));
+    const float fx = l->x / col->spacing, fz = l->z / col->spacing;
+    if (!(fx >= 0.0f) || !(fz >= 0.0f) || fx > (float)(col->cols - 1) || fz > (float)(col->rows - 1))
+        return false;
+    uint32_t i = (uint32_t)fx, j = (uint32_t)fz;
+    if (i > col->cols - 2) i = col->cols - 2;
+    if (j > col->rows - 2) j = col->rows - 2;
+    const float u = fx - (float)i, v = fz - (float)j, s = col->spacing;
+    const float* hr = col->heights + (size_t)j * col->cols + i;
+    const float h00 = hr[0], h10 = hr[1], h01 = hr[col->cols], h11 = hr[col->cols + 1];
+    /* rigid.h's split: (00, 01, 11) where v >= u, else (00, 11, 10); the surface over the
+     * triangle is h00 + a u + b v, its upward normal (-a/s, 1, -b/s) */
+    const float a = v >= u ? h11 - h01 : h10 - h00, b = v >= u ? h01 - h00 : h11 - h10;
+    *y = h00 + a * u + b * v;
+    *n = ak_vec3_normalize(ak_vec3_make(-a / s, 1.0f, -b / s));
+    return true;
+}
+
 /* Rotation of a box or convex collider's frame (zero -> identity). */
 static ak_quat collider_rotation(const ak_fluid_collider* col) {
     const ak_quat q = col->orientation;
@@ -472,6 +502,15 @@ static float collider_distance(const ak_fluid_collider* col, ak_vec3 p, ak_vec3*
         *out_n = ak_quat_rotate(q, ak_vec3_make(pl.x, pl.y, pl.z));
         return best;
     }
+    case AK_FLUID_HEIGHTFIELD: {
+        ak_vec3 l, n;
+        float y;
+        const ak_quat q = collider_rotation(col);
+        *out_n = ak_quat_rotate(q, ak_vec3_make(0, 1, 0));
+        if (!heightfield_surface(col, q, p, &l, &y, &n)) return INFINITY; /* off the grid */
+        *out_n = ak_quat_rotate(q, n);
+        return (l.y - y) * n.y; /* the distance to the triangle's plane */
+    }
     default: {
         ak_vec3 q = col->a;
         if (col->shape == AK_FLUID_CAPSULE) {
@@ -501,6 +540,17 @@ static bool collide_pass(const ctx* c, ak_vec3* p, ak_vec3* v) {
         if (!(depth > 0.0f)) continue;
         moved = true;
         *p = ak_vec3_add(*p, ak_vec3_scale(n, depth));
+        if (col->shape == AK_FLUID_HEIGHTFIELD) {
+            /* along the normal p may have crossed into a neighbouring triangle and still be
+             * under it (a valley): then straight up onto the surface, which is exact */
+            ak_vec3 l, nl;
+            float y;
+            const ak_quat q = collider_rotation(col);
+            if (heightfield_surface(col, q, *p, &l, &y, &nl) && l.y < y) {
+                l.y = y;
+                *p = ak_vec3_add(col->a, ak_quat_rotate(q, l));
+            }
+        }
         if (v) {
             /* the surface's velocity at the projected point */
             const ak_vec3 vs = ak_vec3_add(col->velocity,

@@ -68,6 +68,58 @@ AK_TEST(box_and_convex_colliders_project_to_the_nearest_face) {
     AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_ERR_BAD_ARG);
 }
 
+/* Height of a heightfield's surface at local (x, z) from its two triangles per cell, written
+ * independently of the solver (rigid.h's split: (00, 01, 11) where v >= u, else (00, 11, 10)). */
+static float hf_height(const float* h, uint32_t cols, float spacing, float x, float z) {
+    float fx = x / spacing, fz = z / spacing;
+    uint32_t i = (uint32_t)floorf(fx), j = (uint32_t)floorf(fz);
+    float u = fx - (float)i, v = fz - (float)j;
+    float h00 = h[j * cols + i], h10 = h[j * cols + i + 1], h01 = h[(j + 1) * cols + i],
+          h11 = h[(j + 1) * cols + i + 1];
+    if (v >= u) return h00 + v * (h01 - h00) + u * (h11 - h01);
+    return h00 + u * (h10 - h00) + v * (h11 - h10);
+}
+
+AK_TEST(heightfield_collider_projects_onto_its_triangle) {
+    /* the plane y = 0.5 x sampled 3 x 3, 1 m apart, in a frame turned 30 deg about Y at (2, -1,
+     * 3): a particle 0.15 m under the surface at local (1.3, _, 0.7) goes along the normal
+     * (-0.5, 1, 0)/sqrt(1.25) by 0.15/sqrt(1.25) onto the plane; one off the grid stays */
+    const float h[9] = {0, 0.5f, 1, 0, 0.5f, 1, 0, 0.5f, 1};
+    const ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.5235988f);
+    const ak_vec3 a = {2, -1, 3};
+    ak_fluid_collider hf = {.shape = AK_FLUID_HEIGHTFIELD, .a = a, .orientation = q, .heights = h,
+                            .rows = 3, .cols = 3, .spacing = 1};
+    const ak_vec3 in_l = {1.3f, 0.5f, 0.7f};
+    const ak_vec3 nl = ak_vec3_scale(ak_vec3_make(-0.5f, 1, 0), 1.0f / sqrtf(1.25f));
+    const ak_vec3 want_l = ak_vec3_add(in_l, ak_vec3_scale(nl, 0.15f / sqrtf(1.25f)));
+    const ak_vec3 got = project_one(&hf, ak_vec3_add(a, ak_quat_rotate(q, in_l)));
+    const ak_vec3 got_l = ak_quat_rotate(ak_quat_conjugate(q), ak_vec3_sub(got, a));
+    AK_CHECK_MSG(ak_vec3_distance(got_l, want_l) < 1e-5f, "(%g %g %g)", got_l.x, got_l.y, got_l.z);
+    AK_CHECK_NEAR(got_l.y, 0.5f * got_l.x, 1e-5f);
+    const ak_vec3 off = ak_vec3_add(a, ak_quat_rotate(q, ak_vec3_make(2.5f, -3, 1)));
+    AK_CHECK(ak_vec3_distance(project_one(&hf, off), off) < 1e-6f);
+    const ak_vec3 above = ak_vec3_add(a, ak_quat_rotate(q, ak_vec3_make(1.3f, 0.7f, 0.7f)));
+    AK_CHECK(ak_vec3_distance(project_one(&hf, above), above) < 1e-6f);
+    /* bad heightfields */
+    ak_fluid_desc d = {.h = 0.1f, .particle_mass = 0.001f};
+    ak_vec3 pos[1] = {{0, 0, 0}}, vel[1] = {{0, 0, 0}};
+    size_t n = 1, bytes = ak_fluid_scratch_size(1, &d);
+    unsigned char* mem = malloc(bytes);
+    ak_fluid_step_job job = {.desc = &d, .dt = 0.01f, .positions = {pos, 1}, .velocities = {vel, 1},
+                             .particle_count = &n, .colliders = {&hf, 1}, .scratch = {mem, bytes}};
+    AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_OK);
+    hf.rows = 1;
+    AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_ERR_BAD_ARG);
+    hf.rows = 3, hf.spacing = 0;
+    AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_ERR_BAD_ARG);
+    hf.spacing = 1, hf.heights = NULL;
+    AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_ERR_NULL_ARG);
+    const float bad[9] = {0, 0, 0, 0, NAN, 0, 0, 0, 0};
+    hf.heights = bad;
+    AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_ERR_BAD_ARG);
+    free(mem);
+}
+
 AK_TEST(a_turning_collider_gives_its_surface_velocity) {
     /* SPH (velocities are the solver's own, not derived from positions): a particle resting on
      * top of a box spinning at 2 rad/s about +Y, 0.3 m from the axis, with friction 1, takes the
@@ -108,7 +160,7 @@ AK_TEST(rigid_bodies_become_fluid_colliders) {
     if (!m) return;
     size_t nc = 0, np = 0;
     ak_rigid_fluid_colliders_size(m, &nc, &np);
-    AK_CHECK_EQ(nc, 5u); /* plane, capsule, hull, sphere and box children; no heightfield */
+    AK_CHECK_EQ(nc, 6u); /* plane, capsule, hull, sphere and box children, heightfield */
     AK_CHECK_EQ(np, 4u);
     ak_vec3 x[5], v[5], w[5];
     ak_quat q[5];
@@ -126,7 +178,10 @@ AK_TEST(rigid_bodies_become_fluid_colliders) {
                                          (ak_fluid_collider_span){cols, 8},
                                          (ak_vec4_span){planes, 8}, &got),
                 AK_OK);
-    AK_CHECK_EQ(got, 5u);
+    AK_CHECK_EQ(got, 6u);
+    AK_CHECK_EQ(cols[5].shape, AK_FLUID_HEIGHTFIELD);
+    AK_CHECK(cols[5].rows == 2 && cols[5].cols == 2 && cols[5].spacing == 1.0f && cols[5].heights != NULL);
+    AK_CHECK(cols[5].heights != hts); /* the model's copy */
     AK_CHECK_EQ(cols[0].shape, AK_FLUID_PLANE);
     AK_CHECK(ak_vec3_length(cols[0].velocity) == 0.0f);
     AK_CHECK_NEAR(cols[0].normal.y, 1.0f, 1e-6f);
@@ -162,7 +217,7 @@ AK_TEST(rigid_bodies_become_fluid_colliders) {
     /* errors */
     AK_CHECK_EQ(ak_rigid_fluid_colliders(m, (ak_vec3_cspan){x, 5}, (ak_quat_cspan){q, 5},
                                          (ak_vec3_cspan){v, 5}, (ak_vec3_cspan){w, 5},
-                                         (ak_fluid_collider_span){cols, 4},
+                                         (ak_fluid_collider_span){cols, 5},
                                          (ak_vec4_span){planes, 8}, &got),
                 AK_ERR_SPAN_SMALL);
     AK_CHECK_EQ(ak_rigid_fluid_colliders(m, (ak_vec3_cspan){x, 5}, (ak_quat_cspan){q, 5},
@@ -324,6 +379,43 @@ AK_TEST(liquid_poured_on_a_tilted_hull_never_enters_it) {
     coupled_free(&c);
 }
 
+AK_TEST(liquid_poured_on_a_heightfield_stays_above_it) {
+    /* a static heightfield bowl h = 0.3 + 1.5 ((x - 0.2)^2 + (z - 0.2)^2), 11 x 11 samples 5 cm
+     * apart from x, z = -0.05 (it reaches past the 0.4 x 0.4 m tank's walls: the tank's clamp
+     * must not put a particle back over the grid under its rim); 4 cm particles dropped on it:
+     * at every step no particle is under the surface (the same triangles interpolated
+     * independently, 1e-4 m), and the liquid gathers at the bottom: its mean height under the
+     * rim's */
+    static float bowl[121];
+    for (int j = 0; j < 11; ++j)
+        for (int i = 0; i < 11; ++i) {
+            float x = 0.05f * (float)i - 0.25f, z = 0.05f * (float)j - 0.25f;
+            bowl[j * 11 + i] = 0.3f + 1.5f * (x * x + z * z);
+        }
+    ak_rigid_body_desc b[1] = {{.shape = {.type = AK_RIGID_HEIGHTFIELD, .heights = {bowl, 121},
+                                          .rows = 11, .cols = 11, .spacing = 0.05f},
+                                .position = {-0.05f, 0, -0.05f}}};
+    coupled c;
+    AK_CHECK(coupled_init(&c, b, 1, ak_vec3_make(0, -9.81f, 0), ak_vec3_make(0, 0, 0),
+                          ak_vec3_make(0.4f, 2, 0.4f), ak_vec3_make(0.04f, 0.6f, 0.04f),
+                          ak_vec3_make(0.36f, 0.76f, 0.36f)));
+    float worst = -INFINITY;
+    for (int s = 0; s < 120 && !ak_test_cur_failed_; ++s) {
+        AK_CHECK(coupled_step(&c));
+        for (size_t i = 0; i < c.n; ++i)
+            worst = fmaxf(worst, hf_height(bowl, 11, 0.05f, c.pos[i].x + 0.05f, c.pos[i].z + 0.05f) -
+                                     c.pos[i].y);
+    }
+    double my = 0.0;
+    for (size_t i = 0; i < c.n; ++i) my += c.pos[i].y;
+    my /= (double)c.n;
+    printf("  heightfield bowl: %zu particles, deepest under the surface %g m, mean height %.3f m\n",
+           c.n, (double)worst, my);
+    AK_CHECK_MSG(worst <= 1e-4f, "a particle %g m under the surface", worst);
+    AK_CHECK_MSG(my < 0.3 + 1.5 * 0.08, "mean height %g m: over the rim", my);
+    coupled_free(&c);
+}
+
 AK_TEST(a_moving_box_pushes_the_liquid) {
     /* a box 0.12 m wide moving at 1 m/s along +X (no gravity on the bodies, no contacts: it keeps
      * its speed) through a layer of liquid resting on the tank's floor: no particle inside it at
@@ -391,10 +483,12 @@ AK_TEST(fluid_scene_box_colliders) {
 
 int main(void) {
     AK_RUN(box_and_convex_colliders_project_to_the_nearest_face);
+    AK_RUN(heightfield_collider_projects_onto_its_triangle);
     AK_RUN(a_turning_collider_gives_its_surface_velocity);
     AK_RUN(rigid_bodies_become_fluid_colliders);
     AK_RUN(liquid_poured_on_a_static_box_lands_as_on_a_raised_floor);
     AK_RUN(liquid_poured_on_a_tilted_hull_never_enters_it);
+    AK_RUN(liquid_poured_on_a_heightfield_stays_above_it);
     AK_RUN(a_moving_box_pushes_the_liquid);
     AK_RUN(fluid_scene_box_colliders);
     return ak_test_finish();

@@ -180,6 +180,12 @@ typedef enum ak_fluid_shape {
     AK_FLUID_CONVEX,    /* a convex polytope: the points x with n.(x') <= d for every plane
                            (n, d) of planes, x' = orientation^-1 (x - a) in the collider's frame:
                            the liquid stays outside (a rigid hull: ak_rigid_fluid_colliders) */
+    AK_FLUID_HEIGHTFIELD, /* terrain, solid below its surface: heights[row * cols + col] of
+                           sample (col, row) at (col * spacing, height, row * spacing) in the frame
+                           (a, orientation), each cell two triangles as rigid.h's heightfield
+                           (00-01-11, 00-11-10); a particle over the grid and under the surface is
+                           moved out along its triangle's normal (a rigid heightfield:
+                           ak_rigid_fluid_colliders) */
     AK_FLUID_SHAPE_COUNT
 } ak_fluid_shape;
 
@@ -204,6 +210,9 @@ typedef struct ak_fluid_collider {
     const ak_vec4* planes;    /* convex: (n.x, n.y, n.z, d) in the frame, n unit (within 1e-3);
                                  the liquid stays where n.x' > d for some plane */
     uint32_t plane_count;     /* convex: 1 .. AK_FLUID_CONVEX_MAX_PLANES */
+    const float* heights;     /* heightfield: rows * cols finite heights (m), not copied */
+    uint32_t rows, cols;      /* heightfield: >= 2 each, rows * cols <= 2^24 */
+    float spacing;            /* heightfield: metres between samples, > 0 */
 } ak_fluid_collider;
 
 typedef struct ak_fluid_emitter {

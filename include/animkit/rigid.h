@@ -454,9 +454,8 @@ AK_API ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan 
 /* ---- the bodies as colliders of the fluid (one-way) ------------------------------------ */
 
 /* Colliders and convex planes ak_rigid_fluid_colliders writes for a model: one collider per
- * sphere, box, capsule, plane and hull body and per child of a compound; a hull's collider
- * takes one plane per face. Heightfields and triangle meshes are not passed to the fluid (0).
- * 0 for NULL. */
+ * sphere, box, capsule, plane, hull and heightfield body and per child of a compound; a hull's
+ * collider takes one plane per face. Triangle meshes are not passed to the fluid. 0 for NULL. */
 AK_API void ak_rigid_fluid_colliders_size(const ak_rigid_model* model, size_t* out_collider_count,
                                           size_t* out_plane_count);
 /* The bodies at a state as the fluid's colliders (fluid.h), so a liquid collides one-way with
@@ -471,7 +470,8 @@ AK_API void ak_rigid_fluid_colliders_size(const ak_rigid_model* model, size_t* o
  * A sphere becomes AK_FLUID_SPHERE, a capsule AK_FLUID_CAPSULE (its segment's ends), a box
  * AK_FLUID_BOX, a plane AK_FLUID_PLANE, a hull AK_FLUID_CONVEX (its faces' planes in its body
  * frame, written to out_planes, which the colliders point into: keep it alive while they are
- * used), a compound one of those per child, in body order (children in order). Each collider
+ * used), a heightfield AK_FLUID_HEIGHTFIELD (pointing at the model's samples: keep the model
+ * alive), a compound one of those per child, in body order (children in order). Each collider
  * carries its body's motion: velocity at its point a (v + w x (a - x)) and angular velocity w
  * (zero for static bodies). Sizes from ak_rigid_fluid_colliders_size; *out_collider_count (may
  * be NULL) gets the count written. AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a

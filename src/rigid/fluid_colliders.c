@@ -4,7 +4,7 @@
 
 #include "rigid_impl.h"
 
-/* Colliders and planes one shape needs (0 for a heightfield or trimesh: not passed). */
+/* Colliders and planes one shape needs (0 for a trimesh: not passed). */
 static void shape_need(const ak_rigid_shape* s, const akp_hull* hull, const akp_compound* comp,
                        size_t* nc, size_t* np) {
     switch (s->type) {
@@ -12,6 +12,7 @@ static void shape_need(const ak_rigid_shape* s, const akp_hull* hull, const akp_
     case AK_RIGID_BOX:
     case AK_RIGID_CAPSULE:
     case AK_RIGID_PLANE:
+    case AK_RIGID_HEIGHTFIELD:
         *nc += 1;
         break;
     case AK_RIGID_HULL:
@@ -57,9 +58,7 @@ static void emit_shape(emit_ctx* e, const ak_rigid_shape* s, const akp_hull* hul
         }
         return;
     }
-    if (s->type == AK_RIGID_HEIGHTFIELD || s->type == AK_RIGID_TRIMESH ||
-        (s->type == AK_RIGID_HULL && !hull))
-        return;
+    if (s->type == AK_RIGID_TRIMESH || (s->type == AK_RIGID_HULL && !hull)) return;
     ak_fluid_collider c = {.a = px, .orientation = pq, .angular_velocity = e->w};
     switch (s->type) {
     case AK_RIGID_SPHERE:
@@ -77,6 +76,13 @@ static void emit_shape(emit_ctx* e, const ak_rigid_shape* s, const akp_hull* hul
     case AK_RIGID_BOX:
         c.shape = AK_FLUID_BOX;
         c.half_extents = s->half_extents;
+        break;
+    case AK_RIGID_HEIGHTFIELD: /* the model's copy of the samples */
+        c.shape = AK_FLUID_HEIGHTFIELD;
+        c.heights = s->heights.ptr;
+        c.rows = s->rows;
+        c.cols = s->cols;
+        c.spacing = s->spacing;
         break;
     case AK_RIGID_PLANE:
         c.shape = AK_FLUID_PLANE;
