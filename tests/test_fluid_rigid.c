@@ -481,6 +481,77 @@ AK_TEST(fluid_scene_box_colliders) {
     free(sc);
 }
 
+/* Hydrostatic rest on a body: a WCSPH column (6 x 6 x 16 particles at 1 cm, as test_fluid.c's
+ * hydrostatic column) standing on a static box body 5 cm tall that covers the tank's floor (and
+ * reaches past its walls). The fitted slope of pressure against height, over the particles more
+ * than h from the box's top and from the surface, averaged over the last 500 of 1300 steps of
+ * 3e-4 s, is rho0 g within 5% (the same bound as on the tank's own floor), and no particle is
+ * ever inside the box. */
+AK_TEST(column_on_a_box_body_is_hydrostatic) {
+    ak_fluid_desc d = {.solver = AK_FLUID_WCSPH, .particle_mass = 0.001f, .gravity = {0, -9.81f, 0},
+                       .viscosity = 0.2f, .sound_speed = 15.0f};
+    const float s = ak_fluid_rest_spacing(&d), top_of_box = 0.05f;
+    const int w = 6, ht = 16;
+    d.h = 2.0f * s;
+    d.box_min = ak_vec3_make(0, 0, 0);
+    d.box_max = ak_vec3_make((float)w * s, top_of_box + 3.0f * (float)ht * s, (float)w * s);
+    const ak_vec3 he = {(float)w * s, 0.5f * top_of_box, (float)w * s};
+    const ak_vec3 bx = {0.5f * (float)w * s, 0.5f * top_of_box, 0.5f * (float)w * s};
+    ak_rigid_body_desc b[1] = {{.shape = {.type = AK_RIGID_BOX, .half_extents = he}, .position = bx,
+                                .is_static = true}};
+    ak_rigid_model* m = NULL;
+    AK_CHECK_EQ(ak_rigid_model_create(&(ak_rigid_model_desc){.bodies = {b, 1}}, NULL, &m), AK_OK);
+    if (!m) return;
+    ak_vec3 x[1], v[1], wv[1];
+    ak_quat q[1];
+    ak_rigid_initial_state(m, (ak_vec3_span){x, 1}, (ak_quat_span){q, 1}, (ak_vec3_span){v, 1},
+                           (ak_vec3_span){wv, 1});
+    ak_fluid_collider col[1];
+    size_t nc = 0;
+    AK_CHECK_EQ(ak_rigid_fluid_colliders(m, (ak_vec3_cspan){x, 1}, (ak_quat_cspan){q, 1},
+                                         (ak_vec3_cspan){v, 1}, (ak_vec3_cspan){wv, 1},
+                                         (ak_fluid_collider_span){col, 1}, (ak_vec4_span){NULL, 0}, &nc),
+                AK_OK);
+    const size_t cap = (size_t)w * w * ht;
+    ak_vec3* pos = malloc(cap * sizeof *pos);
+    ak_vec3* vel = calloc(cap, sizeof *vel);
+    float* pres = malloc(cap * sizeof *pres);
+    size_t n = ak_fluid_fill_box(&d, ak_vec3_make(0, top_of_box, 0),
+                                 ak_vec3_make((float)w * s, top_of_box + (float)ht * s, (float)w * s),
+                                 (ak_vec3_span){pos, cap});
+    size_t bytes = ak_fluid_scratch_size(cap, &d);
+    void* mem = malloc(bytes);
+    ak_fluid_step_job job = {.desc = &d, .dt = 3e-4f, .positions = {pos, cap}, .velocities = {vel, cap},
+                             .particle_count = &n, .colliders = {col, nc}, .scratch = {mem, bytes},
+                             .out_pressures = {pres, cap}};
+    double sum = 0.0;
+    int fits = 0;
+    float deepest = -INFINITY;
+    const int steps = 1300, window = 500;
+    for (int step = 0; step < steps && !ak_test_cur_failed_; ++step) {
+        AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+        for (size_t i = 0; i < n; ++i) deepest = fmaxf(deepest, box_depth(pos[i], bx, q[0], he));
+        if (step < steps - window) continue;
+        float top = 0.0f;
+        for (size_t i = 0; i < n; ++i) top = fmaxf(top, pos[i].y);
+        double sx = 0, sy = 0, sxx = 0, sxy = 0;
+        int cnt = 0;
+        for (size_t i = 0; i < n; ++i) {
+            const double y = pos[i].y;
+            if (y < top_of_box + d.h || y > top - d.h) continue;
+            sx += y, sy += pres[i], sxx += y * y, sxy += y * pres[i], ++cnt;
+        }
+        if (cnt > 10) sum += -(cnt * sxy - sx * sy) / (cnt * sxx - sx * sx), ++fits;
+    }
+    const double slope = fits ? sum / fits : NAN;
+    printf("  column on a box body: pressure slope %.1f Pa/m against rho g %.1f; deepest %g m\n",
+           slope, 1000.0 * 9.81, (double)deepest);
+    AK_CHECK_MSG(fabs(slope / (1000.0 * 9.81) - 1.0) < 0.05, "slope %.1f Pa/m", slope);
+    AK_CHECK_MSG(deepest <= 1e-5f, "a particle %g m inside the box", deepest);
+    free(mem), free(pres), free(vel), free(pos);
+    ak_rigid_model_destroy(m);
+}
+
 int main(void) {
     AK_RUN(box_and_convex_colliders_project_to_the_nearest_face);
     AK_RUN(heightfield_collider_projects_onto_its_triangle);
@@ -491,5 +562,6 @@ int main(void) {
     AK_RUN(liquid_poured_on_a_heightfield_stays_above_it);
     AK_RUN(a_moving_box_pushes_the_liquid);
     AK_RUN(fluid_scene_box_colliders);
+    AK_RUN_SLOW(column_on_a_box_body_is_hydrostatic); /* 1300 WCSPH steps: about 1 s */
     return ak_test_finish();
 }
