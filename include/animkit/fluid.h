@@ -41,13 +41,14 @@
  * the caller's order. Each list holds the particles closer than h in a fixed order (cells z,
  * then y, then x, each in index order), the same on both paths.
  *
- * Boundaries (all solvers): a box container, planes, spheres, capsules, oriented boxes and
- * convex polytopes (so rigid bodies reach the liquid one-way: ak_rigid_fluid_colliders in
- * rigid.h), each optionally moving with a velocity and an angular velocity. The method is
- * projection: a particle found inside a collider (or outside the box) is moved to the nearest
- * surface point (a box's or a polytope's: through the face it is least deep under), and its
- * velocity loses only the component into the surface relative to the surface's velocity (the tangential component is
- * kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so the velocity
+ * Boundaries (all solvers): a box container, planes, spheres, capsules, oriented boxes,
+ * convex polytopes and heightfields (so rigid bodies reach the liquid one-way:
+ * ak_rigid_fluid_colliders in rigid.h), each optionally moving with a velocity and an angular
+ * velocity. The method is projection: a particle found inside a collider (or outside the box)
+ * is moved to the nearest surface point (a box's or a polytope's: through the face it is least
+ * deep under; a heightfield's: along the normal of the triangle under it), and its velocity
+ * loses only the component into the surface relative to the surface's velocity (the tangential
+ * component is kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so the velocity
  * update v = (x* - x)/dt inherits the same rule. Nothing leaks (every particle ends each step
  * outside every collider and inside the box, up to float rounding of the projection; where two
  * colliders overlap, a particle in the crease between them may stay inside one: the colliders
