@@ -13,10 +13,12 @@ int main(void) {
     const ak_vec3 wedge[6] = {{-0.15f, 0, -0.15f}, {0.15f, 0, -0.15f}, {-0.15f, 0.15f, -0.15f},
                               {-0.15f, 0, 0.15f},  {0.15f, 0, 0.15f},  {-0.15f, 0.15f, 0.15f}};
     ak_rigid_body_desc bodies[2] = {
-        {.shape = {.type = AK_RIGID_HULL, .points = {wedge, 6}}, .position = {0.3f, 0.0f, 0.2f},
+        {.shape = {.type = AK_RIGID_HULL, .points = {wedge, 6}},
+         .position = {0.3f, 0.0f, 0.2f},
          .is_static = true},
         {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.04f, 0.1f, 0.15f}},
-         .position = {0.7f, 0.1f, 0.2f}, .velocity = {-0.5f, 0, 0}}};
+         .position = {0.7f, 0.1f, 0.2f},
+         .velocity = {-0.5f, 0, 0}}};
     ak_rigid_model* model = NULL;
     if (ak_rigid_model_create(&(ak_rigid_model_desc){.bodies = {bodies, 2}}, NULL, &model) != AK_OK)
         return 1;
@@ -25,15 +27,22 @@ int main(void) {
     ak_rigid_initial_state(model, (ak_vec3_span){x, 2}, (ak_quat_span){q, 2}, (ak_vec3_span){v, 2},
                            (ak_vec3_span){w, 2});
     const float dt = 1.0f / 200.0f;
-    ak_rigid_step_job rj = {.model = model, .dt = dt, .substeps = 4, .positions = {x, 2},
-                            .orientations = {q, 2}, .velocities = {v, 2},
+    ak_rigid_step_job rj = {.model = model,
+                            .dt = dt,
+                            .substeps = 4,
+                            .positions = {x, 2},
+                            .orientations = {q, 2},
+                            .velocities = {v, 2},
                             .angular_velocities = {w, 2}}; /* no gravity: the box keeps sliding */
     size_t rbytes = ak_rigid_step_scratch_size(&rj);
     rj.scratch = (ak_u8_span){malloc(rbytes), rbytes};
 
-    /* liquid: 4 cm particles, a 0.24 x 0.16 x 0.24 m block over the wedge, in a 0.8 x 1 x 0.4 tank */
-    ak_fluid_desc fd = {.h = 0.08f, .particle_mass = 0.064f, .gravity = {0, -9.81f, 0},
-                        .box_min = {0, 0, 0}, .box_max = {0.8f, 1.0f, 0.4f}};
+    /* liquid: 4 cm particles, a 0.24 x 0.16 x 0.24 m block over the wedge; a 0.8 x 1 x 0.4 tank */
+    ak_fluid_desc fd = {.h = 0.08f,
+                        .particle_mass = 0.064f,
+                        .gravity = {0, -9.81f, 0},
+                        .box_min = {0, 0, 0},
+                        .box_max = {0.8f, 1.0f, 0.4f}};
     const ak_vec3 lo = {0.12f, 0.3f, 0.08f}, hi = {0.36f, 0.46f, 0.32f};
     size_t cap = ak_fluid_fill_box(&fd, lo, hi, (ak_vec3_span){NULL, 0}), n;
     ak_vec3* pos = malloc(cap * sizeof *pos);
@@ -42,8 +51,12 @@ int main(void) {
     void* fscratch = malloc(fbytes);
     if (!rj.scratch.ptr || !pos || !vel || !fscratch) return 1;
     n = ak_fluid_fill_box(&fd, lo, hi, (ak_vec3_span){pos, cap});
-    ak_fluid_step_job fj = {.desc = &fd, .dt = dt, .positions = {pos, cap}, .velocities = {vel, cap},
-                            .particle_count = &n, .scratch = {fscratch, fbytes}};
+    ak_fluid_step_job fj = {.desc = &fd,
+                            .dt = dt,
+                            .positions = {pos, cap},
+                            .velocities = {vel, cap},
+                            .particle_count = &n,
+                            .scratch = {fscratch, fbytes}};
 
     size_t nc, np;
     ak_rigid_fluid_colliders_size(model, &nc, &np); /* 2 colliders, the wedge's 5 planes */

@@ -268,10 +268,11 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
         return AK_ERR_BAD_ARG;
     for (size_t c = 0; c < job->colliders.count; ++c) {
         const ak_fluid_collider* k = &job->colliders.ptr[c];
-        if ((unsigned)k->shape >= AK_FLUID_SHAPE_COUNT || !(k->radius >= 0.0f) || !ak_finitef(k->radius) ||
-            !vfinite(k->a) || !vfinite(k->b) || !vfinite(k->normal) || !vfinite(k->velocity) ||
-            !vfinite(k->angular_velocity) || !ak_quat_is_finite(k->orientation) ||
-            !vfinite(k->half_extents) || !(k->half_extents.x >= 0.0f) || !(k->half_extents.y >= 0.0f) ||
+        if ((unsigned)k->shape >= AK_FLUID_SHAPE_COUNT || !(k->radius >= 0.0f) ||
+            !ak_finitef(k->radius) || !vfinite(k->a) || !vfinite(k->b) || !vfinite(k->normal) ||
+            !vfinite(k->velocity) || !vfinite(k->angular_velocity) ||
+            !ak_quat_is_finite(k->orientation) || !vfinite(k->half_extents) ||
+            !(k->half_extents.x >= 0.0f) || !(k->half_extents.y >= 0.0f) ||
             !(k->half_extents.z >= 0.0f))
             return AK_ERR_BAD_ARG;
         if (k->shape == AK_FLUID_HEIGHTFIELD) {
@@ -283,7 +284,8 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
                 if (!ak_finitef(k->heights[q])) return AK_ERR_BAD_ARG;
         }
         if (k->shape == AK_FLUID_CONVEX) {
-            if (k->plane_count == 0 || k->plane_count > AK_FLUID_CONVEX_MAX_PLANES) return AK_ERR_BAD_ARG;
+            if (k->plane_count == 0 || k->plane_count > AK_FLUID_CONVEX_MAX_PLANES)
+                return AK_ERR_BAD_ARG;
             if (!k->planes) return AK_ERR_NULL_ARG;
             for (uint32_t q = 0; q < k->plane_count; ++q) {
                 const ak_vec4 pl = k->planes[q];
@@ -436,7 +438,8 @@ static bool heightfield_surface(const ak_fluid_collider* col, ak_quat q, ak_vec3
                                 float* y, ak_vec3* n) {
     *l = ak_quat_rotate(ak_quat_conjugate(q), ak_vec3_sub(p, col->a));
     const float fx = l->x / col->spacing, fz = l->z / col->spacing;
-    if (!(fx >= 0.0f) || !(fz >= 0.0f) || fx > (float)(col->cols - 1) || fz > (float)(col->rows - 1))
+    if (!(fx >= 0.0f) || !(fz >= 0.0f) || fx > (float)(col->cols - 1) ||
+        fz > (float)(col->rows - 1))
         return false;
     uint32_t i = (uint32_t)fx, j = (uint32_t)fz;
     if (i > col->cols - 2) i = col->cols - 2;
@@ -464,14 +467,16 @@ static ak_quat collider_rotation(const ak_fluid_collider* col) {
 static float collider_distance(const ak_fluid_collider* col, ak_vec3 p, ak_vec3* out_n) {
     switch (col->shape) {
     case AK_FLUID_PLANE: {
-        ak_vec3 n = ak_vec3_length_sq(col->normal) > 0.0f ? ak_vec3_normalize(col->normal) : ak_vec3_make(0, 1, 0);
+        ak_vec3 n = ak_vec3_length_sq(col->normal) > 0.0f ? ak_vec3_normalize(col->normal)
+                                                          : ak_vec3_make(0, 1, 0);
         *out_n = n;
         return ak_vec3_dot(ak_vec3_sub(p, col->a), n);
     }
     case AK_FLUID_BOX: {
         const ak_quat q = collider_rotation(col);
         const ak_vec3 l = ak_quat_rotate(ak_quat_conjugate(q), ak_vec3_sub(p, col->a));
-        const float lc[3] = {l.x, l.y, l.z}, hc[3] = {col->half_extents.x, col->half_extents.y, col->half_extents.z};
+        const float lc[3] = {l.x, l.y, l.z},
+                    hc[3] = {col->half_extents.x, col->half_extents.y, col->half_extents.z};
         float out2 = 0.0f, inside = -INFINITY;
         int axis = 0;
         for (int k = 0; k < 3; ++k) {
@@ -553,8 +558,8 @@ static bool collide_pass(const ctx* c, ak_vec3* p, ak_vec3* v) {
         }
         if (v) {
             /* the surface's velocity at the projected point */
-            const ak_vec3 vs = ak_vec3_add(col->velocity,
-                                           ak_vec3_cross(col->angular_velocity, ak_vec3_sub(*p, col->a)));
+            const ak_vec3 vs = ak_vec3_add(
+                col->velocity, ak_vec3_cross(col->angular_velocity, ak_vec3_sub(*p, col->a)));
             ak_vec3 rel = ak_vec3_sub(*v, vs);
             float vn = ak_vec3_dot(rel, n);
             if (vn < 0.0f) {

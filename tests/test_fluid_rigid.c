@@ -19,8 +19,13 @@ static ak_vec3 project_one(const ak_fluid_collider* col, ak_vec3 p) {
     ak_vec3 pos[1] = {p}, vel[1] = {{0, 0, 0}};
     size_t n = 1, bytes = ak_fluid_scratch_size(1, &d);
     void* mem = malloc(bytes);
-    ak_fluid_step_job job = {.desc = &d, .dt = 0.01f, .positions = {pos, 1}, .velocities = {vel, 1},
-                             .particle_count = &n, .colliders = {col, 1}, .scratch = {mem, bytes}};
+    ak_fluid_step_job job = {.desc = &d,
+                             .dt = 0.01f,
+                             .positions = {pos, 1},
+                             .velocities = {vel, 1},
+                             .particle_count = &n,
+                             .colliders = {col, 1},
+                             .scratch = {mem, bytes}};
     ak_result r = ak_fluid_step_run(&job);
     free(mem);
     return r == AK_OK ? pos[0] : ak_vec3_make(NAN, NAN, NAN);
@@ -30,7 +35,8 @@ AK_TEST(box_and_convex_colliders_project_to_the_nearest_face) {
     /* a box turned 40 deg about (1, 2, 0.5), half extents (0.3, 0.2, 0.25); a particle at local
      * (0.1, 0.05, -0.02) is 0.2, 0.15 and 0.23 under the x, y and z faces: it goes to local
      * (0.1, 0.2, -0.02), through +y */
-    const ak_quat q = ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(1, 2, 0.5f)), 0.6981317f);
+    const ak_quat q =
+        ak_quat_from_axis_angle(ak_vec3_normalize(ak_vec3_make(1, 2, 0.5f)), 0.6981317f);
     const ak_vec3 a = {0.4f, -0.3f, 1.2f}, he = {0.3f, 0.2f, 0.25f};
     const ak_vec3 inside = ak_vec3_add(a, ak_quat_rotate(q, ak_vec3_make(0.1f, 0.05f, -0.02f)));
     const ak_vec3 want = ak_vec3_add(a, ak_quat_rotate(q, ak_vec3_make(0.1f, 0.2f, -0.02f)));
@@ -38,10 +44,10 @@ AK_TEST(box_and_convex_colliders_project_to_the_nearest_face) {
     ak_vec3 got = project_one(&box, inside);
     AK_CHECK_MSG(ak_vec3_distance(got, want) < 1e-5f, "box: (%g %g %g)", got.x, got.y, got.z);
     /* the same box as six planes */
-    ak_vec4 planes[6] = {{1, 0, 0, 0.3f}, {-1, 0, 0, 0.3f}, {0, 1, 0, 0.2f},
+    ak_vec4 planes[6] = {{1, 0, 0, 0.3f},  {-1, 0, 0, 0.3f}, {0, 1, 0, 0.2f},
                          {0, -1, 0, 0.2f}, {0, 0, 1, 0.25f}, {0, 0, -1, 0.25f}};
-    ak_fluid_collider cvx = {.shape = AK_FLUID_CONVEX, .a = a, .orientation = q, .planes = planes,
-                             .plane_count = 6};
+    ak_fluid_collider cvx = {
+        .shape = AK_FLUID_CONVEX, .a = a, .orientation = q, .planes = planes, .plane_count = 6};
     got = project_one(&cvx, inside);
     AK_CHECK_MSG(ak_vec3_distance(got, want) < 1e-5f, "convex: (%g %g %g)", got.x, got.y, got.z);
     /* a point outside stays where it is */
@@ -53,8 +59,13 @@ AK_TEST(box_and_convex_colliders_project_to_the_nearest_face) {
     ak_vec3 pos[1] = {{0, 0, 0}}, vel[1] = {{0, 0, 0}};
     size_t n = 1;
     unsigned char mem[4096];
-    ak_fluid_step_job job = {.desc = &d, .dt = 0.01f, .positions = {pos, 1}, .velocities = {vel, 1},
-                             .particle_count = &n, .colliders = {&cvx, 1}, .scratch = {mem, sizeof mem}};
+    ak_fluid_step_job job = {.desc = &d,
+                             .dt = 0.01f,
+                             .positions = {pos, 1},
+                             .velocities = {vel, 1},
+                             .particle_count = &n,
+                             .colliders = {&cvx, 1},
+                             .scratch = {mem, sizeof mem}};
     cvx.plane_count = 0;
     AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_ERR_BAD_ARG);
     cvx.plane_count = 6, cvx.planes = NULL;
@@ -87,8 +98,13 @@ AK_TEST(heightfield_collider_projects_onto_its_triangle) {
     const float h[9] = {0, 0.5f, 1, 0, 0.5f, 1, 0, 0.5f, 1};
     const ak_quat q = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.5235988f);
     const ak_vec3 a = {2, -1, 3};
-    ak_fluid_collider hf = {.shape = AK_FLUID_HEIGHTFIELD, .a = a, .orientation = q, .heights = h,
-                            .rows = 3, .cols = 3, .spacing = 1};
+    ak_fluid_collider hf = {.shape = AK_FLUID_HEIGHTFIELD,
+                            .a = a,
+                            .orientation = q,
+                            .heights = h,
+                            .rows = 3,
+                            .cols = 3,
+                            .spacing = 1};
     const ak_vec3 in_l = {1.3f, 0.5f, 0.7f};
     const ak_vec3 nl = ak_vec3_scale(ak_vec3_make(-0.5f, 1, 0), 1.0f / sqrtf(1.25f));
     const ak_vec3 want_l = ak_vec3_add(in_l, ak_vec3_scale(nl, 0.15f / sqrtf(1.25f)));
@@ -105,8 +121,13 @@ AK_TEST(heightfield_collider_projects_onto_its_triangle) {
     ak_vec3 pos[1] = {{0, 0, 0}}, vel[1] = {{0, 0, 0}};
     size_t n = 1, bytes = ak_fluid_scratch_size(1, &d);
     unsigned char* mem = malloc(bytes);
-    ak_fluid_step_job job = {.desc = &d, .dt = 0.01f, .positions = {pos, 1}, .velocities = {vel, 1},
-                             .particle_count = &n, .colliders = {&hf, 1}, .scratch = {mem, bytes}};
+    ak_fluid_step_job job = {.desc = &d,
+                             .dt = 0.01f,
+                             .positions = {pos, 1},
+                             .velocities = {vel, 1},
+                             .particle_count = &n,
+                             .colliders = {&hf, 1},
+                             .scratch = {mem, bytes}};
     AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_OK);
     hf.rows = 1;
     AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_ERR_BAD_ARG);
@@ -124,14 +145,22 @@ AK_TEST(a_turning_collider_gives_its_surface_velocity) {
     /* SPH (velocities are the solver's own, not derived from positions): a particle resting on
      * top of a box spinning at 2 rad/s about +Y, 0.3 m from the axis, with friction 1, takes the
      * surface's velocity w x r = (0, 0, -0.6) m/s at r = (0.3, 0, 0) */
-    ak_fluid_desc d = {.solver = AK_FLUID_SPH, .h = 0.1f, .particle_mass = 0.001f, .friction = 1.0f};
-    ak_fluid_collider box = {.shape = AK_FLUID_BOX, .a = {0, 0, 0}, .half_extents = {1, 0.5f, 1},
+    ak_fluid_desc d = {
+        .solver = AK_FLUID_SPH, .h = 0.1f, .particle_mass = 0.001f, .friction = 1.0f};
+    ak_fluid_collider box = {.shape = AK_FLUID_BOX,
+                             .a = {0, 0, 0},
+                             .half_extents = {1, 0.5f, 1},
                              .angular_velocity = {0, 2, 0}};
     ak_vec3 pos[1] = {{0.3f, 0.499f, 0}}, vel[1] = {{0, -0.1f, 0}};
     size_t n = 1, bytes = ak_fluid_scratch_size(1, &d);
     void* mem = malloc(bytes);
-    ak_fluid_step_job job = {.desc = &d, .dt = 1e-4f, .positions = {pos, 1}, .velocities = {vel, 1},
-                             .particle_count = &n, .colliders = {&box, 1}, .scratch = {mem, bytes}};
+    ak_fluid_step_job job = {.desc = &d,
+                             .dt = 1e-4f,
+                             .positions = {pos, 1},
+                             .velocities = {vel, 1},
+                             .particle_count = &n,
+                             .colliders = {&box, 1},
+                             .scratch = {mem, bytes}};
     AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
     free(mem);
     AK_CHECK_NEAR(pos[0].y, 0.5f, 1e-5f);
@@ -144,7 +173,8 @@ AK_TEST(rigid_bodies_become_fluid_colliders) {
     const ak_vec3 tet[4] = {{0, 0, 0}, {0.4f, 0, 0}, {0, 0.4f, 0}, {0, 0, 0.4f}};
     const ak_rigid_child kids[2] = {
         {.shape = {.type = AK_RIGID_SPHERE, .radius = 0.2f}, .position = {-1, 0, 0}},
-        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.2f, 0.2f}}, .position = {1, 0, 0}}};
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.2f, 0.2f}},
+         .position = {1, 0, 0}}};
     static float hts[4] = {0, 0, 0, 0};
     ak_rigid_body_desc b[5] = {
         {.shape = {.type = AK_RIGID_PLANE}, .is_static = true},
@@ -153,7 +183,10 @@ AK_TEST(rigid_bodies_become_fluid_colliders) {
         {.shape = {.type = AK_RIGID_HULL, .points = {tet, 4}}, .position = {3, 1, 0}},
         {.shape = {.type = AK_RIGID_COMPOUND, .children = kids, .child_count = 2},
          .position = {0, 5, 0}},
-        {.shape = {.type = AK_RIGID_HEIGHTFIELD, .heights = {hts, 4}, .rows = 2, .cols = 2,
+        {.shape = {.type = AK_RIGID_HEIGHTFIELD,
+                   .heights = {hts, 4},
+                   .rows = 2,
+                   .cols = 2,
                    .spacing = 1}}};
     ak_rigid_model* m = NULL;
     AK_CHECK_EQ(ak_rigid_model_create(&(ak_rigid_model_desc){.bodies = {b, 5}}, NULL, &m), AK_OK);
@@ -180,7 +213,8 @@ AK_TEST(rigid_bodies_become_fluid_colliders) {
                 AK_OK);
     AK_CHECK_EQ(got, 6u);
     AK_CHECK_EQ(cols[5].shape, AK_FLUID_HEIGHTFIELD);
-    AK_CHECK(cols[5].rows == 2 && cols[5].cols == 2 && cols[5].spacing == 1.0f && cols[5].heights != NULL);
+    AK_CHECK(cols[5].rows == 2 && cols[5].cols == 2 && cols[5].spacing == 1.0f &&
+             cols[5].heights != NULL);
     AK_CHECK(cols[5].heights != hts); /* the model's copy */
     AK_CHECK_EQ(cols[0].shape, AK_FLUID_PLANE);
     AK_CHECK(ak_vec3_length(cols[0].velocity) == 0.0f);
@@ -259,20 +293,28 @@ typedef struct coupled {
 static bool coupled_init(coupled* c, const ak_rigid_body_desc* bodies, size_t nb, ak_vec3 rigid_g,
                          ak_vec3 box_lo, ak_vec3 box_hi, ak_vec3 block_lo, ak_vec3 block_hi) {
     memset(c, 0, sizeof *c);
-    if (ak_rigid_model_create(&(ak_rigid_model_desc){.bodies = {bodies, nb}}, NULL, &c->model) != AK_OK)
+    if (ak_rigid_model_create(&(ak_rigid_model_desc){.bodies = {bodies, nb}}, NULL, &c->model) !=
+        AK_OK)
         return false;
     c->nb = nb;
     ak_rigid_initial_state(c->model, (ak_vec3_span){c->x, nb}, (ak_quat_span){c->q, nb},
                            (ak_vec3_span){c->v, nb}, (ak_vec3_span){c->w, nb});
-    c->rjob = (ak_rigid_step_job){.model = c->model, .dt = 1.0f / 200.0f, .substeps = 4,
-                                  .gravity = rigid_g, .positions = {c->x, nb},
-                                  .orientations = {c->q, nb}, .velocities = {c->v, nb},
+    c->rjob = (ak_rigid_step_job){.model = c->model,
+                                  .dt = 1.0f / 200.0f,
+                                  .substeps = 4,
+                                  .gravity = rigid_g,
+                                  .positions = {c->x, nb},
+                                  .orientations = {c->q, nb},
+                                  .velocities = {c->v, nb},
                                   .angular_velocities = {c->w, nb}};
     size_t rs = ak_rigid_step_scratch_size(&c->rjob);
     c->rjob.scratch = (ak_u8_span){malloc(rs), rs};
     const float s = 0.04f; /* rest spacing: 64 g particles of water */
-    c->fd = (ak_fluid_desc){.h = 2.0f * s, .particle_mass = s * s * s * 1000.0f,
-                            .gravity = {0, -9.81f, 0}, .box_min = box_lo, .box_max = box_hi,
+    c->fd = (ak_fluid_desc){.h = 2.0f * s,
+                            .particle_mass = s * s * s * 1000.0f,
+                            .gravity = {0, -9.81f, 0},
+                            .box_min = box_lo,
+                            .box_max = box_hi,
                             .iterations = 4};
     size_t cap = ak_fluid_fill_box(&c->fd, block_lo, block_hi, (ak_vec3_span){NULL, 0});
     c->pos = malloc(cap * sizeof *c->pos);
@@ -280,8 +322,11 @@ static bool coupled_init(coupled* c, const ak_rigid_body_desc* bodies, size_t nb
     c->n = ak_fluid_fill_box(&c->fd, block_lo, block_hi, (ak_vec3_span){c->pos, cap});
     size_t fs = ak_fluid_scratch_size(cap, &c->fd);
     c->scratch = malloc(fs);
-    c->fjob = (ak_fluid_step_job){.desc = &c->fd, .dt = 1.0f / 200.0f, .positions = {c->pos, cap},
-                                  .velocities = {c->vel, cap}, .particle_count = &c->n,
+    c->fjob = (ak_fluid_step_job){.desc = &c->fd,
+                                  .dt = 1.0f / 200.0f,
+                                  .positions = {c->pos, cap},
+                                  .velocities = {c->vel, cap},
+                                  .particle_count = &c->n,
                                   .scratch = {c->scratch, fs}};
     return c->rjob.scratch.ptr && c->pos && c->vel && c->scratch;
 }
@@ -289,9 +334,9 @@ static bool coupled_init(coupled* c, const ak_rigid_body_desc* bodies, size_t nb
 static bool coupled_step(coupled* c) {
     if (ak_rigid_step_run(&c->rjob) != AK_OK) return false;
     size_t nc = 0;
-    if (ak_rigid_fluid_colliders(c->model, (ak_vec3_cspan){c->x, c->nb}, (ak_quat_cspan){c->q, c->nb},
-                                 (ak_vec3_cspan){c->v, c->nb}, (ak_vec3_cspan){c->w, c->nb},
-                                 (ak_fluid_collider_span){c->cols, 8},
+    if (ak_rigid_fluid_colliders(c->model, (ak_vec3_cspan){c->x, c->nb},
+                                 (ak_quat_cspan){c->q, c->nb}, (ak_vec3_cspan){c->v, c->nb},
+                                 (ak_vec3_cspan){c->w, c->nb}, (ak_fluid_collider_span){c->cols, 8},
                                  (ak_vec4_span){c->planes, 64}, &nc) != AK_OK)
         return false;
     c->fjob.colliders = (ak_fluid_collider_cspan){c->cols, nc};
@@ -320,7 +365,8 @@ AK_TEST(liquid_poured_on_a_static_box_lands_as_on_a_raised_floor) {
     ak_rigid_body_desc b[1] = {
         {.shape = {.type = AK_RIGID_BOX, .half_extents = he}, .position = bx, .is_static = true}};
     ak_rigid_body_desc far[1] = {{.shape = {.type = AK_RIGID_SPHERE, .radius = 0.1f},
-                                  .position = {50, 50, 50}, .is_static = true}};
+                                  .position = {50, 50, 50},
+                                  .is_static = true}};
     coupled c, ref;
     AK_CHECK(coupled_init(&c, b, 1, ak_vec3_make(0, -9.81f, 0), ak_vec3_make(0, 0, 0),
                           ak_vec3_make(0.24f, 2, 0.24f), ak_vec3_make(0, 0.4f, 0),
@@ -360,7 +406,9 @@ AK_TEST(liquid_poured_on_a_tilted_hull_never_enters_it) {
     const ak_quat tilt = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.5235988f);
     const ak_vec3 at = {0.2f, 0.25f, 0.16f};
     ak_rigid_body_desc b[1] = {{.shape = {.type = AK_RIGID_HULL, .points = {corners, 8}},
-                                .position = at, .orientation = tilt, .is_static = true}};
+                                .position = at,
+                                .orientation = tilt,
+                                .is_static = true}};
     coupled c;
     AK_CHECK(coupled_init(&c, b, 1, ak_vec3_make(0, -9.81f, 0), ak_vec3_make(0, 0, 0),
                           ak_vec3_make(0.4f, 2, 0.32f), ak_vec3_make(0.08f, 0.45f, 0.04f),
@@ -368,7 +416,8 @@ AK_TEST(liquid_poured_on_a_tilted_hull_never_enters_it) {
     float deepest = -INFINITY;
     for (int s = 0; s < 100 && !ak_test_cur_failed_; ++s) {
         AK_CHECK(coupled_step(&c));
-        for (size_t i = 0; i < c.n; ++i) deepest = fmaxf(deepest, box_depth(c.pos[i], at, tilt, he));
+        for (size_t i = 0; i < c.n; ++i)
+            deepest = fmaxf(deepest, box_depth(c.pos[i], at, tilt, he));
     }
     AK_CHECK_MSG(deepest <= 1e-5f, "a particle %g m inside the hull", deepest);
     printf("  tilted hull: deepest %g m\n", (double)deepest);
@@ -392,8 +441,11 @@ AK_TEST(liquid_poured_on_a_heightfield_stays_above_it) {
             float x = 0.05f * (float)i - 0.25f, z = 0.05f * (float)j - 0.25f;
             bowl[j * 11 + i] = 0.3f + 1.5f * (x * x + z * z);
         }
-    ak_rigid_body_desc b[1] = {{.shape = {.type = AK_RIGID_HEIGHTFIELD, .heights = {bowl, 121},
-                                          .rows = 11, .cols = 11, .spacing = 0.05f},
+    ak_rigid_body_desc b[1] = {{.shape = {.type = AK_RIGID_HEIGHTFIELD,
+                                          .heights = {bowl, 121},
+                                          .rows = 11,
+                                          .cols = 11,
+                                          .spacing = 0.05f},
                                 .position = {-0.05f, 0, -0.05f}}};
     coupled c;
     AK_CHECK(coupled_init(&c, b, 1, ak_vec3_make(0, -9.81f, 0), ak_vec3_make(0, 0, 0),
@@ -403,14 +455,16 @@ AK_TEST(liquid_poured_on_a_heightfield_stays_above_it) {
     for (int s = 0; s < 120 && !ak_test_cur_failed_; ++s) {
         AK_CHECK(coupled_step(&c));
         for (size_t i = 0; i < c.n; ++i)
-            worst = fmaxf(worst, hf_height(bowl, 11, 0.05f, c.pos[i].x + 0.05f, c.pos[i].z + 0.05f) -
-                                     c.pos[i].y);
+            worst =
+                fmaxf(worst, hf_height(bowl, 11, 0.05f, c.pos[i].x + 0.05f, c.pos[i].z + 0.05f) -
+                                 c.pos[i].y);
     }
     double my = 0.0;
     for (size_t i = 0; i < c.n; ++i) my += c.pos[i].y;
     my /= (double)c.n;
-    printf("  heightfield bowl: %zu particles, deepest under the surface %g m, mean height %.3f m\n",
-           c.n, (double)worst, my);
+    printf(
+        "  heightfield bowl: %zu particles, deepest under the surface %g m, mean height %.3f m\n",
+        c.n, (double)worst, my);
     AK_CHECK_MSG(worst <= 1e-4f, "a particle %g m under the surface", worst);
     AK_CHECK_MSG(my < 0.3 + 1.5 * 0.08, "mean height %g m: over the rim", my);
     coupled_free(&c);
@@ -432,7 +486,8 @@ AK_TEST(a_moving_box_pushes_the_liquid) {
     float deepest = -INFINITY;
     for (int s = 0; s < 30 && !ak_test_cur_failed_; ++s) {
         AK_CHECK(coupled_step(&c));
-        for (size_t i = 0; i < c.n; ++i) deepest = fmaxf(deepest, box_depth(c.pos[i], c.x[0], c.q[0], he));
+        for (size_t i = 0; i < c.n; ++i)
+            deepest = fmaxf(deepest, box_depth(c.pos[i], c.x[0], c.q[0], he));
     }
     AK_CHECK_MSG(deepest <= 1e-5f, "a particle %g m inside the moving box", deepest);
     AK_CHECK_NEAR(c.x[0].x, -0.07f + 0.15f, 1e-4f);
@@ -449,7 +504,8 @@ AK_TEST(a_moving_box_pushes_the_liquid) {
     if (front) front_v /= front;
     printf("  moving box: deepest %g m; %d particles at its front at %.3f m/s; mean %.3f m/s\n",
            (double)deepest, front, front_v, px / (double)c.n);
-    AK_CHECK_MSG(front_v > 0.8 && front_v < 1.3, "front particles at %g m/s, the box at 1", front_v);
+    AK_CHECK_MSG(front_v > 0.8 && front_v < 1.3, "front particles at %g m/s, the box at 1",
+                 front_v);
     AK_CHECK_MSG(px / (double)c.n > 0.05, "mean x velocity %g", px / (double)c.n);
     coupled_free(&c);
 }
@@ -457,7 +513,8 @@ AK_TEST(a_moving_box_pushes_the_liquid) {
 AK_TEST(fluid_scene_box_colliders) {
     ak_fluid_scene* sc = malloc(sizeof *sc);
     ak_diag diag;
-    const char* good = "{\"blocks\": [{\"min\": [0, 0, 0], \"max\": [0.1, 0.1, 0.1]}], \"colliders\": [{\"shape\": \"box\", \"a\": [1, 2, 3], "
+    const char* good = "{\"blocks\": [{\"min\": [0, 0, 0], \"max\": [0.1, 0.1, 0.1]}], "
+                       "\"colliders\": [{\"shape\": \"box\", \"a\": [1, 2, 3], "
                        "\"half_extents\": [0.1, 0.2, 0.3], \"orientation\": [0, 0, 2, 0]}]}";
     AK_CHECK_EQ(ak_fluid_scene_load_bytes(good, strlen(good), "t", sc, &diag), AK_OK);
     AK_CHECK_EQ(sc->collider_count, 1u);
@@ -467,7 +524,8 @@ AK_TEST(fluid_scene_box_colliders) {
     const char* bad[] = {
         "{\"colliders\": [{\"shape\": \"box\", \"a\": [1, 2, 3]}]}",
         "{\"colliders\": [{\"shape\": \"box\", \"half_extents\": [0.1, -0.2, 0.3]}]}",
-        "{\"colliders\": [{\"shape\": \"box\", \"half_extents\": [1, 1, 1], \"orientation\": [0, 0, 0, 0]}]}",
+        "{\"colliders\": [{\"shape\": \"box\", \"half_extents\": [1, 1, 1], \"orientation\": [0, "
+        "0, 0, 0]}]}",
         "{\"colliders\": [{\"shape\": \"sphere\", \"radius\": 1, \"half_extents\": [1, 1, 1]}]}",
         "{\"colliders\": [{\"shape\": \"cone\"}]}",
     };
@@ -475,7 +533,8 @@ AK_TEST(fluid_scene_box_colliders) {
                            "colliders[0].half_extents", "colliders[0].orientation: is the zero",
                            "colliders[0].half_extents: only a box", "colliders[0].shape"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
-        AK_CHECK_EQ(ak_fluid_scene_load_bytes(bad[i], strlen(bad[i]), "t", sc, &diag), AK_ERR_PARSE);
+        AK_CHECK_EQ(ak_fluid_scene_load_bytes(bad[i], strlen(bad[i]), "t", sc, &diag),
+                    AK_ERR_PARSE);
         AK_CHECK_MSG(strstr(diag.message, where[i]) != NULL, "%s", diag.message);
     }
     free(sc);
@@ -488,8 +547,11 @@ AK_TEST(fluid_scene_box_colliders) {
  * 3e-4 s, is rho0 g within 5% (the same bound as on the tank's own floor), and no particle is
  * ever inside the box. */
 AK_TEST(column_on_a_box_body_is_hydrostatic) {
-    ak_fluid_desc d = {.solver = AK_FLUID_WCSPH, .particle_mass = 0.001f, .gravity = {0, -9.81f, 0},
-                       .viscosity = 0.2f, .sound_speed = 15.0f};
+    ak_fluid_desc d = {.solver = AK_FLUID_WCSPH,
+                       .particle_mass = 0.001f,
+                       .gravity = {0, -9.81f, 0},
+                       .viscosity = 0.2f,
+                       .sound_speed = 15.0f};
     const float s = ak_fluid_rest_spacing(&d), top_of_box = 0.05f;
     const int w = 6, ht = 16;
     d.h = 2.0f * s;
@@ -497,8 +559,8 @@ AK_TEST(column_on_a_box_body_is_hydrostatic) {
     d.box_max = ak_vec3_make((float)w * s, top_of_box + 3.0f * (float)ht * s, (float)w * s);
     const ak_vec3 he = {(float)w * s, 0.5f * top_of_box, (float)w * s};
     const ak_vec3 bx = {0.5f * (float)w * s, 0.5f * top_of_box, 0.5f * (float)w * s};
-    ak_rigid_body_desc b[1] = {{.shape = {.type = AK_RIGID_BOX, .half_extents = he}, .position = bx,
-                                .is_static = true}};
+    ak_rigid_body_desc b[1] = {
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = he}, .position = bx, .is_static = true}};
     ak_rigid_model* m = NULL;
     AK_CHECK_EQ(ak_rigid_model_create(&(ak_rigid_model_desc){.bodies = {b, 1}}, NULL, &m), AK_OK);
     if (!m) return;
@@ -510,19 +572,26 @@ AK_TEST(column_on_a_box_body_is_hydrostatic) {
     size_t nc = 0;
     AK_CHECK_EQ(ak_rigid_fluid_colliders(m, (ak_vec3_cspan){x, 1}, (ak_quat_cspan){q, 1},
                                          (ak_vec3_cspan){v, 1}, (ak_vec3_cspan){wv, 1},
-                                         (ak_fluid_collider_span){col, 1}, (ak_vec4_span){NULL, 0}, &nc),
+                                         (ak_fluid_collider_span){col, 1}, (ak_vec4_span){NULL, 0},
+                                         &nc),
                 AK_OK);
     const size_t cap = (size_t)w * w * ht;
     ak_vec3* pos = malloc(cap * sizeof *pos);
     ak_vec3* vel = calloc(cap, sizeof *vel);
     float* pres = malloc(cap * sizeof *pres);
-    size_t n = ak_fluid_fill_box(&d, ak_vec3_make(0, top_of_box, 0),
-                                 ak_vec3_make((float)w * s, top_of_box + (float)ht * s, (float)w * s),
-                                 (ak_vec3_span){pos, cap});
+    size_t n =
+        ak_fluid_fill_box(&d, ak_vec3_make(0, top_of_box, 0),
+                          ak_vec3_make((float)w * s, top_of_box + (float)ht * s, (float)w * s),
+                          (ak_vec3_span){pos, cap});
     size_t bytes = ak_fluid_scratch_size(cap, &d);
     void* mem = malloc(bytes);
-    ak_fluid_step_job job = {.desc = &d, .dt = 3e-4f, .positions = {pos, cap}, .velocities = {vel, cap},
-                             .particle_count = &n, .colliders = {col, nc}, .scratch = {mem, bytes},
+    ak_fluid_step_job job = {.desc = &d,
+                             .dt = 3e-4f,
+                             .positions = {pos, cap},
+                             .velocities = {vel, cap},
+                             .particle_count = &n,
+                             .colliders = {col, nc},
+                             .scratch = {mem, bytes},
                              .out_pressures = {pres, cap}};
     double sum = 0.0;
     int fits = 0;

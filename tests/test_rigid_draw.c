@@ -85,7 +85,8 @@ AK_TEST(hull_mesh_is_closed_holds_the_volume_and_the_points) {
     for (int i = 0; i < 26; ++i) {
         float th = 0.7f * (float)i, z = -1.0f + 2.0f * ((float)i + 0.5f) / 26.0f;
         float r = sqrtf(1.0f - z * z);
-        pts[np++] = ak_vec3_make(1.3f * r * cosf(th) + 0.2f * z, 0.6f * r * sinf(th), 0.9f * z + 0.5f);
+        pts[np++] =
+            ak_vec3_make(1.3f * r * cosf(th) + 0.2f * z, 0.6f * r * sinf(th), 0.9f * z + 0.5f);
     }
     for (int i = 0; i < 6; ++i) pts[np++] = ak_vec3_make(0.1f * (float)i - 0.3f, 0.05f, 0.4f);
     ak_rigid_body_desc b = {.shape = {.type = AK_RIGID_HULL, .points = {pts, np}},
@@ -148,13 +149,15 @@ AK_TEST(compound_mesh_is_its_children) {
      * not overlap) and is closed; the boxes' corners are where the children put them */
     const ak_vec3 tet[4] = {{0, 0, 0}, {0.4f, 0, 0}, {0, 0.4f, 0}, {0, 0, 0.4f}};
     const ak_rigid_child kids[3] = {
-        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.1f, 0.2f}}, .position = {-1, 0, 0}},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.1f, 0.2f}},
+         .position = {-1, 0, 0}},
         {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.3f, 0.1f}},
          .position = {1, 0.5f, 0},
          .orientation = {0, 0, 0.38268343f, 0.92387953f}},
         {.shape = {.type = AK_RIGID_HULL, .points = {tet, 4}}, .position = {0, 1.5f, 0}},
     };
-    ak_rigid_body_desc b = {.shape = {.type = AK_RIGID_COMPOUND, .children = kids, .child_count = 3}};
+    ak_rigid_body_desc b = {
+        .shape = {.type = AK_RIGID_COMPOUND, .children = kids, .child_count = 3}};
     ak_rigid_model* m = NULL;
     AK_CHECK_EQ(ak_rigid_model_create(&(ak_rigid_model_desc){.bodies = {&b, 1}}, NULL, &m), AK_OK);
     if (!m) return;
@@ -187,7 +190,10 @@ AK_TEST(heightfield_and_trimesh_meshes_keep_their_geometry) {
     const ak_vec3 tv[4] = {{0, 0, 0}, {0, 0, 2}, {2, 0, 0}, {2, 1, 2}};
     const uint32_t ti[6] = {0, 1, 2, 2, 1, 3};
     ak_rigid_body_desc b[2] = {
-        {.shape = {.type = AK_RIGID_HEIGHTFIELD, .heights = {h, R * C}, .rows = R, .cols = C,
+        {.shape = {.type = AK_RIGID_HEIGHTFIELD,
+                   .heights = {h, R * C},
+                   .rows = R,
+                   .cols = C,
                    .spacing = 0.5f},
          .position = {5, 0, 0}},
         {.shape = {.type = AK_RIGID_TRIMESH, .vertices = {tv, 4}, .indices = {ti, 6}}}};
@@ -243,15 +249,17 @@ AK_TEST(heightfield_and_trimesh_meshes_keep_their_geometry) {
 /* Pixels of img that differ from ref (the same scene without the body). */
 static long silhouette(const char* path, const char* ref_path) {
     int w, h, w2, h2;
-    if (ak_png_info(path, &w, &h) != AK_OK || ak_png_info(ref_path, &w2, &h2) != AK_OK ||
-        w != w2 || h != h2)
+    if (ak_png_info(path, &w, &h) != AK_OK || ak_png_info(ref_path, &w2, &h2) != AK_OK || w != w2 ||
+        h != h2)
         return -1;
     ak_image a = {.pixels = malloc((size_t)w * h * 4), .width = w, .height = h};
     ak_image b = {.pixels = malloc((size_t)w * h * 4), .width = w, .height = h};
     long n = -1;
-    if (a.pixels && b.pixels && ak_png_read(path, &a) == AK_OK && ak_png_read(ref_path, &b) == AK_OK) {
+    if (a.pixels && b.pixels && ak_png_read(path, &a) == AK_OK &&
+        ak_png_read(ref_path, &b) == AK_OK) {
         n = 0;
-        for (size_t i = 0; i < (size_t)w * h; ++i) n += memcmp(a.pixels + 4 * i, b.pixels + 4 * i, 3) != 0;
+        for (size_t i = 0; i < (size_t)w * h; ++i)
+            n += memcmp(a.pixels + 4 * i, b.pixels + 4 * i, 3) != 0;
     }
     free(a.pixels), free(b.pixels);
     return n;
@@ -266,8 +274,9 @@ AK_TEST(cli_draws_a_hull_as_itself) {
         "{\"shape\": {\"type\": \"hull\", \"points\": [[-0.3,-0.9,-0.2],[0.3,-0.9,-0.2],"
         "[-0.3,0.9,-0.2],[0.3,0.9,-0.2],[-0.3,-0.9,0.2],[0.3,-0.9,0.2],[-0.3,0.9,0.2],"
         "[0.3,0.9,0.2]]}, \"position\": [0, 0, 0], \"orientation\": [0, 0.2588190, 0, 0.9659258]}";
-    const char* body_box = "{\"shape\": {\"type\": \"box\", \"half_extents\": [0.3, 0.9, 0.2]}, "
-                           "\"position\": [0, 0, 0], \"orientation\": [0, 0.2588190, 0, 0.9659258]}";
+    const char* body_box =
+        "{\"shape\": {\"type\": \"box\", \"half_extents\": [0.3, 0.9, 0.2]}, "
+        "\"position\": [0, 0, 0], \"orientation\": [0, 0.2588190, 0, 0.9659258]}";
     const char* body_sphere = "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.9695}, "
                               "\"position\": [0, 0, 0]}";
     const char* far_sphere = "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.01}, "
@@ -294,14 +303,17 @@ AK_TEST(cli_draws_a_hull_as_itself) {
  * `animkit rigid -o X.glb`: one mesh per body, each with the vertex and triangle counts of the
  * body's ak_rigid_body_mesh (before: hulls, compounds and meshes came out empty). */
 AK_TEST(glb_carries_every_shape) {
-    AK_CHECK_MSG(run("rigid " AK_SOURCE_DIR "/examples/rigid_shapes.json --steps 10 -o draw_shapes.glb",
-                     true) == 0, "%s", out_buf);
+    AK_CHECK_MSG(run("rigid " AK_SOURCE_DIR
+                     "/examples/rigid_shapes.json --steps 10 -o draw_shapes.glb",
+                     true) == 0,
+                 "%s", out_buf);
     ak_rigid_scene sc;
     ak_rigid_scene_run rr;
     memset(&rr, 0, sizeof rr);
     ak_diag diag;
     ak_rigid_scene_defaults(&sc);
-    AK_CHECK_EQ(ak_rigid_scene_load_file(AK_SOURCE_DIR "/examples/rigid_shapes.json", &sc, &diag), AK_OK);
+    AK_CHECK_EQ(ak_rigid_scene_load_file(AK_SOURCE_DIR "/examples/rigid_shapes.json", &sc, &diag),
+                AK_OK);
     AK_CHECK_EQ(ak_rigid_scene_run_init(&rr, &sc, "shapes", &diag), AK_OK);
     ak_scene* s = NULL;
     AK_CHECK_EQ(ak_io_load("draw_shapes.glb", NULL, NULL, &s, &diag), AK_OK);
@@ -322,8 +334,10 @@ AK_TEST(glb_carries_every_shape) {
 
 /* The Khronos validator on that file (slow: node starts; SKIP without it). */
 AK_TEST(glb_of_every_shape_validates) {
-    AK_CHECK_MSG(run("rigid " AK_SOURCE_DIR "/examples/rigid_shapes.json --steps 10 -o draw_shapes_v.glb",
-                     true) == 0, "%s", out_buf);
+    AK_CHECK_MSG(run("rigid " AK_SOURCE_DIR
+                     "/examples/rigid_shapes.json --steps 10 -o draw_shapes_v.glb",
+                     true) == 0,
+                 "%s", out_buf);
     const char* files[1] = {"draw_shapes_v.glb"};
     ak_test_gltf_validate(files, 1, "every shape baked");
 }

@@ -48,8 +48,8 @@
  * is moved to the nearest surface point (a box's or a polytope's: through the face it is least
  * deep under; a heightfield's: along the normal of the triangle under it), and its velocity
  * loses only the component into the surface relative to the surface's velocity (the tangential
- * component is kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so the velocity
- * update v = (x* - x)/dt inherits the same rule. Nothing leaks (every particle ends each step
+ * component is kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so
+ * the velocity update v = (x* - x)/dt inherits the same rule. Nothing leaks (every particle ends each step
  * outside every collider and inside the box, up to float rounding of the projection; where two
  * colliders overlap, a particle in the crease between them may stay inside one: the colliders
  * are projected in turn, at most 4 passes) and
@@ -173,20 +173,20 @@ AK_API size_t ak_fluid_fill_box(const ak_fluid_desc* desc, ak_vec3 lo, ak_vec3 h
 /* ---- colliders, emitters, sinks ---------------------------------------------------- */
 
 typedef enum ak_fluid_shape {
-    AK_FLUID_PLANE = 0, /* point a, unit normal n: the liquid stays on the +n side */
-    AK_FLUID_SPHERE,    /* centre a, radius: the liquid stays outside */
-    AK_FLUID_CAPSULE,   /* segment a-b, radius: the liquid stays outside (a limb) */
-    AK_FLUID_BOX,       /* centre a, half_extents along the axes of orientation: the liquid stays
-                           outside (a rigid box: ak_rigid_fluid_colliders) */
-    AK_FLUID_CONVEX,    /* a convex polytope: the points x with n.(x') <= d for every plane
-                           (n, d) of planes, x' = orientation^-1 (x - a) in the collider's frame:
-                           the liquid stays outside (a rigid hull: ak_rigid_fluid_colliders) */
+    AK_FLUID_PLANE = 0,   /* point a, unit normal n: the liquid stays on the +n side */
+    AK_FLUID_SPHERE,      /* centre a, radius: the liquid stays outside */
+    AK_FLUID_CAPSULE,     /* segment a-b, radius: the liquid stays outside (a limb) */
+    AK_FLUID_BOX,         /* centre a, half_extents along the axes of orientation: the liquid stays
+                             outside (a rigid box: ak_rigid_fluid_colliders) */
+    AK_FLUID_CONVEX,      /* a convex polytope: the points x with n.(x') <= d for every plane
+                             (n, d) of planes, x' = orientation^-1 (x - a) in the collider's frame:
+                             the liquid stays outside (a rigid hull: ak_rigid_fluid_colliders) */
     AK_FLUID_HEIGHTFIELD, /* terrain, solid below its surface: heights[row * cols + col] of
-                           sample (col, row) at (col * spacing, height, row * spacing) in the frame
-                           (a, orientation), each cell two triangles as rigid.h's heightfield
-                           (00-01-11, 00-11-10); a particle over the grid and under the surface is
-                           moved out along its triangle's normal (a rigid heightfield:
-                           ak_rigid_fluid_colliders) */
+                             sample (col, row) at (col * spacing, height, row * spacing) in the
+                             frame (a, orientation), each cell two triangles as rigid.h's
+                             heightfield (00-01-11, 00-11-10); a particle over the grid and under
+                             the surface is moved out along its triangle's normal (a rigid
+                             heightfield: ak_rigid_fluid_colliders) */
     AK_FLUID_SHAPE_COUNT
 } ak_fluid_shape;
 

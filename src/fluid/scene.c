@@ -148,8 +148,8 @@ static bool parse(akp_json* j, const char* text, size_t size, ak_fluid_scene* ou
     }
     e = akp_json_array(j, root, "", "colliders", AK_FLUID_SCENE_MAX_ITEMS, &count);
     for (size_t k = 0; e && k < count && !j->failed; ++k, e = e->next) {
-        static const char* const kk[] = {"shape",    "a",           "b",           "normal", "radius",
-                                         "velocity", "half_extents", "orientation", NULL};
+        static const char* const kk[] = {
+            "shape", "a", "b", "normal", "radius", "velocity", "half_extents", "orientation", NULL};
         static const char* const shapes[] = {"plane", "sphere", "capsule", "box", NULL};
         akp_json_index(path, sizeof path, "colliders", k);
         ak_fluid_collider* c = &s->colliders[k];

@@ -145,7 +145,8 @@ static void hull_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, const akp_hull* h
             pos[v + k] = h->verts[h->idx[fc->first + k]];
             nrm[v + k] = fc->n;
         }
-        for (uint32_t k = 1; k + 1 < fc->count; ++k) t[0] = v, t[1] = v + k, t[2] = v + k + 1, t += 3;
+        for (uint32_t k = 1; k + 1 < fc->count; ++k)
+            t[0] = v, t[1] = v + k, t[2] = v + k + 1, t += 3;
         v += fc->count;
     }
 }
@@ -163,8 +164,10 @@ static void heightfield_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, const ak_r
         for (uint32_t i = 0; i < cols; ++i) {
             uint32_t i0 = i ? i - 1 : i, i1 = i + 1 < cols ? i + 1 : i;
             uint32_t j0 = j ? j - 1 : j, j1 = j + 1 < rows ? j + 1 : j;
-            float dx = (hf_point(s, i1, j).y - hf_point(s, i0, j).y) / ((float)(i1 - i0) * s->spacing);
-            float dz = (hf_point(s, i, j1).y - hf_point(s, i, j0).y) / ((float)(j1 - j0) * s->spacing);
+            float dx =
+                (hf_point(s, i1, j).y - hf_point(s, i0, j).y) / ((float)(i1 - i0) * s->spacing);
+            float dz =
+                (hf_point(s, i, j1).y - hf_point(s, i, j0).y) / ((float)(j1 - j0) * s->spacing);
             pos[(size_t)j * cols + i] = hf_point(s, i, j);
             nrm[(size_t)j * cols + i] = ak_vec3_normalize(ak_vec3_make(-dx, 1.0f, -dz));
         }

@@ -114,8 +114,8 @@ static void box_tris(const ak_fluid_collider* k, ak_vec3* pos, ak_vec3* nrm) {
                 float p[3], n[3] = {0, 0, 0};
                 p[axis] = (float)sign, n[axis] = (float)sign;
                 p[u] = cu[cc], p[w] = cw[cc];
-                const ak_vec3 local = ak_vec3_make(p[0] * k->half_extents.x, p[1] * k->half_extents.y,
-                                                   p[2] * k->half_extents.z);
+                const ak_vec3 local = ak_vec3_make(
+                    p[0] * k->half_extents.x, p[1] * k->half_extents.y, p[2] * k->half_extents.z);
                 pos[v] = ak_vec3_add(k->a, ak_quat_rotate(q, local));
                 nrm[v++] = ak_quat_rotate(q, ak_vec3_make(n[0], n[1], n[2]));
             }
@@ -131,8 +131,10 @@ static ak_result draw_colliders(renderer* r, const ak_fluid_scene* s) {
         if (k->shape == AK_FLUID_BOX) {
             ak_vec3 bp[36], bn[36];
             box_tris(k, bp, bn);
-            ak_raster_mesh m = {.positions = {bp, 36}, .normals = {bn, 36},
-                                .material = {.color = ak_vec4_make(0.75f, 0.72f, 0.68f, 1)}, .shading = AK_SHADING_PHONG};
+            ak_raster_mesh m = {.positions = {bp, 36},
+                                .normals = {bn, 36},
+                                .material = {.color = ak_vec4_make(0.75f, 0.72f, 0.68f, 1)},
+                                .shading = AK_SHADING_PHONG};
             ak_result res = ak_raster_draw_mesh(r->raster, &r->cam, &m);
             if (res != AK_OK) return res;
             continue;

@@ -55,10 +55,9 @@ static bool mesh_build(body_mesh* m, const ak_rigid_model* model) {
 static ak_result mesh_pose(body_mesh* m, const ak_rigid_model* model, const ak_vec3* x,
                            const ak_quat* q) {
     const size_t n = ak_rigid_body_count(model);
-    return ak_rigid_world_mesh(model, (ak_vec3_cspan){x, n}, (ak_quat_cspan){q, n},
-                               (ak_vec3_span){m->pos, m->vcount + 1},
-                               (ak_vec3_span){m->nrm, m->vcount + 1},
-                               (ak_u32_span){m->idx, m->icount + 1});
+    return ak_rigid_world_mesh(
+        model, (ak_vec3_cspan){x, n}, (ak_quat_cspan){q, n}, (ak_vec3_span){m->pos, m->vcount + 1},
+        (ak_vec3_span){m->nrm, m->vcount + 1}, (ak_u32_span){m->idx, m->icount + 1});
 }
 
 /* ---- output ------------------------------------------------------------------------------ */
@@ -190,8 +189,10 @@ int cmd_rigid(int argc, char** argv) {
     const bool gif = out && cli_has_ext(out, ".gif"), png = out && cli_has_ext(out, ".png");
     if (gif || png) {
         if (!mesh_build(&mesh, model)) {
-            rc = cli_fail("rigid", "%s: the bodies' mesh (%zu vertices) is too large to draw or "
-                          "out of memory", name, mesh.vcount);
+            rc = cli_fail("rigid",
+                          "%s: the bodies' mesh (%zu vertices) is too large to draw or "
+                          "out of memory",
+                          name, mesh.vcount);
             goto done;
         }
         if ((r = mesh_pose(&mesh, model, x, q)) != AK_OK) {
