@@ -268,9 +268,31 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
         return AK_ERR_BAD_ARG;
     for (size_t c = 0; c < job->colliders.count; ++c) {
         const ak_fluid_collider* k = &job->colliders.ptr[c];
-        if ((unsigned)k->shape >= AK_FLUID_SHAPE_COUNT || !(k->radius >= 0.0f) || !ak_finitef(k->radius) ||
-            !vfinite(k->a) || !vfinite(k->b) || !vfinite(k->normal) || !vfinite(k->velocity))
+        if ((unsigned)k->shape >= AK_FLUID_SHAPE_COUNT || !(k->radius >= 0.0f) ||
+            !ak_finitef(k->radius) || !vfinite(k->a) || !vfinite(k->b) || !vfinite(k->normal) ||
+            !vfinite(k->velocity) || !vfinite(k->angular_velocity) ||
+            !ak_quat_is_finite(k->orientation) || !vfinite(k->half_extents) ||
+            !(k->half_extents.x >= 0.0f) || !(k->half_extents.y >= 0.0f) ||
+            !(k->half_extents.z >= 0.0f))
             return AK_ERR_BAD_ARG;
+        if (k->shape == AK_FLUID_HEIGHTFIELD) {
+            if (k->rows < 2 || k->cols < 2 || (uint64_t)k->rows * k->cols > (1u << 24) ||
+                !(k->spacing > 0.0f) || !ak_finitef(k->spacing))
+                return AK_ERR_BAD_ARG;
+            if (!k->heights) return AK_ERR_NULL_ARG;
+            for (size_t q = 0; q < (size_t)k->rows * k->cols; ++q)
+                if (!ak_finitef(k->heights[q])) return AK_ERR_BAD_ARG;
+        }
+        if (k->shape == AK_FLUID_CONVEX) {
+            if (k->plane_count == 0 || k->plane_count > AK_FLUID_CONVEX_MAX_PLANES)
+                return AK_ERR_BAD_ARG;
+            if (!k->planes) return AK_ERR_NULL_ARG;
+            for (uint32_t q = 0; q < k->plane_count; ++q) {
+                const ak_vec4 pl = k->planes[q];
+                const float l2 = pl.x * pl.x + pl.y * pl.y + pl.z * pl.z;
+                if (!ak_finitef(pl.w) || !(fabsf(l2 - 1.0f) <= 2e-3f)) return AK_ERR_BAD_ARG;
+            }
+        }
     }
     for (size_t e = 0; e < job->emitters.count; ++e) {
         const ak_fluid_emitter* m = &job->emitters.ptr[e];
@@ -410,6 +432,107 @@ static void parallel_n(ctx* c, phase_fn fn, size_t n) {
 
 static void parallel(ctx* c, phase_fn fn) { parallel_n(c, fn, c->n); }
 
+/* A heightfield collider at p: p in its frame (*l), the surface's height under it (*y) and the
+ * upward unit normal of that triangle (*n, in the frame); false when p is off the grid. */
+static bool heightfield_surface(const ak_fluid_collider* col, ak_quat q, ak_vec3 p, ak_vec3* l,
+                                float* y, ak_vec3* n) {
+    *l = ak_quat_rotate(ak_quat_conjugate(q), ak_vec3_sub(p, col->a));
+    const float fx = l->x / col->spacing, fz = l->z / col->spacing;
+    if (!(fx >= 0.0f) || !(fz >= 0.0f) || fx > (float)(col->cols - 1) ||
+        fz > (float)(col->rows - 1))
+        return false;
+    uint32_t i = (uint32_t)fx, j = (uint32_t)fz;
+    if (i > col->cols - 2) i = col->cols - 2;
+    if (j > col->rows - 2) j = col->rows - 2;
+    const float u = fx - (float)i, v = fz - (float)j, s = col->spacing;
+    const float* hr = col->heights + (size_t)j * col->cols + i;
+    const float h00 = hr[0], h10 = hr[1], h01 = hr[col->cols], h11 = hr[col->cols + 1];
+    /* rigid.h's split: (00, 01, 11) where v >= u, else (00, 11, 10); the surface over the
+     * triangle is h00 + a u + b v, its upward normal (-a/s, 1, -b/s) */
+    const float a = v >= u ? h11 - h01 : h10 - h00, b = v >= u ? h01 - h00 : h11 - h10;
+    *y = h00 + a * u + b * v;
+    *n = ak_vec3_normalize(ak_vec3_make(-a / s, 1.0f, -b / s));
+    return true;
+}
+
+/* Rotation of a box or convex collider's frame (zero -> identity). */
+static ak_quat collider_rotation(const ak_fluid_collider* col) {
+    const ak_quat q = col->orientation;
+    return ak_quat_dot(q, q) > 0.0f ? ak_quat_normalize(q) : ak_quat_identity();
+}
+
+/* Signed distance from p to a collider's surface (negative inside; for a convex polytope
+ * outside it, the largest plane distance: a lower bound) and, when p is inside, *out_n the
+ * outward normal of the nearest surface point (p + n * -distance). */
+static float collider_distance(const ak_fluid_collider* col, ak_vec3 p, ak_vec3* out_n) {
+    switch (col->shape) {
+    case AK_FLUID_PLANE: {
+        ak_vec3 n = ak_vec3_length_sq(col->normal) > 0.0f ? ak_vec3_normalize(col->normal)
+                                                          : ak_vec3_make(0, 1, 0);
+        *out_n = n;
+        return ak_vec3_dot(ak_vec3_sub(p, col->a), n);
+    }
+    case AK_FLUID_BOX: {
+        const ak_quat q = collider_rotation(col);
+        const ak_vec3 l = ak_quat_rotate(ak_quat_conjugate(q), ak_vec3_sub(p, col->a));
+        const float lc[3] = {l.x, l.y, l.z},
+                    hc[3] = {col->half_extents.x, col->half_extents.y, col->half_extents.z};
+        float out2 = 0.0f, inside = -INFINITY;
+        int axis = 0;
+        for (int k = 0; k < 3; ++k) {
+            const float e = fabsf(lc[k]) - hc[k];
+            if (e > 0.0f) out2 += e * e;
+            if (e > inside) inside = e, axis = k;
+        }
+        if (out2 > 0.0f) {
+            *out_n = ak_vec3_make(0, 1, 0);
+            return sqrtf(out2);
+        }
+        float nl[3] = {0.0f, 0.0f, 0.0f};
+        nl[axis] = lc[axis] < 0.0f ? -1.0f : 1.0f;
+        *out_n = ak_quat_rotate(q, ak_vec3_make(nl[0], nl[1], nl[2]));
+        return inside;
+    }
+    case AK_FLUID_CONVEX: {
+        const ak_quat q = collider_rotation(col);
+        const ak_vec3 l = ak_quat_rotate(ak_quat_conjugate(q), ak_vec3_sub(p, col->a));
+        float best = -INFINITY;
+        uint32_t face = 0;
+        for (uint32_t k = 0; k < col->plane_count; ++k) {
+            const ak_vec4 pl = col->planes[k];
+            const float e = pl.x * l.x + pl.y * l.y + pl.z * l.z - pl.w;
+            if (e > best) best = e, face = k;
+        }
+        const ak_vec4 pl = col->planes[face];
+        *out_n = ak_quat_rotate(q, ak_vec3_make(pl.x, pl.y, pl.z));
+        return best;
+    }
+    case AK_FLUID_HEIGHTFIELD: {
+        ak_vec3 l, n;
+        float y;
+        const ak_quat q = collider_rotation(col);
+        *out_n = ak_quat_rotate(q, ak_vec3_make(0, 1, 0));
+        if (!heightfield_surface(col, q, p, &l, &y, &n)) return INFINITY; /* off the grid */
+        *out_n = ak_quat_rotate(q, n);
+        return (l.y - y) * n.y; /* the distance to the triangle's plane */
+    }
+    default: {
+        ak_vec3 q = col->a;
+        if (col->shape == AK_FLUID_CAPSULE) {
+            ak_vec3 ab = ak_vec3_sub(col->b, col->a);
+            float l2 = ak_vec3_dot(ab, ab);
+            float t = l2 > 0.0f ? ak_vec3_dot(ak_vec3_sub(p, col->a), ab) / l2 : 0.0f;
+            t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+            q = ak_vec3_add(col->a, ak_vec3_scale(ab, t));
+        }
+        ak_vec3 r = ak_vec3_sub(p, q);
+        float len = ak_vec3_length(r);
+        *out_n = len > 1e-12f ? ak_vec3_scale(r, 1.0f / len) : ak_vec3_make(0, 1, 0);
+        return len - col->radius;
+    }
+    }
+}
+
 /* One pass over the colliders; true when one of them moved p. */
 static bool collide_pass(const ctx* c, ak_vec3* p, ak_vec3* v) {
     const ak_fluid_desc* d = &c->d;
@@ -418,34 +541,30 @@ static bool collide_pass(const ctx* c, ak_vec3* p, ak_vec3* v) {
     for (size_t k = 0; k < job->colliders.count; ++k) {
         const ak_fluid_collider* col = &job->colliders.ptr[k];
         ak_vec3 n;
-        float depth;
-        if (col->shape == AK_FLUID_PLANE) {
-            n = ak_vec3_length_sq(col->normal) > 0.0f ? ak_vec3_normalize(col->normal) : ak_vec3_make(0, 1, 0);
-            depth = -ak_vec3_dot(ak_vec3_sub(*p, col->a), n);
-        } else {
-            ak_vec3 q = col->a;
-            if (col->shape == AK_FLUID_CAPSULE) {
-                ak_vec3 ab = ak_vec3_sub(col->b, col->a);
-                float l2 = ak_vec3_dot(ab, ab);
-                float t = l2 > 0.0f ? ak_vec3_dot(ak_vec3_sub(*p, col->a), ab) / l2 : 0.0f;
-                t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
-                q = ak_vec3_add(col->a, ak_vec3_scale(ab, t));
-            }
-            ak_vec3 r = ak_vec3_sub(*p, q);
-            float len = ak_vec3_length(r);
-            if (len >= col->radius) continue;
-            n = len > 1e-12f ? ak_vec3_scale(r, 1.0f / len) : ak_vec3_make(0, 1, 0);
-            depth = col->radius - len;
-        }
+        const float depth = -collider_distance(col, *p, &n);
         if (!(depth > 0.0f)) continue;
         moved = true;
         *p = ak_vec3_add(*p, ak_vec3_scale(n, depth));
+        if (col->shape == AK_FLUID_HEIGHTFIELD) {
+            /* along the normal p may have crossed into a neighbouring triangle and still be
+             * under it (a valley): then straight up onto the surface, which is exact */
+            ak_vec3 l, nl;
+            float y;
+            const ak_quat q = collider_rotation(col);
+            if (heightfield_surface(col, q, *p, &l, &y, &nl) && l.y < y) {
+                l.y = y;
+                *p = ak_vec3_add(col->a, ak_quat_rotate(q, l));
+            }
+        }
         if (v) {
-            ak_vec3 rel = ak_vec3_sub(*v, col->velocity);
+            /* the surface's velocity at the projected point */
+            const ak_vec3 vs = ak_vec3_add(
+                col->velocity, ak_vec3_cross(col->angular_velocity, ak_vec3_sub(*p, col->a)));
+            ak_vec3 rel = ak_vec3_sub(*v, vs);
             float vn = ak_vec3_dot(rel, n);
             if (vn < 0.0f) {
                 ak_vec3 vt = ak_vec3_sub(rel, ak_vec3_scale(n, vn));
-                *v = ak_vec3_add(col->velocity, ak_vec3_scale(vt, 1.0f - d->friction));
+                *v = ak_vec3_add(vs, ak_vec3_scale(vt, 1.0f - d->friction));
             }
         }
     }
@@ -505,22 +624,8 @@ static float boundary_distance(const ctx* c, ak_vec3 p) {
         }
     }
     for (size_t k = 0; k < c->job->colliders.count; ++k) {
-        const ak_fluid_collider* col = &c->job->colliders.ptr[k];
-        float e;
-        if (col->shape == AK_FLUID_PLANE) {
-            ak_vec3 n = ak_vec3_length_sq(col->normal) > 0.0f ? ak_vec3_normalize(col->normal) : ak_vec3_make(0, 1, 0);
-            e = ak_vec3_dot(ak_vec3_sub(p, col->a), n);
-        } else {
-            ak_vec3 q = col->a;
-            if (col->shape == AK_FLUID_CAPSULE) {
-                ak_vec3 ab = ak_vec3_sub(col->b, col->a);
-                float l2 = ak_vec3_dot(ab, ab);
-                float t = l2 > 0.0f ? ak_vec3_dot(ak_vec3_sub(p, col->a), ab) / l2 : 0.0f;
-                t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
-                q = ak_vec3_add(col->a, ak_vec3_scale(ab, t));
-            }
-            e = ak_vec3_distance(p, q) - col->radius;
-        }
+        ak_vec3 n;
+        const float e = collider_distance(&c->job->colliders.ptr[k], p, &n);
         if (e < best) best = e;
     }
     return best;

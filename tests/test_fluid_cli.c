@@ -228,6 +228,48 @@ AK_TEST(tank_walls_drawn) {
     remove("fluid_tank.json"), remove("tank.png");
 }
 
+/* A box collider (fluid scene key "box") is drawn: the pixels at its centre's projection differ
+ * from the same scene without it, over a patch at least as large as the box's smallest face
+ * would cover. */
+AK_TEST(box_collider_drawn) {
+    const char* base = "{\"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]},"
+                       " \"blocks\": [{\"min\": [0.05, 0, 0.05], \"max\": [0.1, 0.05, 0.1]}]";
+    char with[512], without[512];
+    snprintf(without, sizeof without, "%s}", base);
+    snprintf(
+        with, sizeof with,
+        "%s, \"colliders\": [{\"shape\": \"box\", \"a\": [0.5, 0.4, 0.5], "
+        "\"half_extents\": [0.2, 0.15, 0.1], \"orientation\": [0, 0.38268343, 0, 0.92387953]}]}",
+        base);
+    write_file("fluid_box_with.json", with);
+    write_file("fluid_box_without.json", without);
+    AK_CHECK_EQ(run("fluid fluid_box_with.json --steps 0 -o box_with.png", true), 0);
+    AK_CHECK_EQ(run("fluid fluid_box_without.json --steps 0 -o box_without.png", true), 0);
+    const int w = 800, h = 600;
+    static uint8_t pa[800 * 600 * 4], pb[800 * 600 * 4];
+    ak_image a = {.pixels = pa, .width = w, .height = h},
+             b = {.pixels = pb, .width = w, .height = h};
+    AK_CHECK_EQ(ak_png_read("box_with.png", &a), AK_OK);
+    AK_CHECK_EQ(ak_png_read("box_without.png", &b), AK_OK);
+    long diff = 0;
+    for (size_t i = 0; i < (size_t)w * h; ++i) diff += memcmp(pa + 4 * i, pb + 4 * i, 3) != 0;
+    const ak_vec3 c = {0.5f, 0.5f, 0.5f};
+    const float ext = sqrtf(3.0f);
+    ak_vec3 eye = ak_vec3_add(c, ak_vec3_scale(ak_vec3_make(0.45f, 0.55f, 1.0f), 1.1f * ext));
+    ak_raster_camera cam =
+        ak_raster_camera_perspective(eye, c, 0.7f, (float)w / (float)h, 0.01f * ext, 10.0f * ext);
+    ak_vec3 q;
+    AK_CHECK(ak_raster_camera_project(&cam, w, h, ak_vec3_make(0.5f, 0.4f, 0.5f), &q));
+    AK_CHECK(memcmp(ak_image_pixel(&a, (int)q.x, (int)q.y), ak_image_pixel(&b, (int)q.x, (int)q.y),
+                    3) != 0);
+    /* the box's smallest face, 0.3 x 0.2 m, is about 0.3 x 0.2 x (600 / (2 tan(0.35) x 2.3 m))^2
+     * = 3,700 pixels at the camera's distance; its silhouette is larger */
+    printf("  box collider: %ld pixels changed\n", diff);
+    AK_CHECK_MSG(diff > 3000, "%ld pixels changed", diff);
+    remove("fluid_box_with.json"), remove("fluid_box_without.json"), remove("box_with.png"),
+        remove("box_without.png");
+}
+
 int main(void) {
     AK_RUN(dam_json_contract);
     AK_RUN(scene_files);
@@ -236,5 +278,6 @@ int main(void) {
     AK_RUN(bad_usage);
     AK_RUN(obj_surface);
     AK_RUN(tank_walls_drawn);
+    AK_RUN_SLOW(box_collider_drawn); /* two renders at 800 x 600: about 1 s */
     return ak_test_finish();
 }

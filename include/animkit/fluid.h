@@ -41,12 +41,15 @@
  * the caller's order. Each list holds the particles closer than h in a fixed order (cells z,
  * then y, then x, each in index order), the same on both paths.
  *
- * Boundaries (all solvers): a box container, planes, spheres and capsules, each optionally
- * moving with a velocity. The method is projection: a particle found inside a collider (or
- * outside the box) is moved to the nearest surface point, and its velocity loses only the
- * component into the surface relative to the collider's velocity (the tangential component is
- * kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so the velocity
- * update v = (x* - x)/dt inherits the same rule. Nothing leaks (every particle ends each step
+ * Boundaries (all solvers): a box container, planes, spheres, capsules, oriented boxes,
+ * convex polytopes and heightfields (so rigid bodies reach the liquid one-way:
+ * ak_rigid_fluid_colliders in rigid.h), each optionally moving with a velocity and an angular
+ * velocity. The method is projection: a particle found inside a collider (or outside the box)
+ * is moved to the nearest surface point (a box's or a polytope's: through the face it is least
+ * deep under; a heightfield's: along the normal of the triangle under it), and its velocity
+ * loses only the component into the surface relative to the surface's velocity (the tangential
+ * component is kept, scaled by 1 - friction). PBF projects after every Jacobi iteration, so
+ * the velocity update v = (x* - x)/dt inherits the same rule. Nothing leaks (every particle ends each step
  * outside every collider and inside the box, up to float rounding of the projection; where two
  * colliders overlap, a particle in the crease between them may stay inside one: the colliders
  * are projected in turn, at most 4 passes) and
@@ -170,18 +173,47 @@ AK_API size_t ak_fluid_fill_box(const ak_fluid_desc* desc, ak_vec3 lo, ak_vec3 h
 /* ---- colliders, emitters, sinks ---------------------------------------------------- */
 
 typedef enum ak_fluid_shape {
-    AK_FLUID_PLANE = 0, /* point a, unit normal n: the liquid stays on the +n side */
-    AK_FLUID_SPHERE,    /* centre a, radius: the liquid stays outside */
-    AK_FLUID_CAPSULE,   /* segment a-b, radius: the liquid stays outside (a limb) */
+    AK_FLUID_PLANE = 0,   /* point a, unit normal n: the liquid stays on the +n side */
+    AK_FLUID_SPHERE,      /* centre a, radius: the liquid stays outside */
+    AK_FLUID_CAPSULE,     /* segment a-b, radius: the liquid stays outside (a limb) */
+    AK_FLUID_BOX,         /* centre a, half_extents along the axes of orientation: the liquid stays
+                             outside (a rigid box: ak_rigid_fluid_colliders) */
+    AK_FLUID_CONVEX,      /* a convex polytope: the points x with n.(x') <= d for every plane
+                             (n, d) of planes, x' = orientation^-1 (x - a) in the collider's frame:
+                             the liquid stays outside (a rigid hull: ak_rigid_fluid_colliders) */
+    AK_FLUID_HEIGHTFIELD, /* terrain, solid below its surface: heights[row * cols + col] of
+                             sample (col, row) at (col * spacing, height, row * spacing) in the
+                             frame (a, orientation), each cell two triangles as rigid.h's
+                             heightfield (00-01-11, 00-11-10); a particle over the grid and under
+                             the surface is moved out along its triangle's normal (a rigid
+                             heightfield: ak_rigid_fluid_colliders) */
     AK_FLUID_SHAPE_COUNT
 } ak_fluid_shape;
 
+/* Most planes a convex collider may have. */
+#define AK_FLUID_CONVEX_MAX_PLANES 65536u
+
 typedef struct ak_fluid_collider {
     ak_fluid_shape shape; /* 0 -> plane */
-    ak_vec3 a, b;         /* world: plane point / sphere centre / capsule ends */
+    ak_vec3 a, b;         /* world: plane point / sphere centre / capsule ends / box and convex
+                             frame origin */
     ak_vec3 normal;       /* plane normal (normalised by the solver; zero -> +Y) */
     float radius;         /* sphere and capsule radius (m), >= 0 */
-    ak_vec3 velocity;     /* world m/s: a moving collider (the caller moves a, b each step) */
+    ak_vec3 velocity;     /* world m/s of the point a: a moving collider (the caller moves it
+                             each step) */
+    /* A turning collider: the surface at x moves at velocity + angular_velocity x (x - a), the
+     * velocity a particle pushed out there keeps relative to (any shape; zero -> translation
+     * only, as before). */
+    ak_vec3 angular_velocity; /* world rad/s */
+    ak_quat orientation;      /* box and convex: the frame's rotation, frame to world; zero ->
+                                 identity (normalised here) */
+    ak_vec3 half_extents;     /* box: metres along the frame's axes, each >= 0 */
+    const ak_vec4* planes;    /* convex: (n.x, n.y, n.z, d) in the frame, n unit (within 1e-3);
+                                 the liquid stays where n.x' > d for some plane */
+    uint32_t plane_count;     /* convex: 1 .. AK_FLUID_CONVEX_MAX_PLANES */
+    const float* heights;     /* heightfield: rows * cols finite heights (m), not copied */
+    uint32_t rows, cols;      /* heightfield: >= 2 each, rows * cols <= 2^24 */
+    float spacing;            /* heightfield: metres between samples, > 0 */
 } ak_fluid_collider;
 
 typedef struct ak_fluid_emitter {

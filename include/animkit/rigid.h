@@ -41,8 +41,8 @@
  *
  * What it does NOT do (yet): threads, continuous collision detection (a body moving more than
  * its size in one substep can tunnel), dynamic triangle meshes and heightfields (they are
- * static), collisions with the fluid (cloth and particles take the bodies as a mesh:
- * ak_rigid_world_mesh).
+ * static), two-way coupling with other simulations: cloth and particles take the bodies as a
+ * mesh (ak_rigid_world_mesh), the fluid as its colliders (ak_rigid_fluid_colliders), one-way.
  *
  * Usage (a box dropped on the ground):
  *     ak_rigid_body_desc bodies[2] = {
@@ -70,6 +70,7 @@
 #ifndef ANIMKIT_RIGID_H
 #define ANIMKIT_RIGID_H
 
+#include "fluid.h" /* ak_fluid_collider (ak_rigid_fluid_colliders fills them; no link dependency) */
 #include "math.h"
 
 #ifdef __cplusplus
@@ -406,29 +407,80 @@ AK_API ak_result ak_rigid_ragdoll_pose(const struct ak_skeleton* skeleton,
 
 /* Vertices and indices (3 per triangle) of a shape's mesh: a sphere or capsule as an 8 x 16
  * latitude-longitude grid (capsules with a doubled equator), a box's 6 faces (24 vertices), a
- * plane as a square (4); 0 for NULL or an unknown type. */
+ * plane as a square (4), a heightfield's grid (a vertex per sample, 2 triangles per cell), a
+ * trimesh's triangles (3 vertices each); 0 for a hull or a compound (their faces and children
+ * are built by the model: ak_rigid_body_mesh), for NULL or an unknown type. */
 AK_API void ak_rigid_shape_mesh_size(const ak_rigid_shape* shape, size_t* out_vertex_count,
                                      size_t* out_index_count);
 /* A shape's closed, outward-facing mesh (counter-clockwise seen from outside) in the body's
  * frame: vertices on the shape's surface (a sphere's and a capsule's inscribed in it), unit
  * normals, triangles; a plane is a square of half side plane_size (0 -> 10 m) in its own frame
- * (Y up). Sizes from ak_rigid_shape_mesh_size. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (type),
+ * (Y up); a heightfield is its grid split into triangles as the collisions split it (cell (i, j):
+ * samples 00-01-11 and 00-11-10, counter-clockwise seen from +Y, normals by central
+ * differences), open at its border; a trimesh is its own triangles, each with its face normal.
+ * Sizes from ak_rigid_shape_mesh_size. AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (type),
  * AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_rigid_shape_mesh(const ak_rigid_shape* shape, float plane_size,
                                      ak_vec3_span out_positions, ak_vec3_span out_normals,
                                      ak_u32_span out_indices);
+/* Vertices and indices of body i's mesh as ak_rigid_body_mesh writes it (0 for NULL or an index
+ * out of range). */
+AK_API void ak_rigid_body_mesh_size(const ak_rigid_model* model, size_t body_index,
+                                    size_t* out_vertex_count, size_t* out_index_count);
+/* Body i's mesh in its body frame (centre of mass, principal axes: world = pose * vertex): every
+ * shape drawn as itself. Spheres, boxes, capsules, planes, heightfields and trimeshes as
+ * ak_rigid_shape_mesh draws them; a hull as its convex polygon faces, each fanned into
+ * triangles around its first vertex with its own vertices and the face's outward normal (so
+ * the mesh is closed once equal positions are merged, and its vertices are the hull's); a
+ * compound as each child's mesh placed by the child's pose. AK_ERR_NULL_ARG, AK_ERR_BAD_INDEX,
+ * AK_ERR_BAD_ARG (plane_size negative or not finite), AK_ERR_SPAN_SMALL. */
+AK_API ak_result ak_rigid_body_mesh(const ak_rigid_model* model, size_t body_index,
+                                    float plane_size, ak_vec3_span out_positions,
+                                    ak_vec3_span out_normals, ak_u32_span out_indices);
 /* Totals of ak_rigid_world_mesh: every body but the planes (0 for NULL). */
 AK_API void ak_rigid_world_mesh_size(const ak_rigid_model* model, size_t* out_vertex_count,
                                      size_t* out_index_count);
 /* Every body but the planes as one world-space triangle mesh at a state (body order, each
- * body's ak_rigid_shape_mesh moved by its pose): to draw a scene, or to give cloth
+ * body's ak_rigid_body_mesh moved by its pose): to draw a scene, or to give cloth
  * (ak_cloth_collider_mesh) and particles (ak_particle_mesh) the bodies as a one-way collider
- * each step. Boxes are exact; spheres and capsules are inscribed polyhedra (at most 8% inside
- * the true surface at 8 x 16). AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a
- * non-finite state). */
+ * each step. Boxes, hulls, compounds of them, heightfields and trimeshes are exact; spheres and
+ * capsules are inscribed polyhedra (at most 8% inside the true surface at 8 x 16).
+ * AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a non-finite state), AK_ERR_UNSUPPORTED
+ * (more than 2^32 - 1 vertices: 32-bit indices cannot reach them). */
 AK_API ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan positions,
                                      ak_quat_cspan orientations, ak_vec3_span out_positions,
                                      ak_vec3_span out_normals, ak_u32_span out_indices);
+
+/* ---- the bodies as colliders of the fluid (one-way) ------------------------------------ */
+
+/* Colliders and convex planes ak_rigid_fluid_colliders writes for a model: one collider per
+ * sphere, box, capsule, plane, hull and heightfield body and per child of a compound; a hull's
+ * collider takes one plane per face. Triangle meshes are not passed to the fluid. 0 for NULL. */
+AK_API void ak_rigid_fluid_colliders_size(const ak_rigid_model* model, size_t* out_collider_count,
+                                          size_t* out_plane_count);
+/* The bodies at a state as the fluid's colliders (fluid.h), so a liquid collides one-way with
+ * them: each step, write them at the bodies' current poses and velocities and pass them as the
+ * fluid step job's colliders (after the rigid step, so the liquid is pushed out of where the
+ * bodies now are):
+ *     ak_rigid_step_run(&rigid_job);
+ *     ak_rigid_fluid_colliders(model, x, q, v, w, (ak_fluid_collider_span){cols, nc},
+ *                              (ak_vec4_span){planes, np}, &nc);
+ *     fluid_job.colliders = (ak_fluid_collider_cspan){cols, nc};
+ *     ak_fluid_step_run(&fluid_job);
+ * A sphere becomes AK_FLUID_SPHERE, a capsule AK_FLUID_CAPSULE (its segment's ends), a box
+ * AK_FLUID_BOX, a plane AK_FLUID_PLANE, a hull AK_FLUID_CONVEX (its faces' planes in its body
+ * frame, written to out_planes, which the colliders point into: keep it alive while they are
+ * used), a heightfield AK_FLUID_HEIGHTFIELD (pointing at the model's samples: keep the model
+ * alive), a compound one of those per child, in body order (children in order). Each collider
+ * carries its body's motion: velocity at its point a (v + w x (a - x)) and angular velocity w
+ * (zero for static bodies). Sizes from ak_rigid_fluid_colliders_size; *out_collider_count (may
+ * be NULL) gets the count written. AK_ERR_NULL_ARG, AK_ERR_SPAN_SMALL, AK_ERR_BAD_DATA (a
+ * non-finite state). The fluid sees only the shapes: the bodies feel no force from the liquid. */
+AK_API ak_result ak_rigid_fluid_colliders(const ak_rigid_model* model, ak_vec3_cspan positions,
+                                          ak_quat_cspan orientations, ak_vec3_cspan velocities,
+                                          ak_vec3_cspan angular_velocities,
+                                          ak_fluid_collider_span out_colliders,
+                                          ak_vec4_span out_planes, size_t* out_collider_count);
 
 /* ---- a run baked as glTF node animation ------------------------------------------------ */
 
@@ -449,8 +501,9 @@ typedef struct ak_rigid_bake_desc {
 
 /* Bake recorded frames of a run as an animated scene (io.h's ak_io_save writes it as glTF):
  * a root node named name and one child node "<name>_<i>" per body in body order, each
- * carrying its shape as a mesh in the body's frame (a sphere or capsule as a latitude-
- * longitude grid, a box's 6 faces, a plane as a square around its point with Y along its
+ * carrying its shape as a mesh in the body's frame (ak_rigid_body_mesh: a sphere or capsule
+ * as a latitude-longitude grid, a box's 6 faces, a hull's faces, a compound's children, a
+ * heightfield's or trimesh's triangles, a plane as a square around its point with Y along its
  * normal), rest transform = frame 0's pose; one clip named name with a LINEAR translation and
  * rotation channel per dynamic body keyed at every frame (rotations taken the short way from
  * the previous key), frame k at time k * frame_time. One frame, or only static bodies: no

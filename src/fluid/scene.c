@@ -148,15 +148,16 @@ static bool parse(akp_json* j, const char* text, size_t size, ak_fluid_scene* ou
     }
     e = akp_json_array(j, root, "", "colliders", AK_FLUID_SCENE_MAX_ITEMS, &count);
     for (size_t k = 0; e && k < count && !j->failed; ++k, e = e->next) {
-        static const char* const kk[] = {"shape", "a", "b", "normal", "radius", "velocity", NULL};
-        static const char* const shapes[] = {"plane", "sphere", "capsule", NULL};
+        static const char* const kk[] = {
+            "shape", "a", "b", "normal", "radius", "velocity", "half_extents", "orientation", NULL};
+        static const char* const shapes[] = {"plane", "sphere", "capsule", "box", NULL};
         akp_json_index(path, sizeof path, "colliders", k);
         ak_fluid_collider* c = &s->colliders[k];
         memset(c, 0, sizeof *c);
         c->normal = ak_vec3_make(0.0f, 1.0f, 0.0f);
         if (!akp_json_object(j, e, path, kk)) break;
         if (!cJSON_GetObjectItemCaseSensitive(e, "shape")) {
-            akp_json_fail(j, path, "shape", "required (plane, sphere or capsule)");
+            akp_json_fail(j, path, "shape", "required (plane, sphere, capsule or box)");
             break;
         }
         int shape = 0;
@@ -167,6 +168,24 @@ static bool parse(akp_json* j, const char* text, size_t size, ak_fluid_scene* ou
         parse_vec_in(j, e, path, "normal", &c->normal);
         akp_json_float(j, e, path, "radius", 0.0f, 1e6f, &c->radius);
         parse_vec_in(j, e, path, "velocity", &c->velocity);
+        float hq[4] = {0, 0, 0, 1};
+        if (!j->failed && c->shape == AK_FLUID_BOX) {
+            if (!cJSON_GetObjectItemCaseSensitive(e, "half_extents")) {
+                akp_json_fail(j, path, "half_extents", "required for a box");
+                break;
+            }
+            akp_json_floats(j, e, path, "half_extents", 3, 0.0f, 1e6f, &c->half_extents.x);
+            akp_json_floats(j, e, path, "orientation", 4, -1e3f, 1e3f, hq);
+            if (!j->failed && hq[0] == 0.0f && hq[1] == 0.0f && hq[2] == 0.0f && hq[3] == 0.0f)
+                akp_json_fail(j, path, "orientation", "is the zero quaternion");
+        } else if (!j->failed && (cJSON_GetObjectItemCaseSensitive(e, "half_extents") ||
+                                  cJSON_GetObjectItemCaseSensitive(e, "orientation"))) {
+            akp_json_fail(j, path,
+                          cJSON_GetObjectItemCaseSensitive(e, "half_extents") ? "half_extents"
+                                                                              : "orientation",
+                          "only a box has it");
+        }
+        c->orientation = ak_quat_normalize(ak_quat_make(hq[0], hq[1], hq[2], hq[3]));
         if (!j->failed && c->shape == AK_FLUID_PLANE && ak_vec3_length_sq(c->normal) == 0.0f)
             akp_json_fail(j, path, "normal", "must not be zero");
         s->collider_count = k + 1;

@@ -10,10 +10,11 @@
 #include <string.h>
 
 #include "json.h" /* akp_diag_set */
+#include "rigid_impl.h"
 
 enum { RINGS = 8, SEGS = 16 }; /* sphere and capsule tessellation: latitude rows, longitudes */
 
-/* Vertices and triangles of a body's mesh (0 vertices: nothing drawn). */
+/* Vertices and triangles of a primitive shape's mesh (0 vertices: nothing drawn). */
 static void shape_counts(ak_rigid_shape_type t, size_t* nv, size_t* nt) {
     switch (t) {
     case AK_RIGID_BOX:
@@ -30,6 +31,41 @@ static void shape_counts(ak_rigid_shape_type t, size_t* nv, size_t* nt) {
         break;
     default:
         *nv = 0, *nt = 0;
+        break;
+    }
+}
+
+/* Vertices and triangles of any shape's mesh: a hull's faces fanned (each face its own
+ * vertices, for flat normals), a compound's children, a heightfield's grid (a vertex per
+ * sample), a trimesh's triangles (three vertices each). hull and compound come from the model
+ * (NULL: the shape alone, which draws nothing for those two types). */
+static void mesh_counts(const ak_rigid_shape* s, const akp_hull* hull, const akp_compound* comp,
+                        size_t* nv, size_t* nt) {
+    *nv = 0, *nt = 0;
+    switch (s->type) {
+    case AK_RIGID_HULL:
+        if (hull)
+            for (uint32_t f = 0; f < hull->nf; ++f)
+                *nv += hull->faces[f].count, *nt += hull->faces[f].count - 2;
+        break;
+    case AK_RIGID_COMPOUND:
+        if (comp)
+            for (uint32_t k = 0; k < comp->count; ++k) {
+                size_t a, b;
+                mesh_counts(&comp->kids[k].shape, comp->kids[k].hull, NULL, &a, &b);
+                *nv += a, *nt += b;
+            }
+        break;
+    case AK_RIGID_HEIGHTFIELD:
+        if (s->rows >= 2 && s->cols >= 2 && s->heights.ptr &&
+            s->heights.count == (size_t)s->rows * s->cols)
+            *nv = (size_t)s->rows * s->cols, *nt = 2 * (size_t)(s->rows - 1) * (s->cols - 1);
+        break;
+    case AK_RIGID_TRIMESH:
+        if (s->vertices.ptr && s->indices.ptr) *nt = s->indices.count / 3, *nv = 3 * *nt;
+        break;
+    default:
+        shape_counts(s->type, nv, nt);
         break;
     }
 }
@@ -101,9 +137,67 @@ static void plane_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, float size) {
     memcpy(t, idx, sizeof idx);
 }
 
-/* The shape's mesh into arrays sized by shape_counts. */
-static void shape_mesh(const ak_rigid_shape* sh, float plane_size, ak_vec3* pos, ak_vec3* nrm,
-                       uint32_t* idx) {
+static void hull_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, const akp_hull* h) {
+    uint32_t v = 0;
+    for (uint32_t f = 0; f < h->nf; ++f) {
+        const akp_hull_face* fc = &h->faces[f];
+        for (uint32_t k = 0; k < fc->count; ++k) {
+            pos[v + k] = h->verts[h->idx[fc->first + k]];
+            nrm[v + k] = fc->n;
+        }
+        for (uint32_t k = 1; k + 1 < fc->count; ++k)
+            t[0] = v, t[1] = v + k, t[2] = v + k + 1, t += 3;
+        v += fc->count;
+    }
+}
+
+static ak_vec3 hf_point(const ak_rigid_shape* s, uint32_t i, uint32_t j) {
+    return ak_vec3_make((float)i * s->spacing, s->heights.ptr[(size_t)j * s->cols + i],
+                        (float)j * s->spacing);
+}
+
+/* The grid as the collision code splits it: cell (i, j) is (00, 01, 11) and (00, 11, 10), both
+ * counter-clockwise seen from +Y; normals by central differences. */
+static void heightfield_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, const ak_rigid_shape* s) {
+    const uint32_t rows = s->rows, cols = s->cols;
+    for (uint32_t j = 0; j < rows; ++j)
+        for (uint32_t i = 0; i < cols; ++i) {
+            uint32_t i0 = i ? i - 1 : i, i1 = i + 1 < cols ? i + 1 : i;
+            uint32_t j0 = j ? j - 1 : j, j1 = j + 1 < rows ? j + 1 : j;
+            float dx =
+                (hf_point(s, i1, j).y - hf_point(s, i0, j).y) / ((float)(i1 - i0) * s->spacing);
+            float dz =
+                (hf_point(s, i, j1).y - hf_point(s, i, j0).y) / ((float)(j1 - j0) * s->spacing);
+            pos[(size_t)j * cols + i] = hf_point(s, i, j);
+            nrm[(size_t)j * cols + i] = ak_vec3_normalize(ak_vec3_make(-dx, 1.0f, -dz));
+        }
+    for (uint32_t j = 0; j + 1 < rows; ++j)
+        for (uint32_t i = 0; i + 1 < cols; ++i) {
+            uint32_t a = j * cols + i, b = a + 1, c = a + cols, d = c + 1; /* 00 10 01 11 */
+            t[0] = a, t[1] = c, t[2] = d, t[3] = a, t[4] = d, t[5] = b;
+            t += 6;
+        }
+}
+
+static void trimesh_mesh(ak_vec3* pos, ak_vec3* nrm, uint32_t* t, const ak_rigid_shape* s) {
+    const size_t nt = s->indices.count / 3;
+    for (size_t k = 0; k < nt; ++k) {
+        ak_vec3 p[3];
+        for (int c = 0; c < 3; ++c) p[c] = s->vertices.ptr[s->indices.ptr[3 * k + (size_t)c]];
+        ak_vec3 n = ak_vec3_cross(ak_vec3_sub(p[1], p[0]), ak_vec3_sub(p[2], p[0]));
+        float l = ak_vec3_length(n);
+        n = l > 0.0f ? ak_vec3_scale(n, 1.0f / l) : ak_vec3_make(0.0f, 1.0f, 0.0f);
+        for (int c = 0; c < 3; ++c) {
+            pos[3 * k + (size_t)c] = p[c];
+            nrm[3 * k + (size_t)c] = n;
+            t[3 * k + (size_t)c] = (uint32_t)(3 * k + (size_t)c);
+        }
+    }
+}
+
+/* The shape's mesh into arrays sized by mesh_counts. */
+static void shape_mesh(const ak_rigid_shape* sh, const akp_hull* hull, const akp_compound* comp,
+                       float plane_size, ak_vec3* pos, ak_vec3* nrm, uint32_t* idx) {
     switch (sh->type) {
     case AK_RIGID_BOX:
         box_mesh(pos, nrm, idx, sh->half_extents);
@@ -117,6 +211,36 @@ static void shape_mesh(const ak_rigid_shape* sh, float plane_size, ak_vec3* pos,
     case AK_RIGID_SPHERE:
         round_mesh(pos, nrm, idx, sh->radius, 0.0f, false);
         break;
+    case AK_RIGID_HULL:
+        if (hull) hull_mesh(pos, nrm, idx, hull);
+        break;
+    case AK_RIGID_HEIGHTFIELD: {
+        size_t nv, nt;
+        mesh_counts(sh, NULL, NULL, &nv, &nt);
+        if (nv) heightfield_mesh(pos, nrm, idx, sh);
+        break;
+    }
+    case AK_RIGID_TRIMESH:
+        if (sh->vertices.ptr && sh->indices.ptr) trimesh_mesh(pos, nrm, idx, sh);
+        break;
+    case AK_RIGID_COMPOUND:
+        if (comp) {
+            size_t v = 0, k3 = 0;
+            for (uint32_t k = 0; k < comp->count; ++k) {
+                const rigid_body* kid = &comp->kids[k];
+                size_t a, b;
+                mesh_counts(&kid->shape, kid->hull, NULL, &a, &b);
+                shape_mesh(&kid->shape, kid->hull, NULL, 0.0f, pos + v, nrm + v, idx + k3);
+                const rigid_pose p = comp->poses[k];
+                for (size_t j = v; j < v + a; ++j) {
+                    pos[j] = ak_vec3_add(p.x, ak_quat_rotate(p.q, pos[j]));
+                    nrm[j] = ak_quat_rotate(p.q, nrm[j]);
+                }
+                for (size_t j = k3; j < k3 + 3 * b; ++j) idx[j] += (uint32_t)v;
+                v += a, k3 += 3 * b;
+            }
+        }
+        break;
     default:
         break;
     }
@@ -125,7 +249,8 @@ static void shape_mesh(const ak_rigid_shape* sh, float plane_size, ak_vec3* pos,
 void ak_rigid_shape_mesh_size(const ak_rigid_shape* shape, size_t* out_vertex_count,
                               size_t* out_index_count) {
     size_t nv = 0, nt = 0;
-    if (shape) shape_counts(shape->type, &nv, &nt);
+    if (shape && (unsigned)shape->type < AK_RIGID_SHAPE_COUNT)
+        mesh_counts(shape, NULL, NULL, &nv, &nt);
     if (out_vertex_count) *out_vertex_count = nv;
     if (out_index_count) *out_index_count = 3 * nt;
 }
@@ -140,7 +265,35 @@ ak_result ak_rigid_shape_mesh(const ak_rigid_shape* shape, float plane_size,
     ak_rigid_shape_mesh_size(shape, &nv, &ni);
     if (out_positions.count < nv || out_normals.count < nv || out_indices.count < ni)
         return AK_ERR_SPAN_SMALL;
-    shape_mesh(shape, plane_size, out_positions.ptr, out_normals.ptr, out_indices.ptr);
+    shape_mesh(shape, NULL, NULL, plane_size, out_positions.ptr, out_normals.ptr, out_indices.ptr);
+    return AK_OK;
+}
+
+void ak_rigid_body_mesh_size(const ak_rigid_model* model, size_t body_index,
+                             size_t* out_vertex_count, size_t* out_index_count) {
+    size_t nv = 0, nt = 0;
+    if (model && body_index < model->body_count) {
+        const rigid_body* b = &model->bodies[body_index];
+        mesh_counts(&b->shape, b->hull, b->compound, &nv, &nt);
+    }
+    if (out_vertex_count) *out_vertex_count = nv;
+    if (out_index_count) *out_index_count = 3 * nt;
+}
+
+ak_result ak_rigid_body_mesh(const ak_rigid_model* model, size_t body_index, float plane_size,
+                             ak_vec3_span out_positions, ak_vec3_span out_normals,
+                             ak_u32_span out_indices) {
+    if (!model || !out_positions.ptr || !out_normals.ptr || !out_indices.ptr)
+        return AK_ERR_NULL_ARG;
+    if (body_index >= model->body_count) return AK_ERR_BAD_INDEX;
+    if (!(plane_size >= 0.0f) || !ak_finitef(plane_size)) return AK_ERR_BAD_ARG;
+    size_t nv, ni;
+    ak_rigid_body_mesh_size(model, body_index, &nv, &ni);
+    if (out_positions.count < nv || out_normals.count < nv || out_indices.count < ni)
+        return AK_ERR_SPAN_SMALL;
+    const rigid_body* b = &model->bodies[body_index];
+    shape_mesh(&b->shape, b->hull, b->compound, plane_size, out_positions.ptr, out_normals.ptr,
+               out_indices.ptr);
     return AK_OK;
 }
 
@@ -148,10 +301,9 @@ void ak_rigid_world_mesh_size(const ak_rigid_model* model, size_t* out_vertex_co
                               size_t* out_index_count) {
     size_t nv = 0, ni = 0, n = ak_rigid_body_count(model);
     for (size_t i = 0; i < n; ++i) {
-        ak_rigid_body_desc d = ak_rigid_body_get_desc(model, i);
-        if (d.shape.type == AK_RIGID_PLANE) continue;
+        if (model->bodies[i].shape.type == AK_RIGID_PLANE) continue;
         size_t a, b;
-        ak_rigid_shape_mesh_size(&d.shape, &a, &b);
+        ak_rigid_body_mesh_size(model, i, &a, &b);
         nv += a, ni += b;
     }
     if (out_vertex_count) *out_vertex_count = nv;
@@ -170,16 +322,18 @@ ak_result ak_rigid_world_mesh(const ak_rigid_model* model, ak_vec3_cspan positio
     if (positions.count < n || orientations.count < n || out_positions.count < nv ||
         out_normals.count < nv || out_indices.count < ni)
         return AK_ERR_SPAN_SMALL;
+    if (nv > UINT32_MAX) return AK_ERR_UNSUPPORTED; /* the 32-bit indices could not reach them */
     for (size_t i = 0; i < n; ++i)
         if (!ak_vec3_is_finite(positions.ptr[i]) || !ak_quat_is_finite(orientations.ptr[i]))
             return AK_ERR_BAD_DATA;
     size_t v = 0, k = 0;
     for (size_t i = 0; i < n; ++i) {
-        ak_rigid_body_desc d = ak_rigid_body_get_desc(model, i);
-        if (d.shape.type == AK_RIGID_PLANE) continue;
+        const rigid_body* bd = &model->bodies[i];
+        if (bd->shape.type == AK_RIGID_PLANE) continue;
         size_t a, b;
-        ak_rigid_shape_mesh_size(&d.shape, &a, &b);
-        shape_mesh(&d.shape, 0.0f, out_positions.ptr + v, out_normals.ptr + v, out_indices.ptr + k);
+        ak_rigid_body_mesh_size(model, i, &a, &b);
+        shape_mesh(&bd->shape, bd->hull, bd->compound, 0.0f, out_positions.ptr + v,
+                   out_normals.ptr + v, out_indices.ptr + k);
         const ak_quat q = ak_quat_normalize(orientations.ptr[i]);
         for (size_t j = v; j < v + a; ++j) {
             out_positions.ptr[j] =
@@ -226,12 +380,12 @@ ak_result ak_rigid_bake_scene(const ak_rigid_bake_desc* desc, const ak_allocator
         need = SIZE_MAX;
     else
         need = nf * nb * per_key;
-    const size_t mesh_bytes = (RINGS + 2) * (SEGS + 1) * 2 * sizeof(ak_vec3) +
-                              2 * SEGS * RINGS * 3 * sizeof(uint32_t) + 2048;
-    if (need < SIZE_MAX - nb * mesh_bytes)
-        need += nb * mesh_bytes;
-    else
-        need = SIZE_MAX;
+    for (size_t i = 0; i < nb && need < SIZE_MAX; ++i) {
+        size_t mv, mi; /* each body's mesh as drawn (a trimesh or heightfield may be large) */
+        ak_rigid_body_mesh_size(model, i, &mv, &mi);
+        const size_t mesh_bytes = mv * 2 * sizeof(ak_vec3) + mi * sizeof(uint32_t) + 2048;
+        need = need < SIZE_MAX - mesh_bytes ? need + mesh_bytes : SIZE_MAX;
+    }
     const size_t budget = desc->memory_budget ? desc->memory_budget : AK_SCENE_BAKE_DEFAULT_BUDGET;
     if (need > budget)
         return akp_diag_set(diag, AK_ERR_UNSUPPORTED, "rigid bake",
@@ -284,14 +438,16 @@ ak_result ak_rigid_bake_scene(const ak_rigid_bake_desc* desc, const ak_allocator
     for (size_t i = 0; r == AK_OK && i < nb; ++i) {
         ak_rigid_body_desc d = ak_rigid_body_get_desc(model, i);
         size_t nv, nt;
-        shape_counts(d.shape.type, &nv, &nt);
+        ak_rigid_body_mesh_size(model, i, &nv, &nt);
+        nt /= 3;
         char mname[AK_NAME_SIZE];
         snprintf(mname, sizeof mname, "%.40s_%zu", name, i);
         ak_mesh_desc md = {
             .vertex_count = nv, .triangle_count = nt, .has_normals = true, .name = mname};
         if ((r = ak_mesh_create(&md, &s->alloc, &s->meshes[i].mesh)) != AK_OK) break;
         ak_mesh* m = s->meshes[i].mesh;
-        shape_mesh(&d.shape, desc->plane_size, m->positions, m->normals, m->indices);
+        ak_rigid_body_mesh(model, i, desc->plane_size, (ak_vec3_span){m->positions, nv},
+                           (ak_vec3_span){m->normals, nv}, (ak_u32_span){m->indices, 3 * nt});
         s->meshes[i].node = (int32_t)(i + 1);
         s->meshes[i].has_material = true;
         s->meshes[i].base_color = d.is_static ? ak_vec4_make(0.55f, 0.55f, 0.5f, 1.0f)

@@ -99,12 +99,46 @@ static void renderer_free(renderer* r) {
     free(r->pos), free(r->nrm), free(r->col), free(r->px);
 }
 
-/* Spheres and capsules (as spheres along the segment) in grey; planes are not drawn. */
+/* An oriented box collider as 12 triangles (36 corners, flat normals). */
+static void box_tris(const ak_fluid_collider* k, ak_vec3* pos, ak_vec3* nrm) {
+    const ak_quat q = ak_quat_dot(k->orientation, k->orientation) > 0.0f
+                          ? ak_quat_normalize(k->orientation)
+                          : ak_quat_identity();
+    int v = 0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+            const float cu[6] = {-1, 1, 1, -1, 1, -1}, cw[6] = {-1, -1, 1, -1, 1, 1};
+            for (int c = 0; c < 6; ++c) {
+                const int cc = sign > 0 ? c : (c % 3 == 1 ? c + 1 : c % 3 == 2 ? c - 1 : c);
+                float p[3], n[3] = {0, 0, 0};
+                p[axis] = (float)sign, n[axis] = (float)sign;
+                p[u] = cu[cc], p[w] = cw[cc];
+                const ak_vec3 local = ak_vec3_make(
+                    p[0] * k->half_extents.x, p[1] * k->half_extents.y, p[2] * k->half_extents.z);
+                pos[v] = ak_vec3_add(k->a, ak_quat_rotate(q, local));
+                nrm[v++] = ak_quat_rotate(q, ak_vec3_make(n[0], n[1], n[2]));
+            }
+        }
+}
+
+/* Spheres, capsules (as spheres along the segment) and boxes in grey; planes are not drawn. */
 static ak_result draw_colliders(renderer* r, const ak_fluid_scene* s) {
     ak_vec3 unit[SPHERE_TRIS * 3], pos[SPHERE_TRIS * 3];
     unit_sphere(unit);
     for (size_t c = 0; c < s->collider_count; ++c) {
         const ak_fluid_collider* k = &s->colliders[c];
+        if (k->shape == AK_FLUID_BOX) {
+            ak_vec3 bp[36], bn[36];
+            box_tris(k, bp, bn);
+            ak_raster_mesh m = {.positions = {bp, 36},
+                                .normals = {bn, 36},
+                                .material = {.color = ak_vec4_make(0.75f, 0.72f, 0.68f, 1)},
+                                .shading = AK_SHADING_PHONG};
+            ak_result res = ak_raster_draw_mesh(r->raster, &r->cam, &m);
+            if (res != AK_OK) return res;
+            continue;
+        }
         if (k->shape == AK_FLUID_PLANE || !(k->radius > 0.0f)) continue;
         const int parts = k->shape == AK_FLUID_CAPSULE ? 16 : 1;
         for (int q = 0; q < parts; ++q) {

@@ -13,7 +13,8 @@ static const char* const usage =
     "stack|pyramid|dominoes|avalanche|ragdoll|incline]\n"
     "                     [--steps N] [--dt DT] [--substeps S] [--threads T] [--json OUT.json]\n"
     "                     [-o OUT.gif|OUT.png|OUT.glb]\n"
-    "Simulate rigid bodies (spheres, boxes, capsules, static planes) and joints with XPBD "
+    "Simulate rigid bodies (spheres, boxes, capsules, hulls, compounds, static planes, meshes and\n"
+    "heightfields) and joints with XPBD "
     "substeps,\n"
     "contacts, Coulomb friction and restitution: a 10-box stack, a 20-layer pyramid, dominoes, an\n"
     "avalanche down a slope, builtin:humanoid as a ragdoll, boxes on an incline; or the scene a\n"
@@ -24,106 +25,39 @@ static const char* const usage =
     "(.glb: one node per body, translation and rotation channels).\n"
     "Exit status: 0 success, 1 bad scene or a blow-up (named by its step), 2 bad usage.\n";
 
-/* ---- the bodies as one mesh ---------------------------------------------------------------- */
-
-enum { RINGS = 8, SEGS = 12 };
+/* ---- the bodies as one mesh (the library's: every shape drawn as itself) ------------------ */
 
 typedef struct body_mesh {
-    ak_vec3 *local_pos, *local_nrm, *pos, *nrm;
-    uint32_t* body; /* per vertex */
+    ak_vec3 *pos, *nrm;
     uint32_t* idx;
     size_t vcount, icount;
 } body_mesh;
 
 static void mesh_free(body_mesh* m) {
-    free(m->local_pos), free(m->local_nrm), free(m->pos), free(m->nrm), free(m->body), free(m->idx);
+    free(m->pos), free(m->nrm), free(m->idx);
     memset(m, 0, sizeof *m);
 }
 
-static void add_vertex(body_mesh* m, uint32_t body, ak_vec3 p, ak_vec3 n) {
-    m->local_pos[m->vcount] = p;
-    m->local_nrm[m->vcount] = n;
-    m->body[m->vcount++] = body;
-}
-
-static void add_quad(body_mesh* m, uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
-    uint32_t* t = m->idx + m->icount;
-    t[0] = a, t[1] = b, t[2] = c, t[3] = a, t[4] = c, t[5] = d;
-    m->icount += 6;
-}
+/* Most vertices drawn (1.6 GB of positions and normals): a scene's meshes are bounded by its
+ * file's size, far below this; the check keeps the 32-bit indices exact. */
+#define DRAW_MAX_VERTICES ((size_t)1 << 26)
 
 static bool mesh_build(body_mesh* m, const ak_rigid_model* model) {
     memset(m, 0, sizeof *m);
-    size_t n = ak_rigid_body_count(model), nv = 0, ni = 0;
-    for (size_t i = 0; i < n; ++i) {
-        ak_rigid_shape_type t = ak_rigid_body_get_desc(model, i).shape.type;
-        if (t == AK_RIGID_BOX)
-            nv += 24, ni += 36;
-        else if (t != AK_RIGID_PLANE)
-            nv += (RINGS + 2) * SEGS, ni += (RINGS + 1) * SEGS * 6;
-    }
-    m->local_pos = malloc((nv + 1) * sizeof(ak_vec3));
-    m->local_nrm = malloc((nv + 1) * sizeof(ak_vec3));
-    m->pos = malloc((nv + 1) * sizeof(ak_vec3));
-    m->nrm = malloc((nv + 1) * sizeof(ak_vec3));
-    m->body = malloc((nv + 1) * sizeof(uint32_t));
-    m->idx = malloc((ni + 1) * sizeof(uint32_t));
-    if (!m->local_pos || !m->local_nrm || !m->pos || !m->nrm || !m->body || !m->idx) return false;
-    for (uint32_t i = 0; i < (uint32_t)n; ++i) {
-        ak_rigid_shape s = ak_rigid_body_get_desc(model, i).shape;
-        uint32_t base = (uint32_t)m->vcount;
-        if (s.type == AK_RIGID_BOX) {
-            ak_vec3 h = s.half_extents;
-            for (int axis = 0; axis < 3; ++axis)
-                for (int sg = -1; sg <= 1; sg += 2) {
-                    float f = (float)sg;
-                    ak_vec3 nn = ak_vec3_make(axis == 0 ? f : 0.0f, axis == 1 ? f : 0.0f,
-                                              axis == 2 ? f : 0.0f);
-                    ak_vec3 u = axis == 0   ? ak_vec3_make(0, 1, 0)
-                                : axis == 1 ? ak_vec3_make(0, 0, 1)
-                                            : ak_vec3_make(1, 0, 0);
-                    ak_vec3 v = ak_vec3_cross(nn, u);
-                    uint32_t b0 = (uint32_t)m->vcount;
-                    for (int c = 0; c < 4; ++c) {
-                        float a = (c == 0 || c == 3) ? -1.0f : 1.0f, b = c < 2 ? -1.0f : 1.0f;
-                        ak_vec3 p =
-                            ak_vec3_add(ak_vec3_add(nn, ak_vec3_scale(u, a)), ak_vec3_scale(v, b));
-                        add_vertex(m, i, ak_vec3_mul(p, h), nn);
-                    }
-                    add_quad(m, b0, b0 + 1, b0 + 2, b0 + 3);
-                }
-        } else if (s.type != AK_RIGID_PLANE) {
-            float hh = s.type == AK_RIGID_CAPSULE ? s.half_height : 0.0f;
-            /* rings 0..RINGS/2 on the top cap, RINGS/2..RINGS on the bottom (the equator twice) */
-            for (int r = 0; r <= RINGS + 1; ++r) {
-                int rr = r <= RINGS / 2 ? r : r - 1;
-                float th = 3.14159265f * (float)rr / (float)RINGS;
-                float off = r <= RINGS / 2 ? hh : -hh;
-                for (int k = 0; k < SEGS; ++k) {
-                    float ph = 6.2831853f * (float)k / (float)SEGS;
-                    ak_vec3 nn = ak_vec3_make(sinf(th) * cosf(ph), cosf(th), sinf(th) * sinf(ph));
-                    add_vertex(
-                        m, i, ak_vec3_make(nn.x * s.radius, nn.y * s.radius + off, nn.z * s.radius),
-                        nn);
-                }
-            }
-            for (int r = 0; r <= RINGS; ++r)
-                for (int k = 0; k < SEGS; ++k) {
-                    uint32_t a = base + (uint32_t)(r * SEGS + k),
-                             b = base + (uint32_t)(r * SEGS + (k + 1) % SEGS);
-                    add_quad(m, a, a + SEGS, b + SEGS, b);
-                }
-        }
-    }
-    return true;
+    ak_rigid_world_mesh_size(model, &m->vcount, &m->icount);
+    if (m->vcount > DRAW_MAX_VERTICES) return false;
+    m->pos = malloc((m->vcount + 1) * sizeof(ak_vec3));
+    m->nrm = malloc((m->vcount + 1) * sizeof(ak_vec3));
+    m->idx = malloc((m->icount + 1) * sizeof(uint32_t));
+    return m->pos && m->nrm && m->idx;
 }
 
-static void mesh_pose(body_mesh* m, const ak_vec3* x, const ak_quat* q) {
-    for (size_t v = 0; v < m->vcount; ++v) {
-        uint32_t b = m->body[v];
-        m->pos[v] = ak_vec3_add(x[b], ak_quat_rotate(q[b], m->local_pos[v]));
-        m->nrm[v] = ak_quat_rotate(q[b], m->local_nrm[v]);
-    }
+static ak_result mesh_pose(body_mesh* m, const ak_rigid_model* model, const ak_vec3* x,
+                           const ak_quat* q) {
+    const size_t n = ak_rigid_body_count(model);
+    return ak_rigid_world_mesh(
+        model, (ak_vec3_cspan){x, n}, (ak_quat_cspan){q, n}, (ak_vec3_span){m->pos, m->vcount + 1},
+        (ak_vec3_span){m->nrm, m->vcount + 1}, (ak_u32_span){m->idx, m->icount + 1});
 }
 
 /* ---- output ------------------------------------------------------------------------------ */
@@ -253,12 +187,18 @@ int cmd_rigid(int argc, char** argv) {
     const ak_vec3* x = run.positions;
     const ak_quat* q = run.orientations;
     const bool gif = out && cli_has_ext(out, ".gif"), png = out && cli_has_ext(out, ".png");
-    if (out) {
+    if (gif || png) {
         if (!mesh_build(&mesh, model)) {
-            rc = cli_fail("rigid", "out of memory");
+            rc = cli_fail("rigid",
+                          "%s: the bodies' mesh (%zu vertices) is too large to draw or "
+                          "out of memory",
+                          name, mesh.vcount);
             goto done;
         }
-        mesh_pose(&mesh, x, q);
+        if ((r = mesh_pose(&mesh, model, x, q)) != AK_OK) {
+            rc = cli_fail("rigid", "%s: cannot mesh the bodies: %s", name, ak_result_string(r));
+            goto done;
+        }
     }
     if (out && sim_bake_wanted(out)) {
         /* every step a frame, unless that passes the bake's frame limit or SIM_BAKE_BUDGET */
@@ -299,9 +239,13 @@ int cmd_rigid(int argc, char** argv) {
     int frames = 0;
     float time = 0.0f;
     for (long step = 0; step <= sc.steps; ++step) {
-        if (out) mesh_pose(&mesh, x, q);
         if ((gif && (step == 0 || floorf(time * 25.0f) != floorf((time - sc.dt) * 25.0f))) ||
             (png && step == sc.steps)) {
+            if ((r = mesh_pose(&mesh, model, x, q)) != AK_OK) {
+                rc = cli_fail("rigid", "%s: cannot mesh the bodies at step %ld: %s", name, step,
+                              ak_result_string(r));
+                goto done;
+            }
             ak_raster_mesh extra = {
                 .positions = {mesh.pos, mesh.vcount},
                 .normals = {mesh.nrm, mesh.vcount},

@@ -70,11 +70,12 @@ static void rsim_mesh(rsim* r) {
         if (i >= r->user_count && !r->live[i - r->user_count]) continue;
         ak_rigid_body_desc d = ak_rigid_body_get_desc(m, i);
         if (d.shape.type == AK_RIGID_PLANE) continue;
-        size_t nv, ni;
-        ak_rigid_shape_mesh_size(&d.shape, &nv, &ni);
+        size_t nv, ni; /* each shape as itself (hull faces, compound children, mesh triangles) */
+        ak_rigid_body_mesh_size(m, i, &nv, &ni);
         if (r->mv + nv > r->mv_cap || r->mic + ni > r->mi_cap) break;
-        ak_rigid_shape_mesh(&d.shape, 0.0f, (ak_vec3_span){r->mp + r->mv, nv},
-                            (ak_vec3_span){r->mn + r->mv, nv}, (ak_u32_span){r->mi + r->mic, ni});
+        if (!nv) continue;
+        ak_rigid_body_mesh(m, i, 0.0f, (ak_vec3_span){r->mp + r->mv, nv},
+                           (ak_vec3_span){r->mn + r->mv, nv}, (ak_u32_span){r->mi + r->mic, ni});
         const ak_quat q = ak_quat_normalize(r->run.orientations[i]);
         for (size_t v = r->mv; v < r->mv + nv; ++v) {
             r->mp[v] = ak_vec3_add(r->run.positions[i], ak_quat_rotate(q, r->mp[v]));
@@ -142,9 +143,9 @@ static int rsim_init(void** state, const char* spec, const view_sim_opts* o, cha
         return CLI_BAD_INPUT;
     }
     /* mesh capacity: every body as drawn */
-    for (size_t i = 0; i < r->sc.body_count; ++i) {
+    for (size_t i = 0; i < r->run.body_count; ++i) {
         size_t nv, ni;
-        ak_rigid_shape_mesh_size(&r->sc.bodies[i].shape, &nv, &ni);
+        ak_rigid_body_mesh_size(r->run.model, i, &nv, &ni);
         r->mv_cap += nv, r->mi_cap += ni;
     }
     r->mp = malloc((r->mv_cap + 1) * sizeof *r->mp);
