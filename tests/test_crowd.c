@@ -265,7 +265,7 @@ static double corridor_lane_split(bool skip) {
     job.skip_perturbation = skip;
     double z[2] = {0, 0};
     size_t count[2] = {0, 0};
-    for (int s = 0; s < 250; ++s) { /* 25 s: the fronts meet after about 11 s */
+    for (int s = 0; s < 200; ++s) { /* 20 s: the fronts meet after about 11 s */
         job.step_index = (uint64_t)s;
         if (ak_crowd_step_run(&job) != AK_OK) break;
         memcpy(r.p, r.p2, r.n * sizeof(ak_vec2));
