@@ -220,7 +220,7 @@ typedef struct ak_crowd_step_job {
 
 /* The hard-contact projection's tolerance (m) and its most passes in one step. */
 #define AK_CROWD_CONTACT_TOLERANCE 1e-4f
-#define AK_CROWD_MAX_CONTACT_PASSES 256u
+#define AK_CROWD_MAX_CONTACT_PASSES 1024u
 
 /* Agents stacked on a few points make the neighbour search quadratic; above this load the
  * step returns AK_ERR_BUDGET (about 4,000 agents in one cell). */
