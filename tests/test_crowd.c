@@ -237,7 +237,7 @@ AK_TEST(presets_100_home_apart) {
 }
 
 /* The two presets that jammed: the corridor (two blocks head-on) and the evacuation (one door)
- * with 100 agents (fast) and with 1,000 (slow: about 30 s and a minute here): every agent home
+ * with 100 agents (fast) and with 1,000 (slow: 41 s and 254 s here, on the loaded 2-core VM): every agent home
  * within the preset's default steps, no overlap. */
 AK_TEST(corridor_evacuation_100) {
     preset_home("corridor", 100, 100, 1);
