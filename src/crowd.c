@@ -338,6 +338,7 @@ typedef struct ctx {
                                [cstart[z w + x], cstart[z w + x + 1]) */
     const float *sx, *sz;   /* [n] positions in cell order */
     const uint32_t* sidx;   /* [n] agent of each sorted entry */
+    const ak_vec2* pref;    /* [n] every agent's preferred velocity this step (perturbed) */
     int64_t x0, z0;         /* the rectangle's first cell */
     int32_t w, h;
     float cs;
@@ -823,6 +824,44 @@ static ak_vec2 pref_velocity(const ak_crowd_step_job* job, const ak_crowd_agent*
     return perturb(job, i, g); /* within one second of the goal: arrive */
 }
 
+/* Keep to one side, as pedestrians do (unless skip_perturbation): while walking at full
+ * speed (not on the last second to the goal), the preferred velocity turns SIDE_DRIFT to the
+ * side the -0.01 rad turn of perturb takes ("right" below), and up to SIDE_TURN more, the
+ * more the nearer, when a neighbour ahead heads toward the agent (its preferred velocity
+ * against ours at half its speed or more) and is not already clearly on its right. Two
+ * agents head-on both turn to their own right and pass on the left; in a corridor the two
+ * directions sort into two lanes along the walls before they meet, instead of meeting
+ * head-on across the whole width, where ORCA deadlocks (docs/crowd.md, "Jams"). Reads only
+ * the step's inputs and every agent's preferred velocity (c->pref, computed before the
+ * parallel pass): any thread count gives the same bits. */
+#define SIDE_DRIFT 0.15f /* rad, while walking at full speed */
+#define SIDE_TURN 0.35f  /* rad more, at most, for an oncoming neighbour */
+static ak_vec2 keep_side(const ctx* c, const uint64_t* nb, uint32_t na, ak_vec2 p, const ak_crowd_agent* a,
+                         ak_vec2 pref) {
+    const ak_crowd_step_job* job = c->job;
+    const float s2 = abs_sq(pref);
+    /* only while walking at full speed (not when arriving: goal within a second) */
+    if (job->skip_perturbation || !(s2 > 0.81f * a->pref_speed * a->pref_speed)) return pref;
+    const float inv_s = 1.0f / sqrtf(s2);
+    const ak_vec2 d = mul(inv_s, pref); /* unit heading wanted */
+    float w = 0.0f;
+    for (uint32_t k = 0; k < na; ++k) {
+        const uint32_t j = nkey_index(nb[k]);
+        const ak_vec2 rp = sub(job->positions.ptr[j], p);
+        const float ahead = dot(rp, d);
+        if (ahead <= 0.0f) continue;
+        /* heading toward us at half its speed or more (not an agent settling on its goal) */
+        if (dot(c->pref[j], d) > -0.5f * c->crowd->agents[j].pref_speed) continue;
+        const float cr = a->radius + c->crowd->radii[j];
+        if (det(d, rp) < -cr) continue; /* already clearly on our right: pass as it is */
+        const float closeness = 1.0f - ahead / a->neighbor_distance;
+        if (closeness > w) w = closeness;
+    }
+    const float t = SIDE_DRIFT + SIDE_TURN * w; /* small angles: rotate by -t */
+    const float cs = 1.0f - 0.5f * t * t, sn = t - t * t * t * (1.0f / 6.0f);
+    return v2(cs * pref.x + sn * pref.y, cs * pref.y - sn * pref.x);
+}
+
 /* All lines of agent i into w->lines; returns the count and the obstacle-line count. */
 static size_t build_lines(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const ak_crowd_agent* a, size_t* out_obst) {
     const ctx* c = w->c;
@@ -950,7 +989,7 @@ static void* work(void* arg) {
         const size_t i = c->cstart ? c->sidx[s] : s; /* in cell order: neighbours share the cache */
         const ak_crowd_agent* a = &c->crowd->agents[i];
         const ak_vec2 p = job->positions.ptr[i], v = job->velocities.ptr[i];
-        const ak_vec2 pref = pref_velocity(job, a, i, p);
+        const ak_vec2 pref = c->pref[i];
         if (c->crowd->method == AK_CROWD_VISION) {
             ak_vec2 nv = vision_velocity(w, i, p, v, a, pref);
             if (!ak_finitef(nv.x) || !ak_finitef(nv.y)) nv = v2(0.0f, 0.0f);
@@ -960,8 +999,9 @@ static void* work(void* arg) {
         }
         size_t no = 0;
         const size_t nl = build_lines(w, i, p, v, a, &no);
+        const ak_vec2 want = keep_side(c, w->agent_n, (uint32_t)(nl - no), p, a, pref);
         ak_vec2 nv;
-        const size_t fail = lp2(w->lines, nl, a->max_speed, pref, false, &nv);
+        const size_t fail = lp2(w->lines, nl, a->max_speed, want, false, &nv);
         if (fail < nl) lp3(w->lines, nl, no, fail, a->max_speed, w->proj, &nv);
         if (!ak_finitef(nv.x) || !ak_finitef(nv.y)) nv = v2(0.0f, 0.0f); /* never NaN out */
         job->out_velocities.ptr[i] = nv;
@@ -1045,7 +1085,7 @@ static uint32_t contact_need(const ak_crowd_step_job* job) {
 }
 
 typedef struct layout {
-    size_t grid_pts, grid_mem, per_thread, contact, dense, dense_cap, total;
+    size_t grid_pts, grid_mem, per_thread, contact, dense, dense_cap, pref, total;
     ak_grid_desc gd, contact_gd;
 } layout;
 
@@ -1066,7 +1106,8 @@ static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t 
                     2 * akp_align16(lines * sizeof(ak_crowd_line));
     L->dense_cap = 4 * n + 1024;
     L->dense = dense_grid_bytes(n, L->dense_cap);
-    L->total = L->grid_pts + L->grid_mem + L->contact + L->dense + (size_t)threads * L->per_thread + 16;
+    L->pref = akp_align16(n * sizeof(ak_vec2));
+    L->total = L->grid_pts + L->grid_mem + L->contact + L->dense + L->pref + (size_t)threads * L->per_thread + 16;
     return true;
 }
 
@@ -1178,8 +1219,13 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     ctx c = {.job = job, .crowd = crowd};
     const ak_result gr = search_grid(&c, &L, base, &grid);
     if (gr != AK_OK) return gr;
+    /* every agent's preferred velocity first (keep_side reads the neighbours'), advancing
+     * the waypoints in place */
+    ak_vec2* pref = (ak_vec2*)(void*)(base + L.grid_pts + L.grid_mem + L.contact + L.dense);
+    for (size_t i = 0; i < n; ++i) pref[i] = pref_velocity(job, &crowd->agents[i], i, job->positions.ptr[i]);
+    c.pref = pref;
     worker w[64];
-    char* tb = base + L.grid_pts + L.grid_mem + L.contact + L.dense;
+    char* tb = base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref;
     for (uint32_t t = 0; t < threads; ++t) {
         w[t].c = &c;
         w[t].begin = n * t / threads;
@@ -1229,7 +1275,7 @@ size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd
     if (search_grid(&c, &L, base, &grid) != AK_OK) return 0;
     worker w;
     w.c = &c;
-    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense, &w);
+    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref, &w);
     const ak_crowd_agent* a = &crowd->agents[index];
     size_t no = 0;
     const ak_vec2 p = job->positions.ptr[index], v = job->velocities.ptr[index];

@@ -25,7 +25,8 @@
  *   - the preferred velocity points at the current waypoint at pref_speed, and is the offset
  *     to the waypoint itself (per second) within pref_speed * 1 s of the last one, so agents
  *     slow down and stop on their goal (RVO2's examples do this for pref_speed 1); an agent
- *     moves on to its next waypoint once within waypoint_radius of the current one;
+ *     moves on to its next waypoint once within waypoint_radius of the current one; unless
+ *     skip_perturbation, it is turned to keep to one side (lanes form: see the job);
  *   - thread_count threads each take a range of agents; every agent reads only the step's
  *     inputs, so results are bit-identical for any thread count.
  *
@@ -183,8 +184,16 @@ typedef struct ak_crowd_step_job {
                                     1e-4 m/s (a hash of agent index and step_index): they
                                     break the symmetric deadlocks of ORCA (four agents
                                     crossing head-on, a ring of agents blocking each other at
-                                    the circle's centre); true -> the preferred velocity as
-                                    is (RVO2's bits: bench/vs_rvo2) */
+                                    the circle's centre); and, for ORCA, the side
+                                    preference: while an agent walks at 90% of its
+                                    pref_speed or more, its preferred velocity turns a
+                                    further 0.15 rad to that side, and up to 0.35 rad more
+                                    (the more the nearer) when a neighbour ahead heads
+                                    toward it and is not already clearly on that side, so
+                                    that people walking in opposite directions pass on one
+                                    side and form lanes (docs/crowd.md, "Jams"); true ->
+                                    the preferred velocity as is (RVO2's bits:
+                                    bench/vs_rvo2) */
     uint32_t contact_iterations; /* with allow_overlap: 0 -> pure ORCA, which lets agents
                                     overlap when the crowd is so dense that its program is
                                     infeasible (the 3D program then only minimises the
@@ -211,7 +220,7 @@ typedef struct ak_crowd_step_job {
 
 /* The hard-contact projection's tolerance (m) and its most passes in one step. */
 #define AK_CROWD_CONTACT_TOLERANCE 1e-4f
-#define AK_CROWD_MAX_CONTACT_PASSES 256u
+#define AK_CROWD_MAX_CONTACT_PASSES 1024u
 
 /* Agents stacked on a few points make the neighbour search quadratic; above this load the
  * step returns AK_ERR_BUDGET (about 4,000 agents in one cell). */
@@ -343,7 +352,8 @@ AK_API ak_result ak_crowd_scene_load_file(const char* path, ak_crowd_scene* scen
 /* The defaults, then the preset name (AK_CROWD_SCENE_PRESETS; docs/crowd.md gives their
  * layouts) with count agents (0 -> AK_CROWD_SCENE_DEFAULT_AGENTS): "circle" (on a circle,
  * each to the antipode), "crossing" (four blocks cross from the four sides), "corridor" (two
- * groups meet in an 8 m corridor between two walls), "evacuation" (a room empties through one
+ * groups, 5 abreast, meet in an 8 m corridor between two walls; each group's goals lie
+ * beyond the other's start), "evacuation" (a room empties through one
  * door). Sets duration, and steps = ceil(duration / dt). *out_scene is overwritten without
  * being freed (pass a new or freed scene). AK_ERR_NOT_FOUND for another name, AK_ERR_BAD_ARG
  * for count above AK_CROWD_SCENE_MAX_AGENTS, AK_ERR_NO_MEMORY, AK_ERR_NULL_ARG; on failure

@@ -125,12 +125,15 @@ static int preset_fill(const char* name, size_t count, ak_crowd_scene* s) {
         return 0;
     }
     if (strcmp(name, "corridor") == 0) {
-        /* two groups walk at each other down an 8 m wide corridor (walls along x) */
+        /* two groups (5 abreast, 1 m apart: a 4.6 m wide block) walk at each other down an
+         * 8 m wide corridor (walls along x); each group's goals are a block of the same
+         * layout beyond where the other group started, so that nobody arrives where the other
+         * group still is (agents caught in a parked block cannot walk out of it) */
         const size_t n = count ? count : 100;
-        const float W = 8.0f, sp = 0.8f;
-        const size_t per_row = 9, rows = ((n + 1) / 2 + per_row - 1) / per_row;
+        const float W = 8.0f, sp = 1.0f;
+        const size_t per_row = 5, rows = ((n + 1) / 2 + per_row - 1) / per_row;
         const float L = 30.0f, depth = sp * (float)rows;
-        const float travel = L + depth;
+        const float travel = L + 2.0f * depth + 2.0f;
         const float end = 0.5f * L + depth + 2.0f;
         if (alloc_scene(s, n, 1, 2, 4)) return 1;
         wall(s, 0, (ak_vec2){-end - travel, -0.5f * W}, (ak_vec2){end + travel, -0.5f * W});
