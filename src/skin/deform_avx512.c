@@ -550,17 +550,41 @@ AKP_AVX512_INLINE static inline void lbs_range_k(const akp_skin_ctx* c, size_t b
 AKP_DQ_RANGE_K(block_dqs)
 AKP_DQ_RANGE_K(block_cor)
 
-#define AKP_K_SWITCH(call)                                                                 \
+/* One function per method and influence count: the same loops as one function holding all
+ * eight counts (one call per range more; bench_skin's rates did not move), but each small
+ * enough for the compilers' register allocation and scheduling, whose cost grows faster than
+ * the function. As three huge functions this file took 21.6 s of gcc -O3 CPU (11.9 s now) and
+ * over 200 s of clang with ASan + UBSan + fuzzer coverage (106 s now): the last object of
+ * CI's sanitizer build, with the other core idle. */
+#define AKP_K_FUNCS(name, body)                                                            \
+    AKP_AVX512 __attribute__((noinline)) static void name##_1(AKP_K_ARGS) { body(1u); }    \
+    AKP_AVX512 __attribute__((noinline)) static void name##_2(AKP_K_ARGS) { body(2u); }    \
+    AKP_AVX512 __attribute__((noinline)) static void name##_3(AKP_K_ARGS) { body(3u); }    \
+    AKP_AVX512 __attribute__((noinline)) static void name##_4(AKP_K_ARGS) { body(4u); }    \
+    AKP_AVX512 __attribute__((noinline)) static void name##_5(AKP_K_ARGS) { body(5u); }    \
+    AKP_AVX512 __attribute__((noinline)) static void name##_6(AKP_K_ARGS) { body(6u); }    \
+    AKP_AVX512 __attribute__((noinline)) static void name##_7(AKP_K_ARGS) { body(7u); }    \
+    AKP_AVX512 __attribute__((noinline)) static void name##_8(AKP_K_ARGS) { body(8u); }
+#define AKP_K_SWITCH(name, ...)                                                            \
     switch (c->k) {                                                                        \
-    case 1: call(1u); break;                                                               \
-    case 2: call(2u); break;                                                               \
-    case 3: call(3u); break;                                                               \
-    case 4: call(4u); break;                                                               \
-    case 5: call(5u); break;                                                               \
-    case 6: call(6u); break;                                                               \
-    case 7: call(7u); break;                                                               \
-    default: call(8u); break;                                                              \
+    case 1: name##_1(__VA_ARGS__); break;                                                  \
+    case 2: name##_2(__VA_ARGS__); break;                                                  \
+    case 3: name##_3(__VA_ARGS__); break;                                                  \
+    case 4: name##_4(__VA_ARGS__); break;                                                  \
+    case 5: name##_5(__VA_ARGS__); break;                                                  \
+    case 6: name##_6(__VA_ARGS__); break;                                                  \
+    case 7: name##_7(__VA_ARGS__); break;                                                  \
+    default: name##_8(__VA_ARGS__); break;                                                 \
     }
+#define AKP_K_ARGS const akp_skin_ctx *c, size_t begin, size_t end, uint32_t neg
+#define AKP_LBS_BODY(K) ((void)neg, lbs_range_k(c, begin, end, (K)))
+#define AKP_DQS_BODY(K) block_dqs_range_k(c, begin, end, neg, (K))
+#define AKP_COR_BODY(K) block_cor_range_k(c, begin, end, neg, (K))
+AKP_K_FUNCS(lbs_k, AKP_LBS_BODY)
+AKP_K_FUNCS(dqs_k, AKP_DQS_BODY)
+AKP_K_FUNCS(cor_k, AKP_COR_BODY)
+#undef AKP_K_ARGS
+
 AKP_AVX512 static void lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
     if (c->rigid_single) {
         size_t i = begin;
@@ -568,21 +592,15 @@ AKP_AVX512 static void lbs_range(const akp_skin_ctx* c, size_t begin, size_t end
         if (i < end) block_lbs_rigid1(c, i, (unsigned)(end - i));
         return;
     }
-#define AKP_CALL(K) lbs_range_k(c, begin, end, (K))
-    AKP_K_SWITCH(AKP_CALL)
-#undef AKP_CALL
+    AKP_K_SWITCH(lbs_k, c, begin, end, 0u)
 }
 AKP_AVX512 static void dqs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
-#define AKP_CALL(K) block_dqs_range_k(c, begin, end, 0u, (K))
-    AKP_K_SWITCH(AKP_CALL)
-#undef AKP_CALL
+    AKP_K_SWITCH(dqs_k, c, begin, end, 0u)
 }
 AKP_AVX512 static void cor_range(const akp_skin_ctx* c, size_t begin, size_t end) {
     /* offset from joint 0's cor_rows to joint 0's negated rows (see akp_skin_cor_neg_rows) */
     const uint32_t neg = (uint32_t)(c->palette_count * sizeof(akp_skin_joint) - offsetof(akp_skin_joint, cor_rows));
-#define AKP_CALL(K) block_cor_range_k(c, begin, end, neg, (K))
-    AKP_K_SWITCH(AKP_CALL)
-#undef AKP_CALL
+    AKP_K_SWITCH(cor_k, c, begin, end, neg)
 }
 
 bool akp_skin_range_avx512(const akp_skin_ctx* c, size_t begin, size_t end) {
