@@ -11,6 +11,7 @@ WEB=0
 PACKAGES=(
   build-essential   # gcc, make
   cmake             # >= 3.25 (Debian 12 ships 3.25)
+  ninja-build       # CMake's generator when present (the Makefile and .ci/run pick it)
   pkg-config
   libpng-dev        # PNG output (raster)
   libgif-dev        # animated GIF output (raster)
