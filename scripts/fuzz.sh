@@ -14,6 +14,8 @@
 #   tests/fuzz/<name>.dict   libFuzzer dictionary (optional)
 #   tests/fuzz/<name>.options extra libFuzzer flags on one line (optional)
 # The corpus grows in build-fuzz/corpus/<name> and is kept between runs. Environment:
+# FUZZ_LIB (a build folder configured with AK_SANITIZE=ON and -fsanitize=fuzzer-no-link whose
+# libanimkit.a the targets link instead of building build-fuzz/lib; .ci/run passes build-asan),
 # FUZZ_JOBS (parallel targets, default 1), FUZZ_MAX_LEN (default 65536), CC (default clang),
 # FUZZ_SEED (libFuzzer's -seed, default 1, so that a run from the seed corpus is reproducible and
 # CI's short run repeats the sequence that was checked before committing; 0 = a random seed per
@@ -35,13 +37,25 @@ SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-fram
 command -v "$CC" >/dev/null || { echo "fuzz.sh: $CC not found (scripts/install-deps.sh installs clang)" >&2; exit 1; }
 
 mkdir -p "$OUT"
-echo "== fuzz: building the library with $CC, libFuzzer + ASan + UBSan"
-cmake -S . -B "$OUT/lib" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER="$CC" \
-  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_C_FLAGS="-fsanitize=fuzzer-no-link $SAN" \
-  -DAK_BUILD_TESTS=OFF -DAK_BUILD_EXAMPLES=OFF -DAK_BUILD_BENCH=OFF -DAK_BUILD_TOOLS=OFF \
-  > "$OUT/lib.log" 2>&1 || { tail -30 "$OUT/lib.log"; exit 1; }
-cmake --build "$OUT/lib" -j "$JOBS" --target animkit_static >> "$OUT/lib.log" 2>&1 || { tail -30 "$OUT/lib.log"; exit 1; }
-LIBS=$(sed -n 's/^Libs.private: //p' "$OUT/lib/animkit.pc")
+if [ -n "${FUZZ_LIB:-}" ]; then
+  # A library already built with the instrumentation: CI's ASan stage configures build-asan with
+  # -fsanitize=fuzzer-no-link (clang, AK_SANITIZE=ON), so the fuzz stage does not compile the
+  # whole library a second time. Refuse a build without coverage: libFuzzer would fuzz blind.
+  LIBDIR=$(cd "$FUZZ_LIB" && pwd)
+  grep -q 'fuzzer-no-link' "$LIBDIR/CMakeCache.txt" 2>/dev/null && grep -q '^AK_SANITIZE:BOOL=ON' "$LIBDIR/CMakeCache.txt" ||
+    { echo "fuzz.sh: FUZZ_LIB=$FUZZ_LIB was not configured with AK_SANITIZE=ON and -fsanitize=fuzzer-no-link" >&2; exit 1; }
+  echo "== fuzz: the library of $FUZZ_LIB (ASan + UBSan + libFuzzer coverage)"
+  cmake --build "$LIBDIR" -j "$JOBS" --target animkit_static > "$OUT/lib.log" 2>&1 || { tail -30 "$OUT/lib.log"; exit 1; }
+else
+  LIBDIR=$OUT/lib
+  echo "== fuzz: building the library with $CC, libFuzzer + ASan + UBSan"
+  cmake -S . -B "$LIBDIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER="$CC" \
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_C_FLAGS="-fsanitize=fuzzer-no-link $SAN" \
+    -DAK_BUILD_TESTS=OFF -DAK_BUILD_EXAMPLES=OFF -DAK_BUILD_BENCH=OFF -DAK_BUILD_TOOLS=OFF \
+    > "$OUT/lib.log" 2>&1 || { tail -30 "$OUT/lib.log"; exit 1; }
+  cmake --build "$LIBDIR" -j "$JOBS" --target animkit_static >> "$OUT/lib.log" 2>&1 || { tail -30 "$OUT/lib.log"; exit 1; }
+fi
+LIBS=$(sed -n 's/^Libs.private: //p' "$LIBDIR/animkit.pc")
 
 CFLAGS=(-std=c11 -D_POSIX_C_SOURCE=200809L -O1 -g $SAN -Wall -Wextra -Werror
         -Iinclude -Isrc -Itools/animkit -DAK_FUZZ_ASSETS="\"$ASSETS\"")
@@ -78,7 +92,7 @@ for src in tests/fuzz/fuzz_*.c; do
   if [ ${#ONLY[@]} -gt 0 ] && [[ ! " ${ONLY[*]} " == *" $name "* ]]; then continue; fi
   echo "== fuzz: building fuzz_$name"
   spawn "$CC" "${CFLAGS[@]}" -fsanitize=fuzzer "$src" -o "$OUT/bin/fuzz_$name" \
-    ${cli_objs:+"$OUT/libanimkit_cli.a"} "$OUT/lib/libanimkit.a" $LIBS
+    ${cli_objs:+"$OUT/libanimkit_cli.a"} "$LIBDIR/libanimkit.a" $LIBS
   targets+=("$name")
 done
 wait_all
