@@ -55,10 +55,11 @@ typedef struct layout {
     uint32_t* cell_start;
     ak_grid_cell* cell_coord;
     uint32_t* bucket_start;
-    ak_grid_cell* point_cell; /* temporaries from here on */
-    uint32_t* point_bucket;
-    uint32_t* tmp;
-    uint32_t* bucket_fill;
+    ak_grid_bucket_entry* bucket_entry;
+    uint64_t* key; /* temporaries from here on */
+    uint64_t* key_tmp;
+    uint32_t* idx_tmp;
+    ak_grid_cell* point_cell;
 } layout;
 
 static size_t carve(uint8_t* base, size_t n, size_t buckets, layout* l) {
@@ -75,10 +76,11 @@ static size_t carve(uint8_t* base, size_t n, size_t buckets, layout* l) {
     GRID_TAKE(cell_start, uint32_t, n + 1);
     GRID_TAKE(cell_coord, ak_grid_cell, n);
     GRID_TAKE(bucket_start, uint32_t, buckets + 1);
+    GRID_TAKE(bucket_entry, ak_grid_bucket_entry, n);
+    GRID_TAKE(key, uint64_t, n);
+    GRID_TAKE(key_tmp, uint64_t, n);
+    GRID_TAKE(idx_tmp, uint32_t, n);
     GRID_TAKE(point_cell, ak_grid_cell, n);
-    GRID_TAKE(point_bucket, uint32_t, n);
-    GRID_TAKE(tmp, uint32_t, n);
-    GRID_TAKE(bucket_fill, uint32_t, buckets + 1);
 #undef GRID_TAKE
     return off;
 }
@@ -100,6 +102,53 @@ static void sort_by_cell(uint32_t* idx, uint32_t* tmp, size_t n, const ak_grid_c
         dst = t;
     }
     if (src != idx) memcpy(idx, src, n * sizeof *idx);
+}
+
+/* The low 21 bits of v spread to every third bit (bit i -> bit 3i). */
+static inline uint64_t spread21(uint64_t v) {
+    v &= 0x1FFFFFu;
+    v = (v | v << 32) & 0x001F00000000FFFFull;
+    v = (v | v << 16) & 0x001F0000FF0000FFull;
+    v = (v | v << 8) & 0x100F00F00F00F00Full;
+    v = (v | v << 4) & 0x10C30C30C30C30C3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+}
+
+/* Stable LSD radix sort of (key, idx)[0..n) on the low `bits` bits of key, 11 bits a pass
+ * (digits every key shares are skipped). The result ends in key/idx. */
+static void radix_sort(uint64_t* key, uint32_t* idx, uint64_t* key_tmp, uint32_t* idx_tmp, size_t n,
+                       unsigned bits) {
+    enum { DIGIT = 11, BINS = 1 << DIGIT };
+    uint64_t *ks = key, *kd = key_tmp;
+    uint32_t *is = idx, *id = idx_tmp;
+    uint32_t count[BINS];
+    for (unsigned shift = 0; shift < bits; shift += DIGIT) {
+        memset(count, 0, sizeof count);
+        for (size_t i = 0; i < n; ++i) count[(ks[i] >> shift) & (BINS - 1)]++;
+        if (count[(ks[0] >> shift) & (BINS - 1)] == n) continue; /* one digit for all */
+        uint32_t sum = 0;
+        for (unsigned b = 0; b < BINS; ++b) {
+            uint32_t c = count[b];
+            count[b] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t o = count[(ks[i] >> shift) & (BINS - 1)]++;
+            kd[o] = ks[i];
+            id[o] = is[i];
+        }
+        uint64_t* kt = ks;
+        ks = kd;
+        kd = kt;
+        uint32_t* it = is;
+        is = id;
+        id = it;
+    }
+    if (ks != key) {
+        memcpy(key, ks, n * sizeof *key);
+        memcpy(idx, is, n * sizeof *idx);
+    }
 }
 
 /* Rings of cells a radius needs: the smallest k with k * cell_size >= radius. */
@@ -151,47 +200,58 @@ ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_sp
         const ak_vec3 p = points.ptr[i];
         if (!ak_finitef(p.x) || !ak_finitef(p.y) || !ak_finitef(p.z)) return AK_ERR_BAD_DATA;
     }
-    const size_t buckets = bucket_count_for(n);
-    const uint32_t mask = (uint32_t)(buckets - 1);
     uint8_t* base = memory.ptr + ((16u - ((uintptr_t)memory.ptr & 15u)) & 15u);
     layout l;
-    carve(base, n, buckets, &l);
+    carve(base, n, bucket_count_for(n), &l);
+    out_grid->cell_size = desc->cell_size;
 
-    /* Cell and bucket of every point, then a counting sort by bucket (stable: by index). */
+    /* Cell of every point and the box of occupied cells. */
     const double inv = 1.0 / (double)desc->cell_size;
-    memset(l.bucket_fill, 0, (buckets + 1) * sizeof(uint32_t));
+    int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
     for (size_t i = 0; i < n; ++i) {
         const ak_vec3 p = points.ptr[i];
-        l.point_cell[i] = cell_of(p.x, p.y, p.z, inv);
-        l.point_bucket[i] = cell_hash(l.point_cell[i]) & mask;
-        l.bucket_fill[l.point_bucket[i] + 1]++;
+        const ak_grid_cell c = cell_of(p.x, p.y, p.z, inv);
+        l.point_cell[i] = c;
+        lo[0] = c.x < lo[0] ? c.x : lo[0], hi[0] = c.x > hi[0] ? c.x : hi[0];
+        lo[1] = c.y < lo[1] ? c.y : lo[1], hi[1] = c.y > hi[1] ? c.y : hi[1];
+        lo[2] = c.z < lo[2] ? c.z : lo[2], hi[2] = c.z > hi[2] ? c.z : hi[2];
     }
-    for (size_t b = 0; b < buckets; ++b) l.bucket_fill[b + 1] += l.bucket_fill[b];
-    for (size_t i = 0; i < n; ++i) l.order[l.bucket_fill[l.point_bucket[i]]++] = (uint32_t)i;
-    /* bucket_fill[b] is now the end of bucket b (= start of b + 1). */
-
-    /* Buckets shared by several cells: group each cell (stable, so indices stay increasing). */
-    size_t start = 0;
-    for (size_t b = 0; b < buckets; ++b) {
-        size_t end = l.bucket_fill[b];
-        for (size_t k = start + 1; k < end; ++k) {
-            if (!cell_eq(l.point_cell[l.order[k]], l.point_cell[l.order[start]])) {
-                sort_by_cell(l.order + start, l.tmp, end - start, l.point_cell);
-                break;
-            }
+    /* Morton code of (cell - lowest cell); beyond 2^21 cells on an axis, of the offsets shifted
+     * right until they fit (cells sharing a code are then ordered by cell_less below). */
+    unsigned bits = 0, shift = 0;
+    for (int a = 0; a < 3 && n > 0; ++a) {
+        const uint64_t ext = (uint64_t)((int64_t)hi[a] - lo[a]);
+        unsigned b = 0;
+        while (b < 40 && (ext >> b) != 0) ++b;
+        bits = b > bits ? b : bits;
+    }
+    if (bits > 21) shift = bits - 21, bits = 21;
+    for (size_t i = 0; i < n; ++i) {
+        const ak_grid_cell c = l.point_cell[i];
+        const uint64_t ox = (uint64_t)((int64_t)c.x - lo[0]) >> shift;
+        const uint64_t oy = (uint64_t)((int64_t)c.y - lo[1]) >> shift;
+        const uint64_t oz = (uint64_t)((int64_t)c.z - lo[2]) >> shift;
+        l.key[i] = spread21(ox) | spread21(oy) << 1 | spread21(oz) << 2;
+        l.order[i] = (uint32_t)i;
+    }
+    /* Stable: the points of a cell keep increasing original index. */
+    if (n > 0) radix_sort(l.key, l.order, l.key_tmp, l.idx_tmp, n, 3 * bits);
+    if (shift > 0) {
+        size_t start = 0;
+        for (size_t k = 1; k <= n; ++k) {
+            if (k < n && l.key[k] == l.key[start]) continue;
+            if (k - start > 1) sort_by_cell(l.order + start, l.idx_tmp, k - start, l.point_cell);
+            start = k;
         }
-        start = end;
     }
 
-    /* Cells in sorted order, positions in sorted order, and each bucket's first cell. */
+    /* Cells in that order and positions in sorted order. */
     uint32_t cells = 0;
-    memset(l.bucket_start, 0, (buckets + 1) * sizeof(uint32_t));
     for (size_t k = 0; k < n; ++k) {
         const uint32_t i = l.order[k];
         if (k == 0 || !cell_eq(l.point_cell[i], l.cell_coord[cells - 1])) {
             l.cell_start[cells] = (uint32_t)k;
             l.cell_coord[cells] = l.point_cell[i];
-            l.bucket_start[l.point_bucket[i] + 1]++;
             ++cells;
         }
         l.x[k] = points.ptr[i].x;
@@ -199,9 +259,19 @@ ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_sp
         l.z[k] = points.ptr[i].z;
     }
     l.cell_start[cells] = (uint32_t)n;
-    for (size_t b = 0; b < buckets; ++b) l.bucket_start[b + 1] += l.bucket_start[b];
 
-    out_grid->cell_size = desc->cell_size;
+    /* The hash index: cells of bucket b (increasing m) at bucket_entry[bucket_start[b] ..). */
+    const size_t buckets = bucket_count_for(cells);
+    const uint32_t mask = (uint32_t)(buckets - 1);
+    memset(l.bucket_start, 0, (buckets + 1) * sizeof(uint32_t));
+    for (uint32_t m = 0; m < cells; ++m) l.bucket_start[cell_hash(l.cell_coord[m]) & mask]++;
+    for (size_t b = 1; b < buckets; ++b) l.bucket_start[b] += l.bucket_start[b - 1];
+    l.bucket_start[buckets] = cells; /* bucket_start[b] is now the end of bucket b */
+    for (uint32_t m = cells; m-- > 0;) {
+        const uint32_t b = cell_hash(l.cell_coord[m]) & mask;
+        l.bucket_entry[--l.bucket_start[b]] = (ak_grid_bucket_entry){l.cell_coord[m], m};
+    }
+
     out_grid->point_count = (uint32_t)n;
     out_grid->cell_count = cells;
     out_grid->bucket_count = (uint32_t)buckets;
@@ -212,6 +282,7 @@ ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_sp
     out_grid->cell_start = l.cell_start;
     out_grid->cell_coord = l.cell_coord;
     out_grid->bucket_start = l.bucket_start;
+    out_grid->bucket_entry = l.bucket_entry;
     return AK_OK;
 }
 
@@ -226,8 +297,8 @@ ak_grid_cell ak_grid_cell_of(const ak_grid* grid, ak_vec3 p) {
 uint32_t ak_grid_cell_find(const ak_grid* grid, ak_grid_cell cell) {
     if (!grid || grid->cell_count == 0) return UINT32_MAX;
     const uint32_t b = cell_hash(cell) & (grid->bucket_count - 1);
-    for (uint32_t m = grid->bucket_start[b]; m < grid->bucket_start[b + 1]; ++m)
-        if (cell_eq(grid->cell_coord[m], cell)) return m;
+    for (uint32_t e = grid->bucket_start[b]; e < grid->bucket_start[b + 1]; ++e)
+        if (cell_eq(grid->bucket_entry[e].cell, cell)) return grid->bucket_entry[e].index;
     return UINT32_MAX;
 }
 

@@ -63,6 +63,12 @@ typedef struct ak_grid_pair {
 
 AK_DEFINE_SPAN(grid_pair, ak_grid_pair)
 
+/* One entry of the grid's hash index: an occupied cell and its index m. */
+typedef struct ak_grid_bucket_entry {
+    ak_grid_cell cell;
+    uint32_t index;
+} ak_grid_bucket_entry;
+
 typedef struct ak_grid_desc {
     float cell_size; /* required, > 0 and finite: cell edge in the points' units; best = radius */
 } ak_grid_desc;
@@ -80,8 +86,9 @@ typedef struct ak_grid {
     const uint32_t*
         cell_start; /* [cell_count + 1]: cell m = sorted [cell_start[m], cell_start[m+1]) */
     const ak_grid_cell* cell_coord; /* [cell_count]: integer coordinates of cell m */
-    const uint32_t*
-        bucket_start; /* [bucket_count + 1]: cells of bucket b = [bucket_start[b], [b+1]) */
+    const uint32_t* bucket_start; /* [bucket_count + 1]: bucket b = bucket_entry[bucket_start[b]
+                                     .. bucket_start[b + 1]) */
+    const ak_grid_bucket_entry* bucket_entry; /* [cell_count]: the hash index of the cells */
 } ak_grid;
 
 /* Bytes of memory ak_grid_build needs for point_count points (any alignment is fine; the
