@@ -5,6 +5,7 @@
 
 #include "tasks.h"
 #include "internal.h"
+#include "grid/grid_internal.h"
 
 #define GRID_COORD_LIMIT 1073741824.0 /* 2^30: clamp for cell coordinates */
 #define GRID_MAX_THREADS 64u
@@ -367,38 +368,54 @@ static inline void emit(pair_task* t, uint32_t a, uint32_t b) {
     t->count++;
 }
 
-/* Pairs between cell a and another cell b. */
-static void pairs_between(pair_task* t, uint32_t ca, uint32_t cb) {
+/* Pairs of sorted entries a in [a0, a1), b in [b(a), b1) where b(a) = a + 1 inside one cell
+ * (same) and b0 otherwise. When the output has room for every candidate, hits are written
+ * without a branch (a miss writes a slot the next hit overwrites). */
+static inline void pairs_range(pair_task* t, uint32_t a0, uint32_t a1, uint32_t b0, uint32_t b1,
+                               bool same) {
     const ak_grid* g = t->grid;
     const float* x = g->x;
     const float* y = g->y;
     const float* z = g->z;
+    const uint32_t* order = g->order;
     const float r2 = t->r2;
-    const uint32_t b0 = g->cell_start[cb], b1 = g->cell_start[cb + 1];
-    for (uint32_t a = g->cell_start[ca]; a < g->cell_start[ca + 1]; ++a) {
+    const uint64_t candidates = same ? (uint64_t)(a1 - a0) * (a1 - a0 - 1) / 2
+                                     : (uint64_t)(a1 - a0) * (b1 - b0);
+    if (t->count + candidates <= t->capacity) {
+        ak_grid_pair* out = t->out;
+        size_t count = t->count;
+        for (uint32_t a = a0; a < a1; ++a) {
+            const float ax = x[a], ay = y[a], az = z[a];
+            const uint32_t oa = order[a];
+            for (uint32_t b = same ? a + 1 : b0; b < b1; ++b) {
+                const float dx = x[b] - ax, dy = y[b] - ay, dz = z[b] - az;
+                const uint32_t ob = order[b];
+                out[count] = oa < ob ? (ak_grid_pair){oa, ob} : (ak_grid_pair){ob, oa};
+                count += dx * dx + dy * dy + dz * dz < r2;
+            }
+        }
+        t->count = count;
+        return;
+    }
+    for (uint32_t a = a0; a < a1; ++a) {
         const float ax = x[a], ay = y[a], az = z[a];
-        for (uint32_t b = b0; b < b1; ++b) {
+        for (uint32_t b = same ? a + 1 : b0; b < b1; ++b) {
             const float dx = x[b] - ax, dy = y[b] - ay, dz = z[b] - az;
-            if (dx * dx + dy * dy + dz * dz < r2) emit(t, g->order[a], g->order[b]);
+            if (dx * dx + dy * dy + dz * dz < r2) emit(t, order[a], order[b]);
         }
     }
 }
 
+/* Pairs between cell a and another cell b. */
+static void pairs_between(pair_task* t, uint32_t ca, uint32_t cb) {
+    const uint32_t* cs = t->grid->cell_start;
+    pairs_range(t, cs[ca], cs[ca + 1], cs[cb], cs[cb + 1], false);
+}
+
 /* Pairs inside one cell. */
 static void pairs_within(pair_task* t, uint32_t c) {
-    const ak_grid* g = t->grid;
-    const float* x = g->x;
-    const float* y = g->y;
-    const float* z = g->z;
-    const float r2 = t->r2;
-    const uint32_t e = g->cell_start[c + 1];
-    for (uint32_t a = g->cell_start[c]; a < e; ++a) {
-        const float ax = x[a], ay = y[a], az = z[a];
-        for (uint32_t b = a + 1; b < e; ++b) {
-            const float dx = x[b] - ax, dy = y[b] - ay, dz = z[b] - az;
-            if (dx * dx + dy * dy + dz * dz < r2) emit(t, g->order[a], g->order[b]);
-        }
-    }
+    const uint32_t* cs = t->grid->cell_start;
+    pairs_range(t, cs[c], cs[c + 1], 0, cs[c + 1], true);
 }
 
 static void* pair_thread(void* arg) {
@@ -546,4 +563,141 @@ uint64_t ak_grid_candidate_count(const ak_grid* grid, float radius) {
         }
     }
     return total;
+}
+
+/* ---- public: per-point neighbour lists (CSR) -------------------------------------------- */
+
+size_t akp_grid_row_scalar(const float* x, const float* y, const float* z, const uint32_t* order,
+                           const akp_grid_range* ranges, uint32_t range_count, uint32_t self,
+                           float qx, float qy, float qz, float r2, uint32_t* out) {
+    size_t count = 0;
+    for (uint32_t r = 0; r < range_count; ++r)
+        for (uint32_t b = ranges[r].begin; b < ranges[r].end; ++b) {
+            const float dx = x[b] - qx, dy = y[b] - qy, dz = z[b] - qz;
+            if (dx * dx + dy * dy + dz * dz < r2 && b != self) {
+                if (out) out[count] = order[b];
+                ++count;
+            }
+        }
+    return count;
+}
+
+#define GRID_ROW_RANGES 27u /* the 3 x 3 x 3 block; wider stencils go in chunks */
+
+typedef struct row_task {
+    const ak_grid* grid;
+    float r2;
+    int64_t rings;
+    bool all_cells, avx512;
+    uint32_t cell_begin, cell_end;
+    uint32_t* offsets; /* [point_count + 1] */
+    uint32_t* indices; /* NULL: count pass (counts into offsets[i + 1]) */
+} row_task;
+
+/* The occupied cells around cell m in ak_grid_query's order, GRID_ROW_RANGES at a time: fills
+ * ranges from *cursor on and returns how many (0 when done). */
+static uint32_t next_ranges(const row_task* t, uint32_t m, uint64_t* cursor, akp_grid_range* ranges) {
+    const ak_grid* g = t->grid;
+    const ak_grid_cell c = g->cell_coord[m];
+    const int64_t k = t->rings, side = 2 * k + 1;
+    uint32_t n = 0;
+    if (t->all_cells) {
+        for (; *cursor < g->cell_count && n < GRID_ROW_RANGES; ++*cursor) {
+            const uint32_t o = (uint32_t)*cursor;
+            if (cells_within(g->cell_coord[o], c, k))
+                ranges[n++] = (akp_grid_range){g->cell_start[o], g->cell_start[o + 1]};
+        }
+        return n;
+    }
+    const uint64_t total = (uint64_t)(side * side * side);
+    for (; *cursor < total && n < GRID_ROW_RANGES; ++*cursor) {
+        const int64_t s = (int64_t)*cursor;
+        const int64_t dz = s / (side * side) - k, dy = s / side % side - k, dx = s % side - k;
+        if (!coord_offset_ok(c.x, dx) || !coord_offset_ok(c.y, dy) || !coord_offset_ok(c.z, dz))
+            continue;
+        const ak_grid_cell nc = {(int32_t)(c.x + dx), (int32_t)(c.y + dy), (int32_t)(c.z + dz)};
+        const uint32_t o = ak_grid_cell_find(g, nc);
+        if (o != UINT32_MAX) ranges[n++] = (akp_grid_range){g->cell_start[o], g->cell_start[o + 1]};
+    }
+    return n;
+}
+
+static void* row_thread(void* arg) {
+    const row_task* t = (const row_task*)arg;
+    const ak_grid* g = t->grid;
+    size_t (*row)(const float*, const float*, const float*, const uint32_t*, const akp_grid_range*,
+                  uint32_t, uint32_t, float, float, float, float, uint32_t*) =
+        t->avx512 ? akp_grid_row_avx512 : akp_grid_row_scalar;
+    akp_grid_range ranges[GRID_ROW_RANGES];
+    for (uint32_t m = t->cell_begin; m < t->cell_end; ++m) {
+        uint64_t cursor = 0;
+        uint32_t nr = next_ranges(t, m, &cursor, ranges);
+        akp_grid_range probe[GRID_ROW_RANGES];
+        const bool one_chunk = next_ranges(t, m, &(uint64_t){cursor}, probe) == 0;
+        for (uint32_t a = g->cell_start[m]; a < g->cell_start[m + 1]; ++a) {
+            const uint32_t i = g->order[a];
+            uint32_t* out = t->indices ? t->indices + t->offsets[i] : NULL;
+            size_t count = row(g->x, g->y, g->z, g->order, ranges, nr, a, g->x[a], g->y[a], g->z[a],
+                               t->r2, out);
+            if (!one_chunk) { /* wide stencils: the further chunks, for this point */
+                akp_grid_range more[GRID_ROW_RANGES];
+                uint64_t c2 = cursor;
+                uint32_t n2;
+                while ((n2 = next_ranges(t, m, &c2, more)) > 0)
+                    count += row(g->x, g->y, g->z, g->order, more, n2, a, g->x[a], g->y[a], g->z[a],
+                                 t->r2, out ? out + count : NULL);
+            }
+            if (!t->indices) t->offsets[i + 1] = (uint32_t)(count < UINT32_MAX ? count : UINT32_MAX);
+        }
+    }
+    return NULL;
+}
+
+ak_result ak_grid_neighbors_validate(const ak_grid_neighbors_job* job) {
+    if (!job || !job->grid || !job->out_index_count || !job->out_offsets.ptr ||
+        (!job->out_indices.ptr && job->out_indices.count > 0))
+        return AK_ERR_NULL_ARG;
+    if (!(job->radius > 0.0f) || !ak_finitef(job->radius) || job->thread_count > GRID_MAX_THREADS)
+        return AK_ERR_BAD_ARG;
+    if (job->out_offsets.count < (size_t)job->grid->point_count + 1) return AK_ERR_SPAN_SMALL;
+    return AK_OK;
+}
+
+ak_result ak_grid_neighbors_run(const ak_grid_neighbors_job* job) {
+    ak_result r = ak_grid_neighbors_validate(job);
+    if (r != AK_OK) return r;
+    const ak_grid* g = job->grid;
+    const uint32_t n = g->point_count;
+    uint32_t* offsets = job->out_offsets.ptr;
+    *job->out_index_count = 0;
+    offsets[0] = 0;
+    if (n == 0) return AK_OK;
+    uint32_t threads = job->thread_count ? job->thread_count : 1;
+    if (threads > g->cell_count) threads = g->cell_count;
+    const int64_t k = rings_for(g, job->radius);
+    row_task tasks[GRID_MAX_THREADS];
+    uint32_t m = 0;
+    for (uint32_t t = 0; t < threads; ++t) { /* contiguous cells, about equal points each */
+        uint32_t begin = m;
+        uint64_t target = (uint64_t)n * (t + 1) / threads;
+        while (m < g->cell_count && (t + 1 == threads || g->cell_start[m] < target)) ++m;
+        tasks[t] = (row_task){g,        job->radius * job->radius, k, scan_all_cells(g, k),
+                              !job->scalar_only && akp_grid_have_avx512(),
+                              begin,    m,
+                              offsets,  NULL};
+    }
+    akp_run_tasks(row_thread, tasks, sizeof(row_task), threads);
+    uint64_t total = 0;
+    bool over = false;
+    for (uint32_t i = 0; i < n; ++i) {
+        total += offsets[i + 1];
+        over = over || offsets[i + 1] == UINT32_MAX;
+        offsets[i + 1] = (uint32_t)(total < UINT32_MAX ? total : UINT32_MAX);
+    }
+    *job->out_index_count = (size_t)total;
+    if (over || total >= UINT32_MAX) return AK_ERR_BUDGET;
+    if (total > job->out_indices.count) return AK_ERR_SPAN_SMALL;
+    for (uint32_t t = 0; t < threads; ++t) tasks[t].indices = job->out_indices.ptr;
+    akp_run_tasks(row_thread, tasks, sizeof(row_task), threads);
+    return AK_OK;
 }

@@ -121,6 +121,37 @@ AK_API uint32_t ak_grid_cell_find(const ak_grid* grid, ak_grid_cell cell);
  * > 0, NaN/infinite q or radius, or an empty grid -> 0. */
 AK_API size_t ak_grid_query(const ak_grid* grid, ak_vec3 q, float radius, ak_u32_span out_indices);
 
+/* Per-point neighbour lists in CSR form (the form SPH codes take): for every point i (original
+ * index), the indices j != i with |p_j - p_i| < radius (the module's distance test, q = p_i),
+ * at out_indices[out_offsets[i] .. out_offsets[i + 1]). Row i holds the same indices in the
+ * same order as ak_grid_query(grid, p_i, radius) without i itself (cells around p_i in a fixed
+ * order, then sorted order), so j is in row i exactly when i is in row j. */
+typedef struct ak_grid_neighbors_job {
+    const ak_grid* grid;      /* required */
+    float radius;             /* required, > 0 and finite */
+    uint32_t thread_count;    /* 0 -> 1; at most 64 */
+    ak_u32_span out_offsets;  /* required, count >= point_count + 1 */
+    ak_u32_span out_indices;  /* the lists; may be empty to count */
+    size_t* out_index_count;  /* required: total entries (also when above capacity) */
+    bool scalar_only;         /* use the scalar kernel even where AVX-512 is available (tests
+                                 and benchmarks; the result is the same) */
+} ak_grid_neighbors_job;
+
+/* First failing rule: AK_ERR_NULL_ARG (job, grid, out_index_count or out_offsets.ptr NULL, or
+ * out_indices.ptr NULL with count > 0), AK_ERR_BAD_ARG (radius not > 0 and finite,
+ * thread_count > 64), AK_ERR_SPAN_SMALL (out_offsets shorter than point_count + 1). */
+AK_API ak_result ak_grid_neighbors_validate(const ak_grid_neighbors_job* job);
+
+/* Fills the neighbour lists: a counting pass writes out_offsets (always, when validation
+ * passes), then, when out_indices has room for every entry, a second pass writes the lists.
+ * Returns the validate codes, AK_OK, AK_ERR_SPAN_SMALL when out_indices.count is below the
+ * total (*out_index_count says how many are needed; out_offsets is complete, out_indices
+ * untouched), AK_ERR_BUDGET when the total reaches 2^32 - 1 (offsets are 32-bit). Output is
+ * identical for any thread_count and on every CPU path. Never allocates. Cost: each point
+ * tests the points of the 27 cells around it twice (count, then fill); use
+ * 2 * ak_grid_candidate_count as the work estimate for untrusted input. */
+AK_API ak_result ak_grid_neighbors_run(const ak_grid_neighbors_job* job);
+
 /* The work a radius search over the whole grid does: the number of unordered point pairs
  * (i < j) that share a cell or lie in cells within reach of radius, i.e. the distance tests
  * ak_grid_pairs_run makes (the pairs it returns are a subset). Points spread at a density of

@@ -1,0 +1,26 @@
+/* Internal kernels of the neighbour grid. Never installed. */
+#ifndef ANIMKIT_GRID_INTERNAL_H
+#define ANIMKIT_GRID_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* Sorted entries [begin, end) of one neighbour cell. */
+typedef struct akp_grid_range {
+    uint32_t begin, end;
+} akp_grid_range;
+
+/* One row of the neighbour lists: the entries b of the ranges (in order) other than `self`
+ * with dx*dx + dy*dy + dz*dz < r2, dx = x[b] - qx etc. (the module's test, float, no FMA).
+ * out NULL: returns the count; otherwise writes order[b] of each hit to out and returns the
+ * count. The AVX-512 kernel (akp_grid_have_avx512) gives exactly the scalar kernel's result. */
+size_t akp_grid_row_scalar(const float* x, const float* y, const float* z, const uint32_t* order,
+                           const akp_grid_range* ranges, uint32_t range_count, uint32_t self,
+                           float qx, float qy, float qz, float r2, uint32_t* out);
+bool akp_grid_have_avx512(void);
+size_t akp_grid_row_avx512(const float* x, const float* y, const float* z, const uint32_t* order,
+                           const akp_grid_range* ranges, uint32_t range_count, uint32_t self,
+                           float qx, float qy, float qz, float r2, uint32_t* out);
+
+#endif
