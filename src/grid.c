@@ -193,7 +193,8 @@ ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_sp
     if (!desc || !out_grid || !memory.ptr || (!points.ptr && points.count > 0))
         return AK_ERR_NULL_ARG;
     if (!(desc->cell_size > 0.0f) || !ak_finitef(desc->cell_size) ||
-        points.count >= ((size_t)1 << 31))
+        points.count >= ((size_t)1 << 31) ||
+        (desc->cell_order != AK_GRID_ORDER_MORTON && desc->cell_order != AK_GRID_ORDER_HASH))
         return AK_ERR_BAD_ARG;
     const size_t n = points.count;
     if (memory.count < ak_grid_memory_size(n, desc)) return AK_ERR_SPAN_SMALL;
@@ -227,17 +228,30 @@ ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_sp
         bits = b > bits ? b : bits;
     }
     if (bits > 21) shift = bits - 21, bits = 21;
-    for (size_t i = 0; i < n; ++i) {
-        const ak_grid_cell c = l.point_cell[i];
-        const uint64_t ox = (uint64_t)((int64_t)c.x - lo[0]) >> shift;
-        const uint64_t oy = (uint64_t)((int64_t)c.y - lo[1]) >> shift;
-        const uint64_t oz = (uint64_t)((int64_t)c.z - lo[2]) >> shift;
-        l.key[i] = spread21(ox) | spread21(oy) << 1 | spread21(oz) << 2;
-        l.order[i] = (uint32_t)i;
+    unsigned key_bits = 3 * bits;
+    bool ties = shift > 0; /* cells may share a key */
+    if (desc->cell_order == AK_GRID_ORDER_HASH) { /* key = hash bucket (the table of n points) */
+        const size_t hb = bucket_count_for(n);
+        key_bits = 0;
+        while (((size_t)1 << key_bits) < hb) ++key_bits;
+        ties = true;
+        for (size_t i = 0; i < n; ++i) {
+            l.key[i] = cell_hash(l.point_cell[i]) & (uint32_t)(hb - 1);
+            l.order[i] = (uint32_t)i;
+        }
+    } else {
+        for (size_t i = 0; i < n; ++i) {
+            const ak_grid_cell c = l.point_cell[i];
+            const uint64_t ox = (uint64_t)((int64_t)c.x - lo[0]) >> shift;
+            const uint64_t oy = (uint64_t)((int64_t)c.y - lo[1]) >> shift;
+            const uint64_t oz = (uint64_t)((int64_t)c.z - lo[2]) >> shift;
+            l.key[i] = spread21(ox) | spread21(oy) << 1 | spread21(oz) << 2;
+            l.order[i] = (uint32_t)i;
+        }
     }
     /* Stable: the points of a cell keep increasing original index. */
-    if (n > 0) radix_sort(l.key, l.order, l.key_tmp, l.idx_tmp, n, 3 * bits);
-    if (shift > 0) {
+    if (n > 0) radix_sort(l.key, l.order, l.key_tmp, l.idx_tmp, n, key_bits);
+    if (ties) {
         size_t start = 0;
         for (size_t k = 1; k <= n; ++k) {
             if (k < n && l.key[k] == l.key[start]) continue;
@@ -609,6 +623,22 @@ static uint32_t next_ranges(const row_task* t, uint32_t m, uint64_t* cursor, akp
         }
         return n;
     }
+    if (k == 1 && *cursor == 0) { /* the 3 x 3 x 3 block: no division per cell */
+        for (int64_t dz = -1; dz <= 1; ++dz) {
+            if (!coord_offset_ok(c.z, dz)) continue;
+            for (int64_t dy = -1; dy <= 1; ++dy) {
+                if (!coord_offset_ok(c.y, dy)) continue;
+                for (int64_t dx = -1; dx <= 1; ++dx) {
+                    if (!coord_offset_ok(c.x, dx)) continue;
+                    const ak_grid_cell nc = {(int32_t)(c.x + dx), (int32_t)(c.y + dy), (int32_t)(c.z + dz)};
+                    const uint32_t o = ak_grid_cell_find(g, nc);
+                    if (o != UINT32_MAX) ranges[n++] = (akp_grid_range){g->cell_start[o], g->cell_start[o + 1]};
+                }
+            }
+        }
+        *cursor = 27;
+        return n;
+    }
     const uint64_t total = (uint64_t)(side * side * side);
     for (; *cursor < total && n < GRID_ROW_RANGES; ++*cursor) {
         const int64_t s = (int64_t)*cursor;
@@ -632,8 +662,16 @@ static void* row_thread(void* arg) {
     for (uint32_t m = t->cell_begin; m < t->cell_end; ++m) {
         uint64_t cursor = 0;
         uint32_t nr = next_ranges(t, m, &cursor, ranges);
-        akp_grid_range probe[GRID_ROW_RANGES];
-        const bool one_chunk = next_ranges(t, m, &(uint64_t){cursor}, probe) == 0;
+        const bool one_chunk = t->all_cells ? cursor >= g->cell_count
+                                            : (uint64_t)(2 * t->rings + 1) * (uint64_t)(2 * t->rings + 1) *
+                                                      (uint64_t)(2 * t->rings + 1) <= cursor;
+        /* Neighbour cells next to each other in memory read as one range (same entries, same order). */
+        uint32_t merged = 0;
+        for (uint32_t r = 0; r < nr; ++r) {
+            if (merged > 0 && ranges[merged - 1].end == ranges[r].begin) ranges[merged - 1].end = ranges[r].end;
+            else ranges[merged++] = ranges[r];
+        }
+        nr = merged;
         for (uint32_t a = g->cell_start[m]; a < g->cell_start[m + 1]; ++a) {
             const uint32_t i = g->order[a];
             uint32_t* out = t->indices ? t->indices + t->offsets[i] : NULL;

@@ -69,8 +69,21 @@ typedef struct ak_grid_bucket_entry {
     uint32_t index;
 } ak_grid_bucket_entry;
 
+/* The order of the cells in a built grid (what every pass that walks cells m = 0, 1, ... sees). */
+typedef enum ak_grid_cell_order {
+    /* Morton (z-curve) order of the cell coordinates minus the lowest occupied cell per axis:
+     * cells near in space are near in memory, which keeps big grids in cache. When occupied
+     * cells span 2^21 or more on an axis, the code of the offsets shifted right until they fit
+     * (cells sharing that code follow in (z, y, x) order). */
+    AK_GRID_ORDER_MORTON = 0,
+    /* Grouped by hash bucket (ties in (z, y, x) order): the layout of animkit before the Morton
+     * order, kept for callers whose results depend on the visit order (a Gauss-Seidel pass). */
+    AK_GRID_ORDER_HASH = 1
+} ak_grid_cell_order;
+
 typedef struct ak_grid_desc {
     float cell_size; /* required, > 0 and finite: cell edge in the points' units; best = radius */
+    ak_grid_cell_order cell_order; /* 0 = AK_GRID_ORDER_MORTON; anything else not listed -> BAD_ARG */
 } ak_grid_desc;
 
 /* A built grid: every array points into the memory given to ak_grid_build. Read-only. */
@@ -96,11 +109,11 @@ typedef struct ak_grid {
 AK_API size_t ak_grid_memory_size(size_t point_count, const ak_grid_desc* desc);
 
 /* Sort points into the grid. memory.count >= ak_grid_memory_size(points.count, desc); the
- * memory is the grid's storage until the caller reuses it. Order inside the grid: cells
- * grouped by hash bucket, points of a cell in increasing original index (so the layout is a
- * pure function of the points and the desc). points.count == 0 builds an empty grid.
+ * memory is the grid's storage until the caller reuses it. Order inside the grid: cells in
+ * desc->cell_order, points of a cell in increasing original index (so the layout is a pure
+ * function of the points and the desc). points.count == 0 builds an empty grid.
  * Returns AK_ERR_NULL_ARG (desc, out_grid, memory.ptr, or points.ptr with count > 0),
- * AK_ERR_BAD_ARG (cell_size not > 0 and finite, or 2^31 points or more), AK_ERR_SPAN_SMALL
+ * AK_ERR_BAD_ARG (cell_size not > 0 and finite, cell_order not listed, or 2^31 points or more), AK_ERR_SPAN_SMALL
  * (memory too small), AK_ERR_BAD_DATA (a NaN or infinite coordinate). On error *out_grid is
  * an empty grid. */
 AK_API ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_span memory,
