@@ -417,12 +417,12 @@ static size_t check_csr(const ak_vec3* p, size_t n, float cell, float r) {
 }
 
 AK_TEST(csr_random_and_clustered) {
-    enum { N = 1200 };
+    enum { N = 700 };
     static ak_vec3 p[N];
     ak_rng rng = ak_rng_make(321);
     for (size_t i = 0; i < N; ++i) /* a uniform cloud, a tight clump, duplicates */
-        p[i] = i < 800    ? ak_vec3_make(ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 3))
-               : i < 1100 ? ak_vec3_make(ak_rng_range(&rng, 1, 1.4f), ak_rng_range(&rng, 1, 1.4f), ak_rng_range(&rng, 1, 1.4f))
+        p[i] = i < 450    ? ak_vec3_make(ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 3), ak_rng_range(&rng, -3, 3))
+               : i < 650  ? ak_vec3_make(ak_rng_range(&rng, 1, 1.4f), ak_rng_range(&rng, 1, 1.4f), ak_rng_range(&rng, 1, 1.4f))
                           : p[i - 300];
     AK_CHECK(check_csr(p, N, 0.5f, 0.5f) > 2000);  /* cell = radius: the 27-cell block */
     AK_CHECK(check_csr(p, N, 0.25f, 0.5f) > 2000); /* radius 2 cells: 125 cells, in chunks */
@@ -494,6 +494,51 @@ AK_TEST(csr_one_cell_empty_and_errors) {
     AK_CHECK_EQ(off[0], 0);
 }
 
+/* Morton order: the z-curve code of (cell - lowest cell), computed bit by bit here, increases
+ * with m; the hash order lists the same cells; an unknown order is refused. */
+AK_TEST(cell_orders) {
+    ak_rng rng = ak_rng_make(17);
+    ak_vec3 p[600];
+    for (int i = 0; i < 600; ++i)
+        p[i] = ak_vec3_make(ak_rng_range(&rng, -3, 5), ak_rng_range(&rng, -2, 2), ak_rng_range(&rng, 0, 9));
+    built b = build(p, 600, 0.5f);
+    const ak_grid* g = &b.grid;
+    int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX};
+    for (uint32_t m = 0; m < g->cell_count; ++m) {
+        const int32_t c[3] = {g->cell_coord[m].x, g->cell_coord[m].y, g->cell_coord[m].z};
+        for (int a = 0; a < 3; ++a) lo[a] = c[a] < lo[a] ? c[a] : lo[a];
+    }
+    uint64_t prev = 0;
+    for (uint32_t m = 0; m < g->cell_count; ++m) {
+        const uint64_t o[3] = {(uint64_t)(g->cell_coord[m].x - lo[0]), (uint64_t)(g->cell_coord[m].y - lo[1]),
+                               (uint64_t)(g->cell_coord[m].z - lo[2])};
+        uint64_t code = 0;
+        for (int bit = 0; bit < 21; ++bit)
+            for (int a = 0; a < 3; ++a) code |= ((o[a] >> bit) & 1u) << (3 * bit + a);
+        if (m > 0) AK_CHECK(code > prev);
+        prev = code;
+    }
+    ak_grid_desc hd = {.cell_size = 0.5f, .cell_order = AK_GRID_ORDER_HASH};
+    size_t bytes = ak_grid_memory_size(600, &hd);
+    void* mem = malloc(bytes);
+    ak_grid h;
+    AK_CHECK_EQ(ak_grid_build(&hd, (ak_vec3_cspan){p, 600}, (ak_u8_span){(uint8_t*)mem, bytes}, &h), AK_OK);
+    AK_CHECK_EQ(h.cell_count, g->cell_count);
+    size_t moved = 0;
+    for (uint32_t m = 0; m < h.cell_count; ++m) {
+        const uint32_t o = ak_grid_cell_find(g, h.cell_coord[m]);
+        AK_CHECK(o != UINT32_MAX);
+        if (o == UINT32_MAX) continue;
+        moved += o != m;
+        AK_CHECK_EQ(h.cell_start[m + 1] - h.cell_start[m], g->cell_start[o + 1] - g->cell_start[o]);
+    }
+    AK_CHECK(moved > 0); /* a different order of the same cells */
+    hd.cell_order = (ak_grid_cell_order)7;
+    AK_CHECK_EQ(ak_grid_build(&hd, (ak_vec3_cspan){p, 600}, (ak_u8_span){(uint8_t*)mem, bytes}, &h), AK_ERR_BAD_ARG);
+    free(mem);
+    free(b.mem);
+}
+
 int main(void) {
     AK_RUN(random_cloud_matches_brute_force);
     AK_RUN(points_on_cell_boundaries);
@@ -504,6 +549,7 @@ int main(void) {
     AK_RUN(short_output_reports_count);
     AK_RUN(validation_codes);
     AK_RUN(candidate_count_matches_brute_force);
+    AK_RUN(cell_orders);
     AK_RUN(csr_random_and_clustered);
     AK_RUN(csr_points_at_the_radius);
     AK_RUN(csr_one_cell_empty_and_errors);
