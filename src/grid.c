@@ -367,7 +367,7 @@ typedef struct pair_task {
     const ak_grid* grid;
     float r2;
     int64_t rings;
-    bool all_cells;
+    bool all_cells, avx512;
     uint32_t cell_begin, cell_end;
     ak_grid_pair* out;
     size_t capacity;
@@ -395,6 +395,10 @@ static inline void pairs_range(pair_task* t, uint32_t a0, uint32_t a1, uint32_t 
     const float r2 = t->r2;
     const uint64_t candidates = same ? (uint64_t)(a1 - a0) * (a1 - a0 - 1) / 2
                                      : (uint64_t)(a1 - a0) * (b1 - b0);
+    if (t->count + candidates <= t->capacity && t->avx512) {
+        t->count += akp_grid_pairs_avx512(x, y, z, order, a0, a1, b0, b1, same, r2, t->out + t->count);
+        return;
+    }
     if (t->count + candidates <= t->capacity) {
         ak_grid_pair* out = t->out;
         size_t count = t->count;
@@ -490,6 +494,7 @@ ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
     if (threads > g->cell_count) threads = g->cell_count;
     const int64_t k = rings_for(g, job->radius);
     const bool all_cells = scan_all_cells(g, k);
+    const bool avx512 = !job->scalar_only && akp_grid_have_avx512();
     pair_task tasks[GRID_MAX_THREADS];
     /* Contiguous cell ranges with about the same number of points each. */
     uint32_t m = 0;
@@ -497,7 +502,8 @@ ak_result ak_grid_pairs_run(const ak_grid_pairs_job* job) {
         uint32_t begin = m;
         uint64_t target = (uint64_t)g->point_count * (t + 1) / threads;
         while (m < g->cell_count && (t + 1 == threads || g->cell_start[m] < target)) ++m;
-        tasks[t] = (pair_task){g, job->radius * job->radius, k, all_cells, begin, m, NULL, 0, 0};
+        tasks[t] = (pair_task){g,     job->radius * job->radius, k, all_cells, avx512, begin,
+                               m,     NULL,                      0, 0};
     }
     /* First try: each thread writes into its share of the output; if one overflows but the
      * total fits, a second pass writes at exact offsets. The content is the same either way. */

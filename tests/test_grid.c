@@ -50,14 +50,16 @@ static size_t check_cloud(const ak_vec3* p, size_t n, float cell, float r) {
             if (near_brute(p[i], p[j], r)) want[w++] = (ak_grid_pair){(uint32_t)i, (uint32_t)j};
 
     ak_grid_pair* first = NULL;
-    for (uint32_t threads = 1; threads <= 3; ++threads) {
+    for (uint32_t run = 0; run < 6; ++run) { /* 1, 2, 3 threads; the SIMD kernel, then scalar */
+        const uint32_t threads = 1 + run % 3;
         ak_grid_pair* got = (ak_grid_pair*)malloc((brute + 1) * sizeof *got);
         size_t count = 0;
         ak_grid_pairs_job job = {.grid = &b.grid,
                                  .radius = r,
                                  .thread_count = threads,
                                  .out_pairs = {got, brute},
-                                 .out_pair_count = &count};
+                                 .out_pair_count = &count,
+                                 .scalar_only = run >= 3};
         AK_CHECK_EQ(ak_grid_pairs_run(&job), AK_OK);
         AK_CHECK_EQ(count, brute);
         if (count == brute) {
@@ -66,7 +68,7 @@ static size_t check_cloud(const ak_vec3* p, size_t n, float cell, float r) {
                 first = (ak_grid_pair*)malloc((brute + 1) * sizeof *first);
                 memcpy(first, got, brute * sizeof *got);
             } else {
-                /* Same pairs in the same order on any thread count. */
+                /* Same pairs in the same order on any thread count and kernel. */
                 AK_CHECK(memcmp(first, got, brute * sizeof *got) == 0);
             }
             qsort(got, count, sizeof *got, pair_cmp);

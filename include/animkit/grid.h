@@ -181,6 +181,8 @@ typedef struct ak_grid_pairs_job {
     uint32_t thread_count;       /* 0 -> 1; at most 64 */
     ak_grid_pair_span out_pairs; /* pairs (i < j, original indices); may be empty to count */
     size_t* out_pair_count;      /* required: the number of pairs (also when above capacity) */
+    bool scalar_only; /* use the scalar loops even where AVX-512 is available (tests and
+                         benchmarks; the result is the same) */
 } ak_grid_pairs_job;
 
 /* First failing rule: AK_ERR_NULL_ARG (job, grid, out_pair_count, or out_pairs.ptr NULL with
