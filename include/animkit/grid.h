@@ -1,10 +1,12 @@
 /* animkit grid: uniform-grid neighbour search over a point cloud (particles, boids, cloth).
  *
- * What it does: sorts points into cubic cells of edge cell_size (a counting sort on hashed
- * cell keys, so points anywhere work: no bounds to declare, no point is "outside"), then
- * answers, for a radius r, every point within r of a query point (ak_grid_query) and every
- * pair of points closer than r (ak_grid_pairs_run). Both return exactly the brute-force set
- * under the one distance test the whole module uses:
+ * What it does: sorts points into cubic cells of edge cell_size (a radix sort on the Morton
+ * code of each point's cell, so a cell's points are contiguous and cells near in space are
+ * near in memory; a hash table finds a cell from its coordinates, so points anywhere work: no
+ * bounds to declare, no point is "outside"), then answers, for a radius r, every point within
+ * r of a query point (ak_grid_query), every pair of points closer than r (ak_grid_pairs_run)
+ * and every point's neighbour list in CSR form (ak_grid_neighbors_run). All return exactly the
+ * brute-force set under the one distance test the whole module uses:
  *
  *     dx = pj.x - q.x, dy = pj.y - q.y, dz = pj.z - q.z   (float)
  *     neighbour  <=>  dx*dx + dy*dy + dz*dz < r*r         (float, strict <)
@@ -30,6 +32,9 @@
  *     ak_grid_pairs_job job = {.grid = &grid, .radius = r, .out_pairs = {pairs, cap},
  *                              .out_pair_count = &pair_count, .thread_count = 2};
  *     if (ak_grid_pairs_run(&job) == AK_ERR_SPAN_SMALL) { grow pairs to pair_count, rerun }
+ *
+ * The pair and list passes test 8 or 16 candidates at a time with AVX-512 where the CPU has
+ * it (chosen at run time; the same float operations, so the same output as the scalar loops).
  *
  * Hot loops can walk the sorted layout directly: grid.x/y/z[k] is the k-th point in sorted
  * order (original index grid.order[k]); cell m holds sorted entries [cell_start[m],
