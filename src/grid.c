@@ -275,6 +275,39 @@ ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_sp
     }
     l.cell_start[cells] = (uint32_t)n;
 
+    /* A dense table over the box of occupied cells when it has at most 4 cells per point: it
+     * lives where the hash index would (bucket_entry: 16 bytes = 4 slots per point). */
+    const uint64_t dim[3] = {n ? (uint64_t)((int64_t)hi[0] - lo[0]) + 1 : 0,
+                             n ? (uint64_t)((int64_t)hi[1] - lo[1]) + 1 : 0,
+                             n ? (uint64_t)((int64_t)hi[2] - lo[2]) + 1 : 0};
+    if (n > 0 && dim[0] <= 4 * (uint64_t)n && dim[1] <= 4 * (uint64_t)n && dim[2] <= 4 * (uint64_t)n &&
+        dim[0] * dim[1] <= 4 * (uint64_t)n && dim[0] * dim[1] * dim[2] <= 4 * (uint64_t)n) {
+        uint32_t* table = (uint32_t*)(void*)l.bucket_entry;
+        const size_t vol = (size_t)(dim[0] * dim[1] * dim[2]);
+        memset(table, 0xFF, vol * sizeof *table);
+        for (uint32_t m = 0; m < cells; ++m) {
+            const ak_grid_cell c = l.cell_coord[m];
+            table[((size_t)((int64_t)c.z - lo[2]) * dim[1] + (size_t)((int64_t)c.y - lo[1])) * dim[0] +
+                  (size_t)((int64_t)c.x - lo[0])] = m;
+        }
+        l.bucket_start[0] = 0;
+        out_grid->dense = table;
+        out_grid->dense_origin = (ak_grid_cell){lo[0], lo[1], lo[2]};
+        for (int a = 0; a < 3; ++a) out_grid->dense_dim[a] = (uint32_t)dim[a];
+        out_grid->point_count = (uint32_t)n;
+        out_grid->cell_count = cells;
+        out_grid->bucket_count = 0;
+        out_grid->order = l.order;
+        out_grid->x = l.x;
+        out_grid->y = l.y;
+        out_grid->z = l.z;
+        out_grid->cell_start = l.cell_start;
+        out_grid->cell_coord = l.cell_coord;
+        out_grid->bucket_start = l.bucket_start;
+        out_grid->bucket_entry = NULL;
+        return AK_OK;
+    }
+
     /* The hash index: cells of bucket b (increasing m) at bucket_entry[bucket_start[b] ..). */
     const size_t buckets = bucket_count_for(cells);
     const uint32_t mask = (uint32_t)(buckets - 1);
@@ -311,6 +344,14 @@ ak_grid_cell ak_grid_cell_of(const ak_grid* grid, ak_vec3 p) {
 
 uint32_t ak_grid_cell_find(const ak_grid* grid, ak_grid_cell cell) {
     if (!grid || grid->cell_count == 0) return UINT32_MAX;
+    if (grid->dense) {
+        const uint64_t x = (uint64_t)((int64_t)cell.x - grid->dense_origin.x);
+        const uint64_t y = (uint64_t)((int64_t)cell.y - grid->dense_origin.y);
+        const uint64_t z = (uint64_t)((int64_t)cell.z - grid->dense_origin.z);
+        if (x >= grid->dense_dim[0] || y >= grid->dense_dim[1] || z >= grid->dense_dim[2])
+            return UINT32_MAX;
+        return grid->dense[(z * grid->dense_dim[1] + y) * grid->dense_dim[0] + x];
+    }
     const uint32_t b = cell_hash(cell) & (grid->bucket_count - 1);
     for (uint32_t e = grid->bucket_start[b]; e < grid->bucket_start[b + 1]; ++e)
         if (cell_eq(grid->bucket_entry[e].cell, cell)) return grid->bucket_entry[e].index;

@@ -20,6 +20,8 @@ static int u32_cmp(const void* a, const void* b) {
     return x < y ? -1 : (x > y ? 1 : 0);
 }
 
+static bool cell_eq(ak_grid_cell a, ak_grid_cell b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
 typedef struct built {
     ak_grid grid;
     void* mem;
@@ -145,6 +147,10 @@ AK_TEST(points_far_outside_any_bounds) {
     /* Small cells: far points clamp into shared cells but pairs stay exact. */
     AK_CHECK(check_cloud(p, n, 0.5f, 0.5f) > 0);
     check_cloud(p, n, 0.5f, 5e3f);
+    built b = build(p, n, 0.5f); /* a box far too big for a dense table: the hash index */
+    AK_CHECK(b.grid.dense == NULL && b.grid.bucket_count > 0);
+    for (uint32_t m = 0; m < b.grid.cell_count; ++m) AK_CHECK_EQ(ak_grid_cell_find(&b.grid, b.grid.cell_coord[m]), m);
+    free(b.mem);
 }
 
 AK_TEST(duplicates_and_large_radius) {
@@ -197,6 +203,19 @@ AK_TEST(sorted_layout_and_cells) {
     for (int i = 0; i < 500; ++i) AK_CHECK_EQ(seen[i], 1);
     ak_grid_cell empty = {1000, 1000, 1000};
     AK_CHECK_EQ(ak_grid_cell_find(g, empty), UINT32_MAX);
+    AK_CHECK(g->dense != NULL); /* 8^3 cells for 500 points: the dense table */
+    for (int dz = -1; dz <= 8; ++dz) /* every cell of (and around) the box, against the points */
+        for (int dy = -1; dy <= 8; ++dy)
+            for (int dx = -1; dx <= 8; ++dx) {
+                ak_grid_cell c = {dx - 4, dy - 4, dz - 4};
+                bool any = false;
+                for (int i = 0; i < 500; ++i)
+                    any = any || ((int32_t)floor(p[i].x / 0.5) == c.x && (int32_t)floor(p[i].y / 0.5) == c.y &&
+                                  (int32_t)floor(p[i].z / 0.5) == c.z);
+                const uint32_t m = ak_grid_cell_find(g, c);
+                AK_CHECK(any == (m != UINT32_MAX));
+                if (m != UINT32_MAX) AK_CHECK(cell_eq(g->cell_coord[m], c));
+            }
     ak_grid_cell c = ak_grid_cell_of(g, ak_vec3_make(-0.25f, 0.5f, 1.99f));
     AK_CHECK(c.x == -1 && c.y == 1 && c.z == 3);
     free(b.mem);

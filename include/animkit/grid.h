@@ -107,6 +107,13 @@ typedef struct ak_grid {
     const uint32_t* bucket_start; /* [bucket_count + 1]: bucket b = bucket_entry[bucket_start[b]
                                      .. bucket_start[b + 1]) */
     const ak_grid_bucket_entry* bucket_entry; /* [cell_count]: the hash index of the cells */
+    /* When the box of occupied cells has at most 4 cells per point, a dense table replaces the
+     * hash index (bucket_count is then 0): cell (x, y, z) of the box is m = dense[((z - oz) *
+     * dy + y - oy) * dx + x - ox] (UINT32_MAX when empty), origin (ox, oy, oz), dims (dx, dy,
+     * dz). NULL otherwise. Either way ak_grid_cell_find answers. */
+    const uint32_t* dense;
+    ak_grid_cell dense_origin;
+    uint32_t dense_dim[3];
 } ak_grid;
 
 /* Bytes of memory ak_grid_build needs for point_count points (any alignment is fine; the
