@@ -52,8 +52,8 @@ static size_t check_cloud(const ak_vec3* p, size_t n, float cell, float r) {
             if (near_brute(p[i], p[j], r)) want[w++] = (ak_grid_pair){(uint32_t)i, (uint32_t)j};
 
     ak_grid_pair* first = NULL;
-    for (uint32_t run = 0; run < 6; ++run) { /* 1, 2, 3 threads; the SIMD kernel, then scalar */
-        const uint32_t threads = 1 + run % 3;
+    for (uint32_t run = 0; run < 4; ++run) { /* 1, 2, 3 threads, then the scalar loops */
+        const uint32_t threads = run < 3 ? 1 + run : 1;
         ak_grid_pair* got = (ak_grid_pair*)malloc((brute + 1) * sizeof *got);
         size_t count = 0;
         ak_grid_pairs_job job = {.grid = &b.grid,
@@ -61,7 +61,7 @@ static size_t check_cloud(const ak_vec3* p, size_t n, float cell, float r) {
                                  .thread_count = threads,
                                  .out_pairs = {got, brute},
                                  .out_pair_count = &count,
-                                 .scalar_only = run >= 3};
+                                 .scalar_only = run == 3};
         AK_CHECK_EQ(ak_grid_pairs_run(&job), AK_OK);
         AK_CHECK_EQ(count, brute);
         if (count == brute) {
@@ -367,7 +367,7 @@ static bool near_ref(ak_vec3 a, ak_vec3 b, float r, int* ambiguous) {
     return d2 < r2;
 }
 
-/* Builds with `cell`, runs the lists for radius r on 1, 2, 3 threads and both kernels, checks
+/* Builds with `cell`, runs the lists for radius r on 1, 2, 3 threads and the scalar kernel, checks
  * every row against the double reference (as a set), that all runs are bit-identical, and that
  * row i is ak_grid_query(p_i) without i. Returns the total entries. */
 static size_t check_csr(const ak_vec3* p, size_t n, float cell, float r) {
@@ -390,8 +390,8 @@ static size_t check_csr(const ak_vec3* p, size_t n, float cell, float r) {
     uint32_t* off = (uint32_t*)malloc((n + 1) * sizeof *off);
     uint32_t* idx = (uint32_t*)malloc((ref_total + 1) * sizeof *idx);
     uint32_t* row = (uint32_t*)malloc((n + 1) * sizeof *row);
-    for (int scalar = 0; scalar <= 1; ++scalar)
-        for (uint32_t threads = 1; threads <= 3; ++threads) {
+    for (int scalar = 0; scalar <= 1; ++scalar) /* 1, 2, 3 threads, then the scalar kernel */
+        for (uint32_t threads = 1; threads <= (scalar ? 1u : 3u); ++threads) {
             size_t total = 0;
             memset(idx, 0xAB, (ref_total + 1) * sizeof *idx);
             ak_grid_neighbors_job job = {.grid = &b.grid, .radius = r, .thread_count = threads,

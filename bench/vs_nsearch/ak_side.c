@@ -11,6 +11,7 @@ static double wall(void) {
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+static int scalar_only = -1; /* AK_SCALAR=1 in the environment: the scalar loops */
 static void* mem;
 static size_t mem_bytes;
 static ak_grid grid;
@@ -20,6 +21,7 @@ static uint32_t *offsets, *indices;
 static size_t index_cap;
 
 static void build(const float* p, size_t n, float r, double* t_build) {
+    if (scalar_only < 0) scalar_only = getenv("AK_SCALAR") != NULL && getenv("AK_SCALAR")[0] == '1';
     ak_grid_desc gd = {.cell_size = r};
     size_t need = ak_grid_memory_size(n, &gd);
     if (need > mem_bytes) free(mem), mem = malloc(need), mem_bytes = need;
@@ -37,7 +39,8 @@ size_t ak_pairs_step(const float* p, size_t n, float r, unsigned threads, double
     double t0 = wall();
     for (;;) {
         ak_grid_pairs_job job = {.grid = &grid, .radius = r, .thread_count = threads,
-                                 .out_pairs = {pairs, pair_cap}, .out_pair_count = &count};
+                                 .out_pairs = {pairs, pair_cap}, .out_pair_count = &count,
+                                 .scalar_only = scalar_only == 1};
         ak_result rc = ak_grid_pairs_run(&job);
         if (rc == AK_ERR_SPAN_SMALL) {
             free(pairs), pair_cap = count + count / 8, pairs = malloc(pair_cap * sizeof *pairs);
@@ -60,7 +63,7 @@ size_t ak_csr_step(const float* p, size_t n, float r, unsigned threads, double* 
     for (;;) {
         ak_grid_neighbors_job job = {.grid = &grid, .radius = r, .thread_count = threads,
                                      .out_offsets = {offsets, n + 1}, .out_indices = {indices, index_cap},
-                                     .out_index_count = &count};
+                                     .out_index_count = &count, .scalar_only = scalar_only == 1};
         ak_result rc = ak_grid_neighbors_run(&job);
         if (rc == AK_ERR_SPAN_SMALL) {
             free(indices), index_cap = count + count / 8, indices = malloc(index_cap * sizeof *indices);

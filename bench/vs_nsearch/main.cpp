@@ -6,7 +6,8 @@
 //   CNS      : NeighborhoodSearch::find_neighbors on a persistent search (lists, both directions)
 // Checks that all three find the same set (order-independent hashes), prints medians of wall
 // and process CPU time, per-round CPU ratios CNS / animkit, and CPU ns per pair.
-// Usage: bench/vs_nsearch/run.sh [BUILD_DIR] [SIDE] [ROUNDS] [z]
+// Usage: bench/vs_nsearch/run.sh [BUILD_DIR] [SIDE] [ROUNDS] [z]   (AK_SCALAR=1: animkit's
+// scalar loops instead of its AVX-512 kernels)
 #include <CompactNSearch>
 #include <omp.h>
 #include <time.h>
@@ -56,8 +57,9 @@ int main(int argc, char** argv) {
         tmp.z_sort();
         tmp.point_set(tid).sort_field(reinterpret_cast<std::array<float, 3>*>(p.data()));
     }
-    printf("%zu points (%d^3 lattice, spacing h/2, jitter +-10%%), radius h, %s order\n", n, side,
-           zs ? "CNS z-curve" : "lattice");
+    const char* sc = getenv("AK_SCALAR");
+    printf("%zu points (%d^3 lattice, spacing h/2, jitter +-10%%), radius h, %s order, animkit %s\n", n, side,
+           zs ? "CNS z-curve" : "lattice", sc && sc[0] == '1' ? "scalar loops" : "default kernels");
     CompactNSearch::NeighborhoodSearch ns(h);
     unsigned id = ns.add_point_set(p.data(), n, true, true);
     ns.find_neighbors();
