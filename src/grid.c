@@ -634,6 +634,17 @@ size_t akp_grid_row_scalar(const float* x, const float* y, const float* z, const
     /* No branch on the hits (a quarter of the candidates, at random): counted as 0/1, and
      * written to a local block first (a miss writes a slot the next hit overwrites). */
     size_t count = 0;
+    if (!out) { /* the counting pass: a plain reduction the compiler can vectorise */
+        for (uint32_t r = 0; r < range_count; ++r) {
+            uint32_t k = 0;
+            for (uint32_t b = ranges[r].begin; b < ranges[r].end; ++b) {
+                const float dx = x[b] - qx, dy = y[b] - qy, dz = z[b] - qz;
+                k += (uint32_t)((dx * dx + dy * dy + dz * dz < r2) & (b != self));
+            }
+            count += k;
+        }
+        return count;
+    }
     uint32_t block[32];
     for (uint32_t r = 0; r < range_count; ++r)
         for (uint32_t b0 = ranges[r].begin; b0 < ranges[r].end; b0 += 32) {
