@@ -1093,6 +1093,8 @@ static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t 
     memset(L, 0, sizeof *L);
     L->gd.cell_size = c->cell_size;
     L->contact_gd.cell_size = ak_maxf(2.0f * c->max_radius, 1e-3f);
+    /* the contact pass is Gauss-Seidel in the grid's cell order: keep the order it was tuned on */
+    L->gd.cell_order = L->contact_gd.cell_order = AK_GRID_ORDER_HASH;
     size_t gm = ak_grid_memory_size(n, &L->gd);
     if (contact_iterations > 0) {
         const size_t gm2 = ak_grid_memory_size(n, &L->contact_gd);
@@ -1300,7 +1302,7 @@ static int xkey_cmp(const void* a, const void* b) {
 
 size_t ak_crowd_clearance_scratch_size(const ak_crowd* crowd, size_t count) {
     if (!crowd || count > AK_CROWD_MAX_AGENTS) return 0;
-    ak_grid_desc gd = {.cell_size = ak_maxf(2.0f * crowd->max_radius, 1e-3f)};
+    ak_grid_desc gd = {.cell_size = ak_maxf(2.0f * crowd->max_radius, 1e-3f), .cell_order = AK_GRID_ORDER_HASH};
     return akp_align16(count * sizeof(ak_vec3)) + akp_align16(ak_grid_memory_size(count, &gd)) +
            akp_align16(count * sizeof(xkey)) + 16;
 }
@@ -1317,7 +1319,7 @@ ak_result ak_crowd_clearance(const ak_crowd* crowd, ak_vec2_cspan positions, flo
     if (!scratch.ptr || scratch.count < need) return AK_ERR_SPAN_SMALL;
     for (size_t i = 0; i < n; ++i)
         if (!finite_in(positions.ptr[i].x, COORD_MAX) || !finite_in(positions.ptr[i].y, COORD_MAX)) return AK_ERR_BAD_DATA;
-    ak_grid_desc gd = {.cell_size = ak_maxf(2.0f * crowd->max_radius, 1e-3f)};
+    ak_grid_desc gd = {.cell_size = ak_maxf(2.0f * crowd->max_radius, 1e-3f), .cell_order = AK_GRID_ORDER_HASH};
     char* base = align_up(scratch.ptr);
     ak_vec3* pts = (ak_vec3*)(void*)base;
     for (size_t i = 0; i < n; ++i) pts[i] = ak_vec3_make(positions.ptr[i].x, 0.0f, positions.ptr[i].y);

@@ -1,10 +1,12 @@
 /* animkit grid: uniform-grid neighbour search over a point cloud (particles, boids, cloth).
  *
- * What it does: sorts points into cubic cells of edge cell_size (a counting sort on hashed
- * cell keys, so points anywhere work: no bounds to declare, no point is "outside"), then
- * answers, for a radius r, every point within r of a query point (ak_grid_query) and every
- * pair of points closer than r (ak_grid_pairs_run). Both return exactly the brute-force set
- * under the one distance test the whole module uses:
+ * What it does: sorts points into cubic cells of edge cell_size (a radix sort on the Morton
+ * code of each point's cell, so a cell's points are contiguous and cells near in space are
+ * near in memory; a hash table finds a cell from its coordinates, so points anywhere work: no
+ * bounds to declare, no point is "outside"), then answers, for a radius r, every point within
+ * r of a query point (ak_grid_query), every pair of points closer than r (ak_grid_pairs_run)
+ * and every point's neighbour list in CSR form (ak_grid_neighbors_run). All return exactly the
+ * brute-force set under the one distance test the whole module uses:
  *
  *     dx = pj.x - q.x, dy = pj.y - q.y, dz = pj.z - q.z   (float)
  *     neighbour  <=>  dx*dx + dy*dy + dz*dz < r*r         (float, strict <)
@@ -30,6 +32,9 @@
  *     ak_grid_pairs_job job = {.grid = &grid, .radius = r, .out_pairs = {pairs, cap},
  *                              .out_pair_count = &pair_count, .thread_count = 2};
  *     if (ak_grid_pairs_run(&job) == AK_ERR_SPAN_SMALL) { grow pairs to pair_count, rerun }
+ *
+ * The pair and list passes test 8 or 16 candidates at a time with AVX-512 where the CPU has
+ * it (chosen at run time; the same float operations, so the same output as the scalar loops).
  *
  * Hot loops can walk the sorted layout directly: grid.x/y/z[k] is the k-th point in sorted
  * order (original index grid.order[k]); cell m holds sorted entries [cell_start[m],
@@ -63,8 +68,27 @@ typedef struct ak_grid_pair {
 
 AK_DEFINE_SPAN(grid_pair, ak_grid_pair)
 
+/* One entry of the grid's hash index: an occupied cell and its index m. */
+typedef struct ak_grid_bucket_entry {
+    ak_grid_cell cell;
+    uint32_t index;
+} ak_grid_bucket_entry;
+
+/* The order of the cells in a built grid (what every pass that walks cells m = 0, 1, ... sees). */
+typedef enum ak_grid_cell_order {
+    /* Morton (z-curve) order of the cell coordinates minus the lowest occupied cell per axis:
+     * cells near in space are near in memory, which keeps big grids in cache. When occupied
+     * cells span 2^21 or more on an axis, the code of the offsets shifted right until they fit
+     * (cells sharing that code follow in (z, y, x) order). */
+    AK_GRID_ORDER_MORTON = 0,
+    /* Grouped by hash bucket (ties in (z, y, x) order): the layout of animkit before the Morton
+     * order, kept for callers whose results depend on the visit order (a Gauss-Seidel pass). */
+    AK_GRID_ORDER_HASH = 1
+} ak_grid_cell_order;
+
 typedef struct ak_grid_desc {
     float cell_size; /* required, > 0 and finite: cell edge in the points' units; best = radius */
+    ak_grid_cell_order cell_order; /* 0 = AK_GRID_ORDER_MORTON; anything else not listed -> BAD_ARG */
 } ak_grid_desc;
 
 /* A built grid: every array points into the memory given to ak_grid_build. Read-only. */
@@ -80,8 +104,16 @@ typedef struct ak_grid {
     const uint32_t*
         cell_start; /* [cell_count + 1]: cell m = sorted [cell_start[m], cell_start[m+1]) */
     const ak_grid_cell* cell_coord; /* [cell_count]: integer coordinates of cell m */
-    const uint32_t*
-        bucket_start; /* [bucket_count + 1]: cells of bucket b = [bucket_start[b], [b+1]) */
+    const uint32_t* bucket_start; /* [bucket_count + 1]: bucket b = bucket_entry[bucket_start[b]
+                                     .. bucket_start[b + 1]) */
+    const ak_grid_bucket_entry* bucket_entry; /* [cell_count]: the hash index of the cells */
+    /* When the box of occupied cells has at most 4 cells per point, a dense table replaces the
+     * hash index (bucket_count is then 0): cell (x, y, z) of the box is m = dense[((z - oz) *
+     * dy + y - oy) * dx + x - ox] (UINT32_MAX when empty), origin (ox, oy, oz), dims (dx, dy,
+     * dz). NULL otherwise. Either way ak_grid_cell_find answers. */
+    const uint32_t* dense;
+    ak_grid_cell dense_origin;
+    uint32_t dense_dim[3];
 } ak_grid;
 
 /* Bytes of memory ak_grid_build needs for point_count points (any alignment is fine; the
@@ -89,11 +121,11 @@ typedef struct ak_grid {
 AK_API size_t ak_grid_memory_size(size_t point_count, const ak_grid_desc* desc);
 
 /* Sort points into the grid. memory.count >= ak_grid_memory_size(points.count, desc); the
- * memory is the grid's storage until the caller reuses it. Order inside the grid: cells
- * grouped by hash bucket, points of a cell in increasing original index (so the layout is a
- * pure function of the points and the desc). points.count == 0 builds an empty grid.
+ * memory is the grid's storage until the caller reuses it. Order inside the grid: cells in
+ * desc->cell_order, points of a cell in increasing original index (so the layout is a pure
+ * function of the points and the desc). points.count == 0 builds an empty grid.
  * Returns AK_ERR_NULL_ARG (desc, out_grid, memory.ptr, or points.ptr with count > 0),
- * AK_ERR_BAD_ARG (cell_size not > 0 and finite, or 2^31 points or more), AK_ERR_SPAN_SMALL
+ * AK_ERR_BAD_ARG (cell_size not > 0 and finite, cell_order not listed, or 2^31 points or more), AK_ERR_SPAN_SMALL
  * (memory too small), AK_ERR_BAD_DATA (a NaN or infinite coordinate). On error *out_grid is
  * an empty grid. */
 AK_API ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_span memory,
@@ -114,6 +146,37 @@ AK_API uint32_t ak_grid_cell_find(const ak_grid* grid, ak_grid_cell cell);
  * > 0, NaN/infinite q or radius, or an empty grid -> 0. */
 AK_API size_t ak_grid_query(const ak_grid* grid, ak_vec3 q, float radius, ak_u32_span out_indices);
 
+/* Per-point neighbour lists in CSR form (the form SPH codes take): for every point i (original
+ * index), the indices j != i with |p_j - p_i| < radius (the module's distance test, q = p_i),
+ * at out_indices[out_offsets[i] .. out_offsets[i + 1]). Row i holds the same indices in the
+ * same order as ak_grid_query(grid, p_i, radius) without i itself (cells around p_i in a fixed
+ * order, then sorted order), so j is in row i exactly when i is in row j. */
+typedef struct ak_grid_neighbors_job {
+    const ak_grid* grid;      /* required */
+    float radius;             /* required, > 0 and finite */
+    uint32_t thread_count;    /* 0 -> 1; at most 64 */
+    ak_u32_span out_offsets;  /* required, count >= point_count + 1 */
+    ak_u32_span out_indices;  /* the lists; may be empty to count */
+    size_t* out_index_count;  /* required: total entries (also when above capacity) */
+    bool scalar_only;         /* use the scalar kernel even where AVX-512 is available (tests
+                                 and benchmarks; the result is the same) */
+} ak_grid_neighbors_job;
+
+/* First failing rule: AK_ERR_NULL_ARG (job, grid, out_index_count or out_offsets.ptr NULL, or
+ * out_indices.ptr NULL with count > 0), AK_ERR_BAD_ARG (radius not > 0 and finite,
+ * thread_count > 64), AK_ERR_SPAN_SMALL (out_offsets shorter than point_count + 1). */
+AK_API ak_result ak_grid_neighbors_validate(const ak_grid_neighbors_job* job);
+
+/* Fills the neighbour lists: a counting pass writes out_offsets (always, when validation
+ * passes), then, when out_indices has room for every entry, a second pass writes the lists.
+ * Returns the validate codes, AK_OK, AK_ERR_SPAN_SMALL when out_indices.count is below the
+ * total (*out_index_count says how many are needed; out_offsets is complete, out_indices
+ * untouched), AK_ERR_BUDGET when the total reaches 2^32 - 1 (offsets are 32-bit). Output is
+ * identical for any thread_count and on every CPU path. Never allocates. Cost: each point
+ * tests the points of the 27 cells around it twice (count, then fill); use
+ * 2 * ak_grid_candidate_count as the work estimate for untrusted input. */
+AK_API ak_result ak_grid_neighbors_run(const ak_grid_neighbors_job* job);
+
 /* The work a radius search over the whole grid does: the number of unordered point pairs
  * (i < j) that share a cell or lie in cells within reach of radius, i.e. the distance tests
  * ak_grid_pairs_run makes (the pairs it returns are a subset). Points spread at a density of
@@ -130,6 +193,8 @@ typedef struct ak_grid_pairs_job {
     uint32_t thread_count;       /* 0 -> 1; at most 64 */
     ak_grid_pair_span out_pairs; /* pairs (i < j, original indices); may be empty to count */
     size_t* out_pair_count;      /* required: the number of pairs (also when above capacity) */
+    bool scalar_only; /* use the scalar loops even where AVX-512 is available (tests and
+                         benchmarks; the result is the same) */
 } ak_grid_pairs_job;
 
 /* First failing rule: AK_ERR_NULL_ARG (job, grid, out_pair_count, or out_pairs.ptr NULL with
