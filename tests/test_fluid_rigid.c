@@ -524,8 +524,7 @@ AK_TEST(fluid_scene_box_colliders) {
     const char* bad[] = {
         "{\"colliders\": [{\"shape\": \"box\", \"a\": [1, 2, 3]}]}",
         "{\"colliders\": [{\"shape\": \"box\", \"half_extents\": [0.1, -0.2, 0.3]}]}",
-        "{\"colliders\": [{\"shape\": \"box\", \"half_extents\": [1, 1, 1], \"orientation\": [0, "
-        "0, 0, 0]}]}",
+        "{\"colliders\": [{\"shape\": \"box\", \"half_extents\": [1, 1, 1], \"orientation\": [0, 0, 0, 0]}]}",
         "{\"colliders\": [{\"shape\": \"sphere\", \"radius\": 1, \"half_extents\": [1, 1, 1]}]}",
         "{\"colliders\": [{\"shape\": \"cone\"}]}",
     };
