@@ -237,14 +237,16 @@ AK_TEST(presets_100_home_apart) {
 }
 
 /* The two presets that jammed: the corridor (two blocks head-on) and the evacuation (one door)
- * with 100 agents (fast) and with 1,000 (slow: 41 s and 254 s here, on the loaded 2-core VM): every agent home
- * within the preset's default steps, no overlap. */
+ * with 100 agents (fast), the corridor with 1,000 and the evacuation with 500 (slow: 41 s at
+ * load 10-14, and 27 s of CPU quiet): every agent home within the preset's default steps, no
+ * overlap. The evacuation of 1,000 (all home after 5,093 of 11,427 steps, measured with
+ * `animkit crowd --preset evacuation --agents 1000`) takes minutes, too long for CI's slow stage. */
 AK_TEST(corridor_evacuation_100) {
     preset_home("corridor", 100, 100, 1);
     preset_home("evacuation", 100, 100, 1);
 }
 AK_TEST(corridor_1000) { preset_home("corridor", 1000, 1000, 2); }
-AK_TEST(evacuation_1000) { preset_home("evacuation", 1000, 1000, 2); }
+AK_TEST(evacuation_500) { preset_home("evacuation", 500, 500, 2); }
 
 /* Lane formation: in the corridor preset the two groups keep to their own right (the side
  * preference of the step): while they pass each other, the agents of group 0 (walking +x)
@@ -909,7 +911,7 @@ int main(void) {
     AK_RUN(corridor_lanes);
     AK_RUN_SLOW(presets_100_home_apart);
     AK_RUN_SLOW(corridor_1000);
-    AK_RUN_SLOW(evacuation_1000);
+    AK_RUN_SLOW(evacuation_500);
     AK_RUN_SLOW(circle_250);
     return ak_test_finish();
 }
