@@ -436,6 +436,7 @@ static inline void pairs_range(pair_task* t, uint32_t a0, uint32_t a1, uint32_t 
     const float r2 = t->r2;
     const uint64_t candidates = same ? (uint64_t)(a1 - a0) * (a1 - a0 - 1) / 2
                                      : (uint64_t)(a1 - a0) * (b1 - b0);
+    if (candidates == 0) return; /* (and a counting run's output is NULL: no NULL + 0 below) */
     if (t->count + candidates <= t->capacity && t->avx512) {
         t->count += akp_grid_pairs_avx512(x, y, z, order, a0, a1, b0, b1, same, r2, t->out + t->count);
         return;

@@ -237,8 +237,11 @@ ak_result ak_ik_fabrik_tree_validate(const ak_ik_fabrik_tree_job* job) {
     for (size_t k = 0; k < job->effectors.count; ++k) {
         ak_transform acc = ak_transform_identity();
         for (int p = job->effectors.ptr[k]; p >= 0; p = parents.ptr[p]) {
-            acc = ak_transform_mul(job->pose.ptr[p], acc);
-            if (!ak_transform_is_finite(acc)) return AK_ERR_BAD_DATA;
+            /* (through a named local: clang 14 with ASan and libFuzzer's coverage counters
+             * reported the returned temporary as used after its scope here) */
+            const ak_transform next = ak_transform_mul(job->pose.ptr[p], acc);
+            if (!ak_transform_is_finite(next)) return AK_ERR_BAD_DATA;
+            acc = next;
         }
     }
     if (!(job->tolerance >= 0.0f && ak_finitef(job->tolerance))) return AK_ERR_BAD_ARG;
