@@ -4,7 +4,7 @@ JOBS  ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 # Ninja when it is installed (scripts/install-deps.sh installs ninja-build): it keeps both cores
 # busy through the whole build, where CMake's Makefiles left one idle about a tenth of the time
-# (measured, docs/BENCHMARKS.md "The test suite and CI"). An existing build folder keeps the
+# (measured: docs/BENCHMARKS.md "Test suite and CI"). An existing build folder keeps the
 # generator it was configured with.
 GENERATOR ?= $(shell command -v ninja >/dev/null 2>&1 && echo Ninja)
 
