@@ -63,6 +63,23 @@ typedef struct layout {
     ak_grid_cell* point_cell;
 } layout;
 
+/* The grid's arrays from the carved layout: the same for the dense table (no buckets, no
+ * bucket entries: the table lives in their place) and the hash index. */
+static void publish(ak_grid* g, const layout* l, size_t n, uint32_t cells, size_t buckets,
+                    ak_grid_bucket_entry* bucket_entry) {
+    g->point_count = (uint32_t)n;
+    g->cell_count = cells;
+    g->bucket_count = (uint32_t)buckets;
+    g->order = l->order;
+    g->x = l->x;
+    g->y = l->y;
+    g->z = l->z;
+    g->cell_start = l->cell_start;
+    g->cell_coord = l->cell_coord;
+    g->bucket_start = l->bucket_start;
+    g->bucket_entry = bucket_entry;
+}
+
 static size_t carve(uint8_t* base, size_t n, size_t buckets, layout* l) {
     size_t off = 0;
 #define GRID_TAKE(field, type, count)                                                              \
@@ -294,17 +311,7 @@ ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_sp
         out_grid->dense = table;
         out_grid->dense_origin = (ak_grid_cell){lo[0], lo[1], lo[2]};
         for (int a = 0; a < 3; ++a) out_grid->dense_dim[a] = (uint32_t)dim[a];
-        out_grid->point_count = (uint32_t)n;
-        out_grid->cell_count = cells;
-        out_grid->bucket_count = 0;
-        out_grid->order = l.order;
-        out_grid->x = l.x;
-        out_grid->y = l.y;
-        out_grid->z = l.z;
-        out_grid->cell_start = l.cell_start;
-        out_grid->cell_coord = l.cell_coord;
-        out_grid->bucket_start = l.bucket_start;
-        out_grid->bucket_entry = NULL;
+        publish(out_grid, &l, n, cells, 0, NULL);
         return AK_OK;
     }
 
@@ -320,17 +327,7 @@ ak_result ak_grid_build(const ak_grid_desc* desc, ak_vec3_cspan points, ak_u8_sp
         l.bucket_entry[--l.bucket_start[b]] = (ak_grid_bucket_entry){l.cell_coord[m], m};
     }
 
-    out_grid->point_count = (uint32_t)n;
-    out_grid->cell_count = cells;
-    out_grid->bucket_count = (uint32_t)buckets;
-    out_grid->order = l.order;
-    out_grid->x = l.x;
-    out_grid->y = l.y;
-    out_grid->z = l.z;
-    out_grid->cell_start = l.cell_start;
-    out_grid->cell_coord = l.cell_coord;
-    out_grid->bucket_start = l.bucket_start;
-    out_grid->bucket_entry = l.bucket_entry;
+    publish(out_grid, &l, n, cells, buckets, l.bucket_entry);
     return AK_OK;
 }
 
