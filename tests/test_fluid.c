@@ -3,6 +3,7 @@
 #include <animkit/fluid.h>
 
 #include "ak_test.h"
+#include "fluid_fit.h"
 
 #define PI_D 3.14159265358979323846
 
@@ -167,16 +168,8 @@ static double column_slope(int w, int ht, float jitter, uint32_t seed, int steps
     for (int step = 0; step < steps; ++step) {
         if (ak_fluid_step_run(&job) != AK_OK) break;
         if (step < steps - window) continue;
-        float top = 0.0f;
-        for (size_t i = 0; i < n; ++i) top = fmaxf(top, pos[i].y);
-        double sx = 0, sy = 0, sxx = 0, sxy = 0;
-        int cnt = 0;
-        for (size_t i = 0; i < n; ++i) {
-            const double y = pos[i].y;
-            if (y < d.h || y > top - d.h) continue;
-            sx += y, sy += pres[i], sxx += y * y, sxy += y * pres[i], ++cnt;
-        }
-        if (cnt > 10) sum += -(cnt * sxy - sx * sy) / (cnt * sxx - sx * sx), ++fits;
+        double slope;
+        if (fluid_pressure_slope(pos, pres, n, d.h, d.h, &slope)) sum += slope, ++fits;
     }
     free(mem);
     free(pres);

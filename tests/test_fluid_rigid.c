@@ -11,6 +11,7 @@
 #include <animkit/animkit.h>
 
 #include "ak_test.h"
+#include "fluid_fit.h"
 
 /* One step of a single particle with no gravity: PBF moves it only by the projection (alone it
  * has less than rest density, so the unilateral constraint is inactive). */
@@ -600,16 +601,8 @@ AK_TEST(column_on_a_box_body_is_hydrostatic) {
         AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
         for (size_t i = 0; i < n; ++i) deepest = fmaxf(deepest, box_depth(pos[i], bx, q[0], he));
         if (step < steps - window) continue;
-        float top = 0.0f;
-        for (size_t i = 0; i < n; ++i) top = fmaxf(top, pos[i].y);
-        double sx = 0, sy = 0, sxx = 0, sxy = 0;
-        int cnt = 0;
-        for (size_t i = 0; i < n; ++i) {
-            const double y = pos[i].y;
-            if (y < top_of_box + d.h || y > top - d.h) continue;
-            sx += y, sy += pres[i], sxx += y * y, sxy += y * pres[i], ++cnt;
-        }
-        if (cnt > 10) sum += -(cnt * sxy - sx * sy) / (cnt * sxx - sx * sx), ++fits;
+        double slope;
+        if (fluid_pressure_slope(pos, pres, n, top_of_box + d.h, d.h, &slope)) sum += slope, ++fits;
     }
     const double slope = fits ? sum / fits : NAN;
     printf("  column on a box body: pressure slope %.1f Pa/m against rho g %.1f; deepest %g m\n",
