@@ -2,6 +2,7 @@
 #include <animkit/builtin.h>
 
 #include "internal.h"
+#include "simd.h"
 
 /* ---- private types ------------------------------------------------------------------- */
 
@@ -58,7 +59,7 @@ enum {
     H_COUNT
 };
 
-#define H_CAPSULES 18
+#define H_CAPSULES 18 /* even: body_field runs the capsules in pairs */
 
 typedef struct humanoid_def {
     hjoint joints[H_COUNT];
@@ -383,30 +384,69 @@ static void humanoid_define(humanoid_def* h) {
 
 #define BLEND_K 0.012 /* smooth-union radius, metres */
 
-static double capsule_distance(const capsule* c, double px, double py, double pz) {
-    double abx = (double)c->b.x - c->a.x, aby = (double)c->b.y - c->a.y,
-           abz = (double)c->b.z - c->a.z;
-    double apx = px - c->a.x, apy = py - c->a.y, apz = pz - c->a.z;
-    double len2 = abx * abx + aby * aby + abz * abz;
-    double t = len2 > 0.0 ? (apx * abx + apy * aby + apz * abz) / len2 : 0.0;
-    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    double vx = apx - t * abx, vy = apy - t * aby, vz = (apz - t * abz) / c->zscale;
-    return sqrt(vx * vx + vy * vy + vz * vz) - (c->ra + t * ((double)c->rb - c->ra));
+/* The capsules as flat double arrays (the field's hot loop runs over them in lanes), with the
+ * same double values the per-capsule formula computed from the floats. */
+typedef struct body_soa {
+    double ax[H_CAPSULES], ay[H_CAPSULES], az[H_CAPSULES];
+    double abx[H_CAPSULES], aby[H_CAPSULES], abz[H_CAPSULES], len2[H_CAPSULES];
+    double ra[H_CAPSULES], dr[H_CAPSULES], zscale[H_CAPSULES];
+} body_soa;
+
+_Static_assert(H_CAPSULES % 2 == 0, "body_field runs the capsules in pairs");
+
+static void body_soa_make(const humanoid_def* h, body_soa* b) {
+    for (int i = 0; i < H_CAPSULES; ++i) {
+        const capsule* c = &h->caps[i];
+        b->ax[i] = c->a.x, b->ay[i] = c->a.y, b->az[i] = c->a.z;
+        b->abx[i] = (double)c->b.x - c->a.x, b->aby[i] = (double)c->b.y - c->a.y, b->abz[i] = (double)c->b.z - c->a.z;
+        b->len2[i] = b->abx[i] * b->abx[i] + b->aby[i] * b->aby[i] + b->abz[i] * b->abz[i];
+        if (!(b->len2[i] > 0.0)) b->len2[i] = 1.0; /* a point capsule: its dot product is 0, t = 0 */
+        b->ra[i] = c->ra, b->dr[i] = (double)c->rb - c->ra, b->zscale[i] = c->zscale;
+    }
 }
 
-/* Signed field: negative inside. Smooth minimum (log-sum-exp) of the capsule distances. */
-static double body_field(const humanoid_def* h, double x, double y, double z) {
+/* Signed field: negative inside. Smooth minimum (log-sum-exp) of the capsule distances (a
+ * tapered capsule flattened front to back: the distance to the segment, z divided by zscale,
+ * minus the radius interpolated along it). A capsule more than 38 blend radii farther than
+ * the nearest adds under exp(-38) = 3e-17 to a sum of at least 1: below half an ulp of it, so
+ * leaving out its exp() changes nothing (the meshes were compared byte for byte). */
+static double body_field(const body_soa* b, double x, double y, double z) {
     double d[H_CAPSULES], m = 1e30;
-    for (int i = 0; i < H_CAPSULES; ++i) {
-        d[i] = capsule_distance(&h->caps[i], x, y, z);
-        if (d[i] < m) m = d[i];
+#if AK_SIMD_SSE2
+    /* two capsules a step, the scalar loop's operations in its order (bit-identical: the clamps
+     * differ only for t = -0, which gives the same distance) */
+    const __m128d px = _mm_set1_pd(x), py = _mm_set1_pd(y), pz = _mm_set1_pd(z);
+    for (int i = 0; i < H_CAPSULES; i += 2) {
+        const __m128d apx = _mm_sub_pd(px, _mm_loadu_pd(b->ax + i)), apy = _mm_sub_pd(py, _mm_loadu_pd(b->ay + i)),
+                      apz = _mm_sub_pd(pz, _mm_loadu_pd(b->az + i));
+        const __m128d abx = _mm_loadu_pd(b->abx + i), aby = _mm_loadu_pd(b->aby + i), abz = _mm_loadu_pd(b->abz + i);
+        __m128d t = _mm_add_pd(_mm_add_pd(_mm_mul_pd(apx, abx), _mm_mul_pd(apy, aby)), _mm_mul_pd(apz, abz));
+        t = _mm_div_pd(t, _mm_loadu_pd(b->len2 + i));
+        t = _mm_min_pd(_mm_max_pd(t, _mm_setzero_pd()), _mm_set1_pd(1.0));
+        const __m128d vx = _mm_sub_pd(apx, _mm_mul_pd(t, abx)), vy = _mm_sub_pd(apy, _mm_mul_pd(t, aby));
+        const __m128d vz = _mm_div_pd(_mm_sub_pd(apz, _mm_mul_pd(t, abz)), _mm_loadu_pd(b->zscale + i));
+        const __m128d len = _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(vx, vx), _mm_mul_pd(vy, vy)), _mm_mul_pd(vz, vz)));
+        const __m128d r = _mm_add_pd(_mm_loadu_pd(b->ra + i), _mm_mul_pd(t, _mm_loadu_pd(b->dr + i)));
+        _mm_storeu_pd(d + i, _mm_sub_pd(len, r));
     }
+#else
+    for (int i = 0; i < H_CAPSULES; ++i) {
+        const double apx = x - b->ax[i], apy = y - b->ay[i], apz = z - b->az[i];
+        double t = (apx * b->abx[i] + apy * b->aby[i] + apz * b->abz[i]) / b->len2[i];
+        t = t < 0.0 ? 0.0 : t;
+        t = t > 1.0 ? 1.0 : t;
+        const double vx = apx - t * b->abx[i], vy = apy - t * b->aby[i], vz = (apz - t * b->abz[i]) / b->zscale[i];
+        d[i] = sqrt(vx * vx + vy * vy + vz * vz) - (b->ra[i] + t * b->dr[i]);
+    }
+#endif
+    for (int i = 0; i < H_CAPSULES; ++i) m = d[i] < m ? d[i] : m;
     double s = 0.0;
-    for (int i = 0; i < H_CAPSULES; ++i) s += exp(-(d[i] - m) / BLEND_K);
+    for (int i = 0; i < H_CAPSULES; ++i)
+        if (d[i] - m < 38.0 * BLEND_K) s += exp(-(d[i] - m) / BLEND_K);
     return m - BLEND_K * log(s);
 }
 
-static ak_vec3 body_gradient(const humanoid_def* h, ak_vec3 p, double eps) {
+static ak_vec3 body_gradient(const body_soa* h, ak_vec3 p, double eps) {
     double gx = body_field(h, p.x + eps, p.y, p.z) - body_field(h, p.x - eps, p.y, p.z);
     double gy = body_field(h, p.x, p.y + eps, p.z) - body_field(h, p.x, p.y - eps, p.z);
     double gz = body_field(h, p.x, p.y, p.z + eps) - body_field(h, p.x, p.y, p.z - eps);
@@ -557,6 +597,8 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
             ak_vec3_max(hi, ak_vec3_add(ak_vec3_max(h->caps[i].a, h->caps[i].b), ak_vec3_splat(r)));
     }
     const double hstep = cell, margin = 3.0 * cell;
+    body_soa soa;
+    body_soa_make(h, &soa);
     mt_grid g;
     memset(&g, 0, sizeof g);
     g.h = hstep;
@@ -577,7 +619,7 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
         for (int j = 0; j < g.ny; ++j)
             for (int i = 0; i < g.nx; ++i)
                 f[grid_index(&g, i, j, k)] =
-                    body_field(h, g.x0 + hstep * i, g.y0 + hstep * j, g.z0 + hstep * k);
+                    body_field(&soa, g.x0 + hstep * i, g.y0 + hstep * j, g.z0 + hstep * k);
     /* Exact output bounds: one vertex per sign-changing edge (lower end, direction 1..7),
      * at most two triangles per tetrahedron with mixed signs. */
     for (int k = 0; k < g.nz; ++k)
@@ -642,8 +684,8 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
                 ak_vec3 p = g.verts[v];
                 if (cnt[v]) p = ak_vec3_lerp(p, ak_vec3_scale(acc[v], 1.0f / (float)cnt[v]), 0.5f);
                 for (int n = 0; n < 3; ++n) {
-                    double fv = body_field(h, p.x, p.y, p.z);
-                    ak_vec3 gr = body_gradient(h, p, eps);
+                    double fv = body_field(&soa, p.x, p.y, p.z);
+                    ak_vec3 gr = body_gradient(&soa, p, eps);
                     float g2 = ak_vec3_length_sq(gr);
                     if (!(g2 > 1e-8f)) break;
                     float step = (float)(fv / g2);
@@ -671,7 +713,7 @@ static ak_result humanoid_surface(const humanoid_def* h, float cell, const ak_al
         memcpy(m->indices, g.tris, 3 * g.tri_count * sizeof(uint32_t));
         ak_mesh_compute_normals(m); /* fallback where the field gradient degenerates */
         for (size_t v = 0; v < g.vert_count; ++v) {
-            ak_vec3 n = ak_vec3_normalize(body_gradient(h, m->positions[v], 0.05 * hstep));
+            ak_vec3 n = ak_vec3_normalize(body_gradient(&soa, m->positions[v], 0.05 * hstep));
             if (ak_vec3_length_sq(n) > 0.5f) m->normals[v] = n;
         }
         *out = m;
