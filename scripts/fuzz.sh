@@ -14,8 +14,9 @@
 #   tests/fuzz/<name>.dict   libFuzzer dictionary (optional)
 #   tests/fuzz/<name>.options extra libFuzzer flags on one line (optional)
 # The corpus grows in build-fuzz/corpus/<name> and is kept between runs. Environment:
-# FUZZ_LIB (a build folder configured with AK_SANITIZE=ON and -fsanitize=fuzzer-no-link whose
-# libanimkit.a the targets link instead of building build-fuzz/lib; .ci/run passes build-asan),
+# FUZZ_LIB (a build folder configured with AK_SANITIZE=ON and either AK_FUZZ_COVERAGE=ON (coverage
+# on the parsers only, as .ci/run's build-asan) or -fsanitize=fuzzer-no-link in CMAKE_C_FLAGS
+# (everywhere), whose libanimkit.a the targets link instead of building build-fuzz/lib),
 # FUZZ_JOBS (parallel targets, default 1), FUZZ_MAX_LEN (default 65536), CC (default clang),
 # FUZZ_SEED (libFuzzer's -seed, default 1, so that a run from the seed corpus is reproducible and
 # CI's short run repeats the sequence that was checked before committing; 0 = a random seed per
@@ -39,11 +40,13 @@ command -v "$CC" >/dev/null || { echo "fuzz.sh: $CC not found (scripts/install-d
 mkdir -p "$OUT"
 if [ -n "${FUZZ_LIB:-}" ]; then
   # A library already built with the instrumentation: CI's ASan stage configures build-asan with
-  # -fsanitize=fuzzer-no-link (clang, AK_SANITIZE=ON), so the fuzz stage does not compile the
-  # whole library a second time. Refuse a build without coverage: libFuzzer would fuzz blind.
+  # AK_FUZZ_COVERAGE=ON (libFuzzer coverage on the parsers, CMakeLists.txt), so the fuzz stage
+  # does not compile the whole library a second time. Refuse a build without coverage: libFuzzer
+  # would fuzz blind.
   LIBDIR=$(cd "$FUZZ_LIB" && pwd)
-  grep -q 'fuzzer-no-link' "$LIBDIR/CMakeCache.txt" 2>/dev/null && grep -q '^AK_SANITIZE:BOOL=ON' "$LIBDIR/CMakeCache.txt" ||
-    { echo "fuzz.sh: FUZZ_LIB=$FUZZ_LIB was not configured with AK_SANITIZE=ON and -fsanitize=fuzzer-no-link" >&2; exit 1; }
+  grep -q '^AK_SANITIZE:BOOL=ON' "$LIBDIR/CMakeCache.txt" 2>/dev/null &&
+    { grep -q '^AK_FUZZ_COVERAGE:BOOL=ON' "$LIBDIR/CMakeCache.txt" || grep -q 'fuzzer-no-link' "$LIBDIR/CMakeCache.txt"; } ||
+    { echo "fuzz.sh: FUZZ_LIB=$FUZZ_LIB was not configured with AK_SANITIZE=ON and AK_FUZZ_COVERAGE=ON (or -fsanitize=fuzzer-no-link)" >&2; exit 1; }
   echo "== fuzz: the library of $FUZZ_LIB (ASan + UBSan + libFuzzer coverage)"
   cmake --build "$LIBDIR" -j "$JOBS" --target animkit_static > "$OUT/lib.log" 2>&1 || { tail -30 "$OUT/lib.log"; exit 1; }
 else
