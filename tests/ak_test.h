@@ -12,7 +12,12 @@
  * what runs: "fast" (the cases of AK_RUN only), "slow" (AK_RUN_SLOW only), unset or anything
  * else: all. tests/CMakeLists.txt registers every program as TEST (AK_TEST_SELECT=fast) and,
  * when its source holds AK_RUN_SLOW, also as TEST_slow (AK_TEST_SELECT=slow, ctest label
- * "slow"): `make test` runs ctest -LE slow (under a minute on 2 cores), .ci/run runs both. */
+ * "slow"): `make test` runs ctest -LE slow (under a minute on 2 cores), .ci/run runs both.
+ *
+ * Under valgrind (.ci/run's memcheck stage, about 30 times slower) AK_TEST_SELECT=light runs the
+ * fast cases except those marked AK_RUN_HEAVY (long runs of code that lighter cases of the same
+ * program also run: they print "skip NAME (heavy)"), and AK_TEST_REPS(n, light_n) gives the
+ * smaller count of a case's repetitions (random trials, not the length of a physical run). */
 #ifndef ANIMKIT_TEST_H
 #define ANIMKIT_TEST_H
 
@@ -31,15 +36,18 @@ static const char* ak_test_cur_name_ = "";
 
 #define AK_TEST(name) static void ak_test_##name(void)
 
-/* 0: run every case; 1: only AK_RUN (fast); 2: only AK_RUN_SLOW. */
+/* 0: run every case; 1: only AK_RUN (fast); 2: only AK_RUN_SLOW; 3: AK_RUN without the heavy
+ * ones, fewer repetitions (light). */
 static inline int ak_test_select_(void) {
     static int sel = -1;
     if (sel < 0) {
         const char* s = getenv("AK_TEST_SELECT");
-        sel = s && strcmp(s, "fast") == 0 ? 1 : s && strcmp(s, "slow") == 0 ? 2 : 0;
+        sel = !s ? 0 : strcmp(s, "fast") == 0 ? 1 : strcmp(s, "slow") == 0 ? 2 : strcmp(s, "light") == 0 ? 3 : 0;
     }
     return sel;
 }
+
+#define AK_TEST_REPS(n, light_n) (ak_test_select_() == 3 ? (light_n) : (n))
 
 static inline double ak_test_now_(void) {
     struct timespec ts;
@@ -50,6 +58,7 @@ static inline double ak_test_now_(void) {
 #define AK_RUN_AS_(name, slow)                                                             \
     do {                                                                                   \
         if (ak_test_select_() == ((slow) ? 1 : 2)) break;                                  \
+        if ((slow) && ak_test_select_() == 3) break;                                       \
         ak_test_cur_failed_ = 0;                                                           \
         ak_test_cur_name_ = #name;                                                         \
         const double ak_t0_ = ak_test_now_();                                              \
@@ -66,6 +75,15 @@ static inline double ak_test_now_(void) {
     } while (0)
 
 #define AK_RUN(name) AK_RUN_AS_(name, 0)
+#define AK_RUN_HEAVY(name)                                                                 \
+    do {                                                                                   \
+        if (ak_test_select_() == 3) {                                                      \
+            printf("skip %s (heavy: not under AK_TEST_SELECT=light)\n", #name);           \
+            ++ak_test_skipped_;                                                            \
+        } else {                                                                           \
+            AK_RUN_AS_(name, 0);                                                           \
+        }                                                                                  \
+    } while (0)
 #define AK_RUN_SLOW(name) AK_RUN_AS_(name, 1)
 
 #define AK_FAIL_(...)                                                                      \

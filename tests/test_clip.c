@@ -328,17 +328,18 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
         ak_u32_span st = pass == 0 ? (ak_u32_span){seg + 1, full} : (ak_u32_span){seg, ak_clip_channel_count(c)};
         AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, st), AK_OK);
         enum { T = 6000 };
+        const int nt = AK_TEST_REPS(T, T / 8); /* the samples (fewer under valgrind) */
         static float times[T];
         float dur = ak_clip_duration(c);
         /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
-        for (int i = 0; i < T; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)T;
-        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-        for (int i = 0; i < T; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)T;
-        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-        for (int i = 0; i < T; ++i) times[i] = ak_time_wrap(3.3f * dur * (float)i / (float)T, dur, AK_WRAP_LOOP);
-        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
-        for (int i = 0; i < T; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
-        AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
+        for (int i = 0; i < nt; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)nt;
+        AK_CHECK_EQ(compare_run(c, &cur, times, nt), 0);
+        for (int i = 0; i < nt; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)nt;
+        AK_CHECK_EQ(compare_run(c, &cur, times, nt), 0);
+        for (int i = 0; i < nt; ++i) times[i] = ak_time_wrap(3.3f * dur * (float)i / (float)nt, dur, AK_WRAP_LOOP);
+        AK_CHECK_EQ(compare_run(c, &cur, times, nt), 0);
+        for (int i = 0; i < nt; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
+        AK_CHECK_EQ(compare_run(c, &cur, times, nt), 0);
         /* on keys, next to keys, infinities and NaN */
         for (size_t ci = 0; ci < ak_clip_channel_count(c); ++ci) {
             ak_f32_cspan kt = ak_track_times(ak_clip_channel_track(c, ci));
@@ -407,16 +408,17 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
         AK_CHECK(ak_clip_cursor_storage_count(c) <= 4096);
         AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg)), AK_OK);
         enum { T = 3000 };
+        const int nt = AK_TEST_REPS(T, T / 8); /* the samples (fewer under valgrind) */
         static float times[T];
         float dur = ak_clip_duration(c);
         /* forward at a small step, backwards, random seeks, all reaching outside the keys */
-        for (int i = 0; i < T; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)T;
-        AK_CHECK_EQ(ref_clip_check_against_tracks(c, &cur, times, T, CJ, &worst), 0);
-        for (int i = 0; i < T; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)T;
-        AK_CHECK_EQ(ref_clip_check_against_tracks(c, &cur, times, T, CJ, &worst), 0);
-        for (int i = 0; i < T; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
-        AK_CHECK_EQ(ref_clip_check_against_tracks(c, &cur, times, T, CJ, &worst), 0);
-        AK_CHECK_EQ(ref_clip_check_against_tracks(c, NULL, times, T, CJ, &worst), 0);
+        for (int i = 0; i < nt; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)nt;
+        AK_CHECK_EQ(ref_clip_check_against_tracks(c, &cur, times, nt, CJ, &worst), 0);
+        for (int i = 0; i < nt; ++i) times[i] = dur + 1.0f - (dur + 2.0f) * (float)i / (float)nt;
+        AK_CHECK_EQ(ref_clip_check_against_tracks(c, &cur, times, nt, CJ, &worst), 0);
+        for (int i = 0; i < nt; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
+        AK_CHECK_EQ(ref_clip_check_against_tracks(c, &cur, times, nt, CJ, &worst), 0);
+        AK_CHECK_EQ(ref_clip_check_against_tracks(c, NULL, times, nt, CJ, &worst), 0);
         ak_clip_destroy(c);
     }
     /* Large angles up to the shortest-arc limit (pi/2 per half-angle) and nearly parallel keys. */
@@ -444,9 +446,10 @@ AK_TEST(inline_sampler_matches_track_eval_and_double_slerp) {
         AK_CHECK(ak_clip_cursor_storage_count(c) <= 128);
         ak_clip_cursor_init(&cur, c, (ak_u32_span)AK_SPAN(seg));
         enum { T = 20000 };
+        const int nt = AK_TEST_REPS(T, T / 8); /* the samples (fewer under valgrind) */
         static float times[T];
-        for (int i = 0; i < T; ++i) times[i] = -0.5f + (t + 1.0f) * (float)i / (float)T;
-        AK_CHECK_EQ(ref_clip_check_against_tracks(c, &cur, times, T, 1, &worst), 0);
+        for (int i = 0; i < nt; ++i) times[i] = -0.5f + (t + 1.0f) * (float)i / (float)nt;
+        AK_CHECK_EQ(ref_clip_check_against_tracks(c, &cur, times, nt, 1, &worst), 0);
         ak_clip_destroy(c);
     }
     printf("  max |component| error of LINEAR rotations vs double-precision slerp: %.2e\n", worst);

@@ -907,7 +907,7 @@ int main(void) {
     AK_RUN(scene_errors_name_key_paths);
     AK_RUN(scene_presets);
     AK_RUN(presets_24_home_apart);
-    AK_RUN(corridor_evacuation_100);
+    AK_RUN_HEAVY(corridor_evacuation_100); /* valgrind: the other cases step the same code */
     AK_RUN(corridor_lanes);
     AK_RUN_SLOW(presets_100_home_apart);
     AK_RUN_SLOW(corridor_1000);
