@@ -179,6 +179,82 @@ AK_TEST(field_is_inside_out_and_rigid) {
     cyl_free(&c);
 }
 
+/* The per-bone grids (the paper's 3D textures) against the HRBFs evaluated directly
+ * (grid_resolution UINT32_MAX): the composed field and its gradient agree everywhere around
+ * the bent cylinder, and the deformed surfaces agree to a small fraction of the radius. */
+AK_TEST(grid_matches_direct_field) {
+    cyl c;
+    AK_CHECK(cyl_make(&c, 24, 16));
+    const ak_mesh* m = c.mesh;
+    ak_skin_implicit_desc d = {
+        .positions = {m->positions, m->vertex_count},
+        .indices = {m->indices, 3 * m->triangle_count},
+        .joints = {m->joints, m->vertex_count * m->influence_count},
+        .weights = {m->weights, m->vertex_count * m->influence_count},
+        .influence_count = m->influence_count,
+        .joint_count = c.slots,
+        .grid_resolution = UINT32_MAX,
+    };
+    ak_skin_implicit* direct = NULL;
+    AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &direct), AK_OK);
+    ak_mat4 pal[8];
+    cyl_palette(&c, ak_vec3_make(0, 0, 1), 90.0f * PI_F / 180.0f, pal);
+    double worst = 0.0, sum = 0.0, gworst = 0.0;
+    size_t n = 0, far = 0;
+    for (int i = 0; i <= 12; ++i)
+        for (int j = 0; j <= 26; ++j)
+            for (int k = 0; k <= 12; ++k) {
+                ak_vec3 p = ak_vec3_make(-1.2f + 0.15f * (float)i, -0.3f + 0.1f * (float)j, -0.6f + 0.1f * (float)k);
+                ak_vec3 ga, gb;
+                float fa = ak_skin_implicit_field(c.imp, (ak_mat4_cspan){pal, c.slots}, p, &ga);
+                float fb = ak_skin_implicit_field(direct, (ak_mat4_cspan){pal, c.slots}, p, &gb);
+                double e = fabs((double)fa - (double)fb);
+                worst = fmax(worst, e), sum += e, ++n;
+                far += e > 0.05;
+                /* gradient error relative to the field's steepest slope (1 / support radius) */
+                gworst = fmax(gworst, (double)ak_vec3_length(ak_vec3_sub(ga, gb)));
+            }
+    printf("  grid vs direct field: max %.4f mean %.5f (%zu of %zu points off by more than 0.05), gradient max %.3f\n",
+           worst, sum / (double)n, far, n, gworst);
+    /* trilinear interpolation is exact to first order: small on average; larger only in the
+     * cells that straddle a kink of the distance (the capsule bound meets the HRBF) */
+    AK_CHECK(sum / (double)n < 0.002); /* measured 0.0008 */
+    AK_CHECK(far * 100 < n);           /* measured 4 of 4563 */
+    AK_CHECK(worst < 0.3);             /* measured 0.16 */
+    ak_vec3* a = alloc_out(&c);
+    ak_vec3* b = alloc_out(&c);
+    AK_CHECK_EQ(skin_implicit(&c, pal, a, 1), AK_OK);
+    ak_skin_implicit* keep = c.imp;
+    c.imp = direct;
+    AK_CHECK_EQ(skin_implicit(&c, pal, b, 1), AK_OK);
+    c.imp = keep;
+    float dmax = 0.0f;
+    double dsum = 0.0;
+    size_t dfar = 0;
+    for (size_t v = 0; v < m->vertex_count; ++v) {
+        float dd = ak_vec3_length(ak_vec3_sub(a[v], b[v]));
+        dmax = ak_maxf(dmax, dd), dsum += dd, dfar += dd > 0.02f * 0.25f;
+    }
+    printf("  grid vs direct surface at 90 degrees: mean %.5f max %.4f, %zu of %zu vertices off by > 2%% of the "
+           "radius (0.25)\n", dsum / (double)m->vertex_count, (double)dmax, dfar, m->vertex_count);
+    /* measured: mean 0.3% of the radius, 8 of 402 vertices beyond 2%, the worst 27% (a vertex
+     * whose march stops on the other side of a gradient turn in one field and not the other) */
+    AK_CHECK(dsum / (double)m->vertex_count < 0.005 * 0.25);
+    AK_CHECK(dfar * 25 < m->vertex_count);
+    AK_CHECK(dmax < 0.5f * 0.25f);
+    /* resolutions outside 8..128 are refused */
+    ak_skin_implicit* x = NULL;
+    d.grid_resolution = 7;
+    AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &x), AK_ERR_BAD_ARG);
+    d.grid_resolution = 129;
+    AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &x), AK_ERR_BAD_ARG);
+    AK_CHECK(x == NULL);
+    free(a);
+    free(b);
+    ak_skin_implicit_destroy(direct);
+    cyl_free(&c);
+}
+
 AK_TEST(bent_cylinder_methods) {
     /* bends of 120 and 150 degrees: LBS and DQS interpenetrate at the elbow (exact count > 0);
      * the implicit result is measured beside them (volume, crossings) */
@@ -201,10 +277,10 @@ AK_TEST(bent_cylinder_methods) {
                r[2].volume_ratio);
         AK_CHECK(r[0].crossings > 0 && r[1].crossings > 0);
         for (size_t v = 0; v < c.mesh->vertex_count; ++v) AK_CHECK(ak_vec3_is_finite(out[v]));
-        /* measured: -5.5% at 120 and +1.8% at 150 (the issue's target of 3% is not met at 120,
-         * nor zero crossings: the contact sheets of both sides land on one surface): a
-         * regression guard at 7% */
-        AK_CHECK(fabs(r[2].volume_ratio - 1.0) < 0.07);
+        /* the issue's targets: no self-intersecting pair, volume within 3% (kept by the contact
+         * bulge on this closed mesh: measured 1.0001 and 1.0000) */
+        AK_CHECK_EQ(r[2].crossings, 0);
+        AK_CHECK(fabs(r[2].volume_ratio - 1.0) < 0.03);
     }
     free(out);
     cyl_free(&c);
@@ -393,6 +469,7 @@ AK_TEST(cesium_man) {
 int main(void) {
     AK_RUN(bind_pose_reproduces_the_mesh);
     AK_RUN(field_is_inside_out_and_rigid);
+    AK_RUN(grid_matches_direct_field);
     AK_RUN(bent_cylinder_methods);
     AK_RUN(twist_180_does_not_collapse);
     AK_RUN(threads_give_the_same_bits);

@@ -392,6 +392,12 @@ typedef struct ak_skin_implicit_desc {
     uint32_t thread_count;    /* fitting threads; 0 -> 2; 1 -> calling thread only */
     float bulge;              /* contact bulge strength; 0 -> 0.5; negative -> none (plain
                                  union); at most 10 */
+    uint32_t grid_resolution; /* each part's field is sampled (value and gradient) on a 3D grid
+                                 in bone space with this many nodes along the box's longest
+                                 side, and evaluated per frame by trilinear interpolation (the
+                                 paper's 3D textures); 0 -> 40; 8..128; UINT32_MAX -> no grid:
+                                 the HRBFs evaluated directly (hundreds of times slower; a
+                                 reference for tests) */
 } ak_skin_implicit_desc;
 
 /* The desc with every zero field replaced by its documented default. */
