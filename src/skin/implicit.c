@@ -1524,6 +1524,34 @@ static void keep_volume(const run_ctx* c, ak_vec3* grad) {
 }
 
 
+/* Whether vertex v follows one joint rigidly (a single influence of weight 1) and its DQS
+ * position lies in a broad-phase cell that no other bone's field reaches: its field is then
+ * that of its rest position, i.e. its iso-value, and the projection would keep it. */
+static bool rigid_alone(const run_ctx* c, size_t v) {
+    const ak_skin_implicit* o = c->o;
+    const broad_phase* bp = c->fc.bp;
+    if (!bp || bp->empty) return false;
+    const uint32_t k = o->influence_count;
+    const float* w = o->weights + v * k;
+    const uint16_t* j = o->joints + v * k;
+    size_t b = SIZE_MAX;
+    for (uint32_t q = 0; q < k; ++q) {
+        if (w[q] == 0.0f) continue;
+        if (w[q] != 1.0f || b != SIZE_MAX) return false;
+        b = j[q];
+    }
+    if (b == SIZE_MAX) return false;
+    ak_vec3 x = c->pos[v];
+    float p[3] = {(x.x - bp->lo[0]) * bp->inv_cell[0], (x.y - bp->lo[1]) * bp->inv_cell[1], (x.z - bp->lo[2]) * bp->inv_cell[2]};
+    const float top = (float)bp->cells;
+    if (!(p[0] >= 0.0f && p[1] >= 0.0f && p[2] >= 0.0f && p[0] < top && p[1] < top && p[2] < top)) return false;
+    const size_t cell = (size_t)p[0] + bp->cells * ((size_t)p[1] + bp->cells * (size_t)p[2]);
+    const uint64_t* mw = bp->mask + cell * bp->words;
+    for (size_t q = 0; q < bp->words; ++q)
+        if (mw[q] != (q == b / 64 ? (uint64_t)1 << (b & 63) : 0u)) return false;
+    return true;
+}
+
 typedef struct run_task {
     run_ctx* c;
     size_t begin, end;
@@ -1537,6 +1565,7 @@ static void* run_worker(void* arg) {
     for (size_t v = t->begin; v < t->end; ++v) {
         if (o->rep[v] != v || !projectable(o->iso[v])) continue;
         if (t->phase == 0) {
+            if (rigid_alone(c, v)) continue; /* kept: exactly at its iso-value already */
             c->state[v] = project(c, o->iso[v], &c->pos[v], &c->grad[v], true);
         } else if (t->phase == 1) {
             if (c->state[v] == ST_KEEP) continue;
