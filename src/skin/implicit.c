@@ -30,6 +30,7 @@
 #define PAIR_FLOATS 16 /* part i, part j, joint centre c(3), unit axes u_i(3) u_j(3) (from c into each
                           part), reach rho, seam radius, rest normal n(3) = unit(u_i - u_j); bind space */
 #define BULGE_REACH 3.0f /* seam radii around a folded joint that swell to keep the volume */
+#define CONTACT_FOLD 0.5f /* |R_i u_i + R_j u_j| beyond its rest value: about 30 degrees of bend */
 #define CONTACT_SMOOTH 8 /* smoothing rounds of the contact region */
 #define PAIR_FRAME 12 /* per joint and frame: posed centre (3), contact normal (3), folded flag, pad,
                         inner direction (3), pad */
@@ -748,7 +749,7 @@ static void fill_pairs(ak_skin_implicit* o) {
         nr = ak_vec3_scale(nr, 1.0f / ln);
         P[2] = cc.x, P[3] = cc.y, P[4] = cc.z;
         P[5] = ui.x, P[6] = ui.y, P[7] = ui.z, P[8] = uj.x, P[9] = uj.y, P[10] = uj.z;
-        P[11] = (float)(10.0 * hr), P[12] = (float)hr;
+        P[11] = (float)(4.0 * hr), P[12] = (float)hr;
         P[13] = nr.x, P[14] = nr.y, P[15] = nr.z;
     }
 }
@@ -1411,7 +1412,7 @@ static void contact_frames(const ak_skin_implicit* o, const ak_mat4* palette, fl
         ak_vec3 in = ak_vec3_add(pi, pj), rest_in = ak_vec3_add(ui, uj);
         float fold = ak_vec3_length(in) - ak_vec3_length(rest_in);
         F[0] = cp.x, F[1] = cp.y, F[2] = cp.z, F[3] = n.x, F[4] = n.y, F[5] = n.z;
-        F[6] = fold > 0.05f ? 1.0f : 0.0f;
+        F[6] = fold > CONTACT_FOLD ? 1.0f : 0.0f;
         ak_vec3 ind = ak_vec3_normalize(in);
         if (ak_vec3_is_finite(ind)) F[8] = ind.x, F[9] = ind.y, F[10] = ind.z;
     }
@@ -1440,6 +1441,10 @@ static void contact_vertex(const run_ctx* c, size_t v, bool revert) {
         const ak_vec3 cp = ak_vec3_make(F[0], F[1], F[2]), n = ak_vec3_make(F[3], F[4], F[5]);
         const ak_vec3 nr = ak_vec3_make(P[13], P[14], P[15]);
         const float gap = 0.02f * P[12], band = 0.4f * P[12];
+        /* the inner side of the fold only: the half-space the folded axes point into */
+        if (ak_vec3_dot(ak_vec3_sub(x, cp), ak_vec3_make(F[8], F[9], F[10])) <= 0.0f &&
+            ak_vec3_dot(ak_vec3_sub(c->dq[v], cp), ak_vec3_make(F[8], F[9], F[10])) <= 0.0f)
+            continue;
         float s_rest = side * ak_vec3_dot(ak_vec3_sub(vb, cb), nr);
         float need = s_rest < gap ? s_rest : gap;
         float s = side * ak_vec3_dot(ak_vec3_sub(x, cp), n);
