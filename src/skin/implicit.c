@@ -32,8 +32,8 @@
 #define BULGE_REACH 3.0f /* seam radii around a folded joint that swell to keep the volume */
 #define CONTACT_FOLD 0.5f /* |R_i u_i + R_j u_j| beyond its rest value: about 30 degrees of bend */
 #define CONTACT_SMOOTH 8 /* smoothing rounds of the contact region */
-#define PAIR_FRAME 12 /* per joint and frame: posed centre (3), contact normal (3), folded flag, pad,
-                        inner direction (3), pad */
+#define PAIR_FRAME 20 /* per joint and frame: posed centre (3), contact normal (3), folded flag, pad,
+                        inner direction (3), pad, posed axis of part i (3), pad, of part j (3), pad */
 #define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
 
 struct ak_skin_implicit {
@@ -1415,6 +1415,7 @@ static void contact_frames(const ak_skin_implicit* o, const ak_mat4* palette, fl
         F[6] = fold > CONTACT_FOLD ? 1.0f : 0.0f;
         ak_vec3 ind = ak_vec3_normalize(in);
         if (ak_vec3_is_finite(ind)) F[8] = ind.x, F[9] = ind.y, F[10] = ind.z;
+        F[12] = pi.x, F[13] = pi.y, F[14] = pi.z, F[16] = pj.x, F[17] = pj.y, F[18] = pj.z;
     }
 }
 
@@ -1500,28 +1501,40 @@ static void keep_volume(const run_ctx* c, ak_vec3* grad) {
             for (size_t v = 0; v < nv; ++v) {
                 if (o->rep[v] != v || (c->state[v] & ST_CONTACT) || !projectable(o->iso[v])) continue;
                 float w = 0.0f, cap = 0.0f;
+                ak_vec3 dir = ak_vec3_zero();
                 for (size_t p = 0; p < o->pair_count; ++p) {
                     const float* P = o->pairs + p * PAIR_FLOATS;
                     if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
                     if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
                     const float* F = c->frame + p * PAIR_FRAME;
-                    /* the inner side of the fold only (where the parts press together) */
-                    if (ak_vec3_dot(ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2])), ak_vec3_make(F[8], F[9], F[10])) <= 0.0f)
-                        continue;
+                    /* the inner side of the fold only (where the parts press together),
+                     * fading in over a seam radius */
+                    float inner = ak_vec3_dot(ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2])), ak_vec3_make(F[8], F[9], F[10])) / P[12];
+                    if (!(inner > 0.0f)) continue;
+                    inner = inner < 1.0f ? inner * inner * (3.0f - 2.0f * inner) : 1.0f;
                     float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
                     float u = 1.0f - dist / (BULGE_REACH * P[12]);
-                    if (u > 0.0f && u * u > w) w = u * u, cap = P[12];
+                    if (u > 0.0f && inner * u * u > w) {
+                        /* away from the part's posed axis (a smooth direction, unlike the
+                         * per-vertex volume gradient of a crumpled surface) */
+                        ak_vec3 a = (uint32_t)P[0] == o->part[v] ? ak_vec3_make(F[12], F[13], F[14])
+                                                                 : ak_vec3_make(F[16], F[17], F[18]);
+                        ak_vec3 rel = ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2]));
+                        ak_vec3 rad = ak_vec3_normalize(ak_vec3_sub(rel, ak_vec3_scale(a, ak_vec3_dot(rel, a))));
+                        if (!ak_vec3_is_finite(rad)) continue;
+                        w = inner * u * u, cap = P[12], dir = rad;
+                    }
                 }
                 if (w == 0.0f) continue;
-                const float gl = ak_vec3_length(grad[v]);
-                if (!(gl > 0.0f) || !ak_finitef(gl)) continue;
+                const float e = ak_vec3_dot(grad[v], dir); /* volume change per unit move */
+                if (!(e > 0.0f) || !ak_finitef(e)) continue;
                 if (!pass) {
-                    sum += (double)w * gl;
+                    sum += (double)w * e;
                     continue;
                 }
                 float step = k * w;
                 step = ak_clampf(step, -cap, cap);
-                ak_vec3 q = ak_vec3_add(pos[v], ak_vec3_scale(grad[v], step / gl));
+                ak_vec3 q = ak_vec3_add(pos[v], ak_vec3_scale(dir, step));
                 if (ak_vec3_is_finite(q)) pos[v] = q, c->state[v] |= ST_MOVED;
             }
         }
