@@ -749,7 +749,7 @@ static void fill_pairs(ak_skin_implicit* o) {
         nr = ak_vec3_scale(nr, 1.0f / ln);
         P[2] = cc.x, P[3] = cc.y, P[4] = cc.z;
         P[5] = ui.x, P[6] = ui.y, P[7] = ui.z, P[8] = uj.x, P[9] = uj.y, P[10] = uj.z;
-        P[11] = (float)(4.0 * hr), P[12] = (float)hr;
+        P[11] = (float)(10.0 * hr), P[12] = (float)hr;
         P[13] = nr.x, P[14] = nr.y, P[15] = nr.z;
     }
 }
