@@ -1,7 +1,9 @@
 /* Implicit skinning (ak_skin_implicit_*) beside DQS in the same run: ms per frame on CesiumMan
  * (when the asset is present: ANIMKIT_ASSETS or ../shared/assets) and on builtin:cylinder
- * tessellated to about 50k vertices, 1 and 2 threads; the precompute time. The ratio
- * implicit / DQS per frame is machine-independent enough to compare (target <= 5x).
+ * tessellated to about 50k vertices, 1 and 2 threads (wall time), plus the CPU time of one
+ * thread (on a loaded machine the fairer ratio) and the same frame with the HRBFs evaluated
+ * directly instead of from the per-bone grids; the precompute times. The ratio implicit / DQS
+ * per frame is machine-independent enough to compare (target <= 5x).
  *     build/bench/bench_implicit */
 #include <stdio.h>
 #include <string.h>
@@ -55,16 +57,19 @@ static void run_implicit(const frame_ctx* c) {
     ak_skin_implicit_run(&job);
 }
 
-static double median_ms(void (*fn)(const frame_ctx*), const frame_ctx* c, int rounds) {
+static double median_ms_clock(void (*fn)(const frame_ctx*), const frame_ctx* c, int rounds, double (*clk)(void)) {
     double t[64];
     if (rounds > 64) rounds = 64;
     fn(c); /* warm */
     for (int r = 0; r < rounds; ++r) {
-        double t0 = bench_wall_s();
+        double t0 = clk();
         fn(c);
-        t[r] = 1e3 * (bench_wall_s() - t0);
+        t[r] = 1e3 * (clk() - t0);
     }
     return bench_percentile(t, (size_t)rounds, 0.5);
+}
+static double median_ms(void (*fn)(const frame_ctx*), const frame_ctx* c, int rounds) {
+    return median_ms_clock(fn, c, rounds, bench_wall_s);
 }
 
 static void bench_model(const char* name, ak_scene* s, int clip, float t) {
@@ -96,9 +101,18 @@ static void bench_model(const char* name, ak_scene* s, int clip, float t) {
         printf("%s: precompute failed: %s\n", name, ak_result_string(r));
         return;
     }
-    size_t ss = ak_skin_implicit_scratch_size(imp, jc);
+    ak_skin_implicit_desc dd = d;
+    dd.grid_resolution = UINT32_MAX; /* the reference: HRBFs evaluated directly */
+    ak_skin_implicit* direct = NULL;
+    t0 = bench_wall_s();
+    r = ak_skin_implicit_create(&dd, NULL, &direct);
+    double pre_direct = bench_wall_s() - t0;
+    if (r != AK_OK) direct = NULL;
+    size_t ss = ak_skin_implicit_scratch_size(imp, jc), ss2 = direct ? ak_skin_implicit_scratch_size(direct, jc) : 0;
+    if (ss2 > ss) ss = ss2;
     unsigned char* scratch = malloc(ss);
-    printf("%s: %zu vertices, %zu joints; precompute %.3f s (2 threads)\n", name, m->vertex_count, jc, pre);
+    printf("%s: %zu vertices, %zu joints; precompute %.3f s with grids, %.3f s without (2 threads)\n", name,
+           m->vertex_count, jc, pre, pre_direct);
     printf("  %-8s %12s %12s %10s\n", "threads", "DQS ms", "implicit ms", "ratio");
     int rounds = bench_quick() ? 3 : 15;
     for (uint32_t th = 1; th <= 2; ++th) {
@@ -106,6 +120,19 @@ static void bench_model(const char* name, ak_scene* s, int clip, float t) {
         double dq = median_ms(run_dqs, &c, rounds * 4), im = median_ms(run_implicit, &c, rounds);
         printf("  %-8u %12.4f %12.3f %9.1fx\n", th, dq, im, im / dq);
     }
+    {
+        frame_ctx c = {m, imp, pal, jc, out, scratch, ss, 1};
+        double dq = median_ms_clock(run_dqs, &c, rounds * 4, bench_cpu_s);
+        double im = median_ms_clock(run_implicit, &c, rounds, bench_cpu_s);
+        printf("  1 thread, CPU time: DQS %.4f ms, implicit %.3f ms (%.1fx)", dq, im, im / dq);
+        if (direct) {
+            c.imp = direct;
+            double di = median_ms_clock(run_implicit, &c, bench_quick() ? 1 : 3, bench_cpu_s);
+            printf(", without grids %.3f ms (%.1fx): grids %.1fx faster", di, di / dq, di / im);
+        }
+        printf("\n");
+    }
+    ak_skin_implicit_destroy(direct);
     free(scratch);
     ak_skin_implicit_destroy(imp);
     free(local), free(world), free(pal), free(out);

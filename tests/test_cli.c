@@ -360,6 +360,12 @@ AK_TEST(skin_compare_orders_methods) {
      * collapse under the twist; volume_change is volume_ratio - 1 */
     AK_CHECK(VAL(bend120, "LBS", "self_intersections") > 0 && VAL(bend120, "DQS", "self_intersections") > 0);
     AK_CHECK(VAL(twist, "implicit", "min_radius") > 0.7);
+    /* implicit at the 120- and 150-degree bends: no crossing pair, volume within 3% (issue 29) */
+    for (int k = 1; k <= 2; ++k) {
+        cJSON* b = cJSON_GetArrayItem(poses, k);
+        AK_CHECK_EQ(VAL(b, "implicit", "self_intersections"), 0.0);
+        AK_CHECK(fabs(VAL(b, "implicit", "volume_change")) < 0.03);
+    }
     AK_CHECK_NEAR(VAL(twist, "implicit", "volume_change"), VAL(twist, "implicit", "volume_ratio") - 1.0, 1e-6);
     /* soft (volumetric): the bent tube does not pass through itself where LBS does, and keeps
      * its volume and its section under the twist */

@@ -179,6 +179,82 @@ AK_TEST(field_is_inside_out_and_rigid) {
     cyl_free(&c);
 }
 
+/* The per-bone grids (the paper's 3D textures) against the HRBFs evaluated directly
+ * (grid_resolution UINT32_MAX): the composed field and its gradient agree everywhere around
+ * the bent cylinder, and the deformed surfaces agree to a small fraction of the radius. */
+AK_TEST(grid_matches_direct_field) {
+    cyl c;
+    AK_CHECK(cyl_make(&c, 24, 16));
+    const ak_mesh* m = c.mesh;
+    ak_skin_implicit_desc d = {
+        .positions = {m->positions, m->vertex_count},
+        .indices = {m->indices, 3 * m->triangle_count},
+        .joints = {m->joints, m->vertex_count * m->influence_count},
+        .weights = {m->weights, m->vertex_count * m->influence_count},
+        .influence_count = m->influence_count,
+        .joint_count = c.slots,
+        .grid_resolution = UINT32_MAX,
+    };
+    ak_skin_implicit* direct = NULL;
+    AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &direct), AK_OK);
+    ak_mat4 pal[8];
+    cyl_palette(&c, ak_vec3_make(0, 0, 1), 90.0f * PI_F / 180.0f, pal);
+    double worst = 0.0, sum = 0.0, gworst = 0.0;
+    size_t n = 0, far = 0;
+    for (int i = 0; i <= 12; ++i)
+        for (int j = 0; j <= 26; ++j)
+            for (int k = 0; k <= 12; ++k) {
+                ak_vec3 p = ak_vec3_make(-1.2f + 0.15f * (float)i, -0.3f + 0.1f * (float)j, -0.6f + 0.1f * (float)k);
+                ak_vec3 ga, gb;
+                float fa = ak_skin_implicit_field(c.imp, (ak_mat4_cspan){pal, c.slots}, p, &ga);
+                float fb = ak_skin_implicit_field(direct, (ak_mat4_cspan){pal, c.slots}, p, &gb);
+                double e = fabs((double)fa - (double)fb);
+                worst = fmax(worst, e), sum += e, ++n;
+                far += e > 0.05;
+                /* gradient error relative to the field's steepest slope (1 / support radius) */
+                gworst = fmax(gworst, (double)ak_vec3_length(ak_vec3_sub(ga, gb)));
+            }
+    printf("  grid vs direct field: max %.4f mean %.5f (%zu of %zu points off by more than 0.05), gradient max %.3f\n",
+           worst, sum / (double)n, far, n, gworst);
+    /* trilinear interpolation is exact to first order: small on average; larger only in the
+     * cells that straddle a kink of the distance (the capsule bound meets the HRBF) */
+    AK_CHECK(sum / (double)n < 0.002); /* measured 0.0008 */
+    AK_CHECK(far * 100 < n);           /* measured 4 of 4563 */
+    AK_CHECK(worst < 0.3);             /* measured 0.16 */
+    ak_vec3* a = alloc_out(&c);
+    ak_vec3* b = alloc_out(&c);
+    AK_CHECK_EQ(skin_implicit(&c, pal, a, 1), AK_OK);
+    ak_skin_implicit* keep = c.imp;
+    c.imp = direct;
+    AK_CHECK_EQ(skin_implicit(&c, pal, b, 1), AK_OK);
+    c.imp = keep;
+    float dmax = 0.0f;
+    double dsum = 0.0;
+    size_t dfar = 0;
+    for (size_t v = 0; v < m->vertex_count; ++v) {
+        float dd = ak_vec3_length(ak_vec3_sub(a[v], b[v]));
+        dmax = ak_maxf(dmax, dd), dsum += dd, dfar += dd > 0.02f * 0.25f;
+    }
+    printf("  grid vs direct surface at 90 degrees: mean %.5f max %.4f, %zu of %zu vertices off by > 2%% of the "
+           "radius (0.25)\n", dsum / (double)m->vertex_count, (double)dmax, dfar, m->vertex_count);
+    /* measured: mean 0.3% of the radius, 8 of 402 vertices beyond 2%, the worst 27% (a vertex
+     * whose march stops on the other side of a gradient turn in one field and not the other) */
+    AK_CHECK(dsum / (double)m->vertex_count < 0.005 * 0.25);
+    AK_CHECK(dfar * 25 < m->vertex_count);
+    AK_CHECK(dmax < 0.5f * 0.25f);
+    /* resolutions outside 8..128 are refused */
+    ak_skin_implicit* x = NULL;
+    d.grid_resolution = 7;
+    AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &x), AK_ERR_BAD_ARG);
+    d.grid_resolution = 129;
+    AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &x), AK_ERR_BAD_ARG);
+    AK_CHECK(x == NULL);
+    free(a);
+    free(b);
+    ak_skin_implicit_destroy(direct);
+    cyl_free(&c);
+}
+
 AK_TEST(bent_cylinder_methods) {
     /* bends of 120 and 150 degrees: LBS and DQS interpenetrate at the elbow (exact count > 0);
      * the implicit result is measured beside them (volume, crossings) */
@@ -201,10 +277,10 @@ AK_TEST(bent_cylinder_methods) {
                r[2].volume_ratio);
         AK_CHECK(r[0].crossings > 0 && r[1].crossings > 0);
         for (size_t v = 0; v < c.mesh->vertex_count; ++v) AK_CHECK(ak_vec3_is_finite(out[v]));
-        /* measured: -5.5% at 120 and +1.8% at 150 (the issue's target of 3% is not met at 120,
-         * nor zero crossings: the contact sheets of both sides land on one surface): a
-         * regression guard at 7% */
-        AK_CHECK(fabs(r[2].volume_ratio - 1.0) < 0.07);
+        /* the issue's targets: no self-intersecting pair, volume within 3% (kept by the contact
+         * bulge on this closed mesh: measured 1.0001 and 1.0000) */
+        AK_CHECK_EQ(r[2].crossings, 0);
+        AK_CHECK(fabs(r[2].volume_ratio - 1.0) < 0.03);
     }
     free(out);
     cyl_free(&c);
@@ -390,13 +466,110 @@ AK_TEST(cesium_man) {
     ak_scene_destroy(s);
 }
 
+/* CesiumMan's left knee flexed 140 degrees from its bind pose about the axis it turns about
+ * most in the walk (assets via ANIMKIT_ASSETS or ../shared/assets): LBS and DQS interpenetrate
+ * (exact count); the implicit result is measured beside them. Measured 2026-11-28: crossings
+ * LBS 118, DQS 98, implicit 103 (the issue's "none" is not met: the knee's contact plane keeps
+ * the calf off the thigh, 2 pairs left there, but the foot enters the buttock and the thighs
+ * touch, parts without a joint between them), volume (the welded mesh is closed) LBS 0.988,
+ * DQS 0.997, implicit 1.000. */
+AK_TEST(cesium_man_knee_flexed) {
+    const char* roots[3] = {getenv("ANIMKIT_ASSETS"), AK_SOURCE_DIR "/../shared/assets", "../shared/assets"};
+    char path[1024];
+    ak_scene* s = NULL;
+    for (int k = 0; k < 3 && !s; ++k) {
+        if (!roots[k]) continue;
+        snprintf(path, sizeof path, "%s/gltf/CesiumMan/glTF-Binary/CesiumMan.glb", roots[k]);
+        if (ak_io_load(path, NULL, NULL, &s, NULL) != AK_OK) s = NULL;
+    }
+    if (!s) {
+        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
+        return;
+    }
+    const ak_scene_mesh* sm = &s->meshes[0];
+    const ak_mesh* m = sm->mesh;
+    const size_t jc = s->skins[sm->skin].joint_count, nj = ak_scene_joint_count(s), nv = m->vertex_count;
+    const int knee = ak_skeleton_find_joint(s->skeleton, "leg_joint_L_2");
+    AK_CHECK(knee >= 0 && s->clip_count > 0);
+    if (knee < 0 || s->clip_count == 0) {
+        ak_scene_destroy(s);
+        return;
+    }
+    ak_transform* rest = (ak_transform*)malloc(nj * sizeof(ak_transform));
+    ak_transform* local = (ak_transform*)malloc(nj * sizeof(ak_transform));
+    ak_mat4* world = (ak_mat4*)malloc(nj * sizeof(ak_mat4));
+    ak_mat4* pal = (ak_mat4*)malloc(jc * sizeof(ak_mat4));
+    ak_vec3* out = (ak_vec3*)malloc(nv * sizeof(ak_vec3));
+    ak_scene_rest_pose(s, (ak_transform_span){rest, nj});
+    /* the flexion axis: the knee's largest turn from rest over the walk */
+    float best = 0.0f;
+    ak_vec3 axis = ak_vec3_make(1, 0, 0);
+    for (int f = 0; f < 48; ++f) {
+        memcpy(local, rest, nj * sizeof(ak_transform));
+        ak_clip_sample(s->clips[0], (float)f * ak_clip_duration(s->clips[0]) / 48.0f, NULL, (ak_transform_span){local, nj},
+                       (ak_f32_span){0}, (ak_f32_span){0});
+        ak_quat d = ak_quat_mul(ak_quat_conjugate(rest[knee].rotation), local[knee].rotation);
+        float sg = d.w < 0.0f ? -1.0f : 1.0f, w = fminf(1.0f, sg * d.w), ang = 2.0f * acosf(w);
+        if (ang > best) best = ang, axis = ak_vec3_normalize(ak_vec3_make(sg * d.x, sg * d.y, sg * d.z));
+    }
+    memcpy(local, rest, nj * sizeof(ak_transform));
+    local[knee].rotation = ak_quat_mul(rest[knee].rotation, ak_quat_from_axis_angle(axis, 140.0f * PI_F / 180.0f));
+    ak_scene_world_matrices(s, (ak_transform_cspan){local, nj}, (ak_mat4_span){world, nj});
+    ak_scene_skin_palette(s, (size_t)sm->skin, (ak_mat4_cspan){world, nj}, (ak_mat4_span){pal, jc});
+    const ak_u32_cspan ix = {m->indices, 3 * m->triangle_count};
+    const double v0 = ak_volume_compute((ak_vec3_cspan){m->positions, nv}, ix);
+    size_t cross[3] = {0, 0, 0};
+    double vol[3] = {0, 0, 0};
+    for (int meth = 0; meth < 3; ++meth) {
+        if (meth < 2) {
+            unsigned char scratch[1 << 14];
+            ak_skin_job job = {.method = meth ? AK_SKIN_DQS : AK_SKIN_LBS,
+                               .influence_count = m->influence_count,
+                               .palette = {pal, jc},
+                               .positions = {m->positions, nv, 0},
+                               .joints = {m->joints, nv, 0},
+                               .weights = {m->weights, nv, 0},
+                               .scratch = {scratch, sizeof scratch},
+                               .out_positions = {out, nv, 0}};
+            AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+        } else {
+            ak_skin_implicit_desc d = {.positions = {m->positions, nv},
+                                       .indices = ix,
+                                       .joints = {m->joints, nv * m->influence_count},
+                                       .weights = {m->weights, nv * m->influence_count},
+                                       .influence_count = m->influence_count,
+                                       .joint_count = jc};
+            ak_skin_implicit* o = NULL;
+            AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &o), AK_OK);
+            size_t ss = ak_skin_implicit_scratch_size(o, jc);
+            unsigned char* scratch = (unsigned char*)malloc(ss);
+            ak_skin_implicit_job job = {.implicit = o, .palette = {pal, jc}, .thread_count = 2, .scratch = {scratch, ss},
+                                        .out_positions = {out, nv}};
+            AK_CHECK_EQ(ak_skin_implicit_run(&job), AK_OK);
+            free(scratch);
+            ak_skin_implicit_destroy(o);
+        }
+        AK_CHECK_EQ(ak_mesh_self_intersections((ak_vec3_cspan){out, nv}, ix, (ak_u32_span){0}, &cross[meth]), AK_OK);
+        vol[meth] = ak_volume_compute((ak_vec3_cspan){out, nv}, ix) / v0;
+    }
+    printf("  knee 140 degrees (walk's largest turn %.0f): crossings LBS %zu DQS %zu implicit %zu | volume LBS %.4f DQS "
+           "%.4f implicit %.4f\n",
+           (double)best * 57.29578, cross[0], cross[1], cross[2], vol[0], vol[1], vol[2]);
+    AK_CHECK(cross[0] > 0 && cross[1] > 0);
+    AK_CHECK(fabs(vol[2] - 1.0) < 0.03);
+    free(rest), free(local), free(world), free(pal), free(out);
+    ak_scene_destroy(s);
+}
+
 int main(void) {
     AK_RUN(bind_pose_reproduces_the_mesh);
     AK_RUN(field_is_inside_out_and_rigid);
+    AK_RUN(grid_matches_direct_field);
     AK_RUN(bent_cylinder_methods);
     AK_RUN(twist_180_does_not_collapse);
     AK_RUN(threads_give_the_same_bits);
     AK_RUN(cache_round_trip_and_errors);
     AK_RUN_SLOW(cesium_man);
+    AK_RUN_SLOW(cesium_man_knee_flexed);
     return ak_test_finish();
 }

@@ -376,6 +376,14 @@ AK_API const char* ak_skin_simd_name(void);
  * relaxation (towards the one-ring centroid, in the tangent plane) and re-projection.
  * Vertices whose DQS position is already at their iso-value (within 1e-4) keep it, so the
  * bind pose reproduces the mesh exactly. Split vertices (same bind position) move together.
+ * The fields are sampled once into a grid per bone in bone space (distance and gradient,
+ * trilinear per frame: the paper's 3D textures; grid_resolution) behind a per-frame broad
+ * phase of the bones' posed boxes.
+ * Contact at folded joints (pairs of parts sharing a seam): the contact surface is the plane
+ * through the joint bisecting the two parts' posed axes; near it vertices go back to DQS, none
+ * passes it (beyond its rest offset), and the touched region is smoothed; on closed meshes the
+ * skin beside each folded joint then swells along the volume gradient until the enclosed volume
+ * is the rest volume (the bulge on contact). See docs/implicit.md.
  * Multithreaded by vertex ranges with the same result on any thread count. */
 
 typedef struct ak_skin_implicit ak_skin_implicit;
@@ -392,6 +400,12 @@ typedef struct ak_skin_implicit_desc {
     uint32_t thread_count;    /* fitting threads; 0 -> 2; 1 -> calling thread only */
     float bulge;              /* contact bulge strength; 0 -> 0.5; negative -> none (plain
                                  union); at most 10 */
+    uint32_t grid_resolution; /* each part's field is sampled (value and gradient) on a 3D grid
+                                 in bone space with this many nodes along the box's longest
+                                 side, and evaluated per frame by trilinear interpolation (the
+                                 paper's 3D textures); 0 -> 40; 8..128; UINT32_MAX -> no grid:
+                                 the HRBFs evaluated directly (hundreds of times slower; a
+                                 reference for tests) */
 } ak_skin_implicit_desc;
 
 /* The desc with every zero field replaced by its documented default. */

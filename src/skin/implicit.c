@@ -16,20 +16,33 @@
 #include <pthread.h> /* thread_count > 1 */
 
 #include "skin_internal.h"
+#include "../tasks.h"
 
 #define MAX_CAPS 16
 #define STOP_COS 0.57357643635f /* cos 55 degrees: the 2014 paper's discontinuity angle */
 #define ISO_EPS 1e-4f
 #define CAPSULE_AT 12
-#define BONE_FLOATS (CAPSULE_AT + 8) /* cx cy cz s | ax ay az b | r sphere2 valid pad |
-                                        capsule a(3) b(3) radius pad, bind space */
+#define GRID_AT (CAPSULE_AT + 8)
+#define BONE_FLOATS (GRID_AT + 4) /* cx cy cz s | ax ay az b | r sphere2 valid pad |
+                                     capsule a(3) b(3) radius pad | grid origin(3) 1/h, bind space */
+#define GRID_INFO 4                /* per bone: nx ny nz, first node (0 0 0 0: no grid) */
+#define GRID_MAX_NODES (1u << 23)  /* all grids together: 128 MiB at most */
+#define PAIR_FLOATS 16 /* part i, part j, joint centre c(3), unit axes u_i(3) u_j(3) (from c into each
+                          part), reach rho, seam radius, rest normal n(3) = unit(u_i - u_j); bind space */
+#define BULGE_REACH 3.0f /* seam radii around a folded joint that swell to keep the volume */
+#define CONTACT_FOLD 0.5f /* |R_i u_i + R_j u_j| beyond its rest value: about 30 degrees of bend */
+#define CONTACT_SMOOTH 8 /* smoothing rounds of the contact region */
+#define PAIR_FRAME 20 /* per joint and frame: posed centre (3), contact normal (3), folded flag, pad,
+                        inner direction (3), pad, posed axis of part i (3), pad, of part j (3), pad */
 #define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
 
 struct ak_skin_implicit {
     ak_allocator alloc;
     size_t arrays_size; /* bytes of the arrays after the struct (the file's payload) */
-    size_t vertex_count, triangle_count, joint_count, adj_count, sample_capacity;
+    size_t vertex_count, triangle_count, joint_count, adj_count, sample_capacity, grid_nodes, pair_count;
     uint32_t influence_count;
+    uint32_t closed;     /* 1: the welded mesh is closed (every edge in two triangles, opposite ways) */
+    float rest_volume;   /* enclosed volume at the bind pose (closed meshes) */
     float step_cap; /* largest Newton step: half the mean support radius */
     float bulge;    /* contact bulge strength (0: plain union) */
     ak_vec3* positions;
@@ -44,15 +57,30 @@ struct ak_skin_implicit {
     uint32_t* sample_start; /* [joint_count + 1] */
     float* samples;         /* [sample_capacity * SAMPLE_FLOATS] */
     float* bones;           /* [joint_count * BONE_FLOATS] */
+    float* pairs;           /* [pair_count * PAIR_FLOATS]: parts that share a seam (a joint) */
+    uint32_t* grid_info;    /* [joint_count * GRID_INFO] */
+    float* grid;            /* [grid_nodes * 4]: HRBF distance d and grad d (bind space) per node;
+                               the last array */
 };
 
 static size_t align64(size_t n) { return (n + 63u) & ~(size_t)63u; }
+
+static inline unsigned ctz64(uint64_t v) {
+#if defined(__GNUC__) || defined(__clang__)
+    return (unsigned)__builtin_ctzll(v);
+#else
+    unsigned n = 0;
+    while (!(v & 1u)) v >>= 1, ++n;
+    return n;
+#endif
+}
 
 /* ---- object memory ----------------------------------------------------------------------- */
 
 typedef struct implicit_counts {
     size_t vertex_count, triangle_count, joint_count, adj_count, sample_capacity;
     uint32_t influence_count;
+    size_t grid_nodes, pair_count;
 } implicit_counts;
 
 static bool add_bytes(size_t* total, size_t count, size_t elem) {
@@ -77,7 +105,8 @@ static ak_skin_implicit* object_alloc(const implicit_counts* c, const ak_allocat
               add_bytes(&total, nv, 4) && add_bytes(&total, nv, 4) && add_bytes(&total, nv + 1, 4) &&
               add_bytes(&total, c->adj_count, 4) && add_bytes(&total, c->joint_count + 1, 4) &&
               add_bytes(&total, c->sample_capacity, SAMPLE_FLOATS * 4) &&
-              add_bytes(&total, c->joint_count, BONE_FLOATS * 4);
+              add_bytes(&total, c->joint_count, BONE_FLOATS * 4) && add_bytes(&total, c->pair_count, PAIR_FLOATS * 4) &&
+              add_bytes(&total, c->joint_count, GRID_INFO * 4) && add_bytes(&total, c->grid_nodes, 16);
     if (!ok) return NULL;
     unsigned char* mem = (unsigned char*)akp_alloc(alloc, total);
     if (!mem) return NULL;
@@ -86,6 +115,7 @@ static ak_skin_implicit* object_alloc(const implicit_counts* c, const ak_allocat
     if (alloc) o->alloc = *alloc;
     o->vertex_count = nv, o->triangle_count = c->triangle_count, o->joint_count = c->joint_count;
     o->adj_count = c->adj_count, o->sample_capacity = c->sample_capacity, o->influence_count = c->influence_count;
+    o->grid_nodes = c->grid_nodes, o->pair_count = c->pair_count;
     o->arrays_size = total - akp_align16(sizeof(ak_skin_implicit));
     unsigned char* cur = mem + akp_align16(sizeof(ak_skin_implicit));
     o->positions = (ak_vec3*)take(&cur, nv, sizeof(ak_vec3));
@@ -100,6 +130,9 @@ static ak_skin_implicit* object_alloc(const implicit_counts* c, const ak_allocat
     o->sample_start = (uint32_t*)take(&cur, c->joint_count + 1, 4);
     o->samples = (float*)take(&cur, c->sample_capacity, SAMPLE_FLOATS * 4);
     o->bones = (float*)take(&cur, c->joint_count, BONE_FLOATS * 4);
+    o->pairs = (float*)take(&cur, c->pair_count, PAIR_FLOATS * 4);
+    o->grid_info = (uint32_t*)take(&cur, c->joint_count, GRID_INFO * 4);
+    o->grid = (float*)take(&cur, c->grid_nodes, 16);
     return o;
 }
 
@@ -147,14 +180,11 @@ static bool bone_distance(const ak_skin_implicit* o, size_t b, ak_vec3 y, float*
     return true;
 }
 
-/* Compact-support reparameterisation: t(u) = 1/2 - 15/16 (u - 2u^3/3 + u^5/5), u = d / r. */
-static float bone_field(const ak_skin_implicit* o, size_t b, ak_vec3 y, ak_vec3* out_g) {
-    float d;
-    ak_vec3 g;
-    *out_g = ak_vec3_zero();
-    if (!bone_distance(o, b, y, &d, &g)) return 0.0f;
-    const float r = o->bones[b * BONE_FLOATS + 8];
+/* Compact-support reparameterisation: t(u) = 1/2 - 15/16 (u - 2u^3/3 + u^5/5), u = d / r, of
+ * distance d with gradient g (support radius r); the field's gradient to *out_g. */
+static inline float compact(float r, float d, ak_vec3 g, ak_vec3* out_g) {
     float u = d / r;
+    *out_g = ak_vec3_zero();
     if (!(u < 1.0f)) return 0.0f;
     if (u <= -1.0f) return 1.0f;
     float u2 = u * u;
@@ -164,48 +194,128 @@ static float bone_field(const ak_skin_implicit* o, size_t b, ak_vec3 y, ak_vec3*
     return t;
 }
 
+/* Distance of bone b at bind-space point y and its gradient, from the bone's grid when the
+ * object has grids (trilinear interpolation of the stored HRBF distance and gradient: the
+ * paper's 3D textures), else directly; false outside the grid's box or the bounding sphere
+ * (the field is 0 there). */
+static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, float* out_d, ak_vec3* out_g) {
+    if (o->grid_nodes == 0) return bone_distance(o, b, y, out_d, out_g);
+    const uint32_t* I = o->grid_info + b * GRID_INFO;
+    const float* B = o->bones + b * BONE_FLOATS + GRID_AT;
+    const uint32_t nx = I[0], ny = I[1], nz = I[2];
+    float px = (y.x - B[0]) * B[3], py = (y.y - B[1]) * B[3], pz = (y.z - B[2]) * B[3];
+    if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= (float)(nx - 1) && py <= (float)(ny - 1) &&
+          pz <= (float)(nz - 1)) || nx < 2)
+        return false;
+    uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
+    if (ix > nx - 2) ix = nx - 2;
+    if (iy > ny - 2) iy = ny - 2;
+    if (iz > nz - 2) iz = nz - 2;
+    const float tx = px - (float)ix, ty = py - (float)iy, tz = pz - (float)iz;
+    const size_t sy = nx, sz = (size_t)nx * ny;
+    const float* n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * sy + iz * sz);
+    const float* n010 = n000 + 4 * sy;
+    const float* n001 = n000 + 4 * sz;
+    const float* n011 = n001 + 4 * sy;
+    float r[4];
+    for (int k = 0; k < 4; ++k) {
+        float a = n000[k] + tx * (n000[4 + k] - n000[k]);
+        float bq = n010[k] + tx * (n010[4 + k] - n010[k]);
+        float cq = n001[k] + tx * (n001[4 + k] - n001[k]);
+        float dq = n011[k] + tx * (n011[4 + k] - n011[k]);
+        float e = a + ty * (bq - a), f = cq + ty * (dq - cq);
+        r[k] = e + tz * (f - e);
+    }
+    *out_d = r[0];
+    *out_g = ak_vec3_make(r[1], r[2], r[3]);
+    return true;
+}
+
+/* The compact-support field of bone b from bone_distance_fast. */
+static float bone_field_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, ak_vec3* out_g) {
+    float d;
+    ak_vec3 g;
+    *out_g = ak_vec3_zero();
+    if (!bone_distance_fast(o, b, y, &d, &g)) return 0.0f;
+    return compact(o->bones[b * BONE_FLOATS + 8], d, g, out_g);
+}
+
+/* Per-frame broad phase: a coarse grid over the posed boxes of the bones' fields, one bit per
+ * bone per cell (set when the bone's posed box overlaps the cell); a point outside every box
+ * has field 0. */
+typedef struct broad_phase {
+    float lo[3], inv_cell[3];
+    uint32_t cells; /* per axis */
+    size_t words;   /* 64-bit words per cell */
+    uint64_t* mask; /* [cells^3 * words] */
+    bool empty;
+} broad_phase;
+
 /* Per-joint inverse transforms for one run: 12 floats (3x3 linear part column-major, then the
  * translation); identity when xf is NULL. */
 typedef struct field_ctx {
     const ak_skin_implicit* o;
     const float* inv; /* [joint_count * 12] or NULL (bind pose) */
     float bulge;
+    const broad_phase* bp; /* optional: skips bones whose box does not hold the point */
 } field_ctx;
+
+typedef struct field_acc {
+    float f1, f2;
+    ak_vec3 g1, g2;
+} field_acc;
+
+static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc* a) {
+    const ak_skin_implicit* o = c->o;
+    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return;
+    ak_vec3 y = x;
+    const float* m = c->inv ? c->inv + 12 * b : NULL;
+    if (m)
+        y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
+                         m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
+    ak_vec3 gy;
+    float f = bone_field_fast(o, b, y, &gy);
+    if (f <= 0.0f) return;
+    /* gradient in posed space: (M^-1)^T gy */
+    ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
+                                 m[6] * gy.x + m[7] * gy.y + m[8] * gy.z)
+                  : gy;
+    if (f > a->f1) {
+        a->f2 = a->f1, a->g2 = a->g1;
+        a->f1 = f, a->g1 = g;
+    } else if (f > a->f2) {
+        a->f2 = f, a->g2 = g;
+    }
+}
 
 static float field_eval(const field_ctx* c, ak_vec3 x, ak_vec3* out_g) {
     const ak_skin_implicit* o = c->o;
-    float f1 = 0.0f, f2 = 0.0f;
-    ak_vec3 g1 = ak_vec3_zero(), g2 = ak_vec3_zero();
-    for (size_t b = 0; b < o->joint_count; ++b) {
-        if (o->bones[b * BONE_FLOATS + 10] == 0.0f) continue;
-        ak_vec3 y = x;
-        const float* m = c->inv ? c->inv + 12 * b : NULL;
-        if (m)
-            y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
-                             m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
-        ak_vec3 gy;
-        float f = bone_field(o, b, y, &gy);
-        if (f <= 0.0f) continue;
-        /* gradient in posed space: (M^-1)^T gy */
-        ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
-                                     m[6] * gy.x + m[7] * gy.y + m[8] * gy.z)
-                      : gy;
-        if (f > f1) {
-            f2 = f1, g2 = g1;
-            f1 = f, g1 = g;
-        } else if (f > f2) {
-            f2 = f, g2 = g;
+    field_acc a = {0.0f, 0.0f, ak_vec3_zero(), ak_vec3_zero()};
+    const broad_phase* bp = c->bp;
+    if (bp) {
+        float p[3] = {(x.x - bp->lo[0]) * bp->inv_cell[0], (x.y - bp->lo[1]) * bp->inv_cell[1],
+                      (x.z - bp->lo[2]) * bp->inv_cell[2]};
+        const float top = (float)bp->cells;
+        if (bp->empty || !(p[0] >= 0.0f && p[1] >= 0.0f && p[2] >= 0.0f && p[0] < top && p[1] < top && p[2] < top)) {
+            *out_g = ak_vec3_zero();
+            return 0.0f;
         }
+        size_t cell = (size_t)p[0] + bp->cells * ((size_t)p[1] + bp->cells * (size_t)p[2]);
+        const uint64_t* mw = bp->mask + cell * bp->words;
+        for (size_t w = 0; w < bp->words; ++w)
+            for (uint64_t bits = mw[w]; bits; bits &= bits - 1) field_add(c, 64 * w + (size_t)ctz64(bits), x, &a);
+    } else {
+        for (size_t b = 0; b < o->joint_count; ++b) field_add(c, b, x, &a);
     }
-    float F = f1;
-    ak_vec3 G = g1;
-    if (c->bulge > 0.0f && f2 > 0.0f) {
-        float l1 = ak_vec3_length(g1), l2 = ak_vec3_length(g2);
+    float F = a.f1;
+    ak_vec3 G = a.g1;
+    if (c->bulge > 0.0f && a.f2 > 0.0f) {
+        float l1 = ak_vec3_length(a.g1), l2 = ak_vec3_length(a.g2);
         if (l1 > 0.0f && l2 > 0.0f) {
-            float w = -ak_vec3_dot(g1, g2) / (l1 * l2);
+            float w = -ak_vec3_dot(a.g1, a.g2) / (l1 * l2);
             if (w > 0.0f) {
-                F += c->bulge * w * f2 * f2;
-                G = ak_vec3_add(G, ak_vec3_scale(g2, 2.0f * c->bulge * w * f2));
+                F += c->bulge * w * a.f2 * a.f2;
+                G = ak_vec3_add(G, ak_vec3_scale(a.g2, 2.0f * c->bulge * w * a.f2));
             }
         }
     }
@@ -222,6 +332,7 @@ ak_skin_implicit_desc ak_skin_implicit_desc_resolved(const ak_skin_implicit_desc
     if (d.support_scale == 0.0f) d.support_scale = 0.5f;
     if (d.thread_count == 0) d.thread_count = 2;
     if (d.bulge == 0.0f) d.bulge = 0.5f;
+    if (d.grid_resolution == 0) d.grid_resolution = 40;
     return d;
 }
 
@@ -229,7 +340,7 @@ uint64_t ak_skin_implicit_key(const ak_skin_implicit_desc* desc) {
     if (!desc) return 0;
     ak_skin_implicit_desc d = ak_skin_implicit_desc_resolved(desc);
     uint64_t h = 0xcbf29ce484222325ull;
-    h = akp_fnv1a(h, "AKIS1", 5);
+    h = akp_fnv1a(h, "AKIS2", 5);
     if (d.positions.ptr) h = akp_fnv1a(h, d.positions.ptr, d.positions.count * sizeof(ak_vec3));
     if (d.indices.ptr) h = akp_fnv1a(h, d.indices.ptr, d.indices.count * sizeof(uint32_t));
     if (d.joints.ptr) h = akp_fnv1a(h, d.joints.ptr, d.joints.count * sizeof(uint16_t));
@@ -240,6 +351,7 @@ uint64_t ak_skin_implicit_key(const ak_skin_implicit_desc* desc) {
     h = akp_fnv1a(h, &d.samples_per_bone, sizeof d.samples_per_bone);
     h = akp_fnv1a(h, &d.support_scale, sizeof d.support_scale);
     h = akp_fnv1a(h, &d.bulge, sizeof d.bulge);
+    h = akp_fnv1a(h, &d.grid_resolution, sizeof d.grid_resolution);
     return h;
 }
 
@@ -535,6 +647,113 @@ static void* fit_worker(void* arg) {
     return NULL;
 }
 
+/* The grid of bone b: its capsule's box grown by the capsule radius plus the support radius
+ * (the field is 0 on and beyond its faces), clipped to the bone's bounding sphere; nodes every
+ * h along each axis, res along the longest side. False when the bone has no field. */
+static bool grid_box(const ak_skin_implicit* o, size_t b, uint32_t res, float lo[3], float* out_h, uint32_t n[3]) {
+    const float* B = o->bones + b * BONE_FLOATS;
+    if (B[10] == 0.0f) return false;
+    const float* K = B + CAPSULE_AT;
+    const float ext = K[6] + B[8], R = sqrtf(B[9]) * B[3];
+    float hi[3], side = 0.0f;
+    for (int q = 0; q < 3; ++q) {
+        lo[q] = fmaxf(fminf(K[q], K[3 + q]) - ext, B[q] - R);
+        hi[q] = fminf(fmaxf(K[q], K[3 + q]) + ext, B[q] + R);
+        if (!(hi[q] > lo[q])) return false;
+        side = fmaxf(side, hi[q] - lo[q]);
+    }
+    const float h = side / (float)(res - 1);
+    if (!(h > 0.0f) || !ak_finitef(h)) return false;
+    for (int q = 0; q < 3; ++q) {
+        float c = ceilf((hi[q] - lo[q]) / h - 1e-3f);
+        n[q] = (uint32_t)fmaxf(c, 1.0f) + 1u;
+        if (n[q] > res + 1) n[q] = res + 1;
+    }
+    *out_h = h;
+    return true;
+}
+
+typedef struct grid_task {
+    ak_skin_implicit* o;
+    uint32_t index, count;
+} grid_task;
+
+/* Task t fills the z-slices z = t, t + count, ... of every grid with the direct field. */
+static void* grid_fill(void* arg) {
+    const grid_task* t = (const grid_task*)arg;
+    ak_skin_implicit* o = t->o;
+    for (size_t b = 0; b < o->joint_count; ++b) {
+        const uint32_t* I = o->grid_info + b * GRID_INFO;
+        if (I[0] < 2) continue;
+        const float* G = o->bones + b * BONE_FLOATS + GRID_AT;
+        const float h = 1.0f / G[3];
+        for (uint32_t z = t->index; z < I[2]; z += t->count)
+            for (uint32_t y = 0; y < I[1]; ++y)
+                for (uint32_t x = 0; x < I[0]; ++x) {
+                    ak_vec3 p = ak_vec3_make(G[0] + (float)x * h, G[1] + (float)y * h, G[2] + (float)z * h), g;
+                    float dist;
+                    if (!bone_distance(o, b, p, &dist, &g)) /* outside the sphere: no field */
+                        dist = o->bones[b * BONE_FLOATS + 8], g = ak_vec3_zero();
+                    float* N = o->grid + 4 * ((size_t)I[3] + x + (size_t)I[0] * (y + (size_t)I[1] * z));
+                    N[0] = dist, N[1] = g.x, N[2] = g.y, N[3] = g.z;
+                }
+    }
+    return NULL;
+}
+
+/* Each joint (pair of parts sharing a seam): its centre (the mean of the seam's edge ends),
+ * seam radius, each part's unit axis from the centre to the part's centroid, the rest normal of
+ * the contact plane and the reach rho (3 seam radii) of the contact there. A pair whose parts
+ * have no field is left inert (rho 0). */
+static void fill_pairs(ak_skin_implicit* o) {
+    for (size_t p = 0; p < o->pair_count; ++p) {
+        float* P = o->pairs + p * PAIR_FLOATS;
+        const uint32_t i = (uint32_t)P[0], j = (uint32_t)P[1];
+        memset(P + 2, 0, (PAIR_FLOATS - 2) * sizeof(float));
+        const float* Bi = o->bones + (size_t)i * BONE_FLOATS;
+        const float* Bj = o->bones + (size_t)j * BONE_FLOATS;
+        if (Bi[10] == 0.0f || Bj[10] == 0.0f) continue;
+        double c[3] = {0, 0, 0};
+        size_t n = 0;
+        for (size_t v = 0; v < o->vertex_count; ++v) {
+            if (o->rep[v] != v || (o->part[v] != i && o->part[v] != j)) continue;
+            for (uint32_t e = o->adj_start[v]; e < o->adj_start[v + 1]; ++e) {
+                uint32_t w = o->adj[e];
+                if (o->part[w] == o->part[v] || (o->part[w] != i && o->part[w] != j)) continue;
+                c[0] += o->positions[v].x, c[1] += o->positions[v].y, c[2] += o->positions[v].z, ++n;
+                break;
+            }
+        }
+        if (n == 0) continue;
+        for (int q = 0; q < 3; ++q) c[q] /= (double)n;
+        double hr = 0.0;
+        for (size_t v = 0; v < o->vertex_count; ++v) {
+            if (o->rep[v] != v || (o->part[v] != i && o->part[v] != j)) continue;
+            for (uint32_t e = o->adj_start[v]; e < o->adj_start[v + 1]; ++e) {
+                uint32_t w = o->adj[e];
+                if (o->part[w] == o->part[v] || (o->part[w] != i && o->part[w] != j)) continue;
+                ak_vec3 q = o->positions[v];
+                hr += sqrt((q.x - c[0]) * (q.x - c[0]) + (q.y - c[1]) * (q.y - c[1]) + (q.z - c[2]) * (q.z - c[2]));
+                break;
+            }
+        }
+        hr /= (double)n;
+        ak_vec3 cc = ak_vec3_make((float)c[0], (float)c[1], (float)c[2]);
+        ak_vec3 ui = ak_vec3_sub(ak_vec3_make(Bi[0], Bi[1], Bi[2]), cc), uj = ak_vec3_sub(ak_vec3_make(Bj[0], Bj[1], Bj[2]), cc);
+        float li = ak_vec3_length(ui), lj = ak_vec3_length(uj);
+        if (!(li > 1e-6f * (float)hr) || !(lj > 1e-6f * (float)hr) || !(hr > 0.0)) continue;
+        ui = ak_vec3_scale(ui, 1.0f / li), uj = ak_vec3_scale(uj, 1.0f / lj);
+        ak_vec3 nr = ak_vec3_sub(ui, uj);
+        float ln = ak_vec3_length(nr);
+        if (!(ln > 1e-3f)) continue; /* both parts on one side of their seam: no hinge */
+        nr = ak_vec3_scale(nr, 1.0f / ln);
+        P[2] = cc.x, P[3] = cc.y, P[4] = cc.z;
+        P[5] = ui.x, P[6] = ui.y, P[7] = ui.z, P[8] = uj.x, P[9] = uj.y, P[10] = uj.z;
+        P[11] = (float)(10.0 * hr), P[12] = (float)hr;
+        P[13] = nr.x, P[14] = nr.y, P[15] = nr.z;
+    }
+}
+
 static int cmp_u64_implicit(const void* a, const void* b) {
     uint64_t x = *(const uint64_t*)a, y = *(const uint64_t*)b;
     return (x > y) - (x < y);
@@ -545,7 +764,9 @@ static ak_result check_desc(const ak_skin_implicit_desc* d) {
     if (d->positions.count == 0 || d->indices.count == 0) return AK_ERR_EMPTY;
     if (d->influence_count == 0 || d->influence_count > AK_MAX_INFLUENCES || d->indices.count % 3 ||
         d->samples_per_bone < 8 || d->samples_per_bone > 256 || !(d->support_scale > 0.0f) ||
-        !(d->support_scale <= 100.0f) || !(d->bulge <= 10.0f) || d->joint_count == 0 || d->joint_count > 65535 || d->thread_count > 64)
+        !(d->support_scale <= 100.0f) || !(d->bulge <= 10.0f) ||
+        (d->grid_resolution != UINT32_MAX && (d->grid_resolution < 8 || d->grid_resolution > 128)) ||
+        d->joint_count == 0 || d->joint_count > 65535 || d->thread_count > 64)
         return AK_ERR_BAD_ARG;
     const size_t nv = d->positions.count;
     if (nv > (1u << 24) || d->indices.count / 3 > (1u << 26)) return AK_ERR_BUDGET;
@@ -599,7 +820,7 @@ ak_result ak_skin_implicit_create(const ak_skin_implicit_desc* desc, const ak_al
     for (size_t i = 0; i < ne; ++i)
         if (uniq == 0 || edges[i] != edges[uniq - 1]) edges[uniq++] = edges[i];
     /* parts: dominant joint per vertex (first of the largest weights) */
-    implicit_counts cnt = {nv, nt, jc, uniq, 0, (uint32_t)k};
+    implicit_counts cnt = {nv, nt, jc, uniq, 0, (uint32_t)k, 0, 0};
     /* count vertices per part to size the sample pool */
     uint16_t* parts = (uint16_t*)malloc(nv * sizeof(uint16_t));
     if (!parts) {
@@ -622,12 +843,62 @@ ak_result ak_skin_implicit_create(const ak_skin_implicit_desc* desc, const ak_al
         if (part_start[b + 1] >= 4) cnt.sample_capacity += d.samples_per_bone;
         part_start[b + 1] += part_start[b];
     }
-    o = object_alloc(&cnt, alloc);
-    if (!o) {
-        free(parts);
+    /* joints: pairs of parts that share an edge (keys part_i << 16 | part_j, i < j), and whether
+     * the welded mesh is closed (each directed edge once, its reverse present) */
+    uint64_t* pair_keys = (uint64_t*)malloc((uniq + 1) * sizeof(uint64_t));
+    uint64_t* dir = (uint64_t*)malloc((3 * nt + 1) * sizeof(uint64_t));
+    if (!pair_keys || !dir) {
+        free(parts), free(pair_keys), free(dir);
         r = AK_ERR_NO_MEMORY;
         goto fail;
     }
+    for (size_t i = 0; i < uniq; ++i) {
+        uint32_t pa = parts[edges[i] >> 32], pb = parts[(uint32_t)edges[i]];
+        if (pa < pb) pair_keys[cnt.pair_count++] = ((uint64_t)pa << 16) | pb;
+    }
+    qsort(pair_keys, cnt.pair_count, sizeof(uint64_t), cmp_u64_implicit);
+    {
+        size_t u = 0;
+        for (size_t i = 0; i < cnt.pair_count; ++i)
+            if (u == 0 || pair_keys[i] != pair_keys[u - 1]) pair_keys[u++] = pair_keys[i];
+        cnt.pair_count = u;
+    }
+    bool closed = true;
+    {
+        size_t nd = 0;
+        for (size_t t = 0; t < nt; ++t)
+            for (int e = 0; e < 3; ++e) {
+                uint32_t a = wscratch[d.indices.ptr[3 * t + (size_t)e]];
+                uint32_t b = wscratch[d.indices.ptr[3 * t + (size_t)((e + 1) % 3)]];
+                if (a == b) closed = false;
+                dir[nd++] = ((uint64_t)a << 32) | b;
+            }
+        qsort(dir, nd, sizeof(uint64_t), cmp_u64_implicit);
+        for (size_t i = 0; closed && i < nd; ++i) {
+            if (i > 0 && dir[i] == dir[i - 1]) closed = false;
+            uint64_t rev = (dir[i] << 32) | (dir[i] >> 32);
+            size_t lo = 0, hi = nd;
+            while (lo < hi) {
+                size_t mid = (lo + hi) / 2;
+                if (dir[mid] < rev) lo = mid + 1;
+                else hi = mid;
+            }
+            if (lo == nd || dir[lo] != rev) closed = false;
+        }
+    }
+    free(dir);
+    o = object_alloc(&cnt, alloc);
+    if (!o) {
+        free(parts), free(pair_keys);
+        r = AK_ERR_NO_MEMORY;
+        goto fail;
+    }
+    o->closed = closed ? 1u : 0u;
+    for (size_t i = 0; i < cnt.pair_count; ++i) {
+        o->pairs[i * PAIR_FLOATS] = (float)(pair_keys[i] >> 16);
+        o->pairs[i * PAIR_FLOATS + 1] = (float)(pair_keys[i] & 0xffffu);
+    }
+    free(pair_keys);
     memcpy(o->positions, d.positions.ptr, nv * sizeof(ak_vec3));
     memcpy(o->indices, d.indices.ptr, 3 * nt * sizeof(uint32_t));
     memcpy(o->joints, d.joints.ptr, nv * k * sizeof(uint16_t));
@@ -671,6 +942,52 @@ ak_result ak_skin_implicit_create(const ak_skin_implicit_desc* desc, const ak_al
             goto fail;
         }
     }
+    fill_pairs(o);
+    if (o->closed)
+        o->rest_volume = (float)ak_volume_compute((ak_vec3_cspan){o->positions, nv}, (ak_u32_cspan){o->indices, 3 * nt});
+    if (!(o->rest_volume > 0.0f) || !ak_finitef(o->rest_volume)) o->closed = 0, o->rest_volume = 0.0f;
+    if (d.grid_resolution != UINT32_MAX) {
+        /* sample every part's field on its grid: a second object with the grids appended (the
+         * arrays before them keep their layout, so one copy moves them) */
+        cnt.grid_nodes = 0;
+        for (size_t b = 0; b < jc; ++b) {
+            float lo[3], h;
+            uint32_t n[3];
+            if (!grid_box(o, b, d.grid_resolution, lo, &h, n)) continue;
+            cnt.grid_nodes += (size_t)n[0] * n[1] * n[2];
+            if (cnt.grid_nodes > GRID_MAX_NODES) {
+                r = AK_ERR_BUDGET;
+                goto fail;
+            }
+        }
+        ak_skin_implicit* g = cnt.grid_nodes ? object_alloc(&cnt, alloc) : NULL;
+        if (cnt.grid_nodes && !g) {
+            r = AK_ERR_NO_MEMORY;
+            goto fail;
+        }
+        if (g) {
+            memcpy((unsigned char*)g + akp_align16(sizeof(ak_skin_implicit)),
+                   (const unsigned char*)o + akp_align16(sizeof(ak_skin_implicit)), o->arrays_size);
+            g->closed = o->closed, g->rest_volume = o->rest_volume;
+            akp_free(alloc, o);
+            o = g;
+            size_t first = 0;
+            for (size_t b = 0; b < jc; ++b) {
+                float lo[3], h;
+                uint32_t n[3];
+                if (!grid_box(o, b, d.grid_resolution, lo, &h, n)) continue;
+                uint32_t* I = o->grid_info + b * GRID_INFO;
+                I[0] = n[0], I[1] = n[1], I[2] = n[2], I[3] = (uint32_t)first;
+                float* G = o->bones + b * BONE_FLOATS + GRID_AT;
+                G[0] = lo[0], G[1] = lo[1], G[2] = lo[2], G[3] = 1.0f / h;
+                first += (size_t)n[0] * n[1] * n[2];
+            }
+            grid_task tasks[64];
+            uint32_t th = d.thread_count > 1 ? d.thread_count : 1;
+            for (uint32_t t = 0; t < th; ++t) tasks[t] = (grid_task){o, t, th};
+            akp_run_tasks(grid_fill, tasks, sizeof tasks[0], th);
+        }
+    }
     {
         double rsum = 0.0;
         size_t rn = 0;
@@ -678,7 +995,7 @@ ak_result ak_skin_implicit_create(const ak_skin_implicit_desc* desc, const ak_al
             if (o->bones[b * BONE_FLOATS + 10] != 0.0f) rsum += o->bones[b * BONE_FLOATS + 8], ++rn;
         o->step_cap = rn ? (float)(0.5 * rsum / (double)rn) : 0.0f;
         o->bulge = d.bulge > 0.0f ? d.bulge : 0.0f;
-        field_ctx fc = {o, NULL, o->bulge};
+        field_ctx fc = {o, NULL, o->bulge, NULL};
         for (size_t v = 0; v < nv; ++v) {
             ak_vec3 g;
             o->iso[v] = o->rep[v] == v ? field_eval(&fc, o->positions[v], &g) : o->iso[o->rep[v]];
@@ -753,7 +1070,7 @@ float ak_skin_implicit_field(const ak_skin_implicit* implicit, ak_mat4_cspan pal
             ok = inv && palette.count >= implicit->joint_count && invert_palette(implicit, palette.ptr, inv);
         }
         if (ok) {
-            field_ctx fc = {implicit, inv, implicit->bulge};
+            field_ctx fc = {implicit, inv, implicit->bulge, NULL};
             f = field_eval(&fc, x, &g);
         }
         if (inv && inv != stack_inv) free(inv);
@@ -763,10 +1080,11 @@ float ak_skin_implicit_field(const ak_skin_implicit* implicit, ak_mat4_cspan pal
 }
 
 /* ---- cache file ------------------------------------------------------------------------------
- * "AKIS", u32 version 1, u64 key, u64 counts x5 (vertices, triangles, joints, adjacency,
- * sample capacity), u32 influence count, f32 step cap, f32 bulge, u32 zero, then the arrays
+ * "AKIS", u32 version 2, u64 key, u64 counts x5 (vertices, triangles, joints, adjacency,
+ * sample capacity), u32 influence count, f32 step cap, f32 bulge, u32 zero, u64 grid nodes,
+ * u64 joint pairs, u32 closed, f32 rest volume, then the arrays
  * exactly as the object holds them (little-endian hosts only: others refuse to read/write). */
-#define FILE_HEADER 72
+#define FILE_HEADER 96
 
 static bool host_little_endian(void) {
     const uint32_t one = 1;
@@ -786,13 +1104,16 @@ ak_result ak_skin_implicit_write_file(const ak_skin_implicit* implicit, uint64_t
     if (!host_little_endian()) return AK_ERR_UNSUPPORTED;
     unsigned char h[FILE_HEADER] = {0};
     memcpy(h, "AKIS", 4);
-    akp_put_u32(h + 4, 1);
+    akp_put_u32(h + 4, 2);
     put_u64(h + 8, key);
     put_u64(h + 16, implicit->vertex_count), put_u64(h + 24, implicit->triangle_count);
     put_u64(h + 32, implicit->joint_count), put_u64(h + 40, implicit->adj_count);
     put_u64(h + 48, implicit->sample_capacity);
     akp_put_u32(h + 56, implicit->influence_count);
     akp_put_f32(h + 60, implicit->step_cap), akp_put_f32(h + 64, implicit->bulge);
+    put_u64(h + 72, implicit->grid_nodes);
+    put_u64(h + 80, implicit->pair_count);
+    akp_put_u32(h + 88, implicit->closed), akp_put_f32(h + 92, implicit->rest_volume);
     ak_atomic_file f;
     if (ak_atomic_file_open(&f, path) != AK_OK) return AK_ERR_IO;
     const unsigned char* arrays = (const unsigned char*)implicit + akp_align16(sizeof(ak_skin_implicit));
@@ -805,6 +1126,25 @@ ak_result ak_skin_implicit_write_file(const ak_skin_implicit* implicit, uint64_t
     return ak_atomic_file_commit(&f);
 }
 
+/* Whether the file holds at least the arrays the counts imply after the header (so that a
+ * forged header cannot make the reader allocate more than the file's size). */
+static bool file_holds(FILE* f, long header, const implicit_counts* c) {
+    size_t need = akp_align16(sizeof(ak_skin_implicit));
+    size_t nv = c->vertex_count, k = c->influence_count;
+    bool ok = add_bytes(&need, nv, sizeof(ak_vec3)) && add_bytes(&need, 3 * c->triangle_count, 4) &&
+              add_bytes(&need, nv * k, 2) && add_bytes(&need, nv * k, 4) && add_bytes(&need, nv, 2) &&
+              add_bytes(&need, nv, 4) && add_bytes(&need, nv, 4) && add_bytes(&need, nv + 1, 4) &&
+              add_bytes(&need, c->adj_count, 4) && add_bytes(&need, c->joint_count + 1, 4) &&
+              add_bytes(&need, c->sample_capacity, SAMPLE_FLOATS * 4) &&
+              add_bytes(&need, c->joint_count, BONE_FLOATS * 4) && add_bytes(&need, c->pair_count, PAIR_FLOATS * 4) &&
+              add_bytes(&need, c->joint_count, GRID_INFO * 4) &&
+              add_bytes(&need, c->grid_nodes, 16);
+    if (!ok || fseek(f, 0, SEEK_END) != 0) return false;
+    long end = ftell(f);
+    if (end < 0 || fseek(f, header, SEEK_SET) != 0) return false;
+    return (size_t)end - (size_t)header >= need - akp_align16(sizeof(ak_skin_implicit));
+}
+
 ak_result ak_skin_implicit_read_file(const char* path, uint64_t key, const ak_allocator* alloc,
                                      ak_skin_implicit** out_implicit) {
     if (out_implicit) *out_implicit = NULL;
@@ -815,23 +1155,28 @@ ak_result ak_skin_implicit_read_file(const char* path, uint64_t key, const ak_al
     unsigned char h[FILE_HEADER];
     ak_result r = AK_OK;
     ak_skin_implicit* o = NULL;
-    if (fread(h, 1, FILE_HEADER, f) != FILE_HEADER || memcmp(h, "AKIS", 4) != 0 || akp_get_u32(h + 4) != 1) {
+    if (fread(h, 1, FILE_HEADER, f) != FILE_HEADER || memcmp(h, "AKIS", 4) != 0 || akp_get_u32(h + 4) != 2) {
         r = AK_ERR_PARSE;
     } else if (get_u64(h + 8) != key) {
         r = AK_ERR_NOT_FOUND;
     } else {
         implicit_counts c = {get_u64(h + 16), get_u64(h + 24), get_u64(h + 32), get_u64(h + 40), get_u64(h + 48),
-                             akp_get_u32(h + 56)};
+                             akp_get_u32(h + 56), get_u64(h + 72), get_u64(h + 80)};
         if (c.vertex_count == 0 || c.vertex_count > (1u << 24) || c.triangle_count > (1u << 26) ||
             c.joint_count == 0 || c.joint_count > 65535 || c.adj_count > 6 * c.triangle_count ||
             c.sample_capacity > 256 * c.joint_count || c.influence_count == 0 ||
-            c.influence_count > AK_MAX_INFLUENCES) {
+            c.influence_count > AK_MAX_INFLUENCES || c.grid_nodes > GRID_MAX_NODES ||
+            c.pair_count > c.adj_count) {
             r = AK_ERR_PARSE;
+        } else if (!file_holds(f, FILE_HEADER, &c)) {
+            r = AK_ERR_PARSE; /* shorter than its counts say: refused before allocating */
         } else if (!(o = object_alloc(&c, alloc))) {
             r = AK_ERR_NO_MEMORY;
         } else {
             unsigned char* arrays = (unsigned char*)o + akp_align16(sizeof(ak_skin_implicit));
             o->step_cap = akp_get_f32(h + 60), o->bulge = akp_get_f32(h + 64);
+            o->closed = akp_get_u32(h + 88), o->rest_volume = akp_get_f32(h + 92);
+            if (o->closed > 1 || !(o->rest_volume >= 0.0f && o->rest_volume < 1e30f)) r = AK_ERR_PARSE;
             if (fread(arrays, 1, o->arrays_size, f) != o->arrays_size) r = AK_ERR_PARSE;
             /* the arrays index each other: check every index before trusting them */
             for (size_t i = 0; r == AK_OK && i < 3 * c.triangle_count; ++i)
@@ -863,6 +1208,26 @@ ak_result ak_skin_implicit_read_file(const char* path, uint64_t key, const ak_al
                     r = AK_ERR_PARSE;
             for (size_t v = 0; r == AK_OK && v < c.vertex_count; ++v)
                 if (!ak_finitef(o->iso[v])) r = AK_ERR_PARSE;
+            /* grids: each within the node pool, of a valid bone, with a positive step */
+            for (size_t b = 0; r == AK_OK && b < c.joint_count; ++b) {
+                const uint32_t* I = o->grid_info + b * GRID_INFO;
+                if ((I[0] | I[1] | I[2] | I[3]) == 0) continue;
+                if (c.grid_nodes == 0 || I[0] < 2 || I[1] < 2 || I[2] < 2 || I[0] > 129 || I[1] > 129 || I[2] > 129 ||
+                    o->bones[b * BONE_FLOATS + 10] == 0.0f || !(o->bones[b * BONE_FLOATS + GRID_AT + 3] > 0.0f) ||
+                    (uint64_t)I[3] + (uint64_t)I[0] * I[1] * I[2] > c.grid_nodes)
+                    r = AK_ERR_PARSE;
+            }
+            /* joints: two distinct parts, every float finite */
+            for (size_t p = 0; r == AK_OK && p < c.pair_count; ++p) {
+                const float* P = o->pairs + p * PAIR_FLOATS;
+                for (int q = 0; q < PAIR_FLOATS; ++q)
+                    if (!ak_finitef(P[q]) || fabsf(P[q]) > 1e15f) r = AK_ERR_PARSE;
+                if (r == AK_OK && !(P[0] >= 0.0f && P[0] < P[1] && P[1] < (float)c.joint_count && P[0] == floorf(P[0]) &&
+                                    P[1] == floorf(P[1]) && P[11] >= 0.0f))
+                    r = AK_ERR_PARSE;
+            }
+            for (size_t i = 0; r == AK_OK && i < 4 * c.grid_nodes; ++i)
+                if (!ak_finitef(o->grid[i]) || fabsf(o->grid[i]) > 1e15f) r = AK_ERR_PARSE;
             if (r == AK_OK &&
                 ak_skin_weights_validate((ak_u16_cspan){o->joints, c.vertex_count * c.influence_count},
                                          (ak_f32_cspan){o->weights, c.vertex_count * c.influence_count}, c.vertex_count,
@@ -896,16 +1261,80 @@ ak_result ak_skin_implicit_cached(const ak_skin_implicit_desc* desc, const char*
 
 /* ---- per frame ------------------------------------------------------------------------------- */
 
+/* Broad-phase cells per axis: 16, fewer for skeletons so large that the masks would pass 2 MiB. */
+static uint32_t bp_cells(const ak_skin_implicit* o) {
+    size_t words = (o->joint_count + 63) / 64;
+    uint32_t cells = 16;
+    while (cells > 4 && (size_t)cells * cells * cells * words > ((size_t)1 << 18)) cells /= 2;
+    return cells;
+}
+
+static size_t bp_mask_bytes(const ak_skin_implicit* o) {
+    if (o->grid_nodes == 0) return 0;
+    size_t c = bp_cells(o);
+    return c * c * c * ((o->joint_count + 63) / 64) * sizeof(uint64_t);
+}
+
+/* The posed boxes of the grids (palette: bind to posed) into the broad phase's cells. */
+static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, uint64_t* mask, broad_phase* bp) {
+    const uint32_t cells = bp_cells(o);
+    const size_t words = (o->joint_count + 63) / 64;
+    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    bp->cells = cells, bp->words = words, bp->mask = mask, bp->empty = true;
+    memset(mask, 0, (size_t)cells * cells * cells * words * sizeof(uint64_t));
+    /* pass 0: the union of the posed boxes; pass 1: the bits */
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t b = 0; b < o->joint_count; ++b) {
+            const uint32_t* I = o->grid_info + b * GRID_INFO;
+            if (I[0] < 2) continue;
+            const float* G = o->bones + b * BONE_FLOATS + GRID_AT;
+            const float* m = palette[b].m;
+            const float h = 1.0f / G[3];
+            float c[3], e[3], wc[3], we[3];
+            for (int q = 0; q < 3; ++q) e[q] = 0.5f * h * (float)(I[q] - 1), c[q] = G[q] + e[q];
+            for (int q = 0; q < 3; ++q) {
+                wc[q] = m[q] * c[0] + m[4 + q] * c[1] + m[8 + q] * c[2] + m[12 + q];
+                we[q] = fabsf(m[q]) * e[0] + fabsf(m[4 + q]) * e[1] + fabsf(m[8 + q]) * e[2];
+                we[q] = we[q] * 1.0001f + 1e-6f * fabsf(wc[q]); /* rounding of the inverse transform */
+            }
+            if (pass == 0) {
+                for (int q = 0; q < 3; ++q) lo[q] = fminf(lo[q], wc[q] - we[q]), hi[q] = fmaxf(hi[q], wc[q] + we[q]);
+                continue;
+            }
+            uint32_t a[3], z[3];
+            for (int q = 0; q < 3; ++q) {
+                float pa = (wc[q] - we[q] - bp->lo[q]) * bp->inv_cell[q], pz = (wc[q] + we[q] - bp->lo[q]) * bp->inv_cell[q];
+                a[q] = pa > 0.0f ? (pa < (float)cells ? (uint32_t)pa : cells - 1) : 0;
+                z[q] = pz > 0.0f ? (pz < (float)cells ? (uint32_t)pz : cells - 1) : 0;
+            }
+            const uint64_t bit = (uint64_t)1 << (b & 63);
+            for (uint32_t k = a[2]; k <= z[2]; ++k)
+                for (uint32_t j = a[1]; j <= z[1]; ++j)
+                    for (uint32_t i = a[0]; i <= z[0]; ++i)
+                        mask[((size_t)i + cells * ((size_t)j + (size_t)cells * k)) * words + b / 64] |= bit;
+        }
+        if (pass == 0) {
+            if (!(lo[0] <= hi[0]) || !ak_finitef(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2])) return;
+            bp->empty = false;
+            for (int q = 0; q < 3; ++q) {
+                float ext = fmaxf(hi[q] - lo[q], 1e-20f);
+                bp->lo[q] = lo[q], bp->inv_cell[q] = (float)cells / ext;
+            }
+        }
+    }
+}
+
 size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count) {
     if (!implicit) return 0;
     ak_mat4 probe;
     ak_skin_job dq = {.method = AK_SKIN_DQS, .palette = {&probe, palette_count}};
     size_t nv = implicit->vertex_count;
     return 64 + align64(implicit->joint_count * 12 * sizeof(float)) + align64(ak_skin_job_scratch_size(&dq)) +
-           align64(nv) + 2 * align64(nv * sizeof(ak_vec3));
+           align64(nv) + 3 * align64(nv * sizeof(ak_vec3)) + align64(bp_mask_bytes(implicit)) +
+           align64(implicit->pair_count * PAIR_FRAME * sizeof(float));
 }
 
-enum { ST_KEEP = 0, ST_MOVED = 1, ST_STOPPED = 2 };
+enum { ST_KEEP = 0, ST_MOVED = 1, ST_STOPPED = 2, ST_CONTACT = 8 };
 
 typedef struct run_ctx {
     const ak_skin_implicit* o;
@@ -915,6 +1344,8 @@ typedef struct run_ctx {
     ak_vec3* prev;
     ak_vec3* grad;
     uint8_t* state;
+    const ak_vec3* dq;   /* the DQS result */
+    const float* frame;  /* [pair_count * PAIR_FRAME] */
 } run_ctx;
 
 /* Newton steps from *p towards the vertex's iso-value; returns the state. */
@@ -949,12 +1380,200 @@ static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, 
     return st;
 }
 
+/* The contact planes of the joints (the paper's contact surface f_i = f_j, which for two parts
+ * of equal thickness meeting at a hinge is the plane bisecting their axes; taken from the bone
+ * axes so that it stays defined when a deep fold saturates both fields): per joint and frame,
+ * the posed centre (the mean of the centre moved by either part), the normal unit(R_i u_i -
+ * R_j u_j) and the inner side (the sum of the posed axes, towards which the joint folds). */
+static void contact_frames(const ak_skin_implicit* o, const ak_mat4* palette, float* frame) {
+    for (size_t p = 0; p < o->pair_count; ++p) {
+        const float* P = o->pairs + p * PAIR_FLOATS;
+        float* F = frame + p * PAIR_FRAME;
+        memset(F, 0, PAIR_FRAME * sizeof(float));
+        if (!(P[11] > 0.0f)) continue;
+        const float* mi = palette[(size_t)P[0]].m;
+        const float* mj = palette[(size_t)P[1]].m;
+        ak_vec3 c = ak_vec3_make(P[2], P[3], P[4]), ui = ak_vec3_make(P[5], P[6], P[7]), uj = ak_vec3_make(P[8], P[9], P[10]);
+        ak_vec3 ci = ak_vec3_make(mi[0] * c.x + mi[4] * c.y + mi[8] * c.z + mi[12], mi[1] * c.x + mi[5] * c.y + mi[9] * c.z + mi[13],
+                                  mi[2] * c.x + mi[6] * c.y + mi[10] * c.z + mi[14]);
+        ak_vec3 cj = ak_vec3_make(mj[0] * c.x + mj[4] * c.y + mj[8] * c.z + mj[12], mj[1] * c.x + mj[5] * c.y + mj[9] * c.z + mj[13],
+                                  mj[2] * c.x + mj[6] * c.y + mj[10] * c.z + mj[14]);
+        ak_vec3 pi = ak_vec3_normalize(ak_vec3_make(mi[0] * ui.x + mi[4] * ui.y + mi[8] * ui.z, mi[1] * ui.x + mi[5] * ui.y + mi[9] * ui.z,
+                                                    mi[2] * ui.x + mi[6] * ui.y + mi[10] * ui.z));
+        ak_vec3 pj = ak_vec3_normalize(ak_vec3_make(mj[0] * uj.x + mj[4] * uj.y + mj[8] * uj.z, mj[1] * uj.x + mj[5] * uj.y + mj[9] * uj.z,
+                                                    mj[2] * uj.x + mj[6] * uj.y + mj[10] * uj.z));
+        ak_vec3 n = ak_vec3_sub(pi, pj);
+        float ln = ak_vec3_length(n);
+        if (!(ln > 1e-3f) || !ak_finitef(ln)) continue;
+        n = ak_vec3_scale(n, 1.0f / ln);
+        ak_vec3 cp = ak_vec3_scale(ak_vec3_add(ci, cj), 0.5f);
+        if (!ak_vec3_is_finite(cp)) continue;
+        /* folded this far (the rest axes are opposite: a straight limb has no inner side) */
+        ak_vec3 in = ak_vec3_add(pi, pj), rest_in = ak_vec3_add(ui, uj);
+        float fold = ak_vec3_length(in) - ak_vec3_length(rest_in);
+        F[0] = cp.x, F[1] = cp.y, F[2] = cp.z, F[3] = n.x, F[4] = n.y, F[5] = n.z;
+        F[6] = fold > CONTACT_FOLD ? 1.0f : 0.0f;
+        ak_vec3 ind = ak_vec3_normalize(in);
+        if (ak_vec3_is_finite(ind)) F[8] = ind.x, F[9] = ind.y, F[10] = ind.z;
+        F[12] = pi.x, F[13] = pi.y, F[14] = pi.z, F[16] = pj.x, F[17] = pj.y, F[18] = pj.z;
+    }
+}
+
+/* One vertex against the contact planes of its part's joints (those folded by more than a
+ * little): within a joint's reach, a vertex that the projection or DQS leaves within a band
+ * of the plane goes back to its DQS position (the projection folds the skin there), and a
+ * vertex past the plane (beyond its rest offset, capped at a small gap) is moved onto it. */
+static void contact_vertex(const run_ctx* c, size_t v, bool revert) {
+    const ak_skin_implicit* o = c->o;
+    const uint32_t part = o->part[v];
+    const ak_vec3 vb = o->positions[v];
+    ak_vec3 x = c->pos[v];
+    bool touched = false;
+    for (size_t p = 0; p < o->pair_count; ++p) {
+        const float* P = o->pairs + p * PAIR_FLOATS;
+        const float* F = c->frame + p * PAIR_FRAME;
+        if (F[6] == 0.0f) continue;
+        float side;
+        if ((uint32_t)P[0] == part) side = 1.0f;
+        else if ((uint32_t)P[1] == part) side = -1.0f;
+        else continue;
+        ak_vec3 cb = ak_vec3_make(P[2], P[3], P[4]);
+        if (!(ak_vec3_length(ak_vec3_sub(vb, cb)) < P[11])) continue;
+        const ak_vec3 cp = ak_vec3_make(F[0], F[1], F[2]), n = ak_vec3_make(F[3], F[4], F[5]);
+        const ak_vec3 nr = ak_vec3_make(P[13], P[14], P[15]);
+        const float gap = 0.02f * P[12], band = 0.4f * P[12];
+        /* the inner side of the fold only: the half-space the folded axes point into */
+        if (ak_vec3_dot(ak_vec3_sub(x, cp), ak_vec3_make(F[8], F[9], F[10])) <= 0.0f &&
+            ak_vec3_dot(ak_vec3_sub(c->dq[v], cp), ak_vec3_make(F[8], F[9], F[10])) <= 0.0f)
+            continue;
+        float s_rest = side * ak_vec3_dot(ak_vec3_sub(vb, cb), nr);
+        float need = s_rest < gap ? s_rest : gap;
+        float s = side * ak_vec3_dot(ak_vec3_sub(x, cp), n);
+        float s_dq = side * ak_vec3_dot(ak_vec3_sub(c->dq[v], cp), n);
+        if (revert && (s < need + band || s_dq < need + band)) {
+            x = c->dq[v];
+            s = s_dq;
+            touched = true;
+        }
+        if (s < need) {
+            x = ak_vec3_add(x, ak_vec3_scale(n, side * (need - s)));
+            touched = true;
+        }
+    }
+    if (touched && ak_vec3_is_finite(x)) {
+        c->pos[v] = x;
+        c->state[v] = ST_STOPPED | ST_CONTACT;
+    }
+}
+
 static bool projectable(float iso) { return iso > 0.02f && iso < 0.98f; }
+
+/* Volume kept at contacts (closed meshes): the contact planes remove the parts' overlap, so
+ * the skin around each folded joint swells along the volume gradient, with weight (1 -
+ * distance / reach)^2 over BULGE_REACH seam radii of the joint at the bind pose (contact
+ * vertices excepted), by the amount that brings the enclosed volume back to the rest volume
+ * (Newton steps on the linearised volume; each vertex's move capped at a seam radius). Serial,
+ * so the result does not depend on the thread count. grad is scratch for nv vectors. */
+static void keep_volume(const run_ctx* c, ak_vec3* grad) {
+    const ak_skin_implicit* o = c->o;
+    ak_vec3* pos = c->pos;
+    const size_t nv = o->vertex_count;
+    for (int it = 0; it < 3; ++it) {
+        for (size_t v = 0; v < nv; ++v)
+            if (o->rep[v] != v) pos[v] = pos[o->rep[v]];
+        double vol = 0.0;
+        memset(grad, 0, nv * sizeof(ak_vec3));
+        for (size_t t = 0; t < o->triangle_count; ++t) {
+            const uint32_t* ix = o->indices + 3 * t;
+            ak_vec3 a = pos[ix[0]], b = pos[ix[1]], d = pos[ix[2]];
+            vol += (double)ak_vec3_dot(a, ak_vec3_cross(b, d)) / 6.0;
+            uint32_t ra = o->rep[ix[0]], rb = o->rep[ix[1]], rd = o->rep[ix[2]];
+            grad[ra] = ak_vec3_add(grad[ra], ak_vec3_scale(ak_vec3_cross(b, d), 1.0f / 6.0f));
+            grad[rb] = ak_vec3_add(grad[rb], ak_vec3_scale(ak_vec3_cross(d, a), 1.0f / 6.0f));
+            grad[rd] = ak_vec3_add(grad[rd], ak_vec3_scale(ak_vec3_cross(a, b), 1.0f / 6.0f));
+        }
+        const double dv = (double)o->rest_volume - vol;
+        if (!isfinite(dv) || fabs(dv) < 1e-4 * (double)o->rest_volume) break;
+        double sum = 0.0;
+        for (int pass = 0; pass < 2; ++pass) {
+            const float k = pass ? (float)(dv / sum) : 0.0f;
+            if (pass && !(sum > 0.0 && isfinite(k))) break;
+            for (size_t v = 0; v < nv; ++v) {
+                if (o->rep[v] != v || (c->state[v] & ST_CONTACT) || !projectable(o->iso[v])) continue;
+                float w = 0.0f, cap = 0.0f;
+                ak_vec3 dir = ak_vec3_zero();
+                for (size_t p = 0; p < o->pair_count; ++p) {
+                    const float* P = o->pairs + p * PAIR_FLOATS;
+                    if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
+                    if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
+                    const float* F = c->frame + p * PAIR_FRAME;
+                    /* the inner side of the fold only (where the parts press together),
+                     * fading in over a seam radius */
+                    float inner = ak_vec3_dot(ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2])), ak_vec3_make(F[8], F[9], F[10])) / P[12];
+                    if (!(inner > 0.0f)) continue;
+                    inner = inner < 1.0f ? inner * inner * (3.0f - 2.0f * inner) : 1.0f;
+                    float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
+                    float u = 1.0f - dist / (BULGE_REACH * P[12]);
+                    if (u > 0.0f && inner * u * u > w) {
+                        /* away from the part's posed axis (a smooth direction, unlike the
+                         * per-vertex volume gradient of a crumpled surface) */
+                        ak_vec3 a = (uint32_t)P[0] == o->part[v] ? ak_vec3_make(F[12], F[13], F[14])
+                                                                 : ak_vec3_make(F[16], F[17], F[18]);
+                        ak_vec3 rel = ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2]));
+                        ak_vec3 rad = ak_vec3_normalize(ak_vec3_sub(rel, ak_vec3_scale(a, ak_vec3_dot(rel, a))));
+                        if (!ak_vec3_is_finite(rad)) continue;
+                        w = inner * u * u, cap = P[12], dir = rad;
+                    }
+                }
+                if (w == 0.0f) continue;
+                const float e = ak_vec3_dot(grad[v], dir); /* volume change per unit move */
+                if (!(e > 0.0f) || !ak_finitef(e)) continue;
+                if (!pass) {
+                    sum += (double)w * e;
+                    continue;
+                }
+                float step = k * w;
+                step = ak_clampf(step, -cap, cap);
+                ak_vec3 q = ak_vec3_add(pos[v], ak_vec3_scale(dir, step));
+                if (ak_vec3_is_finite(q)) pos[v] = q, c->state[v] |= ST_MOVED;
+            }
+        }
+    }
+}
+
+
+/* Whether vertex v follows one joint rigidly (a single influence of weight 1) and its DQS
+ * position lies in a broad-phase cell that no other bone's field reaches: its field is then
+ * that of its rest position, i.e. its iso-value, and the projection would keep it. */
+static bool rigid_alone(const run_ctx* c, size_t v) {
+    const ak_skin_implicit* o = c->o;
+    const broad_phase* bp = c->fc.bp;
+    if (!bp || bp->empty) return false;
+    const uint32_t k = o->influence_count;
+    const float* w = o->weights + v * k;
+    const uint16_t* j = o->joints + v * k;
+    size_t b = SIZE_MAX;
+    for (uint32_t q = 0; q < k; ++q) {
+        if (w[q] == 0.0f) continue;
+        if (w[q] != 1.0f || b != SIZE_MAX) return false;
+        b = j[q];
+    }
+    if (b == SIZE_MAX) return false;
+    ak_vec3 x = c->pos[v];
+    float p[3] = {(x.x - bp->lo[0]) * bp->inv_cell[0], (x.y - bp->lo[1]) * bp->inv_cell[1], (x.z - bp->lo[2]) * bp->inv_cell[2]};
+    const float top = (float)bp->cells;
+    if (!(p[0] >= 0.0f && p[1] >= 0.0f && p[2] >= 0.0f && p[0] < top && p[1] < top && p[2] < top)) return false;
+    const size_t cell = (size_t)p[0] + bp->cells * ((size_t)p[1] + bp->cells * (size_t)p[2]);
+    const uint64_t* mw = bp->mask + cell * bp->words;
+    for (size_t q = 0; q < bp->words; ++q)
+        if (mw[q] != (q == b / 64 ? (uint64_t)1 << (b & 63) : 0u)) return false;
+    return true;
+}
 
 typedef struct run_task {
     run_ctx* c;
     size_t begin, end;
-    int phase; /* 0 first projection, 1 relax, 2 re-projection */
+    int phase; /* 0 first projection, 1 relax, 2 re-projection, 3 contact */
 } run_task;
 
 static void* run_worker(void* arg) {
@@ -964,6 +1583,7 @@ static void* run_worker(void* arg) {
     for (size_t v = t->begin; v < t->end; ++v) {
         if (o->rep[v] != v || !projectable(o->iso[v])) continue;
         if (t->phase == 0) {
+            if (rigid_alone(c, v)) continue; /* kept: exactly at its iso-value already */
             c->state[v] = project(c, o->iso[v], &c->pos[v], &c->grad[v], true);
         } else if (t->phase == 1) {
             if (c->state[v] == ST_KEEP) continue;
@@ -976,10 +1596,23 @@ static void* run_worker(void* arg) {
             d = ak_vec3_sub(d, ak_vec3_scale(n, ak_vec3_dot(d, n)));
             ak_vec3 q = ak_vec3_add(c->prev[v], ak_vec3_scale(d, 0.5f));
             c->pos[v] = ak_vec3_is_finite(q) ? q : c->prev[v];
-        } else {
+        } else if (t->phase == 2) {
             if (c->state[v] == ST_KEEP) continue;
             uint8_t st = project(c, o->iso[v], &c->pos[v], &c->grad[v], false);
             if (st == ST_STOPPED) c->state[v] = ST_STOPPED;
+        } else if (t->phase == 3) {
+            contact_vertex(c, v, true);
+        } else {
+            /* phase 4: smoothing of the contact region (half-way to the one-ring centroid of the
+             * previous round), then the planes again */
+            if (!(c->state[v] & ST_CONTACT)) continue;
+            uint32_t a = o->adj_start[v], b = o->adj_start[v + 1];
+            if (a == b) continue;
+            ak_vec3 sum = ak_vec3_zero();
+            for (uint32_t e = a; e < b; ++e) sum = ak_vec3_add(sum, c->prev[o->adj[e]]);
+            ak_vec3 q = ak_vec3_lerp(c->prev[v], ak_vec3_scale(sum, 1.0f / (float)(b - a)), 0.5f);
+            if (ak_vec3_is_finite(q)) c->pos[v] = q;
+            contact_vertex(c, v, false);
         }
     }
     return NULL;
@@ -987,17 +1620,9 @@ static void* run_worker(void* arg) {
 
 static void run_phase(run_ctx* c, int phase, uint32_t threads) {
     run_task tasks[64];
-    pthread_t ids[64];
-    bool started[64] = {false};
     size_t n = c->o->vertex_count;
-    for (uint32_t t = 0; t < threads; ++t)
-        tasks[t] = (run_task){c, n * t / threads, n * (t + 1) / threads, phase};
-    for (uint32_t t = 1; t < threads; ++t) started[t] = pthread_create(&ids[t], NULL, run_worker, &tasks[t]) == 0;
-    run_worker(&tasks[0]);
-    for (uint32_t t = 1; t < threads; ++t) {
-        if (started[t]) pthread_join(ids[t], NULL);
-        else run_worker(&tasks[t]);
-    }
+    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (run_task){c, n * t / threads, n * (t + 1) / threads, phase};
+    akp_run_tasks(run_worker, tasks, sizeof tasks[0], threads);
 }
 
 ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
@@ -1023,6 +1648,12 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     ak_vec3* grad = (ak_vec3*)(void*)base;
     base += align64(nv * sizeof(ak_vec3));
     ak_vec3* prev = (ak_vec3*)(void*)base;
+    base += align64(nv * sizeof(ak_vec3));
+    ak_vec3* dqpos = (ak_vec3*)(void*)base;
+    base += align64(nv * sizeof(ak_vec3));
+    float* frame = (float*)(void*)base;
+    base += align64(o->pair_count * PAIR_FRAME * sizeof(float));
+    uint64_t* mask = (uint64_t*)(void*)base;
     if (!invert_palette(o, job->palette.ptr, inv)) return AK_ERR_BAD_DATA;
     const uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
     dq = (ak_skin_job){
@@ -1045,7 +1676,10 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     if (r != AK_OK) return r;
     ak_vec3* pos = job->out_positions.ptr;
     memset(state, 0, nv);
-    run_ctx c = {o, {o, inv, o->bulge}, job->iterations ? job->iterations : 10, pos, prev, grad, state};
+    broad_phase bp;
+    if (o->grid_nodes) bp_build(o, job->palette.ptr, mask, &bp);
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame};
+    memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     run_phase(&c, 0, threads);
     uint32_t rounds = job->relax_rounds == 0 ? 3 : job->relax_rounds == UINT32_MAX ? 0 : job->relax_rounds;
     if (rounds > 64) rounds = 64;
@@ -1053,6 +1687,19 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
         memcpy(prev, pos, nv * sizeof(ak_vec3));
         run_phase(&c, 1, threads);
         run_phase(&c, 2, threads);
+    }
+    if (o->pair_count) {
+        bool contact = false;
+        contact_frames(o, job->palette.ptr, frame);
+        for (size_t p = 0; p < o->pair_count; ++p) contact = contact || frame[p * PAIR_FRAME + 6] != 0.0f;
+        if (contact) {
+            run_phase(&c, 3, threads);
+            for (int k = 0; k < CONTACT_SMOOTH; ++k) {
+                memcpy(prev, pos, nv * sizeof(ak_vec3));
+                run_phase(&c, 4, threads);
+            }
+            if (o->closed) keep_volume(&c, prev);
+        }
     }
     size_t moved = 0;
     for (size_t v = 0; v < nv; ++v) {
