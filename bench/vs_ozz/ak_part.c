@@ -1,6 +1,7 @@
 /* animkit side of the vs_ozz harness (a copy of ../shared/peers/vs_ozz/ak_part.c, public API
- * only) whose skinning jobs take job.simd_limit from AK_VS_OZZ_SIMD (scalar, avx2, avx512;
- * unset: the default, the fastest kernel), so ozz can be compared with each animkit kernel.
+ * only) whose skinning jobs, FK (ak_skeleton_set_simd_limit) and clip sampling take their
+ * SIMD limit from AK_VS_OZZ_SIMD (scalar, avx2, avx512; unset: the default, the fastest
+ * kernel), so ozz can be compared with each animkit kernel.
  * Run with bench/vs_ozz/run.sh. */
 #include <stdlib.h>
 #include <string.h>
@@ -48,6 +49,13 @@ int akh_skin(const skin_data* d, int method, int normals, int threads) {
     ak_skin_job job = make_job(d, method, normals, threads);
     return (int)ak_skin_job_run(&job);
 }
+static ak_fk_simd fk_limit(void) {
+    const char* e = getenv("AK_VS_OZZ_SIMD");
+    if (!e || !*e) return AK_FK_SIMD_DEFAULT;
+    if (!strcmp(e, "scalar")) return AK_FK_SIMD_SCALAR;
+    if (!strcmp(e, "avx2")) return AK_FK_SIMD_AVX2;
+    return AK_FK_SIMD_AVX512;
+}
 const char* akh_skin_kernel(void) {
     const char* e = getenv("AK_VS_OZZ_SIMD");
     return e && *e ? e : ak_skin_simd_name();
@@ -80,6 +88,7 @@ int akh_anim_setup(int joints, const int* parents, const float* rest_t, int keys
     }
     ak_skeleton_desc sd = {.joints = js, .joint_count = (size_t)joints};
     if (ak_skeleton_create(&sd, NULL, &g_sk, NULL) != AK_OK) return 1;
+    if (ak_skeleton_set_simd_limit(g_sk, fk_limit()) != AK_OK) return 1;
     free(js);
     free(names);
     for (int c = 0; c < 2; ++c) {
@@ -113,6 +122,8 @@ void akh_anim_eval(int clip, float time, int use_cursor, int fk) {
                        (ak_f32_span){0}, (ak_f32_span){0});
     if (fk) ak_skeleton_local_to_model(g_sk, (ak_transform_cspan){g_local, g_nj}, (ak_mat4_span){g_model, g_nj});
 }
+const char* akh_fk_kernel(void) { return ak_skeleton_simd_name(g_sk); }
+const char* akh_sample_kernel(void) { return "sse2"; }
 const float* akh_anim_model(void) { return g_model[0].m; }
 const float* akh_anim_local(void) { return &g_local[0].translation.x; }
 
