@@ -373,6 +373,12 @@ static inline __m128 load3(const float* p) {
     return _mm_movelh_ps(_mm_loadl_pi(_mm_setzero_ps(), (const __m64*)(const void*)p), _mm_load_ss(p + 2));
 }
 
+#if defined(__GNUC__)
+#define AKP_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define AKP_ALWAYS_INLINE inline
+#endif
+
 /* One lane's refreshed state. */
 typedef struct lane_keys {
     float lo, hi, t0, dt;
@@ -382,7 +388,7 @@ typedef struct lane_keys {
 } lane_keys;
 
 /* Lane l's new interval and key pointers (refresh true), or harmless fillers. */
-static inline lane_keys lane_refresh(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, int l, bool refresh,
+static AKP_ALWAYS_INLINE lane_keys lane_refresh(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, int l, bool refresh,
                                      float t) {
     const ak_track* tr = &clip->channels[G->ch[l]].track;
     const float* times = tr->times;
@@ -406,12 +412,6 @@ static inline lane_keys lane_refresh(const ak_clip* clip, const akp_clip_group* 
     }
     return r;
 }
-
-#if defined(__GNUC__)
-#define AKP_ALWAYS_INLINE __attribute__((always_inline)) inline
-#else
-#define AKP_ALWAYS_INLINE inline
-#endif
 
 /* Write the keys k0..k3 of the lanes in mask into the cache (full: all four, no blend). */
 static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int mask, bool full, lane_keys k0,
@@ -471,7 +471,7 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
  * four lanes are transposed in SIMD registers and the refreshed lanes written into the cache.
  * A group whose channels share their key times (G->shared) refreshes all four lanes together,
  * so lane 0's segment serves all four. */
-static void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
+static AKP_ALWAYS_INLINE void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
     if (mask == 15 && G->shared) {
         lane_keys k[4];
         k[0] = lane_refresh(clip, G, segs, 0, true, t);
@@ -491,8 +491,9 @@ static void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t
     else cache_write(G, f, mask, false, k0, k1, k2, k3);
 }
 
-/* Sample every group through the cache (time not NaN). */
-static void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache, float* pose) {
+/* Sample every group through the cache (time not NaN). The body of the kernels below. */
+static AKP_ALWAYS_INLINE void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache,
+                                            float* pose) {
     const __m128 T = _mm_set1_ps(time), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f),
                  ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
     for (size_t g = 0; g < clip->group_count; ++g) {
@@ -561,7 +562,58 @@ static void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint3
                 if (redo >> l & 1) eval_fast(&clip->channels[G->ch[l]], segs[G->ch[l]], time, pose);
     }
 }
+
+/* sample_groups compiled three times: SSE2 (the x86-64 baseline), and with the VEX (AVX2) and
+ * EVEX (AVX-512 VL: 32 registers) encodings for CPUs that have them, chosen at run time
+ * (clip->sample_kernel). The same SSE-width operations in the same order, no FMA (the build
+ * disables contraction), so every kernel gives the same floats. */
+static void sample_groups_sse2(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache, float* pose) {
+    sample_groups(clip, time, segs, cache, pose);
+}
+#if defined(__GNUC__) && defined(__x86_64__)
+#define AKP_CLIP_VEX 1
+__attribute__((target("avx2"))) static void sample_groups_avx2(const ak_clip* clip, float time, uint32_t* segs,
+                                                               uint32_t* cache, float* pose) {
+    sample_groups(clip, time, segs, cache, pose);
+}
+__attribute__((target("avx512f,avx512vl,avx2"))) static void sample_groups_avx512(const ak_clip* clip, float time,
+                                                                                  uint32_t* segs, uint32_t* cache,
+                                                                                  float* pose) {
+    sample_groups(clip, time, segs, cache, pose);
+}
+#else
+#define AKP_CLIP_VEX 0
 #endif
+#endif
+
+/* The sampling kernel for a limit on this CPU (AKP_CLIP_K_*). */
+static uint8_t clip_kernel_pick(ak_clip_simd limit) {
+    const ak_clip_simd lim = limit == AK_CLIP_SIMD_DEFAULT ? AK_CLIP_SIMD_AVX512 : limit;
+    if (lim == AK_CLIP_SIMD_SCALAR) return AKP_CLIP_K_SCALAR;
+#if AK_SIMD_SSE2 && AKP_CLIP_VEX
+    if (lim >= AK_CLIP_SIMD_AVX512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx2"))
+        return AKP_CLIP_K_AVX512;
+    if (lim >= AK_CLIP_SIMD_AVX2 && __builtin_cpu_supports("avx2")) return AKP_CLIP_K_AVX2;
+#endif
+#if AK_SIMD_SSE2
+    return AKP_CLIP_K_SSE2;
+#else
+    return AKP_CLIP_K_SCALAR;
+#endif
+}
+
+ak_result ak_clip_set_simd_limit(ak_clip* clip, ak_clip_simd limit) {
+    if (!clip) return AK_ERR_NULL_ARG;
+    if ((unsigned)limit >= (unsigned)AK_CLIP_SIMD_COUNT) return AK_ERR_BAD_ARG;
+    clip->sample_kernel = clip_kernel_pick(limit);
+    return AK_OK;
+}
+
+const char* ak_clip_simd_name(const ak_clip* clip) {
+    static const char* const names[] = {"scalar", "sse2", "avx2", "avx512"};
+    return clip ? names[clip->sample_kernel] : "";
+}
 
 /* Group the FAST channels four by four per kind (SIMD builds); the rest go to the slow list. */
 static void make_groups(ak_clip* clip) {
@@ -689,6 +741,7 @@ ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_cl
     }
     clip->duration = raw->duration > 0.0f ? raw->duration : last;
     make_groups(clip);
+    clip->sample_kernel = clip_kernel_pick(AK_CLIP_SIMD_DEFAULT);
     *out_clip = clip;
     return AK_OK;
 }
@@ -753,8 +806,17 @@ ak_result ak_clip_sample(const ak_clip* clip, float time, ak_clip_cursor* cursor
     if (s && scalars.count < clip->scalar_count) return AK_ERR_SPAN_SMALL;
     uint32_t* cache = cursor && time == time ? cursor_cache(cursor) : NULL; /* NaN: the plain path */
 #if AK_SIMD_SSE2
-    if (cache) {
-        if (clip->has_joint_channels) sample_groups(clip, time, cursor->segments, cache, &local.ptr[0].translation.x);
+    if (cache && clip->sample_kernel != AKP_CLIP_K_SCALAR) {
+        if (clip->has_joint_channels) {
+            float* pose = &local.ptr[0].translation.x;
+            switch (clip->sample_kernel) {
+#if AKP_CLIP_VEX
+            case AKP_CLIP_K_AVX512: sample_groups_avx512(clip, time, cursor->segments, cache, pose); break;
+            case AKP_CLIP_K_AVX2: sample_groups_avx2(clip, time, cursor->segments, cache, pose); break;
+#endif
+            default: sample_groups_sse2(clip, time, cursor->segments, cache, pose); break;
+            }
+        }
         sample_channels(clip, clip->slow, clip->slow_count, time, cursor->segments, local.ptr, w, s);
         return AK_OK;
     }

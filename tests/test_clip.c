@@ -323,12 +323,27 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
     size_t full = ak_clip_cursor_storage_count(c);
     AK_CHECK(full >= ak_clip_channel_count(c));
     uint32_t* seg = (uint32_t*)calloc(full + 1, sizeof *seg);
-    for (int pass = 0; pass < 2; ++pass) {
+    char dflt[16];
+    snprintf(dflt, sizeof dflt, "%s", ak_clip_simd_name(c));
+    /* pass 0..3: the full storage with each sampling kernel this CPU has (scalar, SSE2, AVX2,
+     * AVX-512; the same floats), pass 4: the minimum storage with the default kernel */
+    for (int pass = 0; pass < 5; ++pass) {
+        static const ak_clip_simd lims[5] = {AK_CLIP_SIMD_SCALAR, AK_CLIP_SIMD_SSE2, AK_CLIP_SIMD_AVX2,
+                                             AK_CLIP_SIMD_AVX512, AK_CLIP_SIMD_DEFAULT};
+        AK_CHECK_EQ(ak_clip_set_simd_limit(c, lims[pass]), AK_OK);
+        if (pass > 0 && pass < 4 && !strcmp(ak_clip_simd_name(c), "scalar")) continue; /* no SIMD build */
+        if (pass == 2 && strcmp(ak_clip_simd_name(c), "avx2") != 0) continue;     /* not on this CPU */
+        if (pass == 3 && strcmp(ak_clip_simd_name(c), "avx512") != 0) continue;
+        /* the default kernel gets every sequence; the narrower ones a quarter of each (time) */
+        const bool all = pass == 4 || !strcmp(ak_clip_simd_name(c), dflt);
+        printf("  common %d, storage %s, kernel %s%s\n", common, pass < 4 ? "full" : "minimum", ak_clip_simd_name(c),
+               all ? "" : " (short)");
         ak_clip_cursor cur;
-        ak_u32_span st = pass == 0 ? (ak_u32_span){seg + 1, full} : (ak_u32_span){seg, ak_clip_channel_count(c)};
+        ak_u32_span st = pass < 4 ? (ak_u32_span){seg + 1, full} : (ak_u32_span){seg, ak_clip_channel_count(c)};
         AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, st), AK_OK);
-        enum { T = 6000 };
-        static float times[T];
+        enum { TMAX = 6000 };
+        static float times[TMAX];
+        const int T = all ? TMAX : TMAX / 4;
         float dur = ak_clip_duration(c);
         /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
         for (int i = 0; i < T; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)T;
@@ -340,7 +355,7 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
         for (int i = 0; i < T; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
         AK_CHECK_EQ(compare_run(c, &cur, times, T), 0);
         /* on keys, next to keys, infinities and NaN */
-        for (size_t ci = 0; ci < ak_clip_channel_count(c); ++ci) {
+        for (size_t ci = 0; ci < (all ? ak_clip_channel_count(c) : 2u); ++ci) {
             ak_f32_cspan kt = ak_track_times(ak_clip_channel_track(c, ci));
             AK_CHECK_EQ(compare_run(c, &cur, kt.ptr, kt.count), 0);
             for (size_t k = 0; k < kt.count; ++k) {
@@ -351,6 +366,9 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
         float odd[5] = {INFINITY, -INFINITY, NAN, 0.5f, -0.0f};
         AK_CHECK_EQ(compare_run(c, &cur, odd, 5), 0);
     }
+    AK_CHECK_EQ(ak_clip_set_simd_limit(c, AK_CLIP_SIMD_COUNT), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_clip_set_simd_limit(NULL, AK_CLIP_SIMD_DEFAULT), AK_ERR_NULL_ARG);
+    AK_CHECK(!strcmp(ak_clip_simd_name(NULL), ""));
     free(seg);
     ak_clip_destroy(c);
     }

@@ -107,6 +107,12 @@ int akh_anim_setup(int joints, const int* parents, const float* rest_t, int keys
         ak_result r = ak_clip_build(&raw, NULL, &g_clip[c], NULL);
         free(ch);
         if (r != AK_OK) return 2;
+        const ak_fk_simd lim = fk_limit();
+        if (ak_clip_set_simd_limit(g_clip[c], lim == AK_FK_SIMD_SCALAR ? AK_CLIP_SIMD_SCALAR
+                                              : lim == AK_FK_SIMD_AVX2 ? AK_CLIP_SIMD_AVX2
+                                              : lim == AK_FK_SIMD_AVX512 ? AK_CLIP_SIMD_AVX512
+                                                                         : AK_CLIP_SIMD_DEFAULT) != AK_OK)
+            return 2;
         size_t sc = ak_clip_cursor_storage_count(g_clip[c]);
         g_seg[c] = calloc(sc, sizeof(uint32_t));
         ak_clip_cursor_init(&g_cur[c], g_clip[c], (ak_u32_span){g_seg[c], sc});
@@ -123,7 +129,7 @@ void akh_anim_eval(int clip, float time, int use_cursor, int fk) {
     if (fk) ak_skeleton_local_to_model(g_sk, (ak_transform_cspan){g_local, g_nj}, (ak_mat4_span){g_model, g_nj});
 }
 const char* akh_fk_kernel(void) { return ak_skeleton_simd_name(g_sk); }
-const char* akh_sample_kernel(void) { return "sse2"; }
+const char* akh_sample_kernel(void) { return ak_clip_simd_name(g_clip[0]); }
 const float* akh_anim_model(void) { return g_model[0].m; }
 const float* akh_anim_local(void) { return &g_local[0].translation.x; }
 

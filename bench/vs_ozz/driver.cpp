@@ -459,32 +459,59 @@ int main(int argc, char** argv) {
                            {"ozz (iframes 1 s)", 4}};
     const char* modes[3] = {"sample only", "FK only", "sample+FK"};
     // stats[access][mode][impl] in us/eval
-    Stat st[2][3][5];
+    Stat st[2][3][5];      // us per evaluation: per round, the fastest chunk
+    Stat rt[2][3][5][2];   // per round: median over reps of (impl chunk time / ozz chunk time), vs ozz and ozz-iframes
+    // A rep runs the whole time sequence (C = F evaluations, 6.8 passes over the clip when
+    // sequential) with every implementation, in an order rotated every rep; reps repeat until
+    // every implementation has run ANIM_MS ms (and at least REP times).
+    const int C = F;
+    const double ANIM_MS = getenv("AK_VS_OZZ_ANIM_MS") ? atof(getenv("AK_VS_OZZ_ANIM_MS")) : 40.0;
     for (int round = 0; round < ROUNDS; ++round)
       for (int acc = 0; acc < (seq_only ? 1 : 2); ++acc)
         for (int mode = 0; mode < 3; ++mode) {
           const std::vector<float>& tm = acc == 0 ? seq : rnd;
           int fk = mode == 0 ? 0 : mode == 1 ? 2 : 1;
-          for (int ii = 0; ii < 5; ++ii) {
-            if (mode == 1 && (ii == 1 || ii == 2 || ii == 4)) continue;
-            double best = 1e30;
-            for (int rep = 0; rep < REP; ++rep) {
+          std::vector<int> act;
+          for (int ii = 0; ii < 5; ++ii)
+            if (!(mode == 1 && (ii == 1 || ii == 2 || ii == 4))) act.push_back(ii);
+          double best[5], spent[5];
+          int pos[5] = {0, 0, 0, 0, 0};
+          std::vector<double> times[5];
+          for (int ii = 0; ii < 5; ++ii) best[ii] = 1e30, spent[ii] = 0;
+          for (int rep = 0;; ++rep) {
+            bool done = rep >= REP;
+            for (int ii : act) done = done && spent[ii] >= 1e-3 * ANIM_MS;
+            if (done) break;
+            for (size_t o = 0; o < act.size(); ++o) {
+              const int ii = act[(o + rep) % act.size()];
+              const int f0 = pos[ii];
               double t0 = wall();
               switch (impls[ii].kind) {
-                case 0: for (int f = 0; f < F; ++f) akh_anim_eval(0, tm[f], 1, fk); break;
-                case 1: for (int f = 0; f < F; ++f) akh_anim_eval(1, tm[f], 1, fk); break;
-                case 2: for (int f = 0; f < F; ++f) akh_anim_eval(1, tm[f], 0, fk); break;
-                case 3: for (int f = 0; f < F; ++f) ozz_eval(anim0.get(), &ctx0, tm[f], fk); break;
-                case 4: for (int f = 0; f < F; ++f) ozz_eval(anim1.get(), &ctx1, tm[f], fk); break;
+                case 0: for (int f = f0; f < f0 + C; ++f) akh_anim_eval(0, tm[f], 1, fk); break;
+                case 1: for (int f = f0; f < f0 + C; ++f) akh_anim_eval(1, tm[f], 1, fk); break;
+                case 2: for (int f = f0; f < f0 + C; ++f) akh_anim_eval(1, tm[f], 0, fk); break;
+                case 3: for (int f = f0; f < f0 + C; ++f) ozz_eval(anim0.get(), &ctx0, tm[f], fk); break;
+                case 4: for (int f = f0; f < f0 + C; ++f) ozz_eval(anim1.get(), &ctx1, tm[f], fk); break;
               }
-              best = std::min(best, wall() - t0);
+              double t = wall() - t0;
+              best[ii] = std::min(best[ii], t), spent[ii] += t, times[ii].push_back(t);
             }
-            st[acc][mode][ii].add(best / F * 1e6);
+          }
+          for (int ii : act) {
+            st[acc][mode][ii].add(best[ii] / C * 1e6);
+            for (int ref = 0; ref < 2; ++ref) {
+              const int jj = ref == 0 ? 3 : 4;
+              if (ii == jj || times[jj].empty()) continue;
+              std::vector<double> q;
+              for (size_t k = 0; k < times[ii].size(); ++k) q.push_back(times[ii][k] / times[jj][k]);
+              rt[acc][mode][ii][ref].add(median(q));
+            }
           }
         }
-    printf("us per evaluation of 60 joints (median of %d rounds [min-max]); ratio = animkit time / ozz(no iframes) "
-           "time per round\n",
-           ROUNDS);
+    printf("us per evaluation of 60 joints (median of %d rounds [min-max] of each round's fastest %d-evaluation chunk); "
+           "ratio = animkit time / ozz(no iframes) time: per round the median over adjacent chunks; spread = (max - min) / "
+           "median of the rounds' ratios\n",
+           ROUNDS, C);
     for (int acc = 0; acc < 2; ++acc)
       for (int mode = 0; mode < 3; ++mode)
         for (int ii = 0; ii < 5; ++ii) {
@@ -493,13 +520,11 @@ int main(int argc, char** argv) {
           printf("  %-10s %-12s %-30s %8.3f [%.3f-%.3f]", acc ? "random" : "sequential", modes[mode], impls[ii].name,
                  s.med(), s.lo(), s.hi());
           if (ii != 3) {
-            Stat r;
-            for (int i = 0; i < ROUNDS; ++i) r.add(s.v[i] / st[acc][mode][3].v[i]);
+            const Stat& r = rt[acc][mode][ii][0];
             printf("  time vs ozz x%.2f [%.2f-%.2f] spread %.0f%%", r.med(), r.lo(), r.hi(), r.spread());
           }
-          if (ii < 3 && !st[acc][mode][4].v.empty()) {
-            Stat r;
-            for (int i = 0; i < ROUNDS; ++i) r.add(s.v[i] / st[acc][mode][4].v[i]);
+          if (ii < 3 && !rt[acc][mode][ii][1].v.empty()) {
+            const Stat& r = rt[acc][mode][ii][1];
             printf("  vs ozz-iframes x%.2f [%.2f-%.2f]", r.med(), r.lo(), r.hi());
           }
           printf("\n");
