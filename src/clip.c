@@ -418,6 +418,11 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
                                           lane_keys k1, lane_keys k2, lane_keys k3) {
     const float* pa[4] = {k0.pa, k1.pa, k2.pa, k3.pa};
     const float* pb[4] = {k0.pb, k1.pb, k2.pb, k3.pb};
+    /* Forward playback reads each track's keys in order, but a clip has more tracks than the
+     * hardware prefetcher follows streams: fetch the cache line after the new keys now, so
+     * the refreshes a few keys later find it. */
+    for (int l = 0; l < 4; ++l)
+        if (mask >> l & 1) _mm_prefetch((const char*)(const void*)(pb[l] + 16), _MM_HINT_T0);
     const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
     const __m128 m = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(mask), bits), bits));
 #define AKP_PUT(field, v)                                                                                        \
