@@ -422,7 +422,7 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
      * hardware prefetcher follows streams: fetch the cache line after the new keys now, so
      * the refreshes a few keys later find it. */
     for (int l = 0; l < 4; ++l)
-        if (mask >> l & 1) _mm_prefetch((const char*)(const void*)(pb[l] + 16), _MM_HINT_T0);
+        if (mask >> l & 1) _mm_prefetch((const char*)(uintptr_t)((uintptr_t)pb[l] + 64u), _MM_HINT_T0); /* may pass the end: a hint */
     const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
     const __m128 m = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(mask), bits), bits));
 #define AKP_PUT(field, v)                                                                                        \
