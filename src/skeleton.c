@@ -372,34 +372,31 @@ static bool mat4_affine(const ak_mat4* m) {
 #if AK_SIMD_SSE2 && defined(__GNUC__) && defined(__x86_64__)
 #define AKP_FK_AVX 1
 #include <immintrin.h>
-/* The rotation and scale of joints b .. b + 7 (joints past cnt repeat joint b) as four-joint
- * SSE vectors: q[h] = qx qy qz qw, s[h] = qw sx sy sz of joints b + 4h .. b + 4h + 3,
- * transposed to lanes (q[h][0] = the four qx, ...). Loads stay inside each ak_transform; the
- * translations are not gathered (the products broadcast them from the pose itself). */
-static inline void gather8(const ak_transform* local, size_t b, size_t cnt, __m128 q[2][4], __m128 s[2][4]) {
-    for (int h = 0; h < 2; ++h) {
-        for (int v = 0; v < 4; ++v) {
-            size_t j = (size_t)(4 * h + v);
-            const float* f = &local[b + (j < cnt ? j : 0)].rotation.x;
-            q[h][v] = _mm_loadu_ps(f);     /* qx qy qz qw */
-            s[h][v] = _mm_loadu_ps(f + 3); /* qw sx sy sz */
-        }
-        _MM_TRANSPOSE4_PS(q[h][0], q[h][1], q[h][2], q[h][3]);
-        _MM_TRANSPOSE4_PS(s[h][0], s[h][1], s[h][2], s[h][3]);
-    }
-}
-
 /* The local 3x3 parts of joints b .. b + cnt - 1 (cnt <= 8) in structure-of-arrays form:
  * L[0..8] column by column (ak_mat3_from_quat's formulas times the scale, lane by lane, no
- * FMA, so the same floats as ak_transform_to_mat4). */
+ * FMA, so the same floats as ak_transform_to_mat4). The rotations (and scales) of joints v and
+ * v + 4 load into the two halves of one AVX register (the second half an insert from memory, no
+ * shuffle), and one 4x4 transpose within the halves gives all eight joints' components; joints
+ * past cnt repeat joint b. The translations are not gathered (the products broadcast them from
+ * the pose itself). */
 __attribute__((target("avx"), always_inline)) static inline void local_soa8(const ak_transform* local, size_t b,
                                                                             size_t cnt, float L[9][8]) {
-    __m128 q[2][4], s[2][4];
-    gather8(local, b, cnt, q, s);
-#define AKP_W8(a, k) _mm256_insertf128_ps(_mm256_castps128_ps256(a[0][k]), a[1][k], 1)
-    const __m256 x = AKP_W8(q, 0), y = AKP_W8(q, 1), z = AKP_W8(q, 2), w = AKP_W8(q, 3);
-    const __m256 sx = AKP_W8(s, 1), sy = AKP_W8(s, 2), sz = AKP_W8(s, 3);
-#undef AKP_W8
+    __m256 r[4], c[4];
+    for (int v = 0; v < 4; ++v) {
+        const size_t jl = (size_t)v < cnt ? (size_t)v : 0, jh = (size_t)v + 4 < cnt ? (size_t)v + 4 : 0;
+        const float* lo = &local[b + jl].rotation.x;
+        const float* hi = &local[b + jh].rotation.x;
+        r[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1); /* q */
+        c[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo + 3)), _mm_loadu_ps(hi + 3), 1); /* qw s */
+    }
+    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
+    const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    const __m256 x = _mm256_shuffle_ps(t0, t1, 0x44), y = _mm256_shuffle_ps(t0, t1, 0xEE);
+    const __m256 z = _mm256_shuffle_ps(t2, t3, 0x44), w = _mm256_shuffle_ps(t2, t3, 0xEE);
+    const __m256 u0 = _mm256_unpacklo_ps(c[0], c[1]), u1 = _mm256_unpacklo_ps(c[2], c[3]); /* qw qw sx sx */
+    const __m256 u2 = _mm256_unpackhi_ps(c[0], c[1]), u3 = _mm256_unpackhi_ps(c[2], c[3]); /* sy sy sz sz */
+    const __m256 sx = _mm256_shuffle_ps(u0, u1, 0xEE), sy = _mm256_shuffle_ps(u2, u3, 0x44),
+                 sz = _mm256_shuffle_ps(u2, u3, 0xEE);
     const __m256 xx = _mm256_mul_ps(x, x), yy = _mm256_mul_ps(y, y), zz = _mm256_mul_ps(z, z);
     const __m256 xy = _mm256_mul_ps(x, y), xz = _mm256_mul_ps(x, z), yz = _mm256_mul_ps(y, z);
     const __m256 wx = _mm256_mul_ps(w, x), wy = _mm256_mul_ps(w, y), wz = _mm256_mul_ps(w, z);
