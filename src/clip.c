@@ -496,18 +496,27 @@ static AKP_ALWAYS_INLINE void refresh_group(const ak_clip* clip, const akp_clip_
     else cache_write(G, f, mask, false, k0, k1, k2, k3);
 }
 
-/* Sample every group through the cache (time not NaN). The body of the kernels below. */
-static AKP_ALWAYS_INLINE void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache,
-                                            float* pose) {
+/* Make group g's cached lanes valid for time: refresh the lanes whose interval it has left. */
+static AKP_ALWAYS_INLINE void group_validate(const ak_clip* clip, size_t g, float time, uint32_t* segs,
+                                             uint32_t* cache) {
+    const __m128 T = _mm_set1_ps(time);
+    uint32_t* c = cache + g * CACHE_GROUP_U32;
+    const float* f = (const float*)(const void*)c;
+    int in = _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(T, _mm_load_ps(f + 4 * F_LO)),
+                                        _mm_cmplt_ps(T, _mm_load_ps(f + 4 * F_HI))));
+    if (in != 15) refresh_group(clip, &clip->groups[g], segs, (float*)(void*)c, ~in & 15, time);
+}
+
+/* Sample group g through the cache (time not NaN). */
+static AKP_ALWAYS_INLINE void sample_group(const ak_clip* clip, size_t g, float time, uint32_t* segs, uint32_t* cache,
+                                           float* pose) {
     const __m128 T = _mm_set1_ps(time), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f),
                  ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
-    for (size_t g = 0; g < clip->group_count; ++g) {
+    {
         const akp_clip_group* G = &clip->groups[g];
         uint32_t* c = cache + g * CACHE_GROUP_U32;
         const float* f = (const float*)(const void*)c;
-        int in = _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(T, _mm_load_ps(f + 4 * F_LO)),
-                                            _mm_cmplt_ps(T, _mm_load_ps(f + 4 * F_HI))));
-        if (in != 15) refresh_group(clip, G, segs, (float*)(void*)c, ~in & 15, time);
+        group_validate(clip, g, time, segs, cache);
         __m128 u = _mm_div_ps(_mm_sub_ps(T, _mm_load_ps(f + 4 * F_T0)), _mm_load_ps(f + 4 * F_DT));
         u = _mm_min_ps(one, _mm_max_ps(zero, u)); /* u < 0 ? 0 : (u > 1 ? 1 : u), NaN kept */
         const __m128 hold = _mm_load_ps(f + 4 * F_HOLD);
@@ -529,7 +538,7 @@ static AKP_ALWAYS_INLINE void sample_groups(const ak_clip* clip, float time, uin
                 _mm_storel_pi((__m64*)(void*)o, r[l]);
                 _mm_store_ss(o + 2, _mm_movehl_ps(r[l], r[l]));
             }
-            continue;
+            return;
         }
         __m128 aw = _mm_load_ps(f + 4 * (F_A + 3));
         __m128 qx, qy, qz, qw;
@@ -568,6 +577,96 @@ static AKP_ALWAYS_INLINE void sample_groups(const ak_clip* clip, float time, uin
     }
 }
 
+/* Sample every group through the cache (time not NaN): the SSE2 kernel. */
+static AKP_ALWAYS_INLINE void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache,
+                                            float* pose) {
+    for (size_t g = 0; g < clip->group_count; ++g) sample_group(clip, g, time, segs, cache, pose);
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+/* sin4_half_pi on eight lanes. */
+__attribute__((target("avx2"), always_inline)) static inline __m256 sin8_half_pi(__m256 x) {
+    __m256 x2 = _mm256_mul_ps(x, x);
+    __m256 p = _mm256_set1_ps(1.0f / 6227020800.0f);
+    p = _mm256_sub_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 39916800.0f));
+    p = _mm256_add_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 362880.0f));
+    p = _mm256_sub_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 5040.0f));
+    p = _mm256_add_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 120.0f));
+    p = _mm256_sub_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 6.0f));
+    return _mm256_add_ps(x, _mm256_mul_ps(x, _mm256_mul_ps(x2, p)));
+}
+
+/* Two SLERP groups g and g + 1 at once, group g in the low and g + 1 in the high half of AVX
+ * registers: sample_group's SLERP operations lane for lane (the same floats), half the
+ * instructions for the interpolation and the transposes. */
+__attribute__((target("avx2"), always_inline)) static inline void slerp_pair8(const ak_clip* clip, size_t g, float time,
+                                                                              uint32_t* segs, uint32_t* cache,
+                                                                              float* pose) {
+    group_validate(clip, g, time, segs, cache);
+    group_validate(clip, g + 1, time, segs, cache);
+    const akp_clip_group* G[2] = {&clip->groups[g], &clip->groups[g + 1]};
+    const float* f0 = (const float*)(const void*)(cache + g * CACHE_GROUP_U32);
+    const float* f1 = f0 + CACHE_GROUP_U32;
+#define AKP_LD8(field) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(f0 + 4 * (field))), _mm_load_ps(f1 + 4 * (field)), 1)
+    const __m256 T = _mm256_set1_ps(time), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f),
+                 ones = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    __m256 u = _mm256_div_ps(_mm256_sub_ps(T, AKP_LD8(F_T0)), AKP_LD8(F_DT));
+    u = _mm256_min_ps(one, _mm256_max_ps(zero, u));
+    const __m256 hold = AKP_LD8(F_HOLD);
+    const __m256 ax = AKP_LD8(F_A), ay = AKP_LD8(F_A + 1), az = AKP_LD8(F_A + 2), aw = AKP_LD8(F_A + 3);
+    const __m256 bx = AKP_LD8(F_B), by = AKP_LD8(F_B + 1), bz = AKP_LD8(F_B + 2), bw = AKP_LD8(F_B + 3);
+    const __m256 th = AKP_LD8(F_TH), is = AKP_LD8(F_IS);
+    __m256 wa = _mm256_mul_ps(sin8_half_pi(_mm256_mul_ps(_mm256_sub_ps(one, u), th)), is);
+    __m256 wb = _mm256_mul_ps(_mm256_mul_ps(sin8_half_pi(_mm256_mul_ps(u, th)), is), AKP_LD8(F_SG));
+    __m256 qx = _mm256_add_ps(_mm256_mul_ps(wa, ax), _mm256_mul_ps(wb, bx));
+    __m256 qy = _mm256_add_ps(_mm256_mul_ps(wa, ay), _mm256_mul_ps(wb, by));
+    __m256 qz = _mm256_add_ps(_mm256_mul_ps(wa, az), _mm256_mul_ps(wb, bz));
+    __m256 qw = _mm256_add_ps(_mm256_mul_ps(wa, aw), _mm256_mul_ps(wb, bw));
+    __m256 n2 = _mm256_add_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(qx, qx), _mm256_mul_ps(qy, qy)), _mm256_mul_ps(qz, qz)),
+        _mm256_mul_ps(qw, qw));
+    __m256 ok = _mm256_and_ps(_mm256_cmp_ps(n2, _mm256_set1_ps(1e-30f), _CMP_GT_OQ),
+                              _mm256_cmp_ps(n2, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ));
+    __m256 sc = _mm256_div_ps(one, _mm256_sqrt_ps(n2));
+    qx = _mm256_blendv_ps(_mm256_mul_ps(qx, sc), ax, hold);
+    qy = _mm256_blendv_ps(_mm256_mul_ps(qy, sc), ay, hold);
+    qz = _mm256_blendv_ps(_mm256_mul_ps(qz, sc), az, hold);
+    qw = _mm256_blendv_ps(_mm256_mul_ps(qw, sc), aw, hold);
+    /* _MM_TRANSPOSE4_PS in both halves */
+    const __m256 t0 = _mm256_unpacklo_ps(qx, qy), t1 = _mm256_unpackhi_ps(qx, qy);
+    const __m256 t2 = _mm256_unpacklo_ps(qz, qw), t3 = _mm256_unpackhi_ps(qz, qw);
+    const __m256 r[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE),
+                         _mm256_shuffle_ps(t1, t3, 0x44), _mm256_shuffle_ps(t1, t3, 0xEE)};
+    const int redo = _mm256_movemask_ps(
+        _mm256_andnot_ps(hold, _mm256_or_ps(_mm256_andnot_ps(ok, ones), AKP_LD8(F_FIX))));
+#undef AKP_LD8
+    for (int l = 0; l < 4; ++l) {
+        _mm_storeu_ps(pose + G[0]->dst[l], _mm256_castps256_ps128(r[l]));
+        _mm_storeu_ps(pose + G[1]->dst[l], _mm256_extractf128_ps(r[l], 1));
+    }
+    if (redo)
+        for (int h = 0; h < 2; ++h)
+            for (int l = 0; l < 4; ++l)
+                if (redo >> (4 * h + l) & 1) eval_fast(&clip->channels[G[h]->ch[l]], segs[G[h]->ch[l]], time, pose);
+}
+
+/* The AVX kernels' loop: consecutive SLERP groups two by two, the rest as sample_groups. */
+__attribute__((target("avx2"), always_inline)) static inline void sample_groups_pairs(const ak_clip* clip, float time,
+                                                                                      uint32_t* segs, uint32_t* cache,
+                                                                                      float* pose) {
+    for (size_t g = 0; g < clip->group_count; ++g) {
+        if (g + 1 < clip->group_count && clip->groups[g].kind == AKP_CLIP_FAST_SLERP &&
+            clip->groups[g + 1].kind == AKP_CLIP_FAST_SLERP) {
+            slerp_pair8(clip, g, time, segs, cache, pose);
+            ++g;
+            continue;
+        }
+        sample_group(clip, g, time, segs, cache, pose);
+    }
+}
+#endif
+
 /* sample_groups compiled three times: SSE2 (the x86-64 baseline), and with the VEX (AVX2) and
  * EVEX (AVX-512 VL: 32 registers) encodings for CPUs that have them, chosen at run time
  * (clip->sample_kernel). The same SSE-width operations in the same order, no FMA (the build
@@ -579,12 +678,12 @@ static void sample_groups_sse2(const ak_clip* clip, float time, uint32_t* segs, 
 #define AKP_CLIP_VEX 1
 __attribute__((target("avx2"))) static void sample_groups_avx2(const ak_clip* clip, float time, uint32_t* segs,
                                                                uint32_t* cache, float* pose) {
-    sample_groups(clip, time, segs, cache, pose);
+    sample_groups_pairs(clip, time, segs, cache, pose);
 }
 __attribute__((target("avx512f,avx512vl,avx2"))) static void sample_groups_avx512(const ak_clip* clip, float time,
                                                                                   uint32_t* segs, uint32_t* cache,
                                                                                   float* pose) {
-    sample_groups(clip, time, segs, cache, pose);
+    sample_groups_pairs(clip, time, segs, cache, pose);
 }
 #else
 #define AKP_CLIP_VEX 0

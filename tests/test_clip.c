@@ -310,6 +310,50 @@ static int compare_run(const ak_clip* c, ak_clip_cursor* cur, const float* times
     return mismatches;
 }
 
+AK_TEST(slerp_groups_in_pairs_bit_identical) {
+    /* 40 LINEAR (slerp) rotation channels: ten key-cache groups, sampled two by two in the AVX
+     * kernels; random keys with repeated ones (degenerate segments redone in scalar code), own
+     * or shared key times, times outside the keys. Every kernel must give the binary search's
+     * floats. */
+    enum { NJ = 40, NK = 12 };
+    static float times[NJ][NK], vals[NJ][NK * 4];
+    ak_rng rng = ak_rng_make(99);
+    for (int shared = 0; shared < 2; ++shared) {
+        ak_raw_channel ch[NJ];
+        for (int j = 0; j < NJ; ++j) {
+            float t = shared ? 0.0f : ak_rng_range(&rng, -0.3f, 0.3f);
+            for (int k = 0; k < NK; ++k) {
+                times[j][k] = t;
+                t += shared ? 0.1f : ak_rng_range(&rng, 0.02f, 0.2f);
+                for (int e = 0; e < 4; ++e)
+                    vals[j][4 * k + e] = k > 0 && (j + k) % 5 == 0 ? vals[j][4 * (k - 1) + e] : ak_rng_range(&rng, -1, 1);
+            }
+            memset(&ch[j], 0, sizeof ch[j]);
+            ch[j].target = AK_CHANNEL_ROTATION, ch[j].index = (uint32_t)j, ch[j].interp = AK_INTERP_LINEAR;
+            ch[j].key_count = NK, ch[j].times = times[j], ch[j].values = vals[j];
+        }
+        ak_raw_clip raw = {.channels = ch, .channel_count = NJ, .joint_count = NJ};
+        ak_clip* c = build(&raw);
+        AK_CHECK(c != NULL);
+        if (!c) return;
+        size_t full = ak_clip_cursor_storage_count(c);
+        uint32_t* seg = (uint32_t*)calloc(full, sizeof *seg);
+        for (int lim = AK_CLIP_SIMD_SCALAR; lim < AK_CLIP_SIMD_COUNT; ++lim) {
+            AK_CHECK_EQ(ak_clip_set_simd_limit(c, (ak_clip_simd)lim), AK_OK);
+            ak_clip_cursor cur;
+            AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span){seg, full}), AK_OK);
+            enum { T = 700 };
+            float ts[T];
+            for (int i = 0; i < T; ++i) ts[i] = -0.5f + 2.0f * (float)i / (float)T; /* forward, past both ends */
+            AK_CHECK_MSG(compare_run(c, &cur, ts, T) == 0, "kernel %s, shared %d", ak_clip_simd_name(c), shared);
+            for (int i = 0; i < T; ++i) ts[i] = ak_rng_range(&rng, -0.5f, 1.5f);
+            AK_CHECK_MSG(compare_run(c, &cur, ts, T) == 0, "kernel %s, shared %d (random)", ak_clip_simd_name(c), shared);
+        }
+        free(seg);
+        ak_clip_destroy(c);
+    }
+}
+
 AK_TEST(cursor_is_bit_identical_to_binary_search) {
     ak_rng rng = ak_rng_make(12);
     static float store[200000];
@@ -987,6 +1031,7 @@ int main(void) {
     AK_RUN(sample_rejects_bad_spans);
     AK_RUN(gltf_interpolation_matches_spec_formulas);
     AK_RUN(cursor_is_bit_identical_to_binary_search);
+    AK_RUN(slerp_groups_in_pairs_bit_identical);
     AK_RUN(cursor_nan_sample_keeps_degenerate_segments_exact);
     AK_RUN(inline_sampler_matches_track_eval_and_double_slerp);
     AK_RUN(blend_properties);
