@@ -7,6 +7,10 @@
 // time for two threads, the round's ratio the ratio of the two. Reported: median over
 // ROUNDS rounds, per-round ratio animkit/ozz (median, min-max) and its spread
 // (max - min) / median of the per-round ratios, in percent (the +-15% criterion is spread <= 30%).
+// The animation rows likewise run the implementations in turn, whole 4096-evaluation passes,
+// until each has run AK_VS_OZZ_ANIM_MS, in thread CPU time; ratio = fastest pass / ozz's.
+// AK_VS_OZZ_ANIM_MS (default 40) is the animation rows' time per implementation and round;
+// AK_BENCH_QUICK=1 (make bench's quick mode) shortens both (10 ms, and REP runs).
 // AK_VS_OZZ_ROWS=substring keeps only the skinning rows whose name contains it (e.g. "P+N");
 // AK_VS_OZZ_ACCESS=seq skips the random-access animation rows.
 #include <time.h>
@@ -133,6 +137,8 @@ int main(int argc, char** argv) {
   size_t n = argc > 1 ? strtoull(argv[1], nullptr, 10) : 1000000;
   if (argc > 2) ROUNDS = atoi(argv[2]);
   if (getenv("REP")) REP = atoi(getenv("REP"));
+  const bool quick = getenv("AK_BENCH_QUICK") && !strcmp(getenv("AK_BENCH_QUICK"), "1");  // make bench's quick mode
+  if (quick) ROUND_MS = 10;
   if (getenv("AK_VS_OZZ_ROUND_MS")) ROUND_MS = atof(getenv("AK_VS_OZZ_ROUND_MS"));
   if (getenv("AK_VS_OZZ_CLOCK") && !strcmp(getenv("AK_VS_OZZ_CLOCK"), "wall")) CPU_CLOCK = false;
   const char* row_filter = getenv("AK_VS_OZZ_ROWS");
@@ -473,7 +479,7 @@ int main(int argc, char** argv) {
     // sequential) with every implementation, in an order rotated every rep; reps repeat until
     // every implementation has run ANIM_MS ms (and at least REP times).
     const int C = F;
-    const double ANIM_MS = getenv("AK_VS_OZZ_ANIM_MS") ? atof(getenv("AK_VS_OZZ_ANIM_MS")) : 40.0;
+    const double ANIM_MS = getenv("AK_VS_OZZ_ANIM_MS") ? atof(getenv("AK_VS_OZZ_ANIM_MS")) : quick ? 0.0 : 40.0;
     for (int round = 0; round < ROUNDS; ++round)
       for (int acc = 0; acc < (seq_only ? 1 : 2); ++acc)
         for (int mode = 0; mode < 3; ++mode) {
