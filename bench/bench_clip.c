@@ -107,6 +107,24 @@ int main(void) {
             printf("%-12s %-10s %14.3e %14.3e %14.3e %11.2f %11.2f\n", ak_interp_name(modes[m]), names[s], j[0], j[1],
                    j[2], j[0] / j[2], j[1] / j[2]);
         }
+        if (modes[m] == AK_INTERP_LINEAR) {
+            /* the key cache with each sampling kernel this CPU has (ak_clip_set_simd_limit),
+             * interleaved rep by rep, sequential access */
+            double best[AK_CLIP_SIMD_COUNT];
+            char name[AK_CLIP_SIMD_COUNT][16];
+            for (int k = 0; k < AK_CLIP_SIMD_COUNT; ++k) best[k] = 1e30;
+            for (int rep = 0; rep < 11; ++rep)
+                for (int k = AK_CLIP_SIMD_SSE2; k < AK_CLIP_SIMD_COUNT; ++k) {
+                    ak_clip_set_simd_limit(clip, (ak_clip_simd)k);
+                    snprintf(name[k], sizeof name[k], "%s", ak_clip_simd_name(clip));
+                    double d = run_once(clip, seq, 0, &checksum);
+                    best[k] = d < best[k] ? d : best[k];
+                }
+            ak_clip_set_simd_limit(clip, AK_CLIP_SIMD_DEFAULT);
+            for (int k = AK_CLIP_SIMD_SSE2; k < AK_CLIP_SIMD_COUNT; ++k)
+                printf("  key cache, linear, sequential, kernel limit %d: %-7s %12.3e j/s  time vs sse2 %.2f\n", k,
+                       name[k], (double)FRAMES * JOINTS / best[k], best[k] / best[AK_CLIP_SIMD_SSE2]);
+        }
         ak_clip_destroy(clip);
     }
     printf("(checksum %g)\n", (double)checksum);

@@ -65,8 +65,26 @@ int main(void) {
         if (t2 - t1 < best_trs) best_trs = t2 - t1;
         if (t3 - t2 < best_batch) best_batch = t3 - t2;
     }
+    /* Each FK kernel this CPU has (ak_skeleton_set_simd_limit), interleaved rep by rep. */
+    double best_k[AK_FK_SIMD_COUNT];
+    char kname[AK_FK_SIMD_COUNT][16];
+    for (int k = 0; k < AK_FK_SIMD_COUNT; ++k) best_k[k] = 1e9;
+    for (int rep = 0; rep < REPS; ++rep)
+        for (int k = AK_FK_SIMD_SCALAR; k < AK_FK_SIMD_COUNT; ++k) {
+            ak_skeleton_set_simd_limit(sk, (ak_fk_simd)k);
+            snprintf(kname[k], sizeof kname[k], "%s", ak_skeleton_simd_name(sk));
+            double t0 = bench_cpu_s();
+            for (int c = 0; c < CHARS; ++c)
+                ak_skeleton_local_to_model(sk, (ak_transform_cspan){poses + c * J, J}, (ak_mat4_span){model + c * J, J});
+            double t1 = bench_cpu_s();
+            if (t1 - t0 < best_k[k]) best_k[k] = t1 - t0;
+        }
+    ak_skeleton_set_simd_limit(sk, AK_FK_SIMD_DEFAULT);
     const double jn = (double)CHARS * J;
     printf("FK, %d joints x %d characters, best of %d (thread CPU time)\n", J, CHARS, REPS);
+    for (int k = AK_FK_SIMD_SCALAR; k < AK_FK_SIMD_COUNT; ++k)
+        printf("  kernel limit %d: %-8s %8.2f Mjoints/s   time vs scalar %.2f\n", k, kname[k], jn / best_k[k] * 1e-6,
+               best_k[k] / best_k[AK_FK_SIMD_SCALAR]);
     printf("  local_to_model (matrix chain)   %8.2f Mjoints/s\n", jn / best_mat * 1e-6);
     printf("  TRS compose + to_mat4           %8.2f Mjoints/s   matrix/TRS time ratio %.2f\n",
            jn / best_trs * 1e-6, best_mat / best_trs);

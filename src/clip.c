@@ -373,6 +373,12 @@ static inline __m128 load3(const float* p) {
     return _mm_movelh_ps(_mm_loadl_pi(_mm_setzero_ps(), (const __m64*)(const void*)p), _mm_load_ss(p + 2));
 }
 
+#if defined(__GNUC__)
+#define AKP_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define AKP_ALWAYS_INLINE inline
+#endif
+
 /* One lane's refreshed state. */
 typedef struct lane_keys {
     float lo, hi, t0, dt;
@@ -382,7 +388,7 @@ typedef struct lane_keys {
 } lane_keys;
 
 /* Lane l's new interval and key pointers (refresh true), or harmless fillers. */
-static inline lane_keys lane_refresh(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, int l, bool refresh,
+static AKP_ALWAYS_INLINE lane_keys lane_refresh(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, int l, bool refresh,
                                      float t) {
     const ak_track* tr = &clip->channels[G->ch[l]].track;
     const float* times = tr->times;
@@ -407,17 +413,16 @@ static inline lane_keys lane_refresh(const ak_clip* clip, const akp_clip_group* 
     return r;
 }
 
-#if defined(__GNUC__)
-#define AKP_ALWAYS_INLINE __attribute__((always_inline)) inline
-#else
-#define AKP_ALWAYS_INLINE inline
-#endif
-
 /* Write the keys k0..k3 of the lanes in mask into the cache (full: all four, no blend). */
 static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int mask, bool full, lane_keys k0,
                                           lane_keys k1, lane_keys k2, lane_keys k3) {
     const float* pa[4] = {k0.pa, k1.pa, k2.pa, k3.pa};
     const float* pb[4] = {k0.pb, k1.pb, k2.pb, k3.pb};
+    /* Forward playback reads each track's keys in order, but a clip has more tracks than the
+     * hardware prefetcher follows streams: fetch the cache line after the new keys now, so
+     * the refreshes a few keys later find it. */
+    for (int l = 0; l < 4; ++l)
+        if (mask >> l & 1) _mm_prefetch((const char*)(uintptr_t)((uintptr_t)pb[l] + 64u), _MM_HINT_T0); /* may pass the end: a hint */
     const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
     const __m128 m = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(mask), bits), bits));
 #define AKP_PUT(field, v)                                                                                        \
@@ -471,7 +476,7 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
  * four lanes are transposed in SIMD registers and the refreshed lanes written into the cache.
  * A group whose channels share their key times (G->shared) refreshes all four lanes together,
  * so lane 0's segment serves all four. */
-static void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
+static AKP_ALWAYS_INLINE void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
     if (mask == 15 && G->shared) {
         lane_keys k[4];
         k[0] = lane_refresh(clip, G, segs, 0, true, t);
@@ -491,17 +496,27 @@ static void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t
     else cache_write(G, f, mask, false, k0, k1, k2, k3);
 }
 
-/* Sample every group through the cache (time not NaN). */
-static void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache, float* pose) {
+/* Make group g's cached lanes valid for time: refresh the lanes whose interval it has left. */
+static AKP_ALWAYS_INLINE void group_validate(const ak_clip* clip, size_t g, float time, uint32_t* segs,
+                                             uint32_t* cache) {
+    const __m128 T = _mm_set1_ps(time);
+    uint32_t* c = cache + g * CACHE_GROUP_U32;
+    const float* f = (const float*)(const void*)c;
+    int in = _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(T, _mm_load_ps(f + 4 * F_LO)),
+                                        _mm_cmplt_ps(T, _mm_load_ps(f + 4 * F_HI))));
+    if (in != 15) refresh_group(clip, &clip->groups[g], segs, (float*)(void*)c, ~in & 15, time);
+}
+
+/* Sample group g through the cache (time not NaN). */
+static AKP_ALWAYS_INLINE void sample_group(const ak_clip* clip, size_t g, float time, uint32_t* segs, uint32_t* cache,
+                                           float* pose) {
     const __m128 T = _mm_set1_ps(time), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f),
                  ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
-    for (size_t g = 0; g < clip->group_count; ++g) {
+    {
         const akp_clip_group* G = &clip->groups[g];
         uint32_t* c = cache + g * CACHE_GROUP_U32;
         const float* f = (const float*)(const void*)c;
-        int in = _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(T, _mm_load_ps(f + 4 * F_LO)),
-                                            _mm_cmplt_ps(T, _mm_load_ps(f + 4 * F_HI))));
-        if (in != 15) refresh_group(clip, G, segs, (float*)(void*)c, ~in & 15, time);
+        group_validate(clip, g, time, segs, cache);
         __m128 u = _mm_div_ps(_mm_sub_ps(T, _mm_load_ps(f + 4 * F_T0)), _mm_load_ps(f + 4 * F_DT));
         u = _mm_min_ps(one, _mm_max_ps(zero, u)); /* u < 0 ? 0 : (u > 1 ? 1 : u), NaN kept */
         const __m128 hold = _mm_load_ps(f + 4 * F_HOLD);
@@ -523,7 +538,7 @@ static void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint3
                 _mm_storel_pi((__m64*)(void*)o, r[l]);
                 _mm_store_ss(o + 2, _mm_movehl_ps(r[l], r[l]));
             }
-            continue;
+            return;
         }
         __m128 aw = _mm_load_ps(f + 4 * (F_A + 3));
         __m128 qx, qy, qz, qw;
@@ -561,7 +576,148 @@ static void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint3
                 if (redo >> l & 1) eval_fast(&clip->channels[G->ch[l]], segs[G->ch[l]], time, pose);
     }
 }
+
+/* Sample every group through the cache (time not NaN): the SSE2 kernel. */
+static AKP_ALWAYS_INLINE void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache,
+                                            float* pose) {
+    for (size_t g = 0; g < clip->group_count; ++g) sample_group(clip, g, time, segs, cache, pose);
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+/* sin4_half_pi on eight lanes. */
+__attribute__((target("avx2"), always_inline)) static inline __m256 sin8_half_pi(__m256 x) {
+    __m256 x2 = _mm256_mul_ps(x, x);
+    __m256 p = _mm256_set1_ps(1.0f / 6227020800.0f);
+    p = _mm256_sub_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 39916800.0f));
+    p = _mm256_add_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 362880.0f));
+    p = _mm256_sub_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 5040.0f));
+    p = _mm256_add_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 120.0f));
+    p = _mm256_sub_ps(_mm256_mul_ps(p, x2), _mm256_set1_ps(1.0f / 6.0f));
+    return _mm256_add_ps(x, _mm256_mul_ps(x, _mm256_mul_ps(x2, p)));
+}
+
+/* Two SLERP groups g and g + 1 at once, group g in the low and g + 1 in the high half of AVX
+ * registers: sample_group's SLERP operations lane for lane (the same floats), half the
+ * instructions for the interpolation and the transposes. */
+__attribute__((target("avx2"), always_inline)) static inline void slerp_pair8(const ak_clip* clip, size_t g, float time,
+                                                                              uint32_t* segs, uint32_t* cache,
+                                                                              float* pose) {
+    group_validate(clip, g, time, segs, cache);
+    group_validate(clip, g + 1, time, segs, cache);
+    const akp_clip_group* G[2] = {&clip->groups[g], &clip->groups[g + 1]};
+    const float* f0 = (const float*)(const void*)(cache + g * CACHE_GROUP_U32);
+    const float* f1 = f0 + CACHE_GROUP_U32;
+#define AKP_LD8(field) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(f0 + 4 * (field))), _mm_load_ps(f1 + 4 * (field)), 1)
+    const __m256 T = _mm256_set1_ps(time), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f),
+                 ones = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    __m256 u = _mm256_div_ps(_mm256_sub_ps(T, AKP_LD8(F_T0)), AKP_LD8(F_DT));
+    u = _mm256_min_ps(one, _mm256_max_ps(zero, u));
+    const __m256 hold = AKP_LD8(F_HOLD);
+    const __m256 ax = AKP_LD8(F_A), ay = AKP_LD8(F_A + 1), az = AKP_LD8(F_A + 2), aw = AKP_LD8(F_A + 3);
+    const __m256 bx = AKP_LD8(F_B), by = AKP_LD8(F_B + 1), bz = AKP_LD8(F_B + 2), bw = AKP_LD8(F_B + 3);
+    const __m256 th = AKP_LD8(F_TH), is = AKP_LD8(F_IS);
+    __m256 wa = _mm256_mul_ps(sin8_half_pi(_mm256_mul_ps(_mm256_sub_ps(one, u), th)), is);
+    __m256 wb = _mm256_mul_ps(_mm256_mul_ps(sin8_half_pi(_mm256_mul_ps(u, th)), is), AKP_LD8(F_SG));
+    __m256 qx = _mm256_add_ps(_mm256_mul_ps(wa, ax), _mm256_mul_ps(wb, bx));
+    __m256 qy = _mm256_add_ps(_mm256_mul_ps(wa, ay), _mm256_mul_ps(wb, by));
+    __m256 qz = _mm256_add_ps(_mm256_mul_ps(wa, az), _mm256_mul_ps(wb, bz));
+    __m256 qw = _mm256_add_ps(_mm256_mul_ps(wa, aw), _mm256_mul_ps(wb, bw));
+    __m256 n2 = _mm256_add_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(qx, qx), _mm256_mul_ps(qy, qy)), _mm256_mul_ps(qz, qz)),
+        _mm256_mul_ps(qw, qw));
+    __m256 ok = _mm256_and_ps(_mm256_cmp_ps(n2, _mm256_set1_ps(1e-30f), _CMP_GT_OQ),
+                              _mm256_cmp_ps(n2, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ));
+    __m256 sc = _mm256_div_ps(one, _mm256_sqrt_ps(n2));
+    qx = _mm256_blendv_ps(_mm256_mul_ps(qx, sc), ax, hold);
+    qy = _mm256_blendv_ps(_mm256_mul_ps(qy, sc), ay, hold);
+    qz = _mm256_blendv_ps(_mm256_mul_ps(qz, sc), az, hold);
+    qw = _mm256_blendv_ps(_mm256_mul_ps(qw, sc), aw, hold);
+    /* _MM_TRANSPOSE4_PS in both halves */
+    const __m256 t0 = _mm256_unpacklo_ps(qx, qy), t1 = _mm256_unpackhi_ps(qx, qy);
+    const __m256 t2 = _mm256_unpacklo_ps(qz, qw), t3 = _mm256_unpackhi_ps(qz, qw);
+    const __m256 r[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE),
+                         _mm256_shuffle_ps(t1, t3, 0x44), _mm256_shuffle_ps(t1, t3, 0xEE)};
+    const int redo = _mm256_movemask_ps(
+        _mm256_andnot_ps(hold, _mm256_or_ps(_mm256_andnot_ps(ok, ones), AKP_LD8(F_FIX))));
+#undef AKP_LD8
+    for (int l = 0; l < 4; ++l) {
+        _mm_storeu_ps(pose + G[0]->dst[l], _mm256_castps256_ps128(r[l]));
+        _mm_storeu_ps(pose + G[1]->dst[l], _mm256_extractf128_ps(r[l], 1));
+    }
+    if (redo)
+        for (int h = 0; h < 2; ++h)
+            for (int l = 0; l < 4; ++l)
+                if (redo >> (4 * h + l) & 1) eval_fast(&clip->channels[G[h]->ch[l]], segs[G[h]->ch[l]], time, pose);
+}
+
+/* The AVX kernels' loop: consecutive SLERP groups two by two, the rest as sample_groups. */
+__attribute__((target("avx2"), always_inline)) static inline void sample_groups_pairs(const ak_clip* clip, float time,
+                                                                                      uint32_t* segs, uint32_t* cache,
+                                                                                      float* pose) {
+    for (size_t g = 0; g < clip->group_count; ++g) {
+        if (g + 1 < clip->group_count && clip->groups[g].kind == AKP_CLIP_FAST_SLERP &&
+            clip->groups[g + 1].kind == AKP_CLIP_FAST_SLERP) {
+            slerp_pair8(clip, g, time, segs, cache, pose);
+            ++g;
+            continue;
+        }
+        sample_group(clip, g, time, segs, cache, pose);
+    }
+}
 #endif
+
+/* sample_groups compiled three times: SSE2 (the x86-64 baseline), and with the VEX (AVX2) and
+ * EVEX (AVX-512 VL: 32 registers) encodings for CPUs that have them, chosen at run time
+ * (clip->sample_kernel). The same SSE-width operations in the same order, no FMA (the build
+ * disables contraction), so every kernel gives the same floats. */
+static void sample_groups_sse2(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache, float* pose) {
+    sample_groups(clip, time, segs, cache, pose);
+}
+#if defined(__GNUC__) && defined(__x86_64__)
+#define AKP_CLIP_VEX 1
+__attribute__((target("avx2"))) static void sample_groups_avx2(const ak_clip* clip, float time, uint32_t* segs,
+                                                               uint32_t* cache, float* pose) {
+    sample_groups_pairs(clip, time, segs, cache, pose);
+}
+__attribute__((target("avx512f,avx512vl,avx2"))) static void sample_groups_avx512(const ak_clip* clip, float time,
+                                                                                  uint32_t* segs, uint32_t* cache,
+                                                                                  float* pose) {
+    sample_groups_pairs(clip, time, segs, cache, pose);
+}
+#else
+#define AKP_CLIP_VEX 0
+#endif
+#endif
+
+/* The sampling kernel for a limit on this CPU (AKP_CLIP_K_*). */
+static uint8_t clip_kernel_pick(ak_clip_simd limit) {
+    const ak_clip_simd lim = limit == AK_CLIP_SIMD_DEFAULT ? AK_CLIP_SIMD_AVX512 : limit;
+    if (lim == AK_CLIP_SIMD_SCALAR) return AKP_CLIP_K_SCALAR;
+#if AK_SIMD_SSE2 && AKP_CLIP_VEX
+    if (lim >= AK_CLIP_SIMD_AVX512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx2"))
+        return AKP_CLIP_K_AVX512;
+    if (lim >= AK_CLIP_SIMD_AVX2 && __builtin_cpu_supports("avx2")) return AKP_CLIP_K_AVX2;
+#endif
+#if AK_SIMD_SSE2
+    return AKP_CLIP_K_SSE2;
+#else
+    return AKP_CLIP_K_SCALAR;
+#endif
+}
+
+ak_result ak_clip_set_simd_limit(ak_clip* clip, ak_clip_simd limit) {
+    if (!clip) return AK_ERR_NULL_ARG;
+    if ((unsigned)limit >= (unsigned)AK_CLIP_SIMD_COUNT) return AK_ERR_BAD_ARG;
+    clip->sample_kernel = clip_kernel_pick(limit);
+    return AK_OK;
+}
+
+const char* ak_clip_simd_name(const ak_clip* clip) {
+    static const char* const names[] = {"scalar", "sse2", "avx2", "avx512"};
+    return clip ? names[clip->sample_kernel] : "";
+}
 
 /* Group the FAST channels four by four per kind (SIMD builds); the rest go to the slow list. */
 static void make_groups(ak_clip* clip) {
@@ -689,6 +845,7 @@ ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_cl
     }
     clip->duration = raw->duration > 0.0f ? raw->duration : last;
     make_groups(clip);
+    clip->sample_kernel = clip_kernel_pick(AK_CLIP_SIMD_DEFAULT);
     *out_clip = clip;
     return AK_OK;
 }
@@ -753,8 +910,17 @@ ak_result ak_clip_sample(const ak_clip* clip, float time, ak_clip_cursor* cursor
     if (s && scalars.count < clip->scalar_count) return AK_ERR_SPAN_SMALL;
     uint32_t* cache = cursor && time == time ? cursor_cache(cursor) : NULL; /* NaN: the plain path */
 #if AK_SIMD_SSE2
-    if (cache) {
-        if (clip->has_joint_channels) sample_groups(clip, time, cursor->segments, cache, &local.ptr[0].translation.x);
+    if (cache && clip->sample_kernel != AKP_CLIP_K_SCALAR) {
+        if (clip->has_joint_channels) {
+            float* pose = &local.ptr[0].translation.x;
+            switch (clip->sample_kernel) {
+#if AKP_CLIP_VEX
+            case AKP_CLIP_K_AVX512: sample_groups_avx512(clip, time, cursor->segments, cache, pose); break;
+            case AKP_CLIP_K_AVX2: sample_groups_avx2(clip, time, cursor->segments, cache, pose); break;
+#endif
+            default: sample_groups_sse2(clip, time, cursor->segments, cache, pose); break;
+            }
+        }
         sample_channels(clip, clip->slow, clip->slow_count, time, cursor->segments, local.ptr, w, s);
         return AK_OK;
     }

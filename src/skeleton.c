@@ -16,7 +16,12 @@ struct ak_skeleton {
     uint32_t* child_counts;      /* [n] */
     uint8_t* types;              /* [n] ak_joint_type */
     bool palette_from_skins;     /* desc.palette_from_skins */
+    uint8_t fk_kernel;           /* AKP_FK_K_*: the FK kernel (fk_pick at create, or the limit set) */
 };
+
+/* FK kernels (src/skeleton.c, "forward kinematics"). */
+enum { AKP_FK_K_SCALAR = 0, AKP_FK_K_AVX, AKP_FK_K_AVX2, AKP_FK_K_AVX512 };
+static uint8_t fk_pick(ak_fk_simd limit);
 
 #define MAX_JOINTS 32767u
 
@@ -183,6 +188,7 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
     sk->joint_count = n;
     if (desc->name) snprintf(sk->name, sizeof sk->name, "%s", desc->name);
     sk->palette_from_skins = desc->palette_from_skins;
+    sk->fk_kernel = fk_pick(AK_FK_SIMD_DEFAULT);
     sk->parents = (int16_t*)(base + off_parents);
     sk->rest = (ak_transform*)(base + off_rest);
     sk->inverse_binds = (ak_mat4*)(base + off_ib);
@@ -366,39 +372,31 @@ static bool mat4_affine(const ak_mat4* m) {
 #if AK_SIMD_SSE2 && defined(__GNUC__) && defined(__x86_64__)
 #define AKP_FK_AVX 1
 #include <immintrin.h>
-/* The TRS of joints b .. b + 7 (joints past cnt repeat joint b) as four-joint SSE vectors:
- * t[h] = tx ty tz qx, q[h] = qx qy qz qw, s[h] = qw sx sy sz of joints b + 4h .. b + 4h + 3,
- * transposed to lanes (t[h][0] = the four tx, ...). Loads stay inside each ak_transform. */
-static inline void gather8(const ak_transform* local, size_t b, size_t cnt, __m128 q[2][4], __m128 t[2][4],
-                           __m128 s[2][4]) {
-    for (int h = 0; h < 2; ++h) {
-        for (int v = 0; v < 4; ++v) {
-            size_t j = (size_t)(4 * h + v);
-            const float* f = &local[b + (j < cnt ? j : 0)].translation.x;
-            t[h][v] = _mm_loadu_ps(f);     /* tx ty tz qx */
-            q[h][v] = _mm_loadu_ps(f + 3); /* qx qy qz qw */
-            s[h][v] = _mm_loadu_ps(f + 6); /* qw sx sy sz */
-        }
-        _MM_TRANSPOSE4_PS(t[h][0], t[h][1], t[h][2], t[h][3]);
-        _MM_TRANSPOSE4_PS(q[h][0], q[h][1], q[h][2], q[h][3]);
-        _MM_TRANSPOSE4_PS(s[h][0], s[h][1], s[h][2], s[h][3]);
-    }
-}
-
-/* The local matrices of joints b .. b + cnt - 1 (cnt <= 8) in structure-of-arrays form, for
- * fk_affine_avx and fk_affine_fma: L[0..8] the 3x3 part column by column (ak_mat3_from_quat's
- * formulas times the scale, lane by lane, no FMA), L[9..11] the translation. */
+/* The local 3x3 parts of joints b .. b + cnt - 1 (cnt <= 8) in structure-of-arrays form:
+ * L[0..8] column by column (ak_mat3_from_quat's formulas times the scale, lane by lane, no
+ * FMA, so the same floats as ak_transform_to_mat4). The rotations (and scales) of joints v and
+ * v + 4 load into the two halves of one AVX register (the second half an insert from memory, no
+ * shuffle), and one 4x4 transpose within the halves gives all eight joints' components; joints
+ * past cnt repeat joint b. The translations are not gathered (the products broadcast them from
+ * the pose itself). */
 __attribute__((target("avx"), always_inline)) static inline void local_soa8(const ak_transform* local, size_t b,
-                                                                            size_t cnt, float L[12][8]) {
-    __m128 q[2][4], t[2][4], s[2][4];
-    gather8(local, b, cnt, q, t, s);
-#define AKP_W8(a, k) _mm256_insertf128_ps(_mm256_castps128_ps256(a[0][k]), a[1][k], 1)
-    const __m256 x = AKP_W8(q, 0), y = AKP_W8(q, 1), z = AKP_W8(q, 2), w = AKP_W8(q, 3);
-    const __m256 sx = AKP_W8(s, 1), sy = AKP_W8(s, 2), sz = AKP_W8(s, 3);
-    _mm256_store_ps(L[9], AKP_W8(t, 0));
-    _mm256_store_ps(L[10], AKP_W8(t, 1));
-    _mm256_store_ps(L[11], AKP_W8(t, 2));
-#undef AKP_W8
+                                                                            size_t cnt, float L[9][8]) {
+    __m256 r[4], c[4];
+    for (int v = 0; v < 4; ++v) {
+        const size_t jl = (size_t)v < cnt ? (size_t)v : 0, jh = (size_t)v + 4 < cnt ? (size_t)v + 4 : 0;
+        const float* lo = &local[b + jl].rotation.x;
+        const float* hi = &local[b + jh].rotation.x;
+        r[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1); /* q */
+        c[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo + 3)), _mm_loadu_ps(hi + 3), 1); /* qw s */
+    }
+    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
+    const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    const __m256 x = _mm256_shuffle_ps(t0, t1, 0x44), y = _mm256_shuffle_ps(t0, t1, 0xEE);
+    const __m256 z = _mm256_shuffle_ps(t2, t3, 0x44), w = _mm256_shuffle_ps(t2, t3, 0xEE);
+    const __m256 u0 = _mm256_unpacklo_ps(c[0], c[1]), u1 = _mm256_unpacklo_ps(c[2], c[3]); /* qw qw sx sx */
+    const __m256 u2 = _mm256_unpackhi_ps(c[0], c[1]), u3 = _mm256_unpackhi_ps(c[2], c[3]); /* sy sy sz sz */
+    const __m256 sx = _mm256_shuffle_ps(u0, u1, 0xEE), sy = _mm256_shuffle_ps(u2, u3, 0x44),
+                 sz = _mm256_shuffle_ps(u2, u3, 0xEE);
     const __m256 xx = _mm256_mul_ps(x, x), yy = _mm256_mul_ps(y, y), zz = _mm256_mul_ps(z, z);
     const __m256 xy = _mm256_mul_ps(x, y), xz = _mm256_mul_ps(x, z), yz = _mm256_mul_ps(y, z);
     const __m256 wx = _mm256_mul_ps(w, x), wy = _mm256_mul_ps(w, y), wz = _mm256_mul_ps(w, z);
@@ -416,107 +414,120 @@ __attribute__((target("avx"), always_inline)) static inline void local_soa8(cons
 #undef AKP_TWO
 }
 
-/* fk for no root or an affine root, with AVX (no FMA: the same roundings as ak_mat4_mul and
- * ak_transform_to_mat4): the local matrices of 8 joints at a time from their TRS (loaded as
- * vectors and transposed, gather8) in structure-of-arrays form (ak_mat3_from_quat's formulas,
- * lane by lane), then the parent products joint by joint, broadcasting the local entries from
- * memory (loads, not shuffles). */
-__attribute__((target("avx"))) static void fk_affine_avx(const ak_skeleton* sk, const ak_mat4* root,
-                                                         const ak_transform* local, ak_mat4* out) {
-    const size_t n = sk->joint_count;
-    _Alignas(32) float L[12][8];  /* columns 0..2 (x y z each) and the translation, 8 joints */
-    __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()}; /* out[i - 1] */
-    for (size_t b = 0; b < n; b += 8) {
-        const size_t cnt = n - b < 8 ? n - b : 8;
-        local_soa8(local, b, cnt, L);
-        for (size_t v = 0; v < cnt; ++v) {
-            const size_t i = b + v;
-            const int p = sk->parents[i];
-            __m128 a0, a1, a2, a3;
-            if (p >= 0 && (size_t)p + 1 == i) { /* a chain: the parent is still in registers */
-                a0 = prev[0], a1 = prev[1], a2 = prev[2], a3 = prev[3];
-            } else if (p >= 0 || root) {
-                const ak_mat4* a = p >= 0 ? &out[p] : root;
-                a0 = _mm_loadu_ps(a->m), a1 = _mm_loadu_ps(a->m + 4), a2 = _mm_loadu_ps(a->m + 8),
-                a3 = _mm_loadu_ps(a->m + 12);
-            } else { /* a root joint without root matrix: the local matrix itself */
-                for (int c = 0; c < 4; ++c)
-                    prev[c] = _mm_setr_ps(L[3 * c][v], L[3 * c + 1][v], L[3 * c + 2][v], c == 3 ? 1.0f : 0.0f);
-                for (int c = 0; c < 4; ++c) _mm_storeu_ps(out[i].m + 4 * c, prev[c]);
-                continue;
-            }
-            for (int c = 0; c < 4; ++c) { /* ((a0 b0 + a1 b1) + a2 b2) [+ a3]: ak_mat4_mul's order */
-                __m128 r = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, _mm_broadcast_ss(&L[3 * c][v])),
-                                                 _mm_mul_ps(a1, _mm_broadcast_ss(&L[3 * c + 1][v]))),
-                                      _mm_mul_ps(a2, _mm_broadcast_ss(&L[3 * c + 2][v])));
-                if (c == 3) r = _mm_add_ps(r, a3);
-                prev[c] = r;
-                _mm_storeu_ps(out[i].m + 4 * c, r);
-            }
-        }
+/* The FK kernels for no root or an affine root: the local 3x3 parts of 8 joints at a time in
+ * structure-of-arrays form (local_soa8), then the parent products joint by joint, each local
+ * entry broadcast from memory (the translation straight from the pose): with AVX-512 VL the
+ * broadcasts fold into the multiplies (embedded broadcast operands), a third of the
+ * instructions of the AVX2 kernel. A joint whose parent is the joint before it takes the
+ * parent's columns from registers. AKP_FK_PRODUCT: without FMA ((a0 b0 + a1 b1) + a2 b2
+ * [+ a3], ak_mat4_mul's order and roundings), with FMA one multiply and two fused
+ * multiply-adds per column (the translation column: three fused steps onto a3). */
+#define AKP_FK_KERNEL(NAME, TARGET, FMA)                                                                          \
+    __attribute__((target(TARGET))) static void NAME(const ak_skeleton* sk, const ak_mat4* root,                \
+                                                     const ak_transform* local, ak_mat4* out) {                \
+        const size_t n = sk->joint_count;                                                                      \
+        const int16_t* const parents = sk->parents;                                                            \
+        _Alignas(32) float L[9][8]; /* columns 0..2 (x y z each), 8 joints */                                  \
+        __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};             \
+        for (size_t b = 0; b < n; b += 8) {                                                                    \
+            const size_t cnt = n - b < 8 ? n - b : 8;                                                          \
+            local_soa8(local, b, cnt, L);                                                                      \
+            for (size_t v = 0; v < cnt; ++v) {                                                                 \
+                const size_t i = b + v;                                                                        \
+                const int p = parents[i];                                                                      \
+                const float* t = &local[i].translation.x;                                                      \
+                float* o = out[i].m;                                                                           \
+                __m128 a0, a1, a2, a3;                                                                         \
+                if (p >= 0 && (size_t)p + 1 == i) {                                                            \
+                    a0 = prev[0], a1 = prev[1], a2 = prev[2], a3 = prev[3];                                    \
+                } else if (p >= 0 || root) {                                                                   \
+                    const float* a = p >= 0 ? out[p].m : root->m;                                              \
+                    a0 = _mm_loadu_ps(a), a1 = _mm_loadu_ps(a + 4), a2 = _mm_loadu_ps(a + 8),                  \
+                    a3 = _mm_loadu_ps(a + 12);                                                                 \
+                } else { /* a root joint without root matrix: the local matrix itself */                      \
+                    for (int c = 0; c < 3; ++c) prev[c] = _mm_setr_ps(L[3 * c][v], L[3 * c + 1][v], L[3 * c + 2][v], 0.0f); \
+                    prev[3] = _mm_setr_ps(t[0], t[1], t[2], 1.0f);                                             \
+                    for (int c = 0; c < 4; ++c) _mm_storeu_ps(o + 4 * c, prev[c]);                             \
+                    continue;                                                                                  \
+                }                                                                                              \
+                AKP_FK_PRODUCT_##FMA                                                                           \
+                for (int c = 0; c < 4; ++c) _mm_storeu_ps(o + 4 * c, prev[c]);                                 \
+            }                                                                                                  \
+        }                                                                                                      \
     }
-}
+#define AKP_FK_PRODUCT_0                                                                                       \
+    for (int c = 0; c < 4; ++c) {                                                                              \
+        const float* e0 = c < 3 ? &L[3 * c][v] : t;                                                            \
+        const float* e1 = c < 3 ? &L[3 * c + 1][v] : t + 1;                                                    \
+        const float* e2 = c < 3 ? &L[3 * c + 2][v] : t + 2;                                                    \
+        __m128 r = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, _mm_broadcast_ss(e0)), _mm_mul_ps(a1, _mm_broadcast_ss(e1))),  \
+                              _mm_mul_ps(a2, _mm_broadcast_ss(e2)));                                               \
+        prev[c] = c == 3 ? _mm_add_ps(r, a3) : r;                                                              \
+    }
+#define AKP_FK_PRODUCT_1                                                                                       \
+    for (int c = 0; c < 3; ++c) {                                                                              \
+        __m128 r = _mm_mul_ps(a0, _mm_broadcast_ss(&L[3 * c][v]));                                                   \
+        r = _mm_fmadd_ps(a1, _mm_broadcast_ss(&L[3 * c + 1][v]), r);                                                 \
+        prev[c] = _mm_fmadd_ps(a2, _mm_broadcast_ss(&L[3 * c + 2][v]), r);                                           \
+    }                                                                                                          \
+    {                                                                                                          \
+        __m128 r = _mm_fmadd_ps(a0, _mm_broadcast_ss(t + 0), a3);                                                    \
+        r = _mm_fmadd_ps(a1, _mm_broadcast_ss(t + 1), r);                                                            \
+        prev[3] = _mm_fmadd_ps(a2, _mm_broadcast_ss(t + 2), r);                                                      \
+    }
 
-/* fk_affine_avx with fused multiply-adds (AVX2 + FMA CPUs, chosen at run time): the same
- * structure-of-arrays local matrices, and each model column is one multiply and two fused
- * multiply-adds. The floats differ from ak_mat4_mul's within rounding (each fused step
- * rounds once instead of twice); tests/test_skeleton.c bounds them against double. */
-__attribute__((target("avx2,fma"))) static void fk_affine_fma(const ak_skeleton* sk, const ak_mat4* root,
-                                                              const ak_transform* local, ak_mat4* out) {
-    const size_t n = sk->joint_count;
-    _Alignas(32) float L[12][8]; /* columns 0..2 (x y z each) and the translation, 8 joints */
-    __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()}; /* out[i - 1] */
-    for (size_t b = 0; b < n; b += 8) {
-        const size_t cnt = n - b < 8 ? n - b : 8;
-        local_soa8(local, b, cnt, L);
-        for (size_t v = 0; v < cnt; ++v) {
-            const size_t i = b + v;
-            const int p = sk->parents[i];
-            __m128 a0, a1, a2, a3;
-            if (p >= 0 && (size_t)p + 1 == i) { /* a chain: the parent is still in registers */
-                a0 = prev[0], a1 = prev[1], a2 = prev[2], a3 = prev[3];
-            } else if (p >= 0 || root) {
-                const ak_mat4* a = p >= 0 ? &out[p] : root;
-                a0 = _mm_loadu_ps(a->m), a1 = _mm_loadu_ps(a->m + 4), a2 = _mm_loadu_ps(a->m + 8),
-                a3 = _mm_loadu_ps(a->m + 12);
-            } else { /* a root joint without root matrix: the local matrix itself */
-                for (int c = 0; c < 4; ++c)
-                    prev[c] = _mm_setr_ps(L[3 * c][v], L[3 * c + 1][v], L[3 * c + 2][v], c == 3 ? 1.0f : 0.0f);
-                for (int c = 0; c < 4; ++c) _mm_storeu_ps(out[i].m + 4 * c, prev[c]);
-                continue;
-            }
-            for (int c = 0; c < 3; ++c) {
-                __m128 r = _mm_mul_ps(a0, _mm_broadcast_ss(&L[3 * c][v]));
-                r = _mm_fmadd_ps(a1, _mm_broadcast_ss(&L[3 * c + 1][v]), r);
-                prev[c] = _mm_fmadd_ps(a2, _mm_broadcast_ss(&L[3 * c + 2][v]), r);
-            }
-            __m128 r = _mm_fmadd_ps(a0, _mm_broadcast_ss(&L[9][v]), a3);
-            r = _mm_fmadd_ps(a1, _mm_broadcast_ss(&L[10][v]), r);
-            prev[3] = _mm_fmadd_ps(a2, _mm_broadcast_ss(&L[11][v]), r);
-            for (int c = 0; c < 4; ++c) _mm_storeu_ps(out[i].m + 4 * c, prev[c]);
-        }
-    }
-}
+AKP_FK_KERNEL(fk_affine_avx, "avx", 0)
+AKP_FK_KERNEL(fk_affine_fma, "avx2,fma", 1)
+AKP_FK_KERNEL(fk_affine_avx512, "avx512f,avx512vl,avx2,fma", 1)
+#undef AKP_FK_KERNEL
+#undef AKP_FK_PRODUCT_0
+#undef AKP_FK_PRODUCT_1
 #else
 #define AKP_FK_AVX 0
 #endif
 
+/* The kernel for a limit on this CPU. */
+static uint8_t fk_pick(ak_fk_simd limit) {
+#if AKP_FK_AVX
+    const ak_fk_simd lim = limit == AK_FK_SIMD_DEFAULT ? AK_FK_SIMD_AVX512 : limit;
+    if (lim >= AK_FK_SIMD_AVX512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+        return AKP_FK_K_AVX512;
+    if (lim >= AK_FK_SIMD_AVX2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+        return AKP_FK_K_AVX2;
+    if (lim >= AK_FK_SIMD_AVX2 && __builtin_cpu_supports("avx")) return AKP_FK_K_AVX;
+#else
+    (void)limit;
+#endif
+    return AKP_FK_K_SCALAR;
+}
+
+ak_result ak_skeleton_set_simd_limit(ak_skeleton* skeleton, ak_fk_simd limit) {
+    if (!skeleton) return AK_ERR_NULL_ARG;
+    if ((unsigned)limit >= (unsigned)AK_FK_SIMD_COUNT) return AK_ERR_BAD_ARG;
+    skeleton->fk_kernel = fk_pick(limit);
+    return AK_OK;
+}
+
+const char* ak_skeleton_simd_name(const ak_skeleton* skeleton) {
+    static const char* const names[] = {"scalar", "avx", "avx2", "avx512"};
+    return skeleton ? names[skeleton->fk_kernel] : "";
+}
+
 /* Local TRS to model matrices, parents first. Local matrices are affine, so with no root or an
  * affine root every model matrix is affine and the products skip the bottom row's terms
- * (affine_mul: a quarter fewer multiplies, SSE2 columns); a projective root keeps the full
- * 4x4 products. */
+ * (affine_mul: a quarter fewer multiplies, SSE2 columns; the SIMD kernels above where the
+ * skeleton's kernel is one); a projective root keeps the full 4x4 products. */
 static void fk(const ak_skeleton* sk, const ak_mat4* root, const ak_transform* local,
                ak_mat4* out) {
     const size_t n = sk->joint_count;
     if (!root || mat4_affine(root)) {
 #if AKP_FK_AVX
-        if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
-            fk_affine_fma(sk, root, local, out);
-            return;
-        }
-        if (__builtin_cpu_supports("avx")) {
-            fk_affine_avx(sk, root, local, out);
-            return;
+        switch (sk->fk_kernel) {
+        case AKP_FK_K_AVX512: fk_affine_avx512(sk, root, local, out); return;
+        case AKP_FK_K_AVX2: fk_affine_fma(sk, root, local, out); return;
+        case AKP_FK_K_AVX: fk_affine_avx(sk, root, local, out); return;
+        default: break;
         }
 #endif
         for (size_t i = 0; i < n; ++i) {

@@ -310,6 +310,50 @@ static int compare_run(const ak_clip* c, ak_clip_cursor* cur, const float* times
     return mismatches;
 }
 
+AK_TEST(slerp_groups_in_pairs_bit_identical) {
+    /* 40 LINEAR (slerp) rotation channels: ten key-cache groups, sampled two by two in the AVX
+     * kernels; random keys with repeated ones (degenerate segments redone in scalar code), own
+     * or shared key times, times outside the keys. Every kernel must give the binary search's
+     * floats. */
+    enum { NJ = 40, NK = 12 };
+    static float times[NJ][NK], vals[NJ][NK * 4];
+    ak_rng rng = ak_rng_make(99);
+    for (int shared = 0; shared < 2; ++shared) {
+        ak_raw_channel ch[NJ];
+        for (int j = 0; j < NJ; ++j) {
+            float t = shared ? 0.0f : ak_rng_range(&rng, -0.3f, 0.3f);
+            for (int k = 0; k < NK; ++k) {
+                times[j][k] = t;
+                t += shared ? 0.1f : ak_rng_range(&rng, 0.02f, 0.2f);
+                for (int e = 0; e < 4; ++e)
+                    vals[j][4 * k + e] = k > 0 && (j + k) % 5 == 0 ? vals[j][4 * (k - 1) + e] : ak_rng_range(&rng, -1, 1);
+            }
+            memset(&ch[j], 0, sizeof ch[j]);
+            ch[j].target = AK_CHANNEL_ROTATION, ch[j].index = (uint32_t)j, ch[j].interp = AK_INTERP_LINEAR;
+            ch[j].key_count = NK, ch[j].times = times[j], ch[j].values = vals[j];
+        }
+        ak_raw_clip raw = {.channels = ch, .channel_count = NJ, .joint_count = NJ};
+        ak_clip* c = build(&raw);
+        AK_CHECK(c != NULL);
+        if (!c) return;
+        size_t full = ak_clip_cursor_storage_count(c);
+        uint32_t* seg = (uint32_t*)calloc(full, sizeof *seg);
+        for (int lim = AK_CLIP_SIMD_SCALAR; lim < AK_CLIP_SIMD_COUNT; ++lim) {
+            AK_CHECK_EQ(ak_clip_set_simd_limit(c, (ak_clip_simd)lim), AK_OK);
+            ak_clip_cursor cur;
+            AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span){seg, full}), AK_OK);
+            enum { T = 700 };
+            float ts[T];
+            for (int i = 0; i < T; ++i) ts[i] = -0.5f + 2.0f * (float)i / (float)T; /* forward, past both ends */
+            AK_CHECK_MSG(compare_run(c, &cur, ts, T) == 0, "kernel %s, shared %d", ak_clip_simd_name(c), shared);
+            for (int i = 0; i < T; ++i) ts[i] = ak_rng_range(&rng, -0.5f, 1.5f);
+            AK_CHECK_MSG(compare_run(c, &cur, ts, T) == 0, "kernel %s, shared %d (random)", ak_clip_simd_name(c), shared);
+        }
+        free(seg);
+        ak_clip_destroy(c);
+    }
+}
+
 AK_TEST(cursor_is_bit_identical_to_binary_search) {
     ak_rng rng = ak_rng_make(12);
     static float store[200000];
@@ -323,13 +367,29 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
     size_t full = ak_clip_cursor_storage_count(c);
     AK_CHECK(full >= ak_clip_channel_count(c));
     uint32_t* seg = (uint32_t*)calloc(full + 1, sizeof *seg);
-    for (int pass = 0; pass < 2; ++pass) {
+    char dflt[16];
+    snprintf(dflt, sizeof dflt, "%s", ak_clip_simd_name(c));
+    /* pass 0..3: the full storage with each sampling kernel this CPU has (scalar, SSE2, AVX2,
+     * AVX-512; the same floats), pass 4: the minimum storage with the default kernel */
+    for (int pass = 0; pass < 5; ++pass) {
+        static const ak_clip_simd lims[5] = {AK_CLIP_SIMD_SCALAR, AK_CLIP_SIMD_SSE2, AK_CLIP_SIMD_AVX2,
+                                             AK_CLIP_SIMD_AVX512, AK_CLIP_SIMD_DEFAULT};
+        AK_CHECK_EQ(ak_clip_set_simd_limit(c, lims[pass]), AK_OK);
+        if (pass > 0 && pass < 4 && !strcmp(ak_clip_simd_name(c), "scalar")) continue; /* no SIMD build */
+        if (pass == 2 && strcmp(ak_clip_simd_name(c), "avx2") != 0) continue;     /* not on this CPU */
+        if (pass == 3 && strcmp(ak_clip_simd_name(c), "avx512") != 0) continue;
+        /* the default kernel gets every sequence; the narrower ones a quarter of each (time) */
+        const bool all = pass == 4 || !strcmp(ak_clip_simd_name(c), dflt);
+        printf("  common %d, storage %s, kernel %s%s\n", common, pass < 4 ? "full" : "minimum", ak_clip_simd_name(c),
+               all ? "" : " (short)");
         ak_clip_cursor cur;
-        ak_u32_span st = pass == 0 ? (ak_u32_span){seg + 1, full} : (ak_u32_span){seg, ak_clip_channel_count(c)};
+        ak_u32_span st = pass < 4 ? (ak_u32_span){seg + 1, full} : (ak_u32_span){seg, ak_clip_channel_count(c)};
         AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, st), AK_OK);
-        enum { T = 6000 };
-        const int nt = AK_TEST_REPS(T, T / 8); /* the samples (fewer under valgrind) */
-        static float times[T];
+        enum { TMAX = 6000 };
+        static float times[TMAX];
+        /* the samples: all of them for the default kernel, a quarter for the narrower ones; an
+         * eighth of those under valgrind (AK_TEST_SELECT=light) */
+        const int nt = AK_TEST_REPS(all ? TMAX : TMAX / 4, all ? TMAX / 8 : TMAX / 32);
         float dur = ak_clip_duration(c);
         /* Forward, backward, looping (3.3 loops), random; plus times outside the keys and on keys. */
         for (int i = 0; i < nt; ++i) times[i] = -1.0f + (dur + 2.0f) * (float)i / (float)nt;
@@ -341,7 +401,7 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
         for (int i = 0; i < nt; ++i) times[i] = ak_rng_range(&rng, -1.0f, dur + 1.0f);
         AK_CHECK_EQ(compare_run(c, &cur, times, nt), 0);
         /* on keys, next to keys, infinities and NaN */
-        for (size_t ci = 0; ci < ak_clip_channel_count(c); ++ci) {
+        for (size_t ci = 0; ci < (all ? ak_clip_channel_count(c) : 2u); ++ci) {
             ak_f32_cspan kt = ak_track_times(ak_clip_channel_track(c, ci));
             AK_CHECK_EQ(compare_run(c, &cur, kt.ptr, kt.count), 0);
             for (size_t k = 0; k < kt.count; ++k) {
@@ -352,6 +412,9 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
         float odd[5] = {INFINITY, -INFINITY, NAN, 0.5f, -0.0f};
         AK_CHECK_EQ(compare_run(c, &cur, odd, 5), 0);
     }
+    AK_CHECK_EQ(ak_clip_set_simd_limit(c, AK_CLIP_SIMD_COUNT), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_clip_set_simd_limit(NULL, AK_CLIP_SIMD_DEFAULT), AK_ERR_NULL_ARG);
+    AK_CHECK(!strcmp(ak_clip_simd_name(NULL), ""));
     free(seg);
     ak_clip_destroy(c);
     }
@@ -972,6 +1035,7 @@ int main(void) {
     AK_RUN(sample_rejects_bad_spans);
     AK_RUN(gltf_interpolation_matches_spec_formulas);
     AK_RUN(cursor_is_bit_identical_to_binary_search);
+    AK_RUN(slerp_groups_in_pairs_bit_identical);
     AK_RUN(cursor_nan_sample_keeps_degenerate_segments_exact);
     AK_RUN(inline_sampler_matches_track_eval_and_double_slerp);
     AK_RUN(blend_properties);

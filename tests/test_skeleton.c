@@ -326,12 +326,16 @@ AK_TEST(fk_affine_products_equal_full_products) {
     roots[1] = ak_transform_to_mat4(random_transform(&rng));
     roots[2] = roots[1];
     roots[2].m[3] = 0.25f, roots[2].m[15] = 2.0f; /* projective */
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
-    const float tol = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? 2e-6f : 0.0f;
-#else
-    const float tol = 0.0f;
-#endif
-    printf("  FK tolerance vs ak_mat4_mul chains: %g x the largest element\n", (double)tol);
+    /* every kernel this CPU has: scalar and AVX give ak_mat4_mul's floats, the FMA kernels
+     * (AVX2 + FMA, AVX-512) stay within a few roundings */
+    for (int lim = AK_FK_SIMD_SCALAR; lim < AK_FK_SIMD_COUNT; ++lim) {
+    AK_CHECK_EQ(ak_skeleton_set_simd_limit(sk, (ak_fk_simd)lim), AK_OK);
+    const char* kernel = ak_skeleton_simd_name(sk);
+    const bool fused = !strcmp(kernel, "avx2") || !strcmp(kernel, "avx512");
+    if (lim == AK_FK_SIMD_SCALAR) AK_CHECK(!strcmp(kernel, "scalar"));
+    if (lim == AK_FK_SIMD_AVX2) AK_CHECK(strcmp(kernel, "avx512") != 0);
+    const float tol = fused ? 2e-6f : 0.0f;
+    printf("  FK kernel %s: tolerance vs ak_mat4_mul chains %g x the largest element\n", kernel, (double)tol);
     for (int r = 0; r < 4; ++r) {
         ak_mat4 model[FK_N], ref[FK_N];
         const ak_mat4* root = r == 3 ? NULL : &roots[r];
@@ -354,8 +358,12 @@ AK_TEST(fk_affine_products_equal_full_products) {
             if (r != 2) AK_CHECK(model[i].m[3] == 0.0f && model[i].m[7] == 0.0f && model[i].m[11] == 0.0f &&
                                  model[i].m[15] == 1.0f);
         }
-        AK_CHECK_MSG(differ == 0, "root %d: %d floats differ from the full products", r, differ);
+        AK_CHECK_MSG(differ == 0, "kernel %s, root %d: %d floats differ from the full products", kernel, r, differ);
     }
+    }
+    AK_CHECK_EQ(ak_skeleton_set_simd_limit(sk, AK_FK_SIMD_COUNT), AK_ERR_BAD_ARG);
+    AK_CHECK_EQ(ak_skeleton_set_simd_limit(NULL, AK_FK_SIMD_DEFAULT), AK_ERR_NULL_ARG);
+    AK_CHECK(!strcmp(ak_skeleton_simd_name(NULL), ""));
     ak_skeleton_destroy(sk);
 }
 
@@ -368,17 +376,24 @@ AK_TEST(fk_matches_naive_double) {
     if (!sk) return;
     for (int i = 0; i < FK_N; ++i) pose[i] = random_transform(&rng);
     ak_mat4 model[FK_N];
-    AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N},
-                                           (ak_mat4_span){model, FK_N}),
-                AK_OK);
     double worst = 0.0;
-    for (int i = 0; i < FK_N; ++i) {
-        dmat4 ref = ref_world(parents, pose, i);
-        double scale = 1.0;
-        for (int k = 12; k < 15; ++k) scale = fmax(scale, fabs(ref.m[k]));
-        worst = fmax(worst, max_diff(&model[i], &ref) / scale);
+    for (int lim = AK_FK_SIMD_SCALAR; lim < AK_FK_SIMD_COUNT; ++lim) { /* every kernel this CPU has */
+        AK_CHECK_EQ(ak_skeleton_set_simd_limit(sk, (ak_fk_simd)lim), AK_OK);
+        AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N},
+                                               (ak_mat4_span){model, FK_N}),
+                    AK_OK);
+        worst = 0.0;
+        for (int i = 0; i < FK_N; ++i) {
+            dmat4 ref = ref_world(parents, pose, i);
+            double scale = 1.0;
+            for (int k = 12; k < 15; ++k) scale = fmax(scale, fabs(ref.m[k]));
+            worst = fmax(worst, max_diff(&model[i], &ref) / scale);
+        }
+        AK_CHECK_MSG(worst < 1e-4, "FK kernel %s: relative error %g", ak_skeleton_simd_name(sk), worst);
     }
-    AK_CHECK_MSG(worst < 1e-4, "FK relative error %g", worst);
+    AK_CHECK_EQ(ak_skeleton_set_simd_limit(sk, AK_FK_SIMD_DEFAULT), AK_OK);
+    AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, FK_N}, (ak_mat4_span){model, FK_N}),
+                AK_OK);
 
     /* Rooted: every root gets the extra transform. */
     ak_transform rt = random_transform(&rng);

@@ -1,6 +1,7 @@
 /* animkit side of the vs_ozz harness (a copy of ../shared/peers/vs_ozz/ak_part.c, public API
- * only) whose skinning jobs take job.simd_limit from AK_VS_OZZ_SIMD (scalar, avx2, avx512;
- * unset: the default, the fastest kernel), so ozz can be compared with each animkit kernel.
+ * only) whose skinning jobs, FK (ak_skeleton_set_simd_limit) and clip sampling take their
+ * SIMD limit from AK_VS_OZZ_SIMD (scalar, avx2, avx512; unset: the default, the fastest
+ * kernel), so ozz can be compared with each animkit kernel.
  * Run with bench/vs_ozz/run.sh. */
 #include <stdlib.h>
 #include <string.h>
@@ -48,6 +49,13 @@ int akh_skin(const skin_data* d, int method, int normals, int threads) {
     ak_skin_job job = make_job(d, method, normals, threads);
     return (int)ak_skin_job_run(&job);
 }
+static ak_fk_simd fk_limit(void) {
+    const char* e = getenv("AK_VS_OZZ_SIMD");
+    if (!e || !*e) return AK_FK_SIMD_DEFAULT;
+    if (!strcmp(e, "scalar")) return AK_FK_SIMD_SCALAR;
+    if (!strcmp(e, "avx2")) return AK_FK_SIMD_AVX2;
+    return AK_FK_SIMD_AVX512;
+}
 const char* akh_skin_kernel(void) {
     const char* e = getenv("AK_VS_OZZ_SIMD");
     return e && *e ? e : ak_skin_simd_name();
@@ -80,6 +88,7 @@ int akh_anim_setup(int joints, const int* parents, const float* rest_t, int keys
     }
     ak_skeleton_desc sd = {.joints = js, .joint_count = (size_t)joints};
     if (ak_skeleton_create(&sd, NULL, &g_sk, NULL) != AK_OK) return 1;
+    if (ak_skeleton_set_simd_limit(g_sk, fk_limit()) != AK_OK) return 1;
     free(js);
     free(names);
     for (int c = 0; c < 2; ++c) {
@@ -98,6 +107,12 @@ int akh_anim_setup(int joints, const int* parents, const float* rest_t, int keys
         ak_result r = ak_clip_build(&raw, NULL, &g_clip[c], NULL);
         free(ch);
         if (r != AK_OK) return 2;
+        const ak_fk_simd lim = fk_limit();
+        if (ak_clip_set_simd_limit(g_clip[c], lim == AK_FK_SIMD_SCALAR ? AK_CLIP_SIMD_SCALAR
+                                              : lim == AK_FK_SIMD_AVX2 ? AK_CLIP_SIMD_AVX2
+                                              : lim == AK_FK_SIMD_AVX512 ? AK_CLIP_SIMD_AVX512
+                                                                         : AK_CLIP_SIMD_DEFAULT) != AK_OK)
+            return 2;
         size_t sc = ak_clip_cursor_storage_count(g_clip[c]);
         g_seg[c] = calloc(sc, sizeof(uint32_t));
         ak_clip_cursor_init(&g_cur[c], g_clip[c], (ak_u32_span){g_seg[c], sc});
@@ -113,6 +128,8 @@ void akh_anim_eval(int clip, float time, int use_cursor, int fk) {
                        (ak_f32_span){0}, (ak_f32_span){0});
     if (fk) ak_skeleton_local_to_model(g_sk, (ak_transform_cspan){g_local, g_nj}, (ak_mat4_span){g_model, g_nj});
 }
+const char* akh_fk_kernel(void) { return ak_skeleton_simd_name(g_sk); }
+const char* akh_sample_kernel(void) { return ak_clip_simd_name(g_clip[0]); }
 const float* akh_anim_model(void) { return g_model[0].m; }
 const float* akh_anim_local(void) { return &g_local[0].translation.x; }
 

@@ -1,7 +1,12 @@
 #!/usr/bin/env bash
-# bench/vs_ozz/run.sh: ../shared/peers/vs_ozz/run.sh with this directory's ak_part.c (the
-# skinning jobs take job.simd_limit from AK_VS_OZZ_SIMD=scalar|avx2|avx512). Same arguments:
+# bench/vs_ozz/run.sh: ../shared/peers/vs_ozz/run.sh with this directory's ak_part.c, driver.cpp
+# and harness.h (copies of the shared ones): the skinning jobs, FK and clip sampling take their
+# SIMD limit from AK_VS_OZZ_SIMD=scalar|avx2|avx512, and the skinning rounds are long (each side
+# runs >= AK_VS_OZZ_ROUND_MS per round, default 150) with the per-round spread of the ratios
+# printed. Same arguments as the shared run.sh:
 #   AK_VS_OZZ_SIMD=avx2 bench/vs_ozz/run.sh build 1000000 11 s
+# AK_VS_OZZ_ROWS=P+N keeps only the skinning rows with normals; AK_VS_OZZ_ACCESS=seq only the
+# sequential animation rows (see driver.cpp).
 # Side-by-side benchmark: animkit (public API, C) against ozz-animation (C++), in one process,
 # alternating the two libraries every round. Run from the project root after a Release build:
 #   ../shared/peers/vs_ozz/run.sh [BUILD_DIR=build] [VERTICES=1000000] [ROUNDS=11] [WHAT=sai]
@@ -24,8 +29,8 @@ if [[ ! -f $O/src/geometry/runtime/libozz_geometry_r.a ]]; then
   cmake --build "$O" -j"$(nproc)" --target ozz_base ozz_animation ozz_animation_offline ozz_geometry >"$B/peers/ozz-build.log" 2>&1
 fi
 mkdir -p "$B/peers/vs_ozz_simd"; cd "$B/peers/vs_ozz_simd"
-cc -O2 -std=c11 -I"$ROOT/include" -I"$HERE" -c "$MINE/ak_part.c" -o ak_part.o
-c++ -O3 -march=native -DNDEBUG -std=c++17 -I"$HERE/../ozz-animation/include" -I"$HERE" -c "$HERE/driver.cpp" -o driver.o
+cc -O2 -std=c11 -I"$ROOT/include" -I"$MINE" -c "$MINE/ak_part.c" -o ak_part.o
+c++ -O3 -march=native -DNDEBUG -std=c++17 -I"$HERE/../ozz-animation/include" -I"$MINE" -c "$MINE/driver.cpp" -o driver.o
 c++ -o vs_ozz driver.o ak_part.o "$B/libanimkit.a" "$O/src/geometry/runtime/libozz_geometry_r.a" \
   "$O/src/animation/offline/libozz_animation_offline_r.a" "$O/src/animation/runtime/libozz_animation_r.a" \
   "$O/src/base/libozz_base_r.a" ${AK_LIBS:--lcholmod -lpng -lgif -lassimp -lcjson} -lm -lpthread

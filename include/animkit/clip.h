@@ -167,6 +167,24 @@ AK_API size_t ak_clip_cursor_storage_count(const ak_clip* clip);
 AK_API ak_result ak_clip_cursor_init(ak_clip_cursor* cursor, const ak_clip* clip,
                                      ak_u32_span storage);
 
+/* Sampling kernels, for ak_clip_set_simd_limit. */
+typedef enum ak_clip_simd {
+    AK_CLIP_SIMD_DEFAULT = 0, /* the widest kernel this CPU has */
+    AK_CLIP_SIMD_SCALAR,      /* no SIMD lanes: a cursor keeps segments only (its key cache idle) */
+    AK_CLIP_SIMD_SSE2,        /* the key cache's lanes in SSE2 (the x86-64 baseline) */
+    AK_CLIP_SIMD_AVX2,        /* at most the same lanes with the AVX2 (VEX) encoding */
+    AK_CLIP_SIMD_AVX512,      /* at most the AVX-512 VL (EVEX) encoding, 32 registers */
+    AK_CLIP_SIMD_COUNT
+} ak_clip_simd;
+
+/* Cap the kernel ak_clip_sample uses with a cursor's key cache (the widest the CPU has, checked
+ * at run time, at or below limit; build picks the DEFAULT). Every kernel gives the same floats.
+ * For comparisons and tests: call it before sharing the clip between threads. Returns
+ * AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (out of range). */
+AK_API ak_result ak_clip_set_simd_limit(ak_clip* clip, ak_clip_simd limit);
+/* The sampling kernel in use: "scalar", "sse2", "avx2" or "avx512" ("" for NULL). */
+AK_API const char* ak_clip_simd_name(const ak_clip* clip);
+
 /* Write the clip's values at time into a pose. Channels write only what they animate:
  * joints, weights and scalars the clip does not animate are left untouched, so callers
  * initialise inout_local with the rest pose (and weights with their defaults).

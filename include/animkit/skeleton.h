@@ -124,13 +124,32 @@ AK_API bool ak_skeleton_palette_from_skins(const ak_skeleton* skeleton);
 /* Number of children of a joint (0: a leaf, or out of range). */
 AK_API size_t ak_skeleton_child_count(const ak_skeleton* skeleton, size_t joint_index);
 
+/* FK kernels, for ak_skeleton_set_simd_limit. */
+typedef enum ak_fk_simd {
+    AK_FK_SIMD_DEFAULT = 0, /* the widest kernel this CPU has */
+    AK_FK_SIMD_SCALAR,      /* portable code (SSE2 columns on x86-64): ak_mat4_mul's floats */
+    AK_FK_SIMD_AVX2,        /* at most AVX2 + FMA (AVX without FMA on CPUs that lack them) */
+    AK_FK_SIMD_AVX512,      /* at most AVX-512 F + VL (same floats as AVX2 + FMA) */
+    AK_FK_SIMD_COUNT
+} ak_fk_simd;
+
+/* Cap the FK kernel this skeleton's FK functions use (the widest the CPU has, checked at run
+ * time, at or below limit; create picks the DEFAULT). For comparisons and tests: call it before
+ * sharing the skeleton between threads. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (out of
+ * range). */
+AK_API ak_result ak_skeleton_set_simd_limit(ak_skeleton* skeleton, ak_fk_simd limit);
+/* The FK kernel in use: "scalar", "avx" (AVX, no FMA), "avx2" (AVX2 + FMA) or "avx512"
+ * ("" for NULL). */
+AK_API const char* ak_skeleton_simd_name(const ak_skeleton* skeleton);
+
 /* Forward kinematics: local[i] -> model[i] = model[parent] * local[i] (model[root] = local).
  * Needs local.count >= joint_count, out_model.count >= joint_count. Returns AK_ERR_NULL_ARG,
  * AK_ERR_SPAN_SMALL. Non-finite input propagates (validate poses with ak_pose_is_finite).
  * Local matrices are built eight joints at a time (structure of arrays) and multiplied as
- * affine matrices; on x86-64 CPUs with AVX2 and FMA (checked at run time) the products use
- * fused multiply-adds, so the floats may differ from ak_mat4_mul chains by a rounding per
- * product (elsewhere they are the same floats). */
+ * affine matrices; the kernels with FMA (AVX2 + FMA, AVX-512, chosen at run time, see
+ * ak_skeleton_set_simd_limit) use fused multiply-adds, so the floats may differ from
+ * ak_mat4_mul chains by a rounding per product (the scalar and AVX kernels give the same
+ * floats). */
 AK_API ak_result ak_skeleton_local_to_model(const ak_skeleton* skeleton, ak_transform_cspan local,
                                             ak_mat4_span out_model);
 /* Same, with an extra root transform (e.g. the node above the skeleton) applied to every root. */

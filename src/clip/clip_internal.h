@@ -48,7 +48,11 @@ struct ak_clip {
     size_t scalar_count;
     float duration;
     bool has_joint_channels;
+    uint8_t sample_kernel; /* AKP_CLIP_K_*: how a cursor's key cache is sampled (src/clip.c) */
     char name[AK_NAME_SIZE];
 };
+
+/* Key-cache sampling kernels (ak_clip_set_simd_limit). */
+enum { AKP_CLIP_K_SCALAR = 0, AKP_CLIP_K_SSE2, AKP_CLIP_K_AVX2, AKP_CLIP_K_AVX512 };
 
 #endif
