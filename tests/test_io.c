@@ -1283,10 +1283,11 @@ static int cut_everywhere(const char* rel, size_t step) {
 
 AK_TEST(truncated_files_fail_cleanly) {
     int cuts = 0;
-    cuts += cut_everywhere("gltf/SimpleSkin/glTF-Embedded/SimpleSkin.gltf", 1);
-    cuts += cut_everywhere("gltf/SimpleMorph/glTF-Embedded/SimpleMorph.gltf", 1);
-    cuts += cut_everywhere("gltf/AnimatedMorphCube/glTF-Binary/AnimatedMorphCube.glb", 1);
-    cuts += cut_everywhere("gltf/RiggedSimple/glTF-Binary/RiggedSimple.glb", 7);
+    const size_t every = AK_TEST_REPS(1, 5); /* under valgrind every fifth cut past 64 bytes */
+    cuts += cut_everywhere("gltf/SimpleSkin/glTF-Embedded/SimpleSkin.gltf", every);
+    cuts += cut_everywhere("gltf/SimpleMorph/glTF-Embedded/SimpleMorph.gltf", every);
+    cuts += cut_everywhere("gltf/AnimatedMorphCube/glTF-Binary/AnimatedMorphCube.glb", every);
+    cuts += cut_everywhere("gltf/RiggedSimple/glTF-Binary/RiggedSimple.glb", 7 * every);
     if (cuts == 0) AK_SKIP("no glTF assets");
     else printf("  %d truncated copies rejected\n", cuts);
     /* GLB header lies */
@@ -2091,7 +2092,8 @@ AK_TEST(bvh_truncated_prefixes_fail) {
     ak_scene_destroy(s);
     size_t hier = (size_t)(motion - text) + 2048;
     int loaded = 0, cuts = 0;
-    for (size_t l = 0; l < last; l += l < hier ? 1 : 61) {
+    const size_t every = AK_TEST_REPS(1, 5); /* under valgrind every fifth cut in the hierarchy */
+    for (size_t l = 0; l < last; l += l < hier ? every : 61) {
         ak_io_desc as_bvh = {.format = AK_IO_FORMAT_BVH};
         s = NULL;
         if (ak_io_load_memory(small, l, "cut.bvh", NULL, &as_bvh, NULL, &s, NULL) == AK_OK) ++loaded;

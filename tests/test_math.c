@@ -9,7 +9,7 @@
 #include "ak_test.h"
 #include "ref/ref_math.h"
 
-#define CASES 10000
+#define CASES AK_TEST_REPS(10000, 1000) /* random trials per property (fewer under valgrind) */
 
 /* ---- helpers ------------------------------------------------------------------------- */
 
