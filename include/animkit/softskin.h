@@ -102,6 +102,10 @@ typedef struct ak_skin_soft_desc {
     float jiggle_damping;      /* 1/s: the flesh's velocity relative to the skinned motion
                                   (see previous_palette) decays as exp(-jiggle_damping t);
                                   0 -> 5; negative -> none */
+    bool join_distant_parts;   /* false (default): drop the lattice cells whose corners lie
+                                  nearest to bones that share no joint (keeps the two legs,
+                                  an arm and the chest apart); true: keep them (limbs closer
+                                  than a cube are joined; the behaviour before, for comparison) */
 } ak_skin_soft_desc;
 
 /* The desc with every zero field replaced by its documented default. */
@@ -132,6 +136,9 @@ AK_API size_t ak_skin_soft_tet_count(const ak_skin_soft* soft);
 AK_API size_t ak_skin_soft_kinematic_count(const ak_skin_soft* soft);
 /* Surface vertices embedded (the vertex count of the desc); 0 for NULL. */
 AK_API size_t ak_skin_soft_vertex_count(const ak_skin_soft* soft);
+/* Lattice cells dropped because their corners belong to bones that share no joint (see
+ * join_distant_parts); 0 for NULL. */
+AK_API size_t ak_skin_soft_cut_cell_count(const ak_skin_soft* soft);
 /* Bind-space node positions into out (count >= node count). AK_ERR_NULL_ARG,
  * AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_skin_soft_rest_nodes(const ak_skin_soft* soft, ak_vec3_span out_positions);
