@@ -589,7 +589,9 @@ AK_TEST(cesiumman_bind_and_legs_apart) {
     cman_free(&c);
 }
 
-/* 2 s of the walk at 60 Hz stay finite; distance from LBS with the limbs kept apart and joined. */
+/* 2 s of the walk at 60 Hz stay finite; distance from LBS with the limbs kept apart and joined
+ * (join_distant_parts): the largest is printed, not bounded (0.10 of the diagonal: the toes of
+ * the small feet, one or two cubes of the lattice); the mean must be smaller apart. */
 AK_TEST(cesiumman_walk) {
     cman c;
     if (!cman_load(&c)) {
@@ -607,8 +609,122 @@ AK_TEST(cesiumman_walk) {
     printf("  CesiumMan walk 2 s, distance from LBS / diagonal %.3f: limbs apart max %.4f mean %.5f (%zu leg bridges);"
            " joined max %.4f mean %.5f (%zu)\n",
            (double)c.diag, mx[0], mean[0], br[0], mx[1], mean[1], br[1]);
+    /* keeping the legs apart brings the flesh closer to the skeleton's motion on average */
+    AK_CHECK_MSG(mean[0] < mean[1], "mean distance %g with the limbs apart, %g joined", mean[0], mean[1]);
     cman_free(&c);
 }
+
+/* Bind-space palette that turns the joint of `slot` and every slot below it by `angle` about
+ * `axis` through the joint (the rest of the body at the bind pose). */
+static void cman_flex_palette(const cman* c, int slot, ak_vec3 axis, float angle, ak_mat4* pal) {
+    ak_mat4 turn = ak_mat4_mul(ak_mat4_translation(c->jp[slot]),
+                               ak_mat4_mul(ak_mat4_from_quat(ak_quat_from_axis_angle(axis, angle)),
+                                           ak_mat4_translation(ak_vec3_neg(c->jp[slot]))));
+    for (size_t k = 0; k < c->ns; ++k) {
+        bool below = false;
+        for (int j = (int)k; j >= 0 && !below; j = c->par[j]) below = j == slot;
+        pal[k] = below ? turn : ak_mat4_identity();
+    }
+}
+
+static size_t cman_pairs(const cman* c, const ak_vec3* p) {
+    size_t count = 0;
+    ak_result r = ak_mesh_self_intersections((ak_vec3_cspan){p, c->nv}, (ak_u32_cspan){c->m->indices, 3 * c->m->triangle_count},
+                                             (ak_u32_span){NULL, 0}, &count);
+    return r == AK_OK ? count : SIZE_MAX;
+}
+
+/* The joint named `joint` (child `child` sets the limb's direction) turned to `degrees` over 20
+ * frames at 60 Hz and held 1 s, at resolution 32 and joint_zone 1.5. Soft: no self-intersecting
+ * triangle pair more than the bind pose has (0), while LBS and DQS interpenetrate; the enclosed
+ * volume of the body (divergence theorem; CesiumMan is not closed, but its openings do not
+ * move in this pose, so the change is the limb's) within 1% of the rest. */
+static void cman_flex_case(const char* joint, const char* child, float degrees) {
+    cman c;
+    if (!cman_load(&c)) {
+        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
+        cman_free(&c);
+        return;
+    }
+    int slot = cman_slot(&c, joint), cs = cman_slot(&c, child);
+    AK_CHECK(slot >= 0 && cs >= 0);
+    if (slot < 0 || cs < 0) {
+        cman_free(&c);
+        return;
+    }
+    /* flexion: the limb below the joint swings towards the front (+X: the toes point there)
+     * and folds onto the limb above */
+    ak_vec3 limb = ak_vec3_sub(c.jp[cs], c.jp[slot]);
+    ak_vec3 axis = ak_vec3_normalize(ak_vec3_cross(limb, ak_vec3_make(1, 0, 0)));
+    if (strstr(joint, "leg")) axis = ak_vec3_neg(axis); /* a knee folds backwards */
+    ak_skin_soft_desc d = cman_desc(&c);
+    /* the defaults (resolution 16, zone 3) leave too few lattice nodes and too much free flesh
+     * at CesiumMan's thin limbs: 62 pairs at the knee, 30 at the elbow (docs/softskin.md) */
+    d.resolution = 32;
+    d.joint_zone = 1.5f;
+    ak_skin_soft* soft = NULL;
+    AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_OK);
+    size_t nn = ak_skin_soft_node_count(soft), nt = ak_skin_soft_tet_count(soft), ss = ak_skin_soft_step_scratch_size(soft), nv = c.nv;
+    ak_vec3 *x = malloc(nn * sizeof(ak_vec3)), *v = malloc(nn * sizeof(ak_vec3)), *out = malloc(nv * sizeof(ak_vec3));
+    ak_vec3 *lbs = malloc(nv * sizeof(ak_vec3)), *dqs = malloc(nv * sizeof(ak_vec3)), *rest = malloc(nn * sizeof(ak_vec3));
+    ak_mat4 *pal = malloc(c.ns * sizeof(ak_mat4)), *prev = malloc(c.ns * sizeof(ak_mat4));
+    uint32_t* tt = malloc(4 * nt * sizeof(uint32_t));
+    uint8_t* scratch = malloc(ss);
+    cman_flex_palette(&c, slot, axis, 0.0f, pal);
+    AK_CHECK_EQ(ak_skin_soft_state_init(soft, (ak_mat4_cspan){pal, c.ns}, (ak_vec3_span){x, nn}, (ak_vec3_span){v, nn}), AK_OK);
+    for (int f = 1; f <= 80; ++f) {
+        memcpy(prev, pal, c.ns * sizeof(ak_mat4));
+        cman_flex_palette(&c, slot, axis, ak_radians(degrees) * (float)(f < 20 ? f : 20) / 20.0f, pal);
+        ak_skin_soft_step_job job = {.soft = soft,
+                                     .palette = {pal, c.ns},
+                                     .previous_palette = {prev, c.ns},
+                                     .node_positions = {x, nn},
+                                     .node_velocities = {v, nn},
+                                     .scratch = {scratch, ss},
+                                     .out_positions = {out, nv}};
+        AK_CHECK_EQ(ak_skin_soft_step_run(&job), AK_OK);
+    }
+    /* the pose is a flexion: the child joint moved to the front (arm) or the back (leg) */
+    ak_vec3 tip = ak_mat4_transform_point(pal[cs], c.jp[cs]);
+    AK_CHECK(strstr(joint, "leg") ? tip.x < c.jp[slot].x : tip.x > c.jp[slot].x);
+    cman_skin(&c, AK_SKIN_LBS, pal, lbs);
+    cman_skin(&c, AK_SKIN_DQS, pal, dqs);
+    ak_u32_cspan idx = {c.m->indices, 3 * c.m->triangle_count};
+    double v0 = ak_volume_compute((ak_vec3_cspan){c.m->positions, nv}, idx);
+    double vs = ak_volume_compute((ak_vec3_cspan){out, nv}, idx) / v0, vl = ak_volume_compute((ak_vec3_cspan){lbs, nv}, idx) / v0,
+           vd = ak_volume_compute((ak_vec3_cspan){dqs, nv}, idx) / v0;
+    size_t p0 = cman_pairs(&c, c.m->positions), ps = cman_pairs(&c, out), pl = cman_pairs(&c, lbs), pd = cman_pairs(&c, dqs);
+    /* lattice volume near the joint: tets with a node within the limb's length of the joint */
+    ak_skin_soft_rest_nodes(soft, (ak_vec3_span){rest, nn});
+    ak_skin_soft_tets(soft, (ak_u32_span){tt, 4 * nt});
+    double lr = 0.0, ln = 0.0, reach = ak_vec3_length(limb);
+    for (size_t q = 0; q < nt; ++q) {
+        bool near = false;
+        for (int k = 0; k < 4; ++k) near = near || ak_vec3_distance(rest[tt[4 * q + k]], c.jp[slot]) < reach;
+        if (!near) continue;
+        const ak_vec3* X[2] = {rest, x};
+        for (int k = 0; k < 2; ++k) {
+            ak_vec3 a = X[k][tt[4 * q]];
+            double vol = ak_vec3_dot(ak_vec3_sub(X[k][tt[4 * q + 1]], a),
+                                     ak_vec3_cross(ak_vec3_sub(X[k][tt[4 * q + 2]], a), ak_vec3_sub(X[k][tt[4 * q + 3]], a))) / 6.0;
+            *(k ? &ln : &lr) += vol;
+        }
+    }
+    printf("  CesiumMan %s %.0f deg: intersecting pairs soft %zu LBS %zu DQS %zu (bind %zu); volume ratio soft %.5f LBS %.5f DQS %.5f;"
+           " lattice near the joint %.5f\n",
+           joint, (double)degrees, ps, pl, pd, p0, vs, vl, vd, lr > 0.0 ? ln / lr : 0.0);
+    AK_CHECK_MSG(pl > p0 && pd > p0, "LBS and DQS should interpenetrate (%zu, %zu; bind %zu)", pl, pd, p0);
+    AK_CHECK_MSG(ps <= p0, "soft: %zu self-intersecting pairs (bind %zu)", ps, p0);
+    AK_CHECK_MSG(fabs(vs - 1.0) < 0.01, "soft: volume ratio %g", vs);
+    /* the lattice volume near the joint is printed, not bounded: it is not within 1% (the knee
+     * keeps 98.3%, the elbow 91.8%, while the enclosed volume of the whole body holds) */
+    free(x), free(v), free(out), free(lbs), free(dqs), free(rest), free(pal), free(prev), free(tt), free(scratch);
+    ak_skin_soft_destroy(soft);
+    cman_free(&c);
+}
+
+AK_TEST(cesiumman_knee_130) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 130.0f); }
+AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f); }
 
 AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 16, true); }
 AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 16, true); }
@@ -623,5 +739,7 @@ int main(void) {
     AK_RUN_SLOW(twist_180_does_not_collapse);
     AK_RUN(cesiumman_bind_and_legs_apart);
     AK_RUN_SLOW(cesiumman_walk);
+    AK_RUN_SLOW(cesiumman_knee_130);
+    AK_RUN_SLOW(cesiumman_elbow_130);
     return ak_test_finish();
 }

@@ -121,6 +121,7 @@ ak_skin_soft_desc ak_skin_soft_desc_resolved(const ak_skin_soft_desc* desc) {
     if (d.substeps == 0) d.substeps = 10;
     if (d.bone_radius == 0.0f) d.bone_radius = 0.5f;
     if (d.jiggle_damping == 0.0f) d.jiggle_damping = 5.0f;
+    if (d.joint_zone == 0.0f) d.joint_zone = 3.0f;
     if (d.memory_budget == 0) d.memory_budget = (size_t)512 << 20;
     return d;
 }
@@ -166,7 +167,8 @@ static ak_result check_desc(const ak_skin_soft_desc* d) {
         return AK_ERR_BAD_ARG;
     if (d->resolution < 2 || d->resolution > 256 || !(d->youngs_modulus > 0.0f) || !isfinite(d->youngs_modulus) ||
         !(d->poisson_ratio > 0.0f && d->poisson_ratio <= 0.4999f) || !(d->density > 0.0f) || !isfinite(d->density) ||
-        !isfinite(d->damping) || !isfinite(d->jiggle_damping) || d->substeps > 1000 || !(d->bone_radius > 0.0f && d->bone_radius <= 1.0f))
+        !isfinite(d->damping) || !isfinite(d->jiggle_damping) || d->substeps > 1000 || !(d->bone_radius > 0.0f && d->bone_radius <= 1.0f) ||
+        !(d->joint_zone > 0.0f && d->joint_zone <= 100.0f))
         return AK_ERR_BAD_ARG;
     size_t wn = d->positions.count * d->influence_count;
     if (d->joints.count < wn || d->weights.count < wn) return AK_ERR_SPAN_SMALL;
@@ -697,7 +699,7 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     /* ... and not within three capsule radii (at most half its own bone's length) of
      * another bone: the flesh around a joint stays free, so that the bones' cores do not crush
      * it at a deep bend */
-    const float zone = 3.0f;
+    const float zone = d.joint_zone;
     /* per joint: whether any node became kinematic with these rules; a joint that got none (its
      * bones too short or too crowded for them: a dense skeleton at a coarse lattice) takes every
      * node inside its capsule that it weighs most */
