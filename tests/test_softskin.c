@@ -339,6 +339,9 @@ AK_TEST(bad_input_gets_clear_errors) {
     d.resolution = 1000;
     AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_ERR_BAD_ARG);
     d = rig_desc(&g, 8);
+    d.joint_zone = -1.0f;
+    AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_ERR_BAD_ARG);
+    d = rig_desc(&g, 8);
     d.poisson_ratio = 0.5f;
     AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_ERR_BAD_ARG);
     d = rig_desc(&g, 8);

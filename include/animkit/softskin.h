@@ -6,7 +6,9 @@
  *     the mesh's bounds (`resolution` cubes along the longest side), keeping the cubes whose
  *     centre is inside the mesh (signed crossings of a ray along +X: the winding number of a
  *     closed mesh) or that hold a surface vertex, each cube split into 6 tetrahedra (Kuhn:
- *     consistent across neighbouring cubes);
+ *     consistent across neighbouring cubes); a cube whose corners lie nearest to bones more
+ *     than two skeleton steps apart (one step: bones that meet at an end or share a joint) is
+ *     dropped, so the two thighs, or a hanging forearm and the chest, are not joined;
  *   - embeds each surface vertex barycentrically in the tetrahedron that holds it (a vertex in
  *     no kept cube: the nearest tetrahedron, with extrapolated barycentrics);
  *   - each bone that owns surface vertices (their largest weight is its joint's; nearest bone of
@@ -14,7 +16,7 @@
  *     distance of those vertices from the segment, at least 1.2 lattice cubes. Every node gets
  *     inverse-distance weights to these bones (ak_skin_weights_compute's DISTANCE method). A node
  *     inside its own bone's capsule, bound to one joint (largest weight >= 0.99) and farther than
- *     three capsule radii from every other bone is kinematic: it follows the skeleton by linear
+ *     joint_zone capsule radii from every other bone is kinematic: it follows the skeleton by linear
  *     blend skinning of the node (the bone; the flesh around a joint stays free, so that the
  *     two bones' cores do not crush it at a deep bend); a connected piece of the lattice with no
  *     kinematic node is kinematic whole;
@@ -32,16 +34,17 @@
  *     on that side at the bind pose, within the longer bone plus two flesh radii of the joint)
  *     stays on its side of the plane through the joint that bisects the two posed bones, so
  *     the two sides press flat against each other instead of passing through; (2) a flesh node
- *     stays outside the kinematic capsule of every other joint's bone that it was outside of
- *     at the bind pose;
+ *     stays outside the core (bone_radius x its flesh radius) of every other joint's bone that
+ *     it was outside of at the bind pose;
  *   - determinism and threads: tetrahedra are coloured at build time (no two of a colour share
  *     a node) and solved colour by colour, so the result is bit-identical for every
  *     thread_count; threads split each colour and the per-node phases.
  *
  * What it does NOT do: general self-collision of the surface (only the two kinds above),
  * continuous collision detection, morph targets (the bind positions are embedded), or separate
- * lattice copies for parts that one cube spans (two limbs closer than a cube are joined: raise
- * the resolution). The lattice is coarse next to the mesh (resolution 16: a few cubes across
+ * lattice copies for parts that one cube spans (parts at most two skeleton steps apart stay
+ * joined; farther ones are cut apart, their surface vertices extrapolated from a neighbouring
+ * cube of their own part). The lattice is coarse next to the mesh (resolution 16: a few cubes across
  * a limb), so the surface follows the tetrahedra's piecewise-linear motion: visible facets at
  * strong deformations. Normals: compute them from the deformed surface (ak_normals_compute).
  *
