@@ -638,11 +638,11 @@ static size_t cman_pairs(const cman* c, const ak_vec3* p) {
 }
 
 /* The joint named `joint` (child `child` sets the limb's direction) turned to `degrees` over 20
- * frames at 60 Hz and held 1 s, at resolution 32 and joint_zone 1.5. Soft: no self-intersecting
+ * frames at 60 Hz and held 1 s, at resolution 32, joint_zone 1.5 and 40 substeps. Soft: no self-intersecting
  * triangle pair more than the bind pose has (0), while LBS and DQS interpenetrate; the enclosed
  * volume of the body (divergence theorem; CesiumMan is not closed, but its openings do not
  * move in this pose, so the change is the limb's) within 1% of the rest. */
-static void cman_flex_case(const char* joint, const char* child, float degrees) {
+static void cman_flex_case(const char* joint, const char* child, float degrees, double lattice_tol) {
     cman c;
     if (!cman_load(&c)) {
         AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
@@ -665,6 +665,7 @@ static void cman_flex_case(const char* joint, const char* child, float degrees) 
      * at CesiumMan's thin limbs: 62 pairs at the knee, 30 at the elbow (docs/softskin.md) */
     d.resolution = 32;
     d.joint_zone = 1.5f;
+    d.substeps = 40; /* 10: the lattice near the knee keeps 98.3%, near the elbow 91.8% */
     ak_skin_soft* soft = NULL;
     AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_OK);
     size_t nn = ak_skin_soft_node_count(soft), nt = ak_skin_soft_tet_count(soft), ss = ak_skin_soft_step_scratch_size(soft), nv = c.nv;
@@ -719,15 +720,17 @@ static void cman_flex_case(const char* joint, const char* child, float degrees) 
     AK_CHECK_MSG(pl > p0 && pd > p0, "LBS and DQS should interpenetrate (%zu, %zu; bind %zu)", pl, pd, p0);
     AK_CHECK_MSG(ps <= p0, "soft: %zu self-intersecting pairs (bind %zu)", ps, p0);
     AK_CHECK_MSG(fabs(vs - 1.0) < 0.01, "soft: volume ratio %g", vs);
-    /* the lattice volume near the joint is printed, not bounded: it is not within 1% (the knee
-     * keeps 98.3%, the elbow 91.8%, while the enclosed volume of the whole body holds) */
+    /* the lattice volume near the joint (the flesh there, not diluted by the body): within
+     * lattice_tol where given (the knee: 1%); the elbow's is printed only (it keeps 97.3%) */
+    if (lattice_tol > 0.0)
+        AK_CHECK_MSG(lr > 0.0 && fabs(ln / lr - 1.0) < lattice_tol, "soft: lattice volume near the joint %g", lr > 0.0 ? ln / lr : 0.0);
     free(x), free(v), free(out), free(lbs), free(dqs), free(rest), free(pal), free(prev), free(tt), free(scratch);
     ak_skin_soft_destroy(soft);
     cman_free(&c);
 }
 
-AK_TEST(cesiumman_knee_130) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 130.0f); }
-AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f); }
+AK_TEST(cesiumman_knee_130) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 130.0f, 0.01); }
+AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f, 0.0); }
 
 AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 16, true); }
 AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 16, true); }
