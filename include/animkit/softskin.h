@@ -108,8 +108,8 @@ typedef struct ak_skin_soft_desc {
     float joint_zone;          /* flesh zone around a joint, in kinematic capsule radii (at
                                   most half the bone's length), in (0, 100]; 0 -> 3. Smaller:
                                   more of the limb near a joint follows the bone (CesiumMan's
-                                  knee at 130 degrees needs 1.5 at resolution 32; the cylinder
-                                  bent 150 degrees needs 3) */
+                                  knee at 130 degrees needs 1.5 at resolution 32 with 40
+                                  substeps; the cylinder bent 150 degrees needs 3) */
     bool join_distant_parts;   /* false (default): drop the lattice cells whose corners lie
                                   nearest to bones that share no joint (keeps the two legs,
                                   an arm and the chest apart); true: keep them (limbs closer
