@@ -339,6 +339,9 @@ AK_TEST(bad_input_gets_clear_errors) {
     d.resolution = 1000;
     AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_ERR_BAD_ARG);
     d = rig_desc(&g, 8);
+    d.joint_zone = -1.0f;
+    AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_ERR_BAD_ARG);
+    d = rig_desc(&g, 8);
     d.poisson_ratio = 0.5f;
     AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_ERR_BAD_ARG);
     d = rig_desc(&g, 8);
@@ -384,84 +387,146 @@ AK_TEST(bad_input_gets_clear_errors) {
 }
 
 
-/* CesiumMan (assets via ANIMKIT_ASSETS or ../shared/assets; SKIP when absent): the bind pose
- * is reproduced within 1e-4 of the bounding-box diagonal, and 2 s of the walk at 60 Hz stay
- * finite. The largest distance from LBS is printed, not bounded: at resolution 16 the lattice
- * joins the legs (a cube spans the gap), so the soft result strays 0.28 (15% of the diagonal)
- * from LBS; see docs/softskin.md, Limits. */
-AK_TEST(cesiumman_bind_and_walk) {
+/* ---- CesiumMan (assets via ANIMKIT_ASSETS or ../shared/assets; SKIP when absent) ---------- */
+
+typedef struct cman {
+    ak_scene* sc;
+    const ak_mesh* m;
+    size_t mi, nv, nj, ns, nb;
+    ak_skin_bone* bones;
+    ak_vec3* jp;    /* [slot] bind positions of the joints */
+    int16_t* par;   /* [slot] nearest ancestor slot */
+    float diag;
+} cman;
+
+static void cman_free(cman* c) {
+    free(c->bones), free(c->jp), free(c->par);
+    ak_scene_destroy(c->sc);
+}
+
+static bool cman_load(cman* c) {
+    memset(c, 0, sizeof *c);
     char path[1200];
-    if (!ak_test_asset(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) {
-        AK_SKIP("CesiumMan.glb not found");
-        return;
-    }
-    ak_scene* sc = NULL;
-    AK_CHECK_EQ(ak_io_load(path, NULL, NULL, &sc, NULL), AK_OK);
-    if (!sc) return;
-    size_t mi = 0;
-    while (mi < sc->mesh_count && (sc->meshes[mi].skin < 0 || !sc->meshes[mi].mesh->triangle_count)) ++mi;
-    AK_CHECK(mi < sc->mesh_count && sc->clip_count > 0);
-    if (mi == sc->mesh_count || sc->clip_count == 0) {
-        ak_scene_destroy(sc);
-        return;
-    }
-    const ak_mesh* m = sc->meshes[mi].mesh;
-    const ak_scene_skin* sk = &sc->skins[sc->meshes[mi].skin];
-    size_t nv = m->vertex_count, nj = ak_scene_joint_count(sc), ns = sk->joint_count;
+    if (!ak_test_asset(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) return false;
+    if (ak_io_load(path, NULL, NULL, &c->sc, NULL) != AK_OK || !c->sc) return false;
+    ak_scene* sc = c->sc;
+    while (c->mi < sc->mesh_count && (sc->meshes[c->mi].skin < 0 || !sc->meshes[c->mi].mesh->triangle_count)) ++c->mi;
+    if (c->mi == sc->mesh_count || sc->clip_count == 0) return false;
+    c->m = sc->meshes[c->mi].mesh;
+    const ak_scene_skin* sk = &sc->skins[sc->meshes[c->mi].skin];
+    c->nv = c->m->vertex_count, c->nj = ak_scene_joint_count(sc), c->ns = sk->joint_count;
     /* bones: slot -> nearest ancestor slot (point bones for leaves) */
-    ak_skin_bone* bones = calloc(2 * ns + 1, sizeof(ak_skin_bone));
-    ak_vec3* jp = calloc(ns, sizeof(ak_vec3));
-    int16_t* par = calloc(ns, sizeof(int16_t));
+    c->bones = calloc(2 * c->ns + 1, sizeof(ak_skin_bone));
+    c->jp = calloc(c->ns, sizeof(ak_vec3));
+    c->par = calloc(c->ns, sizeof(int16_t));
+    if (!c->bones || !c->jp || !c->par) return false;
     ak_i16_cspan sp = ak_skeleton_parents(sc->skeleton);
-    for (size_t k = 0; k < ns; ++k) {
-        jp[k] = ak_mat4_get_translation(ak_mat4_inverse_affine(sk->inverse_binds[k]));
-        par[k] = -1;
-        for (int j = sp.ptr[sk->joints[k]]; j >= 0 && par[k] < 0; j = sp.ptr[j])
-            for (size_t q = 0; q < ns; ++q)
-                if (sk->joints[q] == j) par[k] = (int16_t)q;
+    bool ordered = true; /* ak_skin_bones_from_joints wants parents first: CesiumMan's are */
+    for (size_t k = 0; k < c->ns; ++k) {
+        c->jp[k] = ak_mat4_get_translation(ak_mat4_inverse_affine(sk->inverse_binds[k]));
+        c->par[k] = -1;
+        for (int j = sp.ptr[sk->joints[k]]; j >= 0 && c->par[k] < 0; j = sp.ptr[j])
+            for (size_t q = 0; q < c->ns; ++q)
+                if (sk->joints[q] == j) c->par[k] = (int16_t)q;
+        ordered = ordered && c->par[k] < (int16_t)k;
     }
-    /* ak_skin_bones_from_joints wants parents before children: CesiumMan's slots are ordered */
-    size_t nb = 0;
-    bool ordered = true;
-    for (size_t k = 0; k < ns; ++k) ordered = ordered && par[k] < (int16_t)k;
-    AK_CHECK(ordered);
-    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, ns}, (ak_i16_cspan){par, ns}, false,
-                                          (ak_skin_bone_span){bones, 2 * ns + 1}, &nb),
-                AK_OK);
-    size_t wn = nv * m->influence_count;
-    ak_skin_soft_desc d = {.positions = {m->positions, nv},
-                           .indices = {m->indices, 3 * m->triangle_count},
-                           .joints = {m->joints, wn},
-                           .weights = {m->weights, wn},
-                           .influence_count = m->influence_count,
-                           .bones = {bones, nb}};
+    ak_vec3 lo, hi;
+    ak_mesh_bounds(c->m, &lo, &hi);
+    c->diag = ak_vec3_distance(lo, hi);
+    return ordered && ak_skin_bones_from_joints((ak_vec3_cspan){c->jp, c->ns}, (ak_i16_cspan){c->par, c->ns}, false,
+                                                (ak_skin_bone_span){c->bones, 2 * c->ns + 1}, &c->nb) == AK_OK;
+}
+
+/* Skin slot of the joint named `name`, -1 when absent. */
+static int cman_slot(const cman* c, const char* name) {
+    int j = ak_skeleton_find_joint(c->sc->skeleton, name);
+    const ak_scene_skin* sk = &c->sc->skins[c->sc->meshes[c->mi].skin];
+    for (size_t k = 0; k < c->ns; ++k)
+        if (j >= 0 && (int)sk->joints[k] == j) return (int)k;
+    return -1;
+}
+
+static ak_skin_soft_desc cman_desc(const cman* c) {
+    size_t wn = c->nv * c->m->influence_count;
+    ak_skin_soft_desc d = {.positions = {c->m->positions, c->nv},
+                           .indices = {c->m->indices, 3 * c->m->triangle_count},
+                           .joints = {c->m->joints, wn},
+                           .weights = {c->m->weights, wn},
+                           .influence_count = c->m->influence_count,
+                           .bones = {c->bones, c->nb}};
+    return d;
+}
+
+static void cman_skin(const cman* c, ak_skin_method method, const ak_mat4* pal, ak_vec3* out) {
+    uint8_t scratch[64 + 192 * 32];
+    ak_skin_job lj = {.method = method,
+                      .influence_count = c->m->influence_count,
+                      .palette = {pal, c->ns},
+                      .positions = {c->m->positions, c->nv, 0},
+                      .joints = {c->m->joints, c->nv, 0},
+                      .weights = {c->m->weights, c->nv, 0},
+                      .scratch = {scratch, sizeof scratch},
+                      .out_positions = {out, c->nv, 0}};
+    AK_CHECK_EQ(ak_skin_job_run(&lj), AK_OK);
+}
+
+/* Lattice tets whose four nodes lie below the middle of the thighs and that have nodes on both
+ * sides of the body's mid-plane between the hips: tets that bridge the two legs (the gap
+ * between the legs is wider than zero there, so no tet of one leg crosses the plane). */
+static size_t cman_leg_bridges(const cman* c, const ak_skin_soft* soft) {
+    int hl = cman_slot(c, "leg_joint_L_1"), hr = cman_slot(c, "leg_joint_R_1");
+    int kl = cman_slot(c, "leg_joint_L_2"), kr = cman_slot(c, "leg_joint_R_2");
+    AK_CHECK(hl >= 0 && hr >= 0 && kl >= 0 && kr >= 0);
+    if (hl < 0 || hr < 0 || kl < 0 || kr < 0) return SIZE_MAX;
+    ak_vec3 hip = ak_vec3_scale(ak_vec3_add(c->jp[hl], c->jp[hr]), 0.5f);
+    ak_vec3 knee = ak_vec3_scale(ak_vec3_add(c->jp[kl], c->jp[kr]), 0.5f);
+    ak_vec3 side = ak_vec3_normalize(ak_vec3_sub(c->jp[hl], c->jp[hr]));
+    ak_vec3 down = ak_vec3_sub(knee, hip);
+    float thigh = ak_vec3_length(down);
+    down = ak_vec3_scale(down, 1.0f / thigh);
+    size_t nn = ak_skin_soft_node_count(soft), nt = ak_skin_soft_tet_count(soft), bridges = 0;
+    ak_vec3* rest = malloc(nn * sizeof(ak_vec3));
+    uint32_t* tt = malloc(4 * nt * sizeof(uint32_t));
+    ak_skin_soft_rest_nodes(soft, (ak_vec3_span){rest, nn});
+    ak_skin_soft_tets(soft, (ak_u32_span){tt, 4 * nt});
+    for (size_t q = 0; q < nt; ++q) {
+        bool low = true, left = false, right = false;
+        for (int k = 0; k < 4; ++k) {
+            ak_vec3 r = ak_vec3_sub(rest[tt[4 * q + k]], hip);
+            low = low && ak_vec3_dot(r, down) > 0.5f * thigh;
+            left = left || ak_vec3_dot(r, side) > 0.0f;
+            right = right || ak_vec3_dot(r, side) < 0.0f;
+        }
+        bridges += low && left && right;
+    }
+    free(rest);
+    free(tt);
+    return bridges;
+}
+
+/* The first `frames` frames of the walk at 60 Hz: largest and mean distance of the soft
+ * surface from LBS's, over the bounding-box diagonal; false if not finite. */
+static bool cman_walk(const cman* c, const ak_skin_soft_desc* d, int frames, double* out_max, double* out_mean, size_t* out_bridges) {
     ak_skin_soft* soft = NULL;
-    AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_OK);
-    size_t nn = ak_skin_soft_node_count(soft), ss = ak_skin_soft_step_scratch_size(soft);
+    AK_CHECK_EQ(ak_skin_soft_create(d, NULL, &soft), AK_OK);
+    if (!soft) return false;
+    *out_bridges = cman_leg_bridges(c, soft);
+    size_t nn = ak_skin_soft_node_count(soft), ss = ak_skin_soft_step_scratch_size(soft), nv = c->nv, ns = c->ns, nj = c->nj;
     ak_vec3 *x = malloc(nn * sizeof(ak_vec3)), *v = malloc(nn * sizeof(ak_vec3)), *out = malloc(nv * sizeof(ak_vec3));
     ak_vec3* lbs = malloc(nv * sizeof(ak_vec3));
     ak_mat4 *pal = malloc(ns * sizeof(ak_mat4)), *prev = malloc(ns * sizeof(ak_mat4)), *world = malloc(nj * sizeof(ak_mat4));
     ak_transform* local = malloc(nj * sizeof(ak_transform));
     uint8_t* scratch = malloc(ss);
-    /* bind pose: the inverse binds undo the joints' bind world matrices: the palette is identity */
-    for (size_t k = 0; k < ns; ++k) pal[k] = ak_mat4_identity();
-    AK_CHECK_EQ(ak_skin_soft_state_init(soft, (ak_mat4_cspan){pal, ns}, (ak_vec3_span){x, nn}, (ak_vec3_span){v, nn}), AK_OK);
-    AK_CHECK_EQ(ak_skin_soft_surface(soft, (ak_vec3_cspan){x, nn}, (ak_vec3_span){out, nv}), AK_OK);
-    ak_vec3 lo, hi;
-    ak_mesh_bounds(m, &lo, &hi);
-    float diag = ak_vec3_distance(lo, hi), err = 0.0f;
-    for (size_t q = 0; q < nv; ++q) err = ak_maxf(err, ak_vec3_distance(out[q], m->positions[q]));
-    AK_CHECK_MSG(err <= 1e-4f * diag, "bind error %g > %g", (double)err, (double)(1e-4f * diag));
-    /* the walk */
-    float worst = 0.0f;
+    double worst = 0.0, sum = 0.0;
+    size_t count = 0;
     bool finite = true;
-    for (int f = 0; f <= 120; ++f) {
+    for (int f = 0; f <= frames; ++f) {
         memcpy(prev, pal, ns * sizeof(ak_mat4));
-        ak_scene_rest_pose(sc, (ak_transform_span){local, nj});
-        ak_clip_sample(sc->clips[0], fmodf((float)f / 60.0f, ak_clip_duration(sc->clips[0])), NULL,
+        ak_scene_rest_pose(c->sc, (ak_transform_span){local, nj});
+        ak_clip_sample(c->sc->clips[0], fmodf((float)f / 60.0f, ak_clip_duration(c->sc->clips[0])), NULL,
                        (ak_transform_span){local, nj}, (ak_f32_span){0}, (ak_f32_span){0});
-        ak_scene_world_matrices(sc, (ak_transform_cspan){local, nj}, (ak_mat4_span){world, nj});
-        ak_scene_skin_palette(sc, (size_t)sc->meshes[mi].skin, (ak_mat4_cspan){world, nj}, (ak_mat4_span){pal, ns});
+        ak_scene_world_matrices(c->sc, (ak_transform_cspan){local, nj}, (ak_mat4_span){world, nj});
+        ak_scene_skin_palette(c->sc, (size_t)c->sc->meshes[c->mi].skin, (ak_mat4_cspan){world, nj}, (ak_mat4_span){pal, ns});
         if (f == 0) {
             ak_skin_soft_state_init(soft, (ak_mat4_cspan){pal, ns}, (ak_vec3_span){x, nn}, (ak_vec3_span){v, nn});
             continue;
@@ -474,26 +539,198 @@ AK_TEST(cesiumman_bind_and_walk) {
                                      .scratch = {scratch, ss},
                                      .out_positions = {out, nv}};
         AK_CHECK_EQ(ak_skin_soft_step_run(&job), AK_OK);
-        ak_skin_job lj = {.influence_count = m->influence_count,
-                          .palette = {pal, ns},
-                          .positions = {m->positions, nv, 0},
-                          .joints = {m->joints, nv, 0},
-                          .weights = {m->weights, nv, 0},
-                          .out_positions = {lbs, nv, 0}};
-        AK_CHECK_EQ(ak_skin_job_run(&lj), AK_OK);
+        cman_skin(c, AK_SKIN_LBS, pal, lbs);
         for (size_t q = 0; q < nv; ++q) {
             finite = finite && ak_vec3_is_finite(out[q]);
-            worst = ak_maxf(worst, ak_vec3_distance(out[q], lbs[q]));
+            double dist = ak_vec3_distance(out[q], lbs[q]);
+            worst = dist > worst ? dist : worst;
+            sum += dist;
+            ++count;
         }
     }
-    printf("  CesiumMan: %zu nodes, %zu kinematic; largest distance from LBS over the walk %.3f (diagonal %.3f)\n", nn,
-           ak_skin_soft_kinematic_count(soft), (double)worst, (double)diag);
-    AK_CHECK(finite);
+    *out_max = worst / c->diag;
+    *out_mean = count ? sum / (double)count / c->diag : 0.0;
     free(x), free(v), free(out), free(lbs), free(pal), free(prev), free(world), free(local), free(scratch);
-    free(bones), free(jp), free(par);
     ak_skin_soft_destroy(soft);
-    ak_scene_destroy(sc);
+    return finite;
 }
+
+/* Bind pose reproduced within 1e-4 of the bounding-box diagonal; no tet bridges the legs
+ * (while the lattice that keeps every cell has such tets: the check can fail). */
+AK_TEST(cesiumman_bind_and_legs_apart) {
+    cman c;
+    if (!cman_load(&c)) {
+        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
+        cman_free(&c);
+        return;
+    }
+    ak_skin_soft_desc d = cman_desc(&c);
+    ak_skin_soft* soft = NULL;
+    AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_OK);
+    size_t nn = ak_skin_soft_node_count(soft), nv = c.nv;
+    ak_vec3 *x = malloc(nn * sizeof(ak_vec3)), *v = malloc(nn * sizeof(ak_vec3)), *out = malloc(nv * sizeof(ak_vec3));
+    ak_mat4* pal = malloc(c.ns * sizeof(ak_mat4));
+    /* bind pose: the inverse binds undo the joints' bind world matrices: the palette is identity */
+    for (size_t k = 0; k < c.ns; ++k) pal[k] = ak_mat4_identity();
+    AK_CHECK_EQ(ak_skin_soft_state_init(soft, (ak_mat4_cspan){pal, c.ns}, (ak_vec3_span){x, nn}, (ak_vec3_span){v, nn}), AK_OK);
+    AK_CHECK_EQ(ak_skin_soft_surface(soft, (ak_vec3_cspan){x, nn}, (ak_vec3_span){out, nv}), AK_OK);
+    float err = 0.0f;
+    for (size_t q = 0; q < nv; ++q) err = ak_maxf(err, ak_vec3_distance(out[q], c.m->positions[q]));
+    AK_CHECK_MSG(err <= 1e-4f * c.diag, "bind error %g > %g", (double)err, (double)(1e-4f * c.diag));
+    size_t bridges = cman_leg_bridges(&c, soft);
+    d.join_distant_parts = true;
+    ak_skin_soft* joined = NULL;
+    AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &joined), AK_OK);
+    size_t bridges_joined = joined ? cman_leg_bridges(&c, joined) : 0;
+    printf("  CesiumMan: %zu nodes, %zu tets, %zu cells cut; tets bridging the legs %zu (%zu when every cell is kept)\n", nn,
+           ak_skin_soft_tet_count(soft), ak_skin_soft_cut_cell_count(soft), bridges, bridges_joined);
+    AK_CHECK_MSG(bridges_joined > 0, "the joined lattice should bridge the legs (the check could not fail)");
+    AK_CHECK_MSG(bridges == 0, "%zu tets bridge the legs", bridges);
+    free(x), free(v), free(out), free(pal);
+    ak_skin_soft_destroy(soft);
+    ak_skin_soft_destroy(joined);
+    cman_free(&c);
+}
+
+/* 2 s of the walk at 60 Hz stay finite; distance from LBS with the limbs kept apart and joined
+ * (join_distant_parts): the largest is printed, not bounded (0.10 of the diagonal: the toes of
+ * the small feet, one or two cubes of the lattice); the mean must be smaller apart. */
+AK_TEST(cesiumman_walk) {
+    cman c;
+    if (!cman_load(&c)) {
+        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
+        cman_free(&c);
+        return;
+    }
+    ak_skin_soft_desc d = cman_desc(&c);
+    double mx[2], mean[2];
+    size_t br[2];
+    for (int joined = 0; joined < 2; ++joined) {
+        d.join_distant_parts = joined;
+        AK_CHECK(cman_walk(&c, &d, 120, &mx[joined], &mean[joined], &br[joined]));
+    }
+    printf("  CesiumMan walk 2 s, distance from LBS / diagonal %.3f: limbs apart max %.4f mean %.5f (%zu leg bridges);"
+           " joined max %.4f mean %.5f (%zu)\n",
+           (double)c.diag, mx[0], mean[0], br[0], mx[1], mean[1], br[1]);
+    /* keeping the legs apart brings the flesh closer to the skeleton's motion on average */
+    AK_CHECK_MSG(mean[0] < mean[1], "mean distance %g with the limbs apart, %g joined", mean[0], mean[1]);
+    cman_free(&c);
+}
+
+/* Bind-space palette that turns the joint of `slot` and every slot below it by `angle` about
+ * `axis` through the joint (the rest of the body at the bind pose). */
+static void cman_flex_palette(const cman* c, int slot, ak_vec3 axis, float angle, ak_mat4* pal) {
+    ak_mat4 turn = ak_mat4_mul(ak_mat4_translation(c->jp[slot]),
+                               ak_mat4_mul(ak_mat4_from_quat(ak_quat_from_axis_angle(axis, angle)),
+                                           ak_mat4_translation(ak_vec3_neg(c->jp[slot]))));
+    for (size_t k = 0; k < c->ns; ++k) {
+        bool below = false;
+        for (int j = (int)k; j >= 0 && !below; j = c->par[j]) below = j == slot;
+        pal[k] = below ? turn : ak_mat4_identity();
+    }
+}
+
+static size_t cman_pairs(const cman* c, const ak_vec3* p) {
+    size_t count = 0;
+    ak_result r = ak_mesh_self_intersections((ak_vec3_cspan){p, c->nv}, (ak_u32_cspan){c->m->indices, 3 * c->m->triangle_count},
+                                             (ak_u32_span){NULL, 0}, &count);
+    return r == AK_OK ? count : SIZE_MAX;
+}
+
+/* The joint named `joint` (child `child` sets the limb's direction) turned to `degrees` over 20
+ * frames at 60 Hz and held 1 s, at resolution 32, joint_zone 1.5 and 40 substeps. Soft: no self-intersecting
+ * triangle pair more than the bind pose has (0), while LBS and DQS interpenetrate; the enclosed
+ * volume of the body (divergence theorem; CesiumMan is not closed, but its openings do not
+ * move in this pose, so the change is the limb's) within 1% of the rest. */
+static void cman_flex_case(const char* joint, const char* child, float degrees, double lattice_tol) {
+    cman c;
+    if (!cman_load(&c)) {
+        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
+        cman_free(&c);
+        return;
+    }
+    int slot = cman_slot(&c, joint), cs = cman_slot(&c, child);
+    AK_CHECK(slot >= 0 && cs >= 0);
+    if (slot < 0 || cs < 0) {
+        cman_free(&c);
+        return;
+    }
+    /* flexion: the limb below the joint swings towards the front (+X: the toes point there)
+     * and folds onto the limb above */
+    ak_vec3 limb = ak_vec3_sub(c.jp[cs], c.jp[slot]);
+    ak_vec3 axis = ak_vec3_normalize(ak_vec3_cross(limb, ak_vec3_make(1, 0, 0)));
+    if (strstr(joint, "leg")) axis = ak_vec3_neg(axis); /* a knee folds backwards */
+    ak_skin_soft_desc d = cman_desc(&c);
+    /* the defaults (resolution 16, zone 3) leave too few lattice nodes and too much free flesh
+     * at CesiumMan's thin limbs: 62 pairs at the knee, 30 at the elbow (docs/softskin.md) */
+    d.resolution = 32;
+    d.joint_zone = 1.5f;
+    d.substeps = 40; /* 10: the lattice near the knee keeps 98.3%, near the elbow 91.8% */
+    ak_skin_soft* soft = NULL;
+    AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_OK);
+    size_t nn = ak_skin_soft_node_count(soft), nt = ak_skin_soft_tet_count(soft), ss = ak_skin_soft_step_scratch_size(soft), nv = c.nv;
+    ak_vec3 *x = malloc(nn * sizeof(ak_vec3)), *v = malloc(nn * sizeof(ak_vec3)), *out = malloc(nv * sizeof(ak_vec3));
+    ak_vec3 *lbs = malloc(nv * sizeof(ak_vec3)), *dqs = malloc(nv * sizeof(ak_vec3)), *rest = malloc(nn * sizeof(ak_vec3));
+    ak_mat4 *pal = malloc(c.ns * sizeof(ak_mat4)), *prev = malloc(c.ns * sizeof(ak_mat4));
+    uint32_t* tt = malloc(4 * nt * sizeof(uint32_t));
+    uint8_t* scratch = malloc(ss);
+    cman_flex_palette(&c, slot, axis, 0.0f, pal);
+    AK_CHECK_EQ(ak_skin_soft_state_init(soft, (ak_mat4_cspan){pal, c.ns}, (ak_vec3_span){x, nn}, (ak_vec3_span){v, nn}), AK_OK);
+    for (int f = 1; f <= 80; ++f) {
+        memcpy(prev, pal, c.ns * sizeof(ak_mat4));
+        cman_flex_palette(&c, slot, axis, ak_radians(degrees) * (float)(f < 20 ? f : 20) / 20.0f, pal);
+        ak_skin_soft_step_job job = {.soft = soft,
+                                     .palette = {pal, c.ns},
+                                     .previous_palette = {prev, c.ns},
+                                     .node_positions = {x, nn},
+                                     .node_velocities = {v, nn},
+                                     .scratch = {scratch, ss},
+                                     .out_positions = {out, nv}};
+        AK_CHECK_EQ(ak_skin_soft_step_run(&job), AK_OK);
+    }
+    /* the pose is a flexion: the child joint moved to the front (arm) or the back (leg) */
+    ak_vec3 tip = ak_mat4_transform_point(pal[cs], c.jp[cs]);
+    AK_CHECK(strstr(joint, "leg") ? tip.x < c.jp[slot].x : tip.x > c.jp[slot].x);
+    cman_skin(&c, AK_SKIN_LBS, pal, lbs);
+    cman_skin(&c, AK_SKIN_DQS, pal, dqs);
+    ak_u32_cspan idx = {c.m->indices, 3 * c.m->triangle_count};
+    double v0 = ak_volume_compute((ak_vec3_cspan){c.m->positions, nv}, idx);
+    double vs = ak_volume_compute((ak_vec3_cspan){out, nv}, idx) / v0, vl = ak_volume_compute((ak_vec3_cspan){lbs, nv}, idx) / v0,
+           vd = ak_volume_compute((ak_vec3_cspan){dqs, nv}, idx) / v0;
+    size_t p0 = cman_pairs(&c, c.m->positions), ps = cman_pairs(&c, out), pl = cman_pairs(&c, lbs), pd = cman_pairs(&c, dqs);
+    /* lattice volume near the joint: tets with a node within the limb's length of the joint */
+    ak_skin_soft_rest_nodes(soft, (ak_vec3_span){rest, nn});
+    ak_skin_soft_tets(soft, (ak_u32_span){tt, 4 * nt});
+    double lr = 0.0, ln = 0.0, reach = ak_vec3_length(limb);
+    for (size_t q = 0; q < nt; ++q) {
+        bool near = false;
+        for (int k = 0; k < 4; ++k) near = near || ak_vec3_distance(rest[tt[4 * q + k]], c.jp[slot]) < reach;
+        if (!near) continue;
+        const ak_vec3* X[2] = {rest, x};
+        for (int k = 0; k < 2; ++k) {
+            ak_vec3 a = X[k][tt[4 * q]];
+            double vol = ak_vec3_dot(ak_vec3_sub(X[k][tt[4 * q + 1]], a),
+                                     ak_vec3_cross(ak_vec3_sub(X[k][tt[4 * q + 2]], a), ak_vec3_sub(X[k][tt[4 * q + 3]], a))) / 6.0;
+            *(k ? &ln : &lr) += vol;
+        }
+    }
+    printf("  CesiumMan %s %.0f deg: intersecting pairs soft %zu LBS %zu DQS %zu (bind %zu); volume ratio soft %.5f LBS %.5f DQS %.5f;"
+           " lattice near the joint %.5f\n",
+           joint, (double)degrees, ps, pl, pd, p0, vs, vl, vd, lr > 0.0 ? ln / lr : 0.0);
+    AK_CHECK_MSG(pl > p0 && pd > p0, "LBS and DQS should interpenetrate (%zu, %zu; bind %zu)", pl, pd, p0);
+    AK_CHECK_MSG(ps <= p0, "soft: %zu self-intersecting pairs (bind %zu)", ps, p0);
+    AK_CHECK_MSG(fabs(vs - 1.0) < 0.01, "soft: volume ratio %g", vs);
+    /* the lattice volume near the joint (the flesh there, not diluted by the body): within
+     * lattice_tol where given (the knee: 1%); the elbow's is printed only (it keeps 97.3%) */
+    if (lattice_tol > 0.0)
+        AK_CHECK_MSG(lr > 0.0 && fabs(ln / lr - 1.0) < lattice_tol, "soft: lattice volume near the joint %g", lr > 0.0 ? ln / lr : 0.0);
+    free(x), free(v), free(out), free(lbs), free(dqs), free(rest), free(pal), free(prev), free(tt), free(scratch);
+    ak_skin_soft_destroy(soft);
+    cman_free(&c);
+}
+
+AK_TEST(cesiumman_knee_130) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 130.0f, 0.01); }
+AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f, 0.0); }
 
 AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 16, true); }
 AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 16, true); }
@@ -506,6 +743,9 @@ int main(void) {
     AK_RUN_SLOW(bend_120_keeps_volume);
     AK_RUN_SLOW(bend_150_keeps_volume);
     AK_RUN_SLOW(twist_180_does_not_collapse);
-    AK_RUN_SLOW(cesiumman_bind_and_walk);
+    AK_RUN(cesiumman_bind_and_legs_apart);
+    AK_RUN_SLOW(cesiumman_walk);
+    AK_RUN_SLOW(cesiumman_knee_130);
+    AK_RUN_SLOW(cesiumman_elbow_130);
     return ak_test_finish();
 }

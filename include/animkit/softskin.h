@@ -6,7 +6,9 @@
  *     the mesh's bounds (`resolution` cubes along the longest side), keeping the cubes whose
  *     centre is inside the mesh (signed crossings of a ray along +X: the winding number of a
  *     closed mesh) or that hold a surface vertex, each cube split into 6 tetrahedra (Kuhn:
- *     consistent across neighbouring cubes);
+ *     consistent across neighbouring cubes); a cube whose corners lie nearest to bones more
+ *     than two skeleton steps apart (one step: bones that meet at an end or share a joint) is
+ *     dropped, so the two thighs, or a hanging forearm and the chest, are not joined;
  *   - embeds each surface vertex barycentrically in the tetrahedron that holds it (a vertex in
  *     no kept cube: the nearest tetrahedron, with extrapolated barycentrics);
  *   - each bone that owns surface vertices (their largest weight is its joint's; nearest bone of
@@ -14,7 +16,7 @@
  *     distance of those vertices from the segment, at least 1.2 lattice cubes. Every node gets
  *     inverse-distance weights to these bones (ak_skin_weights_compute's DISTANCE method). A node
  *     inside its own bone's capsule, bound to one joint (largest weight >= 0.99) and farther than
- *     three capsule radii from every other bone is kinematic: it follows the skeleton by linear
+ *     joint_zone capsule radii from every other bone is kinematic: it follows the skeleton by linear
  *     blend skinning of the node (the bone; the flesh around a joint stays free, so that the
  *     two bones' cores do not crush it at a deep bend); a connected piece of the lattice with no
  *     kinematic node is kinematic whole;
@@ -32,16 +34,17 @@
  *     on that side at the bind pose, within the longer bone plus two flesh radii of the joint)
  *     stays on its side of the plane through the joint that bisects the two posed bones, so
  *     the two sides press flat against each other instead of passing through; (2) a flesh node
- *     stays outside the kinematic capsule of every other joint's bone that it was outside of
- *     at the bind pose;
+ *     stays outside the core (bone_radius x its flesh radius) of every other joint's bone that
+ *     it was outside of at the bind pose;
  *   - determinism and threads: tetrahedra are coloured at build time (no two of a colour share
  *     a node) and solved colour by colour, so the result is bit-identical for every
  *     thread_count; threads split each colour and the per-node phases.
  *
  * What it does NOT do: general self-collision of the surface (only the two kinds above),
  * continuous collision detection, morph targets (the bind positions are embedded), or separate
- * lattice copies for parts that one cube spans (two limbs closer than a cube are joined: raise
- * the resolution). The lattice is coarse next to the mesh (resolution 16: a few cubes across
+ * lattice copies for parts that one cube spans (parts at most two skeleton steps apart stay
+ * joined; farther ones are cut apart, their surface vertices extrapolated from a neighbouring
+ * cube of their own part). The lattice is coarse next to the mesh (resolution 16: a few cubes across
  * a limb), so the surface follows the tetrahedra's piecewise-linear motion: visible facets at
  * strong deformations. Normals: compute them from the deformed surface (ak_normals_compute).
  *
@@ -102,6 +105,15 @@ typedef struct ak_skin_soft_desc {
     float jiggle_damping;      /* 1/s: the flesh's velocity relative to the skinned motion
                                   (see previous_palette) decays as exp(-jiggle_damping t);
                                   0 -> 5; negative -> none */
+    float joint_zone;          /* flesh zone around a joint, in kinematic capsule radii (at
+                                  most half the bone's length), in (0, 100]; 0 -> 3. Smaller:
+                                  more of the limb near a joint follows the bone (CesiumMan's
+                                  knee at 130 degrees needs 1.5 at resolution 32 with 40
+                                  substeps; the cylinder bent 150 degrees needs 3) */
+    bool join_distant_parts;   /* false (default): drop the lattice cells whose corners lie
+                                  nearest to bones that share no joint (keeps the two legs,
+                                  an arm and the chest apart); true: keep them (limbs closer
+                                  than a cube are joined; the behaviour before, for comparison) */
 } ak_skin_soft_desc;
 
 /* The desc with every zero field replaced by its documented default. */
@@ -132,6 +144,9 @@ AK_API size_t ak_skin_soft_tet_count(const ak_skin_soft* soft);
 AK_API size_t ak_skin_soft_kinematic_count(const ak_skin_soft* soft);
 /* Surface vertices embedded (the vertex count of the desc); 0 for NULL. */
 AK_API size_t ak_skin_soft_vertex_count(const ak_skin_soft* soft);
+/* Lattice cells dropped because their corners belong to bones that share no joint (see
+ * join_distant_parts); 0 for NULL. */
+AK_API size_t ak_skin_soft_cut_cell_count(const ak_skin_soft* soft);
 /* Bind-space node positions into out (count >= node count). AK_ERR_NULL_ARG,
  * AK_ERR_SPAN_SMALL. */
 AK_API ak_result ak_skin_soft_rest_nodes(const ak_skin_soft* soft, ak_vec3_span out_positions);

@@ -11,10 +11,13 @@
 #define SOFT_MAX_COLORS 128u
 #define SOFT_INFLUENCES 4u
 #define SOFT_NODE_PLANES 4u
+#define SOFT_MAX_CUT_BONES 1024u              /* more bones: limbs are not kept apart */
+#define SOFT_PART_UNSET (UINT32_MAX - 1u)
 
 struct ak_skin_soft {
     ak_allocator alloc;
     size_t node_count, tet_count, kin_count, vertex_count, bone_count;
+    size_t cut_cells;       /* cells dropped to keep limbs apart */
     float mu, lambda, damping, jiggle_damping;
     uint32_t substeps;
     uint16_t max_joint;
@@ -33,7 +36,8 @@ struct ak_skin_soft {
     float* embed_bary;      /* [4 * vertex] */
     ak_skin_bone* bones;    /* [bone] */
     float* contact_radius;  /* [bone] median distance of the bone's vertices (0: owns none) */
-    float* core_radius;     /* [bone] kinematic capsule and collider radius */
+    float* core_radius;     /* [bone] kinematic capsule radius (at least 1.2 cubes) */
+    float* collide_radius;  /* [bone] collider radius: bone_radius x contact_radius */
     uint64_t* collide;      /* [node * collide_words]: bit b -> node collides with bone b */
     size_t collide_words;
     uint32_t plane_count;
@@ -117,6 +121,7 @@ ak_skin_soft_desc ak_skin_soft_desc_resolved(const ak_skin_soft_desc* desc) {
     if (d.substeps == 0) d.substeps = 10;
     if (d.bone_radius == 0.0f) d.bone_radius = 0.5f;
     if (d.jiggle_damping == 0.0f) d.jiggle_damping = 5.0f;
+    if (d.joint_zone == 0.0f) d.joint_zone = 3.0f;
     if (d.memory_budget == 0) d.memory_budget = (size_t)512 << 20;
     return d;
 }
@@ -139,6 +144,7 @@ void ak_skin_soft_destroy(ak_skin_soft* s) {
     akp_free(a, s->bones);
     akp_free(a, s->contact_radius);
     akp_free(a, s->core_radius);
+    akp_free(a, s->collide_radius);
     akp_free(a, s->collide);
     akp_free(a, s->planes);
     akp_free(a, s->node_planes);
@@ -161,7 +167,8 @@ static ak_result check_desc(const ak_skin_soft_desc* d) {
         return AK_ERR_BAD_ARG;
     if (d->resolution < 2 || d->resolution > 256 || !(d->youngs_modulus > 0.0f) || !isfinite(d->youngs_modulus) ||
         !(d->poisson_ratio > 0.0f && d->poisson_ratio <= 0.4999f) || !(d->density > 0.0f) || !isfinite(d->density) ||
-        !isfinite(d->damping) || !isfinite(d->jiggle_damping) || d->substeps > 1000 || !(d->bone_radius > 0.0f && d->bone_radius <= 1.0f))
+        !isfinite(d->damping) || !isfinite(d->jiggle_damping) || d->substeps > 1000 || !(d->bone_radius > 0.0f && d->bone_radius <= 1.0f) ||
+        !(d->joint_zone > 0.0f && d->joint_zone <= 100.0f))
         return AK_ERR_BAD_ARG;
     size_t wn = d->positions.count * d->influence_count;
     if (d->joints.count < wn || d->weights.count < wn) return AK_ERR_SPAN_SMALL;
@@ -191,6 +198,9 @@ typedef struct build_tmp {
     uint8_t* comp_kin;     /* [node] */
     float* dist;           /* [vertex] */
     uint32_t* owner;       /* [vertex] bone of a vertex */
+    uint32_t* grid_part;   /* [grid nodes] nearest owning bone, UINT32_MAX unset */
+    uint32_t* node_part;   /* [node] the same per lattice node */
+    uint64_t* adjacent;    /* [bone * words] bit b: at most two steps apart */
 } build_tmp;
 
 static void tmp_free(const ak_allocator* a, build_tmp* t) {
@@ -207,6 +217,37 @@ static void tmp_free(const ak_allocator* a, build_tmp* t) {
     akp_free(a, t->comp_kin);
     akp_free(a, t->dist);
     akp_free(a, t->owner);
+    akp_free(a, t->grid_part);
+    akp_free(a, t->node_part);
+    akp_free(a, t->adjacent);
+}
+
+/* The owning bone (contact_radius > 0) nearest to p; UINT32_MAX when none owns vertices. */
+static uint32_t nearest_part(const ak_skin_soft* s, ak_vec3 p) {
+    float best = INFINITY;
+    uint32_t part = UINT32_MAX;
+    for (size_t b = 0; b < s->bone_count; ++b) {
+        if (!(s->contact_radius[b] > 0.0f)) continue;
+        float d2 = akp_segment_dist_sq(p, s->bones[b].head, s->bones[b].tail, NULL);
+        if (d2 < best) {
+            best = d2;
+            part = (uint32_t)b;
+        }
+    }
+    return part;
+}
+
+static bool parts_adjacent(const build_tmp* t, size_t words, uint32_t a, uint32_t b) {
+    if (a == b || a >= SOFT_PART_UNSET || b >= SOFT_PART_UNSET || !t->adjacent) return true;
+    return (t->adjacent[(size_t)a * words + b / 64] >> (b % 64)) & 1u;
+}
+
+/* Whether every node of a tet belongs to a part that shares a joint with bone `part`. */
+static bool tet_fits(const build_tmp* t, size_t words, const uint32_t* tt, uint32_t part) {
+    if (!t->node_part) return true;
+    for (int c = 0; c < 4; ++c)
+        if (!parts_adjacent(t, words, t->node_part[tt[c]], part)) return false;
+    return true;
 }
 
 /* Kuhn split of a cube: the 6 monotone paths from corner 0 to corner 7 (bits x=1, y=2, z=4). */
@@ -242,7 +283,8 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     const size_t cells = nx * ny * nz, gnodes = (nx + 1) * (ny + 1) * (nz + 1), cols = ny * nz;
     /* budget: temporaries and the worst case (every cell kept) of the result */
     size_t budget_need = cells * (1 + 4 + 6 * (16 + 4 + 4 + 36 + 4 + 4)) + gnodes * (4 + 12 + 1 + 8 + 4 + 32 + 16 + 4 + 1 + 8 * ((nb + 63) / 64)) +
-                         (cols + 1) * 4 + nv * (4 + 16 + 4 + 4) + nb * 64;
+                         (cols + 1) * 4 + nv * (4 + 16 + 4 + 4) + nb * 64 + gnodes * 8 +
+                         (nb <= SOFT_MAX_CUT_BONES ? 2 * nb * ((nb + 63) / 64) * 8 : 0);
     if (budget_need > d.memory_budget) return AK_ERR_BUDGET;
 
     const ak_allocator* A = alloc;
@@ -266,6 +308,46 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
             goto fail;                                                \
         }                                                             \
     } while (0)
+
+    /* 0. bones: flesh radius = median distance of the vertices each bone owns */
+    SOFT_ALLOC(s->bones, ak_skin_bone, nb);
+    SOFT_ALLOC(s->contact_radius, float, nb);
+    SOFT_ALLOC(s->core_radius, float, nb);
+    SOFT_ALLOC(s->collide_radius, float, nb);
+    memcpy(s->bones, d.bones.ptr, nb * sizeof(ak_skin_bone));
+    for (size_t b = 0; b < nb; ++b)
+        if (s->bones[b].joint_index > s->max_joint) s->max_joint = s->bones[b].joint_index;
+    SOFT_ALLOC(t.dist, float, nv);
+    SOFT_ALLOC(t.owner, uint32_t, nv);
+    for (size_t v = 0; v < nv; ++v) {
+        const uint16_t* jv = &d.joints.ptr[v * d.influence_count];
+        const float* wv = &d.weights.ptr[v * d.influence_count];
+        uint16_t dom = jv[0];
+        float wmax = wv[0];
+        for (uint32_t k = 1; k < d.influence_count; ++k)
+            if (wv[k] > wmax) {
+                wmax = wv[k];
+                dom = jv[k];
+            }
+        float best = INFINITY;
+        t.owner[v] = UINT32_MAX;
+        for (size_t b = 0; b < nb; ++b) {
+            if (s->bones[b].joint_index != dom) continue;
+            float dd = akp_segment_dist_sq(P[v], s->bones[b].head, s->bones[b].tail, NULL);
+            if (dd < best) {
+                best = dd;
+                t.owner[v] = (uint32_t)b;
+            }
+        }
+    }
+    for (size_t b = 0; b < nb; ++b) {
+        size_t cnt = 0;
+        for (size_t v = 0; v < nv; ++v)
+            if (t.owner[v] == b) t.dist[cnt++] = sqrtf(akp_segment_dist_sq(P[v], s->bones[b].head, s->bones[b].tail, NULL));
+        if (cnt == 0) continue;
+        qsort(t.dist, cnt, sizeof(float), cmp_float);
+        s->contact_radius[b] = t.dist[cnt / 2];
+    }
 
     /* 1. inside test: per column of cell centres, signed crossings of a ray along +X */
     SOFT_ALLOC(t.keep, uint8_t, cells);
@@ -344,6 +426,62 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
         t.keep[(ci[2] * ny + ci[1]) * nx + ci[0]] = 1;
     }
 
+    /* 1b. keep distinct limbs apart: each corner of a kept cell belongs to its nearest owning
+     * bone (its part); a cell with corners of two parts more than two steps apart along the
+     * skeleton (the two thighs, a hanging forearm and the chest) is dropped, so the lattice
+     * does not bridge a gap between limbs that one cube spans. One step: two bones that meet
+     * at an end or belong to the same joint. */
+#define GRID(i, j, k) ((((k) * (ny + 1)) + (j)) * (nx + 1) + (i))
+    const size_t adj_words = (nb + 63) / 64;
+    if (!d.join_distant_parts && nb <= SOFT_MAX_CUT_BONES) {
+        SOFT_ALLOC(t.adjacent, uint64_t, nb * adj_words);
+        const float tol = 1e-4f * longest;
+        for (size_t b1 = 0; b1 < nb; ++b1)
+            for (size_t b2 = 0; b2 < nb; ++b2) {
+                const ak_skin_bone *u = &s->bones[b1], *w = &s->bones[b2];
+                bool adj = b1 == b2 || u->joint_index == w->joint_index || ak_vec3_distance(u->head, w->head) <= tol ||
+                           ak_vec3_distance(u->head, w->tail) <= tol || ak_vec3_distance(u->tail, w->head) <= tol ||
+                           ak_vec3_distance(u->tail, w->tail) <= tol;
+                if (adj) t.adjacent[b1 * adj_words + b2 / 64] |= (uint64_t)1 << (b2 % 64);
+            }
+        /* two steps along the skeleton: a point bone at a toe and the shin, the thigh and the
+         * belly are together; the two thighs (three steps through the pelvis) are not */
+        uint64_t* one = (uint64_t*)akp_alloc(A, nb * adj_words * sizeof(uint64_t));
+        if (!one) {
+            r = AK_ERR_NO_MEMORY;
+            goto fail;
+        }
+        memcpy(one, t.adjacent, nb * adj_words * sizeof(uint64_t));
+        for (size_t b1 = 0; b1 < nb; ++b1)
+            for (size_t b2 = 0; b2 < nb; ++b2)
+                if ((one[b1 * adj_words + b2 / 64] >> (b2 % 64)) & 1u)
+                    for (size_t w = 0; w < adj_words; ++w) t.adjacent[b1 * adj_words + w] |= one[b2 * adj_words + w];
+        akp_free(A, one);
+        SOFT_ALLOC(t.grid_part, uint32_t, gnodes);
+        for (size_t g = 0; g < gnodes; ++g) t.grid_part[g] = SOFT_PART_UNSET;
+        for (size_t k = 0; k < nz; ++k)
+            for (size_t j = 0; j < ny; ++j)
+                for (size_t i = 0; i < nx; ++i) {
+                    size_t cell = (k * ny + j) * nx + i;
+                    if (!t.keep[cell]) continue;
+                    uint32_t parts[8];
+                    for (int c = 0; c < 8; ++c) {
+                        size_t gi = i + (size_t)(c & 1), gj = j + (size_t)((c >> 1) & 1), gk = k + (size_t)((c >> 2) & 1);
+                        size_t g = GRID(gi, gj, gk);
+                        if (t.grid_part[g] == SOFT_PART_UNSET)
+                            t.grid_part[g] = nearest_part(s, ak_vec3_make(org[0] + (float)gi * h, org[1] + (float)gj * h, org[2] + (float)gk * h));
+                        parts[c] = t.grid_part[g];
+                    }
+                    bool together = true;
+                    for (int a = 0; a < 8 && together; ++a)
+                        for (int b = a + 1; b < 8 && together; ++b) together = parts_adjacent(&t, adj_words, parts[a], parts[b]);
+                    if (!together) {
+                        t.keep[cell] = 0;
+                        s->cut_cells++;
+                    }
+                }
+    }
+
     /* 2. nodes: the corners of kept cells, numbered in grid order */
     SOFT_ALLOC(t.grid_node, uint32_t, gnodes);
     size_t kept = 0;
@@ -353,7 +491,6 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
         goto fail;
     }
     for (size_t g = 0; g < gnodes; ++g) t.grid_node[g] = 0;
-#define GRID(i, j, k) ((((k) * (ny + 1)) + (j)) * (nx + 1) + (i))
     for (size_t k = 0; k < nz; ++k)
         for (size_t j = 0; j < ny; ++j)
             for (size_t i = 0; i < nx; ++i)
@@ -363,6 +500,11 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     for (size_t g = 0; g < gnodes; ++g) t.grid_node[g] = t.grid_node[g] ? (uint32_t)nn++ : UINT32_MAX;
     s->node_count = nn;
     SOFT_ALLOC(s->rest, ak_vec3, nn);
+    if (t.grid_part) {
+        SOFT_ALLOC(t.node_part, uint32_t, nn);
+        for (size_t g = 0; g < gnodes; ++g)
+            if (t.grid_node[g] != UINT32_MAX) t.node_part[t.grid_node[g]] = t.grid_part[g];
+    }
     for (size_t k = 0; k <= nz; ++k)
         for (size_t j = 0; j <= ny; ++j)
             for (size_t i = 0; i <= nx; ++i) {
@@ -472,22 +614,38 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
             float f = floorf((p3[a] - org[a]) / h);
             ci[a] = f < 0.0f ? 0 : (size_t)f >= dim[a] ? dim[a] - 1 : (size_t)f;
         }
-        uint32_t first = t.cell_tet[(ci[2] * ny + ci[1]) * nx + ci[0]];
+        /* the tet of the vertex's cell that holds it best; when that cell was dropped, or
+         * holds nodes of a part that shares no joint with the vertex's bone, the best-fitting
+         * tet of the nearest kept cells of its own parts (extrapolated barycentrics: exact at
+         * the bind pose) */
+        const uint32_t ov = t.owner[v];
         float best = -INFINITY, bary[4];
-        uint32_t best_t = 0;
-        if (first != UINT32_MAX) {
-            for (uint32_t q = first; q < first + 6; ++q) {
-                uint32_t tq = t.perm[q];
-                tet_bary(s->rest[s->tets[4 * tq]], &s->dm_inv[9 * tq], P[v], bary);
-                if (min4(bary) > best) {
-                    best = min4(bary);
-                    best_t = tq;
-                }
-            }
-        } else { /* nearest tet by centroid (cannot happen: every vertex's cell is kept) */
+        uint32_t best_t = UINT32_MAX;
+        for (long reach = 0; reach <= 2 && best_t == UINT32_MAX; ++reach)
+            for (long dk = -reach; dk <= reach; ++dk)
+                for (long dj = -reach; dj <= reach; ++dj)
+                    for (long di = -reach; di <= reach; ++di) {
+                        long mx = labs(di) > labs(dj) ? labs(di) : labs(dj);
+                        if ((labs(dk) > mx ? labs(dk) : mx) != reach) continue; /* the shell only */
+                        long ii = (long)ci[0] + di, jj = (long)ci[1] + dj, kk = (long)ci[2] + dk;
+                        if (ii < 0 || jj < 0 || kk < 0 || ii >= (long)nx || jj >= (long)ny || kk >= (long)nz) continue;
+                        uint32_t first = t.cell_tet[((size_t)kk * ny + (size_t)jj) * nx + (size_t)ii];
+                        if (first == UINT32_MAX) continue;
+                        for (uint32_t q = first; q < first + 6; ++q) {
+                            uint32_t tq = t.perm[q];
+                            if (!tet_fits(&t, adj_words, &s->tets[4 * tq], ov)) continue;
+                            tet_bary(s->rest[s->tets[4 * tq]], &s->dm_inv[9 * tq], P[v], bary);
+                            if (min4(bary) > best) {
+                                best = min4(bary);
+                                best_t = tq;
+                            }
+                        }
+                    }
+        for (int any = 0; any < 2 && best_t == UINT32_MAX; ++any) { /* nearest tet by centroid */
             float bd = INFINITY;
             for (size_t q = 0; q < nt; ++q) {
                 const uint32_t* tt = &s->tets[4 * q];
+                if (!any && !tet_fits(&t, adj_words, tt, ov)) continue;
                 ak_vec3 cen = ak_vec3_scale(
                     ak_vec3_add(ak_vec3_add(s->rest[tt[0]], s->rest[tt[1]]), ak_vec3_add(s->rest[tt[2]], s->rest[tt[3]])), 0.25f);
                 float dd = ak_vec3_length_sq(ak_vec3_sub(cen, P[v]));
@@ -499,45 +657,6 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
         }
         s->embed_tet[v] = best_t;
         tet_bary(s->rest[s->tets[4 * best_t]], &s->dm_inv[9 * best_t], P[v], &s->embed_bary[4 * v]);
-    }
-
-    /* 7. bones: flesh radius = median distance of the vertices each bone owns */
-    SOFT_ALLOC(s->bones, ak_skin_bone, nb);
-    SOFT_ALLOC(s->contact_radius, float, nb);
-    SOFT_ALLOC(s->core_radius, float, nb);
-    memcpy(s->bones, d.bones.ptr, nb * sizeof(ak_skin_bone));
-    for (size_t b = 0; b < nb; ++b)
-        if (s->bones[b].joint_index > s->max_joint) s->max_joint = s->bones[b].joint_index;
-    SOFT_ALLOC(t.dist, float, nv);
-    SOFT_ALLOC(t.owner, uint32_t, nv);
-    for (size_t v = 0; v < nv; ++v) {
-        const uint16_t* jv = &d.joints.ptr[v * d.influence_count];
-        const float* wv = &d.weights.ptr[v * d.influence_count];
-        uint16_t dom = jv[0];
-        float wmax = wv[0];
-        for (uint32_t k = 1; k < d.influence_count; ++k)
-            if (wv[k] > wmax) {
-                wmax = wv[k];
-                dom = jv[k];
-            }
-        float best = INFINITY;
-        t.owner[v] = UINT32_MAX;
-        for (size_t b = 0; b < nb; ++b) {
-            if (s->bones[b].joint_index != dom) continue;
-            float dd = akp_segment_dist_sq(P[v], s->bones[b].head, s->bones[b].tail, NULL);
-            if (dd < best) {
-                best = dd;
-                t.owner[v] = (uint32_t)b;
-            }
-        }
-    }
-    for (size_t b = 0; b < nb; ++b) {
-        size_t cnt = 0;
-        for (size_t v = 0; v < nv; ++v)
-            if (t.owner[v] == b) t.dist[cnt++] = sqrtf(akp_segment_dist_sq(P[v], s->bones[b].head, s->bones[b].tail, NULL));
-        if (cnt == 0) continue;
-        qsort(t.dist, cnt, sizeof(float), cmp_float);
-        s->contact_radius[b] = t.dist[cnt / 2];
     }
 
     /* 8. node weights (inverse distance to the bones) and kinematic nodes */
@@ -571,12 +690,16 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     /* at least 1.2 cubes: every bone holds a column of nodes and its nearest neighbours */
     for (size_t b = 0; b < nb; ++b)
         s->core_radius[b] = s->contact_radius[b] > 0.0f ? ak_maxf(d.bone_radius * s->contact_radius[b], 1.2f * h) : 0.0f;
+    /* the collider is the bone's core without the 1.2-cube floor: the floor makes every bone
+     * hold lattice nodes, but as a collider it pushes the flesh next to a thin limb (CesiumMan's
+     * waist beside the swinging thigh) away by up to a cube */
+    for (size_t b = 0; b < nb; ++b) s->collide_radius[b] = d.bone_radius * s->contact_radius[b];
     /* kinematic: inside a capsule and bound (almost) rigidly to one joint, so that the nodes
      * around a joint, whose weights blend, are flesh */
     /* ... and not within three capsule radii (at most half its own bone's length) of
      * another bone: the flesh around a joint stays free, so that the bones' cores do not crush
      * it at a deep bend */
-    const float zone = 3.0f;
+    const float zone = d.joint_zone;
     /* per joint: whether any node became kinematic with these rules; a joint that got none (its
      * bones too short or too crowded for them: a dense skeleton at a coarse lattice) takes every
      * node inside its capsule that it weighs most */
@@ -630,7 +753,7 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
         if (s->kinematic[n]) continue;
         uint16_t part = s->node_joints[n * SOFT_INFLUENCES];
         for (size_t b = 0; b < nb; ++b) {
-            float rc = s->core_radius[b];
+            float rc = s->collide_radius[b];
             if (!(rc > 0.0f) || s->bones[b].joint_index == part) continue;
             if (akp_segment_dist_sq(s->rest[n], s->bones[b].head, s->bones[b].tail, NULL) < rc * rc) continue;
             s->collide[n * s->collide_words + b / 64] |= (uint64_t)1 << (b % 64);
@@ -699,6 +822,7 @@ size_t ak_skin_soft_node_count(const ak_skin_soft* s) { return s ? s->node_count
 size_t ak_skin_soft_tet_count(const ak_skin_soft* s) { return s ? s->tet_count : 0; }
 size_t ak_skin_soft_kinematic_count(const ak_skin_soft* s) { return s ? s->kin_count : 0; }
 size_t ak_skin_soft_vertex_count(const ak_skin_soft* s) { return s ? s->vertex_count : 0; }
+size_t ak_skin_soft_cut_cell_count(const ak_skin_soft* s) { return s ? s->cut_cells : 0; }
 
 ak_result ak_skin_soft_rest_nodes(const ak_skin_soft* s, ak_vec3_span out) {
     if (!s || !out.ptr) return AK_ERR_NULL_ARG;
@@ -879,7 +1003,7 @@ static void collide_node(const step_ctx* c, size_t n) {
     for (size_t wi = 0; wi < s->collide_words; ++wi)
         for (uint64_t m = bits[wi]; m; m &= m - 1) {
             size_t b = wi * 64 + (size_t)__builtin_ctzll(m);
-            float rc = s->core_radius[b];
+            float rc = s->collide_radius[b];
             ak_vec3 cp;
             float d2 = akp_segment_dist_sq(c->x[n], c->bones[2 * b], c->bones[2 * b + 1], &cp);
             if (d2 >= rc * rc || d2 < 1e-20f) continue;
