@@ -376,6 +376,88 @@ AK_TEST(bake_scene) {
     ak_scene_destroy(baked);
 }
 
+/* Foot planting on one standing character: pins, the IK holding them, the step, the errors. */
+AK_TEST(foot_planting_unit) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    const size_t J = ak_scene_joint_count(sc);
+    ak_transform* local = malloc(J * sizeof *local);
+    ak_mat4* world = malloc(J * sizeof *world);
+    const size_t bytes = ak_crowd_characters_scratch_size(&g);
+    AK_CHECK(bytes >= J * sizeof(ak_transform));
+    AK_CHECK_EQ(ak_crowd_characters_scratch_size(NULL), 0u);
+    uint8_t* scratch = malloc(bytes);
+    ak_crowd_character c = ak_crowd_character_init(&g, ak_vec2_make(1, 0), 0.0f);
+    ak_vec2 v = {0, 0}, p = {2, 3};
+    ak_crowd_characters_job job = {.gait = &g, .dt = 1.0f / 60.0f, .velocities = {&v, 1}, .characters = {&c, 1},
+                                   .positions = {&p, 1}, .scratch = {scratch, bytes}};
+    /* errors: no scratch, too small, short positions, a NaN position (nothing written) */
+    job.scratch.count = bytes - 17;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_SPAN_SMALL);
+    job.scratch.count = bytes;
+    job.positions.count = 0;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_SPAN_SMALL);
+    job.positions.count = 1;
+    p.x = NAN;
+    const ak_crowd_character before = c;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_BAD_DATA);
+    AK_CHECK(memcmp(&before, &c, sizeof c) == 0);
+    p.x = 2;
+    /* standing still: both feet come down in the rest pose and are pinned where they are */
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    ak_vec3 feet[2], feet0[2];
+    feet_world(&g, &c, p, local, world, J, feet0);
+    for (int f = 0; f < 2; ++f) {
+        AK_CHECK_EQ(c.foot_state[f], AK_CROWD_FOOT_PINNED);
+        AK_CHECK_NEAR(c.foot_pin[f].x, feet0[f].x, 1e-5f);
+        AK_CHECK_NEAR(c.foot_pin[f].y, feet0[f].z, 1e-5f);
+    }
+    /* pushed 8 cm sideways without walking: the planted pose keeps the ankles on their pins
+     * (forward kinematics of the returned pose, independent of the solver), the clip's pose
+     * moved them with the body */
+    p.y += 0.08f;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    feet_world(&g, &c, p, local, world, J, feet);
+    AK_CHECK_NEAR(feet[0].z - feet0[0].z, 0.08f, 1e-5f); /* unplanted */
+    AK_CHECK_EQ(ak_crowd_character_pose_planted(&g, &c, p, (ak_transform_span){local, J}), AK_OK);
+    ak_scene_world_matrices(sc, (ak_transform_cspan){local, J}, (ak_mat4_span){world, J});
+    const ak_mat4 root = ak_crowd_character_root(&g, &c, p);
+    for (int f = 0; f < 2; ++f) {
+        AK_CHECK_EQ(c.foot_state[f], AK_CROWD_FOOT_PINNED);
+        const ak_vec3 w = ak_mat4_transform_point(root, ak_mat4_get_translation(world[g.feet[f]]));
+        AK_CHECK_MSG(hypotf(w.x - feet0[f].x, w.z - feet0[f].z) < 1e-4f, "foot %d moved %g m", f,
+                     (double)hypotf(w.x - feet0[f].x, w.z - feet0[f].z));
+        AK_CHECK_NEAR(w.y, feet0[f].y, 1e-4f);
+    }
+    /* 20 cm (beyond AK_CROWD_PLANT_MAX_OFFSET): one foot steps, the other stays pinned */
+    p.y += 0.12f;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    AK_CHECK_EQ((c.foot_state[0] == AK_CROWD_FOOT_STEPPING) + (c.foot_state[1] == AK_CROWD_FOOT_STEPPING), 1);
+    /* the step lifts the foot: half-way it is well above the ground */
+    const int stepping = c.foot_state[0] == AK_CROWD_FOOT_STEPPING ? 0 : 1;
+    for (int k = 0; k < 7; ++k) AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    AK_CHECK_EQ(c.foot_state[stepping], AK_CROWD_FOOT_STEPPING);
+    AK_CHECK_EQ(ak_crowd_character_pose_planted(&g, &c, p, (ak_transform_span){local, J}), AK_OK);
+    ak_scene_world_matrices(sc, (ak_transform_cspan){local, J}, (ak_mat4_span){world, J});
+    const ak_vec3 lifted = ak_mat4_transform_point(root, ak_mat4_get_translation(world[g.feet[stepping]]));
+    AK_CHECK_MSG(lifted.y > feet0[stepping].y + 0.04f, "stepping foot at %g m (ground %g m)", (double)lifted.y,
+                 (double)feet0[stepping].y);
+    /* a character with free feet: the planted pose is the clip's pose, exactly */
+    ak_crowd_character free_c = ak_crowd_character_init(&g, ak_vec2_make(0, 1), 0.3f);
+    free_c.walk_weight = 1.0f;
+    ak_transform* a = malloc(J * sizeof *a);
+    AK_CHECK_EQ(ak_crowd_character_pose(&g, &free_c, (ak_transform_span){a, J}), AK_OK);
+    AK_CHECK_EQ(ak_crowd_character_pose_planted(&g, &free_c, p, (ak_transform_span){local, J}), AK_OK);
+    AK_CHECK(memcmp(a, local, J * sizeof *a) == 0);
+    free(a);
+    free(scratch);
+    free(local);
+    free(world);
+}
+
 /* ---- foot sliding in crowds ----------------------------------------------------------------- */
 
 typedef struct crowd_slide {
@@ -562,6 +644,7 @@ int main(void) {
     AK_RUN(turning_and_idle);
     AK_RUN(validation);
     AK_RUN(bake_scene);
+    AK_RUN(foot_planting_unit);
     AK_RUN(foot_sliding_crowd_crossing);
     AK_RUN_SLOW(foot_sliding_crowd_slow);
     ak_scene_destroy(g_humanoid);
