@@ -43,7 +43,8 @@
  *
  *   - characters: each agent drives a skinned character's in-place walk clip, its clip time
  *     following the distance walked (measured from the clip's stance foot: ak_crowd_gait_*),
- *     its heading the velocity, idle when stopped; the crowd baked into an animated scene
+ *     its heading the velocity, idle when stopped, its stance feet planted in the world (leg
+ *     IK, ik.h's two-bone solver; a short step when pushed); the crowd baked into an animated scene
  *     for glTF (ak_crowd_bake_scene). See the "characters" sections below.
  *
  * What it does NOT do: dynamic obstacles, path planning (waypoints come from the caller), 3D
