@@ -476,9 +476,9 @@ static int cmp_double(const void* a, const void* b) {
 
 /* A preset run with ORCA (default step) at dt 1/60 s, every agent driving a character; the
  * ankles' world positions come from the pose (planted or not) and the root. A foot is in
- * stance while its world height is within 1 cm of the lowest that foot of that agent reaches
- * over the run (after the first second; every frame counts, walking or idle); a stance's slide
- * is the largest horizontal distance from where it began. The run stops one second after
+ * stance while its world height is within 1 cm of the lowest that foot reaches within 3 s either
+ * side (after the first second; every frame counts, walking or idle); a stance's slide is the
+ * largest horizontal distance from where it began. The run stops one second after
  * everyone is home (or at the preset's duration). */
 static bool crowd_slide_run(const ak_crowd_gait* g, const char* preset, size_t agents, bool plant, crowd_slide* out) {
     memset(out, 0, sizeof *out);
@@ -563,20 +563,36 @@ static bool crowd_slide_run(const ak_crowd_gait* g, const char* preset, size_t a
     }
     out->agents = n;
     out->frames = (long)len;
-    /* stances and their slides: with the 1 cm band, and a 2 cm band as a check */
-    const size_t skip = 60;
+    /* stances and their slides: with the 1 cm band, and a 2 cm band as a check. The ground
+     * reference is the lowest the foot is within 3 s either side (a sliding minimum): a
+     * standing character's ankle rests higher or lower than a walking one's in stance, and one
+     * lowest height over a whole run of walking and standing would leave the other's stances
+     * out of the band */
+    const size_t skip = 60, W = 180;
+    float* low = malloc(len * sizeof *low);
+    size_t* dq = malloc(len * sizeof *dq);
     for (int band = 0; band < 2; ++band) {
         size_t scap = 1024, sl = 0;
         double* slides = malloc(scap * sizeof *slides);
         for (size_t i = 0; i < n; ++i)
             for (int k = 0; k < 2; ++k) {
-                float low = INFINITY;
-                for (size_t s = skip; s < len; ++s) low = fminf(low, rec[(s * n + i) * 6 + 3 * k + 1]);
+#define Y(s) rec[((s) * n + i) * 6 + 3 * k + 1]
+                /* low[s] = min of Y over [s - W, s + W] (a monotonic deque) */
+                size_t head = 0, tail = 0, next = 0;
+                for (size_t s = 0; s < len; ++s) {
+                    for (; next < len && next <= s + W; ++next) {
+                        while (tail > head && Y(dq[tail - 1]) >= Y(next)) --tail;
+                        dq[tail++] = next;
+                    }
+                    while (dq[head] + W < s) ++head;
+                    low[s] = Y(dq[head]);
+                }
                 long start = -1;
                 double worst = 0.0;
                 for (size_t s = skip; s <= len; ++s) {
                     const float* r = s < len ? rec + (s * n + i) * 6 + 3 * k : NULL;
-                    const bool st = r && r[1] <= low + (band ? 0.02f : 0.01f);
+                    const bool st = r && r[1] <= low[s] + (band ? 0.02f : 0.01f);
+#undef Y
                     if (st && start < 0) start = (long)s, worst = 0.0;
                     if (st) {
                         const float* r0 = rec + ((size_t)start * n + i) * 6 + 3 * k;
@@ -598,6 +614,8 @@ static bool crowd_slide_run(const ak_crowd_gait* g, const char* preset, size_t a
         }
         free(slides);
     }
+    free(low);
+    free(dq);
     free(rec);
     free(cscr);
     free(scratch);
