@@ -1066,6 +1066,107 @@ static float contact_pass(const ak_crowd* crowd, const ak_grid* g, ak_vec2* P, f
     return depth;
 }
 
+/* The projection's candidates: every pair closer than its radii + CONTACT_MARGIN rmax and
+ * every (agent, obstacle edge) closer than the radius + that margin, gathered in
+ * contact_pass's order (grid cells, the 9-cell stencil, sorted entries; agents in index order
+ * and edges in vertex order), and each agent's displacement since (an upper bound: the sum of
+ * its moves). While no agent moved more than half the margin, no other pair or edge can
+ * overlap, so passes over the lists do what contact_pass over a grid of the present positions
+ * would, in a fixed order. */
+typedef struct contact_set {
+    uint32_t* pairs; /* [2 * pair_count] */
+    size_t pair_count, pair_cap;
+    uint32_t* edges; /* [2 * edge_count]: agent, vertex */
+    size_t edge_count, edge_cap;
+    float* moved;    /* [agent_count] */
+    float margin;
+} contact_set;
+
+/* Gather the candidates (grid: cells of 2 rmax + margin over the present positions); false
+ * when a list is full (the caller falls back to contact_pass). */
+static bool contact_gather(const ak_crowd* crowd, const ak_grid* g, const ak_vec2* P, contact_set* s) {
+    s->pair_count = s->edge_count = 0;
+    const float m = s->margin;
+    for (uint32_t c = 0; c < g->cell_count; ++c) {
+        const ak_grid_cell cm = g->cell_coord[c];
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const ak_grid_cell cc = {cm.x + dx, 0, cm.z + dz};
+                const uint32_t c2 = ak_grid_cell_find(g, cc);
+                if (c2 == UINT32_MAX || c2 < c) continue;
+                for (uint32_t a = g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
+                    const uint32_t i = g->order[a];
+                    for (uint32_t b = (c2 == c ? a + 1 : g->cell_start[c2]); b < g->cell_start[c2 + 1]; ++b) {
+                        const uint32_t j = g->order[b];
+                        const float rr = crowd->radii[i] + crowd->radii[j] + m;
+                        if (!(abs_sq(sub(P[i], P[j])) < rr * rr)) continue;
+                        if (s->pair_count == s->pair_cap) return false;
+                        s->pairs[2 * s->pair_count] = i;
+                        s->pairs[2 * s->pair_count + 1] = j;
+                        ++s->pair_count;
+                    }
+                }
+            }
+    }
+    for (size_t i = 0; i < crowd->agent_count && crowd->vertex_count; ++i) {
+        const float r = crowd->agents[i].radius + m;
+        for (uint32_t k = 0; k < crowd->vertex_count; ++k) {
+            const obst_vertex* o1 = &crowd->verts[k];
+            const ak_vec2 e = sub(crowd->verts[o1->next].point, o1->point);
+            const float t = ak_clampf(dot(sub(P[i], o1->point), e) / abs_sq(e), 0.0f, 1.0f);
+            if (!(abs_sq(sub(P[i], add(o1->point, mul(t, e)))) < r * r)) continue;
+            if (s->edge_count == s->edge_cap) return false;
+            s->edges[2 * s->edge_count] = (uint32_t)i;
+            s->edges[2 * s->edge_count + 1] = k;
+            ++s->edge_count;
+        }
+    }
+    memset(s->moved, 0, crowd->agent_count * sizeof *s->moved);
+    return true;
+}
+
+/* contact_pass over the gathered candidates (the same moves, in the gathered order); returns
+ * the deepest overlap and sets *out_moved to the largest displacement of an agent since the
+ * gather. */
+static float contact_pass_set(const ak_crowd* crowd, contact_set* s, ak_vec2* P, float skin, float* out_moved) {
+    float depth = 0.0f, moved = 0.0f;
+    for (size_t k = 0; k < s->pair_count; ++k) {
+        const uint32_t i = s->pairs[2 * k], j = s->pairs[2 * k + 1];
+        const float rr = crowd->radii[i] + crowd->radii[j];
+        const ak_vec2 d = sub(P[i], P[j]);
+        const float d2 = abs_sq(d);
+        if (!(d2 < rr * rr)) continue;
+        const float dl = sqrtf(d2);
+        if (rr - dl > depth) depth = rr - dl;
+        const ak_vec2 dir = dl > 1e-6f * rr ? mul(1.0f / dl, d) : v2(i < j ? -1.0f : 1.0f, 0.0f);
+        const float hl = 0.5f * (rr + skin - dl);
+        const ak_vec2 h = mul(hl, dir);
+        P[i] = add(P[i], h);
+        P[j] = sub(P[j], h);
+        s->moved[i] += hl;
+        s->moved[j] += hl;
+        moved = ak_maxf(moved, ak_maxf(s->moved[i], s->moved[j]));
+    }
+    for (size_t k = 0; k < s->edge_count; ++k) {
+        const uint32_t i = s->edges[2 * k];
+        const obst_vertex* o1 = &crowd->verts[s->edges[2 * k + 1]];
+        const ak_vec2 b = crowd->verts[o1->next].point, q = P[i];
+        const float r = crowd->agents[i].radius;
+        const ak_vec2 e = sub(b, o1->point);
+        const float t = ak_clampf(dot(sub(q, o1->point), e) / abs_sq(e), 0.0f, 1.0f);
+        const ak_vec2 d = sub(q, add(o1->point, mul(t, e)));
+        const float d2 = abs_sq(d);
+        if (d2 >= r * r || !(d2 > 0.0f) || left_of(o1->point, b, q) > 0.0f) continue;
+        const float dl = sqrtf(d2);
+        if (r - dl > depth) depth = r - dl;
+        P[i] = add(q, mul((r + skin - dl) / dl, d));
+        s->moved[i] += r + skin - dl;
+        moved = ak_maxf(moved, s->moved[i]);
+    }
+    *out_moved = moved;
+    return depth;
+}
+
 static void run_threads(void* (*fn)(void*), worker* w, uint32_t threads) {
     akp_run_tasks(fn, w, sizeof(worker), threads); /* the library's worker team (src/tasks.h) */
 }
@@ -1086,19 +1187,34 @@ static uint32_t contact_need(const ak_crowd_step_job* job) {
 
 typedef struct layout {
     size_t grid_pts, grid_mem, per_thread, contact, dense, dense_cap, pref, total;
-    ak_grid_desc gd, contact_gd;
+    size_t pair_cap, edge_cap; /* the projection's candidate lists (contact) */
+    ak_grid_desc gd, contact_gd, gather_gd;
 } layout;
 
-static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t contact_iterations, layout* L) {
+/* The projection gathers candidate pairs closer than their radii + this (a fraction of the
+ * largest radius) once, and gathers again only after some agent moved half of it. */
+#define CONTACT_MARGIN 0.5f
+
+static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t contact_iterations, bool projection,
+                        layout* L) {
     memset(L, 0, sizeof *L);
     L->gd.cell_size = c->cell_size;
     L->contact_gd.cell_size = ak_maxf(2.0f * c->max_radius, 1e-3f);
+    L->gather_gd.cell_size = ak_maxf((2.0f + CONTACT_MARGIN) * c->max_radius, 1e-3f);
     /* the contact pass is Gauss-Seidel in the grid's cell order: keep the order it was tuned on */
-    L->gd.cell_order = L->contact_gd.cell_order = AK_GRID_ORDER_HASH;
+    L->gd.cell_order = L->contact_gd.cell_order = L->gather_gd.cell_order = AK_GRID_ORDER_HASH;
     size_t gm = ak_grid_memory_size(n, &L->gd);
     if (contact_iterations > 0) {
         const size_t gm2 = ak_grid_memory_size(n, &L->contact_gd);
         if (gm2 > gm) gm = gm2;
+    }
+    if (projection) {
+        const size_t gm3 = ak_grid_memory_size(n, &L->gather_gd);
+        if (gm3 > gm) gm = gm3;
+        L->pair_cap = 6 * n + 1024;
+        L->edge_cap = c->vertex_count ? 2 * n + 1024 : 0;
+        L->contact = akp_align16(L->pair_cap * 2 * sizeof(uint32_t)) + akp_align16(L->edge_cap * 2 * sizeof(uint32_t)) +
+                     akp_align16(n * sizeof(float));
     }
     if (gm == 0 && n > 0) return false;
     L->grid_pts = akp_align16(n * sizeof(ak_vec3));
@@ -1130,7 +1246,7 @@ size_t ak_crowd_step_scratch_size(const ak_crowd_step_job* job) {
     if (!job || !job->crowd || job->thread_count > 64 || job->contact_iterations > 64) return 0;
     const size_t n = job->crowd->agent_count;
     layout L;
-    if (!make_layout(job->crowd, n, thread_total(job, n), contact_need(job), &L)) return 0;
+    if (!make_layout(job->crowd, n, thread_total(job, n), contact_need(job), !job->allow_overlap, &L)) return 0;
     return L.total;
 }
 
@@ -1215,7 +1331,7 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     const size_t n = crowd->agent_count;
     const uint32_t threads = thread_total(job, n);
     layout L;
-    make_layout(crowd, n, threads, contact_need(job), &L);
+    make_layout(crowd, n, threads, contact_need(job), !job->allow_overlap, &L);
     char* base = align_up(job->scratch.ptr);
     ak_grid grid;
     ctx c = {.job = job, .crowd = crowd};
@@ -1249,11 +1365,37 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
      * moved apart to a skin of a tenth of it beyond touching so that rounding does not leave
      * them overlapping. */
     const float tol = AK_CROWD_CONTACT_TOLERANCE;
+    char* cb = base + L.grid_pts + L.grid_mem;
+    contact_set set = {.pairs = (uint32_t*)(void*)cb, .pair_cap = L.pair_cap, .margin = CONTACT_MARGIN * crowd->max_radius};
+    cb += akp_align16(L.pair_cap * 2 * sizeof(uint32_t));
+    set.edges = (uint32_t*)(void*)cb;
+    set.edge_cap = L.edge_cap;
+    cb += akp_align16(L.edge_cap * 2 * sizeof(uint32_t));
+    set.moved = (float*)(void*)cb;
+    bool gathered = false;
     for (uint32_t it = 0; it < AK_CROWD_MAX_CONTACT_PASSES; ++it) {
-        const ak_result cr = build_grid(job, &L, &L.contact_gd, job->out_positions.ptr, base, &grid);
-        if (cr != AK_OK) return cr;
-        const float depth = contact_pass(crowd, &grid, job->out_positions.ptr, 0.1f * tol);
-        if (!(depth > tol) && it + 1 >= job->contact_iterations) break;
+        float depth;
+        if (!gathered) {
+            /* (re)gather the candidates over the present positions; a full list -> this pass
+             * the grid way */
+            const ak_result cr = build_grid(job, &L, &L.gather_gd, job->out_positions.ptr, base, &grid);
+            if (cr != AK_OK) return cr;
+            gathered = contact_gather(crowd, &grid, job->out_positions.ptr, &set);
+            if (!gathered) {
+                const ak_result cr2 = build_grid(job, &L, &L.contact_gd, job->out_positions.ptr, base, &grid);
+                if (cr2 != AK_OK) return cr2;
+                depth = contact_pass(crowd, &grid, job->out_positions.ptr, 0.1f * tol);
+                if (!(depth > tol) && it + 1 >= job->contact_iterations) break;
+                continue;
+            }
+        }
+        float moved = 0.0f;
+        depth = contact_pass_set(crowd, &set, job->out_positions.ptr, 0.1f * tol, &moved);
+        /* moved half the margin: a pair outside the lists may overlap now; gather again
+         * before trusting a pass */
+        const bool stale = !(moved < 0.5f * set.margin);
+        if (!(depth > tol) && !stale && it + 1 >= job->contact_iterations) break;
+        if (stale) gathered = false;
     }
     if (!job->orca_velocities) {
         /* the velocity the agent actually moved with */
@@ -1270,7 +1412,7 @@ size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd
     if (ak_crowd_step_validate(job) != AK_OK || index >= job->crowd->agent_count) return 0;
     const ak_crowd* crowd = job->crowd;
     layout L;
-    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), contact_need(job), &L);
+    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), contact_need(job), !job->allow_overlap, &L);
     char* base = align_up(job->scratch.ptr);
     ak_grid grid;
     ctx c = {.job = job, .crowd = crowd};

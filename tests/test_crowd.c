@@ -842,6 +842,8 @@ AK_TEST(scene_presets) {
         AK_CHECK((p.x != g.x && p.x * g.x < 0) || (p.y != g.y && p.y * g.y < 0)); /* through the centre */
     }
     AK_CHECK(groups[0] == 3 && groups[1] == 3 && groups[2] == 3 && groups[3] == 3);
+    /* 3 per block: 2 columns, 2 rows; travel = 2 (0.5 * 1.6 * 2 + 4) + 1.6 * 2 = 14.4 m */
+    AK_CHECK_NEAR(s.duration, 2.0 * 14.4 / 1.3 + 120.0 + 0.06 * 12, 1e-3);
     ak_crowd_scene_free(&s);
     /* corridor: two walls along x at z = +-4, two groups walking at each other */
     AK_CHECK_EQ(ak_crowd_scene_preset("corridor", 12, &s, &d), AK_OK);

@@ -376,12 +376,295 @@ AK_TEST(bake_scene) {
     ak_scene_destroy(baked);
 }
 
+/* Foot planting on one standing character: pins, the IK holding them, the step, the errors. */
+AK_TEST(foot_planting_unit) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    const size_t J = ak_scene_joint_count(sc);
+    ak_transform* local = malloc(J * sizeof *local);
+    ak_mat4* world = malloc(J * sizeof *world);
+    const size_t bytes = ak_crowd_characters_scratch_size(&g);
+    AK_CHECK(bytes >= J * sizeof(ak_transform));
+    AK_CHECK_EQ(ak_crowd_characters_scratch_size(NULL), 0u);
+    uint8_t* scratch = malloc(bytes);
+    ak_crowd_character c = ak_crowd_character_init(&g, ak_vec2_make(1, 0), 0.0f);
+    ak_vec2 v = {0, 0}, p = {2, 3};
+    ak_crowd_characters_job job = {.gait = &g, .dt = 1.0f / 60.0f, .velocities = {&v, 1}, .characters = {&c, 1},
+                                   .positions = {&p, 1}, .scratch = {scratch, bytes}};
+    /* errors: no scratch, too small, short positions, a NaN position (nothing written) */
+    job.scratch.count = bytes - 17;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_SPAN_SMALL);
+    job.scratch.count = bytes;
+    job.positions.count = 0;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_SPAN_SMALL);
+    job.positions.count = 1;
+    p.x = NAN;
+    const ak_crowd_character before = c;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_ERR_BAD_DATA);
+    AK_CHECK(memcmp(&before, &c, sizeof c) == 0);
+    p.x = 2;
+    /* standing still: both feet come down in the rest pose and are pinned where they are */
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    ak_vec3 feet[2], feet0[2];
+    feet_world(&g, &c, p, local, world, J, feet0);
+    for (int f = 0; f < 2; ++f) {
+        AK_CHECK_EQ(c.foot_state[f], AK_CROWD_FOOT_PINNED);
+        AK_CHECK_NEAR(c.foot_pin[f].x, feet0[f].x, 1e-5f);
+        AK_CHECK_NEAR(c.foot_pin[f].y, feet0[f].z, 1e-5f);
+    }
+    /* pushed 8 cm sideways without walking: the planted pose keeps the ankles on their pins
+     * (forward kinematics of the returned pose, independent of the solver), the clip's pose
+     * moved them with the body */
+    p.y += 0.08f;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    feet_world(&g, &c, p, local, world, J, feet);
+    AK_CHECK_NEAR(feet[0].z - feet0[0].z, 0.08f, 1e-5f); /* unplanted */
+    AK_CHECK_EQ(ak_crowd_character_pose_planted(&g, &c, p, (ak_transform_span){local, J}), AK_OK);
+    ak_scene_world_matrices(sc, (ak_transform_cspan){local, J}, (ak_mat4_span){world, J});
+    const ak_mat4 root = ak_crowd_character_root(&g, &c, p);
+    for (int f = 0; f < 2; ++f) {
+        AK_CHECK_EQ(c.foot_state[f], AK_CROWD_FOOT_PINNED);
+        const ak_vec3 w = ak_mat4_transform_point(root, ak_mat4_get_translation(world[g.feet[f]]));
+        AK_CHECK_MSG(hypotf(w.x - feet0[f].x, w.z - feet0[f].z) < 1e-4f, "foot %d moved %g m", f,
+                     (double)hypotf(w.x - feet0[f].x, w.z - feet0[f].z));
+        AK_CHECK_NEAR(w.y, feet0[f].y, 1e-4f);
+    }
+    /* 20 cm (beyond AK_CROWD_PLANT_MAX_OFFSET): one foot steps, the other stays pinned */
+    p.y += 0.12f;
+    AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    AK_CHECK_EQ((c.foot_state[0] == AK_CROWD_FOOT_STEPPING) + (c.foot_state[1] == AK_CROWD_FOOT_STEPPING), 1);
+    /* the step lifts the foot: half-way it is well above the ground */
+    const int stepping = c.foot_state[0] == AK_CROWD_FOOT_STEPPING ? 0 : 1;
+    for (int k = 0; k < 7; ++k) AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
+    AK_CHECK_EQ(c.foot_state[stepping], AK_CROWD_FOOT_STEPPING);
+    AK_CHECK_EQ(ak_crowd_character_pose_planted(&g, &c, p, (ak_transform_span){local, J}), AK_OK);
+    ak_scene_world_matrices(sc, (ak_transform_cspan){local, J}, (ak_mat4_span){world, J});
+    const ak_vec3 lifted = ak_mat4_transform_point(root, ak_mat4_get_translation(world[g.feet[stepping]]));
+    AK_CHECK_MSG(lifted.y > feet0[stepping].y + 0.04f, "stepping foot at %g m (ground %g m)", (double)lifted.y,
+                 (double)feet0[stepping].y);
+    /* a character with free feet: the planted pose is the clip's pose, exactly */
+    ak_crowd_character free_c = ak_crowd_character_init(&g, ak_vec2_make(0, 1), 0.3f);
+    free_c.walk_weight = 1.0f;
+    ak_transform* a = malloc(J * sizeof *a);
+    AK_CHECK_EQ(ak_crowd_character_pose(&g, &free_c, (ak_transform_span){a, J}), AK_OK);
+    AK_CHECK_EQ(ak_crowd_character_pose_planted(&g, &free_c, p, (ak_transform_span){local, J}), AK_OK);
+    AK_CHECK(memcmp(a, local, J * sizeof *a) == 0);
+    free(a);
+    free(scratch);
+    free(local);
+    free(world);
+}
+
+/* ---- foot sliding in crowds ----------------------------------------------------------------- */
+
+typedef struct crowd_slide {
+    double max, p95;  /* largest and 95th percentile slide over every stance (m) */
+    double max2;      /* the largest with a 2 cm stance band */
+    size_t stances;   /* stances measured */
+    size_t steps;     /* forced steps (planting only) */
+    size_t home, agents;
+    long frames;
+} crowd_slide;
+
+static int cmp_double(const void* a, const void* b) {
+    const double x = *(const double*)a, y = *(const double*)b;
+    return x < y ? -1 : x > y;
+}
+
+/* A preset run with ORCA (default step) at dt 1/60 s, every agent driving a character; the
+ * ankles' world positions come from the pose (planted or not) and the root. A foot is in
+ * stance while its world height is within 1 cm of the lowest that foot reaches within 3 s either
+ * side (after the first second; every frame counts, walking or idle); a stance's slide is the
+ * largest horizontal distance from where it began. The run stops one second after
+ * everyone is home (or at the preset's duration). */
+static bool crowd_slide_run(const ak_crowd_gait* g, const char* preset, size_t agents, bool plant, crowd_slide* out) {
+    memset(out, 0, sizeof *out);
+    ak_crowd_scene sc;
+    ak_diag diag;
+    if (ak_crowd_scene_preset(preset, agents, &sc, &diag) != AK_OK) return false;
+    const size_t n = sc.agent_count;
+    const float dt = 1.0f / 60.0f;
+    const long max_frames = (long)ceilf(sc.duration / dt);
+    ak_crowd_desc d = {.agents = {sc.agents, n}, .obstacles = sc.obstacles, .obstacle_count = (uint32_t)sc.obstacle_count};
+    ak_crowd* crowd = NULL;
+    if (ak_crowd_create(&d, NULL, &crowd) != AK_OK) {
+        ak_crowd_scene_free(&sc);
+        return false;
+    }
+    const size_t J = ak_scene_joint_count(g->scene);
+    ak_vec2 *p = malloc(n * sizeof *p), *v = calloc(n, sizeof *v), *p2 = malloc(n * sizeof *p2), *v2 = malloc(n * sizeof *v2);
+    uint32_t* wp = calloc(n, sizeof *wp);
+    ak_crowd_character* ch = malloc(n * sizeof *ch);
+    ak_transform* local = malloc(J * sizeof *local);
+    ak_mat4* world = malloc(J * sizeof *world);
+    size_t cap = 1024, len = 0;
+    float* rec = malloc(cap * n * 6 * sizeof *rec); /* per frame, agent, foot: x, y, z */
+    const size_t cs_bytes = ak_crowd_characters_scratch_size(g);
+    uint8_t* cscr = malloc(cs_bytes);
+    memcpy(p, sc.positions, n * sizeof *p);
+    for (size_t i = 0; i < n; ++i) {
+        const ak_vec2 goal = sc.agents[i].goals.ptr[sc.agents[i].goals.count - 1];
+        ch[i] = ak_crowd_character_init(g, ak_vec2_sub(goal, p[i]), (float)((i * 0.618033988749895) - floor(i * 0.618033988749895)));
+    }
+    ak_crowd_step_job job = {.crowd = crowd, .dt = dt};
+    job.positions = (ak_vec2_cspan){p, n};
+    job.velocities = (ak_vec2_cspan){v, n};
+    job.waypoints = (ak_u32_span){wp, n};
+    job.out_positions = (ak_vec2_span){p2, n};
+    job.out_velocities = (ak_vec2_span){v2, n};
+    const size_t sb = ak_crowd_step_scratch_size(&job);
+    uint8_t* scratch = malloc(sb);
+    job.scratch = (ak_u8_span){scratch, sb};
+    long after_home = -1, f = 0;
+    uint8_t prev_state[2 * 4096] = {0};
+    for (; f < max_frames; ++f) {
+        job.positions = (ak_vec2_cspan){p, n};
+        job.velocities = (ak_vec2_cspan){v, n};
+        job.out_positions = (ak_vec2_span){p2, n};
+        job.out_velocities = (ak_vec2_span){v2, n};
+        job.step_index = (uint64_t)f;
+        if (ak_crowd_step_run(&job) != AK_OK) break;
+        ak_vec2* t = p;
+        p = p2, p2 = t;
+        t = v, v = v2, v2 = t;
+        ak_crowd_characters_job cj = {.gait = g, .dt = dt, .velocities = {v, n}, .characters = {ch, n}};
+        if (plant) cj.positions = (ak_vec2_cspan){p, n}, cj.scratch = (ak_u8_span){cscr, cs_bytes};
+        if (ak_crowd_characters_update(&cj) != AK_OK) break;
+        if (len == cap) {
+            cap *= 2;
+            float* r2 = realloc(rec, cap * n * 6 * sizeof *rec);
+            if (!r2) break;
+            rec = r2;
+        }
+        for (size_t i = 0; i < n; ++i) {
+            if (plant) ak_crowd_character_pose_planted(g, &ch[i], p[i], (ak_transform_span){local, J});
+            else ak_crowd_character_pose(g, &ch[i], (ak_transform_span){local, J});
+            ak_scene_world_matrices(g->scene, (ak_transform_cspan){local, J}, (ak_mat4_span){world, J});
+            const ak_mat4 root = ak_crowd_character_root(g, &ch[i], p[i]);
+            for (int k = 0; k < 2; ++k) {
+                const ak_vec3 w = ak_mat4_transform_point(root, ak_mat4_get_translation(world[g->feet[k]]));
+                float* r = rec + (len * n + i) * 6 + 3 * k;
+                r[0] = w.x, r[1] = w.y, r[2] = w.z;
+                if (i < 4096) {
+                    out->steps += ch[i].foot_state[k] == AK_CROWD_FOOT_STEPPING && prev_state[2 * i + k] != AK_CROWD_FOOT_STEPPING;
+                    prev_state[2 * i + k] = ch[i].foot_state[k];
+                }
+            }
+        }
+        ++len;
+        size_t home = 0;
+        for (size_t i = 0; i < n; ++i) home += ak_crowd_goal_reached(crowd, i, p[i], wp[i]);
+        out->home = home;
+        if (home == n && after_home < 0) after_home = f;
+        if (after_home >= 0 && f - after_home >= 60) break;
+    }
+    out->agents = n;
+    out->frames = (long)len;
+    /* stances and their slides: with the 1 cm band, and a 2 cm band as a check. The ground
+     * reference is the lowest the foot is within 3 s either side (a sliding minimum): a
+     * standing character's ankle rests higher or lower than a walking one's in stance, and one
+     * lowest height over a whole run of walking and standing would leave the other's stances
+     * out of the band */
+    const size_t skip = 60, W = 180;
+    float* low = malloc(len * sizeof *low);
+    size_t* dq = malloc(len * sizeof *dq);
+    for (int band = 0; band < 2; ++band) {
+        size_t scap = 1024, sl = 0;
+        double* slides = malloc(scap * sizeof *slides);
+        for (size_t i = 0; i < n; ++i)
+            for (int k = 0; k < 2; ++k) {
+#define Y(s) rec[((s) * n + i) * 6 + 3 * k + 1]
+                /* low[s] = min of Y over [s - W, s + W] (a monotonic deque) */
+                size_t head = 0, tail = 0, next = 0;
+                for (size_t s = 0; s < len; ++s) {
+                    for (; next < len && next <= s + W; ++next) {
+                        while (tail > head && Y(dq[tail - 1]) >= Y(next)) --tail;
+                        dq[tail++] = next;
+                    }
+                    while (dq[head] + W < s) ++head;
+                    low[s] = Y(dq[head]);
+                }
+                long start = -1;
+                double worst = 0.0;
+                for (size_t s = skip; s <= len; ++s) {
+                    const float* r = s < len ? rec + (s * n + i) * 6 + 3 * k : NULL;
+                    const bool st = r && r[1] <= low[s] + (band ? 0.02f : 0.01f);
+#undef Y
+                    if (st && start < 0) start = (long)s, worst = 0.0;
+                    if (st) {
+                        const float* r0 = rec + ((size_t)start * n + i) * 6 + 3 * k;
+                        worst = fmax(worst, hypot((double)r[0] - r0[0], (double)r[2] - r0[2]));
+                    } else if (start >= 0) {
+                        if (sl == scap) slides = realloc(slides, (scap *= 2) * sizeof *slides);
+                        slides[sl++] = worst;
+                        start = -1;
+                    }
+                }
+            }
+        qsort(slides, sl, sizeof *slides, cmp_double);
+        if (band) {
+            out->max2 = sl ? slides[sl - 1] : 0.0;
+        } else {
+            out->stances = sl;
+            out->max = sl ? slides[sl - 1] : 0.0;
+            out->p95 = sl ? slides[(size_t)(0.95 * (double)(sl - 1))] : 0.0;
+        }
+        free(slides);
+    }
+    free(low);
+    free(dq);
+    free(rec);
+    free(cscr);
+    free(scratch);
+    free(local);
+    free(world);
+    free(ch);
+    free(p), free(v), free(p2), free(v2), free(wp);
+    ak_crowd_destroy(crowd);
+    ak_crowd_scene_free(&sc);
+    return true;
+}
+
+static void crowd_slide_case(const char* preset, size_t agents, double limit) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    crowd_slide off, on;
+    AK_CHECK(crowd_slide_run(&g, preset, agents, false, &off));
+    AK_CHECK(crowd_slide_run(&g, preset, agents, true, &on));
+    printf("  %s %zu: %zu/%zu home in %ld frames; stance slide without planting max %.2f cm, p95 %.2f cm (%zu "
+           "stances; 2 cm band: max %.2f cm); planted max %.2f cm, p95 %.2f cm (%zu stances, %zu forced steps; 2 cm "
+           "band: max %.2f cm)\n",
+           preset, agents, on.home, on.agents, on.frames, 100 * off.max, 100 * off.p95, off.stances, 100 * off.max2,
+           100 * on.max, 100 * on.p95, on.stances, on.steps, 100 * on.max2);
+    AK_CHECK(on.stances >= 4 * on.agents);
+    AK_CHECK_MSG(on.max < limit, "%s %zu: a planted stance foot slides %.2f cm", preset, agents, 100 * on.max);
+    /* the measure can fail: without planting the same run slides more than the limit */
+    AK_CHECK_MSG(off.max > limit, "%s %zu: unplanted slide %.2f cm", preset, agents, 100 * off.max);
+}
+
+AK_TEST(foot_sliding_crowd_crossing) { crowd_slide_case("crossing", 12, 0.02); }
+AK_TEST(foot_sliding_crowd_slow) {
+    crowd_slide_case("circle", 250, 0.02);
+    crowd_slide_case("crossing", 100, 0.02);
+    crowd_slide_case("corridor", 100, 0.02);
+    crowd_slide_case("evacuation", 100, 0.02);
+}
+
 int main(void) {
     AK_RUN(gait_of_builtin_walk);
     AK_RUN(foot_sliding_straight);
     AK_RUN(turning_and_idle);
     AK_RUN(validation);
     AK_RUN(bake_scene);
+    AK_RUN(foot_planting_unit);
+    AK_RUN(foot_sliding_crowd_crossing);
+    AK_RUN_SLOW(foot_sliding_crowd_slow);
     ak_scene_destroy(g_humanoid);
     return ak_test_finish();
 }

@@ -10,6 +10,9 @@
 //                        point mirrored through the block's centre, 1 and 2 threads (RVO2
 //                        through OpenMP when built with it).
 //   vs_rvo2 time1 [N...] the same on 1 thread only (for profiling).
+//   vs_rvo2 vision [N...] animkit's vision-based steering (default view: 48 pixels over 150
+//                        degrees) beside its ORCA on the same block, 1 thread, rounds
+//                        alternating: agents per second of each (default N: 1000, 10000).
 //
 // RVO2 is linked from ../shared/peers/rvo2 (Apache-2.0), never copied into animkit.
 #include <algorithm>
@@ -18,6 +21,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <time.h>
 #include <vector>
 
 #if defined(_OPENMP)
@@ -102,7 +107,7 @@ struct Ak {
     std::vector<uint32_t> wp;
     std::vector<uint8_t> scratch;
     ak_crowd_step_job job;
-    Ak(const Scenario& s, uint32_t threads) : n(s.start.size()) {
+    Ak(const Scenario& s, uint32_t threads, ak_crowd_method method = AK_CROWD_ORCA) : n(s.start.size()) {
         std::vector<ak_crowd_agent> ag(n);
         for (size_t i = 0; i < n; ++i) {
             ag[i] = ak_crowd_agent{};
@@ -118,6 +123,7 @@ struct Ak {
         ak_crowd_desc d{};
         d.agents.ptr = ag.data();
         d.agents.count = n;
+        d.method = method;
         if (ak_crowd_create(&d, nullptr, &crowd) != AK_OK) std::abort();
         p = s.start;
         v.assign(n, ak_vec2{0, 0});
@@ -190,6 +196,16 @@ double now() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// This thread's CPU time (s): on a loaded machine it leaves out the time the thread waited
+// for a core, which wall time counts (one-thread rows only).
+double cpu_now() {
+#if defined(CLOCK_THREAD_CPUTIME_ID)
+    timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0) return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+#endif
+    return now();
+}
+
 void time_one(size_t n, int threads) {
     const Scenario s = block(n);
 #if defined(_OPENMP)
@@ -204,25 +220,59 @@ void time_one(size_t n, int threads) {
     Ak ak(s, static_cast<uint32_t>(threads));
     const int rounds = n >= 100000 ? 5 : n >= 10000 ? 9 : 15;
     const int per = n >= 100000 ? 2 : n >= 10000 ? 4 : 20;
-    std::vector<double> tr, ta;
+    std::vector<double> tr, ta, cr, ca;
     rvo.step();
     ak.step();
     for (int r = 0; r < rounds; ++r) {
-        double t0 = now();
+        double c0 = cpu_now(), t0 = now();
         for (int k = 0; k < per; ++k) rvo.step();
-        double t1 = now();
+        double c1 = cpu_now(), t1 = now();
         for (int k = 0; k < per; ++k) ak.step();
-        double t2 = now();
+        double c2 = cpu_now(), t2 = now();
         tr.push_back((t1 - t0) / per);
         ta.push_back((t2 - t1) / per);
+        cr.push_back((c1 - c0) / per);
+        ca.push_back((c2 - c1) / per);
     }
     std::sort(tr.begin(), tr.end());
     std::sort(ta.begin(), ta.end());
+    std::sort(cr.begin(), cr.end());
+    std::sort(ca.begin(), ca.end());
     const double mr = tr[tr.size() / 2], ma = ta[ta.size() / 2];
     std::printf("%8zu agents %d thread%s: RVO2 %9.3f ms/step  animkit %9.3f ms/step  (%.2f M agent-steps/s)  "
-                "animkit/RVO2 speed %.2fx  [ranges %.3f-%.3f, %.3f-%.3f]\n",
+                "animkit/RVO2 speed %.2fx  [ranges %.3f-%.3f, %.3f-%.3f]",
                 n, threads, threads > 1 ? "s" : " ", 1e3 * mr, 1e3 * ma, 1e-6 * static_cast<double>(n) / ma, mr / ma,
                 1e3 * tr.front(), 1e3 * tr.back(), 1e3 * ta.front(), 1e3 * ta.back());
+    if (threads == 1)
+        std::printf("  thread CPU time: RVO2 %.3f, animkit %.3f ms/step, speed %.2fx", 1e3 * cr[cr.size() / 2],
+                    1e3 * ca[ca.size() / 2], cr[cr.size() / 2] / ca[ca.size() / 2]);
+    std::printf("\n");
+    std::fflush(stdout);
+}
+
+void time_vision(size_t n) {
+    const Scenario s = block(n);
+    Ak orca(s, 1), vision(s, 1, AK_CROWD_VISION);
+    const int rounds = n >= 10000 ? 7 : 11, per = n >= 10000 ? 3 : 10;
+    std::vector<double> to, tv;
+    orca.step();
+    vision.step();
+    for (int r = 0; r < rounds; ++r) {
+        double t0 = now();
+        for (int k = 0; k < per; ++k) orca.step();
+        double t1 = now();
+        for (int k = 0; k < per; ++k) vision.step();
+        double t2 = now();
+        to.push_back((t1 - t0) / per);
+        tv.push_back((t2 - t1) / per);
+    }
+    std::sort(to.begin(), to.end());
+    std::sort(tv.begin(), tv.end());
+    const double mo = to[to.size() / 2], mv = tv[tv.size() / 2];
+    std::printf("%8zu agents 1 thread : ORCA %8.3f ms/step (%.2f M agents/s)  vision (48 px, 150 deg) %8.3f ms/step "
+                "(%.3f M agents/s)  vision/ORCA time %.2fx  [ranges %.3f-%.3f, %.3f-%.3f]\n",
+                n, 1e3 * mo, 1e-6 * static_cast<double>(n) / mo, 1e3 * mv, 1e-6 * static_cast<double>(n) / mv, mv / mo,
+                1e3 * to.front(), 1e3 * to.back(), 1e3 * tv.front(), 1e3 * tv.back());
     std::fflush(stdout);
 }
 
@@ -239,6 +289,13 @@ int main(int argc, char** argv) {
             for (int t = 1; t <= max_threads; ++t) time_one(n, t);
         return 0;
     }
-    std::fprintf(stderr, "usage: vs_rvo2 agree [STEPS] | time [N...] | time1 [N...]\n");
+    if (argc >= 2 && std::strcmp(argv[1], "vision") == 0) {
+        std::vector<size_t> sizes;
+        for (int i = 2; i < argc; ++i) sizes.push_back(static_cast<size_t>(std::atol(argv[i])));
+        if (sizes.empty()) sizes = {1000, 10000};
+        for (size_t n : sizes) time_vision(n);
+        return 0;
+    }
+    std::fprintf(stderr, "usage: vs_rvo2 agree [STEPS] | time [N...] | time1 [N...] | vision [N...]\n");
     return 2;
 }

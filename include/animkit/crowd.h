@@ -43,7 +43,8 @@
  *
  *   - characters: each agent drives a skinned character's in-place walk clip, its clip time
  *     following the distance walked (measured from the clip's stance foot: ak_crowd_gait_*),
- *     its heading the velocity, idle when stopped; the crowd baked into an animated scene
+ *     its heading the velocity, idle when stopped, its stance feet planted in the world (leg
+ *     IK, ik.h's two-bone solver; a short step when pushed); the crowd baked into an animated scene
  *     for glTF (ak_crowd_bake_scene). See the "characters" sections below.
  *
  * What it does NOT do: dynamic obstacles, path planning (waypoints come from the caller), 3D
@@ -427,11 +428,40 @@ AK_API ak_result ak_crowd_gait_measure(const ak_crowd_gait_desc* desc, const ak_
 AK_API float ak_crowd_gait_clip_time(const ak_crowd_gait* gait, float distance);
 
 /* One agent's character state (caller-owned, one per agent). */
+/* A foot's planting state (ak_crowd_character.foot_state). */
+typedef enum ak_crowd_foot_state {
+    AK_CROWD_FOOT_FREE = 0,  /* the clip's foot */
+    AK_CROWD_FOOT_PINNED,    /* held at foot_pin by leg IK while the clip has it down */
+    AK_CROWD_FOOT_RELEASING, /* lifted off by the clip: the pin fades out (foot_weight 1 -> 0) */
+    AK_CROWD_FOOT_STEPPING   /* the pin got too far from the clip's foot while down: a short
+                                step (the foot lifted on an arc) from foot_pin to the clip's */
+} ak_crowd_foot_state;
+
+/* Foot planting (ak_crowd_characters_job.positions; docs/crowd.md, "Foot planting"): a foot
+ * the clip puts down (model height within AK_CROWD_PLANT_BAND of its lowest) is pinned where
+ * it landed in the world and the leg is solved to it with ik.h's two-bone solver (the pelvis
+ * lowered when a leg cannot reach, at most AK_CROWD_PLANT_MAX_DROP); at lift-off the pin
+ * fades out over AK_CROWD_PLANT_RELEASE_TIME; a pin farther than AK_CROWD_PLANT_MAX_OFFSET
+ * from the clip's foot (or needing more drop) makes the foot step: lifted by up to
+ * AK_CROWD_PLANT_STEP_HEIGHT over AK_CROWD_PLANT_STEP_TIME onto the clip's foot (one foot at a
+ * time). */
+#define AK_CROWD_PLANT_BAND 0.02f         /* m above the foot's lowest model height */
+#define AK_CROWD_PLANT_RELEASE_TIME 0.1f  /* s */
+#define AK_CROWD_PLANT_MAX_OFFSET 0.15f   /* m, horizontal */
+#define AK_CROWD_PLANT_MAX_DROP 0.06f     /* m */
+#define AK_CROWD_PLANT_STEP_TIME 0.25f    /* s */
+#define AK_CROWD_PLANT_STEP_HEIGHT 0.06f  /* m */
+
 typedef struct ak_crowd_character {
     float distance;    /* m walked along the cycle, in [0, stride_length) */
     float clip_time;   /* s: ak_crowd_gait_clip_time(distance) */
     ak_vec2 heading;   /* unit facing on the ground (x, z) */
     float walk_weight; /* 1 walking .. 0 idle (the rest pose) */
+    /* foot planting, per foot (left, right); all zero (free) unless the update gets positions */
+    ak_vec2 foot_pin[2];      /* world (x, z) the foot is held at (PINNED, RELEASING) or steps
+                                 from (STEPPING) */
+    float foot_weight[2];     /* PINNED 1; RELEASING and STEPPING: 1 -> 0 as it ends */
+    uint8_t foot_state[2];    /* ak_crowd_foot_state */
 } ak_crowd_character;
 
 AK_DEFINE_SPAN(crowd_character, ak_crowd_character)
@@ -452,13 +482,24 @@ typedef struct ak_crowd_characters_job {
     float idle_speed;    /* m/s: below it the character blends to the rest pose
                             (walk_weight = smoothstep(speed / idle_speed)) and keeps its
                             heading; 0 -> 0.15 */
+    ak_vec2_cspan positions; /* optional: [count] the agents' ground positions after this
+                                step -> foot planting (the foot_* fields; pose the
+                                characters with ak_crowd_character_pose_planted); empty ->
+                                no planting (the foot_* fields are left as they are) */
+    ak_u8_span scratch;      /* with positions: >= ak_crowd_characters_scratch_size(gait) */
 } ak_crowd_characters_job;
 
+/* Scratch bytes ak_crowd_characters_update needs with positions (a pose of the gait's
+ * skeleton); 0 for a NULL gait. */
+AK_API size_t ak_crowd_characters_scratch_size(const ak_crowd_gait* gait);
+
 /* Advance every character by dt: distance += |v| dt (wrapped), clip_time from the gait,
- * heading turned toward v (while |v| > idle_speed / 2), walk_weight from the speed.
- * Returns AK_ERR_NULL_ARG (job, gait, a span), AK_ERR_BAD_ARG (dt not > 0 and finite, a
- * negative or non-finite parameter), AK_ERR_SPAN_SMALL (velocities shorter than
- * characters), AK_ERR_BAD_DATA (a non-finite velocity: nothing is written). */
+ * heading turned toward v (while |v| > idle_speed / 2), walk_weight from the speed; with
+ * positions, then each foot's planting state (see AK_CROWD_PLANT_BAND) from the clip's foot
+ * placed at the new position. Returns AK_ERR_NULL_ARG (job, gait, a span), AK_ERR_BAD_ARG
+ * (dt not > 0 and finite, a negative or non-finite parameter), AK_ERR_SPAN_SMALL
+ * (velocities or positions shorter than characters, scratch too small), AK_ERR_BAD_DATA (a
+ * non-finite velocity or position: nothing is written). */
 AK_API ak_result ak_crowd_characters_update(const ak_crowd_characters_job* job);
 
 /* The character's local pose: the rest pose, the walk clip at clip_time over it, then every
@@ -471,6 +512,17 @@ AK_API ak_result ak_crowd_character_pose(const ak_crowd_gait* gait, const ak_cro
 /* Model-to-world matrix of the character standing at ground position p: a rotation about +y
  * turning the gait's forward onto the heading, then the translation (p.x, 0, p.y). */
 AK_API ak_mat4 ak_crowd_character_root(const ak_crowd_gait* gait, const ak_crowd_character* character, ak_vec2 p);
+
+/* ak_crowd_character_pose, then the feet planted (the character standing at ground position
+ * p): each foot not FREE is pulled onto its target by the two-bone solver on its leg (the
+ * foot's parent and grandparent: knee and hip; knee toward the gait's forward), weighted by
+ * foot_weight: PINNED and RELEASING target foot_pin at the clip foot's height; STEPPING moves
+ * from foot_pin to the clip's foot (smoothstep of the progress 1 - foot_weight) lifted by
+ * AK_CROWD_PLANT_STEP_HEIGHT sin(pi progress). The pelvis (the skeleton's root joint) is
+ * lowered, at most AK_CROWD_PLANT_MAX_DROP, where a leg cannot reach. Returns as
+ * ak_crowd_character_pose. */
+AK_API ak_result ak_crowd_character_pose_planted(const ak_crowd_gait* gait, const ak_crowd_character* character,
+                                                 ak_vec2 p, ak_transform_span out_local);
 
 /* ---- the crowd as an animated glTF scene ---------------------------------------------------- */
 

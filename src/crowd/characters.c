@@ -2,6 +2,7 @@
 #include <math.h>
 
 #include <animkit/crowd.h>
+#include <animkit/ik.h>
 
 #include "internal.h"
 
@@ -23,6 +24,55 @@ static ak_result feet_at(const ak_crowd_gait_desc* d, int left, int right, float
 static float smoothstep01(float x) {
     x = ak_clampf(x, 0.0f, 1.0f);
     return x * x * (3.0f - 2.0f * x);
+}
+
+/* Model transform of joint j: its ancestors' locals composed (at most joint-count levels). */
+static ak_transform model_of(ak_i16_cspan parents, const ak_transform* local, int j) {
+    ak_transform m = local[j];
+    size_t guard = parents.count;
+    for (int p = parents.ptr[j]; p >= 0 && (size_t)p < parents.count && guard-- > 0; p = parents.ptr[p])
+        m = ak_transform_mul(local[p], m);
+    return m;
+}
+
+/* The rotation about +y that turns the gait's forward onto the character's heading. */
+static ak_quat root_rotation(const ak_crowd_gait* g, const ak_crowd_character* c) {
+    const float af = atan2f(g->forward.x, g->forward.z);
+    const float ah = atan2f(c->heading.x, c->heading.y);
+    return ak_quat_from_axis_angle(ak_vec3_make(0.0f, 1.0f, 0.0f), ah - af);
+}
+
+/* The leg of foot f: hip, knee, ankle joints; false when the foot has no grandparent. */
+static bool leg_of(const ak_crowd_gait* g, ak_i16_cspan parents, int f, int leg[3]) {
+    const int a = g->feet[f];
+    if (a < 0 || (size_t)a >= parents.count) return false;
+    const int k = parents.ptr[a];
+    if (k < 0 || (size_t)k >= parents.count) return false;
+    const int h = parents.ptr[k];
+    if (h < 0 || (size_t)h >= parents.count) return false;
+    leg[0] = h, leg[1] = k, leg[2] = a;
+    return true;
+}
+
+/* How far the hip must come down for the leg (hip, knee, ankle model positions) to reach the
+ * target at 99.9% of its length; INFINITY when no drop makes it (horizontally too far). */
+static float leg_drop(ak_vec3 hip, ak_vec3 knee, ak_vec3 ankle, ak_vec3 target) {
+    const float reach = 0.999f * (ak_vec3_length(ak_vec3_sub(knee, hip)) + ak_vec3_length(ak_vec3_sub(ankle, knee)));
+    const float dx = target.x - hip.x, dz = target.z - hip.z, h2 = dx * dx + dz * dz;
+    if (h2 >= reach * reach) return INFINITY;
+    const float need = sqrtf(reach * reach - h2); /* the largest vertical hip-target distance */
+    return fmaxf(0.0f, (hip.y - target.y) - need);
+}
+
+/* World (x, z) of a model point for a character standing at p. */
+static ak_vec2 to_world(ak_quat q, ak_vec2 p, ak_vec3 m) {
+    const ak_vec3 w = ak_quat_rotate(q, m);
+    return ak_vec2_make(w.x + p.x, w.z + p.y);
+}
+
+/* Model point of world ground point w at height y, for a character standing at p. */
+static ak_vec3 to_model(ak_quat q, ak_vec2 p, ak_vec2 w, float y) {
+    return ak_quat_rotate(ak_quat_conjugate(q), ak_vec3_make(w.x - p.x, y, w.y - p.y));
 }
 
 /* ---- public -------------------------------------------------------------------------------- */
@@ -172,6 +222,62 @@ ak_crowd_character ak_crowd_character_init(const ak_crowd_gait* gait, ak_vec2 he
     return c;
 }
 
+size_t ak_crowd_characters_scratch_size(const ak_crowd_gait* gait) {
+    if (!gait || !gait->scene) return 0;
+    return ak_scene_joint_count(gait->scene) * sizeof(ak_transform) + 16u;
+}
+
+/* One character's feet after its update, standing at p (local: a pose's room). The clip's
+ * foot (the unplanted pose) decides: down while within AK_CROWD_PLANT_BAND of its lowest (the
+ * clip's lowest blended toward the rest pose's height by 1 - walk_weight, as the pose is). */
+static void plant_feet(const ak_crowd_gait* g, ak_crowd_character* c, ak_vec2 p, float dt, ak_transform* local) {
+    const ak_skeleton* sk = g->scene->skeleton;
+    const size_t J = ak_skeleton_joint_count(sk);
+    const ak_i16_cspan parents = ak_skeleton_parents(sk);
+    if (ak_crowd_character_pose(g, c, (ak_transform_span){local, J}) != AK_OK) return;
+    const ak_quat q = root_rotation(g, c);
+    for (int f = 0; f < 2; ++f) {
+        int leg[3];
+        if (!leg_of(g, parents, f, leg)) return;
+        const ak_vec3 hip = model_of(parents, local, leg[0]).translation;
+        const ak_vec3 knee = model_of(parents, local, leg[1]).translation;
+        const ak_vec3 a = model_of(parents, local, leg[2]).translation;
+        const ak_vec2 aw = to_world(q, p, a);
+        /* the lowest the clip's foot goes, blended toward the rest pose's as the pose is */
+        const float rest_y = model_of(parents, ak_skeleton_rest_pose(sk).ptr, leg[2]).translation.y;
+        const float low = rest_y + (g->foot_min_y[f] - rest_y) * ak_clampf(c->walk_weight, 0.0f, 1.0f);
+        const bool down = a.y <= low + AK_CROWD_PLANT_BAND;
+        uint8_t* st = &c->foot_state[f];
+        float* w = &c->foot_weight[f];
+        if (*st == AK_CROWD_FOOT_RELEASING && down) {
+            /* put down again before the pin faded out (the clip stopped mid-swing: the idle
+             * blend lowers the foot): step from where the foot is now */
+            c->foot_pin[f] = ak_vec2_add(aw, ak_vec2_scale(ak_vec2_sub(c->foot_pin[f], aw), *w));
+            *st = AK_CROWD_FOOT_STEPPING, *w = 1.0f;
+        } else if (*st == AK_CROWD_FOOT_RELEASING || *st == AK_CROWD_FOOT_STEPPING) {
+            *w -= dt / (*st == AK_CROWD_FOOT_RELEASING ? AK_CROWD_PLANT_RELEASE_TIME : AK_CROWD_PLANT_STEP_TIME);
+            if (!(*w > 1e-3f)) *st = AK_CROWD_FOOT_FREE, *w = 0.0f; /* ended (float steps leave ~1e-8) */
+        } else if (*st == AK_CROWD_FOOT_PINNED) {
+            if (!down) {
+                *st = AK_CROWD_FOOT_RELEASING, *w = 1.0f;
+            } else {
+                const float off = ak_vec2_length(ak_vec2_sub(c->foot_pin[f], aw));
+                const float drop = leg_drop(hip, knee, a, to_model(q, p, c->foot_pin[f], a.y));
+                /* one foot steps at a time, unless the leg can no longer hold this one */
+                if ((off > AK_CROWD_PLANT_MAX_OFFSET && c->foot_state[1 - f] != AK_CROWD_FOOT_STEPPING) ||
+                    drop > AK_CROWD_PLANT_MAX_DROP || !ak_finitef(off))
+                    *st = AK_CROWD_FOOT_STEPPING, *w = 1.0f;
+            }
+        } else if (*st != AK_CROWD_FOOT_FREE) {
+            *st = AK_CROWD_FOOT_FREE, *w = 0.0f;
+        }
+        if (*st == AK_CROWD_FOOT_FREE && down) {
+            *st = AK_CROWD_FOOT_PINNED, *w = 1.0f;
+            c->foot_pin[f] = aw;
+        }
+    }
+}
+
 ak_result ak_crowd_characters_update(const ak_crowd_characters_job* job) {
     if (!job || !job->gait || !job->characters.ptr || (job->characters.count && !job->velocities.ptr))
         return AK_ERR_NULL_ARG;
@@ -185,6 +291,21 @@ ak_result ak_crowd_characters_update(const ak_crowd_characters_job* job) {
         if (!ak_finitef(job->velocities.ptr[i].x) || !ak_finitef(job->velocities.ptr[i].y) ||
             fabsf(job->velocities.ptr[i].x) > 1e7f || fabsf(job->velocities.ptr[i].y) > 1e7f)
             return AK_ERR_BAD_DATA;
+    const bool plant = job->positions.count > 0 || job->positions.ptr;
+    ak_transform* local = NULL;
+    if (plant) {
+        if (n && !job->positions.ptr) return AK_ERR_NULL_ARG;
+        if (job->positions.count < n) return AK_ERR_SPAN_SMALL;
+        if (!job->gait->scene || !job->gait->scene->skeleton) return AK_ERR_NULL_ARG;
+        const size_t need = ak_crowd_characters_scratch_size(job->gait);
+        if (!job->scratch.ptr || job->scratch.count < need) return AK_ERR_SPAN_SMALL;
+        const uintptr_t a = ((uintptr_t)job->scratch.ptr + 15u) & ~(uintptr_t)15u;
+        local = (ak_transform*)a;
+        for (size_t i = 0; i < n; ++i)
+            if (!ak_finitef(job->positions.ptr[i].x) || !ak_finitef(job->positions.ptr[i].y) ||
+                fabsf(job->positions.ptr[i].x) > 1e7f || fabsf(job->positions.ptr[i].y) > 1e7f)
+                return AK_ERR_BAD_DATA;
+    }
     const ak_crowd_gait* g = job->gait;
     const float turn_time = job->turn_time > 0.0f ? job->turn_time : 0.1f;
     const float max_turn = (job->max_turn_rate > 0.0f ? job->max_turn_rate : 6.0f) * job->dt;
@@ -213,6 +334,7 @@ ak_result ak_crowd_characters_update(const ak_crowd_characters_job* job) {
             c->heading = l > 1e-6f && ak_finitef(l) ? ak_vec2_scale(nh, 1.0f / l) : u;
         }
         c->walk_weight = smoothstep01(speed / idle);
+        if (plant) plant_feet(g, c, job->positions.ptr[i], job->dt, local);
     }
     return AK_OK;
 }
@@ -238,6 +360,70 @@ ak_result ak_crowd_character_pose(const ak_crowd_gait* gait, const ak_crowd_char
     return AK_OK;
 }
 
+ak_result ak_crowd_character_pose_planted(const ak_crowd_gait* gait, const ak_crowd_character* character,
+                                          ak_vec2 p, ak_transform_span out_local) {
+    ak_result r = ak_crowd_character_pose(gait, character, out_local);
+    if (r != AK_OK) return r;
+    bool any = false;
+    for (int f = 0; f < 2; ++f)
+        any |= character->foot_state[f] != AK_CROWD_FOOT_FREE && character->foot_weight[f] > 0.0f;
+    if (!any || !ak_finitef(p.x) || !ak_finitef(p.y)) return AK_OK;
+    const ak_skeleton* sk = gait->scene->skeleton;
+    const ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_transform* local = out_local.ptr;
+    const ak_quat q = root_rotation(gait, character);
+    int legs[2][3];
+    ak_vec3 target[2];
+    ak_quat foot_rot[2];
+    float drop = 0.0f;
+    for (int f = 0; f < 2; ++f) {
+        if (!leg_of(gait, parents, f, legs[f])) return AK_OK;
+        const ak_transform am = model_of(parents, local, legs[f][2]);
+        const ak_vec3 a = am.translation;
+        foot_rot[f] = am.rotation;
+        const float w = ak_clampf(ak_finitef(character->foot_weight[f]) ? character->foot_weight[f] : 0.0f, 0.0f, 1.0f);
+        const ak_vec3 pin = to_model(q, p, character->foot_pin[f], a.y);
+        switch (character->foot_state[f]) {
+        case AK_CROWD_FOOT_PINNED:
+        case AK_CROWD_FOOT_RELEASING: target[f] = ak_vec3_lerp(a, pin, w); break;
+        case AK_CROWD_FOOT_STEPPING: {
+            const float s = 1.0f - w;
+            target[f] = ak_vec3_lerp(pin, a, smoothstep01(s));
+            target[f].y = a.y + AK_CROWD_PLANT_STEP_HEIGHT * sinf(3.14159265f * s);
+            break;
+        }
+        default: target[f] = a; break;
+        }
+        const ak_vec3 hip = model_of(parents, local, legs[f][0]).translation;
+        const ak_vec3 knee = model_of(parents, local, legs[f][1]).translation;
+        drop = fmaxf(drop, leg_drop(hip, knee, a, target[f]));
+    }
+    /* the pelvis: the common root of the legs, lowered where a leg cannot reach */
+    drop = fminf(drop, AK_CROWD_PLANT_MAX_DROP);
+    if (drop > 0.0f) {
+        int root = legs[0][0];
+        for (size_t guard = parents.count; parents.ptr[root] >= 0 && guard-- > 0;) root = parents.ptr[root];
+        local[root].translation.y -= drop;
+    }
+    for (int f = 0; f < 2; ++f) {
+        const int* L = legs[f];
+        const ak_transform h = model_of(parents, local, L[0]), k = model_of(parents, local, L[1]),
+                           a = model_of(parents, local, L[2]);
+        if (drop <= 0.0f && ak_vec3_length_sq(ak_vec3_sub(a.translation, target[f])) < 1e-12f) continue;
+        ak_quat cs, cm;
+        ak_ik_two_bone_job job = {.start = ak_transform_to_mat4(h), .mid = ak_transform_to_mat4(k),
+                                  .end = ak_transform_to_mat4(a), .target = target[f], .pole = gait->forward,
+                                  .out_start_rot = &cs, .out_mid_rot = &cm};
+        if (ak_ik_two_bone_run(&job) != AK_OK) continue;
+        local[L[0]].rotation = ak_quat_normalize(ak_quat_mul(local[L[0]].rotation, cs));
+        local[L[1]].rotation = ak_quat_normalize(ak_quat_mul(local[L[1]].rotation, cm));
+        /* the foot keeps its model orientation (the clip's) */
+        const ak_quat kr = model_of(parents, local, L[1]).rotation;
+        local[L[2]].rotation = ak_quat_normalize(ak_quat_mul(ak_quat_conjugate(kr), foot_rot[f]));
+    }
+    return AK_OK;
+}
+
 ak_mat4 ak_crowd_character_root(const ak_crowd_gait* gait, const ak_crowd_character* character, ak_vec2 p) {
     if (!gait || !character) return ak_mat4_identity();
     /* yaw about +y maps (x, z) by x' = x cos + z sin, z' = -x sin + z cos; turn forward onto heading */
@@ -252,12 +438,6 @@ ak_mat4 ak_crowd_character_root(const ak_crowd_gait* gait, const ak_crowd_charac
 }
 
 /* ---- baking the crowd into a scene -------------------------------------------------------- */
-
-static ak_quat root_rotation(const ak_crowd_gait* g, const ak_crowd_character* c) {
-    const float af = atan2f(g->forward.x, g->forward.z);
-    const float ah = atan2f(c->heading.x, c->heading.y);
-    return ak_quat_from_axis_angle(ak_vec3_make(0.0f, 1.0f, 0.0f), ah - af);
-}
 
 ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
                               ak_diag* out_diag) {
@@ -350,7 +530,7 @@ ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator
                                                              ak_vec3_make(1.0f, 1.0f, 1.0f))};
         sc->is_joint[base] = false;
         /* the nodes rest in the first frame's pose (a one-frame scene is that frame) */
-        res = ak_crowd_character_pose(g, c0, (ak_transform_span){pose, J});
+        res = ak_crowd_character_pose_planted(g, c0, p0, (ak_transform_span){pose, J});
         if (res != AK_OK) goto done;
         for (size_t j = 0; j < J; ++j) {
             snprintf(names[base + 1 + j], AK_NAME_SIZE, "%zu/%.40s", a, ak_skeleton_joint_name(cs->skeleton, j));
@@ -428,7 +608,7 @@ ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator
             float* rq = kv + F * 4 + 4 * f;
             if (f > 0 && rq[-4] * r.x + rq[-3] * r.y + rq[-2] * r.z + rq[-1] * r.w < 0.0f) r = ak_quat_neg(r);
             rq[0] = r.x, rq[1] = r.y, rq[2] = r.z, rq[3] = r.w;
-            res = ak_crowd_character_pose(g, chr, (ak_transform_span){pose, J});
+            res = ak_crowd_character_pose_planted(g, chr, p, (ak_transform_span){pose, J});
             if (res != AK_OK) goto done;
             for (size_t q = 2; q < per_agent; ++q) {
                 const size_t j = c[q].index - base - 1;

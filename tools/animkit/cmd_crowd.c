@@ -404,7 +404,7 @@ int cmd_crowd(int argc, char** argv) {
         if (s == sc.steps) break;
         if (res == AK_OK && (res = run_step(&st, s)) != AK_OK) failed_step = s;
         else done = s + 1;
-        if (res == AK_OK && cp && (res = crowd_chars_update(cp, st.v, sc.dt)) != AK_OK) failed_step = s;
+        if (res == AK_OK && cp && (res = crowd_chars_update(cp, st.v, st.p, sc.dt)) != AK_OK) failed_step = s;
         cli_progress("crowd", (size_t)s + 1, (size_t)sc.steps);
     }
     const double elapsed = cli_now() - t0;

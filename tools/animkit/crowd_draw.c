@@ -19,6 +19,7 @@ void crowd_chars_free(crowd_chars* c) {
     free(c->ch);
     free(c->rec_pos);
     free(c->rec_ch);
+    free(c->plant_scratch);
     memset(c, 0, sizeof *c);
 }
 
@@ -42,6 +43,9 @@ ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t fram
     c->ch = malloc(c->n * sizeof *c->ch);
     if (!c->ch) return AK_ERR_NO_MEMORY;
     crowd_chars_reset(c, sc);
+    c->plant_bytes = ak_crowd_characters_scratch_size(&c->gait);
+    c->plant_scratch = malloc(c->plant_bytes);
+    if (!c->plant_scratch) return AK_ERR_NO_MEMORY;
     if (cli_poser_init(&c->poser, c->scene)) return AK_ERR_NO_MEMORY;
     c->poser_ready = true;
     if (frame_cap) {
@@ -53,9 +57,10 @@ ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t fram
     return AK_OK;
 }
 
-ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, float dt) {
+ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, const ak_vec2* positions, float dt) {
     ak_crowd_characters_job job = {.gait = &c->gait, .dt = dt, .velocities = {velocities, c->n},
-                                   .characters = {c->ch, c->n}};
+                                   .characters = {c->ch, c->n}, .positions = {positions, c->n},
+                                   .scratch = {c->plant_scratch, c->plant_bytes}};
     return ak_crowd_characters_update(&job);
 }
 
@@ -95,13 +100,14 @@ bool crowd_people_init(crowd_people* pp, size_t n, const crowd_chars* chars) {
     return pp->pos && pp->nrm && pp->col;
 }
 
-/* Each character posed (its clip time and heading), skinned (LBS) and placed in the world. */
+/* Each character posed (its clip time and heading, its feet planted), skinned (LBS) and placed in the world. */
 static ak_result pose_characters(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
                                  crowd_chars* c) {
     const ak_mesh* m = c->scene->meshes[0].mesh;
     const size_t J = ak_scene_joint_count(c->scene);
     for (size_t i = 0; i < c->n; ++i) {
-        ak_result res = ak_crowd_character_pose(&c->gait, &c->ch[i], (ak_transform_span){c->poser.local, J});
+        ak_result res = ak_crowd_character_pose_planted(&c->gait, &c->ch[i], positions[i],
+                                                        (ak_transform_span){c->poser.local, J});
         if (res == AK_OK) res = cli_poser_deform(&c->poser, false, CLI_LBS);
         if (res != AK_OK) return res;
         const ak_mat4 root = ak_crowd_character_root(&c->gait, &c->ch[i], positions[i]);

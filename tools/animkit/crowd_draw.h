@@ -21,6 +21,8 @@ typedef struct crowd_chars {
     ak_vec2* rec_pos; /* recorded frames (glTF): [frame_cap * n] */
     ak_crowd_character* rec_ch;
     size_t frames, frame_cap;
+    uint8_t* plant_scratch; /* ak_crowd_characters_scratch_size: foot planting */
+    size_t plant_bytes;
 } crowd_chars;
 
 /* The humanoid, its gait, one character per agent facing its first waypoint (phases spread),
@@ -29,7 +31,9 @@ ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t fram
 void crowd_chars_free(crowd_chars* c);
 /* Back to the start: every character facing its first waypoint, standing; no recorded frame. */
 void crowd_chars_reset(crowd_chars* c, const ak_crowd_scene* sc);
-ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, float dt);
+/* Advance the characters by dt from the agents' velocities, their feet planted at the agents'
+ * new positions. */
+ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, const ak_vec2* positions, float dt);
 /* Record the current frame (positions of the n agents, the characters); no-op when full. */
 void crowd_chars_record(crowd_chars* c, const ak_vec2* positions);
 

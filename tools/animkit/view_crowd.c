@@ -165,7 +165,7 @@ static bool xsim_step_once(void* state) {
                              .out_velocities = {x->v2, x->n}, .step_index = (uint64_t)x->step_index,
                              .contact_iterations = x->sc.contact_iterations};
     ak_result r = ak_crowd_step_run(&job);
-    if (r == AK_OK && x->with_chars) r = crowd_chars_update(&x->chars, x->v2, x->sc.dt);
+    if (r == AK_OK && x->with_chars) r = crowd_chars_update(&x->chars, x->v2, x->p2, x->sc.dt);
     if (r != AK_OK) {
         cli_fail("view", "%s: step %ld: %s", x->name, x->step_index + 1, ak_result_string(r));
         return false;
