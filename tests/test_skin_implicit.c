@@ -406,21 +406,24 @@ AK_TEST(cache_round_trip_and_errors) {
     cyl_free(&c);
 }
 
+/* CesiumMan from the shared assets (ANIMKIT_ASSETS or ../shared/assets, tests/ak_test.h): NULL
+ * after a SKIP line when absent, or a failed check when present but not loaded. */
+static ak_scene* cesium_man_load(void) {
+    char path[4096];
+    if (!ak_test_asset(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) {
+        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
+        return NULL;
+    }
+    ak_scene* s = NULL;
+    AK_CHECK_EQ(ak_io_load(path, NULL, NULL, &s, NULL), AK_OK);
+    return s;
+}
+
 /* CesiumMan (assets via ANIMKIT_ASSETS or ../shared/assets): bind pose reproduced, and a frame
  * of its walk deformed without NaN. */
 AK_TEST(cesium_man) {
-    const char* roots[3] = {getenv("ANIMKIT_ASSETS"), AK_SOURCE_DIR "/../shared/assets", "../shared/assets"};
-    char path[1024];
-    ak_scene* s = NULL;
-    for (int k = 0; k < 3 && !s; ++k) {
-        if (!roots[k]) continue;
-        snprintf(path, sizeof path, "%s/gltf/CesiumMan/glTF-Binary/CesiumMan.glb", roots[k]);
-        if (ak_io_load(path, NULL, NULL, &s, NULL) != AK_OK) s = NULL;
-    }
-    if (!s) {
-        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
-        return;
-    }
+    ak_scene* s = cesium_man_load();
+    if (!s) return;
     const ak_scene_mesh* sm = &s->meshes[0];
     const ak_mesh* m = sm->mesh;
     size_t jc = s->skins[sm->skin].joint_count;
@@ -474,18 +477,8 @@ AK_TEST(cesium_man) {
  * touch, parts without a joint between them), volume (the welded mesh is closed) LBS 0.988,
  * DQS 0.997, implicit 1.000. */
 AK_TEST(cesium_man_knee_flexed) {
-    const char* roots[3] = {getenv("ANIMKIT_ASSETS"), AK_SOURCE_DIR "/../shared/assets", "../shared/assets"};
-    char path[1024];
-    ak_scene* s = NULL;
-    for (int k = 0; k < 3 && !s; ++k) {
-        if (!roots[k]) continue;
-        snprintf(path, sizeof path, "%s/gltf/CesiumMan/glTF-Binary/CesiumMan.glb", roots[k]);
-        if (ak_io_load(path, NULL, NULL, &s, NULL) != AK_OK) s = NULL;
-    }
-    if (!s) {
-        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
-        return;
-    }
+    ak_scene* s = cesium_man_load();
+    if (!s) return;
     const ak_scene_mesh* sm = &s->meshes[0];
     const ak_mesh* m = sm->mesh;
     const size_t jc = s->skins[sm->skin].joint_count, nj = ak_scene_joint_count(s), nv = m->vertex_count;
