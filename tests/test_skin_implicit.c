@@ -23,6 +23,19 @@ typedef struct cyl {
     ak_skin_implicit* imp;
 } cyl;
 
+/* The implicit skin's descriptor for a skinned mesh: its positions, triangles and influences,
+ * joint_count palette slots; the rest at the defaults. */
+static ak_skin_implicit_desc implicit_desc_of(const ak_mesh* m, size_t joint_count) {
+    return (ak_skin_implicit_desc){
+        .positions = {m->positions, m->vertex_count},
+        .indices = {m->indices, 3 * m->triangle_count},
+        .joints = {m->joints, m->vertex_count * m->influence_count},
+        .weights = {m->weights, m->vertex_count * m->influence_count},
+        .influence_count = m->influence_count,
+        .joint_count = joint_count,
+    };
+}
+
 static bool cyl_make(cyl* c, uint32_t rings, uint32_t segments) {
     memset(c, 0, sizeof *c);
     ak_builtin_desc bd = {.rings = rings, .segments = segments};
@@ -31,14 +44,7 @@ static bool cyl_make(cyl* c, uint32_t rings, uint32_t segments) {
     c->slots = c->scene->skins[0].joint_count;
     for (size_t k = 0; k < c->slots && k < 8; ++k) c->slot_joint[k] = c->scene->skins[0].joints[k];
     const ak_mesh* m = c->mesh;
-    ak_skin_implicit_desc d = {
-        .positions = {m->positions, m->vertex_count},
-        .indices = {m->indices, 3 * m->triangle_count},
-        .joints = {m->joints, m->vertex_count * m->influence_count},
-        .weights = {m->weights, m->vertex_count * m->influence_count},
-        .influence_count = m->influence_count,
-        .joint_count = c->slots,
-    };
+    ak_skin_implicit_desc d = implicit_desc_of(m, c->slots);
     return ak_skin_implicit_create(&d, NULL, &c->imp) == AK_OK;
 }
 
@@ -186,15 +192,8 @@ AK_TEST(grid_matches_direct_field) {
     cyl c;
     AK_CHECK(cyl_make(&c, 24, 16));
     const ak_mesh* m = c.mesh;
-    ak_skin_implicit_desc d = {
-        .positions = {m->positions, m->vertex_count},
-        .indices = {m->indices, 3 * m->triangle_count},
-        .joints = {m->joints, m->vertex_count * m->influence_count},
-        .weights = {m->weights, m->vertex_count * m->influence_count},
-        .influence_count = m->influence_count,
-        .joint_count = c.slots,
-        .grid_resolution = UINT32_MAX,
-    };
+    ak_skin_implicit_desc d = implicit_desc_of(m, c.slots);
+    d.grid_resolution = UINT32_MAX; /* the HRBFs evaluated directly */
     ak_skin_implicit* direct = NULL;
     AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &direct), AK_OK);
     ak_mat4 pal[8];
@@ -324,14 +323,7 @@ AK_TEST(cache_round_trip_and_errors) {
     cyl c;
     AK_CHECK(cyl_make(&c, 16, 12));
     const ak_mesh* m = c.mesh;
-    ak_skin_implicit_desc d = {
-        .positions = {m->positions, m->vertex_count},
-        .indices = {m->indices, 3 * m->triangle_count},
-        .joints = {m->joints, m->vertex_count * m->influence_count},
-        .weights = {m->weights, m->vertex_count * m->influence_count},
-        .influence_count = m->influence_count,
-        .joint_count = c.slots,
-    };
+    ak_skin_implicit_desc d = implicit_desc_of(m, c.slots);
     const char* path = "implicit_cache.akis";
     remove(path);
     ak_skin_implicit* a = NULL;
@@ -427,14 +419,7 @@ AK_TEST(cesium_man) {
     const ak_scene_mesh* sm = &s->meshes[0];
     const ak_mesh* m = sm->mesh;
     size_t jc = s->skins[sm->skin].joint_count;
-    ak_skin_implicit_desc d = {
-        .positions = {m->positions, m->vertex_count},
-        .indices = {m->indices, 3 * m->triangle_count},
-        .joints = {m->joints, m->vertex_count * m->influence_count},
-        .weights = {m->weights, m->vertex_count * m->influence_count},
-        .influence_count = m->influence_count,
-        .joint_count = jc,
-    };
+    ak_skin_implicit_desc d = implicit_desc_of(m, jc);
     ak_skin_implicit* imp = NULL;
     AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &imp), AK_OK);
     size_t n = m->vertex_count, nj = ak_scene_joint_count(s);
@@ -526,12 +511,7 @@ AK_TEST(cesium_man_knee_flexed) {
                                .out_positions = {out, nv, 0}};
             AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
         } else {
-            ak_skin_implicit_desc d = {.positions = {m->positions, nv},
-                                       .indices = ix,
-                                       .joints = {m->joints, nv * m->influence_count},
-                                       .weights = {m->weights, nv * m->influence_count},
-                                       .influence_count = m->influence_count,
-                                       .joint_count = jc};
+            const ak_skin_implicit_desc d = implicit_desc_of(m, jc);
             ak_skin_implicit* o = NULL;
             AK_CHECK_EQ(ak_skin_implicit_create(&d, NULL, &o), AK_OK);
             size_t ss = ak_skin_implicit_scratch_size(o, jc);
