@@ -404,10 +404,8 @@ static void cman_free(cman* c) {
     ak_scene_destroy(c->sc);
 }
 
-static bool cman_load(cman* c) {
-    memset(c, 0, sizeof *c);
-    char path[1200];
-    if (!ak_test_asset(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) return false;
+/* Reads CesiumMan at path into c (cman_load below). */
+static bool cman_read(cman* c, const char* path) {
     if (ak_io_load(path, NULL, NULL, &c->sc, NULL) != AK_OK || !c->sc) return false;
     ak_scene* sc = c->sc;
     while (c->mi < sc->mesh_count && (sc->meshes[c->mi].skin < 0 || !sc->meshes[c->mi].mesh->triangle_count)) ++c->mi;
@@ -435,6 +433,21 @@ static bool cman_load(cman* c) {
     c->diag = ak_vec3_distance(lo, hi);
     return ordered && ak_skin_bones_from_joints((ak_vec3_cspan){c->jp, c->ns}, (ak_i16_cspan){c->par, c->ns}, false,
                                                 (ak_skin_bone_span){c->bones, 2 * c->ns + 1}, &c->nb) == AK_OK;
+}
+
+/* CesiumMan's skinned mesh, skin slots and bones. False after a SKIP line when the asset is
+ * absent, or a failed check when it is there but does not load as expected; c is freed then. */
+static bool cman_load(cman* c) {
+    memset(c, 0, sizeof *c);
+    char path[1200];
+    if (!ak_test_asset(path, sizeof path, "gltf/CesiumMan/glTF-Binary/CesiumMan.glb")) {
+        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
+        return false;
+    }
+    const bool ok = cman_read(c, path);
+    AK_CHECK_MSG(ok, "%s: not the skinned, animated CesiumMan these cases expect", path);
+    if (!ok) cman_free(c);
+    return ok;
 }
 
 /* Skin slot of the joint named `name`, -1 when absent. */
@@ -559,11 +572,7 @@ static bool cman_walk(const cman* c, const ak_skin_soft_desc* d, int frames, dou
  * (while the lattice that keeps every cell has such tets: the check can fail). */
 AK_TEST(cesiumman_bind_and_legs_apart) {
     cman c;
-    if (!cman_load(&c)) {
-        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
-        cman_free(&c);
-        return;
-    }
+    if (!cman_load(&c)) return;
     ak_skin_soft_desc d = cman_desc(&c);
     ak_skin_soft* soft = NULL;
     AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_OK);
@@ -597,11 +606,7 @@ AK_TEST(cesiumman_bind_and_legs_apart) {
  * the small feet, one or two cubes of the lattice); the mean must be smaller apart. */
 AK_TEST(cesiumman_walk) {
     cman c;
-    if (!cman_load(&c)) {
-        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
-        cman_free(&c);
-        return;
-    }
+    if (!cman_load(&c)) return;
     ak_skin_soft_desc d = cman_desc(&c);
     double mx[2], mean[2];
     size_t br[2];
@@ -644,11 +649,7 @@ static size_t cman_pairs(const cman* c, const ak_vec3* p) {
  * move in this pose, so the change is the limb's) within 1% of the rest. */
 static void cman_flex_case(const char* joint, const char* child, float degrees, double lattice_tol) {
     cman c;
-    if (!cman_load(&c)) {
-        AK_SKIP("CesiumMan.glb not found (ANIMKIT_ASSETS or ../shared/assets)");
-        cman_free(&c);
-        return;
-    }
+    if (!cman_load(&c)) return;
     int slot = cman_slot(&c, joint), cs = cman_slot(&c, child);
     AK_CHECK(slot >= 0 && cs >= 0);
     if (slot < 0 || cs < 0) {
