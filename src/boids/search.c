@@ -918,6 +918,10 @@ void akp_boids_search_fill(const akp_boids_ctx* c, size_t part, size_t parts) {
     const ak_vec3* V = c->job->velocities.ptr;
     const uint8_t* S = c->job->species.ptr;
     for (size_t d = b; d < e; ++d) {
+        if (d + 16 < e) { /* the reads through sj are scattered: fetch ahead */
+            __builtin_prefetch(&P[c->sj[d + 16]]);
+            __builtin_prefetch(&V[c->sj[d + 16]]);
+        }
         const uint32_t i = c->sj[d];
         const uint8_t s = S ? S[i] : 0;
         const float as = c->sp[s].ali_scale;
