@@ -518,6 +518,7 @@ static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boid
     const int64_t* qv = c->sqv;
     const int64_t* qi = qv + 3 * (size_t)g->self_k;
     const float px = g->p.x, py = g->p.y, pz = g->p.z;
+    const bool cone = S->fov != 0;
     int64_t s0 = 0, s1 = 0, s2 = 0, a0 = 0, a1 = 0, a2 = 0, c0 = 0, c1 = 0, c2 = 0;
     uint32_t ns = 0, na = 0, nc = 0, nf = 0;
     for (uint32_t u = 0; u < h; ++u) {
@@ -525,10 +526,13 @@ static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boid
         const float dd = hb->d2[u];
         if (!(dd < S->rn2)) continue;
         const float dx = X[t] - px, dy = Y[t] - py, dz = Z[t] - pz;
-        const bool see_i = in_view(S, g, dx, dy, dz, dd);
-        const ak_vec3 vj = c->sv[t];
-        const bool see_j = in_view_v(S, vj, ak_vec3_length_sq(vj), -dx, -dy, -dz, dd);
-        if (!see_i && !see_j) continue;
+        bool see_i = true, see_j = true;
+        if (cone) { /* (no read of the partner's velocity without one) */
+            see_i = in_view(S, g, dx, dy, dz, dd);
+            const ak_vec3 vj = c->sv[t];
+            see_j = in_view_v(S, vj, ak_vec3_length_sq(vj), -dx, -dy, -dz, dd);
+            if (!see_i && !see_j) continue;
+        }
         const bool bs = dd < S->rs2, ba = dd < S->ra2, bc = dd < S->rc2;
         int64_t e[3] = {0, 0, 0}, f[3] = {0, 0, 0};
         if (bs) {
