@@ -123,15 +123,15 @@ ak_skin_soft_desc ak_skin_soft_desc_resolved(const ak_skin_soft_desc* desc) {
     ak_skin_soft_desc d;
     if (desc) d = *desc;
     else memset(&d, 0, sizeof d);
-    if (d.resolution == 0) d.resolution = 16;
+    if (d.resolution == 0) d.resolution = 32;
     if (d.youngs_modulus == 0.0f) d.youngs_modulus = 5e4f;
     if (d.poisson_ratio == 0.0f) d.poisson_ratio = 0.499f;
     if (d.density == 0.0f) d.density = 1000.0f;
     if (d.damping == 0.0f) d.damping = 0.1f;
-    if (d.substeps == 0) d.substeps = 10;
+    if (d.substeps == 0) d.substeps = 40;
     if (d.bone_radius == 0.0f) d.bone_radius = 0.5f;
     if (d.jiggle_damping == 0.0f) d.jiggle_damping = 5.0f;
-    if (d.joint_zone == 0.0f) d.joint_zone = 3.0f;
+    if (d.joint_zone == 0.0f) d.joint_zone = 1.5f;
     if (d.memory_budget == 0) d.memory_budget = (size_t)512 << 20;
     return d;
 }
