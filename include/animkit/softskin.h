@@ -189,7 +189,7 @@ typedef struct ak_skin_soft_step_job {
     ak_vec3_span out_positions;     /* optional (ptr NULL -> none): the surface afterwards */
     float* out_kinetic_energy;      /* optional: joules of the flesh nodes afterwards */
     uint32_t thread_count;          /* 0 or 1 -> calling thread; n (<= 64) -> up to n threads,
-                                       at most one per 256 nodes (a barrier per colour and
+                                       at most one per 4096 nodes (a barrier per colour and
                                        substep: worth it from a few thousand nodes) */
 } ak_skin_soft_step_job;
 

@@ -19,6 +19,7 @@
 #define SOFT_MAX_COLORS 128u
 #define SOFT_INFLUENCES 4u
 #define SOFT_NODE_PLANES 4u
+#define SOFT_NODES_PER_THREAD 4096u           /* fewer nodes per thread: fewer threads */
 #define SOFT_MAX_CUT_BONES 1024u              /* more bones: limbs are not kept apart */
 #define SOFT_PART_UNSET (UINT32_MAX - 1u)
 
@@ -1325,7 +1326,10 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
         c.planes[2 * pl + 1] = ak_vec3_length(u) > 0.1f ? ak_vec3_normalize(u) : ak_vec3_zero(); /* folded: off */
     }
     uint32_t tc = j->thread_count > 1 ? j->thread_count : 1;
-    if (tc > 1 && nn < 256 * (size_t)tc) tc = (uint32_t)(nn / 256 > 1 ? nn / 256 : 1);
+    /* a barrier per colour and substep costs microseconds; the AVX2 solve of a colour of a
+     * few-thousand-node lattice takes about as long: threads only from SOFT_NODES_PER_THREAD */
+    if (tc > 1 && nn < SOFT_NODES_PER_THREAD * (size_t)tc)
+        tc = (uint32_t)(nn / SOFT_NODES_PER_THREAD > 1 ? nn / SOFT_NODES_PER_THREAD : 1);
     soft_team team;
     team.c = &c;
     team.count = 1;
