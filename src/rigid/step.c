@@ -32,9 +32,24 @@ typedef struct pair_entry {
     uint32_t cached;
 } pair_entry;
 
+/* One contact's row, set once per substep on the poses after the joints' first sweep: the
+ * world arms' responses to a unit impulse along the normal. Within the position solve a body's
+ * corrections are summed as a displacement cx and a rotation vector ct, and the contact's
+ * depth is read to first order, d = d0 + n . (cx_b - cx_a) + ct_b . rnb - ct_a . rna (the
+ * exact pose moves a point by cx + ct x r: second-order terms, (ct)^2 r, are under 1e-6 of
+ * the correction); the velocity solve reuses the same arms. */
+typedef struct contact_row {
+    ak_vec3 rna, rnb; /* ra x n, rb x n (zero for a body that does not move) */
+    ak_vec3 ta, tb;   /* I^-1 (r x n) (zero for a body that does not move) */
+    float ima, imb;   /* inverse masses (zero for a body that does not move) */
+    float d0;         /* depth at the row's set-up */
+    float inv_w;      /* 1 / (generalised inverse masses), 0 when neither body moves */
+} contact_row;
+
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, sap, pairs, contacts, groups, parent, awake, total;
+    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, sap, pairs, contacts, groups, rows, cx, ct, turn0,
+        parent, awake, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -57,6 +72,11 @@ static layout layout_of(const ak_rigid_model* m) {
                                      sizeof(rigid_contact));
     l.groups = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
                                    sizeof(contact_group));
+    l.rows = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
+                               sizeof(contact_row));
+    l.cx = off, off += align16(n * sizeof(ak_vec3));
+    l.ct = off, off += align16(n * sizeof(ak_vec3));
+    l.turn0 = off, off += align16(n * sizeof(ak_vec3));
     l.parent = off, off += align16(n * sizeof(uint32_t));
     l.awake = off, off += align16(n);
     l.total = off + 16; /* room to align the base */
@@ -121,6 +141,10 @@ typedef struct solver {
     const uint8_t* awake; /* 1: dynamic and awake (moves); 0: static or asleep */
     ak_mat3* iw;          /* world inverse inertia R diag(I^-1) R^T at the substep's start */
     const ak_quat* drive_targets; /* the job's, per joint; NULL -> the model's */
+    contact_row* rows;    /* per contact of the substep */
+    ak_vec3* cx;          /* the contact solve's displacement of each body (see contact_row) */
+    ak_vec3* ct;          /* the contact solve's rotation vector of each body */
+    ak_vec3* turn0;       /* each body's rotation from the substep's start to the contact solve's */
     float h;
     float joint_error; /* the largest joint correction of the sweep (m or rad) */
 } solver;
@@ -464,16 +488,6 @@ static ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) {
     return ak_vec3_add(s->x[i], ak_quat_rotate(s->q[i], l));
 }
 
-/* Motion of body i's local point l since the start of the step, without the cancellation that
- * (x + q l) - (x0 + q0 l) suffers far from the origin. Static friction undoes the slip of the
- * whole step, not only of the substep: a slip left over by one substep (the next pair's solve
- * moves a box after its friction ran) is taken back by the next, so stacks do not creep. */
-static ak_vec3 point_motion(const solver* s, uint32_t i, ak_vec3 l) {
-    if (!s->awake[i]) return ak_vec3_zero();
-    ak_vec3 d = ak_vec3_add(s->ds[i], s->dx[i]);
-    return ak_vec3_add(d, ak_vec3_sub(ak_quat_rotate(s->q[i], l), ak_quat_rotate(s->q0[i], l)));
-}
-
 /* Centre of pressure of a group (the contacts' local points weighted by their normal
  * multipliers) in each body's frame, the group's total multiplier and the multipliers' mean
  * distance from the centre (the lever arm of torsional friction); false when no contact of the
@@ -524,7 +538,59 @@ static ak_vec3 substep_rotation(const solver* s, uint32_t i) {
     return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
 }
 
+/* Motion of body i's local point l since the start of the step (the contact solve's pose, cx
+ * and ct included), without the cancellation that (x + q l) - (x0 + q0 l) suffers far from the
+ * origin; *out_arm gets its world offset. Static friction undoes the slip of the whole step,
+ * not only of the substep: a slip left over by one substep (the next pair's solve moves a box
+ * after its friction ran) is taken back by the next, so stacks do not creep. */
+static ak_vec3 moved_point(const solver* s, uint32_t i, ak_vec3 l, ak_vec3* out_arm) {
+    ak_vec3 r = ak_quat_rotate(s->q[i], l);
+    r = ak_vec3_add(r, ak_vec3_cross(s->ct[i], r));
+    *out_arm = r;
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_vec3 d = ak_vec3_add(s->ds[i], ak_vec3_add(s->dx[i], s->cx[i]));
+    return ak_vec3_add(d, ak_vec3_sub(r, ak_quat_rotate(s->q0[i], l)));
+}
+
+/* Rows of the substep's contacts on the current poses (see contact_row). */
+static void setup_rows(solver* s, const contact_buf* cb) {
+    for (uint32_t k = 0; k < cb->count; ++k) {
+        const rigid_contact* c = &cb->c[k];
+        contact_row* r = &s->rows[k];
+        uint32_t a = c->a, b = c->b;
+        ak_vec3 ra = ak_quat_rotate(s->q[a], c->la), rb = ak_quat_rotate(s->q[b], c->lb);
+        r->d0 = ak_vec3_dot(ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra)), c->n);
+        float w = 0.0f;
+        if (s->awake[a]) {
+            r->rna = ak_vec3_cross(ra, c->n);
+            r->ta = ak_mat3_mul_vec3(s->iw[a], r->rna);
+            r->ima = s->bodies[a].inv_mass;
+            w += r->ima + ak_vec3_dot(r->rna, r->ta);
+        } else {
+            r->rna = r->ta = ak_vec3_zero();
+            r->ima = 0.0f;
+        }
+        if (s->awake[b]) {
+            r->rnb = ak_vec3_cross(rb, c->n);
+            r->tb = ak_mat3_mul_vec3(s->iw[b], r->rnb);
+            r->imb = s->bodies[b].inv_mass;
+            w += r->imb + ak_vec3_dot(r->rnb, r->tb);
+        } else {
+            r->rnb = r->tb = ak_vec3_zero();
+            r->imb = 0.0f;
+        }
+        r->inv_w = w > 0.0f ? 1.0f / w : 0.0f;
+    }
+}
+
 static void solve_positions(solver* s, contact_buf* cb) {
+    uint32_t n = (uint32_t)s->m->body_count;
+    ak_vec3 *cx = s->cx, *ct = s->ct;
+    for (uint32_t i = 0; i < n; ++i) {
+        cx[i] = ct[i] = ak_vec3_zero();
+        s->turn0[i] = substep_rotation(s, i);
+    }
+    setup_rows(s, cb);
     for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
         uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
         /* (alternating the points' order from substep to substep halves a 10-box stack's creep
@@ -532,17 +598,21 @@ static void solve_positions(solver* s, contact_buf* cb) {
          * the order stays fixed) */
         for (uint32_t k = k0; k < k1; ++k) {
             rigid_contact* c = &cb->c[k];
-            ak_vec3 pa = world_point(s, c->a, c->la), pb = world_point(s, c->b, c->lb);
-            float d = ak_vec3_dot(ak_vec3_sub(pb, pa), c->n);
-            if (d <= 0.0f) continue;
-            ak_vec3 ra = ak_vec3_sub(pa, s->x[c->a]), rb = ak_vec3_sub(pb, s->x[c->b]);
-            response oa = respond(s, c->a, ra, c->n), ob = respond(s, c->b, rb, c->n);
-            float w = oa.w + ob.w;
-            if (!(w > 0.0f)) continue;
-            float dl = d / w;
+            const contact_row* r = &s->rows[k];
+            uint32_t a = c->a, b = c->b;
+            float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cx[b], cx[a])) +
+                      ak_vec3_dot(ct[b], r->rnb) - ak_vec3_dot(ct[a], r->rna);
+            if (d <= 0.0f || r->inv_w == 0.0f) continue;
+            float dl = d * r->inv_w;
             c->lambda_n += dl;
-            move_along(s, c->a, c->n, dl, oa);
-            move_along(s, c->b, c->n, -dl, ob);
+            if (r->ima > 0.0f) {
+                cx[a] = ak_vec3_madd(cx[a], c->n, dl * r->ima);
+                ct[a] = ak_vec3_madd(ct[a], r->ta, dl);
+            }
+            if (r->imb > 0.0f) {
+                cx[b] = ak_vec3_madd(cx[b], c->n, -dl * r->imb);
+                ct[b] = ak_vec3_madd(ct[b], r->tb, -dl);
+            }
         }
         /* static friction, once per pair at the centre of pressure with the pair's whole normal
          * multiplier: undo the relative tangential motion of this substep when the force it
@@ -553,33 +623,50 @@ static void solve_positions(solver* s, contact_buf* cb) {
         ak_vec3 la = grp->la, lb = grp->lb;
         float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
+        uint32_t a = c->a, b = c->b;
         if (c->friction > 0.0f && grp->pressed) {
-            ak_vec3 dp = ak_vec3_sub(point_motion(s, c->a, la), point_motion(s, c->b, lb));
+            ak_vec3 ra, rb;
+            ak_vec3 dp = ak_vec3_sub(moved_point(s, a, la, &ra), moved_point(s, b, lb, &rb));
             ak_vec3 dt = ak_vec3_madd(dp, c->n, -ak_vec3_dot(dp, c->n));
             float lt = ak_vec3_length(dt);
             if (lt > 1e-12f) {
                 ak_vec3 t = ak_vec3_scale(dt, 1.0f / lt);
-                ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
-                response oa = respond(s, c->a, ra, t), ob = respond(s, c->b, rb, t);
+                response oa = respond(s, a, ra, t), ob = respond(s, b, rb, t);
                 float wt = oa.w + ob.w;
                 float dlt = wt > 0.0f ? lt / wt : INFINITY;
                 if (dlt < c->friction * lambda) {
-                    move_along(s, c->a, t, -dlt, oa);
-                    move_along(s, c->b, t, dlt, ob);
+                    if (s->awake[a]) {
+                        cx[a] = ak_vec3_madd(cx[a], t, -dlt * s->bodies[a].inv_mass);
+                        ct[a] = ak_vec3_madd(ct[a], oa.turn, -dlt);
+                    }
+                    if (s->awake[b]) {
+                        cx[b] = ak_vec3_madd(cx[b], t, dlt * s->bodies[b].inv_mass);
+                        ct[b] = ak_vec3_madd(ct[b], ob.turn, dlt);
+                    }
                 }
             }
             /* torsional friction: a patch of contacts also resists twisting about the normal, up
              * to mu times the normal multiplier times its mean lever arm */
-            float twist = ak_vec3_dot(
-                ak_vec3_sub(substep_rotation(s, c->a), substep_rotation(s, c->b)), c->n);
-            float wr = gen_inv_inertia(s, c->a, c->n) + gen_inv_inertia(s, c->b, c->n);
+            ak_vec3 rot_a = s->awake[a] ? ak_vec3_add(s->turn0[a], ct[a]) : ak_vec3_zero();
+            ak_vec3 rot_b = s->awake[b] ? ak_vec3_add(s->turn0[b], ct[b]) : ak_vec3_zero();
+            float twist = ak_vec3_dot(ak_vec3_sub(rot_a, rot_b), c->n);
+            float wr = gen_inv_inertia(s, a, c->n) + gen_inv_inertia(s, b, c->n);
             if (wr > 0.0f && fabsf(twist) > 0.0f &&
                 fabsf(twist) / wr < c->friction * lambda * arm) {
                 ak_vec3 pr = ak_vec3_scale(c->n, -twist / wr);
-                apply_angular_impulse(s, c->a, pr, 1.0f);
-                apply_angular_impulse(s, c->b, pr, -1.0f);
+                if (s->awake[a]) ct[a] = ak_vec3_add(ct[a], inv_inertia_mul(s, a, pr));
+                if (s->awake[b]) ct[b] = ak_vec3_sub(ct[b], inv_inertia_mul(s, b, pr));
             }
         }
+    }
+    /* the summed corrections onto the poses (orientations normalised in update_velocities) */
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!s->awake[i]) continue;
+        s->dx[i] = ak_vec3_add(s->dx[i], cx[i]);
+        s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
+        ak_vec3 dw = ak_vec3_scale(ct[i], 0.5f);
+        ak_quat q = s->q[i];
+        s->q[i] = ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q));
     }
 }
 
@@ -760,21 +847,27 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
     for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
         uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
         for (uint32_t k = k0; k < k1; ++k) {
-            rigid_contact* c = &cb->c[k];
+            const rigid_contact* c = &cb->c[k];
             if (!(c->lambda_n > 0.0f)) continue;
-            ak_vec3 ra = moving_arm(s, c->a, c->la), rb = moving_arm(s, c->b, c->lb);
-            float vn = ak_vec3_dot(
-                c->n, ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb)));
+            const contact_row* r = &s->rows[k];
+            uint32_t a = c->a, b = c->b;
+            /* n . (v + w x r) = n . v + w . (r x n), the arms of the position solve's rows */
+            float vn = ak_vec3_dot(c->n, ak_vec3_sub(s->v[a], s->v[b])) +
+                       ak_vec3_dot(s->w[a], r->rna) - ak_vec3_dot(s->w[b], r->rnb);
             /* restitution: the normal velocity becomes -e times the one before the solve (none
              * for slow impacts, which gravity alone could have made in two substeps) */
             float e = fabsf(c->vn_before) <= 2.0f * gmag * h ? 0.0f : c->restitution;
             float dvn = -vn + ak_maxf(-e * c->vn_before, 0.0f);
-            if (fabsf(dvn) < 1e-12f) continue;
-            response oa = respond(s, c->a, ra, c->n), ob = respond(s, c->b, rb, c->n);
-            float w = oa.w + ob.w;
-            if (!(w > 0.0f)) continue;
-            push_along(s, c->a, c->n, dvn / w, oa);
-            push_along(s, c->b, c->n, -dvn / w, ob);
+            if (fabsf(dvn) < 1e-12f || r->inv_w == 0.0f) continue;
+            float mag = dvn * r->inv_w;
+            if (r->ima > 0.0f) {
+                s->v[a] = ak_vec3_madd(s->v[a], c->n, mag * r->ima);
+                s->w[a] = ak_vec3_madd(s->w[a], r->ta, mag);
+            }
+            if (r->imb > 0.0f) {
+                s->v[b] = ak_vec3_madd(s->v[b], c->n, -mag * r->imb);
+                s->w[b] = ak_vec3_madd(s->w[b], r->tb, -mag);
+            }
         }
         /* dynamic friction at the centre of pressure (their eq. 30 with the units made whole) */
         const contact_group* grp = &cb->groups[gi];
@@ -893,6 +986,10 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         .awake = awake,
         .iw = (ak_mat3*)(base + l.iw),
         .drive_targets = job->drive_targets.count ? job->drive_targets.ptr : NULL,
+        .rows = (contact_row*)(base + l.rows),
+        .cx = (ak_vec3*)(base + l.cx),
+        .ct = (ak_vec3*)(base + l.ct),
+        .turn0 = (ak_vec3*)(base + l.turn0),
         .h = job->dt / (float)substeps,
     };
     memcpy(x0, s.x, n * sizeof *x0);
