@@ -596,23 +596,27 @@ static void solve_positions(solver* s, contact_buf* cb) {
         /* (alternating the points' order from substep to substep halves a 10-box stack's creep
          * but moves the centre of pressure each substep, and a block on an incline then creeps:
          * the order stays fixed) */
-        for (uint32_t k = k0; k < k1; ++k) {
-            rigid_contact* c = &cb->c[k];
-            const contact_row* r = &s->rows[k];
-            uint32_t a = c->a, b = c->b;
-            float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cx[b], cx[a])) +
-                      ak_vec3_dot(ct[b], r->rnb) - ak_vec3_dot(ct[a], r->rna);
-            if (d <= 0.0f || r->inv_w == 0.0f) continue;
-            float dl = d * r->inv_w;
-            c->lambda_n += dl;
-            if (r->ima > 0.0f) {
-                cx[a] = ak_vec3_madd(cx[a], c->n, dl * r->ima);
-                ct[a] = ak_vec3_madd(ct[a], r->ta, dl);
+        /* every contact of a group joins the same two bodies: their corrections stay in
+         * registers over the group */
+        {
+            uint32_t a = cb->c[k0].a, b = cb->c[k0].b;
+            ak_vec3 cxa = cx[a], cta = ct[a], cxb = cx[b], ctb = ct[b];
+            for (uint32_t k = k0; k < k1; ++k) {
+                rigid_contact* c = &cb->c[k];
+                const contact_row* r = &s->rows[k];
+                float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cxb, cxa)) +
+                          ak_vec3_dot(ctb, r->rnb) - ak_vec3_dot(cta, r->rna);
+                if (d <= 0.0f || r->inv_w == 0.0f) continue;
+                float dl = d * r->inv_w;
+                c->lambda_n += dl;
+                /* (a body that does not move has a zero row: its sums stay zero) */
+                cxa = ak_vec3_madd(cxa, c->n, dl * r->ima);
+                cta = ak_vec3_madd(cta, r->ta, dl);
+                cxb = ak_vec3_madd(cxb, c->n, -dl * r->imb);
+                ctb = ak_vec3_madd(ctb, r->tb, -dl);
             }
-            if (r->imb > 0.0f) {
-                cx[b] = ak_vec3_madd(cx[b], c->n, -dl * r->imb);
-                ct[b] = ak_vec3_madd(ct[b], r->tb, -dl);
-            }
+            if (s->awake[a]) cx[a] = cxa, ct[a] = cta;
+            if (s->awake[b]) cx[b] = cxb, ct[b] = ctb;
         }
         /* static friction, once per pair at the centre of pressure with the pair's whole normal
          * multiplier: undo the relative tangential motion of this substep when the force it
