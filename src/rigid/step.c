@@ -20,6 +20,9 @@ typedef struct contact_group {
     uint32_t pressed;
     ak_vec3 la, lb;
     float lambda, arm;
+    ak_vec3 ra, rb; /* its world offsets after the position solve (zero for a body that does
+                       not move), which the velocity solve's friction reuses */
+    float wr;       /* n . I^-1 n summed over the two bodies */
 } contact_group;
 
 /* A pair of bodies the broad phase found at the step's start. Pairs of boxes and planes
@@ -50,7 +53,7 @@ typedef struct contact_row {
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
     size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, sap, pairs, contacts, groups, rows, cx, ct, turn0,
-        jorder, jstart, jchain, croot, parent, awake, total;
+        jorder, jstart, jchain, croot, rot, rot0, parent, awake, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -82,6 +85,8 @@ static layout layout_of(const ak_rigid_model* m) {
     l.jstart = off, off += align16((m->joint_count + 1) * sizeof(uint32_t));
     l.jchain = off, off += align16(m->joint_count * sizeof(uint32_t));
     l.croot = off, off += align16(n * sizeof(uint32_t));
+    l.rot = off, off += align16(n * sizeof(ak_mat3));
+    l.rot0 = off, off += align16(n * sizeof(ak_mat3));
     l.parent = off, off += align16(n * sizeof(uint32_t));
     l.awake = off, off += align16(n);
     l.total = off + 16; /* room to align the base */
@@ -150,6 +155,8 @@ typedef struct solver {
     ak_vec3* cx;          /* the contact solve's displacement of each body (see contact_row) */
     ak_vec3* ct;          /* the contact solve's rotation vector of each body */
     ak_vec3* turn0;       /* each body's rotation from the substep's start to the contact solve's */
+    ak_mat3* rot;         /* each body's rotation at the contact solve's start */
+    ak_mat3* rot0;        /* each body's rotation at the step's start */
     float h;
 } solver;
 
@@ -548,12 +555,12 @@ static ak_vec3 substep_rotation(const solver* s, uint32_t i) {
  * not only of the substep: a slip left over by one substep (the next pair's solve moves a box
  * after its friction ran) is taken back by the next, so stacks do not creep. */
 static ak_vec3 moved_point(const solver* s, uint32_t i, ak_vec3 l, ak_vec3* out_arm) {
-    ak_vec3 r = ak_quat_rotate(s->q[i], l);
+    ak_vec3 r = ak_mat3_mul_vec3(s->rot[i], l);
     r = ak_vec3_add(r, ak_vec3_cross(s->ct[i], r));
     *out_arm = r;
     if (!s->awake[i]) return ak_vec3_zero();
     ak_vec3 d = ak_vec3_add(s->ds[i], ak_vec3_add(s->dx[i], s->cx[i]));
-    return ak_vec3_add(d, ak_vec3_sub(r, ak_quat_rotate(s->q0[i], l)));
+    return ak_vec3_add(d, ak_vec3_sub(r, ak_mat3_mul_vec3(s->rot0[i], l)));
 }
 
 /* Rows of the substep's contacts on the current poses (see contact_row). */
@@ -562,7 +569,7 @@ static void setup_rows(solver* s, const contact_buf* cb) {
         const rigid_contact* c = &cb->c[k];
         contact_row* r = &s->rows[k];
         uint32_t a = c->a, b = c->b;
-        ak_vec3 ra = ak_quat_rotate(s->q[a], c->la), rb = ak_quat_rotate(s->q[b], c->lb);
+        ak_vec3 ra = ak_mat3_mul_vec3(s->rot[a], c->la), rb = ak_mat3_mul_vec3(s->rot[b], c->lb);
         r->d0 = ak_vec3_dot(ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra)), c->n);
         float w = 0.0f;
         if (s->awake[a]) {
@@ -593,6 +600,7 @@ static void solve_positions(solver* s, contact_buf* cb) {
     for (uint32_t i = 0; i < n; ++i) {
         cx[i] = ct[i] = ak_vec3_zero();
         s->turn0[i] = substep_rotation(s, i);
+        s->rot[i] = ak_mat3_from_quat(s->q[i]);
     }
     setup_rows(s, cb);
     for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
@@ -632,9 +640,13 @@ static void solve_positions(solver* s, contact_buf* cb) {
         float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
         uint32_t a = c->a, b = c->b;
-        if (c->friction > 0.0f && grp->pressed) {
-            ak_vec3 ra, rb;
-            ak_vec3 dp = ak_vec3_sub(moved_point(s, a, la, &ra), moved_point(s, b, lb, &rb));
+        if (!grp->pressed) continue;
+        ak_vec3 ra, rb;
+        ak_vec3 dp = ak_vec3_sub(moved_point(s, a, la, &ra), moved_point(s, b, lb, &rb));
+        grp->ra = s->awake[a] ? ra : ak_vec3_zero();
+        grp->rb = s->awake[b] ? rb : ak_vec3_zero();
+        grp->wr = gen_inv_inertia(s, a, c->n) + gen_inv_inertia(s, b, c->n);
+        if (c->friction > 0.0f) {
             ak_vec3 dt = ak_vec3_madd(dp, c->n, -ak_vec3_dot(dp, c->n));
             float lt = ak_vec3_length(dt);
             if (lt > 1e-12f) {
@@ -658,7 +670,7 @@ static void solve_positions(solver* s, contact_buf* cb) {
             ak_vec3 rot_a = s->awake[a] ? ak_vec3_add(s->turn0[a], ct[a]) : ak_vec3_zero();
             ak_vec3 rot_b = s->awake[b] ? ak_vec3_add(s->turn0[b], ct[b]) : ak_vec3_zero();
             float twist = ak_vec3_dot(ak_vec3_sub(rot_a, rot_b), c->n);
-            float wr = gen_inv_inertia(s, a, c->n) + gen_inv_inertia(s, b, c->n);
+            float wr = grp->wr;
             if (wr > 0.0f && fabsf(twist) > 0.0f &&
                 fabsf(twist) / wr < c->friction * lambda * arm) {
                 ak_vec3 pr = ak_vec3_scale(c->n, -twist / wr);
@@ -843,12 +855,6 @@ static void update_velocities(solver* s) {
     }
 }
 
-/* World offset of body i's local point l, zero for a body that does not move (its velocity
- * and its response are zero whatever the offset). */
-static ak_vec3 moving_arm(const solver* s, uint32_t i, ak_vec3 l) {
-    return s->awake[i] ? ak_quat_rotate(s->q[i], l) : ak_vec3_zero();
-}
-
 static ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
     return ak_vec3_add(s->v[i], ak_vec3_cross(s->w[i], r));
 }
@@ -882,11 +888,10 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
         }
         /* dynamic friction at the centre of pressure (their eq. 30 with the units made whole) */
         const contact_group* grp = &cb->groups[gi];
-        ak_vec3 la = grp->la, lb = grp->lb;
         float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
         if (c->dynamic_friction > 0.0f && grp->pressed) {
-            ak_vec3 ra = moving_arm(s, c->a, la), rb = moving_arm(s, c->b, lb);
+            ak_vec3 ra = grp->ra, rb = grp->rb;
             ak_vec3 vr = ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb));
             ak_vec3 vt = ak_vec3_madd(vr, c->n, -ak_vec3_dot(vr, c->n));
             float lt = ak_vec3_length(vt);
@@ -903,7 +908,7 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
                 }
             }
             float spin = ak_vec3_dot(ak_vec3_sub(s->w[c->a], s->w[c->b]), c->n);
-            float wr = gen_inv_inertia(s, c->a, c->n) + gen_inv_inertia(s, c->b, c->n);
+            float wr = grp->wr;
             if (wr > 0.0f && spin != 0.0f) {
                 float cut = ak_minf(c->dynamic_friction * lambda * arm * wr / h, fabsf(spin));
                 ak_vec3 pr = ak_vec3_scale(c->n, (spin > 0.0f ? -cut : cut) / wr);
@@ -1058,6 +1063,8 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         .cx = (ak_vec3*)(base + l.cx),
         .ct = (ak_vec3*)(base + l.ct),
         .turn0 = (ak_vec3*)(base + l.turn0),
+        .rot = (ak_mat3*)(base + l.rot),
+        .rot0 = (ak_mat3*)(base + l.rot0),
         .h = job->dt / (float)substeps,
     };
     memcpy(x0, s.x, n * sizeof *x0);
@@ -1070,6 +1077,7 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         awake[i] = m->bodies[i].inv_mass > 0.0f &&
                    !(sleeping && job->sleep_timers.ptr[i] >= m->desc.sleep_time);
         if (awake[i]) s.q[i] = q0[i] = ak_quat_normalize(s.q[i]);
+        s.rot0[i] = ak_mat3_from_quat(q0[i]);
     }
     contact_buf cb = {(rigid_contact*)(base + l.contacts), 0, m->desc.max_contacts, 0,
                       (contact_group*)(base + l.groups),   0};
