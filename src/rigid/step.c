@@ -182,15 +182,22 @@ static ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
     return ak_mat3_mul_vec3(s->iw[i], v);
 }
 
+/* q + [dw, 0] q brought back to unit length by one Newton step for 1 / |.| (a joint's
+ * correction turns by well under a radian, so the norm is 1 + |dw|^2 / 2 and the step leaves
+ * an error of order |dw|^4: no square root or division on the joints' dependency chain; the
+ * orientations are normalised exactly once per substep in update_velocities). */
+static inline ak_quat turn_by(ak_quat q, ak_vec3 dw) {
+    ak_quat r = ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q));
+    return ak_quat_scale(r, 1.5f - 0.5f * ak_quat_dot(r, r));
+}
+
 /* Apply positional impulse p at offset r to body i (sign +1 or -1). */
 static void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
     if (!s->awake[i]) return;
     s->dx[i] = ak_vec3_madd(s->dx[i], p, sign * s->bodies[i].inv_mass);
     s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
-    ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, ak_vec3_cross(r, p)), sign * 0.5f);
-    ak_quat q = s->q[i];
-    ak_quat dq = ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q);
-    s->q[i] = ak_quat_normalize(ak_quat_add(q, dq));
+    ak_vec3 dw = ak_vec3_scale(ak_mat3_mul_vec3(s->iw[i], ak_vec3_cross(r, p)), sign * 0.5f);
+    s->q[i] = turn_by(s->q[i], dw);
 }
 
 /* Body i's response to a unit impulse along unit n at offset r: the turn I^-1 (r x n) and the
@@ -535,10 +542,8 @@ static float gen_inv_inertia(const solver* s, uint32_t i, ak_vec3 n) {
 /* Rotate body i by the angular position impulse (sign) * p (world). */
 static void apply_angular_impulse(solver* s, uint32_t i, ak_vec3 p, float sign) {
     if (!s->awake[i]) return;
-    ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, p), sign * 0.5f);
-    ak_quat q = s->q[i];
-    s->q[i] =
-        ak_quat_normalize(ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q)));
+    ak_vec3 dw = ak_vec3_scale(ak_mat3_mul_vec3(s->iw[i], p), sign * 0.5f);
+    s->q[i] = turn_by(s->q[i], dw);
 }
 
 /* Rotation vector of body i over this substep (small-angle). */
@@ -692,17 +697,6 @@ static void solve_positions(solver* s, contact_buf* cb) {
 
 /* ---- joints (XPBD positional and angular constraints, Mueller et al. 2020, 3.3) ---------- */
 
-/* World inverse inertia tensor of body i (zero when it does not move). */
-static ak_mat3 inv_inertia_world(const solver* s, uint32_t i) {
-    if (!s->awake[i]) return ak_mat3_scale(ak_mat3_identity(), 0.0f);
-    return s->iw[i];
-}
-
-static ak_mat3 skew(ak_vec3 v) {
-    ak_mat3 m = {{0.0f, v.z, -v.y, -v.z, 0.0f, v.x, v.y, -v.x, 0.0f}};
-    return m;
-}
-
 /* Move anchor points pa (on a, offset ra) and pb (on b, offset rb) together by e = pb - pa
  * with compliance alpha (m/N), all three directions at once: the impulse p = K^-1 e with K =
  * (1/m_a + 1/m_b + alpha/h^2) 1 - [ra]x Ia^-1 [ra]x - [rb]x Ib^-1 [rb]x moves the anchors by
@@ -715,15 +709,28 @@ static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec
     *err = ak_maxf(*err, ak_vec3_length(e));
     float lin = (s->awake[a] ? s->bodies[a].inv_mass : 0.0f) +
                 (s->awake[b] ? s->bodies[b].inv_mass : 0.0f) + alpha / (s->h * s->h);
-    ak_mat3 sa = skew(ra), sb = skew(rb);
-    ak_mat3 k = ak_mat3_scale(ak_mat3_identity(), lin);
-    k = ak_mat3_add(
-        k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sa, inv_inertia_world(s, a)), sa), -1.0f));
-    k = ak_mat3_add(
-        k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sb, inv_inertia_world(s, b)), sb), -1.0f));
-    float det = ak_mat3_determinant(k);
+    /* K is symmetric: its six entries, each body adding S I^-1 S^T (S = [r]x, rows s_i) */
+    float k00 = lin, k01 = 0.0f, k02 = 0.0f, k11 = lin, k12 = 0.0f, k22 = lin;
+    for (int side = 0; side < 2; ++side) {
+        uint32_t i = side ? b : a;
+        if (!s->awake[i]) continue;
+        ak_vec3 r = side ? rb : ra;
+        ak_vec3 s0 = ak_vec3_make(0.0f, -r.z, r.y), s1 = ak_vec3_make(r.z, 0.0f, -r.x),
+                s2 = ak_vec3_make(-r.y, r.x, 0.0f);
+        ak_vec3 i0 = ak_mat3_mul_vec3(s->iw[i], s0), i1 = ak_mat3_mul_vec3(s->iw[i], s1),
+                i2 = ak_mat3_mul_vec3(s->iw[i], s2);
+        k00 += ak_vec3_dot(s0, i0), k01 += ak_vec3_dot(s0, i1), k02 += ak_vec3_dot(s0, i2);
+        k11 += ak_vec3_dot(s1, i1), k12 += ak_vec3_dot(s1, i2), k22 += ak_vec3_dot(s2, i2);
+    }
+    /* p = K^-1 e by cofactors */
+    float c00 = k11 * k22 - k12 * k12, c01 = k02 * k12 - k01 * k22, c02 = k01 * k12 - k02 * k11;
+    float det = k00 * c00 + k01 * c01 + k02 * c02;
     if (!(fabsf(det) > 1e-30f) || !ak_finitef(det)) return;
-    ak_vec3 p = ak_mat3_mul_vec3(ak_mat3_inverse(k), e);
+    float c11 = k00 * k22 - k02 * k02, c12 = k01 * k02 - k00 * k12, c22 = k00 * k11 - k01 * k01;
+    float id = 1.0f / det;
+    ak_vec3 p = ak_vec3_make((c00 * e.x + c01 * e.y + c02 * e.z) * id,
+                             (c01 * e.x + c11 * e.y + c12 * e.z) * id,
+                             (c02 * e.x + c12 * e.y + c22 * e.z) * id);
     apply_position_impulse(s, a, ra, p, 1.0f);
     apply_position_impulse(s, b, rb, p, -1.0f);
 }
