@@ -217,18 +217,6 @@ static inline response respond(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n
     return o;
 }
 
-/* Positional impulse mag * n on body i (n, o: as given to respond). The orientation is left
- * unnormalised (a turn of 1e-3 rad changes its norm by 1e-7, about a float's rounding) and is
- * normalised once after the position solve, in update_velocities. */
-static inline void move_along(solver* s, uint32_t i, ak_vec3 n, float mag, response o) {
-    if (!s->awake[i]) return;
-    s->dx[i] = ak_vec3_madd(s->dx[i], n, mag * s->bodies[i].inv_mass);
-    s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
-    ak_vec3 dw = ak_vec3_scale(o.turn, 0.5f * mag);
-    ak_quat q = s->q[i];
-    s->q[i] = ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q));
-}
-
 /* Velocity impulse mag * n on body i. */
 static inline void push_along(solver* s, uint32_t i, ak_vec3 n, float mag, response o) {
     if (!s->awake[i]) return;
