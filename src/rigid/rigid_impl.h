@@ -131,6 +131,7 @@ typedef struct rigid_joint {
     bool limited, drive, twist_limited;
     float lower, upper, compliance, drive_compliance, angle_offset, twist_lower, twist_upper;
     float drive_damping; /* 1/s: the drive's relative angular velocity damped each substep */
+    float cos_upper;     /* ball: cos(upper), -INFINITY when upper >= pi, INFINITY when < 0 */
 } rigid_joint;
 
 /* Signed angle (rad) of body b about the hinge axis relative to a, zero as built. */

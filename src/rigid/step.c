@@ -783,10 +783,16 @@ static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* 
         if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
             ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a),
                     a2 = ak_quat_rotate(s->q[b], j->axis_b);
-            ak_vec3 cr = ak_vec3_cross(a1, a2);
-            float sn = ak_vec3_length(cr), swing = atan2f(sn, ak_vec3_dot(a1, a2));
-            if (swing > j->upper && sn > 1e-9f)
-                joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f, err);
+            float cs = ak_vec3_dot(a1, a2);
+            /* the angle only when not well inside the cone (the orientations are unit to well
+             * under 1e-3 within a substep, so cs is the swing's cosine within 1e-3) */
+            if (!(cs > j->cos_upper + 1e-3f)) {
+                ak_vec3 cr = ak_vec3_cross(a1, a2);
+                float sn = ak_vec3_length(cr), swing = atan2f(sn, cs);
+                if (swing > j->upper && sn > 1e-9f)
+                    joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f,
+                                   err);
+            }
         }
         if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited) {
             ak_vec3 n;
