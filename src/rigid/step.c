@@ -744,6 +744,21 @@ static ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
     return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
 }
 
+/* True when ball joint j's twist is inside its limits by at least 1e-4 rad (without the angle:
+ * akp_rigid_twist_angle's half angle t/2 = atan2(y, w) of rel, taken with w >= 0, lies
+ * between the limits' half angles L and H when sin(t/2 - L) and sin(H - t/2) are positive,
+ * which needs no atan2); false also when it cannot tell (twist_fast off). */
+static inline bool twist_inside(const rigid_joint* j, ak_quat qa, ak_quat qb) {
+    if (!j->twist_fast) return false;
+    ak_quat rel = ak_quat_mul(ak_quat_conjugate(ak_quat_mul(qa, j->frame_a)),
+                              ak_quat_mul(qb, j->frame_b));
+    float y = rel.w < 0.0f ? -rel.y : rel.y, w = fabsf(rel.w);
+    float r = sqrtf(y * y + w * w);
+    if (!(r > 1e-6f)) return false;
+    return y * j->twist_cl - w * j->twist_sl > 1e-4f * r &&
+           w * j->twist_sh - y * j->twist_ch > 1e-4f * r;
+}
+
 /* One sweep over the joints idx[0 .. count) (NULL idx: every joint in model order); *err gets
  * the largest correction (m or rad). */
 static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* err) {
@@ -794,7 +809,8 @@ static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* 
                                    err);
             }
         }
-        if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited) {
+        if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited &&
+            !twist_inside(j, s->q[a], s->q[b])) {
             ak_vec3 n;
             float tw = akp_rigid_twist_angle(j, s->q[a], s->q[b], &n) + j->angle_offset;
             float target = ak_clampf(tw, j->twist_lower, j->twist_upper);
