@@ -634,7 +634,8 @@ AK_TEST(ragdolls_bit_identical_for_any_thread_count) {
     float* timers = malloc(nb * sizeof *timers);
     bool alloc_ok = pose && bones && bodies && joints && timers;
     for (int t = 0; t < 3; ++t) {
-        for (int k = 0; k < 3; ++k) alloc_ok = alloc_ok && (st[t][k] = malloc(nb * sizeof(ak_vec3)));
+        for (int k = 0; k < 3; ++k)
+            alloc_ok = alloc_ok && (st[t][k] = malloc(nb * sizeof(ak_vec3)));
         alloc_ok = alloc_ok && (sq[t] = malloc(nb * sizeof(ak_quat)));
     }
     ak_rigid_model* m = NULL;
@@ -647,14 +648,15 @@ AK_TEST(ragdolls_bit_identical_for_any_thread_count) {
         ak_vec3 axis = ak_vec3_make(1.0f, 0.3f * (float)r, 0.5f * (float)(r % 3));
         ak_mat4 root = ak_mat4_mul(
             ak_mat4_translation(ak_vec3_make(2.5f * (float)r, 0.3f + 0.2f * (float)r, 0.0f)),
-            ak_mat4_from_quat(ak_quat_from_axis_angle(axis, (20.0f + 25.0f * (float)r) *
-                                                                3.14159265f / 180.0f)));
+            ak_mat4_from_quat(
+                ak_quat_from_axis_angle(axis, (20.0f + 25.0f * (float)r) * 3.14159265f / 180.0f)));
         ak_rigid_ragdoll_desc rd = {.skeleton = sk,
                                     .local_pose = {pose, n},
                                     .root = root,
                                     .body_offset = (uint32_t)(1 + r * per),
                                     .collision_group = (uint32_t)r + 1};
-        AK_CHECK_EQ(ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){bodies + 1 + r * per, per},
+        AK_CHECK_EQ(ak_rigid_ragdoll_build(&rd,
+                                           (ak_rigid_body_desc_span){bodies + 1 + r * per, per},
                                            (ak_rigid_joint_desc_span){joints + r * pj, pj},
                                            (ak_rigid_ragdoll_bone_span){bones, n}),
                     AK_OK);

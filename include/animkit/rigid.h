@@ -41,10 +41,10 @@
  *     bodies, a ragdoll each), among the library's worker team; every other phase (and a scene
  *     without joints) runs on the calling thread.
  *
- * What it does NOT do (yet): threads for the contacts, continuous collision detection (a body moving more than
- * its size in one substep can tunnel), dynamic triangle meshes and heightfields (they are
- * static), two-way coupling with other simulations: cloth and particles take the bodies as a
- * mesh (ak_rigid_world_mesh), the fluid as its colliders (ak_rigid_fluid_colliders), one-way.
+ * What it does NOT do (yet): threads for the contacts, continuous collision detection (a body
+ * moving more than its size in one substep can tunnel), dynamic triangle meshes and heightfields
+ * (they are static), two-way coupling with other simulations: cloth and particles take the bodies
+ * as a mesh (ak_rigid_world_mesh), the fluid as its colliders (ak_rigid_fluid_colliders), one-way.
  *
  * Usage (a box dropped on the ground):
  *     ak_rigid_body_desc bodies[2] = {

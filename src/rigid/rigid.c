@@ -507,8 +507,8 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         j->lower = jd->lower;
         j->upper = jd->upper;
         /* the swing limit's cosine: a cone of pi or wider never binds, a negative one always */
-        j->cos_upper = jd->upper >= 3.14159265f ? -INFINITY
-                                                : (jd->upper < 0.0f ? INFINITY : cosf(jd->upper));
+        j->cos_upper =
+            jd->upper >= 3.14159265f ? -INFINITY : (jd->upper < 0.0f ? INFINITY : cosf(jd->upper));
         j->compliance = jd->compliance;
         j->drive_compliance = jd->drive_compliance;
         j->drive_damping = jd->drive_damping;

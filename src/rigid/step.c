@@ -77,7 +77,7 @@ static layout layout_of(const ak_rigid_model* m) {
     l.groups = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
                                    sizeof(contact_group));
     l.rows = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
-                               sizeof(contact_row));
+                                 sizeof(contact_row));
     l.cx = off, off += align16(n * sizeof(ak_vec3));
     l.ct = off, off += align16(n * sizeof(ak_vec3));
     l.turn0 = off, off += align16(n * sizeof(ak_vec3));
@@ -151,12 +151,12 @@ typedef struct solver {
     const uint8_t* awake; /* 1: dynamic and awake (moves); 0: static or asleep */
     ak_mat3* iw;          /* world inverse inertia R diag(I^-1) R^T at the substep's start */
     const ak_quat* drive_targets; /* the job's, per joint; NULL -> the model's */
-    contact_row* rows;    /* per contact of the substep */
-    ak_vec3* cx;          /* the contact solve's displacement of each body (see contact_row) */
-    ak_vec3* ct;          /* the contact solve's rotation vector of each body */
-    ak_vec3* turn0;       /* each body's rotation from the substep's start to the contact solve's */
-    ak_mat3* rot;         /* each body's rotation at the contact solve's start */
-    ak_mat3* rot0;        /* each body's rotation at the step's start */
+    contact_row* rows;            /* per contact of the substep */
+    ak_vec3* cx;    /* the contact solve's displacement of each body (see contact_row) */
+    ak_vec3* ct;    /* the contact solve's rotation vector of each body */
+    ak_vec3* turn0; /* each body's rotation from the substep's start to the contact solve's */
+    ak_mat3* rot;   /* each body's rotation at the contact solve's start */
+    ak_mat3* rot0;  /* each body's rotation at the step's start */
     float h;
 } solver;
 
@@ -750,8 +750,8 @@ static ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
  * which needs no atan2); false also when it cannot tell (twist_fast off). */
 static inline bool twist_inside(const rigid_joint* j, ak_quat qa, ak_quat qb) {
     if (!j->twist_fast) return false;
-    ak_quat rel = ak_quat_mul(ak_quat_conjugate(ak_quat_mul(qa, j->frame_a)),
-                              ak_quat_mul(qb, j->frame_b));
+    ak_quat rel =
+        ak_quat_mul(ak_quat_conjugate(ak_quat_mul(qa, j->frame_a)), ak_quat_mul(qb, j->frame_b));
     float y = rel.w < 0.0f ? -rel.y : rel.y, w = fabsf(rel.w);
     float r = sqrtf(y * y + w * w);
     if (!(r > 1e-6f)) return false;
@@ -805,8 +805,7 @@ static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* 
                 ak_vec3 cr = ak_vec3_cross(a1, a2);
                 float sn = ak_vec3_length(cr), swing = atan2f(sn, cs);
                 if (swing > j->upper && sn > 1e-9f)
-                    joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f,
-                                   err);
+                    joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f, err);
             }
         }
         if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited &&
@@ -1120,8 +1119,9 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
     if (nj) {
         uint32_t* order = (uint32_t*)(base + l.jorder);
         uint32_t* start = (uint32_t*)(base + l.jstart);
-        uint32_t chains = joint_chains(&s, (uint32_t*)(base + l.parent), (uint32_t*)(base + l.croot),
-                                       (uint32_t*)(base + l.jchain), order, start);
+        uint32_t chains =
+            joint_chains(&s, (uint32_t*)(base + l.parent), (uint32_t*)(base + l.croot),
+                         (uint32_t*)(base + l.jchain), order, start);
         uint32_t want = job->thread_count ? job->thread_count : 1;
         if (want > chains) want = chains;
         if (want > AKP_TASKS_MAX) want = AKP_TASKS_MAX;
@@ -1134,8 +1134,8 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
             while (c < chains && (t + 1 == want || start[c + 1] <= upto)) ++c;
             if (c == c0 && c < chains) ++c;
             if (c == c0) continue;
-            tasks[tasks_n++] = (chain_task){.s = &s, .order = order, .start = start, .c0 = c0,
-                                            .c1 = c, .sweeps = 8};
+            tasks[tasks_n++] = (chain_task){
+                .s = &s, .order = order, .start = start, .c0 = c0, .c1 = c, .sweeps = 8};
         }
     }
     for (uint32_t step = 0; step < substeps; ++step) {
