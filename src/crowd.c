@@ -901,7 +901,8 @@ static float ray_segment(ak_vec2 o, ak_vec2 d, ak_vec2 a, ak_vec2 b) {
     return (t > 0.0f && u >= 0.0f && u <= 1.0f) ? t : INFINITY;
 }
 
-#define VISION_STAND_TTC 0.845f /* s: 1 - exp(-0.5 t^2) = 0.3 */
+#define VISION_STAND_SPEED 0.25f /* m/s */
+#define VISION_STAND_TTC 0.845f  /* s: 1 - exp(-0.5 t^2) = 0.3 */
 
 /* Within a second of its last goal (pref_speed * 1 s), its own waypoints driving it: then the
  * preferred velocity is the offset to the goal per second (pref_velocity). */
@@ -914,20 +915,21 @@ static bool vision_arriving(const ak_crowd_step_job* job, const ak_crowd_agent* 
 
 /* Synthetic-vision steering (Ondrej et al. 2010) for one agent: a 1D view of vision_width
  * pixels; per pixel the visible object's hit point, its time to interaction and the rate of
- * its bearing; threats turn and slow the agent. */
+ * its bearing; the threats' bearing rates bound the turn rate and the nearest threat's time to
+ * interaction sets the speed (the paper's two controls); the goal is a pixel kept in view. */
 static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const ak_crowd_agent* a, ak_vec2 pref) {
     const ctx* c = w->c;
     const ak_crowd* crowd = c->crowd;
     const ak_crowd_step_job* job = c->job;
-    const uint32_t na = agent_neighbors(c, i, p, a, w->agent_n);
-    const uint32_t no = crowd->vertex_count ? obstacle_neighbors(crowd, p, a, w->obst_n) : 0;
-    const float speed = len(v);
-    const float pref_len = len(pref);
     /* Arrival (as ORCA's preferred velocity): within a second of its last goal pref is the
      * offset to the goal per second; the agent walks it, onto its place, unslowed and unturned
      * by the view: a neighbour in the way is pushed by the contact projection, and one pushed
      * off its place walks back at the same rule instead of freezing against its neighbours. */
     if (vision_arriving(job, a, i, p)) return pref;
+    const uint32_t na = agent_neighbors(c, i, p, a, w->agent_n);
+    const uint32_t no = crowd->vertex_count ? obstacle_neighbors(crowd, p, a, w->obst_n) : 0;
+    const float speed = len(v);
+    const float pref_len = len(pref);
     /* heading: the velocity, or the goal's direction when standing */
     const ak_vec2 head = speed > 1e-3f ? mul(1.0f / speed, v) : (pref_len > 0.0f ? mul(1.0f / pref_len, pref) : v2(1.0f, 0.0f));
     const float theta = atan2f(head.y, head.x);
@@ -971,12 +973,16 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
         const float rate = dist2 > 0.0f ? det(rp, rv) / dist2 : 0.0f; /* bearing rate, rad/s */
         const float thr = 0.6f * powf(fmaxf(ttc, 1e-3f), -1.5f);
         if (fabsf(rate) >= thr) continue; /* not a threat: it will pass */
-        /* a standing agent (under 0.1 m/s: parked, or waiting) slows the agent to a walk of
-         * 30% of pref_speed at most (ttc 0.85 s): it steps into it and the contact projection
-         * shoulders both aside, as people squeeze past those standing; a wall or a walker stops it */
-        const bool standing = agent && abs_sq(ovel) < 0.0625f;
-        if ((standing ? fmaxf(ttc, VISION_STAND_TTC) : ttc) < ttc_min) ttc_min = standing ? fmaxf(ttc, VISION_STAND_TTC) : ttc;
-        if (standing) continue; /* and does not turn it: the way to the goal goes through */
+        /* an agent standing or shuffling (under VISION_STAND_SPEED: parked, or jostled on its
+         * place) slows the agent to 30% of pref_speed at most (ttc 0.845 s) and does not turn
+         * it: it steps on through, and the contact projection shoulders both aside, as people
+         * squeeze past those standing (a parked block is otherwise a wall the agent walks
+         * along and never enters); a wall or a walker can stop it */
+        const bool standing = agent && abs_sq(ovel) < VISION_STAND_SPEED * VISION_STAND_SPEED &&
+                              dot(ovel, rp) >= -0.05f * dist;
+        const float ttc_slow = standing ? fmaxf(ttc, VISION_STAND_TTC) : ttc;
+        if (ttc_slow < ttc_min) ttc_min = ttc_slow;
+        if (standing) continue;
         /* Turning the heading by delta changes this bearing rate by about -k delta, with
          * k = (own speed) cos(angle to the point) / distance: keep the rate's sign and lift
          * it over the threshold (points beside or behind do not respond to a turn). */
