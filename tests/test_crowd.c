@@ -938,7 +938,7 @@ int main(void) {
     AK_RUN(groups_crossing);
     AK_RUN(obstacle_square);
     AK_RUN(vision_head_on_and_crossing);
-    AK_RUN(vision_presets_home);
+    AK_RUN_HEAVY(vision_presets_home); /* valgrind: 8 s; vision_head_on_and_crossing steps the same code */
     AK_RUN(lp_vs_brute_force);
     AK_RUN(step_velocity_is_lp_optimum);
     AK_RUN(threads_bit_identical);
