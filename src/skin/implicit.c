@@ -34,6 +34,8 @@
 #define CONTACT_SMOOTH 8 /* smoothing rounds of the contact region */
 #define PAIR_FRAME 20 /* per joint and frame: posed centre (3), contact normal (3), folded flag, pad,
                         inner direction (3), pad, posed axis of part i (3), pad, of part j (3), pad */
+#define CULL_FLOATS 8 /* per bone and frame: capsule end a(3), b - a (3), 1 / |b - a|^2, squared
+                         distance from the segment past which the grid's field is 0 (0: no cull) */
 #define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
 
 struct ak_skin_implicit {
@@ -197,8 +199,10 @@ static inline float compact(float r, float d, ak_vec3 g, ak_vec3* out_g) {
 /* Distance of bone b at bind-space point y and its gradient, from the bone's grid when the
  * object has grids (trilinear interpolation of the stored HRBF distance and gradient: the
  * paper's 3D textures), else directly; false outside the grid's box or the bounding sphere
- * (the field is 0 there). */
-static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, float* out_d, ak_vec3* out_g) {
+ * (the field is 0 there), and false as well where cull (CULL_FLOATS, or NULL) shows that the
+ * interpolated distance is at least the support radius (the field is 0 there too; cull_build). */
+static inline bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, const float* cull, float* out_d,
+                                      ak_vec3* out_g) {
     if (o->grid_nodes == 0) return bone_distance(o, b, y, out_d, out_g);
     const uint32_t* I = o->grid_info + b * GRID_INFO;
     const float* B = o->bones + b * BONE_FLOATS + GRID_AT;
@@ -207,6 +211,16 @@ static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, f
     if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= (float)(nx - 1) && py <= (float)(ny - 1) &&
           pz <= (float)(nz - 1)) || nx < 2)
         return false;
+    if (cull && cull[7] > 0.0f) {
+        /* the capsule bound (cull_build): field 0 this far from the capsule's segment */
+        const float ax = y.x - cull[0], ay = y.y - cull[1], az = y.z - cull[2];
+        float t = (ax * cull[3] + ay * cull[4] + az * cull[5]) * cull[6];
+        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+        const float wx = ax - cull[3] * t, wy = ay - cull[4] * t, wz = az - cull[5] * t;
+        if (wx * wx + wy * wy + wz * wz >= cull[7]) {
+            return false;
+        }
+    }
     uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
     if (ix > nx - 2) ix = nx - 2;
     if (iy > ny - 2) iy = ny - 2;
@@ -232,11 +246,11 @@ static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, f
 }
 
 /* The compact-support field of bone b from bone_distance_fast. */
-static float bone_field_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, ak_vec3* out_g) {
+static inline float bone_field_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, const float* cull, ak_vec3* out_g) {
     float d;
     ak_vec3 g;
     *out_g = ak_vec3_zero();
-    if (!bone_distance_fast(o, b, y, &d, &g)) return 0.0f;
+    if (!bone_distance_fast(o, b, y, cull, &d, &g)) return 0.0f;
     return compact(o->bones[b * BONE_FLOATS + 8], d, g, out_g);
 }
 
@@ -258,6 +272,7 @@ typedef struct field_ctx {
     const float* inv; /* [joint_count * 12] or NULL (bind pose) */
     float bulge;
     const broad_phase* bp; /* optional: skips bones whose box does not hold the point */
+    const float* cull;     /* optional: [joint_count * CULL_FLOATS], cull_build's capsule bounds */
 } field_ctx;
 
 typedef struct field_acc {
@@ -274,7 +289,7 @@ static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc*
         y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
                          m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
     ak_vec3 gy;
-    float f = bone_field_fast(o, b, y, &gy);
+    float f = bone_field_fast(o, b, y, c->cull ? c->cull + CULL_FLOATS * b : NULL, &gy);
     if (f <= 0.0f) return;
     /* gradient in posed space: (M^-1)^T gy */
     ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
@@ -995,7 +1010,7 @@ ak_result ak_skin_implicit_create(const ak_skin_implicit_desc* desc, const ak_al
             if (o->bones[b * BONE_FLOATS + 10] != 0.0f) rsum += o->bones[b * BONE_FLOATS + 8], ++rn;
         o->step_cap = rn ? (float)(0.5 * rsum / (double)rn) : 0.0f;
         o->bulge = d.bulge > 0.0f ? d.bulge : 0.0f;
-        field_ctx fc = {o, NULL, o->bulge, NULL};
+        field_ctx fc = {o, NULL, o->bulge, NULL, NULL};
         for (size_t v = 0; v < nv; ++v) {
             ak_vec3 g;
             o->iso[v] = o->rep[v] == v ? field_eval(&fc, o->positions[v], &g) : o->iso[o->rep[v]];
@@ -1070,7 +1085,7 @@ float ak_skin_implicit_field(const ak_skin_implicit* implicit, ak_mat4_cspan pal
             ok = inv && palette.count >= implicit->joint_count && invert_palette(implicit, palette.ptr, inv);
         }
         if (ok) {
-            field_ctx fc = {implicit, inv, implicit->bulge, NULL};
+            field_ctx fc = {implicit, inv, implicit->bulge, NULL, NULL};
             f = field_eval(&fc, x, &g);
         }
         if (inv && inv != stack_inv) free(inv);
@@ -1324,6 +1339,34 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, uint64_t
     }
 }
 
+/* The capsule bounds of the grids' fields (CULL_FLOATS per bone, bind space). A node stores
+ * max(HRBF, capsule distance) inside the bone's bounding sphere and the support radius outside
+ * it, so at least min(capsule distance, support radius); the capsule distance is 1-Lipschitz, so
+ * at a point farther than the support radius plus a cell diagonal from the capsule every corner
+ * of its cell holds at least the support radius, and so does their interpolation: field 0. */
+static void cull_build(const ak_skin_implicit* o, float* cull) {
+    for (size_t b = 0; b < o->joint_count; ++b) {
+        float* C = cull + b * CULL_FLOATS;
+        memset(C, 0, CULL_FLOATS * sizeof(float));
+        const float* B = o->bones + b * BONE_FLOATS;
+        const uint32_t* I = o->grid_info + b * GRID_INFO;
+        if (B[10] == 0.0f || I[0] < 2 || !(B[GRID_AT + 3] > 0.0f)) continue;
+        const float* K = B + CAPSULE_AT;
+        const float r = B[8], h = 1.0f / B[GRID_AT + 3];
+        float scale = fmaxf(K[6], r);
+        for (int q = 0; q < 6; ++q) scale = fmaxf(scale, fabsf(K[q]));
+        const float margin = 1e-3f * r + 1e-5f * scale;
+        const ak_vec3 a = ak_vec3_make(K[0], K[1], K[2]), e = ak_vec3_make(K[3], K[4], K[5]);
+        if (!(r > 0.0f)) continue;
+        const ak_vec3 ab = ak_vec3_sub(e, a);
+        const float l2 = ak_vec3_dot(ab, ab), reach = K[6] + r + 1.7321f * h + margin;
+        C[0] = a.x, C[1] = a.y, C[2] = a.z, C[3] = ab.x, C[4] = ab.y, C[5] = ab.z;
+        C[6] = l2 > 0.0f ? 1.0f / l2 : 0.0f;
+        C[7] = reach * reach;
+        if (!ak_finitef(C[6]) || !ak_finitef(C[7])) memset(C, 0, CULL_FLOATS * sizeof(float));
+    }
+}
+
 size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count) {
     if (!implicit) return 0;
     ak_mat4 probe;
@@ -1331,7 +1374,8 @@ size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t pa
     size_t nv = implicit->vertex_count;
     return 64 + align64(implicit->joint_count * 12 * sizeof(float)) + align64(ak_skin_job_scratch_size(&dq)) +
            align64(nv) + 3 * align64(nv * sizeof(ak_vec3)) + align64(bp_mask_bytes(implicit)) +
-           align64(implicit->pair_count * PAIR_FRAME * sizeof(float));
+           align64(implicit->pair_count * PAIR_FRAME * sizeof(float)) + align64(implicit->joint_count * CULL_FLOATS * sizeof(float)) +
+           align64(nv * sizeof(uint32_t)) + align64(nv) + align64(implicit->triangle_count * sizeof(uint32_t));
 }
 
 enum { ST_KEEP = 0, ST_MOVED = 1, ST_STOPPED = 2, ST_CONTACT = 8 };
@@ -1474,20 +1518,49 @@ static bool projectable(float iso) { return iso > 0.02f && iso < 0.98f; }
  * vertices excepted), by the amount that brings the enclosed volume back to the rest volume
  * (Newton steps on the linearised volume; each vertex's move capped at a seam radius). Serial,
  * so the result does not depend on the thread count. grad is scratch for nv vectors. */
-static void keep_volume(const run_ctx* c, ak_vec3* grad) {
+static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t* flag, uint32_t* tris) {
     const ak_skin_implicit* o = c->o;
     ak_vec3* pos = c->pos;
     const size_t nv = o->vertex_count;
+    /* the vertices that may move (welded representatives near a folded joint of their part,
+     * in index order) and the triangles that touch them; the others keep their volume */
+    size_t nl = 0, nt = 0;
+    for (size_t v = 0; v < nv; ++v) {
+        flag[v] = 0;
+        if (o->rep[v] != v || (c->state[v] & ST_CONTACT) || !projectable(o->iso[v])) continue;
+        for (size_t p = 0; p < o->pair_count; ++p) {
+            const float* P = o->pairs + p * PAIR_FLOATS;
+            if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
+            if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
+            float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
+            if (1.0f - dist / (BULGE_REACH * P[12]) > 0.0f) {
+                flag[v] = 1, list[nl++] = (uint32_t)v;
+                break;
+            }
+        }
+    }
+    if (nl == 0) return;
+    double fixed = 0.0;
+    for (size_t t = 0; t < o->triangle_count; ++t) {
+        const uint32_t* ix = o->indices + 3 * t;
+        uint32_t ra = o->rep[ix[0]], rb = o->rep[ix[1]], rd = o->rep[ix[2]];
+        if (flag[ra] | flag[rb] | flag[rd]) {
+            tris[nt++] = (uint32_t)t;
+            continue;
+        }
+        fixed += (double)ak_vec3_dot(pos[ra], ak_vec3_cross(pos[rb], pos[rd])) / 6.0;
+    }
     for (int it = 0; it < 3; ++it) {
-        for (size_t v = 0; v < nv; ++v)
-            if (o->rep[v] != v) pos[v] = pos[o->rep[v]];
-        double vol = 0.0;
-        memset(grad, 0, nv * sizeof(ak_vec3));
-        for (size_t t = 0; t < o->triangle_count; ++t) {
-            const uint32_t* ix = o->indices + 3 * t;
-            ak_vec3 a = pos[ix[0]], b = pos[ix[1]], d = pos[ix[2]];
-            vol += (double)ak_vec3_dot(a, ak_vec3_cross(b, d)) / 6.0;
+        double vol = fixed;
+        for (size_t i = 0; i < nt; ++i) {
+            const uint32_t* ix = o->indices + 3 * tris[i];
+            grad[o->rep[ix[0]]] = grad[o->rep[ix[1]]] = grad[o->rep[ix[2]]] = ak_vec3_zero();
+        }
+        for (size_t i = 0; i < nt; ++i) {
+            const uint32_t* ix = o->indices + 3 * tris[i];
             uint32_t ra = o->rep[ix[0]], rb = o->rep[ix[1]], rd = o->rep[ix[2]];
+            ak_vec3 a = pos[ra], b = pos[rb], d = pos[rd];
+            vol += (double)ak_vec3_dot(a, ak_vec3_cross(b, d)) / 6.0;
             grad[ra] = ak_vec3_add(grad[ra], ak_vec3_scale(ak_vec3_cross(b, d), 1.0f / 6.0f));
             grad[rb] = ak_vec3_add(grad[rb], ak_vec3_scale(ak_vec3_cross(d, a), 1.0f / 6.0f));
             grad[rd] = ak_vec3_add(grad[rd], ak_vec3_scale(ak_vec3_cross(a, b), 1.0f / 6.0f));
@@ -1498,8 +1571,8 @@ static void keep_volume(const run_ctx* c, ak_vec3* grad) {
         for (int pass = 0; pass < 2; ++pass) {
             const float k = pass ? (float)(dv / sum) : 0.0f;
             if (pass && !(sum > 0.0 && isfinite(k))) break;
-            for (size_t v = 0; v < nv; ++v) {
-                if (o->rep[v] != v || (c->state[v] & ST_CONTACT) || !projectable(o->iso[v])) continue;
+            for (size_t i = 0; i < nl; ++i) {
+                const size_t v = list[i];
                 float w = 0.0f, cap = 0.0f;
                 ak_vec3 dir = ak_vec3_zero();
                 for (size_t p = 0; p < o->pair_count; ++p) {
@@ -1570,8 +1643,22 @@ static bool rigid_alone(const run_ctx* c, size_t v) {
     return true;
 }
 
+/* Whether contact_vertex can act on vertex v: a joint of its part is folded and v lies within
+ * the joint's reach at the bind pose. */
+static bool near_fold(const run_ctx* c, size_t v) {
+    const ak_skin_implicit* o = c->o;
+    const uint32_t part = o->part[v];
+    for (size_t p = 0; p < o->pair_count; ++p) {
+        const float* P = o->pairs + p * PAIR_FLOATS;
+        if (c->frame[p * PAIR_FRAME + 6] == 0.0f || ((uint32_t)P[0] != part && (uint32_t)P[1] != part)) continue;
+        if (ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4]))) < P[11]) return true;
+    }
+    return false;
+}
+
 typedef struct run_task {
     run_ctx* c;
+    const uint32_t* list; /* the vertices to visit, or NULL: all */
     size_t begin, end;
     int phase; /* 0 first projection, 1 relax, 2 re-projection, 3 contact */
 } run_task;
@@ -1580,7 +1667,8 @@ static void* run_worker(void* arg) {
     run_task* t = (run_task*)arg;
     run_ctx* c = t->c;
     const ak_skin_implicit* o = c->o;
-    for (size_t v = t->begin; v < t->end; ++v) {
+    for (size_t i = t->begin; i < t->end; ++i) {
+        const size_t v = t->list ? t->list[i] : i;
         if (o->rep[v] != v || !projectable(o->iso[v])) continue;
         if (t->phase == 0) {
             if (rigid_alone(c, v)) continue; /* kept: exactly at its iso-value already */
@@ -1618,10 +1706,9 @@ static void* run_worker(void* arg) {
     return NULL;
 }
 
-static void run_phase(run_ctx* c, int phase, uint32_t threads) {
+static void run_phase(run_ctx* c, int phase, uint32_t threads, const uint32_t* list, size_t n) {
     run_task tasks[64];
-    size_t n = c->o->vertex_count;
-    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (run_task){c, n * t / threads, n * (t + 1) / threads, phase};
+    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (run_task){c, list, n * t / threads, n * (t + 1) / threads, phase};
     akp_run_tasks(run_worker, tasks, sizeof tasks[0], threads);
 }
 
@@ -1653,6 +1740,14 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     base += align64(nv * sizeof(ak_vec3));
     float* frame = (float*)(void*)base;
     base += align64(o->pair_count * PAIR_FRAME * sizeof(float));
+    float* cull = (float*)(void*)base;
+    base += align64(o->joint_count * CULL_FLOATS * sizeof(float));
+    uint32_t* list = (uint32_t*)(void*)base;
+    base += align64(nv * sizeof(uint32_t));
+    uint8_t* flag = base;
+    base += align64(nv);
+    uint32_t* tris = (uint32_t*)(void*)base;
+    base += align64(o->triangle_count * sizeof(uint32_t));
     uint64_t* mask = (uint64_t*)(void*)base;
     if (!invert_palette(o, job->palette.ptr, inv)) return AK_ERR_BAD_DATA;
     const uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
@@ -1678,27 +1773,37 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     memset(state, 0, nv);
     broad_phase bp;
     if (o->grid_nodes) bp_build(o, job->palette.ptr, mask, &bp);
-    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame};
+    if (o->grid_nodes) cull_build(o, cull);
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? cull : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame};
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
-    run_phase(&c, 0, threads);
+    run_phase(&c, 0, threads, NULL, nv);
     uint32_t rounds = job->relax_rounds == 0 ? 3 : job->relax_rounds == UINT32_MAX ? 0 : job->relax_rounds;
     if (rounds > 64) rounds = 64;
     for (uint32_t k = 0; k < rounds; ++k) {
         memcpy(prev, pos, nv * sizeof(ak_vec3));
-        run_phase(&c, 1, threads);
-        run_phase(&c, 2, threads);
+        run_phase(&c, 1, threads, NULL, nv);
+        run_phase(&c, 2, threads, NULL, nv);
     }
     if (o->pair_count) {
         bool contact = false;
         contact_frames(o, job->palette.ptr, frame);
         for (size_t p = 0; p < o->pair_count; ++p) contact = contact || frame[p * PAIR_FRAME + 6] != 0.0f;
         if (contact) {
-            run_phase(&c, 3, threads);
+            /* phase 3 visits the vertices near a folded joint of their part, phase 4 those it
+             * touched (only they move there, so prev needs only their copies after the first) */
+            size_t nl = 0, nc = 0;
+            for (size_t v = 0; v < nv; ++v)
+                if (o->rep[v] == v && projectable(o->iso[v]) && near_fold(&c, v)) list[nl++] = (uint32_t)v;
+            run_phase(&c, 3, threads, list, nl);
+            for (size_t i = 0; i < nl; ++i)
+                if (state[list[i]] & ST_CONTACT) list[nc++] = list[i];
+            memcpy(prev, pos, nv * sizeof(ak_vec3));
             for (int k = 0; k < CONTACT_SMOOTH; ++k) {
-                memcpy(prev, pos, nv * sizeof(ak_vec3));
-                run_phase(&c, 4, threads);
+                if (k)
+                    for (size_t i = 0; i < nc; ++i) prev[list[i]] = pos[list[i]];
+                run_phase(&c, 4, threads, list, nc);
             }
-            if (o->closed) keep_volume(&c, prev);
+            if (o->closed) keep_volume(&c, prev, list, flag, tris);
         }
     }
     size_t moved = 0;
