@@ -1290,8 +1290,13 @@ static size_t bp_mask_bytes(const ak_skin_implicit* o) {
     return c * c * c * ((o->joint_count + 63) / 64) * sizeof(uint64_t);
 }
 
-/* The posed boxes of the grids (palette: bind to posed) into the broad phase's cells. */
-static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, uint64_t* mask, broad_phase* bp) {
+/* The posed boxes of the grids (palette: bind to posed) into the broad phase's cells; with cull
+ * (cull_build's bounds) and inv (the inverse palette), a cell whose every point lies past a
+ * bone's capsule bound (its centre's bind-space distance from the capsule's segment exceeds the
+ * bound plus the cell's half diagonal times the inverse's norm) leaves the bone out, as the
+ * bound would at every point of the cell. */
+static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const float* inv, const float* cull, uint64_t* mask,
+                     broad_phase* bp) {
     const uint32_t cells = bp_cells(o);
     const size_t words = (o->joint_count + 63) / 64;
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
@@ -1323,10 +1328,34 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, uint64_t
                 z[q] = pz > 0.0f ? (pz < (float)cells ? (uint32_t)pz : cells - 1) : 0;
             }
             const uint64_t bit = (uint64_t)1 << (b & 63);
+            const float* C = cull ? cull + b * CULL_FLOATS : NULL;
+            const float* M = inv + 12 * b;
+            float reach2 = 0.0f;
+            if (C && C[7] > 0.0f) {
+                float fro = 0.0f, diag = 0.0f;
+                for (int q = 0; q < 9; ++q) fro += M[q] * M[q];
+                for (int q = 0; q < 3; ++q) diag += 1.0f / (bp->inv_cell[q] * bp->inv_cell[q]);
+                const float reach = sqrtf(C[7]) + sqrtf(fro) * 0.5f * sqrtf(diag) * 1.001f;
+                reach2 = reach * reach;
+                if (!ak_finitef(reach2)) reach2 = 0.0f;
+            }
             for (uint32_t k = a[2]; k <= z[2]; ++k)
                 for (uint32_t j = a[1]; j <= z[1]; ++j)
-                    for (uint32_t i = a[0]; i <= z[0]; ++i)
+                    for (uint32_t i = a[0]; i <= z[0]; ++i) {
+                        if (reach2 > 0.0f) {
+                            const float x = bp->lo[0] + ((float)i + 0.5f) / bp->inv_cell[0];
+                            const float y = bp->lo[1] + ((float)j + 0.5f) / bp->inv_cell[1];
+                            const float zz = bp->lo[2] + ((float)k + 0.5f) / bp->inv_cell[2];
+                            const float ax = M[0] * x + M[3] * y + M[6] * zz + M[9] - C[0];
+                            const float ay = M[1] * x + M[4] * y + M[7] * zz + M[10] - C[1];
+                            const float az = M[2] * x + M[5] * y + M[8] * zz + M[11] - C[2];
+                            float t = (ax * C[3] + ay * C[4] + az * C[5]) * C[6];
+                            t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+                            const float wx = ax - C[3] * t, wy = ay - C[4] * t, wz = az - C[5] * t;
+                            if (wx * wx + wy * wy + wz * wz > reach2) continue;
+                        }
                         mask[((size_t)i + cells * ((size_t)j + (size_t)cells * k)) * words + b / 64] |= bit;
+                    }
         }
         if (pass == 0) {
             if (!(lo[0] <= hi[0]) || !ak_finitef(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2])) return;
@@ -1375,7 +1404,8 @@ size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t pa
     return 64 + align64(implicit->joint_count * 12 * sizeof(float)) + align64(ak_skin_job_scratch_size(&dq)) +
            align64(nv) + 3 * align64(nv * sizeof(ak_vec3)) + align64(bp_mask_bytes(implicit)) +
            align64(implicit->pair_count * PAIR_FRAME * sizeof(float)) + align64(implicit->joint_count * CULL_FLOATS * sizeof(float)) +
-           align64(nv * sizeof(uint32_t)) + align64(nv) + align64(implicit->triangle_count * sizeof(uint32_t));
+           align64(nv * sizeof(uint32_t)) + align64(nv) + align64(implicit->triangle_count * sizeof(uint32_t)) +
+           align64(nv * sizeof(uint32_t)) + align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(nv * 8 * sizeof(float));
 }
 
 enum { ST_KEEP = 0, ST_MOVED = 1, ST_STOPPED = 2, ST_CONTACT = 8 };
@@ -1518,7 +1548,7 @@ static bool projectable(float iso) { return iso > 0.02f && iso < 0.98f; }
  * vertices excepted), by the amount that brings the enclosed volume back to the rest volume
  * (Newton steps on the linearised volume; each vertex's move capped at a seam radius). Serial,
  * so the result does not depend on the thread count. grad is scratch for nv vectors. */
-static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t* flag, uint32_t* tris) {
+static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t* flag, uint32_t* tris, float* cache) {
     const ak_skin_implicit* o = c->o;
     ak_vec3* pos = c->pos;
     const size_t nv = o->vertex_count;
@@ -1567,49 +1597,54 @@ static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t
         }
         const double dv = (double)o->rest_volume - vol;
         if (!isfinite(dv) || fabs(dv) < 1e-4 * (double)o->rest_volume) break;
+        /* the weight, cap and direction of each vertex (from its own position, which only its
+         * own step changes), then the steps that sum to the missing volume */
         double sum = 0.0;
-        for (int pass = 0; pass < 2; ++pass) {
-            const float k = pass ? (float)(dv / sum) : 0.0f;
-            if (pass && !(sum > 0.0 && isfinite(k))) break;
-            for (size_t i = 0; i < nl; ++i) {
-                const size_t v = list[i];
-                float w = 0.0f, cap = 0.0f;
-                ak_vec3 dir = ak_vec3_zero();
-                for (size_t p = 0; p < o->pair_count; ++p) {
-                    const float* P = o->pairs + p * PAIR_FLOATS;
-                    if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
-                    if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
-                    const float* F = c->frame + p * PAIR_FRAME;
-                    /* the inner side of the fold only (where the parts press together),
-                     * fading in over a seam radius */
-                    float inner = ak_vec3_dot(ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2])), ak_vec3_make(F[8], F[9], F[10])) / P[12];
-                    if (!(inner > 0.0f)) continue;
-                    inner = inner < 1.0f ? inner * inner * (3.0f - 2.0f * inner) : 1.0f;
-                    float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
-                    float u = 1.0f - dist / (BULGE_REACH * P[12]);
-                    if (u > 0.0f && inner * u * u > w) {
-                        /* away from the part's posed axis (a smooth direction, unlike the
-                         * per-vertex volume gradient of a crumpled surface) */
-                        ak_vec3 a = (uint32_t)P[0] == o->part[v] ? ak_vec3_make(F[12], F[13], F[14])
-                                                                 : ak_vec3_make(F[16], F[17], F[18]);
-                        ak_vec3 rel = ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2]));
-                        ak_vec3 rad = ak_vec3_normalize(ak_vec3_sub(rel, ak_vec3_scale(a, ak_vec3_dot(rel, a))));
-                        if (!ak_vec3_is_finite(rad)) continue;
-                        w = inner * u * u, cap = P[12], dir = rad;
-                    }
+        for (size_t i = 0; i < nl; ++i) {
+            const size_t v = list[i];
+            float w = 0.0f, cap = 0.0f;
+            ak_vec3 dir = ak_vec3_zero();
+            for (size_t p = 0; p < o->pair_count; ++p) {
+                const float* P = o->pairs + p * PAIR_FLOATS;
+                if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
+                if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
+                const float* F = c->frame + p * PAIR_FRAME;
+                /* the inner side of the fold only (where the parts press together),
+                 * fading in over a seam radius */
+                float inner = ak_vec3_dot(ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2])), ak_vec3_make(F[8], F[9], F[10])) / P[12];
+                if (!(inner > 0.0f)) continue;
+                inner = inner < 1.0f ? inner * inner * (3.0f - 2.0f * inner) : 1.0f;
+                float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
+                float u = 1.0f - dist / (BULGE_REACH * P[12]);
+                if (u > 0.0f && inner * u * u > w) {
+                    /* away from the part's posed axis (a smooth direction, unlike the
+                     * per-vertex volume gradient of a crumpled surface) */
+                    ak_vec3 a = (uint32_t)P[0] == o->part[v] ? ak_vec3_make(F[12], F[13], F[14])
+                                                             : ak_vec3_make(F[16], F[17], F[18]);
+                    ak_vec3 rel = ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2]));
+                    ak_vec3 rad = ak_vec3_normalize(ak_vec3_sub(rel, ak_vec3_scale(a, ak_vec3_dot(rel, a))));
+                    if (!ak_vec3_is_finite(rad)) continue;
+                    w = inner * u * u, cap = P[12], dir = rad;
                 }
-                if (w == 0.0f) continue;
-                const float e = ak_vec3_dot(grad[v], dir); /* volume change per unit move */
-                if (!(e > 0.0f) || !ak_finitef(e)) continue;
-                if (!pass) {
-                    sum += (double)w * e;
-                    continue;
-                }
-                float step = k * w;
-                step = ak_clampf(step, -cap, cap);
-                ak_vec3 q = ak_vec3_add(pos[v], ak_vec3_scale(dir, step));
-                if (ak_vec3_is_finite(q)) pos[v] = q, c->state[v] |= ST_MOVED;
             }
+            float* W = cache + 8 * i;
+            W[0] = 0.0f;
+            if (w == 0.0f) continue;
+            const float e = ak_vec3_dot(grad[v], dir); /* volume change per unit move */
+            if (!(e > 0.0f) || !ak_finitef(e)) continue;
+            sum += (double)w * e;
+            W[0] = w, W[1] = cap, W[2] = dir.x, W[3] = dir.y, W[4] = dir.z;
+        }
+        const float k = (float)(dv / sum);
+        if (!(sum > 0.0 && isfinite(k))) break;
+        for (size_t i = 0; i < nl; ++i) {
+            const float* W = cache + 8 * i;
+            if (W[0] == 0.0f) continue;
+            const size_t v = list[i];
+            float step = k * W[0];
+            step = ak_clampf(step, -W[1], W[1]);
+            ak_vec3 q = ak_vec3_add(pos[v], ak_vec3_scale(ak_vec3_make(W[2], W[3], W[4]), step));
+            if (ak_vec3_is_finite(q)) pos[v] = q, c->state[v] |= ST_MOVED;
         }
     }
 }
@@ -1706,6 +1741,23 @@ static void* run_worker(void* arg) {
     return NULL;
 }
 
+/* The projectable welded representatives into order, grouped by part (counting sort; index
+ * order within a part); returns their number. counts: joint_count + 1 scratch. */
+static size_t order_by_part(const ak_skin_implicit* o, uint32_t* order, uint32_t* counts) {
+    const size_t nv = o->vertex_count, nj = o->joint_count;
+    memset(counts, 0, (nj + 1) * sizeof(uint32_t));
+    for (size_t v = 0; v < nv; ++v)
+        if (o->rep[v] == v && projectable(o->iso[v])) ++counts[o->part[v] < nj ? o->part[v] : nj];
+    uint32_t at = 0;
+    for (size_t j = 0; j <= nj; ++j) {
+        const uint32_t n = counts[j];
+        counts[j] = at, at += n;
+    }
+    for (size_t v = 0; v < nv; ++v)
+        if (o->rep[v] == v && projectable(o->iso[v])) order[counts[o->part[v] < nj ? o->part[v] : nj]++] = (uint32_t)v;
+    return at;
+}
+
 static void run_phase(run_ctx* c, int phase, uint32_t threads, const uint32_t* list, size_t n) {
     run_task tasks[64];
     for (uint32_t t = 0; t < threads; ++t) tasks[t] = (run_task){c, list, n * t / threads, n * (t + 1) / threads, phase};
@@ -1748,6 +1800,12 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     base += align64(nv);
     uint32_t* tris = (uint32_t*)(void*)base;
     base += align64(o->triangle_count * sizeof(uint32_t));
+    uint32_t* order = (uint32_t*)(void*)base;
+    base += align64(nv * sizeof(uint32_t));
+    uint32_t* counts = (uint32_t*)(void*)base;
+    base += align64((o->joint_count + 1) * sizeof(uint32_t));
+    float* vcache = (float*)(void*)base;
+    base += align64(nv * 8 * sizeof(float));
     uint64_t* mask = (uint64_t*)(void*)base;
     if (!invert_palette(o, job->palette.ptr, inv)) return AK_ERR_BAD_DATA;
     const uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
@@ -1772,17 +1830,21 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     ak_vec3* pos = job->out_positions.ptr;
     memset(state, 0, nv);
     broad_phase bp;
-    if (o->grid_nodes) bp_build(o, job->palette.ptr, mask, &bp);
     if (o->grid_nodes) cull_build(o, cull);
+    if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
     run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? cull : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame};
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
-    run_phase(&c, 0, threads, NULL, nv);
+    /* the projectable representatives grouped by part (counting sort, index order within a
+     * part), so that consecutive projections read the same grids (each vertex's projection
+     * is independent of the others': the order changes no result) */
+    const size_t np = order_by_part(o, order, counts);
+    run_phase(&c, 0, threads, order, np);
     uint32_t rounds = job->relax_rounds == 0 ? 3 : job->relax_rounds == UINT32_MAX ? 0 : job->relax_rounds;
     if (rounds > 64) rounds = 64;
     for (uint32_t k = 0; k < rounds; ++k) {
         memcpy(prev, pos, nv * sizeof(ak_vec3));
-        run_phase(&c, 1, threads, NULL, nv);
-        run_phase(&c, 2, threads, NULL, nv);
+        run_phase(&c, 1, threads, order, np);
+        run_phase(&c, 2, threads, order, np);
     }
     if (o->pair_count) {
         bool contact = false;
@@ -1803,7 +1865,7 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
                     for (size_t i = 0; i < nc; ++i) prev[list[i]] = pos[list[i]];
                 run_phase(&c, 4, threads, list, nc);
             }
-            if (o->closed) keep_volume(&c, prev, list, flag, tris);
+            if (o->closed) keep_volume(&c, prev, list, flag, tris, vcache);
         }
     }
     size_t moved = 0;
