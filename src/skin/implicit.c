@@ -303,6 +303,95 @@ static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc*
     }
 }
 
+/* One bone's grid cell for a point (field_eval's grid path): the first corner node, the
+ * strides, the fractions, the support radius and the inverse palette matrix (NULL: bind pose). */
+typedef struct grid_probe {
+    const float* n000;
+    const float* m;
+    size_t sy, sz; /* floats */
+    float tx, ty, tz, r;
+} grid_probe;
+
+static inline void prefetch_node(const float* p) {
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + 7);
+#else
+    (void)p;
+#endif
+}
+
+/* The cell of bone b's grid holding point x (posed) into *q, its nodes prefetched; false
+ * where bone_distance_fast would be (the field is 0). Split from the interpolation so that
+ * field_eval locates (and prefetches) every bone of a point before interpolating any. */
+static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_probe* q) {
+    const ak_skin_implicit* o = c->o;
+    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return false;
+    ak_vec3 y = x;
+    const float* m = c->inv ? c->inv + 12 * b : NULL;
+    if (m)
+        y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
+                         m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
+    const uint32_t* I = o->grid_info + b * GRID_INFO;
+    const float* B = o->bones + b * BONE_FLOATS + GRID_AT;
+    const uint32_t nx = I[0], ny = I[1], nz = I[2];
+    float px = (y.x - B[0]) * B[3], py = (y.y - B[1]) * B[3], pz = (y.z - B[2]) * B[3];
+    if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= (float)(nx - 1) && py <= (float)(ny - 1) &&
+          pz <= (float)(nz - 1)) || nx < 2)
+        return false;
+    const float* cull = c->cull ? c->cull + CULL_FLOATS * b : NULL;
+    if (cull && cull[7] > 0.0f) {
+        const float ax = y.x - cull[0], ay = y.y - cull[1], az = y.z - cull[2];
+        float t = (ax * cull[3] + ay * cull[4] + az * cull[5]) * cull[6];
+        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+        const float wx = ax - cull[3] * t, wy = ay - cull[4] * t, wz = az - cull[5] * t;
+        if (wx * wx + wy * wy + wz * wz >= cull[7]) return false;
+    }
+    uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
+    if (ix > nx - 2) ix = nx - 2;
+    if (iy > ny - 2) iy = ny - 2;
+    if (iz > nz - 2) iz = nz - 2;
+    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
+    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
+    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+    q->m = m;
+    q->r = o->bones[b * BONE_FLOATS + 8];
+    prefetch_node(q->n000);
+    prefetch_node(q->n000 + q->sy);
+    prefetch_node(q->n000 + q->sz);
+    prefetch_node(q->n000 + q->sz + q->sy);
+    return true;
+}
+
+/* The located cell's field (the trilinear interpolation and compact map of bone_field_fast,
+ * then field_add's gradient transform) into the two strongest. */
+static inline void grid_apply(const grid_probe* q, field_acc* a) {
+    const float *n000 = q->n000, *n010 = n000 + q->sy, *n001 = n000 + q->sz, *n011 = n001 + q->sy;
+    const float tx = q->tx, ty = q->ty, tz = q->tz;
+    float r[4];
+    for (int k = 0; k < 4; ++k) {
+        float a0 = n000[k] + tx * (n000[4 + k] - n000[k]);
+        float bq = n010[k] + tx * (n010[4 + k] - n010[k]);
+        float cq = n001[k] + tx * (n001[4 + k] - n001[k]);
+        float dq = n011[k] + tx * (n011[4 + k] - n011[k]);
+        float e = a0 + ty * (bq - a0), f = cq + ty * (dq - cq);
+        r[k] = e + tz * (f - e);
+    }
+    ak_vec3 gy;
+    const float f = compact(q->r, r[0], ak_vec3_make(r[1], r[2], r[3]), &gy);
+    if (f <= 0.0f) return;
+    const float* m = q->m;
+    ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
+                                 m[6] * gy.x + m[7] * gy.y + m[8] * gy.z)
+                  : gy;
+    if (f > a->f1) {
+        a->f2 = a->f1, a->g2 = a->g1;
+        a->f1 = f, a->g1 = g;
+    } else if (f > a->f2) {
+        a->f2 = f, a->g2 = g;
+    }
+}
+
 static float field_eval(const field_ctx* c, ak_vec3 x, ak_vec3* out_g) {
     const ak_skin_implicit* o = c->o;
     field_acc a = {0.0f, 0.0f, ak_vec3_zero(), ak_vec3_zero()};
@@ -317,8 +406,17 @@ static float field_eval(const field_ctx* c, ak_vec3 x, ak_vec3* out_g) {
         }
         size_t cell = (size_t)p[0] + bp->cells * ((size_t)p[1] + bp->cells * (size_t)p[2]);
         const uint64_t* mw = bp->mask + cell * bp->words;
+        /* with grids (the broad phase exists only then): locate every bone's cell first (their
+         * nodes load meanwhile), then interpolate, in the same bone order */
+        grid_probe probe[16];
+        unsigned n = 0;
         for (size_t w = 0; w < bp->words; ++w)
-            for (uint64_t bits = mw[w]; bits; bits &= bits - 1) field_add(c, 64 * w + (size_t)ctz64(bits), x, &a);
+            for (uint64_t bits = mw[w]; bits; bits &= bits - 1)
+                if (grid_locate(c, 64 * w + (size_t)ctz64(bits), x, &probe[n]) && ++n == 16) {
+                    for (unsigned k = 0; k < n; ++k) grid_apply(&probe[k], &a);
+                    n = 0;
+                }
+        for (unsigned k = 0; k < n; ++k) grid_apply(&probe[k], &a);
     } else {
         for (size_t b = 0; b < o->joint_count; ++b) field_add(c, b, x, &a);
     }
