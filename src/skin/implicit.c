@@ -20,7 +20,7 @@
 
 #define MAX_CAPS 16
 #define STOP_COS 0.57357643635f /* cos 55 degrees: the 2014 paper's discontinuity angle */
-#define ISO_EPS 1e-4f
+#define ISO_EPS 1e-3f /* |F - iso| that ends a projection: about 0.1 % of the support radius */
 #define CAPSULE_AT 12
 #define GRID_AT (CAPSULE_AT + 8)
 #define BONE_FLOATS (GRID_AT + 4) /* cx cy cz s | ax ay az b | r sphere2 valid pad |
