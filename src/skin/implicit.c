@@ -196,14 +196,20 @@ static inline float compact(float r, float d, ak_vec3 g, ak_vec3* out_g) {
     return t;
 }
 
-/* Distance of bone b at bind-space point y and its gradient, from the bone's grid when the
- * object has grids (trilinear interpolation of the stored HRBF distance and gradient: the
- * paper's 3D textures), else directly; false outside the grid's box or the bounding sphere
- * (the field is 0 there), and false as well where cull (CULL_FLOATS, or NULL) shows that the
- * interpolated distance is at least the support radius (the field is 0 there too; cull_build). */
-static inline bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, const float* cull, float* out_d,
-                                      ak_vec3* out_g) {
-    if (o->grid_nodes == 0) return bone_distance(o, b, y, out_d, out_g);
+/* One bone's grid cell for a point: the first corner node, the strides, the fractions, and
+ * for field_eval the support radius and the inverse palette matrix (NULL: bind pose). */
+typedef struct grid_probe {
+    const float* n000;
+    const float* m;
+    size_t sy, sz; /* floats */
+    float tx, ty, tz, r;
+} grid_probe;
+
+/* The cell of bone b's grid that holds bind-space point y into *q; false outside the grid's
+ * box (the field is 0 there), and false as well where cull (CULL_FLOATS, or NULL) shows that
+ * the interpolated distance is at least the support radius (the field is 0 there too;
+ * cull_build). */
+static inline bool grid_cell(const ak_skin_implicit* o, size_t b, ak_vec3 y, const float* cull, grid_probe* q) {
     const uint32_t* I = o->grid_info + b * GRID_INFO;
     const float* B = o->bones + b * BONE_FLOATS + GRID_AT;
     const uint32_t nx = I[0], ny = I[1], nz = I[2];
@@ -212,26 +218,26 @@ static inline bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_ve
           pz <= (float)(nz - 1)) || nx < 2)
         return false;
     if (cull && cull[7] > 0.0f) {
-        /* the capsule bound (cull_build): field 0 this far from the capsule's segment */
         const float ax = y.x - cull[0], ay = y.y - cull[1], az = y.z - cull[2];
         float t = (ax * cull[3] + ay * cull[4] + az * cull[5]) * cull[6];
         t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
         const float wx = ax - cull[3] * t, wy = ay - cull[4] * t, wz = az - cull[5] * t;
-        if (wx * wx + wy * wy + wz * wz >= cull[7]) {
-            return false;
-        }
+        if (wx * wx + wy * wy + wz * wz >= cull[7]) return false;
     }
     uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
     if (ix > nx - 2) ix = nx - 2;
     if (iy > ny - 2) iy = ny - 2;
     if (iz > nz - 2) iz = nz - 2;
-    const float tx = px - (float)ix, ty = py - (float)iy, tz = pz - (float)iz;
-    const size_t sy = nx, sz = (size_t)nx * ny;
-    const float* n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * sy + iz * sz);
-    const float* n010 = n000 + 4 * sy;
-    const float* n001 = n000 + 4 * sz;
-    const float* n011 = n001 + 4 * sy;
-    float r[4];
+    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
+    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
+    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+    return true;
+}
+
+/* Trilinear interpolation of the 4 values per node (distance, gradient) of q's cell. */
+static inline void grid_interp(const grid_probe* q, float r[4]) {
+    const float *n000 = q->n000, *n010 = n000 + q->sy, *n001 = n000 + q->sz, *n011 = n001 + q->sy;
+    const float tx = q->tx, ty = q->ty, tz = q->tz;
     for (int k = 0; k < 4; ++k) {
         float a = n000[k] + tx * (n000[4 + k] - n000[k]);
         float bq = n010[k] + tx * (n010[4 + k] - n010[k]);
@@ -240,17 +246,29 @@ static inline bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_ve
         float e = a + ty * (bq - a), f = cq + ty * (dq - cq);
         r[k] = e + tz * (f - e);
     }
+}
+
+/* Distance of bone b at bind-space point y and its gradient, from the bone's grid when the
+ * object has grids (trilinear interpolation of the stored HRBF distance and gradient: the
+ * paper's 3D textures), else directly; false outside the grid's box or the bounding sphere
+ * (the field is 0 there). */
+static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, float* out_d, ak_vec3* out_g) {
+    if (o->grid_nodes == 0) return bone_distance(o, b, y, out_d, out_g);
+    grid_probe q;
+    if (!grid_cell(o, b, y, NULL, &q)) return false;
+    float r[4];
+    grid_interp(&q, r);
     *out_d = r[0];
     *out_g = ak_vec3_make(r[1], r[2], r[3]);
     return true;
 }
 
 /* The compact-support field of bone b from bone_distance_fast. */
-static inline float bone_field_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, const float* cull, ak_vec3* out_g) {
+static float bone_field_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, ak_vec3* out_g) {
     float d;
     ak_vec3 g;
     *out_g = ak_vec3_zero();
-    if (!bone_distance_fast(o, b, y, cull, &d, &g)) return 0.0f;
+    if (!bone_distance_fast(o, b, y, &d, &g)) return 0.0f;
     return compact(o->bones[b * BONE_FLOATS + 8], d, g, out_g);
 }
 
@@ -289,7 +307,7 @@ static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc*
         y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
                          m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
     ak_vec3 gy;
-    float f = bone_field_fast(o, b, y, c->cull ? c->cull + CULL_FLOATS * b : NULL, &gy);
+    float f = bone_field_fast(o, b, y, &gy);
     if (f <= 0.0f) return;
     /* gradient in posed space: (M^-1)^T gy */
     ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
@@ -303,15 +321,6 @@ static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc*
     }
 }
 
-/* One bone's grid cell for a point (field_eval's grid path): the first corner node, the
- * strides, the fractions, the support radius and the inverse palette matrix (NULL: bind pose). */
-typedef struct grid_probe {
-    const float* n000;
-    const float* m;
-    size_t sy, sz; /* floats */
-    float tx, ty, tz, r;
-} grid_probe;
-
 static inline void prefetch_node(const float* p) {
 #if defined(__GNUC__) || defined(__clang__)
     __builtin_prefetch(p);
@@ -322,8 +331,8 @@ static inline void prefetch_node(const float* p) {
 }
 
 /* The cell of bone b's grid holding point x (posed) into *q, its nodes prefetched; false
- * where bone_distance_fast would be (the field is 0). Split from the interpolation so that
- * field_eval locates (and prefetches) every bone of a point before interpolating any. */
+ * where the field is 0 (grid_cell, with the capsule bound). Split from the interpolation so
+ * that field_eval locates (and prefetches) every bone of a point before interpolating any. */
 static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_probe* q) {
     const ak_skin_implicit* o = c->o;
     if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return false;
@@ -332,28 +341,7 @@ static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_pro
     if (m)
         y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
                          m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
-    const uint32_t* I = o->grid_info + b * GRID_INFO;
-    const float* B = o->bones + b * BONE_FLOATS + GRID_AT;
-    const uint32_t nx = I[0], ny = I[1], nz = I[2];
-    float px = (y.x - B[0]) * B[3], py = (y.y - B[1]) * B[3], pz = (y.z - B[2]) * B[3];
-    if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= (float)(nx - 1) && py <= (float)(ny - 1) &&
-          pz <= (float)(nz - 1)) || nx < 2)
-        return false;
-    const float* cull = c->cull ? c->cull + CULL_FLOATS * b : NULL;
-    if (cull && cull[7] > 0.0f) {
-        const float ax = y.x - cull[0], ay = y.y - cull[1], az = y.z - cull[2];
-        float t = (ax * cull[3] + ay * cull[4] + az * cull[5]) * cull[6];
-        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
-        const float wx = ax - cull[3] * t, wy = ay - cull[4] * t, wz = az - cull[5] * t;
-        if (wx * wx + wy * wy + wz * wz >= cull[7]) return false;
-    }
-    uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
-    if (ix > nx - 2) ix = nx - 2;
-    if (iy > ny - 2) iy = ny - 2;
-    if (iz > nz - 2) iz = nz - 2;
-    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
-    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
-    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+    if (!grid_cell(o, b, y, c->cull ? c->cull + CULL_FLOATS * b : NULL, q)) return false;
     q->m = m;
     q->r = o->bones[b * BONE_FLOATS + 8];
     prefetch_node(q->n000);
@@ -363,20 +351,11 @@ static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_pro
     return true;
 }
 
-/* The located cell's field (the trilinear interpolation and compact map of bone_field_fast,
- * then field_add's gradient transform) into the two strongest. */
+/* The located cell's field (bone_field_fast's interpolation and compact map, then
+ * field_add's gradient transform) into the two strongest. */
 static inline void grid_apply(const grid_probe* q, field_acc* a) {
-    const float *n000 = q->n000, *n010 = n000 + q->sy, *n001 = n000 + q->sz, *n011 = n001 + q->sy;
-    const float tx = q->tx, ty = q->ty, tz = q->tz;
     float r[4];
-    for (int k = 0; k < 4; ++k) {
-        float a0 = n000[k] + tx * (n000[4 + k] - n000[k]);
-        float bq = n010[k] + tx * (n010[4 + k] - n010[k]);
-        float cq = n001[k] + tx * (n001[4 + k] - n001[k]);
-        float dq = n011[k] + tx * (n011[4 + k] - n011[k]);
-        float e = a0 + ty * (bq - a0), f = cq + ty * (dq - cq);
-        r[k] = e + tz * (f - e);
-    }
+    grid_interp(q, r);
     ak_vec3 gy;
     const float f = compact(q->r, r[0], ak_vec3_make(r[1], r[2], r[3]), &gy);
     if (f <= 0.0f) return;
