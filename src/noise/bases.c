@@ -146,6 +146,55 @@ static uint32_t cell_hash(const int* cell, uint32_t dims, uint64_t seed) {
     return h;
 }
 
+/* The nearest (d1, near) and second nearest (d2) squared distances found so far. */
+typedef struct worley_best {
+    float d1, d2, near[3];
+} worley_best;
+
+/* Visit the cell base + off: its feature point, then the running minimum with strict "<" (the
+ * first of equal distances stays; written as selects, which give the branches' values). h is
+ * the cell's hash. */
+static inline __attribute__((always_inline)) void worley_visit(uint32_t dims, uint32_t h, const float* f,
+                                                               const int* off, worley_best* b) {
+    float dist2 = 0.0f, dv[3] = {0, 0, 0};
+    for (uint32_t k = 0; k < dims; ++k) {
+        const float fp = (float)(h & 1023u) / 1024.0f + 0.5f / 1024.0f; /* feature point in the cell */
+        h = h >> 10 | h << 22;
+        dv[k] = f[k] - ((float)off[k] + fp);
+        dist2 += dv[k] * dv[k];
+    }
+    const bool closer = dist2 < b->d1;
+    b->d2 = closer ? b->d1 : dist2 < b->d2 ? dist2 : b->d2;
+    for (uint32_t k = 0; k < dims; ++k) b->near[k] = closer ? dv[k] : b->near[k];
+    b->d1 = closer ? dist2 : b->d1;
+}
+
+/* Rings 0 and 1 (the 3^dims cells around the point): ring 0 first, then ring 1 in the order
+ * c = 0, 1, ... (axis 0 fastest), each axis's share cell_k * mul_k of cell_hash computed once.
+ * Inlined with a constant dims; the SIMD kernels (simd_body.h) repeat it lane by lane. */
+static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dims, uint64_t seed, const int* base,
+                                                                    const float* f, worley_best* b) {
+    static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
+    const uint32_t seed_mix = (uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32);
+    uint32_t axis[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (uint32_t k = 0; k < dims; ++k)
+        for (int o = 0; o < 3; ++o) axis[k][o] = (uint32_t)(base[k] + o - 1) * mul[k];
+    const int cells = dims == 1 ? 3 : dims == 2 ? 9 : 27, center = cells / 2;
+    for (int step = 0; step < cells; ++step) {
+        const int c = step == 0 ? center : step <= center ? step - 1 : step;
+        const int o[3] = {c % 3, c / 3 % 3, c / 9};
+        uint32_t h = seed_mix;
+        for (uint32_t k = 0; k < dims; ++k) h ^= axis[k][o[k]];
+        h ^= h >> 16;
+        h *= 0x85EBCA6Bu;
+        h ^= h >> 13;
+        h *= 0xC2B2AE35u;
+        h ^= h >> 16;
+        const int off[3] = {o[0] - 1, o[1] - 1, o[2] - 1};
+        worley_visit(dims, h, f, off, b);
+    }
+}
+
 float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_f2,
                       float* out_gradient) {
     if (dimensions < 1 || dimensions > 3) {
@@ -163,14 +212,19 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
         f[k] = point[k] - fl;
         margin = fminf(margin, fminf(f[k], 1.0f - f[k]));
     }
-    float d1 = INFINITY, d2 = INFINITY, near[3] = {0, 0, 0};
+    worley_best b = {INFINITY, INFINITY, {0, 0, 0}};
     /* Ring r holds the cells at Chebyshev distance r from the point's cell; their feature
-     * points are at least (r - 1) + margin away, so the search stops once that exceeds F2. */
-    for (int r = 0; r <= 6; ++r) {
-        if (r >= 1) {
-            const float bound = (float)(r - 1) + margin;
-            if (bound * bound >= d2) break;
-        }
+     * points are at least (r - 1) + margin (+ 1/2048) away, so the search stops once that
+     * exceeds F2 (or F1 when F2 is not asked for: a farther cell cannot change the nearest).
+     * Rings 0 and 1 are always searched. */
+    switch (dimensions) {
+    case 1: worley_near_rings(1, noise->seed, base, f, &b); break;
+    case 2: worley_near_rings(2, noise->seed, base, f, &b); break;
+    default: worley_near_rings(3, noise->seed, base, f, &b); break;
+    }
+    for (int r = 2; r <= 6; ++r) {
+        const float bound = (float)(r - 1) + margin;
+        if (bound * bound >= (out_f2 ? b.d2 : b.d1)) break;
         const int span = 2 * r + 1;
         const int cells = dimensions == 1 ? span : dimensions == 2 ? span * span : span * span * span;
         for (int c = 0; c < cells; ++c) {
@@ -183,26 +237,12 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
             if (cheb != r) continue;
             int cell[3];
             for (uint32_t k = 0; k < dimensions; ++k) cell[k] = base[k] + off[k];
-            uint32_t h = cell_hash(cell, dimensions, noise->seed);
-            float dist2 = 0.0f, dv[3] = {0, 0, 0};
-            for (uint32_t k = 0; k < dimensions; ++k) {
-                const float fp = (float)(h & 1023u) / 1024.0f + 0.5f / 1024.0f; /* feature point in the cell */
-                h = h >> 10 | h << 22;
-                dv[k] = f[k] - ((float)off[k] + fp);
-                dist2 += dv[k] * dv[k];
-            }
-            if (dist2 < d1) {
-                d2 = d1;
-                d1 = dist2;
-                memcpy(near, dv, sizeof near);
-            } else if (dist2 < d2) {
-                d2 = dist2;
-            }
+            worley_visit(dimensions, cell_hash(cell, dimensions, noise->seed), f, off, &b);
         }
     }
-    const float f1 = sqrtf(d1);
-    if (out_f2) *out_f2 = sqrtf(d2);
+    const float f1 = sqrtf(b.d1);
+    if (out_f2) *out_f2 = sqrtf(b.d2);
     if (out_gradient && f1 > 0.0f)
-        for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = near[k] / f1;
+        for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = b.near[k] / f1;
     return f1;
 }

@@ -335,7 +335,7 @@ KI static inline VF worley_v(const ak_noise* noise, int dims, const VF* p, VF* g
     const int cells = dims == 2 ? 9 : 27, center = dims == 2 ? 4 : 13;
     VF d1 = vf_set1(INFINITY), near[3] = {vf_zero(), vf_zero(), vf_zero()};
     const VF fscale = vf_set1(1.0f / 1024.0f), fhalf = vf_set1(0.5f / 1024.0f);
-    AKP_UNROLL
+    AKP_PRAGMA(GCC unroll 27)
     for (int step = 0; step < cells; ++step) {
         /* ring 0 first, then ring 1 in scalar order */
         const int c = step == 0 ? center : step <= center ? step - 1 : step;
@@ -352,7 +352,7 @@ KI static inline VF worley_v(const ak_noise* noise, int dims, const VF* p, VF* g
         AKP_UNROLL
         for (int k = 0; k < dims; ++k) {
             const VF fp = vf_add(vf_mul(vf_cvt(vi_and(h, vi_set1(1023))), fscale), fhalf);
-            if (k + 1 < dims) h = vi_or(VI_SRLI(h, 10), VI_SLLI(h, 22));
+            if (k + 1 < dims) h = vi_ror10(h);
             dv[k] = vf_sub(f[k], vf_add(vf_set1((float)(o[k] - 1)), fp));
             dist2 = k == 0 ? vf_mul(dv[0], dv[0]) : vf_add(dist2, vf_mul(dv[k], dv[k]));
         }
