@@ -154,24 +154,45 @@ typedef struct worley_best {
 /* Visit the cell base + off: its feature point, then the running minimum with strict "<" (the
  * first of equal distances stays; written as selects, which give the branches' values). h is
  * the cell's hash. */
-static inline __attribute__((always_inline)) void worley_visit(uint32_t dims, uint32_t h, const float* f,
-                                                               const int* off, worley_best* b) {
-    float dist2 = 0.0f, dv[3] = {0, 0, 0};
+/* The offset dv = f - (feature point of the cell at offset off, hash h) and its squared
+ * length. */
+static inline __attribute__((always_inline)) float worley_offset(uint32_t dims, uint32_t h, const float* f,
+                                                                 const int* off, float* dv) {
+    float dist2 = 0.0f;
     for (uint32_t k = 0; k < dims; ++k) {
-        const float fp = (float)(h & 1023u) / 1024.0f + 0.5f / 1024.0f; /* feature point in the cell */
-        h = h >> 10 | h << 22;
-        dv[k] = f[k] - ((float)off[k] + fp);
+        /* The feature point's coordinate k in the cell is (m + 1/2) / 1024, m = bits 10 k ..
+         * 10 k + 9 of h; off[k] + that is exact in float, and equals (1 + (2 m + 1) / 2048) -
+         * (1 - off[k]), whose first term is the float with exponent 0 and m in mantissa bits
+         * 13..22 (one bit operation instead of a conversion, a multiply and two adds). */
+        const uint32_t bits = 0x3F801000u | ((h >> (10 * k)) & 1023u) << 13;
+        float fp;
+        memcpy(&fp, &bits, sizeof fp);
+        dv[k] = f[k] - (fp - (float)(1 - off[k]));
         dist2 += dv[k] * dv[k];
     }
-    const bool closer = dist2 < b->d1;
-    b->d2 = closer ? b->d1 : dist2 < b->d2 ? dist2 : b->d2;
-    for (uint32_t k = 0; k < dims; ++k) b->near[k] = closer ? dv[k] : b->near[k];
-    b->d1 = closer ? dist2 : b->d1;
+    return dist2;
+}
+
+/* Visit a cell: the running minimum with strict "<" (the first of equal distances stays). */
+static inline __attribute__((always_inline)) void worley_visit(uint32_t dims, uint32_t h, const float* f,
+                                                               const int* off, worley_best* b) {
+    float dv[3] = {0, 0, 0};
+    const float dist2 = worley_offset(dims, h, f, off, dv);
+    if (dist2 < b->d1) {
+        b->d2 = b->d1;
+        b->d1 = dist2;
+        memcpy(b->near, dv, sizeof dv);
+    } else if (dist2 < b->d2) {
+        b->d2 = dist2;
+    }
 }
 
 /* Rings 0 and 1 (the 3^dims cells around the point): ring 0 first, then ring 1 in the order
  * c = 0, 1, ... (axis 0 fastest), each axis's share cell_k * mul_k of cell_hash computed once.
- * Inlined with a constant dims; the SIMD kernels (simd_body.h) repeat it lane by lane. */
+ * Branch-free: d1 = min(d1, dist2), d2 = min(max(dist2, d1), d2) and the step of the nearest
+ * cell (kept on strict "<") are the values of worley_visit's branches; the nearest offset is
+ * computed again at the end. Inlined with a constant dims; the SIMD kernels (simd_body.h)
+ * repeat it lane by lane. */
 static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dims, uint64_t seed, const int* base,
                                                                     const float* f, worley_best* b) {
     static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
@@ -180,6 +201,10 @@ static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dim
     for (uint32_t k = 0; k < dims; ++k)
         for (int o = 0; o < 3; ++o) axis[k][o] = (uint32_t)(base[k] + o - 1) * mul[k];
     const int cells = dims == 1 ? 3 : dims == 2 ? 9 : 27, center = cells / 2;
+    float d1 = b->d1, d2 = b->d2;
+    int best = 0;
+    uint32_t best_h = 0;
+#pragma GCC unroll 27
     for (int step = 0; step < cells; ++step) {
         const int c = step == 0 ? center : step <= center ? step - 1 : step;
         const int o[3] = {c % 3, c / 3 % 3, c / 9};
@@ -191,8 +216,21 @@ static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dim
         h *= 0xC2B2AE35u;
         h ^= h >> 16;
         const int off[3] = {o[0] - 1, o[1] - 1, o[2] - 1};
-        worley_visit(dims, h, f, off, b);
+        float dv[3];
+        const float dist2 = worley_offset(dims, h, f, off, dv);
+        const bool closer = dist2 < d1;
+        best = closer ? c : best;
+        best_h = closer ? h : best_h;
+        const float hi = dist2 > d1 ? dist2 : d1;
+        d2 = hi < d2 ? hi : d2;
+        d1 = closer ? dist2 : d1;
     }
+    const int off[3] = {best % 3 - 1, best / 3 % 3 - 1, best / 9 - 1};
+    float dv[3] = {0, 0, 0};
+    worley_offset(dims, best_h, f, off, dv);
+    memcpy(b->near, dv, sizeof dv);
+    b->d1 = d1;
+    b->d2 = d2;
 }
 
 float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_f2,

@@ -40,7 +40,6 @@ KI static inline VI vi_add(VI a, VI b) { return _mm256_add_epi32(a, b); }
 KI static inline VI vi_xor(VI a, VI b) { return _mm256_xor_si256(a, b); }
 KI static inline VI vi_or(VI a, VI b) { return _mm256_or_si256(a, b); }
 KI static inline VI vi_mullo(VI a, VI b) { return _mm256_mullo_epi32(a, b); }
-KI static inline VI vi_ror10(VI a) { return _mm256_or_si256(_mm256_srli_epi32(a, 10), _mm256_slli_epi32(a, 22)); }
 KI static inline VF vf_div(VF a, VF b) { return _mm256_div_ps(a, b); }
 KI static inline VF vf_sqrt(VF a) { return _mm256_sqrt_ps(a); }
 KI static inline VF vf_cvt(VI a) { return _mm256_cvtepi32_ps(a); }

@@ -41,7 +41,6 @@ KI static inline VI vi_add(VI a, VI b) { return _mm512_add_epi32(a, b); }
 KI static inline VI vi_xor(VI a, VI b) { return _mm512_xor_si512(a, b); }
 KI static inline VI vi_or(VI a, VI b) { return _mm512_or_si512(a, b); }
 KI static inline VI vi_mullo(VI a, VI b) { return _mm512_mullo_epi32(a, b); }
-KI static inline VI vi_ror10(VI a) { return _mm512_ror_epi32(a, 10); }
 KI static inline VF vf_div(VF a, VF b) { return _mm512_div_ps(a, b); }
 KI static inline VF vf_sqrt(VF a) { return _mm512_sqrt_ps(a); }
 KI static inline VF vf_cvt(VI a) { return _mm512_cvtepi32_ps(a); }

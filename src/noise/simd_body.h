@@ -334,7 +334,6 @@ KI static inline VF worley_v(const ak_noise* noise, int dims, const VF* p, VF* g
     }
     const int cells = dims == 2 ? 9 : 27, center = dims == 2 ? 4 : 13;
     VF d1 = vf_set1(INFINITY), near[3] = {vf_zero(), vf_zero(), vf_zero()};
-    const VF fscale = vf_set1(1.0f / 1024.0f), fhalf = vf_set1(0.5f / 1024.0f);
     AKP_PRAGMA(GCC unroll 27)
     for (int step = 0; step < cells; ++step) {
         /* ring 0 first, then ring 1 in scalar order */
@@ -351,9 +350,13 @@ KI static inline VF worley_v(const ak_noise* noise, int dims, const VF* p, VF* g
         VF dv[3], dist2 = vf_zero();
         AKP_UNROLL
         for (int k = 0; k < dims; ++k) {
-            const VF fp = vf_add(vf_mul(vf_cvt(vi_and(h, vi_set1(1023))), fscale), fhalf);
-            if (k + 1 < dims) h = vi_ror10(h);
-            dv[k] = vf_sub(f[k], vf_add(vf_set1((float)(o[k] - 1)), fp));
+            /* bases.c: (o - 1) + ((h >> 10 k & 1023) / 1024 + 0.5 / 1024), every step exact: the
+             * same number is (1 + (2 m + 1) / 2048) - (2 - o), the first term built from the bits
+             * of m = h >> 10 k & 1023 as a float with exponent 0 (m into mantissa bits 13..22) */
+            const VI m13 = k == 0 ? VI_SLLI(h, 13) : k == 1 ? VI_SLLI(h, 3) : VI_SRLI(h, 7);
+            VF fp = vf_cast(vi_or(vi_and(m13, vi_set1(1023 << 13)), vi_set1(0x3F801000)));
+            if (o[k] != 2) fp = vf_sub(fp, vf_set1((float)(2 - o[k])));
+            dv[k] = vf_sub(f[k], fp);
             dist2 = k == 0 ? vf_mul(dv[0], dv[0]) : vf_add(dist2, vf_mul(dv[k], dv[k]));
         }
         const VM closer = m_lt(dist2, d1);
