@@ -433,7 +433,7 @@ AK_TEST(batch_simd_equals_scalar) {
 
 /* The plain value and Worley bases (one octave) through every batch path against the scalar
  * per-point functions, bit for bit, on points built to hit the edge cases: lattice/cell
- * borders (integers, one ulp either side, halves), negative and huge coordinates up to
+ * borders (integers, one ulp either side, halves; lattice points giving every corner value), negative and huge coordinates up to
  * 2^24 - 1 (and beyond it, NaN, infinity: 0), tiny and signed-zero coordinates, and random
  * points (which include Worley points whose nearest feature point lies two cells away). */
 AK_TEST(batch_value_worley_edges) {
@@ -456,6 +456,9 @@ AK_TEST(batch_value_worley_edges) {
             c[k][i] = x;
         }
     for (int i = 0; i < 40; ++i) c[i % 3][i * 97 % N] = edge[nedge - 6 + i % 6]; /* out of range */
+    /* lattice points (-3, j, 5), j = 0..255: value noise there is the corner value of hash
+     * perm[perm[perm[-3 & 255] + j] + 5], every one of the 256 hash values once */
+    for (int j = 0; j < 256; ++j) c[0][N - 1 - j] = -3.0f, c[1][N - 1 - j] = (float)j, c[2][N - 1 - j] = 5.0f;
     ak_noise_simd paths[3];
     const int npaths = simd_paths(paths);
     const ak_noise_basis bases[2] = {AK_NOISE_BASIS_VALUE, AK_NOISE_BASIS_WORLEY};

@@ -187,7 +187,7 @@ AK_API void ak_fractal_range(const ak_fractal_desc* desc, uint32_t dimensions, f
 typedef enum ak_noise_simd {
     AK_NOISE_SIMD_DEFAULT = 0, /* -> the widest kernel this CPU has (AK_NOISE_SIMD_AVX512) */
     AK_NOISE_SIMD_SCALAR,      /* scalar code (as skip_simd) */
-    AK_NOISE_SIMD_AVX2,        /* 8 points per block, where the CPU has AVX2 */
+    AK_NOISE_SIMD_AVX2,        /* 8 points per block, where the CPU has AVX2 and FMA */
     AK_NOISE_SIMD_AVX512,      /* 16 points per block, where the CPU has AVX-512 F and DQ, else AVX2 */
     AK_NOISE_SIMD_COUNT
 } ak_noise_simd;

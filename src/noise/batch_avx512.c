@@ -42,6 +42,8 @@ KI static inline VI vi_xor(VI a, VI b) { return _mm512_xor_si512(a, b); }
 KI static inline VI vi_or(VI a, VI b) { return _mm512_or_si512(a, b); }
 KI static inline VI vi_mullo(VI a, VI b) { return _mm512_mullo_epi32(a, b); }
 KI static inline VF vf_div(VF a, VF b) { return _mm512_div_ps(a, b); }
+KI static inline VF vf_fmadd(VF a, VF b, VF c) { return _mm512_fmadd_ps(a, b, c); }   /* a b + c, one rounding */
+KI static inline VF vf_fnmadd(VF a, VF b, VF c) { return _mm512_fnmadd_ps(a, b, c); } /* c - a b, one rounding */
 KI static inline VF vf_sqrt(VF a) { return _mm512_sqrt_ps(a); }
 KI static inline VF vf_cvt(VI a) { return _mm512_cvtepi32_ps(a); }
 #define VI_SLLI(a, n) _mm512_slli_epi32((a), (n))
