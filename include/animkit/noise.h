@@ -13,8 +13,9 @@
  *   - a batch job over coordinate arrays and a grid job over a 2D lattice of points, on
  *     threads, 16 points at a time with AVX-512 or 8 with AVX2 where the CPU has it (chosen
  *     at run time, scalar reference always built; AK_NO_SIMD, skip_simd or simd_limit force
- *     it). The SIMD paths give the same bits as the scalar one (no FMA contraction on either
- *     side).
+ *     it) for Perlin, simplex, value and Worley noise in 2D and 3D and every fractal type;
+ *     1D, 4D and domain warping run the scalar reference. The SIMD paths give the same bits
+ *     as the scalar one (no implicit FMA contraction on either side).
  *
  * What it does NOT do: sparse convolution or wavelet noise, anti-aliasing of the sum (octaves
  * above the sampling rate are the caller's business), textures or images (see terrain.h).
