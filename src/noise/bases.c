@@ -268,18 +268,29 @@ static inline __attribute__((always_inline)) void worley_visit(uint32_t dims, ui
 
 /* Rings 0 and 1 (the 3^dims cells around the point): ring 0 first, then ring 1 in the order
  * c = 0, 1, ... (axis 0 fastest), each axis's share cell_k * mul_k of cell_hash computed once.
- * Branch-free: d1 = min(d1, dist2), d2 = min(max(dist2, d1), d2) and the step of the nearest
- * cell (kept on strict "<") are the values of worley_visit's branches; the nearest offset is
- * computed again at the end. Inlined with a constant dims; the SIMD kernels (simd_body.h)
- * repeat it lane by lane. */
+ * The updates are selects: d1 = min(d1, dist2), d2 = min(max(dist2, d1), d2) and the step of
+ * the nearest cell (kept on strict "<") are the values of worley_visit's branches; the nearest
+ * offset is computed again at the end. Inlined with a constant dims; the SIMD kernels
+ * (simd_body.h) visit the same cells in the same order without skipping any (a skipped cell
+ * cannot change the result). */
 static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dims, uint64_t seed, const int* base,
-                                                                    const float* f, worley_best* b) {
+                                                                    const float* f, bool want_f2, worley_best* b) {
     static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
     const uint32_t seed_mix = (uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32);
     uint32_t axis[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     for (uint32_t k = 0; k < dims; ++k)
         for (int o = 0; o < 3; ++o) axis[k][o] = (uint32_t)(base[k] + o - 1) * mul[k];
     const int cells = dims == 1 ? 3 : dims == 2 ? 9 : 27, center = cells / 2;
+    /* gap[k][o]: the squared distance along axis k from the point to the cell at offset o - 1
+     * (f^2, 0, (1 - f)^2); a cell whose sum is at least the distance that matters (F1, or F2
+     * when asked for) cannot change the result (its feature point is farther by at least
+     * 1/2048 along each such axis) and is skipped. */
+    float gap[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (uint32_t k = 0; k < dims; ++k) {
+        const float e = 1.0f - f[k];
+        gap[k][0] = f[k] * f[k];
+        gap[k][2] = e * e;
+    }
     float d1 = b->d1, d2 = b->d2;
     int best = 0;
     uint32_t best_h = 0;
@@ -287,6 +298,11 @@ static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dim
     for (int step = 0; step < cells; ++step) {
         const int c = step == 0 ? center : step <= center ? step - 1 : step;
         const int o[3] = {c % 3, c / 3 % 3, c / 9};
+        if (step > 0) {
+            float lower = 0.0f;
+            for (uint32_t k = 0; k < dims; ++k) lower += gap[k][o[k]];
+            if (lower >= (want_f2 ? d2 : d1)) continue;
+        }
         uint32_t h = seed_mix;
         for (uint32_t k = 0; k < dims; ++k) h ^= axis[k][o[k]];
         h ^= h >> 16;
@@ -336,9 +352,9 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
      * exceeds F2 (or F1 when F2 is not asked for: a farther cell cannot change the nearest).
      * Rings 0 and 1 are always searched. */
     switch (dimensions) {
-    case 1: worley_near_rings(1, noise->seed, base, f, &b); break;
-    case 2: worley_near_rings(2, noise->seed, base, f, &b); break;
-    default: worley_near_rings(3, noise->seed, base, f, &b); break;
+    case 1: worley_near_rings(1, noise->seed, base, f, out_f2 != NULL, &b); break;
+    case 2: worley_near_rings(2, noise->seed, base, f, out_f2 != NULL, &b); break;
+    default: worley_near_rings(3, noise->seed, base, f, out_f2 != NULL, &b); break;
     }
     for (int r = 2; r <= 6; ++r) {
         const float bound = (float)(r - 1) + margin;
