@@ -66,11 +66,7 @@ static ak_skin_soft_desc rig_desc(const rig* g, uint32_t resolution) {
                            .weights = {m->weights, wn},
                            .influence_count = m->influence_count,
                            .bones = {g->bones, g->bone_count},
-                           .resolution = resolution,
-                           /* the fat tube (radius a quarter of its bones' length) needs the wider free
-                            * zone around its joint: at the default 1.5 the 150-degree bend inverts a
-                            * tetrahedron (docs/softskin.md) */
-                           .joint_zone = 3.0f};
+                           .resolution = resolution};
     return d;
 }
 
@@ -745,20 +741,11 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
 AK_TEST(cesiumman_knee_130) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 130.0f, 0.01); }
 AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f, 0.03); }
 
-AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 16, true); }
-AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 16, true); }
+/* the default desc (resolution 32, 40 substeps, the default free zone around the joint) */
+AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 0, true); }
+AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 0, true); }
 
 int main(void) {
-    if (getenv("XSIDES")) { // XDEV
-        const float angs[3] = {120.0f, 130.0f, 140.0f};
-        for (int a = 0; a < 3; ++a) {
-            cman_flex_case("leg_joint_L_2", "leg_joint_L_3", angs[a], 0.01);
-            cman_flex_case("leg_joint_R_2", "leg_joint_R_3", angs[a], 0.01);
-            cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", angs[a], 0.03);
-            cman_flex_case("Skeleton_arm_joint_R__3_", "Skeleton_arm_joint_R__2_", angs[a], 0.03);
-        }
-        return ak_test_finish();
-    }
     AK_RUN(bind_pose_reproduces_the_mesh);
     AK_RUN(held_pose_converges_and_keeps_volume);
     AK_RUN(threads_give_identical_results);

@@ -108,11 +108,13 @@ typedef struct ak_skin_soft_desc {
                                   (see previous_palette) decays as exp(-jiggle_damping t);
                                   0 -> 5; negative -> none */
     float joint_zone;          /* flesh zone around a joint, in kinematic capsule radii (at
-                                  most half the bone's length), in (0, 100]; 0 -> 1.5 (tuned on
-                                  CesiumMan's knee and elbow at 130 degrees). Smaller: more of
-                                  the limb near a joint follows the bone. A fat limb (the
-                                  builtin cylinder, radius a quarter of its bones' length) bent
-                                  150 degrees needs 3 (docs/softskin.md) */
+                                  most half the bone's length), in (0, 100]; 0 -> 1.5, and at
+                                  least 2 flesh radii of a bone whose capsule (bone_radius x
+                                  flesh radius) is above the 1.2-cube floor (a limb the lattice
+                                  resolves: the fat builtin cylinder; tuned on it and on
+                                  CesiumMan's knee and elbow at 130 degrees, docs/softskin.md).
+                                  Explicit: capsule radii only. Smaller: more of the limb near
+                                  a joint follows the bone */
     bool join_distant_parts;   /* false (default): drop the lattice cells whose corners lie
                                   nearest to bones that share no joint (keeps the two legs,
                                   an arm and the chest apart); true: keep them (limbs closer

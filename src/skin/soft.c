@@ -720,6 +720,12 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
      * another bone: the flesh around a joint stays free, so that the bones' cores do not crush
      * it at a deep bend */
     const float zone = d.joint_zone;
+    /* the default (joint_zone 0): where a bone's capsule is sized by its flesh (half its flesh
+     * radius is more than the 1.2-cube floor: the lattice resolves the limb, as on the fat
+     * builtin cylinder), the free zone around it also reaches two of its flesh radii (at most
+     * half the node's own bone): the flesh that folds into a deep bend reaches that far. A thin limb
+     * (CesiumMan's, one or two cubes across) keeps 1.5 capsule radii (docs/softskin.md) */
+    const bool flesh_zone = !(desc_in && desc_in->joint_zone != 0.0f);
     /* per joint: whether any node became kinematic with these rules; a joint that got none (its
      * bones too short or too crowded for them: a dense skeleton at a coarse lattice) takes every
      * node inside its capsule that it weighs most */
@@ -742,6 +748,8 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
                 if (!(core > 0.0f)) continue;
                 float d2 = akp_segment_dist_sq(s->rest[n], s->bones[b].head, s->bones[b].tail, NULL);
                 float z = ak_minf(zone * core, own_len / 2.0f);
+                if (flesh_zone && d.bone_radius * s->contact_radius[b] > 1.2f * h)
+                    z = ak_minf(ak_maxf(zone * core, 2.0f * s->contact_radius[b]), own_len / 2.0f);
                 if (s->bones[b].joint_index == part) inside = inside || d2 < core * core;
                 else near_other = near_other || (pass == 0 && d2 < z * z);
             }
