@@ -107,6 +107,29 @@ KI static inline VF dfade_v(VF t) {
 KI static inline VF lerp_v(VF t, VF a, VF b) { return vf_add(a, vf_mul(t, vf_sub(b, a))); }
 
 /* Perlin noise at W points p[0..dims-1]; value returned, gradient into grad when want_grad. */
+/* Blends the 2^dims corner values (and gradients) of a cell along each axis in turn with the
+ * quintic fade of the fractional coordinates f: val[0] (gv[0]) ends as the cell's value
+ * (gradient). Shared by Perlin and value noise; the operation order is the scalar reference's. */
+KI static inline void lerp_corners(int dims, const VF* f, VF* val, VF (*gv)[3], bool want_grad) {
+    const int corners = 1 << dims;
+    AKP_UNROLL
+    for (int k = 0; k < dims; ++k) {
+        const VF t = fade_v(f[k]);
+        const VF dt = want_grad ? dfade_v(f[k]) : vf_zero();
+        const int step = 1 << k;
+        AKP_UNROLL
+        for (int c = 0; c < corners; c += 2 * step) {
+            const VF a = val[c], b = val[c + step];
+            val[c] = lerp_v(t, a, b);
+            if (want_grad) {
+                AKP_UNROLL
+                for (int m = 0; m < dims; ++m) gv[c][m] = lerp_v(t, gv[c][m], gv[c + step][m]);
+                gv[c][k] = vf_add(gv[c][k], vf_mul(vf_sub(b, a), dt));
+            }
+        }
+    }
+}
+
 KI static inline VF perlin_v(const PermTab* perm, int dims, const VF* p, VF* grad, bool want_grad) {
     const VM valid = in_range(dims, p);
     VI lo[3];
@@ -128,22 +151,7 @@ KI static inline VF perlin_v(const PermTab* perm, int dims, const VF* p, VF* gra
         for (int k = 0; k < dims; ++k) d[k] = ((c >> k) & 1) ? vf_sub(f[k], vf_set1(1.0f)) : f[k];
         val[c] = corner_perlin(dims, hash[c], d, gv[c], want_grad);
     }
-    AKP_UNROLL
-    for (int k = 0; k < dims; ++k) {
-        const VF t = fade_v(f[k]);
-        const VF dt = want_grad ? dfade_v(f[k]) : vf_zero();
-        const int step = 1 << k;
-        AKP_UNROLL
-        for (int c = 0; c < corners; c += 2 * step) {
-            const VF a = val[c], b = val[c + step];
-            val[c] = lerp_v(t, a, b);
-            if (want_grad) {
-                AKP_UNROLL
-                for (int m = 0; m < dims; ++m) gv[c][m] = lerp_v(t, gv[c][m], gv[c + step][m]);
-                gv[c][k] = vf_add(gv[c][k], vf_mul(vf_sub(b, a), dt));
-            }
-        }
-    }
+    lerp_corners(dims, f, val, gv, want_grad);
     if (want_grad)
         AKP_UNROLL
         for (int m = 0; m < dims; ++m) grad[m] = vf_maskz(valid, gv[0][m]);
@@ -288,22 +296,7 @@ KI static inline VF value_v(const PermTab* perm, int dims, const VF* p, VF* grad
             AKP_UNROLL
             for (int m = 0; m < dims; ++m) gv[c][m] = vf_zero();
     }
-    AKP_UNROLL
-    for (int k = 0; k < dims; ++k) {
-        const VF t = fade_v(f[k]);
-        const VF dt = want_grad ? dfade_v(f[k]) : vf_zero();
-        const int step = 1 << k;
-        AKP_UNROLL
-        for (int c = 0; c < corners; c += 2 * step) {
-            const VF a = val[c], b = val[c + step];
-            val[c] = lerp_v(t, a, b);
-            if (want_grad) {
-                AKP_UNROLL
-                for (int m = 0; m < dims; ++m) gv[c][m] = lerp_v(t, gv[c][m], gv[c + step][m]);
-                gv[c][k] = vf_add(gv[c][k], vf_mul(vf_sub(b, a), dt));
-            }
-        }
-    }
+    lerp_corners(dims, f, val, gv, want_grad);
     if (want_grad)
         AKP_UNROLL
         for (int m = 0; m < dims; ++m) grad[m] = vf_maskz(valid, gv[0][m]);
