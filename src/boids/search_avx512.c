@@ -127,6 +127,21 @@ AKP_AVX512 static inline void add_gathered(__m512i* sum, __mmask16 m, __m512i k3
     *sum = _mm512_add_epi64(*sum, _mm512_add_epi64(lo, hi));
 }
 
+/* Adds the lanes of the nine fixed-point accumulators to the agent's separation, alignment and
+ * cohesion sums (integer adds: the order does not matter). */
+AKP_AVX512 static inline void add_sums(akp_boids_gather* g, __m512i s0, __m512i s1, __m512i s2, __m512i a0, __m512i a1,
+                                       __m512i a2, __m512i c0, __m512i c1, __m512i c2) {
+    g->sep[0] += _mm512_reduce_add_epi64(s0);
+    g->sep[1] += _mm512_reduce_add_epi64(s1);
+    g->sep[2] += _mm512_reduce_add_epi64(s2);
+    g->ali[0] += _mm512_reduce_add_epi64(a0);
+    g->ali[1] += _mm512_reduce_add_epi64(a1);
+    g->ali[2] += _mm512_reduce_add_epi64(a2);
+    g->coh[0] += _mm512_reduce_add_epi64(c0);
+    g->coh[1] += _mm512_reduce_add_epi64(c1);
+    g->coh[2] += _mm512_reduce_add_epi64(c2);
+}
+
 AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h,
                                        uint32_t count) {
     const akp_boids_sp* S = g->sp;
@@ -197,15 +212,7 @@ AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather*
             nc += (uint32_t)__builtin_popcount(mc);
         }
     }
-    g->sep[0] += _mm512_reduce_add_epi64(s0);
-    g->sep[1] += _mm512_reduce_add_epi64(s1);
-    g->sep[2] += _mm512_reduce_add_epi64(s2);
-    g->ali[0] += _mm512_reduce_add_epi64(a0);
-    g->ali[1] += _mm512_reduce_add_epi64(a1);
-    g->ali[2] += _mm512_reduce_add_epi64(a2);
-    g->coh[0] += _mm512_reduce_add_epi64(c0);
-    g->coh[1] += _mm512_reduce_add_epi64(c1);
-    g->coh[2] += _mm512_reduce_add_epi64(c2);
+    add_sums(g, s0, s1, s2, a0, a1, a2, c0, c1, c2);
     g->ns += ns;
     g->na += na;
     g->nc += nc;
@@ -466,15 +473,7 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
         }
     }
     if (reduce) {
-        g->sep[0] += _mm512_reduce_add_epi64(s0);
-        g->sep[1] += _mm512_reduce_add_epi64(s1);
-        g->sep[2] += _mm512_reduce_add_epi64(s2);
-        g->ali[0] += _mm512_reduce_add_epi64(a0);
-        g->ali[1] += _mm512_reduce_add_epi64(a1);
-        g->ali[2] += _mm512_reduce_add_epi64(a2);
-        g->coh[0] += _mm512_reduce_add_epi64(c0);
-        g->coh[1] += _mm512_reduce_add_epi64(c1);
-        g->coh[2] += _mm512_reduce_add_epi64(c2);
+        add_sums(g, s0, s1, s2, a0, a1, a2, c0, c1, c2);
     }
     int64_t r8[8], r4[4], ra[8];
     _mm512_storeu_si512((void*)r8, i8);
