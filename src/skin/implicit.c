@@ -298,27 +298,35 @@ typedef struct field_acc {
     ak_vec3 g1, g2;
 } field_acc;
 
-static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc* a) {
-    const ak_skin_implicit* o = c->o;
-    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return;
-    ak_vec3 y = x;
-    const float* m = c->inv ? c->inv + 12 * b : NULL;
-    if (m)
-        y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
-                         m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
-    ak_vec3 gy;
-    float f = bone_field_fast(o, b, y, &gy);
-    if (f <= 0.0f) return;
-    /* gradient in posed space: (M^-1)^T gy */
-    ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
-                                 m[6] * gy.x + m[7] * gy.y + m[8] * gy.z)
-                  : gy;
+/* x (posed) into the bind space of a bone: the 3x4 column-major inverse palette matrix m. */
+static inline ak_vec3 to_bone(const float* m, ak_vec3 x) {
+    return ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
+                        m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
+}
+
+/* One bone's field f > 0 with its bind-space gradient gy into the two strongest, the gradient
+ * taken to posed space: (M^-1)^T gy (m NULL: the bind pose). */
+static inline void keep_strongest(field_acc* a, const float* m, float f, ak_vec3 gy) {
+    const ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
+                                       m[6] * gy.x + m[7] * gy.y + m[8] * gy.z)
+                        : gy;
     if (f > a->f1) {
         a->f2 = a->f1, a->g2 = a->g1;
         a->f1 = f, a->g1 = g;
     } else if (f > a->f2) {
         a->f2 = f, a->g2 = g;
     }
+}
+
+static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc* a) {
+    const ak_skin_implicit* o = c->o;
+    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return;
+    const float* m = c->inv ? c->inv + 12 * b : NULL;
+    const ak_vec3 y = m ? to_bone(m, x) : x;
+    ak_vec3 gy;
+    float f = bone_field_fast(o, b, y, &gy);
+    if (f <= 0.0f) return;
+    keep_strongest(a, m, f, gy);
 }
 
 static inline void prefetch_node(const float* p) {
@@ -336,11 +344,8 @@ static inline void prefetch_node(const float* p) {
 static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_probe* q) {
     const ak_skin_implicit* o = c->o;
     if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return false;
-    ak_vec3 y = x;
     const float* m = c->inv ? c->inv + 12 * b : NULL;
-    if (m)
-        y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
-                         m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
+    const ak_vec3 y = m ? to_bone(m, x) : x;
     if (!grid_cell(o, b, y, c->cull ? c->cull + CULL_FLOATS * b : NULL, q)) return false;
     q->m = m;
     q->r = o->bones[b * BONE_FLOATS + 8];
@@ -360,15 +365,7 @@ static inline void grid_apply(const grid_probe* q, field_acc* a) {
     const float f = compact(q->r, r[0], ak_vec3_make(r[1], r[2], r[3]), &gy);
     if (f <= 0.0f) return;
     const float* m = q->m;
-    ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
-                                 m[6] * gy.x + m[7] * gy.y + m[8] * gy.z)
-                  : gy;
-    if (f > a->f1) {
-        a->f2 = a->f1, a->g2 = a->g1;
-        a->f1 = f, a->g1 = g;
-    } else if (f > a->f2) {
-        a->f2 = f, a->g2 = g;
-    }
+    keep_strongest(a, m, f, gy);
 }
 
 static float field_eval(const field_ctx* c, ak_vec3 x, ak_vec3* out_g) {
