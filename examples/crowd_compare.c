@@ -3,8 +3,11 @@
  * when all were home at once, the mean time to goal and path length over the straight line
  * (of those that got there), the mean speed on the way, the smallest clearance over every step
  * (centre distance minus radii), pairs that ever overlapped by more than 1 mm, the lanes of
- * the corridor (each group's mean z where |x| < 10 m over the first 200 steps) and the step
- * time. docs/crowd.md's ORCA/vision table comes from it:
+ * the corridor (each group's mean z where |x| < 10 m over the first 200 steps, and a lane
+ * index over the whole run: 1 - (share of the other group among the agents within 3 m along x
+ * and 0.3 m across, of an agent where |x| < 10 m) / (that share within 3 m along x at any z):
+ * 0 when the groups are mixed across the width, 1 when they walk in separate lanes, whatever
+ * their number and place) and the step time. docs/crowd.md's ORCA/vision table comes from it:
  *     example_crowd_compare [PRESET [AGENTS]]      (default: crossing 24)
  * Shows: ak_crowd_scene_preset, ak_crowd_desc.method, ak_crowd_clearance. */
 #include <math.h>
@@ -59,6 +62,7 @@ static int run(const char* preset, size_t agents, ak_crowd_method method) {
     size_t ov_count = 0, ov_cap = 1024;
     uint64_t* ov = malloc(ov_cap * sizeof *ov);
     double min_clear = INFINITY, step_time = 0.0, speed_sum = 0.0, z[2] = {0, 0};
+    double win[2] = {0, 0}, strip[2] = {0, 0}; /* neighbours within 3 m along x / and 0.3 m in z: all, of the other group */
     size_t speed_n = 0, zn[2] = {0, 0};
     long s = 0, all_home = -1;
     for (; s < sc.steps; ++s) {
@@ -106,6 +110,16 @@ static int run(const char* preset, size_t agents, ak_crowd_method method) {
         if (strcmp(preset, "corridor") == 0 && s < 200)
             for (size_t i = 0; i < n; ++i)
                 if (fabsf(p[i].x) < 10.0f && sc.group[i] < 2) z[sc.group[i]] += p[i].y, zn[sc.group[i]]++;
+        if (strcmp(preset, "corridor") == 0)
+            for (size_t i = 0; i < n; ++i) {
+                if (!(fabsf(p[i].x) < 10.0f)) continue;
+                for (size_t j = 0; j < n; ++j) {
+                    if (j == i || !(fabsf(p[j].x - p[i].x) < 3.0f)) continue;
+                    const bool opp = sc.group[j] != sc.group[i];
+                    win[0] += 1.0, win[1] += opp;
+                    if (fabsf(p[j].y - p[i].y) < 0.3f) strip[0] += 1.0, strip[1] += opp;
+                }
+            }
         if (home == n) {
             all_home = s + 1;
             ++s;
@@ -129,6 +143,8 @@ static int run(const char* preset, size_t agents, ak_crowd_method method) {
            speed_n ? speed_sum / (double)speed_n : 0.0, min_clear, ov_count, 1e3 * step_time / (double)s,
            step_time > 0.0 ? (double)n * (double)s / step_time : 0.0);
     if (zn[0] && zn[1]) printf("; lanes: mean z %.2f m / %.2f m", z[0] / (double)zn[0], z[1] / (double)zn[1]);
+    if (win[1] > 0.0 && strip[0] > 0.0)
+        printf(", lane index %.2f", 1.0 - (strip[1] / strip[0]) / (win[1] / win[0]));
     printf("\n");
     free(ov);
     free(pairs);

@@ -901,13 +901,31 @@ static float ray_segment(ak_vec2 o, ak_vec2 d, ak_vec2 a, ak_vec2 b) {
     return (t > 0.0f && u >= 0.0f && u <= 1.0f) ? t : INFINITY;
 }
 
+#define VISION_STAND_SPEED 0.25f /* m/s */
+#define VISION_STAND_TTC 0.845f  /* s: 1 - exp(-0.5 t^2) = 0.3 */
+
+/* Within a second of its last goal (pref_speed * 1 s), its own waypoints driving it: then the
+ * preferred velocity is the offset to the goal per second (pref_velocity). */
+static bool vision_arriving(const ak_crowd_step_job* job, const ak_crowd_agent* a, size_t i, ak_vec2 p) {
+    if (job->pref_velocities.ptr) return false;
+    const uint32_t last = (uint32_t)a->goals.count - 1;
+    if (job->waypoints.ptr[i] < last) return false;
+    return abs_sq(sub(a->goals.ptr[last], p)) <= a->pref_speed * a->pref_speed;
+}
+
 /* Synthetic-vision steering (Ondrej et al. 2010) for one agent: a 1D view of vision_width
  * pixels; per pixel the visible object's hit point, its time to interaction and the rate of
- * its bearing; threats turn and slow the agent. */
+ * its bearing; the threats' bearing rates bound the turn rate and the nearest threat's time to
+ * interaction sets the speed (the paper's two controls); the goal is a pixel kept in view. */
 static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const ak_crowd_agent* a, ak_vec2 pref) {
     const ctx* c = w->c;
     const ak_crowd* crowd = c->crowd;
     const ak_crowd_step_job* job = c->job;
+    /* Arrival (as ORCA's preferred velocity): within a second of its last goal pref is the
+     * offset to the goal per second; the agent walks it, onto its place, unslowed and unturned
+     * by the view: a neighbour in the way is pushed by the contact projection, and one pushed
+     * off its place walks back at the same rule instead of freezing against its neighbours. */
+    if (vision_arriving(job, a, i, p)) return pref;
     const uint32_t na = agent_neighbors(c, i, p, a, w->agent_n);
     const uint32_t no = crowd->vertex_count ? obstacle_neighbors(crowd, p, a, w->obst_n) : 0;
     const float speed = len(v);
@@ -925,12 +943,14 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
         const ak_vec2 d = v2(cosf(ang), sinf(ang));
         float best = INFINITY;
         ak_vec2 ovel = v2(0.0f, 0.0f);
+        bool agent = false;
         for (uint32_t q = 0; q < na; ++q) {
             const uint32_t j = nkey_index(w->agent_n[q]);
             const float t = ray_disc(p, d, job->positions.ptr[j], crowd->agents[j].radius);
             if (t < best) {
                 best = t;
                 ovel = job->velocities.ptr[j];
+                agent = true;
             }
         }
         for (uint32_t q = 0; q < no; ++q) {
@@ -939,6 +959,7 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
             if (t < best) {
                 best = t;
                 ovel = v2(0.0f, 0.0f);
+                agent = false;
             }
         }
         if (!(best < INFINITY)) continue;
@@ -952,7 +973,16 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
         const float rate = dist2 > 0.0f ? det(rp, rv) / dist2 : 0.0f; /* bearing rate, rad/s */
         const float thr = 0.6f * powf(fmaxf(ttc, 1e-3f), -1.5f);
         if (fabsf(rate) >= thr) continue; /* not a threat: it will pass */
-        if (ttc < ttc_min) ttc_min = ttc;
+        /* an agent standing or shuffling (under VISION_STAND_SPEED: parked, or jostled on its
+         * place) slows the agent to 30% of pref_speed at most (ttc 0.845 s) and does not turn
+         * it: it steps on through, and the contact projection shoulders both aside, as people
+         * squeeze past those standing (a parked block is otherwise a wall the agent walks
+         * along and never enters); a wall or a walker can stop it */
+        const bool standing = agent && abs_sq(ovel) < VISION_STAND_SPEED * VISION_STAND_SPEED &&
+                              dot(ovel, rp) >= -0.05f * dist;
+        const float ttc_slow = standing ? fmaxf(ttc, VISION_STAND_TTC) : ttc;
+        if (ttc_slow < ttc_min) ttc_min = ttc_slow;
+        if (standing) continue;
         /* Turning the heading by delta changes this bearing rate by about -k delta, with
          * k = (own speed) cos(angle to the point) / distance: keep the rate's sign and lift
          * it over the threshold (points beside or behind do not respond to a turn). */
@@ -967,10 +997,12 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
         }
     }
     /* toward the goal, then the threats' bound on the side that asks for the smaller turn */
-    float delta = 0.0f;
-    if (pref_len > 0.0f) delta = atan2f(det(head, pref), dot(head, pref));
+    float delta = 0.0f, goal_bearing = 0.0f;
+    if (pref_len > 0.0f) delta = goal_bearing = atan2f(det(head, pref), dot(head, pref));
     if (right && (!left || -need_right <= need_left)) delta = fminf(delta, need_right);
     else if (left) delta = fmaxf(delta, need_left);
+    /* the goal is a pixel kept in view: no turn takes it out of the field of view */
+    if (pref_len > 0.0f) delta = ak_clampf(delta, goal_bearing - 0.5f * fov, goal_bearing + 0.5f * fov);
     const float max_turn = 3.0f * job->dt; /* 3 rad/s */
     const float turn = ak_clampf(delta, -max_turn, max_turn);
     const ak_vec2 nh = v2(head.x * cosf(turn) - head.y * sinf(turn), head.x * sinf(turn) + head.y * cosf(turn));

@@ -359,7 +359,7 @@ AK_TEST(presets_24_home_apart) {
 }
 
 
-/* Vision-based steering: head-on and four crossing reach their goals without overlap. */
+/* Vision-based steering: head-on and four crossing reach their goals, keeping 0.2 m apart. */
 AK_TEST(vision_head_on_and_crossing) {
     const ak_vec2 s2[2] = {{-5, 0}, {5, 0}}, s4[4] = {{-6, 0}, {6, 0}, {0, -6}, {0, 6}};
     for (int which = 0; which < 2; ++which) {
@@ -376,10 +376,49 @@ AK_TEST(vision_head_on_and_crossing) {
         AK_CHECK(run_init(&r, &desc, start));
         AK_CHECK_EQ(run_steps(&r, 0.1f, 1, 600, true), AK_OK);
         AK_CHECK_MSG(all_reached(&r), "%zu agents: not all reached after %d steps", n, r.steps_done);
-        AK_CHECK_MSG(r.min_clearance >= -1e-3, "%zu agents: min clearance %g", n, r.min_clearance);
+        /* they steer round each other (0.46 m and 0.37 m measured), not shoulder through on the
+         * contact projection (a turn rate of the seen rate minus the threshold, the paper's
+         * rule taken literally, left them touching: 0.0000 m) */
+        AK_CHECK_MSG(r.min_clearance >= 0.2, "%zu agents: min clearance %g", n, r.min_clearance);
         printf("  vision, %zu agents: %d steps, min clearance %.4f m\n", n, r.steps_done, r.min_clearance);
         run_free(&r);
     }
+}
+
+/* Vision-based steering on a preset with n agents, on 1 and 2 threads, for the preset's default
+ * steps: every agent ends on its goal (the arrival rule: agents reach their places in the goal
+ * blocks and stay there; before it, agents arriving into a parked block pushed others off
+ * their places and froze beside them), no overlap beyond 1 mm (the test's own pairwise
+ * measure), and the two runs are bit-identical. */
+static void vision_preset(const char* name, size_t n) {
+    ak_crowd_scene sc;
+    ak_diag d;
+    AK_CHECK_EQ(ak_crowd_scene_preset(name, n, &sc, &d), AK_OK);
+    ak_crowd_desc desc = {.agents = {sc.agents, sc.agent_count}, .obstacles = sc.obstacles,
+                          .obstacle_count = (uint32_t)sc.obstacle_count, .method = AK_CROWD_VISION};
+    run r[2];
+    for (int t = 0; t < 2; ++t) {
+        AK_CHECK(run_init(&r[t], &desc, sc.positions));
+        r[t].contacts = sc.contact_iterations;
+        AK_CHECK_EQ(run_steps(&r[t], sc.dt, (uint32_t)t + 1, (int)sc.steps, true), AK_OK);
+    }
+    size_t home = 0;
+    for (size_t i = 0; i < r[0].n; ++i) home += ak_crowd_goal_reached(r[0].crowd, i, r[0].p[i], r[0].wp[i]);
+    printf("  vision, %s %zu: %d of %ld steps, %zu home, min clearance %.5f m\n", name, n, r[0].steps_done,
+           sc.steps, home, r[0].min_clearance);
+    AK_CHECK_MSG(home == r[0].n, "%s: %zu of %zu home after %ld steps", name, home, r[0].n, sc.steps);
+    AK_CHECK_MSG(r[0].min_clearance >= -1e-3, "%s: min clearance %g", name, r[0].min_clearance);
+    AK_CHECK_EQ(r[0].steps_done, r[1].steps_done);
+    AK_CHECK(memcmp(r[0].p, r[1].p, r[0].n * sizeof(ak_vec2)) == 0);
+    AK_CHECK(memcmp(r[0].v, r[1].v, r[0].n * sizeof(ak_vec2)) == 0);
+    run_free(&r[0]);
+    run_free(&r[1]);
+    ak_crowd_scene_free(&sc);
+}
+
+AK_TEST(vision_presets_home) {
+    vision_preset("corridor", 20);
+    vision_preset("crossing", 20);
 }
 
 /* ---- obstacles ------------------------------------------------------------------------------ */
@@ -958,6 +997,7 @@ int main(void) {
     AK_RUN(groups_crossing);
     AK_RUN(obstacle_square);
     AK_RUN(vision_head_on_and_crossing);
+    AK_RUN_HEAVY(vision_presets_home); /* valgrind: 8 s; vision_head_on_and_crossing steps the same code */
     AK_RUN(lp_vs_brute_force);
     AK_RUN(step_velocity_is_lp_optimum);
     AK_RUN(threads_bit_identical);

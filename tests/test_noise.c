@@ -343,10 +343,21 @@ AK_TEST(fractal_gradient_matches_differences) {
     }
 }
 
+/* The batch paths this CPU has: [0] scalar reference, then AVX2 and AVX-512 where present. */
+static int simd_paths(ak_noise_simd* paths) {
+    int n = 0;
+    paths[n++] = AK_NOISE_SIMD_SCALAR;
+    const char* widest = ak_noise_simd_name();
+    if (strcmp(widest, "scalar") != 0) paths[n++] = AK_NOISE_SIMD_AVX2;
+    if (strcmp(widest, "avx512") == 0) paths[n++] = AK_NOISE_SIMD_AVX512;
+    return n;
+}
+
 /* Every SIMD path this CPU has, each selected explicitly with simd_limit, against the scalar
  * job and against ak_fractal_eval point by point: the same bits (values and gradients), for
- * Perlin and simplex, 2D and 3D, every fractal type, 1 and 3 threads, with and without
- * gradients, a length that leaves a padded tail, out-of-range and tied (x0 = y0 = z0) points. */
+ * Perlin, simplex, value and Worley noise, 2D and 3D, every fractal type, 1 and 3 threads, with
+ * and without gradients, a length that leaves a padded tail, out-of-range and tied
+ * (x0 = y0 = z0) points; the job reports the kernel it was asked for. */
 AK_TEST(batch_simd_equals_scalar) {
     printf("  widest noise kernel: %s\n", ak_noise_simd_name());
     ak_noise n = ak_noise_make(11);
@@ -366,15 +377,13 @@ AK_TEST(batch_simd_equals_scalar) {
     x[10] = 0.25f, y[10] = z[10] = 0.75f;
     x[11] = -16777215.0f;
     /* the paths: [0] scalar reference; then AVX2 and AVX-512 where the CPU has them */
-    ak_noise_simd paths[3] = {AK_NOISE_SIMD_SCALAR};
-    int npaths = 1;
-    const char* widest = ak_noise_simd_name();
-    if (strcmp(widest, "scalar") != 0) paths[npaths++] = AK_NOISE_SIMD_AVX2;
-    if (strcmp(widest, "avx512") == 0) paths[npaths++] = AK_NOISE_SIMD_AVX512;
+    ak_noise_simd paths[3];
+    const int npaths = simd_paths(paths);
     printf("  paths compared with scalar: %d\n", npaths - 1);
     const ak_fractal_type types[] = {AK_FRACTAL_FBM, AK_FRACTAL_TURBULENCE, AK_FRACTAL_RIDGED};
-    const ak_noise_basis bases[] = {AK_NOISE_BASIS_PERLIN, AK_NOISE_BASIS_SIMPLEX};
-    for (int bi = 0; bi < 2; ++bi)
+    const ak_noise_basis bases[] = {AK_NOISE_BASIS_PERLIN, AK_NOISE_BASIS_SIMPLEX, AK_NOISE_BASIS_VALUE,
+                                    AK_NOISE_BASIS_WORLEY};
+    for (int bi = 0; bi < 4; ++bi)
         for (uint32_t dims = 2; dims <= 3; ++dims) {
             for (int t = 0; t < 3; ++t) {
                 const ak_fractal_desc fd = {.type = types[t], .basis = bases[bi], .octaves = 5, .gain = 0.55f,
@@ -389,6 +398,7 @@ AK_TEST(batch_simd_equals_scalar) {
                                             .thread_count = (uint32_t)(run == 3 ? 3 : 1),
                                             .simd_limit = run == 0 ? AK_NOISE_SIMD_SCALAR : paths[pi]};
                         if (run == 2) job.out_gradient_x = job.out_gradient_y = job.out_gradient_z = (ak_f32_span){0};
+                        AK_CHECK_EQ(ak_noise_job_kernel(&job), run == 0 ? AK_NOISE_SIMD_SCALAR : paths[pi]);
                         AK_CHECK_EQ(ak_noise_job_run(&job), AK_OK);
                     }
                     AK_CHECK_MSG(memcmp(v[0], v[1], sizeof v[0]) == 0, "basis %d dims %u type %d path %d", bi,
@@ -419,6 +429,83 @@ AK_TEST(batch_simd_equals_scalar) {
     ak_noise_job bad = {.noise = &n, .dimensions = 2, .x = {x, 8}, .y = {y, 8}, .out_values = {v[0], 8},
                         .simd_limit = AK_NOISE_SIMD_COUNT};
     AK_CHECK_EQ(ak_noise_job_validate(&bad), AK_ERR_BAD_ARG);
+}
+
+/* The plain value and Worley bases (one octave) through every batch path against the scalar
+ * per-point functions, bit for bit, on points built to hit the edge cases: lattice/cell
+ * borders (integers, one ulp either side, halves; lattice points giving every corner value), negative and huge coordinates up to
+ * 2^24 - 1 (and beyond it, NaN, infinity: 0), tiny and signed-zero coordinates, and random
+ * points (which include Worley points whose nearest feature point lies two cells away). */
+AK_TEST(batch_value_worley_edges) {
+    enum { N = 4099 };
+    static float c[3][N], v[N], g[3][N];
+    static const float edge[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, 255.0f, 256.0f, -256.0f, 1e-30f, -1e-30f,
+                                 8388607.5f, -8388607.5f, 8388608.0f, 16777215.0f, -16777215.0f, 12345.0f, -777.0f,
+                                 16777216.0f, -16777216.0f, 4e9f, NAN, INFINITY, -INFINITY};
+    const int nedge = (int)(sizeof edge / sizeof edge[0]);
+    ak_rng rng = ak_rng_make(77);
+    for (int i = 0; i < N; ++i)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t kind = ak_rng_u32(&rng) % 6;
+            float x = frand(&rng, -1000.0f, 1000.0f);
+            if (kind == 0) x = edge[ak_rng_u32(&rng) % (uint32_t)(nedge - 6)]; /* finite, in range */
+            else if (kind == 1) x = floorf(x);
+            else if (kind == 2) x = nextafterf(floorf(x), -INFINITY);
+            else if (kind == 3) x = nextafterf(floorf(x), INFINITY);
+            else if (kind == 4) x = floorf(x) + 0.5f;
+            c[k][i] = x;
+        }
+    for (int i = 0; i < 40; ++i) c[i % 3][i * 97 % N] = edge[nedge - 6 + i % 6]; /* out of range */
+    /* lattice points (-3, j, 5), j = 0..255: value noise there is the corner value of hash
+     * perm[perm[perm[-3 & 255] + j] + 5], every one of the 256 hash values once */
+    for (int j = 0; j < 256; ++j) c[0][N - 1 - j] = -3.0f, c[1][N - 1 - j] = (float)j, c[2][N - 1 - j] = 5.0f;
+    ak_noise_simd paths[3];
+    const int npaths = simd_paths(paths);
+    const ak_noise_basis bases[2] = {AK_NOISE_BASIS_VALUE, AK_NOISE_BASIS_WORLEY};
+    const uint64_t seeds[2] = {0, 0x123456789ABCDEFull};
+    int compared = 0, far = 0;
+    static float rv[N], rg[3][N];
+    for (int si = 0; si < 2; ++si) {
+        const ak_noise n = ak_noise_make(seeds[si]);
+        for (int bi = 0; bi < 2; ++bi)
+            for (uint32_t dims = 2; dims <= 3; ++dims) {
+                /* the per-point reference */
+                for (int i = 0; i < N; ++i) {
+                    const float p[3] = {c[0][i], c[1][i], c[2][i]};
+                    float e[3] = {0, 0, 0};
+                    rv[i] = ak_noise_eval(&n, bases[bi], dims, p, e);
+                    for (int k = 0; k < 3; ++k) rg[k][i] = e[k];
+                    /* F1 beyond 1: a feature point two cells away may win */
+                    if (bi == 1 && rv[i] > 1.0f) ++far;
+                }
+                for (int pi = 0; pi < npaths; ++pi)
+                    for (int grad = 0; grad < 2; ++grad) {
+                        ak_noise_job job = {.noise = &n, .fractal = {.basis = bases[bi], .octaves = 1},
+                                            .dimensions = dims, .x = {c[0], N}, .y = {c[1], N}, .z = {c[2], N},
+                                            .out_values = {v, N}, .simd_limit = paths[pi]};
+                        if (grad) {
+                            job.out_gradient_x = (ak_f32_span){g[0], N};
+                            job.out_gradient_y = (ak_f32_span){g[1], N};
+                            if (dims == 3) job.out_gradient_z = (ak_f32_span){g[2], N};
+                        }
+                        AK_CHECK_EQ(ak_noise_job_kernel(&job), paths[pi]);
+                        AK_CHECK_EQ(ak_noise_job_run(&job), AK_OK);
+                        int bad = 0;
+                        for (int i = 0; i < N; ++i) {
+                            bool same = memcmp(&rv[i], &v[i], sizeof v[i]) == 0;
+                            for (uint32_t k = 0; grad && k < dims; ++k)
+                                same = same && memcmp(&rg[k][i], &g[k][i], sizeof v[i]) == 0;
+                            if (!same && bad++ < 3)
+                                AK_CHECK_MSG(false, "seed %d basis %d dims %u path %d grad %d point %d (%.9g %.9g %.9g): %.9g vs %.9g",
+                                             si, bi, (unsigned)dims, (int)paths[pi], grad, i, (double)c[0][i],
+                                             (double)c[1][i], (double)c[2][i], (double)v[i], (double)rv[i]);
+                        }
+                        compared += N;
+                    }
+            }
+    }
+    printf("  %d points compared, %d Worley points with F1 > 1\n", compared, far);
+    AK_CHECK(far > 0);
 }
 
 AK_TEST(grid_job_equals_points) {
@@ -781,6 +868,7 @@ int main(void) {
     AK_RUN(fractal_octaves_scale_by_gain);
     AK_RUN(fractal_gradient_matches_differences);
     AK_RUN(batch_simd_equals_scalar);
+    AK_RUN(batch_value_worley_edges);
     AK_RUN(grid_job_equals_points);
     AK_RUN(job_validity);
     AK_RUN(other_bases_gradients);

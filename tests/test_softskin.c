@@ -308,12 +308,13 @@ AK_TEST(threads_give_identical_results) {
     rig g;
     AK_CHECK(rig_load(&g, 12, 8));
     rig_pose(&g, ak_quat_identity());
-    ak_skin_soft_desc d = rig_desc(&g, 24);
+    ak_skin_soft_desc d = rig_desc(&g, 64);
+    d.substeps = 2; /* the same arithmetic per substep: two are enough to compare */
     sim a, b;
     AK_CHECK(sim_init(&a, &g, &d));
     AK_CHECK(sim_init(&b, &g, &d));
     size_t nn = ak_skin_soft_node_count(a.soft);
-    AK_CHECK(nn >= 3 * 256); /* large enough that 3 threads really run */
+    AK_CHECK(nn >= 3 * 4096); /* large enough that 3 threads really run (one per 4096 nodes) */
     b.job.thread_count = 3;
     for (int f = 1; f <= 4; ++f) {
         rig_pose(&g, ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 0.3f * (float)f));
@@ -574,6 +575,9 @@ AK_TEST(cesiumman_bind_and_legs_apart) {
     cman c;
     if (!cman_load(&c)) return;
     ak_skin_soft_desc d = cman_desc(&c);
+    /* resolution 16: cubes wide enough to span the gap between the legs (at the default 32
+     * even the lattice that keeps every cube has no such tet, and the check could not fail) */
+    d.resolution = 16;
     ak_skin_soft* soft = NULL;
     AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_OK);
     size_t nn = ak_skin_soft_node_count(soft), nv = c.nv;
@@ -643,7 +647,7 @@ static size_t cman_pairs(const cman* c, const ak_vec3* p) {
 }
 
 /* The joint named `joint` (child `child` sets the limb's direction) turned to `degrees` over 20
- * frames at 60 Hz and held 1 s, at resolution 32, joint_zone 1.5 and 40 substeps. Soft: no self-intersecting
+ * frames at 60 Hz and held 1 s, with the default desc. Soft: no self-intersecting
  * triangle pair more than the bind pose has (0), while LBS and DQS interpenetrate; the enclosed
  * volume of the body (divergence theorem; CesiumMan is not closed, but its openings do not
  * move in this pose, so the change is the limb's) within 1% of the rest. */
@@ -662,11 +666,9 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
     ak_vec3 axis = ak_vec3_normalize(ak_vec3_cross(limb, ak_vec3_make(1, 0, 0)));
     if (strstr(joint, "leg")) axis = ak_vec3_neg(axis); /* a knee folds backwards */
     ak_skin_soft_desc d = cman_desc(&c);
-    /* the defaults (resolution 16, zone 3) leave too few lattice nodes and too much free flesh
-     * at CesiumMan's thin limbs: 62 pairs at the knee, 30 at the elbow (docs/softskin.md) */
-    d.resolution = 32;
-    d.joint_zone = 1.5f;
-    d.substeps = 40; /* 10: the lattice near the knee keeps 98.3%, near the elbow 91.8% */
+    /* the default desc (resolution 32, joint_zone 1.5, 40 substeps) */
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
     ak_skin_soft* soft = NULL;
     AK_CHECK_EQ(ak_skin_soft_create(&d, NULL, &soft), AK_OK);
     size_t nn = ak_skin_soft_node_count(soft), nt = ak_skin_soft_tet_count(soft), ss = ak_skin_soft_step_scratch_size(soft), nv = c.nv;
@@ -677,6 +679,7 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
     uint8_t* scratch = malloc(ss);
     cman_flex_palette(&c, slot, axis, 0.0f, pal);
     AK_CHECK_EQ(ak_skin_soft_state_init(soft, (ak_mat4_cspan){pal, c.ns}, (ak_vec3_span){x, nn}, (ak_vec3_span){v, nn}), AK_OK);
+    float ke = 0.0f, ke_moving = 0.0f;
     for (int f = 1; f <= 80; ++f) {
         memcpy(prev, pal, c.ns * sizeof(ak_mat4));
         cman_flex_palette(&c, slot, axis, ak_radians(degrees) * (float)(f < 20 ? f : 20) / 20.0f, pal);
@@ -686,9 +689,13 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
                                      .node_positions = {x, nn},
                                      .node_velocities = {v, nn},
                                      .scratch = {scratch, ss},
-                                     .out_positions = {out, nv}};
+                                     .out_positions = {out, nv},
+                                     .out_kinetic_energy = &ke};
         AK_CHECK_EQ(ak_skin_soft_step_run(&job), AK_OK);
+        if (f <= 20) ke_moving = ke > ke_moving ? ke : ke_moving;
     }
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
+    const double ms = ((double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6) / 80.0;
     /* the pose is a flexion: the child joint moved to the front (arm) or the back (leg) */
     ak_vec3 tip = ak_mat4_transform_point(pal[cs], c.jp[cs]);
     AK_CHECK(strstr(joint, "leg") ? tip.x < c.jp[slot].x : tip.x > c.jp[slot].x);
@@ -716,25 +723,27 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
         }
     }
     printf("  CesiumMan %s %.0f deg: intersecting pairs soft %zu LBS %zu DQS %zu (bind %zu); volume ratio soft %.5f LBS %.5f DQS %.5f;"
-           " lattice near the joint %.5f\n",
-           joint, (double)degrees, ps, pl, pd, p0, vs, vl, vd, lr > 0.0 ? ln / lr : 0.0);
+           " lattice near the joint %.5f; kinetic energy held 1 s %.3g (largest while bending %.3g); %zu nodes, %.2f ms per frame"
+           " (thread CPU)\n",
+           joint, (double)degrees, ps, pl, pd, p0, vs, vl, vd, lr > 0.0 ? ln / lr : 0.0, (double)ke, (double)ke_moving, nn, ms);
+    AK_CHECK_MSG(ke < 1e-3f * ke_moving, "soft: kinetic energy %g after 1 s held (%g while bending)", (double)ke, (double)ke_moving);
     AK_CHECK_MSG(pl > p0 && pd > p0, "LBS and DQS should interpenetrate (%zu, %zu; bind %zu)", pl, pd, p0);
     AK_CHECK_MSG(ps <= p0, "soft: %zu self-intersecting pairs (bind %zu)", ps, p0);
     AK_CHECK_MSG(fabs(vs - 1.0) < 0.01, "soft: volume ratio %g", vs);
     /* the lattice volume near the joint (the flesh there, not diluted by the body): within
-     * lattice_tol where given (the knee: 1%); the elbow's is printed only (it keeps 97.3%) */
-    if (lattice_tol > 0.0)
-        AK_CHECK_MSG(lr > 0.0 && fabs(ln / lr - 1.0) < lattice_tol, "soft: lattice volume near the joint %g", lr > 0.0 ? ln / lr : 0.0);
+     * lattice_tol (the knee: 1%; the elbow: 3%, it keeps 97.3%, the issue's 1% is not met) */
+    AK_CHECK_MSG(lr > 0.0 && fabs(ln / lr - 1.0) < lattice_tol, "soft: lattice volume near the joint %g", lr > 0.0 ? ln / lr : 0.0);
     free(x), free(v), free(out), free(lbs), free(dqs), free(rest), free(pal), free(prev), free(tt), free(scratch);
     ak_skin_soft_destroy(soft);
     cman_free(&c);
 }
 
 AK_TEST(cesiumman_knee_130) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 130.0f, 0.01); }
-AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f, 0.0); }
+AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f, 0.03); }
 
-AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 16, true); }
-AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 16, true); }
+/* the default desc (resolution 32, 40 substeps, the default free zone around the joint) */
+AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 0, true); }
+AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 0, true); }
 
 int main(void) {
     AK_RUN(bind_pose_reproduces_the_mesh);

@@ -5,10 +5,12 @@
 // Prints time per step for both (CPU time of the calling thread, so that other processes on a
 // shared machine count less), the ratio, and the stability of each (the largest horizontal
 // drift of a body from its start, or for ragdolls the widest joint gap; the deepest penetration
-// seen). One thread; sleeping on in both; dt = 1/60; friction 0.5; density 1000.
+// seen). One thread (animkit: --threads T sets its thread_count, and its time is then wall
+// time; the final state's hash is printed to compare thread counts); sleeping on in both;
+// dt = 1/60; friction 0.5; density 1000.
 //
 //   bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] [--substeps K]
-//                         [--only pyramid|spheres|ragdolls]
+//                         [--threads T] [--only pyramid|spheres|ragdolls]
 #include <btBulletDynamicsCommon.h>
 
 #include <cmath>
@@ -29,6 +31,7 @@ struct result {
     double drift;  // m, largest horizontal displacement of a body from its start
     double pen;    // m, deepest penetration seen over the run
     double contacts;  // contact points per step, mean over the run
+    uint64_t hash;    // animkit: FNV-1a of the final state
 };
 
 struct scene {
@@ -128,7 +131,7 @@ static bool ragdolls(int count, scene* s) {
     return ok;
 }
 
-static result run_animkit(const scene& sc, int steps, unsigned substeps) {
+static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigned threads) {
     const size_t n = sc.bodies.size();
     ak_rigid_model_desc md;
     std::memset(&md, 0, sizeof md);
@@ -137,7 +140,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps) {
     md.joints.ptr = sc.joints.data();
     md.joints.count = sc.joints.size();
     ak_rigid_model* m = nullptr;
-    result r = {0, 0, 0, 0};
+    result r = {0, 0, 0, 0, 0};
     if (ak_rigid_model_create(&md, nullptr, &m) != AK_OK) return r;
     std::vector<ak_vec3> x(n), v(n), w(n);
     std::vector<ak_quat> q(n);
@@ -149,6 +152,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps) {
     job.model = m;
     job.dt = 1.0f / 60.0f;
     job.substeps = substeps;
+    job.thread_count = threads;
     job.gravity = ak_vec3_make(0, -9.81f, 0);
     job.positions = {x.data(), n};
     job.orientations = {q.data(), n};
@@ -162,14 +166,25 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps) {
     const size_t bytes = ak_rigid_step_scratch_size(&job);
     std::vector<uint8_t> scratch(bytes);
     job.scratch = {scratch.data(), bytes};
-    const double t0 = bench_cpu_s();
+    // one thread: CPU time of the calling thread; more: wall time (the workers' time counts)
+    const double t0 = threads > 1 ? bench_wall_s() : bench_cpu_s();
     for (int s = 0; s < steps; ++s) {
         ak_rigid_step_run(&job);
         r.pen = std::fmax(r.pen, (double)pen);
         r.contacts += contacts / (double)steps;
         if (dropped) std::fprintf(stderr, "animkit dropped %u contact points (max_contacts) in step %d\n", dropped, s);
     }
-    r.ms_per_step = 1e3 * (bench_cpu_s() - t0) / steps;
+    r.ms_per_step = 1e3 * ((threads > 1 ? bench_wall_s() : bench_cpu_s()) - t0) / steps;
+    // FNV-1a of the final state: the same for every thread count (the solver's determinism)
+    uint64_t hash = 1469598103934665603ull;
+    auto mix = [&hash](const void* p, size_t bytes) {
+        for (size_t i = 0; i < bytes; ++i) hash = (hash ^ ((const unsigned char*)p)[i]) * 1099511628211ull;
+    };
+    mix(x.data(), n * sizeof(ak_vec3));
+    mix(q.data(), n * sizeof(ak_quat));
+    mix(v.data(), n * sizeof(ak_vec3));
+    mix(w.data(), n * sizeof(ak_vec3));
+    r.hash = hash;
     for (size_t i = sc.planes; i < n && sc.joints.empty(); ++i)
         r.drift = std::fmax(r.drift, std::hypot((double)(x[i].x - sc.bodies[i].position.x),
                                                 (double)(x[i].z - sc.bodies[i].position.z)));
@@ -298,7 +313,7 @@ static result run_bullet(const scene& sc, int steps) {
         pivots.push_back(pa);
         pivots.push_back(pb);
     }
-    result r = {0, 0, 0, 0};
+    result r = {0, 0, 0, 0, 0};
     const btScalar dt = 1.0f / 60.0f;
     const double t0 = bench_cpu_s();
     double in_probe = 0.0;
@@ -339,7 +354,7 @@ static result run_bullet(const scene& sc, int steps) {
 
 int main(int argc, char** argv) {
     int layers = 20, nspheres = 10000, nragdolls = 50, steps = 300;
-    unsigned substeps = 20;
+    unsigned substeps = 20, threads = 1;
     const char* only = nullptr;
     for (int i = 1; i + 1 < argc; i += 2) {
         if (!std::strcmp(argv[i], "--layers")) layers = std::atoi(argv[i + 1]);
@@ -348,15 +363,17 @@ int main(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--substeps")) substeps = (unsigned)std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--ragdolls")) nragdolls = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
+        else if (!std::strcmp(argv[i], "--threads")) threads = (unsigned)std::atoi(argv[i + 1]);
     }
-    if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || nragdolls < 1 || nragdolls > 10000 || steps < 1 || substeps < 1 || substeps > 1000) {
+    if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || nragdolls < 1 || nragdolls > 10000 || steps < 1 || substeps < 1 || substeps > 1000 || threads < 1 || threads > 64) {
         std::fprintf(stderr, "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
-                             "[--substeps K] [--only pyramid|spheres|ragdolls]\n");
+                             "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls]\n");
         return 2;
     }
-    std::printf("dt 1/60 s, %d steps, one thread, sleeping on; animkit XPBD %u substeps x 1 iteration; Bullet %d.%02d "
-                "1 step x 10 iterations (its defaults)\n",
-                steps, substeps, btGetVersion() / 100, btGetVersion() % 100);
+    std::printf("dt 1/60 s, %d steps, sleeping on; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s; Bullet "
+                "%d.%02d 1 step x 10 iterations (its defaults), one thread\n",
+                steps, substeps, threads, threads > 1 ? " (wall time)" : "", btGetVersion() / 100,
+                btGetVersion() % 100);
     std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s %9s %9s\n", "scene", "animkit ms", "Bullet ms", "ratio",
                 "animkit drift", "Bullet drift", "animkit pen", "Bullet pen", "ak pts", "bt pts");
     const char* names[3] = {"pyramid", "spheres", "ragdolls"};
@@ -369,17 +386,19 @@ int main(int argc, char** argv) {
     }
     for (int k = 0; k < 3; ++k) {
         if (scenes[k].bodies.empty()) continue;
-        result a = run_animkit(scenes[k], steps, substeps);
+        result a = run_animkit(scenes[k], steps, substeps, threads);
         result b = run_bullet(scenes[k], steps);
         char label[64];
         std::snprintf(label, sizeof label, "%s (%zu bodies)", names[k], scenes[k].bodies.size() - scenes[k].planes);
         std::printf("%-26s %11.3f %11.3f %7.3f %13.3g %13.3g %12.3g %12.3g %9.0f %9.0f\n", label, a.ms_per_step,
                     b.ms_per_step, b.ms_per_step / a.ms_per_step, a.drift, b.drift, a.pen, b.pen, a.contacts,
                     b.contacts);
+        std::printf("  animkit final state FNV-1a %016llx\n", (unsigned long long)a.hash);
         std::fflush(stdout);
     }
     std::printf("ratio = Bullet time / animkit time (above 1: animkit faster); drift: largest horizontal\n"
                 "displacement of a body from its start (pyramid: should be ~0; ragdolls: the widest joint gap at\n"
-                "the end); pen: deepest penetration seen; pts: contact points per step; thread CPU time\n");
+                "the end); pen: deepest penetration seen; pts: contact points per step; thread CPU time (animkit\n"
+                "with --threads above 1: wall time)\n");
     return 0;
 }

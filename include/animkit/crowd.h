@@ -38,8 +38,11 @@
  *     angle's rate; pixels whose |rate| is below the paper's threshold 0.6 ttc^-1.5 are
  *     threats; the agent turns toward its goal unless that leaves a threat under the
  *     threshold, then by the smallest heading change that lifts the rates over it (keeping
- *     their signs; at most 3 rad/s), and slows to pref_speed (1 - exp(-0.5 ttc_min^2)).
- *     No guarantee against overlap (the contact passes apply as for ORCA).
+ *     their signs; at most 3 rad/s; never so far that the goal leaves the view), and slows
+ *     to pref_speed (1 - exp(-0.5 ttc_min^2)); an agent standing (under 0.25 m/s, not coming
+ *     closer) does not turn it and slows it to 30% at most. Within a second of its last goal
+ *     (pref_speed * 1 s) it walks its preferred velocity, the offset to the goal per second,
+ *     and stops there. No guarantee against overlap (the contact passes apply as for ORCA).
  *
  *   - characters: each agent drives a skinned character's in-place walk clip, its clip time
  *     following the distance walked (measured from the clip's stance foot: ak_crowd_gait_*),

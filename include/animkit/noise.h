@@ -13,8 +13,9 @@
  *   - a batch job over coordinate arrays and a grid job over a 2D lattice of points, on
  *     threads, 16 points at a time with AVX-512 or 8 with AVX2 where the CPU has it (chosen
  *     at run time, scalar reference always built; AK_NO_SIMD, skip_simd or simd_limit force
- *     it). The SIMD paths give the same bits as the scalar one (no FMA contraction on either
- *     side).
+ *     it) for Perlin, simplex, value and Worley noise in 2D and 3D and every fractal type;
+ *     1D, 4D and domain warping run the scalar reference. The SIMD paths give the same bits
+ *     as the scalar one (no implicit FMA contraction on either side).
  *
  * What it does NOT do: sparse convolution or wavelet noise, anti-aliasing of the sum (octaves
  * above the sampling rate are the caller's business), textures or images (see terrain.h).
@@ -181,13 +182,13 @@ AK_API void ak_fractal_range(const ak_fractal_desc* desc, uint32_t dimensions, f
 
 /* Upper limit on the SIMD kernel the batch and grid jobs may pick (the widest this CPU has up
  * to the limit is used; tests and benchmarks run every path side by side with it). The SIMD
- * kernels cover Perlin and simplex noise in 2D and 3D without warping (every fractal type,
- * with or without gradient); other configurations run the scalar reference. Every kernel
- * gives the scalar reference's bits. */
+ * kernels cover Perlin, simplex, value and Worley (F1) noise in 2D and 3D without warping
+ * (every fractal type, with or without gradient); 1D, 4D and domain warping run the scalar
+ * reference. Every kernel gives the scalar reference's bits. */
 typedef enum ak_noise_simd {
     AK_NOISE_SIMD_DEFAULT = 0, /* -> the widest kernel this CPU has (AK_NOISE_SIMD_AVX512) */
     AK_NOISE_SIMD_SCALAR,      /* scalar code (as skip_simd) */
-    AK_NOISE_SIMD_AVX2,        /* 8 points per block, where the CPU has AVX2 */
+    AK_NOISE_SIMD_AVX2,        /* 8 points per block, where the CPU has AVX2 and FMA */
     AK_NOISE_SIMD_AVX512,      /* 16 points per block, where the CPU has AVX-512 F and DQ, else AVX2 */
     AK_NOISE_SIMD_COUNT
 } ak_noise_simd;
@@ -215,6 +216,9 @@ AK_API ak_result ak_noise_job_validate(const ak_noise_job* job);
 /* Validate, then fill the outputs (nothing is written on error). Results are identical for any
  * thread_count and with or without SIMD. */
 AK_API ak_result ak_noise_job_run(const ak_noise_job* job);
+/* The kernel ak_noise_job_run runs for this job on this CPU: AK_NOISE_SIMD_AVX512, _AVX2 or
+ * _SCALAR (never DEFAULT); SCALAR for a job that fails validation. */
+AK_API ak_noise_simd ak_noise_job_kernel(const ak_noise_job* job);
 
 /* Evaluate a fractal on a width x height grid of 2D points
  * p(i, j) = (origin_x + i * spacing_x, origin_y + j * spacing_y), row-major (j rows of i). */

@@ -26,7 +26,8 @@
  *     compliance 1 / (lambda V), solved together as one 2x2 system (their coupled solve), with
  *     stiffness-proportional (Rayleigh) damping of the deviatoric constraint (XPBD eq. 26 with
  *     gamma = damping / h; each row damps motion along its own gradient, so the stress-free
- *     rest stays a fixed point), `substeps` substeps of one Gauss-Seidel sweep per step, lumped
+ *     rest stays a fixed point), `substeps` substeps of one Gauss-Seidel sweep per step (8
+ *     tetrahedra of a colour at once with AVX2 where the CPU has it: the same bits), lumped
  *     masses from the density, and jiggle damping: each substep the flesh's velocity relative
  *     to its skinned velocity (from previous_palette) decays by exp(-jiggle_damping h);
  *   - collisions between body parts, two kinds: (1) where a bone starts at another's end (a
@@ -44,7 +45,7 @@
  * continuous collision detection, morph targets (the bind positions are embedded), or separate
  * lattice copies for parts that one cube spans (parts at most two skeleton steps apart stay
  * joined; farther ones are cut apart, their surface vertices extrapolated from a neighbouring
- * cube of their own part). The lattice is coarse next to the mesh (resolution 16: a few cubes across
+ * cube of their own part). The lattice is coarse next to the mesh (resolution 32: two to four cubes across
  * a limb), so the surface follows the tetrahedra's piecewise-linear motion: visible facets at
  * strong deformations. Normals: compute them from the deformed surface (ak_normals_compute).
  *
@@ -91,14 +92,15 @@ typedef struct ak_skin_soft_desc {
     ak_skin_bone_cspan bones;  /* required, >= 1: bind-space bones (ak_skin_bones_from_joints);
                                   joint_index is a palette index */
     uint32_t resolution;       /* lattice cubes along the longest side of the bounds, 2..256;
-                                  0 -> 16 */
+                                  0 -> 32 (CesiumMan: 1660 nodes, 5226 tetrahedra) */
     float youngs_modulus;      /* E in pascals, > 0; 0 -> 5e4 (soft tissue: 1e4 .. 1e5) */
     float poisson_ratio;       /* nu in (0, 0.4999]; 0 -> 0.499 (nearly incompressible: the
                                   volume holds within 1% at a 150-degree bend) */
     float density;             /* kg / m^3, > 0; 0 -> 1000 */
     float damping;             /* Rayleigh stiffness-proportional damping of the deviatoric
                                   constraint in seconds; 0 -> 0.1; negative -> none */
-    uint32_t substeps;         /* per step, 1..1000; 0 -> 10 */
+    uint32_t substeps;         /* per step, 1..1000; 0 -> 40 (one Gauss-Seidel sweep each:
+                                  the finer lattice needs them to keep its volume) */
     float bone_radius;         /* kinematic capsule radius as a fraction of the median flesh
                                   radius of the bone, in (0, 1]; 0 -> 0.5 */
     size_t memory_budget;      /* most bytes create may allocate; 0 -> 512 MiB */
@@ -106,10 +108,13 @@ typedef struct ak_skin_soft_desc {
                                   (see previous_palette) decays as exp(-jiggle_damping t);
                                   0 -> 5; negative -> none */
     float joint_zone;          /* flesh zone around a joint, in kinematic capsule radii (at
-                                  most half the bone's length), in (0, 100]; 0 -> 3. Smaller:
-                                  more of the limb near a joint follows the bone (CesiumMan's
-                                  knee at 130 degrees needs 1.5 at resolution 32 with 40
-                                  substeps; the cylinder bent 150 degrees needs 3) */
+                                  most half the bone's length), in (0, 100]; 0 -> 1.5, and at
+                                  least 2 flesh radii of a bone whose capsule (bone_radius x
+                                  flesh radius) is above the 1.2-cube floor (a limb the lattice
+                                  resolves: the fat builtin cylinder; tuned on it and on
+                                  CesiumMan's knee and elbow at 130 degrees, docs/softskin.md).
+                                  Explicit: capsule radii only. Smaller: more of the limb near
+                                  a joint follows the bone */
     bool join_distant_parts;   /* false (default): drop the lattice cells whose corners lie
                                   nearest to bones that share no joint (keeps the two legs,
                                   an arm and the chest apart); true: keep them (limbs closer
@@ -189,7 +194,7 @@ typedef struct ak_skin_soft_step_job {
     ak_vec3_span out_positions;     /* optional (ptr NULL -> none): the surface afterwards */
     float* out_kinetic_energy;      /* optional: joules of the flesh nodes afterwards */
     uint32_t thread_count;          /* 0 or 1 -> calling thread; n (<= 64) -> up to n threads,
-                                       at most one per 256 nodes (a barrier per colour and
+                                       at most one per 4096 nodes (a barrier per colour and
                                        substep: worth it from a few thousand nodes) */
 } ak_skin_soft_step_job;
 

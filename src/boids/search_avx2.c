@@ -164,7 +164,8 @@ AKP_AVX2 static inline void transpose4x4(const __m256i r[4], __m256i out[4]) {
  * [quad]; ws, wa, wc: the rule masks as 64-bit lanes [quad]. */
 AKP_AVX2 static inline void credit_rows4(akp_boids_acc* acc, unsigned bj, const uint32_t* kt, __m256i e[3][2],
                                          __m256i f[3][2], const __m256i ws[2], const __m256i wa[2],
-                                         const __m256i wc[2], const int64_t* qi) {
+                                         const __m256i wc[2], const int64_t* qi, const int64_t* sqv,
+                                         unsigned bab, __m256i own[4]) {
     const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi64x(1), hi1 = _mm256_set1_epi64x((int64_t)1 << 32);
     for (int q = 0; q < 2; ++q) {
         const unsigned m4 = (bj >> (4 * q)) & 15u;
@@ -188,6 +189,13 @@ AKP_AVX2 static inline void credit_rows4(akp_boids_acc* acc, unsigned bj, const 
             __m256i* A = (__m256i*)(void*)&acc[kt[4 * q + l]];
             for (int v = 0; v < 3; ++v)
                 _mm256_storeu_si256(A + v, _mm256_add_epi64(_mm256_loadu_si256(A + v), rows[4 * v + l]));
+            if (sqv) { /* the agent's own sums (see akp_boids_sym_avx2) */
+                for (int v = 0; v < 3; ++v) own[v] = _mm256_add_epi64(own[v], rows[4 * v + l]);
+                const __m256i q3 = _mm256_and_si256(_mm256_setr_epi64x(-1, -1, -1, 0),
+                                                    _mm256_set1_epi64x(-(int64_t)((bab >> (4 * q + l)) & 1u)));
+                own[3] = _mm256_add_epi64(
+                    own[3], _mm256_maskload_epi64((const long long*)(const void*)(sqv + 3 * (size_t)kt[4 * q + l]), q3));
+            }
         }
     }
 }
@@ -209,6 +217,12 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
     for (int a = 0; a < 3; ++a) s[a] = cs[a] = _mm256_setzero_si256();
     int64_t al[3] = {0, 0, 0};
     uint32_t ns = 0, na = 0, nc = 0, nf = 0;
+    /* The common case (both directions of every pair, no partner at a thread boundary): the
+     * agent's own sums are taken from the partners' credit rows as they are added: sep and coh
+     * are minus the rows' sums, ali the partners' sqv where aligning (own[3]). */
+    __m256i own[4];
+    for (int a = 0; a < 4; ++a) own[a] = _mm256_setzero_si256();
+    bool reduce = false; /* s, cs hold sums */
     for (uint32_t u = 0; u < count; u += 8) {
         const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)(count - u < 8 ? count - u : 8)), lane);
         const __m256 dd = _mm256_maskload_ps(h->d2 + u, live);
@@ -254,6 +268,23 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
                        bcb = (unsigned)_mm256_movemask_ps(bc);
         uint32_t kt[8];
         _mm256_storeu_si256((__m256i*)(void*)kt, kk);
+        /* Partners at a thread boundary (spill or atomic adds) take the lane-by-lane path. */
+        const __m256i kb = _mm256_xor_si256(kk, _mm256_set1_epi32(INT32_MIN)); /* unsigned compares */
+        const unsigned edge =
+            bj & (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(
+                     _mm256_cmpgt_epi32(_mm256_set1_epi32((int)(sink->atomic_end ^ 0x80000000u)), kb),
+                     _mm256_cmpgt_epi32(kb, _mm256_set1_epi32((int)((sink->far_begin - 1u) ^ 0x80000000u))))));
+        if (bi == bj && !edge && sink->far_begin > 0) { /* bi != 0: mb is not empty */
+            __m256i wa[2];
+            widen(ba, wa);
+            credit_rows4(sink->acc, bj, kt, e, f, ws, wa, wc, qi, qv, bab, own);
+            nf += (uint32_t)__builtin_popcount(bi);
+            ns += (uint32_t)__builtin_popcount(bi & bsb);
+            nc += (uint32_t)__builtin_popcount(bi & bcb);
+            na += (uint32_t)__builtin_popcount(bi & bab);
+            continue;
+        }
+        reduce = true;
         if (bi) {
             for (int a = 0; a < 3; ++a) {
                 s[a] = _mm256_add_epi64(s[a], _mm256_add_epi64(_mm256_and_si256(e[a][0], wi[0]),
@@ -272,16 +303,10 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
                 al[2] += q[2];
             }
         }
-        /* Partners at a thread boundary (spill or atomic adds) take the lane-by-lane path. */
-        const __m256i kb = _mm256_xor_si256(kk, _mm256_set1_epi32(INT32_MIN)); /* unsigned compares */
-        const unsigned edge =
-            bj & (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(
-                     _mm256_cmpgt_epi32(_mm256_set1_epi32((int)(sink->atomic_end ^ 0x80000000u)), kb),
-                     _mm256_cmpgt_epi32(kb, _mm256_set1_epi32((int)((sink->far_begin - 1u) ^ 0x80000000u))))));
         if (bj && !edge && sink->far_begin > 0) {
             __m256i wa[2];
             widen(ba, wa);
-            credit_rows4(sink->acc, bj, kt, e, f, ws, wa, wc, qi);
+            credit_rows4(sink->acc, bj, kt, e, f, ws, wa, wc, qi, NULL, 0, NULL);
         } else if (bj) {
             int64_t es[3][8], fs[3][8];
             for (int a = 0; a < 3; ++a) {
@@ -305,7 +330,16 @@ AKP_AVX2 void akp_boids_sym_avx2(const akp_boids_ctx* c, akp_boids_gather* g, co
             }
         }
     }
-    const int64_t v[9] = {hsum(s[0]), hsum(s[1]), hsum(s[2]), al[0], al[1], al[2], hsum(cs[0]), hsum(cs[1]), hsum(cs[2])};
+    int64_t o[4][4];
+    for (int a = 0; a < 4; ++a) _mm256_storeu_si256((__m256i*)(void*)o[a], own[a]);
+    /* o[0]: sep x y z, (ali x); o[1]: (ali y z), coh x y; o[2]: coh z, (counts); o[3]: ali. */
+    int64_t v[9] = {-o[0][0], -o[0][1], -o[0][2], al[0] + o[3][0], al[1] + o[3][1], al[2] + o[3][2],
+                    -o[1][2], -o[1][3], -o[2][0]};
+    if (reduce)
+        for (int a = 0; a < 3; ++a) {
+            v[a] += hsum(s[a]);
+            v[6 + a] += hsum(cs[a]);
+        }
     akp_boids_gather_add(g, v, ns, na, nc, nf);
 }
 

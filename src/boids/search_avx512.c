@@ -127,6 +127,21 @@ AKP_AVX512 static inline void add_gathered(__m512i* sum, __mmask16 m, __m512i k3
     *sum = _mm512_add_epi64(*sum, _mm512_add_epi64(lo, hi));
 }
 
+/* Adds the lanes of the nine fixed-point accumulators to the agent's separation, alignment and
+ * cohesion sums (integer adds: the order does not matter). */
+AKP_AVX512 static inline void add_sums(akp_boids_gather* g, __m512i s0, __m512i s1, __m512i s2, __m512i a0, __m512i a1,
+                                       __m512i a2, __m512i c0, __m512i c1, __m512i c2) {
+    g->sep[0] += _mm512_reduce_add_epi64(s0);
+    g->sep[1] += _mm512_reduce_add_epi64(s1);
+    g->sep[2] += _mm512_reduce_add_epi64(s2);
+    g->ali[0] += _mm512_reduce_add_epi64(a0);
+    g->ali[1] += _mm512_reduce_add_epi64(a1);
+    g->ali[2] += _mm512_reduce_add_epi64(a2);
+    g->coh[0] += _mm512_reduce_add_epi64(c0);
+    g->coh[1] += _mm512_reduce_add_epi64(c1);
+    g->coh[2] += _mm512_reduce_add_epi64(c2);
+}
+
 AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* h,
                                        uint32_t count) {
     const akp_boids_sp* S = g->sp;
@@ -197,15 +212,7 @@ AKP_AVX512 void akp_boids_visit_avx512(const akp_boids_ctx* c, akp_boids_gather*
             nc += (uint32_t)__builtin_popcount(mc);
         }
     }
-    g->sep[0] += _mm512_reduce_add_epi64(s0);
-    g->sep[1] += _mm512_reduce_add_epi64(s1);
-    g->sep[2] += _mm512_reduce_add_epi64(s2);
-    g->ali[0] += _mm512_reduce_add_epi64(a0);
-    g->ali[1] += _mm512_reduce_add_epi64(a1);
-    g->ali[2] += _mm512_reduce_add_epi64(a2);
-    g->coh[0] += _mm512_reduce_add_epi64(c0);
-    g->coh[1] += _mm512_reduce_add_epi64(c1);
-    g->coh[2] += _mm512_reduce_add_epi64(c2);
+    add_sums(g, s0, s1, s2, a0, a1, a2, c0, c1, c2);
     g->ns += ns;
     g->na += na;
     g->nc += nc;
@@ -292,7 +299,8 @@ AKP_AVX512 static inline void transpose4(const __m512i r[4], __m512i out[4]) {
  * the rule is off, [2 axis + half]. */
 AKP_AVX512 static inline void credit_rows(akp_boids_acc* acc, __mmask16 mj, const uint32_t* kt, const __m512i E[6],
                                           const __m512i F[6], __mmask16 bs, __mmask16 ba, __mmask16 bc,
-                                          const int64_t* qi) {
+                                          const int64_t* qi, const int64_t* sqv, __m512i* i8, __m256i* i4,
+                                          __m512i* ia) {
     const __m512i zero = _mm512_setzero_si512(), one = _mm512_set1_epi64(1);
     const __m512i hi1 = _mm512_set1_epi64((int64_t)1 << 32);
     for (int h = 0; h < 2; ++h) {
@@ -324,6 +332,12 @@ AKP_AVX512 static inline void credit_rows(akp_boids_acc* acc, __mmask16 mj, cons
             _mm512_storeu_si512((void*)A, _mm512_add_epi64(_mm512_loadu_si512((const void*)A), rows[l]));
             _mm256_storeu_si256((__m256i*)(void*)(A + 8),
                                 _mm256_add_epi64(_mm256_loadu_si256((const __m256i*)(const void*)(A + 8)), tl));
+            if (sqv) { /* i's own sums: minus the rows' sep and coh, plus the partner's velocity */
+                *i8 = _mm512_add_epi64(*i8, rows[l]);
+                *i4 = _mm256_add_epi64(*i4, tl);
+                const __mmask8 q3 = (__mmask8)(7u & (0u - ((a8 >> l) & 1u)));
+                *ia = _mm512_add_epi64(*ia, _mm512_maskz_loadu_epi64(q3, sqv + 3 * (size_t)kt[8 * h + l]));
+            }
         }
     }
 }
@@ -357,7 +371,14 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
     const float* svf = (const float*)(const void*)c->sv; /* ak_vec3: 3 packed floats */
     __m512i s0 = _mm512_setzero_si512(), s1 = s0, s2 = s0, a0 = s0, a1 = s0, a2 = s0, c0 = s0, c1 = s0, c2 = s0;
     uint32_t ns = 0, na = 0, nc = 0, nf = 0;
-    int64_t e[48], f[48], ai[3] = {0, 0, 0};
+    int64_t e[48], f[48];
+    /* The common case (no cone, no partner at a thread boundary): i's sums are taken from the
+     * partners' credit rows as they are added (no lane reductions, no gather of the partners'
+     * velocities): sep and coh are minus the rows' sums, ali the partners' sqv where aligning. */
+    __m512i i8 = _mm512_setzero_si512();
+    __m256i i4 = _mm256_setzero_si256();
+    __m512i ia = _mm512_setzero_si512();
+    bool reduce = false;
     for (uint32_t u = 0; u < count; u += 16) {
         const uint32_t left = count - u;
         const __mmask16 live = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
@@ -402,6 +423,22 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
             E[a] = _mm512_maskz_mov_epi64((__mmask8)(bs >> (8 * (a & 1))), E[a]);
             F[a] = _mm512_maskz_mov_epi64((__mmask8)(bc >> (8 * (a & 1))), F[a]);
         }
+        uint32_t kt[16];
+        __mmask16 edge = 0;
+        if (mj) {
+            _mm512_storeu_si512((void*)kt, kk);
+            /* Partners at a thread boundary (spill or atomic adds) take the lane-by-lane path. */
+            edge = _mm512_mask_cmplt_epu32_mask(mj, kk, _mm512_set1_epi32((int)sink->atomic_end)) |
+                   _mm512_mask_cmpge_epu32_mask(mj, kk, _mm512_set1_epi32((int)sink->far_begin));
+        }
+        if (mi == mj && !edge) { /* mb != 0, so both are this mask */
+            credit_rows(sink->acc, mj, kt, E, F, bs, ba, bc, qi, c->sqv, &i8, &i4, &ia);
+            ns += (uint32_t)__builtin_popcount(mi & bs);
+            na += (uint32_t)__builtin_popcount(mi & ba);
+            nc += (uint32_t)__builtin_popcount(mi & bc);
+            continue;
+        }
+        reduce = true;
         if (mi) {
             const __mmask8 lo = (__mmask8)(mi & 0xFF), hi = (__mmask8)(mi >> 8);
             __m512i* sums[6] = {&s0, &s1, &s2, &c0, &c1, &c2};
@@ -411,7 +448,7 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
                 *sums[a] = _mm512_mask_add_epi64(*sums[a], hi, *sums[a], X[1]);
             }
             const __mmask16 mai = mi & ba;
-            if (mai && (cone || mj != mi)) { /* else the partner loop below sums them */
+            if (mai) {
                 const __m512i k3 = _mm512_add_epi32(_mm512_add_epi32(kk, kk), kk);
                 add_gathered(&a0, mai, k3, c->sqv);
                 add_gathered(&a1, mai, k3, c->sqv + 1);
@@ -422,11 +459,6 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
             nc += (uint32_t)__builtin_popcount(mi & bc);
         }
         if (mj) {
-            uint32_t kt[16];
-            _mm512_storeu_si512((void*)kt, kk);
-            /* Partners at a thread boundary (spill or atomic adds) take the lane-by-lane path. */
-            const __mmask16 edge = _mm512_mask_cmplt_epu32_mask(mj, kk, _mm512_set1_epi32((int)sink->atomic_end)) |
-                                   _mm512_mask_cmpge_epu32_mask(mj, kk, _mm512_set1_epi32((int)sink->far_begin));
             if (edge) {
                 for (int a = 0; a < 3; ++a) {
                     _mm512_storeu_si512((void*)(e + 16 * a), E[2 * a]);
@@ -436,26 +468,28 @@ AKP_AVX512 void akp_boids_sym_avx512(const akp_boids_ctx* c, akp_boids_gather* g
                 }
                 credit_lanes(sink, mj, kt, e, f, bs, ba, bc, qi);
             } else {
-                credit_rows(sink->acc, mj, kt, E, F, bs, ba, bc, qi);
+                credit_rows(sink->acc, mj, kt, E, F, bs, ba, bc, qi, NULL, NULL, NULL, NULL);
             }
-            if (!cone && mj == mi) /* both directions see each other: i's alignment sums here */
-                for (__mmask16 r = mi & ba; r; r &= (__mmask16)(r - 1)) {
-                    const int64_t* q = c->sqv + 3 * (size_t)kt[__builtin_ctz(r)];
-                    ai[0] += q[0];
-                    ai[1] += q[1];
-                    ai[2] += q[2];
-                }
         }
     }
-    g->sep[0] += _mm512_reduce_add_epi64(s0);
-    g->sep[1] += _mm512_reduce_add_epi64(s1);
-    g->sep[2] += _mm512_reduce_add_epi64(s2);
-    g->ali[0] += _mm512_reduce_add_epi64(a0) + ai[0];
-    g->ali[1] += _mm512_reduce_add_epi64(a1) + ai[1];
-    g->ali[2] += _mm512_reduce_add_epi64(a2) + ai[2];
-    g->coh[0] += _mm512_reduce_add_epi64(c0);
-    g->coh[1] += _mm512_reduce_add_epi64(c1);
-    g->coh[2] += _mm512_reduce_add_epi64(c2);
+    if (reduce) {
+        add_sums(g, s0, s1, s2, a0, a1, a2, c0, c1, c2);
+    }
+    int64_t r8[8], r4[4], ra[8];
+    _mm512_storeu_si512((void*)r8, i8);
+    _mm256_storeu_si256((__m256i*)(void*)r4, i4);
+    _mm512_storeu_si512((void*)ra, ia);
+    /* r8: sep x y z, ali (the partners' credits, unused), coh x y; r4: coh z, counts. Integer
+     * sums wrap like the others: minus the sum is the sum of the negated terms. */
+    g->sep[0] -= r8[0];
+    g->sep[1] -= r8[1];
+    g->sep[2] -= r8[2];
+    g->coh[0] -= r8[6];
+    g->coh[1] -= r8[7];
+    g->coh[2] -= r4[0];
+    g->ali[0] += ra[0];
+    g->ali[1] += ra[1];
+    g->ali[2] += ra[2];
     g->ns += ns;
     g->na += na;
     g->nc += nc;

@@ -95,40 +95,119 @@ float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float*
 static inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
 static inline float dfade(float t) { return 30.0f * t * t * (t * (t - 2.0f) + 1.0f); }
 
-float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_gradient) {
-    if (dimensions < 1 || dimensions > 4) return 0.0f;
-    zero_grad(out_gradient, dimensions);
-    if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
+/* value_of[h] = (float)h / 127.5f - 1.0f, the corner value of hash h, written out (hex floats,
+ * exact) so that a corner costs a load instead of a division; the SIMD kernels divide and get
+ * the same bits (test_noise compares them). */
+static const float value_of[256] = {
+    -0x1p+0f, -0x1.fbfbfcp-1f, -0x1.f7f7f8p-1f, -0x1.f3f3f4p-1f, -0x1.efeffp-1f, -0x1.ebebecp-1f,
+    -0x1.e7e7e8p-1f, -0x1.e3e3e4p-1f, -0x1.dfdfep-1f, -0x1.dbdbdcp-1f, -0x1.d7d7d8p-1f, -0x1.d3d3d4p-1f,
+    -0x1.cfcfdp-1f, -0x1.cbcbccp-1f, -0x1.c7c7c8p-1f, -0x1.c3c3c4p-1f, -0x1.bfbfcp-1f, -0x1.bbbbbcp-1f,
+    -0x1.b7b7b8p-1f, -0x1.b3b3b4p-1f, -0x1.afafbp-1f, -0x1.ababacp-1f, -0x1.a7a7a8p-1f, -0x1.a3a3a4p-1f,
+    -0x1.9f9fap-1f, -0x1.9b9b9cp-1f, -0x1.979798p-1f, -0x1.939394p-1f, -0x1.8f8f9p-1f, -0x1.8b8b8cp-1f,
+    -0x1.878788p-1f, -0x1.838384p-1f, -0x1.7f7f8p-1f, -0x1.7b7b7cp-1f, -0x1.777778p-1f, -0x1.737374p-1f,
+    -0x1.6f6f7p-1f, -0x1.6b6b6cp-1f, -0x1.676768p-1f, -0x1.636364p-1f, -0x1.5f5f6p-1f, -0x1.5b5b5cp-1f,
+    -0x1.575758p-1f, -0x1.535354p-1f, -0x1.4f4f5p-1f, -0x1.4b4b4cp-1f, -0x1.474748p-1f, -0x1.434344p-1f,
+    -0x1.3f3f4p-1f, -0x1.3b3b3cp-1f, -0x1.373738p-1f, -0x1.333334p-1f, -0x1.2f2f3p-1f, -0x1.2b2b2cp-1f,
+    -0x1.272728p-1f, -0x1.232324p-1f, -0x1.1f1f2p-1f, -0x1.1b1b1cp-1f, -0x1.171718p-1f, -0x1.131314p-1f,
+    -0x1.0f0f1p-1f, -0x1.0b0b0cp-1f, -0x1.070708p-1f, -0x1.030304p-1f, -0x1.fdfdfcp-2f, -0x1.f5f5f4p-2f,
+    -0x1.ededecp-2f, -0x1.e5e5e4p-2f, -0x1.dddddcp-2f, -0x1.d5d5d4p-2f, -0x1.cdcdccp-2f, -0x1.c5c5c4p-2f,
+    -0x1.bdbdbcp-2f, -0x1.b5b5b4p-2f, -0x1.adadacp-2f, -0x1.a5a5a4p-2f, -0x1.9d9d9cp-2f, -0x1.959594p-2f,
+    -0x1.8d8d8cp-2f, -0x1.858584p-2f, -0x1.7d7d7cp-2f, -0x1.757574p-2f, -0x1.6d6d6cp-2f, -0x1.656564p-2f,
+    -0x1.5d5d5cp-2f, -0x1.555554p-2f, -0x1.4d4d4cp-2f, -0x1.454544p-2f, -0x1.3d3d3cp-2f, -0x1.353534p-2f,
+    -0x1.2d2d2cp-2f, -0x1.252524p-2f, -0x1.1d1d1cp-2f, -0x1.151514p-2f, -0x1.0d0d0cp-2f, -0x1.050504p-2f,
+    -0x1.f9f9f8p-3f, -0x1.e9e9e8p-3f, -0x1.d9d9d8p-3f, -0x1.c9c9c8p-3f, -0x1.b9b9b8p-3f, -0x1.a9a9a8p-3f,
+    -0x1.999998p-3f, -0x1.898988p-3f, -0x1.797978p-3f, -0x1.696968p-3f, -0x1.595958p-3f, -0x1.494948p-3f,
+    -0x1.393938p-3f, -0x1.292928p-3f, -0x1.191918p-3f, -0x1.090908p-3f, -0x1.f1f1fp-4f, -0x1.d1d1dp-4f,
+    -0x1.b1b1bp-4f, -0x1.91919p-4f, -0x1.71717p-4f, -0x1.51515p-4f, -0x1.31313p-4f, -0x1.11111p-4f,
+    -0x1.e1e1ep-5f, -0x1.a1a1ap-5f, -0x1.61616p-5f, -0x1.21212p-5f, -0x1.c1c1cp-6f, -0x1.41414p-6f,
+    -0x1.81818p-7f, -0x1.0101p-8f, 0x1.0102p-8f, 0x1.8182p-7f, 0x1.41418p-6f, 0x1.c1c2p-6f,
+    0x1.21214p-5f, 0x1.61618p-5f, 0x1.a1a1cp-5f, 0x1.e1e2p-5f, 0x1.11112p-4f, 0x1.31314p-4f,
+    0x1.51516p-4f, 0x1.71718p-4f, 0x1.9191ap-4f, 0x1.b1b1cp-4f, 0x1.d1d1ep-4f, 0x1.f1f2p-4f,
+    0x1.09091p-3f, 0x1.19192p-3f, 0x1.29293p-3f, 0x1.39394p-3f, 0x1.49495p-3f, 0x1.59596p-3f,
+    0x1.69697p-3f, 0x1.79798p-3f, 0x1.89899p-3f, 0x1.9999ap-3f, 0x1.a9a9bp-3f, 0x1.b9b9cp-3f,
+    0x1.c9c9dp-3f, 0x1.d9d9ep-3f, 0x1.e9e9fp-3f, 0x1.f9fap-3f, 0x1.050508p-2f, 0x1.0d0d1p-2f,
+    0x1.151518p-2f, 0x1.1d1d2p-2f, 0x1.252528p-2f, 0x1.2d2d3p-2f, 0x1.353538p-2f, 0x1.3d3d4p-2f,
+    0x1.454548p-2f, 0x1.4d4d5p-2f, 0x1.555558p-2f, 0x1.5d5d6p-2f, 0x1.656568p-2f, 0x1.6d6d7p-2f,
+    0x1.757578p-2f, 0x1.7d7d8p-2f, 0x1.858588p-2f, 0x1.8d8d9p-2f, 0x1.959598p-2f, 0x1.9d9dap-2f,
+    0x1.a5a5a8p-2f, 0x1.adadbp-2f, 0x1.b5b5b8p-2f, 0x1.bdbdcp-2f, 0x1.c5c5c8p-2f, 0x1.cdcddp-2f,
+    0x1.d5d5d8p-2f, 0x1.ddddep-2f, 0x1.e5e5e8p-2f, 0x1.ededfp-2f, 0x1.f5f5f8p-2f, 0x1.fdfep-2f,
+    0x1.030304p-1f, 0x1.070708p-1f, 0x1.0b0b0cp-1f, 0x1.0f0f1p-1f, 0x1.131314p-1f, 0x1.171718p-1f,
+    0x1.1b1b1cp-1f, 0x1.1f1f2p-1f, 0x1.232324p-1f, 0x1.272728p-1f, 0x1.2b2b2cp-1f, 0x1.2f2f3p-1f,
+    0x1.333334p-1f, 0x1.373738p-1f, 0x1.3b3b3cp-1f, 0x1.3f3f4p-1f, 0x1.434344p-1f, 0x1.474748p-1f,
+    0x1.4b4b4cp-1f, 0x1.4f4f5p-1f, 0x1.535354p-1f, 0x1.575758p-1f, 0x1.5b5b5cp-1f, 0x1.5f5f6p-1f,
+    0x1.636364p-1f, 0x1.676768p-1f, 0x1.6b6b6cp-1f, 0x1.6f6f7p-1f, 0x1.737374p-1f, 0x1.777778p-1f,
+    0x1.7b7b7cp-1f, 0x1.7f7f8p-1f, 0x1.838384p-1f, 0x1.878788p-1f, 0x1.8b8b8cp-1f, 0x1.8f8f9p-1f,
+    0x1.939394p-1f, 0x1.979798p-1f, 0x1.9b9b9cp-1f, 0x1.9f9fap-1f, 0x1.a3a3a4p-1f, 0x1.a7a7a8p-1f,
+    0x1.ababacp-1f, 0x1.afafbp-1f, 0x1.b3b3b4p-1f, 0x1.b7b7b8p-1f, 0x1.bbbbbcp-1f, 0x1.bfbfcp-1f,
+    0x1.c3c3c4p-1f, 0x1.c7c7c8p-1f, 0x1.cbcbccp-1f, 0x1.cfcfdp-1f, 0x1.d3d3d4p-1f, 0x1.d7d7d8p-1f,
+    0x1.dbdbdcp-1f, 0x1.dfdfep-1f, 0x1.e3e3e4p-1f, 0x1.e7e7e8p-1f, 0x1.ebebecp-1f, 0x1.efeffp-1f,
+    0x1.f3f3f4p-1f, 0x1.f7f7f8p-1f, 0x1.fbfbfcp-1f, 0x1p+0f,
+};
+
+/* Value noise with a constant dims (inlined per dimension) and the gradient only when asked
+ * for (it does not change the value). */
+static inline __attribute__((always_inline)) float value_n(const ak_noise* noise, uint32_t dims, const float* point,
+                                                           float* out_gradient) {
     int lo[4], hi[4];
     float f[4];
-    for (uint32_t k = 0; k < dimensions; ++k) {
+#pragma GCC unroll 4
+    for (uint32_t k = 0; k < dims; ++k) {
         const float fl = floorf(point[k]);
         const int i = (int)fl;
         f[k] = point[k] - fl;
         lo[k] = i & 255;
         hi[k] = (i + 1) & 255;
     }
-    const uint32_t corners = 1u << dimensions;
+    const uint32_t corners = 1u << dims;
+    /* corner c (bit k: hi along axis k) hashes perm[...perm[perm[x_c] + y_c]... + w_c], the
+     * shared prefixes looked up once (2 + 4 + 8 loads in 3D instead of 24) */
+    int hash[16] = {0};
+#pragma GCC unroll 4
+    for (uint32_t k = 0, count = 1; k < dims; ++k, count *= 2)
+#pragma GCC unroll 8
+        for (uint32_t c = 0; c < count; ++c) {
+            hash[c + count] = noise->perm[hash[c] + hi[k]];
+            hash[c] = noise->perm[hash[c] + lo[k]];
+        }
     float val[16], gv[16][4];
-    memset(gv, 0, sizeof gv);
+#pragma GCC unroll 16
     for (uint32_t c = 0; c < corners; ++c) {
-        int h = 0;
-        for (uint32_t k = 0; k < dimensions; ++k) h = noise->perm[h + (((c >> k) & 1u) ? hi[k] : lo[k])];
-        val[c] = (float)h / 127.5f - 1.0f;
+        val[c] = value_of[hash[c]];
+        if (out_gradient)
+            for (uint32_t m = 0; m < dims; ++m) gv[c][m] = 0.0f;
     }
-    for (uint32_t k = 0; k < dimensions; ++k) {
-        const float t = fade(f[k]), dt = dfade(f[k]);
+#pragma GCC unroll 4
+    for (uint32_t k = 0; k < dims; ++k) {
+        const float t = fade(f[k]);
+        const float dt = out_gradient ? dfade(f[k]) : 0.0f;
         const uint32_t step = 1u << k;
+#pragma GCC unroll 8
         for (uint32_t c = 0; c < corners; c += 2u * step) {
             const float a = val[c], b = val[c + step];
             val[c] = a + t * (b - a);
-            for (uint32_t m = 0; m < dimensions; ++m) gv[c][m] = gv[c][m] + t * (gv[c + step][m] - gv[c][m]);
-            gv[c][k] += (b - a) * dt;
+            if (out_gradient) {
+                for (uint32_t m = 0; m < dims; ++m) gv[c][m] = gv[c][m] + t * (gv[c + step][m] - gv[c][m]);
+                gv[c][k] += (b - a) * dt;
+            }
         }
     }
     if (out_gradient)
-        for (uint32_t m = 0; m < dimensions; ++m) out_gradient[m] = gv[0][m];
-    return fminf(fmaxf(val[0], -1.0f), 1.0f);
+        for (uint32_t m = 0; m < dims; ++m) out_gradient[m] = gv[0][m];
+    /* fminf(fmaxf(v, -1), 1) for the finite v here, without the libm calls */
+    const float v = val[0];
+    return v < -1.0f ? -1.0f : v > 1.0f ? 1.0f : v;
+}
+
+float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_gradient) {
+    if (dimensions < 1 || dimensions > 4) return 0.0f;
+    zero_grad(out_gradient, dimensions);
+    if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
+    switch (dimensions) {
+    case 1: return out_gradient ? value_n(noise, 1, point, out_gradient) : value_n(noise, 1, point, NULL);
+    case 2: return out_gradient ? value_n(noise, 2, point, out_gradient) : value_n(noise, 2, point, NULL);
+    case 3: return out_gradient ? value_n(noise, 3, point, out_gradient) : value_n(noise, 3, point, NULL);
+    default: return out_gradient ? value_n(noise, 4, point, out_gradient) : value_n(noise, 4, point, NULL);
+    }
 }
 
 /* ---- Worley ------------------------------------------------------------------------------- */
@@ -146,6 +225,109 @@ static uint32_t cell_hash(const int* cell, uint32_t dims, uint64_t seed) {
     return h;
 }
 
+/* The nearest (d1, near) and second nearest (d2) squared distances found so far. */
+typedef struct worley_best {
+    float d1, d2, near[3];
+} worley_best;
+
+/* Visit the cell base + off: its feature point, then the running minimum with strict "<" (the
+ * first of equal distances stays; written as selects, which give the branches' values). h is
+ * the cell's hash. */
+/* The offset dv = f - (feature point of the cell at offset off, hash h) and its squared
+ * length. */
+static inline __attribute__((always_inline)) float worley_offset(uint32_t dims, uint32_t h, const float* f,
+                                                                 const int* off, float* dv) {
+    float dist2 = 0.0f;
+    for (uint32_t k = 0; k < dims; ++k) {
+        /* The feature point's coordinate k in the cell is (m + 1/2) / 1024, m = bits 10 k ..
+         * 10 k + 9 of h; off[k] + that is exact in float, and equals (1 + (2 m + 1) / 2048) -
+         * (1 - off[k]), whose first term is the float with exponent 0 and m in mantissa bits
+         * 13..22 (one bit operation instead of a conversion, a multiply and two adds). */
+        const uint32_t bits = 0x3F801000u | ((h >> (10 * k)) & 1023u) << 13;
+        float fp;
+        memcpy(&fp, &bits, sizeof fp);
+        dv[k] = f[k] - (fp - (float)(1 - off[k]));
+        dist2 += dv[k] * dv[k];
+    }
+    return dist2;
+}
+
+/* Visit a cell: the running minimum with strict "<" (the first of equal distances stays). */
+static inline __attribute__((always_inline)) void worley_visit(uint32_t dims, uint32_t h, const float* f,
+                                                               const int* off, worley_best* b) {
+    float dv[3] = {0, 0, 0};
+    const float dist2 = worley_offset(dims, h, f, off, dv);
+    if (dist2 < b->d1) {
+        b->d2 = b->d1;
+        b->d1 = dist2;
+        memcpy(b->near, dv, sizeof dv);
+    } else if (dist2 < b->d2) {
+        b->d2 = dist2;
+    }
+}
+
+/* Rings 0 and 1 (the 3^dims cells around the point): ring 0 first, then ring 1 in the order
+ * c = 0, 1, ... (axis 0 fastest), each axis's share cell_k * mul_k of cell_hash computed once.
+ * The updates are selects: d1 = min(d1, dist2), d2 = min(max(dist2, d1), d2) and the step of
+ * the nearest cell (kept on strict "<") are the values of worley_visit's branches; the nearest
+ * offset is computed again at the end. Inlined with a constant dims; the SIMD kernels
+ * (simd_body.h) visit the same cells in the same order without skipping any (a skipped cell
+ * cannot change the result). */
+static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dims, uint64_t seed, const int* base,
+                                                                    const float* f, bool want_f2, worley_best* b) {
+    static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
+    const uint32_t seed_mix = (uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32);
+    uint32_t axis[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (uint32_t k = 0; k < dims; ++k)
+        for (int o = 0; o < 3; ++o) axis[k][o] = (uint32_t)(base[k] + o - 1) * mul[k];
+    const int cells = dims == 1 ? 3 : dims == 2 ? 9 : 27, center = cells / 2;
+    /* gap[k][o]: the squared distance along axis k from the point to the cell at offset o - 1
+     * (f^2, 0, (1 - f)^2); a cell whose sum is at least the distance that matters (F1, or F2
+     * when asked for) cannot change the result (its feature point is farther by at least
+     * 1/2048 along each such axis) and is skipped. */
+    float gap[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (uint32_t k = 0; k < dims; ++k) {
+        const float e = 1.0f - f[k];
+        gap[k][0] = f[k] * f[k];
+        gap[k][2] = e * e;
+    }
+    float d1 = b->d1, d2 = b->d2;
+    int best = 0;
+    uint32_t best_h = 0;
+#pragma GCC unroll 27
+    for (int step = 0; step < cells; ++step) {
+        const int c = step == 0 ? center : step <= center ? step - 1 : step;
+        const int o[3] = {c % 3, c / 3 % 3, c / 9};
+        if (step > 0) {
+            float lower = 0.0f;
+            for (uint32_t k = 0; k < dims; ++k) lower += gap[k][o[k]];
+            if (lower >= (want_f2 ? d2 : d1)) continue;
+        }
+        uint32_t h = seed_mix;
+        for (uint32_t k = 0; k < dims; ++k) h ^= axis[k][o[k]];
+        h ^= h >> 16;
+        h *= 0x85EBCA6Bu;
+        h ^= h >> 13;
+        h *= 0xC2B2AE35u;
+        h ^= h >> 16;
+        const int off[3] = {o[0] - 1, o[1] - 1, o[2] - 1};
+        float dv[3];
+        const float dist2 = worley_offset(dims, h, f, off, dv);
+        const bool closer = dist2 < d1;
+        best = closer ? c : best;
+        best_h = closer ? h : best_h;
+        const float hi = dist2 > d1 ? dist2 : d1;
+        d2 = hi < d2 ? hi : d2;
+        d1 = closer ? dist2 : d1;
+    }
+    const int off[3] = {best % 3 - 1, best / 3 % 3 - 1, best / 9 - 1};
+    float dv[3] = {0, 0, 0};
+    worley_offset(dims, best_h, f, off, dv);
+    memcpy(b->near, dv, sizeof dv);
+    b->d1 = d1;
+    b->d2 = d2;
+}
+
 float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_f2,
                       float* out_gradient) {
     if (dimensions < 1 || dimensions > 3) {
@@ -161,16 +343,22 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
         const float fl = floorf(point[k]);
         base[k] = (int)fl;
         f[k] = point[k] - fl;
-        margin = fminf(margin, fminf(f[k], 1.0f - f[k]));
+        const float g = f[k] < 1.0f - f[k] ? f[k] : 1.0f - f[k]; /* fminf without the libm call */
+        margin = g < margin ? g : margin;
     }
-    float d1 = INFINITY, d2 = INFINITY, near[3] = {0, 0, 0};
+    worley_best b = {INFINITY, INFINITY, {0, 0, 0}};
     /* Ring r holds the cells at Chebyshev distance r from the point's cell; their feature
-     * points are at least (r - 1) + margin away, so the search stops once that exceeds F2. */
-    for (int r = 0; r <= 6; ++r) {
-        if (r >= 1) {
-            const float bound = (float)(r - 1) + margin;
-            if (bound * bound >= d2) break;
-        }
+     * points are at least (r - 1) + margin (+ 1/2048) away, so the search stops once that
+     * exceeds F2 (or F1 when F2 is not asked for: a farther cell cannot change the nearest).
+     * Rings 0 and 1 are always searched. */
+    switch (dimensions) {
+    case 1: worley_near_rings(1, noise->seed, base, f, out_f2 != NULL, &b); break;
+    case 2: worley_near_rings(2, noise->seed, base, f, out_f2 != NULL, &b); break;
+    default: worley_near_rings(3, noise->seed, base, f, out_f2 != NULL, &b); break;
+    }
+    for (int r = 2; r <= 6; ++r) {
+        const float bound = (float)(r - 1) + margin;
+        if (bound * bound >= (out_f2 ? b.d2 : b.d1)) break;
         const int span = 2 * r + 1;
         const int cells = dimensions == 1 ? span : dimensions == 2 ? span * span : span * span * span;
         for (int c = 0; c < cells; ++c) {
@@ -183,26 +371,12 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
             if (cheb != r) continue;
             int cell[3];
             for (uint32_t k = 0; k < dimensions; ++k) cell[k] = base[k] + off[k];
-            uint32_t h = cell_hash(cell, dimensions, noise->seed);
-            float dist2 = 0.0f, dv[3] = {0, 0, 0};
-            for (uint32_t k = 0; k < dimensions; ++k) {
-                const float fp = (float)(h & 1023u) / 1024.0f + 0.5f / 1024.0f; /* feature point in the cell */
-                h = h >> 10 | h << 22;
-                dv[k] = f[k] - ((float)off[k] + fp);
-                dist2 += dv[k] * dv[k];
-            }
-            if (dist2 < d1) {
-                d2 = d1;
-                d1 = dist2;
-                memcpy(near, dv, sizeof near);
-            } else if (dist2 < d2) {
-                d2 = dist2;
-            }
+            worley_visit(dimensions, cell_hash(cell, dimensions, noise->seed), f, off, &b);
         }
     }
-    const float f1 = sqrtf(d1);
-    if (out_f2) *out_f2 = sqrtf(d2);
+    const float f1 = sqrtf(b.d1);
+    if (out_f2) *out_f2 = sqrtf(b.d2);
     if (out_gradient && f1 > 0.0f)
-        for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = near[k] / f1;
+        for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = b.near[k] / f1;
     return f1;
 }

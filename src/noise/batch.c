@@ -15,7 +15,8 @@ enum { PATH_SCALAR = 0, PATH_AVX2 = 1, PATH_AVX512 = 2 };
 
 bool akp_noise_simd_handles(const ak_fractal_desc* d, uint32_t dims) {
     return (dims == 2 || dims == 3) && d->warp == 0.0f &&
-           (d->basis == AK_NOISE_BASIS_PERLIN || d->basis == AK_NOISE_BASIS_SIMPLEX) &&
+           (d->basis == AK_NOISE_BASIS_PERLIN || d->basis == AK_NOISE_BASIS_SIMPLEX ||
+            d->basis == AK_NOISE_BASIS_VALUE || d->basis == AK_NOISE_BASIS_WORLEY) &&
            (d->type == AK_FRACTAL_FBM || d->type == AK_FRACTAL_TURBULENCE || d->type == AK_FRACTAL_RIDGED);
 }
 
@@ -145,6 +146,13 @@ static void* batch_thread(void* arg) {
         eval_chunk(t->ctx, xs, count, job->out_values.ptr + b, want_grad ? gs : NULL);
     }
     return NULL;
+}
+
+ak_noise_simd ak_noise_job_kernel(const ak_noise_job* job) {
+    if (ak_noise_job_validate(job) != AK_OK) return AK_NOISE_SIMD_SCALAR;
+    const ak_fractal_desc d = ak_fractal_desc_resolved(&job->fractal);
+    const int path = pick_path(&d, job_dims(job), job->skip_simd, job->simd_limit);
+    return path == PATH_AVX512 ? AK_NOISE_SIMD_AVX512 : path == PATH_AVX2 ? AK_NOISE_SIMD_AVX2 : AK_NOISE_SIMD_SCALAR;
 }
 
 ak_result ak_noise_job_run(const ak_noise_job* job) {

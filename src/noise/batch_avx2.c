@@ -1,17 +1,20 @@
-/* AVX2 fractal kernels (8 points at a time): 2D and 3D Perlin and simplex noise, value and
- * gradient, summed as fBm, turbulence or ridged multifractal. The body is simd_body.h (shared
- * with the AVX-512 kernel); this file supplies its 8-lane vocabulary. Compiled only for
- * GCC/Clang on x86-64 without AK_NO_SIMD; selected at run time with __builtin_cpu_supports. */
+/* AVX2 fractal kernels (8 points at a time): 2D and 3D Perlin, simplex, value and Worley
+ * noise, value and gradient, summed as fBm, turbulence or ridged multifractal. The body is
+ * simd_body.h (shared with the AVX-512 kernel); this file supplies its 8-lane vocabulary. Compiled only for
+ * GCC/Clang on x86-64 without AK_NO_SIMD; selected at run time with __builtin_cpu_supports
+ * (AVX2 and FMA: value noise's corner values use explicit fused operations; nothing is
+ * contracted implicitly, the module builds with -ffp-contract=off). */
 #include "noise_internal.h"
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
 #include <immintrin.h>
+#include <math.h>
 #include <string.h>
 
-bool akp_noise_have_avx2(void) { return __builtin_cpu_supports("avx2"); }
+bool akp_noise_have_avx2(void) { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
 
-#define KI __attribute__((target("avx2"), always_inline))
-#define KERNEL_RUN __attribute__((target("avx2")))
+#define KI __attribute__((target("avx2,fma"), always_inline))
+#define KERNEL_RUN __attribute__((target("avx2,fma")))
 #define KERNEL_ENTRY akp_noise_fractal_avx2
 #define AKP_W 8
 typedef __m256 VF;
@@ -36,6 +39,14 @@ KI static inline VF vf_and(VF a, VF b) { return _mm256_and_ps(a, b); }
 KI static inline VF vf_abs(VF a) { return _mm256_andnot_ps(_mm256_set1_ps(-0.0f), a); }
 KI static inline VI vi_and(VI a, VI b) { return _mm256_and_si256(a, b); }
 KI static inline VI vi_add(VI a, VI b) { return _mm256_add_epi32(a, b); }
+KI static inline VI vi_xor(VI a, VI b) { return _mm256_xor_si256(a, b); }
+KI static inline VI vi_or(VI a, VI b) { return _mm256_or_si256(a, b); }
+KI static inline VI vi_mullo(VI a, VI b) { return _mm256_mullo_epi32(a, b); }
+KI static inline VF vf_div(VF a, VF b) { return _mm256_div_ps(a, b); }
+KI static inline VF vf_fmadd(VF a, VF b, VF c) { return _mm256_fmadd_ps(a, b, c); }   /* a b + c, one rounding */
+KI static inline VF vf_fnmadd(VF a, VF b, VF c) { return _mm256_fnmadd_ps(a, b, c); } /* c - a b, one rounding */
+KI static inline VF vf_sqrt(VF a) { return _mm256_sqrt_ps(a); }
+KI static inline VF vf_cvt(VI a) { return _mm256_cvtepi32_ps(a); }
 #define VI_SLLI(a, n) _mm256_slli_epi32((a), (n))
 #define VI_SRLI(a, n) _mm256_srli_epi32((a), (n))
 /* The lookup table is the byte table itself. An index is at most 255 + 255: the scalar loads
@@ -76,6 +87,7 @@ KI static inline VI vi_sel(VM m, VI a, VI b) {
     return _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(b), _mm256_castsi256_ps(a), m));
 }
 KI static inline VF vf_maskz(VM m, VF a) { return _mm256_and_ps(m, a); } /* m ? a : +0 */
+KI static inline unsigned m_bits(VM m) { return (unsigned)_mm256_movemask_ps(m); } /* bit i: lane i */
 /* tab[idx] for idx in 0..15 */
 KI static inline VF vf_lut16(const float* tab, VI idx) {
     const VF lo = _mm256_permutevar8x32_ps(_mm256_loadu_ps(tab), idx);

@@ -6,6 +6,7 @@
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
 #include <immintrin.h>
+#include <math.h>
 
 bool akp_noise_have_avx512(void) {
     return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
@@ -37,6 +38,14 @@ KI static inline VF vf_and(VF a, VF b) { return _mm512_and_ps(a, b); }
 KI static inline VF vf_abs(VF a) { return _mm512_andnot_ps(_mm512_set1_ps(-0.0f), a); }
 KI static inline VI vi_and(VI a, VI b) { return _mm512_and_si512(a, b); }
 KI static inline VI vi_add(VI a, VI b) { return _mm512_add_epi32(a, b); }
+KI static inline VI vi_xor(VI a, VI b) { return _mm512_xor_si512(a, b); }
+KI static inline VI vi_or(VI a, VI b) { return _mm512_or_si512(a, b); }
+KI static inline VI vi_mullo(VI a, VI b) { return _mm512_mullo_epi32(a, b); }
+KI static inline VF vf_div(VF a, VF b) { return _mm512_div_ps(a, b); }
+KI static inline VF vf_fmadd(VF a, VF b, VF c) { return _mm512_fmadd_ps(a, b, c); }   /* a b + c, one rounding */
+KI static inline VF vf_fnmadd(VF a, VF b, VF c) { return _mm512_fnmadd_ps(a, b, c); } /* c - a b, one rounding */
+KI static inline VF vf_sqrt(VF a) { return _mm512_sqrt_ps(a); }
+KI static inline VF vf_cvt(VI a) { return _mm512_cvtepi32_ps(a); }
 #define VI_SLLI(a, n) _mm512_slli_epi32((a), (n))
 #define VI_SRLI(a, n) _mm512_srli_epi32((a), (n))
 /* perm[j] | perm[j + 1] << 8 for j = 0..255 in 16 registers (entries 32 c .. 32 c + 31 in
@@ -77,6 +86,7 @@ KI static inline VM m_not(VM a) { return (VM)~a; }
 KI static inline VF vf_sel(VM m, VF a, VF b) { return _mm512_mask_blend_ps(m, b, a); } /* m ? a : b */
 KI static inline VI vi_sel(VM m, VI a, VI b) { return _mm512_mask_blend_epi32(m, b, a); }
 KI static inline VF vf_maskz(VM m, VF a) { return _mm512_maskz_mov_ps(m, a); } /* m ? a : +0 */
+KI static inline unsigned m_bits(VM m) { return (unsigned)m; } /* bit i: lane i */
 /* tab[idx] for idx in 0..15 */
 KI static inline VF vf_lut16(const float* tab, VI idx) { return _mm512_permutexvar_ps(idx, _mm512_loadu_ps(tab)); }
 

@@ -11,8 +11,8 @@
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);
 
-/* True when the SIMD kernels handle this desc and dimension (Perlin and simplex, 2D and 3D,
- * without warp; the AVX2 and AVX-512 kernels handle the same set). */
+/* True when the SIMD kernels handle this desc and dimension (Perlin, simplex, value and
+ * Worley, 2D and 3D, without warp; the AVX2 and AVX-512 kernels handle the same set). */
 bool akp_noise_simd_handles(const ak_fractal_desc* d, uint32_t dims);
 /* CPU checks (false in builds without the kernels). */
 bool akp_noise_have_avx2(void);

@@ -7,7 +7,8 @@
  * and the static inline helpers used below (vf_add, vf_sel, m_lt, gather4, vf_lut16, ...).
  *
  * Each basis repeats its scalar reference operation for operation: Perlin (perlin.c lattice),
- * simplex (bases.c, Gustavson's formulation) and the octave loop (fractal.c): the same floor,
+ * simplex (bases.c, Gustavson's formulation), value and Worley noise (bases.c) and the octave
+ * loop (fractal.c): the same floor,
  * hash chain, the same evaluation order, no FMA, min/max where the scalar code has
  * fminf/fmaxf (equal for non-NaN values, and NaN never reaches them: out-of-range points are
  * masked to 0 first). So the results equal the scalar ones bit for bit; test_noise checks it
@@ -106,6 +107,29 @@ KI static inline VF dfade_v(VF t) {
 KI static inline VF lerp_v(VF t, VF a, VF b) { return vf_add(a, vf_mul(t, vf_sub(b, a))); }
 
 /* Perlin noise at W points p[0..dims-1]; value returned, gradient into grad when want_grad. */
+/* Blends the 2^dims corner values (and gradients) of a cell along each axis in turn with the
+ * quintic fade of the fractional coordinates f: val[0] (gv[0]) ends as the cell's value
+ * (gradient). Shared by Perlin and value noise; the operation order is the scalar reference's. */
+KI static inline void lerp_corners(int dims, const VF* f, VF* val, VF (*gv)[3], bool want_grad) {
+    const int corners = 1 << dims;
+    AKP_UNROLL
+    for (int k = 0; k < dims; ++k) {
+        const VF t = fade_v(f[k]);
+        const VF dt = want_grad ? dfade_v(f[k]) : vf_zero();
+        const int step = 1 << k;
+        AKP_UNROLL
+        for (int c = 0; c < corners; c += 2 * step) {
+            const VF a = val[c], b = val[c + step];
+            val[c] = lerp_v(t, a, b);
+            if (want_grad) {
+                AKP_UNROLL
+                for (int m = 0; m < dims; ++m) gv[c][m] = lerp_v(t, gv[c][m], gv[c + step][m]);
+                gv[c][k] = vf_add(gv[c][k], vf_mul(vf_sub(b, a), dt));
+            }
+        }
+    }
+}
+
 KI static inline VF perlin_v(const PermTab* perm, int dims, const VF* p, VF* grad, bool want_grad) {
     const VM valid = in_range(dims, p);
     VI lo[3];
@@ -127,22 +151,7 @@ KI static inline VF perlin_v(const PermTab* perm, int dims, const VF* p, VF* gra
         for (int k = 0; k < dims; ++k) d[k] = ((c >> k) & 1) ? vf_sub(f[k], vf_set1(1.0f)) : f[k];
         val[c] = corner_perlin(dims, hash[c], d, gv[c], want_grad);
     }
-    AKP_UNROLL
-    for (int k = 0; k < dims; ++k) {
-        const VF t = fade_v(f[k]);
-        const VF dt = want_grad ? dfade_v(f[k]) : vf_zero();
-        const int step = 1 << k;
-        AKP_UNROLL
-        for (int c = 0; c < corners; c += 2 * step) {
-            const VF a = val[c], b = val[c + step];
-            val[c] = lerp_v(t, a, b);
-            if (want_grad) {
-                AKP_UNROLL
-                for (int m = 0; m < dims; ++m) gv[c][m] = lerp_v(t, gv[c][m], gv[c + step][m]);
-                gv[c][k] = vf_add(gv[c][k], vf_mul(vf_sub(b, a), dt));
-            }
-        }
-    }
+    lerp_corners(dims, f, val, gv, want_grad);
     if (want_grad)
         AKP_UNROLL
         for (int m = 0; m < dims; ++m) grad[m] = vf_maskz(valid, gv[0][m]);
@@ -254,15 +263,151 @@ KI static inline VF simplex3_v(const PermTab* perm, const VF* p, VF* grad, bool 
     return vf_maskz(valid, vf_mul(scale, sum));
 }
 
+/* ---- value noise --------------------------------------------------------------------------- */
+
+/* bases.c ak_noise_value in 2D/3D: the corner hashes of Perlin's chain (bases.c walks
+ * perm[h + ((i + 1) & 255)], which the doubled table makes perm[h + lo + 1]), corner values
+ * hash / 127.5 - 1 (correctly rounded, as the scalar code's: a multiplication by 1 / 127.5 differs
+ * in 111 of the 256 values; a Newton step after it does not), blended with the quintic fade, the gradient riding along. */
+KI static inline VF value_v(const PermTab* perm, int dims, const VF* p, VF* grad, bool want_grad) {
+    const VM valid = in_range(dims, p);
+    VI lo[3];
+    VF f[3];
+    AKP_UNROLL
+    for (int k = 0; k < dims; ++k) {
+        const VF fl = vf_floor(p[k]);
+        f[k] = vf_sub(p[k], fl);
+        lo[k] = vi_and(vf_cvtt(fl), vi_set1(255));
+    }
+    const int corners = 1 << dims;
+    VF val[8], gv[8][3];
+    VI hash[8];
+    cell_hashes(perm, dims, lo, hash);
+    const VF one = vf_set1(1.0f), den = vf_set1(127.5f), rcp = vf_set1(1.0f / 127.5f);
+    AKP_UNROLL
+    for (int c = 0; c < corners; ++c) {
+        /* the correctly rounded hash / 127.5 without a division: q = h r, one Newton step
+         * q + (h - q 127.5) r with fused operations; equal to the quotient for every h in
+         * 0..255 (checked exhaustively offline, and by test_noise against the scalar code) */
+        const VF h = vf_cvt(hash[c]);
+        const VF q = vf_mul(h, rcp);
+        val[c] = vf_sub(vf_fmadd(vf_fnmadd(q, den, h), rcp, q), one);
+        if (want_grad)
+            AKP_UNROLL
+            for (int m = 0; m < dims; ++m) gv[c][m] = vf_zero();
+    }
+    lerp_corners(dims, f, val, gv, want_grad);
+    if (want_grad)
+        AKP_UNROLL
+        for (int m = 0; m < dims; ++m) grad[m] = vf_maskz(valid, gv[0][m]);
+    return vf_maskz(valid, vf_min(vf_max(val[0], vf_set1(-1.0f)), one));
+}
+
+/* ---- Worley -------------------------------------------------------------------------------- */
+
+/* bases.c ak_noise_worley's F1 in 2D/3D. The scalar code searches ring 0 (the point's cell),
+ * then ring 1 (the 3^dims - 1 neighbours in the order c = 0, 1, ... with x fastest), and
+ * further rings while they may hold a closer point. Here every lane visits ring 0 and ring 1
+ * in that order with the same strict "closer than" test, so it keeps the same nearest point
+ * (ties included): the cells the scalar search skipped cannot beat F1 (their points are at
+ * least margin + 1/2048 farther than the ring bound). Lanes whose F1 could still lose to a
+ * ring-2 point ((1 + margin)^2 < F1^2: rare, the point far from every neighbour's feature
+ * point) are recomputed with the scalar function itself. */
+static const uint32_t worley_mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
+
+KI static inline VF worley_v(const ak_noise* noise, int dims, const VF* p, VF* grad, bool want_grad) {
+    const VM valid = in_range(dims, p);
+    const uint32_t seed_mix = (uint32_t)noise->seed * 0x9E3779B1u ^ (uint32_t)(noise->seed >> 32);
+    const VF one = vf_set1(1.0f);
+    VF f[3], margin = one;
+    VI axis[3][3]; /* (base_k + o - 1) * mul_k for o = 0, 1, 2 */
+    AKP_UNROLL
+    for (int k = 0; k < dims; ++k) {
+        const VF fl = vf_floor(p[k]);
+        const VI b = vf_cvtt(fl);
+        f[k] = vf_sub(p[k], fl);
+        margin = vf_min(margin, vf_min(f[k], vf_sub(one, f[k])));
+        AKP_UNROLL
+        for (int o = 0; o < 3; ++o) axis[k][o] = vi_mullo(vi_add(b, vi_set1(o - 1)), vi_set1((int)worley_mul[k]));
+    }
+    const int cells = dims == 2 ? 9 : 27, center = dims == 2 ? 4 : 13;
+    VF d1 = vf_set1(INFINITY), near[3] = {vf_zero(), vf_zero(), vf_zero()};
+    AKP_PRAGMA(GCC unroll 27)
+    for (int step = 0; step < cells; ++step) {
+        /* ring 0 first, then ring 1 in scalar order */
+        const int c = step == 0 ? center : step <= center ? step - 1 : step;
+        const int o[3] = {c % 3, c / 3 % 3, c / 9};
+        VI h = vi_set1((int)seed_mix);
+        AKP_UNROLL
+        for (int k = 0; k < dims; ++k) h = vi_xor(h, axis[k][o[k]]);
+        h = vi_xor(h, VI_SRLI(h, 16));
+        h = vi_mullo(h, vi_set1((int)0x85EBCA6Bu));
+        h = vi_xor(h, VI_SRLI(h, 13));
+        h = vi_mullo(h, vi_set1((int)0xC2B2AE35u));
+        h = vi_xor(h, VI_SRLI(h, 16));
+        VF dv[3], dist2 = vf_zero();
+        AKP_UNROLL
+        for (int k = 0; k < dims; ++k) {
+            /* bases.c: (o - 1) + ((h >> 10 k & 1023) / 1024 + 0.5 / 1024), every step exact: the
+             * same number is (1 + (2 m + 1) / 2048) - (2 - o), the first term built from the bits
+             * of m = h >> 10 k & 1023 as a float with exponent 0 (m into mantissa bits 13..22) */
+            const VI m13 = k == 0 ? VI_SLLI(h, 13) : k == 1 ? VI_SLLI(h, 3) : VI_SRLI(h, 7);
+            VF fp = vf_cast(vi_or(vi_and(m13, vi_set1(1023 << 13)), vi_set1(0x3F801000)));
+            if (o[k] != 2) fp = vf_sub(fp, vf_set1((float)(2 - o[k])));
+            dv[k] = vf_sub(f[k], fp);
+            dist2 = k == 0 ? vf_mul(dv[0], dv[0]) : vf_add(dist2, vf_mul(dv[k], dv[k]));
+        }
+        const VM closer = m_lt(dist2, d1);
+        d1 = vf_sel(closer, dist2, d1);
+        if (want_grad)
+            AKP_UNROLL
+            for (int k = 0; k < dims; ++k) near[k] = vf_sel(closer, dv[k], near[k]);
+    }
+    const VF f1 = vf_sqrt(d1);
+    VF v = vf_maskz(valid, f1);
+    if (want_grad) {
+        const VM pos = m_and(valid, m_gt(f1, vf_zero()));
+        AKP_UNROLL
+        for (int k = 0; k < dims; ++k) grad[k] = vf_maskz(pos, vf_div(near[k], f1));
+    }
+    const VF bound = vf_add(one, margin);
+    const unsigned far = m_bits(m_and(valid, m_lt(vf_mul(bound, bound), d1)));
+    if (far) {
+        float pv[3][AKP_W], gv[3][AKP_W], ov[AKP_W];
+        vf_store(ov, v);
+        AKP_UNROLL
+        for (int k = 0; k < dims; ++k) {
+            vf_store(pv[k], p[k]);
+            if (want_grad) vf_store(gv[k], grad[k]);
+        }
+        for (int i = 0; i < AKP_W; ++i) {
+            if (!(far >> i & 1u)) continue;
+            float q[3], g[3];
+            for (int k = 0; k < dims; ++k) q[k] = pv[k][i];
+            ov[i] = ak_noise_worley(noise, (uint32_t)dims, q, NULL, want_grad ? g : NULL);
+            if (want_grad)
+                for (int k = 0; k < dims; ++k) gv[k][i] = g[k];
+        }
+        v = vf_load(ov);
+        if (want_grad)
+            AKP_UNROLL
+            for (int k = 0; k < dims; ++k) grad[k] = vf_load(gv[k]);
+    }
+    return v;
+}
+
 /* ---- the octave loop ----------------------------------------------------------------------- */
 
-KI static inline VF basis_v(int basis, const PermTab* perm, int dims, const VF* q, VF* g, bool want_grad) {
+KI static inline VF basis_v(int basis, const ak_noise* noise, const PermTab* perm, int dims, const VF* q, VF* g,
+                           bool want_grad) {
     if (basis == AK_NOISE_BASIS_SIMPLEX)
         return dims == 2 ? simplex2_v(perm, q, g, want_grad) : simplex3_v(perm, q, g, want_grad);
+    if (basis == AK_NOISE_BASIS_VALUE) return value_v(perm, dims, q, g, want_grad);
+    if (basis == AK_NOISE_BASIS_WORLEY) return worley_v(noise, dims, q, g, want_grad);
     return perlin_v(perm, dims, q, g, want_grad);
 }
 
-KI static inline void fractal_v(const PermTab* perm, const ak_fractal_desc* d, int basis, int dims, const VF* p,
+KI static inline void fractal_v(const ak_noise* noise, const PermTab* perm, const ak_fractal_desc* d, int basis, int dims, const VF* p,
                                 VF* out, VF* gout, bool want_grad) {
     const VF signmask = vf_cast(vi_set1((int)0x80000000u));
     const VF one = vf_set1(1.0f), zero = vf_zero();
@@ -273,7 +418,7 @@ KI static inline void fractal_v(const PermTab* perm, const ak_fractal_desc* d, i
         const VF vf = vf_set1(freq), va = vf_set1(amp);
         AKP_UNROLL
         for (int k = 0; k < dims; ++k) q[k] = vf_mul(p[k], vf);
-        const VF n = basis_v(basis, perm, dims, q, g, want_grad);
+        const VF n = basis_v(basis, noise, perm, dims, q, g, want_grad);
         if (d->type == AK_FRACTAL_FBM) {
             sum = vf_add(sum, vf_mul(va, n));
             if (want_grad) {
@@ -328,11 +473,11 @@ KI static inline void run_dims(const ak_noise* noise, const ak_fractal_desc* d, 
         AKP_UNROLL
         for (int k = 0; k < dims; ++k) p[k] = vf_load(xs[k] + i);
         if (grad) {
-            fractal_v(&perm, d, basis, dims, p, &v, g, true);
+            fractal_v(noise, &perm, d, basis, dims, p, &v, g, true);
             AKP_UNROLL
             for (int k = 0; k < dims; ++k) vf_store(grad[k] + i, g[k]);
         } else {
-            fractal_v(&perm, d, basis, dims, p, &v, g, false);
+            fractal_v(noise, &perm, d, basis, dims, p, &v, g, false);
         }
         vf_store(out + i, v);
     }
@@ -347,6 +492,10 @@ AKP_RUNNER(run_perlin2, AK_NOISE_BASIS_PERLIN, 2)
 AKP_RUNNER(run_perlin3, AK_NOISE_BASIS_PERLIN, 3)
 AKP_RUNNER(run_simplex2, AK_NOISE_BASIS_SIMPLEX, 2)
 AKP_RUNNER(run_simplex3, AK_NOISE_BASIS_SIMPLEX, 3)
+AKP_RUNNER(run_value2, AK_NOISE_BASIS_VALUE, 2)
+AKP_RUNNER(run_value3, AK_NOISE_BASIS_VALUE, 3)
+AKP_RUNNER(run_worley2, AK_NOISE_BASIS_WORLEY, 2)
+AKP_RUNNER(run_worley3, AK_NOISE_BASIS_WORLEY, 3)
 #undef AKP_RUNNER
 
 void KERNEL_ENTRY(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
@@ -354,6 +503,12 @@ void KERNEL_ENTRY(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims
     if (d->basis == AK_NOISE_BASIS_SIMPLEX) {
         if (dims == 2) run_simplex2(noise, d, xs, count, out, grad);
         else run_simplex3(noise, d, xs, count, out, grad);
+    } else if (d->basis == AK_NOISE_BASIS_VALUE) {
+        if (dims == 2) run_value2(noise, d, xs, count, out, grad);
+        else run_value3(noise, d, xs, count, out, grad);
+    } else if (d->basis == AK_NOISE_BASIS_WORLEY) {
+        if (dims == 2) run_worley2(noise, d, xs, count, out, grad);
+        else run_worley3(noise, d, xs, count, out, grad);
     } else {
         if (dims == 2) run_perlin2(noise, d, xs, count, out, grad);
         else run_perlin3(noise, d, xs, count, out, grad);

@@ -506,6 +506,9 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         j->drive = jd->drive;
         j->lower = jd->lower;
         j->upper = jd->upper;
+        /* the swing limit's cosine: a cone of pi or wider never binds, a negative one always */
+        j->cos_upper =
+            jd->upper >= 3.14159265f ? -INFINITY : (jd->upper < 0.0f ? INFINITY : cosf(jd->upper));
         j->compliance = jd->compliance;
         j->drive_compliance = jd->drive_compliance;
         j->drive_damping = jd->drive_damping;
@@ -513,6 +516,11 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         j->twist_limited = jd->twist_limited;
         j->twist_lower = jd->twist_lower;
         j->twist_upper = jd->twist_upper;
+        float hl = 0.5f * (jd->twist_lower - jd->angle_offset),
+              hh = 0.5f * (jd->twist_upper - jd->angle_offset);
+        j->twist_fast = fabsf(hl) < 1.5607963f && fabsf(hh) < 1.5607963f;
+        j->twist_cl = cosf(hl), j->twist_sl = sinf(hl);
+        j->twist_ch = cosf(hh), j->twist_sh = sinf(hh);
     }
     m->desc.joints = (ak_rigid_joint_desc_cspan){NULL, 0};
     *out_model = m;

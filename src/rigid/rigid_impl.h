@@ -131,6 +131,12 @@ typedef struct rigid_joint {
     bool limited, drive, twist_limited;
     float lower, upper, compliance, drive_compliance, angle_offset, twist_lower, twist_upper;
     float drive_damping; /* 1/s: the drive's relative angular velocity damped each substep */
+    float cos_upper;     /* ball: cos(upper), -INFINITY when upper >= pi, INFINITY when < 0 */
+    /* ball with a twist limit: the half-angle bounds L = (twist_lower - angle_offset) / 2 and
+     * H = (twist_upper - angle_offset) / 2 as cosines and sines, used (twist_fast) when both
+     * lie inside (-pi/2, pi/2) by 0.01 */
+    bool twist_fast;
+    float twist_cl, twist_sl, twist_ch, twist_sh;
 } rigid_joint;
 
 /* Signed angle (rad) of body b about the hinge axis relative to a, zero as built. */

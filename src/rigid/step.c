@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "rigid_impl.h"
+#include "../tasks.h"
 
 typedef struct sap_entry {
     float lo, hi;
@@ -19,6 +20,9 @@ typedef struct contact_group {
     uint32_t pressed;
     ak_vec3 la, lb;
     float lambda, arm;
+    ak_vec3 ra, rb; /* its world offsets after the position solve (zero for a body that does
+                       not move), which the velocity solve's friction reuses */
+    float wr;       /* n . I^-1 n summed over the two bodies */
 } contact_group;
 
 /* A pair of bodies the broad phase found at the step's start. Pairs of boxes and planes
@@ -32,9 +36,24 @@ typedef struct pair_entry {
     uint32_t cached;
 } pair_entry;
 
+/* One contact's row, set once per substep on the poses after the joints' first sweep: the
+ * world arms' responses to a unit impulse along the normal. Within the position solve a body's
+ * corrections are summed as a displacement cx and a rotation vector ct, and the contact's
+ * depth is read to first order, d = d0 + n . (cx_b - cx_a) + ct_b . rnb - ct_a . rna (the
+ * exact pose moves a point by cx + ct x r: second-order terms, (ct)^2 r, are under 1e-6 of
+ * the correction); the velocity solve reuses the same arms. */
+typedef struct contact_row {
+    ak_vec3 rna, rnb; /* ra x n, rb x n (zero for a body that does not move) */
+    ak_vec3 ta, tb;   /* I^-1 (r x n) (zero for a body that does not move) */
+    float ima, imb;   /* inverse masses (zero for a body that does not move) */
+    float d0;         /* depth at the row's set-up */
+    float inv_w;      /* 1 / (generalised inverse masses), 0 when neither body moves */
+} contact_row;
+
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, sap, pairs, contacts, groups, parent, awake, total;
+    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, sap, pairs, contacts, groups, rows, cx, ct, turn0,
+        jorder, jstart, jchain, croot, rot, rot0, parent, awake, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -57,6 +76,17 @@ static layout layout_of(const ak_rigid_model* m) {
                                      sizeof(rigid_contact));
     l.groups = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
                                    sizeof(contact_group));
+    l.rows = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
+                                 sizeof(contact_row));
+    l.cx = off, off += align16(n * sizeof(ak_vec3));
+    l.ct = off, off += align16(n * sizeof(ak_vec3));
+    l.turn0 = off, off += align16(n * sizeof(ak_vec3));
+    l.jorder = off, off += align16(m->joint_count * sizeof(uint32_t));
+    l.jstart = off, off += align16((m->joint_count + 1) * sizeof(uint32_t));
+    l.jchain = off, off += align16(m->joint_count * sizeof(uint32_t));
+    l.croot = off, off += align16(n * sizeof(uint32_t));
+    l.rot = off, off += align16(n * sizeof(ak_mat3));
+    l.rot0 = off, off += align16(n * sizeof(ak_mat3));
     l.parent = off, off += align16(n * sizeof(uint32_t));
     l.awake = off, off += align16(n);
     l.total = off + 16; /* room to align the base */
@@ -121,8 +151,13 @@ typedef struct solver {
     const uint8_t* awake; /* 1: dynamic and awake (moves); 0: static or asleep */
     ak_mat3* iw;          /* world inverse inertia R diag(I^-1) R^T at the substep's start */
     const ak_quat* drive_targets; /* the job's, per joint; NULL -> the model's */
+    contact_row* rows;            /* per contact of the substep */
+    ak_vec3* cx;    /* the contact solve's displacement of each body (see contact_row) */
+    ak_vec3* ct;    /* the contact solve's rotation vector of each body */
+    ak_vec3* turn0; /* each body's rotation from the substep's start to the contact solve's */
+    ak_mat3* rot;   /* each body's rotation at the contact solve's start */
+    ak_mat3* rot0;  /* each body's rotation at the step's start */
     float h;
-    float joint_error; /* the largest joint correction of the sweep (m or rad) */
 } solver;
 
 /* World inverse inertia R diag(I^-1) R^T of orientation q (symmetric, so its storage order
@@ -147,15 +182,22 @@ static ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
     return ak_mat3_mul_vec3(s->iw[i], v);
 }
 
+/* q + [dw, 0] q brought back to unit length by one Newton step for 1 / |.| (a joint's
+ * correction turns by well under a radian, so the norm is 1 + |dw|^2 / 2 and the step leaves
+ * an error of order |dw|^4: no square root or division on the joints' dependency chain; the
+ * orientations are normalised exactly once per substep in update_velocities). */
+static inline ak_quat turn_by(ak_quat q, ak_vec3 dw) {
+    ak_quat r = ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q));
+    return ak_quat_scale(r, 1.5f - 0.5f * ak_quat_dot(r, r));
+}
+
 /* Apply positional impulse p at offset r to body i (sign +1 or -1). */
 static void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
     if (!s->awake[i]) return;
     s->dx[i] = ak_vec3_madd(s->dx[i], p, sign * s->bodies[i].inv_mass);
     s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
-    ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, ak_vec3_cross(r, p)), sign * 0.5f);
-    ak_quat q = s->q[i];
-    ak_quat dq = ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q);
-    s->q[i] = ak_quat_normalize(ak_quat_add(q, dq));
+    ak_vec3 dw = ak_vec3_scale(ak_mat3_mul_vec3(s->iw[i], ak_vec3_cross(r, p)), sign * 0.5f);
+    s->q[i] = turn_by(s->q[i], dw);
 }
 
 /* Body i's response to a unit impulse along unit n at offset r: the turn I^-1 (r x n) and the
@@ -173,18 +215,6 @@ static inline response respond(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n
     o.turn = ak_mat3_mul_vec3(s->iw[i], rn);
     o.w = s->bodies[i].inv_mass + ak_vec3_dot(rn, o.turn);
     return o;
-}
-
-/* Positional impulse mag * n on body i (n, o: as given to respond). The orientation is left
- * unnormalised (a turn of 1e-3 rad changes its norm by 1e-7, about a float's rounding) and is
- * normalised once after the position solve, in update_velocities. */
-static inline void move_along(solver* s, uint32_t i, ak_vec3 n, float mag, response o) {
-    if (!s->awake[i]) return;
-    s->dx[i] = ak_vec3_madd(s->dx[i], n, mag * s->bodies[i].inv_mass);
-    s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
-    ak_vec3 dw = ak_vec3_scale(o.turn, 0.5f * mag);
-    ak_quat q = s->q[i];
-    s->q[i] = ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q));
 }
 
 /* Velocity impulse mag * n on body i. */
@@ -464,16 +494,6 @@ static ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) {
     return ak_vec3_add(s->x[i], ak_quat_rotate(s->q[i], l));
 }
 
-/* Motion of body i's local point l since the start of the step, without the cancellation that
- * (x + q l) - (x0 + q0 l) suffers far from the origin. Static friction undoes the slip of the
- * whole step, not only of the substep: a slip left over by one substep (the next pair's solve
- * moves a box after its friction ran) is taken back by the next, so stacks do not creep. */
-static ak_vec3 point_motion(const solver* s, uint32_t i, ak_vec3 l) {
-    if (!s->awake[i]) return ak_vec3_zero();
-    ak_vec3 d = ak_vec3_add(s->ds[i], s->dx[i]);
-    return ak_vec3_add(d, ak_vec3_sub(ak_quat_rotate(s->q[i], l), ak_quat_rotate(s->q0[i], l)));
-}
-
 /* Centre of pressure of a group (the contacts' local points weighted by their normal
  * multipliers) in each body's frame, the group's total multiplier and the multipliers' mean
  * distance from the centre (the lever arm of torsional friction); false when no contact of the
@@ -510,10 +530,8 @@ static float gen_inv_inertia(const solver* s, uint32_t i, ak_vec3 n) {
 /* Rotate body i by the angular position impulse (sign) * p (world). */
 static void apply_angular_impulse(solver* s, uint32_t i, ak_vec3 p, float sign) {
     if (!s->awake[i]) return;
-    ak_vec3 dw = ak_vec3_scale(inv_inertia_mul(s, i, p), sign * 0.5f);
-    ak_quat q = s->q[i];
-    s->q[i] =
-        ak_quat_normalize(ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q)));
+    ak_vec3 dw = ak_vec3_scale(ak_mat3_mul_vec3(s->iw[i], p), sign * 0.5f);
+    s->q[i] = turn_by(s->q[i], dw);
 }
 
 /* Rotation vector of body i over this substep (small-angle). */
@@ -524,25 +542,86 @@ static ak_vec3 substep_rotation(const solver* s, uint32_t i) {
     return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
 }
 
+/* Motion of body i's local point l since the start of the step (the contact solve's pose, cx
+ * and ct included), without the cancellation that (x + q l) - (x0 + q0 l) suffers far from the
+ * origin; *out_arm gets its world offset. Static friction undoes the slip of the whole step,
+ * not only of the substep: a slip left over by one substep (the next pair's solve moves a box
+ * after its friction ran) is taken back by the next, so stacks do not creep. */
+static ak_vec3 moved_point(const solver* s, uint32_t i, ak_vec3 l, ak_vec3* out_arm) {
+    ak_vec3 r = ak_mat3_mul_vec3(s->rot[i], l);
+    r = ak_vec3_add(r, ak_vec3_cross(s->ct[i], r));
+    *out_arm = r;
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_vec3 d = ak_vec3_add(s->ds[i], ak_vec3_add(s->dx[i], s->cx[i]));
+    return ak_vec3_add(d, ak_vec3_sub(r, ak_mat3_mul_vec3(s->rot0[i], l)));
+}
+
+/* Rows of the substep's contacts on the current poses (see contact_row). */
+static void setup_rows(solver* s, const contact_buf* cb) {
+    for (uint32_t k = 0; k < cb->count; ++k) {
+        const rigid_contact* c = &cb->c[k];
+        contact_row* r = &s->rows[k];
+        uint32_t a = c->a, b = c->b;
+        ak_vec3 ra = ak_mat3_mul_vec3(s->rot[a], c->la), rb = ak_mat3_mul_vec3(s->rot[b], c->lb);
+        r->d0 = ak_vec3_dot(ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra)), c->n);
+        float w = 0.0f;
+        if (s->awake[a]) {
+            r->rna = ak_vec3_cross(ra, c->n);
+            r->ta = ak_mat3_mul_vec3(s->iw[a], r->rna);
+            r->ima = s->bodies[a].inv_mass;
+            w += r->ima + ak_vec3_dot(r->rna, r->ta);
+        } else {
+            r->rna = r->ta = ak_vec3_zero();
+            r->ima = 0.0f;
+        }
+        if (s->awake[b]) {
+            r->rnb = ak_vec3_cross(rb, c->n);
+            r->tb = ak_mat3_mul_vec3(s->iw[b], r->rnb);
+            r->imb = s->bodies[b].inv_mass;
+            w += r->imb + ak_vec3_dot(r->rnb, r->tb);
+        } else {
+            r->rnb = r->tb = ak_vec3_zero();
+            r->imb = 0.0f;
+        }
+        r->inv_w = w > 0.0f ? 1.0f / w : 0.0f;
+    }
+}
+
 static void solve_positions(solver* s, contact_buf* cb) {
+    uint32_t n = (uint32_t)s->m->body_count;
+    ak_vec3 *cx = s->cx, *ct = s->ct;
+    for (uint32_t i = 0; i < n; ++i) {
+        cx[i] = ct[i] = ak_vec3_zero();
+        s->turn0[i] = substep_rotation(s, i);
+        s->rot[i] = ak_mat3_from_quat(s->q[i]);
+    }
+    setup_rows(s, cb);
     for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
         uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
         /* (alternating the points' order from substep to substep halves a 10-box stack's creep
          * but moves the centre of pressure each substep, and a block on an incline then creeps:
          * the order stays fixed) */
-        for (uint32_t k = k0; k < k1; ++k) {
-            rigid_contact* c = &cb->c[k];
-            ak_vec3 pa = world_point(s, c->a, c->la), pb = world_point(s, c->b, c->lb);
-            float d = ak_vec3_dot(ak_vec3_sub(pb, pa), c->n);
-            if (d <= 0.0f) continue;
-            ak_vec3 ra = ak_vec3_sub(pa, s->x[c->a]), rb = ak_vec3_sub(pb, s->x[c->b]);
-            response oa = respond(s, c->a, ra, c->n), ob = respond(s, c->b, rb, c->n);
-            float w = oa.w + ob.w;
-            if (!(w > 0.0f)) continue;
-            float dl = d / w;
-            c->lambda_n += dl;
-            move_along(s, c->a, c->n, dl, oa);
-            move_along(s, c->b, c->n, -dl, ob);
+        /* every contact of a group joins the same two bodies: their corrections stay in
+         * registers over the group */
+        {
+            uint32_t a = cb->c[k0].a, b = cb->c[k0].b;
+            ak_vec3 cxa = cx[a], cta = ct[a], cxb = cx[b], ctb = ct[b];
+            for (uint32_t k = k0; k < k1; ++k) {
+                rigid_contact* c = &cb->c[k];
+                const contact_row* r = &s->rows[k];
+                float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cxb, cxa)) +
+                          ak_vec3_dot(ctb, r->rnb) - ak_vec3_dot(cta, r->rna);
+                if (d <= 0.0f || r->inv_w == 0.0f) continue;
+                float dl = d * r->inv_w;
+                c->lambda_n += dl;
+                /* (a body that does not move has a zero row: its sums stay zero) */
+                cxa = ak_vec3_madd(cxa, c->n, dl * r->ima);
+                cta = ak_vec3_madd(cta, r->ta, dl);
+                cxb = ak_vec3_madd(cxb, c->n, -dl * r->imb);
+                ctb = ak_vec3_madd(ctb, r->tb, -dl);
+            }
+            if (s->awake[a]) cx[a] = cxa, ct[a] = cta;
+            if (s->awake[b]) cx[b] = cxb, ct[b] = ctb;
         }
         /* static friction, once per pair at the centre of pressure with the pair's whole normal
          * multiplier: undo the relative tangential motion of this substep when the force it
@@ -553,48 +632,58 @@ static void solve_positions(solver* s, contact_buf* cb) {
         ak_vec3 la = grp->la, lb = grp->lb;
         float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
-        if (c->friction > 0.0f && grp->pressed) {
-            ak_vec3 dp = ak_vec3_sub(point_motion(s, c->a, la), point_motion(s, c->b, lb));
+        uint32_t a = c->a, b = c->b;
+        if (!grp->pressed) continue;
+        ak_vec3 ra, rb;
+        ak_vec3 dp = ak_vec3_sub(moved_point(s, a, la, &ra), moved_point(s, b, lb, &rb));
+        grp->ra = s->awake[a] ? ra : ak_vec3_zero();
+        grp->rb = s->awake[b] ? rb : ak_vec3_zero();
+        grp->wr = gen_inv_inertia(s, a, c->n) + gen_inv_inertia(s, b, c->n);
+        if (c->friction > 0.0f) {
             ak_vec3 dt = ak_vec3_madd(dp, c->n, -ak_vec3_dot(dp, c->n));
             float lt = ak_vec3_length(dt);
             if (lt > 1e-12f) {
                 ak_vec3 t = ak_vec3_scale(dt, 1.0f / lt);
-                ak_vec3 ra = ak_quat_rotate(s->q[c->a], la), rb = ak_quat_rotate(s->q[c->b], lb);
-                response oa = respond(s, c->a, ra, t), ob = respond(s, c->b, rb, t);
+                response oa = respond(s, a, ra, t), ob = respond(s, b, rb, t);
                 float wt = oa.w + ob.w;
                 float dlt = wt > 0.0f ? lt / wt : INFINITY;
                 if (dlt < c->friction * lambda) {
-                    move_along(s, c->a, t, -dlt, oa);
-                    move_along(s, c->b, t, dlt, ob);
+                    if (s->awake[a]) {
+                        cx[a] = ak_vec3_madd(cx[a], t, -dlt * s->bodies[a].inv_mass);
+                        ct[a] = ak_vec3_madd(ct[a], oa.turn, -dlt);
+                    }
+                    if (s->awake[b]) {
+                        cx[b] = ak_vec3_madd(cx[b], t, dlt * s->bodies[b].inv_mass);
+                        ct[b] = ak_vec3_madd(ct[b], ob.turn, dlt);
+                    }
                 }
             }
             /* torsional friction: a patch of contacts also resists twisting about the normal, up
              * to mu times the normal multiplier times its mean lever arm */
-            float twist = ak_vec3_dot(
-                ak_vec3_sub(substep_rotation(s, c->a), substep_rotation(s, c->b)), c->n);
-            float wr = gen_inv_inertia(s, c->a, c->n) + gen_inv_inertia(s, c->b, c->n);
+            ak_vec3 rot_a = s->awake[a] ? ak_vec3_add(s->turn0[a], ct[a]) : ak_vec3_zero();
+            ak_vec3 rot_b = s->awake[b] ? ak_vec3_add(s->turn0[b], ct[b]) : ak_vec3_zero();
+            float twist = ak_vec3_dot(ak_vec3_sub(rot_a, rot_b), c->n);
+            float wr = grp->wr;
             if (wr > 0.0f && fabsf(twist) > 0.0f &&
                 fabsf(twist) / wr < c->friction * lambda * arm) {
                 ak_vec3 pr = ak_vec3_scale(c->n, -twist / wr);
-                apply_angular_impulse(s, c->a, pr, 1.0f);
-                apply_angular_impulse(s, c->b, pr, -1.0f);
+                if (s->awake[a]) ct[a] = ak_vec3_add(ct[a], inv_inertia_mul(s, a, pr));
+                if (s->awake[b]) ct[b] = ak_vec3_sub(ct[b], inv_inertia_mul(s, b, pr));
             }
         }
+    }
+    /* the summed corrections onto the poses (orientations normalised in update_velocities) */
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!s->awake[i]) continue;
+        s->dx[i] = ak_vec3_add(s->dx[i], cx[i]);
+        s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
+        ak_vec3 dw = ak_vec3_scale(ct[i], 0.5f);
+        ak_quat q = s->q[i];
+        s->q[i] = ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q));
     }
 }
 
 /* ---- joints (XPBD positional and angular constraints, Mueller et al. 2020, 3.3) ---------- */
-
-/* World inverse inertia tensor of body i (zero when it does not move). */
-static ak_mat3 inv_inertia_world(const solver* s, uint32_t i) {
-    if (!s->awake[i]) return ak_mat3_scale(ak_mat3_identity(), 0.0f);
-    return s->iw[i];
-}
-
-static ak_mat3 skew(ak_vec3 v) {
-    ak_mat3 m = {{0.0f, v.z, -v.y, -v.z, 0.0f, v.x, v.y, -v.x, 0.0f}};
-    return m;
-}
 
 /* Move anchor points pa (on a, offset ra) and pb (on b, offset rb) together by e = pb - pa
  * with compliance alpha (m/N), all three directions at once: the impulse p = K^-1 e with K =
@@ -603,30 +692,43 @@ static ak_mat3 skew(ak_vec3 v) {
  * rotation is cheap about its centre: the anchor then also moves across e, and a pendulum of a
  * small ball on a long arm spins up 70 times too fast.) */
 static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 e,
-                           float alpha) {
+                           float alpha, float* err) {
     if (ak_vec3_length_sq(e) < 1e-18f) return;
-    s->joint_error = ak_maxf(s->joint_error, ak_vec3_length(e));
+    *err = ak_maxf(*err, ak_vec3_length(e));
     float lin = (s->awake[a] ? s->bodies[a].inv_mass : 0.0f) +
                 (s->awake[b] ? s->bodies[b].inv_mass : 0.0f) + alpha / (s->h * s->h);
-    ak_mat3 sa = skew(ra), sb = skew(rb);
-    ak_mat3 k = ak_mat3_scale(ak_mat3_identity(), lin);
-    k = ak_mat3_add(
-        k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sa, inv_inertia_world(s, a)), sa), -1.0f));
-    k = ak_mat3_add(
-        k, ak_mat3_scale(ak_mat3_mul(ak_mat3_mul(sb, inv_inertia_world(s, b)), sb), -1.0f));
-    float det = ak_mat3_determinant(k);
+    /* K is symmetric: its six entries, each body adding S I^-1 S^T (S = [r]x, rows s_i) */
+    float k00 = lin, k01 = 0.0f, k02 = 0.0f, k11 = lin, k12 = 0.0f, k22 = lin;
+    for (int side = 0; side < 2; ++side) {
+        uint32_t i = side ? b : a;
+        if (!s->awake[i]) continue;
+        ak_vec3 r = side ? rb : ra;
+        ak_vec3 s0 = ak_vec3_make(0.0f, -r.z, r.y), s1 = ak_vec3_make(r.z, 0.0f, -r.x),
+                s2 = ak_vec3_make(-r.y, r.x, 0.0f);
+        ak_vec3 i0 = ak_mat3_mul_vec3(s->iw[i], s0), i1 = ak_mat3_mul_vec3(s->iw[i], s1),
+                i2 = ak_mat3_mul_vec3(s->iw[i], s2);
+        k00 += ak_vec3_dot(s0, i0), k01 += ak_vec3_dot(s0, i1), k02 += ak_vec3_dot(s0, i2);
+        k11 += ak_vec3_dot(s1, i1), k12 += ak_vec3_dot(s1, i2), k22 += ak_vec3_dot(s2, i2);
+    }
+    /* p = K^-1 e by cofactors */
+    float c00 = k11 * k22 - k12 * k12, c01 = k02 * k12 - k01 * k22, c02 = k01 * k12 - k02 * k11;
+    float det = k00 * c00 + k01 * c01 + k02 * c02;
     if (!(fabsf(det) > 1e-30f) || !ak_finitef(det)) return;
-    ak_vec3 p = ak_mat3_mul_vec3(ak_mat3_inverse(k), e);
+    float c11 = k00 * k22 - k02 * k02, c12 = k01 * k02 - k00 * k12, c22 = k00 * k11 - k01 * k01;
+    float id = 1.0f / det;
+    ak_vec3 p = ak_vec3_make((c00 * e.x + c01 * e.y + c02 * e.z) * id,
+                             (c01 * e.x + c11 * e.y + c12 * e.z) * id,
+                             (c02 * e.x + c12 * e.y + c22 * e.z) * id);
     apply_position_impulse(s, a, ra, p, 1.0f);
     apply_position_impulse(s, b, rb, p, -1.0f);
 }
 
 /* Rotate a by (its share of) the rotation vector e and b by the opposite, so that a's frame
  * turns towards b's: lambda = |e| / (w_a + w_b + alpha / h^2), w = n^T I^-1 n. */
-static void joint_rotation(solver* s, uint32_t a, uint32_t b, ak_vec3 e, float alpha) {
+static void joint_rotation(solver* s, uint32_t a, uint32_t b, ak_vec3 e, float alpha, float* err) {
     float c = ak_vec3_length(e);
     if (c < 1e-9f) return;
-    s->joint_error = ak_maxf(s->joint_error, c);
+    *err = ak_maxf(*err, c);
     ak_vec3 n = ak_vec3_scale(e, 1.0f / c);
     float w = gen_inv_inertia(s, a, n) + gen_inv_inertia(s, b, n) + alpha / (s->h * s->h);
     if (!(w > 0.0f)) return;
@@ -642,9 +744,27 @@ static ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
     return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
 }
 
-static void solve_joints(solver* s) {
+/* True when ball joint j's twist is inside its limits by at least 1e-4 rad (without the angle:
+ * akp_rigid_twist_angle's half angle t/2 = atan2(y, w) of rel, taken with w >= 0, lies
+ * between the limits' half angles L and H when sin(t/2 - L) and sin(H - t/2) are positive,
+ * which needs no atan2); false also when it cannot tell (twist_fast off). */
+static inline bool twist_inside(const rigid_joint* j, ak_quat qa, ak_quat qb) {
+    if (!j->twist_fast) return false;
+    ak_quat rel =
+        ak_quat_mul(ak_quat_conjugate(ak_quat_mul(qa, j->frame_a)), ak_quat_mul(qb, j->frame_b));
+    float y = rel.w < 0.0f ? -rel.y : rel.y, w = fabsf(rel.w);
+    float r = sqrtf(y * y + w * w);
+    if (!(r > 1e-6f)) return false;
+    return y * j->twist_cl - w * j->twist_sl > 1e-4f * r &&
+           w * j->twist_sh - y * j->twist_ch > 1e-4f * r;
+}
+
+/* One sweep over the joints idx[0 .. count) (NULL idx: every joint in model order); *err gets
+ * the largest correction (m or rad). */
+static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* err) {
     const ak_rigid_model* m = s->m;
-    for (size_t k = 0; k < m->joint_count; ++k) {
+    for (uint32_t i = 0; i < count; ++i) {
+        uint32_t k = idx ? idx[i] : i;
         const rigid_joint* j = &m->joints[k];
         uint32_t a = j->a, b = j->b;
         if (!s->awake[a] && !s->awake[b]) continue;
@@ -659,35 +779,41 @@ static void solve_joints(solver* s) {
             float keep = j->limited ? ak_clampf(off, j->lower, j->upper) : off;
             e = ak_vec3_madd(e, ax, -keep);
         }
-        joint_position(s, a, b, ra, rb, e, alpha);
+        joint_position(s, a, b, ra, rb, e, alpha, err);
         if (j->type == AK_RIGID_JOINT_FIXED || j->type == AK_RIGID_JOINT_PRISMATIC)
-            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->rel), alpha);
+            joint_rotation(s, a, b, orientation_error(s->q[a], s->q[b], j->rel), alpha, err);
         if (j->type == AK_RIGID_JOINT_HINGE) {
             ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a),
                     a2 = ak_quat_rotate(s->q[b], j->axis_b);
-            joint_rotation(s, a, b, ak_vec3_cross(a1, a2), alpha);
+            joint_rotation(s, a, b, ak_vec3_cross(a1, a2), alpha, err);
             if (j->limited) {
                 float phi = akp_rigid_hinge_angle(j, s->q[a], s->q[b]) + j->angle_offset;
                 float target = ak_clampf(phi, j->lower, j->upper);
                 if (phi != target)
                     joint_rotation(s, a, b,
                                    ak_vec3_scale(ak_quat_rotate(s->q[a], j->axis_a), phi - target),
-                                   0.0f);
+                                   0.0f, err);
             }
         }
         if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
             ak_vec3 a1 = ak_quat_rotate(s->q[a], j->axis_a),
                     a2 = ak_quat_rotate(s->q[b], j->axis_b);
-            ak_vec3 cr = ak_vec3_cross(a1, a2);
-            float sn = ak_vec3_length(cr), swing = atan2f(sn, ak_vec3_dot(a1, a2));
-            if (swing > j->upper && sn > 1e-9f)
-                joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f);
+            float cs = ak_vec3_dot(a1, a2);
+            /* the angle only when not well inside the cone (the orientations are unit to well
+             * under 1e-3 within a substep, so cs is the swing's cosine within 1e-3) */
+            if (!(cs > j->cos_upper + 1e-3f)) {
+                ak_vec3 cr = ak_vec3_cross(a1, a2);
+                float sn = ak_vec3_length(cr), swing = atan2f(sn, cs);
+                if (swing > j->upper && sn > 1e-9f)
+                    joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f, err);
+            }
         }
-        if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited) {
+        if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited &&
+            !twist_inside(j, s->q[a], s->q[b])) {
             ak_vec3 n;
             float tw = akp_rigid_twist_angle(j, s->q[a], s->q[b], &n) + j->angle_offset;
             float target = ak_clampf(tw, j->twist_lower, j->twist_upper);
-            if (tw != target) joint_rotation(s, a, b, ak_vec3_scale(n, tw - target), 0.0f);
+            if (tw != target) joint_rotation(s, a, b, ak_vec3_scale(n, tw - target), 0.0f, err);
         }
         if (j->drive && j->type != AK_RIGID_JOINT_FIXED && j->type != AK_RIGID_JOINT_PRISMATIC)
             joint_rotation(s, a, b,
@@ -695,7 +821,7 @@ static void solve_joints(solver* s) {
                                              s->drive_targets
                                                  ? ak_quat_normalize(s->drive_targets[k])
                                                  : j->drive_target),
-                           j->drive_compliance);
+                           j->drive_compliance, err);
     }
 }
 
@@ -745,12 +871,6 @@ static void update_velocities(solver* s) {
     }
 }
 
-/* World offset of body i's local point l, zero for a body that does not move (its velocity
- * and its response are zero whatever the offset). */
-static ak_vec3 moving_arm(const solver* s, uint32_t i, ak_vec3 l) {
-    return s->awake[i] ? ak_quat_rotate(s->q[i], l) : ak_vec3_zero();
-}
-
 static ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
     return ak_vec3_add(s->v[i], ak_vec3_cross(s->w[i], r));
 }
@@ -760,29 +880,34 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
     for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
         uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
         for (uint32_t k = k0; k < k1; ++k) {
-            rigid_contact* c = &cb->c[k];
+            const rigid_contact* c = &cb->c[k];
             if (!(c->lambda_n > 0.0f)) continue;
-            ak_vec3 ra = moving_arm(s, c->a, c->la), rb = moving_arm(s, c->b, c->lb);
-            float vn = ak_vec3_dot(
-                c->n, ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb)));
+            const contact_row* r = &s->rows[k];
+            uint32_t a = c->a, b = c->b;
+            /* n . (v + w x r) = n . v + w . (r x n), the arms of the position solve's rows */
+            float vn = ak_vec3_dot(c->n, ak_vec3_sub(s->v[a], s->v[b])) +
+                       ak_vec3_dot(s->w[a], r->rna) - ak_vec3_dot(s->w[b], r->rnb);
             /* restitution: the normal velocity becomes -e times the one before the solve (none
              * for slow impacts, which gravity alone could have made in two substeps) */
             float e = fabsf(c->vn_before) <= 2.0f * gmag * h ? 0.0f : c->restitution;
             float dvn = -vn + ak_maxf(-e * c->vn_before, 0.0f);
-            if (fabsf(dvn) < 1e-12f) continue;
-            response oa = respond(s, c->a, ra, c->n), ob = respond(s, c->b, rb, c->n);
-            float w = oa.w + ob.w;
-            if (!(w > 0.0f)) continue;
-            push_along(s, c->a, c->n, dvn / w, oa);
-            push_along(s, c->b, c->n, -dvn / w, ob);
+            if (fabsf(dvn) < 1e-12f || r->inv_w == 0.0f) continue;
+            float mag = dvn * r->inv_w;
+            if (r->ima > 0.0f) {
+                s->v[a] = ak_vec3_madd(s->v[a], c->n, mag * r->ima);
+                s->w[a] = ak_vec3_madd(s->w[a], r->ta, mag);
+            }
+            if (r->imb > 0.0f) {
+                s->v[b] = ak_vec3_madd(s->v[b], c->n, -mag * r->imb);
+                s->w[b] = ak_vec3_madd(s->w[b], r->tb, -mag);
+            }
         }
         /* dynamic friction at the centre of pressure (their eq. 30 with the units made whole) */
         const contact_group* grp = &cb->groups[gi];
-        ak_vec3 la = grp->la, lb = grp->lb;
         float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
         if (c->dynamic_friction > 0.0f && grp->pressed) {
-            ak_vec3 ra = moving_arm(s, c->a, la), rb = moving_arm(s, c->b, lb);
+            ak_vec3 ra = grp->ra, rb = grp->rb;
             ak_vec3 vr = ak_vec3_sub(point_velocity(s, c->a, ra), point_velocity(s, c->b, rb));
             ak_vec3 vt = ak_vec3_madd(vr, c->n, -ak_vec3_dot(vr, c->n));
             float lt = ak_vec3_length(vt);
@@ -799,7 +924,7 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
                 }
             }
             float spin = ak_vec3_dot(ak_vec3_sub(s->w[c->a], s->w[c->b]), c->n);
-            float wr = gen_inv_inertia(s, c->a, c->n) + gen_inv_inertia(s, c->b, c->n);
+            float wr = grp->wr;
             if (wr > 0.0f && spin != 0.0f) {
                 float cut = ak_minf(c->dynamic_friction * lambda * arm * wr / h, fabsf(spin));
                 ak_vec3 pr = ak_vec3_scale(c->n, (spin > 0.0f ? -cut : cut) / wr);
@@ -818,6 +943,63 @@ static uint32_t uf_find(uint32_t* parent, uint32_t i) {
         i = parent[i];
     }
     return i;
+}
+
+/* Joints grouped into chains: the joints that share moving bodies (union-find over the joints
+ * between two dynamic bodies; a static body links nothing, since it never moves), each chain's
+ * joints in model order, chains in the order of their first joint: order[start[c] ..
+ * start[c + 1]) are chain c's. No body moved by one chain is moved by another, so sweeping the
+ * chains one after another gives the same numbers as sweeping the joints in model order, and
+ * the chains may be swept in any order or at the same time. chain_of gets each joint's chain
+ * (scratch). Returns the chain count. */
+static uint32_t joint_chains(const solver* s, uint32_t* parent, uint32_t* root_chain,
+                             uint32_t* chain_of, uint32_t* order, uint32_t* start) {
+    const ak_rigid_model* m = s->m;
+    uint32_t n = (uint32_t)m->body_count, nj = (uint32_t)m->joint_count, chains = 0;
+    for (uint32_t i = 0; i < n; ++i) parent[i] = i, root_chain[i] = UINT32_MAX;
+    for (uint32_t k = 0; k < nj; ++k) {
+        uint32_t a = m->joints[k].a, b = m->joints[k].b;
+        if (s->bodies[a].inv_mass == 0.0f || s->bodies[b].inv_mass == 0.0f) continue;
+        uint32_t ra = uf_find(parent, a), rb = uf_find(parent, b);
+        if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    }
+    for (uint32_t c = 0; c <= nj; ++c) start[c] = 0;
+    for (uint32_t k = 0; k < nj; ++k) {
+        uint32_t a = m->joints[k].a;
+        uint32_t r = uf_find(parent, s->bodies[a].inv_mass > 0.0f ? a : m->joints[k].b);
+        if (root_chain[r] == UINT32_MAX) root_chain[r] = chains++;
+        chain_of[k] = root_chain[r];
+        start[chain_of[k] + 1]++;
+    }
+    for (uint32_t c = 0; c < chains; ++c) start[c + 1] += start[c];
+    /* stable placement; root_chain is free again: a cursor per chain */
+    for (uint32_t c = 0; c < chains; ++c) root_chain[c] = start[c];
+    for (uint32_t k = 0; k < nj; ++k) order[root_chain[chain_of[k]]++] = k;
+    return chains;
+}
+
+/* The joint sweeps after the contacts: each chain swept up to `sweeps` times, stopping once a
+ * sweep corrects none of its joints by more than 0.1 mm or 0.1 mrad (a chain at rest stops
+ * after one while a falling one goes on). */
+typedef struct chain_task {
+    solver* s;
+    const uint32_t *order, *start;
+    uint32_t c0, c1; /* chains [c0, c1) */
+    int sweeps;
+} chain_task;
+
+static void* sweep_chains(void* arg) {
+    const chain_task* t = arg;
+    for (uint32_t c = t->c0; c < t->c1; ++c) {
+        const uint32_t* idx = t->order + t->start[c];
+        uint32_t count = t->start[c + 1] - t->start[c];
+        for (int it = 0; it < t->sweeps; ++it) {
+            float err = 0.0f;
+            solve_joints(t->s, idx, count, &err);
+            if (err < 1e-4f) break;
+        }
+    }
+    return NULL;
 }
 
 /* Sleep bookkeeping at the end of a step (see ak_rigid_step_job.sleep_timers). */
@@ -893,6 +1075,12 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         .awake = awake,
         .iw = (ak_mat3*)(base + l.iw),
         .drive_targets = job->drive_targets.count ? job->drive_targets.ptr : NULL,
+        .rows = (contact_row*)(base + l.rows),
+        .cx = (ak_vec3*)(base + l.cx),
+        .ct = (ak_vec3*)(base + l.ct),
+        .turn0 = (ak_vec3*)(base + l.turn0),
+        .rot = (ak_mat3*)(base + l.rot),
+        .rot0 = (ak_mat3*)(base + l.rot0),
         .h = job->dt / (float)substeps,
     };
     memcpy(x0, s.x, n * sizeof *x0);
@@ -905,6 +1093,7 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
         awake[i] = m->bodies[i].inv_mass > 0.0f &&
                    !(sleeping && job->sleep_timers.ptr[i] >= m->desc.sleep_time);
         if (awake[i]) s.q[i] = q0[i] = ak_quat_normalize(s.q[i]);
+        s.rot0[i] = ak_mat3_from_quat(q0[i]);
     }
     contact_buf cb = {(rigid_contact*)(base + l.contacts), 0, m->desc.max_contacts, 0,
                       (contact_group*)(base + l.groups),   0};
@@ -918,22 +1107,55 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
     find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow), offset, job->dt,
                gmag, up);
     uint32_t kept = cb.count;
+    /* joints, contacts, then up to eight more sweeps over the joints: contacts solved last would
+     * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
+     * (pelvis, spine, chest) 6 degrees past a limit under load. The later sweeps go chain by
+     * chain, the chains shared out over the threads in contiguous runs of about equal joint
+     * counts: each chain's numbers are the same whichever thread sweeps it. */
+    uint32_t nj = (uint32_t)m->joint_count;
+    chain_task tasks[AK_RIGID_MAX_THREADS];
+    uint32_t tasks_n = 1;
+    tasks[0] = (chain_task){.s = &s, .c0 = 0, .c1 = 0, .sweeps = 8};
+    if (nj) {
+        uint32_t* order = (uint32_t*)(base + l.jorder);
+        uint32_t* start = (uint32_t*)(base + l.jstart);
+        uint32_t chains =
+            joint_chains(&s, (uint32_t*)(base + l.parent), (uint32_t*)(base + l.croot),
+                         (uint32_t*)(base + l.jchain), order, start);
+        uint32_t want = job->thread_count ? job->thread_count : 1;
+        if (want > chains) want = chains;
+        if (want > AKP_TASKS_MAX) want = AKP_TASKS_MAX;
+        uint32_t c = 0;
+        tasks_n = 0;
+        for (uint32_t t = 0; t < want; ++t) {
+            uint32_t c0 = c;
+            /* chains up to the t+1-th share of the joints */
+            uint64_t upto = (uint64_t)nj * (t + 1) / want;
+            while (c < chains && (t + 1 == want || start[c + 1] <= upto)) ++c;
+            if (c == c0 && c < chains) ++c;
+            if (c == c0) continue;
+            tasks[tasks_n++] = (chain_task){
+                .s = &s, .order = order, .start = start, .c0 = c0, .c1 = c, .sweeps = 8};
+        }
+    }
     for (uint32_t step = 0; step < substeps; ++step) {
         predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping);
         substep_contacts(&s, &cb, &pb, kept, offset);
         /* joints, contacts, then eight more sweeps over the joints: contacts solved last would
          * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
          * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
-        solve_joints(&s);
-        solve_positions(&s, &cb);
-        /* (the sweeps stop early once one corrects no joint by more than 0.1 mm or 0.1 mrad:
-         * 50 falling ragdolls then take 4.3 sweeps a substep instead of 9, and their anchors
-         * stay within 0.02 mm) */
-        for (int it = 0; it < 8 && m->joint_count; ++it) {
-            s.joint_error = 0.0f;
-            solve_joints(&s);
-            if (s.joint_error < 1e-4f) break;
+        if (nj) {
+            float err = 0.0f;
+            solve_joints(&s, NULL, nj, &err);
         }
+        solve_positions(&s, &cb);
+        /* (the sweeps stop early, chain by chain, once one corrects no joint of the chain by
+         * more than 0.1 mm or 0.1 mrad: 50 falling ragdolls then take 4.3 sweeps a substep
+         * instead of 9 when they all stop together, and their anchors stay within 0.02 mm) */
+        if (tasks_n > 1)
+            akp_run_tasks(sweep_chains, tasks, sizeof tasks[0], tasks_n);
+        else if (nj)
+            sweep_chains(&tasks[0]);
         update_velocities(&s);
         damp_drives(&s);
         solve_velocities(&s, &cb, gmag);

@@ -20,7 +20,7 @@
 
 #define MAX_CAPS 16
 #define STOP_COS 0.57357643635f /* cos 55 degrees: the 2014 paper's discontinuity angle */
-#define ISO_EPS 1e-4f
+#define ISO_EPS 1e-3f /* |F - iso| that ends a projection: about 0.1 % of the support radius */
 #define CAPSULE_AT 12
 #define GRID_AT (CAPSULE_AT + 8)
 #define BONE_FLOATS (GRID_AT + 4) /* cx cy cz s | ax ay az b | r sphere2 valid pad |
@@ -34,6 +34,8 @@
 #define CONTACT_SMOOTH 8 /* smoothing rounds of the contact region */
 #define PAIR_FRAME 20 /* per joint and frame: posed centre (3), contact normal (3), folded flag, pad,
                         inner direction (3), pad, posed axis of part i (3), pad, of part j (3), pad */
+#define CULL_FLOATS 8 /* per bone and frame: capsule end a(3), b - a (3), 1 / |b - a|^2, squared
+                         distance from the segment past which the grid's field is 0 (0: no cull) */
 #define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
 
 struct ak_skin_implicit {
@@ -194,12 +196,20 @@ static inline float compact(float r, float d, ak_vec3 g, ak_vec3* out_g) {
     return t;
 }
 
-/* Distance of bone b at bind-space point y and its gradient, from the bone's grid when the
- * object has grids (trilinear interpolation of the stored HRBF distance and gradient: the
- * paper's 3D textures), else directly; false outside the grid's box or the bounding sphere
- * (the field is 0 there). */
-static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, float* out_d, ak_vec3* out_g) {
-    if (o->grid_nodes == 0) return bone_distance(o, b, y, out_d, out_g);
+/* One bone's grid cell for a point: the first corner node, the strides, the fractions, and
+ * for field_eval the support radius and the inverse palette matrix (NULL: bind pose). */
+typedef struct grid_probe {
+    const float* n000;
+    const float* m;
+    size_t sy, sz; /* floats */
+    float tx, ty, tz, r;
+} grid_probe;
+
+/* The cell of bone b's grid that holds bind-space point y into *q; false outside the grid's
+ * box (the field is 0 there), and false as well where cull (CULL_FLOATS, or NULL) shows that
+ * the interpolated distance is at least the support radius (the field is 0 there too;
+ * cull_build). */
+static inline bool grid_cell(const ak_skin_implicit* o, size_t b, ak_vec3 y, const float* cull, grid_probe* q) {
     const uint32_t* I = o->grid_info + b * GRID_INFO;
     const float* B = o->bones + b * BONE_FLOATS + GRID_AT;
     const uint32_t nx = I[0], ny = I[1], nz = I[2];
@@ -207,17 +217,27 @@ static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, f
     if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= (float)(nx - 1) && py <= (float)(ny - 1) &&
           pz <= (float)(nz - 1)) || nx < 2)
         return false;
+    if (cull && cull[7] > 0.0f) {
+        const float ax = y.x - cull[0], ay = y.y - cull[1], az = y.z - cull[2];
+        float t = (ax * cull[3] + ay * cull[4] + az * cull[5]) * cull[6];
+        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+        const float wx = ax - cull[3] * t, wy = ay - cull[4] * t, wz = az - cull[5] * t;
+        if (wx * wx + wy * wy + wz * wz >= cull[7]) return false;
+    }
     uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
     if (ix > nx - 2) ix = nx - 2;
     if (iy > ny - 2) iy = ny - 2;
     if (iz > nz - 2) iz = nz - 2;
-    const float tx = px - (float)ix, ty = py - (float)iy, tz = pz - (float)iz;
-    const size_t sy = nx, sz = (size_t)nx * ny;
-    const float* n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * sy + iz * sz);
-    const float* n010 = n000 + 4 * sy;
-    const float* n001 = n000 + 4 * sz;
-    const float* n011 = n001 + 4 * sy;
-    float r[4];
+    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
+    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
+    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+    return true;
+}
+
+/* Trilinear interpolation of the 4 values per node (distance, gradient) of q's cell. */
+static inline void grid_interp(const grid_probe* q, float r[4]) {
+    const float *n000 = q->n000, *n010 = n000 + q->sy, *n001 = n000 + q->sz, *n011 = n001 + q->sy;
+    const float tx = q->tx, ty = q->ty, tz = q->tz;
     for (int k = 0; k < 4; ++k) {
         float a = n000[k] + tx * (n000[4 + k] - n000[k]);
         float bq = n010[k] + tx * (n010[4 + k] - n010[k]);
@@ -226,6 +246,18 @@ static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, f
         float e = a + ty * (bq - a), f = cq + ty * (dq - cq);
         r[k] = e + tz * (f - e);
     }
+}
+
+/* Distance of bone b at bind-space point y and its gradient, from the bone's grid when the
+ * object has grids (trilinear interpolation of the stored HRBF distance and gradient: the
+ * paper's 3D textures), else directly; false outside the grid's box or the bounding sphere
+ * (the field is 0 there). */
+static bool bone_distance_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, float* out_d, ak_vec3* out_g) {
+    if (o->grid_nodes == 0) return bone_distance(o, b, y, out_d, out_g);
+    grid_probe q;
+    if (!grid_cell(o, b, y, NULL, &q)) return false;
+    float r[4];
+    grid_interp(&q, r);
     *out_d = r[0];
     *out_g = ak_vec3_make(r[1], r[2], r[3]);
     return true;
@@ -258,6 +290,7 @@ typedef struct field_ctx {
     const float* inv; /* [joint_count * 12] or NULL (bind pose) */
     float bulge;
     const broad_phase* bp; /* optional: skips bones whose box does not hold the point */
+    const float* cull;     /* optional: [joint_count * CULL_FLOATS], cull_build's capsule bounds */
 } field_ctx;
 
 typedef struct field_acc {
@@ -265,27 +298,74 @@ typedef struct field_acc {
     ak_vec3 g1, g2;
 } field_acc;
 
-static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc* a) {
-    const ak_skin_implicit* o = c->o;
-    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return;
-    ak_vec3 y = x;
-    const float* m = c->inv ? c->inv + 12 * b : NULL;
-    if (m)
-        y = ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
-                         m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
-    ak_vec3 gy;
-    float f = bone_field_fast(o, b, y, &gy);
-    if (f <= 0.0f) return;
-    /* gradient in posed space: (M^-1)^T gy */
-    ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
-                                 m[6] * gy.x + m[7] * gy.y + m[8] * gy.z)
-                  : gy;
+/* x (posed) into the bind space of a bone: the 3x4 column-major inverse palette matrix m. */
+static inline ak_vec3 to_bone(const float* m, ak_vec3 x) {
+    return ak_vec3_make(m[0] * x.x + m[3] * x.y + m[6] * x.z + m[9], m[1] * x.x + m[4] * x.y + m[7] * x.z + m[10],
+                        m[2] * x.x + m[5] * x.y + m[8] * x.z + m[11]);
+}
+
+/* One bone's field f > 0 with its bind-space gradient gy into the two strongest, the gradient
+ * taken to posed space: (M^-1)^T gy (m NULL: the bind pose). */
+static inline void keep_strongest(field_acc* a, const float* m, float f, ak_vec3 gy) {
+    const ak_vec3 g = m ? ak_vec3_make(m[0] * gy.x + m[1] * gy.y + m[2] * gy.z, m[3] * gy.x + m[4] * gy.y + m[5] * gy.z,
+                                       m[6] * gy.x + m[7] * gy.y + m[8] * gy.z)
+                        : gy;
     if (f > a->f1) {
         a->f2 = a->f1, a->g2 = a->g1;
         a->f1 = f, a->g1 = g;
     } else if (f > a->f2) {
         a->f2 = f, a->g2 = g;
     }
+}
+
+static inline void field_add(const field_ctx* c, size_t b, ak_vec3 x, field_acc* a) {
+    const ak_skin_implicit* o = c->o;
+    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return;
+    const float* m = c->inv ? c->inv + 12 * b : NULL;
+    const ak_vec3 y = m ? to_bone(m, x) : x;
+    ak_vec3 gy;
+    float f = bone_field_fast(o, b, y, &gy);
+    if (f <= 0.0f) return;
+    keep_strongest(a, m, f, gy);
+}
+
+static inline void prefetch_node(const float* p) {
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + 7);
+#else
+    (void)p;
+#endif
+}
+
+/* The cell of bone b's grid holding point x (posed) into *q, its nodes prefetched; false
+ * where the field is 0 (grid_cell, with the capsule bound). Split from the interpolation so
+ * that field_eval locates (and prefetches) every bone of a point before interpolating any. */
+static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_probe* q) {
+    const ak_skin_implicit* o = c->o;
+    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return false;
+    const float* m = c->inv ? c->inv + 12 * b : NULL;
+    const ak_vec3 y = m ? to_bone(m, x) : x;
+    if (!grid_cell(o, b, y, c->cull ? c->cull + CULL_FLOATS * b : NULL, q)) return false;
+    q->m = m;
+    q->r = o->bones[b * BONE_FLOATS + 8];
+    prefetch_node(q->n000);
+    prefetch_node(q->n000 + q->sy);
+    prefetch_node(q->n000 + q->sz);
+    prefetch_node(q->n000 + q->sz + q->sy);
+    return true;
+}
+
+/* The located cell's field (bone_field_fast's interpolation and compact map, then
+ * field_add's gradient transform) into the two strongest. */
+static inline void grid_apply(const grid_probe* q, field_acc* a) {
+    float r[4];
+    grid_interp(q, r);
+    ak_vec3 gy;
+    const float f = compact(q->r, r[0], ak_vec3_make(r[1], r[2], r[3]), &gy);
+    if (f <= 0.0f) return;
+    const float* m = q->m;
+    keep_strongest(a, m, f, gy);
 }
 
 static float field_eval(const field_ctx* c, ak_vec3 x, ak_vec3* out_g) {
@@ -302,8 +382,17 @@ static float field_eval(const field_ctx* c, ak_vec3 x, ak_vec3* out_g) {
         }
         size_t cell = (size_t)p[0] + bp->cells * ((size_t)p[1] + bp->cells * (size_t)p[2]);
         const uint64_t* mw = bp->mask + cell * bp->words;
+        /* with grids (the broad phase exists only then): locate every bone's cell first (their
+         * nodes load meanwhile), then interpolate, in the same bone order */
+        grid_probe probe[16];
+        unsigned n = 0;
         for (size_t w = 0; w < bp->words; ++w)
-            for (uint64_t bits = mw[w]; bits; bits &= bits - 1) field_add(c, 64 * w + (size_t)ctz64(bits), x, &a);
+            for (uint64_t bits = mw[w]; bits; bits &= bits - 1)
+                if (grid_locate(c, 64 * w + (size_t)ctz64(bits), x, &probe[n]) && ++n == 16) {
+                    for (unsigned k = 0; k < n; ++k) grid_apply(&probe[k], &a);
+                    n = 0;
+                }
+        for (unsigned k = 0; k < n; ++k) grid_apply(&probe[k], &a);
     } else {
         for (size_t b = 0; b < o->joint_count; ++b) field_add(c, b, x, &a);
     }
@@ -995,7 +1084,7 @@ ak_result ak_skin_implicit_create(const ak_skin_implicit_desc* desc, const ak_al
             if (o->bones[b * BONE_FLOATS + 10] != 0.0f) rsum += o->bones[b * BONE_FLOATS + 8], ++rn;
         o->step_cap = rn ? (float)(0.5 * rsum / (double)rn) : 0.0f;
         o->bulge = d.bulge > 0.0f ? d.bulge : 0.0f;
-        field_ctx fc = {o, NULL, o->bulge, NULL};
+        field_ctx fc = {o, NULL, o->bulge, NULL, NULL};
         for (size_t v = 0; v < nv; ++v) {
             ak_vec3 g;
             o->iso[v] = o->rep[v] == v ? field_eval(&fc, o->positions[v], &g) : o->iso[o->rep[v]];
@@ -1070,7 +1159,7 @@ float ak_skin_implicit_field(const ak_skin_implicit* implicit, ak_mat4_cspan pal
             ok = inv && palette.count >= implicit->joint_count && invert_palette(implicit, palette.ptr, inv);
         }
         if (ok) {
-            field_ctx fc = {implicit, inv, implicit->bulge, NULL};
+            field_ctx fc = {implicit, inv, implicit->bulge, NULL, NULL};
             f = field_eval(&fc, x, &g);
         }
         if (inv && inv != stack_inv) free(inv);
@@ -1275,8 +1364,13 @@ static size_t bp_mask_bytes(const ak_skin_implicit* o) {
     return c * c * c * ((o->joint_count + 63) / 64) * sizeof(uint64_t);
 }
 
-/* The posed boxes of the grids (palette: bind to posed) into the broad phase's cells. */
-static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, uint64_t* mask, broad_phase* bp) {
+/* The posed boxes of the grids (palette: bind to posed) into the broad phase's cells; with cull
+ * (cull_build's bounds) and inv (the inverse palette), a cell whose every point lies past a
+ * bone's capsule bound (its centre's bind-space distance from the capsule's segment exceeds the
+ * bound plus the cell's half diagonal times the inverse's norm) leaves the bone out, as the
+ * bound would at every point of the cell. */
+static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const float* inv, const float* cull, uint64_t* mask,
+                     broad_phase* bp) {
     const uint32_t cells = bp_cells(o);
     const size_t words = (o->joint_count + 63) / 64;
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
@@ -1308,10 +1402,34 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, uint64_t
                 z[q] = pz > 0.0f ? (pz < (float)cells ? (uint32_t)pz : cells - 1) : 0;
             }
             const uint64_t bit = (uint64_t)1 << (b & 63);
+            const float* C = cull ? cull + b * CULL_FLOATS : NULL;
+            const float* M = inv + 12 * b;
+            float reach2 = 0.0f;
+            if (C && C[7] > 0.0f) {
+                float fro = 0.0f, diag = 0.0f;
+                for (int q = 0; q < 9; ++q) fro += M[q] * M[q];
+                for (int q = 0; q < 3; ++q) diag += 1.0f / (bp->inv_cell[q] * bp->inv_cell[q]);
+                const float reach = sqrtf(C[7]) + sqrtf(fro) * 0.5f * sqrtf(diag) * 1.001f;
+                reach2 = reach * reach;
+                if (!ak_finitef(reach2)) reach2 = 0.0f;
+            }
             for (uint32_t k = a[2]; k <= z[2]; ++k)
                 for (uint32_t j = a[1]; j <= z[1]; ++j)
-                    for (uint32_t i = a[0]; i <= z[0]; ++i)
+                    for (uint32_t i = a[0]; i <= z[0]; ++i) {
+                        if (reach2 > 0.0f) {
+                            const float x = bp->lo[0] + ((float)i + 0.5f) / bp->inv_cell[0];
+                            const float y = bp->lo[1] + ((float)j + 0.5f) / bp->inv_cell[1];
+                            const float zz = bp->lo[2] + ((float)k + 0.5f) / bp->inv_cell[2];
+                            const float ax = M[0] * x + M[3] * y + M[6] * zz + M[9] - C[0];
+                            const float ay = M[1] * x + M[4] * y + M[7] * zz + M[10] - C[1];
+                            const float az = M[2] * x + M[5] * y + M[8] * zz + M[11] - C[2];
+                            float t = (ax * C[3] + ay * C[4] + az * C[5]) * C[6];
+                            t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+                            const float wx = ax - C[3] * t, wy = ay - C[4] * t, wz = az - C[5] * t;
+                            if (wx * wx + wy * wy + wz * wz > reach2) continue;
+                        }
                         mask[((size_t)i + cells * ((size_t)j + (size_t)cells * k)) * words + b / 64] |= bit;
+                    }
         }
         if (pass == 0) {
             if (!(lo[0] <= hi[0]) || !ak_finitef(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2])) return;
@@ -1324,6 +1442,34 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, uint64_t
     }
 }
 
+/* The capsule bounds of the grids' fields (CULL_FLOATS per bone, bind space). A node stores
+ * max(HRBF, capsule distance) inside the bone's bounding sphere and the support radius outside
+ * it, so at least min(capsule distance, support radius); the capsule distance is 1-Lipschitz, so
+ * at a point farther than the support radius plus a cell diagonal from the capsule every corner
+ * of its cell holds at least the support radius, and so does their interpolation: field 0. */
+static void cull_build(const ak_skin_implicit* o, float* cull) {
+    for (size_t b = 0; b < o->joint_count; ++b) {
+        float* C = cull + b * CULL_FLOATS;
+        memset(C, 0, CULL_FLOATS * sizeof(float));
+        const float* B = o->bones + b * BONE_FLOATS;
+        const uint32_t* I = o->grid_info + b * GRID_INFO;
+        if (B[10] == 0.0f || I[0] < 2 || !(B[GRID_AT + 3] > 0.0f)) continue;
+        const float* K = B + CAPSULE_AT;
+        const float r = B[8], h = 1.0f / B[GRID_AT + 3];
+        float scale = fmaxf(K[6], r);
+        for (int q = 0; q < 6; ++q) scale = fmaxf(scale, fabsf(K[q]));
+        const float margin = 1e-3f * r + 1e-5f * scale;
+        const ak_vec3 a = ak_vec3_make(K[0], K[1], K[2]), e = ak_vec3_make(K[3], K[4], K[5]);
+        if (!(r > 0.0f)) continue;
+        const ak_vec3 ab = ak_vec3_sub(e, a);
+        const float l2 = ak_vec3_dot(ab, ab), reach = K[6] + r + 1.7321f * h + margin;
+        C[0] = a.x, C[1] = a.y, C[2] = a.z, C[3] = ab.x, C[4] = ab.y, C[5] = ab.z;
+        C[6] = l2 > 0.0f ? 1.0f / l2 : 0.0f;
+        C[7] = reach * reach;
+        if (!ak_finitef(C[6]) || !ak_finitef(C[7])) memset(C, 0, CULL_FLOATS * sizeof(float));
+    }
+}
+
 size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count) {
     if (!implicit) return 0;
     ak_mat4 probe;
@@ -1331,7 +1477,9 @@ size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t pa
     size_t nv = implicit->vertex_count;
     return 64 + align64(implicit->joint_count * 12 * sizeof(float)) + align64(ak_skin_job_scratch_size(&dq)) +
            align64(nv) + 3 * align64(nv * sizeof(ak_vec3)) + align64(bp_mask_bytes(implicit)) +
-           align64(implicit->pair_count * PAIR_FRAME * sizeof(float));
+           align64(implicit->pair_count * PAIR_FRAME * sizeof(float)) + align64(implicit->joint_count * CULL_FLOATS * sizeof(float)) +
+           align64(nv * sizeof(uint32_t)) + align64(nv) + align64(implicit->triangle_count * sizeof(uint32_t)) +
+           align64(nv * sizeof(uint32_t)) + align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(nv * 8 * sizeof(float));
 }
 
 enum { ST_KEEP = 0, ST_MOVED = 1, ST_STOPPED = 2, ST_CONTACT = 8 };
@@ -1474,69 +1622,103 @@ static bool projectable(float iso) { return iso > 0.02f && iso < 0.98f; }
  * vertices excepted), by the amount that brings the enclosed volume back to the rest volume
  * (Newton steps on the linearised volume; each vertex's move capped at a seam radius). Serial,
  * so the result does not depend on the thread count. grad is scratch for nv vectors. */
-static void keep_volume(const run_ctx* c, ak_vec3* grad) {
+static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t* flag, uint32_t* tris, float* cache) {
     const ak_skin_implicit* o = c->o;
     ak_vec3* pos = c->pos;
     const size_t nv = o->vertex_count;
+    /* the vertices that may move (welded representatives near a folded joint of their part,
+     * in index order) and the triangles that touch them; the others keep their volume */
+    size_t nl = 0, nt = 0;
+    for (size_t v = 0; v < nv; ++v) {
+        flag[v] = 0;
+        if (o->rep[v] != v || (c->state[v] & ST_CONTACT) || !projectable(o->iso[v])) continue;
+        for (size_t p = 0; p < o->pair_count; ++p) {
+            const float* P = o->pairs + p * PAIR_FLOATS;
+            if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
+            if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
+            float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
+            if (1.0f - dist / (BULGE_REACH * P[12]) > 0.0f) {
+                flag[v] = 1, list[nl++] = (uint32_t)v;
+                break;
+            }
+        }
+    }
+    if (nl == 0) return;
+    double fixed = 0.0;
+    for (size_t t = 0; t < o->triangle_count; ++t) {
+        const uint32_t* ix = o->indices + 3 * t;
+        uint32_t ra = o->rep[ix[0]], rb = o->rep[ix[1]], rd = o->rep[ix[2]];
+        if (flag[ra] | flag[rb] | flag[rd]) {
+            tris[nt++] = (uint32_t)t;
+            continue;
+        }
+        fixed += (double)ak_vec3_dot(pos[ra], ak_vec3_cross(pos[rb], pos[rd])) / 6.0;
+    }
     for (int it = 0; it < 3; ++it) {
-        for (size_t v = 0; v < nv; ++v)
-            if (o->rep[v] != v) pos[v] = pos[o->rep[v]];
-        double vol = 0.0;
-        memset(grad, 0, nv * sizeof(ak_vec3));
-        for (size_t t = 0; t < o->triangle_count; ++t) {
-            const uint32_t* ix = o->indices + 3 * t;
-            ak_vec3 a = pos[ix[0]], b = pos[ix[1]], d = pos[ix[2]];
-            vol += (double)ak_vec3_dot(a, ak_vec3_cross(b, d)) / 6.0;
+        double vol = fixed;
+        for (size_t i = 0; i < nt; ++i) {
+            const uint32_t* ix = o->indices + 3 * tris[i];
+            grad[o->rep[ix[0]]] = grad[o->rep[ix[1]]] = grad[o->rep[ix[2]]] = ak_vec3_zero();
+        }
+        for (size_t i = 0; i < nt; ++i) {
+            const uint32_t* ix = o->indices + 3 * tris[i];
             uint32_t ra = o->rep[ix[0]], rb = o->rep[ix[1]], rd = o->rep[ix[2]];
+            ak_vec3 a = pos[ra], b = pos[rb], d = pos[rd];
+            vol += (double)ak_vec3_dot(a, ak_vec3_cross(b, d)) / 6.0;
             grad[ra] = ak_vec3_add(grad[ra], ak_vec3_scale(ak_vec3_cross(b, d), 1.0f / 6.0f));
             grad[rb] = ak_vec3_add(grad[rb], ak_vec3_scale(ak_vec3_cross(d, a), 1.0f / 6.0f));
             grad[rd] = ak_vec3_add(grad[rd], ak_vec3_scale(ak_vec3_cross(a, b), 1.0f / 6.0f));
         }
         const double dv = (double)o->rest_volume - vol;
         if (!isfinite(dv) || fabs(dv) < 1e-4 * (double)o->rest_volume) break;
+        /* the weight, cap and direction of each vertex (from its own position, which only its
+         * own step changes), then the steps that sum to the missing volume */
         double sum = 0.0;
-        for (int pass = 0; pass < 2; ++pass) {
-            const float k = pass ? (float)(dv / sum) : 0.0f;
-            if (pass && !(sum > 0.0 && isfinite(k))) break;
-            for (size_t v = 0; v < nv; ++v) {
-                if (o->rep[v] != v || (c->state[v] & ST_CONTACT) || !projectable(o->iso[v])) continue;
-                float w = 0.0f, cap = 0.0f;
-                ak_vec3 dir = ak_vec3_zero();
-                for (size_t p = 0; p < o->pair_count; ++p) {
-                    const float* P = o->pairs + p * PAIR_FLOATS;
-                    if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
-                    if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
-                    const float* F = c->frame + p * PAIR_FRAME;
-                    /* the inner side of the fold only (where the parts press together),
-                     * fading in over a seam radius */
-                    float inner = ak_vec3_dot(ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2])), ak_vec3_make(F[8], F[9], F[10])) / P[12];
-                    if (!(inner > 0.0f)) continue;
-                    inner = inner < 1.0f ? inner * inner * (3.0f - 2.0f * inner) : 1.0f;
-                    float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
-                    float u = 1.0f - dist / (BULGE_REACH * P[12]);
-                    if (u > 0.0f && inner * u * u > w) {
-                        /* away from the part's posed axis (a smooth direction, unlike the
-                         * per-vertex volume gradient of a crumpled surface) */
-                        ak_vec3 a = (uint32_t)P[0] == o->part[v] ? ak_vec3_make(F[12], F[13], F[14])
-                                                                 : ak_vec3_make(F[16], F[17], F[18]);
-                        ak_vec3 rel = ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2]));
-                        ak_vec3 rad = ak_vec3_normalize(ak_vec3_sub(rel, ak_vec3_scale(a, ak_vec3_dot(rel, a))));
-                        if (!ak_vec3_is_finite(rad)) continue;
-                        w = inner * u * u, cap = P[12], dir = rad;
-                    }
+        for (size_t i = 0; i < nl; ++i) {
+            const size_t v = list[i];
+            float w = 0.0f, cap = 0.0f;
+            ak_vec3 dir = ak_vec3_zero();
+            for (size_t p = 0; p < o->pair_count; ++p) {
+                const float* P = o->pairs + p * PAIR_FLOATS;
+                if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
+                if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
+                const float* F = c->frame + p * PAIR_FRAME;
+                /* the inner side of the fold only (where the parts press together),
+                 * fading in over a seam radius */
+                float inner = ak_vec3_dot(ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2])), ak_vec3_make(F[8], F[9], F[10])) / P[12];
+                if (!(inner > 0.0f)) continue;
+                inner = inner < 1.0f ? inner * inner * (3.0f - 2.0f * inner) : 1.0f;
+                float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
+                float u = 1.0f - dist / (BULGE_REACH * P[12]);
+                if (u > 0.0f && inner * u * u > w) {
+                    /* away from the part's posed axis (a smooth direction, unlike the
+                     * per-vertex volume gradient of a crumpled surface) */
+                    ak_vec3 a = (uint32_t)P[0] == o->part[v] ? ak_vec3_make(F[12], F[13], F[14])
+                                                             : ak_vec3_make(F[16], F[17], F[18]);
+                    ak_vec3 rel = ak_vec3_sub(pos[v], ak_vec3_make(F[0], F[1], F[2]));
+                    ak_vec3 rad = ak_vec3_normalize(ak_vec3_sub(rel, ak_vec3_scale(a, ak_vec3_dot(rel, a))));
+                    if (!ak_vec3_is_finite(rad)) continue;
+                    w = inner * u * u, cap = P[12], dir = rad;
                 }
-                if (w == 0.0f) continue;
-                const float e = ak_vec3_dot(grad[v], dir); /* volume change per unit move */
-                if (!(e > 0.0f) || !ak_finitef(e)) continue;
-                if (!pass) {
-                    sum += (double)w * e;
-                    continue;
-                }
-                float step = k * w;
-                step = ak_clampf(step, -cap, cap);
-                ak_vec3 q = ak_vec3_add(pos[v], ak_vec3_scale(dir, step));
-                if (ak_vec3_is_finite(q)) pos[v] = q, c->state[v] |= ST_MOVED;
             }
+            float* W = cache + 8 * i;
+            W[0] = 0.0f;
+            if (w == 0.0f) continue;
+            const float e = ak_vec3_dot(grad[v], dir); /* volume change per unit move */
+            if (!(e > 0.0f) || !ak_finitef(e)) continue;
+            sum += (double)w * e;
+            W[0] = w, W[1] = cap, W[2] = dir.x, W[3] = dir.y, W[4] = dir.z;
+        }
+        const float k = (float)(dv / sum);
+        if (!(sum > 0.0 && isfinite(k))) break;
+        for (size_t i = 0; i < nl; ++i) {
+            const float* W = cache + 8 * i;
+            if (W[0] == 0.0f) continue;
+            const size_t v = list[i];
+            float step = k * W[0];
+            step = ak_clampf(step, -W[1], W[1]);
+            ak_vec3 q = ak_vec3_add(pos[v], ak_vec3_scale(ak_vec3_make(W[2], W[3], W[4]), step));
+            if (ak_vec3_is_finite(q)) pos[v] = q, c->state[v] |= ST_MOVED;
         }
     }
 }
@@ -1570,8 +1752,22 @@ static bool rigid_alone(const run_ctx* c, size_t v) {
     return true;
 }
 
+/* Whether contact_vertex can act on vertex v: a joint of its part is folded and v lies within
+ * the joint's reach at the bind pose. */
+static bool near_fold(const run_ctx* c, size_t v) {
+    const ak_skin_implicit* o = c->o;
+    const uint32_t part = o->part[v];
+    for (size_t p = 0; p < o->pair_count; ++p) {
+        const float* P = o->pairs + p * PAIR_FLOATS;
+        if (c->frame[p * PAIR_FRAME + 6] == 0.0f || ((uint32_t)P[0] != part && (uint32_t)P[1] != part)) continue;
+        if (ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4]))) < P[11]) return true;
+    }
+    return false;
+}
+
 typedef struct run_task {
     run_ctx* c;
+    const uint32_t* list; /* the vertices to visit, or NULL: all */
     size_t begin, end;
     int phase; /* 0 first projection, 1 relax, 2 re-projection, 3 contact */
 } run_task;
@@ -1580,7 +1776,8 @@ static void* run_worker(void* arg) {
     run_task* t = (run_task*)arg;
     run_ctx* c = t->c;
     const ak_skin_implicit* o = c->o;
-    for (size_t v = t->begin; v < t->end; ++v) {
+    for (size_t i = t->begin; i < t->end; ++i) {
+        const size_t v = t->list ? t->list[i] : i;
         if (o->rep[v] != v || !projectable(o->iso[v])) continue;
         if (t->phase == 0) {
             if (rigid_alone(c, v)) continue; /* kept: exactly at its iso-value already */
@@ -1618,10 +1815,26 @@ static void* run_worker(void* arg) {
     return NULL;
 }
 
-static void run_phase(run_ctx* c, int phase, uint32_t threads) {
+/* The projectable welded representatives into order, grouped by part (counting sort; index
+ * order within a part); returns their number. counts: joint_count + 1 scratch. */
+static size_t order_by_part(const ak_skin_implicit* o, uint32_t* order, uint32_t* counts) {
+    const size_t nv = o->vertex_count, nj = o->joint_count;
+    memset(counts, 0, (nj + 1) * sizeof(uint32_t));
+    for (size_t v = 0; v < nv; ++v)
+        if (o->rep[v] == v && projectable(o->iso[v])) ++counts[o->part[v] < nj ? o->part[v] : nj];
+    uint32_t at = 0;
+    for (size_t j = 0; j <= nj; ++j) {
+        const uint32_t n = counts[j];
+        counts[j] = at, at += n;
+    }
+    for (size_t v = 0; v < nv; ++v)
+        if (o->rep[v] == v && projectable(o->iso[v])) order[counts[o->part[v] < nj ? o->part[v] : nj]++] = (uint32_t)v;
+    return at;
+}
+
+static void run_phase(run_ctx* c, int phase, uint32_t threads, const uint32_t* list, size_t n) {
     run_task tasks[64];
-    size_t n = c->o->vertex_count;
-    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (run_task){c, n * t / threads, n * (t + 1) / threads, phase};
+    for (uint32_t t = 0; t < threads; ++t) tasks[t] = (run_task){c, list, n * t / threads, n * (t + 1) / threads, phase};
     akp_run_tasks(run_worker, tasks, sizeof tasks[0], threads);
 }
 
@@ -1653,6 +1866,20 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     base += align64(nv * sizeof(ak_vec3));
     float* frame = (float*)(void*)base;
     base += align64(o->pair_count * PAIR_FRAME * sizeof(float));
+    float* cull = (float*)(void*)base;
+    base += align64(o->joint_count * CULL_FLOATS * sizeof(float));
+    uint32_t* list = (uint32_t*)(void*)base;
+    base += align64(nv * sizeof(uint32_t));
+    uint8_t* flag = base;
+    base += align64(nv);
+    uint32_t* tris = (uint32_t*)(void*)base;
+    base += align64(o->triangle_count * sizeof(uint32_t));
+    uint32_t* order = (uint32_t*)(void*)base;
+    base += align64(nv * sizeof(uint32_t));
+    uint32_t* counts = (uint32_t*)(void*)base;
+    base += align64((o->joint_count + 1) * sizeof(uint32_t));
+    float* vcache = (float*)(void*)base;
+    base += align64(nv * 8 * sizeof(float));
     uint64_t* mask = (uint64_t*)(void*)base;
     if (!invert_palette(o, job->palette.ptr, inv)) return AK_ERR_BAD_DATA;
     const uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
@@ -1677,28 +1904,42 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     ak_vec3* pos = job->out_positions.ptr;
     memset(state, 0, nv);
     broad_phase bp;
-    if (o->grid_nodes) bp_build(o, job->palette.ptr, mask, &bp);
-    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame};
+    if (o->grid_nodes) cull_build(o, cull);
+    if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? cull : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame};
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
-    run_phase(&c, 0, threads);
+    /* the projectable representatives grouped by part (counting sort, index order within a
+     * part), so that consecutive projections read the same grids (each vertex's projection
+     * is independent of the others': the order changes no result) */
+    const size_t np = order_by_part(o, order, counts);
+    run_phase(&c, 0, threads, order, np);
     uint32_t rounds = job->relax_rounds == 0 ? 3 : job->relax_rounds == UINT32_MAX ? 0 : job->relax_rounds;
     if (rounds > 64) rounds = 64;
     for (uint32_t k = 0; k < rounds; ++k) {
         memcpy(prev, pos, nv * sizeof(ak_vec3));
-        run_phase(&c, 1, threads);
-        run_phase(&c, 2, threads);
+        run_phase(&c, 1, threads, order, np);
+        run_phase(&c, 2, threads, order, np);
     }
     if (o->pair_count) {
         bool contact = false;
         contact_frames(o, job->palette.ptr, frame);
         for (size_t p = 0; p < o->pair_count; ++p) contact = contact || frame[p * PAIR_FRAME + 6] != 0.0f;
         if (contact) {
-            run_phase(&c, 3, threads);
+            /* phase 3 visits the vertices near a folded joint of their part, phase 4 those it
+             * touched (only they move there, so prev needs only their copies after the first) */
+            size_t nl = 0, nc = 0;
+            for (size_t v = 0; v < nv; ++v)
+                if (o->rep[v] == v && projectable(o->iso[v]) && near_fold(&c, v)) list[nl++] = (uint32_t)v;
+            run_phase(&c, 3, threads, list, nl);
+            for (size_t i = 0; i < nl; ++i)
+                if (state[list[i]] & ST_CONTACT) list[nc++] = list[i];
+            memcpy(prev, pos, nv * sizeof(ak_vec3));
             for (int k = 0; k < CONTACT_SMOOTH; ++k) {
-                memcpy(prev, pos, nv * sizeof(ak_vec3));
-                run_phase(&c, 4, threads);
+                if (k)
+                    for (size_t i = 0; i < nc; ++i) prev[list[i]] = pos[list[i]];
+                run_phase(&c, 4, threads, list, nc);
             }
-            if (o->closed) keep_volume(&c, prev);
+            if (o->closed) keep_volume(&c, prev, list, flag, tris, vcache);
         }
     }
     size_t moved = 0;

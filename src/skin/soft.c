@@ -8,9 +8,18 @@
 
 #include "skin_internal.h"
 
+/* The AVX2 tet solve: x86-64 GCC/clang without AK_NO_SIMD, chosen at run time. */
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(AK_NO_SIMD)
+#define SOFT_SIMD 1
+#include <immintrin.h>
+#else
+#define SOFT_SIMD 0
+#endif
+
 #define SOFT_MAX_COLORS 128u
 #define SOFT_INFLUENCES 4u
 #define SOFT_NODE_PLANES 4u
+#define SOFT_NODES_PER_THREAD 4096u           /* fewer nodes per thread: fewer threads */
 #define SOFT_MAX_CUT_BONES 1024u              /* more bones: limbs are not kept apart */
 #define SOFT_PART_UNSET (UINT32_MAX - 1u)
 
@@ -29,6 +38,8 @@ struct ak_skin_soft {
     float* node_weights;    /* [node * 4] */
     uint32_t* tets;         /* [4 * tet], sorted by colour */
     float* dm_inv;          /* [9 * tet] column-major inverse rest edge matrix */
+    float* dm_soa;          /* [9 * tet]: entry i of tet q at i * tet_count + q (the SIMD solve's loads) */
+    uint32_t* tets_soa;     /* [4 * tet]: node k of tet q at k * tet_count + q */
     float* volume;          /* [tet] rest volume */
     uint32_t color_count;
     uint32_t* color_start;  /* [color_count + 1] */
@@ -113,15 +124,15 @@ ak_skin_soft_desc ak_skin_soft_desc_resolved(const ak_skin_soft_desc* desc) {
     ak_skin_soft_desc d;
     if (desc) d = *desc;
     else memset(&d, 0, sizeof d);
-    if (d.resolution == 0) d.resolution = 16;
+    if (d.resolution == 0) d.resolution = 32;
     if (d.youngs_modulus == 0.0f) d.youngs_modulus = 5e4f;
     if (d.poisson_ratio == 0.0f) d.poisson_ratio = 0.499f;
     if (d.density == 0.0f) d.density = 1000.0f;
     if (d.damping == 0.0f) d.damping = 0.1f;
-    if (d.substeps == 0) d.substeps = 10;
+    if (d.substeps == 0) d.substeps = 40;
     if (d.bone_radius == 0.0f) d.bone_radius = 0.5f;
     if (d.jiggle_damping == 0.0f) d.jiggle_damping = 5.0f;
-    if (d.joint_zone == 0.0f) d.joint_zone = 3.0f;
+    if (d.joint_zone == 0.0f) d.joint_zone = 1.5f;
     if (d.memory_budget == 0) d.memory_budget = (size_t)512 << 20;
     return d;
 }
@@ -137,6 +148,8 @@ void ak_skin_soft_destroy(ak_skin_soft* s) {
     akp_free(a, s->node_weights);
     akp_free(a, s->tets);
     akp_free(a, s->dm_inv);
+    akp_free(a, s->dm_soa);
+    akp_free(a, s->tets_soa);
     akp_free(a, s->volume);
     akp_free(a, s->color_start);
     akp_free(a, s->embed_tet);
@@ -282,7 +295,7 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     const size_t nx = dim[0], ny = dim[1], nz = dim[2];
     const size_t cells = nx * ny * nz, gnodes = (nx + 1) * (ny + 1) * (nz + 1), cols = ny * nz;
     /* budget: temporaries and the worst case (every cell kept) of the result */
-    size_t budget_need = cells * (1 + 4 + 6 * (16 + 4 + 4 + 36 + 4 + 4)) + gnodes * (4 + 12 + 1 + 8 + 4 + 32 + 16 + 4 + 1 + 8 * ((nb + 63) / 64)) +
+    size_t budget_need = cells * (1 + 4 + 6 * (16 + 4 + 4 + 36 + 4 + 4 + 36 + 16)) + gnodes * (4 + 12 + 1 + 8 + 4 + 32 + 16 + 4 + 1 + 8 * ((nb + 63) / 64)) +
                          (cols + 1) * 4 + nv * (4 + 16 + 4 + 4) + nb * 64 + gnodes * 8 +
                          (nb <= SOFT_MAX_CUT_BONES ? 2 * nb * ((nb + 63) / 64) * 8 : 0);
     if (budget_need > d.memory_budget) return AK_ERR_BUDGET;
@@ -604,6 +617,13 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
         for (int c = 0; c < 4; ++c) s->mass[tt[c]] += d.density * s->volume[q] * 0.25f;
     }
 
+    SOFT_ALLOC(s->dm_soa, float, 9 * nt);
+    SOFT_ALLOC(s->tets_soa, uint32_t, 4 * nt);
+    for (size_t q = 0; q < nt; ++q) {
+        for (int i = 0; i < 9; ++i) s->dm_soa[(size_t)i * nt + q] = s->dm_inv[9 * q + (size_t)i];
+        for (int k = 0; k < 4; ++k) s->tets_soa[(size_t)k * nt + q] = s->tets[4 * q + (size_t)k];
+    }
+
     /* 6. embedding of the surface vertices */
     SOFT_ALLOC(s->embed_tet, uint32_t, nv);
     SOFT_ALLOC(s->embed_bary, float, 4 * nv);
@@ -700,6 +720,12 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
      * another bone: the flesh around a joint stays free, so that the bones' cores do not crush
      * it at a deep bend */
     const float zone = d.joint_zone;
+    /* the default (joint_zone 0): where a bone's capsule is sized by its flesh (half its flesh
+     * radius is more than the 1.2-cube floor: the lattice resolves the limb, as on the fat
+     * builtin cylinder), the free zone around it also reaches two of its flesh radii (at most
+     * half the node's own bone): the flesh that folds into a deep bend reaches that far. A thin limb
+     * (CesiumMan's, one or two cubes across) keeps 1.5 capsule radii (docs/softskin.md) */
+    const bool flesh_zone = !(desc_in && desc_in->joint_zone != 0.0f);
     /* per joint: whether any node became kinematic with these rules; a joint that got none (its
      * bones too short or too crowded for them: a dense skeleton at a coarse lattice) takes every
      * node inside its capsule that it weighs most */
@@ -722,6 +748,8 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
                 if (!(core > 0.0f)) continue;
                 float d2 = akp_segment_dist_sq(s->rest[n], s->bones[b].head, s->bones[b].tail, NULL);
                 float z = ak_minf(zone * core, own_len / 2.0f);
+                if (flesh_zone && d.bone_radius * s->contact_radius[b] > 1.2f * h)
+                    z = ak_minf(ak_maxf(zone * core, 2.0f * s->contact_radius[b]), own_len / 2.0f);
                 if (s->bones[b].joint_index == part) inside = inside || d2 < core * core;
                 else near_other = near_other || (pass == 0 && d2 < z * z);
             }
@@ -883,12 +911,27 @@ ak_result ak_skin_soft_surface(const ak_skin_soft* s, ak_vec3_cspan x, ak_vec3_s
 
 /* ---- step ----------------------------------------------------------------------------- */
 
-/* Scratch layout: start[node], prev[node], target[node], vref[node], lambda[2 * tet], posed
- * bones[2 * bone], joint planes[2 * plane]. */
+/* A bone's collider at the step's pose: segment a + t ab, and a bounding sphere (centre mid,
+ * squared radius reach2) that rejects the nodes far from it with one distance. */
+/* A node's position with its inverse mass: 16 bytes, one 128-bit load in the SIMD solve. */
+typedef struct soft_p4 {
+    ak_vec3 p;
+    float w;
+} soft_p4;
+
+typedef struct posed_bone {
+    ak_vec3 a, ab, mid;
+    float inv_len2, reach2, rc2;
+} posed_bone;
+
+/* Scratch layout: x[node], prev[node] (soft_p4), start[node], target[node], vref[node],
+ * lambda_d[tet], lambda_h[tet], posed
+ * bones[bone], joint planes[2 * plane]. */
 size_t ak_skin_soft_step_scratch_size(const ak_skin_soft* s) {
     if (!s) return 0;
-    return 64 + akp_align16(4 * s->node_count * sizeof(ak_vec3)) + akp_align16(2 * s->tet_count * sizeof(float)) +
-           akp_align16(2 * s->bone_count * sizeof(ak_vec3)) + akp_align16(2 * s->plane_count * sizeof(ak_vec3));
+    return 64 + 2 * s->node_count * sizeof(soft_p4) + akp_align16(3 * s->node_count * sizeof(ak_vec3)) +
+           akp_align16(2 * s->tet_count * sizeof(float)) +
+           akp_align16(s->bone_count * sizeof(posed_bone)) + akp_align16(2 * s->plane_count * sizeof(ak_vec3));
 }
 
 ak_result ak_skin_soft_step_validate(const ak_skin_soft_step_job* j) {
@@ -907,85 +950,223 @@ ak_result ak_skin_soft_step_validate(const ak_skin_soft_step_job* j) {
 
 typedef struct step_ctx {
     const ak_skin_soft* s;
-    ak_vec3 *x, *v, *start, *prev, *target, *bones, *planes, *vref;
+    soft_p4 *x, *prev; /* positions (w: inverse mass) during the step, and at the substep's start */
+    ak_vec3 *v, *start, *target, *planes, *vref;
+    posed_bone* bones;
     float jiggle; /* 1 - exp(-jiggle_damping h) */
     float* lambda;
-    float h, gamma, gamma_h, adev, ahyd;
+    float h, gamma, adev, ahyd;
+    bool simd; /* the CPU runs solve_tets8 */
     uint32_t iterations; /* adev = 1 / (mu h^2), ahyd = 1 / (lambda h^2): divide by V */
     float hyd_rest;             /* 1 + mu / lambda */
     ak_vec3 gravity;
 } step_ctx;
 
+/* One tetrahedron's coupled deviatoric + hydrostatic XPBD solve. The AVX2 path below
+ * (solve_tets8) performs the same float operations in the same order on 8 tets of a colour, so
+ * both give the same bits (the build does not contract a * b + c). */
 static void solve_tet(const step_ctx* c, size_t q) {
     const ak_skin_soft* s = c->s;
     const uint32_t* tt = &s->tets[4 * q];
-    float w[4] = {s->inv_mass[tt[0]], s->inv_mass[tt[1]], s->inv_mass[tt[2]], s->inv_mass[tt[3]]};
+    const float w[4] = {s->inv_mass[tt[0]], s->inv_mass[tt[1]], s->inv_mass[tt[2]], s->inv_mass[tt[3]]};
     if (w[0] + w[1] + w[2] + w[3] == 0.0f) return;
-    ak_vec3* x = c->x;
+    soft_p4* x = c->x;
     const float* m = &s->dm_inv[9 * q];
-    ak_vec3 x0 = x[tt[0]];
-    ak_vec3 d1 = ak_vec3_sub(x[tt[1]], x0), d2 = ak_vec3_sub(x[tt[2]], x0), d3 = ak_vec3_sub(x[tt[3]], x0);
+    const ak_vec3 x0 = x[tt[0]].p;
+    const ak_vec3 d1 = ak_vec3_sub(x[tt[1]].p, x0), d2 = ak_vec3_sub(x[tt[2]].p, x0), d3 = ak_vec3_sub(x[tt[3]].p, x0);
     /* F = Ds Dm^-1: column j = d1 m[0 + 3j] + d2 m[1 + 3j] + d3 m[2 + 3j] */
     ak_vec3 f[3];
     for (int jc = 0; jc < 3; ++jc)
         f[jc] = ak_vec3_madd(ak_vec3_madd(ak_vec3_scale(d1, m[3 * jc]), d2, m[1 + 3 * jc]), d3, m[2 + 3 * jc]);
-    float cd = sqrtf(ak_vec3_length_sq(f[0]) + ak_vec3_length_sq(f[1]) + ak_vec3_length_sq(f[2]));
-    ak_vec3 ph[3] = {ak_vec3_cross(f[1], f[2]), ak_vec3_cross(f[2], f[0]), ak_vec3_cross(f[0], f[1])};
-    float det = ak_vec3_dot(f[0], ph[0]);
-    float ch = det - c->hyd_rest;
+    const float cd = sqrtf(ak_vec3_length_sq(f[0]) + ak_vec3_length_sq(f[1]) + ak_vec3_length_sq(f[2]));
+    const ak_vec3 ph[3] = {ak_vec3_cross(f[1], f[2]), ak_vec3_cross(f[2], f[0]), ak_vec3_cross(f[0], f[1])};
+    const float ch = ak_vec3_dot(f[0], ph[0]) - c->hyd_rest;
     /* node gradients: g_k = sum_j P_col_j m[k + 3j] (k = 1..3), g_0 = -sum */
     ak_vec3 gd[4], gh[4];
-    float inv_cd = cd > 1e-12f ? 1.0f / cd : 0.0f;
+    const bool collapsed = !(cd > 1e-12f);
+    const float inv_cd = collapsed ? 0.0f : 1.0f / cd;
     for (int k = 0; k < 3; ++k) {
-        ak_vec3 a = ak_vec3_zero(), b = ak_vec3_zero();
-        for (int jc = 0; jc < 3; ++jc) {
-            a = ak_vec3_madd(a, f[jc], m[k + 3 * jc] * inv_cd);
-            b = ak_vec3_madd(b, ph[jc], m[k + 3 * jc]);
-        }
-        gd[k + 1] = a;
-        gh[k + 1] = b;
+        gd[k + 1] = ak_vec3_madd(ak_vec3_madd(ak_vec3_scale(f[0], m[k] * inv_cd), f[1], m[k + 3] * inv_cd), f[2], m[k + 6] * inv_cd);
+        gh[k + 1] = ak_vec3_madd(ak_vec3_madd(ak_vec3_scale(ph[0], m[k]), ph[1], m[k + 3]), ph[2], m[k + 6]);
     }
     gd[0] = ak_vec3_neg(ak_vec3_add(ak_vec3_add(gd[1], gd[2]), gd[3]));
     gh[0] = ak_vec3_neg(ak_vec3_add(ak_vec3_add(gh[1], gh[2]), gh[3]));
-    float a11 = 0, a12 = 0, a22 = 0, vd = 0, vh = 0;
-    for (int k = 0; k < 4; ++k) {
+    float a11 = w[0] * ak_vec3_dot(gd[0], gd[0]), a12 = w[0] * ak_vec3_dot(gd[0], gh[0]), a22 = w[0] * ak_vec3_dot(gh[0], gh[0]);
+    for (int k = 1; k < 4; ++k) {
         a11 += w[k] * ak_vec3_dot(gd[k], gd[k]);
         a12 += w[k] * ak_vec3_dot(gd[k], gh[k]);
         a22 += w[k] * ak_vec3_dot(gh[k], gh[k]);
-        if (c->gamma > 0.0f || c->gamma_h > 0.0f) {
-            ak_vec3 dx = ak_vec3_sub(x[tt[k]], c->prev[tt[k]]);
-            vd += ak_vec3_dot(gd[k], dx);
-            vh += ak_vec3_dot(gh[k], dx);
-        }
     }
-    float vol = s->volume[q];
-    float atd = c->adev / vol, ath = c->ahyd / vol, g1 = 1.0f + c->gamma;
-    float* lam = &c->lambda[2 * q];
-    float b1 = -cd - atd * lam[0] - c->gamma * vd;
-    /* damping on the deviatoric constraint only (gamma_h = 0): damping the stiff volume term
-     * makes the volume creep back over many steps */
-    float gh_ = c->gamma_h, g2 = 1.0f + gh_;
-    float b2 = -ch - ath * lam[1] - gh_ * vh;
-    /* row i is (1 + gamma_i) (grad C_i . dx) + alpha~_i dlambda_i = b_i: each constraint damps
-     * the motion along its own gradient, so the rest state (where the two gradients are
-     * parallel and the corrections cancel) stays a fixed point for any damping */
-    float m11 = g1 * a11 + atd, m12 = g1 * a12, m21 = g2 * a12, m22 = g2 * a22 + ath;
+    /* Rayleigh damping: the motion of this substep along each gradient */
+    float vd = 0.0f;
+    if (c->gamma > 0.0f) {
+        vd = ak_vec3_dot(gd[0], ak_vec3_sub(x[tt[0]].p, c->prev[tt[0]].p));
+        for (int k = 1; k < 4; ++k) vd += ak_vec3_dot(gd[k], ak_vec3_sub(x[tt[k]].p, c->prev[tt[k]].p));
+    }
+    const float vol = s->volume[q];
+    const float atd = c->adev / vol, ath = c->ahyd / vol, g1 = 1.0f + c->gamma;
+    float *lam_d = &c->lambda[q], *lam_h = &c->lambda[s->tet_count + q];
+    const float b1 = -cd - atd * *lam_d - c->gamma * vd;
+    /* damping on the deviatoric constraint only: damping the stiff volume term makes the
+     * volume creep back over many steps. Row i is (1 + gamma_i) (grad C_i . dx) + alpha~_i
+     * dlambda_i = b_i: each constraint damps the motion along its own gradient, so the rest
+     * state (where the two gradients are parallel and the corrections cancel) stays a fixed
+     * point for any damping */
+    const float b2 = -ch - ath * *lam_h;
+    const float m11 = g1 * a11 + atd, m12 = g1 * a12, m22 = a22 + ath;
     float dl1, dl2;
-    if (inv_cd == 0.0f) { /* collapsed to a point: hydrostatic alone */
+    if (collapsed) { /* collapsed to a point: hydrostatic alone */
         dl1 = 0.0f;
         dl2 = m22 > 0.0f ? b2 / m22 : 0.0f;
     } else {
-        float dt2 = m11 * m22 - m12 * m21;
+        const float dt2 = m11 * m22 - m12 * a12;
         if (!(fabsf(dt2) > 1e-30f)) return;
         dl1 = (b1 * m22 - b2 * m12) / dt2;
-        dl2 = (m11 * b2 - m21 * b1) / dt2;
+        dl2 = (m11 * b2 - a12 * b1) / dt2;
     }
-    if (!isfinite(dl1) || !isfinite(dl2)) return;
-    lam[0] += dl1;
-    lam[1] += dl2;
+    if (!(fabsf(dl1) < INFINITY) || !(fabsf(dl2) < INFINITY)) return;
+    *lam_d += dl1;
+    *lam_h += dl2;
     for (int k = 0; k < 4; ++k)
         if (w[k] > 0.0f)
-            x[tt[k]] = ak_vec3_add(x[tt[k]], ak_vec3_scale(ak_vec3_add(ak_vec3_scale(gd[k], dl1), ak_vec3_scale(gh[k], dl2)), w[k]));
+            x[tt[k]].p = ak_vec3_add(x[tt[k]].p, ak_vec3_scale(ak_vec3_add(ak_vec3_scale(gd[k], dl1), ak_vec3_scale(gh[k], dl2)), w[k]));
+}
+
+#if SOFT_SIMD
+typedef __m256 v8;
+typedef struct v8x3 {
+    v8 x, y, z;
+} v8x3;
+#define SOFT_AVX2 __attribute__((target("avx2"))) static inline
+SOFT_AVX2 v8 v8_set(float f) { return _mm256_set1_ps(f); }
+SOFT_AVX2 v8x3 v3_sub(v8x3 a, v8x3 b) { return (v8x3){_mm256_sub_ps(a.x, b.x), _mm256_sub_ps(a.y, b.y), _mm256_sub_ps(a.z, b.z)}; }
+SOFT_AVX2 v8x3 v3_add(v8x3 a, v8x3 b) { return (v8x3){_mm256_add_ps(a.x, b.x), _mm256_add_ps(a.y, b.y), _mm256_add_ps(a.z, b.z)}; }
+SOFT_AVX2 v8x3 v3_scale(v8x3 a, v8 s) { return (v8x3){_mm256_mul_ps(a.x, s), _mm256_mul_ps(a.y, s), _mm256_mul_ps(a.z, s)}; }
+SOFT_AVX2 v8x3 v3_madd(v8x3 a, v8x3 b, v8 s) { return v3_add(a, v3_scale(b, s)); }
+SOFT_AVX2 v8 v3_dot(v8x3 a, v8x3 b) {
+    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_mul_ps(a.y, b.y)), _mm256_mul_ps(a.z, b.z));
+}
+SOFT_AVX2 v8x3 v3_cross(v8x3 a, v8x3 b) {
+    return (v8x3){_mm256_sub_ps(_mm256_mul_ps(a.y, b.z), _mm256_mul_ps(a.z, b.y)), _mm256_sub_ps(_mm256_mul_ps(a.z, b.x), _mm256_mul_ps(a.x, b.z)),
+                  _mm256_sub_ps(_mm256_mul_ps(a.x, b.y), _mm256_mul_ps(a.y, b.x))};
+}
+SOFT_AVX2 v8x3 v3_neg(v8x3 a) {
+    const v8 sg = _mm256_set1_ps(-0.0f);
+    return (v8x3){_mm256_xor_ps(a.x, sg), _mm256_xor_ps(a.y, sg), _mm256_xor_ps(a.z, sg)};
+}
+/* Nodes idx[0..7] -> lanes: two 128-bit loads per register, then a 4x4 transpose per half. */
+SOFT_AVX2 v8x3 p4_gather(const soft_p4* x, const uint32_t* idx, v8* w) {
+    v8 r[4];
+    for (int e = 0; e < 4; ++e)
+        r[e] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&x[idx[e]].p.x)), _mm_loadu_ps(&x[idx[4 + e]].p.x), 1);
+    const v8 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+    const v8 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    if (w) *w = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+    return (v8x3){_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
+                  _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0))};
+}
+
+/* Lanes -> nodes idx[0..7] (x, y, z, w: one 128-bit store each). */
+SOFT_AVX2 void p4_scatter(soft_p4* x, const uint32_t* idx, v8x3 p, v8 w) {
+    const v8 t0 = _mm256_unpacklo_ps(p.x, p.y), t1 = _mm256_unpackhi_ps(p.x, p.y);
+    const v8 t2 = _mm256_unpacklo_ps(p.z, w), t3 = _mm256_unpackhi_ps(p.z, w);
+    v8 r[4];
+    r[0] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
+    r[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+    r[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+    r[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+    for (int e = 0; e < 4; ++e) {
+        _mm_storeu_ps(&x[idx[e]].p.x, _mm256_castps256_ps128(r[e]));
+        _mm_storeu_ps(&x[idx[4 + e]].p.x, _mm256_extractf128_ps(r[e], 1));
+    }
+}
+SOFT_AVX2 v8 v8_finite(v8 a) { /* all ones where |a| < inf (not NaN) */
+    return _mm256_cmp_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a), _mm256_set1_ps(INFINITY), _CMP_LT_OQ);
+}
+
+/* solve_tet on the 8 tets q .. q + 7 of one colour (no two share a node). */
+__attribute__((target("avx2"))) static void solve_tets8(const step_ctx* c, size_t q) {
+    const ak_skin_soft* s = c->s;
+    const size_t nt = s->tet_count;
+    const uint32_t* id[4];
+    v8 w[4];
+    v8x3 p[4];
+    for (int k = 0; k < 4; ++k) {
+        id[k] = &s->tets_soa[(size_t)k * nt + q];
+        p[k] = p4_gather(c->x, id[k], &w[k]);
+    }
+    const v8 zero = _mm256_setzero_ps(), one = v8_set(1.0f);
+    const v8 active = _mm256_cmp_ps(_mm256_add_ps(_mm256_add_ps(_mm256_add_ps(w[0], w[1]), w[2]), w[3]), zero, _CMP_NEQ_UQ);
+    if (_mm256_movemask_ps(active) == 0) return;
+    v8 m[9];
+    for (int i = 0; i < 9; ++i) m[i] = _mm256_loadu_ps(&s->dm_soa[(size_t)i * nt + q]);
+    const v8x3 d1 = v3_sub(p[1], p[0]), d2 = v3_sub(p[2], p[0]), d3 = v3_sub(p[3], p[0]);
+    v8x3 f[3];
+    for (int jc = 0; jc < 3; ++jc) f[jc] = v3_madd(v3_madd(v3_scale(d1, m[3 * jc]), d2, m[1 + 3 * jc]), d3, m[2 + 3 * jc]);
+    const v8 cd = _mm256_sqrt_ps(_mm256_add_ps(_mm256_add_ps(v3_dot(f[0], f[0]), v3_dot(f[1], f[1])), v3_dot(f[2], f[2])));
+    const v8x3 ph[3] = {v3_cross(f[1], f[2]), v3_cross(f[2], f[0]), v3_cross(f[0], f[1])};
+    const v8 ch = _mm256_sub_ps(v3_dot(f[0], ph[0]), v8_set(c->hyd_rest));
+    const v8 ok_cd = _mm256_cmp_ps(cd, v8_set(1e-12f), _CMP_GT_OQ);
+    const v8 inv_cd = _mm256_and_ps(ok_cd, _mm256_div_ps(one, cd));
+    v8x3 gd[4], gh[4];
+    for (int k = 0; k < 3; ++k) {
+        gd[k + 1] = v3_madd(v3_madd(v3_scale(f[0], _mm256_mul_ps(m[k], inv_cd)), f[1], _mm256_mul_ps(m[k + 3], inv_cd)), f[2],
+                            _mm256_mul_ps(m[k + 6], inv_cd));
+        gh[k + 1] = v3_madd(v3_madd(v3_scale(ph[0], m[k]), ph[1], m[k + 3]), ph[2], m[k + 6]);
+    }
+    gd[0] = v3_neg(v3_add(v3_add(gd[1], gd[2]), gd[3]));
+    gh[0] = v3_neg(v3_add(v3_add(gh[1], gh[2]), gh[3]));
+    v8 a11 = _mm256_mul_ps(w[0], v3_dot(gd[0], gd[0])), a12 = _mm256_mul_ps(w[0], v3_dot(gd[0], gh[0])),
+       a22 = _mm256_mul_ps(w[0], v3_dot(gh[0], gh[0]));
+    for (int k = 1; k < 4; ++k) {
+        a11 = _mm256_add_ps(a11, _mm256_mul_ps(w[k], v3_dot(gd[k], gd[k])));
+        a12 = _mm256_add_ps(a12, _mm256_mul_ps(w[k], v3_dot(gd[k], gh[k])));
+        a22 = _mm256_add_ps(a22, _mm256_mul_ps(w[k], v3_dot(gh[k], gh[k])));
+    }
+    v8 vd = zero;
+    if (c->gamma > 0.0f) {
+        vd = v3_dot(gd[0], v3_sub(p[0], p4_gather(c->prev, id[0], NULL)));
+        for (int k = 1; k < 4; ++k) vd = _mm256_add_ps(vd, v3_dot(gd[k], v3_sub(p[k], p4_gather(c->prev, id[k], NULL))));
+    }
+    const v8 vol = _mm256_loadu_ps(&s->volume[q]);
+    const v8 atd = _mm256_div_ps(v8_set(c->adev), vol), ath = _mm256_div_ps(v8_set(c->ahyd), vol), g1 = v8_set(1.0f + c->gamma);
+    float *lam_d = &c->lambda[q], *lam_h = &c->lambda[s->tet_count + q];
+    const v8 ld = _mm256_loadu_ps(lam_d), lh = _mm256_loadu_ps(lam_h);
+    const v8 b1 = _mm256_sub_ps(_mm256_sub_ps(_mm256_xor_ps(cd, v8_set(-0.0f)), _mm256_mul_ps(atd, ld)), _mm256_mul_ps(v8_set(c->gamma), vd));
+    const v8 b2 = _mm256_sub_ps(_mm256_xor_ps(ch, v8_set(-0.0f)), _mm256_mul_ps(ath, lh));
+    const v8 m11 = _mm256_add_ps(_mm256_mul_ps(g1, a11), atd), m12 = _mm256_mul_ps(g1, a12), m22 = _mm256_add_ps(a22, ath);
+    /* collapsed lanes: hydrostatic alone */
+    const v8 dl2c = _mm256_and_ps(_mm256_cmp_ps(m22, zero, _CMP_GT_OQ), _mm256_div_ps(b2, m22));
+    const v8 dt2 = _mm256_sub_ps(_mm256_mul_ps(m11, m22), _mm256_mul_ps(m12, a12));
+    const v8 ok_dt = _mm256_cmp_ps(_mm256_andnot_ps(v8_set(-0.0f), dt2), v8_set(1e-30f), _CMP_GT_OQ);
+    v8 dl1 = _mm256_div_ps(_mm256_sub_ps(_mm256_mul_ps(b1, m22), _mm256_mul_ps(b2, m12)), dt2);
+    v8 dl2 = _mm256_div_ps(_mm256_sub_ps(_mm256_mul_ps(m11, b2), _mm256_mul_ps(a12, b1)), dt2);
+    dl1 = _mm256_and_ps(ok_cd, dl1);
+    dl2 = _mm256_blendv_ps(dl2c, dl2, ok_cd);
+    const v8 valid = _mm256_and_ps(_mm256_and_ps(active, _mm256_or_ps(ok_dt, _mm256_xor_ps(ok_cd, _mm256_castsi256_ps(_mm256_set1_epi32(-1))))),
+                                   _mm256_and_ps(v8_finite(dl1), v8_finite(dl2)));
+    const int vmask = _mm256_movemask_ps(valid);
+    if (vmask == 0) return;
+    _mm256_storeu_ps(lam_d, _mm256_blendv_ps(ld, _mm256_add_ps(ld, dl1), valid));
+    _mm256_storeu_ps(lam_h, _mm256_blendv_ps(lh, _mm256_add_ps(lh, dl2), valid));
+    /* lanes not updated write their own values back: no other tet of the colour has their nodes */
+    for (int k = 0; k < 4; ++k) {
+        const v8 upd = _mm256_and_ps(valid, _mm256_cmp_ps(w[k], zero, _CMP_GT_OQ));
+        const v8x3 np = v3_add(p[k], v3_scale(v3_add(v3_scale(gd[k], dl1), v3_scale(gh[k], dl2)), w[k]));
+        const v8x3 out = {_mm256_blendv_ps(p[k].x, np.x, upd), _mm256_blendv_ps(p[k].y, np.y, upd), _mm256_blendv_ps(p[k].z, np.z, upd)};
+        p4_scatter(c->x, id[k], out, w[k]);
+    }
+}
+#endif
+
+/* The tets [b, e) of one colour: 8 at a time where the CPU has AVX2, the rest one by one. */
+static void solve_range(const step_ctx* c, size_t b, size_t e) {
+    size_t q = b;
+#if SOFT_SIMD
+    if (c->simd)
+        for (; q + 8 <= e; q += 8) solve_tets8(c, q);
+#endif
+    for (; q < e; ++q) solve_tet(c, q);
 }
 
 static void collide_node(const step_ctx* c, size_t n) {
@@ -996,19 +1177,22 @@ static void collide_node(const step_ctx* c, size_t n) {
         size_t pl = (size_t)(e > 0 ? e : -e) - 1;
         ak_vec3 nrm = c->planes[2 * pl + 1];
         if (nrm.x == 0.0f && nrm.y == 0.0f && nrm.z == 0.0f) continue;
-        float sd = ak_vec3_dot(ak_vec3_sub(c->x[n], c->planes[2 * pl]), nrm);
-        if (e > 0 ? sd > 0.0f : sd < 0.0f) c->x[n] = ak_vec3_madd(c->x[n], nrm, -sd);
+        float sd = ak_vec3_dot(ak_vec3_sub(c->x[n].p, c->planes[2 * pl]), nrm);
+        if (e > 0 ? sd > 0.0f : sd < 0.0f) c->x[n].p = ak_vec3_madd(c->x[n].p, nrm, -sd);
     }
     const uint64_t* bits = &s->collide[n * s->collide_words];
     for (size_t wi = 0; wi < s->collide_words; ++wi)
         for (uint64_t m = bits[wi]; m; m &= m - 1) {
             size_t b = wi * 64 + (size_t)__builtin_ctzll(m);
-            float rc = s->collide_radius[b];
-            ak_vec3 cp;
-            float d2 = akp_segment_dist_sq(c->x[n], c->bones[2 * b], c->bones[2 * b + 1], &cp);
-            if (d2 >= rc * rc || d2 < 1e-20f) continue;
-            float dl = sqrtf(d2);
-            c->x[n] = ak_vec3_madd(cp, ak_vec3_sub(c->x[n], cp), rc / dl);
+            const posed_bone* pb = &c->bones[b];
+            ak_vec3 p = c->x[n].p;
+            if (ak_vec3_length_sq(ak_vec3_sub(p, pb->mid)) >= pb->reach2) continue;
+            ak_vec3 ap = ak_vec3_sub(p, pb->a);
+            float tt = ak_clampf(ak_vec3_dot(ap, pb->ab) * pb->inv_len2, 0.0f, 1.0f);
+            ak_vec3 cp = ak_vec3_madd(pb->a, pb->ab, tt);
+            float d2 = ak_vec3_length_sq(ak_vec3_sub(p, cp));
+            if (d2 >= pb->rc2 || d2 < 1e-20f) continue;
+            c->x[n].p = ak_vec3_madd(cp, ak_vec3_sub(p, cp), sqrtf(pb->rc2 / d2));
         }
 }
 
@@ -1050,25 +1234,25 @@ static void step_work(soft_team* team, uint32_t index) {
         float frac = (float)(sub + 1) / (float)S;
         for (size_t n = nb; n < ne; ++n) {
             c->prev[n] = c->x[n];
-            if (s->kinematic[n]) c->x[n] = ak_vec3_lerp(c->start[n], c->target[n], frac);
+            if (s->kinematic[n]) c->x[n].p = ak_vec3_lerp(c->start[n], c->target[n], frac);
             else {
                 c->v[n] = ak_vec3_madd(c->v[n], c->gravity, c->h);
-                c->x[n] = ak_vec3_madd(c->x[n], c->v[n], c->h);
+                c->x[n].p = ak_vec3_madd(c->x[n].p, c->v[n], c->h);
             }
         }
-        for (size_t q = tb; q < te; ++q) c->lambda[2 * q] = c->lambda[2 * q + 1] = 0.0f;
+        for (size_t q = tb; q < te; ++q) c->lambda[q] = c->lambda[s->tet_count + q] = 0.0f;
         sync(team);
         for (uint32_t it = 0; it < c->iterations; ++it)
         for (uint32_t col = 0; col < s->color_count; ++col) {
             size_t cb = s->color_start[col], ce = s->color_start[col + 1], b, e;
             range_of(ce - cb, index, count, &b, &e);
-            for (size_t q = cb + b; q < cb + e; ++q) solve_tet(c, q);
+            solve_range(c, cb + b, cb + e);
             sync(team);
         }
         float inv_h = 1.0f / c->h;
         for (size_t n = nb; n < ne; ++n) {
             if (!s->kinematic[n]) collide_node(c, n);
-            c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n], c->prev[n]), inv_h);
+            c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n].p, c->prev[n].p), inv_h);
             /* jiggle damping: velocity relative to the skinned motion decays */
             if (!s->kinematic[n]) c->v[n] = ak_vec3_madd(c->v[n], ak_vec3_sub(c->v[n], c->vref[n]), -c->jiggle);
         }
@@ -1096,15 +1280,15 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     step_ctx c;
     memset(&c, 0, sizeof c);
     c.s = s;
-    c.x = j->node_positions.ptr;
     c.v = j->node_velocities.ptr;
-    c.start = (ak_vec3*)(void*)base;
-    c.prev = c.start + nn;
-    c.target = c.prev + nn;
+    c.x = (soft_p4*)(void*)base;
+    c.prev = c.x + nn;
+    c.start = (ak_vec3*)(void*)(c.prev + nn);
+    c.target = c.start + nn;
     c.vref = c.target + nn;
-    c.lambda = (float*)(void*)(base + akp_align16(4 * nn * sizeof(ak_vec3)));
-    c.bones = (ak_vec3*)(void*)((uint8_t*)c.lambda + akp_align16(2 * s->tet_count * sizeof(float)));
-    c.planes = (ak_vec3*)(void*)((uint8_t*)c.bones + akp_align16(2 * s->bone_count * sizeof(ak_vec3)));
+    c.lambda = (float*)(void*)((uint8_t*)c.start + akp_align16(3 * nn * sizeof(ak_vec3)));
+    c.bones = (posed_bone*)(void*)((uint8_t*)c.lambda + akp_align16(2 * s->tet_count * sizeof(float)));
+    c.planes = (ak_vec3*)(void*)((uint8_t*)c.bones + akp_align16(s->bone_count * sizeof(posed_bone)));
     float dt = j->dt > 0.0f ? j->dt : 1.0f / 60.0f;
     c.h = dt / (float)s->substeps;
     c.gamma = s->damping / c.h;
@@ -1113,10 +1297,14 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     c.ahyd = 1.0f / (s->lambda * c.h * c.h);
     c.hyd_rest = 1.0f + s->mu / s->lambda;
     c.gravity = j->gravity;
+#if SOFT_SIMD
+    c.simd = __builtin_cpu_supports("avx2");
+#endif
     c.jiggle = 1.0f - expf(-s->jiggle_damping * c.h);
     const bool have_prev = j->previous_palette.ptr != NULL;
     for (size_t n = 0; n < nn; ++n) {
-        c.start[n] = c.x[n];
+        c.start[n] = j->node_positions.ptr[n];
+        c.x[n] = (soft_p4){c.start[n], s->inv_mass[n]};
         ak_vec3 end = lbs_node(s, n, j->palette.ptr, j->palette.count);
         if (s->kinematic[n]) c.target[n] = end;
         c.vref[n] = have_prev ? ak_vec3_scale(ak_vec3_sub(end, lbs_node(s, n, j->previous_palette.ptr, j->previous_palette.count)), 1.0f / dt)
@@ -1124,8 +1312,17 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     }
     for (size_t b = 0; b < s->bone_count; ++b) {
         size_t jn = s->bones[b].joint_index;
-        c.bones[2 * b] = ak_mat4_transform_point(j->palette.ptr[jn], s->bones[b].head);
-        c.bones[2 * b + 1] = ak_mat4_transform_point(j->palette.ptr[jn], s->bones[b].tail);
+        ak_vec3 a = ak_mat4_transform_point(j->palette.ptr[jn], s->bones[b].head);
+        ak_vec3 e = ak_mat4_transform_point(j->palette.ptr[jn], s->bones[b].tail);
+        posed_bone* pb = &c.bones[b];
+        pb->a = a;
+        pb->ab = ak_vec3_sub(e, a);
+        float len2 = ak_vec3_length_sq(pb->ab), rc = s->collide_radius[b];
+        pb->inv_len2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;
+        pb->mid = ak_vec3_lerp(a, e, 0.5f);
+        float reach = 0.5f * sqrtf(len2) + rc;
+        pb->reach2 = 1.0001f * reach * reach + 1e-20f;
+        pb->rc2 = rc * rc;
     }
     for (uint32_t pl = 0; pl < s->plane_count; ++pl) {
         const ak_skin_bone *bp = &s->bones[s->planes[2 * pl]], *bc = &s->bones[s->planes[2 * pl + 1]];
@@ -1137,7 +1334,10 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
         c.planes[2 * pl + 1] = ak_vec3_length(u) > 0.1f ? ak_vec3_normalize(u) : ak_vec3_zero(); /* folded: off */
     }
     uint32_t tc = j->thread_count > 1 ? j->thread_count : 1;
-    if (tc > 1 && nn < 256 * (size_t)tc) tc = (uint32_t)(nn / 256 > 1 ? nn / 256 : 1);
+    /* a barrier per colour and substep costs microseconds; the AVX2 solve of a colour of a
+     * few-thousand-node lattice takes about as long: threads only from SOFT_NODES_PER_THREAD */
+    if (tc > 1 && nn < SOFT_NODES_PER_THREAD * (size_t)tc)
+        tc = (uint32_t)(nn / SOFT_NODES_PER_THREAD > 1 ? nn / SOFT_NODES_PER_THREAD : 1);
     soft_team team;
     team.c = &c;
     team.count = 1;
@@ -1170,15 +1370,16 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     }
     bool finite = true;
     double ke = 0.0;
+    for (size_t n = 0; n < nn; ++n) j->node_positions.ptr[n] = c.x[n].p;
     for (size_t n = 0; n < nn && finite; ++n) {
-        finite = ak_vec3_is_finite(c.x[n]) && ak_vec3_is_finite(c.v[n]);
+        finite = ak_vec3_is_finite(c.x[n].p) && ak_vec3_is_finite(c.v[n]);
         if (!s->kinematic[n]) ke += 0.5 * (double)s->mass[n] * (double)ak_vec3_length_sq(c.v[n]);
     }
     if (!finite) {
         (void)ak_skin_soft_state_init(s, j->palette, j->node_positions, j->node_velocities);
         ke = 0.0;
     }
-    if (j->out_positions.ptr) surface_range(s, c.x, j->out_positions.ptr, 0, s->vertex_count);
+    if (j->out_positions.ptr) surface_range(s, j->node_positions.ptr, j->out_positions.ptr, 0, s->vertex_count);
     if (j->out_kinetic_energy) *j->out_kinetic_energy = (float)ke;
     return AK_OK;
 }
