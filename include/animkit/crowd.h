@@ -211,7 +211,10 @@ typedef struct ak_crowd_step_job {
                                     hard-contact projection repeats contact passes until
                                     none finds a pair or an obstacle edge overlapping by
                                     more than AK_CROWD_CONTACT_TOLERANCE (at most
-                                    AK_CROWD_MAX_CONTACT_PASSES). true -> RVO2's behaviour:
+                                    AK_CROWD_MAX_CONTACT_PASSES; from a step's 32nd pass
+                                    on, pairs are over-relaxed: moved apart by 1.9 times
+                                    their overlap, so that a press against a wall
+                                    converges). true -> RVO2's behaviour:
                                     only the contact_iterations passes (0: pure ORCA, whose
                                     positions overlap where its program is infeasible;
                                     bench/vs_rvo2) */
