@@ -107,6 +107,19 @@ KI static inline VF dfade_v(VF t) {
 KI static inline VF lerp_v(VF t, VF a, VF b) { return vf_add(a, vf_mul(t, vf_sub(b, a))); }
 
 /* Perlin noise at W points p[0..dims-1]; value returned, gradient into grad when want_grad. */
+/* The lattice cell of p: the fractional coordinates f and the 2^dims corner hashes (Perlin's
+ * and value noise's permutation chain, the integer coordinates wrapped to 0..255). */
+KI static inline void lattice_cell(const PermTab* perm, int dims, const VF* p, VF* f, VI* hash) {
+    VI lo[3];
+    AKP_UNROLL
+    for (int k = 0; k < dims; ++k) {
+        const VF fl = vf_floor(p[k]);
+        f[k] = vf_sub(p[k], fl);
+        lo[k] = vi_and(vf_cvtt(fl), vi_set1(255));
+    }
+    cell_hashes(perm, dims, lo, hash);
+}
+
 /* Blends the 2^dims corner values (and gradients) of a cell along each axis in turn with the
  * quintic fade of the fractional coordinates f: val[0] (gv[0]) ends as the cell's value
  * (gradient). Shared by Perlin and value noise; the operation order is the scalar reference's. */
@@ -132,18 +145,11 @@ KI static inline void lerp_corners(int dims, const VF* f, VF* val, VF (*gv)[3], 
 
 KI static inline VF perlin_v(const PermTab* perm, int dims, const VF* p, VF* grad, bool want_grad) {
     const VM valid = in_range(dims, p);
-    VI lo[3];
     VF f[3];
-    AKP_UNROLL
-    for (int k = 0; k < dims; ++k) {
-        const VF fl = vf_floor(p[k]);
-        f[k] = vf_sub(p[k], fl);
-        lo[k] = vi_and(vf_cvtt(fl), vi_set1(255));
-    }
+    VI hash[8];
+    lattice_cell(perm, dims, p, f, hash);
     const int corners = 1 << dims;
     VF val[8], gv[8][3];
-    VI hash[8];
-    cell_hashes(perm, dims, lo, hash);
     AKP_UNROLL
     for (int c = 0; c < corners; ++c) {
         VF d[3];
@@ -271,18 +277,11 @@ KI static inline VF simplex3_v(const PermTab* perm, const VF* p, VF* grad, bool 
  * in 111 of the 256 values; a Newton step after it does not), blended with the quintic fade, the gradient riding along. */
 KI static inline VF value_v(const PermTab* perm, int dims, const VF* p, VF* grad, bool want_grad) {
     const VM valid = in_range(dims, p);
-    VI lo[3];
     VF f[3];
-    AKP_UNROLL
-    for (int k = 0; k < dims; ++k) {
-        const VF fl = vf_floor(p[k]);
-        f[k] = vf_sub(p[k], fl);
-        lo[k] = vi_and(vf_cvtt(fl), vi_set1(255));
-    }
+    VI hash[8];
+    lattice_cell(perm, dims, p, f, hash);
     const int corners = 1 << dims;
     VF val[8], gv[8][3];
-    VI hash[8];
-    cell_hashes(perm, dims, lo, hash);
     const VF one = vf_set1(1.0f), den = vf_set1(127.5f), rcp = vf_set1(1.0f / 127.5f);
     AKP_UNROLL
     for (int c = 0; c < corners; ++c) {
