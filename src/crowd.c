@@ -15,6 +15,13 @@
 #include "internal.h"
 #include "tasks.h"
 
+#if !defined(AK_NO_SIMD) && (defined(__SSE2__) || defined(_M_X64) || defined(_M_AMD64))
+#define CROWD_SSE2 1
+#include <xmmintrin.h>
+#else
+#define CROWD_SSE2 0
+#endif
+
 #define EPS 1e-5f   /* the LP's parallel-line tolerance (RVO2's RVO_EPSILON) */
 #define COORD_MAX 1e7f
 
@@ -258,6 +265,19 @@ static bool lp1(const ak_crowd_line* lines, size_t no, float radius, ak_vec2 opt
     return true;
 }
 
+#if CROWD_SSE2
+/* Bit k set when line k of lines[0, 4) has r on its right (det(direction, point - r) > 0). */
+static inline int violated4(const ak_crowd_line* l, ak_vec2 r) {
+    __m128 a = _mm_loadu_ps(&l[0].point.x), b = _mm_loadu_ps(&l[1].point.x); /* px py dx dy */
+    __m128 c = _mm_loadu_ps(&l[2].point.x), d = _mm_loadu_ps(&l[3].point.x);
+    _MM_TRANSPOSE4_PS(a, b, c, d); /* a: px of the four lines, b: py, c: dx, d: dy */
+    const __m128 ex = _mm_sub_ps(a, _mm_set1_ps(r.x)), ey = _mm_sub_ps(b, _mm_set1_ps(r.y));
+    const __m128 dt = _mm_sub_ps(_mm_mul_ps(c, ey), _mm_mul_ps(d, ex));
+    return _mm_movemask_ps(_mm_cmpgt_ps(dt, _mm_setzero_ps()));
+}
+static inline int ctz4(int m) { return (m & 1) ? 0 : (m & 2) ? 1 : (m & 4) ? 2 : 3; }
+#endif
+
 /* 2D program (incremental, Seidel-style in input order). Returns the first line that could
  * not be satisfied, or count. */
 static size_t lp2(const ak_crowd_line* lines, size_t count, float radius, ak_vec2 opt, bool dir_opt, ak_vec2* result) {
@@ -265,6 +285,19 @@ static size_t lp2(const ak_crowd_line* lines, size_t count, float radius, ak_vec
     else if (abs_sq(opt) > radius * radius) *result = mul(radius, normalize(opt));
     else *result = opt;
     for (size_t i = 0; i < count; ++i) {
+#if CROWD_SSE2
+        /* four lines at a time: skip to the first the current result violates (the same
+         * products and differences as det(), so the same bits) */
+        while (i + 4 <= count) {
+            const int m = violated4(lines + i, *result);
+            if (m) {
+                i += (size_t)ctz4(m);
+                break;
+            }
+            i += 4;
+        }
+        if (i >= count) break;
+#endif
         if (det(lines[i].direction, sub(lines[i].point, *result)) > 0.0f) {
             const ak_vec2 keep = *result;
             if (!lp1(lines, i, radius, opt, dir_opt, result)) {
@@ -433,11 +466,36 @@ static inline float nkey_dist(uint64_t key) {
     return d;
 }
 
-/* Insert (d, j) into a list sorted by (distance, index); when the list is full the range
- * shrinks to its last entry (the k nearest, as RVO2 selects them). */
+/* Sort keys[0, n) (n <= RANK_MAX, all distinct: each holds its agent's index) by rank: each
+ * key's place is the count of smaller keys. Branch-free compares, unlike an insertion sort
+ * of keys that arrive in no order. */
+#define RANK_MAX 64
+static void rank_sort(uint64_t* keys, uint32_t n) {
+    uint64_t tmp[RANK_MAX];
+    for (uint32_t a = 0; a < n; ++a) {
+        uint32_t r = 0;
+        for (uint32_t b = 0; b < n; ++b) r += keys[b] < keys[a];
+        tmp[r] = keys[a];
+    }
+    memcpy(keys, tmp, n * sizeof *keys);
+}
+
+/* Insert (d, j) into the list of the k nearest (by (distance, index), as RVO2 selects them).
+ * Up to k <= RANK_MAX the first k keys are appended as found and rank-sorted once the list
+ * is full (or at the end: neighbors_done); from then on (and always for a larger k) the
+ * list is kept sorted by insertion, and the range shrinks to its last entry. The list and
+ * its order are those of insertion throughout (keys are distinct). */
 static inline void insert_agent(uint64_t* list, uint32_t* count, uint32_t k, float* range_sq, float d, uint32_t j) {
     if (!(d < *range_sq)) return;
     const uint64_t key = nkey(d, j);
+    if (*count < k && k <= RANK_MAX) {
+        list[(*count)++] = key;
+        if (*count == k) {
+            rank_sort(list, k);
+            *range_sq = nkey_dist(list[k - 1]);
+        }
+        return;
+    }
     uint32_t i = *count < k ? (*count)++ : k - 1;
     while (i > 0 && key < list[i - 1]) {
         list[i] = list[i - 1];
@@ -445,6 +503,18 @@ static inline void insert_agent(uint64_t* list, uint32_t* count, uint32_t k, flo
     }
     list[i] = key;
     if (*count == k) *range_sq = nkey_dist(list[k - 1]);
+}
+
+/* The end of a search: a list that never filled is still in the order found. */
+static inline uint32_t neighbors_done(uint64_t* list, uint32_t count, uint32_t k) {
+    if (count < k && k <= RANK_MAX) rank_sort(list, count);
+    return count;
+}
+
+/* ceil(x) for 0 <= x < 2^31 (no libm call). */
+static inline int64_t ceil_nonneg(float x) {
+    const int64_t t = (int64_t)x; /* truncation = floor for x >= 0 */
+    return t + ((float)t < x);
 }
 
 /* The ring search on the dense grid: a ring's top and bottom rows are each one contiguous
@@ -458,7 +528,7 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
     const float cs = c->cs;
     /* the home cell's corner relative to p (cell bounds as the shared grid's) */
     const float bx = (float)(hx + c->x0) * cs - p.x, bz = (float)(hz + c->z0) * cs - p.y;
-    const int64_t rmax = (int64_t)ceilf(a->neighbor_distance / cs) + 1;
+    const int64_t rmax = ceil_nonneg(a->neighbor_distance / cs) + 1;
     const uint32_t* cstart = c->cstart;
     const float *sx = c->sx, *sz = c->sz;
     const uint32_t* sidx = c->sidx;
@@ -530,7 +600,7 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
         }
     }
 #undef SCAN
-    return count;
+    return neighbors_done(out, count, k);
 }
 
 static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, uint64_t* out) {
@@ -584,7 +654,7 @@ static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_c
             }
         }
     }
-    return count;
+    return neighbors_done(out, count, a->max_neighbors);
 }
 
 /* Obstacle edges within range that the agent sees from their outer (right) side, nearest
