@@ -466,12 +466,12 @@ static inline float nkey_dist(uint64_t key) {
     return d;
 }
 
-/* Sort keys[0, n) (n <= RANK_MAX, all distinct: each holds its agent's index) by rank: each
- * key's place is the count of smaller keys. Branch-free compares, unlike an insertion sort
- * of keys that arrive in no order. */
-#define RANK_MAX 64
+/* Sort keys[0, n) (n <= AK_CROWD_MAX_NEIGHBORS, all distinct: each holds its agent's index)
+ * by rank: each key's place is the count of smaller keys. Branch-free compares, where a
+ * sorted insertion of keys arriving in no order mispredicts its shifts (bench/vs_rvo2 10k:
+ * 3.56x RVO2's speed against 3.24x, docs/BENCHMARKS.md). */
 static void rank_sort(uint64_t* keys, uint32_t n) {
-    uint64_t tmp[RANK_MAX];
+    uint64_t tmp[AK_CROWD_MAX_NEIGHBORS];
     for (uint32_t a = 0; a < n; ++a) {
         uint32_t r = 0;
         for (uint32_t b = 0; b < n; ++b) r += keys[b] < keys[a];
@@ -481,33 +481,28 @@ static void rank_sort(uint64_t* keys, uint32_t n) {
 }
 
 /* Insert (d, j) into the list of the k nearest (by (distance, index), as RVO2 selects them).
- * Up to k <= RANK_MAX the first k keys are appended as found and rank-sorted once the list
- * is full (or at the end: neighbors_done); from then on (and always for a larger k) the
- * list is kept sorted by insertion, and the range shrinks to its last entry. The list and
- * its order are those of insertion throughout (keys are distinct). */
-static inline void insert_agent(uint64_t* list, uint32_t* count, uint32_t k, float* range_sq, float d, uint32_t j) {
+ * The list is kept in no order: once full, a nearer key replaces the largest (*top: its
+ * place), and the range shrinks to the largest's distance; neighbors_done rank-sorts it at
+ * the end. The set, and then the order, are those of a sorted insertion (keys are distinct). */
+static inline void insert_agent(uint64_t* list, uint32_t* count, uint32_t* top, uint32_t k, float* range_sq, float d,
+                                uint32_t j) {
     if (!(d < *range_sq)) return;
     const uint64_t key = nkey(d, j);
-    if (*count < k && k <= RANK_MAX) {
+    if (*count < k) {
         list[(*count)++] = key;
-        if (*count == k) {
-            rank_sort(list, k);
-            *range_sq = nkey_dist(list[k - 1]);
-        }
-        return;
+        if (*count < k) return;
+    } else {
+        list[*top] = key;
     }
-    uint32_t i = *count < k ? (*count)++ : k - 1;
-    while (i > 0 && key < list[i - 1]) {
-        list[i] = list[i - 1];
-        --i;
-    }
-    list[i] = key;
-    if (*count == k) *range_sq = nkey_dist(list[k - 1]);
+    uint32_t t = 0;
+    for (uint32_t q = 1; q < k; ++q) t = list[q] > list[t] ? q : t;
+    *top = t;
+    *range_sq = nkey_dist(list[t]);
 }
 
-/* The end of a search: a list that never filled is still in the order found. */
-static inline uint32_t neighbors_done(uint64_t* list, uint32_t count, uint32_t k) {
-    if (count < k && k <= RANK_MAX) rank_sort(list, count);
+/* The end of a search: the list in order. */
+static inline uint32_t neighbors_done(uint64_t* list, uint32_t count) {
+    rank_sort(list, count);
     return count;
 }
 
@@ -520,7 +515,7 @@ static inline int64_t ceil_nonneg(float x) {
 /* The ring search on the dense grid: a ring's top and bottom rows are each one contiguous
  * range of sorted entries (cut to the cells within range), its sides single cells. */
 static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, uint64_t* out) {
-    uint32_t count = 0;
+    uint32_t count = 0, top = 0;
     const uint32_t k = a->max_neighbors;
     float range_sq = a->neighbor_distance * a->neighbor_distance;
     const double inv = 1.0 / (double)c->cs;
@@ -537,7 +532,7 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
     for (uint32_t s = (s0); s < (s1); ++s) {                                                          \
         const float ddx = p.x - sx[s], ddz = p.y - sz[s];                                             \
         const float d = ddx * ddx + ddz * ddz;                                                        \
-        if (d < range_sq && sidx[s] != self32) insert_agent(out, &count, k, &range_sq, d, sidx[s]); \
+        if (d < range_sq && sidx[s] != self32) insert_agent(out, &count, &top, k, &range_sq, d, sidx[s]); \
     }
     /* first the 5 x 3 block (rings 0 and 1, and ring 2's side cells of these rows): three
      * row ranges, the home row first; then ring 2's top and bottom rows; then rings >= 3 */
@@ -600,14 +595,14 @@ static uint32_t agent_neighbors_dense(const ctx* c, size_t self, ak_vec2 p, cons
         }
     }
 #undef SCAN
-    return neighbors_done(out, count, k);
+    return neighbors_done(out, count);
 }
 
 static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_crowd_agent* a, uint64_t* out) {
     if (a->max_neighbors == 0) return 0;
     if (c->cstart) return agent_neighbors_dense(c, self, p, a, out);
     const ak_grid* g = c->grid;
-    uint32_t count = 0;
+    uint32_t count = 0, top = 0;
     float range_sq = a->neighbor_distance * a->neighbor_distance;
     const ak_grid_cell home = ak_grid_cell_of(g, ak_vec3_make(p.x, 0.0f, p.y));
     const float cs = g->cell_size;
@@ -650,11 +645,11 @@ static uint32_t agent_neighbors(const ctx* c, size_t self, ak_vec2 p, const ak_c
                 if (j == self) continue;
                 const float dx2 = p.x - g->x[s], dz2 = p.y - g->z[s];
                 const float d = dx2 * dx2 + dz2 * dz2;
-                insert_agent(out, &count, a->max_neighbors, &range_sq, d, j);
+                insert_agent(out, &count, &top, a->max_neighbors, &range_sq, d, j);
             }
         }
     }
-    return neighbors_done(out, count, a->max_neighbors);
+    return neighbors_done(out, count);
 }
 
 /* Obstacle edges within range that the agent sees from their outer (right) side, nearest
