@@ -856,6 +856,83 @@ static ak_crowd_line agent_line(ak_vec2 pos, ak_vec2 vel, float radius, ak_vec2 
     return line;
 }
 
+#if CROWD_SSE2
+/* agent_line for four neighbours at once: every case computed in every lane and the lane's
+ * own selected, each lane the same operations in the same order as agent_line (so the same
+ * bits: SSE's add, mul, div and sqrt round as the scalar ones). */
+static void agent_lines4(ak_vec2 pos, ak_vec2 vel, float radius, const ak_vec2* P, const ak_vec2* V, const float* R,
+                         const uint64_t* keys, uint32_t self, float inv_th, float dt, ak_crowd_line* out) {
+    const uint32_t j0 = nkey_index(keys[0]), j1 = nkey_index(keys[1]), j2 = nkey_index(keys[2]),
+                   j3 = nkey_index(keys[3]);
+    const __m128 opx = _mm_setr_ps(P[j0].x, P[j1].x, P[j2].x, P[j3].x);
+    const __m128 opy = _mm_setr_ps(P[j0].y, P[j1].y, P[j2].y, P[j3].y);
+    const __m128 ovx = _mm_setr_ps(V[j0].x, V[j1].x, V[j2].x, V[j3].x);
+    const __m128 ovy = _mm_setr_ps(V[j0].y, V[j1].y, V[j2].y, V[j3].y);
+    const __m128 orad = _mm_setr_ps(R[j0], R[j1], R[j2], R[j3]);
+    const __m128 tie = _mm_setr_ps(self < j0 ? 1.0f : -1.0f, self < j1 ? 1.0f : -1.0f, self < j2 ? 1.0f : -1.0f,
+                                   self < j3 ? 1.0f : -1.0f);
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    const __m128 sign = _mm_set1_ps(-0.0f); /* negation flips the sign bit, as the scalar's does */
+    const __m128 rpx = _mm_sub_ps(opx, _mm_set1_ps(pos.x)), rpy = _mm_sub_ps(opy, _mm_set1_ps(pos.y));
+    const __m128 vx = _mm_set1_ps(vel.x), vy = _mm_set1_ps(vel.y);
+    const __m128 rvx = _mm_sub_ps(vx, ovx), rvy = _mm_sub_ps(vy, ovy);
+    const __m128 dsq = _mm_add_ps(_mm_mul_ps(rpx, rpx), _mm_mul_ps(rpy, rpy));
+    const __m128 cr = _mm_add_ps(_mm_set1_ps(radius), orad);
+    const __m128 cr2 = _mm_mul_ps(cr, cr);
+    const __m128 apart = _mm_cmpgt_ps(dsq, cr2);
+    /* apart: w from the cut-off centre */
+    const __m128 ith = _mm_set1_ps(inv_th);
+    const __m128 wx = _mm_sub_ps(rvx, _mm_mul_ps(ith, rpx)), wy = _mm_sub_ps(rvy, _mm_mul_ps(ith, rpy));
+    const __m128 wl2 = _mm_add_ps(_mm_mul_ps(wx, wx), _mm_mul_ps(wy, wy));
+    const __m128 dp = _mm_add_ps(_mm_mul_ps(wx, rpx), _mm_mul_ps(wy, rpy));
+    const __m128 cut = _mm_and_ps(_mm_cmplt_ps(dp, zero), _mm_cmpgt_ps(_mm_mul_ps(dp, dp), _mm_mul_ps(cr2, wl2)));
+    /* the cut-off circle */
+    const __m128 wl = _mm_sqrt_ps(wl2);
+    const __m128 iwl = _mm_div_ps(one, wl);
+    const __m128 cux = _mm_mul_ps(wx, iwl), cuy = _mm_mul_ps(wy, iwl);
+    const __m128 cs = _mm_sub_ps(_mm_mul_ps(cr, ith), wl);
+    const __m128 c_dx = cuy, c_dy = _mm_xor_ps(sign, cux);
+    const __m128 c_ux = _mm_mul_ps(cs, cux), c_uy = _mm_mul_ps(cs, cuy);
+    /* a leg */
+    const __m128 leg = _mm_sqrt_ps(_mm_sub_ps(dsq, cr2));
+    const __m128 idsq = _mm_div_ps(one, dsq);
+    const __m128 left = _mm_cmpgt_ps(_mm_sub_ps(_mm_mul_ps(rpx, wy), _mm_mul_ps(rpy, wx)), zero);
+    const __m128 llx = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(rpx, leg), _mm_mul_ps(rpy, cr)), idsq);
+    const __m128 lly = _mm_mul_ps(_mm_add_ps(_mm_mul_ps(rpx, cr), _mm_mul_ps(rpy, leg)), idsq);
+    const __m128 nrpx = _mm_xor_ps(sign, rpx);
+    const __m128 rlx = _mm_xor_ps(sign, _mm_mul_ps(_mm_add_ps(_mm_mul_ps(rpx, leg), _mm_mul_ps(rpy, cr)), idsq));
+    const __m128 rly = _mm_xor_ps(sign, _mm_mul_ps(_mm_add_ps(_mm_mul_ps(nrpx, cr), _mm_mul_ps(rpy, leg)), idsq));
+    const __m128 l_dx = _mm_or_ps(_mm_and_ps(left, llx), _mm_andnot_ps(left, rlx));
+    const __m128 l_dy = _mm_or_ps(_mm_and_ps(left, lly), _mm_andnot_ps(left, rly));
+    const __m128 ld = _mm_add_ps(_mm_mul_ps(rvx, l_dx), _mm_mul_ps(rvy, l_dy));
+    const __m128 l_ux = _mm_sub_ps(_mm_mul_ps(ld, l_dx), rvx), l_uy = _mm_sub_ps(_mm_mul_ps(ld, l_dy), rvy);
+    /* overlapping: resolve within one step */
+    const __m128 idt = _mm_set1_ps(1.0f / dt);
+    const __m128 ox = _mm_sub_ps(rvx, _mm_mul_ps(idt, rpx)), oy = _mm_sub_ps(rvy, _mm_mul_ps(idt, rpy));
+    const __m128 owl = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(ox, ox), _mm_mul_ps(oy, oy)));
+    const __m128 pos_wl = _mm_cmpgt_ps(owl, zero);
+    const __m128 iowl = _mm_div_ps(one, owl);
+    const __m128 oux = _mm_or_ps(_mm_and_ps(pos_wl, _mm_mul_ps(ox, iowl)), _mm_andnot_ps(pos_wl, tie));
+    const __m128 ouy = _mm_and_ps(pos_wl, _mm_mul_ps(oy, iowl));
+    const __m128 os = _mm_sub_ps(_mm_mul_ps(cr, idt), owl);
+    const __m128 o_dx = ouy, o_dy = _mm_xor_ps(sign, oux);
+    const __m128 o_ux = _mm_mul_ps(os, oux), o_uy = _mm_mul_ps(os, ouy);
+    /* select: apart ? (cut ? cut-off : leg) : overlap */
+#define SEL(m, a, b) _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b))
+    const __m128 ac = _mm_and_ps(apart, cut);
+    __m128 dx = SEL(apart, SEL(ac, c_dx, l_dx), o_dx), dy = SEL(apart, SEL(ac, c_dy, l_dy), o_dy);
+    const __m128 ux = SEL(apart, SEL(ac, c_ux, l_ux), o_ux), uy = SEL(apart, SEL(ac, c_uy, l_uy), o_uy);
+#undef SEL
+    const __m128 half = _mm_set1_ps(0.5f);
+    __m128 px = _mm_add_ps(vx, _mm_mul_ps(half, ux)), py = _mm_add_ps(vy, _mm_mul_ps(half, uy));
+    _MM_TRANSPOSE4_PS(px, py, dx, dy);
+    _mm_storeu_ps(&out[0].point.x, px);
+    _mm_storeu_ps(&out[1].point.x, py);
+    _mm_storeu_ps(&out[2].point.x, dx);
+    _mm_storeu_ps(&out[3].point.x, dy);
+}
+#endif
+
 static uint64_t mix64(uint64_t x) {
     x ^= x >> 30;
     x *= 0xbf58476d1ce4e5b9ull;
@@ -936,7 +1013,15 @@ static size_t build_lines(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const
     *out_obst = nl;
     const uint32_t na = agent_neighbors(c, i, p, a, w->agent_n);
     const float inv_th = 1.0f / a->time_horizon;
-    for (uint32_t k = 0; k < na; ++k) {
+    uint32_t k = 0;
+#if CROWD_SSE2
+    for (; k + 4 <= na; k += 4) {
+        agent_lines4(p, v, a->radius, job->positions.ptr, job->velocities.ptr, c->crowd->radii, w->agent_n + k,
+                     (uint32_t)i, inv_th, job->dt, w->lines + nl);
+        nl += 4;
+    }
+#endif
+    for (; k < na; ++k) {
         const uint32_t j = nkey_index(w->agent_n[k]);
         w->lines[nl++] = agent_line(p, v, a->radius, job->positions.ptr[j], job->velocities.ptr[j],
                                     c->crowd->radii[j], inv_th, job->dt, i < j ? 1.0f : -1.0f);
