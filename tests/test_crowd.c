@@ -1,5 +1,6 @@
 /* crowd: ORCA scenarios (goals reached, no overlap, measured by an independent pairwise
  * pass in double), the linear program against a brute-force search over a velocity grid,
+ * the ORCA half-planes and neighbour order against a naive construction in double,
  * obstacles never entered, thread-count invariance, validation codes; the scene format and
  * presets of the library (values read equal the numbers written, defaults as docs/crowd.md,
  * errors naming the key path, preset layouts against their closed forms). */
@@ -585,6 +586,156 @@ AK_TEST(step_velocity_is_lp_optimum) {
     run_free(&r);
 }
 
+/* Each agent's ORCA half-planes against a naive construction in double (paper section 4),
+ * with no code of the library's: the neighbours by brute force (the max_neighbors nearest
+ * within neighbor_distance, by distance then index); for a pair apart, the truncated
+ * velocity obstacle K = {v : |t v - p| < r for some t in (0, tau]} is convex, with support
+ * function h(n) = (p.n + r) / tau where p.n + r <= 0 (+inf elsewhere), so the signed distance
+ * of the relative velocity w to K is max over unit n of (w.n - h(n)), a maximum found among
+ * n = (w - p / tau) / |.| and the two normals with p.n = -r (closed form); u = -sd n, the
+ * line through v + u / 2 with n on its left. For an overlapping pair, the disc of radius
+ * r / dt about p / dt (resolve within the step). */
+typedef struct naive_line {
+    double px, py, dx, dy;
+} naive_line;
+
+static int naive_candidates(double wx, double wy, double px, double py, double r, double tau, double dt,
+                            naive_line* out, double vx, double vy) {
+    const double d2 = px * px + py * py;
+    int m = 0;
+    double best = -INFINITY;
+    double nx[3], ny[3], sd[3];
+    if (d2 <= r * r) {
+        const double cx = wx - px / dt, cy = wy - py / dt, l = hypot(cx, cy);
+        nx[0] = cx / l;
+        ny[0] = cy / l;
+        sd[0] = l - r / dt;
+        m = 1;
+    } else {
+        const double d = sqrt(d2), a = acos(r / d); /* the normals of the two legs */
+        const double bx = -px / d, by = -py / d;    /* p.n = -d cos(angle to -p) = -r */
+        nx[0] = bx * cos(a) - by * sin(a);
+        ny[0] = bx * sin(a) + by * cos(a);
+        nx[1] = bx * cos(a) + by * sin(a);
+        ny[1] = -bx * sin(a) + by * cos(a);
+        for (int q = 0; q < 2; ++q) sd[q] = wx * nx[q] + wy * ny[q]; /* h = 0 on a leg */
+        m = 2;
+        const double cx = wx - px / tau, cy = wy - py / tau, l = hypot(cx, cy);
+        if (l > 0.0 && (px * cx + py * cy) / l + r <= 0.0) { /* a valid normal */
+            nx[2] = cx / l;
+            ny[2] = cy / l;
+            sd[2] = l - r / tau;
+            m = 3;
+        }
+    }
+    for (int q = 0; q < m; ++q) best = fmax(best, sd[q]);
+    int k = 0;
+    for (int q = 0; q < m; ++q) {
+        if (sd[q] < best - 1e-3) continue; /* keep near ties: either is the answer */
+        out[k].px = vx - 0.5 * sd[q] * nx[q];
+        out[k].py = vy - 0.5 * sd[q] * ny[q];
+        out[k].dx = ny[q];
+        out[k].dy = -nx[q];
+        ++k;
+    }
+    return k;
+}
+
+AK_TEST(agent_lines_vs_naive) {
+    enum { N = 160 };
+    ak_vec2 start[N], goal[N];
+    ak_crowd_agent ag[N];
+    uint64_t seed = 4242;
+    for (int i = 0; i < N; ++i) {
+        start[i] = (ak_vec2){lcg(&seed) * 14.0f, lcg(&seed) * 14.0f};
+        goal[i] = (ak_vec2){lcg(&seed) * 14.0f, lcg(&seed) * 14.0f};
+        /* k from 2 to 16 (full lists) and some 40 (lists that never fill) */
+        const uint32_t k = i % 7 == 0 ? 40u : 2u + (uint32_t)(lcg(&seed) * 15.0f);
+        ag[i] = (ak_crowd_agent){.goals = {&goal[i], 1}, .radius = 0.25f + 0.3f * lcg(&seed),
+                                 .neighbor_distance = 3.0f + 2.0f * lcg(&seed), .max_neighbors = k,
+                                 .time_horizon = 1.0f + 2.0f * lcg(&seed), .max_speed = 2.0f};
+    }
+    ak_crowd_desc desc = {.agents = {ag, N}};
+    run r;
+    AK_CHECK(run_init(&r, &desc, start));
+    r.allow_overlap = true;
+    for (int i = 0; i < N; ++i) r.v[i] = (ak_vec2){3.0f * (lcg(&seed) - 0.5f), 3.0f * (lcg(&seed) - 0.5f)};
+    const float dt = 0.1f;
+    ak_crowd_step_job job = run_job(&r, dt, 1);
+    int checked = 0, overlapping = 0, cutoff = 0, leg = 0, partial = 0, skipped = 0;
+    double worst = 0.0;
+    for (size_t i = 0; i < N; ++i) {
+        const ak_crowd_agent a = ak_crowd_agent_get(r.crowd, i);
+        /* brute-force neighbours: insertion by (distance, index) */
+        uint32_t nb[64];
+        double nd[64];
+        uint32_t cnt = 0;
+        bool ambiguous = false;
+        for (uint32_t j = 0; j < N; ++j) {
+            if (j == i) continue;
+            const double dx = (double)r.p[j].x - r.p[i].x, dy = (double)r.p[j].y - r.p[i].y;
+            const double d = dx * dx + dy * dy, range = (double)a.neighbor_distance * a.neighbor_distance;
+            if (fabs(d - range) < 1e-4 * range) ambiguous = true; /* on the range: rounding decides */
+            if (d >= range) continue;
+            uint32_t q = cnt < a.max_neighbors ? cnt++ : a.max_neighbors;
+            if (q == a.max_neighbors && !(d < nd[q - 1])) {
+                if (fabs(d - nd[q - 1]) < 1e-5 * d) ambiguous = true;
+                continue;
+            }
+            if (q == a.max_neighbors) --q;
+            while (q > 0 && d < nd[q - 1]) {
+                nb[q] = nb[q - 1];
+                nd[q] = nd[q - 1];
+                --q;
+            }
+            nb[q] = j;
+            nd[q] = d;
+        }
+        for (uint32_t q = 1; q < cnt; ++q)
+            if (nd[q] - nd[q - 1] < 1e-5 * nd[q]) ambiguous = true;
+        ak_crowd_line lines[64];
+        size_t no = 7;
+        const size_t nl = ak_crowd_agent_lines(&job, i, (ak_crowd_line_span)AK_SPAN(lines), &no);
+        AK_CHECK_EQ(no, 0);
+        if (ambiguous) {
+            ++skipped;
+            continue;
+        }
+        AK_CHECK_MSG(nl == cnt, "agent %zu: %zu lines, %u neighbours", i, nl, cnt);
+        if (nl != cnt) continue;
+        if (cnt < a.max_neighbors) ++partial;
+        for (uint32_t q = 0; q < cnt; ++q) {
+            const uint32_t j = nb[q];
+            const double px = (double)r.p[j].x - r.p[i].x, py = (double)r.p[j].y - r.p[i].y;
+            const double rr = (double)a.radius + r.radius[j];
+            const double wx = (double)r.v[i].x - r.v[j].x, wy = (double)r.v[i].y - r.v[j].y;
+            const double d = sqrt(px * px + py * py);
+            if (fabs(d - rr) < 0.02) continue; /* touching: the legs' sqrt is ill-conditioned */
+            naive_line c[3];
+            const int nc = naive_candidates(wx, wy, px, py, rr, a.time_horizon, dt, c, r.v[i].x, r.v[i].y);
+            double err = INFINITY;
+            for (int e = 0; e < nc; ++e)
+                err = fmin(err, fmax(fmax(fabs(lines[q].point.x - c[e].px), fabs(lines[q].point.y - c[e].py)),
+                                     fmax(fabs(lines[q].direction.x - c[e].dx), fabs(lines[q].direction.y - c[e].dy))));
+            AK_CHECK_MSG(err <= 1e-4, "agent %zu neighbour %u (#%u): off by %g", i, j, q, err);
+            worst = fmax(worst, err);
+            ++checked;
+            if (d < rr) ++overlapping;
+            else if (fabs(fabs(lines[q].direction.x * py - lines[q].direction.y * px) - rr) > 1e-3) ++cutoff;
+            else ++leg; /* its normal n has |p.n| = r */
+        }
+    }
+    printf("  %d lines checked (%d overlapping, %d on a leg, %d on the cut-off circle; %d agents with a list "
+           "not full, %d skipped near a tie), worst %.2g\n", checked, overlapping, leg, cutoff, partial, skipped, worst);
+    AK_CHECK(checked >= 600);
+    AK_CHECK(overlapping >= 5);
+    AK_CHECK(cutoff >= 20);
+    AK_CHECK(leg >= 100);
+    AK_CHECK(partial >= 5);
+    AK_CHECK(skipped <= N / 10);
+    run_free(&r);
+}
+
 /* ---- determinism, validation ------------------------------------------------------------------- */
 
 AK_TEST(threads_bit_identical) {
@@ -1000,6 +1151,7 @@ int main(void) {
     AK_RUN_HEAVY(vision_presets_home); /* valgrind: 8 s; vision_head_on_and_crossing steps the same code */
     AK_RUN(lp_vs_brute_force);
     AK_RUN(step_velocity_is_lp_optimum);
+    AK_RUN(agent_lines_vs_naive);
     AK_RUN(threads_bit_identical);
     AK_RUN(validation);
     AK_RUN(degenerate_finite);

@@ -10,6 +10,11 @@
 //                        point mirrored through the block's centre, 1 and 2 threads (RVO2
 //                        through OpenMP when built with it).
 //   vs_rvo2 time1 [N...] the same on 1 thread only (for profiling).
+//   vs_rvo2 work [N...]  CPU work on 2 threads: the CPU time of all the process's threads
+//                        (CLOCK_PROCESS_CPUTIME_ID) per step of each library, rounds
+//                        alternating, and their ratio; OpenMP's idle threads sleep
+//                        (OMP_WAIT_POLICY=passive, set by re-running itself) so that no
+//                        spinning of one library's threads is charged to the other's rounds.
 //   vs_rvo2 vision [N...] animkit's vision-based steering (default view: 48 pixels over 150
 //                        degrees) beside its ORCA on the same block, 1 thread, rounds
 //                        alternating: agents per second of each (default N: 1000, 10000).
@@ -23,6 +28,7 @@
 #include <cstring>
 #include <ctime>
 #include <time.h>
+#include <unistd.h>
 #include <vector>
 
 #if defined(_OPENMP)
@@ -250,6 +256,53 @@ void time_one(size_t n, int threads) {
     std::fflush(stdout);
 }
 
+// CPU time of every thread of the process (s).
+double process_cpu_now() {
+#if defined(CLOCK_PROCESS_CPUTIME_ID)
+    timespec ts;
+    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) == 0) return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+#endif
+    return now();
+}
+
+// 2 threads, CPU time of all threads per step (the work a step costs, whatever the cores'
+// load): medians over rounds, the libraries alternating.
+void time_work(size_t n) {
+    const int threads = 2;
+    const Scenario s = block(n);
+#if defined(_OPENMP)
+    omp_set_num_threads(threads);
+#else
+    std::printf("%8zu agents %d threads: RVO2 built without OpenMP, skipped\n", n, threads);
+    return;
+#endif
+    Rvo rvo(s);
+    Ak ak(s, static_cast<uint32_t>(threads));
+    const int rounds = n >= 100000 ? 5 : n >= 10000 ? 9 : 15;
+    const int per = n >= 100000 ? 2 : n >= 10000 ? 4 : 20;
+    std::vector<double> cr, ca, tr, ta;
+    rvo.step();
+    ak.step();
+    for (int r = 0; r < rounds; ++r) {
+        const double c0 = process_cpu_now(), t0 = now();
+        for (int k = 0; k < per; ++k) rvo.step();
+        const double c1 = process_cpu_now(), t1 = now();
+        for (int k = 0; k < per; ++k) ak.step();
+        const double c2 = process_cpu_now(), t2 = now();
+        cr.push_back((c1 - c0) / per);
+        ca.push_back((c2 - c1) / per);
+        tr.push_back((t1 - t0) / per);
+        ta.push_back((t2 - t1) / per);
+    }
+    for (auto* v : {&cr, &ca, &tr, &ta}) std::sort(v->begin(), v->end());
+    const double mr = cr[cr.size() / 2], ma = ca[ca.size() / 2];
+    std::printf("%8zu agents %d threads: CPU time of all threads: RVO2 %9.3f ms/step  animkit %9.3f ms/step  "
+                "animkit/RVO2 work speed %.2fx  [ranges %.3f-%.3f, %.3f-%.3f]  (wall: RVO2 %.3f, animkit %.3f ms/step)\n",
+                n, threads, 1e3 * mr, 1e3 * ma, mr / ma, 1e3 * cr.front(), 1e3 * cr.back(), 1e3 * ca.front(),
+                1e3 * ca.back(), 1e3 * tr[tr.size() / 2], 1e3 * ta[ta.size() / 2]);
+    std::fflush(stdout);
+}
+
 void time_vision(size_t n) {
     const Scenario s = block(n);
     Ak orca(s, 1), vision(s, 1, AK_CROWD_VISION);
@@ -289,6 +342,22 @@ int main(int argc, char** argv) {
             for (int t = 1; t <= max_threads; ++t) time_one(n, t);
         return 0;
     }
+    if (argc >= 2 && std::strcmp(argv[1], "work") == 0) {
+#if defined(_OPENMP)
+        // libgomp reads the policy when it loads: run again with it set
+        if (!std::getenv("OMP_WAIT_POLICY")) {
+            setenv("OMP_WAIT_POLICY", "passive", 1);
+            execv("/proc/self/exe", argv);
+            std::fprintf(stderr, "vs_rvo2: could not re-run with OMP_WAIT_POLICY=passive; set it and run again\n");
+            return 1;
+        }
+#endif
+        std::vector<size_t> sizes;
+        for (int i = 2; i < argc; ++i) sizes.push_back(static_cast<size_t>(std::atol(argv[i])));
+        if (sizes.empty()) sizes = {1000, 10000, 100000};
+        for (size_t n : sizes) time_work(n);
+        return 0;
+    }
     if (argc >= 2 && std::strcmp(argv[1], "vision") == 0) {
         std::vector<size_t> sizes;
         for (int i = 2; i < argc; ++i) sizes.push_back(static_cast<size_t>(std::atol(argv[i])));
@@ -296,6 +365,6 @@ int main(int argc, char** argv) {
         for (size_t n : sizes) time_vision(n);
         return 0;
     }
-    std::fprintf(stderr, "usage: vs_rvo2 agree [STEPS] | time [N...] | time1 [N...] | vision [N...]\n");
+    std::fprintf(stderr, "usage: vs_rvo2 agree [STEPS] | time [N...] | time1 [N...] | work [N...] | vision [N...]\n");
     return 2;
 }
