@@ -22,9 +22,10 @@
 #define SOFT_NODES_PER_THREAD 4096u           /* fewer nodes per thread: fewer threads */
 #define SOFT_MAX_CUT_BONES 1024u              /* more bones: limbs are not kept apart */
 #define SOFT_PART_UNSET (UINT32_MAX - 1u)
-#ifndef SOFT_RELEASE_CONE
-#define SOFT_RELEASE_CONE 0.35f /* sin of the release cone's half-angle about a joint plane */
-#endif
+/* The cone rule (release_nodes): 0.40-0.48 give the elbow 0 pairs at 130, 140 and 150 deg
+ * (0.35: 25 pairs at 150; 0.5: 2 at 130), docs/softskin.md */
+#define SOFT_RELEASE_CONE 0.44f     /* sin of the release cone's half-angle about a joint plane */
+#define SOFT_RELEASE_BEND_COS 0.0f  /* released only where the bones part by more than 90 deg */
 
 struct ak_skin_soft {
     ak_allocator alloc;
@@ -1287,12 +1288,13 @@ static void* step_thread(void* arg) {
     return NULL;
 }
 
-/* The cone rule: a kinematic node of either bone of a bent joint whose target lies near its
- * own side of the joint's contact plane (closer to the plane than SOFT_RELEASE_CONE times its
- * distance from the joint, or already across it) is flesh for this step, held on its side of
- * the plane: at a deep bend the two bones' cores would otherwise crush the flesh between
- * them (docs/softskin.md). */
-static void release_nodes(const ak_skin_soft* s, step_ctx* c) {
+/* The cone rule: a kinematic node of either bone of a joint bent past 90 deg whose target lies
+ * near its own side of the joint's contact plane (closer to the plane than SOFT_RELEASE_CONE
+ * times its distance from the joint, or already across it) is flesh for this step, held on its
+ * side of the plane: at a deep bend the two bones' cores would otherwise crush the flesh
+ * between them (docs/softskin.md). A node that lies within the cone of the bind pose's plane
+ * (a hip or shoulder whose bones meet at a steep angle at rest) stays kinematic. */
+static void release_nodes(const ak_skin_soft* s, step_ctx* c, const ak_mat4* palette) {
     const size_t nn = s->node_count;
     memset(c->released, 0, nn * sizeof(int32_t));
     for (uint32_t pl = 0; pl < s->plane_count; ++pl) {
@@ -1300,6 +1302,17 @@ static void release_nodes(const ak_skin_soft* s, step_ctx* c) {
         if (nrm.x == 0.0f && nrm.y == 0.0f && nrm.z == 0.0f) continue;
         const uint32_t bp = s->planes[2 * pl], bc = s->planes[2 * pl + 1];
         const ak_skin_bone *P1 = &s->bones[bp], *C1 = &s->bones[bc];
+        /* the plane at the bind pose: a node already within the cone there (the bones of a hip
+         * or a shoulder meet at a steep angle at rest) stays kinematic */
+        ak_vec3 u0 = ak_vec3_add(ak_vec3_normalize(ak_vec3_sub(P1->tail, P1->head)), ak_vec3_normalize(ak_vec3_sub(C1->tail, C1->head)));
+        if (!(ak_vec3_length(u0) > 0.05f)) continue;
+        { /* bent past SOFT_RELEASE_BEND_COS (90 deg): a walk's knees and elbows stay as before */
+            const ak_mat4 mp = palette[P1->joint_index], mc = palette[C1->joint_index];
+            ak_vec3 up = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mp, P1->tail), ak_mat4_transform_point(mp, P1->head)));
+            ak_vec3 uc = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mc, C1->tail), ak_mat4_transform_point(mc, C1->head)));
+            if (ak_vec3_dot(up, uc) > SOFT_RELEASE_BEND_COS) continue;
+        }
+        const ak_vec3 nrm0 = ak_vec3_normalize(u0), o0 = P1->tail;
         const float reach = ak_maxf(ak_vec3_distance(P1->head, P1->tail), ak_vec3_distance(C1->head, C1->tail)) +
                             2.0f * ak_maxf(s->contact_radius[bp], s->contact_radius[bc]);
         for (size_t n = 0; n < nn; ++n) {
@@ -1311,6 +1324,9 @@ static void release_nodes(const ak_skin_soft* s, step_ctx* c) {
             float dist = ak_vec3_length(rel);
             if (dist > reach) continue;
             float sd = ak_vec3_dot(rel, nrm), own = parent ? -sd : sd;
+            ak_vec3 rel0 = ak_vec3_sub(s->rest[n], o0);
+            float sd0 = ak_vec3_dot(rel0, nrm0);
+            if ((parent ? -sd0 : sd0) < SOFT_RELEASE_CONE * ak_vec3_length(rel0)) continue;
             if (own < SOFT_RELEASE_CONE * dist) {
                 c->released[n] = parent ? (int32_t)pl + 1 : -((int32_t)pl + 1);
                 c->x[n].w = s->mass[n] > 0.0f ? 1.0f / s->mass[n] : 0.0f;
@@ -1383,7 +1399,7 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
         /* folded: off (|u| = 2 cos(a / 2) at an angle a between the bones: 0.05 is 177.1 deg) */
         c.planes[2 * pl + 1] = ak_vec3_length(u) > 0.05f ? ak_vec3_normalize(u) : ak_vec3_zero();
     }
-    release_nodes(s, &c);
+    release_nodes(s, &c, j->palette.ptr);
     uint32_t tc = j->thread_count > 1 ? j->thread_count : 1;
     /* a barrier per colour and substep costs microseconds; the AVX2 solve of a colour of a
      * few-thousand-node lattice takes about as long: threads only from SOFT_NODES_PER_THREAD */
