@@ -651,7 +651,7 @@ static size_t cman_pairs(const cman* c, const ak_vec3* p) {
  * triangle pair more than the bind pose has (0), while LBS and DQS interpenetrate; the enclosed
  * volume of the body (divergence theorem; CesiumMan is not closed, but its openings do not
  * move in this pose, so the change is the limb's) within 1% of the rest. */
-static void cman_flex_case(const char* joint, const char* child, float degrees, double lattice_tol) {
+static void cman_flex_case(const char* joint, const char* child, float degrees, double lattice_tol, double volume_tol) {
     cman c;
     if (!cman_load(&c)) return;
     int slot = cman_slot(&c, joint), cs = cman_slot(&c, child);
@@ -709,43 +709,59 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
     /* lattice volume near the joint: tets with a node within the limb's length of the joint */
     ak_skin_soft_rest_nodes(soft, (ak_vec3_span){rest, nn});
     ak_skin_soft_tets(soft, (ak_u32_span){tt, 4 * nt});
-    double lr = 0.0, ln = 0.0, reach = ak_vec3_length(limb);
+    double lr = 0.0, ln = 0.0, reach = ak_vec3_length(limb), jmin = INFINITY;
     for (size_t q = 0; q < nt; ++q) {
         bool near = false;
         for (int k = 0; k < 4; ++k) near = near || ak_vec3_distance(rest[tt[4 * q + k]], c.jp[slot]) < reach;
         if (!near) continue;
         const ak_vec3* X[2] = {rest, x};
+        double vol[2];
         for (int k = 0; k < 2; ++k) {
             ak_vec3 a = X[k][tt[4 * q]];
-            double vol = ak_vec3_dot(ak_vec3_sub(X[k][tt[4 * q + 1]], a),
-                                     ak_vec3_cross(ak_vec3_sub(X[k][tt[4 * q + 2]], a), ak_vec3_sub(X[k][tt[4 * q + 3]], a))) / 6.0;
-            *(k ? &ln : &lr) += vol;
+            vol[k] = ak_vec3_dot(ak_vec3_sub(X[k][tt[4 * q + 1]], a),
+                                 ak_vec3_cross(ak_vec3_sub(X[k][tt[4 * q + 2]], a), ak_vec3_sub(X[k][tt[4 * q + 3]], a))) / 6.0;
         }
+        lr += vol[0], ln += vol[1];
+        if (vol[0] > 0.0 && vol[1] / vol[0] < jmin) jmin = vol[1] / vol[0];
     }
     printf("  CesiumMan %s %.0f deg: intersecting pairs soft %zu LBS %zu DQS %zu (bind %zu); volume ratio soft %.5f LBS %.5f DQS %.5f;"
-           " lattice near the joint %.5f; kinetic energy held 1 s %.3g (largest while bending %.3g); %zu nodes, %.2f ms per frame"
+           " lattice near the joint %.5f (smallest tet %.3f of its rest volume); kinetic energy held 1 s %.3g (largest while bending %.3g); %zu nodes, %.2f ms per frame"
            " (thread CPU)\n",
-           joint, (double)degrees, ps, pl, pd, p0, vs, vl, vd, lr > 0.0 ? ln / lr : 0.0, (double)ke, (double)ke_moving, nn, ms);
+           joint, (double)degrees, ps, pl, pd, p0, vs, vl, vd, lr > 0.0 ? ln / lr : 0.0, jmin, (double)ke, (double)ke_moving, nn, ms);
     AK_CHECK_MSG(ke < 1e-3f * ke_moving, "soft: kinetic energy %g after 1 s held (%g while bending)", (double)ke, (double)ke_moving);
     AK_CHECK_MSG(pl > p0 && pd > p0, "LBS and DQS should interpenetrate (%zu, %zu; bind %zu)", pl, pd, p0);
     AK_CHECK_MSG(ps <= p0, "soft: %zu self-intersecting pairs (bind %zu)", ps, p0);
-    AK_CHECK_MSG(fabs(vs - 1.0) < 0.01, "soft: volume ratio %g", vs);
+    AK_CHECK_MSG(fabs(vs - 1.0) < volume_tol, "soft: volume ratio %g (tolerance %g)", vs, volume_tol);
     /* the lattice volume near the joint (the flesh there, not diluted by the body): within
-     * lattice_tol (the knee: 1%; the elbow: 3%, it keeps 97.3%, the issue's 1% is not met) */
+     * lattice_tol (the issue's 1% at 130 deg; the elbow kept 97.3% before the cone rule) */
     AK_CHECK_MSG(lr > 0.0 && fabs(ln / lr - 1.0) < lattice_tol, "soft: lattice volume near the joint %g", lr > 0.0 ? ln / lr : 0.0);
     free(x), free(v), free(out), free(lbs), free(dqs), free(rest), free(pal), free(prev), free(tt), free(scratch);
     ak_skin_soft_destroy(soft);
     cman_free(&c);
 }
 
-AK_TEST(cesiumman_knee_130) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 130.0f, 0.01); }
-AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f, 0.03); }
+/* issue 29: lattice volume within 1%, enclosed volume within 0.5% held at 130 deg */
+AK_TEST(cesiumman_knee_130) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 130.0f, 0.01, 0.005); }
+AK_TEST(cesiumman_elbow_130) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 130.0f, 0.01, 0.005); }
+/* full flexion: no self-intersecting pair (the base code had 89, LBS 97) */
+AK_TEST(cesiumman_elbow_150) { cman_flex_case("Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_L__2_", 150.0f, 0.01, 0.005); }
 
 /* the default desc (resolution 32, 40 substeps, the default free zone around the joint) */
 AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 0, true); }
 AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 0, true); }
 
 int main(void) {
+    /* AK_SOFT_FLEX=JOINT:CHILD:DEGREES runs that CesiumMan flexion alone (the measurements of
+     * docs/softskin.md at other angles; its checks are the 130 deg ones, failures expected) */
+    const char* flex = getenv("AK_SOFT_FLEX");
+    if (flex) {
+        char joint[128], child[128];
+        float degrees = 0.0f;
+        if (sscanf(flex, "%127[^:]:%127[^:]:%f", joint, child, &degrees) != 3) return 2;
+        ak_test_cur_name_ = "flex";
+        cman_flex_case(joint, child, degrees, 0.01, 0.005);
+        return ak_test_finish();
+    }
     AK_RUN(bind_pose_reproduces_the_mesh);
     AK_RUN(held_pose_converges_and_keeps_volume);
     AK_RUN(threads_give_identical_results);
@@ -757,5 +773,6 @@ int main(void) {
     AK_RUN_SLOW(cesiumman_walk);
     AK_RUN_SLOW(cesiumman_knee_130);
     AK_RUN_SLOW(cesiumman_elbow_130);
+    AK_RUN_SLOW(cesiumman_elbow_150);
     return ak_test_finish();
 }

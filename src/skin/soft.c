@@ -22,6 +22,10 @@
 #define SOFT_NODES_PER_THREAD 4096u           /* fewer nodes per thread: fewer threads */
 #define SOFT_MAX_CUT_BONES 1024u              /* more bones: limbs are not kept apart */
 #define SOFT_PART_UNSET (UINT32_MAX - 1u)
+/* The cone rule (release_nodes): 0.40-0.48 give the elbow 0 pairs at 130, 140 and 150 deg
+ * (0.35: 25 pairs at 150; 0.5: 2 at 130), docs/softskin.md */
+#define SOFT_RELEASE_CONE 0.44f     /* sin of the release cone's half-angle about a joint plane */
+#define SOFT_RELEASE_BEND_COS 0.0f  /* released only where the bones part by more than 90 deg */
 
 struct ak_skin_soft {
     ak_allocator alloc;
@@ -926,12 +930,13 @@ typedef struct posed_bone {
 
 /* Scratch layout: x[node], prev[node] (soft_p4), start[node], target[node], vref[node],
  * lambda_d[tet], lambda_h[tet], posed
- * bones[bone], joint planes[2 * plane]. */
+ * bones[bone], joint planes[2 * plane], released[node]. */
 size_t ak_skin_soft_step_scratch_size(const ak_skin_soft* s) {
     if (!s) return 0;
     return 64 + 2 * s->node_count * sizeof(soft_p4) + akp_align16(3 * s->node_count * sizeof(ak_vec3)) +
            akp_align16(2 * s->tet_count * sizeof(float)) +
-           akp_align16(s->bone_count * sizeof(posed_bone)) + akp_align16(2 * s->plane_count * sizeof(ak_vec3));
+           akp_align16(s->bone_count * sizeof(posed_bone)) + akp_align16(2 * s->plane_count * sizeof(ak_vec3)) +
+           akp_align16(s->node_count * sizeof(int32_t));
 }
 
 ak_result ak_skin_soft_step_validate(const ak_skin_soft_step_job* j) {
@@ -952,6 +957,8 @@ typedef struct step_ctx {
     const ak_skin_soft* s;
     soft_p4 *x, *prev; /* positions (w: inverse mass) during the step, and at the substep's start */
     ak_vec3 *v, *start, *target, *planes, *vref;
+    int32_t* released; /* [node] kinematic node simulated this step: +(p + 1) parent side of
+                          plane p, -(p + 1) child side; 0 kinematic (or flesh) */
     posed_bone* bones;
     float jiggle; /* 1 - exp(-jiggle_damping h) */
     float* lambda;
@@ -968,9 +975,10 @@ typedef struct step_ctx {
 static void solve_tet(const step_ctx* c, size_t q) {
     const ak_skin_soft* s = c->s;
     const uint32_t* tt = &s->tets[4 * q];
-    const float w[4] = {s->inv_mass[tt[0]], s->inv_mass[tt[1]], s->inv_mass[tt[2]], s->inv_mass[tt[3]]};
-    if (w[0] + w[1] + w[2] + w[3] == 0.0f) return;
     soft_p4* x = c->x;
+    /* the step's inverse masses (x.w: a released kinematic node has its mass) */
+    const float w[4] = {x[tt[0]].w, x[tt[1]].w, x[tt[2]].w, x[tt[3]].w};
+    if (w[0] + w[1] + w[2] + w[3] == 0.0f) return;
     const float* m = &s->dm_inv[9 * q];
     const ak_vec3 x0 = x[tt[0]].p;
     const ak_vec3 d1 = ak_vec3_sub(x[tt[1]].p, x0), d2 = ak_vec3_sub(x[tt[2]].p, x0), d3 = ak_vec3_sub(x[tt[3]].p, x0);
@@ -1169,16 +1177,24 @@ static void solve_range(const step_ctx* c, size_t b, size_t e) {
     for (; q < e; ++q) solve_tet(c, q);
 }
 
+static void plane_clamp(const step_ctx* c, size_t n, int32_t e) {
+    size_t pl = (size_t)(e > 0 ? e : -e) - 1;
+    ak_vec3 nrm = c->planes[2 * pl + 1];
+    if (nrm.x == 0.0f && nrm.y == 0.0f && nrm.z == 0.0f) return;
+    float sd = ak_vec3_dot(ak_vec3_sub(c->x[n].p, c->planes[2 * pl]), nrm);
+    if (e > 0 ? sd > 0.0f : sd < 0.0f) c->x[n].p = ak_vec3_madd(c->x[n].p, nrm, -sd);
+}
+
 static void collide_node(const step_ctx* c, size_t n) {
     const ak_skin_soft* s = c->s;
+    if (s->kinematic[n]) { /* released for this step: its own plane only */
+        plane_clamp(c, n, c->released[n]);
+        return;
+    }
     for (uint32_t k = 0; k < SOFT_NODE_PLANES && s->plane_count; ++k) {
         int32_t e = s->node_planes[SOFT_NODE_PLANES * n + k];
         if (e == 0) break;
-        size_t pl = (size_t)(e > 0 ? e : -e) - 1;
-        ak_vec3 nrm = c->planes[2 * pl + 1];
-        if (nrm.x == 0.0f && nrm.y == 0.0f && nrm.z == 0.0f) continue;
-        float sd = ak_vec3_dot(ak_vec3_sub(c->x[n].p, c->planes[2 * pl]), nrm);
-        if (e > 0 ? sd > 0.0f : sd < 0.0f) c->x[n].p = ak_vec3_madd(c->x[n].p, nrm, -sd);
+        plane_clamp(c, n, e);
     }
     const uint64_t* bits = &s->collide[n * s->collide_words];
     for (size_t wi = 0; wi < s->collide_words; ++wi)
@@ -1234,7 +1250,7 @@ static void step_work(soft_team* team, uint32_t index) {
         float frac = (float)(sub + 1) / (float)S;
         for (size_t n = nb; n < ne; ++n) {
             c->prev[n] = c->x[n];
-            if (s->kinematic[n]) c->x[n].p = ak_vec3_lerp(c->start[n], c->target[n], frac);
+            if (s->kinematic[n] && !c->released[n]) c->x[n].p = ak_vec3_lerp(c->start[n], c->target[n], frac);
             else {
                 c->v[n] = ak_vec3_madd(c->v[n], c->gravity, c->h);
                 c->x[n].p = ak_vec3_madd(c->x[n].p, c->v[n], c->h);
@@ -1251,10 +1267,11 @@ static void step_work(soft_team* team, uint32_t index) {
         }
         float inv_h = 1.0f / c->h;
         for (size_t n = nb; n < ne; ++n) {
-            if (!s->kinematic[n]) collide_node(c, n);
+            const bool sim = !s->kinematic[n] || c->released[n];
+            if (sim) collide_node(c, n);
             c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n].p, c->prev[n].p), inv_h);
             /* jiggle damping: velocity relative to the skinned motion decays */
-            if (!s->kinematic[n]) c->v[n] = ak_vec3_madd(c->v[n], ak_vec3_sub(c->v[n], c->vref[n]), -c->jiggle);
+            if (sim) c->v[n] = ak_vec3_madd(c->v[n], ak_vec3_sub(c->v[n], c->vref[n]), -c->jiggle);
         }
         sync(team);
     }
@@ -1269,6 +1286,53 @@ static void* step_thread(void* arg) {
     pthread_mutex_unlock(&t->mutex);
     if (go > 0 && w->index < t->count) step_work(t, w->index);
     return NULL;
+}
+
+/* The cone rule: a kinematic node of either bone of a joint bent past 90 deg whose target lies
+ * near its own side of the joint's contact plane (closer to the plane than SOFT_RELEASE_CONE
+ * times its distance from the joint, or already across it) is flesh for this step, held on its
+ * side of the plane: at a deep bend the two bones' cores would otherwise crush the flesh
+ * between them (docs/softskin.md). A node that lies within the cone of the bind pose's plane
+ * (a hip or shoulder whose bones meet at a steep angle at rest) stays kinematic. */
+static void release_nodes(const ak_skin_soft* s, step_ctx* c, const ak_mat4* palette) {
+    const size_t nn = s->node_count;
+    memset(c->released, 0, nn * sizeof(int32_t));
+    for (uint32_t pl = 0; pl < s->plane_count; ++pl) {
+        ak_vec3 nrm = c->planes[2 * pl + 1], o = c->planes[2 * pl];
+        if (nrm.x == 0.0f && nrm.y == 0.0f && nrm.z == 0.0f) continue;
+        const uint32_t bp = s->planes[2 * pl], bc = s->planes[2 * pl + 1];
+        const ak_skin_bone *P1 = &s->bones[bp], *C1 = &s->bones[bc];
+        /* the plane at the bind pose: a node already within the cone there (the bones of a hip
+         * or a shoulder meet at a steep angle at rest) stays kinematic */
+        ak_vec3 u0 = ak_vec3_add(ak_vec3_normalize(ak_vec3_sub(P1->tail, P1->head)), ak_vec3_normalize(ak_vec3_sub(C1->tail, C1->head)));
+        if (!(ak_vec3_length(u0) > 0.05f)) continue;
+        { /* bent past SOFT_RELEASE_BEND_COS (90 deg): a walk's knees and elbows stay as before */
+            const ak_mat4 mp = palette[P1->joint_index], mc = palette[C1->joint_index];
+            ak_vec3 up = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mp, P1->tail), ak_mat4_transform_point(mp, P1->head)));
+            ak_vec3 uc = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mc, C1->tail), ak_mat4_transform_point(mc, C1->head)));
+            if (ak_vec3_dot(up, uc) > SOFT_RELEASE_BEND_COS) continue;
+        }
+        const ak_vec3 nrm0 = ak_vec3_normalize(u0), o0 = P1->tail;
+        const float reach = ak_maxf(ak_vec3_distance(P1->head, P1->tail), ak_vec3_distance(C1->head, C1->tail)) +
+                            2.0f * ak_maxf(s->contact_radius[bp], s->contact_radius[bc]);
+        for (size_t n = 0; n < nn; ++n) {
+            if (!s->kinematic[n] || c->released[n]) continue;
+            const uint16_t part = s->node_joints[SOFT_INFLUENCES * n];
+            const bool parent = part == P1->joint_index;
+            if (!parent && part != C1->joint_index) continue;
+            ak_vec3 rel = ak_vec3_sub(c->target[n], o);
+            float dist = ak_vec3_length(rel);
+            if (dist > reach) continue;
+            float sd = ak_vec3_dot(rel, nrm), own = parent ? -sd : sd;
+            ak_vec3 rel0 = ak_vec3_sub(s->rest[n], o0);
+            float sd0 = ak_vec3_dot(rel0, nrm0);
+            if ((parent ? -sd0 : sd0) < SOFT_RELEASE_CONE * ak_vec3_length(rel0)) continue;
+            if (own < SOFT_RELEASE_CONE * dist) {
+                c->released[n] = parent ? (int32_t)pl + 1 : -((int32_t)pl + 1);
+                c->x[n].w = s->mass[n] > 0.0f ? 1.0f / s->mass[n] : 0.0f;
+            }
+        }
+    }
 }
 
 ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
@@ -1289,6 +1353,7 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     c.lambda = (float*)(void*)((uint8_t*)c.start + akp_align16(3 * nn * sizeof(ak_vec3)));
     c.bones = (posed_bone*)(void*)((uint8_t*)c.lambda + akp_align16(2 * s->tet_count * sizeof(float)));
     c.planes = (ak_vec3*)(void*)((uint8_t*)c.bones + akp_align16(s->bone_count * sizeof(posed_bone)));
+    c.released = (int32_t*)(void*)((uint8_t*)c.planes + akp_align16(2 * s->plane_count * sizeof(ak_vec3)));
     float dt = j->dt > 0.0f ? j->dt : 1.0f / 60.0f;
     c.h = dt / (float)s->substeps;
     c.gamma = s->damping / c.h;
@@ -1331,8 +1396,10 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
         ak_vec3 uc = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mc, bc->tail), ak_mat4_transform_point(mc, bc->head)));
         ak_vec3 u = ak_vec3_add(up, uc);
         c.planes[2 * pl] = ak_mat4_transform_point(mp, bp->tail);
-        c.planes[2 * pl + 1] = ak_vec3_length(u) > 0.1f ? ak_vec3_normalize(u) : ak_vec3_zero(); /* folded: off */
+        /* folded: off (|u| = 2 cos(a / 2) at an angle a between the bones: 0.05 is 177.1 deg) */
+        c.planes[2 * pl + 1] = ak_vec3_length(u) > 0.05f ? ak_vec3_normalize(u) : ak_vec3_zero();
     }
+    release_nodes(s, &c, j->palette.ptr);
     uint32_t tc = j->thread_count > 1 ? j->thread_count : 1;
     /* a barrier per colour and substep costs microseconds; the AVX2 solve of a colour of a
      * few-thousand-node lattice takes about as long: threads only from SOFT_NODES_PER_THREAD */
@@ -1373,7 +1440,7 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     for (size_t n = 0; n < nn; ++n) j->node_positions.ptr[n] = c.x[n].p;
     for (size_t n = 0; n < nn && finite; ++n) {
         finite = ak_vec3_is_finite(c.x[n].p) && ak_vec3_is_finite(c.v[n]);
-        if (!s->kinematic[n]) ke += 0.5 * (double)s->mass[n] * (double)ak_vec3_length_sq(c.v[n]);
+        if (!s->kinematic[n] || c.released[n]) ke += 0.5 * (double)s->mass[n] * (double)ak_vec3_length_sq(c.v[n]);
     }
     if (!finite) {
         (void)ak_skin_soft_state_init(s, j->palette, j->node_positions, j->node_velocities);
