@@ -491,7 +491,7 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
             int wa = add_accessor(c, wb, nv, GL_FLOAT, 4, GL_ARRAY_BUFFER, false);
             if (ja < 0 || wa < 0) r = oom(c);
             else {
-                char jk[16], wk[16];
+                char jk[24], wk[24]; /* room for any unsigned set index (gcc -O1 -Wformat-truncation) */
                 snprintf(jk, sizeof jk, "JOINTS_%u", s);
                 snprintf(wk, sizeof wk, "WEIGHTS_%u", s);
                 add_num(attrs, jk, ja);
