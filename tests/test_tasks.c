@@ -256,6 +256,77 @@ AK_TEST(profile_counts_sections_waits_and_barriers) {
     AK_CHECK_EQ(pr.sections, 0u); /* enabling reset the counts; off counts nothing */
 }
 
+/* ---- CPU time per phase --------------------------------------------------------------------- */
+
+static double thread_cpu_ms(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+/* Burn `ms` of this thread's CPU time (CPU, not wall: a loaded machine only makes it slower). */
+static void burn_cpu_ms(double ms) {
+    const double until = thread_cpu_ms() + ms;
+    volatile unsigned x = 1;
+    while (thread_cpu_ms() < until) {
+        for (int k = 0; k < 1000; ++k) x = x * 1664525u + 1013904223u;
+    }
+}
+
+typedef struct burner {
+    akp_barrier* barrier;
+    uint32_t index;
+} burner;
+
+/* Phase 0: task 0 alone works 3 ms (a serial part inside the section); phase 1: every task 2 ms. */
+static void* burner_task(void* arg) {
+    burner* b = (burner*)arg;
+    if (b->index == 0) burn_cpu_ms(3.0);
+    akp_barrier_wait(b->barrier);
+    burn_cpu_ms(2.0);
+    return NULL;
+}
+
+AK_TEST(profile_cpu_time_per_phase) {
+    enum { STEPS = 3, T = 3 };
+    akp_tasks_profile_enable(true);
+    for (int s = 0; s < STEPS; ++s) {
+        akp_tasks_profile_step();
+        burn_cpu_ms(1.5); /* serial, before the section */
+        akp_barrier bar;
+        akp_barrier_init(&bar, T);
+        burner tasks[T];
+        for (uint32_t t = 0; t < T; ++t) tasks[t] = (burner){&bar, t};
+        akp_team_run run;
+        AK_CHECK(akp_team_begin(&run, burner_task, tasks, sizeof(burner), T));
+        burner_task(&tasks[0]);
+        akp_team_end(&run);
+        akp_barrier_destroy(&bar);
+        burn_cpu_ms(1.0); /* serial tail */
+    }
+    akp_phase_cpu ph[AKP_PHASES_MAX];
+    const size_t n = akp_tasks_profile_phases(ph, AKP_PHASES_MAX);
+    akp_tasks_profile_enable(false);
+    AK_CHECK_EQ(n, 4u); /* serial, phase 0, phase 1, serial tail */
+    if (n != 4) return;
+    const double tol = 0.4 * STEPS; /* ms: clock reads, wake-ups, the barrier */
+    AK_CHECK_EQ(ph[0].threads, 1u);
+    AK_CHECK_EQ(ph[0].runs, (uint64_t)STEPS);
+    AK_CHECK_NEAR(1e3 * ph[0].serial_s, 1.5 * STEPS, tol);
+    AK_CHECK_EQ(ph[1].threads, (uint32_t)T);
+    AK_CHECK_NEAR(1e3 * ph[1].serial_s, 3.0 * STEPS, tol);
+    AK_CHECK_NEAR(1e3 * ph[1].parallel_s, 0.0, tol);
+    AK_CHECK_NEAR(1e3 * ph[1].critical_s, 3.0 * STEPS, tol);
+    AK_CHECK_NEAR(1e3 * ph[2].serial_s, 0.0, tol);
+    AK_CHECK_NEAR(1e3 * ph[2].parallel_s, 2.0 * T * STEPS, tol);
+    AK_CHECK_NEAR(1e3 * ph[2].critical_s, 2.0 * STEPS, tol);
+    AK_CHECK_EQ(ph[3].threads, 1u);
+    AK_CHECK_NEAR(1e3 * ph[3].serial_s, 1.0 * STEPS, tol);
+    /* off: nothing recorded, and enabling cleared the phases */
+    akp_tasks_profile_step();
+    AK_CHECK_EQ(akp_tasks_profile_phases(ph, AKP_PHASES_MAX), 0u);
+}
+
 int main(void) {
     AK_RUN(every_task_once_on_its_own_thread);
     AK_RUN(tasks_run_at_the_same_time);
@@ -266,5 +337,6 @@ int main(void) {
     AK_RUN(team_run_with_barriers);
     AK_RUN(team_run_from_inside_a_task);
     AK_RUN(profile_counts_sections_waits_and_barriers);
+    AK_RUN(profile_cpu_time_per_phase);
     return ak_test_finish();
 }
