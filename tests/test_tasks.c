@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "ak_test.h"
+#include "csort.h"
 #include "tasks.h"
 
 typedef struct probe {
@@ -327,6 +328,63 @@ AK_TEST(profile_cpu_time_per_phase) {
     AK_CHECK_EQ(akp_tasks_profile_phases(ph, AKP_PHASES_MAX), 0u);
 }
 
+/* ---- akp_csort ------------------------------------------------------------------------------ */
+
+typedef struct keyed {
+    uint32_t key, index;
+} keyed;
+
+static int keyed_cmp(const void* a, const void* b) {
+    const keyed *x = (const keyed*)a, *y = (const keyed*)b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return x->index < y->index ? -1 : x->index > y->index; /* (key, index): the stable order */
+}
+
+/* Against qsort on (key, index) pairs, for bucket counts below, at and far above the part
+ * count, empty inputs and one bucket, with 1 to 64 parts: the same order and bucket starts. */
+AK_TEST(counting_sort_is_stable_and_split_free) {
+    const size_t sizes[] = {0, 1, 7, 1000, 30011};
+    const uint32_t buckets[] = {1, 3, 16, 1000, 200000};
+    const uint32_t parts[] = {1, 2, 3, 5, 16, 64};
+    uint32_t state = 12345u;
+    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; ++si)
+        for (size_t bi = 0; bi < sizeof buckets / sizeof buckets[0]; ++bi) {
+            const size_t n = sizes[si];
+            const uint32_t B = buckets[bi];
+            uint32_t* keys = malloc((n + 1) * sizeof(uint32_t));
+            keyed* ref = malloc((n + 1) * sizeof(keyed));
+            uint32_t* ref_start = calloc((size_t)B + 1, sizeof(uint32_t));
+            for (size_t i = 0; i < n; ++i) {
+                state = state * 1664525u + 1013904223u;
+                /* clustered keys: many duplicates, some buckets empty */
+                keys[i] = (uint32_t)((state >> 8) % B);
+                if (state & 1u) keys[i] &= ~3u;
+                if (keys[i] >= B) keys[i] = B - 1;
+                ref[i] = (keyed){keys[i], (uint32_t)i};
+                ref_start[keys[i] + 1]++;
+            }
+            for (uint32_t k = 0; k < B; ++k) ref_start[k + 1] += ref_start[k];
+            qsort(ref, n, sizeof(keyed), keyed_cmp);
+            for (size_t pi = 0; pi < sizeof parts / sizeof parts[0]; ++pi) {
+                akp_csort* cs = malloc(sizeof *cs);
+                uint32_t* order = malloc((n + 1) * sizeof(uint32_t));
+                uint32_t* start = malloc(((size_t)B + 1) * sizeof(uint32_t));
+                uint32_t* tmp = malloc((2 * n + 1) * sizeof(uint32_t));
+                for (size_t i = 0; i < n; ++i) order[i] = 0xdeadbeefu;
+                for (uint32_t k = 0; k <= B; ++k) start[k] = 0xdeadbeefu;
+                *cs = (akp_csort){.keys = keys, .n = n, .buckets = B, .parts = parts[pi], .order = order,
+                                  .start = start, .tmp = tmp};
+                akp_csort_run(cs);
+                size_t bad = 0;
+                for (size_t i = 0; i < n; ++i) bad += order[i] != ref[i].index;
+                for (uint32_t k = 0; k <= B; ++k) bad += start[k] != ref_start[k];
+                AK_CHECK_MSG(bad == 0, "n %zu, %u buckets, %u parts: %zu wrong", n, B, parts[pi], bad);
+                free(cs), free(order), free(start), free(tmp);
+            }
+            free(keys), free(ref), free(ref_start);
+        }
+}
+
 int main(void) {
     AK_RUN(every_task_once_on_its_own_thread);
     AK_RUN(tasks_run_at_the_same_time);
@@ -338,5 +396,6 @@ int main(void) {
     AK_RUN(team_run_from_inside_a_task);
     AK_RUN(profile_counts_sections_waits_and_barriers);
     AK_RUN(profile_cpu_time_per_phase);
+    AK_RUN(counting_sort_is_stable_and_split_free);
     return ak_test_finish();
 }
