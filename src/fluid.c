@@ -16,6 +16,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "csort.h"
 #include "tasks.h"
 
 #define FLUID_PI 3.14159265358979323846
@@ -751,15 +752,71 @@ static void ph_pad_lists(ctx* c, size_t b, size_t e, uint32_t t) {
 /* Sorts the predicted positions c->pred by cell into c->order / px, py, pz. Dense (z, y, x)
  * cells when the bounding box holds at most dense_cells(cap) cells, else the shared grid.
  * Returns false on a non-finite prediction. Sets *dense. */
-static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t cap, bool* dense) {
-    const size_t n = c->n;
+/* The predictions' bounds over [b, e), per thread (min and max: any split gives the same box). */
+static void ph_bounds(ctx* c, size_t b, size_t e, uint32_t t) {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i < n; ++i) {
+    bool bad = false;
+    for (size_t i = b; i < e; ++i) {
         const float* p = &c->pred[i].x;
         for (int a = 0; a < 3; ++a) {
-            if (!ak_finitef(p[a])) return false;
+            bad = bad || !ak_finitef(p[a]);
             lo[a] = p[a] < lo[a] ? p[a] : lo[a];
             hi[a] = p[a] > hi[a] ? p[a] : hi[a];
+        }
+    }
+    for (int a = 0; a < 3; ++a) c->box_lo[t][a] = lo[a], c->box_hi[t][a] = hi[a];
+    c->box_bad[t] = bad;
+}
+
+/* Each particle's dense cell, (z, y, x) order. */
+static void ph_cell_keys(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        const ak_vec3 p = c->pred[i];
+        const int64_t x = cell_coord(c, p.x) - c->cmin[0], y = cell_coord(c, p.y) - c->cmin[1],
+                      z = cell_coord(c, p.z) - c->cmin[2];
+        c->cell[i] = (uint32_t)((z * c->dim[1] + y) * c->dim[0] + x);
+    }
+}
+
+static void ph_csort_count(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)b, (void)e;
+    akp_csort_count(c->csort, t);
+}
+
+static void ph_csort_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)b, (void)e;
+    akp_csort_scatter(c->csort, t);
+}
+
+static void ph_csort_finish(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)b, (void)e;
+    akp_csort_finish(c->csort, t);
+}
+
+/* The predictions in sorted order. */
+static void ph_sorted_positions(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t a = b; a < e; ++a) {
+        const ak_vec3 p = c->pred[c->order[a]];
+        c->px[a] = p.x, c->py[a] = p.y, c->pz[a] = p.z;
+        if (c->simd) c->p4[4 * a] = p.x, c->p4[4 * a + 1] = p.y, c->p4[4 * a + 2] = p.z, c->p4[4 * a + 3] = 0.0f;
+    }
+}
+
+/* Sort the predictions by cell: the dense (z, y, x) box of cells when it fits dense_cells, a
+ * stable counting sort over the team (src/csort.h: index order within a cell, for any thread
+ * count), else the shared hashed grid (one thread). False when a prediction is not finite. */
+static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t cap, bool* dense) {
+    const size_t n = c->n;
+    const uint32_t T = c->team ? c->team->size : 1u;
+    parallel(c, ph_bounds);
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t t = 0; t < T; ++t) {
+        if (c->box_bad[t]) return false;
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = c->box_lo[t][a] < lo[a] ? c->box_lo[t][a] : lo[a];
+            hi[a] = c->box_hi[t][a] > hi[a] ? c->box_hi[t][a] : hi[a];
         }
     }
     double volume = n ? 1.0 : 0.0;
@@ -770,36 +827,30 @@ static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t ca
     }
     *dense = n > 0 && volume <= (double)dense_cells(cap) && volume < 4294967295.0;
     if (*dense) {
-        const size_t cells = (size_t)volume;
-        uint32_t* start = c->dstart;
-        memset(start, 0, (cells + 1) * sizeof(uint32_t));
-        for (size_t i = 0; i < n; ++i) {
-            const ak_vec3 p = c->pred[i];
-            const int64_t x = cell_coord(c, p.x) - c->cmin[0], y = cell_coord(c, p.y) - c->cmin[1],
-                          z = cell_coord(c, p.z) - c->cmin[2];
-            const uint32_t m = (uint32_t)((z * c->dim[1] + y) * c->dim[0] + x);
-            c->cell[i] = m;
-            ++start[m + 1];
+        parallel(c, ph_cell_keys);
+        akp_csort cs = {.keys = c->cell, .n = n, .buckets = (uint32_t)volume, .order = c->order, .start = c->dstart};
+        /* the grid's memory (unused on this path) holds the sort's 2 n scratch */
+        uint32_t* tmp = (uint32_t*)(void*)(((uintptr_t)grid_mem + 3u) & ~(uintptr_t)3u);
+        cs.parts = T > 1 && grid_bytes >= 8 * n + 8 ? T : 1u;
+        cs.tmp = tmp;
+        c->csort = &cs;
+        if (cs.parts > 1) {
+            parallel(c, ph_csort_count);
+            akp_csort_offsets(&cs);
+            parallel(c, ph_csort_scatter);
+            parallel(c, ph_csort_finish);
+        } else {
+            akp_csort_offsets(&cs);
+            akp_csort_finish(&cs, 0);
         }
-        for (size_t m = 0; m < cells; ++m) start[m + 1] += start[m];
-        /* stable scatter (index order within a cell), then start[m] is back at cell m's start */
-        for (size_t i = 0; i < n; ++i) {
-            const uint32_t a = start[c->cell[i]]++;
-            c->order[a] = (uint32_t)i;
-        }
-        for (size_t m = cells; m > 0; --m) start[m] = start[m - 1];
-        start[0] = 0;
+        c->csort = NULL;
     } else {
         ak_grid_desc gd = {.cell_size = c->h};
         if (ak_grid_build(&gd, (ak_vec3_cspan){c->pred, n}, (ak_u8_span){grid_mem, grid_bytes}, &c->grid) != AK_OK)
             return false;
         memcpy(c->order, c->grid.order, n * sizeof(uint32_t));
     }
-    for (size_t a = 0; a < n; ++a) {
-        const ak_vec3 p = c->pred[c->order[a]];
-        c->px[a] = p.x, c->py[a] = p.y, c->pz[a] = p.z;
-        if (c->simd) c->p4[4 * a] = p.x, c->p4[4 * a + 1] = p.y, c->p4[4 * a + 2] = p.z, c->p4[4 * a + 3] = 0.0f;
-    }
+    parallel(c, ph_sorted_positions);
     return true;
 }
 
@@ -1292,7 +1343,8 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
         if (c->d.vorticity_epsilon != 0.0f) parallel(c, ph_vorticity);
         if (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f) {
             parallel(c, ph_xsph);
-            memcpy(c->v, c->vnew, n * sizeof(ak_vec3));
+            ak_vec3* t = c->v; /* the smoothed velocities are the step's */
+            c->v = c->vnew, c->vnew = t;
         }
     } else {
         parallel(c, ph_density);
