@@ -358,6 +358,15 @@ static inline ak_vec3 P(const ctx* c, uint32_t a) { return ak_vec3_make(c->px[a]
 
 typedef void (*phase_fn)(ctx* c, size_t begin, size_t end, uint32_t t);
 
+/* The end-of-step statistics of one chunk of STATS_CHUNK sorted particles. */
+#define STATS_CHUNK 1024u
+typedef struct akp_fluid_stats_part {
+    double sum_err, sum_rho;
+    float max_err;
+    uint32_t surface, full;
+    bool blown;
+} stats_part;
+
 /* Start of thread t's share of [0, n): a multiple of 16 (whole blocks of neighbour lists). */
 static size_t split(size_t n, uint32_t t, uint32_t threads) {
     return t >= threads ? n : (n * t / threads) & ~(size_t)15;
@@ -1177,6 +1186,31 @@ static void ph_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
     }
 }
 
+/* The statistics of sorted particles [k STATS_CHUNK, (k + 1) STATS_CHUNK) for chunks k in
+ * [b, e) (see the end of ak_fluid_step_run). */
+static void ph_stats(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const float limit = 100.0f * c->h;
+    for (size_t k = b; k < e; ++k) {
+        stats_part q = {0};
+        const size_t a1 = (k + 1) * STATS_CHUNK < c->n ? (k + 1) * STATS_CHUNK : c->n;
+        for (size_t a = k * STATS_CHUNK; a < a1; ++a) {
+            const uint32_t i = c->order[a];
+            const ak_vec3 v = c->vo[i];
+            if (!vfinite(c->xo[i]) || !vfinite(v) || !(ak_vec3_length(v) * c->dt <= limit)) q.blown = true;
+            if (c->flags[a] & AK_FLUID_FLAG_SURFACE) ++q.surface;
+            if (c->flags[a] & AK_FLUID_FLAG_FULL) {
+                float err = fabsf(c->rho[a] / c->rho0 - 1.0f);
+                if (err > q.max_err) q.max_err = err;
+                q.sum_err += err;
+                q.sum_rho += c->rho[a];
+                ++q.full;
+            }
+        }
+        c->stats[k] = q;
+    }
+}
+
 static double now_seconds(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -1356,25 +1390,26 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     parallel(c, ph_flags);
     parallel(c, ph_full);
     parallel(c, ph_scatter);
+    /* blow-up check, statistics: per chunk of STATS_CHUNK sorted particles over the team, the
+     * chunks then summed in order (the same sums for any thread count). The chunks' partials
+     * live in acc, free by now (or on the stack for small steps). */
+    const size_t chunks = (n + STATS_CHUNK - 1) / STATS_CHUNK;
+    stats_part small[8];
+    c->stats = chunks <= 8 ? small : (stats_part*)(void*)c->acc;
+    parallel_n(c, ph_stats, chunks);
     team_stop(c);
-
-    /* blow-up check, statistics (sorted order: the same for any thread count) */
-    const float limit = 100.0f * c->h;
     bool blown = false;
     double sum = 0.0, sum_rho = 0.0;
-    for (size_t a = 0; a < n; ++a) {
-        const uint32_t i = c->order[a];
-        const ak_vec3 v = c->vo[i];
-        if (!vfinite(c->xo[i]) || !vfinite(v) || !(ak_vec3_length(v) * c->dt <= limit)) blown = true;
-        if (c->flags[a] & AK_FLUID_FLAG_SURFACE) ++st.surface_count;
-        if (c->flags[a] & AK_FLUID_FLAG_FULL) {
-            float err = fabsf(c->rho[a] / c->rho0 - 1.0f);
-            if (err > st.max_density_error) st.max_density_error = err;
-            sum += err;
-            sum_rho += c->rho[a];
-            ++st.full_count;
-        }
+    for (size_t k = 0; k < chunks; ++k) {
+        const stats_part* q = &c->stats[k];
+        blown = blown || q->blown;
+        st.surface_count += q->surface;
+        st.full_count += q->full;
+        if (q->max_err > st.max_density_error) st.max_density_error = q->max_err;
+        sum += q->sum_err;
+        sum_rho += q->sum_rho;
     }
+    c->stats = NULL;
     st.mean_density_error = st.full_count ? (float)(sum / (double)st.full_count) : 0.0f;
     st.mean_density = st.full_count ? (float)(sum_rho / (double)st.full_count) : 0.0f;
     st.rest_lattice_density = c->rho_c;
