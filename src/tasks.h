@@ -27,7 +27,7 @@
  * bandwidth and wake-up costs). Only runs begun by the thread that called enable or step are
  * split into phases (a run begun inside a task is part of that task's work); phases past
  * AKP_PHASES_MAX - 1 add up in the last slot. Enabling resets these too. */
-#define AKP_PHASES_MAX 256u
+#define AKP_PHASES_MAX 512u
 typedef struct akp_phase_cpu {
     uint64_t runs;     /* times this phase ran */
     uint32_t threads;  /* threads in its last run; 1 for a serial part between sections */
@@ -131,7 +131,7 @@ void akp_tasks_profile_read(akp_tasks_profile* out);
  * bandwidth and wake-up costs). Only runs begun by the thread that called enable or step are
  * split into phases (a run begun inside a task is part of that task's work); phases past
  * AKP_PHASES_MAX - 1 add up in the last slot. Enabling resets these too. */
-#define AKP_PHASES_MAX 256u
+#define AKP_PHASES_MAX 512u
 typedef struct akp_phase_cpu {
     uint64_t runs;     /* times this phase ran */
     uint32_t threads;  /* threads in its last run; 1 for a serial part between sections */
