@@ -236,6 +236,7 @@ bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t s
     if (count > AKP_TASKS_MAX || count < 2) return false;
     run->begin_s = atomic_load_explicit(&profiling, memory_order_relaxed) ? now_s() : 0.0;
     run->profiled = run->begin_s > 0.0 && prof_owner && !prof_in_run;
+    run->outer = prof_in_run;
     run->fn = fn, run->base = (char*)tasks, run->size = size, run->count = count;
     pthread_once(&team_once, team_init);
     if (pthread_mutex_trylock(&team_lock) == 0) {
@@ -247,6 +248,7 @@ bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t s
             run->on_team = true;
             atomic_fetch_add_explicit(&team_runs, 1u, memory_order_relaxed);
             if (run->profiled) serial_done(), task_enter(true, 0);
+            prof_in_run = run->profiled; /* a run inside a task: its barriers are not the outer run's */
             return true;
         }
         pthread_mutex_unlock(&team_lock);
@@ -256,6 +258,7 @@ bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t s
     if (run->profiled) serial_done(); /* before the threads start: they may reach a barrier first */
     if (begin_fresh(run)) {
         if (run->profiled) task_enter(true, 0);
+        prof_in_run = run->profiled;
         return true;
     }
     run->count = 1;
@@ -286,6 +289,7 @@ void akp_team_end(akp_team_run* run) {
         prof_outside = cpu_s();
         run->profiled = false;
     }
+    prof_in_run = run->outer; /* back in the outer task's phase (its CPU clock ran on) */
     run->count = 1;
 }
 

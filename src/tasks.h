@@ -78,6 +78,7 @@ typedef struct akp_team_run {
         uint32_t index;
     } fresh[AKP_TASKS_MAX];
     bool profiled;    /* its phases are recorded (akp_tasks_profile_step) */
+    bool outer;       /* begun by a task of a profiled run (whose phase it is part of) */
 } akp_team_run;
 bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
 void akp_team_end(akp_team_run* run);
