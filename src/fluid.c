@@ -16,6 +16,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "csort.h"
 #include "tasks.h"
 
 #define FLUID_PI 3.14159265358979323846
@@ -356,6 +357,15 @@ static inline ak_vec3 k_cubic_grad(const ctx* c, ak_vec3 r) {
 static inline ak_vec3 P(const ctx* c, uint32_t a) { return ak_vec3_make(c->px[a], c->py[a], c->pz[a]); }
 
 typedef void (*phase_fn)(ctx* c, size_t begin, size_t end, uint32_t t);
+
+/* The end-of-step statistics of one chunk of STATS_CHUNK sorted particles. */
+#define STATS_CHUNK 1024u
+typedef struct akp_fluid_stats_part {
+    double sum_err, sum_rho;
+    float max_err;
+    uint32_t surface, full;
+    bool blown;
+} stats_part;
 
 /* Start of thread t's share of [0, n): a multiple of 16 (whole blocks of neighbour lists). */
 static size_t split(size_t n, uint32_t t, uint32_t threads) {
@@ -751,15 +761,71 @@ static void ph_pad_lists(ctx* c, size_t b, size_t e, uint32_t t) {
 /* Sorts the predicted positions c->pred by cell into c->order / px, py, pz. Dense (z, y, x)
  * cells when the bounding box holds at most dense_cells(cap) cells, else the shared grid.
  * Returns false on a non-finite prediction. Sets *dense. */
-static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t cap, bool* dense) {
-    const size_t n = c->n;
+/* The predictions' bounds over [b, e), per thread (min and max: any split gives the same box). */
+static void ph_bounds(ctx* c, size_t b, size_t e, uint32_t t) {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i < n; ++i) {
+    bool bad = false;
+    for (size_t i = b; i < e; ++i) {
         const float* p = &c->pred[i].x;
         for (int a = 0; a < 3; ++a) {
-            if (!ak_finitef(p[a])) return false;
+            bad = bad || !ak_finitef(p[a]);
             lo[a] = p[a] < lo[a] ? p[a] : lo[a];
             hi[a] = p[a] > hi[a] ? p[a] : hi[a];
+        }
+    }
+    for (int a = 0; a < 3; ++a) c->box_lo[t][a] = lo[a], c->box_hi[t][a] = hi[a];
+    c->box_bad[t] = bad;
+}
+
+/* Each particle's dense cell, (z, y, x) order. */
+static void ph_cell_keys(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t i = b; i < e; ++i) {
+        const ak_vec3 p = c->pred[i];
+        const int64_t x = cell_coord(c, p.x) - c->cmin[0], y = cell_coord(c, p.y) - c->cmin[1],
+                      z = cell_coord(c, p.z) - c->cmin[2];
+        c->cell[i] = (uint32_t)((z * c->dim[1] + y) * c->dim[0] + x);
+    }
+}
+
+static void ph_csort_count(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)b, (void)e;
+    akp_csort_count(c->csort, t);
+}
+
+static void ph_csort_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)b, (void)e;
+    akp_csort_scatter(c->csort, t);
+}
+
+static void ph_csort_finish(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)b, (void)e;
+    akp_csort_finish(c->csort, t);
+}
+
+/* The predictions in sorted order. */
+static void ph_sorted_positions(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    for (size_t a = b; a < e; ++a) {
+        const ak_vec3 p = c->pred[c->order[a]];
+        c->px[a] = p.x, c->py[a] = p.y, c->pz[a] = p.z;
+        if (c->simd) c->p4[4 * a] = p.x, c->p4[4 * a + 1] = p.y, c->p4[4 * a + 2] = p.z, c->p4[4 * a + 3] = 0.0f;
+    }
+}
+
+/* Sort the predictions by cell: the dense (z, y, x) box of cells when it fits dense_cells, a
+ * stable counting sort over the team (src/csort.h: index order within a cell, for any thread
+ * count), else the shared hashed grid (one thread). False when a prediction is not finite. */
+static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t cap, bool* dense) {
+    const size_t n = c->n;
+    const uint32_t T = c->team ? c->team->size : 1u;
+    parallel(c, ph_bounds);
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t t = 0; t < T; ++t) {
+        if (c->box_bad[t]) return false;
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = c->box_lo[t][a] < lo[a] ? c->box_lo[t][a] : lo[a];
+            hi[a] = c->box_hi[t][a] > hi[a] ? c->box_hi[t][a] : hi[a];
         }
     }
     double volume = n ? 1.0 : 0.0;
@@ -770,36 +836,30 @@ static bool sort_by_cell(ctx* c, uint8_t* grid_mem, size_t grid_bytes, size_t ca
     }
     *dense = n > 0 && volume <= (double)dense_cells(cap) && volume < 4294967295.0;
     if (*dense) {
-        const size_t cells = (size_t)volume;
-        uint32_t* start = c->dstart;
-        memset(start, 0, (cells + 1) * sizeof(uint32_t));
-        for (size_t i = 0; i < n; ++i) {
-            const ak_vec3 p = c->pred[i];
-            const int64_t x = cell_coord(c, p.x) - c->cmin[0], y = cell_coord(c, p.y) - c->cmin[1],
-                          z = cell_coord(c, p.z) - c->cmin[2];
-            const uint32_t m = (uint32_t)((z * c->dim[1] + y) * c->dim[0] + x);
-            c->cell[i] = m;
-            ++start[m + 1];
+        parallel(c, ph_cell_keys);
+        akp_csort cs = {.keys = c->cell, .n = n, .buckets = (uint32_t)volume, .order = c->order, .start = c->dstart};
+        /* the grid's memory (unused on this path) holds the sort's 2 n scratch */
+        uint32_t* tmp = (uint32_t*)(void*)(((uintptr_t)grid_mem + 3u) & ~(uintptr_t)3u);
+        cs.parts = T > 1 && grid_bytes >= 8 * n + 8 ? T : 1u;
+        cs.tmp = tmp;
+        c->csort = &cs;
+        if (cs.parts > 1) {
+            parallel(c, ph_csort_count);
+            akp_csort_offsets(&cs);
+            parallel(c, ph_csort_scatter);
+            parallel(c, ph_csort_finish);
+        } else {
+            akp_csort_offsets(&cs);
+            akp_csort_finish(&cs, 0);
         }
-        for (size_t m = 0; m < cells; ++m) start[m + 1] += start[m];
-        /* stable scatter (index order within a cell), then start[m] is back at cell m's start */
-        for (size_t i = 0; i < n; ++i) {
-            const uint32_t a = start[c->cell[i]]++;
-            c->order[a] = (uint32_t)i;
-        }
-        for (size_t m = cells; m > 0; --m) start[m] = start[m - 1];
-        start[0] = 0;
+        c->csort = NULL;
     } else {
         ak_grid_desc gd = {.cell_size = c->h};
         if (ak_grid_build(&gd, (ak_vec3_cspan){c->pred, n}, (ak_u8_span){grid_mem, grid_bytes}, &c->grid) != AK_OK)
             return false;
         memcpy(c->order, c->grid.order, n * sizeof(uint32_t));
     }
-    for (size_t a = 0; a < n; ++a) {
-        const ak_vec3 p = c->pred[c->order[a]];
-        c->px[a] = p.x, c->py[a] = p.y, c->pz[a] = p.z;
-        if (c->simd) c->p4[4 * a] = p.x, c->p4[4 * a + 1] = p.y, c->p4[4 * a + 2] = p.z, c->p4[4 * a + 3] = 0.0f;
-    }
+    parallel(c, ph_sorted_positions);
     return true;
 }
 
@@ -1126,6 +1186,31 @@ static void ph_scatter(ctx* c, size_t b, size_t e, uint32_t t) {
     }
 }
 
+/* The statistics of sorted particles [k STATS_CHUNK, (k + 1) STATS_CHUNK) for chunks k in
+ * [b, e) (see the end of ak_fluid_step_run). */
+static void ph_stats(ctx* c, size_t b, size_t e, uint32_t t) {
+    (void)t;
+    const float limit = 100.0f * c->h;
+    for (size_t k = b; k < e; ++k) {
+        stats_part q = {0};
+        const size_t a1 = (k + 1) * STATS_CHUNK < c->n ? (k + 1) * STATS_CHUNK : c->n;
+        for (size_t a = k * STATS_CHUNK; a < a1; ++a) {
+            const uint32_t i = c->order[a];
+            const ak_vec3 v = c->vo[i];
+            if (!vfinite(c->xo[i]) || !vfinite(v) || !(ak_vec3_length(v) * c->dt <= limit)) q.blown = true;
+            if (c->flags[a] & AK_FLUID_FLAG_SURFACE) ++q.surface;
+            if (c->flags[a] & AK_FLUID_FLAG_FULL) {
+                float err = fabsf(c->rho[a] / c->rho0 - 1.0f);
+                if (err > q.max_err) q.max_err = err;
+                q.sum_err += err;
+                q.sum_rho += c->rho[a];
+                ++q.full;
+            }
+        }
+        c->stats[k] = q;
+    }
+}
+
 static double now_seconds(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -1292,7 +1377,8 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
         if (c->d.vorticity_epsilon != 0.0f) parallel(c, ph_vorticity);
         if (c->d.vorticity_epsilon != 0.0f || c->d.xsph_c != 0.0f) {
             parallel(c, ph_xsph);
-            memcpy(c->v, c->vnew, n * sizeof(ak_vec3));
+            ak_vec3* t = c->v; /* the smoothed velocities are the step's */
+            c->v = c->vnew, c->vnew = t;
         }
     } else {
         parallel(c, ph_density);
@@ -1304,25 +1390,26 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     parallel(c, ph_flags);
     parallel(c, ph_full);
     parallel(c, ph_scatter);
+    /* blow-up check, statistics: per chunk of STATS_CHUNK sorted particles over the team, the
+     * chunks then summed in order (the same sums for any thread count). The chunks' partials
+     * live in acc, free by now (or on the stack for small steps). */
+    const size_t chunks = (n + STATS_CHUNK - 1) / STATS_CHUNK;
+    stats_part small[8];
+    c->stats = chunks <= 8 ? small : (stats_part*)(void*)c->acc;
+    parallel_n(c, ph_stats, chunks);
     team_stop(c);
-
-    /* blow-up check, statistics (sorted order: the same for any thread count) */
-    const float limit = 100.0f * c->h;
     bool blown = false;
     double sum = 0.0, sum_rho = 0.0;
-    for (size_t a = 0; a < n; ++a) {
-        const uint32_t i = c->order[a];
-        const ak_vec3 v = c->vo[i];
-        if (!vfinite(c->xo[i]) || !vfinite(v) || !(ak_vec3_length(v) * c->dt <= limit)) blown = true;
-        if (c->flags[a] & AK_FLUID_FLAG_SURFACE) ++st.surface_count;
-        if (c->flags[a] & AK_FLUID_FLAG_FULL) {
-            float err = fabsf(c->rho[a] / c->rho0 - 1.0f);
-            if (err > st.max_density_error) st.max_density_error = err;
-            sum += err;
-            sum_rho += c->rho[a];
-            ++st.full_count;
-        }
+    for (size_t k = 0; k < chunks; ++k) {
+        const stats_part* q = &c->stats[k];
+        blown = blown || q->blown;
+        st.surface_count += q->surface;
+        st.full_count += q->full;
+        if (q->max_err > st.max_density_error) st.max_density_error = q->max_err;
+        sum += q->sum_err;
+        sum_rho += q->sum_rho;
     }
+    c->stats = NULL;
     st.mean_density_error = st.full_count ? (float)(sum / (double)st.full_count) : 0.0f;
     st.mean_density = st.full_count ? (float)(sum_rho / (double)st.full_count) : 0.0f;
     st.rest_lattice_density = c->rho_c;

@@ -8,7 +8,41 @@
  * with several parallel phases per step pays per phase. */
 #include "tasks.h"
 
+#include <string.h>
 #include <time.h>
+
+/* ---- CPU time per phase (tasks.h, akp_tasks_profile_step) ---------------------------------- */
+
+static _Thread_local bool prof_owner;     /* this thread enabled the profile / marks the steps */
+static _Thread_local double prof_outside; /* the owner's CPU time when its serial part started */
+static _Thread_local bool prof_stepping;  /* the owner has marked a step since enabling */
+static akp_phase_cpu prof_phases[AKP_PHASES_MAX];
+static uint32_t prof_phase;                /* the next phase's number; written by one thread at a time */
+
+static double cpu_s(void) {
+    struct timespec ts;
+#ifdef CLOCK_THREAD_CPUTIME_ID
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+#else
+    clock_gettime(CLOCK_MONOTONIC, &ts); /* one thread anyway */
+#endif
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void phase_add(uint32_t threads, double serial, double parallel, double critical) {
+    akp_phase_cpu* p = &prof_phases[prof_phase < AKP_PHASES_MAX ? prof_phase : AKP_PHASES_MAX - 1];
+    if (prof_phase < AKP_PHASES_MAX) ++prof_phase;
+    p->runs++;
+    p->threads = threads;
+    p->serial_s += serial, p->parallel_s += parallel, p->critical_s += critical;
+}
+
+/* The owner's serial part since its last section (or step mark) ends here. */
+static void serial_done(void) {
+    const double c = cpu_s();
+    phase_add(1, c - prof_outside, 0.0, c - prof_outside);
+    prof_outside = c;
+}
 
 #ifndef AKP_NO_THREADS
 #include <sched.h>
@@ -19,6 +53,7 @@ typedef struct team_job {
     void* (*fn)(void*);
     char* base;
     size_t size;
+    bool profiled;
 } team_job;
 
 static pthread_mutex_t team_lock = PTHREAD_MUTEX_INITIALIZER; /* held by the caller for one run */
@@ -42,6 +77,38 @@ static double now_s(void) {
 
 static void prof_add(atomic_ullong* counter, double seconds) {
     atomic_fetch_add_explicit(counter, (unsigned long long)(seconds * 1e9 + 0.5), memory_order_relaxed);
+}
+
+/* CPU time per phase: the tasks' side */
+static _Thread_local bool prof_in_run;    /* this thread runs a task of a profiled run */
+static _Thread_local uint32_t prof_index; /* its task index there */
+static _Thread_local double prof_start;   /* CPU time when its current phase started */
+static double prof_work[AKP_TASKS_MAX];   /* per task: CPU seconds of the phase that ends */
+
+/* The phase whose tasks recorded prof_work[0 .. threads) has ended (every thread is at the
+ * meeting, so nobody writes prof_work meanwhile). */
+static void phase_done(uint32_t threads) {
+    double sum = 0.0, max = 0.0;
+    for (uint32_t t = 0; t < threads; ++t) {
+        sum += prof_work[t];
+        if (prof_work[t] > max) max = prof_work[t];
+    }
+    double serial = threads > 1 ? max - (sum - max) / (double)(threads - 1) : sum;
+    if (serial < 0.0) serial = 0.0;
+    phase_add(threads, serial, sum - serial, max);
+}
+
+static void task_enter(bool profiled, uint32_t index) {
+    prof_in_run = profiled;
+    if (!profiled) return;
+    prof_index = index;
+    prof_start = cpu_s();
+}
+
+static void task_leave(void) {
+    if (!prof_in_run) return;
+    prof_work[prof_index] = cpu_s() - prof_start;
+    prof_in_run = false;
 }
 
 /* Take the semaphore, polling it `spins` times before sleeping: a job's next parallel phase
@@ -68,7 +135,9 @@ static void* worker_main(void* arg) {
     const uint32_t index = (uint32_t)(uintptr_t)arg;
     for (;;) {
         take(&worker_go[index]);
+        task_enter(job.profiled, index);
         job.fn(job.base + index * job.size);
+        task_leave();
         if (atomic_fetch_sub_explicit(&pending, 1u, memory_order_acq_rel) == 1u) sem_post(&team_done);
     }
     return NULL;
@@ -122,7 +191,11 @@ static void* fresh_main(void* arg) {
     while (run->gate == 0) pthread_cond_wait(&run->gate_cv, &run->gate_m);
     const int go = run->gate;
     pthread_mutex_unlock(&run->gate_m);
-    if (go > 0) run->fn(run->base + f->index * run->size);
+    if (go > 0) {
+        task_enter(run->profiled, f->index);
+        run->fn(run->base + f->index * run->size);
+        task_leave();
+    }
     return NULL;
 }
 
@@ -159,31 +232,43 @@ static bool begin_fresh(akp_team_run* run) {
 bool akp_team_begin(akp_team_run* run, void* (*fn)(void*), void* tasks, size_t size, uint32_t count) {
     run->count = 1;
     run->on_team = false;
+    run->profiled = false;
     if (count > AKP_TASKS_MAX || count < 2) return false;
     run->begin_s = atomic_load_explicit(&profiling, memory_order_relaxed) ? now_s() : 0.0;
+    run->profiled = run->begin_s > 0.0 && prof_owner && !prof_in_run;
+    run->outer = prof_in_run;
     run->fn = fn, run->base = (char*)tasks, run->size = size, run->count = count;
     pthread_once(&team_once, team_init);
     if (pthread_mutex_trylock(&team_lock) == 0) {
         if (team_grow(count)) {
-            job = (team_job){fn, (char*)tasks, size};
+            job = (team_job){fn, (char*)tasks, size, run->profiled};
             atomic_store_explicit(&spin_count, (long)count <= cpu_count ? TEAM_SPIN : 0, memory_order_relaxed);
             atomic_store_explicit(&pending, count - 1u, memory_order_release);
             for (uint32_t t = 1; t < count; ++t) sem_post(&worker_go[t]); /* a post orders the writes above */
             run->on_team = true;
             atomic_fetch_add_explicit(&team_runs, 1u, memory_order_relaxed);
+            if (run->profiled) serial_done(), task_enter(true, 0);
+            prof_in_run = run->profiled; /* a run inside a task: its barriers are not the outer run's */
             return true;
         }
         pthread_mutex_unlock(&team_lock);
     }
     /* the team is busy (another caller, or a task calling in) or cannot grow */
     atomic_fetch_add_explicit(&fresh_runs, 1u, memory_order_relaxed);
-    if (begin_fresh(run)) return true;
+    if (run->profiled) serial_done(); /* before the threads start: they may reach a barrier first */
+    if (begin_fresh(run)) {
+        if (run->profiled) task_enter(true, 0);
+        prof_in_run = run->profiled;
+        return true;
+    }
     run->count = 1;
+    run->profiled = false;
     return false;
 }
 
 void akp_team_end(akp_team_run* run) {
     if (run->count < 2) return;
+    if (run->profiled) task_leave();
     const double wait_s = run->begin_s > 0.0 ? now_s() : 0.0;
     if (run->on_team) {
         take(&team_done);
@@ -199,6 +284,12 @@ void akp_team_end(akp_team_run* run) {
         prof_add(&prof_section_ns, end_s - run->begin_s);
         prof_add(&prof_caller_wait_ns, end_s - wait_s);
     }
+    if (run->profiled) {
+        phase_done(run->count);
+        prof_outside = cpu_s();
+        run->profiled = false;
+    }
+    prof_in_run = run->outer; /* back in the outer task's phase (its CPU clock ran on) */
     run->count = 1;
 }
 
@@ -247,7 +338,9 @@ void akp_barrier_wait(akp_barrier* b) {
 
 static void barrier_wait(akp_barrier* b) {
     const unsigned g = atomic_load(&b->generation);
+    if (prof_in_run) prof_work[prof_index] = cpu_s() - prof_start; /* before arriving: see phase_done */
     if (atomic_fetch_add(&b->arrived, 1) + 1 == b->size) {
+        if (prof_in_run) phase_done(b->size), prof_start = cpu_s();
         atomic_store(&b->arrived, 0);
         atomic_fetch_add(&b->generation, 1);
         if (atomic_load(&b->sleepers)) {
@@ -258,7 +351,10 @@ static void barrier_wait(akp_barrier* b) {
         return;
     }
     for (int k = 0; k < AKP_BARRIER_SPIN; ++k) {
-        if (atomic_load_explicit(&b->generation, memory_order_acquire) != g) return;
+        if (atomic_load_explicit(&b->generation, memory_order_acquire) != g) {
+            if (prof_in_run) prof_start = cpu_s();
+            return;
+        }
         cpu_relax();
     }
     pthread_mutex_lock(&b->m);
@@ -266,6 +362,7 @@ static void barrier_wait(akp_barrier* b) {
     while (atomic_load(&b->generation) == g) pthread_cond_wait(&b->cv, &b->m);
     atomic_fetch_sub(&b->sleepers, 1);
     pthread_mutex_unlock(&b->m);
+    if (prof_in_run) prof_start = cpu_s();
 }
 
 void akp_barrier_destroy(akp_barrier* b) {
@@ -309,7 +406,32 @@ void akp_tasks_stats(uint64_t* out_team_runs, uint64_t* out_fresh_runs) {
     if (out_fresh_runs) *out_fresh_runs = atomic_load_explicit(&fresh_runs, memory_order_relaxed);
 }
 
+void akp_tasks_profile_step(void) {
+    if (!atomic_load_explicit(&profiling, memory_order_relaxed)) return;
+    if (prof_owner && prof_stepping) serial_done(); /* the last step's serial tail */
+    prof_owner = prof_stepping = true;
+    prof_phase = 0;
+    prof_outside = cpu_s();
+}
+
+size_t akp_tasks_profile_phases(akp_phase_cpu* out, size_t cap) {
+    if (prof_owner && atomic_load_explicit(&profiling, memory_order_relaxed)) {
+        const uint32_t keep = prof_phase;
+        serial_done(); /* the serial tail so far, in the phase after the last one */
+        prof_phase = keep;
+    }
+    size_t n = 0;
+    while (n < AKP_PHASES_MAX && prof_phases[n].runs) ++n;
+    for (size_t i = 0; i < n && i < cap; ++i) out[i] = prof_phases[i];
+    return n;
+}
+
 void akp_tasks_profile_enable(bool on) {
+    memset(prof_phases, 0, sizeof prof_phases);
+    prof_phase = 0;
+    prof_owner = on;
+    prof_stepping = false;
+    prof_outside = cpu_s();
     atomic_store(&prof_sections, 0u);
     atomic_store(&prof_barrier_waits, 0u);
     atomic_store(&prof_section_ns, 0u);

@@ -916,6 +916,47 @@ AK_TEST(deterministic_for_any_thread_count) {
     }
 }
 
+/* The default thread bound (no exact_thread_count: one thread per 1024 constraints of an
+ * average colour, so a 128 x 128 XPBD sheet takes several) with 1, 2, 3 and 16 threads asked
+ * for: bit-identical positions, velocities and residuals, the set-up and the finish of the step
+ * (residuals in, start + displacement out) being split over the threads too. Pinned vertices
+ * end exactly at their pins with zero residuals. */
+AK_TEST(default_thread_bound_bit_identical) {
+    enum { W = 128, STEPS = 6 };
+    const uint32_t counts[4] = {1, 2, 3, 16};
+    uint32_t pins[2] = {0, W - 1};
+    ak_cloth_desc d = {.solver = AK_CLOTH_XPBD, .grid_width = W, .grid_height = W, .spacing = 1.0f / (W - 1),
+                       .grid_origin = {-0.5f, 1.0f, 0.5f}, .pins = AK_SPAN(pins)};
+    ak_vec3* out[4] = {NULL, NULL, NULL, NULL};
+    for (int k = 0; k < 4; ++k) {
+        sim s;
+        AK_CHECK(sim_init(&s, &d));
+        ak_vec3* res = calloc(s.n, sizeof(ak_vec3));
+        const ak_cloth_sphere sp = {{0, 0.5f, 0}, 0.3f};
+        s.job.spheres = &sp, s.job.sphere_count = 1, s.job.friction = 0.3f, s.job.damping = 0.5f;
+        s.job.substeps = 4;
+        s.job.position_residuals = (ak_vec3_span){res, s.n};
+        s.job.thread_count = counts[k];
+        sim_scratch(&s);
+        for (int f = 0; f < STEPS; ++f) AK_CHECK_EQ(ak_cloth_step_run(&s.job), AK_OK);
+        out[k] = malloc(3 * s.n * sizeof(ak_vec3));
+        memcpy(out[k], s.x, s.n * sizeof(ak_vec3));
+        memcpy(out[k] + s.n, s.v, s.n * sizeof(ak_vec3));
+        memcpy(out[k] + 2 * s.n, res, s.n * sizeof(ak_vec3));
+        for (int p = 0; p < 2; ++p) {
+            const ak_vec3 r0 = res[pins[p]];
+            AK_CHECK(r0.x == 0.0f && r0.y == 0.0f && r0.z == 0.0f);
+        }
+        /* the sheet moved: not a trivially equal rest state */
+        AK_CHECK(s.x[W * W / 2].y < 1.0f - 1e-3f);
+        if (k > 0)
+            AK_CHECK_MSG(memcmp(out[0], out[k], 3 * s.n * sizeof(ak_vec3)) == 0, "%u threads differ from 1", counts[k]);
+        free(res);
+        sim_free(&s);
+    }
+    for (int k = 0; k < 4; ++k) free(out[k]);
+}
+
 /* Smooth normals of a flat sheet are u x v; of a folded one, unit and area-weighted. */
 AK_TEST(normals) {
     ak_cloth_desc d = {.grid_width = 5, .grid_height = 4, .grid_axis_u = {0, 0, 1}, .grid_axis_v = {0, 1, 0}};
@@ -1097,6 +1138,7 @@ int main(void) {
     AK_RUN(springs_blow_up_reported);
     AK_RUN(springs_stable_substep);
     AK_RUN(deterministic_for_any_thread_count);
+    AK_RUN(default_thread_bound_bit_identical);
     AK_RUN(normals);
     AK_RUN(wind_drag_direction);
     AK_RUN(simd_paths_bit_identical);

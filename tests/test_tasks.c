@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "ak_test.h"
+#include "csort.h"
 #include "tasks.h"
 
 typedef struct probe {
@@ -256,6 +257,147 @@ AK_TEST(profile_counts_sections_waits_and_barriers) {
     AK_CHECK_EQ(pr.sections, 0u); /* enabling reset the counts; off counts nothing */
 }
 
+/* ---- CPU time per phase --------------------------------------------------------------------- */
+
+static double thread_cpu_ms(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+/* Burn `ms` of this thread's CPU time (CPU, not wall: a loaded machine only makes it slower). */
+static void burn_cpu_ms(double ms) {
+    const double until = thread_cpu_ms() + ms;
+    volatile unsigned x = 1;
+    while (thread_cpu_ms() < until) {
+        for (int k = 0; k < 1000; ++k) x = x * 1664525u + 1013904223u;
+    }
+}
+
+typedef struct burner {
+    akp_barrier* barrier;
+    uint32_t index;
+    int nested_errors;
+    double nested_ms; /* CPU time of task 1's nested job: imbalance of phase 1 */
+} burner;
+
+/* Phase 0: task 0 alone works 3 ms (a serial part inside the section); phase 1: every task 2 ms,
+ * task 1 also running a phased job of its own (fresh threads, barriers that are not this run's:
+ * part of its phase, not phases of their own). */
+static void* burner_task(void* arg) {
+    burner* b = (burner*)arg;
+    if (b->index == 0) burn_cpu_ms(3.0);
+    akp_barrier_wait(b->barrier);
+    if (b->index == 1) {
+        const double t0 = thread_cpu_ms();
+        b->nested_errors = run_phased(2, 5);
+        b->nested_ms = thread_cpu_ms() - t0;
+    }
+    burn_cpu_ms(2.0);
+    return NULL;
+}
+
+AK_TEST(profile_cpu_time_per_phase) {
+    enum { STEPS = 3, T = 3 };
+    double nested_ms = 0.0;
+    akp_tasks_profile_enable(true);
+    for (int s = 0; s < STEPS; ++s) {
+        akp_tasks_profile_step();
+        burn_cpu_ms(1.5); /* serial, before the section */
+        akp_barrier bar;
+        akp_barrier_init(&bar, T);
+        burner tasks[T];
+        for (uint32_t t = 0; t < T; ++t) tasks[t] = (burner){&bar, t, 0, 0.0};
+        akp_team_run run;
+        AK_CHECK(akp_team_begin(&run, burner_task, tasks, sizeof(burner), T));
+        burner_task(&tasks[0]);
+        akp_team_end(&run);
+        akp_barrier_destroy(&bar);
+        AK_CHECK_EQ(tasks[1].nested_errors, 0);
+        nested_ms += tasks[1].nested_ms;
+        burn_cpu_ms(1.0); /* serial tail */
+    }
+    akp_phase_cpu ph[AKP_PHASES_MAX];
+    const size_t n = akp_tasks_profile_phases(ph, AKP_PHASES_MAX);
+    akp_tasks_profile_enable(false);
+    AK_CHECK_EQ(n, 4u); /* serial, phase 0, phase 1, serial tail */
+    if (n != 4) return;
+    const double tol = 0.4 * STEPS; /* ms: clock reads, wake-ups, the barrier */
+    AK_CHECK_EQ(ph[0].threads, 1u);
+    AK_CHECK_EQ(ph[0].runs, (uint64_t)STEPS);
+    AK_CHECK_NEAR(1e3 * ph[0].serial_s, 1.5 * STEPS, tol);
+    AK_CHECK_EQ(ph[1].threads, (uint32_t)T);
+    AK_CHECK_NEAR(1e3 * ph[1].serial_s, 3.0 * STEPS, tol);
+    AK_CHECK_NEAR(1e3 * ph[1].parallel_s, 0.0, tol);
+    AK_CHECK_NEAR(1e3 * ph[1].critical_s, 3.0 * STEPS, tol);
+    /* phase 1: task 1's nested job is its excess over the others (w = 2, 2 + x, 2 ms) */
+    AK_CHECK_NEAR(1e3 * ph[2].serial_s, nested_ms, tol);
+    AK_CHECK_NEAR(1e3 * ph[2].parallel_s, 2.0 * T * STEPS, tol);
+    AK_CHECK_NEAR(1e3 * ph[2].critical_s, 2.0 * STEPS + nested_ms, tol);
+    AK_CHECK_EQ(ph[3].threads, 1u);
+    AK_CHECK_NEAR(1e3 * ph[3].serial_s, 1.0 * STEPS, tol);
+    /* off: nothing recorded, and enabling cleared the phases */
+    akp_tasks_profile_step();
+    AK_CHECK_EQ(akp_tasks_profile_phases(ph, AKP_PHASES_MAX), 0u);
+}
+
+/* ---- akp_csort ------------------------------------------------------------------------------ */
+
+typedef struct keyed {
+    uint32_t key, index;
+} keyed;
+
+static int keyed_cmp(const void* a, const void* b) {
+    const keyed *x = (const keyed*)a, *y = (const keyed*)b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return x->index < y->index ? -1 : x->index > y->index; /* (key, index): the stable order */
+}
+
+/* Against qsort on (key, index) pairs, for bucket counts below, at and far above the part
+ * count, empty inputs and one bucket, with 1 to 64 parts: the same order and bucket starts. */
+AK_TEST(counting_sort_is_stable_and_split_free) {
+    const size_t sizes[] = {0, 1, 7, 1000, 30011};
+    const uint32_t buckets[] = {1, 3, 16, 1000, 200000};
+    const uint32_t parts[] = {1, 2, 3, 5, 16, 64};
+    uint32_t state = 12345u;
+    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; ++si)
+        for (size_t bi = 0; bi < sizeof buckets / sizeof buckets[0]; ++bi) {
+            const size_t n = sizes[si];
+            const uint32_t B = buckets[bi];
+            uint32_t* keys = malloc((n + 1) * sizeof(uint32_t));
+            keyed* ref = malloc((n + 1) * sizeof(keyed));
+            uint32_t* ref_start = calloc((size_t)B + 1, sizeof(uint32_t));
+            for (size_t i = 0; i < n; ++i) {
+                state = state * 1664525u + 1013904223u;
+                /* clustered keys: many duplicates, some buckets empty */
+                keys[i] = (uint32_t)((state >> 8) % B);
+                if (state & 1u) keys[i] &= ~3u;
+                if (keys[i] >= B) keys[i] = B - 1;
+                ref[i] = (keyed){keys[i], (uint32_t)i};
+                ref_start[keys[i] + 1]++;
+            }
+            for (uint32_t k = 0; k < B; ++k) ref_start[k + 1] += ref_start[k];
+            qsort(ref, n, sizeof(keyed), keyed_cmp);
+            for (size_t pi = 0; pi < sizeof parts / sizeof parts[0]; ++pi) {
+                akp_csort* cs = malloc(sizeof *cs);
+                uint32_t* order = malloc((n + 1) * sizeof(uint32_t));
+                uint32_t* start = malloc(((size_t)B + 1) * sizeof(uint32_t));
+                uint32_t* tmp = malloc((2 * n + 1) * sizeof(uint32_t));
+                for (size_t i = 0; i < n; ++i) order[i] = 0xdeadbeefu;
+                for (uint32_t k = 0; k <= B; ++k) start[k] = 0xdeadbeefu;
+                *cs = (akp_csort){.keys = keys, .n = n, .buckets = B, .parts = parts[pi], .order = order,
+                                  .start = start, .tmp = tmp};
+                akp_csort_run(cs);
+                size_t bad = 0;
+                for (size_t i = 0; i < n; ++i) bad += order[i] != ref[i].index;
+                for (uint32_t k = 0; k <= B; ++k) bad += start[k] != ref_start[k];
+                AK_CHECK_MSG(bad == 0, "n %zu, %u buckets, %u parts: %zu wrong", n, B, parts[pi], bad);
+                free(cs), free(order), free(start), free(tmp);
+            }
+            free(keys), free(ref), free(ref_start);
+        }
+}
+
 int main(void) {
     AK_RUN(every_task_once_on_its_own_thread);
     AK_RUN(tasks_run_at_the_same_time);
@@ -266,5 +408,7 @@ int main(void) {
     AK_RUN(team_run_with_barriers);
     AK_RUN(team_run_from_inside_a_task);
     AK_RUN(profile_counts_sections_waits_and_barriers);
+    AK_RUN(profile_cpu_time_per_phase);
+    AK_RUN(counting_sort_is_stable_and_split_free);
     return ak_test_finish();
 }

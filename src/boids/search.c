@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "boids_internal.h"
+#include "../csort.h"
 #include "../simd.h"
 
 /* ---- the per-candidate rules ----------------------------------------------------------- */
@@ -947,6 +948,46 @@ static void* fill_thread(void* arg) {
     return NULL;
 }
 
+/* The dense layout's parts (akp_boids_search_prepare): agents [n part / parts, n (part + 1) /
+ * parts) for the box indices, cells [volume part / parts, ...) for the load. */
+typedef struct box_task {
+    const akp_boids_ctx* c;
+    const int32_t* cells;
+    uint32_t* keys;
+    const uint32_t* start;
+    size_t volume;
+    uint32_t part, parts;
+    uint64_t load;
+} box_task;
+
+static void* keys_thread(void* arg) {
+    box_task* t = (box_task*)arg;
+    const akp_boids_ctx* c = t->c;
+    const size_t dimx = (size_t)c->dense_dim[0], dimxy = dimx * (size_t)c->dense_dim[1];
+    const int32_t* cells = t->cells;
+    for (size_t i = c->n * t->part / t->parts, e = c->n * (t->part + 1) / t->parts; i < e; ++i)
+        t->keys[i] = (uint32_t)((size_t)(cells[3 * i + 2] - c->dense_min[2]) * dimxy +
+                                (size_t)(cells[3 * i + 1] - c->dense_min[1]) * dimx +
+                                (size_t)(cells[3 * i] - c->dense_min[0]));
+    return NULL;
+}
+
+static void* load_thread(void* arg) {
+    box_task* t = (box_task*)arg;
+    uint64_t load = 0;
+    for (size_t b = t->volume * t->part / t->parts, e = t->volume * (t->part + 1) / t->parts; b < e; ++b) {
+        const uint64_t k = t->start[b + 1] - t->start[b];
+        load += k * k;
+    }
+    t->load = load;
+    return NULL;
+}
+
+static void run_parts(void* (*fn)(void*), void* tasks, size_t size, uint32_t parts) {
+    if (parts == 1) fn(tasks);
+    else akp_boids_run_tasks(fn, tasks, size, parts);
+}
+
 /* The job's budget on the sum over cells of (agents in the cell)^2 (boids.h). */
 static uint64_t cell_budget(const akp_boids_ctx* c) {
     return c->job->max_cell_load ? c->job->max_cell_load : AK_BOIDS_DEFAULT_CELL_LOAD;
@@ -1015,27 +1056,28 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
         }
         return AK_OK;
     }
-    /* Counting sort of the agents into the box's (z, y, x) cell order, stable. */
+    /* Counting sort of the agents into the box's (z, y, x) cell order, stable, over the team
+     * (src/csort.h; the same order for any thread count): the box indices go to sx, the sort's
+     * scratch to qv (both filled only later, by akp_boids_search_fill). */
     const size_t volume = (size_t)c->dense_dim[0] * (size_t)c->dense_dim[1] * (size_t)c->dense_dim[2];
-    const size_t dimx = (size_t)c->dense_dim[0], dimxy = dimx * (size_t)c->dense_dim[1];
-    uint32_t* idx = (uint32_t*)(void*)cells; /* overwrites cells[i] with i's box index: i <= 3i */
-    memset(dstart, 0, (volume + 1) * sizeof(uint32_t));
-    for (size_t i = 0; i < n; ++i) {
-        const size_t b = (size_t)(cells[3 * i + 2] - c->dense_min[2]) * dimxy +
-                         (size_t)(cells[3 * i + 1] - c->dense_min[1]) * dimx + (size_t)(cells[3 * i] - c->dense_min[0]);
-        idx[i] = (uint32_t)b;
-        dstart[b + 1]++;
+    const uint32_t sort_parts = n < 2048 ? 1u : akp_boids_threads(c->job->thread_count, n);
+    uint32_t* keys = (uint32_t*)(void*)sx;
+    {
+        box_task tasks[64];
+        for (uint32_t t = 0; t < sort_parts; ++t) tasks[t] = (box_task){c, cells, keys, NULL, volume, t, sort_parts, 0};
+        run_parts(keys_thread, tasks, sizeof tasks[0], sort_parts);
+        akp_csort cs_store; /* 16 KiB of counts: on the stack, not in the context */
+        akp_csort* cs = &cs_store;
+        *cs = (akp_csort){.keys = keys, .n = n, .buckets = (uint32_t)volume, .parts = sort_parts, .order = sj,
+                          .start = dstart, .tmp = (uint32_t*)(void*)qv};
+        akp_csort_run(cs);
+        /* the budget: the sum over cells of (agents in the cell)^2, per range of cells */
+        for (uint32_t t = 0; t < sort_parts; ++t) tasks[t].start = dstart;
+        run_parts(load_thread, tasks, sizeof tasks[0], sort_parts);
+        uint64_t load = 0;
+        for (uint32_t t = 0; t < sort_parts; ++t) load += tasks[t].load;
+        if (load > cell_budget(c)) return AK_ERR_BUDGET;
     }
-    uint64_t load = 0;
-    for (size_t b = 0; b < volume; ++b) {
-        load += (uint64_t)dstart[b + 1] * dstart[b + 1];
-        dstart[b + 1] += dstart[b];
-    }
-    if (load > cell_budget(c)) return AK_ERR_BUDGET;
-    for (size_t i = 0; i < n; ++i) sj[dstart[idx[i]]++] = (uint32_t)i;
-    /* dstart[b] is now the end of cell b: shift back to starts. */
-    memmove(dstart + 1, dstart, volume * sizeof(uint32_t));
-    dstart[0] = 0;
     c->sx = sx;
     c->sy = sy;
     c->sz = sz;

@@ -25,8 +25,11 @@
  * share of a colour must be thousands of constraints to outweigh a meeting (about a microsecond
  * between two running threads, a scheduler time slice when the partner was descheduled): XPBD
  * and PBD use at most one thread per this many constraints of an average colour, unless the job
- * asks for exact_thread_count. */
-#define THREAD_MIN_PER_COLOR 8192u
+ * asks for exact_thread_count. 1024 (was 8192, which held a 256^2 grid to 4 threads and a 512^2
+ * one to 16 of 64): a share of 1024 constraints is 2-5 us of work against a ~1 us meeting, and
+ * the per-phase CPU profile (bench_scaling --cpu) predicts 16 threads on 256^2 at about half
+ * the efficiency of 512^2 rather than a quarter (docs/BENCHMARKS.md, issue 35). */
+#define THREAD_MIN_PER_COLOR 1024u
 
 /* ---- scratch layout --------------------------------------------------------------------- */
 
@@ -172,6 +175,7 @@ typedef struct ctx {
     uint32_t cg_max;     /* IMPLICIT: most CG iterations per substep */
     int simd;            /* 0 scalar, 1 AVX2, 2 AVX-512 */
     akp_barrier bar; /* the step's team meets here between phases (src/tasks.h) */
+    bool finite[MAX_THREADS]; /* per thread: its vertices ended finite */
 } ctx;
 
 typedef struct worker {
@@ -738,6 +742,13 @@ static void run_spmd(ctx* c, unsigned t) {
     size_t tb, te;
     range(n, t, c->T, &b, &e);
     range(cl->tri_count, t, c->T, &tb, &te);
+    /* displacements start at the residuals (the part of the position the float missed) */
+    ak_vec3* const res = job->position_residuals.ptr;
+    for (size_t v = b; v < e; ++v) {
+        const ak_vec3 d0 = res && cl->inv_mass[v] > 0.0f ? res[v] : ak_vec3_make(0, 0, 0);
+        c->x[v] = (akp_px){d0, cl->inv_mass[v]};
+        c->prev[v] = (akp_px){d0, 0.0f};
+    }
     memset(c->ext + b, 0, (e - b) * sizeof(ak_vec3));
     /* the constraints' vectors at the start of the step (XPBD/PBD solves add the displacements) */
     if (!akp_spring_solver(cl->desc.solver)) {
@@ -882,6 +893,18 @@ static void run_spmd(ctx* c, unsigned t) {
         }
         barrier(c);
     }
+    /* the end of the step: start + displacement (nobody reads the start positions any more) */
+    bool finite = true;
+    for (size_t v = b; v < e; ++v) {
+        const ak_vec3 x0 = job->positions.ptr[v], d = c->x[v].p, x1 = ak_vec3_add(x0, d);
+        job->positions.ptr[v] = x1;
+        /* what the rounding lost: d - (x1 - x0), both differences exact for |d| << |x0|
+         * (Sterbenz); kept when the caller keeps residuals (kinematic particles: none).
+         * Velocities stay the integrated ones */
+        if (res) res[v] = cl->inv_mass[v] == 0.0f ? ak_vec3_make(0, 0, 0) : ak_vec3_sub(d, ak_vec3_sub(x1, x0));
+        finite = finite && ak_vec3_is_finite(d) && ak_vec3_is_finite(c->v[v]);
+    }
+    c->finite[t] = finite;
 }
 
 const char* ak_cloth_simd_name(void) {
@@ -934,12 +957,6 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.cg_max = job->iterations ? job->iterations : 100;
     /* displacements start at the residuals (the part of the position the float missed) */
     c.base = job->positions.ptr;
-    ak_vec3* const res = job->position_residuals.ptr;
-    for (size_t v = 0; v < cl->n; ++v) {
-        const ak_vec3 d0 = res && cl->inv_mass[v] > 0.0f ? res[v] : ak_vec3_make(0, 0, 0);
-        c.x[v] = (akp_px){d0, cl->inv_mass[v]};
-        c.prev[v] = (akp_px){d0, 0.0f};
-    }
     c.solve = (akp_solve){.cl = cl, .x = c.x, .prev = c.prev, .lambda = c.lambda, .h = c.h, .h2 = c.h * c.h,
                           .beta = cl->desc.constraint_damping, .pbd_stiffness = cl->desc.pbd_stiffness,
                           .bend_alpha = 1.0f / cl->desc.dihedral_stiffness, .pbd = cl->desc.solver == AK_CLOTH_PBD,
@@ -984,21 +1001,12 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
         akp_team_end(&team);
         akp_barrier_destroy(&c.bar);
     }
-    /* the end of the step: start + displacement, kinematic particles exactly at their targets */
+    /* the end of the step (each thread's vertices: run_spmd), then kinematic particles exactly
+     * at their targets */
     bool finite = true;
-    for (size_t v = 0; v < cl->n; ++v) {
-        const ak_vec3 x0 = job->positions.ptr[v], d = c.x[v].p, x1 = ak_vec3_add(x0, d);
-        job->positions.ptr[v] = x1;
-        /* what the rounding lost: d - (x1 - x0), both differences exact for |d| << |x0|
-         * (Sterbenz); kept when the caller keeps residuals. Velocities stay the integrated ones */
-        if (res) res[v] = ak_vec3_sub(d, ak_vec3_sub(x1, x0));
-
-        finite = finite && ak_vec3_is_finite(d) && ak_vec3_is_finite(c.v[v]);
-    }
+    for (unsigned t = 0; t < c.T; ++t) finite = finite && c.finite[t];
     for (size_t k = 0; k < cl->pin_count; ++k) job->positions.ptr[cl->pins[k]] = cl->pin_pos[k];
     for (size_t k = 0; k < cl->attach_count; ++k) job->positions.ptr[cl->attach[k]] = job->attachment_targets.ptr[k];
-    for (size_t v = 0; v < cl->n && res; ++v)
-        if (cl->inv_mass[v] == 0.0f) res[v] = ak_vec3_make(0, 0, 0);
     if (!finite) return AK_ERR_NO_CONVERGENCE;
     if (job->out_normals.ptr)
         ak_cloth_normals(cl, (ak_vec3_cspan){job->positions.ptr, cl->n}, job->out_normals);

@@ -63,6 +63,10 @@ typedef struct akp_fluid_ctx {
     /* per-thread results */
     size_t truncated[AKP_FLUID_MAX_THREADS];
     size_t coincident[AKP_FLUID_MAX_THREADS];
+    float box_lo[AKP_FLUID_MAX_THREADS][3], box_hi[AKP_FLUID_MAX_THREADS][3]; /* predictions' bounds */
+    bool box_bad[AKP_FLUID_MAX_THREADS];                                       /* a non-finite one */
+    struct akp_csort* csort; /* fluid.c: the dense cell sort over the team */
+    struct akp_fluid_stats_part* stats; /* fluid.c: the statistics' partials per chunk */
 } akp_fluid_ctx;
 
 /* Neighbour q of sorted particle a is akp_fluid_nb(c, a)[16 q]: particles come in blocks of
