@@ -8,6 +8,7 @@
 #include <animkit/noise.h>
 
 #include "ak_test.h"
+#include "noise/noise_internal.h" /* akp_floor, akp_floor_frac */
 #include "ref/ref_noise.h"
 
 /* Big runs (10^7 points for the ranges) only in optimised builds outside valgrind;
@@ -856,8 +857,42 @@ AK_TEST(sway_layer) {
     AK_CHECK_EQ(ak_noise_sway_validate(&job2), AK_ERR_BAD_DATA);
 }
 
+/* akp_floor / akp_floor_frac (the per-point functions' floor) give libm's floorf bit for bit:
+ * every 61st float pattern below the 2^24 limit of either sign, and around every integer
+ * within 4096 of zero the integer itself, both neighbours and +-0. */
+static int floor_mismatch(float x) {
+    int i = 7, j = 7;
+    const float fl = akp_floor(x, &i), fr = akp_floor_frac(x, &j);
+    const float want = floorf(x), want_fr = x - want;
+    return memcmp(&fl, &want, sizeof fl) != 0 || memcmp(&fr, &want_fr, sizeof fr) != 0 || i != (int)want ||
+           j != (int)want;
+}
+
+AK_TEST(floor_matches_libm) {
+    long bad = 0, count = 0;
+    for (uint32_t bits = 0; bits < 0x4B800000u; bits += 61u)
+        for (uint32_t sign = 0; sign < 2; ++sign) {
+            const uint32_t b = bits | sign << 31;
+            float x;
+            memcpy(&x, &b, sizeof x);
+            bad += floor_mismatch(x), ++count;
+        }
+    for (int k = -4096; k <= 4096; ++k) {
+        const float x = (float)k;
+        bad += floor_mismatch(x) + floor_mismatch(nextafterf(x, -INFINITY)) + floor_mismatch(nextafterf(x, INFINITY));
+        count += 3;
+    }
+    bad += floor_mismatch(0.0f) + floor_mismatch(-0.0f) + floor_mismatch(nextafterf(16777216.0f, 0.0f)) +
+           floor_mismatch(-nextafterf(16777216.0f, 0.0f));
+    AK_CHECK_MSG(bad == 0, "%ld of %ld floors differ from floorf", bad, count + 4);
+    float x = -0.0f; /* the one case truncation alone gets wrong in sign */
+    int i;
+    AK_CHECK(signbit(akp_floor(x, &i)) && i == 0 && !signbit(akp_floor_frac(x, &i)));
+}
+
 int main(void) {
     AK_RUN(permutations);
+    AK_RUN(floor_matches_libm);
     AK_RUN(perlin3_published_value);
     AK_RUN(perlin_matches_reference);
     AK_RUN(zero_at_lattice);

@@ -41,11 +41,12 @@ float ak_noise_simplex2(const ak_noise* noise, float x, float y, float* out_grad
     if (!noise || !all_finite(2, p)) return 0.0f;
     const float F2 = 0.36602540378f, G2 = 0.2113248654f; /* (sqrt 3 - 1) / 2, (3 - sqrt 3) / 6 */
     const float s = (x + y) * F2;
-    const float fi = floorf(x + s), fj = floorf(y + s);
+    int ii, jj;
+    const float fi = akp_floor(x + s, &ii), fj = akp_floor(y + s, &jj);
     const float t = (fi + fj) * G2;
     const float x0 = x - (fi - t), y0 = y - (fj - t);
     const int i1 = x0 > y0 ? 1 : 0, j1 = 1 - i1;
-    const int ii = (int)fi & 255, jj = (int)fj & 255;
+    ii &= 255, jj &= 255;
     const uint8_t* perm = noise->perm;
     const int h[3] = {perm[perm[ii] + jj], perm[perm[ii + i1] + jj + j1], perm[perm[ii + 1] + jj + 1]};
     const float d[3][2] = {{x0, y0}, {x0 - (float)i1 + G2, y0 - (float)j1 + G2}, {x0 - 1.0f + 2.0f * G2, y0 - 1.0f + 2.0f * G2}};
@@ -61,7 +62,8 @@ float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float*
     if (!noise || !all_finite(3, p)) return 0.0f;
     const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
     const float s = (x + y + z) * F3;
-    const float fi = floorf(x + s), fj = floorf(y + s), fk = floorf(z + s);
+    int ii, jj, kk;
+    const float fi = akp_floor(x + s, &ii), fj = akp_floor(y + s, &jj), fk = akp_floor(z + s, &kk);
     const float t = (fi + fj + fk) * G3;
     const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
     /* the simplex: the order of x0, y0, z0 from largest to smallest */
@@ -75,7 +77,7 @@ float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float*
         else if (x0 < z0) o1[0] = 0, o1[1] = 1, o1[2] = 0, o2[0] = 0, o2[1] = 1, o2[2] = 1;
         else o1[0] = 0, o1[1] = 1, o1[2] = 0, o2[0] = 1, o2[1] = 1, o2[2] = 0;
     }
-    const int ii = (int)fi & 255, jj = (int)fj & 255, kk = (int)fk & 255;
+    ii &= 255, jj &= 255, kk &= 255;
     const uint8_t* perm = noise->perm;
     const int offs[4][3] = {{0, 0, 0}, {o1[0], o1[1], o1[2]}, {o2[0], o2[1], o2[2]}, {1, 1, 1}};
     float sum = 0.0f, g[3] = {0, 0, 0};
@@ -152,9 +154,8 @@ static inline __attribute__((always_inline)) float value_n(const ak_noise* noise
     float f[4];
 #pragma GCC unroll 4
     for (uint32_t k = 0; k < dims; ++k) {
-        const float fl = floorf(point[k]);
-        const int i = (int)fl;
-        f[k] = point[k] - fl;
+        int i;
+        f[k] = akp_floor_frac(point[k], &i);
         lo[k] = i & 255;
         hi[k] = (i + 1) & 255;
     }
@@ -340,9 +341,7 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
     int base[3] = {0, 0, 0};
     float f[3] = {0, 0, 0}, margin = 1.0f;
     for (uint32_t k = 0; k < dimensions; ++k) {
-        const float fl = floorf(point[k]);
-        base[k] = (int)fl;
-        f[k] = point[k] - fl;
+        f[k] = akp_floor_frac(point[k], &base[k]);
         const float g = f[k] < 1.0f - f[k] ? f[k] : 1.0f - f[k]; /* fminf without the libm call */
         margin = g < margin ? g : margin;
     }

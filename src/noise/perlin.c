@@ -171,9 +171,8 @@ static inline __attribute__((always_inline)) float perlin_n(const ak_noise* nois
                 for (uint32_t m = 0; m < dims; ++m) grad[m] = 0.0f;
             return 0.0f;
         }
-        const float fl = floorf(p[k]);
-        const int i = (int)fl;
-        f[k] = p[k] - fl;
+        int i;
+        f[k] = akp_floor_frac(p[k], &i);
         if (period) {
             const int per = period[k];
             int w = i % per;
