@@ -14,7 +14,7 @@ LIB=$(find "$BUILD" -maxdepth 2 -name 'libanimkit.a' | head -1); [[ -n $LIB ]] |
 OUT=$(mktemp -d); trap 'rm -rf "$OUT"' EXIT
 mkdir -p "$OUT/old"
 git -C "$ROOT" archive "$REV" src/noise include | tar -x -C "$OUT/old"
-CFLAGS="-O3 -DNDEBUG -std=c11 -fno-math-errno -ffp-contract=off -D_POSIX_C_SOURCE=200809L ${EXTRA_CFLAGS:-}"
+CFLAGS="-O3 -DNDEBUG -std=c11 -Wall -Wextra -Wpedantic -fno-math-errno -ffp-contract=off -D_POSIX_C_SOURCE=200809L ${EXTRA_CFLAGS:-}"
 for side in old new; do
   src=$([[ $side == old ]] && echo "$OUT/old" || echo "$ROOT")
   objs=()

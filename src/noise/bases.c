@@ -35,6 +35,19 @@ static float simplex_corner(uint32_t dims, float r0, const float* d, const float
     return t4 * gd;
 }
 
+/* simplex_corner's value without the branch (r0 = 1/2): where t <= 0 the term is t^4 gd with t
+ * = 0, a zero of either sign instead of +0.0, which leaves the sum unchanged: the sum starts at
+ * +0.0 and a round-to-nearest sum is -0.0 only when both terms are, so it is never -0.0, and
+ * s + (+-0.0) is s. */
+static inline __attribute__((always_inline)) float simplex_corner_value(uint32_t dims, const float* d, const float* g) {
+    float r2 = 0.0f, gd = 0.0f;
+    for (uint32_t k = 0; k < dims; ++k) r2 += d[k] * d[k], gd += g[k] * d[k];
+    float t = 0.5f - r2;
+    t = t > 0.0f ? t : 0.0f;
+    const float t2 = t * t;
+    return t2 * t2 * gd;
+}
+
 float ak_noise_simplex2(const ak_noise* noise, float x, float y, float* out_gradient) {
     const float p[2] = {x, y};
     zero_grad(out_gradient, 2);
@@ -51,32 +64,81 @@ float ak_noise_simplex2(const ak_noise* noise, float x, float y, float* out_grad
     const int h[3] = {perm[perm[ii] + jj], perm[perm[ii + i1] + jj + j1], perm[perm[ii + 1] + jj + 1]};
     const float d[3][2] = {{x0, y0}, {x0 - (float)i1 + G2, y0 - (float)j1 + G2}, {x0 - 1.0f + 2.0f * G2, y0 - 1.0f + 2.0f * G2}};
     float sum = 0.0f, g[2] = {0, 0};
-    for (int c = 0; c < 3; ++c) sum += simplex_corner(2, 0.5f, d[c], simplex_g2[h[c] & 7], out_gradient ? g : NULL);
+    for (int c = 0; c < 3; ++c)
+        sum += out_gradient ? simplex_corner(2, 0.5f, d[c], simplex_g2[h[c] & 7], g) : simplex_corner_value(2, d[c], simplex_g2[h[c] & 7]);
     if (out_gradient) out_gradient[0] = 70.0f * g[0], out_gradient[1] = 70.0f * g[1];
     return 70.0f * sum;
+}
+
+/* simplex_corner_value for 3D with the offset in three scalars (an array here made gcc store
+ * the floats one by one and load them back as a pair, a store-forwarding stall). */
+static inline __attribute__((always_inline)) float simplex3_corner_value(float dx, float dy, float dz, const float* g) {
+    const float r2 = ((0.0f + dx * dx) + dy * dy) + dz * dz;
+    const float gd = ((0.0f + g[0] * dx) + g[1] * dy) + g[2] * dz;
+    const float t = 0.5f - r2;
+    if (t <= 0.0f) return 0.0f;
+    const float t2 = t * t;
+    return t2 * t2 * gd;
+}
+
+/* simplex3's o1 and o2 as floats, by (x0 >= y0) | (y0 >= z0) << 1 | (x0 >= z0) << 2 (two of the
+ * eight cannot occur: the comparisons of finite floats are transitive). */
+static const float simplex3_steps[8][2][3] = {
+    {{0.0f, 0.0f, 1.0f}, {0.0f, 1.0f, 1.0f}},
+    {{0.0f, 0.0f, 1.0f}, {1.0f, 0.0f, 1.0f}},
+    {{0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 1.0f}},
+    {{0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}},
+    {{0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}},
+    {{1.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 1.0f}},
+    {{0.0f, 1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}},
+    {{1.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 0.0f}},
+};
+
+/* ak_noise_simplex3's value without the gradient for finite x, y, z: the same operations, the
+ * corner offsets from simplex3_steps (no branches on the order: random points mispredict
+ * them) and the corner terms from simplex3_corner_value. */
+static inline __attribute__((always_inline)) float simplex3_value(const uint8_t* perm, float x, float y, float z) {
+    const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
+    const float s = (x + y + z) * F3;
+    int ii, jj, kk;
+    /* a floor of -0.0 only when x, y and z are all -0.0; then fi - t is +0.0 with either zero */
+    const float fi = akp_floor_unsigned_zero(x + s, &ii), fj = akp_floor_unsigned_zero(y + s, &jj),
+                fk = akp_floor_unsigned_zero(z + s, &kk);
+    const float t = (fi + fj + fk) * G3;
+    const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
+    const int xy = x0 >= y0, yz = y0 >= z0, xz = x0 >= z0;
+    const float(*st)[3] = simplex3_steps[xy | yz << 1 | xz << 2];
+    const int o1[3] = {xy & xz, (xy ^ 1) & yz, (xz ^ 1) & (yz ^ 1)}, o2[3] = {xy | xz, (xy ^ 1) | yz, (xz ^ 1) | (yz ^ 1)};
+    ii &= 255, jj &= 255, kk &= 255;
+    const int h0 = perm[perm[perm[ii] + jj] + kk];
+    const int h1 = perm[perm[perm[ii + o1[0]] + jj + o1[1]] + kk + o1[2]];
+    const int h2 = perm[perm[perm[ii + o2[0]] + jj + o2[1]] + kk + o2[2]];
+    const int h3 = perm[perm[perm[ii + 1] + jj + 1] + kk + 1];
+    const float k1 = 1.0f * G3, k2 = 2.0f * G3, k3 = 3.0f * G3;
+    float sum = 0.0f;
+    sum += simplex3_corner_value(x0 - 0.0f + 0.0f, y0 - 0.0f + 0.0f, z0 - 0.0f + 0.0f, simplex_g3[h0 & 15]);
+    sum += simplex3_corner_value(x0 - st[0][0] + k1, y0 - st[0][1] + k1, z0 - st[0][2] + k1, simplex_g3[h1 & 15]);
+    sum += simplex3_corner_value(x0 - st[1][0] + k2, y0 - st[1][1] + k2, z0 - st[1][2] + k2, simplex_g3[h2 & 15]);
+    sum += simplex3_corner_value(x0 - 1.0f + k3, y0 - 1.0f + k3, z0 - 1.0f + k3, simplex_g3[h3 & 15]);
+    return 76.0f * sum;
 }
 
 float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
     const float p[3] = {x, y, z};
     zero_grad(out_gradient, 3);
     if (!noise || !all_finite(3, p)) return 0.0f;
+    if (!out_gradient) return simplex3_value(noise->perm, x, y, z);
     const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
     const float s = (x + y + z) * F3;
     int ii, jj, kk;
     const float fi = akp_floor(x + s, &ii), fj = akp_floor(y + s, &jj), fk = akp_floor(z + s, &kk);
     const float t = (fi + fj + fk) * G3;
     const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
-    /* the simplex: the order of x0, y0, z0 from largest to smallest */
-    int o1[3], o2[3];
-    if (x0 >= y0) {
-        if (y0 >= z0) o1[0] = 1, o1[1] = 0, o1[2] = 0, o2[0] = 1, o2[1] = 1, o2[2] = 0;
-        else if (x0 >= z0) o1[0] = 1, o1[1] = 0, o1[2] = 0, o2[0] = 1, o2[1] = 0, o2[2] = 1;
-        else o1[0] = 0, o1[1] = 0, o1[2] = 1, o2[0] = 1, o2[1] = 0, o2[2] = 1;
-    } else {
-        if (y0 < z0) o1[0] = 0, o1[1] = 0, o1[2] = 1, o2[0] = 0, o2[1] = 1, o2[2] = 1;
-        else if (x0 < z0) o1[0] = 0, o1[1] = 1, o1[2] = 0, o2[0] = 0, o2[1] = 1, o2[2] = 1;
-        else o1[0] = 0, o1[1] = 1, o1[2] = 0, o2[0] = 1, o2[1] = 1, o2[2] = 0;
-    }
+    /* the simplex: the order of x0, y0, z0 from largest to smallest, as Gustavson's six
+     * branches give it (the comparisons of finite floats are transitive, so o1 is the
+     * largest axis, o2 the two largest), without branches: random points mispredict them */
+    const int xy = x0 >= y0, yz = y0 >= z0, xz = x0 >= z0;
+    const int o1[3] = {xy & xz, (xy ^ 1) & yz, (xz ^ 1) & (yz ^ 1)}, o2[3] = {xy | xz, (xy ^ 1) | yz, (xz ^ 1) | (yz ^ 1)};
     ii &= 255, jj &= 255, kk &= 255;
     const uint8_t* perm = noise->perm;
     const int offs[4][3] = {{0, 0, 0}, {o1[0], o1[1], o1[2]}, {o2[0], o2[1], o2[2]}, {1, 1, 1}};

@@ -29,9 +29,32 @@ static inline float akp_floor(float x, int* out_i) {
     return copysignf(ft - one, x);
 }
 
-/* x - floorf(x) (the fraction in [0, 1); +0.0 for -0.0 as x - floorf(x) gives) and floorf(x)
- * as an int, in one. */
-static inline float akp_floor_frac(float x, int* out_i) { return x - akp_floor(x, out_i); }
+/* akp_floor without the sign step: floorf(x) except +0.0 for x = -0.0, for callers where that
+ * zero's sign cannot reach the result (simplex: see simplex3_value). */
+static inline float akp_floor_unsigned_zero(float x, int* out_i) {
+    const int t = (int)x;
+    const float ft = (float)t;
+    const int up = ft > x;
+    *out_i = t - up;
+    const uint32_t one_bits = (uint32_t)-up & 0x3F800000u;
+    float one;
+    memcpy(&one, &one_bits, sizeof one);
+    return ft - one;
+}
+
+/* x - floorf(x) (the fraction in [0, 1)) and floorf(x) as an int, in one. The floor is taken
+ * without its sign here: only x = -0.0 tells (-0.0 - +0.0 is -0.0 where x - floorf(x) is
+ * +0.0), and adding +0.0 turns that -0.0 into +0.0 and changes no other value. */
+static inline float akp_floor_frac(float x, int* out_i) {
+    const int t = (int)x;
+    const float ft = (float)t;
+    const int up = ft > x;
+    *out_i = t - up;
+    const uint32_t one_bits = (uint32_t)-up & 0x3F800000u;
+    float one;
+    memcpy(&one, &one_bits, sizeof one);
+    return (x - (ft - one)) + 0.0f;
+}
 
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);

@@ -159,6 +159,66 @@ static inline __attribute__((always_inline)) float lattice(const uint8_t* perm, 
     return val[0];
 }
 
+/* The value-only lattice of 2D and 3D (no gradient asked for): the same corner values with
+ * fewer loads. slots[c][h] names, for corner c and hash h, the two terms of Perlin's
+ * (+-u) + (+-v) in a 16-float table D of the corner offsets: D[2 k + b] = f[k] - b (axis k,
+ * corner bit b; 2D's slot for axis 2 holds the zero its axis gradients read), D[8 + i] =
+ * -D[i]; low nibble the u term, high nibble the v term. D[u] + D[v] is the sign-times-offset
+ * sum of corner_dot exactly (multiplying by -1 is negation); generated from g3_u/g3_v
+ * (g2_u/g2_v) and the sign bits h & 1 (u) and h & 2 (v). */
+static const uint8_t corner_slots3[8][16] = {
+    {0x20, 0x28, 0xA0, 0xA8, 0x40, 0x48, 0xC0, 0xC8, 0x42, 0x4A, 0xC2, 0xCA, 0x02, 0x4A, 0x82, 0xCA},
+    {0x21, 0x29, 0xA1, 0xA9, 0x41, 0x49, 0xC1, 0xC9, 0x42, 0x4A, 0xC2, 0xCA, 0x12, 0x4A, 0x92, 0xCA},
+    {0x30, 0x38, 0xB0, 0xB8, 0x40, 0x48, 0xC0, 0xC8, 0x43, 0x4B, 0xC3, 0xCB, 0x03, 0x4B, 0x83, 0xCB},
+    {0x31, 0x39, 0xB1, 0xB9, 0x41, 0x49, 0xC1, 0xC9, 0x43, 0x4B, 0xC3, 0xCB, 0x13, 0x4B, 0x93, 0xCB},
+    {0x20, 0x28, 0xA0, 0xA8, 0x50, 0x58, 0xD0, 0xD8, 0x52, 0x5A, 0xD2, 0xDA, 0x02, 0x5A, 0x82, 0xDA},
+    {0x21, 0x29, 0xA1, 0xA9, 0x51, 0x59, 0xD1, 0xD9, 0x52, 0x5A, 0xD2, 0xDA, 0x12, 0x5A, 0x92, 0xDA},
+    {0x30, 0x38, 0xB0, 0xB8, 0x50, 0x58, 0xD0, 0xD8, 0x53, 0x5B, 0xD3, 0xDB, 0x03, 0x5B, 0x83, 0xDB},
+    {0x31, 0x39, 0xB1, 0xB9, 0x51, 0x59, 0xD1, 0xD9, 0x53, 0x5B, 0xD3, 0xDB, 0x13, 0x5B, 0x93, 0xDB},
+};
+static const uint8_t corner_slots2[4][8] = {
+    {0x20, 0x28, 0xA0, 0xA8, 0x40, 0x48, 0xC2, 0xCA},
+    {0x21, 0x29, 0xA1, 0xA9, 0x41, 0x49, 0xC2, 0xCA},
+    {0x30, 0x38, 0xB0, 0xB8, 0x40, 0x48, 0xC3, 0xCB},
+    {0x31, 0x39, 0xB1, 0xB9, 0x41, 0x49, 0xC3, 0xCB},
+};
+
+static inline __attribute__((always_inline)) float lattice_value(const uint8_t* perm, uint32_t dims, const int* lo,
+                                                                 const int* hi, const float* f) {
+    int hash[8];
+    hash[0] = perm[lo[0]];
+    hash[1] = perm[hi[0]];
+    AKP_UNROLL
+    for (uint32_t k = 1; k < dims; ++k) {
+        const uint32_t half = 1u << k;
+        AKP_UNROLL
+        for (uint32_t c = 0; c < half; ++c) {
+            hash[c + half] = perm[hash[c] + hi[k]];
+            hash[c] = perm[hash[c] + lo[k]];
+        }
+    }
+    float D[16] = {0};
+    AKP_UNROLL
+    for (uint32_t k = 0; k < dims; ++k) D[2 * k] = f[k], D[2 * k + 1] = f[k] - 1.0f;
+    AKP_UNROLL
+    for (int i = 0; i < 8; ++i) D[8 + i] = -D[i];
+    float val[8];
+    const uint32_t corners = 1u << dims;
+    AKP_UNROLL
+    for (uint32_t c = 0; c < corners; ++c) {
+        const uint32_t s = dims == 3 ? corner_slots3[c][hash[c] & 15] : corner_slots2[c][hash[c] & 7];
+        val[c] = D[s & 15u] + D[s >> 4];
+    }
+    AKP_UNROLL
+    for (uint32_t k = 0; k < dims; ++k) {
+        const float t = fade(f[k]);
+        const uint32_t step = 1u << k;
+        AKP_UNROLL
+        for (uint32_t c = 0; c < corners; c += 2u * step) val[c] = lerp(t, val[c], val[c + step]);
+    }
+    return val[0];
+}
+
 static inline __attribute__((always_inline)) float perlin_n(const ak_noise* noise, uint32_t dims, const float* p,
                                                             const int* period, float* grad) {
     int lo[4], hi[4];
@@ -184,6 +244,7 @@ static inline __attribute__((always_inline)) float perlin_n(const ak_noise* nois
             hi[k] = (i + 1) & 255;
         }
     }
+    if (!grad && (dims == 2 || dims == 3)) return lattice_value(noise->perm, dims, lo, hi, f);
     return lattice(noise->perm, dims, lo, hi, f, grad);
 }
 
