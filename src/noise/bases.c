@@ -441,3 +441,52 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
         for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = b.near[k] / f1;
     return f1;
 }
+
+/* ---- fBm over simplex, value and Worley noise ---------------------------------------------- */
+
+/* One octave's basis value, as fractal.c's basis_eval gives it without gradient. */
+static inline __attribute__((always_inline)) float basis_value(const ak_noise* noise, ak_noise_basis basis,
+                                                               uint32_t dims, const float* q) {
+    switch (basis) {
+    case AK_NOISE_BASIS_SIMPLEX:
+        if (dims == 3) return all_finite(3, q) ? simplex3_value(noise->perm, q[0], q[1], q[2]) : 0.0f;
+        return ak_noise_simplex2(noise, q[0], dims == 1 ? 0.0f : q[1], NULL);
+    case AK_NOISE_BASIS_VALUE: return all_finite(dims, q) ? value_n(noise, dims, q, NULL) : 0.0f;
+    default: return ak_noise_worley(noise, dims, q, NULL, NULL);
+    }
+}
+
+static inline __attribute__((always_inline)) float fbm_other_n(const ak_noise* noise, const ak_fractal_desc* d,
+                                                               ak_noise_basis basis, uint32_t dims, const float* p) {
+    float freq = d->frequency, amp = 1.0f, sum = 0.0f;
+    const float lacunarity = d->lacunarity, gain = d->gain;
+    for (uint32_t o = 0; o < d->octaves; ++o) {
+        float q[4];
+#pragma GCC unroll 4
+        for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
+        sum = sum + amp * basis_value(noise, basis, dims, q);
+        freq = freq * lacunarity;
+        amp = amp * gain;
+    }
+    return sum;
+}
+
+float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
+    switch (d->basis) {
+    case AK_NOISE_BASIS_SIMPLEX:
+        return dims == 1   ? fbm_other_n(noise, d, AK_NOISE_BASIS_SIMPLEX, 1, p)
+               : dims == 2 ? fbm_other_n(noise, d, AK_NOISE_BASIS_SIMPLEX, 2, p)
+                           : fbm_other_n(noise, d, AK_NOISE_BASIS_SIMPLEX, 3, p);
+    case AK_NOISE_BASIS_VALUE:
+        switch (dims) {
+        case 1: return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 1, p);
+        case 2: return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 2, p);
+        case 3: return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 3, p);
+        default: return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 4, p);
+        }
+    default:
+        return dims == 1   ? fbm_other_n(noise, d, AK_NOISE_BASIS_WORLEY, 1, p)
+               : dims == 2 ? fbm_other_n(noise, d, AK_NOISE_BASIS_WORLEY, 2, p)
+                           : fbm_other_n(noise, d, AK_NOISE_BASIS_WORLEY, 3, p);
+    }
+}

@@ -56,6 +56,12 @@ static inline float akp_floor_frac(float x, int* out_i) {
     return (x - (ft - one)) + 0.0f;
 }
 
+/* The fBm octave sum without gradient or warp, for a resolved, valid desc of type FBM and a
+ * dims the basis supports: octaves()'s loop (fractal.c) with the basis inlined, the same float
+ * operations in the same order. Perlin in perlin.c, the other bases in bases.c. */
+float akp_fbm_perlin(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
+float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
+
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);
 

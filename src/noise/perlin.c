@@ -300,3 +300,28 @@ float ak_noise_perlin_periodic(const ak_noise* noise, uint32_t dimensions, const
     default: return perlin_n(noise, 4, point, period, out_gradient);
     }
 }
+
+/* fBm over Perlin noise with a constant dims (akp_fbm_perlin). */
+static inline __attribute__((always_inline)) float fbm_perlin_n(const ak_noise* noise, const ak_fractal_desc* d,
+                                                                uint32_t dims, const float* p) {
+    float freq = d->frequency, amp = 1.0f, sum = 0.0f;
+    const float lacunarity = d->lacunarity, gain = d->gain;
+    for (uint32_t o = 0; o < d->octaves; ++o) {
+        float q[4];
+        AKP_UNROLL
+        for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
+        sum = sum + amp * perlin_n(noise, dims, q, NULL, NULL);
+        freq = freq * lacunarity;
+        amp = amp * gain;
+    }
+    return sum;
+}
+
+float akp_fbm_perlin(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
+    switch (dims) {
+    case 1: return fbm_perlin_n(noise, d, 1, p);
+    case 2: return fbm_perlin_n(noise, d, 2, p);
+    case 3: return fbm_perlin_n(noise, d, 3, p);
+    default: return fbm_perlin_n(noise, d, 4, p);
+    }
+}
