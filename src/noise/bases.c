@@ -391,6 +391,131 @@ static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dim
     b->d2 = d2;
 }
 
+/* Rings 0 and 1 for F1 alone (no F2 asked for): worley_near_rings's nearest cell without the
+ * second distance and without skipping cells (random points mispredict the skip test; a cell
+ * it passes over is not closer). The running minimum with strict "<" in visiting order is the
+ * first cell in that order among those at the least distance; it is kept here as three running
+ * minima over the first, second and last third of the visiting order (three short dependency
+ * chains instead of one of 27 compares), merged in order, a later third winning only when
+ * strictly closer: the same cell and the same d1. */
+static inline __attribute__((always_inline)) void worley_f1_rings(uint32_t dims, uint64_t seed, const int* base,
+                                                                  const float* f, worley_best* b) {
+    static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
+    const uint32_t seed_mix = (uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32);
+    uint32_t axis[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (uint32_t k = 0; k < dims; ++k)
+        for (int o = 0; o < 3; ++o) axis[k][o] = (uint32_t)(base[k] + o - 1) * mul[k];
+    const int cells = dims == 1 ? 3 : dims == 2 ? 9 : 27, center = cells / 2;
+    float d1[3] = {b->d1, b->d1, b->d1};
+    int best[3] = {0, 0, 0};
+    uint32_t best_h[3] = {0, 0, 0};
+#pragma GCC unroll 27
+    for (int step = 0; step < cells; ++step) {
+        const int c = step == 0 ? center : step <= center ? step - 1 : step;
+        const int o[3] = {c % 3, c / 3 % 3, c / 9};
+        const int chain = step * 3 / cells;
+        uint32_t h = seed_mix;
+        for (uint32_t k = 0; k < dims; ++k) h ^= axis[k][o[k]];
+        h ^= h >> 16;
+        h *= 0x85EBCA6Bu;
+        h ^= h >> 13;
+        h *= 0xC2B2AE35u;
+        h ^= h >> 16;
+        const int off[3] = {o[0] - 1, o[1] - 1, o[2] - 1};
+        float dv[3];
+        const float dist2 = worley_offset(dims, h, f, off, dv);
+        /* selects as masks: gcc turned the ?: forms into branches */
+        const uint32_t m = 0u - (uint32_t)(dist2 < d1[chain]);
+        best[chain] = (int)(((uint32_t)c & m) | ((uint32_t)best[chain] & ~m));
+        best_h[chain] = (h & m) | (best_h[chain] & ~m);
+        d1[chain] = dist2 < d1[chain] ? dist2 : d1[chain];
+    }
+#pragma GCC unroll 2
+    for (int chain = 1; chain < 3; ++chain) {
+        const bool closer = d1[chain] < d1[0];
+        best[0] = closer ? best[chain] : best[0];
+        best_h[0] = closer ? best_h[chain] : best_h[0];
+        d1[0] = closer ? d1[chain] : d1[0];
+    }
+    const int off[3] = {best[0] % 3 - 1, best[0] / 3 % 3 - 1, best[0] / 9 - 1};
+    float dv[3] = {0, 0, 0};
+    worley_offset(dims, best_h[0], f, off, dv);
+    memcpy(b->near, dv, sizeof dv);
+    b->d1 = d1[0];
+}
+
+/* Rings 2 to 6, when rings 0 and 1 left a nearest (or second nearest, want_f2) distance that
+ * a farther cell could beat: ring r holds the cells at Chebyshev distance r from the point's
+ * cell; their feature points are at least (r - 1) + margin (+ 1/2048) away, so the search
+ * stops once that exceeds F2 (or F1 when F2 is not asked for: a farther cell cannot change the
+ * nearest). Rare, so out of line. */
+static __attribute__((noinline)) void worley_far_rings(uint32_t dims, uint64_t seed, const int* base, const float* f,
+                                                       float margin, bool want_f2, worley_best* b) {
+    for (int r = 2; r <= 6; ++r) {
+        const float bound = (float)(r - 1) + margin;
+        if (bound * bound >= (want_f2 ? b->d2 : b->d1)) break;
+        const int span = 2 * r + 1;
+        const int cells = dims == 1 ? span : dims == 2 ? span * span : span * span * span;
+        for (int c = 0; c < cells; ++c) {
+            int off[3] = {0, 0, 0}, cc = c, cheb = 0;
+            for (uint32_t k = 0; k < dims; ++k) {
+                off[k] = cc % span - r;
+                cc /= span;
+                cheb = off[k] < 0 ? (-off[k] > cheb ? -off[k] : cheb) : (off[k] > cheb ? off[k] : cheb);
+            }
+            if (cheb != r) continue;
+            int cell[3];
+            for (uint32_t k = 0; k < dims; ++k) cell[k] = base[k] + off[k];
+            worley_visit(dims, cell_hash(cell, dims, seed), f, off, b);
+        }
+    }
+}
+
+/* Worley noise at a finite point with a constant dims and want_f2 (out_f2 != NULL) when
+ * inlined: rings 0 and 1 (worley_near_rings, or worley_f1_rings for F1 alone), then the far
+ * rings when they could matter. */
+static inline __attribute__((always_inline)) float worley_n(const ak_noise* noise, uint32_t dims, bool want_f2,
+                                                            const float* point, float* out_f2, float* out_gradient) {
+    int base[3] = {0, 0, 0};
+    float f[3] = {0, 0, 0}, margin = 1.0f;
+    for (uint32_t k = 0; k < dims; ++k) {
+        f[k] = akp_floor_frac(point[k], &base[k]);
+        const float g = f[k] < 1.0f - f[k] ? f[k] : 1.0f - f[k]; /* fminf without the libm call */
+        margin = g < margin ? g : margin;
+    }
+    worley_best b = {INFINITY, INFINITY, {0, 0, 0}};
+    if (want_f2) worley_near_rings(dims, noise->seed, base, f, true, &b);
+    else worley_f1_rings(dims, noise->seed, base, f, &b);
+    const float bound = 1.0f + margin; /* ring 2's */
+    if (bound * bound < (want_f2 ? b.d2 : b.d1)) worley_far_rings(dims, noise->seed, base, f, margin, want_f2, &b);
+    const float f1 = sqrtf(b.d1);
+    if (want_f2) *out_f2 = sqrtf(b.d2);
+    if (out_gradient && f1 > 0.0f)
+        for (uint32_t k = 0; k < dims; ++k) out_gradient[k] = b.near[k] / f1;
+    return f1;
+}
+
+/* One compiled body per dimension and F2 choice (a single body holding all six was not
+ * unrolled as well). */
+#define AKP_WORLEY_VARIANT(name, dims, want_f2)                                                                    \
+    static __attribute__((noinline)) float name(const ak_noise* noise, const float* point, float* out_f2,          \
+                                                float* out_gradient) {                                             \
+        return worley_n(noise, dims, want_f2, point, out_f2, out_gradient);                                        \
+    }
+/* F1 alone and no gradient: the common call */
+static __attribute__((noinline)) float worley3_value(const ak_noise* noise, const float* point) {
+    return worley_n(noise, 3, false, point, NULL, NULL);
+}
+static __attribute__((noinline)) float worley2_value(const ak_noise* noise, const float* point) {
+    return worley_n(noise, 2, false, point, NULL, NULL);
+}
+AKP_WORLEY_VARIANT(worley1_f1, 1, false)
+AKP_WORLEY_VARIANT(worley2_f1, 2, false)
+AKP_WORLEY_VARIANT(worley3_f1, 3, false)
+AKP_WORLEY_VARIANT(worley1_f2, 1, true)
+AKP_WORLEY_VARIANT(worley2_f2, 2, true)
+AKP_WORLEY_VARIANT(worley3_f2, 3, true)
+
 float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_f2,
                       float* out_gradient) {
     if (dimensions < 1 || dimensions > 3) {
@@ -400,46 +525,17 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
     zero_grad(out_gradient, dimensions);
     if (out_f2) *out_f2 = 0.0f;
     if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
-    int base[3] = {0, 0, 0};
-    float f[3] = {0, 0, 0}, margin = 1.0f;
-    for (uint32_t k = 0; k < dimensions; ++k) {
-        f[k] = akp_floor_frac(point[k], &base[k]);
-        const float g = f[k] < 1.0f - f[k] ? f[k] : 1.0f - f[k]; /* fminf without the libm call */
-        margin = g < margin ? g : margin;
-    }
-    worley_best b = {INFINITY, INFINITY, {0, 0, 0}};
-    /* Ring r holds the cells at Chebyshev distance r from the point's cell; their feature
-     * points are at least (r - 1) + margin (+ 1/2048) away, so the search stops once that
-     * exceeds F2 (or F1 when F2 is not asked for: a farther cell cannot change the nearest).
-     * Rings 0 and 1 are always searched. */
     switch (dimensions) {
-    case 1: worley_near_rings(1, noise->seed, base, f, out_f2 != NULL, &b); break;
-    case 2: worley_near_rings(2, noise->seed, base, f, out_f2 != NULL, &b); break;
-    default: worley_near_rings(3, noise->seed, base, f, out_f2 != NULL, &b); break;
+    case 1: return out_f2 ? worley1_f2(noise, point, out_f2, out_gradient) : worley1_f1(noise, point, NULL, out_gradient);
+    case 2:
+        return out_f2         ? worley2_f2(noise, point, out_f2, out_gradient)
+               : out_gradient ? worley2_f1(noise, point, NULL, out_gradient)
+                              : worley2_value(noise, point);
+    default:
+        return out_f2         ? worley3_f2(noise, point, out_f2, out_gradient)
+               : out_gradient ? worley3_f1(noise, point, NULL, out_gradient)
+                              : worley3_value(noise, point);
     }
-    for (int r = 2; r <= 6; ++r) {
-        const float bound = (float)(r - 1) + margin;
-        if (bound * bound >= (out_f2 ? b.d2 : b.d1)) break;
-        const int span = 2 * r + 1;
-        const int cells = dimensions == 1 ? span : dimensions == 2 ? span * span : span * span * span;
-        for (int c = 0; c < cells; ++c) {
-            int off[3] = {0, 0, 0}, cc = c, cheb = 0;
-            for (uint32_t k = 0; k < dimensions; ++k) {
-                off[k] = cc % span - r;
-                cc /= span;
-                cheb = off[k] < 0 ? (-off[k] > cheb ? -off[k] : cheb) : (off[k] > cheb ? off[k] : cheb);
-            }
-            if (cheb != r) continue;
-            int cell[3];
-            for (uint32_t k = 0; k < dimensions; ++k) cell[k] = base[k] + off[k];
-            worley_visit(dimensions, cell_hash(cell, dimensions, noise->seed), f, off, &b);
-        }
-    }
-    const float f1 = sqrtf(b.d1);
-    if (out_f2) *out_f2 = sqrtf(b.d2);
-    if (out_gradient && f1 > 0.0f)
-        for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = b.near[k] / f1;
-    return f1;
 }
 
 /* ---- fBm over simplex, value and Worley noise ---------------------------------------------- */
@@ -452,7 +548,7 @@ static inline __attribute__((always_inline)) float basis_value(const ak_noise* n
         if (dims == 3) return all_finite(3, q) ? simplex3_value(noise->perm, q[0], q[1], q[2]) : 0.0f;
         return ak_noise_simplex2(noise, q[0], dims == 1 ? 0.0f : q[1], NULL);
     case AK_NOISE_BASIS_VALUE: return all_finite(dims, q) ? value_n(noise, dims, q, NULL) : 0.0f;
-    default: return ak_noise_worley(noise, dims, q, NULL, NULL);
+    default: return all_finite(dims, q) ? worley_n(noise, dims, false, q, NULL, NULL) : 0.0f;
     }
 }
 
