@@ -224,13 +224,13 @@ static inline __attribute__((always_inline)) float value_n(const ak_noise* noise
     const uint32_t corners = 1u << dims;
     /* corner c (bit k: hi along axis k) hashes perm[...perm[perm[x_c] + y_c]... + w_c], the
      * shared prefixes looked up once (2 + 4 + 8 loads in 3D instead of 24) */
-    int hash[16] = {0};
+    uint32_t hash[16] = {0}; /* unsigned: the index arithmetic needs no sign extension */
 #pragma GCC unroll 4
     for (uint32_t k = 0, count = 1; k < dims; ++k, count *= 2)
 #pragma GCC unroll 8
         for (uint32_t c = 0; c < count; ++c) {
-            hash[c + count] = noise->perm[hash[c] + hi[k]];
-            hash[c] = noise->perm[hash[c] + lo[k]];
+            hash[c + count] = noise->perm[hash[c] + (uint32_t)hi[k]];
+            hash[c] = noise->perm[hash[c] + (uint32_t)lo[k]];
         }
     float val[16], gv[16][4];
 #pragma GCC unroll 16
@@ -261,14 +261,23 @@ static inline __attribute__((always_inline)) float value_n(const ak_noise* noise
     return v < -1.0f ? -1.0f : v > 1.0f ? 1.0f : v;
 }
 
+/* The value-only paths of 2D and 3D, each its own compiled body (no derivative work, and
+ * not sharing one function's registers with the other seven variants). */
+static __attribute__((noinline)) float value2_value(const ak_noise* noise, const float* point) {
+    return value_n(noise, 2, point, NULL);
+}
+static __attribute__((noinline)) float value3_value(const ak_noise* noise, const float* point) {
+    return value_n(noise, 3, point, NULL);
+}
+
 float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_gradient) {
     if (dimensions < 1 || dimensions > 4) return 0.0f;
     zero_grad(out_gradient, dimensions);
     if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
     switch (dimensions) {
     case 1: return out_gradient ? value_n(noise, 1, point, out_gradient) : value_n(noise, 1, point, NULL);
-    case 2: return out_gradient ? value_n(noise, 2, point, out_gradient) : value_n(noise, 2, point, NULL);
-    case 3: return out_gradient ? value_n(noise, 3, point, out_gradient) : value_n(noise, 3, point, NULL);
+    case 2: return out_gradient ? value_n(noise, 2, point, out_gradient) : value2_value(noise, point);
+    case 3: return out_gradient ? value_n(noise, 3, point, out_gradient) : value3_value(noise, point);
     default: return out_gradient ? value_n(noise, 4, point, out_gradient) : value_n(noise, 4, point, NULL);
     }
 }

@@ -185,7 +185,7 @@ static const uint8_t corner_slots2[4][8] = {
 
 static inline __attribute__((always_inline)) float lattice_value(const uint8_t* perm, uint32_t dims, const int* lo,
                                                                  const int* hi, const float* f) {
-    int hash[8];
+    uint32_t hash[8]; /* unsigned: the index arithmetic needs no sign extension */
     hash[0] = perm[lo[0]];
     hash[1] = perm[hi[0]];
     AKP_UNROLL
@@ -193,8 +193,8 @@ static inline __attribute__((always_inline)) float lattice_value(const uint8_t* 
         const uint32_t half = 1u << k;
         AKP_UNROLL
         for (uint32_t c = 0; c < half; ++c) {
-            hash[c + half] = perm[hash[c] + hi[k]];
-            hash[c] = perm[hash[c] + lo[k]];
+            hash[c + half] = perm[hash[c] + (uint32_t)hi[k]];
+            hash[c] = perm[hash[c] + (uint32_t)lo[k]];
         }
     }
     float D[16] = {0};
