@@ -65,7 +65,8 @@ float ak_noise_simplex2(const ak_noise* noise, float x, float y, float* out_grad
     const float d[3][2] = {{x0, y0}, {x0 - (float)i1 + G2, y0 - (float)j1 + G2}, {x0 - 1.0f + 2.0f * G2, y0 - 1.0f + 2.0f * G2}};
     float sum = 0.0f, g[2] = {0, 0};
     for (int c = 0; c < 3; ++c)
-        sum += out_gradient ? simplex_corner(2, 0.5f, d[c], simplex_g2[h[c] & 7], g) : simplex_corner_value(2, d[c], simplex_g2[h[c] & 7]);
+        sum += out_gradient ? simplex_corner(2, 0.5f, d[c], simplex_g2[h[c] & 7], g)
+                            : simplex_corner_value(2, d[c], simplex_g2[h[c] & 7]);
     if (out_gradient) out_gradient[0] = 70.0f * g[0], out_gradient[1] = 70.0f * g[1];
     return 70.0f * sum;
 }
@@ -108,7 +109,8 @@ static inline __attribute__((always_inline)) float simplex3_value(const uint8_t*
     const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
     const int xy = x0 >= y0, yz = y0 >= z0, xz = x0 >= z0;
     const float(*st)[3] = simplex3_steps[xy | yz << 1 | xz << 2];
-    const int o1[3] = {xy & xz, (xy ^ 1) & yz, (xz ^ 1) & (yz ^ 1)}, o2[3] = {xy | xz, (xy ^ 1) | yz, (xz ^ 1) | (yz ^ 1)};
+    const int o1[3] = {xy & xz, (xy ^ 1) & yz, (xz ^ 1) & (yz ^ 1)};
+    const int o2[3] = {xy | xz, (xy ^ 1) | yz, (xz ^ 1) | (yz ^ 1)};
     ii &= 255, jj &= 255, kk &= 255;
     const int h0 = perm[perm[perm[ii] + jj] + kk];
     const int h1 = perm[perm[perm[ii + o1[0]] + jj + o1[1]] + kk + o1[2]];
@@ -138,7 +140,8 @@ float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float*
      * branches give it (the comparisons of finite floats are transitive, so o1 is the
      * largest axis, o2 the two largest), without branches: random points mispredict them */
     const int xy = x0 >= y0, yz = y0 >= z0, xz = x0 >= z0;
-    const int o1[3] = {xy & xz, (xy ^ 1) & yz, (xz ^ 1) & (yz ^ 1)}, o2[3] = {xy | xz, (xy ^ 1) | yz, (xz ^ 1) | (yz ^ 1)};
+    const int o1[3] = {xy & xz, (xy ^ 1) & yz, (xz ^ 1) & (yz ^ 1)};
+    const int o2[3] = {xy | xz, (xy ^ 1) | yz, (xz ^ 1) | (yz ^ 1)};
     ii &= 255, jj &= 255, kk &= 255;
     const uint8_t* perm = noise->perm;
     const int offs[4][3] = {{0, 0, 0}, {o1[0], o1[1], o1[2]}, {o2[0], o2[1], o2[2]}, {1, 1, 1}};
@@ -535,7 +538,9 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
     if (out_f2) *out_f2 = 0.0f;
     if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
     switch (dimensions) {
-    case 1: return out_f2 ? worley1_f2(noise, point, out_f2, out_gradient) : worley1_f1(noise, point, NULL, out_gradient);
+    case 1:
+        return out_f2 ? worley1_f2(noise, point, out_f2, out_gradient)
+                      : worley1_f1(noise, point, NULL, out_gradient);
     case 2:
         return out_f2         ? worley2_f2(noise, point, out_f2, out_gradient)
                : out_gradient ? worley2_f1(noise, point, NULL, out_gradient)
