@@ -581,22 +581,33 @@ static inline __attribute__((always_inline)) float fbm_other_n(const ak_noise* n
     return sum;
 }
 
+/* One compiled body per basis and dimension. */
+#define AKP_FBM_OTHER(name, basis, dims)                                                            \
+    static __attribute__((noinline)) float name(const ak_noise* noise, const ak_fractal_desc* d,   \
+                                                const float* p) {                                  \
+        return fbm_other_n(noise, d, basis, dims, p);                                              \
+    }
+AKP_FBM_OTHER(fbm_simplex1, AK_NOISE_BASIS_SIMPLEX, 1)
+AKP_FBM_OTHER(fbm_simplex2, AK_NOISE_BASIS_SIMPLEX, 2)
+AKP_FBM_OTHER(fbm_simplex3, AK_NOISE_BASIS_SIMPLEX, 3)
+AKP_FBM_OTHER(fbm_value1, AK_NOISE_BASIS_VALUE, 1)
+AKP_FBM_OTHER(fbm_value2, AK_NOISE_BASIS_VALUE, 2)
+AKP_FBM_OTHER(fbm_value3, AK_NOISE_BASIS_VALUE, 3)
+AKP_FBM_OTHER(fbm_value4, AK_NOISE_BASIS_VALUE, 4)
+AKP_FBM_OTHER(fbm_worley1, AK_NOISE_BASIS_WORLEY, 1)
+AKP_FBM_OTHER(fbm_worley2, AK_NOISE_BASIS_WORLEY, 2)
+AKP_FBM_OTHER(fbm_worley3, AK_NOISE_BASIS_WORLEY, 3)
+
 float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
     switch (d->basis) {
     case AK_NOISE_BASIS_SIMPLEX:
-        return dims == 1   ? fbm_other_n(noise, d, AK_NOISE_BASIS_SIMPLEX, 1, p)
-               : dims == 2 ? fbm_other_n(noise, d, AK_NOISE_BASIS_SIMPLEX, 2, p)
-                           : fbm_other_n(noise, d, AK_NOISE_BASIS_SIMPLEX, 3, p);
+        return dims == 1 ? fbm_simplex1(noise, d, p) : dims == 2 ? fbm_simplex2(noise, d, p) : fbm_simplex3(noise, d, p);
     case AK_NOISE_BASIS_VALUE:
-        switch (dims) {
-        case 1: return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 1, p);
-        case 2: return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 2, p);
-        case 3: return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 3, p);
-        default: return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 4, p);
-        }
+        return dims == 1   ? fbm_value1(noise, d, p)
+               : dims == 2 ? fbm_value2(noise, d, p)
+               : dims == 3 ? fbm_value3(noise, d, p)
+                           : fbm_value4(noise, d, p);
     default:
-        return dims == 1   ? fbm_other_n(noise, d, AK_NOISE_BASIS_WORLEY, 1, p)
-               : dims == 2 ? fbm_other_n(noise, d, AK_NOISE_BASIS_WORLEY, 2, p)
-                           : fbm_other_n(noise, d, AK_NOISE_BASIS_WORLEY, 3, p);
+        return dims == 1 ? fbm_worley1(noise, d, p) : dims == 2 ? fbm_worley2(noise, d, p) : fbm_worley3(noise, d, p);
     }
 }

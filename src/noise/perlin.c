@@ -317,11 +317,22 @@ static inline __attribute__((always_inline)) float fbm_perlin_n(const ak_noise* 
     return sum;
 }
 
+/* One compiled body per dimension (sharing one function cost the loop its registers). */
+#define AKP_FBM_PERLIN(name, dims)                                                                  \
+    static __attribute__((noinline)) float name(const ak_noise* noise, const ak_fractal_desc* d,   \
+                                                const float* p) {                                  \
+        return fbm_perlin_n(noise, d, dims, p);                                                    \
+    }
+AKP_FBM_PERLIN(fbm_perlin1, 1)
+AKP_FBM_PERLIN(fbm_perlin2, 2)
+AKP_FBM_PERLIN(fbm_perlin3, 3)
+AKP_FBM_PERLIN(fbm_perlin4, 4)
+
 float akp_fbm_perlin(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
     switch (dims) {
-    case 1: return fbm_perlin_n(noise, d, 1, p);
-    case 2: return fbm_perlin_n(noise, d, 2, p);
-    case 3: return fbm_perlin_n(noise, d, 3, p);
-    default: return fbm_perlin_n(noise, d, 4, p);
+    case 1: return fbm_perlin1(noise, d, p);
+    case 2: return fbm_perlin2(noise, d, p);
+    case 3: return fbm_perlin3(noise, d, p);
+    default: return fbm_perlin4(noise, d, p);
     }
 }
