@@ -127,6 +127,7 @@ typedef struct {
     int kind, dims, oct, random;
     ak_noise_basis basis;
     double t[2][MAXR];
+    int grad;
 } timed;
 
 static float* TX[2][3];
@@ -135,15 +136,15 @@ static volatile float sink;
 static void run_timed(int side, const ak_noise* n, const timed* v) {
     const float *x = TX[v->random][0], *y = TX[v->random][1], *z = TX[v->random][2];
     float s = 0.0f;
-    ncase c = {.kind = v->oct > 1 ? K_FRACTAL : v->kind, .dims = v->dims, .basis = v->basis};
+    ncase c = {.kind = v->oct > 1 ? K_FRACTAL : v->kind, .dims = v->dims, .basis = v->basis, .grad = v->grad};
     c.fd = (ak_fractal_desc){.type = AK_FRACTAL_FBM, .basis = v->basis, .octaves = (uint32_t)v->oct, .lacunarity = 2,
                              .gain = 0.5f, .frequency = 1};
-    if (c.kind == K_PERLIN && v->dims == 3) {
+    if (c.kind == K_PERLIN && v->dims == 3 && !v->grad) {
         if (side == 0)
             for (int i = 0; i < TN; ++i) s += old_ak_noise_perlin3(n, x[i], y[i], z[i], NULL);
         else
             for (int i = 0; i < TN; ++i) s += new_ak_noise_perlin3(n, x[i], y[i], z[i], NULL);
-    } else if (c.kind == K_SIMPLEX && v->dims == 3) {
+    } else if (c.kind == K_SIMPLEX && v->dims == 3 && !v->grad) {
         if (side == 0)
             for (int i = 0; i < TN; ++i) s += old_ak_noise_simplex3(n, x[i], y[i], z[i], NULL);
         else
@@ -255,6 +256,9 @@ int main(int argc, char** argv) {
         {"simplex3 random", K_SIMPLEX, 3, 1, 1, AK_NOISE_BASIS_SIMPLEX, {{0}}},
         {"value3 random", K_VALUE, 3, 1, 1, AK_NOISE_BASIS_VALUE, {{0}}},
         {"worley3 F1 random", K_WORLEY, 3, 1, 1, AK_NOISE_BASIS_WORLEY, {{0}}},
+        {"perlin3+grad", K_PERLIN, 3, 1, 0, AK_NOISE_BASIS_PERLIN, {{0}}, 1},
+        {"perlin2+grad", K_PERLIN, 2, 1, 0, AK_NOISE_BASIS_PERLIN, {{0}}, 1},
+        {"fbm8 perlin2+grad", K_FRACTAL, 2, 8, 0, AK_NOISE_BASIS_PERLIN, {{0}}, 1},
     };
     const int nt = (int)(sizeof tv / sizeof tv[0]);
     const ak_noise* tn[2] = {&on[1], &nn[1]};

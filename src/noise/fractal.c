@@ -111,9 +111,6 @@ ak_result ak_fractal_desc_validate(const ak_fractal_desc* desc) {
 
 /* The octave sum at p (no warping). */
 static float octaves(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad) {
-    /* fBm without gradient, the common case, in loops specialised per basis and dimension */
-    if (!grad && d->type == AK_FRACTAL_FBM)
-        return d->basis == AK_NOISE_BASIS_PERLIN ? akp_fbm_perlin(noise, d, dims, p) : akp_fbm_other(noise, d, dims, p);
     float freq = d->frequency, amp = 1.0f, sum = 0.0f, weight = 1.0f;
     float gs[4] = {0, 0, 0, 0}, gw[4] = {0, 0, 0, 0};
     for (uint32_t o = 0; o < d->octaves; ++o) {
@@ -156,7 +153,13 @@ static float octaves(const ak_noise* noise, const ak_fractal_desc* d, uint32_t d
 }
 
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad) {
-    if (d->warp == 0.0f) return octaves(noise, d, dims, p, grad);
+    if (d->warp == 0.0f) {
+        /* fBm without gradient, the common case, in loops specialised per basis and dimension */
+        if (!grad && d->type == AK_FRACTAL_FBM)
+            return d->basis == AK_NOISE_BASIS_PERLIN ? akp_fbm_perlin(noise, d, dims, p)
+                                                     : akp_fbm_other(noise, d, dims, p);
+        return octaves(noise, d, dims, p, grad);
+    }
     static const float offset[4] = {5.2f, 1.3f, 7.1f, 2.9f};
     float q[4] = {0, 0, 0, 0}, wg[4][4];
     for (uint32_t k = 0; k < dims; ++k) {
