@@ -158,6 +158,8 @@ float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_
         if (!grad && d->type == AK_FRACTAL_FBM)
             return d->basis == AK_NOISE_BASIS_PERLIN ? akp_fbm_perlin(noise, d, dims, p)
                                                      : akp_fbm_other(noise, d, dims, p);
+        if (d->type == AK_FRACTAL_FBM && d->basis == AK_NOISE_BASIS_PERLIN && (dims == 2 || dims == 3))
+            return akp_fbm_perlin_grad(noise, d, dims, p, grad);
         return octaves(noise, d, dims, p, grad);
     }
     static const float offset[4] = {5.2f, 1.3f, 7.1f, 2.9f};

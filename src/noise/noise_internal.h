@@ -61,6 +61,9 @@ static inline float akp_floor_frac(float x, int* out_i) {
  * operations in the same order. Perlin in perlin.c, the other bases in bases.c. */
 float akp_fbm_perlin(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
 float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
+/* The same with the gradient, Perlin in 2D and 3D (dims 2 or 3). */
+float akp_fbm_perlin_grad(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p,
+                          float* grad);
 
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);

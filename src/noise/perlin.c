@@ -317,6 +317,41 @@ static inline __attribute__((always_inline)) float fbm_perlin_n(const ak_noise* 
     return sum;
 }
 
+/* fBm over Perlin noise with its gradient (octaves()'s FBM branch: the same operations). */
+static inline __attribute__((always_inline)) float fbm_perlin_grad_n(const ak_noise* noise, const ak_fractal_desc* d,
+                                                                     uint32_t dims, const float* p, float* grad) {
+    float freq = d->frequency, amp = 1.0f, sum = 0.0f, gs[4] = {0, 0, 0, 0};
+    const float lacunarity = d->lacunarity, gain = d->gain;
+    for (uint32_t o = 0; o < d->octaves; ++o) {
+        float q[4], g[4];
+        AKP_UNROLL
+        for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
+        const float n = perlin_n(noise, dims, q, NULL, g);
+        sum = sum + amp * n;
+        AKP_UNROLL
+        for (uint32_t k = 0; k < dims; ++k) gs[k] = gs[k] + (amp * freq) * g[k];
+        freq = freq * lacunarity;
+        amp = amp * gain;
+    }
+    AKP_UNROLL
+    for (uint32_t k = 0; k < dims; ++k) grad[k] = gs[k];
+    return sum;
+}
+
+static __attribute__((noinline)) float fbm_perlin2_grad(const ak_noise* noise, const ak_fractal_desc* d,
+                                                        const float* p, float* grad) {
+    return fbm_perlin_grad_n(noise, d, 2, p, grad);
+}
+static __attribute__((noinline)) float fbm_perlin3_grad(const ak_noise* noise, const ak_fractal_desc* d,
+                                                        const float* p, float* grad) {
+    return fbm_perlin_grad_n(noise, d, 3, p, grad);
+}
+
+float akp_fbm_perlin_grad(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p,
+                          float* grad) {
+    return dims == 2 ? fbm_perlin2_grad(noise, d, p, grad) : fbm_perlin3_grad(noise, d, p, grad);
+}
+
 /* One compiled body per dimension (sharing one function cost the loop its registers). */
 #define AKP_FBM_PERLIN(name, dims)                                                                  \
     static __attribute__((noinline)) float name(const ak_noise* noise, const ak_fractal_desc* d,   \
