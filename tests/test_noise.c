@@ -8,6 +8,7 @@
 #include <animkit/noise.h>
 
 #include "ak_test.h"
+#include "noise/noise_internal.h" /* akp_floor, akp_floor_frac */
 #include "ref/ref_noise.h"
 
 /* Big runs (10^7 points for the ranges) only in optimised builds outside valgrind;
@@ -856,8 +857,104 @@ AK_TEST(sway_layer) {
     AK_CHECK_EQ(ak_noise_sway_validate(&job2), AK_ERR_BAD_DATA);
 }
 
+/* akp_floor / akp_floor_frac (the per-point functions' floor) give libm's floorf bit for bit:
+ * every 61st float pattern below the 2^24 limit of either sign, and around every integer
+ * within 4096 of zero the integer itself, both neighbours and +-0. */
+static int floor_mismatch(float x) {
+    int i = 7, j = 7;
+    const float fl = akp_floor(x, &i), fr = akp_floor_frac(x, &j);
+    const float want = floorf(x), want_fr = x - want;
+    return memcmp(&fl, &want, sizeof fl) != 0 || memcmp(&fr, &want_fr, sizeof fr) != 0 || i != (int)want ||
+           j != (int)want;
+}
+
+AK_TEST(floor_matches_libm) {
+    long bad = 0, count = 0;
+    for (uint32_t bits = 0; bits < 0x4B800000u; bits += 61u)
+        for (uint32_t sign = 0; sign < 2; ++sign) {
+            const uint32_t b = bits | sign << 31;
+            float x;
+            memcpy(&x, &b, sizeof x);
+            bad += floor_mismatch(x), ++count;
+        }
+    for (int k = -4096; k <= 4096; ++k) {
+        const float x = (float)k;
+        bad += floor_mismatch(x) + floor_mismatch(nextafterf(x, -INFINITY)) + floor_mismatch(nextafterf(x, INFINITY));
+        count += 3;
+    }
+    bad += floor_mismatch(0.0f) + floor_mismatch(-0.0f) + floor_mismatch(nextafterf(16777216.0f, 0.0f)) +
+           floor_mismatch(-nextafterf(16777216.0f, 0.0f));
+    AK_CHECK_MSG(bad == 0, "%ld of %ld floors differ from floorf", bad, count + 4);
+    float x = -0.0f; /* the one case truncation alone gets wrong in sign */
+    int i;
+    AK_CHECK(signbit(akp_floor(x, &i)) && i == 0 && !signbit(akp_floor_frac(x, &i)));
+}
+
+/* The per-point calls (ak_noise_perlin2/3, simplex2/3, value, worley F1) against a one-octave
+ * fBm job at frequency 1 on every path this CPU has: the same value for every point, the same
+ * bits except one documented case. The job sums octaves from +0.0 (0.0f + 1 * n), so where the
+ * per-point value is -0.0 the job gives +0.0 (equal as numbers; this test pins that down, it
+ * does not change it). Random points, the integer lattice (where Perlin noise is a signed zero)
+ * and coordinates of -0.0. */
+static float per_point(const ak_noise* n, ak_noise_basis b, uint32_t dims, const float* p) {
+    switch (b) {
+    case AK_NOISE_BASIS_PERLIN:
+        return dims == 2 ? ak_noise_perlin2(n, p[0], p[1], NULL) : ak_noise_perlin3(n, p[0], p[1], p[2], NULL);
+    case AK_NOISE_BASIS_SIMPLEX:
+        return dims == 2 ? ak_noise_simplex2(n, p[0], p[1], NULL) : ak_noise_simplex3(n, p[0], p[1], p[2], NULL);
+    case AK_NOISE_BASIS_VALUE: return ak_noise_value(n, dims, p, NULL);
+    default: return ak_noise_worley(n, dims, p, NULL, NULL);
+    }
+}
+
+AK_TEST(per_point_matches_job_signed_zero) {
+    ak_noise n = ak_noise_make(3);
+    enum { N = 6000 };
+    static float x[N], y[N], z[N], out[N];
+    ak_rng rng = ak_rng_make(7);
+    for (int i = 0; i < N; ++i) {
+        if (i % 3 == 0) { /* integer lattice points, some coordinates -0.0 */
+            x[i] = (float)((int)(ak_rng_u32(&rng) % 41) - 20);
+            y[i] = (float)((int)(ak_rng_u32(&rng) % 41) - 20);
+            z[i] = (float)((int)(ak_rng_u32(&rng) % 41) - 20);
+            if (i % 9 == 0) x[i] = -0.0f;
+            if (i % 27 == 0) y[i] = z[i] = -0.0f;
+        } else {
+            x[i] = frand(&rng, -60, 60), y[i] = frand(&rng, -60, 60), z[i] = frand(&rng, -60, 60);
+        }
+    }
+    ak_noise_simd paths[3];
+    const int npaths = simd_paths(paths);
+    const ak_noise_basis bases[] = {AK_NOISE_BASIS_PERLIN, AK_NOISE_BASIS_SIMPLEX, AK_NOISE_BASIS_VALUE,
+                                    AK_NOISE_BASIS_WORLEY};
+    long neg_zero = 0;
+    for (int bi = 0; bi < 4; ++bi)
+        for (uint32_t dims = 2; dims <= 3; ++dims)
+            for (int pi = 0; pi < npaths; ++pi) {
+                ak_noise_job job = {.noise = &n, .fractal = {.type = AK_FRACTAL_FBM, .basis = bases[bi], .octaves = 1},
+                                    .dimensions = dims, .x = {x, N}, .y = {y, N}, .z = {dims == 3 ? z : NULL, N},
+                                    .out_values = {out, N}, .thread_count = 1, .simd_limit = paths[pi]};
+                AK_CHECK_EQ(ak_noise_job_run(&job), AK_OK);
+                long other = 0;
+                for (int i = 0; i < N; ++i) {
+                    const float p[3] = {x[i], y[i], z[i]};
+                    const float v = per_point(&n, bases[bi], dims, p);
+                    if (memcmp(&v, &out[i], sizeof v) == 0) continue;
+                    if (v == 0.0f && signbit(v) && out[i] == 0.0f && !signbit(out[i])) ++neg_zero;
+                    else if (other++ < 3)
+                        AK_CHECK_MSG(false, "basis %d, %uD, path %d, point %d: per point %a, job %a", bi, dims,
+                                     (int)paths[pi], i, v, out[i]);
+                }
+                AK_CHECK_MSG(other == 0, "basis %d, %uD, path %d: %ld values differ", bi, dims, (int)paths[pi], other);
+            }
+    /* the documented case occurs (Perlin noise at lattice points), so the rule above is exercised */
+    printf("  per-point -0.0 where the job gives +0.0: %ld values over %d paths\n", neg_zero, npaths);
+    AK_CHECK(neg_zero > 0);
+}
+
 int main(void) {
     AK_RUN(permutations);
+    AK_RUN(floor_matches_libm);
     AK_RUN(perlin3_published_value);
     AK_RUN(perlin_matches_reference);
     AK_RUN(zero_at_lattice);
@@ -868,6 +965,7 @@ int main(void) {
     AK_RUN(fractal_octaves_scale_by_gain);
     AK_RUN(fractal_gradient_matches_differences);
     AK_RUN(batch_simd_equals_scalar);
+    AK_RUN(per_point_matches_job_signed_zero);
     AK_RUN(batch_value_worley_edges);
     AK_RUN(grid_job_equals_points);
     AK_RUN(job_validity);

@@ -184,7 +184,10 @@ AK_API void ak_fractal_range(const ak_fractal_desc* desc, uint32_t dimensions, f
  * to the limit is used; tests and benchmarks run every path side by side with it). The SIMD
  * kernels cover Perlin, simplex, value and Worley (F1) noise in 2D and 3D without warping
  * (every fractal type, with or without gradient); 1D, 4D and domain warping run the scalar
- * reference. Every kernel gives the scalar reference's bits. */
+ * reference. Every kernel gives the scalar reference's bits. A one-octave fBm job at frequency
+ * 1 gives the per-point functions' bits too, except one case: the octave sum starts at +0.0, so
+ * where a per-point call returns -0.0 the job returns +0.0 (equal as numbers; test_noise
+ * per_point_matches_job_signed_zero). */
 typedef enum ak_noise_simd {
     AK_NOISE_SIMD_DEFAULT = 0, /* -> the widest kernel this CPU has (AK_NOISE_SIMD_AVX512) */
     AK_NOISE_SIMD_SCALAR,      /* scalar code (as skip_simd) */

@@ -35,47 +35,114 @@ static float simplex_corner(uint32_t dims, float r0, const float* d, const float
     return t4 * gd;
 }
 
+/* simplex_corner's value without the branch (r0 = 1/2): where t <= 0 the term is t^4 gd with t
+ * = 0, a zero of either sign instead of +0.0, which leaves the sum unchanged: the sum starts at
+ * +0.0 and a round-to-nearest sum is -0.0 only when both terms are, so it is never -0.0, and
+ * s + (+-0.0) is s. */
+static inline __attribute__((always_inline)) float simplex_corner_value(uint32_t dims, const float* d, const float* g) {
+    float r2 = 0.0f, gd = 0.0f;
+    for (uint32_t k = 0; k < dims; ++k) r2 += d[k] * d[k], gd += g[k] * d[k];
+    float t = 0.5f - r2;
+    t = t > 0.0f ? t : 0.0f;
+    const float t2 = t * t;
+    return t2 * t2 * gd;
+}
+
 float ak_noise_simplex2(const ak_noise* noise, float x, float y, float* out_gradient) {
     const float p[2] = {x, y};
     zero_grad(out_gradient, 2);
     if (!noise || !all_finite(2, p)) return 0.0f;
     const float F2 = 0.36602540378f, G2 = 0.2113248654f; /* (sqrt 3 - 1) / 2, (3 - sqrt 3) / 6 */
     const float s = (x + y) * F2;
-    const float fi = floorf(x + s), fj = floorf(y + s);
+    int ii, jj;
+    const float fi = akp_floor(x + s, &ii), fj = akp_floor(y + s, &jj);
     const float t = (fi + fj) * G2;
     const float x0 = x - (fi - t), y0 = y - (fj - t);
     const int i1 = x0 > y0 ? 1 : 0, j1 = 1 - i1;
-    const int ii = (int)fi & 255, jj = (int)fj & 255;
+    ii &= 255, jj &= 255;
     const uint8_t* perm = noise->perm;
     const int h[3] = {perm[perm[ii] + jj], perm[perm[ii + i1] + jj + j1], perm[perm[ii + 1] + jj + 1]};
     const float d[3][2] = {{x0, y0}, {x0 - (float)i1 + G2, y0 - (float)j1 + G2}, {x0 - 1.0f + 2.0f * G2, y0 - 1.0f + 2.0f * G2}};
     float sum = 0.0f, g[2] = {0, 0};
-    for (int c = 0; c < 3; ++c) sum += simplex_corner(2, 0.5f, d[c], simplex_g2[h[c] & 7], out_gradient ? g : NULL);
+    for (int c = 0; c < 3; ++c)
+        sum += out_gradient ? simplex_corner(2, 0.5f, d[c], simplex_g2[h[c] & 7], g)
+                            : simplex_corner_value(2, d[c], simplex_g2[h[c] & 7]);
     if (out_gradient) out_gradient[0] = 70.0f * g[0], out_gradient[1] = 70.0f * g[1];
     return 70.0f * sum;
+}
+
+/* simplex_corner_value for 3D with the offset in three scalars (an array here made gcc store
+ * the floats one by one and load them back as a pair, a store-forwarding stall). */
+static inline __attribute__((always_inline)) float simplex3_corner_value(float dx, float dy, float dz, const float* g) {
+    const float r2 = ((0.0f + dx * dx) + dy * dy) + dz * dz;
+    const float gd = ((0.0f + g[0] * dx) + g[1] * dy) + g[2] * dz;
+    const float t = 0.5f - r2;
+    if (t <= 0.0f) return 0.0f;
+    const float t2 = t * t;
+    return t2 * t2 * gd;
+}
+
+/* simplex3's o1 and o2 as floats, by (x0 >= y0) | (y0 >= z0) << 1 | (x0 >= z0) << 2 (two of the
+ * eight cannot occur: the comparisons of finite floats are transitive). */
+static const float simplex3_steps[8][2][3] = {
+    {{0.0f, 0.0f, 1.0f}, {0.0f, 1.0f, 1.0f}},
+    {{0.0f, 0.0f, 1.0f}, {1.0f, 0.0f, 1.0f}},
+    {{0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 1.0f}},
+    {{0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}},
+    {{0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}},
+    {{1.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 1.0f}},
+    {{0.0f, 1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}},
+    {{1.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 0.0f}},
+};
+
+/* ak_noise_simplex3's value without the gradient for finite x, y, z: the same operations, the
+ * corner offsets from simplex3_steps (no branches on the order: random points mispredict
+ * them) and the corner terms from simplex3_corner_value. */
+static inline __attribute__((always_inline)) float simplex3_value(const uint8_t* perm, float x, float y, float z) {
+    const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
+    const float s = (x + y + z) * F3;
+    int ii, jj, kk;
+    /* a floor of -0.0 only when x, y and z are all -0.0; then fi - t is +0.0 with either zero */
+    const float fi = akp_floor_unsigned_zero(x + s, &ii), fj = akp_floor_unsigned_zero(y + s, &jj),
+                fk = akp_floor_unsigned_zero(z + s, &kk);
+    const float t = (fi + fj + fk) * G3;
+    const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
+    const int xy = x0 >= y0, yz = y0 >= z0, xz = x0 >= z0;
+    const float(*st)[3] = simplex3_steps[xy | yz << 1 | xz << 2];
+    const int o1[3] = {xy & xz, (xy ^ 1) & yz, (xz ^ 1) & (yz ^ 1)};
+    const int o2[3] = {xy | xz, (xy ^ 1) | yz, (xz ^ 1) | (yz ^ 1)};
+    ii &= 255, jj &= 255, kk &= 255;
+    const int h0 = perm[perm[perm[ii] + jj] + kk];
+    const int h1 = perm[perm[perm[ii + o1[0]] + jj + o1[1]] + kk + o1[2]];
+    const int h2 = perm[perm[perm[ii + o2[0]] + jj + o2[1]] + kk + o2[2]];
+    const int h3 = perm[perm[perm[ii + 1] + jj + 1] + kk + 1];
+    const float k1 = 1.0f * G3, k2 = 2.0f * G3, k3 = 3.0f * G3;
+    float sum = 0.0f;
+    sum += simplex3_corner_value(x0 - 0.0f + 0.0f, y0 - 0.0f + 0.0f, z0 - 0.0f + 0.0f, simplex_g3[h0 & 15]);
+    sum += simplex3_corner_value(x0 - st[0][0] + k1, y0 - st[0][1] + k1, z0 - st[0][2] + k1, simplex_g3[h1 & 15]);
+    sum += simplex3_corner_value(x0 - st[1][0] + k2, y0 - st[1][1] + k2, z0 - st[1][2] + k2, simplex_g3[h2 & 15]);
+    sum += simplex3_corner_value(x0 - 1.0f + k3, y0 - 1.0f + k3, z0 - 1.0f + k3, simplex_g3[h3 & 15]);
+    return 76.0f * sum;
 }
 
 float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
     const float p[3] = {x, y, z};
     zero_grad(out_gradient, 3);
     if (!noise || !all_finite(3, p)) return 0.0f;
+    if (!out_gradient) return simplex3_value(noise->perm, x, y, z);
     const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
     const float s = (x + y + z) * F3;
-    const float fi = floorf(x + s), fj = floorf(y + s), fk = floorf(z + s);
+    int ii, jj, kk;
+    const float fi = akp_floor(x + s, &ii), fj = akp_floor(y + s, &jj), fk = akp_floor(z + s, &kk);
     const float t = (fi + fj + fk) * G3;
     const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
-    /* the simplex: the order of x0, y0, z0 from largest to smallest */
-    int o1[3], o2[3];
-    if (x0 >= y0) {
-        if (y0 >= z0) o1[0] = 1, o1[1] = 0, o1[2] = 0, o2[0] = 1, o2[1] = 1, o2[2] = 0;
-        else if (x0 >= z0) o1[0] = 1, o1[1] = 0, o1[2] = 0, o2[0] = 1, o2[1] = 0, o2[2] = 1;
-        else o1[0] = 0, o1[1] = 0, o1[2] = 1, o2[0] = 1, o2[1] = 0, o2[2] = 1;
-    } else {
-        if (y0 < z0) o1[0] = 0, o1[1] = 0, o1[2] = 1, o2[0] = 0, o2[1] = 1, o2[2] = 1;
-        else if (x0 < z0) o1[0] = 0, o1[1] = 1, o1[2] = 0, o2[0] = 0, o2[1] = 1, o2[2] = 1;
-        else o1[0] = 0, o1[1] = 1, o1[2] = 0, o2[0] = 1, o2[1] = 1, o2[2] = 0;
-    }
-    const int ii = (int)fi & 255, jj = (int)fj & 255, kk = (int)fk & 255;
+    /* the simplex: the order of x0, y0, z0 from largest to smallest, as Gustavson's six
+     * branches give it (the comparisons of finite floats are transitive, so o1 is the
+     * largest axis, o2 the two largest), without branches: random points mispredict them */
+    const int xy = x0 >= y0, yz = y0 >= z0, xz = x0 >= z0;
+    const int o1[3] = {xy & xz, (xy ^ 1) & yz, (xz ^ 1) & (yz ^ 1)};
+    const int o2[3] = {xy | xz, (xy ^ 1) | yz, (xz ^ 1) | (yz ^ 1)};
+    ii &= 255, jj &= 255, kk &= 255;
     const uint8_t* perm = noise->perm;
     const int offs[4][3] = {{0, 0, 0}, {o1[0], o1[1], o1[2]}, {o2[0], o2[1], o2[2]}, {1, 1, 1}};
     float sum = 0.0f, g[3] = {0, 0, 0};
@@ -152,22 +219,21 @@ static inline __attribute__((always_inline)) float value_n(const ak_noise* noise
     float f[4];
 #pragma GCC unroll 4
     for (uint32_t k = 0; k < dims; ++k) {
-        const float fl = floorf(point[k]);
-        const int i = (int)fl;
-        f[k] = point[k] - fl;
+        int i;
+        f[k] = akp_floor_frac(point[k], &i);
         lo[k] = i & 255;
         hi[k] = (i + 1) & 255;
     }
     const uint32_t corners = 1u << dims;
     /* corner c (bit k: hi along axis k) hashes perm[...perm[perm[x_c] + y_c]... + w_c], the
      * shared prefixes looked up once (2 + 4 + 8 loads in 3D instead of 24) */
-    int hash[16] = {0};
+    uint32_t hash[16] = {0}; /* unsigned: the index arithmetic needs no sign extension */
 #pragma GCC unroll 4
     for (uint32_t k = 0, count = 1; k < dims; ++k, count *= 2)
 #pragma GCC unroll 8
         for (uint32_t c = 0; c < count; ++c) {
-            hash[c + count] = noise->perm[hash[c] + hi[k]];
-            hash[c] = noise->perm[hash[c] + lo[k]];
+            hash[c + count] = noise->perm[hash[c] + (uint32_t)hi[k]];
+            hash[c] = noise->perm[hash[c] + (uint32_t)lo[k]];
         }
     float val[16], gv[16][4];
 #pragma GCC unroll 16
@@ -198,14 +264,23 @@ static inline __attribute__((always_inline)) float value_n(const ak_noise* noise
     return v < -1.0f ? -1.0f : v > 1.0f ? 1.0f : v;
 }
 
+/* The value-only paths of 2D and 3D, each its own compiled body (no derivative work, and
+ * not sharing one function's registers with the other seven variants). */
+static __attribute__((noinline)) float value2_value(const ak_noise* noise, const float* point) {
+    return value_n(noise, 2, point, NULL);
+}
+static __attribute__((noinline)) float value3_value(const ak_noise* noise, const float* point) {
+    return value_n(noise, 3, point, NULL);
+}
+
 float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_gradient) {
     if (dimensions < 1 || dimensions > 4) return 0.0f;
     zero_grad(out_gradient, dimensions);
     if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
     switch (dimensions) {
     case 1: return out_gradient ? value_n(noise, 1, point, out_gradient) : value_n(noise, 1, point, NULL);
-    case 2: return out_gradient ? value_n(noise, 2, point, out_gradient) : value_n(noise, 2, point, NULL);
-    case 3: return out_gradient ? value_n(noise, 3, point, out_gradient) : value_n(noise, 3, point, NULL);
+    case 2: return out_gradient ? value_n(noise, 2, point, out_gradient) : value2_value(noise, point);
+    case 3: return out_gradient ? value_n(noise, 3, point, out_gradient) : value3_value(noise, point);
     default: return out_gradient ? value_n(noise, 4, point, out_gradient) : value_n(noise, 4, point, NULL);
     }
 }
@@ -328,6 +403,131 @@ static inline __attribute__((always_inline)) void worley_near_rings(uint32_t dim
     b->d2 = d2;
 }
 
+/* Rings 0 and 1 for F1 alone (no F2 asked for): worley_near_rings's nearest cell without the
+ * second distance and without skipping cells (random points mispredict the skip test; a cell
+ * it passes over is not closer). The running minimum with strict "<" in visiting order is the
+ * first cell in that order among those at the least distance; it is kept here as three running
+ * minima over the first, second and last third of the visiting order (three short dependency
+ * chains instead of one of 27 compares), merged in order, a later third winning only when
+ * strictly closer: the same cell and the same d1. */
+static inline __attribute__((always_inline)) void worley_f1_rings(uint32_t dims, uint64_t seed, const int* base,
+                                                                  const float* f, worley_best* b) {
+    static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
+    const uint32_t seed_mix = (uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32);
+    uint32_t axis[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (uint32_t k = 0; k < dims; ++k)
+        for (int o = 0; o < 3; ++o) axis[k][o] = (uint32_t)(base[k] + o - 1) * mul[k];
+    const int cells = dims == 1 ? 3 : dims == 2 ? 9 : 27, center = cells / 2;
+    float d1[3] = {b->d1, b->d1, b->d1};
+    int best[3] = {0, 0, 0};
+    uint32_t best_h[3] = {0, 0, 0};
+#pragma GCC unroll 27
+    for (int step = 0; step < cells; ++step) {
+        const int c = step == 0 ? center : step <= center ? step - 1 : step;
+        const int o[3] = {c % 3, c / 3 % 3, c / 9};
+        const int chain = step * 3 / cells;
+        uint32_t h = seed_mix;
+        for (uint32_t k = 0; k < dims; ++k) h ^= axis[k][o[k]];
+        h ^= h >> 16;
+        h *= 0x85EBCA6Bu;
+        h ^= h >> 13;
+        h *= 0xC2B2AE35u;
+        h ^= h >> 16;
+        const int off[3] = {o[0] - 1, o[1] - 1, o[2] - 1};
+        float dv[3];
+        const float dist2 = worley_offset(dims, h, f, off, dv);
+        /* selects as masks: gcc turned the ?: forms into branches */
+        const uint32_t m = 0u - (uint32_t)(dist2 < d1[chain]);
+        best[chain] = (int)(((uint32_t)c & m) | ((uint32_t)best[chain] & ~m));
+        best_h[chain] = (h & m) | (best_h[chain] & ~m);
+        d1[chain] = dist2 < d1[chain] ? dist2 : d1[chain];
+    }
+#pragma GCC unroll 2
+    for (int chain = 1; chain < 3; ++chain) {
+        const bool closer = d1[chain] < d1[0];
+        best[0] = closer ? best[chain] : best[0];
+        best_h[0] = closer ? best_h[chain] : best_h[0];
+        d1[0] = closer ? d1[chain] : d1[0];
+    }
+    const int off[3] = {best[0] % 3 - 1, best[0] / 3 % 3 - 1, best[0] / 9 - 1};
+    float dv[3] = {0, 0, 0};
+    worley_offset(dims, best_h[0], f, off, dv);
+    memcpy(b->near, dv, sizeof dv);
+    b->d1 = d1[0];
+}
+
+/* Rings 2 to 6, when rings 0 and 1 left a nearest (or second nearest, want_f2) distance that
+ * a farther cell could beat: ring r holds the cells at Chebyshev distance r from the point's
+ * cell; their feature points are at least (r - 1) + margin (+ 1/2048) away, so the search
+ * stops once that exceeds F2 (or F1 when F2 is not asked for: a farther cell cannot change the
+ * nearest). Rare, so out of line. */
+static __attribute__((noinline)) void worley_far_rings(uint32_t dims, uint64_t seed, const int* base, const float* f,
+                                                       float margin, bool want_f2, worley_best* b) {
+    for (int r = 2; r <= 6; ++r) {
+        const float bound = (float)(r - 1) + margin;
+        if (bound * bound >= (want_f2 ? b->d2 : b->d1)) break;
+        const int span = 2 * r + 1;
+        const int cells = dims == 1 ? span : dims == 2 ? span * span : span * span * span;
+        for (int c = 0; c < cells; ++c) {
+            int off[3] = {0, 0, 0}, cc = c, cheb = 0;
+            for (uint32_t k = 0; k < dims; ++k) {
+                off[k] = cc % span - r;
+                cc /= span;
+                cheb = off[k] < 0 ? (-off[k] > cheb ? -off[k] : cheb) : (off[k] > cheb ? off[k] : cheb);
+            }
+            if (cheb != r) continue;
+            int cell[3];
+            for (uint32_t k = 0; k < dims; ++k) cell[k] = base[k] + off[k];
+            worley_visit(dims, cell_hash(cell, dims, seed), f, off, b);
+        }
+    }
+}
+
+/* Worley noise at a finite point with a constant dims and want_f2 (out_f2 != NULL) when
+ * inlined: rings 0 and 1 (worley_near_rings, or worley_f1_rings for F1 alone), then the far
+ * rings when they could matter. */
+static inline __attribute__((always_inline)) float worley_n(const ak_noise* noise, uint32_t dims, bool want_f2,
+                                                            const float* point, float* out_f2, float* out_gradient) {
+    int base[3] = {0, 0, 0};
+    float f[3] = {0, 0, 0}, margin = 1.0f;
+    for (uint32_t k = 0; k < dims; ++k) {
+        f[k] = akp_floor_frac(point[k], &base[k]);
+        const float g = f[k] < 1.0f - f[k] ? f[k] : 1.0f - f[k]; /* fminf without the libm call */
+        margin = g < margin ? g : margin;
+    }
+    worley_best b = {INFINITY, INFINITY, {0, 0, 0}};
+    if (want_f2) worley_near_rings(dims, noise->seed, base, f, true, &b);
+    else worley_f1_rings(dims, noise->seed, base, f, &b);
+    const float bound = 1.0f + margin; /* ring 2's */
+    if (bound * bound < (want_f2 ? b.d2 : b.d1)) worley_far_rings(dims, noise->seed, base, f, margin, want_f2, &b);
+    const float f1 = sqrtf(b.d1);
+    if (want_f2) *out_f2 = sqrtf(b.d2);
+    if (out_gradient && f1 > 0.0f)
+        for (uint32_t k = 0; k < dims; ++k) out_gradient[k] = b.near[k] / f1;
+    return f1;
+}
+
+/* One compiled body per dimension and F2 choice (a single body holding all six was not
+ * unrolled as well). */
+#define AKP_WORLEY_VARIANT(name, dims, want_f2)                                                                    \
+    static __attribute__((noinline)) float name(const ak_noise* noise, const float* point, float* out_f2,          \
+                                                float* out_gradient) {                                             \
+        return worley_n(noise, dims, want_f2, point, out_f2, out_gradient);                                        \
+    }
+/* F1 alone and no gradient: the common call */
+static __attribute__((noinline)) float worley3_value(const ak_noise* noise, const float* point) {
+    return worley_n(noise, 3, false, point, NULL, NULL);
+}
+static __attribute__((noinline)) float worley2_value(const ak_noise* noise, const float* point) {
+    return worley_n(noise, 2, false, point, NULL, NULL);
+}
+AKP_WORLEY_VARIANT(worley1_f1, 1, false)
+AKP_WORLEY_VARIANT(worley2_f1, 2, false)
+AKP_WORLEY_VARIANT(worley3_f1, 3, false)
+AKP_WORLEY_VARIANT(worley1_f2, 1, true)
+AKP_WORLEY_VARIANT(worley2_f2, 2, true)
+AKP_WORLEY_VARIANT(worley3_f2, 3, true)
+
 float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_f2,
                       float* out_gradient) {
     if (dimensions < 1 || dimensions > 3) {
@@ -337,46 +537,77 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
     zero_grad(out_gradient, dimensions);
     if (out_f2) *out_f2 = 0.0f;
     if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
-    int base[3] = {0, 0, 0};
-    float f[3] = {0, 0, 0}, margin = 1.0f;
-    for (uint32_t k = 0; k < dimensions; ++k) {
-        const float fl = floorf(point[k]);
-        base[k] = (int)fl;
-        f[k] = point[k] - fl;
-        const float g = f[k] < 1.0f - f[k] ? f[k] : 1.0f - f[k]; /* fminf without the libm call */
-        margin = g < margin ? g : margin;
-    }
-    worley_best b = {INFINITY, INFINITY, {0, 0, 0}};
-    /* Ring r holds the cells at Chebyshev distance r from the point's cell; their feature
-     * points are at least (r - 1) + margin (+ 1/2048) away, so the search stops once that
-     * exceeds F2 (or F1 when F2 is not asked for: a farther cell cannot change the nearest).
-     * Rings 0 and 1 are always searched. */
     switch (dimensions) {
-    case 1: worley_near_rings(1, noise->seed, base, f, out_f2 != NULL, &b); break;
-    case 2: worley_near_rings(2, noise->seed, base, f, out_f2 != NULL, &b); break;
-    default: worley_near_rings(3, noise->seed, base, f, out_f2 != NULL, &b); break;
+    case 1:
+        return out_f2 ? worley1_f2(noise, point, out_f2, out_gradient)
+                      : worley1_f1(noise, point, NULL, out_gradient);
+    case 2:
+        return out_f2         ? worley2_f2(noise, point, out_f2, out_gradient)
+               : out_gradient ? worley2_f1(noise, point, NULL, out_gradient)
+                              : worley2_value(noise, point);
+    default:
+        return out_f2         ? worley3_f2(noise, point, out_f2, out_gradient)
+               : out_gradient ? worley3_f1(noise, point, NULL, out_gradient)
+                              : worley3_value(noise, point);
     }
-    for (int r = 2; r <= 6; ++r) {
-        const float bound = (float)(r - 1) + margin;
-        if (bound * bound >= (out_f2 ? b.d2 : b.d1)) break;
-        const int span = 2 * r + 1;
-        const int cells = dimensions == 1 ? span : dimensions == 2 ? span * span : span * span * span;
-        for (int c = 0; c < cells; ++c) {
-            int off[3] = {0, 0, 0}, cc = c, cheb = 0;
-            for (uint32_t k = 0; k < dimensions; ++k) {
-                off[k] = cc % span - r;
-                cc /= span;
-                cheb = off[k] < 0 ? (-off[k] > cheb ? -off[k] : cheb) : (off[k] > cheb ? off[k] : cheb);
-            }
-            if (cheb != r) continue;
-            int cell[3];
-            for (uint32_t k = 0; k < dimensions; ++k) cell[k] = base[k] + off[k];
-            worley_visit(dimensions, cell_hash(cell, dimensions, noise->seed), f, off, &b);
-        }
+}
+
+/* ---- fBm over simplex, value and Worley noise ---------------------------------------------- */
+
+/* One octave's basis value, as fractal.c's basis_eval gives it without gradient. */
+static inline __attribute__((always_inline)) float basis_value(const ak_noise* noise, ak_noise_basis basis,
+                                                               uint32_t dims, const float* q) {
+    switch (basis) {
+    case AK_NOISE_BASIS_SIMPLEX:
+        if (dims == 3) return all_finite(3, q) ? simplex3_value(noise->perm, q[0], q[1], q[2]) : 0.0f;
+        return ak_noise_simplex2(noise, q[0], dims == 1 ? 0.0f : q[1], NULL);
+    case AK_NOISE_BASIS_VALUE: return all_finite(dims, q) ? value_n(noise, dims, q, NULL) : 0.0f;
+    default: return all_finite(dims, q) ? worley_n(noise, dims, false, q, NULL, NULL) : 0.0f;
     }
-    const float f1 = sqrtf(b.d1);
-    if (out_f2) *out_f2 = sqrtf(b.d2);
-    if (out_gradient && f1 > 0.0f)
-        for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = b.near[k] / f1;
-    return f1;
+}
+
+static inline __attribute__((always_inline)) float fbm_other_n(const ak_noise* noise, const ak_fractal_desc* d,
+                                                               ak_noise_basis basis, uint32_t dims, const float* p) {
+    float freq = d->frequency, amp = 1.0f, sum = 0.0f;
+    const float lacunarity = d->lacunarity, gain = d->gain;
+    for (uint32_t o = 0; o < d->octaves; ++o) {
+        float q[4];
+#pragma GCC unroll 4
+        for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
+        sum = sum + amp * basis_value(noise, basis, dims, q);
+        freq = freq * lacunarity;
+        amp = amp * gain;
+    }
+    return sum;
+}
+
+/* One compiled body per basis and dimension. */
+#define AKP_FBM_OTHER(name, basis, dims)                                                            \
+    static __attribute__((noinline)) float name(const ak_noise* noise, const ak_fractal_desc* d,   \
+                                                const float* p) {                                  \
+        return fbm_other_n(noise, d, basis, dims, p);                                              \
+    }
+AKP_FBM_OTHER(fbm_simplex1, AK_NOISE_BASIS_SIMPLEX, 1)
+AKP_FBM_OTHER(fbm_simplex2, AK_NOISE_BASIS_SIMPLEX, 2)
+AKP_FBM_OTHER(fbm_simplex3, AK_NOISE_BASIS_SIMPLEX, 3)
+AKP_FBM_OTHER(fbm_value1, AK_NOISE_BASIS_VALUE, 1)
+AKP_FBM_OTHER(fbm_value2, AK_NOISE_BASIS_VALUE, 2)
+AKP_FBM_OTHER(fbm_value3, AK_NOISE_BASIS_VALUE, 3)
+AKP_FBM_OTHER(fbm_value4, AK_NOISE_BASIS_VALUE, 4)
+AKP_FBM_OTHER(fbm_worley1, AK_NOISE_BASIS_WORLEY, 1)
+AKP_FBM_OTHER(fbm_worley2, AK_NOISE_BASIS_WORLEY, 2)
+AKP_FBM_OTHER(fbm_worley3, AK_NOISE_BASIS_WORLEY, 3)
+
+float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
+    switch (d->basis) {
+    case AK_NOISE_BASIS_SIMPLEX:
+        return dims == 1 ? fbm_simplex1(noise, d, p) : dims == 2 ? fbm_simplex2(noise, d, p) : fbm_simplex3(noise, d, p);
+    case AK_NOISE_BASIS_VALUE:
+        return dims == 1   ? fbm_value1(noise, d, p)
+               : dims == 2 ? fbm_value2(noise, d, p)
+               : dims == 3 ? fbm_value3(noise, d, p)
+                           : fbm_value4(noise, d, p);
+    default:
+        return dims == 1 ? fbm_worley1(noise, d, p) : dims == 2 ? fbm_worley2(noise, d, p) : fbm_worley3(noise, d, p);
+    }
 }

@@ -77,7 +77,9 @@ void ak_noise_range(ak_noise_basis basis, uint32_t dimensions, float* out_lo, fl
     if (out_hi) *out_hi = hi;
 }
 
-ak_fractal_desc ak_fractal_desc_resolved(const ak_fractal_desc* desc) {
+/* The desc with defaults filled in, and its checks (inlined into ak_fractal_eval, which is
+ * called per point). */
+static inline ak_fractal_desc resolve(const ak_fractal_desc* desc) {
     ak_fractal_desc d;
     if (desc) d = *desc;
     else memset(&d, 0, sizeof d);
@@ -90,15 +92,21 @@ ak_fractal_desc ak_fractal_desc_resolved(const ak_fractal_desc* desc) {
     return d;
 }
 
-ak_result ak_fractal_desc_validate(const ak_fractal_desc* desc) {
-    const ak_fractal_desc d = ak_fractal_desc_resolved(desc);
-    if ((unsigned)d.type >= AK_FRACTAL_TYPE_COUNT || (unsigned)d.basis >= AK_NOISE_BASIS_COUNT) return AK_ERR_BAD_ARG;
-    if (d.octaves > 16) return AK_ERR_BAD_ARG;
-    if (!(d.lacunarity > 0.0f && d.lacunarity <= 16.0f)) return AK_ERR_BAD_ARG;
-    if (!(d.gain > 0.0f && d.gain <= 2.0f)) return AK_ERR_BAD_ARG;
-    if (!(d.frequency > 0.0f && d.frequency <= 1e6f)) return AK_ERR_BAD_ARG;
-    if (!(fabsf(d.warp) <= 1e6f)) return AK_ERR_BAD_ARG;
+static inline ak_result validate_resolved(const ak_fractal_desc* d) {
+    if ((unsigned)d->type >= AK_FRACTAL_TYPE_COUNT || (unsigned)d->basis >= AK_NOISE_BASIS_COUNT) return AK_ERR_BAD_ARG;
+    if (d->octaves > 16) return AK_ERR_BAD_ARG;
+    if (!(d->lacunarity > 0.0f && d->lacunarity <= 16.0f)) return AK_ERR_BAD_ARG;
+    if (!(d->gain > 0.0f && d->gain <= 2.0f)) return AK_ERR_BAD_ARG;
+    if (!(d->frequency > 0.0f && d->frequency <= 1e6f)) return AK_ERR_BAD_ARG;
+    if (!(fabsf(d->warp) <= 1e6f)) return AK_ERR_BAD_ARG;
     return AK_OK;
+}
+
+ak_fractal_desc ak_fractal_desc_resolved(const ak_fractal_desc* desc) { return resolve(desc); }
+
+ak_result ak_fractal_desc_validate(const ak_fractal_desc* desc) {
+    const ak_fractal_desc d = resolve(desc);
+    return validate_resolved(&d);
 }
 
 /* The octave sum at p (no warping). */
@@ -145,7 +153,15 @@ static float octaves(const ak_noise* noise, const ak_fractal_desc* d, uint32_t d
 }
 
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad) {
-    if (d->warp == 0.0f) return octaves(noise, d, dims, p, grad);
+    if (d->warp == 0.0f) {
+        /* fBm without gradient, the common case, in loops specialised per basis and dimension */
+        if (!grad && d->type == AK_FRACTAL_FBM)
+            return d->basis == AK_NOISE_BASIS_PERLIN ? akp_fbm_perlin(noise, d, dims, p)
+                                                     : akp_fbm_other(noise, d, dims, p);
+        if (d->type == AK_FRACTAL_FBM && d->basis == AK_NOISE_BASIS_PERLIN && (dims == 2 || dims == 3))
+            return akp_fbm_perlin_grad(noise, d, dims, p, grad);
+        return octaves(noise, d, dims, p, grad);
+    }
     static const float offset[4] = {5.2f, 1.3f, 7.1f, 2.9f};
     float q[4] = {0, 0, 0, 0}, wg[4][4];
     for (uint32_t k = 0; k < dims; ++k) {
@@ -170,9 +186,9 @@ float ak_fractal_eval(const ak_noise* noise, const ak_fractal_desc* desc, uint32
                       float* out_gradient) {
     if (out_gradient && dimensions <= 4)
         for (uint32_t k = 0; k < dimensions; ++k) out_gradient[k] = 0.0f;
-    if (!noise || !point || ak_fractal_desc_validate(desc) != AK_OK) return 0.0f;
-    const ak_fractal_desc d = ak_fractal_desc_resolved(desc);
-    if (!ak_noise_basis_supports(d.basis, dimensions)) return 0.0f;
+    if (!noise || !point) return 0.0f;
+    const ak_fractal_desc d = resolve(desc);
+    if (validate_resolved(&d) != AK_OK || !ak_noise_basis_supports(d.basis, dimensions)) return 0.0f;
     return akp_fractal_point(noise, &d, dimensions, point, out_gradient);
 }
 

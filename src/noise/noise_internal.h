@@ -2,11 +2,68 @@
 #ifndef ANIMKIT_NOISE_INTERNAL_H
 #define ANIMKIT_NOISE_INTERNAL_H
 
+#include <math.h>
+#include <string.h>
+
 #include <animkit/noise.h>
 
 /* Coordinates at or beyond this magnitude (and NaN) give 0: their floor would not fit the
  * integer lattice arithmetic, and floats there have no fractional part anyway. */
 #define AKP_NOISE_LIMIT 16777216.0f
+
+/* floorf(x) and the same value as an int, for |x| < 2^31 (callers check AKP_NOISE_LIMIT first):
+ * truncate, step down where truncation rounded up (negative non-integers), and take x's sign,
+ * which only changes -0.0 (floorf(-0.0) is -0.0; the int conversion gives +0.0). The same
+ * float as floorf bit for bit (test_noise floor_matches_libm), without the rounding-mode
+ * branch gcc emits for floorf on baseline x86-64 (no SSE4.1 roundss). */
+static inline float akp_floor(float x, int* out_i) {
+    const int t = (int)x;
+    const float ft = (float)t;
+    const int up = ft > x;
+    *out_i = t - up;
+    /* ft - 1 or ft - 0 (ft is never -0.0, so ft - 0 is ft) without a branch: random signs
+     * would mispredict one */
+    const uint32_t one_bits = (uint32_t)-up & 0x3F800000u;
+    float one;
+    memcpy(&one, &one_bits, sizeof one);
+    return copysignf(ft - one, x);
+}
+
+/* akp_floor without the sign step: floorf(x) except +0.0 for x = -0.0, for callers where that
+ * zero's sign cannot reach the result (simplex: see simplex3_value). */
+static inline float akp_floor_unsigned_zero(float x, int* out_i) {
+    const int t = (int)x;
+    const float ft = (float)t;
+    const int up = ft > x;
+    *out_i = t - up;
+    const uint32_t one_bits = (uint32_t)-up & 0x3F800000u;
+    float one;
+    memcpy(&one, &one_bits, sizeof one);
+    return ft - one;
+}
+
+/* x - floorf(x) (the fraction in [0, 1)) and floorf(x) as an int, in one. The floor is taken
+ * without its sign here: only x = -0.0 tells (-0.0 - +0.0 is -0.0 where x - floorf(x) is
+ * +0.0), and adding +0.0 turns that -0.0 into +0.0 and changes no other value. */
+static inline float akp_floor_frac(float x, int* out_i) {
+    const int t = (int)x;
+    const float ft = (float)t;
+    const int up = ft > x;
+    *out_i = t - up;
+    const uint32_t one_bits = (uint32_t)-up & 0x3F800000u;
+    float one;
+    memcpy(&one, &one_bits, sizeof one);
+    return (x - (ft - one)) + 0.0f;
+}
+
+/* The fBm octave sum without gradient or warp, for a resolved, valid desc of type FBM and a
+ * dims the basis supports: octaves()'s loop (fractal.c) with the basis inlined, the same float
+ * operations in the same order. Perlin in perlin.c, the other bases in bases.c. */
+float akp_fbm_perlin(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
+float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
+/* The same with the gradient, Perlin in 2D and 3D (dims 2 or 3). */
+float akp_fbm_perlin_grad(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p,
+                          float* grad);
 
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);

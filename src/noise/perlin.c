@@ -159,6 +159,66 @@ static inline __attribute__((always_inline)) float lattice(const uint8_t* perm, 
     return val[0];
 }
 
+/* The value-only lattice of 2D and 3D (no gradient asked for): the same corner values with
+ * fewer loads. slots[c][h] names, for corner c and hash h, the two terms of Perlin's
+ * (+-u) + (+-v) in a 16-float table D of the corner offsets: D[2 k + b] = f[k] - b (axis k,
+ * corner bit b; 2D's slot for axis 2 holds the zero its axis gradients read), D[8 + i] =
+ * -D[i]; low nibble the u term, high nibble the v term. D[u] + D[v] is the sign-times-offset
+ * sum of corner_dot exactly (multiplying by -1 is negation); generated from g3_u/g3_v
+ * (g2_u/g2_v) and the sign bits h & 1 (u) and h & 2 (v). */
+static const uint8_t corner_slots3[8][16] = {
+    {0x20, 0x28, 0xA0, 0xA8, 0x40, 0x48, 0xC0, 0xC8, 0x42, 0x4A, 0xC2, 0xCA, 0x02, 0x4A, 0x82, 0xCA},
+    {0x21, 0x29, 0xA1, 0xA9, 0x41, 0x49, 0xC1, 0xC9, 0x42, 0x4A, 0xC2, 0xCA, 0x12, 0x4A, 0x92, 0xCA},
+    {0x30, 0x38, 0xB0, 0xB8, 0x40, 0x48, 0xC0, 0xC8, 0x43, 0x4B, 0xC3, 0xCB, 0x03, 0x4B, 0x83, 0xCB},
+    {0x31, 0x39, 0xB1, 0xB9, 0x41, 0x49, 0xC1, 0xC9, 0x43, 0x4B, 0xC3, 0xCB, 0x13, 0x4B, 0x93, 0xCB},
+    {0x20, 0x28, 0xA0, 0xA8, 0x50, 0x58, 0xD0, 0xD8, 0x52, 0x5A, 0xD2, 0xDA, 0x02, 0x5A, 0x82, 0xDA},
+    {0x21, 0x29, 0xA1, 0xA9, 0x51, 0x59, 0xD1, 0xD9, 0x52, 0x5A, 0xD2, 0xDA, 0x12, 0x5A, 0x92, 0xDA},
+    {0x30, 0x38, 0xB0, 0xB8, 0x50, 0x58, 0xD0, 0xD8, 0x53, 0x5B, 0xD3, 0xDB, 0x03, 0x5B, 0x83, 0xDB},
+    {0x31, 0x39, 0xB1, 0xB9, 0x51, 0x59, 0xD1, 0xD9, 0x53, 0x5B, 0xD3, 0xDB, 0x13, 0x5B, 0x93, 0xDB},
+};
+static const uint8_t corner_slots2[4][8] = {
+    {0x20, 0x28, 0xA0, 0xA8, 0x40, 0x48, 0xC2, 0xCA},
+    {0x21, 0x29, 0xA1, 0xA9, 0x41, 0x49, 0xC2, 0xCA},
+    {0x30, 0x38, 0xB0, 0xB8, 0x40, 0x48, 0xC3, 0xCB},
+    {0x31, 0x39, 0xB1, 0xB9, 0x41, 0x49, 0xC3, 0xCB},
+};
+
+static inline __attribute__((always_inline)) float lattice_value(const uint8_t* perm, uint32_t dims, const int* lo,
+                                                                 const int* hi, const float* f) {
+    uint32_t hash[8]; /* unsigned: the index arithmetic needs no sign extension */
+    hash[0] = perm[lo[0]];
+    hash[1] = perm[hi[0]];
+    AKP_UNROLL
+    for (uint32_t k = 1; k < dims; ++k) {
+        const uint32_t half = 1u << k;
+        AKP_UNROLL
+        for (uint32_t c = 0; c < half; ++c) {
+            hash[c + half] = perm[hash[c] + (uint32_t)hi[k]];
+            hash[c] = perm[hash[c] + (uint32_t)lo[k]];
+        }
+    }
+    float D[16] = {0};
+    AKP_UNROLL
+    for (uint32_t k = 0; k < dims; ++k) D[2 * k] = f[k], D[2 * k + 1] = f[k] - 1.0f;
+    AKP_UNROLL
+    for (int i = 0; i < 8; ++i) D[8 + i] = -D[i];
+    float val[8];
+    const uint32_t corners = 1u << dims;
+    AKP_UNROLL
+    for (uint32_t c = 0; c < corners; ++c) {
+        const uint32_t s = dims == 3 ? corner_slots3[c][hash[c] & 15] : corner_slots2[c][hash[c] & 7];
+        val[c] = D[s & 15u] + D[s >> 4];
+    }
+    AKP_UNROLL
+    for (uint32_t k = 0; k < dims; ++k) {
+        const float t = fade(f[k]);
+        const uint32_t step = 1u << k;
+        AKP_UNROLL
+        for (uint32_t c = 0; c < corners; c += 2u * step) val[c] = lerp(t, val[c], val[c + step]);
+    }
+    return val[0];
+}
+
 static inline __attribute__((always_inline)) float perlin_n(const ak_noise* noise, uint32_t dims, const float* p,
                                                             const int* period, float* grad) {
     int lo[4], hi[4];
@@ -171,9 +231,8 @@ static inline __attribute__((always_inline)) float perlin_n(const ak_noise* nois
                 for (uint32_t m = 0; m < dims; ++m) grad[m] = 0.0f;
             return 0.0f;
         }
-        const float fl = floorf(p[k]);
-        const int i = (int)fl;
-        f[k] = p[k] - fl;
+        int i;
+        f[k] = akp_floor_frac(p[k], &i);
         if (period) {
             const int per = period[k];
             int w = i % per;
@@ -185,6 +244,7 @@ static inline __attribute__((always_inline)) float perlin_n(const ak_noise* nois
             hi[k] = (i + 1) & 255;
         }
     }
+    if (!grad && (dims == 2 || dims == 3)) return lattice_value(noise->perm, dims, lo, hi, f);
     return lattice(noise->perm, dims, lo, hi, f, grad);
 }
 
@@ -238,5 +298,76 @@ float ak_noise_perlin_periodic(const ak_noise* noise, uint32_t dimensions, const
     case 2: return perlin_n(noise, 2, point, period, out_gradient);
     case 3: return perlin_n(noise, 3, point, period, out_gradient);
     default: return perlin_n(noise, 4, point, period, out_gradient);
+    }
+}
+
+/* fBm over Perlin noise with a constant dims (akp_fbm_perlin). */
+static inline __attribute__((always_inline)) float fbm_perlin_n(const ak_noise* noise, const ak_fractal_desc* d,
+                                                                uint32_t dims, const float* p) {
+    float freq = d->frequency, amp = 1.0f, sum = 0.0f;
+    const float lacunarity = d->lacunarity, gain = d->gain;
+    for (uint32_t o = 0; o < d->octaves; ++o) {
+        float q[4];
+        AKP_UNROLL
+        for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
+        sum = sum + amp * perlin_n(noise, dims, q, NULL, NULL);
+        freq = freq * lacunarity;
+        amp = amp * gain;
+    }
+    return sum;
+}
+
+/* fBm over Perlin noise with its gradient (octaves()'s FBM branch: the same operations). */
+static inline __attribute__((always_inline)) float fbm_perlin_grad_n(const ak_noise* noise, const ak_fractal_desc* d,
+                                                                     uint32_t dims, const float* p, float* grad) {
+    float freq = d->frequency, amp = 1.0f, sum = 0.0f, gs[4] = {0, 0, 0, 0};
+    const float lacunarity = d->lacunarity, gain = d->gain;
+    for (uint32_t o = 0; o < d->octaves; ++o) {
+        float q[4], g[4];
+        AKP_UNROLL
+        for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
+        const float n = perlin_n(noise, dims, q, NULL, g);
+        sum = sum + amp * n;
+        AKP_UNROLL
+        for (uint32_t k = 0; k < dims; ++k) gs[k] = gs[k] + (amp * freq) * g[k];
+        freq = freq * lacunarity;
+        amp = amp * gain;
+    }
+    AKP_UNROLL
+    for (uint32_t k = 0; k < dims; ++k) grad[k] = gs[k];
+    return sum;
+}
+
+static __attribute__((noinline)) float fbm_perlin2_grad(const ak_noise* noise, const ak_fractal_desc* d,
+                                                        const float* p, float* grad) {
+    return fbm_perlin_grad_n(noise, d, 2, p, grad);
+}
+static __attribute__((noinline)) float fbm_perlin3_grad(const ak_noise* noise, const ak_fractal_desc* d,
+                                                        const float* p, float* grad) {
+    return fbm_perlin_grad_n(noise, d, 3, p, grad);
+}
+
+float akp_fbm_perlin_grad(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p,
+                          float* grad) {
+    return dims == 2 ? fbm_perlin2_grad(noise, d, p, grad) : fbm_perlin3_grad(noise, d, p, grad);
+}
+
+/* One compiled body per dimension (sharing one function cost the loop its registers). */
+#define AKP_FBM_PERLIN(name, dims)                                                                  \
+    static __attribute__((noinline)) float name(const ak_noise* noise, const ak_fractal_desc* d,   \
+                                                const float* p) {                                  \
+        return fbm_perlin_n(noise, d, dims, p);                                                    \
+    }
+AKP_FBM_PERLIN(fbm_perlin1, 1)
+AKP_FBM_PERLIN(fbm_perlin2, 2)
+AKP_FBM_PERLIN(fbm_perlin3, 3)
+AKP_FBM_PERLIN(fbm_perlin4, 4)
+
+float akp_fbm_perlin(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
+    switch (dims) {
+    case 1: return fbm_perlin1(noise, d, p);
+    case 2: return fbm_perlin2(noise, d, p);
+    case 3: return fbm_perlin3(noise, d, p);
+    default: return fbm_perlin4(noise, d, p);
     }
 }
