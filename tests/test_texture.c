@@ -193,6 +193,7 @@ AK_TEST(jpeg_decode) {
     if (r == AK_ERR_UNSUPPORTED) {
         free(jpg);
         AK_SKIP("this build has no JPEG decoder");
+        return;
     }
     AK_CHECK_EQ(r, AK_OK);
     AK_CHECK_EQ(w, W);
@@ -722,7 +723,7 @@ AK_TEST(gltf_assets_textured) {
     const char* fox_png = asset("Fox/glTF/Texture.png");
     const char* man = asset("CesiumMan/glTF-Binary/CesiumMan.glb");
     if (!file_exists(fox_glb) || !file_exists(fox_gltf) || !file_exists(man))
-        AK_SKIP("assets not found");
+        { AK_SKIP("assets not found"); return; }
     /* the PNG file itself, read by libpng's file reader: the independent reference */
     int w = 0, h = 0;
     AK_CHECK_EQ(ak_png_info(fox_png, &w, &h), AK_OK);
@@ -783,7 +784,7 @@ static bool same_texture(const ak_scene* a, const ak_scene* b, size_t mesh) {
 /* `animkit export Fox.glb -o x.glb` keeps the texture: the re-loaded file has the same texels. */
 AK_TEST(cli_export_keeps_texture) {
     const char* fox = asset("Fox/glTF-Binary/Fox.glb");
-    if (!file_exists(fox)) AK_SKIP("assets not found");
+    if (!file_exists(fox)) { AK_SKIP("assets not found"); return; }
     char args[2048];
     snprintf(args, sizeof args, "export '%s' -o tex_fox.glb", fox);
     AK_CHECK_EQ(run(args, true), 0);
@@ -806,7 +807,7 @@ AK_TEST(cli_export_keeps_texture) {
  * origin); animkit's OBJ reader gives back the same texels for the same UVs. */
 AK_TEST(obj_export_map_kd) {
     const char* fox = asset("Fox/glTF-Binary/Fox.glb");
-    if (!file_exists(fox)) AK_SKIP("assets not found");
+    if (!file_exists(fox)) { AK_SKIP("assets not found"); return; }
     ak_scene *a = NULL, *b = NULL;
     ak_diag diag;
     AK_CHECK_EQ(ak_io_load(fox, NULL, NULL, &a, &diag), AK_OK);
@@ -894,7 +895,7 @@ static void check_head(const ak_image* img, int from, const char* what) {
 /* `render` to a PNG shows the texture on the head. */
 AK_TEST(cesium_man_head_textured) {
     const char* man = asset("CesiumMan/glTF-Binary/CesiumMan.glb");
-    if (!file_exists(man)) AK_SKIP("assets not found");
+    if (!file_exists(man)) { AK_SKIP("assets not found"); return; }
     char args[2048];
     snprintf(args, sizeof args, "render '%s' -o tex_man.png", man);
     AK_CHECK_EQ(run(args, true), 0);
@@ -910,7 +911,7 @@ AK_TEST(cesium_man_head_textured) {
 /* The GIF and the viewer draw through the same frame code: checked as slow cases. */
 AK_TEST(cesium_man_head_gif_and_viewer) {
     const char* man = asset("CesiumMan/glTF-Binary/CesiumMan.glb");
-    if (!file_exists(man)) AK_SKIP("assets not found");
+    if (!file_exists(man)) { AK_SKIP("assets not found"); return; }
     char args[2048];
     int w = 0, h = 0;
     uint8_t* px = NULL;
