@@ -328,12 +328,14 @@ RIGID_HOT float contact_vn(const solver* s, const rigid_contact* c);
 
 static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float margin) {
     rigid_pose pa = {s->x[a], s->q[a]}, pb = {s->x[b], s->q[b]};
-    /* the buffer has AKP_RIGID_MAX_PAIR_CONTACTS slack past cap */
+    /* at most the room left (an island's region ends where the next one's starts): the
+     * points past it would be dropped below anyway, and the first ones are the same */
+    uint32_t room = cb->cap - cb->count;
     int found = akp_rigid_collide(s->m, a, b, pa, pb, margin, cb->c + cb->count,
-                                  AKP_RIGID_MAX_PAIR_CONTACTS);
+                                  room < AKP_RIGID_MAX_PAIR_CONTACTS ? (int)room
+                                                                    : AKP_RIGID_MAX_PAIR_CONTACTS);
     int kept = found < AKP_RIGID_MAX_PAIR_CONTACTS ? found : AKP_RIGID_MAX_PAIR_CONTACTS;
     if (cb->count + (uint32_t)kept > cb->cap) {
-        uint32_t room = cb->cap - cb->count;
         cb->dropped += (uint32_t)found - room;
         kept = (int)room;
     } else {
