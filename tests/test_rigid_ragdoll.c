@@ -15,6 +15,8 @@
 #include <animkit/animkit.h>
 
 #include "ak_test.h"
+#include "rigid/rigid_impl.h"
+#include "tasks.h"
 
 #define CESIUM "gltf/CesiumMan/glTF-Binary/CesiumMan.glb"
 
@@ -698,6 +700,199 @@ done:
     ak_scene_destroy(scene);
 }
 
+/* Islands: the bodies joined by the step's contact pairs and by joints are solved island by
+ * island (on the worker team when thread_count > 1), with the same numbers as one solve of
+ * the whole world (akp_rigid_step_run with islands off: the solver as it was before them).
+ * The world mixes what an island holds: the ground, four humanoid ragdolls (the first two
+ * overlap, so they collide and make one island of two joint chains), a stack of three boxes
+ * (cached flat contacts), spheres on the ground and on the stack (their narrow phase runs each
+ * substep), a capsule swinging on a ball joint from a static box (a joint to a static body),
+ * a box dropped onto that static box, and a box asleep at the start that a sphere wakes. 36 steps
+ * with 1, 2 and 3 threads against the one-island run, state, sleep timers, contact counts and
+ * deepest penetration equal to the bit at every step; once more with max_contacts too small for the
+ * islands' contact regions (the step falls back to one island, and still drops the same). The
+ * two-thread run must also have used the team once per step (the islands' one parallel
+ * section), not once per substep as the chain sweeps of the one-island path do. */
+enum { ISL_STEPS = 36 };
+
+typedef struct isl_run {
+    ak_vec3 *x, *v, *w;
+    ak_quat* q;
+    float* timers;
+    uint32_t contacts[ISL_STEPS], dropped[ISL_STEPS];
+    float pen[ISL_STEPS];
+} isl_run;
+
+static bool isl_step_all(const ak_rigid_model* m, size_t nb, uint32_t threads, bool islands,
+                         const float* timers0, isl_run* out) {
+    ak_rigid_initial_state(m, (ak_vec3_span){out->x, nb}, (ak_quat_span){out->q, nb},
+                           (ak_vec3_span){out->v, nb}, (ak_vec3_span){out->w, nb});
+    memcpy(out->timers, timers0, nb * sizeof *timers0);
+    float pen = 0.0f;
+    uint32_t contacts = 0, dropped = 0;
+    ak_rigid_step_job job = {.model = m,
+                             .dt = 1.0f / 60.0f,
+                             .substeps = 10,
+                             .gravity = ak_vec3_make(0.0f, -9.81f, 0.0f),
+                             .thread_count = threads,
+                             .positions = {out->x, nb},
+                             .orientations = {out->q, nb},
+                             .velocities = {out->v, nb},
+                             .angular_velocities = {out->w, nb},
+                             .sleep_timers = {out->timers, nb},
+                             .out_max_penetration = &pen,
+                             .out_contact_count = &contacts,
+                             .out_dropped_contacts = &dropped};
+    size_t bytes = ak_rigid_step_scratch_size(&job);
+    uint8_t* scratch = malloc(bytes);
+    if (!scratch) return false;
+    job.scratch = (ak_u8_span){scratch, bytes};
+    bool ok = true;
+    for (int s = 0; s < ISL_STEPS && ok; ++s) {
+        ok = akp_rigid_step_run(&job, islands) == AK_OK;
+        out->contacts[s] = contacts, out->dropped[s] = dropped, out->pen[s] = pen;
+    }
+    free(scratch);
+    return ok;
+}
+
+static bool isl_same(const isl_run* a, const isl_run* b, size_t nb) {
+    return memcmp(a->x, b->x, nb * sizeof(ak_vec3)) == 0 &&
+           memcmp(a->v, b->v, nb * sizeof(ak_vec3)) == 0 &&
+           memcmp(a->w, b->w, nb * sizeof(ak_vec3)) == 0 &&
+           memcmp(a->q, b->q, nb * sizeof(ak_quat)) == 0 &&
+           memcmp(a->timers, b->timers, nb * sizeof(float)) == 0 &&
+           memcmp(a->contacts, b->contacts, sizeof a->contacts) == 0 &&
+           memcmp(a->dropped, b->dropped, sizeof a->dropped) == 0 &&
+           memcmp(a->pen, b->pen, sizeof a->pen) == 0;
+}
+
+AK_TEST(islands_bit_identical_for_any_thread_count) {
+    enum { RAGDOLLS = 4, EXTRA = 11, RUNS = 4 };
+    ak_scene* scene = NULL;
+    ak_builtin_desc bd = {.cell_size = 0.1f};
+    AK_CHECK_EQ(ak_builtin_create("humanoid", &bd, NULL, &scene), AK_OK);
+    if (!scene) return;
+    const ak_skeleton* sk = scene->skeleton;
+    size_t n = ak_skeleton_joint_count(sk), per = ak_rigid_ragdoll_body_count(sk),
+           pj = ak_rigid_ragdoll_joint_count(sk);
+    size_t nb = 1 + RAGDOLLS * per + EXTRA, nj = RAGDOLLS * pj + 1;
+    ak_transform* pose = malloc(n * sizeof *pose);
+    ak_rigid_ragdoll_bone* bones = malloc(n * sizeof *bones);
+    ak_rigid_body_desc* bodies = calloc(nb, sizeof *bodies);
+    ak_rigid_joint_desc* joints = calloc(nj, sizeof *joints);
+    float* timers0 = calloc(nb, sizeof *timers0);
+    isl_run runs[RUNS];
+    memset(runs, 0, sizeof runs);
+    bool alloc_ok = pose && bones && bodies && joints && timers0;
+    for (int r = 0; r < RUNS; ++r) {
+        runs[r].x = malloc(nb * sizeof(ak_vec3)), runs[r].v = malloc(nb * sizeof(ak_vec3));
+        runs[r].w = malloc(nb * sizeof(ak_vec3)), runs[r].q = malloc(nb * sizeof(ak_quat));
+        runs[r].timers = malloc(nb * sizeof(float));
+        alloc_ok = alloc_ok && runs[r].x && runs[r].v && runs[r].w && runs[r].q && runs[r].timers;
+    }
+    ak_rigid_model* m = NULL;
+    ak_rigid_model* small = NULL;
+    AK_CHECK(alloc_ok);
+    if (!alloc_ok) goto done;
+    ak_scene_rest_pose(scene, (ak_transform_span){pose, n});
+    bodies[0].shape.type = AK_RIGID_PLANE;
+    for (int r = 0; r < RAGDOLLS; ++r) {
+        /* ragdolls 0 and 1 side by side 0.3 m apart: they fall into each other */
+        float xr = r == 0 ? 0.0f : (r == 1 ? 0.3f : 2.5f * (float)r);
+        ak_vec3 axis = ak_vec3_make(1.0f, 0.3f * (float)r, 0.5f * (float)(r % 3));
+        ak_mat4 root =
+            ak_mat4_mul(ak_mat4_translation(ak_vec3_make(xr, 0.3f + 0.2f * (float)r, 0.0f)),
+                        ak_mat4_from_quat(ak_quat_from_axis_angle(axis, (20.0f + 25.0f * (float)r) *
+                                                                            3.14159265f / 180.0f)));
+        ak_rigid_ragdoll_desc rd = {.skeleton = sk,
+                                    .local_pose = {pose, n},
+                                    .root = root,
+                                    .body_offset = (uint32_t)(1 + r * per),
+                                    .collision_group = (uint32_t)r + 1};
+        AK_CHECK_EQ(ak_rigid_ragdoll_build(&rd,
+                                           (ak_rigid_body_desc_span){bodies + 1 + r * per, per},
+                                           (ak_rigid_joint_desc_span){joints + r * pj, pj},
+                                           (ak_rigid_ragdoll_bone_span){bones, n}),
+                    AK_OK);
+    }
+    ak_rigid_body_desc* e = bodies + 1 + RAGDOLLS * per;
+    size_t e0 = 1 + RAGDOLLS * per;
+    for (int k = 0; k < 3; ++k) /* a stack of three boxes, the top one turned a little */
+        e[k] = (ak_rigid_body_desc){
+            .shape = {.type = AK_RIGID_BOX, .half_extents = {0.25f, 0.25f, 0.25f}},
+            .position = {-3.0f, 0.25f + 0.5f * (float)k, 0.0f},
+            .orientation = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.2f * (float)k)};
+    e[3] = (ak_rigid_body_desc){.shape = {.type = AK_RIGID_SPHERE, .radius = 0.1f},
+                                .position = {-3.05f, 1.45f, 0.02f},
+                                .restitution = 0.3f};
+    e[4] = (ak_rigid_body_desc){.shape = {.type = AK_RIGID_SPHERE, .radius = 0.15f},
+                                .position = {-5.0f, 0.4f, 0.0f},
+                                .velocity = {1.0f, 0, 0}};
+    e[5] = (ak_rigid_body_desc){.shape = {.type = AK_RIGID_SPHERE, .radius = 0.15f},
+                                .position = {-4.6f, 0.15f, 0.0f}};
+    e[6] = (ak_rigid_body_desc){.shape = {.type = AK_RIGID_BOX, .half_extents = {0.2f, 0.2f, 0.2f}},
+                                .position = {-8.0f, 2.0f, 0.0f},
+                                .orientation = ak_quat_from_axis_angle(ak_vec3_make(0, 1, 0), 0.4f),
+                                .is_static = true};
+    e[7] = (ak_rigid_body_desc){
+        .shape = {.type = AK_RIGID_CAPSULE, .radius = 0.1f, .half_height = 0.3f},
+        .position = {-7.4f, 2.0f, 0.0f},
+        .orientation = ak_quat_from_axis_angle(ak_vec3_make(0, 0, 1), 1.5707963f)};
+    /* asleep at the start, under the capsule's swing: woken when something touches it */
+    e[8] = (ak_rigid_body_desc){.shape = {.type = AK_RIGID_BOX, .half_extents = {0.3f, 0.3f, 0.3f}},
+                                .position = {-8.0f, 0.3f, 0.0f}};
+    e[9] = (ak_rigid_body_desc){.shape = {.type = AK_RIGID_SPHERE, .radius = 0.2f},
+                                .position = {-8.1f, 1.2f, 0.05f}};
+    /* a box dropped onto the (turned) static box */
+    e[10] =
+        (ak_rigid_body_desc){.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.1f, 0.1f}},
+                             .position = {-8.05f, 2.45f, 0.05f}};
+    timers0[e0 + 8] = 10.0f;
+    joints[nj - 1] = (ak_rigid_joint_desc){.type = AK_RIGID_JOINT_BALL,
+                                           .body_a = (uint32_t)(e0 + 6),
+                                           .body_b = (uint32_t)(e0 + 7),
+                                           .anchor = {-7.8f, 2.0f, 0.0f}};
+    ak_rigid_model_desc md = {.bodies = {bodies, nb}, .joints = {joints, nj}};
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
+    if (!m) goto done;
+    AK_CHECK(isl_step_all(m, nb, 1, false, timers0, &runs[0]));
+    uint64_t team0 = 0, fresh0 = 0, team1 = 0, fresh1 = 0;
+    for (int t = 1; t <= 3; ++t) {
+        if (t == 2) akp_tasks_stats(&team0, &fresh0);
+        AK_CHECK(isl_step_all(m, nb, (uint32_t)t, true, timers0, &runs[t]));
+        if (t == 2) akp_tasks_stats(&team1, &fresh1);
+        AK_CHECK_MSG(isl_same(&runs[0], &runs[t], nb),
+                     "islands, %d thread(s): the state differs from the one-island solve's", t);
+    }
+    AK_CHECK_MSG((team1 - team0) + (fresh1 - fresh0) == ISL_STEPS,
+                 "2 threads: %llu parallel sections in %d steps",
+                 (unsigned long long)((team1 - team0) + (fresh1 - fresh0)), ISL_STEPS);
+    /* the world did something: the ragdolls reached the ground, the sleeper was woken */
+    for (int r = 0; r < RAGDOLLS; ++r) {
+        float low = INFINITY;
+        for (size_t b = 0; b < per; ++b) low = ak_minf(low, runs[1].x[1 + r * per + b].y);
+        AK_CHECK_MSG(low < 0.25f, "ragdoll %d: lowest body at %g m", r, low);
+    }
+    AK_CHECK_MSG(runs[1].timers[e0 + 8] < 0.5f, "the sleeping box was not woken (timer %g)",
+                 runs[1].timers[e0 + 8]);
+    /* too small a contact buffer: the islands' regions do not fit, one island it is */
+    md.max_contacts = 40;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &small), AK_OK);
+    if (!small) goto done;
+    AK_CHECK(isl_step_all(small, nb, 1, false, timers0, &runs[0]));
+    AK_CHECK(isl_step_all(small, nb, 2, true, timers0, &runs[2]));
+    AK_CHECK_MSG(isl_same(&runs[0], &runs[2], nb), "max_contacts 40: the fallback differs");
+    AK_CHECK_MSG(runs[0].dropped[ISL_STEPS - 1] > 0, "max_contacts 40 dropped nothing");
+done:
+    ak_rigid_model_destroy(small);
+    ak_rigid_model_destroy(m);
+    for (int r = 0; r < RUNS; ++r)
+        free(runs[r].x), free(runs[r].v), free(runs[r].w), free(runs[r].q), free(runs[r].timers);
+    free(pose), free(bones), free(bodies), free(joints), free(timers0);
+    ak_scene_destroy(scene);
+}
+
 int main(void) {
     AK_RUN_SLOW(humanoid_ragdoll_from_rest);
     AK_RUN(humanoid_ragdoll_from_walk);
@@ -707,5 +902,6 @@ int main(void) {
     AK_RUN(powered_ragdoll_tracks_clip_and_recovers);
     AK_RUN(step_drive_targets_override);
     AK_RUN(ragdolls_bit_identical_for_any_thread_count);
+    AK_RUN(islands_bit_identical_for_any_thread_count);
     return ak_test_finish();
 }

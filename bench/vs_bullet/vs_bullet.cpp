@@ -6,7 +6,9 @@
 // shared machine count less), the ratio, and the stability of each (the largest horizontal
 // drift of a body from its start, or for ragdolls the widest joint gap; the deepest penetration
 // seen). One thread (animkit: --threads T sets its thread_count, and its time is then wall
-// time; the final state's hash is printed to compare thread counts); sleeping on in both;
+// time; the final state's hash is printed to compare thread counts, and a second line gives
+// animkit's CPU time per step on the calling thread and on all threads, with the share of the
+// latter spent off the calling thread, by the worker team); sleeping on in both;
 // dt = 1/60; friction 0.5; density 1000.
 //
 //   bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] [--substeps K]
@@ -28,6 +30,7 @@
 
 struct result {
     double ms_per_step;
+    double cpu_ms, proc_ms, wall_ms;  // animkit: per step, CPU of the calling thread, of all threads, wall
     double drift;  // m, largest horizontal displacement of a body from its start
     double pen;    // m, deepest penetration seen over the run
     double contacts;  // contact points per step, mean over the run
@@ -140,7 +143,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     md.joints.ptr = sc.joints.data();
     md.joints.count = sc.joints.size();
     ak_rigid_model* m = nullptr;
-    result r = {0, 0, 0, 0, 0};
+    result r = {};
     if (ak_rigid_model_create(&md, nullptr, &m) != AK_OK) return r;
     std::vector<ak_vec3> x(n), v(n), w(n);
     std::vector<ak_quat> q(n);
@@ -168,6 +171,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     job.scratch = {scratch.data(), bytes};
     // one thread: CPU time of the calling thread; more: wall time (the workers' time counts)
     const double t0 = threads > 1 ? bench_wall_s() : bench_cpu_s();
+    const double c0 = bench_cpu_s(), p0 = bench_proc_s(), w0 = bench_wall_s();
     for (int s = 0; s < steps; ++s) {
         ak_rigid_step_run(&job);
         r.pen = std::fmax(r.pen, (double)pen);
@@ -175,6 +179,9 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
         if (dropped) std::fprintf(stderr, "animkit dropped %u contact points (max_contacts) in step %d\n", dropped, s);
     }
     r.ms_per_step = 1e3 * ((threads > 1 ? bench_wall_s() : bench_cpu_s()) - t0) / steps;
+    r.cpu_ms = 1e3 * (bench_cpu_s() - c0) / steps;
+    r.proc_ms = 1e3 * (bench_proc_s() - p0) / steps;
+    r.wall_ms = 1e3 * (bench_wall_s() - w0) / steps;
     // FNV-1a of the final state: the same for every thread count (the solver's determinism)
     uint64_t hash = 1469598103934665603ull;
     auto mix = [&hash](const void* p, size_t bytes) {
@@ -313,7 +320,7 @@ static result run_bullet(const scene& sc, int steps) {
         pivots.push_back(pa);
         pivots.push_back(pb);
     }
-    result r = {0, 0, 0, 0, 0};
+    result r = {};
     const btScalar dt = 1.0f / 60.0f;
     const double t0 = bench_cpu_s();
     double in_probe = 0.0;
@@ -394,6 +401,12 @@ int main(int argc, char** argv) {
                     b.ms_per_step, b.ms_per_step / a.ms_per_step, a.drift, b.drift, a.pen, b.pen, a.contacts,
                     b.contacts);
         std::printf("  animkit final state FNV-1a %016llx\n", (unsigned long long)a.hash);
+        // where animkit's time went: the calling thread's CPU, every thread's (the worker team's
+        // included, so the islands' share off the calling thread shows), and wall time
+        std::printf("  animkit ms per step: calling thread CPU %.3f, all threads CPU %.3f (%.0f%% off the "
+                    "calling thread), wall %.3f\n",
+                    a.cpu_ms, a.proc_ms, a.proc_ms > 0 ? 100.0 * (a.proc_ms - a.cpu_ms) / a.proc_ms : 0.0,
+                    a.wall_ms);
         std::fflush(stdout);
     }
     std::printf("ratio = Bullet time / animkit time (above 1: animkit faster); drift: largest horizontal\n"

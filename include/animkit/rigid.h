@@ -36,15 +36,19 @@
  *   - sleeping: a connected group of touching or joined bodies whose speeds all stay under the
  *     thresholds for sleep_time seconds is frozen until an awake body touches it;
  *   - deterministic: the same inputs give the same bits (contacts are found and solved in an
- *     order fixed by the positions and body indices), whatever the thread count: thread_count
- *     shares out the joint sweeps after the contacts, chain by chain (joints that share moving
- *     bodies, a ragdoll each), among the library's worker team; every other phase (and a scene
- *     without joints) runs on the calling thread.
+ *     order fixed by the positions and body indices), whatever the thread count: each step the
+ *     bodies joined by contact pairs or joints form islands (a ragdoll on the ground is one, a
+ *     pyramid is one), solved whole, substeps and all, one after another; thread_count shares
+ *     the islands out among the library's worker team. When the contact buffer cannot give
+ *     every island a region of its own (max_contacts), the step solves the world as one island
+ *     and thread_count shares out only its joint sweeps, chain by chain (joints that share
+ *     moving bodies). Either way the numbers are the same to the bit.
  *
- * What it does NOT do (yet): threads for the contacts, continuous collision detection (a body
- * moving more than its size in one substep can tunnel), dynamic triangle meshes and heightfields
- * (they are static), two-way coupling with other simulations: cloth and particles take the bodies
- * as a mesh (ak_rigid_world_mesh), the fluid as its colliders (ak_rigid_fluid_colliders), one-way.
+ * What it does NOT do (yet): threads within one island (a single pile gains nothing), continuous
+ * collision detection (a body moving more than its size in one substep can tunnel), dynamic
+ * triangle meshes and heightfields (they are static), two-way coupling with other simulations:
+ * cloth and particles take the bodies as a mesh (ak_rigid_world_mesh), the fluid as its colliders
+ * (ak_rigid_fluid_colliders), one-way.
  *
  * Usage (a box dropped on the ground):
  *     ak_rigid_body_desc bodies[2] = {
@@ -559,9 +563,8 @@ typedef struct ak_rigid_step_job {
     float dt;                    /* seconds, > 0 (required) */
     uint32_t substeps;           /* XPBD substeps per step; 0 -> 10; <= 1000 */
     ak_vec3 gravity;             /* m/s^2, world (zero is a real choice: no gravity) */
-    uint32_t thread_count;       /* <= AK_RIGID_MAX_THREADS; 0 -> 1. Shares out the joint
-                                    chains' sweeps (see the header's opening); the same bits
-                                    for any value */
+    uint32_t thread_count;       /* <= AK_RIGID_MAX_THREADS; 0 -> 1. Shares out the islands
+                                    (see the header's opening); the same bits for any value */
     /* State, one element per body, read and written (world space). */
     ak_vec3_span positions;
     ak_quat_span orientations;

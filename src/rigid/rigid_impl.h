@@ -194,4 +194,9 @@ int akp_rigid_collide(const ak_rigid_model* m, uint32_t a, uint32_t b, rigid_pos
 
 #define AKP_RIGID_MAX_PAIR_CONTACTS 8
 
+/* ak_rigid_step_run with the islands (bodies joined by contacts and joints, solved one after
+ * another or on the worker team) allowed or not: the results are the same to the bit either
+ * way, which the tests check. ak_rigid_step_run allows them. */
+ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands);
+
 #endif

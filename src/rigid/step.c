@@ -7,6 +7,14 @@
 #include "rigid_impl.h"
 #include "../tasks.h"
 
+/* Small helpers of the solver's inner loops, inlined into every caller (the islands call the
+ * substep's phases from a second place, and the compiler then stops inlining some of them). */
+#if defined(__GNUC__) || defined(__clang__)
+#define RIGID_HOT static inline __attribute__((always_inline))
+#else
+#define RIGID_HOT static inline
+#endif
+
 typedef struct sap_entry {
     float lo, hi;
     uint32_t body;
@@ -50,10 +58,25 @@ typedef struct contact_row {
     float inv_w;      /* 1 / (generalised inverse masses), 0 when neither body moves */
 } contact_row;
 
+/* An island: dynamic bodies joined by the step's pairs and by joints (union-find; static
+ * bodies join nothing, since no island writes them). Its bodies, pairs, joints and joint chains
+ * are runs of the step's island-ordered lists (each run in the global order), and its
+ * non-cached pairs' contacts go to a region of the contact buffer of its own, so islands are
+ * solved one after another or at the same time with the same numbers as the one-island solve. */
+typedef struct island {
+    uint32_t body0, body1, pair0, pair1, joint0, joint1, chain0, chain1;
+    uint32_t region, region_end; /* contact buffer [region, region_end) */
+    uint32_t count_last;         /* contacts of the last substep in the region */
+    uint32_t dropped;
+    uint32_t work; /* a cost estimate, to share islands out over the threads */
+    bool awake;    /* some body of it moves (else nothing to solve) */
+} island;
+
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
     size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, sap, pairs, contacts, groups, rows, cx, ct, turn0,
-        jorder, jstart, jchain, croot, rot, rot0, parent, awake, total;
+        jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies, ipairs,
+        ijoints, ichains, islands, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -89,6 +112,12 @@ static layout layout_of(const ak_rigid_model* m) {
     l.rot0 = off, off += align16(n * sizeof(ak_mat3));
     l.parent = off, off += align16(n * sizeof(uint32_t));
     l.awake = off, off += align16(n);
+    l.island_of = off, off += align16(n * sizeof(uint32_t));
+    l.ibodies = off, off += align16(n * sizeof(uint32_t));
+    l.ipairs = off, off += align16((size_t)m->desc.max_contacts * sizeof(pair_entry));
+    l.ijoints = off, off += align16(m->joint_count * sizeof(uint32_t));
+    l.ichains = off, off += align16(m->joint_count * sizeof(uint32_t));
+    l.islands = off, off += align16(n * sizeof(struct island));
     l.total = off + 16; /* room to align the base */
     return l;
 }
@@ -164,7 +193,7 @@ typedef struct solver {
  * does not matter). The solver takes it once per substep, after the prediction: within a
  * substep a body turns by |w| h (under a thousandth of a radian for 5 rad/s at 1200 Hz), and
  * the tensor only scales the corrections, which are then exact to that order. */
-static ak_mat3 world_inv_inertia(ak_quat q, ak_vec3 ii) {
+RIGID_HOT ak_mat3 world_inv_inertia(ak_quat q, ak_vec3 ii) {
     ak_mat3 r = ak_mat3_from_quat(q), o;
     for (int row = 0; row < 3; ++row)
         for (int col = row; col < 3; ++col) {
@@ -177,7 +206,7 @@ static ak_mat3 world_inv_inertia(ak_quat q, ak_vec3 ii) {
 }
 
 /* I^-1 (world) applied to v for body i (zero when it does not move). */
-static ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
+RIGID_HOT ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
     if (!s->awake[i]) return ak_vec3_zero();
     return ak_mat3_mul_vec3(s->iw[i], v);
 }
@@ -186,13 +215,13 @@ static ak_vec3 inv_inertia_mul(const solver* s, uint32_t i, ak_vec3 v) {
  * correction turns by well under a radian, so the norm is 1 + |dw|^2 / 2 and the step leaves
  * an error of order |dw|^4: no square root or division on the joints' dependency chain; the
  * orientations are normalised exactly once per substep in update_velocities). */
-static inline ak_quat turn_by(ak_quat q, ak_vec3 dw) {
+RIGID_HOT ak_quat turn_by(ak_quat q, ak_vec3 dw) {
     ak_quat r = ak_quat_add(q, ak_quat_mul(ak_quat_make(dw.x, dw.y, dw.z, 0.0f), q));
     return ak_quat_scale(r, 1.5f - 0.5f * ak_quat_dot(r, r));
 }
 
 /* Apply positional impulse p at offset r to body i (sign +1 or -1). */
-static void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
+RIGID_HOT void apply_position_impulse(solver* s, uint32_t i, ak_vec3 r, ak_vec3 p, float sign) {
     if (!s->awake[i]) return;
     s->dx[i] = ak_vec3_madd(s->dx[i], p, sign * s->bodies[i].inv_mass);
     s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
@@ -208,7 +237,7 @@ typedef struct response {
     float w;
 } response;
 
-static inline response respond(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n) {
+RIGID_HOT response respond(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n) {
     response o = {ak_vec3_zero(), 0.0f};
     if (!s->awake[i]) return o;
     ak_vec3 rn = ak_vec3_cross(r, n);
@@ -218,16 +247,15 @@ static inline response respond(const solver* s, uint32_t i, ak_vec3 r, ak_vec3 n
 }
 
 /* Velocity impulse mag * n on body i. */
-static inline void push_along(solver* s, uint32_t i, ak_vec3 n, float mag, response o) {
+RIGID_HOT void push_along(solver* s, uint32_t i, ak_vec3 n, float mag, response o) {
     if (!s->awake[i]) return;
     s->v[i] = ak_vec3_madd(s->v[i], n, mag * s->bodies[i].inv_mass);
     s->w[i] = ak_vec3_madd(s->w[i], o.turn, mag);
 }
 
-
 /* Angular velocity after one implicit (backward Euler) step of Euler's equations without torque,
  * I w' = -w x (I w), linearised once about w (Newton's first iterate), in the body frame. */
-static ak_vec3 gyroscopic_step(ak_vec3 w, ak_vec3 inertia, float h) {
+RIGID_HOT ak_vec3 gyroscopic_step(ak_vec3 w, ak_vec3 inertia, float h) {
     ak_vec3 iw = ak_vec3_mul(inertia, w);
     ak_vec3 f = ak_vec3_scale(ak_vec3_cross(w, iw), h);
     /* J = I + h (skew(w) I - skew(I w)) */
@@ -241,9 +269,12 @@ static ak_vec3 gyroscopic_step(ak_vec3 w, ak_vec3 inertia, float h) {
     return ak_vec3_sub(w, ak_mat3_mul_vec3(ak_mat3_inverse(j), f));
 }
 
-static void predict(solver* s, ak_vec3 g, float lin_damp, float ang_damp) {
+/* The bodies list[0 .. count) (NULL list: every body). */
+static void predict(solver* s, ak_vec3 g, float lin_damp, float ang_damp, const uint32_t* list,
+                    uint32_t count) {
     float h = s->h;
-    for (uint32_t i = 0; i < (uint32_t)s->m->body_count; ++i) {
+    for (uint32_t t = 0; t < count; ++t) {
+        uint32_t i = list ? list[t] : t;
         s->qp[i] = s->q[i];
         s->dx[i] = ak_vec3_zero();
         if (!s->awake[i]) continue;
@@ -293,16 +324,18 @@ typedef struct contact_buf {
     uint32_t group_count;
 } contact_buf;
 
-static float contact_vn(const solver* s, const rigid_contact* c);
+RIGID_HOT float contact_vn(const solver* s, const rigid_contact* c);
 
 static void narrow(solver* s, contact_buf* cb, uint32_t a, uint32_t b, float margin) {
     rigid_pose pa = {s->x[a], s->q[a]}, pb = {s->x[b], s->q[b]};
-    /* the buffer has AKP_RIGID_MAX_PAIR_CONTACTS slack past cap */
+    /* at most the room left (an island's region ends where the next one's starts): the
+     * points past it would be dropped below anyway, and the first ones are the same */
+    uint32_t room = cb->cap - cb->count;
     int found = akp_rigid_collide(s->m, a, b, pa, pb, margin, cb->c + cb->count,
-                                  AKP_RIGID_MAX_PAIR_CONTACTS);
+                                  room < AKP_RIGID_MAX_PAIR_CONTACTS ? (int)room
+                                                                    : AKP_RIGID_MAX_PAIR_CONTACTS);
     int kept = found < AKP_RIGID_MAX_PAIR_CONTACTS ? found : AKP_RIGID_MAX_PAIR_CONTACTS;
     if (cb->count + (uint32_t)kept > cb->cap) {
-        uint32_t room = cb->cap - cb->count;
         cb->dropped += (uint32_t)found - room;
         kept = (int)room;
     } else {
@@ -327,7 +360,7 @@ static float axis_comp(ak_vec3 v, int axis) { return axis == 0 ? v.x : (axis == 
 static bool flat_shape(ak_rigid_shape_type t) { return t == AK_RIGID_BOX || t == AK_RIGID_PLANE; }
 
 /* Relative normal velocity of contact c's points (before the solve; restitution reads it). */
-static float contact_vn(const solver* s, const rigid_contact* c) {
+RIGID_HOT float contact_vn(const solver* s, const rigid_contact* c) {
     ak_vec3 ra = ak_quat_rotate(s->q[c->a], c->la), rb = ak_quat_rotate(s->q[c->b], c->lb);
     ak_vec3 va = ak_vec3_add(s->v[c->a], ak_vec3_cross(s->w[c->a], ra));
     ak_vec3 vb = ak_vec3_add(s->v[c->b], ak_vec3_cross(s->w[c->b], rb));
@@ -460,19 +493,19 @@ static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb,
 /* A substep's contacts, pair by pair in the step's order: the kept contacts of flat pairs
  * (their multipliers reset, their normal velocity read again) and the narrow phase of the
  * others on the predicted poses. */
-static void substep_contacts(solver* s, contact_buf* cb, const pair_buf* pb, uint32_t kept,
-                             float offset) {
-    cb->count = kept;
-    for (uint32_t k = 0; k < kept; ++k) {
-        rigid_contact* c = &cb->c[k];
-        c->lambda_n = 0.0f;
-        /* only restitution reads it */
-        c->vn_before = c->restitution > 0.0f ? contact_vn(s, c) : 0.0f;
-    }
+static void substep_contacts(solver* s, contact_buf* cb, const pair_entry* pairs, uint32_t npairs,
+                             uint32_t count0, float offset) {
+    cb->count = count0;
     uint32_t g = 0;
-    for (uint32_t i = 0; i < pb->count; ++i) {
-        const pair_entry* e = &pb->p[i];
+    for (uint32_t i = 0; i < npairs; ++i) {
+        const pair_entry* e = &pairs[i];
         if (e->cached) {
+            for (uint32_t k = e->start; k < e->end; ++k) {
+                rigid_contact* c = &cb->c[k];
+                c->lambda_n = 0.0f;
+                /* only restitution reads it */
+                c->vn_before = c->restitution > 0.0f ? contact_vn(s, c) : 0.0f;
+            }
             cb->groups[g++] = (contact_group){.start = e->start, .end = e->end, .height = e->height};
             continue;
         }
@@ -490,7 +523,7 @@ static void substep_contacts(solver* s, contact_buf* cb, const pair_buf* pb, uin
     cb->group_count = g;
 }
 
-static ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) {
+RIGID_HOT ak_vec3 world_point(const solver* s, uint32_t i, ak_vec3 l) {
     return ak_vec3_add(s->x[i], ak_quat_rotate(s->q[i], l));
 }
 
@@ -522,20 +555,20 @@ static bool pressure_centre(const contact_buf* cb, uint32_t k0, uint32_t k1, ak_
 }
 
 /* I^-1 n . n of body i (0 when it does not move). */
-static float gen_inv_inertia(const solver* s, uint32_t i, ak_vec3 n) {
+RIGID_HOT float gen_inv_inertia(const solver* s, uint32_t i, ak_vec3 n) {
     if (!s->awake[i]) return 0.0f;
     return ak_vec3_dot(n, ak_mat3_mul_vec3(s->iw[i], n));
 }
 
 /* Rotate body i by the angular position impulse (sign) * p (world). */
-static void apply_angular_impulse(solver* s, uint32_t i, ak_vec3 p, float sign) {
+RIGID_HOT void apply_angular_impulse(solver* s, uint32_t i, ak_vec3 p, float sign) {
     if (!s->awake[i]) return;
     ak_vec3 dw = ak_vec3_scale(ak_mat3_mul_vec3(s->iw[i], p), sign * 0.5f);
     s->q[i] = turn_by(s->q[i], dw);
 }
 
 /* Rotation vector of body i over this substep (small-angle). */
-static ak_vec3 substep_rotation(const solver* s, uint32_t i) {
+RIGID_HOT ak_vec3 substep_rotation(const solver* s, uint32_t i) {
     if (!s->awake[i]) return ak_vec3_zero();
     ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->qp[i]));
     float k = dq.w >= 0.0f ? 2.0f : -2.0f;
@@ -547,7 +580,7 @@ static ak_vec3 substep_rotation(const solver* s, uint32_t i) {
  * origin; *out_arm gets its world offset. Static friction undoes the slip of the whole step,
  * not only of the substep: a slip left over by one substep (the next pair's solve moves a box
  * after its friction ran) is taken back by the next, so stacks do not creep. */
-static ak_vec3 moved_point(const solver* s, uint32_t i, ak_vec3 l, ak_vec3* out_arm) {
+RIGID_HOT ak_vec3 moved_point(const solver* s, uint32_t i, ak_vec3 l, ak_vec3* out_arm) {
     ak_vec3 r = ak_mat3_mul_vec3(s->rot[i], l);
     r = ak_vec3_add(r, ak_vec3_cross(s->ct[i], r));
     *out_arm = r;
@@ -558,39 +591,42 @@ static ak_vec3 moved_point(const solver* s, uint32_t i, ak_vec3 l, ak_vec3* out_
 
 /* Rows of the substep's contacts on the current poses (see contact_row). */
 static void setup_rows(solver* s, const contact_buf* cb) {
-    for (uint32_t k = 0; k < cb->count; ++k) {
-        const rigid_contact* c = &cb->c[k];
-        contact_row* r = &s->rows[k];
-        uint32_t a = c->a, b = c->b;
-        ak_vec3 ra = ak_mat3_mul_vec3(s->rot[a], c->la), rb = ak_mat3_mul_vec3(s->rot[b], c->lb);
-        r->d0 = ak_vec3_dot(ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra)), c->n);
-        float w = 0.0f;
-        if (s->awake[a]) {
-            r->rna = ak_vec3_cross(ra, c->n);
-            r->ta = ak_mat3_mul_vec3(s->iw[a], r->rna);
-            r->ima = s->bodies[a].inv_mass;
-            w += r->ima + ak_vec3_dot(r->rna, r->ta);
-        } else {
-            r->rna = r->ta = ak_vec3_zero();
-            r->ima = 0.0f;
+    for (uint32_t gi = 0; gi < cb->group_count; ++gi)
+        for (uint32_t k = cb->groups[gi].start; k < cb->groups[gi].end; ++k) {
+            const rigid_contact* c = &cb->c[k];
+            contact_row* r = &s->rows[k];
+            uint32_t a = c->a, b = c->b;
+            ak_vec3 ra = ak_mat3_mul_vec3(s->rot[a], c->la),
+                    rb = ak_mat3_mul_vec3(s->rot[b], c->lb);
+            r->d0 =
+                ak_vec3_dot(ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra)), c->n);
+            float w = 0.0f;
+            if (s->awake[a]) {
+                r->rna = ak_vec3_cross(ra, c->n);
+                r->ta = ak_mat3_mul_vec3(s->iw[a], r->rna);
+                r->ima = s->bodies[a].inv_mass;
+                w += r->ima + ak_vec3_dot(r->rna, r->ta);
+            } else {
+                r->rna = r->ta = ak_vec3_zero();
+                r->ima = 0.0f;
+            }
+            if (s->awake[b]) {
+                r->rnb = ak_vec3_cross(rb, c->n);
+                r->tb = ak_mat3_mul_vec3(s->iw[b], r->rnb);
+                r->imb = s->bodies[b].inv_mass;
+                w += r->imb + ak_vec3_dot(r->rnb, r->tb);
+            } else {
+                r->rnb = r->tb = ak_vec3_zero();
+                r->imb = 0.0f;
+            }
+            r->inv_w = w > 0.0f ? 1.0f / w : 0.0f;
         }
-        if (s->awake[b]) {
-            r->rnb = ak_vec3_cross(rb, c->n);
-            r->tb = ak_mat3_mul_vec3(s->iw[b], r->rnb);
-            r->imb = s->bodies[b].inv_mass;
-            w += r->imb + ak_vec3_dot(r->rnb, r->tb);
-        } else {
-            r->rnb = r->tb = ak_vec3_zero();
-            r->imb = 0.0f;
-        }
-        r->inv_w = w > 0.0f ? 1.0f / w : 0.0f;
-    }
 }
 
-static void solve_positions(solver* s, contact_buf* cb) {
-    uint32_t n = (uint32_t)s->m->body_count;
+static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, uint32_t n) {
     ak_vec3 *cx = s->cx, *ct = s->ct;
-    for (uint32_t i = 0; i < n; ++i) {
+    for (uint32_t t = 0; t < n; ++t) {
+        uint32_t i = list ? list[t] : t;
         cx[i] = ct[i] = ak_vec3_zero();
         s->turn0[i] = substep_rotation(s, i);
         s->rot[i] = ak_mat3_from_quat(s->q[i]);
@@ -673,7 +709,8 @@ static void solve_positions(solver* s, contact_buf* cb) {
         }
     }
     /* the summed corrections onto the poses (orientations normalised in update_velocities) */
-    for (uint32_t i = 0; i < n; ++i) {
+    for (uint32_t t = 0; t < n; ++t) {
+        uint32_t i = list ? list[t] : t;
         if (!s->awake[i]) continue;
         s->dx[i] = ak_vec3_add(s->dx[i], cx[i]);
         s->x[i] = ak_vec3_add(s->x0[i], ak_vec3_add(s->ds[i], s->dx[i]));
@@ -691,8 +728,8 @@ static void solve_positions(solver* s, contact_buf* cb) {
  * exactly e to first order. (Solving along e alone, as for a contact, turns a body whose
  * rotation is cheap about its centre: the anchor then also moves across e, and a pendulum of a
  * small ball on a long arm spins up 70 times too fast.) */
-static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 e,
-                           float alpha, float* err) {
+RIGID_HOT void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec3 rb, ak_vec3 e,
+                              float alpha, float* err) {
     if (ak_vec3_length_sq(e) < 1e-18f) return;
     *err = ak_maxf(*err, ak_vec3_length(e));
     float lin = (s->awake[a] ? s->bodies[a].inv_mass : 0.0f) +
@@ -703,12 +740,21 @@ static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec
         uint32_t i = side ? b : a;
         if (!s->awake[i]) continue;
         ak_vec3 r = side ? rb : ra;
-        ak_vec3 s0 = ak_vec3_make(0.0f, -r.z, r.y), s1 = ak_vec3_make(r.z, 0.0f, -r.x),
-                s2 = ak_vec3_make(-r.y, r.x, 0.0f);
-        ak_vec3 i0 = ak_mat3_mul_vec3(s->iw[i], s0), i1 = ak_mat3_mul_vec3(s->iw[i], s1),
-                i2 = ak_mat3_mul_vec3(s->iw[i], s2);
-        k00 += ak_vec3_dot(s0, i0), k01 += ak_vec3_dot(s0, i1), k02 += ak_vec3_dot(s0, i2);
-        k11 += ak_vec3_dot(s1, i1), k12 += ak_vec3_dot(s1, i2), k22 += ak_vec3_dot(s2, i2);
+        /* the rows s0 = (0, -z, y), s1 = (z, 0, -x), s2 = (-y, x, 0) times I^-1 and dotted
+         * with each other, their zero entries' products left out: a product with zero only
+         * adds an exact zero, which changes no sum but possibly an exact zero's sign, and
+         * every entry below starts from +0 or from lin > 0, which erases that sign: the same
+         * bits as the full products, in two thirds of the multiplications */
+        const float* mm = s->iw[i].m;
+        float x = r.x, y = r.y, z = r.z, nx = -r.x, ny = -r.y, nz = -r.z;
+        ak_vec3 i0 = ak_vec3_make(mm[3] * nz + mm[6] * y, mm[4] * nz + mm[7] * y,
+                                  mm[5] * nz + mm[8] * y);
+        ak_vec3 i1 = ak_vec3_make(mm[0] * z + mm[6] * nx, mm[1] * z + mm[7] * nx,
+                                  mm[2] * z + mm[8] * nx);
+        ak_vec3 i2 = ak_vec3_make(mm[0] * ny + mm[3] * x, mm[1] * ny + mm[4] * x,
+                                  mm[2] * ny + mm[5] * x);
+        k00 += nz * i0.y + y * i0.z, k01 += nz * i1.y + y * i1.z, k02 += nz * i2.y + y * i2.z;
+        k11 += z * i1.x + nx * i1.z, k12 += z * i2.x + nx * i2.z, k22 += ny * i2.x + x * i2.y;
     }
     /* p = K^-1 e by cofactors */
     float c00 = k11 * k22 - k12 * k12, c01 = k02 * k12 - k01 * k22, c02 = k01 * k12 - k02 * k11;
@@ -725,7 +771,8 @@ static void joint_position(solver* s, uint32_t a, uint32_t b, ak_vec3 ra, ak_vec
 
 /* Rotate a by (its share of) the rotation vector e and b by the opposite, so that a's frame
  * turns towards b's: lambda = |e| / (w_a + w_b + alpha / h^2), w = n^T I^-1 n. */
-static void joint_rotation(solver* s, uint32_t a, uint32_t b, ak_vec3 e, float alpha, float* err) {
+RIGID_HOT void joint_rotation(solver* s, uint32_t a, uint32_t b, ak_vec3 e, float alpha,
+                              float* err) {
     float c = ak_vec3_length(e);
     if (c < 1e-9f) return;
     *err = ak_maxf(*err, c);
@@ -738,7 +785,7 @@ static void joint_rotation(solver* s, uint32_t a, uint32_t b, ak_vec3 e, float a
 }
 
 /* The rotation vector that turns a's frame times target onto b's orientation. */
-static ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
+RIGID_HOT ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
     ak_quat dq = ak_quat_mul(qb, ak_quat_conjugate(ak_quat_mul(qa, target)));
     float k = dq.w >= 0.0f ? 2.0f : -2.0f;
     return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
@@ -748,7 +795,7 @@ static ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
  * akp_rigid_twist_angle's half angle t/2 = atan2(y, w) of rel, taken with w >= 0, lies
  * between the limits' half angles L and H when sin(t/2 - L) and sin(H - t/2) are positive,
  * which needs no atan2); false also when it cannot tell (twist_fast off). */
-static inline bool twist_inside(const rigid_joint* j, ak_quat qa, ak_quat qb) {
+RIGID_HOT bool twist_inside(const rigid_joint* j, ak_quat qa, ak_quat qb) {
     if (!j->twist_fast) return false;
     ak_quat rel =
         ak_quat_mul(ak_quat_conjugate(ak_quat_mul(qa, j->frame_a)), ak_quat_mul(qb, j->frame_b));
@@ -836,10 +883,10 @@ static bool joined(const ak_rigid_model* m, uint32_t a, uint32_t b) {
 
 /* Drive damping: remove the fraction min(c h, 1) of each driven joint's relative angular
  * velocity with an equal and opposite angular impulse (momentum kept). */
-static void damp_drives(solver* s) {
+static void damp_drives(solver* s, const uint32_t* idx, uint32_t count) {
     const ak_rigid_model* m = s->m;
-    for (size_t k = 0; k < m->joint_count; ++k) {
-        const rigid_joint* j = &m->joints[k];
+    for (uint32_t i = 0; i < count; ++i) {
+        const rigid_joint* j = &m->joints[idx ? idx[i] : i];
         if (!j->drive || !(j->drive_damping > 0.0f)) continue;
         uint32_t a = j->a, b = j->b;
         if (!s->awake[a] && !s->awake[b]) continue;
@@ -850,14 +897,16 @@ static void damp_drives(solver* s) {
         float wsum = gen_inv_inertia(s, a, n) + gen_inv_inertia(s, b, n);
         if (!(wsum > 0.0f)) continue;
         ak_vec3 p = ak_vec3_scale(n, c * ak_minf(j->drive_damping * s->h, 1.0f) / wsum);
-        s->w[a] = ak_vec3_add(s->w[a], inv_inertia_mul(s, a, p));
-        s->w[b] = ak_vec3_sub(s->w[b], inv_inertia_mul(s, b, p));
+        /* (a static body is left alone: islands share them) */
+        if (s->bodies[a].inv_mass > 0.0f) s->w[a] = ak_vec3_add(s->w[a], inv_inertia_mul(s, a, p));
+        if (s->bodies[b].inv_mass > 0.0f) s->w[b] = ak_vec3_sub(s->w[b], inv_inertia_mul(s, b, p));
     }
 }
 
-static void update_velocities(solver* s) {
+static void update_velocities(solver* s, const uint32_t* list, uint32_t count) {
     float inv_h = 1.0f / s->h;
-    for (uint32_t i = 0; i < (uint32_t)s->m->body_count; ++i) {
+    for (uint32_t t = 0; t < count; ++t) {
+        uint32_t i = list ? list[t] : t;
         if (!s->awake[i]) continue;
         s->v[i] = ak_vec3_scale(s->dx[i], inv_h);
         s->ds[i] = ak_vec3_add(s->ds[i], s->dx[i]);
@@ -871,7 +920,7 @@ static void update_velocities(solver* s) {
     }
 }
 
-static ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
+RIGID_HOT ak_vec3 point_velocity(const solver* s, uint32_t i, ak_vec3 r) {
     return ak_vec3_add(s->v[i], ak_vec3_cross(s->w[i], r));
 }
 
@@ -1002,6 +1051,172 @@ static void* sweep_chains(void* arg) {
     return NULL;
 }
 
+/* Sweep the chains list[0 .. count) (see chain_task). */
+static void sweep_chain_list(solver* s, const uint32_t* order, const uint32_t* start,
+                             const uint32_t* list, uint32_t count, int sweeps) {
+    for (uint32_t t = 0; t < count; ++t) {
+        uint32_t c = list[t];
+        const uint32_t* idx = order + start[c];
+        uint32_t n = start[c + 1] - start[c];
+        for (int it = 0; it < sweeps; ++it) {
+            float err = 0.0f;
+            solve_joints(s, idx, n, &err);
+            if (err < 1e-4f) break;
+        }
+    }
+}
+
+/* Contact points a non-cached pair can give in a substep: one for a sphere against a sphere,
+ * a plane or a box (closed forms), else AKP_RIGID_MAX_PAIR_CONTACTS. */
+static uint32_t pair_bound(const rigid_body* ba, const rigid_body* bb) {
+    if (ba->compound || bb->compound || ba->mesh || bb->mesh) return AKP_RIGID_MAX_PAIR_CONTACTS;
+    ak_rigid_shape_type ta = ba->shape.type, tb = bb->shape.type;
+    if (ta == AK_RIGID_SPHERE &&
+        (tb == AK_RIGID_SPHERE || tb == AK_RIGID_PLANE || tb == AK_RIGID_BOX))
+        return 1;
+    if (tb == AK_RIGID_SPHERE && (ta == AK_RIGID_PLANE || ta == AK_RIGID_BOX)) return 1;
+    return AKP_RIGID_MAX_PAIR_CONTACTS;
+}
+
+/* What an island task needs: the islands [i0, i1) solved one after another, every substep of
+ * one before the next. */
+typedef struct island_task {
+    solver* s;
+    island* isl;
+    uint32_t i0, i1;
+    const uint32_t *ibodies, *ijoints, *ichains, *order, *start;
+    const pair_entry* ipairs;
+    rigid_contact* c;
+    contact_group* groups;
+    ak_vec3 gravity;
+    float offset, gmag;
+    uint32_t substeps;
+} island_task;
+
+static void* solve_islands(void* arg) {
+    const island_task* t = arg;
+    solver* s = t->s;
+    const ak_rigid_model_desc* d = &s->m->desc;
+    for (uint32_t ii = t->i0; ii < t->i1; ++ii) {
+        island* is = &t->isl[ii];
+        if (!is->awake) continue; /* nothing moves: no pair, its joints skipped */
+        const uint32_t* bodies = t->ibodies + is->body0;
+        uint32_t nb = is->body1 - is->body0;
+        const uint32_t* joints = t->ijoints + is->joint0;
+        uint32_t nj = is->joint1 - is->joint0;
+        contact_buf cb = {t->c, is->region, is->region_end, 0, t->groups + is->pair0, 0};
+        for (uint32_t step = 0; step < t->substeps; ++step) {
+            predict(s, t->gravity, d->linear_damping, d->angular_damping, bodies, nb);
+            substep_contacts(s, &cb, t->ipairs + is->pair0, is->pair1 - is->pair0, is->region,
+                             t->offset);
+            if (nj) {
+                float err = 0.0f;
+                solve_joints(s, joints, nj, &err);
+            }
+            solve_positions(s, &cb, bodies, nb);
+            sweep_chain_list(s, t->order, t->start, t->ichains + is->chain0,
+                             is->chain1 - is->chain0, 8);
+            update_velocities(s, bodies, nb);
+            damp_drives(s, joints, nj);
+            solve_velocities(s, &cb, t->gmag);
+        }
+        is->count_last = cb.count - is->region;
+        is->dropped = cb.dropped;
+    }
+    return NULL;
+}
+
+/* The step's islands (see island) into isl, their lists into ibodies, ipairs, ijoints and
+ * ichains (chains from joint_chains); the regions of the contact buffer follow its cached
+ * contacts, [0, kept). Returns the island count, or 0 when every pair's region does not fit in
+ * cap contacts (the caller then solves one island). parent and island_of are scratch. */
+static uint32_t build_islands(const solver* s, const pair_buf* pb, uint32_t kept, uint32_t cap,
+                              uint32_t chains, const uint32_t* order, const uint32_t* start,
+                              uint32_t* parent, uint32_t* island_of, uint32_t* ibodies,
+                              pair_entry* ipairs, uint32_t* ijoints, uint32_t* ichains,
+                              island* isl) {
+    const ak_rigid_model* m = s->m;
+    const rigid_body* bd = s->bodies;
+    uint32_t n = (uint32_t)m->body_count, nj = (uint32_t)m->joint_count, count = 0;
+    /* the region bound first: nothing else is needed when it does not fit */
+    uint64_t need = kept;
+    for (uint32_t k = 0; k < pb->count; ++k)
+        if (!pb->p[k].cached) need += pair_bound(&bd[pb->p[k].a], &bd[pb->p[k].b]);
+    if (need > cap) return 0;
+    for (uint32_t i = 0; i < n; ++i) parent[i] = i;
+    for (uint32_t k = 0; k < pb->count; ++k) {
+        uint32_t a = pb->p[k].a, b = pb->p[k].b;
+        if (bd[a].inv_mass == 0.0f || bd[b].inv_mass == 0.0f) continue;
+        uint32_t ra = uf_find(parent, a), rb = uf_find(parent, b);
+        if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    }
+    for (uint32_t k = 0; k < nj; ++k) {
+        uint32_t a = m->joints[k].a, b = m->joints[k].b;
+        if (bd[a].inv_mass == 0.0f || bd[b].inv_mass == 0.0f) continue;
+        uint32_t ra = uf_find(parent, a), rb = uf_find(parent, b);
+        if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    }
+    /* islands numbered by their lowest body (every root is its set's lowest index) */
+    for (uint32_t i = 0; i < n; ++i) {
+        island_of[i] = UINT32_MAX;
+        if (bd[i].inv_mass == 0.0f) continue;
+        uint32_t r = uf_find(parent, i);
+        if (r == i) {
+            isl[count] = (island){0};
+            island_of[i] = count++;
+        } else {
+            island_of[i] = island_of[r];
+        }
+        island* is = &isl[island_of[i]];
+        is->body1++;
+        is->awake = is->awake || s->awake[i];
+    }
+    for (uint32_t k = 0; k < pb->count; ++k) {
+        island* is = &isl[island_of[pb->p[k].a]]; /* a moves */
+        is->pair1++;
+        if (!pb->p[k].cached) is->region_end += pair_bound(&bd[pb->p[k].a], &bd[pb->p[k].b]);
+    }
+    for (uint32_t k = 0; k < nj; ++k) {
+        uint32_t a = m->joints[k].a, b = m->joints[k].b;
+        uint32_t i = bd[a].inv_mass > 0.0f ? a : b;
+        if (bd[i].inv_mass > 0.0f) isl[island_of[i]].joint1++;
+    }
+    for (uint32_t c = 0; c < chains; ++c) {
+        const rigid_joint* j = &m->joints[order[start[c]]];
+        uint32_t i = bd[j->a].inv_mass > 0.0f ? j->a : j->b;
+        if (bd[i].inv_mass > 0.0f) isl[island_of[i]].chain1++;
+    }
+    /* counts to runs */
+    uint32_t nb = 0, np = 0, nk = 0, nc = 0, region = kept;
+    for (uint32_t k = 0; k < count; ++k) {
+        island* is = &isl[k];
+        uint32_t cb = is->body1, cp = is->pair1, ck = is->joint1, cc = is->chain1,
+                 cr = is->region_end;
+        is->work = is->awake ? cb + 2 * cp + 3 * ck : 0;
+        is->body0 = is->body1 = nb, nb += cb;
+        is->pair0 = is->pair1 = np, np += cp;
+        is->joint0 = is->joint1 = nk, nk += ck;
+        is->chain0 = is->chain1 = nc, nc += cc;
+        is->region = region, region += cr;
+        is->region_end = region;
+    }
+    /* stable placement: each island's lists in the global order */
+    for (uint32_t i = 0; i < n; ++i)
+        if (bd[i].inv_mass > 0.0f) ibodies[isl[island_of[i]].body1++] = i;
+    for (uint32_t k = 0; k < pb->count; ++k) ipairs[isl[island_of[pb->p[k].a]].pair1++] = pb->p[k];
+    for (uint32_t k = 0; k < nj; ++k) {
+        uint32_t a = m->joints[k].a, b = m->joints[k].b;
+        uint32_t i = bd[a].inv_mass > 0.0f ? a : b;
+        if (bd[i].inv_mass > 0.0f) ijoints[isl[island_of[i]].joint1++] = k;
+    }
+    for (uint32_t c = 0; c < chains; ++c) {
+        const rigid_joint* j = &m->joints[order[start[c]]];
+        uint32_t i = bd[j->a].inv_mass > 0.0f ? j->a : j->b;
+        if (bd[i].inv_mass > 0.0f) ichains[isl[island_of[i]].chain1++] = c;
+    }
+    return count;
+}
+
 /* Sleep bookkeeping at the end of a step (see ak_rigid_step_job.sleep_timers). */
 static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_buf* cb,
                          uint32_t* parent) {
@@ -1047,7 +1262,9 @@ static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_
     }
 }
 
-ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
+ak_result ak_rigid_step_run(const ak_rigid_step_job* job) { return akp_rigid_step_run(job, true); }
+
+ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
     ak_result r = ak_rigid_step_validate(job);
     if (r != AK_OK) return r;
     const ak_rigid_model* m = job->model;
@@ -1107,58 +1324,122 @@ ak_result ak_rigid_step_run(const ak_rigid_step_job* job) {
     find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow), offset, job->dt,
                gmag, up);
     uint32_t kept = cb.count;
-    /* joints, contacts, then up to eight more sweeps over the joints: contacts solved last would
-     * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
-     * (pelvis, spine, chest) 6 degrees past a limit under load. The later sweeps go chain by
-     * chain, the chains shared out over the threads in contiguous runs of about equal joint
-     * counts: each chain's numbers are the same whichever thread sweeps it. */
-    uint32_t nj = (uint32_t)m->joint_count;
-    chain_task tasks[AK_RIGID_MAX_THREADS];
-    uint32_t tasks_n = 1;
-    tasks[0] = (chain_task){.s = &s, .c0 = 0, .c1 = 0, .sweeps = 8};
-    if (nj) {
-        uint32_t* order = (uint32_t*)(base + l.jorder);
-        uint32_t* start = (uint32_t*)(base + l.jstart);
-        uint32_t chains =
-            joint_chains(&s, (uint32_t*)(base + l.parent), (uint32_t*)(base + l.croot),
-                         (uint32_t*)(base + l.jchain), order, start);
+    uint32_t nj = (uint32_t)m->joint_count, chains = 0;
+    uint32_t* order = (uint32_t*)(base + l.jorder);
+    uint32_t* start = (uint32_t*)(base + l.jstart);
+    if (nj)
+        chains = joint_chains(&s, (uint32_t*)(base + l.parent), (uint32_t*)(base + l.croot),
+                              (uint32_t*)(base + l.jchain), order, start);
+    island* isl = (island*)(base + l.islands);
+    uint32_t islands_n =
+        islands ? build_islands(&s, &pb, kept, m->desc.max_contacts, chains, order, start,
+                                (uint32_t*)(base + l.parent), (uint32_t*)(base + l.island_of),
+                                (uint32_t*)(base + l.ibodies), (pair_entry*)(base + l.ipairs),
+                                (uint32_t*)(base + l.ijoints), (uint32_t*)(base + l.ichains), isl)
+                : 0;
+    if (islands_n) {
+        /* what no island writes (static bodies; the others are set again in each substep) */
+        for (uint32_t i = 0; i < n; ++i) {
+            s.cx[i] = s.ct[i] = s.turn0[i] = ak_vec3_zero();
+            s.rot[i] = ak_mat3_from_quat(s.q[i]);
+        }
+        /* the islands shared out over the threads in contiguous runs of about equal work */
+        uint64_t total = 0;
+        uint32_t busy = 0;
+        for (uint32_t k = 0; k < islands_n; ++k) total += isl[k].work, busy += isl[k].work > 0;
         uint32_t want = job->thread_count ? job->thread_count : 1;
-        if (want > chains) want = chains;
+        if (want > busy) want = busy ? busy : 1;
         if (want > AKP_TASKS_MAX) want = AKP_TASKS_MAX;
-        uint32_t c = 0;
-        tasks_n = 0;
+        island_task itasks[AK_RIGID_MAX_THREADS];
+        uint32_t itasks_n = 0, k = 0;
+        uint64_t acc = 0;
         for (uint32_t t = 0; t < want; ++t) {
-            uint32_t c0 = c;
-            /* chains up to the t+1-th share of the joints */
-            uint64_t upto = (uint64_t)nj * (t + 1) / want;
-            while (c < chains && (t + 1 == want || start[c + 1] <= upto)) ++c;
-            if (c == c0 && c < chains) ++c;
-            if (c == c0) continue;
-            tasks[tasks_n++] = (chain_task){
-                .s = &s, .order = order, .start = start, .c0 = c0, .c1 = c, .sweeps = 8};
+            uint32_t k0 = k;
+            uint64_t upto = total * (t + 1) / want;
+            while (k < islands_n && (t + 1 == want || acc + isl[k].work <= upto))
+                acc += isl[k++].work;
+            if (k == k0 && k < islands_n) acc += isl[k++].work;
+            if (k == k0) continue;
+            itasks[itasks_n++] = (island_task){.s = &s,
+                                               .isl = isl,
+                                               .i0 = k0,
+                                               .i1 = k,
+                                               .ibodies = (uint32_t*)(base + l.ibodies),
+                                               .ijoints = (uint32_t*)(base + l.ijoints),
+                                               .ichains = (uint32_t*)(base + l.ichains),
+                                               .order = order,
+                                               .start = start,
+                                               .ipairs = (pair_entry*)(base + l.ipairs),
+                                               .c = cb.c,
+                                               .groups = cb.groups,
+                                               .gravity = job->gravity,
+                                               .offset = offset,
+                                               .gmag = gmag,
+                                               .substeps = substeps};
         }
-    }
-    for (uint32_t step = 0; step < substeps; ++step) {
-        predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping);
-        substep_contacts(&s, &cb, &pb, kept, offset);
-        /* joints, contacts, then eight more sweeps over the joints: contacts solved last would
-         * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
-         * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
+        if (itasks_n > 1)
+            akp_run_tasks(solve_islands, itasks, sizeof itasks[0], itasks_n);
+        else if (itasks_n)
+            solve_islands(&itasks[0]);
+        /* the last substep's contacts brought together after the cached ones (regions ascend,
+         * so each moves down over free room) */
+        uint32_t cursor = kept;
+        for (uint32_t i = 0; i < islands_n; ++i) {
+            if (!isl[i].awake) continue;
+            if (isl[i].count_last && cursor != isl[i].region)
+                memmove(cb.c + cursor, cb.c + isl[i].region, isl[i].count_last * sizeof *cb.c);
+            cursor += isl[i].count_last;
+            cb.dropped += isl[i].dropped;
+        }
+        cb.count = cursor;
+    } else {
+        /* joints, contacts, then up to eight more sweeps over the joints: contacts solved last
+         * would pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
+         * (pelvis, spine, chest) 6 degrees past a limit under load. The later sweeps go chain by
+         * chain, the chains shared out over the threads in contiguous runs of about equal joint
+         * counts: each chain's numbers are the same whichever thread sweeps it. */
+        chain_task tasks[AK_RIGID_MAX_THREADS];
+        uint32_t tasks_n = 1;
+        tasks[0] = (chain_task){.s = &s, .c0 = 0, .c1 = 0, .sweeps = 8};
         if (nj) {
-            float err = 0.0f;
-            solve_joints(&s, NULL, nj, &err);
+            uint32_t want = job->thread_count ? job->thread_count : 1;
+            if (want > chains) want = chains;
+            if (want > AKP_TASKS_MAX) want = AKP_TASKS_MAX;
+            uint32_t c = 0;
+            tasks_n = 0;
+            for (uint32_t t = 0; t < want; ++t) {
+                uint32_t c0 = c;
+                /* chains up to the t+1-th share of the joints */
+                uint64_t upto = (uint64_t)nj * (t + 1) / want;
+                while (c < chains && (t + 1 == want || start[c + 1] <= upto)) ++c;
+                if (c == c0 && c < chains) ++c;
+                if (c == c0) continue;
+                tasks[tasks_n++] = (chain_task){
+                    .s = &s, .order = order, .start = start, .c0 = c0, .c1 = c, .sweeps = 8};
+            }
         }
-        solve_positions(&s, &cb);
-        /* (the sweeps stop early, chain by chain, once one corrects no joint of the chain by
-         * more than 0.1 mm or 0.1 mrad: 50 falling ragdolls then take 4.3 sweeps a substep
-         * instead of 9 when they all stop together, and their anchors stay within 0.02 mm) */
-        if (tasks_n > 1)
-            akp_run_tasks(sweep_chains, tasks, sizeof tasks[0], tasks_n);
-        else if (nj)
-            sweep_chains(&tasks[0]);
-        update_velocities(&s);
-        damp_drives(&s);
-        solve_velocities(&s, &cb, gmag);
+        for (uint32_t step = 0; step < substeps; ++step) {
+            predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping, NULL, n);
+            substep_contacts(&s, &cb, pb.p, pb.count, kept, offset);
+            /* joints, contacts, then eight more sweeps over the joints: contacts solved last would
+             * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
+             * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
+            if (nj) {
+                float err = 0.0f;
+                solve_joints(&s, NULL, nj, &err);
+            }
+            solve_positions(&s, &cb, NULL, n);
+            /* (the sweeps stop early, chain by chain, once one corrects no joint of the chain by
+             * more than 0.1 mm or 0.1 mrad: 50 falling ragdolls then take 4.3 sweeps a substep
+             * instead of 9 when they all stop together, and their anchors stay within 0.02 mm) */
+            if (tasks_n > 1)
+                akp_run_tasks(sweep_chains, tasks, sizeof tasks[0], tasks_n);
+            else if (nj)
+                sweep_chains(&tasks[0]);
+            update_velocities(&s, NULL, n);
+            damp_drives(&s, NULL, nj);
+            solve_velocities(&s, &cb, gmag);
+        }
     }
     bool finite = true;
     for (uint32_t i = 0; i < n && finite; ++i)
