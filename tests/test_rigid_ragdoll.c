@@ -617,6 +617,27 @@ static bool threads_run(uint32_t threads, size_t nb, const ak_rigid_model* m, ak
     return ok;
 }
 
+/* Ragdoll r of a row (bodies from 1 + r * per, joints from r * pj, collision group r + 1):
+ * tipped over by 20 + 25 r degrees about a different axis each, 0.3 + 0.2 r m up, at x = xr. */
+static ak_result tipped_ragdoll(const ak_skeleton* sk, const ak_transform* pose, size_t n, int r,
+                                float xr, ak_rigid_body_desc* bodies, size_t per,
+                                ak_rigid_joint_desc* joints, size_t pj,
+                                ak_rigid_ragdoll_bone* bones) {
+    ak_vec3 axis = ak_vec3_make(1.0f, 0.3f * (float)r, 0.5f * (float)(r % 3));
+    ak_mat4 root = ak_mat4_mul(
+        ak_mat4_translation(ak_vec3_make(xr, 0.3f + 0.2f * (float)r, 0.0f)),
+        ak_mat4_from_quat(
+            ak_quat_from_axis_angle(axis, (20.0f + 25.0f * (float)r) * 3.14159265f / 180.0f)));
+    ak_rigid_ragdoll_desc rd = {.skeleton = sk,
+                                .local_pose = {pose, n},
+                                .root = root,
+                                .body_offset = (uint32_t)(1 + (size_t)r * per),
+                                .collision_group = (uint32_t)r + 1};
+    return ak_rigid_ragdoll_build(&rd, (ak_rigid_body_desc_span){bodies + 1 + (size_t)r * per, per},
+                                  (ak_rigid_joint_desc_span){joints + (size_t)r * pj, pj},
+                                  (ak_rigid_ragdoll_bone_span){bones, n});
+}
+
 AK_TEST(ragdolls_bit_identical_for_any_thread_count) {
     enum { RAGDOLLS = 4 };
     ak_scene* scene = NULL;
@@ -645,24 +666,9 @@ AK_TEST(ragdolls_bit_identical_for_any_thread_count) {
     if (!alloc_ok) goto done;
     ak_scene_rest_pose(scene, (ak_transform_span){pose, n});
     bodies[0].shape.type = AK_RIGID_PLANE;
-    for (int r = 0; r < RAGDOLLS; ++r) {
-        /* tipped over by 20 + 25 r degrees about a different axis each, 0.3 to 1.3 m up */
-        ak_vec3 axis = ak_vec3_make(1.0f, 0.3f * (float)r, 0.5f * (float)(r % 3));
-        ak_mat4 root = ak_mat4_mul(
-            ak_mat4_translation(ak_vec3_make(2.5f * (float)r, 0.3f + 0.2f * (float)r, 0.0f)),
-            ak_mat4_from_quat(
-                ak_quat_from_axis_angle(axis, (20.0f + 25.0f * (float)r) * 3.14159265f / 180.0f)));
-        ak_rigid_ragdoll_desc rd = {.skeleton = sk,
-                                    .local_pose = {pose, n},
-                                    .root = root,
-                                    .body_offset = (uint32_t)(1 + r * per),
-                                    .collision_group = (uint32_t)r + 1};
-        AK_CHECK_EQ(ak_rigid_ragdoll_build(&rd,
-                                           (ak_rigid_body_desc_span){bodies + 1 + r * per, per},
-                                           (ak_rigid_joint_desc_span){joints + r * pj, pj},
-                                           (ak_rigid_ragdoll_bone_span){bones, n}),
+    for (int r = 0; r < RAGDOLLS; ++r)
+        AK_CHECK_EQ(tipped_ragdoll(sk, pose, n, r, 2.5f * (float)r, bodies, per, joints, pj, bones),
                     AK_OK);
-    }
     ak_rigid_model_desc md = {.bodies = {bodies, nb}, .joints = {joints, nj}};
     AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &m), AK_OK);
     if (!m) goto done;
@@ -800,21 +806,7 @@ AK_TEST(islands_bit_identical_for_any_thread_count) {
     for (int r = 0; r < RAGDOLLS; ++r) {
         /* ragdolls 0 and 1 side by side 0.3 m apart: they fall into each other */
         float xr = r == 0 ? 0.0f : (r == 1 ? 0.3f : 2.5f * (float)r);
-        ak_vec3 axis = ak_vec3_make(1.0f, 0.3f * (float)r, 0.5f * (float)(r % 3));
-        ak_mat4 root =
-            ak_mat4_mul(ak_mat4_translation(ak_vec3_make(xr, 0.3f + 0.2f * (float)r, 0.0f)),
-                        ak_mat4_from_quat(ak_quat_from_axis_angle(axis, (20.0f + 25.0f * (float)r) *
-                                                                            3.14159265f / 180.0f)));
-        ak_rigid_ragdoll_desc rd = {.skeleton = sk,
-                                    .local_pose = {pose, n},
-                                    .root = root,
-                                    .body_offset = (uint32_t)(1 + r * per),
-                                    .collision_group = (uint32_t)r + 1};
-        AK_CHECK_EQ(ak_rigid_ragdoll_build(&rd,
-                                           (ak_rigid_body_desc_span){bodies + 1 + r * per, per},
-                                           (ak_rigid_joint_desc_span){joints + r * pj, pj},
-                                           (ak_rigid_ragdoll_bone_span){bones, n}),
-                    AK_OK);
+        AK_CHECK_EQ(tipped_ragdoll(sk, pose, n, r, xr, bodies, per, joints, pj, bones), AK_OK);
     }
     ak_rigid_body_desc* e = bodies + 1 + RAGDOLLS * per;
     size_t e0 = 1 + RAGDOLLS * per;
