@@ -212,6 +212,31 @@ double cpu_now() {
     return now();
 }
 
+// Per-step times of a and b over rounds of `per` steps each, the two alternating (one warm-up
+// step each first): wall time and the given CPU clock, each list sorted (medians, ranges).
+struct Alternated {
+    std::vector<double> wall_a, wall_b, cpu_a, cpu_b;
+};
+template <class A, class B>
+Alternated alternate(A& a, B& b, int rounds, int per, double (*cpu)()) {
+    Alternated r;
+    a.step();
+    b.step();
+    for (int k = 0; k < rounds; ++k) {
+        const double c0 = cpu(), t0 = now();
+        for (int i = 0; i < per; ++i) a.step();
+        const double c1 = cpu(), t1 = now();
+        for (int i = 0; i < per; ++i) b.step();
+        const double c2 = cpu(), t2 = now();
+        r.wall_a.push_back((t1 - t0) / per);
+        r.wall_b.push_back((t2 - t1) / per);
+        r.cpu_a.push_back((c1 - c0) / per);
+        r.cpu_b.push_back((c2 - c1) / per);
+    }
+    for (auto* v : {&r.wall_a, &r.wall_b, &r.cpu_a, &r.cpu_b}) std::sort(v->begin(), v->end());
+    return r;
+}
+
 void time_one(size_t n, int threads) {
     const Scenario s = block(n);
 #if defined(_OPENMP)
@@ -226,24 +251,8 @@ void time_one(size_t n, int threads) {
     Ak ak(s, static_cast<uint32_t>(threads));
     const int rounds = n >= 100000 ? 5 : n >= 10000 ? 9 : 15;
     const int per = n >= 100000 ? 2 : n >= 10000 ? 4 : 20;
-    std::vector<double> tr, ta, cr, ca;
-    rvo.step();
-    ak.step();
-    for (int r = 0; r < rounds; ++r) {
-        double c0 = cpu_now(), t0 = now();
-        for (int k = 0; k < per; ++k) rvo.step();
-        double c1 = cpu_now(), t1 = now();
-        for (int k = 0; k < per; ++k) ak.step();
-        double c2 = cpu_now(), t2 = now();
-        tr.push_back((t1 - t0) / per);
-        ta.push_back((t2 - t1) / per);
-        cr.push_back((c1 - c0) / per);
-        ca.push_back((c2 - c1) / per);
-    }
-    std::sort(tr.begin(), tr.end());
-    std::sort(ta.begin(), ta.end());
-    std::sort(cr.begin(), cr.end());
-    std::sort(ca.begin(), ca.end());
+    const Alternated t = alternate(rvo, ak, rounds, per, cpu_now);
+    const std::vector<double>&tr = t.wall_a, &ta = t.wall_b, &cr = t.cpu_a, &ca = t.cpu_b;
     const double mr = tr[tr.size() / 2], ma = ta[ta.size() / 2];
     std::printf("%8zu agents %d thread%s: RVO2 %9.3f ms/step  animkit %9.3f ms/step  (%.2f M agent-steps/s)  "
                 "animkit/RVO2 speed %.2fx  [ranges %.3f-%.3f, %.3f-%.3f]",
@@ -280,21 +289,8 @@ void time_work(size_t n) {
     Ak ak(s, static_cast<uint32_t>(threads));
     const int rounds = n >= 100000 ? 5 : n >= 10000 ? 9 : 15;
     const int per = n >= 100000 ? 2 : n >= 10000 ? 4 : 20;
-    std::vector<double> cr, ca, tr, ta;
-    rvo.step();
-    ak.step();
-    for (int r = 0; r < rounds; ++r) {
-        const double c0 = process_cpu_now(), t0 = now();
-        for (int k = 0; k < per; ++k) rvo.step();
-        const double c1 = process_cpu_now(), t1 = now();
-        for (int k = 0; k < per; ++k) ak.step();
-        const double c2 = process_cpu_now(), t2 = now();
-        cr.push_back((c1 - c0) / per);
-        ca.push_back((c2 - c1) / per);
-        tr.push_back((t1 - t0) / per);
-        ta.push_back((t2 - t1) / per);
-    }
-    for (auto* v : {&cr, &ca, &tr, &ta}) std::sort(v->begin(), v->end());
+    const Alternated t = alternate(rvo, ak, rounds, per, process_cpu_now);
+    const std::vector<double>&tr = t.wall_a, &ta = t.wall_b, &cr = t.cpu_a, &ca = t.cpu_b;
     const double mr = cr[cr.size() / 2], ma = ca[ca.size() / 2];
     std::printf("%8zu agents %d threads: CPU time of all threads: RVO2 %9.3f ms/step  animkit %9.3f ms/step  "
                 "animkit/RVO2 work speed %.2fx  [ranges %.3f-%.3f, %.3f-%.3f]  (wall: RVO2 %.3f, animkit %.3f ms/step)\n",
@@ -307,20 +303,8 @@ void time_vision(size_t n) {
     const Scenario s = block(n);
     Ak orca(s, 1), vision(s, 1, AK_CROWD_VISION);
     const int rounds = n >= 10000 ? 7 : 11, per = n >= 10000 ? 3 : 10;
-    std::vector<double> to, tv;
-    orca.step();
-    vision.step();
-    for (int r = 0; r < rounds; ++r) {
-        double t0 = now();
-        for (int k = 0; k < per; ++k) orca.step();
-        double t1 = now();
-        for (int k = 0; k < per; ++k) vision.step();
-        double t2 = now();
-        to.push_back((t1 - t0) / per);
-        tv.push_back((t2 - t1) / per);
-    }
-    std::sort(to.begin(), to.end());
-    std::sort(tv.begin(), tv.end());
+    const Alternated t = alternate(orca, vision, rounds, per, cpu_now);
+    const std::vector<double>&to = t.wall_a, &tv = t.wall_b;
     const double mo = to[to.size() / 2], mv = tv[tv.size() / 2];
     std::printf("%8zu agents 1 thread : ORCA %8.3f ms/step (%.2f M agents/s)  vision (48 px, 150 deg) %8.3f ms/step "
                 "(%.3f M agents/s)  vision/ORCA time %.2fx  [ranges %.3f-%.3f, %.3f-%.3f]\n",
