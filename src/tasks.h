@@ -13,30 +13,6 @@
 /* Builds without threads (WebAssembly/WASI) run every task on the calling thread. */
 #if defined(__wasi__) && !defined(AKP_NO_THREADS)
 #define AKP_NO_THREADS 1
-/* CPU time per phase (benchmarks; recorded while the profile is on). Every thread measures its
- * own CPU time (CLOCK_THREAD_CPUTIME_ID, so other processes on a loaded machine do not count)
- * from the start of its task to each barrier, between barriers, and from the last barrier to
- * the task's end; a phase is the work between two meetings of a run's threads. Phases are
- * numbered in order from akp_tasks_profile_step (a benchmark calls it before each step): the
- * caller's serial parts between parallel sections get a number too. Per phase, with w_t the CPU
- * seconds of thread t among T: serial_s = max w - mean of the other w (work no other thread
- * shared: a part only task 0 does, or the busiest thread's excess), parallel_s = sum w -
- * serial_s, critical_s = max w. A serial part between sections is all serial_s. Then
- * Amdahl predicts the step on N threads as sum(serial_s + parallel_s / N) and the critical path
- * at T threads is sum(critical_s), a time a machine with T free cores would need (less memory
- * bandwidth and wake-up costs). Only runs begun by the thread that called enable or step are
- * split into phases (a run begun inside a task is part of that task's work); phases past
- * AKP_PHASES_MAX - 1 add up in the last slot. Enabling resets these too. */
-#define AKP_PHASES_MAX 512u
-typedef struct akp_phase_cpu {
-    uint64_t runs;     /* times this phase ran */
-    uint32_t threads;  /* threads in its last run; 1 for a serial part between sections */
-    double serial_s, parallel_s, critical_s;
-} akp_phase_cpu;
-void akp_tasks_profile_step(void);
-/* The phases recorded so far, in order (at most cap); returns how many there are. */
-size_t akp_tasks_profile_phases(akp_phase_cpu* out, size_t cap);
-
 #endif
 
 /* Most tasks one call runs (the jobs cap thread_count at this). */
