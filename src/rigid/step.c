@@ -74,7 +74,7 @@ typedef struct island {
 
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, sap, pairs, contacts, groups, rows, cx, ct, turn0,
+    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, sap, pairs, contacts, groups, rows, cx, ct, turn0,
         jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies, ipairs,
         ijoints, ichains, islands, total;
 } layout;
@@ -93,6 +93,7 @@ static layout layout_of(const ak_rigid_model* m) {
     l.ds = off, off += align16(n * sizeof(ak_vec3));
     l.iw = off, off += align16(n * sizeof(ak_mat3));
     l.grow = off, off += align16(n * sizeof(float));
+    l.slack = off, off += align16(n * sizeof(float));
     l.sap = off, off += align16(n * sizeof(sap_entry));
     l.pairs = off, off += align16((size_t)m->desc.max_contacts * sizeof(pair_entry));
     l.contacts = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
@@ -402,6 +403,14 @@ static void add_pair(solver* s, contact_buf* cb, pair_buf* pb, const float* grow
     pb->count++;
 }
 
+/* Whether body i's bounding sphere, grown by its step's reach, comes within the offset of
+ * plane p. */
+static bool plane_near(const solver* s, uint32_t i, uint32_t p, float offset, const float* grow) {
+    const rigid_body* pl = &s->bodies[p];
+    float dist = ak_vec3_dot(ak_vec3_sub(s->x[i], s->x[p]), pl->shape.normal);
+    return !(dist - s->bodies[i].bound_radius > offset + grow[i]);
+}
+
 static bool pair_before(const pair_entry* a, const pair_entry* b) {
     return a->height > b->height || (a->height == b->height && a->start < b->start) ||
            (a->height == b->height && a->start == b->start &&
@@ -415,17 +424,18 @@ static bool pair_before(const pair_entry* a, const pair_entry* b) {
  * in a stack or a pyramid the ground is then solved last, which lets a 10-box stack creep
  * several times less than bottom-up order. Shell sorts (no allocation, a total order). */
 static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb, float* grow,
-                       float offset, float dt, float gmag, ak_vec3 up) {
+                       float* slack, float offset, float dt, float gmag, ak_vec3 up) {
     const ak_rigid_model* m = s->m;
     uint32_t n = (uint32_t)m->body_count, ns = 0;
     cb->count = 0;
     pb->count = 0;
     for (uint32_t i = 0; i < n; ++i) {
         const rigid_body* b = &s->bodies[i];
-        grow[i] = 0.0f;
+        grow[i] = slack[i] = 0.0f;
         if (!s->awake[i]) continue;
         float turn = flat_shape(b->shape.type) ? ak_vec3_length(s->w[i]) * b->bound_radius : 0.0f;
         grow[i] = 2.0f * dt * (ak_vec3_length(s->v[i]) + turn) + dt * dt * gmag;
+        slack[i] = 2.0f * dt * turn + dt * ak_vec3_length(s->v[i]);
     }
     /* sweep along the axis over which the bodies spread most (their centres' variance) */
     double mean[3] = {0, 0, 0}, var[3] = {0, 0, 0};
@@ -451,6 +461,18 @@ static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb,
         ++ns;
     }
     sap_sort(sap, ns);
+    /* the pairs with planes (the walls and the ground) are kept first when the pairs overflow
+     * max_contacts: room is held back for them while the bodies' pairs are found, so an
+     * overflow drops pairs between bodies (they may sink into each other) but never lets a
+     * body through the ground */
+    uint32_t planes_near = 0;
+    for (uint32_t i = 0; i < n && m->plane_count; ++i) {
+        if (!s->awake[i]) continue;
+        for (size_t k = 0; k < m->plane_count; ++k)
+            planes_near += plane_near(s, i, m->planes[k], offset, grow);
+    }
+    uint32_t cap = pb->cap;
+    pb->cap = planes_near < cap ? cap - planes_near : 0;
     for (uint32_t i = 0; i < ns; ++i) {
         uint32_t a = sap[i].body;
         for (uint32_t j = i + 1; j < ns && sap[j].lo <= sap[i].hi; ++j) {
@@ -458,7 +480,13 @@ static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb,
             if (!s->awake[a] && !s->awake[b]) continue;
             float rr = s->bodies[a].bound_radius + s->bodies[b].bound_radius + offset + grow[a] +
                        grow[b];
-            if (ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b])) > rr * rr) continue;
+            float d2 = ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b]));
+            if (d2 > rr * rr) continue;
+            if (s->awake[a] && s->awake[b]) {
+                float rel = s->bodies[a].bound_radius + s->bodies[b].bound_radius + offset +
+                            2.0f * dt * ak_vec3_length(ak_vec3_sub(s->v[a], s->v[b])) + slack[a] + slack[b];
+                if (d2 > rel * rel) continue;
+            }
             if (s->bodies[a].group != 0 && s->bodies[a].group == s->bodies[b].group) continue;
             if (m->joint_count && joined(m, a, b)) continue;
             /* the awake (or lower-index) body first, so a static body is always b */
@@ -468,14 +496,12 @@ static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb,
                 add_pair(s, cb, pb, grow, a, b, offset, up);
         }
     }
+    pb->cap = cap;
     for (uint32_t i = 0; i < n && m->plane_count; ++i) {
         if (!s->awake[i]) continue;
-        for (size_t k = 0; k < m->plane_count; ++k) {
-            const rigid_body* pl = &s->bodies[m->planes[k]];
-            float dist = ak_vec3_dot(ak_vec3_sub(s->x[i], s->x[m->planes[k]]), pl->shape.normal);
-            if (dist - s->bodies[i].bound_radius > offset + grow[i]) continue;
-            add_pair(s, cb, pb, grow, i, m->planes[k], offset, up);
-        }
+        for (size_t k = 0; k < m->plane_count; ++k)
+            if (plane_near(s, i, m->planes[k], offset, grow))
+                add_pair(s, cb, pb, grow, i, m->planes[k], offset, up);
     }
     static const uint32_t gaps[] = {701, 301, 132, 57, 23, 10, 4, 1};
     pair_entry* e = pb->p;
@@ -1321,7 +1347,8 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
      * substep, the others run the narrow phase in each */
     float offset = m->desc.contact_offset;
     pair_buf pb = {(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts};
-    find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow), offset, job->dt,
+    find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow),
+               (float*)(base + l.slack), offset, job->dt,
                gmag, up);
     uint32_t kept = cb.count;
     uint32_t nj = (uint32_t)m->joint_count, chains = 0;
