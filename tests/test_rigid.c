@@ -591,11 +591,11 @@ AK_TEST(fixed_joint_keeps_the_pose) {
  * layer shifted by 1 cm) into an open 4 x 4 m box: the ground and four walls. The bodies 0..4
  * are the planes. */
 typedef struct pour_stats {
-    bool ok;             /* every step returned AK_OK and the state stayed finite */
-    uint64_t dropped;    /* out_dropped_contacts summed over the run */
-    float outside;       /* the furthest a sphere's surface got past a wall or the ground */
-    float pen_reported;  /* the deepest out_max_penetration of any step */
-    float overlap;       /* the deepest overlap of two spheres at the end (all pairs, naive) */
+    bool ok;            /* every step returned AK_OK and the state stayed finite */
+    uint64_t dropped;   /* out_dropped_contacts summed over the run */
+    float outside;      /* the furthest a sphere's surface got past a wall or the ground */
+    float pen_reported; /* the deepest out_max_penetration of any step */
+    float overlap;      /* the deepest overlap of two spheres at the end (all pairs, naive) */
     double ke_peak, ke_end;
 } pour_stats;
 
@@ -655,8 +655,8 @@ static pour_stats pour_run(int count, uint32_t max_contacts, int frames) {
             ke += 0.5 * mass * (double)ak_vec3_dot(v[i], v[i]);
             /* the surface past each plane: r - (distance of the centre from the plane) */
             for (int k = 0; k < 5; ++k)
-                st.outside = ak_maxf(st.outside, r - ak_vec3_dot(ak_vec3_sub(x[i], points[k]),
-                                                                 normals[k]));
+                st.outside =
+                    ak_maxf(st.outside, r - ak_vec3_dot(ak_vec3_sub(x[i], points[k]), normals[k]));
         }
         if (ke > st.ke_peak) st.ke_peak = ke;
         st.ke_end = ke;

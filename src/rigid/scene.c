@@ -394,7 +394,8 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
         static const char* const keys[] = {
             "gravity",         "bodies",         "joints",  "dt",
             "steps",           "substeps",       "threads", "linear_damping",
-            "angular_damping", "contact_offset", "sleep",   "max_contacts", NULL};
+            "angular_damping", "contact_offset", "sleep",   "max_contacts",
+            NULL};
         akp_json_object(&j, root, "", keys);
         akp_json_vec3(&j, root, "", "gravity", &s->gravity);
         if (!j.failed && ak_vec3_length(s->gravity) > 1e4f)

@@ -74,8 +74,8 @@ typedef struct island {
 
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, sap, pairs, contacts, groups, rows, cx, ct, turn0,
-        jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies, ipairs,
+    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, sap, pairs, contacts, groups, rows, cx, ct,
+        turn0, jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies, ipairs,
         ijoints, ichains, islands, total;
 } layout;
 
@@ -428,9 +428,9 @@ static bool pair_before(const pair_entry* a, const pair_entry* b) {
  * (contacts can stop one of them within the step while the other goes on) and, for flat
  * shapes, their corners' turn (slack). A falling block of spheres then pairs each sphere with
  * the neighbours it can touch, not with every one within twice its own travel. */
-static void body_pairs(solver* s, const sap_entry* sap, uint32_t ns, contact_buf* cb,
-                       pair_buf* pb, const float* grow, const float* slack, float offset, float dt,
-                       ak_vec3 up, float scale) {
+static void body_pairs(solver* s, const sap_entry* sap, uint32_t ns, contact_buf* cb, pair_buf* pb,
+                       const float* grow, const float* slack, float offset, float dt, ak_vec3 up,
+                       float scale) {
     const ak_rigid_model* m = s->m;
     for (uint32_t i = 0; i < ns; ++i) {
         uint32_t a = sap[i].body;
