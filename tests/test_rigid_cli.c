@@ -134,6 +134,30 @@ AK_TEST(bad_scenes_name_the_key) {
     }
 }
 
+/* Contacts dropped over max_contacts are not silent: a column of five spheres on the ground with
+ * "max_contacts": 2 runs (exit 0) and warns naming max_contacts; the same scene with the
+ * default prints no warning. */
+AK_TEST(dropped_contacts_warn) {
+    static const char* const bodies =
+        "\"bodies\": [{\"shape\": {\"type\": \"plane\", \"normal\": [0, 1, 0]}, \"static\": true},"
+        "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.1}, \"position\": [0, 0.1, 0]},"
+        "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.1}, \"position\": [0, 0.3, 0]},"
+        "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.1}, \"position\": [0, 0.5, 0]},"
+        "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.1}, \"position\": [0, 0.7, 0]},"
+        "{\"shape\": {\"type\": \"sphere\", \"radius\": 0.1}, \"position\": [0, 0.9, 0]}]}";
+    char text[1024];
+    snprintf(text, sizeof text, "{\"steps\": 10, \"max_contacts\": 2, %s", bodies);
+    AK_CHECK(write_file("rigid_small.json", text));
+    AK_CHECK_EQ(run("rigid rigid_small.json", true), 0);
+    AK_CHECK_MSG(strstr(out_buf, "warning") && strstr(out_buf, "max_contacts") &&
+                     strstr(out_buf, "dropped"),
+                 "%s", out_buf);
+    snprintf(text, sizeof text, "{\"steps\": 10, %s", bodies);
+    AK_CHECK(write_file("rigid_small.json", text));
+    AK_CHECK_EQ(run("rigid rigid_small.json", true), 0);
+    AK_CHECK_MSG(!strstr(out_buf, "max_contacts"), "%s", out_buf);
+}
+
 /* Dominoes fall in order: after 6 s every domino but the last two has tipped, and each is tipped
  * at least as far as the one after it (the wave runs from the first to the last), except the
  * last one, which may already lie flat. */
@@ -170,6 +194,7 @@ int main(void) {
     AK_RUN(json_contract_and_closed_forms);
     AK_RUN(incline_preset);
     AK_RUN(bad_scenes_name_the_key);
+    AK_RUN(dropped_contacts_warn);
     AK_RUN_SLOW(dominoes_fall_in_order);
     return ak_test_finish();
 }

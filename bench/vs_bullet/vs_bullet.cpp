@@ -35,6 +35,8 @@ struct result {
     double pen;    // m, deepest penetration seen over the run
     double contacts;  // contact points per step, mean over the run
     uint64_t hash;    // animkit: FNV-1a of the final state
+    uint64_t dropped = 0;  // animkit: contact points (and pairs) over max_contacts, whole run
+    int drop_steps = 0, drop_first = -1;  // steps that dropped any, the first of them
 };
 
 struct scene {
@@ -176,7 +178,10 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
         ak_rigid_step_run(&job);
         r.pen = std::fmax(r.pen, (double)pen);
         r.contacts += contacts / (double)steps;
-        if (dropped) std::fprintf(stderr, "animkit dropped %u contact points (max_contacts) in step %d\n", dropped, s);
+        if (dropped) {
+            r.dropped += dropped;
+            if (!r.drop_steps++) r.drop_first = s;
+        }
     }
     r.ms_per_step = 1e3 * ((threads > 1 ? bench_wall_s() : bench_cpu_s()) - t0) / steps;
     r.cpu_ms = 1e3 * (bench_cpu_s() - c0) / steps;
@@ -401,6 +406,12 @@ int main(int argc, char** argv) {
                     b.ms_per_step, b.ms_per_step / a.ms_per_step, a.drift, b.drift, a.pen, b.pen, a.contacts,
                     b.contacts);
         std::printf("  animkit final state FNV-1a %016llx\n", (unsigned long long)a.hash);
+        if (a.dropped)
+            std::printf("  WARNING: animkit DROPPED %llu contact points over max_contacts in %d of %d steps "
+                        "(from step %d): its simulation of this scene is broken and its timing not comparable\n",
+                        (unsigned long long)a.dropped, a.drop_steps, steps, a.drop_first);
+        else
+            std::printf("  animkit dropped no contacts (max_contacts held every pair)\n");
         // where animkit's time went: the calling thread's CPU, every thread's (the worker team's
         // included, so the islands' share off the calling thread shows), and wall time
         std::printf("  animkit ms per step: calling thread CPU %.3f, all threads CPU %.3f (%.0f%% off the "

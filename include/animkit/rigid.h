@@ -706,9 +706,14 @@ typedef struct ak_rigid_scene_run {
     float max_penetration; /* metres, after the last step (0 before the first) */
     long step_index;       /* steps taken */
     double time;           /* seconds simulated: step_index * dt */
+    uint64_t dropped_contacts; /* contact points (and pairs) over max_contacts, summed over the
+                                  steps (out_dropped_contacts): 0 unless the scene's
+                                  max_contacts is too small for it */
+    long dropped_first_step;   /* the first step (1-based) that dropped any, 0 when none did */
     ak_rigid_step_job job; /* points into the arrays above */
     /* private */
     float* sleep_timers;
+    uint32_t dropped_last;
 } ak_rigid_scene_run;
 
 /* Build the model and the initial state and validate the step job. The scene may be freed

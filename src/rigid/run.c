@@ -42,7 +42,8 @@ ak_result ak_rigid_scene_run_init(ak_rigid_scene_run* run, const ak_rigid_scene*
                                    .orientations = {run->orientations, n},
                                    .velocities = {run->velocities, n},
                                    .angular_velocities = {run->angular_velocities, n},
-                                   .out_max_penetration = &run->max_penetration};
+                                   .out_max_penetration = &run->max_penetration,
+                                   .out_dropped_contacts = &run->dropped_last};
     if (sc->sleep) run->job.sleep_timers = (ak_f32_span){run->sleep_timers, n};
     const size_t bytes = ak_rigid_step_scratch_size(&run->job);
     run->job.scratch = (ak_u8_span){malloc(bytes ? bytes : 1), bytes};
@@ -58,9 +59,12 @@ ak_result ak_rigid_scene_run_step(ak_rigid_scene_run* run) {
     if (!run || !run->model) return AK_ERR_NULL_ARG;
     /* the job points at max_penetration inside *run: re-aim it in case the struct was copied */
     run->job.out_max_penetration = &run->max_penetration;
+    run->job.out_dropped_contacts = &run->dropped_last;
     const ak_result r = ak_rigid_step_run(&run->job);
     if (r != AK_OK) return r;
     ++run->step_index;
+    run->dropped_contacts += run->dropped_last;
+    if (run->dropped_last && !run->dropped_first_step) run->dropped_first_step = run->step_index;
     run->time = (double)run->step_index * (double)run->job.dt;
     return AK_OK;
 }

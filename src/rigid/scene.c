@@ -394,7 +394,8 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
         static const char* const keys[] = {
             "gravity",         "bodies",         "joints",  "dt",
             "steps",           "substeps",       "threads", "linear_damping",
-            "angular_damping", "contact_offset", "sleep",   NULL};
+            "angular_damping", "contact_offset", "sleep",   "max_contacts",
+            NULL};
         akp_json_object(&j, root, "", keys);
         akp_json_vec3(&j, root, "", "gravity", &s->gravity);
         if (!j.failed && ak_vec3_length(s->gravity) > 1e4f)
@@ -409,6 +410,9 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
         akp_json_float(&j, root, "", "angular_damping", 0.0f, 1e3f, &s->model.angular_damping);
         akp_json_float(&j, root, "", "contact_offset", 1e-5f, 1.0f, &s->model.contact_offset);
         akp_json_bool(&j, root, "", "sleep", &s->sleep);
+        long mc = (long)s->model.max_contacts;
+        akp_json_int(&j, root, "", "max_contacts", 0, 100000000, &mc);
+        s->model.max_contacts = (uint32_t)mc;
         size_t n = 0;
         const cJSON* e = akp_json_array(&j, root, "", "bodies", AK_RIGID_SCENE_MAX_BODIES, &n);
         if (!j.failed && n == 0)

@@ -74,8 +74,8 @@ typedef struct island {
 
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, sap, pairs, contacts, groups, rows, cx, ct, turn0,
-        jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies, ipairs,
+    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, sap, pairs, contacts, groups, rows, cx, ct,
+        turn0, jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies, ipairs,
         ijoints, ichains, islands, total;
 } layout;
 
@@ -93,6 +93,7 @@ static layout layout_of(const ak_rigid_model* m) {
     l.ds = off, off += align16(n * sizeof(ak_vec3));
     l.iw = off, off += align16(n * sizeof(ak_mat3));
     l.grow = off, off += align16(n * sizeof(float));
+    l.slack = off, off += align16(n * sizeof(float));
     l.sap = off, off += align16(n * sizeof(sap_entry));
     l.pairs = off, off += align16((size_t)m->desc.max_contacts * sizeof(pair_entry));
     l.contacts = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
@@ -187,6 +188,9 @@ typedef struct solver {
     ak_mat3* rot;   /* each body's rotation at the contact solve's start */
     ak_mat3* rot0;  /* each body's rotation at the step's start */
     float h;
+    /* after an overflow of max_contacts, the most a contact between two moving bodies
+     * corrects in a substep (INFINITY otherwise; see find_pairs) */
+    float push_max;
 } solver;
 
 /* World inverse inertia R diag(I^-1) R^T of orientation q (symmetric, so its storage order
@@ -370,6 +374,7 @@ RIGID_HOT float contact_vn(const solver* s, const rigid_contact* c) {
 typedef struct pair_buf {
     pair_entry* p;
     uint32_t count, cap;
+    uint32_t dropped; /* pairs over cap */
 } pair_buf;
 
 /* Keep pair (a, b) for the step: a pair of flat shapes gets its contacts now, at the step's
@@ -378,7 +383,7 @@ typedef struct pair_buf {
 static void add_pair(solver* s, contact_buf* cb, pair_buf* pb, const float* grow, uint32_t a,
                      uint32_t b, float offset, ak_vec3 up) {
     if (pb->count >= pb->cap) {
-        cb->dropped += 1;
+        pb->dropped += 1;
         return;
     }
     pair_entry* e = &pb->p[pb->count];
@@ -402,10 +407,54 @@ static void add_pair(solver* s, contact_buf* cb, pair_buf* pb, const float* grow
     pb->count++;
 }
 
+/* Whether body i's bounding sphere, grown by its step's reach, comes within the offset of
+ * plane p. */
+static bool plane_near(const solver* s, uint32_t i, uint32_t p, float offset, const float* grow) {
+    const rigid_body* pl = &s->bodies[p];
+    float dist = ak_vec3_dot(ak_vec3_sub(s->x[i], s->x[p]), pl->shape.normal);
+    return !(dist - s->bodies[i].bound_radius > offset + grow[i]);
+}
+
 static bool pair_before(const pair_entry* a, const pair_entry* b) {
     return a->height > b->height || (a->height == b->height && a->start < b->start) ||
            (a->height == b->height && a->start == b->start &&
             (a->a < b->a || (a->a == b->a && a->b < b->b)));
+}
+
+/* The pairs of bodies the sweep sap[0 .. ns) overlaps, their motion margins scaled by scale
+ * (1: the full test; see find_pairs). A pair of two awake bodies under the same gravity is
+ * tested on their relative motion: gravity moves both alike and cancels, so the gap has to be
+ * within the offset plus twice their relative speed times dt, plus each one's own travel dt |v|
+ * (contacts can stop one of them within the step while the other goes on) and, for flat
+ * shapes, their corners' turn (slack). A falling block of spheres then pairs each sphere with
+ * the neighbours it can touch, not with every one within twice its own travel. */
+static void body_pairs(solver* s, const sap_entry* sap, uint32_t ns, contact_buf* cb, pair_buf* pb,
+                       const float* grow, const float* slack, float offset, float dt, ak_vec3 up,
+                       float scale) {
+    const ak_rigid_model* m = s->m;
+    for (uint32_t i = 0; i < ns; ++i) {
+        uint32_t a = sap[i].body;
+        for (uint32_t j = i + 1; j < ns && sap[j].lo <= sap[i].hi; ++j) {
+            uint32_t b = sap[j].body;
+            if (!s->awake[a] && !s->awake[b]) continue;
+            float rb = s->bodies[a].bound_radius + s->bodies[b].bound_radius + offset;
+            float rr = rb + scale * (grow[a] + grow[b]);
+            float d2 = ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b]));
+            if (d2 > rr * rr) continue;
+            if (s->awake[a] && s->awake[b]) {
+                float rel = rb + scale * (2.0f * dt * ak_vec3_distance(s->v[a], s->v[b]) +
+                                          slack[a] + slack[b]);
+                if (d2 > rel * rel) continue;
+            }
+            if (s->bodies[a].group != 0 && s->bodies[a].group == s->bodies[b].group) continue;
+            if (m->joint_count && joined(m, a, b)) continue;
+            /* the awake (or lower-index) body first, so a static body is always b */
+            if (!s->awake[a] || (s->awake[b] && b < a))
+                add_pair(s, cb, pb, grow, b, a, offset, up);
+            else
+                add_pair(s, cb, pb, grow, a, b, offset, up);
+        }
+    }
 }
 
 /* Broad phase, once per step on the step's start poses: sweep and prune over bounding spheres
@@ -415,17 +464,18 @@ static bool pair_before(const pair_entry* a, const pair_entry* b) {
  * in a stack or a pyramid the ground is then solved last, which lets a 10-box stack creep
  * several times less than bottom-up order. Shell sorts (no allocation, a total order). */
 static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb, float* grow,
-                       float offset, float dt, float gmag, ak_vec3 up) {
+                       float* slack, float offset, float dt, float gmag, ak_vec3 up) {
     const ak_rigid_model* m = s->m;
     uint32_t n = (uint32_t)m->body_count, ns = 0;
     cb->count = 0;
     pb->count = 0;
     for (uint32_t i = 0; i < n; ++i) {
         const rigid_body* b = &s->bodies[i];
-        grow[i] = 0.0f;
+        grow[i] = slack[i] = 0.0f;
         if (!s->awake[i]) continue;
         float turn = flat_shape(b->shape.type) ? ak_vec3_length(s->w[i]) * b->bound_radius : 0.0f;
         grow[i] = 2.0f * dt * (ak_vec3_length(s->v[i]) + turn) + dt * dt * gmag;
+        slack[i] = 2.0f * dt * turn + dt * ak_vec3_length(s->v[i]);
     }
     /* sweep along the axis over which the bodies spread most (their centres' variance) */
     double mean[3] = {0, 0, 0}, var[3] = {0, 0, 0};
@@ -451,32 +501,53 @@ static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb,
         ++ns;
     }
     sap_sort(sap, ns);
-    for (uint32_t i = 0; i < ns; ++i) {
-        uint32_t a = sap[i].body;
-        for (uint32_t j = i + 1; j < ns && sap[j].lo <= sap[i].hi; ++j) {
-            uint32_t b = sap[j].body;
-            if (!s->awake[a] && !s->awake[b]) continue;
-            float rr = s->bodies[a].bound_radius + s->bodies[b].bound_radius + offset + grow[a] +
-                       grow[b];
-            if (ak_vec3_length_sq(ak_vec3_sub(s->x[a], s->x[b])) > rr * rr) continue;
-            if (s->bodies[a].group != 0 && s->bodies[a].group == s->bodies[b].group) continue;
-            if (m->joint_count && joined(m, a, b)) continue;
-            /* the awake (or lower-index) body first, so a static body is always b */
-            if (!s->awake[a] || (s->awake[b] && b < a))
-                add_pair(s, cb, pb, grow, b, a, offset, up);
-            else
-                add_pair(s, cb, pb, grow, a, b, offset, up);
-        }
-    }
+    /* the pairs with planes (the walls and the ground) are kept first when the pairs overflow
+     * max_contacts: room is held back for them while the bodies' pairs are found, so an
+     * overflow drops pairs between bodies (they may sink into each other) but never lets a
+     * body through the ground */
+    uint32_t planes_near = 0;
     for (uint32_t i = 0; i < n && m->plane_count; ++i) {
         if (!s->awake[i]) continue;
-        for (size_t k = 0; k < m->plane_count; ++k) {
-            const rigid_body* pl = &s->bodies[m->planes[k]];
-            float dist = ak_vec3_dot(ak_vec3_sub(s->x[i], s->x[m->planes[k]]), pl->shape.normal);
-            if (dist - s->bodies[i].bound_radius > offset + grow[i]) continue;
-            add_pair(s, cb, pb, grow, i, m->planes[k], offset, up);
-        }
+        for (size_t k = 0; k < m->plane_count; ++k)
+            planes_near += plane_near(s, i, m->planes[k], offset, grow);
     }
+    uint32_t cap = pb->cap;
+    pb->cap = planes_near < cap ? cap - planes_near : 0;
+    /* when the bodies' pairs do not fit, the sweep runs again with the margins for the step's
+     * motion at two thirds, one third, then none (the pairs within the contact offset now): the
+     * pairs dropped are then the furthest apart, not the last ones the sweep met. The dropped
+     * count is the full test's pairs that were not kept. */
+    uint32_t wanted = 0, dropped0 = cb->dropped;
+    for (int pass = 0; pass < 4; ++pass) {
+        cb->count = 0;
+        cb->dropped = dropped0;
+        pb->count = 0;
+        pb->dropped = 0;
+        body_pairs(s, sap, ns, cb, pb, grow, slack, offset, dt, up, (float)(3 - pass) / 3.0f);
+        if (pass == 0) wanted = pb->count + pb->dropped;
+        if (pb->dropped == 0) break;
+    }
+    pb->dropped = wanted - pb->count;
+    pb->cap = cap;
+    for (uint32_t i = 0; i < n && m->plane_count; ++i) {
+        if (!s->awake[i]) continue;
+        for (size_t k = 0; k < m->plane_count; ++k)
+            if (plane_near(s, i, m->planes[k], offset, grow)) {
+                uint32_t before = pb->count;
+                add_pair(s, cb, pb, grow, i, m->planes[k], offset, up);
+                /* after an overflow the plane pairs are solved last in each substep: bodies the
+                 * dropped pairs let sink into each other are pushed apart, and the last push on
+                 * each is then the walls' and the ground's, which they end the solve outside of */
+                if (pb->dropped && pb->count > before) pb->p[before].height = -INFINITY;
+            }
+    }
+    cb->dropped += pb->dropped;
+    /* bodies whose pairs were dropped can sink deep into each other, and pushing them apart in
+     * one substep would throw them out at the depth over h (60 m/s for 10 cm at 600 Hz), past
+     * the margins of their pairs with the walls: after an overflow a contact between two moving
+     * bodies corrects at most 1 m/s times h per substep (contacts with static bodies and planes
+     * in full) */
+    if (pb->dropped) s->push_max = 1.0f * s->h;
     static const uint32_t gaps[] = {701, 301, 132, 57, 23, 10, 4, 1};
     pair_entry* e = pb->p;
     for (size_t gi = 0; gi < sizeof gaps / sizeof gaps[0]; ++gi) {
@@ -648,6 +719,7 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
                 float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cxb, cxa)) +
                           ak_vec3_dot(ctb, r->rnb) - ak_vec3_dot(cta, r->rna);
                 if (d <= 0.0f || r->inv_w == 0.0f) continue;
+                if (r->imb != 0.0f && d > s->push_max) d = s->push_max;
                 float dl = d * r->inv_w;
                 c->lambda_n += dl;
                 /* (a body that does not move has a zero row: its sums stay zero) */
@@ -1299,6 +1371,7 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
         .rot = (ak_mat3*)(base + l.rot),
         .rot0 = (ak_mat3*)(base + l.rot0),
         .h = job->dt / (float)substeps,
+        .push_max = INFINITY,
     };
     memcpy(x0, s.x, n * sizeof *x0);
     memcpy(q0, s.q, n * sizeof *q0);
@@ -1320,8 +1393,9 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
      * with margins that cover the step's motion; flat pairs keep their contacts for every
      * substep, the others run the narrow phase in each */
     float offset = m->desc.contact_offset;
-    pair_buf pb = {(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts};
-    find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow), offset, job->dt,
+    pair_buf pb = {(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts, 0};
+    find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow),
+               (float*)(base + l.slack), offset, job->dt,
                gmag, up);
     uint32_t kept = cb.count;
     uint32_t nj = (uint32_t)m->joint_count, chains = 0;

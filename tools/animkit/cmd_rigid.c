@@ -352,6 +352,12 @@ int cmd_rigid(int argc, char** argv) {
            "penetration %.3g m, energy %.6g J\n",
            name, n, sc.joint_count, sc.steps, (double)sc.dt, sc.substeps, (double)time, (double)pen,
            energy);
+    if (run.dropped_contacts)
+        fprintf(stderr,
+                "animkit rigid: warning: %s: %llu contact points dropped over max_contacts (from "
+                "step %ld on): bodies may sink into each other; raise \"max_contacts\" in the "
+                "scene (0: 16 per body + 64)\n",
+                name, (unsigned long long)run.dropped_contacts, run.dropped_first_step);
     if (gif)
         cli_wrote(out, "%d frames", frames);
     else if (rec_cap && sc.ragdoll_bone_count)
