@@ -11,12 +11,9 @@
  * integer lattice arithmetic, and floats there have no fractional part anyway. */
 #define AKP_NOISE_LIMIT 16777216.0f
 
-/* floorf(x) and the same value as an int, for |x| < 2^31 (callers check AKP_NOISE_LIMIT first):
- * truncate, step down where truncation rounded up (negative non-integers), and take x's sign,
- * which only changes -0.0 (floorf(-0.0) is -0.0; the int conversion gives +0.0). The same
- * float as floorf bit for bit (test_noise floor_matches_libm), without the rounding-mode
- * branch gcc emits for floorf on baseline x86-64 (no SSE4.1 roundss). */
-static inline float akp_floor(float x, int* out_i) {
+/* akp_floor (below) without the sign step: floorf(x) except +0.0 for x = -0.0, for callers where that
+ * zero's sign cannot reach the result (simplex: see simplex3_value). */
+static inline float akp_floor_unsigned_zero(float x, int* out_i) {
     const int t = (int)x;
     const float ft = (float)t;
     const int up = ft > x;
@@ -26,34 +23,21 @@ static inline float akp_floor(float x, int* out_i) {
     const uint32_t one_bits = (uint32_t)-up & 0x3F800000u;
     float one;
     memcpy(&one, &one_bits, sizeof one);
-    return copysignf(ft - one, x);
-}
-
-/* akp_floor without the sign step: floorf(x) except +0.0 for x = -0.0, for callers where that
- * zero's sign cannot reach the result (simplex: see simplex3_value). */
-static inline float akp_floor_unsigned_zero(float x, int* out_i) {
-    const int t = (int)x;
-    const float ft = (float)t;
-    const int up = ft > x;
-    *out_i = t - up;
-    const uint32_t one_bits = (uint32_t)-up & 0x3F800000u;
-    float one;
-    memcpy(&one, &one_bits, sizeof one);
     return ft - one;
 }
+
+/* floorf(x) and the same value as an int, for |x| < 2^31 (callers check AKP_NOISE_LIMIT first):
+ * truncate, step down where truncation rounded up (negative non-integers), and take x's sign,
+ * which only changes -0.0 (floorf(-0.0) is -0.0; the int conversion gives +0.0). The same
+ * float as floorf bit for bit (test_noise floor_matches_libm), without the rounding-mode
+ * branch gcc emits for floorf on baseline x86-64 (no SSE4.1 roundss). */
+static inline float akp_floor(float x, int* out_i) { return copysignf(akp_floor_unsigned_zero(x, out_i), x); }
 
 /* x - floorf(x) (the fraction in [0, 1)) and floorf(x) as an int, in one. The floor is taken
  * without its sign here: only x = -0.0 tells (-0.0 - +0.0 is -0.0 where x - floorf(x) is
  * +0.0), and adding +0.0 turns that -0.0 into +0.0 and changes no other value. */
 static inline float akp_floor_frac(float x, int* out_i) {
-    const int t = (int)x;
-    const float ft = (float)t;
-    const int up = ft > x;
-    *out_i = t - up;
-    const uint32_t one_bits = (uint32_t)-up & 0x3F800000u;
-    float one;
-    memcpy(&one, &one_bits, sizeof one);
-    return (x - (ft - one)) + 0.0f;
+    return (x - akp_floor_unsigned_zero(x, out_i)) + 0.0f;
 }
 
 /* The fBm octave sum without gradient or warp, for a resolved, valid desc of type FBM and a
