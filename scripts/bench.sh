@@ -9,9 +9,14 @@
 # AK_BENCH_QUICK=1 to it (bench_clock.h's bench_quick(): fewer rounds or a slow fixed-size part
 # left out): it checks the pipeline in about two minutes; its numbers are not measurements. It runs a peer harness only
 # when the peer library is already built (the full run builds ozz once, ~1 min, and FastNoise2
-# once, 5-9 min, under BUILD). AK_BENCH_PEERS=0 leaves the peers out; AK_BENCH_ONLY='bench_ik
-# vs_ozz' runs only the named programs; AK_BENCH_NSEARCH_SIDES (default "38 80": 55k and 512k
-# points) sets the neighbour-search sizes.
+# once, 5-9 min, under BUILD). AK_BENCH_PEERS=0 leaves the peers out; AK_BENCH_PEERS_DIR sets
+# where the peers are (default ../shared/peers; a git worktree elsewhere points it at the main
+# checkout's); AK_BENCH_ONLY='bench_ik vs_ozz' runs only the named programs;
+# AK_BENCH_NSEARCH_SIDES (default "38 80": 55k and 512k points) sets the neighbour-search sizes.
+# Also run when built: bench_rigid_vs_bullet (needs libbullet-dev) and vs_rvo2 (needs the RVO2
+# peer at configure time, -DAK_RVO2_DIR); the Python benches when `make python` put the module
+# in python/animkit (bench_batch_dask.py also needs dask.distributed). Each one missing is
+# skipped with a line saying why; a skip never fails the run, a failed program does.
 set -uo pipefail
 B=${1:-build}
 QUICK=${AK_BENCH_QUICK:-0}
@@ -20,7 +25,10 @@ QUICK=${AK_BENCH_QUICK:-0}
 PEERS_ON=${AK_BENCH_PEERS:-1}
 ONLY=${AK_BENCH_ONLY:-}
 ROOT=$PWD
-PEERS=$ROOT/../shared/peers
+# The shared assets (CesiumMan, the CMU BVH files): benches without them skip those parts, and
+# bench_retarget, which needs them, is skipped.
+ASSETS=${ANIMKIT_ASSETS:-$ROOT/../shared/assets}
+PEERS=${AK_BENCH_PEERS_DIR:-$ROOT/../shared/peers}
 [[ -d $PEERS ]] && PEERS=$(cd "$PEERS" && pwd)
 [[ -d $B/bench ]] || { echo "bench.sh: no $B/bench: build the project first (make build, Release)" >&2; exit 2; }
 B=$(cd "$B" && pwd)
@@ -36,6 +44,7 @@ wanted() { [[ -z $ONLY || " $ONLY " == *" $1 "* ]]; }
 # A bench not listed runs with its defaults in both modes.
 quick_args() {
     case $1 in
+        bench_batch) echo "3" ;;               # repeats
         bench_blendshape) echo "3000 5 10" ;;  # vertices, targets, moved %
         bench_boids) echo "--quick" ;;         # 5 steps instead of 21, no 1M-agent run
         bench_cloth) echo "5" ;;               # frames
@@ -43,6 +52,8 @@ quick_args() {
         bench_ik) echo "200" ;;                # targets per chain
         bench_particles) echo "10000" ;;       # particles of the step (the grid part is fixed)
         bench_retarget) echo "1" ;;            # repetitions
+        bench_rigid_vs_bullet) echo "--layers 6 --spheres 300 --ragdolls 3 --steps 20 --substeps 10" ;;
+        bench_scaling) echo "--quick" ;;       # small sizes, few steps (1 and 2 threads)
         bench_skin) echo "20000" ;;            # vertices (the triad and in-cache parts are fixed)
         *) echo "" ;;
     esac
@@ -94,12 +105,58 @@ for exe in "$B"/bench/bench_*; do
     found=1
     name=$(basename "$exe")
     wanted "$name" || continue
+    if [[ $name == bench_retarget && ! -f $ASSETS/bvh/01_01.bvh ]]; then
+        skip "$name" "no $ASSETS/bvh/01_01.bvh (set ANIMKIT_ASSETS to the shared assets)"
+        continue
+    fi
     args=
     [[ -n $QUICK ]] && args=$(quick_args "$name")
+    # bench_batch writes its jobs' outputs under the current folder: keep them out of the tree.
+    cwd=()
+    [[ $name == bench_batch ]] && cwd=(env -C "$OUT")
     # shellcheck disable=SC2086
-    run "$name" "$exe" $args
+    run "$name" "${cwd[@]}" "$exe" $args
 done
 [[ $found == 1 ]] || echo "bench.sh: no benchmark programs in $B/bench (configure with -DAK_BUILD_BENCH=ON)"
+if [[ $found == 1 && ! -x $B/bench/bench_rigid_vs_bullet ]] && wanted bench_rigid_vs_bullet; then
+    skip bench_rigid_vs_bullet "not built: Bullet 3 not found by pkg-config at configure time (apt-get install libbullet-dev)"
+fi
+
+# 1b. animkit crowd beside RVO2 (bench/vs_rvo2, built when the RVO2 peer was there at configure time).
+if [[ -x $B/bench/vs_rvo2 ]]; then
+    if [[ -n $QUICK ]]; then
+        wanted vs_rvo2_agree && run vs_rvo2_agree "$B/bench/vs_rvo2" agree 50
+        wanted vs_rvo2_time && run vs_rvo2_time "$B/bench/vs_rvo2" time 1000
+        wanted vs_rvo2_work && run vs_rvo2_work "$B/bench/vs_rvo2" work 1000
+    else
+        wanted vs_rvo2_agree && run vs_rvo2_agree "$B/bench/vs_rvo2" agree
+        wanted vs_rvo2_time && run vs_rvo2_time "$B/bench/vs_rvo2" time 1000 10000 100000
+        wanted vs_rvo2_work && run vs_rvo2_work "$B/bench/vs_rvo2" work 10000
+    fi
+elif wanted vs_rvo2_time; then
+    skip vs_rvo2 "not built: no RVO2 peer at configure time (-DAK_RVO2_DIR=.../peers/rvo2, now $PEERS/rvo2)"
+fi
+
+# 1c. The Python benches (bench/*.py), with the module `make python` puts in python/animkit.
+if wanted bench_python || wanted bench_batch_dask; then
+    PY=/usr/bin/python3
+    if [[ ! -x $PY ]]; then
+        skip bench_python "no /usr/bin/python3"
+    elif ! PYTHONPATH=$ROOT/python $PY -c 'import animkit' >/dev/null 2>&1; then
+        skip bench_python "no Python module in python/animkit (make python first; needs numpy)"
+    else
+        wanted bench_python && run bench_python env PYTHONPATH="$ROOT/python" $PY "$ROOT/bench/bench_python.py"
+        if ! wanted bench_batch_dask; then
+            :
+        elif ! PYTHONPATH=$ROOT/python $PY -c 'import dask.distributed' >/dev/null 2>&1; then
+            skip bench_batch_dask "no dask.distributed for /usr/bin/python3"
+        elif [[ -n $QUICK ]]; then
+            run bench_batch_dask env PYTHONPATH="$ROOT/python" $PY "$ROOT/bench/bench_batch_dask.py" 8 80x60
+        else
+            run bench_batch_dask env PYTHONPATH="$ROOT/python" $PY "$ROOT/bench/bench_batch_dask.py" 48 640x480
+        fi
+    fi
+fi
 
 # 2. The side-by-side harnesses (../shared/peers/*/run.sh, arguments from each run.sh's usage line).
 peer_lib_missing() { # prints why the harness cannot run, or nothing
@@ -123,35 +180,43 @@ else
             # The skinning rows again with animkit capped to its AVX2 kernel (bench/vs_ozz), on a CPU
             # that also has AVX-512: the targets hold on every CPU path.
             if wanted vs_ozz_avx2 && [[ -x $ROOT/bench/vs_ozz/run.sh ]] && grep -q avx512f /proc/cpuinfo; then
-                run vs_ozz_avx2 env AK_VS_OZZ_SIMD=avx2 "$ROOT/bench/vs_ozz/run.sh" "$B" "$1" "$2" s
+                run vs_ozz_avx2 env AK_VS_OZZ_SIMD=avx2 VS_OZZ_PEER="$PEERS/vs_ozz" "$ROOT/bench/vs_ozz/run.sh" "$B" "$1" "$2" s
             fi
         fi
     fi
-    # vs_noise: FastNoiseLite and FastNoise2.
+    # vs_noise: FastNoiseLite and FastNoise2, every basis (this repository's harness,
+    # bench/vs_noise/run.sh; the peers' own run.sh when it is gone).
     if wanted vs_noise; then
-        if [[ ! -x $PEERS/noise/run.sh || ! -d $PEERS/noise/FastNoise2 ]]; then
+        if [[ ! -d $PEERS/noise/FastNoise2 ]]; then
             skip vs_noise "peer absent ($PEERS/noise)"
         elif [[ -n $QUICK && ! -f $B/vs_noise/fn2/lib/libFastNoise.a && ! -f $B/vs_noise/fn2/Release/lib/libFastNoise.a ]]; then
             skip vs_noise "quick mode: FastNoise2 not built yet under $B/vs_noise (make bench builds it, 5-9 min)"
         else
             if [[ -n $QUICK ]]; then rounds=1; else rounds=5; fi
-            run vs_noise "$PEERS/noise/run.sh" "$B" "$rounds"
+            if [[ -x $ROOT/bench/vs_noise/run.sh ]]; then
+                run vs_noise env NOISE_PEERS="$PEERS/noise" "$ROOT/bench/vs_noise/run.sh" "$B" "$rounds"
+            else
+                run vs_noise "$PEERS/noise/run.sh" "$B" "$rounds"
+            fi
         fi
     fi
-    # vs_nsearch: CompactNSearch, at each size.
-    if [[ ! -x $PEERS/nsearch/run.sh || ! -d $PEERS/nsearch/CompactNSearch ]]; then
+    # vs_nsearch: CompactNSearch (pairs and CSR lists, bench/vs_nsearch/run.sh), at each size.
+    nsearch=("$PEERS/nsearch/run.sh")
+    [[ -x $ROOT/bench/vs_nsearch/run.sh ]] && nsearch=(env CNS_DIR="$PEERS/nsearch/CompactNSearch" "$ROOT/bench/vs_nsearch/run.sh")
+    if [[ ! -d $PEERS/nsearch/CompactNSearch ]]; then
         skip vs_nsearch "peer absent ($PEERS/nsearch)"
     elif [[ -n $QUICK ]]; then
-        wanted vs_nsearch_12 && run vs_nsearch_12 "$PEERS/nsearch/run.sh" "$B" 12 1
+        wanted vs_nsearch_12 && run vs_nsearch_12 "${nsearch[@]}" "$B" 12 1
     else
         for side in ${AK_BENCH_NSEARCH_SIDES:-38 80}; do
-            wanted "vs_nsearch_$side" && run "vs_nsearch_$side" "$PEERS/nsearch/run.sh" "$B" "$side" 7
+            wanted "vs_nsearch_$side" && run "vs_nsearch_$side" "${nsearch[@]}" "$B" "$side" 5
         done
     fi
     # Peers with no harness here, said once so that nobody wonders.
     [[ -z $ONLY ]] && for d in "$PEERS"/*/; do
         p=$(basename "$d")
         case $p in vs_ozz | ozz-animation | noise | nsearch) continue ;; esac
+        [[ $p == rvo2 ]] && continue # bench/vs_rvo2, above
         if [[ -x $d/run.sh ]]; then
             skip "peer_$p" "$d/run.sh: no arguments known to scripts/bench.sh"
         else

@@ -86,10 +86,11 @@ EXTRACT = {
         ("path", "{} build", r"moved per target \(([^)]*?) build\)"),
     ],
     "bench_noise": [
-        ("rate", "Perlin 3D batch {} M samples/s", r"batch job, value: scalar.*?(?:AVX2|AVX-512|SIMD)\s+" + NUM),
-        ("ratio", "SIMD/scalar {}", r"batch job, value: scalar.*ratio (\S+x)"),
-        ("ratio", "fBm grid {}", r"1 thread : scalar.*ratio (\S+x)"),
-        ("path", "AVX2 kernel {}", r"AVX2 kernel (available|NOT available)"),
+        ("rate", "Perlin 3D batch {} M samples/s (widest)", r"Perlin\s+batch job, value\s+scalar.*?(?:AVX-512|AVX2)\s+" + NUM + r" M samples/s"),
+        ("ratio", "Perlin AVX2/scalar {}", r"Perlin\s+batch job, value\s+.*AVX2/scalar (\S+x)"),
+        ("ratio", "simplex AVX2/scalar {}", r"simplex batch job, value\s+.*AVX2/scalar (\S+x)"),
+        ("ratio", "fBm grid SIMD/scalar {}", r"1 thread : scalar.*ratio (\S+x)"),
+        ("path", "{}", r"widest SIMD kernel (\w[\w-]*)"),
     ],
     "bench_particles": [
         ("rate", "step {} M particles/s", r"1 thread :\s+" + NUM + " M particles/s"),
@@ -114,8 +115,10 @@ EXTRACT = {
     "bench_fluid": [
         ("rate", "PBF {} 2 thr {} ms wall", r"^PBF \(4 it\)\s+(\w+)\s+2\s+\d+\s+" + NUM),
         ("rate", "1 thr {} ms CPU", r"^PBF \(4 it\)\s+\w+\s+1\s+\d+\s+\S+\s+" + NUM),
-        ("ratio", "PBF vs scalar cpu {}", r"^PBF \(4 it\)\s+\w+\s+2 vs 1 thread.*vs scalar \(1 thread\): cpu (\S+x)"),
-        ("ratio", "SPH vs scalar {}", r"^SPH\s+\w+\s+2 vs 1 thread.*vs scalar \(1 thread\): cpu (\S+x)"),
+        ("ratio", "PBF 2 vs 1 thread wall {}", r"^PBF \(4 it\)\s+\w+\s+2 vs 1 thread: wall (\S+x)"),
+        ("ratio", "PBF SIMD/scalar CPU {} (1 thread)", r"^PBF \(4 it\)\s+\w+\s+2 vs 1 thread.*SIMD/scalar cpu time: (\S+) \(1 thread\)"),
+        ("ratio", "SPH {}", r"^SPH\s+\w+\s+2 vs 1 thread.*SIMD/scalar cpu time: (\S+) \(1 thread\)"),
+        ("ratio", "WCSPH {}", r"^WCSPH\s+\w+\s+2 vs 1 thread.*SIMD/scalar cpu time: (\S+) \(1 thread\)"),
         ("path", "{}", r"default kernels here: (\w+)"),
     ],
     "bench_retarget": [
@@ -136,11 +139,84 @@ EXTRACT = {
         ("path", "{}", r"kernel animkit=(\w+)"),
     ],
     "vs_noise": noise_peers,
+    "bench_batch": [
+        ("rate", "bake run {} ms", r"^bake .*? run\s+" + NUM + " ms"),
+        ("rate", "FNV-1a {} MB/s", r"FNV-1a 64 hashing\s+" + NUM + " MB/s"),
+        ("ratio", "bake skip/run {}", r"^bake .*skip/run " + NUM),
+        ("ratio", "retarget skip/run {}", r"^retarget .*skip/run " + NUM),
+    ],
+    "bench_implicit": [
+        ("rate", "CesiumMan implicit {} ms CPU", r"(?s)^CesiumMan: \d+ vertices.*?1 thread, CPU time: DQS \S+ ms, implicit " + NUM + " ms"),
+        ("rate", "cylinder 50k implicit {} ms CPU", r"(?s)^builtin:cylinder.*?1 thread, CPU time: DQS \S+ ms, implicit " + NUM + " ms"),
+        ("ratio", "CesiumMan implicit/DQS {}", r"(?s)^CesiumMan: \d+ vertices.*?1 thread, CPU time: .*? \((\S+x)\)"),
+        ("ratio", "cylinder implicit/DQS {}", r"(?s)^builtin:cylinder.*?1 thread, CPU time: .*? \((\S+x)\)"),
+    ],
+    "bench_softskin": [
+        ("rate", "CesiumMan soft 1t {} ms", r"^CesiumMan(?:[ \t]+\S+){5}[ \t]+" + NUM),
+        ("rate", "cylinder soft 1t {} ms", r"^cylinder 48x32(?:[ \t]+\S+){5}[ \t]+" + NUM),
+        ("ratio", "CesiumMan soft/DQS {}", r"^CesiumMan(?:[ \t]+\S+){8}[ \t]+" + NUM),
+        ("ratio", "cylinder soft/DQS {}", r"^cylinder 48x32(?:[ \t]+\S+){8}[ \t]+" + NUM),
+    ],
+    "bench_sprites": [
+        ("rate", "10k sprites (alpha) {} ms", r"^\s+10000\s+\S+\s+" + NUM),
+        ("ratio", "sprites/points at 1k {}", r"^\s+1000\s+(?:\S+\s+){4}" + NUM),
+        ("ratio", "at 50k {}", r"^\s+50000\s+(?:\S+\s+){4}" + NUM),
+    ],
+    "bench_tasks": [
+        ("rate", "2 empty tasks {} us a section", r"^2\s+empty\s+" + NUM),
+        ("ratio", "fresh threads/team, 2 empty {}", r"^2\s+empty\s+\S+\s+\S+\s+(\S+x)"),
+        ("ratio", "2 x 100 us {}", r"^2\s+100 us\s+\S+\s+\S+\s+(\S+x)"),
+    ],
+    "bench_scaling": [
+        ("rate", "boids100k 2 thr {} ms", r"^boids100k\s+\d+\s+2\s+" + NUM),
+        ("ratio", "2 thr efficiency: boids100k {}", r"^boids100k\s+\d+\s+2\s+\S+\s+\S+\s+(\d+%)"),
+        ("ratio", "pbf55k {}", r"^pbf55k\s+\d+\s+2\s+\S+\s+\S+\s+(\d+%)"),
+        ("ratio", "cloth256 {}", r"^cloth256\s+\d+\s+2\s+\S+\s+\S+\s+(\d+%)"),
+        ("ratio", "lbs1m {}", r"^lbs1m\s+\d+\s+2\s+\S+\s+\S+\s+(\d+%)"),
+    ],
+    "bench_rigid_vs_bullet": [
+        ("rate", "pyramid {} ms/step", r"^pyramid \(\d+ bodies\)\s+" + NUM),
+        ("rate", "spheres {} ms", r"^spheres \(\d+ bodies\)\s+" + NUM),
+        ("rate", "ragdolls {} ms", r"^ragdolls \(\d+ bodies\)\s+" + NUM),
+        ("ratio", "Bullet/animkit time: pyramid {}", r"^pyramid \(\d+ bodies\)\s+\S+\s+\S+\s+" + NUM),
+        ("ratio", "spheres {}", r"^spheres \(\d+ bodies\)\s+\S+\s+\S+\s+" + NUM),
+        ("ratio", "ragdolls {}", r"^ragdolls \(\d+ bodies\)\s+\S+\s+\S+\s+" + NUM),
+        ("path", "{}", r"(WARNING: animkit DROPPED)"),
+    ],
+    "vs_rvo2_agree": [
+        ("rate", "{}", r"(circle 250 agents, \d+ steps)"),
+        ("ratio", "max |p_animkit - p_rvo2| {} m", r"max \|p_animkit - p_rvo2\| = (\S+) m"),
+        ("path", "{}", r"^(PASS|FAIL):"),
+    ],
+    "vs_rvo2_time": [
+        ("rate", "{} agents, 1 thr: animkit {} ms/step", r"^\s*(\d+) agents 1 thread :.*?animkit\s+" + NUM + " ms/step"),
+        ("ratio", "animkit/RVO2 speed 1 thr {}", r"agents 1 thread :.*?animkit/RVO2 speed (\S+x)"),
+        ("ratio", "CPU {}", r"agents 1 thread :.*?thread CPU time: .*?speed (\S+x)"),
+        ("ratio", "2 thr {}", r"agents 2 threads:.*?animkit/RVO2 speed (\S+x)"),
+    ],
+    "vs_rvo2_work": [
+        ("rate", "{} agents, 2 thr: animkit {} CPU ms/step", r"^\s*(\d+) agents 2 threads: CPU time of all threads:.*?animkit\s+" + NUM + " ms/step"),
+        ("ratio", "animkit/RVO2 work speed {}", r"animkit/RVO2 work speed (\S+x)"),
+    ],
+    "bench_python": [
+        ("rate", "{}", r"(?m)^(.*\bus\b.*)$"),
+    ],
+    "bench_batch_dask": [
+        ("rate", "{}", r"(?m)^(.*jobs/s.*)$"),
+    ],
 }
 EXTRACT["vs_ozz_avx2"] = [e for e in EXTRACT["vs_ozz"] if "LBS" in e[1] or "K=" in e[1] or e[0] == "path"]
 for side in ("12", "38", "80", "160"):
     EXTRACT["vs_nsearch_" + side] = [
         ("rate", "{} points, {} pairs", r"^(\d+) points .*\n(?:.*\n)*?pairs: animkit (\d+)"),
+        ("rate", "{} points", r"^(\d+) points \("),
+        ("rate", "{} pairs, sets {}", r"^pairs (\d+), list entries.*sets (\w+)"),
+        ("rate", "1 thr build+pairs CPU {} ms", r"^threads 1\s+animkit build\+pairs\s+CPU\s+" + NUM + " ms"),
+        ("ratio", "CNS/animkit CPU, pairs 1 thr {}", r"^threads 1\s+per-round CPU ratio CNS / animkit pairs: median " + NUM),
+        ("ratio", "lists 1 thr {}", r"^threads 1\s+per-round CPU ratio .*CNS / animkit lists: median " + NUM),
+        ("ratio", "pairs 2 thr {}", r"^threads 2\s+per-round CPU ratio CNS / animkit pairs: median " + NUM),
+        ("ratio", "lists 2 thr {}", r"^threads 2\s+per-round CPU ratio .*CNS / animkit lists: median " + NUM),
+        # the peers' harness (../shared/peers/nsearch/run.sh)
         ("rate", "1 thr {} ms", r"^threads 1\s+animkit build\+pairs\s+" + NUM + " ms"),
         ("ratio", "CNS/animkit 1 thr x{}", r"^threads 1\s+CNS find_neighbors.*?\(median\) " + NUM),
         ("ratio", "2 thr x{}", r"^threads 2\s+CNS find_neighbors.*?\(median\) " + NUM),

@@ -15,7 +15,7 @@
 # ozz is built once into BUILD_DIR/peers/ozz (about a minute on 2 cores).
 set -euo pipefail
 MINE=$(cd "$(dirname "$0")" && pwd)
-HERE=$(cd "$MINE/../../../shared/peers/vs_ozz" && pwd)
+HERE=$(cd "${VS_OZZ_PEER:-$MINE/../../../shared/peers/vs_ozz}" && pwd) # VS_OZZ_PEER: the peers' vs_ozz/
 ROOT=$PWD
 B=$(cd "${1:-build}" && pwd)
 N=${2:-1000000}; R=${3:-11}; W=${4:-sai}
