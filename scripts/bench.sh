@@ -137,23 +137,28 @@ elif wanted vs_rvo2_time; then
     skip vs_rvo2 "not built: no RVO2 peer at configure time (-DAK_RVO2_DIR=.../peers/rvo2, now $PEERS/rvo2)"
 fi
 
-# 1c. The Python benches (bench/*.py), with the module `make python` puts in python/animkit.
+# 1c. The Python benches (bench/*.py), with the module `make python` puts in python/animkit
+# (or the build's own copy under BUILD/python).
 if wanted bench_python || wanted bench_batch_dask; then
     PY=/usr/bin/python3
+    PYDIR=
+    for d in "$ROOT/python" "$B/python"; do
+        if [[ -x $PY ]] && PYTHONPATH=$d $PY -c 'import animkit._core' >/dev/null 2>&1; then PYDIR=$d; break; fi
+    done
     if [[ ! -x $PY ]]; then
         skip bench_python "no /usr/bin/python3"
-    elif ! PYTHONPATH=$ROOT/python $PY -c 'import animkit' >/dev/null 2>&1; then
-        skip bench_python "no Python module in python/animkit (make python first; needs numpy)"
+    elif [[ -z $PYDIR ]]; then
+        skip bench_python "no importable Python module in python/animkit or $B/python (make python; needs numpy)"
     else
-        wanted bench_python && run bench_python env PYTHONPATH="$ROOT/python" $PY "$ROOT/bench/bench_python.py"
+        wanted bench_python && run bench_python env PYTHONPATH="$PYDIR" $PY "$ROOT/bench/bench_python.py"
         if ! wanted bench_batch_dask; then
             :
-        elif ! PYTHONPATH=$ROOT/python $PY -c 'import dask.distributed' >/dev/null 2>&1; then
+        elif ! PYTHONPATH=$PYDIR $PY -c 'import dask.distributed' >/dev/null 2>&1; then
             skip bench_batch_dask "no dask.distributed for /usr/bin/python3"
         elif [[ -n $QUICK ]]; then
-            run bench_batch_dask env PYTHONPATH="$ROOT/python" $PY "$ROOT/bench/bench_batch_dask.py" 8 80x60
+            run bench_batch_dask env PYTHONPATH="$PYDIR" $PY "$ROOT/bench/bench_batch_dask.py" 8 80x60
         else
-            run bench_batch_dask env PYTHONPATH="$ROOT/python" $PY "$ROOT/bench/bench_batch_dask.py" 48 640x480
+            run bench_batch_dask env PYTHONPATH="$PYDIR" $PY "$ROOT/bench/bench_batch_dask.py" 48 640x480
         fi
     fi
 fi
@@ -176,7 +181,12 @@ else
             skip vs_ozz "quick mode: ozz not built yet under $B/peers/ozz (make bench builds it, ~1 min)"
         else
             if [[ -n $QUICK ]]; then set -- 10000 3 sai; else set -- 1000000 11 sai; fi
-            wanted vs_ozz && run vs_ozz "$PEERS/vs_ozz/run.sh" "$B" "$@"
+            # this repository's copy of the driver (long rounds, per-round spread) when present
+            if [[ -x $ROOT/bench/vs_ozz/run.sh ]]; then
+                wanted vs_ozz && run vs_ozz env VS_OZZ_PEER="$PEERS/vs_ozz" "$ROOT/bench/vs_ozz/run.sh" "$B" "$@"
+            else
+                wanted vs_ozz && run vs_ozz "$PEERS/vs_ozz/run.sh" "$B" "$@"
+            fi
             # The skinning rows again with animkit capped to its AVX2 kernel (bench/vs_ozz), on a CPU
             # that also has AVX-512: the targets hold on every CPU path.
             if wanted vs_ozz_avx2 && [[ -x $ROOT/bench/vs_ozz/run.sh ]] && grep -q avx512f /proc/cpuinfo; then

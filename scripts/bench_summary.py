@@ -128,10 +128,10 @@ EXTRACT = {
     ],
     "vs_ozz": [
         ("rate", "LBS P+N K=4 {} Mvert/s", r"^LBS P\+N K=4\s+\S+\s+" + NUM),
-        ("ratio", "LBS P+N rate vs ozz K=1 {}", r"^LBS P\+N K=1 .*\s([0-9.]+ \[[^\]]*\])\s*$"),
-        ("ratio", "K=2 {}", r"^LBS P\+N K=2 .*\s([0-9.]+ \[[^\]]*\])\s*$"),
-        ("ratio", "K=4 {}", r"^LBS P\+N K=4 .*\s([0-9.]+ \[[^\]]*\])\s*$"),
-        ("ratio", "K=8 {}", r"^LBS P\+N K=8 .*\s([0-9.]+ \[[^\]]*\])\s*$"),
+        ("ratio", "LBS P+N rate vs ozz K=1 {}", r"^LBS P\+N K=1 .*?\s([0-9.]+ \[[^\]]*\])(?:\s+[0-9.]+%)?\s*$"),
+        ("ratio", "K=2 {}", r"^LBS P\+N K=2 .*?\s([0-9.]+ \[[^\]]*\])(?:\s+[0-9.]+%)?\s*$"),
+        ("ratio", "K=4 {}", r"^LBS P\+N K=4 .*?\s([0-9.]+ \[[^\]]*\])(?:\s+[0-9.]+%)?\s*$"),
+        ("ratio", "K=8 {}", r"^LBS P\+N K=8 .*?\s([0-9.]+ \[[^\]]*\])(?:\s+[0-9.]+%)?\s*$"),
         ("ratio", "seq. sample+FK time vs ozz x{}",
          r"sequential sample\+FK\s+animkit LINEAR\(slerp\) cursor.*?time vs ozz x([0-9.]+ \[[^\]]*\])"),
         ("ratio", "FK x{}", r"sequential FK only\s+animkit LINEAR\(slerp\) cursor.*?time vs ozz x([0-9.]+ \[[^\]]*\])"),
@@ -199,10 +199,16 @@ EXTRACT = {
         ("ratio", "animkit/RVO2 work speed {}", r"animkit/RVO2 work speed (\S+x)"),
     ],
     "bench_python": [
-        ("rate", "{}", r"(?m)^(.*\bus\b.*)$"),
+        ("rate", "C loop {} us per sample+skin", r"^C loop\s+" + NUM + " us per"),
+        ("ratio", "added by Python: out= {} us", r"^Python, out=\s+\S+ us\s+overhead\s+" + NUM + " us"),
+        ("ratio", "keywords {} us", r"^Python, keywords\s+\S+ us\s+overhead\s+" + NUM + " us"),
+        ("ratio", "new array {} us", r"^Python, new array\s+\S+ us\s+overhead\s+" + NUM + " us"),
     ],
     "bench_batch_dask": [
-        ("rate", "{}", r"(?m)^(.*jobs/s.*)$"),
+        ("rate", "in-process {} jobs/s", r"^in-process\s+" + NUM + " jobs/s"),
+        ("rate", "Dask 2 workers {} jobs/s", r"^Dask, 2 workers\s+" + NUM + " jobs/s"),
+        ("ratio", "2 vs 1 worker {}", r"scaling 2 vs 1 worker: (\S+)"),
+        ("ratio", "Dask overhead {} ms a job", r"Dask overhead per job .*?: " + NUM + " ms"),
     ],
 }
 EXTRACT["vs_ozz_avx2"] = [e for e in EXTRACT["vs_ozz"] if "LBS" in e[1] or "K=" in e[1] or e[0] == "path"]
