@@ -41,8 +41,10 @@ python: configure
 	cmake --build $(BUILD) -j $(JOBS) --target animkit_python
 	cp $(BUILD)/python/animkit/_core*.so python/animkit/
 
-# Every benchmark and every side-by-side harness of ../shared/peers (skipped when absent): full
-# outputs and SUMMARY.md under $(BUILD)/bench-results (scripts/bench.sh, docs/BENCHMARKS.md).
+# Every benchmark (bench/bench_*, vs_rvo2 and bench_rigid_vs_bullet when built, the Python benches
+# after `make python`) and every side-by-side harness of ../shared/peers (each skipped with a line
+# when absent): full outputs and one SUMMARY.md under $(BUILD)/bench-results (scripts/bench.sh,
+# docs/BENCHMARKS.md).
 # `make bench-quick` runs the same pipeline at the smallest sizes (a check, not a measurement).
 bench: build
 	@bash scripts/bench.sh $(BUILD)

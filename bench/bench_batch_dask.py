@@ -1,5 +1,5 @@
 """animkit.batch on Dask: throughput with 1 and 2 workers and per-job overhead
-(docs/BENCHMARKS.md, "Python bindings").
+(docs/BENCHMARKS.md, "batch jobs and Python bindings").
 
     make python && PYTHONPATH=build/python /usr/bin/python3 bench/bench_batch_dask.py [JOBS] [WxH]
 

@@ -1,4 +1,4 @@
-"""Python overhead per call of animkit's bindings (docs/BENCHMARKS.md, "Python bindings").
+"""Python overhead per call of animkit's bindings (docs/BENCHMARKS.md, "batch jobs and Python bindings").
 
     make python && PYTHONPATH=python /usr/bin/python3 bench/bench_python.py [MODEL]
 
