@@ -2,6 +2,9 @@
  * with its own clip and time, sampled, FK'd and skinned (LBS with normals) every frame, the
  * characters split over the library's worker team (bench/crowd_frame.h).
  *     bench_crowd_frame [--threads 1,2,4,8,16] [--frames N] [--characters N] [--phases]
+ * Default threads: 1, 2, 4, ... up to the cores online (and that count itself), so `make bench`
+ * on a 16-core machine measures 1, 2, 4, 8 and 16 threads. Defaults: 60 frames, 1,000
+ * characters (AK_BENCH_QUICK: 6 frames, 100 characters).
  * Characters alternate between builtin:humanoid (clips "walk", "wave") and CesiumMan
  * ($ANIMKIT_ASSETS/gltf/CesiumMan/glTF-Binary/CesiumMan.glb, default ../shared/assets; its one
  * clip); without CesiumMan every character is a humanoid (said on stdout). Character i plays
@@ -25,6 +28,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "bench_clock.h"
 #include "crowd_frame.h"
@@ -69,8 +73,11 @@ static bool profile_cpu(crowd* c, uint64_t* frame, uint32_t T, int frames, cpu_p
 }
 
 int main(int argc, char** argv) {
-    uint32_t counts[MAX_COUNTS] = {1, 2};
-    int count_n = 2, frames = 60;
+    uint32_t counts[MAX_COUNTS] = {1};
+    int count_n = 1, frames = 60;
+    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    for (uint32_t t = 2; (long)t <= cores && t <= AKP_TASKS_MAX && count_n < MAX_COUNTS - 1; t *= 2) counts[count_n++] = t;
+    if (cores > 1 && (long)counts[count_n - 1] != cores && cores <= (long)AKP_TASKS_MAX) counts[count_n++] = (uint32_t)cores;
     size_t characters = 1000;
     bool phases = false;
     if (bench_quick()) frames = 6, characters = 100;
@@ -117,6 +124,22 @@ int main(int argc, char** argv) {
         printf("FAIL: frame 0 (with the data check) failed\n");
         crowd_fini(&c);
         return 1;
+    }
+    /* each model's measured CPU per character beside the partition's estimate (one serial frame) */
+    {
+        double us[2] = {0, 0}, est[2] = {0, 0};
+        size_t n[2] = {0, 0};
+        for (size_t i = 0; i < c.count; ++i) {
+            const int k = (int)(c.chars[i].m - c.models);
+            const double t0 = bench_cpu_s();
+            crowd_character_frame(&c.chars[i], 1, false);
+            us[k] += (bench_cpu_s() - t0) * 1e6, est[k] += crowd_character_cost(&c.chars[i]), n[k]++;
+        }
+        printf("CPU per character (1 thread, one frame):");
+        for (int k = 0; k < c.model_count; ++k)
+            if (n[k]) printf("%s %s %.1f us (estimate %.0f units, %.2f ns a unit)", k ? "," : "", c.models[k].scene->name,
+                             us[k] / n[k], est[k] / n[k], 1e3 * us[k] / est[k]);
+        printf("\n");
     }
     printf("median wall ms per frame over %d frames after 2 warm-up frames; cpu: process CPU ms per frame\n", frames);
     const double out_gb = (double)verts * 2.0 * sizeof(ak_vec3) * 1e-9; /* positions and normals written a frame */

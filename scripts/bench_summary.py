@@ -118,6 +118,11 @@ EXTRACT = {
         ("ratio", "SPH vs scalar {}", r"^SPH\s+\w+\s+2 vs 1 thread.*vs scalar \(1 thread\): cpu (\S+x)"),
         ("path", "{}", r"default kernels here: (\w+)"),
     ],
+    "bench_crowd_frame": [
+        ("rate", "1,000 characters, 1 thr {} fps", r"^\s+1\s+\S+\s+" + NUM),
+        ("ratio", "2 thr {} ({})", r"^\s+2\s+\S+\s+\S+\s+\S+\s+(\S+x)\s+(\d+%)"),
+        ("ratio", "16 thr {} ({})", r"^\s+16\s+\S+\s+\S+\s+\S+\s+(\S+x)\s+(\d+%)"),
+    ],
     "bench_retarget": [
         ("rate", "{} frames/s", r"without foot clean-up:\s+" + NUM + " frames/s"),
         ("rate", ".glb {} MB/s", r"\.glb:\s+" + NUM + " MB/s"),
