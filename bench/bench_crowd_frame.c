@@ -2,6 +2,7 @@
  * with its own clip and time, sampled, FK'd and skinned (LBS with normals) every frame, the
  * characters split over the library's worker team (bench/crowd_frame.h).
  *     bench_crowd_frame [--threads 1,2,4,8,16] [--frames N] [--characters N] [--phases]
+ *                       [--schedule static|dynamic]
  * Default threads: 1, 2, 4, ... up to the cores online (and that count itself), so `make bench`
  * on a 16-core machine measures 1, 2, 4, 8 and 16 threads. Defaults: 60 frames, 1,000
  * characters (AK_BENCH_QUICK: 6 frames, 100 characters).
@@ -9,13 +10,15 @@
  * ($ANIMKIT_ASSETS/gltf/CesiumMan/glTF-Binary/CesiumMan.glb, default ../shared/assets; its one
  * clip); without CesiumMan every character is a humanoid (said on stdout). Character i plays
  * clip (i / 2) mod the model's clip count from a fixed-seed random offset, advancing 1/60 s a
- * frame. The skin data is validated once (frame 0); frames after that skip the O(n) check.
+ * frame. --schedule (bench/crowd_frame.h): static, contiguous ranges of equal estimated cost,
+ * one per thread (the default), or dynamic, chunks of 4 characters from a shared counter. The
+ * skin data is validated once (frame 0); frames after that skip the O(n) check.
  *
  * Per thread count T (the list starts with 1, the reference): the median wall ms per frame over
  * N frames after 2 warm-up frames, frames per second (1000 / that), the process CPU ms per
  * frame (all threads), the speed-up and efficiency of the wall time over 1 thread, the GB/s of
  * skinned positions and normals written (every character has its own output buffers: about
- * 295 MB a frame for 1,000 characters, more than any cache, so this is the memory traffic that
+ * 147 MB a frame for 1,000 characters, more than any cache, so this is the memory traffic that
  * may bound the scaling on many cores), and the hash (FNV-1a 64) of every character's positions and normals after the last frame: the same
  * for every T (else "DIFFERS" and exit code 1).
  * Then the CPU-time profile of src/tasks.h per T (akp_tasks_profile_step per frame, 6 frames):
@@ -79,7 +82,7 @@ int main(int argc, char** argv) {
     for (uint32_t t = 2; (long)t <= cores && t <= AKP_TASKS_MAX && count_n < MAX_COUNTS - 1; t *= 2) counts[count_n++] = t;
     if (cores > 1 && (long)counts[count_n - 1] != cores && cores <= (long)AKP_TASKS_MAX) counts[count_n++] = (uint32_t)cores;
     size_t characters = 1000;
-    bool phases = false;
+    bool phases = false, dynamic = false;
     if (bench_quick()) frames = 6, characters = 100;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
@@ -91,10 +94,18 @@ int main(int argc, char** argv) {
             frames = atoi(argv[++i]);
         } else if (strcmp(argv[i], "--characters") == 0 && i + 1 < argc) {
             characters = (size_t)strtoull(argv[++i], NULL, 10);
+        } else if (strcmp(argv[i], "--schedule") == 0 && i + 1 < argc) {
+            ++i;
+            if (strcmp(argv[i], "static") != 0 && strcmp(argv[i], "dynamic") != 0) {
+                fprintf(stderr, "bench_crowd_frame: --schedule static or dynamic\n");
+                return 2;
+            }
+            dynamic = strcmp(argv[i], "dynamic") == 0;
         } else if (strcmp(argv[i], "--phases") == 0) {
             phases = true;
         } else {
-            fprintf(stderr, "usage: bench_crowd_frame [--threads 1,2,4,8,16] [--frames N] [--characters N] [--phases]\n");
+            fprintf(stderr, "usage: bench_crowd_frame [--threads 1,2,4,8,16] [--frames N] [--characters N] [--phases] "
+                            "[--schedule static|dynamic]\n");
             return 2;
         }
     }
@@ -112,9 +123,11 @@ int main(int argc, char** argv) {
         printf("SKIP: could not set up the crowd (no memory, or builtin:humanoid failed)\n");
         return 0;
     }
+    c.dynamic = dynamic;
     size_t verts = 0;
     for (size_t i = 0; i < c.count; ++i) verts += c.chars[i].m->mesh->vertex_count;
-    printf("crowd frame: %zu characters, %zu skinned vertices a frame", c.count, verts);
+    printf("crowd frame (%s schedule): %zu characters, %zu skinned vertices a frame", dynamic ? "dynamic" : "static",
+           c.count, verts);
     for (int k = 0; k < c.model_count; ++k)
         printf("%s %s (%zu vertices, %zu joints, %zu clips)", k ? "," : ":", c.models[k].scene->name,
                c.models[k].mesh->vertex_count, c.models[k].joints, c.models[k].scene->clip_count);

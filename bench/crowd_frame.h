@@ -11,14 +11,19 @@
  * inputs (its clip, its time, its cursor), with the same code whatever the thread count, so the
  * bits of a frame do not depend on the thread count or the partition.
  *
- * Partition by work: characters differ (CesiumMan: 3,273 vertices, 19 joints; builtin:humanoid
- * its own counts), so each task gets a contiguous range of about equal estimated cost
- * (crowd_character_cost), not of equal length. */
+ * Two schedules (crowd.dynamic):
+ *   - static (false): characters differ (builtin:humanoid: 9,010 vertices, 17 joints;
+ *     CesiumMan: 3,273 vertices, 22 joints), so each task gets one contiguous range of about
+ *     equal estimated cost (crowd_character_cost), not of equal length;
+ *   - dynamic (true): the tasks take chunks of CROWD_CHUNK characters in order from a shared
+ *     atomic counter until none is left, so a thread that was descheduled or slowed takes fewer
+ *     (a job system's way). Which thread skins a character never changes its bits. */
 #ifndef ANIMKIT_BENCH_CROWD_FRAME_H
 #define ANIMKIT_BENCH_CROWD_FRAME_H
 
 #include <animkit/animkit.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,6 +33,7 @@
 
 #define CROWD_MAX_JOINTS 256   /* per-character scratch lives on the task's stack */
 #define CROWD_DT (1.0 / 60.0)  /* seconds a frame */
+#define CROWD_CHUNK 4          /* characters a dynamic task takes at a time */
 
 typedef struct crowd_model {
     ak_scene* scene;
@@ -51,11 +57,14 @@ typedef struct crowd {
     crowd_character* chars;
     size_t count;
     double* cost_prefix;      /* [count + 1]: estimated cost of characters [0, i) */
+    bool dynamic;             /* false: static ranges of equal estimated cost; true: chunks
+                                 from a shared counter */
 } crowd;
 
 typedef struct crowd_task {
     crowd* c;
-    size_t begin, end;
+    size_t begin, end;        /* static: the range; dynamic: unused */
+    atomic_size_t* next;      /* dynamic: the next character nobody has taken; NULL: static */
     uint64_t frame;
     bool check;
     bool ok;
@@ -124,7 +133,16 @@ static inline bool crowd_character_frame(crowd_character* ch, uint64_t frame, bo
 static inline void* crowd_task_run(void* arg) {
     crowd_task* t = (crowd_task*)arg;
     bool ok = true;
-    for (size_t i = t->begin; i < t->end; ++i) ok = crowd_character_frame(&t->c->chars[i], t->frame, t->check) && ok;
+    if (!t->next) {
+        for (size_t i = t->begin; i < t->end; ++i) ok = crowd_character_frame(&t->c->chars[i], t->frame, t->check) && ok;
+    } else {
+        for (;;) {
+            const size_t b = atomic_fetch_add_explicit(t->next, CROWD_CHUNK, memory_order_relaxed);
+            if (b >= t->c->count) break;
+            const size_t e = b + CROWD_CHUNK < t->c->count ? b + CROWD_CHUNK : t->c->count;
+            for (size_t i = b; i < e; ++i) ok = crowd_character_frame(&t->c->chars[i], t->frame, t->check) && ok;
+        }
+    }
     t->ok = ok;
     return NULL;
 }
@@ -190,10 +208,13 @@ static inline size_t crowd_split(const crowd* c, uint32_t t, uint32_t n) {
  * thread). check: validate the skin data this frame. */
 static inline bool crowd_frame(crowd* c, uint64_t frame, uint32_t threads, bool check) {
     crowd_task tasks[AKP_TASKS_MAX];
+    atomic_size_t next;
+    atomic_init(&next, 0);
     if (threads < 1) threads = 1;
     if (threads > AKP_TASKS_MAX) threads = AKP_TASKS_MAX;
     for (uint32_t t = 0; t < threads; ++t)
-        tasks[t] = (crowd_task){c, crowd_split(c, t, threads), crowd_split(c, t + 1, threads), frame, check, false};
+        tasks[t] = (crowd_task){c, crowd_split(c, t, threads), crowd_split(c, t + 1, threads),
+                                c->dynamic && threads > 1 ? &next : NULL, frame, check, false};
     if (threads == 1) crowd_task_run(&tasks[0]);
     else akp_run_tasks(crowd_task_run, tasks, sizeof(crowd_task), threads);
     bool ok = true;
