@@ -25,9 +25,11 @@
  * CPU ms per frame, its serial part (the caller's work outside the parallel section, plus the
  * busiest thread's excess over the others' mean), the parallel part, the critical path (the
  * busiest thread's CPU), Amdahl's efficiency at 16 threads for the serial fraction measured at
- * T, and 1-thread CPU / (T x critical path): what T free cores would give (neither sees memory
+ * T, 1-thread CPU / (T x critical path): what T free cores would give (neither sees memory
  * bandwidth or wake-ups; docs/BENCHMARKS.md "Predicted 16-thread efficiency from a CPU-time
- * profile per phase"). --phases lists each phase of every T > 1. */
+ * profile per phase"), and the static partition's estimated imbalance (the largest range's
+ * estimated cost over the mean, less 1; the dynamic schedule has none to estimate). --phases
+ * lists each phase of every T > 1. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -55,6 +57,17 @@ typedef struct cpu_profile {
     size_t phase_count;
     akp_phase_cpu phases[AKP_PHASES_MAX];
 } cpu_profile;
+
+/* The static partition's estimated imbalance on T threads: the largest range's estimated cost
+ * over the mean, less 1 (what the partition alone costs the critical path). */
+static double estimated_imbalance(const crowd* c, uint32_t T) {
+    double worst = 0.0;
+    for (uint32_t t = 0; t < T; ++t) {
+        const double w = c->cost_prefix[crowd_split(c, t + 1, T)] - c->cost_prefix[crowd_split(c, t, T)];
+        if (w > worst) worst = w;
+    }
+    return worst / (c->cost_prefix[c->count] / T) - 1.0;
+}
 
 /* frames profiled frames starting at *frame on T threads. */
 static bool profile_cpu(crowd* c, uint64_t* frame, uint32_t T, int frames, cpu_profile* out) {
@@ -191,8 +204,8 @@ int main(int argc, char** argv) {
     profile_cpu(&c, &frame, 1, pf, pr);
     const double cpu1 = pr->serial_ms + pr->parallel_ms;
     printf("cpu profile (src/tasks.h), %d frames per thread count: CPU ms per frame summed over threads\n", pf);
-    printf("%7s %9s %9s %9s %9s %9s %10s\n", "threads", "cpu ms", "serial", "parallel", "critical", "amdahl16",
-           "critical T");
+    printf("%7s %9s %9s %9s %9s %9s %10s %9s\n", "threads", "cpu ms", "serial", "parallel", "critical", "amdahl16",
+           "critical T", "est. imb");
     printf("%7u %9.3f %9.3f %9.3f %9.3f\n", 1u, cpu1, pr->serial_ms, pr->parallel_ms, pr->critical_ms);
     for (int k = 0; k < count_n; ++k) {
         const uint32_t T = counts[k];
@@ -202,8 +215,10 @@ int main(int argc, char** argv) {
         const double sf = total > 0.0 ? pr->serial_ms / total : 0.0;
         const double amdahl = 1.0 / (16.0 * (sf + (1.0 - sf) / 16.0));
         const double crit = pr->critical_ms > 0.0 ? cpu1 / (T * pr->critical_ms) : 0.0;
-        printf("%7u %9.3f %9.3f %9.3f %9.3f %8.1f%% %9.1f%%%s\n", T, total, pr->serial_ms, pr->parallel_ms,
-               pr->critical_ms, 100.0 * amdahl, 100.0 * crit, ok ? "" : "  (a frame failed)");
+        char imb[32] = "-";
+        if (!c.dynamic) snprintf(imb, sizeof imb, "%.2f%%", 100.0 * estimated_imbalance(&c, T));
+        printf("%7u %9.3f %9.3f %9.3f %9.3f %8.1f%% %9.1f%% %9s%s\n", T, total, pr->serial_ms, pr->parallel_ms,
+               pr->critical_ms, 100.0 * amdahl, 100.0 * crit, imb, ok ? "" : "  (a frame failed)");
         if (phases) {
             for (size_t i = 0; i < pr->phase_count; ++i) {
                 const akp_phase_cpu* p = &pr->phases[i];
