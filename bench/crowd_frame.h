@@ -13,7 +13,7 @@
  *
  * Two schedules (crowd.dynamic):
  *   - static (false): characters differ (builtin:humanoid: 9,010 vertices, 17 joints;
- *     CesiumMan: 3,273 vertices, 22 joints), so each task gets one contiguous range of about
+ *     CesiumMan: 3,273 vertices, 22 nodes), so each task gets one contiguous range of about
  *     equal estimated cost (crowd_character_cost), not of equal length;
  *   - dynamic (true): the tasks take chunks of CROWD_CHUNK characters in order from a shared
  *     atomic counter until none is left, so a thread that was descheduled or slowed takes fewer
