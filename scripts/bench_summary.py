@@ -121,6 +121,11 @@ EXTRACT = {
         ("ratio", "WCSPH {}", r"^WCSPH\s+\w+\s+2 vs 1 thread.*SIMD/scalar cpu time: (\S+) \(1 thread\)"),
         ("path", "{}", r"default kernels here: (\w+)"),
     ],
+    "bench_crowd_frame": [
+        ("rate", "1,000 characters, 1 thr {} fps", r"^\s+1\s+\S+\s+" + NUM),
+        ("ratio", "2 thr {} ({})", r"^\s+2\s+\S+\s+\S+\s+\S+\s+(\S+x)\s+(\d+%)"),
+        ("ratio", "16 thr {} ({})", r"^\s+16\s+\S+\s+\S+\s+\S+\s+(\S+x)\s+(\d+%)"),
+    ],
     "bench_retarget": [
         ("rate", "{} frames/s", r"without foot clean-up:\s+" + NUM + " frames/s"),
         ("rate", ".glb {} MB/s", r"\.glb:\s+" + NUM + " MB/s"),
