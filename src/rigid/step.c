@@ -1359,18 +1359,19 @@ static bool near_at_start(const solver* s, const ak_vec3* v0, uint32_t a, uint32
 
 /* Whether the step has to be solved again: the broad phase, once per step, grows each body's
  * bounding sphere by its start speed v0 (plus launch) times dt, so a body at rest that an impact
- * or a joint sets moving within the step finds no pair with what lies ahead of it, and sinks
- * into it or passes through until the next step. A body went further than its margins covered
- * when its displacement in the step exceeds dt (|v0| + launch) by more than dt^2 |g| (what
- * gravity adds) plus a quarter of its bounding radius, or half the contact offset if more
- * (bodies slowed or stopped by a contact, a box landing, move less than that and never count;
- * below a quarter of the radius a body pushed within a pile sinks no deeper than that and is
- * separated the next step, as before: the 10,000 spheres poured by bench/vs_bullet were 24%
- * slower when every push past half the offset solved the step again); if margins grown by that excess (launch raised by excess / dt,
- * which adds twice the excess to the margins, as a start speed would) find a pair with a plane or a body (through the step's sweep, sap[0 .. ns) along axis)
- * that the step's margins did not, its launch is raised and the step is solved again with it. A
- * ragdoll's limb whipped faster than it started by its joints, with nothing new in its reach,
- * costs nothing more. */
+ * or a joint sets moving within the step finds no pair with what lies ahead of it, and sinks into
+ * it or passes through until the next step. A body went further than its margins covered when its
+ * displacement in the step exceeds dt (|v0| + launch) by more than dt^2 |g| (what gravity adds)
+ * plus a quarter of its bounding radius, or half the contact offset if more (bodies slowed or
+ * stopped by a contact, a box landing, move less than that and never count; below a quarter of the
+ * radius a body pushed within a pile sinks no deeper than that and is separated the next step, as
+ * before: the 10,000 spheres poured by bench/vs_bullet were 24% slower when every push past half
+ * the offset solved the step again); if margins grown by that excess (launch raised by excess /
+ * dt, which adds twice the excess to the margins, as a start speed would) find a pair with a plane
+ * or a body (through the step's sweep, sap[0 .. ns) along axis) that the step's margins did not,
+ * its launch is raised and the step is solved again with it. A ragdoll's limb whipped faster than
+ * it started by its joints, with nothing new in its reach, costs nothing more.
+ */
 static bool launched_past(const solver* s, const ak_vec3* v0, float* launch, const float* grow,
                           const float* slack, const sap_entry* sap, uint32_t ns, int axis, float dt,
                           float gmag, float offset, uint32_t n) {
