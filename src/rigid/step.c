@@ -74,9 +74,9 @@ typedef struct island {
 
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, launch, sap, pairs, contacts, groups, rows, cx, ct,
-        turn0, jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies, ipairs,
-        ijoints, ichains, islands, total;
+    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, launch, sap, pairs, contacts, groups, rows,
+        cx, ct, turn0, jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies,
+        ipairs, ijoints, ichains, islands, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -1121,7 +1121,7 @@ static void* sweep_chains(void* arg) {
         for (int it = 0; it < t->sweeps; ++it) {
             float err = 0.0f;
             solve_joints(t->s, idx, count, &err);
-            if (err < 1e-4f) break;
+            if (err < t->s->m->desc.joint_tolerance) break;
         }
     }
     return NULL;
@@ -1137,7 +1137,7 @@ static void sweep_chain_list(solver* s, const uint32_t* order, const uint32_t* s
         for (int it = 0; it < sweeps; ++it) {
             float err = 0.0f;
             solve_joints(s, idx, n, &err);
-            if (err < 1e-4f) break;
+            if (err < s->m->desc.joint_tolerance) break;
         }
     }
 }
@@ -1344,8 +1344,8 @@ static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_
 
 /* body_pairs' test (scale 1) for bodies a and b on the step's start poses, with margins ga, gb
  * (grow) and sa, sb (slack) */
-static bool near_at_start(const solver* s, const ak_vec3* v0, uint32_t a, uint32_t b, float ga, float gb,
-                          float sa, float sb, float offset, float dt) {
+static bool near_at_start(const solver* s, const ak_vec3* v0, uint32_t a, uint32_t b, float ga,
+                          float gb, float sa, float sb, float offset, float dt) {
     float rb = s->bodies[a].bound_radius + s->bodies[b].bound_radius + offset;
     float rr = rb + (ga + gb);
     float d2 = ak_vec3_length_sq(ak_vec3_sub(s->x0[a], s->x0[b]));
@@ -1480,8 +1480,7 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
          * substep, the others run the narrow phase in each */
         pair_buf pb = {(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts, 0};
         find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow),
-                   (float*)(base + l.slack), launch, offset, job->dt,
-                   gmag, up, &ns, &axis);
+                   (float*)(base + l.slack), launch, offset, job->dt, gmag, up, &ns, &axis);
         uint32_t kept = cb.count;
         uint32_t nj = (uint32_t)m->joint_count, chains = 0;
         uint32_t* order = (uint32_t*)(base + l.jorder);
@@ -1491,11 +1490,12 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
                                   (uint32_t*)(base + l.jchain), order, start);
         island* isl = (island*)(base + l.islands);
         uint32_t islands_n =
-            islands ? build_islands(&s, &pb, kept, m->desc.max_contacts, chains, order, start,
-                                    (uint32_t*)(base + l.parent), (uint32_t*)(base + l.island_of),
-                                    (uint32_t*)(base + l.ibodies), (pair_entry*)(base + l.ipairs),
-                                    (uint32_t*)(base + l.ijoints), (uint32_t*)(base + l.ichains), isl)
-                    : 0;
+            islands
+                ? build_islands(&s, &pb, kept, m->desc.max_contacts, chains, order, start,
+                                (uint32_t*)(base + l.parent), (uint32_t*)(base + l.island_of),
+                                (uint32_t*)(base + l.ibodies), (pair_entry*)(base + l.ipairs),
+                                (uint32_t*)(base + l.ijoints), (uint32_t*)(base + l.ichains), isl)
+                : 0;
         if (islands_n) {
             /* what no island writes (static bodies; the others are set again in each substep) */
             for (uint32_t i = 0; i < n; ++i) {
@@ -1553,10 +1553,10 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
             cb.count = cursor;
         } else {
             /* joints, contacts, then up to eight more sweeps over the joints: contacts solved last
-             * would pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
-             * (pelvis, spine, chest) 6 degrees past a limit under load. The later sweeps go chain by
-             * chain, the chains shared out over the threads in contiguous runs of about equal joint
-             * counts: each chain's numbers are the same whichever thread sweeps it. */
+             * would pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of
+             * joints (pelvis, spine, chest) 6 degrees past a limit under load. The later sweeps go
+             * chain by chain, the chains shared out over the threads in contiguous runs of about
+             * equal joint counts: each chain's numbers are the same whichever thread sweeps it. */
             chain_task tasks[AK_RIGID_MAX_THREADS];
             uint32_t tasks_n = 1;
             tasks[0] = (chain_task){.s = &s, .c0 = 0, .c1 = 0, .sweeps = 8};
@@ -1580,17 +1580,19 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
             for (uint32_t step = 0; step < substeps; ++step) {
                 predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping, NULL, n);
                 substep_contacts(&s, &cb, pb.p, pb.count, kept, offset);
-                /* joints, contacts, then eight more sweeps over the joints: contacts solved last would
-                 * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
-                 * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
+                /* joints, contacts, then eight more sweeps over the joints: contacts solved last
+                 * would pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of
+                 * joints (pelvis, spine, chest) 6 degrees past a limit under load; joints are few
+                 * and cheap */
                 if (nj) {
                     float err = 0.0f;
                     solve_joints(&s, NULL, nj, &err);
                 }
                 solve_positions(&s, &cb, NULL, n);
-                /* (the sweeps stop early, chain by chain, once one corrects no joint of the chain by
-                 * more than 0.1 mm or 0.1 mrad: 50 falling ragdolls then take 4.3 sweeps a substep
-                 * instead of 9 when they all stop together, and their anchors stay within 0.02 mm) */
+                /* (the sweeps stop early, chain by chain, once one corrects no joint of the chain
+                 * by more than joint_tolerance, by default 1e-4, 0.1 mm or 0.1 mrad: 50 falling
+                 * ragdolls take 4.3 sweeps a substep instead of 9 when they all stop together, and
+                 * their anchors stay within 0.02 mm) */
                 if (tasks_n > 1)
                     akp_run_tasks(sweep_chains, tasks, sizeof tasks[0], tasks_n);
                 else if (nj)
@@ -1601,8 +1603,9 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
             }
         }
         if (attempt >= LAUNCH_ATTEMPTS || pb.dropped ||
-            !launched_past(&s, v0, launch, (const float*)(base + l.grow), (const float*)(base + l.slack),
-                           (const sap_entry*)(base + l.sap), ns, axis, job->dt, gmag, offset, n))
+            !launched_past(&s, v0, launch, (const float*)(base + l.grow),
+                           (const float*)(base + l.slack), (const sap_entry*)(base + l.sap), ns,
+                           axis, job->dt, gmag, offset, n))
             break;
         memcpy(s.x, x0, n * sizeof *x0);
         memcpy(s.q, q0, n * sizeof *q0);
