@@ -717,8 +717,10 @@ done:
  * with 1, 2 and 3 threads against the one-island run, state, sleep timers, contact counts and
  * deepest penetration equal to the bit at every step; once more with max_contacts too small for the
  * islands' contact regions (the step falls back to one island, and still drops the same). The
- * two-thread run must also have used the team once per step (the islands' one parallel
- * section), not once per substep as the chain sweeps of the one-island path do. */
+ * two-thread run must also have used the team once per solve of a step (the islands' one
+ * parallel section), not once per substep (360) as the chain sweeps of the one-island path do: a
+ * step is solved once, or again (at most 3 times in all) when an impact sets a body moving past
+ * its pairs' margins (the two ragdolls falling into each other here). */
 enum { ISL_STEPS = 36 };
 
 typedef struct isl_run {
@@ -857,7 +859,8 @@ AK_TEST(islands_bit_identical_for_any_thread_count) {
         AK_CHECK_MSG(isl_same(&runs[0], &runs[t], nb),
                      "islands, %d thread(s): the state differs from the one-island solve's", t);
     }
-    AK_CHECK_MSG((team1 - team0) + (fresh1 - fresh0) == ISL_STEPS,
+    AK_CHECK_MSG((team1 - team0) + (fresh1 - fresh0) >= ISL_STEPS &&
+                     (team1 - team0) + (fresh1 - fresh0) <= 3 * ISL_STEPS,
                  "2 threads: %llu parallel sections in %d steps",
                  (unsigned long long)((team1 - team0) + (fresh1 - fresh0)), ISL_STEPS);
     /* the world did something: the ragdolls reached the ground, the sleeper was woken */

@@ -13,12 +13,24 @@
 //
 //   bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] [--substeps K]
 //                         [--threads T] [--only pyramid|spheres|ragdolls]
+//                         [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10]
+//                                  [--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]
+//
+// --sweep compares at matched stability instead: per scene, animkit at each substep count of
+// --ak-substeps and Bullet at each of --bt-iterations x --bt-substeps (a step of dt taken as that
+// many fixed substeps), R rounds interleaved, with the stability measured after every step (the
+// largest drift, penetration, joint gap and joint-limit excess over the whole run, both engines'
+// poses measured by the same code); then the cheapest animkit setting as stable as Bullet's
+// defaults on every measure and the cheapest Bullet setting as stable as animkit at --ak-ref
+// substeps, with their time ratios.
 #include <btBulletDynamicsCommon.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
+#include <algorithm>
 #include <vector>
 
 #include <animkit/builtin.h>
@@ -37,6 +49,12 @@ struct result {
     uint64_t hash;    // animkit: FNV-1a of the final state
     uint64_t dropped = 0;  // animkit: contact points (and pairs) over max_contacts, whole run
     int drop_steps = 0, drop_first = -1;  // steps that dropped any, the first of them
+    // --sweep only, sampled after every step (the probes' time is left out of ms_per_step and
+    // cpu_ms): the largest horizontal drift of a body from its start (scenes without joints),
+    // the widest joint gap (m) and the largest joint-limit excess (rad) over all steps, and the
+    // bodies found more than 5 cm behind a plane (through the ground or a wall) at any step
+    double drift_max = 0, gap_max = 0, limit_max = 0;
+    int escaped = 0;
 };
 
 struct scene {
@@ -44,6 +62,36 @@ struct scene {
     size_t planes = 0;
     std::vector<ak_rigid_joint_desc> joints;  // ragdolls: `drift` is then the widest joint gap
 };
+
+// The --sweep probe of one state (x, q: every body's pose, planes included): see result.
+// Both engines' states go through it, Bullet's poses copied in (a capsule is along local Y in
+// both and its centre of mass is the body origin), so each measure is the same code for both;
+// m is a model of the scene (its joints' local anchors and limits).
+static void probe(const scene& sc, const ak_rigid_model* m, const std::vector<ak_vec3>& x,
+                  const std::vector<ak_quat>& q, result* r) {
+    const size_t n = x.size();
+    int behind = 0;
+    for (size_t i = sc.planes; i < n; ++i) {
+        if (sc.joints.empty())
+            r->drift_max =
+                std::fmax(r->drift_max, std::hypot((double)(x[i].x - sc.bodies[i].position.x),
+                                                   (double)(x[i].z - sc.bodies[i].position.z)));
+        for (size_t k = 0; k < sc.planes; ++k) {
+            const ak_vec3 nr = sc.bodies[k].shape.normal, p = sc.bodies[k].position;
+            if (nr.x * (x[i].x - p.x) + nr.y * (x[i].y - p.y) + nr.z * (x[i].z - p.z) < -0.05f) {
+                ++behind;
+                break;
+            }
+        }
+    }
+    r->escaped = std::max(r->escaped, behind);
+    for (size_t k = 0; k < sc.joints.size(); ++k) {
+        float gap = 0.0f, excess = 0.0f;
+        ak_rigid_joint_error(m, k, {x.data(), n}, {q.data(), n}, &gap, &excess);
+        r->gap_max = std::fmax(r->gap_max, (double)gap);
+        r->limit_max = std::fmax(r->limit_max, (double)excess);
+    }
+}
 
 static ak_rigid_body_desc zero_body() {
     ak_rigid_body_desc b;
@@ -136,7 +184,8 @@ static bool ragdolls(int count, scene* s) {
     return ok;
 }
 
-static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigned threads) {
+static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigned threads,
+                          bool track = false) {
     const size_t n = sc.bodies.size();
     ak_rigid_model_desc md;
     std::memset(&md, 0, sizeof md);
@@ -174,8 +223,14 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     // one thread: CPU time of the calling thread; more: wall time (the workers' time counts)
     const double t0 = threads > 1 ? bench_wall_s() : bench_cpu_s();
     const double c0 = bench_cpu_s(), p0 = bench_proc_s(), w0 = bench_wall_s();
+    double in_probe = 0.0; // --sweep: the probes' CPU time, left out of ms_per_step and cpu_ms
     for (int s = 0; s < steps; ++s) {
         ak_rigid_step_run(&job);
+        if (track) {
+            const double t = bench_cpu_s();
+            probe(sc, m, x, q, &r);
+            in_probe += bench_cpu_s() - t;
+        }
         r.pen = std::fmax(r.pen, (double)pen);
         r.contacts += contacts / (double)steps;
         if (dropped) {
@@ -183,8 +238,8 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
             if (!r.drop_steps++) r.drop_first = s;
         }
     }
-    r.ms_per_step = 1e3 * ((threads > 1 ? bench_wall_s() : bench_cpu_s()) - t0) / steps;
-    r.cpu_ms = 1e3 * (bench_cpu_s() - c0) / steps;
+    r.ms_per_step = 1e3 * ((threads > 1 ? bench_wall_s() : bench_cpu_s()) - t0 - in_probe) / steps;
+    r.cpu_ms = 1e3 * (bench_cpu_s() - c0 - in_probe) / steps;
     r.proc_ms = 1e3 * (bench_proc_s() - p0) / steps;
     r.wall_ms = 1e3 * (bench_wall_s() - w0) / steps;
     // FNV-1a of the final state: the same for every thread count (the solver's determinism)
@@ -231,7 +286,12 @@ static btMatrix3x3 basis_x(const btVector3& x) {
 
 static btVector3 bt(ak_vec3 v) { return btVector3(v.x, v.y, v.z); }
 
-static result run_bullet(const scene& sc, int steps) {
+// Bullet at its defaults (iterations 10, substeps 1) or, for --sweep, with `iterations` solver
+// iterations and each step of 1/60 s taken as `substeps` calls of stepSimulation(h, 1, h),
+// h = dt / substeps (the same as Bullet's own fixed substeps, without its accumulator's
+// rounding: each call is exactly one internal step)
+static result run_bullet(const scene& sc, int steps, int iterations = 10, int substeps = 1,
+                         bool track = false) {
     btDefaultCollisionConfiguration config;
     btCollisionDispatcher dispatcher(&config);
     btDbvtBroadphase broadphase;
@@ -239,6 +299,7 @@ static result run_bullet(const scene& sc, int steps) {
     broadphase.getOverlappingPairCache()->setOverlapFilterCallback(&filter);
     btSequentialImpulseConstraintSolver solver;
     btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
+    world.getSolverInfo().m_numIterations = iterations;
     world.setGravity(btVector3(0, -9.81f, 0));
     std::vector<btCollisionShape*> shapes;
     std::vector<btRigidBody*> bodies;
@@ -326,12 +387,37 @@ static result run_bullet(const scene& sc, int steps) {
         pivots.push_back(pb);
     }
     result r = {};
-    const btScalar dt = 1.0f / 60.0f;
+    const btScalar dt = 1.0f / 60.0f, h = dt / (btScalar)substeps;
+    // --sweep: a model of the scene for ak_rigid_joint_error, and the poses copied out of Bullet
+    ak_rigid_model* model = nullptr;
+    std::vector<ak_vec3> px(sc.bodies.size());
+    std::vector<ak_quat> pq(sc.bodies.size());
+    if (track) {
+        ak_rigid_model_desc md;
+        std::memset(&md, 0, sizeof md);
+        md.bodies.ptr = sc.bodies.data();
+        md.bodies.count = sc.bodies.size();
+        md.joints.ptr = sc.joints.data();
+        md.joints.count = sc.joints.size();
+        if (ak_rigid_model_create(&md, nullptr, &model) != AK_OK) return r;
+    }
     const double t0 = bench_cpu_s();
     double in_probe = 0.0;
     for (int s = 0; s < steps; ++s) {
-        world.stepSimulation(dt, 1, dt);
+        for (int k = 0; k < substeps; ++k)
+            world.stepSimulation(substeps > 1 ? h : dt, 1, substeps > 1 ? h : dt);
         const double p0 = bench_cpu_s();
+        if (track) {
+            for (size_t i = 0; i < bodies.size(); ++i) {
+                const btTransform t = bodies[i]->getCenterOfMassTransform();
+                const btQuaternion o = t.getRotation();
+                px[i] = ak_vec3_make(t.getOrigin().x(), t.getOrigin().y(), t.getOrigin().z());
+                pq[i] = ak_quat{o.x(), o.y(), o.z(), o.w()};
+                if (i < sc.planes)
+                    px[i] = sc.bodies[i].position; // Bullet's plane sits at the origin
+            }
+            probe(sc, model, px, pq, &r);
+        }
         for (int k = 0; k < dispatcher.getNumManifolds(); ++k) {
             btPersistentManifold* mf = dispatcher.getManifoldByIndexInternal(k);
             r.contacts += mf->getNumContacts() / (double)steps;
@@ -355,6 +441,7 @@ static result run_bullet(const scene& sc, int steps) {
         r.drift = std::fmax(r.drift, std::hypot((double)(p.x() - sc.bodies[i].position.x),
                                                 (double)(p.z() - sc.bodies[i].position.z)));
     }
+    ak_rigid_model_destroy(model);
     for (size_t i = 0; i < bodies.size(); ++i) {
         world.removeRigidBody(bodies[i]);
         delete bodies[i];
@@ -364,12 +451,159 @@ static result run_bullet(const scene& sc, int steps) {
     return r;
 }
 
+// "2,3,4" -> {2, 3, 4}; empty on a bad entry
+static std::vector<int> int_list(const char* s) {
+    std::vector<int> v;
+    for (const char* p = s; *p;) {
+        char* end = nullptr;
+        const long k = std::strtol(p, &end, 10);
+        if (end == p || k < 1 || k > 1000) return {};
+        v.push_back((int)k);
+        p = *end == ',' ? end + 1 : end;
+        if (*end && *end != ',') return {};
+    }
+    return v;
+}
+
+struct sweep_row {
+    bool bullet;
+    int a, b;               // animkit: substeps; Bullet: iterations, substeps
+    result r;               // the first round's (both engines are deterministic: the measures
+                            // are the same every round)
+    std::vector<double> ms; // ms per step, one per round
+    double med = 0, lo = 0, hi = 0;
+};
+
+static sweep_row make_row(bool bullet, int a, int b) {
+    sweep_row row;
+    row.bullet = bullet;
+    row.a = a;
+    row.b = b;
+    row.r = result();
+    return row;
+}
+
+// whether x is as stable as y or more on every measure of the scene: pyramid and spheres the
+// largest drift (pyramid only: the spheres are meant to spread), penetration and bodies behind a
+// plane; ragdolls the widest joint gap, the largest limit excess, penetration and bodies behind
+// a plane
+static bool as_stable(const scene& sc, bool spheres, const result& x, const result& y) {
+    if (x.pen > y.pen || x.escaped > y.escaped) return false;
+    if (!sc.joints.empty()) return x.gap_max <= y.gap_max && x.limit_max <= y.limit_max;
+    return spheres || x.drift_max <= y.drift_max;
+}
+
+// --sweep: per scene, animkit at each of ak_subs and Bullet at each of bt_iters x bt_subs,
+// `rounds` rounds interleaved (every setting once per round), the probes after every step; then
+// the cheapest animkit setting as stable as Bullet's defaults on every measure, and the cheapest
+// Bullet setting as stable as animkit at ak_ref substeps
+static void sweep(const char* name, const scene& sc, int steps, unsigned threads, int rounds,
+                  int ak_ref, const std::vector<int>& ak_subs, const std::vector<int>& bt_iters,
+                  const std::vector<int>& bt_subs) {
+    std::vector<sweep_row> rows;
+    for (int k : ak_subs) rows.push_back(make_row(false, k, 0));
+    if (std::find(ak_subs.begin(), ak_subs.end(), ak_ref) == ak_subs.end())
+        rows.push_back(make_row(false, ak_ref, 0));
+    rows.push_back(make_row(true, 10, 1)); // Bullet's defaults, always
+    for (int it : bt_iters)
+        for (int sub : bt_subs)
+            if (it != 10 || sub != 1) rows.push_back(make_row(true, it, sub));
+    for (int round = 0; round < rounds; ++round)
+        for (sweep_row& row : rows) {
+            const result r = row.bullet ? run_bullet(sc, steps, row.a, row.b, true)
+                                        : run_animkit(sc, steps, (unsigned)row.a, threads, true);
+            if (!round) row.r = r;
+            row.ms.push_back(r.ms_per_step);
+        }
+    const bool is_spheres = !std::strcmp(name, "spheres");
+    std::printf("\nsweep: %s (%zu bodies), %d steps, %d round(s); ms per step: median (range) of "
+                "the rounds; "
+                "measures: max over all steps\n",
+                name, sc.bodies.size() - sc.planes, steps, rounds);
+    std::printf("%-8s %-22s %22s %11s %11s %10s %11s %7s %8s\n", "engine", "setting", "ms per step",
+                "drift mm", "pen mm", "gap mm", "limit deg", "behind", "pts");
+    for (sweep_row& row : rows) {
+        std::vector<double> v = row.ms;
+        std::sort(v.begin(), v.end());
+        row.med = v[v.size() / 2];
+        row.lo = v.front();
+        row.hi = v.back();
+        char setting[64], ms[64];
+        if (row.bullet)
+            std::snprintf(setting, sizeof setting, "%d iterations x %d sub", row.a, row.b);
+        else
+            std::snprintf(setting, sizeof setting, "%d substeps", row.a);
+        std::snprintf(ms, sizeof ms, "%.3f (%.3f-%.3f)", row.med, row.lo, row.hi);
+        std::printf("%-8s %-22s %22s %11.3f %11.3f %10.3f %11.3f %7d %8.0f\n",
+                    row.bullet ? "Bullet" : "animkit", setting, ms, 1e3 * row.r.drift_max,
+                    1e3 * row.r.pen, 1e3 * row.r.gap_max,
+                    row.r.limit_max * 180.0 / 3.14159265358979, row.r.escaped, row.r.contacts);
+    }
+    const sweep_row* bt_def = nullptr;
+    const sweep_row* ak_def = nullptr;
+    for (const sweep_row& row : rows) {
+        if (row.bullet && row.a == 10 && row.b == 1) bt_def = &row;
+        if (!row.bullet && row.a == ak_ref) ak_def = &row;
+    }
+    const sweep_row* ak_best = nullptr;
+    const sweep_row* bt_best = nullptr;
+    for (const sweep_row& row : rows) {
+        if (!row.bullet && as_stable(sc, is_spheres, row.r, bt_def->r) &&
+            (!ak_best || row.med < ak_best->med))
+            ak_best = &row;
+        if (row.bullet && as_stable(sc, is_spheres, row.r, ak_def->r) &&
+            (!bt_best || row.med < bt_best->med))
+            bt_best = &row;
+    }
+    if (ak_best)
+        std::printf("matched to Bullet's defaults (10 iterations x 1 sub, %.3f ms): animkit at %d "
+                    "substeps, %.3f ms: "
+                    "ratio (Bullet / animkit) %.2f (%.2f-%.2f)\n",
+                    bt_def->med, ak_best->a, ak_best->med, bt_def->med / ak_best->med,
+                    bt_def->lo / ak_best->hi, bt_def->hi / ak_best->lo);
+    else
+        std::printf("matched to Bullet's defaults: no animkit setting tried is as stable on every "
+                    "measure\n");
+    if (bt_best)
+        std::printf("matched to animkit at %d substeps (%.3f ms): Bullet at %d iterations x %d "
+                    "sub, %.3f ms: ratio "
+                    "(Bullet / animkit) %.2f (%.2f-%.2f)\n",
+                    ak_ref, ak_def->med, bt_best->a, bt_best->b, bt_best->med,
+                    bt_best->med / ak_def->med, bt_best->lo / ak_def->hi, bt_best->hi / ak_def->lo);
+    else
+        std::printf("matched to animkit at %d substeps: no Bullet setting tried is as stable on "
+                    "every measure\n",
+                    ak_ref);
+    std::fflush(stdout);
+}
+
 int main(int argc, char** argv) {
     int layers = 20, nspheres = 10000, nragdolls = 50, steps = 300;
     unsigned substeps = 20, threads = 1;
     const char* only = nullptr;
-    for (int i = 1; i + 1 < argc; i += 2) {
-        if (!std::strcmp(argv[i], "--layers")) layers = std::atoi(argv[i + 1]);
+    bool do_sweep = false;
+    int rounds = 3, ak_ref = 10;
+    std::vector<int> ak_subs = {2, 3, 4, 6, 10}, bt_iters = {10, 20, 50}, bt_subs = {1, 2, 4};
+    bool lists_ok = true;
+    for (int i = 1; i < argc; i += 2) {
+        if (!std::strcmp(argv[i], "--sweep")) { // a flag without a value
+            do_sweep = true;
+            --i;
+            continue;
+        }
+        if (i + 1 >= argc) break;
+        if (!std::strcmp(argv[i], "--rounds"))
+            rounds = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--ak-ref"))
+            ak_ref = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--ak-substeps"))
+            lists_ok &= !(ak_subs = int_list(argv[i + 1])).empty();
+        else if (!std::strcmp(argv[i], "--bt-iterations"))
+            lists_ok &= !(bt_iters = int_list(argv[i + 1])).empty();
+        else if (!std::strcmp(argv[i], "--bt-substeps"))
+            lists_ok &= !(bt_subs = int_list(argv[i + 1])).empty();
+        else if (!std::strcmp(argv[i], "--layers"))
+            layers = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--spheres")) nspheres = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--substeps")) substeps = (unsigned)std::atoi(argv[i + 1]);
@@ -377,17 +611,25 @@ int main(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
         else if (!std::strcmp(argv[i], "--threads")) threads = (unsigned)std::atoi(argv[i + 1]);
     }
-    if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || nragdolls < 1 || nragdolls > 10000 || steps < 1 || substeps < 1 || substeps > 1000 || threads < 1 || threads > 64) {
-        std::fprintf(stderr, "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
-                             "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls]\n");
+    if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || nragdolls < 1 ||
+        nragdolls > 10000 || steps < 1 || substeps < 1 || substeps > 1000 || threads < 1 ||
+        threads > 64 || !lists_ok || rounds < 1 || rounds > 100 || ak_ref < 1 || ak_ref > 1000) {
+        std::fprintf(
+            stderr,
+            "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
+            "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls]\n"
+            "       [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10] "
+            "[--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]\n");
         return 2;
     }
     std::printf("dt 1/60 s, %d steps, sleeping on; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s; Bullet "
                 "%d.%02d 1 step x 10 iterations (its defaults), one thread\n",
                 steps, substeps, threads, threads > 1 ? " (wall time)" : "", btGetVersion() / 100,
                 btGetVersion() % 100);
-    std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s %9s %9s\n", "scene", "animkit ms", "Bullet ms", "ratio",
-                "animkit drift", "Bullet drift", "animkit pen", "Bullet pen", "ak pts", "bt pts");
+    if (!do_sweep)
+        std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s %9s %9s\n", "scene", "animkit ms",
+                    "Bullet ms", "ratio", "animkit drift", "Bullet drift", "animkit pen",
+                    "Bullet pen", "ak pts", "bt pts");
     const char* names[3] = {"pyramid", "spheres", "ragdolls"};
     scene scenes[3];
     if (!only || !std::strcmp(only, names[0])) scenes[0] = pyramid(layers);
@@ -395,6 +637,24 @@ int main(int argc, char** argv) {
     if ((!only || !std::strcmp(only, names[2])) && !ragdolls(nragdolls, &scenes[2])) {
         std::fprintf(stderr, "bench_rigid_vs_bullet: the ragdolls cannot be built\n");
         return 1;
+    }
+    if (do_sweep) {
+        for (int k = 0; k < 3; ++k)
+            if (!scenes[k].bodies.empty())
+                sweep(names[k], scenes[k], steps, threads, rounds, ak_ref, ak_subs, bt_iters,
+                      bt_subs);
+        std::printf("\nmatched: the cheapest setting (median time) whose every measure is at most "
+                    "the other\n"
+                    "engine's reference; drift: largest horizontal displacement of a body from its "
+                    "start (not\n"
+                    "a measure for the spheres, which spread); gap: widest joint anchor gap; "
+                    "limit: largest joint\n"
+                    "angle outside its limits; behind: most bodies more than 5 cm behind a plane "
+                    "at one step;\n"
+                    "pen: deepest penetration after a step; all over every step of the run "
+                    "(ak_rigid_joint_error\n"
+                    "measures both engines' poses); pts: contact points per step (first round)\n");
+        return 0;
     }
     for (int k = 0; k < 3; ++k) {
         if (scenes[k].bodies.empty()) continue;

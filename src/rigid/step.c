@@ -74,9 +74,9 @@ typedef struct island {
 
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
-    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, sap, pairs, contacts, groups, rows, cx, ct,
-        turn0, jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies, ipairs,
-        ijoints, ichains, islands, total;
+    size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, launch, sap, pairs, contacts, groups, rows,
+        cx, ct, turn0, jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies,
+        ipairs, ijoints, ichains, islands, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -94,6 +94,7 @@ static layout layout_of(const ak_rigid_model* m) {
     l.iw = off, off += align16(n * sizeof(ak_mat3));
     l.grow = off, off += align16(n * sizeof(float));
     l.slack = off, off += align16(n * sizeof(float));
+    l.launch = off, off += align16(n * sizeof(float));
     l.sap = off, off += align16(n * sizeof(sap_entry));
     l.pairs = off, off += align16((size_t)m->desc.max_contacts * sizeof(pair_entry));
     l.contacts = off, off += align16(((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS) *
@@ -464,7 +465,8 @@ static void body_pairs(solver* s, const sap_entry* sap, uint32_t ns, contact_buf
  * in a stack or a pyramid the ground is then solved last, which lets a 10-box stack creep
  * several times less than bottom-up order. Shell sorts (no allocation, a total order). */
 static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb, float* grow,
-                       float* slack, float offset, float dt, float gmag, ak_vec3 up) {
+                       float* slack, const float* launch, float offset, float dt, float gmag,
+                       ak_vec3 up, uint32_t* out_ns, int* out_axis) {
     const ak_rigid_model* m = s->m;
     uint32_t n = (uint32_t)m->body_count, ns = 0;
     cb->count = 0;
@@ -474,8 +476,8 @@ static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb,
         grow[i] = slack[i] = 0.0f;
         if (!s->awake[i]) continue;
         float turn = flat_shape(b->shape.type) ? ak_vec3_length(s->w[i]) * b->bound_radius : 0.0f;
-        grow[i] = 2.0f * dt * (ak_vec3_length(s->v[i]) + turn) + dt * dt * gmag;
-        slack[i] = 2.0f * dt * turn + dt * ak_vec3_length(s->v[i]);
+        grow[i] = 2.0f * dt * (ak_vec3_length(s->v[i]) + turn + launch[i]) + dt * dt * gmag;
+        slack[i] = 2.0f * dt * (turn + launch[i]) + dt * ak_vec3_length(s->v[i]);
     }
     /* sweep along the axis over which the bodies spread most (their centres' variance) */
     double mean[3] = {0, 0, 0}, var[3] = {0, 0, 0};
@@ -501,6 +503,8 @@ static void find_pairs(solver* s, sap_entry* sap, contact_buf* cb, pair_buf* pb,
         ++ns;
     }
     sap_sort(sap, ns);
+    *out_ns = ns;
+    *out_axis = axis;
     /* the pairs with planes (the walls and the ground) are kept first when the pairs overflow
      * max_contacts: room is held back for them while the bodies' pairs are found, so an
      * overflow drops pairs between bodies (they may sink into each other) but never lets a
@@ -1117,7 +1121,7 @@ static void* sweep_chains(void* arg) {
         for (int it = 0; it < t->sweeps; ++it) {
             float err = 0.0f;
             solve_joints(t->s, idx, count, &err);
-            if (err < 1e-4f) break;
+            if (err < t->s->m->desc.joint_tolerance) break;
         }
     }
     return NULL;
@@ -1133,7 +1137,7 @@ static void sweep_chain_list(solver* s, const uint32_t* order, const uint32_t* s
         for (int it = 0; it < sweeps; ++it) {
             float err = 0.0f;
             solve_joints(s, idx, n, &err);
-            if (err < 1e-4f) break;
+            if (err < s->m->desc.joint_tolerance) break;
         }
     }
 }
@@ -1334,6 +1338,77 @@ static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_
     }
 }
 
+/* How many times a step may be solved (launched_past): the first, then once per link of a chain
+ * of bodies set moving within the step (a Newton's cradle of 3 spheres takes 2). */
+#define LAUNCH_ATTEMPTS 3
+
+/* body_pairs' test (scale 1) for bodies a and b on the step's start poses, with margins ga, gb
+ * (grow) and sa, sb (slack) */
+static bool near_at_start(const solver* s, const ak_vec3* v0, uint32_t a, uint32_t b, float ga,
+                          float gb, float sa, float sb, float offset, float dt) {
+    float rb = s->bodies[a].bound_radius + s->bodies[b].bound_radius + offset;
+    float rr = rb + (ga + gb);
+    float d2 = ak_vec3_length_sq(ak_vec3_sub(s->x0[a], s->x0[b]));
+    if (d2 > rr * rr) return false;
+    if (s->awake[a] && s->awake[b]) {
+        float rel = rb + (2.0f * dt * ak_vec3_distance(v0[a], v0[b]) + sa + sb);
+        if (d2 > rel * rel) return false;
+    }
+    return true;
+}
+
+/* Whether the step has to be solved again: the broad phase, once per step, grows each body's
+ * bounding sphere by its start speed v0 (plus launch) times dt, so a body at rest that an impact
+ * or a joint sets moving within the step finds no pair with what lies ahead of it, and sinks into
+ * it or passes through until the next step. A body went further than its margins covered when its
+ * displacement in the step exceeds dt (|v0| + launch) by more than dt^2 |g| (what gravity adds)
+ * plus a quarter of its bounding radius, or half the contact offset if more (bodies slowed or
+ * stopped by a contact, a box landing, move less than that and never count; below a quarter of the
+ * radius a body pushed within a pile sinks no deeper than that and is separated the next step, as
+ * before: the 10,000 spheres poured by bench/vs_bullet were 24% slower when every push past half
+ * the offset solved the step again); if margins grown by that excess (launch raised by excess /
+ * dt, which adds twice the excess to the margins, as a start speed would) find a pair with a plane
+ * or a body (through the step's sweep, sap[0 .. ns) along axis) that the step's margins did not,
+ * its launch is raised and the step is solved again with it. A ragdoll's limb whipped faster than
+ * it started by its joints, with nothing new in its reach, costs nothing more.
+ */
+static bool launched_past(const solver* s, const ak_vec3* v0, float* launch, const float* grow,
+                          const float* slack, const sap_entry* sap, uint32_t ns, int axis, float dt,
+                          float gmag, float offset, uint32_t n) {
+    const ak_rigid_model* m = s->m;
+    bool any = false;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!s->awake[i]) continue;
+        float d = ak_vec3_distance(s->x[i], s->x0[i]);
+        float excess = d - dt * (ak_vec3_length(v0[i]) + launch[i]);
+        if (!(excess > dt * dt * gmag + ak_maxf(0.5f * offset, 0.25f * s->bodies[i].bound_radius)))
+            continue;
+        float gi = grow[i] + 2.0f * excess, si = slack[i] + 2.0f * excess;
+        const rigid_body* bi = &s->bodies[i];
+        bool found = false;
+        for (size_t k = 0; k < m->plane_count && !found; ++k) {
+            const rigid_body* pl = &s->bodies[m->planes[k]];
+            float dist = ak_vec3_dot(ak_vec3_sub(s->x0[i], s->x0[m->planes[k]]), pl->shape.normal) -
+                         bi->bound_radius;
+            found = !(dist > offset + gi) && dist > offset + grow[i];
+        }
+        float c = axis_comp(s->x0[i], axis), reach = bi->bound_radius + offset + gi;
+        for (uint32_t e = 0; e < ns && !found && sap[e].lo <= c + reach; ++e) {
+            uint32_t j = sap[e].body;
+            if (j == i || sap[e].hi < c - reach) continue;
+            if (bi->group != 0 && bi->group == s->bodies[j].group) continue;
+            if (m->joint_count && joined(m, i, j)) continue;
+            found = near_at_start(s, v0, i, j, gi, grow[j], si, slack[j], offset, dt) &&
+                    !near_at_start(s, v0, i, j, grow[i], grow[j], slack[i], slack[j], offset, dt);
+        }
+        if (found) {
+            launch[i] += excess / dt;
+            any = true;
+        }
+    }
+    return any;
+}
+
 ak_result ak_rigid_step_run(const ak_rigid_step_job* job) { return akp_rigid_step_run(job, true); }
 
 ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
@@ -1377,143 +1452,165 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
     memcpy(q0, s.q, n * sizeof *q0);
     memcpy(v0, s.v, n * sizeof *v0);
     memcpy(w0, s.w, n * sizeof *w0);
-    memset(s.ds, 0, n * sizeof *s.ds);
     const bool sleeping = job->sleep_timers.count > 0;
-    for (uint32_t i = 0; i < n; ++i) {
-        awake[i] = m->bodies[i].inv_mass > 0.0f &&
-                   !(sleeping && job->sleep_timers.ptr[i] >= m->desc.sleep_time);
-        if (awake[i]) s.q[i] = q0[i] = ak_quat_normalize(s.q[i]);
-        s.rot0[i] = ak_mat3_from_quat(q0[i]);
-    }
-    contact_buf cb = {(rigid_contact*)(base + l.contacts), 0, m->desc.max_contacts, 0,
-                      (contact_group*)(base + l.groups),   0};
     ak_vec3 up = ak_vec3_scale(ak_vec3_normalize(job->gravity), -1.0f);
     float gmag = ak_vec3_length(job->gravity);
-    /* pairs once per step (Mueller et al. 2020: "collect potential pairs once per time step"),
-     * with margins that cover the step's motion; flat pairs keep their contacts for every
-     * substep, the others run the narrow phase in each */
     float offset = m->desc.contact_offset;
-    pair_buf pb = {(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts, 0};
-    find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow),
-               (float*)(base + l.slack), offset, job->dt,
-               gmag, up);
-    uint32_t kept = cb.count;
-    uint32_t nj = (uint32_t)m->joint_count, chains = 0;
-    uint32_t* order = (uint32_t*)(base + l.jorder);
-    uint32_t* start = (uint32_t*)(base + l.jstart);
-    if (nj)
-        chains = joint_chains(&s, (uint32_t*)(base + l.parent), (uint32_t*)(base + l.croot),
-                              (uint32_t*)(base + l.jchain), order, start);
-    island* isl = (island*)(base + l.islands);
-    uint32_t islands_n =
-        islands ? build_islands(&s, &pb, kept, m->desc.max_contacts, chains, order, start,
+    float* launch = (float*)(base + l.launch);
+    memset(launch, 0, n * sizeof *launch);
+    contact_buf cb;
+    uint32_t ns = 0;
+    int axis = 0;
+    /* the step, again from its start with wider margins for the bodies an impact or a joint
+     * sent further than their pairs' margins covered (launched_past), at most LAUNCH_ATTEMPTS
+     * times in all */
+    for (int attempt = 1;; ++attempt) {
+        memset(s.ds, 0, n * sizeof *s.ds);
+        for (uint32_t i = 0; i < n; ++i) {
+            awake[i] = m->bodies[i].inv_mass > 0.0f &&
+                       !(sleeping && job->sleep_timers.ptr[i] >= m->desc.sleep_time);
+            if (awake[i]) s.q[i] = q0[i] = ak_quat_normalize(s.q[i]);
+            s.rot0[i] = ak_mat3_from_quat(q0[i]);
+        }
+        cb = (contact_buf){(rigid_contact*)(base + l.contacts), 0, m->desc.max_contacts, 0,
+                           (contact_group*)(base + l.groups),   0};
+        s.push_max = INFINITY;
+        /* pairs once per step (Mueller et al. 2020: "collect potential pairs once per time step"),
+         * with margins that cover the step's motion; flat pairs keep their contacts for every
+         * substep, the others run the narrow phase in each */
+        pair_buf pb = {(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts, 0};
+        find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow),
+                   (float*)(base + l.slack), launch, offset, job->dt, gmag, up, &ns, &axis);
+        uint32_t kept = cb.count;
+        uint32_t nj = (uint32_t)m->joint_count, chains = 0;
+        uint32_t* order = (uint32_t*)(base + l.jorder);
+        uint32_t* start = (uint32_t*)(base + l.jstart);
+        if (nj)
+            chains = joint_chains(&s, (uint32_t*)(base + l.parent), (uint32_t*)(base + l.croot),
+                                  (uint32_t*)(base + l.jchain), order, start);
+        island* isl = (island*)(base + l.islands);
+        uint32_t islands_n =
+            islands
+                ? build_islands(&s, &pb, kept, m->desc.max_contacts, chains, order, start,
                                 (uint32_t*)(base + l.parent), (uint32_t*)(base + l.island_of),
                                 (uint32_t*)(base + l.ibodies), (pair_entry*)(base + l.ipairs),
                                 (uint32_t*)(base + l.ijoints), (uint32_t*)(base + l.ichains), isl)
                 : 0;
-    if (islands_n) {
-        /* what no island writes (static bodies; the others are set again in each substep) */
-        for (uint32_t i = 0; i < n; ++i) {
-            s.cx[i] = s.ct[i] = s.turn0[i] = ak_vec3_zero();
-            s.rot[i] = ak_mat3_from_quat(s.q[i]);
-        }
-        /* the islands shared out over the threads in contiguous runs of about equal work */
-        uint64_t total = 0;
-        uint32_t busy = 0;
-        for (uint32_t k = 0; k < islands_n; ++k) total += isl[k].work, busy += isl[k].work > 0;
-        uint32_t want = job->thread_count ? job->thread_count : 1;
-        if (want > busy) want = busy ? busy : 1;
-        if (want > AKP_TASKS_MAX) want = AKP_TASKS_MAX;
-        island_task itasks[AK_RIGID_MAX_THREADS];
-        uint32_t itasks_n = 0, k = 0;
-        uint64_t acc = 0;
-        for (uint32_t t = 0; t < want; ++t) {
-            uint32_t k0 = k;
-            uint64_t upto = total * (t + 1) / want;
-            while (k < islands_n && (t + 1 == want || acc + isl[k].work <= upto))
-                acc += isl[k++].work;
-            if (k == k0 && k < islands_n) acc += isl[k++].work;
-            if (k == k0) continue;
-            itasks[itasks_n++] = (island_task){.s = &s,
-                                               .isl = isl,
-                                               .i0 = k0,
-                                               .i1 = k,
-                                               .ibodies = (uint32_t*)(base + l.ibodies),
-                                               .ijoints = (uint32_t*)(base + l.ijoints),
-                                               .ichains = (uint32_t*)(base + l.ichains),
-                                               .order = order,
-                                               .start = start,
-                                               .ipairs = (pair_entry*)(base + l.ipairs),
-                                               .c = cb.c,
-                                               .groups = cb.groups,
-                                               .gravity = job->gravity,
-                                               .offset = offset,
-                                               .gmag = gmag,
-                                               .substeps = substeps};
-        }
-        if (itasks_n > 1)
-            akp_run_tasks(solve_islands, itasks, sizeof itasks[0], itasks_n);
-        else if (itasks_n)
-            solve_islands(&itasks[0]);
-        /* the last substep's contacts brought together after the cached ones (regions ascend,
-         * so each moves down over free room) */
-        uint32_t cursor = kept;
-        for (uint32_t i = 0; i < islands_n; ++i) {
-            if (!isl[i].awake) continue;
-            if (isl[i].count_last && cursor != isl[i].region)
-                memmove(cb.c + cursor, cb.c + isl[i].region, isl[i].count_last * sizeof *cb.c);
-            cursor += isl[i].count_last;
-            cb.dropped += isl[i].dropped;
-        }
-        cb.count = cursor;
-    } else {
-        /* joints, contacts, then up to eight more sweeps over the joints: contacts solved last
-         * would pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
-         * (pelvis, spine, chest) 6 degrees past a limit under load. The later sweeps go chain by
-         * chain, the chains shared out over the threads in contiguous runs of about equal joint
-         * counts: each chain's numbers are the same whichever thread sweeps it. */
-        chain_task tasks[AK_RIGID_MAX_THREADS];
-        uint32_t tasks_n = 1;
-        tasks[0] = (chain_task){.s = &s, .c0 = 0, .c1 = 0, .sweeps = 8};
-        if (nj) {
+        if (islands_n) {
+            /* what no island writes (static bodies; the others are set again in each substep) */
+            for (uint32_t i = 0; i < n; ++i) {
+                s.cx[i] = s.ct[i] = s.turn0[i] = ak_vec3_zero();
+                s.rot[i] = ak_mat3_from_quat(s.q[i]);
+            }
+            /* the islands shared out over the threads in contiguous runs of about equal work */
+            uint64_t total = 0;
+            uint32_t busy = 0;
+            for (uint32_t k = 0; k < islands_n; ++k) total += isl[k].work, busy += isl[k].work > 0;
             uint32_t want = job->thread_count ? job->thread_count : 1;
-            if (want > chains) want = chains;
+            if (want > busy) want = busy ? busy : 1;
             if (want > AKP_TASKS_MAX) want = AKP_TASKS_MAX;
-            uint32_t c = 0;
-            tasks_n = 0;
+            island_task itasks[AK_RIGID_MAX_THREADS];
+            uint32_t itasks_n = 0, k = 0;
+            uint64_t acc = 0;
             for (uint32_t t = 0; t < want; ++t) {
-                uint32_t c0 = c;
-                /* chains up to the t+1-th share of the joints */
-                uint64_t upto = (uint64_t)nj * (t + 1) / want;
-                while (c < chains && (t + 1 == want || start[c + 1] <= upto)) ++c;
-                if (c == c0 && c < chains) ++c;
-                if (c == c0) continue;
-                tasks[tasks_n++] = (chain_task){
-                    .s = &s, .order = order, .start = start, .c0 = c0, .c1 = c, .sweeps = 8};
+                uint32_t k0 = k;
+                uint64_t upto = total * (t + 1) / want;
+                while (k < islands_n && (t + 1 == want || acc + isl[k].work <= upto))
+                    acc += isl[k++].work;
+                if (k == k0 && k < islands_n) acc += isl[k++].work;
+                if (k == k0) continue;
+                itasks[itasks_n++] = (island_task){.s = &s,
+                                                   .isl = isl,
+                                                   .i0 = k0,
+                                                   .i1 = k,
+                                                   .ibodies = (uint32_t*)(base + l.ibodies),
+                                                   .ijoints = (uint32_t*)(base + l.ijoints),
+                                                   .ichains = (uint32_t*)(base + l.ichains),
+                                                   .order = order,
+                                                   .start = start,
+                                                   .ipairs = (pair_entry*)(base + l.ipairs),
+                                                   .c = cb.c,
+                                                   .groups = cb.groups,
+                                                   .gravity = job->gravity,
+                                                   .offset = offset,
+                                                   .gmag = gmag,
+                                                   .substeps = substeps};
             }
-        }
-        for (uint32_t step = 0; step < substeps; ++step) {
-            predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping, NULL, n);
-            substep_contacts(&s, &cb, pb.p, pb.count, kept, offset);
-            /* joints, contacts, then eight more sweeps over the joints: contacts solved last would
-             * pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of joints
-             * (pelvis, spine, chest) 6 degrees past a limit under load; joints are few and cheap */
+            if (itasks_n > 1)
+                akp_run_tasks(solve_islands, itasks, sizeof itasks[0], itasks_n);
+            else if (itasks_n)
+                solve_islands(&itasks[0]);
+            /* the last substep's contacts brought together after the cached ones (regions ascend,
+             * so each moves down over free room) */
+            uint32_t cursor = kept;
+            for (uint32_t i = 0; i < islands_n; ++i) {
+                if (!isl[i].awake) continue;
+                if (isl[i].count_last && cursor != isl[i].region)
+                    memmove(cb.c + cursor, cb.c + isl[i].region, isl[i].count_last * sizeof *cb.c);
+                cursor += isl[i].count_last;
+                cb.dropped += isl[i].dropped;
+            }
+            cb.count = cursor;
+        } else {
+            /* joints, contacts, then up to eight more sweeps over the joints: contacts solved last
+             * would pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of
+             * joints (pelvis, spine, chest) 6 degrees past a limit under load. The later sweeps go
+             * chain by chain, the chains shared out over the threads in contiguous runs of about
+             * equal joint counts: each chain's numbers are the same whichever thread sweeps it. */
+            chain_task tasks[AK_RIGID_MAX_THREADS];
+            uint32_t tasks_n = 1;
+            tasks[0] = (chain_task){.s = &s, .c0 = 0, .c1 = 0, .sweeps = 8};
             if (nj) {
-                float err = 0.0f;
-                solve_joints(&s, NULL, nj, &err);
+                uint32_t want = job->thread_count ? job->thread_count : 1;
+                if (want > chains) want = chains;
+                if (want > AKP_TASKS_MAX) want = AKP_TASKS_MAX;
+                uint32_t c = 0;
+                tasks_n = 0;
+                for (uint32_t t = 0; t < want; ++t) {
+                    uint32_t c0 = c;
+                    /* chains up to the t+1-th share of the joints */
+                    uint64_t upto = (uint64_t)nj * (t + 1) / want;
+                    while (c < chains && (t + 1 == want || start[c + 1] <= upto)) ++c;
+                    if (c == c0 && c < chains) ++c;
+                    if (c == c0) continue;
+                    tasks[tasks_n++] = (chain_task){
+                        .s = &s, .order = order, .start = start, .c0 = c0, .c1 = c, .sweeps = 8};
+                }
             }
-            solve_positions(&s, &cb, NULL, n);
-            /* (the sweeps stop early, chain by chain, once one corrects no joint of the chain by
-             * more than 0.1 mm or 0.1 mrad: 50 falling ragdolls then take 4.3 sweeps a substep
-             * instead of 9 when they all stop together, and their anchors stay within 0.02 mm) */
-            if (tasks_n > 1)
-                akp_run_tasks(sweep_chains, tasks, sizeof tasks[0], tasks_n);
-            else if (nj)
-                sweep_chains(&tasks[0]);
-            update_velocities(&s, NULL, n);
-            damp_drives(&s, NULL, nj);
-            solve_velocities(&s, &cb, gmag);
+            for (uint32_t step = 0; step < substeps; ++step) {
+                predict(&s, job->gravity, m->desc.linear_damping, m->desc.angular_damping, NULL, n);
+                substep_contacts(&s, &cb, pb.p, pb.count, kept, offset);
+                /* joints, contacts, then eight more sweeps over the joints: contacts solved last
+                 * would pull a ragdoll's joints apart at an impact, and one sweep leaves a chain of
+                 * joints (pelvis, spine, chest) 6 degrees past a limit under load; joints are few
+                 * and cheap */
+                if (nj) {
+                    float err = 0.0f;
+                    solve_joints(&s, NULL, nj, &err);
+                }
+                solve_positions(&s, &cb, NULL, n);
+                /* (the sweeps stop early, chain by chain, once one corrects no joint of the chain
+                 * by more than joint_tolerance, by default 1e-4, 0.1 mm or 0.1 mrad: 50 falling
+                 * ragdolls take 4.3 sweeps a substep instead of 9 when they all stop together, and
+                 * their anchors stay within 0.02 mm) */
+                if (tasks_n > 1)
+                    akp_run_tasks(sweep_chains, tasks, sizeof tasks[0], tasks_n);
+                else if (nj)
+                    sweep_chains(&tasks[0]);
+                update_velocities(&s, NULL, n);
+                damp_drives(&s, NULL, nj);
+                solve_velocities(&s, &cb, gmag);
+            }
         }
+        if (attempt >= LAUNCH_ATTEMPTS || pb.dropped ||
+            !launched_past(&s, v0, launch, (const float*)(base + l.grow),
+                           (const float*)(base + l.slack), (const sap_entry*)(base + l.sap), ns,
+                           axis, job->dt, gmag, offset, n))
+            break;
+        memcpy(s.x, x0, n * sizeof *x0);
+        memcpy(s.q, q0, n * sizeof *q0);
+        memcpy(s.v, v0, n * sizeof *v0);
+        memcpy(s.w, w0, n * sizeof *w0);
     }
     bool finite = true;
     for (uint32_t i = 0; i < n && finite; ++i)
