@@ -871,8 +871,18 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
         SOFT_ALLOC(s->xnode_start, uint32_t, np + 1);
         SOFT_ALLOC(s->snode_start, uint32_t, 2 * np + 1);
         const size_t jw = ((size_t)s->max_joint + 64) / 64;
-        uint64_t* jset = NULL; /* [2 * jw]: the parent side's joints, the child side's joints */
-        SOFT_ALLOC(jset, uint64_t, 2 * jw);
+        /* [2 * jw] the parent side's joints, the child side's joints; then [nb] each bone's
+         * bone above (one whose tail is its head, of another joint; UINT32_MAX: none) */
+        uint64_t* jset = NULL;
+        SOFT_ALLOC(jset, uint64_t, 2 * jw + (nb + 1) / 2);
+        uint32_t* above = (uint32_t*)(void*)(jset + 2 * jw);
+        for (size_t b = 0; b < nb; ++b) {
+            above[b] = UINT32_MAX;
+            for (size_t b2 = 0; b2 < nb && above[b] == UINT32_MAX; ++b2)
+                if (s->bones[b2].joint_index != s->bones[b].joint_index &&
+                    ak_vec3_distance(s->bones[b2].tail, s->bones[b].head) <= 1e-4f * longest)
+                    above[b] = (uint32_t)b2;
+        }
 #define SOFT_JSET(set, j) (((set)[(j) / 64] >> ((j) % 64)) & 1u)
 #define SOFT_JADD(set, j) ((set)[(j) / 64] |= (uint64_t)1 << ((j) % 64))
         size_t nx = 0, ns = 0;
@@ -889,17 +899,13 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
                 const ak_vec3 nrm = ak_vec3_normalize(u);
                 memset(jset, 0, 2 * jw * sizeof(uint64_t));
                 uint64_t *jp = jset, *jc = jset + jw;
-                SOFT_JADD(jc, C1->joint_index);
-                for (bool grew = true; grew;) { /* every joint below the lower bone */
-                    grew = false;
-                    for (size_t b = 0; b < nb; ++b) {
-                        if (!SOFT_JSET(jc, s->bones[b].joint_index)) continue;
-                        for (size_t b2 = 0; b2 < nb; ++b2) {
-                            uint16_t j2 = s->bones[b2].joint_index;
-                            if (j2 == P1->joint_index || SOFT_JSET(jc, j2)) continue;
-                            if (ak_vec3_distance(s->bones[b2].head, s->bones[b].tail) > 1e-4f * longest) continue;
-                            SOFT_JADD(jc, j2);
-                            grew = true;
+                for (size_t b = 0; b < nb; ++b) { /* the lower bone's joint and every joint below it */
+                    uint32_t k = (uint32_t)b;
+                    for (size_t steps = 0; k != UINT32_MAX && steps <= nb; ++steps, k = above[k]) {
+                        if (s->bones[k].joint_index == P1->joint_index) break;
+                        if (s->bones[k].joint_index == C1->joint_index) {
+                            SOFT_JADD(jc, s->bones[b].joint_index);
+                            break;
                         }
                     }
                 }
