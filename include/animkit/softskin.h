@@ -34,7 +34,11 @@
  *     knee, an elbow), the flesh of each side (nodes whose largest weight is that side's joint,
  *     on that side at the bind pose, within the longer bone plus two flesh radii of the joint)
  *     stays on its side of the plane through the joint that bisects the two posed bones, so
- *     the two sides press flat against each other instead of passing through; (2) a flesh node
+ *     the two sides press flat against each other instead of passing through; at a joint
+ *     bent past 90 deg (and not at the bind pose) the plane also holds, for that step, the
+ *     nodes of the parts beyond the two bones (the joint above the upper bone, every joint
+ *     below the lower one: the hips and the foot at a knee) whose skinned positions lie within
+ *     3 lattice cubes of the other side's (the heel against the buttock); (2) a flesh node
  *     stays outside the core (bone_radius x its flesh radius) of every other joint's bone that
  *     it was outside of at the bind pose;
  *   - determinism and threads: tetrahedra are coloured at build time (no two of a colour share
