@@ -1071,6 +1071,7 @@ AK_TEST(scene_defaults_and_bytes) {
     AK_CHECK_EQ(s.steps, 1000);
     AK_CHECK_EQ(s.contact_iterations, 8u);
     AK_CHECK_EQ(s.method, AK_CROWD_ORCA);
+    AK_CHECK_EQ(s.vision_view, AK_CROWD_VIEW_RAYCAST);
     AK_CHECK_NEAR(s.duration, 0.0f, 0.0f);
     AK_CHECK(s.agents == NULL && s.agent_count == 0 && s.obstacle_count == 0);
     AK_CHECK_NEAR(s.defaults.radius, 0.3f, 0.0f);
@@ -1082,7 +1083,8 @@ AK_TEST(scene_defaults_and_bytes) {
     AK_CHECK_NEAR(s.defaults.time_horizon_obstacles, 2.0f, 0.0f);
     AK_CHECK_NEAR(s.defaults.waypoint_radius, 0.0f, 0.0f); /* 0: each agent's radius */
 
-    const char* text = "{\"dt\": 0.05, \"steps\": 321, \"method\": \"vision\", \"contact_iterations\": 3,"
+    const char* text = "{\"dt\": 0.05, \"steps\": 321, \"method\": \"vision\", \"vision_view\": \"raster\","
+                       " \"contact_iterations\": 3,"
                        " \"agent_defaults\": {\"radius\": 0.4, \"max_neighbors\": 7},"
                        " \"obstacles\": [{\"vertices\": [[5, 5], [6, 5], [6, 6]]}, {\"vertices\": [[-9, 2], [-9, 3]]}],"
                        " \"agents\": [{\"position\": [1, 2], \"velocity\": [0.5, -0.25], \"goal\": [3, 4], \"group\": 7},"
@@ -1092,6 +1094,7 @@ AK_TEST(scene_defaults_and_bytes) {
     AK_CHECK_NEAR(s.dt, 0.05f, 0.0f);
     AK_CHECK_EQ(s.steps, 321);
     AK_CHECK_EQ(s.method, AK_CROWD_VISION);
+    AK_CHECK_EQ(s.vision_view, AK_CROWD_VIEW_RASTER);
     AK_CHECK_EQ(s.contact_iterations, 3u);
     AK_CHECK_EQ(s.obstacle_count, 2u);
     AK_CHECK_EQ(s.vertex_count, 5u);

@@ -384,6 +384,7 @@ typedef struct ak_crowd_scene {
                                      file sets "steps" */
     uint32_t contact_iterations;  /* default 8 */
     ak_crowd_method method;       /* default AK_CROWD_ORCA */
+    ak_crowd_view vision_view;    /* "vision_view": "raycast" (default) or "raster" */
 } ak_crowd_scene;
 
 /* The defaults of every key (the scene without a file: no agents, no obstacles); owns
