@@ -466,6 +466,7 @@ typedef struct vision_raster {
     uint8_t* rgba;  /* [W * H * 4] */
     float* depth;   /* [W * H] */
     size_t cap;
+    float tan_half_fov; /* tan(vision_fov / 2) */
 } vision_raster;
 
 /* Agent neighbours are kept as one key each, (bits of the squared distance) << 32 | index:
@@ -1182,16 +1183,27 @@ static bool vision_render(const worker* w, vision_raster* vr, ak_vec2 p, ak_vec2
     const uint32_t S = AK_CROWD_VISION_PRISM_SIDES;
     const float H = AK_CROWD_VISION_AGENT_HEIGHT, HW = AK_CROWD_VISION_WALL_HEIGHT;
     const float cs = cosf(3.14159265f / (float)S);
+    ak_vec2 corner[AK_CROWD_VISION_PRISM_SIDES + 1]; /* the unit polygon's corners, the first again */
+    ak_vec2 normal[AK_CROWD_VISION_PRISM_SIDES];     /* and its faces' outward normals */
+    for (uint32_t m = 0; m <= S; ++m) {
+        const float a = 6.28318531f * (float)(m % S) / (float)S, b = 6.28318531f * ((float)m + 0.5f) / (float)S;
+        corner[m] = v2(cosf(a), sinf(a));
+        if (m < S) normal[m] = v2(cosf(b), sinf(b));
+    }
     size_t n = 0;
     for (uint32_t q = 0; q < na; ++q) {
         const uint32_t j = nkey_index(w->agent_n[q]);
         const ak_vec2 c = job->positions.ptr[j];
         const float R = crowd->agents[j].radius / cs; /* faces touch the disc */
+        const ak_vec2 pc = sub(p, c);
+        /* what the rasterizer would clip or cull anyway, left out before it: a prism wholly
+         * behind the near plane, and the faces turned away from the eye */
+        if (-dot(pc, head) + R < VISION_NEAR) continue;
         const ak_vec4 col = vision_id_color(q + 1);
         for (uint32_t m = 0; m < S; ++m) {
-            const float a0 = 6.28318531f * (float)m / (float)S, a1 = 6.28318531f * (float)(m + 1) / (float)S;
-            const ak_vec3 b0 = ak_vec3_make(c.x + R * cosf(a0), 0.0f, c.y + R * sinf(a0));
-            const ak_vec3 b1 = ak_vec3_make(c.x + R * cosf(a1), 0.0f, c.y + R * sinf(a1));
+            if (!(dot(normal[m], pc) > crowd->agents[j].radius)) continue;
+            const ak_vec3 b0 = ak_vec3_make(c.x + R * corner[m].x, 0.0f, c.y + R * corner[m].y);
+            const ak_vec3 b1 = ak_vec3_make(c.x + R * corner[m + 1].x, 0.0f, c.y + R * corner[m + 1].y);
             const ak_vec3 t0 = ak_vec3_make(b0.x, H, b0.z), t1 = ak_vec3_make(b1.x, H, b1.z);
             /* counter-clockwise seen from outside */
             const ak_vec3 tri[6] = {b0, t1, b1, b0, t0, t1};
@@ -1202,6 +1214,7 @@ static bool vision_render(const worker* w, vision_raster* vr, ak_vec2 p, ak_vec2
     for (uint32_t q = 0; q < no; ++q) {
         const obst_vertex* o1 = &crowd->verts[w->obst_n[q].index];
         const ak_vec2 a = o1->point, b = crowd->verts[o1->next].point;
+        if (dot(sub(a, p), head) < VISION_NEAR && dot(sub(b, p), head) < VISION_NEAR) continue; /* behind */
         const ak_vec3 a0 = ak_vec3_make(a.x, 0.0f, a.y), b0 = ak_vec3_make(b.x, 0.0f, b.y);
         const ak_vec3 a1 = ak_vec3_make(a.x, HW, a.y), b1 = ak_vec3_make(b.x, HW, b.y);
         const ak_vec4 col = vision_id_color(na + q + 1);
@@ -1209,11 +1222,11 @@ static bool vision_render(const worker* w, vision_raster* vr, ak_vec2 p, ak_vec2
         for (int k = 0; k < 12; ++k) vr->pos[n + (size_t)k] = tri[k], vr->col[n + (size_t)k] = col;
         n += 12;
     }
-    const float hfov = crowd->vision_fov, vfov = AK_CROWD_VISION_VFOV * (3.14159265f / 180.0f);
+    const float vfov = AK_CROWD_VISION_VFOV * (3.14159265f / 180.0f);
     const ak_vec3 eye = ak_vec3_make(p.x, AK_CROWD_VISION_EYE_HEIGHT, p.y);
     const ak_vec3 at = ak_vec3_make(p.x + head.x, AK_CROWD_VISION_EYE_HEIGHT, p.y + head.y);
     const ak_raster_camera cam =
-        ak_raster_camera_perspective(eye, at, vfov, tanf(0.5f * hfov) / tanf(0.5f * vfov), VISION_NEAR, VISION_FAR);
+        ak_raster_camera_perspective(eye, at, vfov, vr->tan_half_fov / tanf(0.5f * vfov), VISION_NEAR, VISION_FAR);
     const ak_vec4 black = ak_vec4_make(0.0f, 0.0f, 0.0f, 1.0f);
     ak_raster_clear(vr->r, black, black);
     if (n) {
@@ -1237,7 +1250,7 @@ static uint32_t vision_raster_pixel(const ak_crowd* crowd, const vision_raster* 
     const float n = VISION_NEAR, f = VISION_FAR;
     const float z = 2.0f * n * f / (f + n - (2.0f * vr->depth[i] - 1.0f) * (f - n)); /* along the heading */
     const float xn = 2.0f * ((float)x + 0.5f) / (float)crowd->vision_width - 1.0f;
-    const float s = xn * tanf(0.5f * crowd->vision_fov);
+    const float s = xn * vr->tan_half_fov;
     const ak_vec2 dir = v2(head.x - s * head.y, head.y + s * head.x); /* head + s * right */
     *rp = mul(z, dir);
     *d = mul(1.0f / sqrtf(abs_sq(dir)), dir);
@@ -1270,6 +1283,11 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
         if (vision_render(w, w->vr, p, head, na, no))
             for (uint32_t y = 0; y < crowd->vision_height; ++y)
                 for (uint32_t x = 0; x < W; ++x) {
+                    /* the pixel above with the same object and depth gives the same bounds */
+                    const size_t px = (size_t)y * W + x;
+                    if (y > 0 && memcmp(w->vr->rgba + 4 * px, w->vr->rgba + 4 * (px - W), 4) == 0 &&
+                        memcmp(&w->vr->depth[px], &w->vr->depth[px - W], sizeof(float)) == 0)
+                        continue;
                     ak_vec2 rp, d;
                     const uint32_t id = vision_raster_pixel(crowd, w->vr, head, x, y, &rp, &d);
                     if (id == 0 || id > na + no) continue;
@@ -1615,6 +1633,7 @@ static ak_result vision_rasters_make(const ak_crowd* crowd, vision_raster* vr, u
         vr[t].rgba = (uint8_t*)(mem + s_pos + s_col);
         vr[t].depth = (float*)(void*)(mem + s_pos + s_col + s_rgba);
         vr[t].cap = cap;
+        vr[t].tan_half_fov = tanf(0.5f * crowd->vision_fov);
     }
     return AK_OK;
 }
