@@ -30,6 +30,7 @@ static int run(const char* preset, size_t agents, ak_crowd_method method, const 
     ak_diag diag;
     const size_t plen = strlen(preset);
     const bool file = plen > 5 && strcmp(preset + plen - 5, ".json") == 0;
+    if (file) ak_crowd_scene_defaults(&sc); /* a file is read over the defaults */
     if ((file ? ak_crowd_scene_load_file(preset, &sc, &diag) : ak_crowd_scene_preset(preset, agents, &sc, &diag)) !=
         AK_OK) {
         fprintf(stderr, "%s\n", diag.message);
