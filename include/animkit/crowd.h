@@ -33,8 +33,10 @@
  *   - AK_CROWD_VISION instead: synthetic-vision steering (Ondrej, Pettre, Olivier, Donikian,
  *     "A synthetic-vision based steering approach for crowd simulation", SIGGRAPH 2010): each
  *     agent casts vision_width rays over vision_fov around its heading against its neighbours'
- *     discs and the obstacle edges (a direct per-pixel ray cast, not the rasterizer: it gives
- *     each pixel its object and hit point); per pixel, the time to interaction and the bearing
+ *     discs and the obstacle edges (a direct per-pixel ray cast: each pixel its object and hit
+ *     point), or with vision_view RASTER renders them with raster.h into a vision_width x
+ *     vision_height image (prisms and walls, object ids as flat colours, hit points from the
+ *     depth); per pixel, the time to interaction and the bearing
  *     angle's rate; pixels whose |rate| is below the paper's threshold 0.6 ttc^-1.5 are
  *     threats; the agent turns toward its goal unless that leaves a threat under the
  *     threshold, then by the smallest heading change that lifts the rates over it (keeping
@@ -128,8 +130,9 @@ typedef enum ak_crowd_view {
 /* The scene a RASTER view renders, per agent: a level perspective camera at its centre,
  * AK_CROWD_VISION_EYE_HEIGHT above the ground, looking along its heading, vision_fov wide
  * and AK_CROWD_VISION_VFOV degrees high (so every pixel of a column has the same bearing:
- * column k looks at atan(tan(vision_fov / 2) (1 - 2 (k + 0.5) / vision_width)) to the left of
- * the heading; planar projection, so the columns are narrower toward the edges); each
+ * column k looks along the heading turned by atan(tan(vision_fov / 2) (1 - 2 (k + 0.5) /
+ * vision_width)) from x toward z, column 0 the agent's right, the image's column
+ * vision_width - 1 - k; planar projection, so the columns are narrower toward the edges); each
  * neighbour a vertical AK_CROWD_VISION_PRISM_SIDES-sided prism round its disc (faces
  * touching the circle), AK_CROWD_VISION_AGENT_HEIGHT tall, each obstacle edge a wall
  * AK_CROWD_VISION_WALL_HEIGHT tall, seen from both sides; no ground. Each object is drawn
@@ -298,9 +301,9 @@ AK_DEFINE_SPAN(crowd_line, ak_crowd_line)
 AK_API size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd_line_span out_lines,
                                    size_t* out_obstacle_line_count);
 
-/* A VISION agent's view for the given state, per column (vision_width of them, column 0 on
- * the left of the heading: for RAYCAST at heading angle + vision_fov (0.5 - (k + 0.5) /
- * vision_width), for RASTER as AK_CROWD_VISION_VFOV's comment says): the object the column
+/* A VISION agent's view for the given state, per column (vision_width of them, column 0 the
+ * agent's right: RAYCAST column k along the heading turned by vision_fov (0.5 - (k + 0.5) /
+ * vision_width) from x toward z, RASTER as AK_CROWD_VISION_VFOV's comment says): the object the column
  * sees nearest (an agent's index; agent_count + v for the obstacle edge from obstacle vertex
  * v, vertices numbered over the obstacles in order; UINT32_MAX for nothing) and its hit
  * point's distance on the ground from the agent's centre (INFINITY for nothing); RASTER: the
