@@ -1145,6 +1145,24 @@ AK_TEST(scene_defaults_and_bytes) {
     AK_CHECK_EQ(s.steps, 400);
     if (s.agent_count == 6) AK_CHECK_NEAR(s.agents[5].radius, 0.25f, 0.0f);
     ak_crowd_scene_free(&s);
+    /* the random-start corridors of docs/crowd.md ("Lanes"): every agent inside the 8 m
+     * corridor, 0.75 m apart at least, the groups alternating */
+    const char* const files[2] = {AK_SOURCE_DIR "/examples/crowd_corridor_jitter.json",
+                                  AK_SOURCE_DIR "/examples/crowd_corridor_mixed.json"};
+    for (int f = 0; f < 2; ++f) {
+        ak_crowd_scene_defaults(&s);
+        AK_CHECK_EQ(ak_crowd_scene_load_file(files[f], &s, &d), AK_OK);
+        AK_CHECK_EQ(s.agent_count, f ? 200u : 100u);
+        AK_CHECK_EQ(s.obstacle_count, 2u);
+        double closest = INFINITY;
+        for (size_t i = 0; i < s.agent_count; ++i) {
+            AK_CHECK(fabsf(s.positions[i].y) <= 3.4f && s.group[i] == i % 2);
+            for (size_t j = 0; j < i; ++j)
+                closest = fmin(closest, hypot(s.positions[i].x - s.positions[j].x, s.positions[i].y - s.positions[j].y));
+        }
+        AK_CHECK_MSG(closest >= 0.7499, "%s: closest start pair %g m", files[f], closest);
+        ak_crowd_scene_free(&s);
+    }
 }
 
 /* Every error names the file and the key path, as one line. */
