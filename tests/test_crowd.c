@@ -904,14 +904,15 @@ AK_TEST(threads_bit_identical) {
         goal[i] = (ak_vec2){lcg(&seed) * 60.0f, lcg(&seed) * 60.0f};
         ag[i] = (ak_crowd_agent){.goals = {&goal[i], 1}};
     }
-    for (int method = 0; method < 2; ++method) { /* ORCA, then vision */
-        ak_crowd_desc desc = {.agents = {ag, N}, .method = method ? AK_CROWD_VISION : AK_CROWD_ORCA};
+    for (int method = 0; method < 3; ++method) { /* ORCA, then vision (ray cast, raster view) */
+        ak_crowd_desc desc = {.agents = {ag, N}, .method = method ? AK_CROWD_VISION : AK_CROWD_ORCA,
+                              .vision_view = method == 2 ? AK_CROWD_VIEW_RASTER : AK_CROWD_VIEW_RAYCAST};
         run a, b;
         AK_CHECK(run_init(&a, &desc, start));
         AK_CHECK(run_init(&b, &desc, start));
         a.contacts = b.contacts = 2;
-        AK_CHECK_EQ(run_steps(&a, 0.1f, 1, method ? 10 : 20, false), AK_OK);
-        AK_CHECK_EQ(run_steps(&b, 0.1f, 2, method ? 10 : 20, false), AK_OK);
+        AK_CHECK_EQ(run_steps(&a, 0.1f, 1, method == 2 ? 4 : method ? 10 : 20, false), AK_OK);
+        AK_CHECK_EQ(run_steps(&b, 0.1f, 2, method == 2 ? 4 : method ? 10 : 20, false), AK_OK);
         AK_CHECK(memcmp(a.p, b.p, N * sizeof(ak_vec2)) == 0);
         AK_CHECK(memcmp(a.v, b.v, N * sizeof(ak_vec2)) == 0);
         AK_CHECK(memcmp(a.wp, b.wp, N * sizeof(uint32_t)) == 0);
