@@ -1081,6 +1081,12 @@ static bool vision_arriving(const ak_crowd_step_job* job, const ak_crowd_agent* 
     return abs_sq(sub(a->goals.ptr[last], p)) <= a->pref_speed * a->pref_speed;
 }
 
+#if defined(__GNUC__) || defined(__clang__)
+#define VISION_INLINE inline __attribute__((always_inline)) /* the ray cast's inner loop */
+#else
+#define VISION_INLINE inline
+#endif
+
 /* The turn and speed bounds gathered over a view's pixels. */
 typedef struct vision_acc {
     float need_right, need_left; /* turn-rate bounds from the threats */
@@ -1090,7 +1096,7 @@ typedef struct vision_acc {
 
 /* One pixel of the view: the visible object's point rp relative to the agent (along the unit
  * direction d), its velocity ovel, whether it is an agent. */
-static void vision_pixel(vision_acc* acc, const ak_crowd_agent* a, ak_vec2 head, float speed, float pref_len,
+static VISION_INLINE void vision_pixel(vision_acc* acc, const ak_crowd_agent* a, ak_vec2 head, float speed, float pref_len,
                          ak_vec2 v, ak_vec2 d, ak_vec2 rp, ak_vec2 ovel, bool agent) {
     /* the pixel's point relative to the agent, and its relative velocity */
     const ak_vec2 rv = sub(ovel, v);
@@ -1135,7 +1141,7 @@ static ak_vec2 vision_heading(ak_vec2 v, ak_vec2 pref) {
 /* RAYCAST: the ray from p along d against the na agent and no obstacle neighbours; returns the
  * nearest hit's distance (INFINITY: none), its velocity, whether an agent, its object id (an
  * agent's index, or agent_count + the edge's first vertex). */
-static float vision_cast(const worker* w, ak_vec2 p, ak_vec2 d, uint32_t na, uint32_t no, ak_vec2* ovel, bool* agent,
+static VISION_INLINE float vision_cast(const worker* w, ak_vec2 p, ak_vec2 d, uint32_t na, uint32_t no, ak_vec2* ovel, bool* agent,
                          uint32_t* object) {
     const ak_crowd* crowd = w->c->crowd;
     const ak_crowd_step_job* job = w->c->job;
