@@ -441,7 +441,8 @@ AK_TEST(vision_raster_view_vs_raycast) {
         ak_crowd_agent ag[N];
         size_t n = 0;
         for (int tries = 0; n < N && tries < 1000; ++tries) {
-            const ak_vec2 q = {(float)(RND() * 10.0 - 5.0), (float)(RND() * 10.0 - 5.0)};
+            const float qx = (float)(RND() * 10.0 - 5.0); /* two statements: a fixed order */
+            const ak_vec2 q = {qx, (float)(RND() * 10.0 - 5.0)};
             const float r = (float)(0.2 + 0.2 * RND());
             bool ok = true;
             for (size_t j = 0; j < n; ++j)
