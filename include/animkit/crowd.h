@@ -79,7 +79,8 @@
  * by threads. The state (positions, velocities, waypoint indices) is caller-owned: the step
  * job reads the inputs, writes the outputs (which must not alias the inputs) and advances
  * each agent's waypoint index in place. The step never allocates (scratch comes from the
- * caller); thread_count > 1 starts pthreads.
+ * caller), except a VISION crowd's RASTER view (a render target per thread, each step);
+ * thread_count > 1 starts pthreads.
  */
 #ifndef ANIMKIT_CROWD_H
 #define ANIMKIT_CROWD_H
@@ -159,7 +160,8 @@ typedef struct ak_crowd_desc {
     const ak_crowd_obstacle* obstacles;  /* optional: [obstacle_count] */
     uint32_t obstacle_count;
     ak_crowd_method method;              /* 0 -> ORCA */
-    uint32_t vision_width;               /* VISION: pixels of each agent's 1D view; 0 -> 48;
+    uint32_t vision_width;               /* VISION: pixels across each agent's view (RAYCAST:
+                                            the 1D view; RASTER: the image's width); 0 -> 48;
                                             <= 1024 */
     float vision_fov;                    /* VISION: field of view, degrees; 0 -> 150; < 360
                                             (RASTER: < 180) */
