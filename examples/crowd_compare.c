@@ -8,8 +8,11 @@
  * and 0.3 m across, of an agent where |x| < 10 m) / (that share within 3 m along x at any z):
  * 0 when the groups are mixed across the width, 1 when they walk in separate lanes, whatever
  * their number and place) and the step time. docs/crowd.md's ORCA/vision table comes from it:
- *     example_crowd_compare [PRESET [AGENTS]]      (default: crossing 24)
- * Shows: ak_crowd_scene_preset, ak_crowd_desc.method, ak_crowd_clearance. */
+ *     example_crowd_compare [PRESET|SCENE.json [AGENTS [raycast|raster]]]   (default: crossing 24)
+ * A scene file (AGENTS ignored; its "vision_view" unless the third argument says) gets the
+ * corridor's lane measures (its groups 0 and 1). The third argument is the vision run's view.
+ * Shows: ak_crowd_scene_preset, ak_crowd_scene_load_file, ak_crowd_desc.method and
+ * vision_view, ak_crowd_clearance. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,16 +25,23 @@ static double seconds(void) {
     return (double)clock() / CLOCKS_PER_SEC;
 }
 
-static int run(const char* preset, size_t agents, ak_crowd_method method) {
+static int run(const char* preset, size_t agents, ak_crowd_method method, const char* view) {
     ak_crowd_scene sc;
     ak_diag diag;
-    if (ak_crowd_scene_preset(preset, agents, &sc, &diag) != AK_OK) {
+    const size_t plen = strlen(preset);
+    const bool file = plen > 5 && strcmp(preset + plen - 5, ".json") == 0;
+    if (file) ak_crowd_scene_defaults(&sc); /* a file is read over the defaults */
+    if ((file ? ak_crowd_scene_load_file(preset, &sc, &diag) : ak_crowd_scene_preset(preset, agents, &sc, &diag)) !=
+        AK_OK) {
         fprintf(stderr, "%s\n", diag.message);
         return 1;
     }
+    if (view) sc.vision_view = strcmp(view, "raster") == 0 ? AK_CROWD_VIEW_RASTER : AK_CROWD_VIEW_RAYCAST;
+    const bool lanes = file || strcmp(preset, "corridor") == 0;
     const size_t n = sc.agent_count;
     ak_crowd_desc d = {.agents = {sc.agents, n}, .obstacles = sc.obstacles,
-                       .obstacle_count = (uint32_t)sc.obstacle_count, .method = method};
+                       .obstacle_count = (uint32_t)sc.obstacle_count, .method = method,
+                       .vision_view = sc.vision_view};
     ak_crowd* c = NULL;
     if (ak_crowd_create(&d, NULL, &c) != AK_OK) return 1;
     ak_vec2 *p = malloc(n * sizeof *p), *v = calloc(n, sizeof *v), *p2 = malloc(n * sizeof *p2),
@@ -107,10 +117,10 @@ static int run(const char* preset, size_t agents, ak_crowd_method method) {
             if (h && t_home[i] < 0) t_home[i] = s + 1;
             home += h;
         }
-        if (strcmp(preset, "corridor") == 0 && s < 200)
+        if (lanes && s < 200)
             for (size_t i = 0; i < n; ++i)
                 if (fabsf(p[i].x) < 10.0f && sc.group[i] < 2) z[sc.group[i]] += p[i].y, zn[sc.group[i]]++;
-        if (strcmp(preset, "corridor") == 0)
+        if (lanes)
             for (size_t i = 0; i < n; ++i) {
                 if (!(fabsf(p[i].x) < 10.0f)) continue;
                 for (size_t j = 0; j < n; ++j) {
@@ -135,10 +145,11 @@ static int run(const char* preset, size_t agents, ak_crowd_method method) {
         tt += (double)t_home[i] * sc.dt;
         ratio += straight[i] > 0.0 ? walked[i] / straight[i] : 1.0;
     }
-    printf("%-10s %-6s %zu agents: at goal at the end %zu, got there %zu; all home at step %ld of %ld; "
+    printf("%-10s %-6s%s %zu agents: at goal at the end %zu, got there %zu; all home at step %ld of %ld; "
            "time to goal %.1f s, path / straight %.3f, speed on the way %.2f m/s; min clearance %.5f m, "
            "%zu pairs overlapped > 1 mm; %.2f ms per step (%.0f agent-steps/s)",
-           preset, method == AK_CROWD_VISION ? "vision" : "orca", n, at_goal, reached, all_home, sc.steps,
+           preset, method == AK_CROWD_VISION ? "vision" : "orca",
+           method == AK_CROWD_VISION && sc.vision_view == AK_CROWD_VIEW_RASTER ? " (raster view)" : "", n, at_goal, reached, all_home, sc.steps,
            reached ? tt / (double)reached : 0.0, reached ? ratio / (double)reached : 0.0,
            speed_n ? speed_sum / (double)speed_n : 0.0, min_clear, ov_count, 1e3 * step_time / (double)s,
            step_time > 0.0 ? (double)n * (double)s / step_time : 0.0);
@@ -159,6 +170,11 @@ static int run(const char* preset, size_t agents, ak_crowd_method method) {
 int main(int argc, char** argv) {
     const char* preset = argc > 1 ? argv[1] : "crossing";
     const size_t agents = argc > 2 ? (size_t)strtoul(argv[2], NULL, 10) : 24;
-    if (run(preset, agents, AK_CROWD_ORCA) != 0) return 1;
-    return run(preset, agents, AK_CROWD_VISION);
+    const char* view = argc > 3 ? argv[3] : NULL;
+    if (view && strcmp(view, "raycast") != 0 && strcmp(view, "raster") != 0) {
+        fprintf(stderr, "view '%s': raycast or raster\n", view);
+        return 1;
+    }
+    if (run(preset, agents, AK_CROWD_ORCA, NULL) != 0) return 1;
+    return run(preset, agents, AK_CROWD_VISION, view);
 }

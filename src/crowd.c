@@ -11,6 +11,7 @@
 
 #include <animkit/crowd.h>
 #include <animkit/grid.h>
+#include <animkit/raster.h>
 
 #include "internal.h"
 #include "tasks.h"
@@ -45,6 +46,8 @@ struct ak_crowd {
     ak_crowd_method method;
     uint32_t vision_width;
     float vision_fov; /* radians */
+    ak_crowd_view vision_view;
+    uint32_t vision_height;
     float max_neighbor_distance;
     float max_radius;
     uint32_t max_k;
@@ -127,7 +130,8 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
         if (vert_total > AK_CROWD_MAX_OBSTACLE_VERTICES) return AK_ERR_BAD_ARG;
     }
     if (n > AK_CROWD_MAX_AGENTS || (unsigned)desc->method >= AK_CROWD_METHOD_COUNT || desc->vision_width > 1024 ||
-        !(desc->vision_fov >= 0.0f && desc->vision_fov < 360.0f) ||
+        !(desc->vision_fov >= 0.0f && desc->vision_fov < 360.0f) || (unsigned)desc->vision_view >= AK_CROWD_VIEW_COUNT ||
+        desc->vision_height > 256 || (desc->vision_view == AK_CROWD_VIEW_RASTER && !(desc->vision_fov < 180.0f)) ||
         desc->obstacle_count > AK_CROWD_MAX_OBSTACLE_VERTICES)
         return AK_ERR_BAD_ARG;
     if (n == 0) return AK_ERR_EMPTY;
@@ -172,6 +176,8 @@ ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, 
     c->method = desc->method;
     c->vision_width = desc->vision_width ? desc->vision_width : 48;
     c->vision_fov = (desc->vision_fov > 0.0f ? desc->vision_fov : 150.0f) * (3.14159265358979f / 180.0f);
+    c->vision_view = desc->vision_view;
+    c->vision_height = desc->vision_height ? desc->vision_height : 8;
     size_t w = 0;
     for (size_t i = 0; i < n; ++i) {
         ak_crowd_agent a = ak_crowd_agent_resolved(&desc->agents.ptr[i]);
@@ -449,7 +455,19 @@ typedef struct worker {
     neigh* obst_n;        /* [vertex_count] */
     ak_crowd_line* lines; /* [max_k + vertex_count] */
     ak_crowd_line* proj;  /* [max_k + vertex_count] */
+    struct vision_raster* vr; /* VISION RASTER: this worker's render target and buffers */
 } worker;
+
+/* A RASTER view's render target and buffers, one per worker, allocated for one step. */
+typedef struct vision_raster {
+    ak_raster* r;
+    ak_vec3* pos;   /* [cap] triangle soup */
+    ak_vec4* col;   /* [cap] flat id colours */
+    uint8_t* rgba;  /* [W * H * 4] */
+    float* depth;   /* [W * H] */
+    size_t cap;
+    float tan_half_fov; /* tan(vision_fov / 2) */
+} vision_raster;
 
 /* Agent neighbours are kept as one key each, (bits of the squared distance) << 32 | index:
  * distances are >= 0, so the keys order as (distance, index) do. */
@@ -1063,8 +1081,190 @@ static bool vision_arriving(const ak_crowd_step_job* job, const ak_crowd_agent* 
     return abs_sq(sub(a->goals.ptr[last], p)) <= a->pref_speed * a->pref_speed;
 }
 
-/* Synthetic-vision steering (Ondrej et al. 2010) for one agent: a 1D view of vision_width
- * pixels; per pixel the visible object's hit point, its time to interaction and the rate of
+#if defined(__GNUC__) || defined(__clang__)
+#define VISION_INLINE inline __attribute__((always_inline)) /* the ray cast's inner loop */
+#else
+#define VISION_INLINE inline
+#endif
+
+/* The turn and speed bounds gathered over a view's pixels. */
+typedef struct vision_acc {
+    float need_right, need_left; /* turn-rate bounds from the threats */
+    bool right, left;
+    float ttc_min;
+} vision_acc;
+
+/* One pixel of the view: the visible object's point rp relative to the agent (along the unit
+ * direction d), its velocity ovel, whether it is an agent. */
+static VISION_INLINE void vision_pixel(vision_acc* acc, const ak_crowd_agent* a, ak_vec2 head, float speed, float pref_len,
+                         ak_vec2 v, ak_vec2 d, ak_vec2 rp, ak_vec2 ovel, bool agent) {
+    /* the pixel's point relative to the agent, and its relative velocity */
+    const ak_vec2 rv = sub(ovel, v);
+    const float dist2 = abs_sq(rp);
+    const float closing = -dot(rp, rv); /* > 0 when approaching (times |rp|) */
+    if (!(closing > 0.0f)) return;
+    const float dist = sqrtf(dist2);
+    const float ttc = fmaxf(dist - a->radius, 0.0f) * dist / closing;
+    const float rate = dist2 > 0.0f ? det(rp, rv) / dist2 : 0.0f; /* bearing rate, rad/s */
+    const float thr = 0.6f * powf(fmaxf(ttc, 1e-3f), -1.5f);
+    if (fabsf(rate) >= thr) return; /* not a threat: it will pass */
+    /* an agent standing or shuffling (under VISION_STAND_SPEED: parked, or jostled on its
+     * place) slows the agent to 30% of pref_speed at most (ttc 0.845 s) and does not turn
+     * it: it steps on through, and the contact projection shoulders both aside, as people
+     * squeeze past those standing (a parked block is otherwise a wall the agent walks
+     * along and never enters); a wall or a walker can stop it */
+    const bool standing = agent && abs_sq(ovel) < VISION_STAND_SPEED * VISION_STAND_SPEED &&
+                          dot(ovel, rp) >= -0.05f * dist;
+    const float ttc_slow = standing ? fmaxf(ttc, VISION_STAND_TTC) : ttc;
+    if (ttc_slow < acc->ttc_min) acc->ttc_min = ttc_slow;
+    if (standing) return;
+    /* Turning the heading by delta changes this bearing rate by about -k delta, with
+     * k = (own speed) cos(angle to the point) / distance: keep the rate's sign and lift
+     * it over the threshold (points beside or behind do not respond to a turn). */
+    const float k = fmaxf(speed, 0.1f * pref_len) * dot(head, d) / dist;
+    if (!(k > 1e-4f)) return;
+    if (rate >= 0.0f) {
+        acc->right = true;
+        acc->need_right = fminf(acc->need_right, (rate - thr) / k); /* delta <= this (< 0: clockwise) */
+    } else {
+        acc->left = true;
+        acc->need_left = fmaxf(acc->need_left, (rate + thr) / k); /* delta >= this (> 0) */
+    }
+}
+
+/* The heading the view looks along: the velocity, or the goal's direction when standing. */
+static ak_vec2 vision_heading(ak_vec2 v, ak_vec2 pref) {
+    const float speed = len(v), pref_len = len(pref);
+    return speed > 1e-3f ? mul(1.0f / speed, v) : (pref_len > 0.0f ? mul(1.0f / pref_len, pref) : v2(1.0f, 0.0f));
+}
+
+/* RAYCAST: the ray from p along d against the na agent and no obstacle neighbours; returns the
+ * nearest hit's distance (INFINITY: none), its velocity, whether an agent, its object id (an
+ * agent's index, or agent_count + the edge's first vertex). */
+static VISION_INLINE float vision_cast(const worker* w, ak_vec2 p, ak_vec2 d, uint32_t na, uint32_t no, ak_vec2* ovel, bool* agent,
+                         uint32_t* object) {
+    const ak_crowd* crowd = w->c->crowd;
+    const ak_crowd_step_job* job = w->c->job;
+    float best = INFINITY;
+    *ovel = v2(0.0f, 0.0f);
+    *agent = false;
+    *object = UINT32_MAX;
+    for (uint32_t q = 0; q < na; ++q) {
+        const uint32_t j = nkey_index(w->agent_n[q]);
+        const float t = ray_disc(p, d, job->positions.ptr[j], crowd->agents[j].radius);
+        if (t < best) {
+            best = t;
+            *ovel = job->velocities.ptr[j];
+            *agent = true;
+            *object = j;
+        }
+    }
+    for (uint32_t q = 0; q < no; ++q) {
+        const obst_vertex* o1 = &crowd->verts[w->obst_n[q].index];
+        const float t = ray_segment(p, d, o1->point, crowd->verts[o1->next].point);
+        if (t < best) {
+            best = t;
+            *ovel = v2(0.0f, 0.0f);
+            *agent = false;
+            *object = (uint32_t)crowd->agent_count + w->obst_n[q].index;
+        }
+    }
+    return best;
+}
+
+#define VISION_NEAR 0.1f /* m: the RASTER camera's near and far planes (depth error about 6e-8 z^2 / near per ulp) */
+#define VISION_FAR 100.0f
+
+/* Flat colour of view object id (1-based; 0 is the background): its 24 bits as bytes. */
+static ak_vec4 vision_id_color(uint32_t id) {
+    return ak_vec4_make((float)(id & 255u) / 255.0f, (float)((id >> 8) & 255u) / 255.0f,
+                        (float)((id >> 16) & 255u) / 255.0f, 1.0f);
+}
+
+/* RASTER: render the view of the agent at p looking along head into vr (ids 1..na: the
+ * agent neighbours in order, na + 1 ..: the obstacle neighbours); false when drawing failed. */
+static bool vision_render(const worker* w, vision_raster* vr, ak_vec2 p, ak_vec2 head, uint32_t na, uint32_t no) {
+    const ak_crowd* crowd = w->c->crowd;
+    const ak_crowd_step_job* job = w->c->job;
+    const uint32_t S = AK_CROWD_VISION_PRISM_SIDES;
+    const float H = AK_CROWD_VISION_AGENT_HEIGHT, HW = AK_CROWD_VISION_WALL_HEIGHT;
+    const float cs = cosf(3.14159265f / (float)S);
+    ak_vec2 corner[AK_CROWD_VISION_PRISM_SIDES + 1]; /* the unit polygon's corners, the first again */
+    ak_vec2 normal[AK_CROWD_VISION_PRISM_SIDES];     /* and its faces' outward normals */
+    for (uint32_t m = 0; m <= S; ++m) {
+        const float a = 6.28318531f * (float)(m % S) / (float)S, b = 6.28318531f * ((float)m + 0.5f) / (float)S;
+        corner[m] = v2(cosf(a), sinf(a));
+        if (m < S) normal[m] = v2(cosf(b), sinf(b));
+    }
+    size_t n = 0;
+    for (uint32_t q = 0; q < na; ++q) {
+        const uint32_t j = nkey_index(w->agent_n[q]);
+        const ak_vec2 c = job->positions.ptr[j];
+        const float R = crowd->agents[j].radius / cs; /* faces touch the disc */
+        const ak_vec2 pc = sub(p, c);
+        /* what the rasterizer would clip or cull anyway, left out before it: a prism wholly
+         * behind the near plane, and the faces turned away from the eye */
+        if (-dot(pc, head) + R < VISION_NEAR) continue;
+        const ak_vec4 col = vision_id_color(q + 1);
+        for (uint32_t m = 0; m < S; ++m) {
+            if (!(dot(normal[m], pc) > crowd->agents[j].radius)) continue;
+            const ak_vec3 b0 = ak_vec3_make(c.x + R * corner[m].x, 0.0f, c.y + R * corner[m].y);
+            const ak_vec3 b1 = ak_vec3_make(c.x + R * corner[m + 1].x, 0.0f, c.y + R * corner[m + 1].y);
+            const ak_vec3 t0 = ak_vec3_make(b0.x, H, b0.z), t1 = ak_vec3_make(b1.x, H, b1.z);
+            /* counter-clockwise seen from outside */
+            const ak_vec3 tri[6] = {b0, t1, b1, b0, t0, t1};
+            for (int k = 0; k < 6; ++k) vr->pos[n + (size_t)k] = tri[k], vr->col[n + (size_t)k] = col;
+            n += 6;
+        }
+    }
+    for (uint32_t q = 0; q < no; ++q) {
+        const obst_vertex* o1 = &crowd->verts[w->obst_n[q].index];
+        const ak_vec2 a = o1->point, b = crowd->verts[o1->next].point;
+        if (dot(sub(a, p), head) < VISION_NEAR && dot(sub(b, p), head) < VISION_NEAR) continue; /* behind */
+        const ak_vec3 a0 = ak_vec3_make(a.x, 0.0f, a.y), b0 = ak_vec3_make(b.x, 0.0f, b.y);
+        const ak_vec3 a1 = ak_vec3_make(a.x, HW, a.y), b1 = ak_vec3_make(b.x, HW, b.y);
+        const ak_vec4 col = vision_id_color(na + q + 1);
+        const ak_vec3 tri[12] = {a0, b0, b1, a0, b1, a1, a0, b1, b0, a0, a1, b1}; /* both sides */
+        for (int k = 0; k < 12; ++k) vr->pos[n + (size_t)k] = tri[k], vr->col[n + (size_t)k] = col;
+        n += 12;
+    }
+    const float vfov = AK_CROWD_VISION_VFOV * (3.14159265f / 180.0f);
+    const ak_vec3 eye = ak_vec3_make(p.x, AK_CROWD_VISION_EYE_HEIGHT, p.y);
+    const ak_vec3 at = ak_vec3_make(p.x + head.x, AK_CROWD_VISION_EYE_HEIGHT, p.y + head.y);
+    const ak_raster_camera cam =
+        ak_raster_camera_perspective(eye, at, vfov, vr->tan_half_fov / tanf(0.5f * vfov), VISION_NEAR, VISION_FAR);
+    const ak_vec4 black = ak_vec4_make(0.0f, 0.0f, 0.0f, 1.0f);
+    ak_raster_clear(vr->r, black, black);
+    if (n) {
+        ak_raster_mesh m = {.positions = {vr->pos, n}, .colors = {vr->col, n},
+                            .material = {.color = {1.0f, 1.0f, 1.0f, 1.0f}},
+                            .shading = AK_SHADING_UNLIT, .cull_back_faces = true};
+        if (ak_raster_draw_mesh(vr->r, &cam, &m) != AK_OK) return false;
+    }
+    const size_t px = (size_t)crowd->vision_width * crowd->vision_height;
+    return ak_raster_read_samples(vr->r, (ak_u8_span){vr->rgba, 4 * px}, (ak_f32_span){vr->depth, px}) == AK_OK;
+}
+
+/* RASTER: pixel (x, y)'s object (0: none; else its 1-based view id) and its point relative to
+ * the agent (rp) and unit direction on the ground (d), from the depth. */
+static uint32_t vision_raster_pixel(const ak_crowd* crowd, const vision_raster* vr, ak_vec2 head, uint32_t x, uint32_t y,
+                                    ak_vec2* rp, ak_vec2* d) {
+    const size_t i = (size_t)y * crowd->vision_width + x;
+    const uint8_t* c = vr->rgba + 4 * i;
+    const uint32_t id = (uint32_t)c[0] | (uint32_t)c[1] << 8 | (uint32_t)c[2] << 16;
+    if (id == 0) return 0;
+    const float n = VISION_NEAR, f = VISION_FAR;
+    const float z = 2.0f * n * f / (f + n - (2.0f * vr->depth[i] - 1.0f) * (f - n)); /* along the heading */
+    const float xn = 2.0f * ((float)x + 0.5f) / (float)crowd->vision_width - 1.0f;
+    const float s = xn * vr->tan_half_fov;
+    const ak_vec2 dir = v2(head.x - s * head.y, head.y + s * head.x); /* head + s * right */
+    *rp = mul(z, dir);
+    *d = mul(1.0f / sqrtf(abs_sq(dir)), dir);
+    return id;
+}
+
+/* Synthetic-vision steering (Ondrej et al. 2010) for one agent: a view of vision_width
+ * columns; per pixel the visible object's hit point, its time to interaction and the rate of
  * its bearing; the threats' bearing rates bound the turn rate and the nearest threat's time to
  * interaction sets the speed (the paper's two controls); the goal is a pixel kept in view. */
 static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, const ak_crowd_agent* a, ak_vec2 pref) {
@@ -1080,72 +1280,41 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
     const uint32_t no = crowd->vertex_count ? obstacle_neighbors(crowd, p, a, w->obst_n) : 0;
     const float speed = len(v);
     const float pref_len = len(pref);
-    /* heading: the velocity, or the goal's direction when standing */
-    const ak_vec2 head = speed > 1e-3f ? mul(1.0f / speed, v) : (pref_len > 0.0f ? mul(1.0f / pref_len, pref) : v2(1.0f, 0.0f));
+    const ak_vec2 head = vision_heading(v, pref);
     const float theta = atan2f(head.y, head.x);
     const float fov = crowd->vision_fov;
     const uint32_t W = crowd->vision_width;
-    float need_right = INFINITY, need_left = -INFINITY; /* turn-rate bounds from the threats */
-    bool right = false, left = false;
-    float ttc_min = INFINITY;
-    for (uint32_t k = 0; k < W; ++k) {
-        const float ang = theta + fov * (0.5f - ((float)k + 0.5f) / (float)W);
-        const ak_vec2 d = v2(cosf(ang), sinf(ang));
-        float best = INFINITY;
-        ak_vec2 ovel = v2(0.0f, 0.0f);
-        bool agent = false;
-        for (uint32_t q = 0; q < na; ++q) {
-            const uint32_t j = nkey_index(w->agent_n[q]);
-            const float t = ray_disc(p, d, job->positions.ptr[j], crowd->agents[j].radius);
-            if (t < best) {
-                best = t;
-                ovel = job->velocities.ptr[j];
-                agent = true;
-            }
-        }
-        for (uint32_t q = 0; q < no; ++q) {
-            const obst_vertex* o1 = &crowd->verts[w->obst_n[q].index];
-            const float t = ray_segment(p, d, o1->point, crowd->verts[o1->next].point);
-            if (t < best) {
-                best = t;
-                ovel = v2(0.0f, 0.0f);
-                agent = false;
-            }
-        }
-        if (!(best < INFINITY)) continue;
-        /* the pixel's point relative to the agent, and its relative velocity */
-        const ak_vec2 rp = mul(best, d), rv = sub(ovel, v);
-        const float dist2 = abs_sq(rp);
-        const float closing = -dot(rp, rv); /* > 0 when approaching (times |rp|) */
-        if (!(closing > 0.0f)) continue;
-        const float dist = sqrtf(dist2);
-        const float ttc = fmaxf(dist - a->radius, 0.0f) * dist / closing;
-        const float rate = dist2 > 0.0f ? det(rp, rv) / dist2 : 0.0f; /* bearing rate, rad/s */
-        const float thr = 0.6f * powf(fmaxf(ttc, 1e-3f), -1.5f);
-        if (fabsf(rate) >= thr) continue; /* not a threat: it will pass */
-        /* an agent standing or shuffling (under VISION_STAND_SPEED: parked, or jostled on its
-         * place) slows the agent to 30% of pref_speed at most (ttc 0.845 s) and does not turn
-         * it: it steps on through, and the contact projection shoulders both aside, as people
-         * squeeze past those standing (a parked block is otherwise a wall the agent walks
-         * along and never enters); a wall or a walker can stop it */
-        const bool standing = agent && abs_sq(ovel) < VISION_STAND_SPEED * VISION_STAND_SPEED &&
-                              dot(ovel, rp) >= -0.05f * dist;
-        const float ttc_slow = standing ? fmaxf(ttc, VISION_STAND_TTC) : ttc;
-        if (ttc_slow < ttc_min) ttc_min = ttc_slow;
-        if (standing) continue;
-        /* Turning the heading by delta changes this bearing rate by about -k delta, with
-         * k = (own speed) cos(angle to the point) / distance: keep the rate's sign and lift
-         * it over the threshold (points beside or behind do not respond to a turn). */
-        const float k = fmaxf(speed, 0.1f * pref_len) * dot(head, d) / dist;
-        if (!(k > 1e-4f)) continue;
-        if (rate >= 0.0f) {
-            right = true;
-            need_right = fminf(need_right, (rate - thr) / k); /* delta <= this (< 0: clockwise) */
-        } else {
-            left = true;
-            need_left = fmaxf(need_left, (rate + thr) / k); /* delta >= this (> 0) */
+    vision_acc acc = {INFINITY, -INFINITY, false, false, INFINITY};
+    if (crowd->vision_view == AK_CROWD_VIEW_RASTER) {
+        if (vision_render(w, w->vr, p, head, na, no))
+            for (uint32_t y = 0; y < crowd->vision_height; ++y)
+                for (uint32_t x = 0; x < W; ++x) {
+                    /* the pixel above with the same object and depth gives the same bounds */
+                    const size_t px = (size_t)y * W + x;
+                    if (y > 0 && memcmp(w->vr->rgba + 4 * px, w->vr->rgba + 4 * (px - W), 4) == 0 &&
+                        memcmp(&w->vr->depth[px], &w->vr->depth[px - W], sizeof(float)) == 0)
+                        continue;
+                    ak_vec2 rp, d;
+                    const uint32_t id = vision_raster_pixel(crowd, w->vr, head, x, y, &rp, &d);
+                    if (id == 0 || id > na + no) continue;
+                    const bool agent = id <= na;
+                    const ak_vec2 ovel = agent ? job->velocities.ptr[nkey_index(w->agent_n[id - 1])] : v2(0.0f, 0.0f);
+                    vision_pixel(&acc, a, head, speed, pref_len, v, d, rp, ovel, agent);
+                }
+    } else {
+        for (uint32_t k = 0; k < W; ++k) {
+            const float ang = theta + fov * (0.5f - ((float)k + 0.5f) / (float)W);
+            const ak_vec2 d = v2(cosf(ang), sinf(ang));
+            ak_vec2 ovel;
+            bool agent;
+            uint32_t object;
+            const float best = vision_cast(w, p, d, na, no, &ovel, &agent, &object);
+            if (!(best < INFINITY)) continue;
+            vision_pixel(&acc, a, head, speed, pref_len, v, d, mul(best, d), ovel, agent);
         }
     }
+    const float need_right = acc.need_right, need_left = acc.need_left, ttc_min = acc.ttc_min;
+    const bool right = acc.right, left = acc.left;
     /* toward the goal, then the threats' bound on the side that asks for the smaller turn */
     float delta = 0.0f, goal_bearing = 0.0f;
     if (pref_len > 0.0f) delta = goal_bearing = atan2f(det(head, pref), dot(head, pref));
@@ -1439,6 +1608,46 @@ static void carve_worker(const ak_crowd* c, char* base, worker* w) {
     w->proj = (ak_crowd_line*)(void*)base;
 }
 
+/* The RASTER view's render targets and buffers, one per worker (AK_ERR_NO_MEMORY: none kept). */
+static void vision_rasters_free(const ak_crowd* crowd, vision_raster* vr, uint32_t count) {
+    const ak_allocator* al = crowd->alloc.alloc ? &crowd->alloc : NULL;
+    for (uint32_t t = 0; t < count; ++t) {
+        ak_raster_destroy(vr[t].r);
+        if (vr[t].pos) akp_free(al, vr[t].pos);
+        vr[t].r = NULL;
+        vr[t].pos = NULL;
+    }
+}
+
+static ak_result vision_rasters_make(const ak_crowd* crowd, vision_raster* vr, uint32_t count) {
+    const ak_allocator* al = crowd->alloc.alloc ? &crowd->alloc : NULL;
+    const size_t cap = (size_t)crowd->max_k * AK_CROWD_VISION_PRISM_SIDES * 6 + (size_t)crowd->vertex_count * 12;
+    const size_t px = (size_t)crowd->vision_width * crowd->vision_height;
+    const size_t s_pos = akp_align16(cap * sizeof(ak_vec3)), s_col = akp_align16(cap * sizeof(ak_vec4));
+    const size_t s_rgba = akp_align16(px * 4), s_depth = akp_align16(px * sizeof(float));
+    const ak_raster_desc rd = {.width = (int)crowd->vision_width, .height = (int)crowd->vision_height};
+    memset(vr, 0, count * sizeof *vr);
+    for (uint32_t t = 0; t < count; ++t) {
+        char* mem = (char*)akp_alloc(al, s_pos + s_col + s_rgba + s_depth + 16);
+        if (!mem || ak_raster_create(&rd, al, &vr[t].r) != AK_OK) {
+            if (mem) akp_free(al, mem);
+            vision_rasters_free(crowd, vr, count);
+            return AK_ERR_NO_MEMORY;
+        }
+        vr[t].pos = (ak_vec3*)(void*)mem;
+        vr[t].col = (ak_vec4*)(void*)(mem + s_pos);
+        vr[t].rgba = (uint8_t*)(mem + s_pos + s_col);
+        vr[t].depth = (float*)(void*)(mem + s_pos + s_col + s_rgba);
+        vr[t].cap = cap;
+        vr[t].tan_half_fov = tanf(0.5f * crowd->vision_fov);
+    }
+    return AK_OK;
+}
+
+static bool vision_raster_view(const ak_crowd* crowd) {
+    return crowd->method == AK_CROWD_VISION && crowd->vision_view == AK_CROWD_VIEW_RASTER;
+}
+
 static char* align_up(void* p) { return (char*)(((uintptr_t)p + 15u) & ~(uintptr_t)15u); }
 
 size_t ak_crowd_step_scratch_size(const ak_crowd_step_job* job) {
@@ -1542,14 +1751,22 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     for (size_t i = 0; i < n; ++i) pref[i] = pref_velocity(job, &crowd->agents[i], i, job->positions.ptr[i]);
     c.pref = pref;
     worker w[64];
+    vision_raster vrs[64];
+    const bool raster = vision_raster_view(crowd);
+    if (raster) {
+        const ak_result mr = vision_rasters_make(crowd, vrs, threads);
+        if (mr != AK_OK) return mr;
+    }
     char* tb = base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref;
     for (uint32_t t = 0; t < threads; ++t) {
         w[t].c = &c;
         w[t].begin = n * t / threads;
         w[t].end = n * (t + 1) / threads;
         carve_worker(crowd, tb + (size_t)t * L.per_thread, &w[t]);
+        w[t].vr = raster ? &vrs[t] : NULL;
     }
     run_threads(work, w, threads);
+    if (raster) vision_rasters_free(crowd, vrs, threads);
     if (job->allow_overlap) {
         /* RVO2's behaviour, with at most contact_iterations passes after it (0: pure ORCA) */
         for (uint32_t it = 0; it < job->contact_iterations; ++it) {
@@ -1627,6 +1844,71 @@ size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd
     for (size_t k = 0; k < nl && k < out_lines.count && out_lines.ptr; ++k) out_lines.ptr[k] = w.lines[k];
     if (out_obstacle_line_count) *out_obstacle_line_count = no;
     return nl;
+}
+
+size_t ak_crowd_agent_view(const ak_crowd_step_job* job, size_t index, ak_u32_span out_object,
+                           ak_f32_span out_distance) {
+    if (ak_crowd_step_validate(job) != AK_OK || index >= job->crowd->agent_count) return 0;
+    const ak_crowd* crowd = job->crowd;
+    const uint32_t W = crowd->vision_width;
+    if (crowd->method != AK_CROWD_VISION || (out_object.count && (!out_object.ptr || out_object.count < W)) ||
+        (out_distance.count && (!out_distance.ptr || out_distance.count < W)))
+        return 0;
+    layout L;
+    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), contact_need(job), !job->allow_overlap, &L);
+    char* base = align_up(job->scratch.ptr);
+    ak_grid grid;
+    ctx c = {.job = job, .crowd = crowd};
+    if (search_grid(&c, &L, base, &grid) != AK_OK) return 0;
+    /* the preferred velocity as the step computes it (this agent's only: the heading needs it) */
+    const ak_vec2 p = job->positions.ptr[index], v = job->velocities.ptr[index];
+    const ak_crowd_agent* a = &crowd->agents[index];
+    uint32_t wp_saved = job->waypoints.ptr[index];
+    const ak_vec2 pref = pref_velocity(job, a, index, p);
+    job->waypoints.ptr[index] = wp_saved; /* a view changes no state */
+    worker w;
+    w.c = &c;
+    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref, &w);
+    const uint32_t na = agent_neighbors(&c, index, p, a, w.agent_n);
+    const uint32_t no = crowd->vertex_count ? obstacle_neighbors(crowd, p, a, w.obst_n) : 0;
+    const ak_vec2 head = vision_heading(v, pref);
+    for (uint32_t k = 0; k < W; ++k) {
+        if (out_object.count) out_object.ptr[k] = UINT32_MAX;
+        if (out_distance.count) out_distance.ptr[k] = INFINITY;
+    }
+    if (crowd->vision_view == AK_CROWD_VIEW_RASTER) {
+        vision_raster vr;
+        if (vision_rasters_make(crowd, &vr, 1) != AK_OK) return 0;
+        w.vr = &vr;
+        const bool ok = vision_render(&w, &vr, p, head, na, no);
+        for (uint32_t y = 0; ok && y < crowd->vision_height; ++y)
+            for (uint32_t x = 0; x < W; ++x) {
+                ak_vec2 rp, d;
+                const uint32_t id = vision_raster_pixel(crowd, &vr, head, x, y, &rp, &d);
+                if (id == 0 || id > na + no) continue;
+                const uint32_t k = W - 1 - x; /* image x grows to the agent's right; column 0 is its right */
+                const float dist = len(rp);
+                if (out_distance.count && !(dist < out_distance.ptr[k])) continue;
+                if (out_distance.count) out_distance.ptr[k] = dist;
+                if (out_object.count)
+                    out_object.ptr[k] = id <= na ? nkey_index(w.agent_n[id - 1])
+                                                 : (uint32_t)crowd->agent_count + w.obst_n[id - 1 - na].index;
+            }
+        vision_rasters_free(crowd, &vr, 1);
+        return ok ? W : 0;
+    }
+    const float theta = atan2f(head.y, head.x);
+    for (uint32_t k = 0; k < W; ++k) {
+        const float ang = theta + crowd->vision_fov * (0.5f - ((float)k + 0.5f) / (float)W);
+        const ak_vec2 d = v2(cosf(ang), sinf(ang));
+        ak_vec2 ovel;
+        bool agent;
+        uint32_t object;
+        const float best = vision_cast(&w, p, d, na, no, &ovel, &agent, &object);
+        if (out_object.count) out_object.ptr[k] = object;
+        if (out_distance.count) out_distance.ptr[k] = best;
+    }
+    return W;
 }
 
 /* ---- measures ------------------------------------------------------------------------------- */

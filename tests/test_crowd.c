@@ -360,19 +360,21 @@ AK_TEST(presets_24_home_apart) {
 }
 
 
-/* Vision-based steering: head-on and four crossing reach their goals, keeping 0.2 m apart. */
+/* Vision-based steering: head-on and four crossing reach their goals, keeping 0.2 m apart,
+ * with either view (the ray cast, the rasterizer's). */
 AK_TEST(vision_head_on_and_crossing) {
     const ak_vec2 s2[2] = {{-5, 0}, {5, 0}}, s4[4] = {{-6, 0}, {6, 0}, {0, -6}, {0, 6}};
-    for (int which = 0; which < 2; ++which) {
-        const size_t n = which == 0 ? 2 : 4;
-        const ak_vec2* start = which == 0 ? s2 : s4;
+    for (int which = 0; which < 4; ++which) {
+        const ak_crowd_view view = which < 2 ? AK_CROWD_VIEW_RAYCAST : AK_CROWD_VIEW_RASTER;
+        const size_t n = which % 2 == 0 ? 2 : 4;
+        const ak_vec2* start = which % 2 == 0 ? s2 : s4;
         ak_vec2 goal[4];
         ak_crowd_agent ag[4];
         for (size_t i = 0; i < n; ++i) {
             goal[i] = (ak_vec2){-start[i].x, -start[i].y};
             ag[i] = (ak_crowd_agent){.goals = {&goal[i], 1}};
         }
-        ak_crowd_desc desc = {.agents = {ag, n}, .method = AK_CROWD_VISION};
+        ak_crowd_desc desc = {.agents = {ag, n}, .method = AK_CROWD_VISION, .vision_view = view};
         run r;
         AK_CHECK(run_init(&r, &desc, start));
         AK_CHECK_EQ(run_steps(&r, 0.1f, 1, 600, true), AK_OK);
@@ -381,9 +383,163 @@ AK_TEST(vision_head_on_and_crossing) {
          * contact projection (a turn rate of the seen rate minus the threshold, the paper's
          * rule taken literally, left them touching: 0.0000 m) */
         AK_CHECK_MSG(r.min_clearance >= 0.2, "%zu agents: min clearance %g", n, r.min_clearance);
-        printf("  vision, %zu agents: %d steps, min clearance %.4f m\n", n, r.steps_done, r.min_clearance);
+        printf("  vision (%s), %zu agents: %d steps, min clearance %.4f m\n", view ? "raster" : "raycast", n,
+               r.steps_done, r.min_clearance);
         run_free(&r);
     }
+}
+
+/* The test's own ray cast in double: nearest hit of the ray from o along unit d on the discs
+ * (radius scaled by grow) and the segments; its object (agent index, n + first vertex) or
+ * UINT32_MAX, the distance in *t, and the runner-up's distance in *t2. */
+static uint32_t ref_cast(const ak_vec2* P, const float* R, size_t n, const ak_vec2* seg, size_t nseg, double ox,
+                         double oz, double dx, double dz, double grow, double* t, double* t2) {
+    uint32_t best = UINT32_MAX;
+    *t = *t2 = INFINITY;
+    for (size_t j = 0; j < n + nseg; ++j) {
+        double h = INFINITY;
+        if (j < n) {
+            const double mx = ox - P[j].x, mz = oz - P[j].y, r = R[j] * grow;
+            const double b = mx * dx + mz * dz, c = mx * mx + mz * mz - r * r, disc = b * b - c;
+            if (c > 0.0 && b < 0.0 && disc >= 0.0) h = -b - sqrt(disc);
+        } else {
+            const ak_vec2 a = seg[2 * (j - n)], e = {seg[2 * (j - n) + 1].x - a.x, seg[2 * (j - n) + 1].y - a.y};
+            const double den = dx * e.y - dz * e.x;
+            if (fabs(den) > 1e-12) {
+                const double ax = a.x - ox, az = a.y - oz;
+                const double tt = (ax * e.y - az * e.x) / den, u = (ax * dz - az * dx) / den;
+                if (tt > 0.0 && u >= 0.0 && u <= 1.0) h = tt;
+            }
+        }
+        if (h < *t) {
+            *t2 = *t;
+            *t = h;
+            best = j < n ? (uint32_t)j : (uint32_t)(n + 2 * (j - n)); /* a segment's vertices: 2 each */
+        } else if (h < *t2) {
+            *t2 = h;
+        }
+    }
+    return best;
+}
+
+/* The views (ak_crowd_agent_view) against the test's own ray cast in double, on random small
+ * scenes (every agent and wall within the neighbour ranges): per column the nearest object
+ * and its distance on the ground. RAYCAST at its columns' angles (exact up to float);
+ * RASTER (raster.h, 48 x 8) at its planar projection's column angles: the same object and
+ * the distance between the disc's and the circumscribed circle's hits (the octagonal prism
+ * lies between them), columns where that slack or a near runner-up leaves the object open
+ * skipped (the pixel quantisation), but at most a quarter of the columns that see anything. */
+AK_TEST(vision_raster_view_vs_raycast) {
+    uint32_t seed = 12345u;
+#define RND() ((seed = seed * 1664525u + 1013904223u) >> 8) * (1.0 / 16777216.0)
+    size_t compared[2] = {0, 0}, skipped[2] = {0, 0};
+    double worst[2] = {0, 0}; /* largest distance outside [disc hit (RASTER: circumscribed), disc hit] */
+    for (int scene = 0; scene < 24; ++scene) {
+        enum { N = 7, NS = 2, W = 48 };
+        ak_vec2 P[N], V[N], goal[N], seg[2 * NS];
+        float R[N];
+        ak_crowd_agent ag[N];
+        size_t n = 0;
+        for (int tries = 0; n < N && tries < 1000; ++tries) {
+            const float qx = (float)(RND() * 10.0 - 5.0); /* two statements: a fixed order */
+            const ak_vec2 q = {qx, (float)(RND() * 10.0 - 5.0)};
+            const float r = (float)(0.2 + 0.2 * RND());
+            bool ok = true;
+            for (size_t j = 0; j < n; ++j)
+                ok = ok && hypot(q.x - P[j].x, q.y - P[j].y) > r + R[j] + 0.1;
+            if (!ok) continue;
+            P[n] = q, R[n] = r;
+            const double a = RND() * 6.283185307;
+            V[n] = (ak_vec2){(float)cos(a), (float)sin(a)};
+            goal[n] = (ak_vec2){0, 0};
+            ag[n] = (ak_crowd_agent){.radius = r, .neighbor_distance = 30, .max_neighbors = 64,
+                                     .time_horizon_obstacles = 20, .goals = {&goal[n], 1}};
+            ++n;
+        }
+        /* two walls 5.5-7 m from the centre, 0.5 m or more from every agent (the RASTER
+         * camera's near plane is 0.1 m) */
+        ak_crowd_obstacle ob[NS];
+        for (int k = 0; k < NS;) {
+            const double a = RND() * 6.283185307, d = 5.5 + 1.5 * RND(), l = 2.0 + 4.0 * RND();
+            const double cx = d * cos(a), cz = d * sin(a), tx = -sin(a), tz = cos(a);
+            seg[2 * k] = (ak_vec2){(float)(cx - l * tx), (float)(cz - l * tz)};
+            seg[2 * k + 1] = (ak_vec2){(float)(cx + l * tx), (float)(cz + l * tz)};
+            bool clear = true;
+            for (size_t j = 0; j < n; ++j) { /* distance of agent j to the wall's line, within its length */
+                const double px = P[j].x - cx, pz = P[j].y - cz, along = px * tx + pz * tz;
+                const double off = fabs(px * tz - pz * tx);
+                clear = clear && !(fabs(along) < l + 0.5 + R[j] && off < 0.5 + R[j]);
+            }
+            if (!clear) continue;
+            ob[k] = (ak_crowd_obstacle){.vertices = {&seg[2 * k], 2}};
+            ++k;
+        }
+        for (int view = 0; view < 2; ++view) {
+            ak_crowd_desc desc = {.agents = {ag, n}, .obstacles = ob, .obstacle_count = NS,
+                                  .method = AK_CROWD_VISION, .vision_width = W,
+                                  .vision_view = view ? AK_CROWD_VIEW_RASTER : AK_CROWD_VIEW_RAYCAST};
+            run r;
+            AK_CHECK(run_init(&r, &desc, P));
+            memcpy(r.v, V, n * sizeof *V);
+            ak_crowd_step_job job = run_job(&r, 0.1f, 1);
+            for (size_t i = 0; i < n; ++i) {
+                uint32_t obj[W];
+                float dist[W];
+                AK_CHECK_EQ(ak_crowd_agent_view(&job, i, (ak_u32_span){obj, W}, (ak_f32_span){dist, W}), (size_t)W);
+                const double hx = V[i].x / hypot(V[i].x, V[i].y), hz = V[i].y / hypot(V[i].x, V[i].y);
+                const double fov = 150.0 * 3.14159265358979 / 180.0;
+                size_t seen = 0, skip = 0;
+                for (int k = 0; k < W; ++k) {
+                    const double ang = view ? atan(tan(0.5 * fov) * (1.0 - 2.0 * (k + 0.5) / W))
+                                            : fov * (0.5 - (k + 0.5) / W);
+                    const double dx = hx * cos(ang) - hz * sin(ang), dz = hx * sin(ang) + hz * cos(ang);
+                    /* the agent itself is not in the view: cast among the others */
+                    ak_vec2 Po[N];
+                    float Ro[N];
+                    size_t m = 0;
+                    for (size_t j = 0; j < n; ++j)
+                        if (j != i) Po[m] = P[j], Ro[m] = R[j], ++m;
+                    double t, t2, tg, tg2;
+                    const double grow = view ? 1.0 / cos(3.14159265358979 / AK_CROWD_VISION_PRISM_SIDES) : 1.0 + 1e-4;
+                    uint32_t o = ref_cast(Po, Ro, m, seg, NS, P[i].x, P[i].y, dx, dz, 1.0, &t, &t2);
+                    const uint32_t og = ref_cast(Po, Ro, m, seg, NS, P[i].x, P[i].y, dx, dz, grow, &tg, &tg2);
+                    if (o != UINT32_MAX) o = o < m ? (uint32_t)(o + (o >= i)) : (uint32_t)(n + (o - m));
+                    const uint32_t ogi = og == UINT32_MAX ? og : (og < m ? (uint32_t)(og + (og >= i)) : (uint32_t)(n + (og - m)));
+                    if (o != UINT32_MAX || ogi != UINT32_MAX) ++seen;
+                    /* open: the disc and its slack disagree, or a runner-up within the slack */
+                    if (o != ogi || (o != UINT32_MAX && tg2 < t + 0.05)) {
+                        ++skip;
+                        continue;
+                    }
+                    /* a segment's two edges (a->b, b->a) are one wall: either vertex */
+                    const bool same = obj[k] == o || (o >= n && o != UINT32_MAX && obj[k] == o + 1);
+                    AK_CHECK_MSG(same, "scene %d view %d agent %zu column %d: object %u, reference %u", scene, view, i,
+                                 k, obj[k], o);
+                    if (o == UINT32_MAX) continue;
+                    /* RASTER: plus the float depth buffer's quantisation (near plane 0.1 m: about
+                     * 6e-7 z^2 m per ulp of depth) and the vertices' snap to 1/256 pixel (the
+                     * column's angular width over 256 at the distance, times up to 8 for a
+                     * face seen obliquely) */
+                    const double colw = fabs(atan(tan(0.5 * fov) * (1.0 - 2.0 * k / W)) -
+                                             atan(tan(0.5 * fov) * (1.0 - 2.0 * (k + 1.0) / W)));
+                    const double q = 1e-4 * t + (view ? 1e-3 + 1e-5 * t * t + t * colw / 32.0 : 1e-4);
+                    const double lo = (view ? tg : t) - q, hi = t + q;
+                    AK_CHECK_MSG(dist[k] >= lo && dist[k] <= hi, "scene %d view %d agent %zu column %d: distance %g, reference %g..%g",
+                                 scene, view, i, k, dist[k], lo, hi);
+                    ++compared[view];
+                    worst[view] = fmax(worst[view], dist[k] > t ? dist[k] - t : (view ? fmax(tg - dist[k], 0.0) : t - dist[k]));
+                }
+                AK_CHECK_MSG(skip * 4 <= seen + 4, "view %d: %zu of %zu columns open", view, skip, seen);
+                skipped[view] += skip;
+            }
+            run_free(&r);
+        }
+    }
+#undef RND
+    printf("  views vs the test's ray cast: raycast %zu columns compared (%zu open), worst %.2g m; raster %zu (%zu "
+           "open), worst %.2g m outside its prism's slack\n",
+           compared[0], skipped[0], worst[0], compared[1], skipped[1], worst[1]);
+    AK_CHECK(compared[0] > 2000 && compared[1] > 2000);
 }
 
 /* Vision-based steering on a preset with n agents, on 1 and 2 threads, for the preset's default
@@ -749,14 +905,15 @@ AK_TEST(threads_bit_identical) {
         goal[i] = (ak_vec2){lcg(&seed) * 60.0f, lcg(&seed) * 60.0f};
         ag[i] = (ak_crowd_agent){.goals = {&goal[i], 1}};
     }
-    for (int method = 0; method < 2; ++method) { /* ORCA, then vision */
-        ak_crowd_desc desc = {.agents = {ag, N}, .method = method ? AK_CROWD_VISION : AK_CROWD_ORCA};
+    for (int method = 0; method < 3; ++method) { /* ORCA, then vision (ray cast, raster view) */
+        ak_crowd_desc desc = {.agents = {ag, N}, .method = method ? AK_CROWD_VISION : AK_CROWD_ORCA,
+                              .vision_view = method == 2 ? AK_CROWD_VIEW_RASTER : AK_CROWD_VIEW_RAYCAST};
         run a, b;
         AK_CHECK(run_init(&a, &desc, start));
         AK_CHECK(run_init(&b, &desc, start));
         a.contacts = b.contacts = 2;
-        AK_CHECK_EQ(run_steps(&a, 0.1f, 1, method ? 10 : 20, false), AK_OK);
-        AK_CHECK_EQ(run_steps(&b, 0.1f, 2, method ? 10 : 20, false), AK_OK);
+        AK_CHECK_EQ(run_steps(&a, 0.1f, 1, method == 2 ? 4 : method ? 10 : 20, false), AK_OK);
+        AK_CHECK_EQ(run_steps(&b, 0.1f, 2, method == 2 ? 4 : method ? 10 : 20, false), AK_OK);
         AK_CHECK(memcmp(a.p, b.p, N * sizeof(ak_vec2)) == 0);
         AK_CHECK(memcmp(a.v, b.v, N * sizeof(ak_vec2)) == 0);
         AK_CHECK(memcmp(a.wp, b.wp, N * sizeof(uint32_t)) == 0);
@@ -815,6 +972,16 @@ AK_TEST(validation) {
     d.vision_width = 1025;
     AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_ERR_BAD_ARG);
     d.vision_width = 0;
+    d.vision_view = AK_CROWD_VIEW_COUNT;
+    AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d.vision_view = AK_CROWD_VIEW_RASTER;
+    d.vision_height = 257;
+    AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d.vision_height = 0;
+    d.vision_fov = 180.0f; /* a planar projection: under 180 */
+    AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_ERR_BAD_ARG);
+    d.vision_fov = 0.0f;
+    d.vision_view = AK_CROWD_VIEW_RAYCAST;
     d.method = AK_CROWD_ORCA;
     AK_CHECK_EQ(ak_crowd_create(&d, NULL, &c), AK_OK);
     const ak_crowd_agent r = ak_crowd_agent_get(c, 0);
@@ -906,6 +1073,7 @@ AK_TEST(scene_defaults_and_bytes) {
     AK_CHECK_EQ(s.steps, 1000);
     AK_CHECK_EQ(s.contact_iterations, 8u);
     AK_CHECK_EQ(s.method, AK_CROWD_ORCA);
+    AK_CHECK_EQ(s.vision_view, AK_CROWD_VIEW_RAYCAST);
     AK_CHECK_NEAR(s.duration, 0.0f, 0.0f);
     AK_CHECK(s.agents == NULL && s.agent_count == 0 && s.obstacle_count == 0);
     AK_CHECK_NEAR(s.defaults.radius, 0.3f, 0.0f);
@@ -917,7 +1085,8 @@ AK_TEST(scene_defaults_and_bytes) {
     AK_CHECK_NEAR(s.defaults.time_horizon_obstacles, 2.0f, 0.0f);
     AK_CHECK_NEAR(s.defaults.waypoint_radius, 0.0f, 0.0f); /* 0: each agent's radius */
 
-    const char* text = "{\"dt\": 0.05, \"steps\": 321, \"method\": \"vision\", \"contact_iterations\": 3,"
+    const char* text = "{\"dt\": 0.05, \"steps\": 321, \"method\": \"vision\", \"vision_view\": \"raster\","
+                       " \"contact_iterations\": 3,"
                        " \"agent_defaults\": {\"radius\": 0.4, \"max_neighbors\": 7},"
                        " \"obstacles\": [{\"vertices\": [[5, 5], [6, 5], [6, 6]]}, {\"vertices\": [[-9, 2], [-9, 3]]}],"
                        " \"agents\": [{\"position\": [1, 2], \"velocity\": [0.5, -0.25], \"goal\": [3, 4], \"group\": 7},"
@@ -927,6 +1096,7 @@ AK_TEST(scene_defaults_and_bytes) {
     AK_CHECK_NEAR(s.dt, 0.05f, 0.0f);
     AK_CHECK_EQ(s.steps, 321);
     AK_CHECK_EQ(s.method, AK_CROWD_VISION);
+    AK_CHECK_EQ(s.vision_view, AK_CROWD_VIEW_RASTER);
     AK_CHECK_EQ(s.contact_iterations, 3u);
     AK_CHECK_EQ(s.obstacle_count, 2u);
     AK_CHECK_EQ(s.vertex_count, 5u);
@@ -977,6 +1147,24 @@ AK_TEST(scene_defaults_and_bytes) {
     AK_CHECK_EQ(s.steps, 400);
     if (s.agent_count == 6) AK_CHECK_NEAR(s.agents[5].radius, 0.25f, 0.0f);
     ak_crowd_scene_free(&s);
+    /* the random-start corridors of docs/crowd.md ("Lanes"): every agent inside the 8 m
+     * corridor, 0.75 m apart at least, the groups alternating */
+    const char* const files[2] = {AK_SOURCE_DIR "/examples/crowd_corridor_jitter.json",
+                                  AK_SOURCE_DIR "/examples/crowd_corridor_mixed.json"};
+    for (int f = 0; f < 2; ++f) {
+        ak_crowd_scene_defaults(&s);
+        AK_CHECK_EQ(ak_crowd_scene_load_file(files[f], &s, &d), AK_OK);
+        AK_CHECK_EQ(s.agent_count, f ? 200u : 100u);
+        AK_CHECK_EQ(s.obstacle_count, 2u);
+        double closest = INFINITY;
+        for (size_t i = 0; i < s.agent_count; ++i) {
+            AK_CHECK(fabsf(s.positions[i].y) <= 3.4f && s.group[i] == i % 2);
+            for (size_t j = 0; j < i; ++j)
+                closest = fmin(closest, hypot(s.positions[i].x - s.positions[j].x, s.positions[i].y - s.positions[j].y));
+        }
+        AK_CHECK_MSG(closest >= 0.7499, "%s: closest start pair %g m", files[f], closest);
+        ak_crowd_scene_free(&s);
+    }
 }
 
 /* Every error names the file and the key path, as one line. */
@@ -1148,6 +1336,7 @@ int main(void) {
     AK_RUN(groups_crossing);
     AK_RUN(obstacle_square);
     AK_RUN(vision_head_on_and_crossing);
+    AK_RUN(vision_raster_view_vs_raycast);
     AK_RUN_HEAVY(vision_presets_home); /* valgrind: 8 s; vision_head_on_and_crossing steps the same code */
     AK_RUN(lp_vs_brute_force);
     AK_RUN(step_velocity_is_lp_optimum);

@@ -25,6 +25,8 @@ AK_TEST(usage) {
     AK_CHECK_EQ(run("crowd -o out.txt", true), 2);
     AK_CHECK_EQ(run("crowd --method rvo", true), 2);
     AK_CHECK(strstr(out_buf, "orca or vision") != NULL);
+    AK_CHECK_EQ(run("crowd --vision-view gl", true), 2);
+    AK_CHECK(strstr(out_buf, "raycast or raster") != NULL);
     AK_CHECK_EQ(run("crowd --preset stadium", true), 2);
     AK_CHECK(strstr(out_buf, "circle, crossing, corridor, evacuation") != NULL);
     AK_CHECK_EQ(run("crowd a.json b.json", true), 2);
@@ -70,6 +72,7 @@ AK_TEST(bad_scenes_name_the_key) {
         {"{\"obstacles\": [{\"vertices\": [[0, 0], [1, 0], [1, 0]]}]}", "obstacles[0].vertices[2]"},
         {"{\"agents\": [{\"position\": [0, 0], \"goal\": [1, 0], \"pref_speed\": 0}]}", "agents[0].pref_speed"},
         {"{\"method\": \"rvo\"}", "method"},
+        {"{\"vision_view\": \"gl\"}", "vision_view"},
         {"{\"contact_iterations\": 65}", "contact_iterations"},
         {"{\"dt\": 0}", "dt"},
         {"{\"steps\": 1.5}", "steps"},
@@ -157,6 +160,21 @@ AK_TEST(vision_head_on) {
     AK_CHECK_EQ(run("crowd crowd_two_v.json --steps 120 --json crowd_two_v_out.json", true), 0);
     char* a = strdup(read_file("crowd_two_vision.json"));
     AK_CHECK(a && strcmp(a, read_file("crowd_two_v_out.json")) == 0);
+    free(a);
+    /* the raster view (--vision-view, and "vision_view" in the file: the same run) */
+    AK_CHECK_EQ(run("crowd crowd_two.json --method vision --vision-view raster --steps 120 --json crowd_two_r.json", true),
+                0);
+    j = check_contract("crowd_two_r.json", 2, 12.0);
+    if (!j) return;
+    AK_CHECK(all_home(j));
+    AK_CHECK(cJSON_GetObjectItem(j, "min_distance")->valuedouble >= -1e-3);
+    AK_CHECK_EQ(cJSON_GetObjectItem(j, "collisions")->valueint, 0);
+    cJSON_Delete(j);
+    write_file("crowd_two_rv.json", "{\"method\": \"vision\", \"vision_view\": \"raster\", \"agents\": [{\"position\":"
+                                    " [-3, 0], \"goal\": [3, 0]}, {\"position\": [3, 0], \"goal\": [-3, 0]}]}");
+    AK_CHECK_EQ(run("crowd crowd_two_rv.json --steps 120 --json crowd_two_rv_out.json", true), 0);
+    a = strdup(read_file("crowd_two_r.json"));
+    AK_CHECK(a && strcmp(a, read_file("crowd_two_rv_out.json")) == 0);
     free(a);
 }
 

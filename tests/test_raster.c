@@ -212,6 +212,66 @@ static ak_raster_mesh unlit_tri(const ak_vec3* p, ak_vec4 color) {
     return m;
 }
 
+/* ak_raster_read_samples: UNLIT per-vertex colours that are exact bytes come back exactly (an
+ * id channel), and the depth, turned into the distance along the view axis by the header's
+ * formula, matches the plane z = -x/2 hit by each sample's ray (closed form, double). */
+AK_TEST(read_samples_ids_and_depth) {
+    const int W = 16, H = 12, SS = 2, SW = W * SS, SH = H * SS;
+    ak_raster* r = NULL;
+    AK_CHECK_EQ(ak_raster_create(&(ak_raster_desc){.width = W, .height = H, .supersample = SS}, NULL, &r), AK_OK);
+    const float n = 0.1f, f = 10.0f, fovy = ak_radians(60), aspect = (float)W / (float)H;
+    ak_raster_camera cam = ak_raster_camera_perspective(ak_vec3_make(0, 0, 3), ak_vec3_zero(), fovy, aspect, n, f);
+    ak_raster_clear(r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+    const ak_vec3 pos[6] = {{-1, -1, 0.5f}, {1, -1, -0.5f}, {1, 1, -0.5f}, {-1, -1, 0.5f}, {1, 1, -0.5f}, {-1, 1, 0.5f}};
+    const uint8_t id[3] = {17, 200, 3};
+    ak_vec4 col[6];
+    for (int k = 0; k < 6; ++k) col[k] = ak_vec4_make(id[0] / 255.0f, id[1] / 255.0f, id[2] / 255.0f, 1);
+    ak_raster_mesh m = {.positions = {pos, 6}, .colors = {col, 6}, .material = {.color = {1, 1, 1, 1}},
+                        .shading = AK_SHADING_UNLIT};
+    AK_CHECK_EQ(ak_raster_draw_mesh(r, &cam, &m), AK_OK);
+    uint8_t* rgba = malloc((size_t)SW * SH * 4);
+    float* depth = malloc((size_t)SW * SH * sizeof(float));
+    AK_CHECK(rgba && depth);
+    AK_CHECK_EQ(ak_raster_read_samples(NULL, (ak_u8_span){rgba, (size_t)SW * SH * 4}, (ak_f32_span){0}), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_raster_read_samples(r, (ak_u8_span){rgba, (size_t)SW * SH * 4 - 1}, (ak_f32_span){0}),
+                AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_raster_read_samples(r, (ak_u8_span){0}, (ak_f32_span){depth, (size_t)SW * SH - 1}), AK_ERR_SPAN_SMALL);
+    AK_CHECK_EQ(ak_raster_read_samples(r, (ak_u8_span){NULL, 4}, (ak_f32_span){0}), AK_ERR_NULL_ARG);
+    AK_CHECK_EQ(ak_raster_read_samples(r, (ak_u8_span){rgba, (size_t)SW * SH * 4}, (ak_f32_span){depth, (size_t)SW * SH}),
+                AK_OK);
+    const double ty = tan(0.5 * fovy), tx = ty * aspect;
+    int covered = 0, background = 0;
+    double worst = 0.0;
+    for (int y = 0; y < SH; ++y)
+        for (int x = 0; x < SW; ++x) {
+            const uint8_t* c = rgba + 4 * ((size_t)y * SW + x);
+            const float d = depth[(size_t)y * SW + x];
+            const double xn = 2.0 * (x + 0.5) / SW - 1.0, yn = 1.0 - 2.0 * (y + 0.5) / SH;
+            /* the sample's ray eye + s (xn tx, yn ty, -1) meets the plane z = -x / 2 at s */
+            const double s = 3.0 / (1.0 - 0.5 * xn * tx), hx = s * xn * tx, hy = s * yn * ty;
+            const bool inside = fabs(hx) < 0.99 && fabs(hy) < 0.99, outside = fabs(hx) > 1.01 || fabs(hy) > 1.01;
+            if (c[0] == 0 && c[1] == 0 && c[2] == 0) {
+                AK_CHECK_MSG(!inside, "sample %d %d inside the quad not drawn", x, y);
+                AK_CHECK(d == 1.0f);
+                ++background;
+                continue;
+            }
+            AK_CHECK_MSG(!outside, "sample %d %d outside the quad drawn", x, y);
+            AK_CHECK_MSG(c[0] == id[0] && c[1] == id[1] && c[2] == id[2] && c[3] == 255, "sample %d %d: %d %d %d %d", x, y,
+                         c[0], c[1], c[2], c[3]);
+            const double z = 2.0 * n * f / (f + n - (2.0 * d - 1.0) * (f - n));
+            worst = fmax(worst, fabs(z - s) / s);
+            ++covered;
+        }
+    printf("  %d samples covered (id bytes exact), %d background; depth -> distance worst relative error %.2g\n",
+           covered, background, worst);
+    AK_CHECK(covered > 100 && background > 10);
+    AK_CHECK_MSG(worst < 1e-4, "worst %g", worst);
+    free(rgba);
+    free(depth);
+    ak_raster_destroy(r);
+}
+
 AK_TEST(depth_test_orders_by_distance) {
     target t;
     AK_CHECK(target_make(&t, 32, 32, 1, 1));
@@ -1160,6 +1220,7 @@ int main(void) {
     AK_RUN(coverage_matches_point_in_triangle);
     AK_RUN(shared_edges_quad_and_fan_cover_once);
     AK_RUN(depth_test_orders_by_distance);
+    AK_RUN(read_samples_ids_and_depth);
     AK_RUN(near_plane_crossing_triangle_is_clipped_not_dropped);
     AK_RUN(cube_corners_where_projection_puts_them);
     AK_RUN(perspective_correct_interpolation);

@@ -17,7 +17,9 @@
 //                        spinning of one library's threads is charged to the other's rounds.
 //   vs_rvo2 vision [N...] animkit's vision-based steering (default view: 48 pixels over 150
 //                        degrees) beside its ORCA on the same block, 1 thread, rounds
-//                        alternating: agents per second of each (default N: 1000, 10000).
+//                        alternating: agents per second of each (default N: 1000, 10000);
+//                        then vision's two views alternating, the ray cast and the raster
+//                        view (raster.h, 48 x 8 pixels, ak_crowd_desc.vision_view).
 //
 // RVO2 is linked from ../shared/peers/rvo2 (Apache-2.0), never copied into animkit.
 #include <algorithm>
@@ -113,7 +115,9 @@ struct Ak {
     std::vector<uint32_t> wp;
     std::vector<uint8_t> scratch;
     ak_crowd_step_job job;
-    Ak(const Scenario& s, uint32_t threads, ak_crowd_method method = AK_CROWD_ORCA) : n(s.start.size()) {
+    Ak(const Scenario& s, uint32_t threads, ak_crowd_method method = AK_CROWD_ORCA,
+       ak_crowd_view view = AK_CROWD_VIEW_RAYCAST)
+        : n(s.start.size()) {
         std::vector<ak_crowd_agent> ag(n);
         for (size_t i = 0; i < n; ++i) {
             ag[i] = ak_crowd_agent{};
@@ -130,6 +134,7 @@ struct Ak {
         d.agents.ptr = ag.data();
         d.agents.count = n;
         d.method = method;
+        d.vision_view = view;
         if (ak_crowd_create(&d, nullptr, &crowd) != AK_OK) std::abort();
         p = s.start;
         v.assign(n, ak_vec2{0, 0});
@@ -310,6 +315,17 @@ void time_vision(size_t n) {
                 "(%.3f M agents/s)  vision/ORCA time %.2fx  [ranges %.3f-%.3f, %.3f-%.3f]\n",
                 n, 1e3 * mo, 1e-6 * static_cast<double>(n) / mo, 1e3 * mv, 1e-6 * static_cast<double>(n) / mv, mv / mo,
                 1e3 * to.front(), 1e3 * to.back(), 1e3 * tv.front(), 1e3 * tv.back());
+    std::fflush(stdout);
+    // the two views of vision, alternating: the ray cast and the rasterizer's 48 x 8 image
+    Ak ray(s, 1, AK_CROWD_VISION), ras(s, 1, AK_CROWD_VISION, AK_CROWD_VIEW_RASTER);
+    const Alternated u = alternate(ray, ras, rounds, per, cpu_now);
+    const std::vector<double>&ur = u.cpu_a, &us = u.cpu_b;  // this thread's CPU time
+    const double mr = ur[ur.size() / 2], ms = us[us.size() / 2];
+    std::printf("%8zu agents 1 thread : CPU time: vision raycast view (48 px) %8.3f ms/step (%.3f M agents/s)  raster view "
+                "(48 x 8 px) %8.3f ms/step (%.4f M agents/s)  raster/raycast time %.2fx  [ranges %.3f-%.3f, "
+                "%.3f-%.3f]\n",
+                n, 1e3 * mr, 1e-6 * static_cast<double>(n) / mr, 1e3 * ms, 1e-6 * static_cast<double>(n) / ms, ms / mr,
+                1e3 * ur.front(), 1e3 * ur.back(), 1e3 * us.front(), 1e3 * us.back());
     std::fflush(stdout);
 }
 

@@ -33,8 +33,10 @@
  *   - AK_CROWD_VISION instead: synthetic-vision steering (Ondrej, Pettre, Olivier, Donikian,
  *     "A synthetic-vision based steering approach for crowd simulation", SIGGRAPH 2010): each
  *     agent casts vision_width rays over vision_fov around its heading against its neighbours'
- *     discs and the obstacle edges (a direct per-pixel ray cast, not the rasterizer: it gives
- *     each pixel its object and hit point); per pixel, the time to interaction and the bearing
+ *     discs and the obstacle edges (a direct per-pixel ray cast: each pixel its object and hit
+ *     point), or with vision_view RASTER renders them with raster.h into a vision_width x
+ *     vision_height image (prisms and walls, object ids as flat colours, hit points from the
+ *     depth); per pixel, the time to interaction and the bearing
  *     angle's rate; pixels whose |rate| is below the paper's threshold 0.6 ttc^-1.5 are
  *     threats; the agent turns toward its goal unless that leaves a threat under the
  *     threshold, then by the smallest heading change that lifts the rates over it (keeping
@@ -77,7 +79,8 @@
  * by threads. The state (positions, velocities, waypoint indices) is caller-owned: the step
  * job reads the inputs, writes the outputs (which must not alias the inputs) and advances
  * each agent's waypoint index in place. The step never allocates (scratch comes from the
- * caller); thread_count > 1 starts pthreads.
+ * caller), except a VISION crowd's RASTER view (a render target per thread, each step);
+ * thread_count > 1 starts pthreads.
  */
 #ifndef ANIMKIT_CROWD_H
 #define ANIMKIT_CROWD_H
@@ -115,6 +118,33 @@ typedef struct ak_crowd_obstacle {
     ak_vec2_cspan vertices; /* >= 2, ground (x, z) m */
 } ak_crowd_obstacle;
 
+/* How a VISION agent's view is made (ak_crowd_desc.vision_view). */
+typedef enum ak_crowd_view {
+    AK_CROWD_VIEW_RAYCAST = 0, /* default: a 1D view, vision_width rays at equal angles over
+                                  vision_fov, cast against the neighbours' discs and the
+                                  obstacle edges (exact hit points, no rasterizer) */
+    AK_CROWD_VIEW_RASTER,      /* the paper's way: raster.h renders each agent's surroundings
+                                  into a vision_width x vision_height image (see below) */
+    AK_CROWD_VIEW_COUNT
+} ak_crowd_view;
+
+/* The scene a RASTER view renders, per agent: a level perspective camera at its centre,
+ * AK_CROWD_VISION_EYE_HEIGHT above the ground, looking along its heading, vision_fov wide
+ * and AK_CROWD_VISION_VFOV degrees high (so every pixel of a column has the same bearing:
+ * column k looks along the heading turned by atan(tan(vision_fov / 2) (1 - 2 (k + 0.5) /
+ * vision_width)) from x toward z, column 0 the agent's right, the image's column
+ * vision_width - 1 - k; planar projection, so the columns are narrower toward the edges); each
+ * neighbour a vertical AK_CROWD_VISION_PRISM_SIDES-sided prism round its disc (faces
+ * touching the circle), AK_CROWD_VISION_AGENT_HEIGHT tall, each obstacle edge a wall
+ * AK_CROWD_VISION_WALL_HEIGHT tall, seen from both sides; no ground. Each object is drawn
+ * UNLIT in a flat colour that is its id, and each pixel's hit point comes from the depth
+ * buffer (ak_raster_read_samples); then the same per-pixel rule as the ray cast. */
+#define AK_CROWD_VISION_EYE_HEIGHT 1.6f   /* m */
+#define AK_CROWD_VISION_AGENT_HEIGHT 1.8f /* m */
+#define AK_CROWD_VISION_WALL_HEIGHT 2.5f  /* m */
+#define AK_CROWD_VISION_VFOV 80.0f        /* degrees (the paper's 80) */
+#define AK_CROWD_VISION_PRISM_SIDES 8u
+
 /* Avoidance method. */
 typedef enum ak_crowd_method {
     AK_CROWD_ORCA = 0, /* default: velocity-based (ORCA) */
@@ -130,9 +160,15 @@ typedef struct ak_crowd_desc {
     const ak_crowd_obstacle* obstacles;  /* optional: [obstacle_count] */
     uint32_t obstacle_count;
     ak_crowd_method method;              /* 0 -> ORCA */
-    uint32_t vision_width;               /* VISION: pixels of each agent's 1D view; 0 -> 48;
+    uint32_t vision_width;               /* VISION: pixels across each agent's view (RAYCAST:
+                                            the 1D view; RASTER: the image's width); 0 -> 48;
                                             <= 1024 */
-    float vision_fov;                    /* VISION: field of view, degrees; 0 -> 150; < 360 */
+    float vision_fov;                    /* VISION: field of view, degrees; 0 -> 150; < 360
+                                            (RASTER: < 180) */
+    ak_crowd_view vision_view;           /* VISION: 0 -> RAYCAST; RASTER renders with raster.h
+                                            (one render target per thread, allocated by each
+                                            step: the RASTER step allocates, RAYCAST never) */
+    uint32_t vision_height;              /* VISION RASTER: image rows; 0 -> 8; <= 256 */
 } ak_crowd_desc;
 
 typedef struct ak_crowd ak_crowd;
@@ -144,8 +180,8 @@ AK_API ak_crowd_agent ak_crowd_agent_resolved(const ak_crowd_agent* agent);
  * agents.ptr, an agent's goals.ptr, obstacles with obstacle_count > 0, an obstacle's
  * vertices), AK_ERR_EMPTY (no agents, an agent without waypoints), AK_ERR_BAD_ARG (a
  * parameter negative or not finite, max_speed < pref_speed, max_neighbors > 64, an obstacle
- * with fewer than 2 vertices, an unknown method, vision_width > 1024, vision_fov not in
- * [0, 360) or not finite, counts above the AK_CROWD_MAX_* limits),
+ * with fewer than 2 vertices, an unknown method or view, vision_width > 1024,
+ * vision_height > 256, vision_fov not in [0, 360) ([0, 180) for RASTER) or not finite, counts above the AK_CROWD_MAX_* limits),
  * AK_ERR_BAD_DATA (a NaN or infinite waypoint or vertex, or beyond 1e7 m; an obstacle edge
  * of zero length), AK_ERR_NO_MEMORY. */
 AK_API ak_result ak_crowd_create(const ak_crowd_desc* desc, const ak_allocator* alloc, ak_crowd** out_crowd);
@@ -245,7 +281,8 @@ AK_API ak_result ak_crowd_step_validate(const ak_crowd_step_job* job);
 
 /* One ORCA step for every agent: neighbours, half-planes, linear program, then
  * p_out = p + dt * v_out (then the contact passes, when asked). Validates first and writes nothing on failure; besides the
- * validation codes returns AK_ERR_BUDGET (cell load above max_cell_load). */
+ * validation codes returns AK_ERR_BUDGET (cell load above max_cell_load) and, for a VISION
+ * crowd with the RASTER view, AK_ERR_NO_MEMORY (its render targets). */
 AK_API ak_result ak_crowd_step_run(const ak_crowd_step_job* job);
 
 /* ---- the linear program (exposed for tests and tools) --------------------------------- */
@@ -265,6 +302,20 @@ AK_DEFINE_SPAN(crowd_line, ak_crowd_line)
  * for the step job (one thread). */
 AK_API size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd_line_span out_lines,
                                    size_t* out_obstacle_line_count);
+
+/* A VISION agent's view for the given state, per column (vision_width of them, column 0 the
+ * agent's right: RAYCAST column k along the heading turned by vision_fov (0.5 - (k + 0.5) /
+ * vision_width) from x toward z, RASTER as AK_CROWD_VISION_VFOV's comment says): the object the column
+ * sees nearest (an agent's index; agent_count + v for the obstacle edge from obstacle vertex
+ * v, vertices numbered over the obstacles in order; UINT32_MAX for nothing) and its hit
+ * point's distance on the ground from the agent's centre (INFINITY for nothing); RASTER: the
+ * nearest over the column's pixels. Among the objects the step looks at (the same neighbour
+ * selection), with the heading the step uses (the velocity's direction, or the preferred
+ * velocity's when standing). out_object / out_distance may be empty; else at least
+ * vision_width long. Returns the column count, 0 on a bad argument (validation, index out
+ * of range, not a VISION crowd, a span too small, no memory). scratch as for the step job. */
+AK_API size_t ak_crowd_agent_view(const ak_crowd_step_job* job, size_t index, ak_u32_span out_object,
+                                  ak_f32_span out_distance);
 
 /* Solve ORCA's program: the velocity closest to pref within |v| <= max_speed satisfying every
  * line; when none exists, the velocity minimising the largest violation of lines
@@ -338,6 +389,7 @@ typedef struct ak_crowd_scene {
                                      file sets "steps" */
     uint32_t contact_iterations;  /* default 8 */
     ak_crowd_method method;       /* default AK_CROWD_ORCA */
+    ak_crowd_view vision_view;    /* "vision_view": "raycast" (default) or "raster" */
 } ak_crowd_scene;
 
 /* The defaults of every key (the scene without a file: no agents, no obstacles); owns

@@ -179,6 +179,17 @@ AK_API void ak_raster_clear_depth(ak_raster* raster);
  * linear light. Returns AK_ERR_NULL_ARG or AK_ERR_BAD_ARG (size mismatch). */
 AK_API ak_result ak_raster_resolve(const ak_raster* raster, const ak_image* out);
 
+/* Copy the target's sample buffers out, unfiltered (width * supersample by height *
+ * supersample samples, rows top to bottom): out_color gets RGBA8 sRGB bytes (4 per sample),
+ * out_depth the depth per sample in [0, 1] (1: cleared, nothing drawn). Either span may be
+ * empty (not read). With UNLIT shading and per-vertex or material colours that are exact
+ * bytes (k / 255), opaque samples hold those bytes exactly: flat colours can carry integer ids
+ * (an id buffer; see crowd.h's raster view). Depth is NDC z * 0.5 + 0.5; for a perspective
+ * projection (near n, far f) the distance along the view axis is 2 n f / (f + n - (2 d - 1)
+ * (f - n)). Returns AK_ERR_NULL_ARG (raster NULL, or a non-empty span without ptr),
+ * AK_ERR_SPAN_SMALL (a non-empty span shorter than the sample count, times 4 for colour). */
+AK_API ak_result ak_raster_read_samples(const ak_raster* raster, ak_u8_span out_color, ak_f32_span out_depth);
+
 /* ---- lighting and materials ----------------------------------------------------------- */
 
 typedef enum ak_shading {

@@ -19,6 +19,7 @@ void ak_crowd_scene_defaults(ak_crowd_scene* s) {
     s->dt = 0.1f;
     s->contact_iterations = 8;
     s->method = AK_CROWD_ORCA;
+    s->vision_view = AK_CROWD_VIEW_RAYCAST;
 }
 
 /* The agents and their arrays (a file's "agents" replaces them). */
@@ -263,8 +264,8 @@ static double signed_area(const ak_vec2* p, size_t n) {
 
 /* The keys of root over s; false (j failed) on the first error. */
 static bool parse(akp_json* j, const cJSON* root, ak_crowd_scene* s) {
-    static const char* const keys[] = {"dt",     "steps",     "method", "contact_iterations", "agent_defaults",
-                                       "agents", "obstacles", NULL};
+    static const char* const keys[] = {"dt",     "steps",     "method",      "contact_iterations", "agent_defaults",
+                                       "agents", "obstacles", "vision_view", NULL};
     akp_json_object(j, root, "", keys);
     akp_json_float(j, root, "", "dt", 1e-4f, 10.0f, &s->dt);
     long steps = s->steps;
@@ -274,6 +275,10 @@ static bool parse(akp_json* j, const cJSON* root, ak_crowd_scene* s) {
     int method = (int)s->method;
     akp_json_enum(j, root, "", "method", methods, &method);
     s->method = (ak_crowd_method)method;
+    static const char* const views[] = {"raycast", "raster", NULL}; /* ak_crowd_view's order */
+    int view = (int)s->vision_view;
+    akp_json_enum(j, root, "", "vision_view", views, &view);
+    s->vision_view = (ak_crowd_view)view;
     long ci = (long)s->contact_iterations;
     akp_json_int(j, root, "", "contact_iterations", 0, 64, &ci);
     s->contact_iterations = (uint32_t)ci;

@@ -303,6 +303,16 @@ void ak_raster_clear_depth(ak_raster* raster) {
     for (size_t i = 0; i < n; ++i) raster->depth[i] = 1.0f;
 }
 
+ak_result ak_raster_read_samples(const ak_raster* raster, ak_u8_span out_color, ak_f32_span out_depth) {
+    if (!raster || (out_color.count && !out_color.ptr) || (out_depth.count && !out_depth.ptr)) return AK_ERR_NULL_ARG;
+    const size_t n = (size_t)raster->sw * (size_t)raster->sh;
+    if ((out_color.count && out_color.count < 4 * n) || (out_depth.count && out_depth.count < n))
+        return AK_ERR_SPAN_SMALL;
+    if (out_color.count) memcpy(out_color.ptr, raster->color, 4 * n);
+    if (out_depth.count) memcpy(out_depth.ptr, raster->depth, n * sizeof(float));
+    return AK_OK;
+}
+
 ak_result ak_raster_resolve(const ak_raster* raster, const ak_image* out) {
     if (!raster || !out || !out->pixels) return AK_ERR_NULL_ARG;
     if (out->width != raster->desc.width || out->height != raster->desc.height) return AK_ERR_BAD_ARG;
@@ -349,7 +359,7 @@ ak_raster_lighting ak_raster_lighting_resolved(const ak_raster_lighting* lightin
     return l;
 }
 
-static void setup_lighting(drawctx* dc, const ak_raster_lighting* lighting, ak_raster_material mat) {
+static void setup_lighting(drawctx* dc, const ak_raster_lighting* lighting, ak_raster_material mat, bool unlit) {
     ak_raster_lighting l = ak_raster_lighting_resolved(lighting);
     dc->key_l = ak_vec3_normalize(ak_vec3_neg(l.key_direction));
     dc->fill_l = ak_vec3_normalize(ak_vec3_neg(l.fill_direction));
@@ -364,6 +374,7 @@ static void setup_lighting(drawctx* dc, const ak_raster_lighting* lighting, ak_r
     dc->shininess = mat.shininess > 0.0f ? mat.shininess : 32.0f;
     if (!ak_finitef(dc->specular)) dc->specular = 0.25f;
     if (!ak_finitef(dc->shininess)) dc->shininess = 32.0f;
+    if (unlit) return; /* no specular term: skip the table (1,025 powf, most of a small draw's set-up) */
     for (int i = 0; i <= POW_LUT_SIZE; ++i)
         dc->pow_lut[i] = dc->specular * powf((float)i / POW_LUT_SIZE, dc->shininess);
 }
@@ -1346,8 +1357,8 @@ ak_result ak_raster_draw_mesh(ak_raster* raster, const ak_raster_camera* camera,
     dc.blend = mesh->blend == AK_BLEND_DEFAULT ? AK_BLEND_OPAQUE : mesh->blend;
     dc.depth_test = !mesh->no_depth_test;
     dc.depth_write = dc.blend == AK_BLEND_OPAQUE;
-    setup_lighting(&dc, mesh->lighting, mesh->material);
     ak_shading sh = mesh->shading == AK_SHADING_DEFAULT ? AK_SHADING_PHONG : mesh->shading;
+    setup_lighting(&dc, mesh->lighting, mesh->material, sh == AK_SHADING_UNLIT);
     switch (sh) {
     case AK_SHADING_UNLIT: {
         ak_vec4 c = vec4_is_zero(mesh->material.color) ? ak_vec4_make(0.78f, 0.74f, 0.70f, 1) : mesh->material.color;

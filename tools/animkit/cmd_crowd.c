@@ -9,8 +9,8 @@
 
 static const char* const usage =
     "usage: animkit crowd [SCENE.json | --preset circle|crossing|corridor|evacuation] [--agents N]\n"
-    "                     [--method orca|vision] [--steps N] [--dt DT] [--threads T] [--json OUT.json]\n"
-    "                     [-o OUT.gif|OUT.png|OUT.glb]\n"
+    "                     [--method orca|vision] [--vision-view raycast|raster] [--steps N] [--dt DT]\n"
+    "                     [--threads T] [--json OUT.json] [-o OUT.gif|OUT.png|OUT.glb]\n"
     "People walking to their goals without colliding: ORCA (van den Berg et al. 2011, as RVO2)\n"
     "on the ground plane; see docs/crowd.md for the scene keys. Without a scene or preset it runs\n"
     "the circle preset.\n"
@@ -19,6 +19,8 @@ static const char* const usage =
     "             empties through one door)\n"
     "  --agents   agents of the preset (default 100; up to 1000000)\n"
     "  --method   orca (default) or vision (synthetic-vision steering, Ondrej et al. 2010)\n"
+    "  --vision-view  raycast (default: rays against the neighbours' discs) or raster (each agent's\n"
+    "             view rendered by the library's rasterizer, docs/crowd.md)\n"
     "  --steps    steps to run (default: the preset's, long enough for every agent to arrive)\n"
     "  --dt       seconds per step (default 0.1)\n"
     "  --threads  threads per step (default 1; results are identical for any count)\n"
@@ -129,7 +131,7 @@ static ak_result run_init(crowd_run* r, const ak_crowd_scene* sc, uint32_t threa
     r->min_distance = INFINITY;
     ak_crowd_desc d = {.agents = {sc->agents, sc->agent_count}, .obstacles = sc->obstacles,
                        .obstacle_count = (uint32_t)sc->obstacle_count,
-                       .method = sc->method};
+                       .method = sc->method, .vision_view = sc->vision_view};
     ak_result res = ak_crowd_create(&d, NULL, &r->crowd);
     if (res != AK_OK) return res;
     const size_t n = r->n = sc->agent_count;
@@ -279,7 +281,7 @@ static int write_json(const char* path, double time, const crowd_run* st) {
 int cmd_crowd(int argc, char** argv) {
     static const cli_opt opts[] = {
         {"--agents", NULL, true}, {"--steps", NULL, true},  {"--dt", NULL, true},     {"--threads", NULL, true},
-        {"--json", NULL, true},   {"--output", "-o", true}, {"--preset", NULL, true}, {"--method", NULL, true},
+        {"--json", NULL, true},   {"--output", "-o", true}, {"--preset", NULL, true}, {"--method", NULL, true}, {"--vision-view", NULL, true},
         {"--size", NULL, true},
     };
     cli_args a;
@@ -293,6 +295,9 @@ int cmd_crowd(int argc, char** argv) {
     const char* preset = CLI_GET(&a, "--preset");
     if (preset && a.pos_count == 1) return cli_usage("crowd", "give a scene file or --preset, not both");
     const char* method = CLI_GET(&a, "--method");
+    const char* vview = CLI_GET(&a, "--vision-view");
+    if (vview && strcmp(vview, "raycast") != 0 && strcmp(vview, "raster") != 0)
+        return cli_usage("crowd", "--vision-view '%s' must be raycast or raster", vview);
     if (method && strcmp(method, "orca") != 0 && strcmp(method, "vision") != 0)
         return cli_usage("crowd", "--method '%s' must be orca or vision", method);
     long agents = 0, steps = -1, threads = 1;
@@ -334,6 +339,7 @@ int cmd_crowd(int argc, char** argv) {
     }
     if (steps >= 0) sc.steps = steps;
     if (method) sc.method = strcmp(method, "vision") == 0 ? AK_CROWD_VISION : AK_CROWD_ORCA;
+    if (vview) sc.vision_view = strcmp(vview, "raster") == 0 ? AK_CROWD_VIEW_RASTER : AK_CROWD_VIEW_RAYCAST;
     const bool is_glb = out && cli_has_ext(out, ".glb"), is_gif = out && cli_has_ext(out, ".gif");
     /* Refused before any work: a glTF crowd holds at most 32767 nodes (18 per character). */
     if (is_glb && sc.agent_count > 1800) {
