@@ -1823,20 +1823,30 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     return AK_OK;
 }
 
+/* One agent's probe (ak_crowd_agent_lines, ak_crowd_agent_view): the step's layout over the job's
+ * scratch, the neighbour search over every agent, and one worker's buffers. c, grid and w are the
+ * caller's (w and c point into grid and the scratch). False when the search fails. */
+static bool probe_worker(const ak_crowd_step_job* job, ctx* c, ak_grid* grid, worker* w) {
+    const ak_crowd* crowd = job->crowd;
+    layout L;
+    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), contact_need(job), !job->allow_overlap, &L);
+    char* base = align_up(job->scratch.ptr);
+    *c = (ctx){.job = job, .crowd = crowd};
+    if (search_grid(c, &L, base, grid) != AK_OK) return false;
+    w->c = c;
+    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref, w);
+    return true;
+}
+
 size_t ak_crowd_agent_lines(const ak_crowd_step_job* job, size_t index, ak_crowd_line_span out_lines,
                             size_t* out_obstacle_line_count) {
     if (out_obstacle_line_count) *out_obstacle_line_count = 0;
     if (ak_crowd_step_validate(job) != AK_OK || index >= job->crowd->agent_count) return 0;
     const ak_crowd* crowd = job->crowd;
-    layout L;
-    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), contact_need(job), !job->allow_overlap, &L);
-    char* base = align_up(job->scratch.ptr);
+    ctx c;
     ak_grid grid;
-    ctx c = {.job = job, .crowd = crowd};
-    if (search_grid(&c, &L, base, &grid) != AK_OK) return 0;
     worker w;
-    w.c = &c;
-    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref, &w);
+    if (!probe_worker(job, &c, &grid, &w)) return 0;
     const ak_crowd_agent* a = &crowd->agents[index];
     size_t no = 0;
     const ak_vec2 p = job->positions.ptr[index], v = job->velocities.ptr[index];
@@ -1854,21 +1864,16 @@ size_t ak_crowd_agent_view(const ak_crowd_step_job* job, size_t index, ak_u32_sp
     if (crowd->method != AK_CROWD_VISION || (out_object.count && (!out_object.ptr || out_object.count < W)) ||
         (out_distance.count && (!out_distance.ptr || out_distance.count < W)))
         return 0;
-    layout L;
-    make_layout(crowd, crowd->agent_count, thread_total(job, crowd->agent_count), contact_need(job), !job->allow_overlap, &L);
-    char* base = align_up(job->scratch.ptr);
+    ctx c;
     ak_grid grid;
-    ctx c = {.job = job, .crowd = crowd};
-    if (search_grid(&c, &L, base, &grid) != AK_OK) return 0;
+    worker w;
+    if (!probe_worker(job, &c, &grid, &w)) return 0;
     /* the preferred velocity as the step computes it (this agent's only: the heading needs it) */
     const ak_vec2 p = job->positions.ptr[index], v = job->velocities.ptr[index];
     const ak_crowd_agent* a = &crowd->agents[index];
     uint32_t wp_saved = job->waypoints.ptr[index];
     const ak_vec2 pref = pref_velocity(job, a, index, p);
     job->waypoints.ptr[index] = wp_saved; /* a view changes no state */
-    worker w;
-    w.c = &c;
-    carve_worker(crowd, base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref, &w);
     const uint32_t na = agent_neighbors(&c, index, p, a, w.agent_n);
     const uint32_t no = crowd->vertex_count ? obstacle_neighbors(crowd, p, a, w.obst_n) : 0;
     const ak_vec2 head = vision_heading(v, pref);
