@@ -464,6 +464,48 @@ AK_TEST(pyramid_stands) {
     AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
 }
 
+/* Static friction on a face pressed on a face must not turn the solver's small tilts into
+ * sideways steps: a 10-layer pyramid awake for 5 s at only 10 substeps stays within 6 mm of where
+ * it started (it measured 2.5 mm; reading the tilt as slip walked it 31 mm). */
+AK_TEST(pyramid_does_not_walk_at_10_substeps) {
+    float drift, pen;
+    bool ok;
+    pyramid_run(10, 5.0f, 10, false, &drift, &pen, &ok);
+    AK_CHECK(ok);
+    AK_CHECK_MSG(drift < 6e-3f, "drift %g m", drift);
+    AK_CHECK_MSG(pen < 0.01f, "penetration %g m (contact offset 0.01)", pen);
+}
+
+/* A tall box (half extents 0.1, 0.5, 0.3) sent sliding along x at 3 m/s on a floor: friction
+ * mu g at the base against gravity's moment about the front edge tips it when mu > 0.1 / 0.5 =
+ * 0.2 (mu 0.5: it falls on its face, 90 degrees), and it slides upright below (mu 0.15). */
+static float slide_tilt(float mu) {
+    ak_rigid_body_desc b[2] = {
+        {.shape = {.type = AK_RIGID_PLANE, .normal = {0, 1, 0}}, .friction = mu},
+        {.shape = {.type = AK_RIGID_BOX, .half_extents = {0.1f, 0.5f, 0.3f}},
+         .position = {0, 0.5f, 0},
+         .friction = mu},
+    };
+    world wd;
+    if (!world_init(&wd, b, 2, NULL, 1.0f / 60.0f, 10, G)) return NAN;
+    wd.v[1] = ak_vec3_make(3.0f, 0, 0);
+    float tilt = 0.0f;
+    for (int f = 0; f < 120; ++f) {
+        ak_rigid_step_run(&wd.job);
+        ak_vec3 up = ak_quat_rotate(wd.q[1], ak_vec3_make(0, 1, 0));
+        tilt = ak_maxf(tilt, acosf(ak_clampf(up.y, -1.0f, 1.0f)));
+    }
+    world_free(&wd);
+    return tilt;
+}
+
+AK_TEST(sliding_tall_box_tips_when_mu_exceeds_its_aspect) {
+    float t = slide_tilt(0.5f);
+    AK_CHECK_MSG(t > ak_radians(80.0f), "mu 0.5: tilt %g deg, should tip", t * 57.29578f);
+    t = slide_tilt(0.15f);
+    AK_CHECK_MSG(t < ak_radians(5.0f), "mu 0.15: tilt %g deg, should slide upright", t * 57.29578f);
+}
+
 AK_TEST(pyramid_20_layers_20s) {
     float drift, pen;
     bool ok;
@@ -808,6 +850,8 @@ int main(void) {
     AK_RUN(sphere_pour_keeps_every_contact);
     AK_RUN(sphere_pour_overflow_degrades_gracefully);
     AK_RUN_SLOW(pyramid_stands);
+    AK_RUN(pyramid_does_not_walk_at_10_substeps);
+    AK_RUN(sliding_tall_box_tips_when_mu_exceeds_its_aspect);
     AK_RUN(pendulum_period_ball_joint);
     AK_RUN(hinge_limits_hold);
     AK_RUN(prismatic_slides_along_its_axis);
