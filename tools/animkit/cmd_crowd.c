@@ -33,7 +33,7 @@ static const char* const usage =
     "             (up to 1800 agents)\n"
     "  --size     WxH of the PNG or GIF (default 640x480)\n"
     "  --poses    PNG and GIF characters: exact (each agent posed, feet planted, and skinned) or\n"
-    "             shared (one skinned pose per phase bucket, 32 per cycle, drawn under each agent's\n"
+    "             shared (one skinned pose per phase bucket, 128 per cycle, drawn under each agent's\n"
     "             root; no foot planting); default exact up to 500 agents, shared above\n"
     "Without --json or -o prints a summary line.\n";
 
