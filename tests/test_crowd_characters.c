@@ -40,7 +40,8 @@ static void feet_world(const ak_crowd_gait* g, const ak_crowd_character* c, ak_v
 }
 
 /* How the clip time is chosen in a sliding run. */
-typedef enum { TIME_GAIT, TIME_RATE_ONE, TIME_CONSTANT_RATE } time_mode;
+typedef enum { TIME_GAIT, TIME_RATE_ONE, TIME_CONSTANT_RATE, TIME_SHARED } time_mode;
+static uint32_t g_phase_buckets = AK_CROWD_PHASE_BUCKETS; /* TIME_SHARED: the gait's time, posed by bucket */
 
 /* The agent's path: a straight line at speed along dir, or a circle of radius R. */
 typedef struct path {
@@ -81,7 +82,9 @@ static double max_slide(const ak_crowd_gait* g, const path* pa, time_mode mode, 
         AK_CHECK_EQ(ak_crowd_characters_update(&job), AK_OK);
         if (mode == TIME_RATE_ONE) c.clip_time = fmodf(t, g->duration);
         if (mode == TIME_CONSTANT_RATE) c.clip_time = fmodf(t * pa->speed / g->stride_speed, g->duration);
-        feet_world(g, &c, path_pos(pa, t), local, world, n, feet[s]);
+        ak_crowd_character q = c;
+        if (mode == TIME_SHARED) ak_crowd_character_bucket(g, &c, g_phase_buckets, AK_CROWD_WEIGHT_LEVELS, &q);
+        feet_world(g, &q, path_pos(pa, t), local, world, n, feet[s]);
     }
     const int skip = (int)(1.0f / dt);
     double worst = 0.0, along = 0.0;
@@ -183,6 +186,17 @@ AK_TEST(foot_sliding_straight) {
         const double slide2 = max_slide(&g, &pa, TIME_GAIT, secs, 0.02f, NULL, &along2);
         const double one = max_slide(&g, &pa, TIME_RATE_ONE, secs, 0.01f, NULL, NULL);
         const double constant = max_slide(&g, &pa, TIME_CONSTANT_RATE, secs, 0.01f, NULL, NULL);
+        /* shared poses (ak_crowd_character_bucket): the clip time quantised adds a sawtooth
+         * along the path; AK_CROWD_PHASE_BUCKETS keeps the slide under 2 cm, 32 would not */
+        double shared_along = 0.0, shared_along32 = 0.0;
+        const double shared = max_slide(&g, &pa, TIME_SHARED, secs, 0.01f, NULL, &shared_along);
+        g_phase_buckets = 32;
+        const double shared32 = max_slide(&g, &pa, TIME_SHARED, secs, 0.01f, NULL, &shared_along32);
+        g_phase_buckets = AK_CROWD_PHASE_BUCKETS;
+        printf("  shared poses: %u buckets %.2f cm (along %.2f cm); 32 buckets %.2f cm (along %.2f cm)\n",
+               AK_CROWD_PHASE_BUCKETS, 100 * shared, 100 * shared_along, 100 * shared32, 100 * shared_along32);
+        AK_CHECK_MSG(shared < 0.02, "%.1f m/s: shared poses slide %.2f cm", (double)speeds[k], 100 * shared);
+        AK_CHECK_MSG(shared32 > 0.02, "32 buckets should slide (%.2f cm)", 100 * shared32);
         printf("  %.1f m/s: %d stances, slide %.2f cm (along the path %.2f cm); 2 cm band: %.2f cm (along %.2f cm); "
                "rate 1: %.1f cm; constant rate: %.1f cm\n",
                (double)speeds[k], stances, 100 * slide, 100 * along, 100 * slide2, 100 * along2, 100 * one,
@@ -245,6 +259,119 @@ AK_TEST(turning_and_idle) {
     ak_crowd_characters_update(&job);
     AK_CHECK_NEAR(c.walk_weight, 0.5f, 1e-6f);
     free(local);
+}
+
+/* Skinned positions of the character's mesh (model space), by a naive LBS written here in
+ * double: sum over influences of weight x (joint world x inverse bind) x rest vertex. */
+static void skin_naive(const ak_crowd_gait* g, const ak_crowd_character* c, ak_transform* local, ak_mat4* world,
+                       size_t n, double* out /* [3 * vertex_count] */) {
+    const ak_scene* sc = g->scene;
+    const ak_mesh* m = sc->meshes[0].mesh;
+    const ak_scene_skin* sk = &sc->skins[sc->meshes[0].skin];
+    ak_crowd_character_pose(g, c, (ak_transform_span){local, n});
+    ak_scene_world_matrices(sc, (ak_transform_cspan){local, n}, (ak_mat4_span){world, n});
+    for (size_t v = 0; v < m->vertex_count; ++v) {
+        double acc[3] = {0, 0, 0};
+        const ak_vec3 p = m->positions[v];
+        for (uint32_t k = 0; k < m->influence_count; ++k) {
+            const double w = m->weights[v * m->influence_count + k];
+            if (w == 0.0) continue;
+            const uint16_t slot = m->joints[v * m->influence_count + k];
+            const ak_mat4 M = ak_mat4_mul(world[sk->joints[slot]], sk->inverse_binds[slot]);
+            const double q[3] = {p.x, p.y, p.z};
+            for (int r = 0; r < 3; ++r) {
+                double x = M.m[12 + r]; /* column-major */
+                for (int cc = 0; cc < 3; ++cc) x += (double)M.m[4 * cc + r] * q[cc];
+                acc[r] += w * x;
+            }
+        }
+        for (int r = 0; r < 3; ++r) out[3 * v + r] = acc[r];
+    }
+}
+
+/* Shared poses (ak_crowd_character_bucket): a walking character's bucket pose is within the
+ * documented phase error of its exact pose: every skinned vertex within (largest vertex speed
+ * in the clip, measured here by finite differences over 1,024 samples) x (duration / (2 x
+ * AK_CROWD_PHASE_BUCKETS)), with 10% for the sampling of that speed. Also: the bucket index is
+ * in range and determines the snapped pose; weights round to the nearest level. */
+AK_TEST(shared_pose_phase_error) {
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(humanoid(), &g));
+    const ak_mesh* m = g.scene->meshes[0].mesh;
+    const size_t n = ak_scene_joint_count(g.scene), V = m->vertex_count;
+    AK_CHECK(m->influence_count > 0 && g.scene->meshes[0].skin >= 0);
+    ak_transform* local = malloc(n * sizeof *local);
+    ak_mat4* world = malloc(n * sizeof *world);
+    double *a = malloc(3 * V * sizeof *a), *b = malloc(3 * V * sizeof *b);
+    const int S = 1024;
+    double vmax = 0.0;
+    ak_crowd_character c = ak_crowd_character_init(&g, ak_vec2_make(0, 1), 0.0f);
+    c.walk_weight = 1.0f;
+    c.clip_time = 0.0f;
+    skin_naive(&g, &c, local, world, n, a);
+    for (int k = 1; k <= S; ++k) {
+        c.clip_time = g.duration * (float)k / (float)S;
+        skin_naive(&g, &c, local, world, n, b);
+        for (size_t v = 0; v < V; ++v) {
+            const double d = sqrt((a[3 * v] - b[3 * v]) * (a[3 * v] - b[3 * v]) +
+                                  (a[3 * v + 1] - b[3 * v + 1]) * (a[3 * v + 1] - b[3 * v + 1]) +
+                                  (a[3 * v + 2] - b[3 * v + 2]) * (a[3 * v + 2] - b[3 * v + 2]));
+            vmax = fmax(vmax, d / (g.duration / S));
+        }
+        double* t = a;
+        a = b;
+        b = t;
+    }
+    const double bound = 1.1 * vmax * g.duration / (2.0 * AK_CROWD_PHASE_BUCKETS) + 1e-5;
+    const size_t count = ak_crowd_character_bucket_count(AK_CROWD_PHASE_BUCKETS, AK_CROWD_WEIGHT_LEVELS);
+    AK_CHECK_EQ(count, 1u + 3u * AK_CROWD_PHASE_BUCKETS);
+    double worst = 0.0;
+    uint32_t rng = 12345u;
+    for (int trial = 0; trial < 64; ++trial) {
+        rng = rng * 1664525u + 1013904223u;
+        ak_crowd_character e = ak_crowd_character_init(&g, ak_vec2_make(1, 0), 0.0f), q;
+        e.walk_weight = 1.0f;
+        e.clip_time = g.duration * (float)(rng >> 8) / 16777216.0f;
+        const size_t k = ak_crowd_character_bucket(&g, &e, AK_CROWD_PHASE_BUCKETS, AK_CROWD_WEIGHT_LEVELS, &q);
+        AK_CHECK(k >= 1 && k < count);
+        AK_CHECK_EQ(q.walk_weight, 1.0f);
+        /* the bucket's pose is the clip at the bucket's phase: its index says which */
+        const double tq = (double)g.duration * (double)((k - 1) % AK_CROWD_PHASE_BUCKETS) / AK_CROWD_PHASE_BUCKETS;
+        AK_CHECK(fabs(q.clip_time - tq) < 1e-6);
+        skin_naive(&g, &e, local, world, n, a);
+        skin_naive(&g, &q, local, world, n, b);
+        for (size_t v = 0; v < 3 * V; v += 3) {
+            const double d = sqrt((a[v] - b[v]) * (a[v] - b[v]) + (a[v + 1] - b[v + 1]) * (a[v + 1] - b[v + 1]) +
+                                  (a[v + 2] - b[v + 2]) * (a[v + 2] - b[v + 2]));
+            worst = fmax(worst, d);
+        }
+    }
+    printf("shared poses: largest vertex speed %.3f m/s, bound %.2f cm, worst of 64 random phases %.2f cm\n", vmax,
+           100.0 * bound, 100.0 * worst);
+    AK_CHECK(worst <= bound);
+    AK_CHECK(worst > 0.25 * bound); /* the measure sees the quantisation at all */
+    /* weights: nearest of 0, 1/3, 2/3, 1; 0 is one bucket whatever the phase */
+    ak_crowd_character e = ak_crowd_character_init(&g, ak_vec2_make(1, 0), 0.3f), q;
+    e.walk_weight = 0.1f;
+    AK_CHECK_EQ(ak_crowd_character_bucket(&g, &e, AK_CROWD_PHASE_BUCKETS, AK_CROWD_WEIGHT_LEVELS, &q), 0u);
+    AK_CHECK_EQ(q.walk_weight, 0.0f);
+    e.walk_weight = 0.6f;
+    AK_CHECK(ak_crowd_character_bucket(&g, &e, AK_CROWD_PHASE_BUCKETS, AK_CROWD_WEIGHT_LEVELS, &q) >=
+             1u + AK_CROWD_PHASE_BUCKETS);
+    AK_CHECK(fabsf(q.walk_weight - 2.0f / 3.0f) < 1e-6f);
+    e.clip_time = g.duration * 0.999f; /* the cycle's end is its start */
+    e.walk_weight = 1.0f;
+    AK_CHECK_EQ(ak_crowd_character_bucket(&g, &e, AK_CROWD_PHASE_BUCKETS, AK_CROWD_WEIGHT_LEVELS, &q),
+                1u + 2u * AK_CROWD_PHASE_BUCKETS);
+    AK_CHECK_EQ(q.clip_time, 0.0f);
+    AK_CHECK_EQ(ak_crowd_character_bucket(NULL, &e, 32, 4, &q), SIZE_MAX);
+    AK_CHECK_EQ(ak_crowd_character_bucket(&g, &e, 0, 4, &q), SIZE_MAX);
+    AK_CHECK_EQ(ak_crowd_character_bucket(&g, &e, 32, 1, &q), SIZE_MAX);
+    AK_CHECK_EQ(ak_crowd_character_bucket_count(32, 1), 0u);
+    free(local);
+    free(world);
+    free(a);
+    free(b);
 }
 
 AK_TEST(validation) {
@@ -660,6 +787,7 @@ int main(void) {
     AK_RUN(gait_of_builtin_walk);
     AK_RUN(foot_sliding_straight);
     AK_RUN(turning_and_idle);
+    AK_RUN(shared_pose_phase_error);
     AK_RUN(validation);
     AK_RUN(bake_scene);
     AK_RUN(foot_planting_unit);

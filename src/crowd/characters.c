@@ -339,6 +339,29 @@ ak_result ak_crowd_characters_update(const ak_crowd_characters_job* job) {
     return AK_OK;
 }
 
+size_t ak_crowd_character_bucket_count(uint32_t phase_buckets, uint32_t weight_levels) {
+    if (phase_buckets == 0 || weight_levels < 2) return 0;
+    return 1u + (size_t)(weight_levels - 1u) * phase_buckets;
+}
+
+size_t ak_crowd_character_bucket(const ak_crowd_gait* gait, const ak_crowd_character* character,
+                                 uint32_t phase_buckets, uint32_t weight_levels, ak_crowd_character* out) {
+    if (!gait || !character || !(gait->duration > 0.0f) || phase_buckets == 0 || weight_levels < 2) return SIZE_MAX;
+    const float w = ak_clampf(ak_finitef(character->walk_weight) ? character->walk_weight : 0.0f, 0.0f, 1.0f);
+    const uint32_t top = weight_levels - 1u;
+    uint32_t level = (uint32_t)lrintf(w * (float)top);
+    if (level > top) level = top;
+    const float t = ak_finitef(character->clip_time) ? ak_clampf(character->clip_time, 0.0f, gait->duration) : 0.0f;
+    uint32_t ph = (uint32_t)lrint((double)t / (double)gait->duration * (double)phase_buckets);
+    if (ph >= phase_buckets) ph = 0; /* the end of the cycle is its start */
+    if (out) {
+        *out = *character;
+        out->walk_weight = (float)level / (float)top;
+        out->clip_time = level ? (float)((double)ph * (double)gait->duration / (double)phase_buckets) : 0.0f;
+    }
+    return level ? 1u + (size_t)(level - 1u) * phase_buckets + ph : 0u;
+}
+
 ak_result ak_crowd_character_pose(const ak_crowd_gait* gait, const ak_crowd_character* character,
                                   ak_transform_span out_local) {
     if (!gait || !character || !gait->scene || !gait->scene->skeleton || !out_local.ptr) return AK_ERR_NULL_ARG;

@@ -11,6 +11,7 @@ static const char* const usage =
     "usage: animkit crowd [SCENE.json | --preset circle|crossing|corridor|evacuation] [--agents N]\n"
     "                     [--method orca|vision] [--vision-view raycast|raster] [--steps N] [--dt DT]\n"
     "                     [--threads T] [--json OUT.json] [-o OUT.gif|OUT.png|OUT.glb]\n"
+    "                     [--size WxH] [--poses exact|shared]\n"
     "People walking to their goals without colliding: ORCA (van den Berg et al. 2011, as RVO2)\n"
     "on the ground plane; see docs/crowd.md for the scene keys. Without a scene or preset it runs\n"
     "the circle preset.\n"
@@ -27,8 +28,13 @@ static const char* const usage =
     "  --json     write {\"time\", \"agents\": [{\"position\", \"velocity\", \"goal_reached\"}],\n"
     "             \"min_distance\", \"collisions\"} after the run\n"
     "  -o         .png (the last step) or .gif (the run) rendered, walking characters (builtin:humanoid)\n"
-    "             up to 500 agents, discs above; .glb: the run as glTF, a skinned character per agent\n"
+    "             per agent (posed each up to 500 agents, shared poses above); .glb: the run as glTF, a\n"
+    "             skinned character per agent\n"
     "             (up to 1800 agents)\n"
+    "  --size     WxH of the PNG or GIF (default 640x480)\n"
+    "  --poses    PNG and GIF characters: exact (each agent posed, feet planted, and skinned) or\n"
+    "             shared (one skinned pose per phase bucket, 128 per cycle, drawn under each agent's\n"
+    "             root; no foot planting); default exact up to 500 agents, shared above\n"
     "Without --json or -o prints a summary line.\n";
 
 /* ---- collisions: the set of pairs that ever overlapped ------------------------------------ */
@@ -217,7 +223,7 @@ static void renderer_free(renderer* r) {
     free(r->pixels);
 }
 
-static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc, const crowd_chars* chars) {
+static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc, const crowd_chars* chars, bool shared) {
     memset(r, 0, sizeof *r);
     r->w = w;
     r->h = h;
@@ -237,7 +243,9 @@ static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc, co
     r->cam = ak_raster_camera_perspective(eye, r->center, ak_radians(45), (float)w / (float)h, 0.05f * r->extent,
                                           10.0f * r->extent);
     r->pixels = malloc((size_t)w * (size_t)h * 4);
-    if (!r->pixels || !crowd_people_init(&r->people, sc->agent_count, chars)) return 1;
+    if (!r->pixels || !(shared && chars ? crowd_people_init_shared(&r->people, sc->agent_count, chars)
+                               : crowd_people_init(&r->people, sc->agent_count, chars)))
+        return 1;
     return crowd_walls(sc, &r->wall, &r->wall_count) ? 0 : 1;
 }
 
@@ -247,15 +255,18 @@ static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_r
     ak_raster_mesh people;
     ak_result res = crowd_people_update(&r->people, sc, st->p, st->v, chars, &people);
     if (res != AK_OK) return res;
-    const size_t k = people.positions.count;
+    crowd_people* pp = &r->people;
+    const size_t k = pp->shared ? pp->n : people.positions.count;
     ak_raster_mesh walls = {.positions = {r->wall, r->wall_count}, .material = {.color = {0.6f, 0.6f, 0.62f, 1}}};
     ak_raster_mesh casters[2] = {people, walls};
+    if (pp->shared) pp->casters[pp->n] = walls; /* every agent's bucket mesh, then the walls */
     ak_raster_clear(r->raster, ak_vec4_make(0.80f, 0.86f, 0.93f, 1), ak_vec4_make(0.55f, 0.60f, 0.68f, 1));
     ak_raster_ground g = {.height = 0.0f, .center = r->center, .half_extent = 1.6f * r->extent,
-                          .casters = casters, .caster_count = r->wall_count ? 2 : 1};
+                          .casters = pp->shared ? pp->casters : casters,
+                          .caster_count = (pp->shared ? pp->n : 1) + (r->wall_count ? 1 : 0)};
     res = k ? ak_raster_draw_ground(r->raster, &r->cam, &g) : AK_OK;
     if (res == AK_OK && r->wall_count) res = ak_raster_draw_mesh(r->raster, &r->cam, &walls);
-    if (res == AK_OK && k) res = ak_raster_draw_mesh(r->raster, &r->cam, &people);
+    if (res == AK_OK && k) res = crowd_people_draw(pp, r->raster, &r->cam, &people);
     if (res == AK_OK) res = ak_raster_resolve(r->raster, out);
     return res;
 }
@@ -282,7 +293,7 @@ int cmd_crowd(int argc, char** argv) {
     static const cli_opt opts[] = {
         {"--agents", NULL, true}, {"--steps", NULL, true},  {"--dt", NULL, true},     {"--threads", NULL, true},
         {"--json", NULL, true},   {"--output", "-o", true}, {"--preset", NULL, true}, {"--method", NULL, true}, {"--vision-view", NULL, true},
-        {"--size", NULL, true},
+        {"--size", NULL, true},   {"--poses", NULL, true},
     };
     cli_args a;
     int rc = cli_parse("crowd", argc, argv, opts, sizeof opts / sizeof opts[0], &a);
@@ -300,6 +311,9 @@ int cmd_crowd(int argc, char** argv) {
         return cli_usage("crowd", "--vision-view '%s' must be raycast or raster", vview);
     if (method && strcmp(method, "orca") != 0 && strcmp(method, "vision") != 0)
         return cli_usage("crowd", "--method '%s' must be orca or vision", method);
+    const char* poses = CLI_GET(&a, "--poses");
+    if (poses && strcmp(poses, "exact") != 0 && strcmp(poses, "shared") != 0)
+        return cli_usage("crowd", "--poses '%s' must be exact or shared", poses);
     long agents = 0, steps = -1, threads = 1;
     float dt = -1.0f;
     int w = 640, h = 480;
@@ -364,10 +378,12 @@ int cmd_crowd(int argc, char** argv) {
     const long every = sc.steps > max_frames ? (sc.steps + max_frames - 1) / max_frames : 1;
     crowd_chars chars;
     memset(&chars, 0, sizeof chars);
-    const bool with_chars = is_glb || (out && sc.agent_count <= CROWD_CHARACTERS_MAX);
+    const bool with_chars = is_glb || out;
+    const bool shared_poses = !is_glb && (poses ? strcmp(poses, "shared") == 0 : sc.agent_count > CROWD_CHARACTERS_MAX);
     if (with_chars) {
         ak_diag cd = {0};
         res = crowd_chars_init(&chars, &sc, is_glb ? (size_t)(sc.steps / every + 1) : 0, &cd);
+        chars.unplanted = shared_poses; /* shared poses have no foot planting */
         if (res != AK_OK) {
             crowd_chars_free(&chars);
             run_free(&st);
@@ -381,7 +397,7 @@ int cmd_crowd(int argc, char** argv) {
     ak_image img = {0};
     const bool rendering = out != NULL && !is_glb;
     if (rendering) {
-        if (renderer_init(&rd, w, h, &sc, with_chars ? &chars : NULL)) {
+        if (renderer_init(&rd, w, h, &sc, with_chars ? &chars : NULL, shared_poses)) {
             renderer_free(&rd);
             crowd_chars_free(&chars);
             run_free(&st);

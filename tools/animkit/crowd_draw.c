@@ -61,6 +61,7 @@ ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, const ak
     ak_crowd_characters_job job = {.gait = &c->gait, .dt = dt, .velocities = {velocities, c->n},
                                    .characters = {c->ch, c->n}, .positions = {positions, c->n},
                                    .scratch = {c->plant_scratch, c->plant_bytes}};
+    if (c->unplanted) job.positions = (ak_vec2_cspan){0}, job.scratch = (ak_u8_span){0};
     return ak_crowd_characters_update(&job);
 }
 
@@ -74,6 +75,13 @@ void crowd_chars_record(crowd_chars* c, const ak_vec2* positions) {
 /* ---- people ------------------------------------------------------------------------------------ */
 
 void crowd_people_free(crowd_people* pp) {
+    free(pp->bpos);
+    free(pp->bnrm);
+    free(pp->bucket_frame);
+    free(pp->agent_bucket);
+    free(pp->roots);
+    free(pp->agent_col);
+    free(pp->casters);
     free(pp->pos);
     free(pp->nrm);
     free(pp->col);
@@ -98,6 +106,91 @@ bool crowd_people_init(crowd_people* pp, size_t n, const crowd_chars* chars) {
     pp->nrm = malloc(pp->vcount * sizeof *pp->nrm);
     pp->col = malloc(pp->vcount * sizeof *pp->col);
     return pp->pos && pp->nrm && pp->col;
+}
+
+bool crowd_people_init_shared(crowd_people* pp, size_t n, const crowd_chars* chars) {
+    const size_t chunk = n < CROWD_SHARED_CHUNK ? n : CROWD_SHARED_CHUNK;
+    if (!crowd_people_init(pp, chunk, chars)) return false;
+    const ak_mesh* m = chars->scene->meshes[0].mesh;
+    pp->shared = true;
+    pp->n = n;
+    pp->mesh_vertices = m->vertex_count;
+    pp->bucket_count = ak_crowd_character_bucket_count(AK_CROWD_PHASE_BUCKETS, AK_CROWD_WEIGHT_LEVELS);
+    pp->bpos = malloc(pp->bucket_count * m->vertex_count * sizeof *pp->bpos);
+    pp->bnrm = malloc(pp->bucket_count * m->vertex_count * sizeof *pp->bnrm);
+    pp->bucket_frame = calloc(pp->bucket_count, sizeof *pp->bucket_frame);
+    pp->agent_bucket = malloc(n * sizeof *pp->agent_bucket);
+    pp->roots = malloc(n * sizeof *pp->roots);
+    pp->agent_col = malloc(n * sizeof *pp->agent_col);
+    pp->casters = calloc(n + 1, sizeof *pp->casters);
+    return pp->bpos && pp->bnrm && pp->bucket_frame && pp->agent_bucket && pp->roots && pp->agent_col && pp->casters;
+}
+
+/* Shared poses: each agent's bucket (ak_crowd_character_bucket), each bucket used this frame
+ * posed (unplanted) and skinned once, each agent's root matrix and shadow caster. */
+static ak_result share_characters(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
+                                  crowd_chars* c) {
+    const ak_mesh* m = c->scene->meshes[0].mesh;
+    const size_t J = ak_scene_joint_count(c->scene), V = pp->mesh_vertices;
+    if (++pp->frame == 0) { /* wrapped: forget every stamp */
+        memset(pp->bucket_frame, 0, pp->bucket_count * sizeof *pp->bucket_frame);
+        pp->frame = 1;
+    }
+    pp->posed = 0;
+    for (size_t i = 0; i < pp->n; ++i) {
+        ak_crowd_character q;
+        const size_t b = ak_crowd_character_bucket(&c->gait, &c->ch[i], AK_CROWD_PHASE_BUCKETS,
+                                                   AK_CROWD_WEIGHT_LEVELS, &q);
+        if (b >= pp->bucket_count) return AK_ERR_BAD_DATA;
+        if (pp->bucket_frame[b] != pp->frame) {
+            ak_result res = ak_crowd_character_pose(&c->gait, &q, (ak_transform_span){c->poser.local, J});
+            if (res == AK_OK) res = cli_poser_deform(&c->poser, false, CLI_LBS);
+            if (res != AK_OK) return res;
+            memcpy(pp->bpos + b * V, c->poser.positions[0], V * sizeof *pp->bpos);
+            memcpy(pp->bnrm + b * V, c->poser.normals[0], V * sizeof *pp->bnrm);
+            pp->bucket_frame[b] = pp->frame;
+            ++pp->posed;
+        }
+        pp->agent_bucket[i] = (uint32_t)b;
+        pp->roots[i] = ak_crowd_character_root(&c->gait, &c->ch[i], positions[i]);
+        pp->agent_col[i] = crowd_palette[sc->group[i] % 4];
+        pp->casters[i] = (ak_raster_mesh){.positions = {pp->bpos + b * V, V}, .normals = {pp->bnrm + b * V, V},
+                                          .indices = {m->indices, m->triangle_count * 3},
+                                          .model = &pp->roots[i], .material = {.color = pp->agent_col[i]}};
+    }
+    return AK_OK;
+}
+
+ak_result crowd_people_draw(crowd_people* pp, ak_raster* raster, const ak_raster_camera* cam,
+                            const ak_raster_mesh* people) {
+    if (!pp->shared) return people->positions.count ? ak_raster_draw_mesh(raster, cam, people) : AK_OK;
+    /* One colour per draw call (material colour: per-vertex colours would be converted to
+     * linear light at every triangle's corners), CROWD_SHARED_CHUNK agents at a time. */
+    const size_t V = pp->mesh_vertices, I = pp->icount / (pp->n < CROWD_SHARED_CHUNK ? pp->n : CROWD_SHARED_CHUNK);
+    for (size_t g = 0; g < 4; ++g) {
+        const ak_vec4 colour = crowd_palette[g];
+        size_t i = 0;
+        for (;;) {
+            size_t cnt = 0;
+            for (; i < pp->n && cnt < CROWD_SHARED_CHUNK; ++i) {
+                if (memcmp(&pp->agent_col[i], &colour, sizeof colour) != 0) continue;
+                const ak_mat4 root = pp->roots[i];
+                const ak_vec3 *bp = pp->bpos + (size_t)pp->agent_bucket[i] * V, *bn = pp->bnrm + (size_t)pp->agent_bucket[i] * V;
+                ak_vec3 *op = pp->pos + cnt * V, *on = pp->nrm + cnt * V;
+                for (size_t v = 0; v < V; ++v) {
+                    op[v] = ak_mat4_transform_point(root, bp[v]);
+                    on[v] = ak_mat4_transform_vector(root, bn[v]);
+                }
+                ++cnt;
+            }
+            if (!cnt) break;
+            const ak_raster_mesh mesh = {.positions = {pp->pos, cnt * V}, .normals = {pp->nrm, cnt * V},
+                                         .indices = {pp->idx, cnt * I}, .material = {.color = colour}};
+            const ak_result res = ak_raster_draw_mesh(raster, cam, &mesh);
+            if (res != AK_OK) return res;
+        }
+    }
+    return AK_OK;
 }
 
 /* Each character posed (its clip time and heading, its feet planted), skinned (LBS) and placed in the world. */
@@ -152,7 +245,12 @@ static void prisms(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* po
 
 ak_result crowd_people_update(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
                               const ak_vec2* velocities, crowd_chars* chars, ak_raster_mesh* out) {
-    if (chars) {
+    if (chars && pp->shared) {
+        const ak_result r = share_characters(pp, sc, positions, chars);
+        if (r != AK_OK) return r;
+        *out = (ak_raster_mesh){0};
+        return AK_OK;
+    } else if (chars) {
         const ak_result r = pose_characters(pp, sc, positions, chars);
         if (r != AK_OK) return r;
     } else {

@@ -1,13 +1,18 @@
 /* The crowd's characters and drawing, shared by `animkit crowd` (PNG, GIF, glTF) and
- * `animkit view crowd`: builtin:humanoid walking per agent (crowd.h's characters), or
- * octagonal prisms above CROWD_CHARACTERS_MAX agents, and the obstacles as walls. */
+ * `animkit view crowd`: builtin:humanoid walking per agent (crowd.h's characters), posed and
+ * skinned per agent up to CROWD_CHARACTERS_MAX agents; above, `animkit crowd` shares the
+ * skinned poses (crowd.h's ak_crowd_character_bucket: one pose per phase and weight bucket,
+ * each agent drawn as its bucket's mesh under its root matrix) and `animkit view crowd` draws
+ * octagonal prisms; the obstacles as walls. */
 #ifndef ANIMKIT_CLI_CROWD_DRAW_H
 #define ANIMKIT_CLI_CROWD_DRAW_H
 
 #include "cli.h"
 
 #define CROWD_CHARACTER_CELL 0.08f /* builtin:humanoid's grid: about 2,300 triangles */
-#define CROWD_CHARACTERS_MAX 500u  /* drawn as characters up to this many agents, prisms above */
+#define CROWD_CHARACTERS_MAX 500u  /* posed per agent up to this many agents; shared poses (or
+                                      prisms in the viewer) above */
+#define CROWD_SHARED_CHUNK 128u    /* shared poses: agents per draw call */
 
 extern const ak_vec4 crowd_palette[4]; /* colour per group (group % 4) */
 
@@ -23,6 +28,7 @@ typedef struct crowd_chars {
     size_t frames, frame_cap;
     uint8_t* plant_scratch; /* ak_crowd_characters_scratch_size: foot planting */
     size_t plant_bytes;
+    bool unplanted; /* crowd_chars_update without foot planting (shared poses have none) */
 } crowd_chars;
 
 /* The humanoid, its gait, one character per agent facing its first waypoint (phases spread),
@@ -37,22 +43,41 @@ ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, const ak
 /* Record the current frame (positions of the n agents, the characters); no-op when full. */
 void crowd_chars_record(crowd_chars* c, const ak_vec2* positions);
 
-/* World-space triangles of every agent, rebuilt each frame. */
+/* World-space triangles of every agent, rebuilt each frame; with shared poses, the buckets'
+ * skinned meshes (model space), each agent's bucket and root matrix, and world-space
+ * triangles for CROWD_SHARED_CHUNK agents at a time. */
 typedef struct crowd_people {
     ak_vec3 *pos, *nrm;
     ak_vec4* col;
     size_t vcount;
     uint32_t* idx; /* characters: indexed; prisms: none */
     size_t icount;
+    bool shared;
+    size_t n, bucket_count, mesh_vertices;
+    ak_vec3 *bpos, *bnrm;    /* [bucket_count * mesh_vertices] */
+    uint32_t* bucket_frame;  /* [bucket_count]: the frame it was last posed in (0: never) */
+    uint32_t frame;
+    uint32_t* agent_bucket;  /* [n] */
+    ak_mat4* roots;          /* [n] */
+    ak_vec4* agent_col;      /* [n] */
+    ak_raster_mesh* casters; /* [n + 1]: each agent's bucket mesh under its root (shadows);
+                                the last slot is the caller's */
+    size_t posed;            /* buckets posed in the last update */
 } crowd_people;
 
 /* Room for n agents, as characters when chars is not NULL. Returns false when out of memory. */
 bool crowd_people_init(crowd_people* pp, size_t n, const crowd_chars* chars);
+/* Room for n agents as characters with shared poses (chars required). */
+bool crowd_people_init_shared(crowd_people* pp, size_t n, const crowd_chars* chars);
 void crowd_people_free(crowd_people* pp);
 /* Pose and place every agent (positions, velocities: [n]; radius and group from sc) and return
  * the mesh (colours per vertex). */
 ak_result crowd_people_update(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
                               const ak_vec2* velocities, crowd_chars* chars, ak_raster_mesh* out);
+/* Draw the people: the mesh crowd_people_update returned, or with shared poses every agent
+ * (CROWD_SHARED_CHUNK at a time). */
+ak_result crowd_people_draw(crowd_people* pp, ak_raster* raster, const ak_raster_camera* cam,
+                            const ak_raster_mesh* people);
 
 /* The obstacles' edges as 1.2 m high walls: 6 vertices per edge into *out (malloc; NULL when
  * there is none). Returns false when out of memory. */
