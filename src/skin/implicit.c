@@ -16,6 +16,7 @@
 #include <pthread.h> /* thread_count > 1 */
 
 #include "skin_internal.h"
+#include "../simd.h" /* AK_SIMD_SSE2: the trilinear interpolation 4 channels at a time */
 #include "../tasks.h"
 
 #define MAX_CAPS 16
@@ -234,9 +235,22 @@ static inline bool grid_cell(const ak_skin_implicit* o, size_t b, ak_vec3 y, con
     return true;
 }
 
-/* Trilinear interpolation of the 4 values per node (distance, gradient) of q's cell. */
+/* Trilinear interpolation of the 4 values per node (distance, gradient) of q's cell. The SSE2
+ * path does per lane exactly the scalar loop's operations in the same order (lerp in x, then
+ * y, then z; no fused multiply-add), so both give the same bits. */
 static inline void grid_interp(const grid_probe* q, float r[4]) {
     const float *n000 = q->n000, *n010 = n000 + q->sy, *n001 = n000 + q->sz, *n011 = n001 + q->sy;
+#if AK_SIMD_SSE2
+    const __m128 tx = _mm_set1_ps(q->tx), ty = _mm_set1_ps(q->ty), tz = _mm_set1_ps(q->tz);
+    const __m128 a0 = _mm_loadu_ps(n000), a1 = _mm_loadu_ps(n000 + 4), b0 = _mm_loadu_ps(n010), b1 = _mm_loadu_ps(n010 + 4);
+    const __m128 c0 = _mm_loadu_ps(n001), c1 = _mm_loadu_ps(n001 + 4), d0 = _mm_loadu_ps(n011), d1 = _mm_loadu_ps(n011 + 4);
+    const __m128 a = _mm_add_ps(a0, _mm_mul_ps(tx, _mm_sub_ps(a1, a0)));
+    const __m128 bq = _mm_add_ps(b0, _mm_mul_ps(tx, _mm_sub_ps(b1, b0)));
+    const __m128 cq = _mm_add_ps(c0, _mm_mul_ps(tx, _mm_sub_ps(c1, c0)));
+    const __m128 dq = _mm_add_ps(d0, _mm_mul_ps(tx, _mm_sub_ps(d1, d0)));
+    const __m128 e = _mm_add_ps(a, _mm_mul_ps(ty, _mm_sub_ps(bq, a))), f = _mm_add_ps(cq, _mm_mul_ps(ty, _mm_sub_ps(dq, cq)));
+    _mm_storeu_ps(r, _mm_add_ps(e, _mm_mul_ps(tz, _mm_sub_ps(f, e))));
+#else
     const float tx = q->tx, ty = q->ty, tz = q->tz;
     for (int k = 0; k < 4; ++k) {
         float a = n000[k] + tx * (n000[4 + k] - n000[k]);
@@ -246,6 +260,7 @@ static inline void grid_interp(const grid_probe* q, float r[4]) {
         float e = a + ty * (bq - a), f = cq + ty * (dq - cq);
         r[k] = e + tz * (f - e);
     }
+#endif
 }
 
 /* Distance of bone b at bind-space point y and its gradient, from the bone's grid when the
