@@ -22,6 +22,8 @@
 #define MAX_CAPS 16
 #define STOP_COS 0.57357643635f /* cos 55 degrees: the 2014 paper's discontinuity angle */
 #define ISO_EPS 1e-3f /* |F - iso| that ends a projection: about 0.1 % of the support radius */
+#define UNCHECKED_EPS (4.0f * ISO_EPS) /* |F - iso| from which one Newton step is taken to
+                                         converge when a later round checks it anyway */
 #define CAPSULE_AT 12
 #define GRID_AT (CAPSULE_AT + 8)
 #define BONE_FLOATS (GRID_AT + 4) /* cx cy cz s | ax ay az b | r sphere2 valid pad |
@@ -1509,10 +1511,15 @@ typedef struct run_ctx {
     uint8_t* state;
     const ak_vec3* dq;   /* the DQS result */
     const float* frame;  /* [pair_count * PAIR_FRAME] */
+    float unchecked_below; /* project's: FLT_MAX in the rounds before the last, UNCHECKED_EPS in
+                              the first projection when rounds follow, else 0 */
 } run_ctx;
 
-/* Newton steps from *p towards the vertex's iso-value; returns the state. */
-static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, bool first) {
+/* Newton steps from *p towards the vertex's iso-value; returns the state. A step taken where
+ * |F - iso| < unchecked_below is the last one and its end is not evaluated (out_g is then the
+ * gradient where it started): used where a later relaxation round evaluates the point anyway
+ * (0: every step is checked). */
+static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, bool first, float unchecked_below) {
     ak_vec3 g, gprev = ak_vec3_zero();
     ak_vec3 x = *p;
     uint8_t st = first ? ST_KEEP : ST_MOVED;
@@ -1532,6 +1539,7 @@ static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, 
         x = ak_vec3_add(x, step);
         gprev = g;
         if (st == ST_KEEP) st = ST_MOVED;
+        if (fabsf(e) < unchecked_below) break;
     }
     if (!ak_vec3_is_finite(x) || !ak_vec3_is_finite(g)) { /* never NaN out: keep the start */
         x = *p;
@@ -1796,7 +1804,7 @@ static void* run_worker(void* arg) {
         if (o->rep[v] != v || !projectable(o->iso[v])) continue;
         if (t->phase == 0) {
             if (rigid_alone(c, v)) continue; /* kept: exactly at its iso-value already */
-            c->state[v] = project(c, o->iso[v], &c->pos[v], &c->grad[v], true);
+            c->state[v] = project(c, o->iso[v], &c->pos[v], &c->grad[v], true, c->unchecked_below);
         } else if (t->phase == 1) {
             if (c->state[v] == ST_KEEP) continue;
             uint32_t a = o->adj_start[v], b = o->adj_start[v + 1];
@@ -1810,7 +1818,7 @@ static void* run_worker(void* arg) {
             c->pos[v] = ak_vec3_is_finite(q) ? q : c->prev[v];
         } else if (t->phase == 2) {
             if (c->state[v] == ST_KEEP) continue;
-            uint8_t st = project(c, o->iso[v], &c->pos[v], &c->grad[v], false);
+            uint8_t st = project(c, o->iso[v], &c->pos[v], &c->grad[v], false, c->unchecked_below);
             if (st == ST_STOPPED) c->state[v] = ST_STOPPED;
         } else if (t->phase == 3) {
             contact_vertex(c, v, true);
@@ -1921,18 +1929,20 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     broad_phase bp;
     if (o->grid_nodes) cull_build(o, cull);
     if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
-    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? cull : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame};
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? cull : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, 0.0f};
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     /* the projectable representatives grouped by part (counting sort, index order within a
      * part), so that consecutive projections read the same grids (each vertex's projection
      * is independent of the others': the order changes no result) */
     const size_t np = order_by_part(o, order, counts);
-    run_phase(&c, 0, threads, order, np);
     uint32_t rounds = job->relax_rounds == 0 ? 3 : job->relax_rounds == UINT32_MAX ? 0 : job->relax_rounds;
     if (rounds > 64) rounds = 64;
+    c.unchecked_below = rounds ? UNCHECKED_EPS : 0.0f;
+    run_phase(&c, 0, threads, order, np);
     for (uint32_t k = 0; k < rounds; ++k) {
         memcpy(prev, pos, nv * sizeof(ak_vec3));
         run_phase(&c, 1, threads, order, np);
+        c.unchecked_below = k + 1 < rounds ? FLT_MAX : 0.0f;
         run_phase(&c, 2, threads, order, np);
     }
     if (o->pair_count) {
