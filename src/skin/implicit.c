@@ -39,6 +39,10 @@
                         inner direction (3), pad, posed axis of part i (3), pad, of part j (3), pad */
 #define CULL_FLOATS 8 /* per bone and frame: capsule end a(3), b - a (3), 1 / |b - a|^2, squared
                          distance from the segment past which the grid's field is 0 (0: no cull) */
+#define BF_FLOATS 32 /* per bone and frame (bone_frames_build): posed point to grid coordinates (3x3
+                        column-major, then translation), the capsule bound in grid units (end a(3),
+                        b - a (3), 1 / |b - a|^2, squared reach; 0: no cull), the grid's upper
+                        corner nx - 1, ny - 1, nz - 1, 1 / r, r, pad */
 #define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
 
 struct ak_skin_implicit {
@@ -186,15 +190,15 @@ static bool bone_distance(const ak_skin_implicit* o, size_t b, ak_vec3 y, float*
 }
 
 /* Compact-support reparameterisation: t(u) = 1/2 - 15/16 (u - 2u^3/3 + u^5/5), u = d / r, of
- * distance d with gradient g (support radius r); the field's gradient to *out_g. */
-static inline float compact(float r, float d, ak_vec3 g, ak_vec3* out_g) {
-    float u = d / r;
+ * distance d with gradient g (inv_r: 1 / the support radius r); the field's gradient to *out_g. */
+static inline float compact(float inv_r, float d, ak_vec3 g, ak_vec3* out_g) {
+    float u = d * inv_r;
     *out_g = ak_vec3_zero();
     if (!(u < 1.0f)) return 0.0f;
     if (u <= -1.0f) return 1.0f;
     float u2 = u * u;
     float t = 0.5f - 0.9375f * (u - u2 * u * (2.0f / 3.0f) + u2 * u2 * u * 0.2f);
-    float dt = -0.9375f * (1.0f - u2) * (1.0f - u2) / r;
+    float dt = -0.9375f * (1.0f - u2) * (1.0f - u2) * inv_r;
     *out_g = ak_vec3_scale(g, dt);
     return t;
 }
@@ -205,7 +209,7 @@ typedef struct grid_probe {
     const float* n000;
     const float* m;
     size_t sy, sz; /* floats */
-    float tx, ty, tz, r;
+    float tx, ty, tz, r; /* r: 1 / the support radius */
 } grid_probe;
 
 /* The cell of bone b's grid that holds bind-space point y into *q; false outside the grid's
@@ -286,7 +290,7 @@ static float bone_field_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, ak_
     ak_vec3 g;
     *out_g = ak_vec3_zero();
     if (!bone_distance_fast(o, b, y, &d, &g)) return 0.0f;
-    return compact(o->bones[b * BONE_FLOATS + 8], d, g, out_g);
+    return compact(1.0f / o->bones[b * BONE_FLOATS + 8], d, g, out_g);
 }
 
 /* Per-frame broad phase: a coarse grid over the posed boxes of the bones' fields, one bit per
@@ -307,7 +311,7 @@ typedef struct field_ctx {
     const float* inv; /* [joint_count * 12] or NULL (bind pose) */
     float bulge;
     const broad_phase* bp; /* optional: skips bones whose box does not hold the point */
-    const float* cull;     /* optional: [joint_count * CULL_FLOATS], cull_build's capsule bounds */
+    const float* bf;       /* with bp: [joint_count * BF_FLOATS], bone_frames_build's records */
 } field_ctx;
 
 typedef struct field_acc {
@@ -360,12 +364,29 @@ static inline void prefetch_node(const float* p) {
  * that field_eval locates (and prefetches) every bone of a point before interpolating any. */
 static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_probe* q) {
     const ak_skin_implicit* o = c->o;
-    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return false;
-    const float* m = c->inv ? c->inv + 12 * b : NULL;
-    const ak_vec3 y = m ? to_bone(m, x) : x;
-    if (!grid_cell(o, b, y, c->cull ? c->cull + CULL_FLOATS * b : NULL, q)) return false;
-    q->m = m;
-    q->r = o->bones[b * BONE_FLOATS + 8];
+    const float* F = c->bf + BF_FLOATS * b; /* the broad phase holds bones with grids only */
+    const float px = F[0] * x.x + F[3] * x.y + F[6] * x.z + F[9];
+    const float py = F[1] * x.x + F[4] * x.y + F[7] * x.z + F[10];
+    const float pz = F[2] * x.x + F[5] * x.y + F[8] * x.z + F[11];
+    if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= F[20] && py <= F[21] && pz <= F[22])) return false;
+    if (F[19] > 0.0f) {
+        const float ax = px - F[12], ay = py - F[13], az = pz - F[14];
+        float t = (ax * F[15] + ay * F[16] + az * F[17]) * F[18];
+        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+        const float wx = ax - F[15] * t, wy = ay - F[16] * t, wz = az - F[17] * t;
+        if (wx * wx + wy * wy + wz * wz >= F[19]) return false;
+    }
+    const uint32_t* I = o->grid_info + b * GRID_INFO;
+    const uint32_t nx = I[0], ny = I[1], nz = I[2];
+    uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
+    if (ix > nx - 2) ix = nx - 2;
+    if (iy > ny - 2) iy = ny - 2;
+    if (iz > nz - 2) iz = nz - 2;
+    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
+    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
+    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+    q->m = c->inv + 12 * b;
+    q->r = F[23];
     prefetch_node(q->n000);
     prefetch_node(q->n000 + q->sy);
     prefetch_node(q->n000 + q->sz);
@@ -1487,6 +1508,36 @@ static void cull_build(const ak_skin_implicit* o, float* cull) {
     }
 }
 
+/* Per bone and frame (BF_FLOATS): the map from a posed point to the bone's grid coordinates
+ * (the inverse palette matrix inv, then (y - grid origin) / h, folded into one affine map), the
+ * capsule bound of cull_build in grid units, the grid's upper corner and the support radius. A
+ * point's grid coordinates round differently from the two-step map's (a few ulps); the bound's
+ * margin (cull_build) covers that, and the point's cell and fractions come from the same
+ * coordinates as its bound. */
+static void bone_frames_build(const ak_skin_implicit* o, const float* inv, const float* cull, float* bf) {
+    for (size_t b = 0; b < o->joint_count; ++b) {
+        float* F = bf + b * BF_FLOATS;
+        memset(F, 0, BF_FLOATS * sizeof(float));
+        const uint32_t* I = o->grid_info + b * GRID_INFO;
+        if (I[0] < 2) continue;
+        const float* G = o->bones + b * BONE_FLOATS + GRID_AT;
+        const float* M = inv + 12 * b;
+        const float s = G[3];
+        for (int q = 0; q < 9; ++q) F[q] = M[q] * s;
+        for (int q = 0; q < 3; ++q) F[9 + q] = (M[9 + q] - G[q]) * s;
+        const float* C = cull + b * CULL_FLOATS;
+        if (C[7] > 0.0f) {
+            for (int q = 0; q < 3; ++q) F[12 + q] = (C[q] - G[q]) * s, F[15 + q] = C[3 + q] * s;
+            F[18] = C[6] / (s * s);
+            F[19] = C[7] * (s * s);
+            if (!ak_finitef(F[18]) || !ak_finitef(F[19])) F[19] = 0.0f;
+        }
+        for (int q = 0; q < 3; ++q) F[20 + q] = (float)(I[q] - 1);
+        F[23] = 1.0f / o->bones[b * BONE_FLOATS + 8];
+        F[24] = o->bones[b * BONE_FLOATS + 8];
+    }
+}
+
 size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count) {
     if (!implicit) return 0;
     ak_mat4 probe;
@@ -1495,6 +1546,7 @@ size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t pa
     return 64 + align64(implicit->joint_count * 12 * sizeof(float)) + align64(ak_skin_job_scratch_size(&dq)) +
            align64(nv) + 3 * align64(nv * sizeof(ak_vec3)) + align64(bp_mask_bytes(implicit)) +
            align64(implicit->pair_count * PAIR_FRAME * sizeof(float)) + align64(implicit->joint_count * CULL_FLOATS * sizeof(float)) +
+           align64(implicit->joint_count * BF_FLOATS * sizeof(float)) +
            align64(nv * sizeof(uint32_t)) + align64(nv) + align64(implicit->triangle_count * sizeof(uint32_t)) +
            align64(nv * sizeof(uint32_t)) + align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(nv * 8 * sizeof(float));
 }
@@ -1891,6 +1943,8 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     base += align64(o->pair_count * PAIR_FRAME * sizeof(float));
     float* cull = (float*)(void*)base;
     base += align64(o->joint_count * CULL_FLOATS * sizeof(float));
+    float* bf = (float*)(void*)base;
+    base += align64(o->joint_count * BF_FLOATS * sizeof(float));
     uint32_t* list = (uint32_t*)(void*)base;
     base += align64(nv * sizeof(uint32_t));
     uint8_t* flag = base;
@@ -1929,7 +1983,8 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     broad_phase bp;
     if (o->grid_nodes) cull_build(o, cull);
     if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
-    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? cull : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, 0.0f};
+    if (o->grid_nodes) bone_frames_build(o, inv, cull, bf);
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, 0.0f};
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     /* the projectable representatives grouped by part (counting sort, index order within a
      * part), so that consecutive projections read the same grids (each vertex's projection
