@@ -1661,7 +1661,7 @@ static void contact_vertex(const run_ctx* c, size_t v, bool revert) {
         else if ((uint32_t)P[1] == part) side = -1.0f;
         else continue;
         ak_vec3 cb = ak_vec3_make(P[2], P[3], P[4]);
-        if (!(ak_vec3_length(ak_vec3_sub(vb, cb)) < P[11])) continue;
+        if (!(ak_vec3_length_sq(ak_vec3_sub(vb, cb)) < P[11] * P[11])) continue; /* the reach (near_fold) */
         const ak_vec3 cp = ak_vec3_make(F[0], F[1], F[2]), n = ak_vec3_make(F[3], F[4], F[5]);
         const ak_vec3 nr = ak_vec3_make(P[13], P[14], P[15]);
         const float gap = 0.02f * P[12], band = 0.4f * P[12];
@@ -1835,7 +1835,7 @@ static bool near_fold(const run_ctx* c, size_t v) {
     for (size_t p = 0; p < o->pair_count; ++p) {
         const float* P = o->pairs + p * PAIR_FLOATS;
         if (c->frame[p * PAIR_FRAME + 6] == 0.0f || ((uint32_t)P[0] != part && (uint32_t)P[1] != part)) continue;
-        if (ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4]))) < P[11]) return true;
+        if (ak_vec3_length_sq(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4]))) < P[11] * P[11]) return true;
     }
     return false;
 }
