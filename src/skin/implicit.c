@@ -22,7 +22,7 @@
 #define MAX_CAPS 16
 #define STOP_COS 0.57357643635f /* cos 55 degrees: the 2014 paper's discontinuity angle */
 #define ISO_EPS 1e-3f /* |F - iso| that ends a projection: about 0.1 % of the support radius */
-#define UNCHECKED_EPS (4.0f * ISO_EPS) /* |F - iso| from which one Newton step is taken to
+#define UNCHECKED_EPS (16.0f * ISO_EPS) /* |F - iso| from which one Newton step is taken to
                                          converge when a later round checks it anyway */
 #define CAPSULE_AT 12
 #define GRID_AT (CAPSULE_AT + 8)
