@@ -43,7 +43,9 @@
                         column-major, then translation), the capsule bound in grid units (end a(3),
                         b - a (3), 1 / |b - a|^2, squared reach; 0: no cull), the grid's upper
                         corner nx - 1, ny - 1, nz - 1, 1 / r, r, pad */
-#define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
+#define SAMPLE_FLOATS 8
+#define GROUP_FLOATS (24 * 4) /* a group of 4 bones: BF_FLOATS 0..23 of each, lane-interleaved */
+#define GROUP_CAP 1024        /* groups per frame; cells beyond take the scalar loop */ /* x y z alpha | bx by bz pad (normalised coordinates) */
 
 struct ak_skin_implicit {
     ak_allocator alloc;
@@ -82,6 +84,12 @@ static inline unsigned ctz64(uint64_t v) {
     while (!(v & 1u)) v >>= 1, ++n;
     return n;
 #endif
+}
+
+static inline uint32_t popcount64(uint64_t v) {
+    uint32_t n = 0;
+    for (; v; v &= v - 1) ++n;
+    return n;
 }
 
 /* ---- object memory ----------------------------------------------------------------------- */
@@ -302,6 +310,11 @@ typedef struct broad_phase {
     size_t words;   /* 64-bit words per cell */
     uint64_t* mask; /* [cells^3 * words] */
     bool empty;
+    /* SSE2, at most 64 bones: the bones of each distinct cell mask as groups of 4 (groups_build);
+     * per cell its first group and count (count UINT32_MAX: no group, the scalar loop) */
+    const uint32_t* cell_group; /* [2 * cells^3] or NULL */
+    const float* group;         /* [GROUP_CAP * GROUP_FLOATS] */
+    const uint32_t* group_bone; /* [GROUP_CAP * 4] */
 } broad_phase;
 
 /* Per-joint inverse transforms for one run: 12 floats (3x3 linear part column-major, then the
@@ -394,6 +407,58 @@ static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_pro
     return true;
 }
 
+#if AK_SIMD_SSE2
+/* grid_locate for the 4 bones of group G at once (lanes in bone order; a padding lane fails its
+ * box test): each lane does the scalar test's operations in the same order, so the same bones
+ * pass with the same coordinates. Appends the located ones to probe[*n]. */
+static inline void grid_locate4(const field_ctx* c, const float* G, const uint32_t* bones, ak_vec3 x, grid_probe* probe,
+                                unsigned* n) {
+    const __m128 X = _mm_set1_ps(x.x), Y = _mm_set1_ps(x.y), Z = _mm_set1_ps(x.z), zero = _mm_setzero_ps();
+#define GQ(q) _mm_load_ps(G + 4 * (q))
+    const __m128 px = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(GQ(0), X), _mm_mul_ps(GQ(3), Y)), _mm_mul_ps(GQ(6), Z)), GQ(9));
+    const __m128 py = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(GQ(1), X), _mm_mul_ps(GQ(4), Y)), _mm_mul_ps(GQ(7), Z)), GQ(10));
+    const __m128 pz = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(GQ(2), X), _mm_mul_ps(GQ(5), Y)), _mm_mul_ps(GQ(8), Z)), GQ(11));
+    __m128 in = _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(px, zero), _mm_cmpge_ps(py, zero)), _mm_cmpge_ps(pz, zero));
+    in = _mm_and_ps(in, _mm_and_ps(_mm_and_ps(_mm_cmple_ps(px, GQ(20)), _mm_cmple_ps(py, GQ(21))), _mm_cmple_ps(pz, GQ(22))));
+    if (!_mm_movemask_ps(in)) return;
+    const __m128 ax = _mm_sub_ps(px, GQ(12)), ay = _mm_sub_ps(py, GQ(13)), az = _mm_sub_ps(pz, GQ(14));
+    __m128 t = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, GQ(15)), _mm_mul_ps(ay, GQ(16))), _mm_mul_ps(az, GQ(17))), GQ(18));
+    const __m128 one = _mm_set1_ps(1.0f);
+    t = akp_simd_select(_mm_cmplt_ps(t, one), t, one);
+    t = _mm_and_ps(_mm_cmpgt_ps(t, zero), t);
+    const __m128 wx = _mm_sub_ps(ax, _mm_mul_ps(GQ(15), t)), wy = _mm_sub_ps(ay, _mm_mul_ps(GQ(16), t)),
+                 wz = _mm_sub_ps(az, _mm_mul_ps(GQ(17), t));
+    const __m128 w2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, wx), _mm_mul_ps(wy, wy)), _mm_mul_ps(wz, wz));
+    const __m128 culled = _mm_and_ps(_mm_cmpgt_ps(GQ(19), zero), _mm_cmpge_ps(w2, GQ(19)));
+    int bits = _mm_movemask_ps(_mm_andnot_ps(culled, in));
+#undef GQ
+    if (!bits) return;
+    float lx[4], ly[4], lz[4];
+    _mm_storeu_ps(lx, px), _mm_storeu_ps(ly, py), _mm_storeu_ps(lz, pz);
+    const ak_skin_implicit* o = c->o;
+    for (; bits; bits &= bits - 1) {
+        const unsigned l = (unsigned)ctz64((uint64_t)bits);
+        const size_t b = bones[l];
+        grid_probe* q = &probe[(*n)++];
+        const uint32_t* I = o->grid_info + b * GRID_INFO;
+        const uint32_t nx = I[0], ny = I[1], nz = I[2];
+        uint32_t ix = (uint32_t)lx[l], iy = (uint32_t)ly[l], iz = (uint32_t)lz[l];
+        if (ix > nx - 2) ix = nx - 2;
+        if (iy > ny - 2) iy = ny - 2;
+        if (iz > nz - 2) iz = nz - 2;
+        q->tx = lx[l] - (float)ix, q->ty = ly[l] - (float)iy, q->tz = lz[l] - (float)iz;
+        q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
+        q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+        q->m = c->inv + 12 * b;
+        q->r = G[4 * 23 + l];
+        prefetch_node(q->n000);
+        prefetch_node(q->n000 + q->sy);
+        prefetch_node(q->n000 + q->sz);
+        prefetch_node(q->n000 + q->sz + q->sy);
+    }
+}
+#endif
+
 /* The located cell's field (bone_field_fast's interpolation and compact map, then
  * field_add's gradient transform) into the two strongest. */
 static inline void grid_apply(const grid_probe* q, field_acc* a) {
@@ -424,7 +489,20 @@ static float field_eval(const field_ctx* c, ak_vec3 x, ak_vec3* out_g) {
          * nodes load meanwhile), then interpolate, in the same bone order */
         grid_probe probe[16];
         unsigned n = 0;
-        for (size_t w = 0; w < bp->words; ++w)
+#if AK_SIMD_SSE2
+        const uint32_t* cg = bp->cell_group ? bp->cell_group + 2 * cell : NULL;
+        if (cg && cg[1] != UINT32_MAX) {
+            for (uint32_t g = cg[0]; g < cg[0] + cg[1]; ++g) {
+                grid_locate4(c, bp->group + (size_t)g * GROUP_FLOATS, bp->group_bone + 4 * (size_t)g, x, probe, &n);
+                if (n > 12) { /* room for the next group's 4 */
+                    for (unsigned k = 0; k < n; ++k) grid_apply(&probe[k], &a);
+                    n = 0;
+                }
+            }
+            mw = NULL;
+        }
+#endif
+        for (size_t w = 0; mw && w < bp->words; ++w)
             for (uint64_t bits = mw[w]; bits; bits &= bits - 1)
                 if (grid_locate(c, 64 * w + (size_t)ctz64(bits), x, &probe[n]) && ++n == 16) {
                     for (unsigned k = 0; k < n; ++k) grid_apply(&probe[k], &a);
@@ -1538,6 +1616,63 @@ static void bone_frames_build(const ak_skin_implicit* o, const float* inv, const
     }
 }
 
+/* The SIMD broad phase (SSE2, at most 64 bones): the bones of every distinct cell mask, in bone
+ * order, as groups of 4 bone records (bone_frames_build's, lane-interleaved; a padding lane has an
+ * empty box); cell_group[2 cell] its first group and count (UINT32_MAX: more groups than
+ * GROUP_CAP, the scalar loop). table: [2 cells^3] scratch for the masks' hash. */
+static void groups_build(const float* bf, broad_phase* bp, uint32_t* cell_group, uint32_t* table,
+                         float* group, uint32_t* group_bone) {
+    bp->cell_group = NULL, bp->group = group, bp->group_bone = group_bone;
+#if AK_SIMD_SSE2
+    if (bp->empty || bp->words != 1) return;
+    const size_t ncell = (size_t)bp->cells * bp->cells * bp->cells, tsize = 2 * ncell; /* a power of 2 */
+    memset(table, 0xff, tsize * sizeof(uint32_t));
+    uint32_t used = 0;
+    for (size_t cell = 0; cell < ncell; ++cell) {
+        const uint64_t m = bp->mask[cell];
+        uint32_t* cg = cell_group + 2 * cell;
+        cg[0] = 0, cg[1] = 0;
+        if (!m) continue;
+        size_t h = (size_t)((m * 0x9E3779B97F4A7C15ull) >> 32) & (tsize - 1);
+        while (table[h] != UINT32_MAX && bp->mask[table[h]] != m) h = (h + 1) & (tsize - 1);
+        if (table[h] != UINT32_MAX) { /* a cell with the same bones: its groups */
+            cg[0] = cell_group[2 * (size_t)table[h]], cg[1] = cell_group[2 * (size_t)table[h] + 1];
+            continue;
+        }
+        table[h] = (uint32_t)cell;
+        const uint32_t count = (popcount64(m) + 3) / 4;
+        if (used + count > GROUP_CAP) {
+            cg[1] = UINT32_MAX;
+            continue;
+        }
+        cg[0] = used, cg[1] = count;
+        uint64_t bits = m;
+        for (uint32_t g = used; g < used + count; ++g) {
+            float* G = group + (size_t)g * GROUP_FLOATS;
+            for (unsigned l = 0; l < 4; ++l) {
+                uint32_t b = UINT32_MAX;
+                if (bits) b = ctz64(bits), bits &= bits - 1;
+                group_bone[4 * (size_t)g + l] = b;
+                for (int q = 0; q < 24; ++q) G[4 * q + l] = b != UINT32_MAX ? bf[(size_t)b * BF_FLOATS + q] : 0.0f;
+                if (b == UINT32_MAX) G[4 * 20 + l] = G[4 * 21 + l] = G[4 * 22 + l] = -1.0f; /* never in the box */
+            }
+        }
+        used += count;
+    }
+    bp->cell_group = cell_group;
+#else
+    (void)bf, (void)cell_group, (void)table;
+#endif
+}
+
+/* Scratch of groups_build: cell_group and table, the groups and their bones (0 without grids). */
+static size_t groups_bytes(const ak_skin_implicit* o) {
+    if (o->grid_nodes == 0) return 0;
+    const size_t c = bp_cells(o), ncell = c * c * c;
+    return align64(2 * ncell * sizeof(uint32_t)) + align64(2 * ncell * sizeof(uint32_t)) +
+           align64((size_t)GROUP_CAP * GROUP_FLOATS * sizeof(float)) + align64((size_t)GROUP_CAP * 4 * sizeof(uint32_t));
+}
+
 size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count) {
     if (!implicit) return 0;
     ak_mat4 probe;
@@ -1546,7 +1681,7 @@ size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t pa
     return 64 + align64(implicit->joint_count * 12 * sizeof(float)) + align64(ak_skin_job_scratch_size(&dq)) +
            align64(nv) + 3 * align64(nv * sizeof(ak_vec3)) + align64(bp_mask_bytes(implicit)) +
            align64(implicit->pair_count * PAIR_FRAME * sizeof(float)) + align64(implicit->joint_count * CULL_FLOATS * sizeof(float)) +
-           align64(implicit->joint_count * BF_FLOATS * sizeof(float)) +
+           align64(implicit->joint_count * BF_FLOATS * sizeof(float)) + groups_bytes(implicit) +
            align64(nv * sizeof(uint32_t)) + align64(nv) + align64(implicit->triangle_count * sizeof(uint32_t)) +
            align64(nv * sizeof(uint32_t)) + align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(nv * 8 * sizeof(float));
 }
@@ -1945,6 +2080,8 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     base += align64(o->joint_count * CULL_FLOATS * sizeof(float));
     float* bf = (float*)(void*)base;
     base += align64(o->joint_count * BF_FLOATS * sizeof(float));
+    unsigned char* groups = base;
+    base += groups_bytes(o);
     uint32_t* list = (uint32_t*)(void*)base;
     base += align64(nv * sizeof(uint32_t));
     uint8_t* flag = base;
@@ -1983,7 +2120,15 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     broad_phase bp;
     if (o->grid_nodes) cull_build(o, cull);
     if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
-    if (o->grid_nodes) bone_frames_build(o, inv, cull, bf);
+    if (o->grid_nodes) {
+        bone_frames_build(o, inv, cull, bf);
+        const size_t ncell = (size_t)bp.cells * bp.cells * bp.cells;
+        uint32_t* cell_group = (uint32_t*)(void*)groups;
+        uint32_t* table = (uint32_t*)(void*)(groups + align64(2 * ncell * sizeof(uint32_t)));
+        float* group = (float*)(void*)(groups + 2 * align64(2 * ncell * sizeof(uint32_t)));
+        uint32_t* group_bone = (uint32_t*)(void*)((unsigned char*)group + align64((size_t)GROUP_CAP * GROUP_FLOATS * sizeof(float)));
+        groups_build(bf, &bp, cell_group, table, group, group_bone);
+    }
     run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, 0.0f};
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     /* the projectable representatives grouped by part (counting sort, index order within a
