@@ -1683,7 +1683,8 @@ size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t pa
            align64(implicit->pair_count * PAIR_FRAME * sizeof(float)) + align64(implicit->joint_count * CULL_FLOATS * sizeof(float)) +
            align64(implicit->joint_count * BF_FLOATS * sizeof(float)) + groups_bytes(implicit) +
            align64(nv * sizeof(uint32_t)) + align64(nv) + align64(implicit->triangle_count * sizeof(uint32_t)) +
-           align64(nv * sizeof(uint32_t)) + align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(nv * 8 * sizeof(float));
+           align64(nv * sizeof(uint32_t)) + align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(nv * 8 * sizeof(float)) +
+           align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(2 * implicit->pair_count * sizeof(uint32_t));
 }
 
 enum { ST_KEEP = 0, ST_MOVED = 1, ST_STOPPED = 2, ST_CONTACT = 8 };
@@ -1698,6 +1699,8 @@ typedef struct run_ctx {
     uint8_t* state;
     const ak_vec3* dq;   /* the DQS result */
     const float* frame;  /* [pair_count * PAIR_FRAME] */
+    const uint32_t* fold_start; /* [joint_count + 1]: per part, its folded joints (fold_lists_build) */
+    const uint32_t* fold_pair;  /* [2 * pair_count] */
     float unchecked_below; /* project's: FLT_MAX in the rounds before the last, UNCHECKED_EPS in
                               the first projection when rounds follow, else 0 */
 } run_ctx;
@@ -1777,6 +1780,34 @@ static void contact_frames(const ak_skin_implicit* o, const ak_mat4* palette, fl
     }
 }
 
+/* Per part, its folded joints (contact_frames' flag) in joint order: fold_pair[fold_start[part]
+ * .. fold_start[part + 1]) (CSR over joint_count parts); parts out of range have none
+ * (FOLD_FIRST, FOLD_END). */
+static void fold_lists_build(const ak_skin_implicit* o, const float* frame, uint32_t* fold_start, uint32_t* fold_pair) {
+    const size_t nj = o->joint_count;
+    memset(fold_start, 0, (nj + 1) * sizeof(uint32_t));
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t p = 0; p < o->pair_count; ++p) {
+            if (frame[p * PAIR_FRAME + 6] == 0.0f) continue;
+            const float* P = o->pairs + p * PAIR_FLOATS;
+            const uint32_t i = (uint32_t)P[0], j = (uint32_t)P[1];
+            for (int e = 0; e < (i == j ? 1 : 2); ++e) {
+                const uint32_t part = e ? j : i;
+                if (part >= nj) continue;
+                if (pass == 0) ++fold_start[part + 1];
+                else fold_pair[fold_start[part]++] = (uint32_t)p;
+            }
+        }
+        if (pass == 0)
+            for (size_t b = 0; b < nj; ++b) fold_start[b + 1] += fold_start[b];
+        else /* the fill moved every start to the next part's: back by one part */
+            for (size_t b = nj; b > 0; --b) fold_start[b] = fold_start[b - 1];
+    }
+    fold_start[0] = 0;
+}
+#define FOLD_FIRST(c, part) ((part) < (c)->o->joint_count ? (c)->fold_start[(part)] : 0u)
+#define FOLD_END(c, part) ((part) < (c)->o->joint_count ? (c)->fold_start[(part) + 1] : 0u)
+
 /* One vertex against the contact planes of its part's joints (those folded by more than a
  * little): within a joint's reach, a vertex that the projection or DQS leaves within a band
  * of the plane goes back to its DQS position (the projection folds the skin there), and a
@@ -1787,10 +1818,10 @@ static void contact_vertex(const run_ctx* c, size_t v, bool revert) {
     const ak_vec3 vb = o->positions[v];
     ak_vec3 x = c->pos[v];
     bool touched = false;
-    for (size_t p = 0; p < o->pair_count; ++p) {
+    for (uint32_t k = FOLD_FIRST(c, part); k < FOLD_END(c, part); ++k) {
+        const size_t p = c->fold_pair[k];
         const float* P = o->pairs + p * PAIR_FLOATS;
         const float* F = c->frame + p * PAIR_FRAME;
-        if (F[6] == 0.0f) continue;
         float side;
         if ((uint32_t)P[0] == part) side = 1.0f;
         else if ((uint32_t)P[1] == part) side = -1.0f;
@@ -1842,10 +1873,8 @@ static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t
     for (size_t v = 0; v < nv; ++v) {
         flag[v] = 0;
         if (o->rep[v] != v || (c->state[v] & ST_CONTACT) || !projectable(o->iso[v])) continue;
-        for (size_t p = 0; p < o->pair_count; ++p) {
-            const float* P = o->pairs + p * PAIR_FLOATS;
-            if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
-            if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
+        for (uint32_t k = FOLD_FIRST(c, o->part[v]); k < FOLD_END(c, o->part[v]); ++k) {
+            const float* P = o->pairs + (size_t)c->fold_pair[k] * PAIR_FLOATS;
             float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
             if (1.0f - dist / (BULGE_REACH * P[12]) > 0.0f) {
                 flag[v] = 1, list[nl++] = (uint32_t)v;
@@ -1888,10 +1917,9 @@ static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t
             const size_t v = list[i];
             float w = 0.0f, cap = 0.0f;
             ak_vec3 dir = ak_vec3_zero();
-            for (size_t p = 0; p < o->pair_count; ++p) {
+            for (uint32_t k = FOLD_FIRST(c, o->part[v]); k < FOLD_END(c, o->part[v]); ++k) {
+                const size_t p = c->fold_pair[k];
                 const float* P = o->pairs + p * PAIR_FLOATS;
-                if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
-                if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
                 const float* F = c->frame + p * PAIR_FRAME;
                 /* the inner side of the fold only (where the parts press together),
                  * fading in over a seam radius */
@@ -1967,9 +1995,8 @@ static bool rigid_alone(const run_ctx* c, size_t v) {
 static bool near_fold(const run_ctx* c, size_t v) {
     const ak_skin_implicit* o = c->o;
     const uint32_t part = o->part[v];
-    for (size_t p = 0; p < o->pair_count; ++p) {
-        const float* P = o->pairs + p * PAIR_FLOATS;
-        if (c->frame[p * PAIR_FRAME + 6] == 0.0f || ((uint32_t)P[0] != part && (uint32_t)P[1] != part)) continue;
+    for (uint32_t k = FOLD_FIRST(c, part); k < FOLD_END(c, part); ++k) {
+        const float* P = o->pairs + (size_t)c->fold_pair[k] * PAIR_FLOATS;
         if (ak_vec3_length_sq(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4]))) < P[11] * P[11]) return true;
     }
     return false;
@@ -2094,6 +2121,10 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     base += align64((o->joint_count + 1) * sizeof(uint32_t));
     float* vcache = (float*)(void*)base;
     base += align64(nv * 8 * sizeof(float));
+    uint32_t* fold_start = (uint32_t*)(void*)base;
+    base += align64((o->joint_count + 1) * sizeof(uint32_t));
+    uint32_t* fold_pair = (uint32_t*)(void*)base;
+    base += align64(2 * o->pair_count * sizeof(uint32_t));
     uint64_t* mask = (uint64_t*)(void*)base;
     if (!invert_palette(o, job->palette.ptr, inv)) return AK_ERR_BAD_DATA;
     const uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
@@ -2129,7 +2160,7 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
         uint32_t* group_bone = (uint32_t*)(void*)((unsigned char*)group + align64((size_t)GROUP_CAP * GROUP_FLOATS * sizeof(float)));
         groups_build(bf, &bp, cell_group, table, group, group_bone);
     }
-    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, 0.0f};
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, fold_start, fold_pair, 0.0f};
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     /* the projectable representatives grouped by part (counting sort, index order within a
      * part), so that consecutive projections read the same grids (each vertex's projection
@@ -2148,6 +2179,7 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     if (o->pair_count) {
         bool contact = false;
         contact_frames(o, job->palette.ptr, frame);
+        fold_lists_build(o, frame, fold_start, fold_pair);
         for (size_t p = 0; p < o->pair_count; ++p) contact = contact || frame[p * PAIR_FRAME + 6] != 0.0f;
         if (contact) {
             /* phase 3 visits the vertices near a folded joint of their part, phase 4 those it
