@@ -86,11 +86,13 @@ static inline unsigned ctz64(uint64_t v) {
 #endif
 }
 
+#if AK_SIMD_SSE2
 static inline uint32_t popcount64(uint64_t v) {
     uint32_t n = 0;
     for (; v; v &= v - 1) ++n;
     return n;
 }
+#endif
 
 /* ---- object memory ----------------------------------------------------------------------- */
 
