@@ -43,9 +43,9 @@
                         column-major, then translation), the capsule bound in grid units (end a(3),
                         b - a (3), 1 / |b - a|^2, squared reach; 0: no cull), the grid's upper
                         corner nx - 1, ny - 1, nz - 1, 1 / r, r, pad */
-#define SAMPLE_FLOATS 8
+#define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
 #define GROUP_FLOATS (24 * 4) /* a group of 4 bones: BF_FLOATS 0..23 of each, lane-interleaved */
-#define GROUP_CAP 1024        /* groups per frame; cells beyond take the scalar loop */ /* x y z alpha | bx by bz pad (normalised coordinates) */
+#define GROUP_CAP 1024        /* groups per frame; cells beyond take the scalar loop */
 
 struct ak_skin_implicit {
     ak_allocator alloc;
@@ -424,10 +424,9 @@ static inline void grid_locate4(const field_ctx* c, const float* G, const uint32
     in = _mm_and_ps(in, _mm_and_ps(_mm_and_ps(_mm_cmple_ps(px, GQ(20)), _mm_cmple_ps(py, GQ(21))), _mm_cmple_ps(pz, GQ(22))));
     if (!_mm_movemask_ps(in)) return;
     const __m128 ax = _mm_sub_ps(px, GQ(12)), ay = _mm_sub_ps(py, GQ(13)), az = _mm_sub_ps(pz, GQ(14));
-    __m128 t = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, GQ(15)), _mm_mul_ps(ay, GQ(16))), _mm_mul_ps(az, GQ(17))), GQ(18));
-    const __m128 one = _mm_set1_ps(1.0f);
-    t = akp_simd_select(_mm_cmplt_ps(t, one), t, one);
-    t = _mm_and_ps(_mm_cmpgt_ps(t, zero), t);
+    const __m128 t0 = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, GQ(15)), _mm_mul_ps(ay, GQ(16))), _mm_mul_ps(az, GQ(17))), GQ(18));
+    const __m128 one = _mm_set1_ps(1.0f); /* t0 > 0 ? (t0 < 1 ? t0 : 1) : 0, as the scalar test */
+    const __m128 t = _mm_and_ps(_mm_cmpgt_ps(t0, zero), akp_simd_select(_mm_cmplt_ps(t0, one), t0, one));
     const __m128 wx = _mm_sub_ps(ax, _mm_mul_ps(GQ(15), t)), wy = _mm_sub_ps(ay, _mm_mul_ps(GQ(16), t)),
                  wz = _mm_sub_ps(az, _mm_mul_ps(GQ(17), t));
     const __m128 w2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, wx), _mm_mul_ps(wy, wy)), _mm_mul_ps(wz, wz));
