@@ -373,7 +373,8 @@ AK_API const char* ak_skin_simd_name(void);
  * of letting it sink. Vertices start from DQS, march along the gradient to their rest
  * iso-value (Newton steps), stop where the gradient turns by more than 55 degrees (the 2014
  * rule at gradient discontinuities: the contact surface), then alternate tangential
- * relaxation (towards the one-ring centroid, in the tangent plane) and re-projection.
+ * relaxation (towards the one-ring centroid, in the tangent plane) and re-projection (a step
+ * that a later round evaluates anyway is not re-evaluated).
  * Vertices whose DQS position is already at their iso-value (within 1e-4) keep it, so the
  * bind pose reproduces the mesh exactly. Split vertices (same bind position) move together.
  * The fields are sampled once into a grid per bone in bone space (distance and gradient,
@@ -454,7 +455,9 @@ typedef struct ak_skin_implicit_job {
     const ak_skin_implicit* implicit; /* required */
     ak_mat4_cspan palette;       /* required: skinning matrices (count >= joint_count) */
     uint32_t iterations;         /* Newton steps per projection; 0 -> 10 */
-    uint32_t relax_rounds;       /* relaxation + re-projection rounds; 0 -> 3 (UINT32_MAX -> none) */
+    uint32_t relax_rounds;       /* relaxation + re-projection rounds; 0 -> 3 (UINT32_MAX -> none);
+                                    the rounds before the last re-project with one Newton step
+                                    (checked by the next round), the last converges */
     uint32_t thread_count;       /* 0 or 1 -> calling thread; n (<= 64) -> n vertex ranges */
     ak_u8_span scratch;          /* >= ak_skin_implicit_scratch_size(implicit, palette.count) */
     ak_vec3_span out_positions;  /* required: count >= vertex count */

@@ -16,11 +16,14 @@
 #include <pthread.h> /* thread_count > 1 */
 
 #include "skin_internal.h"
+#include "../simd.h" /* AK_SIMD_SSE2: the trilinear interpolation 4 channels at a time */
 #include "../tasks.h"
 
 #define MAX_CAPS 16
 #define STOP_COS 0.57357643635f /* cos 55 degrees: the 2014 paper's discontinuity angle */
 #define ISO_EPS 1e-3f /* |F - iso| that ends a projection: about 0.1 % of the support radius */
+#define UNCHECKED_EPS (16.0f * ISO_EPS) /* |F - iso| from which one Newton step is taken to
+                                         converge when a later round checks it anyway */
 #define CAPSULE_AT 12
 #define GRID_AT (CAPSULE_AT + 8)
 #define BONE_FLOATS (GRID_AT + 4) /* cx cy cz s | ax ay az b | r sphere2 valid pad |
@@ -36,7 +39,13 @@
                         inner direction (3), pad, posed axis of part i (3), pad, of part j (3), pad */
 #define CULL_FLOATS 8 /* per bone and frame: capsule end a(3), b - a (3), 1 / |b - a|^2, squared
                          distance from the segment past which the grid's field is 0 (0: no cull) */
+#define BF_FLOATS 32 /* per bone and frame (bone_frames_build): posed point to grid coordinates (3x3
+                        column-major, then translation), the capsule bound in grid units (end a(3),
+                        b - a (3), 1 / |b - a|^2, squared reach; 0: no cull), the grid's upper
+                        corner nx - 1, ny - 1, nz - 1, 1 / r, r, pad */
 #define SAMPLE_FLOATS 8 /* x y z alpha | bx by bz pad (normalised coordinates) */
+#define GROUP_FLOATS (24 * 4) /* a group of 4 bones: BF_FLOATS 0..23 of each, lane-interleaved */
+#define GROUP_CAP 1024        /* groups per frame; cells beyond take the scalar loop */
 
 struct ak_skin_implicit {
     ak_allocator alloc;
@@ -76,6 +85,14 @@ static inline unsigned ctz64(uint64_t v) {
     return n;
 #endif
 }
+
+#if AK_SIMD_SSE2
+static inline uint32_t popcount64(uint64_t v) {
+    uint32_t n = 0;
+    for (; v; v &= v - 1) ++n;
+    return n;
+}
+#endif
 
 /* ---- object memory ----------------------------------------------------------------------- */
 
@@ -183,15 +200,15 @@ static bool bone_distance(const ak_skin_implicit* o, size_t b, ak_vec3 y, float*
 }
 
 /* Compact-support reparameterisation: t(u) = 1/2 - 15/16 (u - 2u^3/3 + u^5/5), u = d / r, of
- * distance d with gradient g (support radius r); the field's gradient to *out_g. */
-static inline float compact(float r, float d, ak_vec3 g, ak_vec3* out_g) {
-    float u = d / r;
+ * distance d with gradient g (inv_r: 1 / the support radius r); the field's gradient to *out_g. */
+static inline float compact(float inv_r, float d, ak_vec3 g, ak_vec3* out_g) {
+    float u = d * inv_r;
     *out_g = ak_vec3_zero();
     if (!(u < 1.0f)) return 0.0f;
     if (u <= -1.0f) return 1.0f;
     float u2 = u * u;
     float t = 0.5f - 0.9375f * (u - u2 * u * (2.0f / 3.0f) + u2 * u2 * u * 0.2f);
-    float dt = -0.9375f * (1.0f - u2) * (1.0f - u2) / r;
+    float dt = -0.9375f * (1.0f - u2) * (1.0f - u2) * inv_r;
     *out_g = ak_vec3_scale(g, dt);
     return t;
 }
@@ -202,7 +219,7 @@ typedef struct grid_probe {
     const float* n000;
     const float* m;
     size_t sy, sz; /* floats */
-    float tx, ty, tz, r;
+    float tx, ty, tz, r; /* r: 1 / the support radius */
 } grid_probe;
 
 /* The cell of bone b's grid that holds bind-space point y into *q; false outside the grid's
@@ -234,9 +251,22 @@ static inline bool grid_cell(const ak_skin_implicit* o, size_t b, ak_vec3 y, con
     return true;
 }
 
-/* Trilinear interpolation of the 4 values per node (distance, gradient) of q's cell. */
+/* Trilinear interpolation of the 4 values per node (distance, gradient) of q's cell. The SSE2
+ * path does per lane exactly the scalar loop's operations in the same order (lerp in x, then
+ * y, then z; no fused multiply-add), so both give the same bits. */
 static inline void grid_interp(const grid_probe* q, float r[4]) {
     const float *n000 = q->n000, *n010 = n000 + q->sy, *n001 = n000 + q->sz, *n011 = n001 + q->sy;
+#if AK_SIMD_SSE2
+    const __m128 tx = _mm_set1_ps(q->tx), ty = _mm_set1_ps(q->ty), tz = _mm_set1_ps(q->tz);
+    const __m128 a0 = _mm_loadu_ps(n000), a1 = _mm_loadu_ps(n000 + 4), b0 = _mm_loadu_ps(n010), b1 = _mm_loadu_ps(n010 + 4);
+    const __m128 c0 = _mm_loadu_ps(n001), c1 = _mm_loadu_ps(n001 + 4), d0 = _mm_loadu_ps(n011), d1 = _mm_loadu_ps(n011 + 4);
+    const __m128 a = _mm_add_ps(a0, _mm_mul_ps(tx, _mm_sub_ps(a1, a0)));
+    const __m128 bq = _mm_add_ps(b0, _mm_mul_ps(tx, _mm_sub_ps(b1, b0)));
+    const __m128 cq = _mm_add_ps(c0, _mm_mul_ps(tx, _mm_sub_ps(c1, c0)));
+    const __m128 dq = _mm_add_ps(d0, _mm_mul_ps(tx, _mm_sub_ps(d1, d0)));
+    const __m128 e = _mm_add_ps(a, _mm_mul_ps(ty, _mm_sub_ps(bq, a))), f = _mm_add_ps(cq, _mm_mul_ps(ty, _mm_sub_ps(dq, cq)));
+    _mm_storeu_ps(r, _mm_add_ps(e, _mm_mul_ps(tz, _mm_sub_ps(f, e))));
+#else
     const float tx = q->tx, ty = q->ty, tz = q->tz;
     for (int k = 0; k < 4; ++k) {
         float a = n000[k] + tx * (n000[4 + k] - n000[k]);
@@ -246,6 +276,7 @@ static inline void grid_interp(const grid_probe* q, float r[4]) {
         float e = a + ty * (bq - a), f = cq + ty * (dq - cq);
         r[k] = e + tz * (f - e);
     }
+#endif
 }
 
 /* Distance of bone b at bind-space point y and its gradient, from the bone's grid when the
@@ -269,7 +300,7 @@ static float bone_field_fast(const ak_skin_implicit* o, size_t b, ak_vec3 y, ak_
     ak_vec3 g;
     *out_g = ak_vec3_zero();
     if (!bone_distance_fast(o, b, y, &d, &g)) return 0.0f;
-    return compact(o->bones[b * BONE_FLOATS + 8], d, g, out_g);
+    return compact(1.0f / o->bones[b * BONE_FLOATS + 8], d, g, out_g);
 }
 
 /* Per-frame broad phase: a coarse grid over the posed boxes of the bones' fields, one bit per
@@ -281,6 +312,11 @@ typedef struct broad_phase {
     size_t words;   /* 64-bit words per cell */
     uint64_t* mask; /* [cells^3 * words] */
     bool empty;
+    /* SSE2, at most 64 bones: the bones of each distinct cell mask as groups of 4 (groups_build);
+     * per cell its first group and count (count UINT32_MAX: no group, the scalar loop) */
+    const uint32_t* cell_group; /* [2 * cells^3] or NULL */
+    const float* group;         /* [GROUP_CAP * GROUP_FLOATS] */
+    const uint32_t* group_bone; /* [GROUP_CAP * 4] */
 } broad_phase;
 
 /* Per-joint inverse transforms for one run: 12 floats (3x3 linear part column-major, then the
@@ -290,7 +326,7 @@ typedef struct field_ctx {
     const float* inv; /* [joint_count * 12] or NULL (bind pose) */
     float bulge;
     const broad_phase* bp; /* optional: skips bones whose box does not hold the point */
-    const float* cull;     /* optional: [joint_count * CULL_FLOATS], cull_build's capsule bounds */
+    const float* bf;       /* with bp: [joint_count * BF_FLOATS], bone_frames_build's records */
 } field_ctx;
 
 typedef struct field_acc {
@@ -343,18 +379,86 @@ static inline void prefetch_node(const float* p) {
  * that field_eval locates (and prefetches) every bone of a point before interpolating any. */
 static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_probe* q) {
     const ak_skin_implicit* o = c->o;
-    if (o->bones[b * BONE_FLOATS + 10] == 0.0f) return false;
-    const float* m = c->inv ? c->inv + 12 * b : NULL;
-    const ak_vec3 y = m ? to_bone(m, x) : x;
-    if (!grid_cell(o, b, y, c->cull ? c->cull + CULL_FLOATS * b : NULL, q)) return false;
-    q->m = m;
-    q->r = o->bones[b * BONE_FLOATS + 8];
+    const float* F = c->bf + BF_FLOATS * b; /* the broad phase holds bones with grids only */
+    const float px = F[0] * x.x + F[3] * x.y + F[6] * x.z + F[9];
+    const float py = F[1] * x.x + F[4] * x.y + F[7] * x.z + F[10];
+    const float pz = F[2] * x.x + F[5] * x.y + F[8] * x.z + F[11];
+    if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= F[20] && py <= F[21] && pz <= F[22])) return false;
+    if (F[19] > 0.0f) {
+        const float ax = px - F[12], ay = py - F[13], az = pz - F[14];
+        float t = (ax * F[15] + ay * F[16] + az * F[17]) * F[18];
+        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+        const float wx = ax - F[15] * t, wy = ay - F[16] * t, wz = az - F[17] * t;
+        if (wx * wx + wy * wy + wz * wz >= F[19]) return false;
+    }
+    const uint32_t* I = o->grid_info + b * GRID_INFO;
+    const uint32_t nx = I[0], ny = I[1], nz = I[2];
+    uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
+    if (ix > nx - 2) ix = nx - 2;
+    if (iy > ny - 2) iy = ny - 2;
+    if (iz > nz - 2) iz = nz - 2;
+    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
+    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
+    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+    q->m = c->inv + 12 * b;
+    q->r = F[23];
     prefetch_node(q->n000);
     prefetch_node(q->n000 + q->sy);
     prefetch_node(q->n000 + q->sz);
     prefetch_node(q->n000 + q->sz + q->sy);
     return true;
 }
+
+#if AK_SIMD_SSE2
+/* grid_locate for the 4 bones of group G at once (lanes in bone order; a padding lane fails its
+ * box test): each lane does the scalar test's operations in the same order, so the same bones
+ * pass with the same coordinates. Appends the located ones to probe[*n]. */
+static inline void grid_locate4(const field_ctx* c, const float* G, const uint32_t* bones, ak_vec3 x, grid_probe* probe,
+                                unsigned* n) {
+    const __m128 X = _mm_set1_ps(x.x), Y = _mm_set1_ps(x.y), Z = _mm_set1_ps(x.z), zero = _mm_setzero_ps();
+#define GQ(q) _mm_load_ps(G + 4 * (q))
+    const __m128 px = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(GQ(0), X), _mm_mul_ps(GQ(3), Y)), _mm_mul_ps(GQ(6), Z)), GQ(9));
+    const __m128 py = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(GQ(1), X), _mm_mul_ps(GQ(4), Y)), _mm_mul_ps(GQ(7), Z)), GQ(10));
+    const __m128 pz = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(GQ(2), X), _mm_mul_ps(GQ(5), Y)), _mm_mul_ps(GQ(8), Z)), GQ(11));
+    __m128 in = _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(px, zero), _mm_cmpge_ps(py, zero)), _mm_cmpge_ps(pz, zero));
+    in = _mm_and_ps(in, _mm_and_ps(_mm_and_ps(_mm_cmple_ps(px, GQ(20)), _mm_cmple_ps(py, GQ(21))), _mm_cmple_ps(pz, GQ(22))));
+    if (!_mm_movemask_ps(in)) return;
+    const __m128 ax = _mm_sub_ps(px, GQ(12)), ay = _mm_sub_ps(py, GQ(13)), az = _mm_sub_ps(pz, GQ(14));
+    const __m128 t0 = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, GQ(15)), _mm_mul_ps(ay, GQ(16))), _mm_mul_ps(az, GQ(17))), GQ(18));
+    const __m128 one = _mm_set1_ps(1.0f); /* t0 > 0 ? (t0 < 1 ? t0 : 1) : 0, as the scalar test */
+    const __m128 t = _mm_and_ps(_mm_cmpgt_ps(t0, zero), akp_simd_select(_mm_cmplt_ps(t0, one), t0, one));
+    const __m128 wx = _mm_sub_ps(ax, _mm_mul_ps(GQ(15), t)), wy = _mm_sub_ps(ay, _mm_mul_ps(GQ(16), t)),
+                 wz = _mm_sub_ps(az, _mm_mul_ps(GQ(17), t));
+    const __m128 w2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, wx), _mm_mul_ps(wy, wy)), _mm_mul_ps(wz, wz));
+    const __m128 culled = _mm_and_ps(_mm_cmpgt_ps(GQ(19), zero), _mm_cmpge_ps(w2, GQ(19)));
+    int bits = _mm_movemask_ps(_mm_andnot_ps(culled, in));
+#undef GQ
+    if (!bits) return;
+    float lx[4], ly[4], lz[4];
+    _mm_storeu_ps(lx, px), _mm_storeu_ps(ly, py), _mm_storeu_ps(lz, pz);
+    const ak_skin_implicit* o = c->o;
+    for (; bits; bits &= bits - 1) {
+        const unsigned l = (unsigned)ctz64((uint64_t)bits);
+        const size_t b = bones[l];
+        grid_probe* q = &probe[(*n)++];
+        const uint32_t* I = o->grid_info + b * GRID_INFO;
+        const uint32_t nx = I[0], ny = I[1], nz = I[2];
+        uint32_t ix = (uint32_t)lx[l], iy = (uint32_t)ly[l], iz = (uint32_t)lz[l];
+        if (ix > nx - 2) ix = nx - 2;
+        if (iy > ny - 2) iy = ny - 2;
+        if (iz > nz - 2) iz = nz - 2;
+        q->tx = lx[l] - (float)ix, q->ty = ly[l] - (float)iy, q->tz = lz[l] - (float)iz;
+        q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
+        q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+        q->m = c->inv + 12 * b;
+        q->r = G[4 * 23 + l];
+        prefetch_node(q->n000);
+        prefetch_node(q->n000 + q->sy);
+        prefetch_node(q->n000 + q->sz);
+        prefetch_node(q->n000 + q->sz + q->sy);
+    }
+}
+#endif
 
 /* The located cell's field (bone_field_fast's interpolation and compact map, then
  * field_add's gradient transform) into the two strongest. */
@@ -386,7 +490,20 @@ static float field_eval(const field_ctx* c, ak_vec3 x, ak_vec3* out_g) {
          * nodes load meanwhile), then interpolate, in the same bone order */
         grid_probe probe[16];
         unsigned n = 0;
-        for (size_t w = 0; w < bp->words; ++w)
+#if AK_SIMD_SSE2
+        const uint32_t* cg = bp->cell_group ? bp->cell_group + 2 * cell : NULL;
+        if (cg && cg[1] != UINT32_MAX) {
+            for (uint32_t g = cg[0]; g < cg[0] + cg[1]; ++g) {
+                grid_locate4(c, bp->group + (size_t)g * GROUP_FLOATS, bp->group_bone + 4 * (size_t)g, x, probe, &n);
+                if (n > 12) { /* room for the next group's 4 */
+                    for (unsigned k = 0; k < n; ++k) grid_apply(&probe[k], &a);
+                    n = 0;
+                }
+            }
+            mw = NULL;
+        }
+#endif
+        for (size_t w = 0; mw && w < bp->words; ++w)
             for (uint64_t bits = mw[w]; bits; bits &= bits - 1)
                 if (grid_locate(c, 64 * w + (size_t)ctz64(bits), x, &probe[n]) && ++n == 16) {
                     for (unsigned k = 0; k < n; ++k) grid_apply(&probe[k], &a);
@@ -1470,6 +1587,93 @@ static void cull_build(const ak_skin_implicit* o, float* cull) {
     }
 }
 
+/* Per bone and frame (BF_FLOATS): the map from a posed point to the bone's grid coordinates
+ * (the inverse palette matrix inv, then (y - grid origin) / h, folded into one affine map), the
+ * capsule bound of cull_build in grid units, the grid's upper corner and the support radius. A
+ * point's grid coordinates round differently from the two-step map's (a few ulps); the bound's
+ * margin (cull_build) covers that, and the point's cell and fractions come from the same
+ * coordinates as its bound. */
+static void bone_frames_build(const ak_skin_implicit* o, const float* inv, const float* cull, float* bf) {
+    for (size_t b = 0; b < o->joint_count; ++b) {
+        float* F = bf + b * BF_FLOATS;
+        memset(F, 0, BF_FLOATS * sizeof(float));
+        const uint32_t* I = o->grid_info + b * GRID_INFO;
+        if (I[0] < 2) continue;
+        const float* G = o->bones + b * BONE_FLOATS + GRID_AT;
+        const float* M = inv + 12 * b;
+        const float s = G[3];
+        for (int q = 0; q < 9; ++q) F[q] = M[q] * s;
+        for (int q = 0; q < 3; ++q) F[9 + q] = (M[9 + q] - G[q]) * s;
+        const float* C = cull + b * CULL_FLOATS;
+        if (C[7] > 0.0f) {
+            for (int q = 0; q < 3; ++q) F[12 + q] = (C[q] - G[q]) * s, F[15 + q] = C[3 + q] * s;
+            F[18] = C[6] / (s * s);
+            F[19] = C[7] * (s * s);
+            if (!ak_finitef(F[18]) || !ak_finitef(F[19])) F[19] = 0.0f;
+        }
+        for (int q = 0; q < 3; ++q) F[20 + q] = (float)(I[q] - 1);
+        F[23] = 1.0f / o->bones[b * BONE_FLOATS + 8];
+        F[24] = o->bones[b * BONE_FLOATS + 8];
+    }
+}
+
+/* The SIMD broad phase (SSE2, at most 64 bones): the bones of every distinct cell mask, in bone
+ * order, as groups of 4 bone records (bone_frames_build's, lane-interleaved; a padding lane has an
+ * empty box); cell_group[2 cell] its first group and count (UINT32_MAX: more groups than
+ * GROUP_CAP, the scalar loop). table: [2 cells^3] scratch for the masks' hash. */
+static void groups_build(const float* bf, broad_phase* bp, uint32_t* cell_group, uint32_t* table,
+                         float* group, uint32_t* group_bone) {
+    bp->cell_group = NULL, bp->group = group, bp->group_bone = group_bone;
+#if AK_SIMD_SSE2
+    if (bp->empty || bp->words != 1) return;
+    const size_t ncell = (size_t)bp->cells * bp->cells * bp->cells, tsize = 2 * ncell; /* a power of 2 */
+    memset(table, 0xff, tsize * sizeof(uint32_t));
+    uint32_t used = 0;
+    for (size_t cell = 0; cell < ncell; ++cell) {
+        const uint64_t m = bp->mask[cell];
+        uint32_t* cg = cell_group + 2 * cell;
+        cg[0] = 0, cg[1] = 0;
+        if (!m) continue;
+        size_t h = (size_t)((m * 0x9E3779B97F4A7C15ull) >> 32) & (tsize - 1);
+        while (table[h] != UINT32_MAX && bp->mask[table[h]] != m) h = (h + 1) & (tsize - 1);
+        if (table[h] != UINT32_MAX) { /* a cell with the same bones: its groups */
+            cg[0] = cell_group[2 * (size_t)table[h]], cg[1] = cell_group[2 * (size_t)table[h] + 1];
+            continue;
+        }
+        table[h] = (uint32_t)cell;
+        const uint32_t count = (popcount64(m) + 3) / 4;
+        if (used + count > GROUP_CAP) {
+            cg[1] = UINT32_MAX;
+            continue;
+        }
+        cg[0] = used, cg[1] = count;
+        uint64_t bits = m;
+        for (uint32_t g = used; g < used + count; ++g) {
+            float* G = group + (size_t)g * GROUP_FLOATS;
+            for (unsigned l = 0; l < 4; ++l) {
+                uint32_t b = UINT32_MAX;
+                if (bits) b = ctz64(bits), bits &= bits - 1;
+                group_bone[4 * (size_t)g + l] = b;
+                for (int q = 0; q < 24; ++q) G[4 * q + l] = b != UINT32_MAX ? bf[(size_t)b * BF_FLOATS + q] : 0.0f;
+                if (b == UINT32_MAX) G[4 * 20 + l] = G[4 * 21 + l] = G[4 * 22 + l] = -1.0f; /* never in the box */
+            }
+        }
+        used += count;
+    }
+    bp->cell_group = cell_group;
+#else
+    (void)bf, (void)cell_group, (void)table;
+#endif
+}
+
+/* Scratch of groups_build: cell_group and table, the groups and their bones (0 without grids). */
+static size_t groups_bytes(const ak_skin_implicit* o) {
+    if (o->grid_nodes == 0) return 0;
+    const size_t c = bp_cells(o), ncell = c * c * c;
+    return align64(2 * ncell * sizeof(uint32_t)) + align64(2 * ncell * sizeof(uint32_t)) +
+           align64((size_t)GROUP_CAP * GROUP_FLOATS * sizeof(float)) + align64((size_t)GROUP_CAP * 4 * sizeof(uint32_t));
+}
+
 size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count) {
     if (!implicit) return 0;
     ak_mat4 probe;
@@ -1478,8 +1682,10 @@ size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t pa
     return 64 + align64(implicit->joint_count * 12 * sizeof(float)) + align64(ak_skin_job_scratch_size(&dq)) +
            align64(nv) + 3 * align64(nv * sizeof(ak_vec3)) + align64(bp_mask_bytes(implicit)) +
            align64(implicit->pair_count * PAIR_FRAME * sizeof(float)) + align64(implicit->joint_count * CULL_FLOATS * sizeof(float)) +
+           align64(implicit->joint_count * BF_FLOATS * sizeof(float)) + groups_bytes(implicit) +
            align64(nv * sizeof(uint32_t)) + align64(nv) + align64(implicit->triangle_count * sizeof(uint32_t)) +
-           align64(nv * sizeof(uint32_t)) + align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(nv * 8 * sizeof(float));
+           align64(nv * sizeof(uint32_t)) + align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(nv * 8 * sizeof(float)) +
+           align64((implicit->joint_count + 1) * sizeof(uint32_t)) + align64(2 * implicit->pair_count * sizeof(uint32_t));
 }
 
 enum { ST_KEEP = 0, ST_MOVED = 1, ST_STOPPED = 2, ST_CONTACT = 8 };
@@ -1494,10 +1700,17 @@ typedef struct run_ctx {
     uint8_t* state;
     const ak_vec3* dq;   /* the DQS result */
     const float* frame;  /* [pair_count * PAIR_FRAME] */
+    const uint32_t* fold_start; /* [joint_count + 1]: per part, its folded joints (fold_lists_build) */
+    const uint32_t* fold_pair;  /* [2 * pair_count] */
+    float unchecked_below; /* project's: FLT_MAX in the rounds before the last, UNCHECKED_EPS in
+                              the first projection when rounds follow, else 0 */
 } run_ctx;
 
-/* Newton steps from *p towards the vertex's iso-value; returns the state. */
-static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, bool first) {
+/* Newton steps from *p towards the vertex's iso-value; returns the state. A step taken where
+ * |F - iso| < unchecked_below is the last one and its end is not evaluated (out_g is then the
+ * gradient where it started): used where a later relaxation round evaluates the point anyway
+ * (0: every step is checked). */
+static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, bool first, float unchecked_below) {
     ak_vec3 g, gprev = ak_vec3_zero();
     ak_vec3 x = *p;
     uint8_t st = first ? ST_KEEP : ST_MOVED;
@@ -1517,6 +1730,7 @@ static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, 
         x = ak_vec3_add(x, step);
         gprev = g;
         if (st == ST_KEEP) st = ST_MOVED;
+        if (fabsf(e) < unchecked_below) break;
     }
     if (!ak_vec3_is_finite(x) || !ak_vec3_is_finite(g)) { /* never NaN out: keep the start */
         x = *p;
@@ -1567,6 +1781,34 @@ static void contact_frames(const ak_skin_implicit* o, const ak_mat4* palette, fl
     }
 }
 
+/* Per part, its folded joints (contact_frames' flag) in joint order: fold_pair[fold_start[part]
+ * .. fold_start[part + 1]) (CSR over joint_count parts); parts out of range have none
+ * (FOLD_FIRST, FOLD_END). */
+static void fold_lists_build(const ak_skin_implicit* o, const float* frame, uint32_t* fold_start, uint32_t* fold_pair) {
+    const size_t nj = o->joint_count;
+    memset(fold_start, 0, (nj + 1) * sizeof(uint32_t));
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t p = 0; p < o->pair_count; ++p) {
+            if (frame[p * PAIR_FRAME + 6] == 0.0f) continue;
+            const float* P = o->pairs + p * PAIR_FLOATS;
+            const uint32_t i = (uint32_t)P[0], j = (uint32_t)P[1];
+            for (int e = 0; e < (i == j ? 1 : 2); ++e) {
+                const uint32_t part = e ? j : i;
+                if (part >= nj) continue;
+                if (pass == 0) ++fold_start[part + 1];
+                else fold_pair[fold_start[part]++] = (uint32_t)p;
+            }
+        }
+        if (pass == 0)
+            for (size_t b = 0; b < nj; ++b) fold_start[b + 1] += fold_start[b];
+        else /* the fill moved every start to the next part's: back by one part */
+            for (size_t b = nj; b > 0; --b) fold_start[b] = fold_start[b - 1];
+    }
+    fold_start[0] = 0;
+}
+#define FOLD_FIRST(c, part) ((part) < (c)->o->joint_count ? (c)->fold_start[(part)] : 0u)
+#define FOLD_END(c, part) ((part) < (c)->o->joint_count ? (c)->fold_start[(part) + 1] : 0u)
+
 /* One vertex against the contact planes of its part's joints (those folded by more than a
  * little): within a joint's reach, a vertex that the projection or DQS leaves within a band
  * of the plane goes back to its DQS position (the projection folds the skin there), and a
@@ -1577,16 +1819,16 @@ static void contact_vertex(const run_ctx* c, size_t v, bool revert) {
     const ak_vec3 vb = o->positions[v];
     ak_vec3 x = c->pos[v];
     bool touched = false;
-    for (size_t p = 0; p < o->pair_count; ++p) {
+    for (uint32_t k = FOLD_FIRST(c, part); k < FOLD_END(c, part); ++k) {
+        const size_t p = c->fold_pair[k];
         const float* P = o->pairs + p * PAIR_FLOATS;
         const float* F = c->frame + p * PAIR_FRAME;
-        if (F[6] == 0.0f) continue;
         float side;
         if ((uint32_t)P[0] == part) side = 1.0f;
         else if ((uint32_t)P[1] == part) side = -1.0f;
         else continue;
         ak_vec3 cb = ak_vec3_make(P[2], P[3], P[4]);
-        if (!(ak_vec3_length(ak_vec3_sub(vb, cb)) < P[11])) continue;
+        if (!(ak_vec3_length_sq(ak_vec3_sub(vb, cb)) < P[11] * P[11])) continue; /* the reach (near_fold) */
         const ak_vec3 cp = ak_vec3_make(F[0], F[1], F[2]), n = ak_vec3_make(F[3], F[4], F[5]);
         const ak_vec3 nr = ak_vec3_make(P[13], P[14], P[15]);
         const float gap = 0.02f * P[12], band = 0.4f * P[12];
@@ -1632,10 +1874,8 @@ static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t
     for (size_t v = 0; v < nv; ++v) {
         flag[v] = 0;
         if (o->rep[v] != v || (c->state[v] & ST_CONTACT) || !projectable(o->iso[v])) continue;
-        for (size_t p = 0; p < o->pair_count; ++p) {
-            const float* P = o->pairs + p * PAIR_FLOATS;
-            if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
-            if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
+        for (uint32_t k = FOLD_FIRST(c, o->part[v]); k < FOLD_END(c, o->part[v]); ++k) {
+            const float* P = o->pairs + (size_t)c->fold_pair[k] * PAIR_FLOATS;
             float dist = ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4])));
             if (1.0f - dist / (BULGE_REACH * P[12]) > 0.0f) {
                 flag[v] = 1, list[nl++] = (uint32_t)v;
@@ -1678,10 +1918,9 @@ static void keep_volume(const run_ctx* c, ak_vec3* grad, uint32_t* list, uint8_t
             const size_t v = list[i];
             float w = 0.0f, cap = 0.0f;
             ak_vec3 dir = ak_vec3_zero();
-            for (size_t p = 0; p < o->pair_count; ++p) {
+            for (uint32_t k = FOLD_FIRST(c, o->part[v]); k < FOLD_END(c, o->part[v]); ++k) {
+                const size_t p = c->fold_pair[k];
                 const float* P = o->pairs + p * PAIR_FLOATS;
-                if (c->frame[p * PAIR_FRAME + 6] == 0.0f) continue;
-                if ((uint32_t)P[0] != o->part[v] && (uint32_t)P[1] != o->part[v]) continue;
                 const float* F = c->frame + p * PAIR_FRAME;
                 /* the inner side of the fold only (where the parts press together),
                  * fading in over a seam radius */
@@ -1757,10 +1996,9 @@ static bool rigid_alone(const run_ctx* c, size_t v) {
 static bool near_fold(const run_ctx* c, size_t v) {
     const ak_skin_implicit* o = c->o;
     const uint32_t part = o->part[v];
-    for (size_t p = 0; p < o->pair_count; ++p) {
-        const float* P = o->pairs + p * PAIR_FLOATS;
-        if (c->frame[p * PAIR_FRAME + 6] == 0.0f || ((uint32_t)P[0] != part && (uint32_t)P[1] != part)) continue;
-        if (ak_vec3_length(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4]))) < P[11]) return true;
+    for (uint32_t k = FOLD_FIRST(c, part); k < FOLD_END(c, part); ++k) {
+        const float* P = o->pairs + (size_t)c->fold_pair[k] * PAIR_FLOATS;
+        if (ak_vec3_length_sq(ak_vec3_sub(o->positions[v], ak_vec3_make(P[2], P[3], P[4]))) < P[11] * P[11]) return true;
     }
     return false;
 }
@@ -1781,7 +2019,7 @@ static void* run_worker(void* arg) {
         if (o->rep[v] != v || !projectable(o->iso[v])) continue;
         if (t->phase == 0) {
             if (rigid_alone(c, v)) continue; /* kept: exactly at its iso-value already */
-            c->state[v] = project(c, o->iso[v], &c->pos[v], &c->grad[v], true);
+            c->state[v] = project(c, o->iso[v], &c->pos[v], &c->grad[v], true, c->unchecked_below);
         } else if (t->phase == 1) {
             if (c->state[v] == ST_KEEP) continue;
             uint32_t a = o->adj_start[v], b = o->adj_start[v + 1];
@@ -1795,7 +2033,7 @@ static void* run_worker(void* arg) {
             c->pos[v] = ak_vec3_is_finite(q) ? q : c->prev[v];
         } else if (t->phase == 2) {
             if (c->state[v] == ST_KEEP) continue;
-            uint8_t st = project(c, o->iso[v], &c->pos[v], &c->grad[v], false);
+            uint8_t st = project(c, o->iso[v], &c->pos[v], &c->grad[v], false, c->unchecked_below);
             if (st == ST_STOPPED) c->state[v] = ST_STOPPED;
         } else if (t->phase == 3) {
             contact_vertex(c, v, true);
@@ -1868,6 +2106,10 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     base += align64(o->pair_count * PAIR_FRAME * sizeof(float));
     float* cull = (float*)(void*)base;
     base += align64(o->joint_count * CULL_FLOATS * sizeof(float));
+    float* bf = (float*)(void*)base;
+    base += align64(o->joint_count * BF_FLOATS * sizeof(float));
+    unsigned char* groups = base;
+    base += groups_bytes(o);
     uint32_t* list = (uint32_t*)(void*)base;
     base += align64(nv * sizeof(uint32_t));
     uint8_t* flag = base;
@@ -1880,6 +2122,10 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     base += align64((o->joint_count + 1) * sizeof(uint32_t));
     float* vcache = (float*)(void*)base;
     base += align64(nv * 8 * sizeof(float));
+    uint32_t* fold_start = (uint32_t*)(void*)base;
+    base += align64((o->joint_count + 1) * sizeof(uint32_t));
+    uint32_t* fold_pair = (uint32_t*)(void*)base;
+    base += align64(2 * o->pair_count * sizeof(uint32_t));
     uint64_t* mask = (uint64_t*)(void*)base;
     if (!invert_palette(o, job->palette.ptr, inv)) return AK_ERR_BAD_DATA;
     const uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
@@ -1906,23 +2152,35 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     broad_phase bp;
     if (o->grid_nodes) cull_build(o, cull);
     if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
-    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? cull : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame};
+    if (o->grid_nodes) {
+        bone_frames_build(o, inv, cull, bf);
+        const size_t ncell = (size_t)bp.cells * bp.cells * bp.cells;
+        uint32_t* cell_group = (uint32_t*)(void*)groups;
+        uint32_t* table = (uint32_t*)(void*)(groups + align64(2 * ncell * sizeof(uint32_t)));
+        float* group = (float*)(void*)(groups + 2 * align64(2 * ncell * sizeof(uint32_t)));
+        uint32_t* group_bone = (uint32_t*)(void*)((unsigned char*)group + align64((size_t)GROUP_CAP * GROUP_FLOATS * sizeof(float)));
+        groups_build(bf, &bp, cell_group, table, group, group_bone);
+    }
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, fold_start, fold_pair, 0.0f};
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     /* the projectable representatives grouped by part (counting sort, index order within a
      * part), so that consecutive projections read the same grids (each vertex's projection
      * is independent of the others': the order changes no result) */
     const size_t np = order_by_part(o, order, counts);
-    run_phase(&c, 0, threads, order, np);
     uint32_t rounds = job->relax_rounds == 0 ? 3 : job->relax_rounds == UINT32_MAX ? 0 : job->relax_rounds;
     if (rounds > 64) rounds = 64;
+    c.unchecked_below = rounds ? UNCHECKED_EPS : 0.0f;
+    run_phase(&c, 0, threads, order, np);
     for (uint32_t k = 0; k < rounds; ++k) {
         memcpy(prev, pos, nv * sizeof(ak_vec3));
         run_phase(&c, 1, threads, order, np);
+        c.unchecked_below = k + 1 < rounds ? FLT_MAX : 0.0f;
         run_phase(&c, 2, threads, order, np);
     }
     if (o->pair_count) {
         bool contact = false;
         contact_frames(o, job->palette.ptr, frame);
+        fold_lists_build(o, frame, fold_start, fold_pair);
         for (size_t p = 0; p < o->pair_count; ++p) contact = contact || frame[p * PAIR_FRAME + 6] != 0.0f;
         if (contact) {
             /* phase 3 visits the vertices near a folded joint of their part, phase 4 those it
