@@ -42,8 +42,7 @@ static float simplex_corner(uint32_t dims, float r0, const float* d, const float
 static inline __attribute__((always_inline)) float simplex_corner_value(uint32_t dims, const float* d, const float* g) {
     float r2 = 0.0f, gd = 0.0f;
     for (uint32_t k = 0; k < dims; ++k) r2 += d[k] * d[k], gd += g[k] * d[k];
-    float t = 0.5f - r2;
-    t = t > 0.0f ? t : 0.0f;
+    const float t = akp_max0(0.5f - r2);
     const float t2 = t * t;
     return t2 * t2 * gd;
 }
@@ -76,8 +75,8 @@ float ak_noise_simplex2(const ak_noise* noise, float x, float y, float* out_grad
 static inline __attribute__((always_inline)) float simplex3_corner_value(float dx, float dy, float dz, const float* g) {
     const float r2 = ((0.0f + dx * dx) + dy * dy) + dz * dz;
     const float gd = ((0.0f + g[0] * dx) + g[1] * dy) + g[2] * dz;
-    const float t = 0.5f - r2;
-    if (t <= 0.0f) return 0.0f;
+    float t = 0.5f - r2;
+    t = akp_max0(t); /* as simplex_corner_value: a zero term of either sign, no branch */
     const float t2 = t * t;
     return t2 * t2 * gd;
 }

@@ -4,12 +4,26 @@
 
 #include <math.h>
 #include <string.h>
+#if defined(__SSE__) || defined(__x86_64__)
+#include <xmmintrin.h>
+#endif
 
 #include <animkit/noise.h>
 
 /* Coordinates at or beyond this magnitude (and NaN) give 0: their floor would not fit the
  * integer lattice arithmetic, and floats there have no fractional part anyway. */
 #define AKP_NOISE_LIMIT 16777216.0f
+
+/* t > 0 ? t : +0.0f as one maxss on x86 (gcc compiles the ?: of a float to a branch, which
+ * random points mispredict); the same value either way, NaN included (maxss returns its second
+ * operand, +0.0, when the comparison is false). */
+static inline float akp_max0(float t) {
+#if defined(__SSE__) || defined(__x86_64__)
+    return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(t), _mm_setzero_ps()));
+#else
+    return t > 0.0f ? t : 0.0f;
+#endif
+}
 
 /* akp_floor (below) without the sign step: floorf(x) except +0.0 for x = -0.0, for callers where that
  * zero's sign cannot reach the result (simplex: see simplex3_value). */
