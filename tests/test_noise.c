@@ -857,14 +857,27 @@ AK_TEST(sway_layer) {
     AK_CHECK_EQ(ak_noise_sway_validate(&job2), AK_ERR_BAD_DATA);
 }
 
-/* akp_floor / akp_floor_frac (the per-point functions' floor) give libm's floorf bit for bit:
+/* akp_floor / akp_floor_frac (the per-point functions' floor) give libm's floorf bit for bit,
+ * and so do both floors they choose between (truncation; roundss on SSE4.1 CPUs):
  * every 61st float pattern below the 2^24 limit of either sign, and around every integer
  * within 4096 of zero the integer itself, both neighbours and +-0. */
 static int floor_mismatch(float x) {
     int i = 7, j = 7;
     const float fl = akp_floor(x, &i), fr = akp_floor_frac(x, &j);
     const float want = floorf(x), want_fr = x - want;
-    return memcmp(&fl, &want, sizeof fl) != 0 || memcmp(&fr, &want_fr, sizeof fr) != 0 || i != (int)want ||
+    /* both variants akp_floor chooses between: +0.0 where floorf gives -0.0 */
+    const float want_u = want + 0.0f;
+    int k = 7;
+    const float tr = akp_floor_trunc(x, &k);
+    int bad = memcmp(&tr, &want_u, sizeof tr) != 0 || k != (int)want;
+#ifdef AKP_HAVE_FLOOR_ROUNDSS
+    if (__builtin_cpu_supports("sse4.1")) {
+        k = 7;
+        const float rs = akp_floor_roundss(x, &k);
+        bad |= memcmp(&rs, &want_u, sizeof rs) != 0 || k != (int)want;
+    }
+#endif
+    return bad || memcmp(&fl, &want, sizeof fl) != 0 || memcmp(&fr, &want_fr, sizeof fr) != 0 || i != (int)want ||
            j != (int)want;
 }
 
