@@ -701,6 +701,35 @@ AK_TEST(worley_matches_brute_force) {
     }
 }
 
+/* Worley F1 without gradient (on AVX2 CPUs: the 3^dims near cells side by side in vector
+ * lanes, point_avx2.c) against F1 with gradient (the scalar ring search, which keeps the
+ * nearest cell): the same bits, 2D and 3D, two seeds, points of every magnitude up to 2^22
+ * and of either sign, some on cell borders and corners (where the far rings are searched). */
+AK_TEST(worley_value_path_matches_gradient_path) {
+    long bad = 0, count = 0;
+    for (uint64_t seed = 0; seed < 2; ++seed) {
+        const ak_noise n = ak_noise_make(seed * 0x9E3779B97F4A7C15ull + 5);
+        ak_rng rng = ak_rng_make(11 + seed);
+        for (int i = 0; i < 40000; ++i) {
+            float p[3];
+            for (int k = 0; k < 3; ++k) {
+                const float scale = ldexpf(1.0f, (int)(ak_rng_u32(&rng) % 23)); /* 1 .. 2^22 */
+                p[k] = frand(&rng, -scale, scale);
+                if (i % 4 == 0) p[k] = floorf(p[k]) + (i % 8 == 0 ? 0.0f : 1e-3f); /* borders */
+            }
+            for (uint32_t dims = 2; dims <= 3; ++dims) {
+                float g[3];
+                const float v = ak_noise_worley(&n, dims, p, NULL, NULL), w = ak_noise_worley(&n, dims, p, NULL, g);
+                bad += memcmp(&v, &w, sizeof v) != 0, ++count;
+            }
+        }
+    }
+#ifdef AKP_HAVE_POINT_AVX2
+    printf("  value-only path: %s\n", __builtin_cpu_supports("avx2") ? "AVX2 lanes" : "scalar rings (no AVX2)");
+#endif
+    AK_CHECK_MSG(bad == 0, "%ld of %ld Worley values differ between the two paths", bad, count);
+}
+
 static float comp(ak_vec3 v, int k) { return k == 0 ? v.x : k == 1 ? v.y : v.z; }
 static void set_comp(ak_vec3* v, int k, float x) {
     if (k == 0) v->x = x;
@@ -968,6 +997,7 @@ AK_TEST(per_point_matches_job_signed_zero) {
 int main(void) {
     AK_RUN(permutations);
     AK_RUN(floor_matches_libm);
+    AK_RUN(worley_value_path_matches_gradient_path);
     AK_RUN(perlin3_published_value);
     AK_RUN(perlin_matches_reference);
     AK_RUN(zero_at_lattice);

@@ -496,6 +496,11 @@ static inline __attribute__((always_inline)) float worley_n(const ak_noise* nois
     }
     worley_best b = {INFINITY, INFINITY, {0, 0, 0}};
     if (want_f2) worley_near_rings(dims, noise->seed, base, f, true, &b);
+#ifdef AKP_HAVE_POINT_AVX2
+    /* the value alone (no nearest offset to keep): the cells in AVX2 lanes */
+    else if (dims >= 2 && !out_gradient && __builtin_cpu_supports("avx2"))
+        b.d1 = akp_worley_d1_avx2(dims, noise->seed, base, f);
+#endif
     else worley_f1_rings(dims, noise->seed, base, f, &b);
     const float bound = 1.0f + margin; /* ring 2's */
     if (bound * bound < (want_f2 ? b.d2 : b.d1)) worley_far_rings(dims, noise->seed, base, f, margin, want_f2, &b);

@@ -86,6 +86,15 @@ static inline float akp_floor_frac(float x, int* out_i) {
     return (x - akp_floor_unsigned_zero(x, out_i)) + 0.0f;
 }
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
+#define AKP_HAVE_POINT_AVX2 1
+/* point_avx2.c, for CPUs with AVX2 (callers check): Worley F1's squared distance over rings 0
+ * and 1 (the 3^dims cells around the point, dims 2 or 3), the cells side by side in the lanes;
+ * bases.c's worley_f1_rings's d1 bit for bit (the same float operations per cell; a minimum
+ * does not depend on the order). base: the point's cell, f: its offset in the cell. */
+float akp_worley_d1_avx2(uint32_t dims, uint64_t seed, const int* base, const float* f);
+#endif
+
 /* The fBm octave sum without gradient or warp, for a resolved, valid desc of type FBM and a
  * dims the basis supports: octaves()'s loop (fractal.c) with the basis inlined, the same float
  * operations in the same order. Perlin in perlin.c, the other bases in bases.c. */
