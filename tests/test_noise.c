@@ -292,6 +292,40 @@ AK_TEST(fractal_octaves_scale_by_gain) {
     }
 }
 
+/* ak_fractal_eval reads a desc with every field given where it is and fills in the defaults of
+ * one that leaves fields at 0: the documented defaults written out give the same bits as the
+ * zeros, with and without gradient, and an out-of-range field given explicitly still gives 0. */
+AK_TEST(fractal_eval_explicit_fields_equal_defaults) {
+    const ak_noise n = ak_noise_make(9);
+    const ak_fractal_desc zero = {.type = AK_FRACTAL_DEFAULT}; /* FBM, Perlin, 6 octaves, 2, 0.5, 1 */
+    const ak_fractal_desc full = {.type = AK_FRACTAL_FBM, .basis = AK_NOISE_BASIS_PERLIN, .octaves = 6,
+                                  .lacunarity = 2.0f, .gain = 0.5f, .frequency = 1.0f};
+    ak_rng rng = ak_rng_make(19);
+    long bad = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const float p[3] = {frand(&rng, -40, 40), frand(&rng, -40, 40), frand(&rng, -40, 40)};
+        for (uint32_t dims = 2; dims <= 3; ++dims) {
+            float ga[3] = {0, 0, 0}, gb[3] = {0, 0, 0};
+            const float a = ak_fractal_eval(&n, &zero, dims, p, NULL), b = ak_fractal_eval(&n, &full, dims, p, NULL);
+            const float c = ak_fractal_eval(&n, &zero, dims, p, ga), d = ak_fractal_eval(&n, &full, dims, p, gb);
+            bad += memcmp(&a, &b, sizeof a) != 0 || memcmp(&c, &d, sizeof c) != 0 || memcmp(ga, gb, sizeof ga) != 0;
+            bad += a == 0.0f; /* a non-trivial value (Perlin fBm is 0 only on the lattice) */
+        }
+    }
+    AK_CHECK_MSG(bad == 0, "%ld of 4000 points differ", bad);
+    const float p[3] = {0.3f, 0.7f, 0.1f};
+    ak_fractal_desc wrong = full;
+    wrong.octaves = 17;
+    AK_CHECK_EQ(ak_fractal_eval(&n, &wrong, 3, p, NULL), 0.0f);
+    wrong = full;
+    wrong.gain = 2.5f;
+    AK_CHECK_EQ(ak_fractal_eval(&n, &wrong, 3, p, NULL), 0.0f);
+    wrong = full;
+    wrong.basis = AK_NOISE_BASIS_SIMPLEX;
+    AK_CHECK_EQ(ak_fractal_eval(&n, &wrong, 4, (const float[4]){0.3f, 0.7f, 0.1f, 0.2f}, NULL), 0.0f);
+    AK_CHECK(ak_fractal_eval(&n, &full, 3, p, NULL) != 0.0f);
+}
+
 /* Analytic fractal gradients (chain rule through |n|, the ridged weights, the warp) against
  * central differences; points within h of a kink of |n| (where two step sizes disagree) are
  * skipped, and they must be rare. */
@@ -998,6 +1032,7 @@ int main(void) {
     AK_RUN(permutations);
     AK_RUN(floor_matches_libm);
     AK_RUN(worley_value_path_matches_gradient_path);
+    AK_RUN(fractal_eval_explicit_fields_equal_defaults);
     AK_RUN(perlin3_published_value);
     AK_RUN(perlin_matches_reference);
     AK_RUN(zero_at_lattice);
