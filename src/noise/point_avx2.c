@@ -6,6 +6,7 @@
 
 #ifdef AKP_HAVE_POINT_AVX2
 #include <immintrin.h>
+#include <string.h>
 
 #define KT __attribute__((target("avx2")))
 
@@ -37,15 +38,16 @@ static const int32_t worley_off3[3][32] = {
     {-1, -1, -1, 0, 0, 0, 1, 1, 1, -1, -1, -1, 0, 0, 0, 1, 1, 1, -1, -1, -1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0},
     {-1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0},
 };
-static const int32_t worley_off2[2][16] = {
-    {-1, 0, 1, -1, 0, 1, -1, 0, 1, 0, 0, 0, 0, 0, 0, 0},
-    {-1, -1, -1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0},
+static const int32_t worley_off2[2][8] = {
+    {-1, 0, 1, -1, 0, 1, -1, 0},
+    {-1, -1, -1, 0, 0, 0, 1, 1},
 };
 
 KT float akp_worley_d1_avx2(uint32_t dims, uint64_t seed, const int* base, const float* f) {
     static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
     const __m256i seed_mix = _mm256_set1_epi32((int)((uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32)));
-    const uint32_t vectors = dims == 3 ? 4 : 2;
+    /* 2D: cells 0..7 in one vector, cell 8 (offset (1, 1)) below in scalar */
+    const uint32_t vectors = dims == 3 ? 4 : 1;
     __m256 d1 = _mm256_set1_ps(INFINITY);
     for (uint32_t v = 0; v < vectors; ++v) {
         __m256i a[3] = {_mm256_setzero_si256(), _mm256_setzero_si256(), _mm256_setzero_si256()};
@@ -61,6 +63,24 @@ KT float akp_worley_d1_avx2(uint32_t dims, uint64_t seed, const int* base, const
         d1 = _mm256_min_ps(d1, worley_lanes(dims, seed_mix, a, c, f));
     }
     __m128 m = _mm_min_ps(_mm256_castps256_ps128(d1), _mm256_extractf128_ps(d1, 1));
+    if (dims == 2) {
+        uint32_t h = ((uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32)) ^ (uint32_t)(base[0] + 1) * mul[0] ^
+                     (uint32_t)(base[1] + 1) * mul[1];
+        h ^= h >> 16;
+        h *= 0x85EBCA6Bu;
+        h ^= h >> 13;
+        h *= 0xC2B2AE35u;
+        h ^= h >> 16;
+        float dist2 = 0.0f;
+        for (uint32_t k = 0; k < 2; ++k) {
+            const uint32_t bits = 0x3F801000u | ((h >> (10 * k)) & 1023u) << 13;
+            float fp;
+            memcpy(&fp, &bits, sizeof fp);
+            const float dv = f[k] - (fp - 0.0f); /* off 1: 1 - off = 0 */
+            dist2 += dv * dv;
+        }
+        m = _mm_min_ps(m, _mm_set1_ps(dist2));
+    }
     m = _mm_min_ps(m, _mm_movehl_ps(m, m));
     m = _mm_min_ss(m, _mm_shuffle_ps(m, m, 1));
     return _mm_cvtss_f32(m);
