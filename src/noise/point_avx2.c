@@ -12,8 +12,8 @@
 
 /* Squared distances to the feature points of 8 cells (bases.c worley_offset, lane by lane):
  * a[k] the cells' axis-k hash terms, c[k] the floats 1 - off[k] of each lane's cell. */
-KT static inline __m256 worley_lanes(uint32_t dims, __m256i seed_mix, const __m256i* a, const __m256* c,
-                                     const float* f) {
+KT static inline __m256 worley_lanes(uint32_t dims, __m256i seed_mix, const __m256i* a,
+                                     const __m256* c, const float* f) {
     __m256i h = _mm256_xor_si256(seed_mix, a[0]);
     for (uint32_t k = 1; k < dims; ++k) h = _mm256_xor_si256(h, a[k]);
     h = _mm256_xor_si256(h, _mm256_srli_epi32(h, 16));
@@ -23,8 +23,10 @@ KT static inline __m256 worley_lanes(uint32_t dims, __m256i seed_mix, const __m2
     h = _mm256_xor_si256(h, _mm256_srli_epi32(h, 16));
     __m256 dist2 = _mm256_setzero_ps();
     for (uint32_t k = 0; k < dims; ++k) {
-        const __m256i m = _mm256_and_si256(_mm256_srli_epi32(h, (int)(10 * k)), _mm256_set1_epi32(1023));
-        const __m256 fp = _mm256_castsi256_ps(_mm256_or_si256(_mm256_slli_epi32(m, 13), _mm256_set1_epi32(0x3F801000)));
+        const __m256i m =
+            _mm256_and_si256(_mm256_srli_epi32(h, (int)(10 * k)), _mm256_set1_epi32(1023));
+        const __m256 fp = _mm256_castsi256_ps(
+            _mm256_or_si256(_mm256_slli_epi32(m, 13), _mm256_set1_epi32(0x3F801000)));
         const __m256 dv = _mm256_sub_ps(_mm256_set1_ps(f[k]), _mm256_sub_ps(fp, c[k]));
         dist2 = _mm256_add_ps(dist2, _mm256_mul_ps(dv, dv));
     }
@@ -34,9 +36,12 @@ KT static inline __m256 worley_lanes(uint32_t dims, __m256i seed_mix, const __m2
 /* Cell offsets o - 1 per lane (cell index c: o = (c % 3, c / 3 % 3, c / 9)); lanes past the
  * last cell repeat the centre cell, which leaves the minimum unchanged. */
 static const int32_t worley_off3[3][32] = {
-    {-1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1, 0, 0, 0, 0, 0},
-    {-1, -1, -1, 0, 0, 0, 1, 1, 1, -1, -1, -1, 0, 0, 0, 1, 1, 1, -1, -1, -1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0},
-    {-1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0},
+    {-1, 0, 1,  -1, 0, 1,  -1, 0, 1,  -1, 0, 1, -1, 0, 1, -1,
+     0,  1, -1, 0,  1, -1, 0,  1, -1, 0,  1, 0, 0,  0, 0, 0},
+    {-1, -1, -1, 0,  0,  0, 1, 1, 1, -1, -1, -1, 0, 0, 0, 1,
+     1,  1,  -1, -1, -1, 0, 0, 0, 1, 1,  1,  0,  0, 0, 0, 0},
+    {-1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 0, 0, 0, 0, 0, 0,
+     0,  0,  1,  1,  1,  1,  1,  1,  1,  1, 1, 0, 0, 0, 0, 0},
 };
 static const int32_t worley_off2[2][8] = {
     {-1, 0, 1, -1, 0, 1, -1, 0},
@@ -45,7 +50,8 @@ static const int32_t worley_off2[2][8] = {
 
 KT float akp_worley_d1_avx2(uint32_t dims, uint64_t seed, const int* base, const float* f) {
     static const uint32_t mul[3] = {0x8DA6B343u, 0xD8163841u, 0xCB1AB31Fu};
-    const __m256i seed_mix = _mm256_set1_epi32((int)((uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32)));
+    const __m256i seed_mix =
+        _mm256_set1_epi32((int)((uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32)));
     /* 2D: cells 0..7 in one vector, cell 8 (offset (1, 1)) below in scalar */
     const uint32_t vectors = dims == 3 ? 4 : 1;
     __m256 d1 = _mm256_set1_ps(INFINITY);
@@ -56,7 +62,8 @@ KT float akp_worley_d1_avx2(uint32_t dims, uint64_t seed, const int* base, const
             const int32_t* off = dims == 3 ? worley_off3[k] + 8 * v : worley_off2[k] + 8 * v;
             const __m256i o = _mm256_loadu_si256((const __m256i*)off);
             /* (base + off) * mul, wrapping, as bases.c's axis terms */
-            a[k] = _mm256_mullo_epi32(_mm256_add_epi32(_mm256_set1_epi32(base[k]), o), _mm256_set1_epi32((int)mul[k]));
+            a[k] = _mm256_mullo_epi32(_mm256_add_epi32(_mm256_set1_epi32(base[k]), o),
+                                      _mm256_set1_epi32((int)mul[k]));
             /* (float)(1 - off), exact */
             c[k] = _mm256_cvtepi32_ps(_mm256_sub_epi32(_mm256_set1_epi32(1), o));
         }
@@ -64,8 +71,8 @@ KT float akp_worley_d1_avx2(uint32_t dims, uint64_t seed, const int* base, const
     }
     __m128 m = _mm_min_ps(_mm256_castps256_ps128(d1), _mm256_extractf128_ps(d1, 1));
     if (dims == 2) {
-        uint32_t h = ((uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32)) ^ (uint32_t)(base[0] + 1) * mul[0] ^
-                     (uint32_t)(base[1] + 1) * mul[1];
+        uint32_t h = ((uint32_t)seed * 0x9E3779B1u ^ (uint32_t)(seed >> 32)) ^
+                     (uint32_t)(base[0] + 1) * mul[0] ^ (uint32_t)(base[1] + 1) * mul[1];
         h ^= h >> 16;
         h *= 0x85EBCA6Bu;
         h ^= h >> 13;
