@@ -124,11 +124,10 @@ static inline __attribute__((always_inline)) float simplex3_value(const uint8_t*
     return 76.0f * sum;
 }
 
-float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
-    const float p[3] = {x, y, z};
-    zero_grad(out_gradient, 3);
-    if (!noise || !all_finite(3, p)) return 0.0f;
-    if (!out_gradient) return simplex3_value(noise->perm, x, y, z);
+/* ak_noise_simplex3 with the gradient at a finite point, out of line (the value-only call
+ * then needs no frame for its registers). */
+static __attribute__((noinline)) float simplex3_grad(const ak_noise* noise, float x, float y, float z,
+                                                     float* out_gradient) {
     const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
     const float s = (x + y + z) * F3;
     int ii, jj, kk;
@@ -154,6 +153,14 @@ float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float*
     if (out_gradient)
         for (int k = 0; k < 3; ++k) out_gradient[k] = 76.0f * g[k];
     return 76.0f * sum;
+}
+
+float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
+    const float p[3] = {x, y, z};
+    if (!out_gradient) return noise && all_finite(3, p) ? simplex3_value(noise->perm, x, y, z) : 0.0f;
+    zero_grad(out_gradient, 3);
+    if (!noise || !all_finite(3, p)) return 0.0f;
+    return simplex3_grad(noise, x, y, z, out_gradient);
 }
 
 /* ---- value noise --------------------------------------------------------------------------- */
