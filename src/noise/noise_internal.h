@@ -61,7 +61,7 @@ static inline float akp_floor_roundss(float x, int* out_i) {
  * SSE4.1 (every x86-64 CPU since 2008; a cached CPUID bit, a branch that never mispredicts):
  * akp_floor_trunc's chain of truncation, conversion back, compare and subtract sat on every
  * lattice hash's path (per point: value 3D 1.43x -> 1.16x FastNoiseLite's time, Perlin 3D
- * 1.07x -> 0.88x; docs/noise.md). */
+ * 1.07x -> 0.88x; docs/BENCHMARKS.md, noise). */
 static inline float akp_floor_unsigned_zero(float x, int* out_i) {
 #ifdef AKP_HAVE_FLOOR_ROUNDSS
 #ifndef __SSE4_1__
