@@ -292,6 +292,40 @@ AK_TEST(fractal_octaves_scale_by_gain) {
     }
 }
 
+/* ak_fractal_eval reads a desc with every field given where it is and fills in the defaults of
+ * one that leaves fields at 0: the documented defaults written out give the same bits as the
+ * zeros, with and without gradient, and an out-of-range field given explicitly still gives 0. */
+AK_TEST(fractal_eval_explicit_fields_equal_defaults) {
+    const ak_noise n = ak_noise_make(9);
+    const ak_fractal_desc zero = {.type = AK_FRACTAL_DEFAULT}; /* FBM, Perlin, 6 octaves, 2, 0.5, 1 */
+    const ak_fractal_desc full = {.type = AK_FRACTAL_FBM, .basis = AK_NOISE_BASIS_PERLIN, .octaves = 6,
+                                  .lacunarity = 2.0f, .gain = 0.5f, .frequency = 1.0f};
+    ak_rng rng = ak_rng_make(19);
+    long bad = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const float p[3] = {frand(&rng, -40, 40), frand(&rng, -40, 40), frand(&rng, -40, 40)};
+        for (uint32_t dims = 2; dims <= 3; ++dims) {
+            float ga[3] = {0, 0, 0}, gb[3] = {0, 0, 0};
+            const float a = ak_fractal_eval(&n, &zero, dims, p, NULL), b = ak_fractal_eval(&n, &full, dims, p, NULL);
+            const float c = ak_fractal_eval(&n, &zero, dims, p, ga), d = ak_fractal_eval(&n, &full, dims, p, gb);
+            bad += memcmp(&a, &b, sizeof a) != 0 || memcmp(&c, &d, sizeof c) != 0 || memcmp(ga, gb, sizeof ga) != 0;
+            bad += a == 0.0f; /* a non-trivial value (Perlin fBm is 0 only on the lattice) */
+        }
+    }
+    AK_CHECK_MSG(bad == 0, "%ld of 4000 points differ", bad);
+    const float p[3] = {0.3f, 0.7f, 0.1f};
+    ak_fractal_desc wrong = full;
+    wrong.octaves = 17;
+    AK_CHECK_EQ(ak_fractal_eval(&n, &wrong, 3, p, NULL), 0.0f);
+    wrong = full;
+    wrong.gain = 2.5f;
+    AK_CHECK_EQ(ak_fractal_eval(&n, &wrong, 3, p, NULL), 0.0f);
+    wrong = full;
+    wrong.basis = AK_NOISE_BASIS_SIMPLEX;
+    AK_CHECK_EQ(ak_fractal_eval(&n, &wrong, 4, (const float[4]){0.3f, 0.7f, 0.1f, 0.2f}, NULL), 0.0f);
+    AK_CHECK(ak_fractal_eval(&n, &full, 3, p, NULL) != 0.0f);
+}
+
 /* Analytic fractal gradients (chain rule through |n|, the ridged weights, the warp) against
  * central differences; points within h of a kink of |n| (where two step sizes disagree) are
  * skipped, and they must be rare. */
@@ -701,6 +735,35 @@ AK_TEST(worley_matches_brute_force) {
     }
 }
 
+/* Worley F1 without gradient (on AVX2 CPUs: the 3^dims near cells side by side in vector
+ * lanes, point_avx2.c) against F1 with gradient (the scalar ring search, which keeps the
+ * nearest cell): the same bits, 2D and 3D, two seeds, points of every magnitude up to 2^22
+ * and of either sign, some on cell borders and corners (where the far rings are searched). */
+AK_TEST(worley_value_path_matches_gradient_path) {
+    long bad = 0, count = 0;
+    for (uint64_t seed = 0; seed < 2; ++seed) {
+        const ak_noise n = ak_noise_make(seed * 0x9E3779B97F4A7C15ull + 5);
+        ak_rng rng = ak_rng_make(11 + seed);
+        for (int i = 0; i < 40000; ++i) {
+            float p[3];
+            for (int k = 0; k < 3; ++k) {
+                const float scale = ldexpf(1.0f, (int)(ak_rng_u32(&rng) % 23)); /* 1 .. 2^22 */
+                p[k] = frand(&rng, -scale, scale);
+                if (i % 4 == 0) p[k] = floorf(p[k]) + (i % 8 == 0 ? 0.0f : 1e-3f); /* borders */
+            }
+            for (uint32_t dims = 2; dims <= 3; ++dims) {
+                float g[3];
+                const float v = ak_noise_worley(&n, dims, p, NULL, NULL), w = ak_noise_worley(&n, dims, p, NULL, g);
+                bad += memcmp(&v, &w, sizeof v) != 0, ++count;
+            }
+        }
+    }
+#ifdef AKP_HAVE_POINT_AVX2
+    printf("  value-only path: %s\n", __builtin_cpu_supports("avx2") ? "AVX2 lanes" : "scalar rings (no AVX2)");
+#endif
+    AK_CHECK_MSG(bad == 0, "%ld of %ld Worley values differ between the two paths", bad, count);
+}
+
 static float comp(ak_vec3 v, int k) { return k == 0 ? v.x : k == 1 ? v.y : v.z; }
 static void set_comp(ak_vec3* v, int k, float x) {
     if (k == 0) v->x = x;
@@ -857,14 +920,27 @@ AK_TEST(sway_layer) {
     AK_CHECK_EQ(ak_noise_sway_validate(&job2), AK_ERR_BAD_DATA);
 }
 
-/* akp_floor / akp_floor_frac (the per-point functions' floor) give libm's floorf bit for bit:
+/* akp_floor / akp_floor_frac (the per-point functions' floor) give libm's floorf bit for bit,
+ * and so do both floors they choose between (truncation; roundss on SSE4.1 CPUs):
  * every 61st float pattern below the 2^24 limit of either sign, and around every integer
  * within 4096 of zero the integer itself, both neighbours and +-0. */
 static int floor_mismatch(float x) {
     int i = 7, j = 7;
     const float fl = akp_floor(x, &i), fr = akp_floor_frac(x, &j);
     const float want = floorf(x), want_fr = x - want;
-    return memcmp(&fl, &want, sizeof fl) != 0 || memcmp(&fr, &want_fr, sizeof fr) != 0 || i != (int)want ||
+    /* both variants akp_floor chooses between: +0.0 where floorf gives -0.0 */
+    const float want_u = want + 0.0f;
+    int k = 7;
+    const float tr = akp_floor_trunc(x, &k);
+    int bad = memcmp(&tr, &want_u, sizeof tr) != 0 || k != (int)want;
+#ifdef AKP_HAVE_FLOOR_ROUNDSS
+    if (__builtin_cpu_supports("sse4.1")) {
+        k = 7;
+        const float rs = akp_floor_roundss(x, &k);
+        bad |= memcmp(&rs, &want_u, sizeof rs) != 0 || k != (int)want;
+    }
+#endif
+    return bad || memcmp(&fl, &want, sizeof fl) != 0 || memcmp(&fr, &want_fr, sizeof fr) != 0 || i != (int)want ||
            j != (int)want;
 }
 
@@ -955,6 +1031,8 @@ AK_TEST(per_point_matches_job_signed_zero) {
 int main(void) {
     AK_RUN(permutations);
     AK_RUN(floor_matches_libm);
+    AK_RUN(worley_value_path_matches_gradient_path);
+    AK_RUN(fractal_eval_explicit_fields_equal_defaults);
     AK_RUN(perlin3_published_value);
     AK_RUN(perlin_matches_reference);
     AK_RUN(zero_at_lattice);

@@ -42,8 +42,7 @@ static float simplex_corner(uint32_t dims, float r0, const float* d, const float
 static inline __attribute__((always_inline)) float simplex_corner_value(uint32_t dims, const float* d, const float* g) {
     float r2 = 0.0f, gd = 0.0f;
     for (uint32_t k = 0; k < dims; ++k) r2 += d[k] * d[k], gd += g[k] * d[k];
-    float t = 0.5f - r2;
-    t = t > 0.0f ? t : 0.0f;
+    const float t = akp_max0(0.5f - r2);
     const float t2 = t * t;
     return t2 * t2 * gd;
 }
@@ -76,8 +75,8 @@ float ak_noise_simplex2(const ak_noise* noise, float x, float y, float* out_grad
 static inline __attribute__((always_inline)) float simplex3_corner_value(float dx, float dy, float dz, const float* g) {
     const float r2 = ((0.0f + dx * dx) + dy * dy) + dz * dz;
     const float gd = ((0.0f + g[0] * dx) + g[1] * dy) + g[2] * dz;
-    const float t = 0.5f - r2;
-    if (t <= 0.0f) return 0.0f;
+    float t = 0.5f - r2;
+    t = akp_max0(t); /* as simplex_corner_value: a zero term of either sign, no branch */
     const float t2 = t * t;
     return t2 * t2 * gd;
 }
@@ -125,11 +124,10 @@ static inline __attribute__((always_inline)) float simplex3_value(const uint8_t*
     return 76.0f * sum;
 }
 
-float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
-    const float p[3] = {x, y, z};
-    zero_grad(out_gradient, 3);
-    if (!noise || !all_finite(3, p)) return 0.0f;
-    if (!out_gradient) return simplex3_value(noise->perm, x, y, z);
+/* ak_noise_simplex3 with the gradient at a finite point, out of line (the value-only call
+ * then needs no frame for its registers). */
+static __attribute__((noinline)) float simplex3_grad(const ak_noise* noise, float x, float y, float z,
+                                                     float* out_gradient) {
     const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
     const float s = (x + y + z) * F3;
     int ii, jj, kk;
@@ -155,6 +153,14 @@ float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float*
     if (out_gradient)
         for (int k = 0; k < 3; ++k) out_gradient[k] = 76.0f * g[k];
     return 76.0f * sum;
+}
+
+float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
+    const float p[3] = {x, y, z};
+    if (!out_gradient) return noise && all_finite(3, p) ? simplex3_value(noise->perm, x, y, z) : 0.0f;
+    zero_grad(out_gradient, 3);
+    if (!noise || !all_finite(3, p)) return 0.0f;
+    return simplex3_grad(noise, x, y, z, out_gradient);
 }
 
 /* ---- value noise --------------------------------------------------------------------------- */
@@ -273,7 +279,9 @@ static __attribute__((noinline)) float value3_value(const ak_noise* noise, const
     return value_n(noise, 3, point, NULL);
 }
 
-float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_gradient) {
+/* ak_noise_value's every case (the public function keeps the common one in front). */
+static __attribute__((noinline)) float value_any(const ak_noise* noise, uint32_t dimensions, const float* point,
+                                                 float* out_gradient) {
     if (dimensions < 1 || dimensions > 4) return 0.0f;
     zero_grad(out_gradient, dimensions);
     if (!noise || !point || !all_finite(dimensions, point)) return 0.0f;
@@ -283,6 +291,16 @@ float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* po
     case 3: return out_gradient ? value_n(noise, 3, point, out_gradient) : value3_value(noise, point);
     default: return out_gradient ? value_n(noise, 4, point, out_gradient) : value_n(noise, 4, point, NULL);
     }
+}
+
+float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* point, float* out_gradient) {
+    /* The value alone in 2D or 3D, the common call, first: with every variant inlined here the
+     * function pushed five registers and set up a stack frame on every call. */
+    if (!out_gradient && noise && point && (dimensions == 2 || dimensions == 3)) {
+        if (!all_finite(dimensions, point)) return 0.0f;
+        return dimensions == 3 ? value3_value(noise, point) : value2_value(noise, point);
+    }
+    return value_any(noise, dimensions, point, out_gradient);
 }
 
 /* ---- Worley ------------------------------------------------------------------------------- */
@@ -497,6 +515,11 @@ static inline __attribute__((always_inline)) float worley_n(const ak_noise* nois
     }
     worley_best b = {INFINITY, INFINITY, {0, 0, 0}};
     if (want_f2) worley_near_rings(dims, noise->seed, base, f, true, &b);
+#ifdef AKP_HAVE_POINT_AVX2
+    /* the value alone (no nearest offset to keep): the cells in AVX2 lanes */
+    else if (dims >= 2 && !out_gradient && __builtin_cpu_supports("avx2"))
+        b.d1 = akp_worley_d1_avx2(dims, noise->seed, base, f);
+#endif
     else worley_f1_rings(dims, noise->seed, base, f, &b);
     const float bound = 1.0f + margin; /* ring 2's */
     if (bound * bound < (want_f2 ? b.d2 : b.d1)) worley_far_rings(dims, noise->seed, base, f, margin, want_f2, &b);

@@ -4,6 +4,9 @@
 
 #include <math.h>
 #include <string.h>
+#if defined(__SSE__) || defined(__x86_64__)
+#include <xmmintrin.h>
+#endif
 
 #include <animkit/noise.h>
 
@@ -11,9 +14,20 @@
  * integer lattice arithmetic, and floats there have no fractional part anyway. */
 #define AKP_NOISE_LIMIT 16777216.0f
 
-/* akp_floor (below) without the sign step: floorf(x) except +0.0 for x = -0.0, for callers where that
- * zero's sign cannot reach the result (simplex: see simplex3_value). */
-static inline float akp_floor_unsigned_zero(float x, int* out_i) {
+/* t > 0 ? t : +0.0f as one maxss on x86 (gcc compiles the ?: of a float to a branch, which
+ * random points mispredict); the same value either way, NaN included (maxss returns its second
+ * operand, +0.0, when the comparison is false). */
+static inline float akp_max0(float t) {
+#if defined(__SSE__) || defined(__x86_64__)
+    return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(t), _mm_setzero_ps()));
+#else
+    return t > 0.0f ? t : 0.0f;
+#endif
+}
+
+/* akp_floor_unsigned_zero (below) on any CPU: truncate, convert back, step down where
+ * truncation rounded up. */
+static inline float akp_floor_trunc(float x, int* out_i) {
     const int t = (int)x;
     const float ft = (float)t;
     const int up = ft > x;
@@ -26,11 +40,43 @@ static inline float akp_floor_unsigned_zero(float x, int* out_i) {
     return ft - one;
 }
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
+#define AKP_HAVE_FLOOR_ROUNDSS 1
+/* The same with SSE4.1's roundss toward -inf (imm 9: round down, no inexact exception), only
+ * on CPUs that have it: floorf's value, + 0.0f turns floorf(-0.0) into +0.0 as
+ * akp_floor_trunc gives. Written as asm because the module is compiled for baseline x86-64;
+ * the operand is both source and destination (roundss keeps the upper lanes of its
+ * destination: no dependency on a stale register). */
+static inline float akp_floor_roundss(float x, int* out_i) {
+    float fl = x;
+    __asm__("roundss $9, %0, %0" : "+x"(fl));
+    fl = fl + 0.0f;
+    *out_i = (int)fl;
+    return fl;
+}
+#endif
+
+/* akp_floor (below) without the sign step: floorf(x) except +0.0 for x = -0.0, for callers where that
+ * zero's sign cannot reach the result (simplex: see simplex3_value). roundss where the CPU has
+ * SSE4.1 (every x86-64 CPU since 2008; a cached CPUID bit, a branch that never mispredicts):
+ * akp_floor_trunc's chain of truncation, conversion back, compare and subtract sat on every
+ * lattice hash's path (per point: value 3D 1.43x -> 1.16x FastNoiseLite's time, Perlin 3D
+ * 1.07x -> 0.88x; docs/BENCHMARKS.md, noise). */
+static inline float akp_floor_unsigned_zero(float x, int* out_i) {
+#ifdef AKP_HAVE_FLOOR_ROUNDSS
+#ifndef __SSE4_1__
+    if (__builtin_cpu_supports("sse4.1"))
+#endif
+        return akp_floor_roundss(x, out_i);
+#endif
+    return akp_floor_trunc(x, out_i);
+}
+
 /* floorf(x) and the same value as an int, for |x| < 2^31 (callers check AKP_NOISE_LIMIT first):
  * truncate, step down where truncation rounded up (negative non-integers), and take x's sign,
  * which only changes -0.0 (floorf(-0.0) is -0.0; the int conversion gives +0.0). The same
- * float as floorf bit for bit (test_noise floor_matches_libm), without the rounding-mode
- * branch gcc emits for floorf on baseline x86-64 (no SSE4.1 roundss). */
+ * float as floorf bit for bit (test_noise floor_matches_libm, both variants), without the
+ * rounding-mode branch gcc emits for floorf on baseline x86-64 (no SSE4.1 roundss). */
 static inline float akp_floor(float x, int* out_i) { return copysignf(akp_floor_unsigned_zero(x, out_i), x); }
 
 /* x - floorf(x) (the fraction in [0, 1)) and floorf(x) as an int, in one. The floor is taken
@@ -39,6 +85,15 @@ static inline float akp_floor(float x, int* out_i) { return copysignf(akp_floor_
 static inline float akp_floor_frac(float x, int* out_i) {
     return (x - akp_floor_unsigned_zero(x, out_i)) + 0.0f;
 }
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
+#define AKP_HAVE_POINT_AVX2 1
+/* point_avx2.c, for CPUs with AVX2 (callers check): Worley F1's squared distance over rings 0
+ * and 1 (the 3^dims cells around the point, dims 2 or 3), the cells side by side in the lanes;
+ * bases.c's worley_f1_rings's d1 bit for bit (the same float operations per cell; a minimum
+ * does not depend on the order). base: the point's cell, f: its offset in the cell. */
+float akp_worley_d1_avx2(uint32_t dims, uint64_t seed, const int* base, const float* f);
+#endif
 
 /* The fBm octave sum without gradient or warp, for a resolved, valid desc of type FBM and a
  * dims the basis supports: octaves()'s loop (fractal.c) with the basis inlined, the same float

@@ -257,13 +257,22 @@ float ak_noise_perlin1(const ak_noise* noise, float x, float* out_gradient) {
     return perlin_n(noise, 1, p, NULL, out_gradient);
 }
 
+/* 2D and 3D with the gradient, out of line: the value-only call then needs no frame for the
+ * gradient's registers (ak_noise_perlin3 pushed six and reserved 192 bytes per call). */
+static __attribute__((noinline)) float perlin2_grad(const ak_noise* noise, const float* p, float* grad) {
+    return perlin_n(noise, 2, p, NULL, grad);
+}
+static __attribute__((noinline)) float perlin3_grad(const ak_noise* noise, const float* p, float* grad) {
+    return perlin_n(noise, 3, p, NULL, grad);
+}
+
 float ak_noise_perlin2(const ak_noise* noise, float x, float y, float* out_gradient) {
     if (!noise) {
         if (out_gradient) out_gradient[0] = out_gradient[1] = 0.0f;
         return 0.0f;
     }
     const float p[2] = {x, y};
-    return perlin_n(noise, 2, p, NULL, out_gradient);
+    return out_gradient ? perlin2_grad(noise, p, out_gradient) : perlin_n(noise, 2, p, NULL, NULL);
 }
 
 float ak_noise_perlin3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
@@ -272,7 +281,7 @@ float ak_noise_perlin3(const ak_noise* noise, float x, float y, float z, float* 
         return 0.0f;
     }
     const float p[3] = {x, y, z};
-    return perlin_n(noise, 3, p, NULL, out_gradient);
+    return out_gradient ? perlin3_grad(noise, p, out_gradient) : perlin_n(noise, 3, p, NULL, NULL);
 }
 
 float ak_noise_perlin4(const ak_noise* noise, float x, float y, float z, float w, float* out_gradient) {
