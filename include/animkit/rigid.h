@@ -610,7 +610,8 @@ typedef struct ak_rigid_step_job {
        them and writes the new ones. About one per touching pair of boxes or planes: 4 per body
        is plenty for piles; pairs beyond the room get none (their friction then acts as without
        the cache). Empty -> no anchors carried between steps (each step's static friction undoes
-       only that step's slip). contact_anchor_count is required when contact_anchors is given. */
+       only that step's slip). contact_anchor_count is required when contact_anchors is given.
+       After moving bodies by hand (a teleport, a reset), set *contact_anchor_count to 0. */
     ak_rigid_contact_anchor_span contact_anchors;
     uint32_t* contact_anchor_count;
     /* Outputs (optional). */
