@@ -1018,7 +1018,7 @@ int main(void) {
     AK_RUN(sliding_tall_box_tips_when_mu_exceeds_its_aspect);
     AK_RUN(incline_stack_does_not_creep_at_4_substeps);
     AK_RUN(stack_top_does_not_creep_at_4_substeps);
-    AK_RUN(pyramid_does_not_walk_at_4_substeps);
+    AK_RUN_HEAVY(pyramid_does_not_walk_at_4_substeps);
     AK_RUN(contact_anchors_bit_identical_for_any_thread_count);
     AK_RUN(contact_anchors_validated);
     AK_RUN(pendulum_period_ball_joint);
