@@ -184,6 +184,8 @@ static bool ragdolls(int count, scene* s) {
     return ok;
 }
 
+static bool g_anchors = true; // --no-anchors: animkit without its contact anchor cache
+
 static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigned threads,
                           bool track = false) {
     const size_t n = sc.bodies.size();
@@ -217,6 +219,13 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     uint32_t contacts = 0, dropped = 0;
     job.out_contact_count = &contacts;
     job.out_dropped_contacts = &dropped;
+    // persistent contacts (ak_rigid_contact_anchor), 4 per body; --no-anchors leaves them out
+    std::vector<ak_rigid_contact_anchor> anchors(4 * n + 4);
+    uint32_t anchor_count = 0;
+    if (g_anchors) {
+        job.contact_anchors = {anchors.data(), anchors.size()};
+        job.contact_anchor_count = &anchor_count;
+    }
     const size_t bytes = ak_rigid_step_scratch_size(&job);
     std::vector<uint8_t> scratch(bytes);
     job.scratch = {scratch.data(), bytes};
@@ -591,6 +600,11 @@ int main(int argc, char** argv) {
             --i;
             continue;
         }
+        if (!std::strcmp(argv[i], "--no-anchors")) { // a flag without a value
+            g_anchors = false;
+            --i;
+            continue;
+        }
         if (i + 1 >= argc) break;
         if (!std::strcmp(argv[i], "--rounds"))
             rounds = std::atoi(argv[i + 1]);
@@ -617,14 +631,15 @@ int main(int argc, char** argv) {
         std::fprintf(
             stderr,
             "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
-            "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls]\n"
+            "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls] [--no-anchors]\n"
             "       [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10] "
             "[--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]\n");
         return 2;
     }
-    std::printf("dt 1/60 s, %d steps, sleeping on; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s; Bullet "
+    std::printf("dt 1/60 s, %d steps, sleeping on; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s%s; Bullet "
                 "%d.%02d 1 step x 10 iterations (its defaults), one thread\n",
-                steps, substeps, threads, threads > 1 ? " (wall time)" : "", btGetVersion() / 100,
+                steps, substeps, threads, threads > 1 ? " (wall time)" : "",
+                g_anchors ? ", contact anchors" : ", no contact anchors", btGetVersion() / 100,
                 btGetVersion() % 100);
     if (!do_sweep)
         std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s %9s %9s\n", "scene", "animkit ms",

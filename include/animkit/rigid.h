@@ -564,6 +564,26 @@ AK_API ak_result ak_rigid_bake_ragdoll_clip(const ak_rigid_bake_ragdoll_desc* de
 
 #define AK_RIGID_MAX_THREADS 64
 
+/* One entry of a step's contact anchor cache (ak_rigid_step_job.contact_anchors): a pair of
+ * touching bodies whose static friction held at the end of the step (box and plane pairs: flat
+ * faces and corners), keyed by (body_a, body_b) with body_a < body_b. `drift` is how far body_a's
+ * contact anchor has slipped along the contact plane from body_b's since the contact began,
+ * which the step's static friction has not yet undone (what later pairs of the sequential solve
+ * moved after a pair's friction ran); `normal` is the contact normal (from body_b towards
+ * body_a). Both are in body_b's frame, so the entry turns with the pair. The next step adds the
+ * drift to the slip its static friction undoes: the anchors persist from step to step (Mueller et
+ * al. 2020, 3.5), and a pile does not creep by what each step leaves over. Written by
+ * ak_rigid_step_run; callers only allocate, zero the count, and keep the array between steps. */
+typedef struct ak_rigid_contact_anchor {
+    uint32_t body_a, body_b; /* body_a < body_b */
+    ak_vec3 drift;           /* metres, body_b's frame */
+    ak_vec3 normal;          /* unit, body_b's frame */
+    float twist;             /* radians body_a has turned about the normal against body_b since
+                                the contact began, not yet undone by torsional friction */
+} ak_rigid_contact_anchor;
+
+AK_DEFINE_SPAN(rigid_contact_anchor, ak_rigid_contact_anchor)
+
 typedef struct ak_rigid_step_job {
     const ak_rigid_model* model; /* required */
     float dt;                    /* seconds, > 0 (required) */
@@ -584,6 +604,16 @@ typedef struct ak_rigid_step_job {
                                     desc's (a powered ragdoll's animation: see
                                     ak_rigid_ragdoll_drive_targets; normalised here); entries
                                     of joints without a drive are ignored; empty -> the descs' */
+    /* Optional persistent contacts (state, kept by the caller between steps; see
+       ak_rigid_contact_anchor): contact_anchors holds up to its count entries, of which
+       *contact_anchor_count (start at 0) are valid, sorted by (body_a, body_b); each step reads
+       them and writes the new ones. About one per touching pair of boxes or planes: 4 per body
+       is plenty for piles; pairs beyond the room get none (their friction then acts as without
+       the cache). Empty -> no anchors carried between steps (each step's static friction undoes
+       only that step's slip). contact_anchor_count is required when contact_anchors is given.
+       After moving bodies by hand (a teleport, a reset), set *contact_anchor_count to 0. */
+    ak_rigid_contact_anchor_span contact_anchors;
+    uint32_t* contact_anchor_count;
     /* Outputs (optional). */
     float* out_max_penetration;     /* metres: deepest contact after the step's last solve */
     uint32_t* out_contact_count;    /* contact points of the last substep */
@@ -600,7 +630,9 @@ AK_API size_t ak_rigid_step_scratch_size(const ak_rigid_step_job* job);
  * AK_RIGID_MAX_THREADS, non-finite gravity), AK_ERR_SPAN_SMALL (a state span shorter than the
  * body count, sleep_timers neither empty nor long enough, drive_targets neither empty nor one
  * per joint, scratch too small), AK_ERR_BAD_DATA (a non-finite state value, a non-finite or
- * zero drive target). */
+ * zero drive target, a contact anchor count over its span or an anchor entry not finite, not
+ * naming two bodies in order, or out of (body_a, body_b) order); AK_ERR_NULL_ARG also for
+ * contact_anchors counted without a pointer or without contact_anchor_count. */
 AK_API ak_result ak_rigid_step_validate(const ak_rigid_step_job* job);
 
 /* Advance the state by dt. Validates first and writes nothing on failure. Returns AK_ERR_BAD_DATA
@@ -720,6 +752,8 @@ typedef struct ak_rigid_scene_run {
     /* private */
     float* sleep_timers;
     uint32_t dropped_last;
+    ak_rigid_contact_anchor* anchors; /* 4 per body: the step's persistent contacts */
+    uint32_t anchor_count;
 } ak_rigid_scene_run;
 
 /* Build the model and the initial state and validate the step job. The scene may be freed

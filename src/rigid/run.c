@@ -26,8 +26,9 @@ ak_result ak_rigid_scene_run_init(ak_rigid_scene_run* run, const ak_rigid_scene*
     run->velocities = malloc((n ? n : 1) * sizeof *run->velocities);
     run->angular_velocities = malloc((n ? n : 1) * sizeof *run->angular_velocities);
     run->sleep_timers = calloc(n ? n : 1, sizeof *run->sleep_timers);
+    run->anchors = malloc((4 * n + 4) * sizeof *run->anchors);
     if (!run->positions || !run->orientations || !run->velocities || !run->angular_velocities ||
-        !run->sleep_timers)
+        !run->sleep_timers || !run->anchors)
         return akp_diag_set(out_diag, AK_ERR_NO_MEMORY, file, "out of memory for %zu bodies", n);
     run->body_count = n;
     run->gravity = sc->gravity;
@@ -42,6 +43,8 @@ ak_result ak_rigid_scene_run_init(ak_rigid_scene_run* run, const ak_rigid_scene*
                                    .orientations = {run->orientations, n},
                                    .velocities = {run->velocities, n},
                                    .angular_velocities = {run->angular_velocities, n},
+                                   .contact_anchors = {run->anchors, 4 * n + 4},
+                                   .contact_anchor_count = &run->anchor_count,
                                    .out_max_penetration = &run->max_penetration,
                                    .out_dropped_contacts = &run->dropped_last};
     if (sc->sleep) run->job.sleep_timers = (ak_f32_span){run->sleep_timers, n};
@@ -60,6 +63,7 @@ ak_result ak_rigid_scene_run_step(ak_rigid_scene_run* run) {
     /* the job points at max_penetration inside *run: re-aim it in case the struct was copied */
     run->job.out_max_penetration = &run->max_penetration;
     run->job.out_dropped_contacts = &run->dropped_last;
+    run->job.contact_anchor_count = &run->anchor_count;
     const ak_result r = ak_rigid_step_run(&run->job);
     if (r != AK_OK) return r;
     ++run->step_index;
@@ -85,6 +89,7 @@ void ak_rigid_scene_run_free(ak_rigid_scene_run* run) {
     free(run->velocities);
     free(run->angular_velocities);
     free(run->sleep_timers);
+    free(run->anchors);
     free(run->job.scratch.ptr);
     memset(run, 0, sizeof *run);
 }

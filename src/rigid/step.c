@@ -26,14 +26,17 @@ typedef struct contact_group {
     float height; /* the pair's midpoint against gravity: higher pairs are solved first */
     /* the centre of pressure after the position solve (the velocity solve reads it again) */
     uint32_t pressed;
-    uint32_t patch; /* at least three contacts pushed, both bodies moving, neither round: a face
-                       on a face (see patch_slip) */
+    uint32_t patch; /* at least two contacts pushed, both bodies moving, neither round: a face
+                       or an edge line on a face (see patch_slip) */
     uint32_t stuck; /* a patch whose static friction held this substep */
     ak_vec3 la, lb;
     float lambda, arm;
     ak_vec3 ra, rb; /* its world offsets after the position solve (zero for a body that does
                        not move), which the velocity solve's friction reuses */
     float wr;       /* n . I^-1 n summed over the two bodies */
+    ak_vec3 carry;  /* the pair's anchor drift left from earlier steps (world; see
+                       ak_rigid_contact_anchor), added to the slip static friction undoes */
+    float carry_twist; /* and its twist about n (a against b, radians) */
 } contact_group;
 
 /* A pair of bodies the broad phase found at the step's start. Pairs of boxes and planes
@@ -45,6 +48,9 @@ typedef struct pair_entry {
     uint32_t start, end;
     float height; /* the pair's midpoint against gravity: higher pairs are solved first */
     uint32_t cached;
+    ak_vec3 carry; /* cached pairs: the anchor drift from the job's contact anchors (world, along
+                      the contact plane at the step's start); zero without one */
+    float carry_twist; /* and the anchor's twist about the normal (radians, a against b) */
 } pair_entry;
 
 /* One contact's row, set once per substep on the poses after the joints' first sweep: the
@@ -78,8 +84,8 @@ typedef struct island {
 /* Scratch layout, in 16-byte aligned blocks. */
 typedef struct layout {
     size_t x0, q0, v0, w0, qp, dx, ds, iw, grow, slack, launch, sap, pairs, contacts, groups, rows,
-        cx, ct, turn0, jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies,
-        ipairs, ijoints, ichains, islands, total;
+        cx, ct, jorder, jstart, jchain, croot, rot, rot0, parent, awake, island_of, ibodies,
+        ipairs, ijoints, ichains, islands, held, total;
 } layout;
 
 static size_t align16(size_t s) { return (s + 15) & ~(size_t)15; }
@@ -108,7 +114,6 @@ static layout layout_of(const ak_rigid_model* m) {
                                  sizeof(contact_row));
     l.cx = off, off += align16(n * sizeof(ak_vec3));
     l.ct = off, off += align16(n * sizeof(ak_vec3));
-    l.turn0 = off, off += align16(n * sizeof(ak_vec3));
     l.jorder = off, off += align16(m->joint_count * sizeof(uint32_t));
     l.jstart = off, off += align16((m->joint_count + 1) * sizeof(uint32_t));
     l.jchain = off, off += align16(m->joint_count * sizeof(uint32_t));
@@ -123,6 +128,7 @@ static layout layout_of(const ak_rigid_model* m) {
     l.ijoints = off, off += align16(m->joint_count * sizeof(uint32_t));
     l.ichains = off, off += align16(m->joint_count * sizeof(uint32_t));
     l.islands = off, off += align16(n * sizeof(struct island));
+    l.held = off, off += align16((size_t)m->desc.max_contacts + AKP_RIGID_MAX_PAIR_CONTACTS);
     l.total = off + 16; /* room to align the base */
     return l;
 }
@@ -130,6 +136,11 @@ static layout layout_of(const ak_rigid_model* m) {
 size_t ak_rigid_step_scratch_size(const ak_rigid_step_job* job) {
     if (!job || !job->model) return 0;
     return layout_of(job->model).total;
+}
+
+/* The contact anchor cache's order: (body_a, body_b) ascending. */
+static bool anchor_before(const ak_rigid_contact_anchor* x, const ak_rigid_contact_anchor* y) {
+    return x->body_a < y->body_a || (x->body_a == y->body_a && x->body_b < y->body_b);
 }
 
 ak_result ak_rigid_step_validate(const ak_rigid_step_job* job) {
@@ -155,6 +166,18 @@ ak_result ak_rigid_step_validate(const ak_rigid_step_job* job) {
             return AK_ERR_BAD_DATA;
         if (job->sleep_timers.count && !ak_finitef(job->sleep_timers.ptr[i]))
             return AK_ERR_BAD_DATA;
+    }
+    if (job->contact_anchors.count) {
+        if (!job->contact_anchors.ptr || !job->contact_anchor_count) return AK_ERR_NULL_ARG;
+        uint32_t na = *job->contact_anchor_count;
+        if (na > job->contact_anchors.count) return AK_ERR_BAD_DATA;
+        for (uint32_t k = 0; k < na; ++k) {
+            const ak_rigid_contact_anchor* e = &job->contact_anchors.ptr[k];
+            if (!(e->body_a < e->body_b) || e->body_b >= n || !ak_vec3_is_finite(e->drift) ||
+                !ak_vec3_is_finite(e->normal) || !ak_finitef(e->twist))
+                return AK_ERR_BAD_DATA;
+            if (k && !anchor_before(&job->contact_anchors.ptr[k - 1], e)) return AK_ERR_BAD_DATA;
+        }
     }
     if (job->drive_targets.count) {
         if (!job->drive_targets.ptr) return AK_ERR_NULL_ARG;
@@ -188,9 +211,10 @@ typedef struct solver {
     contact_row* rows;            /* per contact of the substep */
     ak_vec3* cx;    /* the contact solve's displacement of each body (see contact_row) */
     ak_vec3* ct;    /* the contact solve's rotation vector of each body */
-    ak_vec3* turn0; /* each body's rotation from the substep's start to the contact solve's */
     ak_mat3* rot;   /* each body's rotation at the contact solve's start */
     ak_mat3* rot0;  /* each body's rotation at the step's start */
+    uint8_t* held; /* per contact: at a cached pair's first contact, whether its static
+                      friction held (or had nothing to undo) in the latest substep */
     float h;
     /* after an overflow of max_contacts, the most a contact between two moving bodies
      * corrects in a substep (INFINITY otherwise; see find_pairs) */
@@ -584,7 +608,9 @@ static void substep_contacts(solver* s, contact_buf* cb, const pair_entry* pairs
                 /* only restitution reads it */
                 c->vn_before = c->restitution > 0.0f ? contact_vn(s, c) : 0.0f;
             }
-            cb->groups[g++] = (contact_group){.start = e->start, .end = e->end, .height = e->height};
+            cb->groups[g++] = (contact_group){
+                .start = e->start, .end = e->end, .height = e->height, .carry = e->carry,
+                .carry_twist = e->carry_twist};
             continue;
         }
         /* bounding spheres apart by more than the offset now: nothing to find this substep */
@@ -648,14 +674,6 @@ RIGID_HOT void apply_angular_impulse(solver* s, uint32_t i, ak_vec3 p, float sig
     s->q[i] = turn_by(s->q[i], dw);
 }
 
-/* Rotation vector of body i over this substep (small-angle). */
-RIGID_HOT ak_vec3 substep_rotation(const solver* s, uint32_t i) {
-    if (!s->awake[i]) return ak_vec3_zero();
-    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->qp[i]));
-    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
-    return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
-}
-
 /* Motion of body i's local point l since the start of the step (the contact solve's pose, cx
  * and ct included), without the cancellation that (x + q l) - (x0 + q0 l) suffers far from the
  * origin; *out_arm gets its world offset. Static friction undoes the slip of the whole step,
@@ -689,9 +707,13 @@ RIGID_HOT ak_vec3 in_plane(ak_vec3 r, ak_vec3 n) { return ak_vec3_madd(r, n, -ak
  * 20-layer pyramid spread 110 mm in 5 s at 10 substeps, 160 mm at mu 5, 54 mm at mu 0.2 (11 mm
  * with no static friction at all). Static friction on a patch therefore reads and moves only the
  * translation and the twist about n (the response uses the arm's in-plane part, whose cross
- * product with a tangent is along n): 21 mm. Dynamic friction reads the same motion only where
- * static friction held (on every patch it took away the torque that tips a tall box sliding on
- * a rough floor), always with the whole arm in its response. Spheres and capsules are never a
+ * product with a tangent is along n): 21 mm. Two pushed points (a box resting on a support's
+ * edge line) rock about that line the same way, and read whole they walked the pyramid still
+ * (66 mm at 4 substeps): they are a patch too (10 mm; 1.9 mm at 10 substeps). Dynamic friction
+ * reads the same motion only where static friction held on three or more points (on every
+ * patch it took away the torque that tips a tall box sliding on a rough floor; on two points
+ * the pyramid crept at 40 substeps and never slept), always with the whole arm in its
+ * response. Spheres and capsules are never a
  * patch (a mesh reports several points of one touch), nor pairs with a body that does not move
  * (a box on a static slope near its friction cone crept under the rule). */
 RIGID_HOT ak_vec3 patch_slip(const solver* s, uint32_t i, ak_vec3 l, ak_vec3 n) {
@@ -702,6 +724,24 @@ RIGID_HOT ak_vec3 patch_slip(const solver* s, uint32_t i, ak_vec3 l, ak_vec3 n) 
     ak_vec3 r0 = ak_mat3_mul_vec3(s->rot0[i], l);
     ak_vec3 d = ak_vec3_add(s->ds[i], ak_vec3_add(s->dx[i], s->cx[i]));
     return ak_vec3_add(d, ak_vec3_scale(ak_vec3_cross(n, r0), ak_vec3_dot(turn, n)));
+}
+
+/* Rotation vector of body i since the step's start, the contact solve's ct included (zero for
+ * a body that does not move). */
+RIGID_HOT ak_vec3 step_turn(const solver* s, uint32_t i) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->q0[i]));
+    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
+    return ak_vec3_add(ak_vec3_make(dq.x * k, dq.y * k, dq.z * k), s->ct[i]);
+}
+
+/* Rotation vector of body i since the substep's start (small-angle), the contact solve's ct
+ * included (zero for a body that does not move). */
+RIGID_HOT ak_vec3 substep_turn(const solver* s, uint32_t i) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->qp[i]));
+    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
+    return ak_vec3_add(ak_vec3_make(dq.x * k, dq.y * k, dq.z * k), s->ct[i]);
 }
 
 /* Rows of the substep's contacts on the current poses (see contact_row). */
@@ -743,7 +783,6 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
     for (uint32_t t = 0; t < n; ++t) {
         uint32_t i = list ? list[t] : t;
         cx[i] = ct[i] = ak_vec3_zero();
-        s->turn0[i] = substep_rotation(s, i);
         s->rot[i] = ak_mat3_from_quat(s->q[i]);
     }
     setup_rows(s, cb);
@@ -783,13 +822,14 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
         uint32_t points = 0;
         grp->pressed =
             pressure_centre(cb, k0, k1, &grp->la, &grp->lb, &grp->lambda, &grp->arm, &points);
-        grp->patch = points >= 3 && s->awake[cb->c[k0].a] && s->awake[cb->c[k0].b] &&
+        grp->patch = points >= 2 && s->awake[cb->c[k0].a] && s->awake[cb->c[k0].b] &&
                      !round_shape(s, cb->c[k0].a) && !round_shape(s, cb->c[k0].b);
         grp->stuck = 0;
         ak_vec3 la = grp->la, lb = grp->lb;
         float lambda = grp->lambda, arm = grp->arm;
         const rigid_contact* c = &cb->c[k0];
         uint32_t a = c->a, b = c->b;
+        s->held[k0] = 0;
         if (!grp->pressed) continue;
         ak_vec3 ra, rb;
         ak_vec3 dp = ak_vec3_sub(moved_point(s, a, la, &ra), moved_point(s, b, lb, &rb));
@@ -800,16 +840,20 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
             /* (a patch: translation and twist only, see patch_slip) */
             if (grp->patch)
                 dp = ak_vec3_sub(patch_slip(s, a, la, c->n), patch_slip(s, b, lb, c->n));
+
+            /* (the anchors' drift from earlier steps, when the job keeps them) */
+            dp = ak_vec3_add(dp, grp->carry);
             ak_vec3 dt = ak_vec3_madd(dp, c->n, -ak_vec3_dot(dp, c->n));
             float lt = ak_vec3_length(dt);
-            grp->stuck = grp->patch;
+            grp->stuck = grp->patch && points >= 3;
+            s->held[k0] = 1;
             if (lt > 1e-12f) {
                 ak_vec3 t = ak_vec3_scale(dt, 1.0f / lt);
                 response oa = respond(s, a, grp->patch ? in_plane(ra, c->n) : ra, t),
                          ob = respond(s, b, grp->patch ? in_plane(rb, c->n) : rb, t);
                 float wt = oa.w + ob.w;
                 float dlt = wt > 0.0f ? lt / wt : INFINITY;
-                if (!(dlt < c->friction * lambda)) grp->stuck = 0;
+                if (!(dlt < c->friction * lambda)) grp->stuck = 0, s->held[k0] = 0;
                 if (dlt < c->friction * lambda) {
                     if (s->awake[a]) {
                         cx[a] = ak_vec3_madd(cx[a], t, -dlt * s->bodies[a].inv_mass);
@@ -823,10 +867,21 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
             }
             /* torsional friction: a patch of contacts also resists twisting about the normal, up
              * to mu times the normal multiplier times its mean lever arm */
-            ak_vec3 rot_a = s->awake[a] ? ak_vec3_add(s->turn0[a], ct[a]) : ak_vec3_zero();
-            ak_vec3 rot_b = s->awake[b] ? ak_vec3_add(s->turn0[b], ct[b]) : ak_vec3_zero();
-            float twist = ak_vec3_dot(ak_vec3_sub(rot_a, rot_b), c->n);
+            /* (pairs of boxes and planes, which keep anchors, since the step's start, as their
+             * static friction; the others, as before the anchors, since the substep's start:
+             * reading a lying capsule's twist since the step's start sank CesiumMan's skinned
+             * mesh 4.7 cm into the ground against 1.9) */
+            ak_vec3 rot_a, rot_b;
+            if (flat_shape(s->bodies[a].shape.type) && flat_shape(s->bodies[b].shape.type)) {
+                rot_a = step_turn(s, a), rot_b = step_turn(s, b);
+            } else {
+                rot_a = substep_turn(s, a), rot_b = substep_turn(s, b);
+            }
+            float twist = ak_vec3_dot(ak_vec3_sub(rot_a, rot_b), c->n) + grp->carry_twist;
             float wr = grp->wr;
+            if (wr > 0.0f && fabsf(twist) > 0.0f &&
+                !(fabsf(twist) / wr < c->friction * lambda * arm))
+                s->held[k0] = 0;
             if (wr > 0.0f && fabsf(twist) > 0.0f &&
                 fabsf(twist) / wr < c->friction * lambda * arm) {
                 ak_vec3 pr = ak_vec3_scale(c->n, -twist / wr);
@@ -1476,6 +1531,115 @@ static bool launched_past(const solver* s, const ak_vec3* v0, float* launch, con
     return any;
 }
 
+/* ---- persistent contact anchors (ak_rigid_contact_anchor) ------------------------------- */
+
+/* The job's anchor of the pair of bodies lo < hi, or NULL (binary search: sorted by key). */
+static const ak_rigid_contact_anchor* anchor_find(const ak_rigid_step_job* job, uint32_t lo,
+                                                  uint32_t hi) {
+    const ak_rigid_contact_anchor* e = job->contact_anchors.ptr;
+    uint32_t l = 0, r = *job->contact_anchor_count;
+    ak_rigid_contact_anchor key = {.body_a = lo, .body_b = hi};
+    while (l < r) {
+        uint32_t mid = l + (r - l) / 2;
+        if (anchor_before(&e[mid], &key))
+            l = mid + 1;
+        else
+            r = mid;
+    }
+    return l < *job->contact_anchor_count && e[l].body_a == lo && e[l].body_b == hi ? &e[l] : NULL;
+}
+
+/* Each cached pair's carry from the job's anchors, on the step's start poses: the drift turned
+ * to world by body_b's start orientation and taken along the contact plane, oriented from
+ * the pair's b to its a. A pair whose normal has turned by more than about 6 degrees from the
+ * anchor's (another face or edge now touches) starts again from zero. */
+static void anchors_read(solver* s, const ak_rigid_step_job* job, pair_buf* pb,
+                         const contact_buf* cb) {
+    for (uint32_t i = 0; i < pb->count; ++i) {
+        pair_entry* e = &pb->p[i];
+        e->carry = ak_vec3_zero();
+        e->carry_twist = 0.0f;
+        if (!job->contact_anchors.count || !e->cached || e->end == e->start) continue;
+        uint32_t lo = e->a < e->b ? e->a : e->b, hi = e->a < e->b ? e->b : e->a;
+        const ak_rigid_contact_anchor* an = anchor_find(job, lo, hi);
+        if (!an) continue;
+        float sign = e->a == lo ? 1.0f : -1.0f;
+        ak_vec3 n = cb->c[e->start].n;
+        ak_vec3 nw = ak_vec3_scale(ak_mat3_mul_vec3(s->rot0[hi], an->normal), sign);
+        if (!(ak_vec3_dot(nw, n) > 0.995f)) continue;
+        ak_vec3 d = ak_vec3_scale(ak_mat3_mul_vec3(s->rot0[hi], an->drift), sign);
+        e->carry = ak_vec3_madd(d, n, -ak_vec3_dot(d, n));
+        e->carry_twist = an->twist; /* (the same either way round: n flips with the pair) */
+    }
+}
+
+/* Rotation vector of body i over the whole step (after it). */
+static ak_vec3 step_turn_end(const solver* s, uint32_t i) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->q0[i]));
+    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
+    return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
+}
+
+/* Motion over the whole step of body i's local point l (as patch_slip and moved_point read it
+ * during the solve: translation and the turn about n only on a patch). */
+static ak_vec3 step_slip(const solver* s, uint32_t i, ak_vec3 l, ak_vec3 n, bool patch) {
+    if (!s->awake[i]) return ak_vec3_zero();
+    ak_vec3 r0 = ak_mat3_mul_vec3(s->rot0[i], l);
+    if (patch) {
+        float turn = ak_vec3_dot(step_turn_end(s, i), n);
+        return ak_vec3_add(s->ds[i], ak_vec3_scale(ak_vec3_cross(n, r0), turn));
+    }
+    return ak_vec3_add(s->ds[i], ak_vec3_sub(ak_quat_rotate(s->q[i], l), r0));
+}
+
+/* The step's anchors into the job's cache: every cached pair whose static friction held in the
+ * last substep keeps its carry plus the slip the step left at its centre of pressure (along
+ * the contact plane, in body_b's frame); a pair that slid, separated or has no room starts
+ * again. Sorted by key (shell sort: no allocation, keys unique so the order is total). */
+static void anchors_write(const solver* s, const ak_rigid_step_job* job, const pair_buf* pb,
+                          const contact_buf* cb) {
+    ak_rigid_contact_anchor* out = job->contact_anchors.ptr;
+    uint32_t cap = (uint32_t)(job->contact_anchors.count > UINT32_MAX ? UINT32_MAX
+                                                                       : job->contact_anchors.count);
+    uint32_t na = 0;
+    for (uint32_t i = 0; i < pb->count && na < cap; ++i) {
+        const pair_entry* e = &pb->p[i];
+        if (!e->cached || e->end == e->start || !s->held[e->start]) continue;
+        ak_vec3 la, lb;
+        float lambda, arm;
+        uint32_t points = 0;
+        ak_vec3 n = cb->c[e->start].n;
+        if (!pressure_centre(cb, e->start, e->end, &la, &lb, &lambda, &arm, &points)) continue;
+        bool patch = points >= 2 && s->awake[e->a] && s->awake[e->b];
+        ak_vec3 d = ak_vec3_add(e->carry, ak_vec3_sub(step_slip(s, e->a, la, n, patch),
+                                                      step_slip(s, e->b, lb, n, patch)));
+        d = ak_vec3_madd(d, n, -ak_vec3_dot(d, n));
+        uint32_t lo = e->a < e->b ? e->a : e->b, hi = e->a < e->b ? e->b : e->a;
+        float sign = e->a == lo ? 1.0f : -1.0f;
+        float tw = e->carry_twist +
+                   ak_vec3_dot(ak_vec3_sub(step_turn_end(s, e->a), step_turn_end(s, e->b)), n);
+        ak_quat qi = ak_quat_conjugate(s->q[hi]);
+        out[na++] = (ak_rigid_contact_anchor){
+            .body_a = lo,
+            .body_b = hi,
+            .drift = ak_quat_rotate(qi, ak_vec3_scale(d, sign)),
+            .normal = ak_quat_rotate(qi, ak_vec3_scale(n, sign)),
+            .twist = tw,
+        };
+    }
+    static const uint32_t gaps[] = {701, 301, 132, 57, 23, 10, 4, 1};
+    for (size_t gi = 0; gi < sizeof gaps / sizeof gaps[0]; ++gi)
+        for (uint32_t i = gaps[gi]; i < na; ++i) {
+            ak_rigid_contact_anchor t = out[i];
+            uint32_t j = i;
+            for (; j >= gaps[gi] && anchor_before(&t, &out[j - gaps[gi]]); j -= gaps[gi])
+                out[j] = out[j - gaps[gi]];
+            out[j] = t;
+        }
+    *job->contact_anchor_count = na;
+}
+
 ak_result ak_rigid_step_run(const ak_rigid_step_job* job) { return akp_rigid_step_run(job, true); }
 
 ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
@@ -1509,9 +1673,9 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
         .rows = (contact_row*)(base + l.rows),
         .cx = (ak_vec3*)(base + l.cx),
         .ct = (ak_vec3*)(base + l.ct),
-        .turn0 = (ak_vec3*)(base + l.turn0),
         .rot = (ak_mat3*)(base + l.rot),
         .rot0 = (ak_mat3*)(base + l.rot0),
+        .held = base + l.held,
         .h = job->dt / (float)substeps,
         .push_max = INFINITY,
     };
@@ -1526,6 +1690,7 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
     float* launch = (float*)(base + l.launch);
     memset(launch, 0, n * sizeof *launch);
     contact_buf cb;
+    pair_buf pb;
     uint32_t ns = 0;
     int axis = 0;
     /* the step, again from its start with wider margins for the bodies an impact or a joint
@@ -1545,10 +1710,12 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
         /* pairs once per step (Mueller et al. 2020: "collect potential pairs once per time step"),
          * with margins that cover the step's motion; flat pairs keep their contacts for every
          * substep, the others run the narrow phase in each */
-        pair_buf pb = {(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts, 0};
+        pb = (pair_buf){(pair_entry*)(base + l.pairs), 0, m->desc.max_contacts, 0};
         find_pairs(&s, (sap_entry*)(base + l.sap), &cb, &pb, (float*)(base + l.grow),
                    (float*)(base + l.slack), launch, offset, job->dt, gmag, up, &ns, &axis);
         uint32_t kept = cb.count;
+        memset(s.held, 0, kept);
+        anchors_read(&s, job, &pb, &cb);
         uint32_t nj = (uint32_t)m->joint_count, chains = 0;
         uint32_t* order = (uint32_t*)(base + l.jorder);
         uint32_t* start = (uint32_t*)(base + l.jstart);
@@ -1566,7 +1733,7 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
         if (islands_n) {
             /* what no island writes (static bodies; the others are set again in each substep) */
             for (uint32_t i = 0; i < n; ++i) {
-                s.cx[i] = s.ct[i] = s.turn0[i] = ak_vec3_zero();
+                s.cx[i] = s.ct[i] = ak_vec3_zero();
                 s.rot[i] = ak_mat3_from_quat(s.q[i]);
             }
             /* the islands shared out over the threads in contiguous runs of about equal work */
@@ -1702,6 +1869,7 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
     }
     if (job->out_contact_count) *job->out_contact_count = cb.count;
     if (job->out_dropped_contacts) *job->out_dropped_contacts = cb.dropped;
+    if (job->contact_anchors.count) anchors_write(&s, job, &pb, &cb);
     if (sleeping) update_sleep(&s, job, &cb, (uint32_t*)(base + l.parent));
     return AK_OK;
 }
