@@ -684,7 +684,8 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
     AK_CHECK_EQ(ak_skin_soft_state_init(soft, (ak_mat4_cspan){pal, c.ns}, (ak_vec3_span){x, nn}, (ak_vec3_span){v, nn}), AK_OK);
     float ke = 0.0f, ke_moving = 0.0f;
     /* the fastest point of the mesh moved rigidly with its bones (LBS of the rest mesh at two
-     * frames, differenced), and the fastest lattice node of the soft state, over every frame */
+     * frames, differenced; dqs holds the previous frame's LBS until the DQS below), and the
+     * fastest lattice node of the soft state, over every frame */
     double skin_speed = 0.0, node_speed = 0.0;
     int node_frame = 0;
     cman_skin(&c, AK_SKIN_LBS, pal, dqs);
