@@ -189,7 +189,11 @@ typedef struct ak_skin_soft_step_job {
     ak_mat4_cspan previous_palette; /* optional (ptr NULL -> none): the previous step's palette
                                        (count >= palette.count): jiggle damping then damps the
                                        flesh's motion relative to the skinned motion; without it,
-                                       the absolute velocity (a drag) */
+                                       the absolute velocity (a drag). The colliders (bone cores,
+                                       joint planes) also move from its pose to palette's across
+                                       the substeps, so it must be the previous step's: a stale
+                                       one (a held pose passing an older palette) makes them jump
+                                       back at every step */
     float dt;                       /* seconds, in (0, 1]; 0 -> 1/60 */
     ak_vec3 gravity;                /* m/s^2 on the flesh; zero -> none */
     ak_vec3_span node_positions;    /* required: state, in and out (count >= node count) */
