@@ -157,21 +157,23 @@ AKP_AVX2_INLINE static inline void blend_matrix_vertex(const akp_skin_ctx* c, si
 
 #include "skin_avx2_shared.h" /* joint offsets, DQS/CoR phase 1 */
 
-/* Blend of two 8-float rows at base + off[k] with the 4 weights of vertex i: the palette
- * matrices for LBS (offsets from joint_offsets with AKP_MAT_SHIFT), the CoR rows for CoR. */
+/* Blend of two 8-float rows at base + off[k] with the K weights of vertex i: the palette
+ * matrices for LBS (offsets from joint_offsets with AKP_MAT_SHIFT), the CoR rows for CoR. Each
+ * weight is broadcast straight from memory and each offset is its own 32-bit load (as one
+ * 64-bit word, each costs a move, a shift and a register broadcast). */
 AKP_AVX2_INLINE static inline void blend_matrix_rows(const akp_skin_ctx* c, size_t i, const char* base,
                                                       const uint32_t* off, __m256* out01, __m256* out23,
                                                       const uint32_t K) {
-    float ww[8];
-    memcpy(ww, c->wgt + i * c->wgt_stride, 4u * K);
-    size_t o[8];
-    vertex_offsets(off, o, K);
-    __m256 w = _mm256_set1_ps(ww[0]);
-    const float* m = (const float*)(const void*)(base + o[0]);
+    const char* wp = c->wgt + i * c->wgt_stride;
+    float wk;
+    memcpy(&wk, wp, 4);
+    __m256 w = _mm256_set1_ps(wk);
+    const float* m = (const float*)(const void*)(base + (size_t)off[0]);
     __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
     for (uint32_t k = 1; k < K; ++k) {
-        m = (const float*)(const void*)(base + o[k]);
-        w = _mm256_set1_ps(ww[k]);
+        m = (const float*)(const void*)(base + (size_t)off[k]);
+        memcpy(&wk, wp + 4u * k, 4);
+        w = _mm256_set1_ps(wk);
         a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
         a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
     }
@@ -213,14 +215,15 @@ AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t 
 }
 
 
-/* off: with 4 influences, the block's palette offsets (joint_offsets), computed a block ahead
- * by the caller so that they are read back from memory as plain loads; NULL otherwise. */
+/* off: with 2, 3, 4 or 8 influences, the block's palette offsets (joint_offsets, AKP_SLOTS(K)
+ * per vertex), computed a block ahead by the caller so that they are read back from memory as
+ * plain loads; NULL otherwise. */
 AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K, const uint32_t* off) {
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
     if (off) {
         for (int v = 0; v < 8; ++v)
-            blend_matrix_rows(c, i0 + (size_t)v, (const char*)c->palette, off + 4 * v, &c01[v], &c23[v], 4);
+            blend_matrix_rows(c, i0 + (size_t)v, (const char*)c->palette, off + AKP_SLOTS(K) * v, &c01[v], &c23[v], K);
     } else {
         for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
     }
@@ -397,13 +400,14 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
-/* The LBS block loop, specialised for 4 influences (the common case) so the compiler unrolls;
- * the palette offsets of the next block are computed before the current block runs (two
- * buffers in turn), so the blend reads them back as plain loads: extracting 32 offsets from
- * SIMD registers costs more, and reading them right after the vector store stalls. */
-/* Influence counts other than 4 run vertex by vertex through the blends; with the count a
- * compile-time constant for the common ones (1, 2, 3, 8) the compiler unrolls them (measured
- * in cache before this: 1 and 2 influences ran slower than 4, 8 at a third of 4's speed). */
+/* The LBS block loop, specialised for 2, 3, 4 and 8 influences so the compiler unrolls; the
+ * palette offsets of the next block are computed before the current block runs (two buffers in
+ * turn), so the blend reads them back as plain loads: extracting 32 offsets from SIMD registers
+ * costs more, and reading them right after the vector store stalls. Pipelined like 4, 2 and 8
+ * influences went from 1.07x / 1.10x to 1.08x / 1.29x ozz's rate (LBS with normals, 100k, Zen 5).
+ * Other counts (1 without the rigid path, 5, 6, 7) run vertex by vertex through the blends;
+ * with the count a compile-time constant for 1 the compiler unrolls them (measured in cache
+ * before this: 1 and 2 influences ran slower than 4, 8 at a third of 4's speed). */
 #define AKP_K_DISPATCH(RUN)                                                                \
     switch (c->k) {                                                                        \
     case 1: RUN(1u); break;                                                                \
@@ -416,14 +420,22 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
 AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
     if (c->rigid_single) {
         for (size_t i = begin; i < end; i += 8) block_lbs_rigid1(c, i);
-    } else if (c->k == 4) {
-        uint32_t off[2][32];
-        joint_offsets(c, begin, AKP_MAT_SHIFT, off[0], 4);
-        unsigned b = 0;
-        for (size_t i = begin; i < end; i += 8, b ^= 1u) {
-            if (i + 8 < end) joint_offsets(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], 4);
-            block_lbs(c, i, 4, off[b]);
-        }
+    } else if (c->k == 2 || c->k == 3 || c->k == 4 || c->k == 8) {
+#define AKP_LBS_PIPELINE(K)                                                                \
+    do {                                                                                   \
+        uint32_t off[2][64];                                                               \
+        joint_offsets(c, begin, AKP_MAT_SHIFT, off[0], (K));                              \
+        unsigned b = 0;                                                                    \
+        for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                 \
+            if (i + 8 < end) joint_offsets(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], (K));    \
+            block_lbs(c, i, (K), off[b]);                                                  \
+        }                                                                                  \
+    } while (0)
+        if (c->k == 2) AKP_LBS_PIPELINE(2u);
+        else if (c->k == 3) AKP_LBS_PIPELINE(3u);
+        else if (c->k == 4) AKP_LBS_PIPELINE(4u);
+        else AKP_LBS_PIPELINE(8u);
+#undef AKP_LBS_PIPELINE
     } else {
 #define AKP_LBS_K(K)                                                                       \
     for (size_t i = begin; i < end; i += 8) block_lbs(c, i, (K), NULL)
