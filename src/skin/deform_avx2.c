@@ -161,10 +161,8 @@ AKP_AVX2_INLINE static inline void blend_matrix_vertex(const akp_skin_ctx* c, si
  * matrices for LBS (offsets from joint_offsets with AKP_MAT_SHIFT), the CoR rows for CoR. Each
  * weight is broadcast straight from memory and each offset is its own 32-bit load (as one
  * 64-bit word, each costs a move, a shift and a register broadcast). */
-AKP_AVX2_INLINE static inline void blend_matrix_rows(const akp_skin_ctx* c, size_t i, const char* base,
-                                                      const uint32_t* off, __m256* out01, __m256* out23,
-                                                      const uint32_t K) {
-    const char* wp = c->wgt + i * c->wgt_stride;
+AKP_AVX2_INLINE static inline void blend_matrix_rows_w(const char* wp, const char* base, const uint32_t* off,
+                                                        __m256* out01, __m256* out23, const uint32_t K) {
     float wk;
     memcpy(&wk, wp, 4);
     __m256 w = _mm256_set1_ps(wk);
@@ -179,6 +177,25 @@ AKP_AVX2_INLINE static inline void blend_matrix_rows(const akp_skin_ctx* c, size
     }
     *out01 = a01;
     *out23 = a23;
+}
+AKP_AVX2_INLINE static inline void blend_matrix_rows(const akp_skin_ctx* c, size_t i, const char* base,
+                                                      const uint32_t* off, __m256* out01, __m256* out23,
+                                                      const uint32_t K) {
+    blend_matrix_rows_w(c->wgt + i * c->wgt_stride, base, off, out01, out23, K);
+}
+
+/* Packed joints and weights (strides 2 K and 4 K bytes), K = 2, 4 or 8: the palette byte
+ * offsets of 8 vertices, off[K v + k], from K loads of 8 indices (widen, clamp, shift) instead
+ * of joint_offsets' two loads, an unpack and a convert per pair of vertices (block_lbs then
+ * reads vertex v's weights 4 K v bytes after the block's). */
+AKP_AVX2_INLINE static inline void offsets8_dense(const akp_skin_ctx* c, size_t i0, uint32_t* off, const uint32_t K) {
+    const char* jp = c->jnt + i0 * 2u * K;
+    const size_t last = c->palette_count - 1;
+    const __m256i lim = _mm256_set1_epi32((int)(last > 65535u ? 65535u : last));
+    for (uint32_t q = 0; q < K; ++q) {
+        const __m256i j = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i*)(const void*)(jp + 16u * q)));
+        _mm256_storeu_si256((__m256i*)(void*)(off + 8u * q), _mm256_slli_epi32(_mm256_min_epu32(j, lim), AKP_MAT_SHIFT));
+    }
 }
 
 /* Hemisphere-aligned blend of (real | dual) quaternions of vertex i. */
@@ -218,10 +235,15 @@ AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t 
 /* off: with 2, 3, 4 or 8 influences, the block's palette offsets (joint_offsets, AKP_SLOTS(K)
  * per vertex), computed a block ahead by the caller so that they are read back from memory as
  * plain loads; NULL otherwise. */
-AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K, const uint32_t* off) {
+AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K, const uint32_t* off,
+                                             bool dense) {
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
-    if (off) {
+    if (off && dense) {
+        const char* wb = c->wgt + i0 * 4u * K;
+        for (uint32_t v = 0; v < 8; ++v)
+            blend_matrix_rows_w(wb + 4u * K * v, (const char*)c->palette, off + K * v, &c01[v], &c23[v], K);
+    } else if (off) {
         for (int v = 0; v < 8; ++v)
             blend_matrix_rows(c, i0 + (size_t)v, (const char*)c->palette, off + AKP_SLOTS(K) * v, &c01[v], &c23[v], K);
     } else {
@@ -424,11 +446,20 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
 #define AKP_LBS_PIPELINE(K)                                                                \
     do {                                                                                   \
         uint32_t off[2][64];                                                               \
+        if ((K) != 3u && c->jnt_stride == 2u * (K) && c->wgt_stride == 4u * (K)) {         \
+            offsets8_dense(c, begin, off[0], (K));                                         \
+            unsigned b = 0;                                                                \
+            for (size_t i = begin; i < end; i += 8, b ^= 1u) {                             \
+                if (i + 8 < end) offsets8_dense(c, i + 8, off[b ^ 1u], (K));               \
+                block_lbs(c, i, (K), off[b], true);                                        \
+            }                                                                              \
+            break;                                                                         \
+        }                                                                                  \
         joint_offsets(c, begin, AKP_MAT_SHIFT, off[0], (K));                              \
         unsigned b = 0;                                                                    \
         for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                 \
             if (i + 8 < end) joint_offsets(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], (K));    \
-            block_lbs(c, i, (K), off[b]);                                                  \
+            block_lbs(c, i, (K), off[b], false);                                           \
         }                                                                                  \
     } while (0)
         if (c->k == 2) AKP_LBS_PIPELINE(2u);
@@ -438,7 +469,7 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
 #undef AKP_LBS_PIPELINE
     } else {
 #define AKP_LBS_K(K)                                                                       \
-    for (size_t i = begin; i < end; i += 8) block_lbs(c, i, (K), NULL)
+    for (size_t i = begin; i < end; i += 8) block_lbs(c, i, (K), NULL, false)
         AKP_K_DISPATCH(AKP_LBS_K)
 #undef AKP_LBS_K
     }
