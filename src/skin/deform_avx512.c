@@ -295,12 +295,12 @@ AKP_AVX512_INLINE static inline __m512 blend_cor(const akp_skin_ctx* c, size_t i
     return acc;
 }
 
-/* The weighted sum of the K rows of 16 floats at base + the byte offsets off (joint_offsets
- * layout) with the weights of vertex i: palette matrices for LBS, CoR rows for CoR. Each weight
- * is broadcast straight from memory and each offset is its own 32-bit load: read as one 64-bit
- * word (the weights, the offsets in pairs), they cost a move, a shift and a register broadcast
- * each, which were a third of the blend's instructions (measured, Zen 5, 100k vertices, LBS with
- * normals, 2 influences: 1.32x -> 1.48x ozz's rate). */
+/* The weighted sum of the K palette matrices at base + the byte offsets off (joint_offsets
+ * layout) with the weights of vertex i. Each weight is broadcast straight from memory and each
+ * offset is its own 32-bit load: read as one 64-bit word (the weights, the offsets in pairs),
+ * they cost a move, a shift and a register broadcast each, a third of the blend's instructions
+ * (Zen 5, 100k vertices, LBS with normals, 2 influences: 1.32x -> 1.48x ozz's rate). CoR keeps
+ * the word reads: see blend_cor_rows_at. */
 AKP_AVX512_INLINE static inline __m512 blend_rows_at(const akp_skin_ctx* c, size_t i, const char* base,
                                                      const uint32_t* off, const uint32_t K) {
     const char* wp = c->wgt + i * c->wgt_stride;
@@ -310,6 +310,21 @@ AKP_AVX512_INLINE static inline __m512 blend_rows_at(const akp_skin_ctx* c, size
     for (uint32_t k = 1; k < K; ++k) acc = _mm512_fmadd_ps(AKP_ROW(k), AKP_W(k), acc);
 #undef AKP_ROW
 #undef AKP_W
+    return acc;
+}
+
+/* The same blend for CoR's rows, with the weights read as one word and the offsets in pairs
+ * (vertex_offsets): the per-load form above made CoR 4% slower (224 -> 216 M vertices/s, 4
+ * influences, 100k vertices, Zen 5), where LBS gained 10%. */
+AKP_AVX512_INLINE static inline __m512 blend_cor_rows_at(const akp_skin_ctx* c, size_t i, const char* base,
+                                                         const uint32_t* off, const uint32_t K) {
+    float ww[AK_MAX_INFLUENCES];
+    memcpy(ww, c->wgt + i * c->wgt_stride, 4u * K);
+    size_t o[8];
+    vertex_offsets(off, o, K);
+    __m512 acc = _mm512_mul_ps(_mm512_loadu_ps((const float*)(const void*)(base + o[0])), _mm512_set1_ps(ww[0]));
+    for (uint32_t k = 1; k < K; ++k)
+        acc = _mm512_fmadd_ps(_mm512_loadu_ps((const float*)(const void*)(base + o[k])), _mm512_set1_ps(ww[k]), acc);
     return acc;
 }
 
@@ -519,14 +534,14 @@ AKP_AVX512_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0,
     const char* rows = (const char*)c->joints_prep + offsetof(akp_skin_joint, cor_rows);
     if (p) { /* as block_dqs: the next block's phase 1 in two halves between the blends */
         if (next) dq_signs_block(c, i_next, &next->h[0], neg, K);
-        for (unsigned v = 0; v < 8; ++v) lo[v] = blend_rows_at(c, i0 + v, rows, AKP_OFF(p, v, K), K);
+        for (unsigned v = 0; v < 8; ++v) lo[v] = blend_cor_rows_at(c, i0 + v, rows, AKP_OFF(p, v, K), K);
         if (next) dq_signs_block(c, i_next + 8, &next->h[1], neg, K);
     }
     for (unsigned v = 0; v < 8; ++v) {
         __m512 a, b;
         if (p) {
             a = lo[v];
-            b = blend_rows_at(c, i0 + v + 8, rows, AKP_OFF(p, v + 8, K), K);
+            b = blend_cor_rows_at(c, i0 + v + 8, rows, AKP_OFF(p, v + 8, K), K);
         } else {
             a = v < n ? blend_cor(c, i0 + v, K) : _mm512_setzero_ps();
             b = v + 8 < n ? blend_cor(c, i0 + v + 8, K) : _mm512_setzero_ps();
