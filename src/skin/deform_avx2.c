@@ -103,15 +103,16 @@ AKP_AVX2_INLINE static inline void store_xyz8(char* p, size_t stride, __m256 x, 
     }
 }
 
-/* (x, y, z) / |(x, y, z)| with rsqrt + one Newton step; a zero vector stays zero. */
-AKP_AVX2_INLINE static inline void normalize8(__m256* x, __m256* y, __m256* z) {
+/* (x, y, z) / |(x, y, z)| with rsqrt + one Newton step, its sign flipped where sign is -0
+ * (sign: 0 or -0 per lane); a zero vector stays zero. */
+AKP_AVX2_INLINE static inline void normalize8_signed(__m256* x, __m256* y, __m256* z, __m256 sign) {
     __m256 l2 = _mm256_fmadd_ps(*x, *x, _mm256_fmadd_ps(*y, *y, _mm256_mul_ps(*z, *z)));
     l2 = _mm256_max_ps(l2, _mm256_set1_ps(1e-30f));
     const __m256 r = _mm256_rsqrt_ps(l2), a = _mm256_mul_ps(_mm256_set1_ps(0.5f), l2);
     /* v r (1.5 - 0.5 l2 r^2), with v r beside the Newton factor: after the estimate, the chain
      * is a multiply, an FMA and a multiply (it was four multiplies and a subtract, the end of
      * each block's longest dependency chain) */
-    const __m256 t = _mm256_fnmadd_ps(a, _mm256_mul_ps(r, r), _mm256_set1_ps(1.5f));
+    const __m256 t = _mm256_xor_ps(_mm256_fnmadd_ps(a, _mm256_mul_ps(r, r), _mm256_set1_ps(1.5f)), sign);
     *x = _mm256_mul_ps(_mm256_mul_ps(*x, r), t);
     *y = _mm256_mul_ps(_mm256_mul_ps(*y, r), t);
     *z = _mm256_mul_ps(_mm256_mul_ps(*z, r), t);
@@ -265,20 +266,18 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
     store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, ox, oy, oz);
     if (!c->do_normals) return;
 
-    __m256 nx, ny, nz, k0x, k0y, k0z, k1x, k1y, k1z, k2x, k2y, k2z;
+    __m256 nx, ny, nz, k0x, k0y, k0z, k1x, k1y, k1z;
     load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
-    AKP_CROSS(bx, by, bz, cx, cy, cz, k0x, k0y, k0z); /* cofactor columns */
-    AKP_CROSS(cx, cy, cz, ax, ay, az, k1x, k1y, k1z);
-    AKP_CROSS(ax, ay, az, bx, by, bz, k2x, k2y, k2z);
-    __m256 det = _mm256_fmadd_ps(ax, k0x, _mm256_fmadd_ps(ay, k0y, _mm256_mul_ps(az, k0z)));
-    __m256 s = _mm256_and_ps(det, _mm256_set1_ps(-0.0f));
-    __m256 mx = _mm256_fmadd_ps(k0x, nx, _mm256_fmadd_ps(k1x, ny, _mm256_mul_ps(k2x, nz)));
-    __m256 my = _mm256_fmadd_ps(k0y, nx, _mm256_fmadd_ps(k1y, ny, _mm256_mul_ps(k2y, nz)));
-    __m256 mz = _mm256_fmadd_ps(k0z, nx, _mm256_fmadd_ps(k1z, ny, _mm256_mul_ps(k2z, nz)));
-    mx = _mm256_xor_ps(mx, s);
-    my = _mm256_xor_ps(my, s);
-    mz = _mm256_xor_ps(mz, s);
-    normalize8(&mx, &my, &mz);
+    /* cof(M) n = nx (b x c) + ny (c x a) + nz (a x b) = nx (b x c) + (ny c - nz b) x a: two
+     * cross products instead of three; sign(det) goes on the Newton factor */
+    AKP_CROSS(bx, by, bz, cx, cy, cz, k0x, k0y, k0z);
+    const __m256 ux = _mm256_fmsub_ps(ny, cx, _mm256_mul_ps(nz, bx));
+    const __m256 uy = _mm256_fmsub_ps(ny, cy, _mm256_mul_ps(nz, by));
+    const __m256 uz = _mm256_fmsub_ps(ny, cz, _mm256_mul_ps(nz, bz));
+    AKP_CROSS(ux, uy, uz, ax, ay, az, k1x, k1y, k1z);
+    const __m256 det = _mm256_fmadd_ps(ax, k0x, _mm256_fmadd_ps(ay, k0y, _mm256_mul_ps(az, k0z)));
+    __m256 mx = _mm256_fmadd_ps(k0x, nx, k1x), my = _mm256_fmadd_ps(k0y, nx, k1y), mz = _mm256_fmadd_ps(k0z, nx, k1z);
+    normalize8_signed(&mx, &my, &mz, _mm256_and_ps(det, _mm256_set1_ps(-0.0f)));
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, mx, my, mz);
 }
 

@@ -162,13 +162,16 @@ AKP_AVX512_INLINE static inline void pair_rows(__m512 a, __m512 b, __m512* r01, 
         oz = _mm512_fmsub_ps(ax, by, _mm512_mul_ps(ay, bx));                               \
     } while (0)
 
-/* (x, y, z) / |(x, y, z)| with rsqrt14 + one Newton step; a zero vector stays zero. */
-AKP_AVX512_INLINE static inline void normalize16(__m512* x, __m512* y, __m512* z) {
+/* (x, y, z) / |(x, y, z)| with rsqrt14 + one Newton step, negated in the lanes of flip; a
+ * zero vector stays zero. */
+AKP_AVX512_INLINE static inline void normalize16_signed(__m512* x, __m512* y, __m512* z, __mmask16 flip) {
     __m512 l2 = _mm512_fmadd_ps(*x, *x, _mm512_fmadd_ps(*y, *y, _mm512_mul_ps(*z, *z)));
     l2 = _mm512_max_ps(l2, _mm512_set1_ps(1e-30f));
     const __m512 r = _mm512_rsqrt14_ps(l2), a = _mm512_mul_ps(_mm512_set1_ps(0.5f), l2);
-    /* v r (1.5 - 0.5 l2 r^2), v r beside the Newton factor (as normalize8 in deform_avx2.c) */
-    const __m512 t = _mm512_fnmadd_ps(a, _mm512_mul_ps(r, r), _mm512_set1_ps(1.5f));
+    /* v r (1.5 - 0.5 l2 r^2), v r beside the Newton factor (as normalize8_signed in
+     * deform_avx2.c) */
+    __m512 t = _mm512_fnmadd_ps(a, _mm512_mul_ps(r, r), _mm512_set1_ps(1.5f));
+    t = _mm512_mask_sub_ps(t, flip, _mm512_setzero_ps(), t);
     *x = _mm512_mul_ps(_mm512_mul_ps(*x, r), t);
     *y = _mm512_mul_ps(_mm512_mul_ps(*y, r), t);
     *z = _mm512_mul_ps(_mm512_mul_ps(*z, r), t);
@@ -353,21 +356,18 @@ AKP_AVX512_INLINE static inline void lbs_finish(const akp_skin_ctx* c, size_t i0
     __m512 oz = _mm512_fmadd_ps(az, px, _mm512_fmadd_ps(bz, py, _mm512_fmadd_ps(cz, pz, tz)));
     store_xyz16(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, n, ox, oy, oz);
     if (!c->do_normals) return;
-    __m512 nx, ny, nz, k0x, k0y, k0z, k1x, k1y, k1z, k2x, k2y, k2z;
+    __m512 nx, ny, nz, k0x, k0y, k0z, k1x, k1y, k1z;
     load_xyz16(c->nrm + i0 * c->nrm_stride, c->nrm_stride, n, &nx, &ny, &nz);
-    AKP_CROSS16(bx, by, bz, cx, cy, cz, k0x, k0y, k0z); /* cofactor columns */
-    AKP_CROSS16(cx, cy, cz, ax, ay, az, k1x, k1y, k1z);
-    AKP_CROSS16(ax, ay, az, bx, by, bz, k2x, k2y, k2z);
+    /* cof(M) n = nx (b x c) + (ny c - nz b) x a (as deform_avx2.c); sign(det) on the Newton
+     * factor */
+    AKP_CROSS16(bx, by, bz, cx, cy, cz, k0x, k0y, k0z);
+    const __m512 ux = _mm512_fmsub_ps(ny, cx, _mm512_mul_ps(nz, bx));
+    const __m512 uy = _mm512_fmsub_ps(ny, cy, _mm512_mul_ps(nz, by));
+    const __m512 uz = _mm512_fmsub_ps(ny, cz, _mm512_mul_ps(nz, bz));
+    AKP_CROSS16(ux, uy, uz, ax, ay, az, k1x, k1y, k1z);
     const __m512 det = _mm512_fmadd_ps(ax, k0x, _mm512_fmadd_ps(ay, k0y, _mm512_mul_ps(az, k0z)));
-    const __mmask16 flip = _mm512_cmp_ps_mask(det, _mm512_setzero_ps(), _CMP_LT_OQ);
-    __m512 mx = _mm512_fmadd_ps(k0x, nx, _mm512_fmadd_ps(k1x, ny, _mm512_mul_ps(k2x, nz)));
-    __m512 my = _mm512_fmadd_ps(k0y, nx, _mm512_fmadd_ps(k1y, ny, _mm512_mul_ps(k2y, nz)));
-    __m512 mz = _mm512_fmadd_ps(k0z, nx, _mm512_fmadd_ps(k1z, ny, _mm512_mul_ps(k2z, nz)));
-    const __m512 zero = _mm512_setzero_ps();
-    mx = _mm512_mask_sub_ps(mx, flip, zero, mx);
-    my = _mm512_mask_sub_ps(my, flip, zero, my);
-    mz = _mm512_mask_sub_ps(mz, flip, zero, mz);
-    normalize16(&mx, &my, &mz);
+    __m512 mx = _mm512_fmadd_ps(k0x, nx, k1x), my = _mm512_fmadd_ps(k0y, nx, k1y), mz = _mm512_fmadd_ps(k0z, nx, k1z);
+    normalize16_signed(&mx, &my, &mz, _mm512_cmp_ps_mask(det, _mm512_setzero_ps(), _CMP_LT_OQ));
     store_xyz16(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, n, mx, my, mz);
 }
 
