@@ -196,7 +196,8 @@ AKP_AVX2_INLINE static inline void offsets8_dense(const akp_skin_ctx* c, size_t 
     const __m256i lim = _mm256_set1_epi32((int)(last > 65535u ? 65535u : last));
     for (uint32_t q = 0; q < K; ++q) {
         const __m256i j = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i*)(const void*)(jp + 16u * q)));
-        _mm256_storeu_si256((__m256i*)(void*)(off + 8u * q), _mm256_slli_epi32(_mm256_min_epu32(j, lim), AKP_MAT_SHIFT));
+        const __m256i o = _mm256_slli_epi32(_mm256_min_epu32(j, lim), AKP_MAT_SHIFT);
+        _mm256_storeu_si256((__m256i*)(void*)(off + 8u * q), o);
     }
 }
 
