@@ -21,8 +21,8 @@
         unsigned b = 0;                                                                            \
         for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                         \
             __asm volatile("# LLVM-MCA-BEGIN " #name);                                             \
-            joint_offsets(&c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], 4);                               \
-            block_lbs(&c, i, 4, off[b]);                                                           \
+            offsets8_dense(&c, i + 8, off[b ^ 1u], 4); /* packed: the block loop's dense path */   \
+            block_lbs(&c, i, 4, off[b], true);                                                     \
             __asm volatile("# LLVM-MCA-END " #name);                                               \
         }                                                                                          \
     }

@@ -103,17 +103,19 @@ AKP_AVX2_INLINE static inline void store_xyz8(char* p, size_t stride, __m256 x, 
     }
 }
 
-/* (x, y, z) / |(x, y, z)| with rsqrt + one Newton step; a zero vector stays zero. */
-AKP_AVX2_INLINE static inline void normalize8(__m256* x, __m256* y, __m256* z) {
+/* (x, y, z) / |(x, y, z)| with rsqrt + one Newton step, its sign flipped where sign is -0
+ * (sign: 0 or -0 per lane); a zero vector stays zero. */
+AKP_AVX2_INLINE static inline void normalize8_signed(__m256* x, __m256* y, __m256* z, __m256 sign) {
     __m256 l2 = _mm256_fmadd_ps(*x, *x, _mm256_fmadd_ps(*y, *y, _mm256_mul_ps(*z, *z)));
     l2 = _mm256_max_ps(l2, _mm256_set1_ps(1e-30f));
-    __m256 r = _mm256_rsqrt_ps(l2);
-    /* r' = r (1.5 - 0.5 l2 r^2) */
-    __m256 h = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), l2), _mm256_mul_ps(r, r));
-    r = _mm256_mul_ps(r, _mm256_sub_ps(_mm256_set1_ps(1.5f), h));
-    *x = _mm256_mul_ps(*x, r);
-    *y = _mm256_mul_ps(*y, r);
-    *z = _mm256_mul_ps(*z, r);
+    const __m256 r = _mm256_rsqrt_ps(l2), a = _mm256_mul_ps(_mm256_set1_ps(0.5f), l2);
+    /* v r (1.5 - 0.5 l2 r^2), with v r beside the Newton factor: after the estimate, the chain
+     * is a multiply, an FMA and a multiply (it was four multiplies and a subtract, the end of
+     * each block's longest dependency chain) */
+    const __m256 t = _mm256_xor_ps(_mm256_fnmadd_ps(a, _mm256_mul_ps(r, r), _mm256_set1_ps(1.5f)), sign);
+    *x = _mm256_mul_ps(_mm256_mul_ps(*x, r), t);
+    *y = _mm256_mul_ps(_mm256_mul_ps(*y, r), t);
+    *z = _mm256_mul_ps(_mm256_mul_ps(*z, r), t);
 }
 
 /* a x b, componentwise vectors. */
@@ -157,26 +159,46 @@ AKP_AVX2_INLINE static inline void blend_matrix_vertex(const akp_skin_ctx* c, si
 
 #include "skin_avx2_shared.h" /* joint offsets, DQS/CoR phase 1 */
 
-/* Blend of two 8-float rows at base + off[k] with the 4 weights of vertex i: the palette
- * matrices for LBS (offsets from joint_offsets with AKP_MAT_SHIFT), the CoR rows for CoR. */
-AKP_AVX2_INLINE static inline void blend_matrix_rows(const akp_skin_ctx* c, size_t i, const char* base,
-                                                      const uint32_t* off, __m256* out01, __m256* out23,
-                                                      const uint32_t K) {
-    float ww[8];
-    memcpy(ww, c->wgt + i * c->wgt_stride, 4u * K);
-    size_t o[8];
-    vertex_offsets(off, o, K);
-    __m256 w = _mm256_set1_ps(ww[0]);
-    const float* m = (const float*)(const void*)(base + o[0]);
+/* Blend of two 8-float rows at base + off[k] with the K weights of vertex i: the palette
+ * matrices for LBS (offsets from joint_offsets with AKP_MAT_SHIFT), the CoR rows for CoR. Each
+ * weight is broadcast straight from memory and each offset is its own 32-bit load (as one
+ * 64-bit word, each costs a move, a shift and a register broadcast). */
+AKP_AVX2_INLINE static inline void blend_matrix_rows_w(const char* wp, const char* base, const uint32_t* off,
+                                                        __m256* out01, __m256* out23, const uint32_t K) {
+    float wk;
+    memcpy(&wk, wp, 4);
+    __m256 w = _mm256_set1_ps(wk);
+    const float* m = (const float*)(const void*)(base + (size_t)off[0]);
     __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
     for (uint32_t k = 1; k < K; ++k) {
-        m = (const float*)(const void*)(base + o[k]);
-        w = _mm256_set1_ps(ww[k]);
+        m = (const float*)(const void*)(base + (size_t)off[k]);
+        memcpy(&wk, wp + 4u * k, 4);
+        w = _mm256_set1_ps(wk);
         a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
         a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
     }
     *out01 = a01;
     *out23 = a23;
+}
+AKP_AVX2_INLINE static inline void blend_matrix_rows(const akp_skin_ctx* c, size_t i, const char* base,
+                                                      const uint32_t* off, __m256* out01, __m256* out23,
+                                                      const uint32_t K) {
+    blend_matrix_rows_w(c->wgt + i * c->wgt_stride, base, off, out01, out23, K);
+}
+
+/* Packed joints and weights (strides 2 K and 4 K bytes), K = 2, 4 or 8: the palette byte
+ * offsets of 8 vertices, off[K v + k], from K loads of 8 indices (widen, clamp, shift) instead
+ * of joint_offsets' two loads, an unpack and a convert per pair of vertices (block_lbs then
+ * reads vertex v's weights 4 K v bytes after the block's). */
+AKP_AVX2_INLINE static inline void offsets8_dense(const akp_skin_ctx* c, size_t i0, uint32_t* off, const uint32_t K) {
+    const char* jp = c->jnt + i0 * 2u * K;
+    const size_t last = c->palette_count - 1;
+    const __m256i lim = _mm256_set1_epi32((int)(last > 65535u ? 65535u : last));
+    for (uint32_t q = 0; q < K; ++q) {
+        const __m256i j = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i*)(const void*)(jp + 16u * q)));
+        const __m256i o = _mm256_slli_epi32(_mm256_min_epu32(j, lim), AKP_MAT_SHIFT);
+        _mm256_storeu_si256((__m256i*)(void*)(off + 8u * q), o);
+    }
 }
 
 /* Hemisphere-aligned blend of (real | dual) quaternions of vertex i. */
@@ -213,14 +235,20 @@ AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t 
 }
 
 
-/* off: with 4 influences, the block's palette offsets (joint_offsets), computed a block ahead
- * by the caller so that they are read back from memory as plain loads; NULL otherwise. */
-AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K, const uint32_t* off) {
+/* off: with 2, 3, 4 or 8 influences, the block's palette offsets (joint_offsets, AKP_SLOTS(K)
+ * per vertex), computed a block ahead by the caller so that they are read back from memory as
+ * plain loads; NULL otherwise. */
+AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K, const uint32_t* off,
+                                             bool dense) {
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
-    if (off) {
+    if (off && dense) {
+        const char* wb = c->wgt + i0 * 4u * K;
+        for (uint32_t v = 0; v < 8; ++v)
+            blend_matrix_rows_w(wb + 4u * K * v, (const char*)c->palette, off + K * v, &c01[v], &c23[v], K);
+    } else if (off) {
         for (int v = 0; v < 8; ++v)
-            blend_matrix_rows(c, i0 + (size_t)v, (const char*)c->palette, off + 4 * v, &c01[v], &c23[v], 4);
+            blend_matrix_rows(c, i0 + (size_t)v, (const char*)c->palette, off + AKP_SLOTS(K) * v, &c01[v], &c23[v], K);
     } else {
         for (int v = 0; v < 8; ++v) blend_matrix_vertex(c, i0 + (size_t)v, K, &c01[v], &c23[v]);
     }
@@ -239,20 +267,18 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
     store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, ox, oy, oz);
     if (!c->do_normals) return;
 
-    __m256 nx, ny, nz, k0x, k0y, k0z, k1x, k1y, k1z, k2x, k2y, k2z;
+    __m256 nx, ny, nz, k0x, k0y, k0z, k1x, k1y, k1z;
     load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
-    AKP_CROSS(bx, by, bz, cx, cy, cz, k0x, k0y, k0z); /* cofactor columns */
-    AKP_CROSS(cx, cy, cz, ax, ay, az, k1x, k1y, k1z);
-    AKP_CROSS(ax, ay, az, bx, by, bz, k2x, k2y, k2z);
-    __m256 det = _mm256_fmadd_ps(ax, k0x, _mm256_fmadd_ps(ay, k0y, _mm256_mul_ps(az, k0z)));
-    __m256 s = _mm256_and_ps(det, _mm256_set1_ps(-0.0f));
-    __m256 mx = _mm256_fmadd_ps(k0x, nx, _mm256_fmadd_ps(k1x, ny, _mm256_mul_ps(k2x, nz)));
-    __m256 my = _mm256_fmadd_ps(k0y, nx, _mm256_fmadd_ps(k1y, ny, _mm256_mul_ps(k2y, nz)));
-    __m256 mz = _mm256_fmadd_ps(k0z, nx, _mm256_fmadd_ps(k1z, ny, _mm256_mul_ps(k2z, nz)));
-    mx = _mm256_xor_ps(mx, s);
-    my = _mm256_xor_ps(my, s);
-    mz = _mm256_xor_ps(mz, s);
-    normalize8(&mx, &my, &mz);
+    /* cof(M) n = nx (b x c) + ny (c x a) + nz (a x b) = nx (b x c) + (ny c - nz b) x a: two
+     * cross products instead of three; sign(det) goes on the Newton factor */
+    AKP_CROSS(bx, by, bz, cx, cy, cz, k0x, k0y, k0z);
+    const __m256 ux = _mm256_fmsub_ps(ny, cx, _mm256_mul_ps(nz, bx));
+    const __m256 uy = _mm256_fmsub_ps(ny, cy, _mm256_mul_ps(nz, by));
+    const __m256 uz = _mm256_fmsub_ps(ny, cz, _mm256_mul_ps(nz, bz));
+    AKP_CROSS(ux, uy, uz, ax, ay, az, k1x, k1y, k1z);
+    const __m256 det = _mm256_fmadd_ps(ax, k0x, _mm256_fmadd_ps(ay, k0y, _mm256_mul_ps(az, k0z)));
+    __m256 mx = _mm256_fmadd_ps(k0x, nx, k1x), my = _mm256_fmadd_ps(k0y, nx, k1y), mz = _mm256_fmadd_ps(k0z, nx, k1z);
+    normalize8_signed(&mx, &my, &mz, _mm256_and_ps(det, _mm256_set1_ps(-0.0f)));
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, mx, my, mz);
 }
 
@@ -397,13 +423,14 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, nx, ny, nz);
 }
 
-/* The LBS block loop, specialised for 4 influences (the common case) so the compiler unrolls;
- * the palette offsets of the next block are computed before the current block runs (two
- * buffers in turn), so the blend reads them back as plain loads: extracting 32 offsets from
- * SIMD registers costs more, and reading them right after the vector store stalls. */
-/* Influence counts other than 4 run vertex by vertex through the blends; with the count a
- * compile-time constant for the common ones (1, 2, 3, 8) the compiler unrolls them (measured
- * in cache before this: 1 and 2 influences ran slower than 4, 8 at a third of 4's speed). */
+/* The LBS block loop, specialised for 2, 3, 4 and 8 influences so the compiler unrolls; the
+ * palette offsets of the next block are computed before the current block runs (two buffers in
+ * turn), so the blend reads them back as plain loads: extracting 32 offsets from SIMD registers
+ * costs more, and reading them right after the vector store stalls. Pipelined like 4, 2 and 8
+ * influences went from 1.07x / 1.10x to 1.08x / 1.29x ozz's rate (LBS with normals, 100k, Zen 5).
+ * Other counts (1 without the rigid path, 5, 6, 7) run vertex by vertex through the blends;
+ * with the count a compile-time constant for 1 the compiler unrolls them (measured in cache
+ * before this: 1 and 2 influences ran slower than 4, 8 at a third of 4's speed). */
 #define AKP_K_DISPATCH(RUN)                                                                \
     switch (c->k) {                                                                        \
     case 1: RUN(1u); break;                                                                \
@@ -416,17 +443,34 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
 AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
     if (c->rigid_single) {
         for (size_t i = begin; i < end; i += 8) block_lbs_rigid1(c, i);
-    } else if (c->k == 4) {
-        uint32_t off[2][32];
-        joint_offsets(c, begin, AKP_MAT_SHIFT, off[0], 4);
-        unsigned b = 0;
-        for (size_t i = begin; i < end; i += 8, b ^= 1u) {
-            if (i + 8 < end) joint_offsets(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], 4);
-            block_lbs(c, i, 4, off[b]);
-        }
+    } else if (c->k == 2 || c->k == 3 || c->k == 4 || c->k == 8) {
+#define AKP_LBS_PIPELINE(K)                                                                \
+    do {                                                                                   \
+        uint32_t off[2][64];                                                               \
+        if ((K) != 3u && c->jnt_stride == 2u * (K) && c->wgt_stride == 4u * (K)) {         \
+            offsets8_dense(c, begin, off[0], (K));                                         \
+            unsigned b = 0;                                                                \
+            for (size_t i = begin; i < end; i += 8, b ^= 1u) {                             \
+                if (i + 8 < end) offsets8_dense(c, i + 8, off[b ^ 1u], (K));               \
+                block_lbs(c, i, (K), off[b], true);                                        \
+            }                                                                              \
+            break;                                                                         \
+        }                                                                                  \
+        joint_offsets(c, begin, AKP_MAT_SHIFT, off[0], (K));                              \
+        unsigned b = 0;                                                                    \
+        for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                 \
+            if (i + 8 < end) joint_offsets(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], (K));    \
+            block_lbs(c, i, (K), off[b], false);                                           \
+        }                                                                                  \
+    } while (0)
+        if (c->k == 2) AKP_LBS_PIPELINE(2u);
+        else if (c->k == 3) AKP_LBS_PIPELINE(3u);
+        else if (c->k == 4) AKP_LBS_PIPELINE(4u);
+        else AKP_LBS_PIPELINE(8u);
+#undef AKP_LBS_PIPELINE
     } else {
 #define AKP_LBS_K(K)                                                                       \
-    for (size_t i = begin; i < end; i += 8) block_lbs(c, i, (K), NULL)
+    for (size_t i = begin; i < end; i += 8) block_lbs(c, i, (K), NULL, false)
         AKP_K_DISPATCH(AKP_LBS_K)
 #undef AKP_LBS_K
     }
