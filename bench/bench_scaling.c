@@ -16,8 +16,9 @@
  * idle but still scale badly is limited by memory bandwidth or by threads that cannot run (a
  * loaded machine). The last column is Amdahl's speed-up at 16 threads for the serial fraction
  * that explains the idle time at 2 threads (s = 1 / (1 - idle) - 1).
- *     bench_scaling --cpu [--cpu-threads 2,16] [--phases] ...
- * adds a CPU-time profile per workload (src/tasks.h, akp_tasks_profile_step): every thread's
+ *     bench_scaling --cpu [--cpu-threads 2,16] [--cpu-steps N] [--phases] ...
+ * adds a CPU-time profile per workload over N steps (default up to 6) (src/tasks.h,
+ * akp_tasks_profile_step): every thread's
  * CPU time per phase, so a loaded machine, or one with fewer cores than threads, still measures
  * the work. Per thread count T (the job run with T threads): CPU ms per step, the serial part
  * (the caller's work between sections, plus each phase's busiest thread beyond the others'
@@ -485,7 +486,7 @@ static bool in_list(const char* list, const char* name) {
 
 int main(int argc, char** argv) {
     uint32_t counts[MAX_COUNTS] = {1, 2};
-    int count_n = 2, steps = 0;
+    int count_n = 2, steps = 0, cpu_steps = 0;
     uint32_t cpu_counts[MAX_COUNTS] = {2, 16};
     int cpu_n = 2;
     bool cpu = false, phases = false;
@@ -514,6 +515,8 @@ int main(int argc, char** argv) {
                 cpu_counts[cpu_n++] = (uint32_t)v;
                 if (*p == ',') ++p;
             }
+        } else if (strcmp(argv[i], "--cpu-steps") == 0 && i + 1 < argc) {
+            cpu = true, cpu_steps = atoi(argv[++i]);
         } else if (strcmp(argv[i], "--cpu") == 0) {
             cpu = true;
         } else if (strcmp(argv[i], "--phases") == 0) {
@@ -525,7 +528,7 @@ int main(int argc, char** argv) {
         } else if (strcmp(argv[i], "--quick") == 0) {
             quick = true;
         } else {
-            fprintf(stderr, "usage: bench_scaling [--threads 1,2,4,8,16] [--cpu] [--cpu-threads 2,16] [--phases] [--only NAME,...] "
+            fprintf(stderr, "usage: bench_scaling [--threads 1,2,4,8,16] [--cpu] [--cpu-threads 2,16] [--cpu-steps N] [--phases] [--only NAME,...] "
                             "[--steps N] [--quick]\n");
             return 2;
         }
@@ -600,7 +603,7 @@ int main(int argc, char** argv) {
                    ok ? "" : "  (a step failed)");
             fflush(stdout);
         }
-        if (cpu) cpu_report(w, cpu_counts, cpu_n, n_steps < 6 ? n_steps : 6, phases);
+        if (cpu) cpu_report(w, cpu_counts, cpu_n, cpu_steps > 0 ? cpu_steps : n_steps < 6 ? n_steps : 6, phases);
         w->fini(w);
     }
     return 0;
