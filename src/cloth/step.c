@@ -1,11 +1,10 @@
 /* Cloth step: XPBD, PBD and mass-spring solvers, wind, collisions, threads.
  *
  * Threads run the whole step together (SPMD): every phase splits its elements (particles,
- * triangles) into thread_count contiguous ranges, or hands out the constraints of one colour in
- * chunks from a shared counter (solve_color), and the threads meet at a barrier between phases.
- * Every element is computed the same way whatever range or chunk it falls in, and no two threads
- * write the same particle within a phase, so the result depends neither on the thread count nor
- * on which thread took which chunk. The XPBD/PBD constraint solves are cloth_kernel.h's,
+ * triangles, or the constraints of one colour) into thread_count contiguous ranges and the
+ * threads meet at a barrier between phases. Every element is computed the same way whatever
+ * range it falls in, and no two threads write the same particle within a phase, so the result
+ * does not depend on the thread count. The XPBD/PBD constraint solves are cloth_kernel.h's,
  * here in their scalar variant and in cloth_avx2.c / cloth_avx512.c in SIMD ones (chosen at run
  * time; the same bits). The step works on a copy of the positions as 16-byte (position, inverse
  * mass) records, copied back at the end. */
@@ -183,10 +182,7 @@ typedef struct ctx {
                             transverse factor (1; -1: degenerate) */
     uint32_t cg_max;     /* IMPLICIT: most CG iterations per substep */
     int simd;            /* 0 scalar, 1 AVX2, 2 AVX-512 */
-    _Alignas(64) akp_barrier bar; /* the step's team meets here between phases (src/tasks.h); its
-                                     own cache lines, away from the fields every thread reads */
-    _Alignas(64) atomic_ullong ticket; /* chunks of the colours taken so far (solve_color) */
-    char ticket_pad[64 - sizeof(atomic_ullong)];
+    akp_barrier bar; /* the step's team meets here between phases (src/tasks.h) */
     bool finite[MAX_THREADS]; /* per thread: its vertices ended finite */
     bool bad[MAX_THREADS];    /* per thread: one of its vertices came in non-finite */
 } ctx;
@@ -205,10 +201,32 @@ static void range(size_t count, unsigned t, unsigned T, size_t* b, size_t* e) {
     *e = count * (t + 1) / T;
 }
 
-/* ---- positions ---------------------------------------------------------------------------- */
+/* range() with the inner boundaries on multiples of 16, so that each thread's share of a
+ * colour is whole SIMD blocks but for the last one's tail. */
+static void block_range(size_t count, unsigned t, unsigned T, size_t* b, size_t* e) {
+    const size_t blocks = (count + 15) / 16;
+    *b = t == 0 ? 0 : blocks * t / T * 16;
+    *e = t + 1 == T ? count : blocks * (t + 1) / T * 16;
+    if (*b > count) *b = count;
+    if (*e > count) *e = count;
+}
 
-/* Chunks per thread of a colour's constraints (solve_color). */
-#define COLOR_CHUNKS_PER_THREAD 8u
+/* Thread t's share [*kb, *ke) of colour col of a constraint list whose colours start at
+ * starts[0..AKP_MAX_COLORS + 1]: the serial colour all on thread 0, the others in blocks of 16
+ * (block_range). False when the colour is empty (every thread skips it, barrier included). */
+static bool color_share(const uint32_t* starts, int col, unsigned t, unsigned T, size_t* kb, size_t* ke) {
+    const size_t cb = starts[col], ce = starts[col + 1];
+    if (cb == ce) return false;
+    if (col == AKP_SERIAL_COLOR) {
+        *kb = t == 0 ? cb : ce, *ke = ce;
+    } else {
+        block_range(ce - cb, t, T, kb, ke);
+        *kb += cb, *ke += cb;
+    }
+    return true;
+}
+
+/* ---- positions ---------------------------------------------------------------------------- */
 
 /* x_i - x_j now: the difference at the start of the step (exact for nearby floats) plus the
  * difference of the displacements, so it keeps its relative precision far from the origin. */
@@ -449,39 +467,6 @@ static void solve_bend_range(const ctx* c, size_t kb, size_t ke, bool first) {
     if (c->simd >= 1) k = akp_cloth_bend_avx2(&c->solve, k, ke, first);
 #endif
     for (; k < ke; ++k) scalar_bend(&c->solve, k, first);
-}
-
-/* Thread t's part of colour col of the distance (bend false) or bending constraints, whose
- * colours start at starts[]: the serial colour on thread 0; with one thread the whole colour;
- * else chunks of whole SIMD blocks (about COLOR_CHUNKS_PER_THREAD per thread) taken in turn from
- * the step's ticket counter, so a thread that runs faster (its data in cache, its core not
- * shared with another process) takes more: the constraints of a colour share no particle, so
- * which thread solves one changes nothing in the result. Every thread calls this for every
- * non-empty colour and takes tickets until one is past the colour's chunks, so a colour uses
- * exactly chunks + T tickets and *base (the same on every thread) moves on by that. */
-static void solve_color(ctx* c, const uint32_t* starts, int col, unsigned t, bool first, bool bend, uint64_t* base) {
-    const size_t cb = starts[col], ce = starts[col + 1];
-    if (col == AKP_SERIAL_COLOR) {
-        if (t == 0)
-            for (size_t k = cb; k < ce; ++k) bend ? scalar_bend(&c->solve, k, first) : scalar_dist(&c->solve, k, first);
-        return;
-    }
-    if (c->T == 1) {
-        bend ? solve_bend_range(c, cb, ce, first) : solve_dist_range(c, cb, ce, first);
-        return;
-    }
-    const size_t blocks = (ce - cb + 15) / 16;
-    size_t chunks = (size_t)COLOR_CHUNKS_PER_THREAD * c->T;
-    if (chunks > blocks) chunks = blocks;
-    for (;;) {
-        const uint64_t k = atomic_fetch_add_explicit(&c->ticket, 1u, memory_order_relaxed) - *base;
-        if (k >= chunks) break;
-        const size_t kb = cb + blocks * (size_t)k / chunks * 16;
-        size_t ke = cb + blocks * ((size_t)k + 1) / chunks * 16;
-        if (ke > ce) ke = ce;
-        bend ? solve_bend_range(c, kb, ke, first) : solve_dist_range(c, kb, ke, first);
-    }
-    *base += chunks + c->T;
 }
 
 /* Spring force of spring k added to acc (force accumulators) of its two particles. */
@@ -838,7 +823,6 @@ static void run_spmd(ctx* c, unsigned t) {
      * included) touch only each thread's own vertices, so they run as one phase, saving a meeting
      * per substep (and the one before the end of the step) */
     const bool fuse = !wind && !c->self;
-    uint64_t ticket_base = 0; /* solve_color */
     for (uint32_t s = 0; s < c->substeps; ++s) {
         const float f = (float)(s + 1) / (float)c->substeps;
         /* wind each substep: drag acts like a damper of rate rho C_d A |v| / m, which an
@@ -897,13 +881,21 @@ static void run_spmd(ctx* c, unsigned t) {
         barrier(c);
         for (uint32_t it = 0; it < c->iterations; ++it) {
             for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
-                if (cl->dist_color[col] == cl->dist_color[col + 1]) continue;
-                solve_color(c, cl->dist_color, col, t, it == 0, false, &ticket_base);
+                size_t kb, ke;
+                if (!color_share(cl->dist_color, col, t, c->T, &kb, &ke)) continue;
+                if (col == AKP_SERIAL_COLOR)
+                    for (size_t k = kb; k < ke; ++k) scalar_dist(&c->solve, k, it == 0);
+                else
+                    solve_dist_range(c, kb, ke, it == 0);
                 barrier(c);
             }
             for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
-                if (cl->bend_color[col] == cl->bend_color[col + 1]) continue;
-                solve_color(c, cl->bend_color, col, t, it == 0, true, &ticket_base);
+                size_t kb, ke;
+                if (!color_share(cl->bend_color, col, t, c->T, &kb, &ke)) continue;
+                if (col == AKP_SERIAL_COLOR)
+                    for (size_t k = kb; k < ke; ++k) scalar_bend(&c->solve, k, it == 0);
+                else
+                    solve_bend_range(c, kb, ke, it == 0);
                 barrier(c);
             }
             if (cl->lra_anchor) {
@@ -1004,7 +996,6 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     c.cg_max = job->iterations ? job->iterations : 100;
     /* displacements start at the residuals (the part of the position the float missed) */
     c.base = job->positions.ptr;
-    atomic_init(&c.ticket, 0u);
     c.solve = (akp_solve){.cl = cl, .x = c.x, .prev = c.prev, .lambda = c.lambda, .h = c.h, .h2 = c.h * c.h,
                           .beta = cl->desc.constraint_damping, .pbd_stiffness = cl->desc.pbd_stiffness,
                           .bend_alpha = 1.0f / cl->desc.dihedral_stiffness, .pbd = cl->desc.solver == AK_CLOTH_PBD,
