@@ -961,7 +961,7 @@ AK_TEST(default_thread_bound_bit_identical) {
  * substep's prediction and kinematic placement as one phase per thread, each thread placing the
  * pins and attachments of its own vertices, and checks the vertices' data on the threads. With
  * pins in the first and last thirds of the sheet and a moving attachment in the middle one, on
- * 1, 2 and 3 threads: the same bits (positions, velocities, residuals); pins and the attachment
+ * 1, 2, 3 and 8 threads: the same bits (positions, velocities, residuals); pins and the attachment
  * exactly at their targets; the attachment's velocity its target's speed (it moves 0.01 m a
  * step in equal parts per substep, so every substep's velocity is 0.01 / dt); and a non-finite
  * velocity in the last thread's vertices reported as AK_ERR_BAD_DATA with nothing written. */
@@ -971,8 +971,9 @@ AK_TEST(fused_substeps_kinematic_bit_identical) {
     uint32_t att[1] = {W * (W / 2) + W / 2};
     ak_cloth_desc d = {.solver = AK_CLOTH_XPBD, .grid_width = W, .grid_height = W, .spacing = 1.0f / (W - 1),
                        .grid_origin = {-0.5f, 1.0f, 0.5f}, .pins = AK_SPAN(pins), .attachments = AK_SPAN(att)};
-    ak_vec3* out[3] = {NULL, NULL, NULL};
-    for (int k = 0; k < 3; ++k) {
+    const uint32_t counts[4] = {1, 2, 3, 8};
+    ak_vec3* out[4] = {NULL, NULL, NULL, NULL};
+    for (int k = 0; k < 4; ++k) {
         sim s;
         AK_CHECK(sim_init(&s, &d));
         ak_vec3* res = calloc(s.n, sizeof(ak_vec3));
@@ -983,7 +984,7 @@ AK_TEST(fused_substeps_kinematic_bit_identical) {
         s.job.substeps = 6;
         s.job.position_residuals = (ak_vec3_span){res, s.n};
         s.job.attachment_targets = (ak_vec3_cspan){&target, 1};
-        s.job.thread_count = (uint32_t)(k + 1);
+        s.job.thread_count = counts[k];
         s.job.exact_thread_count = true;
         sim_scratch(&s);
         for (int f = 0; f < STEPS; ++f) {
@@ -1000,7 +1001,7 @@ AK_TEST(fused_substeps_kinematic_bit_identical) {
         memcpy(out[k] + s.n, s.v, s.n * sizeof(ak_vec3));
         memcpy(out[k] + 2 * s.n, res, s.n * sizeof(ak_vec3));
         if (k > 0)
-            AK_CHECK_MSG(memcmp(out[0], out[k], 3 * s.n * sizeof(ak_vec3)) == 0, "%d threads differ from 1", k + 1);
+            AK_CHECK_MSG(memcmp(out[0], out[k], 3 * s.n * sizeof(ak_vec3)) == 0, "%u threads differ from 1", counts[k]);
         /* bad data in the last thread's share: nothing written */
         s.v[s.n - 2].z = NAN;
         target.x += 0.01f;
@@ -1012,7 +1013,7 @@ AK_TEST(fused_substeps_kinematic_bit_identical) {
         free(res);
         sim_free(&s);
     }
-    for (int k = 0; k < 3; ++k) free(out[k]);
+    for (int k = 0; k < 4; ++k) free(out[k]);
     /* A sheet translating rigidly: every border vertex attached to a target moving by dx per
      * step, every vertex starting at velocity dx / dt, no gravity or damping. Each substep then
      * moves the free vertices by the prediction and the attachments by their share of dx

@@ -182,7 +182,10 @@ typedef struct ctx {
                             transverse factor (1; -1: degenerate) */
     uint32_t cg_max;     /* IMPLICIT: most CG iterations per substep */
     int simd;            /* 0 scalar, 1 AVX2, 2 AVX-512 */
-    akp_barrier bar; /* the step's team meets here between phases (src/tasks.h) */
+    _Alignas(64) akp_barrier bar; /* the step's team meets here between phases (src/tasks.h): on
+                                     cache lines of its own, as every thread writes it at every
+                                     meeting and the fields above are read all the time */
+    char bar_pad[64];             /* nothing after it on its last line */
     bool finite[MAX_THREADS]; /* per thread: its vertices ended finite */
     bool bad[MAX_THREADS];    /* per thread: one of its vertices came in non-finite */
 } ctx;
