@@ -16,8 +16,9 @@
  * idle but still scale badly is limited by memory bandwidth or by threads that cannot run (a
  * loaded machine). The last column is Amdahl's speed-up at 16 threads for the serial fraction
  * that explains the idle time at 2 threads (s = 1 / (1 - idle) - 1).
- *     bench_scaling --cpu [--cpu-threads 2,16] [--phases] ...
- * adds a CPU-time profile per workload (src/tasks.h, akp_tasks_profile_step): every thread's
+ *     bench_scaling --cpu [--cpu-threads 2,16] [--cpu-steps N] [--phases] ...
+ * adds a CPU-time profile per workload over N steps (default up to 6) (src/tasks.h,
+ * akp_tasks_profile_step): every thread's
  * CPU time per phase, so a loaded machine, or one with fewer cores than threads, still measures
  * the work. Per thread count T (the job run with T threads): CPU ms per step, the serial part
  * (the caller's work between sections, plus each phase's busiest thread beyond the others'
@@ -25,7 +26,12 @@
  * two predictions of the efficiency at T threads on T free cores: Amdahl's law from the serial
  * fraction measured at the first T > 1 of the list, and 1-thread CPU / (T x critical path)
  * (which also sees the work added by splitting and the imbalance of the partition at T). Both
- * leave out memory bandwidth and wake-ups. --phases lists each phase of the first T > 1. */
+ * leave out memory bandwidth and wake-ups. "steady" is the persistent part of the serial ms
+ * (src/tasks.h: each thread's CPU per phase summed over the steps before taking the busiest
+ * one's excess, so an excess that moves between threads from step to step, as on a loaded
+ * machine, cancels) and amdahl-s Amdahl's law from it: the serial fraction a machine with free
+ * cores would see, where "serial" includes that noise. --phases lists each phase of the first
+ * T > 1. */
 #include <animkit/animkit.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -402,6 +408,7 @@ static void chars_fini(workload* w) {
 
 typedef struct cpu_profile {
     double serial_ms, parallel_ms, critical_ms; /* per step */
+    double steady_ms;                           /* the persistent part of serial_ms (tasks.h) */
     size_t phase_count;
     akp_phase_cpu phases[AKP_PHASES_MAX];
 } cpu_profile;
@@ -415,11 +422,13 @@ static bool profile_cpu(workload* w, uint32_t threads, int steps, cpu_profile* o
     }
     out->phase_count = akp_tasks_profile_phases(out->phases, AKP_PHASES_MAX);
     akp_tasks_profile_enable(false);
-    out->serial_ms = out->parallel_ms = out->critical_ms = 0.0;
+    out->serial_ms = out->parallel_ms = out->critical_ms = out->steady_ms = 0.0;
     for (size_t k = 0; k < out->phase_count; ++k) {
         akp_phase_cpu* p = &out->phases[k];
         p->serial_s *= 1e3 / steps, p->parallel_s *= 1e3 / steps, p->critical_s *= 1e3 / steps; /* ms per step */
+        p->steady_serial_s *= 1e3 / steps;
         out->serial_ms += p->serial_s, out->parallel_ms += p->parallel_s, out->critical_ms += p->critical_s;
+        out->steady_ms += p->steady_serial_s;
     }
     return ok;
 }
@@ -429,9 +438,9 @@ static void cpu_report(workload* w, const uint32_t* counts, int count_n, int ste
     if (!pr) return;
     profile_cpu(w, 1, steps, pr);
     const double cpu1 = pr->serial_ms + pr->parallel_ms;
-    double sf = -1.0; /* the serial fraction at the first T > 1 */
-    printf("  cpu %-10s %7s %9s %9s %9s %9s %8s %8s\n", "", "threads", "cpu ms", "serial", "parallel", "critical",
-           "amdahl", "critical");
+    double sf = -1.0, sf_steady = 0.0; /* the serial fractions at the first T > 1 */
+    printf("  cpu %-10s %7s %9s %9s %9s %9s %8s %8s %9s %8s\n", "", "threads", "cpu ms", "serial", "parallel", "critical",
+           "amdahl", "critical", "steady", "amdahl-s");
     printf("  cpu %-10s %7u %9.2f\n", w->name, 1u, cpu1);
     for (int k = 0; k < count_n; ++k) {
         const uint32_t T = counts[k];
@@ -440,19 +449,22 @@ static void cpu_report(workload* w, const uint32_t* counts, int count_n, int ste
         const double total = pr->serial_ms + pr->parallel_ms;
         if (sf < 0.0) {
             sf = total > 0.0 ? pr->serial_ms / total : 0.0;
+            sf_steady = total > 0.0 ? pr->steady_ms / total : 0.0;
             if (phases) {
                 for (size_t i = 0; i < pr->phase_count; ++i) {
                     const akp_phase_cpu* p = &pr->phases[i];
                     if (p->serial_s + p->parallel_s < 0.005 * total) continue; /* under 0.5% */
-                    printf("  cpu %-10s   phase %2zu x%-2u serial %8.3f ms  parallel %8.3f ms\n", w->name, i, p->threads,
-                           p->serial_s, p->parallel_s);
+                    printf("  cpu %-10s   phase %2zu x%-2u serial %8.3f ms  parallel %8.3f ms  steady %8.3f ms\n", w->name, i,
+                           p->threads, p->serial_s, p->parallel_s, p->steady_serial_s);
                 }
             }
         }
         const double amdahl = 1.0 / (T * (sf + (1.0 - sf) / T));
+        const double amdahl_s = 1.0 / (T * (sf_steady + (1.0 - sf_steady) / T));
         const double crit = pr->critical_ms > 0.0 ? cpu1 / (T * pr->critical_ms) : 0.0;
-        printf("  cpu %-10s %7u %9.2f %9.2f %9.2f %9.2f %7.0f%% %7.0f%%%s\n", w->name, T, total, pr->serial_ms,
-               pr->parallel_ms, pr->critical_ms, 100.0 * amdahl, 100.0 * crit, ok ? "" : "  (a step failed)");
+        printf("  cpu %-10s %7u %9.2f %9.2f %9.2f %9.2f %7.0f%% %7.0f%% %9.2f %7.0f%%%s\n", w->name, T, total,
+               pr->serial_ms, pr->parallel_ms, pr->critical_ms, 100.0 * amdahl, 100.0 * crit, pr->steady_ms,
+               100.0 * amdahl_s, ok ? "" : "  (a step failed)");
         fflush(stdout);
     }
     free(pr);
@@ -474,7 +486,7 @@ static bool in_list(const char* list, const char* name) {
 
 int main(int argc, char** argv) {
     uint32_t counts[MAX_COUNTS] = {1, 2};
-    int count_n = 2, steps = 0;
+    int count_n = 2, steps = 0, cpu_steps = 0;
     uint32_t cpu_counts[MAX_COUNTS] = {2, 16};
     int cpu_n = 2;
     bool cpu = false, phases = false;
@@ -503,6 +515,8 @@ int main(int argc, char** argv) {
                 cpu_counts[cpu_n++] = (uint32_t)v;
                 if (*p == ',') ++p;
             }
+        } else if (strcmp(argv[i], "--cpu-steps") == 0 && i + 1 < argc) {
+            cpu = true, cpu_steps = atoi(argv[++i]);
         } else if (strcmp(argv[i], "--cpu") == 0) {
             cpu = true;
         } else if (strcmp(argv[i], "--phases") == 0) {
@@ -514,7 +528,7 @@ int main(int argc, char** argv) {
         } else if (strcmp(argv[i], "--quick") == 0) {
             quick = true;
         } else {
-            fprintf(stderr, "usage: bench_scaling [--threads 1,2,4,8,16] [--cpu] [--cpu-threads 2,16] [--phases] [--only NAME,...] "
+            fprintf(stderr, "usage: bench_scaling [--threads 1,2,4,8,16] [--cpu] [--cpu-threads 2,16] [--cpu-steps N] [--phases] [--only NAME,...] "
                             "[--steps N] [--quick]\n");
             return 2;
         }
@@ -589,7 +603,7 @@ int main(int argc, char** argv) {
                    ok ? "" : "  (a step failed)");
             fflush(stdout);
         }
-        if (cpu) cpu_report(w, cpu_counts, cpu_n, n_steps < 6 ? n_steps : 6, phases);
+        if (cpu) cpu_report(w, cpu_counts, cpu_n, cpu_steps > 0 ? cpu_steps : n_steps < 6 ? n_steps : 6, phases);
         w->fini(w);
     }
     return 0;

@@ -247,7 +247,24 @@ const char* ak_fluid_kernels_name(ak_fluid_kernels k) {
 
 static bool vfinite(ak_vec3 v) { return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z); }
 
-ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
+/* The particles' data (positions and velocities finite) of [b, e): the O(n) part of validation,
+ * which ak_fluid_step_run splits over its threads. */
+typedef struct scan_task {
+    const ak_fluid_step_job* job;
+    size_t b, e;
+    bool bad;
+} scan_task;
+
+static void* scan_thread(void* arg) {
+    scan_task* t = (scan_task*)arg;
+    bool ok = true;
+    for (size_t i = t->b; i < t->e; ++i) ok = vfinite(t->job->positions.ptr[i]) && vfinite(t->job->velocities.ptr[i]) && ok;
+    t->bad = !ok;
+    return NULL;
+}
+
+/* ak_fluid_step_validate; scan_particles false leaves out the particles' data (scan_thread). */
+static ak_result validate(const ak_fluid_step_job* job, bool scan_particles) {
     if (!job || !job->desc || !job->particle_count || !job->positions.ptr || !job->velocities.ptr ||
         !job->scratch.ptr)
         return AK_ERR_NULL_ARG;
@@ -311,10 +328,12 @@ ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) {
     const size_t need = ak_fluid_scratch_size(cap, d);
     if (need == 0) return AK_ERR_BAD_ARG;
     if (job->scratch.count < need) return AK_ERR_SPAN_SMALL;
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i = 0; scan_particles && i < n; ++i)
         if (!vfinite(job->positions.ptr[i]) || !vfinite(job->velocities.ptr[i])) return AK_ERR_BAD_DATA;
     return AK_OK;
 }
+
+ak_result ak_fluid_step_validate(const ak_fluid_step_job* job) { return validate(job, true); }
 
 /* ---- the solver ------------------------------------------------------------------- */
 /* ---- the solver ------------------------------------------------------------------- */
@@ -1271,8 +1290,22 @@ static void emit(const ak_fluid_step_job* job, float s, size_t* n, ak_fluid_stat
 
 
 ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
-    ak_result r = ak_fluid_step_validate(job);
+    ak_result r = validate(job, false);
     if (r != AK_OK) return r;
+    {
+        /* the particles' data, split over the threads (one read of 24 bytes a particle: half a
+         * millisecond for 500,000 on one core, all of it serial before) */
+        const size_t n0 = *job->particle_count;
+        uint32_t parts = job->thread_count ? job->thread_count : 1u;
+        if (parts > AKP_TASKS_MAX) parts = AKP_TASKS_MAX;
+        if (n0 < 65536) parts = 1; /* a section costs more than the scan saves */
+        scan_task scan[AKP_TASKS_MAX];
+        for (uint32_t t = 0; t < parts; ++t) scan[t] = (scan_task){job, n0 * t / parts, n0 * (t + 1) / parts, false};
+        if (parts == 1) scan_thread(&scan[0]);
+        else akp_run_tasks(scan_thread, scan, sizeof scan[0], parts);
+        for (uint32_t t = 0; t < parts; ++t)
+            if (scan[t].bad) return AK_ERR_BAD_DATA;
+    }
     ctx cstore;
     ctx* c = &cstore;
     memset(c, 0, sizeof *c);

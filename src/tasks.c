@@ -17,6 +17,7 @@ static _Thread_local bool prof_owner;     /* this thread enabled the profile / m
 static _Thread_local double prof_outside; /* the owner's CPU time when its serial part started */
 static _Thread_local bool prof_stepping;  /* the owner has marked a step since enabling */
 static akp_phase_cpu prof_phases[AKP_PHASES_MAX];
+static double prof_acc[AKP_PHASES_MAX][AKP_TASKS_MAX]; /* per phase and task: CPU seconds over its runs */
 static uint32_t prof_phase;                /* the next phase's number; written by one thread at a time */
 
 static double cpu_s(void) {
@@ -29,18 +30,21 @@ static double cpu_s(void) {
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void phase_add(uint32_t threads, double serial, double parallel, double critical) {
-    akp_phase_cpu* p = &prof_phases[prof_phase < AKP_PHASES_MAX ? prof_phase : AKP_PHASES_MAX - 1];
+/* work[t]: task t's CPU seconds in this run of the phase (threads of them) */
+static void phase_add(uint32_t threads, double serial, double parallel, double critical, const double* work) {
+    const uint32_t slot = prof_phase < AKP_PHASES_MAX ? prof_phase : AKP_PHASES_MAX - 1;
+    akp_phase_cpu* p = &prof_phases[slot];
     if (prof_phase < AKP_PHASES_MAX) ++prof_phase;
     p->runs++;
     p->threads = threads;
     p->serial_s += serial, p->parallel_s += parallel, p->critical_s += critical;
+    for (uint32_t t = 0; t < threads && t < AKP_TASKS_MAX; ++t) prof_acc[slot][t] += work[t];
 }
 
 /* The owner's serial part since its last section (or step mark) ends here. */
 static void serial_done(void) {
-    const double c = cpu_s();
-    phase_add(1, c - prof_outside, 0.0, c - prof_outside);
+    const double c = cpu_s(), w = c - prof_outside;
+    phase_add(1, w, 0.0, w, &w);
     prof_outside = c;
 }
 
@@ -95,7 +99,7 @@ static void phase_done(uint32_t threads) {
     }
     double serial = threads > 1 ? max - (sum - max) / (double)(threads - 1) : sum;
     if (serial < 0.0) serial = 0.0;
-    phase_add(threads, serial, sum - serial, max);
+    phase_add(threads, serial, sum - serial, max, prof_work);
 }
 
 static void task_enter(bool profiled, uint32_t index) {
@@ -422,12 +426,24 @@ size_t akp_tasks_profile_phases(akp_phase_cpu* out, size_t cap) {
     }
     size_t n = 0;
     while (n < AKP_PHASES_MAX && prof_phases[n].runs) ++n;
-    for (size_t i = 0; i < n && i < cap; ++i) out[i] = prof_phases[i];
+    for (size_t i = 0; i < n && i < cap; ++i) {
+        out[i] = prof_phases[i];
+        /* the busiest task over all runs beyond the others' mean over all runs */
+        const uint32_t T = out[i].threads < AKP_TASKS_MAX ? out[i].threads : AKP_TASKS_MAX;
+        double sum = 0.0, max = 0.0;
+        for (uint32_t t = 0; t < T; ++t) {
+            sum += prof_acc[i][t];
+            if (prof_acc[i][t] > max) max = prof_acc[i][t];
+        }
+        double steady = T > 1 ? max - (sum - max) / (double)(T - 1) : sum;
+        out[i].steady_serial_s = steady > 0.0 ? steady : 0.0;
+    }
     return n;
 }
 
 void akp_tasks_profile_enable(bool on) {
     memset(prof_phases, 0, sizeof prof_phases);
+    memset(prof_acc, 0, sizeof prof_acc);
     prof_phase = 0;
     prof_owner = on;
     prof_stepping = false;

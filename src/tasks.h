@@ -105,7 +105,12 @@ void akp_tasks_profile_read(akp_tasks_profile* out);
  * serial_s, critical_s = max w. A serial part between sections is all serial_s. Then
  * Amdahl predicts the step on N threads as sum(serial_s + parallel_s / N) and the critical path
  * at T threads is sum(critical_s), a time a machine with T free cores would need (less memory
- * bandwidth and wake-up costs). Only runs begun by the thread that called enable or step are
+ * bandwidth and wake-up costs). steady_serial_s is serial_s computed once from each task's CPU
+ * seconds summed over the phase's runs instead of per run: an excess that moves from task to
+ * task between runs (a thread slowed by another process, cache interference on a loaded machine)
+ * cancels there, while one that stays with a task (a partition that gives it more work, a part
+ * only task 0 does) remains; serial_s >= steady_serial_s, and the gap is the transient part.
+ * Only runs begun by the thread that called enable or step are
  * split into phases (a run begun inside a task is part of that task's work); phases past
  * AKP_PHASES_MAX - 1 add up in the last slot. Enabling resets these too. */
 #define AKP_PHASES_MAX 512u
@@ -113,6 +118,7 @@ typedef struct akp_phase_cpu {
     uint64_t runs;     /* times this phase ran */
     uint32_t threads;  /* threads in its last run; 1 for a serial part between sections */
     double serial_s, parallel_s, critical_s;
+    double steady_serial_s; /* the persistent part of serial_s (above) */
 } akp_phase_cpu;
 void akp_tasks_profile_step(void);
 /* The phases recorded so far, in order (at most cap); returns how many there are. */

@@ -701,6 +701,49 @@ AK_TEST(simd_and_scalar_kernels_are_bit_identical) {
     }
 }
 
+/* ak_fluid_step_run checks the particles' data on its threads when there are many (70,000
+ * here): a non-finite position or velocity at the start, middle or end, on 1, 2 and 3 threads,
+ * is AK_ERR_BAD_DATA with nothing written, as ak_fluid_step_validate (one thread) says; all
+ * finite, the step runs. */
+AK_TEST(validation_scan_split_over_threads) {
+    enum { N = 70000 };
+    ak_fluid_desc d = {.particle_mass = 0.001f, .h = 0.02f, .box_max = {1, 1, 1}};
+    const float sp = ak_fluid_rest_spacing(&d);
+    d.h = 2.0f * sp;
+    ak_vec3* pos = malloc(N * sizeof(ak_vec3));
+    ak_vec3* vel = calloc(N, sizeof(ak_vec3));
+    ak_vec3* copy = malloc(2 * N * sizeof(ak_vec3));
+    const size_t bytes = ak_fluid_scratch_size(N, &d);
+    void* mem = malloc(bytes);
+    AK_CHECK(pos && vel && copy && mem);
+    if (!pos || !vel || !copy || !mem) return;
+    for (size_t i = 0; i < N; ++i) /* a 50 x 50 x 28 lattice, the last layer part full */
+        pos[i] = ak_vec3_make(sp * (float)(i % 50), sp * (float)(i / 2500), sp * (float)(i / 50 % 50));
+    size_t n = N;
+    ak_fluid_step_job job = {.desc = &d, .dt = 0.001f, .positions = {pos, N}, .velocities = {vel, N},
+                             .particle_count = &n, .scratch = {mem, bytes}};
+    const size_t at[3] = {0, N / 2, N - 1};
+    for (uint32_t threads = 1; threads <= 3; ++threads) {
+        job.thread_count = threads;
+        for (int k = 0; k < 3; ++k)
+            for (int field = 0; field < 2; ++field) {
+                ak_vec3* a = field ? vel : pos;
+                const float keep = a[at[k]].y;
+                a[at[k]].y = field ? INFINITY : NAN;
+                memcpy(copy, pos, N * sizeof(ak_vec3));
+                memcpy(copy + N, vel, N * sizeof(ak_vec3));
+                AK_CHECK_EQ(ak_fluid_step_validate(&job), AK_ERR_BAD_DATA);
+                AK_CHECK_MSG(ak_fluid_step_run(&job) == AK_ERR_BAD_DATA, "%u threads, particle %zu", threads, at[k]);
+                AK_CHECK(memcmp(copy, pos, N * sizeof(ak_vec3)) == 0 && memcmp(copy + N, vel, N * sizeof(ak_vec3)) == 0);
+                a[at[k]].y = keep;
+            }
+    }
+    job.thread_count = 2;
+    AK_CHECK_EQ(ak_fluid_step_run(&job), AK_OK);
+    AK_CHECK_EQ(n, (size_t)N);
+    free(pos), free(vel), free(copy), free(mem);
+}
+
 AK_TEST(validation_and_blow_up) {
     ak_fluid_desc d = {.particle_mass = 0.001f, .h = 0.02f};
     ak_vec3 pos[4] = {{0, 0, 0}, {0.01f, 0, 0}}, vel[4] = {{0}};
@@ -749,6 +792,7 @@ int main(void) {
     AK_RUN(large_dam_thread_count_gives_identical_results);
     AK_RUN(densities_match_naive_sum_on_every_path);
     AK_RUN(simd_and_scalar_kernels_are_bit_identical);
+    AK_RUN(validation_scan_split_over_threads);
     AK_RUN(validation_and_blow_up);
     AK_RUN_SLOW(pbf_dam_break_front_against_martin_moyce);
     return ak_test_finish();

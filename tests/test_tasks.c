@@ -341,6 +341,45 @@ AK_TEST(profile_cpu_time_per_phase) {
     AK_CHECK_EQ(akp_tasks_profile_phases(ph, AKP_PHASES_MAX), 0u);
 }
 
+/* Two tasks, one phase, one of them burning 1 ms more: the same task every step (a lasting
+ * imbalance: steady_serial_s about the whole excess, as serial_s) or each task every other step
+ * (a passing one, as another process slowing a thread: serial_s the same, steady_serial_s
+ * about 0). */
+typedef struct extra_burner {
+    uint32_t index, heavy;
+} extra_burner;
+
+static void* extra_burner_task(void* arg) {
+    const extra_burner* b = (const extra_burner*)arg;
+    burn_cpu_ms(b->index == b->heavy ? 2.0 : 1.0);
+    return NULL;
+}
+
+AK_TEST(profile_steady_serial_part) {
+    enum { STEPS = 4 };
+    for (int alternate = 0; alternate < 2; ++alternate) {
+        akp_tasks_profile_enable(true);
+        for (uint32_t s = 0; s < STEPS; ++s) {
+            akp_tasks_profile_step();
+            extra_burner tasks[2];
+            for (uint32_t t = 0; t < 2; ++t) tasks[t] = (extra_burner){t, alternate ? s % 2 : 1};
+            akp_run_tasks(extra_burner_task, tasks, sizeof(extra_burner), 2);
+        }
+        akp_phase_cpu ph[AKP_PHASES_MAX];
+        const size_t n = akp_tasks_profile_phases(ph, AKP_PHASES_MAX);
+        akp_tasks_profile_enable(false);
+        AK_CHECK(n >= 2);
+        if (n < 2) continue;
+        const double tol = 0.3 * STEPS; /* ms */
+        AK_CHECK_EQ(ph[1].threads, 2u);
+        AK_CHECK_NEAR(1e3 * ph[1].serial_s, 1.0 * STEPS, tol);
+        AK_CHECK_NEAR(1e3 * ph[1].steady_serial_s, alternate ? 0.0 : 1.0 * STEPS, tol);
+        AK_CHECK(ph[1].steady_serial_s <= ph[1].serial_s);
+        /* a serial part between sections is all steady */
+        AK_CHECK_NEAR(ph[0].steady_serial_s, ph[0].serial_s, 1e-12);
+    }
+}
+
 /* ---- akp_csort ------------------------------------------------------------------------------ */
 
 typedef struct keyed {
@@ -409,6 +448,7 @@ int main(void) {
     AK_RUN(team_run_from_inside_a_task);
     AK_RUN(profile_counts_sections_waits_and_barriers);
     AK_RUN(profile_cpu_time_per_phase);
+    AK_RUN(profile_steady_serial_part);
     AK_RUN(counting_sort_is_stable_and_split_free);
     return ak_test_finish();
 }

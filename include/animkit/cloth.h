@@ -303,7 +303,8 @@ AK_API size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job);
  * collider mesh index out of range), AK_ERR_BAD_DATA (a non-finite position, velocity,
  * gravity, wind, collider, target or residual). A zero-initialised job gives AK_ERR_NULL_ARG. */
 AK_API ak_result ak_cloth_step_validate(const ak_cloth_step_job* job);
-/* Validate, then step (writes nothing on a validation failure). Returns
+/* Validate, then step (writes nothing on a validation failure; the per-vertex data checks run
+ * on the step's threads, before anything is written). Returns
  * AK_ERR_NO_CONVERGENCE when the state became non-finite (a blow-up: the spring solver with too
  * large a step); the state then holds the non-finite values, so keep a copy to go back to. */
 AK_API ak_result ak_cloth_step_run(const ak_cloth_step_job* job);

@@ -94,7 +94,15 @@ size_t ak_cloth_step_scratch_size(const ak_cloth_step_job* job) {
 
 static bool bad_nonneg(float x) { return !(x >= 0.0f) || !ak_finitef(x); }
 
-ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) {
+/* A vertex's caller data are finite (positions, velocities, residuals when kept). */
+static bool vertex_finite(const ak_cloth_step_job* job, size_t v) {
+    return ak_vec3_is_finite(job->positions.ptr[v]) && ak_vec3_is_finite(job->velocities.ptr[v]) &&
+           (!job->position_residuals.ptr || ak_vec3_is_finite(job->position_residuals.ptr[v]));
+}
+
+/* The checks of ak_cloth_step_validate; scan_vertices false leaves out the O(n) check of the
+ * vertices' data (vertex_finite), which ak_cloth_step_run does on its threads instead. */
+static ak_result validate(const ak_cloth_step_job* job, bool scan_vertices) {
     if (!job || !job->cloth || !job->positions.ptr || !job->velocities.ptr || !job->scratch.ptr) return AK_ERR_NULL_ARG;
     const ak_cloth* c = job->cloth;
     if ((job->plane_count && !job->planes) || (job->sphere_count && !job->spheres) ||
@@ -121,10 +129,8 @@ ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) {
         if (job->mesh.indices.ptr[k] >= job->mesh.positions.count) return AK_ERR_BAD_INDEX;
     /* data */
     if (!ak_vec3_is_finite(job->gravity) || !ak_vec3_is_finite(job->wind)) return AK_ERR_BAD_DATA;
-    for (size_t v = 0; v < c->n; ++v)
-        if (!ak_vec3_is_finite(job->positions.ptr[v]) || !ak_vec3_is_finite(job->velocities.ptr[v]) ||
-            (job->position_residuals.ptr && !ak_vec3_is_finite(job->position_residuals.ptr[v])))
-            return AK_ERR_BAD_DATA;
+    for (size_t v = 0; scan_vertices && v < c->n; ++v)
+        if (!vertex_finite(job, v)) return AK_ERR_BAD_DATA;
     for (size_t k = 0; k < job->plane_count; ++k)
         if (!ak_vec3_is_finite(job->planes[k].normal) || !ak_finitef(job->planes[k].offset)) return AK_ERR_BAD_DATA;
     for (size_t k = 0; k < job->sphere_count; ++k)
@@ -139,6 +145,8 @@ ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) {
         if (!ak_vec3_is_finite(job->attachment_targets.ptr[k])) return AK_ERR_BAD_DATA;
     return AK_OK;
 }
+
+ak_result ak_cloth_step_validate(const ak_cloth_step_job* job) { return validate(job, true); }
 
 /* ---- the shared step context ------------------------------------------------------------ */
 
@@ -174,8 +182,12 @@ typedef struct ctx {
                             transverse factor (1; -1: degenerate) */
     uint32_t cg_max;     /* IMPLICIT: most CG iterations per substep */
     int simd;            /* 0 scalar, 1 AVX2, 2 AVX-512 */
-    akp_barrier bar; /* the step's team meets here between phases (src/tasks.h) */
+    _Alignas(64) akp_barrier bar; /* the step's team meets here between phases (src/tasks.h): on
+                                     cache lines of its own, as every thread writes it at every
+                                     meeting and the fields above are read all the time */
+    char bar_pad[64];             /* nothing after it on its last line */
     bool finite[MAX_THREADS]; /* per thread: its vertices ended finite */
+    bool bad[MAX_THREADS];    /* per thread: one of its vertices came in non-finite */
 } ctx;
 
 typedef struct worker {
@@ -566,22 +578,24 @@ static void gather_wind(const ctx* c, size_t b, size_t e) {
     }
 }
 
-/* Move the kinematic particles to where they are at fraction f of the step: attachments on the
- * line from their start to their target, pins at their pin positions (as displacements). */
-static void kinematic_targets(const ctx* c, float f, unsigned t) {
+/* Move the kinematic particles among [vb, ve) to where they are at fraction f of the step:
+ * attachments on the line from their start to their target, pins at their pin positions (as
+ * displacements). Each thread places those of its own vertices, so this phase, like the
+ * prediction before it, touches only the thread's vertices (run_spmd fuses it with the end of
+ * the previous substep). */
+static void kinematic_targets(const ctx* c, float f, size_t vb, size_t ve) {
     const ak_cloth* cl = c->c;
-    size_t b, e;
-    range(cl->attach_count, t, c->T, &b, &e);
-    for (size_t k = b; k < e; ++k) {
+    for (size_t k = 0; k < cl->attach_count; ++k) {
         const uint32_t v = cl->attach[k];
+        if (v < vb || v >= ve) continue;
         c->prev[v].p = c->x[v].p;
         const ak_vec3 to = ak_vec3_sub(c->job->attachment_targets.ptr[k], c->base[v]);
         c->x[v].p = f >= 1.0f ? to : ak_vec3_scale(to, f);
         c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / c->h);
     }
-    range(cl->pin_count, t, c->T, &b, &e);
-    for (size_t k = b; k < e; ++k) {
+    for (size_t k = 0; k < cl->pin_count; ++k) {
         const uint32_t v = cl->pins[k];
+        if (v < vb || v >= ve) continue;
         c->prev[v].p = c->x[v].p;
         c->x[v].p = ak_vec3_sub(cl->pin_pos[k], c->base[v]);
         c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / c->h);
@@ -589,6 +603,23 @@ static void kinematic_targets(const ctx* c, float f, unsigned t) {
 }
 
 static bool is_free(const ak_cloth* cl, size_t v) { return cl->inv_mass[v] > 0.0f; }
+
+/* XPBD / PBD: predict the free particles of [b, e) at the start of a substep, then place the
+ * kinematic ones (substep fraction f). */
+static void predict(const ctx* c, size_t b, size_t e, float f) {
+    const ak_cloth* cl = c->c;
+    const ak_cloth_step_job* job = c->job;
+    const float h = c->h;
+    for (size_t v = b; v < e; ++v) {
+        if (!is_free(cl, v)) continue;
+        /* damp, then accelerate: at rest (v = 0) damping then leaves the rest point alone */
+        const ak_vec3 vel = ak_vec3_madd(ak_vec3_scale(c->v[v], c->decay),
+                                         ak_vec3_madd(job->gravity, c->ext[v], cl->inv_mass[v]), h);
+        c->prev[v].p = c->x[v].p;
+        c->x[v].p = ak_vec3_madd(c->x[v].p, vel, h);
+    }
+    kinematic_targets(c, f, b, e);
+}
 
 /* ---- implicit Euler (Baraff & Witkin 1998) ---------------------------------------------- */
 
@@ -742,6 +773,10 @@ static void run_spmd(ctx* c, unsigned t) {
     size_t tb, te;
     range(n, t, c->T, &b, &e);
     range(cl->tri_count, t, c->T, &tb, &te);
+    /* the data check of ak_cloth_step_validate, each thread its vertices */
+    bool ok = true;
+    for (size_t v = b; v < e; ++v) ok = vertex_finite(job, v) && ok;
+    c->bad[t] = !ok;
     /* displacements start at the residuals (the part of the position the float missed) */
     ak_vec3* const res = job->position_residuals.ptr;
     for (size_t v = b; v < e; ++v) {
@@ -781,7 +816,16 @@ static void run_spmd(ctx* c, unsigned t) {
         }
     }
     barrier(c);
+    /* every thread checked its vertices' data: a non-finite one anywhere stops the step before
+     * anything of the caller's is written (ak_cloth_step_run returns AK_ERR_BAD_DATA) */
+    for (unsigned u = 0; u < c->T; ++u)
+        if (c->bad[u]) return;
     const bool springs = cl->desc.solver == AK_CLOTH_SPRINGS, implicit = cl->desc.solver == AK_CLOTH_IMPLICIT;
+    /* XPBD / PBD without wind or self-collision: a substep's last phase (collisions and
+     * velocities, per vertex) and the next one's prediction (per vertex, kinematic particles
+     * included) touch only each thread's own vertices, so they run as one phase, saving a meeting
+     * per substep (and the one before the end of the step) */
+    const bool fuse = !wind && !c->self;
     for (uint32_t s = 0; s < c->substeps; ++s) {
         const float f = (float)(s + 1) / (float)c->substeps;
         /* wind each substep: drag acts like a damper of rate rho C_d A |v| / m, which an
@@ -815,7 +859,7 @@ static void run_spmd(ctx* c, unsigned t) {
                 c->x[v].p = ak_vec3_madd(c->x[v].p, vel, h);
             }
             }
-            kinematic_targets(c, f, t);
+            kinematic_targets(c, f, b, e);
             barrier(c);
             if (c->self) {
                 if (t == 0) self_grid(c);
@@ -835,16 +879,8 @@ static void run_spmd(ctx* c, unsigned t) {
             barrier(c);
             continue;
         }
-        /* XPBD / PBD: predict */
-        for (size_t v = b; v < e; ++v) {
-            if (!is_free(cl, v)) continue;
-            /* damp, then accelerate: at rest (v = 0) damping then leaves the rest point alone */
-            const ak_vec3 vel = ak_vec3_madd(ak_vec3_scale(c->v[v], c->decay),
-                                             ak_vec3_madd(job->gravity, c->ext[v], cl->inv_mass[v]), h);
-            c->prev[v].p = c->x[v].p;
-            c->x[v].p = ak_vec3_madd(c->x[v].p, vel, h);
-        }
-        kinematic_targets(c, f, t);
+        /* XPBD / PBD: predict (when fused, the previous substep's last phase did) */
+        if (!fuse || s == 0) predict(c, b, e, f);
         barrier(c);
         for (uint32_t it = 0; it < c->iterations; ++it) {
             for (int col = 0; col <= AKP_MAX_COLORS; ++col) {
@@ -891,6 +927,12 @@ static void run_spmd(ctx* c, unsigned t) {
             }
             c->v[v] = ak_vec3_scale(ak_vec3_sub(c->x[v].p, c->prev[v].p), 1.0f / h);
         }
+        if (fuse) {
+            /* no meeting: the next phase (the next substep's prediction, or the end of the
+             * step) reads and writes only this thread's vertices */
+            if (s + 1 < c->substeps) predict(c, b, e, (float)(s + 2) / (float)c->substeps);
+            continue;
+        }
         barrier(c);
     }
     /* the end of the step: start + displacement (nobody reads the start positions any more) */
@@ -922,7 +964,7 @@ static void* worker_main(void* arg) {
 }
 
 ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
-    ak_result r = ak_cloth_step_validate(job);
+    ak_result r = validate(job, false); /* the vertices' data: checked on the threads (run_spmd) */
     if (r != AK_OK) return r;
     const ak_cloth* cl = job->cloth;
     const size_t mesh_tris = job->mesh.indices.count / 3;
@@ -1004,7 +1046,10 @@ ak_result ak_cloth_step_run(const ak_cloth_step_job* job) {
     /* the end of the step (each thread's vertices: run_spmd), then kinematic particles exactly
      * at their targets */
     bool finite = true;
-    for (unsigned t = 0; t < c.T; ++t) finite = finite && c.finite[t];
+    for (unsigned t = 0; t < c.T; ++t) {
+        if (c.bad[t]) return AK_ERR_BAD_DATA; /* nothing written */
+        finite = finite && c.finite[t];
+    }
     for (size_t k = 0; k < cl->pin_count; ++k) job->positions.ptr[cl->pins[k]] = cl->pin_pos[k];
     for (size_t k = 0; k < cl->attach_count; ++k) job->positions.ptr[cl->attach[k]] = job->attachment_targets.ptr[k];
     if (!finite) return AK_ERR_NO_CONVERGENCE;
