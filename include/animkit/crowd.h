@@ -78,8 +78,9 @@
  * waypoints, obstacles) into one allocation; the built crowd is read-only and may be shared
  * by threads. The state (positions, velocities, waypoint indices) is caller-owned: the step
  * job reads the inputs, writes the outputs (which must not alias the inputs) and advances
- * each agent's waypoint index in place. The step never allocates (scratch comes from the
- * caller), except a VISION crowd's RASTER view (a render target per thread, each step);
+ * each agent's waypoint index in place. The step never allocates: scratch comes from the
+ * caller (a VISION crowd's RASTER view makes its render targets in it, about 0.5 MiB per
+ * thread, instead of allocating them every step as before 2026-11-29);
  * thread_count > 1 starts pthreads.
  */
 #ifndef ANIMKIT_CROWD_H
@@ -166,8 +167,8 @@ typedef struct ak_crowd_desc {
     float vision_fov;                    /* VISION: field of view, degrees; 0 -> 150; < 360
                                             (RASTER: < 180) */
     ak_crowd_view vision_view;           /* VISION: 0 -> RAYCAST; RASTER renders with raster.h
-                                            (one render target per thread, allocated by each
-                                            step: the RASTER step allocates, RAYCAST never) */
+                                            (one render target per thread, made in the step's
+                                            scratch: neither view allocates) */
     uint32_t vision_height;              /* VISION RASTER: image rows; 0 -> 8; <= 256 */
 } ak_crowd_desc;
 
