@@ -42,7 +42,7 @@ int main(void) {
                                                    ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1)));
         poses[i] = ak_transform_make(ak_vec3_make(0.1f, 0.5f, 0.0f), q, ak_vec3_one());
     }
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     double best_mat = 1e9, best_trs = 1e9, best_batch = 1e9;
     for (int rep = 0; rep < REPS; ++rep) {
         double t0 = bench_cpu_s();

@@ -28,7 +28,7 @@ static const char* asset_path(char* buf, size_t size, const char* rel) {
 /* Bind-space bones of skin k: segment slot -> child slot, point bones for leaves. */
 static size_t skin_bones(const ak_scene* s, const ak_scene_skin* skin, ak_skin_bone* out) {
     size_t n = skin->joint_count, count = 0;
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     ak_vec3* pos = calloc(n, sizeof(ak_vec3));
     int* parent_slot = calloc(n, sizeof(int));
     char* has_child = calloc(n, 1);

@@ -27,7 +27,7 @@ int main(void) {
     }
     const ak_skeleton* sk = scene->skeleton;
     const size_t n = ak_skeleton_joint_count(sk);
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     printf("%s: %zu joints\n", scene->name, n);
     for (size_t j = 0; j < n; ++j) {
         ak_joint_type t = ak_skeleton_joint_type(sk, j);

@@ -12,7 +12,7 @@
 #include <stdlib.h>
 
 enum { JOINTS = 5, FRAMES = 121 };
-static const int16_t parents[JOINTS] = {-1, 0, 1, 2, 3};
+static const int32_t parents[JOINTS] = {-1, 0, 1, 2, 3};
 
 /* Column-major 4x4 in double: m[col * 4 + row]. */
 static void trs_matrix(const ak_transform* t, double m[16]) {

@@ -7,7 +7,7 @@
 #include <animkit/deform.h>
 
 enum { N = 6 };
-static const int16_t parents[N] = {-1, 0, 1, 2, 3, 4}; /* root, hip, tail0..tail3 */
+static const int32_t parents[N] = {-1, 0, 1, 2, 3, 4}; /* root, hip, tail0..tail3 */
 static const ak_vec3 offsets[N] = {{0, 0, 0}, {0, 1, 0}, {0, 0, -0.1f}, {0, 0, -0.25f}, {0, 0, -0.25f}, {0, 0, -0.25f}};
 
 int main(void) {

@@ -46,7 +46,7 @@ int main(void) {
 
     ak_mat4 joints[3] = {ak_mat4_identity(), ak_mat4_translation(ak_vec3_make(0, 1, 0)),
                          ak_mat4_translation(ak_vec3_make(-sinf(bend), 1 + cosf(bend), 0))};
-    int16_t parents[3] = {-1, 0, 1};
+    int32_t parents[3] = {-1, 0, 1};
     ak_view_skeleton sk = {.joint_model = {joints, 3}, .parents = {parents, 3}};
 
     enum { PW = 360, PH = 300 };

@@ -49,10 +49,10 @@ int main(void) {
 
     /* automatic weights (bone heat) for the chain hip (0, 0, 0) -> knee (0, 1, 0) -> end */
     ak_vec3 joint_pos[3] = {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}};
-    int16_t parents[3] = {-1, 0, 1};
+    int32_t parents[3] = {-1, 0, 1};
     ak_skin_bone bones[6];
     size_t bone_count = 0;
-    ak_skin_bones_from_joints((ak_vec3_cspan){joint_pos, 3}, (ak_i16_cspan){parents, 3}, true,
+    ak_skin_bones_from_joints((ak_vec3_cspan){joint_pos, 3}, (ak_i32_cspan){parents, 3}, true,
                               (ak_skin_bone_span){bones, 6}, &bone_count);
     ak_weights_desc wd = {
         .positions = {pos, n},

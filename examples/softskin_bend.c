@@ -18,17 +18,17 @@ int main(void) {
 
     /* bones from the skin's bind joint positions (slot order is parent first here) */
     ak_vec3 jp[8];
-    int16_t parent[8];
-    ak_i16_cspan sp = ak_skeleton_parents(s->skeleton);
+    int32_t parent[8];
+    ak_i32_cspan sp = ak_skeleton_parents(s->skeleton);
     for (size_t k = 0; k < ns; ++k) {
         jp[k] = ak_mat4_get_translation(ak_mat4_inverse_affine(sk->inverse_binds[k]));
         parent[k] = -1;
         for (size_t q = 0; q < ns; ++q)
-            if (sk->joints[q] == sp.ptr[sk->joints[k]]) parent[k] = (int16_t)q;
+            if (sk->joints[q] == sp.ptr[sk->joints[k]]) parent[k] = (int32_t)q;
     }
     ak_skin_bone bones[16];
     size_t nb = 0;
-    if (ak_skin_bones_from_joints((ak_vec3_cspan){jp, ns}, (ak_i16_cspan){parent, ns}, false,
+    if (ak_skin_bones_from_joints((ak_vec3_cspan){jp, ns}, (ak_i32_cspan){parent, ns}, false,
                                   (ak_skin_bone_span){bones, 16}, &nb) != AK_OK)
         return 1;
 

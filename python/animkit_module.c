@@ -508,7 +508,7 @@ static PyObject* scene_parents(SceneObject* o, void* c) {
     (void)c;
     size_t n = ak_scene_joint_count(o->scene);
     npy_intp dims[1] = {(npy_intp)n};
-    return view_array((PyObject*)o, 1, dims, NULL, NPY_INT16, n ? ak_skeleton_parents(o->scene->skeleton).ptr : NULL, 0);
+    return view_array((PyObject*)o, 1, dims, NULL, NPY_INT32, n ? ak_skeleton_parents(o->scene->skeleton).ptr : NULL, 0);
 }
 
 static PyObject* scene_clip_names(SceneObject* o, void* c) {
@@ -679,7 +679,7 @@ static bool ik_is_joint(const ak_scene* s, bool all, int j) { return all || !s->
  * states the rule): walk up from the effector through joints a skin uses, stopping below the
  * first ancestor with more than one child joint once the chain has two joints. */
 static int ik_default_root(const ak_scene* s, int eff) {
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     const bool all = !ik_is_joint(s, false, eff);
     size_t size = 1;
     int root = eff;
@@ -733,7 +733,7 @@ static PyObject* scene_ik(SceneObject* o, PyObject* args, PyObject* kw) {
     if (clip_arg(o, clip_obj, -1, &clip) < 0) return NULL;
     int eff = find_joint(s, eff_name);
     if (eff < 0) return raise_as(NotFoundError, AK_ERR_NOT_FOUND, s->name, "no joint named '%s'", eff_name);
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     int root;
     if (root_name) {
         root = find_joint(s, root_name);
@@ -960,7 +960,7 @@ static PyGetSetDef scene_getset[] = {
     {"name", (getter)scene_name, NULL, "File name or 'builtin:NAME'.", NULL},
     {"joint_names", (getter)scene_joint_names, NULL, "Names of the skeleton's joints (list of str), parents first.",
      NULL},
-    {"parents", (getter)scene_parents, NULL, "Parent index per joint (-1 for roots), a read-only int16 view.", NULL},
+    {"parents", (getter)scene_parents, NULL, "Parent index per joint (-1 for roots), a read-only int32 view.", NULL},
     {"clip_names", (getter)scene_clip_names, NULL, "Names of the clips (list of str), file order.", NULL},
     {"clip_durations", (getter)scene_clip_durations, NULL, "Duration of each clip in seconds (list of float).", NULL},
     {"meshes", (getter)scene_meshes, NULL, "The scene's meshes (tuple of Mesh), file order.", NULL},

@@ -682,7 +682,7 @@ static ak_result run_render(job_ctx* c) {
     const size_t nj = sc ? ak_scene_joint_count(sc) : 0;
     ak_transform* local = calloc(nj + 1, sizeof *local);
     ak_mat4* world = calloc(nj + 1, sizeof *world);
-    int16_t* parents = calloc(nj + 1, sizeof *parents);
+    int32_t* parents = calloc(nj + 1, sizeof *parents);
     uint8_t* px = calloc((size_t)job->width * (size_t)job->height, 4);
     if (r != AK_OK) goto done;
     if (!local || !world || !parents || !px) {
@@ -704,7 +704,7 @@ static ak_result run_render(job_ctx* c) {
         goto done;
     }
     if ((r = pose_meshes(c, sc, world, nj, &pm)) != AK_OK) goto done;
-    const ak_i16_cspan par = ak_skeleton_parents(sc->skeleton);
+    const ak_i32_cspan par = ak_skeleton_parents(sc->skeleton);
     for (size_t i = 0; i < nj; ++i) parents[i] = i < par.count ? par.ptr[i] : -1;
     /* the skeleton over a model without meshes (a BVH); with meshes, the meshes alone */
     ak_view_skeleton vs = {.joint_model = {world, nj}, .parents = {parents, nj}};

@@ -66,6 +66,40 @@ static bool channels_overlap(const ak_raw_channel* a, const ak_raw_channel* b) {
     return a->index < eb && b->index < ea;
 }
 
+/* A channel's target range, to find overlapping channels by sorting (a baked crowd has
+ * hundreds of thousands of channels: the pairwise check was quadratic). */
+typedef struct channel_span {
+    uint32_t target, begin, end;
+} channel_span;
+
+static int channel_span_cmp(const void* a, const void* b) {
+    const channel_span *x = (const channel_span*)a, *y = (const channel_span*)b;
+    if (x->target != y->target) return x->target < y->target ? -1 : 1;
+    return x->begin < y->begin ? -1 : x->begin > y->begin;
+}
+
+/* Whether two channels overlap (channels_overlap), in O(n log n); AK_ERR_NO_MEMORY as -1. */
+static int any_overlap(const ak_raw_channel* ch, size_t n, const ak_allocator* alloc) {
+    channel_span* s = (channel_span*)akp_alloc(alloc, (n ? n : 1) * sizeof *s);
+    if (!s) return -1;
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t end = is_joint_target(ch[i].target) ? ch[i].index + 1u : ch[i].index + resolved_components(&ch[i]);
+        s[i] = (channel_span){(uint32_t)ch[i].target, ch[i].index, end};
+    }
+    qsort(s, n, sizeof *s, channel_span_cmp);
+    /* within a target, sorted by begin: an overlap is a begin below the largest end before it
+     * (joint targets: the same index twice) */
+    int found = 0;
+    uint32_t max_end = 0;
+    for (size_t i = 0; i < n && !found; ++i) {
+        if (i == 0 || s[i].target != s[i - 1].target) max_end = s[i].end;
+        else if (s[i].begin < max_end) found = 1;
+        else if (s[i].end > max_end) max_end = s[i].end;
+    }
+    akp_free(alloc, s);
+    return found;
+}
+
 static ak_raw_track channel_as_track(const ak_raw_channel* ch) {
     ak_raw_track t;
     memset(&t, 0, sizeof t);
@@ -799,7 +833,9 @@ ak_result ak_clip_build(const ak_raw_clip* raw, const ak_allocator* alloc, ak_cl
         size += akp_track_data_size(&resolved);
         joints = joints || is_joint_target(raw->channels[i].target);
     }
-    for (size_t i = 0; i < nch; ++i) {
+    const int overlap = any_overlap(raw->channels, nch, alloc);
+    if (overlap < 0) return AK_ERR_NO_MEMORY;
+    for (size_t i = 0; overlap && i < nch; ++i) { /* name the first pair, as the pairwise check did */
         for (size_t j = i + 1; j < nch; ++j) {
             if (channels_overlap(&raw->channels[i], &raw->channels[j])) {
                 akp_diag_set(diag, NULL, "channels %zu and %zu both animate %s %u", i, j,

@@ -1553,8 +1553,28 @@ static uint32_t contact_need(const ak_crowd_step_job* job) {
     return job->allow_overlap ? job->contact_iterations : 1u;
 }
 
+/* A VISION RASTER worker's buffers: the triangle soup, the samples read back. */
+static void vision_raster_sizes(const ak_crowd* crowd, size_t* cap, size_t* s_pos, size_t* s_col, size_t* s_rgba,
+                                size_t* s_depth) {
+    *cap = (size_t)crowd->max_k * AK_CROWD_VISION_PRISM_SIDES * 6 + (size_t)crowd->vertex_count * 12;
+    const size_t px = (size_t)crowd->vision_width * crowd->vision_height;
+    *s_pos = akp_align16(*cap * sizeof(ak_vec3)), *s_col = akp_align16(*cap * sizeof(ak_vec4));
+    *s_rgba = akp_align16(px * 4), *s_depth = akp_align16(px * sizeof(float));
+}
+
+/* Step scratch of one VISION RASTER worker: its render target (made in the scratch) and buffers
+ * (0: the view's size is out of the rasterizer's range). */
+static size_t vision_raster_bytes(const ak_crowd* crowd) {
+    size_t cap, s_pos, s_col, s_rgba, s_depth;
+    vision_raster_sizes(crowd, &cap, &s_pos, &s_col, &s_rgba, &s_depth);
+    const ak_raster_desc rd = {.width = (int)crowd->vision_width, .height = (int)crowd->vision_height};
+    const size_t target = ak_raster_memory_size(&rd);
+    return target ? akp_align16(target) + 16 + s_pos + s_col + s_rgba + s_depth : 0;
+}
+
 typedef struct layout {
     size_t grid_pts, grid_mem, per_thread, contact, dense, dense_cap, pref, total;
+    size_t raster; /* VISION RASTER: per thread, its render target and buffers (vision_raster) */
     size_t pair_cap, edge_cap; /* the projection's candidate lists (contact) */
     ak_grid_desc gd, contact_gd, gather_gd;
 } layout;
@@ -1593,7 +1613,12 @@ static bool make_layout(const ak_crowd* c, size_t n, uint32_t threads, uint32_t 
     L->dense_cap = 4 * n + 1024;
     L->dense = dense_grid_bytes(n, L->dense_cap);
     L->pref = akp_align16(n * sizeof(ak_vec2));
-    L->total = L->grid_pts + L->grid_mem + L->contact + L->dense + L->pref + (size_t)threads * L->per_thread + 16;
+    if (c->method == AK_CROWD_VISION && c->vision_view == AK_CROWD_VIEW_RASTER) {
+        L->raster = vision_raster_bytes(c);
+        if (L->raster == 0) return false;
+    }
+    L->total = L->grid_pts + L->grid_mem + L->contact + L->dense + L->pref +
+               (size_t)threads * (L->per_thread + L->raster) + 16;
     return true;
 }
 
@@ -1638,6 +1663,46 @@ static ak_result vision_rasters_make(const ak_crowd* crowd, vision_raster* vr, u
         vr[t].col = (ak_vec4*)(void*)(mem + s_pos);
         vr[t].rgba = (uint8_t*)(mem + s_pos + s_col);
         vr[t].depth = (float*)(void*)(mem + s_pos + s_col + s_rgba);
+        vr[t].cap = cap;
+        vr[t].tan_half_fov = tanf(0.5f * crowd->vision_fov);
+    }
+    return AK_OK;
+}
+
+/* An allocator over one block of step scratch: hands it out once (the render target's one
+ * allocation); frees nothing. */
+typedef struct scratch_arena {
+    char* ptr;
+    size_t left;
+} scratch_arena;
+
+static void* arena_alloc(size_t size, void* user) {
+    scratch_arena* a = (scratch_arena*)user;
+    if (size > a->left) return NULL;
+    a->left = 0;
+    return a->ptr;
+}
+
+static void arena_free(void* ptr, void* user) { (void)ptr, (void)user; }
+
+/* The RASTER view's targets and buffers in the step scratch (mem: count blocks of
+ * vision_raster_bytes, 16-byte aligned): no allocation per step. */
+static ak_result vision_rasters_in_scratch(const ak_crowd* crowd, vision_raster* vr, uint32_t count, char* mem,
+                                           size_t block) {
+    size_t cap, s_pos, s_col, s_rgba, s_depth;
+    vision_raster_sizes(crowd, &cap, &s_pos, &s_col, &s_rgba, &s_depth);
+    const ak_raster_desc rd = {.width = (int)crowd->vision_width, .height = (int)crowd->vision_height};
+    memset(vr, 0, count * sizeof *vr);
+    for (uint32_t t = 0; t < count; ++t) {
+        char* b = mem + (size_t)t * block;
+        scratch_arena arena = {b, block - s_pos - s_col - s_rgba - s_depth};
+        const ak_allocator al = {.alloc = arena_alloc, .free = arena_free, .user = &arena};
+        if (ak_raster_create(&rd, &al, &vr[t].r) != AK_OK) return AK_ERR_BAD_ARG; /* the scratch is sized for it */
+        char* buf = b + (block - s_pos - s_col - s_rgba - s_depth);
+        vr[t].pos = (ak_vec3*)(void*)buf;
+        vr[t].col = (ak_vec4*)(void*)(buf + s_pos);
+        vr[t].rgba = (uint8_t*)(buf + s_pos + s_col);
+        vr[t].depth = (float*)(void*)(buf + s_pos + s_col + s_rgba);
         vr[t].cap = cap;
         vr[t].tan_half_fov = tanf(0.5f * crowd->vision_fov);
     }
@@ -1753,11 +1818,11 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
     worker w[64];
     vision_raster vrs[64];
     const bool raster = vision_raster_view(crowd);
-    if (raster) {
-        const ak_result mr = vision_rasters_make(crowd, vrs, threads);
+    char* tb = base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref;
+    if (raster) { /* the render targets live in the step scratch, after the workers' */
+        const ak_result mr = vision_rasters_in_scratch(crowd, vrs, threads, tb + (size_t)threads * L.per_thread, L.raster);
         if (mr != AK_OK) return mr;
     }
-    char* tb = base + L.grid_pts + L.grid_mem + L.contact + L.dense + L.pref;
     for (uint32_t t = 0; t < threads; ++t) {
         w[t].c = &c;
         w[t].begin = n * t / threads;
@@ -1766,7 +1831,6 @@ ak_result ak_crowd_step_run(const ak_crowd_step_job* job) {
         w[t].vr = raster ? &vrs[t] : NULL;
     }
     run_threads(work, w, threads);
-    if (raster) vision_rasters_free(crowd, vrs, threads);
     if (job->allow_overlap) {
         /* RVO2's behaviour, with at most contact_iterations passes after it (0: pure ORCA) */
         for (uint32_t it = 0; it < job->contact_iterations; ++it) {

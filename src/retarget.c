@@ -80,7 +80,7 @@ static int lookup(const char* core, bool sided) {
 
 /* Quaternion chain FK: model-space rotations (uniform scales assumed). */
 static void model_rotations(const ak_skeleton* sk, const ak_transform* local, ak_quat* out) {
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     for (size_t j = 0; j < parents.count; ++j)
         out[j] = parents.ptr[j] < 0 ? local[j].rotation
                                     : ak_quat_normalize(ak_quat_mul(out[parents.ptr[j]], local[j].rotation));
@@ -89,7 +89,7 @@ static void model_rotations(const ak_skeleton* sk, const ak_transform* local, ak
 static ak_vec3 model_position(const ak_mat4* m) { return ak_mat4_get_translation(*m); }
 
 static bool is_ancestor(const ak_skeleton* sk, int a, int j) {
-    ak_i16_cspan p = ak_skeleton_parents(sk);
+    ak_i32_cspan p = ak_skeleton_parents(sk);
     while (j >= 0) {
         if (j == a) return true;
         j = p.ptr[j];
@@ -136,7 +136,7 @@ ak_result ak_humanoid_bones_of_skeleton(const ak_skeleton* skeleton, ak_i32_span
     if (!skeleton || !out_bones.ptr) return AK_ERR_NULL_ARG;
     size_t n = ak_skeleton_joint_count(skeleton);
     if (out_bones.count < n) return AK_ERR_SPAN_SMALL;
-    ak_i16_cspan parents = ak_skeleton_parents(skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(skeleton);
     int32_t* b = out_bones.ptr;
     bool taken[AK_BONE_COUNT] = {false};
     for (size_t j = 0; j < n; ++j) b[j] = (int32_t)ak_humanoid_bone_of_name(ak_skeleton_joint_name(skeleton, j));
@@ -430,13 +430,13 @@ ak_result ak_retarget_clip(const ak_retarget_desc* desc_in, const ak_allocator* 
     float scale = d.unscaled_root_motion || !(s_leg > 1e-12f) || !(t_leg > 0.0f) ? 1.0f : t_leg / s_leg;
 
     /* rest alignment: target rest bone direction onto the source's */
-    ak_i16_cspan tpar = ak_skeleton_parents(dst);
+    ak_i32_cspan tpar = ak_skeleton_parents(dst);
     for (size_t k = 0; k < nt; ++k) {
         align[k] = ak_quat_identity();
         bool set = false;
         if (map[k] >= 0 && (int)k != root) {
             for (size_t c = k + 1; c < nt; ++c) {
-                if (tpar.ptr[c] != (int16_t)k || map[c] < 0) continue;
+                if (tpar.ptr[c] != (int32_t)k || map[c] < 0) continue;
                 ak_vec3 dt = ak_vec3_sub(model_position(&t_rest_m[c]), model_position(&t_rest_m[k]));
                 ak_vec3 ds = ak_vec3_sub(model_position(&s_rest_m[map[c]]), model_position(&s_rest_m[map[k]]));
                 if (ak_vec3_length(dt) > 1e-12f && ak_vec3_length(ds) > 1e-12f) {
@@ -598,7 +598,7 @@ enum { WORD_NONE = 0, WORD_TORSO, WORD_HEAD, WORD_ARM, WORD_LEG };
 typedef struct role_ctx {
     const ak_skeleton* sk;
     size_t n;
-    const int16_t* parent;
+    const int32_t* parent;
     ak_vec3* pos;          /* rest model positions */
     int32_t* first_child;  /* child lists in index order */
     int32_t* next_sibling;

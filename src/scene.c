@@ -86,7 +86,8 @@ void ak_scene_destroy(ak_scene* scene) {
     if (!scene) return;
     ak_allocator a = scene->alloc;
     ak_skeleton_destroy(scene->skeleton);
-    for (size_t i = 0; i < scene->mesh_count; ++i) ak_mesh_destroy(scene->meshes[i].mesh);
+    for (size_t i = 0; i < scene->mesh_count; ++i)
+        if (!scene->meshes[i].shares_mesh) ak_mesh_destroy(scene->meshes[i].mesh);
     for (size_t i = 0; i < scene->skin_count; ++i) {
         akp_free(&a, scene->skins[i].joints);
         akp_free(&a, scene->skins[i].inverse_binds);

@@ -8,7 +8,7 @@ struct ak_skeleton {
     ak_allocator alloc;
     size_t joint_count;
     char name[AK_NAME_SIZE];
-    int16_t* parents;            /* [n] */
+    int32_t* parents;            /* [n] */
     ak_transform* rest;          /* [n], rotations normalised */
     ak_mat4* inverse_binds;      /* [n] */
     char (*names)[AK_NAME_SIZE]; /* [n] */
@@ -23,7 +23,7 @@ struct ak_skeleton {
 enum { AKP_FK_K_SCALAR = 0, AKP_FK_K_AVX, AKP_FK_K_AVX2, AKP_FK_K_AVX512 };
 static uint8_t fk_pick(ak_fk_simd limit);
 
-#define MAX_JOINTS 32767u
+#define MAX_JOINTS AK_SKELETON_MAX_JOINTS
 
 static bool limits_finite(const ak_joint_limits* l) {
     return ak_vec3_is_finite(l->axis) && ak_finitef(l->min) && ak_finitef(l->max) &&
@@ -162,7 +162,7 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
 
     size_t total = akp_align16(sizeof(ak_skeleton));
     const size_t off_parents = total;
-    total = akp_align16(total + n * sizeof(int16_t));
+    total = akp_align16(total + n * sizeof(int32_t));
     const size_t off_rest = total;
     total = akp_align16(total + n * sizeof(ak_transform));
     const size_t off_ib = total;
@@ -189,7 +189,7 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
     if (desc->name) snprintf(sk->name, sizeof sk->name, "%s", desc->name);
     sk->palette_from_skins = desc->palette_from_skins;
     sk->fk_kernel = fk_pick(AK_FK_SIMD_DEFAULT);
-    sk->parents = (int16_t*)(base + off_parents);
+    sk->parents = (int32_t*)(base + off_parents);
     sk->rest = (ak_transform*)(base + off_rest);
     sk->inverse_binds = (ak_mat4*)(base + off_ib);
     sk->names = (char(*)[AK_NAME_SIZE])(base + off_names);
@@ -199,7 +199,7 @@ ak_result ak_skeleton_create(const ak_skeleton_desc* desc, const ak_allocator* a
 
     for (size_t i = 0; i < n; ++i) {
         const ak_joint_desc* j = &desc->joints[i];
-        sk->parents[i] = (int16_t)j->parent;
+        sk->parents[i] = (int32_t)j->parent;
         sk->rest[i] = j->rest;
         sk->rest[i].rotation = ak_quat_normalize(j->rest.rotation);
         snprintf(sk->names[i], AK_NAME_SIZE, "%s", j->name);
@@ -292,8 +292,8 @@ size_t ak_skeleton_joint_count(const ak_skeleton* skeleton) {
     return skeleton ? skeleton->joint_count : 0;
 }
 
-ak_i16_cspan ak_skeleton_parents(const ak_skeleton* skeleton) {
-    ak_i16_cspan s = {skeleton ? skeleton->parents : NULL, skeleton ? skeleton->joint_count : 0};
+ak_i32_cspan ak_skeleton_parents(const ak_skeleton* skeleton) {
+    ak_i32_cspan s = {skeleton ? skeleton->parents : NULL, skeleton ? skeleton->joint_count : 0};
     return s;
 }
 
@@ -426,7 +426,7 @@ __attribute__((target("avx"), always_inline)) static inline void local_soa8(cons
     __attribute__((target(TARGET))) static void NAME(const ak_skeleton* sk, const ak_mat4* root,                \
                                                      const ak_transform* local, ak_mat4* out) {                \
         const size_t n = sk->joint_count;                                                                      \
-        const int16_t* const parents = sk->parents;                                                            \
+        const int32_t* const parents = sk->parents;                                                            \
         _Alignas(32) float L[9][8]; /* columns 0..2 (x y z each), 8 joints */                                  \
         __m128 prev[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};             \
         for (size_t b = 0; b < n; b += 8) {                                                                    \

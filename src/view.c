@@ -235,7 +235,7 @@ ak_result ak_view_draw_skeleton(ak_raster* raster, const ak_raster_camera* camer
     if (s->parents.count != s->joint_model.count) return AK_ERR_BAD_ARG;
     const size_t n = s->joint_model.count;
     for (size_t i = 0; i < n; ++i)
-        if (s->parents.ptr[i] >= (int16_t)(n > 32767 ? 32767 : n) || s->parents.ptr[i] < -1) return AK_ERR_BAD_INDEX;
+        if (s->parents.ptr[i] < -1 || (size_t)(s->parents.ptr[i] + 1) > n) return AK_ERR_BAD_INDEX;
     ak_vec4 bone = or_default(s->bone_color, rgba(0.97f, 0.97f, 1.0f, 1));
     ak_vec4 joint = or_default(s->joint_color, rgba(1.0f, 0.78f, 0.18f, 1));
     float bw = s->bone_width > 0.0f ? s->bone_width : 2.5f;

@@ -251,7 +251,7 @@ AK_TEST(export_matches_double_precision_skinning) {
     ak_clip_sample(s->clips[clip], 0.5f, NULL, (ak_transform_span){local, n}, (ak_f32_span){0}, (ak_f32_span){0});
     /* world matrices in double, by walking the parents */
     double W[16][16];
-    ak_i16_cspan par = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan par = ak_skeleton_parents(s->skeleton);
     for (size_t j = 0; j < n; ++j) {
         ak_mat4 lm = ak_transform_to_mat4(local[j]);
         double L[16];

@@ -480,6 +480,27 @@ AK_TEST(bake_scene) {
     bd.memory_budget = 1000;
     AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
     AK_CHECK(baked == NULL && strstr(diag.message, "budget") != NULL);
+    /* ak_crowd_bake_max_frames agrees with the check: at every budget where it allows 1..4
+     * frames, that many bake and one more is refused (budget), nothing allocated */
+    size_t seen = 0;
+    for (size_t b = 100000; b < 4000000 && seen < 4; b += 512) {
+        const size_t fit = ak_crowd_bake_max_frames(&g, N, b);
+        if (fit == 0 || fit > 4 || fit == seen) continue;
+        seen = fit;
+        bd.memory_budget = b;
+        bd.frame_count = fit;
+        AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_OK);
+        ak_scene_destroy(baked);
+        bd.frame_count = fit + 1;
+        AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
+        AK_CHECK(baked == NULL && strstr(diag.message, "budget") != NULL);
+    }
+    AK_CHECK_EQ(seen, 4u);
+    bd.frame_count = F;
+    AK_CHECK_EQ(ak_crowd_bake_max_frames(&g, 60000, 0), 0u); /* the nodes */
+    AK_CHECK_EQ(ak_crowd_bake_max_frames(NULL, 1, 0), 0u);
+    printf("  bake frames within the default budget: 2,000 agents %zu, 10,000 agents %zu\n",
+           ak_crowd_bake_max_frames(&g, 2000, 0), ak_crowd_bake_max_frames(&g, 10000, 0));
     bd.memory_budget = 0;
     bd.frame_count = AK_SCENE_BAKE_MAX_FRAMES + 1;
     AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
@@ -491,8 +512,9 @@ AK_TEST(bake_scene) {
     bd.frame_time = 0.1f;
     pos[4].x = NAN;
     AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_BAD_DATA);
-    bd.agent_count = 2000;
+    bd.agent_count = 60000; /* 60,000 x 19 nodes: more than a skeleton holds (checked first) */
     AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_ERR_UNSUPPORTED);
+    AK_CHECK(strstr(diag.message, "nodes") != NULL);
     AK_CHECK_EQ(ak_crowd_bake_scene(NULL, NULL, &baked, &diag), AK_ERR_NULL_ARG);
     /* one frame: no clip, the nodes rest in that frame */
     pos[4].x = 0;
@@ -501,6 +523,121 @@ AK_TEST(bake_scene) {
     AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_OK);
     if (baked) AK_CHECK_EQ(baked->clip_count, 0u);
     ak_scene_destroy(baked);
+}
+
+/* Occurrences of needle in the n bytes at s. */
+static size_t count_in(const char* s, size_t n, const char* needle) {
+    size_t c = 0, k = strlen(needle);
+    for (size_t i = 0; i + k <= n; ++i) c += memcmp(s + i, needle, k) == 0;
+    return c;
+}
+
+/* A crowd above the 32767 nodes of the old int16 skeletons (2,000 agents x 19 nodes), baked,
+ * written as .glb and read back with ak_io_load: the file holds one mesh and 2,000 skins (its
+ * JSON counted by hand), and every agent's joints, posed by the read clip at each frame, sit
+ * where the character's own FK placed by the agent's root matrix puts them. */
+AK_TEST(bake_gltf_2000_agents) {
+    ak_scene* sc = humanoid();
+    AK_CHECK(sc);
+    if (!sc) return;
+    ak_crowd_gait g;
+    AK_CHECK(gait_of(sc, &g));
+    enum { N = 2000, F = 3 };
+    ak_vec2* pos = malloc(sizeof(ak_vec2) * N * F);
+    ak_crowd_character* ch = malloc(sizeof(ak_crowd_character) * N * F);
+    for (int a = 0; a < N; ++a) {
+        const float ang = 0.37f * (float)a;
+        ak_crowd_character c = ak_crowd_character_init(&g, ak_vec2_make(cosf(ang), sinf(ang)), (float)(a % 7) / 7.0f);
+        ak_vec2 v = ak_vec2_make(1.3f * cosf(ang), 1.3f * sinf(ang));
+        ak_crowd_characters_job job = {.gait = &g, .dt = 0.1f, .velocities = {&v, 1}, .characters = {&c, 1}};
+        for (int f = 0; f < F; ++f) {
+            pos[f * N + a] = ak_vec2_make((float)(a % 50) * 1.5f + 0.13f * (float)f * cosf(ang),
+                                          (float)(a / 50) * 1.5f + 0.13f * (float)f * sinf(ang));
+            ch[f * N + a] = c;
+            ak_crowd_characters_update(&job);
+        }
+    }
+    ak_crowd_bake_desc bd = {.gait = &g, .agent_count = N, .frame_count = F, .positions = pos, .characters = ch,
+                             .frame_time = 0.1f};
+    ak_scene* baked = NULL;
+    ak_diag diag;
+    AK_CHECK_EQ(ak_crowd_bake_scene(&bd, NULL, &baked, &diag), AK_OK);
+    if (baked) {
+        AK_CHECK_EQ(baked->mesh_count, (size_t)N);
+        AK_CHECK(!baked->meshes[0].shares_mesh && baked->meshes[N - 1].shares_mesh);
+        AK_CHECK(baked->meshes[N - 1].mesh == baked->meshes[0].mesh);
+        AK_CHECK_EQ(ak_io_save("crowd_2000.glb", baked, NULL, &diag), AK_OK);
+    }
+    ak_scene_destroy(baked);
+    /* the JSON chunk, counted without the library's reader */
+    FILE* fp = fopen("crowd_2000.glb", "rb");
+    uint8_t head[20] = {0};
+    AK_CHECK(fp && fread(head, 1, 20, fp) == 20);
+    const size_t jn = (size_t)head[12] | (size_t)head[13] << 8 | (size_t)head[14] << 16 | (size_t)head[15] << 24;
+    char* json = malloc(jn + 1);
+    AK_CHECK(fp && json && fread(json, 1, jn, fp) == jn);
+    if (fp) fclose(fp);
+    if (json) {
+        AK_CHECK_EQ(count_in(json, jn, "\"primitives\""), 1u);         /* one glTF mesh */
+        AK_CHECK_EQ(count_in(json, jn, "\"POSITION\""), 1u);           /* its vertices once */
+        AK_CHECK_EQ(count_in(json, jn, "\"inverseBindMatrices\""), (size_t)N); /* N skins */
+        AK_CHECK_EQ(count_in(json, jn, "\"skin\":"), (size_t)N);       /* N skinned nodes */
+        AK_CHECK_EQ(count_in(json, jn, "\"mesh\":"), (size_t)N);       /* placing that mesh */
+    }
+    free(json);
+    ak_scene* rd = NULL;
+    AK_CHECK_EQ(ak_io_load("crowd_2000.glb", NULL, NULL, &rd, &diag), AK_OK);
+    if (!rd) {
+        free(pos), free(ch);
+        return;
+    }
+    const size_t J = ak_scene_joint_count(sc), n = ak_scene_joint_count(rd);
+    AK_CHECK(n >= (size_t)N * (J + 1) && n > 32767);
+    AK_CHECK_EQ(rd->skin_count, (size_t)N);
+    AK_CHECK_EQ(rd->mesh_count, (size_t)N);
+    AK_CHECK_EQ(rd->clip_count, 1u);
+    size_t shared = 0;
+    for (size_t m = 1; m < rd->mesh_count; ++m) shared += rd->meshes[m].shares_mesh && rd->meshes[m].mesh == rd->meshes[0].mesh;
+    AK_CHECK_EQ(shared, (size_t)N - 1); /* the reader keeps one mesh too */
+    ak_transform* lb = malloc(n * sizeof *lb);
+    ak_mat4* wb = malloc(n * sizeof *wb);
+    ak_transform* lc = malloc(J * sizeof *lc);
+    ak_mat4* wc = malloc(J * sizeof *wc);
+    const ak_scene_skin* cskin = &sc->skins[0];
+    double worst = 0.0;
+    size_t checked = 0, misnamed = 0;
+    for (int f = 0; f < F; ++f) {
+        ak_scene_rest_pose(rd, (ak_transform_span){lb, n});
+        ak_clip_sample(rd->clips[0], 0.1f * (float)f, NULL, (ak_transform_span){lb, n}, (ak_f32_span){0}, (ak_f32_span){0});
+        ak_scene_world_matrices(rd, (ak_transform_cspan){lb, n}, (ak_mat4_span){wb, n});
+        for (int a = 0; a < N; ++a) {
+            ak_crowd_character_pose(&g, &ch[f * N + a], (ak_transform_span){lc, J});
+            ak_scene_world_matrices(sc, (ak_transform_cspan){lc, J}, (ak_mat4_span){wc, J});
+            const ak_mat4 root = ak_crowd_character_root(&g, &ch[f * N + a], pos[f * N + a]);
+            const ak_scene_skin* sk = &rd->skins[a];
+            if (sk->joint_count != cskin->joint_count) {
+                ++misnamed;
+                continue;
+            }
+            for (size_t k = 0; k < sk->joint_count; ++k) {
+                const int32_t cj = cskin->joints[k], bj = sk->joints[k];
+                char want_name[AK_NAME_SIZE];
+                snprintf(want_name, sizeof want_name, "%d/%s", a, ak_skeleton_joint_name(sc->skeleton, (size_t)cj));
+                if (f == 0) misnamed += strcmp(ak_skeleton_joint_name(rd->skeleton, (size_t)bj), want_name) != 0;
+                const ak_vec3 want = ak_mat4_transform_point(root, ak_mat4_get_translation(wc[cj]));
+                const ak_vec3 got = ak_mat4_get_translation(wb[bj]);
+                worst = fmax(worst, (double)ak_vec3_length(ak_vec3_sub(want, got)));
+                ++checked;
+            }
+        }
+    }
+    printf("  2,000 agents read back: %zu joint positions vs the characters' own FK, %.2g m at most\n", checked, worst);
+    AK_CHECK_EQ(misnamed, 0u);
+    AK_CHECK_EQ(checked, (size_t)N * F * cskin->joint_count);
+    AK_CHECK(worst < 1e-4);
+    free(lb), free(wb), free(lc), free(wc), free(pos), free(ch);
+    ak_scene_destroy(rd);
+    remove("crowd_2000.glb");
 }
 
 /* Foot planting on one standing character: pins, the IK holding them, the step, the errors. */
@@ -790,6 +927,7 @@ int main(void) {
     AK_RUN(shared_pose_phase_error);
     AK_RUN(validation);
     AK_RUN(bake_scene);
+    AK_RUN(bake_gltf_2000_agents);
     AK_RUN(foot_planting_unit);
     AK_RUN(foot_sliding_crowd_crossing);
     AK_RUN_SLOW(foot_sliding_crowd_slow);

@@ -109,7 +109,7 @@ static double reference_error(const crowd_character* ch, uint64_t frame, double*
     const float t = (float)fmod(ch->offset + (double)frame / 60.0, dur);
     ak_scene_rest_pose(sc, (ak_transform_span){local, nj});
     ak_clip_sample(ch->clip, t, NULL, (ak_transform_span){local, nj}, (ak_f32_span){0}, (ak_f32_span){0});
-    const ak_i16_cspan parents = ak_skeleton_parents(sc->skeleton);
+    const ak_i32_cspan parents = ak_skeleton_parents(sc->skeleton);
     for (size_t j = 0; j < nj; ++j) {
         const dmat4 l = dtrs(&local[j]);
         world[j] = parents.ptr[j] < 0 ? l : dmul(&world[parents.ptr[j]], &l);

@@ -436,7 +436,7 @@ AK_TEST(squash_tracker_from_motion) {
 /* A small rig: 0 root, 1 body (translation jiggle), 2..4 a tail chain along -Z (rotation jiggle),
  * 5 a non-jiggling tip under joint 4. Model matrices come from the root transform only. */
 enum { RIG_N = 6 };
-static const int16_t rig_parents[RIG_N] = {-1, 0, 0, 2, 3, 4};
+static const int32_t rig_parents[RIG_N] = {-1, 0, 0, 2, 3, 4};
 static const ak_vec3 rig_local[RIG_N] = {{0, 0, 0}, {0, 1, 0}, {0, 1, -0.3f}, {0, 0, -0.4f}, {0, 0, -0.4f}, {0, 0, -0.4f}};
 
 static void rig_model(ak_mat4 root, ak_mat4* out) {
@@ -666,8 +666,8 @@ AK_TEST(jiggle_bad_input_codes) {
     AK_CHECK_EQ(ak_jiggle_run(&j), AK_ERR_BAD_INDEX);
     oob[0].joint = -1;
     AK_CHECK_EQ(ak_jiggle_run(&j), AK_ERR_BAD_INDEX);
-    const int16_t loop[RIG_N] = {-1, 0, 3, 2, 3, 4};
-    j = ok, j.parents = (ak_i16_cspan){loop, RIG_N};
+    const int32_t loop[RIG_N] = {-1, 0, 3, 2, 3, 4};
+    j = ok, j.parents = (ak_i32_cspan){loop, RIG_N};
     AK_CHECK_EQ(ak_jiggle_run(&j), AK_ERR_BAD_HIERARCHY);
     j = ok, j.states.count = 3;
     AK_CHECK_EQ(ak_jiggle_run(&j), AK_ERR_SPAN_SMALL);

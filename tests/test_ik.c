@@ -1210,7 +1210,7 @@ AK_TEST(fabrik_tree) {
         ak_skeleton_local_to_model(sk, (ak_transform_cspan)AK_SPAN(pose), (ak_mat4_span)AK_SPAN(after));
         /* Root (spine) stays; every bone keeps its length; reported error is the true max. */
         AK_CHECK_NEAR(ak_vec3_distance(ak_mat4_get_translation(after[1]), ak_mat4_get_translation(before[1])), 0, 1e-6);
-        const int16_t* par = ak_skeleton_parents(sk).ptr;
+        const int32_t* par = ak_skeleton_parents(sk).ptr;
         for (int i = 1; i < 9; ++i) {
             float l0 = ak_vec3_distance(ak_mat4_get_translation(before[i]), ak_mat4_get_translation(before[par[i]]));
             float l1 = ak_vec3_distance(ak_mat4_get_translation(after[i]), ak_mat4_get_translation(after[par[i]]));

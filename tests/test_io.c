@@ -132,7 +132,7 @@ static void check_gltf_file(const char* path) {
     }
     AK_CHECK_MSG(bad_joint == 0, "%s: %d nodes not found by name", path, bad_joint);
     if (bad_joint == 0 && n_nodes) {
-        ak_i16_cspan par = ak_skeleton_parents(s->skeleton);
+        ak_i32_cspan par = ak_skeleton_parents(s->skeleton);
         ak_transform_cspan rest = ak_skeleton_rest_pose(s->skeleton);
         int bad_parent = 0, bad_rest = 0;
         for (int i = 0; i < n_nodes; ++i) {

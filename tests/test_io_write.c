@@ -539,6 +539,99 @@ AK_TEST(builtin_round_trip) {
     }
 }
 
+/* Occurrences of needle in the n bytes at s. */
+static size_t count_in(const char* s, size_t n, const char* needle) {
+    size_t c = 0, k = strlen(needle);
+    for (size_t i = 0; i + k <= n; ++i) c += memcmp(s + i, needle, k) == 0;
+    return c;
+}
+
+/* Vertex-attribute bufferViews (target 34962), glTF meshes, materials and skinned nodes in a
+ * written .glb's JSON, counted by hand (not with the library's reader). */
+typedef struct glb_counts {
+    size_t vertex_views, meshes, materials, skinned;
+} glb_counts;
+
+static glb_counts glb_count(const char* path) {
+    glb_counts c = {0, 0, 0, 0};
+    FILE* fp = fopen(path, "rb");
+    unsigned char head[20] = {0};
+    if (!fp || fread(head, 1, 20, fp) != 20) {
+        if (fp) fclose(fp);
+        return c;
+    }
+    const size_t jn = (size_t)head[12] | (size_t)head[13] << 8 | (size_t)head[14] << 16 | (size_t)head[15] << 24;
+    char* json = malloc(jn + 1);
+    if (json && fread(json, 1, jn, fp) == jn) {
+        c.vertex_views = count_in(json, jn, "34962");
+        c.meshes = count_in(json, jn, "\"primitives\"");
+        c.materials = count_in(json, jn, "\"baseColorFactor\"");
+        c.skinned = count_in(json, jn, "\"skin\":");
+    }
+    free(json);
+    fclose(fp);
+    return c;
+}
+
+/* Instances (scene.h shares_mesh): the humanoid's mesh placed three times with its skin, twice
+ * red and once blue. The file holds the vertices once (as many vertex views as the humanoid
+ * written alone) and two glTF meshes (one per colour); read back, the posed vertices match,
+ * the two red entries share one ak_mesh and the blue one is blue. */
+AK_TEST(instances_round_trip) {
+    ak_scene* h = NULL;
+    AK_CHECK_EQ(ak_builtin_create("humanoid", NULL, NULL, &h), AK_OK);
+    ak_scene* a = NULL;
+    AK_CHECK_EQ(ak_scene_alloc(3, 1, 0, NULL, &a), AK_OK);
+    if (!h || !a || h->mesh_count != 1 || h->skin_count != 1) {
+        ak_scene_destroy(h);
+        ak_scene_destroy(a);
+        return;
+    }
+    char one[1024], out[1024];
+    ak_diag diag;
+    AK_CHECK_EQ(ak_io_save(tmp_path(one, sizeof one, "instances_one.glb"), h, NULL, &diag), AK_OK);
+    const glb_counts c1 = glb_count(one);
+    /* the instanced scene takes the humanoid's skeleton and mesh */
+    a->skeleton = h->skeleton, h->skeleton = NULL;
+    AK_CHECK_EQ(ak_scene_skin_alloc(a, 0, h->skins[0].joint_count), AK_OK);
+    memcpy(a->skins[0].joints, h->skins[0].joints, h->skins[0].joint_count * sizeof(int32_t));
+    memcpy(a->skins[0].inverse_binds, h->skins[0].inverse_binds, h->skins[0].joint_count * sizeof(ak_mat4));
+    const ak_vec4 red = {1, 0, 0, 1}, blue = {0, 0, 1, 1};
+    for (int m = 0; m < 3; ++m) {
+        a->meshes[m] = h->meshes[0];
+        a->meshes[m].shares_mesh = m > 0;
+        a->meshes[m].has_material = true;
+        a->meshes[m].base_color = m == 2 ? blue : red;
+        a->meshes[m].texture = -1;
+    }
+    h->meshes[0].mesh = NULL;
+    ak_scene_destroy(h);
+    AK_CHECK_EQ(ak_io_save(tmp_path(out, sizeof out, "instances.glb"), a, NULL, &diag), AK_OK);
+    const glb_counts c3 = glb_count(out);
+    AK_CHECK(c1.vertex_views >= 2);
+    AK_CHECK_EQ(c3.vertex_views, c1.vertex_views); /* the vertices once */
+    AK_CHECK_EQ(c3.meshes, 2u);                     /* a glTF mesh per colour */
+    AK_CHECK_EQ(c3.materials, 2u);
+    AK_CHECK_EQ(c3.skinned, 3u);                    /* three instances */
+    ak_scene* b = NULL;
+    AK_CHECK_EQ(ak_io_load(out, &k_load, NULL, &b, &diag), AK_OK);
+    if (b) {
+        AK_CHECK_EQ(compare_scenes(a, b, "instances"), 0);
+        int red_shared = 0, blue_own = 0, blue_is_blue = 0;
+        for (size_t m = 0; m < b->mesh_count; ++m) {
+            const bool is_blue = b->meshes[m].base_color.z > 0.5f;
+            if (!is_blue && b->meshes[m].shares_mesh) red_shared += b->meshes[m].mesh != NULL;
+            if (is_blue) blue_own += !b->meshes[m].shares_mesh, blue_is_blue += b->meshes[m].base_color.x < 0.5f;
+        }
+        AK_CHECK_EQ(red_shared, 1);
+        AK_CHECK_EQ(blue_own, 1);
+        AK_CHECK_EQ(blue_is_blue, 1);
+    }
+    queue_validate(out);
+    ak_scene_destroy(a);
+    ak_scene_destroy(b);
+}
+
 /* BVH motion capture (Euler channels, no mesh) written as glTF: the same poses. */
 AK_TEST(bvh_round_trip) {
     char src[1200];
@@ -604,6 +697,7 @@ int main(void) {
     AK_RUN(bad_input);
     AK_RUN(tangents);
     AK_RUN(builtin_round_trip);
+    AK_RUN(instances_round_trip);
     AK_RUN(bvh_round_trip);
 #ifdef AK_CLI_PATH
     AK_RUN_SLOW(cli_export);

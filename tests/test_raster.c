@@ -1215,7 +1215,67 @@ AK_TEST(fill_rect_translucent_matches_closed_form) {
                  changed);
 }
 
+/* ak_raster_memory_size is the one allocation ak_raster_create asks for (an allocator that
+ * records it), for several descs; a target made in a caller's block of that size draws as one
+ * from the heap; out-of-range descs give 0. */
+typedef struct one_block {
+    unsigned char* mem;
+    size_t cap, asked;
+    int calls;
+} one_block;
+
+static void* one_block_alloc(size_t size, void* user) {
+    one_block* b = (one_block*)user;
+    b->asked = size;
+    ++b->calls;
+    return size <= b->cap ? b->mem : NULL;
+}
+
+static void one_block_free(void* ptr, void* user) { (void)ptr, (void)user; }
+
+AK_TEST(memory_size_is_the_allocation) {
+    const ak_raster_desc descs[3] = {{.width = 48, .height = 8}, {.width = 64, .height = 40, .supersample = 2},
+                                     {.width = 300, .height = 200, .supersample = 3, .thread_count = 3}};
+    for (int i = 0; i < 3; ++i) {
+        const size_t need = ak_raster_memory_size(&descs[i]);
+        one_block b = {malloc(need), need, 0, 0};
+        const ak_allocator al = {.alloc = one_block_alloc, .free = one_block_free, .user = &b};
+        ak_raster *r = NULL, *h = NULL;
+        AK_CHECK_EQ(ak_raster_create(&descs[i], &al, &r), AK_OK);
+        AK_CHECK_EQ(b.calls, 1);
+        AK_CHECK_EQ(b.asked, need);
+        AK_CHECK_EQ(ak_raster_create(&descs[i], NULL, &h), AK_OK);
+        if (r && h) {
+            const ak_raster_camera cam = ak_raster_camera_perspective(ak_vec3_make(0, 1, 4), ak_vec3_make(0, 0, 0),
+                                                                      0.8f, (float)descs[i].width / (float)descs[i].height,
+                                                                      0.1f, 50.0f);
+            const ak_vec3 tri[3] = {{-1, 0, 0}, {1, 0, 0}, {0, 1.5f, 0}};
+            const ak_raster_mesh m = {.positions = {tri, 3}};
+            ak_raster_clear(r, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+            ak_raster_clear(h, ak_vec4_make(0, 0, 0, 1), ak_vec4_make(0, 0, 0, 1));
+            AK_CHECK_EQ(ak_raster_draw_mesh(r, &cam, &m), AK_OK);
+            AK_CHECK_EQ(ak_raster_draw_mesh(h, &cam, &m), AK_OK);
+            const size_t ss = descs[i].supersample ? (size_t)descs[i].supersample : 1u; /* samples */
+            const size_t px = (size_t)descs[i].width * ss * (size_t)descs[i].height * ss;
+            uint8_t* a = malloc(px * 4);
+            uint8_t* c = malloc(px * 4);
+            AK_CHECK_EQ(ak_raster_read_samples(r, (ak_u8_span){a, px * 4}, (ak_f32_span){0}), AK_OK);
+            AK_CHECK_EQ(ak_raster_read_samples(h, (ak_u8_span){c, px * 4}, (ak_f32_span){0}), AK_OK);
+            AK_CHECK(memcmp(a, c, px * 4) == 0);
+            free(a);
+            free(c);
+        }
+        ak_raster_destroy(r);
+        ak_raster_destroy(h);
+        free(b.mem);
+    }
+    const ak_raster_desc bad[3] = {{.width = 0, .height = 8}, {.width = 8, .height = 9000}, {.width = 8, .height = 8, .supersample = 5}};
+    for (int i = 0; i < 3; ++i) AK_CHECK_EQ(ak_raster_memory_size(&bad[i]), 0u);
+    AK_CHECK_EQ(ak_raster_memory_size(NULL), 0u);
+}
+
 int main(void) {
+    AK_RUN(memory_size_is_the_allocation);
     AK_RUN(fill_rect_translucent_matches_closed_form);
     AK_RUN(coverage_matches_point_in_triangle);
     AK_RUN(shared_edges_quad_and_fan_cover_once);

@@ -60,7 +60,7 @@ static run_result run(const ak_scene* src, const ak_scene* dst, const int32_t* m
     ak_mat4 *ms = malloc(ns * sizeof *ms), *mt = malloc(nt * sizeof *mt);
     ak_mat4* mt_rest = malloc(nt * sizeof *mt_rest);
     ak_skeleton_local_to_model(ts, ak_skeleton_rest_pose(ts), (ak_mat4_span){mt_rest, nt});
-    ak_i16_cspan tp = ak_skeleton_parents(ts);
+    ak_i32_cspan tp = ak_skeleton_parents(ts);
     /* source contact detection (same rule and thresholds as documented, in double) */
     size_t nf = st->frame_count;
     double* sy = malloc(2 * nf * sizeof(double));

@@ -64,13 +64,13 @@ static float limit_excess(const ak_skeleton* sk, size_t i, ak_transform local) {
  * its children's rest offsets, in the joint's rest frame, against the same turned by the local
  * rotation relative to rest (the skeleton's measure). -1 for a joint that is not coned. */
 static float cone_swing_deg(const ak_skeleton* sk, size_t i, ak_transform local) {
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_transform_cspan rest = ak_skeleton_rest_pose(sk);
     if (parents.ptr[i] < 0 || ak_skeleton_joint_type(sk, i) != AK_JOINT_FREE) return -1.0f;
     ak_vec3 dir = ak_vec3_zero();
     bool kids = false;
     for (size_t c = i + 1; c < parents.count; ++c)
-        if (parents.ptr[c] == (int16_t)i)
+        if (parents.ptr[c] == (int32_t)i)
             dir = ak_vec3_add(dir, rest.ptr[c].translation), kids = true;
     if (!kids) return -1.0f;
     dir = ak_vec3_length_sq(dir) > 1e-12f ? ak_vec3_normalize(dir) : ak_vec3_make(0, 1, 0);
@@ -341,7 +341,7 @@ static track_result track(float compliance, float damping, float kick, int frame
     const ak_clip* clip = scene->clip_count ? scene->clips[0] : NULL;
     size_t n = ak_skeleton_joint_count(sk), nb = ak_rigid_ragdoll_body_count(sk),
            nj = ak_rigid_ragdoll_joint_count(sk);
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_transform* pose = malloc(n * sizeof *pose);
     ak_transform* prev = malloc(n * sizeof *prev);
     ak_transform* back = malloc(n * sizeof *back);

@@ -114,7 +114,7 @@ AK_TEST(create_and_query) {
     AK_CHECK_EQ(ak_skeleton_joint_type(sk, 0), AK_JOINT_FREE);
     AK_CHECK_EQ(ak_skeleton_child_count(sk, 0), 2);
     AK_CHECK_EQ(ak_skeleton_child_count(sk, 2), 0);
-    ak_i16_cspan par = ak_skeleton_parents(sk);
+    ak_i32_cspan par = ak_skeleton_parents(sk);
     AK_CHECK_EQ(par.count, 4);
     AK_CHECK(par.ptr[0] == -1 && par.ptr[1] == 0 && par.ptr[2] == 1 && par.ptr[3] == 0);
     /* Resolved default axes: hinge (1,0,0), ball (0,1,0). */

@@ -1413,10 +1413,10 @@ AK_TEST(heat_weights_do_not_bleed_between_legs) {
                   1e-5);
     ak_vec3 joints[7] = {{0, 0.9f, 0},     {-0.15f, 0.8f, 0}, {-0.15f, 0.4f, 0}, {-0.15f, 0.05f, 0},
                          {0.15f, 0.8f, 0}, {0.15f, 0.4f, 0},  {0.15f, 0.05f, 0}};
-    int16_t parents[7] = {-1, 0, 1, 2, 0, 4, 5};
+    int32_t parents[7] = {-1, 0, 1, 2, 0, 4, 5};
     ak_skin_bone bones[14];
     size_t bone_count = 0;
-    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){joints, 7}, (ak_i16_cspan){parents, 7},
+    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){joints, 7}, (ak_i32_cspan){parents, 7},
                                           false, (ak_skin_bone_span){bones, 14}, &bone_count),
                 AK_OK);
     AK_CHECK_EQ(bone_count, 8); /* pelvis->2 hips, hip->knee, knee->ankle, two point ankles */
@@ -1721,26 +1721,26 @@ AK_TEST(weights_format_round_trip) {
 
 AK_TEST(bones_from_joints) {
     ak_vec3 jp[4] = {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}, {1, 1, 0}};
-    int16_t parents[4] = {-1, 0, 1, 1};
+    int32_t parents[4] = {-1, 0, 1, 1};
     ak_skin_bone b[8];
     size_t count = 0;
     AK_CHECK_EQ(ak_skin_bones_from_joints_bound(4), 8);
-    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, 4}, (ak_i16_cspan){parents, 4}, true,
+    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, 4}, (ak_i32_cspan){parents, 4}, true,
                                           (ak_skin_bone_span){b, 8}, &count),
                 AK_OK);
     AK_CHECK_EQ(count, 3); /* 0->1, 1->2, 1->3; leaves skipped */
     AK_CHECK(b[0].joint_index == 0 && b[1].joint_index == 1 && b[2].joint_index == 1);
     AK_CHECK(b[2].tail.x == 1.0f);
-    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, 4}, (ak_i16_cspan){parents, 4}, false,
+    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, 4}, (ak_i32_cspan){parents, 4}, false,
                                           (ak_skin_bone_span){b, 8}, &count),
                 AK_OK);
     AK_CHECK_EQ(count, 5);
     parents[2] = 3;
-    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, 4}, (ak_i16_cspan){parents, 4}, false,
+    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, 4}, (ak_i32_cspan){parents, 4}, false,
                                           (ak_skin_bone_span){b, 8}, &count),
                 AK_ERR_BAD_HIERARCHY);
     parents[2] = 1;
-    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, 4}, (ak_i16_cspan){parents, 4}, false,
+    AK_CHECK_EQ(ak_skin_bones_from_joints((ak_vec3_cspan){jp, 4}, (ak_i32_cspan){parents, 4}, false,
                                           (ak_skin_bone_span){b, 4}, &count),
                 AK_ERR_SPAN_SMALL);
 }

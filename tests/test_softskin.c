@@ -30,16 +30,16 @@ static bool rig_load(rig* g, uint32_t rings, uint32_t segments) {
     if (g->joints > 8 || g->slots > 8) return false;
     /* bones from the skin's bind positions: slot k -> child slot, point bones for leaves */
     ak_vec3 pos[8];
-    int16_t parent[8];
-    ak_i16_cspan par = ak_skeleton_parents(g->scene->skeleton);
+    int32_t parent[8];
+    ak_i32_cspan par = ak_skeleton_parents(g->scene->skeleton);
     for (size_t k = 0; k < g->slots; ++k) {
         pos[k] = ak_mat4_get_translation(ak_mat4_inverse_affine(sk->inverse_binds[k]));
         parent[k] = -1;
         int pj = par.ptr[sk->joints[k]];
         for (size_t q = 0; q < g->slots; ++q)
-            if (sk->joints[q] == pj) parent[k] = (int16_t)q;
+            if (sk->joints[q] == pj) parent[k] = (int32_t)q;
     }
-    if (ak_skin_bones_from_joints((ak_vec3_cspan){pos, g->slots}, (ak_i16_cspan){parent, g->slots}, false,
+    if (ak_skin_bones_from_joints((ak_vec3_cspan){pos, g->slots}, (ak_i32_cspan){parent, g->slots}, false,
                                   (ak_skin_bone_span){g->bones, 16}, &g->bone_count) != AK_OK)
         return false;
     rig_pose(g, ak_quat_identity()); /* twice: the previous palette is the bind pose too */
@@ -399,7 +399,7 @@ typedef struct cman {
     size_t mi, nv, nj, ns, nb;
     ak_skin_bone* bones;
     ak_vec3* jp;    /* [slot] bind positions of the joints */
-    int16_t* par;   /* [slot] nearest ancestor slot */
+    int32_t* par;   /* [slot] nearest ancestor slot */
     float diag;
 } cman;
 
@@ -420,22 +420,22 @@ static bool cman_read(cman* c, const char* path) {
     /* bones: slot -> nearest ancestor slot (point bones for leaves) */
     c->bones = calloc(2 * c->ns + 1, sizeof(ak_skin_bone));
     c->jp = calloc(c->ns, sizeof(ak_vec3));
-    c->par = calloc(c->ns, sizeof(int16_t));
+    c->par = calloc(c->ns, sizeof(int32_t));
     if (!c->bones || !c->jp || !c->par) return false;
-    ak_i16_cspan sp = ak_skeleton_parents(sc->skeleton);
+    ak_i32_cspan sp = ak_skeleton_parents(sc->skeleton);
     bool ordered = true; /* ak_skin_bones_from_joints wants parents first: CesiumMan's are */
     for (size_t k = 0; k < c->ns; ++k) {
         c->jp[k] = ak_mat4_get_translation(ak_mat4_inverse_affine(sk->inverse_binds[k]));
         c->par[k] = -1;
         for (int j = sp.ptr[sk->joints[k]]; j >= 0 && c->par[k] < 0; j = sp.ptr[j])
             for (size_t q = 0; q < c->ns; ++q)
-                if (sk->joints[q] == j) c->par[k] = (int16_t)q;
-        ordered = ordered && c->par[k] < (int16_t)k;
+                if (sk->joints[q] == j) c->par[k] = (int32_t)q;
+        ordered = ordered && c->par[k] < (int32_t)k;
     }
     ak_vec3 lo, hi;
     ak_mesh_bounds(c->m, &lo, &hi);
     c->diag = ak_vec3_distance(lo, hi);
-    return ordered && ak_skin_bones_from_joints((ak_vec3_cspan){c->jp, c->ns}, (ak_i16_cspan){c->par, c->ns}, false,
+    return ordered && ak_skin_bones_from_joints((ak_vec3_cspan){c->jp, c->ns}, (ak_i32_cspan){c->par, c->ns}, false,
                                                 (ak_skin_bone_span){c->bones, 2 * c->ns + 1}, &c->nb) == AK_OK;
 }
 

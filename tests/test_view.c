@@ -207,7 +207,7 @@ AK_TEST(scene_render_skeleton_and_gif) {
     ak_vec3 tri[3] = {{-0.5f, 0, 0}, {0.5f, 0, 0}, {0, 1, 0}};
     ak_raster_mesh m = {.positions = {tri, 3}};
     ak_mat4 joints[2] = {ak_mat4_translation(ak_vec3_make(0, 0.2f, 0.3f)), ak_mat4_translation(ak_vec3_make(0, 0.9f, 0.3f))};
-    int16_t parents[2] = {-1, 0};
+    int32_t parents[2] = {-1, 0};
     ak_view_skeleton sk = {.joint_model = {joints, 2}, .parents = {parents, 2}, .joint_color = {1, 0, 1, 1}};
     ak_view_scene scene = {.meshes = &m, .mesh_count = 1, .skeleton = &sk, .title = "t"};
     ak_vec3 lo, hi;
@@ -233,11 +233,11 @@ AK_TEST(scene_render_skeleton_and_gif) {
     AK_CHECK_EQ(h, H);
     AK_CHECK_EQ(n, 3);
     AK_CHECK_EQ(ak_view_frames_write_gif("view_frames.gif", frames, 0, 5), AK_ERR_EMPTY);
-    int16_t bad_parents[2] = {-1, 5};
-    sk.parents = (ak_i16_cspan){bad_parents, 2};
+    int32_t bad_parents[2] = {-1, 5};
+    sk.parents = (ak_i32_cspan){bad_parents, 2};
     ak_raster_camera cam = ak_view_orbit_camera(lo, hi, NULL);
     AK_CHECK_EQ(ak_view_draw_skeleton(r, &cam, &sk), AK_ERR_BAD_INDEX);
-    sk.parents = (ak_i16_cspan){parents, 1};
+    sk.parents = (ak_i32_cspan){parents, 1};
     AK_CHECK_EQ(ak_view_draw_skeleton(r, &cam, &sk), AK_ERR_BAD_ARG);
     AK_CHECK_EQ(ak_view_render(r, &cam, NULL, &frames[0]), AK_ERR_NULL_ARG);
     ak_view_skeleton zero_sk = {0};

@@ -329,7 +329,7 @@ AK_API ak_result ak_clip_bake(const ak_clip_bake_desc* desc, const ak_allocator*
 
 /* What ak_clip_reduce measures the error against. */
 typedef struct ak_clip_reduce_desc {
-    const int16_t* parents;       /* required: [ak_clip_joint_count] parent of each joint, -1 for
+    const int32_t* parents;       /* required: [ak_clip_joint_count] parent of each joint, -1 for
                                      a root, parents before children (ak_skeleton_parents) */
     ak_transform_cspan rest_pose; /* required: count >= ak_clip_joint_count; the local transform
                                      of joints and properties the clip does not animate */

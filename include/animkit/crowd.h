@@ -78,8 +78,9 @@
  * waypoints, obstacles) into one allocation; the built crowd is read-only and may be shared
  * by threads. The state (positions, velocities, waypoint indices) is caller-owned: the step
  * job reads the inputs, writes the outputs (which must not alias the inputs) and advances
- * each agent's waypoint index in place. The step never allocates (scratch comes from the
- * caller), except a VISION crowd's RASTER view (a render target per thread, each step);
+ * each agent's waypoint index in place. The step never allocates: scratch comes from the
+ * caller (a VISION crowd's RASTER view makes its render targets in it, about 0.5 MiB per
+ * thread, instead of allocating them every step as before 2026-11-29);
  * thread_count > 1 starts pthreads.
  */
 #ifndef ANIMKIT_CROWD_H
@@ -166,8 +167,8 @@ typedef struct ak_crowd_desc {
     float vision_fov;                    /* VISION: field of view, degrees; 0 -> 150; < 360
                                             (RASTER: < 180) */
     ak_crowd_view vision_view;           /* VISION: 0 -> RAYCAST; RASTER renders with raster.h
-                                            (one render target per thread, allocated by each
-                                            step: the RASTER step allocates, RAYCAST never) */
+                                            (one render target per thread, made in the step's
+                                            scratch: neither view allocates) */
     uint32_t vision_height;              /* VISION RASTER: image rows; 0 -> 8; <= 256 */
 } ak_crowd_desc;
 
@@ -625,16 +626,25 @@ typedef struct ak_crowd_bake_desc {
 /* Build an animated scene of the crowd (io.h's ak_io_save writes it as glTF): per agent a root
  * node "<name>_<i>" (translation and rotation keyed at every frame: the root matrix of
  * ak_crowd_character_root) holding a copy of the character's nodes ("<i>/<joint name>") with
- * their own skin and a copy of the character's meshes, and one clip "<name>" keying, for every
- * agent, the joint properties the walk clip animates at every frame (ak_crowd_character_pose;
- * LINEAR, rotations sign-continuous). The scene model owns one mesh per entry, so each agent
- * carries its own copy of the mesh (glTF itself would let agents share one mesh).
+ * their own skin, and one clip "<name>" keying, for every agent, the joint properties the walk
+ * clip animates at every frame (ak_crowd_character_pose; LINEAR, rotations sign-continuous).
+ * The character's meshes are copied once (agent 0's scene meshes own them) and every other
+ * agent's scene meshes are instances of them (shares_mesh, scene.h) with the agent's skin and
+ * colour, so ak_io_save writes the mesh data once. Agents: at most
+ * AK_SKELETON_MAX_JOINTS / (the character's joint count + 1) (55,188 for builtin:humanoid).
  * Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no agent or frame), AK_ERR_BAD_ARG (frame_time not
  * > 0 and finite), AK_ERR_BAD_DATA (a non-finite position), AK_ERR_UNSUPPORTED (more than
- * AK_SCENE_BAKE_MAX_FRAMES frames, more than 32767 nodes in all, or more bytes than
- * memory_budget: checked before allocating; diag gives the numbers), AK_ERR_NO_MEMORY. */
+ * AK_SCENE_BAKE_MAX_FRAMES frames, more than AK_SKELETON_MAX_JOINTS nodes in all, or more bytes
+ * than memory_budget (ak_crowd_bake_max_frames): checked before allocating; diag gives the
+ * numbers), AK_ERR_NO_MEMORY. */
 AK_API ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
                                      ak_diag* out_diag);
+
+/* The most frames ak_crowd_bake_scene takes for agent_count agents of gait's character within
+ * memory_budget (0 -> AK_SCENE_BAKE_DEFAULT_BUDGET) and AK_SCENE_BAKE_MAX_FRAMES, by the estimate
+ * it checks before allocating; 0 when not even one frame fits (or gait is NULL, or the agents'
+ * nodes pass AK_SKELETON_MAX_JOINTS). */
+AK_API size_t ak_crowd_bake_max_frames(const ak_crowd_gait* gait, size_t agent_count, size_t memory_budget);
 
 #ifdef __cplusplus
 }

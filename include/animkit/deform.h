@@ -220,7 +220,7 @@ AK_DEFINE_SPAN(jiggle_state, ak_jiggle_state)
 /* Step the jiggle joints by dt and write the model matrices with the jiggle applied. */
 typedef struct ak_jiggle_job {
     ak_jiggle_params params;      /* shared by every joint of the job */
-    ak_i16_cspan parents;         /* required, parent per skeleton joint (parent < index, -1 root) */
+    ak_i32_cspan parents;         /* required, parent per skeleton joint (parent < index, -1 root) */
     const ak_jiggle_joint* joints;/* required, joint_count entries, strictly increasing .joint */
     size_t joint_count;           /* required, > 0 */
     ak_jiggle_state_span states;  /* required, count >= joint_count, same order as joints */

@@ -58,7 +58,8 @@ extern "C" {
  * root_joint == effector_joint gives a one-joint chain. Needs out_joints.count >= the chain's
  * joint count (ak_skeleton_joint_count always suffices). Returns AK_ERR_NULL_ARG,
  * AK_ERR_BAD_INDEX (a joint out of range), AK_ERR_NOT_FOUND (root_joint is not an ancestor
- * of effector_joint), AK_ERR_SPAN_SMALL (*out_count then holds the size needed). */
+ * of effector_joint), AK_ERR_SPAN_SMALL (*out_count then holds the size needed),
+ * AK_ERR_UNSUPPORTED (effector_joint above 32767: chains hold int16 joint indices). */
 AK_API ak_result ak_ik_chain_build(const ak_skeleton* skeleton, int root_joint, int effector_joint,
                                    ak_i16_span out_joints, size_t* out_count);
 

@@ -185,7 +185,7 @@ AK_API ak_io_desc ak_io_desc_resolved(const ak_io_desc* desc);
  * inverse binds or key values), AK_ERR_BAD_WEIGHTS (a negative skin weight),
  * AK_ERR_BAD_HIERARCHY (node cycle or a node with two parents), AK_ERR_UNSORTED (sampler
  * times not strictly increasing), AK_ERR_DUPLICATE (two channels animate one node path),
- * AK_ERR_UNSUPPORTED (a required extension, glTF 1.x, more than 32767 nodes, a skin of more
+ * AK_ERR_UNSUPPORTED (a required extension, glTF 1.x, more than AK_SKELETON_MAX_JOINTS nodes, a skin of more
  * than 65535 joints, an animation with no usable channel, the memory budget exceeded, BVH
  * nesting deeper than AK_IO_BVH_MAX_DEPTH or Assimp input nested deeper than
  * AK_IO_ASSIMP_MAX_DEPTH), AK_ERR_NOT_FOUND (Assimp: a bone

@@ -164,6 +164,10 @@ AK_API ak_raster_desc ak_raster_desc_resolved(const ak_raster_desc* desc);
  * Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (a field out of range), AK_ERR_NO_MEMORY;
  * *out_raster is NULL on failure. */
 AK_API ak_result ak_raster_create(const ak_raster_desc* desc, const ak_allocator* alloc, ak_raster** out_raster);
+/* The bytes of that one allocation for desc (what ak_raster_create asks alloc for: callers
+ * that create targets from their own scratch, through an allocator over it); 0 when desc is
+ * NULL or a field is out of range. */
+AK_API size_t ak_raster_memory_size(const ak_raster_desc* desc);
 /* Free a target; NULL is a no-op. */
 AK_API void ak_raster_destroy(ak_raster* raster);
 /* The resolved desc the target was created with (zeros if raster is NULL). */

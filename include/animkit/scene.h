@@ -84,9 +84,11 @@ typedef struct ak_scene_texture {
     ak_texture_filter mag_filter, min_filter;
 } ak_scene_texture;
 
-/* One mesh (one glTF primitive) placed in the scene. */
+/* One mesh (one glTF primitive) placed in the scene. Several entries may place one mesh
+ * (instances: each with its own node, skin and material): the first entry with that pointer
+ * owns it, the later ones set shares_mesh. ak_io_save writes an instanced mesh's data once. */
 typedef struct ak_scene_mesh {
-    ak_mesh* mesh; /* owned; mesh->joints index skin slots */
+    ak_mesh* mesh; /* owned (unless shares_mesh); mesh->joints index skin slots */
     int32_t node;  /* skeleton joint carrying the mesh, -1 -> identity */
     int32_t skin;  /* index into scene->skins, -1 -> unskinned */
     bool has_material;  /* glTF: the primitive names a material; false -> none */
@@ -95,6 +97,8 @@ typedef struct ak_scene_mesh {
     int32_t texture;    /* base colour texture: index into scene->textures (its texels are
                            multiplied by base_color; texture coordinates are the mesh's uvs),
                            -1 -> none (ak_scene_alloc sets -1) */
+    bool shares_mesh;   /* true: mesh is an earlier entry's (the same pointer), which owns it;
+                           ak_scene_destroy frees only the owner's. false: this entry owns it */
 } ak_scene_mesh;
 
 typedef struct ak_scene {

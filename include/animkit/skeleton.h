@@ -68,9 +68,12 @@ typedef struct ak_joint_desc {
     ak_joint_limits limits; /* used by the type; zero -> unlimited */
 } ak_joint_desc;
 
+/* The most joints a skeleton holds (parent indices are int32; 2^20 = 1,048,576). */
+#define AK_SKELETON_MAX_JOINTS 1048576u
+
 typedef struct ak_skeleton_desc {
     const ak_joint_desc* joints; /* required, parents before children */
-    size_t joint_count;          /* required, 1 .. 32767 */
+    size_t joint_count;          /* required, 1 .. AK_SKELETON_MAX_JOINTS */
     const char* name;            /* NULL -> "" */
     bool palette_from_skins;     /* true: meshes bound to this skeleton index the slots of
                                     their own skins, not skeleton joints (every scene loaded
@@ -106,7 +109,7 @@ AK_API ak_result ak_skeleton_reorder(ak_i32_cspan parents, ak_i32_span out_order
 /* Number of joints (0 for NULL). */
 AK_API size_t ak_skeleton_joint_count(const ak_skeleton* skeleton);
 /* Parent index per joint (parent[i] < i, -1 for roots); empty span for NULL. */
-AK_API ak_i16_cspan ak_skeleton_parents(const ak_skeleton* skeleton);
+AK_API ak_i32_cspan ak_skeleton_parents(const ak_skeleton* skeleton);
 /* Rest (bind) local transform per joint; empty span for NULL. */
 AK_API ak_transform_cspan ak_skeleton_rest_pose(const ak_skeleton* skeleton);
 /* Model-space inverse bind matrix per joint; empty span for NULL. */

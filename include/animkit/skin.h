@@ -82,7 +82,7 @@ AK_API size_t ak_skin_bones_from_joints_bound(size_t joint_count);
  * Needs parents.count >= joint_positions.count, out_bones.count >= the bound above.
  * Returns AK_ERR_NULL_ARG, AK_ERR_EMPTY (no joints), AK_ERR_BAD_ARG (more than 65535 joints),
  * AK_ERR_BAD_HIERARCHY (parent >= own index or < -1), AK_ERR_SPAN_SMALL. */
-AK_API ak_result ak_skin_bones_from_joints(ak_vec3_cspan joint_positions, ak_i16_cspan parents,
+AK_API ak_result ak_skin_bones_from_joints(ak_vec3_cspan joint_positions, ak_i32_cspan parents,
                                            bool skip_leaf_joints, ak_skin_bone_span out_bones,
                                            size_t* out_bone_count);
 

@@ -90,7 +90,7 @@ AK_API ak_raster_mesh ak_view_raster_mesh(const ak_mesh* mesh);
 
 typedef struct ak_view_skeleton {
     ak_mat4_cspan joint_model; /* required; model-space joint matrices (translation = position) */
-    ak_i16_cspan parents;      /* required; parent per joint, -1 for roots; count == joint_model.count */
+    ak_i32_cspan parents;      /* required; parent per joint, -1 for roots; count == joint_model.count */
     const ak_mat4* model;      /* model -> world; NULL -> identity */
     ak_vec4 bone_color;        /* sRGB; zero -> near white (0.97, 0.97, 1.0), with a dark halo */
     ak_vec4 joint_color;       /* sRGB; zero -> (1.0, 0.78, 0.18, 1) */

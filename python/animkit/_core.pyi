@@ -108,7 +108,7 @@ class Scene:
     def joint_names(self) -> List[str]:
         """Names of the skeleton's joints, parents first."""
     @property
-    def parents(self) -> npt.NDArray[np.int16]:
+    def parents(self) -> npt.NDArray[np.int32]:
         """Parent index per joint, -1 for roots (read-only view)."""
     @property
     def clip_names(self) -> List[str]: ...

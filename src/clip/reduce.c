@@ -88,7 +88,7 @@ static void simplify(const akp_clip_channel* ch, double tol, double radius, uint
 }
 
 /* Model matrices of pose by parents (parents before children). */
-static void pose_fk(const int16_t* parents, const ak_transform* pose, size_t n, ak_mat4* out) {
+static void pose_fk(const int32_t* parents, const ak_transform* pose, size_t n, ak_mat4* out) {
     for (size_t i = 0; i < n; ++i) {
         ak_mat4 m = ak_transform_to_mat4(pose[i]);
         out[i] = parents[i] >= 0 ? ak_mat4_mul(out[parents[i]], m) : m;
@@ -160,7 +160,7 @@ ak_result ak_clip_reduce(const ak_clip* clip, const ak_clip_reduce_desc* desc, c
         }
     }
     for (size_t j = 0; j < n; ++j) {
-        if (d.parents[j] >= (int16_t)j || d.parents[j] < -1) {
+        if (d.parents[j] >= (int32_t)j || d.parents[j] < -1) {
             akp_diag_set(diag, NULL, "joint %zu has parent %d (parents must come first)", j, (int)d.parents[j]);
             return AK_ERR_BAD_INDEX;
         }

@@ -27,7 +27,7 @@ static float smoothstep01(float x) {
 }
 
 /* Model transform of joint j: its ancestors' locals composed (at most joint-count levels). */
-static ak_transform model_of(ak_i16_cspan parents, const ak_transform* local, int j) {
+static ak_transform model_of(ak_i32_cspan parents, const ak_transform* local, int j) {
     ak_transform m = local[j];
     size_t guard = parents.count;
     for (int p = parents.ptr[j]; p >= 0 && (size_t)p < parents.count && guard-- > 0; p = parents.ptr[p])
@@ -43,7 +43,7 @@ static ak_quat root_rotation(const ak_crowd_gait* g, const ak_crowd_character* c
 }
 
 /* The leg of foot f: hip, knee, ankle joints; false when the foot has no grandparent. */
-static bool leg_of(const ak_crowd_gait* g, ak_i16_cspan parents, int f, int leg[3]) {
+static bool leg_of(const ak_crowd_gait* g, ak_i32_cspan parents, int f, int leg[3]) {
     const int a = g->feet[f];
     if (a < 0 || (size_t)a >= parents.count) return false;
     const int k = parents.ptr[a];
@@ -233,7 +233,7 @@ size_t ak_crowd_characters_scratch_size(const ak_crowd_gait* gait) {
 static void plant_feet(const ak_crowd_gait* g, ak_crowd_character* c, ak_vec2 p, float dt, ak_transform* local) {
     const ak_skeleton* sk = g->scene->skeleton;
     const size_t J = ak_skeleton_joint_count(sk);
-    const ak_i16_cspan parents = ak_skeleton_parents(sk);
+    const ak_i32_cspan parents = ak_skeleton_parents(sk);
     if (ak_crowd_character_pose(g, c, (ak_transform_span){local, J}) != AK_OK) return;
     const ak_quat q = root_rotation(g, c);
     for (int f = 0; f < 2; ++f) {
@@ -392,7 +392,7 @@ ak_result ak_crowd_character_pose_planted(const ak_crowd_gait* gait, const ak_cr
         any |= character->foot_state[f] != AK_CROWD_FOOT_FREE && character->foot_weight[f] > 0.0f;
     if (!any || !ak_finitef(p.x) || !ak_finitef(p.y)) return AK_OK;
     const ak_skeleton* sk = gait->scene->skeleton;
-    const ak_i16_cspan parents = ak_skeleton_parents(sk);
+    const ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_transform* local = out_local.ptr;
     const ak_quat q = root_rotation(gait, character);
     int legs[2][3];
@@ -462,6 +462,51 @@ ak_mat4 ak_crowd_character_root(const ak_crowd_gait* gait, const ak_crowd_charac
 
 /* ---- baking the crowd into a scene -------------------------------------------------------- */
 
+/* The walk clip's joint channels (translation, rotation, scale of the character's joints):
+ * each becomes one channel per agent. */
+static size_t bake_clip_channels(const ak_crowd_gait* g) {
+    const ak_clip* clip = g->scene->clips[g->clip_index];
+    const size_t J = ak_scene_joint_count(g->scene);
+    size_t cc = 0;
+    for (size_t c = 0; c < ak_clip_channel_count(clip); ++c) {
+        const ak_channel_target t = ak_clip_channel_target(clip, c);
+        if ((t == AK_CHANNEL_TRANSLATION || t == AK_CHANNEL_ROTATION || t == AK_CHANNEL_SCALE) &&
+            ak_clip_channel_index(clip, c) < J)
+            ++cc;
+    }
+    return cc;
+}
+
+/* Bytes a bake takes, estimated before allocating: the character's meshes (once: the agents
+ * share them), per agent its nodes (the joint descs and the skeleton: 256 bytes a node) and
+ * skin, and per agent, channel and frame a raw key and a built one (16 bytes each). */
+static void bake_bytes(const ak_crowd_gait* g, size_t N, double* out_fixed, double* out_per_frame) {
+    const ak_scene* cs = g->scene;
+    const size_t J = ak_scene_joint_count(cs);
+    double mesh = 0.0, skin = 0.0;
+    for (size_t m = 0; m < cs->mesh_count; ++m) {
+        const ak_mesh* me = cs->meshes[m].mesh;
+        if (!me) continue;
+        mesh += (double)me->vertex_count * (80.0 + 6.0 * me->influence_count) + 12.0 * (double)me->triangle_count +
+                40.0 * (double)me->vertex_count * (double)me->morph_target_count;
+    }
+    for (size_t s = 0; s < cs->skin_count; ++s) skin += 68.0 * (double)cs->skins[s].joint_count;
+    *out_fixed = mesh + (double)N * ((double)(J + 1) * 256.0 + skin + 128.0 * (double)cs->mesh_count);
+    *out_per_frame = 2.0 * (double)N * (double)(2 + bake_clip_channels(g)) * 16.0;
+}
+
+size_t ak_crowd_bake_max_frames(const ak_crowd_gait* gait, size_t agent_count, size_t memory_budget) {
+    if (!gait || !gait->scene || !gait->scene->skeleton || agent_count == 0) return 0;
+    const size_t J = ak_scene_joint_count(gait->scene);
+    if ((double)agent_count * (double)(J + 1) > (double)AK_SKELETON_MAX_JOINTS) return 0;
+    double fixed, per_frame;
+    bake_bytes(gait, agent_count, &fixed, &per_frame);
+    const double budget = (double)(memory_budget ? memory_budget : AK_SCENE_BAKE_DEFAULT_BUDGET);
+    if (fixed + per_frame > budget) return 0;
+    const double f = floor((budget - fixed) / per_frame);
+    return f >= (double)AK_SCENE_BAKE_MAX_FRAMES ? AK_SCENE_BAKE_MAX_FRAMES : (size_t)f;
+}
+
 ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator* alloc, ak_scene** out_scene,
                               ak_diag* out_diag) {
     if (out_scene) *out_scene = NULL;
@@ -488,8 +533,8 @@ ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator
     const ak_crowd_gait* g = desc->gait;
     const ak_scene* cs = g->scene;
     const size_t J = ak_scene_joint_count(cs);
-    if ((double)N * (double)(J + 1) > 32767.0) {
-        akp_diag_set(out_diag, name, "%zu agents x %zu nodes: more than 32767 nodes", N, J + 1);
+    if ((double)N * (double)(J + 1) > (double)AK_SKELETON_MAX_JOINTS) {
+        akp_diag_set(out_diag, name, "%zu agents x %zu nodes: more than %u nodes", N, J + 1, AK_SKELETON_MAX_JOINTS);
         return AK_ERR_UNSUPPORTED;
     }
     for (size_t k = 0; k < N * F; ++k)
@@ -500,24 +545,11 @@ ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator
         }
     /* The walk clip's joint channels: each becomes one channel per agent. */
     const ak_clip* clip = cs->clips[g->clip_index];
-    size_t cc = 0;
-    for (size_t c = 0; c < ak_clip_channel_count(clip); ++c) {
-        const ak_channel_target t = ak_clip_channel_target(clip, c);
-        if ((t == AK_CHANNEL_TRANSLATION || t == AK_CHANNEL_ROTATION || t == AK_CHANNEL_SCALE) &&
-            ak_clip_channel_index(clip, c) < J)
-            ++cc;
-    }
-    const size_t per_agent = 2 + cc; /* root translation and rotation, then the clip's */
-    /* Bytes, estimated before allocating: the meshes, the raw keys and the built clip. */
-    double bytes = 0.0;
-    for (size_t m = 0; m < cs->mesh_count; ++m) {
-        const ak_mesh* me = cs->meshes[m].mesh;
-        if (!me) continue;
-        bytes += (double)me->vertex_count * (80.0 + 6.0 * me->influence_count) + 12.0 * (double)me->triangle_count +
-                 40.0 * (double)me->vertex_count * (double)me->morph_target_count;
-    }
-    bytes *= (double)N;
-    bytes += 2.0 * (double)N * (double)per_agent * (double)F * 16.0 + (double)N * (double)J * 256.0;
+    const size_t per_agent = 2 + bake_clip_channels(g); /* root translation and rotation, then the clip's */
+    /* Bytes, estimated before allocating: the meshes, the nodes, the raw keys and the built clip. */
+    double fixed, per_frame;
+    bake_bytes(g, N, &fixed, &per_frame);
+    const double bytes = fixed + per_frame * (double)F;
     const size_t budget = desc->memory_budget ? desc->memory_budget : AK_SCENE_BAKE_DEFAULT_BUDGET;
     if (bytes > (double)budget) {
         akp_diag_set(out_diag, name, "%zu agents x %zu frames need about %.0f MB, more than the budget of %.0f MB", N,
@@ -542,7 +574,7 @@ ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator
         goto done;
     }
     /* nodes: per agent its root, then the character's nodes */
-    const ak_i16_cspan parents = ak_skeleton_parents(cs->skeleton);
+    const ak_i32_cspan parents = ak_skeleton_parents(cs->skeleton);
     for (size_t a = 0; a < N; ++a) {
         const size_t base = a * (J + 1);
         const ak_crowd_character* c0 = &desc->characters[a];
@@ -594,9 +626,12 @@ ak_result ak_crowd_bake_scene(const ak_crowd_bake_desc* desc, const ak_allocator
                 to->has_material = true;
                 to->base_color = desc->colors[a];
             }
-            if (from->mesh) {
+            if (from->mesh && a == 0) { /* agent 0 owns the copy, the others place it */
                 res = ak_mesh_clone(from->mesh, &sc->alloc, &to->mesh);
-                if (res == AK_OK) snprintf(to->mesh->name, sizeof to->mesh->name, "%zu/%.40s", a, from->mesh->name);
+                if (res == AK_OK) snprintf(to->mesh->name, sizeof to->mesh->name, "%.40s", from->mesh->name);
+            } else if (from->mesh) {
+                to->mesh = sc->meshes[m].mesh;
+                to->shares_mesh = true;
             }
         }
     }

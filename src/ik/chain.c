@@ -12,7 +12,7 @@
 
 /* Model transform of joint j's parent (identity for a root): walk up, composing on the left. */
 static ak_transform parent_model(const ak_skeleton* sk, const ak_transform* pose, int j) {
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_transform acc = ak_transform_identity();
     for (int p = parents.ptr[j]; p >= 0; p = parents.ptr[p]) acc = ak_transform_mul(pose[p], acc);
     return acc;
@@ -21,7 +21,7 @@ static ak_transform parent_model(const ak_skeleton* sk, const ak_transform* pose
 /* Index and hierarchy checks of a chain. */
 static ak_result check_chain(const ak_skeleton* sk, ak_i16_cspan chain) {
     const size_t n = ak_skeleton_joint_count(sk);
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     for (size_t k = 0; k < chain.count; ++k)
         if (chain.ptr[k] < 0 || (size_t)chain.ptr[k] >= n) return AK_ERR_BAD_INDEX;
     for (size_t k = 1; k < chain.count; ++k)
@@ -44,7 +44,7 @@ static double translation_l1(const ak_transform* t) {
  * model translations are bounded, in double, by sum_k |t_k|_1 prod_{j<k} max|s_j|
  * (rotations keep lengths); only when that passes 1e30 does the exact float FK decide. */
 static bool pose_chain_finite(const ak_skeleton* sk, const ak_transform* pose, ak_i16_cspan chain) {
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     double bound = 0.0, scale = 1.0;
     for (size_t k = chain.count; k-- > 0;) { /* bottom-up: the chain, then its ancestors */
         const ak_transform* t = &pose[chain.ptr[k]];
@@ -94,7 +94,7 @@ ak_result ak_ik_chain_build(const ak_skeleton* skeleton, int root_joint, int eff
     const size_t n = ak_skeleton_joint_count(skeleton);
     if (root_joint < 0 || effector_joint < 0 || (size_t)root_joint >= n || (size_t)effector_joint >= n)
         return AK_ERR_BAD_INDEX;
-    ak_i16_cspan parents = ak_skeleton_parents(skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(skeleton);
     size_t count = 1;
     int j = effector_joint;
     while (j != root_joint) {
@@ -105,6 +105,7 @@ ak_result ak_ik_chain_build(const ak_skeleton* skeleton, int root_joint, int eff
     *out_count = count;
     if (!out_joints.ptr) return AK_ERR_NULL_ARG;
     if (out_joints.count < count) return AK_ERR_SPAN_SMALL;
+    if (effector_joint > INT16_MAX) return AK_ERR_UNSUPPORTED; /* chains hold int16 joint indices */
     j = effector_joint;
     for (size_t k = count; k-- > 0;) {
         out_joints.ptr[k] = (int16_t)j;

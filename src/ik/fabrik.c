@@ -175,11 +175,11 @@ typedef struct tree_mem {
     ak_vec3* fwd;   /* forward-pass positions */
     ak_vec3* sum;   /* sub-base centroid accumulators */
     float* len;     /* bone length to the parent */
-    int16_t* count; /* proposals received (forward pass) */
-    int16_t* target; /* effector slot, or -1 */
-    int16_t* first_child;
-    int16_t* next_sibling;
-    int16_t* nodes; /* tree joints, ascending (parents first) */
+    int32_t* count; /* proposals received (forward pass) */
+    int32_t* target; /* effector slot, or -1 */
+    int32_t* first_child;
+    int32_t* next_sibling;
+    int32_t* nodes; /* tree joints, ascending (parents first) */
     ak_vec3* goal;  /* [effector count] targets in the solve's frame */
 } tree_mem;
 
@@ -195,11 +195,11 @@ static size_t tree_layout(size_t n, unsigned char* base, tree_mem* m) {
     AKP_CARVE(fwd, ak_vec3);
     AKP_CARVE(sum, ak_vec3);
     AKP_CARVE(len, float);
-    AKP_CARVE(count, int16_t);
-    AKP_CARVE(target, int16_t);
-    AKP_CARVE(first_child, int16_t);
-    AKP_CARVE(next_sibling, int16_t);
-    AKP_CARVE(nodes, int16_t);
+    AKP_CARVE(count, int32_t);
+    AKP_CARVE(target, int32_t);
+    AKP_CARVE(first_child, int32_t);
+    AKP_CARVE(next_sibling, int32_t);
+    AKP_CARVE(nodes, int32_t);
     AKP_CARVE(goal, ak_vec3);
 #undef AKP_CARVE
     return off;
@@ -216,7 +216,7 @@ ak_result ak_ik_fabrik_tree_validate(const ak_ik_fabrik_tree_job* job) {
     const size_t n = ak_skeleton_joint_count(job->skeleton);
     if (job->pose.count < n || job->targets.count < job->effectors.count) return AK_ERR_SPAN_SMALL;
     if (job->root_joint < 0 || (size_t)job->root_joint >= n) return AK_ERR_BAD_INDEX;
-    ak_i16_cspan parents = ak_skeleton_parents(job->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(job->skeleton);
     for (size_t k = 0; k < job->effectors.count; ++k)
         if (job->effectors.ptr[k] < 0 || (size_t)job->effectors.ptr[k] >= n) return AK_ERR_BAD_INDEX;
     for (size_t k = 0; k < job->effectors.count; ++k)
@@ -275,7 +275,7 @@ ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job) {
     if (res != AK_OK) return res;
     const ak_skeleton* sk = job->skeleton;
     const size_t n = ak_skeleton_joint_count(sk);
-    const int16_t* parents = ak_skeleton_parents(sk).ptr;
+    const int32_t* parents = ak_skeleton_parents(sk).ptr;
     ak_transform* pose = job->pose.ptr;
     const bool limits = !job->ignore_limits;
     const size_t max_iterations = job->max_iterations ? job->max_iterations : 50u;
@@ -290,17 +290,17 @@ ak_result ak_ik_fabrik_tree_run(const ak_ik_fabrik_tree_job* job) {
         m.first_child[j] = m.next_sibling[j] = -1;
     }
     for (size_t k = 0; k < job->effectors.count; ++k) {
-        m.target[job->effectors.ptr[k]] = (int16_t)k;
+        m.target[job->effectors.ptr[k]] = (int32_t)k;
         for (int j = job->effectors.ptr[k]; j != root; j = parents[j]) m.count[j] = 1;
     }
     m.count[root] = 1;
     size_t node_count = 0;
     for (size_t j = (size_t)root; j < n; ++j)
-        if (m.count[j]) m.nodes[node_count++] = (int16_t)j;
+        if (m.count[j]) m.nodes[node_count++] = (int32_t)j;
     for (size_t k = node_count; k-- > 1;) { /* children lists, in ascending order */
         int j = m.nodes[k], p = parents[j];
         m.next_sibling[j] = m.first_child[p];
-        m.first_child[p] = (int16_t)j;
+        m.first_child[p] = (int32_t)j;
     }
 
     /* Forward kinematics of the tree. */

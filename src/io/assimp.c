@@ -788,7 +788,7 @@ static void put_scene(as_wbuf* b, const ak_scene* s, const as_wbuf* clips) {
     wb_put(b, counts, sizeof counts);
     uint8_t has_is_joint = s->is_joint != NULL;
     wb_put(b, &has_is_joint, 1);
-    ak_i16_cspan parents = nj ? ak_skeleton_parents(s->skeleton) : (ak_i16_cspan){NULL, 0};
+    ak_i32_cspan parents = nj ? ak_skeleton_parents(s->skeleton) : (ak_i32_cspan){NULL, 0};
     ak_transform_cspan rest = nj ? ak_skeleton_rest_pose(s->skeleton) : (ak_transform_cspan){NULL, 0};
     ak_mat4_cspan ibind = nj ? ak_skeleton_inverse_binds(s->skeleton) : (ak_mat4_cspan){NULL, 0};
     for (size_t j = 0; j < nj; ++j) {

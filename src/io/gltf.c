@@ -1403,6 +1403,7 @@ static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* m
             /* Instances in node order; one uninstanced entry when no node uses the mesh. */
             bool any = false;
             size_t k = 0;
+            ak_mesh* plain = NULL; /* the instances' mesh with the default morph weights */
             for (size_t ni = 0; r == AK_OK && ni <= c->n_nodes; ++ni) {
                 int64_t nm = -1, ns = -1;
                 const cJSON* node = ni < c->n_nodes ? nodes->items[ni] : NULL;
@@ -1422,7 +1423,16 @@ static ak_result load_meshes(gl_ctx* c, const gl_table* nodes, const gl_table* m
                 if (ns >= 0 && !p.infl)
                     r = fail(c, AK_ERR_PARSE, "%s: nodes[%zu] has a skin but the primitive has no JOINTS_0/WEIGHTS_0",
                              where, ni);
-                if (r == AK_OK) r = make_mesh(c, &p, name, mj, where, &sm->mesh);
+                /* later instances share the first one's mesh, unless their node sets its own
+                 * morph weights (a mesh's default weights are the mesh's) */
+                const bool own_weights = node && p.targets && cJSON_GetObjectItemCaseSensitive(node, "weights");
+                if (r == AK_OK && plain && !own_weights) {
+                    sm->mesh = plain;
+                    sm->shares_mesh = true;
+                } else if (r == AK_OK) {
+                    r = make_mesh(c, &p, name, mj, where, &sm->mesh);
+                    if (r == AK_OK && !own_weights) plain = sm->mesh;
+                }
                 if (r == AK_OK && sm->texture >= 0 && !sm->mesh->uvs) {
                     char msg[240];
                     snprintf(msg, sizeof msg, "%s has a base colour texture but no TEXCOORD_0; drawn untextured", where);

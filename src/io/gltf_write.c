@@ -37,6 +37,14 @@ typedef struct w_ctx {
     int32_t* node_of_mesh; /* [mesh_count] glTF node carrying scene mesh m's glTF mesh, -1 none */
     int32_t* group_of_mesh; /* [mesh_count] first scene mesh of m's group (one glTF mesh) */
     size_t* morph_base; /* [mesh_count] first morph weight index of scene mesh m */
+    /* instanced meshes (one ak_mesh placed by several scene meshes): accessors written once */
+    int32_t* owner_of_mesh; /* [mesh_count] first scene mesh with m's ak_mesh pointer */
+    bool* instanced;        /* [mesh_count] that pointer is placed more than once */
+    int32_t* gltf_mesh_of;  /* [mesh_count] glTF mesh written for m, -1 not yet */
+    cJSON** prim_of_mesh;   /* [mesh_count] the primitive written for an instanced owner */
+    /* the last animation input written: channels keyed at the same times share it */
+    int last_times_accessor;
+    size_t last_times_offset, last_times_keys;
 } w_ctx;
 
 /* One morph-weight sampler as written: key times, values in glTF layout. */
@@ -215,7 +223,7 @@ static ak_result add_child(w_ctx* c, int32_t parent, size_t child) {
 static ak_result write_skeleton(w_ctx* c) {
     const ak_skeleton* sk = c->scene->skeleton;
     size_t n = sk ? ak_skeleton_joint_count(sk) : 0;
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_transform_cspan rest = ak_skeleton_rest_pose(sk);
     for (size_t j = 0; j < n; ++j) {
         cJSON* node = cJSON_CreateObject();
@@ -230,7 +238,8 @@ static ak_result write_skeleton(w_ctx* c) {
     return AK_OK;
 }
 
-/* A new node with identity transform for a mesh (a root unless parent >= 0). */
+/* A new node with identity transform for a mesh (a root unless parent >= 0), named
+ * "<mesh_name>_node". */
 static ak_result add_mesh_node(w_ctx* c, const char* mesh_name, int32_t parent, int32_t* out_node) {
     cJSON* node = cJSON_CreateObject();
     if (!push_node(c, node)) return oom(c);
@@ -369,6 +378,7 @@ static bool morph_equal(const w_morph* a, const w_morph* b, size_t tc) {
 static bool same_group(w_ctx* c, size_t a, size_t b, ak_result* err) {
     const ak_scene_mesh* ma = &c->scene->meshes[a];
     const ak_scene_mesh* mb = &c->scene->meshes[b];
+    if (c->instanced[a] || c->instanced[b]) return false; /* an instance is a glTF mesh of its own */
     if (ma->node != mb->node || ma->skin != mb->skin || ma->node < 0) return false;
     size_t tc = ma->mesh->morph_target_count;
     if (tc != mb->mesh->morph_target_count) return false;
@@ -631,8 +641,95 @@ static void group_name(const char* first, size_t members, char out[AK_NAME_SIZE]
     if (members > 1 && n > 2 && out[n - 1] == '0' && out[n - 2] == '_') out[n - 2] = '\0';
 }
 
+typedef struct mesh_ref {
+    uintptr_t ptr;
+    size_t index;
+} mesh_ref;
+
+static int mesh_ref_cmp(const void* a, const void* b) {
+    const mesh_ref *x = (const mesh_ref*)a, *y = (const mesh_ref*)b;
+    if (x->ptr != y->ptr) return x->ptr < y->ptr ? -1 : 1;
+    return x->index < y->index ? -1 : x->index > y->index;
+}
+
+/* owner_of_mesh and instanced: scene meshes that place the same ak_mesh, by sorting pointers
+ * (a scene may hold thousands of instances). */
+static ak_result find_instances(w_ctx* c) {
+    const ak_scene* s = c->scene;
+    const size_t n = s->mesh_count;
+    mesh_ref* refs = (mesh_ref*)malloc((n ? n : 1) * sizeof *refs);
+    if (!refs) return oom(c);
+    for (size_t m = 0; m < n; ++m) refs[m] = (mesh_ref){(uintptr_t)s->meshes[m].mesh, m};
+    qsort(refs, n, sizeof *refs, mesh_ref_cmp);
+    for (size_t i = 0; i < n;) {
+        size_t e = i + 1;
+        while (e < n && refs[e].ptr == refs[i].ptr) ++e;
+        for (size_t k = i; k < e; ++k) {
+            c->owner_of_mesh[refs[k].index] = (int32_t)refs[i].index;
+            c->instanced[refs[k].index] = e - i > 1;
+        }
+        i = e;
+    }
+    free(refs);
+    for (size_t m = 0; m < n; ++m)
+        if (s->meshes[m].shares_mesh && c->owner_of_mesh[m] == (int32_t)m)
+            return BAD(c, AK_ERR_BAD_DATA, "mesh %zu (%s) shares its mesh but no earlier entry places it", m,
+                       s->meshes[m].mesh->name);
+    return AK_OK;
+}
+
+static bool same_material(const ak_scene_mesh* a, const ak_scene_mesh* b) {
+    return a->has_material == b->has_material && a->texture == b->texture &&
+           (!a->has_material || !memcmp(&a->base_color, &b->base_color, sizeof a->base_color));
+}
+
+/* The material of scene mesh k's primitive (none, a colour, a texture). */
+static ak_result set_material(w_ctx* c, size_t k, cJSON* prim) {
+    const ak_scene* s = c->scene;
+    const ak_scene_mesh* sk = &s->meshes[k];
+    bool textured = sk->texture >= 0 && (size_t)sk->texture < s->texture_count && s->textures[sk->texture].pixels &&
+                    sk->mesh->uvs;
+    if (!sk->has_material && !textured) return AK_OK;
+    int ti = textured ? texture_index(c, (size_t)sk->texture) : -1;
+    int mi = textured && ti < 0 ? -1 : material_index(c, sk->has_material ? sk->base_color : ak_vec4_make(1, 1, 1, 1), ti);
+    if (mi < 0) return oom(c);
+    add_num(prim, "material", mi);
+    return AK_OK;
+}
+
+/* An instanced scene mesh m whose owner was written: the glTF mesh of an earlier instance
+ * with the same material, else a new glTF mesh whose primitive reads the owner's accessors. */
+static ak_result instance_mesh(w_ctx* c, size_t m, int* out_mesh) {
+    const ak_scene* s = c->scene;
+    const size_t owner = (size_t)c->owner_of_mesh[m];
+    for (size_t k = owner; k < m; ++k)
+        if (c->owner_of_mesh[k] == (int32_t)owner && c->gltf_mesh_of[k] >= 0 && same_material(&s->meshes[k], &s->meshes[m])) {
+            *out_mesh = c->gltf_mesh_of[k];
+            return AK_OK;
+        }
+    cJSON* prim = cJSON_Duplicate(c->prim_of_mesh[owner], true);
+    cJSON* gm = cJSON_CreateObject();
+    cJSON* prims = gm ? cJSON_AddArrayToObject(gm, "primitives") : NULL;
+    if (!prim || !prims || !cJSON_AddItemToArray(prims, prim) || !cJSON_AddItemToArray(c->meshes, gm)) {
+        cJSON_Delete(prim);
+        cJSON_Delete(gm);
+        return oom(c);
+    }
+    cJSON_DeleteItemFromObjectCaseSensitive(prim, "material");
+    cJSON_AddStringToObject(gm, "name", s->meshes[owner].mesh->name);
+    WTRY(set_material(c, m, prim));
+    const cJSON* w = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(c->meshes, c->gltf_mesh_of[owner]), "weights");
+    const cJSON* ex = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(c->meshes, c->gltf_mesh_of[owner]), "extras");
+    if ((w && !cJSON_AddItemToObject(gm, "weights", cJSON_Duplicate(w, true))) ||
+        (ex && !cJSON_AddItemToObject(gm, "extras", cJSON_Duplicate(ex, true))))
+        return oom(c);
+    *out_mesh = c->n_meshes++;
+    return AK_OK;
+}
+
 static ak_result write_meshes(w_ctx* c) {
     const ak_scene* s = c->scene;
+    WTRY(find_instances(c));
     size_t base = 0;
     for (size_t m = 0; m < s->mesh_count; ++m) {
         c->morph_base[m] = base;
@@ -641,7 +738,7 @@ static ak_result write_meshes(w_ctx* c) {
     }
     bool* used = (bool*)calloc(c->n_nodes ? c->n_nodes : 1, sizeof(bool));
     if (!used) return oom(c);
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     size_t n_joints = c->n_nodes;
     ak_result r = AK_OK;
     for (size_t m = 0; m < s->mesh_count && r == AK_OK;) {
@@ -657,9 +754,25 @@ static ak_result write_meshes(w_ctx* c) {
         bool skinned = sm->skin >= 0 && mesh->influence_count > 0;
         if (sm->node >= 0 && (size_t)sm->node < n_joints && !used[sm->node] && (!skinned || parents.ptr[sm->node] < 0))
             node = sm->node;
-        else if ((r = add_mesh_node(c, mesh->name, skinned ? -1 : sm->node, &node)) != AK_OK)
-            break;
+        else {
+            char nn[AK_NAME_SIZE]; /* instances: node names that tell them apart */
+            if (c->instanced[m]) snprintf(nn, sizeof nn, "%.40s_%zu", mesh->name[0] ? mesh->name : "mesh", m);
+            if ((r = add_mesh_node(c, c->instanced[m] ? nn : mesh->name, skinned ? -1 : sm->node, &node)) != AK_OK)
+                break;
+        }
         if ((size_t)node < n_joints) used[node] = true;
+        if (c->instanced[m] && c->owner_of_mesh[m] != (int32_t)m) { /* the owner's accessors */
+            int gi = -1;
+            if ((r = instance_mesh(c, m, &gi)) != AK_OK) break;
+            c->gltf_mesh_of[m] = gi;
+            c->node_of_mesh[m] = node;
+            c->group_of_mesh[m] = (int32_t)m;
+            cJSON* nj = node_at(c, node);
+            add_num(nj, "mesh", gi);
+            if (skinned) add_num(nj, "skin", sm->skin);
+            m = end;
+            continue;
+        }
         cJSON* gm = cJSON_CreateObject();
         cJSON* prims = gm ? cJSON_AddArrayToObject(gm, "primitives") : NULL;
         if (!prims || !cJSON_AddItemToArray(c->meshes, gm)) {
@@ -675,18 +788,11 @@ static ak_result write_meshes(w_ctx* c) {
             cJSON* prim = cJSON_CreateObject();
             if (!prim || !cJSON_AddItemToArray(prims, prim)) r = oom(c);
             else r = write_primitive(c, k, prim);
-            const ak_scene_mesh* sk = &s->meshes[k];
-            bool textured = sk->texture >= 0 && (size_t)sk->texture < s->texture_count &&
-                            s->textures[sk->texture].pixels && sk->mesh->uvs;
-            if (r == AK_OK && (sk->has_material || textured)) {
-                int ti = textured ? texture_index(c, (size_t)sk->texture) : -1;
-                int mi = textured && ti < 0 ? -1
-                                            : material_index(c, sk->has_material ? sk->base_color : ak_vec4_make(1, 1, 1, 1), ti);
-                if (mi < 0) r = oom(c);
-                else add_num(prim, "material", mi);
-            }
+            if (r == AK_OK) r = set_material(c, k, prim);
             c->node_of_mesh[k] = node;
             c->group_of_mesh[k] = (int32_t)m;
+            c->gltf_mesh_of[k] = c->n_meshes - 1;
+            c->prim_of_mesh[k] = prim;
         }
         if (r == AK_OK && mesh->morph_target_count) {
             cJSON* w = cJSON_AddArrayToObject(gm, "weights");
@@ -737,7 +843,13 @@ static ak_result write_skins(w_ctx* c) {
 static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t keys, const float* values,
                              size_t value_count, int comps, ak_interp interp, int* out_index) {
     cJSON* samplers = cJSON_GetObjectItemCaseSensitive(an, "samplers");
-    int in = add_accessor(c, times, keys, GL_FLOAT, 1, 0, true);
+    /* channels keyed at the same times (a baked crowd: all of them) share one input */
+    int in = c->last_times_accessor;
+    if (in < 0 || keys != c->last_times_keys || memcmp(c->bin + c->last_times_offset, times, keys * sizeof(float))) {
+        size_t offset = c->bin_size;
+        in = add_accessor(c, times, keys, GL_FLOAT, 1, 0, true);
+        c->last_times_accessor = in, c->last_times_offset = offset, c->last_times_keys = keys;
+    }
     int outa = add_accessor(c, values, value_count, GL_FLOAT, comps, 0, false);
     cJSON* sm = cJSON_CreateObject();
     if (in < 0 || outa < 0 || !sm || !cJSON_AddItemToArray(samplers, sm)) return oom(c);
@@ -919,6 +1031,13 @@ static ak_result build_document(w_ctx* c) {
     c->node_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
     c->group_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
     c->morph_base = (size_t*)calloc(mc, sizeof(size_t));
+    c->owner_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
+    c->instanced = (bool*)calloc(mc, sizeof(bool));
+    c->gltf_mesh_of = (int32_t*)malloc(mc * sizeof(int32_t));
+    c->prim_of_mesh = (cJSON**)calloc(mc, sizeof(cJSON*));
+    if (!c->owner_of_mesh || !c->instanced || !c->gltf_mesh_of || !c->prim_of_mesh) return oom(c);
+    for (size_t m = 0; m < mc; ++m) c->gltf_mesh_of[m] = -1;
+    c->last_times_accessor = -1;
     if (!c->nodes || !c->meshes || !c->skins || !c->animations || !c->views || !c->accessors || !c->materials ||
         !c->node_of_mesh || !c->group_of_mesh || !c->morph_base)
         return oom(c);
@@ -1066,5 +1185,9 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
     free(c.node_tab);
     free(c.group_of_mesh);
     free(c.morph_base);
+    free(c.owner_of_mesh);
+    free(c.instanced);
+    free(c.gltf_mesh_of);
+    free(c.prim_of_mesh);
     return r;
 }

@@ -8,8 +8,8 @@
 
 #include "../internal.h"
 
-/* Most nodes a file may have: the skeleton stores parents as int16. */
-#define AKP_IO_MAX_NODES 32767u
+/* Most nodes a file may have: the most joints a skeleton holds. */
+#define AKP_IO_MAX_NODES AK_SKELETON_MAX_JOINTS
 /* Most elements an accessor (or Assimp array) may declare; guards allocations against
  * absurd counts in corrupt files. */
 #define AKP_IO_MAX_ELEMENTS (1u << 26)

@@ -217,22 +217,42 @@ ak_raster_desc ak_raster_desc_resolved(const ak_raster_desc* desc) {
     return d;
 }
 
+/* The one allocation of a target: its parts' offsets and the total (false: desc out of range). */
+typedef struct raster_layout {
+    size_t off_color, off_depth, off_shadow, off_tmp, off_segs, nseg, total;
+} raster_layout;
+
+static bool raster_layout_of(const ak_raster_desc* d, raster_layout* L) {
+    if (d->width < 1 || d->width > 8192 || d->height < 1 || d->height > 8192) return false;
+    if (d->supersample < 1 || d->supersample > 4 || d->thread_count < 1 || d->thread_count > MAX_THREADS) return false;
+    size_t sw = (size_t)d->width * (size_t)d->supersample, sh = (size_t)d->height * (size_t)d->supersample;
+    L->off_color = akp_align16(sizeof(ak_raster));
+    L->off_depth = L->off_color + akp_align16(sw * sh * 4u);
+    L->off_shadow = L->off_depth + akp_align16(sw * sh * sizeof(float));
+    L->off_tmp = L->off_shadow + akp_align16((size_t)SHADOW_RES * SHADOW_RES * sizeof(float));
+    L->off_segs = L->off_tmp + akp_align16((size_t)SHADOW_RES * SHADOW_RES * sizeof(float));
+    L->nseg = d->thread_count > 1 ? (size_t)d->thread_count * SEG_CAP : 0;
+    L->total = L->off_segs + L->nseg * sizeof(rtri);
+    return true;
+}
+
+size_t ak_raster_memory_size(const ak_raster_desc* desc) {
+    if (!desc) return 0;
+    const ak_raster_desc d = ak_raster_desc_resolved(desc);
+    raster_layout L;
+    return raster_layout_of(&d, &L) ? L.total : 0;
+}
+
 ak_result ak_raster_create(const ak_raster_desc* desc, const ak_allocator* alloc, ak_raster** out_raster) {
     if (out_raster) *out_raster = NULL;
     if (!desc || !out_raster) return AK_ERR_NULL_ARG;
     if (alloc && (!alloc->alloc != !alloc->free)) return AK_ERR_BAD_ARG;
     ak_raster_desc d = ak_raster_desc_resolved(desc);
-    if (d.width < 1 || d.width > 8192 || d.height < 1 || d.height > 8192) return AK_ERR_BAD_ARG;
-    if (d.supersample < 1 || d.supersample > 4 || d.thread_count < 1 || d.thread_count > MAX_THREADS)
-        return AK_ERR_BAD_ARG;
+    raster_layout L;
+    if (!raster_layout_of(&d, &L)) return AK_ERR_BAD_ARG;
     size_t sw = (size_t)d.width * (size_t)d.supersample, sh = (size_t)d.height * (size_t)d.supersample;
-    size_t off_color = akp_align16(sizeof(ak_raster));
-    size_t off_depth = off_color + akp_align16(sw * sh * 4u);
-    size_t off_shadow = off_depth + akp_align16(sw * sh * sizeof(float));
-    size_t off_tmp = off_shadow + akp_align16((size_t)SHADOW_RES * SHADOW_RES * sizeof(float));
-    size_t off_segs = off_tmp + akp_align16((size_t)SHADOW_RES * SHADOW_RES * sizeof(float));
-    size_t nseg = d.thread_count > 1 ? (size_t)d.thread_count * SEG_CAP : 0;
-    size_t total = off_segs + nseg * sizeof(rtri);
+    const size_t off_color = L.off_color, off_depth = L.off_depth, off_shadow = L.off_shadow, off_tmp = L.off_tmp,
+                 off_segs = L.off_segs, nseg = L.nseg, total = L.total;
     uint8_t* mem = (uint8_t*)akp_alloc(alloc, total);
     if (!mem) return AK_ERR_NO_MEMORY;
     ak_raster* r = (ak_raster*)mem;

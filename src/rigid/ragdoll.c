@@ -10,7 +10,7 @@
 /* World matrix of joint i: root * local[roots..i], walking up the parents (no storage; a
  * skeleton's parents come before their children, so the walk ends). */
 static ak_mat4 joint_world(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 root, size_t i) {
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_mat4 m = ak_transform_to_mat4(pose.ptr[i]);
     for (int p = parents.ptr[i]; p >= 0; p = parents.ptr[p])
         m = ak_mat4_mul(ak_transform_to_mat4(pose.ptr[p]), m);
@@ -32,11 +32,11 @@ static bool has_children(const ak_skeleton* sk, size_t i) {
 /* Mean world position of joint i's children. */
 static ak_vec3 children_mean(const ak_skeleton* sk, ak_transform_cspan pose, ak_mat4 root,
                              size_t i) {
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_vec3 sum = ak_vec3_zero();
     float n = 0.0f;
     for (size_t c = i + 1; c < parents.count; ++c)
-        if (parents.ptr[c] == (int16_t)i) {
+        if (parents.ptr[c] == (int32_t)i) {
             sum = ak_vec3_add(sum, ak_mat4_get_translation(joint_world(sk, pose, root, c)));
             n += 1.0f;
         }
@@ -52,7 +52,7 @@ size_t ak_rigid_ragdoll_body_count(const ak_skeleton* sk) {
 
 size_t ak_rigid_ragdoll_joint_count(const ak_skeleton* sk) {
     size_t n = sk ? ak_skeleton_joint_count(sk) : 0, count = 0;
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     for (size_t i = 0; i < n; ++i) count += has_children(sk, i) && parents.ptr[i] >= 0;
     return count;
 }
@@ -150,7 +150,7 @@ static bool skin_given(const ak_rigid_ragdoll_desc* d, size_t joint_count, ak_re
 static bool skin_fit(const ak_rigid_ragdoll_desc* d, ak_mat4 root, size_t i, ak_vec3 x, ak_quat q,
                      float* out_radius, float* out_lo, float* out_hi) {
     const ak_skeleton* sk = d->skeleton;
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     const size_t nv = d->skin_positions.count, k = d->skin_influence_count;
     const float wmin = d->skin_min_weight > 0.0f ? d->skin_min_weight : 0.5f;
     const size_t need = d->skin_min_vertices ? d->skin_min_vertices : 8;
@@ -165,7 +165,7 @@ static bool skin_fit(const ak_rigid_ragdoll_desc* d, ak_mat4 root, size_t i, ak_
         const uint16_t slot = d->skin_joints.ptr[v * k + best];
         const size_t j = (size_t)d->skin_slot_joints.ptr[slot];
         if (d->skin_weights.ptr[v * k + best] < wmin ||
-            !(j == i || (parents.ptr[j] == (int16_t)i && !has_children(sk, j))))
+            !(j == i || (parents.ptr[j] == (int32_t)i && !has_children(sk, j))))
             continue;
         const ak_mat4 m =
             ak_mat4_mul(joint_world(sk, d->local_pose, root, j), d->skin_inverse_binds.ptr[slot]);
@@ -228,7 +228,7 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
     const float scale = desc->radius_scale > 0.0f ? desc->radius_scale : 0.2f;
     const float rmax = desc->max_radius > 0.0f ? desc->max_radius : 0.1f;
     const uint32_t group = desc->collision_group ? desc->collision_group : 1u;
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_transform_cspan rest = ak_skeleton_rest_pose(sk);
     uint32_t k = 0, kj = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -247,7 +247,7 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
          * 0.4 max_radius so no limb is a thousand times lighter than its neighbour */
         float spread = 0.0f;
         for (size_t c = i + 1; c < n; ++c)
-            if (parents.ptr[c] == (int16_t)i) {
+            if (parents.ptr[c] == (int32_t)i) {
                 ak_vec3 pc = ak_mat4_get_translation(joint_world(sk, desc->local_pose, root, c));
                 ak_vec3 d = ak_vec3_sub(pc, children_mean(sk, desc->local_pose, root, i));
                 spread = ak_maxf(spread, ak_vec3_length(d));
@@ -360,7 +360,7 @@ ak_result ak_rigid_ragdoll_build(const ak_rigid_ragdoll_desc* desc,
                 if (desc->free_cone_angle > 0.0f) {
                     ak_vec3 dir = ak_vec3_zero();
                     for (size_t c = i + 1; c < n; ++c)
-                        if (parents.ptr[c] == (int16_t)i)
+                        if (parents.ptr[c] == (int32_t)i)
                             dir = ak_vec3_add(dir, rest.ptr[c].translation);
                     dir = ak_vec3_length_sq(dir) > 1e-12f ? ak_vec3_normalize(dir)
                                                           : ak_vec3_make(0, 1, 0);
@@ -384,7 +384,7 @@ ak_result ak_rigid_ragdoll_drive_targets(const ak_skeleton* sk, ak_rigid_ragdoll
     const size_t n = ak_skeleton_joint_count(sk);
     if (bones.count < n || pose.count < n || out.count < ak_rigid_ragdoll_joint_count(sk))
         return AK_ERR_SPAN_SMALL;
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     size_t k = 0;
     for (size_t i = 0; i < n; ++i) {
         /* the build's order: a joint per joint with a body and a parent */
@@ -413,7 +413,7 @@ ak_result ak_rigid_ragdoll_pose(const ak_skeleton* sk, ak_rigid_ragdoll_bone_csp
             ((size_t)bones.ptr[i].body >= x.count || (size_t)bones.ptr[i].body >= q.count))
             return AK_ERR_BAD_INDEX;
     if (mat_is_zero(root)) root = ak_mat4_identity();
-    ak_i16_cspan parents = ak_skeleton_parents(sk);
+    ak_i32_cspan parents = ak_skeleton_parents(sk);
     /* world rotation and position of each joint with a body; the others follow their parent
      * (parents come first, so one forward pass; out holds locals, world values are rebuilt
      * from the bodies each time they are needed) */

@@ -8,7 +8,7 @@
 
 size_t ak_skin_bones_from_joints_bound(size_t joint_count) { return 2u * joint_count; }
 
-ak_result ak_skin_bones_from_joints(ak_vec3_cspan joint_positions, ak_i16_cspan parents, bool skip_leaf_joints,
+ak_result ak_skin_bones_from_joints(ak_vec3_cspan joint_positions, ak_i32_cspan parents, bool skip_leaf_joints,
                                     ak_skin_bone_span out_bones, size_t* out_bone_count) {
     if (!joint_positions.ptr || !parents.ptr || !out_bones.ptr || !out_bone_count) return AK_ERR_NULL_ARG;
     const size_t n = joint_positions.count;
@@ -22,7 +22,7 @@ ak_result ak_skin_bones_from_joints(ak_vec3_cspan joint_positions, ak_i16_cspan 
     for (size_t i = 0; i < n; ++i) {
         bool has_child = false;
         for (size_t c = i + 1; c < n; ++c) {
-            if (parents.ptr[c] != (int16_t)i) continue;
+            if (parents.ptr[c] != (int32_t)i) continue;
             has_child = true;
             if (count >= out_bones.count) return AK_ERR_SPAN_SMALL;
             ak_skin_bone b = {joint_positions.ptr[i], joint_positions.ptr[c], (uint16_t)i};

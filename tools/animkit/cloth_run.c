@@ -36,7 +36,7 @@ static int character_bones(cloth_character* c, float scale) {
     const ak_scene* s = c->scene;
     const size_t n = ak_scene_joint_count(s);
     if (!n || !s->skeleton) return CLI_OK;
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     c->bone_parent = calloc(n, sizeof(int));
     c->bone_child = calloc(n, sizeof(int));
     c->bone_radius = calloc(n, sizeof(float));

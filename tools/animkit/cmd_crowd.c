@@ -29,8 +29,8 @@ static const char* const usage =
     "             \"min_distance\", \"collisions\"} after the run\n"
     "  -o         .png (the last step) or .gif (the run) rendered, walking characters (builtin:humanoid)\n"
     "             per agent (posed each up to 500 agents, shared poses above); .glb: the run as glTF, a\n"
-    "             skinned character per agent\n"
-    "             (up to 1800 agents)\n"
+    "             skinned character per agent (one mesh, a skin each; up to 300 frames, fewer\n"
+    "             where the 512 MB bake budget needs it: 10,000 agents get 87)\n"
     "  --size     WxH of the PNG or GIF (default 640x480)\n"
     "  --poses    PNG and GIF characters: exact (each agent posed, feet planted, and skinned) or\n"
     "             shared (one skinned pose per phase bucket, 128 per cycle, drawn under each agent's\n"
@@ -355,12 +355,6 @@ int cmd_crowd(int argc, char** argv) {
     if (method) sc.method = strcmp(method, "vision") == 0 ? AK_CROWD_VISION : AK_CROWD_ORCA;
     if (vview) sc.vision_view = strcmp(vview, "raster") == 0 ? AK_CROWD_VIEW_RASTER : AK_CROWD_VIEW_RAYCAST;
     const bool is_glb = out && cli_has_ext(out, ".glb"), is_gif = out && cli_has_ext(out, ".gif");
-    /* Refused before any work: a glTF crowd holds at most 32767 nodes (18 per character). */
-    if (is_glb && sc.agent_count > 1800) {
-        ak_crowd_scene_free(&sc);
-        return cli_fail("crowd", "%s: %zu agents: glTF export holds at most 1800 characters (use --agents)", out,
-                        sc.agent_count);
-    }
     if ((rc = cli_work_check("crowd", (double)sc.agent_count * (double)sc.steps, "agent updates (agents x steps)",
                              "--steps or --agents"))) {
         ak_crowd_scene_free(&sc);
@@ -373,17 +367,35 @@ int cmd_crowd(int argc, char** argv) {
         ak_crowd_scene_free(&sc);
         return cli_fail("crowd", "%s: %s", a.pos_count ? a.pos[0] : "preset", ak_result_string(res));
     }
-    /* Frames: at most 150 in a GIF, 300 in a glTF file. */
-    const long max_frames = is_glb ? 300 : 150;
-    const long every = sc.steps > max_frames ? (sc.steps + max_frames - 1) / max_frames : 1;
     crowd_chars chars;
     memset(&chars, 0, sizeof chars);
     const bool with_chars = is_glb || out;
     const bool shared_poses = !is_glb && (poses ? strcmp(poses, "shared") == 0 : sc.agent_count > CROWD_CHARACTERS_MAX);
+    /* Frames: at most 150 in a GIF; in a glTF file at most 300, and as many as the bake's memory
+     * budget holds for this many agents (refused before the run when not even one fits). */
+    long max_frames = is_glb ? 300 : 150, every = 1;
     if (with_chars) {
         ak_diag cd = {0};
-        res = crowd_chars_init(&chars, &sc, is_glb ? (size_t)(sc.steps / every + 1) : 0, &cd);
+        res = crowd_chars_init(&chars, &sc, 0, &cd);
         chars.unplanted = shared_poses; /* shared poses have no foot planting */
+        if (res == AK_OK && is_glb) {
+            const size_t fit = ak_crowd_bake_max_frames(&chars.gait, sc.agent_count, 0);
+            if (fit == 0) {
+                const size_t n = sc.agent_count;
+                crowd_chars_free(&chars);
+                run_free(&st);
+                ak_crowd_scene_free(&sc);
+                return cli_fail("crowd", "%s: %zu agents: not one frame of the glTF crowd fits (its memory budget of "
+                                "%zu MB, at most %u nodes; use --agents)", out, n,
+                                AK_SCENE_BAKE_DEFAULT_BUDGET >> 20, AK_SKELETON_MAX_JOINTS);
+            }
+            if ((long)fit < max_frames) max_frames = (long)fit;
+        }
+        if (!is_glb) every = sc.steps > max_frames ? (sc.steps + max_frames - 1) / max_frames : 1;
+        else if (max_frames < 2) every = sc.steps + 1; /* one frame */
+        else /* the frames recorded, steps / every + 1, are at most max_frames */
+            every = sc.steps > max_frames - 1 ? (sc.steps + max_frames - 2) / (max_frames - 1) : 1;
+        if (res == AK_OK && is_glb) res = crowd_chars_record_reserve(&chars, (size_t)(sc.steps / every + 1));
         if (res != AK_OK) {
             crowd_chars_free(&chars);
             run_free(&st);

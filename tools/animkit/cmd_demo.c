@@ -175,7 +175,7 @@ static int humanoid_part(demo* d, double* t_used) {
     for (int k = 0; k < TAIL_JOINTS; ++k)
         tail_rest[k] = ak_vec3_add(base, ak_vec3_make(0, 0.06f * (float)k - 0.012f * (float)(k * k), -0.065f * (float)k));
     tube_build(tail, tail_rest, 0.045f, 0.015f);
-    int16_t parents[TAIL_JOINTS + 1];
+    int32_t parents[TAIL_JOINTS + 1];
     ak_mat4 model[TAIL_JOINTS + 1], out_model[TAIL_JOINTS + 1], local[TAIL_JOINTS + 1], rest_inv[TAIL_JOINTS + 1];
     ak_jiggle_joint jj[TAIL_JOINTS - 1];
     ak_jiggle_state js[TAIL_JOINTS - 1];
@@ -183,7 +183,7 @@ static int humanoid_part(demo* d, double* t_used) {
     parents[0] = -1;
     ak_mat4 prev = pelvis_rest;
     for (int k = 0; k < TAIL_JOINTS; ++k) {
-        parents[k + 1] = (int16_t)k;
+        parents[k + 1] = (int32_t)k;
         ak_mat4 m = ak_mat4_translation(tail_rest[k]);
         local[k + 1] = ak_mat4_mul(ak_mat4_inverse_affine(prev), m);
         rest_inv[k + 1] = ak_mat4_inverse_affine(m);

@@ -55,7 +55,7 @@ static bool is_joint(const ak_scene* s, bool all, int j) { return all || !s->is_
  * two joints, and at the topmost joint. Plain nodes above the skeleton never join (unless
  * the effector is itself a plain node: then every node counts as a joint). */
 static int default_root(const ak_scene* s, int eff) {
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     const bool all = !is_joint(s, false, eff); /* an effector no skin uses: every node counts */
     size_t size = 1;
     int root = eff;
@@ -127,7 +127,7 @@ int cmd_ik(int argc, char** argv) {
         rc = cli_fail("ik", "%s: no joint named '%s'", a.pos[0], eff_name);
         goto done;
     }
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     int root = -1;
     if (CLI_GET(&a, "--root")) {
         root = find_joint(s, CLI_GET(&a, "--root"));

@@ -28,7 +28,7 @@ static const char* joint_type_name(ak_joint_type t) {
 static size_t list_joints(const ak_scene* s, int* out_list, int* out_parent, int* node_to_list) {
     size_t n = ak_scene_joint_count(s), count = 0;
     if (n == 0) return 0;
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     for (size_t j = 0; j < n; ++j) {
         node_to_list[j] = -1;
         if (s->is_joint && !s->is_joint[j]) continue;

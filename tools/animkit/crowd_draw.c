@@ -48,13 +48,17 @@ ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t fram
     if (!c->plant_scratch) return AK_ERR_NO_MEMORY;
     if (cli_poser_init(&c->poser, c->scene)) return AK_ERR_NO_MEMORY;
     c->poser_ready = true;
-    if (frame_cap) {
-        c->frame_cap = frame_cap;
-        c->rec_pos = malloc(frame_cap * c->n * sizeof *c->rec_pos);
-        c->rec_ch = malloc(frame_cap * c->n * sizeof *c->rec_ch);
-        if (!c->rec_pos || !c->rec_ch) return AK_ERR_NO_MEMORY;
-    }
-    return AK_OK;
+    return frame_cap ? crowd_chars_record_reserve(c, frame_cap) : AK_OK;
+}
+
+ak_result crowd_chars_record_reserve(crowd_chars* c, size_t frame_cap) {
+    free(c->rec_pos);
+    free(c->rec_ch);
+    c->frames = 0;
+    c->frame_cap = frame_cap;
+    c->rec_pos = malloc(frame_cap * c->n * sizeof *c->rec_pos);
+    c->rec_ch = malloc(frame_cap * c->n * sizeof *c->rec_ch);
+    return c->rec_pos && c->rec_ch ? AK_OK : AK_ERR_NO_MEMORY;
 }
 
 ak_result crowd_chars_update(crowd_chars* c, const ak_vec2* velocities, const ak_vec2* positions, float dt) {

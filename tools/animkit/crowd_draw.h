@@ -34,6 +34,8 @@ typedef struct crowd_chars {
 /* The humanoid, its gait, one character per agent facing its first waypoint (phases spread),
  * and room to record frame_cap frames (0: none). */
 ak_result crowd_chars_init(crowd_chars* c, const ak_crowd_scene* sc, size_t frame_cap, ak_diag* diag);
+/* Room to record frame_cap frames (> 0), replacing any recorded. */
+ak_result crowd_chars_record_reserve(crowd_chars* c, size_t frame_cap);
 void crowd_chars_free(crowd_chars* c);
 /* Back to the start: every character facing its first waypoint, standing; no recorded frame. */
 void crowd_chars_reset(crowd_chars* c, const ak_crowd_scene* sc);

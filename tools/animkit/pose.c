@@ -113,7 +113,7 @@ void cli_poser_free(cli_poser* p) {
 
 size_t cli_skin_bones(const ak_scene* s, const ak_scene_skin* skin, ak_skin_bone* out) {
     size_t n = skin->joint_count, count = 0;
-    ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+    ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
     ak_vec3* pos = calloc(n, sizeof(ak_vec3));
     int* parent_slot = calloc(n, sizeof(int));
     bool* has_child = calloc(n, sizeof(bool));

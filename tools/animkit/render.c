@@ -82,7 +82,7 @@ int cli_frame_init_camera(cli_frame* f, const ak_scene* s, int width, int height
     f->draw = calloc(f->draw_capacity, sizeof(ak_raster_mesh));
     f->tex = calloc(f->draw_capacity, sizeof(ak_raster_texture));
     f->joint_list = calloc(n + 1, sizeof(int));
-    f->joint_parent = calloc(n + 1, sizeof(int16_t));
+    f->joint_parent = calloc(n + 1, sizeof(int32_t));
     f->joint_model = calloc(n + 1, sizeof(ak_mat4));
     int* map = calloc(n + 1, sizeof(int));
     if (!f->draw || !f->tex || !f->joint_list || !f->joint_parent || !f->joint_model || !map) {
@@ -91,7 +91,7 @@ int cli_frame_init_camera(cli_frame* f, const ak_scene* s, int width, int height
         return CLI_BAD_INPUT;
     }
     if (n) {
-        ak_i16_cspan parents = ak_skeleton_parents(s->skeleton);
+        ak_i32_cspan parents = ak_skeleton_parents(s->skeleton);
         for (size_t j = 0; j < n; ++j) {
             map[j] = -1;
             if (s->is_joint && !s->is_joint[j]) continue;
@@ -99,7 +99,7 @@ int cli_frame_init_camera(cli_frame* f, const ak_scene* s, int width, int height
             while (p >= 0 && map[p] < 0) p = parents.ptr[p];
             map[j] = (int)f->joint_count;
             f->joint_list[f->joint_count] = (int)j;
-            f->joint_parent[f->joint_count] = (int16_t)(p >= 0 ? map[p] : -1);
+            f->joint_parent[f->joint_count] = (int32_t)(p >= 0 ? map[p] : -1);
             ++f->joint_count;
         }
     }

@@ -13,7 +13,7 @@ typedef struct cli_frame {
     ak_raster_camera camera;
     ak_vec3 bmin, bmax;
     int* joint_list;      /* skeleton joints drawn in the overlay */
-    int16_t* joint_parent;
+    int32_t* joint_parent;
     ak_mat4* joint_model;
     size_t joint_count;
     ak_raster_mesh* draw;  /* draw list: every scene mesh plus CLI_MAX_EXTRA extras */

@@ -127,7 +127,7 @@ int view_app_resize(view_app* a, int w, int h) {
 static const ak_skeleton* skel(const view_app* a) { return a->scene->skeleton; }
 
 static int joint_parent(const view_app* a, int j) {
-    ak_i16_cspan par = ak_skeleton_parents(skel(a));
+    ak_i32_cspan par = ak_skeleton_parents(skel(a));
     return j >= 0 && (size_t)j < par.count ? par.ptr[j] : -1;
 }
 
