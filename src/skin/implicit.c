@@ -222,6 +222,29 @@ typedef struct grid_probe {
     float tx, ty, tz, r; /* r: 1 / the support radius */
 } grid_probe;
 
+/* Whether a point at (ax, ay, az) from a capsule's start lies at least its radius from the
+ * segment: c holds the segment's direction (3 floats, start to end), 1 / its squared length
+ * and the squared radius. */
+static inline bool beyond_capsule(float ax, float ay, float az, const float c[5]) {
+    float t = (ax * c[0] + ay * c[1] + az * c[2]) * c[3];
+    t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+    const float wx = ax - c[0] * t, wy = ay - c[1] * t, wz = az - c[2] * t;
+    return wx * wx + wy * wy + wz * wz >= c[4];
+}
+
+/* The grid cell (grid info I: nodes per axis and first node) holding grid coordinates
+ * (px, py, pz), inside the grid's box, into q's corner node, strides and fractions. */
+static inline void cell_at(const ak_skin_implicit* o, const uint32_t* I, float px, float py, float pz, grid_probe* q) {
+    const uint32_t nx = I[0], ny = I[1], nz = I[2];
+    uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
+    if (ix > nx - 2) ix = nx - 2;
+    if (iy > ny - 2) iy = ny - 2;
+    if (iz > nz - 2) iz = nz - 2;
+    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
+    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
+    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+}
+
 /* The cell of bone b's grid that holds bind-space point y into *q; false outside the grid's
  * box (the field is 0 there), and false as well where cull (CULL_FLOATS, or NULL) shows that
  * the interpolated distance is at least the support radius (the field is 0 there too;
@@ -234,20 +257,8 @@ static inline bool grid_cell(const ak_skin_implicit* o, size_t b, ak_vec3 y, con
     if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= (float)(nx - 1) && py <= (float)(ny - 1) &&
           pz <= (float)(nz - 1)) || nx < 2)
         return false;
-    if (cull && cull[7] > 0.0f) {
-        const float ax = y.x - cull[0], ay = y.y - cull[1], az = y.z - cull[2];
-        float t = (ax * cull[3] + ay * cull[4] + az * cull[5]) * cull[6];
-        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
-        const float wx = ax - cull[3] * t, wy = ay - cull[4] * t, wz = az - cull[5] * t;
-        if (wx * wx + wy * wy + wz * wz >= cull[7]) return false;
-    }
-    uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
-    if (ix > nx - 2) ix = nx - 2;
-    if (iy > ny - 2) iy = ny - 2;
-    if (iz > nz - 2) iz = nz - 2;
-    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
-    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
-    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+    if (cull && cull[7] > 0.0f && beyond_capsule(y.x - cull[0], y.y - cull[1], y.z - cull[2], cull + 3)) return false;
+    cell_at(o, I, px, py, pz, q);
     return true;
 }
 
@@ -384,22 +395,8 @@ static inline bool grid_locate(const field_ctx* c, size_t b, ak_vec3 x, grid_pro
     const float py = F[1] * x.x + F[4] * x.y + F[7] * x.z + F[10];
     const float pz = F[2] * x.x + F[5] * x.y + F[8] * x.z + F[11];
     if (!(px >= 0.0f && py >= 0.0f && pz >= 0.0f && px <= F[20] && py <= F[21] && pz <= F[22])) return false;
-    if (F[19] > 0.0f) {
-        const float ax = px - F[12], ay = py - F[13], az = pz - F[14];
-        float t = (ax * F[15] + ay * F[16] + az * F[17]) * F[18];
-        t = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
-        const float wx = ax - F[15] * t, wy = ay - F[16] * t, wz = az - F[17] * t;
-        if (wx * wx + wy * wy + wz * wz >= F[19]) return false;
-    }
-    const uint32_t* I = o->grid_info + b * GRID_INFO;
-    const uint32_t nx = I[0], ny = I[1], nz = I[2];
-    uint32_t ix = (uint32_t)px, iy = (uint32_t)py, iz = (uint32_t)pz;
-    if (ix > nx - 2) ix = nx - 2;
-    if (iy > ny - 2) iy = ny - 2;
-    if (iz > nz - 2) iz = nz - 2;
-    q->tx = px - (float)ix, q->ty = py - (float)iy, q->tz = pz - (float)iz;
-    q->sy = 4 * (size_t)nx, q->sz = 4 * (size_t)nx * ny;
-    q->n000 = o->grid + 4 * ((size_t)I[3] + ix + iy * (size_t)nx + iz * (size_t)nx * ny);
+    if (F[19] > 0.0f && beyond_capsule(px - F[12], py - F[13], pz - F[14], F + 15)) return false;
+    cell_at(o, o->grid_info + b * GRID_INFO, px, py, pz, q);
     q->m = c->inv + 12 * b;
     q->r = F[23];
     prefetch_node(q->n000);
