@@ -415,6 +415,56 @@ AK_TEST(validation) {
 
 /* ak_crowd_bake_scene: every agent's joints in the baked scene, posed by its clip at frame k,
  * sit where the character's own forward kinematics, placed by the root matrix, puts them. */
+/* The largest distance between a baked (or read-back) crowd's joints, posed by its clip at every
+ * frame, and where each agent's character puts them by its own FK placed under the agent's root
+ * matrix. via_skins false: agent a's joint j is node a * (J + 1) + 1 + j (the bake's layout);
+ * true: the joints are found through each agent's skin, whose names must be "a/<joint>"
+ * (mismatches counted in *misnamed). *checked counts the joints compared. */
+static double baked_joint_error(const ak_crowd_gait* g, const ak_scene* sc, const ak_scene* rd,
+                                const ak_crowd_character* ch, const ak_vec2* pos, int N, int F, bool via_skins,
+                                size_t* checked, size_t* misnamed) {
+    const size_t J = ak_scene_joint_count(sc), n = ak_scene_joint_count(rd);
+    const ak_scene_skin* cskin = &sc->skins[0];
+    ak_transform* lb = malloc(n * sizeof *lb);
+    ak_mat4* wb = malloc(n * sizeof *wb);
+    ak_transform* lc = malloc(J * sizeof *lc);
+    ak_mat4* wc = malloc(J * sizeof *wc);
+    double worst = 0.0;
+    *checked = *misnamed = 0;
+    for (int f = 0; lb && wb && lc && wc && f < F; ++f) {
+        ak_scene_rest_pose(rd, (ak_transform_span){lb, n});
+        ak_clip_sample(rd->clips[0], 0.1f * (float)f, NULL, (ak_transform_span){lb, n}, (ak_f32_span){0},
+                       (ak_f32_span){0});
+        ak_scene_world_matrices(rd, (ak_transform_cspan){lb, n}, (ak_mat4_span){wb, n});
+        for (int a = 0; a < N; ++a) {
+            ak_crowd_character_pose(g, &ch[f * N + a], (ak_transform_span){lc, J});
+            ak_scene_world_matrices(sc, (ak_transform_cspan){lc, J}, (ak_mat4_span){wc, J});
+            const ak_mat4 root = ak_crowd_character_root(g, &ch[f * N + a], pos[f * N + a]);
+            const ak_scene_skin* sk = &rd->skins[a];
+            if (via_skins && sk->joint_count != cskin->joint_count) {
+                ++*misnamed;
+                continue;
+            }
+            const size_t count = via_skins ? sk->joint_count : J;
+            for (size_t k = 0; k < count; ++k) {
+                const size_t cj = via_skins ? (size_t)cskin->joints[k] : k;
+                const size_t bj = via_skins ? (size_t)sk->joints[k] : (size_t)a * (J + 1) + 1 + k;
+                if (via_skins && f == 0) {
+                    char want_name[AK_NAME_SIZE];
+                    snprintf(want_name, sizeof want_name, "%d/%s", a, ak_skeleton_joint_name(sc->skeleton, cj));
+                    *misnamed += strcmp(ak_skeleton_joint_name(rd->skeleton, bj), want_name) != 0;
+                }
+                const ak_vec3 want = ak_mat4_transform_point(root, ak_mat4_get_translation(wc[cj]));
+                const ak_vec3 got = ak_mat4_get_translation(wb[bj]);
+                worst = fmax(worst, (double)ak_vec3_length(ak_vec3_sub(want, got)));
+                ++*checked;
+            }
+        }
+    }
+    free(lb), free(wb), free(lc), free(wc);
+    return worst;
+}
+
 AK_TEST(bake_scene) {
     ak_scene* sc = humanoid();
     AK_CHECK(sc);
@@ -446,35 +496,13 @@ AK_TEST(bake_scene) {
     AK_CHECK_EQ(baked->skin_count, (size_t)N * sc->skin_count);
     AK_CHECK_EQ(baked->clip_count, 1u);
     AK_CHECK_NEAR(ak_clip_duration(baked->clips[0]), 0.4f, 1e-6f);
-    ak_transform* lb = malloc(n * sizeof *lb);
-    ak_mat4* wb = malloc(n * sizeof *wb);
-    ak_transform* lc = malloc(J * sizeof *lc);
-    ak_mat4* wc = malloc(J * sizeof *wc);
-    double worst = 0.0;
-    for (int f = 0; f < F; ++f) {
-        ak_scene_rest_pose(baked, (ak_transform_span){lb, n});
-        ak_clip_sample(baked->clips[0], 0.1f * (float)f, NULL, (ak_transform_span){lb, n}, (ak_f32_span){0},
-                       (ak_f32_span){0});
-        ak_scene_world_matrices(baked, (ak_transform_cspan){lb, n}, (ak_mat4_span){wb, n});
-        for (int a = 0; a < N; ++a) {
-            ak_crowd_character_pose(&g, &ch[f * N + a], (ak_transform_span){lc, J});
-            ak_scene_world_matrices(sc, (ak_transform_cspan){lc, J}, (ak_mat4_span){wc, J});
-            const ak_mat4 root = ak_crowd_character_root(&g, &ch[f * N + a], pos[f * N + a]);
-            for (size_t j = 0; j < J; ++j) {
-                const ak_vec3 want = ak_mat4_transform_point(root, ak_mat4_get_translation(wc[j]));
-                const ak_vec3 got = ak_mat4_get_translation(wb[(size_t)a * (J + 1) + 1 + j]);
-                worst = fmax(worst, (double)ak_vec3_length(ak_vec3_sub(want, got)));
-            }
-        }
-    }
+    size_t checked, misnamed;
+    const double worst = baked_joint_error(&g, sc, baked, ch, pos, N, F, false, &checked, &misnamed);
     printf("  baked joints vs the characters' own: %.2g m at most\n", worst);
     AK_CHECK(worst < 1e-4);
+    AK_CHECK_EQ(checked, (size_t)N * F * J);
     /* each skin names its agent's joints */
     AK_CHECK_EQ(baked->skins[N - 1].joints[0], (int32_t)((N - 1) * (J + 1) + 1) + sc->skins[0].joints[0]);
-    free(lb);
-    free(wb);
-    free(lc);
-    free(wc);
     ak_scene_destroy(baked);
     /* errors, checked before allocating */
     bd.memory_budget = 1000;
@@ -599,43 +627,13 @@ AK_TEST(bake_gltf_2000_agents) {
     size_t shared = 0;
     for (size_t m = 1; m < rd->mesh_count; ++m) shared += rd->meshes[m].shares_mesh && rd->meshes[m].mesh == rd->meshes[0].mesh;
     AK_CHECK_EQ(shared, (size_t)N - 1); /* the reader keeps one mesh too */
-    ak_transform* lb = malloc(n * sizeof *lb);
-    ak_mat4* wb = malloc(n * sizeof *wb);
-    ak_transform* lc = malloc(J * sizeof *lc);
-    ak_mat4* wc = malloc(J * sizeof *wc);
-    const ak_scene_skin* cskin = &sc->skins[0];
-    double worst = 0.0;
-    size_t checked = 0, misnamed = 0;
-    for (int f = 0; f < F; ++f) {
-        ak_scene_rest_pose(rd, (ak_transform_span){lb, n});
-        ak_clip_sample(rd->clips[0], 0.1f * (float)f, NULL, (ak_transform_span){lb, n}, (ak_f32_span){0}, (ak_f32_span){0});
-        ak_scene_world_matrices(rd, (ak_transform_cspan){lb, n}, (ak_mat4_span){wb, n});
-        for (int a = 0; a < N; ++a) {
-            ak_crowd_character_pose(&g, &ch[f * N + a], (ak_transform_span){lc, J});
-            ak_scene_world_matrices(sc, (ak_transform_cspan){lc, J}, (ak_mat4_span){wc, J});
-            const ak_mat4 root = ak_crowd_character_root(&g, &ch[f * N + a], pos[f * N + a]);
-            const ak_scene_skin* sk = &rd->skins[a];
-            if (sk->joint_count != cskin->joint_count) {
-                ++misnamed;
-                continue;
-            }
-            for (size_t k = 0; k < sk->joint_count; ++k) {
-                const int32_t cj = cskin->joints[k], bj = sk->joints[k];
-                char want_name[AK_NAME_SIZE];
-                snprintf(want_name, sizeof want_name, "%d/%s", a, ak_skeleton_joint_name(sc->skeleton, (size_t)cj));
-                if (f == 0) misnamed += strcmp(ak_skeleton_joint_name(rd->skeleton, (size_t)bj), want_name) != 0;
-                const ak_vec3 want = ak_mat4_transform_point(root, ak_mat4_get_translation(wc[cj]));
-                const ak_vec3 got = ak_mat4_get_translation(wb[bj]);
-                worst = fmax(worst, (double)ak_vec3_length(ak_vec3_sub(want, got)));
-                ++checked;
-            }
-        }
-    }
+    size_t checked, misnamed;
+    const double worst = baked_joint_error(&g, sc, rd, ch, pos, N, F, true, &checked, &misnamed);
     printf("  2,000 agents read back: %zu joint positions vs the characters' own FK, %.2g m at most\n", checked, worst);
     AK_CHECK_EQ(misnamed, 0u);
-    AK_CHECK_EQ(checked, (size_t)N * F * cskin->joint_count);
+    AK_CHECK_EQ(checked, (size_t)N * F * sc->skins[0].joint_count);
     AK_CHECK(worst < 1e-4);
-    free(lb), free(wb), free(lc), free(wc), free(pos), free(ch);
+    free(pos), free(ch);
     ak_scene_destroy(rd);
     remove("crowd_2000.glb");
 }
