@@ -414,14 +414,12 @@ __attribute__((target("avx"), always_inline)) static inline void local_soa8(cons
 #undef AKP_TWO
 }
 
-/* The FK kernels for no root or an affine root: the local 3x3 parts of 8 joints at a time in
- * structure-of-arrays form (local_soa8), then the parent products joint by joint, each local
- * entry broadcast from memory (the translation straight from the pose): with AVX-512 VL the
- * broadcasts fold into the multiplies (embedded broadcast operands), a third of the
- * instructions of the AVX2 kernel. A joint whose parent is the joint before it takes the
- * parent's columns from registers. AKP_FK_PRODUCT: without FMA ((a0 b0 + a1 b1) + a2 b2
- * [+ a3], ak_mat4_mul's order and roundings), with FMA one multiply and two fused
- * multiply-adds per column (the translation column: three fused steps onto a3). */
+/* The AVX kernel (no FMA) for no root or an affine root: the local 3x3 parts of 8 joints at a
+ * time in structure-of-arrays form (local_soa8), then the parent products joint by joint, one
+ * column at a time, each local entry broadcast from memory (the translation straight from the
+ * pose). A joint whose parent is the joint before it takes the parent's columns from registers.
+ * AKP_FK_PRODUCT_0: (a0 b0 + a1 b1) + a2 b2 [+ a3], ak_mat4_mul's order and roundings. The
+ * AVX2 + FMA and AVX-512 kernels below hold two or four columns per register instead. */
 #define AKP_FK_KERNEL(NAME, TARGET, FMA)                                                                          \
     __attribute__((target(TARGET))) static void NAME(const ak_skeleton* sk, const ak_mat4* root,                \
                                                      const ak_transform* local, ak_mat4* out) {                \
@@ -464,24 +462,143 @@ __attribute__((target("avx"), always_inline)) static inline void local_soa8(cons
                               _mm_mul_ps(a2, _mm_broadcast_ss(e2)));                                               \
         prev[c] = c == 3 ? _mm_add_ps(r, a3) : r;                                                              \
     }
-#define AKP_FK_PRODUCT_1                                                                                       \
-    for (int c = 0; c < 3; ++c) {                                                                              \
-        __m128 r = _mm_mul_ps(a0, _mm_broadcast_ss(&L[3 * c][v]));                                                   \
-        r = _mm_fmadd_ps(a1, _mm_broadcast_ss(&L[3 * c + 1][v]), r);                                                 \
-        prev[c] = _mm_fmadd_ps(a2, _mm_broadcast_ss(&L[3 * c + 2][v]), r);                                           \
-    }                                                                                                          \
-    {                                                                                                          \
-        __m128 r = _mm_fmadd_ps(a0, _mm_broadcast_ss(t + 0), a3);                                                    \
-        r = _mm_fmadd_ps(a1, _mm_broadcast_ss(t + 1), r);                                                            \
-        prev[3] = _mm_fmadd_ps(a2, _mm_broadcast_ss(t + 2), r);                                                      \
-    }
-
 AKP_FK_KERNEL(fk_affine_avx, "avx", 0)
-AKP_FK_KERNEL(fk_affine_fma, "avx2,fma", 1)
-AKP_FK_KERNEL(fk_affine_avx512, "avx512f,avx512vl,avx2,fma", 1)
+/* The AVX2 + FMA kernel: a joint's model matrix in two 256-bit registers, columns 0 1 and 2 3
+ * (one per 128-bit half), the AVX-512 kernel's scheme at half width: per half, the local
+ * coefficients (B[k][c] x4, B[k][c + 1] x4) of 4 joints sit in one register per k (the SoA rows
+ * of two columns, one 128-bit half each), and one lane permute per k and half picks the joint's;
+ * the parent's columns come from the previous joint's registers (128-bit lane permutes) or
+ * 128-bit broadcast loads. Per half a0 b0 + a1 b1 + a2 b2 (+ a3) in fused steps, the order of
+ * the per-column FMA kernel this replaces (same floats). 16 vector operations and at most 4
+ * loads per joint where the per-column kernel spent 12 operations on 12 broadcast loads: 6%
+ * less time on Zen 5 (docs/fk.md). */
+__attribute__((target("avx2,fma"))) static void fk_affine_fma(const ak_skeleton* sk, const ak_mat4* root,
+                                                             const ak_transform* local, ak_mat4* out) {
+    const size_t n = sk->joint_count;
+    const int32_t* const parents = sk->parents;
+    _Alignas(32) float L[9][8];
+    const __m256i base_idx = _mm256_setr_epi32(0, 0, 0, 0, 4, 4, 4, 4);
+    const __m256 id01_0 = _mm256_setr_ps(1, 0, 0, 0, 1, 0, 0, 0), id01_1 = _mm256_setr_ps(0, 1, 0, 0, 0, 1, 0, 0);
+    const __m256 id01_2 = _mm256_setr_ps(0, 0, 1, 0, 0, 0, 1, 0), id3 = _mm256_setr_ps(0, 0, 0, 0, 0, 0, 0, 1);
+    __m256 o01 = _mm256_setzero_ps(), o23 = _mm256_setzero_ps();
+    for (size_t b = 0; b < n; b += 8) {
+        const size_t cnt = n - b < 8 ? n - b : 8;
+        local_soa8(local, b, cnt, L);
+        __m256 r[4];
+        for (int v = 0; v < 4; ++v) {
+            const size_t jl = (size_t)v < cnt ? (size_t)v : 0, jh = (size_t)v + 4 < cnt ? (size_t)v + 4 : 0;
+            r[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&local[b + jl].translation.x)),
+                                        _mm_loadu_ps(&local[b + jh].translation.x), 1);
+        }
+        const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
+        const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+        const __m256 T[3] = {_mm256_shuffle_ps(t0, t1, 0x44), _mm256_shuffle_ps(t0, t1, 0xEE), _mm256_shuffle_ps(t2, t3, 0x44)};
+        for (size_t h = 0; h < 2 && 4 * h < cnt; ++h) {
+            __m256 r01[3], r23[3];
+            for (int k = 0; k < 3; ++k) {
+                r01[k] = h ? _mm256_permute2f128_ps(_mm256_load_ps(L[k]), _mm256_load_ps(L[3 + k]), 0x31)
+                           : _mm256_permute2f128_ps(_mm256_load_ps(L[k]), _mm256_load_ps(L[3 + k]), 0x20);
+                r23[k] = h ? _mm256_permute2f128_ps(_mm256_load_ps(L[6 + k]), T[k], 0x31)
+                           : _mm256_permute2f128_ps(_mm256_load_ps(L[6 + k]), T[k], 0x20);
+            }
+            const size_t e = cnt - 4 * h < 4 ? cnt - 4 * h : 4;
+            for (size_t v = 0; v < e; ++v) {
+                const size_t i = b + 4 * h + v;
+                const int p = parents[i];
+                const __m256i idx = _mm256_add_epi32(base_idx, _mm256_set1_epi32((int)v));
+                __m256 p0, p1, p2, p3;
+                if (p >= 0 && (size_t)p + 1 == i) {
+                    p0 = _mm256_permute2f128_ps(o01, o01, 0x00), p1 = _mm256_permute2f128_ps(o01, o01, 0x11);
+                    p2 = _mm256_permute2f128_ps(o23, o23, 0x00), p3 = _mm256_permute2f128_ps(o23, o23, 0x18);
+                } else if (p >= 0 || root) {
+                    const float* a = p >= 0 ? out[p].m : root->m;
+                    p0 = _mm256_broadcast_ps((const __m128*)a), p1 = _mm256_broadcast_ps((const __m128*)(a + 4));
+                    p2 = _mm256_broadcast_ps((const __m128*)(a + 8));
+                    p3 = _mm256_insertf128_ps(_mm256_setzero_ps(), _mm_loadu_ps(a + 12), 1);
+                } else {
+                    p0 = id01_0, p1 = id01_1, p2 = id01_2, p3 = id3;
+                }
+                const __m256 a0 = _mm256_permutevar8x32_ps(r01[0], idx), a1 = _mm256_permutevar8x32_ps(r01[1], idx),
+                             a2 = _mm256_permutevar8x32_ps(r01[2], idx);
+                const __m256 b0 = _mm256_permutevar8x32_ps(r23[0], idx), b1 = _mm256_permutevar8x32_ps(r23[1], idx),
+                             b2 = _mm256_permutevar8x32_ps(r23[2], idx);
+                o01 = _mm256_fmadd_ps(p2, a2, _mm256_fmadd_ps(p1, a1, _mm256_mul_ps(p0, a0)));
+                o23 = _mm256_fmadd_ps(p2, b2, _mm256_fmadd_ps(p1, b1, _mm256_fmadd_ps(p0, b0, p3)));
+                _mm256_storeu_ps(out[i].m, o01);
+                _mm256_storeu_ps(out[i].m + 8, o23);
+            }
+        }
+    }
+}
+/* The AVX-512 kernel: one joint's whole model matrix per 512-bit register (four columns, one
+ * per 128-bit block). model = parent * local is, per block c, a0 B[0][c] + a1 B[1][c] +
+ * a2 B[2][c] (+ a3 in block 3), with P_k = parent column k in every block and C_k = (B[k][0] x4,
+ * B[k][1] x4, B[k][2] x4, t_k x4), summed as (a0 B[0][c] + a3) + (a2 B[2][c] + a1 B[1][c]): two
+ * fused multiply-adds, one multiply and one add, a parent-to-child dependency chain of about 9
+ * cycles (Zen 5) where a0 b0 + a1 b1 + a2 b2 in fused steps takes 12; within a few roundings of
+ * ak_mat4_mul, like the FMA kernel. C_k comes from the 8-joint structure-of-arrays rows
+ * (local_soa8 and the transposed translations) by one two-source permute per k, P_k from the
+ * previous joint's register (block shuffles) or 128-bit broadcast loads: about 10 vector
+ * operations and at most 4 loads per joint where the per-column kernel spends 12 operations on
+ * 12 broadcast loads (docs/fk.md). */
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) static void fk_affine_avx512(const ak_skeleton* sk,
+                                                                                const ak_mat4* root,
+                                                                                const ak_transform* local,
+                                                                                ak_mat4* out) {
+    const size_t n = sk->joint_count;
+    const int32_t* const parents = sk->parents;
+    _Alignas(32) float L[9][8];
+    const __m512i base_idx = _mm512_setr_epi32(0, 0, 0, 0, 8, 8, 8, 8, 16, 16, 16, 16, 24, 24, 24, 24);
+    /* a root joint without root matrix: the identity as parent (exact: products by 1 and 0) */
+    const __m512 id0 = _mm512_broadcast_f32x4(_mm_setr_ps(1.0f, 0.0f, 0.0f, 0.0f));
+    const __m512 id1 = _mm512_broadcast_f32x4(_mm_setr_ps(0.0f, 1.0f, 0.0f, 0.0f));
+    const __m512 id2 = _mm512_broadcast_f32x4(_mm_setr_ps(0.0f, 0.0f, 1.0f, 0.0f));
+    const __m512 id3 = _mm512_maskz_broadcast_f32x4(0xF000, _mm_setr_ps(0.0f, 0.0f, 0.0f, 1.0f));
+    __m512 prev = _mm512_setzero_ps();
+    for (size_t b = 0; b < n; b += 8) {
+        const size_t cnt = n - b < 8 ? n - b : 8;
+        local_soa8(local, b, cnt, L);
+        /* translations of the 8 joints (x y z rows), the transpose local_soa8 does for q */
+        __m256 r[4];
+        for (int v = 0; v < 4; ++v) {
+            const size_t jl = (size_t)v < cnt ? (size_t)v : 0, jh = (size_t)v + 4 < cnt ? (size_t)v + 4 : 0;
+            r[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&local[b + jl].translation.x)),
+                                        _mm_loadu_ps(&local[b + jh].translation.x), 1);
+        }
+        const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
+        const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+        const __m256 tx = _mm256_shuffle_ps(t0, t1, 0x44), ty = _mm256_shuffle_ps(t0, t1, 0xEE),
+                     tz = _mm256_shuffle_ps(t2, t3, 0x44);
+#define AKP_Z(A, B) _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_castps_pd(A)), _mm256_castps_pd(B), 1))
+        const __m512 z0l = AKP_Z(_mm256_load_ps(L[0]), _mm256_load_ps(L[3])), z0h = AKP_Z(_mm256_load_ps(L[6]), tx);
+        const __m512 z1l = AKP_Z(_mm256_load_ps(L[1]), _mm256_load_ps(L[4])), z1h = AKP_Z(_mm256_load_ps(L[7]), ty);
+        const __m512 z2l = AKP_Z(_mm256_load_ps(L[2]), _mm256_load_ps(L[5])), z2h = AKP_Z(_mm256_load_ps(L[8]), tz);
+#undef AKP_Z
+        for (size_t v = 0; v < cnt; ++v) {
+            const size_t i = b + v;
+            const int p = parents[i];
+            const __m512i idx = _mm512_add_epi32(base_idx, _mm512_set1_epi32((int)v));
+            const __m512 c0 = _mm512_permutex2var_ps(z0l, idx, z0h), c1 = _mm512_permutex2var_ps(z1l, idx, z1h),
+                         c2 = _mm512_permutex2var_ps(z2l, idx, z2h);
+            __m512 p0, p1, p2, p3;
+            if (p >= 0 && (size_t)p + 1 == i) {
+                p0 = _mm512_shuffle_f32x4(prev, prev, 0x00), p1 = _mm512_shuffle_f32x4(prev, prev, 0x55);
+                p2 = _mm512_shuffle_f32x4(prev, prev, 0xAA), p3 = _mm512_maskz_shuffle_f32x4(0xF000, prev, prev, 0xFF);
+            } else if (p >= 0 || root) {
+                const float* a = p >= 0 ? out[p].m : root->m;
+                p0 = _mm512_broadcast_f32x4(_mm_loadu_ps(a)), p1 = _mm512_broadcast_f32x4(_mm_loadu_ps(a + 4));
+                p2 = _mm512_broadcast_f32x4(_mm_loadu_ps(a + 8));
+                p3 = _mm512_maskz_broadcast_f32x4(0xF000, _mm_loadu_ps(a + 12));
+            } else {
+                p0 = id0, p1 = id1, p2 = id2, p3 = id3;
+            }
+            prev = _mm512_add_ps(_mm512_fmadd_ps(p0, c0, p3), _mm512_fmadd_ps(p2, c2, _mm512_mul_ps(p1, c1)));
+            _mm512_storeu_ps(out[i].m, prev);
+        }
+    }
+}
 #undef AKP_FK_KERNEL
 #undef AKP_FK_PRODUCT_0
-#undef AKP_FK_PRODUCT_1
 #else
 #define AKP_FK_AVX 0
 #endif

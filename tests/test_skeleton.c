@@ -367,6 +367,64 @@ AK_TEST(fk_affine_products_equal_full_products) {
     ak_skeleton_destroy(sk);
 }
 
+AK_TEST(fk_kernels_chains_and_partial_batches) {
+    /* Every FK kernel against the double-precision chain of products, on skeletons whose joint
+     * counts are not multiples of the kernels' 8-joint batches, with long parent = i - 1 chains
+     * (the kernels' register path), branches back to earlier joints (parents read from the
+     * output), two roots, and with no root and an affine root matrix. */
+    static const int counts[] = {1, 3, 8, 13, 61};
+    ak_rng rng = ak_rng_make(77);
+    for (size_t ci = 0; ci < sizeof counts / sizeof counts[0]; ++ci) {
+        const int n = counts[ci];
+        int parents[61];
+        ak_transform pose[61];
+        char names[61][8];
+        ak_joint_desc js[61];
+        for (int i = 0; i < n; ++i) {
+            parents[i] = i == 0 || i == 40 ? -1 : i % 7 == 0 ? i / 3 : i - 1;
+            pose[i] = random_transform(&rng);
+            pose[i].scale = ak_vec3_make(ak_rng_range(&rng, 0.5f, 2.0f), ak_rng_range(&rng, 0.5f, 2.0f),
+                                         ak_rng_range(&rng, 0.5f, 2.0f));
+            snprintf(names[i], sizeof names[i], "j%d", i);
+            memset(&js[i], 0, sizeof js[i]);
+            js[i].name = names[i], js[i].parent = parents[i], js[i].rest = ak_transform_identity();
+        }
+        ak_skeleton_desc d = {.joints = js, .joint_count = (size_t)n};
+        ak_skeleton* sk = NULL;
+        AK_CHECK_EQ(ak_skeleton_create(&d, NULL, &sk, NULL), AK_OK);
+        if (!sk) return;
+        const ak_transform rt = random_transform(&rng);
+        const dmat4 droot = dmat_from_trs(rt);
+        for (int lim = AK_FK_SIMD_SCALAR; lim < AK_FK_SIMD_COUNT; ++lim) {
+            AK_CHECK_EQ(ak_skeleton_set_simd_limit(sk, (ak_fk_simd)lim), AK_OK);
+            for (int rooted = 0; rooted < 2; ++rooted) {
+                ak_mat4 model[62];
+                model[n].m[0] = 12345.0f; /* past the end: must stay untouched */
+                if (rooted)
+                    AK_CHECK_EQ(ak_skeleton_local_to_model_rooted(sk, ak_transform_to_mat4(rt), (ak_transform_cspan){pose, (size_t)n},
+                                                                  (ak_mat4_span){model, (size_t)n}),
+                                AK_OK);
+                else
+                    AK_CHECK_EQ(ak_skeleton_local_to_model(sk, (ak_transform_cspan){pose, (size_t)n}, (ak_mat4_span){model, (size_t)n}),
+                                AK_OK);
+                double worst = 0.0;
+                for (int i = 0; i < n; ++i) {
+                    dmat4 ref = ref_world(parents, pose, i);
+                    if (rooted) ref = dmat_mul(droot, ref);
+                    double scale = 1.0;
+                    for (int k = 0; k < 16; ++k) scale = fmax(scale, fabs(ref.m[k]));
+                    worst = fmax(worst, max_diff(&model[i], &ref) / scale);
+                    AK_CHECK(model[i].m[3] == 0.0f && model[i].m[7] == 0.0f && model[i].m[11] == 0.0f && model[i].m[15] == 1.0f);
+                }
+                AK_CHECK(model[n].m[0] == 12345.0f);
+                AK_CHECK_MSG(worst < 2e-5, "FK kernel %s, %d joints, root %d: relative error %g",
+                             ak_skeleton_simd_name(sk), n, rooted, worst);
+            }
+        }
+        ak_skeleton_destroy(sk);
+    }
+}
+
 AK_TEST(fk_matches_naive_double) {
     ak_rng rng = ak_rng_make(3);
     int parents[FK_N];
@@ -738,6 +796,7 @@ int main(void) {
     AK_RUN(one_allocation);
     AK_RUN(reorder_shuffled);
     AK_RUN(reorder_errors);
+    AK_RUN(fk_kernels_chains_and_partial_batches);
     AK_RUN(fk_matches_naive_double);
     AK_RUN(fk_batch);
     AK_RUN(swing_twist);

@@ -132,7 +132,7 @@ typedef enum ak_fk_simd {
     AK_FK_SIMD_DEFAULT = 0, /* the widest kernel this CPU has */
     AK_FK_SIMD_SCALAR,      /* portable code (SSE2 columns on x86-64): ak_mat4_mul's floats */
     AK_FK_SIMD_AVX2,        /* at most AVX2 + FMA (AVX without FMA on CPUs that lack them) */
-    AK_FK_SIMD_AVX512,      /* at most AVX-512 F + VL (same floats as AVX2 + FMA) */
+    AK_FK_SIMD_AVX512,      /* at most AVX-512 F + VL (FMA; sums in another order than AVX2) */
     AK_FK_SIMD_COUNT
 } ak_fk_simd;
 
