@@ -972,6 +972,73 @@ AK_TEST(symmetric_pass_threads_and_kernels) {
     }
 }
 
+/* The threads split the symmetric pass (and the gather of the other path) into runs of whole
+ * rows of cells (z, y) of about equal estimated work, so a part starts mid slab, and a part's
+ * first dim_y + 1 rows wait for the part before. A flock in a long column (5 x 5 cells across,
+ * 30 slabs) denser at one end (z = 48 u^2), and the same spread evenly: on 1, 2, 3 and 8
+ * threads (8: more parts than fit at 6 rows each in the dense half, and parts of very
+ * different lengths), the naive loop's bits and interaction count, for the symmetric pass and
+ * for two species (the gather path). */
+AK_TEST(work_partition_threads_bit_identical) {
+    enum { N = 4096 };
+    ak_boids_species sp[2] = {{.max_speed = 2, .separation_weight = 2, .separation_radius = 0.6f,
+                               .alignment_weight = 1, .alignment_radius = 1.4f, .cohesion_weight = 1,
+                               .cohesion_radius = 1.6f, .view_angle = 270},
+                              {.max_speed = 2, .separation_weight = 1, .separation_radius = 0.8f,
+                               .cohesion_weight = 1, .cohesion_radius = 1.6f}};
+    const uint32_t threads[4] = {1, 2, 3, 8};
+    for (int clumped = 0; clumped < 2; ++clumped)
+        for (uint32_t species = 1; species <= 2; ++species) {
+            ak_boids_params pp = {.species = sp, .species_count = species};
+            flock base = flock_make(N);
+            ak_rng r = ak_rng_make(900u + (uint64_t)clumped);
+            for (size_t i = 0; i < N; ++i) {
+                const float u = ak_rng_range(&r, 0.0f, 1.0f);
+                base.p[i] = ak_vec3_make(ak_rng_range(&r, 0.0f, 8.0f), ak_rng_range(&r, 0.0f, 8.0f),
+                                         48.0f * (clumped ? u * u : u));
+                base.v[i] = ak_vec3_make(ak_rng_range(&r, -1.5f, 1.5f), ak_rng_range(&r, -1.5f, 1.5f),
+                                         ak_rng_range(&r, -1.5f, 1.5f));
+                base.s[i] = (uint8_t)(i % species);
+            }
+            flock ref = flock_make(N);
+            memcpy(ref.p, base.p, N * sizeof(ak_vec3));
+            memcpy(ref.v, base.v, N * sizeof(ak_vec3));
+            memcpy(ref.s, base.s, N);
+            uint64_t ref_inter = 0;
+            for (int s = 0; s < 2; ++s) {
+                ak_boids_step_job j = job_for(&ref, &pp, 0.05f);
+                j.use_naive = true;
+                j.out_interaction_count = &ref_inter;
+                AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
+                memcpy(ref.p, ref.p2, N * sizeof(ak_vec3));
+                memcpy(ref.v, ref.v2, N * sizeof(ak_vec3));
+            }
+            AK_CHECK(ref_inter > 2u * N);
+            for (int t = 0; t < 4; ++t) {
+                flock f = flock_make(N);
+                memcpy(f.p, base.p, N * sizeof(ak_vec3));
+                memcpy(f.v, base.v, N * sizeof(ak_vec3));
+                memcpy(f.s, base.s, N);
+                uint64_t inter = 0;
+                for (int s = 0; s < 2; ++s) {
+                    ak_boids_step_job j = job_for(&f, &pp, 0.05f);
+                    j.thread_count = threads[t];
+                    j.out_interaction_count = &inter;
+                    AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
+                    memcpy(f.p, f.p2, N * sizeof(ak_vec3));
+                    memcpy(f.v, f.v2, N * sizeof(ak_vec3));
+                }
+                AK_CHECK_MSG(memcmp(f.p, ref.p, N * sizeof(ak_vec3)) == 0 &&
+                                 memcmp(f.v, ref.v, N * sizeof(ak_vec3)) == 0 && inter == ref_inter,
+                             "%s, %u species, %u threads: differs from the naive loop", clumped ? "clumped" : "even",
+                             species, threads[t]);
+                flock_free(&f);
+            }
+            flock_free(&ref);
+            flock_free(&base);
+        }
+}
+
 /* ---- measures ---------------------------------------------------------------------------- */
 
 AK_TEST(order_and_min_distance) {
@@ -1047,6 +1114,7 @@ int main(void) {
     AK_RUN(threads_and_paths_bit_identical);
     AK_RUN(large_flock_threads_bit_identical);
     AK_RUN(symmetric_pass_threads_and_kernels);
+    AK_RUN(work_partition_threads_bit_identical);
     AK_RUN(order_and_min_distance);
     return ak_test_finish();
 }

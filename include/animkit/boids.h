@@ -67,8 +67,8 @@
  *     }                                                   // the job's pointers) for the next step
  *
  * Ownership and threading: the job reads and writes caller-owned arrays and keeps no pointer.
- * ak_boids_step_run never allocates (thread_count > 1 starts pthreads: z slabs of the flock
- * per thread). Outputs must not alias inputs (the wander state is updated in place: each agent
+ * ak_boids_step_run never allocates (thread_count > 1 starts pthreads: runs of cell rows of
+ * about equal estimated work per thread; the bits do not depend on the thread count). Outputs must not alias inputs (the wander state is updated in place: each agent
  * touches only its own entry).
  *
  * Speed (docs/boids.md, docs/BENCHMARKS.md): agents re-sorted by cell; for one species that

@@ -677,6 +677,7 @@ ak_result ak_boids_step_run(const ak_boids_step_job* job) {
     const uint32_t threads = akp_boids_threads(job->thread_count, c.n);
     step_task tasks[64];
     for (uint32_t t = 0; t < threads; ++t) tasks[t] = (step_task){&c, t, threads, 0, 0, NULL};
+    akp_boids_partition(&c, threads);
     if (c.sym) akp_boids_sym_clear(&c, threads);
     akp_boids_run_tasks(step_thread, tasks, sizeof tasks[0], threads);
     if (c.sym && threads > 1) akp_boids_run_tasks(step_finish_thread, tasks, sizeof tasks[0], threads);
