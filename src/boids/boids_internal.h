@@ -82,6 +82,7 @@ typedef struct akp_boids_ctx {
      * part_row[0]). part_count: the parts it was made for (0: none). */
     uint32_t part_row[65], defer_row[65];
     uint32_t part_count;
+    bool sym_zeroed;         /* the deferred rows' sums (acc or spill) were zeroed in the fill */
     /* The spatial arrays, writable, for akp_boids_search_fill. */
     float *fill_sx, *fill_sy, *fill_sz;
     ak_vec3* fill_sv;
@@ -275,7 +276,9 @@ void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, a
  * rows, from the rows' agent counts); the symmetric pass needs every part but the last to hold
  * more than dim[1] rows (a row's pairs reach dim[1] + 1 rows ahead), so there are fewer
  * non-empty parts when the box has few rows; the empty ones come last. Serial: one read of
- * the rows' starts. No-op without the dense layout. */
+ * the rows' starts. No-op without the dense layout, or when made for these parts already
+ * (akp_boids_search_prepare makes it before its fill section, whose threads also zero the
+ * symmetric pass's deferred sums: akp_boids_sym_clear then has nothing left to do). */
 void akp_boids_partition(akp_boids_ctx* c, size_t parts);
 /* The symmetric pass (c->sym): akp_boids_partition and akp_boids_sym_clear once before the
  * threads start;

@@ -643,10 +643,11 @@ static uint64_t row_work(const akp_boids_ctx* c, size_t r) {
 }
 
 void akp_boids_partition(akp_boids_ctx* c, size_t parts) {
-    c->part_count = 0;
-    if (!c->dstart) return;
     if (parts < 1) parts = 1;
     if (parts > 64) parts = 64;
+    if (c->dstart && c->part_count == parts) return; /* made by akp_boids_search_prepare */
+    c->part_count = 0;
+    if (!c->dstart) return;
     const size_t dimy = (size_t)c->dense_dim[1], rows = dimy * (size_t)c->dense_dim[2];
     const size_t min_rows = c->sym ? dimy + 1 : 1;
     size_t use = rows / min_rows < parts ? rows / min_rows : parts;
@@ -689,10 +690,36 @@ static size_t spill_base(const akp_boids_ctx* c, size_t p) {
     return base;
 }
 
+/* Whether the deferred rows' credits go to spill (they fit it) or to acc by atomic adds. */
+static void sym_plan(akp_boids_ctx* c, size_t parts) { c->use_spill = spill_base(c, parts) <= c->spill_cap; }
+
+/* Part `part` of `parts` of the zeroing of the deferred rows' sums (spill entries, or the
+ * rows' acc entries), taken in order as in spill: for the fill's threads, so the caller does
+ * not zero them between sections (about 28 MB at 16 threads of a 1M step). */
+static void sym_zero_share(const akp_boids_ctx* c, size_t part, size_t parts) {
+    const size_t total = spill_base(c, c->part_count);
+    const size_t m0 = total * part / parts, m1 = total * (part + 1) / parts;
+    if (c->use_spill) {
+        memset(c->spill + m0, 0, (m1 - m0) * sizeof(akp_boids_acc));
+        return;
+    }
+    size_t base = 0;
+    for (size_t t = 1; t < c->part_count && base < m1; ++t) {
+        const uint32_t b = row_start(c, c->part_row[t]), e = row_start(c, c->defer_row[t]);
+        const size_t from = m0 > base ? m0 - base : 0, to = m1 - base < e - b ? m1 - base : e - b;
+        if (from < to) memset(c->acc + b + from, 0, (to - from) * sizeof(akp_boids_acc));
+        base += e - b;
+    }
+}
+
 void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts) {
-    if (c->part_count != parts) akp_boids_partition(c, parts);
+    if (c->part_count != parts) {
+        akp_boids_partition(c, parts);
+        c->sym_zeroed = false;
+    }
+    if (c->sym_zeroed) return; /* sym_plan and the zeroing ran in the fill */
     const size_t need = spill_base(c, parts);
-    c->use_spill = need <= c->spill_cap;
+    sym_plan(c, parts);
     if (c->use_spill) {
         memset(c->spill, 0, need * sizeof(akp_boids_acc));
         return;
@@ -988,6 +1015,7 @@ void akp_boids_search_fill(const akp_boids_ctx* c, size_t part, size_t parts) {
 static void* fill_thread(void* arg) {
     const akp_boids_fill_task* t = (const akp_boids_fill_task*)arg;
     akp_boids_search_fill(t->c, t->part, t->parts);
+    if (t->c->sym && t->c->part_count == t->parts) sym_zero_share(t->c, t->part, t->parts);
     return NULL;
 }
 
@@ -1135,20 +1163,24 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     c->fill_qv = qv;
     /* The agents' data in spatial order: read through sj (in order), written in order, so it
      * splits over threads (akp_boids_search_fill); small steps fill here. */
-    const uint32_t parts = akp_boids_threads(c->job->thread_count, n);
-    if (parts <= 1 || n < 2048) akp_boids_search_fill(c, 0, 1);
-    else {
-        akp_boids_fill_task tasks[64];
-        for (uint32_t t = 0; t < parts; ++t) tasks[t] = (akp_boids_fill_task){c, t, parts};
-        akp_boids_run_tasks(fill_thread, tasks, sizeof tasks[0], parts);
-    }
-    c->avx512 = !c->job->skip_simd && !c->job->skip_avx512 && akp_boids_have_avx512();
-    c->avx2 = !c->job->skip_simd && !c->avx512 && akp_boids_have_avx2();
-    c->one_species = c->params->species_count == 1;
     c->sym = sym_ok && c->rings == 1;
     /* The grid's memory is free on this path (the cell coordinates are done with). */
     c->spill = (akp_boids_acc*)(void*)base;
     c->spill_cap = gbytes / sizeof(akp_boids_acc);
+    const uint32_t parts = akp_boids_threads(c->job->thread_count, n);
+    if (parts <= 1 || n < 2048) akp_boids_search_fill(c, 0, 1);
+    else {
+        /* the step's partition, and the symmetric pass's deferred sums zeroed in the fill */
+        akp_boids_partition(c, parts);
+        if (c->sym) sym_plan(c, parts);
+        akp_boids_fill_task tasks[64];
+        for (uint32_t t = 0; t < parts; ++t) tasks[t] = (akp_boids_fill_task){c, t, parts};
+        akp_boids_run_tasks(fill_thread, tasks, sizeof tasks[0], parts);
+        c->sym_zeroed = c->sym;
+    }
+    c->avx512 = !c->job->skip_simd && !c->job->skip_avx512 && akp_boids_have_avx512();
+    c->avx2 = !c->job->skip_simd && !c->avx512 && akp_boids_have_avx2();
+    c->one_species = c->params->species_count == 1;
     return AK_OK;
 }
 
