@@ -112,6 +112,66 @@ AK_TEST(validate_every_coordinate) {
     flock_free(&f);
 }
 
+/* ak_boids_step_run checks the agents' data on its threads when there are many (70,000 here,
+ * two species, wander on): a bad species index, a non-finite or too large position, velocity
+ * or wander offset at the start, either side of a part boundary or the end, on 1, 2 and 3
+ * threads, gives what ak_boids_step_validate (the serial check) says, with nothing written;
+ * a bad species anywhere wins over bad data anywhere (the serial check's order of rules), and
+ * bad data wins over an output span too small. All data good, the step runs. */
+AK_TEST(validation_scan_split_over_threads) {
+    enum { N = 70000 };
+    flock f = flock_make(N);
+    flock_random(&f, 11, 20.0f, 1.0f, false);
+    for (size_t i = 0; i < N; ++i) f.s[i] = (uint8_t)(i & 1u);
+    ak_boids_species sp[2] = {{.separation_weight = 1, .wander_weight = 0.5f}, {.cohesion_weight = 1}};
+    ak_boids_params prm = {.species = sp, .species_count = 2};
+    ak_boids_step_job j = job_for(&f, &prm, 0.05f);
+    AK_CHECK_EQ(ak_boids_step_validate(&j), AK_OK);
+    /* the first agent, the last of a part and the first of the next (3 threads), the last of
+     * the first part (2 threads), the last agent */
+    const size_t at[5] = {0, N / 3 - 1, N / 3, N / 2 - 1, N - 1};
+    const size_t bytes = N * sizeof(ak_vec3);
+    memset(f.p2, 0x5a, bytes);
+    memset(f.v2, 0xa5, bytes);
+    ak_vec3* copy = malloc(2 * bytes);
+    AK_CHECK(copy != NULL);
+    if (!copy) return;
+    memcpy(copy, f.p2, bytes);
+    memcpy(copy + N, f.v2, bytes);
+    int wrong = 0;
+    for (uint32_t threads = 1; threads <= 3; ++threads) {
+        j.thread_count = threads;
+        for (size_t k = 0; k < 5; ++k)
+            for (int what = 0; what < 6; ++what) {
+                const size_t i = at[k], other = at[4 - k];
+                const ak_vec3 keep_p = f.p[i], keep_v = f.v[i], keep_w = f.w[i];
+                const uint8_t keep_s = f.s[other];
+                ak_boids_step_job b = j;
+                ak_result want = AK_ERR_BAD_DATA;
+                if (what == 0) f.p[i].y = NAN;
+                if (what == 1) f.v[i].z = INFINITY;
+                if (what == 2) f.w[i].x = -2e15f;
+                if (what == 3) f.s[other] = 2, want = AK_ERR_BAD_INDEX;
+                if (what == 4) f.p[i].x = NAN, f.s[other] = 7, want = AK_ERR_BAD_INDEX;
+                if (what == 5) f.v[i].x = NAN, b.out_velocities.count = N - 1;
+                const ak_result v = ak_boids_step_validate(&b), r = ak_boids_step_run(&b);
+                if (v != want || r != want || memcmp(copy, f.p2, bytes) != 0 || memcmp(copy + N, f.v2, bytes) != 0) {
+                    ++wrong;
+                    printf("  %u threads, agent %zu, case %d: validate %d, run %d, want %d\n", threads, i, what, (int)v,
+                           (int)r, (int)want);
+                }
+                f.p[i] = keep_p, f.v[i] = keep_v, f.w[i] = keep_w, f.s[other] = keep_s;
+            }
+        AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
+        AK_CHECK(memcmp(copy, f.p2, bytes) != 0); /* it did write */
+        memset(f.p2, 0x5a, bytes);
+        memset(f.v2, 0xa5, bytes);
+    }
+    AK_CHECK_EQ(wrong, 0);
+    free(copy);
+    flock_free(&f);
+}
+
 AK_TEST(validate_rules) {
     ak_boids_step_job zero = {0};
     AK_CHECK_EQ(ak_boids_step_validate(&zero), AK_ERR_NULL_ARG);
@@ -912,6 +972,73 @@ AK_TEST(symmetric_pass_threads_and_kernels) {
     }
 }
 
+/* The threads split the symmetric pass (and the gather of the other path) into runs of whole
+ * rows of cells (z, y) of about equal estimated work, so a part starts mid slab, and a part's
+ * first dim_y + 1 rows wait for the part before. A flock in a long column (5 x 5 cells across,
+ * 30 slabs) denser at one end (z = 48 u^2), and the same spread evenly: on 1, 2, 3 and 8
+ * threads (8: more parts than fit at 6 rows each in the dense half, and parts of very
+ * different lengths), the naive loop's bits and interaction count, for the symmetric pass and
+ * for two species (the gather path). */
+AK_TEST(work_partition_threads_bit_identical) {
+    enum { N = 4096 };
+    ak_boids_species sp[2] = {{.max_speed = 2, .separation_weight = 2, .separation_radius = 0.6f,
+                               .alignment_weight = 1, .alignment_radius = 1.4f, .cohesion_weight = 1,
+                               .cohesion_radius = 1.6f, .view_angle = 270},
+                              {.max_speed = 2, .separation_weight = 1, .separation_radius = 0.8f,
+                               .cohesion_weight = 1, .cohesion_radius = 1.6f}};
+    const uint32_t threads[4] = {1, 2, 3, 8};
+    for (int clumped = 0; clumped < 2; ++clumped)
+        for (uint32_t species = 1; species <= 2; ++species) {
+            ak_boids_params pp = {.species = sp, .species_count = species};
+            flock base = flock_make(N);
+            ak_rng r = ak_rng_make(900u + (uint64_t)clumped);
+            for (size_t i = 0; i < N; ++i) {
+                const float u = ak_rng_range(&r, 0.0f, 1.0f);
+                base.p[i] = ak_vec3_make(ak_rng_range(&r, 0.0f, 8.0f), ak_rng_range(&r, 0.0f, 8.0f),
+                                         48.0f * (clumped ? u * u : u));
+                base.v[i] = ak_vec3_make(ak_rng_range(&r, -1.5f, 1.5f), ak_rng_range(&r, -1.5f, 1.5f),
+                                         ak_rng_range(&r, -1.5f, 1.5f));
+                base.s[i] = (uint8_t)(i % species);
+            }
+            flock ref = flock_make(N);
+            memcpy(ref.p, base.p, N * sizeof(ak_vec3));
+            memcpy(ref.v, base.v, N * sizeof(ak_vec3));
+            memcpy(ref.s, base.s, N);
+            uint64_t ref_inter = 0;
+            for (int s = 0; s < 2; ++s) {
+                ak_boids_step_job j = job_for(&ref, &pp, 0.05f);
+                j.use_naive = true;
+                j.out_interaction_count = &ref_inter;
+                AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
+                memcpy(ref.p, ref.p2, N * sizeof(ak_vec3));
+                memcpy(ref.v, ref.v2, N * sizeof(ak_vec3));
+            }
+            AK_CHECK(ref_inter > 2u * N);
+            for (int t = 0; t < 4; ++t) {
+                flock f = flock_make(N);
+                memcpy(f.p, base.p, N * sizeof(ak_vec3));
+                memcpy(f.v, base.v, N * sizeof(ak_vec3));
+                memcpy(f.s, base.s, N);
+                uint64_t inter = 0;
+                for (int s = 0; s < 2; ++s) {
+                    ak_boids_step_job j = job_for(&f, &pp, 0.05f);
+                    j.thread_count = threads[t];
+                    j.out_interaction_count = &inter;
+                    AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
+                    memcpy(f.p, f.p2, N * sizeof(ak_vec3));
+                    memcpy(f.v, f.v2, N * sizeof(ak_vec3));
+                }
+                AK_CHECK_MSG(memcmp(f.p, ref.p, N * sizeof(ak_vec3)) == 0 &&
+                                 memcmp(f.v, ref.v, N * sizeof(ak_vec3)) == 0 && inter == ref_inter,
+                             "%s, %u species, %u threads: differs from the naive loop", clumped ? "clumped" : "even",
+                             species, threads[t]);
+                flock_free(&f);
+            }
+            flock_free(&ref);
+            flock_free(&base);
+        }
+}
+
 /* ---- measures ---------------------------------------------------------------------------- */
 
 AK_TEST(order_and_min_distance) {
@@ -973,6 +1100,7 @@ int main(void) {
     AK_RUN(cell_load_budget);
     AK_RUN(validate_rules);
     AK_RUN(validate_every_coordinate);
+    AK_RUN(validation_scan_split_over_threads);
     AK_RUN(neighbors_random_flocks);
     AK_RUN(neighbors_cell_boundaries_and_far_agents);
     AK_RUN(rule_separation_two_agents);
@@ -986,6 +1114,7 @@ int main(void) {
     AK_RUN(threads_and_paths_bit_identical);
     AK_RUN(large_flock_threads_bit_identical);
     AK_RUN(symmetric_pass_threads_and_kernels);
+    AK_RUN(work_partition_threads_bit_identical);
     AK_RUN(order_and_min_distance);
     return ak_test_finish();
 }

@@ -67,8 +67,8 @@
  *     }                                                   // the job's pointers) for the next step
  *
  * Ownership and threading: the job reads and writes caller-owned arrays and keeps no pointer.
- * ak_boids_step_run never allocates (thread_count > 1 starts pthreads: z slabs of the flock
- * per thread). Outputs must not alias inputs (the wander state is updated in place: each agent
+ * ak_boids_step_run never allocates (thread_count > 1 starts pthreads: runs of cell rows of
+ * about equal estimated work per thread; the bits do not depend on the thread count). Outputs must not alias inputs (the wander state is updated in place: each agent
  * touches only its own entry).
  *
  * Speed (docs/boids.md, docs/BENCHMARKS.md): agents re-sorted by cell; for one species that
@@ -222,7 +222,9 @@ AK_API size_t ak_boids_step_scratch_size(const ak_boids_step_job* job);
 AK_API ak_result ak_boids_step_validate(const ak_boids_step_job* job);
 
 /* One step for every agent (see the header block). Validates first and writes nothing on
- * failure. Output is finite for valid input. Besides the validation codes: AK_ERR_BUDGET when
+ * failure (from 65,536 agents on, the O(n) check of the agents' data runs on the step's
+ * threads; the result is the one ak_boids_step_validate gives). Output is finite for valid
+ * input. Besides the validation codes: AK_ERR_BUDGET when
  * the agents are packed so densely that the grid's cell load exceeds max_cell_load (above). */
 AK_API ak_result ak_boids_step_run(const ak_boids_step_job* job);
 

@@ -125,8 +125,26 @@ ak_boids_bounds akp_boids_bounds_mode(const ak_boids_params* p) {
     return p->bounds == AK_BOIDS_BOUNDS_DEFAULT ? AK_BOIDS_BOUNDS_STEER : p->bounds;
 }
 
-/* Everything but dt, the wander span and the outputs (shared with the neighbours job). */
-ak_result akp_boids_validate_inputs(const ak_boids_step_job* job, bool need_wander) {
+/* The agents' data of [b, e): species indices, positions and velocities (and the wander
+ * offsets when need_wander): the O(n) part of validation, which ak_boids_step_run splits over
+ * its threads. AK_ERR_BAD_INDEX before AK_ERR_BAD_DATA, as validate_inputs checks them. */
+static ak_result scan_agents(const ak_boids_step_job* job, bool need_wander, size_t b, size_t e) {
+    const ak_boids_params* p = job->params;
+    if (job->species.ptr)
+        for (size_t i = b; i < e; ++i)
+            if (job->species.ptr[i] >= p->species_count) return AK_ERR_BAD_INDEX;
+    if (!floats_ok((const float*)(const void*)(job->positions.ptr + b), 3 * (e - b)) ||
+        !floats_ok((const float*)(const void*)(job->velocities.ptr + b), 3 * (e - b)))
+        return AK_ERR_BAD_DATA;
+    if (need_wander && job->wander.ptr)
+        for (size_t i = b; i < e; ++i)
+            if (!vec_ok(job->wander.ptr[i])) return AK_ERR_BAD_DATA;
+    return AK_OK;
+}
+
+/* Everything but dt, the wander span and the outputs (shared with the neighbours job); scan
+ * false leaves out the agents' data (scan_agents). */
+static ak_result validate_inputs(const ak_boids_step_job* job, bool need_wander, bool scan) {
     if (!job || !job->params || !job->params->species || !job->positions.ptr || !job->velocities.ptr)
         return AK_ERR_NULL_ARG;
     const ak_boids_params* p = job->params;
@@ -162,16 +180,11 @@ ak_result akp_boids_validate_inputs(const ak_boids_step_job* job, bool need_wand
     if (job->velocities.count < n || (job->species.ptr && job->species.count < n) ||
         (need_wander && job->wander.ptr && job->wander.count < n))
         return AK_ERR_SPAN_SMALL;
-    if (job->species.ptr)
-        for (size_t i = 0; i < n; ++i)
-            if (job->species.ptr[i] >= p->species_count) return AK_ERR_BAD_INDEX;
-    if (!floats_ok((const float*)(const void*)job->positions.ptr, 3 * n) ||
-        !floats_ok((const float*)(const void*)job->velocities.ptr, 3 * n))
-        return AK_ERR_BAD_DATA;
-    if (need_wander && job->wander.ptr)
-        for (size_t i = 0; i < n; ++i)
-            if (!vec_ok(job->wander.ptr[i])) return AK_ERR_BAD_DATA;
-    return AK_OK;
+    return scan ? scan_agents(job, need_wander, 0, n) : AK_OK;
+}
+
+ak_result akp_boids_validate_inputs(const ak_boids_step_job* job, bool need_wander) {
+    return validate_inputs(job, need_wander, true);
 }
 
 size_t ak_boids_step_scratch_size(const ak_boids_step_job* job) {
@@ -183,8 +196,9 @@ size_t ak_boids_step_scratch_size(const ak_boids_step_job* job) {
     return akp_boids_search_scratch_size(job);
 }
 
-ak_result ak_boids_step_validate(const ak_boids_step_job* job) {
-    ak_result r = akp_boids_validate_inputs(job, true);
+/* ak_boids_step_validate; scan false leaves out the agents' data (scan_agents). */
+static ak_result step_validate(const ak_boids_step_job* job, bool scan) {
+    ak_result r = validate_inputs(job, true, scan);
     if (r != AK_OK && r != AK_ERR_EMPTY && r != AK_ERR_SPAN_SMALL && r != AK_ERR_BAD_INDEX && r != AK_ERR_BAD_DATA)
         return r;
     if (job && (!job->out_positions.ptr || !job->out_velocities.ptr)) return AK_ERR_NULL_ARG;
@@ -209,6 +223,8 @@ ak_result ak_boids_step_validate(const ak_boids_step_job* job) {
     }
     return AK_OK;
 }
+
+ak_result ak_boids_step_validate(const ak_boids_step_job* job) { return step_validate(job, true); }
 
 /* ---- obstacles ----------------------------------------------------------------------- */
 
@@ -615,8 +631,44 @@ void akp_boids_ctx_init(akp_boids_ctx* c, const ak_boids_step_job* job) {
     for (uint32_t s = 0; s < job->params->species_count; ++s) species_runtime(&job->params->species[s], &c->sp[s]);
 }
 
+/* ak_boids_step_run's data check: agents [n part / parts, n (part + 1) / parts). */
+typedef struct scan_task {
+    const ak_boids_step_job* job;
+    uint32_t part, parts;
+    ak_result r;
+} scan_task;
+
+static void* scan_thread(void* arg) {
+    scan_task* t = (scan_task*)arg;
+    const size_t n = t->job->positions.count;
+    t->r = scan_agents(t->job, true, n * t->part / t->parts, n * (t->part + 1) / t->parts);
+    return NULL;
+}
+
+/* ak_boids_step_validate with the agents' data checked on the step's threads (one read of the
+ * positions and velocities: 0.8 ms of a 1M-agent step on one core, all of it serial before).
+ * Same result: when a rule other than the data fails, the serial check answers (its order of
+ * rules); else AK_ERR_BAD_INDEX if any part has a bad species, else AK_ERR_BAD_DATA if any has
+ * bad data, as scan_agents over all agents would say. */
+static ak_result step_validate_split(const ak_boids_step_job* job) {
+    ak_result r = step_validate(job, false);
+    if (r != AK_OK) return ak_boids_step_validate(job);
+    const size_t n = job->positions.count;
+    uint32_t parts = akp_boids_threads(job->thread_count, n);
+    if (n < AKP_BOIDS_SCAN_SPLIT) parts = 1; /* a section costs more than the scan saves */
+    scan_task tasks[64];
+    for (uint32_t t = 0; t < parts; ++t) tasks[t] = (scan_task){job, t, parts, AK_OK};
+    if (parts == 1) scan_thread(&tasks[0]);
+    else akp_boids_run_tasks(scan_thread, tasks, sizeof tasks[0], parts);
+    for (uint32_t t = 0; t < parts; ++t)
+        if (tasks[t].r == AK_ERR_BAD_INDEX) return AK_ERR_BAD_INDEX;
+    for (uint32_t t = 0; t < parts; ++t)
+        if (tasks[t].r != AK_OK) return tasks[t].r;
+    return AK_OK;
+}
+
 ak_result ak_boids_step_run(const ak_boids_step_job* job) {
-    ak_result r = ak_boids_step_validate(job);
+    ak_result r = step_validate_split(job);
     if (r != AK_OK) return r;
     akp_boids_ctx c;
     akp_boids_ctx_init(&c, job);
@@ -625,6 +677,7 @@ ak_result ak_boids_step_run(const ak_boids_step_job* job) {
     const uint32_t threads = akp_boids_threads(job->thread_count, c.n);
     step_task tasks[64];
     for (uint32_t t = 0; t < threads; ++t) tasks[t] = (step_task){&c, t, threads, 0, 0, NULL};
+    akp_boids_partition(&c, threads);
     if (c.sym) akp_boids_sym_clear(&c, threads);
     akp_boids_run_tasks(step_thread, tasks, sizeof tasks[0], threads);
     if (c.sym && threads > 1) akp_boids_run_tasks(step_finish_thread, tasks, sizeof tasks[0], threads);

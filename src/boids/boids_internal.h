@@ -74,7 +74,15 @@ typedef struct akp_boids_ctx {
     akp_boids_acc* acc;
     akp_boids_acc* spill;    /* credits across thread boundaries (in the grid's unused memory) */
     size_t spill_cap;        /* entries spill holds */
-    bool use_spill;          /* set by akp_boids_sym_clear: the boundary slabs fit spill */
+    bool use_spill;          /* set by akp_boids_sym_clear: the deferred rows fit spill */
+    /* The dense layout's rows (row r: z = r / dim[1], y = r % dim[1]) split into the step's
+     * parts by estimated work (akp_boids_partition): part p walks rows [part_row[p],
+     * part_row[p + 1]); in the symmetric pass its rows [part_row[p], defer_row[p]) also
+     * receive from part p - 1 and integrate in akp_boids_sym_finish (defer_row[0] =
+     * part_row[0]). part_count: the parts it was made for (0: none). */
+    uint32_t part_row[65], defer_row[65];
+    uint32_t part_count;
+    bool sym_zeroed;         /* the deferred rows' sums (acc or spill) were zeroed in the fill */
     /* The spatial arrays, writable, for akp_boids_search_fill. */
     float *fill_sx, *fill_sy, *fill_sz;
     ak_vec3* fill_sv;
@@ -103,6 +111,9 @@ typedef struct akp_boids_gather {
 } akp_boids_gather;
 
 ak_result akp_boids_validate_inputs(const ak_boids_step_job* job, bool need_wander);
+/* From this many agents on, ak_boids_step_run checks the agents' data on its threads (one
+ * part per thread); below, on the calling thread. */
+#define AKP_BOIDS_SCAN_SPLIT 65536u
 ak_boids_bounds akp_boids_bounds_mode(const ak_boids_params* p);
 void akp_boids_ctx_init(akp_boids_ctx* c, const ak_boids_step_job* job);
 void akp_boids_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
@@ -260,10 +271,20 @@ void akp_boids_list_agent(const akp_boids_ctx* c, size_t i, uint32_t* out, uint3
  * cells so each cell's neighbour cells are looked up once. */
 typedef void (*akp_boids_agent_fn)(const akp_boids_ctx* c, size_t i, const akp_boids_gather* g, void* user);
 void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);
-/* The symmetric pass (c->sym): akp_boids_sym_clear once before the threads start;
+/* Split the dense layout's rows into `parts` parts (c->part_row, c->defer_row) by estimated
+ * work: each row's agents times (a fixed cost per agent plus the candidates of its forward
+ * rows, from the rows' agent counts); the symmetric pass needs every part but the last to hold
+ * more than dim[1] rows (a row's pairs reach dim[1] + 1 rows ahead), so there are fewer
+ * non-empty parts when the box has few rows; the empty ones come last. Serial: one read of
+ * the rows' starts. No-op without the dense layout, or when made for these parts already
+ * (akp_boids_search_prepare makes it before its fill section, whose threads also zero the
+ * symmetric pass's deferred sums: akp_boids_sym_clear then has nothing left to do). */
+void akp_boids_partition(akp_boids_ctx* c, size_t parts);
+/* The symmetric pass (c->sym): akp_boids_partition and akp_boids_sym_clear once before the
+ * threads start;
  * akp_boids_sym_range(part, parts) on each thread finds every pair once and calls fn for
  * each agent whose sums are complete; after all of them returned, akp_boids_sym_finish
- * (part, parts) calls fn for the rest (the agents of each part's first z slab, which the part
+ * (part, parts) calls fn for the rest (the agents of each part's deferred rows, which the part
  * before also credits), a 1/parts share of them each. */
 void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts);
 void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user);

@@ -498,10 +498,12 @@ static void gather_rows(const akp_boids_ctx* c, const row_ranges* r, akp_boids_g
  * j - i is exactly -(i - j) in floats, fix() is odd, so what j receives from the pair is
  * bit for bit what j's own walk over its neighbourhood would have summed. Every agent's sums
  * are complete once the agents before it are done, so integration follows at once; only the
- * first z slab of each thread after the first waits: its agents also receive from the slab
- * before, on the other thread, which credits them in a spill buffer (or, when the boundary
- * slabs hold more agents than it has room for, by atomic adds); the slab integrates after
- * both are done. Integer sums: the same bits in any order. */
+ * first rows of each part after the first wait (its deferred rows: the dim[1] + 1 rows that
+ * the part before reaches): their agents also receive from the rows before, on the other
+ * thread, which credits them in a spill buffer (or, when the deferred rows hold more agents
+ * than it has room for, by atomic adds); they integrate after both are done. The parts are
+ * runs of whole rows of about equal estimated work (akp_boids_partition). Integer sums: the
+ * same bits in any order, so the partition does not change them. */
 
 /* Agent g against its forward hits [0, h): g's sums in g, the hits' credits in c->acc. */
 static void sym_hits(const akp_boids_ctx* c, akp_boids_gather* g, const akp_boids_hits* hb, uint32_t h,
@@ -615,45 +617,114 @@ static uint32_t filter_sse2(const float* restrict X, const float* restrict Y, co
     return h - at;
 }
 
-/* First slab of part `part` of `parts` (the slabs of part p: [slab_of(p), slab_of(p + 1))). */
-static size_t slab_of(const akp_boids_ctx* c, size_t part, size_t parts) {
-    return (size_t)c->dense_dim[2] * part / parts;
-}
+/* Spatial index of the first agent of row r of the dense box (r <= dim[1] dim[2]). */
+static uint32_t row_start(const akp_boids_ctx* c, size_t r) { return c->dstart[r * (size_t)c->dense_dim[0]]; }
 
-/* Spatial index of the first agent of slab z (z <= dim[2]). */
-static uint32_t slab_start(const akp_boids_ctx* c, size_t z) {
-    return c->dstart[z * (size_t)c->dense_dim[0] * (size_t)c->dense_dim[1]];
-}
-
-static void acc_zero(const akp_boids_ctx* c, size_t z) {
-    const uint32_t b = slab_start(c, z), e = slab_start(c, z + 1);
+static void acc_zero_rows(const akp_boids_ctx* c, size_t r0, size_t r1) {
+    const uint32_t b = row_start(c, r0), e = row_start(c, r1);
     memset(c->acc + b, 0, (size_t)(e - b) * sizeof(akp_boids_acc));
 }
 
-/* First spill entry of deferred slab z: the deferred slabs (first slabs of the parts after the
- * first) before it, in order, side by side. */
-static size_t spill_base(const akp_boids_ctx* c, size_t parts, size_t z) {
-    size_t base = 0, prev = 0;
-    for (size_t t = 1; t < parts; ++t) {
-        const size_t s = slab_of(c, t, parts);
-        if (s >= z || s >= (size_t)c->dense_dim[2]) break;
-        if (s != prev) base += slab_start(c, s + 1) - slab_start(c, s);
-        prev = s;
+/* A row's estimated work, in units of a candidate's distance test times 2 dim[0]: its agents
+ * times (a fixed cost per agent, ROW_AGENT_COST tests, plus the candidates of the forward
+ * rows of the symmetric pass: 3 cells of each of them, a cell and a half of its own row). */
+#define ROW_AGENT_COST 32u
+static uint64_t row_work(const akp_boids_ctx* c, size_t r) {
+    const size_t dimy = (size_t)c->dense_dim[1], dimz = (size_t)c->dense_dim[2], y = r % dimy, z = r / dimy;
+    const uint64_t k = row_start(c, r + 1) - row_start(c, r);
+    if (!k) return 0;
+    uint64_t f2 = k; /* twice the forward rows' agents, the own row counted half */
+    if (y + 1 < dimy) f2 += 2u * (row_start(c, r + 2) - row_start(c, r + 1));
+    if (z + 1 < dimz) {
+        const size_t a = y > 0 ? r + dimy - 1 : r + dimy, b = y + 1 < dimy ? r + dimy + 2 : r + dimy + 1;
+        f2 += 2u * (uint64_t)(row_start(c, b) - row_start(c, a));
     }
+    return k * (2u * ROW_AGENT_COST * (uint64_t)c->dense_dim[0] + 3u * f2);
+}
+
+void akp_boids_partition(akp_boids_ctx* c, size_t parts) {
+    if (parts < 1) parts = 1;
+    if (parts > 64) parts = 64;
+    if (c->dstart && c->part_count == parts) return; /* made by akp_boids_search_prepare */
+    c->part_count = 0;
+    if (!c->dstart) return;
+    const size_t dimy = (size_t)c->dense_dim[1], rows = dimy * (size_t)c->dense_dim[2];
+    const size_t min_rows = c->sym ? dimy + 1 : 1;
+    size_t use = rows / min_rows < parts ? rows / min_rows : parts;
+    if (use < 1) use = 1;
+    uint64_t total = 0;
+    for (size_t r = 0; r < rows; ++r) total += row_work(c, r);
+    /* Part p starts at the first row whose work before it reaches p / use of the total
+     * (walked once), kept min_rows after the part before and min_rows per part to come
+     * before the end. */
+    c->part_row[0] = 0;
+    uint64_t done = 0;
+    size_t r = 0;
+    for (size_t p = 1; p < use; ++p) {
+        const uint64_t target = total / use * p + total % use * p / use;
+        while (r < rows && done < target) done += row_work(c, r++);
+        size_t b = r;
+        if (b < c->part_row[p - 1] + min_rows) b = c->part_row[p - 1] + min_rows;
+        if (b > rows - (use - p) * min_rows) b = rows - (use - p) * min_rows;
+        c->part_row[p] = (uint32_t)b;
+    }
+    for (size_t p = use; p <= parts; ++p) c->part_row[p] = (uint32_t)rows;
+    /* A row's forward rows reach dim[1] + 1 rows ahead: the rows part p - 1 credits. */
+    c->defer_row[0] = 0;
+    for (size_t p = 1; p < parts; ++p) {
+        const size_t b = c->part_row[p], reach = b + dimy + 1;
+        c->defer_row[p] = (uint32_t)(!c->sym ? b : reach < c->part_row[p + 1] ? reach : c->part_row[p + 1]);
+    }
+    c->part_count = (uint32_t)parts;
+}
+
+/* Agents of part p's deferred rows (none for p = 0 and empty parts). */
+static size_t deferred_count(const akp_boids_ctx* c, size_t p) {
+    return row_start(c, c->defer_row[p]) - row_start(c, c->part_row[p]);
+}
+
+/* First spill entry of part p's deferred rows: those of parts 1 .. p - 1, side by side. */
+static size_t spill_base(const akp_boids_ctx* c, size_t p) {
+    size_t base = 0;
+    for (size_t t = 1; t < p; ++t) base += deferred_count(c, t);
     return base;
 }
 
+/* Whether the deferred rows' credits go to spill (they fit it) or to acc by atomic adds. */
+static void sym_plan(akp_boids_ctx* c, size_t parts) { c->use_spill = spill_base(c, parts) <= c->spill_cap; }
+
+/* Part `part` of `parts` of the zeroing of the deferred rows' sums (spill entries, or the
+ * rows' acc entries), taken in order as in spill: for the fill's threads, so the caller does
+ * not zero them between sections (about 28 MB at 16 threads of a 1M step). */
+static void sym_zero_share(const akp_boids_ctx* c, size_t part, size_t parts) {
+    const size_t total = spill_base(c, c->part_count);
+    const size_t m0 = total * part / parts, m1 = total * (part + 1) / parts;
+    if (c->use_spill) {
+        memset(c->spill + m0, 0, (m1 - m0) * sizeof(akp_boids_acc));
+        return;
+    }
+    size_t base = 0;
+    for (size_t t = 1; t < c->part_count && base < m1; ++t) {
+        const uint32_t b = row_start(c, c->part_row[t]), e = row_start(c, c->defer_row[t]);
+        const size_t from = m0 > base ? m0 - base : 0, to = m1 - base < e - b ? m1 - base : e - b;
+        if (from < to) memset(c->acc + b + from, 0, (to - from) * sizeof(akp_boids_acc));
+        base += e - b;
+    }
+}
+
 void akp_boids_sym_clear(akp_boids_ctx* c, size_t parts) {
-    const size_t need = spill_base(c, parts, (size_t)c->dense_dim[2] + 1);
-    c->use_spill = need <= c->spill_cap;
+    if (c->part_count != parts) {
+        akp_boids_partition(c, parts);
+        c->sym_zeroed = false;
+    }
+    if (c->sym_zeroed) return; /* sym_plan and the zeroing ran in the fill */
+    const size_t need = spill_base(c, parts);
+    sym_plan(c, parts);
     if (c->use_spill) {
         memset(c->spill, 0, need * sizeof(akp_boids_acc));
         return;
     }
-    for (size_t t = 1; t < parts; ++t) {
-        const size_t z = slab_of(c, t, parts);
-        if (z > 0 && z < (size_t)c->dense_dim[2]) acc_zero(c, z);
-    }
+    for (size_t t = 1; t < parts; ++t) acc_zero_rows(c, c->part_row[t], c->defer_row[t]);
 }
 
 /* What the agent received, added to its own sums. */
@@ -663,25 +734,35 @@ static void add_received(const akp_boids_acc* A, akp_boids_gather* g) {
 }
 
 void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user) {
-    const size_t z0 = slab_of(c, part, parts), z1 = slab_of(c, part + 1, parts);
-    if (z0 == z1) return;
+    (void)parts; /* c->part_row was made for them (akp_boids_sym_clear) */
+    const size_t r0 = c->part_row[part], r1 = c->part_row[part + 1];
+    if (r0 == r1) return;
     const int64_t dimx = c->dense_dim[0], dimy = c->dense_dim[1], dimz = c->dense_dim[2];
+    const size_t rows = (size_t)dimy * (size_t)dimz;
     const uint32_t* ds = c->dstart;
-    /* Slab z0 waits when a part before this one credits it (z0 > 0 means one does). */
-    const uint32_t first_end = z0 > 0 ? slab_start(c, z0 + 1) : 0;
-    akp_boids_sink sink = {c->acc, NULL, c->use_spill ? 0 : first_end, slab_start(c, z1)};
-    if (c->use_spill && z1 < (size_t)dimz) sink.spill = c->spill + spill_base(c, parts, z1);
+    /* The deferred rows wait: the part before credits them too. */
+    const uint32_t first_end = part > 0 ? row_start(c, c->defer_row[part]) : 0;
+    akp_boids_sink sink = {c->acc, NULL, c->use_spill ? 0 : first_end, row_start(c, r1)};
+    if (c->use_spill && r1 < rows) sink.spill = c->spill + spill_base(c, part + 1);
     const float q2 = c->sp[0].query_radius * c->sp[0].query_radius;
     const float *X = c->sx, *Y = c->sy, *Z = c->sz;
     akp_boids_gather g;
     akp_boids_hits hb;
     akp_boids_packed pkv; /* 6 KiB */
     akp_boids_packed* pk = &pkv;
-    if (z0 == 0 || c->use_spill) acc_zero(c, z0); /* else akp_boids_sym_clear did */
-    for (int64_t z = (int64_t)z0; z < (int64_t)z1; ++z) {
-        if (z + 1 < (int64_t)z1) acc_zero(c, (size_t)z + 1);
-        for (int64_t y = 0; y < dimy; ++y) {
-            const size_t row = ((size_t)z * (size_t)dimy + (size_t)y) * (size_t)dimx;
+    /* acc is zeroed a little ahead of the rows that credit it (dim[1] + 1 rows ahead of the
+     * current one); the deferred rows' by akp_boids_sym_clear unless spill takes the part
+     * before's credits. */
+    size_t zeroed = part == 0 || c->use_spill ? r0 : c->defer_row[part];
+    for (size_t rw = r0; rw < r1; ++rw) {
+        const size_t ahead = rw + (size_t)dimy + 2 < r1 ? rw + (size_t)dimy + 2 : r1;
+        if (zeroed < ahead) {
+            acc_zero_rows(c, zeroed, ahead);
+            zeroed = ahead;
+        }
+        const int64_t z = (int64_t)(rw / (size_t)dimy), y = (int64_t)(rw % (size_t)dimy);
+        {
+            const size_t row = rw * (size_t)dimx;
             for (int64_t x = 0; x < dimx; ++x) {
                 const uint32_t k0 = ds[row + (size_t)x], k1 = ds[row + (size_t)x + 1];
                 if (k0 == k1) continue;
@@ -737,7 +818,7 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
                             }
                     sym_hits(c, &g, &hb, h, &sink);
                     if (k < first_end) {
-                        /* First slab of a later part: the part before credits it too. */
+                        /* A deferred row: the part before credits it too. */
                         const int64_t v[9] = {g.sep[0], g.sep[1], g.sep[2], g.ali[0], g.ali[1],
                                               g.ali[2], g.coh[0], g.coh[1], g.coh[2]};
                         akp_boids_credit(&c->acc[k], v, (uint64_t)g.ns | (uint64_t)g.na << 32,
@@ -753,28 +834,17 @@ void akp_boids_sym_range(const akp_boids_ctx* c, size_t part, size_t parts, akp_
 }
 
 void akp_boids_sym_finish(const akp_boids_ctx* c, size_t part, size_t parts, akp_boids_agent_fn fn, void* user) {
-    /* The deferred agents (the first slabs of the parts after the first, in order, as in
+    /* The deferred agents (the deferred rows of the parts after the first, in order, as in
      * spill) split evenly over the parts. */
-    size_t total = 0, prev = 0;
-    for (size_t t = 1; t < parts; ++t) {
-        const size_t z = slab_of(c, t, parts);
-        if (z != prev && z < (size_t)c->dense_dim[2]) total += slab_start(c, z + 1) - slab_start(c, z);
-        prev = z;
-    }
+    const size_t total = spill_base(c, parts);
     const size_t mine0 = total * part / parts, mine1 = total * (part + 1) / parts;
     akp_boids_gather g;
     size_t base = 0;
-    prev = 0;
     for (size_t t = 1; t < parts && base < mine1; ++t) {
-        const size_t z = slab_of(c, t, parts);
-        if (z == prev || z >= (size_t)c->dense_dim[2]) {
-            prev = z;
-            continue;
-        }
-        prev = z;
-        const uint32_t b = slab_start(c, z), e = slab_start(c, z + 1);
+        const uint32_t b = row_start(c, c->part_row[t]), e = row_start(c, c->defer_row[t]);
+        if (b == e) continue;
         const akp_boids_acc* spill = c->use_spill ? c->spill + base : NULL;
-        /* This slab's deferred positions [base, base + e - b) against [mine0, mine1). */
+        /* This part's deferred positions [base, base + e - b) against [mine0, mine1). */
         const size_t from = mine0 > base ? mine0 - base : 0, to = mine1 - base < e - b ? mine1 - base : e - b;
         for (size_t d = from; d < to; ++d) {
             const uint32_t k = b + (uint32_t)d;
@@ -945,6 +1015,7 @@ void akp_boids_search_fill(const akp_boids_ctx* c, size_t part, size_t parts) {
 static void* fill_thread(void* arg) {
     const akp_boids_fill_task* t = (const akp_boids_fill_task*)arg;
     akp_boids_search_fill(t->c, t->part, t->parts);
+    if (t->c->sym && t->c->part_count == t->parts) sym_zero_share(t->c, t->part, t->parts);
     return NULL;
 }
 
@@ -1092,20 +1163,24 @@ ak_result akp_boids_search_prepare(akp_boids_ctx* c, ak_u8_span scratch) {
     c->fill_qv = qv;
     /* The agents' data in spatial order: read through sj (in order), written in order, so it
      * splits over threads (akp_boids_search_fill); small steps fill here. */
-    const uint32_t parts = akp_boids_threads(c->job->thread_count, n);
-    if (parts <= 1 || n < 2048) akp_boids_search_fill(c, 0, 1);
-    else {
-        akp_boids_fill_task tasks[64];
-        for (uint32_t t = 0; t < parts; ++t) tasks[t] = (akp_boids_fill_task){c, t, parts};
-        akp_boids_run_tasks(fill_thread, tasks, sizeof tasks[0], parts);
-    }
-    c->avx512 = !c->job->skip_simd && !c->job->skip_avx512 && akp_boids_have_avx512();
-    c->avx2 = !c->job->skip_simd && !c->avx512 && akp_boids_have_avx2();
-    c->one_species = c->params->species_count == 1;
     c->sym = sym_ok && c->rings == 1;
     /* The grid's memory is free on this path (the cell coordinates are done with). */
     c->spill = (akp_boids_acc*)(void*)base;
     c->spill_cap = gbytes / sizeof(akp_boids_acc);
+    const uint32_t parts = akp_boids_threads(c->job->thread_count, n);
+    if (parts <= 1 || n < 2048) akp_boids_search_fill(c, 0, 1);
+    else {
+        /* the step's partition, and the symmetric pass's deferred sums zeroed in the fill */
+        akp_boids_partition(c, parts);
+        if (c->sym) sym_plan(c, parts);
+        akp_boids_fill_task tasks[64];
+        for (uint32_t t = 0; t < parts; ++t) tasks[t] = (akp_boids_fill_task){c, t, parts};
+        akp_boids_run_tasks(fill_thread, tasks, sizeof tasks[0], parts);
+        c->sym_zeroed = c->sym;
+    }
+    c->avx512 = !c->job->skip_simd && !c->job->skip_avx512 && akp_boids_have_avx512();
+    c->avx2 = !c->job->skip_simd && !c->avx512 && akp_boids_have_avx2();
+    c->one_species = c->params->species_count == 1;
     return AK_OK;
 }
 
@@ -1194,26 +1269,29 @@ void akp_boids_gather_range(const akp_boids_ctx* c, size_t part, size_t parts, a
     }
     if (c->dstart) {
         /* Box cells in spatial order (neighbouring cells share their candidates in cache), the
-         * z slabs split between the threads. */
+         * rows split between the threads by estimated work (akp_boids_partition; whole rows by
+         * count if it was not made for these parts). */
         const int32_t* dim = c->dense_dim;
-        const size_t z0 = (size_t)dim[2] * part / parts, z1 = (size_t)dim[2] * (part + 1) / parts;
-        const size_t slab = (size_t)dim[0] * (size_t)dim[1];
+        const size_t rows = (size_t)dim[1] * (size_t)dim[2];
+        const bool planned = c->part_count == parts;
+        const size_t r0 = planned ? c->part_row[part] : rows * part / parts;
+        const size_t r1 = planned ? c->part_row[part + 1] : rows * (part + 1) / parts;
         row_ranges rr;
-        for (size_t z = z0; z < z1; ++z)
-            for (size_t y = 0; y < (size_t)dim[1]; ++y) {
-                const size_t row = z * slab + y * (size_t)dim[0];
-                for (size_t x = 0; x < (size_t)dim[0]; ++x) {
-                    const uint32_t k0 = c->dstart[row + x], k1 = c->dstart[row + x + 1];
-                    if (k0 == k1) continue;
-                    rows_around(c, (int64_t)x, (int64_t)y, (int64_t)z, &rr);
-                    for (uint32_t k = k0; k < k1; ++k) {
-                        gather_begin_spatial(c, k, &g);
-                        gather_rows(c, &rr, &g);
-                        gather_end(c, &g);
-                        fn(c, g.i, &g, user);
-                    }
+        for (size_t rw = r0; rw < r1; ++rw) {
+            const size_t z = rw / (size_t)dim[1], y = rw % (size_t)dim[1];
+            const size_t row = rw * (size_t)dim[0];
+            for (size_t x = 0; x < (size_t)dim[0]; ++x) {
+                const uint32_t k0 = c->dstart[row + x], k1 = c->dstart[row + x + 1];
+                if (k0 == k1) continue;
+                rows_around(c, (int64_t)x, (int64_t)y, (int64_t)z, &rr);
+                for (uint32_t k = k0; k < k1; ++k) {
+                    gather_begin_spatial(c, k, &g);
+                    gather_rows(c, &rr, &g);
+                    gather_end(c, &g);
+                    fn(c, g.i, &g, user);
                 }
             }
+        }
         return;
     }
     const ak_grid* gr = &c->grid;
