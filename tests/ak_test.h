@@ -167,11 +167,11 @@ static inline ak_allocator ak_test_counting_allocator(ak_test_counter* c) {
 /* Directory of the shared real assets: $ANIMKIT_ASSETS, else ../shared/assets relative to the
  * source tree (AK_SOURCE_DIR is defined by CMake), else NULL. */
 static inline const char* ak_test_assets_dir(void) {
-    static char buf[1024];
     struct stat st;
     const char* env = getenv("ANIMKIT_ASSETS");
     if (env && *env && stat(env, &st) == 0) return env;
 #ifdef AK_SOURCE_DIR
+    static char buf[1024];
     snprintf(buf, sizeof buf, "%s/../shared/assets", AK_SOURCE_DIR);
     if (stat(buf, &st) == 0) return buf;
 #endif
