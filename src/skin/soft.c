@@ -1449,16 +1449,15 @@ static void step_work(soft_team* team, uint32_t index) {
             solve_range(c, cb + b, cb + e);
             sync(team);
         }
-        /* a released kinematic node: its tether to the skinned position at this substep */
+        float inv_h = 1.0f / c->h;
         const float back = c->h * (float)(S - sub - 1);
-        for (size_t n = nb; n < ne && c->tether > 0.0f; ++n)
-            if (s->kinematic[n] && c->released[n]) {
+        for (size_t n = nb; n < ne; ++n) {
+            const bool sim = !s->kinematic[n] || c->released[n];
+            if (sim && s->kinematic[n] && c->tether > 0.0f) {
+                /* a released kinematic node: its tether to the skinned position at this substep */
                 ak_vec3 t = ak_vec3_madd(c->target[n], c->vref[n], -back);
                 c->x[n].p = ak_vec3_madd(c->x[n].p, ak_vec3_sub(t, c->x[n].p), c->tether);
             }
-        float inv_h = 1.0f / c->h;
-        for (size_t n = nb; n < ne; ++n) {
-            const bool sim = !s->kinematic[n] || c->released[n];
             if (sim) collide_node(c, n);
             c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n].p, c->prev[n].p), inv_h);
             /* jiggle damping: velocity relative to the skinned motion decays */
