@@ -26,6 +26,15 @@
  * (0.35: 25 pairs at 150; 0.5: 2 at 130), docs/softskin.md */
 #define SOFT_RELEASE_CONE 0.44f     /* sin of the release cone's half-angle about a joint plane */
 #define SOFT_RELEASE_BEND_COS 0.0f  /* released only where the bones part by more than 90 deg */
+/* a released kinematic node is tied to its skinned position by a zero-length spring of this
+ * natural frequency (rad/s; XPBD, one projection per substep after the tets). Untied, the
+ * forearm's 22 released nodes of CesiumMan's elbow held at 140 deg slid up to 0.29 m from their
+ * skinned positions over 20 held frames and the held elbow kept 1.8e-3 of its bending energy
+ * after 1 s. 20 and 30 pass every flexion; 40 gives the elbow at 150 deg 14 pairs
+ * (docs/softskin.md) */
+#ifndef SOFT_TETHER_OMEGA
+#define SOFT_TETHER_OMEGA 30.0f
+#endif
 /* cubes: a node of a part beyond a joint's two bones (the buttock, the heel) takes the joint's
  * plane when its skinned position lies this close to a skinned node of the other side. Measured
  * on CesiumMan's knees (docs/softskin.md): 1.5 left 54 pairs at the left knee's 150 deg, 2 left
@@ -1081,6 +1090,7 @@ typedef struct step_ctx {
                           p, -(p + 1) child side; 0 none */
     posed_bone* bones; /* this substep's (pose_substep) */
     float jiggle; /* 1 - exp(-jiggle_damping h) */
+    float tether; /* (omega h)^2 / (1 + (omega h)^2): the XPBD step of a released node's tether */
     float* lambda;
     float h, gamma, adev, ahyd;
     bool simd; /* the CPU runs solve_tets8 */
@@ -1440,8 +1450,14 @@ static void step_work(soft_team* team, uint32_t index) {
             sync(team);
         }
         float inv_h = 1.0f / c->h;
+        const float back = c->h * (float)(S - sub - 1);
         for (size_t n = nb; n < ne; ++n) {
             const bool sim = !s->kinematic[n] || c->released[n];
+            if (sim && s->kinematic[n] && c->tether > 0.0f) {
+                /* a released kinematic node: its tether to the skinned position at this substep */
+                ak_vec3 t = ak_vec3_madd(c->target[n], c->vref[n], -back);
+                c->x[n].p = ak_vec3_madd(c->x[n].p, ak_vec3_sub(t, c->x[n].p), c->tether);
+            }
             if (sim) collide_node(c, n);
             c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n].p, c->prev[n].p), inv_h);
             /* jiggle damping: velocity relative to the skinned motion decays */
@@ -1580,6 +1596,10 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     c.simd = __builtin_cpu_supports("avx2");
 #endif
     c.jiggle = 1.0f - expf(-s->jiggle_damping * c.h);
+    {
+        const float wh2 = SOFT_TETHER_OMEGA * c.h * SOFT_TETHER_OMEGA * c.h;
+        c.tether = wh2 / (1.0f + wh2);
+    }
     const bool have_prev = j->previous_palette.ptr != NULL;
     for (size_t n = 0; n < nn; ++n) {
         c.start[n] = j->node_positions.ptr[n];
