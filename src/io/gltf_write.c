@@ -31,6 +31,9 @@ typedef struct w_ctx {
     cJSON *root, *views, *accessors, *nodes, *meshes, *skins, *animations, *materials;
     cJSON *textures, *images, *samplers;
     int32_t* gltf_texture; /* [scene texture_count] glTF texture written for it, -1 not yet */
+    uint8_t** png;         /* [scene texture_count] its PNG, encoded once for both passes
+                              (owned by the w_plan), NULL not yet */
+    size_t* png_size;
     int n_textures;
     size_t n_nodes; /* written so far (joints, then extra mesh nodes) */
     /* counts and a node table: cJSON arrays are linked lists, and asking their size or
@@ -565,11 +568,9 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
 static int texture_index(w_ctx* c, size_t ti) {
     if (c->gltf_texture[ti] >= 0) return c->gltf_texture[ti];
     const ak_scene_texture* st = &c->scene->textures[ti];
-    uint8_t* png = NULL;
-    size_t png_size = 0;
-    if (akp_image_encode_png(st->pixels, st->width, st->height, &png, &png_size) != AK_OK) return -1;
-    int view = add_view(c, png, png_size, 0);
-    free(png);
+    if (!c->png[ti] && akp_image_encode_png(st->pixels, st->width, st->height, &c->png[ti], &c->png_size[ti]) != AK_OK)
+        return -1;
+    int view = add_view(c, c->png[ti], c->png_size[ti], 0);
     if (view < 0) return -1;
     static const int wraps[3] = {10497, 33071, 33648};
     cJSON* im = cJSON_CreateObject();
@@ -1114,7 +1115,8 @@ static void ctx_free(w_ctx* c) {
     free(c->gltf_mesh_of);
     free(c->prim_of_mesh);
     free(c->last_times);
-    *c = (w_ctx){.scene = c->scene, .path = c->path, .diag = c->diag, .logger = c->logger};
+    *c = (w_ctx){.scene = c->scene, .path = c->path, .diag = c->diag, .logger = c->logger, .png = c->png,
+                 .png_size = c->png_size};
 }
 
 /* What the measuring pass found: the printed JSON and the sizes of what will be written. */
@@ -1123,6 +1125,8 @@ typedef struct w_plan {
     char* json;   /* the document's JSON text (malloc'd by cJSON) */
     size_t json_size, bin_size;
     size_t total; /* bytes of every file written: the .glb, or the .gltf and its .bin */
+    uint8_t** png; /* [texture_count] the textures' PNGs (w_ctx.png) */
+    size_t* png_size;
     char bin_path[4096], bin_uri[4096];
 } w_plan;
 
@@ -1132,8 +1136,11 @@ static ak_result plan_save(const char* path, const ak_scene* scene, const ak_log
                            w_plan* plan) {
     memset(plan, 0, sizeof *plan);
     plan->glb = ends_with(path, ".glb");
-    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = logger};
-    ak_result r = build_document(&c);
+    const size_t tc = scene->texture_count ? scene->texture_count : 1;
+    plan->png = (uint8_t**)calloc(tc, sizeof *plan->png);
+    plan->png_size = (size_t*)calloc(tc, sizeof *plan->png_size);
+    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = logger, .png = plan->png, .png_size = plan->png_size};
+    ak_result r = plan->png && plan->png_size ? build_document(&c) : oom(&c);
     /* the file name of the .bin beside a .gltf: the .gltf's name with .bin */
     if (r == AK_OK && !plan->glb && c.bin_size) {
         size_t n = strlen(path);
@@ -1174,18 +1181,24 @@ static ak_result plan_save(const char* path, const ak_scene* scene, const ak_log
         }
     }
     ctx_free(&c);
-    if (r != AK_OK) {
-        free(plan->json);
-        plan->json = NULL;
-    }
     return r;
+}
+
+/* Free what plan_save left in plan. */
+static void plan_free(const ak_scene* scene, w_plan* plan) {
+    free(plan->json);
+    for (size_t t = 0; plan->png && t < scene->texture_count; ++t) free(plan->png[t]);
+    free(plan->png);
+    free(plan->png_size);
+    memset(plan, 0, sizeof *plan);
 }
 
 /* The writing pass: the document built again (the same scene gives the same views in the
  * same order), every view streamed to f as it is made; the JSON of this pass is thrown away. */
 static ak_result stream_bin(const char* path, const ak_scene* scene, ak_diag* diag, const w_plan* plan, FILE* f) {
     ak_logger none = {0}; /* the measuring pass gave the warnings */
-    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = &none, .sink = f};
+    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = &none, .sink = f, .png = plan->png,
+               .png_size = plan->png_size};
     ak_result r = build_document(&c);
     if (r == AK_OK && c.sink_failed) {
         akp_diag_set(diag, path, "cannot write file (%s)", strerror(c.sink_err));
@@ -1230,7 +1243,7 @@ ak_result ak_io_save_size(const char* path, const ak_scene* scene, const ak_io_s
     }
     ak_result r = plan_save(path, scene, desc ? &desc->logger : &none, diag, plan);
     if (r == AK_OK) *out_bytes = plan->total;
-    free(plan->json);
+    plan_free(scene, plan);
     free(plan);
     return r;
 }
@@ -1312,7 +1325,7 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
         ak_atomic_file_abort(out);
     }
     free(out);
-    free(plan->json);
+    plan_free(scene, plan);
     free(plan);
     return r;
 }
