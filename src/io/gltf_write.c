@@ -98,6 +98,7 @@ static int add_view(w_ctx* c, const void* data, size_t bytes, int target) {
         }
     }
     c->bin_size += padded;
+    if (c->sink) return c->n_views++; /* the writing pass: its JSON is the measuring pass's */
     cJSON* v = cJSON_CreateObject();
     if (!v || !cJSON_AddItemToArray(c->views, v)) return -1;
     add_num(v, "buffer", 0);
@@ -127,6 +128,7 @@ static int add_accessor(w_ctx* c, const void* data, size_t count, int ctype, int
     size_t bytes = count * (size_t)comps * ctype_size(ctype);
     int view = add_view(c, data, bytes, target);
     if (view < 0) return -1;
+    if (c->sink) return c->n_accessors++;
     cJSON* a = cJSON_CreateObject();
     if (!a || !cJSON_AddItemToArray(c->accessors, a)) return -1;
     const int index = c->n_accessors++;
@@ -858,6 +860,11 @@ static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t key
         c->last_times_accessor = in, c->last_times_keys = keys;
     }
     int outa = add_accessor(c, values, value_count, GL_FLOAT, comps, 0, false);
+    if (c->sink) { /* the writing pass: only the data matters */
+        if (in < 0 || outa < 0) return oom(c);
+        *out_index = c->n_samplers++;
+        return AK_OK;
+    }
     cJSON* sm = cJSON_CreateObject();
     if (in < 0 || outa < 0 || !sm || !cJSON_AddItemToArray(samplers, sm)) return oom(c);
     add_num(sm, "input", in);
@@ -869,6 +876,7 @@ static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t key
 }
 
 static ak_result add_channel(w_ctx* c, cJSON* an, int sampler, int32_t node, const char* path) {
+    if (c->sink) return AK_OK; /* the writing pass: no JSON */
     cJSON* ch = cJSON_CreateObject();
     cJSON* chans = cJSON_GetObjectItemCaseSensitive(an, "channels");
     if (!ch || !cJSON_AddItemToArray(chans, ch)) return oom(c);
