@@ -632,6 +632,187 @@ AK_TEST(instances_round_trip) {
     ak_scene_destroy(b);
 }
 
+/* ---- memory budget (ak_io_save_desc.memory_budget, ak_io_save_size) --------------------- */
+
+/* Size of a file in bytes, -1 when it does not exist. */
+static long long file_size(const char* path) {
+    struct stat st;
+    return stat(path, &st) == 0 ? (long long)st.st_size : -1;
+}
+
+/* The whole file (malloc'd, *n bytes), NULL when it cannot be read. */
+static unsigned char* read_all(const char* path, size_t* n) {
+    FILE* fp = fopen(path, "rb");
+    if (!fp) return NULL;
+    fseek(fp, 0, SEEK_END);
+    long len = ftell(fp);
+    fseek(fp, 0, SEEK_SET);
+    unsigned char* b = len >= 0 ? malloc((size_t)len + 1) : NULL;
+    if (b && fread(b, 1, (size_t)len, fp) != (size_t)len) free(b), b = NULL;
+    fclose(fp);
+    *n = (size_t)len;
+    return b;
+}
+
+/* Files in the test directory whose name starts with prefix (the writer's temporaries are
+ * ".NAME.XXXXXX"). */
+static int count_prefixed(const char* prefix) {
+    DIR* d = opendir(g_tmp);
+    int n = 0;
+    for (struct dirent* e; d && (e = readdir(d)) != NULL;) n += strncmp(e->d_name, prefix, strlen(prefix)) == 0;
+    if (d) closedir(d);
+    return n;
+}
+
+/* The humanoid's skinned mesh placed three times (shares_mesh), twice red, once blue. */
+static ak_scene* make_instances(void) {
+    ak_scene *h = NULL, *a = NULL;
+    if (ak_builtin_create("humanoid", NULL, NULL, &h) != AK_OK || ak_scene_alloc(3, 1, 0, NULL, &a) != AK_OK ||
+        h->mesh_count != 1 || h->skin_count != 1 || ak_scene_skin_alloc(a, 0, h->skins[0].joint_count) != AK_OK) {
+        ak_scene_destroy(h);
+        ak_scene_destroy(a);
+        return NULL;
+    }
+    a->skeleton = h->skeleton, h->skeleton = NULL;
+    memcpy(a->skins[0].joints, h->skins[0].joints, h->skins[0].joint_count * sizeof(int32_t));
+    memcpy(a->skins[0].inverse_binds, h->skins[0].inverse_binds, h->skins[0].joint_count * sizeof(ak_mat4));
+    for (int m = 0; m < 3; ++m) {
+        a->meshes[m] = h->meshes[0];
+        a->meshes[m].shares_mesh = m > 0;
+        a->meshes[m].has_material = true;
+        a->meshes[m].base_color = m == 2 ? ak_vec4_make(0, 0, 1, 1) : ak_vec4_make(1, 0, 0, 1);
+        a->meshes[m].texture = -1;
+    }
+    h->meshes[0].mesh = NULL;
+    ak_scene_destroy(h);
+    return a;
+}
+
+/* One scene, .glb and .gltf (file names of one length: a .gltf holds its .bin's name): the size
+ * ak_io_save_size gives ahead is the size of what
+ * ak_io_save writes (stat of the .glb, or of the .gltf plus its .bin; for a .glb also the
+ * length in its own header); a budget one byte below it is refused (AK_ERR_UNSUPPORTED, the
+ * message naming both numbers) with no file and no temporary left; a budget of exactly that
+ * size, and a large one, write the same bytes as the default. formats 1: only .glb. Returns
+ * the .glb size. */
+static size_t check_budget(const ak_scene* s, const char* tag, int formats) {
+    size_t glb_size = 0;
+    for (int f = 0; f < formats; ++f) {
+        const char* ext = f ? "gltf" : "glb";
+        char name[128], out[1024], bin[1040], refused[1024], exact[1024], prefix[160];
+        ak_diag diag;
+        snprintf(name, sizeof name, "budget_%s_D.%s", tag, ext);
+        tmp_path(out, sizeof out, name);
+        snprintf(bin, sizeof bin, "%.*s.bin", (int)(strlen(out) - 5), out);
+        size_t ahead = 0;
+        ak_result r = ak_io_save_size(out, s, NULL, &ahead, &diag);
+        AK_CHECK_MSG(r == AK_OK, "%s: %s", name, diag.message);
+        AK_CHECK_MSG(file_size(out) < 0, "%s: ak_io_save_size wrote a file", name);
+        AK_CHECK_EQ(ak_io_save(out, s, NULL, &diag), AK_OK);
+        long long written = file_size(out);
+        if (f) written += file_size(bin) > 0 ? file_size(bin) : 0;
+        AK_CHECK_MSG(written == (long long)ahead, "%s: %zu bytes computed ahead, %lld written", name, ahead, written);
+        if (!f) {
+            glb_size = ahead;
+            size_t n = 0;
+            unsigned char* b = read_all(out, &n);
+            size_t hl = b && n >= 12 ? (size_t)b[8] | (size_t)b[9] << 8 | (size_t)b[10] << 16 | (size_t)b[11] << 24 : 0;
+            AK_CHECK_MSG(hl == n, "%s: GLB header says %zu bytes, the file has %zu", name, hl, n);
+            free(b);
+        }
+        /* one byte short: refused before any file exists */
+        snprintf(name, sizeof name, "budget_%s_R.%s", tag, ext);
+        tmp_path(refused, sizeof refused, name);
+        snprintf(prefix, sizeof prefix, ".budget_%s_R.", tag);
+        ak_io_save_desc small = {.memory_budget = ahead - 1};
+        r = ak_io_save(refused, s, &small, &diag);
+        AK_CHECK_MSG(r == AK_ERR_UNSUPPORTED, "%s: budget %zu below %zu gave %s", name, ahead - 1, ahead, ak_result_string(r));
+        char num_a[32], num_b[32];
+        snprintf(num_a, sizeof num_a, "%zu", ahead);
+        snprintf(num_b, sizeof num_b, "%zu", ahead - 1);
+        AK_CHECK_MSG(strstr(diag.message, num_a) && strstr(diag.message, num_b) && strstr(diag.message, "budget"),
+                     "%s: message '%s' should name %s and %s", name, diag.message, num_a, num_b);
+        AK_CHECK_MSG(file_size(refused) < 0, "%s: a refused save left a file", name);
+        snprintf(name, sizeof name, "budget_%s_R.bin", tag);
+        AK_CHECK_MSG(file_size(tmp_path(refused, sizeof refused, name)) < 0, "%s: a refused save left a .bin", name);
+        AK_CHECK_MSG(count_prefixed(prefix) == 0, "%s: a refused save left a temporary", prefix);
+        /* exactly the size, and far above it: the same bytes as the default */
+        const size_t budgets[2] = {ahead, (size_t)1 << 40};
+        for (int k = 0; k < 2; ++k) {
+            snprintf(name, sizeof name, "budget_%s_%d.%s", tag, k, ext);
+            tmp_path(exact, sizeof exact, name);
+            ak_io_save_desc big = {.memory_budget = budgets[k]};
+            r = ak_io_save(exact, s, &big, &diag);
+            AK_CHECK_MSG(r == AK_OK, "%s: budget %zu: %s", name, budgets[k], diag.message);
+            size_t na = 0, nb = 0;
+            unsigned char* a = read_all(out, &na);
+            unsigned char* b = read_all(exact, &nb);
+            /* a .gltf names its own .bin: compare the binary files, and the JSON up to the uri */
+            if (f) {
+                char bin2[1040];
+                snprintf(bin2, sizeof bin2, "%.*s.bin", (int)(strlen(exact) - 5), exact);
+                size_t ma = 0, mb = 0;
+                unsigned char* x = read_all(bin, &ma);
+                unsigned char* y = read_all(bin2, &mb);
+                AK_CHECK_MSG((!x && !y) || (x && y && ma == mb && memcmp(x, y, ma) == 0), "%s: the .bin differs", name);
+                free(x);
+                free(y);
+                /* the same length of name: the JSON differs only in the .bin's uri, one byte */
+                size_t differ = 0;
+                for (size_t i = 0; a && b && i < na && i < nb; ++i) differ += a[i] != b[i];
+                AK_CHECK_MSG(a && b && na == nb && differ == 1, "%s: %zu JSON bytes, %zu without a budget, %zu differ",
+                             name, nb, na, differ);
+            } else {
+                AK_CHECK_MSG(a && b && na == nb && memcmp(a, b, na) == 0, "%s: bytes differ from the default's", name);
+            }
+            free(a);
+            free(b);
+        }
+    }
+    return glb_size;
+}
+
+/* ak_io_save_size against the files ak_io_save writes, and the budget refusing and allowing,
+ * on: the hand-made scene (skinned, 6 influences, morph targets, STEP/LINEAR/CUBICSPLINE/HERMITE
+ * keys), a shared mesh placed three times, the builtin humanoid, and the shared assets
+ * (CesiumMan: skinned, animated, a texture; AnimatedMorphCube: morph targets; Fox). */
+AK_TEST(save_budget) {
+    ak_scene* s = make_scene(AK_INTERP_CUBICSPLINE);
+    if (s) check_budget(s, "handmade", 2);
+    ak_scene_destroy(s);
+    s = make_instances();
+    AK_CHECK(s != NULL);
+    if (s) check_budget(s, "instances", 2);
+    ak_scene_destroy(s);
+    s = NULL;
+    AK_CHECK_EQ(ak_builtin_create("humanoid", NULL, NULL, &s), AK_OK);
+    if (s) {
+        size_t n = 0;
+        ak_diag diag;
+        check_budget(s, "humanoid", 2);
+        AK_CHECK_EQ(ak_io_save_size("x.glb", s, NULL, NULL, &diag), AK_ERR_NULL_ARG);
+        AK_CHECK_EQ(ak_io_save_size("x.obj", s, NULL, &n, &diag), AK_ERR_BAD_ARG);
+        AK_CHECK_EQ(ak_io_save_size("x.glb", NULL, NULL, &n, &diag), AK_ERR_NULL_ARG);
+    }
+    ak_scene_destroy(s);
+    const char* dir = ak_test_assets_dir();
+    const char* assets[] = {"CesiumMan", "AnimatedMorphCube", "Fox"};
+    for (int i = 0; dir && i < 3; ++i) {
+        char src[1200];
+        snprintf(src, sizeof src, "%s/gltf/%s/glTF-Binary/%s.glb", dir, assets[i], assets[i]);
+        if (file_size(src) < 0) {
+            printf("  %s absent\n", src);
+            continue;
+        }
+        ak_diag diag;
+        s = NULL;
+        AK_CHECK_MSG(ak_io_load(src, &k_load, NULL, &s, &diag) == AK_OK, "%s: %s", src, diag.message);
+        /* .gltf on the small one only: the textured ones spend their time encoding PNGs */
+        if (s) printf("  %s: %zu bytes as .glb\n", assets[i], check_budget(s, assets[i], i == 1 ? 2 : 1));
+        ak_scene_destroy(s);
+    }
+}
+
 /* BVH motion capture (Euler channels, no mesh) written as glTF: the same poses. */
 AK_TEST(bvh_round_trip) {
     char src[1200];
@@ -699,6 +880,7 @@ int main(void) {
     AK_RUN(builtin_round_trip);
     AK_RUN(instances_round_trip);
     AK_RUN(bvh_round_trip);
+    AK_RUN(save_budget);
 #ifdef AK_CLI_PATH
     AK_RUN_SLOW(cli_export);
 #endif

@@ -248,9 +248,16 @@ AK_API ak_result ak_io_image_decode(const void* data, size_t size, size_t memory
 /* Free pixels from ak_io_image_decode (alloc as given to it); NULL is a no-op. */
 AK_API void ak_io_image_free(const ak_allocator* alloc, uint8_t* pixels);
 
+/* Default memory budget of one ak_io_save (ak_io_save_desc.memory_budget = 0): 1 GiB of output. */
+#define AK_IO_SAVE_DEFAULT_BUDGET ((size_t)1 << 30)
+
 /* How ak_io_save writes (all fields zero -> defaults). */
 typedef struct ak_io_save_desc {
-    ak_logger logger; /* warnings (scalar channels and clips glTF cannot hold); zero -> silent */
+    ak_logger logger;     /* warnings (scalar channels and clips glTF cannot hold); zero -> silent */
+    size_t memory_budget; /* most bytes of output (JSON text + binary chunk: the .glb, or the
+                             .gltf and its .bin, exactly as ak_io_save_size counts them) one save
+                             may produce; over it -> AK_ERR_UNSUPPORTED before any file is
+                             created. 0 -> AK_IO_SAVE_DEFAULT_BUDGET */
 } ak_io_save_desc;
 
 /* Write a scene as glTF 2.0: a path ending in .glb (any case) gives one binary GLB file; .gltf
@@ -291,13 +298,20 @@ typedef struct ak_io_save_desc {
  * reader takes the last key time), ak_skeleton joint types and limits.
  * Layout: one buffer, one bufferView per accessor (4-byte aligned, zero padded, so no
  * byteStride), GLB JSON chunk padded with spaces and BIN chunk with zeros.
+ * Memory: two passes over the scene. The first builds the JSON document (a cJSON tree) with
+ * the binary chunk only counted, prints it and frees the tree: that gives the exact output size
+ * (ak_io_save_size), checked against desc->memory_budget before a file is created. The second
+ * builds the document again and streams each bufferView's data straight to the file (.glb: after
+ * the JSON chunk, whose text is freed first; .gltf: to the .bin), so the binary chunk is never
+ * held whole; the peak is about the cJSON tree plus the JSON text (docs/io.md has measurements).
  * Returns AK_ERR_NULL_ARG (path or scene NULL, a scene mesh without data), AK_ERR_BAD_ARG
  * (another extension), AK_ERR_BAD_DATA (a non-finite position, normal, UV, colour, morph
  * delta, default weight, rest transform, inverse bind or key), AK_ERR_BAD_WEIGHTS (a
  * negative weight), AK_ERR_BAD_INDEX (a triangle index, skin joint, channel joint, or a
  * scene mesh's skin or node out of range), AK_ERR_UNSUPPORTED (an interpolation glTF cannot express: NLERP, SQUAD, LAGRANGE,
  * or a cubic mode other than HERMITE on a rotation: bake the clip first; two channels
- * animating one mesh's morph weights; more than 4 GiB in a GLB), AK_ERR_IO (cannot create or
+ * animating one mesh's morph weights; more than 4 GiB in a GLB; output larger than
+ * desc->memory_budget: diag names both sizes, no file is created), AK_ERR_IO (cannot create or
  * write a file), AK_ERR_NO_MEMORY. diag (optional) names the file and the problem. Temporary
  * memory comes from malloc. Files are written whole or not at all: each to a temporary
  * ".NAME.XXXXXX" beside it, renamed into place (a symlink there is replaced, not followed)
@@ -305,6 +319,14 @@ typedef struct ak_io_save_desc {
  * temporaries are removed and the named files are left untouched (only a failed rename of
  * the .gltf after its .bin's can leave a new .bin beside the old .gltf). */
 AK_API ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_desc* desc, ak_diag* diag);
+
+/* The exact number of bytes ak_io_save(path, scene, desc) would write (the .glb; or the .gltf
+ * plus its .bin), into *out_bytes, without writing anything: the first of ak_io_save's two passes
+ * (it builds and prints the JSON document, so it costs about that pass's time and memory).
+ * desc->memory_budget is not applied. Returns ak_io_save's codes other than AK_ERR_IO, and
+ * AK_ERR_NULL_ARG when out_bytes is NULL; on failure *out_bytes is 0. */
+AK_API ak_result ak_io_save_size(const char* path, const ak_scene* scene, const ak_io_save_desc* desc,
+                                 size_t* out_bytes, ak_diag* diag);
 
 #ifdef __cplusplus
 }

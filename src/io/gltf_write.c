@@ -22,11 +22,18 @@ typedef struct w_ctx {
     const char* path;
     ak_diag* diag;
     const ak_logger* logger;
-    uint8_t* bin;
-    size_t bin_size, bin_cap;
+    /* the binary chunk is never held whole: a measuring pass (sink NULL) only adds up its
+     * size and offsets; the writing pass streams each view to sink */
+    FILE* sink;
+    bool sink_failed; /* a write to sink failed (errno in sink_err) */
+    int sink_err;
+    size_t bin_size;
     cJSON *root, *views, *accessors, *nodes, *meshes, *skins, *animations, *materials;
     cJSON *textures, *images, *samplers;
     int32_t* gltf_texture; /* [scene texture_count] glTF texture written for it, -1 not yet */
+    uint8_t** png;         /* [scene texture_count] its PNG, encoded once for both passes
+                              (owned by the w_plan), NULL not yet */
+    size_t* png_size;
     int n_textures;
     size_t n_nodes; /* written so far (joints, then extra mesh nodes) */
     /* counts and a node table: cJSON arrays are linked lists, and asking their size or
@@ -44,7 +51,8 @@ typedef struct w_ctx {
     cJSON** prim_of_mesh;   /* [mesh_count] the primitive written for an instanced owner */
     /* the last animation input written: channels keyed at the same times share it */
     int last_times_accessor;
-    size_t last_times_offset, last_times_keys;
+    float* last_times; /* a copy of its keys */
+    size_t last_times_keys, last_times_cap;
 } w_ctx;
 
 /* One morph-weight sampler as written: key times, values in glTF layout. */
@@ -69,31 +77,28 @@ static ak_result oom(w_ctx* c) {
     return AK_ERR_NO_MEMORY;
 }
 
-static ak_result bin_reserve(w_ctx* c, size_t extra) {
-    if (extra > SIZE_MAX / 2 - c->bin_size) return oom(c);
-    size_t need = c->bin_size + extra;
-    if (need <= c->bin_cap) return AK_OK;
-    size_t cap = c->bin_cap ? c->bin_cap : 4096;
-    while (cap < need) cap *= 2;
-    uint8_t* p = (uint8_t*)realloc(c->bin, cap);
-    if (!p) return oom(c);
-    c->bin = p;
-    c->bin_cap = cap;
-    return AK_OK;
-}
 
 static cJSON* num(double v) { return cJSON_CreateNumber(v); }
 
 static bool add_num(cJSON* obj, const char* key, double v) { return cJSON_AddItemToObject(obj, key, num(v)); }
 
-/* Append data as a new bufferView (4-byte aligned, zero padded); returns its index or -1. */
+/* Append data as a new bufferView (4-byte aligned, zero padded): written to c->sink when
+ * there is one (a failed write is remembered in sink_failed), else only counted. Returns its
+ * index or -1 (out of memory). */
 static int add_view(w_ctx* c, const void* data, size_t bytes, int target) {
     size_t padded = (bytes + 3u) & ~(size_t)3u;
-    if (bin_reserve(c, padded) != AK_OK) return -1;
+    if (padded < bytes || padded > SIZE_MAX / 2 - c->bin_size) return -1;
     size_t offset = c->bin_size;
-    memcpy(c->bin + offset, data, bytes);
-    memset(c->bin + offset + bytes, 0, padded - bytes);
+    if (c->sink && !c->sink_failed) {
+        static const uint8_t zeros[4] = {0, 0, 0, 0};
+        if ((bytes && fwrite(data, 1, bytes, c->sink) != bytes) ||
+            (padded > bytes && fwrite(zeros, 1, padded - bytes, c->sink) != padded - bytes)) {
+            c->sink_failed = true;
+            c->sink_err = errno ? errno : EIO;
+        }
+    }
     c->bin_size += padded;
+    if (c->sink) return c->n_views++; /* the writing pass: its JSON is the measuring pass's */
     cJSON* v = cJSON_CreateObject();
     if (!v || !cJSON_AddItemToArray(c->views, v)) return -1;
     add_num(v, "buffer", 0);
@@ -123,6 +128,7 @@ static int add_accessor(w_ctx* c, const void* data, size_t count, int ctype, int
     size_t bytes = count * (size_t)comps * ctype_size(ctype);
     int view = add_view(c, data, bytes, target);
     if (view < 0) return -1;
+    if (c->sink) return c->n_accessors++;
     cJSON* a = cJSON_CreateObject();
     if (!a || !cJSON_AddItemToArray(c->accessors, a)) return -1;
     const int index = c->n_accessors++;
@@ -564,11 +570,9 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
 static int texture_index(w_ctx* c, size_t ti) {
     if (c->gltf_texture[ti] >= 0) return c->gltf_texture[ti];
     const ak_scene_texture* st = &c->scene->textures[ti];
-    uint8_t* png = NULL;
-    size_t png_size = 0;
-    if (akp_image_encode_png(st->pixels, st->width, st->height, &png, &png_size) != AK_OK) return -1;
-    int view = add_view(c, png, png_size, 0);
-    free(png);
+    if (!c->png[ti] && akp_image_encode_png(st->pixels, st->width, st->height, &c->png[ti], &c->png_size[ti]) != AK_OK)
+        return -1;
+    int view = add_view(c, c->png[ti], c->png_size[ti], 0);
     if (view < 0) return -1;
     static const int wraps[3] = {10497, 33071, 33648};
     cJSON* im = cJSON_CreateObject();
@@ -845,12 +849,22 @@ static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t key
     cJSON* samplers = cJSON_GetObjectItemCaseSensitive(an, "samplers");
     /* channels keyed at the same times (a baked crowd: all of them) share one input */
     int in = c->last_times_accessor;
-    if (in < 0 || keys != c->last_times_keys || memcmp(c->bin + c->last_times_offset, times, keys * sizeof(float))) {
-        size_t offset = c->bin_size;
+    if (in < 0 || keys != c->last_times_keys || (keys && memcmp(c->last_times, times, keys * sizeof(float)))) {
+        if (keys > c->last_times_cap) {
+            float* t = (float*)realloc(c->last_times, keys * sizeof(float));
+            if (!t) return oom(c);
+            c->last_times = t, c->last_times_cap = keys;
+        }
+        if (keys) memcpy(c->last_times, times, keys * sizeof(float));
         in = add_accessor(c, times, keys, GL_FLOAT, 1, 0, true);
-        c->last_times_accessor = in, c->last_times_offset = offset, c->last_times_keys = keys;
+        c->last_times_accessor = in, c->last_times_keys = keys;
     }
     int outa = add_accessor(c, values, value_count, GL_FLOAT, comps, 0, false);
+    if (c->sink) { /* the writing pass: only the data matters */
+        if (in < 0 || outa < 0) return oom(c);
+        *out_index = c->n_samplers++;
+        return AK_OK;
+    }
     cJSON* sm = cJSON_CreateObject();
     if (in < 0 || outa < 0 || !sm || !cJSON_AddItemToArray(samplers, sm)) return oom(c);
     add_num(sm, "input", in);
@@ -862,6 +876,7 @@ static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t key
 }
 
 static ak_result add_channel(w_ctx* c, cJSON* an, int sampler, int32_t node, const char* path) {
+    if (c->sink) return AK_OK; /* the writing pass: no JSON */
     cJSON* ch = cJSON_CreateObject();
     cJSON* chans = cJSON_GetObjectItemCaseSensitive(an, "channels");
     if (!ch || !cJSON_AddItemToArray(chans, ch)) return oom(c);
@@ -1085,109 +1100,240 @@ static ak_result build_document(w_ctx* c) {
     return AK_OK;
 }
 
-/* ---- public ---------------------------------------------------------------------------- */
+/* Free everything a pass built and zero the context's tables (scene, path, diag kept). */
+static void ctx_free(w_ctx* c) {
+    cJSON_Delete(c->root);
+    cJSON_Delete(c->nodes);
+    cJSON_Delete(c->meshes);
+    cJSON_Delete(c->skins);
+    cJSON_Delete(c->animations);
+    cJSON_Delete(c->views);
+    cJSON_Delete(c->accessors);
+    cJSON_Delete(c->materials);
+    cJSON_Delete(c->textures);
+    cJSON_Delete(c->images);
+    cJSON_Delete(c->samplers);
+    free(c->gltf_texture);
+    free(c->node_of_mesh);
+    free(c->node_tab);
+    free(c->group_of_mesh);
+    free(c->morph_base);
+    free(c->owner_of_mesh);
+    free(c->instanced);
+    free(c->gltf_mesh_of);
+    free(c->prim_of_mesh);
+    free(c->last_times);
+    *c = (w_ctx){.scene = c->scene, .path = c->path, .diag = c->diag, .logger = c->logger, .png = c->png,
+                 .png_size = c->png_size};
+}
 
-ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_desc* desc, ak_diag* diag) {
-    if (!path || !scene) {
-        akp_diag_set(diag, path, "path and scene are required");
-        return AK_ERR_NULL_ARG;
-    }
-    bool glb = ends_with(path, ".glb");
-    if (!glb && !ends_with(path, ".gltf")) {
-        akp_diag_set(diag, path, "the file name must end in .glb or .gltf");
-        return AK_ERR_BAD_ARG;
-    }
-    ak_logger none = {0};
-    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = desc ? &desc->logger : &none};
-    ak_result r = build_document(&c);
+/* What the measuring pass found: the printed JSON and the sizes of what will be written. */
+typedef struct w_plan {
+    bool glb;
+    char* json;   /* the document's JSON text (malloc'd by cJSON) */
+    size_t json_size, bin_size;
+    size_t total; /* bytes of every file written: the .glb, or the .gltf and its .bin */
+    uint8_t** png; /* [texture_count] the textures' PNGs (w_ctx.png) */
+    size_t* png_size;
+    char bin_path[4096], bin_uri[4096];
+} w_plan;
+
+/* The measuring pass: the whole document built with the binary chunk only counted, printed,
+ * and freed again; plan gets the JSON and the exact sizes. */
+static ak_result plan_save(const char* path, const ak_scene* scene, const ak_logger* logger, ak_diag* diag,
+                           w_plan* plan) {
+    memset(plan, 0, sizeof *plan);
+    plan->glb = ends_with(path, ".glb");
+    const size_t tc = scene->texture_count ? scene->texture_count : 1;
+    plan->png = (uint8_t**)calloc(tc, sizeof *plan->png);
+    plan->png_size = (size_t*)calloc(tc, sizeof *plan->png_size);
+    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = logger, .png = plan->png, .png_size = plan->png_size};
+    ak_result r = plan->png && plan->png_size ? build_document(&c) : oom(&c);
     /* the file name of the .bin beside a .gltf: the .gltf's name with .bin */
-    char bin_path[4096] = "", bin_uri[4096] = "";
-    if (r == AK_OK && !glb && c.bin_size) {
+    if (r == AK_OK && !plan->glb && c.bin_size) {
         size_t n = strlen(path);
-        if (n + 1 > sizeof bin_path) {
+        if (n + 1 > sizeof plan->bin_path) {
             akp_diag_set(diag, path, "path is too long");
             r = AK_ERR_BAD_ARG;
         } else {
-            memcpy(bin_path, path, n - 5);
-            memcpy(bin_path + n - 5, ".bin", 5);
-            const char* base = strrchr(bin_path, '/');
-            uri_encode(base ? base + 1 : bin_path, bin_uri, sizeof bin_uri);
+            memcpy(plan->bin_path, path, n - 5);
+            memcpy(plan->bin_path + n - 5, ".bin", 5);
+            const char* base = strrchr(plan->bin_path, '/');
+            uri_encode(base ? base + 1 : plan->bin_path, plan->bin_uri, sizeof plan->bin_uri);
         }
     }
     if (r == AK_OK && c.bin_size) {
         cJSON* buffers = cJSON_AddArrayToObject(c.root, "buffers");
         cJSON* b = cJSON_CreateObject();
-        if (!buffers || !b || !cJSON_AddItemToArray(buffers, b)) r = oom(&c);
-        else {
+        if (!buffers || !b || !cJSON_AddItemToArray(buffers, b)) {
+            cJSON_Delete(b);
+            r = oom(&c);
+        } else {
             add_num(b, "byteLength", (double)c.bin_size);
-            if (!glb) cJSON_AddStringToObject(b, "uri", bin_uri);
+            if (!plan->glb) cJSON_AddStringToObject(b, "uri", plan->bin_uri);
         }
     }
-    /* the temporaries of the file and its .bin (16 KiB: kept off the stack) */
-    ak_atomic_file* out = NULL;
-    if (r == AK_OK && !(out = (ak_atomic_file*)calloc(2, sizeof *out))) r = oom(&c);
-    char* json = NULL;
-    if (r == AK_OK && !(json = glb ? cJSON_PrintUnformatted(c.root) : cJSON_Print(c.root))) r = oom(&c);
-    if (r == AK_OK && glb) {
-        size_t jn = strlen(json), jpad = (jn + 3u) & ~(size_t)3u;
-        size_t total = 12 + 8 + jpad + (c.bin_size ? 8 + c.bin_size : 0);
-        if (total > UINT32_MAX) {
-            akp_diag_set(diag, path, "%zu bytes is more than a GLB file can hold", total);
-            r = AK_ERR_UNSUPPORTED;
-        } else {
-            uint8_t* head = (uint8_t*)malloc(12 + 8 + jpad + 8);
-            if (!head) r = oom(&c);
-            else {
-                put_u32(head, 0x46546C67u); /* "glTF" */
-                put_u32(head + 4, 2);
-                put_u32(head + 8, (uint32_t)total);
-                put_u32(head + 12, (uint32_t)jpad);
-                put_u32(head + 16, 0x4E4F534Au); /* "JSON" */
-                memcpy(head + 20, json, jn);
-                memset(head + 20 + jn, ' ', jpad - jn); /* JSON chunk padding: spaces */
-                size_t hn = 20 + jpad;
-                if (c.bin_size) { /* BIN: views are 4-byte padded with zeros, so is its end */
-                    put_u32(head + hn, (uint32_t)c.bin_size);
-                    put_u32(head + hn + 4, 0x004E4942u); /* "BIN\0" */
-                    hn += 8;
-                }
-                r = write_bytes(&c, path, head, hn, c.bin, c.bin_size, out);
-                if (r == AK_OK) r = rename_into_place(&c, out);
-                free(head);
+    if (r == AK_OK && !(plan->json = plan->glb ? cJSON_PrintUnformatted(c.root) : cJSON_Print(c.root))) r = oom(&c);
+    if (r == AK_OK) {
+        plan->json_size = strlen(plan->json);
+        plan->bin_size = c.bin_size;
+        if (plan->glb) {
+            size_t jpad = (plan->json_size + 3u) & ~(size_t)3u;
+            plan->total = 12 + 8 + jpad + (c.bin_size ? 8 + c.bin_size : 0);
+            if (plan->total > UINT32_MAX) {
+                akp_diag_set(diag, path, "%zu bytes is more than a GLB file can hold", plan->total);
+                r = AK_ERR_UNSUPPORTED;
             }
+        } else {
+            plan->total = plan->json_size + 1 + c.bin_size; /* the .gltf ends in a newline */
+        }
+    }
+    ctx_free(&c);
+    return r;
+}
+
+/* Free what plan_save left in plan. */
+static void plan_free(const ak_scene* scene, w_plan* plan) {
+    free(plan->json);
+    for (size_t t = 0; plan->png && t < scene->texture_count; ++t) free(plan->png[t]);
+    free(plan->png);
+    free(plan->png_size);
+    memset(plan, 0, sizeof *plan);
+}
+
+/* The writing pass: the document built again (the same scene gives the same views in the
+ * same order), every view streamed to f as it is made; the JSON of this pass is thrown away. */
+static ak_result stream_bin(const char* path, const ak_scene* scene, ak_diag* diag, const w_plan* plan, FILE* f) {
+    ak_logger none = {0}; /* the measuring pass gave the warnings */
+    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = &none, .sink = f, .png = plan->png,
+               .png_size = plan->png_size};
+    ak_result r = build_document(&c);
+    if (r == AK_OK && c.sink_failed) {
+        akp_diag_set(diag, path, "cannot write file (%s)", strerror(c.sink_err));
+        r = AK_ERR_IO;
+    }
+    if (r == AK_OK && c.bin_size != plan->bin_size) {
+        akp_diag_set(diag, path, "the binary chunk came out %zu bytes instead of %zu (the scene changed while written?)",
+                     c.bin_size, plan->bin_size);
+        r = AK_ERR_IO;
+    }
+    ctx_free(&c);
+    return r;
+}
+
+/* ---- public ---------------------------------------------------------------------------- */
+
+static ak_result check_args(const char* path, const ak_scene* scene, ak_diag* diag) {
+    if (!path || !scene) {
+        akp_diag_set(diag, path, "path and scene are required");
+        return AK_ERR_NULL_ARG;
+    }
+    if (!ends_with(path, ".glb") && !ends_with(path, ".gltf")) {
+        akp_diag_set(diag, path, "the file name must end in .glb or .gltf");
+        return AK_ERR_BAD_ARG;
+    }
+    return AK_OK;
+}
+
+ak_result ak_io_save_size(const char* path, const ak_scene* scene, const ak_io_save_desc* desc, size_t* out_bytes,
+                          ak_diag* diag) {
+    if (out_bytes) *out_bytes = 0;
+    if (!out_bytes) {
+        akp_diag_set(diag, path, "out_bytes is required");
+        return AK_ERR_NULL_ARG;
+    }
+    WTRY(check_args(path, scene, diag));
+    ak_logger none = {0};
+    w_plan* plan = (w_plan*)malloc(sizeof *plan);
+    if (!plan) {
+        akp_diag_set(diag, path, "out of memory");
+        return AK_ERR_NO_MEMORY;
+    }
+    ak_result r = plan_save(path, scene, desc ? &desc->logger : &none, diag, plan);
+    if (r == AK_OK) *out_bytes = plan->total;
+    plan_free(scene, plan);
+    free(plan);
+    return r;
+}
+
+ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_desc* desc, ak_diag* diag) {
+    WTRY(check_args(path, scene, diag));
+    ak_logger none = {0};
+    const size_t budget = desc && desc->memory_budget ? desc->memory_budget : AK_IO_SAVE_DEFAULT_BUDGET;
+    /* the plan (8 KiB of paths) and the temporaries of the file and its .bin: off the stack */
+    w_plan* plan = (w_plan*)malloc(sizeof *plan);
+    ak_atomic_file* out = (ak_atomic_file*)calloc(2, sizeof *out);
+    if (!plan || !out) {
+        free(plan);
+        free(out);
+        akp_diag_set(diag, path, "out of memory");
+        return AK_ERR_NO_MEMORY;
+    }
+    ak_result r = plan_save(path, scene, desc ? &desc->logger : &none, diag, plan);
+    if (r == AK_OK && plan->total > budget) {
+        akp_diag_set(diag, path,
+                     "the glTF output is %zu bytes (JSON %zu, binary %zu), over the writer's memory budget of %zu "
+                     "bytes (ak_io_save_desc.memory_budget); nothing written",
+                     plan->total, plan->json_size, plan->bin_size, budget);
+        r = AK_ERR_UNSUPPORTED;
+    }
+    if (r == AK_OK && plan->glb) {
+        if (ak_atomic_file_open(out, path) != AK_OK) {
+            akp_diag_set(diag, path, "cannot create file (%s)", strerror(out->err));
+            r = AK_ERR_IO;
+        } else {
+            size_t jn = plan->json_size, jpad = (jn + 3u) & ~(size_t)3u;
+            uint8_t head[20], pad[3] = {' ', ' ', ' '}, binh[8];
+            put_u32(head, 0x46546C67u); /* "glTF" */
+            put_u32(head + 4, 2);
+            put_u32(head + 8, (uint32_t)plan->total);
+            put_u32(head + 12, (uint32_t)jpad);
+            put_u32(head + 16, 0x4E4F534Au); /* "JSON" */
+            put_u32(binh, (uint32_t)plan->bin_size);
+            put_u32(binh + 4, 0x004E4942u); /* "BIN\0": views are 4-byte padded with zeros */
+            bool ok = fwrite(head, 1, 20, out->f) == 20 && fwrite(plan->json, 1, jn, out->f) == jn &&
+                      fwrite(pad, 1, jpad - jn, out->f) == jpad - jn && /* JSON chunk padding: spaces */
+                      (!plan->bin_size || fwrite(binh, 1, 8, out->f) == 8);
+            free(plan->json); /* the JSON is in the file: not held while the binary is made */
+            plan->json = NULL;
+            if (!ok) {
+                akp_diag_set(diag, path, "cannot write file (%s)", strerror(errno ? errno : EIO));
+                r = AK_ERR_IO;
+            }
+            if (r == AK_OK && plan->bin_size) r = stream_bin(path, scene, diag, plan, out->f);
+            if (r == AK_OK && ak_atomic_file_close(out) != AK_OK) {
+                akp_diag_set(diag, path, "cannot write file (%s)", strerror(out->err ? out->err : EIO));
+                r = AK_ERR_IO;
+            }
+            if (r == AK_OK) {
+                w_ctx c = {.scene = scene, .path = path, .diag = diag};
+                r = rename_into_place(&c, out);
+            }
+            ak_atomic_file_abort(out);
         }
     } else if (r == AK_OK) {
         /* both files are written in full before either is renamed into place: the .bin first,
          * so a reader never sees a new .gltf beside an old .bin */
-        if (c.bin_size) r = write_bytes(&c, bin_path, c.bin, c.bin_size, NULL, 0, &out[1]);
-        if (r == AK_OK) r = write_bytes(&c, path, json, strlen(json), "\n", 1, out);
-        if (r == AK_OK && c.bin_size) r = rename_into_place(&c, &out[1]);
+        w_ctx c = {.scene = scene, .path = path, .diag = diag};
+        if (plan->bin_size) {
+            if (ak_atomic_file_open(&out[1], plan->bin_path) != AK_OK) {
+                akp_diag_set(diag, plan->bin_path, "cannot create file (%s)", strerror(out[1].err));
+                r = AK_ERR_IO;
+            }
+            if (r == AK_OK) r = stream_bin(plan->bin_path, scene, diag, plan, out[1].f);
+            if (r == AK_OK && ak_atomic_file_close(&out[1]) != AK_OK) {
+                akp_diag_set(diag, plan->bin_path, "cannot write file (%s)", strerror(out[1].err ? out[1].err : EIO));
+                r = AK_ERR_IO;
+            }
+        }
+        if (r == AK_OK) r = write_bytes(&c, path, plan->json, plan->json_size, "\n", 1, out);
+        if (r == AK_OK && plan->bin_size) r = rename_into_place(&c, &out[1]);
         if (r == AK_OK) r = rename_into_place(&c, out);
         ak_atomic_file_abort(&out[1]);
         ak_atomic_file_abort(out);
     }
     free(out);
-    free(json);
-    cJSON_Delete(c.root);
-    cJSON_Delete(c.nodes);
-    cJSON_Delete(c.meshes);
-    cJSON_Delete(c.skins);
-    cJSON_Delete(c.animations);
-    cJSON_Delete(c.views);
-    cJSON_Delete(c.accessors);
-    cJSON_Delete(c.materials);
-    cJSON_Delete(c.textures);
-    cJSON_Delete(c.images);
-    cJSON_Delete(c.samplers);
-    free(c.gltf_texture);
-    free(c.bin);
-    free(c.node_of_mesh);
-    free(c.node_tab);
-    free(c.group_of_mesh);
-    free(c.morph_base);
-    free(c.owner_of_mesh);
-    free(c.instanced);
-    free(c.gltf_mesh_of);
-    free(c.prim_of_mesh);
+    plan_free(scene, plan);
+    free(plan);
     return r;
 }

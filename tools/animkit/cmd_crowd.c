@@ -183,6 +183,10 @@ static size_t reached_count(const crowd_run* r) {
     return k;
 }
 
+/* The one memory budget of the glTF crowd: the bake (ak_crowd_bake_max_frames, ak_crowd_bake_scene)
+ * and the writer (ak_io_save: the file's bytes) are each held to it. */
+#define CROWD_GLTF_BUDGET AK_SCENE_BAKE_DEFAULT_BUDGET
+
 /* The recorded run as glTF: a skinned character per agent (ak_crowd_bake_scene). */
 static int chars_write_gltf(crowd_chars* c, const ak_crowd_scene* sc, float frame_time, const char* out) {
     ak_vec4* colors = malloc(c->n * sizeof *colors);
@@ -190,13 +194,14 @@ static int chars_write_gltf(crowd_chars* c, const ak_crowd_scene* sc, float fram
     for (size_t i = 0; i < c->n; ++i) colors[i] = crowd_palette[sc->group[i] % 4];
     ak_crowd_bake_desc bd = {.gait = &c->gait, .agent_count = c->n, .frame_count = c->frames,
                              .positions = c->rec_pos, .characters = c->rec_ch, .frame_time = frame_time,
-                             .colors = colors, .name = "crowd"};
+                             .colors = colors, .name = "crowd", .memory_budget = CROWD_GLTF_BUDGET};
     ak_scene* baked = NULL;
     ak_diag diag = {0};
     ak_result r = ak_crowd_bake_scene(&bd, NULL, &baked, &diag);
     free(colors);
     if (r != AK_OK) return cli_fail("crowd", "%s: %s", out, diag.message[0] ? diag.message : ak_result_string(r));
-    r = ak_io_save(out, baked, NULL, &diag);
+    const ak_io_save_desc sd = {.memory_budget = CROWD_GLTF_BUDGET};
+    r = ak_io_save(out, baked, &sd, &diag);
     ak_scene_destroy(baked);
     if (r != AK_OK) return cli_fail("crowd", "%s: %s", out, diag.message[0] ? diag.message : ak_result_string(r));
     return CLI_OK;
@@ -379,7 +384,7 @@ int cmd_crowd(int argc, char** argv) {
         res = crowd_chars_init(&chars, &sc, 0, &cd);
         chars.unplanted = shared_poses; /* shared poses have no foot planting */
         if (res == AK_OK && is_glb) {
-            const size_t fit = ak_crowd_bake_max_frames(&chars.gait, sc.agent_count, 0);
+            const size_t fit = ak_crowd_bake_max_frames(&chars.gait, sc.agent_count, CROWD_GLTF_BUDGET);
             if (fit == 0) {
                 const size_t n = sc.agent_count;
                 crowd_chars_free(&chars);
@@ -387,7 +392,7 @@ int cmd_crowd(int argc, char** argv) {
                 ak_crowd_scene_free(&sc);
                 return cli_fail("crowd", "%s: %zu agents: not one frame of the glTF crowd fits (its memory budget of "
                                 "%zu MB, at most %u nodes; use --agents)", out, n,
-                                AK_SCENE_BAKE_DEFAULT_BUDGET >> 20, AK_SKELETON_MAX_JOINTS);
+                                (size_t)CROWD_GLTF_BUDGET >> 20, AK_SKELETON_MAX_JOINTS);
             }
             if ((long)fit < max_frames) max_frames = (long)fit;
         }
