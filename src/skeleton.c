@@ -414,6 +414,21 @@ __attribute__((target("avx"), always_inline)) static inline void local_soa8(cons
 #undef AKP_TWO
 }
 
+/* The translations of joints b .. b + cnt - 1 (cnt <= 8) as x, y, z rows of 8 lanes (lanes past
+ * cnt repeat joint b): the transpose local_soa8 does for the rotations. */
+__attribute__((target("avx"), always_inline)) static inline void translation_soa8(const ak_transform* local, size_t b,
+                                                                                size_t cnt, __m256 T[3]) {
+    __m256 r[4];
+    for (int v = 0; v < 4; ++v) {
+        const size_t jl = (size_t)v < cnt ? (size_t)v : 0, jh = (size_t)v + 4 < cnt ? (size_t)v + 4 : 0;
+        r[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&local[b + jl].translation.x)),
+                                    _mm_loadu_ps(&local[b + jh].translation.x), 1);
+    }
+    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
+    const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    T[0] = _mm256_shuffle_ps(t0, t1, 0x44), T[1] = _mm256_shuffle_ps(t0, t1, 0xEE), T[2] = _mm256_shuffle_ps(t2, t3, 0x44);
+}
+
 /* The AVX kernel (no FMA) for no root or an affine root: the local 3x3 parts of 8 joints at a
  * time in structure-of-arrays form (local_soa8), then the parent products joint by joint, one
  * column at a time, each local entry broadcast from memory (the translation straight from the
@@ -484,15 +499,8 @@ __attribute__((target("avx2,fma"))) static void fk_affine_fma(const ak_skeleton*
     for (size_t b = 0; b < n; b += 8) {
         const size_t cnt = n - b < 8 ? n - b : 8;
         local_soa8(local, b, cnt, L);
-        __m256 r[4];
-        for (int v = 0; v < 4; ++v) {
-            const size_t jl = (size_t)v < cnt ? (size_t)v : 0, jh = (size_t)v + 4 < cnt ? (size_t)v + 4 : 0;
-            r[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&local[b + jl].translation.x)),
-                                        _mm_loadu_ps(&local[b + jh].translation.x), 1);
-        }
-        const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
-        const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-        const __m256 T[3] = {_mm256_shuffle_ps(t0, t1, 0x44), _mm256_shuffle_ps(t0, t1, 0xEE), _mm256_shuffle_ps(t2, t3, 0x44)};
+        __m256 T[3];
+        translation_soa8(local, b, cnt, T);
         for (size_t h = 0; h < 2 && 4 * h < cnt; ++h) {
             __m256 r01[3], r23[3];
             for (int k = 0; k < 3; ++k) {
@@ -558,17 +566,9 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) static void fk_affine_avx51
     for (size_t b = 0; b < n; b += 8) {
         const size_t cnt = n - b < 8 ? n - b : 8;
         local_soa8(local, b, cnt, L);
-        /* translations of the 8 joints (x y z rows), the transpose local_soa8 does for q */
-        __m256 r[4];
-        for (int v = 0; v < 4; ++v) {
-            const size_t jl = (size_t)v < cnt ? (size_t)v : 0, jh = (size_t)v + 4 < cnt ? (size_t)v + 4 : 0;
-            r[v] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&local[b + jl].translation.x)),
-                                        _mm_loadu_ps(&local[b + jh].translation.x), 1);
-        }
-        const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
-        const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-        const __m256 tx = _mm256_shuffle_ps(t0, t1, 0x44), ty = _mm256_shuffle_ps(t0, t1, 0xEE),
-                     tz = _mm256_shuffle_ps(t2, t3, 0x44);
+        __m256 T[3];
+        translation_soa8(local, b, cnt, T);
+        const __m256 tx = T[0], ty = T[1], tz = T[2];
 #define AKP_Z(A, B) _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_castps_pd(A)), _mm256_castps_pd(B), 1))
         const __m512 z0l = AKP_Z(_mm256_load_ps(L[0]), _mm256_load_ps(L[3])), z0h = AKP_Z(_mm256_load_ps(L[6]), tx);
         const __m512 z1l = AKP_Z(_mm256_load_ps(L[1]), _mm256_load_ps(L[4])), z1h = AKP_Z(_mm256_load_ps(L[7]), ty);
