@@ -888,6 +888,30 @@ AK_TEST(threads_and_paths_bit_identical) {
     flock_free(&base);
 }
 
+/* A copy of base (positions, velocities, species) stepped twice by dt 0.05: by the naive loop
+ * (threads 0), or by the grid on that many threads with simd 0 (fastest), 1 (no AVX-512) or 2
+ * (scalar); the interactions counted into *inter. */
+static flock two_steps(const flock* base, const ak_boids_params* pp, unsigned threads, int simd, uint64_t* inter) {
+    const size_t n = base->n;
+    flock f = flock_make(n);
+    memcpy(f.p, base->p, n * sizeof(ak_vec3));
+    memcpy(f.v, base->v, n * sizeof(ak_vec3));
+    memcpy(f.s, base->s, n);
+    *inter = 0;
+    for (int s = 0; s < 2; ++s) {
+        ak_boids_step_job j = job_for(&f, pp, 0.05f);
+        j.use_naive = threads == 0;
+        j.thread_count = threads;
+        j.skip_avx512 = simd == 1;
+        j.skip_simd = simd == 2;
+        j.out_interaction_count = inter;
+        AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
+        memcpy(f.p, f.p2, n * sizeof(ak_vec3));
+        memcpy(f.v, f.v2, n * sizeof(ak_vec3));
+    }
+    return f;
+}
+
 /* The plain flock takes the symmetric pair pass: each pair's distance test runs once and both
  * agents are credited, with their own view cones; threads meet at z-slab boundaries, through
  * a spill buffer when the boundary slabs are few, by atomic adds when most slabs are boundary
@@ -930,37 +954,15 @@ AK_TEST(symmetric_pass_threads_and_kernels) {
         }
         base.v[5] = ak_vec3_zero(); /* a viewer without a heading sees all around */
         base.p[7] = base.p[6];      /* coincident agents */
-        flock ref = flock_make(n);
-        memcpy(ref.p, base.p, n * sizeof(ak_vec3));
-        memcpy(ref.v, base.v, n * sizeof(ak_vec3));
         uint64_t ref_inter = 0;
-        for (int s = 0; s < 2; ++s) {
-            ak_boids_step_job j = job_for(&ref, &pp, 0.05f);
-            j.use_naive = true;
-            j.out_interaction_count = &ref_inter;
-            AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
-            memcpy(ref.p, ref.p2, n * sizeof(ak_vec3));
-            memcpy(ref.v, ref.v2, n * sizeof(ak_vec3));
-        }
+        flock ref = two_steps(&base, &pp, 0, 0, &ref_inter);
         printf("  case %zu: %.1f neighbours per agent\n", cs, (double)ref_inter / (double)n);
         AK_CHECK(ref_inter > 3u * n);
         for (int t = 0; t < 4; ++t)
             for (int simd = 0; simd < 3; ++simd) { /* fastest, AVX2 instead of AVX-512, scalar */
                 if (simd == 1 && strcmp(ak_boids_simd_name(), "avx512") != 0) continue; /* same as fastest */
-                flock f = flock_make(n);
-                memcpy(f.p, base.p, n * sizeof(ak_vec3));
-                memcpy(f.v, base.v, n * sizeof(ak_vec3));
                 uint64_t inter = 0;
-                for (int s = 0; s < 2; ++s) {
-                    ak_boids_step_job j = job_for(&f, &pp, 0.05f);
-                    j.thread_count = threads[t];
-                    j.skip_avx512 = simd == 1;
-                    j.skip_simd = simd == 2;
-                    j.out_interaction_count = &inter;
-                    AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
-                    memcpy(f.p, f.p2, n * sizeof(ak_vec3));
-                    memcpy(f.v, f.v2, n * sizeof(ak_vec3));
-                }
+                flock f = two_steps(&base, &pp, threads[t], simd, &inter);
                 AK_CHECK_MSG(memcmp(f.p, ref.p, n * sizeof(ak_vec3)) == 0 &&
                                  memcmp(f.v, ref.v, n * sizeof(ak_vec3)) == 0 && inter == ref_inter,
                              "case %zu, %u threads, %s: differs from the naive loop", cs, threads[t],
@@ -1000,34 +1002,12 @@ AK_TEST(work_partition_threads_bit_identical) {
                                          ak_rng_range(&r, -1.5f, 1.5f));
                 base.s[i] = (uint8_t)(i % species);
             }
-            flock ref = flock_make(N);
-            memcpy(ref.p, base.p, N * sizeof(ak_vec3));
-            memcpy(ref.v, base.v, N * sizeof(ak_vec3));
-            memcpy(ref.s, base.s, N);
             uint64_t ref_inter = 0;
-            for (int s = 0; s < 2; ++s) {
-                ak_boids_step_job j = job_for(&ref, &pp, 0.05f);
-                j.use_naive = true;
-                j.out_interaction_count = &ref_inter;
-                AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
-                memcpy(ref.p, ref.p2, N * sizeof(ak_vec3));
-                memcpy(ref.v, ref.v2, N * sizeof(ak_vec3));
-            }
+            flock ref = two_steps(&base, &pp, 0, 0, &ref_inter);
             AK_CHECK(ref_inter > 2u * N);
             for (int t = 0; t < 4; ++t) {
-                flock f = flock_make(N);
-                memcpy(f.p, base.p, N * sizeof(ak_vec3));
-                memcpy(f.v, base.v, N * sizeof(ak_vec3));
-                memcpy(f.s, base.s, N);
                 uint64_t inter = 0;
-                for (int s = 0; s < 2; ++s) {
-                    ak_boids_step_job j = job_for(&f, &pp, 0.05f);
-                    j.thread_count = threads[t];
-                    j.out_interaction_count = &inter;
-                    AK_CHECK_EQ(ak_boids_step_run(&j), AK_OK);
-                    memcpy(f.p, f.p2, N * sizeof(ak_vec3));
-                    memcpy(f.v, f.v2, N * sizeof(ak_vec3));
-                }
+                flock f = two_steps(&base, &pp, threads[t], 0, &inter);
                 AK_CHECK_MSG(memcmp(f.p, ref.p, N * sizeof(ak_vec3)) == 0 &&
                                  memcmp(f.v, ref.v, N * sizeof(ak_vec3)) == 0 && inter == ref_inter,
                              "%s, %u species, %u threads: differs from the naive loop", clumped ? "clumped" : "even",
