@@ -142,7 +142,7 @@ AK_TEST(create_validation_codes) {
     AK_CHECK_EQ(ak_skeleton_create(&zero, NULL, &sk, NULL), AK_ERR_EMPTY);
     ak_skeleton_desc nojoints = {.joints = NULL, .joint_count = 2};
     AK_CHECK_EQ(ak_skeleton_create(&nojoints, NULL, &sk, NULL), AK_ERR_NULL_ARG);
-    ak_skeleton_desc many = {.joints = js, .joint_count = 32768};
+    ak_skeleton_desc many = {.joints = js, .joint_count = (size_t)AK_SKELETON_MAX_JOINTS + 1}; /* refused before any joint is read */
     AK_CHECK_EQ(ak_skeleton_create(&many, NULL, &sk, NULL), AK_ERR_BAD_ARG);
 
     js[2].type = AK_JOINT_TYPE_COUNT;
