@@ -217,16 +217,33 @@ static const float value_of[256] = {
     0x1.f3f3f4p-1f, 0x1.f7f7f8p-1f, 0x1.fbfbfcp-1f, 0x1p+0f,
 };
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
+#define AKP_HAVE_VALUE_VEX 1
+/* The value-only 2D/3D bodies below are compiled a second time for CPUs with AVX (VEX
+ * encoding: three-operand arithmetic, no register copies before each operation; no FMA, so the
+ * same roundings), chosen at run time. Their floor is vroundss (every AVX CPU has SSE4.1):
+ * akp_floor_frac's roundss branch, the same bits. */
+#define AKP_VEX __attribute__((target("avx")))
+static inline __attribute__((always_inline)) float value_floor_frac_vex(float x, int* out_i) {
+    float fl;
+    __asm__("vroundss $9, %1, %1, %0" : "=x"(fl) : "x"(x));
+    *out_i = (int)fl;
+    return x - fl;
+}
+#else
+static inline float value_floor_frac_vex(float x, int* out_i) { return akp_floor_frac(x, out_i); }
+#endif
+
 /* Value noise with a constant dims (inlined per dimension) and the gradient only when asked
  * for (it does not change the value). */
-static inline __attribute__((always_inline)) float value_n(const ak_noise* noise, uint32_t dims, const float* point,
-                                                           float* out_gradient) {
+static inline __attribute__((always_inline)) float value_nv(const ak_noise* noise, uint32_t dims, const float* point,
+                                                            float* out_gradient, bool vex) {
     int lo[4], hi[4];
     float f[4];
 #pragma GCC unroll 4
     for (uint32_t k = 0; k < dims; ++k) {
         int i;
-        f[k] = akp_floor_frac(point[k], &i);
+        f[k] = vex ? value_floor_frac_vex(point[k], &i) : akp_floor_frac(point[k], &i);
         lo[k] = i & 255;
         hi[k] = (i + 1) & 255;
     }
@@ -267,7 +284,15 @@ static inline __attribute__((always_inline)) float value_n(const ak_noise* noise
         for (uint32_t m = 0; m < dims; ++m) out_gradient[m] = gv[0][m];
     /* fminf(fmaxf(v, -1), 1) for the finite v here, without the libm calls */
     const float v = val[0];
-    return v < -1.0f ? -1.0f : v > 1.0f ? 1.0f : v;
+    /* written as max then min, which gcc makes maxss and minss (the nested ?: was a compare and
+     * branch before a minss); the same value for every v but NaN, which never comes here */
+    const float v1 = v > -1.0f ? v : -1.0f;
+    return v1 < 1.0f ? v1 : 1.0f;
+}
+
+static inline __attribute__((always_inline)) float value_n(const ak_noise* noise, uint32_t dims, const float* point,
+                                                           float* out_gradient) {
+    return value_nv(noise, dims, point, out_gradient, false);
 }
 
 /* The value-only paths of 2D and 3D, each its own compiled body (no derivative work, and
@@ -278,6 +303,14 @@ static __attribute__((noinline)) float value2_value(const ak_noise* noise, const
 static __attribute__((noinline)) float value3_value(const ak_noise* noise, const float* point) {
     return value_n(noise, 3, point, NULL);
 }
+#ifdef AKP_HAVE_VALUE_VEX
+AKP_VEX static __attribute__((noinline)) float value2_value_vex(const ak_noise* noise, const float* point) {
+    return value_nv(noise, 2, point, NULL, true);
+}
+AKP_VEX static __attribute__((noinline)) float value3_value_vex(const ak_noise* noise, const float* point) {
+    return value_nv(noise, 3, point, NULL, true);
+}
+#endif
 
 /* ak_noise_value's every case (the public function keeps the common one in front). */
 static __attribute__((noinline)) float value_any(const ak_noise* noise, uint32_t dimensions, const float* point,
@@ -298,6 +331,10 @@ float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* po
      * function pushed five registers and set up a stack frame on every call. */
     if (!out_gradient && noise && point && (dimensions == 2 || dimensions == 3)) {
         if (!all_finite(dimensions, point)) return 0.0f;
+#ifdef AKP_HAVE_VALUE_VEX
+        if (__builtin_cpu_supports("avx"))
+            return dimensions == 3 ? value3_value_vex(noise, point) : value2_value_vex(noise, point);
+#endif
         return dimensions == 3 ? value3_value(noise, point) : value2_value(noise, point);
     }
     return value_any(noise, dimensions, point, out_gradient);

@@ -83,6 +83,21 @@ static inline float akp_floor(float x, int* out_i) { return copysignf(akp_floor_
  * without its sign here: only x = -0.0 tells (-0.0 - +0.0 is -0.0 where x - floorf(x) is
  * +0.0), and adding +0.0 turns that -0.0 into +0.0 and changes no other value. */
 static inline float akp_floor_frac(float x, int* out_i) {
+#ifdef AKP_HAVE_FLOOR_ROUNDSS
+#ifndef __SSE4_1__
+    if (__builtin_cpu_supports("sse4.1"))
+#endif
+    {
+        /* roundss keeps the sign of a zero: x = -0.0 gives fl = -0.0 and x - fl = +0.0, and no
+         * other x gives a zero of either sign but +0.0 (x - fl is zero only where x == fl). So
+         * the two + 0.0f of the general form change nothing here: two additions fewer on the
+         * lattice hash's path. The int is the same ((int)-0.0f is 0). */
+        float fl = x;
+        __asm__("roundss $9, %0, %0" : "+x"(fl));
+        *out_i = (int)fl;
+        return x - fl;
+    }
+#endif
     return (x - akp_floor_unsigned_zero(x, out_i)) + 0.0f;
 }
 
