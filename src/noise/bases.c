@@ -616,25 +616,26 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
 
 /* One octave's basis value, as fractal.c's basis_eval gives it without gradient. */
 static inline __attribute__((always_inline)) float basis_value(const ak_noise* noise, ak_noise_basis basis,
-                                                               uint32_t dims, const float* q) {
+                                                               uint32_t dims, const float* q, bool vex) {
     switch (basis) {
     case AK_NOISE_BASIS_SIMPLEX:
         if (dims == 3) return all_finite(3, q) ? simplex3_value(noise->perm, q[0], q[1], q[2]) : 0.0f;
         return ak_noise_simplex2(noise, q[0], dims == 1 ? 0.0f : q[1], NULL);
-    case AK_NOISE_BASIS_VALUE: return all_finite(dims, q) ? value_n(noise, dims, q, NULL) : 0.0f;
+    case AK_NOISE_BASIS_VALUE: return all_finite(dims, q) ? value_nv(noise, dims, q, NULL, vex) : 0.0f;
     default: return all_finite(dims, q) ? worley_n(noise, dims, false, q, NULL, NULL) : 0.0f;
     }
 }
 
 static inline __attribute__((always_inline)) float fbm_other_n(const ak_noise* noise, const ak_fractal_desc* d,
-                                                               ak_noise_basis basis, uint32_t dims, const float* p) {
+                                                               ak_noise_basis basis, uint32_t dims, const float* p,
+                                                               bool vex) {
     float freq = d->frequency, amp = 1.0f, sum = 0.0f;
     const float lacunarity = d->lacunarity, gain = d->gain;
     for (uint32_t o = 0; o < d->octaves; ++o) {
         float q[4];
 #pragma GCC unroll 4
         for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
-        sum = sum + amp * basis_value(noise, basis, dims, q);
+        sum = sum + amp * basis_value(noise, basis, dims, q, vex);
         freq = freq * lacunarity;
         amp = amp * gain;
     }
@@ -645,7 +646,7 @@ static inline __attribute__((always_inline)) float fbm_other_n(const ak_noise* n
 #define AKP_FBM_OTHER(name, basis, dims)                                                            \
     static __attribute__((noinline)) float name(const ak_noise* noise, const ak_fractal_desc* d,   \
                                                 const float* p) {                                  \
-        return fbm_other_n(noise, d, basis, dims, p);                                              \
+        return fbm_other_n(noise, d, basis, dims, p, false);                                       \
     }
 AKP_FBM_OTHER(fbm_simplex1, AK_NOISE_BASIS_SIMPLEX, 1)
 AKP_FBM_OTHER(fbm_simplex2, AK_NOISE_BASIS_SIMPLEX, 2)
@@ -657,12 +658,27 @@ AKP_FBM_OTHER(fbm_value4, AK_NOISE_BASIS_VALUE, 4)
 AKP_FBM_OTHER(fbm_worley1, AK_NOISE_BASIS_WORLEY, 1)
 AKP_FBM_OTHER(fbm_worley2, AK_NOISE_BASIS_WORLEY, 2)
 AKP_FBM_OTHER(fbm_worley3, AK_NOISE_BASIS_WORLEY, 3)
+#ifdef AKP_HAVE_VALUE_VEX
+/* fBm over value noise in 2D/3D, the VEX build (as value3_value_vex) */
+AKP_VEX static __attribute__((noinline)) float fbm_value2_vex(const ak_noise* noise, const ak_fractal_desc* d,
+                                                              const float* p) {
+    return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 2, p, true);
+}
+AKP_VEX static __attribute__((noinline)) float fbm_value3_vex(const ak_noise* noise, const ak_fractal_desc* d,
+                                                              const float* p) {
+    return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 3, p, true);
+}
+#endif
 
 float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
     switch (d->basis) {
     case AK_NOISE_BASIS_SIMPLEX:
         return dims == 1 ? fbm_simplex1(noise, d, p) : dims == 2 ? fbm_simplex2(noise, d, p) : fbm_simplex3(noise, d, p);
     case AK_NOISE_BASIS_VALUE:
+#ifdef AKP_HAVE_VALUE_VEX
+        if ((dims == 2 || dims == 3) && __builtin_cpu_supports("avx"))
+            return dims == 3 ? fbm_value3_vex(noise, d, p) : fbm_value2_vex(noise, d, p);
+#endif
         return dims == 1   ? fbm_value1(noise, d, p)
                : dims == 2 ? fbm_value2(noise, d, p)
                : dims == 3 ? fbm_value3(noise, d, p)
