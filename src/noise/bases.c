@@ -340,6 +340,10 @@ float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* po
     return value_any(noise, dimensions, point, out_gradient);
 }
 
+float akp_value_baseline(const ak_noise* noise, uint32_t dims, const float* p) {
+    return dims == 3 ? value3_value(noise, p) : value2_value(noise, p);
+}
+
 /* ---- Worley ------------------------------------------------------------------------------- */
 
 /* A 32-bit hash of a cell and the seed (murmur3 finaliser over a linear mix). */
@@ -669,6 +673,10 @@ AKP_VEX static __attribute__((noinline)) float fbm_value3_vex(const ak_noise* no
     return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 3, p, true);
 }
 #endif
+
+float akp_fbm_value_baseline(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
+    return dims == 3 ? fbm_value3(noise, d, p) : fbm_value2(noise, d, p);
+}
 
 float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
     switch (d->basis) {

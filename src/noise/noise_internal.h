@@ -119,6 +119,12 @@ float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t di
 float akp_fbm_perlin_grad(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p,
                           float* grad);
 
+/* ak_noise_value without gradient (dims 2 or 3, finite point) and akp_fbm_other over value
+ * noise (dims 2 or 3) in the baseline x86-64 build, whatever the CPU: the bodies a CPU without
+ * AVX runs, so that tests on any CPU can check them against the VEX build bit for bit. */
+float akp_value_baseline(const ak_noise* noise, uint32_t dims, const float* p);
+float akp_fbm_value_baseline(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
+
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);
 
