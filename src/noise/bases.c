@@ -217,23 +217,6 @@ static const float value_of[256] = {
     0x1.f3f3f4p-1f, 0x1.f7f7f8p-1f, 0x1.fbfbfcp-1f, 0x1p+0f,
 };
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
-#define AKP_HAVE_VALUE_VEX 1
-/* The value-only 2D/3D bodies below are compiled a second time for CPUs with AVX (VEX
- * encoding: three-operand arithmetic, no register copies before each operation; no FMA, so the
- * same roundings), chosen at run time. Their floor is vroundss (every AVX CPU has SSE4.1):
- * akp_floor_frac's roundss branch, the same bits. */
-#define AKP_VEX __attribute__((target("avx")))
-static inline __attribute__((always_inline)) float value_floor_frac_vex(float x, int* out_i) {
-    float fl;
-    __asm__("vroundss $9, %1, %1, %0" : "=x"(fl) : "x"(x));
-    *out_i = (int)fl;
-    return x - fl;
-}
-#else
-static inline float value_floor_frac_vex(float x, int* out_i) { return akp_floor_frac(x, out_i); }
-#endif
-
 /* Value noise with a constant dims (inlined per dimension) and the gradient only when asked
  * for (it does not change the value). */
 static inline __attribute__((always_inline)) float value_nv(const ak_noise* noise, uint32_t dims, const float* point,
@@ -243,7 +226,7 @@ static inline __attribute__((always_inline)) float value_nv(const ak_noise* nois
 #pragma GCC unroll 4
     for (uint32_t k = 0; k < dims; ++k) {
         int i;
-        f[k] = vex ? value_floor_frac_vex(point[k], &i) : akp_floor_frac(point[k], &i);
+        f[k] = vex ? akp_floor_frac_vex(point[k], &i) : akp_floor_frac(point[k], &i);
         lo[k] = i & 255;
         hi[k] = (i + 1) & 255;
     }
@@ -296,14 +279,16 @@ static inline __attribute__((always_inline)) float value_n(const ak_noise* noise
 }
 
 /* The value-only paths of 2D and 3D, each its own compiled body (no derivative work, and
- * not sharing one function's registers with the other seven variants). */
+ * not sharing one function's registers with the other seven variants), and again in the VEX
+ * build (AKP_VEX, noise_internal.h) for CPUs with AVX: value 3D per point 1.08x -> 0.94x
+ * FastNoiseLite's time (docs/BENCHMARKS.md, noise). */
 static __attribute__((noinline)) float value2_value(const ak_noise* noise, const float* point) {
     return value_n(noise, 2, point, NULL);
 }
 static __attribute__((noinline)) float value3_value(const ak_noise* noise, const float* point) {
     return value_n(noise, 3, point, NULL);
 }
-#ifdef AKP_HAVE_VALUE_VEX
+#ifdef AKP_HAVE_VEX
 AKP_VEX static __attribute__((noinline)) float value2_value_vex(const ak_noise* noise, const float* point) {
     return value_nv(noise, 2, point, NULL, true);
 }
@@ -331,7 +316,7 @@ float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* po
      * function pushed five registers and set up a stack frame on every call. */
     if (!out_gradient && noise && point && (dimensions == 2 || dimensions == 3)) {
         if (!all_finite(dimensions, point)) return 0.0f;
-#ifdef AKP_HAVE_VALUE_VEX
+#ifdef AKP_HAVE_VEX
         if (__builtin_cpu_supports("avx"))
             return dimensions == 3 ? value3_value_vex(noise, point) : value2_value_vex(noise, point);
 #endif
@@ -662,7 +647,7 @@ AKP_FBM_OTHER(fbm_value4, AK_NOISE_BASIS_VALUE, 4)
 AKP_FBM_OTHER(fbm_worley1, AK_NOISE_BASIS_WORLEY, 1)
 AKP_FBM_OTHER(fbm_worley2, AK_NOISE_BASIS_WORLEY, 2)
 AKP_FBM_OTHER(fbm_worley3, AK_NOISE_BASIS_WORLEY, 3)
-#ifdef AKP_HAVE_VALUE_VEX
+#ifdef AKP_HAVE_VEX
 /* fBm over value noise in 2D/3D, the VEX build (as value3_value_vex) */
 AKP_VEX static __attribute__((noinline)) float fbm_value2_vex(const ak_noise* noise, const ak_fractal_desc* d,
                                                               const float* p) {
@@ -683,7 +668,7 @@ float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t di
     case AK_NOISE_BASIS_SIMPLEX:
         return dims == 1 ? fbm_simplex1(noise, d, p) : dims == 2 ? fbm_simplex2(noise, d, p) : fbm_simplex3(noise, d, p);
     case AK_NOISE_BASIS_VALUE:
-#ifdef AKP_HAVE_VALUE_VEX
+#ifdef AKP_HAVE_VEX
         if ((dims == 2 || dims == 3) && __builtin_cpu_supports("avx"))
             return dims == 3 ? fbm_value3_vex(noise, d, p) : fbm_value2_vex(noise, d, p);
 #endif

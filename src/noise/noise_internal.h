@@ -102,6 +102,24 @@ static inline float akp_floor_frac(float x, int* out_i) {
 }
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
+#define AKP_HAVE_VEX 1
+/* Hot per-point bodies (value noise 2D/3D, fBm over value and Perlin noise) are compiled a
+ * second time for CPUs with AVX and chosen at run time: VEX encoding (three-operand
+ * arithmetic, none of the register copies before each operation), no FMA, so the same
+ * roundings. Their floor is vroundss (every AVX CPU has SSE4.1): akp_floor_frac's roundss
+ * branch, the same bits. */
+#define AKP_VEX __attribute__((target("avx")))
+static inline __attribute__((always_inline)) float akp_floor_frac_vex(float x, int* out_i) {
+    float fl;
+    __asm__("vroundss $9, %1, %1, %0" : "=x"(fl) : "x"(x));
+    *out_i = (int)fl;
+    return x - fl;
+}
+#else
+static inline float akp_floor_frac_vex(float x, int* out_i) { return akp_floor_frac(x, out_i); }
+#endif
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
 #define AKP_HAVE_POINT_AVX2 1
 /* point_avx2.c, for CPUs with AVX2 (callers check): Worley F1's squared distance over rings 0
  * and 1 (the 3^dims cells around the point, dims 2 or 3), the cells side by side in the lanes;
@@ -124,6 +142,8 @@ float akp_fbm_perlin_grad(const ak_noise* noise, const ak_fractal_desc* d, uint3
  * AVX runs, so that tests on any CPU can check them against the VEX build bit for bit. */
 float akp_value_baseline(const ak_noise* noise, uint32_t dims, const float* p);
 float akp_fbm_value_baseline(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
+/* akp_fbm_perlin (dims 2 or 3) in the baseline x86-64 build, whatever the CPU (as above). */
+float akp_fbm_perlin_baseline(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
 
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);
