@@ -97,13 +97,15 @@ static const float simplex3_steps[8][2][3] = {
 /* ak_noise_simplex3's value without the gradient for finite x, y, z: the same operations, the
  * corner offsets from simplex3_steps (no branches on the order: random points mispredict
  * them) and the corner terms from simplex3_corner_value. */
-static inline __attribute__((always_inline)) float simplex3_value(const uint8_t* perm, float x, float y, float z) {
+static inline __attribute__((always_inline)) float simplex3_value_v(const uint8_t* perm, float x, float y, float z,
+                                                                    bool vex) {
     const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
     const float s = (x + y + z) * F3;
     int ii, jj, kk;
     /* a floor of -0.0 only when x, y and z are all -0.0; then fi - t is +0.0 with either zero */
-    const float fi = akp_floor_unsigned_zero(x + s, &ii), fj = akp_floor_unsigned_zero(y + s, &jj),
-                fk = akp_floor_unsigned_zero(z + s, &kk);
+    const float fi = vex ? akp_floor_unsigned_zero_vex(x + s, &ii) : akp_floor_unsigned_zero(x + s, &ii),
+                fj = vex ? akp_floor_unsigned_zero_vex(y + s, &jj) : akp_floor_unsigned_zero(y + s, &jj),
+                fk = vex ? akp_floor_unsigned_zero_vex(z + s, &kk) : akp_floor_unsigned_zero(z + s, &kk);
     const float t = (fi + fj + fk) * G3;
     const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
     const int xy = x0 >= y0, yz = y0 >= z0, xz = x0 >= z0;
@@ -123,6 +125,16 @@ static inline __attribute__((always_inline)) float simplex3_value(const uint8_t*
     sum += simplex3_corner_value(x0 - 1.0f + k3, y0 - 1.0f + k3, z0 - 1.0f + k3, simplex_g3[h3 & 15]);
     return 76.0f * sum;
 }
+
+static inline __attribute__((always_inline)) float simplex3_value(const uint8_t* perm, float x, float y, float z) {
+    return simplex3_value_v(perm, x, y, z, false);
+}
+#ifdef AKP_HAVE_VEX
+/* the VEX build (AKP_VEX, noise_internal.h), chosen where the CPU has AVX */
+AKP_VEX static __attribute__((noinline)) float simplex3_value_vex(const uint8_t* perm, float x, float y, float z) {
+    return simplex3_value_v(perm, x, y, z, true);
+}
+#endif
 
 /* ak_noise_simplex3 with the gradient at a finite point, out of line (the value-only call
  * then needs no frame for its registers). */
@@ -157,7 +169,13 @@ static __attribute__((noinline)) float simplex3_grad(const ak_noise* noise, floa
 
 float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
     const float p[3] = {x, y, z};
-    if (!out_gradient) return noise && all_finite(3, p) ? simplex3_value(noise->perm, x, y, z) : 0.0f;
+    if (!out_gradient) {
+        if (!noise || !all_finite(3, p)) return 0.0f;
+#ifdef AKP_HAVE_VEX
+        if (__builtin_cpu_supports("avx")) return simplex3_value_vex(noise->perm, x, y, z);
+#endif
+        return simplex3_value(noise->perm, x, y, z);
+    }
     zero_grad(out_gradient, 3);
     if (!noise || !all_finite(3, p)) return 0.0f;
     return simplex3_grad(noise, x, y, z, out_gradient);

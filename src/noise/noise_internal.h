@@ -115,8 +115,17 @@ static inline __attribute__((always_inline)) float akp_floor_frac_vex(float x, i
     *out_i = (int)fl;
     return x - fl;
 }
+/* akp_floor_unsigned_zero's roundss branch in the VEX build */
+static inline __attribute__((always_inline)) float akp_floor_unsigned_zero_vex(float x, int* out_i) {
+    float fl;
+    __asm__("vroundss $9, %1, %1, %0" : "=x"(fl) : "x"(x));
+    fl = fl + 0.0f;
+    *out_i = (int)fl;
+    return fl;
+}
 #else
 static inline float akp_floor_frac_vex(float x, int* out_i) { return akp_floor_frac(x, out_i); }
+static inline float akp_floor_unsigned_zero_vex(float x, int* out_i) { return akp_floor_unsigned_zero(x, out_i); }
 #endif
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
