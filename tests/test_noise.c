@@ -966,6 +966,100 @@ AK_TEST(floor_matches_libm) {
     AK_CHECK(signbit(akp_floor(x, &i)) && i == 0 && !signbit(akp_floor_frac(x, &i)));
 }
 
+/* Value noise written out from its definition, one corner at a time: corner c (bit k: the upper
+ * lattice line along axis k) hashes perm[...perm[perm[x_c] + y_c]... + w_c], its value is
+ * h / 127.5 - 1, the corners are blended along axis 0, then 1, ... with a + s (b - a),
+ * s = t^3 (t (6 t - 15) + 10), and the sum is clamped to [-1, 1]: the float operations the
+ * library documents, in their order, so the bits must agree. */
+static float value_naive(const ak_noise* n, uint32_t dims, const float* p) {
+    int cell[4];
+    float t[4];
+    for (uint32_t k = 0; k < dims; ++k) {
+        const float fl = floorf(p[k]);
+        cell[k] = (int)fl;
+        t[k] = p[k] - fl;
+    }
+    float v[16];
+    for (uint32_t c = 0; c < (1u << dims); ++c) {
+        uint32_t h = 0;
+        for (uint32_t k = 0; k < dims; ++k) h = n->perm[h + (uint32_t)((cell[k] + (int)(c >> k & 1u)) & 255)];
+        v[c] = (float)h / 127.5f - 1.0f;
+    }
+    for (uint32_t k = 0; k < dims; ++k) {
+        const float s = t[k] * t[k] * t[k] * (t[k] * (t[k] * 6.0f - 15.0f) + 10.0f);
+        for (uint32_t c = 0; c < (1u << dims); c += 2u << k) v[c] = v[c] + s * (v[c + (1u << k)] - v[c]);
+    }
+    return v[0] < -1.0f ? -1.0f : v[0] > 1.0f ? 1.0f : v[0];
+}
+
+static int bits_differ(float a, float b) { return memcmp(&a, &b, sizeof a) != 0; }
+
+/* ak_noise_value (the build this CPU runs, with and without gradient, and the baseline x86-64
+ * build of the 2D/3D bodies) and fBm over value noise (the CPU's build and the baseline one)
+ * against value_naive, bit for bit: random points, points near integers and signed zeros. */
+AK_TEST(value_matches_naive_definition) {
+    ak_rng rng = ak_rng_make(77);
+    long bad = 0, count = 0;
+    for (uint32_t dims = 1; dims <= 4; ++dims) {
+        const ak_noise n = ak_noise_make(dims * 5 + 1);
+        for (int i = 0; i < 20000; ++i) {
+            float p[4], g[4];
+            for (uint32_t k = 0; k < dims; ++k) {
+                const float r = frand(&rng, -300.0f, 300.0f);
+                /* every 4th point on or next to an integer (and +-0) */
+                p[k] = i % 4 ? r : i % 8 == 0 ? nextafterf(roundf(r), (float)(i % 3) - 1.0f) : (i & 16 ? -0.0f : roundf(r));
+            }
+            const float want = value_naive(&n, dims, p);
+            bad += bits_differ(ak_noise_value(&n, dims, p, NULL), want) + bits_differ(ak_noise_value(&n, dims, p, g), want);
+            count += 2;
+            if (dims == 2 || dims == 3) bad += bits_differ(akp_value_baseline(&n, dims, p), want), ++count;
+            if ((dims == 2 || dims == 3) && i % 8 == 1) {
+                /* fBm 4 octaves: sum = sum + amp * noise(p * freq), from freq 1.5, amp 1 */
+                const ak_fractal_desc d = {.type = AK_FRACTAL_FBM, .basis = AK_NOISE_BASIS_VALUE, .octaves = 4,
+                                           .lacunarity = 2.0f, .gain = 0.5f, .frequency = 1.5f};
+                float sum = 0.0f, freq = 1.5f, amp = 1.0f;
+                for (int o = 0; o < 4; ++o) {
+                    float q[3];
+                    for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
+                    sum = sum + amp * value_naive(&n, dims, q);
+                    freq = freq * 2.0f, amp = amp * 0.5f;
+                }
+                bad += bits_differ(ak_fractal_eval(&n, &d, dims, p, NULL), sum) +
+                       bits_differ(akp_fbm_value_baseline(&n, &d, dims, p), sum);
+                count += 2;
+            }
+        }
+    }
+    AK_CHECK_MSG(bad == 0, "%ld of %ld value noise results differ from the definition", bad, count);
+}
+
+/* fBm over Perlin noise in 2D/3D, the build this CPU runs (ak_fractal_eval) and the baseline
+ * x86-64 one (akp_fbm_perlin_baseline), against the octave sum written out over the per-point
+ * calls (sum = sum + amp * perlin(p * freq)), bit for bit. */
+AK_TEST(fbm_perlin_builds_match_octave_sum) {
+    ak_rng rng = ak_rng_make(78);
+    long bad = 0, count = 0;
+    const ak_fractal_desc d = {.type = AK_FRACTAL_FBM, .basis = AK_NOISE_BASIS_PERLIN, .octaves = 5,
+                               .lacunarity = 2.0f, .gain = 0.5f, .frequency = 0.75f};
+    for (uint32_t dims = 2; dims <= 3; ++dims) {
+        const ak_noise n = ak_noise_make(dims + 40);
+        for (int i = 0; i < 4000; ++i) {
+            float p[3];
+            for (uint32_t k = 0; k < dims; ++k) p[k] = i % 4 ? frand(&rng, -200.0f, 200.0f) : (float)(i % 7) - 3.0f;
+            float sum = 0.0f, freq = 0.75f, amp = 1.0f;
+            for (int o = 0; o < 5; ++o) {
+                const float x = p[0] * freq, y = p[1] * freq, z = dims == 3 ? p[2] * freq : 0.0f;
+                sum = sum + amp * (dims == 3 ? ak_noise_perlin3(&n, x, y, z, NULL) : ak_noise_perlin2(&n, x, y, NULL));
+                freq = freq * 2.0f, amp = amp * 0.5f;
+            }
+            bad += bits_differ(ak_fractal_eval(&n, &d, dims, p, NULL), sum) +
+                   bits_differ(akp_fbm_perlin_baseline(&n, &d, dims, p), sum);
+            count += 2;
+        }
+    }
+    AK_CHECK_MSG(bad == 0, "%ld of %ld fBm Perlin results differ from the octave sum", bad, count);
+}
+
 /* The per-point calls (ak_noise_perlin2/3, simplex2/3, value, worley F1) against a one-octave
  * fBm job at frequency 1 on every path this CPU has: the same value for every point, the same
  * bits except one documented case. The job sums octaves from +0.0 (0.0f + 1 * n), so where the
@@ -1031,6 +1125,8 @@ AK_TEST(per_point_matches_job_signed_zero) {
 int main(void) {
     AK_RUN(permutations);
     AK_RUN(floor_matches_libm);
+    AK_RUN(value_matches_naive_definition);
+    AK_RUN(fbm_perlin_builds_match_octave_sum);
     AK_RUN(worley_value_path_matches_gradient_path);
     AK_RUN(fractal_eval_explicit_fields_equal_defaults);
     AK_RUN(perlin3_published_value);

@@ -97,13 +97,15 @@ static const float simplex3_steps[8][2][3] = {
 /* ak_noise_simplex3's value without the gradient for finite x, y, z: the same operations, the
  * corner offsets from simplex3_steps (no branches on the order: random points mispredict
  * them) and the corner terms from simplex3_corner_value. */
-static inline __attribute__((always_inline)) float simplex3_value(const uint8_t* perm, float x, float y, float z) {
+static inline __attribute__((always_inline)) float simplex3_value_v(const uint8_t* perm, float x, float y, float z,
+                                                                    bool vex) {
     const float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;
     const float s = (x + y + z) * F3;
     int ii, jj, kk;
     /* a floor of -0.0 only when x, y and z are all -0.0; then fi - t is +0.0 with either zero */
-    const float fi = akp_floor_unsigned_zero(x + s, &ii), fj = akp_floor_unsigned_zero(y + s, &jj),
-                fk = akp_floor_unsigned_zero(z + s, &kk);
+    const float fi = vex ? akp_floor_unsigned_zero_vex(x + s, &ii) : akp_floor_unsigned_zero(x + s, &ii),
+                fj = vex ? akp_floor_unsigned_zero_vex(y + s, &jj) : akp_floor_unsigned_zero(y + s, &jj),
+                fk = vex ? akp_floor_unsigned_zero_vex(z + s, &kk) : akp_floor_unsigned_zero(z + s, &kk);
     const float t = (fi + fj + fk) * G3;
     const float x0 = x - (fi - t), y0 = y - (fj - t), z0 = z - (fk - t);
     const int xy = x0 >= y0, yz = y0 >= z0, xz = x0 >= z0;
@@ -123,6 +125,16 @@ static inline __attribute__((always_inline)) float simplex3_value(const uint8_t*
     sum += simplex3_corner_value(x0 - 1.0f + k3, y0 - 1.0f + k3, z0 - 1.0f + k3, simplex_g3[h3 & 15]);
     return 76.0f * sum;
 }
+
+static inline __attribute__((always_inline)) float simplex3_value(const uint8_t* perm, float x, float y, float z) {
+    return simplex3_value_v(perm, x, y, z, false);
+}
+#ifdef AKP_HAVE_VEX
+/* the VEX build (AKP_VEX, noise_internal.h), chosen where the CPU has AVX */
+AKP_VEX static __attribute__((noinline)) float simplex3_value_vex(const uint8_t* perm, float x, float y, float z) {
+    return simplex3_value_v(perm, x, y, z, true);
+}
+#endif
 
 /* ak_noise_simplex3 with the gradient at a finite point, out of line (the value-only call
  * then needs no frame for its registers). */
@@ -157,7 +169,13 @@ static __attribute__((noinline)) float simplex3_grad(const ak_noise* noise, floa
 
 float ak_noise_simplex3(const ak_noise* noise, float x, float y, float z, float* out_gradient) {
     const float p[3] = {x, y, z};
-    if (!out_gradient) return noise && all_finite(3, p) ? simplex3_value(noise->perm, x, y, z) : 0.0f;
+    if (!out_gradient) {
+        if (!noise || !all_finite(3, p)) return 0.0f;
+#ifdef AKP_HAVE_VEX
+        if (__builtin_cpu_supports("avx")) return simplex3_value_vex(noise->perm, x, y, z);
+#endif
+        return simplex3_value(noise->perm, x, y, z);
+    }
     zero_grad(out_gradient, 3);
     if (!noise || !all_finite(3, p)) return 0.0f;
     return simplex3_grad(noise, x, y, z, out_gradient);
@@ -219,14 +237,14 @@ static const float value_of[256] = {
 
 /* Value noise with a constant dims (inlined per dimension) and the gradient only when asked
  * for (it does not change the value). */
-static inline __attribute__((always_inline)) float value_n(const ak_noise* noise, uint32_t dims, const float* point,
-                                                           float* out_gradient) {
+static inline __attribute__((always_inline)) float value_nv(const ak_noise* noise, uint32_t dims, const float* point,
+                                                            float* out_gradient, bool vex) {
     int lo[4], hi[4];
     float f[4];
 #pragma GCC unroll 4
     for (uint32_t k = 0; k < dims; ++k) {
         int i;
-        f[k] = akp_floor_frac(point[k], &i);
+        f[k] = vex ? akp_floor_frac_vex(point[k], &i) : akp_floor_frac(point[k], &i);
         lo[k] = i & 255;
         hi[k] = (i + 1) & 255;
     }
@@ -267,17 +285,35 @@ static inline __attribute__((always_inline)) float value_n(const ak_noise* noise
         for (uint32_t m = 0; m < dims; ++m) out_gradient[m] = gv[0][m];
     /* fminf(fmaxf(v, -1), 1) for the finite v here, without the libm calls */
     const float v = val[0];
-    return v < -1.0f ? -1.0f : v > 1.0f ? 1.0f : v;
+    /* written as max then min, which gcc makes maxss and minss (the nested ?: was a compare and
+     * branch before a minss); the same value for every v but NaN, which never comes here */
+    const float v1 = v > -1.0f ? v : -1.0f;
+    return v1 < 1.0f ? v1 : 1.0f;
+}
+
+static inline __attribute__((always_inline)) float value_n(const ak_noise* noise, uint32_t dims, const float* point,
+                                                           float* out_gradient) {
+    return value_nv(noise, dims, point, out_gradient, false);
 }
 
 /* The value-only paths of 2D and 3D, each its own compiled body (no derivative work, and
- * not sharing one function's registers with the other seven variants). */
+ * not sharing one function's registers with the other seven variants), and again in the VEX
+ * build (AKP_VEX, noise_internal.h) for CPUs with AVX: value 3D per point 1.08x -> 0.94x
+ * FastNoiseLite's time (docs/BENCHMARKS.md, noise). */
 static __attribute__((noinline)) float value2_value(const ak_noise* noise, const float* point) {
     return value_n(noise, 2, point, NULL);
 }
 static __attribute__((noinline)) float value3_value(const ak_noise* noise, const float* point) {
     return value_n(noise, 3, point, NULL);
 }
+#ifdef AKP_HAVE_VEX
+AKP_VEX static __attribute__((noinline)) float value2_value_vex(const ak_noise* noise, const float* point) {
+    return value_nv(noise, 2, point, NULL, true);
+}
+AKP_VEX static __attribute__((noinline)) float value3_value_vex(const ak_noise* noise, const float* point) {
+    return value_nv(noise, 3, point, NULL, true);
+}
+#endif
 
 /* ak_noise_value's every case (the public function keeps the common one in front). */
 static __attribute__((noinline)) float value_any(const ak_noise* noise, uint32_t dimensions, const float* point,
@@ -298,9 +334,17 @@ float ak_noise_value(const ak_noise* noise, uint32_t dimensions, const float* po
      * function pushed five registers and set up a stack frame on every call. */
     if (!out_gradient && noise && point && (dimensions == 2 || dimensions == 3)) {
         if (!all_finite(dimensions, point)) return 0.0f;
+#ifdef AKP_HAVE_VEX
+        if (__builtin_cpu_supports("avx"))
+            return dimensions == 3 ? value3_value_vex(noise, point) : value2_value_vex(noise, point);
+#endif
         return dimensions == 3 ? value3_value(noise, point) : value2_value(noise, point);
     }
     return value_any(noise, dimensions, point, out_gradient);
+}
+
+float akp_value_baseline(const ak_noise* noise, uint32_t dims, const float* p) {
+    return dims == 3 ? value3_value(noise, p) : value2_value(noise, p);
 }
 
 /* ---- Worley ------------------------------------------------------------------------------- */
@@ -579,25 +623,26 @@ float ak_noise_worley(const ak_noise* noise, uint32_t dimensions, const float* p
 
 /* One octave's basis value, as fractal.c's basis_eval gives it without gradient. */
 static inline __attribute__((always_inline)) float basis_value(const ak_noise* noise, ak_noise_basis basis,
-                                                               uint32_t dims, const float* q) {
+                                                               uint32_t dims, const float* q, bool vex) {
     switch (basis) {
     case AK_NOISE_BASIS_SIMPLEX:
         if (dims == 3) return all_finite(3, q) ? simplex3_value(noise->perm, q[0], q[1], q[2]) : 0.0f;
         return ak_noise_simplex2(noise, q[0], dims == 1 ? 0.0f : q[1], NULL);
-    case AK_NOISE_BASIS_VALUE: return all_finite(dims, q) ? value_n(noise, dims, q, NULL) : 0.0f;
+    case AK_NOISE_BASIS_VALUE: return all_finite(dims, q) ? value_nv(noise, dims, q, NULL, vex) : 0.0f;
     default: return all_finite(dims, q) ? worley_n(noise, dims, false, q, NULL, NULL) : 0.0f;
     }
 }
 
 static inline __attribute__((always_inline)) float fbm_other_n(const ak_noise* noise, const ak_fractal_desc* d,
-                                                               ak_noise_basis basis, uint32_t dims, const float* p) {
+                                                               ak_noise_basis basis, uint32_t dims, const float* p,
+                                                               bool vex) {
     float freq = d->frequency, amp = 1.0f, sum = 0.0f;
     const float lacunarity = d->lacunarity, gain = d->gain;
     for (uint32_t o = 0; o < d->octaves; ++o) {
         float q[4];
 #pragma GCC unroll 4
         for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
-        sum = sum + amp * basis_value(noise, basis, dims, q);
+        sum = sum + amp * basis_value(noise, basis, dims, q, vex);
         freq = freq * lacunarity;
         amp = amp * gain;
     }
@@ -608,7 +653,7 @@ static inline __attribute__((always_inline)) float fbm_other_n(const ak_noise* n
 #define AKP_FBM_OTHER(name, basis, dims)                                                            \
     static __attribute__((noinline)) float name(const ak_noise* noise, const ak_fractal_desc* d,   \
                                                 const float* p) {                                  \
-        return fbm_other_n(noise, d, basis, dims, p);                                              \
+        return fbm_other_n(noise, d, basis, dims, p, false);                                       \
     }
 AKP_FBM_OTHER(fbm_simplex1, AK_NOISE_BASIS_SIMPLEX, 1)
 AKP_FBM_OTHER(fbm_simplex2, AK_NOISE_BASIS_SIMPLEX, 2)
@@ -620,12 +665,31 @@ AKP_FBM_OTHER(fbm_value4, AK_NOISE_BASIS_VALUE, 4)
 AKP_FBM_OTHER(fbm_worley1, AK_NOISE_BASIS_WORLEY, 1)
 AKP_FBM_OTHER(fbm_worley2, AK_NOISE_BASIS_WORLEY, 2)
 AKP_FBM_OTHER(fbm_worley3, AK_NOISE_BASIS_WORLEY, 3)
+#ifdef AKP_HAVE_VEX
+/* fBm over value noise in 2D/3D, the VEX build (as value3_value_vex) */
+AKP_VEX static __attribute__((noinline)) float fbm_value2_vex(const ak_noise* noise, const ak_fractal_desc* d,
+                                                              const float* p) {
+    return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 2, p, true);
+}
+AKP_VEX static __attribute__((noinline)) float fbm_value3_vex(const ak_noise* noise, const ak_fractal_desc* d,
+                                                              const float* p) {
+    return fbm_other_n(noise, d, AK_NOISE_BASIS_VALUE, 3, p, true);
+}
+#endif
+
+float akp_fbm_value_baseline(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
+    return dims == 3 ? fbm_value3(noise, d, p) : fbm_value2(noise, d, p);
+}
 
 float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
     switch (d->basis) {
     case AK_NOISE_BASIS_SIMPLEX:
         return dims == 1 ? fbm_simplex1(noise, d, p) : dims == 2 ? fbm_simplex2(noise, d, p) : fbm_simplex3(noise, d, p);
     case AK_NOISE_BASIS_VALUE:
+#ifdef AKP_HAVE_VEX
+        if ((dims == 2 || dims == 3) && __builtin_cpu_supports("avx"))
+            return dims == 3 ? fbm_value3_vex(noise, d, p) : fbm_value2_vex(noise, d, p);
+#endif
         return dims == 1   ? fbm_value1(noise, d, p)
                : dims == 2 ? fbm_value2(noise, d, p)
                : dims == 3 ? fbm_value3(noise, d, p)

@@ -83,8 +83,50 @@ static inline float akp_floor(float x, int* out_i) { return copysignf(akp_floor_
  * without its sign here: only x = -0.0 tells (-0.0 - +0.0 is -0.0 where x - floorf(x) is
  * +0.0), and adding +0.0 turns that -0.0 into +0.0 and changes no other value. */
 static inline float akp_floor_frac(float x, int* out_i) {
+#ifdef AKP_HAVE_FLOOR_ROUNDSS
+#ifndef __SSE4_1__
+    if (__builtin_cpu_supports("sse4.1"))
+#endif
+    {
+        /* roundss keeps the sign of a zero: x = -0.0 gives fl = -0.0 and x - fl = +0.0, and no
+         * other x gives a zero of either sign but +0.0 (x - fl is zero only where x == fl). So
+         * the two + 0.0f of the general form change nothing here: two additions fewer on the
+         * lattice hash's path. The int is the same ((int)-0.0f is 0). */
+        float fl = x;
+        __asm__("roundss $9, %0, %0" : "+x"(fl));
+        *out_i = (int)fl;
+        return x - fl;
+    }
+#endif
     return (x - akp_floor_unsigned_zero(x, out_i)) + 0.0f;
 }
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
+#define AKP_HAVE_VEX 1
+/* Hot per-point bodies (value noise 2D/3D, fBm over value and Perlin noise) are compiled a
+ * second time for CPUs with AVX and chosen at run time: VEX encoding (three-operand
+ * arithmetic, none of the register copies before each operation), no FMA, so the same
+ * roundings. Their floor is vroundss (every AVX CPU has SSE4.1): akp_floor_frac's roundss
+ * branch, the same bits. */
+#define AKP_VEX __attribute__((target("avx")))
+static inline __attribute__((always_inline)) float akp_floor_frac_vex(float x, int* out_i) {
+    float fl;
+    __asm__("vroundss $9, %1, %1, %0" : "=x"(fl) : "x"(x));
+    *out_i = (int)fl;
+    return x - fl;
+}
+/* akp_floor_unsigned_zero's roundss branch in the VEX build */
+static inline __attribute__((always_inline)) float akp_floor_unsigned_zero_vex(float x, int* out_i) {
+    float fl;
+    __asm__("vroundss $9, %1, %1, %0" : "=x"(fl) : "x"(x));
+    fl = fl + 0.0f;
+    *out_i = (int)fl;
+    return fl;
+}
+#else
+static inline float akp_floor_frac_vex(float x, int* out_i) { return akp_floor_frac(x, out_i); }
+static inline float akp_floor_unsigned_zero_vex(float x, int* out_i) { return akp_floor_unsigned_zero(x, out_i); }
+#endif
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(AK_NO_SIMD)
 #define AKP_HAVE_POINT_AVX2 1
@@ -103,6 +145,14 @@ float akp_fbm_other(const ak_noise* noise, const ak_fractal_desc* d, uint32_t di
 /* The same with the gradient, Perlin in 2D and 3D (dims 2 or 3). */
 float akp_fbm_perlin_grad(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p,
                           float* grad);
+
+/* ak_noise_value without gradient (dims 2 or 3, finite point) and akp_fbm_other over value
+ * noise (dims 2 or 3) in the baseline x86-64 build, whatever the CPU: the bodies a CPU without
+ * AVX runs, so that tests on any CPU can check them against the VEX build bit for bit. */
+float akp_value_baseline(const ak_noise* noise, uint32_t dims, const float* p);
+float akp_fbm_value_baseline(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
+/* akp_fbm_perlin (dims 2 or 3) in the baseline x86-64 build, whatever the CPU (as above). */
+float akp_fbm_perlin_baseline(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p);
 
 /* Scalar reference of the batch kernels: one point of a resolved, valid fractal desc. */
 float akp_fractal_point(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p, float* grad);

@@ -219,8 +219,8 @@ static inline __attribute__((always_inline)) float lattice_value(const uint8_t* 
     return val[0];
 }
 
-static inline __attribute__((always_inline)) float perlin_n(const ak_noise* noise, uint32_t dims, const float* p,
-                                                            const int* period, float* grad) {
+static inline __attribute__((always_inline)) float perlin_nv(const ak_noise* noise, uint32_t dims, const float* p,
+                                                             const int* period, float* grad, bool vex) {
     int lo[4], hi[4];
     float f[4];
     AKP_UNROLL
@@ -232,7 +232,7 @@ static inline __attribute__((always_inline)) float perlin_n(const ak_noise* nois
             return 0.0f;
         }
         int i;
-        f[k] = akp_floor_frac(p[k], &i);
+        f[k] = vex ? akp_floor_frac_vex(p[k], &i) : akp_floor_frac(p[k], &i);
         if (period) {
             const int per = period[k];
             int w = i % per;
@@ -246,6 +246,11 @@ static inline __attribute__((always_inline)) float perlin_n(const ak_noise* nois
     }
     if (!grad && (dims == 2 || dims == 3)) return lattice_value(noise->perm, dims, lo, hi, f);
     return lattice(noise->perm, dims, lo, hi, f, grad);
+}
+
+static inline __attribute__((always_inline)) float perlin_n(const ak_noise* noise, uint32_t dims, const float* p,
+                                                            const int* period, float* grad) {
+    return perlin_nv(noise, dims, p, period, grad, false);
 }
 
 float ak_noise_perlin1(const ak_noise* noise, float x, float* out_gradient) {
@@ -312,14 +317,14 @@ float ak_noise_perlin_periodic(const ak_noise* noise, uint32_t dimensions, const
 
 /* fBm over Perlin noise with a constant dims (akp_fbm_perlin). */
 static inline __attribute__((always_inline)) float fbm_perlin_n(const ak_noise* noise, const ak_fractal_desc* d,
-                                                                uint32_t dims, const float* p) {
+                                                                uint32_t dims, const float* p, bool vex) {
     float freq = d->frequency, amp = 1.0f, sum = 0.0f;
     const float lacunarity = d->lacunarity, gain = d->gain;
     for (uint32_t o = 0; o < d->octaves; ++o) {
         float q[4];
         AKP_UNROLL
         for (uint32_t k = 0; k < dims; ++k) q[k] = p[k] * freq;
-        sum = sum + amp * perlin_n(noise, dims, q, NULL, NULL);
+        sum = sum + amp * perlin_nv(noise, dims, q, NULL, NULL, vex);
         freq = freq * lacunarity;
         amp = amp * gain;
     }
@@ -365,14 +370,33 @@ float akp_fbm_perlin_grad(const ak_noise* noise, const ak_fractal_desc* d, uint3
 #define AKP_FBM_PERLIN(name, dims)                                                                  \
     static __attribute__((noinline)) float name(const ak_noise* noise, const ak_fractal_desc* d,   \
                                                 const float* p) {                                  \
-        return fbm_perlin_n(noise, d, dims, p);                                                    \
+        return fbm_perlin_n(noise, d, dims, p, false);                                             \
     }
 AKP_FBM_PERLIN(fbm_perlin1, 1)
 AKP_FBM_PERLIN(fbm_perlin2, 2)
 AKP_FBM_PERLIN(fbm_perlin3, 3)
 AKP_FBM_PERLIN(fbm_perlin4, 4)
+#ifdef AKP_HAVE_VEX
+/* 2D and 3D again in the VEX build (noise_internal.h, AKP_VEX), chosen where the CPU has AVX */
+AKP_VEX static __attribute__((noinline)) float fbm_perlin2_vex(const ak_noise* noise, const ak_fractal_desc* d,
+                                                               const float* p) {
+    return fbm_perlin_n(noise, d, 2, p, true);
+}
+AKP_VEX static __attribute__((noinline)) float fbm_perlin3_vex(const ak_noise* noise, const ak_fractal_desc* d,
+                                                               const float* p) {
+    return fbm_perlin_n(noise, d, 3, p, true);
+}
+#endif
+
+float akp_fbm_perlin_baseline(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
+    return dims == 3 ? fbm_perlin3(noise, d, p) : fbm_perlin2(noise, d, p);
+}
 
 float akp_fbm_perlin(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* p) {
+#ifdef AKP_HAVE_VEX
+    if ((dims == 2 || dims == 3) && __builtin_cpu_supports("avx"))
+        return dims == 3 ? fbm_perlin3_vex(noise, d, p) : fbm_perlin2_vex(noise, d, p);
+#endif
     switch (dims) {
     case 1: return fbm_perlin1(noise, d, p);
     case 2: return fbm_perlin2(noise, d, p);
