@@ -214,7 +214,9 @@ static double skinned_volume(const rig* g, ak_skin_method method, size_t* out_pa
     return v;
 }
 
-static void bend_case(float degrees, int res, bool print) {
+/* j_tol > 0: every tetrahedron's volume ratio J (posed over rest, a property of the lattice
+ * alone) within 1 +- j_tol after the hold. */
+static void bend_case(float degrees, int res, bool print, double j_tol) {
     rig g;
     AK_CHECK(rig_load(&g, 48, 32));
     rig_pose(&g, ak_quat_identity());
@@ -246,6 +248,9 @@ static void bend_case(float degrees, int res, bool print) {
         }
         if (print) printf("  lattice volume ratio %.5f, J in [%.4f, %.4f]\n", v_now / v_rest, jmin, jmax);
         AK_CHECK_MSG(jmin > 0.0, "bend %g: an inverted tetrahedron (J = %g)", (double)degrees, jmin);
+        if (j_tol > 0.0)
+            AK_CHECK_MSG(jmin >= 1.0 - j_tol && jmax <= 1.0 + j_tol, "bend %g: tet volume ratios [%g, %g] beyond 1 +- %g",
+                         (double)degrees, jmin, jmax, j_tol);
         free(rest);
         free(tt);
     }
@@ -689,7 +694,8 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
     double skin_speed = 0.0, node_speed = 0.0;
     int node_frame = 0;
     cman_skin(&c, AK_SKIN_LBS, pal, dqs);
-    for (int f = 1; f <= 80; ++f) {
+    const int frames = getenv("AK_SOFT_FRAMES") ? atoi(getenv("AK_SOFT_FRAMES")) : 80;
+    for (int f = 1; f <= frames; ++f) {
         memcpy(prev, pal, c.ns * sizeof(ak_mat4));
         cman_flex_palette(&c, slot, axis, ak_radians(degrees) * (float)(f < 20 ? f : 20) / 20.0f, pal);
         cman_skin(&c, AK_SKIN_LBS, pal, lbs);
@@ -709,7 +715,7 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
             if (ak_vec3_length(v[n]) > node_speed) node_speed = ak_vec3_length(v[n]), node_frame = f;
     }
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
-    const double ms = ((double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6) / 80.0;
+    const double ms = ((double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6) / (double)frames;
     /* the pose is a flexion: the child joint moved to the front (arm) or the back (leg) */
     ak_vec3 tip = ak_mat4_transform_point(pal[cs], c.jp[cs]);
     AK_CHECK(strstr(joint, "leg") ? tip.x < c.jp[slot].x : tip.x > c.jp[slot].x);
@@ -738,11 +744,22 @@ static void cman_flex_case(const char* joint, const char* child, float degrees, 
         lr += vol[0], ln += vol[1];
         if (vol[0] > 0.0 && vol[1] / vol[0] < jmin) jmin = vol[1] / vol[0];
     }
+    /* the kinematic nodes released by the cone rule: how far the flesh took them from their
+     * skinned positions (the others are there) */
+    double released_off = 0.0;
+    {
+        uint8_t* kin = malloc(nn);
+        AK_CHECK_EQ(ak_skin_soft_kinematic_flags(soft, (ak_u8_span){kin, nn}), AK_OK);
+        AK_CHECK_EQ(ak_skin_soft_state_init(soft, (ak_mat4_cspan){pal, c.ns}, (ak_vec3_span){rest, nn}, (ak_vec3_span){v, nn}), AK_OK);
+        for (size_t n = 0; n < nn; ++n)
+            if (kin[n]) released_off = fmax(released_off, ak_vec3_distance(rest[n], x[n]));
+        free(kin);
+    }
     printf("  CesiumMan %s %.0f deg: intersecting pairs soft %zu LBS %zu DQS %zu (bind %zu); volume ratio soft %.5f LBS %.5f DQS %.5f;"
-           " lattice near the joint %.5f (smallest tet %.3f of its rest volume); kinetic energy held 1 s %.3g (largest while bending %.3g); fastest node %.2f m/s (frame %d), fastest skinned vertex %.2f m/s; %zu nodes, %.2f ms"
-           " per frame (thread CPU)\n",
+           " lattice near the joint %.5f (smallest tet %.3f of its rest volume); kinetic energy held 1 s %.3g (largest while bending %.3g); fastest node %.2f m/s (frame %d), fastest skinned vertex %.2f m/s; kinematic nodes up to %.3f m off their skinned"
+           " positions; %zu nodes, %.2f ms per frame (thread CPU)\n",
            joint, (double)degrees, ps, pl, pd, p0, vs, vl, vd, lr > 0.0 ? ln / lr : 0.0, jmin, (double)ke, (double)ke_moving, node_speed,
-           node_frame, skin_speed, nn, ms);
+           node_frame, skin_speed, released_off, nn, ms);
     AK_CHECK_MSG(ke < 1e-3f * ke_moving, "soft: kinetic energy %g after 1 s held (%g while bending)", (double)ke, (double)ke_moving);
     /* no node of the flesh moves faster than 3 times the fastest point of the mesh moved rigidly
      * with its bones (the flesh whips to about twice that as a bend starts at full speed). The
@@ -778,8 +795,11 @@ AK_TEST(cesiumman_knee_150) { cman_flex_case("leg_joint_L_2", "leg_joint_L_3", 1
 AK_TEST(cesiumman_right_knee_140) { cman_flex_case("leg_joint_R_2", "leg_joint_R_3", 140.0f, 0.01, 0.01); }
 
 /* the default desc (resolution 32, 40 substeps, the default free zone around the joint) */
-AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 0, true); }
-AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 0, true); }
+AK_TEST(bend_120_keeps_volume) { bend_case(120.0f, 0, true, 0.0); }
+/* held at 150 deg every tet keeps its volume within 5%: untied, the released core nodes gave
+ * 0.987-1.014; a spring tying them to their skinned positions (30 rad/s) gave 0.750-1.336
+ * (docs/softskin.md). At 120 deg no node is released and the fold keeps 0.854-1.136: no bound */
+AK_TEST(bend_150_keeps_volume) { bend_case(150.0f, 0, true, 0.05); }
 
 int main(void) {
     /* AK_SOFT_FLEX=JOINT:CHILD:DEGREES runs that CesiumMan flexion alone (the measurements of
@@ -791,6 +811,13 @@ int main(void) {
         if (sscanf(flex, "%127[^:]:%127[^:]:%f", joint, child, &degrees) != 3) return 2;
         ak_test_cur_name_ = "flex";
         cman_flex_case(joint, child, degrees, 0.01, 0.005);
+        return ak_test_finish();
+    }
+    /* AK_SOFT_BEND=DEGREES runs builtin:cylinder's bend to that angle alone (default desc) */
+    const char* bend = getenv("AK_SOFT_BEND");
+    if (bend) {
+        ak_test_cur_name_ = "bend";
+        bend_case((float)atof(bend), 0, true, 0.0);
         return ak_test_finish();
     }
     AK_RUN(bind_pose_reproduces_the_mesh);
