@@ -26,17 +26,14 @@
  * (0.35: 25 pairs at 150; 0.5: 2 at 130), docs/softskin.md */
 #define SOFT_RELEASE_CONE 0.44f     /* sin of the release cone's half-angle about a joint plane */
 #define SOFT_RELEASE_BEND_COS 0.0f  /* released only where the bones part by more than 90 deg */
-/* 1/s: a released kinematic node's velocity relative to its skinned velocity decays at this
- * rate (on top of the jiggle damping; per substep after the tets, before its plane). Untied, the
+/* a released kinematic node is tied to its skinned position by a zero-length spring of this
+ * natural frequency (rad/s; XPBD, one projection per substep after the tets). Untied, the
  * forearm's 22 released nodes of CesiumMan's elbow held at 140 deg slid up to 0.29 m from their
  * skinned positions over 20 held frames and the held elbow kept 1.8e-3 of its bending energy
- * after 1 s. A damping, not a spring to the skinned position: the spring (30 rad/s) settled the
- * elbow too but pulled the released nodes of builtin:cylinder bent 150 deg towards positions the
- * flesh cannot take (tet volume ratios 0.750-1.336, 0.987-1.014 untied); damped at 10-27/s the
- * cylinder keeps 0.987-1.009 and the elbow settles; from 30/s the cylinder's tets strain again
- * (0.89-1.14 at 30 and 35, 0.84-1.19 at 60; docs/softskin.md) */
-#ifndef SOFT_TETHER_DAMPING
-#define SOFT_TETHER_DAMPING 20.0f
+ * after 1 s. 20 and 30 pass every flexion; 40 gives the elbow at 150 deg 14 pairs
+ * (docs/softskin.md) */
+#ifndef SOFT_TETHER_OMEGA
+#define SOFT_TETHER_OMEGA 30.0f
 #endif
 /* cubes: a node of a part beyond a joint's two bones (the buttock, the heel) takes the joint's
  * plane when its skinned position lies this close to a skinned node of the other side. Measured
@@ -1093,7 +1090,7 @@ typedef struct step_ctx {
                           p, -(p + 1) child side; 0 none */
     posed_bone* bones; /* this substep's (pose_substep) */
     float jiggle; /* 1 - exp(-jiggle_damping h) */
-    float tether; /* 1 - exp(-SOFT_TETHER_DAMPING h): a released node's relative velocity's decay */
+    float tether; /* (omega h)^2 / (1 + (omega h)^2): the XPBD step of a released node's tether */
     float* lambda;
     float h, gamma, adev, ahyd;
     bool simd; /* the CPU runs solve_tets8 */
@@ -1453,13 +1450,13 @@ static void step_work(soft_team* team, uint32_t index) {
             sync(team);
         }
         float inv_h = 1.0f / c->h;
+        const float back = c->h * (float)(S - sub - 1);
         for (size_t n = nb; n < ne; ++n) {
             const bool sim = !s->kinematic[n] || c->released[n];
             if (sim && s->kinematic[n] && c->tether > 0.0f) {
-                /* a released kinematic node: its substep's motion relative to the skinned motion
-                 * is damped (no pull towards a position: the flesh keeps its shape) */
-                ak_vec3 rel = ak_vec3_madd(ak_vec3_sub(c->x[n].p, c->prev[n].p), c->vref[n], -c->h);
-                c->x[n].p = ak_vec3_madd(c->x[n].p, rel, -c->tether);
+                /* a released kinematic node: its tether to the skinned position at this substep */
+                ak_vec3 t = ak_vec3_madd(c->target[n], c->vref[n], -back);
+                c->x[n].p = ak_vec3_madd(c->x[n].p, ak_vec3_sub(t, c->x[n].p), c->tether);
             }
             if (sim) collide_node(c, n);
             c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n].p, c->prev[n].p), inv_h);
@@ -1599,7 +1596,10 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     c.simd = __builtin_cpu_supports("avx2");
 #endif
     c.jiggle = 1.0f - expf(-s->jiggle_damping * c.h);
-    c.tether = 1.0f - expf(-SOFT_TETHER_DAMPING * c.h);
+    {
+        const float wh2 = SOFT_TETHER_OMEGA * c.h * SOFT_TETHER_OMEGA * c.h;
+        c.tether = wh2 / (1.0f + wh2);
+    }
     const bool have_prev = j->previous_palette.ptr != NULL;
     for (size_t n = 0; n < nn; ++n) {
         c.start[n] = j->node_positions.ptr[n];
