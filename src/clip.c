@@ -364,7 +364,8 @@ enum {
     F_TH = 14,  /* SLERP: the segment's angle, 1 / sin, sign of b */
     F_IS = 15,
     F_SG = 16,
-    CACHE_FIELDS = 17
+    F_BR = 17,  /* VEC3, NLERP: b as stored (SLERP: F_B), the next segment's a */
+    CACHE_FIELDS = 21
 };
 #define CACHE_GROUP_U32 ((size_t)CACHE_FIELDS * 4u)
 
@@ -476,6 +477,7 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
         /* hold lanes: b = a, so b - a = 0 */
         AKP_PUT(F_A, ax), AKP_PUT(F_A + 1, ay), AKP_PUT(F_A + 2, az);
         AKP_PUT(F_B, _mm_sub_ps(bx, ax)), AKP_PUT(F_B + 1, _mm_sub_ps(by, ay)), AKP_PUT(F_B + 2, _mm_sub_ps(bz, az));
+        AKP_PUT(F_BR, bx), AKP_PUT(F_BR + 1, by), AKP_PUT(F_BR + 2, bz);
         return;
     }
     __m128 ax = _mm_loadu_ps(pa[0]), ay = _mm_loadu_ps(pa[1]), az = _mm_loadu_ps(pa[2]), aw = _mm_loadu_ps(pa[3]);
@@ -492,6 +494,7 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
         AKP_PUT(F_B + 1, _mm_sub_ps(_mm_xor_ps(by, flip), ay));
         AKP_PUT(F_B + 2, _mm_sub_ps(_mm_xor_ps(bz, flip), az));
         AKP_PUT(F_B + 3, _mm_sub_ps(_mm_xor_ps(bw, flip), aw));
+        AKP_PUT(F_BR, bx), AKP_PUT(F_BR + 1, by), AKP_PUT(F_BR + 2, bz), AKP_PUT(F_BR + 3, bw);
         AKP_PUT(F_FIX, _mm_setzero_ps());
         return;
     }
@@ -505,6 +508,61 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
 #undef AKP_PUT
 }
 
+/* cache_write of a shared group whose four lanes moved from segment k - 1 to k (k: the new
+ * interval in k0, pa the new a keys): the new a keys are the old b keys, still in the cache
+ * (F_BR; F_B for SLERP) as the same floats, so only the b keys (and SLERP's constants) are
+ * loaded and transposed; the stored fields are those cache_write would store. */
+static AKP_ALWAYS_INLINE void cache_write_step(const akp_clip_group* G, float* f, lane_keys k0, const float* const* pa) {
+    const float* pb[4] = {pa[0] + (k0.pb - k0.pa), pa[1] + (k0.pb - k0.pa), pa[2] + (k0.pb - k0.pa),
+                          pa[3] + (k0.pb - k0.pa)};
+    for (int l = 0; l < 4; ++l) _mm_prefetch((const char*)(uintptr_t)((uintptr_t)pb[l] + 64u), _MM_HINT_T0); /* a hint */
+    _mm_store_ps(f + 4 * F_LO, _mm_set1_ps(k0.lo));
+    _mm_store_ps(f + 4 * F_HI, _mm_set1_ps(k0.hi));
+    _mm_store_ps(f + 4 * F_T0, _mm_set1_ps(k0.t0));
+    _mm_store_ps(f + 4 * F_DT, _mm_set1_ps(k0.dt));
+    _mm_store_ps(f + 4 * F_HOLD, _mm_setzero_ps());
+    if (G->kind == AKP_CLIP_FAST_VEC3) {
+        const __m128 ax = _mm_load_ps(f + 4 * F_BR), ay = _mm_load_ps(f + 4 * (F_BR + 1)),
+                     az = _mm_load_ps(f + 4 * (F_BR + 2));
+        __m128 bx = load3(pb[0]), by = load3(pb[1]), bz = load3(pb[2]), bw = load3(pb[3]);
+        AKP_SIMD_TRANSPOSE4(bx, by, bz, bw);
+        (void)bw;
+        _mm_store_ps(f + 4 * F_A, ax), _mm_store_ps(f + 4 * (F_A + 1), ay), _mm_store_ps(f + 4 * (F_A + 2), az);
+        _mm_store_ps(f + 4 * F_B, _mm_sub_ps(bx, ax)), _mm_store_ps(f + 4 * (F_B + 1), _mm_sub_ps(by, ay));
+        _mm_store_ps(f + 4 * (F_B + 2), _mm_sub_ps(bz, az));
+        _mm_store_ps(f + 4 * F_BR, bx), _mm_store_ps(f + 4 * (F_BR + 1), by), _mm_store_ps(f + 4 * (F_BR + 2), bz);
+        return;
+    }
+    const int src = G->kind == AKP_CLIP_FAST_NLERP ? F_BR : F_B;
+    const __m128 ax = _mm_load_ps(f + 4 * src), ay = _mm_load_ps(f + 4 * (src + 1)), az = _mm_load_ps(f + 4 * (src + 2)),
+                 aw = _mm_load_ps(f + 4 * (src + 3));
+    __m128 bx = _mm_loadu_ps(pb[0]), by = _mm_loadu_ps(pb[1]), bz = _mm_loadu_ps(pb[2]), bw = _mm_loadu_ps(pb[3]);
+    AKP_SIMD_TRANSPOSE4(bx, by, bz, bw);
+    _mm_store_ps(f + 4 * F_A, ax), _mm_store_ps(f + 4 * (F_A + 1), ay), _mm_store_ps(f + 4 * (F_A + 2), az);
+    _mm_store_ps(f + 4 * (F_A + 3), aw);
+    if (G->kind == AKP_CLIP_FAST_NLERP) {
+        __m128 dot = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz)),
+                                _mm_mul_ps(aw, bw));
+        __m128 flip = _mm_and_ps(_mm_cmplt_ps(dot, _mm_setzero_ps()), _mm_set1_ps(-0.0f));
+        _mm_store_ps(f + 4 * F_B, _mm_sub_ps(_mm_xor_ps(bx, flip), ax));
+        _mm_store_ps(f + 4 * (F_B + 1), _mm_sub_ps(_mm_xor_ps(by, flip), ay));
+        _mm_store_ps(f + 4 * (F_B + 2), _mm_sub_ps(_mm_xor_ps(bz, flip), az));
+        _mm_store_ps(f + 4 * (F_B + 3), _mm_sub_ps(_mm_xor_ps(bw, flip), aw));
+        _mm_store_ps(f + 4 * F_BR, bx), _mm_store_ps(f + 4 * (F_BR + 1), by), _mm_store_ps(f + 4 * (F_BR + 2), bz);
+        _mm_store_ps(f + 4 * (F_BR + 3), bw);
+        _mm_store_ps(f + 4 * F_FIX, _mm_setzero_ps());
+        return;
+    }
+    __m128 th = _mm_loadu_ps(pa[0] + 4), is = _mm_loadu_ps(pa[1] + 4), sg = _mm_loadu_ps(pa[2] + 4),
+           z3 = _mm_loadu_ps(pa[3] + 4);
+    AKP_SIMD_TRANSPOSE4(th, is, sg, z3);
+    (void)z3;
+    _mm_store_ps(f + 4 * F_B, bx), _mm_store_ps(f + 4 * (F_B + 1), by), _mm_store_ps(f + 4 * (F_B + 2), bz);
+    _mm_store_ps(f + 4 * (F_B + 3), bw);
+    _mm_store_ps(f + 4 * F_TH, th), _mm_store_ps(f + 4 * F_IS, is), _mm_store_ps(f + 4 * F_SG, sg);
+    _mm_store_ps(f + 4 * F_FIX, _mm_cmpeq_ps(is, _mm_setzero_ps()));
+}
+
 /* Refresh the lanes of group G set in mask for time t (not NaN): per lane, in scalar code, the
  * segment (usually the next one) or the key it holds outside the keys; then the keys of the
  * four lanes are transposed in SIMD registers and the refreshed lanes written into the cache.
@@ -513,8 +571,24 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
 static AKP_ALWAYS_INLINE void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
     if (mask == 15 && G->shared) {
         lane_keys k[4];
+        /* The cache holds segment k - 1 of every lane (shared groups refresh all four lanes
+         * together; the interval's end identifies the segment) and t is in segment k: the
+         * forward playback step. */
+        const uint32_t old = segs[G->ch[0]];
+        const float old_hi = f[4 * F_HI];
+        const bool old_inside = ((const uint32_t*)(const void*)f)[4 * F_HOLD] == 0u;
         k[0] = lane_refresh(clip, G, segs, 0, true, t);
         const float* v0 = clip->channels[G->ch[0]].track.values;
+        if (k[0].hold == 0 && old_inside && segs[G->ch[0]] == old + 1u &&
+            old_hi == clip->channels[G->ch[0]].track.times[old + 1u]) {
+            const float* pa[4];
+            for (int l = 0; l < 4; ++l) {
+                pa[l] = clip->channels[G->ch[l]].track.values + (k[0].pa - v0);
+                segs[G->ch[l]] = old + 1u;
+            }
+            cache_write_step(G, f, k[0], pa);
+            return;
+        }
         for (int l = 1; l < 4; ++l) {
             const float* v = clip->channels[G->ch[l]].track.values;
             k[l] = k[0];

@@ -154,8 +154,8 @@ typedef struct ak_clip_cursor {
 } ak_clip_cursor;
 
 /* Elements of uint32_t storage for a cursor with its key cache: the channel count, plus 3 +
- * 68 per group of four cached channels in SIMD builds (about 54 per joint with T, R and S
- * channels: 216 bytes, 13 KB for 60 joints). NULL -> 0. The minimum a cursor accepts is
+ * 84 per group of four cached channels in SIMD builds (about 66 per joint with T, R and S
+ * channels: 264 bytes, 16 KB for 60 joints). NULL -> 0. The minimum a cursor accepts is
  * ak_clip_channel_count (segments only, no key cache: slower, same results). */
 AK_API size_t ak_clip_cursor_storage_count(const ak_clip* clip);
 
