@@ -517,7 +517,9 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
  * loaded and transposed; the stored fields are those cache_write would store. */
 static AKP_ALWAYS_INLINE void cache_write_step(const akp_clip_group* G, float* f, lane_keys k0, const float* const* pa,
                                                const float* const* pb) {
-    for (int l = 0; l < 4; ++l) _mm_prefetch((const char*)(uintptr_t)((uintptr_t)pb[l] + 64u), _MM_HINT_T0); /* a hint */
+    /* No prefetch here (cache_write has one): in forward playback the tracks' keys are read in
+     * ascending order, and on the vs_ozz clip (180 tracks, 60 fps playback of 30 fps keys) the
+     * four prefetches per group and step made sampling about 10% slower (EPYC Zen 5). */
     _mm_store_ps(f + 4 * F_LO, _mm_set1_ps(k0.lo));
     _mm_store_ps(f + 4 * F_HI, _mm_set1_ps(k0.hi));
     _mm_store_ps(f + 4 * F_T0, _mm_set1_ps(k0.t0));
