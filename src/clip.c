@@ -516,15 +516,17 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
  * (F_BR; F_B for SLERP) as the same floats, so only the b keys (and SLERP's constants) are
  * loaded and transposed; the stored fields are those cache_write would store. */
 static AKP_ALWAYS_INLINE void cache_write_step(const akp_clip_group* G, float* f, lane_keys k0, const float* const* pa,
-                                               const float* const* pb) {
+                                               const float* const* pb, bool intervals) {
     /* No prefetch here (cache_write has one): in forward playback the tracks' keys are read in
      * ascending order, and on the vs_ozz clip (180 tracks, 60 fps playback of 30 fps keys) the
      * four prefetches per group and step made sampling about 10% slower (EPYC Zen 5). */
-    _mm_store_ps(f + 4 * F_LO, _mm_set1_ps(k0.lo));
-    _mm_store_ps(f + 4 * F_HI, _mm_set1_ps(k0.hi));
-    _mm_store_ps(f + 4 * F_T0, _mm_set1_ps(k0.t0));
-    _mm_store_ps(f + 4 * F_DT, _mm_set1_ps(k0.dt));
-    _mm_store_ps(f + 4 * F_HOLD, _mm_setzero_ps());
+    if (intervals) {
+        _mm_store_ps(f + 4 * F_LO, _mm_set1_ps(k0.lo));
+        _mm_store_ps(f + 4 * F_HI, _mm_set1_ps(k0.hi));
+        _mm_store_ps(f + 4 * F_T0, _mm_set1_ps(k0.t0));
+        _mm_store_ps(f + 4 * F_DT, _mm_set1_ps(k0.dt));
+        _mm_store_ps(f + 4 * F_HOLD, _mm_setzero_ps());
+    }
     if (G->kind == AKP_CLIP_FAST_VEC3) {
         const __m128 ax = _mm_load_ps(f + 4 * F_BR), ay = _mm_load_ps(f + 4 * (F_BR + 1)),
                      az = _mm_load_ps(f + 4 * (F_BR + 2));
@@ -586,7 +588,7 @@ static AKP_ALWAYS_INLINE void refresh_shared(const ak_clip* clip, const akp_clip
     if (k0.hold == 0) {
         for (int l = 0; l < 4; ++l) segs[G->ch[l]] = k0.ka;
         if (old_inside && k0.ka == old + 1u && old_hi == clip->channels[G->ch[0]].track.times[k0.ka]) {
-            cache_write_step(G, f, k0, pa, pb);
+            cache_write_step(G, f, k0, pa, pb, true);
             return;
         }
     } else {
@@ -707,25 +709,50 @@ static AKP_ALWAYS_INLINE void sample_group(const ak_clip* clip, size_t g, float 
 }
 
 /* A uniform clip (clip->uniform: every group shared, all with the same key times) keeps one
- * interval for the whole cache: every sample validates or refreshes all groups together, so
- * their intervals, t0, dt and hold lanes are equal, and group 0's stand for all. Make the cache
- * valid for time (not NaN): refresh every group when group 0's interval does not hold it, with
- * group 0's search (lane_refresh once per clip instead of once per group). */
+ * interval for the whole cache, in group 0's fields: every sample validates or refreshes all
+ * groups together (the groups' caches hold the same segment), and the other groups' interval
+ * fields (lo, hi, t0, dt, hold) are written only by full refreshes and never read. Make the
+ * cache valid for time (not NaN): when group 0's interval does not hold it, one key search
+ * (lane_refresh of group 0's lane 0) and every group refreshed with its result; the forward
+ * step (cache_write_step) when group 0's cache holds the segment before the new one and the
+ * group's lane 0 segment is group 0's (the scalar kernel moves the segments, not the cache). */
 static AKP_ALWAYS_INLINE void uniform_validate(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache) {
     const __m128 T = _mm_set1_ps(time);
-    const float* f0 = (const float*)(const void*)cache;
+    float* f0 = (float*)(void*)cache;
     if (_mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(T, _mm_load_ps(f0 + 4 * F_LO)), _mm_cmplt_ps(T, _mm_load_ps(f0 + 4 * F_HI)))) ==
         15)
         return;
     const akp_clip_group* G0 = &clip->groups[0];
-    uint32_t old = segs[G0->ch[0]];
+    const uint32_t old = segs[G0->ch[0]];
+    const float old_hi = f0[4 * F_HI];
+    const bool old_inside = ((const uint32_t*)(const void*)f0)[4 * F_HOLD] == 0u;
     const lane_keys k0 = lane_refresh(clip, G0, segs, 0, true, time);
-    segs[G0->ch[0]] = old; /* refresh_shared reads the old segment of each group */
+    segs[G0->ch[0]] = old;
+    const bool step = k0.hold == 0 && old_inside && k0.ka == old + 1u &&
+                      old_hi == clip->channels[G0->ch[0]].track.times[k0.ka];
     for (size_t g = 0; g < clip->group_count; ++g) {
         const akp_clip_group* G = &clip->groups[g];
         float* f = (float*)(void*)(cache + g * CACHE_GROUP_U32);
-        refresh_shared(clip, G, segs, f, k0, segs[G->ch[0]], f[4 * F_HI],
-                       ((const uint32_t*)(const void*)f)[4 * F_HOLD] == 0u);
+        const float* pa[4];
+        const float* pb[4];
+        const size_t stride = clip->channels[G->ch[0]].track.stride, oa = k0.ka * stride, ob = k0.kb * stride;
+        for (int l = 0; l < 4; ++l) {
+            const float* v = clip->channels[G->ch[l]].track.values;
+            pa[l] = v + oa, pb[l] = v + ob;
+        }
+        const bool gstep = step && segs[G->ch[0]] == old;
+        if (k0.hold == 0) {
+            for (int l = 0; l < 4; ++l) segs[G->ch[l]] = k0.ka;
+        } else {
+            for (int l = 1; l < 4; ++l) segs[G->ch[l]] = segs[G->ch[0]];
+        }
+        if (gstep) {
+            cache_write_step(G, f, k0, pa, pb, g == 0);
+        } else {
+            lane_keys k[4];
+            for (int l = 0; l < 4; ++l) k[l] = k0, k[l].pa = pa[l], k[l].pb = pb[l];
+            cache_write(G, f, 15, true, k[0], k[1], k[2], k[3]);
+        }
     }
 }
 

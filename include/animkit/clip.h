@@ -144,7 +144,8 @@ AK_API const ak_track* ak_clip_channel_track(const ak_clip* clip, size_t channel
  * with two or more keys, laid out four channels per SIMD vector (structure of arrays). A
  * sample then checks four channels' key intervals in one operation, interpolates four
  * channels per operation, and reloads only the channels whose interval the time has left
- * (once per group when the four channels share their key times, as baked clips do).
+ * (once per group when the four channels share their key times, as baked clips do; one key
+ * search and one interval for the whole clip when every group has the same key times).
  * Caller-owned; initialise with ak_clip_cursor_init. One cursor per playing instance (and per
  * thread). */
 typedef struct ak_clip_cursor {
