@@ -364,7 +364,8 @@ enum {
     F_TH = 14,  /* SLERP: the segment's angle, 1 / sin, sign of b */
     F_IS = 15,
     F_SG = 16,
-    CACHE_FIELDS = 17
+    F_BR = 17,  /* VEC3, NLERP: b as stored (SLERP: F_B), the next segment's a */
+    CACHE_FIELDS = 21
 };
 #define CACHE_GROUP_U32 ((size_t)CACHE_FIELDS * 4u)
 
@@ -419,6 +420,7 @@ typedef struct lane_keys {
     int hold; /* -1 or 0 */
     const float* pa;
     const float* pb;
+    uint32_t ka, kb; /* the key indices of pa and pb */
 } lane_keys;
 
 /* Lane l's new interval and key pointers (refresh true), or harmless fillers. */
@@ -427,13 +429,14 @@ static AKP_ALWAYS_INLINE lane_keys lane_refresh(const ak_clip* clip, const akp_c
     const ak_track* tr = &clip->channels[G->ch[l]].track;
     const float* times = tr->times;
     const size_t n = tr->key_count, stride = tr->stride;
-    lane_keys r = {0.0f, 0.0f, 0.0f, 1.0f, -1, tr->values, tr->values};
+    lane_keys r = {0.0f, 0.0f, 0.0f, 1.0f, -1, tr->values, tr->values, 0u, 0u};
     if (!refresh) return r;
     if (!(t > times[0])) {
         r.lo = -INFINITY, r.hi = next_up(times[0]);
     } else if (t >= times[n - 1]) {
         r.lo = times[n - 1], r.hi = INFINITY;
         r.pa = r.pb = tr->values + (n - 1) * stride;
+        r.ka = r.kb = (uint32_t)(n - 1);
     } else {
         uint32_t* slot = &segs[G->ch[l]];
         size_t k = *slot;
@@ -443,6 +446,7 @@ static AKP_ALWAYS_INLINE lane_keys lane_refresh(const ak_clip* clip, const akp_c
         r.lo = k == 0 ? next_up(times[0]) : times[k], r.hi = times[k + 1];
         r.t0 = times[k], r.dt = times[k + 1] - times[k], r.hold = 0;
         r.pa = tr->values + k * stride, r.pb = r.pa + stride;
+        r.ka = (uint32_t)k, r.kb = (uint32_t)k + 1u;
     }
     return r;
 }
@@ -476,6 +480,7 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
         /* hold lanes: b = a, so b - a = 0 */
         AKP_PUT(F_A, ax), AKP_PUT(F_A + 1, ay), AKP_PUT(F_A + 2, az);
         AKP_PUT(F_B, _mm_sub_ps(bx, ax)), AKP_PUT(F_B + 1, _mm_sub_ps(by, ay)), AKP_PUT(F_B + 2, _mm_sub_ps(bz, az));
+        AKP_PUT(F_BR, bx), AKP_PUT(F_BR + 1, by), AKP_PUT(F_BR + 2, bz);
         return;
     }
     __m128 ax = _mm_loadu_ps(pa[0]), ay = _mm_loadu_ps(pa[1]), az = _mm_loadu_ps(pa[2]), aw = _mm_loadu_ps(pa[3]);
@@ -492,6 +497,7 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
         AKP_PUT(F_B + 1, _mm_sub_ps(_mm_xor_ps(by, flip), ay));
         AKP_PUT(F_B + 2, _mm_sub_ps(_mm_xor_ps(bz, flip), az));
         AKP_PUT(F_B + 3, _mm_sub_ps(_mm_xor_ps(bw, flip), aw));
+        AKP_PUT(F_BR, bx), AKP_PUT(F_BR + 1, by), AKP_PUT(F_BR + 2, bz), AKP_PUT(F_BR + 3, bw);
         AKP_PUT(F_FIX, _mm_setzero_ps());
         return;
     }
@@ -505,6 +511,94 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
 #undef AKP_PUT
 }
 
+/* cache_write of a shared group whose four lanes moved from segment k - 1 to k (k: the new
+ * interval in k0, pa the new a keys): the new a keys are the old b keys, still in the cache
+ * (F_BR; F_B for SLERP) as the same floats, so only the b keys (and SLERP's constants) are
+ * loaded and transposed; the stored fields are those cache_write would store. */
+static AKP_ALWAYS_INLINE void cache_write_step(const akp_clip_group* G, float* f, lane_keys k0, const float* const* pa,
+                                               const float* const* pb, bool intervals) {
+    /* No prefetch here (cache_write has one): in forward playback the tracks' keys are read in
+     * ascending order, and on the vs_ozz clip (180 tracks, 60 fps playback of 30 fps keys) the
+     * four prefetches per group and step made sampling about 10% slower (EPYC Zen 5). */
+    if (intervals) {
+        _mm_store_ps(f + 4 * F_LO, _mm_set1_ps(k0.lo));
+        _mm_store_ps(f + 4 * F_HI, _mm_set1_ps(k0.hi));
+        _mm_store_ps(f + 4 * F_T0, _mm_set1_ps(k0.t0));
+        _mm_store_ps(f + 4 * F_DT, _mm_set1_ps(k0.dt));
+        _mm_store_ps(f + 4 * F_HOLD, _mm_setzero_ps());
+    }
+    if (G->kind == AKP_CLIP_FAST_VEC3) {
+        const __m128 ax = _mm_load_ps(f + 4 * F_BR), ay = _mm_load_ps(f + 4 * (F_BR + 1)),
+                     az = _mm_load_ps(f + 4 * (F_BR + 2));
+        __m128 bx = load3(pb[0]), by = load3(pb[1]), bz = load3(pb[2]), bw = load3(pb[3]);
+        AKP_SIMD_TRANSPOSE4(bx, by, bz, bw);
+        (void)bw;
+        _mm_store_ps(f + 4 * F_A, ax), _mm_store_ps(f + 4 * (F_A + 1), ay), _mm_store_ps(f + 4 * (F_A + 2), az);
+        _mm_store_ps(f + 4 * F_B, _mm_sub_ps(bx, ax)), _mm_store_ps(f + 4 * (F_B + 1), _mm_sub_ps(by, ay));
+        _mm_store_ps(f + 4 * (F_B + 2), _mm_sub_ps(bz, az));
+        _mm_store_ps(f + 4 * F_BR, bx), _mm_store_ps(f + 4 * (F_BR + 1), by), _mm_store_ps(f + 4 * (F_BR + 2), bz);
+        return;
+    }
+    const int src = G->kind == AKP_CLIP_FAST_NLERP ? F_BR : F_B;
+    const __m128 ax = _mm_load_ps(f + 4 * src), ay = _mm_load_ps(f + 4 * (src + 1)), az = _mm_load_ps(f + 4 * (src + 2)),
+                 aw = _mm_load_ps(f + 4 * (src + 3));
+    __m128 bx = _mm_loadu_ps(pb[0]), by = _mm_loadu_ps(pb[1]), bz = _mm_loadu_ps(pb[2]), bw = _mm_loadu_ps(pb[3]);
+    AKP_SIMD_TRANSPOSE4(bx, by, bz, bw);
+    _mm_store_ps(f + 4 * F_A, ax), _mm_store_ps(f + 4 * (F_A + 1), ay), _mm_store_ps(f + 4 * (F_A + 2), az);
+    _mm_store_ps(f + 4 * (F_A + 3), aw);
+    if (G->kind == AKP_CLIP_FAST_NLERP) {
+        __m128 dot = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz)),
+                                _mm_mul_ps(aw, bw));
+        __m128 flip = _mm_and_ps(_mm_cmplt_ps(dot, _mm_setzero_ps()), _mm_set1_ps(-0.0f));
+        _mm_store_ps(f + 4 * F_B, _mm_sub_ps(_mm_xor_ps(bx, flip), ax));
+        _mm_store_ps(f + 4 * (F_B + 1), _mm_sub_ps(_mm_xor_ps(by, flip), ay));
+        _mm_store_ps(f + 4 * (F_B + 2), _mm_sub_ps(_mm_xor_ps(bz, flip), az));
+        _mm_store_ps(f + 4 * (F_B + 3), _mm_sub_ps(_mm_xor_ps(bw, flip), aw));
+        _mm_store_ps(f + 4 * F_BR, bx), _mm_store_ps(f + 4 * (F_BR + 1), by), _mm_store_ps(f + 4 * (F_BR + 2), bz);
+        _mm_store_ps(f + 4 * (F_BR + 3), bw);
+        _mm_store_ps(f + 4 * F_FIX, _mm_setzero_ps());
+        return;
+    }
+    __m128 th = _mm_loadu_ps(pa[0] + 4), is = _mm_loadu_ps(pa[1] + 4), sg = _mm_loadu_ps(pa[2] + 4),
+           z3 = _mm_loadu_ps(pa[3] + 4);
+    AKP_SIMD_TRANSPOSE4(th, is, sg, z3);
+    (void)z3;
+    _mm_store_ps(f + 4 * F_B, bx), _mm_store_ps(f + 4 * (F_B + 1), by), _mm_store_ps(f + 4 * (F_B + 2), bz);
+    _mm_store_ps(f + 4 * (F_B + 3), bw);
+    _mm_store_ps(f + 4 * F_TH, th), _mm_store_ps(f + 4 * F_IS, is), _mm_store_ps(f + 4 * F_SG, sg);
+    _mm_store_ps(f + 4 * F_FIX, _mm_cmpeq_ps(is, _mm_setzero_ps()));
+}
+
+/* Write the cache of shared group G for the interval and key indices in k0 (lane_refresh of
+ * lane 0, or of a track with the same key times), and the lanes' segments; old, old_hi and
+ * old_inside: lane 0's segment, interval end and hold flag before. When the cache holds
+ * segment k - 1 of every lane (shared groups refresh all four lanes together; the interval's
+ * end identifies the segment) and the new interval is segment k, the forward playback step,
+ * only the b keys are loaded (cache_write_step). */
+static AKP_ALWAYS_INLINE void refresh_shared(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f,
+                                             lane_keys k0, uint32_t old, float old_hi, bool old_inside) {
+    const float* pa[4];
+    const float* pb[4];
+    const size_t stride = clip->channels[G->ch[0]].track.stride; /* the same for the four (shared) */
+    const size_t oa = k0.ka * stride, ob = k0.kb * stride;
+    for (int l = 0; l < 4; ++l) {
+        const float* v = clip->channels[G->ch[l]].track.values;
+        pa[l] = v + oa, pb[l] = v + ob;
+    }
+    if (k0.hold == 0) {
+        for (int l = 0; l < 4; ++l) segs[G->ch[l]] = k0.ka;
+        if (old_inside && k0.ka == old + 1u && old_hi == clip->channels[G->ch[0]].track.times[k0.ka]) {
+            cache_write_step(G, f, k0, pa, pb, true);
+            return;
+        }
+    } else {
+        for (int l = 1; l < 4; ++l) segs[G->ch[l]] = segs[G->ch[0]];
+    }
+    lane_keys k[4];
+    for (int l = 0; l < 4; ++l) k[l] = k0, k[l].pa = pa[l], k[l].pb = pb[l];
+    cache_write(G, f, 15, true, k[0], k[1], k[2], k[3]);
+}
+
 /* Refresh the lanes of group G set in mask for time t (not NaN): per lane, in scalar code, the
  * segment (usually the next one) or the key it holds outside the keys; then the keys of the
  * four lanes are transposed in SIMD registers and the refreshed lanes written into the cache.
@@ -512,16 +606,10 @@ static AKP_ALWAYS_INLINE void cache_write(const akp_clip_group* G, float* f, int
  * so lane 0's segment serves all four. */
 static AKP_ALWAYS_INLINE void refresh_group(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f, int mask, float t) {
     if (mask == 15 && G->shared) {
-        lane_keys k[4];
-        k[0] = lane_refresh(clip, G, segs, 0, true, t);
-        const float* v0 = clip->channels[G->ch[0]].track.values;
-        for (int l = 1; l < 4; ++l) {
-            const float* v = clip->channels[G->ch[l]].track.values;
-            k[l] = k[0];
-            k[l].pa = v + (k[0].pa - v0), k[l].pb = v + (k[0].pb - v0);
-            segs[G->ch[l]] = segs[G->ch[0]];
-        }
-        cache_write(G, f, 15, true, k[0], k[1], k[2], k[3]);
+        const uint32_t old = segs[G->ch[0]];
+        const float old_hi = f[4 * F_HI];
+        const bool old_inside = ((const uint32_t*)(const void*)f)[4 * F_HOLD] == 0u;
+        refresh_shared(clip, G, segs, f, lane_refresh(clip, G, segs, 0, true, t), old, old_hi, old_inside);
         return;
     }
     const lane_keys k0 = lane_refresh(clip, G, segs, 0, mask & 1, t), k1 = lane_refresh(clip, G, segs, 1, mask & 2, t),
@@ -541,19 +629,20 @@ static AKP_ALWAYS_INLINE void group_validate(const ak_clip* clip, size_t g, floa
     if (in != 15) refresh_group(clip, &clip->groups[g], segs, (float*)(void*)c, ~in & 15, time);
 }
 
-/* Sample group g through the cache (time not NaN). */
-static AKP_ALWAYS_INLINE void sample_group(const ak_clip* clip, size_t g, float time, uint32_t* segs, uint32_t* cache,
-                                           float* pose) {
-    const __m128 T = _mm_set1_ps(time), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f),
-                 ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
+/* The lanes' interpolation parameter at time T from cache fields f: u = (t - t0) / dt clamped. */
+static AKP_ALWAYS_INLINE __m128 lanes_u(const float* f, __m128 T) {
+    __m128 u = _mm_div_ps(_mm_sub_ps(T, _mm_load_ps(f + 4 * F_T0)), _mm_load_ps(f + 4 * F_DT));
+    return _mm_min_ps(_mm_set1_ps(1.0f), _mm_max_ps(_mm_setzero_ps(), u)); /* u < 0 ? 0 : (u > 1 ? 1 : u), NaN kept */
+}
+
+/* Sample group g through its valid cache with the lanes' u (lanes_u) and hold mask. */
+static AKP_ALWAYS_INLINE void sample_group_at(const ak_clip* clip, size_t g, __m128 u, __m128 hold, float time,
+                                              uint32_t* segs, uint32_t* cache, float* pose) {
+    const __m128 one = _mm_set1_ps(1.0f), ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
     {
         const akp_clip_group* G = &clip->groups[g];
         uint32_t* c = cache + g * CACHE_GROUP_U32;
         const float* f = (const float*)(const void*)c;
-        group_validate(clip, g, time, segs, cache);
-        __m128 u = _mm_div_ps(_mm_sub_ps(T, _mm_load_ps(f + 4 * F_T0)), _mm_load_ps(f + 4 * F_DT));
-        u = _mm_min_ps(one, _mm_max_ps(zero, u)); /* u < 0 ? 0 : (u > 1 ? 1 : u), NaN kept */
-        const __m128 hold = _mm_load_ps(f + 4 * F_HOLD);
         __m128 ax = _mm_load_ps(f + 4 * F_A), ay = _mm_load_ps(f + 4 * (F_A + 1)), az = _mm_load_ps(f + 4 * (F_A + 2));
         if (G->kind == AKP_CLIP_FAST_VEC3) {
             __m128 x = _mm_add_ps(ax, _mm_mul_ps(_mm_load_ps(f + 4 * F_B), u));
@@ -611,9 +700,72 @@ static AKP_ALWAYS_INLINE void sample_group(const ak_clip* clip, size_t g, float 
     }
 }
 
+/* Sample group g through the cache (time not NaN). */
+static AKP_ALWAYS_INLINE void sample_group(const ak_clip* clip, size_t g, float time, uint32_t* segs, uint32_t* cache,
+                                           float* pose) {
+    group_validate(clip, g, time, segs, cache);
+    const float* f = (const float*)(const void*)(cache + g * CACHE_GROUP_U32);
+    sample_group_at(clip, g, lanes_u(f, _mm_set1_ps(time)), _mm_load_ps(f + 4 * F_HOLD), time, segs, cache, pose);
+}
+
+/* A uniform clip (clip->uniform: every group shared, all with the same key times) keeps one
+ * interval for the whole cache, in group 0's fields: every sample validates or refreshes all
+ * groups together (the groups' caches hold the same segment), and the other groups' interval
+ * fields (lo, hi, t0, dt, hold) are written only by full refreshes and never read. Make the
+ * cache valid for time (not NaN): when group 0's interval does not hold it, one key search
+ * (lane_refresh of group 0's lane 0) and every group refreshed with its result; the forward
+ * step (cache_write_step) when group 0's cache holds the segment before the new one and the
+ * group's lane 0 segment is group 0's (the scalar kernel moves the segments, not the cache). */
+static AKP_ALWAYS_INLINE void uniform_validate(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache) {
+    const __m128 T = _mm_set1_ps(time);
+    float* f0 = (float*)(void*)cache;
+    if (_mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(T, _mm_load_ps(f0 + 4 * F_LO)), _mm_cmplt_ps(T, _mm_load_ps(f0 + 4 * F_HI)))) ==
+        15)
+        return;
+    const akp_clip_group* G0 = &clip->groups[0];
+    const uint32_t old = segs[G0->ch[0]];
+    const float old_hi = f0[4 * F_HI];
+    const bool old_inside = ((const uint32_t*)(const void*)f0)[4 * F_HOLD] == 0u;
+    const lane_keys k0 = lane_refresh(clip, G0, segs, 0, true, time);
+    segs[G0->ch[0]] = old;
+    const bool step = k0.hold == 0 && old_inside && k0.ka == old + 1u &&
+                      old_hi == clip->channels[G0->ch[0]].track.times[k0.ka];
+    for (size_t g = 0; g < clip->group_count; ++g) {
+        const akp_clip_group* G = &clip->groups[g];
+        float* f = (float*)(void*)(cache + g * CACHE_GROUP_U32);
+        const float* pa[4];
+        const float* pb[4];
+        const size_t stride = clip->channels[G->ch[0]].track.stride, oa = k0.ka * stride, ob = k0.kb * stride;
+        for (int l = 0; l < 4; ++l) {
+            const float* v = clip->channels[G->ch[l]].track.values;
+            pa[l] = v + oa, pb[l] = v + ob;
+        }
+        const bool gstep = step && segs[G->ch[0]] == old;
+        if (k0.hold == 0) {
+            for (int l = 0; l < 4; ++l) segs[G->ch[l]] = k0.ka;
+        } else {
+            for (int l = 1; l < 4; ++l) segs[G->ch[l]] = segs[G->ch[0]];
+        }
+        if (gstep) {
+            cache_write_step(G, f, k0, pa, pb, g == 0);
+        } else {
+            lane_keys k[4];
+            for (int l = 0; l < 4; ++l) k[l] = k0, k[l].pa = pa[l], k[l].pb = pb[l];
+            cache_write(G, f, 15, true, k[0], k[1], k[2], k[3]);
+        }
+    }
+}
+
 /* Sample every group through the cache (time not NaN): the SSE2 kernel. */
 static AKP_ALWAYS_INLINE void sample_groups(const ak_clip* clip, float time, uint32_t* segs, uint32_t* cache,
                                             float* pose) {
+    if (clip->uniform) {
+        uniform_validate(clip, time, segs, cache);
+        const float* f0 = (const float*)(const void*)cache;
+        const __m128 u = lanes_u(f0, _mm_set1_ps(time)), hold = _mm_load_ps(f0 + 4 * F_HOLD);
+        for (size_t g = 0; g < clip->group_count; ++g) sample_group_at(clip, g, u, hold, time, segs, cache, pose);
+        return;
+    }
     for (size_t g = 0; g < clip->group_count; ++g) sample_group(clip, g, time, segs, cache, pose);
 }
 
@@ -634,20 +786,14 @@ __attribute__((target("avx2"), always_inline)) static inline __m256 sin8_half_pi
 /* Two SLERP groups g and g + 1 at once, group g in the low and g + 1 in the high half of AVX
  * registers: sample_group's SLERP operations lane for lane (the same floats), half the
  * instructions for the interpolation and the transposes. */
-__attribute__((target("avx2"), always_inline)) static inline void slerp_pair8(const ak_clip* clip, size_t g, float time,
-                                                                              uint32_t* segs, uint32_t* cache,
-                                                                              float* pose) {
-    group_validate(clip, g, time, segs, cache);
-    group_validate(clip, g + 1, time, segs, cache);
+__attribute__((target("avx2"), always_inline)) static inline void slerp_pair8_at(const ak_clip* clip, size_t g, __m256 u,
+                                                                                 __m256 hold, float time, uint32_t* segs,
+                                                                                 uint32_t* cache, float* pose) {
     const akp_clip_group* G[2] = {&clip->groups[g], &clip->groups[g + 1]};
     const float* f0 = (const float*)(const void*)(cache + g * CACHE_GROUP_U32);
     const float* f1 = f0 + CACHE_GROUP_U32;
 #define AKP_LD8(field) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(f0 + 4 * (field))), _mm_load_ps(f1 + 4 * (field)), 1)
-    const __m256 T = _mm256_set1_ps(time), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f),
-                 ones = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-    __m256 u = _mm256_div_ps(_mm256_sub_ps(T, AKP_LD8(F_T0)), AKP_LD8(F_DT));
-    u = _mm256_min_ps(one, _mm256_max_ps(zero, u));
-    const __m256 hold = AKP_LD8(F_HOLD);
+    const __m256 one = _mm256_set1_ps(1.0f), ones = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
     const __m256 ax = AKP_LD8(F_A), ay = AKP_LD8(F_A + 1), az = AKP_LD8(F_A + 2), aw = AKP_LD8(F_A + 3);
     const __m256 bx = AKP_LD8(F_B), by = AKP_LD8(F_B + 1), bz = AKP_LD8(F_B + 2), bw = AKP_LD8(F_B + 3);
     const __m256 th = AKP_LD8(F_TH), is = AKP_LD8(F_IS);
@@ -685,10 +831,42 @@ __attribute__((target("avx2"), always_inline)) static inline void slerp_pair8(co
                 if (redo >> (4 * h + l) & 1) eval_fast(&clip->channels[G[h]->ch[l]], segs[G[h]->ch[l]], time, pose);
 }
 
+/* Two SLERP groups g and g + 1 through the cache (time not NaN), each with its own interval. */
+__attribute__((target("avx2"), always_inline)) static inline void slerp_pair8(const ak_clip* clip, size_t g, float time,
+                                                                              uint32_t* segs, uint32_t* cache,
+                                                                              float* pose) {
+    group_validate(clip, g, time, segs, cache);
+    group_validate(clip, g + 1, time, segs, cache);
+    const float* f0 = (const float*)(const void*)(cache + g * CACHE_GROUP_U32);
+    const float* f1 = f0 + CACHE_GROUP_U32;
+    const __m128 T = _mm_set1_ps(time);
+    const __m256 u = _mm256_insertf128_ps(_mm256_castps128_ps256(lanes_u(f0, T)), lanes_u(f1, T), 1);
+    const __m256 hold =
+        _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(f0 + 4 * F_HOLD)), _mm_load_ps(f1 + 4 * F_HOLD), 1);
+    slerp_pair8_at(clip, g, u, hold, time, segs, cache, pose);
+}
+
 /* The AVX kernels' loop: consecutive SLERP groups two by two, the rest as sample_groups. */
 __attribute__((target("avx2"), always_inline)) static inline void sample_groups_pairs(const ak_clip* clip, float time,
                                                                                       uint32_t* segs, uint32_t* cache,
                                                                                       float* pose) {
+    if (clip->uniform) {
+        uniform_validate(clip, time, segs, cache);
+        const float* f0 = (const float*)(const void*)cache;
+        const __m128 u = lanes_u(f0, _mm_set1_ps(time)), hold = _mm_load_ps(f0 + 4 * F_HOLD);
+        const __m256 u8 = _mm256_insertf128_ps(_mm256_castps128_ps256(u), u, 1),
+                     hold8 = _mm256_insertf128_ps(_mm256_castps128_ps256(hold), hold, 1);
+        for (size_t g = 0; g < clip->group_count; ++g) {
+            if (g + 1 < clip->group_count && clip->groups[g].kind == AKP_CLIP_FAST_SLERP &&
+                clip->groups[g + 1].kind == AKP_CLIP_FAST_SLERP) {
+                slerp_pair8_at(clip, g, u8, hold8, time, segs, cache, pose);
+                ++g;
+                continue;
+            }
+            sample_group_at(clip, g, u, hold, time, segs, cache, pose);
+        }
+        return;
+    }
     for (size_t g = 0; g < clip->group_count; ++g) {
         if (g + 1 < clip->group_count && clip->groups[g].kind == AKP_CLIP_FAST_SLERP &&
             clip->groups[g + 1].kind == AKP_CLIP_FAST_SLERP) {
@@ -784,6 +962,13 @@ static void make_groups(ak_clip* clip) {
             G->shared = G->shared && tl->key_count == t0->key_count && tl->stride == t0->stride &&
                         (tl->times == t0->times || !memcmp(tl->times, t0->times, t0->key_count * sizeof(float)));
         }
+    }
+    clip->uniform = clip->group_count > 0;
+    for (size_t g = 0; g < clip->group_count && clip->uniform; ++g) {
+        const ak_track* t0 = &clip->channels[clip->groups[0].ch[0]].track;
+        const ak_track* tg = &clip->channels[clip->groups[g].ch[0]].track;
+        clip->uniform = clip->groups[g].shared && tg->key_count == t0->key_count &&
+                        (tg->times == t0->times || !memcmp(tg->times, t0->times, t0->key_count * sizeof(float)));
     }
     for (size_t i = 0; i < clip->channel_count; ++i)
         if (clip->channels[i].fast == AKP_CLIP_FAST_NONE) clip->slow[clip->slow_count++] = (uint32_t)i;

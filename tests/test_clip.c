@@ -420,6 +420,40 @@ AK_TEST(cursor_is_bit_identical_to_binary_search) {
     }
 }
 
+/* One cursor kept across kernel changes: the scalar kernel moves the cursor's segments but
+ * not its key cache, so a SIMD kernel afterwards must not take the cache for the segment
+ * before the cursor's (the forward step reuses the cached keys only when the cache's interval
+ * is that segment's). Clips with shared key times (one interval for the whole cache) and own
+ * ones; forward playback, the kernel picked at random for every sample. */
+AK_TEST(key_cache_survives_kernel_changes) {
+    ak_rng rng = ak_rng_make(31);
+    static float store[200000];
+    for (int common = 0; common < 2; ++common) {
+        ak_clip* c = random_clip(&rng, store, sizeof store / sizeof store[0], common == 1);
+        AK_CHECK(c != NULL);
+        if (!c) return;
+        size_t full = ak_clip_cursor_storage_count(c);
+        uint32_t* seg = (uint32_t*)calloc(full, sizeof *seg);
+        ak_clip_cursor cur;
+        AK_CHECK_EQ(ak_clip_cursor_init(&cur, c, (ak_u32_span){seg, full}), AK_OK);
+        const float dur = ak_clip_duration(c);
+        int bad = 0;
+        /* 40 sweeps of 80 samples, about three per key interval (some intervals are shorter),
+         * each sample with a random kernel */
+        for (int sweep = 0; sweep < 40; ++sweep) {
+            const float t0 = ak_rng_range(&rng, -0.3f, 0.0f);
+            for (int i = 0; i < 80; ++i) {
+                AK_CHECK_EQ(ak_clip_set_simd_limit(c, (ak_clip_simd)(AK_CLIP_SIMD_SCALAR + ak_rng_u32(&rng) % 4)), AK_OK);
+                float t = t0 + (dur + 0.6f) * (float)i / 80.0f;
+                bad += compare_run(c, &cur, &t, 1);
+            }
+        }
+        AK_CHECK_MSG(bad == 0, "common %d: %d samples differ from the binary search", common, bad);
+        free(seg);
+        ak_clip_destroy(c);
+    }
+}
+
 /* A NaN sample between two samples in one key interval, on rotation channels with equal
  * neighbouring keys (motion capture holds a pose: the key cache redoes such slerp segments in
  * scalar code, from the cursor's segments, which the NaN sample must not move). */
@@ -1057,6 +1091,7 @@ int main(void) {
     AK_RUN(sample_rejects_bad_spans);
     AK_RUN(gltf_interpolation_matches_spec_formulas);
     AK_RUN(cursor_is_bit_identical_to_binary_search);
+    AK_RUN(key_cache_survives_kernel_changes);
     AK_RUN(slerp_groups_in_pairs_bit_identical);
     AK_RUN(cursor_nan_sample_keeps_degenerate_segments_exact);
     AK_RUN(inline_sampler_matches_track_eval_and_double_slerp);

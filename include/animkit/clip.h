@@ -144,7 +144,8 @@ AK_API const ak_track* ak_clip_channel_track(const ak_clip* clip, size_t channel
  * with two or more keys, laid out four channels per SIMD vector (structure of arrays). A
  * sample then checks four channels' key intervals in one operation, interpolates four
  * channels per operation, and reloads only the channels whose interval the time has left
- * (once per group when the four channels share their key times, as baked clips do).
+ * (once per group when the four channels share their key times, as baked clips do; one key
+ * search and one interval for the whole clip when every group has the same key times).
  * Caller-owned; initialise with ak_clip_cursor_init. One cursor per playing instance (and per
  * thread). */
 typedef struct ak_clip_cursor {
@@ -154,8 +155,8 @@ typedef struct ak_clip_cursor {
 } ak_clip_cursor;
 
 /* Elements of uint32_t storage for a cursor with its key cache: the channel count, plus 3 +
- * 68 per group of four cached channels in SIMD builds (about 54 per joint with T, R and S
- * channels: 216 bytes, 13 KB for 60 joints). NULL -> 0. The minimum a cursor accepts is
+ * 84 per group of four cached channels in SIMD builds (about 66 per joint with T, R and S
+ * channels: 264 bytes, 16 KB for 60 joints). NULL -> 0. The minimum a cursor accepts is
  * ak_clip_channel_count (segments only, no key cache: slower, same results). */
 AK_API size_t ak_clip_cursor_storage_count(const ak_clip* clip);
 

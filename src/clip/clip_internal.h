@@ -48,6 +48,7 @@ struct ak_clip {
     size_t scalar_count;
     float duration;
     bool has_joint_channels;
+    bool uniform; /* groups exist, every one shared, all with the same key times (src/clip.c) */
     uint8_t sample_kernel; /* AKP_CLIP_K_*: how a cursor's key cache is sampled (src/clip.c) */
     char name[AK_NAME_SIZE];
 };
