@@ -247,23 +247,17 @@ const char* ak_fluid_kernels_name(ak_fluid_kernels k) {
 
 static bool vfinite(ak_vec3 v) { return ak_finitef(v.x) && ak_finitef(v.y) && ak_finitef(v.z); }
 
-/* The particles' data (positions and velocities finite) of [b, e): the O(n) part of validation,
- * which ak_fluid_step_run splits over its threads. */
-typedef struct scan_task {
-    const ak_fluid_step_job* job;
-    size_t b, e;
-    bool bad;
-} scan_task;
-
-static void* scan_thread(void* arg) {
-    scan_task* t = (scan_task*)arg;
+/* The particles' data (positions and velocities finite) of [b, e) of the job at ctx: the O(n)
+ * part of validation, which ak_fluid_step_run splits over its threads (akp_check_split);
+ * 0 or AK_ERR_BAD_DATA. */
+static int scan_particles_part(const void* ctx, size_t b, size_t e) {
+    const ak_fluid_step_job* job = (const ak_fluid_step_job*)ctx;
     bool ok = true;
-    for (size_t i = t->b; i < t->e; ++i) ok = vfinite(t->job->positions.ptr[i]) && vfinite(t->job->velocities.ptr[i]) && ok;
-    t->bad = !ok;
-    return NULL;
+    for (size_t i = b; i < e; ++i) ok = vfinite(job->positions.ptr[i]) && vfinite(job->velocities.ptr[i]) && ok;
+    return ok ? (int)AK_OK : (int)AK_ERR_BAD_DATA;
 }
 
-/* ak_fluid_step_validate; scan_particles false leaves out the particles' data (scan_thread). */
+/* ak_fluid_step_validate; scan_particles false leaves out the particles' data (scan_particles_part). */
 static ak_result validate(const ak_fluid_step_job* job, bool scan_particles) {
     if (!job || !job->desc || !job->particle_count || !job->positions.ptr || !job->velocities.ptr ||
         !job->scratch.ptr)
@@ -1295,16 +1289,10 @@ ak_result ak_fluid_step_run(const ak_fluid_step_job* job) {
     {
         /* the particles' data, split over the threads (one read of 24 bytes a particle: half a
          * millisecond for 500,000 on one core, all of it serial before) */
-        const size_t n0 = *job->particle_count;
-        uint32_t parts = job->thread_count ? job->thread_count : 1u;
-        if (parts > AKP_TASKS_MAX) parts = AKP_TASKS_MAX;
-        if (n0 < 65536) parts = 1; /* a section costs more than the scan saves */
-        scan_task scan[AKP_TASKS_MAX];
-        for (uint32_t t = 0; t < parts; ++t) scan[t] = (scan_task){job, n0 * t / parts, n0 * (t + 1) / parts, false};
-        if (parts == 1) scan_thread(&scan[0]);
-        else akp_run_tasks(scan_thread, scan, sizeof scan[0], parts);
+        int res[AKP_TASKS_MAX];
+        const uint32_t parts = akp_check_split(*job->particle_count, job->thread_count, scan_particles_part, job, res);
         for (uint32_t t = 0; t < parts; ++t)
-            if (scan[t].bad) return AK_ERR_BAD_DATA;
+            if (res[t] != (int)AK_OK) return AK_ERR_BAD_DATA;
     }
     ctx cstore;
     ctx* c = &cstore;

@@ -463,3 +463,29 @@ void akp_tasks_profile_read(akp_tasks_profile* out) {
     out->caller_wait_seconds = 1e-9 * (double)atomic_load(&prof_caller_wait_ns);
     out->barrier_wait_seconds = 1e-9 * (double)atomic_load(&prof_barrier_ns);
 }
+
+/* akp_check_split: one task per part */
+typedef struct check_task {
+    int (*check)(const void*, size_t, size_t);
+    const void* ctx;
+    size_t b, e;
+    int r;
+} check_task;
+
+static void* check_task_run(void* arg) {
+    check_task* t = (check_task*)arg;
+    t->r = t->check(t->ctx, t->b, t->e);
+    return NULL;
+}
+
+uint32_t akp_check_split(size_t n, uint32_t parts, int (*check)(const void* ctx, size_t b, size_t e), const void* ctx,
+                         int results[AKP_TASKS_MAX]) {
+    if (parts == 0 || n < AKP_CHECK_SPLIT_MIN) parts = 1;
+    if (parts > AKP_TASKS_MAX) parts = AKP_TASKS_MAX;
+    check_task tasks[AKP_TASKS_MAX];
+    for (uint32_t p = 0; p < parts; ++p) tasks[p] = (check_task){check, ctx, n * p / parts, n * (p + 1) / parts, 0};
+    if (parts == 1) check_task_run(&tasks[0]);
+    else akp_run_tasks(check_task_run, tasks, sizeof tasks[0], parts);
+    for (uint32_t p = 0; p < parts; ++p) results[p] = tasks[p].r;
+    return parts;
+}

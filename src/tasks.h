@@ -30,6 +30,16 @@
  * work is fixed by its index. */
 void akp_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
 
+/* A job's O(n) input check (finite positions, valid indices) split over its threads: items
+ * [0, n) in `parts` contiguous parts (capped at AKP_TASKS_MAX; a single part below
+ * AKP_CHECK_SPLIT_MIN items, where starting a section costs more than the scan saves), part p
+ * being [n p / parts, n (p + 1) / parts); check(ctx, b, e) returns 0 or the part's error code,
+ * stored in results[p]. Returns the number of parts; the caller reduces the results in the
+ * order its serial check would report them. */
+#define AKP_CHECK_SPLIT_MIN 65536u
+uint32_t akp_check_split(size_t n, uint32_t parts, int (*check)(const void* ctx, size_t b, size_t e), const void* ctx,
+                         int results[AKP_TASKS_MAX]);
+
 /* A team run split in two, for jobs whose calling thread leads the others through phases
  * (barriers between them) rather than running one task: akp_team_begin starts tasks 1 ..
  * count - 1, each on its own thread, all at the same time, and returns true; the caller then

@@ -631,18 +631,9 @@ void akp_boids_ctx_init(akp_boids_ctx* c, const ak_boids_step_job* job) {
     for (uint32_t s = 0; s < job->params->species_count; ++s) species_runtime(&job->params->species[s], &c->sp[s]);
 }
 
-/* ak_boids_step_run's data check: agents [n part / parts, n (part + 1) / parts). */
-typedef struct scan_task {
-    const ak_boids_step_job* job;
-    uint32_t part, parts;
-    ak_result r;
-} scan_task;
-
-static void* scan_thread(void* arg) {
-    scan_task* t = (scan_task*)arg;
-    const size_t n = t->job->positions.count;
-    t->r = scan_agents(t->job, true, n * t->part / t->parts, n * (t->part + 1) / t->parts);
-    return NULL;
+/* akp_check_split's check: scan_agents over agents [b, e) of the job at ctx. */
+static int scan_part(const void* ctx, size_t b, size_t e) {
+    return (int)scan_agents((const ak_boids_step_job*)ctx, true, b, e);
 }
 
 /* ak_boids_step_validate with the agents' data checked on the step's threads (one read of the
@@ -654,16 +645,12 @@ static ak_result step_validate_split(const ak_boids_step_job* job) {
     ak_result r = step_validate(job, false);
     if (r != AK_OK) return ak_boids_step_validate(job);
     const size_t n = job->positions.count;
-    uint32_t parts = akp_boids_threads(job->thread_count, n);
-    if (n < AKP_BOIDS_SCAN_SPLIT) parts = 1; /* a section costs more than the scan saves */
-    scan_task tasks[64];
-    for (uint32_t t = 0; t < parts; ++t) tasks[t] = (scan_task){job, t, parts, AK_OK};
-    if (parts == 1) scan_thread(&tasks[0]);
-    else akp_boids_run_tasks(scan_thread, tasks, sizeof tasks[0], parts);
+    int res[AKP_TASKS_MAX];
+    const uint32_t parts = akp_check_split(n, akp_boids_threads(job->thread_count, n), scan_part, job, res);
     for (uint32_t t = 0; t < parts; ++t)
-        if (tasks[t].r == AK_ERR_BAD_INDEX) return AK_ERR_BAD_INDEX;
+        if (res[t] == (int)AK_ERR_BAD_INDEX) return AK_ERR_BAD_INDEX;
     for (uint32_t t = 0; t < parts; ++t)
-        if (tasks[t].r != AK_OK) return tasks[t].r;
+        if (res[t] != (int)AK_OK) return (ak_result)res[t];
     return AK_OK;
 }
 

@@ -111,9 +111,6 @@ typedef struct akp_boids_gather {
 } akp_boids_gather;
 
 ak_result akp_boids_validate_inputs(const ak_boids_step_job* job, bool need_wander);
-/* From this many agents on, ak_boids_step_run checks the agents' data on its threads (one
- * part per thread); below, on the calling thread. */
-#define AKP_BOIDS_SCAN_SPLIT 65536u
 ak_boids_bounds akp_boids_bounds_mode(const ak_boids_params* p);
 void akp_boids_ctx_init(akp_boids_ctx* c, const ak_boids_step_job* job);
 void akp_boids_run_tasks(void* (*fn)(void*), void* tasks, size_t size, uint32_t count);
