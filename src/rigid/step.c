@@ -697,6 +697,26 @@ RIGID_HOT bool round_shape(const solver* s, uint32_t i) {
 /* The part of arm r in the contact plane of normal n. */
 RIGID_HOT ak_vec3 in_plane(ak_vec3 r, ak_vec3 n) { return ak_vec3_madd(r, n, -ak_vec3_dot(r, n)); }
 
+/* The small-angle rotation vector that turns orientation from onto to (twice the vector part of
+ * to from^-1, taken the short way). */
+RIGID_HOT ak_vec3 small_turn(ak_quat to, ak_quat from) {
+    ak_quat dq = ak_quat_mul(to, ak_quat_conjugate(from));
+    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
+    return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
+}
+
+/* Rotation vector of body i since the step's start, the contact solve's ct included (zero for
+ * a body that does not move). */
+RIGID_HOT ak_vec3 step_turn(const solver* s, uint32_t i) {
+    return s->awake[i] ? ak_vec3_add(small_turn(s->q[i], s->q0[i]), s->ct[i]) : ak_vec3_zero();
+}
+
+/* Rotation vector of body i since the substep's start (small-angle), the contact solve's ct
+ * included (zero for a body that does not move). */
+RIGID_HOT ak_vec3 substep_turn(const solver* s, uint32_t i) {
+    return s->awake[i] ? ak_vec3_add(small_turn(s->q[i], s->qp[i]), s->ct[i]) : ak_vec3_zero();
+}
+
 /* Motion since the step's start of body i's point at world arm r0 (at the step's start) of a
  * patch pair with normal n: the body's translation and its turn about n only. A face pressed on
  * a face over three or more points cannot tilt about an axis in the contact plane: the normal
@@ -718,30 +738,10 @@ RIGID_HOT ak_vec3 in_plane(ak_vec3 r, ak_vec3 n) { return ak_vec3_madd(r, n, -ak
  * (a box on a static slope near its friction cone crept under the rule). */
 RIGID_HOT ak_vec3 patch_slip(const solver* s, uint32_t i, ak_vec3 l, ak_vec3 n) {
     if (!s->awake[i]) return ak_vec3_zero();
-    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->q0[i]));
-    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
-    ak_vec3 turn = ak_vec3_add(ak_vec3_make(dq.x * k, dq.y * k, dq.z * k), s->ct[i]);
+    ak_vec3 turn = step_turn(s, i);
     ak_vec3 r0 = ak_mat3_mul_vec3(s->rot0[i], l);
     ak_vec3 d = ak_vec3_add(s->ds[i], ak_vec3_add(s->dx[i], s->cx[i]));
     return ak_vec3_add(d, ak_vec3_scale(ak_vec3_cross(n, r0), ak_vec3_dot(turn, n)));
-}
-
-/* Rotation vector of body i since the step's start, the contact solve's ct included (zero for
- * a body that does not move). */
-RIGID_HOT ak_vec3 step_turn(const solver* s, uint32_t i) {
-    if (!s->awake[i]) return ak_vec3_zero();
-    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->q0[i]));
-    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
-    return ak_vec3_add(ak_vec3_make(dq.x * k, dq.y * k, dq.z * k), s->ct[i]);
-}
-
-/* Rotation vector of body i since the substep's start (small-angle), the contact solve's ct
- * included (zero for a body that does not move). */
-RIGID_HOT ak_vec3 substep_turn(const solver* s, uint32_t i) {
-    if (!s->awake[i]) return ak_vec3_zero();
-    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->qp[i]));
-    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
-    return ak_vec3_add(ak_vec3_make(dq.x * k, dq.y * k, dq.z * k), s->ct[i]);
 }
 
 /* Rows of the substep's contacts on the current poses (see contact_row). */
@@ -968,9 +968,7 @@ RIGID_HOT void joint_rotation(solver* s, uint32_t a, uint32_t b, ak_vec3 e, floa
 
 /* The rotation vector that turns a's frame times target onto b's orientation. */
 RIGID_HOT ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
-    ak_quat dq = ak_quat_mul(qb, ak_quat_conjugate(ak_quat_mul(qa, target)));
-    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
-    return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
+    return small_turn(qb, ak_quat_mul(qa, target));
 }
 
 /* True when ball joint j's twist is inside its limits by at least 1e-4 rad (without the angle:
@@ -1575,10 +1573,7 @@ static void anchors_read(solver* s, const ak_rigid_step_job* job, pair_buf* pb,
 
 /* Rotation vector of body i over the whole step (after it). */
 static ak_vec3 step_turn_end(const solver* s, uint32_t i) {
-    if (!s->awake[i]) return ak_vec3_zero();
-    ak_quat dq = ak_quat_mul(s->q[i], ak_quat_conjugate(s->q0[i]));
-    float k = dq.w >= 0.0f ? 2.0f : -2.0f;
-    return ak_vec3_make(dq.x * k, dq.y * k, dq.z * k);
+    return s->awake[i] ? small_turn(s->q[i], s->q0[i]) : ak_vec3_zero();
 }
 
 /* Motion over the whole step of body i's local point l (as patch_slip and moved_point read it
