@@ -853,7 +853,6 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
                          ob = respond(s, b, grp->patch ? in_plane(rb, c->n) : rb, t);
                 float wt = oa.w + ob.w;
                 float dlt = wt > 0.0f ? lt / wt : INFINITY;
-                if (!(dlt < c->friction * lambda)) grp->stuck = 0, s->held[k0] = 0;
                 if (dlt < c->friction * lambda) {
                     if (s->awake[a]) {
                         cx[a] = ak_vec3_madd(cx[a], t, -dlt * s->bodies[a].inv_mass);
@@ -863,6 +862,8 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
                         cx[b] = ak_vec3_madd(cx[b], t, dlt * s->bodies[b].inv_mass);
                         ct[b] = ak_vec3_madd(ct[b], ob.turn, dlt);
                     }
+                } else {
+                    grp->stuck = 0, s->held[k0] = 0; /* it slid */
                 }
             }
             /* torsional friction: a patch of contacts also resists twisting about the normal, up
@@ -879,14 +880,14 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
             }
             float twist = ak_vec3_dot(ak_vec3_sub(rot_a, rot_b), c->n) + grp->carry_twist;
             float wr = grp->wr;
-            if (wr > 0.0f && fabsf(twist) > 0.0f &&
-                !(fabsf(twist) / wr < c->friction * lambda * arm))
-                s->held[k0] = 0;
-            if (wr > 0.0f && fabsf(twist) > 0.0f &&
-                fabsf(twist) / wr < c->friction * lambda * arm) {
-                ak_vec3 pr = ak_vec3_scale(c->n, -twist / wr);
-                if (s->awake[a]) ct[a] = ak_vec3_add(ct[a], inv_inertia_mul(s, a, pr));
-                if (s->awake[b]) ct[b] = ak_vec3_sub(ct[b], inv_inertia_mul(s, b, pr));
+            if (wr > 0.0f && fabsf(twist) > 0.0f) {
+                if (fabsf(twist) / wr < c->friction * lambda * arm) {
+                    ak_vec3 pr = ak_vec3_scale(c->n, -twist / wr);
+                    if (s->awake[a]) ct[a] = ak_vec3_add(ct[a], inv_inertia_mul(s, a, pr));
+                    if (s->awake[b]) ct[b] = ak_vec3_sub(ct[b], inv_inertia_mul(s, b, pr));
+                } else {
+                    s->held[k0] = 0; /* the twist slipped */
+                }
             }
         }
     }
