@@ -570,13 +570,13 @@ static AKP_ALWAYS_INLINE void cache_write_step(const akp_clip_group* G, float* f
 }
 
 /* Write the cache of shared group G for the interval and key indices in k0 (lane_refresh of
- * lane 0, or of a track with the same key times), and the lanes' segments; old, old_hi and
- * old_inside: lane 0's segment, interval end and hold flag before. When the cache holds
- * segment k - 1 of every lane (shared groups refresh all four lanes together; the interval's
- * end identifies the segment) and the new interval is segment k, the forward playback step,
- * only the b keys are loaded (cache_write_step). */
+ * lane 0, or of a track with the same key times), and the lanes' segments. step: the cache
+ * holds segment k - 1 of every lane and the new interval is segment k (the forward playback
+ * step, k0.hold == 0; the caller tells it from the segment, interval end and hold flag the
+ * cache had): only the b keys are loaded (cache_write_step), the interval fields written when
+ * intervals. Otherwise the whole cache is written (cache_write). */
 static AKP_ALWAYS_INLINE void refresh_shared(const ak_clip* clip, const akp_clip_group* G, uint32_t* segs, float* f,
-                                             lane_keys k0, uint32_t old, float old_hi, bool old_inside) {
+                                             lane_keys k0, bool step, bool intervals) {
     const float* pa[4];
     const float* pb[4];
     const size_t stride = clip->channels[G->ch[0]].track.stride; /* the same for the four (shared) */
@@ -587,8 +587,8 @@ static AKP_ALWAYS_INLINE void refresh_shared(const ak_clip* clip, const akp_clip
     }
     if (k0.hold == 0) {
         for (int l = 0; l < 4; ++l) segs[G->ch[l]] = k0.ka;
-        if (old_inside && k0.ka == old + 1u && old_hi == clip->channels[G->ch[0]].track.times[k0.ka]) {
-            cache_write_step(G, f, k0, pa, pb, true);
+        if (step) {
+            cache_write_step(G, f, k0, pa, pb, intervals);
             return;
         }
     } else {
@@ -609,7 +609,11 @@ static AKP_ALWAYS_INLINE void refresh_group(const ak_clip* clip, const akp_clip_
         const uint32_t old = segs[G->ch[0]];
         const float old_hi = f[4 * F_HI];
         const bool old_inside = ((const uint32_t*)(const void*)f)[4 * F_HOLD] == 0u;
-        refresh_shared(clip, G, segs, f, lane_refresh(clip, G, segs, 0, true, t), old, old_hi, old_inside);
+        const lane_keys k0 = lane_refresh(clip, G, segs, 0, true, t);
+        refresh_shared(clip, G, segs, f, k0,
+                       k0.hold == 0 && old_inside && k0.ka == old + 1u &&
+                           old_hi == clip->channels[G->ch[0]].track.times[k0.ka],
+                       true);
         return;
     }
     const lane_keys k0 = lane_refresh(clip, G, segs, 0, mask & 1, t), k1 = lane_refresh(clip, G, segs, 1, mask & 2, t),
@@ -733,26 +737,8 @@ static AKP_ALWAYS_INLINE void uniform_validate(const ak_clip* clip, float time, 
     for (size_t g = 0; g < clip->group_count; ++g) {
         const akp_clip_group* G = &clip->groups[g];
         float* f = (float*)(void*)(cache + g * CACHE_GROUP_U32);
-        const float* pa[4];
-        const float* pb[4];
-        const size_t stride = clip->channels[G->ch[0]].track.stride, oa = k0.ka * stride, ob = k0.kb * stride;
-        for (int l = 0; l < 4; ++l) {
-            const float* v = clip->channels[G->ch[l]].track.values;
-            pa[l] = v + oa, pb[l] = v + ob;
-        }
-        const bool gstep = step && segs[G->ch[0]] == old;
-        if (k0.hold == 0) {
-            for (int l = 0; l < 4; ++l) segs[G->ch[l]] = k0.ka;
-        } else {
-            for (int l = 1; l < 4; ++l) segs[G->ch[l]] = segs[G->ch[0]];
-        }
-        if (gstep) {
-            cache_write_step(G, f, k0, pa, pb, g == 0);
-        } else {
-            lane_keys k[4];
-            for (int l = 0; l < 4; ++l) k[l] = k0, k[l].pa = pa[l], k[l].pb = pb[l];
-            cache_write(G, f, 15, true, k[0], k[1], k[2], k[3]);
-        }
+        /* the step needs this group's cache to hold segment old too */
+        refresh_shared(clip, G, segs, f, k0, step && segs[G->ch[0]] == old, g == 0);
     }
 }
 
