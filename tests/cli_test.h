@@ -11,8 +11,10 @@
 #ifndef ANIMKIT_CLI_TEST_H
 #define ANIMKIT_CLI_TEST_H
 
+#include <animkit/animkit.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
 
@@ -67,5 +69,26 @@ static inline cJSON* read_json(const char* path) {
     return text ? cJSON_Parse(text) : NULL;
 }
 #endif
+
+/* Two same-size renders of a crowd: *people_a and *people_b count each one's saturated pixels
+ * (the people: ground, grid, sky and walls are greys and a pale blue), *differ the pixels
+ * where a channel differs by more than 64. */
+static inline void crowd_people_pixels(const ak_image* a, const ak_image* b, size_t* people_a, size_t* people_b,
+                                       size_t* differ) {
+    *people_a = *people_b = *differ = 0;
+    const size_t n = (size_t)a->width * (size_t)a->height;
+    for (size_t i = 0; i < n; ++i) {
+        const uint8_t *p = a->pixels + 4 * i, *q = b->pixels + 4 * i;
+        int d = 0, lo_a = 255, hi_a = 0, lo_b = 255, hi_b = 0;
+        for (int k = 0; k < 3; ++k) {
+            d = abs(p[k] - q[k]) > d ? abs(p[k] - q[k]) : d;
+            lo_a = p[k] < lo_a ? p[k] : lo_a, hi_a = p[k] > hi_a ? p[k] : hi_a;
+            lo_b = q[k] < lo_b ? q[k] : lo_b, hi_b = q[k] > hi_b ? q[k] : hi_b;
+        }
+        *differ += d > 64;
+        *people_a += hi_a - lo_a > 40;
+        *people_b += hi_b - lo_b > 40;
+    }
+}
 
 #endif

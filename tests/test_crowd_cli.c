@@ -279,21 +279,9 @@ AK_TEST(render_characters_above_500) {
         free(b.pixels);
         return;
     }
-    /* a person's pixel: saturated (the ground, grid and sky are greys and a pale blue) */
-    size_t differ = 0, people_a = 0, people_b = 0;
+    size_t differ, people_a, people_b;
     const size_t n = (size_t)a.width * (size_t)a.height;
-    for (size_t i = 0; i < n; ++i) {
-        const uint8_t *p = a.pixels + 4 * i, *q = b.pixels + 4 * i;
-        int d = 0, lo_a = 255, hi_a = 0, lo_b = 255, hi_b = 0;
-        for (int k = 0; k < 3; ++k) {
-            d = abs(p[k] - q[k]) > d ? abs(p[k] - q[k]) : d;
-            lo_a = p[k] < lo_a ? p[k] : lo_a, hi_a = p[k] > hi_a ? p[k] : hi_a;
-            lo_b = q[k] < lo_b ? q[k] : lo_b, hi_b = q[k] > hi_b ? q[k] : hi_b;
-        }
-        differ += d > 64;
-        people_a += hi_a - lo_a > 40;
-        people_b += hi_b - lo_b > 40;
-    }
+    crowd_people_pixels(&a, &b, &people_a, &people_b, &differ);
     printf("  600 agents, 320x240: people %zu px shared, %zu px exact; %zu px differ by > 64\n", people_a, people_b,
            differ);
     AK_CHECK(people_b > n / 100); /* the reference shows the crowd at all */

@@ -248,17 +248,17 @@ static int renderer_init(renderer* r, int w, int h, const ak_crowd_scene* sc, co
     r->cam = ak_raster_camera_perspective(eye, r->center, ak_radians(45), (float)w / (float)h, 0.05f * r->extent,
                                           10.0f * r->extent);
     r->pixels = malloc((size_t)w * (size_t)h * 4);
-    if (!r->pixels || !(shared && chars ? crowd_people_init_shared(&r->people, sc->agent_count, chars)
+    if (!r->pixels || !(shared ? crowd_people_init_shared(&r->people, sc->agent_count, chars)
                                : crowd_people_init(&r->people, sc->agent_count, chars)))
         return 1;
     return crowd_walls(sc, &r->wall, &r->wall_count) ? 0 : 1;
 }
 
-/* The agents (characters or prisms) and the walls, over the ground with shadows. */
+/* The agents' characters and the walls, over the ground with shadows. */
 static ak_result draw_frame(renderer* r, const ak_crowd_scene* sc, const crowd_run* st, crowd_chars* chars,
                             ak_image* out) {
     ak_raster_mesh people;
-    ak_result res = crowd_people_update(&r->people, sc, st->p, st->v, chars, &people);
+    ak_result res = crowd_people_update(&r->people, sc, st->p, chars, &people);
     if (res != AK_OK) return res;
     crowd_people* pp = &r->people;
     const size_t k = pp->shared ? pp->n : people.positions.count;
@@ -414,7 +414,7 @@ int cmd_crowd(int argc, char** argv) {
     ak_image img = {0};
     const bool rendering = out != NULL && !is_glb;
     if (rendering) {
-        if (renderer_init(&rd, w, h, &sc, with_chars ? &chars : NULL, shared_poses)) {
+        if (renderer_init(&rd, w, h, &sc, &chars, shared_poses)) {
             renderer_free(&rd);
             crowd_chars_free(&chars);
             run_free(&st);

@@ -5,9 +5,6 @@
 
 #include "crowd_draw.h"
 
-#define SIDES 8
-#define VERTS_PER_PRISM (9 * SIDES)
-
 const ak_vec4 crowd_palette[4] = {{0.93f, 0.55f, 0.20f, 1}, {0.25f, 0.45f, 0.80f, 1}, {0.35f, 0.70f, 0.35f, 1},
                                   {0.75f, 0.30f, 0.55f, 1}};
 
@@ -95,17 +92,14 @@ void crowd_people_free(crowd_people* pp) {
 
 bool crowd_people_init(crowd_people* pp, size_t n, const crowd_chars* chars) {
     memset(pp, 0, sizeof *pp);
-    pp->vcount = n * VERTS_PER_PRISM;
-    if (chars) {
-        const ak_mesh* m = chars->scene->meshes[0].mesh;
-        pp->vcount = n * m->vertex_count;
-        pp->icount = n * m->triangle_count * 3;
-        pp->idx = malloc(pp->icount * sizeof *pp->idx);
-        if (!pp->idx) return false;
-        for (size_t a = 0; a < n; ++a)
-            for (size_t k = 0; k < m->triangle_count * 3; ++k)
-                pp->idx[a * m->triangle_count * 3 + k] = (uint32_t)(a * m->vertex_count + m->indices[k]);
-    }
+    const ak_mesh* m = chars->scene->meshes[0].mesh;
+    pp->vcount = n * m->vertex_count;
+    pp->icount = n * m->triangle_count * 3;
+    pp->idx = malloc(pp->icount * sizeof *pp->idx);
+    if (!pp->idx) return false;
+    for (size_t a = 0; a < n; ++a)
+        for (size_t k = 0; k < m->triangle_count * 3; ++k)
+            pp->idx[a * m->triangle_count * 3 + k] = (uint32_t)(a * m->vertex_count + m->indices[k]);
     pp->pos = malloc(pp->vcount * sizeof *pp->pos);
     pp->nrm = malloc(pp->vcount * sizeof *pp->nrm);
     pp->col = malloc(pp->vcount * sizeof *pp->col);
@@ -219,47 +213,16 @@ static ak_result pose_characters(crowd_people* pp, const ak_crowd_scene* sc, con
     return AK_OK;
 }
 
-/* Each agent an upright octagonal prism (1.7 m, its radius) coloured by group, its front face
- * (toward the velocity) light. */
-static void prisms(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions, const ak_vec2* velocities) {
-    const float pi = 3.14159265358979f;
-    size_t k = 0;
-    for (size_t i = 0; i < sc->agent_count; ++i) {
-        const float rad = sc->agents[i].radius > 0.0f ? sc->agents[i].radius : 0.3f, hgt = 1.7f;
-        const ak_vec2 p = positions[i], v = velocities[i];
-        const float heading = (v.x * v.x + v.y * v.y) > 1e-6f ? atan2f(v.y, v.x) : 0.0f;
-        const ak_vec4 c = crowd_palette[sc->group[i] % 4];
-        for (int s = 0; s < SIDES; ++s) {
-            const float a0 = heading + 2.0f * pi * ((float)s - 0.5f) / SIDES, a1 = heading + 2.0f * pi * ((float)s + 0.5f) / SIDES;
-            const ak_vec3 b0 = {p.x + rad * cosf(a0), 0, p.y + rad * sinf(a0)}, b1 = {p.x + rad * cosf(a1), 0, p.y + rad * sinf(a1)};
-            const ak_vec3 t0 = {b0.x, hgt, b0.z}, t1 = {b1.x, hgt, b1.z}, top = {p.x, hgt, p.y};
-            const float am = heading + 2.0f * pi * (float)s / SIDES;
-            const ak_vec3 n = {cosf(am), 0, sinf(am)}, up = {0, 1, 0};
-            const ak_vec4 cc = s == 0 ? ak_vec4_make(0.95f, 0.95f, 0.9f, 1) : c;
-            const ak_vec3 tri[9] = {b0, b1, t1, b0, t1, t0, t0, t1, top};
-            for (int q = 0; q < 9; ++q) {
-                pp->pos[k] = tri[q];
-                pp->nrm[k] = q < 6 ? n : up;
-                pp->col[k] = cc;
-                ++k;
-            }
-        }
-    }
-}
-
-ak_result crowd_people_update(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
-                              const ak_vec2* velocities, crowd_chars* chars, ak_raster_mesh* out) {
-    if (chars && pp->shared) {
+ak_result crowd_people_update(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions, crowd_chars* chars,
+                              ak_raster_mesh* out) {
+    if (pp->shared) {
         const ak_result r = share_characters(pp, sc, positions, chars);
         if (r != AK_OK) return r;
         *out = (ak_raster_mesh){0};
         return AK_OK;
-    } else if (chars) {
-        const ak_result r = pose_characters(pp, sc, positions, chars);
-        if (r != AK_OK) return r;
-    } else {
-        prisms(pp, sc, positions, velocities);
     }
+    const ak_result r = pose_characters(pp, sc, positions, chars);
+    if (r != AK_OK) return r;
     *out = (ak_raster_mesh){.positions = {pp->pos, pp->vcount}, .normals = {pp->nrm, pp->vcount},
                             .colors = {pp->col, pp->vcount}, .indices = {pp->idx, pp->icount},
                             .material = {.color = {1, 1, 1, 1}}};

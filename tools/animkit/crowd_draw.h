@@ -1,17 +1,15 @@
 /* The crowd's characters and drawing, shared by `animkit crowd` (PNG, GIF, glTF) and
  * `animkit view crowd`: builtin:humanoid walking per agent (crowd.h's characters), posed and
- * skinned per agent up to CROWD_CHARACTERS_MAX agents; above, `animkit crowd` shares the
- * skinned poses (crowd.h's ak_crowd_character_bucket: one pose per phase and weight bucket,
- * each agent drawn as its bucket's mesh under its root matrix) and `animkit view crowd` draws
- * octagonal prisms; the obstacles as walls. */
+ * skinned per agent up to CROWD_CHARACTERS_MAX agents; above, both share the skinned poses
+ * (crowd.h's ak_crowd_character_bucket: one pose per phase and weight bucket, each agent drawn
+ * as its bucket's mesh under its root matrix); the obstacles as walls. */
 #ifndef ANIMKIT_CLI_CROWD_DRAW_H
 #define ANIMKIT_CLI_CROWD_DRAW_H
 
 #include "cli.h"
 
 #define CROWD_CHARACTER_CELL 0.08f /* builtin:humanoid's grid: about 2,300 triangles */
-#define CROWD_CHARACTERS_MAX 500u  /* posed per agent up to this many agents; shared poses (or
-                                      prisms in the viewer) above */
+#define CROWD_CHARACTERS_MAX 500u  /* posed per agent up to this many agents; shared poses above */
 #define CROWD_SHARED_CHUNK 128u    /* shared poses: agents per draw call */
 
 extern const ak_vec4 crowd_palette[4]; /* colour per group (group % 4) */
@@ -67,15 +65,16 @@ typedef struct crowd_people {
     size_t posed;            /* buckets posed in the last update */
 } crowd_people;
 
-/* Room for n agents, as characters when chars is not NULL. Returns false when out of memory. */
+/* Room for n agents, each posed and skinned on its own (chars required). Returns false when
+ * out of memory. */
 bool crowd_people_init(crowd_people* pp, size_t n, const crowd_chars* chars);
 /* Room for n agents as characters with shared poses (chars required). */
 bool crowd_people_init_shared(crowd_people* pp, size_t n, const crowd_chars* chars);
 void crowd_people_free(crowd_people* pp);
-/* Pose and place every agent (positions, velocities: [n]; radius and group from sc) and return
- * the mesh (colours per vertex). */
-ak_result crowd_people_update(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions,
-                              const ak_vec2* velocities, crowd_chars* chars, ak_raster_mesh* out);
+/* Pose and place every agent (positions: [n]; group from sc) and return the mesh (colours per
+ * vertex; empty with shared poses, which crowd_people_draw places). */
+ak_result crowd_people_update(crowd_people* pp, const ak_crowd_scene* sc, const ak_vec2* positions, crowd_chars* chars,
+                              ak_raster_mesh* out);
 /* Draw the people: the mesh crowd_people_update returned, or with shared poses every agent
  * (CROWD_SHARED_CHUNK at a time). */
 ak_result crowd_people_draw(crowd_people* pp, ak_raster* raster, const ak_raster_camera* cam,

@@ -1,5 +1,6 @@
 /* animkit view crowd: a crowd (include/animkit/crowd.h) walking live, as `animkit crowd` draws
- * it (characters up to CROWD_CHARACTERS_MAX agents, prisms above). `crowd` runs the circle
+ * it: a walking character per agent, each posed on its own up to CROWD_CHARACTERS_MAX agents,
+ * sharing skinned poses above (no foot planting, no shadows). `crowd` runs the circle
  * preset, `crowd:preset:NAME` another preset, `crowd:SCENE.json` a scene file (the command
  * line's `view crowd --preset NAME` and `view crowd SCENE.json` say the same). A left click on
  * the ground sends the group of the agent nearest to the click there, each agent keeping its
@@ -27,7 +28,7 @@ typedef struct xsim {
     size_t scratch_size;
     uint32_t threads;
     crowd_chars chars;
-    bool with_chars;
+    bool shared; /* more than CROWD_CHARACTERS_MAX agents: shared poses, drawn by xsim_draw */
     crowd_people people;
     ak_vec3* wall;
     size_t wall_count;
@@ -89,7 +90,7 @@ static int xsim_restart(xsim* x) {
     x->carry = 0.0;
     x->failed = false;
     x->has_marker = false;
-    if (x->with_chars) crowd_chars_reset(&x->chars, &x->sc);
+    crowd_chars_reset(&x->chars, &x->sc);
     return rebuild(x) == AK_OK ? CLI_OK : CLI_BAD_INPUT;
 }
 
@@ -133,11 +134,14 @@ static int xsim_init(void** state, const char* spec, const view_sim_opts* o, cha
     x->p2 = malloc(n * sizeof *x->p2);
     x->v2 = malloc(n * sizeof *x->v2);
     x->wp = malloc(n * sizeof *x->wp);
-    x->with_chars = n <= CROWD_CHARACTERS_MAX;
+    x->shared = n > CROWD_CHARACTERS_MAX;
     bool ok = x->agents && x->goal && x->p && x->v && x->p2 && x->v2 && x->wp;
-    if (ok && x->with_chars) ok = crowd_chars_init(&x->chars, &x->sc, 0, &diag) == AK_OK;
-    if (ok) ok = crowd_people_init(&x->people, n, x->with_chars ? &x->chars : NULL) &&
-                 crowd_walls(&x->sc, &x->wall, &x->wall_count);
+    if (ok) ok = crowd_chars_init(&x->chars, &x->sc, 0, &diag) == AK_OK;
+    x->chars.unplanted = x->shared; /* shared poses have no foot planting */
+    if (ok)
+        ok = (x->shared ? crowd_people_init_shared(&x->people, n, &x->chars)
+                        : crowd_people_init(&x->people, n, &x->chars)) &&
+             crowd_walls(&x->sc, &x->wall, &x->wall_count);
     if (!ok || xsim_restart(x) != CLI_OK) {
         snprintf(err, err_size, "%s: cannot start the crowd (out of memory or a bad scene)", x->name);
         xsim_destroy(x);
@@ -165,7 +169,7 @@ static bool xsim_step_once(void* state) {
                              .out_velocities = {x->v2, x->n}, .step_index = (uint64_t)x->step_index,
                              .contact_iterations = x->sc.contact_iterations};
     ak_result r = ak_crowd_step_run(&job);
-    if (r == AK_OK && x->with_chars) r = crowd_chars_update(&x->chars, x->v2, x->p2, x->sc.dt);
+    if (r == AK_OK) r = crowd_chars_update(&x->chars, x->v2, x->p2, x->sc.dt);
     if (r != AK_OK) {
         cli_fail("view", "%s: step %ld: %s", x->name, x->step_index + 1, ak_result_string(r));
         return false;
@@ -205,13 +209,24 @@ static size_t xsim_meshes(void* state, ak_raster_mesh* out, size_t cap) {
     xsim* x = state;
     size_t k = 0;
     ak_raster_mesh people;
-    if (k < cap && crowd_people_update(&x->people, &x->sc, x->p, x->v, x->with_chars ? &x->chars : NULL, &people) == AK_OK)
+    if (!x->shared && k < cap && crowd_people_update(&x->people, &x->sc, x->p, &x->chars, &people) == AK_OK)
         out[k++] = people;
     if (k < cap && x->wall_count)
         out[k++] = (ak_raster_mesh){.positions = {x->wall, x->wall_count}, .material = {.color = {0.6f, 0.6f, 0.62f, 1}}};
     if (k < cap && x->has_marker)
         out[k++] = (ak_raster_mesh){.positions = {x->marker, MARKER_VERTS}, .material = {.color = {0.9f, 0.15f, 0.1f, 1}}};
     return k;
+}
+
+/* Above CROWD_CHARACTERS_MAX agents the characters share skinned poses and are drawn here,
+ * CROWD_SHARED_CHUNK at a time, after the ground (the scene's meshes carry the walls only). */
+static ak_result xsim_draw(void* state, ak_raster* raster, const ak_raster_camera* cam, int w, int h) {
+    (void)w, (void)h;
+    xsim* x = state;
+    if (!x->shared) return AK_OK;
+    ak_raster_mesh people;
+    const ak_result r = crowd_people_update(&x->people, &x->sc, x->p, &x->chars, &people);
+    return r == AK_OK ? crowd_people_draw(&x->people, raster, cam, &people) : r;
 }
 
 static void xsim_bounds(void* state, ak_vec3* lo, ak_vec3* hi) {
@@ -326,6 +341,7 @@ const view_sim view_crowd_sim = {
     .step = xsim_step,
     .reset = xsim_reset,
     .meshes = xsim_meshes,
+    .draw = xsim_draw,
     .bounds = xsim_bounds,
     .key = xsim_key,
     .grab = xsim_grab,
