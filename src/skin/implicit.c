@@ -1699,44 +1699,79 @@ typedef struct run_ctx {
     const float* frame;  /* [pair_count * PAIR_FRAME] */
     const uint32_t* fold_start; /* [joint_count + 1]: per part, its folded joints (fold_lists_build) */
     const uint32_t* fold_pair;  /* [2 * pair_count] */
+    /* the lane kernel of the projections (NULL: project, one vertex at a time), its lanes and
+     * its per-frame data; set only with grids and at most 64 bones (one mask word per cell) */
+    bool (*lanes_fn)(const akp_implicit_field* fd, akp_implicit_lanes* l);
+    unsigned lanes;
+    akp_implicit_field lanes_fd;
     float unchecked_below; /* project's: FLT_MAX in the rounds before the last, UNCHECKED_EPS in
                               the first projection when rounds follow, else 0 */
 } run_ctx;
+
+/* One vertex's Newton march (project and the lane driver project_lanes share it): the point,
+ * where it started, the previous gradient, the steps taken and the state. */
+typedef struct march {
+    ak_vec3 x, start, gprev;
+    uint32_t it;
+    uint8_t st;
+} march;
+
+static void march_start(march* m, ak_vec3 p, bool first) {
+    m->x = m->start = p;
+    m->gprev = ak_vec3_zero();
+    m->it = 0;
+    m->st = first ? ST_KEEP : ST_MOVED;
+}
+
+/* One step of the march from the field F and its gradient g at m->x; true when the march ends
+ * (m->x is then its end, g the gradient to keep). A step taken where |F - iso| <
+ * unchecked_below is the last one. */
+static bool march_step(const run_ctx* c, float iso, march* m, float F, ak_vec3 g, float unchecked_below) {
+    const float e = iso - F;
+    if (fabsf(e) < ISO_EPS || m->it == c->iterations) return true;
+    const float gl2 = ak_vec3_length_sq(g);
+    if (!(gl2 > 1e-20f)) return true;
+    if (m->it > 0 && ak_vec3_dot(g, m->gprev) < STOP_COS * sqrtf(gl2 * ak_vec3_length_sq(m->gprev))) {
+        m->st = ST_STOPPED; /* gradient discontinuity: a contact surface */
+        return true;
+    }
+    ak_vec3 step = ak_vec3_scale(g, e / gl2);
+    const float sl = ak_vec3_length(step);
+    if (sl > c->o->step_cap) step = ak_vec3_scale(step, c->o->step_cap / sl);
+    m->x = ak_vec3_add(m->x, step);
+    m->gprev = g;
+    if (m->st == ST_KEEP) m->st = ST_MOVED;
+    if (fabsf(e) < unchecked_below) return true;
+    ++m->it;
+    return false;
+}
+
+/* The march's end into *p and *out_g (never NaN out: a non-finite end keeps the start); returns
+ * the state. */
+static uint8_t march_end(march* m, ak_vec3 g, ak_vec3* p, ak_vec3* out_g) {
+    if (!ak_vec3_is_finite(m->x) || !ak_vec3_is_finite(g)) {
+        m->x = m->start;
+        g = ak_vec3_zero();
+        m->st = ST_STOPPED;
+    }
+    *p = m->x;
+    *out_g = g;
+    return m->st;
+}
 
 /* Newton steps from *p towards the vertex's iso-value; returns the state. A step taken where
  * |F - iso| < unchecked_below is the last one and its end is not evaluated (out_g is then the
  * gradient where it started): used where a later relaxation round evaluates the point anyway
  * (0: every step is checked). */
 static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, bool first, float unchecked_below) {
-    ak_vec3 g, gprev = ak_vec3_zero();
-    ak_vec3 x = *p;
-    uint8_t st = first ? ST_KEEP : ST_MOVED;
-    for (uint32_t it = 0;; ++it) {
-        float F = field_eval(&c->fc, x, &g);
-        float e = iso - F;
-        if (fabsf(e) < ISO_EPS || it == c->iterations) break;
-        float gl2 = ak_vec3_length_sq(g);
-        if (!(gl2 > 1e-20f)) break;
-        if (it > 0 && ak_vec3_dot(g, gprev) < STOP_COS * sqrtf(gl2 * ak_vec3_length_sq(gprev))) {
-            st = ST_STOPPED; /* gradient discontinuity: a contact surface */
-            break;
-        }
-        ak_vec3 step = ak_vec3_scale(g, e / gl2);
-        float sl = ak_vec3_length(step);
-        if (sl > c->o->step_cap) step = ak_vec3_scale(step, c->o->step_cap / sl);
-        x = ak_vec3_add(x, step);
-        gprev = g;
-        if (st == ST_KEEP) st = ST_MOVED;
-        if (fabsf(e) < unchecked_below) break;
+    march m;
+    march_start(&m, *p, first);
+    ak_vec3 g;
+    for (;;) {
+        const float F = field_eval(&c->fc, m.x, &g);
+        if (march_step(c, iso, &m, F, g, unchecked_below)) break;
     }
-    if (!ak_vec3_is_finite(x) || !ak_vec3_is_finite(g)) { /* never NaN out: keep the start */
-        x = *p;
-        g = ak_vec3_zero();
-        st = ST_STOPPED;
-    }
-    *p = x;
-    *out_g = g;
-    return st;
+    return march_end(&m, g, p, out_g);
 }
 
 /* The contact planes of the joints (the paper's contact surface f_i = f_j, which for two parts
@@ -2000,6 +2035,63 @@ static bool near_fold(const run_ctx* c, size_t v) {
     return false;
 }
 
+/* The bones of x's broad-phase cell (the broad phase has one mask word per cell); 0 outside
+ * the broad phase's box, where field_eval gives 0. */
+static uint64_t cell_bones(const broad_phase* bp, ak_vec3 x) {
+    const float p[3] = {(x.x - bp->lo[0]) * bp->inv_cell[0], (x.y - bp->lo[1]) * bp->inv_cell[1],
+                        (x.z - bp->lo[2]) * bp->inv_cell[2]};
+    const float top = (float)bp->cells;
+    if (bp->empty || !(p[0] >= 0.0f && p[1] >= 0.0f && p[2] >= 0.0f && p[0] < top && p[1] < top && p[2] < top)) return 0;
+    return bp->mask[(size_t)p[0] + bp->cells * ((size_t)p[1] + bp->cells * (size_t)p[2])];
+}
+
+/* Phases 0 (first projection) and 2 (re-projection) of run_worker over list[begin, end) with the
+ * lane kernel: c->lanes vertices march at once, each lane taking the next vertex of the list as
+ * soon as its own ends. Every march takes the steps project takes (the kernel gives
+ * field_eval's bits, march_step is shared), so the results are the scalar path's bits. */
+static void project_lanes(const run_ctx* c, const uint32_t* list, size_t begin, size_t end, int phase) {
+    const ak_skin_implicit* o = c->o;
+    akp_implicit_lanes L;
+    march m[16];
+    uint32_t vert[16];
+    const unsigned W = c->lanes;
+    unsigned live = 0;
+    size_t i = begin;
+    memset(&L, 0, sizeof L);
+    for (;;) {
+        for (unsigned l = 0; l < W; ++l) {
+            if (live >> l & 1u) continue;
+            while (i < end) {
+                const size_t v = list ? list[i] : i;
+                ++i;
+                if (o->rep[v] != v || !projectable(o->iso[v])) continue;
+                if (phase == 0 ? rigid_alone(c, v) : c->state[v] == ST_KEEP) continue;
+                vert[l] = (uint32_t)v;
+                march_start(&m[l], c->pos[v], phase == 0);
+                live |= 1u << l;
+                break;
+            }
+        }
+        if (!live) break;
+        for (unsigned l = 0; l < W; ++l) {
+            const ak_vec3 x = m[l].x;
+            L.x[l] = x.x, L.y[l] = x.y, L.z[l] = x.z;
+            L.mask[l] = live >> l & 1u ? cell_bones(c->fc.bp, x) : 0u;
+        }
+        c->lanes_fn(&c->lanes_fd, &L);
+        for (unsigned bits = live; bits; bits &= bits - 1) {
+            const unsigned l = (unsigned)ctz64(bits);
+            const uint32_t v = vert[l];
+            const ak_vec3 g = ak_vec3_make(L.gx[l], L.gy[l], L.gz[l]);
+            if (!march_step(c, o->iso[v], &m[l], L.f[l], g, c->unchecked_below)) continue;
+            const uint8_t st = march_end(&m[l], g, &c->pos[v], &c->grad[v]);
+            if (phase == 0) c->state[v] = st;
+            else if (st == ST_STOPPED) c->state[v] = ST_STOPPED;
+            live &= ~(1u << l);
+        }
+    }
+}
+
 typedef struct run_task {
     run_ctx* c;
     const uint32_t* list; /* the vertices to visit, or NULL: all */
@@ -2011,6 +2103,10 @@ static void* run_worker(void* arg) {
     run_task* t = (run_task*)arg;
     run_ctx* c = t->c;
     const ak_skin_implicit* o = c->o;
+    if (c->lanes_fn && (t->phase == 0 || t->phase == 2)) {
+        project_lanes(c, t->list, t->begin, t->end, t->phase);
+        return NULL;
+    }
     for (size_t i = t->begin; i < t->end; ++i) {
         const size_t v = t->list ? t->list[i] : i;
         if (o->rep[v] != v || !projectable(o->iso[v])) continue;
@@ -2077,7 +2173,7 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     if (!job || !job->implicit || !job->palette.ptr || !job->out_positions.ptr || !job->scratch.ptr)
         return AK_ERR_NULL_ARG;
     const ak_skin_implicit* o = job->implicit;
-    if (job->thread_count > 64) return AK_ERR_BAD_ARG;
+    if (job->thread_count > 64 || (unsigned)job->simd_limit >= AK_SKIN_SIMD_COUNT) return AK_ERR_BAD_ARG;
     const size_t nv = o->vertex_count;
     if (job->palette.count < o->joint_count || job->out_positions.count < nv ||
         (job->out_normals.ptr && job->out_normals.count < nv) || (job->normals.ptr && job->normals.count < nv) ||
@@ -2158,7 +2254,14 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
         uint32_t* group_bone = (uint32_t*)(void*)((unsigned char*)group + align64((size_t)GROUP_CAP * GROUP_FLOATS * sizeof(float)));
         groups_build(bf, &bp, cell_group, table, group, group_bone);
     }
-    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, fold_start, fold_pair, 0.0f};
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, fold_start, fold_pair, NULL, 0, {0}, 0.0f};
+    if (o->grid_nodes && bp.words == 1) {
+        /* the lane kernel this CPU has, up to the job's simd_limit */
+        const ak_skin_simd level = job->simd_limit == AK_SKIN_SIMD_DEFAULT ? AK_SKIN_SIMD_AVX512 : job->simd_limit;
+        if (level >= AK_SKIN_SIMD_AVX512 && akp_skin_have_avx512()) c.lanes_fn = akp_implicit_field_avx512, c.lanes = 16;
+        else if (level >= AK_SKIN_SIMD_AVX2 && akp_skin_have_avx2()) c.lanes_fn = akp_implicit_field_avx2, c.lanes = 8;
+        c.lanes_fd = (akp_implicit_field){o->grid, o->grid_info, bf, inv, BF_FLOATS, o->bulge};
+    }
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     /* the projectable representatives grouped by part (counting sort, index order within a
      * part), so that consecutive projections read the same grids (each vertex's projection

@@ -107,4 +107,37 @@ static inline float akp_get_f32(const unsigned char* p) {
     return f;
 }
 
+/* Implicit skinning's field at up to 16 points at once (implicit.c's Newton march feeds them; the
+ * kernels are implicit_avx2.c, 8 lanes, and implicit_avx512.c, 16 lanes). Per bone: its grid
+ * (nodes of 4 floats: distance, gradient; grid_info nx ny nz first node), its per-frame record
+ * of bf_floats floats (implicit.c's bone_frames_build) and its inverse palette matrix (12
+ * floats). A kernel does per lane the scalar field_eval's operations in the same order (no fused
+ * multiply-add), so the results are bitwise the scalar path's. */
+typedef struct akp_implicit_field {
+    const float* grid;
+    const uint32_t* grid_info;
+    const float* bf;
+    const float* inv;
+    uint32_t bf_floats;
+    float bulge;
+} akp_implicit_field;
+
+/* The lanes of one call: the points (x, y, z), per lane the bones of its broad-phase cell (bit b:
+ * bone b; 0: the field is 0 there), and the composed field and its gradient out. */
+typedef struct akp_implicit_lanes {
+    _Alignas(64) float x[16];
+    _Alignas(64) float y[16];
+    _Alignas(64) float z[16];
+    _Alignas(64) float f[16];
+    _Alignas(64) float gx[16];
+    _Alignas(64) float gy[16];
+    _Alignas(64) float gz[16];
+    uint64_t mask[16];
+} akp_implicit_lanes;
+
+/* The field at the 16 lanes of l (AVX-512) or its first 8 (AVX2); false (nothing written) where
+ * this build has no such kernel. Callers check akp_skin_have_avx512 / akp_skin_have_avx2. */
+bool akp_implicit_field_avx512(const akp_implicit_field* fd, akp_implicit_lanes* l);
+bool akp_implicit_field_avx2(const akp_implicit_field* fd, akp_implicit_lanes* l);
+
 #endif

@@ -1,0 +1,106 @@
+/* The body of implicit skinning's lane kernels (implicit_avx2.c, implicit_avx512.c): the field
+ * of implicit.c's field_eval (broad-phase bones, trilinear grid interpolation, compact support,
+ * gradient to posed space, the two strongest fields, the contact bulge) at LANES points at
+ * once. The including file defines the vector types and operations:
+ *   LANES, VF (floats), VI (int32), VM (lane mask), KFUNC (function attributes),
+ *   F_SET1 F_LOAD F_STORE F_ADD F_SUB F_MUL F_DIV F_SQRT F_ZERO, F_SEL(m, a, b) (m ? a : b),
+ *   M_LT M_LE M_GT M_GE (ordered: false on NaN), M_AND, M_ANDNOT(a, b) (a and not b), M_ANY,
+ *   M_FROM_BITS, I_SET1 I_ADD I_MUL I_MIN I_TRUNC (float to int, toward 0) I_TO_F,
+ *   F_GATHER(m, base, index) (index in floats, lanes off m give 0).
+ * Every lane does the scalar code's operations in the same order (lerp in x, then y, then z;
+ * sums left to right; no fused multiply-add), so the results are bitwise field_eval's. */
+
+KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* L) {
+    uint64_t all = 0;
+    for (unsigned l = 0; l < LANES; ++l) all |= L->mask[l];
+    const VF zero = F_ZERO(), one = F_SET1(1.0f);
+    const VF X = F_LOAD(L->x), Y = F_LOAD(L->y), Z = F_LOAD(L->z);
+    VF f1 = zero, f2 = zero, g1x = zero, g1y = zero, g1z = zero, g2x = zero, g2y = zero, g2z = zero;
+    for (; all; all &= all - 1) {
+        const unsigned b = (unsigned)__builtin_ctzll(all);
+        unsigned bits = 0;
+        for (unsigned l = 0; l < LANES; ++l) bits |= (unsigned)((L->mask[l] >> b) & 1u) << l;
+        const float* F = fd->bf + (size_t)b * fd->bf_floats;
+        /* grid_locate: posed point to grid coordinates, the grid's box, the capsule bound */
+        const VF px = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[0]), X), F_MUL(F_SET1(F[3]), Y)), F_MUL(F_SET1(F[6]), Z)), F_SET1(F[9]));
+        const VF py = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[1]), X), F_MUL(F_SET1(F[4]), Y)), F_MUL(F_SET1(F[7]), Z)), F_SET1(F[10]));
+        const VF pz = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[2]), X), F_MUL(F_SET1(F[5]), Y)), F_MUL(F_SET1(F[8]), Z)), F_SET1(F[11]));
+        VM in = M_AND(M_FROM_BITS(bits), M_AND(M_AND(M_GE(px, zero), M_GE(py, zero)), M_GE(pz, zero)));
+        in = M_AND(in, M_AND(M_AND(M_LE(px, F_SET1(F[20])), M_LE(py, F_SET1(F[21]))), M_LE(pz, F_SET1(F[22]))));
+        if (!M_ANY(in)) continue;
+        if (F[19] > 0.0f) {
+            const VF ax = F_SUB(px, F_SET1(F[12])), ay = F_SUB(py, F_SET1(F[13])), az = F_SUB(pz, F_SET1(F[14]));
+            const VF c0 = F_SET1(F[15]), c1 = F_SET1(F[16]), c2 = F_SET1(F[17]);
+            const VF t0 = F_MUL(F_ADD(F_ADD(F_MUL(ax, c0), F_MUL(ay, c1)), F_MUL(az, c2)), F_SET1(F[18]));
+            const VF t = F_SEL(M_GT(t0, zero), F_SEL(M_LT(t0, one), t0, one), zero);
+            const VF wx = F_SUB(ax, F_MUL(c0, t)), wy = F_SUB(ay, F_MUL(c1, t)), wz = F_SUB(az, F_MUL(c2, t));
+            const VF w2 = F_ADD(F_ADD(F_MUL(wx, wx), F_MUL(wy, wy)), F_MUL(wz, wz));
+            in = M_ANDNOT(in, M_GE(w2, F_SET1(F[19])));
+            if (!M_ANY(in)) continue;
+        }
+        /* cell_at: the cell (clamped to the last one) and the fractions */
+        const uint32_t* I = fd->grid_info + (size_t)b * 4;
+        const int nx = (int)I[0], ny = (int)I[1], nz = (int)I[2];
+        const VI ix = I_MIN(I_TRUNC(px), I_SET1(nx - 2)), iy = I_MIN(I_TRUNC(py), I_SET1(ny - 2)),
+                 iz = I_MIN(I_TRUNC(pz), I_SET1(nz - 2));
+        const VF tx = F_SUB(px, I_TO_F(ix)), ty = F_SUB(py, I_TO_F(iy)), tz = F_SUB(pz, I_TO_F(iz));
+        const VI node = I_ADD(I_ADD(I_ADD(I_SET1((int)I[3]), ix), I_MUL(iy, I_SET1(nx))), I_MUL(iz, I_SET1(nx * ny)));
+        const VI i000 = I_MUL(node, I_SET1(4)), i010 = I_ADD(i000, I_SET1(4 * nx));
+        const VI i001 = I_ADD(i000, I_SET1(4 * nx * ny)), i011 = I_ADD(i001, I_SET1(4 * nx));
+        /* grid_interp, channel k: distance, gradient x y z */
+        VF r[4];
+        for (int k = 0; k < 4; ++k) {
+            const float* g = fd->grid + k;
+            const VF a0 = F_GATHER(in, g, i000), a1 = F_GATHER(in, g + 4, i000);
+            const VF b0 = F_GATHER(in, g, i010), b1 = F_GATHER(in, g + 4, i010);
+            const VF c0 = F_GATHER(in, g, i001), c1 = F_GATHER(in, g + 4, i001);
+            const VF d0 = F_GATHER(in, g, i011), d1 = F_GATHER(in, g + 4, i011);
+            const VF a = F_ADD(a0, F_MUL(tx, F_SUB(a1, a0))), bq = F_ADD(b0, F_MUL(tx, F_SUB(b1, b0)));
+            const VF cq = F_ADD(c0, F_MUL(tx, F_SUB(c1, c0))), dq = F_ADD(d0, F_MUL(tx, F_SUB(d1, d0)));
+            const VF e = F_ADD(a, F_MUL(ty, F_SUB(bq, a))), f = F_ADD(cq, F_MUL(ty, F_SUB(dq, cq)));
+            r[k] = F_ADD(e, F_MUL(tz, F_SUB(f, e)));
+        }
+        /* compact: t(u) inside the support, 1 (gradient 0) deep inside, nothing beyond */
+        const VF inv_r = F_SET1(F[23]);
+        const VF u = F_MUL(r[0], inv_r), u2 = F_MUL(u, u);
+        const VF poly = F_ADD(F_SUB(u, F_MUL(F_MUL(u2, u), F_SET1(2.0f / 3.0f))), F_MUL(F_MUL(F_MUL(u2, u2), u), F_SET1(0.2f)));
+        const VM deep = M_LE(u, F_SET1(-1.0f));
+        const VF t = F_SEL(deep, one, F_SUB(F_SET1(0.5f), F_MUL(F_SET1(0.9375f), poly)));
+        const VF w = F_SUB(one, u2);
+        const VF dt = F_MUL(F_MUL(F_MUL(F_SET1(-0.9375f), w), w), inv_r);
+        const VM keep = M_AND(M_AND(in, M_LT(u, one)), M_GT(t, zero));
+        if (!M_ANY(keep)) continue;
+        /* deep inside, the scalar code's gradient is +0 (not the product's possibly signed zero) */
+        const VF gyx = F_SEL(deep, zero, F_MUL(r[1], dt)), gyy = F_SEL(deep, zero, F_MUL(r[2], dt)),
+                 gyz = F_SEL(deep, zero, F_MUL(r[3], dt));
+        /* keep_strongest: the gradient to posed space, (M^-1)^T gy */
+        const float* m = fd->inv + 12 * (size_t)b;
+        const VF gx = F_ADD(F_ADD(F_MUL(F_SET1(m[0]), gyx), F_MUL(F_SET1(m[1]), gyy)), F_MUL(F_SET1(m[2]), gyz));
+        const VF gy = F_ADD(F_ADD(F_MUL(F_SET1(m[3]), gyx), F_MUL(F_SET1(m[4]), gyy)), F_MUL(F_SET1(m[5]), gyz));
+        const VF gz = F_ADD(F_ADD(F_MUL(F_SET1(m[6]), gyx), F_MUL(F_SET1(m[7]), gyy)), F_MUL(F_SET1(m[8]), gyz));
+        const VM over1 = M_AND(keep, M_GT(t, f1));
+        const VM over2 = M_ANDNOT(M_AND(keep, M_GT(t, f2)), over1);
+        f2 = F_SEL(over1, f1, F_SEL(over2, t, f2));
+        g2x = F_SEL(over1, g1x, F_SEL(over2, gx, g2x));
+        g2y = F_SEL(over1, g1y, F_SEL(over2, gy, g2y));
+        g2z = F_SEL(over1, g1z, F_SEL(over2, gz, g2z));
+        f1 = F_SEL(over1, t, f1);
+        g1x = F_SEL(over1, gx, g1x), g1y = F_SEL(over1, gy, g1y), g1z = F_SEL(over1, gz, g1z);
+    }
+    VF Fo = f1, Gx = g1x, Gy = g1y, Gz = g1z;
+    if (fd->bulge > 0.0f) {
+        const VF l1 = F_SQRT(F_ADD(F_ADD(F_MUL(g1x, g1x), F_MUL(g1y, g1y)), F_MUL(g1z, g1z)));
+        const VF l2 = F_SQRT(F_ADD(F_ADD(F_MUL(g2x, g2x), F_MUL(g2y, g2y)), F_MUL(g2z, g2z)));
+        const VF dot = F_ADD(F_ADD(F_MUL(g1x, g2x), F_MUL(g1y, g2y)), F_MUL(g1z, g2z));
+        const VF w = F_DIV(F_SUB(zero, dot), F_MUL(l1, l2));
+        const VM c = M_AND(M_AND(M_GT(f2, zero), M_AND(M_GT(l1, zero), M_GT(l2, zero))), M_GT(w, zero));
+        if (M_ANY(c)) {
+            const VF k = F_MUL(F_MUL(F_SET1(2.0f * fd->bulge), w), f2);
+            Fo = F_SEL(c, F_ADD(f1, F_MUL(F_MUL(F_MUL(F_SET1(fd->bulge), w), f2), f2)), f1);
+            Gx = F_SEL(c, F_ADD(g1x, F_MUL(g2x, k)), g1x);
+            Gy = F_SEL(c, F_ADD(g1y, F_MUL(g2y, k)), g1y);
+            Gz = F_SEL(c, F_ADD(g1z, F_MUL(g2z, k)), g1z);
+        }
+    }
+    F_STORE(L->f, Fo), F_STORE(L->gx, Gx), F_STORE(L->gy, Gy), F_STORE(L->gz, Gz);
+}
