@@ -36,12 +36,17 @@
 #define I_MIN(a, b) _mm256_min_epi32((a), (b))
 #define I_TRUNC(a) _mm256_cvttps_epi32(a)
 #define I_TO_F(a) _mm256_cvtepi32_ps(a)
-#define F_GATHER(m, base, index) _mm256_mask_i32gather_ps(_mm256_setzero_ps(), (base), (index), (m), 4)
+#define GATHER4(m, base, index, out) gather4((m), (base), (index), (out))
 
 /* Lane l all ones where bit l of bits is set. */
 KFUNC static inline __m256 from_bits(unsigned bits) {
     const __m256i lane = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
     return _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32((int)bits), lane), lane));
+}
+
+/* The 4 floats at base + index of each lane (lanes off m: 0), one gather per float. */
+KFUNC static inline void gather4(__m256 m, const float* base, __m256i index, __m256* out) {
+    for (int k = 0; k < 4; ++k) out[k] = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), base + k, index, m, 4);
 }
 
 #include "implicit_lanes.h"

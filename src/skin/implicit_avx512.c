@@ -36,7 +36,22 @@
 #define I_MIN(a, b) _mm512_min_epi32((a), (b))
 #define I_TRUNC(a) _mm512_cvttps_epi32(a)
 #define I_TO_F(a) _mm512_cvtepi32_ps(a)
-#define F_GATHER(m, base, index) _mm512_mask_i32gather_ps(_mm512_setzero_ps(), (m), (index), (base), 4)
+#define GATHER4(m, base, index, out) gather4((m), (base), (index), (out))
+
+/* The 4 floats at base + index of each lane (lanes off m: 0): pairs of floats as 64-bit gathers
+ * (8 lanes each, half the elements of 32-bit gathers), split into even and odd floats. */
+KFUNC static inline void gather4(__mmask16 m, const float* base, __m512i index, __m512* out) {
+    const __m256i lo = _mm512_castsi512_si256(index), hi = _mm512_extracti64x4_epi64(index, 1);
+    const __mmask8 mlo = (__mmask8)m, mhi = (__mmask8)(m >> 8);
+    const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+    const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+    for (int k = 0; k < 4; k += 2) {
+        const __m512 a = _mm512_castpd_ps(_mm512_mask_i32gather_pd(_mm512_setzero_pd(), mlo, lo, base + k, 4));
+        const __m512 b = _mm512_castpd_ps(_mm512_mask_i32gather_pd(_mm512_setzero_pd(), mhi, hi, base + k, 4));
+        out[k] = _mm512_permutex2var_ps(a, even, b);
+        out[k + 1] = _mm512_permutex2var_ps(a, odd, b);
+    }
+}
 
 #include "implicit_lanes.h"
 

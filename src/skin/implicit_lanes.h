@@ -6,7 +6,7 @@
  *   F_SET1 F_LOAD F_STORE F_ADD F_SUB F_MUL F_DIV F_SQRT F_ZERO, F_SEL(m, a, b) (m ? a : b),
  *   M_LT M_LE M_GT M_GE (ordered: false on NaN), M_AND, M_ANDNOT(a, b) (a and not b), M_ANY,
  *   M_FROM_BITS, I_SET1 I_ADD I_MUL I_MIN I_TRUNC (float to int, toward 0) I_TO_F,
- *   F_GATHER(m, base, index) (index in floats, lanes off m give 0).
+ *   GATHER4(m, base, index, out) (out[k]: float base[index + k], k < 4; lanes off m give 0).
  * Every lane does the scalar code's operations in the same order (lerp in x, then y, then z;
  * sums left to right; no fused multiply-add), so the results are bitwise field_eval's. */
 
@@ -47,17 +47,20 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
         const VI node = I_ADD(I_ADD(I_ADD(I_SET1((int)I[3]), ix), I_MUL(iy, I_SET1(nx))), I_MUL(iz, I_SET1(nx * ny)));
         const VI i000 = I_MUL(node, I_SET1(4)), i010 = I_ADD(i000, I_SET1(4 * nx));
         const VI i001 = I_ADD(i000, I_SET1(4 * nx * ny)), i011 = I_ADD(i001, I_SET1(4 * nx));
-        /* grid_interp, channel k: distance, gradient x y z */
+        /* grid_interp: the 4 values (distance, gradient x y z) of the cell's 8 nodes, lerp in x
+         * per (y, z) corner, then in y, then in z */
+        VF a[4], bq[4], cq[4], dq[4], n0[4], n1[4];
+        GATHER4(in, fd->grid, i000, n0), GATHER4(in, fd->grid + 4, i000, n1);
+        for (int k = 0; k < 4; ++k) a[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
+        GATHER4(in, fd->grid, i010, n0), GATHER4(in, fd->grid + 4, i010, n1);
+        for (int k = 0; k < 4; ++k) bq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
+        GATHER4(in, fd->grid, i001, n0), GATHER4(in, fd->grid + 4, i001, n1);
+        for (int k = 0; k < 4; ++k) cq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
+        GATHER4(in, fd->grid, i011, n0), GATHER4(in, fd->grid + 4, i011, n1);
+        for (int k = 0; k < 4; ++k) dq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
         VF r[4];
         for (int k = 0; k < 4; ++k) {
-            const float* g = fd->grid + k;
-            const VF a0 = F_GATHER(in, g, i000), a1 = F_GATHER(in, g + 4, i000);
-            const VF b0 = F_GATHER(in, g, i010), b1 = F_GATHER(in, g + 4, i010);
-            const VF c0 = F_GATHER(in, g, i001), c1 = F_GATHER(in, g + 4, i001);
-            const VF d0 = F_GATHER(in, g, i011), d1 = F_GATHER(in, g + 4, i011);
-            const VF a = F_ADD(a0, F_MUL(tx, F_SUB(a1, a0))), bq = F_ADD(b0, F_MUL(tx, F_SUB(b1, b0)));
-            const VF cq = F_ADD(c0, F_MUL(tx, F_SUB(c1, c0))), dq = F_ADD(d0, F_MUL(tx, F_SUB(d1, d0)));
-            const VF e = F_ADD(a, F_MUL(ty, F_SUB(bq, a))), f = F_ADD(cq, F_MUL(ty, F_SUB(dq, cq)));
+            const VF e = F_ADD(a[k], F_MUL(ty, F_SUB(bq[k], a[k]))), f = F_ADD(cq[k], F_MUL(ty, F_SUB(dq[k], cq[k])));
             r[k] = F_ADD(e, F_MUL(tz, F_SUB(f, e)));
         }
         /* compact: t(u) inside the support, 1 (gradient 0) deep inside, nothing beyond */
