@@ -1527,13 +1527,13 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
                 reach2 = reach * reach;
                 if (!ak_finitef(reach2)) reach2 = 0.0f;
             }
-            for (uint32_t k = a[2]; k <= z[2]; ++k)
-                for (uint32_t j = a[1]; j <= z[1]; ++j)
+            for (uint32_t k = a[2]; k <= z[2]; ++k) {
+                const float zz = bp->lo[2] + ((float)k + 0.5f) / bp->inv_cell[2];
+                for (uint32_t j = a[1]; j <= z[1]; ++j) {
+                    const float y = bp->lo[1] + ((float)j + 0.5f) / bp->inv_cell[1];
                     for (uint32_t i = a[0]; i <= z[0]; ++i) {
                         if (reach2 > 0.0f) {
                             const float x = bp->lo[0] + ((float)i + 0.5f) / bp->inv_cell[0];
-                            const float y = bp->lo[1] + ((float)j + 0.5f) / bp->inv_cell[1];
-                            const float zz = bp->lo[2] + ((float)k + 0.5f) / bp->inv_cell[2];
                             const float ax = M[0] * x + M[3] * y + M[6] * zz + M[9] - C[0];
                             const float ay = M[1] * x + M[4] * y + M[7] * zz + M[10] - C[1];
                             const float az = M[2] * x + M[5] * y + M[8] * zz + M[11] - C[2];
@@ -1544,6 +1544,8 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
                         }
                         mask[((size_t)i + cells * ((size_t)j + (size_t)cells * k)) * words + b / 64] |= bit;
                     }
+                }
+            }
         }
         if (pass == 0) {
             if (!(lo[0] <= hi[0]) || !ak_finitef(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2])) return;
@@ -2245,6 +2247,14 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     broad_phase bp;
     if (o->grid_nodes) cull_build(o, cull);
     if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
+    /* the lane kernel this CPU has, up to the job's simd_limit (with grids and at most 64 bones) */
+    bool (*lanes_fn)(const akp_implicit_field*, akp_implicit_lanes*) = NULL;
+    unsigned lanes = 0;
+    if (o->grid_nodes && bp.words == 1) {
+        const ak_skin_simd level = job->simd_limit == AK_SKIN_SIMD_DEFAULT ? AK_SKIN_SIMD_AVX512 : job->simd_limit;
+        if (level >= AK_SKIN_SIMD_AVX512 && akp_skin_have_avx512()) lanes_fn = akp_implicit_field_avx512, lanes = 16;
+        else if (level >= AK_SKIN_SIMD_AVX2 && akp_skin_have_avx2()) lanes_fn = akp_implicit_field_avx2, lanes = 8;
+    }
     if (o->grid_nodes) {
         bone_frames_build(o, inv, cull, bf);
         const size_t ncell = (size_t)bp.cells * bp.cells * bp.cells;
@@ -2252,14 +2262,12 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
         uint32_t* table = (uint32_t*)(void*)(groups + align64(2 * ncell * sizeof(uint32_t)));
         float* group = (float*)(void*)(groups + 2 * align64(2 * ncell * sizeof(uint32_t)));
         uint32_t* group_bone = (uint32_t*)(void*)((unsigned char*)group + align64((size_t)GROUP_CAP * GROUP_FLOATS * sizeof(float)));
-        groups_build(bf, &bp, cell_group, table, group, group_bone);
+        if (lanes_fn) bp.cell_group = NULL, bp.group = NULL, bp.group_bone = NULL; /* no field_eval */
+        else groups_build(bf, &bp, cell_group, table, group, group_bone);
     }
     run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, fold_start, fold_pair, NULL, 0, {0}, 0.0f};
-    if (o->grid_nodes && bp.words == 1) {
-        /* the lane kernel this CPU has, up to the job's simd_limit */
-        const ak_skin_simd level = job->simd_limit == AK_SKIN_SIMD_DEFAULT ? AK_SKIN_SIMD_AVX512 : job->simd_limit;
-        if (level >= AK_SKIN_SIMD_AVX512 && akp_skin_have_avx512()) c.lanes_fn = akp_implicit_field_avx512, c.lanes = 16;
-        else if (level >= AK_SKIN_SIMD_AVX2 && akp_skin_have_avx2()) c.lanes_fn = akp_implicit_field_avx2, c.lanes = 8;
+    if (lanes_fn) {
+        c.lanes_fn = lanes_fn, c.lanes = lanes;
         c.lanes_fd = (akp_implicit_field){o->grid, o->grid_info, bf, inv, BF_FLOATS, o->bulge};
     }
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
