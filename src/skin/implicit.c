@@ -1703,7 +1703,7 @@ typedef struct run_ctx {
     const uint32_t* fold_pair;  /* [2 * pair_count] */
     /* the lane kernel of the projections (NULL: project, one vertex at a time), its lanes and
      * its per-frame data; set only with grids and at most 64 bones (one mask word per cell) */
-    bool (*lanes_fn)(const akp_implicit_field* fd, akp_implicit_lanes* l);
+    unsigned (*lanes_fn)(const akp_implicit_field* fd, akp_implicit_lanes* l, unsigned live);
     unsigned lanes;
     akp_implicit_field lanes_fd;
     float unchecked_below; /* project's: FLT_MAX in the rounds before the last, UNCHECKED_EPS in
@@ -2037,26 +2037,18 @@ static bool near_fold(const run_ctx* c, size_t v) {
     return false;
 }
 
-/* The bones of x's broad-phase cell (the broad phase has one mask word per cell); 0 outside
- * the broad phase's box, where field_eval gives 0. */
-static uint64_t cell_bones(const broad_phase* bp, ak_vec3 x) {
-    const float p[3] = {(x.x - bp->lo[0]) * bp->inv_cell[0], (x.y - bp->lo[1]) * bp->inv_cell[1],
-                        (x.z - bp->lo[2]) * bp->inv_cell[2]};
-    const float top = (float)bp->cells;
-    if (bp->empty || !(p[0] >= 0.0f && p[1] >= 0.0f && p[2] >= 0.0f && p[0] < top && p[1] < top && p[2] < top)) return 0;
-    return bp->mask[(size_t)p[0] + bp->cells * ((size_t)p[1] + bp->cells * (size_t)p[2])];
-}
-
 /* Phases 0 (first projection) and 2 (re-projection) of run_worker over list[begin, end) with the
  * lane kernel: c->lanes vertices march at once, each lane taking the next vertex of the list as
- * soon as its own ends. Every march takes the steps project takes (the kernel gives
- * field_eval's bits, march_step is shared), so the results are the scalar path's bits. */
+ * soon as its own march ends. The kernel takes the steps march_step takes, with the bits of
+ * field_eval, and march_end finishes each march, so the results are the scalar path's bits. */
 static void project_lanes(const run_ctx* c, const uint32_t* list, size_t begin, size_t end, int phase) {
     const ak_skin_implicit* o = c->o;
     akp_implicit_lanes L;
-    march m[16];
+    ak_vec3 start[16];
     uint32_t vert[16];
     const unsigned W = c->lanes;
+    akp_implicit_field fd = c->lanes_fd;
+    fd.unchecked_below = c->unchecked_below;
     unsigned live = 0;
     size_t i = begin;
     memset(&L, 0, sizeof L);
@@ -2068,25 +2060,22 @@ static void project_lanes(const run_ctx* c, const uint32_t* list, size_t begin, 
                 ++i;
                 if (o->rep[v] != v || !projectable(o->iso[v])) continue;
                 if (phase == 0 ? rigid_alone(c, v) : c->state[v] == ST_KEEP) continue;
-                vert[l] = (uint32_t)v;
-                march_start(&m[l], c->pos[v], phase == 0);
+                const ak_vec3 x = c->pos[v];
+                vert[l] = (uint32_t)v, start[l] = x;
+                L.x[l] = x.x, L.y[l] = x.y, L.z[l] = x.z, L.iso[l] = o->iso[v];
+                L.px[l] = L.py[l] = L.pz[l] = 0.0f, L.it[l] = 0.0f;
+                L.st[l] = phase == 0 ? (float)ST_KEEP : (float)ST_MOVED;
                 live |= 1u << l;
                 break;
             }
         }
         if (!live) break;
-        for (unsigned l = 0; l < W; ++l) {
-            const ak_vec3 x = m[l].x;
-            L.x[l] = x.x, L.y[l] = x.y, L.z[l] = x.z;
-            L.mask[l] = live >> l & 1u ? cell_bones(c->fc.bp, x) : 0u;
-        }
-        c->lanes_fn(&c->lanes_fd, &L);
-        for (unsigned bits = live; bits; bits &= bits - 1) {
+        const unsigned ended = c->lanes_fn(&fd, &L, live);
+        for (unsigned bits = ended; bits; bits &= bits - 1) {
             const unsigned l = (unsigned)ctz64(bits);
             const uint32_t v = vert[l];
-            const ak_vec3 g = ak_vec3_make(L.gx[l], L.gy[l], L.gz[l]);
-            if (!march_step(c, o->iso[v], &m[l], L.f[l], g, c->unchecked_below)) continue;
-            const uint8_t st = march_end(&m[l], g, &c->pos[v], &c->grad[v]);
+            march m = {ak_vec3_make(L.x[l], L.y[l], L.z[l]), start[l], ak_vec3_zero(), 0, (uint8_t)L.st[l]};
+            const uint8_t st = march_end(&m, ak_vec3_make(L.gx[l], L.gy[l], L.gz[l]), &c->pos[v], &c->grad[v]);
             if (phase == 0) c->state[v] = st;
             else if (st == ST_STOPPED) c->state[v] = ST_STOPPED;
             live &= ~(1u << l);
@@ -2248,12 +2237,12 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     if (o->grid_nodes) cull_build(o, cull);
     if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
     /* the lane kernel this CPU has, up to the job's simd_limit (with grids and at most 64 bones) */
-    bool (*lanes_fn)(const akp_implicit_field*, akp_implicit_lanes*) = NULL;
+    unsigned (*lanes_fn)(const akp_implicit_field*, akp_implicit_lanes*, unsigned) = NULL;
     unsigned lanes = 0;
-    if (o->grid_nodes && bp.words == 1) {
+    if (o->grid_nodes && bp.words == 1 && (job->iterations == 0 || job->iterations <= (1u << 20))) {
         const ak_skin_simd level = job->simd_limit == AK_SKIN_SIMD_DEFAULT ? AK_SKIN_SIMD_AVX512 : job->simd_limit;
-        if (level >= AK_SKIN_SIMD_AVX512 && akp_skin_have_avx512()) lanes_fn = akp_implicit_field_avx512, lanes = 16;
-        else if (level >= AK_SKIN_SIMD_AVX2 && akp_skin_have_avx2()) lanes_fn = akp_implicit_field_avx2, lanes = 8;
+        if (level >= AK_SKIN_SIMD_AVX512 && akp_skin_have_avx512()) lanes_fn = akp_implicit_march_avx512, lanes = 16;
+        else if (level >= AK_SKIN_SIMD_AVX2 && akp_skin_have_avx2()) lanes_fn = akp_implicit_march_avx2, lanes = 8;
     }
     if (o->grid_nodes) {
         bone_frames_build(o, inv, cull, bf);
@@ -2268,7 +2257,9 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, fold_start, fold_pair, NULL, 0, {0}, 0.0f};
     if (lanes_fn) {
         c.lanes_fn = lanes_fn, c.lanes = lanes;
-        c.lanes_fd = (akp_implicit_field){o->grid, o->grid_info, bf, inv, BF_FLOATS, o->bulge};
+        c.lanes_fd = (akp_implicit_field){o->grid, o->grid_info, bf, inv, BF_FLOATS, o->bulge,
+            {bp.lo[0], bp.lo[1], bp.lo[2]}, {bp.inv_cell[0], bp.inv_cell[1], bp.inv_cell[2]}, bp.cells,
+            bp.empty ? NULL : bp.mask, (float)c.iterations, ISO_EPS, STOP_COS, o->step_cap, 0.0f};
     }
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     /* the projectable representatives grouped by part (counting sort, index order within a

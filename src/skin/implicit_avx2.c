@@ -1,4 +1,4 @@
-/* AVX2 kernel of implicit skinning's field (8 points per call): implicit_lanes.h with 256-bit
+/* AVX2 kernel of implicit skinning's Newton march (8 vertices per call): implicit_lanes.h with 256-bit
  * vectors (lane masks are all-ones lanes), the grid nodes read with masked gathers. Compiled
  * only for GCC/Clang on x86-64 without AK_NO_SIMD, with target attributes; implicit.c selects it
  * at run time (akp_skin_have_avx2). Gives the scalar field_eval's bits (see implicit_lanes.h). */
@@ -29,6 +29,11 @@
 #define M_AND(a, b) _mm256_and_ps((a), (b))
 #define M_ANDNOT(a, b) _mm256_andnot_ps((b), (a))
 #define M_ANY(m) (_mm256_movemask_ps(m) != 0)
+#define M_OR(a, b) _mm256_or_ps((a), (b))
+#define M_EQ(a, b) _mm256_cmp_ps((a), (b), _CMP_EQ_OQ)
+#define M_BITS(m) ((unsigned)_mm256_movemask_ps(m))
+#define F_ABS(a) _mm256_andnot_ps(_mm256_set1_ps(-0.0f), (a))
+#define I_STORE(p, a) _mm256_store_si256((__m256i*)(void*)(p), (a))
 #define M_FROM_BITS(bits) from_bits(bits)
 #define I_SET1(a) _mm256_set1_epi32(a)
 #define I_ADD(a, b) _mm256_add_epi32((a), (b))
@@ -51,16 +56,15 @@ KFUNC static inline void gather4(__m256 m, const float* base, __m256i index, __m
 
 #include "implicit_lanes.h"
 
-bool akp_implicit_field_avx2(const akp_implicit_field* fd, akp_implicit_lanes* l) {
-    lanes_field(fd, l);
-    return true;
+unsigned akp_implicit_march_avx2(const akp_implicit_field* fd, akp_implicit_lanes* l, unsigned live) {
+    return lanes_march(fd, l, live);
 }
 
 #else
 
-bool akp_implicit_field_avx2(const akp_implicit_field* fd, akp_implicit_lanes* l) {
-    (void)fd, (void)l;
-    return false;
+unsigned akp_implicit_march_avx2(const akp_implicit_field* fd, akp_implicit_lanes* l, unsigned live) {
+    (void)fd, (void)l, (void)live;
+    return 0;
 }
 
 #endif

@@ -1,4 +1,4 @@
-/* AVX-512 kernel of implicit skinning's field (16 points per call): implicit_lanes.h with
+/* AVX-512 kernel of implicit skinning's Newton march (16 vertices per call): implicit_lanes.h with
  * 512-bit vectors and mask registers, the grid nodes read with masked gathers. Compiled only for
  * GCC/Clang on x86-64 without AK_NO_SIMD, with target attributes; implicit.c selects it at run
  * time (akp_skin_have_avx512). Gives the scalar field_eval's bits (see implicit_lanes.h). */
@@ -29,6 +29,11 @@
 #define M_AND(a, b) ((VM)((a) & (b)))
 #define M_ANDNOT(a, b) ((VM)((a) & ~(b)))
 #define M_ANY(m) ((m) != 0)
+#define M_OR(a, b) ((VM)((a) | (b)))
+#define M_EQ(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_EQ_OQ)
+#define M_BITS(m) ((unsigned)(m))
+#define F_ABS(a) _mm512_abs_ps(a)
+#define I_STORE(p, a) _mm512_store_si512((void*)(p), (a))
 #define M_FROM_BITS(bits) ((VM)(bits))
 #define I_SET1(a) _mm512_set1_epi32(a)
 #define I_ADD(a, b) _mm512_add_epi32((a), (b))
@@ -55,16 +60,15 @@ KFUNC static inline void gather4(__mmask16 m, const float* base, __m512i index, 
 
 #include "implicit_lanes.h"
 
-bool akp_implicit_field_avx512(const akp_implicit_field* fd, akp_implicit_lanes* l) {
-    lanes_field(fd, l);
-    return true;
+unsigned akp_implicit_march_avx512(const akp_implicit_field* fd, akp_implicit_lanes* l, unsigned live) {
+    return lanes_march(fd, l, live);
 }
 
 #else
 
-bool akp_implicit_field_avx512(const akp_implicit_field* fd, akp_implicit_lanes* l) {
-    (void)fd, (void)l;
-    return false;
+unsigned akp_implicit_march_avx512(const akp_implicit_field* fd, akp_implicit_lanes* l, unsigned live) {
+    (void)fd, (void)l, (void)live;
+    return 0;
 }
 
 #endif

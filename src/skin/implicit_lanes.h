@@ -4,8 +4,8 @@
  * once. The including file defines the vector types and operations:
  *   LANES, VF (floats), VI (int32), VM (lane mask), KFUNC (function attributes),
  *   F_SET1 F_LOAD F_STORE F_ADD F_SUB F_MUL F_DIV F_SQRT F_ZERO, F_SEL(m, a, b) (m ? a : b),
- *   M_LT M_LE M_GT M_GE (ordered: false on NaN), M_AND, M_ANDNOT(a, b) (a and not b), M_ANY,
- *   M_FROM_BITS, I_SET1 I_ADD I_MUL I_MIN I_TRUNC (float to int, toward 0) I_TO_F,
+ *   M_LT M_LE M_GT M_GE M_EQ (ordered: false on NaN), M_AND, M_OR, M_ANDNOT(a, b) (a and not
+ *   b), M_ANY, M_FROM_BITS, M_BITS, F_ABS, I_STORE, I_SET1 I_ADD I_MUL I_MIN I_TRUNC (float to int, toward 0) I_TO_F,
  *   GATHER4(m, base, index, out) (out[k]: float base[index + k], k < 4; lanes off m give 0).
  * Every lane does the scalar code's operations in the same order (lerp in x, then y, then z;
  * sums left to right; no fused multiply-add), so the results are bitwise field_eval's. */
@@ -106,4 +106,57 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
         }
     }
     F_STORE(L->f, Fo), F_STORE(L->gx, Gx), F_STORE(L->gy, Gy), F_STORE(L->gz, Gz);
+}
+
+/* project's march_step for the live lanes: the broad-phase cell of each point, the field there,
+ * then one Newton step, each lane as the scalar code; returns the lanes whose march ended. */
+KFUNC static unsigned lanes_march(const akp_implicit_field* fd, akp_implicit_lanes* L, unsigned live) {
+    const VF zero = F_ZERO();
+    const VM on = M_FROM_BITS(live);
+    {
+        /* field_eval's broad-phase cell (-1 outside: the field is 0) */
+        const VF top = F_SET1((float)fd->bp_cells);
+        const VF p0 = F_MUL(F_SUB(F_LOAD(L->x), F_SET1(fd->bp_lo[0])), F_SET1(fd->bp_inv_cell[0]));
+        const VF p1 = F_MUL(F_SUB(F_LOAD(L->y), F_SET1(fd->bp_lo[1])), F_SET1(fd->bp_inv_cell[1]));
+        const VF p2 = F_MUL(F_SUB(F_LOAD(L->z), F_SET1(fd->bp_lo[2])), F_SET1(fd->bp_inv_cell[2]));
+        const VM in = M_AND(M_AND(M_AND(M_GE(p0, zero), M_GE(p1, zero)), M_AND(M_GE(p2, zero), M_LT(p0, top))),
+                            M_AND(M_AND(M_LT(p1, top), M_LT(p2, top)), on));
+        const VI n = I_SET1((int)fd->bp_cells);
+        const VI cell = I_ADD(I_TRUNC(F_SEL(in, p0, zero)),
+                              I_MUL(n, I_ADD(I_TRUNC(F_SEL(in, p1, zero)), I_MUL(n, I_TRUNC(F_SEL(in, p2, zero))))));
+        I_STORE(L->cell, cell);
+        const unsigned inside = fd->bp_mask ? M_BITS(in) : 0u;
+        for (unsigned l = 0; l < LANES; ++l) L->mask[l] = inside >> l & 1u ? fd->bp_mask[L->cell[l]] : 0u;
+    }
+    lanes_field(fd, L);
+    const VF F = F_LOAD(L->f), gx = F_LOAD(L->gx), gy = F_LOAD(L->gy), gz = F_LOAD(L->gz);
+    const VF px = F_LOAD(L->px), py = F_LOAD(L->py), pz = F_LOAD(L->pz), it = F_LOAD(L->it), st = F_LOAD(L->st);
+    /* march_step: the end tests, then the step (capped) */
+    const VF e = F_SUB(F_LOAD(L->iso), F);
+    const VF ae = F_ABS(e);
+    const VF gl2 = F_ADD(F_ADD(F_MUL(gx, gx), F_MUL(gy, gy)), F_MUL(gz, gz));
+    VM done = M_OR(M_OR(M_LT(ae, F_SET1(fd->iso_eps)), M_EQ(it, F_SET1(fd->iterations))), M_ANDNOT(on, M_GT(gl2, F_SET1(1e-20f))));
+    const VF dot = F_ADD(F_ADD(F_MUL(gx, px), F_MUL(gy, py)), F_MUL(gz, pz));
+    const VF pl2 = F_ADD(F_ADD(F_MUL(px, px), F_MUL(py, py)), F_MUL(pz, pz));
+    const VM turn = M_ANDNOT(M_AND(M_GT(it, zero), M_LT(dot, F_MUL(F_SET1(fd->stop_cos), F_SQRT(F_MUL(gl2, pl2))))), done);
+    done = M_OR(done, turn);
+    VF state = F_SEL(turn, F_SET1(2.0f), st); /* ST_STOPPED */
+    const VM go = M_ANDNOT(on, done);
+    const VF q = F_DIV(e, gl2);
+    VF sx = F_MUL(gx, q), sy = F_MUL(gy, q), sz = F_MUL(gz, q);
+    const VF sl = F_SQRT(F_ADD(F_ADD(F_MUL(sx, sx), F_MUL(sy, sy)), F_MUL(sz, sz)));
+    const VF cap = F_SET1(fd->step_cap);
+    const VM long_step = M_GT(sl, cap);
+    const VF k = F_DIV(cap, sl);
+    sx = F_SEL(long_step, F_MUL(sx, k), sx), sy = F_SEL(long_step, F_MUL(sy, k), sy), sz = F_SEL(long_step, F_MUL(sz, k), sz);
+    F_STORE(L->x, F_SEL(go, F_ADD(F_LOAD(L->x), sx), F_LOAD(L->x)));
+    F_STORE(L->y, F_SEL(go, F_ADD(F_LOAD(L->y), sy), F_LOAD(L->y)));
+    F_STORE(L->z, F_SEL(go, F_ADD(F_LOAD(L->z), sz), F_LOAD(L->z)));
+    F_STORE(L->px, F_SEL(go, gx, px)), F_STORE(L->py, F_SEL(go, gy, py)), F_STORE(L->pz, F_SEL(go, gz, pz));
+    state = F_SEL(M_AND(go, M_EQ(state, zero)), F_SET1(1.0f), state); /* ST_KEEP -> ST_MOVED */
+    F_STORE(L->st, state);
+    const VM last = M_AND(go, M_LT(ae, F_SET1(fd->unchecked_below)));
+    done = M_OR(done, last);
+    F_STORE(L->it, F_SEL(M_ANDNOT(go, last), F_ADD(it, F_SET1(1.0f)), it));
+    return M_BITS(done) & live;
 }
