@@ -1488,6 +1488,7 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
     const uint32_t cells = bp_cells(o);
     const size_t words = (o->joint_count + 63) / 64;
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    float centre[3][16]; /* per axis, the cells' centres (bp_cells: at most 16 per axis) */
     bp->cells = cells, bp->words = words, bp->mask = mask, bp->empty = true;
     memset(mask, 0, (size_t)cells * cells * cells * words * sizeof(uint64_t));
     /* pass 0: the union of the posed boxes; pass 1: the bits */
@@ -1528,12 +1529,12 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
                 if (!ak_finitef(reach2)) reach2 = 0.0f;
             }
             for (uint32_t k = a[2]; k <= z[2]; ++k) {
-                const float zz = bp->lo[2] + ((float)k + 0.5f) / bp->inv_cell[2];
+                const float zz = centre[2][k];
                 for (uint32_t j = a[1]; j <= z[1]; ++j) {
-                    const float y = bp->lo[1] + ((float)j + 0.5f) / bp->inv_cell[1];
+                    const float y = centre[1][j];
                     for (uint32_t i = a[0]; i <= z[0]; ++i) {
                         if (reach2 > 0.0f) {
-                            const float x = bp->lo[0] + ((float)i + 0.5f) / bp->inv_cell[0];
+                            const float x = centre[0][i];
                             const float ax = M[0] * x + M[3] * y + M[6] * zz + M[9] - C[0];
                             const float ay = M[1] * x + M[4] * y + M[7] * zz + M[10] - C[1];
                             const float az = M[2] * x + M[5] * y + M[8] * zz + M[11] - C[2];
@@ -1553,6 +1554,7 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
             for (int q = 0; q < 3; ++q) {
                 float ext = fmaxf(hi[q] - lo[q], 1e-20f);
                 bp->lo[q] = lo[q], bp->inv_cell[q] = (float)cells / ext;
+                for (uint32_t i = 0; i < cells; ++i) centre[q][i] = bp->lo[q] + ((float)i + 0.5f) / bp->inv_cell[q];
             }
         }
     }
