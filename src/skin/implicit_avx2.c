@@ -8,6 +8,7 @@
 #include <immintrin.h>
 
 #define LANES 8u
+#define LANES_PACKED 0
 #define KFUNC __attribute__((target("avx2,fma")))
 #define VF __m256
 #define VI __m256i
@@ -34,6 +35,8 @@
 #define M_BITS(m) ((unsigned)_mm256_movemask_ps(m))
 #define F_ABS(a) _mm256_andnot_ps(_mm256_set1_ps(-0.0f), (a))
 #define I_STORE(p, a) _mm256_store_si256((__m256i*)(void*)(p), (a))
+#define I_LOAD(p) _mm256_load_si256((const __m256i*)(const void*)(p))
+#define I_SUB(a, b) _mm256_sub_epi32((a), (b))
 #define M_FROM_BITS(bits) from_bits(bits)
 #define I_SET1(a) _mm256_set1_epi32(a)
 #define I_ADD(a, b) _mm256_add_epi32((a), (b))

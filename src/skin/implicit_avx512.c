@@ -8,6 +8,7 @@
 #include <immintrin.h>
 
 #define LANES 16u
+#define LANES_PACKED 1
 #define KFUNC __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")))
 #define VF __m512
 #define VI __m512i
@@ -34,6 +35,11 @@
 #define M_BITS(m) ((unsigned)(m))
 #define F_ABS(a) _mm512_abs_ps(a)
 #define I_STORE(p, a) _mm512_store_si512((void*)(p), (a))
+#define I_LOAD(p) _mm512_load_si512((const void*)(p))
+#define I_SUB(a, b) _mm512_sub_epi32((a), (b))
+#define COMPRESS_F(dst, m, v) _mm512_mask_compressstoreu_ps((dst), (m), (v))
+#define COMPRESS_I(dst, m, v) _mm512_mask_compressstoreu_epi32((dst), (m), (v))
+#define EXPAND_F(src, m) _mm512_maskz_expandloadu_ps((m), (src))
 #define M_FROM_BITS(bits) ((VM)(bits))
 #define I_SET1(a) _mm512_set1_epi32(a)
 #define I_ADD(a, b) _mm512_add_epi32((a), (b))
