@@ -514,6 +514,11 @@ static size_t same_bits_every_kernel(const ak_skin_implicit* imp, const ak_mat4*
                                     .out_moved = &moved[k]};
         AK_CHECK_EQ(ak_skin_implicit_run(&job), AK_OK);
     }
+    {
+        ak_skin_implicit_job job = {.implicit = imp, .palette = {pal, jc}, .simd_limit = AK_SKIN_SIMD_COUNT,
+                                    .scratch = {scratch, ss}, .out_positions = {out[0], n}};
+        AK_CHECK_EQ(ak_skin_implicit_run(&job), AK_ERR_BAD_ARG); /* simd_limit out of range */
+    }
     for (int k = 1; k < 3; ++k) {
         size_t differ = 0;
         for (size_t v = 0; v < n; ++v) differ += memcmp(&out[k][v], &out[0][v], sizeof(ak_vec3)) != 0;
