@@ -2,7 +2,9 @@
  * (when the asset is present: ANIMKIT_ASSETS or ../shared/assets) and on builtin:cylinder
  * tessellated to about 50k vertices, 1 and 2 threads (wall time), plus the CPU time of one
  * thread (on a loaded machine the fairer ratio) and the same frame with the HRBFs evaluated
- * directly instead of from the per-bone grids; the precompute times. The ratio implicit / DQS
+ * directly instead of from the per-bone grids, and the frame with the scalar projections
+ * (simd_limit AK_SKIN_SIMD_SCALAR: one vertex at a time instead of the AVX-512 / AVX2 lanes); the
+ * precompute times. The ratio implicit / DQS
  * per frame is machine-independent enough to compare (target <= 5x).
  *     build/bench/bench_implicit */
 #include <stdio.h>
@@ -27,6 +29,7 @@ typedef struct frame_ctx {
     unsigned char* scratch;
     size_t scratch_size;
     uint32_t threads;
+    ak_skin_simd simd; /* the projections' kernel (0: the fastest this CPU has) */
 } frame_ctx;
 
 static void run_dqs(const frame_ctx* c) {
@@ -51,6 +54,7 @@ static void run_implicit(const frame_ctx* c) {
         .implicit = c->imp,
         .palette = {c->pal, c->joint_count},
         .thread_count = c->threads,
+        .simd_limit = c->simd,
         .scratch = {c->scratch, c->scratch_size},
         .out_positions = {c->out, c->mesh->vertex_count},
     };
@@ -116,15 +120,19 @@ static void bench_model(const char* name, ak_scene* s, int clip, float t) {
     printf("  %-8s %12s %12s %10s\n", "threads", "DQS ms", "implicit ms", "ratio");
     int rounds = bench_quick() ? 3 : 15;
     for (uint32_t th = 1; th <= 2; ++th) {
-        frame_ctx c = {m, imp, pal, jc, out, scratch, ss, th};
+        frame_ctx c = {m, imp, pal, jc, out, scratch, ss, th, AK_SKIN_SIMD_DEFAULT};
         double dq = median_ms(run_dqs, &c, rounds * 4), im = median_ms(run_implicit, &c, rounds);
         printf("  %-8u %12.4f %12.3f %9.1fx\n", th, dq, im, im / dq);
     }
     {
-        frame_ctx c = {m, imp, pal, jc, out, scratch, ss, 1};
+        frame_ctx c = {m, imp, pal, jc, out, scratch, ss, 1, AK_SKIN_SIMD_DEFAULT};
         double dq = median_ms_clock(run_dqs, &c, rounds * 4, bench_cpu_s);
         double im = median_ms_clock(run_implicit, &c, rounds, bench_cpu_s);
         printf("  1 thread, CPU time: DQS %.4f ms, implicit %.3f ms (%.1fx)", dq, im, im / dq);
+        c.simd = AK_SKIN_SIMD_SCALAR;
+        double sc = median_ms_clock(run_implicit, &c, rounds, bench_cpu_s);
+        printf(", scalar projections %.3f ms (%.1fx)", sc, sc / dq);
+        c.simd = AK_SKIN_SIMD_DEFAULT;
         if (direct) {
             c.imp = direct;
             double di = median_ms_clock(run_implicit, &c, bench_quick() ? 1 : 3, bench_cpu_s);

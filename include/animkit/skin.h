@@ -459,6 +459,11 @@ typedef struct ak_skin_implicit_job {
                                     the rounds before the last re-project with one Newton step
                                     (checked by the next round), the last converges */
     uint32_t thread_count;       /* 0 or 1 -> calling thread; n (<= 64) -> n vertex ranges */
+    ak_skin_simd simd_limit;     /* the projections' field kernel: 0 -> the fastest this CPU has
+                                    (16 vertices at once with AVX-512, 8 with AVX2); else the
+                                    fastest up to this one (AK_SKIN_SIMD_SCALAR: one vertex at a
+                                    time). Every kernel gives the same bits; out of range:
+                                    AK_ERR_BAD_ARG */
     ak_u8_span scratch;          /* >= ak_skin_implicit_scratch_size(implicit, palette.count) */
     ak_vec3_span out_positions;  /* required: count >= vertex count */
     ak_vec3_cspan normals;       /* optional: unit bind-space normals (count >= vertex count),
@@ -473,9 +478,9 @@ typedef struct ak_skin_implicit_job {
 /* Bytes of scratch a run needs (0 for a NULL object). */
 AK_API size_t ak_skin_implicit_scratch_size(const ak_skin_implicit* implicit, size_t palette_count);
 
-/* Deform. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (thread_count > 64), AK_ERR_SPAN_SMALL
- * (palette, scratch, normals or an output), AK_ERR_BAD_DATA (a palette matrix not finite or not
- * invertible); writes nothing on error. Never allocates except thread stacks. */
+/* Deform. Returns AK_ERR_NULL_ARG, AK_ERR_BAD_ARG (thread_count > 64, simd_limit out of range),
+ * AK_ERR_SPAN_SMALL (palette, scratch, normals or an output), AK_ERR_BAD_DATA (a palette matrix
+ * not finite or not invertible); writes nothing on error. Never allocates except thread stacks. */
 AK_API ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job);
 
 #ifdef __cplusplus

@@ -1488,6 +1488,7 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
     const uint32_t cells = bp_cells(o);
     const size_t words = (o->joint_count + 63) / 64;
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    float centre[3][16]; /* per axis, the cells' centres (bp_cells: at most 16 per axis) */
     bp->cells = cells, bp->words = words, bp->mask = mask, bp->empty = true;
     memset(mask, 0, (size_t)cells * cells * cells * words * sizeof(uint64_t));
     /* pass 0: the union of the posed boxes; pass 1: the bits */
@@ -1527,13 +1528,13 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
                 reach2 = reach * reach;
                 if (!ak_finitef(reach2)) reach2 = 0.0f;
             }
-            for (uint32_t k = a[2]; k <= z[2]; ++k)
-                for (uint32_t j = a[1]; j <= z[1]; ++j)
+            for (uint32_t k = a[2]; k <= z[2]; ++k) {
+                const float zz = centre[2][k];
+                for (uint32_t j = a[1]; j <= z[1]; ++j) {
+                    const float y = centre[1][j];
                     for (uint32_t i = a[0]; i <= z[0]; ++i) {
                         if (reach2 > 0.0f) {
-                            const float x = bp->lo[0] + ((float)i + 0.5f) / bp->inv_cell[0];
-                            const float y = bp->lo[1] + ((float)j + 0.5f) / bp->inv_cell[1];
-                            const float zz = bp->lo[2] + ((float)k + 0.5f) / bp->inv_cell[2];
+                            const float x = centre[0][i];
                             const float ax = M[0] * x + M[3] * y + M[6] * zz + M[9] - C[0];
                             const float ay = M[1] * x + M[4] * y + M[7] * zz + M[10] - C[1];
                             const float az = M[2] * x + M[5] * y + M[8] * zz + M[11] - C[2];
@@ -1544,6 +1545,8 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
                         }
                         mask[((size_t)i + cells * ((size_t)j + (size_t)cells * k)) * words + b / 64] |= bit;
                     }
+                }
+            }
         }
         if (pass == 0) {
             if (!(lo[0] <= hi[0]) || !ak_finitef(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2])) return;
@@ -1551,6 +1554,7 @@ static void bp_build(const ak_skin_implicit* o, const ak_mat4* palette, const fl
             for (int q = 0; q < 3; ++q) {
                 float ext = fmaxf(hi[q] - lo[q], 1e-20f);
                 bp->lo[q] = lo[q], bp->inv_cell[q] = (float)cells / ext;
+                for (uint32_t i = 0; i < cells; ++i) centre[q][i] = bp->lo[q] + ((float)i + 0.5f) / bp->inv_cell[q];
             }
         }
     }
@@ -1699,44 +1703,79 @@ typedef struct run_ctx {
     const float* frame;  /* [pair_count * PAIR_FRAME] */
     const uint32_t* fold_start; /* [joint_count + 1]: per part, its folded joints (fold_lists_build) */
     const uint32_t* fold_pair;  /* [2 * pair_count] */
+    /* the lane kernel of the projections (NULL: project, one vertex at a time), its lanes and
+     * its per-frame data; set only with grids and at most 64 bones (one mask word per cell) */
+    unsigned (*lanes_fn)(const akp_implicit_field* fd, akp_implicit_lanes* l, unsigned live);
+    unsigned lanes;
+    akp_implicit_field lanes_fd;
     float unchecked_below; /* project's: FLT_MAX in the rounds before the last, UNCHECKED_EPS in
                               the first projection when rounds follow, else 0 */
 } run_ctx;
+
+/* One vertex's Newton march (project and the lane driver project_lanes share it): the point,
+ * where it started, the previous gradient, the steps taken and the state. */
+typedef struct march {
+    ak_vec3 x, start, gprev;
+    uint32_t it;
+    uint8_t st;
+} march;
+
+static void march_start(march* m, ak_vec3 p, bool first) {
+    m->x = m->start = p;
+    m->gprev = ak_vec3_zero();
+    m->it = 0;
+    m->st = first ? ST_KEEP : ST_MOVED;
+}
+
+/* One step of the march from the field F and its gradient g at m->x; true when the march ends
+ * (m->x is then its end, g the gradient to keep). A step taken where |F - iso| <
+ * unchecked_below is the last one. */
+static bool march_step(const run_ctx* c, float iso, march* m, float F, ak_vec3 g, float unchecked_below) {
+    const float e = iso - F;
+    if (fabsf(e) < ISO_EPS || m->it == c->iterations) return true;
+    const float gl2 = ak_vec3_length_sq(g);
+    if (!(gl2 > 1e-20f)) return true;
+    if (m->it > 0 && ak_vec3_dot(g, m->gprev) < STOP_COS * sqrtf(gl2 * ak_vec3_length_sq(m->gprev))) {
+        m->st = ST_STOPPED; /* gradient discontinuity: a contact surface */
+        return true;
+    }
+    ak_vec3 step = ak_vec3_scale(g, e / gl2);
+    const float sl = ak_vec3_length(step);
+    if (sl > c->o->step_cap) step = ak_vec3_scale(step, c->o->step_cap / sl);
+    m->x = ak_vec3_add(m->x, step);
+    m->gprev = g;
+    if (m->st == ST_KEEP) m->st = ST_MOVED;
+    if (fabsf(e) < unchecked_below) return true;
+    ++m->it;
+    return false;
+}
+
+/* The march's end into *p and *out_g (never NaN out: a non-finite end keeps the start); returns
+ * the state. */
+static uint8_t march_end(march* m, ak_vec3 g, ak_vec3* p, ak_vec3* out_g) {
+    if (!ak_vec3_is_finite(m->x) || !ak_vec3_is_finite(g)) {
+        m->x = m->start;
+        g = ak_vec3_zero();
+        m->st = ST_STOPPED;
+    }
+    *p = m->x;
+    *out_g = g;
+    return m->st;
+}
 
 /* Newton steps from *p towards the vertex's iso-value; returns the state. A step taken where
  * |F - iso| < unchecked_below is the last one and its end is not evaluated (out_g is then the
  * gradient where it started): used where a later relaxation round evaluates the point anyway
  * (0: every step is checked). */
 static uint8_t project(const run_ctx* c, float iso, ak_vec3* p, ak_vec3* out_g, bool first, float unchecked_below) {
-    ak_vec3 g, gprev = ak_vec3_zero();
-    ak_vec3 x = *p;
-    uint8_t st = first ? ST_KEEP : ST_MOVED;
-    for (uint32_t it = 0;; ++it) {
-        float F = field_eval(&c->fc, x, &g);
-        float e = iso - F;
-        if (fabsf(e) < ISO_EPS || it == c->iterations) break;
-        float gl2 = ak_vec3_length_sq(g);
-        if (!(gl2 > 1e-20f)) break;
-        if (it > 0 && ak_vec3_dot(g, gprev) < STOP_COS * sqrtf(gl2 * ak_vec3_length_sq(gprev))) {
-            st = ST_STOPPED; /* gradient discontinuity: a contact surface */
-            break;
-        }
-        ak_vec3 step = ak_vec3_scale(g, e / gl2);
-        float sl = ak_vec3_length(step);
-        if (sl > c->o->step_cap) step = ak_vec3_scale(step, c->o->step_cap / sl);
-        x = ak_vec3_add(x, step);
-        gprev = g;
-        if (st == ST_KEEP) st = ST_MOVED;
-        if (fabsf(e) < unchecked_below) break;
+    march m;
+    march_start(&m, *p, first);
+    ak_vec3 g;
+    for (;;) {
+        const float F = field_eval(&c->fc, m.x, &g);
+        if (march_step(c, iso, &m, F, g, unchecked_below)) break;
     }
-    if (!ak_vec3_is_finite(x) || !ak_vec3_is_finite(g)) { /* never NaN out: keep the start */
-        x = *p;
-        g = ak_vec3_zero();
-        st = ST_STOPPED;
-    }
-    *p = x;
-    *out_g = g;
-    return st;
+    return march_end(&m, g, p, out_g);
 }
 
 /* The contact planes of the joints (the paper's contact surface f_i = f_j, which for two parts
@@ -2000,6 +2039,52 @@ static bool near_fold(const run_ctx* c, size_t v) {
     return false;
 }
 
+/* Phases 0 (first projection) and 2 (re-projection) of run_worker over list[begin, end) with the
+ * lane kernel: c->lanes vertices march at once, each lane taking the next vertex of the list as
+ * soon as its own march ends. The kernel takes the steps march_step takes, with the bits of
+ * field_eval, and march_end finishes each march, so the results are the scalar path's bits. */
+static void project_lanes(const run_ctx* c, const uint32_t* list, size_t begin, size_t end, int phase) {
+    const ak_skin_implicit* o = c->o;
+    akp_implicit_lanes L;
+    ak_vec3 start[16];
+    uint32_t vert[16];
+    const unsigned W = c->lanes;
+    akp_implicit_field fd = c->lanes_fd;
+    fd.unchecked_below = c->unchecked_below;
+    unsigned live = 0;
+    size_t i = begin;
+    memset(&L, 0, sizeof L);
+    for (;;) {
+        for (unsigned l = 0; l < W; ++l) {
+            if (live >> l & 1u) continue;
+            while (i < end) {
+                const size_t v = list ? list[i] : i;
+                ++i;
+                if (o->rep[v] != v || !projectable(o->iso[v])) continue;
+                if (phase == 0 ? rigid_alone(c, v) : c->state[v] == ST_KEEP) continue;
+                const ak_vec3 x = c->pos[v];
+                vert[l] = (uint32_t)v, start[l] = x;
+                L.x[l] = x.x, L.y[l] = x.y, L.z[l] = x.z, L.iso[l] = o->iso[v];
+                L.px[l] = L.py[l] = L.pz[l] = 0.0f, L.it[l] = 0.0f;
+                L.st[l] = phase == 0 ? (float)ST_KEEP : (float)ST_MOVED;
+                live |= 1u << l;
+                break;
+            }
+        }
+        if (!live) break;
+        const unsigned ended = c->lanes_fn(&fd, &L, live);
+        for (unsigned bits = ended; bits; bits &= bits - 1) {
+            const unsigned l = (unsigned)ctz64(bits);
+            const uint32_t v = vert[l];
+            march m = {ak_vec3_make(L.x[l], L.y[l], L.z[l]), start[l], ak_vec3_zero(), 0, (uint8_t)L.st[l]};
+            const uint8_t st = march_end(&m, ak_vec3_make(L.gx[l], L.gy[l], L.gz[l]), &c->pos[v], &c->grad[v]);
+            if (phase == 0) c->state[v] = st;
+            else if (st == ST_STOPPED) c->state[v] = ST_STOPPED;
+            live &= ~(1u << l);
+        }
+    }
+}
+
 typedef struct run_task {
     run_ctx* c;
     const uint32_t* list; /* the vertices to visit, or NULL: all */
@@ -2011,6 +2096,10 @@ static void* run_worker(void* arg) {
     run_task* t = (run_task*)arg;
     run_ctx* c = t->c;
     const ak_skin_implicit* o = c->o;
+    if (c->lanes_fn && (t->phase == 0 || t->phase == 2)) {
+        project_lanes(c, t->list, t->begin, t->end, t->phase);
+        return NULL;
+    }
     for (size_t i = t->begin; i < t->end; ++i) {
         const size_t v = t->list ? t->list[i] : i;
         if (o->rep[v] != v || !projectable(o->iso[v])) continue;
@@ -2077,7 +2166,7 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     if (!job || !job->implicit || !job->palette.ptr || !job->out_positions.ptr || !job->scratch.ptr)
         return AK_ERR_NULL_ARG;
     const ak_skin_implicit* o = job->implicit;
-    if (job->thread_count > 64) return AK_ERR_BAD_ARG;
+    if (job->thread_count > 64 || (unsigned)job->simd_limit >= AK_SKIN_SIMD_COUNT) return AK_ERR_BAD_ARG;
     const size_t nv = o->vertex_count;
     if (job->palette.count < o->joint_count || job->out_positions.count < nv ||
         (job->out_normals.ptr && job->out_normals.count < nv) || (job->normals.ptr && job->normals.count < nv) ||
@@ -2149,6 +2238,14 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
     broad_phase bp;
     if (o->grid_nodes) cull_build(o, cull);
     if (o->grid_nodes) bp_build(o, job->palette.ptr, inv, cull, mask, &bp);
+    /* the lane kernel this CPU has, up to the job's simd_limit (with grids and at most 64 bones) */
+    unsigned (*lanes_fn)(const akp_implicit_field*, akp_implicit_lanes*, unsigned) = NULL;
+    unsigned lanes = 0;
+    if (o->grid_nodes && bp.words == 1 && (job->iterations == 0 || job->iterations <= (1u << 20))) {
+        const ak_skin_simd level = job->simd_limit == AK_SKIN_SIMD_DEFAULT ? AK_SKIN_SIMD_AVX512 : job->simd_limit;
+        if (level >= AK_SKIN_SIMD_AVX512 && akp_skin_have_avx512()) lanes_fn = akp_implicit_march_avx512, lanes = 16;
+        else if (level >= AK_SKIN_SIMD_AVX2 && akp_skin_have_avx2()) lanes_fn = akp_implicit_march_avx2, lanes = 8;
+    }
     if (o->grid_nodes) {
         bone_frames_build(o, inv, cull, bf);
         const size_t ncell = (size_t)bp.cells * bp.cells * bp.cells;
@@ -2156,9 +2253,16 @@ ak_result ak_skin_implicit_run(const ak_skin_implicit_job* job) {
         uint32_t* table = (uint32_t*)(void*)(groups + align64(2 * ncell * sizeof(uint32_t)));
         float* group = (float*)(void*)(groups + 2 * align64(2 * ncell * sizeof(uint32_t)));
         uint32_t* group_bone = (uint32_t*)(void*)((unsigned char*)group + align64((size_t)GROUP_CAP * GROUP_FLOATS * sizeof(float)));
-        groups_build(bf, &bp, cell_group, table, group, group_bone);
+        if (lanes_fn) bp.cell_group = NULL, bp.group = NULL, bp.group_bone = NULL; /* no field_eval */
+        else groups_build(bf, &bp, cell_group, table, group, group_bone);
     }
-    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, fold_start, fold_pair, 0.0f};
+    run_ctx c = {o, {o, inv, o->bulge, o->grid_nodes ? &bp : NULL, o->grid_nodes ? bf : NULL}, job->iterations ? job->iterations : 10, pos, prev, grad, state, dqpos, frame, fold_start, fold_pair, NULL, 0, {0}, 0.0f};
+    if (lanes_fn) {
+        c.lanes_fn = lanes_fn, c.lanes = lanes;
+        c.lanes_fd = (akp_implicit_field){o->grid, o->grid_info, bf, inv, BF_FLOATS, o->bulge,
+            {bp.lo[0], bp.lo[1], bp.lo[2]}, {bp.inv_cell[0], bp.inv_cell[1], bp.inv_cell[2]}, bp.cells,
+            bp.empty ? NULL : bp.mask, (float)c.iterations, ISO_EPS, STOP_COS, o->step_cap, 0.0f};
+    }
     memcpy(dqpos, pos, nv * sizeof(ak_vec3));
     /* the projectable representatives grouped by part (counting sort, index order within a
      * part), so that consecutive projections read the same grids (each vertex's projection

@@ -107,4 +107,56 @@ static inline float akp_get_f32(const unsigned char* p) {
     return f;
 }
 
+/* Implicit skinning's Newton march (implicit.c's project) for up to 16 vertices at once: the
+ * kernels (implicit_avx2.c, 8 lanes; implicit_avx512.c, 16 lanes) find each point's broad-phase
+ * cell, evaluate the field there (per bone: its grid, nodes of 4 floats, distance and gradient;
+ * grid_info nx ny nz first node; its per-frame record of bf_floats floats, implicit.c's
+ * bone_frames_build; its inverse palette matrix, 12 floats) and take one Newton step. A kernel
+ * does per lane the scalar code's operations in the same order (no fused multiply-add), so the
+ * results are bitwise the scalar path's. */
+typedef struct akp_implicit_field {
+    const float* grid;
+    const uint32_t* grid_info;
+    const float* bf;
+    const float* inv;
+    uint32_t bf_floats;
+    float bulge;
+    /* the broad phase: box corner, cells per unit, cells per axis, one mask word per cell
+     * (NULL: empty, the field is 0 everywhere) */
+    float bp_lo[3], bp_inv_cell[3];
+    uint32_t bp_cells;
+    const uint64_t* bp_mask;
+    /* the march: steps at most, |F - iso| that ends it, the cosine of the gradient turn that
+     * stops it, the longest step, |F - iso| below which a step is the last */
+    float iterations, iso_eps, stop_cos, step_cap, unchecked_below;
+} akp_implicit_field;
+
+/* The lanes of one call, each a march in progress: its point (x, y, z), iso-value, previous
+ * gradient (px, py, pz), steps taken (it) and state (st: implicit.c's ST_KEEP, ST_MOVED,
+ * ST_STOPPED), all floats; the kernel leaves the gradient at the point's last evaluation in
+ * (gx, gy, gz), and cell, mask and f as scratch. */
+typedef struct akp_implicit_lanes {
+    _Alignas(64) float x[16];
+    _Alignas(64) float y[16];
+    _Alignas(64) float z[16];
+    _Alignas(64) float iso[16];
+    _Alignas(64) float px[16];
+    _Alignas(64) float py[16];
+    _Alignas(64) float pz[16];
+    _Alignas(64) float it[16];
+    _Alignas(64) float st[16];
+    _Alignas(64) float f[16];
+    _Alignas(64) float gx[16];
+    _Alignas(64) float gy[16];
+    _Alignas(64) float gz[16];
+    _Alignas(64) int32_t cell[16];
+    uint64_t mask[16];
+} akp_implicit_lanes;
+
+/* One evaluation and Newton step of the live lanes (bit l: lane l) of l, 16 (AVX-512) or 8
+ * (AVX2); returns the lanes whose march ended (implicit.c's march_step returned true). 0 where
+ * this build has no such kernel: callers check akp_skin_have_avx512 / akp_skin_have_avx2. */
+unsigned akp_implicit_march_avx512(const akp_implicit_field* fd, akp_implicit_lanes* l, unsigned live);
+unsigned akp_implicit_march_avx2(const akp_implicit_field* fd, akp_implicit_lanes* l, unsigned live);
+
 #endif
