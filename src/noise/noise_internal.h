@@ -163,11 +163,15 @@ bool akp_noise_simd_handles(const ak_fractal_desc* d, uint32_t dims);
 /* CPU checks (false in builds without the kernels). */
 bool akp_noise_have_avx2(void);
 bool akp_noise_have_avx512(void);
+bool akp_noise_have_avx512vbmi(void); /* AVX-512 F, DQ, BW and VBMI */
 /* count % 8 == 0 (AVX2) or % 16 == 0 (AVX-512). xs[d] (d < dims) coordinates; grad[d] may all
  * be NULL (no gradient). */
 void akp_noise_fractal_avx2(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
                             size_t count, float* out, float* const* grad);
 void akp_noise_fractal_avx512(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
                               size_t count, float* out, float* const* grad);
+/* The same kernel with byte-permute lookups, for CPUs with akp_noise_have_avx512vbmi; the same bits. */
+void akp_noise_fractal_avx512vbmi(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims,
+                                  const float* const* xs, size_t count, float* out, float* const* grad);
 
 #endif

@@ -65,6 +65,7 @@ KI static inline VF corner_perlin(int dims, VI h, const VF* d, VF* g, bool want_
  * chain with the upper corner at index + 1 unwrapped (p[A + 1] in his code: the doubled table
  * makes it equal to the wrapped index): one 32-bit gather at perm + i reads perm[i] and
  * perm[i + 1] together, so 3D takes 1 + 2 + 4 gathers instead of 14. */
+#if !defined(AKP_HAVE_CELL_HASHES) /* the vocabulary may bring its own (batch_avx512.c with VBMI) */
 KI static inline void cell_hashes(const PermTab* perm, int dims, const VI* lo, VI* hash) {
     const VI m8 = vi_set1(255);
     {
@@ -83,6 +84,7 @@ KI static inline void cell_hashes(const PermTab* perm, int dims, const VI* lo, V
         }
     }
 }
+#endif
 
 KI static inline VM in_range(int dims, const VF* p) {
     const VF limit = vf_set1(AKP_NOISE_LIMIT);
