@@ -378,18 +378,19 @@ AK_TEST(fractal_gradient_matches_differences) {
     }
 }
 
-/* Both AVX-512 kernels, called directly (the job picks only one: the byte-permute build where
- * the CPU has VBMI), against the scalar reference point by point: the same bits of values and
- * gradients for every basis, 2D and 3D, every fractal type, with out-of-range and lattice
- * points among them. Skipped (passing) on CPUs without AVX-512. */
-AK_TEST(avx512_kernels_equal_scalar) {
+/* Every SIMD kernel build the CPU can run, called directly (a job picks one build per path: AVX2
+ * with scalar loads or gathers, AVX-512 with or without VBMI byte permutes), against the scalar
+ * reference point by point: the same bits of values and gradients for every basis, 2D and 3D,
+ * every fractal type, with out-of-range and lattice points among them. */
+AK_TEST(simd_kernels_equal_scalar) {
     typedef void (*kernel_fn)(const ak_noise*, const ak_fractal_desc*, uint32_t, const float* const*, size_t, float*,
                               float* const*);
-    kernel_fn kernels[2];
+    kernel_fn kernels[4];
     int nk = 0;
+    if (akp_noise_have_avx2()) kernels[nk++] = akp_noise_fractal_avx2, kernels[nk++] = akp_noise_fractal_avx2gather;
     if (akp_noise_have_avx512()) kernels[nk++] = akp_noise_fractal_avx512;
     if (akp_noise_have_avx512vbmi()) kernels[nk++] = akp_noise_fractal_avx512vbmi;
-    printf("  AVX-512 kernels compared: %d\n", nk);
+    printf("  SIMD kernel builds compared: %d\n", nk);
     ak_noise n = ak_noise_make(23);
     enum { N = 512 };
     static float x[N], y[N], z[N], v[N], g[3][N];
@@ -1191,7 +1192,7 @@ int main(void) {
     AK_RUN(fractal_octaves_scale_by_gain);
     AK_RUN(fractal_gradient_matches_differences);
     AK_RUN(batch_simd_equals_scalar);
-    AK_RUN(avx512_kernels_equal_scalar);
+    AK_RUN(simd_kernels_equal_scalar);
     AK_RUN(per_point_matches_job_signed_zero);
     AK_RUN(batch_value_worley_edges);
     AK_RUN(grid_job_equals_points);

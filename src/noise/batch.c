@@ -41,7 +41,7 @@ typedef struct eval_ctx {
     ak_fractal_desc desc; /* resolved */
     uint32_t dims;
     int path; /* PATH_* */
-    bool vbmi; /* PATH_AVX512 through akp_noise_fractal_avx512vbmi */
+    bool alt; /* the other build of the path: PATH_AVX512 with VBMI, PATH_AVX2 with gathers */
 } eval_ctx;
 
 /* Evaluate count (<= CHUNK) points: xs[k][i] coordinates, out[i], grad[k][i] (grad NULL -> none). */
@@ -50,9 +50,9 @@ static void eval_chunk(const eval_ctx* c, const float* const* xs, size_t count, 
     if (c->path != PATH_SCALAR) {
         const size_t w = c->path == PATH_AVX512 ? 16u : 8u;
         void (*kernel)(const ak_noise*, const ak_fractal_desc*, uint32_t, const float* const*, size_t, float*,
-                       float* const*) = c->path == PATH_AVX2 ? akp_noise_fractal_avx2
-                                        : c->vbmi            ? akp_noise_fractal_avx512vbmi
-                                                             : akp_noise_fractal_avx512;
+                       float* const*) = c->path == PATH_AVX2 ? (c->alt ? akp_noise_fractal_avx2gather : akp_noise_fractal_avx2)
+                                        : c->alt ? akp_noise_fractal_avx512vbmi
+                                                 : akp_noise_fractal_avx512;
         const size_t whole = count / w * w;
         if (whole) kernel(c->noise, &c->desc, dims, xs, whole, out, grad);
         const size_t done = whole;
@@ -163,7 +163,7 @@ ak_result ak_noise_job_run(const ak_noise_job* job) {
     if (r != AK_OK) return r;
     eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), job_dims(job), PATH_SCALAR, false};
     ctx.path = pick_path(&ctx.desc, ctx.dims, job->skip_simd, job->simd_limit);
-    ctx.vbmi = ctx.path == PATH_AVX512 && akp_noise_have_avx512vbmi();
+    ctx.alt = ctx.path == PATH_AVX512 ? akp_noise_have_avx512vbmi() : ctx.path == PATH_AVX2 && akp_noise_avx2_gather_preferred();
     const size_t n = job->out_values.count;
     uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
     if (threads > n / CHUNK + 1) threads = (uint32_t)(n / CHUNK + 1);
@@ -226,7 +226,7 @@ ak_result ak_noise_grid_job_run(const ak_noise_grid_job* job) {
     if (r != AK_OK) return r;
     eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), 2, PATH_SCALAR, false};
     ctx.path = pick_path(&ctx.desc, 2, job->skip_simd, job->simd_limit);
-    ctx.vbmi = ctx.path == PATH_AVX512 && akp_noise_have_avx512vbmi();
+    ctx.alt = ctx.path == PATH_AVX512 ? akp_noise_have_avx512vbmi() : ctx.path == PATH_AVX2 && akp_noise_avx2_gather_preferred();
     const size_t rows = job->height;
     uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
     if (threads > rows) threads = (uint32_t)rows;

@@ -11,11 +11,21 @@
 #include <math.h>
 #include <string.h>
 
-bool akp_noise_have_avx2(void) { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
-
 #define KI __attribute__((target("avx2,fma"), always_inline))
 #define KERNEL_RUN __attribute__((target("avx2,fma")))
+#if defined(AKP_NOISE_AVX2_GATHER)
+/* batch_avx2_gather.c: this file again, the lookups as vpgatherdd, entry akp_noise_fractal_avx2gather. */
+#define KERNEL_ENTRY akp_noise_fractal_avx2gather
+bool akp_noise_avx2_gather_preferred(void) {
+    /* Intel CPUs with the gather data sampling mitigation run vpgatherdd in microcode, slower than
+     * the scalar loads; AMD's Zen 5 runs the gather kernel 5-10% faster (docs/noise.md). Zen 4
+     * and later (the AMD CPUs with AVX-512) take it; older AMD and every other CPU the loads. */
+    return __builtin_cpu_is("amd") && __builtin_cpu_supports("avx512f");
+}
+#else
 #define KERNEL_ENTRY akp_noise_fractal_avx2
+bool akp_noise_have_avx2(void) { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+#endif
 #define AKP_W 8
 typedef __m256 VF;
 typedef __m256i VI;
@@ -96,6 +106,14 @@ KI static inline VF vf_lut16(const float* tab, VI idx) {
 }
 
 #include "simd_body.h"
+
+#elif defined(AKP_NOISE_AVX2_GATHER)
+
+bool akp_noise_avx2_gather_preferred(void) { return false; }
+void akp_noise_fractal_avx2gather(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims,
+                                  const float* const* xs, size_t count, float* out, float* const* grad) {
+    (void)noise, (void)d, (void)dims, (void)xs, (void)count, (void)out, (void)grad;
+}
 
 #else
 
