@@ -18,7 +18,7 @@
 #define KERNEL_ENTRY akp_noise_fractal_avx2gather
 bool akp_noise_avx2_gather_preferred(void) {
     /* Intel CPUs with the gather data sampling mitigation run vpgatherdd in microcode, slower than
-     * the scalar loads; AMD's Zen 5 runs the gather kernel 5-10% faster (docs/noise.md). Zen 4
+     * the scalar loads; AMD's Zen 5 runs the gather kernel 5-10% faster (issue 32). Zen 4
      * and later (the AMD CPUs with AVX-512) take it; older AMD and every other CPU the loads. */
     return __builtin_cpu_is("amd") && __builtin_cpu_supports("avx512f");
 }
@@ -88,6 +88,9 @@ KI static inline VM m_gt(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
 KI static inline VM m_ge(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
 KI static inline VM mi_lt(VI a, int v) { return _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(v), a)); }
 KI static inline VM mi_eq(VI a, int v) { return _mm256_castsi256_ps(_mm256_cmpeq_epi32(a, _mm256_set1_epi32(v))); }
+KI static inline VM mi_none(VI a, int bits) { /* (a & bits) == 0 */
+    return _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(a, _mm256_set1_epi32(bits)), _mm256_setzero_si256()));
+}
 KI static inline VM m_and(VM a, VM b) { return _mm256_and_ps(a, b); }
 KI static inline VM m_or(VM a, VM b) { return _mm256_or_ps(a, b); }
 KI static inline VM m_andn(VM a, VM b) { return _mm256_andnot_ps(a, b); } /* !a & b */

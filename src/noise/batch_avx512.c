@@ -140,6 +140,8 @@ KI static inline VM m_gt(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_O
 KI static inline VM m_ge(VF a, VF b) { return _mm512_cmp_ps_mask(a, b, _CMP_GE_OQ); }
 KI static inline VM mi_lt(VI a, int v) { return _mm512_cmplt_epi32_mask(a, _mm512_set1_epi32(v)); }
 KI static inline VM mi_eq(VI a, int v) { return _mm512_cmpeq_epi32_mask(a, _mm512_set1_epi32(v)); }
+/* (a & bits) == 0 */
+KI static inline VM mi_none(VI a, int bits) { return _mm512_testn_epi32_mask(a, _mm512_set1_epi32(bits)); }
 KI static inline VM m_and(VM a, VM b) { return (VM)(a & b); }
 KI static inline VM m_or(VM a, VM b) { return (VM)(a | b); }
 KI static inline VM m_andn(VM a, VM b) { return (VM)(~a & b); } /* !a & b */

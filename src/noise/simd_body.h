@@ -30,7 +30,7 @@
 /* Corner value (and gradient vector) for hash h and offsets d (dims 2 or 3). */
 KI static inline VF corner_perlin(int dims, VI h, const VF* d, VF* g, bool want_grad) {
     const VF one = vf_set1(1.0f);
-    const VF su = vf_cast(VI_SLLI(vi_and(h, vi_set1(1)), 31));
+    const VF su = vf_cast(VI_SLLI(h, 31)); /* bit 0 of h as the sign */
     const VF sv = vf_cast(VI_SLLI(vi_and(h, vi_set1(2)), 30));
     if (dims == 2) {
         h = vi_and(h, vi_set1(7));
@@ -46,9 +46,9 @@ KI static inline VF corner_perlin(int dims, VI h, const VF* d, VF* g, bool want_
         }
         return vf_add(vf_xor(u, su), vf_xor(v, sv));
     }
-    h = vi_and(h, vi_set1(15));
-    const VM u_is_x = mi_lt(h, 8), v_is_y = mi_lt(h, 4);
-    const VM v_is_x = m_andn(v_is_y, m_or(mi_eq(h, 12), mi_eq(h, 14)));
+    /* over h & 15: u_is_x h < 8, v_is_y h < 4, v_is_x h in {12, 14} (h & 13 == 12), as bit tests */
+    const VM u_is_x = mi_none(h, 8), v_is_y = mi_none(h, 12);
+    const VM v_is_x = mi_eq(vi_and(h, vi_set1(13)), 12);
     const VF u = vf_sel(u_is_x, d[0], d[1]);
     const VF v = vf_sel(v_is_y, d[1], vf_sel(v_is_x, d[0], d[2]));
     if (want_grad) {
