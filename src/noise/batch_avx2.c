@@ -101,7 +101,7 @@ KI static inline VI vi_sel(VM m, VI a, VI b) {
 }
 KI static inline VF vf_maskz(VM m, VF a) { return _mm256_and_ps(m, a); } /* m ? a : +0 */
 KI static inline unsigned m_bits(VM m) { return (unsigned)_mm256_movemask_ps(m); } /* bit i: lane i */
-/* tab[idx] for idx in 0..15 */
+/* tab[idx & 15] (bits above 3 are not read) */
 KI static inline VF vf_lut16(const float* tab, VI idx) {
     const VF lo = _mm256_permutevar8x32_ps(_mm256_loadu_ps(tab), idx);
     const VF hi = _mm256_permutevar8x32_ps(_mm256_loadu_ps(tab + 8), idx);

@@ -150,7 +150,7 @@ KI static inline VF vf_sel(VM m, VF a, VF b) { return _mm512_mask_blend_ps(m, b,
 KI static inline VI vi_sel(VM m, VI a, VI b) { return _mm512_mask_blend_epi32(m, b, a); }
 KI static inline VF vf_maskz(VM m, VF a) { return _mm512_maskz_mov_ps(m, a); } /* m ? a : +0 */
 KI static inline unsigned m_bits(VM m) { return (unsigned)m; } /* bit i: lane i */
-/* tab[idx] for idx in 0..15 */
+/* tab[idx & 15] (vpermps reads bits 0..3) */
 KI static inline VF vf_lut16(const float* tab, VI idx) { return _mm512_permutexvar_ps(idx, _mm512_loadu_ps(tab)); }
 
 #include "simd_body.h"

@@ -218,8 +218,8 @@ KI static inline VF simplex2_v(const PermTab* perm, const VF* p, VF* grad, bool 
     VF sum = vf_zero(), G[2] = {vf_zero(), vf_zero()};
     AKP_UNROLL
     for (int c = 0; c < 3; ++c) {
-        const VI hi = vi_and(h[c], vi_set1(7));
-        const VF g[2] = {vf_lut16(simplex_g2x, hi), vf_lut16(simplex_g2y, hi)};
+        /* vf_lut16 reads bits 0..3 of the index; entries 8..15 repeat 0..7: h & 7 needs no mask */
+        const VF g[2] = {vf_lut16(simplex_g2x, h[c]), vf_lut16(simplex_g2y, h[c])};
         sum = vf_add(sum, corner_simplex(2, d[c], g, G, want_grad));
     }
     const VF scale = vf_set1(70.0f);
@@ -260,8 +260,7 @@ KI static inline VF simplex3_v(const PermTab* perm, const VF* p, VF* grad, bool 
         const VF k = vf_set1((float)c * G3);
         const VF d[3] = {vf_add(vf_sub(x0, off[c][0]), k), vf_add(vf_sub(y0, off[c][1]), k),
                          vf_add(vf_sub(z0, off[c][2]), k)};
-        const VI hi = vi_and(h[c], vi_set1(15));
-        const VF g[3] = {vf_lut16(simplex_g3x, hi), vf_lut16(simplex_g3y, hi), vf_lut16(simplex_g3z, hi)};
+        const VF g[3] = {vf_lut16(simplex_g3x, h[c]), vf_lut16(simplex_g3y, h[c]), vf_lut16(simplex_g3z, h[c])};
         sum = vf_add(sum, corner_simplex(3, d, g, G, want_grad));
     }
     const VF scale = vf_set1(76.0f);
