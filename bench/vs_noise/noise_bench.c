@@ -21,7 +21,7 @@ const char* fn2_simd_name(int kind, int simd);
 ak_result old_ak_noise_job_run(const ak_noise_job* job);
 #endif
 
-enum { N = 1 << 20, MAXV = 96, MAXR = 64 };
+enum { N = 1 << 20, MAXV = 128, MAXR = 64 };
 static float *X, *Y, *Z, *X2, *Y2;
 static ak_noise AKN;
 
