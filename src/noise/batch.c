@@ -1,5 +1,7 @@
 /* Batch and grid evaluation: validation, thread fan-out, and the choice between the AVX-512
- * and AVX2 kernels and the scalar reference. Points go through in chunks of CHUNK: the grid
+ * and AVX2 kernels and the scalar reference (and, within a path, between its two builds:
+ * AVX-512 with VBMI byte permutes where the CPU has them; AVX2 with gathers where
+ * akp_noise_avx2_gather_preferred says so). Points go through in chunks of CHUNK: the grid
  * job makes the chunk's coordinates on the stack, the kernel gets whole blocks of 16 (AVX-512)
  * or 8 (AVX2); a short tail is padded into one block, so it also runs the kernel and gives the
  * same bits. */

@@ -16,9 +16,11 @@
  *
  * Permutation lookups go through tab_pair(T, i), which gives perm[i] in the low byte and
  * perm[i + 1] (the upper corner's hash) in the next one, for 0 <= i <= 511 (the table is
- * doubled, so that is a function of i & 255): AVX2 gathers 32 bits at perm + i, AVX-512 looks
- * i & 255 up in a 256-entry table held in registers (PermTab, made once per call by
- * tab_make). Never installed. */
+ * doubled, so that is a function of i & 255): AVX2 gathers 32 bits at perm + i (or loads them
+ * one lane at a time), AVX-512 looks i & 255 up in a 256-entry table held in registers
+ * (PermTab, made once per call by tab_make). With VBMI, batch_avx512.c brings its own
+ * cell_hashes (AKP_HAVE_CELL_HASHES): byte lookups, four corner hashes of a lane at once.
+ * Never installed. */
 
 /* Small fixed loops (dimensions, corners) are unrolled so that per-corner vectors stay in
  * registers. */
