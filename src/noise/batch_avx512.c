@@ -72,10 +72,15 @@ KI static inline VI tab_bytes(const PermTab* t, VI b) {
     const VI hi = _mm512_permutex2var_epi8(t->t[2], b, t->t[3]);
     return _mm512_mask_blend_epi8(_mm512_movepi8_mask(b), lo, hi);
 }
-/* In-lane byte shuffle of dword j's bytes (b0, b1, b2, b3 of dword j, 0..3) into its bytes 0..3. */
+/* In-lane byte shuffle of dword j's bytes (b0, b1, b2, b3 of dword j, 0..3; -1: a zero byte)
+ * into its bytes 0..3. */
 KI static inline VI dword_bytes(VI v, int b0, int b1, int b2, int b3) {
+    const int b[4] = {b0, b1, b2, b3};
     int d[4];
-    for (int j = 0; j < 4; ++j) d[j] = (4 * j + b0) | (4 * j + b1) << 8 | (4 * j + b2) << 16 | (4 * j + b3) << 24;
+    for (int j = 0; j < 4; ++j) {
+        d[j] = 0;
+        for (int k = 0; k < 4; ++k) d[j] |= (b[k] < 0 ? 0x80 : 4 * j + b[k]) << (8 * k);
+    }
     return _mm512_shuffle_epi8(v, _mm512_broadcast_i32x4(_mm_setr_epi32(d[0], d[1], d[2], d[3])));
 }
 /* simd_body.h's cell_hashes over bytes: the same chain (perm[h + lo] and perm[h + lo + 1], the
@@ -88,10 +93,11 @@ KI static inline void cell_hashes(const PermTab* perm, int dims, const VI* lo, V
     const VI g1 = tab_bytes(perm, x); /* perm[x], perm[x + 1], again */
     const VI y = _mm512_add_epi8(dword_bytes(lo[1], 0, 0, 0, 0), inc);
     const VI g2 = tab_bytes(perm, _mm512_add_epi8(dword_bytes(g1, 0, 0, 1, 1), y)); /* corners 0, 2, 1, 3 */
+    /* byte k of each lane zero-extended: one shuffle a corner */
     if (dims == 2) {
         hash[0] = _mm512_and_si512(g2, m8);
-        hash[2] = _mm512_and_si512(_mm512_srli_epi32(g2, 8), m8);
-        hash[1] = _mm512_and_si512(_mm512_srli_epi32(g2, 16), m8);
+        hash[2] = dword_bytes(g2, 1, -1, -1, -1);
+        hash[1] = dword_bytes(g2, 2, -1, -1, -1);
         hash[3] = _mm512_srli_epi32(g2, 24);
         return;
     }
@@ -99,12 +105,12 @@ KI static inline void cell_hashes(const PermTab* perm, int dims, const VI* lo, V
     const VI p = tab_bytes(perm, _mm512_add_epi8(dword_bytes(g2, 0, 0, 1, 1), z)); /* corners 0, 4, 2, 6 */
     const VI q = tab_bytes(perm, _mm512_add_epi8(dword_bytes(g2, 2, 2, 3, 3), z)); /* corners 1, 5, 3, 7 */
     hash[0] = _mm512_and_si512(p, m8);
-    hash[4] = _mm512_and_si512(_mm512_srli_epi32(p, 8), m8);
-    hash[2] = _mm512_and_si512(_mm512_srli_epi32(p, 16), m8);
+    hash[4] = dword_bytes(p, 1, -1, -1, -1);
+    hash[2] = dword_bytes(p, 2, -1, -1, -1);
     hash[6] = _mm512_srli_epi32(p, 24);
     hash[1] = _mm512_and_si512(q, m8);
-    hash[5] = _mm512_and_si512(_mm512_srli_epi32(q, 8), m8);
-    hash[3] = _mm512_and_si512(_mm512_srli_epi32(q, 16), m8);
+    hash[5] = dword_bytes(q, 1, -1, -1, -1);
+    hash[3] = dword_bytes(q, 2, -1, -1, -1);
     hash[7] = _mm512_srli_epi32(q, 24);
 }
 #else
