@@ -76,12 +76,13 @@ KI static inline VI tab_bytes(const PermTab* t, VI b) {
  * into its bytes 0..3. */
 KI static inline VI dword_bytes(VI v, int b0, int b1, int b2, int b3) {
     const int b[4] = {b0, b1, b2, b3};
-    int d[4];
+    uint32_t d[4];
     for (int j = 0; j < 4; ++j) {
         d[j] = 0;
-        for (int k = 0; k < 4; ++k) d[j] |= (b[k] < 0 ? 0x80 : 4 * j + b[k]) << (8 * k);
+        for (int k = 0; k < 4; ++k) d[j] |= (uint32_t)(b[k] < 0 ? 0x80 : 4 * j + b[k]) << (8 * k);
     }
-    return _mm512_shuffle_epi8(v, _mm512_broadcast_i32x4(_mm_setr_epi32(d[0], d[1], d[2], d[3])));
+    return _mm512_shuffle_epi8(
+        v, _mm512_broadcast_i32x4(_mm_setr_epi32((int)d[0], (int)d[1], (int)d[2], (int)d[3])));
 }
 /* simd_body.h's cell_hashes over bytes: the same chain (perm[h + lo] and perm[h + lo + 1], the
  * doubled table making them perm[(h + lo) & 255] and perm[(h + lo + 1) & 255], which byte
