@@ -378,6 +378,59 @@ AK_TEST(fractal_gradient_matches_differences) {
     }
 }
 
+/* Every SIMD kernel build the CPU can run, called directly (a job picks one build per path: AVX2
+ * with scalar loads or gathers, AVX-512 with or without VBMI byte permutes), against the scalar
+ * reference point by point: the same bits of values and gradients for every basis, 2D and 3D,
+ * every fractal type, with out-of-range and lattice points among them. */
+AK_TEST(simd_kernels_equal_scalar) {
+    typedef void (*kernel_fn)(const ak_noise*, const ak_fractal_desc*, uint32_t, const float* const*, size_t, float*,
+                              float* const*);
+    kernel_fn kernels[4];
+    int nk = 0;
+    if (akp_noise_have_avx2()) kernels[nk++] = akp_noise_fractal_avx2, kernels[nk++] = akp_noise_fractal_avx2gather;
+    if (akp_noise_have_avx512()) kernels[nk++] = akp_noise_fractal_avx512;
+    if (akp_noise_have_avx512vbmi()) kernels[nk++] = akp_noise_fractal_avx512vbmi;
+    printf("  SIMD kernel builds compared: %d\n", nk);
+    ak_noise n = ak_noise_make(23);
+    enum { N = 512 };
+    static float x[N], y[N], z[N], v[N], g[3][N];
+    ak_rng rng = ak_rng_make(5);
+    for (int i = 0; i < N; ++i) {
+        x[i] = frand(&rng, -600, 600);
+        y[i] = frand(&rng, -300, 300);
+        z[i] = frand(&rng, -40, 40);
+    }
+    x[3] = NAN, y[4] = 3e7f, z[5] = -INFINITY;
+    x[6] = 255.0f, y[6] = 256.0f, z[6] = -1.0f;
+    x[7] = -0.0f, y[7] = 511.5f, z[7] = 1e-30f;
+    const ak_fractal_type types[] = {AK_FRACTAL_FBM, AK_FRACTAL_TURBULENCE, AK_FRACTAL_RIDGED};
+    const ak_noise_basis bases[] = {AK_NOISE_BASIS_PERLIN, AK_NOISE_BASIS_SIMPLEX, AK_NOISE_BASIS_VALUE,
+                                    AK_NOISE_BASIS_WORLEY};
+    int bad = 0;
+    for (int k = 0; k < nk; ++k)
+        for (int bi = 0; bi < 4; ++bi)
+            for (uint32_t dims = 2; dims <= 3; ++dims)
+                for (int t = 0; t < 3; ++t) {
+                    const ak_fractal_desc raw = {.type = types[t], .basis = bases[bi], .octaves = 4, .gain = 0.5f,
+                                                 .lacunarity = 1.97f, .frequency = 0.9f};
+                    const ak_fractal_desc fd = ak_fractal_desc_resolved(&raw);
+                    const float* xs[4] = {x, y, z, NULL};
+                    float* gs[4] = {g[0], g[1], g[2], NULL};
+                    kernels[k](&n, &fd, dims, xs, N, v, gs);
+                    for (int i = 0; i < N; ++i) {
+                        const float p[3] = {x[i], y[i], z[i]};
+                        float e[3];
+                        const float want = akp_fractal_point(&n, &fd, dims, p, e);
+                        int differ = memcmp(&want, &v[i], sizeof want) != 0;
+                        for (uint32_t d = 0; d < dims; ++d) differ |= memcmp(&e[d], &g[d][i], sizeof want) != 0;
+                        if (differ && bad++ < 5)
+                            printf("  kernel %d basis %d dims %u type %d point %d: %.9g vs %.9g\n", k, bi,
+                                   (unsigned)dims, t, i, (double)v[i], (double)want);
+                    }
+                }
+    AK_CHECK_EQ(bad, 0);
+}
+
 /* The batch paths this CPU has: [0] scalar reference, then AVX2 and AVX-512 where present. */
 static int simd_paths(ak_noise_simd* paths) {
     int n = 0;
@@ -1139,6 +1192,7 @@ int main(void) {
     AK_RUN(fractal_octaves_scale_by_gain);
     AK_RUN(fractal_gradient_matches_differences);
     AK_RUN(batch_simd_equals_scalar);
+    AK_RUN(simd_kernels_equal_scalar);
     AK_RUN(per_point_matches_job_signed_zero);
     AK_RUN(batch_value_worley_edges);
     AK_RUN(grid_job_equals_points);

@@ -2,7 +2,10 @@
  * AVX-512), issue 32; run.sh builds and runs it. One process,
  * interleaved rounds (order reversed on odd rounds), thread CPU time of one pass, 1M points
  * (3D: 128x128x64 lattice, 2D: 1024x1024, spacing 0.173), single thread. Prints the median
- * ns/point and, per group, the median of the per-round ratios ak / peer with their range. */
+ * ns/point and, per group, the median of the per-round ratios ak / peer with their range.
+ * Built with -DAK_AB_OLD (run.sh does when AB_BASE names another build's noise objects, their
+ * symbols renamed old_*), every group also times that build's jobs ("old ak job", lib 4) in the
+ * same rounds and prints new / old and old / FN2 ratios. */
 #define _GNU_SOURCE
 #include <math.h>
 #include <stdio.h>
@@ -14,14 +17,18 @@
 void fnl_run(int kind, int octaves, int dims, int n, const float* x, const float* y, const float* z, float* out);
 void fn2_run(int kind, int octaves, int simd, int dims, int n, const float* x, const float* y, const float* z, float* out);
 const char* fn2_simd_name(int kind, int simd);
+#if defined(AK_AB_OLD)
+ak_result old_ak_noise_job_run(const ak_noise_job* job);
+#endif
 
-enum { N = 1 << 20, MAXV = 96, MAXR = 64 };
+enum { N = 1 << 20, MAXV = 128, MAXR = 64 };
 static float *X, *Y, *Z, *X2, *Y2;
 static ak_noise AKN;
 
 static double cpu_s(void) { struct timespec t; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
 
-/* lib 0: ak per-point call, 1: ak batch job (simd 0 scalar, 1 AVX2, 2 AVX-512), 2: FNL, 3: FN2 (simd 1 AVX2, 2 AVX-512)
+/* lib 0: ak per-point call, 1: ak batch job (simd 0 scalar, 1 AVX2, 2 AVX-512), 2: FNL, 3: FN2 (simd 1 AVX2, 2 AVX-512),
+ * 4: the old build's batch job (AK_AB_OLD)
  * kind 0 perlin, 1 simplex, 3 value, 4 worley F1 / cellular distance, 5 FN2/FNL cellular value (ak: worley F1) */
 typedef struct { char name[64]; int lib, kind, oct, simd, dims; float* out; double t[MAXR]; } variant;
 
@@ -50,13 +57,19 @@ static void run(variant* v) {
             ak_fractal_desc fd = {.type = AK_FRACTAL_FBM, .basis = b, .octaves = (uint32_t)v->oct, .lacunarity = 2, .gain = 0.5f, .frequency = 1};
             for (int i = 0; i < N; ++i) { float p[3] = {x[i], y[i], v->dims == 3 ? z[i] : 0}; o[i] = ak_fractal_eval(&AKN, &fd, (uint32_t)v->dims, p, NULL); }
         }
-    } else if (v->lib == 1) {
+    } else if (v->lib == 1 || v->lib == 4) {
         ak_noise_job job = {.noise = &AKN,
                             .fractal = {.type = AK_FRACTAL_FBM, .basis = basis_of(v->kind), .octaves = (uint32_t)v->oct,
                                         .lacunarity = 2, .gain = 0.5f, .frequency = 1},
                             .dimensions = (uint32_t)v->dims, .x = {x, N}, .y = {y, N}, .z = {v->dims == 3 ? z : NULL, N},
                             .out_values = {o, N}, .thread_count = 1,
                             .simd_limit = v->simd == 0 ? AK_NOISE_SIMD_SCALAR : v->simd == 1 ? AK_NOISE_SIMD_AVX2 : AK_NOISE_SIMD_AVX512};
+#if defined(AK_AB_OLD)
+        if (v->lib == 4) {
+            if (old_ak_noise_job_run(&job) != AK_OK) { fprintf(stderr, "old ak job failed\n"); exit(1); }
+            return;
+        }
+#endif
         if (ak_noise_job_run(&job) != AK_OK) { fprintf(stderr, "ak job failed\n"); exit(1); }
     } else if (v->lib == 2) {
         fnl_run(v->kind, v->oct, v->dims, N, x, y, z, o);
@@ -106,6 +119,10 @@ int main(int argc, char** argv) {
         add(g, "ak job scalar", 1, k, o, 0, d);
         add(g, "ak job AVX2", 1, k, o, 1, d);
         add(g, "ak job AVX-512", 1, k, o, 2, d);
+#if defined(AK_AB_OLD)
+        add(g, "old ak job AVX2", 4, k, o, 1, d);
+        add(g, "old ak job AVX-512", 4, k, o, 2, d);
+#endif
         add(g, k == 4 ? "FNL Cellular distance" : "FastNoiseLite", 2, k, o, 0, d);
         add(g, k == 4 ? "FN2 CellularDistance AVX2" : "FastNoise2 AVX2", 3, k, o, 1, d);
         add(g, k == 4 ? "FN2 CellularDistance AVX-512" : "FastNoise2 AVX-512", 3, k, o, 2, d);
@@ -130,10 +147,11 @@ int main(int argc, char** argv) {
     printf("ratios (ak time / peer time; median of per-round ratios [min-max]; <= 1.00 meets the target)\n");
     for (int a = 0; a < nv; ++a) {
         variant* v = &vs[a];
-        if (v->lib > 1) continue;
+        if (v->lib == 2 || v->lib == 3) continue;
         int peers[3] = {-1, -1, -1}; /* ak call vs FNL (kind, kind 5); ak job AVX2/512 vs FN2 same width */
         if (v->lib == 0) { peers[0] = find(2, v->kind, v->oct, 0, v->dims); if (v->kind == 4) peers[1] = find(2, 5, v->oct, 0, v->dims); }
         else if (v->simd > 0) { peers[0] = find(3, v->kind, v->oct, v->simd, v->dims); if (v->kind == 4) peers[1] = find(3, 5, v->oct, v->simd, v->dims); }
+        if (v->lib == 1 && v->simd > 0) peers[2] = find(4, v->kind, v->oct, v->simd, v->dims); /* new / old */
         for (int p = 0; p < 3; ++p) {
             if (peers[p] < 0) continue;
             double rr[MAXR], lo, hi;
@@ -145,7 +163,7 @@ int main(int argc, char** argv) {
     /* exactness: every ak job path of a group against the scalar job */
     for (int a = 0; a < nv; ++a) {
         variant* v = &vs[a];
-        if (v->lib != 1 || v->simd == 0) continue;
+        if ((v->lib != 1 && v->lib != 4) || v->simd == 0) continue;
         const int s = find(1, v->kind, v->oct, 0, v->dims);
         int diff = 0; for (int i = 0; i < N; ++i) diff += memcmp(&v->out[i], &vs[s].out[i], 4) != 0;
         printf("check: '%s' vs scalar job: %d of %d values differ\n", v->name, diff, N);

@@ -1,5 +1,7 @@
 /* Batch and grid evaluation: validation, thread fan-out, and the choice between the AVX-512
- * and AVX2 kernels and the scalar reference. Points go through in chunks of CHUNK: the grid
+ * and AVX2 kernels and the scalar reference (and, within a path, between its two builds:
+ * AVX-512 with VBMI byte permutes where the CPU has them; AVX2 with gathers where
+ * akp_noise_avx2_gather_preferred says so). Points go through in chunks of CHUNK: the grid
  * job makes the chunk's coordinates on the stack, the kernel gets whole blocks of 16 (AVX-512)
  * or 8 (AVX2); a short tail is padded into one block, so it also runs the kernel and gives the
  * same bits. */
@@ -41,6 +43,7 @@ typedef struct eval_ctx {
     ak_fractal_desc desc; /* resolved */
     uint32_t dims;
     int path; /* PATH_* */
+    bool alt; /* the other build of the path: PATH_AVX512 with VBMI, PATH_AVX2 with gathers */
 } eval_ctx;
 
 /* Evaluate count (<= CHUNK) points: xs[k][i] coordinates, out[i], grad[k][i] (grad NULL -> none). */
@@ -49,7 +52,9 @@ static void eval_chunk(const eval_ctx* c, const float* const* xs, size_t count, 
     if (c->path != PATH_SCALAR) {
         const size_t w = c->path == PATH_AVX512 ? 16u : 8u;
         void (*kernel)(const ak_noise*, const ak_fractal_desc*, uint32_t, const float* const*, size_t, float*,
-                       float* const*) = c->path == PATH_AVX512 ? akp_noise_fractal_avx512 : akp_noise_fractal_avx2;
+                       float* const*) = c->path == PATH_AVX2 ? (c->alt ? akp_noise_fractal_avx2gather : akp_noise_fractal_avx2)
+                                        : c->alt ? akp_noise_fractal_avx512vbmi
+                                                 : akp_noise_fractal_avx512;
         const size_t whole = count / w * w;
         if (whole) kernel(c->noise, &c->desc, dims, xs, whole, out, grad);
         const size_t done = whole;
@@ -158,8 +163,9 @@ ak_noise_simd ak_noise_job_kernel(const ak_noise_job* job) {
 ak_result ak_noise_job_run(const ak_noise_job* job) {
     const ak_result r = ak_noise_job_validate(job);
     if (r != AK_OK) return r;
-    eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), job_dims(job), PATH_SCALAR};
+    eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), job_dims(job), PATH_SCALAR, false};
     ctx.path = pick_path(&ctx.desc, ctx.dims, job->skip_simd, job->simd_limit);
+    ctx.alt = ctx.path == PATH_AVX512 ? akp_noise_have_avx512vbmi() : ctx.path == PATH_AVX2 && akp_noise_avx2_gather_preferred();
     const size_t n = job->out_values.count;
     uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
     if (threads > n / CHUNK + 1) threads = (uint32_t)(n / CHUNK + 1);
@@ -220,8 +226,9 @@ static void* grid_thread(void* arg) {
 ak_result ak_noise_grid_job_run(const ak_noise_grid_job* job) {
     const ak_result r = ak_noise_grid_job_validate(job);
     if (r != AK_OK) return r;
-    eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), 2, PATH_SCALAR};
+    eval_ctx ctx = {job->noise, ak_fractal_desc_resolved(&job->fractal), 2, PATH_SCALAR, false};
     ctx.path = pick_path(&ctx.desc, 2, job->skip_simd, job->simd_limit);
+    ctx.alt = ctx.path == PATH_AVX512 ? akp_noise_have_avx512vbmi() : ctx.path == PATH_AVX2 && akp_noise_avx2_gather_preferred();
     const size_t rows = job->height;
     uint32_t threads = job->thread_count > 1 ? job->thread_count : 1;
     if (threads > rows) threads = (uint32_t)rows;

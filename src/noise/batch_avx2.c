@@ -11,11 +11,21 @@
 #include <math.h>
 #include <string.h>
 
-bool akp_noise_have_avx2(void) { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
-
 #define KI __attribute__((target("avx2,fma"), always_inline))
 #define KERNEL_RUN __attribute__((target("avx2,fma")))
+#if defined(AKP_NOISE_AVX2_GATHER)
+/* batch_avx2_gather.c: this file again, the lookups as vpgatherdd, entry akp_noise_fractal_avx2gather. */
+#define KERNEL_ENTRY akp_noise_fractal_avx2gather
+bool akp_noise_avx2_gather_preferred(void) {
+    /* Intel CPUs with the gather data sampling mitigation run vpgatherdd in microcode, slower than
+     * the scalar loads; AMD's Zen 5 runs the gather kernel 5-10% faster (issue 32). Zen 4
+     * and later (the AMD CPUs with AVX-512) take it; older AMD and every other CPU the loads. */
+    return __builtin_cpu_is("amd") && __builtin_cpu_supports("avx512f");
+}
+#else
 #define KERNEL_ENTRY akp_noise_fractal_avx2
+bool akp_noise_have_avx2(void) { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+#endif
 #define AKP_W 8
 typedef __m256 VF;
 typedef __m256i VI;
@@ -78,6 +88,9 @@ KI static inline VM m_gt(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
 KI static inline VM m_ge(VF a, VF b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
 KI static inline VM mi_lt(VI a, int v) { return _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(v), a)); }
 KI static inline VM mi_eq(VI a, int v) { return _mm256_castsi256_ps(_mm256_cmpeq_epi32(a, _mm256_set1_epi32(v))); }
+KI static inline VM mi_none(VI a, int bits) { /* (a & bits) == 0 */
+    return _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(a, _mm256_set1_epi32(bits)), _mm256_setzero_si256()));
+}
 KI static inline VM m_and(VM a, VM b) { return _mm256_and_ps(a, b); }
 KI static inline VM m_or(VM a, VM b) { return _mm256_or_ps(a, b); }
 KI static inline VM m_andn(VM a, VM b) { return _mm256_andnot_ps(a, b); } /* !a & b */
@@ -88,7 +101,7 @@ KI static inline VI vi_sel(VM m, VI a, VI b) {
 }
 KI static inline VF vf_maskz(VM m, VF a) { return _mm256_and_ps(m, a); } /* m ? a : +0 */
 KI static inline unsigned m_bits(VM m) { return (unsigned)_mm256_movemask_ps(m); } /* bit i: lane i */
-/* tab[idx] for idx in 0..15 */
+/* tab[idx & 15] (bits above 3 are not read) */
 KI static inline VF vf_lut16(const float* tab, VI idx) {
     const VF lo = _mm256_permutevar8x32_ps(_mm256_loadu_ps(tab), idx);
     const VF hi = _mm256_permutevar8x32_ps(_mm256_loadu_ps(tab + 8), idx);
@@ -96,6 +109,14 @@ KI static inline VF vf_lut16(const float* tab, VI idx) {
 }
 
 #include "simd_body.h"
+
+#elif defined(AKP_NOISE_AVX2_GATHER)
+
+bool akp_noise_avx2_gather_preferred(void) { return false; }
+void akp_noise_fractal_avx2gather(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims,
+                                  const float* const* xs, size_t count, float* out, float* const* grad) {
+    (void)noise, (void)d, (void)dims, (void)xs, (void)count, (void)out, (void)grad;
+}
 
 #else
 

@@ -163,11 +163,19 @@ bool akp_noise_simd_handles(const ak_fractal_desc* d, uint32_t dims);
 /* CPU checks (false in builds without the kernels). */
 bool akp_noise_have_avx2(void);
 bool akp_noise_have_avx512(void);
+bool akp_noise_have_avx512vbmi(void); /* AVX-512 F, DQ, BW and VBMI */
+bool akp_noise_avx2_gather_preferred(void); /* AVX2 path: the gather build is the faster one here */
 /* count % 8 == 0 (AVX2) or % 16 == 0 (AVX-512). xs[d] (d < dims) coordinates; grad[d] may all
  * be NULL (no gradient). */
 void akp_noise_fractal_avx2(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
                             size_t count, float* out, float* const* grad);
 void akp_noise_fractal_avx512(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims, const float* const* xs,
                               size_t count, float* out, float* const* grad);
+/* The AVX2 kernel with vpgatherdd lookups (batch_avx2_gather.c); the same bits. */
+void akp_noise_fractal_avx2gather(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims,
+                                  const float* const* xs, size_t count, float* out, float* const* grad);
+/* The same AVX-512 kernel with byte-permute lookups, for CPUs with akp_noise_have_avx512vbmi; the same bits. */
+void akp_noise_fractal_avx512vbmi(const ak_noise* noise, const ak_fractal_desc* d, uint32_t dims,
+                                  const float* const* xs, size_t count, float* out, float* const* grad);
 
 #endif

@@ -16,9 +16,11 @@
  *
  * Permutation lookups go through tab_pair(T, i), which gives perm[i] in the low byte and
  * perm[i + 1] (the upper corner's hash) in the next one, for 0 <= i <= 511 (the table is
- * doubled, so that is a function of i & 255): AVX2 gathers 32 bits at perm + i, AVX-512 looks
- * i & 255 up in a 256-entry table held in registers (PermTab, made once per call by
- * tab_make). Never installed. */
+ * doubled, so that is a function of i & 255): AVX2 gathers 32 bits at perm + i (or loads them
+ * one lane at a time), AVX-512 looks i & 255 up in a 256-entry table held in registers
+ * (PermTab, made once per call by tab_make). With VBMI, batch_avx512.c brings its own
+ * cell_hashes (AKP_HAVE_CELL_HASHES): byte lookups, four corner hashes of a lane at once.
+ * Never installed. */
 
 /* Small fixed loops (dimensions, corners) are unrolled so that per-corner vectors stay in
  * registers. */
@@ -30,7 +32,7 @@
 /* Corner value (and gradient vector) for hash h and offsets d (dims 2 or 3). */
 KI static inline VF corner_perlin(int dims, VI h, const VF* d, VF* g, bool want_grad) {
     const VF one = vf_set1(1.0f);
-    const VF su = vf_cast(VI_SLLI(vi_and(h, vi_set1(1)), 31));
+    const VF su = vf_cast(VI_SLLI(h, 31)); /* bit 0 of h as the sign */
     const VF sv = vf_cast(VI_SLLI(vi_and(h, vi_set1(2)), 30));
     if (dims == 2) {
         h = vi_and(h, vi_set1(7));
@@ -46,9 +48,9 @@ KI static inline VF corner_perlin(int dims, VI h, const VF* d, VF* g, bool want_
         }
         return vf_add(vf_xor(u, su), vf_xor(v, sv));
     }
-    h = vi_and(h, vi_set1(15));
-    const VM u_is_x = mi_lt(h, 8), v_is_y = mi_lt(h, 4);
-    const VM v_is_x = m_andn(v_is_y, m_or(mi_eq(h, 12), mi_eq(h, 14)));
+    /* over h & 15: u_is_x h < 8, v_is_y h < 4, v_is_x h in {12, 14} (h & 13 == 12), as bit tests */
+    const VM u_is_x = mi_none(h, 8), v_is_y = mi_none(h, 12);
+    const VM v_is_x = mi_eq(vi_and(h, vi_set1(13)), 12);
     const VF u = vf_sel(u_is_x, d[0], d[1]);
     const VF v = vf_sel(v_is_y, d[1], vf_sel(v_is_x, d[0], d[2]));
     if (want_grad) {
@@ -65,6 +67,7 @@ KI static inline VF corner_perlin(int dims, VI h, const VF* d, VF* g, bool want_
  * chain with the upper corner at index + 1 unwrapped (p[A + 1] in his code: the doubled table
  * makes it equal to the wrapped index): one 32-bit gather at perm + i reads perm[i] and
  * perm[i + 1] together, so 3D takes 1 + 2 + 4 gathers instead of 14. */
+#if !defined(AKP_HAVE_CELL_HASHES) /* the vocabulary may bring its own (batch_avx512.c with VBMI) */
 KI static inline void cell_hashes(const PermTab* perm, int dims, const VI* lo, VI* hash) {
     const VI m8 = vi_set1(255);
     {
@@ -83,6 +86,7 @@ KI static inline void cell_hashes(const PermTab* perm, int dims, const VI* lo, V
         }
     }
 }
+#endif
 
 KI static inline VM in_range(int dims, const VF* p) {
     const VF limit = vf_set1(AKP_NOISE_LIMIT);
@@ -216,8 +220,8 @@ KI static inline VF simplex2_v(const PermTab* perm, const VF* p, VF* grad, bool 
     VF sum = vf_zero(), G[2] = {vf_zero(), vf_zero()};
     AKP_UNROLL
     for (int c = 0; c < 3; ++c) {
-        const VI hi = vi_and(h[c], vi_set1(7));
-        const VF g[2] = {vf_lut16(simplex_g2x, hi), vf_lut16(simplex_g2y, hi)};
+        /* vf_lut16 reads bits 0..3 of the index; entries 8..15 repeat 0..7: h & 7 needs no mask */
+        const VF g[2] = {vf_lut16(simplex_g2x, h[c]), vf_lut16(simplex_g2y, h[c])};
         sum = vf_add(sum, corner_simplex(2, d[c], g, G, want_grad));
     }
     const VF scale = vf_set1(70.0f);
@@ -258,8 +262,7 @@ KI static inline VF simplex3_v(const PermTab* perm, const VF* p, VF* grad, bool 
         const VF k = vf_set1((float)c * G3);
         const VF d[3] = {vf_add(vf_sub(x0, off[c][0]), k), vf_add(vf_sub(y0, off[c][1]), k),
                          vf_add(vf_sub(z0, off[c][2]), k)};
-        const VI hi = vi_and(h[c], vi_set1(15));
-        const VF g[3] = {vf_lut16(simplex_g3x, hi), vf_lut16(simplex_g3y, hi), vf_lut16(simplex_g3z, hi)};
+        const VF g[3] = {vf_lut16(simplex_g3x, h[c]), vf_lut16(simplex_g3y, h[c]), vf_lut16(simplex_g3z, h[c])};
         sum = vf_add(sum, corner_simplex(3, d, g, G, want_grad));
     }
     const VF scale = vf_set1(76.0f);
