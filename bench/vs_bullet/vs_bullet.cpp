@@ -8,11 +8,11 @@
 // seen). One thread (animkit: --threads T sets its thread_count, and its time is then wall
 // time; the final state's hash is printed to compare thread counts, and a second line gives
 // animkit's CPU time per step on the calling thread and on all threads, with the share of the
-// latter spent off the calling thread, by the worker team); sleeping on in both;
-// dt = 1/60; friction 0.5; density 1000.
+// latter spent off the calling thread, by the worker team); sleeping on in both, each at its
+// own thresholds (--sleep: see sleep_mode); dt = 1/60; friction 0.5; density 1000.
 //
 //   bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] [--substeps K]
-//                         [--threads T] [--only pyramid|spheres|ragdolls]
+//                         [--threads T] [--only pyramid|spheres|ragdolls] [--sleep own|bullet|off]
 //                         [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10]
 //                                  [--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]
 //
@@ -186,6 +186,19 @@ static bool ragdolls(int count, scene* s) {
 
 static bool g_anchors = true; // --no-anchors: animkit without its contact anchor cache
 
+// --sleep: how the two engines put bodies to sleep. "own" (the default): each at its own
+// defaults (animkit: under 0.05 m/s and 0.05 rad/s for 0.5 s; Bullet: under 0.8 m/s and 1 rad/s
+// for 2 s, btRigidBody's thresholds and gDeactivationTime). "bullet": animkit given Bullet's
+// thresholds and time, so both freeze the same motion. "off": neither sleeps (animkit without
+// sleep timers, Bullet's bodies DISABLE_DEACTIVATION), so each step's time is the solver's work.
+enum sleep_mode { SLEEP_OWN, SLEEP_BULLET, SLEEP_OFF };
+static sleep_mode g_sleep = SLEEP_OWN;
+static const char* sleep_name() {
+    return g_sleep == SLEEP_OFF ? "sleeping off in both"
+                                : (g_sleep == SLEEP_BULLET ? "sleeping on, animkit at Bullet's thresholds (0.8 m/s, 1 rad/s, 2 s)"
+                                                           : "sleeping on, each engine at its defaults");
+}
+
 static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigned threads,
                           bool track = false) {
     const size_t n = sc.bodies.size();
@@ -195,6 +208,11 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     md.bodies.count = n;
     md.joints.ptr = sc.joints.data();
     md.joints.count = sc.joints.size();
+    if (g_sleep == SLEEP_BULLET) {
+        md.sleep_linear_speed = 0.8f;
+        md.sleep_angular_speed = 1.0f;
+        md.sleep_time = 2.0f;
+    }
     ak_rigid_model* m = nullptr;
     result r = {};
     if (ak_rigid_model_create(&md, nullptr, &m) != AK_OK) return r;
@@ -214,7 +232,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     job.orientations = {q.data(), n};
     job.velocities = {v.data(), n};
     job.angular_velocities = {w.data(), n};
-    job.sleep_timers = {timers.data(), n};
+    if (g_sleep != SLEEP_OFF) job.sleep_timers = {timers.data(), n};
     job.out_max_penetration = &pen;
     uint32_t contacts = 0, dropped = 0;
     job.out_contact_count = &contacts;
@@ -348,6 +366,7 @@ static result run_bullet(const scene& sc, int steps, int iterations = 10, int su
         b->setUserIndex((int)d.collision_group);
         b->setLinearVelocity(bt(d.velocity));
         b->setAngularVelocity(bt(d.angular_velocity));
+        if (g_sleep == SLEEP_OFF) b->setActivationState(DISABLE_DEACTIVATION);
         world.addRigidBody(b);
         shapes.push_back(shape);
         bodies.push_back(b);
@@ -606,7 +625,16 @@ int main(int argc, char** argv) {
             continue;
         }
         if (i + 1 >= argc) break;
-        if (!std::strcmp(argv[i], "--rounds"))
+        if (!std::strcmp(argv[i], "--sleep")) {
+            if (!std::strcmp(argv[i + 1], "own"))
+                g_sleep = SLEEP_OWN;
+            else if (!std::strcmp(argv[i + 1], "bullet"))
+                g_sleep = SLEEP_BULLET;
+            else if (!std::strcmp(argv[i + 1], "off"))
+                g_sleep = SLEEP_OFF;
+            else
+                lists_ok = false;
+        } else if (!std::strcmp(argv[i], "--rounds"))
             rounds = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--ak-ref"))
             ak_ref = std::atoi(argv[i + 1]);
@@ -632,13 +660,14 @@ int main(int argc, char** argv) {
             stderr,
             "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
             "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls] [--no-anchors]\n"
+            "       [--sleep own|bullet|off]\n"
             "       [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10] "
             "[--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]\n");
         return 2;
     }
-    std::printf("dt 1/60 s, %d steps, sleeping on; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s%s; Bullet "
+    std::printf("dt 1/60 s, %d steps, %s; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s%s; Bullet "
                 "%d.%02d 1 step x 10 iterations (its defaults), one thread\n",
-                steps, substeps, threads, threads > 1 ? " (wall time)" : "",
+                steps, sleep_name(), substeps, threads, threads > 1 ? " (wall time)" : "",
                 g_anchors ? ", contact anchors" : ", no contact anchors", btGetVersion() / 100,
                 btGetVersion() % 100);
     if (!do_sweep)
