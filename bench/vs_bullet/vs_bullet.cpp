@@ -13,6 +13,7 @@
 //
 //   bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] [--substeps K]
 //                         [--threads T] [--only pyramid|spheres|ragdolls] [--sleep own|bullet|off]
+//                         [--contacts-after-joints]
 //                         [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10]
 //                                  [--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]
 //
@@ -199,8 +200,12 @@ static const char* sleep_name() {
                                                            : "sleeping on, each engine at its defaults");
 }
 
+// --contacts-after-joints: animkit's ak_rigid_model_desc.contacts_after_joints (a single run:
+// on; --sweep: each substep count both without and with it, interleaved)
+static bool g_after_joints = false;
+
 static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigned threads,
-                          bool track = false) {
+                          bool track = false, bool after_joints = g_after_joints) {
     const size_t n = sc.bodies.size();
     ak_rigid_model_desc md;
     std::memset(&md, 0, sizeof md);
@@ -208,6 +213,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     md.bodies.count = n;
     md.joints.ptr = sc.joints.data();
     md.joints.count = sc.joints.size();
+    md.contacts_after_joints = after_joints;
     if (g_sleep == SLEEP_BULLET) {
         md.sleep_linear_speed = 0.8f;
         md.sleep_angular_speed = 1.0f;
@@ -495,7 +501,7 @@ static std::vector<int> int_list(const char* s) {
 
 struct sweep_row {
     bool bullet;
-    int a, b;               // animkit: substeps; Bullet: iterations, substeps
+    int a, b;               // animkit: substeps, contacts_after_joints; Bullet: iterations, substeps
     result r;               // the first round's (both engines are deterministic: the measures
                             // are the same every round)
     std::vector<double> ms; // ms per step, one per round
@@ -529,7 +535,10 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
                   int ak_ref, const std::vector<int>& ak_subs, const std::vector<int>& bt_iters,
                   const std::vector<int>& bt_subs) {
     std::vector<sweep_row> rows;
-    for (int k : ak_subs) rows.push_back(make_row(false, k, 0));
+    for (int k : ak_subs) {
+        rows.push_back(make_row(false, k, 0));
+        if (g_after_joints) rows.push_back(make_row(false, k, 1));
+    }
     if (std::find(ak_subs.begin(), ak_subs.end(), ak_ref) == ak_subs.end())
         rows.push_back(make_row(false, ak_ref, 0));
     rows.push_back(make_row(true, 10, 1)); // Bullet's defaults, always
@@ -539,7 +548,8 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
     for (int round = 0; round < rounds; ++round)
         for (sweep_row& row : rows) {
             const result r = row.bullet ? run_bullet(sc, steps, row.a, row.b, true)
-                                        : run_animkit(sc, steps, (unsigned)row.a, threads, true);
+                                        : run_animkit(sc, steps, (unsigned)row.a, threads, true,
+                                                      row.b != 0);
             if (!round) row.r = r;
             row.ms.push_back(r.ms_per_step);
         }
@@ -560,7 +570,8 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
         if (row.bullet)
             std::snprintf(setting, sizeof setting, "%d iterations x %d sub", row.a, row.b);
         else
-            std::snprintf(setting, sizeof setting, "%d substeps", row.a);
+            std::snprintf(setting, sizeof setting, row.b ? "%d sub, after joints" : "%d substeps",
+                          row.a);
         std::snprintf(ms, sizeof ms, "%.3f (%.3f-%.3f)", row.med, row.lo, row.hi);
         std::printf("%-8s %-22s %22s %11.3f %11.3f %10.3f %11.3f %7d %8.0f\n",
                     row.bullet ? "Bullet" : "animkit", setting, ms, 1e3 * row.r.drift_max,
@@ -571,7 +582,7 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
     const sweep_row* ak_def = nullptr;
     for (const sweep_row& row : rows) {
         if (row.bullet && row.a == 10 && row.b == 1) bt_def = &row;
-        if (!row.bullet && row.a == ak_ref) ak_def = &row;
+        if (!row.bullet && row.a == ak_ref && !row.b) ak_def = &row;
     }
     const sweep_row* ak_best = nullptr;
     const sweep_row* bt_best = nullptr;
@@ -585,9 +596,10 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
     }
     if (ak_best)
         std::printf("matched to Bullet's defaults (10 iterations x 1 sub, %.3f ms): animkit at %d "
-                    "substeps, %.3f ms: "
+                    "substeps%s, %.3f ms: "
                     "ratio (Bullet / animkit) %.2f (%.2f-%.2f)\n",
-                    bt_def->med, ak_best->a, ak_best->med, bt_def->med / ak_best->med,
+                    bt_def->med, ak_best->a, ak_best->b ? " (contacts after joints)" : "",
+                    ak_best->med, bt_def->med / ak_best->med,
                     bt_def->lo / ak_best->hi, bt_def->hi / ak_best->lo);
     else
         std::printf("matched to Bullet's defaults: no animkit setting tried is as stable on every "
@@ -621,6 +633,11 @@ int main(int argc, char** argv) {
         }
         if (!std::strcmp(argv[i], "--no-anchors")) { // a flag without a value
             g_anchors = false;
+            --i;
+            continue;
+        }
+        if (!std::strcmp(argv[i], "--contacts-after-joints")) { // a flag without a value
+            g_after_joints = true;
             --i;
             continue;
         }
@@ -660,7 +677,7 @@ int main(int argc, char** argv) {
             stderr,
             "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
             "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls] [--no-anchors]\n"
-            "       [--sleep own|bullet|off]\n"
+            "       [--sleep own|bullet|off] [--contacts-after-joints]\n"
             "       [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10] "
             "[--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]\n");
         return 2;
@@ -668,7 +685,8 @@ int main(int argc, char** argv) {
     std::printf("dt 1/60 s, %d steps, %s; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s%s; Bullet "
                 "%d.%02d 1 step x 10 iterations (its defaults), one thread\n",
                 steps, sleep_name(), substeps, threads, threads > 1 ? " (wall time)" : "",
-                g_anchors ? ", contact anchors" : ", no contact anchors", btGetVersion() / 100,
+                g_anchors ? (g_after_joints ? ", contact anchors, contacts after joints" : ", contact anchors")
+                          : ", no contact anchors", btGetVersion() / 100,
                 btGetVersion() % 100);
     if (!do_sweep)
         std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s %9s %9s\n", "scene", "animkit ms",
