@@ -13,8 +13,9 @@
 //
 //   bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] [--substeps K]
 //                         [--threads T] [--only pyramid|spheres|ragdolls] [--sleep own|bullet|off]
-//                         [--contacts-after-joints]
-//                         [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10]
+//                         [--contacts-after-joints] [--contact-iterations K]
+//                         [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-iterations 1]
+//                                  [--ak-ref 10]
 //                                  [--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]
 //
 // --sweep compares at matched stability instead: per scene, animkit at each substep count of
@@ -204,8 +205,13 @@ static const char* sleep_name() {
 // on; --sweep: each substep count both without and with it, interleaved)
 static bool g_after_joints = false;
 
+// --contact-iterations K: animkit's ak_rigid_model_desc.contact_iterations for a single run;
+// --sweep takes a list (--ak-iterations 1,3: each substep count at each)
+static unsigned g_iterations = 1;
+
 static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigned threads,
-                          bool track = false, bool after_joints = g_after_joints) {
+                          bool track = false, bool after_joints = g_after_joints,
+                          unsigned iterations = g_iterations) {
     const size_t n = sc.bodies.size();
     ak_rigid_model_desc md;
     std::memset(&md, 0, sizeof md);
@@ -214,6 +220,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     md.joints.ptr = sc.joints.data();
     md.joints.count = sc.joints.size();
     md.contacts_after_joints = after_joints;
+    md.contact_iterations = iterations;
     if (g_sleep == SLEEP_BULLET) {
         md.sleep_linear_speed = 0.8f;
         md.sleep_angular_speed = 1.0f;
@@ -505,6 +512,7 @@ struct sweep_row {
     result r;               // the first round's (both engines are deterministic: the measures
                             // are the same every round)
     std::vector<double> ms; // ms per step, one per round
+    int it = 1;             // animkit: contact_iterations
     double med = 0, lo = 0, hi = 0;
 };
 
@@ -532,13 +540,15 @@ static bool as_stable(const scene& sc, bool spheres, const result& x, const resu
 // the cheapest animkit setting as stable as Bullet's defaults on every measure, and the cheapest
 // Bullet setting as stable as animkit at ak_ref substeps
 static void sweep(const char* name, const scene& sc, int steps, unsigned threads, int rounds,
-                  int ak_ref, const std::vector<int>& ak_subs, const std::vector<int>& bt_iters,
-                  const std::vector<int>& bt_subs) {
+                  int ak_ref, const std::vector<int>& ak_subs, const std::vector<int>& ak_its,
+                  const std::vector<int>& bt_iters, const std::vector<int>& bt_subs) {
     std::vector<sweep_row> rows;
-    for (int k : ak_subs) {
-        rows.push_back(make_row(false, k, 0));
-        if (g_after_joints) rows.push_back(make_row(false, k, 1));
-    }
+    for (int k : ak_subs)
+        for (int it : ak_its)
+            for (int aj = 0; aj < (g_after_joints ? 2 : 1); ++aj) {
+                rows.push_back(make_row(false, k, aj));
+                rows.back().it = it;
+            }
     if (std::find(ak_subs.begin(), ak_subs.end(), ak_ref) == ak_subs.end())
         rows.push_back(make_row(false, ak_ref, 0));
     rows.push_back(make_row(true, 10, 1)); // Bullet's defaults, always
@@ -549,7 +559,7 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
         for (sweep_row& row : rows) {
             const result r = row.bullet ? run_bullet(sc, steps, row.a, row.b, true)
                                         : run_animkit(sc, steps, (unsigned)row.a, threads, true,
-                                                      row.b != 0);
+                                                      row.b != 0, (unsigned)row.it);
             if (!round) row.r = r;
             row.ms.push_back(r.ms_per_step);
         }
@@ -569,6 +579,9 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
         char setting[64], ms[64];
         if (row.bullet)
             std::snprintf(setting, sizeof setting, "%d iterations x %d sub", row.a, row.b);
+        else if (row.it > 1)
+            std::snprintf(setting, sizeof setting, row.b ? "%d sub x %d it, after j." : "%d sub x %d it",
+                          row.a, row.it);
         else
             std::snprintf(setting, sizeof setting, row.b ? "%d sub, after joints" : "%d substeps",
                           row.a);
@@ -582,7 +595,7 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
     const sweep_row* ak_def = nullptr;
     for (const sweep_row& row : rows) {
         if (row.bullet && row.a == 10 && row.b == 1) bt_def = &row;
-        if (!row.bullet && row.a == ak_ref && !row.b) ak_def = &row;
+        if (!row.bullet && row.a == ak_ref && !row.b && row.it == 1) ak_def = &row;
     }
     const sweep_row* ak_best = nullptr;
     const sweep_row* bt_best = nullptr;
@@ -596,9 +609,9 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
     }
     if (ak_best)
         std::printf("matched to Bullet's defaults (10 iterations x 1 sub, %.3f ms): animkit at %d "
-                    "substeps%s, %.3f ms: "
+                    "substeps x %d contact iterations%s, %.3f ms: "
                     "ratio (Bullet / animkit) %.2f (%.2f-%.2f)\n",
-                    bt_def->med, ak_best->a, ak_best->b ? " (contacts after joints)" : "",
+                    bt_def->med, ak_best->a, ak_best->it, ak_best->b ? " (contacts after joints)" : "",
                     ak_best->med, bt_def->med / ak_best->med,
                     bt_def->lo / ak_best->hi, bt_def->hi / ak_best->lo);
     else
@@ -623,7 +636,8 @@ int main(int argc, char** argv) {
     const char* only = nullptr;
     bool do_sweep = false;
     int rounds = 3, ak_ref = 10;
-    std::vector<int> ak_subs = {2, 3, 4, 6, 10}, bt_iters = {10, 20, 50}, bt_subs = {1, 2, 4};
+    std::vector<int> ak_subs = {2, 3, 4, 6, 10}, ak_its = {1}, bt_iters = {10, 20, 50},
+                     bt_subs = {1, 2, 4};
     bool lists_ok = true;
     for (int i = 1; i < argc; i += 2) {
         if (!std::strcmp(argv[i], "--sweep")) { // a flag without a value
@@ -655,6 +669,10 @@ int main(int argc, char** argv) {
             rounds = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--ak-ref"))
             ak_ref = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--ak-iterations"))
+            lists_ok &= !(ak_its = int_list(argv[i + 1])).empty();
+        else if (!std::strcmp(argv[i], "--contact-iterations"))
+            g_iterations = (unsigned)std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--ak-substeps"))
             lists_ok &= !(ak_subs = int_list(argv[i + 1])).empty();
         else if (!std::strcmp(argv[i], "--bt-iterations"))
@@ -672,13 +690,13 @@ int main(int argc, char** argv) {
     }
     if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || nragdolls < 1 ||
         nragdolls > 10000 || steps < 1 || substeps < 1 || substeps > 1000 || threads < 1 ||
-        threads > 64 || !lists_ok || rounds < 1 || rounds > 100 || ak_ref < 1 || ak_ref > 1000) {
+        threads > 64 || g_iterations < 1 || g_iterations > 64 || !lists_ok || rounds < 1 || rounds > 100 || ak_ref < 1 || ak_ref > 1000) {
         std::fprintf(
             stderr,
             "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
             "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls] [--no-anchors]\n"
-            "       [--sleep own|bullet|off] [--contacts-after-joints]\n"
-            "       [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10] "
+            "       [--sleep own|bullet|off] [--contacts-after-joints] [--contact-iterations K]\n"
+            "       [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-iterations 1] [--ak-ref 10] "
             "[--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]\n");
         return 2;
     }
@@ -703,8 +721,8 @@ int main(int argc, char** argv) {
     if (do_sweep) {
         for (int k = 0; k < 3; ++k)
             if (!scenes[k].bodies.empty())
-                sweep(names[k], scenes[k], steps, threads, rounds, ak_ref, ak_subs, bt_iters,
-                      bt_subs);
+                sweep(names[k], scenes[k], steps, threads, rounds, ak_ref, ak_subs, ak_its,
+                      bt_iters, bt_subs);
         std::printf("\nmatched: the cheapest setting (median time) whose every measure is at most "
                     "the other\n"
                     "engine's reference; drift: largest horizontal displacement of a body from its "

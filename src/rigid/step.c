@@ -891,6 +891,30 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
             }
         }
     }
+    /* contact_iterations: more passes over the normals, on the same rows (friction and the
+     * centres of pressure stay the first pass's) */
+    for (uint32_t it = 1; it < s->m->desc.contact_iterations; ++it)
+        for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
+            uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
+            uint32_t a = cb->c[k0].a, b = cb->c[k0].b;
+            ak_vec3 cxa = cx[a], cta = ct[a], cxb = cx[b], ctb = ct[b];
+            for (uint32_t k = k0; k < k1; ++k) {
+                rigid_contact* c = &cb->c[k];
+                const contact_row* r = &s->rows[k];
+                float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cxb, cxa)) +
+                          ak_vec3_dot(ctb, r->rnb) - ak_vec3_dot(cta, r->rna);
+                if (d <= 0.0f || r->inv_w == 0.0f) continue;
+                if (r->imb != 0.0f && d > s->push_max) d = s->push_max;
+                float dl = d * r->inv_w;
+                c->lambda_n += dl;
+                cxa = ak_vec3_madd(cxa, c->n, dl * r->ima);
+                cta = ak_vec3_madd(cta, r->ta, dl);
+                cxb = ak_vec3_madd(cxb, c->n, -dl * r->imb);
+                ctb = ak_vec3_madd(ctb, r->tb, -dl);
+            }
+            if (s->awake[a]) cx[a] = cxa, ct[a] = cta;
+            if (s->awake[b]) cx[b] = cxb, ct[b] = ctb;
+        }
     /* the summed corrections onto the poses (orientations normalised in update_velocities) */
     for (uint32_t t = 0; t < n; ++t) {
         uint32_t i = list ? list[t] : t;
