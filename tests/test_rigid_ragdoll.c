@@ -720,7 +720,8 @@ done:
  * two-thread run must also have used the team once per solve of a step (the islands' one
  * parallel section), not once per substep (360) as the chain sweeps of the one-island path do: a
  * step is solved once, or again (at most 3 times in all) when an impact sets a body moving past
- * its pairs' margins (the two ragdolls falling into each other here). */
+ * its pairs' margins (the two ragdolls falling into each other here). And with
+ * contacts_after_joints and 2 contact_iterations, two threads against the one-island run. */
 enum { ISL_STEPS = 36 };
 
 typedef struct isl_run {
@@ -801,6 +802,7 @@ AK_TEST(islands_bit_identical_for_any_thread_count) {
     }
     ak_rigid_model* m = NULL;
     ak_rigid_model* small = NULL;
+    ak_rigid_model* after = NULL;
     AK_CHECK(alloc_ok);
     if (!alloc_ok) goto done;
     ak_scene_rest_pose(scene, (ak_transform_span){pose, n});
@@ -879,7 +881,19 @@ AK_TEST(islands_bit_identical_for_any_thread_count) {
     AK_CHECK(isl_step_all(small, nb, 2, true, timers0, &runs[2]));
     AK_CHECK_MSG(isl_same(&runs[0], &runs[2], nb), "max_contacts 40: the fallback differs");
     AK_CHECK_MSG(runs[0].dropped[ISL_STEPS - 1] > 0, "max_contacts 40 dropped nothing");
+    /* contacts_after_joints and contact_iterations: their passes over each island's contacts
+     * give the same bits too */
+    md.max_contacts = 0;
+    md.contacts_after_joints = true;
+    md.contact_iterations = 2;
+    AK_CHECK_EQ(ak_rigid_model_create(&md, NULL, &after), AK_OK);
+    if (!after) goto done;
+    AK_CHECK(isl_step_all(after, nb, 1, false, timers0, &runs[0]));
+    AK_CHECK(isl_step_all(after, nb, 2, true, timers0, &runs[2]));
+    AK_CHECK_MSG(isl_same(&runs[0], &runs[2], nb), "contacts after joints, 2 iterations: the islands differ");
+    AK_CHECK_MSG(!isl_same(&runs[1], &runs[2], nb), "contacts after joints, 2 iterations: nothing changed");
 done:
+    ak_rigid_model_destroy(after);
     ak_rigid_model_destroy(small);
     ak_rigid_model_destroy(m);
     for (int r = 0; r < RUNS; ++r)

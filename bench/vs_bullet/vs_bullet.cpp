@@ -8,12 +8,14 @@
 // seen). One thread (animkit: --threads T sets its thread_count, and its time is then wall
 // time; the final state's hash is printed to compare thread counts, and a second line gives
 // animkit's CPU time per step on the calling thread and on all threads, with the share of the
-// latter spent off the calling thread, by the worker team); sleeping on in both;
-// dt = 1/60; friction 0.5; density 1000.
+// latter spent off the calling thread, by the worker team); sleeping on in both, each at its
+// own thresholds (--sleep: see sleep_mode); dt = 1/60; friction 0.5; density 1000.
 //
 //   bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] [--substeps K]
-//                         [--threads T] [--only pyramid|spheres|ragdolls]
-//                         [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10]
+//                         [--threads T] [--only pyramid|spheres|ragdolls] [--sleep own|bullet|off]
+//                         [--contacts-after-joints] [--contact-iterations K]
+//                         [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-iterations 1]
+//                                  [--ak-ref 10]
 //                                  [--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]
 //
 // --sweep compares at matched stability instead: per scene, animkit at each substep count of
@@ -186,8 +188,30 @@ static bool ragdolls(int count, scene* s) {
 
 static bool g_anchors = true; // --no-anchors: animkit without its contact anchor cache
 
+// --sleep: how the two engines put bodies to sleep. "own" (the default): each at its own
+// defaults (animkit: under 0.05 m/s and 0.05 rad/s for 0.5 s; Bullet: under 0.8 m/s and 1 rad/s
+// for 2 s, btRigidBody's thresholds and gDeactivationTime). "bullet": animkit given Bullet's
+// thresholds and time, so both freeze the same motion. "off": neither sleeps (animkit without
+// sleep timers, Bullet's bodies DISABLE_DEACTIVATION), so each step's time is the solver's work.
+enum sleep_mode { SLEEP_OWN, SLEEP_BULLET, SLEEP_OFF };
+static sleep_mode g_sleep = SLEEP_OWN;
+static const char* sleep_name() {
+    return g_sleep == SLEEP_OFF ? "sleeping off in both"
+                                : (g_sleep == SLEEP_BULLET ? "sleeping on, animkit at Bullet's thresholds (0.8 m/s, 1 rad/s, 2 s)"
+                                                           : "sleeping on, each engine at its defaults");
+}
+
+// --contacts-after-joints: animkit's ak_rigid_model_desc.contacts_after_joints (a single run:
+// on; --sweep: each substep count both without and with it, interleaved)
+static bool g_after_joints = false;
+
+// --contact-iterations K: animkit's ak_rigid_model_desc.contact_iterations for a single run;
+// --sweep takes a list (--ak-iterations 1,3: each substep count at each)
+static unsigned g_iterations = 1;
+
 static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigned threads,
-                          bool track = false) {
+                          bool track = false, bool after_joints = g_after_joints,
+                          unsigned iterations = g_iterations) {
     const size_t n = sc.bodies.size();
     ak_rigid_model_desc md;
     std::memset(&md, 0, sizeof md);
@@ -195,6 +219,13 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     md.bodies.count = n;
     md.joints.ptr = sc.joints.data();
     md.joints.count = sc.joints.size();
+    md.contacts_after_joints = after_joints;
+    md.contact_iterations = iterations;
+    if (g_sleep == SLEEP_BULLET) {
+        md.sleep_linear_speed = 0.8f;
+        md.sleep_angular_speed = 1.0f;
+        md.sleep_time = 2.0f;
+    }
     ak_rigid_model* m = nullptr;
     result r = {};
     if (ak_rigid_model_create(&md, nullptr, &m) != AK_OK) return r;
@@ -214,7 +245,7 @@ static result run_animkit(const scene& sc, int steps, unsigned substeps, unsigne
     job.orientations = {q.data(), n};
     job.velocities = {v.data(), n};
     job.angular_velocities = {w.data(), n};
-    job.sleep_timers = {timers.data(), n};
+    if (g_sleep != SLEEP_OFF) job.sleep_timers = {timers.data(), n};
     job.out_max_penetration = &pen;
     uint32_t contacts = 0, dropped = 0;
     job.out_contact_count = &contacts;
@@ -348,6 +379,7 @@ static result run_bullet(const scene& sc, int steps, int iterations = 10, int su
         b->setUserIndex((int)d.collision_group);
         b->setLinearVelocity(bt(d.velocity));
         b->setAngularVelocity(bt(d.angular_velocity));
+        if (g_sleep == SLEEP_OFF) b->setActivationState(DISABLE_DEACTIVATION);
         world.addRigidBody(b);
         shapes.push_back(shape);
         bodies.push_back(b);
@@ -476,10 +508,11 @@ static std::vector<int> int_list(const char* s) {
 
 struct sweep_row {
     bool bullet;
-    int a, b;               // animkit: substeps; Bullet: iterations, substeps
+    int a, b;               // animkit: substeps, contacts_after_joints; Bullet: iterations, substeps
     result r;               // the first round's (both engines are deterministic: the measures
                             // are the same every round)
     std::vector<double> ms; // ms per step, one per round
+    int it = 1;             // animkit: contact_iterations
     double med = 0, lo = 0, hi = 0;
 };
 
@@ -507,10 +540,15 @@ static bool as_stable(const scene& sc, bool spheres, const result& x, const resu
 // the cheapest animkit setting as stable as Bullet's defaults on every measure, and the cheapest
 // Bullet setting as stable as animkit at ak_ref substeps
 static void sweep(const char* name, const scene& sc, int steps, unsigned threads, int rounds,
-                  int ak_ref, const std::vector<int>& ak_subs, const std::vector<int>& bt_iters,
-                  const std::vector<int>& bt_subs) {
+                  int ak_ref, const std::vector<int>& ak_subs, const std::vector<int>& ak_its,
+                  const std::vector<int>& bt_iters, const std::vector<int>& bt_subs) {
     std::vector<sweep_row> rows;
-    for (int k : ak_subs) rows.push_back(make_row(false, k, 0));
+    for (int k : ak_subs)
+        for (int it : ak_its)
+            for (int aj = 0; aj < (g_after_joints ? 2 : 1); ++aj) {
+                rows.push_back(make_row(false, k, aj));
+                rows.back().it = it;
+            }
     if (std::find(ak_subs.begin(), ak_subs.end(), ak_ref) == ak_subs.end())
         rows.push_back(make_row(false, ak_ref, 0));
     rows.push_back(make_row(true, 10, 1)); // Bullet's defaults, always
@@ -520,7 +558,8 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
     for (int round = 0; round < rounds; ++round)
         for (sweep_row& row : rows) {
             const result r = row.bullet ? run_bullet(sc, steps, row.a, row.b, true)
-                                        : run_animkit(sc, steps, (unsigned)row.a, threads, true);
+                                        : run_animkit(sc, steps, (unsigned)row.a, threads, true,
+                                                      row.b != 0, (unsigned)row.it);
             if (!round) row.r = r;
             row.ms.push_back(r.ms_per_step);
         }
@@ -540,8 +579,12 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
         char setting[64], ms[64];
         if (row.bullet)
             std::snprintf(setting, sizeof setting, "%d iterations x %d sub", row.a, row.b);
+        else if (row.it > 1)
+            std::snprintf(setting, sizeof setting, row.b ? "%d sub x %d it, after j." : "%d sub x %d it",
+                          row.a, row.it);
         else
-            std::snprintf(setting, sizeof setting, "%d substeps", row.a);
+            std::snprintf(setting, sizeof setting, row.b ? "%d sub, after joints" : "%d substeps",
+                          row.a);
         std::snprintf(ms, sizeof ms, "%.3f (%.3f-%.3f)", row.med, row.lo, row.hi);
         std::printf("%-8s %-22s %22s %11.3f %11.3f %10.3f %11.3f %7d %8.0f\n",
                     row.bullet ? "Bullet" : "animkit", setting, ms, 1e3 * row.r.drift_max,
@@ -552,7 +595,7 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
     const sweep_row* ak_def = nullptr;
     for (const sweep_row& row : rows) {
         if (row.bullet && row.a == 10 && row.b == 1) bt_def = &row;
-        if (!row.bullet && row.a == ak_ref) ak_def = &row;
+        if (!row.bullet && row.a == ak_ref && !row.b && row.it == 1) ak_def = &row;
     }
     const sweep_row* ak_best = nullptr;
     const sweep_row* bt_best = nullptr;
@@ -566,9 +609,10 @@ static void sweep(const char* name, const scene& sc, int steps, unsigned threads
     }
     if (ak_best)
         std::printf("matched to Bullet's defaults (10 iterations x 1 sub, %.3f ms): animkit at %d "
-                    "substeps, %.3f ms: "
+                    "substeps x %d contact iterations%s, %.3f ms: "
                     "ratio (Bullet / animkit) %.2f (%.2f-%.2f)\n",
-                    bt_def->med, ak_best->a, ak_best->med, bt_def->med / ak_best->med,
+                    bt_def->med, ak_best->a, ak_best->it, ak_best->b ? " (contacts after joints)" : "",
+                    ak_best->med, bt_def->med / ak_best->med,
                     bt_def->lo / ak_best->hi, bt_def->hi / ak_best->lo);
     else
         std::printf("matched to Bullet's defaults: no animkit setting tried is as stable on every "
@@ -592,7 +636,8 @@ int main(int argc, char** argv) {
     const char* only = nullptr;
     bool do_sweep = false;
     int rounds = 3, ak_ref = 10;
-    std::vector<int> ak_subs = {2, 3, 4, 6, 10}, bt_iters = {10, 20, 50}, bt_subs = {1, 2, 4};
+    std::vector<int> ak_subs = {2, 3, 4, 6, 10}, ak_its = {1}, bt_iters = {10, 20, 50},
+                     bt_subs = {1, 2, 4};
     bool lists_ok = true;
     for (int i = 1; i < argc; i += 2) {
         if (!std::strcmp(argv[i], "--sweep")) { // a flag without a value
@@ -605,11 +650,29 @@ int main(int argc, char** argv) {
             --i;
             continue;
         }
+        if (!std::strcmp(argv[i], "--contacts-after-joints")) { // a flag without a value
+            g_after_joints = true;
+            --i;
+            continue;
+        }
         if (i + 1 >= argc) break;
-        if (!std::strcmp(argv[i], "--rounds"))
+        if (!std::strcmp(argv[i], "--sleep")) {
+            if (!std::strcmp(argv[i + 1], "own"))
+                g_sleep = SLEEP_OWN;
+            else if (!std::strcmp(argv[i + 1], "bullet"))
+                g_sleep = SLEEP_BULLET;
+            else if (!std::strcmp(argv[i + 1], "off"))
+                g_sleep = SLEEP_OFF;
+            else
+                lists_ok = false;
+        } else if (!std::strcmp(argv[i], "--rounds"))
             rounds = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--ak-ref"))
             ak_ref = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--ak-iterations"))
+            lists_ok &= !(ak_its = int_list(argv[i + 1])).empty();
+        else if (!std::strcmp(argv[i], "--contact-iterations"))
+            g_iterations = (unsigned)std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--ak-substeps"))
             lists_ok &= !(ak_subs = int_list(argv[i + 1])).empty();
         else if (!std::strcmp(argv[i], "--bt-iterations"))
@@ -627,19 +690,21 @@ int main(int argc, char** argv) {
     }
     if (layers < 1 || layers > 200 || nspheres < 1 || nspheres > 1000000 || nragdolls < 1 ||
         nragdolls > 10000 || steps < 1 || substeps < 1 || substeps > 1000 || threads < 1 ||
-        threads > 64 || !lists_ok || rounds < 1 || rounds > 100 || ak_ref < 1 || ak_ref > 1000) {
+        threads > 64 || g_iterations < 1 || g_iterations > 64 || !lists_ok || rounds < 1 || rounds > 100 || ak_ref < 1 || ak_ref > 1000) {
         std::fprintf(
             stderr,
             "usage: bench_rigid_vs_bullet [--layers L] [--spheres N] [--ragdolls R] [--steps S] "
             "[--substeps K] [--threads T] [--only pyramid|spheres|ragdolls] [--no-anchors]\n"
-            "       [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-ref 10] "
+            "       [--sleep own|bullet|off] [--contacts-after-joints] [--contact-iterations K]\n"
+            "       [--sweep [--rounds R] [--ak-substeps 2,3,4,6,10] [--ak-iterations 1] [--ak-ref 10] "
             "[--bt-iterations 10,20,50] [--bt-substeps 1,2,4]]\n");
         return 2;
     }
-    std::printf("dt 1/60 s, %d steps, sleeping on; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s%s; Bullet "
+    std::printf("dt 1/60 s, %d steps, %s; animkit XPBD %u substeps x 1 iteration, %u thread(s)%s%s; Bullet "
                 "%d.%02d 1 step x 10 iterations (its defaults), one thread\n",
-                steps, substeps, threads, threads > 1 ? " (wall time)" : "",
-                g_anchors ? ", contact anchors" : ", no contact anchors", btGetVersion() / 100,
+                steps, sleep_name(), substeps, threads, threads > 1 ? " (wall time)" : "",
+                g_anchors ? (g_after_joints ? ", contact anchors, contacts after joints" : ", contact anchors")
+                          : ", no contact anchors", btGetVersion() / 100,
                 btGetVersion() % 100);
     if (!do_sweep)
         std::printf("%-26s %11s %11s %7s %13s %13s %12s %12s %9s %9s\n", "scene", "animkit ms",
@@ -656,8 +721,8 @@ int main(int argc, char** argv) {
     if (do_sweep) {
         for (int k = 0; k < 3; ++k)
             if (!scenes[k].bodies.empty())
-                sweep(names[k], scenes[k], steps, threads, rounds, ak_ref, ak_subs, bt_iters,
-                      bt_subs);
+                sweep(names[k], scenes[k], steps, threads, rounds, ak_ref, ak_subs, ak_its,
+                      bt_iters, bt_subs);
         std::printf("\nmatched: the cheapest setting (median time) whose every measure is at most "
                     "the other\n"
                     "engine's reference; drift: largest horizontal displacement of a body from its "

@@ -891,6 +891,30 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
             }
         }
     }
+    /* contact_iterations: more passes over the normals, on the same rows (friction and the
+     * centres of pressure stay the first pass's) */
+    for (uint32_t it = 1; it < s->m->desc.contact_iterations; ++it)
+        for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
+            uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
+            uint32_t a = cb->c[k0].a, b = cb->c[k0].b;
+            ak_vec3 cxa = cx[a], cta = ct[a], cxb = cx[b], ctb = ct[b];
+            for (uint32_t k = k0; k < k1; ++k) {
+                rigid_contact* c = &cb->c[k];
+                const contact_row* r = &s->rows[k];
+                float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cxb, cxa)) +
+                          ak_vec3_dot(ctb, r->rnb) - ak_vec3_dot(cta, r->rna);
+                if (d <= 0.0f || r->inv_w == 0.0f) continue;
+                if (r->imb != 0.0f && d > s->push_max) d = s->push_max;
+                float dl = d * r->inv_w;
+                c->lambda_n += dl;
+                cxa = ak_vec3_madd(cxa, c->n, dl * r->ima);
+                cta = ak_vec3_madd(cta, r->ta, dl);
+                cxb = ak_vec3_madd(cxb, c->n, -dl * r->imb);
+                ctb = ak_vec3_madd(ctb, r->tb, -dl);
+            }
+            if (s->awake[a]) cx[a] = cxa, ct[a] = cta;
+            if (s->awake[b]) cx[b] = cxb, ct[b] = ctb;
+        }
     /* the summed corrections onto the poses (orientations normalised in update_velocities) */
     for (uint32_t t = 0; t < n; ++t) {
         uint32_t i = list ? list[t] : t;
@@ -1183,6 +1207,33 @@ static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
     }
 }
 
+/* ak_rigid_model_desc.contacts_after_joints: one Gauss-Seidel pass over the substep's contacts
+ * on the current poses (after the joint sweeps), each pushed out along its normal by its exact
+ * depth (the lever arms of the current orientations, not the rows': the joints have turned the
+ * bodies since), its multiplier raised by the push so the velocity solve treats it as pressed.
+ * Normal only: static friction stays the position solve's. */
+static void contacts_after_joints(solver* s, contact_buf* cb) {
+    for (uint32_t gi = 0; gi < cb->group_count; ++gi)
+        for (uint32_t k = cb->groups[gi].start; k < cb->groups[gi].end; ++k) {
+            rigid_contact* c = &cb->c[k];
+            uint32_t a = c->a, b = c->b;
+            if (!s->awake[a] && !s->awake[b]) continue;
+            ak_vec3 ra = ak_quat_rotate(s->q[a], c->la), rb = ak_quat_rotate(s->q[b], c->lb);
+            float d =
+                ak_vec3_dot(ak_vec3_sub(ak_vec3_add(s->x[b], rb), ak_vec3_add(s->x[a], ra)), c->n);
+            if (!(d > 0.0f)) continue;
+            if (s->awake[b] && d > s->push_max) d = s->push_max; /* (see find_pairs) */
+            response oa = respond(s, a, ra, c->n), ob = respond(s, b, rb, c->n);
+            float w = oa.w + ob.w;
+            if (!(w > 0.0f)) continue;
+            float dl = d / w;
+            c->lambda_n += dl;
+            ak_vec3 p = ak_vec3_scale(c->n, dl);
+            apply_position_impulse(s, a, ra, p, 1.0f);
+            apply_position_impulse(s, b, rb, p, -1.0f);
+        }
+}
+
 static uint32_t uf_find(uint32_t* parent, uint32_t i) {
     while (parent[i] != i) {
         parent[i] = parent[parent[i]];
@@ -1313,6 +1364,7 @@ static void* solve_islands(void* arg) {
             solve_positions(s, &cb, bodies, nb);
             sweep_chain_list(s, t->order, t->start, t->ichains + is->chain0,
                              is->chain1 - is->chain0, 8);
+            if (d->contacts_after_joints) contacts_after_joints(s, &cb);
             update_velocities(s, bodies, nb);
             damp_drives(s, joints, nj);
             solve_velocities(s, &cb, t->gmag);
@@ -1827,6 +1879,7 @@ ak_result akp_rigid_step_run(const ak_rigid_step_job* job, bool islands) {
                     akp_run_tasks(sweep_chains, tasks, sizeof tasks[0], tasks_n);
                 else if (nj)
                     sweep_chains(&tasks[0]);
+                if (m->desc.contacts_after_joints) contacts_after_joints(&s, &cb);
                 update_velocities(&s, NULL, n);
                 damp_drives(&s, NULL, nj);
                 solve_velocities(&s, &cb, gmag);
