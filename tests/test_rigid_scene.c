@@ -19,6 +19,8 @@ AK_TEST(rigid_scene_from_bytes) {
     const char* text =
         "{\"gravity\": [0, -3, 1], \"dt\": 0.01, \"steps\": 7, \"substeps\": 5, \"threads\": 2,"
         " \"linear_damping\": 0.25, \"angular_damping\": 0.5, \"contact_offset\": 0.02, \"sleep\": false,"
+        " \"contact_iterations\": 3, \"contacts_after_joints\": true, \"sleep_linear_speed\": 0.8,"
+        " \"sleep_angular_speed\": 1.0, \"sleep_time\": 2,"
         " \"bodies\": ["
         "  {\"shape\": {\"type\": \"plane\", \"normal\": [0, 2, 0]}, \"static\": true, \"friction\": 0},"
         "  {\"shape\": {\"type\": \"box\", \"half_extents\": [0.1, 0.2, 0.3]}, \"position\": [1, 2, 3],"
@@ -41,6 +43,11 @@ AK_TEST(rigid_scene_from_bytes) {
     AK_CHECK_NEAR(s.model.angular_damping, 0.5f, 0.0f);
     AK_CHECK_NEAR(s.model.contact_offset, 0.02f, 0.0f);
     AK_CHECK(!s.sleep);
+    AK_CHECK_EQ(s.model.contact_iterations, 3u);
+    AK_CHECK(s.model.contacts_after_joints);
+    AK_CHECK_NEAR(s.model.sleep_linear_speed, 0.8f, 0.0f);
+    AK_CHECK_NEAR(s.model.sleep_angular_speed, 1.0f, 0.0f);
+    AK_CHECK_NEAR(s.model.sleep_time, 2.0f, 0.0f);
     AK_CHECK_EQ(s.body_count, 3u);
     AK_CHECK_EQ(s.joint_count, 1u);
     if (s.body_count == 3 && s.joint_count == 1) {
@@ -99,6 +106,10 @@ AK_TEST(rigid_scene_from_bytes) {
     AK_CHECK_EQ(s.thread_count, 1u);
     AK_CHECK(s.sleep);
     AK_CHECK_NEAR(s.model.contact_offset, 0.01f, 0.0f);
+    AK_CHECK(s.model.contact_iterations <= 1u); /* one pass (0 and 1 both mean it) */
+    AK_CHECK(!s.model.contacts_after_joints);
+    /* 0: the model's defaults, 0.05 m/s, 0.05 rad/s, 0.5 s */
+    AK_CHECK(s.model.sleep_linear_speed == 0.0f && s.model.sleep_angular_speed == 0.0f && s.model.sleep_time == 0.0f);
     AK_CHECK_EQ(s.body_count, 1u);
     AK_CHECK_EQ(s.joint_count, 0u);
     if (s.body_count == 1) AK_CHECK_NEAR(s.bodies[0].density, 1000.0f, 0.0f);
@@ -126,6 +137,11 @@ AK_TEST(rigid_scene_errors_name_key_paths) {
          "t.json: joints[0].bodies: a body index is out of range (the scene has 1 bodies)"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"steps\": 1.5}", "t.json: steps"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"substeps\": 1001}", "t.json: substeps"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"contact_iterations\": 65}",
+         "t.json: contact_iterations"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"contacts_after_joints\": 1}",
+         "t.json: contacts_after_joints"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"sleep_time\": 0}", "t.json: sleep_time"},
         {"{\"bodies\": [", "t.json: invalid JSON"},
         {"[1]", "t.json: "},
         {"", "t.json: "},

@@ -395,7 +395,8 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
             "gravity",         "bodies",         "joints",  "dt",
             "steps",           "substeps",       "threads", "linear_damping",
             "angular_damping", "contact_offset", "sleep",   "max_contacts",
-            NULL};
+            "contact_iterations", "contacts_after_joints", "sleep_linear_speed", "sleep_angular_speed",
+            "sleep_time", NULL};
         akp_json_object(&j, root, "", keys);
         akp_json_vec3(&j, root, "", "gravity", &s->gravity);
         if (!j.failed && ak_vec3_length(s->gravity) > 1e4f)
@@ -413,6 +414,14 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
         long mc = (long)s->model.max_contacts;
         akp_json_int(&j, root, "", "max_contacts", 0, 100000000, &mc);
         s->model.max_contacts = (uint32_t)mc;
+        long ci = s->model.contact_iterations ? (long)s->model.contact_iterations : 1;
+        akp_json_int(&j, root, "", "contact_iterations", 1, AK_RIGID_MAX_CONTACT_ITERATIONS, &ci);
+        s->model.contact_iterations = (uint32_t)ci;
+        akp_json_bool(&j, root, "", "contacts_after_joints", &s->model.contacts_after_joints);
+        /* 0 in the model means the default; a file gives a real threshold, above 0 */
+        akp_json_float(&j, root, "", "sleep_linear_speed", 1e-6f, 100.0f, &s->model.sleep_linear_speed);
+        akp_json_float(&j, root, "", "sleep_angular_speed", 1e-6f, 100.0f, &s->model.sleep_angular_speed);
+        akp_json_float(&j, root, "", "sleep_time", 1e-6f, 1e3f, &s->model.sleep_time);
         size_t n = 0;
         const cJSON* e = akp_json_array(&j, root, "", "bodies", AK_RIGID_SCENE_MAX_BODIES, &n);
         if (!j.failed && n == 0)
