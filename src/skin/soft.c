@@ -78,6 +78,9 @@ struct ak_skin_soft {
     /* contact beyond a joint's two bones at a deep bend (release_nodes) */
     float cell;             /* lattice cube edge */
     uint8_t* plane_bent0;   /* [plane] 1: the two bones part by more than 90 deg at the bind pose */
+    ak_vec3* plane_bisector; /* [plane] the bind pose's unit bisector of the two bones' directions
+                                (plane_normal, release_nodes); zero where they meet nearly
+                                antiparallel (|sum of the unit directions| <= 0.05) */
     uint32_t* xnode_start;  /* [plane + 1] ranges of xnode */
     int32_t* xnode;         /* +(n + 1) parent side, -(n + 1) child side: a node of a part beyond
                                the joint's two bones (the hips, the foot), gated each step */
@@ -191,6 +194,7 @@ void ak_skin_soft_destroy(ak_skin_soft* s) {
     akp_free(a, s->planes);
     akp_free(a, s->node_planes);
     akp_free(a, s->plane_bent0);
+    akp_free(a, s->plane_bisector);
     akp_free(a, s->xnode_start);
     akp_free(a, s->xnode);
     akp_free(a, s->snode_start);
@@ -877,6 +881,7 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     {
         const uint32_t np = s->plane_count;
         SOFT_ALLOC(s->plane_bent0, uint8_t, np + 1);
+        SOFT_ALLOC(s->plane_bisector, ak_vec3, np + 1);
         SOFT_ALLOC(s->xnode_start, uint32_t, np + 1);
         SOFT_ALLOC(s->snode_start, uint32_t, 2 * np + 1);
         const size_t jw = ((size_t)s->max_joint + 64) / 64;
@@ -904,6 +909,7 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
                 ak_vec3 dp = ak_vec3_normalize(ak_vec3_sub(P1->tail, P1->head)), dc = ak_vec3_normalize(ak_vec3_sub(C1->tail, C1->head));
                 s->plane_bent0[pl] = ak_vec3_dot(dp, dc) <= SOFT_RELEASE_BEND_COS;
                 ak_vec3 u = ak_vec3_add(dp, dc);
+                s->plane_bisector[pl] = ak_vec3_length(u) > 0.05f ? ak_vec3_normalize(u) : ak_vec3_zero();
                 if (s->plane_bent0[pl] || ak_vec3_length(u) < 0.1f) continue;
                 const ak_vec3 nrm = ak_vec3_normalize(u);
                 memset(jset, 0, 2 * jw * sizeof(uint64_t));
@@ -1379,14 +1385,14 @@ static void sync(soft_team* t) {
  * folding to 150 deg (13.6 in the step before, 3.75 while the bend was shallow), its far parts
  * sweeping the flesh at 10-19 m/s while no point of the bones moved faster than 3 m/s: 219 J
  * (docs/softskin.md). The halfway rotation turns at half the bones' relative rate. Bones that
- * meet nearly antiparallel at the bind pose (no bind bisector) keep u. */
-static ak_vec3 plane_normal(const ak_skin_bone* bp, const ak_skin_bone* bc, ak_mat4 mp, ak_mat4 mc, ak_vec3 u) {
-    ak_vec3 u0 = ak_vec3_add(ak_vec3_normalize(ak_vec3_sub(bp->tail, bp->head)), ak_vec3_normalize(ak_vec3_sub(bc->tail, bc->head)));
-    if (!(ak_vec3_length(u0) > 0.05f)) return ak_vec3_normalize(u);
+ * meet nearly antiparallel at the bind pose (no bind bisector) keep u. u0 is the plane's bind
+ * bisector (s->plane_bisector, computed once at create; zero for those bones). */
+static ak_vec3 plane_normal(ak_vec3 u0, ak_mat4 mp, ak_mat4 mc, ak_vec3 u) {
+    if (u0.x == 0.0f && u0.y == 0.0f && u0.z == 0.0f) return ak_vec3_normalize(u);
     ak_quat qp = ak_quat_from_mat3(ak_mat4_to_mat3(mp)), qc = ak_quat_from_mat3(ak_mat4_to_mat3(mc));
     if (ak_quat_dot(qp, qc) < 0.0f) qc = ak_quat_neg(qc);
     ak_quat mid = ak_quat_normalize(ak_quat_add(qp, qc));
-    return ak_vec3_normalize(ak_quat_rotate(mid, ak_vec3_normalize(u0)));
+    return ak_vec3_normalize(ak_quat_rotate(mid, u0));
 }
 
 /* The colliders at fraction `frac` of the step: the bone cores' segments and the joint planes
@@ -1507,15 +1513,15 @@ static void release_nodes(const ak_skin_soft* s, step_ctx* c, const ak_mat4* pal
         const ak_skin_bone *P1 = &s->bones[bp], *C1 = &s->bones[bc];
         /* the plane at the bind pose: a node already within the cone there (the bones of a hip
          * or a shoulder meet at a steep angle at rest) stays kinematic */
-        ak_vec3 u0 = ak_vec3_add(ak_vec3_normalize(ak_vec3_sub(P1->tail, P1->head)), ak_vec3_normalize(ak_vec3_sub(C1->tail, C1->head)));
-        if (!(ak_vec3_length(u0) > 0.05f)) continue;
+        const ak_vec3 nrm0 = s->plane_bisector[pl];
+        if (nrm0.x == 0.0f && nrm0.y == 0.0f && nrm0.z == 0.0f) continue;
         { /* bent past SOFT_RELEASE_BEND_COS (90 deg): a walk's knees and elbows stay as before */
             const ak_mat4 mp = palette[P1->joint_index], mc = palette[C1->joint_index];
             ak_vec3 up = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mp, P1->tail), ak_mat4_transform_point(mp, P1->head)));
             ak_vec3 uc = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mc, C1->tail), ak_mat4_transform_point(mc, C1->head)));
             if (ak_vec3_dot(up, uc) > SOFT_RELEASE_BEND_COS) continue;
         }
-        const ak_vec3 nrm0 = ak_vec3_normalize(u0), o0 = P1->tail;
+        const ak_vec3 o0 = P1->tail;
         const float reach = ak_maxf(ak_vec3_distance(P1->head, P1->tail), ak_vec3_distance(C1->head, C1->tail)) +
                             2.0f * ak_maxf(s->contact_radius[bp], s->contact_radius[bc]);
         for (size_t n = 0; n < nn; ++n) {
@@ -1627,7 +1633,7 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
             ak_vec3 u = ak_vec3_add(up, uc);
             planes[2 * pl] = ak_mat4_transform_point(mp, bp->tail);
             /* folded: off (|u| = 2 cos(a / 2) at an angle a between the bones: 0.05 is 177.1 deg) */
-            planes[2 * pl + 1] = ak_vec3_length(u) > 0.05f ? plane_normal(bp, bc, mp, mc, u) : ak_vec3_zero();
+            planes[2 * pl + 1] = ak_vec3_length(u) > 0.05f ? plane_normal(s->plane_bisector[pl], mp, mc, u) : ak_vec3_zero();
             if (end) c.plane_active[pl] = !s->plane_bent0[pl] && ak_vec3_length(u) > 0.05f && ak_vec3_dot(up, uc) <= SOFT_RELEASE_BEND_COS;
         }
     }
