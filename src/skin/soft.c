@@ -42,6 +42,17 @@
  * lost 1.02% of the enclosed volume (0.85% at 3): 3 is the edge of a narrow window, not a
  * margin */
 #define SOFT_CONTACT_REACH 3.0f
+/* A bone (kinematic) node of the parts beyond a joint's two bones, gated as above, is let go by
+ * degrees from SOFT_LET_GO cubes of the joint's plane (its skinned position): simulated, tied to
+ * its skinned position by a spring of SOFT_TETHER_OMEGA / (1 - f)^2 rad/s, f rising linearly from
+ * 0 at half a cube (where it was let go at once before, with the plain tether) to 1 at
+ * SOFT_LET_GO (kinematic). Let go at once, the pelvis's bone nodes behind CesiumMan's buttock
+ * were freed in the last frame of a knee's fold to 150 deg while the knee's plane pressed the
+ * buttock's flesh against them: the strain stored against them threw them forward at 7 m/s
+ * and the held flesh's kinetic energy rose from 8 to 33 J within four substeps (54-59 J at the
+ * step's end). From 2, 3 or 4 cubes, the spring's rate 1 / (1 - f)^0.5, 1 or 2: 30-36 J; the
+ * last held the pose best (docs/softskin.md) */
+#define SOFT_LET_GO 3.0f
 
 struct ak_skin_soft {
     ak_allocator alloc;
@@ -78,6 +89,9 @@ struct ak_skin_soft {
     /* contact beyond a joint's two bones at a deep bend (release_nodes) */
     float cell;             /* lattice cube edge */
     uint8_t* plane_bent0;   /* [plane] 1: the two bones part by more than 90 deg at the bind pose */
+    ak_vec3* plane_bisector; /* [plane] the bind pose's unit bisector of the two bones' directions
+                                (plane_normal, release_nodes); zero where they meet nearly
+                                antiparallel (|sum of the unit directions| <= 0.05) */
     uint32_t* xnode_start;  /* [plane + 1] ranges of xnode */
     int32_t* xnode;         /* +(n + 1) parent side, -(n + 1) child side: a node of a part beyond
                                the joint's two bones (the hips, the foot), gated each step */
@@ -191,6 +205,7 @@ void ak_skin_soft_destroy(ak_skin_soft* s) {
     akp_free(a, s->planes);
     akp_free(a, s->node_planes);
     akp_free(a, s->plane_bent0);
+    akp_free(a, s->plane_bisector);
     akp_free(a, s->xnode_start);
     akp_free(a, s->xnode);
     akp_free(a, s->snode_start);
@@ -877,6 +892,7 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
     {
         const uint32_t np = s->plane_count;
         SOFT_ALLOC(s->plane_bent0, uint8_t, np + 1);
+        SOFT_ALLOC(s->plane_bisector, ak_vec3, np + 1);
         SOFT_ALLOC(s->xnode_start, uint32_t, np + 1);
         SOFT_ALLOC(s->snode_start, uint32_t, 2 * np + 1);
         const size_t jw = ((size_t)s->max_joint + 64) / 64;
@@ -904,6 +920,7 @@ ak_result ak_skin_soft_create(const ak_skin_soft_desc* desc_in, const ak_allocat
                 ak_vec3 dp = ak_vec3_normalize(ak_vec3_sub(P1->tail, P1->head)), dc = ak_vec3_normalize(ak_vec3_sub(C1->tail, C1->head));
                 s->plane_bent0[pl] = ak_vec3_dot(dp, dc) <= SOFT_RELEASE_BEND_COS;
                 ak_vec3 u = ak_vec3_add(dp, dc);
+                s->plane_bisector[pl] = ak_vec3_length(u) > 0.05f ? ak_vec3_normalize(u) : ak_vec3_zero();
                 if (s->plane_bent0[pl] || ak_vec3_length(u) < 0.1f) continue;
                 const ak_vec3 nrm = ak_vec3_normalize(u);
                 memset(jset, 0, 2 * jw * sizeof(uint64_t));
@@ -1061,7 +1078,7 @@ size_t ak_skin_soft_step_scratch_size(const ak_skin_soft* s) {
     return 64 + 2 * s->node_count * sizeof(soft_p4) + akp_align16(3 * s->node_count * sizeof(ak_vec3)) +
            akp_align16(2 * s->tet_count * sizeof(float)) + akp_align16(s->bone_count * sizeof(posed_bone)) +
            akp_align16(4 * s->bone_count * sizeof(ak_vec3)) + 3 * akp_align16(2 * s->plane_count * sizeof(ak_vec3)) +
-           akp_align16(s->node_count * sizeof(int32_t)) + akp_align16(s->plane_count + 1);
+           akp_align16(s->node_count * sizeof(int32_t)) + akp_align16(s->plane_count + 1) + akp_align16(s->node_count * sizeof(float));
 }
 
 ak_result ak_skin_soft_step_validate(const ak_skin_soft_step_job* j) {
@@ -1093,6 +1110,7 @@ typedef struct step_ctx {
     float tether; /* (omega h)^2 / (1 + (omega h)^2): the XPBD step of a released node's tether */
     float* lambda;
     float h, gamma, adev, ahyd;
+    float* hold; /* [node] a released kinematic node's tether step (release_nodes) */
     bool simd; /* the CPU runs solve_tets8 */
     uint32_t iterations; /* adev = 1 / (mu h^2), ahyd = 1 / (lambda h^2): divide by V */
     float hyd_rest;             /* 1 + mu / lambda */
@@ -1379,14 +1397,14 @@ static void sync(soft_team* t) {
  * folding to 150 deg (13.6 in the step before, 3.75 while the bend was shallow), its far parts
  * sweeping the flesh at 10-19 m/s while no point of the bones moved faster than 3 m/s: 219 J
  * (docs/softskin.md). The halfway rotation turns at half the bones' relative rate. Bones that
- * meet nearly antiparallel at the bind pose (no bind bisector) keep u. */
-static ak_vec3 plane_normal(const ak_skin_bone* bp, const ak_skin_bone* bc, ak_mat4 mp, ak_mat4 mc, ak_vec3 u) {
-    ak_vec3 u0 = ak_vec3_add(ak_vec3_normalize(ak_vec3_sub(bp->tail, bp->head)), ak_vec3_normalize(ak_vec3_sub(bc->tail, bc->head)));
-    if (!(ak_vec3_length(u0) > 0.05f)) return ak_vec3_normalize(u);
+ * meet nearly antiparallel at the bind pose (no bind bisector) keep u. u0 is the plane's bind
+ * bisector (s->plane_bisector, computed once at create; zero for those bones). */
+static ak_vec3 plane_normal(ak_vec3 u0, ak_mat4 mp, ak_mat4 mc, ak_vec3 u) {
+    if (u0.x == 0.0f && u0.y == 0.0f && u0.z == 0.0f) return ak_vec3_normalize(u);
     ak_quat qp = ak_quat_from_mat3(ak_mat4_to_mat3(mp)), qc = ak_quat_from_mat3(ak_mat4_to_mat3(mc));
     if (ak_quat_dot(qp, qc) < 0.0f) qc = ak_quat_neg(qc);
     ak_quat mid = ak_quat_normalize(ak_quat_add(qp, qc));
-    return ak_vec3_normalize(ak_quat_rotate(mid, ak_vec3_normalize(u0)));
+    return ak_vec3_normalize(ak_quat_rotate(mid, u0));
 }
 
 /* The colliders at fraction `frac` of the step: the bone cores' segments and the joint planes
@@ -1453,10 +1471,10 @@ static void step_work(soft_team* team, uint32_t index) {
         const float back = c->h * (float)(S - sub - 1);
         for (size_t n = nb; n < ne; ++n) {
             const bool sim = !s->kinematic[n] || c->released[n];
-            if (sim && s->kinematic[n] && c->tether > 0.0f) {
+            if (sim && s->kinematic[n] && c->hold[n] > 0.0f) {
                 /* a released kinematic node: its tether to the skinned position at this substep */
                 ak_vec3 t = ak_vec3_madd(c->target[n], c->vref[n], -back);
-                c->x[n].p = ak_vec3_madd(c->x[n].p, ak_vec3_sub(t, c->x[n].p), c->tether);
+                c->x[n].p = ak_vec3_madd(c->x[n].p, ak_vec3_sub(t, c->x[n].p), c->hold[n]);
             }
             if (sim) collide_node(c, n);
             c->v[n] = ak_vec3_scale(ak_vec3_sub(c->x[n].p, c->prev[n].p), inv_h);
@@ -1507,15 +1525,15 @@ static void release_nodes(const ak_skin_soft* s, step_ctx* c, const ak_mat4* pal
         const ak_skin_bone *P1 = &s->bones[bp], *C1 = &s->bones[bc];
         /* the plane at the bind pose: a node already within the cone there (the bones of a hip
          * or a shoulder meet at a steep angle at rest) stays kinematic */
-        ak_vec3 u0 = ak_vec3_add(ak_vec3_normalize(ak_vec3_sub(P1->tail, P1->head)), ak_vec3_normalize(ak_vec3_sub(C1->tail, C1->head)));
-        if (!(ak_vec3_length(u0) > 0.05f)) continue;
+        const ak_vec3 nrm0 = s->plane_bisector[pl];
+        if (nrm0.x == 0.0f && nrm0.y == 0.0f && nrm0.z == 0.0f) continue;
         { /* bent past SOFT_RELEASE_BEND_COS (90 deg): a walk's knees and elbows stay as before */
             const ak_mat4 mp = palette[P1->joint_index], mc = palette[C1->joint_index];
             ak_vec3 up = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mp, P1->tail), ak_mat4_transform_point(mp, P1->head)));
             ak_vec3 uc = ak_vec3_normalize(ak_vec3_sub(ak_mat4_transform_point(mc, C1->tail), ak_mat4_transform_point(mc, C1->head)));
             if (ak_vec3_dot(up, uc) > SOFT_RELEASE_BEND_COS) continue;
         }
-        const ak_vec3 nrm0 = ak_vec3_normalize(u0), o0 = P1->tail;
+        const ak_vec3 o0 = P1->tail;
         const float reach = ak_maxf(ak_vec3_distance(P1->head, P1->tail), ak_vec3_distance(C1->head, C1->tail)) +
                             2.0f * ak_maxf(s->contact_radius[bp], s->contact_radius[bc]);
         for (size_t n = 0; n < nn; ++n) {
@@ -1533,6 +1551,7 @@ static void release_nodes(const ak_skin_soft* s, step_ctx* c, const ak_mat4* pal
             if (own < SOFT_RELEASE_CONE * dist) {
                 c->released[n] = parent ? (int32_t)pl + 1 : -((int32_t)pl + 1);
                 c->x[n].w = s->mass[n] > 0.0f ? 1.0f / s->mass[n] : 0.0f;
+                c->hold[n] = c->tether;
             }
         }
     }
@@ -1547,7 +1566,8 @@ static void release_nodes(const ak_skin_soft* s, step_ctx* c, const ak_mat4* pal
             if (c->released[n]) continue;
             const bool kin = s->kinematic[n] != 0;
             const ak_vec3 p = c->target[n]; /* skinned: the gate does not flicker with the flesh */
-            if (kin && (e > 0 ? -1.0f : 1.0f) * ak_vec3_dot(ak_vec3_sub(p, o), nrm) >= 0.5f * s->cell) continue;
+            const float own = (e > 0 ? -1.0f : 1.0f) * ak_vec3_dot(ak_vec3_sub(p, o), nrm);
+            if (kin && own >= SOFT_LET_GO * s->cell) continue;
             /* a node above the upper bone meets the parts below the lower bone; one below the
              * lower bone meets the whole parent side */
             const uint32_t r0 = s->snode_start[e > 0 ? 2 * pl + 1 : 2 * pl], r1 = s->snode_start[e > 0 ? 2 * pl + 2 : 2 * pl + 1];
@@ -1555,7 +1575,12 @@ static void release_nodes(const ak_skin_soft* s, step_ctx* c, const ak_mat4* pal
             for (uint32_t k = r0; k < r1 && !near; ++k) near = ak_vec3_length_sq(ak_vec3_sub(c->target[s->snode[k]], p)) < reach2;
             if (!near) continue;
             c->released[n] = e > 0 ? (int32_t)pl + 1 : -((int32_t)pl + 1);
-            if (kin) c->x[n].w = s->mass[n] > 0.0f ? 1.0f / s->mass[n] : 0.0f;
+            if (kin) { /* let go by degrees: its tether 30 rad/s / (1 - f)^2, f from 0 at half a cube to 1 at SOFT_LET_GO */
+                c->x[n].w = s->mass[n] > 0.0f ? 1.0f / s->mass[n] : 0.0f;
+                const float f = ak_clampf((own - 0.5f * s->cell) / ((SOFT_LET_GO - 0.5f) * s->cell), 0.0f, 0.999f);
+                const float om = SOFT_TETHER_OMEGA / ((1.0f - f) * (1.0f - f)), wh2 = om * c->h * om * c->h;
+                c->hold[n] = wh2 / (1.0f + wh2);
+            }
         }
     }
 }
@@ -1584,6 +1609,7 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
     c.psub = (ak_vec3*)(void*)((uint8_t*)c.planes0 + plane_bytes);
     c.released = (int32_t*)(void*)((uint8_t*)c.psub + plane_bytes);
     c.plane_active = (uint8_t*)c.released + akp_align16(nn * sizeof(int32_t));
+    c.hold = (float*)(void*)(c.plane_active + akp_align16(s->plane_count + 1));
     float dt = j->dt > 0.0f ? j->dt : 1.0f / 60.0f;
     c.h = dt / (float)s->substeps;
     c.gamma = s->damping / c.h;
@@ -1627,7 +1653,7 @@ ak_result ak_skin_soft_step_run(const ak_skin_soft_step_job* j) {
             ak_vec3 u = ak_vec3_add(up, uc);
             planes[2 * pl] = ak_mat4_transform_point(mp, bp->tail);
             /* folded: off (|u| = 2 cos(a / 2) at an angle a between the bones: 0.05 is 177.1 deg) */
-            planes[2 * pl + 1] = ak_vec3_length(u) > 0.05f ? plane_normal(bp, bc, mp, mc, u) : ak_vec3_zero();
+            planes[2 * pl + 1] = ak_vec3_length(u) > 0.05f ? plane_normal(s->plane_bisector[pl], mp, mc, u) : ak_vec3_zero();
             if (end) c.plane_active[pl] = !s->plane_bent0[pl] && ak_vec3_length(u) > 0.05f && ak_vec3_dot(up, uc) <= SOFT_RELEASE_BEND_COS;
         }
     }
