@@ -1092,13 +1092,13 @@ typedef struct vision_acc {
     float need_right, need_left; /* turn-rate bounds from the threats */
     bool right, left;
     float ttc_min;
-    float ttc_first;  /* the most imminent threat a turn can move (first in pixel order on a tie) */
+    float tti_first;  /* the most imminent threat a turn can move (first in pixel order on a tie) */
     bool first_right; /* and its side: its bearing rate >= 0, cleared by turning right */
 } vision_acc;
 
 /* One pixel of the view: the visible object's point rp relative to the agent (along the unit
  * direction d), its velocity ovel, whether it is an agent. */
-static VISION_INLINE void vision_pixel(vision_acc* acc, ak_vec2 head, float speed, float pref_len,
+static VISION_INLINE void vision_pixel(vision_acc* acc, const ak_crowd_agent* a, ak_vec2 head, float speed, float pref_len,
                          ak_vec2 v, ak_vec2 d, ak_vec2 rp, ak_vec2 ovel, bool agent) {
     /* the pixel's point relative to the agent, and its relative velocity */
     const ak_vec2 rv = sub(ovel, v);
@@ -1106,9 +1106,14 @@ static VISION_INLINE void vision_pixel(vision_acc* acc, ak_vec2 head, float spee
     const float closing = -dot(rp, rv); /* > 0 when approaching (times |rp|) */
     if (!(closing > 0.0f)) return;
     const float dist = sqrtf(dist2);
-    const float ttc = closing / abs_sq(rv); /* time to interaction: to the closest approach */
+    /* time to interaction: to the point's closest approach (the threat test and the turn's
+     * side); the speed reads the time to contact, until the point is one radius away along
+     * the line of sight at the present closing speed (a point passing beside has its closest
+     * approach now, but never touches) */
+    const float tti = closing / abs_sq(rv);
+    const float ttc = fmaxf(dist - a->radius, 0.0f) * dist / closing;
     const float rate = dist2 > 0.0f ? det(rp, rv) / dist2 : 0.0f; /* bearing rate, rad/s */
-    const float thr = 0.6f * powf(fmaxf(ttc, 1e-3f), -1.5f);
+    const float thr = 0.6f * powf(fmaxf(tti, 1e-3f), -1.5f);
     if (fabsf(rate) >= thr) return; /* not a threat: it will pass */
     /* an agent standing or shuffling (under VISION_STAND_SPEED: parked, or jostled on its
      * place) slows the agent to 30% of pref_speed at most (ttc 0.845 s) and does not turn
@@ -1125,7 +1130,7 @@ static VISION_INLINE void vision_pixel(vision_acc* acc, ak_vec2 head, float spee
      * it over the threshold (points beside or behind do not respond to a turn). */
     const float k = fmaxf(speed, 0.1f * pref_len) * dot(head, d) / dist;
     if (!(k > 1e-4f)) return;
-    if (ttc < acc->ttc_first) acc->ttc_first = ttc, acc->first_right = rate >= 0.0f;
+    if (tti < acc->tti_first) acc->tti_first = tti, acc->first_right = rate >= 0.0f;
     if (rate >= 0.0f) {
         acc->right = true;
         acc->need_right = fminf(acc->need_right, (rate - thr) / k); /* delta <= this (< 0: clockwise) */
@@ -1302,7 +1307,7 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
                     if (id == 0 || id > na + no) continue;
                     const bool agent = id <= na;
                     const ak_vec2 ovel = agent ? job->velocities.ptr[nkey_index(w->agent_n[id - 1])] : v2(0.0f, 0.0f);
-                    vision_pixel(&acc, head, speed, pref_len, v, d, rp, ovel, agent);
+                    vision_pixel(&acc, a, head, speed, pref_len, v, d, rp, ovel, agent);
                 }
     } else {
         for (uint32_t k = 0; k < W; ++k) {
@@ -1313,7 +1318,7 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
             uint32_t object;
             const float best = vision_cast(w, p, d, na, no, &ovel, &agent, &object);
             if (!(best < INFINITY)) continue;
-            vision_pixel(&acc, head, speed, pref_len, v, d, mul(best, d), ovel, agent);
+            vision_pixel(&acc, a, head, speed, pref_len, v, d, mul(best, d), ovel, agent);
         }
     }
     const float need_right = acc.need_right, need_left = acc.need_left, ttc_min = acc.ttc_min;

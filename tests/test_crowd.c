@@ -379,9 +379,10 @@ AK_TEST(vision_head_on_and_crossing) {
         AK_CHECK(run_init(&r, &desc, start));
         AK_CHECK_EQ(run_steps(&r, 0.1f, 1, 600, true), AK_OK);
         AK_CHECK_MSG(all_reached(&r), "%zu agents: not all reached after %d steps", n, r.steps_done);
-        /* they steer round each other (0.46 m and 0.37 m measured), not shoulder through on the
-         * contact projection (a turn rate of the seen rate minus the threshold, the paper's
-         * rule taken literally, left them touching: 0.0000 m) */
+        /* they steer round each other (2.45 m and 2.73 m measured with the ray cast, 2.61 m and
+         * 2.70 m with the raster view; 0.46 m and 0.37 m before the time to closest approach),
+         * not shoulder through on the contact projection (a turn rate of the seen rate minus
+         * the threshold, the paper's rule taken literally, left them touching: 0.0000 m) */
         AK_CHECK_MSG(r.min_clearance >= 0.2, "%zu agents: min clearance %g", n, r.min_clearance);
         printf("  vision (%s), %zu agents: %d steps, min clearance %.4f m\n", view ? "raster" : "raycast", n,
                r.steps_done, r.min_clearance);
@@ -644,10 +645,12 @@ AK_TEST(lane_order_measure) {
 
 /* Lanes under vision-based steering: in the corridor preset (100 agents, two blocks head-on)
  * the flows sort into lanes as the paper's corridor shows: Phi over the run >= 0.35 and at
- * least 0.2 over Phi_mix (mixed flows give Phi ~ Phi_mix: the rule before the time to
- * interaction and the passing side of the most imminent threat had Phi -0.01 against Phi_mix
- * 0.01; now 0.56 against 0.20, and 0.49-0.78 with 40-400 agents; ORCA 0.87); and the run
- * still gets everyone home within the preset's steps without an overlap over 1 mm. */
+ * least 0.15 over Phi_mix (flows mixed across the width give Phi ~ Phi_mix). Measured: the
+ * rule before (the time to contact for the threat test, the smaller turn's side) Phi -0.01
+ * against Phi_mix 0.01, and -0.11 to 0.07 over Phi_mix -0.03 to 0.01 with 40, 60 and 200
+ * agents (the largest difference 0.05); now 0.49 against 0.24, and 0.42-0.63 with 40, 60 and
+ * 200 (the smallest difference 0.25); ORCA 0.87 against 0.08. The thresholds sit between.
+ * And the run still gets everyone home within the preset's steps, no overlap over 1 mm. */
 AK_TEST(vision_corridor_lanes) {
     ak_crowd_scene sc;
     ak_diag d;
@@ -679,7 +682,7 @@ AK_TEST(vision_corridor_lanes) {
     const double phi = count ? sum[0] / (double)count : NAN, phi_mix = count ? sum[1] / (double)count : NAN;
     printf("  vision, corridor 100: lane order %.3f (mixed flows' %.3f) over %zu agent-steps; %d of %ld steps, %zu "
            "home, min clearance %.5f m\n", phi, phi_mix, count, r.steps_done, sc.steps, home, r.min_clearance);
-    AK_CHECK_MSG(phi >= 0.35 && phi - phi_mix >= 0.2, "no lanes: lane order %g, mixed %g", phi, phi_mix);
+    AK_CHECK_MSG(phi >= 0.35 && phi - phi_mix >= 0.15, "no lanes: lane order %g, mixed %g", phi, phi_mix);
     AK_CHECK_MSG(home == r.n, "%zu of %zu home after %ld steps", home, r.n, sc.steps);
     AK_CHECK_MSG(r.min_clearance >= -1e-3, "min clearance %g", r.min_clearance);
     free(walking);
