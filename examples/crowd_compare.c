@@ -7,7 +7,12 @@
  * index over the whole run: 1 - (share of the other group among the agents within 3 m along x
  * and 0.3 m across, of an agent where |x| < 10 m) / (that share within 3 m along x at any z):
  * 0 when the groups are mixed across the width, 1 when they walk in separate lanes, whatever
- * their number and place) and the step time. docs/crowd.md's ORCA/vision table comes from it:
+ * their number and place), the lane order Phi of the two flows (each walking agent that meets
+ * the other flow within 3 m ahead: (own - other) / (own + other) among the walking agents
+ * within 3 m ahead and 0.5 m across; Phi is its mean over agents and steps, 1 in lanes; Phi_mix
+ * the same over the whole width ahead, which mixed flows match: docs/crowd.md, "Lanes"; with
+ * ANIMKIT_PHI_EVERY=K in the environment also per K steps) and the step time. docs/crowd.md's
+ * ORCA/vision table comes from it:
  *     example_crowd_compare [PRESET|SCENE.json [AGENTS [raycast|raster]]]   (default: crossing 24)
  * A scene file (AGENTS ignored; its "vision_view" unless the third argument says) gets the
  * corridor's lane measures (its groups 0 and 1). The third argument is the vision run's view.
@@ -23,6 +28,29 @@
 
 static double seconds(void) {
     return (double)clock() / CLOCKS_PER_SEC;
+}
+
+/* Lane order (see the top): adds each meeting agent's order to sum[0] (band across) and to
+ * sum[1] (any z), and counts them in *count. Group 0 walks +x, group 1 -x. */
+static void lane_order(size_t n, const ak_vec2* p, const uint8_t* group, const bool* walking, double sum[2],
+                       size_t* count) {
+    for (size_t i = 0; i < n; ++i) {
+        if (!walking[i] || group[i] > 1) continue;
+        const double dir = group[i] == 0 ? 1.0 : -1.0;
+        int s[2] = {0, 0}, o[2] = {0, 0};
+        for (size_t j = 0; j < n; ++j) {
+            if (j == i || !walking[j] || group[j] > 1) continue;
+            const double ahead = ((double)p[j].x - p[i].x) * dir;
+            if (!(ahead > 0.0 && ahead <= 3.0)) continue;
+            const bool same = group[j] == group[i];
+            s[1] += same, o[1] += !same;
+            if (fabs((double)p[j].y - p[i].y) <= 0.5) s[0] += same, o[0] += !same;
+        }
+        if (o[1] == 0 || s[0] + o[0] == 0) continue; /* o[1] > 0 implies s[1] + o[1] > 0 */
+        sum[0] += (double)(s[0] - o[0]) / (double)(s[0] + o[0]);
+        sum[1] += (double)(s[1] - o[1]) / (double)(s[1] + o[1]);
+        ++*count;
+    }
 }
 
 static int run(const char* preset, size_t agents, ak_crowd_method method, const char* view) {
@@ -74,6 +102,11 @@ static int run(const char* preset, size_t agents, ak_crowd_method method, const 
     double min_clear = INFINITY, step_time = 0.0, speed_sum = 0.0, z[2] = {0, 0};
     double win[2] = {0, 0}, strip[2] = {0, 0}; /* neighbours within 3 m along x / and 0.3 m in z: all, of the other group */
     size_t speed_n = 0, zn[2] = {0, 0};
+    double phi[2] = {0, 0}, wphi[2] = {0, 0}; /* lane order: over the run, over the window */
+    size_t phi_n = 0, wphi_n = 0;
+    const long every = getenv("ANIMKIT_PHI_EVERY") ? strtol(getenv("ANIMKIT_PHI_EVERY"), NULL, 10) : 0;
+    bool* walking = malloc(n * sizeof *walking);
+    if (!walking) return 1;
     long s = 0, all_home = -1;
     for (; s < sc.steps; ++s) {
         job.positions = (ak_vec2_cspan){p, n};
@@ -130,6 +163,18 @@ static int run(const char* preset, size_t agents, ak_crowd_method method, const 
                     if (fabsf(p[j].y - p[i].y) < 0.3f) strip[0] += 1.0, strip[1] += opp;
                 }
             }
+        if (lanes) {
+            for (size_t i = 0; i < n; ++i) walking[i] = !ak_crowd_goal_reached(c, i, p[i], wp[i]);
+            const size_t before = wphi_n;
+            const double b0 = wphi[0], b1 = wphi[1];
+            lane_order(n, p, sc.group, walking, wphi, &wphi_n);
+            phi[0] += wphi[0] - b0, phi[1] += wphi[1] - b1, phi_n += wphi_n - before;
+            if (every > 0 && (s + 1) % every == 0) {
+                if (wphi_n) printf("  steps %ld-%ld: Phi %.2f, Phi_mix %.2f over %zu agent-steps, %zu home\n", s + 2 - every,
+                                   s + 1, wphi[0] / (double)wphi_n, wphi[1] / (double)wphi_n, wphi_n, home);
+                wphi[0] = wphi[1] = 0.0, wphi_n = 0;
+            }
+        }
         if (home == n) {
             all_home = s + 1;
             ++s;
@@ -156,7 +201,9 @@ static int run(const char* preset, size_t agents, ak_crowd_method method, const 
     if (zn[0] && zn[1]) printf("; lanes: mean z %.2f m / %.2f m", z[0] / (double)zn[0], z[1] / (double)zn[1]);
     if (win[1] > 0.0 && strip[0] > 0.0)
         printf(", lane index %.2f", 1.0 - (strip[1] / strip[0]) / (win[1] / win[0]));
+    if (phi_n) printf(", lane order Phi %.2f (Phi_mix %.2f, %zu agent-steps)", phi[0] / (double)phi_n, phi[1] / (double)phi_n, phi_n);
     printf("\n");
+    free(walking);
     free(ov);
     free(pairs);
     free(scratch);

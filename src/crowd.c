@@ -1092,6 +1092,8 @@ typedef struct vision_acc {
     float need_right, need_left; /* turn-rate bounds from the threats */
     bool right, left;
     float ttc_min;
+    float tti_first;  /* the most imminent threat a turn can move (first in pixel order on a tie) */
+    bool first_right; /* and its side: its bearing rate >= 0, cleared by turning right */
 } vision_acc;
 
 /* One pixel of the view: the visible object's point rp relative to the agent (along the unit
@@ -1104,9 +1106,14 @@ static VISION_INLINE void vision_pixel(vision_acc* acc, const ak_crowd_agent* a,
     const float closing = -dot(rp, rv); /* > 0 when approaching (times |rp|) */
     if (!(closing > 0.0f)) return;
     const float dist = sqrtf(dist2);
+    /* time to interaction: to the point's closest approach (the threat test and the turn's
+     * side); the speed reads the time to contact, until the point is one radius away along
+     * the line of sight at the present closing speed (a point passing beside has its closest
+     * approach now, but never touches) */
+    const float tti = closing / abs_sq(rv);
     const float ttc = fmaxf(dist - a->radius, 0.0f) * dist / closing;
     const float rate = dist2 > 0.0f ? det(rp, rv) / dist2 : 0.0f; /* bearing rate, rad/s */
-    const float thr = 0.6f * powf(fmaxf(ttc, 1e-3f), -1.5f);
+    const float thr = 0.6f * powf(fmaxf(tti, 1e-3f), -1.5f);
     if (fabsf(rate) >= thr) return; /* not a threat: it will pass */
     /* an agent standing or shuffling (under VISION_STAND_SPEED: parked, or jostled on its
      * place) slows the agent to 30% of pref_speed at most (ttc 0.845 s) and does not turn
@@ -1123,6 +1130,7 @@ static VISION_INLINE void vision_pixel(vision_acc* acc, const ak_crowd_agent* a,
      * it over the threshold (points beside or behind do not respond to a turn). */
     const float k = fmaxf(speed, 0.1f * pref_len) * dot(head, d) / dist;
     if (!(k > 1e-4f)) return;
+    if (tti < acc->tti_first) acc->tti_first = tti, acc->first_right = rate >= 0.0f;
     if (rate >= 0.0f) {
         acc->right = true;
         acc->need_right = fminf(acc->need_right, (rate - thr) / k); /* delta <= this (< 0: clockwise) */
@@ -1284,7 +1292,7 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
     const float theta = atan2f(head.y, head.x);
     const float fov = crowd->vision_fov;
     const uint32_t W = crowd->vision_width;
-    vision_acc acc = {INFINITY, -INFINITY, false, false, INFINITY};
+    vision_acc acc = {INFINITY, -INFINITY, false, false, INFINITY, INFINITY, false};
     if (crowd->vision_view == AK_CROWD_VIEW_RASTER) {
         if (vision_render(w, w->vr, p, head, na, no))
             for (uint32_t y = 0; y < crowd->vision_height; ++y)
@@ -1315,10 +1323,11 @@ static ak_vec2 vision_velocity(const worker* w, size_t i, ak_vec2 p, ak_vec2 v, 
     }
     const float need_right = acc.need_right, need_left = acc.need_left, ttc_min = acc.ttc_min;
     const bool right = acc.right, left = acc.left;
-    /* toward the goal, then the threats' bound on the side that asks for the smaller turn */
+    /* toward the goal, then the threats' bound on one side: with threats on both sides, the
+     * side that keeps the passing side of the most imminent one */
     float delta = 0.0f, goal_bearing = 0.0f;
     if (pref_len > 0.0f) delta = goal_bearing = atan2f(det(head, pref), dot(head, pref));
-    if (right && (!left || -need_right <= need_left)) delta = fminf(delta, need_right);
+    if (right && (!left || acc.first_right)) delta = fminf(delta, need_right);
     else if (left) delta = fmaxf(delta, need_left);
     /* the goal is a pixel kept in view: no turn takes it out of the field of view */
     if (pref_len > 0.0f) delta = ak_clampf(delta, goal_bearing - 0.5f * fov, goal_bearing + 0.5f * fov);

@@ -36,12 +36,14 @@
  *     discs and the obstacle edges (a direct per-pixel ray cast: each pixel its object and hit
  *     point), or with vision_view RASTER renders them with raster.h into a vision_width x
  *     vision_height image (prisms and walls, object ids as flat colours, hit points from the
- *     depth); per pixel, the time to interaction and the bearing
- *     angle's rate; pixels whose |rate| is below the paper's threshold 0.6 ttc^-1.5 are
- *     threats; the agent turns toward its goal unless that leaves a threat under the
- *     threshold, then by the smallest heading change that lifts the rates over it (keeping
- *     their signs; at most 3 rad/s; never so far that the goal leaves the view), and slows
- *     to pref_speed (1 - exp(-0.5 ttc_min^2)); an agent standing (under 0.25 m/s, not coming
+ *     depth); per pixel, the time to interaction tti (to the point's closest approach) and
+ *     the bearing angle's rate; pixels whose |rate| is below the paper's threshold
+ *     0.6 tti^-1.5 are threats; the agent turns toward its goal unless that leaves a threat
+ *     under the threshold, then by the smallest heading change that lifts the rates of the
+ *     threats on one side over it (keeping their signs; with threats on both sides, the side
+ *     that keeps the passing side of the most imminent one; at most 3 rad/s; never so far
+ *     that the goal leaves the view), and slows to pref_speed (1 - exp(-0.5 ttc_min^2)) over
+ *     the threats' times to contact ttc; an agent standing (under 0.25 m/s, not coming
  *     closer) does not turn it and slows it to 30% at most. Within a second of its last goal
  *     (pref_speed * 1 s) it walks its preferred velocity, the offset to the goal per second,
  *     and stops there. No guarantee against overlap (the contact passes apply as for ORCA).
