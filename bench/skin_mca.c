@@ -22,7 +22,7 @@
         for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                         \
             __asm volatile("# LLVM-MCA-BEGIN " #name);                                             \
             offsets8_dense(&c, i + 8, off[b ^ 1u], 4); /* packed: the block loop's dense path */   \
-            block_lbs(&c, i, 4, off[b], true);                                                     \
+            block_lbs(&c, i, 4, off[b], true, (normals) ? AKP_IO_PN : AKP_IO_P);                       \
             __asm volatile("# LLVM-MCA-END " #name);                                               \
         }                                                                                          \
     }

@@ -106,16 +106,18 @@ AKP_AVX2_INLINE static inline void store_xyz8(char* p, size_t stride, __m256 x, 
 /* (x, y, z) / |(x, y, z)| with rsqrt + one Newton step, its sign flipped where sign is -0
  * (sign: 0 or -0 per lane); a zero vector stays zero. */
 AKP_AVX2_INLINE static inline void normalize8_signed(__m256* x, __m256* y, __m256* z, __m256 sign) {
-    __m256 l2 = _mm256_fmadd_ps(*x, *x, _mm256_fmadd_ps(*y, *y, _mm256_mul_ps(*z, *z)));
+    /* three independent squares and two adds (7 cycles to l2) rather than a multiply and two
+     * dependent FMAs (11): this is the tail of each block's longest dependency chain */
+    __m256 l2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(*x, *x), _mm256_mul_ps(*y, *y)), _mm256_mul_ps(*z, *z));
     l2 = _mm256_max_ps(l2, _mm256_set1_ps(1e-30f));
     const __m256 r = _mm256_rsqrt_ps(l2), a = _mm256_mul_ps(_mm256_set1_ps(0.5f), l2);
-    /* v r (1.5 - 0.5 l2 r^2), with v r beside the Newton factor: after the estimate, the chain
-     * is a multiply, an FMA and a multiply (it was four multiplies and a subtract, the end of
-     * each block's longest dependency chain) */
-    const __m256 t = _mm256_xor_ps(_mm256_fnmadd_ps(a, _mm256_mul_ps(r, r), _mm256_set1_ps(1.5f)), sign);
-    *x = _mm256_mul_ps(_mm256_mul_ps(*x, r), t);
-    *y = _mm256_mul_ps(_mm256_mul_ps(*y, r), t);
-    *z = _mm256_mul_ps(_mm256_mul_ps(*z, r), t);
+    /* v r (1.5 - 0.5 l2 r^2), with the signed v r beside the Newton factor: after the
+     * estimate, the chain is a multiply, an FMA and a multiply */
+    const __m256 t = _mm256_fnmadd_ps(a, _mm256_mul_ps(r, r), _mm256_set1_ps(1.5f));
+    const __m256 rs = _mm256_xor_ps(r, sign);
+    *x = _mm256_mul_ps(_mm256_mul_ps(*x, rs), t);
+    *y = _mm256_mul_ps(_mm256_mul_ps(*y, rs), t);
+    *z = _mm256_mul_ps(_mm256_mul_ps(*z, rs), t);
 }
 
 /* a x b, componentwise vectors. */
@@ -168,14 +170,16 @@ AKP_AVX2_INLINE static inline void blend_matrix_rows_w(const char* wp, const cha
     float wk;
     memcpy(&wk, wp, 4);
     __m256 w = _mm256_set1_ps(wk);
-    const float* m = (const float*)(const void*)(base + (size_t)off[0]);
-    __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps(m), w), a23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
+    const char* base2 = base + 32;
+    size_t o = off[0];
+    __m256 a01 = _mm256_mul_ps(_mm256_loadu_ps((const float*)(const void*)(base + o)), w);
+    __m256 a23 = _mm256_mul_ps(_mm256_loadu_ps((const float*)(const void*)(base2 + o)), w);
     for (uint32_t k = 1; k < K; ++k) {
-        m = (const float*)(const void*)(base + (size_t)off[k]);
+        o = off[k];
         memcpy(&wk, wp + 4u * k, 4);
         w = _mm256_set1_ps(wk);
-        a01 = _mm256_fmadd_ps(_mm256_loadu_ps(m), w, a01);
-        a23 = _mm256_fmadd_ps(_mm256_loadu_ps(m + 8), w, a23);
+        a01 = _mm256_fmadd_ps(_mm256_loadu_ps((const float*)(const void*)(base + o)), w, a01);
+        a23 = _mm256_fmadd_ps(_mm256_loadu_ps((const float*)(const void*)(base2 + o)), w, a23);
     }
     *out01 = a01;
     *out23 = a23;
@@ -238,8 +242,15 @@ AKP_AVX2_INLINE static inline void blend_dq_block(const akp_skin_ctx* c, size_t 
 /* off: with 2, 3, 4 or 8 influences, the block's palette offsets (joint_offsets, AKP_SLOTS(K)
  * per vertex), computed a block ahead by the caller so that they are read back from memory as
  * plain loads; NULL otherwise. */
+/* io: AKP_IO_ANY reads the strides and normals flag from c; AKP_IO_P and AKP_IO_PN are the
+ * packed layouts (every stream 12 bytes a vertex) without and with normals, as compile-time
+ * constants: no stride multiplies and no per-block branches on the layout. */
+enum { AKP_IO_ANY, AKP_IO_P, AKP_IO_PN };
 AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, uint32_t K, const uint32_t* off,
-                                             bool dense) {
+                                             bool dense, const int io) {
+    const size_t ps = io ? 12u : c->pos_stride, ops = io ? 12u : c->out_pos_stride;
+    const size_t ns = io ? 12u : c->nrm_stride, ons = io ? 12u : c->out_nrm_stride;
+    const bool normals = io == AKP_IO_ANY ? c->do_normals : io == AKP_IO_PN;
     __m256 rows[8], cols[8];
     __m256 c01[8], c23[8];
     if (off && dense) {
@@ -260,15 +271,15 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
     const __m256 cx = cols[0], cy = cols[1], cz = cols[2], tx = cols[4], ty = cols[5], tz = cols[6];
 
     __m256 px, py, pz;
-    load_xyz8(c->pos + i0 * c->pos_stride, c->pos_stride, &px, &py, &pz);
+    load_xyz8(c->pos + i0 * ps, ps, &px, &py, &pz);
     __m256 ox = _mm256_fmadd_ps(ax, px, _mm256_fmadd_ps(bx, py, _mm256_fmadd_ps(cx, pz, tx)));
     __m256 oy = _mm256_fmadd_ps(ay, px, _mm256_fmadd_ps(by, py, _mm256_fmadd_ps(cy, pz, ty)));
     __m256 oz = _mm256_fmadd_ps(az, px, _mm256_fmadd_ps(bz, py, _mm256_fmadd_ps(cz, pz, tz)));
-    store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, ox, oy, oz);
-    if (!c->do_normals) return;
+    store_xyz8(c->out_pos + i0 * ops, ops, ox, oy, oz);
+    if (!normals) return;
 
     __m256 nx, ny, nz, k0x, k0y, k0z, k1x, k1y, k1z;
-    load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
+    load_xyz8(c->nrm + i0 * ns, ns, &nx, &ny, &nz);
     /* cof(M) n = nx (b x c) + ny (c x a) + nz (a x b) = nx (b x c) + (ny c - nz b) x a: two
      * cross products instead of three; sign(det) goes on the Newton factor */
     AKP_CROSS(bx, by, bz, cx, cy, cz, k0x, k0y, k0z);
@@ -279,13 +290,16 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
     const __m256 det = _mm256_fmadd_ps(ax, k0x, _mm256_fmadd_ps(ay, k0y, _mm256_mul_ps(az, k0z)));
     __m256 mx = _mm256_fmadd_ps(k0x, nx, k1x), my = _mm256_fmadd_ps(k0y, nx, k1y), mz = _mm256_fmadd_ps(k0z, nx, k1z);
     normalize8_signed(&mx, &my, &mz, _mm256_and_ps(det, _mm256_set1_ps(-0.0f)));
-    store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, mx, my, mz);
+    store_xyz8(c->out_nrm + i0 * ons, ons, mx, my, mz);
 }
 
 /* LBS with 1 influence (ctx.rigid_single: no normals, or a rigid palette): p' = w (M p) and
  * n' = sign(w) R n, without the blend, the cofactor and the renormalisation (R is a rotation:
  * a unit normal stays unit; w = 1 for checked data). */
-AKP_AVX2_INLINE static inline void block_lbs_rigid1(const akp_skin_ctx* c, size_t i0) {
+AKP_AVX2_INLINE static inline void block_lbs_rigid1(const akp_skin_ctx* c, size_t i0, const int io) {
+    const size_t ps = io ? 12u : c->pos_stride, ops = io ? 12u : c->out_pos_stride;
+    const size_t ns = io ? 12u : c->nrm_stride, ons = io ? 12u : c->out_nrm_stride;
+    const bool normals = io == AKP_IO_ANY ? c->do_normals : io == AKP_IO_PN;
     __m256 r01[8], r23[8], cols[8];
     for (int v = 0; v < 8; ++v) {
         uint16_t j;
@@ -307,14 +321,14 @@ AKP_AVX2_INLINE static inline void block_lbs_rigid1(const akp_skin_ctx* c, size_
         w = _mm256_loadu_ps(t);
     }
     __m256 px, py, pz;
-    load_xyz8(c->pos + i0 * c->pos_stride, c->pos_stride, &px, &py, &pz);
+    load_xyz8(c->pos + i0 * ps, ps, &px, &py, &pz);
     const __m256 ox = _mm256_mul_ps(w, _mm256_fmadd_ps(ax, px, _mm256_fmadd_ps(bx, py, _mm256_fmadd_ps(cx, pz, tx))));
     const __m256 oy = _mm256_mul_ps(w, _mm256_fmadd_ps(ay, px, _mm256_fmadd_ps(by, py, _mm256_fmadd_ps(cy, pz, ty))));
     const __m256 oz = _mm256_mul_ps(w, _mm256_fmadd_ps(az, px, _mm256_fmadd_ps(bz, py, _mm256_fmadd_ps(cz, pz, tz))));
-    store_xyz8(c->out_pos + i0 * c->out_pos_stride, c->out_pos_stride, ox, oy, oz);
-    if (!c->do_normals) return;
+    store_xyz8(c->out_pos + i0 * ops, ops, ox, oy, oz);
+    if (!normals) return;
     __m256 nx, ny, nz;
-    load_xyz8(c->nrm + i0 * c->nrm_stride, c->nrm_stride, &nx, &ny, &nz);
+    load_xyz8(c->nrm + i0 * ns, ns, &nx, &ny, &nz);
     /* sign(w): 0 where w is 0 (or NaN: only with unchecked data), negated where w < 0 */
     const __m256 keep = _mm256_cmp_ps(w, _mm256_setzero_ps(), _CMP_NEQ_OQ);
     const __m256 sign = _mm256_and_ps(w, _mm256_set1_ps(-0.0f));
@@ -324,7 +338,7 @@ AKP_AVX2_INLINE static inline void block_lbs_rigid1(const akp_skin_ctx* c, size_
     mx = _mm256_xor_ps(_mm256_and_ps(mx, keep), sign);
     my = _mm256_xor_ps(_mm256_and_ps(my, keep), sign);
     mz = _mm256_xor_ps(_mm256_and_ps(mz, keep), sign);
-    store_xyz8(c->out_nrm + i0 * c->out_nrm_stride, c->out_nrm_stride, mx, my, mz);
+    store_xyz8(c->out_nrm + i0 * ons, ons, mx, my, mz);
 }
 
 /* 2 / |q|^2 for 8 blended quaternions, and 0 where the blend vanished (|q|^2 <= 1e-30: the
@@ -441,36 +455,50 @@ AKP_AVX2_INLINE static inline void block_cor(const akp_skin_ctx* c, size_t i0, u
     }
 
 AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t end) {
+    /* every position and normal stream packed (12 bytes a vertex) */
+    const bool packed = c->pos_stride == 12u && c->out_pos_stride == 12u &&
+                        (!c->do_normals || (c->nrm_stride == 12u && c->out_nrm_stride == 12u));
     if (c->rigid_single) {
-        for (size_t i = begin; i < end; i += 8) block_lbs_rigid1(c, i);
+#define AKP_RIGID1(IO) for (size_t i = begin; i < end; i += 8) block_lbs_rigid1(c, i, (IO))
+        if (packed && c->do_normals) AKP_RIGID1(AKP_IO_PN);
+        else if (packed) AKP_RIGID1(AKP_IO_P);
+        else AKP_RIGID1(AKP_IO_ANY);
+#undef AKP_RIGID1
     } else if (c->k == 2 || c->k == 3 || c->k == 4 || c->k == 8) {
+#define AKP_LBS_DENSE(K, IO)                                                               \
+    do {                                                                                   \
+        offsets8_dense(c, begin, off[0], (K));                                             \
+        unsigned b = 0;                                                                    \
+        for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                 \
+            if (i + 8 < end) offsets8_dense(c, i + 8, off[b ^ 1u], (K));                   \
+            block_lbs(c, i, (K), off[b], true, (IO));                                      \
+        }                                                                                  \
+    } while (0)
 #define AKP_LBS_PIPELINE(K)                                                                \
     do {                                                                                   \
         uint32_t off[2][64];                                                               \
         if ((K) != 3u && c->jnt_stride == 2u * (K) && c->wgt_stride == 4u * (K)) {         \
-            offsets8_dense(c, begin, off[0], (K));                                         \
-            unsigned b = 0;                                                                \
-            for (size_t i = begin; i < end; i += 8, b ^= 1u) {                             \
-                if (i + 8 < end) offsets8_dense(c, i + 8, off[b ^ 1u], (K));               \
-                block_lbs(c, i, (K), off[b], true);                                        \
-            }                                                                              \
+            if (packed && c->do_normals) AKP_LBS_DENSE((K), AKP_IO_PN);                    \
+            else if (packed) AKP_LBS_DENSE((K), AKP_IO_P);                                 \
+            else AKP_LBS_DENSE((K), AKP_IO_ANY);                                           \
             break;                                                                         \
         }                                                                                  \
         joint_offsets(c, begin, AKP_MAT_SHIFT, off[0], (K));                              \
         unsigned b = 0;                                                                    \
         for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                 \
             if (i + 8 < end) joint_offsets(c, i + 8, AKP_MAT_SHIFT, off[b ^ 1u], (K));    \
-            block_lbs(c, i, (K), off[b], false);                                           \
+            block_lbs(c, i, (K), off[b], false, AKP_IO_ANY);                               \
         }                                                                                  \
     } while (0)
         if (c->k == 2) AKP_LBS_PIPELINE(2u);
         else if (c->k == 3) AKP_LBS_PIPELINE(3u);
         else if (c->k == 4) AKP_LBS_PIPELINE(4u);
         else AKP_LBS_PIPELINE(8u);
+#undef AKP_LBS_DENSE
 #undef AKP_LBS_PIPELINE
     } else {
 #define AKP_LBS_K(K)                                                                       \
-    for (size_t i = begin; i < end; i += 8) block_lbs(c, i, (K), NULL, false)
+    for (size_t i = begin; i < end; i += 8) block_lbs(c, i, (K), NULL, false, AKP_IO_ANY)
         AKP_K_DISPATCH(AKP_LBS_K)
 #undef AKP_LBS_K
     }
