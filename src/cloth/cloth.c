@@ -143,7 +143,7 @@ static bool color_grid_dists(const uint32_t* parts, size_t nd, uint32_t w, uint8
 }
 
 /* The bending elements of a grid (build_topology: w x h vertices, the diagonal alternating with
- * the cell's parity, "union jack") in AKP_GRID_BEND_COLORS colours, which is the fewest there can
+ * the cell's parity, "union jack") in 16 colours, which is the fewest there can
  * be: a vertex (i, j) with i + j even (inside the grid) is on 8 edges and 8 triangles, so 16
  * elements hold it (8 along an edge, 8 as a wing opposite one of its triangles) and no two of them
  * can share a colour. Seen from the lattice of even vertices (u, v) = ((i + j) / 2, (i - j) / 2),
@@ -159,7 +159,6 @@ static bool color_grid_dists(const uint32_t* parts, size_t nd, uint32_t w, uint8
  *   mirror image (squares U + 1 without S, U + 2 without N) 6 more for the vertical ones.
  * Writes color[k] for the nb elements (corners p[0..3], edge p[2] -> p[3]); false when an element
  * is not one of the grid's (the caller then colours greedily). */
-#define AKP_GRID_BEND_COLORS 16
 static bool color_grid_bends(const akp_bend* bs, size_t nb, uint32_t w, uint32_t h, uint8_t* color) {
     for (size_t k = 0; k < nb; ++k) {
         const uint32_t a = bs[k].p[2] < bs[k].p[3] ? bs[k].p[2] : bs[k].p[3];
