@@ -45,6 +45,97 @@ static void sim_free(sim* s) {
     ak_cloth_destroy(s->cloth);
 }
 
+/* ---- colouring ---------------------------------------------------------------------------- */
+
+/* Checks the colours of one constraint list (stride particles each, at parts(k, q)): every colour
+ * but the serial one holds no particle twice, and the serial colour is empty. Returns the number
+ * of non-empty colours and the smallest and largest of them; *bound gets the most constraints
+ * holding one particle (they pairwise share it, so no colouring has fewer colours). */
+typedef uint32_t (*part_fn)(const ak_cloth* c, size_t k, int q);
+static uint32_t bend_part(const ak_cloth* c, size_t k, int q) { return c->bend[k].p[q]; }
+static uint32_t dist_part(const ak_cloth* c, size_t k, int q) { return q ? c->dist[k].j : c->dist[k].i; }
+
+static int check_colors(const ak_cloth* c, const uint32_t* starts, size_t count, int stride, part_fn part,
+                        int* bound, size_t* smallest, size_t* largest) {
+    uint32_t* stamp = calloc(c->n, sizeof(uint32_t)); /* colour + 1 that last held the particle */
+    uint32_t* holds = calloc(c->n, sizeof(uint32_t));
+    int colors = 0;
+    *smallest = SIZE_MAX, *largest = 0;
+    AK_CHECK(starts[0] == 0 && starts[AKP_MAX_COLORS + 1] == count);
+    AK_CHECK_MSG(starts[AKP_SERIAL_COLOR] == starts[AKP_SERIAL_COLOR + 1], "serial colour used");
+    for (int col = 0; col < AKP_SERIAL_COLOR; ++col) {
+        const size_t size = starts[col + 1] - starts[col];
+        if (!size) continue;
+        ++colors;
+        if (size < *smallest) *smallest = size;
+        if (size > *largest) *largest = size;
+        for (size_t k = starts[col]; k < starts[col + 1]; ++k)
+            for (int q = 0; q < stride; ++q) {
+                const uint32_t v = part(c, k, q);
+                AK_CHECK_MSG(stamp[v] != (uint32_t)col + 1, "colour %d holds particle %u twice", col, v);
+                stamp[v] = (uint32_t)col + 1;
+            }
+    }
+    *bound = 0;
+    for (size_t k = 0; k < count; ++k)
+        for (int q = 0; q < stride; ++q) holds[part(c, k, q)]++;
+    for (size_t v = 0; v < c->n; ++v)
+        if ((int)holds[v] > *bound) *bound = (int)holds[v];
+    free(stamp), free(holds);
+    return colors;
+}
+
+/* The constraint colouring of grids (and of a mesh): no colour holds a particle twice; a grid's
+ * bending elements (dihedral and isometric) take exactly as many colours as the most elements on
+ * one particle, which is 16 inside a grid of at least 5 x 5 vertices (a vertex with i + j even is on
+ * 8 edges and 8 triangles: 8 elements along an edge, 8 as a wing), so the colouring is minimal;
+ * the distance constraints take 8 (4 edges and 4 cell diagonals at a vertex), 12 with bending
+ * springs (4 more, two apart; greedy took 13). The bound
+ * is counted here from the elements, and the element count is checked against the grid's
+ * interior edges. A mesh (the same triangles given as positions) is coloured greedily: valid. */
+AK_TEST(constraint_coloring_valid_and_minimal) {
+    const uint32_t sizes[][2] = {{2, 2}, {2, 5}, {3, 3}, {4, 4}, {5, 7}, {7, 5}, {33, 17}, {64, 64}, {97, 50}};
+    const ak_cloth_bending kinds[3] = {AK_CLOTH_BEND_DIHEDRAL, AK_CLOTH_BEND_ISOMETRIC, AK_CLOTH_BEND_SPRINGS};
+    for (int bend = 0; bend < 3; ++bend)
+        for (size_t g = 0; g < sizeof sizes / sizeof sizes[0]; ++g) {
+            const uint32_t w = sizes[g][0], h = sizes[g][1];
+            const bool springs = kinds[bend] == AK_CLOTH_BEND_SPRINGS;
+            ak_cloth_desc d = {.solver = AK_CLOTH_XPBD, .grid_width = w, .grid_height = h, .spacing = 0.1f,
+                               .bending = kinds[bend]};
+            ak_cloth* c = NULL;
+            AK_CHECK_EQ(ak_cloth_create(&d, NULL, &c), AK_OK);
+            const size_t edges = (size_t)(w - 1) * h + (size_t)w * (h - 1) + (size_t)(w - 1) * (h - 1);
+            AK_CHECK_EQ(c->bend_count, springs ? 0 : edges - 2 * (size_t)(w - 1) - 2 * (size_t)(h - 1));
+            int bound = 0;
+            size_t lo, hi;
+            const int colors = check_colors(c, c->bend_color, c->bend_count, 4, bend_part, &bound, &lo, &hi);
+            AK_CHECK_MSG(colors <= 16 && colors >= bound, "%ux%u: %d bending colours, bound %d", w, h, colors, bound);
+            if (w >= 5 && h >= 5 && !springs) AK_CHECK_EQ(bound, 16); /* then minimal: colors == bound */
+            /* a diagonal's colour holds a quarter of the cells, an edge's about a sixth */
+            if (w >= 64 && h >= 64) AK_CHECK_MSG(5 * hi <= 8 * lo, "colour sizes %zu..%zu", lo, hi);
+            const int dcolors = check_colors(c, c->dist_color, c->dist_count, 2, dist_part, &bound, &lo, &hi);
+            AK_CHECK_MSG(dcolors >= bound && dcolors <= (springs ? 12 : 8), "%ux%u: %d distance colours, bound %d", w, h,
+                         dcolors, bound);
+            if (w >= 5 && h >= 5) AK_CHECK_EQ(bound, springs ? 12 : 8); /* then minimal */
+            if (g + 1 == sizeof sizes / sizeof sizes[0] && !springs) {
+                /* the same triangles as a mesh: greedy, still valid */
+                const ak_u32_cspan idx = ak_cloth_indices(c);
+                ak_vec3* rest = malloc(c->n * sizeof(ak_vec3));
+                ak_cloth_rest_positions(c, (ak_vec3_span){rest, c->n});
+                ak_cloth_desc m = {.solver = AK_CLOTH_XPBD, .positions = {rest, c->n}, .indices = idx,
+                                   .bending = d.bending};
+                ak_cloth* mc = NULL;
+                AK_CHECK_EQ(ak_cloth_create(&m, NULL, &mc), AK_OK);
+                AK_CHECK_EQ(mc->bend_count, c->bend_count);
+                const int mcolors = check_colors(mc, mc->bend_color, mc->bend_count, 4, bend_part, &bound, &lo, &hi);
+                AK_CHECK(mcolors >= bound && mcolors <= AKP_MAX_COLORS);
+                ak_cloth_destroy(mc);
+                free(rest);
+            }
+            ak_cloth_destroy(c);
+        }
+}
+
 /* ---- validity ----------------------------------------------------------------------------- */
 
 AK_TEST(desc_defaults) {
@@ -1223,6 +1314,7 @@ int main(void) {
     AK_RUN(desc_defaults);
     AK_RUN(create_rules);
     AK_RUN(step_rules);
+    AK_RUN(constraint_coloring_valid_and_minimal);
     AK_RUN(single_spring_static_stretch);
     AK_RUN(dihedral_gradient);
     AK_RUN(isometric_bending);

@@ -20,8 +20,9 @@
 #include "tasks.h"
 
 #define MAX_THREADS 64u
-/* Threads meet at a barrier after every constraint colour (about 29 meetings per substep of a
- * grid with dihedral bending: 8 distance and 18 bending colours, 3 other phases). With the SIMD solves a constraint costs 2-5 ns, so a thread's
+/* Threads meet at a barrier after every constraint colour (25 meetings per substep of a grid
+ * with dihedral bending: 8 distance and 16 bending colours, both the fewest possible on the grid
+ * (cloth.c), and the collisions fused with the next prediction). With the SIMD solves a constraint costs 2-5 ns, so a thread's
  * share of a colour must be thousands of constraints to outweigh a meeting (about a microsecond
  * between two running threads, a scheduler time slice when the partner was descheduled): XPBD
  * and PBD use at most one thread per this many constraints of an average colour, unless the job
