@@ -613,7 +613,10 @@ static bool anchors_run(uint32_t threads, world* wd) {
                 .shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.5f, 0.5f}},
                 .position = {1.1f * ((float)i - 0.5f * (float)(2 - layer)), 0.5f + (float)layer,
                              5.0f}};
-    if (!world_init(wd, b, k, NULL, 1.0f / 60.0f, 4, G)) return false;
+    /* (sleep_time 2 s: the piles, set down at rest, would otherwise sleep within the second and
+     * keep no anchors) */
+    ak_rigid_model_desc md = {.sleep_time = 2.0f};
+    if (!world_init(wd, b, k, &md, 1.0f / 60.0f, 4, G)) return false;
     world_keep_anchors(wd);
     wd->job.thread_count = threads;
     wd->job.sleep_timers = (ak_f32_span){wd->sleep, k};
@@ -638,6 +641,63 @@ AK_TEST(contact_anchors_bit_identical_for_any_thread_count) {
         world_free(&other);
     }
     world_free(&one);
+}
+
+/* A box resting on the ground and a 5-box stack beside it (two groups), 4 substeps, the default
+ * sleep thresholds (0.05 m/s, 0.05 rad/s, 0.5 s) and contact anchors. Awake, after 1.5 s of
+ * settling, every body's speed stays under g h / 10 (4.1 mm/s: a tenth of what one substep of
+ * gravity adds, h = 1/240 s) and its angular speed under that over its half extent; with sleep
+ * timers both groups are asleep within 2 s (velocities exactly zero, timers at sleep_time) and
+ * stay where they were set down (horizontally, 1 mm). Before the sleep fix (rigid28i) a body slow for 0.5 s
+ * whose group was not was frozen alone for a step, then woken: the stack never slept. */
+static bool resting_run(bool sleeping, float seconds, float* vmax, float* wmax, float* drift,
+                        float* asleep_at) {
+    static world wd;
+    ak_rigid_body_desc b[7] = {{.shape = {.type = AK_RIGID_PLANE}}};
+    b[1] = (ak_rigid_body_desc){.shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.5f, 0.5f}},
+                                .position = {-3.0f, 0.5f, 0.0f}};
+    for (int i = 0; i < 5; ++i)
+        b[2 + i] = (ak_rigid_body_desc){
+            .shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.5f, 0.5f}},
+            .position = {0.0f, 0.5f + (float)i, 0.0f}};
+    size_t n = 7;
+    if (!world_init(&wd, b, n, NULL, 1.0f / 60.0f, 4, G)) return false;
+    world_keep_anchors(&wd);
+    if (sleeping) wd.job.sleep_timers = (ak_f32_span){wd.sleep, n};
+    *vmax = *wmax = *drift = 0.0f;
+    *asleep_at = -1.0f;
+    bool ok = true;
+    int steps = (int)(seconds * 60.0f + 0.5f);
+    for (int f = 1; f <= steps && ok; ++f) {
+        ok = ak_rigid_step_run(&wd.job) == AK_OK;
+        bool all = true;
+        for (size_t i = 1; i < n; ++i) {
+            float v = ak_vec3_length(wd.v[i]), w = ak_vec3_length(wd.w[i]);
+            if (f > 90) *vmax = ak_maxf(*vmax, v), *wmax = ak_maxf(*wmax, w);
+            all = all && v == 0.0f && w == 0.0f && (!sleeping || wd.sleep[i] >= 0.5f);
+            *drift = ak_maxf(*drift, hypotf(wd.x[i].x - b[i].position.x,
+                                            wd.x[i].z - b[i].position.z));
+        }
+        if (sleeping && all && *asleep_at < 0.0f) *asleep_at = (float)f / 60.0f;
+        if (sleeping && !all) *asleep_at = -1.0f; /* woke again */
+    }
+    world_free(&wd);
+    return ok;
+}
+
+AK_TEST(resting_box_and_stack_stay_still_and_sleep) {
+    float vmax, wmax, drift, asleep;
+    AK_CHECK(resting_run(false, 4.0f, &vmax, &wmax, &drift, &asleep));
+    float bound = 9.81f / 240.0f / 10.0f;
+    printf("  box and 5-box stack, 4 substeps, awake 1.5 to 4 s: speeds up to %.3g m/s, %.3g rad/s "
+           "(bound %.3g, %.3g); horizontal drift %.3g mm\n", vmax, wmax, bound, bound / 0.5f, 1e3f * drift);
+    AK_CHECK_MSG(vmax < bound, "speed %g m/s", vmax);
+    AK_CHECK_MSG(wmax < bound / 0.5f, "angular speed %g rad/s", wmax);
+    AK_CHECK(resting_run(true, 4.0f, &vmax, &wmax, &drift, &asleep));
+    printf("  with sleep timers: asleep from %.3g s (stayed asleep to 4 s), drift %.3g mm\n",
+           asleep, 1e3f * drift);
+    AK_CHECK_MSG(asleep > 0.0f && asleep <= 2.0f, "asleep at %g s (-1: not asleep at 4 s)", asleep);
+    AK_CHECK_MSG(drift < 1e-3f, "drift %g m", drift);
 }
 
 /* Bad anchors are refused before anything is written. */
@@ -1134,6 +1194,7 @@ int main(void) {
     AK_RUN(stack_top_does_not_creep_at_4_substeps);
     AK_RUN_HEAVY(pyramid_does_not_walk_at_4_substeps);
     AK_RUN(contact_anchors_bit_identical_for_any_thread_count);
+    AK_RUN(resting_box_and_stack_stay_still_and_sleep);
     AK_RUN(contact_anchors_validated);
     AK_RUN(pendulum_period_ball_joint);
     AK_RUN(hinge_limits_hold);

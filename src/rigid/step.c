@@ -1507,6 +1507,12 @@ static void update_sleep(solver* s, const ak_rigid_step_job* job, const contact_
             if (timer[i] < d->sleep_time) timer[i] = d->sleep_time;
         } else if (!s->awake[i]) {
             timer[i] = 0.0f; /* asleep at the step's start, touched by a moving group: wake */
+        } else if (timer[i] >= d->sleep_time) {
+            /* slow long enough itself, but its group is not: the next step reads a timer at
+             * sleep_time as asleep, so it stays just under (frozen alone for a step while its
+             * group moved on, then woken at zero, the bottom boxes of a stack set down at rest
+             * jolted it at 0.5 s and again each time: a 10-box stack never slept) */
+            timer[i] = nextafterf(d->sleep_time, 0.0f);
         }
     }
 }
