@@ -65,6 +65,7 @@ ak_rigid_model_desc ak_rigid_model_desc_resolved(const ak_rigid_model_desc* desc
     if (d.sleep_time == 0.0f) d.sleep_time = 0.5f;
     if (d.joint_tolerance == 0.0f) d.joint_tolerance = 1e-4f;
     if (d.contact_iterations == 0) d.contact_iterations = 1;
+    if (d.velocity_iterations == 0) d.velocity_iterations = 4;
     if (d.max_contacts == 0) {
         size_t n = d.bodies.count > (1u << 24) ? (1u << 24) : d.bodies.count;
         d.max_contacts = (uint32_t)(16 * n + 64);
@@ -267,6 +268,7 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
     if (desc->bodies.count == 0 || !desc->bodies.ptr) return AK_ERR_EMPTY;
     if (desc->bodies.count > (1u << 24)) return AK_ERR_BAD_ARG;
     if (desc->contact_iterations > AK_RIGID_MAX_CONTACT_ITERATIONS) return AK_ERR_BAD_ARG;
+    if (desc->velocity_iterations > AK_RIGID_MAX_CONTACT_ITERATIONS) return AK_ERR_BAD_ARG;
     const float scalars[] = {desc->linear_damping,      desc->angular_damping,
                              desc->contact_offset,      desc->sleep_linear_speed,
                              desc->sleep_angular_speed, desc->sleep_time,

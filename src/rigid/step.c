@@ -1138,6 +1138,30 @@ RIGID_HOT ak_vec3 patch_velocity(const solver* s, uint32_t i, ak_vec3 r, ak_vec3
 
 static void solve_velocities(solver* s, contact_buf* cb, float gmag) {
     float h = s->h;
+    /* velocity_iterations: passes over the normals before the last (Gauss-Seidel, in the pairs'
+     * top-down order). One pass hands a pile's velocities down one contact at a time: in a
+     * 20-layer pyramid at rest the velocities of the position solve's pushes (v = dx / h, about g
+     * h) are left at 0.03-0.08 m/s and it never sleeps; 4 passes leave under 0.015 m/s. */
+    for (uint32_t it = 1; it < s->m->desc.velocity_iterations; ++it)
+        for (uint32_t gi = 0; gi < cb->group_count; ++gi)
+            for (uint32_t k = cb->groups[gi].start; k < cb->groups[gi].end; ++k) {
+                const rigid_contact* c = &cb->c[k];
+                const contact_row* r = &s->rows[k];
+                if (!(c->lambda_n > 0.0f) || r->inv_w == 0.0f) continue;
+                uint32_t a = c->a, b = c->b;
+                float vn = ak_vec3_dot(c->n, ak_vec3_sub(s->v[a], s->v[b])) +
+                           ak_vec3_dot(s->w[a], r->rna) - ak_vec3_dot(s->w[b], r->rnb);
+                float e = fabsf(c->vn_before) <= 2.0f * gmag * h ? 0.0f : c->restitution;
+                float mag = (-vn + ak_maxf(-e * c->vn_before, 0.0f)) * r->inv_w;
+                if (r->ima > 0.0f) {
+                    s->v[a] = ak_vec3_madd(s->v[a], c->n, mag * r->ima);
+                    s->w[a] = ak_vec3_madd(s->w[a], r->ta, mag);
+                }
+                if (r->imb > 0.0f) {
+                    s->v[b] = ak_vec3_madd(s->v[b], c->n, -mag * r->imb);
+                    s->w[b] = ak_vec3_madd(s->w[b], r->tb, -mag);
+                }
+            }
     for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
         uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
         for (uint32_t k = k0; k < k1; ++k) {
