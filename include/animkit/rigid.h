@@ -608,8 +608,9 @@ typedef struct ak_rigid_contact_anchor {
     uint32_t body_a, body_b; /* body_a < body_b */
     ak_vec3 drift;           /* metres, body_b's frame */
     ak_vec3 normal;          /* unit, body_b's frame */
-    float twist;             /* radians body_a has turned about the normal against body_b since
-                                the contact began, not yet undone by torsional friction */
+    float twist;             /* radians body_a turned about the normal against body_b over the
+                                step (reported; not read back: the drift at the centre of
+                                pressure already holds the twist's motion there) */
 } ak_rigid_contact_anchor;
 
 AK_DEFINE_SPAN(rigid_contact_anchor, ak_rigid_contact_anchor)
