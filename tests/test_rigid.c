@@ -685,6 +685,59 @@ static bool resting_run(bool sleeping, float seconds, float* vmax, float* wmax, 
     return ok;
 }
 
+/* A 10-layer pyramid (55 boxes 0.1 m apart) set down at rest, 4 substeps, contact anchors: awake,
+ * every body's speed from 1.5 to 4 s stays under g h / 4 (10 mm/s; a quarter of what one substep
+ * of gravity adds: before rigid28i the pile kept about g h, the velocity of each substep's push,
+ * since one velocity pass hands it down a contact at a time) and its angular speed under that
+ * over the half extent (the anchors' twist, undone twice, rocked it about the vertical); with
+ * the default sleep thresholds it is asleep within 2 s. */
+static bool pyramid_rest_run(uint32_t velocity_iterations, bool sleeping, float* vmax, float* wmax,
+                             float* asleep_at) {
+    static world wd;
+    ak_rigid_body_desc b[56] = {{.shape = {.type = AK_RIGID_PLANE}}};
+    size_t k = 1;
+    for (int l = 0; l < 10; ++l)
+        for (int i = 0; i < 10 - l; ++i, ++k)
+            b[k] = (ak_rigid_body_desc){
+                .shape = {.type = AK_RIGID_BOX, .half_extents = {0.5f, 0.5f, 0.5f}},
+                .position = {1.1f * ((float)i - 0.5f * (float)(9 - l)), 0.5f + (float)l, 0.0f}};
+    ak_rigid_model_desc md = {.velocity_iterations = velocity_iterations};
+    if (!world_init(&wd, b, k, &md, 1.0f / 60.0f, 4, G)) return false;
+    world_keep_anchors(&wd);
+    if (sleeping) wd.job.sleep_timers = (ak_f32_span){wd.sleep, k};
+    *vmax = *wmax = 0.0f;
+    *asleep_at = -1.0f;
+    bool ok = true;
+    for (int f = 1; f <= 240 && ok; ++f) {
+        ok = ak_rigid_step_run(&wd.job) == AK_OK;
+        bool all = true;
+        for (size_t i = 1; i < k; ++i) {
+            float v = ak_vec3_length(wd.v[i]), w = ak_vec3_length(wd.w[i]);
+            if (f > 90) *vmax = ak_maxf(*vmax, v), *wmax = ak_maxf(*wmax, w);
+            all = all && v == 0.0f && w == 0.0f;
+        }
+        if (sleeping && all && *asleep_at < 0.0f) *asleep_at = (float)f / 60.0f;
+        if (sleeping && !all) *asleep_at = -1.0f;
+    }
+    world_free(&wd);
+    return ok;
+}
+
+AK_TEST(pyramid_at_rest_stays_still_and_sleeps) {
+    float vmax, wmax, asleep, v1, w1, a1;
+    AK_CHECK(pyramid_rest_run(0, false, &vmax, &wmax, &asleep));
+    AK_CHECK(pyramid_rest_run(1, false, &v1, &w1, &a1));
+    float bound = 9.81f / 240.0f / 4.0f;
+    printf("  10-layer pyramid, 4 substeps, awake 1.5 to 4 s: speeds up to %.3g m/s, %.3g rad/s "
+           "(bound %.3g, %.3g; one velocity pass: %.3g, %.3g)\n", vmax, wmax, bound, bound / 0.5f,
+           v1, w1);
+    AK_CHECK_MSG(vmax < bound, "speed %g m/s", vmax);
+    AK_CHECK_MSG(wmax < bound / 0.5f, "angular speed %g rad/s", wmax);
+    AK_CHECK(pyramid_rest_run(0, true, &vmax, &wmax, &asleep));
+    printf("  with sleep timers: asleep from %.3g s\n", asleep);
+    AK_CHECK_MSG(asleep > 0.0f && asleep <= 2.0f, "asleep at %g s (-1: not asleep at 4 s)", asleep);
+}
+
 AK_TEST(resting_box_and_stack_stay_still_and_sleep) {
     float vmax, wmax, drift, asleep;
     AK_CHECK(resting_run(false, 4.0f, &vmax, &wmax, &drift, &asleep));
@@ -1195,6 +1248,7 @@ int main(void) {
     AK_RUN_HEAVY(pyramid_does_not_walk_at_4_substeps);
     AK_RUN(contact_anchors_bit_identical_for_any_thread_count);
     AK_RUN(resting_box_and_stack_stay_still_and_sleep);
+    AK_RUN(pyramid_at_rest_stays_still_and_sleeps);
     AK_RUN(contact_anchors_validated);
     AK_RUN(pendulum_period_ball_joint);
     AK_RUN(hinge_limits_hold);

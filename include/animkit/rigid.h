@@ -266,8 +266,8 @@ typedef struct ak_rigid_model_desc {
                                      last adds dynamic friction). One pass hands a pile's
                                      velocities down one contact at a time and leaves a 20-layer
                                      pyramid at rest jittering at 0.03-0.08 m/s (about g h), so
-                                     it never sleeps; 4 passes bring that under 0.015 m/s at
-                                     4 substeps for about 6% more time per pass
+                                     it never sleeps; 4 passes bring that to 0.005-0.016 m/s
+                                     at 4 substeps for about 6% more time per pass
                                      (docs/rigid.md, "Fidelity at rest") */
 } ak_rigid_model_desc;
 
