@@ -20,7 +20,7 @@ AK_TEST(rigid_scene_from_bytes) {
         "{\"gravity\": [0, -3, 1], \"dt\": 0.01, \"steps\": 7, \"substeps\": 5, \"threads\": 2,"
         " \"linear_damping\": 0.25, \"angular_damping\": 0.5, \"contact_offset\": 0.02, \"sleep\": false,"
         " \"contact_iterations\": 3, \"contacts_after_joints\": true, \"sleep_linear_speed\": 0.8,"
-        " \"sleep_angular_speed\": 1.0, \"sleep_time\": 2,"
+        " \"sleep_angular_speed\": 1.0, \"sleep_time\": 2, \"velocity_iterations\": 2,"
         " \"bodies\": ["
         "  {\"shape\": {\"type\": \"plane\", \"normal\": [0, 2, 0]}, \"static\": true, \"friction\": 0},"
         "  {\"shape\": {\"type\": \"box\", \"half_extents\": [0.1, 0.2, 0.3]}, \"position\": [1, 2, 3],"
@@ -44,6 +44,7 @@ AK_TEST(rigid_scene_from_bytes) {
     AK_CHECK_NEAR(s.model.contact_offset, 0.02f, 0.0f);
     AK_CHECK(!s.sleep);
     AK_CHECK_EQ(s.model.contact_iterations, 3u);
+    AK_CHECK_EQ(s.model.velocity_iterations, 2u);
     AK_CHECK(s.model.contacts_after_joints);
     AK_CHECK_NEAR(s.model.sleep_linear_speed, 0.8f, 0.0f);
     AK_CHECK_NEAR(s.model.sleep_angular_speed, 1.0f, 0.0f);
@@ -139,6 +140,8 @@ AK_TEST(rigid_scene_errors_name_key_paths) {
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"substeps\": 1001}", "t.json: substeps"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"contact_iterations\": 65}",
          "t.json: contact_iterations"},
+        {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"velocity_iterations\": 0}",
+         "t.json: velocity_iterations"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"contacts_after_joints\": 1}",
          "t.json: contacts_after_joints"},
         {"{\"bodies\": [{\"shape\": {\"type\": \"sphere\", \"radius\": 1}}], \"sleep_time\": 0}", "t.json: sleep_time"},

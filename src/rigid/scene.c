@@ -396,7 +396,7 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
             "steps",           "substeps",       "threads", "linear_damping",
             "angular_damping", "contact_offset", "sleep",   "max_contacts",
             "contact_iterations", "contacts_after_joints", "sleep_linear_speed", "sleep_angular_speed",
-            "sleep_time", NULL};
+            "sleep_time", "velocity_iterations", NULL};
         akp_json_object(&j, root, "", keys);
         akp_json_vec3(&j, root, "", "gravity", &s->gravity);
         if (!j.failed && ak_vec3_length(s->gravity) > 1e4f)
@@ -417,6 +417,9 @@ static bool parse(akp_json* jp, const char* text, size_t size, ak_rigid_scene* s
         long ci = s->model.contact_iterations ? (long)s->model.contact_iterations : 1;
         akp_json_int(&j, root, "", "contact_iterations", 1, AK_RIGID_MAX_CONTACT_ITERATIONS, &ci);
         s->model.contact_iterations = (uint32_t)ci;
+        long vi = s->model.velocity_iterations ? (long)s->model.velocity_iterations : 4;
+        akp_json_int(&j, root, "", "velocity_iterations", 1, AK_RIGID_MAX_CONTACT_ITERATIONS, &vi);
+        s->model.velocity_iterations = (uint32_t)vi;
         akp_json_bool(&j, root, "", "contacts_after_joints", &s->model.contacts_after_joints);
         /* 0 in the model means the default; a file gives a real threshold, above 0 */
         akp_json_float(&j, root, "", "sleep_linear_speed", 1e-6f, 100.0f, &s->model.sleep_linear_speed);
