@@ -375,22 +375,48 @@ AKP_AVX2_INLINE static inline void block_lbs(const akp_skin_ctx* c, size_t i0, u
 /* LBS with 1 influence (ctx.rigid_single: no normals, or a rigid palette): p' = w (M p) and
  * n' = sign(w) R n, without the blend, the cofactor and the renormalisation (R is a rotation:
  * a unit normal stays unit; w = 1 for checked data). */
-AKP_AVX2_INLINE static inline void block_lbs_rigid1(const akp_skin_ctx* c, size_t i0, const int io) {
+/* rows3: a palette_rows3 copy of the palette (the 8 matrices then take a 12-row transpose
+ * instead of two 8-row ones), or NULL. */
+AKP_AVX2_INLINE static inline void block_lbs_rigid1(const akp_skin_ctx* c, size_t i0, const float* rows3,
+                                                    const int io) {
     const size_t ps = io ? 12u : c->pos_stride, ops = io ? 12u : c->out_pos_stride;
     const size_t ns = io ? 12u : c->nrm_stride, ons = io ? 12u : c->out_nrm_stride;
     const bool normals = io == AKP_IO_ANY ? c->do_normals : io == AKP_IO_PN;
-    __m256 r01[8], r23[8], cols[8];
-    for (int v = 0; v < 8; ++v) {
-        uint16_t j;
-        memcpy(&j, c->jnt + (i0 + (size_t)v) * c->jnt_stride, sizeof j);
-        const float* m = c->palette[clamp_joint(j, c->palette_count)].m;
-        r01[v] = _mm256_loadu_ps(m);
-        r23[v] = _mm256_loadu_ps(m + 8);
+    __m256 ax, ay, az, bx, by, bz, cx, cy, cz, tx, ty, tz;
+    if (rows3) {
+        const char* base = (const char*)rows3;
+        size_t o[8];
+        for (int v = 0; v < 8; ++v) {
+            uint16_t j;
+            memcpy(&j, c->jnt + (i0 + (size_t)v) * c->jnt_stride, sizeof j);
+            o[v] = (size_t)clamp_joint(j, c->palette_count) * 64u;
+        }
+        __m256 r01[8], r2[4], m[8];
+        for (int v = 0; v < 8; ++v) r01[v] = _mm256_loadu_ps((const float*)(const void*)(base + o[v]));
+        for (int v = 0; v < 4; ++v)
+            r2[v] = _mm256_insertf128_ps(
+                _mm256_castps128_ps256(_mm_loadu_ps((const float*)(const void*)(base + 32 + o[v]))),
+                _mm_loadu_ps((const float*)(const void*)(base + 32 + o[v + 4])), 1);
+        transpose8(r01, m);
+        ax = m[0], bx = m[1], cx = m[2], tx = m[3], ay = m[4], by = m[5], cy = m[6], ty = m[7];
+        const __m256 t0 = _mm256_unpacklo_ps(r2[0], r2[1]), t1 = _mm256_unpackhi_ps(r2[0], r2[1]);
+        const __m256 t2 = _mm256_unpacklo_ps(r2[2], r2[3]), t3 = _mm256_unpackhi_ps(r2[2], r2[3]);
+        az = _mm256_shuffle_ps(t0, t2, 0x44), bz = _mm256_shuffle_ps(t0, t2, 0xEE);
+        cz = _mm256_shuffle_ps(t1, t3, 0x44), tz = _mm256_shuffle_ps(t1, t3, 0xEE);
+    } else {
+        __m256 r01[8], r23[8], cols[8];
+        for (int v = 0; v < 8; ++v) {
+            uint16_t j;
+            memcpy(&j, c->jnt + (i0 + (size_t)v) * c->jnt_stride, sizeof j);
+            const float* m = c->palette[clamp_joint(j, c->palette_count)].m;
+            r01[v] = _mm256_loadu_ps(m);
+            r23[v] = _mm256_loadu_ps(m + 8);
+        }
+        transpose8(r01, cols);
+        ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];
+        transpose8(r23, cols);
+        cx = cols[0], cy = cols[1], cz = cols[2], tx = cols[4], ty = cols[5], tz = cols[6];
     }
-    transpose8(r01, cols);
-    const __m256 ax = cols[0], ay = cols[1], az = cols[2], bx = cols[4], by = cols[5], bz = cols[6];
-    transpose8(r23, cols);
-    const __m256 cx = cols[0], cy = cols[1], cz = cols[2], tx = cols[4], ty = cols[5], tz = cols[6];
     __m256 w;
     if (c->wgt_stride == 4) {
         w = _mm256_loadu_ps((const float*)(const void*)(c->wgt + i0 * 4));
@@ -537,15 +563,23 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
     /* every position and normal stream packed (12 bytes a vertex) */
     const bool packed = c->pos_stride == 12u && c->out_pos_stride == 12u &&
                         (!c->do_normals || (c->nrm_stride == 12u && c->out_nrm_stride == 12u));
+    /* the palette as 3x4 rows (blend_rows3_block, block_lbs_rigid1), for up to AKP_ROWS3_MAX
+     * joints */
+    _Alignas(64) float rows3_buf[AKP_ROWS3_MAX * 16];
+    const float* rows3 = NULL;
+    const bool dense = (c->k == 2 || c->k == 4 || c->k == 8) && c->jnt_stride == 2u * c->k &&
+                       c->wgt_stride == 4u * c->k; /* AKP_LBS_PIPELINE's dense blocks */
+    if ((c->rigid_single || dense) && c->palette_count <= AKP_ROWS3_MAX) {
+        palette_rows3(c->palette, c->palette_count, rows3_buf);
+        rows3 = rows3_buf;
+    }
     if (c->rigid_single) {
-#define AKP_RIGID1(IO) for (size_t i = begin; i < end; i += 8) block_lbs_rigid1(c, i, (IO))
+#define AKP_RIGID1(IO) for (size_t i = begin; i < end; i += 8) block_lbs_rigid1(c, i, rows3, (IO))
         if (packed && c->do_normals) AKP_RIGID1(AKP_IO_PN);
         else if (packed) AKP_RIGID1(AKP_IO_P);
         else AKP_RIGID1(AKP_IO_ANY);
 #undef AKP_RIGID1
     } else if (c->k == 2 || c->k == 3 || c->k == 4 || c->k == 8) {
-        /* the palette as 3x4 rows for the dense blocks (blend_rows3_block) */
-        _Alignas(64) float rows3_buf[AKP_ROWS3_MAX * 16];
 #define AKP_LBS_DENSE(K, IO)                                                               \
     do {                                                                                   \
         offsets8_dense(c, begin, off[0], (K));                                             \
@@ -559,11 +593,6 @@ AKP_AVX2 static void block_lbs_range(const akp_skin_ctx* c, size_t begin, size_t
     do {                                                                                   \
         uint32_t off[2][64];                                                               \
         if ((K) != 3u && c->jnt_stride == 2u * (K) && c->wgt_stride == 4u * (K)) {         \
-            const float* rows3 = NULL;                                                     \
-            if (c->palette_count <= AKP_ROWS3_MAX) {                                       \
-                palette_rows3(c->palette, c->palette_count, rows3_buf);                    \
-                rows3 = rows3_buf;                                                         \
-            }                                                                              \
             if (packed && c->do_normals) AKP_LBS_DENSE((K), AKP_IO_PN);                    \
             else if (packed) AKP_LBS_DENSE((K), AKP_IO_P);                                 \
             else AKP_LBS_DENSE((K), AKP_IO_ANY);                                           \
