@@ -1,9 +1,10 @@
 /* AVX2 + FMA skinning kernel, vectorized across vertices (8 per block).
  *
  * Each block runs in two stages. Per vertex, the joint data are blended with contiguous
- * loads (matrix columns for LBS, rotation|dual quaternion pairs for DQS, matrix columns with
- * the rotation in their w slots for CoR), which avoids gathers (slow on every x86 core we
- * target); the 8 blended results are then transposed into structure-of-arrays registers and
+ * loads (matrix columns for LBS, or 3x4 rows from a per-range copy of palettes up to 256
+ * joints for packed 1, 2, 4 and 8 influences; rotation|dual quaternion pairs for DQS, matrix
+ * columns with the rotation in their w slots for CoR), which avoids gathers (slow on every
+ * x86 core we target); the 8 blended results are then transposed into structure-of-arrays registers and
  * the transform, normal and normalisation run 8-wide. The joint offsets of a block are
  * computed with SIMD ahead of it (LBS: 4 influences; DQS/CoR: 2, 3, 4 or 8, which also compute
  * the hemisphere signs one block ahead); other counts run the blends vertex by vertex.
