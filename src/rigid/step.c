@@ -1050,12 +1050,21 @@ static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* 
                     a2 = ak_quat_rotate(s->q[b], j->axis_b);
             joint_rotation(s, a, b, ak_vec3_cross(a1, a2), alpha, err);
             if (j->limited) {
-                float phi = akp_rigid_hinge_angle(j, s->q[a], s->q[b]) + j->angle_offset;
-                float target = ak_clampf(phi, j->lower, j->upper);
-                if (phi != target)
-                    joint_rotation(s, a, b,
-                                   ak_vec3_scale(ak_quat_rotate(s->q[a], j->axis_a), phi - target),
-                                   0.0f, err);
+                /* akp_rigid_hinge_angle's terms; the angle only when not inside the limits by
+                 * 1e-4 rad (with hinge_fast: the angle t = atan2(sn, cs) lies between L and H
+                 * when sin(t - L) and sin(H - t) are positive, as H - L < pi) */
+                ak_quat qa = s->q[a];
+                ak_vec3 n = ak_quat_rotate(qa, j->axis_a);
+                ak_vec3 b1 = ak_quat_rotate(qa, j->perp_a), b2 = ak_quat_rotate(s->q[b], j->perp_b);
+                float sn = ak_vec3_dot(ak_vec3_cross(b1, b2), n), cs = ak_vec3_dot(b1, b2);
+                float r = j->hinge_fast ? sqrtf(sn * sn + cs * cs) : 0.0f;
+                if (!(r > 1e-6f && sn * j->hinge_cl - cs * j->hinge_sl > 1e-4f * r &&
+                      cs * j->hinge_sh - sn * j->hinge_ch > 1e-4f * r)) {
+                    float phi = atan2f(sn, cs) + j->angle_offset;
+                    float target = ak_clampf(phi, j->lower, j->upper);
+                    if (phi != target)
+                        joint_rotation(s, a, b, ak_vec3_scale(n, phi - target), 0.0f, err);
+                }
             }
         }
         if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
