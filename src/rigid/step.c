@@ -996,6 +996,14 @@ RIGID_HOT ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
     return small_turn(qb, ak_quat_mul(qa, target));
 }
 
+/* Whether an angle t of a point at radius r (r2 = r^2) lies inside its limits L and H by at
+ * least 1e-4 rad, given lo = r sin(t - L) and hi = r sin(H - t): both positive and above 1e-4 r,
+ * compared squared (no square root before the branch; rounding moves the test's edge by about
+ * 1e-7 rad, far inside the margin, so a limit's exact test downstream decides the same). */
+RIGID_HOT bool inside_by(float lo, float hi, float r2) {
+    return r2 > 1e-12f && lo > 0.0f && hi > 0.0f && lo * lo > 1e-8f * r2 && hi * hi > 1e-8f * r2;
+}
+
 /* Ball joint j's twist limit (akp_rigid_twist_angle's measure: rel = (qa frame_a)^-1 (qb
  * frame_b), its half angle t/2 = atan2(y, w)): false when the twist is inside its limits by at
  * least 1e-4 rad, found without the angle (t/2, taken with w >= 0, lies between the limits'
@@ -1009,10 +1017,9 @@ RIGID_HOT bool twist_outside(const rigid_joint* j, ak_quat qa, ak_quat qb, ak_ve
     ak_quat rel = ak_quat_mul(ak_quat_conjugate(fa), fb);
     if (j->twist_fast) {
         float y = rel.w < 0.0f ? -rel.y : rel.y, w = fabsf(rel.w);
-        float r = sqrtf(y * y + w * w);
-        if (r > 1e-6f && y * j->twist_cl - w * j->twist_sl > 1e-4f * r &&
-            w * j->twist_sh - y * j->twist_ch > 1e-4f * r)
-            return false;
+        float r2 = y * y + w * w, lo = y * j->twist_cl - w * j->twist_sl,
+              hi = w * j->twist_sh - y * j->twist_ch;
+        if (inside_by(lo, hi, r2)) return false;
     }
     *out_n = ak_quat_rotate(fb, ak_vec3_make(0.0f, 1.0f, 0.0f));
     float t = 2.0f * atan2f(rel.y, rel.w);
@@ -1057,9 +1064,9 @@ static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* 
                 ak_vec3 n = ak_quat_rotate(qa, j->axis_a);
                 ak_vec3 b1 = ak_quat_rotate(qa, j->perp_a), b2 = ak_quat_rotate(s->q[b], j->perp_b);
                 float sn = ak_vec3_dot(ak_vec3_cross(b1, b2), n), cs = ak_vec3_dot(b1, b2);
-                float r = j->hinge_fast ? sqrtf(sn * sn + cs * cs) : 0.0f;
-                if (!(r > 1e-6f && sn * j->hinge_cl - cs * j->hinge_sl > 1e-4f * r &&
-                      cs * j->hinge_sh - sn * j->hinge_ch > 1e-4f * r)) {
+                if (!(j->hinge_fast &&
+                      inside_by(sn * j->hinge_cl - cs * j->hinge_sl,
+                                cs * j->hinge_sh - sn * j->hinge_ch, sn * sn + cs * cs))) {
                     float phi = atan2f(sn, cs) + j->angle_offset;
                     float target = ak_clampf(phi, j->lower, j->upper);
                     if (phi != target)
