@@ -525,11 +525,6 @@ ak_result ak_rigid_model_create(const ak_rigid_model_desc* desc, const ak_alloca
         j->twist_fast = fabsf(hl) < 1.5607963f && fabsf(hh) < 1.5607963f;
         j->twist_cl = cosf(hl), j->twist_sl = sinf(hl);
         j->twist_ch = cosf(hh), j->twist_sh = sinf(hh);
-        float lo = jd->lower - jd->angle_offset, hi = jd->upper - jd->angle_offset;
-        j->hinge_fast = fabsf(lo) < 3.1315927f && fabsf(hi) < 3.1315927f && hi - lo > 0.01f &&
-                        hi - lo < 3.1315927f;
-        j->hinge_cl = cosf(lo), j->hinge_sl = sinf(lo);
-        j->hinge_ch = cosf(hi), j->hinge_sh = sinf(hi);
     }
     m->desc.joints = (ak_rigid_joint_desc_cspan){NULL, 0};
     *out_model = m;

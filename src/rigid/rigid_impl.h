@@ -137,11 +137,6 @@ typedef struct rigid_joint {
      * lie inside (-pi/2, pi/2) by 0.01 */
     bool twist_fast;
     float twist_cl, twist_sl, twist_ch, twist_sh;
-    /* limited hinge: the bounds L = lower - angle_offset and H = upper - angle_offset of
-     * akp_rigid_hinge_angle's atan2 as cosines and sines, used (hinge_fast) when both lie
-     * inside (-pi, pi) and H - L inside (0, pi), by 0.01 */
-    bool hinge_fast;
-    float hinge_cl, hinge_sl, hinge_ch, hinge_sh;
 } rigid_joint;
 
 /* Signed angle (rad) of body b about the hinge axis relative to a, zero as built. */

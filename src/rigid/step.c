@@ -996,37 +996,19 @@ RIGID_HOT ak_vec3 orientation_error(ak_quat qa, ak_quat qb, ak_quat target) {
     return small_turn(qb, ak_quat_mul(qa, target));
 }
 
-/* Whether an angle t of a point at radius r (r2 = r^2) lies inside its limits L and H by at
- * least 1e-4 rad, given lo = r sin(t - L) and hi = r sin(H - t): both positive and above 1e-4 r,
- * compared squared (no square root before the branch; rounding moves the test's edge by about
- * 1e-7 rad, far inside the margin, so a limit's exact test downstream decides the same). */
-RIGID_HOT bool inside_by(float lo, float hi, float r2) {
-    return r2 > 1e-12f && lo > 0.0f && hi > 0.0f && lo * lo > 1e-8f * r2 && hi * hi > 1e-8f * r2;
-}
-
-/* Ball joint j's twist limit (akp_rigid_twist_angle's measure: rel = (qa frame_a)^-1 (qb
- * frame_b), its half angle t/2 = atan2(y, w)): false when the twist is inside its limits by at
- * least 1e-4 rad, found without the angle (t/2, taken with w >= 0, lies between the limits'
- * half angles L and H when sin(t/2 - L) and sin(H - t/2) are positive, which needs no atan2;
- * with twist_fast off it is never found inside); else true, with *out_n the world twist axis
- * and *out_tw the angle plus angle_offset, the same bits as akp_rigid_twist_angle's (the
- * quaternion products taken once for the test and the angle). */
-RIGID_HOT bool twist_outside(const rigid_joint* j, ak_quat qa, ak_quat qb, ak_vec3* out_n,
-                             float* out_tw) {
-    ak_quat fa = ak_quat_mul(qa, j->frame_a), fb = ak_quat_mul(qb, j->frame_b);
-    ak_quat rel = ak_quat_mul(ak_quat_conjugate(fa), fb);
-    if (j->twist_fast) {
-        float y = rel.w < 0.0f ? -rel.y : rel.y, w = fabsf(rel.w);
-        float r2 = y * y + w * w, lo = y * j->twist_cl - w * j->twist_sl,
-              hi = w * j->twist_sh - y * j->twist_ch;
-        if (inside_by(lo, hi, r2)) return false;
-    }
-    *out_n = ak_quat_rotate(fb, ak_vec3_make(0.0f, 1.0f, 0.0f));
-    float t = 2.0f * atan2f(rel.y, rel.w);
-    if (t > 3.14159265f) t -= 6.2831853f;
-    if (t < -3.14159265f) t += 6.2831853f;
-    *out_tw = t + j->angle_offset;
-    return true;
+/* True when ball joint j's twist is inside its limits by at least 1e-4 rad (without the angle:
+ * akp_rigid_twist_angle's half angle t/2 = atan2(y, w) of rel, taken with w >= 0, lies
+ * between the limits' half angles L and H when sin(t/2 - L) and sin(H - t/2) are positive,
+ * which needs no atan2); false also when it cannot tell (twist_fast off). */
+RIGID_HOT bool twist_inside(const rigid_joint* j, ak_quat qa, ak_quat qb) {
+    if (!j->twist_fast) return false;
+    ak_quat rel =
+        ak_quat_mul(ak_quat_conjugate(ak_quat_mul(qa, j->frame_a)), ak_quat_mul(qb, j->frame_b));
+    float y = rel.w < 0.0f ? -rel.y : rel.y, w = fabsf(rel.w);
+    float r = sqrtf(y * y + w * w);
+    if (!(r > 1e-6f)) return false;
+    return y * j->twist_cl - w * j->twist_sl > 1e-4f * r &&
+           w * j->twist_sh - y * j->twist_ch > 1e-4f * r;
 }
 
 /* One sweep over the joints idx[0 .. count) (NULL idx: every joint in model order); *err gets
@@ -1057,21 +1039,12 @@ static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* 
                     a2 = ak_quat_rotate(s->q[b], j->axis_b);
             joint_rotation(s, a, b, ak_vec3_cross(a1, a2), alpha, err);
             if (j->limited) {
-                /* akp_rigid_hinge_angle's terms; the angle only when not inside the limits by
-                 * 1e-4 rad (with hinge_fast: the angle t = atan2(sn, cs) lies between L and H
-                 * when sin(t - L) and sin(H - t) are positive, as H - L < pi) */
-                ak_quat qa = s->q[a];
-                ak_vec3 n = ak_quat_rotate(qa, j->axis_a);
-                ak_vec3 b1 = ak_quat_rotate(qa, j->perp_a), b2 = ak_quat_rotate(s->q[b], j->perp_b);
-                float sn = ak_vec3_dot(ak_vec3_cross(b1, b2), n), cs = ak_vec3_dot(b1, b2);
-                if (!(j->hinge_fast &&
-                      inside_by(sn * j->hinge_cl - cs * j->hinge_sl,
-                                cs * j->hinge_sh - sn * j->hinge_ch, sn * sn + cs * cs))) {
-                    float phi = atan2f(sn, cs) + j->angle_offset;
-                    float target = ak_clampf(phi, j->lower, j->upper);
-                    if (phi != target)
-                        joint_rotation(s, a, b, ak_vec3_scale(n, phi - target), 0.0f, err);
-                }
+                float phi = akp_rigid_hinge_angle(j, s->q[a], s->q[b]) + j->angle_offset;
+                float target = ak_clampf(phi, j->lower, j->upper);
+                if (phi != target)
+                    joint_rotation(s, a, b,
+                                   ak_vec3_scale(ak_quat_rotate(s->q[a], j->axis_a), phi - target),
+                                   0.0f, err);
             }
         }
         if (j->type == AK_RIGID_JOINT_BALL && j->limited) {
@@ -1087,10 +1060,10 @@ static void solve_joints(solver* s, const uint32_t* idx, uint32_t count, float* 
                     joint_rotation(s, a, b, ak_vec3_scale(cr, (swing - j->upper) / sn), 0.0f, err);
             }
         }
-        ak_vec3 n;
-        float tw;
         if (j->type == AK_RIGID_JOINT_BALL && j->twist_limited &&
-            twist_outside(j, s->q[a], s->q[b], &n, &tw)) {
+            !twist_inside(j, s->q[a], s->q[b])) {
+            ak_vec3 n;
+            float tw = akp_rigid_twist_angle(j, s->q[a], s->q[b], &n) + j->angle_offset;
             float target = ak_clampf(tw, j->twist_lower, j->twist_upper);
             if (tw != target) joint_rotation(s, a, b, ak_vec3_scale(n, tw - target), 0.0f, err);
         }
