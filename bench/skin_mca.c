@@ -6,6 +6,9 @@
 #include "skin/deform_avx2.c"
 
 #if AKP_HAVE_AVX2_KERNEL
+/* stands for the 3x4-row palette copy that block_lbs_range makes (palettes <= 256 joints) */
+static _Alignas(64) float mca_rows3[AKP_ROWS3_MAX * 16];
+
 #define MCA_CTX(normals)                                                                           \
     akp_skin_ctx c = *cin;                                                                         \
     c.pos_stride = c.nrm_stride = c.out_pos_stride = c.out_nrm_stride = c.ctr_stride = 12;         \
@@ -22,7 +25,7 @@
         for (size_t i = begin; i < end; i += 8, b ^= 1u) {                                         \
             __asm volatile("# LLVM-MCA-BEGIN " #name);                                             \
             offsets8_dense(&c, i + 8, off[b ^ 1u], 4); /* packed: the block loop's dense path */   \
-            block_lbs(&c, i, 4, off[b], true, (normals) ? AKP_IO_PN : AKP_IO_P);                       \
+            block_lbs(&c, i, 4, off[b], true, mca_rows3, (normals) ? AKP_IO_PN : AKP_IO_P);        \
             __asm volatile("# LLVM-MCA-END " #name);                                               \
         }                                                                                          \
     }

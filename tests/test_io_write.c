@@ -1,7 +1,8 @@
 /* glTF writer (ak_io_save): round trips of every shared glTF asset (same sampled poses,
  * morph weights and skinned vertices, compared with a double-precision reference skinning
  * written here), STEP/CUBICSPLINE kept exactly, the Khronos validator on the output, bad
- * input, and `animkit export -o OUT.glb|.gltf`. */
+ * input, `animkit export -o OUT.glb|.gltf`, and the writer's streaming JSON (src/io/json_write.h)
+ * against cJSON's printing of the same values. */
 #include <animkit/animkit.h>
 #include <dirent.h>
 #include <math.h>
@@ -11,8 +12,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cjson/cJSON.h> /* the reference the streaming JSON writer must match byte for byte */
+
 #include "ak_test.h"
 #include "gltf_validate.h"
+#include "io/json_write.h"
 
 static char g_tmp[400];
 
@@ -867,6 +871,125 @@ AK_TEST(cli_export) {
 }
 #endif
 
+/* ---- the streaming JSON writer against cJSON ------------------------------------------- */
+
+static uint64_t g_jrng = 0x9E3779B97F4A7C15ull;
+static uint64_t jrand(void) {
+    g_jrng ^= g_jrng << 13, g_jrng ^= g_jrng >> 7, g_jrng ^= g_jrng << 17;
+    return g_jrng;
+}
+
+/* A number of the kinds the glTF writer prints (floats widened, indices, byte counts) and
+ * the edges of cJSON's printing: -0, integers past 2^31 and 10^15, random bit patterns,
+ * denormals, NaN and infinities (null). */
+static double jnumber(void) {
+    switch (jrand() % 10) {
+    case 0: return (double)(int32_t)(jrand() % 200000) - 100000;
+    case 1: return -0.0;
+    case 2: return (double)(jrand() % 100000000000000000ull);
+    case 3: {
+        uint32_t b = (uint32_t)jrand();
+        float f;
+        memcpy(&f, &b, 4);
+        return f;
+    }
+    case 4: {
+        uint64_t b = jrand();
+        double d;
+        memcpy(&d, &b, 8);
+        return d;
+    }
+    case 5: return (double)(float)((double)(jrand() % 2000001) / 1000000.0 - 1.0);
+    case 6: return (jrand() & 1 ? 1 : -1) * 4.9e-324 * (double)(jrand() % 1000);
+    case 7: return (double)(jrand() % 4096) / 64.0;
+    case 8: return jrand() % 3 == 0 ? NAN : jrand() & 1 ? INFINITY : -INFINITY;
+    default: return (double)(float)((double)(int64_t)jrand() * 1e-12);
+    }
+}
+
+/* A string of bytes 1..255: quotes, backslashes, control characters, UTF-8 and stray bytes. */
+static void jstring(char* s, size_t cap) {
+    size_t n = jrand() % (cap - 1);
+    static const char special[] = "\"\\\b\f\n\r\t/\x01\x1f\x7f";
+    for (size_t i = 0; i < n; ++i) {
+        uint64_t r = jrand() % 4;
+        s[i] = r == 0 ? special[jrand() % (sizeof special - 1)] : r == 1 ? (char)(1 + jrand() % 255) : (char)('a' + jrand() % 26);
+    }
+    s[n] = '\0';
+}
+
+/* Build the same random value into the cJSON tree (under parent, as key when parent is an
+ * object) and into two writers (w[0] to a file, w[1] counting). */
+static void jvalue(cJSON* parent, akp_jw* w, int depth) {
+    char key[24], str[24];
+    const char* k = NULL;
+    if (cJSON_IsObject(parent)) {
+        jstring(key, sizeof key);
+        k = key;
+    }
+    cJSON* item;
+    uint64_t kind = depth >= 5 ? 2 + jrand() % 2 : jrand() % 4;
+    if (kind < 2) {
+        item = kind == 0 ? cJSON_CreateObject() : cJSON_CreateArray();
+        if (kind == 0) for (int i = 0; i < 2; ++i) akp_jw_object(&w[i], k);
+        else for (int i = 0; i < 2; ++i) akp_jw_array(&w[i], k);
+        size_t n = jrand() % 5;
+        for (size_t i = 0; i < n; ++i) jvalue(item, w, depth + 1);
+        for (int i = 0; i < 2; ++i) akp_jw_end(&w[i]);
+    } else if (kind == 2) {
+        double v = jnumber();
+        item = cJSON_CreateNumber(v);
+        for (int i = 0; i < 2; ++i) akp_jw_number(&w[i], k, v);
+    } else {
+        jstring(str, sizeof str);
+        item = cJSON_CreateString(str);
+        for (int i = 0; i < 2; ++i) akp_jw_string(&w[i], k, str);
+    }
+    if (k) cJSON_AddItemToObject(parent, k, item);
+    else cJSON_AddItemToArray(parent, item);
+}
+
+/* Random documents written by akp_jw (to a file, and counted) are cJSON_Print's and
+ * cJSON_PrintUnformatted's bytes for the same tree. */
+AK_TEST(json_writer_matches_cjson) {
+    char path[512];
+    tmp_path(path, sizeof path, "jw.json");
+    int bad = 0;
+    for (int doc = 0; doc < AK_TEST_REPS(600, 100) && bad < 3; ++doc) {
+        const bool format = doc & 1;
+        FILE* f = fopen(path, "wb");
+        AK_CHECK(f != NULL);
+        if (!f) return;
+        akp_jw* w = (akp_jw*)malloc(2 * sizeof *w);
+        AK_CHECK(w != NULL);
+        if (!w) return;
+        akp_jw_init(&w[0], f, format);
+        akp_jw_init(&w[1], NULL, format);
+        cJSON* root = cJSON_CreateObject();
+        for (int i = 0; i < 2; ++i) akp_jw_object(&w[i], NULL);
+        size_t n = jrand() % 8;
+        for (size_t i = 0; i < n; ++i) jvalue(root, w, 1);
+        for (int i = 0; i < 2; ++i) akp_jw_end(&w[i]);
+        AK_CHECK(akp_jw_flush(&w[0]));
+        fclose(f);
+        char* want = format ? cJSON_Print(root) : cJSON_PrintUnformatted(root);
+        size_t got_n = 0;
+        unsigned char* got = read_all(path, &got_n);
+        if (got) got[got_n] = '\0';
+        bool same = want && got && got_n == strlen(want) && !memcmp(got, want, got_n) && w[0].bytes == got_n &&
+                    w[1].bytes == got_n;
+        if (!same && bad++ < 3)
+            AK_CHECK_MSG(same, "document %d (%s): %zu bytes written, cJSON prints %zu:\n%.300s\n%.300s", doc,
+                         format ? "formatted" : "unformatted", got_n, want ? strlen(want) : 0, got ? (const char*)got : "",
+                         want ? want : "");
+        free(got);
+        cJSON_free(want);
+        cJSON_Delete(root);
+        free(w);
+    }
+    AK_CHECK_EQ(bad, 0);
+}
+
 int main(void) {
     snprintf(g_tmp, sizeof g_tmp, "%s/test_io_write.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
     if (!mkdtemp(g_tmp)) {
@@ -881,6 +1004,7 @@ int main(void) {
     AK_RUN(instances_round_trip);
     AK_RUN(bvh_round_trip);
     AK_RUN(save_budget);
+    AK_RUN(json_writer_matches_cjson);
 #ifdef AK_CLI_PATH
     AK_RUN_SLOW(cli_export);
 #endif

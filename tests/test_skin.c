@@ -734,6 +734,65 @@ AK_TEST(every_simd_kernel_matches_scalar) {
     for (int l = 0; l < 3; ++l) free(op[l]), free(on[l]);
 }
 
+AK_TEST(lbs_kernels_match_reference_around_palette_copy_limit) {
+    /* The AVX2 kernel copies palettes of up to 256 joints into a 3x4-row layout for the packed
+     * K = 1 (rigid), 2, 4, 8 blocks and reads larger ones in place: palettes of 255, 256, 257
+     * and 300 joints, joint indices spread over the whole palette (the last joint included),
+     * every kernel against the double-precision reference (positions and normals). */
+    ak_skin_simd levels[3];
+    const char* names[3];
+    const int level_count = cpu_simd_levels(levels, names);
+    enum { JMAX = 300, N = 77 };
+    static const int joint_counts[4] = {255, 256, 257, JMAX};
+    static const uint32_t ks[4] = {1, 2, 4, 8};
+    ak_rng rng = ak_rng_make(77);
+    ak_mat4* pal = malloc(JMAX * sizeof *pal);
+    ak_vec3 *pos = malloc(N * sizeof *pos), *nrm = malloc(N * sizeof *nrm);
+    ak_vec3 *op = malloc(N * sizeof *op), *on = malloc(N * sizeof *on);
+    uint16_t* jn = malloc(N * 8 * sizeof *jn);
+    float* w = malloc(N * 8 * sizeof *w);
+    for (int ji = 0; ji < 4; ++ji) {
+        const int J = joint_counts[ji];
+        for (int kc = 0; kc < 4; ++kc) {
+            const uint32_t K = ks[kc];
+            /* K = 1: rigid (the kernels' 1-influence path); else scale and shear on odd joints */
+            for (int j = 0; j < J; ++j) pal[j] = rand_matrix(&rng, K > 1 && j % 2 == 1);
+            for (int i = 0; i < N; ++i) {
+                pos[i] = ak_vec3_make(ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1), ak_rng_range(&rng, -1, 1));
+                nrm[i] = rand_unit(&rng);
+                rand_influences(&rng, K, (size_t)J, &jn[K * i], &w[K * i]);
+                if (i % 5 == 0) jn[K * i] = (uint16_t)(J - 1);
+            }
+            for (int l = 0; l < level_count; ++l) {
+                ak_skin_job job = {
+                    .influence_count = K,
+                    .palette = {pal, (size_t)J},
+                    .positions = {pos, N, 0},
+                    .joints = {jn, N, 0},
+                    .weights = {w, N, 0},
+                    .normals = {nrm, N, 0},
+                    .out_positions = {op, N, 0},
+                    .out_normals = {on, N, 0},
+                    .simd_limit = levels[l],
+                };
+                AK_CHECK_EQ(ak_skin_job_run(&job), AK_OK);
+                double worst_p = 0.0, worst_n = 0.0;
+                for (int i = 0; i < N; ++i) {
+                    double rp[3], rn[3];
+                    ref_lbs(pal, &jn[K * i], &w[K * i], K, pos[i], nrm[i], rp, rn);
+                    const double ep = fabs(rp[0] - op[i].x) + fabs(rp[1] - op[i].y) + fabs(rp[2] - op[i].z);
+                    const double en = fabs(rn[0] - on[i].x) + fabs(rn[1] - on[i].y) + fabs(rn[2] - on[i].z);
+                    worst_p = ep == ep ? fmax(worst_p, ep) : INFINITY;
+                    worst_n = en == en ? fmax(worst_n, en) : INFINITY;
+                }
+                AK_CHECK_MSG(worst_p <= 1e-4 && worst_n <= 1e-4, "%s %d joints K %u: %g / %g", names[l], J, K,
+                             worst_p, worst_n);
+            }
+        }
+    }
+    free(pal), free(pos), free(nrm), free(op), free(on), free(jn), free(w);
+}
+
 AK_TEST(lbs_single_influence_rigid_path) {
     /* LBS with 1 influence, normals and a rigid palette takes a path without the blend and the
      * normal's renormalisation in the SIMD kernels: against the scalar code for valid weights
@@ -1753,6 +1812,7 @@ int main(void) {
     AK_RUN(lbs_matches_double_reference);
     AK_RUN(dqs_cor_simd_matches_scalar_for_every_influence_count);
     AK_RUN(every_simd_kernel_matches_scalar);
+    AK_RUN(lbs_kernels_match_reference_around_palette_copy_limit);
     AK_RUN(lbs_single_influence_rigid_path);
     AK_RUN(lbs_tangents_and_face_normals);
     AK_RUN(bad_joint_indices_clamp_in_every_kernel);

@@ -494,7 +494,6 @@ ak_result ak_cloth_create(const ak_cloth_desc* desc_in, const ak_allocator* allo
     const size_t colors_n = nd > nb ? nd : nb;
     uint64_t* used = akp_alloc(a, n * sizeof(uint64_t));
     uint8_t* color = akp_alloc(a, 2 * (colors_n ? colors_n : 1));
-    uint8_t* color2 = color + (colors_n ? colors_n : 1); /* a second colouring to compare */
     uint32_t* parts = akp_alloc(a, (colors_n ? colors_n : 1) * 4 * sizeof(uint32_t));
     char* mem = akp_calloc(a, size);
     if (!used || !color || !parts || !mem) {
@@ -502,6 +501,7 @@ ak_result ak_cloth_create(const ak_cloth_desc* desc_in, const ak_allocator* allo
         build_free(&b);
         return AK_ERR_NO_MEMORY;
     }
+    uint8_t* color2 = color + (colors_n ? colors_n : 1); /* a second colouring to compare */
     ak_cloth* c = (ak_cloth*)mem;
     c->alloc = a ? *a : (ak_allocator){0};
     c->n = n, c->tri_count = nt, c->dist_count = nd, c->bend_count = nb, c->attach_count = na, c->pin_count = np;

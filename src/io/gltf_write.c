@@ -1,12 +1,13 @@
 /* glTF 2.0 writer: a scene as .glb or as .gltf + .bin (io.h, docs/io.md "Writing glTF").
  * One bufferView per accessor (so no byteStride is ever needed), every view 4-byte aligned,
- * one buffer. The JSON is built with cJSON and its own malloc (as the reader does). */
-#include <cjson/cJSON.h> /* Debian libcjson-dev */
+ * one buffer. The document is held as compact tables (w_ctx below), never as a JSON tree,
+ * and its text is streamed by json_write.h: counted to size the file, then written into it. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "io_internal.h"
+#include "json_write.h"
 
 /* ---- private types ---------------------------------------------------------------------- */
 
@@ -16,6 +17,80 @@
 #define GL_FLOAT 5126
 #define GL_ARRAY_BUFFER 34962
 #define GL_ELEMENT_ARRAY_BUFFER 34963
+
+typedef struct w_view {
+    size_t offset, length;
+    int target;
+} w_view;
+
+typedef struct w_accessor {
+    int view, ctype, comps;
+    int32_t minmax; /* first of comps minima then comps maxima in w_ctx.minmax, -1 none */
+    size_t count;
+} w_accessor;
+
+/* A node: a joint (TRS from the rest pose) or a node made for a mesh (named, identity). Keys
+ * are written name, translation, rotation, scale, then children, mesh and skin in the order
+ * they were given (children_last: the first child came after the mesh). */
+typedef struct w_node {
+    int32_t joint; /* skeleton joint, -1 for a mesh node */
+    char* name;    /* a mesh node's name (owned) */
+    int32_t first_child, last_child, next_sibling, parent;
+    int32_t mesh, skin;
+    bool children_last;
+} w_node;
+
+enum { W_POSITION, W_NORMAL, W_TANGENT, W_TEXCOORD_0, W_COLOR_0, W_JOINTS_0, W_WEIGHTS_0, W_JOINTS_1, W_WEIGHTS_1, W_ATTRS };
+static const char* const k_attr_names[W_ATTRS] = {"POSITION", "NORMAL",    "TANGENT",  "TEXCOORD_0", "COLOR_0",
+                                                  "JOINTS_0", "WEIGHTS_0", "JOINTS_1", "WEIGHTS_1"};
+
+typedef struct w_prim {
+    int32_t attr[W_ATTRS]; /* accessor per attribute, -1 absent */
+    int32_t indices, mode, material; /* -1 absent */
+    size_t target_first, target_count; /* in w_ctx.targets, 3 accessors (POSITION NORMAL TANGENT) each */
+} w_prim;
+
+typedef struct w_mesh {
+    char name[AK_NAME_SIZE];
+    size_t prim_first, prim_count; /* in w_ctx.prims */
+    const ak_mesh* morph;          /* default weights and target names from it; NULL none */
+} w_mesh;
+
+typedef struct w_material {
+    float v[4];
+    int texture;
+} w_material;
+
+typedef struct w_texture {
+    size_t scene_texture;
+    int view;
+} w_texture;
+
+typedef struct w_skin {
+    size_t scene_skin;
+    int accessor;
+} w_skin;
+
+typedef struct w_channel {
+    int sampler;
+    int32_t node;
+    const char* path;
+} w_channel;
+
+typedef struct w_sampler {
+    int input, output;
+    ak_interp interp;
+} w_sampler;
+
+typedef struct w_anim {
+    const char* name;
+    size_t channel_first, channel_count, sampler_first, sampler_count;
+} w_anim;
+
+/* A growable array: ptr, count and cap of one table. */
+#define W_TABLE(type, name) \
+    type* name;             \
+    size_t name##_count, name##_cap
 
 typedef struct w_ctx {
     const ak_scene* scene;
@@ -28,19 +103,26 @@ typedef struct w_ctx {
     bool sink_failed; /* a write to sink failed (errno in sink_err) */
     int sink_err;
     size_t bin_size;
-    cJSON *root, *views, *accessors, *nodes, *meshes, *skins, *animations, *materials;
-    cJSON *textures, *images, *samplers;
+    /* the document, table by table */
+    W_TABLE(w_view, views);
+    W_TABLE(w_accessor, accessors);
+    W_TABLE(float, minmax);
+    W_TABLE(w_node, nodes);
+    W_TABLE(w_prim, prims);
+    W_TABLE(int32_t, targets);
+    W_TABLE(w_mesh, meshes);
+    W_TABLE(w_material, materials);
+    W_TABLE(w_texture, textures);
+    W_TABLE(w_skin, skins);
+    W_TABLE(w_channel, channels);
+    W_TABLE(w_sampler, samplers);
+    W_TABLE(w_anim, anims);
     int32_t* gltf_texture; /* [scene texture_count] glTF texture written for it, -1 not yet */
     uint8_t** png;         /* [scene texture_count] its PNG, encoded once for both passes
                               (owned by the w_plan), NULL not yet */
     size_t* png_size;
-    int n_textures;
     size_t n_nodes; /* written so far (joints, then extra mesh nodes) */
-    /* counts and a node table: cJSON arrays are linked lists, and asking their size or
-     * item i walks them (quadratic for scenes of thousands of nodes and accessors) */
-    int n_views, n_accessors, n_meshes, n_samplers;
-    cJSON** node_tab;
-    size_t node_tab_count, node_tab_cap;
+    int n_samplers; /* of the clip being written */
     int32_t* node_of_mesh; /* [mesh_count] glTF node carrying scene mesh m's glTF mesh, -1 none */
     int32_t* group_of_mesh; /* [mesh_count] first scene mesh of m's group (one glTF mesh) */
     size_t* morph_base; /* [mesh_count] first morph weight index of scene mesh m */
@@ -48,7 +130,7 @@ typedef struct w_ctx {
     int32_t* owner_of_mesh; /* [mesh_count] first scene mesh with m's ak_mesh pointer */
     bool* instanced;        /* [mesh_count] that pointer is placed more than once */
     int32_t* gltf_mesh_of;  /* [mesh_count] glTF mesh written for m, -1 not yet */
-    cJSON** prim_of_mesh;   /* [mesh_count] the primitive written for an instanced owner */
+    int32_t* prim_of_mesh;  /* [mesh_count] the primitive (in prims) written for an instanced owner */
     /* the last animation input written: channels keyed at the same times share it */
     int last_times_accessor;
     float* last_times; /* a copy of its keys */
@@ -77,10 +159,24 @@ static ak_result oom(w_ctx* c) {
     return AK_ERR_NO_MEMORY;
 }
 
+/* Room for one more element in a table (*p holds *count of elem bytes, *cap allocated);
+ * false when out of memory. */
+static bool table_grow(void** p, size_t count, size_t* cap, size_t elem, size_t more) {
+    if (count + more <= *cap) return true;
+    size_t want = *cap ? 2 * *cap : 16;
+    while (want < count + more) want *= 2;
+    if (want > SIZE_MAX / elem) return false;
+    void* q = realloc(*p, want * elem);
+    if (!q) return false;
+    *p = q, *cap = want;
+    return true;
+}
 
-static cJSON* num(double v) { return cJSON_CreateNumber(v); }
-
-static bool add_num(cJSON* obj, const char* key, double v) { return cJSON_AddItemToObject(obj, key, num(v)); }
+/* Append to table name of c: evaluates to a pointer to the new (uninitialised) element or NULL. */
+#define W_PUSH(c, name)                                                                                    \
+    (table_grow((void**)&(c)->name, (c)->name##_count, &(c)->name##_cap, sizeof *(c)->name, 1)             \
+         ? &(c)->name[(c)->name##_count++]                                                                \
+         : NULL)
 
 /* Append data as a new bufferView (4-byte aligned, zero padded): written to c->sink when
  * there is one (a failed write is remembered in sink_failed), else only counted. Returns its
@@ -98,14 +194,11 @@ static int add_view(w_ctx* c, const void* data, size_t bytes, int target) {
         }
     }
     c->bin_size += padded;
-    if (c->sink) return c->n_views++; /* the writing pass: its JSON is the measuring pass's */
-    cJSON* v = cJSON_CreateObject();
-    if (!v || !cJSON_AddItemToArray(c->views, v)) return -1;
-    add_num(v, "buffer", 0);
-    if (offset) add_num(v, "byteOffset", (double)offset);
-    add_num(v, "byteLength", (double)bytes);
-    if (target) add_num(v, "target", target);
-    return c->n_views++;
+    if (c->views_count >= INT32_MAX) return -1;
+    w_view* v = W_PUSH(c, views);
+    if (!v) return -1;
+    *v = (w_view){offset, bytes, target};
+    return (int)(c->views_count - 1);
 }
 
 static size_t ctype_size(int ctype) {
@@ -127,20 +220,20 @@ static const char* type_name(int comps) {
 static int add_accessor(w_ctx* c, const void* data, size_t count, int ctype, int comps, int target, bool minmax) {
     size_t bytes = count * (size_t)comps * ctype_size(ctype);
     int view = add_view(c, data, bytes, target);
-    if (view < 0) return -1;
-    if (c->sink) return c->n_accessors++;
-    cJSON* a = cJSON_CreateObject();
-    if (!a || !cJSON_AddItemToArray(c->accessors, a)) return -1;
-    const int index = c->n_accessors++;
-    add_num(a, "bufferView", view);
-    add_num(a, "componentType", ctype);
-    add_num(a, "count", (double)count);
-    cJSON_AddStringToObject(a, "type", type_name(comps));
-    if (minmax && ctype == GL_FLOAT && count) {
+    if (view < 0 || c->accessors_count >= INT32_MAX) return -1;
+    w_accessor* a = W_PUSH(c, accessors);
+    if (!a) return -1;
+    *a = (w_accessor){.view = view, .ctype = ctype, .comps = comps, .minmax = -1, .count = count};
+    const int index = (int)(c->accessors_count - 1);
+    if (minmax && ctype == GL_FLOAT && count && !c->sink) { /* the writing pass: only the data matters */
+        if (c->minmax_count > INT32_MAX - 32 ||
+            !table_grow((void**)&c->minmax, c->minmax_count, &c->minmax_cap, sizeof(float), 2 * (size_t)comps))
+            return -1;
+        float* mn = c->minmax + c->minmax_count;
+        float* mx = mn + comps;
+        a->minmax = (int32_t)c->minmax_count;
+        c->minmax_count += 2 * (size_t)comps;
         const float* f = (const float*)data;
-        cJSON* mn = cJSON_AddArrayToObject(a, "min");
-        cJSON* mx = cJSON_AddArrayToObject(a, "max");
-        if (!mn || !mx) return -1;
         for (int k = 0; k < comps; ++k) {
             float lo = f[k], hi = f[k];
             for (size_t i = 1; i < count; ++i) {
@@ -148,8 +241,7 @@ static int add_accessor(w_ctx* c, const void* data, size_t count, int ctype, int
                 lo = x < lo ? x : lo;
                 hi = x > hi ? x : hi;
             }
-            cJSON_AddItemToArray(mn, num(lo));
-            cJSON_AddItemToArray(mx, num(hi));
+            mn[k] = lo, mx[k] = hi;
         }
     }
     return index;
@@ -165,64 +257,40 @@ static bool finite_floats(const float* f, size_t n) {
 
 /* ---- nodes ------------------------------------------------------------------------------ */
 
-static ak_result write_node_trs(w_ctx* c, cJSON* node, ak_transform t, const char* name) {
-    if (!ak_transform_is_finite(t)) return BAD(c, AK_ERR_BAD_DATA, "joint %s: rest transform is not finite", name);
-    ak_quat q = ak_quat_normalize(t.rotation);
-    if (t.translation.x != 0.0f || t.translation.y != 0.0f || t.translation.z != 0.0f) {
-        cJSON* a = cJSON_AddArrayToObject(node, "translation");
-        if (!a) return oom(c);
-        cJSON_AddItemToArray(a, num(t.translation.x));
-        cJSON_AddItemToArray(a, num(t.translation.y));
-        cJSON_AddItemToArray(a, num(t.translation.z));
+/* Append a node (joint, or -1 with an owned copy of name); out of memory -> NULL. */
+static w_node* push_node(w_ctx* c, int32_t joint, const char* name) {
+    if (c->nodes_count >= INT32_MAX) return NULL;
+    char* copy = NULL;
+    if (joint < 0) {
+        size_t n = strlen(name);
+        if (!(copy = (char*)malloc(n + 1))) return NULL;
+        memcpy(copy, name, n + 1);
     }
-    if (q.x != 0.0f || q.y != 0.0f || q.z != 0.0f || q.w != 1.0f) {
-        cJSON* a = cJSON_AddArrayToObject(node, "rotation");
-        if (!a) return oom(c);
-        cJSON_AddItemToArray(a, num(q.x));
-        cJSON_AddItemToArray(a, num(q.y));
-        cJSON_AddItemToArray(a, num(q.z));
-        cJSON_AddItemToArray(a, num(q.w));
+    w_node* node = W_PUSH(c, nodes);
+    if (!node) {
+        free(copy);
+        return NULL;
     }
-    if (t.scale.x != 1.0f || t.scale.y != 1.0f || t.scale.z != 1.0f) {
-        cJSON* a = cJSON_AddArrayToObject(node, "scale");
-        if (!a) return oom(c);
-        cJSON_AddItemToArray(a, num(t.scale.x));
-        cJSON_AddItemToArray(a, num(t.scale.y));
-        cJSON_AddItemToArray(a, num(t.scale.z));
-    }
-    return AK_OK;
+    *node = (w_node){.joint = joint, .name = copy, .first_child = -1, .last_child = -1, .next_sibling = -1,
+                     .parent = -1, .mesh = -1, .skin = -1};
+    return node;
 }
 
-/* Append a node to nodes and to the node table; false when out of memory (node then freed). */
-static bool push_node(w_ctx* c, cJSON* node) {
-    if (!node) return false;
-    if (c->node_tab_count == c->node_tab_cap) {
-        size_t cap = c->node_tab_cap ? 2 * c->node_tab_cap : 64;
-        cJSON** t = (cJSON**)realloc(c->node_tab, cap * sizeof *t);
-        if (!t) {
-            cJSON_Delete(node);
-            return false;
-        }
-        c->node_tab = t, c->node_tab_cap = cap;
-    }
-    if (!cJSON_AddItemToArray(c->nodes, node)) {
-        cJSON_Delete(node);
-        return false;
-    }
-    c->node_tab[c->node_tab_count++] = node;
-    return true;
-}
-
-static cJSON* node_at(const w_ctx* c, int32_t i) {
-    return i >= 0 && (size_t)i < c->node_tab_count ? c->node_tab[i] : NULL;
+static w_node* node_at(const w_ctx* c, int32_t i) {
+    return i >= 0 && (size_t)i < c->nodes_count ? &c->nodes[i] : NULL;
 }
 
 static ak_result add_child(w_ctx* c, int32_t parent, size_t child) {
-    cJSON* p = node_at(c, parent);
+    w_node* p = node_at(c, parent);
     if (!p) return BAD(c, AK_ERR_BAD_INDEX, "node %d is out of range", (int)parent);
-    cJSON* ch = cJSON_GetObjectItemCaseSensitive(p, "children");
-    if (!ch && !(ch = cJSON_AddArrayToObject(p, "children"))) return oom(c);
-    if (!cJSON_AddItemToArray(ch, num((double)child))) return oom(c);
+    if (p->last_child < 0) {
+        p->first_child = (int32_t)child;
+        p->children_last = p->mesh >= 0;
+    } else {
+        c->nodes[p->last_child].next_sibling = (int32_t)child;
+    }
+    p->last_child = (int32_t)child;
+    c->nodes[child].parent = parent;
     return AK_OK;
 }
 
@@ -232,12 +300,8 @@ static ak_result write_skeleton(w_ctx* c) {
     ak_i32_cspan parents = ak_skeleton_parents(sk);
     ak_transform_cspan rest = ak_skeleton_rest_pose(sk);
     for (size_t j = 0; j < n; ++j) {
-        cJSON* node = cJSON_CreateObject();
-        if (!push_node(c, node)) return oom(c);
-        const char* name = ak_skeleton_joint_name(sk, j);
-        if (!cJSON_AddStringToObject(node, "name", name)) return oom(c);
+        if (!push_node(c, (int32_t)j, NULL) || !ak_skeleton_joint_name(sk, j)) return oom(c);
         if (!ak_transform_is_finite(rest.ptr[j])) return BAD(c, AK_ERR_BAD_DATA, "joint %zu: rest transform is not finite", j);
-        WTRY(write_node_trs(c, node, rest.ptr[j], name));
         if (parents.ptr[j] >= 0) WTRY(add_child(c, parents.ptr[j], j));
     }
     c->n_nodes = n;
@@ -247,11 +311,9 @@ static ak_result write_skeleton(w_ctx* c) {
 /* A new node with identity transform for a mesh (a root unless parent >= 0), named
  * "<mesh_name>_node". */
 static ak_result add_mesh_node(w_ctx* c, const char* mesh_name, int32_t parent, int32_t* out_node) {
-    cJSON* node = cJSON_CreateObject();
-    if (!push_node(c, node)) return oom(c);
     char name[AK_NAME_SIZE + 8];
     snprintf(name, sizeof name, "%s_node", mesh_name[0] ? mesh_name : "mesh");
-    if (!cJSON_AddStringToObject(node, "name", name)) return oom(c);
+    if (!push_node(c, -1, name)) return oom(c);
     *out_node = (int32_t)c->n_nodes++;
     if (parent >= 0) WTRY(add_child(c, parent, (size_t)*out_node));
     return AK_OK;
@@ -405,17 +467,15 @@ static bool same_group(w_ctx* c, size_t a, size_t b, ak_result* err) {
     return true;
 }
 
-static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
+static ak_result write_primitive(w_ctx* c, size_t m, w_prim* prim) {
     const ak_mesh* mesh = c->scene->meshes[m].mesh;
     size_t nv = mesh->vertex_count;
     char what[AK_NAME_SIZE + 32];
     snprintf(what, sizeof what, "mesh %zu (%s)", m, mesh->name);
     if (!finite_floats(&mesh->positions[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: a position is not finite", what);
-    cJSON* attrs = cJSON_AddObjectToObject(prim, "attributes");
-    if (!attrs) return oom(c);
     int a = add_accessor(c, mesh->positions, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, true);
     if (a < 0) return oom(c);
-    add_num(attrs, "POSITION", a);
+    prim->attr[W_POSITION] = a;
     if (mesh->normals) {
         /* glTF requires unit normals: renormalise the ones that are off by more than float
          * rounding (a zero normal becomes +Y, as ak_normals_compute does) */
@@ -433,7 +493,7 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
         a = add_accessor(c, n, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false);
         free(n);
         if (a < 0) return oom(c);
-        add_num(attrs, "NORMAL", a);
+        prim->attr[W_NORMAL] = a;
     }
     const bool tangents = mesh->tangents && mesh->normals; /* glTF: TANGENT needs NORMAL */
     if (mesh->tangents && !mesh->normals) {
@@ -459,17 +519,17 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
         a = add_accessor(c, tg, nv, GL_FLOAT, 4, GL_ARRAY_BUFFER, false);
         free(tg);
         if (a < 0) return oom(c);
-        add_num(attrs, "TANGENT", a);
+        prim->attr[W_TANGENT] = a;
     }
     if (mesh->uvs) {
         if (!finite_floats(&mesh->uvs[0].x, nv * 2)) return BAD(c, AK_ERR_BAD_DATA, "%s: a UV is not finite", what);
         if ((a = add_accessor(c, mesh->uvs, nv, GL_FLOAT, 2, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
-        add_num(attrs, "TEXCOORD_0", a);
+        prim->attr[W_TEXCOORD_0] = a;
     }
     if (mesh->colors) {
         if (!finite_floats(&mesh->colors[0].x, nv * 4)) return BAD(c, AK_ERR_BAD_DATA, "%s: a colour is not finite", what);
         if ((a = add_accessor(c, mesh->colors, nv, GL_FLOAT, 4, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
-        add_num(attrs, "COLOR_0", a);
+        prim->attr[W_COLOR_0] = a;
     }
     if (mesh->influence_count && c->scene->meshes[m].skin >= 0) { /* glTF skins need JOINTS_0 */
         uint32_t infl = mesh->influence_count, sets = infl > 4 ? 2 : 1;
@@ -507,11 +567,8 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
             int wa = add_accessor(c, wb, nv, GL_FLOAT, 4, GL_ARRAY_BUFFER, false);
             if (ja < 0 || wa < 0) r = oom(c);
             else {
-                char jk[24], wk[24]; /* room for any unsigned set index (gcc -O1 -Wformat-truncation) */
-                snprintf(jk, sizeof jk, "JOINTS_%u", s);
-                snprintf(wk, sizeof wk, "WEIGHTS_%u", s);
-                add_num(attrs, jk, ja);
-                add_num(attrs, wk, wa);
+                prim->attr[W_JOINTS_0 + 2 * s] = ja;
+                prim->attr[W_WEIGHTS_0 + 2 * s] = wa;
             }
         }
         free(jb);
@@ -532,32 +589,34 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
             a = add_accessor(c, mesh->indices, ni, GL_UNSIGNED_INT, 1, GL_ELEMENT_ARRAY_BUFFER, false);
         }
         if (a < 0) return oom(c);
-        add_num(prim, "indices", a);
-        add_num(prim, "mode", 4);
+        prim->indices = a;
+        prim->mode = 4;
     } else {
-        add_num(prim, "mode", 0); /* a point cloud */
+        prim->mode = 0; /* a point cloud */
     }
     if (mesh->morph_target_count) {
-        cJSON* targets = cJSON_AddArrayToObject(prim, "targets");
-        if (!targets) return oom(c);
+        prim->target_first = c->targets_count;
         for (size_t t = 0; t < mesh->morph_target_count; ++t) {
-            cJSON* tg = cJSON_CreateObject();
-            if (!tg || !cJSON_AddItemToArray(targets, tg)) return oom(c);
+            if (!table_grow((void**)&c->targets, c->targets_count, &c->targets_cap, sizeof(int32_t), 3)) return oom(c);
+            int32_t* tg = c->targets + c->targets_count;
+            tg[0] = tg[1] = tg[2] = -1;
+            c->targets_count += 3;
+            ++prim->target_count;
             const ak_vec3* d = mesh->morph_positions + t * nv;
             if (!finite_floats(&d[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: morph target %zu is not finite", what, t);
             if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, true)) < 0) return oom(c);
-            add_num(tg, "POSITION", a);
+            tg[0] = a;
             if (mesh->morph_normals) {
                 d = mesh->morph_normals + t * nv;
                 if (!finite_floats(&d[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: morph target %zu is not finite", what, t);
                 if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
-                add_num(tg, "NORMAL", a);
+                tg[1] = a;
             }
             if (tangents && mesh->morph_tangents) {
                 d = mesh->morph_tangents + t * nv;
                 if (!finite_floats(&d[0].x, nv * 3)) return BAD(c, AK_ERR_BAD_DATA, "%s: morph target %zu is not finite", what, t);
                 if ((a = add_accessor(c, d, nv, GL_FLOAT, 3, GL_ARRAY_BUFFER, false)) < 0) return oom(c);
-                add_num(tg, "TANGENT", a);
+                tg[2] = a;
             }
         }
     }
@@ -565,8 +624,9 @@ static ak_result write_primitive(w_ctx* c, size_t m, cJSON* prim) {
 }
 
 /* The glTF texture of scene texture ti, written on first use: its pixels as an embedded PNG
- * (a bufferView, also for .gltf), a sampler with its wrap modes and filters, the texture.
- * Returns the index, -1 when out of memory or the PNG cannot be encoded. */
+ * (a bufferView, also for .gltf), a sampler with its wrap modes and filters, the texture
+ * (image, sampler and texture n are written for glTF texture n). Returns the index, -1 when
+ * out of memory or the PNG cannot be encoded. */
 static int texture_index(w_ctx* c, size_t ti) {
     if (c->gltf_texture[ti] >= 0) return c->gltf_texture[ti];
     const ak_scene_texture* st = &c->scene->textures[ti];
@@ -574,39 +634,11 @@ static int texture_index(w_ctx* c, size_t ti) {
         return -1;
     int view = add_view(c, c->png[ti], c->png_size[ti], 0);
     if (view < 0) return -1;
-    static const int wraps[3] = {10497, 33071, 33648};
-    cJSON* im = cJSON_CreateObject();
-    cJSON* sm = cJSON_CreateObject();
-    cJSON* tx = cJSON_CreateObject();
-    bool ok = im && sm && tx;
-    if (ok) {
-        add_num(im, "bufferView", view);
-        cJSON_AddStringToObject(im, "mimeType", "image/png");
-        if (st->name[0] && akp_io_utf8_valid(st->name, strlen(st->name))) cJSON_AddStringToObject(im, "name", st->name);
-        add_num(sm, "magFilter", st->mag_filter == AK_TEXTURE_FILTER_NEAREST ? 9728 : 9729);
-        add_num(sm, "minFilter", st->min_filter == AK_TEXTURE_FILTER_NEAREST ? 9728 : 9729);
-        add_num(sm, "wrapS", wraps[(unsigned)st->wrap_s < 3u ? st->wrap_s : 0]);
-        add_num(sm, "wrapT", wraps[(unsigned)st->wrap_t < 3u ? st->wrap_t : 0]);
-        add_num(tx, "sampler", c->n_textures);
-        add_num(tx, "source", c->n_textures);
-    }
-    if (!ok || !cJSON_AddItemToArray(c->images, im)) {
-        cJSON_Delete(im);
-        cJSON_Delete(sm);
-        cJSON_Delete(tx);
-        return -1;
-    }
-    if (!cJSON_AddItemToArray(c->samplers, sm)) {
-        cJSON_Delete(sm);
-        cJSON_Delete(tx);
-        return -1;
-    }
-    if (!cJSON_AddItemToArray(c->textures, tx)) {
-        cJSON_Delete(tx);
-        return -1;
-    }
-    c->gltf_texture[ti] = c->n_textures;
-    return c->n_textures++;
+    w_texture* t = W_PUSH(c, textures);
+    if (!t) return -1;
+    *t = (w_texture){ti, view};
+    c->gltf_texture[ti] = (int32_t)(c->textures_count - 1);
+    return c->gltf_texture[ti];
 }
 
 /* Index of a material with this base colour and base colour texture (-1: none) (made on
@@ -614,27 +646,17 @@ static int texture_index(w_ctx* c, size_t ti) {
 static int material_index(w_ctx* c, ak_vec4 col, int texture) {
     float v[4] = {col.x, col.y, col.z, col.w};
     for (int k = 0; k < 4; ++k) v[k] = v[k] < 0.0f ? 0.0f : v[k] > 1.0f ? 1.0f : v[k];
-    int i = 0;
-    for (const cJSON* m = c->materials->child; m; m = m->next, ++i) {
-        const cJSON* pbr = cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness");
-        const cJSON* f = cJSON_GetObjectItemCaseSensitive(pbr, "baseColorFactor");
-        const cJSON* t = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(pbr, "baseColorTexture"), "index");
-        if ((t ? (int)t->valuedouble : -1) != texture) continue;
+    for (size_t i = 0; i < c->materials_count; ++i) {
+        const w_material* m = &c->materials[i];
+        if (m->texture != texture) continue;
         int k = 0;
-        for (const cJSON* e = f ? f->child : NULL; e && k < 4 && e->valuedouble == (double)v[k]; e = e->next) ++k;
-        if (k == 4) return i;
+        while (k < 4 && m->v[k] == v[k]) ++k;
+        if (k == 4) return (int)i;
     }
-    cJSON* m = cJSON_CreateObject();
-    cJSON* pbr = m ? cJSON_AddObjectToObject(m, "pbrMetallicRoughness") : NULL;
-    cJSON* f = pbr ? cJSON_AddArrayToObject(pbr, "baseColorFactor") : NULL;
-    cJSON* bt = pbr && texture >= 0 ? cJSON_AddObjectToObject(pbr, "baseColorTexture") : NULL;
-    if (!f || (texture >= 0 && !bt) || !cJSON_AddItemToArray(c->materials, m)) {
-        cJSON_Delete(m);
-        return -1;
-    }
-    for (int k = 0; k < 4; ++k) cJSON_AddItemToArray(f, num(v[k]));
-    if (bt) add_num(bt, "index", texture);
-    return i;
+    w_material* m = W_PUSH(c, materials);
+    if (!m) return -1;
+    *m = (w_material){{v[0], v[1], v[2], v[3]}, texture};
+    return (int)(c->materials_count - 1);
 }
 
 /* The glTF mesh name of a group: the reader names primitive p of mesh "M" "M_p", so a group
@@ -688,7 +710,7 @@ static bool same_material(const ak_scene_mesh* a, const ak_scene_mesh* b) {
 }
 
 /* The material of scene mesh k's primitive (none, a colour, a texture). */
-static ak_result set_material(w_ctx* c, size_t k, cJSON* prim) {
+static ak_result set_material(w_ctx* c, size_t k, w_prim* prim) {
     const ak_scene* s = c->scene;
     const ak_scene_mesh* sk = &s->meshes[k];
     bool textured = sk->texture >= 0 && (size_t)sk->texture < s->texture_count && s->textures[sk->texture].pixels &&
@@ -697,8 +719,28 @@ static ak_result set_material(w_ctx* c, size_t k, cJSON* prim) {
     int ti = textured ? texture_index(c, (size_t)sk->texture) : -1;
     int mi = textured && ti < 0 ? -1 : material_index(c, sk->has_material ? sk->base_color : ak_vec4_make(1, 1, 1, 1), ti);
     if (mi < 0) return oom(c);
-    add_num(prim, "material", mi);
+    prim->material = mi;
     return AK_OK;
+}
+
+/* A new glTF mesh (its primitives to be appended to prims); NULL when out of memory. */
+static w_mesh* push_mesh(w_ctx* c, const char* name) {
+    if (c->meshes_count >= INT32_MAX) return NULL;
+    w_mesh* gm = W_PUSH(c, meshes);
+    if (!gm) return NULL;
+    *gm = (w_mesh){.prim_first = c->prims_count};
+    snprintf(gm->name, sizeof gm->name, "%s", name);
+    return gm;
+}
+
+/* A new primitive of the last glTF mesh, nothing in it yet; NULL when out of memory. */
+static w_prim* push_prim(w_ctx* c) {
+    w_prim* p = W_PUSH(c, prims);
+    if (!p) return NULL;
+    *p = (w_prim){.indices = -1, .mode = -1, .material = -1};
+    for (int k = 0; k < W_ATTRS; ++k) p->attr[k] = -1;
+    ++c->meshes[c->meshes_count - 1].prim_count;
+    return p;
 }
 
 /* An instanced scene mesh m whose owner was written: the glTF mesh of an earlier instance
@@ -711,24 +753,23 @@ static ak_result instance_mesh(w_ctx* c, size_t m, int* out_mesh) {
             *out_mesh = c->gltf_mesh_of[k];
             return AK_OK;
         }
-    cJSON* prim = cJSON_Duplicate(c->prim_of_mesh[owner], true);
-    cJSON* gm = cJSON_CreateObject();
-    cJSON* prims = gm ? cJSON_AddArrayToObject(gm, "primitives") : NULL;
-    if (!prim || !prims || !cJSON_AddItemToArray(prims, prim) || !cJSON_AddItemToArray(c->meshes, gm)) {
-        cJSON_Delete(prim);
-        cJSON_Delete(gm);
-        return oom(c);
-    }
-    cJSON_DeleteItemFromObjectCaseSensitive(prim, "material");
-    cJSON_AddStringToObject(gm, "name", s->meshes[owner].mesh->name);
+    w_mesh* gm = push_mesh(c, s->meshes[owner].mesh->name);
+    if (!gm) return oom(c);
+    gm->morph = c->meshes[c->gltf_mesh_of[owner]].morph; /* its weights and target names */
+    w_prim* prim = push_prim(c);
+    if (!prim) return oom(c);
+    *prim = c->prims[c->prim_of_mesh[owner]];
+    prim->material = -1;
     WTRY(set_material(c, m, prim));
-    const cJSON* w = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(c->meshes, c->gltf_mesh_of[owner]), "weights");
-    const cJSON* ex = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(c->meshes, c->gltf_mesh_of[owner]), "extras");
-    if ((w && !cJSON_AddItemToObject(gm, "weights", cJSON_Duplicate(w, true))) ||
-        (ex && !cJSON_AddItemToObject(gm, "extras", cJSON_Duplicate(ex, true))))
-        return oom(c);
-    *out_mesh = c->n_meshes++;
+    *out_mesh = (int)(c->meshes_count - 1);
     return AK_OK;
+}
+
+static void set_node_mesh(w_ctx* c, int32_t node, int mesh, int32_t skin) {
+    w_node* nj = node_at(c, node);
+    if (!nj) return;
+    nj->mesh = mesh;
+    nj->skin = skin;
 }
 
 static ak_result write_meshes(w_ctx* c) {
@@ -771,49 +812,34 @@ static ak_result write_meshes(w_ctx* c) {
             c->gltf_mesh_of[m] = gi;
             c->node_of_mesh[m] = node;
             c->group_of_mesh[m] = (int32_t)m;
-            cJSON* nj = node_at(c, node);
-            add_num(nj, "mesh", gi);
-            if (skinned) add_num(nj, "skin", sm->skin);
+            set_node_mesh(c, node, gi, skinned ? sm->skin : -1);
             m = end;
             continue;
         }
-        cJSON* gm = cJSON_CreateObject();
-        cJSON* prims = gm ? cJSON_AddArrayToObject(gm, "primitives") : NULL;
-        if (!prims || !cJSON_AddItemToArray(c->meshes, gm)) {
-            cJSON_Delete(gm);
+        char gname[AK_NAME_SIZE];
+        group_name(mesh->name, end - m, gname);
+        if (!push_mesh(c, gname)) {
             r = oom(c);
             break;
         }
-        ++c->n_meshes;
-        char gname[AK_NAME_SIZE];
-        group_name(mesh->name, end - m, gname);
-        cJSON_AddStringToObject(gm, "name", gname);
+        const int gi = (int)(c->meshes_count - 1);
         for (size_t k = m; k < end && r == AK_OK; ++k) {
-            cJSON* prim = cJSON_CreateObject();
-            if (!prim || !cJSON_AddItemToArray(prims, prim)) r = oom(c);
+            w_prim* prim = push_prim(c);
+            if (!prim) r = oom(c);
             else r = write_primitive(c, k, prim);
+            /* write_primitive may grow prims no further: prim is still valid */
             if (r == AK_OK) r = set_material(c, k, prim);
             c->node_of_mesh[k] = node;
             c->group_of_mesh[k] = (int32_t)m;
-            c->gltf_mesh_of[k] = c->n_meshes - 1;
-            c->prim_of_mesh[k] = prim;
+            c->gltf_mesh_of[k] = gi;
+            c->prim_of_mesh[k] = (int32_t)(c->prims_count - 1);
         }
         if (r == AK_OK && mesh->morph_target_count) {
-            cJSON* w = cJSON_AddArrayToObject(gm, "weights");
-            cJSON* ex = cJSON_AddObjectToObject(gm, "extras");
-            cJSON* names = ex ? cJSON_AddArrayToObject(ex, "targetNames") : NULL;
-            if (!w || !names) r = oom(c);
-            for (size_t t = 0; r == AK_OK && t < mesh->morph_target_count; ++t) {
+            for (size_t t = 0; r == AK_OK && t < mesh->morph_target_count; ++t)
                 if (!ak_finitef(mesh->morph_weights[t])) r = BAD(c, AK_ERR_BAD_DATA, "mesh %s: default weight %zu is not finite", mesh->name, t);
-                cJSON_AddItemToArray(w, num(mesh->morph_weights[t]));
-                cJSON_AddItemToArray(names, cJSON_CreateString(mesh->morph_names ? mesh->morph_names[t] : ""));
-            }
+            c->meshes[gi].morph = mesh;
         }
-        if (r == AK_OK) {
-            cJSON* nj = node_at(c, node);
-            add_num(nj, "mesh", c->n_meshes - 1);
-            if (skinned) add_num(nj, "skin", sm->skin);
-        }
+        if (r == AK_OK) set_node_mesh(c, node, gi, skinned ? sm->skin : -1);
         m = end;
     }
     free(used);
@@ -824,29 +850,25 @@ static ak_result write_skins(w_ctx* c) {
     const ak_scene* s = c->scene;
     for (size_t i = 0; i < s->skin_count; ++i) {
         const ak_scene_skin* sk = &s->skins[i];
-        cJSON* js = cJSON_CreateObject();
-        if (!js || !cJSON_AddItemToArray(c->skins, js)) return oom(c);
-        if (sk->name[0]) cJSON_AddStringToObject(js, "name", sk->name);
-        cJSON* joints = cJSON_AddArrayToObject(js, "joints");
-        if (!joints) return oom(c);
         for (size_t k = 0; k < sk->joint_count; ++k) {
             if (sk->joints[k] < 0 || (size_t)sk->joints[k] >= ak_scene_joint_count(s))
                 return BAD(c, AK_ERR_BAD_INDEX, "skin %s: slot %zu names no joint", sk->name, k);
             if (!ak_mat4_is_finite(&sk->inverse_binds[k])) return BAD(c, AK_ERR_BAD_DATA, "skin %s: inverse bind %zu is not finite", sk->name, k);
-            cJSON_AddItemToArray(joints, num(sk->joints[k]));
         }
         int a = add_accessor(c, sk->inverse_binds, sk->joint_count, GL_FLOAT, 16, 0, false);
-        if (a < 0) return oom(c);
-        add_num(js, "inverseBindMatrices", a);
+        w_skin* js = a < 0 ? NULL : W_PUSH(c, skins);
+        if (!js) return oom(c);
+        *js = (w_skin){i, a};
     }
     return AK_OK;
 }
 
 /* ---- animations ------------------------------------------------------------------------ */
 
-static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t keys, const float* values,
-                             size_t value_count, int comps, ak_interp interp, int* out_index) {
-    cJSON* samplers = cJSON_GetObjectItemCaseSensitive(an, "samplers");
+/* A sampler of the clip being written (its input shared with the previous one when keyed at
+ * the same times); *out_index is its index in the clip. */
+static ak_result add_sampler(w_ctx* c, const float* times, size_t keys, const float* values, size_t value_count,
+                             int comps, ak_interp interp, int* out_index) {
     /* channels keyed at the same times (a baked crowd: all of them) share one input */
     int in = c->last_times_accessor;
     if (in < 0 || keys != c->last_times_keys || (keys && memcmp(c->last_times, times, keys * sizeof(float)))) {
@@ -860,43 +882,23 @@ static ak_result add_sampler(w_ctx* c, cJSON* an, const float* times, size_t key
         c->last_times_accessor = in, c->last_times_keys = keys;
     }
     int outa = add_accessor(c, values, value_count, GL_FLOAT, comps, 0, false);
-    if (c->sink) { /* the writing pass: only the data matters */
-        if (in < 0 || outa < 0) return oom(c);
-        *out_index = c->n_samplers++;
-        return AK_OK;
-    }
-    cJSON* sm = cJSON_CreateObject();
-    if (in < 0 || outa < 0 || !sm || !cJSON_AddItemToArray(samplers, sm)) return oom(c);
-    add_num(sm, "input", in);
-    add_num(sm, "output", outa);
-    cJSON_AddStringToObject(sm, "interpolation", interp == AK_INTERP_STEP ? "STEP"
-                                                 : interp == AK_INTERP_LINEAR ? "LINEAR" : "CUBICSPLINE");
+    w_sampler* sm = in < 0 || outa < 0 ? NULL : W_PUSH(c, samplers);
+    if (!sm) return oom(c);
+    *sm = (w_sampler){in, outa, interp};
     *out_index = c->n_samplers++;
     return AK_OK;
 }
 
-static ak_result add_channel(w_ctx* c, cJSON* an, int sampler, int32_t node, const char* path) {
-    if (c->sink) return AK_OK; /* the writing pass: no JSON */
-    cJSON* ch = cJSON_CreateObject();
-    cJSON* chans = cJSON_GetObjectItemCaseSensitive(an, "channels");
-    if (!ch || !cJSON_AddItemToArray(chans, ch)) return oom(c);
-    add_num(ch, "sampler", sampler);
-    cJSON* tg = cJSON_AddObjectToObject(ch, "target");
-    if (!tg) return oom(c);
-    add_num(tg, "node", node);
-    cJSON_AddStringToObject(tg, "path", path);
+static ak_result add_channel(w_ctx* c, int sampler, int32_t node, const char* path) {
+    w_channel* ch = W_PUSH(c, channels);
+    if (!ch) return oom(c);
+    *ch = (w_channel){sampler, node, path};
     return AK_OK;
 }
 
 static ak_result write_clip(w_ctx* c, const ak_clip* clip, size_t ci) {
-    cJSON* an = cJSON_CreateObject();
-    if (!an) return oom(c);
     c->n_samplers = 0;
-    if (!cJSON_AddArrayToObject(an, "channels") || !cJSON_AddArrayToObject(an, "samplers")) {
-        cJSON_Delete(an);
-        return oom(c);
-    }
-    if (ak_clip_name(clip)[0]) cJSON_AddStringToObject(an, "name", ak_clip_name(clip));
+    const size_t channel_first = c->channels_count, sampler_first = c->samplers_count;
     ak_result r = AK_OK;
     size_t joints = ak_scene_joint_count(c->scene);
     for (size_t ch = 0; ch < ak_clip_channel_count(clip) && r == AK_OK; ++ch) {
@@ -926,14 +928,14 @@ static ak_result write_clip(w_ctx* c, const ak_clip* clip, size_t ci) {
         size_t keys = ak_track_key_count(t), parts = is_cubic(interp) ? 3 : 1;
         uint32_t comps = ak_track_component_count(t);
         float* v = (float*)malloc(keys * parts * comps * sizeof(float));
-        if (!v) return cJSON_Delete(an), oom(c);
+        if (!v) return oom(c);
         r = track_values(c, t, interp, v, comps, 0, NULL);
         int si = -1;
         if (r == AK_OK)
-            r = add_sampler(c, an, ak_track_times(t).ptr, keys, v, keys * parts, (int)comps, interp, &si);
+            r = add_sampler(c, ak_track_times(t).ptr, keys, v, keys * parts, (int)comps, interp, &si);
         free(v);
         if (r == AK_OK)
-            r = add_channel(c, an, si, (int32_t)joint, tgt == AK_CHANNEL_TRANSLATION ? "translation"
+            r = add_channel(c, si, (int32_t)joint, tgt == AK_CHANNEL_TRANSLATION ? "translation"
                                                        : tgt == AK_CHANNEL_ROTATION ? "rotation" : "scale");
     }
     for (size_t m = 0; m < c->scene->mesh_count && r == AK_OK; ++m) {
@@ -942,22 +944,21 @@ static ak_result write_clip(w_ctx* c, const ak_clip* clip, size_t ci) {
         if ((r = morph_sampler(c, clip, m, &w)) != AK_OK || !w.present) continue;
         size_t tc = c->scene->meshes[m].mesh->morph_target_count, parts = is_cubic(w.interp) ? 3 : 1;
         int si = -1;
-        r = add_sampler(c, an, w.times, w.keys, w.values, w.keys * parts * tc, 1, w.interp, &si);
-        if (r == AK_OK) r = add_channel(c, an, si, c->node_of_mesh[m], "weights");
+        r = add_sampler(c, w.times, w.keys, w.values, w.keys * parts * tc, 1, w.interp, &si);
+        if (r == AK_OK) r = add_channel(c, si, c->node_of_mesh[m], "weights");
         morph_free(&w);
     }
-    if (r == AK_OK && cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(an, "channels")) == 0) {
+    if (r == AK_OK && c->channels_count == channel_first) {
         char msg[200];
         snprintf(msg, sizeof msg, "glTF writer: clip %zu ('%s') has nothing glTF can hold; not written", ci,
                  ak_clip_name(clip));
         akp_log(c->logger, AK_LOG_WARN, msg);
-        cJSON_Delete(an);
         return AK_OK;
     }
-    if (r != AK_OK || !cJSON_AddItemToArray(c->animations, an)) {
-        cJSON_Delete(an);
-        return r != AK_OK ? r : oom(c);
-    }
+    w_anim* an = r == AK_OK ? W_PUSH(c, anims) : NULL;
+    if (!an) return r != AK_OK ? r : oom(c);
+    *an = (w_anim){ak_clip_name(clip), channel_first, c->channels_count - channel_first, sampler_first,
+                   c->samplers_count - sampler_first};
     return AK_OK;
 }
 
@@ -976,24 +977,6 @@ static void put_u32(uint8_t* p, uint32_t v) {
     p[1] = (uint8_t)(v >> 8);
     p[2] = (uint8_t)(v >> 16);
     p[3] = (uint8_t)(v >> 24);
-}
-
-/* Write a then b to a temporary beside path and close it (internal.h); out keeps it for
- * ak_atomic_file_rename. On failure nothing is left and path is untouched. */
-static ak_result write_bytes(w_ctx* c, const char* path, const void* a, size_t an, const void* b, size_t bn,
-                             ak_atomic_file* out) {
-    if (ak_atomic_file_open(out, path) != AK_OK) {
-        akp_diag_set(c->diag, path, "cannot create file (%s)", strerror(out->err));
-        return AK_ERR_IO;
-    }
-    bool ok = fwrite(a, 1, an, out->f) == an && (!bn || fwrite(b, 1, bn, out->f) == bn);
-    if (!ok) out->err = errno;
-    if (!ok || ak_atomic_file_close(out) != AK_OK) {
-        ak_atomic_file_abort(out);
-        akp_diag_set(c->diag, path, "cannot write file (%s)", strerror(out->err ? out->err : EIO));
-        return AK_ERR_IO;
-    }
-    return AK_OK;
 }
 
 /* Put a closed temporary in place; the diag names path when that fails. */
@@ -1021,26 +1004,11 @@ static void uri_encode(const char* s, char* out, size_t cap) {
     out[o] = '\0';
 }
 
+
 static ak_result build_document(w_ctx* c) {
     const ak_scene* s = c->scene;
-    c->root = cJSON_CreateObject();
-    if (!c->root) return oom(c);
-    cJSON* asset = cJSON_AddObjectToObject(c->root, "asset");
-    if (!asset) return oom(c);
-    cJSON_AddStringToObject(asset, "version", "2.0");
-    cJSON_AddStringToObject(asset, "generator", "animkit");
-    c->nodes = cJSON_CreateArray();
-    c->meshes = cJSON_CreateArray();
-    c->skins = cJSON_CreateArray();
-    c->animations = cJSON_CreateArray();
-    c->views = cJSON_CreateArray();
-    c->accessors = cJSON_CreateArray();
-    c->materials = cJSON_CreateArray();
-    c->textures = cJSON_CreateArray();
-    c->images = cJSON_CreateArray();
-    c->samplers = cJSON_CreateArray();
     c->gltf_texture = (int32_t*)malloc((s->texture_count ? s->texture_count : 1) * sizeof(int32_t));
-    if (!c->textures || !c->images || !c->samplers || !c->gltf_texture) return oom(c);
+    if (!c->gltf_texture) return oom(c);
     for (size_t t = 0; t < s->texture_count; ++t) c->gltf_texture[t] = -1;
     size_t mc = s->mesh_count ? s->mesh_count : 1;
     c->node_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
@@ -1049,13 +1017,11 @@ static ak_result build_document(w_ctx* c) {
     c->owner_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
     c->instanced = (bool*)calloc(mc, sizeof(bool));
     c->gltf_mesh_of = (int32_t*)malloc(mc * sizeof(int32_t));
-    c->prim_of_mesh = (cJSON**)calloc(mc, sizeof(cJSON*));
+    c->prim_of_mesh = (int32_t*)calloc(mc, sizeof(int32_t));
     if (!c->owner_of_mesh || !c->instanced || !c->gltf_mesh_of || !c->prim_of_mesh) return oom(c);
     for (size_t m = 0; m < mc; ++m) c->gltf_mesh_of[m] = -1;
     c->last_times_accessor = -1;
-    if (!c->nodes || !c->meshes || !c->skins || !c->animations || !c->views || !c->accessors || !c->materials ||
-        !c->node_of_mesh || !c->group_of_mesh || !c->morph_base)
-        return oom(c);
+    if (!c->node_of_mesh || !c->group_of_mesh || !c->morph_base) return oom(c);
     for (size_t m = 0; m < s->mesh_count; ++m) {
         if (!s->meshes[m].mesh) return BAD(c, AK_ERR_NULL_ARG, "mesh %zu has no data", m);
         if (s->meshes[m].skin >= (int32_t)s->skin_count || s->meshes[m].skin < -1 ||
@@ -1068,54 +1034,274 @@ static ak_result build_document(w_ctx* c) {
     WTRY(write_meshes(c));
     for (size_t k = 0; k < s->clip_count; ++k)
         if (s->clips[k]) WTRY(write_clip(c, s->clips[k], k));
-    /* attach the arrays in the order readers expect to find them; empty ones are left out */
-    if (c->n_nodes) {
-        cJSON* scenes = cJSON_AddArrayToObject(c->root, "scenes");
-        cJSON* sc = cJSON_CreateObject();
-        if (!scenes || !sc || !cJSON_AddItemToArray(scenes, sc)) return oom(c);
-        cJSON* roots = cJSON_AddArrayToObject(sc, "nodes");
-        if (!roots) return oom(c);
-        size_t i = 0;
-        bool* child = (bool*)calloc(c->n_nodes, sizeof(bool));
-        if (!child) return oom(c);
-        for (cJSON* n = c->nodes->child; n; n = n->next) {
-            cJSON* ch = cJSON_GetObjectItemCaseSensitive(n, "children");
-            for (cJSON* e = ch ? ch->child : NULL; e; e = e->next) child[(size_t)e->valuedouble] = true;
-        }
-        for (i = 0; i < c->n_nodes; ++i)
-            if (!child[i]) cJSON_AddItemToArray(roots, num((double)i));
-        free(child);
-        add_num(c->root, "scene", 0);
-    }
-    cJSON** arrays[] = {&c->nodes,    &c->meshes,     &c->materials, &c->textures, &c->images,
-                        &c->samplers, &c->skins,      &c->animations, &c->accessors, &c->views};
-    const char* names[] = {"nodes",    "meshes", "materials",  "textures",  "images",
-                           "samplers", "skins",  "animations", "accessors", "bufferViews"};
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
-        cJSON* a = *arrays[i];
-        *arrays[i] = NULL;
-        if (cJSON_GetArraySize(a) == 0) cJSON_Delete(a);
-        else if (!cJSON_AddItemToObject(c->root, names[i], a)) return cJSON_Delete(a), oom(c);
-    }
     return AK_OK;
+}
+
+/* ---- the JSON text ---------------------------------------------------------------------- */
+
+static void emit_floats(akp_jw* w, const char* key, const float* v, size_t n) {
+    akp_jw_array(w, key);
+    for (size_t i = 0; i < n; ++i) akp_jw_number(w, NULL, v[i]);
+    akp_jw_end(w);
+}
+
+static void emit_node(akp_jw* w, const w_ctx* c, const w_node* n) {
+    akp_jw_object(w, NULL);
+    if (n->joint >= 0) {
+        const ak_skeleton* sk = c->scene->skeleton;
+        ak_transform t = ak_skeleton_rest_pose(sk).ptr[n->joint];
+        akp_jw_string(w, "name", ak_skeleton_joint_name(sk, (size_t)n->joint));
+        ak_quat q = ak_quat_normalize(t.rotation);
+        if (t.translation.x != 0.0f || t.translation.y != 0.0f || t.translation.z != 0.0f)
+            emit_floats(w, "translation", (const float[3]){t.translation.x, t.translation.y, t.translation.z}, 3);
+        if (q.x != 0.0f || q.y != 0.0f || q.z != 0.0f || q.w != 1.0f)
+            emit_floats(w, "rotation", (const float[4]){q.x, q.y, q.z, q.w}, 4);
+        if (t.scale.x != 1.0f || t.scale.y != 1.0f || t.scale.z != 1.0f)
+            emit_floats(w, "scale", (const float[3]){t.scale.x, t.scale.y, t.scale.z}, 3);
+    } else {
+        akp_jw_string(w, "name", n->name);
+    }
+    for (int pass = 0; pass < 2; ++pass) {
+        if (n->first_child >= 0 && pass == (n->children_last ? 1 : 0)) {
+            akp_jw_array(w, "children");
+            for (int32_t ch = n->first_child; ch >= 0; ch = c->nodes[ch].next_sibling) akp_jw_number(w, NULL, ch);
+            akp_jw_end(w);
+        }
+        if (pass == 0 && n->mesh >= 0) {
+            akp_jw_number(w, "mesh", n->mesh);
+            if (n->skin >= 0) akp_jw_number(w, "skin", n->skin);
+        }
+    }
+    akp_jw_end(w);
+}
+
+static void emit_prim(akp_jw* w, const w_ctx* c, const w_prim* p) {
+    akp_jw_object(w, NULL);
+    akp_jw_object(w, "attributes");
+    for (int k = 0; k < W_ATTRS; ++k)
+        if (p->attr[k] >= 0) akp_jw_number(w, k_attr_names[k], p->attr[k]);
+    akp_jw_end(w);
+    if (p->indices >= 0) akp_jw_number(w, "indices", p->indices);
+    akp_jw_number(w, "mode", p->mode);
+    if (p->target_count) {
+        akp_jw_array(w, "targets");
+        for (size_t t = 0; t < p->target_count; ++t) {
+            const int32_t* tg = c->targets + p->target_first + 3 * t;
+            akp_jw_object(w, NULL);
+            for (int k = 0; k < 3; ++k)
+                if (tg[k] >= 0) akp_jw_number(w, k_attr_names[k], tg[k]);
+            akp_jw_end(w);
+        }
+        akp_jw_end(w);
+    }
+    if (p->material >= 0) akp_jw_number(w, "material", p->material);
+    akp_jw_end(w);
+}
+
+static void emit_mesh(akp_jw* w, const w_ctx* c, const w_mesh* m) {
+    akp_jw_object(w, NULL);
+    akp_jw_array(w, "primitives");
+    for (size_t p = 0; p < m->prim_count; ++p) emit_prim(w, c, &c->prims[m->prim_first + p]);
+    akp_jw_end(w);
+    akp_jw_string(w, "name", m->name);
+    if (m->morph) {
+        const ak_mesh* mesh = m->morph;
+        emit_floats(w, "weights", mesh->morph_weights, mesh->morph_target_count);
+        akp_jw_object(w, "extras");
+        akp_jw_array(w, "targetNames");
+        for (size_t t = 0; t < mesh->morph_target_count; ++t)
+            akp_jw_string(w, NULL, mesh->morph_names ? mesh->morph_names[t] : "");
+        akp_jw_end(w);
+        akp_jw_end(w);
+    }
+    akp_jw_end(w);
+}
+
+static void emit_anim(akp_jw* w, const w_ctx* c, const w_anim* a) {
+    akp_jw_object(w, NULL);
+    akp_jw_array(w, "channels");
+    for (size_t i = 0; i < a->channel_count; ++i) {
+        const w_channel* ch = &c->channels[a->channel_first + i];
+        akp_jw_object(w, NULL);
+        akp_jw_number(w, "sampler", ch->sampler);
+        akp_jw_object(w, "target");
+        akp_jw_number(w, "node", ch->node);
+        akp_jw_string(w, "path", ch->path);
+        akp_jw_end(w);
+        akp_jw_end(w);
+    }
+    akp_jw_end(w);
+    akp_jw_array(w, "samplers");
+    for (size_t i = 0; i < a->sampler_count; ++i) {
+        const w_sampler* sm = &c->samplers[a->sampler_first + i];
+        akp_jw_object(w, NULL);
+        akp_jw_number(w, "input", sm->input);
+        akp_jw_number(w, "output", sm->output);
+        akp_jw_string(w, "interpolation", sm->interp == AK_INTERP_STEP     ? "STEP"
+                                          : sm->interp == AK_INTERP_LINEAR ? "LINEAR"
+                                                                           : "CUBICSPLINE");
+        akp_jw_end(w);
+    }
+    akp_jw_end(w);
+    if (a->name[0]) akp_jw_string(w, "name", a->name);
+    akp_jw_end(w);
+}
+
+/* The whole document, in the order readers expect to find its arrays (empty ones left out),
+ * with the one buffer (its uri when bin_uri is not NULL). */
+static void emit_document(akp_jw* w, const w_ctx* c, const char* bin_uri) {
+    const ak_scene* s = c->scene;
+    akp_jw_object(w, NULL);
+    akp_jw_object(w, "asset");
+    akp_jw_string(w, "version", "2.0");
+    akp_jw_string(w, "generator", "animkit");
+    akp_jw_end(w);
+    if (c->nodes_count) {
+        akp_jw_array(w, "scenes");
+        akp_jw_object(w, NULL);
+        akp_jw_array(w, "nodes");
+        for (size_t i = 0; i < c->nodes_count; ++i)
+            if (c->nodes[i].parent < 0) akp_jw_number(w, NULL, (double)i);
+        akp_jw_end(w);
+        akp_jw_end(w);
+        akp_jw_end(w);
+        akp_jw_number(w, "scene", 0);
+        akp_jw_array(w, "nodes");
+        for (size_t i = 0; i < c->nodes_count; ++i) emit_node(w, c, &c->nodes[i]);
+        akp_jw_end(w);
+    }
+    if (c->meshes_count) {
+        akp_jw_array(w, "meshes");
+        for (size_t i = 0; i < c->meshes_count; ++i) emit_mesh(w, c, &c->meshes[i]);
+        akp_jw_end(w);
+    }
+    if (c->materials_count) {
+        akp_jw_array(w, "materials");
+        for (size_t i = 0; i < c->materials_count; ++i) {
+            const w_material* m = &c->materials[i];
+            akp_jw_object(w, NULL);
+            akp_jw_object(w, "pbrMetallicRoughness");
+            emit_floats(w, "baseColorFactor", m->v, 4);
+            if (m->texture >= 0) {
+                akp_jw_object(w, "baseColorTexture");
+                akp_jw_number(w, "index", m->texture);
+                akp_jw_end(w);
+            }
+            akp_jw_end(w);
+            akp_jw_end(w);
+        }
+        akp_jw_end(w);
+    }
+    if (c->textures_count) {
+        static const int wraps[3] = {10497, 33071, 33648};
+        akp_jw_array(w, "textures");
+        for (size_t i = 0; i < c->textures_count; ++i) {
+            akp_jw_object(w, NULL);
+            akp_jw_number(w, "sampler", (double)i);
+            akp_jw_number(w, "source", (double)i);
+            akp_jw_end(w);
+        }
+        akp_jw_end(w);
+        akp_jw_array(w, "images");
+        for (size_t i = 0; i < c->textures_count; ++i) {
+            const ak_scene_texture* st = &s->textures[c->textures[i].scene_texture];
+            akp_jw_object(w, NULL);
+            akp_jw_number(w, "bufferView", c->textures[i].view);
+            akp_jw_string(w, "mimeType", "image/png");
+            if (st->name[0] && akp_io_utf8_valid(st->name, strlen(st->name))) akp_jw_string(w, "name", st->name);
+            akp_jw_end(w);
+        }
+        akp_jw_end(w);
+        akp_jw_array(w, "samplers");
+        for (size_t i = 0; i < c->textures_count; ++i) {
+            const ak_scene_texture* st = &s->textures[c->textures[i].scene_texture];
+            akp_jw_object(w, NULL);
+            akp_jw_number(w, "magFilter", st->mag_filter == AK_TEXTURE_FILTER_NEAREST ? 9728 : 9729);
+            akp_jw_number(w, "minFilter", st->min_filter == AK_TEXTURE_FILTER_NEAREST ? 9728 : 9729);
+            akp_jw_number(w, "wrapS", wraps[(unsigned)st->wrap_s < 3u ? st->wrap_s : 0]);
+            akp_jw_number(w, "wrapT", wraps[(unsigned)st->wrap_t < 3u ? st->wrap_t : 0]);
+            akp_jw_end(w);
+        }
+        akp_jw_end(w);
+    }
+    if (c->skins_count) {
+        akp_jw_array(w, "skins");
+        for (size_t i = 0; i < c->skins_count; ++i) {
+            const ak_scene_skin* sk = &s->skins[c->skins[i].scene_skin];
+            akp_jw_object(w, NULL);
+            if (sk->name[0]) akp_jw_string(w, "name", sk->name);
+            akp_jw_array(w, "joints");
+            for (size_t k = 0; k < sk->joint_count; ++k) akp_jw_number(w, NULL, sk->joints[k]);
+            akp_jw_end(w);
+            akp_jw_number(w, "inverseBindMatrices", c->skins[i].accessor);
+            akp_jw_end(w);
+        }
+        akp_jw_end(w);
+    }
+    if (c->anims_count) {
+        akp_jw_array(w, "animations");
+        for (size_t i = 0; i < c->anims_count; ++i) emit_anim(w, c, &c->anims[i]);
+        akp_jw_end(w);
+    }
+    if (c->accessors_count) {
+        akp_jw_array(w, "accessors");
+        for (size_t i = 0; i < c->accessors_count; ++i) {
+            const w_accessor* a = &c->accessors[i];
+            akp_jw_object(w, NULL);
+            akp_jw_number(w, "bufferView", a->view);
+            akp_jw_number(w, "componentType", a->ctype);
+            akp_jw_number(w, "count", (double)a->count);
+            akp_jw_string(w, "type", type_name(a->comps));
+            if (a->minmax >= 0) {
+                emit_floats(w, "min", c->minmax + a->minmax, (size_t)a->comps);
+                emit_floats(w, "max", c->minmax + a->minmax + a->comps, (size_t)a->comps);
+            }
+            akp_jw_end(w);
+        }
+        akp_jw_end(w);
+    }
+    if (c->views_count) {
+        akp_jw_array(w, "bufferViews");
+        for (size_t i = 0; i < c->views_count; ++i) {
+            const w_view* v = &c->views[i];
+            akp_jw_object(w, NULL);
+            akp_jw_number(w, "buffer", 0);
+            if (v->offset) akp_jw_number(w, "byteOffset", (double)v->offset);
+            akp_jw_number(w, "byteLength", (double)v->length);
+            if (v->target) akp_jw_number(w, "target", v->target);
+            akp_jw_end(w);
+        }
+        akp_jw_end(w);
+    }
+    if (c->bin_size) {
+        akp_jw_array(w, "buffers");
+        akp_jw_object(w, NULL);
+        akp_jw_number(w, "byteLength", (double)c->bin_size);
+        if (bin_uri) akp_jw_string(w, "uri", bin_uri);
+        akp_jw_end(w);
+        akp_jw_end(w);
+    }
+    akp_jw_end(w);
 }
 
 /* Free everything a pass built and zero the context's tables (scene, path, diag kept). */
 static void ctx_free(w_ctx* c) {
-    cJSON_Delete(c->root);
-    cJSON_Delete(c->nodes);
-    cJSON_Delete(c->meshes);
-    cJSON_Delete(c->skins);
-    cJSON_Delete(c->animations);
-    cJSON_Delete(c->views);
-    cJSON_Delete(c->accessors);
-    cJSON_Delete(c->materials);
-    cJSON_Delete(c->textures);
-    cJSON_Delete(c->images);
-    cJSON_Delete(c->samplers);
+    for (size_t i = 0; i < c->nodes_count; ++i) free(c->nodes[i].name);
+    free(c->views);
+    free(c->accessors);
+    free(c->minmax);
+    free(c->nodes);
+    free(c->prims);
+    free(c->targets);
+    free(c->meshes);
+    free(c->materials);
+    free(c->textures);
+    free(c->skins);
+    free(c->channels);
+    free(c->samplers);
+    free(c->anims);
     free(c->gltf_texture);
     free(c->node_of_mesh);
-    free(c->node_tab);
     free(c->group_of_mesh);
     free(c->morph_base);
     free(c->owner_of_mesh);
@@ -1127,10 +1313,10 @@ static void ctx_free(w_ctx* c) {
                  .png_size = c->png_size};
 }
 
-/* What the measuring pass found: the printed JSON and the sizes of what will be written. */
+/* What the measuring pass found: the document's tables and the sizes of what will be written. */
 typedef struct w_plan {
     bool glb;
-    char* json;   /* the document's JSON text (malloc'd by cJSON) */
+    w_ctx doc;    /* the document (its binary chunk only counted) */
     size_t json_size, bin_size;
     size_t total; /* bytes of every file written: the .glb, or the .gltf and its .bin */
     uint8_t** png; /* [texture_count] the textures' PNGs (w_ctx.png) */
@@ -1138,8 +1324,25 @@ typedef struct w_plan {
     char bin_path[4096], bin_uri[4096];
 } w_plan;
 
-/* The measuring pass: the whole document built with the binary chunk only counted, printed,
- * and freed again; plan gets the JSON and the exact sizes. */
+/* Write (f) or count (f NULL) the document's JSON text: cJSON_PrintUnformatted's bytes for a
+ * .glb, cJSON_Print's for a .gltf. Returns the bytes; *err gets errno when a write fails. */
+static size_t plan_json(const w_plan* plan, FILE* f, int* err) {
+    akp_jw* w = (akp_jw*)malloc(sizeof *w);
+    if (!w) {
+        *err = ENOMEM;
+        return 0;
+    }
+    akp_jw_init(w, f, !plan->glb);
+    emit_document(w, &plan->doc, plan->glb ? NULL : plan->bin_uri);
+    akp_jw_flush(w);
+    size_t n = w->bytes;
+    *err = w->failed ? (w->err ? w->err : EIO) : 0;
+    free(w);
+    return n;
+}
+
+/* The measuring pass: the whole document built with the binary chunk only counted and its
+ * JSON text counted; plan gets the document and the exact sizes. */
 static ak_result plan_save(const char* path, const ak_scene* scene, const ak_logger* logger, ak_diag* diag,
                            w_plan* plan) {
     memset(plan, 0, sizeof *plan);
@@ -1147,10 +1350,11 @@ static ak_result plan_save(const char* path, const ak_scene* scene, const ak_log
     const size_t tc = scene->texture_count ? scene->texture_count : 1;
     plan->png = (uint8_t**)calloc(tc, sizeof *plan->png);
     plan->png_size = (size_t*)calloc(tc, sizeof *plan->png_size);
-    w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = logger, .png = plan->png, .png_size = plan->png_size};
-    ak_result r = plan->png && plan->png_size ? build_document(&c) : oom(&c);
+    w_ctx* c = &plan->doc;
+    *c = (w_ctx){.scene = scene, .path = path, .diag = diag, .logger = logger, .png = plan->png, .png_size = plan->png_size};
+    ak_result r = plan->png && plan->png_size ? build_document(c) : oom(c);
     /* the file name of the .bin beside a .gltf: the .gltf's name with .bin */
-    if (r == AK_OK && !plan->glb && c.bin_size) {
+    if (r == AK_OK && !plan->glb && c->bin_size) {
         size_t n = strlen(path);
         if (n + 1 > sizeof plan->bin_path) {
             akp_diag_set(diag, path, "path is too long");
@@ -1162,39 +1366,30 @@ static ak_result plan_save(const char* path, const ak_scene* scene, const ak_log
             uri_encode(base ? base + 1 : plan->bin_path, plan->bin_uri, sizeof plan->bin_uri);
         }
     }
-    if (r == AK_OK && c.bin_size) {
-        cJSON* buffers = cJSON_AddArrayToObject(c.root, "buffers");
-        cJSON* b = cJSON_CreateObject();
-        if (!buffers || !b || !cJSON_AddItemToArray(buffers, b)) {
-            cJSON_Delete(b);
-            r = oom(&c);
-        } else {
-            add_num(b, "byteLength", (double)c.bin_size);
-            if (!plan->glb) cJSON_AddStringToObject(b, "uri", plan->bin_uri);
-        }
-    }
-    if (r == AK_OK && !(plan->json = plan->glb ? cJSON_PrintUnformatted(c.root) : cJSON_Print(c.root))) r = oom(&c);
     if (r == AK_OK) {
-        plan->json_size = strlen(plan->json);
-        plan->bin_size = c.bin_size;
+        int err = 0;
+        plan->json_size = plan_json(plan, NULL, &err);
+        if (err) r = oom(c);
+    }
+    if (r == AK_OK) {
+        plan->bin_size = c->bin_size;
         if (plan->glb) {
             size_t jpad = (plan->json_size + 3u) & ~(size_t)3u;
-            plan->total = 12 + 8 + jpad + (c.bin_size ? 8 + c.bin_size : 0);
+            plan->total = 12 + 8 + jpad + (c->bin_size ? 8 + c->bin_size : 0);
             if (plan->total > UINT32_MAX) {
                 akp_diag_set(diag, path, "%zu bytes is more than a GLB file can hold", plan->total);
                 r = AK_ERR_UNSUPPORTED;
             }
         } else {
-            plan->total = plan->json_size + 1 + c.bin_size; /* the .gltf ends in a newline */
+            plan->total = plan->json_size + 1 + c->bin_size; /* the .gltf ends in a newline */
         }
     }
-    ctx_free(&c);
     return r;
 }
 
 /* Free what plan_save left in plan. */
 static void plan_free(const ak_scene* scene, w_plan* plan) {
-    free(plan->json);
+    ctx_free(&plan->doc);
     for (size_t t = 0; plan->png && t < scene->texture_count; ++t) free(plan->png[t]);
     free(plan->png);
     free(plan->png_size);
@@ -1202,7 +1397,7 @@ static void plan_free(const ak_scene* scene, w_plan* plan) {
 }
 
 /* The writing pass: the document built again (the same scene gives the same views in the
- * same order), every view streamed to f as it is made; the JSON of this pass is thrown away. */
+ * same order), every view streamed to f as it is made; the tables of this pass are thrown away. */
 static ak_result stream_bin(const char* path, const ak_scene* scene, ak_diag* diag, const w_plan* plan, FILE* f) {
     ak_logger none = {0}; /* the measuring pass gave the warnings */
     w_ctx c = {.scene = scene, .path = path, .diag = diag, .logger = &none, .sink = f, .png = plan->png,
@@ -1291,11 +1486,12 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
             put_u32(head + 16, 0x4E4F534Au); /* "JSON" */
             put_u32(binh, (uint32_t)plan->bin_size);
             put_u32(binh + 4, 0x004E4942u); /* "BIN\0": views are 4-byte padded with zeros */
-            bool ok = fwrite(head, 1, 20, out->f) == 20 && fwrite(plan->json, 1, jn, out->f) == jn &&
-                      fwrite(pad, 1, jpad - jn, out->f) == jpad - jn && /* JSON chunk padding: spaces */
-                      (!plan->bin_size || fwrite(binh, 1, 8, out->f) == 8);
-            free(plan->json); /* the JSON is in the file: not held while the binary is made */
-            plan->json = NULL;
+            int err = 0;
+            bool ok = fwrite(head, 1, 20, out->f) == 20;
+            if (ok && (plan_json(plan, out->f, &err) != jn || err)) ok = false, errno = err ? err : EIO;
+            ok = ok && fwrite(pad, 1, jpad - jn, out->f) == jpad - jn && /* JSON chunk padding: spaces */
+                 (!plan->bin_size || fwrite(binh, 1, 8, out->f) == 8);
+            ctx_free(&plan->doc); /* the JSON is in the file: its tables are not held while the binary is made */
             if (!ok) {
                 akp_diag_set(diag, path, "cannot write file (%s)", strerror(errno ? errno : EIO));
                 r = AK_ERR_IO;
@@ -1312,10 +1508,24 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
             ak_atomic_file_abort(out);
         }
     } else if (r == AK_OK) {
-        /* both files are written in full before either is renamed into place: the .bin first,
-         * so a reader never sees a new .gltf beside an old .bin */
+        /* both files are written in full (the .gltf first, so the document's tables are freed
+         * before the binary is made) before either is renamed into place: the .bin first, so a
+         * reader never sees a new .gltf beside an old .bin */
         w_ctx c = {.scene = scene, .path = path, .diag = diag};
-        if (plan->bin_size) {
+        if (ak_atomic_file_open(out, path) != AK_OK) {
+            akp_diag_set(diag, path, "cannot create file (%s)", strerror(out->err));
+            r = AK_ERR_IO;
+        } else {
+            int err = 0;
+            if (plan_json(plan, out->f, &err) != plan->json_size || err || fwrite("\n", 1, 1, out->f) != 1) {
+                out->err = err ? err : errno;
+                r = AK_ERR_IO;
+            }
+            if (r == AK_OK && ak_atomic_file_close(out) != AK_OK) r = AK_ERR_IO;
+            if (r != AK_OK) akp_diag_set(diag, path, "cannot write file (%s)", strerror(out->err ? out->err : EIO));
+        }
+        ctx_free(&plan->doc); /* the JSON is in its file: its tables are not held while the binary is made */
+        if (r == AK_OK && plan->bin_size) {
             if (ak_atomic_file_open(&out[1], plan->bin_path) != AK_OK) {
                 akp_diag_set(diag, plan->bin_path, "cannot create file (%s)", strerror(out[1].err));
                 r = AK_ERR_IO;
@@ -1326,7 +1536,6 @@ ak_result ak_io_save(const char* path, const ak_scene* scene, const ak_io_save_d
                 r = AK_ERR_IO;
             }
         }
-        if (r == AK_OK) r = write_bytes(&c, path, plan->json, plan->json_size, "\n", 1, out);
         if (r == AK_OK && plan->bin_size) r = rename_into_place(&c, &out[1]);
         if (r == AK_OK) r = rename_into_place(&c, out);
         ak_atomic_file_abort(&out[1]);

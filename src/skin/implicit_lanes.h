@@ -13,6 +13,50 @@
  * Every lane does the scalar code's operations in the same order (lerp in x, then y, then z;
  * sums left to right; no fused multiply-add), so the results are bitwise field_eval's. */
 
+/* Bone b's grid for the lanes of L that it holds (their mask bits for b): each lane's posed
+ * point in grid coordinates (grid_locate), *in set for the lanes inside the grid's box and the
+ * capsule bound, and the cell (clamped to the last one) and its first node (cell_at). False
+ * when no lane is inside: the bone is skipped. */
+typedef struct lane_cell {
+    const float* F; /* the bone's frame record (fd->bf) */
+    int nx, ny;     /* the grid's nodes along x and y */
+    VF px, py, pz;  /* grid coordinates */
+    VI ix, iy, iz;  /* the cell */
+    VI node;        /* its first node's index */
+} lane_cell;
+
+KFUNC static inline bool lanes_locate(const akp_implicit_field* fd, const akp_implicit_lanes* L, unsigned b, VF X,
+                                      VF Y, VF Z, VM* in_out, lane_cell* c) {
+    const VF zero = F_ZERO(), one = F_SET1(1.0f);
+    unsigned bits = 0;
+    for (unsigned l = 0; l < LANES; ++l) bits |= (unsigned)((L->mask[l] >> b) & 1u) << l;
+    const float* F = fd->bf + (size_t)b * fd->bf_floats;
+    const VF px = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[0]), X), F_MUL(F_SET1(F[3]), Y)), F_MUL(F_SET1(F[6]), Z)), F_SET1(F[9]));
+    const VF py = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[1]), X), F_MUL(F_SET1(F[4]), Y)), F_MUL(F_SET1(F[7]), Z)), F_SET1(F[10]));
+    const VF pz = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[2]), X), F_MUL(F_SET1(F[5]), Y)), F_MUL(F_SET1(F[8]), Z)), F_SET1(F[11]));
+    VM in = M_AND(M_FROM_BITS(bits), M_AND(M_AND(M_GE(px, zero), M_GE(py, zero)), M_GE(pz, zero)));
+    in = M_AND(in, M_AND(M_AND(M_LE(px, F_SET1(F[20])), M_LE(py, F_SET1(F[21]))), M_LE(pz, F_SET1(F[22]))));
+    if (!M_ANY(in)) return false;
+    if (F[19] > 0.0f) {
+        const VF ax = F_SUB(px, F_SET1(F[12])), ay = F_SUB(py, F_SET1(F[13])), az = F_SUB(pz, F_SET1(F[14]));
+        const VF c0 = F_SET1(F[15]), c1 = F_SET1(F[16]), c2 = F_SET1(F[17]);
+        const VF t0 = F_MUL(F_ADD(F_ADD(F_MUL(ax, c0), F_MUL(ay, c1)), F_MUL(az, c2)), F_SET1(F[18]));
+        const VF t = F_SEL(M_GT(t0, zero), F_SEL(M_LT(t0, one), t0, one), zero);
+        const VF wx = F_SUB(ax, F_MUL(c0, t)), wy = F_SUB(ay, F_MUL(c1, t)), wz = F_SUB(az, F_MUL(c2, t));
+        const VF w2 = F_ADD(F_ADD(F_MUL(wx, wx), F_MUL(wy, wy)), F_MUL(wz, wz));
+        in = M_ANDNOT(in, M_GE(w2, F_SET1(F[19])));
+        if (!M_ANY(in)) return false;
+    }
+    const uint32_t* I = fd->grid_info + (size_t)b * 4;
+    const int nx = (int)I[0], ny = (int)I[1], nz = (int)I[2];
+    c->F = F, c->nx = nx, c->ny = ny, c->px = px, c->py = py, c->pz = pz;
+    c->ix = I_MIN(I_TRUNC(px), I_SET1(nx - 2)), c->iy = I_MIN(I_TRUNC(py), I_SET1(ny - 2));
+    c->iz = I_MIN(I_TRUNC(pz), I_SET1(nz - 2));
+    c->node = I_ADD(I_ADD(I_ADD(I_SET1((int)I[3]), c->ix), I_MUL(c->iy, I_SET1(nx))), I_MUL(c->iz, I_SET1(nx * ny)));
+    *in_out = in;
+    return true;
+}
+
 #if LANES_PACKED
 /* The (lane, bone) pairs of one call whose point lies in the bone's grid (phase 1 of
  * lanes_field), packed: the cell's first node and the nodes one step up in y and in z (float
@@ -49,32 +93,13 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
     unsigned n = 0, nb = 0;
     for (; all; all &= all - 1) {
         const unsigned b = (unsigned)__builtin_ctzll(all);
-        unsigned bits = 0;
-        for (unsigned l = 0; l < LANES; ++l) bits |= (unsigned)((L->mask[l] >> b) & 1u) << l;
-        const float* F = fd->bf + (size_t)b * fd->bf_floats;
-        /* grid_locate: posed point to grid coordinates, the grid's box, the capsule bound */
-        const VF px = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[0]), X), F_MUL(F_SET1(F[3]), Y)), F_MUL(F_SET1(F[6]), Z)), F_SET1(F[9]));
-        const VF py = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[1]), X), F_MUL(F_SET1(F[4]), Y)), F_MUL(F_SET1(F[7]), Z)), F_SET1(F[10]));
-        const VF pz = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[2]), X), F_MUL(F_SET1(F[5]), Y)), F_MUL(F_SET1(F[8]), Z)), F_SET1(F[11]));
-        VM in = M_AND(M_FROM_BITS(bits), M_AND(M_AND(M_GE(px, zero), M_GE(py, zero)), M_GE(pz, zero)));
-        in = M_AND(in, M_AND(M_AND(M_LE(px, F_SET1(F[20])), M_LE(py, F_SET1(F[21]))), M_LE(pz, F_SET1(F[22]))));
-        if (!M_ANY(in)) continue;
-        if (F[19] > 0.0f) {
-            const VF ax = F_SUB(px, F_SET1(F[12])), ay = F_SUB(py, F_SET1(F[13])), az = F_SUB(pz, F_SET1(F[14]));
-            const VF c0 = F_SET1(F[15]), c1 = F_SET1(F[16]), c2 = F_SET1(F[17]);
-            const VF t0 = F_MUL(F_ADD(F_ADD(F_MUL(ax, c0), F_MUL(ay, c1)), F_MUL(az, c2)), F_SET1(F[18]));
-            const VF t = F_SEL(M_GT(t0, zero), F_SEL(M_LT(t0, one), t0, one), zero);
-            const VF wx = F_SUB(ax, F_MUL(c0, t)), wy = F_SUB(ay, F_MUL(c1, t)), wz = F_SUB(az, F_MUL(c2, t));
-            const VF w2 = F_ADD(F_ADD(F_MUL(wx, wx), F_MUL(wy, wy)), F_MUL(wz, wz));
-            in = M_ANDNOT(in, M_GE(w2, F_SET1(F[19])));
-            if (!M_ANY(in)) continue;
-        }
-        /* cell_at: the cell (clamped to the last one) and the fractions */
-        const uint32_t* I = fd->grid_info + (size_t)b * 4;
-        const int nx = (int)I[0], ny = (int)I[1], nz = (int)I[2];
-        const VI ix = I_MIN(I_TRUNC(px), I_SET1(nx - 2)), iy = I_MIN(I_TRUNC(py), I_SET1(ny - 2)),
-                 iz = I_MIN(I_TRUNC(pz), I_SET1(nz - 2));
-        const VI node = I_ADD(I_ADD(I_ADD(I_SET1((int)I[3]), ix), I_MUL(iy, I_SET1(nx))), I_MUL(iz, I_SET1(nx * ny)));
+        lane_cell C;
+        VM in;
+        if (!lanes_locate(fd, L, b, X, Y, Z, &in, &C)) continue;
+        const float* F = C.F;
+        const int nx = C.nx, ny = C.ny;
+        const VF px = C.px, py = C.py, pz = C.pz;
+        const VI ix = C.ix, iy = C.iy, iz = C.iz, node = C.node;
         const VI i000 = I_MUL(node, I_SET1(4));
         COMPRESS_I(P.i000 + n, in, i000);
         COMPRESS_I(P.i010 + n, in, I_ADD(i000, I_SET1(4 * nx)));
@@ -158,33 +183,14 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
     VF f1 = zero, f2 = zero, g1x = zero, g1y = zero, g1z = zero, g2x = zero, g2y = zero, g2z = zero;
     for (; all; all &= all - 1) {
         const unsigned b = (unsigned)__builtin_ctzll(all);
-        unsigned bits = 0;
-        for (unsigned l = 0; l < LANES; ++l) bits |= (unsigned)((L->mask[l] >> b) & 1u) << l;
-        const float* F = fd->bf + (size_t)b * fd->bf_floats;
-        /* grid_locate: posed point to grid coordinates, the grid's box, the capsule bound */
-        const VF px = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[0]), X), F_MUL(F_SET1(F[3]), Y)), F_MUL(F_SET1(F[6]), Z)), F_SET1(F[9]));
-        const VF py = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[1]), X), F_MUL(F_SET1(F[4]), Y)), F_MUL(F_SET1(F[7]), Z)), F_SET1(F[10]));
-        const VF pz = F_ADD(F_ADD(F_ADD(F_MUL(F_SET1(F[2]), X), F_MUL(F_SET1(F[5]), Y)), F_MUL(F_SET1(F[8]), Z)), F_SET1(F[11]));
-        VM in = M_AND(M_FROM_BITS(bits), M_AND(M_AND(M_GE(px, zero), M_GE(py, zero)), M_GE(pz, zero)));
-        in = M_AND(in, M_AND(M_AND(M_LE(px, F_SET1(F[20])), M_LE(py, F_SET1(F[21]))), M_LE(pz, F_SET1(F[22]))));
-        if (!M_ANY(in)) continue;
-        if (F[19] > 0.0f) {
-            const VF ax = F_SUB(px, F_SET1(F[12])), ay = F_SUB(py, F_SET1(F[13])), az = F_SUB(pz, F_SET1(F[14]));
-            const VF c0 = F_SET1(F[15]), c1 = F_SET1(F[16]), c2 = F_SET1(F[17]);
-            const VF t0 = F_MUL(F_ADD(F_ADD(F_MUL(ax, c0), F_MUL(ay, c1)), F_MUL(az, c2)), F_SET1(F[18]));
-            const VF t = F_SEL(M_GT(t0, zero), F_SEL(M_LT(t0, one), t0, one), zero);
-            const VF wx = F_SUB(ax, F_MUL(c0, t)), wy = F_SUB(ay, F_MUL(c1, t)), wz = F_SUB(az, F_MUL(c2, t));
-            const VF w2 = F_ADD(F_ADD(F_MUL(wx, wx), F_MUL(wy, wy)), F_MUL(wz, wz));
-            in = M_ANDNOT(in, M_GE(w2, F_SET1(F[19])));
-            if (!M_ANY(in)) continue;
-        }
-        /* cell_at: the cell (clamped to the last one) and the fractions */
-        const uint32_t* I = fd->grid_info + (size_t)b * 4;
-        const int nx = (int)I[0], ny = (int)I[1], nz = (int)I[2];
-        const VI ix = I_MIN(I_TRUNC(px), I_SET1(nx - 2)), iy = I_MIN(I_TRUNC(py), I_SET1(ny - 2)),
-                 iz = I_MIN(I_TRUNC(pz), I_SET1(nz - 2));
+        lane_cell C;
+        VM in;
+        if (!lanes_locate(fd, L, b, X, Y, Z, &in, &C)) continue;
+        const float* F = C.F;
+        const int nx = C.nx, ny = C.ny;
+        const VF px = C.px, py = C.py, pz = C.pz;
+        const VI ix = C.ix, iy = C.iy, iz = C.iz, node = C.node;
         const VF tx = F_SUB(px, I_TO_F(ix)), ty = F_SUB(py, I_TO_F(iy)), tz = F_SUB(pz, I_TO_F(iz));
-        const VI node = I_ADD(I_ADD(I_ADD(I_SET1((int)I[3]), ix), I_MUL(iy, I_SET1(nx))), I_MUL(iz, I_SET1(nx * ny)));
         const VI i000 = I_MUL(node, I_SET1(4)), i010 = I_ADD(i000, I_SET1(4 * nx));
         const VI i001 = I_ADD(i000, I_SET1(4 * nx * ny)), i011 = I_ADD(i001, I_SET1(4 * nx));
         /* grid_interp: the 4 values (distance, gradient x y z) of the cell's 8 nodes, lerp in x
