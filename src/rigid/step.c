@@ -778,6 +778,31 @@ static void setup_rows(solver* s, const contact_buf* cb) {
         }
 }
 
+/* One pass over the normals of a group's contacts [k0, k1) (their eq. for the normal
+ * multiplier, each push capped at push_max). Every contact of a group joins the same two
+ * bodies: their corrections stay in registers over the group. */
+static void solve_normals(solver* s, contact_buf* cb, uint32_t k0, uint32_t k1) {
+    ak_vec3 *cx = s->cx, *ct = s->ct;
+    uint32_t a = cb->c[k0].a, b = cb->c[k0].b;
+    ak_vec3 cxa = cx[a], cta = ct[a], cxb = cx[b], ctb = ct[b];
+    for (uint32_t k = k0; k < k1; ++k) {
+        rigid_contact* c = &cb->c[k];
+        const contact_row* r = &s->rows[k];
+        float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cxb, cxa)) + ak_vec3_dot(ctb, r->rnb) - ak_vec3_dot(cta, r->rna);
+        if (d <= 0.0f || r->inv_w == 0.0f) continue;
+        if (r->imb != 0.0f && d > s->push_max) d = s->push_max;
+        float dl = d * r->inv_w;
+        c->lambda_n += dl;
+        /* (a body that does not move has a zero row: its sums stay zero) */
+        cxa = ak_vec3_madd(cxa, c->n, dl * r->ima);
+        cta = ak_vec3_madd(cta, r->ta, dl);
+        cxb = ak_vec3_madd(cxb, c->n, -dl * r->imb);
+        ctb = ak_vec3_madd(ctb, r->tb, -dl);
+    }
+    if (s->awake[a]) cx[a] = cxa, ct[a] = cta;
+    if (s->awake[b]) cx[b] = cxb, ct[b] = ctb;
+}
+
 static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, uint32_t n) {
     ak_vec3 *cx = s->cx, *ct = s->ct;
     for (uint32_t t = 0; t < n; ++t) {
@@ -791,29 +816,7 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
         /* (alternating the points' order from substep to substep halves a 10-box stack's creep
          * but moves the centre of pressure each substep, and a block on an incline then creeps:
          * the order stays fixed) */
-        /* every contact of a group joins the same two bodies: their corrections stay in
-         * registers over the group */
-        {
-            uint32_t a = cb->c[k0].a, b = cb->c[k0].b;
-            ak_vec3 cxa = cx[a], cta = ct[a], cxb = cx[b], ctb = ct[b];
-            for (uint32_t k = k0; k < k1; ++k) {
-                rigid_contact* c = &cb->c[k];
-                const contact_row* r = &s->rows[k];
-                float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cxb, cxa)) +
-                          ak_vec3_dot(ctb, r->rnb) - ak_vec3_dot(cta, r->rna);
-                if (d <= 0.0f || r->inv_w == 0.0f) continue;
-                if (r->imb != 0.0f && d > s->push_max) d = s->push_max;
-                float dl = d * r->inv_w;
-                c->lambda_n += dl;
-                /* (a body that does not move has a zero row: its sums stay zero) */
-                cxa = ak_vec3_madd(cxa, c->n, dl * r->ima);
-                cta = ak_vec3_madd(cta, r->ta, dl);
-                cxb = ak_vec3_madd(cxb, c->n, -dl * r->imb);
-                ctb = ak_vec3_madd(ctb, r->tb, -dl);
-            }
-            if (s->awake[a]) cx[a] = cxa, ct[a] = cta;
-            if (s->awake[b]) cx[b] = cxb, ct[b] = ctb;
-        }
+        solve_normals(s, cb, k0, k1);
         /* static friction, once per pair at the centre of pressure with the pair's whole normal
          * multiplier: undo the relative tangential motion of this substep when the force it
          * takes stays inside the friction cone (their eq. for lambda_t < mu_s lambda_n); one
@@ -894,27 +897,7 @@ static void solve_positions(solver* s, contact_buf* cb, const uint32_t* list, ui
     /* contact_iterations: more passes over the normals, on the same rows (friction and the
      * centres of pressure stay the first pass's) */
     for (uint32_t it = 1; it < s->m->desc.contact_iterations; ++it)
-        for (uint32_t gi = 0; gi < cb->group_count; ++gi) {
-            uint32_t k0 = cb->groups[gi].start, k1 = cb->groups[gi].end;
-            uint32_t a = cb->c[k0].a, b = cb->c[k0].b;
-            ak_vec3 cxa = cx[a], cta = ct[a], cxb = cx[b], ctb = ct[b];
-            for (uint32_t k = k0; k < k1; ++k) {
-                rigid_contact* c = &cb->c[k];
-                const contact_row* r = &s->rows[k];
-                float d = r->d0 + ak_vec3_dot(c->n, ak_vec3_sub(cxb, cxa)) +
-                          ak_vec3_dot(ctb, r->rnb) - ak_vec3_dot(cta, r->rna);
-                if (d <= 0.0f || r->inv_w == 0.0f) continue;
-                if (r->imb != 0.0f && d > s->push_max) d = s->push_max;
-                float dl = d * r->inv_w;
-                c->lambda_n += dl;
-                cxa = ak_vec3_madd(cxa, c->n, dl * r->ima);
-                cta = ak_vec3_madd(cta, r->ta, dl);
-                cxb = ak_vec3_madd(cxb, c->n, -dl * r->imb);
-                ctb = ak_vec3_madd(ctb, r->tb, -dl);
-            }
-            if (s->awake[a]) cx[a] = cxa, ct[a] = cta;
-            if (s->awake[b]) cx[b] = cxb, ct[b] = ctb;
-        }
+        for (uint32_t gi = 0; gi < cb->group_count; ++gi) solve_normals(s, cb, cb->groups[gi].start, cb->groups[gi].end);
     /* the summed corrections onto the poses (orientations normalised in update_velocities) */
     for (uint32_t t = 0; t < n; ++t) {
         uint32_t i = list ? list[t] : t;
