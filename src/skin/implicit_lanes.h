@@ -57,6 +57,63 @@ KFUNC static inline bool lanes_locate(const akp_implicit_field* fd, const akp_im
     return true;
 }
 
+/* grid_interp and compact for the lanes in `in`: the 4 values (distance, gradient x y z) of
+ * the cell's 8 nodes (first indices i000, i010, i001, i011; fractions tx, ty, tz), lerp in x
+ * per (y, z) corner, then in y, then in z; then the compact-support map t(u), u = distance x
+ * inv_r: 1 (gradient 0) deep inside, nothing beyond. *keep: the lanes with a field; g: the
+ * gradient in the bone's grid frame, +0 deep inside as the scalar code's (not the product's
+ * possibly signed zero). */
+KFUNC static inline void lanes_interp(const akp_implicit_field* fd, VM in, VI i000, VI i010, VI i001, VI i011, VF tx,
+                                      VF ty, VF tz, VF inv_r, VF* t_out, VM* keep_out, VF g[3]) {
+    const VF zero = F_ZERO(), one = F_SET1(1.0f);
+    VF a[4], bq[4], cq[4], dq[4], n0[4], n1[4];
+    GATHER4(in, fd->grid, i000, n0), GATHER4(in, fd->grid + 4, i000, n1);
+    for (int k = 0; k < 4; ++k) a[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
+    GATHER4(in, fd->grid, i010, n0), GATHER4(in, fd->grid + 4, i010, n1);
+    for (int k = 0; k < 4; ++k) bq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
+    GATHER4(in, fd->grid, i001, n0), GATHER4(in, fd->grid + 4, i001, n1);
+    for (int k = 0; k < 4; ++k) cq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
+    GATHER4(in, fd->grid, i011, n0), GATHER4(in, fd->grid + 4, i011, n1);
+    for (int k = 0; k < 4; ++k) dq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
+    VF r[4];
+    for (int k = 0; k < 4; ++k) {
+        const VF e = F_ADD(a[k], F_MUL(ty, F_SUB(bq[k], a[k]))), f = F_ADD(cq[k], F_MUL(ty, F_SUB(dq[k], cq[k])));
+        r[k] = F_ADD(e, F_MUL(tz, F_SUB(f, e)));
+    }
+    /* compact: t(u) inside the support, 1 (gradient 0) deep inside, nothing beyond */
+    const VF u = F_MUL(r[0], inv_r), u2 = F_MUL(u, u);
+    const VF poly = F_ADD(F_SUB(u, F_MUL(F_MUL(u2, u), F_SET1(2.0f / 3.0f))), F_MUL(F_MUL(F_MUL(u2, u2), u), F_SET1(0.2f)));
+    const VM deep = M_LE(u, F_SET1(-1.0f));
+    const VF t = F_SEL(deep, one, F_SUB(F_SET1(0.5f), F_MUL(F_SET1(0.9375f), poly)));
+    const VF w = F_SUB(one, u2);
+    const VF dt = F_MUL(F_MUL(F_MUL(F_SET1(-0.9375f), w), w), inv_r);
+    const VM keep = M_AND(M_AND(in, M_LT(u, one)), M_GT(t, zero));
+    *t_out = t, *keep_out = keep;
+    for (int k = 0; k < 3; ++k) g[k] = F_SEL(deep, zero, F_MUL(r[k + 1], dt));
+}
+
+/* keep_strongest over the lanes: the two strongest fields so far and their gradients in posed
+ * space. */
+typedef struct lane_best {
+    VF f1, f2, g1x, g1y, g1z, g2x, g2y, g2z;
+} lane_best;
+
+/* One bone's field t (where keep) with its grid-frame gradient gy, turned to posed space by
+ * (M^-1)^T (m: the bone's fd->inv record), into the two strongest of B. */
+KFUNC static inline void lanes_keep_strongest(lane_best* B, const float* m, VM keep, VF t, VF gyx, VF gyy, VF gyz) {
+    const VF gx = F_ADD(F_ADD(F_MUL(F_SET1(m[0]), gyx), F_MUL(F_SET1(m[1]), gyy)), F_MUL(F_SET1(m[2]), gyz));
+    const VF gy = F_ADD(F_ADD(F_MUL(F_SET1(m[3]), gyx), F_MUL(F_SET1(m[4]), gyy)), F_MUL(F_SET1(m[5]), gyz));
+    const VF gz = F_ADD(F_ADD(F_MUL(F_SET1(m[6]), gyx), F_MUL(F_SET1(m[7]), gyy)), F_MUL(F_SET1(m[8]), gyz));
+    const VM over1 = M_AND(keep, M_GT(t, B->f1));
+    const VM over2 = M_ANDNOT(M_AND(keep, M_GT(t, B->f2)), over1);
+    B->f2 = F_SEL(over1, B->f1, F_SEL(over2, t, B->f2));
+    B->g2x = F_SEL(over1, B->g1x, F_SEL(over2, gx, B->g2x));
+    B->g2y = F_SEL(over1, B->g1y, F_SEL(over2, gy, B->g2y));
+    B->g2z = F_SEL(over1, B->g1z, F_SEL(over2, gz, B->g2z));
+    B->f1 = F_SEL(over1, t, B->f1);
+    B->g1x = F_SEL(over1, gx, B->g1x), B->g1y = F_SEL(over1, gy, B->g1y), B->g1z = F_SEL(over1, gz, B->g1z);
+}
+
 #if LANES_PACKED
 /* The (lane, bone) pairs of one call whose point lies in the bone's grid (phase 1 of
  * lanes_field), packed: the cell's first node and the nodes one step up in y and in z (float
@@ -88,7 +145,7 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
     lane_pairs P; /* 45 KiB of stack */
     uint64_t all = 0;
     for (unsigned l = 0; l < LANES; ++l) all |= L->mask[l];
-    const VF zero = F_ZERO(), one = F_SET1(1.0f);
+    const VF zero = F_ZERO();
     const VF X = F_LOAD(L->x), Y = F_LOAD(L->y), Z = F_LOAD(L->z);
     unsigned n = 0, nb = 0;
     for (; all; all &= all - 1) {
@@ -118,37 +175,14 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
         const VI i000 = I_LOAD(P.i000 + q), i010 = I_LOAD(P.i010 + q), i001 = I_LOAD(P.i001 + q);
         const VI i011 = I_ADD(i001, I_SUB(i010, i000));
         const VF tx = F_LOAD(P.tx + q), ty = F_LOAD(P.ty + q), tz = F_LOAD(P.tz + q);
-        VF a[4], bq[4], cq[4], dq[4], n0[4], n1[4];
-        GATHER4(in, fd->grid, i000, n0), GATHER4(in, fd->grid + 4, i000, n1);
-        for (int k = 0; k < 4; ++k) a[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
-        GATHER4(in, fd->grid, i010, n0), GATHER4(in, fd->grid + 4, i010, n1);
-        for (int k = 0; k < 4; ++k) bq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
-        GATHER4(in, fd->grid, i001, n0), GATHER4(in, fd->grid + 4, i001, n1);
-        for (int k = 0; k < 4; ++k) cq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
-        GATHER4(in, fd->grid, i011, n0), GATHER4(in, fd->grid + 4, i011, n1);
-        for (int k = 0; k < 4; ++k) dq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
-        VF r[4];
-        for (int k = 0; k < 4; ++k) {
-            const VF e = F_ADD(a[k], F_MUL(ty, F_SUB(bq[k], a[k]))), f = F_ADD(cq[k], F_MUL(ty, F_SUB(dq[k], cq[k])));
-            r[k] = F_ADD(e, F_MUL(tz, F_SUB(f, e)));
-        }
-        /* compact: t(u) inside the support, 1 (gradient 0) deep inside, nothing beyond */
-        const VF inv_r = F_LOAD(P.inv_r + q);
-        const VF u = F_MUL(r[0], inv_r), u2 = F_MUL(u, u);
-        const VF poly = F_ADD(F_SUB(u, F_MUL(F_MUL(u2, u), F_SET1(2.0f / 3.0f))), F_MUL(F_MUL(F_MUL(u2, u2), u), F_SET1(0.2f)));
-        const VM deep = M_LE(u, F_SET1(-1.0f));
-        const VF t = F_SEL(deep, one, F_SUB(F_SET1(0.5f), F_MUL(F_SET1(0.9375f), poly)));
-        const VF w = F_SUB(one, u2);
-        const VF dt = F_MUL(F_MUL(F_MUL(F_SET1(-0.9375f), w), w), inv_r);
-        const VM keep = M_AND(M_AND(in, M_LT(u, one)), M_GT(t, zero));
-        /* f 0 where there is no field; deep inside, the scalar code's gradient is +0 (not the
-         * product's possibly signed zero) */
+        VF t, g[3];
+        VM keep;
+        lanes_interp(fd, in, i000, i010, i001, i011, tx, ty, tz, F_LOAD(P.inv_r + q), &t, &keep, g);
+        /* f 0 where there is no field */
         F_STORE(P.f + q, F_SEL(keep, t, zero));
-        F_STORE(P.gx + q, F_SEL(deep, zero, F_MUL(r[1], dt)));
-        F_STORE(P.gy + q, F_SEL(deep, zero, F_MUL(r[2], dt)));
-        F_STORE(P.gz + q, F_SEL(deep, zero, F_MUL(r[3], dt)));
+        F_STORE(P.gx + q, g[0]), F_STORE(P.gy + q, g[1]), F_STORE(P.gz + q, g[2]);
     }
-    VF f1 = zero, f2 = zero, g1x = zero, g1y = zero, g1z = zero, g2x = zero, g2y = zero, g2z = zero;
+    lane_best B = {zero, zero, zero, zero, zero, zero, zero, zero};
     for (unsigned k = 0; k < nb; ++k) {
         const VM in = M_FROM_BITS(P.lanes[k]);
         const unsigned q = P.start[k];
@@ -156,19 +190,7 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
         const VM keep = M_GT(t, zero);
         if (!M_ANY(keep)) continue;
         const VF gyx = EXPAND_F(P.gx + q, in), gyy = EXPAND_F(P.gy + q, in), gyz = EXPAND_F(P.gz + q, in);
-        /* keep_strongest: the gradient to posed space, (M^-1)^T gy */
-        const float* m = fd->inv + 12 * (size_t)P.bone[k];
-        const VF gx = F_ADD(F_ADD(F_MUL(F_SET1(m[0]), gyx), F_MUL(F_SET1(m[1]), gyy)), F_MUL(F_SET1(m[2]), gyz));
-        const VF gy = F_ADD(F_ADD(F_MUL(F_SET1(m[3]), gyx), F_MUL(F_SET1(m[4]), gyy)), F_MUL(F_SET1(m[5]), gyz));
-        const VF gz = F_ADD(F_ADD(F_MUL(F_SET1(m[6]), gyx), F_MUL(F_SET1(m[7]), gyy)), F_MUL(F_SET1(m[8]), gyz));
-        const VM over1 = M_AND(keep, M_GT(t, f1));
-        const VM over2 = M_ANDNOT(M_AND(keep, M_GT(t, f2)), over1);
-        f2 = F_SEL(over1, f1, F_SEL(over2, t, f2));
-        g2x = F_SEL(over1, g1x, F_SEL(over2, gx, g2x));
-        g2y = F_SEL(over1, g1y, F_SEL(over2, gy, g2y));
-        g2z = F_SEL(over1, g1z, F_SEL(over2, gz, g2z));
-        f1 = F_SEL(over1, t, f1);
-        g1x = F_SEL(over1, gx, g1x), g1y = F_SEL(over1, gy, g1y), g1z = F_SEL(over1, gz, g1z);
+        lanes_keep_strongest(&B, fd->inv + 12 * (size_t)P.bone[k], keep, t, gyx, gyy, gyz);
     }
 #else
 /* field_eval at the lanes of L, bone by bone in bone order (the AVX2 kernel, which has no
@@ -178,9 +200,9 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
 KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* L) {
     uint64_t all = 0;
     for (unsigned l = 0; l < LANES; ++l) all |= L->mask[l];
-    const VF zero = F_ZERO(), one = F_SET1(1.0f);
+    const VF zero = F_ZERO();
     const VF X = F_LOAD(L->x), Y = F_LOAD(L->y), Z = F_LOAD(L->z);
-    VF f1 = zero, f2 = zero, g1x = zero, g1y = zero, g1z = zero, g2x = zero, g2y = zero, g2z = zero;
+    lane_best B = {zero, zero, zero, zero, zero, zero, zero, zero};
     for (; all; all &= all - 1) {
         const unsigned b = (unsigned)__builtin_ctzll(all);
         lane_cell C;
@@ -195,48 +217,14 @@ KFUNC static void lanes_field(const akp_implicit_field* fd, akp_implicit_lanes* 
         const VI i001 = I_ADD(i000, I_SET1(4 * nx * ny)), i011 = I_ADD(i001, I_SET1(4 * nx));
         /* grid_interp: the 4 values (distance, gradient x y z) of the cell's 8 nodes, lerp in x
          * per (y, z) corner, then in y, then in z */
-        VF a[4], bq[4], cq[4], dq[4], n0[4], n1[4];
-        GATHER4(in, fd->grid, i000, n0), GATHER4(in, fd->grid + 4, i000, n1);
-        for (int k = 0; k < 4; ++k) a[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
-        GATHER4(in, fd->grid, i010, n0), GATHER4(in, fd->grid + 4, i010, n1);
-        for (int k = 0; k < 4; ++k) bq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
-        GATHER4(in, fd->grid, i001, n0), GATHER4(in, fd->grid + 4, i001, n1);
-        for (int k = 0; k < 4; ++k) cq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
-        GATHER4(in, fd->grid, i011, n0), GATHER4(in, fd->grid + 4, i011, n1);
-        for (int k = 0; k < 4; ++k) dq[k] = F_ADD(n0[k], F_MUL(tx, F_SUB(n1[k], n0[k])));
-        VF r[4];
-        for (int k = 0; k < 4; ++k) {
-            const VF e = F_ADD(a[k], F_MUL(ty, F_SUB(bq[k], a[k]))), f = F_ADD(cq[k], F_MUL(ty, F_SUB(dq[k], cq[k])));
-            r[k] = F_ADD(e, F_MUL(tz, F_SUB(f, e)));
-        }
-        /* compact: t(u) inside the support, 1 (gradient 0) deep inside, nothing beyond */
-        const VF inv_r = F_SET1(F[23]);
-        const VF u = F_MUL(r[0], inv_r), u2 = F_MUL(u, u);
-        const VF poly = F_ADD(F_SUB(u, F_MUL(F_MUL(u2, u), F_SET1(2.0f / 3.0f))), F_MUL(F_MUL(F_MUL(u2, u2), u), F_SET1(0.2f)));
-        const VM deep = M_LE(u, F_SET1(-1.0f));
-        const VF t = F_SEL(deep, one, F_SUB(F_SET1(0.5f), F_MUL(F_SET1(0.9375f), poly)));
-        const VF w = F_SUB(one, u2);
-        const VF dt = F_MUL(F_MUL(F_MUL(F_SET1(-0.9375f), w), w), inv_r);
-        const VM keep = M_AND(M_AND(in, M_LT(u, one)), M_GT(t, zero));
+        VF t, g[3];
+        VM keep;
+        lanes_interp(fd, in, i000, i010, i001, i011, tx, ty, tz, F_SET1(F[23]), &t, &keep, g);
         if (!M_ANY(keep)) continue;
-        /* deep inside, the scalar code's gradient is +0 (not the product's possibly signed zero) */
-        const VF gyx = F_SEL(deep, zero, F_MUL(r[1], dt)), gyy = F_SEL(deep, zero, F_MUL(r[2], dt)),
-                 gyz = F_SEL(deep, zero, F_MUL(r[3], dt));
-        /* keep_strongest: the gradient to posed space, (M^-1)^T gy */
-        const float* m = fd->inv + 12 * (size_t)b;
-        const VF gx = F_ADD(F_ADD(F_MUL(F_SET1(m[0]), gyx), F_MUL(F_SET1(m[1]), gyy)), F_MUL(F_SET1(m[2]), gyz));
-        const VF gy = F_ADD(F_ADD(F_MUL(F_SET1(m[3]), gyx), F_MUL(F_SET1(m[4]), gyy)), F_MUL(F_SET1(m[5]), gyz));
-        const VF gz = F_ADD(F_ADD(F_MUL(F_SET1(m[6]), gyx), F_MUL(F_SET1(m[7]), gyy)), F_MUL(F_SET1(m[8]), gyz));
-        const VM over1 = M_AND(keep, M_GT(t, f1));
-        const VM over2 = M_ANDNOT(M_AND(keep, M_GT(t, f2)), over1);
-        f2 = F_SEL(over1, f1, F_SEL(over2, t, f2));
-        g2x = F_SEL(over1, g1x, F_SEL(over2, gx, g2x));
-        g2y = F_SEL(over1, g1y, F_SEL(over2, gy, g2y));
-        g2z = F_SEL(over1, g1z, F_SEL(over2, gz, g2z));
-        f1 = F_SEL(over1, t, f1);
-        g1x = F_SEL(over1, gx, g1x), g1y = F_SEL(over1, gy, g1y), g1z = F_SEL(over1, gz, g1z);
+        lanes_keep_strongest(&B, fd->inv + 12 * (size_t)b, keep, t, g[0], g[1], g[2]);
     }
 #endif
+    const VF f1 = B.f1, f2 = B.f2, g1x = B.g1x, g1y = B.g1y, g1z = B.g1z, g2x = B.g2x, g2y = B.g2y, g2z = B.g2z;
     VF Fo = f1, Gx = g1x, Gy = g1y, Gz = g1z;
     if (fd->bulge > 0.0f) {
         const VF l1 = F_SQRT(F_ADD(F_ADD(F_MUL(g1x, g1x), F_MUL(g1y, g1y)), F_MUL(g1z, g1z)));
